@@ -1,0 +1,45 @@
+/*
+** boundary.h -- the frame the lines must stay inside, as a signed distance.
+**
+** lw_boundary_distance returns d(x, y): the Euclidean distance to the boundary
+** curve, negative inside, positive outside, 0 on it (mm).  The boundary energy
+** term integrates 1/d^2 inside and is +infinity where d >= 0.
+**
+** Kinds: rectangle [x0,x1] x [y0,y1]; circle (centre, radius); simple polygon
+** (vertices in order, either orientation, closed implicitly; inside by the
+** even-odd rule).  LW_BOUNDARY_NONE means the term is off: distance -infinity.
+*/
+#ifndef LINEWISE_BOUNDARY_H
+#define LINEWISE_BOUNDARY_H
+
+#include <stddef.h>
+
+#include "linewise/error.h"
+
+typedef enum {
+  LW_BOUNDARY_NONE,
+  LW_BOUNDARY_RECT,
+  LW_BOUNDARY_CIRCLE,
+  LW_BOUNDARY_POLYGON
+} lw_boundary_kind;
+
+typedef struct {
+  lw_boundary_kind kind;
+  double x0, y0, x1, y1;  /* rect, mm; x0 < x1, y0 < y1 */
+  double cx, cy, radius;  /* circle, mm; radius > 0 */
+  size_t n;               /* polygon: vertex count (>= 3) */
+  double *vx, *vy;        /* polygon: vertices, owned */
+} lw_boundary;
+
+/* Polygon from n >= 3 vertices (copied).  LW_EINPUT for fewer vertices,
+** non-finite coordinates or zero area. */
+lw_status lw_boundary_polygon(lw_boundary *b, size_t n, const double *x, const double *y,
+                              lw_error *err);
+void lw_boundary_clear(lw_boundary *b);
+
+double lw_boundary_distance(const lw_boundary *b, double x, double y);
+
+/* Is (x, y) strictly inside? (d < 0) */
+int lw_boundary_inside(const lw_boundary *b, double x, double y);
+
+#endif

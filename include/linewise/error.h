@@ -1,0 +1,41 @@
+/*
+** error.h -- one status enum and a message buffer that travels with it.
+**
+** Library code never prints and never exits: it fills an lw_error and returns
+** its code.  The command line turns the message into one line on stderr and the
+** code into an exit status (2 for bad input or usage, 1 for failures while
+** running).  Messages name the file, line and key where the input was bad.
+*/
+#ifndef LINEWISE_ERROR_H
+#define LINEWISE_ERROR_H
+
+typedef enum {
+  LW_OK = 0,
+  LW_EINPUT,    /* bad input: a file, a key, a value (exit 2) */
+  LW_EUSAGE,    /* bad command line (exit 2) */
+  LW_ENOMEM,    /* allocation failed (exit 1) */
+  LW_EIO,       /* reading or writing a file failed (exit 1) */
+  LW_ERUN       /* a failure while running (exit 1) */
+} lw_status;
+
+#define LW_ERROR_MSG 1024
+
+typedef struct {
+  lw_status code;
+  char msg[LW_ERROR_MSG];
+} lw_error;
+
+/* Sets err (if not NULL) to code and a printf-style message; returns code. */
+lw_status lw_error_set(lw_error *err, lw_status code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* Clears err to LW_OK with an empty message. */
+void lw_error_clear(lw_error *err);
+
+/* The process exit status for a code: 0, 1 or 2. */
+int lw_error_exit_status(lw_status code);
+
+#endif

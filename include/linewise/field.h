@@ -1,0 +1,91 @@
+/*
+** field.h -- the scalar potential Phi(x, y) and the vector field v(x, y) that
+** the potential and field energy terms read.
+**
+** Both are either an analytic preset (no image needed) or samples on a regular
+** grid read by bilinear interpolation.  Coordinates are scene millimetres with
+** the origin at the top-left corner of the page, y pointing down (as in SVG).
+**
+** Presets (c = centre, mm):
+**   potential constant  Phi = value
+**   potential ramp      Phi = 1/2 + 1/2 (r - c).u / h, u = (cos a, sin a), h = scale
+**                       (h defaults to half the page extent along u: Phi in [0,1])
+**   potential radial    Phi = |r - c| / scale
+**   field constant      v = (cos a, sin a)
+**   field radial        v = (r - c) / |r - c|            (0 at c)
+**   field vortex        v = (-(y - cy), x - cx) / |r - c| (0 at c; counter-clockwise
+**                       on a y-up page)
+**   field waves         v = (1, k A cos(k x)) / |(1, k A cos(k x))|, k = 2 pi / wavelength:
+**                       the tangents of the curves y = A sin(k x) + const
+** Grid values beyond the edge take the value at the nearest edge point, so a
+** field is defined everywhere; grid data are sanitised on construction (a
+** non-finite sample becomes 0) so no lookup returns NaN.
+*/
+#ifndef LINEWISE_FIELD_H
+#define LINEWISE_FIELD_H
+
+#include <stddef.h>
+
+#include "linewise/error.h"
+
+/* Samples on a regular grid: node (i, j) sits at (x0 + i hx, y0 + j hy) and
+** holds ncomp values at data[(j * nx + i) * ncomp + c]. */
+typedef struct {
+  int nx, ny;        /* nodes per axis, >= 1 */
+  int ncomp;         /* values per node: 1 (potential) or 2 (field) */
+  double x0, y0;     /* position of node (0, 0), mm */
+  double hx, hy;     /* node spacing, mm (> 0) */
+  double *data;      /* nx * ny * ncomp values, owned */
+} lw_grid2d;
+
+/* Allocates a zeroed grid; NULL and err set on failure. */
+lw_grid2d *lw_grid2d_new(int nx, int ny, int ncomp, double x0, double y0,
+                         double hx, double hy, lw_error *err);
+void lw_grid2d_free(lw_grid2d *g);
+/* Replaces non-finite samples by 0; returns how many were replaced. */
+size_t lw_grid2d_sanitize(lw_grid2d *g);
+/* Bilinear interpolation of all components at (x, y) into out[ncomp]. */
+void lw_grid2d_eval(const lw_grid2d *g, double x, double y, double *out);
+
+typedef enum {
+  LW_POTENTIAL_CONSTANT,
+  LW_POTENTIAL_RAMP,
+  LW_POTENTIAL_RADIAL,
+  LW_POTENTIAL_GRID
+} lw_potential_kind;
+
+typedef struct {
+  lw_potential_kind kind;
+  double value;      /* constant: Phi */
+  double cx, cy;     /* ramp, radial: centre, mm */
+  double ux, uy;     /* ramp: unit direction */
+  double scale;      /* ramp: half extent h; radial: radius, mm (> 0) */
+  lw_grid2d *grid;   /* grid: owned, ncomp = 1 */
+} lw_potential;
+
+typedef enum {
+  LW_FIELD_CONSTANT,
+  LW_FIELD_RADIAL,
+  LW_FIELD_VORTEX,
+  LW_FIELD_WAVES,
+  LW_FIELD_GRID
+} lw_field_kind;
+
+typedef struct {
+  lw_field_kind kind;
+  double ux, uy;       /* constant: unit direction */
+  double cx, cy;       /* radial, vortex: centre, mm */
+  double wavelength;   /* waves: mm (> 0) */
+  double amplitude;    /* waves: mm */
+  lw_grid2d *grid;     /* grid: owned, ncomp = 2 */
+} lw_field;
+
+double lw_potential_eval(const lw_potential *f, double x, double y);
+void lw_field_eval(const lw_field *f, double x, double y, double *vx, double *vy);
+
+/* Free the grid a field owns (if any) and reset it; the struct itself is the
+** caller's. */
+void lw_potential_clear(lw_potential *f);
+void lw_field_clear(lw_field *f);
+
+#endif

@@ -1,0 +1,60 @@
+/*
+** pair.h -- the 1/r repulsion between quadrature samples of different splines.
+**
+**   E_pair = C * sum over pairs of different splines of
+**            double integral |r0'| |r1'| / |r0 - r1| ds1 ds0
+**
+** Far field: each sample pair (i, j) contributes dl_i dl_j / r_ij, the Gauss
+** product rule, with dl = w_q |r'_q|.
+**
+** Near field: the double integral is finite where curves touch or cross, but
+** the product rule is not accurate there (and not finite if two samples
+** coincide).  Each sample owns a straight piece of its curve (its element):
+** the tangent line at the node, from parameter e_q to e_{q+1} (quad.h), i.e.
+** from r - (s_q - e_q) r' to r + (e_{q+1} - s_q) r'.  When two samples are
+** closer than near * max(dl_i, dl_j) the pair contributes the exact double
+** integral of 1/r over the two elements (lw_pair_segseg) instead.  Elements of
+** a straight spline tile it exactly, so for straight lines only the far field
+** carries quadrature error.
+**
+** Cutoff: with rc > 0 the kernel is shifted, 1/r - 1/rc for r < rc and 0
+** beyond, so the energy is continuous at the cutoff; rc = 0 means no cutoff.
+*/
+#ifndef LINEWISE_PAIR_H
+#define LINEWISE_PAIR_H
+
+#include <stdint.h>
+
+#include "linewise/quad.h"
+
+/* One sample as the pair term (and the cell grid) sees it. */
+typedef struct {
+  double x, y;      /* r at the node, mm */
+  double dx, dy;    /* r' at the node, mm per unit s */
+  double dl;        /* w_q |r'_q|, mm */
+  uint32_t spline;  /* owning spline (pairs within a spline do not count) */
+  uint32_t q;       /* node index within its segment */
+} lw_pair_sample;
+
+typedef struct {
+  double cutoff;        /* rc, mm; 0 = none */
+  double inv_cutoff;    /* 1/rc, or 0 */
+  double near;          /* near-field radius in element lengths; 0 = off */
+  double elem_lo[LW_QUAD_MAX]; /* s_q - e_q: element start before the node, in s */
+  double elem_hi[LW_QUAD_MAX]; /* e_{q+1} - s_q: element end after the node, in s */
+} lw_pair_ctx;
+
+void lw_pair_ctx_init(lw_pair_ctx *ctx, const lw_quad *q, double cutoff, double near);
+
+/* Exact double integral of 1/|x - y| over x on segment [a0, a1] and y on
+** [b0, b1] (arc length measure, mm).  Finite for crossing or touching
+** segments; +infinity only where they overlap collinearly over a positive
+** length; 0 if either has zero length. */
+double lw_pair_segseg(const double a0[2], const double a1[2],
+                      const double b0[2], const double b1[2]);
+
+/* The kernel of one sample pair (no coefficient C), cutoff and near field
+** applied.  The caller skips pairs of the same spline. */
+double lw_pair_kernel(const lw_pair_sample *a, const lw_pair_sample *b, const lw_pair_ctx *ctx);
+
+#endif

@@ -1,0 +1,88 @@
+/*
+** spline.h -- storage of all splines of a scene and their evaluation.
+**
+** Spline i has n_i cubic Bezier segments and n_i + 1 nodes; node k holds the
+** point p_k and the vector v_k (mm).  All nodes of all splines live in one
+** contiguous array (the seed's Q), spline after spline, so segment m of
+** spline i reads the 8 doubles node[first[i] + m] and node[first[i] + m + 1].
+**
+** Segments are numbered globally too: segment g belongs to spline
+** seg_spline[g] and starts at node g + seg_spline[g] (each spline has one more
+** node than segments).
+*/
+#ifndef LINEWISE_SPLINE_H
+#define LINEWISE_SPLINE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "linewise/error.h"
+#include "linewise/quad.h"
+
+typedef struct {
+  double px, py; /* point p_k, mm */
+  double vx, vy; /* vector v_k, mm (r'(node) = 3 v_k) */
+} lw_node;
+
+typedef struct {
+  size_t n_splines;
+  size_t n_nodes;
+  size_t n_segments;
+  lw_node *node;          /* n_nodes, contiguous */
+  size_t *first;          /* n_splines + 1 node offsets; first[n_splines] = n_nodes */
+  uint32_t *seg_spline;   /* n_segments: the spline of each segment */
+  double *rest_length;    /* n_splines: L0, mm (> 0) */
+} lw_splines;
+
+/* Allocates n_splines splines with segments[i] >= 1 segments each; nodes are
+** zeroed and rest lengths set to 1.  NULL and err set on failure. */
+lw_splines *lw_splines_new(size_t n_splines, const size_t *segments, lw_error *err);
+void lw_splines_free(lw_splines *sp);
+
+/* A deep copy (NULL on allocation failure). */
+lw_splines *lw_splines_clone(const lw_splines *sp);
+
+static inline size_t lw_splines_segments(const lw_splines *sp, size_t i)
+{
+  return sp->first[i + 1] - sp->first[i] - 1;
+}
+
+/* First node of global segment g. */
+static inline size_t lw_segment_node(const lw_splines *sp, size_t g)
+{
+  return g + sp->seg_spline[g];
+}
+
+/* Global index of segment m of spline i. */
+static inline size_t lw_segment_index(const lw_splines *sp, size_t i, size_t m)
+{
+  return sp->first[i] - i + m;
+}
+
+/* r, r', r'' at parameter s in [0,1] of the segment from node a to node b;
+** any output may be NULL. */
+void lw_segment_eval(const lw_node *a, const lw_node *b, double s,
+                     double r[2], double d1[2], double d2[2]);
+
+/* The samples of one segment at the quadrature nodes: everything an energy
+** term needs, so terms are pure functions of this struct. */
+typedef struct {
+  int n;                     /* nodes */
+  double x[LW_QUAD_MAX], y[LW_QUAD_MAX];     /* r, mm */
+  double dx[LW_QUAD_MAX], dy[LW_QUAD_MAX];   /* r', mm per unit s */
+  double ddx[LW_QUAD_MAX], ddy[LW_QUAD_MAX]; /* r'', mm per unit s^2 */
+  double speed[LW_QUAD_MAX];                 /* |r'| */
+  double dl[LW_QUAD_MAX];                    /* w_q |r'|: length element, mm */
+  double length;                             /* sum of dl, mm */
+} lw_samples;
+
+void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_samples *out);
+
+/* Largest absolute coordinate of any point or vector; 0 for no nodes.  Used
+** to scale tolerances. */
+double lw_splines_extent(const lw_splines *sp);
+
+/* 1 if every coordinate is finite. */
+int lw_splines_finite(const lw_splines *sp);
+
+#endif

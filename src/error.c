@@ -1,0 +1,35 @@
+/* error.c -- status codes and messages (see error.h). */
+#include "linewise/error.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+
+lw_status lw_error_set(lw_error *err, lw_status code, const char *fmt, ...)
+{
+  if (err) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+    va_end(ap);
+    err->code = code;
+  }
+  return code;
+}
+
+void lw_error_clear(lw_error *err)
+{
+  if (err) {
+    err->code = LW_OK;
+    err->msg[0] = '\0';
+  }
+}
+
+int lw_error_exit_status(lw_status code)
+{
+  switch (code) {
+  case LW_OK: return 0;
+  case LW_EINPUT:
+  case LW_EUSAGE: return 2;
+  default: return 1;
+  }
+}

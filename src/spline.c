@@ -1,0 +1,128 @@
+/* spline.c -- contiguous spline storage and segment evaluation (spline.h). */
+#include "linewise/spline.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+lw_splines *lw_splines_new(size_t n_splines, const size_t *segments, lw_error *err)
+{
+  size_t n_nodes = 0;
+  for (size_t i = 0; i < n_splines; i++) {
+    if (segments[i] < 1) {
+      lw_error_set(err, LW_EINPUT, "spline %zu has no segment (at least 1 expected)", i);
+      return NULL;
+    }
+    n_nodes += segments[i] + 1;
+  }
+  lw_splines *sp = calloc(1, sizeof *sp);
+  if (!sp) goto nomem;
+  sp->n_splines = n_splines;
+  sp->n_nodes = n_nodes;
+  sp->n_segments = n_nodes - n_splines;
+  sp->node = calloc(n_nodes ? n_nodes : 1, sizeof *sp->node);
+  sp->first = malloc((n_splines + 1) * sizeof *sp->first);
+  sp->seg_spline = malloc((sp->n_segments ? sp->n_segments : 1) * sizeof *sp->seg_spline);
+  sp->rest_length = malloc((n_splines ? n_splines : 1) * sizeof *sp->rest_length);
+  if (!sp->node || !sp->first || !sp->seg_spline || !sp->rest_length) goto nomem;
+  size_t k = 0, g = 0;
+  for (size_t i = 0; i < n_splines; i++) {
+    sp->first[i] = k;
+    k += segments[i] + 1;
+    for (size_t m = 0; m < segments[i]; m++) sp->seg_spline[g++] = (uint32_t)i;
+    sp->rest_length[i] = 1.0;
+  }
+  sp->first[n_splines] = k;
+  return sp;
+nomem:
+  lw_splines_free(sp);
+  lw_error_set(err, LW_ENOMEM, "out of memory for %zu splines", n_splines);
+  return NULL;
+}
+
+void lw_splines_free(lw_splines *sp)
+{
+  if (!sp) return;
+  free(sp->node);
+  free(sp->first);
+  free(sp->seg_spline);
+  free(sp->rest_length);
+  free(sp);
+}
+
+lw_splines *lw_splines_clone(const lw_splines *sp)
+{
+  size_t *segs = malloc((sp->n_splines ? sp->n_splines : 1) * sizeof *segs);
+  if (!segs) return NULL;
+  for (size_t i = 0; i < sp->n_splines; i++) segs[i] = lw_splines_segments(sp, i);
+  lw_splines *c = lw_splines_new(sp->n_splines, segs, NULL);
+  free(segs);
+  if (!c) return NULL;
+  memcpy(c->node, sp->node, sp->n_nodes * sizeof *sp->node);
+  memcpy(c->rest_length, sp->rest_length, sp->n_splines * sizeof *sp->rest_length);
+  return c;
+}
+
+void lw_segment_eval(const lw_node *a, const lw_node *b, double s,
+                     double r[2], double d1[2], double d2[2])
+{
+  double cp[4], c1[4], c2[4];
+  lw_quad_basis(s, cp, c1, c2);
+  if (r) {
+    r[0] = cp[0] * a->px + cp[1] * a->vx + cp[2] * b->px + cp[3] * b->vx;
+    r[1] = cp[0] * a->py + cp[1] * a->vy + cp[2] * b->py + cp[3] * b->vy;
+  }
+  if (d1) {
+    d1[0] = c1[0] * a->px + c1[1] * a->vx + c1[2] * b->px + c1[3] * b->vx;
+    d1[1] = c1[0] * a->py + c1[1] * a->vy + c1[2] * b->py + c1[3] * b->vy;
+  }
+  if (d2) {
+    d2[0] = c2[0] * a->px + c2[1] * a->vx + c2[2] * b->px + c2[3] * b->vx;
+    d2[1] = c2[0] * a->py + c2[1] * a->vy + c2[2] * b->py + c2[3] * b->vy;
+  }
+}
+
+void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_samples *out)
+{
+  const int n = q->n;
+  double len = 0.0;
+  out->n = n;
+  for (int i = 0; i < n; i++) {
+    const double *cp = q->pos[i], *c1 = q->d1[i], *c2 = q->d2[i];
+    out->x[i] = cp[0] * a->px + cp[1] * a->vx + cp[2] * b->px + cp[3] * b->vx;
+    out->y[i] = cp[0] * a->py + cp[1] * a->vy + cp[2] * b->py + cp[3] * b->vy;
+    double dx = c1[0] * a->px + c1[1] * a->vx + c1[2] * b->px + c1[3] * b->vx;
+    double dy = c1[0] * a->py + c1[1] * a->vy + c1[2] * b->py + c1[3] * b->vy;
+    out->dx[i] = dx;
+    out->dy[i] = dy;
+    out->ddx[i] = c2[0] * a->px + c2[1] * a->vx + c2[2] * b->px + c2[3] * b->vx;
+    out->ddy[i] = c2[0] * a->py + c2[1] * a->vy + c2[2] * b->py + c2[3] * b->vy;
+    double sp = sqrt(dx * dx + dy * dy);
+    out->speed[i] = sp;
+    out->dl[i] = q->w[i] * sp;
+    len += out->dl[i];
+  }
+  out->length = len;
+}
+
+double lw_splines_extent(const lw_splines *sp)
+{
+  double m = 0.0;
+  for (size_t k = 0; k < sp->n_nodes; k++) {
+    const lw_node *nd = &sp->node[k];
+    double c[4] = {nd->px, nd->py, nd->vx, nd->vy};
+    for (int j = 0; j < 4; j++)
+      if (fabs(c[j]) > m) m = fabs(c[j]);
+  }
+  return m;
+}
+
+int lw_splines_finite(const lw_splines *sp)
+{
+  for (size_t k = 0; k < sp->n_nodes; k++) {
+    const lw_node *nd = &sp->node[k];
+    if (!isfinite(nd->px) || !isfinite(nd->py) || !isfinite(nd->vx) || !isfinite(nd->vy))
+      return 0;
+  }
+  return 1;
+}
