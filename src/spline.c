@@ -103,6 +103,10 @@ void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_
     len += out->dl[i];
   }
   out->length = len;
+  out->end_x[0] = a->px;
+  out->end_y[0] = a->py;
+  out->end_x[1] = b->px;
+  out->end_y[1] = b->py;
 }
 
 double lw_splines_extent(const lw_splines *sp)

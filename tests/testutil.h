@@ -2,13 +2,44 @@
 #ifndef LINEWISE_TESTUTIL_H
 #define LINEWISE_TESTUTIL_H
 
+#include <gsl/gsl_math.h>
 #include <math.h>
+
+#include "linewise/spline.h"
 
 /* |a - b| <= tol * max(|b|, floor) */
 static inline int lw_close_rel(double a, double b, double tol, double floor)
 {
   double s = fabs(b) > floor ? fabs(b) : floor;
   return fabs(a - b) <= tol * s;
+}
+
+/* Spline i of sp becomes the straight line from (x0,y0) to (x1,y1) with
+** uniform parametrisation (v_k = chord / (3 n)). */
+static inline void lw_test_straight(lw_splines *sp, size_t i, double x0, double y0, double x1, double y1)
+{
+  size_t n = lw_splines_segments(sp, i);
+  lw_node *nd = &sp->node[sp->first[i]];
+  for (size_t k = 0; k <= n; k++) {
+    double t = (double)k / (double)n;
+    nd[k] = (lw_node){x0 + t * (x1 - x0), y0 + t * (y1 - y0), (x1 - x0) / (3.0 * n), (y1 - y0) / (3.0 * n)};
+  }
+  sp->rest_length[i] = hypot(x1 - x0, y1 - y0);
+}
+
+/* Spline i of sp becomes the standard cubic Bezier approximation of the
+** circle of radius R around (cx, cy), one arc of 2 pi / n per segment
+** (handle length 4/3 tan(theta/4) R). */
+static inline void lw_test_circle(lw_splines *sp, size_t i, double cx, double cy, double R)
+{
+  size_t n = lw_splines_segments(sp, i);
+  double th = 2.0 * M_PI / (double)n, h = 4.0 / 3.0 * tan(th / 4.0) * R;
+  lw_node *nd = &sp->node[sp->first[i]];
+  for (size_t k = 0; k <= n; k++) {
+    double a = th * (double)k;
+    nd[k] = (lw_node){cx + R * cos(a), cy + R * sin(a), -h * sin(a), h * cos(a)};
+  }
+  sp->rest_length[i] = 2.0 * M_PI * R;
 }
 
 #endif

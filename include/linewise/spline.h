@@ -74,6 +74,8 @@ typedef struct {
   double speed[LW_QUAD_MAX];                 /* |r'| */
   double dl[LW_QUAD_MAX];                    /* w_q |r'|: length element, mm */
   double length;                             /* sum of dl, mm */
+  double end_x[2], end_y[2];                 /* r(0) and r(1): the nodes, which no
+                                                Gauss node reaches (boundary term) */
 } lw_samples;
 
 void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_samples *out);

@@ -1,0 +1,60 @@
+/*
+** grid.h -- a uniform cell grid over the pair term's samples.
+**
+** Cells are squares of side >= the pair cutoff, so every sample within the
+** cutoff of a point lies in the 3 x 3 block of cells around it.  Points beyond
+** the covered area fall into the nearest edge cell; clamping is monotone and
+** 1-Lipschitz per axis, so the 3 x 3 rule still holds for them.
+**
+** Each cell keeps the indices of its samples in increasing order.  Sums over
+** neighbours therefore run in an order that depends on the current positions
+** only, never on the history of moves: a run resumed from a checkpoint (which
+** rebuilds the grid) adds the same numbers in the same order as one that never
+** stopped, so results stay bit-identical.  Moving a sample costs a removal and
+** a sorted insertion in cells of a few dozen entries.
+*/
+#ifndef LINEWISE_GRID_H
+#define LINEWISE_GRID_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "linewise/error.h"
+
+typedef struct {
+  uint32_t *idx;   /* sample indices, increasing */
+  uint32_t n, cap;
+} lw_cell;
+
+typedef struct {
+  double x0, y0;     /* lower corner of the covered area, mm */
+  double inv_h;      /* 1 / cell side */
+  int nx, ny;        /* cells per axis */
+  lw_cell *cell;     /* nx * ny */
+  uint32_t *where;   /* per sample: its cell, or UINT32_MAX if absent */
+  size_t n_samples;
+} lw_cellgrid;
+
+/* A grid covering [x0, x0 + w] x [y0, y0 + h] with cells of side >= cell
+** (cell <= 0: a single cell) for sample indices 0 .. n_samples-1.  The cell
+** count per axis is capped so that memory stays proportional to samples. */
+lw_cellgrid *lw_cellgrid_new(double x0, double y0, double w, double h, double cell,
+                             size_t n_samples, lw_error *err);
+void lw_cellgrid_free(lw_cellgrid *g);
+
+/* The cell holding (x, y) after clamping. */
+static inline void lw_cellgrid_locate(const lw_cellgrid *g, double x, double y, int *cx, int *cy)
+{
+  double fx = (x - g->x0) * g->inv_h, fy = (y - g->y0) * g->inv_h;
+  /* comparisons written so that NaN lands in cell 0 instead of overflowing */
+  int ix = fx >= 1.0 ? (fx < (double)g->nx ? (int)fx : g->nx - 1) : 0;
+  int iy = fy >= 1.0 ? (fy < (double)g->ny ? (int)fy : g->ny - 1) : 0;
+  *cx = ix;
+  *cy = iy;
+}
+
+/* Puts sample i at (x, y), moving it if it is already in the grid.
+** LW_ENOMEM if a cell cannot grow (the grid is unchanged then). */
+lw_status lw_cellgrid_place(lw_cellgrid *g, uint32_t i, double x, double y);
+
+#endif

@@ -1,0 +1,144 @@
+/*
+** boundary.c -- signed distance to the frame (boundary.h).
+**
+** Non-finite query points: a NaN or infinite coordinate gives +INFINITY for
+** every bounded kind, i.e. "outside".  The boundary energy is then +infinity,
+** so a step that produced a NaN node is rejected instead of poisoning the
+** sums, and lw_boundary_inside is false there.  LW_BOUNDARY_NONE returns
+** -INFINITY for every point, NaN included: the term is off, whatever the point.
+*/
+#include "linewise/boundary.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+lw_status lw_boundary_polygon(lw_boundary *b, size_t n, const double *x, const double *y,
+                              lw_error *err)
+{
+  if (n < 3 || !x || !y)
+    return lw_error_set(err, LW_EINPUT, "polygon needs at least 3 vertices (got %zu)", n);
+  for (size_t i = 0; i < n; i++)
+    if (!isfinite(x[i]) || !isfinite(y[i]))
+      return lw_error_set(err, LW_EINPUT, "polygon vertex %zu (%g, %g) is not finite", i,
+                          x[i], y[i]);
+
+  /* Shoelace area about the first vertex (less cancellation for a polygon far
+  ** from the origin).  "Zero" is relative to the bounding box, so collinear
+  ** vertices are rejected even when rounding leaves a tiny residue. */
+  double a2 = 0, xmin = x[0], xmax = x[0], ymin = y[0], ymax = y[0];
+  for (size_t i = 1; i + 1 < n; i++)
+    a2 += (x[i] - x[0]) * (y[i + 1] - y[0]) - (x[i + 1] - x[0]) * (y[i] - y[0]);
+  for (size_t i = 1; i < n; i++) {
+    xmin = fmin(xmin, x[i]);
+    xmax = fmax(xmax, x[i]);
+    ymin = fmin(ymin, y[i]);
+    ymax = fmax(ymax, y[i]);
+  }
+  double w = xmax - xmin, h = ymax - ymin;
+  if (!(fabs(a2) > 1e-12 * (w * w + h * h)))
+    return lw_error_set(err, LW_EINPUT, "polygon of %zu vertices has zero area", n);
+
+  if (n > SIZE_MAX / sizeof(double))
+    return lw_error_set(err, LW_ENOMEM, "out of memory for a polygon of %zu vertices", n);
+  double *vx = malloc(n * sizeof *vx), *vy = malloc(n * sizeof *vy);
+  if (!vx || !vy) {
+    free(vx);
+    free(vy);
+    return lw_error_set(err, LW_ENOMEM, "out of memory for a polygon of %zu vertices", n);
+  }
+  memcpy(vx, x, n * sizeof *vx);
+  memcpy(vy, y, n * sizeof *vy);
+  /* b is overwritten, not cleared: it may be uninitialised.  Nothing is
+  ** touched on failure. */
+  memset(b, 0, sizeof *b);
+  b->kind = LW_BOUNDARY_POLYGON;
+  b->n = n;
+  b->vx = vx;
+  b->vy = vy;
+  return LW_OK;
+}
+
+void lw_boundary_clear(lw_boundary *b)
+{
+  if (!b) return;
+  free(b->vx);
+  free(b->vy);
+  b->vx = b->vy = NULL;
+  b->n = 0;
+}
+
+/* Exact signed distance to an axis-aligned box: q is how far the point lies
+** beyond each pair of sides (negative inside).  Outside, the nearest boundary
+** point is on a side (one q > 0) or a corner (both > 0): |max(q, 0)|.
+** Inside, it is the nearest side: max(qx, qy). */
+static double rect_distance(const lw_boundary *b, double x, double y)
+{
+  double qx = fmax(b->x0 - x, x - b->x1);
+  double qy = fmax(b->y0 - y, y - b->y1);
+  if (qx > 0 || qy > 0) {
+    double ox = qx > 0 ? qx : 0, oy = qy > 0 ? qy : 0;
+    return sqrt(ox * ox + oy * oy);
+  }
+  return fmax(qx, qy);
+}
+
+static double circle_distance(const lw_boundary *b, double x, double y)
+{
+  double dx = x - b->cx, dy = y - b->cy;
+  return sqrt(dx * dx + dy * dy) - b->radius;
+}
+
+/* Distance to the nearest edge, negated when the point is inside by the
+** even-odd rule.  Both happen in one pass over the edges.  The crossing test
+** counts edges that straddle the horizontal line through the point (half-open
+** in y, so a vertex on that line is counted once) and cross it to the right of
+** the point.  No orientation enters, so either vertex order works.  A polygon
+** with no vertices (after lw_boundary_clear) has no inside: +INFINITY. */
+static double polygon_distance(const lw_boundary *b, double x, double y)
+{
+  const size_t n = b->n;
+  if (n == 0 || !b->vx || !b->vy) return INFINITY;
+  const double *px = b->vx, *py = b->vy;
+  double best = INFINITY;
+  int inside = 0;
+  for (size_t i = 0, j = n - 1; i < n; j = i++) {
+    double ax = px[j], ay = py[j], ex = px[i] - ax, ey = py[i] - ay;
+    double wx = x - ax, wy = y - ay;
+    double ee = ex * ex + ey * ey, t = 0.0;
+    /* Projection onto the edge clamped to its ends; a repeated vertex gives a
+    ** zero-length edge whose distance is just the distance to the vertex. */
+    if (ee > 0) {
+      t = (wx * ex + wy * ey) / ee;
+      t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    }
+    double dx = wx - t * ex, dy = wy - t * ey, d2 = dx * dx + dy * dy;
+    if (d2 < best) best = d2;
+    if ((ay > y) != (py[i] > y)) {
+      /* ey != 0 here, since the edge straddles y. */
+      double xc = ax + ex * (y - ay) / ey;
+      if (x < xc) inside = !inside;
+    }
+  }
+  double d = sqrt(best);
+  return inside && d > 0 ? -d : d;
+}
+
+double lw_boundary_distance(const lw_boundary *b, double x, double y)
+{
+  if (b->kind == LW_BOUNDARY_NONE) return -INFINITY;
+  if (!isfinite(x) || !isfinite(y)) return INFINITY;
+  switch (b->kind) {
+  case LW_BOUNDARY_RECT: return rect_distance(b, x, y);
+  case LW_BOUNDARY_CIRCLE: return circle_distance(b, x, y);
+  case LW_BOUNDARY_POLYGON: return polygon_distance(b, x, y);
+  case LW_BOUNDARY_NONE: break;
+  }
+  return -INFINITY;
+}
+
+int lw_boundary_inside(const lw_boundary *b, double x, double y)
+{
+  return lw_boundary_distance(b, x, y) < 0;
+}

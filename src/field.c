@@ -1,0 +1,218 @@
+/*
+** field.c -- grids with bilinear interpolation, analytic potentials and vector
+** fields (field.h).
+**
+** Everything past construction runs in the annealer's inner loop: no
+** allocation, one switch on the kind, and a grid lookup that cannot produce
+** NaN whatever the query point (NaN and infinite coordinates are clamped onto
+** the grid like any other far-away point).
+**
+** The analytic presets trust their parameters (scale > 0, wavelength > 0, unit
+** directions): those are checked once where the scene is read, not per call.
+*/
+#include "linewise/field.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+lw_grid2d *lw_grid2d_new(int nx, int ny, int ncomp, double x0, double y0,
+                         double hx, double hy, lw_error *err)
+{
+  if (nx < 1 || ny < 1) {
+    lw_error_set(err, LW_EINPUT, "grid needs at least 1 node per axis (got %d x %d)", nx, ny);
+    return NULL;
+  }
+  if (ncomp != 1 && ncomp != 2) {
+    lw_error_set(err, LW_EINPUT, "grid needs 1 or 2 values per node (got %d)", ncomp);
+    return NULL;
+  }
+  /* A NaN origin or spacing would turn every lookup into NaN. */
+  if (!isfinite(x0) || !isfinite(y0)) {
+    lw_error_set(err, LW_EINPUT, "grid origin (%g, %g) is not finite", x0, y0);
+    return NULL;
+  }
+  if (!isfinite(hx) || !isfinite(hy) || hx <= 0 || hy <= 0) {
+    lw_error_set(err, LW_EINPUT, "grid spacing (%g, %g) must be finite and > 0", hx, hy);
+    return NULL;
+  }
+  /* nx * ny * ncomp in size_t, checked so a huge image cannot wrap around
+  ** to a small allocation. */
+  size_t count = (size_t)nx;
+  if ((size_t)ny > SIZE_MAX / count) goto too_big;
+  count *= (size_t)ny;
+  if ((size_t)ncomp > SIZE_MAX / sizeof(double) / count) goto too_big;
+  count *= (size_t)ncomp;
+
+  lw_grid2d *g = malloc(sizeof *g);
+  if (!g) goto nomem;
+  g->data = calloc(count, sizeof *g->data);
+  if (!g->data) {
+    free(g);
+    goto nomem;
+  }
+  g->nx = nx;
+  g->ny = ny;
+  g->ncomp = ncomp;
+  g->x0 = x0;
+  g->y0 = y0;
+  g->hx = hx;
+  g->hy = hy;
+  return g;
+
+too_big:
+  lw_error_set(err, LW_EINPUT, "grid of %d x %d x %d values is too large", nx, ny, ncomp);
+  return NULL;
+nomem:
+  lw_error_set(err, LW_ENOMEM, "out of memory for a %d x %d grid", nx, ny);
+  return NULL;
+}
+
+void lw_grid2d_free(lw_grid2d *g)
+{
+  if (!g) return;
+  free(g->data);
+  free(g);
+}
+
+size_t lw_grid2d_sanitize(lw_grid2d *g)
+{
+  if (!g || !g->data) return 0;
+  size_t n = (size_t)g->nx * (size_t)g->ny * (size_t)g->ncomp, bad = 0;
+  for (size_t k = 0; k < n; k++) {
+    if (!isfinite(g->data[k])) {
+      g->data[k] = 0.0;
+      bad++;
+    }
+  }
+  return bad;
+}
+
+/* Locates coordinate x on an axis of n nodes: the cell index *i (0 <= *i <=
+** n - 2, or 0 when n == 1) and the fraction *t in [0, 1] inside it.  The
+** coordinate is clamped to the node range first, so points beyond the edge
+** read the edge value; "!(u > 0)" also sends NaN to the first node. */
+static inline void locate(double x, double x0, double h, int n, int *i, double *t)
+{
+  if (n < 2) {
+    *i = 0;
+    *t = 0.0;
+    return;
+  }
+  double u = (x - x0) / h, top = (double)(n - 1);
+  if (!(u > 0.0)) u = 0.0;
+  else if (u > top) u = top;
+  int k = (int)u; /* u >= 0, so truncation is floor */
+  if (k > n - 2) k = n - 2; /* u == top: last cell at t = 1 */
+  *i = k;
+  *t = u - (double)k;
+}
+
+void lw_grid2d_eval(const lw_grid2d *g, double x, double y, double *out)
+{
+  int i, j;
+  double tx, ty;
+  locate(x, g->x0, g->hx, g->nx, &i, &tx);
+  locate(y, g->y0, g->hy, g->ny, &j, &ty);
+  const int nc = g->ncomp;
+  /* A 1-node axis has no neighbour: reuse the same node (weight 0 anyway)
+  ** rather than read past the row or the array. */
+  const size_t di = g->nx > 1 ? (size_t)nc : 0;
+  const size_t dj = g->ny > 1 ? (size_t)g->nx * (size_t)nc : 0;
+  const double *p = g->data + ((size_t)j * (size_t)g->nx + (size_t)i) * (size_t)nc;
+  const double w00 = (1.0 - tx) * (1.0 - ty), w10 = tx * (1.0 - ty);
+  const double w01 = (1.0 - tx) * ty, w11 = tx * ty;
+  for (int c = 0; c < nc; c++)
+    out[c] = w00 * p[c] + w10 * p[di + c] + w01 * p[dj + c] + w11 * p[dj + di + c];
+}
+
+double lw_potential_eval(const lw_potential *f, double x, double y)
+{
+  switch (f->kind) {
+  case LW_POTENTIAL_CONSTANT:
+    return f->value;
+  case LW_POTENTIAL_RAMP:
+    return 0.5 + 0.5 * ((x - f->cx) * f->ux + (y - f->cy) * f->uy) / f->scale;
+  case LW_POTENTIAL_RADIAL: {
+    /* sqrt rather than hypot: page coordinates cannot overflow a square and
+    ** hypot is several times slower. */
+    double dx = x - f->cx, dy = y - f->cy;
+    return sqrt(dx * dx + dy * dy) / f->scale;
+  }
+  case LW_POTENTIAL_GRID: {
+    /* A missing or mis-shaped grid reads as 0, not as out-of-bounds memory. */
+    if (!f->grid || f->grid->ncomp != 1) return 0.0;
+    double v;
+    lw_grid2d_eval(f->grid, x, y, &v);
+    return v;
+  }
+  }
+  return 0.0;
+}
+
+void lw_field_eval(const lw_field *f, double x, double y, double *vx, double *vy)
+{
+  switch (f->kind) {
+  case LW_FIELD_CONSTANT:
+    *vx = f->ux;
+    *vy = f->uy;
+    return;
+  case LW_FIELD_RADIAL:
+  case LW_FIELD_VORTEX: {
+    double dx = x - f->cx, dy = y - f->cy, r2 = dx * dx + dy * dy;
+    /* The direction is undefined at the centre; 0 there keeps the energy
+    ** finite and the centre a neutral point. */
+    if (!(r2 > 0.0)) {
+      *vx = *vy = 0.0;
+      return;
+    }
+    double inv = 1.0 / sqrt(r2);
+    if (f->kind == LW_FIELD_RADIAL) {
+      *vx = dx * inv;
+      *vy = dy * inv;
+    } else {
+      *vx = -dy * inv;
+      *vy = dx * inv;
+    }
+    return;
+  }
+  case LW_FIELD_WAVES: {
+    double k = 2.0 * M_PI / f->wavelength;
+    double s = k * f->amplitude * cos(k * x); /* dy/dx of A sin(kx) */
+    double inv = 1.0 / sqrt(1.0 + s * s);
+    *vx = inv;
+    *vy = s * inv;
+    return;
+  }
+  case LW_FIELD_GRID: {
+    if (!f->grid || f->grid->ncomp != 2) {
+      *vx = *vy = 0.0;
+      return;
+    }
+    double v[2];
+    lw_grid2d_eval(f->grid, x, y, v);
+    *vx = v[0];
+    *vy = v[1];
+    return;
+  }
+  }
+  *vx = *vy = 0.0;
+}
+
+void lw_potential_clear(lw_potential *f)
+{
+  if (!f) return;
+  lw_grid2d_free(f->grid);
+  f->grid = NULL;
+}
+
+void lw_field_clear(lw_field *f)
+{
+  if (!f) return;
+  lw_grid2d_free(f->grid);
+  f->grid = NULL;
+}

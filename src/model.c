@@ -1,0 +1,376 @@
+/*
+** model.c -- state, caches, local energy differences and commits (model.h),
+** and the from-scratch energy that checks them.
+*/
+#include "linewise/model.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Samples one segment and evaluates its length, its local terms and (if ps is
+** not NULL) its pair samples. */
+static void segment_eval(const lw_scene *sc, const lw_node *a, const lw_node *b, uint32_t spline,
+                         lw_samples *s, double *len, double *local, lw_pair_sample *ps)
+{
+  lw_segment_sample(&sc->quad, a, b, s);
+  *len = s->length;
+  for (int t = 0; t < sc->n_local; t++) local[t] = lw_term_types[sc->local[t]].segment(s, sc);
+  if (ps)
+    for (int q = 0; q < s->n; q++)
+      ps[q] = (lw_pair_sample){s->x[q], s->y[q], s->dx[q], s->dy[q], s->dl[q], spline, (uint32_t)q};
+}
+
+/* Pair energy (no coefficient) between the n samples `mine` of spline
+** `spline` and every grid sample of another spline.  Cells and their entries
+** are visited in a fixed order, so the sum depends on positions only. */
+static double pair_against(const lw_cellgrid *g, const lw_pair_sample *all, const lw_pair_sample *mine,
+                           int n, uint32_t spline, const lw_pair_ctx *ctx)
+{
+  double sum = 0.0;
+  for (int i = 0; i < n; i++) {
+    int cx, cy;
+    lw_cellgrid_locate(g, mine[i].x, mine[i].y, &cx, &cy);
+    for (int y = cy - 1; y <= cy + 1; y++) {
+      if (y < 0 || y >= g->ny) continue;
+      for (int x = cx - 1; x <= cx + 1; x++) {
+        if (x < 0 || x >= g->nx) continue;
+        const lw_cell *c = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
+        for (uint32_t k = 0; k < c->n; k++) {
+          const lw_pair_sample *o = &all[c->idx[k]];
+          if (o->spline != spline) sum += lw_pair_kernel(&mine[i], o, ctx);
+        }
+      }
+    }
+  }
+  return sum;
+}
+
+/* Every pair of samples of different splines once (j > i), in a fixed order. */
+static double pair_all(const lw_cellgrid *g, const lw_pair_sample *all, size_t n, const lw_pair_ctx *ctx)
+{
+  double sum = 0.0;
+  for (size_t i = 0; i < n; i++) {
+    int cx, cy;
+    lw_cellgrid_locate(g, all[i].x, all[i].y, &cx, &cy);
+    for (int y = cy - 1; y <= cy + 1; y++) {
+      if (y < 0 || y >= g->ny) continue;
+      for (int x = cx - 1; x <= cx + 1; x++) {
+        if (x < 0 || x >= g->nx) continue;
+        const lw_cell *c = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
+        for (uint32_t k = 0; k < c->n; k++) {
+          uint32_t j = c->idx[k];
+          if (j > i && all[j].spline != all[i].spline) sum += lw_pair_kernel(&all[i], &all[j], ctx);
+        }
+      }
+    }
+  }
+  return sum;
+}
+
+static lw_cellgrid *grid_for(const lw_scene *sc, size_t n_samples, lw_error *err)
+{
+  return lw_cellgrid_new(0.0, 0.0, sc->width, sc->height, sc->pair.cutoff, n_samples, err);
+}
+
+static double strain_of_spline(const lw_scene *sc, const lw_splines *sp, const double *seg_len,
+                               size_t i, double spline_len)
+{
+  double S = sc->coef[LW_TERM_STRAIN];
+  double L0 = sp->rest_length[i];
+  if (!sc->strain_per_segment) return S * lw_term_strain(spline_len, L0);
+  size_t n = lw_splines_segments(sp, i), g0 = lw_segment_index(sp, i, 0);
+  double l0 = L0 / (double)n, e = 0.0;
+  for (size_t m = 0; m < n; m++) e += S * lw_term_strain(seg_len[g0 + m], l0);
+  return e;
+}
+
+double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[LW_TERM_COUNT],
+                         lw_error *err)
+{
+  for (int t = 0; t < LW_TERM_COUNT; t++) term[t] = 0.0;
+  const int nq = sc->quad.n;
+  lw_samples s;
+  double local[LW_TERM_COUNT];
+  lw_pair_sample *ps = NULL;
+  if (sc->on[LW_TERM_PAIR]) {
+    ps = malloc((sp->n_segments ? sp->n_segments : 1) * (size_t)nq * sizeof *ps);
+    if (!ps) {
+      lw_error_set(err, LW_ENOMEM, "out of memory for %zu pair samples", sp->n_segments * (size_t)nq);
+      return NAN;
+    }
+  }
+  double *seg_len = malloc((sp->n_segments ? sp->n_segments : 1) * sizeof *seg_len);
+  if (!seg_len) {
+    free(ps);
+    lw_error_set(err, LW_ENOMEM, "out of memory for %zu segments", sp->n_segments);
+    return NAN;
+  }
+  for (size_t g = 0; g < sp->n_segments; g++) {
+    const lw_node *a = &sp->node[lw_segment_node(sp, g)];
+    segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &seg_len[g], local, ps ? ps + g * (size_t)nq : NULL);
+    for (int t = 0; t < sc->n_local; t++) term[sc->local[t]] += local[t];
+  }
+  if (sc->on[LW_TERM_STRAIN])
+    for (size_t i = 0; i < sp->n_splines; i++) {
+      double L = 0.0;
+      size_t g0 = lw_segment_index(sp, i, 0), n = lw_splines_segments(sp, i);
+      for (size_t m = 0; m < n; m++) L += seg_len[g0 + m];
+      term[LW_TERM_STRAIN] += strain_of_spline(sc, sp, seg_len, i, L);
+    }
+  free(seg_len);
+  if (ps) {
+    size_t n = sp->n_segments * (size_t)nq;
+    lw_cellgrid *g = grid_for(sc, n, err);
+    if (!g) {
+      free(ps);
+      return NAN;
+    }
+    for (size_t i = 0; i < n; i++)
+      if (lw_cellgrid_place(g, (uint32_t)i, ps[i].x, ps[i].y) != LW_OK) {
+        lw_cellgrid_free(g);
+        free(ps);
+        lw_error_set(err, LW_ENOMEM, "out of memory filling the pair grid");
+        return NAN;
+      }
+    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pair_all(g, ps, n, &sc->pair);
+    lw_cellgrid_free(g);
+    free(ps);
+  }
+  double total = 0.0;
+  for (int t = 0; t < LW_TERM_COUNT; t++) total += term[t];
+  return total;
+}
+
+lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
+{
+  lw_model *m = calloc(1, sizeof *m);
+  if (!m) {
+    lw_splines_free(sp);
+    lw_error_set(err, LW_ENOMEM, "out of memory for the model");
+    return NULL;
+  }
+  m->scene = sc;
+  m->sp = sp;
+  size_t ns = sp->n_segments ? sp->n_segments : 1;
+  m->seg_len = malloc(ns * sizeof *m->seg_len);
+  m->seg_local = malloc(ns * (size_t)(sc->n_local ? sc->n_local : 1) * sizeof *m->seg_local);
+  m->spline_len = malloc((sp->n_splines ? sp->n_splines : 1) * sizeof *m->spline_len);
+  if (!m->seg_len || !m->seg_local || !m->spline_len) goto nomem;
+  if (sc->on[LW_TERM_PAIR]) {
+    size_t n = sp->n_segments * (size_t)sc->quad.n;
+    if (n >= UINT32_MAX) {
+      lw_error_set(err, LW_EINPUT, "%zu pair samples exceed the grid's 32-bit index", n);
+      lw_model_free(m);
+      return NULL;
+    }
+    m->ps = malloc((n ? n : 1) * sizeof *m->ps);
+    if (!m->ps) goto nomem;
+    m->grid = grid_for(sc, n, err);
+    if (!m->grid) {
+      lw_model_free(m);
+      return NULL;
+    }
+  }
+  for (size_t i = 0; i < sp->n_splines; i++)
+    if (lw_splines_segments(sp, i) > m->max_segments) m->max_segments = lw_splines_segments(sp, i);
+  if (lw_model_refresh(m, NULL) != LW_OK) goto nomem;
+  return m;
+nomem:
+  lw_error_set(err, LW_ENOMEM, "out of memory for the model of %zu segments", sp->n_segments);
+  lw_model_free(m);
+  return NULL;
+}
+
+void lw_model_free(lw_model *m)
+{
+  if (!m) return;
+  lw_splines_free(m->sp);
+  free(m->seg_len);
+  free(m->seg_local);
+  free(m->spline_len);
+  free(m->ps);
+  lw_cellgrid_free(m->grid);
+  free(m);
+}
+
+double lw_model_total(const lw_model *m)
+{
+  double total = 0.0;
+  for (int t = 0; t < LW_TERM_COUNT; t++) total += m->term[t];
+  return total;
+}
+
+lw_status lw_model_refresh(lw_model *m, double *drift)
+{
+  const lw_scene *sc = m->scene;
+  const lw_splines *sp = m->sp;
+  const int nq = sc->quad.n, nl = sc->n_local;
+  double old_total = lw_model_total(m);
+  double term[LW_TERM_COUNT] = {0};
+  lw_samples s;
+  for (size_t g = 0; g < sp->n_segments; g++) {
+    const lw_node *a = &sp->node[lw_segment_node(sp, g)];
+    double *local = m->seg_local + g * (size_t)nl;
+    segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &m->seg_len[g], local,
+                 m->ps ? m->ps + g * (size_t)nq : NULL);
+    for (int t = 0; t < nl; t++) term[sc->local[t]] += local[t];
+  }
+  for (size_t i = 0; i < sp->n_splines; i++) {
+    size_t g0 = lw_segment_index(sp, i, 0), n = lw_splines_segments(sp, i);
+    double L = 0.0;
+    for (size_t k = 0; k < n; k++) L += m->seg_len[g0 + k];
+    m->spline_len[i] = L;
+    if (sc->on[LW_TERM_STRAIN]) term[LW_TERM_STRAIN] += strain_of_spline(sc, sp, m->seg_len, i, L);
+  }
+  if (m->grid) {
+    size_t n = sp->n_segments * (size_t)nq;
+    for (size_t i = 0; i < n; i++)
+      if (lw_cellgrid_place(m->grid, (uint32_t)i, m->ps[i].x, m->ps[i].y) != LW_OK) return LW_ENOMEM;
+    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pair_all(m->grid, m->ps, n, &sc->pair);
+  }
+  double total = 0.0;
+  for (int t = 0; t < LW_TERM_COUNT; t++) {
+    m->term[t] = term[t];
+    total += term[t];
+  }
+  if (drift) {
+    if (!isfinite(total) || !isfinite(old_total)) *drift = total == old_total ? 0.0 : INFINITY;
+    else *drift = fabs(total - old_total) / fmax(fabs(total), 1.0);
+  }
+  return LW_OK;
+}
+
+lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err)
+{
+  lw_proposal *p = calloc(1, sizeof *p);
+  size_t cap = m->max_segments ? m->max_segments : 1;
+  int nl = m->scene->n_local ? m->scene->n_local : 1;
+  if (p) {
+    p->cap_seg = cap;
+    p->node = malloc((cap + 1) * sizeof *p->node);
+    p->len = malloc(cap * sizeof *p->len);
+    p->local = malloc(cap * (size_t)nl * sizeof *p->local);
+    p->ps = malloc(cap * (size_t)m->scene->quad.n * sizeof *p->ps);
+  }
+  if (!p || !p->node || !p->len || !p->local || !p->ps) {
+    lw_proposal_free(p);
+    lw_error_set(err, LW_ENOMEM, "out of memory for a proposal");
+    return NULL;
+  }
+  return p;
+}
+
+void lw_proposal_free(lw_proposal *p)
+{
+  if (!p) return;
+  free(p->node);
+  free(p->len);
+  free(p->local);
+  free(p->ps);
+  free(p);
+}
+
+/* Node k of the spline as it would be after the proposal. */
+static inline const lw_node *proposed_node(const lw_node *base, const lw_proposal *p, size_t k)
+{
+  return (k >= p->node0 && k < p->node0 + p->n_node) ? &p->node[k - p->node0] : &base[k];
+}
+
+void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t node0,
+                      size_t n_node, const lw_node *nodes)
+{
+  const lw_scene *sc = m->scene;
+  const lw_splines *sp = m->sp;
+  const int nq = sc->quad.n, nl = sc->n_local;
+  const size_t nseg = lw_splines_segments(sp, spline);
+  const lw_node *base = &sp->node[sp->first[spline]];
+  const size_t g0 = lw_segment_index(sp, spline, 0);
+
+  p->spline = spline;
+  p->node0 = node0;
+  p->n_node = n_node;
+  memcpy(p->node, nodes, n_node * sizeof *nodes);
+  p->seg0 = node0 > 0 ? node0 - 1 : 0;
+  size_t seg_end = node0 + n_node < nseg ? node0 + n_node : nseg; /* one past the last */
+  p->n_seg = seg_end - p->seg0;
+  for (int t = 0; t < LW_TERM_COUNT; t++) p->dterm[t] = 0.0;
+
+  lw_samples s;
+  double dlen = 0.0;
+  for (size_t j = 0; j < p->n_seg; j++) {
+    size_t m_loc = p->seg0 + j, g = g0 + m_loc;
+    double *local = p->local + j * (size_t)nl;
+    segment_eval(sc, proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1), spline, &s,
+                 &p->len[j], local, m->ps ? p->ps + j * (size_t)nq : NULL);
+    const double *old = m->seg_local + g * (size_t)nl;
+    for (int t = 0; t < nl; t++) p->dterm[sc->local[t]] += local[t] - old[t];
+    dlen += p->len[j] - m->seg_len[g];
+  }
+  p->new_spline_len = m->spline_len[spline] + dlen;
+
+  if (sc->on[LW_TERM_STRAIN]) {
+    double S = sc->coef[LW_TERM_STRAIN], L0 = sp->rest_length[spline];
+    if (!sc->strain_per_segment) {
+      p->dterm[LW_TERM_STRAIN] = S * (lw_term_strain(p->new_spline_len, L0) -
+                                      lw_term_strain(m->spline_len[spline], L0));
+    } else {
+      double l0 = L0 / (double)nseg;
+      for (size_t j = 0; j < p->n_seg; j++)
+        p->dterm[LW_TERM_STRAIN] += S * (lw_term_strain(p->len[j], l0) -
+                                         lw_term_strain(m->seg_len[g0 + p->seg0 + j], l0));
+    }
+  }
+
+  double dE = 0.0;
+  for (int t = 0; t < LW_TERM_COUNT; t++) dE += p->dterm[t];
+  /* The pair sum is the costly part: skip it when the move is already
+  ** forbidden (+inf) or undefined (NaN). */
+  if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
+    double pe = 0.0;
+    for (size_t j = 0; j < p->n_seg; j++) {
+      size_t g = g0 + p->seg0 + j;
+      pe += pair_against(m->grid, m->ps, p->ps + j * (size_t)nq, nq, spline, &sc->pair);
+      pe -= pair_against(m->grid, m->ps, m->ps + g * (size_t)nq, nq, spline, &sc->pair);
+    }
+    p->dterm[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pe;
+    dE += p->dterm[LW_TERM_PAIR];
+  }
+  p->dE = dE;
+}
+
+lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
+{
+  const lw_scene *sc = m->scene;
+  lw_splines *sp = m->sp;
+  const int nq = sc->quad.n, nl = sc->n_local;
+  const size_t g0 = lw_segment_index(sp, p->spline, 0);
+  if (m->grid) {
+    size_t first = (g0 + p->seg0) * (size_t)nq, n = p->n_seg * (size_t)nq;
+    for (size_t k = 0; k < n; k++)
+      if (lw_cellgrid_place(m->grid, (uint32_t)(first + k), p->ps[k].x, p->ps[k].y) != LW_OK) {
+        /* Put the moved ones back: their old cells kept their capacity, so
+        ** this cannot fail, and the model is as before the call. */
+        for (size_t b = 0; b < k; b++)
+          lw_cellgrid_place(m->grid, (uint32_t)(first + b), m->ps[first + b].x, m->ps[first + b].y);
+        return LW_ENOMEM;
+      }
+  }
+  memcpy(&sp->node[sp->first[p->spline] + p->node0], p->node, p->n_node * sizeof *p->node);
+  int nonfinite = 0;
+  for (size_t j = 0; j < p->n_seg; j++) {
+    size_t g = g0 + p->seg0 + j;
+    m->seg_len[g] = p->len[j];
+    memcpy(m->seg_local + g * (size_t)nl, p->local + j * (size_t)nl, (size_t)nl * sizeof *m->seg_local);
+    if (m->ps) memcpy(m->ps + g * (size_t)nq, p->ps + j * (size_t)nq, (size_t)nq * sizeof *m->ps);
+  }
+  m->spline_len[p->spline] = p->new_spline_len;
+  for (int t = 0; t < LW_TERM_COUNT; t++) {
+    m->term[t] += p->dterm[t];
+    if (!isfinite(m->term[t])) nonfinite = 1;
+  }
+  /* inf - inf leaves NaN in a running total: leaving a forbidden state is
+  ** legal, so rebuild the totals from the caches when that happens. */
+  if (nonfinite) return lw_model_refresh(m, NULL);
+  return LW_OK;
+}

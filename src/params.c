@@ -1,0 +1,365 @@
+/*
+** params.c -- the parameter table, the INI reader (inih), --set overrides,
+** the echo of resolved parameters and the generated docs (params.h).
+**
+** inih does not report line numbers to the handler, so the file is fed to
+** ini_parse_stream through a reader that counts the lines it hands out: the
+** count at the moment the handler runs is the line of that key.
+*/
+#include "linewise/params.h"
+
+#include <errno.h>
+#include <ini.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define OFF(f) offsetof(lw_params, f)
+#define NUM(sec, key, T, f, def, unit, lo, hi, open, help) \
+  {sec, key, T, OFF(f), def, unit, lo, hi, open, NULL, help}
+#define CHOICE(sec, key, f, def, choices, help) \
+  {sec, key, LW_PT_CHOICE, OFF(f), def, "", 0, 0, 0, choices, help}
+#define STRING(sec, key, f, def, unit, help) \
+  {sec, key, LW_PT_STRING, OFF(f), def, unit, 0, 0, 0, NULL, help}
+
+const lw_param_def lw_param_table[] = {
+  NUM("scene", "width", LW_PT_DOUBLE, width, "210", "mm", 0, 1e7, LW_MIN_OPEN,
+      "Page width."),
+  NUM("scene", "height", LW_PT_DOUBLE, height, "297", "mm", 0, 1e7, LW_MIN_OPEN,
+      "Page height."),
+  CHOICE("scene", "boundary", boundary, "rect", "rect|circle|polygon",
+         "Shape of the frame the lines stay inside: the page rectangle inset by `margin`, "
+         "the largest circle inside that rectangle, or `polygon`."),
+  NUM("scene", "margin", LW_PT_DOUBLE, margin, "10", "mm", 0, 1e7, 0,
+      "Inset of the rect and circle boundaries from the page edge."),
+  STRING("scene", "polygon", polygon, "", "mm",
+         "Polygon boundary vertices as `x y x y ...` (at least 3 vertices; either orientation)."),
+  CHOICE("scene", "potential", potential, "constant", "constant|ramp|radial",
+         "Potential Phi read by the potential term: constant `potential_value`; ramp "
+         "Phi = 1/2 + 1/2 (r-c).u/h from 0 to 1 across the page along `potential_angle`; "
+         "radial Phi = |r-c|/h. Built only when [energy] potential is non-zero."),
+  NUM("scene", "potential_value", LW_PT_DOUBLE, potential_value, "1", "", -1e12, 1e12, 0,
+      "Phi of the constant potential."),
+  NUM("scene", "potential_angle", LW_PT_DOUBLE, potential_angle, "0", "degrees", -360, 360, 0,
+      "Direction in which the ramp potential rises (0 = +x, 90 = +y, down the page)."),
+  NUM("scene", "potential_scale", LW_PT_DOUBLE, potential_scale, "0", "mm", 0, 1e7, 0,
+      "h of the ramp and radial potentials; 0 = automatic (half the page extent along the ramp; "
+      "half the page diagonal for radial)."),
+  CHOICE("scene", "field", field, "constant", "constant|radial|vortex|waves",
+         "Vector field v read by the field term (unit length): constant along `field_angle`, "
+         "radial from the centre, vortex around it, or waves tangent to y = A sin(2 pi x / wavelength). "
+         "Built only when [energy] field is non-zero."),
+  NUM("scene", "field_angle", LW_PT_DOUBLE, field_angle, "0", "degrees", -360, 360, 0,
+      "Direction of the constant field (0 = +x, 90 = +y, down the page)."),
+  NUM("scene", "field_wavelength", LW_PT_DOUBLE, field_wavelength, "50", "mm", 0, 1e7, LW_MIN_OPEN,
+      "Wavelength of the waves field."),
+  NUM("scene", "field_amplitude", LW_PT_DOUBLE, field_amplitude, "10", "mm", -1e7, 1e7, 0,
+      "Amplitude A of the waves field."),
+  NUM("scene", "center_x", LW_PT_DOUBLE, center_x, "-1", "mm", -1, 1e7, 0,
+      "Centre of the radial and vortex presets and of the ramp; -1 = page centre."),
+  NUM("scene", "center_y", LW_PT_DOUBLE, center_y, "-1", "mm", -1, 1e7, 0,
+      "See center_x."),
+  NUM("init", "splines", LW_PT_INT, splines, "100", "", 0, 1e8, 0,
+      "Number of splines placed at random inside the boundary."),
+  NUM("init", "segments", LW_PT_INT, segments, "4", "", 1, 1e5, 0,
+      "Cubic Bezier segments per spline."),
+  NUM("init", "segment_length", LW_PT_DOUBLE, segment_length, "10", "mm", 0, 1e7, LW_MIN_OPEN,
+      "Length of each segment; a spline's rest length L0 is segments * segment_length."),
+  STRING("init", "from", from, "", "path",
+         "A state.lw to start from instead of random placement (relative to the scene file)."),
+  NUM("energy", "strain", LW_PT_DOUBLE, strain, "0", "energy", 0, 1e12, 0,
+      "S: strain S (L - L0)^2 / L0^2 * L keeps each spline's length near L0. 0 = off."),
+  CHOICE("energy", "strain_mode", strain_mode, "spline", "spline|segment",
+         "Strain per spline (L = whole length) or per segment (each segment against L0/n)."),
+  NUM("energy", "bending", LW_PT_DOUBLE, bending, "0", "energy mm", 0, 1e12, 0,
+      "B: bending B * integral of curvature^2 dl favours gentle curves. 0 = off."),
+  NUM("energy", "potential", LW_PT_DOUBLE, potential_coef, "0", "energy / mm", -1e12, 1e12, 0,
+      "Q: potential Q * integral of Phi dl draws lines to low Phi (dark tone). 0 = off."),
+  NUM("energy", "field", LW_PT_DOUBLE, field_coef, "0", "energy / mm", -1e12, 1e12, 0,
+      "P: field P * integral of r'.v ds; negative P rewards alignment with v. 0 = off."),
+  CHOICE("energy", "field_mode", field_mode, "axial", "axial|signed",
+         "axial integrates |r'.v| (lines have no direction); signed integrates r'.v."),
+  NUM("energy", "pair", LW_PT_DOUBLE, pair, "0", "energy / mm", 0, 1e12, 0,
+      "C: pair repulsion C * double integral of dl dl / r between different splines. 0 = off."),
+  NUM("energy", "pair_cutoff", LW_PT_DOUBLE, pair_cutoff, "5", "mm", 0, 1e7, 0,
+      "Pair interaction range; the kernel is shifted to 1/r - 1/rc so the energy is continuous. "
+      "0 = no cutoff (all pairs; slow for large scenes)."),
+  NUM("energy", "pair_near", LW_PT_DOUBLE, pair_near, "2", "element lengths", 0, 100, 0,
+      "Near field: sample pairs closer than this many element lengths use the exact integral "
+      "over straight elements (finite where curves touch or cross). 0 = off."),
+  NUM("energy", "boundary", LW_PT_DOUBLE, boundary_coef, "0", "energy mm", 0, 1e12, 0,
+      "R: boundary R * integral of 1/d^2 dl keeps lines inside (+infinity outside). 0 = off."),
+  NUM("energy", "quadrature", LW_PT_INT, quadrature, "8", "nodes", 2, 64, 0,
+      "Gauss-Legendre nodes per segment for every integral."),
+};
+const size_t lw_param_count = sizeof lw_param_table / sizeof lw_param_table[0];
+
+_Static_assert(sizeof lw_param_table / sizeof lw_param_table[0] <= LW_PARAM_MAX,
+               "lw_params.line too small for the table");
+
+const lw_param_def *lw_params_find(const char *section, const char *key)
+{
+  for (size_t i = 0; i < lw_param_count; i++)
+    if (!strcmp(lw_param_table[i].section, section) && !strcmp(lw_param_table[i].key, key))
+      return &lw_param_table[i];
+  return NULL;
+}
+
+static int section_known(const char *section)
+{
+  for (size_t i = 0; i < lw_param_count; i++)
+    if (!strcmp(lw_param_table[i].section, section)) return 1;
+  return 0;
+}
+
+/* Index of word in "a|b|c", or -1. */
+static int choice_index(const char *choices, const char *word)
+{
+  size_t n = strlen(word);
+  int idx = 0;
+  for (const char *c = choices; *c; idx++) {
+    const char *bar = strchr(c, '|');
+    size_t len = bar ? (size_t)(bar - c) : strlen(c);
+    if (len == n && !strncmp(c, word, n)) return idx;
+    if (!bar) break;
+    c = bar + 1;
+  }
+  return -1;
+}
+
+/* The idx-th word of "a|b|c" into buf. */
+static void choice_name(const char *choices, int idx, char *buf, size_t n)
+{
+  const char *c = choices;
+  for (int i = 0; i < idx && c; i++) {
+    c = strchr(c, '|');
+    if (c) c++;
+  }
+  size_t len = 0;
+  if (c) {
+    const char *bar = strchr(c, '|');
+    len = bar ? (size_t)(bar - c) : strlen(c);
+  }
+  if (len >= n) len = n - 1;
+  memcpy(buf, c ? c : "", len);
+  buf[len] = '\0';
+}
+
+static void range_text(const lw_param_def *d, char *buf, size_t n)
+{
+  snprintf(buf, n, "%s %.10g and %s %.10g", (d->open & LW_MIN_OPEN) ? ">" : ">=", d->min,
+           (d->open & LW_MAX_OPEN) ? "<" : "<=", d->max);
+}
+
+/* Parses text into the field of d; on failure writes what was expected. */
+static int assign(lw_params *p, const lw_param_def *d, const char *text, char *expected, size_t n)
+{
+  char *base = (char *)p + d->offset;
+  char range[128];
+  switch (d->type) {
+  case LW_PT_DOUBLE:
+  case LW_PT_INT: {
+    char *end;
+    errno = 0;
+    double v = strtod(text, &end);
+    while (*end == ' ' || *end == '\t') end++;
+    range_text(d, range, sizeof range);
+    if (end == text || *end || errno == ERANGE || !isfinite(v)) {
+      snprintf(expected, n, "a %s %s", d->type == LW_PT_INT ? "whole number" : "number", range);
+      return 0;
+    }
+    if (d->type == LW_PT_INT && v != floor(v)) {
+      snprintf(expected, n, "a whole number %s", range);
+      return 0;
+    }
+    int lo_ok = (d->open & LW_MIN_OPEN) ? v > d->min : v >= d->min;
+    int hi_ok = (d->open & LW_MAX_OPEN) ? v < d->max : v <= d->max;
+    if (!lo_ok || !hi_ok) {
+      snprintf(expected, n, "a value %s", range);
+      return 0;
+    }
+    if (d->type == LW_PT_INT) *(int *)base = (int)v;
+    else *(double *)base = v;
+    return 1;
+  }
+  case LW_PT_CHOICE: {
+    int idx = choice_index(d->choices, text);
+    if (idx < 0) {
+      snprintf(expected, n, "one of %s", d->choices);
+      return 0;
+    }
+    *(int *)base = idx;
+    return 1;
+  }
+  case LW_PT_STRING:
+    if (strlen(text) >= LW_PATH_MAX) {
+      snprintf(expected, n, "at most %d characters", LW_PATH_MAX - 1);
+      return 0;
+    }
+    strcpy(base, text);
+    return 1;
+  }
+  return 0;
+}
+
+void lw_params_defaults(lw_params *p)
+{
+  memset(p, 0, sizeof *p);
+  char expected[256];
+  for (size_t i = 0; i < lw_param_count; i++) assign(p, &lw_param_table[i], lw_param_table[i].def, expected, sizeof expected);
+}
+
+void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size_t n)
+{
+  int line = p->line[d - lw_param_table];
+  if (line > 0) snprintf(buf, n, "%s:%d", p->file, line);
+  else if (line < 0) snprintf(buf, n, "--set");
+  else snprintf(buf, n, "default");
+}
+
+typedef struct {
+  lw_params *p;
+  FILE *f;
+  int line;      /* lines handed to inih so far */
+  lw_error *err;
+  int failed;
+} reader_ctx;
+
+static char *read_line(char *str, int num, void *stream)
+{
+  reader_ctx *rc = stream;
+  char *s = fgets(str, num, rc->f);
+  if (s) rc->line++;
+  return s;
+}
+
+static int on_key(void *user, const char *section, const char *key, const char *value)
+{
+  reader_ctx *rc = user;
+  if (rc->failed) return 0;
+  rc->failed = 1;
+  if (!section_known(section)) {
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: unknown section [%s]", rc->p->file, rc->line, section);
+    return 0;
+  }
+  const lw_param_def *d = lw_params_find(section, key);
+  if (!d) {
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' is not a parameter (see docs/PARAMETERS.md)",
+                 rc->p->file, rc->line, section, key);
+    return 0;
+  }
+  int *line = &rc->p->line[d - lw_param_table];
+  if (*line > 0) {
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' repeated (first set on line %d)",
+                 rc->p->file, rc->line, section, key, *line);
+    return 0;
+  }
+  char expected[256];
+  if (!assign(rc->p, d, value, expected, sizeof expected)) {
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s': expected %s, got '%s'",
+                 rc->p->file, rc->line, section, key, expected, value);
+    return 0;
+  }
+  *line = rc->line;
+  rc->failed = 0;
+  return 1;
+}
+
+lw_status lw_params_read(lw_params *p, const char *path, lw_error *err)
+{
+  lw_params_defaults(p);
+  snprintf(p->file, sizeof p->file, "%s", path);
+  FILE *f = fopen(path, "r");
+  if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open scene file: %s", path, strerror(errno));
+  /* Keys must start at column 0; a continuation line would silently glue a
+  ** typo onto the previous value. */
+  ini_allow_multiline = false;
+  ini_stop_on_first_error = true;
+  reader_ctx rc = {p, f, 0, err, 0};
+  int r = ini_parse_stream(read_line, &rc, on_key, &rc);
+  int read_error = ferror(f);
+  fclose(f);
+  if (rc.failed) return LW_EINPUT;
+  if (read_error) return lw_error_set(err, LW_EIO, "%s: read error", path);
+  if (r > 0)
+    return lw_error_set(err, LW_EINPUT,
+                        "%s:%d: syntax error: expected '[section]', 'key = value' or a comment", path, r);
+  if (r < 0) return lw_error_set(err, LW_ENOMEM, "%s: out of memory while reading", path);
+  return LW_OK;
+}
+
+lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
+{
+  const char *dot = strchr(assignment, '.');
+  const char *eq = strchr(assignment, '=');
+  if (!dot || !eq || dot > eq)
+    return lw_error_set(err, LW_EUSAGE, "--set '%s': expected section.key=value", assignment);
+  char section[64], key[64];
+  size_t ls = (size_t)(dot - assignment), lk = (size_t)(eq - dot - 1);
+  if (ls >= sizeof section || lk >= sizeof key)
+    return lw_error_set(err, LW_EUSAGE, "--set '%s': name too long", assignment);
+  memcpy(section, assignment, ls);
+  section[ls] = '\0';
+  memcpy(key, dot + 1, lk);
+  key[lk] = '\0';
+  const lw_param_def *d = lw_params_find(section, key);
+  if (!d)
+    return lw_error_set(err, LW_EUSAGE, "--set %s.%s: not a parameter (see docs/PARAMETERS.md)",
+                        section, key);
+  char expected[256];
+  if (!assign(p, d, eq + 1, expected, sizeof expected))
+    return lw_error_set(err, LW_EUSAGE, "--set %s.%s: expected %s, got '%s'", section, key,
+                        expected, eq + 1);
+  p->line[d - lw_param_table] = -1;
+  return LW_OK;
+}
+
+static void value_text(const lw_params *p, const lw_param_def *d, char *buf, size_t n)
+{
+  const char *base = (const char *)p + d->offset;
+  switch (d->type) {
+  case LW_PT_DOUBLE: snprintf(buf, n, "%.17g", *(const double *)base); break;
+  case LW_PT_INT: snprintf(buf, n, "%d", *(const int *)base); break;
+  case LW_PT_CHOICE: choice_name(d->choices, *(const int *)base, buf, n); break;
+  case LW_PT_STRING: snprintf(buf, n, "%s", base); break;
+  }
+}
+
+int lw_params_write(const lw_params *p, FILE *f)
+{
+  const char *section = "";
+  char buf[LW_PATH_MAX + 32];
+  for (size_t i = 0; i < lw_param_count; i++) {
+    const lw_param_def *d = &lw_param_table[i];
+    if (strcmp(section, d->section)) {
+      fprintf(f, "%s[%s]\n", i ? "\n" : "", d->section);
+      section = d->section;
+    }
+    value_text(p, d, buf, sizeof buf);
+    fprintf(f, "%s = %s\n", d->key, buf);
+  }
+  return ferror(f) ? -1 : 0;
+}
+
+void lw_params_write_doc(FILE *f)
+{
+  const char *section = "";
+  char range[128];
+  for (size_t i = 0; i < lw_param_count; i++) {
+    const lw_param_def *d = &lw_param_table[i];
+    if (strcmp(section, d->section)) {
+      fprintf(f, "\n## [%s]\n\n| key | type | default | unit | range | meaning |\n"
+                 "|---|---|---|---|---|---|\n", d->section);
+      section = d->section;
+    }
+    const char *type = d->type == LW_PT_DOUBLE ? "number" : d->type == LW_PT_INT ? "integer"
+                       : d->type == LW_PT_CHOICE ? "choice" : "text";
+    if (d->type == LW_PT_CHOICE) snprintf(range, sizeof range, "%s", d->choices);
+    else if (d->type == LW_PT_STRING) snprintf(range, sizeof range, "-");
+    else range_text(d, range, sizeof range);
+    for (char *c = range; *c; c++)
+      if (*c == '|') *c = '/';
+    fprintf(f, "| `%s` | %s | `%s` | %s | %s | %s |\n", d->key, type, d->def,
+            d->unit[0] ? d->unit : "-", range, d->help);
+  }
+}

@@ -1,0 +1,102 @@
+/*
+** terms.c -- the energy terms as pure functions of a segment's samples
+** (terms.h).  No allocation, no I/O, no globals: these run in the proposal
+** loop of every replica at once.
+*/
+#include "linewise/terms.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "linewise/scene.h"
+
+double lw_term_strain(double length, double rest_length)
+{
+  double x = length - rest_length;
+  return x * x / (rest_length * rest_length) * length;
+}
+
+double lw_term_bending(const lw_samples *s, const lw_quad *q)
+{
+  double sum = 0.0;
+  for (int i = 0; i < s->n; i++) {
+    double sp2 = s->speed[i] * s->speed[i];
+    if (sp2 == 0.0) continue; /* r' = 0: numerator is 0 too; a point does not bend */
+    double cross = s->dx[i] * s->ddy[i] - s->ddx[i] * s->dy[i];
+    sum += q->w[i] * cross * cross / (sp2 * sp2 * s->speed[i]);
+  }
+  return sum;
+}
+
+double lw_term_potential(const lw_samples *s, const lw_quad *q, const lw_potential *f)
+{
+  double sum = 0.0;
+  for (int i = 0; i < s->n; i++) {
+    if (s->dl[i] == 0.0) continue; /* no length, no contribution (even at an odd Phi) */
+    sum += lw_potential_eval(f, s->x[i], s->y[i]) * s->dl[i];
+  }
+  return sum;
+}
+
+double lw_term_field(const lw_samples *s, const lw_quad *q, const lw_field *f, int axial)
+{
+  double sum = 0.0;
+  for (int i = 0; i < s->n; i++) {
+    double vx, vy;
+    lw_field_eval(f, s->x[i], s->y[i], &vx, &vy);
+    double dot = s->dx[i] * vx + s->dy[i] * vy;
+    sum += q->w[i] * (axial ? fabs(dot) : dot);
+  }
+  return sum;
+}
+
+double lw_term_boundary(const lw_samples *s, const lw_quad *q, const lw_boundary *b)
+{
+  /* Gauss nodes never reach the segment ends: check the nodes themselves so
+  ** no drawn end pokes out of the frame. */
+  for (int e = 0; e < 2; e++)
+    if (!(lw_boundary_distance(b, s->end_x[e], s->end_y[e]) < 0.0)) return INFINITY;
+  double sum = 0.0;
+  for (int i = 0; i < s->n; i++) {
+    double d = lw_boundary_distance(b, s->x[i], s->y[i]);
+    if (!(d < 0.0)) return INFINITY; /* on or beyond the frame, or NaN: forbidden */
+    sum += s->dl[i] / (d * d);
+  }
+  return sum;
+}
+
+static double seg_bending(const lw_samples *s, const lw_scene *sc)
+{
+  return sc->coef[LW_TERM_BENDING] * lw_term_bending(s, &sc->quad);
+}
+
+static double seg_potential(const lw_samples *s, const lw_scene *sc)
+{
+  return sc->coef[LW_TERM_POTENTIAL] * lw_term_potential(s, &sc->quad, &sc->potential);
+}
+
+static double seg_field(const lw_samples *s, const lw_scene *sc)
+{
+  return sc->coef[LW_TERM_FIELD] * lw_term_field(s, &sc->quad, &sc->field, sc->field_axial);
+}
+
+static double seg_boundary(const lw_samples *s, const lw_scene *sc)
+{
+  return sc->coef[LW_TERM_BOUNDARY] * lw_term_boundary(s, &sc->quad, &sc->boundary);
+}
+
+const lw_term_type lw_term_types[LW_TERM_COUNT] = {
+  {LW_TERM_STRAIN, "strain", NULL},
+  {LW_TERM_BENDING, "bending", seg_bending},
+  {LW_TERM_POTENTIAL, "potential", seg_potential},
+  {LW_TERM_FIELD, "field", seg_field},
+  {LW_TERM_PAIR, "pair", NULL},
+  {LW_TERM_BOUNDARY, "boundary", seg_boundary},
+};
+
+int lw_term_find(const char *name)
+{
+  for (int t = 0; t < LW_TERM_COUNT; t++)
+    if (!strcmp(lw_term_types[t].name, name)) return t;
+  return -1;
+}

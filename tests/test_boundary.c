@@ -1,0 +1,381 @@
+/* test_boundary.c -- signed distance to rectangle, circle and polygon frames. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#include "linewise/boundary.h"
+#include "testutil.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static uint64_t rng_state;
+static void rng_seed(uint64_t s) { rng_state = s; }
+static double urand(double lo, double hi)
+{
+  uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return lo + (hi - lo) * ((double)(z >> 11) * 0x1.0p-53);
+}
+
+/* ---- brute force reference -------------------------------------------- */
+
+/* Points densely sampled on a boundary curve, no two consecutive ones more
+** than `spacing` apart along it.  The distance to the nearest sample is then
+** an upper bound of the true distance d and at most d + spacing/2 (the nearest
+** curve point lies within spacing/2 of a sample, along a chord), so the test
+** knows exactly how much slack it needs. */
+typedef struct {
+  size_t n;
+  double *x, *y;
+  double spacing;
+} samples;
+
+static void samples_free(samples *s)
+{
+  free(s->x);
+  free(s->y);
+}
+
+/* Samples the closed polyline through (px, py) with m points per edge. */
+static samples sample_polyline(size_t n, const double *px, const double *py, size_t m)
+{
+  samples s = {n * m, malloc(n * m * sizeof(double)), malloc(n * m * sizeof(double)), 0};
+  cr_assert(s.x && s.y);
+  for (size_t i = 0; i < n; i++) {
+    size_t j = (i + 1) % n;
+    double len = hypot(px[j] - px[i], py[j] - py[i]);
+    if (len / m > s.spacing) s.spacing = len / m;
+    for (size_t k = 0; k < m; k++) {
+      double t = (double)k / m;
+      s.x[i * m + k] = px[i] + t * (px[j] - px[i]);
+      s.y[i * m + k] = py[i] + t * (py[j] - py[i]);
+    }
+  }
+  return s;
+}
+
+static samples sample_circle(double cx, double cy, double r, size_t m)
+{
+  samples s = {m, malloc(m * sizeof(double)), malloc(m * sizeof(double)), 2 * M_PI * r / m};
+  cr_assert(s.x && s.y);
+  for (size_t k = 0; k < m; k++) {
+    s.x[k] = cx + r * cos(2 * M_PI * k / m);
+    s.y[k] = cy + r * sin(2 * M_PI * k / m);
+  }
+  return s;
+}
+
+static double nearest_sample(const samples *s, double x, double y)
+{
+  double best = INFINITY;
+  for (size_t k = 0; k < s->n; k++) {
+    double dx = x - s->x[k], dy = y - s->y[k], d2 = dx * dx + dy * dy;
+    if (d2 < best) best = d2;
+  }
+  return sqrt(best);
+}
+
+/* Inside test independent of the library's crossing count: the winding number
+** from summed angles (equal to even-odd for a simple polygon, either way
+** round). */
+static int winding_inside(size_t n, const double *px, const double *py, double x, double y)
+{
+  double sum = 0;
+  for (size_t i = 0; i < n; i++) {
+    size_t j = (i + 1) % n;
+    double ax = px[i] - x, ay = py[i] - y, bx = px[j] - x, by = py[j] - y;
+    sum += atan2(ax * by - ay * bx, ax * bx + ay * by);
+  }
+  return fabs(sum) > M_PI;
+}
+
+typedef int (*inside_fn)(const void *shape, double x, double y);
+
+/* Checks d(x, y) at `count` random points of the box [x0,x1] x [y0,y1]
+** against the samples (magnitude) and `inside` (sign). */
+static void check_against_brute(const lw_boundary *b, const samples *s, inside_fn inside,
+                                const void *shape, double x0, double y0, double x1, double y1,
+                                int count, const char *what)
+{
+  int n_in = 0, n_out = 0;
+  for (int k = 0; k < count; k++) {
+    double x = urand(x0, x1), y = urand(y0, y1);
+    double d = lw_boundary_distance(b, x, y), ref = nearest_sample(s, x, y);
+    cr_assert(!isnan(d), "%s: NaN at (%g, %g)", what, x, y);
+    cr_assert(fabs(d) <= ref + 1e-9 && fabs(d) >= ref - s->spacing / 2 - 1e-9,
+              "%s: |d| = %.12g, sampled %.12g (spacing %g) at (%.12g, %.12g)", what, fabs(d), ref,
+              s->spacing, x, y);
+    if (fabs(d) > 1e-9) {
+      int in = inside(shape, x, y);
+      cr_assert_eq(d < 0, in, "%s: sign of %.12g at (%.12g, %.12g), inside %d", what, d, x, y, in);
+      cr_assert_eq(lw_boundary_inside(b, x, y), in);
+      n_in += in;
+      n_out += !in;
+    }
+  }
+  /* the box must actually exercise both sides */
+  cr_assert(n_in > count / 20 && n_out > count / 20, "%s: %d inside, %d outside", what, n_in,
+            n_out);
+}
+
+typedef struct { double x0, y0, x1, y1; } rect;
+static int rect_in(const void *p, double x, double y)
+{
+  const rect *r = p;
+  return x > r->x0 && x < r->x1 && y > r->y0 && y < r->y1;
+}
+typedef struct { double cx, cy, r; } circ;
+static int circ_in(const void *p, double x, double y)
+{
+  const circ *c = p;
+  return (x - c->cx) * (x - c->cx) + (y - c->cy) * (y - c->cy) < c->r * c->r;
+}
+typedef struct { size_t n; const double *x, *y; } poly;
+static int poly_in(const void *p, double x, double y)
+{
+  const poly *q = p;
+  return winding_inside(q->n, q->x, q->y, x, y);
+}
+
+/* ---- tests --------------------------------------------------------------- */
+
+Test(boundary, rect_matches_brute_force_including_corners)
+{
+  rng_seed(0xb0de0001);
+  for (int trial = 0; trial < 5; trial++) {
+    rect r = {urand(-50, 50), urand(-50, 50), 0, 0};
+    r.x1 = r.x0 + urand(20, 200);
+    r.y1 = r.y0 + urand(20, 200);
+    lw_boundary b = {.kind = LW_BOUNDARY_RECT, .x0 = r.x0, .y0 = r.y0, .x1 = r.x1, .y1 = r.y1};
+    double px[4] = {r.x0, r.x1, r.x1, r.x0}, py[4] = {r.y0, r.y0, r.y1, r.y1};
+    samples s = sample_polyline(4, px, py, 4000);
+    double w = r.x1 - r.x0, h = r.y1 - r.y0;
+    check_against_brute(&b, &s, rect_in, &r, r.x0 - w, r.y0 - h, r.x1 + w, r.y1 + h, 1500,
+                        "rect");
+    samples_free(&s);
+
+    /* outside a corner the nearest point is the corner itself */
+    for (int k = 0; k < 50; k++) {
+      double dx = urand(1e-3, 50), dy = urand(1e-3, 50);
+      cr_assert(lw_close_rel(lw_boundary_distance(&b, r.x1 + dx, r.y0 - dy), hypot(dx, dy),
+                             1e-12, 1.0));
+      cr_assert(lw_close_rel(lw_boundary_distance(&b, r.x0 - dx, r.y1 + dy), hypot(dx, dy),
+                             1e-12, 1.0));
+    }
+    /* inside: the nearest side */
+    double x = urand(r.x0, r.x1), y = urand(r.y0, r.y1);
+    double want = -fmin(fmin(x - r.x0, r.x1 - x), fmin(y - r.y0, r.y1 - y));
+    cr_assert(lw_close_rel(lw_boundary_distance(&b, x, y), want, 1e-12, 1.0));
+    /* on the boundary: 0, and not inside */
+    cr_assert(lw_boundary_distance(&b, r.x0, y) == 0.0);
+    cr_assert(lw_boundary_distance(&b, r.x1, r.y1) == 0.0);
+    cr_assert(!lw_boundary_inside(&b, x, r.y1));
+  }
+}
+
+Test(boundary, circle_matches_brute_force)
+{
+  rng_seed(0xb0de0002);
+  for (int trial = 0; trial < 5; trial++) {
+    circ c = {urand(-50, 50), urand(-50, 50), urand(5, 100)};
+    lw_boundary b = {.kind = LW_BOUNDARY_CIRCLE, .cx = c.cx, .cy = c.cy, .radius = c.r};
+    samples s = sample_circle(c.cx, c.cy, c.r, 20000);
+    check_against_brute(&b, &s, circ_in, &c, c.cx - 2 * c.r, c.cy - 2 * c.r, c.cx + 2 * c.r,
+                        c.cy + 2 * c.r, 1500, "circle");
+    samples_free(&s);
+    cr_assert(lw_close_rel(lw_boundary_distance(&b, c.cx, c.cy), -c.r, 1e-15, 1.0));
+    double a = urand(0, 2 * M_PI), t = urand(0, 3 * c.r);
+    cr_assert(lw_close_rel(lw_boundary_distance(&b, c.cx + t * cos(a), c.cy + t * sin(a)),
+                           t - c.r, 1e-12, c.r));
+  }
+}
+
+Test(boundary, square_polygon_agrees_with_rect_either_orientation)
+{
+  rng_seed(0xb0de0003);
+  double x0 = urand(-20, 20), y0 = urand(-20, 20), x1 = x0 + urand(10, 100),
+         y1 = y0 + urand(10, 100);
+  lw_boundary r = {.kind = LW_BOUNDARY_RECT, .x0 = x0, .y0 = y0, .x1 = x1, .y1 = y1};
+  /* counter-clockwise and clockwise on a y-up page, starting at different corners */
+  double ccw_x[4] = {x0, x1, x1, x0}, ccw_y[4] = {y0, y0, y1, y1};
+  double cw_x[4] = {x1, x1, x0, x0}, cw_y[4] = {y0, y1, y1, y0};
+  lw_boundary p, q;
+  lw_error err;
+  cr_assert_eq(lw_boundary_polygon(&p, 4, ccw_x, ccw_y, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_boundary_polygon(&q, 4, cw_x, cw_y, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(p.kind, LW_BOUNDARY_POLYGON);
+  cr_assert_eq(p.n, 4);
+  cr_assert(p.vx != ccw_x, "vertices are copied");
+  double w = x1 - x0, h = y1 - y0;
+  for (int k = 0; k < 3000; k++) {
+    double x = urand(x0 - w, x1 + w), y = urand(y0 - h, y1 + h);
+    double dr = lw_boundary_distance(&r, x, y);
+    cr_assert(lw_close_rel(lw_boundary_distance(&p, x, y), dr, 1e-12, 1.0), "ccw at (%g, %g)",
+              x, y);
+    cr_assert(lw_close_rel(lw_boundary_distance(&q, x, y), dr, 1e-12, 1.0), "cw at (%g, %g)",
+              x, y);
+  }
+  lw_boundary_clear(&p);
+  lw_boundary_clear(&q);
+  cr_assert(p.vx == NULL && p.vy == NULL && p.n == 0);
+}
+
+Test(boundary, concave_l_shape)
+{
+  /* L: the unit square [1,2] x [1,2] cut out of [0,2]^2 */
+  double lx[6] = {0, 2, 2, 1, 1, 0}, ly[6] = {0, 0, 1, 1, 2, 2};
+  lw_boundary b;
+  cr_assert_eq(lw_boundary_polygon(&b, 6, lx, ly, NULL), LW_OK);
+  struct { double x, y, d; } known[] = {
+    {0.5, 0.5, -0.5},             /* inside, the corner block */
+    {1.5, 0.5, -0.5},             /* inside, one arm */
+    {0.5, 1.5, -0.5},             /* inside, the other arm */
+    {1.5, 1.5, 0.5},              /* in the notch: outside, midway between its edges */
+    {1.2, 1.7, 0.2},              /* in the notch, nearer the vertical notch edge */
+    {0.9, 0.9, -0.1 * 1.4142135623730951},   /* inside, nearest the reflex corner (1, 1) */
+    {3, 3, 2.2360679774997898},   /* nearest the convex corners (2, 1) and (1, 2): sqrt 5 */
+    {-1, -1, 1.4142135623730951},            /* beyond the corner (0, 0) */
+    {1, 1, 0},                    /* the reflex vertex itself */
+  };
+  for (size_t k = 0; k < sizeof known / sizeof known[0]; k++) {
+    double d = lw_boundary_distance(&b, known[k].x, known[k].y);
+    cr_assert(fabs(d - known[k].d) < 1e-14, "(%g, %g): %.17g, want %.17g", known[k].x,
+              known[k].y, d, known[k].d);
+  }
+  rng_seed(0xb0de0004);
+  poly shape = {6, lx, ly};
+  samples s = sample_polyline(6, lx, ly, 2000);
+  check_against_brute(&b, &s, poly_in, &shape, -1, -1, 3, 3, 2000, "L");
+  samples_free(&s);
+
+  /* the same L clockwise */
+  double rx[6], ry[6];
+  for (int k = 0; k < 6; k++) {
+    rx[k] = lx[5 - k];
+    ry[k] = ly[5 - k];
+  }
+  lw_boundary c;
+  cr_assert_eq(lw_boundary_polygon(&c, 6, rx, ry, NULL), LW_OK);
+  for (int k = 0; k < 2000; k++) {
+    double x = urand(-1, 3), y = urand(-1, 3);
+    cr_assert(lw_boundary_distance(&b, x, y) == lw_boundary_distance(&c, x, y) ||
+              lw_close_rel(lw_boundary_distance(&b, x, y), lw_boundary_distance(&c, x, y), 1e-14,
+                           1.0));
+  }
+  lw_boundary_clear(&b);
+  lw_boundary_clear(&c);
+}
+
+Test(boundary, random_star_polygons_match_brute_force)
+{
+  /* Star-shaped polygons (vertices at increasing angles, random radii) are
+  ** simple and strongly concave; checked both ways round. */
+  rng_seed(0xb0de0005);
+  for (int trial = 0; trial < 6; trial++) {
+    size_t n = 5 + (size_t)urand(0, 20);
+    double *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y);
+    double *rx = malloc(n * sizeof *rx), *ry = malloc(n * sizeof *ry);
+    cr_assert(x && y && rx && ry);
+    double cx = urand(-30, 30), cy = urand(-30, 30);
+    for (size_t k = 0; k < n; k++) {
+      double a = 2 * M_PI * (k + urand(0.1, 0.9)) / n, r = urand(10, 60);
+      x[k] = cx + r * cos(a);
+      y[k] = cy + r * sin(a);
+      rx[n - 1 - k] = x[k];
+      ry[n - 1 - k] = y[k];
+    }
+    lw_boundary b, c;
+    lw_error err;
+    cr_assert_eq(lw_boundary_polygon(&b, n, x, y, &err), LW_OK, "%s", err.msg);
+    cr_assert_eq(lw_boundary_polygon(&c, n, rx, ry, &err), LW_OK, "%s", err.msg);
+    poly shape = {n, x, y};
+    samples s = sample_polyline(n, x, y, 1000);
+    check_against_brute(&b, &s, poly_in, &shape, cx - 70, cy - 70, cx + 70, cy + 70, 1000,
+                        "star");
+    check_against_brute(&c, &s, poly_in, &shape, cx - 70, cy - 70, cx + 70, cy + 70, 1000,
+                        "star reversed");
+    samples_free(&s);
+    for (size_t k = 0; k < n; k++)
+      cr_assert(lw_boundary_distance(&b, x[k], y[k]) == 0.0, "vertex %zu on the boundary", k);
+    lw_boundary_clear(&b);
+    lw_boundary_clear(&c);
+    free(x);
+    free(y);
+    free(rx);
+    free(ry);
+  }
+}
+
+Test(boundary, invalid_polygons_rejected)
+{
+  double x3[3] = {0, 1, 0}, y3[3] = {0, 0, 1};
+  double colx[4] = {0, 1, 2, 3}, coly[4] = {0, 0.5, 1, 1.5};     /* collinear */
+  double samex[3] = {2, 2, 2}, samey[3] = {5, 5, 5};             /* one point */
+  double nanx[3] = {0, NAN, 0}, infy[3] = {0, 0, INFINITY};
+  /* on y = 3x, but the shoelace sum leaves a rounding residue of ~1e-17 */
+  double rndx[4] = {0.1, 0.7, 0.3, 1.3}, rndy[4] = {0.3, 2.1, 0.9, 3.9};
+  double backx[4] = {0, 1, 1, 0}, backy[4] = {0, 0, 0, 0};       /* there and back */
+  struct { size_t n; const double *x, *y; } bad[] = {
+    {0, x3, y3}, {2, x3, y3}, {4, colx, coly}, {3, samex, samey},
+    {3, nanx, y3}, {3, x3, infy}, {4, backx, backy}, {3, NULL, y3}, {4, rndx, rndy},
+  };
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+    lw_boundary b = {.kind = LW_BOUNDARY_RECT, .x1 = 7, .y1 = 7};
+    lw_error err;
+    lw_error_clear(&err);
+    cr_assert_eq(lw_boundary_polygon(&b, bad[k].n, bad[k].x, bad[k].y, &err), LW_EINPUT,
+                 "case %zu", k);
+    cr_assert_eq(err.code, LW_EINPUT);
+    cr_assert(err.msg[0] != '\0', "case %zu has a message", k);
+    cr_assert(b.kind == LW_BOUNDARY_RECT && b.x1 == 7 && b.vx == NULL, "case %zu: b untouched",
+              k);
+  }
+  /* the valid triangle, and NULL err */
+  lw_boundary b;
+  cr_assert_eq(lw_boundary_polygon(&b, 3, x3, y3, NULL), LW_OK);
+  cr_assert(fabs(lw_boundary_distance(&b, 0.25, 0.25) + 0.25) < 1e-15);
+  cr_assert(fabs(lw_boundary_distance(&b, 1, 1) - 0.70710678118654752) < 1e-15);
+  lw_boundary_clear(&b);
+  cr_assert_eq(lw_boundary_polygon(&b, 2, x3, y3, NULL), LW_EINPUT);
+}
+
+Test(boundary, none_is_minus_infinity)
+{
+  lw_boundary b = {.kind = LW_BOUNDARY_NONE};
+  rng_seed(0xb0de0006);
+  for (int k = 0; k < 100; k++) {
+    double d = lw_boundary_distance(&b, urand(-1e6, 1e6), urand(-1e6, 1e6));
+    cr_assert(isinf(d) && d < 0);
+  }
+  cr_assert(isinf(lw_boundary_distance(&b, NAN, 0)) && lw_boundary_distance(&b, NAN, 0) < 0);
+  cr_assert(lw_boundary_inside(&b, 1e300, -1e300));
+}
+
+Test(boundary, non_finite_points_are_outside_not_nan)
+{
+  double px[5] = {0, 4, 4, 2, 0}, py[5] = {0, 0, 3, 1, 3};
+  lw_boundary poly_b;
+  cr_assert_eq(lw_boundary_polygon(&poly_b, 5, px, py, NULL), LW_OK);
+  lw_boundary shapes[3] = {
+    {.kind = LW_BOUNDARY_RECT, .x0 = 0, .y0 = 0, .x1 = 10, .y1 = 5},
+    {.kind = LW_BOUNDARY_CIRCLE, .cx = 1, .cy = 2, .radius = 3},
+    poly_b,
+  };
+  double pts[][2] = {{NAN, 1}, {1, NAN}, {NAN, NAN}, {INFINITY, 1}, {1, -INFINITY},
+                     {-INFINITY, INFINITY}};
+  for (int s = 0; s < 3; s++)
+    for (size_t k = 0; k < sizeof pts / sizeof pts[0]; k++) {
+      double d = lw_boundary_distance(&shapes[s], pts[k][0], pts[k][1]);
+      cr_assert(isinf(d) && d > 0, "shape %d point %zu gives %g", s, k, d);
+      cr_assert(!lw_boundary_inside(&shapes[s], pts[k][0], pts[k][1]));
+    }
+  lw_boundary_clear(&poly_b);
+  /* a cleared polygon has no inside */
+  cr_assert(isinf(lw_boundary_distance(&poly_b, 1, 0.5)));
+  lw_boundary_clear(&poly_b);
+}

@@ -1,0 +1,362 @@
+/*
+** test_terms.c -- every energy term against closed forms, quadrature
+** convergence, finite-difference checks and degenerate input.
+*/
+#include <criterion/criterion.h>
+#include <gsl/gsl_rng.h>
+#include <math.h>
+
+#include "linewise/model.h"
+#include "linewise/scene.h"
+#include "linewise/terms.h"
+#include "testutil.h"
+
+static lw_splines *splines(size_t n, size_t segs)
+{
+  size_t s[64];
+  for (size_t i = 0; i < n; i++) s[i] = segs;
+  lw_splines *sp = lw_splines_new(n, s, NULL);
+  cr_assert_not_null(sp);
+  return sp;
+}
+
+/* A 100 x 100 mm page with a rect boundary at margin 0 and only what is set. */
+static void scene_with(lw_scene *sc, lw_params *p)
+{
+  lw_error err;
+  cr_assert_eq(lw_scene_init(sc, p, &err), LW_OK, "%s", err.msg);
+}
+
+static lw_params base_params(void)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = p.height = 100;
+  p.margin = 0;
+  return p;
+}
+
+static double samples_of(const lw_quad *q, const lw_splines *sp, size_t g, lw_samples *s)
+{
+  const lw_node *a = &sp->node[lw_segment_node(sp, g)];
+  lw_segment_sample(q, a, a + 1, s);
+  return s->length;
+}
+
+static double spline_length(const lw_quad *q, const lw_splines *sp)
+{
+  lw_samples s;
+  double L = 0;
+  for (size_t g = 0; g < sp->n_segments; g++) L += samples_of(q, sp, g, &s);
+  return L;
+}
+
+/* A random wiggly spline: points on a noisy line, random vectors. */
+static void wiggly(lw_splines *sp, size_t i, gsl_rng *r, double x0, double y0)
+{
+  size_t n = lw_splines_segments(sp, i);
+  lw_node *nd = &sp->node[sp->first[i]];
+  for (size_t k = 0; k <= n; k++)
+    nd[k] = (lw_node){x0 + 6.0 * k + gsl_rng_uniform(r), y0 + 2.0 * gsl_rng_uniform(r),
+                      1.0 + gsl_rng_uniform(r), gsl_rng_uniform(r) - 0.5};
+  sp->rest_length[i] = 6.0 * n;
+}
+
+Test(terms, straight_length_exact_and_bending_zero)
+{
+  lw_quad q;
+  lw_quad_init(&q, 3, NULL);
+  lw_splines *sp = splines(1, 5);
+  lw_test_straight(sp, 0, 1.5, -2.25, 31.7, 13.1);
+  /* non-uniform speed along the line: still straight, |r'| a polynomial */
+  sp->node[2].vx *= 2.5;
+  sp->node[2].vy *= 2.5;
+  double L = hypot(31.7 - 1.5, 13.1 + 2.25);
+  cr_assert(lw_close_rel(spline_length(&q, sp), L, 1e-14, 1), "length %.17g vs %.17g", spline_length(&q, sp), L);
+  lw_samples s;
+  for (size_t g = 0; g < sp->n_segments; g++) {
+    samples_of(&q, sp, g, &s);
+    cr_assert(fabs(lw_term_bending(&s, &q)) < 1e-25, "bending %g", lw_term_bending(&s, &q));
+  }
+  cr_assert(fabs(lw_term_strain(L, L) - 0) < 1e-30);
+  cr_assert(lw_close_rel(lw_term_strain(2 * L, L), 2 * L, 1e-15, 0));
+  lw_splines_free(sp);
+}
+
+Test(terms, strain_derivative_is_the_corrected_seed_formula)
+{
+  /* d/dL [(L-L0)^2/L0^2 L] = (L-L0)(3L-L0)/L0^2 ; the seed's (2+L-L0) is a slip. */
+  const double L0 = 7.3;
+  for (double L = 1.0; L < 20; L += 1.7) {
+    double h = 1e-5, fd = (lw_term_strain(L + h, L0) - lw_term_strain(L - h, L0)) / (2 * h);
+    double exact = (L - L0) * (3 * L - L0) / (L0 * L0);
+    cr_assert(fabs(fd - exact) < 1e-7 * fmax(1, fabs(exact)), "L=%g fd %g exact %g", L, fd, exact);
+  }
+}
+
+Test(terms, constant_field_integral_is_exact_for_any_shape)
+{
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 11);
+  lw_params p = base_params();
+  p.field_coef = -2.5;
+  p.field_mode = LW_FIELDMODE_SIGNED;
+  p.field_angle = 33;
+  p.quadrature = 2;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  lw_splines *sp = splines(1, 7);
+  wiggly(sp, 0, r, 10, 40);
+  double vx = cos(33 * M_PI / 180), vy = sin(33 * M_PI / 180);
+  const lw_node *a = &sp->node[0], *b = &sp->node[7];
+  double exact = -2.5 * (vx * (b->px - a->px) + vy * (b->py - a->py));
+  double term[LW_TERM_COUNT];
+  double total = lw_energy_compute(&sc, sp, term, NULL);
+  cr_assert(lw_close_rel(term[LW_TERM_FIELD], exact, 1e-13, 1), "%.17g vs %.17g", term[LW_TERM_FIELD], exact);
+  cr_assert_eq(total, term[LW_TERM_FIELD]);
+  lw_splines_free(sp);
+  lw_scene_clear(&sc);
+  gsl_rng_free(r);
+}
+
+Test(terms, potential_constant_and_linear_against_exact_integrals)
+{
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 5);
+  /* constant Phi: Q Phi L for any shape (L from a 64-node reference) */
+  lw_params p = base_params();
+  p.potential_coef = 1.75;
+  p.potential = LW_POT_CONSTANT;
+  p.potential_value = 0.6;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  lw_splines *sp = splines(2, 6);
+  wiggly(sp, 0, r, 5, 20);
+  wiggly(sp, 1, r, 5, 60);
+  lw_quad q64;
+  lw_quad_init(&q64, 64, NULL);
+  double term[LW_TERM_COUNT];
+  lw_energy_compute(&sc, sp, term, NULL);
+  double L8 = spline_length(&sc.quad, sp);
+  cr_assert(lw_close_rel(term[LW_TERM_POTENTIAL], 1.75 * 0.6 * L8, 1e-14, 0));
+  cr_assert(lw_close_rel(L8, spline_length(&q64, sp), 1e-6, 0), "8-node length within 1e-6");
+  lw_scene_clear(&sc);
+
+  /* ramp: Phi linear in r; along a straight line the integral is L Phi(midpoint) */
+  p.potential = LW_POT_RAMP;
+  p.potential_angle = 20;
+  p.quadrature = 3;
+  scene_with(&sc, &p);
+  lw_test_straight(sp, 0, 12, 17, 71, 40);
+  lw_test_straight(sp, 1, 80, 5, 20, 95);
+  sp->node[3].vx *= 1.7; /* uneven speed along the line keeps the integrand polynomial */
+  sp->node[3].vy *= 1.7;
+  lw_energy_compute(&sc, sp, term, NULL);
+  double exact = 0;
+  double mids[2][2] = {{(12 + 71) / 2.0, (17 + 40) / 2.0}, {50, 50}};
+  double lens[2] = {hypot(59, 23), hypot(60, 90)};
+  for (int i = 0; i < 2; i++) exact += 1.75 * lens[i] * lw_potential_eval(&sc.potential, mids[i][0], mids[i][1]);
+  cr_assert(lw_close_rel(term[LW_TERM_POTENTIAL], exact, 1e-13, 0), "%.17g vs %.17g", term[LW_TERM_POTENTIAL], exact);
+  lw_splines_free(sp);
+  lw_scene_clear(&sc);
+  gsl_rng_free(r);
+}
+
+/* Bending of the n-segment Bezier circle of radius R with a given quadrature. */
+static double circle_bending(int segs, int nodes, double R)
+{
+  lw_quad q;
+  lw_quad_init(&q, nodes, NULL);
+  lw_splines *sp = splines(1, (size_t)segs);
+  lw_test_circle(sp, 0, 0, 0, R);
+  lw_samples s;
+  double b = 0;
+  for (size_t g = 0; g < sp->n_segments; g++) {
+    samples_of(&q, sp, g, &s);
+    b += lw_term_bending(&s, &q);
+  }
+  lw_splines_free(sp);
+  return b;
+}
+
+Test(terms, bending_of_bezier_circles_converges_to_two_pi_over_r)
+{
+  const double R = 3.7, exact = 2 * M_PI / R;
+  double prev = INFINITY;
+  for (int segs = 4; segs <= 64; segs *= 2) {
+    double err = fabs(circle_bending(segs, 64, R) - exact) / exact;
+    /* the standard handle length leaves a radial error ~ theta^6, so the
+    ** curvature error falls by ~ 2^4 or more per doubling */
+    cr_assert(err < prev / 8, "segments %d: error %g after %g", segs, err, prev);
+    prev = err;
+  }
+  cr_assert(prev < 1e-7, "64 segments: %g", prev);
+}
+
+Test(terms, bending_quadrature_error_falls_with_nodes)
+{
+  /* 4-segment circle: the integrand is smooth, so Gauss-Legendre converges
+  ** geometrically; against the 64-node value. */
+  const double R = 2.0, ref = circle_bending(4, 64, R);
+  double e[5];
+  int nodes[5] = {2, 4, 8, 16, 24};
+  for (int i = 0; i < 5; i++) e[i] = fabs(circle_bending(4, nodes[i], R) - ref) / ref;
+  for (int i = 1; i < 5; i++) cr_assert(e[i] < e[i - 1] || e[i] < 1e-14, "n=%d err %g, n=%d err %g", nodes[i - 1], e[i - 1], nodes[i], e[i]);
+  cr_assert(e[2] < 1e-4, "8 nodes: %g", e[2]);
+  cr_assert(e[3] < 1e-9, "16 nodes: %g", e[3]);
+}
+
+Test(terms, boundary_parallel_to_a_wall_and_outside)
+{
+  lw_params p = base_params();
+  p.boundary_coef = 0.5;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  lw_splines *sp = splines(1, 3);
+  lw_test_straight(sp, 0, 40, 2.5, 62, 2.5); /* 2.5 mm from y = 0, far from the others */
+  double term[LW_TERM_COUNT];
+  lw_energy_compute(&sc, sp, term, NULL);
+  cr_assert(lw_close_rel(term[LW_TERM_BOUNDARY], 0.5 * 22 / (2.5 * 2.5), 1e-14, 0), "%.17g", term[LW_TERM_BOUNDARY]);
+  lw_test_straight(sp, 0, 40, 2.5, 62, -0.001);
+  lw_energy_compute(&sc, sp, term, NULL);
+  cr_assert(isinf(term[LW_TERM_BOUNDARY]) && term[LW_TERM_BOUNDARY] > 0);
+  /* a zero-speed sample outside is still +inf, not 0 * inf = NaN */
+  for (int k = 0; k < 4; k++) sp->node[k] = (lw_node){-5, -5, 0, 0};
+  lw_energy_compute(&sc, sp, term, NULL);
+  cr_assert(isinf(term[LW_TERM_BOUNDARY]) && term[LW_TERM_BOUNDARY] > 0);
+  lw_splines_free(sp);
+  lw_scene_clear(&sc);
+}
+
+static lw_params all_terms(void)
+{
+  lw_params p = base_params();
+  p.strain = 3;
+  p.bending = 0.7;
+  p.potential_coef = 0.4;
+  p.potential = LW_POT_RADIAL;
+  p.field_coef = -0.3;
+  p.field = LW_FLD_VORTEX;
+  p.pair = 0.05;
+  p.pair_cutoff = 8;
+  p.boundary_coef = 0.2;
+  return p;
+}
+
+Test(terms, degenerate_input_never_gives_nan)
+{
+  lw_params p = all_terms();
+  lw_scene sc;
+  scene_with(&sc, &p);
+  lw_splines *sp = splines(3, 3);
+  /* coincident control points everywhere (a zero-length spline) */
+  for (int k = 0; k < 4; k++) sp->node[k] = (lw_node){50, 50, 0, 0};
+  /* a cusp: r' = 0 inside a segment (v0 = -v1 with p0 = p1) */
+  lw_test_straight(sp, 1, 20, 20, 40, 20);
+  sp->node[5] = sp->node[4];
+  sp->node[5].vx = -sp->node[4].vx;
+  sp->node[5].vy = -sp->node[4].vy;
+  /* coincident nodes with non-zero vectors: a loop */
+  lw_test_straight(sp, 2, 20, 70, 60, 70);
+  sp->node[9] = (lw_node){sp->node[8].px, sp->node[8].py, 5, 5};
+  sp->node[10].vx = 5;
+  sp->node[10].vy = -5;
+  double term[LW_TERM_COUNT];
+  double total = lw_energy_compute(&sc, sp, term, NULL);
+  for (int t = 0; t < LW_TERM_COUNT; t++) cr_assert(!isnan(term[t]), "term %s is NaN", lw_term_types[t].name);
+  cr_assert(!isnan(total));
+  cr_assert(term[LW_TERM_BENDING] >= 0);
+  lw_splines_free(sp);
+  lw_scene_clear(&sc);
+}
+
+Test(terms, local_energy_change_equals_full_recomputation_for_every_dof)
+{
+  /* What the annealer relies on: moving any one point or vector changes the
+  ** running total by exactly the full-recomputation difference. */
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 99);
+  lw_params p = all_terms();
+  p.strain_mode = LW_STRAIN_SEGMENT;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  for (int mode = 0; mode < 2; mode++) {
+    sc.strain_per_segment = mode;
+    lw_splines *sp = splines(3, 4);
+    wiggly(sp, 0, r, 20, 30);
+    wiggly(sp, 1, r, 22, 33);
+    wiggly(sp, 2, r, 25, 36);
+    lw_model *m = lw_model_new(&sc, sp, NULL);
+    cr_assert_not_null(m);
+    lw_proposal *pr = lw_proposal_new(m, NULL);
+    double term0[LW_TERM_COUNT], term1[LW_TERM_COUNT];
+    double e0 = lw_energy_compute(&sc, m->sp, term0, NULL);
+    cr_assert(lw_close_rel(lw_model_total(m), e0, 1e-13, 1));
+    for (uint32_t i = 0; i < 3; i++)
+      for (size_t k = 0; k <= 4; k++)
+        for (int which = 0; which < 4; which++) {
+          lw_node nd = m->sp->node[m->sp->first[i] + k];
+          double h = 1e-3 * (1 + gsl_rng_uniform(r));
+          double *c = which == 0 ? &nd.px : which == 1 ? &nd.py : which == 2 ? &nd.vx : &nd.vy;
+          *c += h;
+          lw_model_propose(m, pr, i, k, 1, &nd);
+          /* full recomputation of the moved state */
+          lw_splines *moved = lw_splines_clone(m->sp);
+          moved->node[moved->first[i] + k] = nd;
+          double e1 = lw_energy_compute(&sc, moved, term1, NULL);
+          for (int t = 0; t < LW_TERM_COUNT; t++) {
+            double d = term1[t] - term0[t];
+            cr_assert(fabs(pr->dterm[t] - d) <= 1e-9 * fmax(fabs(term0[t]), 1e-3),
+                      "spline %u node %zu dof %d term %s: local %.17g full %.17g", i, k, which,
+                      lw_term_types[t].name, pr->dterm[t], d);
+          }
+          cr_assert(fabs(pr->dE - (e1 - e0)) <= 1e-9 * fmax(fabs(e0), 1));
+          /* and a smooth energy: dE/h agrees between h and h/2 to first order */
+          lw_splines_free(moved);
+        }
+    lw_proposal_free(pr);
+    lw_model_free(m);
+  }
+  lw_scene_clear(&sc);
+  gsl_rng_free(r);
+}
+
+Test(terms, energy_is_differentiable_in_every_dof)
+{
+  /* Central differences of the local dE at h and h/2 agree to O(h^2): the
+  ** energy is smooth in each point and vector away from the near-field and
+  ** cutoff switches (the pair term is off here so no switch is crossed). */
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 7);
+  lw_params p = all_terms();
+  p.pair = 0;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  lw_splines *sp = splines(2, 3);
+  wiggly(sp, 0, r, 20, 30);
+  wiggly(sp, 1, r, 20, 60);
+  lw_model *m = lw_model_new(&sc, sp, NULL);
+  lw_proposal *pr = lw_proposal_new(m, NULL);
+  for (uint32_t i = 0; i < 2; i++)
+    for (size_t k = 0; k <= 3; k++)
+      for (int which = 0; which < 4; which++) {
+        double slope[2];
+        for (int level = 0; level < 2; level++) {
+          double h = level ? 5e-5 : 1e-4, de[2];
+          for (int sgn = 0; sgn < 2; sgn++) {
+            lw_node nd = m->sp->node[m->sp->first[i] + k];
+            double *c = which == 0 ? &nd.px : which == 1 ? &nd.py : which == 2 ? &nd.vx : &nd.vy;
+            *c += sgn ? -h : h;
+            lw_model_propose(m, pr, i, k, 1, &nd);
+            de[sgn] = pr->dE;
+          }
+          slope[level] = (de[0] - de[1]) / (2 * h);
+        }
+        cr_assert(fabs(slope[0] - slope[1]) <= 1e-5 * fmax(fabs(slope[1]), 1),
+                  "spline %u node %zu dof %d: %.12g vs %.12g", i, k, which, slope[0], slope[1]);
+      }
+  lw_proposal_free(pr);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+  gsl_rng_free(r);
+}
