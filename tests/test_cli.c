@@ -1,0 +1,160 @@
+/*
+** test_cli.c -- the command line as users and scripts see it: outputs,
+** exit codes and messages.  Runs the binary named by $LW_BIN (make test
+** sets it).
+*/
+#include <criterion/criterion.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "linewise/model.h"
+#include "linewise/state.h"
+#include "testutil.h"
+
+static char dir[64];
+
+static void make_dir(void)
+{
+  strcpy(dir, "/tmp/lw_cli_XXXXXX");
+  cr_assert_not_null(mkdtemp(dir));
+}
+
+static void remove_dir(void)
+{
+  char cmd[128];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+  cr_assert_eq(system(cmd), 0);
+}
+
+TestSuite(cli, .init = make_dir, .fini = remove_dir);
+
+static const char *bin(void)
+{
+  const char *b = getenv("LW_BIN");
+  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
+  return b;
+}
+
+/* Runs "linewise <args>" capturing stdout and stderr; returns the exit status. */
+static int run(const char *args, char *out, size_t nout, char *errs, size_t nerr)
+{
+  char cmd[1024];
+  snprintf(cmd, sizeof cmd, "%s %s >%s/out.txt 2>%s/err.txt", bin(), args, dir, dir);
+  int st = system(cmd);
+  char path[128];
+  FILE *f;
+  snprintf(path, sizeof path, "%s/out.txt", dir);
+  f = fopen(path, "r");
+  size_t n = fread(out, 1, nout - 1, f);
+  out[n] = '\0';
+  fclose(f);
+  snprintf(path, sizeof path, "%s/err.txt", dir);
+  f = fopen(path, "r");
+  n = fread(errs, 1, nerr - 1, f);
+  errs[n] = '\0';
+  fclose(f);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static void write_file(const char *name, const char *text)
+{
+  char path[128];
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  FILE *f = fopen(path, "w");
+  fputs(text, f);
+  fclose(f);
+}
+
+static const char scene_text[] =
+  "[scene]\nwidth = 100\nheight = 80\nmargin = 5\npotential = ramp\nfield = waves\n"
+  "[energy]\nstrain = 2\nbending = 0.5\npotential = 0.3\nfield = -0.2\npair = 0.01\nboundary = 0.1\n";
+
+Test(cli, energy_prints_each_enabled_term_and_the_total)
+{
+  write_file("scene.ini", scene_text);
+  size_t segs[2] = {3, 2};
+  lw_state st = {"scene.ini", 7, 0, lw_splines_new(2, segs, NULL)};
+  lw_test_straight(st.sp, 0, 20, 20, 70, 30);
+  lw_test_circle(st.sp, 1, 50, 45, 12);
+  char path[128];
+  snprintf(path, sizeof path, "%s/state.lw", dir);
+  cr_assert_eq(lw_state_write(&st, path, NULL), LW_OK);
+
+  char out[4096], errs[4096];
+  char args[128];
+  snprintf(args, sizeof args, "energy %s", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "stderr: %s", errs);
+
+  /* the same numbers in-process */
+  lw_params p;
+  lw_scene sc;
+  snprintf(path, sizeof path, "%s/scene.ini", dir);
+  cr_assert_eq(lw_params_read(&p, path, NULL), LW_OK);
+  cr_assert_eq(lw_scene_init(&sc, &p, NULL), LW_OK);
+  double term[LW_TERM_COUNT];
+  double total = lw_energy_compute(&sc, st.sp, term, NULL);
+  const char *names[] = {"strain", "bending", "potential", "field", "pair", "boundary", "total"};
+  char *line = strtok(out, "\n");
+  for (int t = 0; t < 7; t++) {
+    cr_assert_not_null(line, "missing line for %s", names[t]);
+    char name[32];
+    double v;
+    cr_assert_eq(sscanf(line, "%31s %lf", name, &v), 2, "line '%s'", line);
+    cr_assert_str_eq(name, names[t]);
+    double want = t < 6 ? term[t] : total;
+    cr_assert(isfinite(v) && v == want, "%s: printed %.17g, computed %.17g", name, v, want);
+    line = strtok(NULL, "\n");
+  }
+  cr_assert_null(line, "extra output");
+  lw_scene_clear(&sc);
+  lw_state_clear(&st);
+}
+
+Test(cli, energy_lists_only_enabled_terms)
+{
+  write_file("scene.ini", "[energy]\nbending = 1\n");
+  write_file("state.lw", "linewise-state 1\nscene scene.ini\nseed 1\nsweep 0\nsplines 1\nspline 1 3\n"
+                         "10 10 1 0\n20 10 1 0\nend\n");
+  char out[1024], errs[1024], args[128];
+  snprintf(args, sizeof args, "energy %s", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert_str_eq(out, "bending 0\ntotal 0\n");
+}
+
+Test(cli, bad_input_exits_2_with_one_message)
+{
+  char out[1024], errs[1024], args[128];
+  /* no state file */
+  snprintf(args, sizeof args, "energy %s", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "state.lw"), "%s", errs);
+  cr_assert_str_eq(out, "");
+  /* a bad key in the scene the state names */
+  write_file("state.lw", "linewise-state 1\nscene scene.ini\nseed 1\nsweep 0\nsplines 0\nend\n");
+  write_file("scene.ini", "[energy]\nbending = 1\nstrain = lots\n");
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "scene.ini:3") && strstr(errs, "energy.strain"), "%s", errs);
+  cr_assert_eq(strchr(errs, '\n'), errs + strlen(errs) - 1, "one line: %s", errs);
+  cr_assert_str_eq(out, "");
+  /* a malformed state */
+  write_file("state.lw", "linewise-state 1\nscene scene.ini\nseed x\n");
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "state.lw:3") && strstr(errs, "seed"), "%s", errs);
+  /* usage */
+  cr_assert_eq(run("energy", out, sizeof out, errs, sizeof errs), 2);
+  cr_assert_eq(run("frobnicate", out, sizeof out, errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "frobnicate"));
+}
+
+Test(cli, empty_scene_has_zero_energy)
+{
+  write_file("scene.ini", "[energy]\npair = 1\nboundary = 1\n");
+  write_file("state.lw", "linewise-state 1\nscene scene.ini\nseed 1\nsweep 0\nsplines 0\nend\n");
+  char out[1024], errs[1024], args[128];
+  snprintf(args, sizeof args, "energy %s", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert_str_eq(out, "pair 0\nboundary 0\ntotal 0\n");
+}

@@ -1,0 +1,159 @@
+/* test_params.c -- the parameter table, INI reading, overrides and errors. */
+#include <criterion/criterion.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "linewise/params.h"
+#include "linewise/scene.h"
+
+/* Writes text to a fresh temporary file; returns its path (static buffer). */
+static const char *ini(const char *text)
+{
+  static char path[64];
+  strcpy(path, "/tmp/lw_params_XXXXXX");
+  int fd = mkstemp(path);
+  cr_assert(fd >= 0);
+  FILE *f = fdopen(fd, "w");
+  fputs(text, f);
+  fclose(f);
+  return path;
+}
+
+static lw_status read_text(const char *text, lw_params *p, lw_error *err)
+{
+  const char *path = ini(text);
+  lw_status s = lw_params_read(p, path, err);
+  unlink(path);
+  return s;
+}
+
+Test(params, defaults_cover_every_key_and_read_back)
+{
+  lw_params p, q;
+  lw_params_defaults(&p);
+  cr_assert_eq(p.quadrature, 8);
+  cr_assert_eq(p.width, 210);
+  /* write every value and read it back */
+  char path[] = "/tmp/lw_params_rt_XXXXXX";
+  int fd = mkstemp(path);
+  FILE *f = fdopen(fd, "w");
+  p.pair = 0.125;
+  p.field = LW_FLD_WAVES;
+  strcpy(p.polygon, "1 2 3 4 5 6");
+  cr_assert_eq(lw_params_write(&p, f), 0);
+  fclose(f);
+  lw_error err;
+  cr_assert_eq(lw_params_read(&q, path, &err), LW_OK, "%s", err.msg);
+  unlink(path);
+  for (size_t i = 0; i < lw_param_count; i++) {
+    const lw_param_def *d = &lw_param_table[i];
+    const char *a = (const char *)&p + d->offset, *b = (const char *)&q + d->offset;
+    size_t n = d->type == LW_PT_DOUBLE ? sizeof(double) : d->type == LW_PT_STRING ? LW_PATH_MAX : sizeof(int);
+    cr_assert(!memcmp(a, b, n), "%s.%s differs after a round trip", d->section, d->key);
+  }
+}
+
+Test(params, reads_values_and_records_lines)
+{
+  lw_params p;
+  lw_error err;
+  cr_assert_eq(read_text("; a comment\n[scene]\nwidth = 120\n\n[energy]\npair = 0.5 ; inline\nquadrature=12\n", &p, &err),
+               LW_OK, "%s", err.msg);
+  cr_assert_eq(p.width, 120);
+  cr_assert_eq(p.pair, 0.5);
+  cr_assert_eq(p.quadrature, 12);
+  const lw_param_def *d = lw_params_find("energy", "quadrature");
+  char where[1100];
+  lw_params_origin(&p, d, where, sizeof where);
+  cr_assert(strstr(where, ":7"), "origin %s names line 7", where);
+}
+
+static void expect_error(const char *text, const char *line, const char *key, const char *expected)
+{
+  lw_params p;
+  lw_error err;
+  lw_error_clear(&err);
+  cr_assert_eq(read_text(text, &p, &err), LW_EINPUT, "accepted: %s", text);
+  cr_assert(strstr(err.msg, line), "message '%s' lacks line '%s'", err.msg, line);
+  if (key) cr_assert(strstr(err.msg, key), "message '%s' lacks key '%s'", err.msg, key);
+  if (expected) cr_assert(strstr(err.msg, expected), "message '%s' lacks '%s'", err.msg, expected);
+}
+
+Test(params, bad_input_names_file_line_and_key)
+{
+  expect_error("[scene]\nwidth = 100\nwidht = 3\n", ":3:", "scene.widht", "not a parameter");
+  expect_error("[scenery]\nwidth = 100\n", ":2:", "[scenery]", "unknown section");
+  expect_error("[energy]\npair = -1\n", ":2:", "energy.pair", ">= 0");
+  expect_error("[energy]\n\n\nquadrature = 65\n", ":4:", "energy.quadrature", "<= 64");
+  expect_error("[energy]\nquadrature = 8.5\n", ":2:", "energy.quadrature", "whole number");
+  expect_error("[energy]\nbending = abc\n", ":2:", "energy.bending", "number");
+  expect_error("[energy]\nbending = nan\n", ":2:", "energy.bending", "number");
+  expect_error("[scene]\nboundary = hexagon\n", ":2:", "scene.boundary", "rect|circle|polygon");
+  expect_error("[scene]\nwidth = 1\nwidth = 2\n", ":3:", "scene.width", "repeated");
+  expect_error("[scene]\nthis line has no equals sign\n", ":2:", NULL, "syntax");
+  expect_error("[scene\nwidth = 1\n", ":1:", NULL, "syntax");
+}
+
+Test(params, missing_file_is_input_error)
+{
+  lw_params p;
+  lw_error err;
+  cr_assert_eq(lw_params_read(&p, "/nonexistent/scene.ini", &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "/nonexistent/scene.ini"));
+}
+
+Test(params, set_overrides)
+{
+  lw_params p;
+  lw_error err;
+  lw_params_defaults(&p);
+  cr_assert_eq(lw_params_set(&p, "energy.bending=2.5", &err), LW_OK);
+  cr_assert_eq(p.bending, 2.5);
+  cr_assert_eq(lw_params_set(&p, "scene.field=vortex", &err), LW_OK);
+  cr_assert_eq(p.field, LW_FLD_VORTEX);
+  cr_assert_eq(lw_params_set(&p, "energy.bendin=2", &err), LW_EUSAGE);
+  cr_assert(strstr(err.msg, "energy.bendin"));
+  cr_assert_eq(lw_params_set(&p, "energy.bending", &err), LW_EUSAGE);
+  cr_assert_eq(lw_params_set(&p, "energy.bending=-3", &err), LW_EUSAGE);
+  cr_assert(strstr(err.msg, ">= 0"));
+  const lw_param_def *d = lw_params_find("energy", "bending");
+  char where[64];
+  lw_params_origin(&p, d, where, sizeof where);
+  cr_assert_str_eq(where, "--set");
+}
+
+Test(params, scene_builds_only_what_is_named)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  lw_scene sc;
+  cr_assert_eq(lw_scene_init(&sc, &p, NULL), LW_OK);
+  for (int t = 0; t < LW_TERM_COUNT; t++) cr_assert(!sc.on[t], "term %d on by default", t);
+  cr_assert_eq(sc.n_local, 0);
+  lw_scene_clear(&sc);
+  p.bending = 1;
+  p.boundary_coef = 2;
+  cr_assert_eq(lw_scene_init(&sc, &p, NULL), LW_OK);
+  cr_assert_eq(sc.n_local, 2);
+  cr_assert_eq(sc.local[0], LW_TERM_BENDING);
+  cr_assert_eq(sc.local[1], LW_TERM_BOUNDARY);
+  cr_assert(!sc.on[LW_TERM_PAIR] && !sc.on[LW_TERM_POTENTIAL] && !sc.on[LW_TERM_FIELD]);
+  lw_scene_clear(&sc);
+}
+
+Test(params, bad_polygon_and_margin_name_the_key)
+{
+  lw_params p;
+  lw_error err;
+  lw_scene sc;
+  cr_assert_eq(read_text("[scene]\nboundary = polygon\npolygon = 0 0 10 0 10\n", &p, &err), LW_OK);
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "scene.polygon") && strstr(err.msg, ":3"), "%s", err.msg);
+  cr_assert_eq(read_text("[scene]\nboundary = polygon\npolygon = 0 0 10 0 20 0\n", &p, &err), LW_OK);
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT, "collinear polygon accepted");
+  cr_assert_eq(read_text("[scene]\nwidth = 50\nmargin = 30\n", &p, &err), LW_OK);
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "scene.margin") && strstr(err.msg, ":3"), "%s", err.msg);
+}
