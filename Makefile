@@ -21,7 +21,7 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_OBJ := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%.o)
 TEST_JOBS ?= 2
 
-.PHONY: all deps test asan run bench install clean
+.PHONY: all deps test asan run bench install clean docs
 all: bin/linewise
 
 $(BUILD)/obj/%.o: src/%.c $(wildcard include/linewise/*.h) | $(BUILD)/obj
@@ -59,6 +59,11 @@ deps:
 
 run: bin/linewise
 	bin/linewise run params/example.ini --out out/example
+
+# The parameter reference is generated from the table the reader uses.
+docs: bin/linewise
+	{ sed '/^## \[/,$$d' docs/PARAMETERS.md; bin/linewise params | sed 1d; } > docs/PARAMETERS.md.new
+	mv docs/PARAMETERS.md.new docs/PARAMETERS.md
 
 install: bin/linewise
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/linewise/params

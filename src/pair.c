@@ -204,8 +204,8 @@ double lw_pair_segseg(const double a0[2], const double a1[2],
     if (gap > d) d = gap;
     if (d > FAR_RATIO * Ls) {
       double sum = 0.0;
-      if (La <= Lb) {
-        /* potential of A at points of B */
+      if (Lb <= La) {
+        /* B is the shorter: potential of A at points of B */
         double mx = 0.5 * (beta0 + beta1), my = 0.5 * (eta0 + eta1);
         double hx = 0.5 * Lb * c, hy = 0.5 * Lb * sn;
         for (int k = 0; k < 5; k++) {
@@ -215,7 +215,7 @@ double lw_pair_segseg(const double a0[2], const double a1[2],
         }
         return 0.5 * Lb * sum;
       }
-      /* potential of B at points of A: in B's frame, A's point s sits at
+      /* A is the shorter: potential of B at points of A; in B's frame, A's point s sits at
       ** ((s - beta0) c - eta0 sn, -(s - beta0) sn - eta0 c) */
       for (int k = 0; k < 5; k++) {
         for (int sgn = -1; sgn <= 1; sgn += 2) {

@@ -359,7 +359,12 @@ void lw_params_write_doc(FILE *f)
     else range_text(d, range, sizeof range);
     for (char *c = range; *c; c++)
       if (*c == '|') *c = '/';
-    fprintf(f, "| `%s` | %s | `%s` | %s | %s | %s |\n", d->key, type, d->def,
-            d->unit[0] ? d->unit : "-", range, d->help);
+    fprintf(f, "| `%s` | %s | `%s` | %s | %s | ", d->key, type, d->def, d->unit[0] ? d->unit : "-",
+            range);
+    for (const char *c = d->help; *c; c++) {
+      if (*c == '|') fputc('\\', f); /* a bare | would end the Markdown cell */
+      fputc(*c, f);
+    }
+    fputs(" |\n", f);
   }
 }
