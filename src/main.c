@@ -4,9 +4,14 @@
 ** stderr and an exit status: 2 for bad usage or input, 1 for failures while
 ** running.
 */
+#include <omp.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+
+#include "linewise/anneal.h"
 
 #include "linewise/model.h"
 #include "linewise/params.h"
@@ -17,6 +22,16 @@ static const char usage[] =
   "usage: linewise <command> [options]\n"
   "\n"
   "commands:\n"
+  "  run SCENE.ini       anneal a scene into a run directory\n"
+  "      --out DIR           run directory (default out/<scene name>)\n"
+  "      --set SEC.KEY=VAL   override a scene parameter (repeatable)\n"
+  "      --seed N            override anneal.seed\n"
+  "      --stop-at N         stop cleanly after sweep N, as if interrupted\n"
+  "      --quiet             no progress or parameter echo on stderr\n"
+  "  resume DIR          continue the run in DIR bit-exactly from DIR/state.lw\n"
+  "      --sweeps N          run N more sweeps (default: to the end of the schedule;\n"
+  "                          past the end the last temperature holds)\n"
+  "      --stop-at N, --quiet  as for run\n"
   "  energy DIR          recompute DIR/state.lw's energy from scratch with its scene;\n"
   "                      prints '<term> <value>' per enabled term, then 'total <value>'\n"
   "  params              print every scene parameter as Markdown (docs/PARAMETERS.md)\n"
@@ -71,6 +86,214 @@ static int cmd_energy(int argc, char **argv)
   return rc;
 }
 
+static volatile sig_atomic_t stop_requested = 0;
+
+static void on_signal(int sig)
+{
+  (void)sig;
+  stop_requested = 1;
+}
+
+/* Progress on stderr: a bar redrawn in place on a terminal, one plain line
+** per tenth of the run otherwise, nothing with --quiet. */
+typedef struct {
+  int quiet, tty;
+  long start_sweep, next_plain, last_plain;
+} progress;
+
+static void progress_show(progress *pg, const lw_anneal *a, int final)
+{
+  if (pg->quiet) return;
+  double t = lw_anneal_seconds(a);
+  long done = a->sweep - pg->start_sweep, total = a->end_sweep - pg->start_sweep;
+  double per = done > 0 ? (t - a->wall_before) / (double)done : 0.0;
+  double left = per * (double)(a->end_sweep - a->sweep);
+  if (pg->tty) {
+    static double shown = -1;
+    if (!final && t - shown < 0.2) return;
+    shown = t;
+    int width = 24, fill = total > 0 ? (int)(width * done / total) : width;
+    fprintf(stderr, "\r[%.*s%*s] sweep %ld/%ld  T %.4g  E %.6g  acc %.3f  left %.0fs ", fill,
+            "########################", width - fill, "", a->sweep, a->end_sweep, lw_anneal_temperature(a),
+            lw_model_total(a->model), lw_anneal_acceptance(a), left);
+    if (final) fputc('\n', stderr);
+  } else if ((final && a->sweep != pg->last_plain) || a->sweep >= pg->next_plain) {
+    pg->last_plain = a->sweep;
+    fprintf(stderr, "sweep %ld/%ld T %.6g E %.10g acc %.4f elapsed %.1fs left %.1fs\n", a->sweep, a->end_sweep,
+            lw_anneal_temperature(a), lw_model_total(a->model), lw_anneal_acceptance(a), t, left);
+    while (pg->next_plain <= a->sweep) pg->next_plain += total / 10 > 0 ? total / 10 : 1;
+  }
+}
+
+/* The loop shared by run and resume: sweeps until done or a signal, then
+** the final files (or a checkpoint for a clean stop). */
+static int anneal_loop(lw_anneal *a, long stop_at, int quiet, lw_error *err)
+{
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+  progress pg = {quiet, isatty(2), a->sweep, a->sweep, -1};
+  int stopped = 0;
+  while (!lw_anneal_done(a)) {
+    if (lw_anneal_sweep(a, err)) return fail(err);
+    progress_show(&pg, a, 0);
+    if (stop_requested || (stop_at >= 0 && a->sweep >= stop_at)) {
+      stopped = 1;
+      break;
+    }
+  }
+  progress_show(&pg, a, 1);
+  if (stopped) {
+    if (lw_anneal_checkpoint(a, err)) return fail(err);
+    if (!quiet)
+      fprintf(stderr, "linewise: stopped after sweep %ld; state saved in %s/state.lw ('linewise resume %s' continues)\n",
+              a->sweep, a->dir, a->dir);
+    return 0;
+  }
+  if (lw_anneal_finish(a, err)) return fail(err);
+  if (!quiet) fprintf(stderr, "linewise: done: %s/final.svg, final.png, summary.json, trace.csv, state.lw\n", a->dir);
+  return 0;
+}
+
+static int parse_count(const char *opt, const char *v, long *out, lw_error *err)
+{
+  char *end;
+  long n = strtol(v ? v : "", &end, 10);
+  if (!v || end == v || *end || n < 0) {
+    lw_error_set(err, LW_EUSAGE, "%s: expected a whole number >= 0, got '%s'", opt, v ? v : "");
+    return 0;
+  }
+  *out = n;
+  return 1;
+}
+
+static int cmd_run(int argc, char **argv)
+{
+  lw_error err;
+  lw_error_clear(&err);
+  const char *scene = NULL, *out = NULL;
+  long stop_at = -1, seed = -1;
+  int quiet = 0;
+  static lw_params p;
+  /* the scene file first, so --set applies on top of it whatever the order */
+  for (int i = 0; i < argc; i++) {
+    if (!strcmp(argv[i], "--set") || !strcmp(argv[i], "--out") || !strcmp(argv[i], "--seed") ||
+        !strcmp(argv[i], "--stop-at") || !strcmp(argv[i], "--threads")) {
+      i++;
+      continue;
+    }
+    if (argv[i][0] == '-' && strcmp(argv[i], "--quiet")) {
+      lw_error_set(&err, LW_EUSAGE, "run: unknown option '%s' (try 'linewise --help')", argv[i]);
+      return fail(&err);
+    }
+    if (argv[i][0] != '-') {
+      if (scene) {
+        lw_error_set(&err, LW_EUSAGE, "run: one scene file expected, got '%s' and '%s'", scene, argv[i]);
+        return fail(&err);
+      }
+      scene = argv[i];
+    }
+  }
+  if (!scene) {
+    lw_error_set(&err, LW_EUSAGE, "run: expected a scene file (usage: linewise run SCENE.ini [options])");
+    return fail(&err);
+  }
+  if (lw_params_read(&p, scene, &err)) return fail(&err);
+  for (int i = 0; i < argc; i++) {
+    const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+    if (!strcmp(argv[i], "--set")) {
+      if (!v) { lw_error_set(&err, LW_EUSAGE, "--set: expected section.key=value"); return fail(&err); }
+      if (lw_params_set(&p, v, &err)) return fail(&err);
+      i++;
+    } else if (!strcmp(argv[i], "--out")) {
+      if (!v) { lw_error_set(&err, LW_EUSAGE, "--out: expected a directory"); return fail(&err); }
+      out = v;
+      i++;
+    } else if (!strcmp(argv[i], "--seed")) {
+      if (!parse_count("--seed", v, &seed, &err)) return fail(&err);
+      char buf[64];
+      snprintf(buf, sizeof buf, "anneal.seed=%ld", seed);
+      if (lw_params_set(&p, buf, &err)) return fail(&err);
+      i++;
+    } else if (!strcmp(argv[i], "--stop-at")) {
+      if (!parse_count("--stop-at", v, &stop_at, &err)) return fail(&err);
+      i++;
+    } else if (!strcmp(argv[i], "--threads")) {
+      long t;
+      if (!parse_count("--threads", v, &t, &err) || t < 1) {
+        lw_error_set(&err, LW_EUSAGE, "--threads: expected a whole number >= 1");
+        return fail(&err);
+      }
+      omp_set_num_threads((int)t); /* results never depend on it (replicas are seeded per stream) */
+      i++;
+    } else if (!strcmp(argv[i], "--quiet")) {
+      quiet = 1;
+    }
+  }
+  char dir[LW_PATH_MAX];
+  if (out) snprintf(dir, sizeof dir, "%s", out);
+  else {
+    const char *base = strrchr(scene, '/');
+    base = base ? base + 1 : scene;
+    snprintf(dir, sizeof dir, "out/%.*s", (int)strcspn(base, "."), base);
+  }
+  static lw_anneal a;
+  if (lw_anneal_start(&a, &p, dir, &err)) {
+    lw_anneal_free(&a);
+    return fail(&err);
+  }
+  if (!quiet) {
+    fprintf(stderr, "linewise: scene %s, seed %lu, %zu splines, %zu segments, into %s\n", scene, a.seed,
+            a.model->sp->n_splines, a.model->sp->n_segments, dir);
+    fprintf(stderr, "linewise: resolved parameters:\n");
+    lw_params_write(&a.params, stderr);
+  }
+  int rc = anneal_loop(&a, stop_at, quiet, &err);
+  lw_anneal_free(&a);
+  return rc;
+}
+
+static int cmd_resume(int argc, char **argv)
+{
+  lw_error err;
+  lw_error_clear(&err);
+  const char *dir = NULL;
+  long more = -1, stop_at = -1;
+  int quiet = 0;
+  for (int i = 0; i < argc; i++) {
+    const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+    if (!strcmp(argv[i], "--sweeps")) {
+      if (!parse_count("--sweeps", v, &more, &err)) return fail(&err);
+      i++;
+    } else if (!strcmp(argv[i], "--stop-at")) {
+      if (!parse_count("--stop-at", v, &stop_at, &err)) return fail(&err);
+      i++;
+    } else if (!strcmp(argv[i], "--quiet")) {
+      quiet = 1;
+    } else if (argv[i][0] == '-' || dir) {
+      lw_error_set(&err, LW_EUSAGE, "resume: unexpected '%s' (usage: linewise resume DIR [--sweeps N])", argv[i]);
+      return fail(&err);
+    } else {
+      dir = argv[i];
+    }
+  }
+  if (!dir) {
+    lw_error_set(&err, LW_EUSAGE, "resume: expected a run directory (usage: linewise resume DIR [--sweeps N])");
+    return fail(&err);
+  }
+  static lw_anneal a;
+  if (lw_anneal_resume(&a, dir, more, &err)) {
+    lw_anneal_free(&a);
+    return fail(&err);
+  }
+  if (!quiet) fprintf(stderr, "linewise: resuming %s at sweep %ld of %ld\n", dir, a.sweep, a.end_sweep);
+  int rc = anneal_loop(&a, stop_at, quiet, &err);
+  lw_anneal_free(&a);
+  return rc;
+}
+
 int main(int argc, char **argv)
 {
   if (argc < 2 || !strcmp(argv[1], "help") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
@@ -78,6 +301,8 @@ int main(int argc, char **argv)
     return argc < 2 ? 2 : 0;
   }
   if (!strcmp(argv[1], "energy")) return cmd_energy(argc - 2, argv + 2);
+  if (!strcmp(argv[1], "run")) return cmd_run(argc - 2, argv + 2);
+  if (!strcmp(argv[1], "resume")) return cmd_resume(argc - 2, argv + 2);
   if (!strcmp(argv[1], "params")) {
     lw_params_write_doc(stdout);
     return 0;

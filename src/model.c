@@ -290,7 +290,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   p->spline = spline;
   p->node0 = node0;
   p->n_node = n_node;
-  memcpy(p->node, nodes, n_node * sizeof *nodes);
+  if (nodes && nodes != p->node) memcpy(p->node, nodes, n_node * sizeof *nodes);
   p->seg0 = node0 > 0 ? node0 - 1 : 0;
   size_t seg_end = node0 + n_node < nseg ? node0 + n_node : nseg; /* one past the last */
   p->n_seg = seg_end - p->seg0;
@@ -364,7 +364,13 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
     memcpy(m->seg_local + g * (size_t)nl, p->local + j * (size_t)nl, (size_t)nl * sizeof *m->seg_local);
     if (m->ps) memcpy(m->ps + g * (size_t)nq, p->ps + j * (size_t)nq, (size_t)nq * sizeof *m->ps);
   }
-  m->spline_len[p->spline] = p->new_spline_len;
+  /* Summed afresh in a fixed order rather than updated by += dlen, so the
+  ** cached length is a function of the state alone and a resumed run sees
+  ** the same value as one that never stopped. */
+  size_t n = lw_splines_segments(sp, p->spline);
+  double L = 0.0;
+  for (size_t k = 0; k < n; k++) L += m->seg_len[g0 + k];
+  m->spline_len[p->spline] = L;
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     m->term[t] += p->dterm[t];
     if (!isfinite(m->term[t])) nonfinite = 1;

@@ -154,7 +154,8 @@ static double seg_potential(double L, double x, double y)
   double d1 = x >= L ? r1 - (L - x) : y2 / (r1 + (L - x));
   double den = d0 + d1;
   if (!(den > 0.0)) return INFINITY;
-  return log((r0 + r1 + L) / den);
+  /* (r0 + r1 + L) / den = 1 + 2L / den: log1p keeps far points accurate */
+  return log1p(2.0 * L / den);
 }
 
 /* Gauss-Legendre nodes and weights on [-1, 1] (10 points, half listed). */
@@ -165,12 +166,84 @@ static const double GL10_W[5] = {0.2955242247147528701738930, 0.2692667193099963
                                  0.2190863625159820439955349, 0.1494513491505805931457763,
                                  0.0666713443086881375935688};
 
-/* Segments whose distance exceeds FAR_RATIO times the shorter length are
-** integrated by 10-point Gauss-Legendre over the shorter one of the longer
-** one's exact potential: the potential is analytic within a distance
-** >= FAR_RATIO * length of the shorter segment, so the rule's error is
-** ~ (2 FAR_RATIO)^-20 < 1e-16, while the corner sum would lose ~ (d/L)^2. */
+/* B farther than FAR_RATIO * Lb from A (Lb <= La) is integrated by 10-point
+** Gauss-Legendre over B of A's exact potential: the potential is analytic
+** within that distance of B, so the rule's error is below ~ (4 FAR_RATIO)^-20,
+** while the corner sum would lose ~ (distance / length)^2 to cancellation. */
 #define FAR_RATIO 3.0
+
+/* A longer than SPLIT_RATIO * Lb is cut into the part near B and the two
+** far parts: the corner sum on a long A loses ~ La / Lb to cancellation. */
+#define SPLIT_RATIO 8.0
+
+/*
+** The integral in A's frame: A = [0, La] x {0}, B from (beta0, eta0) along
+** the unit vector (c, sn), c >= 0, length Lb <= La.
+*/
+static double far_gl(double La, double Lb, double beta0, double eta0, double c, double sn)
+{
+  double mx = beta0 + 0.5 * Lb * c, my = eta0 + 0.5 * Lb * sn;
+  double hx = 0.5 * Lb * c, hy = 0.5 * Lb * sn;
+  double sum = 0.0;
+  for (int k = 0; k < 5; k++) {
+    double x = GL10_X[k];
+    sum += GL10_W[k] * (seg_potential(La, mx + x * hx, my + x * hy) +
+                        seg_potential(La, mx - x * hx, my - x * hy));
+  }
+  return 0.5 * Lb * sum;
+}
+
+/* Lower bound of the distance between the segments. */
+static double gap_bound(double La, double beta0, double eta0, double beta1, double eta1)
+{
+  double d = 0.0;
+  if ((eta0 > 0.0) == (eta1 > 0.0) && eta0 != 0.0 && eta1 != 0.0)
+    d = fabs(eta0) < fabs(eta1) ? fabs(eta0) : fabs(eta1);
+  double gap = beta0 > La ? beta0 - La : (beta1 < 0.0 ? -beta1 : 0.0);
+  return gap > d ? gap : d;
+}
+
+static double corner_sum(double La, double Lb, double beta0, double eta0, double c, double sn)
+{
+  double beta1 = beta0 + Lb * c, eta1 = eta0 + Lb * sn;
+  if (sn == 0.0 && eta0 == 0.0) {
+    /* collinear: B = [beta0, beta1] on A's line, beta1 > beta0 */
+    double lo = beta0 > 0.0 ? beta0 : 0.0, hi = beta1 < La ? beta1 : La;
+    if (hi > lo) return INFINITY;
+    return xlogx(La - beta0) + xlogx(beta1) - xlogx(La - beta1) - xlogx(beta0);
+  }
+  double sigma = fabs(sn), tau = sigma / (1.0 + c);
+  double scale = La + Lb;
+  /* zeta_i = cross(w, a_i - b0), the signed distance of A's ends from line B */
+  double zeta0 = sn * beta0 - c * eta0, zeta1 = zeta0 - sn * La;
+  double g11 = corner(La, beta1, eta1, zeta1, c, sn, sigma, tau, scale);
+  double g01 = corner(0.0, beta1, eta1, zeta0, c, sn, sigma, tau, scale);
+  double g10 = corner(La, beta0, eta0, zeta1, c, sn, sigma, tau, scale);
+  double g00 = corner(0.0, beta0, eta0, zeta0, c, sn, sigma, tau, scale);
+  double v = (g11 - g01) - (g10 - g00);
+  /* the integral is positive; a negative v can only be rounding of a value
+  ** negligible against the corner terms */
+  return v > 0.0 ? v : 0.0;
+}
+
+static double segseg_frame(double La, double Lb, double beta0, double eta0, double c, double sn)
+{
+  double beta1 = beta0 + Lb * c, eta1 = eta0 + Lb * sn;
+  if (gap_bound(La, beta0, eta0, beta1, eta1) > FAR_RATIO * Lb)
+    return far_gl(La, Lb, beta0, eta0, c, sn);
+  if (La > SPLIT_RATIO * Lb) {
+    /* [lo, hi]: B's shadow on A widened by 4 Lb; the rest of A is far */
+    double lo = beta0 - 4.0 * Lb, hi = beta1 + 4.0 * Lb; /* beta1 >= beta0 as c >= 0 */
+    if (lo < 0.0) lo = 0.0;
+    if (hi > La) hi = La;
+    double v = 0.0;
+    if (lo > 0.0) v += far_gl(lo, Lb, beta0, eta0, c, sn);
+    if (hi < La) v += far_gl(La - hi, Lb, beta0 - hi, eta0, c, sn);
+    if (hi > lo) v += corner_sum(hi - lo, Lb, beta0 - lo, eta0, c, sn);
+    return v;
+  }
+  return corner_sum(La, Lb, beta0, eta0, c, sn);
+}
 
 double lw_pair_segseg(const double a0[2], const double a1[2],
                       const double b0[2], const double b1[2])
@@ -192,61 +265,12 @@ double lw_pair_segseg(const double a0[2], const double a1[2],
     c = -c;
     sn = -sn;
   }
-  double beta1 = beta0 + Lb * c, eta1 = eta0 + Lb * sn;
-
-  /* far apart: quadrature over the shorter segment */
-  {
-    double Ls = La < Lb ? La : Lb;
-    /* cheap lower bound of the distance between the segments */
-    double d = fabs(eta0) < fabs(eta1) ? fabs(eta0) : fabs(eta1);
-    if ((eta0 > 0.0) != (eta1 > 0.0)) d = 0.0;
-    double gap = beta0 > La ? beta0 - La : (beta1 < 0.0 ? -beta1 : 0.0);
-    if (gap > d) d = gap;
-    if (d > FAR_RATIO * Ls) {
-      double sum = 0.0;
-      if (Lb <= La) {
-        /* B is the shorter: potential of A at points of B */
-        double mx = 0.5 * (beta0 + beta1), my = 0.5 * (eta0 + eta1);
-        double hx = 0.5 * Lb * c, hy = 0.5 * Lb * sn;
-        for (int k = 0; k < 5; k++) {
-          double x = GL10_X[k];
-          sum += GL10_W[k] * (seg_potential(La, mx + x * hx, my + x * hy) +
-                              seg_potential(La, mx - x * hx, my - x * hy));
-        }
-        return 0.5 * Lb * sum;
-      }
-      /* A is the shorter: potential of B at points of A; in B's frame, A's point s sits at
-      ** ((s - beta0) c - eta0 sn, -(s - beta0) sn - eta0 c) */
-      for (int k = 0; k < 5; k++) {
-        for (int sgn = -1; sgn <= 1; sgn += 2) {
-          double s = 0.5 * La * (1.0 + sgn * GL10_X[k]);
-          double px = (s - beta0) * c - eta0 * sn, py = -(s - beta0) * sn - eta0 * c;
-          sum += GL10_W[k] * seg_potential(Lb, px, py);
-        }
-      }
-      return 0.5 * La * sum;
-    }
+  if (Lb > La) {
+    /* the same geometry in B's frame: A starts at a0 - b0, direction (c, -sn) */
+    double b = -beta0 * c - eta0 * sn, e = sn * beta0 - c * eta0;
+    return segseg_frame(Lb, La, b, e, c, -sn);
   }
-
-  if (sn == 0.0 && eta0 == 0.0) {
-    /* collinear: B = [beta0, beta1] on A's line, beta1 > beta0 */
-    double lo = beta0 > 0.0 ? beta0 : 0.0, hi = beta1 < La ? beta1 : La;
-    if (hi > lo) return INFINITY;
-    return xlogx(La - beta0) + xlogx(beta1) - xlogx(La - beta1) - xlogx(beta0);
-  }
-
-  double sigma = fabs(sn), tau = sigma / (1.0 + c);
-  double scale = La + Lb;
-  /* zeta_i = cross(w, a_i - b0), the signed distance of A's ends from line B */
-  double zeta0 = sn * beta0 - c * eta0, zeta1 = zeta0 - sn * La;
-  double g11 = corner(La, beta1, eta1, zeta1, c, sn, sigma, tau, scale);
-  double g01 = corner(0.0, beta1, eta1, zeta0, c, sn, sigma, tau, scale);
-  double g10 = corner(La, beta0, eta0, zeta1, c, sn, sigma, tau, scale);
-  double g00 = corner(0.0, beta0, eta0, zeta0, c, sn, sigma, tau, scale);
-  double v = (g11 - g01) - (g10 - g00);
-  /* the integral is positive; rounding can only matter for values that are
-  ** negligible against the corner terms */
-  return v > 0.0 ? v : 0.0;
+  return segseg_frame(La, Lb, beta0, eta0, c, sn);
 }
 
 /* ---- the kernel --------------------------------------------------------- */

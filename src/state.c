@@ -6,6 +6,7 @@
 **     scene scene.ini
 **     seed 42
 **     sweep 1000
+**     <key> <value...>             (run data, any number of lines)
 **     splines 2
 **     spline <segments> <rest length L0, mm>
 **     <px> <py> <vx> <vy>          (segments + 1 node lines)
@@ -40,19 +41,59 @@ void lw_state_clear(lw_state *st)
 {
   lw_splines_free(st->sp);
   st->sp = NULL;
+  for (size_t i = 0; i < st->n_extra; i++) {
+    free(st->extra[i].key);
+    free(st->extra[i].value);
+  }
+  free(st->extra);
+  st->extra = NULL;
+  st->n_extra = 0;
+}
+
+static lw_status add_line(lw_state *st, const char *key, size_t nkey, const char *value, int line)
+{
+  lw_state_extra *e = realloc(st->extra, (st->n_extra + 1) * sizeof *e);
+  if (!e) return LW_ENOMEM;
+  st->extra = e;
+  e = &st->extra[st->n_extra];
+  e->key = malloc(nkey + 1);
+  e->value = strdup(value);
+  if (!e->key || !e->value) {
+    free(e->key);
+    free(e->value);
+    return LW_ENOMEM;
+  }
+  memcpy(e->key, key, nkey);
+  e->key[nkey] = '\0';
+  e->line = line;
+  st->n_extra++;
+  return LW_OK;
+}
+
+lw_status lw_state_add(lw_state *st, const char *key, const char *value)
+{
+  return add_line(st, key, strlen(key), value, 0);
+}
+
+const lw_state_extra *lw_state_get(const lw_state *st, const char *key)
+{
+  for (size_t i = 0; i < st->n_extra; i++)
+    if (!strcmp(st->extra[i].key, key)) return &st->extra[i];
+  return NULL;
 }
 
 typedef struct {
   FILE *f;
   const char *path;
   int line;
-  char buf[4096];
+  char *buf;    /* getline's buffer: run data lines (the RNG state) are long */
+  size_t cap;
 } reader;
 
 /* Next line that is not blank or a comment, without its newline; NULL at end. */
 static char *next_line(reader *r)
 {
-  while (fgets(r->buf, sizeof r->buf, r->f)) {
+  while (getline(&r->buf, &r->cap, r->f) >= 0) {
     r->line++;
     r->buf[strcspn(r->buf, "\r\n")] = '\0';
     char *c = r->buf;
@@ -109,7 +150,7 @@ static int parse_doubles(const char *s, double *out, int n)
 lw_status lw_state_read(lw_state *st, const char *path, lw_error *err)
 {
   memset(st, 0, sizeof *st);
-  reader r = {fopen(path, "r"), path, 0, {0}};
+  reader r = {fopen(path, "r"), path, 0, NULL, 0};
   if (!r.f) return lw_error_set(err, LW_EINPUT, "%s: cannot open state file: %s", path, strerror(errno));
   lw_status status = LW_OK;
   size_t *segs = NULL;
@@ -143,7 +184,24 @@ lw_status lw_state_read(lw_state *st, const char *path, lw_error *err)
     status = bad(&r, err, "sweep", "a whole number >= 0", val);
     goto done;
   }
-  if ((status = expect_key(&r, "splines", &val, err))) goto done;
+  /* run data lines until "splines" */
+  for (;;) {
+    c = next_line(&r);
+    if (!c) {
+      status = bad(&r, err, "splines", "a line 'splines <count>'", c);
+      goto done;
+    }
+    size_t nk = strcspn(c, " \t");
+    if (nk == 7 && !strncmp(c, "splines", 7)) break;
+    val = c + nk;
+    while (*val == ' ' || *val == '\t') val++;
+    if (add_line(st, c, nk, val, r.line)) {
+      status = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+      goto done;
+    }
+  }
+  val = c + 7;
+  while (*val == ' ' || *val == '\t') val++;
   if (!parse_long(val, &v) || v < 0 || v > 100000000L) {
     status = bad(&r, err, "splines", "a whole number from 0 to 100000000", val);
     goto done;
@@ -206,6 +264,7 @@ lw_status lw_state_read(lw_state *st, const char *path, lw_error *err)
 done:
   free(segs);
   free(rest);
+  free(r.buf);
   fclose(r.f);
   if (status) lw_state_clear(st);
   return status;
@@ -218,8 +277,10 @@ lw_status lw_state_write(const lw_state *st, const char *path, lw_error *err)
   FILE *f = fopen(tmp, "w");
   if (!f) return lw_error_set(err, LW_EIO, "%s: cannot write: %s", tmp, strerror(errno));
   const lw_splines *sp = st->sp;
-  fprintf(f, "linewise-state %d\nscene %s\nseed %lu\nsweep %ld\nsplines %zu\n", LW_STATE_VERSION,
-          st->scene, st->seed, st->sweep, sp->n_splines);
+  fprintf(f, "linewise-state %d\nscene %s\nseed %lu\nsweep %ld\n", LW_STATE_VERSION, st->scene,
+          st->seed, st->sweep);
+  for (size_t i = 0; i < st->n_extra; i++) fprintf(f, "%s %s\n", st->extra[i].key, st->extra[i].value);
+  fprintf(f, "splines %zu\n", sp->n_splines);
   for (size_t i = 0; i < sp->n_splines; i++) {
     fprintf(f, "spline %zu %.17g\n", lw_splines_segments(sp, i), sp->rest_length[i]);
     for (size_t k = sp->first[i]; k < sp->first[i + 1]; k++) {

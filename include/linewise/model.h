@@ -26,7 +26,7 @@ typedef struct {
   lw_splines *sp;           /* owned */
   double *seg_len;          /* n_segments, mm */
   double *seg_local;        /* n_segments * scene->n_local: cached local energies */
-  double *spline_len;       /* n_splines, mm: sum of seg_len, kept incrementally */
+  double *spline_len;       /* n_splines, mm: sum of seg_len in segment order */
   double term[LW_TERM_COUNT]; /* running totals (0 for terms that are off) */
   lw_pair_sample *ps;       /* n_segments * quad.n pair samples (pair on), else NULL */
   lw_cellgrid *grid;        /* over ps (pair on), else NULL */
@@ -63,7 +63,7 @@ lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err);
 void lw_proposal_free(lw_proposal *p);
 
 /* Evaluates replacing n_node nodes of spline `spline` starting at local node
-** node0 with `nodes` (copied into p).  Fills p->dterm and p->dE; the model is
+** node0 with `nodes` (copied into p; NULL: they are already in p->node).  Fills p->dterm and p->dE; the model is
 ** not changed.  Pure with respect to the model: several threads may propose
 ** against one model if none commits meanwhile. */
 void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t node0,

@@ -75,6 +75,28 @@ typedef struct {
   double pair_cutoff;         /* mm; 0 = none */
   double pair_near;           /* element lengths; 0 = off */
   int quadrature;             /* nodes per segment */
+  /* [moves] */
+  double mix_point, mix_vector, mix_translate, mix_rotate; /* relative frequencies */
+  double step_point, step_vector;  /* initial Gaussian step, mm */
+  double step_translate;      /* initial rigid translation step, mm */
+  double step_rotate;         /* initial rigid rotation step, degrees */
+  double target;              /* acceptance the single-DOF steps tune toward */
+  double target_spline;       /* acceptance the rigid steps tune toward */
+  int tune_sweeps;            /* tuning sweeps at the start of each temperature */
+  /* [anneal] */
+  char schedule[64];          /* a name from the schedule table */
+  double t_start, t_end;      /* temperatures, energy units */
+  int sweeps;                 /* sweeps in all (one sweep = one proposal per node) */
+  int steps;                  /* temperature steps */
+  double lambda;              /* adaptive cooling rate */
+  char table[LW_PATH_MAX];    /* table schedule file */
+  double seed;                /* RNG seed (a whole number, stored as double for the table) */
+  int check_every;            /* sweeps between drift checks */
+  /* [output] */
+  int checkpoint_every;       /* sweeps between state.lw checkpoints */
+  int trace_every;            /* sweeps per trace.csv row */
+  double pen_width;           /* SVG/PNG stroke, mm */
+  double png_scale;           /* preview pixels per mm */
 
   /* Where each value came from: the file and line (0 = default, -1 = --set). */
   char file[LW_PATH_MAX];

@@ -17,12 +17,27 @@
 
 #define LW_STATE_VERSION 1
 
+/* A "key value..." line of run data between the header and the splines
+** (RNG state, step sizes, counters): state.c keeps them as text, the
+** annealer gives them meaning. */
+typedef struct {
+  char *key, *value;        /* owned */
+  int line;                 /* where it was read (0 if made in memory) */
+} lw_state_extra;
+
 typedef struct {
   char scene[LW_PATH_MAX];  /* scene file, relative to the state file's directory */
   unsigned long seed;
   long sweep;               /* sweeps done */
   lw_splines *sp;           /* owned */
+  lw_state_extra *extra;    /* owned */
+  size_t n_extra;
 } lw_state;
+
+/* Appends a key/value line (both copied); LW_ENOMEM on failure. */
+lw_status lw_state_add(lw_state *st, const char *key, const char *value);
+/* The extra line with this key, or NULL. */
+const lw_state_extra *lw_state_get(const lw_state *st, const char *key);
 
 /* Reads path into st (st->sp allocated); messages name the file and line. */
 lw_status lw_state_read(lw_state *st, const char *path, lw_error *err);

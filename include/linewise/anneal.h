@@ -1,0 +1,76 @@
+/*
+** anneal.h -- a whole annealing run: initial state, the temperature steps of
+** a schedule with a tuning phase at the start of each, drift checks,
+** checkpoints and the files of a run directory.  init / sweep / finish, no
+** callbacks: the caller owns the loop (and the progress display).
+**
+** Run directory: scene.ini (the resolved parameters), state.lw, trace.csv,
+** summary.json, final.svg, final.png.  The state file carries everything
+** that steers the future of the run (RNG state, steps, tuning windows, the
+** schedule's inputs, the running energies), so `resume` continues bit for
+** bit: the same sweeps give the same state.lw whether or not the run was
+** stopped in between.
+*/
+#ifndef LINEWISE_ANNEAL_H
+#define LINEWISE_ANNEAL_H
+
+#include <stdio.h>
+
+#include "linewise/mc.h"
+#include "linewise/params.h"
+#include "linewise/scene.h"
+#include "linewise/schedule.h"
+
+typedef struct {
+  lw_params params;
+  lw_scene scene;
+  lw_model *model;
+  lw_chain *chain;
+  const lw_schedule_type *sched_type;
+  lw_schedule sched;
+  char dir[LW_PATH_MAX];
+  unsigned long seed;
+  long sweep;                  /* sweeps done */
+  long end_sweep;              /* stop after this sweep */
+  long block;                  /* current temperature step */
+  double t_prev;               /* temperature of the previous step */
+  lw_block_stats prev;         /* energy statistics of the previous step */
+  double acc_n, acc_sum, acc_sumsq; /* this step's energy samples (after tuning) */
+  double max_drift;            /* largest relative drift seen at a check */
+  double energy_initial;
+  double wall_before;          /* seconds spent before a resume */
+  unsigned long proposals_before; /* proposals made before a resume */
+  double wall_start;           /* monotonic clock at start of this process */
+  lw_move_stats trace_mark[LW_MOVE_KINDS]; /* stats at the last trace row */
+  FILE *trace;
+} lw_anneal;
+
+/* A new run of the scene file (with overrides already applied to p) into
+** dir; seed overrides p->seed when >= 0.  Creates dir (bad input is reported
+** before anything is written). */
+lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_error *err);
+
+/* Continues the run in dir for `more` sweeps (< 0: to the end of the
+** schedule; past the end the last temperature holds). */
+lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *err);
+
+/* One sweep with everything that falls due after it (trace row, drift check,
+** checkpoint). */
+lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err);
+
+static inline int lw_anneal_done(const lw_anneal *a) { return a->sweep >= a->end_sweep; }
+
+/* Writes state.lw now (a clean stop). */
+lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err);
+
+/* The final files: state.lw, final.svg, final.png, summary.json. */
+lw_status lw_anneal_finish(lw_anneal *a, lw_error *err);
+
+void lw_anneal_free(lw_anneal *a);
+
+/* Current temperature and overall acceptance (for progress displays). */
+double lw_anneal_temperature(const lw_anneal *a);
+double lw_anneal_acceptance(const lw_anneal *a);
+double lw_anneal_seconds(const lw_anneal *a);
+
+#endif

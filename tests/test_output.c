@@ -1,0 +1,555 @@
+/* test_output.c -- plotter SVG, PNG preview, atomic writes, JSON writer. */
+#include <cairo.h>
+#include <criterion/criterion.h>
+#include <dirent.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "linewise/json.h"
+#include "linewise/output.h"
+#include "testutil.h"
+
+/* SVG numbers have 4 decimals: within 5e-5 mm, plus slack for the double
+** arithmetic of b1 and b2. */
+#define SVG_TOL (0.5e-4 + 1e-9)
+
+static void make_dir(char *dir)
+{
+  strcpy(dir, "/tmp/lw_output_XXXXXX");
+  cr_assert_not_null(mkdtemp(dir));
+}
+
+/* Whole file as a NUL-terminated string (NULL if it cannot be read). */
+static char *slurp(const char *path, size_t *len)
+{
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  fseek(f, 0, SEEK_END);
+  long n = ftell(f);
+  rewind(f);
+  char *s = malloc((size_t)n + 1);
+  cr_assert_not_null(s);
+  cr_assert_eq(fread(s, 1, (size_t)n, f), (size_t)n);
+  s[n] = '\0';
+  fclose(f);
+  if (len) *len = (size_t)n;
+  return s;
+}
+
+static void write_text(const char *path, const char *text)
+{
+  FILE *f = fopen(path, "w");
+  cr_assert_not_null(f);
+  fputs(text, f);
+  fclose(f);
+}
+
+/* Files in dir whose names end in ".tmp". */
+static int count_tmp(const char *dir)
+{
+  DIR *d = opendir(dir);
+  cr_assert_not_null(d);
+  int n = 0;
+  struct dirent *e;
+  while ((e = readdir(d))) {
+    size_t l = strlen(e->d_name);
+    if (l >= 4 && !strcmp(e->d_name + l - 4, ".tmp")) n++;
+  }
+  closedir(d);
+  return n;
+}
+
+/* Removes the files of dir, then dir (tests leave /tmp clean). */
+static void remove_dir(const char *dir)
+{
+  DIR *d = opendir(dir);
+  if (!d) return;
+  struct dirent *e;
+  char p[512];
+  while ((e = readdir(d))) {
+    if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+    snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
+    if (remove(p)) rmdir(p);
+  }
+  closedir(d);
+  rmdir(dir);
+}
+
+/* Value of attribute name="..." after position s, as a double. */
+static double attr_num(const char *s, const char *name)
+{
+  char key[64];
+  snprintf(key, sizeof key, " %s=\"", name);
+  const char *a = strstr(s, key);
+  cr_assert_not_null(a, "attribute %s present", name);
+  return strtod(a + strlen(key), NULL);
+}
+
+/* Splines: 0 straight (3 segments), 1 a Bezier circle (8 segments), 2 all
+** zero (a point: skipped). */
+static lw_splines *two_splines(void)
+{
+  size_t segs[3] = {3, 8, 2};
+  lw_splines *sp = lw_splines_new(3, segs, NULL);
+  cr_assert_not_null(sp);
+  lw_test_straight(sp, 0, 10.123456, 20.5, 190.987654, 250.25);
+  lw_test_circle(sp, 1, 105.0, 148.5, 61.7);
+  return sp;
+}
+
+Test(output, svg_paths_are_the_exact_bezier_segments)
+{
+  char dir[64], path[128];
+  make_dir(dir);
+  snprintf(path, sizeof path, "%s/drawing.svg", dir);
+  lw_splines *sp = two_splines();
+  lw_output_page page;
+  lw_output_page_init(&page, 210, 297);
+  page.stroke_mm = 0.35;
+  lw_error err;
+  lw_error_clear(&err);
+  cr_assert_eq(lw_output_svg(sp, &page, path, &err), LW_OK, "%s", err.msg);
+  char *svg = slurp(path, NULL);
+  cr_assert_not_null(svg);
+
+  /* page in mm, user units mm; integers printed without decimals */
+  cr_assert_not_null(strstr(svg, "version=\"1.1\""));
+  cr_assert_not_null(strstr(svg, " width=\"210mm\""), "%s", svg);
+  cr_assert_not_null(strstr(svg, " height=\"297mm\""));
+  cr_assert_not_null(strstr(svg, " viewBox=\"0 0 210 297\""));
+  /* Inkscape layer, namespace declared */
+  cr_assert_not_null(strstr(svg, "xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\""));
+  const char *layer = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"pen 1\"");
+  cr_assert_not_null(layer);
+  cr_assert_not_null(strstr(layer, "</g>"));
+
+  size_t n_paths = 0;
+  const char *at = svg;
+  while ((at = strstr(at, "<path"))) {
+    cr_assert(at > layer && at < strstr(layer, "</g>"), "path inside the layer");
+    size_t i = n_paths == 0 ? 0 : 1;  /* spline 2 (zero length) must not appear */
+    cr_assert(n_paths < 2, "the zero-length spline is skipped");
+    const char *close = strstr(at, "/>");
+    cr_assert_not_null(close);
+    cr_assert(fabs(attr_num(at, "stroke-width") - 0.35) < 1e-12, "stroke-width is the pen width");
+    cr_assert_not_null(strstr(at, "fill=\"none\""));
+    cr_assert_not_null(strstr(at, "stroke-linecap=\"round\""));
+    const char *d = strstr(at, " d=\"");
+    cr_assert(d && d < close);
+    d += 4;
+    const char *dend = strchr(d, '"');
+    cr_assert_not_null(dend);
+    /* only M and C commands, no polyline or exponent */
+    size_t nM = 0, nC = 0;
+    for (const char *c = d; c < dend; c++) {
+      cr_assert(*c != 'L' && *c != 'l' && *c != 'e' && *c != 'E', "unexpected '%c' in path data", *c);
+      nM += *c == 'M';
+      nC += *c == 'C';
+    }
+    size_t n = lw_splines_segments(sp, i);
+    cr_assert_eq(nM, 1);
+    cr_assert_eq(nC, n, "spline %zu: %zu C commands for %zu segments", i, nC, n);
+
+    const char *c = d;
+    int used;
+    double x, y;
+    cr_assert_eq(sscanf(c, " M %lf %lf%n", &x, &y, &used), 2);
+    c += used;
+    const lw_node *nd = &sp->node[sp->first[i]];
+    cr_assert(fabs(x - nd[0].px) <= SVG_TOL && fabs(y - nd[0].py) <= SVG_TOL);
+    for (size_t m = 0; m < n; m++) {
+      double b[6];
+      cr_assert_eq(sscanf(c, " C %lf %lf %lf %lf %lf %lf%n", &b[0], &b[1], &b[2], &b[3], &b[4], &b[5], &used), 6,
+                   "spline %zu segment %zu", i, m);
+      c += used;
+      const double want[6] = {nd[m].px + nd[m].vx,         nd[m].py + nd[m].vy,
+                              nd[m + 1].px - nd[m + 1].vx, nd[m + 1].py - nd[m + 1].vy,
+                              nd[m + 1].px,                nd[m + 1].py};
+      for (int k = 0; k < 6; k++)
+        cr_assert(fabs(b[k] - want[k]) <= SVG_TOL, "spline %zu segment %zu value %d: %.6f vs %.6f", i, m, k,
+                  b[k], want[k]);
+    }
+    cr_assert_eq(c, dend, "nothing after the last segment");
+    n_paths++;
+    at = close;
+  }
+  cr_assert_eq(n_paths, 2);
+  cr_assert_eq(count_tmp(dir), 0);
+  free(svg);
+  lw_splines_free(sp);
+  remove_dir(dir);
+}
+
+Test(output, svg_rejects_non_finite_nodes_and_keeps_the_old_file)
+{
+  char dir[64], path[128];
+  make_dir(dir);
+  snprintf(path, sizeof path, "%s/drawing.svg", dir);
+  write_text(path, "old\n");
+  lw_splines *sp = two_splines();
+  sp->node[5].vy = NAN;
+  lw_output_page page;
+  lw_output_page_init(&page, 210, 297);
+  lw_error err;
+  cr_assert_eq(lw_output_svg(sp, &page, path, &err), LW_EINPUT);
+  cr_assert_not_null(strstr(err.msg, "spline 1"), "%s", err.msg);
+  char *s = slurp(path, NULL);
+  cr_assert_str_eq(s, "old\n");
+  cr_assert_eq(count_tmp(dir), 0);
+  /* a colour that would break the XML attribute */
+  sp->node[5].vy = 0;
+  snprintf(page.color, sizeof page.color, "red\" onload=\"x");
+  cr_assert_eq(lw_output_svg(sp, &page, path, &err), LW_EINPUT);
+  free(s);
+  lw_splines_free(sp);
+  remove_dir(dir);
+}
+
+/* Pixel (x, y) of an RGB24/ARGB32 image as grey 0..255 (mean of RGB). */
+static int grey(cairo_surface_t *s, int x, int y)
+{
+  const unsigned char *data = cairo_image_surface_get_data(s);
+  uint32_t px = *(const uint32_t *)(data + (size_t)y * cairo_image_surface_get_stride(s) + 4 * (size_t)x);
+  return (int)(((px >> 16) & 255) + ((px >> 8) & 255) + (px & 255)) / 3;
+}
+
+Test(output, png_preview_pixels)
+{
+  char dir[64], path[128];
+  make_dir(dir);
+  snprintf(path, sizeof path, "%s/preview.png", dir);
+  /* page 100 x 50 mm at 4 px/mm: 400 x 200 px.  A horizontal line at
+  ** y = 25.125 mm runs along pixel row 100's centre (100.5 px); the pen of
+  ** 0.5 mm covers rows 99.5..101.5 px, so the pixel is fully inked. */
+  size_t segs[2] = {2, 8};
+  lw_splines *sp = lw_splines_new(2, segs, NULL);
+  lw_test_straight(sp, 0, 10, 25.125, 60, 25.125);
+  lw_test_circle(sp, 1, 80, 25, 10);
+  lw_output_page page;
+  lw_output_page_init(&page, 100, 50);
+  page.stroke_mm = 0.5;
+  lw_error err;
+  lw_error_clear(&err);
+  cr_assert_eq(lw_output_png(sp, &page, 4.0, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(count_tmp(dir), 0);
+
+  size_t len;
+  char *bytes = slurp(path, &len);
+  cr_assert(bytes && len > 8);
+  cr_assert(!memcmp(bytes, "\x89PNG\r\n\x1a\n", 8), "PNG signature");
+  free(bytes);
+
+  cairo_surface_t *img = cairo_image_surface_create_from_png(path);
+  cr_assert_eq(cairo_surface_status(img), CAIRO_STATUS_SUCCESS);
+  cr_assert_eq(cairo_image_surface_get_width(img), 400);
+  cr_assert_eq(cairo_image_surface_get_height(img), 200);
+  cairo_surface_flush(img);
+  cr_assert(grey(img, 120, 100) < 40, "on the straight line: %d", grey(img, 120, 100));
+  /* circle's rightmost point (90, 25) mm = (360, 100) px, and its top (80, 15) mm */
+  cr_assert(grey(img, 359, 100) < 100 || grey(img, 360, 100) < 100, "on the circle");
+  cr_assert(grey(img, 320, 60) < 100 || grey(img, 320, 59) < 100, "circle top");
+  /* far from every line: white */
+  cr_assert_eq(grey(img, 120, 20), 255);
+  cr_assert_eq(grey(img, 320, 100), 255, "circle centre");
+  cr_assert_eq(grey(img, 5, 190), 255);
+  /* the end cap does not reach x = 65 mm */
+  cr_assert_eq(grey(img, 260, 100), 255);
+  cairo_surface_destroy(img);
+  lw_splines_free(sp);
+  remove_dir(dir);
+}
+
+Test(output, png_size_is_capped)
+{
+  lw_output_page page;
+  lw_output_page_init(&page, 1000, 500);
+  int w, h;
+  double k;
+  cr_assert(lw_output_png_size(&page, 10.0, &w, &h, &k));
+  cr_assert_eq(w, LW_OUTPUT_PNG_MAX_PX);
+  cr_assert_eq(h, LW_OUTPUT_PNG_MAX_PX / 2);
+  cr_assert(fabs(k - 4.096) < 1e-12);
+  lw_output_page_init(&page, 210, 297);
+  cr_assert(lw_output_png_size(&page, 2.0, &w, &h, &k));
+  cr_assert(w == 420 && h == 594 && k == 2.0);
+  cr_assert(!lw_output_png_size(&page, 0.0, &w, &h, &k));
+  cr_assert(!lw_output_png_size(&page, NAN, &w, &h, &k));
+
+  /* and the file really has the capped size */
+  char dir[64], path[128];
+  make_dir(dir);
+  snprintf(path, sizeof path, "%s/big.png", dir);
+  size_t segs[1] = {1};
+  lw_splines *sp = lw_splines_new(1, segs, NULL);
+  lw_test_straight(sp, 0, 0, 0, 1000, 500);
+  lw_output_page_init(&page, 1000, 500);
+  lw_error err;
+  cr_assert_eq(lw_output_png(sp, &page, 10.0, path, &err), LW_OK, "%s", err.msg);
+  cairo_surface_t *img = cairo_image_surface_create_from_png(path);
+  cr_assert_eq(cairo_image_surface_get_width(img), 4096);
+  cr_assert_eq(cairo_image_surface_get_height(img), 2048);
+  cairo_surface_destroy(img);
+  lw_splines_free(sp);
+  remove_dir(dir);
+}
+
+Test(output, atomic_write_missing_directory_fails_with_path)
+{
+  char dir[64], path[160];
+  make_dir(dir);
+  snprintf(path, sizeof path, "%s/no/such/dir/drawing.svg", dir);
+  lw_splines *sp = two_splines();
+  lw_output_page page;
+  lw_output_page_init(&page, 210, 297);
+  lw_error err;
+  lw_error_clear(&err);
+  cr_assert_eq(lw_output_svg(sp, &page, path, &err), LW_EIO);
+  cr_assert_not_null(strstr(err.msg, path), "message names the path: %s", err.msg);
+  lw_error_clear(&err);
+  snprintf(path, sizeof path, "%s/no/preview.png", dir);
+  cr_assert_eq(lw_output_png(sp, &page, 1.0, path, &err), LW_EIO);
+  cr_assert_not_null(strstr(err.msg, path), "%s", err.msg);
+  cr_assert_eq(count_tmp(dir), 0);
+  lw_splines_free(sp);
+  remove_dir(dir);
+}
+
+Test(output, atomic_write_replaces_an_existing_file)
+{
+  char dir[64], path[128];
+  make_dir(dir);
+  snprintf(path, sizeof path, "%s/drawing.svg", dir);
+  write_text(path, "old content that is not an svg\n");
+  lw_splines *sp = two_splines();
+  lw_output_page page;
+  lw_output_page_init(&page, 210, 297);
+  lw_error err;
+  cr_assert_eq(lw_output_svg(sp, &page, path, &err), LW_OK, "%s", err.msg);
+  char *s = slurp(path, NULL);
+  cr_assert(!strncmp(s, "<?xml", 5));
+  cr_assert_null(strstr(s, "old content"));
+  cr_assert_not_null(strstr(s, "</svg>\n"));
+  cr_assert_eq(count_tmp(dir), 0);
+  free(s);
+  lw_splines_free(sp);
+  remove_dir(dir);
+}
+
+Test(output, atomic_write_failed_rename_removes_tmp)
+{
+  /* The target is a directory: the temporary file is written but cannot be
+  ** renamed over it.  The directory stays, the temporary file goes. */
+  char dir[64], path[128];
+  make_dir(dir);
+  snprintf(path, sizeof path, "%s/drawing.svg", dir);
+  cr_assert_eq(mkdir(path, 0700), 0);
+  lw_splines *sp = two_splines();
+  lw_output_page page;
+  lw_output_page_init(&page, 210, 297);
+  lw_error err;
+  lw_error_clear(&err);
+  cr_assert_eq(lw_output_svg(sp, &page, path, &err), LW_EIO);
+  cr_assert_not_null(strstr(err.msg, path), "%s", err.msg);
+  struct stat st;
+  cr_assert_eq(stat(path, &st), 0);
+  cr_assert(S_ISDIR(st.st_mode));
+  cr_assert_eq(count_tmp(dir), 0);
+  lw_splines_free(sp);
+  remove_dir(dir);
+}
+
+Test(output, open_tmp_and_commit_for_text_files)
+{
+  char dir[64], path[128], tmp[LW_OUTPUT_PATH_MAX];
+  make_dir(dir);
+  snprintf(path, sizeof path, "%s/trace.csv", dir);
+  write_text(path, "old\n");
+  lw_error err;
+  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, &err);
+  cr_assert_not_null(f, "%s", err.msg);
+  fputs("sweep,energy\n1,2.5\n", f);
+  /* until the commit, readers see the old file */
+  char *s = slurp(path, NULL);
+  cr_assert_str_eq(s, "old\n");
+  free(s);
+  cr_assert_eq(count_tmp(dir), 1);
+  cr_assert_eq(lw_output_commit(f, tmp, path, &err), LW_OK, "%s", err.msg);
+  s = slurp(path, NULL);
+  cr_assert_str_eq(s, "sweep,energy\n1,2.5\n");
+  free(s);
+  cr_assert_eq(count_tmp(dir), 0);
+  /* abort leaves the old file */
+  f = lw_output_open_tmp(path, tmp, sizeof tmp, &err);
+  fputs("half", f);
+  lw_output_abort(f, tmp);
+  s = slurp(path, NULL);
+  cr_assert_str_eq(s, "sweep,energy\n1,2.5\n");
+  free(s);
+  cr_assert_eq(count_tmp(dir), 0);
+  /* a temporary name that does not fit */
+  char small[8];
+  cr_assert_null(lw_output_open_tmp(path, small, sizeof small, &err));
+  cr_assert_eq(err.code, LW_EIO);
+  remove_dir(dir);
+}
+
+/* ---- JSON ----------------------------------------------------------- */
+
+/* Runs the writer into a memory buffer; returns the text (caller frees). */
+typedef struct {
+  FILE *f;
+  char *buf;
+  size_t len;
+  lw_json j;
+} json_buf;
+
+static void json_open(json_buf *b)
+{
+  b->f = open_memstream(&b->buf, &b->len);
+  cr_assert_not_null(b->f);
+  lw_json_init(&b->j, b->f);
+}
+
+static char *json_close(json_buf *b, lw_status want)
+{
+  lw_error err;
+  lw_error_clear(&err);
+  cr_assert_eq(lw_json_finish(&b->j, &err), want, "%s", err.msg);
+  fclose(b->f);
+  return b->buf;
+}
+
+Test(output, json_nested_exact_text)
+{
+  json_buf b;
+  json_open(&b);
+  lw_json *j = &b.j;
+  lw_json_begin_object(j);
+  lw_json_key(j, "name");
+  lw_json_string(j, "run");
+  lw_json_key(j, "sweeps");
+  lw_json_int(j, 1000);
+  lw_json_key(j, "energy");
+  lw_json_begin_object(j);
+  lw_json_key(j, "total");
+  lw_json_number(j, 1.5);
+  lw_json_key(j, "terms");
+  lw_json_begin_array(j);
+  lw_json_number(j, 0.1);
+  lw_json_number(j, -2e-300);
+  lw_json_begin_array(j);
+  lw_json_end_array(j);
+  lw_json_begin_object(j);
+  lw_json_end_object(j);
+  lw_json_end_array(j);
+  lw_json_end_object(j);
+  lw_json_key(j, "ok");
+  lw_json_bool(j, 1);
+  lw_json_key(j, "failed");
+  lw_json_bool(j, 0);
+  lw_json_key(j, "none");
+  lw_json_null(j);
+  lw_json_end_object(j);
+  char *s = json_close(&b, LW_OK);
+  cr_assert_str_eq(s,
+                   "{\n"
+                   "  \"name\": \"run\",\n"
+                   "  \"sweeps\": 1000,\n"
+                   "  \"energy\": {\n"
+                   "    \"total\": 1.5,\n"
+                   "    \"terms\": [\n"
+                   "      0.10000000000000001,\n"
+                   "      -2.0000000000000001e-300,\n"
+                   "      [],\n"
+                   "      {}\n"
+                   "    ]\n"
+                   "  },\n"
+                   "  \"ok\": true,\n"
+                   "  \"failed\": false,\n"
+                   "  \"none\": null\n"
+                   "}\n");
+  /* %.17g reads back exactly */
+  cr_assert_eq(strtod("0.10000000000000001", NULL), 0.1);
+  free(s);
+}
+
+Test(output, json_escapes_and_non_finite)
+{
+  json_buf b;
+  json_open(&b);
+  lw_json *j = &b.j;
+  lw_json_begin_array(j);
+  lw_json_string(j, "a\"b\\c\nd\te\x01/\xc3\xa9");
+  lw_json_number(j, NAN);
+  lw_json_number(j, INFINITY);
+  lw_json_number(j, -INFINITY);
+  lw_json_int(j, -9223372036854775807LL);
+  lw_json_end_array(j);
+  char *s = json_close(&b, LW_OK);
+  cr_assert_str_eq(s,
+                   "[\n"
+                   "  \"a\\\"b\\\\c\\nd\\te\\u0001/\xc3\xa9\",\n"
+                   "  null,\n"
+                   "  null,\n"
+                   "  null,\n"
+                   "  -9223372036854775807\n"
+                   "]\n");
+  free(s);
+
+  /* keys are escaped too */
+  json_open(&b);
+  lw_json_begin_object(&b.j);
+  lw_json_key(&b.j, "k\"");
+  lw_json_int(&b.j, 1);
+  lw_json_end_object(&b.j);
+  s = json_close(&b, LW_OK);
+  cr_assert_str_eq(s, "{\n  \"k\\\"\": 1\n}\n");
+  free(s);
+}
+
+Test(output, json_misuse_is_reported)
+{
+  json_buf b;
+  /* key inside an array */
+  json_open(&b);
+  lw_json_begin_array(&b.j);
+  lw_json_key(&b.j, "x");
+  lw_json_end_array(&b.j);
+  free(json_close(&b, LW_ERUN));
+  /* value in an object without a key */
+  json_open(&b);
+  lw_json_begin_object(&b.j);
+  lw_json_int(&b.j, 1);
+  lw_json_end_object(&b.j);
+  free(json_close(&b, LW_ERUN));
+  /* mismatched end */
+  json_open(&b);
+  lw_json_begin_object(&b.j);
+  lw_json_end_array(&b.j);
+  free(json_close(&b, LW_ERUN));
+  /* left open */
+  json_open(&b);
+  lw_json_begin_object(&b.j);
+  lw_json_key(&b.j, "a");
+  lw_json_begin_array(&b.j);
+  free(json_close(&b, LW_ERUN));
+  /* key without value */
+  json_open(&b);
+  lw_json_begin_object(&b.j);
+  lw_json_key(&b.j, "a");
+  lw_json_end_object(&b.j);
+  free(json_close(&b, LW_ERUN));
+  /* too deep */
+  json_open(&b);
+  for (int i = 0; i <= LW_JSON_MAX_DEPTH; i++) lw_json_begin_array(&b.j);
+  free(json_close(&b, LW_ERUN));
+  /* a second top-level value */
+  json_open(&b);
+  lw_json_int(&b.j, 1);
+  lw_json_int(&b.j, 2);
+  free(json_close(&b, LW_ERUN));
+}
