@@ -76,7 +76,7 @@ Test(cli, energy_prints_each_enabled_term_and_the_total)
 {
   write_file("scene.ini", scene_text);
   size_t segs[2] = {3, 2};
-  lw_state st = {"scene.ini", 7, 0, lw_splines_new(2, segs, NULL)};
+  lw_state st = {.scene = "scene.ini", .seed = 7, .sp = lw_splines_new(2, segs, NULL)};
   lw_test_straight(st.sp, 0, 20, 20, 70, 30);
   lw_test_circle(st.sp, 1, 50, 45, 12);
   char path[128];

@@ -30,7 +30,7 @@ TestSuite(state, .init = make_dir, .fini = remove_dir);
 Test(state, round_trip_is_bit_exact)
 {
   size_t segs[3] = {1, 4, 2};
-  lw_state st = {"scene.ini", 12345, 678, lw_splines_new(3, segs, NULL)};
+  lw_state st = {.scene = "scene.ini", .seed = 12345, .sweep = 678, .sp = lw_splines_new(3, segs, NULL)};
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
   for (size_t k = 0; k < st.sp->n_nodes; k++) {
     /* high-entropy values across many magnitudes */
@@ -103,7 +103,7 @@ Test(state, failed_write_keeps_the_old_file)
   char path[128];
   snprintf(path, sizeof path, "%s/nodir/state.lw", dir);
   size_t segs[1] = {1};
-  lw_state st = {"s.ini", 1, 0, lw_splines_new(1, segs, NULL)};
+  lw_state st = {.scene = "s.ini", .seed = 1, .sp = lw_splines_new(1, segs, NULL)};
   lw_error err;
   cr_assert_eq(lw_state_write(&st, path, &err), LW_EIO);
   cr_assert(strstr(err.msg, "nodir"));
