@@ -64,11 +64,15 @@ run: bin/linewise
 docs: bin/linewise
 	{ sed '/^## \[/,$$d' docs/PARAMETERS.md; bin/linewise params | sed 1d; } > docs/PARAMETERS.md.new
 	mv docs/PARAMETERS.md.new docs/PARAMETERS.md
+	{ sed '/^| schedule |/,$$d' docs/SCHEDULES.md | sed '$$d'; bin/linewise schedules; } > docs/SCHEDULES.md.new
+	mv docs/SCHEDULES.md.new docs/SCHEDULES.md
 
 install: bin/linewise
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/linewise/params
 	install -m 755 bin/linewise $(DESTDIR)$(PREFIX)/bin/linewise
 	install -m 644 params/*.ini $(DESTDIR)$(PREFIX)/share/linewise/params/
+	install -d $(DESTDIR)$(PREFIX)/share/man/man1
+	install -m 644 docs/linewise.1 $(DESTDIR)$(PREFIX)/share/man/man1/linewise.1
 
 clean:
 	rm -rf build build-asan bin

@@ -35,6 +35,7 @@ static const char usage[] =
   "  energy DIR          recompute DIR/state.lw's energy from scratch with its scene;\n"
   "                      prints '<term> <value>' per enabled term, then 'total <value>'\n"
   "  params              print every scene parameter as Markdown (docs/PARAMETERS.md)\n"
+  "  schedules           print the temperature schedules as Markdown (docs/SCHEDULES.md)\n"
   "  help                this text\n"
   "\n"
   "exit status: 0 done, 1 failed while running, 2 bad usage or bad input\n";
@@ -294,8 +295,20 @@ static int cmd_resume(int argc, char **argv)
   return rc;
 }
 
+/* "linewise CMD --help" prints the usage and exits 0. */
+static int wants_help(int argc, char **argv)
+{
+  for (int i = 2; i < argc; i++)
+    if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) return 1;
+  return 0;
+}
+
 int main(int argc, char **argv)
 {
+  if (argc >= 2 && wants_help(argc, argv)) {
+    fputs(usage, stdout);
+    return 0;
+  }
   if (argc < 2 || !strcmp(argv[1], "help") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
     fputs(usage, argc < 2 ? stderr : stdout);
     return argc < 2 ? 2 : 0;
@@ -303,6 +316,12 @@ int main(int argc, char **argv)
   if (!strcmp(argv[1], "energy")) return cmd_energy(argc - 2, argv + 2);
   if (!strcmp(argv[1], "run")) return cmd_run(argc - 2, argv + 2);
   if (!strcmp(argv[1], "resume")) return cmd_resume(argc - 2, argv + 2);
+  if (!strcmp(argv[1], "schedules")) {
+    printf("\n| schedule | temperature of step b of B |\n|---|---|\n");
+    for (const lw_schedule_type *const *t = lw_schedule_types; *t; t++)
+      printf("| `%s` | %s |\n", (*t)->name, (*t)->formula);
+    return 0;
+  }
   if (!strcmp(argv[1], "params")) {
     lw_params_write_doc(stdout);
     return 0;

@@ -159,15 +159,15 @@ Test(cli, empty_scene_has_zero_energy)
   cr_assert_str_eq(out, "pair 0\nboundary 0\ntotal 0\n");
 }
 
-Test(cli, parameter_reference_is_current)
+/* A generated reference must end with exactly what the command prints. */
+static void check_generated_doc(const char *command, const char *doc_name)
 {
-  /* docs/PARAMETERS.md must end with exactly what the table generates */
   const char *root = getenv("LW_ROOT");
   cr_assert_not_null(root);
   static char out[65536], errs[1024], doc[131072];
-  cr_assert_eq(run("params", out, sizeof out, errs, sizeof errs), 0);
+  cr_assert_eq(run(command, out, sizeof out, errs, sizeof errs), 0);
   char path[1024];
-  snprintf(path, sizeof path, "%s/docs/PARAMETERS.md", root);
+  snprintf(path, sizeof path, "%s/docs/%s", root, doc_name);
   FILE *f = fopen(path, "r");
   cr_assert_not_null(f, "%s missing", path);
   size_t n = fread(doc, 1, sizeof doc - 1, f);
@@ -175,5 +175,11 @@ Test(cli, parameter_reference_is_current)
   fclose(f);
   const char *gen = out + 1; /* the generated text starts with a blank line */
   size_t lg = strlen(gen);
-  cr_assert(n >= lg && !strcmp(doc + n - lg, gen), "docs/PARAMETERS.md is stale: run 'make docs'");
+  cr_assert(n >= lg && !strcmp(doc + n - lg, gen), "docs/%s is stale: run 'make docs'", doc_name);
+}
+
+Test(cli, generated_references_are_current)
+{
+  check_generated_doc("params", "PARAMETERS.md");
+  check_generated_doc("schedules", "SCHEDULES.md");
 }
