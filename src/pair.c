@@ -3,52 +3,53 @@
 **
 ** lw_pair_segseg
 ** --------------
-** Put segment A on the x axis: a(s) = (s, 0), s in [0, La].  Segment B starts
-** at (beta0, eta0) with unit direction (c, sn); orienting B so that c >= 0
-** changes nothing (the integral ignores orientation) and keeps the lines'
-** intersection O "in front of" both when they are nearly parallel.  With z and
-** t the signed coordinates from O along A and B (sigma = |sn|),
+** Put segment A on the x axis, a(s) = (s, 0), s in [0, La].  Segment B starts
+** at (beta0, eta0) with unit direction (c, sn); B is oriented so that c >= 0
+** (the integral ignores orientation), which puts the lines' intersection O
+** "in front of" both when they are nearly parallel.  With z and t the signed
+** coordinates from O along A and B, sigma = |sn|,
 **
 **     G(z, t) = z asinh((t - z c) / (|z| sigma)) + t asinh((z - t c) / (|t| sigma))
 **
 ** has d2G/dz dt = 1/|x - y|, so the integral is the corner sum
-** G(z1,t1) - G(z0,t1) - G(z1,t0) + G(z0,t0).  (A term with z = 0 or t = 0
-** is 0 in the limit.)  Written like this, each corner term is of size |z|,
-** |t| times a log, and the terms cancel to the answer: for nearly parallel
-** lines O is far away (|z| ~ distance / sigma) and the cancellation costs
-** eps / sigma relative accuracy.  Two rewrites remove it:
+** G(z1,t1) - G(z0,t1) - G(z1,t0) + G(z0,t0); a term with z = 0 or t = 0 is
+** 0 in the limit.  Evaluated as written, each corner term is |z| or |t| times
+** a log and the four cancel down to the answer; for nearly parallel lines O
+** is far away (|z| ~ distance / sigma) and the cancellation costs eps / sigma
+** of relative accuracy.  Per corner, with R the distance of its two endpoints,
+** p = (b_j - a_i).w, q = (a_i - b_j).u, h = |z| sigma and k = |t| sigma the
+** endpoints' distances from the other line (G = z asinh(p/h) + t asinh(q/k)):
 **
-**   same-side corners (z, t of one sign; G(-z,-t) = G(z,t), so take both > 0):
-**   with h = z sigma and k = t sigma the distances of the two endpoints from
-**   the other line, delta = t - z and tau = sigma / (1 + c) = tan(theta/2),
-**
-**       G = z (asinh a - asinh b) - delta asinh b,
-**       a = delta/h + tau,  b = delta/k - tau,
-**       (a - b)/sigma = delta^2/(h k) + 2/(1 + c)   (k - h = sigma delta),
-**
-**   so z (asinh a - asinh b) = h * [(asinh a - asinh b)/(a - b)] * (a - b)/sigma
-**   is a product of well-conditioned factors, bounded by the corner's own
-**   geometry (it tends to the endpoint distance sqrt(delta^2 + h^2) as the
-**   lines become parallel).  With sigma = 0 exactly this is the parallel-line
-**   formula, so parallel lines need no separate branch.  delta itself is
-**   computed from endpoint differences (never from the far-away O):
+**   same side (z, t of one sign; G is even, so take both > 0): with
+**   delta = t - z, G = z S + delta asinh(q/k), S = asinh(p/h) + asinh(q/k),
+**   and (R + p)(R + q) / (h k) = 1 + X where
+**       X = [sigma^2 delta^2 + 2 h k (1 - c) + sigma R (h + k)] / ((1 + c) h k)
+**   has no cancellation (every term >= 0), so
+**       z S = h * [log1p(X) / X] * [X / sigma]
+**   keeps full relative accuracy however far away O is; X / sigma contains no
+**   1/sigma ((1 - c)/sigma = sigma/(1 + c)).  z S tends to R as the lines
+**   become parallel, and sigma = 0 gives the parallel-line formula itself.
+**   delta comes from endpoint differences, never from O:
 **   t - z = beta_j - s_i + eta_j sn / (1 + c).
 **
-**   opposite-side corners (z, t of different signs, or one of them 0): with
-**   c >= 0 the endpoints are at least sqrt(z^2 + t^2) apart, so |z|, |t| are
-**   bounded by their own distance and the plain G is well conditioned.
+**   opposite sides (z, t of different signs, or one of them 0): with c >= 0
+**   the endpoints are at least sqrt(z^2 + t^2) apart, so |z|, |t| <= R and the
+**   plain G is well conditioned.
 **
-** Every input to these formulas is derived from one set of numbers (La, Lb,
-** beta0, eta0, c, sn), i.e. from one slightly rounded geometry, so the
-** identities used above (k - h = sigma delta, ...) hold for it and the result
-** is backward stable.  The remaining cancellation is the ordinary one of the
-** four-corner sum, ~ (distance/length)^2 when the segments are far apart
-** compared with their lengths; there a Gauss-Legendre rule over the shorter
-** segment of the other one's exact potential is both accurate and stable
-** (see FAR_RATIO).
+** All these inputs derive from one set of numbers (La, Lb, beta0, eta0, c, sn),
+** one slightly rounded geometry, so the identities used (k - h = sigma delta,
+** ...) hold for it and the result is backward stable.  The cancellation left
+** is that of the four-corner sum itself, ~ (distance / length)^2 for segments
+** far apart and ~ La / Lb for very unequal lengths; FAR_RATIO and SPLIT_RATIO
+** route those cases to a Gauss-Legendre rule of the exact potential, which is
+** accurate there.  Measured against 40-digit references (mpmath): 1e-15 to
+** 3e-14 relative over crossing, skew, parallel, near-parallel (sigma from
+** 1e-12 to 1), collinear and far-apart configurations; endpoint-touching
+** configurations reach 3e-14 because the integral itself is sensitive there
+** (moving an endpoint by e changes it by ~ e log e).
 **
-** Collinear segments (sn = 0 and eta0 = 0) have G -> |u| log|u| summed over
-** the endpoint offsets u, finite when disjoint, +inf when overlapping.
+** Collinear segments: G -> |u| log|u| summed over the endpoint offsets u,
+** finite when disjoint (or meeting end to end), +inf when overlapping.
 */
 #include "linewise/pair.h"
 
@@ -57,83 +58,66 @@
 
 /* ---- the exact element integral ---------------------------------------- */
 
-/* asinh(p / h) for h > 0 without overflow for |p| >> h. */
-static double asinh_ratio(double p, double h)
+/* log((|x| + R) / d) * sign(x) = asinh(x / d) for R = sqrt(x^2 + d^2), d > 0;
+** the log form is free of overflow and costs one log. */
+static double asinh_r(double x, double R, double d)
 {
-  double ap = fabs(p);
-  if (ap > 1e8 * h) {
-    /* asinh x = log 2x + 1/(4x^2) - ...: the tail is below rounding here */
-    double v = log(2.0 * ap) - log(h);
-    return p < 0 ? -v : v;
-  }
-  return asinh(p / h);
+  if (x == 0.0) return 0.0; /* also where R = 0: coincident corner points */
+  double v = log((fabs(x) + R) / d);
+  return x < 0.0 ? -v : v;
 }
 
-/* (asinh a - asinh b) / (a - b) for a >= b; 1/sqrt(1+a^2) when a == b. */
-static double asinh_slope(double a, double b)
+/* Same-side corner distances below TINY * (La + Lb) are raised to it so that
+** R / h and delta^2 / (h k) stay finite; only inputs closer than 1e-140 of
+** the segment length to the other line are affected. */
+#define TINY 1e-140
+
+/*
+** G at one corner.  si: the corner's position along A (0 or La); the B end is
+** (bj, ej) in A's frame; zeta: signed distance of the A end from line B,
+** cross(w, a_i - b0).  With R the corner's endpoint distance,
+** p = (b_j - a_i).w, q = (a_i - b_j).u, h = |zeta|, k = |ej|:
+**     G = z asinh(p/h) + t asinh(q/k).
+** Same side (z, t > 0 after the even flip): with delta = t - z,
+**     G = z S + delta asinh(q/k),   S = asinh(p/h) + asinh(q/k),
+** and (R + p)(R + q) / (h k) = 1 + X with
+**     X = [sigma^2 delta^2 + 2 h k (1 - c) + sigma R (h + k)] / ((1 + c) h k),
+** every term >= 0, so z S = h log1p(X)/X * X/sigma keeps full relative
+** accuracy however far O is; X/sigma has no 1/sigma in it
+** ((1 - c)/sigma = tau = sigma/(1 + c)).
+*/
+static double corner(double si, double bj, double ej, double zeta, double c, double sn,
+                     double sigma, double tau, double inv1c, double floor_)
 {
-  if (b < 0.0 && a <= 0.0) { /* mirror to the side where the formula is stable */
-    double t = -b;
-    b = -a;
-    a = t;
-  }
-  double d = a - b;
-  if (b >= 0.0) {
-    /* asinh a - asinh b = asinh(X), X = (a - b)(a + b) / (a Sb + b Sa) */
-    if (b > 1e8) {
-      /* asinh a - asinh b = log(a/b) + O(1/b^2) */
-      double y = d / b;
-      return y > 1e-8 ? log1p(y) / d : (1.0 - 0.5 * y) / b;
+  double dx = bj - si;
+  double R = sqrt(dx * dx + ej * ej);
+  if (sn == 0.0 || zeta * ej < 0.0) {
+    /* sign(t) = sign(ej sn); for sn == 0 every corner counts as same-side and
+    ** the sign is immaterial (G is even) */
+    double delta = dx + ej * (sn * inv1c), q = -dx;
+    if (ej * sn < 0.0) {
+      delta = -delta;
+      q = -q;
     }
-    double sa = sqrt(1.0 + a * a), sb = sqrt(1.0 + b * b);
-    double den = a * sb + b * sa;
-    if (!(den > 0.0)) return 1.0; /* a = b = 0 */
-    double f = (a + b) / den;
-    double X = d * f;
-    double r = fabs(X) < 1e-5 ? 1.0 - X * X / 6.0 : asinh(X) / X;
-    return r * f;
-  }
-  /* a > 0 > b: no cancellation */
-  return (asinh(a) - asinh(b)) / d;
-}
-
-/* Upper bound of the ratio h/|delta| below which a same-side corner's
-** distances are floored, so delta/h and delta^2/(h k) stay finite.  Only
-** inputs closer than 1e-280 of the segment length are affected. */
-#define TINY 1e-280
-
-/* G at one corner.  si: the corner's position along A (0 or La); the B end
-** is (bj, ej) in A's frame.  zeta: signed distance of the A end from line B
-** (cross(w, a - b0)). */
-static double corner(double si, double bj, double ej, double zeta,
-                     double c, double sn, double sigma, double tau, double scale)
-{
-  int same = sn == 0.0 ? 1 : (zeta * ej < 0.0);
-  if (same) {
-    /* sign(t) = sign(ej * sn); for sn == 0 every corner counts as same-side
-    ** and the sign is immaterial (G is even). */
-    double delta = bj - si + ej * (sn / (1.0 + c));
-    if (ej * sn < 0.0) delta = -delta;
     double h = fabs(zeta), k = fabs(ej);
-    double floor_ = TINY * scale;
     if (h < floor_) h = floor_;
     if (k < floor_) k = floor_;
-    double a = delta / h + tau, b = delta / k - tau;
-    double m = delta * (delta / k) + 2.0 * h / (1.0 + c); /* h (a - b)/sigma */
-    return asinh_slope(a, b) * m - delta * asinh(b);
+    double ih = 1.0 / h, ik = 1.0 / k;
+    double xs = (sigma * delta * delta * ih * ik + 2.0 * tau + R * (ih + ik)) * inv1c; /* X / sigma */
+    double X = sigma * xs;
+    /* log1p(X)/X; log(1 + X) is as accurate for X >= 0.5 and much cheaper */
+    double l = X >= 0.5 ? log(1.0 + X) / X : (X > 1e-8 ? log1p(X) / X : 1.0 - 0.5 * X);
+    double g = h * l * xs;
+    if (q != 0.0) {
+      double v = log((fabs(q) + R) * ik); /* asinh(|q| / k) */
+      g += q < 0.0 ? -delta * v : delta * v;
+    }
+    return g;
   }
-  /* opposite sides: plain G; z = -zeta/sn, t = ej/sn */
-  double g = 0.0;
-  if (zeta != 0.0) {
-    double z = -zeta / sn;
-    double p = (bj - si) * c + ej * sn; /* (b_j - a_i) . w */
-    g += z * asinh_ratio(p, fabs(zeta));
-  }
-  if (ej != 0.0) {
-    double t = ej / sn;
-    double q = si - bj; /* (a_i - b_j) . u */
-    g += t * asinh_ratio(q, fabs(ej));
-  }
+  /* opposite sides: plain G with z = -zeta/sn, t = ej/sn (|z|, |t| <= R) */
+  double g = 0.0, isn = 1.0 / sn;
+  if (zeta != 0.0) g -= zeta * isn * asinh_r(dx * c + ej * sn, R, fabs(zeta));
+  if (ej != 0.0) g += ej * isn * asinh_r(-dx, R, fabs(ej));
   return g;
 }
 
@@ -206,20 +190,25 @@ static double gap_bound(double La, double beta0, double eta0, double beta1, doub
 static double corner_sum(double La, double Lb, double beta0, double eta0, double c, double sn)
 {
   double beta1 = beta0 + Lb * c, eta1 = eta0 + Lb * sn;
-  if (sn == 0.0 && eta0 == 0.0) {
-    /* collinear: B = [beta0, beta1] on A's line, beta1 > beta0 */
+  /* Collinear within the rounding of the frame (eta0 is a cross product of
+  ** rounded differences): B = [beta0, beta1] on A's line, beta1 > beta0.  An
+  ** overlap within that rounding counts as touching, so segments that meet
+  ** end to end stay finite and identical ones are +inf whatever the
+  ** rounding. */
+  double tol = 32.0 * DBL_EPSILON * (fabs(beta0) + fabs(eta0) + La + Lb);
+  if (fabs(eta0) <= tol && fabs(eta1) <= tol) {
     double lo = beta0 > 0.0 ? beta0 : 0.0, hi = beta1 < La ? beta1 : La;
-    if (hi > lo) return INFINITY;
+    if (hi - lo > tol) return INFINITY;
     return xlogx(La - beta0) + xlogx(beta1) - xlogx(La - beta1) - xlogx(beta0);
   }
-  double sigma = fabs(sn), tau = sigma / (1.0 + c);
-  double scale = La + Lb;
+  double inv1c = 1.0 / (1.0 + c), sigma = fabs(sn), tau = sigma * inv1c;
+  double fl = TINY * (La + Lb);
   /* zeta_i = cross(w, a_i - b0), the signed distance of A's ends from line B */
   double zeta0 = sn * beta0 - c * eta0, zeta1 = zeta0 - sn * La;
-  double g11 = corner(La, beta1, eta1, zeta1, c, sn, sigma, tau, scale);
-  double g01 = corner(0.0, beta1, eta1, zeta0, c, sn, sigma, tau, scale);
-  double g10 = corner(La, beta0, eta0, zeta1, c, sn, sigma, tau, scale);
-  double g00 = corner(0.0, beta0, eta0, zeta0, c, sn, sigma, tau, scale);
+  double g11 = corner(La, beta1, eta1, zeta1, c, sn, sigma, tau, inv1c, fl);
+  double g01 = corner(0.0, beta1, eta1, zeta0, c, sn, sigma, tau, inv1c, fl);
+  double g10 = corner(La, beta0, eta0, zeta1, c, sn, sigma, tau, inv1c, fl);
+  double g00 = corner(0.0, beta0, eta0, zeta0, c, sn, sigma, tau, inv1c, fl);
   double v = (g11 - g01) - (g10 - g00);
   /* the integral is positive; a negative v can only be rounding of a value
   ** negligible against the corner terms */
@@ -275,6 +264,32 @@ double lw_pair_segseg(const double a0[2], const double a1[2],
 
 /* ---- the kernel --------------------------------------------------------- */
 
+/*
+** Zones of a sample pair at node distance r, with dm = max(dl_a, dl_b):
+**   r <  near dm            exact integral over the two elements (segseg);
+**                           at least to PAIR_TOUCH dm
+**   r <  PAIR_MID near dm   2x2 Gauss-Legendre over the two elements; its outer
+**                           PAIR_BLEND part blends smoothly into the node rule
+**   beyond                  the node rule dl_a dl_b / r
+** Why the middle zone: a node is not the centre of its element, so the node
+** rule's error on one element pair has a first-order part (~ offset / r) that
+** the Gauss rule cancels only over whole segments.  Switching to element
+** integrals at a radius cuts that cancellation and leaves an error of ~
+** (1 / radius)^2 whatever the geometry (even for lines far apart, where the
+** node rule alone is exact to rounding); the cheap element rule pushes that
+** radius out at 4 inverse distances per pair, while the costly exact
+** integral is needed only where elements can touch.  See
+** tools/pair-accuracy.c for the measurements.
+*/
+#define PAIR_MID 6.0
+#define PAIR_BLEND 0.25
+/* A node lies within 0.6103 of its element's length from either end of the
+** element (the end elements; checked for n = 2..64), so two elements can
+** touch only if their nodes are closer than 1.2206 dm: the exact
+** zone always reaches that far, so that the element rule never meets
+** touching elements (where it would be inaccurate or infinite). */
+#define PAIR_TOUCH 1.25
+
 void lw_pair_ctx_init(lw_pair_ctx *ctx, const lw_quad *q, double cutoff, double near)
 {
   ctx->cutoff = cutoff > 0.0 ? cutoff : 0.0;
@@ -290,13 +305,62 @@ void lw_pair_ctx_init(lw_pair_ctx *ctx, const lw_quad *q, double cutoff, double 
   }
 }
 
+/* 2x2 Gauss-Legendre over the elements of a and b: the element of a runs
+** over r_a + u r'_a, u in [-lo, hi], so its centre is at u = (hi - lo)/2. */
+static double element_rule(const lw_pair_sample *a, const lw_pair_sample *b, const lw_pair_ctx *ctx)
+{
+  const double g = 0.28867513459481288225; /* 1 / (2 sqrt 3) */
+  double la = ctx->elem_lo[a->q], ha = ctx->elem_hi[a->q];
+  double lb = ctx->elem_lo[b->q], hb = ctx->elem_hi[b->q];
+  double ca = 0.5 * (ha - la), wa = g * (ha + la);
+  double cb = 0.5 * (hb - lb), wb = g * (hb + lb);
+  /* centres and half-offsets of the Gauss points */
+  double ax = a->x + ca * a->dx, ay = a->y + ca * a->dy, ox = wa * a->dx, oy = wa * a->dy;
+  double bx = b->x + cb * b->dx, by = b->y + cb * b->dy, px = wb * b->dx, py = wb * b->dy;
+  double dx = ax - bx, dy = ay - by;
+  double s = 0.0;
+  for (int i = -1; i <= 1; i += 2)
+    for (int j = -1; j <= 1; j += 2) {
+      double ex = dx + i * ox - j * px, ey = dy + i * oy - j * py;
+      s += 1.0 / sqrt(ex * ex + ey * ey);
+    }
+  return 0.25 * s * a->dl * b->dl;
+}
+
 double lw_pair_kernel(const lw_pair_sample *a, const lw_pair_sample *b, const lw_pair_ctx *ctx)
 {
   double dx = a->x - b->x, dy = a->y - b->y;
   double r2 = dx * dx + dy * dy;
-  if (ctx->cutoff > 0.0 && r2 >= ctx->cutoff * ctx->cutoff) return 0.0;
-  double rn = ctx->near * (a->dl > b->dl ? a->dl : b->dl);
-  if (r2 >= rn * rn) return a->dl * b->dl * (1.0 / sqrt(r2) - ctx->inv_cutoff);
+  double rc = ctx->cutoff;
+  if (rc > 0.0 && r2 >= rc * rc) return 0.0;
+  double dm = a->dl > b->dl ? a->dl : b->dl;
+  double fo = PAIR_MID * ctx->near; /* outer radius of the element zone / dm */
+  if (fo > 0.0 && fo < PAIR_TOUCH) fo = PAIR_TOUCH;
+  double ro = fo * dm;
+  /* the element zone ends by the cutoff, so the kernel is continuous there */
+  if (rc > 0.0 && ro > rc) ro = rc;
+  double ll = a->dl * b->dl;
+  if (r2 >= ro * ro) return ll * (1.0 / sqrt(r2) - ctx->inv_cutoff);
+  /* A fixed order of the two samples makes the kernel bitwise symmetric, so
+  ** sums over pairs taken in either order (whole energy, move deltas) agree
+  ** to the last bit; samples of different splines are never tied. */
+  if (a->x > b->x || (a->x == b->x && (a->y > b->y || (a->y == b->y && a->spline > b->spline)))) {
+    const lw_pair_sample *t = a;
+    a = b;
+    b = t;
+  }
+  double shift = ll * ctx->inv_cutoff;
+  double rn = (ctx->near > PAIR_TOUCH ? ctx->near : PAIR_TOUCH) * dm;
+  if (r2 >= rn * rn) {
+    double v = element_rule(a, b, ctx) - shift;
+    double r = sqrt(r2), rb = (1.0 - PAIR_BLEND) * ro;
+    if (r > rb) {
+      /* C1 blend into the node rule over the outer part of the zone */
+      double t = (r - rb) / (ro - rb), w = t * t * (3.0 - 2.0 * t);
+      v += w * (ll * (1.0 / r - ctx->inv_cutoff) - v);
+    }
+    return v;
+  }
   /* near field: the exact integral over the two tangent elements */
   double lo = ctx->elem_lo[a->q], hi = ctx->elem_hi[a->q];
   double a0[2] = {a->x - lo * a->dx, a->y - lo * a->dy};
@@ -305,5 +369,5 @@ double lw_pair_kernel(const lw_pair_sample *a, const lw_pair_sample *b, const lw
   hi = ctx->elem_hi[b->q];
   double b0[2] = {b->x - lo * b->dx, b->y - lo * b->dy};
   double b1[2] = {b->x + hi * b->dx, b->y + hi * b->dy};
-  return lw_pair_segseg(a0, a1, b0, b1) - a->dl * b->dl * ctx->inv_cutoff;
+  return lw_pair_segseg(a0, a1, b0, b1) - shift;
 }

@@ -1,0 +1,748 @@
+/* test_pair.c -- the exact segment-segment integral and the pair kernel (pair.h). */
+#include <criterion/criterion.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_integration.h>
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#include "linewise/pair.h"
+#include "linewise/quad.h"
+#include "linewise/spline.h"
+#include "testutil.h"
+
+/* The recommended default near-field radius (pair.h, tools/pair-accuracy.c). */
+#define NEAR_DEFAULT 1.5
+
+static const double PI = 3.14159265358979323846;
+
+/* ---- helpers ------------------------------------------------------------ */
+
+/* xorshift64*: a fixed, portable stream of test configurations. */
+static uint64_t rng_state = 88172645463325252ull;
+static double urand(double lo, double hi)
+{
+  rng_state ^= rng_state >> 12;
+  rng_state ^= rng_state << 25;
+  rng_state ^= rng_state >> 27;
+  uint64_t x = rng_state * 2685821657736338717ull;
+  return lo + (hi - lo) * ((double)(x >> 11) * (1.0 / 9007199254740992.0));
+}
+
+/*
+** Reference: the potential of B at a point in closed form (the elementary
+** log((r0 + r1 + L) / (r0 + r1 - L)), written without cancellation), integrated
+** over A by adaptive Gauss-Kronrod (GSL qagp) split at every point where it
+** is not smooth: the projections of B's ends onto A and A's crossing with B's
+** line (a log singularity).  Independent of the corner formulas; ~1e-11.
+*/
+typedef struct {
+  double a0[2], u[2], b0[2], w[2], Lb;
+} bf_ctx;
+
+static double bf_potential(double s, void *p)
+{
+  const bf_ctx *c = p;
+  double px = c->a0[0] + s * c->u[0] - c->b0[0], py = c->a0[1] + s * c->u[1] - c->b0[1];
+  double x = px * c->w[0] + py * c->w[1], y = px * c->w[1] - py * c->w[0], L = c->Lb;
+  double r0 = hypot(x, y), r1 = hypot(x - L, y);
+  double d0 = x <= 0 ? r0 - x : y * y / (r0 + x);           /* r0 - x */
+  double d1 = x >= L ? r1 - (L - x) : y * y / (r1 + L - x); /* r1 - (L - x) */
+  return log1p(2.0 * L / (d0 + d1));
+}
+
+static int add_break(double *pts, int n, double v, double hi)
+{
+  for (int k = 0; k < n; k++)
+    if (fabs(pts[k] - v) <= 1e-14 * hi) return n;
+  if (v > 1e-14 * hi && v < hi * (1 - 1e-14)) pts[n++] = v;
+  return n;
+}
+
+static void sort_pts(double *p, int n)
+{
+  for (int i = 1; i < n; i++)
+    for (int j = i; j > 0 && p[j - 1] > p[j]; j--) {
+      double t = p[j];
+      p[j] = p[j - 1];
+      p[j - 1] = t;
+    }
+}
+
+static double brute_segseg(const double a0[2], const double a1[2], const double b0[2], const double b1[2])
+{
+  bf_ctx c;
+  double La = hypot(a1[0] - a0[0], a1[1] - a0[1]);
+  c.Lb = hypot(b1[0] - b0[0], b1[1] - b0[1]);
+  if (La == 0.0 || c.Lb == 0.0) return 0.0;
+  for (int k = 0; k < 2; k++) {
+    c.a0[k] = a0[k];
+    c.b0[k] = b0[k];
+    c.u[k] = (a1[k] - a0[k]) / La;
+    c.w[k] = (b1[k] - b0[k]) / c.Lb;
+  }
+  double pts[6];
+  int n = 0;
+  pts[n++] = 0.0;
+  n = add_break(pts, n, (b0[0] - a0[0]) * c.u[0] + (b0[1] - a0[1]) * c.u[1], La);
+  n = add_break(pts, n, (b1[0] - a0[0]) * c.u[0] + (b1[1] - a0[1]) * c.u[1], La);
+  double sn = c.u[0] * c.w[1] - c.u[1] * c.w[0];
+  if (sn != 0.0) /* A's crossing with B's line */
+    n = add_break(pts, n, ((b0[0] - a0[0]) * c.w[1] - (b0[1] - a0[1]) * c.w[0]) / sn, La);
+  sort_pts(pts, n);
+  pts[n++] = La;
+  gsl_error_handler_t *old = gsl_set_error_handler_off();
+  gsl_integration_workspace *wo = gsl_integration_workspace_alloc(1000);
+  gsl_function F = {bf_potential, &c};
+  double res, err;
+  gsl_integration_qagp(&F, pts, (size_t)n, 0.0, 1e-13, 1000, wo, &res, &err);
+  gsl_integration_workspace_free(wo);
+  gsl_set_error_handler(old);
+  return res;
+}
+
+static double seg(const double p[8])
+{
+  return lw_pair_segseg(p, p + 2, p + 4, p + 6);
+}
+
+/* A straight spline from p to q: equally spaced points, v_k = (p_{k+1} - p_k)/3,
+** so the parametrisation is uniform and r' is constant. */
+static void straight(lw_splines *sp, size_t i, const double p[2], const double q[2])
+{
+  size_t m = lw_splines_segments(sp, i);
+  for (size_t k = 0; k <= m; k++) {
+    lw_node *nd = &sp->node[sp->first[i] + k];
+    double t = (double)k / (double)m;
+    nd->px = p[0] + t * (q[0] - p[0]);
+    nd->py = p[1] + t * (q[1] - p[1]);
+    nd->vx = (q[0] - p[0]) / (3.0 * (double)m);
+    nd->vy = (q[1] - p[1]) / (3.0 * (double)m);
+  }
+}
+
+/* An arc of the circle (cx, cy, R) from angle t0 to t1 in the standard cubic
+** approximation (handles 4/3 tan(dt/4) R), one segment per equal angle step. */
+static void arc(lw_splines *sp, size_t i, double cx, double cy, double R, double t0, double t1)
+{
+  size_t m = lw_splines_segments(sp, i);
+  double dt = (t1 - t0) / (double)m, k = 4.0 / 3.0 * tan(dt / 4.0) * R;
+  for (size_t j = 0; j <= m; j++) {
+    double t = t0 + (double)j * dt;
+    lw_node *nd = &sp->node[sp->first[i] + j];
+    nd->px = cx + R * cos(t);
+    nd->py = cy + R * sin(t);
+    nd->vx = -k * sin(t);
+    nd->vy = k * cos(t);
+  }
+}
+
+/* All samples of spline i as the pair term sees them; returns the count. */
+static size_t spline_samples(const lw_splines *sp, const lw_quad *q, size_t i, lw_pair_sample *out)
+{
+  size_t n = 0;
+  for (size_t m = 0; m < lw_splines_segments(sp, i); m++) {
+    size_t g = lw_segment_index(sp, i, m), k = lw_segment_node(sp, g);
+    lw_samples s;
+    lw_segment_sample(q, &sp->node[k], &sp->node[k + 1], &s);
+    for (int j = 0; j < s.n; j++)
+      out[n++] = (lw_pair_sample){s.x[j], s.y[j], s.dx[j], s.dy[j], s.dl[j], (uint32_t)i, (uint32_t)j};
+  }
+  return n;
+}
+
+/* The pair energy (no coefficient) between splines 0 and 1: the kernel
+** summed over every pair of their samples. */
+static double pair_energy(const lw_splines *sp, int nq, double cutoff, double near)
+{
+  lw_quad q;
+  lw_pair_ctx ctx;
+  cr_assert_eq(lw_quad_init(&q, nq, NULL), LW_OK);
+  lw_pair_ctx_init(&ctx, &q, cutoff, near);
+  size_t na = lw_splines_segments(sp, 0) * (size_t)nq, nb = lw_splines_segments(sp, 1) * (size_t)nq;
+  lw_pair_sample *A = malloc(na * sizeof *A), *B = malloc(nb * sizeof *B);
+  cr_assert(A && B);
+  cr_assert_eq(spline_samples(sp, &q, 0, A), na);
+  cr_assert_eq(spline_samples(sp, &q, 1, B), nb);
+  double e = 0.0;
+  for (size_t i = 0; i < na; i++)
+    for (size_t j = 0; j < nb; j++) e += lw_pair_kernel(&A[i], &B[j], &ctx);
+  free(A);
+  free(B);
+  return e;
+}
+
+static lw_splines *two_splines(size_t ma, size_t mb)
+{
+  size_t segs[2] = {ma, mb};
+  lw_splines *sp = lw_splines_new(2, segs, NULL);
+  cr_assert_not_null(sp);
+  return sp;
+}
+
+/* ---- lw_pair_segseg: fixed values ---------------------------------------- */
+
+/* References computed with mpmath at 40 digits (inner integral in closed
+** form, outer tanh-sinh split at every non-smooth point) from these exact
+** doubles; the near-parallel ones rotate B by asin(sigma). */
+static const struct {
+  const char *name;
+  double p[8];
+  double ref;
+} FIXED[] = {
+    {"crossing at right angles", {0.0, 0.0, 2.0, 0.0, 0.5, -1.0, 0.5, 0.75}, 6.2062952463666230502},
+    {"T: b0 inside A", {0.0, 0.0, 1.0, 0.0, 0.25, 0.0, 0.75, 0.5}, 2.449477309048675235},
+    {"L: shared endpoint", {0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 1.5, 0.5}, 1.2248724705666979926},
+    {"skew, apart", {0.0, 0.0, 1.0, 0.5, 0.5, 1.5, 2.0, 0.75}, 1.5853200163683429008},
+    {"parallel, offset", {0.0, 0.0, 1.0, 0.0, 0.5, 0.25, 2.0, 0.25}, 2.4734439835161117772},
+    {"anti-parallel, close", {0.0, 0.0, 1.0, 0.0, 1.5, 0.001, -0.5, 0.001}, 15.111348090634788323},
+    {"collinear disjoint", {0.0, 0.0, 1.0, 0.0, 1.5, 0.0, 3.0, 0.0}, 0.95477125244221922768},
+    {"far apart", {0.0, 0.0, 1.0, 0.0, 300.0, 400.0, 300.5, 401.0}, 0.0022349503007231653616},
+    {"tiny against long", {0.0, 0.0, 10.0, 0.0, 4.0, 0.001, 4.0001, 0.002}, 0.017695091620297736076},
+    {"near-parallel 1e-12", {0.0, 0.0, 1.0, 0.0, 0.3, 0.001, 1.8, 0.0010000000015}, 10.589314311085224554},
+    {"near-parallel crossing 1e-12",
+     {0.0, 0.0, 1.0, 0.0, -0.09999999999999998, -5e-13, 1.1, 6.999999999999999e-13},
+     58.664559341163824169},
+    {"near-parallel 1e-8", {0.0, 0.0, 1.0, 0.0, 0.3, 0.001, 1.8, 0.001000015}, 10.589309411522721589},
+    {"near-parallel crossing 1e-8", {0.0, 0.0, 1.0, 0.0, -0.09999999999999998, -5e-09, 1.1, 7e-09},
+     40.243878597211458962},
+    {"near-parallel 1e-4", {0.0, 0.0, 1.0, 0.0, 0.3, 0.001, 1.7999999925, 0.00115}, 10.541418601979558665},
+    {"near-parallel crossing 1e-4",
+     {0.0, 0.0, 1.0, 0.0, -0.09999999749999999, -5e-05, 1.0999999965, 7e-05}, 21.823197865077274202},
+};
+
+Test(pair, segseg_matches_high_precision_values)
+{
+  for (size_t k = 0; k < sizeof FIXED / sizeof FIXED[0]; k++) {
+    double v = seg(FIXED[k].p);
+    cr_assert(lw_close_rel(v, FIXED[k].ref, 2e-14, 0.0), "%s: %.17g vs %.17g (rel %.1e)", FIXED[k].name, v,
+              FIXED[k].ref, fabs(v / FIXED[k].ref - 1));
+  }
+}
+
+/* Independent closed forms: parallel lines at distance h (the hint's F) and
+** collinear disjoint segments (its h -> 0 limit, |u| log |u|). */
+static double F_par(double u, double h) { return u * asinh(u / h) - sqrt(u * u + h * h); }
+static double F_col(double u) { return u == 0.0 ? 0.0 : fabs(u) * log(fabs(u)); }
+
+Test(pair, segseg_parallel_and_collinear_closed_forms)
+{
+  /* A = [a0, a1], B = [b0, b1] along x, B at height h */
+  const double cases[][5] = {{0, 1, 0.5, 2, 0.25}, {0, 1, -3, -1, 0.7}, {0, 2, 0.5, 1, 1e-3},
+                             {0, 1, 0, 1, 1e-6},   {0, 1, 1, 2, 0.5},   {-1, 1, 0.2, 0.3, 2}};
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    const double *c = cases[k];
+    double h = c[4];
+    double ref = F_par(c[1] - c[2], h) + F_par(c[0] - c[3], h) - F_par(c[1] - c[3], h) - F_par(c[0] - c[2], h);
+    double p[8] = {c[0], 0, c[1], 0, c[2], h, c[3], h};
+    cr_assert(lw_close_rel(seg(p), ref, 1e-13, 0.0), "parallel case %zu: %.17g vs %.17g", k, seg(p), ref);
+    /* reversed B (anti-parallel): same value */
+    double q[8] = {c[0], 0, c[1], 0, c[3], h, c[2], h};
+    cr_assert(lw_close_rel(seg(q), ref, 1e-13, 0.0), "anti-parallel case %zu", k);
+  }
+  /* collinear: disjoint (finite), end to end (finite), overlapping (+inf) */
+  const double col[][4] = {{0, 1, 1.5, 3}, {0, 1, 1, 2}, {-2, -1, 0.5, 4}, {0, 3, 3, 3.5}};
+  for (size_t k = 0; k < sizeof col / sizeof col[0]; k++) {
+    const double *c = col[k];
+    double ref = F_col(c[1] - c[2]) + F_col(c[0] - c[3]) - F_col(c[1] - c[3]) - F_col(c[0] - c[2]);
+    double p[8] = {c[0], 0, c[1], 0, c[2], 0, c[3], 0};
+    cr_assert(isfinite(seg(p)) && lw_close_rel(seg(p), ref, 1e-13, 0.0), "collinear case %zu: %.17g vs %.17g",
+              k, seg(p), ref);
+    /* the same on a slanted line (rounding makes it only nearly collinear) */
+    double s = 0.6, t = 0.8;
+    double r[8] = {c[0] * s, c[0] * t, c[1] * s, c[1] * t, c[2] * s, c[2] * t, c[3] * s, c[3] * t};
+    cr_assert(isfinite(seg(r)) && lw_close_rel(seg(r), ref, 1e-12, 0.0), "slanted collinear case %zu: %.17g",
+              k, seg(r));
+  }
+  const double over[][8] = {{0, 0, 1, 0, 0.5, 0, 2, 0},  {0, 0, 1, 0, 1, 0, 0, 0},
+                            {0, 0, 1, 1, 0.25, 0.25, 0.5, 0.5}, {-3, -1.5, 3, 1.5, 2, 1, -2, -1},
+                            {0, 0, 0.3, 0.7, 0.3, 0.7, 0, 0}};
+  for (size_t k = 0; k < sizeof over / sizeof over[0]; k++)
+    cr_assert(isinf(seg(over[k])) && seg(over[k]) > 0, "overlap case %zu: %g", k, seg(over[k]));
+}
+
+Test(pair, segseg_zero_length_is_zero)
+{
+  double p[8] = {0.3, 0.3, 0.3, 0.3, 0, 0, 1, 1}; /* A is a point on B */
+  cr_assert_eq(seg(p), 0.0);
+  double q[8] = {0, 0, 1, 0, 2, 2, 2, 2};
+  cr_assert_eq(seg(q), 0.0);
+  double r[8] = {1, 1, 1, 1, 1, 1, 1, 1};
+  cr_assert_eq(seg(r), 0.0);
+}
+
+/* ---- lw_pair_segseg: random configurations against brute force ---------- */
+
+enum { SKEW, CROSS, TOUCH_T, TOUCH_L, PARALLEL, NEAR_PARALLEL, COLLINEAR, N_KINDS };
+static const char *KIND[] = {"skew", "crossing", "T-touching", "L-touching", "parallel", "near-parallel",
+                             "collinear disjoint"};
+
+static void random_config(int kind, double p[8])
+{
+  double a0[2] = {urand(-1, 1), urand(-1, 1)}, a1[2] = {urand(-1, 1), urand(-1, 1)};
+  double La = hypot(a1[0] - a0[0], a1[1] - a0[1]);
+  double ux = (a1[0] - a0[0]) / La, uy = (a1[1] - a0[1]) / La;
+  double ang = urand(0, 2 * PI), l0 = urand(0.05, 1.5), l1 = urand(0.05, 1.5);
+  double wx = cos(ang), wy = sin(ang);
+  double f = urand(0.05, 0.95), P[2] = {a0[0] + f * (a1[0] - a0[0]), a0[1] + f * (a1[1] - a0[1])};
+  p[0] = a0[0], p[1] = a0[1], p[2] = a1[0], p[3] = a1[1];
+  switch (kind) {
+  case SKEW:
+    p[4] = urand(-1, 1), p[5] = urand(-1, 1), p[6] = urand(-1, 1), p[7] = urand(-1, 1);
+    break;
+  case CROSS: /* B through a point of A */
+    p[4] = P[0] - l0 * wx, p[5] = P[1] - l0 * wy, p[6] = P[0] + l1 * wx, p[7] = P[1] + l1 * wy;
+    break;
+  case TOUCH_T: /* B starts inside A */
+    p[4] = P[0], p[5] = P[1], p[6] = P[0] + l1 * wx, p[7] = P[1] + l1 * wy;
+    break;
+  case TOUCH_L: /* B starts at A's end */
+    p[4] = a1[0], p[5] = a1[1], p[6] = a1[0] + l1 * wx, p[7] = a1[1] + l1 * wy;
+    break;
+  case PARALLEL: {
+    double d = pow(10.0, urand(-4, 0.3)) * (urand(0, 1) < 0.5 ? -1 : 1), off = urand(-1.5, 1.5);
+    double sgn = urand(0, 1) < 0.5 ? -1 : 1;
+    p[4] = a0[0] + off * ux - d * uy, p[5] = a0[1] + off * uy + d * ux;
+    p[6] = p[4] + sgn * l1 * ux, p[7] = p[5] + sgn * l1 * uy;
+    break;
+  }
+  case NEAR_PARALLEL: {
+    double sig = pow(10.0, urand(-12, -1)), th = asin(sig) * (urand(0, 1) < 0.5 ? -1 : 1);
+    double d = pow(10.0, urand(-6, 0)), off = urand(-1.5, 1.5);
+    double cx = cos(th) * ux - sin(th) * uy, cy = sin(th) * ux + cos(th) * uy;
+    p[4] = a0[0] + off * ux - d * uy, p[5] = a0[1] + off * uy + d * ux;
+    p[6] = p[4] + l1 * cx, p[7] = p[5] + l1 * cy;
+    break;
+  }
+  default: { /* collinear disjoint: B beyond A's end on A's line */
+    double g = urand(0.01, 1);
+    p[4] = a1[0] + g * ux, p[5] = a1[1] + g * uy, p[6] = p[4] + l1 * ux, p[7] = p[5] + l1 * uy;
+    break;
+  }
+  }
+}
+
+Test(pair, segseg_matches_brute_force_on_random_configurations)
+{
+  rng_state = 12345;
+  for (int kind = 0; kind < N_KINDS; kind++)
+    for (int it = 0; it < 12; it++) {
+      double p[8];
+      random_config(kind, p);
+      double v = seg(p), ref = brute_segseg(p, p + 2, p + 4, p + 6);
+      cr_assert(isfinite(v) && lw_close_rel(v, ref, 1e-11, 0.0), "%s #%d: %.15g vs brute force %.15g (rel %.1e)",
+                KIND[kind], it, v, ref, fabs(v / ref - 1));
+    }
+}
+
+/* sigma from 1e-12 to 1 at several distances and offsets, including lines
+** that cross at a shallow angle: the corner sum written naively loses
+** eps / sigma here. */
+Test(pair, segseg_stable_across_near_parallel_angles)
+{
+  for (int e = -12; e <= 0; e++) {
+    double th = asin(pow(10.0, e));
+    const double dist[] = {1e-3, 0.3}, off[] = {-0.7, 0.3}, len[] = {0.5, 1.5};
+    for (int i = 0; i < 2; i++)
+      for (int j = 0; j < 2; j++)
+        for (int k = 0; k < 2; k++) {
+          double p[8] = {0, 0, 1, 0, off[j], dist[i], off[j] + len[k] * cos(th), dist[i] + len[k] * sin(th)};
+          double v = seg(p), ref = brute_segseg(p, p + 2, p + 4, p + 6);
+          cr_assert(lw_close_rel(v, ref, 1e-11, 0.0), "sigma 1e%d d %g off %g L %g: %.15g vs %.15g", e, dist[i],
+                    off[j], len[k], v, ref);
+          /* crossing at a shallow angle: B through (0.4, 0) */
+          double q[8] = {0, 0, 1, 0, 0.4 - 0.5 * cos(th), -0.5 * sin(th), 0.4 + len[k] * cos(th),
+                         len[k] * sin(th)};
+          v = seg(q), ref = brute_segseg(q, q + 2, q + 4, q + 6);
+          cr_assert(lw_close_rel(v, ref, 1e-11, 0.0), "crossing sigma 1e%d: %.15g vs %.15g", e, v, ref);
+        }
+  }
+}
+
+/* ---- lw_pair_segseg: invariances ----------------------------------------- */
+
+/* The integral is only as well determined as its inputs: near-parallel
+** segments at tiny distance, or endpoints touching the other segment, react
+** strongly to rounding of the coordinates.  This is the relative change for
+** a nudge of eps * M (M: the coordinates' magnitude) of the most sensitive
+** coordinate; comparisons between rearranged inputs allow a few of those. */
+static double input_sensitivity(const double p[8], double M)
+{
+  double v = seg(p), s = 0.0;
+  for (int k = 0; k < 8; k++)
+    for (int sg = -1; sg <= 1; sg += 2) {
+      double q[8];
+      for (int j = 0; j < 8; j++) q[j] = p[j];
+      q[k] += sg * DBL_EPSILON * M;
+      double d = fabs(seg(q) / v - 1);
+      if (d > s) s = d;
+    }
+  return s;
+}
+
+static double max_abs(const double p[8])
+{
+  double m = 0;
+  for (int k = 0; k < 8; k++) m = fabs(p[k]) > m ? fabs(p[k]) : m;
+  return m;
+}
+
+Test(pair, segseg_symmetry_reversal_rigid_motion_and_scaling)
+{
+  rng_state = 777;
+  double worst = 0;
+  for (int kind = 0; kind < N_KINDS; kind++)
+    for (int it = 0; it < 40; it++) {
+      double p[8];
+      random_config(kind, p);
+      double v = seg(p);
+      cr_assert(isfinite(v) && v > 0, "%s #%d: %g", KIND[kind], it, v);
+      double tol = 1e-14 + 8.0 * input_sensitivity(p, max_abs(p));
+      if (tol > worst) worst = tol;
+      /* swap the segments; reverse either or both */
+      double s[8] = {p[4], p[5], p[6], p[7], p[0], p[1], p[2], p[3]};
+      double ra[8] = {p[2], p[3], p[0], p[1], p[4], p[5], p[6], p[7]};
+      double rb[8] = {p[0], p[1], p[2], p[3], p[6], p[7], p[4], p[5]};
+      double rab[8] = {p[2], p[3], p[0], p[1], p[6], p[7], p[4], p[5]};
+      cr_assert(lw_close_rel(seg(s), v, tol, 0.0), "%s #%d swap: %.17g vs %.17g", KIND[kind], it, seg(s), v);
+      cr_assert(lw_close_rel(seg(ra), v, tol, 0.0), "%s #%d reverse A", KIND[kind], it);
+      cr_assert(lw_close_rel(seg(rb), v, tol, 0.0), "%s #%d reverse B", KIND[kind], it);
+      cr_assert(lw_close_rel(seg(rab), v, tol, 0.0), "%s #%d reverse both", KIND[kind], it);
+      /* rotation and translation: the moved inputs are rounded at their new
+      ** magnitude */
+      double ang = urand(0, 2 * PI), c = cos(ang), sn = sin(ang), tx = urand(-50, 50), ty = urand(-50, 50);
+      double m[8];
+      for (int k = 0; k < 8; k += 2) {
+        m[k] = c * p[k] - sn * p[k + 1] + tx;
+        m[k + 1] = sn * p[k] + c * p[k + 1] + ty;
+      }
+      double tm = 1e-14 + 8.0 * input_sensitivity(p, max_abs(m));
+      cr_assert(lw_close_rel(seg(m), v, tm, 0.0), "%s #%d rigid motion: %.17g vs %.17g (tol %.1e)", KIND[kind], it,
+                seg(m), v, tm);
+      /* scaling: the integral has the dimension of a length */
+      double lam = urand(0.01, 100), sc[8];
+      for (int k = 0; k < 8; k++) sc[k] = lam * p[k];
+      cr_assert(lw_close_rel(seg(sc), lam * v, tol, 0.0), "%s #%d scaling by %g", KIND[kind], it, lam);
+    }
+  /* the largest sensitivity (near-parallel at ~1e-6 distance) is ~3e-12:
+  ** keep the allowance honest */
+  cr_assert(worst < 1e-10, "largest tolerance used %g", worst);
+}
+
+Test(pair, segseg_never_nan_on_degenerate_grids)
+{
+  /* endpoints on a small integer grid produce every degeneracy: shared
+  ** endpoints, T-junctions, collinear and parallel pairs, zero lengths */
+  rng_state = 99;
+  for (int it = 0; it < 200000; it++) {
+    double p[8], sc = it % 3 == 0 ? 1e-7 : (it % 3 == 1 ? 1.0 : 1e6);
+    for (int k = 0; k < 8; k++) p[k] = sc * floor(urand(-4, 5));
+    double v = seg(p);
+    cr_assert(!isnan(v) && v >= 0, "NaN or negative for %g %g %g %g %g %g %g %g", p[0], p[1], p[2], p[3], p[4],
+              p[5], p[6], p[7]);
+  }
+}
+
+/* ---- the kernel: straight splines ----------------------------------------- */
+
+/*
+** How the error depends on d and near (8 nodes, 6 unit segments per line,
+** h = 1/8 the mean element length; tools/pair-accuracy.c prints the table):
+**   d / h              0.01    0.1     0.5     1       3       10
+**   product rule only  6.5     0.56    3e-2    2e-3    4e-7    1e-15
+**   near = 1.5         1.6e-4  2.2e-4  2.6e-4  2.5e-4  3.4e-4  2.0e-4
+**   near = 3           2.9e-5  4.1e-5  5.6e-5  6.5e-5  8.2e-5  9.6e-5
+** The product rule fails as d falls below a few element lengths (its error
+** grows like a negative power of d); with the near field the error hardly
+** depends on d and falls like 1/near^2: what is left is the product rule's
+** first-order error just beyond the element zone (6 near dm), a fixed
+** fraction of the near-field share of the energy.  Lines farther apart than
+** that zone see the product rule alone, exact to ~1e-7 or better.
+*/
+Test(pair, parallel_straight_splines_match_closed_form)
+{
+  const size_t segs[] = {3, 6, 10};
+  const double ratio[] = {0.05, 0.2, 0.5, 1, 2, 5}; /* d in element lengths h = 1/8 */
+  for (size_t s = 0; s < sizeof segs / sizeof segs[0]; s++)
+    for (size_t k = 0; k < sizeof ratio / sizeof ratio[0]; k++) {
+      lw_splines *sp = two_splines(segs[s], segs[s]);
+      double L = (double)segs[s], d = ratio[k] / 8.0;
+      double p0[2] = {0, 0}, p1[2] = {L, 0}, q0[2] = {0, d}, q1[2] = {L, d};
+      straight(sp, 0, p0, p1);
+      straight(sp, 1, q0, q1);
+      double exact = 2.0 * (L * asinh(L / d) - sqrt(L * L + d * d) + d);
+      double e = pair_energy(sp, 8, 0.0, NEAR_DEFAULT);
+      cr_assert(lw_close_rel(e, exact, 1e-3, 0.0), "%zu segments, d = %g h: %.10g vs %.10g (rel %.1e)", segs[s],
+                ratio[k], e, exact, fabs(e / exact - 1));
+      lw_splines_free(sp);
+    }
+  /* unequal segmentations and an offset: the exact value is lw_pair_segseg */
+  lw_splines *sp = two_splines(4, 7);
+  double p0[2] = {0, 0}, p1[2] = {4, 0}, q0[2] = {1.3, 0.05}, q1[2] = {6.1, 0.05};
+  straight(sp, 0, p0, p1);
+  straight(sp, 1, q0, q1);
+  double exact = lw_pair_segseg(p0, p1, q0, q1), e = pair_energy(sp, 8, 0.0, NEAR_DEFAULT);
+  cr_assert(lw_close_rel(e, exact, 1e-3, 0.0), "unequal segmentations: %.10g vs %.10g", e, exact);
+  lw_splines_free(sp);
+}
+
+Test(pair, crossing_straight_splines_match_segseg)
+{
+  lw_quad q;
+  lw_quad_init(&q, 8, NULL);
+  /* where along their middle segments the two lines cross (segment
+  ** parameter on A, on B): at a spline node, at a sample, in the middle of an
+  ** element, near a segment's end, and somewhere generic */
+  const double where[][2] = {{0.0, 0.0},
+                             {q.s[3], q.s[5]},
+                             {0.5 * (q.e[1] + q.e[2]), 0.5 * (q.e[6] + q.e[7])},
+                             {0.01, 0.99},
+                             {0.37, 0.61}};
+  const double deg[] = {90, 45, 20, 5};
+  for (size_t w = 0; w < sizeof where / sizeof where[0]; w++)
+    for (size_t k = 0; k < sizeof deg / sizeof deg[0]; k++) {
+      lw_splines *sp = two_splines(6, 6);
+      double th = deg[k] * PI / 180.0, sa = 2.0 + where[w][0], sb = 2.0 + where[w][1];
+      double p0[2] = {-sa, 0}, p1[2] = {6 - sa, 0};
+      double q0[2] = {-sb * cos(th), -sb * sin(th)}, q1[2] = {(6 - sb) * cos(th), (6 - sb) * sin(th)};
+      straight(sp, 0, p0, p1);
+      straight(sp, 1, q0, q1);
+      double exact = lw_pair_segseg(p0, p1, q0, q1), e = pair_energy(sp, 8, 0.0, NEAR_DEFAULT);
+      cr_assert(isfinite(e) && lw_close_rel(e, exact, 1e-3, 0.0), "cross %g deg at (%g, %g): %.10g vs %.10g (%.1e)",
+                deg[k], where[w][0], where[w][1], e, exact, fabs(e / exact - 1));
+      lw_splines_free(sp);
+    }
+}
+
+Test(pair, near_field_off_is_the_product_rule)
+{
+  lw_quad q;
+  lw_pair_ctx ctx;
+  lw_quad_init(&q, 8, NULL);
+  lw_pair_ctx_init(&ctx, &q, 0.0, 0.0);
+  lw_pair_sample a = {0, 0, 1, 0, 0.1, 0, 3}, b = {0.05, 0.02, 0, 1, 0.2, 1, 4};
+  double r = hypot(0.05, 0.02);
+  cr_assert(lw_close_rel(lw_pair_kernel(&a, &b, &ctx), 0.02 / r, 1e-15, 0.0));
+}
+
+/* ---- the kernel: curved splines ------------------------------------------ */
+
+/* Brute-force pair energy of two splines over the exact Bezier curves:
+** nested qagp in the splines' global parameters, split at every segment
+** boundary (and the outer one at quarter segments). */
+typedef struct {
+  const lw_splines *sp;
+  double x, y;
+  gsl_integration_workspace *wi;
+} cv_ctx;
+
+static void spline_eval(const lw_splines *sp, size_t i, double u, double r[2], double d[2])
+{
+  size_t m = lw_splines_segments(sp, i), g = (size_t)floor(u);
+  if (g >= m) g = m - 1;
+  const lw_node *a = &sp->node[sp->first[i] + g];
+  lw_segment_eval(a, a + 1, u - (double)g, r, d, NULL);
+}
+
+static double cv_inner(double t, void *p)
+{
+  const cv_ctx *c = p;
+  double r[2], d[2];
+  spline_eval(c->sp, 1, t, r, d);
+  return hypot(d[0], d[1]) / hypot(r[0] - c->x, r[1] - c->y);
+}
+
+static double cv_outer(double s, void *p)
+{
+  cv_ctx *c = p;
+  double r[2], d[2], pts[65];
+  spline_eval(c->sp, 0, s, r, d);
+  c->x = r[0];
+  c->y = r[1];
+  size_t mb = lw_splines_segments(c->sp, 1);
+  for (size_t k = 0; k <= mb; k++) pts[k] = (double)k;
+  gsl_function F = {cv_inner, c};
+  double res, err;
+  gsl_integration_qagp(&F, pts, mb + 1, 0.0, 1e-12, 1000, c->wi, &res, &err);
+  return res * hypot(d[0], d[1]);
+}
+
+static double curve_reference(const lw_splines *sp)
+{
+  gsl_error_handler_t *old = gsl_set_error_handler_off();
+  cv_ctx c = {sp, 0, 0, gsl_integration_workspace_alloc(1000)};
+  gsl_integration_workspace *wo = gsl_integration_workspace_alloc(1000);
+  size_t ma = lw_splines_segments(sp, 0), n = 0;
+  double pts[257];
+  for (size_t k = 0; k <= 4 * ma; k++) pts[n++] = 0.25 * (double)k;
+  gsl_function F = {cv_outer, &c};
+  double res, err;
+  gsl_integration_qagp(&F, pts, n, 0.0, 1e-11, 1000, wo, &res, &err);
+  gsl_integration_workspace_free(wo);
+  gsl_integration_workspace_free(c.wi);
+  gsl_set_error_handler(old);
+  return res;
+}
+
+/*
+** Quarter circles (4 segments each) of radii 3 and 2, one bulging down onto
+** the other: touching tangentially at a spline node, crossing at a shallow
+** and at a steeper angle.  Tolerances at the defaults (8 nodes, near 1.5):
+** crossing 1e-3 (measured 3e-4 and 6e-4).  Touching 5e-3 (measured 2.6e-3):
+** near the contact the tangent elements of the two curves cross each other
+** while the curves only touch, an O(dl) error in absolute terms that halves
+** with each halving of the segments (checked below).
+*/
+Test(pair, curved_arcs_touching_or_crossing_match_reference)
+{
+  const struct {
+    const char *name;
+    double cx, lift, tol;
+  } C[] = {{"touching", 0.0, 0.0, 5e-3}, {"crossing steeply", 0.4, 0.3, 1e-3}, {"crossing shallowly", 0.4, 0.05, 1e-3}};
+  for (size_t k = 0; k < sizeof C / sizeof C[0]; k++) {
+    lw_splines *sp = two_splines(4, 4);
+    arc(sp, 0, 0.0, 3.0, 3.0, -0.75 * PI, -0.25 * PI);                 /* bottom of a circle, r = 3 */
+    arc(sp, 1, C[k].cx, -2.0 + C[k].lift, 2.0, 0.25 * PI, 0.75 * PI); /* top of a circle, r = 2 */
+    double ref = curve_reference(sp), e = pair_energy(sp, 8, 0.0, NEAR_DEFAULT);
+    cr_assert(isfinite(e) && lw_close_rel(e, ref, C[k].tol, 0.0), "%s: %.10g vs %.10g (rel %.1e)", C[k].name, e,
+              ref, fabs(e / ref - 1));
+    lw_splines_free(sp);
+  }
+  /* touching, with the arcs cut into 16 segments each: error down ~4x */
+  lw_splines *sp = two_splines(16, 16);
+  arc(sp, 0, 0.0, 3.0, 3.0, -0.75 * PI, -0.25 * PI);
+  arc(sp, 1, 0.0, -2.0, 2.0, 0.25 * PI, 0.75 * PI);
+  double ref = curve_reference(sp), e = pair_energy(sp, 8, 0.0, NEAR_DEFAULT);
+  cr_assert(lw_close_rel(e, ref, 1e-3, 0.0), "touching, 16 segments: %.10g vs %.10g (rel %.1e)", e, ref,
+            fabs(e / ref - 1));
+  lw_splines_free(sp);
+}
+
+/* ---- the kernel: cutoff and coincident samples --------------------------- */
+
+Test(pair, cutoff_shifts_and_truncates_the_kernel)
+{
+  lw_quad q;
+  lw_pair_ctx ctx;
+  lw_quad_init(&q, 8, NULL);
+  const double rc = 1.0;
+  lw_pair_ctx_init(&ctx, &q, rc, NEAR_DEFAULT);
+  cr_assert(lw_close_rel(ctx.inv_cutoff, 1.0, 1e-15, 0.0));
+  /* small elements: the product rule zone reaches far inside rc */
+  const double dl = 0.01, sp_ = dl / q.w[3];
+  lw_pair_sample a = {0, 0, sp_, 0, dl, 0, 3};
+  const double rs[] = {0.2, 0.5, 0.9, 0.999};
+  for (size_t k = 0; k < sizeof rs / sizeof rs[0]; k++) {
+    lw_pair_sample b = {rs[k] * 0.6, rs[k] * 0.8, 0, sp_, dl, 1, 3};
+    double v = lw_pair_kernel(&a, &b, &ctx);
+    cr_assert(lw_close_rel(v, dl * dl * (1.0 / rs[k] - 1.0 / rc), 1e-13, 0.0), "r = %g: %g", rs[k], v);
+  }
+  const double out[] = {1.0, 1.0 + 1e-15, 1.5, 100.0};
+  for (size_t k = 0; k < sizeof out / sizeof out[0]; k++) {
+    lw_pair_sample b = {out[k], 0, 0, sp_, dl, 1, 3};
+    cr_assert_eq(lw_pair_kernel(&a, &b, &ctx), 0.0, "r = %g", out[k]);
+  }
+  /* continuous at rc, for small elements and for elements so large that rc
+  ** falls inside the element zone (which then ends at rc) */
+  const double dls[] = {0.01, 0.15};
+  for (size_t k = 0; k < 2; k++) {
+    double s = dls[k] / q.w[0];
+    lw_pair_sample c = {0, 0, s * 0.6, s * 0.8, dls[k], 0, 0};
+    lw_pair_sample b = {1.0 - 1e-9, 0, 0, s, dls[k], 1, 7};
+    double v = lw_pair_kernel(&c, &b, &ctx);
+    cr_assert(fabs(v) <= 2e-9 * dls[k] * dls[k], "dl %g: kernel %g just inside rc", dls[k], v);
+  }
+  /* the exact and the element zone subtract the same dl dl / rc (|r'| = 0.1,
+  ** so dm = 0.1 w_4 = 0.018 and the nodes sit 0.56 dm, 3 dm apart) */
+  lw_pair_ctx ctx0;
+  lw_pair_ctx_init(&ctx0, &q, 0.0, NEAR_DEFAULT);
+  lw_pair_sample c = {0, 0, 0.1, 0, 0.1 * q.w[2], 0, 2};
+  const double at[][2] = {{0.004, 0.009}, {0.02, 0.05}};
+  for (int k = 0; k < 2; k++) {
+    lw_pair_sample d = {at[k][0], at[k][1], 0.06, 0.08, 0.1 * q.w[5], 1, 5};
+    double v0 = lw_pair_kernel(&c, &d, &ctx0), v1 = lw_pair_kernel(&c, &d, &ctx);
+    cr_assert(isfinite(v0) && lw_close_rel(v1, v0 - c.dl * d.dl / rc, 1e-14, 0.0), "zone %d", k);
+  }
+}
+
+Test(pair, kernel_continuous_across_the_element_zone_edge)
+{
+  /* the element rule blends into the product rule: no jump at 6 near dm */
+  lw_quad q;
+  lw_pair_ctx ctx;
+  lw_quad_init(&q, 8, NULL);
+  lw_pair_ctx_init(&ctx, &q, 0.0, NEAR_DEFAULT);
+  const double dl = 0.1, ro = 6.0 * NEAR_DEFAULT * dl;
+  lw_pair_sample a = {0, 0, 0.6 * dl / q.w[1], 0.8 * dl / q.w[1], dl, 0, 1};
+  for (int side = 0; side < 2; side++) {
+    double r = side ? ro : 0.75 * ro; /* outer edge, start of the blend */
+    lw_pair_sample b0 = {r - 1e-12, 0, 0, dl / q.w[6], dl, 1, 6}, b1 = {r + 1e-12, 0, 0, dl / q.w[6], dl, 1, 6};
+    double v0 = lw_pair_kernel(&a, &b0, &ctx), v1 = lw_pair_kernel(&a, &b1, &ctx);
+    cr_assert(fabs(v0 - v1) < 1e-9 * v0, "jump %g at r = %g", v1 - v0, r);
+  }
+}
+
+Test(pair, coincident_samples_are_finite_with_the_near_field)
+{
+  lw_quad q;
+  lw_pair_ctx ctx;
+  lw_quad_init(&q, 8, NULL);
+  lw_pair_ctx_init(&ctx, &q, 0.0, NEAR_DEFAULT);
+  /* two curves crossing exactly at a sample of each */
+  for (int qa = 0; qa < 8; qa++)
+    for (int qb = 0; qb < 8; qb++) {
+      double ang = 0.3 + 0.2 * qb;
+      lw_pair_sample a = {1, 2, 0.5, 0, 0.5 * q.w[qa], 0, (uint32_t)qa};
+      lw_pair_sample b = {1, 2, 0.4 * cos(ang), 0.4 * sin(ang), 0.4 * q.w[qb], 1, (uint32_t)qb};
+      double v = lw_pair_kernel(&a, &b, &ctx);
+      /* the exact integral over the two elements, which cross at the nodes */
+      double a0[2] = {1 - 0.5 * (q.s[qa] - q.e[qa]), 2}, a1[2] = {1 + 0.5 * (q.e[qa + 1] - q.s[qa]), 2};
+      double lo = q.s[qb] - q.e[qb], hi = q.e[qb + 1] - q.s[qb];
+      double b0[2] = {1 - lo * 0.4 * cos(ang), 2 - lo * 0.4 * sin(ang)};
+      double b1[2] = {1 + hi * 0.4 * cos(ang), 2 + hi * 0.4 * sin(ang)};
+      double ref = brute_segseg(a0, a1, b0, b1);
+      cr_assert(isfinite(v) && v > 0 && lw_close_rel(v, ref, 1e-11, 0.0), "q %d/%d: %g vs %g", qa, qb, v, ref);
+    }
+  /* the product rule alone is infinite there */
+  lw_pair_ctx off;
+  lw_pair_ctx_init(&off, &q, 0.0, 0.0);
+  lw_pair_sample a = {1, 2, 0.5, 0, 0.1, 0, 2}, b = {1, 2, 0, 0.5, 0.1, 1, 2};
+  cr_assert(isinf(lw_pair_kernel(&a, &b, &off)));
+}
+
+Test(pair, kernel_is_bitwise_symmetric)
+{
+  lw_quad q;
+  lw_pair_ctx ctx;
+  lw_quad_init(&q, 8, NULL);
+  lw_pair_ctx_init(&ctx, &q, 2.0, NEAR_DEFAULT);
+  rng_state = 4242;
+  for (int it = 0; it < 20000; it++) {
+    int qa = (int)urand(0, 8), qb = (int)urand(0, 8);
+    double ta = urand(0, 2 * PI), tb = urand(0, 2 * PI), sa = urand(0.1, 1), sb = urand(0.1, 1);
+    double r = urand(0, 2), t = urand(0, 2 * PI);
+    lw_pair_sample a = {0.3, -0.2, sa * cos(ta), sa * sin(ta), sa * q.w[qa], 0, (uint32_t)qa};
+    lw_pair_sample b = {0.3 + r * cos(t), -0.2 + r * sin(t), sb * cos(tb), sb * sin(tb), sb * q.w[qb], 1,
+                        (uint32_t)qb};
+    double u = lw_pair_kernel(&a, &b, &ctx), v = lw_pair_kernel(&b, &a, &ctx);
+    cr_assert(u == v, "kernel(a,b) = %.17g, kernel(b,a) = %.17g", u, v);
+  }
+}
+
+Test(pair, ctx_init_tabulates_elements)
+{
+  for (int n = LW_QUAD_MIN; n <= LW_QUAD_MAX; n += 7) {
+    lw_quad q;
+    lw_pair_ctx ctx;
+    lw_quad_init(&q, n, NULL);
+    lw_pair_ctx_init(&ctx, &q, -1.0, -2.0); /* negative: no cutoff, near field off */
+    cr_assert_eq(ctx.cutoff, 0.0);
+    cr_assert_eq(ctx.inv_cutoff, 0.0);
+    cr_assert_eq(ctx.near, 0.0);
+    for (int i = 0; i < n; i++) {
+      cr_assert(ctx.elem_lo[i] > 0 && ctx.elem_hi[i] > 0);
+      cr_assert(fabs(ctx.elem_lo[i] + ctx.elem_hi[i] - q.w[i]) < 1e-15, "element %d of %d has length w", i, n);
+    }
+  }
+}
