@@ -4,6 +4,7 @@
 CC      ?= cc
 PREFIX  ?= /usr/local
 BUILD   ?= build
+BIN     ?= bin
 PKGS    := gsl cairo inih
 OPT     ?= -O2
 CFLAGS  ?= $(OPT) -g
@@ -22,7 +23,7 @@ TEST_OBJ := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%.o)
 TEST_JOBS ?= 2
 
 .PHONY: all deps test asan run bench install clean docs
-all: bin/linewise
+all: $(BIN)/linewise
 
 $(BUILD)/obj/%.o: src/%.c $(wildcard include/linewise/*.h) | $(BUILD)/obj
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -c $< -o $@
@@ -30,7 +31,7 @@ $(BUILD)/obj/%.o: src/%.c $(wildcard include/linewise/*.h) | $(BUILD)/obj
 $(BUILD)/liblinewise.a: $(LIB_OBJ)
 	rm -f $@ && ar rcs $@ $^
 
-bin/linewise: src/main.c $(BUILD)/liblinewise.a | bin
+$(BIN)/linewise: src/main.c $(BUILD)/liblinewise.a | $(BIN)
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) $< -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
 
 $(BUILD)/tests/%.o: tests/%.c tests/testutil.h $(wildcard include/linewise/*.h) | $(BUILD)/tests
@@ -39,15 +40,15 @@ $(BUILD)/tests/%.o: tests/%.c tests/testutil.h $(wildcard include/linewise/*.h) 
 $(BUILD)/tests/run: $(TEST_OBJ) $(BUILD)/liblinewise.a
 	$(CC) $(CFLAGS) $(OMP) $(TEST_OBJ) -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS) -lcriterion
 
-$(BUILD)/obj $(BUILD)/tests bin:
+$(BUILD)/obj $(BUILD)/tests $(BIN):
 	mkdir -p $@
 
 # The suite runs the binary too (CLI tests), so both are built first.
-test: bin/linewise $(BUILD)/tests/run
-	LW_BIN=$(CURDIR)/bin/linewise LW_ROOT=$(CURDIR) $(BUILD)/tests/run --jobs $(TEST_JOBS)
+test: $(BIN)/linewise $(BUILD)/tests/run
+	LW_BIN=$(CURDIR)/$(BIN)/linewise LW_ROOT=$(CURDIR) $(BUILD)/tests/run --jobs $(TEST_JOBS)
 
 asan:
-	$(MAKE) BUILD=build-asan OPT=-O1 \
+	$(MAKE) BUILD=build-asan BIN=build-asan/bin OPT=-O1 \
 	  CFLAGS="-O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer" \
 	  LDFLAGS="-fsanitize=address,undefined" test
 
@@ -77,7 +78,7 @@ bench: $(BUILD)/bench
 	  echo; $(BUILD)/bench 5; } > docs/PERFORMANCE.md.new
 	mv docs/PERFORMANCE.md.new docs/PERFORMANCE.md
 
-install: bin/linewise
+install: $(BIN)/linewise
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/linewise/params
 	install -m 755 bin/linewise $(DESTDIR)$(PREFIX)/bin/linewise
 	install -m 644 params/*.ini $(DESTDIR)$(PREFIX)/share/linewise/params/

@@ -21,50 +21,45 @@ static void segment_eval(const lw_scene *sc, const lw_node *a, const lw_node *b,
       ps[q] = (lw_pair_sample){s->x[q], s->y[q], s->dx[q], s->dy[q], s->dl[q], spline, (uint32_t)q};
 }
 
-/* Pair energy (no coefficient) between the n samples `mine` of spline
-** `spline` and every grid sample of another spline.  Cells and their entries
-** are visited in a fixed order, so the sum depends on positions only. */
-static double pair_against(const lw_cellgrid *g, const lw_pair_sample *all, const lw_pair_sample *mine,
-                           int n, uint32_t spline, const lw_pair_ctx *ctx)
+/* Kernel sum of sample `me` (of spline `spline`) with every grid sample of
+** another spline whose index exceeds `after` (-1: all).  Cells and their
+** sorted entries are visited in a fixed order, so the sum depends on the
+** positions only. */
+static double neighbour_sum(const lw_cellgrid *g, const lw_pair_sample *all, const lw_pair_sample *me,
+                            uint32_t spline, long long after, const lw_pair_ctx *ctx)
 {
   double sum = 0.0;
-  for (int i = 0; i < n; i++) {
-    int cx, cy;
-    lw_cellgrid_locate(g, mine[i].x, mine[i].y, &cx, &cy);
-    for (int y = cy - 1; y <= cy + 1; y++) {
-      if (y < 0 || y >= g->ny) continue;
-      for (int x = cx - 1; x <= cx + 1; x++) {
-        if (x < 0 || x >= g->nx) continue;
-        const lw_cell *c = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
-        for (uint32_t k = 0; k < c->n; k++) {
-          const lw_pair_sample *o = &all[c->idx[k]];
-          if (o->spline != spline) sum += lw_pair_kernel(&mine[i], o, ctx);
-        }
+  int cx, cy;
+  lw_cellgrid_locate(g, me->x, me->y, &cx, &cy);
+  for (int y = cy - 1; y <= cy + 1; y++) {
+    if (y < 0 || y >= g->ny) continue;
+    for (int x = cx - 1; x <= cx + 1; x++) {
+      if (x < 0 || x >= g->nx) continue;
+      const lw_cell *c = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
+      for (uint32_t k = 0; k < c->n; k++) {
+        const lw_pair_sample *o = &all[c->idx[k]];
+        if ((long long)c->idx[k] > after && o->spline != spline) sum += lw_pair_kernel(me, o, ctx);
       }
     }
   }
   return sum;
 }
 
-/* Every pair of samples of different splines once (j > i), in a fixed order. */
+/* Pair energy (no coefficient) between the n samples `mine` of spline
+** `spline` and every grid sample of another spline. */
+static double pair_against(const lw_cellgrid *g, const lw_pair_sample *all, const lw_pair_sample *mine,
+                           int n, uint32_t spline, const lw_pair_ctx *ctx)
+{
+  double sum = 0.0;
+  for (int i = 0; i < n; i++) sum += neighbour_sum(g, all, &mine[i], spline, -1, ctx);
+  return sum;
+}
+
+/* Every pair of samples of different splines once (j > i). */
 static double pair_all(const lw_cellgrid *g, const lw_pair_sample *all, size_t n, const lw_pair_ctx *ctx)
 {
   double sum = 0.0;
-  for (size_t i = 0; i < n; i++) {
-    int cx, cy;
-    lw_cellgrid_locate(g, all[i].x, all[i].y, &cx, &cy);
-    for (int y = cy - 1; y <= cy + 1; y++) {
-      if (y < 0 || y >= g->ny) continue;
-      for (int x = cx - 1; x <= cx + 1; x++) {
-        if (x < 0 || x >= g->nx) continue;
-        const lw_cell *c = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
-        for (uint32_t k = 0; k < c->n; k++) {
-          uint32_t j = c->idx[k];
-          if (j > i && all[j].spline != all[i].spline) sum += lw_pair_kernel(&all[i], &all[j], ctx);
-        }
-      }
-    }
-  }
+  for (size_t i = 0; i < n; i++) sum += neighbour_sum(g, all, &all[i], all[i].spline, (long long)i, ctx);
   return sum;
 }
 
