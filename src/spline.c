@@ -109,18 +109,6 @@ void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_
   out->end_y[1] = b->py;
 }
 
-double lw_splines_extent(const lw_splines *sp)
-{
-  double m = 0.0;
-  for (size_t k = 0; k < sp->n_nodes; k++) {
-    const lw_node *nd = &sp->node[k];
-    double c[4] = {nd->px, nd->py, nd->vx, nd->vy};
-    for (int j = 0; j < 4; j++)
-      if (fabs(c[j]) > m) m = fabs(c[j]);
-  }
-  return m;
-}
-
 int lw_splines_finite(const lw_splines *sp)
 {
   for (size_t k = 0; k < sp->n_nodes; k++) {

@@ -93,10 +93,3 @@ const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_PAIR, "pair", NULL},
   {LW_TERM_BOUNDARY, "boundary", seg_boundary},
 };
-
-int lw_term_find(const char *name)
-{
-  for (int t = 0; t < LW_TERM_COUNT; t++)
-    if (!strcmp(lw_term_types[t].name, name)) return t;
-  return -1;
-}

@@ -6,22 +6,7 @@
 #include "linewise/field.h"
 #include "testutil.h"
 
-#ifndef M_PI
-#define M_PI 3.14159265358979323846
-#endif
 
-/* splitmix64: a fixed seed per test keeps failures reproducible while the
-** values themselves carry full 53-bit mantissas (no round test numbers). */
-static uint64_t rng_state;
-static void rng_seed(uint64_t s) { rng_state = s; }
-static double urand(double lo, double hi)
-{
-  uint64_t z = (rng_state += 0x9e3779b97f4a7c15ULL);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  z ^= z >> 31;
-  return lo + (hi - lo) * ((double)(z >> 11) * 0x1.0p-53);
-}
 static int irand(int lo, int hi) { return lo + (int)floor(urand(0, 1) * (hi - lo + 1)); }
 
 typedef struct { double a, b, c, d; } bilin;

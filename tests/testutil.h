@@ -4,8 +4,26 @@
 
 #include <gsl/gsl_math.h>
 #include <math.h>
+#include <stdint.h>
 
 #include "linewise/spline.h"
+
+/* splitmix64: a fixed seed per test keeps failures reproducible while the
+** values carry full 53-bit mantissas (no round test numbers). */
+static inline uint64_t *lw_test_rng_state(void)
+{
+  static uint64_t state;
+  return &state;
+}
+static inline void rng_seed(uint64_t s) { *lw_test_rng_state() = s; }
+static inline double urand(double lo, double hi)
+{
+  uint64_t z = (*lw_test_rng_state() += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return lo + (hi - lo) * ((double)(z >> 11) * 0x1.0p-53);
+}
 
 /* |a - b| <= tol * max(|b|, floor) */
 static inline int lw_close_rel(double a, double b, double tol, double floor)

@@ -80,10 +80,6 @@ typedef struct {
 
 void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_samples *out);
 
-/* Largest absolute coordinate of any point or vector; 0 for no nodes.  Used
-** to scale tolerances. */
-double lw_splines_extent(const lw_splines *sp);
-
 /* 1 if every coordinate is finite. */
 int lw_splines_finite(const lw_splines *sp);
 

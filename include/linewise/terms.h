@@ -50,9 +50,6 @@ typedef struct {
 
 extern const lw_term_type lw_term_types[LW_TERM_COUNT];
 
-/* The term id for a name, or -1. */
-int lw_term_find(const char *name);
-
 double lw_term_strain(double length, double rest_length);
 double lw_term_bending(const lw_samples *s, const lw_quad *q);
 double lw_term_potential(const lw_samples *s, const lw_quad *q, const lw_potential *f);
