@@ -23,9 +23,7 @@ lw_cellgrid *lw_cellgrid_new(double x0, double y0, double w, double h, double ce
   if (g->nx < 1) g->nx = 1;
   if (g->ny < 1) g->ny = 1;
   g->cell = calloc((size_t)g->nx * (size_t)g->ny, sizeof *g->cell);
-  g->where = malloc((n_samples ? n_samples : 1) * sizeof *g->where);
-  if (!g->cell || !g->where) goto nomem;
-  for (size_t i = 0; i < n_samples; i++) g->where[i] = UINT32_MAX;
+  if (!g->cell) goto nomem;
   g->n_samples = n_samples;
   return g;
 nomem:
@@ -40,7 +38,6 @@ void lw_cellgrid_free(lw_cellgrid *g)
   if (g->cell)
     for (size_t c = 0; c < (size_t)g->nx * (size_t)g->ny; c++) free(g->cell[c].idx);
   free(g->cell);
-  free(g->where);
   free(g);
 }
 
@@ -56,31 +53,59 @@ static uint32_t lower_bound(const lw_cell *c, uint32_t i)
   return lo;
 }
 
-lw_status lw_cellgrid_place(lw_cellgrid *g, uint32_t i, double x, double y)
+static uint32_t cell_of(const lw_cellgrid *g, double x, double y)
 {
   int cx, cy;
   lw_cellgrid_locate(g, x, y, &cx, &cy);
-  uint32_t target = (uint32_t)cy * (uint32_t)g->nx + (uint32_t)cx;
-  uint32_t old = g->where[i];
-  if (old == target) return LW_OK;
-  lw_cell *c = &g->cell[target];
-  if (c->n == c->cap) {
-    uint32_t cap = c->cap ? 2 * c->cap : 8;
-    uint32_t *nidx = realloc(c->idx, cap * sizeof *nidx);
-    if (!nidx) return LW_ENOMEM;
-    c->idx = nidx;
-    c->cap = cap;
-  }
-  if (old != UINT32_MAX) {
-    lw_cell *o = &g->cell[old];
-    uint32_t k = lower_bound(o, i);
-    memmove(o->idx + k, o->idx + k + 1, (o->n - k - 1) * sizeof *o->idx);
-    o->n--;
-  }
+  return (uint32_t)cy * (uint32_t)g->nx + (uint32_t)cx;
+}
+
+static lw_status cell_reserve(lw_cell *c)
+{
+  if (c->n < c->cap) return LW_OK;
+  uint32_t cap = c->cap ? 2 * c->cap : 8;
+  uint32_t *nidx = realloc(c->idx, cap * sizeof *nidx);
+  if (!nidx) return LW_ENOMEM;
+  c->idx = nidx;
+  c->cap = cap;
+  return LW_OK;
+}
+
+static void cell_add(lw_cell *c, uint32_t i)
+{
   uint32_t k = lower_bound(c, i);
   memmove(c->idx + k + 1, c->idx + k, (c->n - k) * sizeof *c->idx);
   c->idx[k] = i;
   c->n++;
-  g->where[i] = target;
+}
+
+static void cell_remove(lw_cell *c, uint32_t i)
+{
+  uint32_t k = lower_bound(c, i);
+  if (k == c->n || c->idx[k] != i) return; /* not there: nothing to remove */
+  memmove(c->idx + k, c->idx + k + 1, (c->n - k - 1) * sizeof *c->idx);
+  c->n--;
+}
+
+lw_status lw_cellgrid_insert(lw_cellgrid *g, uint32_t i, double x, double y)
+{
+  lw_cell *c = &g->cell[cell_of(g, x, y)];
+  if (cell_reserve(c) != LW_OK) return LW_ENOMEM;
+  cell_add(c, i);
   return LW_OK;
+}
+
+lw_status lw_cellgrid_move(lw_cellgrid *g, uint32_t i, double ox, double oy, double x, double y)
+{
+  uint32_t from = cell_of(g, ox, oy), to = cell_of(g, x, y);
+  if (from == to) return LW_OK;
+  if (cell_reserve(&g->cell[to]) != LW_OK) return LW_ENOMEM;
+  cell_remove(&g->cell[from], i);
+  cell_add(&g->cell[to], i);
+  return LW_OK;
+}
+
+void lw_cellgrid_clear(lw_cellgrid *g)
+{
+  for (size_t c = 0; c < (size_t)g->nx * (size_t)g->ny; c++) g->cell[c].n = 0;
 }

@@ -122,7 +122,7 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
       return NAN;
     }
     for (size_t i = 0; i < n; i++)
-      if (lw_cellgrid_place(g, (uint32_t)i, ps[i].x, ps[i].y) != LW_OK) {
+      if (lw_cellgrid_insert(g, (uint32_t)i, ps[i].x, ps[i].y) != LW_OK) {
         lw_cellgrid_free(g);
         free(ps);
         lw_error_set(err, LW_ENOMEM, "out of memory filling the pair grid");
@@ -154,8 +154,9 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
   if (!m->seg_len || !m->seg_local || !m->spline_len) goto nomem;
   if (sc->on[LW_TERM_PAIR]) {
     size_t n = sp->n_segments * (size_t)sc->quad.n;
-    if (n >= UINT32_MAX) {
-      lw_error_set(err, LW_EINPUT, "%zu pair samples exceed the grid's 32-bit index", n);
+    if (n >= UINT32_MAX || sp->n_splines > LW_PAIR_MAX_SPLINES) {
+      lw_error_set(err, LW_EINPUT, "%zu pair samples of %zu splines exceed the grid's limits "
+                   "(2^32 samples, 2^26 splines)", n, sp->n_splines);
       lw_model_free(m);
       return NULL;
     }
@@ -220,8 +221,9 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
   }
   if (m->grid) {
     size_t n = sp->n_segments * (size_t)nq;
+    lw_cellgrid_clear(m->grid);
     for (size_t i = 0; i < n; i++)
-      if (lw_cellgrid_place(m->grid, (uint32_t)i, m->ps[i].x, m->ps[i].y) != LW_OK) return LW_ENOMEM;
+      if (lw_cellgrid_insert(m->grid, (uint32_t)i, m->ps[i].x, m->ps[i].y) != LW_OK) return LW_ENOMEM;
     term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pair_all(m->grid, m->ps, n, &sc->pair);
   }
   double total = 0.0;
@@ -342,12 +344,13 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
   const size_t g0 = lw_segment_index(sp, p->spline, 0);
   if (m->grid) {
     size_t first = (g0 + p->seg0) * (size_t)nq, n = p->n_seg * (size_t)nq;
+    const lw_pair_sample *old = m->ps + first;
     for (size_t k = 0; k < n; k++)
-      if (lw_cellgrid_place(m->grid, (uint32_t)(first + k), p->ps[k].x, p->ps[k].y) != LW_OK) {
+      if (lw_cellgrid_move(m->grid, (uint32_t)(first + k), old[k].x, old[k].y, p->ps[k].x, p->ps[k].y) != LW_OK) {
         /* Put the moved ones back: their old cells kept their capacity, so
         ** this cannot fail, and the model is as before the call. */
         for (size_t b = 0; b < k; b++)
-          lw_cellgrid_place(m->grid, (uint32_t)(first + b), m->ps[first + b].x, m->ps[first + b].y);
+          lw_cellgrid_move(m->grid, (uint32_t)(first + b), p->ps[b].x, p->ps[b].y, old[b].x, old[b].y);
         return LW_ENOMEM;
       }
   }

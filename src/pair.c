@@ -294,7 +294,12 @@ void lw_pair_ctx_init(lw_pair_ctx *ctx, const lw_quad *q, double cutoff, double 
 {
   ctx->cutoff = cutoff > 0.0 ? cutoff : 0.0;
   ctx->inv_cutoff = cutoff > 0.0 ? 1.0 / cutoff : 0.0;
+  ctx->cutoff2 = cutoff > 0.0 ? cutoff * cutoff : INFINITY;
+  ctx->zone_cap = cutoff > 0.0 ? cutoff : INFINITY;
   ctx->near = near > 0.0 ? near : 0.0;
+  ctx->zone_outer = PAIR_MID * ctx->near;
+  if (ctx->zone_outer > 0.0 && ctx->zone_outer < PAIR_TOUCH) ctx->zone_outer = PAIR_TOUCH;
+  ctx->zone_exact = ctx->near > PAIR_TOUCH ? ctx->near : PAIR_TOUCH;
   for (int i = 0; i < LW_QUAD_MAX; i++) {
     ctx->elem_lo[i] = 0.0;
     ctx->elem_hi[i] = 0.0;
@@ -324,23 +329,14 @@ static double element_rule(const lw_pair_sample *a, const lw_pair_sample *b, con
       double ex = dx + i * ox - j * px, ey = dy + i * oy - j * py;
       s += 1.0 / sqrt(ex * ex + ey * ey);
     }
-  return 0.25 * s * a->dl * b->dl;
+  return 0.25 * s * ((double)a->dl * (double)b->dl);
 }
 
-double lw_pair_kernel(const lw_pair_sample *a, const lw_pair_sample *b, const lw_pair_ctx *ctx)
+double lw_pair_kernel_near(const lw_pair_sample *a, const lw_pair_sample *b, const lw_pair_ctx *ctx,
+                           double r2, double ro)
 {
-  double dx = a->x - b->x, dy = a->y - b->y;
-  double r2 = dx * dx + dy * dy;
-  double rc = ctx->cutoff;
-  if (rc > 0.0 && r2 >= rc * rc) return 0.0;
+  double ll = (double)a->dl * (double)b->dl;
   double dm = a->dl > b->dl ? a->dl : b->dl;
-  double fo = PAIR_MID * ctx->near; /* outer radius of the element zone / dm */
-  if (fo > 0.0 && fo < PAIR_TOUCH) fo = PAIR_TOUCH;
-  double ro = fo * dm;
-  /* the element zone ends by the cutoff, so the kernel is continuous there */
-  if (rc > 0.0 && ro > rc) ro = rc;
-  double ll = a->dl * b->dl;
-  if (r2 >= ro * ro) return ll * (1.0 / sqrt(r2) - ctx->inv_cutoff);
   /* A fixed order of the two samples makes the kernel bitwise symmetric, so
   ** sums over pairs taken in either order (whole energy, move deltas) agree
   ** to the last bit; samples of different splines are never tied. */
@@ -350,7 +346,7 @@ double lw_pair_kernel(const lw_pair_sample *a, const lw_pair_sample *b, const lw
     b = t;
   }
   double shift = ll * ctx->inv_cutoff;
-  double rn = (ctx->near > PAIR_TOUCH ? ctx->near : PAIR_TOUCH) * dm;
+  double rn = ctx->zone_exact * dm;
   if (r2 >= rn * rn) {
     double v = element_rule(a, b, ctx) - shift;
     double r = sqrt(r2), rb = (1.0 - PAIR_BLEND) * ro;

@@ -31,8 +31,7 @@ typedef struct {
   double inv_h;      /* 1 / cell side */
   int nx, ny;        /* cells per axis */
   lw_cell *cell;     /* nx * ny */
-  uint32_t *where;   /* per sample: its cell, or UINT32_MAX if absent */
-  size_t n_samples;
+  size_t n_samples;  /* indices run from 0 to n_samples - 1 */
 } lw_cellgrid;
 
 /* A grid covering [x0, x0 + w] x [y0, y0 + h] with cells of side >= cell
@@ -53,8 +52,16 @@ static inline void lw_cellgrid_locate(const lw_cellgrid *g, double x, double y, 
   *cy = iy;
 }
 
-/* Puts sample i at (x, y), moving it if it is already in the grid.
-** LW_ENOMEM if a cell cannot grow (the grid is unchanged then). */
-lw_status lw_cellgrid_place(lw_cellgrid *g, uint32_t i, double x, double y);
+/* Inserts sample i at (x, y).  LW_ENOMEM if its cell cannot grow (the grid
+** is unchanged then).  Inserting in increasing index order appends. */
+lw_status lw_cellgrid_insert(lw_cellgrid *g, uint32_t i, double x, double y);
+
+/* Moves sample i from (ox, oy), where it was inserted, to (x, y).  The grid
+** keeps no per-sample cell (4 bytes a sample): the caller knows the old
+** position.  LW_ENOMEM as for insert. */
+lw_status lw_cellgrid_move(lw_cellgrid *g, uint32_t i, double ox, double oy, double x, double y);
+
+/* Empties every cell, keeping their capacity. */
+void lw_cellgrid_clear(lw_cellgrid *g);
 
 #endif

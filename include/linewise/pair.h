@@ -42,21 +42,33 @@
 
 #include <stdint.h>
 
+#include <math.h>
+
 #include "linewise/quad.h"
 
-/* One sample as the pair term (and the cell grid) sees it. */
+/* One sample as the pair term (and the cell grid) sees it: 32 bytes, since
+** the walk over neighbours is bound by memory traffic.  Positions stay double
+** (a page of 1e6 mm must still resolve 1e-6 mm); the derivative and weight
+** are float, relative 6e-8, far below the quadrature's own error.  The
+** energy is defined by these stored values, so every sum (incremental or
+** from scratch) sees the same rounding. */
+#define LW_PAIR_MAX_SPLINES (1u << 26)
 typedef struct {
-  double x, y;      /* r at the node, mm */
-  double dx, dy;    /* r' at the node, mm per unit s */
-  double dl;        /* w_q |r'_q|, mm */
-  uint32_t spline;  /* owning spline (pairs within a spline do not count) */
-  uint32_t q;       /* node index within its segment */
+  double x, y;         /* r at the node, mm */
+  float dx, dy;        /* r' at the node, mm per unit s */
+  float dl;            /* w_q |r'_q|, mm */
+  uint32_t spline : 26; /* owning spline (pairs within a spline do not count) */
+  uint32_t q : 6;      /* node index within its segment (LW_QUAD_MAX = 64) */
 } lw_pair_sample;
 
 typedef struct {
   double cutoff;        /* rc, mm; 0 = none */
   double inv_cutoff;    /* 1/rc, or 0 */
   double near;          /* near-field radius in element lengths; 0 = off */
+  double cutoff2;       /* rc^2, or +inf without a cutoff */
+  double zone_cap;      /* rc, or +inf: the element zone ends by the cutoff */
+  double zone_outer;    /* outer radius of the element zone / dm; 0 = no near field */
+  double zone_exact;    /* outer radius of the exact zone / dm */
   double elem_lo[LW_QUAD_MAX]; /* s_q - e_q: element start before the node, in s */
   double elem_hi[LW_QUAD_MAX]; /* e_{q+1} - s_q: element end after the node, in s */
 } lw_pair_ctx;
@@ -70,8 +82,25 @@ void lw_pair_ctx_init(lw_pair_ctx *ctx, const lw_quad *q, double cutoff, double 
 double lw_pair_segseg(const double a0[2], const double a1[2],
                       const double b0[2], const double b1[2]);
 
+/* The element and exact zones of the kernel (r2: squared node distance, ro:
+** outer radius of the element zone); lw_pair_kernel calls it. */
+double lw_pair_kernel_near(const lw_pair_sample *a, const lw_pair_sample *b, const lw_pair_ctx *ctx,
+                           double r2, double ro);
+
 /* The kernel of one sample pair (no coefficient C), cutoff and near field
-** applied.  The caller skips pairs of the same spline. */
-double lw_pair_kernel(const lw_pair_sample *a, const lw_pair_sample *b, const lw_pair_ctx *ctx);
+** applied.  The caller skips pairs of the same spline.  Inline because the
+** neighbour walk calls it for every candidate and most are beyond the cutoff
+** or in the far field, which costs a comparison or one square root. */
+static inline double lw_pair_kernel(const lw_pair_sample *a, const lw_pair_sample *b, const lw_pair_ctx *ctx)
+{
+  double dx = a->x - b->x, dy = a->y - b->y;
+  double r2 = dx * dx + dy * dy;
+  if (r2 >= ctx->cutoff2) return 0.0;
+  double dm = a->dl > b->dl ? a->dl : b->dl;
+  double ro = ctx->zone_outer * dm;
+  if (ro > ctx->zone_cap) ro = ctx->zone_cap;
+  if (r2 >= ro * ro) return (double)a->dl * (double)b->dl * (1.0 / sqrt(r2) - ctx->inv_cutoff);
+  return lw_pair_kernel_near(a, b, ctx, r2, ro);
+}
 
 #endif
