@@ -117,17 +117,129 @@ static void absolute_path(char *path, const char *scene_file)
   else if (strlen(joined) < LW_PATH_MAX) strcpy(path, joined);
 }
 
-static lw_status build(lw_anneal *a, lw_splines *sp, lw_error *err)
+/* Replicas of the run: the ladder's length, or [tempering] replicas. */
+static int count_ladder(const char *text)
+{
+  int n = 0;
+  for (const char *c = text; *c;) {
+    char *end;
+    strtod(c, &end);
+    if (end == c) return -1;
+    n++;
+    c = end;
+    while (*c == ' ' || *c == '\t' || *c == ',') c++;
+  }
+  return n;
+}
+
+/* The base ladder from [tempering]; messages name the key's line. */
+static lw_status setup_ladder(const lw_anneal *a, double *ladder, lw_error *err)
 {
   const lw_params *p = &a->params;
-  a->model = lw_model_new(&a->scene, sp, err);
-  if (!a->model) return err ? err->code : LW_ENOMEM;
+  char where[LW_PATH_MAX + 32];
+  int n = a->n_rep;
+  if (p->ladder[0]) {
+    lw_params_origin(p, lw_params_find("tempering", "ladder"), where, sizeof where);
+    const char *c = p->ladder;
+    for (int k = 0; k < n; k++) {
+      char *end;
+      ladder[k] = strtod(c, &end);
+      c = end;
+      while (*c == ' ' || *c == '\t' || *c == ',') c++;
+      if (!(ladder[k] > 0.0) || !isfinite(ladder[k]) || (k > 0 && !(ladder[k] > ladder[k - 1])))
+        return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected increasing positive "
+                            "temperatures, got '%s'", where, p->ladder);
+    }
+  } else {
+    lw_params_origin(p, lw_params_find("tempering", "t_max"), where, sizeof where);
+    if (!(p->t_max > p->t_min))
+      return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.t_max': expected a value above t_min = %g, got %g",
+                          where, p->t_min, p->t_max);
+    lw_tempering_geometric(ladder, n, p->t_min, p->t_max);
+  }
+  lw_params_origin(p, lw_params_find("anneal", "t_start"), where, sizeof where);
+  if (!(p->t_start > 0.0))
+    return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.t_start': parallel tempering scales the ladder by "
+                        "T(step) / t_start, so t_start must be > 0", where);
+  return LW_OK;
+}
+
+static lw_status count_replicas(lw_anneal *a, lw_error *err)
+{
+  const lw_params *p = &a->params;
+  a->n_rep = p->replicas;
+  if (p->ladder[0]) {
+    char where[LW_PATH_MAX + 32];
+    lw_params_origin(p, lw_params_find("tempering", "ladder"), where, sizeof where);
+    int n = count_ladder(p->ladder);
+    if (n < 2 || n > LW_TEMPERING_MAX)
+      return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%s'",
+                          where, LW_TEMPERING_MAX, p->ladder);
+    if (p->replicas != 1 && p->replicas != n)
+      return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': %d temperatures for %d replicas", where, n,
+                          p->replicas);
+    a->n_rep = n;
+  }
+  return LW_OK;
+}
+
+/* Chain of rung k: rung 0 draws from stream 1 (as a run without tempering
+** does), the master exchange stream is 2, rung k >= 1 is stream 2 + k. */
+static unsigned long rung_stream(const lw_anneal *a, int k)
+{
+  return lw_stream_seed(a->seed, k == 0 ? 1 : 2 + (unsigned long)k);
+}
+
+/* Models for the n_rep states sp[] (ownership passes, also on failure),
+** chains for the rungs, the exchange machinery. */
+static lw_status build(lw_anneal *a, lw_splines **sp, lw_error *err)
+{
+  const lw_params *p = &a->params;
+  int n = a->n_rep;
+  a->models = calloc((size_t)n, sizeof *a->models);
+  a->chains = calloc((size_t)n, sizeof *a->chains);
+  if (!a->models || !a->chains) {
+    for (int r = 0; r < n; r++) lw_splines_free(sp[r]);
+    return lw_error_set(err, LW_ENOMEM, "out of memory for %d replicas", n);
+  }
+  lw_status s = LW_OK;
+  for (int r = 0; r < n; r++) {
+    if (!s) {
+      a->models[r] = lw_model_new(&a->scene, sp[r], err);
+      if (!a->models[r]) s = err->code;
+    } else {
+      lw_splines_free(sp[r]);
+    }
+  }
+  if (s) return s;
   double weight[LW_MOVE_KINDS] = {p->mix_point, p->mix_vector, p->mix_translate, p->mix_rotate};
   double step[LW_MOVE_KINDS] = {p->step_point, p->step_vector, p->step_translate, p->step_rotate * M_PI / 180.0};
   double target[LW_MOVE_KINDS] = {p->target, p->target, p->target_spline, p->target_spline};
-  a->chain = lw_chain_new(a->model, weight, step, target, lw_stream_seed(a->seed, 1), err);
-  if (!a->chain) return err ? err->code : LW_ENOMEM;
+  for (int k = 0; k < n; k++) {
+    a->chains[k] = lw_chain_new(a->models[k], weight, step, target, rung_stream(a, k), err);
+    if (!a->chains[k]) return err->code;
+  }
+  a->chain = a->chains[0];
+  a->model = a->models[0];
+  if (n > 1) {
+    double ladder[LW_TEMPERING_MAX];
+    if ((s = setup_ladder(a, ladder, err))) return s;
+    a->pt = lw_tempering_new(n, ladder, lw_stream_seed(a->seed, 2), err);
+    if (!a->pt) return err->code;
+  }
   return LW_OK;
+}
+
+/* Rung temperatures from the schedule's: the ladder keeps its ratios and
+** follows the schedule (a constant schedule samples at the ladder itself). */
+static void set_temperatures(lw_anneal *a)
+{
+  if (!a->pt) {
+    a->chain->temperature = a->t_sched;
+    return;
+  }
+  double f = a->t_sched / a->params.t_start;
+  for (int k = 0; k < a->n_rep; k++) a->chains[k]->temperature = a->pt->ladder[k] * f;
 }
 
 static lw_status open_trace(lw_anneal *a, int fresh, lw_error *err)
@@ -142,6 +254,8 @@ static lw_status open_trace(lw_anneal *a, int fresh, lw_error *err)
       if (a->scene.on[t]) fprintf(a->trace, ",%s", lw_term_types[t].name);
     fprintf(a->trace, ",total");
     for (int k = 0; k < LW_MOVE_KINDS; k++) fprintf(a->trace, ",acc_%s", lw_move_names[k]);
+    for (int k = 0; a->pt && k < a->n_rep; k++) fprintf(a->trace, ",replica%d_temperature,replica%d_energy", k, k);
+    for (int k = 0; a->pt && k + 1 < a->n_rep; k++) fprintf(a->trace, ",swap%d", k);
     fprintf(a->trace, "\n");
   }
   return LW_OK;
@@ -158,7 +272,9 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   a->seed = (unsigned long)p->seed;
   a->block = -1;
   lw_status s;
-  if ((s = setup_schedule(a, err)) || (s = lw_scene_init(&a->scene, &a->params, err))) return s;
+  if ((s = count_replicas(a, err)) || (s = setup_schedule(a, err)) ||
+      (s = lw_scene_init(&a->scene, &a->params, err)))
+    return s;
   lw_splines *sp;
   if (a->params.from[0]) {
     lw_state st;
@@ -174,7 +290,14 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
     gsl_rng_free(r);
     if (!sp) return err->code;
   }
-  if ((s = build(a, sp, err))) return s;
+  /* every replica starts from the same state; their streams part them */
+  lw_splines *all[LW_TEMPERING_MAX] = {sp};
+  for (int r = 1; r < a->n_rep; r++)
+    if (!(all[r] = lw_splines_clone(sp))) {
+      for (int q = 0; q < r; q++) lw_splines_free(all[q]);
+      return lw_error_set(err, LW_ENOMEM, "out of memory for %d replicas", a->n_rep);
+    }
+  if ((s = build(a, all, err))) return s;
   a->energy_initial = lw_model_total(a->model);
   a->end_sweep = p->sweeps;
   /* Everything above only read input: the directory appears once the run
@@ -204,48 +327,157 @@ static char *fmt(const char *f, ...)
   return buf;
 }
 
+/* Appends "%lu"/"%.17g" lists to a buffer. */
+static int put_ulongs(char *buf, size_t cap, const unsigned long *v, int n)
+{
+  int k = 0;
+  for (int i = 0; i < n; i++) k += snprintf(buf + k, cap - (size_t)k, "%s%lu", i ? " " : "", v[i]);
+  return k;
+}
+
+static int put_doubles(char *buf, size_t cap, const double *v, int n)
+{
+  int k = 0;
+  for (int i = 0; i < n; i++) k += snprintf(buf + k, cap - (size_t)k, "%s%.17g", i ? " " : "", v[i]);
+  return k;
+}
+
+static void key_of(char *key, size_t n, const char *prefix, const char *name)
+{
+  snprintf(key, n, "%s%s", prefix, name);
+}
+
+/* What steers one rung's chain: its stream, steps, tuning window, counts. */
+static lw_status add_chain(lw_state *st, const char *prefix, const lw_chain *c)
+{
+  char key[64], buf[1024];
+  unsigned long v[3 * LW_MOVE_KINDS];
+  char *hex = lw_rng_save(c->rng);
+  if (!hex) return LW_ENOMEM;
+  key_of(key, sizeof key, prefix, "rng");
+  int bad = lw_state_add(st, key, hex);
+  free(hex);
+  put_doubles(buf, sizeof buf, c->step, LW_MOVE_KINDS);
+  key_of(key, sizeof key, prefix, "steps");
+  bad = bad || lw_state_add(st, key, buf);
+  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+    v[2 * k] = c->win_prop[k];
+    v[2 * k + 1] = c->win_acc[k];
+  }
+  put_ulongs(buf, sizeof buf, v, 2 * LW_MOVE_KINDS);
+  key_of(key, sizeof key, prefix, "tune_window");
+  bad = bad || lw_state_add(st, key, buf);
+  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+    v[3 * k] = c->stats[k].proposed;
+    v[3 * k + 1] = c->stats[k].accepted;
+    v[3 * k + 2] = c->stats[k].nan;
+  }
+  put_ulongs(buf, sizeof buf, v, 3 * LW_MOVE_KINDS);
+  key_of(key, sizeof key, prefix, "moves");
+  bad = bad || lw_state_add(st, key, buf);
+  return bad ? LW_ENOMEM : LW_OK;
+}
+
+static lw_status add_energy(lw_state *st, const lw_model *m)
+{
+  char buf[1024];
+  put_doubles(buf, sizeof buf, m->term, LW_TERM_COUNT);
+  return lw_state_add(st, "energy", buf) ? LW_ENOMEM : LW_OK;
+}
+
+/* The exchange machinery: master stream, ladder, who is where, counts. */
+static lw_status add_tempering(lw_state *st, const lw_anneal *a)
+{
+  const lw_tempering *pt = a->pt;
+  int n = pt->n, bad = 0;
+  char buf[8192];
+  unsigned long v[2 * LW_TEMPERING_MAX];
+  char *hex = lw_rng_save(pt->rng);
+  if (!hex) return LW_ENOMEM;
+  bad = lw_state_add(st, "pt_rng", hex);
+  free(hex);
+  put_doubles(buf, sizeof buf, pt->ladder, n);
+  bad = bad || lw_state_add(st, "pt_ladder", buf);
+  for (int k = 0; k < n; k++) {
+    v[2 * k] = (unsigned long)pt->at[k];
+    v[2 * k + 1] = (unsigned long)(pt->label[k] + 1);
+  }
+  put_ulongs(buf, sizeof buf, v, 2 * n);
+  bad = bad || lw_state_add(st, "pt_at_label", buf);
+  for (int k = 0; k + 1 < n; k++) {
+    v[2 * k] = pt->tried[k];
+    v[2 * k + 1] = pt->accepted[k];
+  }
+  put_ulongs(buf, sizeof buf, v, 2 * (n - 1));
+  bad = bad || lw_state_add(st, "pt_swaps", buf);
+  for (int k = 0; k + 1 < n; k++) {
+    v[2 * k] = pt->win_tried[k];
+    v[2 * k + 1] = pt->win_accepted[k];
+  }
+  put_ulongs(buf, sizeof buf, v, 2 * (n - 1));
+  bad = bad || lw_state_add(st, "pt_window", buf);
+  put_ulongs(buf, sizeof buf, a->swap_mark, 2 * (n - 1));
+  bad = bad || lw_state_add(st, "pt_trace_mark", buf);
+  v[0] = pt->round_trips;
+  v[1] = pt->steps;
+  put_ulongs(buf, sizeof buf, v, 2);
+  bad = bad || lw_state_add(st, "pt_trips_steps", buf);
+  for (int k = 1; !bad && k < n; k++) {
+    char prefix[32];
+    snprintf(prefix, sizeof prefix, "rung%d_", k);
+    bad = add_chain(st, prefix, a->chains[k]) != LW_OK;
+  }
+  return bad ? LW_ENOMEM : LW_OK;
+}
+
+/* replica-K.lw: the state at rung K >= 1 and its running energies. */
+static lw_status write_replica(const lw_anneal *a, int k, lw_error *err)
+{
+  lw_state st = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep, .sp = a->chains[k]->model->sp};
+  char name[64], path[LW_PATH_MAX + 64];
+  snprintf(name, sizeof name, "replica-%d.lw", k);
+  dir_file(path, sizeof path, a, name);
+  lw_status s = add_energy(&st, a->chains[k]->model);
+  if (s) s = lw_error_set(err, LW_ENOMEM, "out of memory writing a checkpoint");
+  else s = lw_state_write(&st, path, err);
+  st.sp = NULL;
+  lw_state_clear(&st);
+  return s;
+}
+
 lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
 {
   lw_chain *c = a->chain;
   lw_state st = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep, .sp = a->model->sp};
   lw_status s = LW_OK;
-  char *hex = lw_chain_rng_save(c);
   char buf[1024];
-  int n;
+  unsigned long v[3 * LW_MOVE_KINDS];
+  /* The replicas first: state.lw, written last, is what resume starts from,
+  ** and its sweep must match theirs. */
+  for (int k = 1; k < a->n_rep && !s; k++) s = write_replica(a, k, err);
+  if (s) return s;
 #define ADD(key, value) do { if (!s && lw_state_add(&st, key, value)) s = LW_ENOMEM; } while (0)
-  ADD("rng", hex ? hex : "");
-  ADD("temperature", fmt("%.17g", c->temperature));
+  s = add_chain(&st, "", c);
+  ADD("temperature", fmt("%.17g", a->t_sched));
   ADD("block", fmt("%ld", a->block));
   ADD("t_prev", fmt("%.17g", a->t_prev));
   ADD("prev_stats", fmt("%.17g %.17g %ld", a->prev.mean, a->prev.sd, a->prev.samples));
   ADD("block_energy", fmt("%.17g %.17g %.17g", a->acc_n, a->acc_sum, a->acc_sumsq));
-  n = 0;
-  for (int k = 0; k < LW_MOVE_KINDS; k++) n += snprintf(buf + n, sizeof buf - (size_t)n, "%s%.17g", k ? " " : "", c->step[k]);
-  ADD("steps", buf);
-  n = 0;
-  for (int k = 0; k < LW_MOVE_KINDS; k++)
-    n += snprintf(buf + n, sizeof buf - (size_t)n, "%s%lu %lu", k ? " " : "", c->win_prop[k], c->win_acc[k]);
-  ADD("tune_window", buf);
-  n = 0;
-  for (int k = 0; k < LW_MOVE_KINDS; k++)
-    n += snprintf(buf + n, sizeof buf - (size_t)n, "%s%lu %lu %lu", k ? " " : "", c->stats[k].proposed,
-                  c->stats[k].accepted, c->stats[k].nan);
-  ADD("moves", buf);
-  n = 0;
-  for (int k = 0; k < LW_MOVE_KINDS; k++)
-    n += snprintf(buf + n, sizeof buf - (size_t)n, "%s%lu %lu %lu", k ? " " : "", a->trace_mark[k].proposed,
-                  a->trace_mark[k].accepted, a->trace_mark[k].nan);
+  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+    v[3 * k] = a->trace_mark[k].proposed;
+    v[3 * k + 1] = a->trace_mark[k].accepted;
+    v[3 * k + 2] = a->trace_mark[k].nan;
+  }
+  put_ulongs(buf, sizeof buf, v, 3 * LW_MOVE_KINDS);
   ADD("trace_mark", buf);
-  n = 0;
-  for (int t = 0; t < LW_TERM_COUNT; t++) n += snprintf(buf + n, sizeof buf - (size_t)n, "%s%.17g", t ? " " : "", a->model->term[t]);
-  ADD("energy", buf);
+  if (!s) s = add_energy(&st, a->model);
   ADD("energy_initial", fmt("%.17g", a->energy_initial));
   ADD("max_drift", fmt("%.17g", a->max_drift));
+  if (!s && a->pt) s = add_tempering(&st, a);
 #undef ADD
-  free(hex);
   char path[LW_PATH_MAX + 32];
   dir_file(path, sizeof path, a, "state.lw");
-  if (!s && hex) s = lw_state_write(&st, path, err);
+  if (!s) s = lw_state_write(&st, path, err);
   else s = lw_error_set(err, LW_ENOMEM, "out of memory writing a checkpoint");
   if (!s && a->trace && fflush(a->trace)) s = lw_error_set(err, LW_EIO, "%s/trace.csv: write failed", a->dir);
   /* Wall time differs from run to run, so it lives beside the state, which
@@ -309,6 +541,89 @@ static lw_status truncate_trace(lw_anneal *a, lw_error *err)
   return s ? s : open_trace(a, 0, err);
 }
 
+static lw_status read_chain(const lw_state *st, const char *path, const char *prefix, lw_chain *c,
+                            lw_error *err)
+{
+  char key[64];
+  double v[3 * LW_MOVE_KINDS];
+  lw_status s;
+  key_of(key, sizeof key, prefix, "rng");
+  const lw_state_extra *rng = lw_state_get(st, key);
+  if (!rng || !lw_rng_load(c->rng, rng->value))
+    return lw_error_set(err, LW_EINPUT, "%s:%d: %s: expected the generator state in hex", path, rng ? rng->line : 0,
+                        key);
+  key_of(key, sizeof key, prefix, "steps");
+  if ((s = read_numbers(st, path, key, v, LW_MOVE_KINDS, err))) return s;
+  for (int k = 0; k < LW_MOVE_KINDS; k++) c->step[k] = v[k];
+  key_of(key, sizeof key, prefix, "tune_window");
+  if ((s = read_numbers(st, path, key, v, 2 * LW_MOVE_KINDS, err))) return s;
+  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+    c->win_prop[k] = (unsigned long)v[2 * k];
+    c->win_acc[k] = (unsigned long)v[2 * k + 1];
+  }
+  key_of(key, sizeof key, prefix, "moves");
+  if ((s = read_numbers(st, path, key, v, 3 * LW_MOVE_KINDS, err))) return s;
+  for (int k = 0; k < LW_MOVE_KINDS; k++)
+    c->stats[k] = (lw_move_stats){(unsigned long)v[3 * k], (unsigned long)v[3 * k + 1], (unsigned long)v[3 * k + 2]};
+  return LW_OK;
+}
+
+/* The running totals carry the rounding of the moves so far; restoring them
+** (rather than the fresh sums) keeps the trace identical to an uninterrupted
+** run. */
+static lw_status read_energy(const lw_state *st, const char *path, lw_model *m, lw_error *err)
+{
+  return read_numbers(st, path, "energy", m->term, LW_TERM_COUNT, err);
+}
+
+static lw_status read_tempering(lw_anneal *a, const lw_state *st, const char *path, lw_error *err)
+{
+  lw_tempering *pt = a->pt;
+  int n = pt->n;
+  double v[2 * LW_TEMPERING_MAX];
+  lw_status s;
+  const lw_state_extra *rng = lw_state_get(st, "pt_rng");
+  if (!rng || !lw_rng_load(pt->rng, rng->value))
+    return lw_error_set(err, LW_EINPUT, "%s:%d: pt_rng: expected the generator state in hex", path,
+                        rng ? rng->line : 0);
+  if ((s = read_numbers(st, path, "pt_ladder", pt->ladder, n, err))) return s;
+  if ((s = read_numbers(st, path, "pt_at_label", v, 2 * n, err))) return s;
+  int seen[LW_TEMPERING_MAX] = {0};
+  for (int k = 0; k < n; k++) {
+    int r = (int)v[2 * k];
+    if (r < 0 || r >= n || seen[r] || v[2 * k + 1] < 0 || v[2 * k + 1] > 2)
+      return lw_error_set(err, LW_EINPUT, "%s: pt_at_label: expected a permutation of the replicas", path);
+    seen[r] = 1;
+    pt->at[k] = r;
+    pt->label[k] = (int)v[2 * k + 1] - 1;
+  }
+  if ((s = read_numbers(st, path, "pt_swaps", v, 2 * (n - 1), err))) return s;
+  for (int k = 0; k + 1 < n; k++) {
+    pt->tried[k] = (unsigned long)v[2 * k];
+    pt->accepted[k] = (unsigned long)v[2 * k + 1];
+  }
+  if ((s = read_numbers(st, path, "pt_window", v, 2 * (n - 1), err))) return s;
+  for (int k = 0; k + 1 < n; k++) {
+    pt->win_tried[k] = (unsigned long)v[2 * k];
+    pt->win_accepted[k] = (unsigned long)v[2 * k + 1];
+  }
+  if ((s = read_numbers(st, path, "pt_trace_mark", v, 2 * (n - 1), err))) return s;
+  for (int k = 0; k < 2 * (n - 1); k++) a->swap_mark[k] = (unsigned long)v[k];
+  if ((s = read_numbers(st, path, "pt_trips_steps", v, 2, err))) return s;
+  pt->round_trips = (unsigned long)v[0];
+  pt->steps = (unsigned long)v[1];
+  for (int k = 1; k < n; k++) {
+    char prefix[32];
+    snprintf(prefix, sizeof prefix, "rung%d_", k);
+    if ((s = read_chain(st, path, prefix, a->chains[k], err))) return s;
+  }
+  /* models[] is by replica: rung k holds replica at[k] */
+  lw_model *by_rung[LW_TEMPERING_MAX];
+  for (int k = 0; k < n; k++) by_rung[k] = a->models[k];
+  for (int k = 0; k < n; k++) a->models[pt->at[k]] = by_rung[k];
+  return LW_OK;
+}
+
 lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *err)
 {
   memset(a, 0, sizeof *a);
@@ -316,57 +631,61 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   char path[LW_PATH_MAX + 32], scene_path[2 * LW_PATH_MAX + 2];
   dir_file(path, sizeof path, a, "state.lw");
-  lw_state st;
+  lw_state st, rep[LW_TEMPERING_MAX];
+  int n_read = 0;
   lw_status s = lw_state_read(&st, path, err);
   if (s) return s;
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);
-  if ((s = lw_params_read(&a->params, scene_path, err)) || (s = setup_schedule(a, err)) ||
-      (s = lw_scene_init(&a->scene, &a->params, err))) {
+  if ((s = lw_params_read(&a->params, scene_path, err)) || (s = count_replicas(a, err)) ||
+      (s = setup_schedule(a, err)) || (s = lw_scene_init(&a->scene, &a->params, err))) {
     lw_state_clear(&st);
     return s;
   }
   a->seed = st.seed;
   a->sweep = st.sweep;
-  lw_splines *sp = st.sp;
+  lw_splines *all[LW_TEMPERING_MAX] = {st.sp};
   st.sp = NULL;
-  if ((s = build(a, sp, err))) {
-    lw_state_clear(&st);
-    return s;
+  for (int k = 1; k < a->n_rep; k++, n_read++) {
+    char name[64], rpath[LW_PATH_MAX + 64];
+    snprintf(name, sizeof name, "replica-%d.lw", k);
+    dir_file(rpath, sizeof rpath, a, name);
+    s = lw_state_read(&rep[k], rpath, err);
+    if (!s && rep[k].sweep != a->sweep)
+      s = lw_error_set(err, LW_EINPUT, "%s: sweep %ld, but state.lw is at sweep %ld (an interrupted checkpoint?)",
+                       rpath, rep[k].sweep, a->sweep);
+    if (s) {
+      lw_state_clear(&rep[k]);
+      for (int q = 0; q < k; q++) lw_splines_free(all[q]);
+      goto out;
+    }
+    all[k] = rep[k].sp;
+    rep[k].sp = NULL;
   }
-  lw_chain *c = a->chain;
-  const lw_state_extra *rng = lw_state_get(&st, "rng");
+  if ((s = build(a, all, err))) goto out;
+  dir_file(path, sizeof path, a, "state.lw");
   double v[3 * LW_MOVE_KINDS];
-  if (!rng || !lw_chain_rng_load(c, rng->value)) {
-    s = lw_error_set(err, LW_EINPUT, "%s:%d: rng: expected the generator state in hex", path, rng ? rng->line : 0);
-    goto out;
-  }
+  if ((s = read_chain(&st, path, "", a->chain, err))) goto out;
 #define NUMS(key, n) if ((s = read_numbers(&st, path, key, v, n, err))) goto out
-  NUMS("temperature", 1); c->temperature = v[0];
+  NUMS("temperature", 1); a->t_sched = v[0];
   NUMS("block", 1); a->block = (long)v[0];
   NUMS("t_prev", 1); a->t_prev = v[0];
   NUMS("prev_stats", 3); a->prev = (lw_block_stats){v[0], v[1], (long)v[2]};
   NUMS("block_energy", 3); a->acc_n = v[0]; a->acc_sum = v[1]; a->acc_sumsq = v[2];
-  NUMS("steps", LW_MOVE_KINDS);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) c->step[k] = v[k];
-  NUMS("tune_window", 2 * LW_MOVE_KINDS);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
-    c->win_prop[k] = (unsigned long)v[2 * k];
-    c->win_acc[k] = (unsigned long)v[2 * k + 1];
-  }
-  NUMS("moves", 3 * LW_MOVE_KINDS);
-  for (int k = 0; k < LW_MOVE_KINDS; k++)
-    c->stats[k] = (lw_move_stats){(unsigned long)v[3 * k], (unsigned long)v[3 * k + 1], (unsigned long)v[3 * k + 2]};
   NUMS("trace_mark", 3 * LW_MOVE_KINDS);
   for (int k = 0; k < LW_MOVE_KINDS; k++)
     a->trace_mark[k] = (lw_move_stats){(unsigned long)v[3 * k], (unsigned long)v[3 * k + 1], (unsigned long)v[3 * k + 2]};
-  /* The running totals carry the rounding of the moves so far; restoring
-  ** them (rather than the fresh sums) keeps the trace identical to an
-  ** uninterrupted run. */
-  NUMS("energy", LW_TERM_COUNT);
-  for (int t = 0; t < LW_TERM_COUNT; t++) a->model->term[t] = v[t];
+  if ((s = read_energy(&st, path, a->model, err))) goto out;
   NUMS("energy_initial", 1); a->energy_initial = v[0];
   NUMS("max_drift", 1); a->max_drift = v[0];
 #undef NUMS
+  for (int k = 1; k < a->n_rep; k++) {
+    char name[64], rpath[LW_PATH_MAX + 64];
+    snprintf(name, sizeof name, "replica-%d.lw", k);
+    dir_file(rpath, sizeof rpath, a, name);
+    if ((s = read_energy(&rep[k], rpath, a->chains[k]->model, err))) goto out;
+  }
+  if (a->pt && (s = read_tempering(a, &st, path, err))) goto out;
+  set_temperatures(a);
   dir_file(path, sizeof path, a, "timing.txt");
   FILE *tf = fopen(path, "r");
   if (tf) {
@@ -374,9 +693,10 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
     fclose(tf);
   }
   a->end_sweep = more >= 0 ? a->sweep + more : (a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) a->proposals_before += c->stats[k].proposed;
+  for (int k = 0; k < LW_MOVE_KINDS; k++) a->proposals_before += a->chain->stats[k].proposed;
   s = truncate_trace(a, err);
 out:
+  for (int k = 1; k <= n_read && k < a->n_rep; k++) lw_state_clear(&rep[k]);
   lw_state_clear(&st);
   return s;
 }
@@ -397,42 +717,118 @@ static void trace_row(lw_anneal *a)
     else fprintf(a->trace, ",");
     a->trace_mark[k] = c->stats[k];
   }
+  if (a->pt) {
+    for (int k = 0; k < a->n_rep; k++)
+      fprintf(a->trace, ",%.10g,%.10g", a->chains[k]->temperature, lw_model_total(a->chains[k]->model));
+    /* swap acceptance since the previous row */
+    for (int k = 0; k + 1 < a->n_rep; k++) {
+      unsigned long tried = a->pt->tried[k] - a->swap_mark[2 * k];
+      unsigned long acc = a->pt->accepted[k] - a->swap_mark[2 * k + 1];
+      if (tried) fprintf(a->trace, ",%.6f", (double)acc / (double)tried);
+      else fprintf(a->trace, ",");
+      a->swap_mark[2 * k] = a->pt->tried[k];
+      a->swap_mark[2 * k + 1] = a->pt->accepted[k];
+    }
+  }
   fprintf(a->trace, "\n");
+}
+
+/* ladder.ini: the tuned ladder, ready to paste into a scene or --set. */
+static lw_status write_ladder(const lw_anneal *a, lw_error *err)
+{
+  char path[LW_PATH_MAX + 32], tmp[LW_PATH_MAX + 64];
+  dir_file(path, sizeof path, a, "ladder.ini");
+  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
+  if (!f) return err->code;
+  fprintf(f, "; ladder tuned toward equal swap acceptance over %d sweeps\n[tempering]\nladder =",
+          a->params.ladder_sweeps);
+  for (int k = 0; k < a->n_rep; k++) fprintf(f, " %.17g", a->pt->ladder[k]);
+  fprintf(f, "\n");
+  return lw_output_commit(f, tmp, path, err);
+}
+
+/* Exchange step and, during the warm-up, ladder tuning; after the warm-up
+** the ladder is frozen and the swap statistics start afresh. */
+static lw_status exchange(lw_anneal *a, lw_error *err)
+{
+  const lw_params *p = &a->params;
+  lw_tempering *pt = a->pt;
+  int n = a->n_rep, swapped[LW_TEMPERING_MAX];
+  double e[LW_TEMPERING_MAX] = {0}, t[LW_TEMPERING_MAX] = {0};
+  for (int k = 0; k < n; k++) {
+    e[k] = lw_model_total(a->chains[k]->model);
+    t[k] = a->chains[k]->temperature;
+  }
+  lw_tempering_exchange(pt, e, t, swapped);
+  for (int k = 0; k + 1 < n; k++)
+    if (swapped[k]) {
+      lw_model *m = a->chains[k]->model;
+      a->chains[k]->model = a->chains[k + 1]->model;
+      a->chains[k + 1]->model = m;
+    }
+  a->model = a->chains[0]->model;
+  if (p->tune_ladder == LW_LADDER_EQUAL && a->sweep <= p->ladder_sweeps) {
+    /* every pair has had ~20 attempts by then */
+    if (pt->steps % 40 == 0) {
+      lw_tempering_tune(pt);
+      set_temperatures(a);
+    }
+    if (a->sweep + p->exchange_every > p->ladder_sweeps) {
+      lw_tempering_reset_stats(pt);
+      memset(a->swap_mark, 0, sizeof a->swap_mark);
+      return write_ladder(a, err);
+    }
+  }
+  return LW_OK;
 }
 
 lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
 {
-  lw_chain *c = a->chain;
   const lw_params *p = &a->params;
+  int n = a->n_rep;
   long b = block_of(a, a->sweep);
   if (b != a->block) {
     if (a->block >= 0) {
-      double n = a->acc_n, mean = n > 0 ? a->acc_sum / n : 0.0;
-      double var = n > 1 ? (a->acc_sumsq - n * mean * mean) / (n - 1) : 0.0;
-      a->prev = (lw_block_stats){mean, var > 0 ? sqrt(var) : 0.0, (long)n};
-      a->t_prev = c->temperature;
+      double cnt = a->acc_n, mean = cnt > 0 ? a->acc_sum / cnt : 0.0;
+      double var = cnt > 1 ? (a->acc_sumsq - cnt * mean * mean) / (cnt - 1) : 0.0;
+      a->prev = (lw_block_stats){mean, var > 0 ? sqrt(var) : 0.0, (long)cnt};
+      a->t_prev = a->t_sched;
     }
-    c->temperature = a->sched_type->temperature(&a->sched, b, a->t_prev, a->block >= 0 ? &a->prev : NULL);
+    a->t_sched = a->sched_type->temperature(&a->sched, b, a->t_prev, a->block >= 0 ? &a->prev : NULL);
+    set_temperatures(a);
     a->block = b;
     a->acc_n = a->acc_sum = a->acc_sumsq = 0.0;
-    memset(c->win_prop, 0, sizeof c->win_prop);
-    memset(c->win_acc, 0, sizeof c->win_acc);
+    for (int k = 0; k < n; k++) {
+      memset(a->chains[k]->win_prop, 0, sizeof a->chains[k]->win_prop);
+      memset(a->chains[k]->win_acc, 0, sizeof a->chains[k]->win_acc);
+    }
   }
-  c->tuning = a->sweep - block_start(a, b) < p->tune_sweeps && a->sweep < p->sweeps;
-  if (lw_chain_sweep(c) != LW_OK) return lw_error_set(err, LW_ENOMEM, "out of memory growing the pair grid");
+  int tuning = a->sweep - block_start(a, b) < p->tune_sweeps && a->sweep < p->sweeps;
+  int failed = 0;
+  /* The rungs are independent between exchanges: each touches only its own
+  ** chain, stream and model, so the thread count cannot change the result. */
+#pragma omp parallel for schedule(static, 1) reduction(| : failed) if (n > 1)
+  for (int k = 0; k < n; k++) {
+    a->chains[k]->tuning = tuning;
+    if (lw_chain_sweep(a->chains[k]) != LW_OK) failed = 1;
+  }
+  if (failed) return lw_error_set(err, LW_ENOMEM, "out of memory growing the pair grid");
   a->sweep++;
+  lw_status s;
+  if (a->pt && a->sweep % p->exchange_every == 0 && (s = exchange(a, err))) return s;
   double e = lw_model_total(a->model);
-  if (!c->tuning && isfinite(e)) {
+  if (!tuning && isfinite(e)) {
     a->acc_n += 1.0;
     a->acc_sum += e;
     a->acc_sumsq += e * e;
   }
   if (a->sweep % p->trace_every == 0 || lw_anneal_done(a)) trace_row(a);
-  if (a->sweep % p->check_every == 0) {
-    double drift;
-    if (lw_model_refresh(a->model, &drift) != LW_OK) return lw_error_set(err, LW_ENOMEM, "out of memory");
-    if (drift > a->max_drift) a->max_drift = drift;
-  }
+  if (a->sweep % p->check_every == 0)
+    for (int r = 0; r < n; r++) {
+      double drift;
+      if (lw_model_refresh(a->models[r], &drift) != LW_OK) return lw_error_set(err, LW_ENOMEM, "out of memory");
+      if (drift > a->max_drift) a->max_drift = drift;
+    }
   if (a->sweep % p->checkpoint_every == 0) return lw_anneal_checkpoint(a, err);
   return LW_OK;
 }
@@ -500,6 +896,34 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     lw_json_number(&j, k == LW_MOVE_ROTATE ? c->step[k] * 180.0 / M_PI : c->step[k]);
   }
   lw_json_end_object(&j);
+  if (a->pt) {
+    const lw_tempering *pt = a->pt;
+    lw_json_key(&j, "replicas");
+    lw_json_begin_array(&j);
+    for (int k = 0; k < a->n_rep; k++) {
+      lw_json_begin_object(&j);
+      lw_json_key(&j, "temperature"); lw_json_number(&j, a->chains[k]->temperature);
+      lw_json_key(&j, "energy"); lw_json_number(&j, lw_model_total(a->chains[k]->model));
+      lw_json_end_object(&j);
+    }
+    lw_json_end_array(&j);
+    lw_json_key(&j, "ladder");
+    lw_json_begin_array(&j);
+    for (int k = 0; k < a->n_rep; k++) lw_json_number(&j, pt->ladder[k]);
+    lw_json_end_array(&j);
+    lw_json_key(&j, "swap_acceptance");
+    lw_json_begin_array(&j);
+    for (int k = 0; k + 1 < a->n_rep; k++) {
+      if (pt->tried[k]) lw_json_number(&j, lw_tempering_acceptance(pt, k));
+      else lw_json_null(&j);
+    }
+    lw_json_end_array(&j);
+    lw_json_key(&j, "swap_attempts");
+    lw_json_begin_array(&j);
+    for (int k = 0; k + 1 < a->n_rep; k++) lw_json_int(&j, (long long)pt->tried[k]);
+    lw_json_end_array(&j);
+    lw_json_key(&j, "round_trips"); lw_json_int(&j, (long long)pt->round_trips);
+  }
   lw_json_end_object(&j);
   lw_status s = lw_json_finish(&j, err);
   if (s) {
@@ -527,8 +951,13 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 void lw_anneal_free(lw_anneal *a)
 {
   if (a->trace) fclose(a->trace);
-  lw_chain_free(a->chain);
-  lw_model_free(a->model);
+  for (int k = 0; k < a->n_rep; k++) {
+    if (a->chains) lw_chain_free(a->chains[k]);
+    if (a->models) lw_model_free(a->models[k]);
+  }
+  free(a->chains);
+  free(a->models);
+  lw_tempering_free(a->pt);
   lw_scene_clear(&a->scene);
   lw_schedule_clear(&a->sched);
   memset(a, 0, sizeof *a);

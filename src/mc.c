@@ -169,10 +169,10 @@ lw_status lw_chain_sweep(lw_chain *c)
   return LW_OK;
 }
 
-char *lw_chain_rng_save(const lw_chain *c)
+char *lw_rng_save(const gsl_rng *r)
 {
-  size_t n = gsl_rng_size(c->rng);
-  const unsigned char *b = gsl_rng_state(c->rng);
+  size_t n = gsl_rng_size(r);
+  const unsigned char *b = gsl_rng_state(r);
   char *hex = malloc(2 * n + 1);
   if (!hex) return NULL;
   for (size_t i = 0; i < n; i++) sprintf(hex + 2 * i, "%02x", b[i]);
@@ -180,11 +180,11 @@ char *lw_chain_rng_save(const lw_chain *c)
   return hex;
 }
 
-int lw_chain_rng_load(lw_chain *c, const char *hex)
+int lw_rng_load(gsl_rng *r, const char *hex)
 {
-  size_t n = gsl_rng_size(c->rng);
+  size_t n = gsl_rng_size(r);
   if (strlen(hex) != 2 * n) return 0;
-  unsigned char *b = gsl_rng_state(c->rng);
+  unsigned char *b = gsl_rng_state(r);
   for (size_t i = 0; i < n; i++) {
     unsigned v;
     if (sscanf(hex + 2 * i, "%2x", &v) != 1) return 0;

@@ -134,6 +134,25 @@ const lw_param_def lw_param_table[] = {
       "Seed of the random number generator; the same scene and seed give the same run."),
   NUM("anneal", "check_every", LW_PT_INT, check_every, "100", "sweeps", 1, 2e9, 0,
       "Sweeps between full recomputations of the energy (the drift check)."),
+  NUM("tempering", "replicas", LW_PT_INT, replicas, "1", "", 1, 256, 0,
+      "Replicas on the temperature ladder (parallel tempering, run by OpenMP threads). 1 = off. "
+      "The coldest replica gives final.svg and state.lw."),
+  NUM("tempering", "t_min", LW_PT_DOUBLE, t_min, "0.01", "energy", 0, 1e300, LW_MIN_OPEN,
+      "Coldest temperature of the geometric ladder t_k = t_min (t_max/t_min)^(k/(R-1)). The whole "
+      "ladder follows the schedule: at step b every rung is t_k * T(b) / anneal.t_start, so a "
+      "constant schedule samples at the ladder itself."),
+  NUM("tempering", "t_max", LW_PT_DOUBLE, t_max, "1", "energy", 0, 1e300, LW_MIN_OPEN,
+      "Hottest temperature of the geometric ladder."),
+  STRING("tempering", "ladder", ladder, "", "energy",
+         "Explicit ladder `t0 t1 ...` (increasing; overrides t_min and t_max; its length sets the "
+         "replicas). A run with ladder tuning writes its tuned ladder to ladder.ini for reuse."),
+  NUM("tempering", "exchange_every", LW_PT_INT, exchange_every, "1", "sweeps", 1, 2e9, 0,
+      "Sweeps between exchange steps; steps alternate between even (0-1, 2-3, ...) and odd pairs."),
+  CHOICE("tempering", "tune_ladder", tune_ladder, "fixed", "fixed|equal",
+         "fixed keeps the ladder; equal moves the inner rungs toward equal swap acceptance during "
+         "the first `ladder_sweeps` sweeps (then the ladder is frozen and swap statistics restart)."),
+  NUM("tempering", "ladder_sweeps", LW_PT_INT, ladder_sweeps, "200", "sweeps", 0, 2e9, 0,
+      "Warm-up sweeps of ladder tuning (tune_ladder = equal)."),
   NUM("output", "checkpoint_every", LW_PT_INT, checkpoint_every, "100", "sweeps", 1, 2e9, 0,
       "Sweeps between checkpoints of state.lw (also written at the end and on SIGINT/SIGTERM)."),
   NUM("output", "trace_every", LW_PT_INT, trace_every, "1", "sweeps", 1, 2e9, 0,

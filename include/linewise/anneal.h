@@ -5,7 +5,12 @@
 ** callbacks: the caller owns the loop (and the progress display).
 **
 ** Run directory: scene.ini (the resolved parameters), state.lw, trace.csv,
-** summary.json, final.svg, final.png.  The state file carries everything
+** summary.json, final.svg, final.png; with parallel tempering also
+** replica-K.lw, the replica at rung K >= 1 (state.lw holds rung 0, the
+** coldest, and the data of every rung's chain), and ladder.ini after ladder
+** tuning.  The rungs sweep in parallel (OpenMP), each with its own stream;
+** exchanges are drawn serially from a master stream, so the result does not
+** depend on the number of threads.  The state file carries everything
 ** that steers the future of the run (RNG state, steps, tuning windows, the
 ** schedule's inputs, the running energies), so `resume` continues bit for
 ** bit: the same sweeps give the same state.lw whether or not the run was
@@ -20,12 +25,19 @@
 #include "linewise/params.h"
 #include "linewise/scene.h"
 #include "linewise/schedule.h"
+#include "linewise/tempering.h"
 
 typedef struct {
   lw_params params;
   lw_scene scene;
-  lw_model *model;
-  lw_chain *chain;
+  lw_model *model;             /* the replica at the coldest rung (= chains[0]->model) */
+  lw_chain *chain;             /* the coldest rung's chain (= chains[0]) */
+  int n_rep;                   /* replicas: 1, or the rungs of parallel tempering */
+  lw_model **models;           /* by replica (owned) */
+  lw_chain **chains;           /* by rung (owned): each has its stream, steps, statistics */
+  lw_tempering *pt;            /* NULL without tempering */
+  double t_sched;              /* the schedule's temperature of this step */
+  unsigned long swap_mark[2 * LW_TEMPERING_MAX]; /* tried, accepted per pair at the last trace row */
   const lw_schedule_type *sched_type;
   lw_schedule sched;
   char dir[LW_PATH_MAX];

@@ -59,8 +59,9 @@ int lw_chain_step(lw_chain *c, lw_move_kind kind);
 ** commit could not grow the grid. */
 lw_status lw_chain_sweep(lw_chain *c);
 
-/* The RNG state as hex text (malloc'ed) and back, for checkpoints. */
-char *lw_chain_rng_save(const lw_chain *c);
-int lw_chain_rng_load(lw_chain *c, const char *hex);
+/* A generator's state as hex text (malloc'ed) and back, for checkpoints;
+** load returns 0 if the text does not fit the generator. */
+char *lw_rng_save(const gsl_rng *r);
+int lw_rng_load(gsl_rng *r, const char *hex);
 
 #endif

@@ -47,6 +47,7 @@ enum { LW_POT_CONSTANT, LW_POT_RAMP, LW_POT_RADIAL };
 enum { LW_FLD_CONSTANT, LW_FLD_RADIAL, LW_FLD_VORTEX, LW_FLD_WAVES };
 enum { LW_STRAIN_SPLINE, LW_STRAIN_SEGMENT };
 enum { LW_FIELDMODE_AXIAL, LW_FIELDMODE_SIGNED };
+enum { LW_LADDER_FIXED, LW_LADDER_EQUAL };
 
 typedef struct {
   /* [scene] */
@@ -92,6 +93,13 @@ typedef struct {
   char table[LW_PATH_MAX];    /* table schedule file */
   double seed;                /* RNG seed (a whole number, stored as double for the table) */
   int check_every;            /* sweeps between drift checks */
+  /* [tempering] */
+  int replicas;               /* 1 = no tempering */
+  double t_min, t_max;        /* geometric ladder, energy units */
+  char ladder[LW_PATH_MAX];   /* explicit ladder "t0 t1 ...", overrides t_min/t_max */
+  int exchange_every;         /* sweeps between exchange steps */
+  int tune_ladder;            /* LW_LADDER_* */
+  int ladder_sweeps;          /* warm-up sweeps of ladder tuning */
   /* [output] */
   int checkpoint_every;       /* sweeps between state.lw checkpoints */
   int trace_every;            /* sweeps per trace.csv row */

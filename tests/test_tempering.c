@@ -1,0 +1,339 @@
+/*
+** test_tempering.c -- exchanges, round trips, ladder tuning, and whole
+** tempering runs: thread-count independence and bit-exact resume.
+**
+** The statistical tests use a system whose energy distribution is known:
+** d independent harmonic degrees of freedom, E = sum x_i^2 / 2.  At
+** temperature T, E follows a Gamma distribution of shape d/2 and scale T.
+*/
+#include <criterion/criterion.h>
+#include <gsl/gsl_cdf.h>
+#include <gsl/gsl_integration.h>
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_sf_gamma.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+
+#include "linewise/tempering.h"
+
+/* ---- the exact swap acceptance --------------------------------------- */
+
+typedef struct {
+  double a, t1, t2; /* shape d/2, temperatures t1 < t2 */
+} swap_ctx;
+
+/*
+** P(swap) = E[min(1, exp((1/t1 - 1/t2)(E1 - E2)))], E1 ~ Gamma(a, t1) at the
+** cold rung, E2 ~ Gamma(a, t2) at the hot one.  For fixed E1 the inner
+** integral over E2 has a closed form: where E2 <= E1 the swap is certain,
+** P(a, E1/t2); where E2 > E1 the weight exp(-(1/t1 - 1/t2)(E2 - E1)) turns
+** the Gamma(a, t2) density into a Gamma(a, t1) one, giving
+** exp((1/t1 - 1/t2) E1) (t1/t2)^a Q(a, E1/t1).  The outer integral is done
+** numerically.
+*/
+static double swap_integrand(double e1, void *p)
+{
+  const swap_ctx *c = p;
+  if (e1 <= 0.0) return 0.0;
+  double f1 = gsl_ran_gamma_pdf(e1, c->a, c->t1);
+  /* f1 exp((1/t1 - 1/t2) e1) (t1/t2)^a is the Gamma(a, t2) density: bounded */
+  double f2 = gsl_ran_gamma_pdf(e1, c->a, c->t2);
+  return f1 * gsl_sf_gamma_inc_P(c->a, e1 / c->t2) + f2 * gsl_sf_gamma_inc_Q(c->a, e1 / c->t1);
+}
+
+static double exact_swap(double d, double t1, double t2)
+{
+  swap_ctx c = {0.5 * d, t1, t2};
+  gsl_function F = {swap_integrand, &c};
+  gsl_integration_workspace *w = gsl_integration_workspace_alloc(1000);
+  double r, err;
+  gsl_integration_qagiu(&F, 0.0, 0.0, 1e-10, 1000, w, &r, &err);
+  gsl_integration_workspace_free(w);
+  return r;
+}
+
+Test(tempering, exact_swap_formula_matches_brute_force_sampling)
+{
+  /* The closed form is checked against plain sampling of the two Gamma
+  ** variables (n = 4e5: sd of the estimate < 8e-4, tolerance 5 sd). */
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 7);
+  const double d = 6, t1 = 1.0, t2 = 1.6;
+  double sum = 0.0;
+  const int n = 400000;
+  for (int i = 0; i < n; i++) {
+    double e1 = gsl_ran_gamma(r, 0.5 * d, t1), e2 = gsl_ran_gamma(r, 0.5 * d, t2);
+    sum += fmin(1.0, exp((1.0 / t1 - 1.0 / t2) * (e1 - e2)));
+  }
+  double p = exact_swap(d, t1, t2);
+  cr_assert(fabs(sum / n - p) < 5 * sqrt(p * (1 - p) / n), "closed form %g, sampled %g", p, sum / n);
+  /* equal temperatures always swap; far apart almost never */
+  cr_assert(fabs(exact_swap(d, 1.0, 1.0 + 1e-12) - 1.0) < 1e-6);
+  cr_assert(exact_swap(d, 1.0, 100.0) < 1e-3);
+  gsl_rng_free(r);
+}
+
+Test(tempering, measured_swap_acceptance_agrees_with_the_exact_expectation)
+{
+  /* Each rung's energy is drawn afresh from its exact distribution before
+  ** every exchange step, so the attempts of a pair are independent Bernoulli
+  ** trials: the measured rate has the binomial sd sqrt(p (1 - p) / N).  We
+  ** allow 4.5 sd per pair (3 pairs; a false alarm is ~2e-5 per run, and the
+  ** seed is fixed). */
+  const int R = 4;
+  const double d = 8, ladder[4] = {1.0, 1.35, 1.9, 2.5};
+  lw_error err;
+  lw_tempering *pt = lw_tempering_new(R, ladder, 11, &err);
+  cr_assert_not_null(pt);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 3);
+  double e[4];
+  for (int step = 0; step < 60000; step++) {
+    for (int k = 0; k < R; k++) e[k] = gsl_ran_gamma(r, 0.5 * d, ladder[k]);
+    lw_tempering_exchange(pt, e, ladder, NULL);
+  }
+  for (int k = 0; k + 1 < R; k++) {
+    double p = exact_swap(d, ladder[k], ladder[k + 1]);
+    double n = (double)pt->tried[k], m = lw_tempering_acceptance(pt, k);
+    cr_assert_eq(pt->tried[k], 30000ul, "pair %d tried %lu times", k, pt->tried[k]);
+    cr_assert(fabs(m - p) < 4.5 * sqrt(p * (1 - p) / n), "pair %d: measured %.4f, exact %.4f", k, m, p);
+  }
+  gsl_rng_free(r);
+  lw_tempering_free(pt);
+}
+
+/* d harmonic degrees of freedom sampled by Metropolis with unit steps. */
+typedef struct {
+  double x[4];
+  double e;
+} oscillator;
+
+static void metropolis_sweep(oscillator *o, double T, gsl_rng *r)
+{
+  for (int i = 0; i < 4; i++) {
+    double old = o->x[i], nx = old + gsl_ran_gaussian(r, 1.5 * sqrt(T));
+    double de = 0.5 * (nx * nx - old * old);
+    if (de <= 0 || gsl_rng_uniform(r) < exp(-de / T)) {
+      o->x[i] = nx;
+      o->e += de;
+    }
+  }
+}
+
+Test(tempering, exchanges_keep_every_rung_in_its_boltzmann_distribution)
+{
+  /* Detailed balance of the exchange step: with Metropolis replicas and
+  ** swaps of state pointers every sweep, the energy at rung k must still
+  ** average d T_k / 2 (Gamma(d/2, T_k): variance d T_k^2 / 2).  Samples are
+  ** correlated, so the error uses batch means (50 batches of 2000 sweeps,
+  ** each much longer than the correlation time of a few sweeps); tolerance
+  ** 5 standard errors per rung. */
+  const int R = 4, batches = 50, per = 2000;
+  const double ladder[4] = {0.5, 0.8, 1.3, 2.0};
+  lw_error err;
+  lw_tempering *pt = lw_tempering_new(R, ladder, 5, &err);
+  oscillator osc[4] = {{{0}, 0}}, *at[4] = {&osc[0], &osc[1], &osc[2], &osc[3]};
+  gsl_rng *rng[4];
+  for (int k = 0; k < R; k++) {
+    rng[k] = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng[k], 100 + (unsigned long)k);
+  }
+  double bm[4][50] = {{0}};
+  int swapped[3];
+  for (int s = -1000; s < batches * per; s++) {
+    double e[4];
+    for (int k = 0; k < R; k++) {
+      metropolis_sweep(at[k], ladder[k], rng[k]);
+      e[k] = at[k]->e;
+    }
+    lw_tempering_exchange(pt, e, ladder, swapped);
+    for (int k = 0; k + 1 < R; k++)
+      if (swapped[k]) {
+        oscillator *t = at[k];
+        at[k] = at[k + 1];
+        at[k + 1] = t;
+      }
+    if (s >= 0)
+      for (int k = 0; k < R; k++) bm[k][s / per] += at[k]->e / per;
+  }
+  for (int k = 0; k < R; k++) {
+    double mean = 0, var = 0;
+    for (int b = 0; b < batches; b++) mean += bm[k][b] / batches;
+    for (int b = 0; b < batches; b++) var += (bm[k][b] - mean) * (bm[k][b] - mean) / (batches - 1);
+    double se = sqrt(var / batches), want = 2.0 * ladder[k];
+    cr_assert(fabs(mean - want) < 5 * se, "rung %d: <E> = %.4f +- %.4f, want %.4f", k, mean, se, want);
+    gsl_rng_free(rng[k]);
+  }
+  /* the replicas did travel */
+  cr_assert(pt->round_trips > 50, "only %lu round trips", pt->round_trips);
+  lw_tempering_free(pt);
+}
+
+Test(tempering, round_trips_count_cold_hot_cold_journeys)
+{
+  /* The cold rung always holds the higher energy, so every attempt swaps.
+  ** With two rungs, pair 0-1 is tried on even steps only: replica 0 goes
+  ** up at steps 0, 4 and down at 2, 6 (trips at 2 and 6); replica 1 reaches
+  ** the cold end at 0 (no trip: it never left it), the hot end at 2, the
+  ** cold end again at 4 (one trip).  Eight steps: 3 round trips. */
+  const double ladder[2] = {1.0, 2.0};
+  lw_error err;
+  lw_tempering *pt = lw_tempering_new(2, ladder, 1, &err);
+  const double e[2] = {5.0, 1.0};
+  for (int s = 0; s < 8; s++) lw_tempering_exchange(pt, e, ladder, NULL);
+  cr_assert_eq(pt->tried[0], 4ul);
+  cr_assert_eq(pt->accepted[0], 4ul);
+  cr_assert_eq(pt->round_trips, 3ul);
+  cr_assert_eq(pt->at[0], 0);
+  lw_tempering_free(pt);
+}
+
+Test(tempering, zero_and_equal_temperatures_are_handled)
+{
+  const double ladder[2] = {1.0, 2.0}, zero[2] = {0.0, 0.0}, cold0[2] = {0.0, 1.0};
+  lw_error err;
+  lw_tempering *pt = lw_tempering_new(2, ladder, 1, &err);
+  /* both at T = 0: the swap changes nothing, it is accepted */
+  const double e[2] = {1.0, 3.0};
+  cr_assert_eq(lw_tempering_exchange(pt, e, zero, NULL), 1);
+  pt->steps = 0;
+  /* a T = 0 rung never takes a higher energy */
+  for (int s = 0; s < 10; s += 2, pt->steps = 0) cr_assert_eq(lw_tempering_exchange(pt, e, cold0, NULL), 0);
+  lw_tempering_free(pt);
+  double bad[2] = {1.0, 1.0};
+  cr_assert_null(lw_tempering_new(2, bad, 1, &err));
+  cr_assert_eq(err.code, LW_EINPUT);
+}
+
+Test(tempering, ladder_tuning_equalises_swap_acceptance)
+{
+  /* For identical harmonic systems the acceptance of a pair depends on the
+  ** ratio t_k+1 / t_k only, so equal acceptance means a geometric ladder.
+  ** Starting from a linear ladder (acceptance 0.2 at the cold end, 0.7 at the
+  ** hot end), tuning must bring the ratios within 10% of each other and keep
+  ** the ends. */
+  const int R = 5;
+  double ladder[5] = {1.0, 3.25, 5.5, 7.75, 10.0};
+  lw_error err;
+  lw_tempering *pt = lw_tempering_new(R, ladder, 9, &err);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 4);
+  const double d = 16;
+  for (int step = 1; step <= 40000; step++) {
+    double e[5];
+    for (int k = 0; k < R; k++) e[k] = gsl_ran_gamma(r, 0.5 * d, pt->ladder[k]);
+    lw_tempering_exchange(pt, e, pt->ladder, NULL);
+    if (step % 200 == 0) lw_tempering_tune(pt);
+  }
+  double lo = INFINITY, hi = 0;
+  for (int k = 0; k + 1 < R; k++) {
+    double q = pt->ladder[k + 1] / pt->ladder[k];
+    lo = fmin(lo, q);
+    hi = fmax(hi, q);
+  }
+  cr_assert(hi / lo < 1.1, "ratios from %g to %g", lo, hi);
+  cr_assert_eq(pt->ladder[0], 1.0);
+  cr_assert_eq(pt->ladder[R - 1], 10.0);
+  gsl_rng_free(r);
+  lw_tempering_free(pt);
+}
+
+/* ---- whole runs through the binary ------------------------------------ */
+
+static char dir[64];
+
+static void make_dir(void)
+{
+  strcpy(dir, "/tmp/lw_pt_XXXXXX");
+  cr_assert_not_null(mkdtemp(dir));
+}
+
+static void remove_dir(void)
+{
+  char cmd[128];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+  cr_assert_eq(system(cmd), 0);
+}
+
+static int sh(const char *fmt, ...)
+{
+  char cmd[2048];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(cmd, sizeof cmd, fmt, ap);
+  va_end(ap);
+  int st = system(cmd);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static const char scene[] =
+  "[scene]\nwidth = 50\nheight = 40\nmargin = 2\n"
+  "[init]\nsplines = 8\nsegments = 3\nsegment_length = 4\n"
+  "[energy]\nstrain = 5\nbending = 0.5\npair = 0.05\npair_cutoff = 4\nboundary = 0.1\n"
+  "[anneal]\nschedule = geometric\nt_start = 0.5\nt_end = 0.05\nsweeps = 90\nsteps = 5\nseed = 8\ncheck_every = 11\n"
+  "[tempering]\nreplicas = 4\nt_min = 0.5\nt_max = 4\ntune_ladder = equal\nladder_sweeps = 40\n"
+  "[output]\ncheckpoint_every = 13\ntrace_every = 4\n";
+
+TestSuite(ptrun, .init = make_dir, .fini = remove_dir);
+
+static void write_scene(void)
+{
+  char path[128];
+  snprintf(path, sizeof path, "%s/s.ini", dir);
+  FILE *f = fopen(path, "w");
+  fputs(scene, f);
+  fclose(f);
+}
+
+Test(ptrun, outputs_do_not_depend_on_the_thread_count)
+{
+  const char *b = getenv("LW_BIN");
+  write_scene();
+  const int threads[3] = {1, 2, 4};
+  for (int i = 0; i < 3; i++)
+    cr_assert_eq(sh("OMP_NUM_THREADS=%d %s run %s/s.ini --out %s/t%d --quiet", threads[i], b, dir, dir, threads[i]), 0);
+  const char *same[] = {"state.lw", "replica-1.lw", "replica-3.lw", "trace.csv", "final.svg", "final.png", "ladder.ini"};
+  for (int i = 1; i < 3; i++)
+    for (int k = 0; k < 7; k++)
+      cr_assert_eq(sh("cmp -s %s/t1/%s %s/t%d/%s", dir, same[k], dir, threads[i], same[k]), 0, "%s differs with %d threads",
+                   same[k], threads[i]);
+  /* the summary reports the ensemble */
+  cr_assert_eq(sh("grep -q '\"swap_acceptance\"' %s/t1/summary.json", dir), 0);
+  cr_assert_eq(sh("grep -q '\"round_trips\"' %s/t1/summary.json", dir), 0);
+  cr_assert_eq(sh("head -1 %s/t1/trace.csv | grep -q 'replica3_energy,swap0,swap1,swap2$'", dir), 0);
+}
+
+Test(ptrun, resume_continues_the_whole_ensemble_bit_exactly)
+{
+  const char *b = getenv("LW_BIN");
+  write_scene();
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/a --quiet", b, dir, dir), 0);
+  /* stopped inside the ladder warm-up and again later */
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/b --quiet --stop-at 23", b, dir, dir), 0);
+  cr_assert_eq(sh("%s resume %s/b --quiet --stop-at 61", b, dir), 0);
+  cr_assert_eq(sh("%s resume %s/b --quiet", b, dir), 0);
+  const char *same[] = {"state.lw", "replica-1.lw", "replica-2.lw", "replica-3.lw", "trace.csv", "final.svg", "ladder.ini"};
+  for (int k = 0; k < 7; k++)
+    cr_assert_eq(sh("cmp -s %s/a/%s %s/b/%s", dir, same[k], dir, same[k]), 0, "%s differs", same[k]);
+  /* a replica file from another checkpoint is refused, not mixed in */
+  cr_assert_eq(sh("cp %s/a/replica-2.lw %s/c.lw && sed -i 's/^sweep .*/sweep 5/' %s/c.lw && cp %s/c.lw %s/b/replica-2.lw",
+                  dir, dir, dir, dir, dir), 0);
+  cr_assert_eq(sh("%s resume %s/b --quiet 2>%s/err.txt", b, dir, dir), 2);
+  cr_assert_eq(sh("grep -q 'replica-2.lw: sweep 5' %s/err.txt", dir), 0);
+}
+
+Test(ptrun, bad_ladders_are_refused_with_the_line)
+{
+  const char *b = getenv("LW_BIN");
+  write_scene();
+  cr_assert_eq(sh("printf '[tempering]\\nladder = 1 0.5 2\\n' > %s/bad.ini", dir), 0);
+  cr_assert_eq(sh("%s run %s/bad.ini --out %s/x --quiet 2>%s/err.txt", b, dir, dir, dir), 2);
+  cr_assert_eq(sh("grep -q 'bad.ini:2: key .tempering.ladder.: expected increasing' %s/err.txt", dir), 0);
+  cr_assert_eq(sh("%s run %s/s.ini --set tempering.t_max=0.1 --out %s/x --quiet 2>%s/err.txt", b, dir, dir, dir), 2);
+  cr_assert_eq(sh("grep -q 'tempering.t_max' %s/err.txt", dir), 0);
+  cr_assert_neq(sh("test -e %s/x", dir), 0, "an output directory was created for bad input");
+}
