@@ -68,14 +68,14 @@ docs: bin/linewise
 	{ sed '/^| schedule |/,$$d' docs/SCHEDULES.md | sed '$$d'; bin/linewise schedules; } > docs/SCHEDULES.md.new
 	mv docs/SCHEDULES.md.new docs/SCHEDULES.md
 
-$(BUILD)/bench: tools/bench.c $(BUILD)/liblinewise.a
+$(BUILD)/bench $(BUILD)/bench-tempering: $(BUILD)/%: tools/%.c $(BUILD)/liblinewise.a
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) $< -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
 
 # Benchmarks rewrite docs/PERFORMANCE.md (machine and date recorded with them).
-bench: $(BUILD)/bench
+bench: $(BUILD)/bench $(BUILD)/bench-tempering
 	{ echo "# Performance"; echo; \
 	  echo "Written by \`make bench\` on $$(date -u +%Y-%m-%d), $$(nproc) cores, $$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')."; \
-	  echo; $(BUILD)/bench 5; } > docs/PERFORMANCE.md.new
+	  echo; $(BUILD)/bench 5; echo; $(BUILD)/bench-tempering 5; } > docs/PERFORMANCE.md.new
 	mv docs/PERFORMANCE.md.new docs/PERFORMANCE.md
 
 install: $(BIN)/linewise
