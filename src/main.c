@@ -27,11 +27,13 @@ static const char usage[] =
   "      --set SEC.KEY=VAL   override a scene parameter (repeatable)\n"
   "      --seed N            override anneal.seed\n"
   "      --stop-at N         stop cleanly after sweep N, as if interrupted\n"
+  "      --threads N         OpenMP threads for the replicas of parallel tempering\n"
+  "                          (default OMP_NUM_THREADS or all cores; results never depend on it)\n"
   "      --quiet             no progress or parameter echo on stderr\n"
   "  resume DIR          continue the run in DIR bit-exactly from DIR/state.lw\n"
   "      --sweeps N          run N more sweeps (default: to the end of the schedule;\n"
   "                          past the end the last temperature holds)\n"
-  "      --stop-at N, --quiet  as for run\n"
+  "      --stop-at N, --threads N, --quiet  as for run\n"
   "  energy DIR          recompute DIR/state.lw's energy from scratch with its scene;\n"
   "                      prints '<term> <value>' per enabled term, then 'total <value>'\n"
   "  params              print every scene parameter as Markdown (docs/PARAMETERS.md)\n"
@@ -170,6 +172,19 @@ static int parse_count(const char *opt, const char *v, long *out, lw_error *err)
   return 1;
 }
 
+/* --threads N: OpenMP threads for the tempering replicas.  Results never
+** depend on it (each rung has its own stream; exchanges are serial). */
+static int set_threads(const char *v, lw_error *err)
+{
+  long t;
+  if (!parse_count("--threads", v, &t, err) || t < 1 || t > 4096) {
+    lw_error_set(err, LW_EUSAGE, "--threads: expected a whole number from 1 to 4096, got '%s'", v ? v : "");
+    return 0;
+  }
+  omp_set_num_threads((int)t);
+  return 1;
+}
+
 static int cmd_run(int argc, char **argv)
 {
   lw_error err;
@@ -222,12 +237,7 @@ static int cmd_run(int argc, char **argv)
       if (!parse_count("--stop-at", v, &stop_at, &err)) return fail(&err);
       i++;
     } else if (!strcmp(argv[i], "--threads")) {
-      long t;
-      if (!parse_count("--threads", v, &t, &err) || t < 1) {
-        lw_error_set(&err, LW_EUSAGE, "--threads: expected a whole number >= 1");
-        return fail(&err);
-      }
-      omp_set_num_threads((int)t); /* results never depend on it (replicas are seeded per stream) */
+      if (!set_threads(v, &err)) return fail(&err);
       i++;
     } else if (!strcmp(argv[i], "--quiet")) {
       quiet = 1;
@@ -270,6 +280,9 @@ static int cmd_resume(int argc, char **argv)
       i++;
     } else if (!strcmp(argv[i], "--stop-at")) {
       if (!parse_count("--stop-at", v, &stop_at, &err)) return fail(&err);
+      i++;
+    } else if (!strcmp(argv[i], "--threads")) {
+      if (!set_threads(v, &err)) return fail(&err);
       i++;
     } else if (!strcmp(argv[i], "--quiet")) {
       quiet = 1;
