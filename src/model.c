@@ -9,16 +9,23 @@
 #include <string.h>
 
 /* Samples one segment and evaluates its length, its local terms and (if ps is
-** not NULL) its pair samples. */
+** not NULL) its pair samples, at the pair term's own nodes when it has them. */
 static void segment_eval(const lw_scene *sc, const lw_node *a, const lw_node *b, uint32_t spline,
                          lw_samples *s, double *len, double *local, lw_pair_sample *ps)
 {
   lw_segment_sample(&sc->quad, a, b, s);
   *len = s->length;
   for (int t = 0; t < sc->n_local; t++) local[t] = lw_term_types[sc->local[t]].segment(s, sc);
-  if (ps)
-    for (int q = 0; q < s->n; q++)
-      ps[q] = (lw_pair_sample){s->x[q], s->y[q], s->dx[q], s->dy[q], s->dl[q], spline, (uint32_t)q};
+  if (!ps) return;
+  lw_samples pair_s;
+  const lw_samples *ss = s;
+  if (sc->pair_quad.n != sc->quad.n) {
+    lw_segment_sample(&sc->pair_quad, a, b, &pair_s);
+    ss = &pair_s;
+  }
+  for (int q = 0; q < ss->n; q++)
+    ps[q] = (lw_pair_sample){ss->x[q], ss->y[q], (float)ss->dx[q], (float)ss->dy[q], (float)ss->dl[q], spline,
+                             (uint32_t)q};
 }
 
 /* Kernel sum of sample `me` (of spline `spline`) with every grid sample of
@@ -84,14 +91,14 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
                          lw_error *err)
 {
   for (int t = 0; t < LW_TERM_COUNT; t++) term[t] = 0.0;
-  const int nq = sc->quad.n;
+  const int np = sc->pair_quad.n;
   lw_samples s;
   double local[LW_TERM_COUNT];
   lw_pair_sample *ps = NULL;
   if (sc->on[LW_TERM_PAIR]) {
-    ps = malloc((sp->n_segments ? sp->n_segments : 1) * (size_t)nq * sizeof *ps);
+    ps = malloc((sp->n_segments ? sp->n_segments : 1) * (size_t)np * sizeof *ps);
     if (!ps) {
-      lw_error_set(err, LW_ENOMEM, "out of memory for %zu pair samples", sp->n_segments * (size_t)nq);
+      lw_error_set(err, LW_ENOMEM, "out of memory for %zu pair samples", sp->n_segments * (size_t)np);
       return NAN;
     }
   }
@@ -103,7 +110,7 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
   }
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
-    segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &seg_len[g], local, ps ? ps + g * (size_t)nq : NULL);
+    segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &seg_len[g], local, ps ? ps + g * (size_t)np : NULL);
     for (int t = 0; t < sc->n_local; t++) term[sc->local[t]] += local[t];
   }
   if (sc->on[LW_TERM_STRAIN])
@@ -115,7 +122,7 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
     }
   free(seg_len);
   if (ps) {
-    size_t n = sp->n_segments * (size_t)nq;
+    size_t n = sp->n_segments * (size_t)np;
     lw_cellgrid *g = grid_for(sc, n, err);
     if (!g) {
       free(ps);
@@ -153,7 +160,7 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
   m->spline_len = malloc((sp->n_splines ? sp->n_splines : 1) * sizeof *m->spline_len);
   if (!m->seg_len || !m->seg_local || !m->spline_len) goto nomem;
   if (sc->on[LW_TERM_PAIR]) {
-    size_t n = sp->n_segments * (size_t)sc->quad.n;
+    size_t n = sp->n_segments * (size_t)sc->pair_quad.n;
     if (n >= UINT32_MAX || sp->n_splines > LW_PAIR_MAX_SPLINES) {
       lw_error_set(err, LW_EINPUT, "%zu pair samples of %zu splines exceed the grid's limits "
                    "(2^32 samples, 2^26 splines)", n, sp->n_splines);
@@ -201,7 +208,7 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
 {
   const lw_scene *sc = m->scene;
   const lw_splines *sp = m->sp;
-  const int nq = sc->quad.n, nl = sc->n_local;
+  const int np = sc->pair_quad.n, nl = sc->n_local;
   double old_total = lw_model_total(m);
   double term[LW_TERM_COUNT] = {0};
   lw_samples s;
@@ -209,7 +216,7 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
     double *local = m->seg_local + g * (size_t)nl;
     segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &m->seg_len[g], local,
-                 m->ps ? m->ps + g * (size_t)nq : NULL);
+                 m->ps ? m->ps + g * (size_t)np : NULL);
     for (int t = 0; t < nl; t++) term[sc->local[t]] += local[t];
   }
   for (size_t i = 0; i < sp->n_splines; i++) {
@@ -220,7 +227,7 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
     if (sc->on[LW_TERM_STRAIN]) term[LW_TERM_STRAIN] += strain_of_spline(sc, sp, m->seg_len, i, L);
   }
   if (m->grid) {
-    size_t n = sp->n_segments * (size_t)nq;
+    size_t n = sp->n_segments * (size_t)np;
     lw_cellgrid_clear(m->grid);
     for (size_t i = 0; i < n; i++)
       if (lw_cellgrid_insert(m->grid, (uint32_t)i, m->ps[i].x, m->ps[i].y) != LW_OK) return LW_ENOMEM;
@@ -248,7 +255,7 @@ lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err)
     p->node = malloc((cap + 1) * sizeof *p->node);
     p->len = malloc(cap * sizeof *p->len);
     p->local = malloc(cap * (size_t)nl * sizeof *p->local);
-    p->ps = malloc(cap * (size_t)m->scene->quad.n * sizeof *p->ps);
+    p->ps = malloc(cap * (size_t)m->scene->pair_quad.n * sizeof *p->ps);
   }
   if (!p || !p->node || !p->len || !p->local || !p->ps) {
     lw_proposal_free(p);
@@ -279,7 +286,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
 {
   const lw_scene *sc = m->scene;
   const lw_splines *sp = m->sp;
-  const int nq = sc->quad.n, nl = sc->n_local;
+  const int np = sc->pair_quad.n, nl = sc->n_local;
   const size_t nseg = lw_splines_segments(sp, spline);
   const lw_node *base = &sp->node[sp->first[spline]];
   const size_t g0 = lw_segment_index(sp, spline, 0);
@@ -299,7 +306,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
     size_t m_loc = p->seg0 + j, g = g0 + m_loc;
     double *local = p->local + j * (size_t)nl;
     segment_eval(sc, proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1), spline, &s,
-                 &p->len[j], local, m->ps ? p->ps + j * (size_t)nq : NULL);
+                 &p->len[j], local, m->ps ? p->ps + j * (size_t)np : NULL);
     const double *old = m->seg_local + g * (size_t)nl;
     for (int t = 0; t < nl; t++) p->dterm[sc->local[t]] += local[t] - old[t];
     dlen += p->len[j] - m->seg_len[g];
@@ -327,8 +334,8 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
     double pe = 0.0;
     for (size_t j = 0; j < p->n_seg; j++) {
       size_t g = g0 + p->seg0 + j;
-      pe += pair_against(m->grid, m->ps, p->ps + j * (size_t)nq, nq, spline, &sc->pair);
-      pe -= pair_against(m->grid, m->ps, m->ps + g * (size_t)nq, nq, spline, &sc->pair);
+      pe += pair_against(m->grid, m->ps, p->ps + j * (size_t)np, np, spline, &sc->pair);
+      pe -= pair_against(m->grid, m->ps, m->ps + g * (size_t)np, np, spline, &sc->pair);
     }
     p->dterm[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pe;
     dE += p->dterm[LW_TERM_PAIR];
@@ -340,10 +347,10 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
 {
   const lw_scene *sc = m->scene;
   lw_splines *sp = m->sp;
-  const int nq = sc->quad.n, nl = sc->n_local;
+  const int np = sc->pair_quad.n, nl = sc->n_local;
   const size_t g0 = lw_segment_index(sp, p->spline, 0);
   if (m->grid) {
-    size_t first = (g0 + p->seg0) * (size_t)nq, n = p->n_seg * (size_t)nq;
+    size_t first = (g0 + p->seg0) * (size_t)np, n = p->n_seg * (size_t)np;
     const lw_pair_sample *old = m->ps + first;
     for (size_t k = 0; k < n; k++)
       if (lw_cellgrid_move(m->grid, (uint32_t)(first + k), old[k].x, old[k].y, p->ps[k].x, p->ps[k].y) != LW_OK) {
@@ -360,7 +367,7 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
     size_t g = g0 + p->seg0 + j;
     m->seg_len[g] = p->len[j];
     memcpy(m->seg_local + g * (size_t)nl, p->local + j * (size_t)nl, (size_t)nl * sizeof *m->seg_local);
-    if (m->ps) memcpy(m->ps + g * (size_t)nq, p->ps + j * (size_t)nq, (size_t)nq * sizeof *m->ps);
+    if (m->ps) memcpy(m->ps + g * (size_t)np, p->ps + j * (size_t)np, (size_t)np * sizeof *m->ps);
   }
   /* Summed afresh in a fixed order rather than updated by += dlen, so the
   ** cached length is a function of the state alone and a resumed run sees

@@ -91,7 +91,11 @@ const lw_param_def lw_param_table[] = {
   NUM("energy", "boundary", LW_PT_DOUBLE, boundary_coef, "0", "energy mm", 0, 1e12, 0,
       "R: boundary R * integral of 1/d^2 dl keeps lines inside (+infinity outside). 0 = off."),
   NUM("energy", "quadrature", LW_PT_INT, quadrature, "8", "nodes", 2, 64, 0,
-      "Gauss-Legendre nodes per segment for every integral."),
+      "Gauss-Legendre nodes per segment for every integral but the pair term's."),
+  NUM("energy", "pair_quadrature", LW_PT_INT, pair_quadrature, "0", "nodes", 0, 64, 0,
+      "Gauss-Legendre nodes per segment for the pair term (its samples in the cell grid); "
+      "0 = the same as `quadrature`. The pair sum costs about the square of this number per "
+      "proposal; docs/ACCURACY.md shows what fewer nodes cost in accuracy."),
   NUM("moves", "point", LW_PT_DOUBLE, mix_point, "0.5", "", 0, 1e6, 0,
       "Relative frequency of moves of one point p_k (Gaussian step in x and y)."),
   NUM("moves", "vector", LW_PT_DOUBLE, mix_vector, "0.4", "", 0, 1e6, 0,

@@ -75,7 +75,17 @@ lw_status lw_scene_init(lw_scene *sc, const lw_params *p, lw_error *err)
   sc->field_axial = p->field_mode == LW_FIELDMODE_AXIAL;
   lw_status st = lw_quad_init(&sc->quad, p->quadrature, err);
   if (st) return st;
-  lw_pair_ctx_init(&sc->pair, &sc->quad, p->pair_cutoff, p->pair_near);
+  sc->pair_quad = sc->quad;
+  if (sc->on[LW_TERM_PAIR] && p->pair_quadrature && p->pair_quadrature != p->quadrature) {
+    if (p->pair_quadrature < LW_QUAD_MIN) {
+      char where[LW_PATH_MAX + 32];
+      lw_params_origin(p, lw_params_find("energy", "pair_quadrature"), where, sizeof where);
+      return lw_error_set(err, LW_EINPUT, "%s: key 'energy.pair_quadrature': expected 0 or %d to %d nodes, got %d",
+                          where, LW_QUAD_MIN, LW_QUAD_MAX, p->pair_quadrature);
+    }
+    if ((st = lw_quad_init(&sc->pair_quad, p->pair_quadrature, err))) return st;
+  }
+  lw_pair_ctx_init(&sc->pair, &sc->pair_quad, p->pair_cutoff, p->pair_near);
 
   double cx = p->center_x >= 0 ? p->center_x : 0.5 * p->width;
   double cy = p->center_y >= 0 ? p->center_y : 0.5 * p->height;

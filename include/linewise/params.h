@@ -76,6 +76,7 @@ typedef struct {
   double pair_cutoff;         /* mm; 0 = none */
   double pair_near;           /* element lengths; 0 = off */
   int quadrature;             /* nodes per segment */
+  int pair_quadrature;        /* pair samples per segment; 0 = quadrature */
   /* [moves] */
   double mix_point, mix_vector, mix_translate, mix_rotate; /* relative frequencies */
   double step_point, step_vector;  /* initial Gaussian step, mm */

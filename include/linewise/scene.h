@@ -24,6 +24,7 @@ typedef struct lw_scene {
   int strain_per_segment;       /* strain mode */
   int field_axial;              /* field mode */
   lw_quad quad;
+  lw_quad pair_quad;            /* nodes of the pair samples (valid when pair is on) */
   lw_pair_ctx pair;
   lw_potential potential;       /* valid when on[LW_TERM_POTENTIAL] */
   lw_field field;               /* valid when on[LW_TERM_FIELD] */
