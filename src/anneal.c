@@ -117,69 +117,55 @@ static void absolute_path(char *path, const char *scene_file)
   else if (strlen(joined) < LW_PATH_MAX) strcpy(path, joined);
 }
 
-/* Replicas of the run: the ladder's length, or [tempering] replicas. */
-static int count_ladder(const char *text)
+/* The numbers of an explicit ladder (at most max are stored); returns how
+** many there are, or -1 if something else is in the text. */
+static int parse_ladder(const char *text, double *out, int max)
 {
   int n = 0;
-  for (const char *c = text; *c;) {
+  for (const char *c = text;;) {
+    while (*c == ' ' || *c == '\t' || *c == ',') c++;
+    if (!*c) return n;
     char *end;
-    strtod(c, &end);
+    double v = strtod(c, &end);
     if (end == c) return -1;
+    if (n < max) out[n] = v;
     n++;
     c = end;
-    while (*c == ' ' || *c == '\t' || *c == ',') c++;
   }
-  return n;
 }
 
-/* The base ladder from [tempering]; messages name the key's line. */
-static lw_status setup_ladder(const lw_anneal *a, double *ladder, lw_error *err)
+/* Replicas of the run (the explicit ladder's length, or [tempering]
+** replicas) and the base ladder; messages name the key's line. */
+static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
 {
   const lw_params *p = &a->params;
   char where[LW_PATH_MAX + 32];
-  int n = a->n_rep;
-  if (p->ladder[0]) {
-    lw_params_origin(p, lw_params_find("tempering", "ladder"), where, sizeof where);
-    const char *c = p->ladder;
-    for (int k = 0; k < n; k++) {
-      char *end;
-      ladder[k] = strtod(c, &end);
-      c = end;
-      while (*c == ' ' || *c == '\t' || *c == ',') c++;
-      if (!(ladder[k] > 0.0) || !isfinite(ladder[k]) || (k > 0 && !(ladder[k] > ladder[k - 1])))
-        return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected increasing positive "
-                            "temperatures, got '%s'", where, p->ladder);
-    }
-  } else {
-    lw_params_origin(p, lw_params_find("tempering", "t_max"), where, sizeof where);
-    if (!(p->t_max > p->t_min))
-      return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.t_max': expected a value above t_min = %g, got %g",
-                          where, p->t_min, p->t_max);
-    lw_tempering_geometric(ladder, n, p->t_min, p->t_max);
-  }
-  lw_params_origin(p, lw_params_find("anneal", "t_start"), where, sizeof where);
-  if (!(p->t_start > 0.0))
-    return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.t_start': parallel tempering scales the ladder by "
-                        "T(step) / t_start, so t_start must be > 0", where);
-  return LW_OK;
-}
-
-static lw_status count_replicas(lw_anneal *a, lw_error *err)
-{
-  const lw_params *p = &a->params;
   a->n_rep = p->replicas;
   if (p->ladder[0]) {
-    char where[LW_PATH_MAX + 32];
     lw_params_origin(p, lw_params_find("tempering", "ladder"), where, sizeof where);
-    int n = count_ladder(p->ladder);
+    int n = parse_ladder(p->ladder, ladder, LW_TEMPERING_MAX);
     if (n < 2 || n > LW_TEMPERING_MAX)
       return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%s'",
                           where, LW_TEMPERING_MAX, p->ladder);
     if (p->replicas != 1 && p->replicas != n)
       return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': %d temperatures for %d replicas", where, n,
                           p->replicas);
+    for (int k = 0; k < n; k++)
+      if (!(ladder[k] > 0.0) || !isfinite(ladder[k]) || (k > 0 && !(ladder[k] > ladder[k - 1])))
+        return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected increasing positive "
+                            "temperatures, got '%s'", where, p->ladder);
     a->n_rep = n;
+  } else if (a->n_rep > 1) {
+    lw_params_origin(p, lw_params_find("tempering", "t_max"), where, sizeof where);
+    if (!(p->t_max > p->t_min))
+      return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.t_max': expected a value above t_min = %g, got %g",
+                          where, p->t_min, p->t_max);
+    lw_tempering_geometric(ladder, a->n_rep, p->t_min, p->t_max);
   }
+  lw_params_origin(p, lw_params_find("anneal", "t_start"), where, sizeof where);
+  if (a->n_rep > 1 && !(p->t_start > 0.0))
+    return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.t_start': parallel tempering scales the ladder by "
+                        "T(step) / t_start, so t_start must be > 0", where);
   return LW_OK;
 }
 
@@ -191,8 +177,8 @@ static unsigned long rung_stream(const lw_anneal *a, int k)
 }
 
 /* Models for the n_rep states sp[] (ownership passes, also on failure),
-** chains for the rungs, the exchange machinery. */
-static lw_status build(lw_anneal *a, lw_splines **sp, lw_error *err)
+** chains for the rungs, the exchange machinery on the base ladder. */
+static lw_status build(lw_anneal *a, lw_splines **sp, const double *ladder, lw_error *err)
 {
   const lw_params *p = &a->params;
   int n = a->n_rep;
@@ -222,8 +208,6 @@ static lw_status build(lw_anneal *a, lw_splines **sp, lw_error *err)
   a->chain = a->chains[0];
   a->model = a->models[0];
   if (n > 1) {
-    double ladder[LW_TEMPERING_MAX];
-    if ((s = setup_ladder(a, ladder, err))) return s;
     a->pt = lw_tempering_new(n, ladder, lw_stream_seed(a->seed, 2), err);
     if (!a->pt) return err->code;
   }
@@ -272,7 +256,8 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   a->seed = (unsigned long)p->seed;
   a->block = -1;
   lw_status s;
-  if ((s = count_replicas(a, err)) || (s = setup_schedule(a, err)) ||
+  double ladder[LW_TEMPERING_MAX];
+  if ((s = setup_ladder(a, ladder, err)) || (s = setup_schedule(a, err)) ||
       (s = lw_scene_init(&a->scene, &a->params, err)))
     return s;
   lw_splines *sp;
@@ -297,7 +282,7 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
       for (int q = 0; q < r; q++) lw_splines_free(all[q]);
       return lw_error_set(err, LW_ENOMEM, "out of memory for %d replicas", a->n_rep);
     }
-  if ((s = build(a, all, err))) return s;
+  if ((s = build(a, all, ladder, err))) return s;
   a->energy_initial = lw_model_total(a->model);
   a->end_sweep = p->sweeps;
   /* Everything above only read input: the directory appears once the run
@@ -636,7 +621,8 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
   lw_status s = lw_state_read(&st, path, err);
   if (s) return s;
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);
-  if ((s = lw_params_read(&a->params, scene_path, err)) || (s = count_replicas(a, err)) ||
+  double ladder[LW_TEMPERING_MAX];
+  if ((s = lw_params_read(&a->params, scene_path, err)) || (s = setup_ladder(a, ladder, err)) ||
       (s = setup_schedule(a, err)) || (s = lw_scene_init(&a->scene, &a->params, err))) {
     lw_state_clear(&st);
     return s;
@@ -661,7 +647,7 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
     all[k] = rep[k].sp;
     rep[k].sp = NULL;
   }
-  if ((s = build(a, all, err))) goto out;
+  if ((s = build(a, all, ladder, err))) goto out;
   dir_file(path, sizeof path, a, "state.lw");
   double v[3 * LW_MOVE_KINDS];
   if ((s = read_chain(&st, path, "", a->chain, err))) goto out;
