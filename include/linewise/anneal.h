@@ -5,7 +5,8 @@
 ** callbacks: the caller owns the loop (and the progress display).
 **
 ** Run directory: scene.ini (the resolved parameters), state.lw, trace.csv,
-** summary.json, final.svg, final.png.  The state file carries everything
+** summary.json, final.svg, final.png, and as asked final.pdf and frames/
+** (drawing.h).  The state file carries everything
 ** that steers the future of the run (RNG state, steps, tuning windows, the
 ** schedule's inputs, the running energies), so `resume` continues bit for
 ** bit: the same sweeps give the same state.lw whether or not the run was
@@ -16,6 +17,7 @@
 
 #include <stdio.h>
 
+#include "linewise/drawing.h"
 #include "linewise/mc.h"
 #include "linewise/params.h"
 #include "linewise/scene.h"
@@ -43,6 +45,7 @@ typedef struct {
   double wall_start;           /* monotonic clock at start of this process */
   lw_move_stats trace_mark[LW_MOVE_KINDS]; /* stats at the last trace row */
   FILE *trace;
+  lw_drawing_report drawing;   /* pen-up travel and fidelity of the final drawing */
 } lw_anneal;
 
 /* A new run of the scene file (with overrides already applied to p) into
@@ -63,7 +66,7 @@ static inline int lw_anneal_done(const lw_anneal *a) { return a->sweep >= a->end
 /* Writes state.lw now (a clean stop). */
 lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err);
 
-/* The final files: state.lw, final.svg, final.png, summary.json. */
+/* The final files: state.lw, the drawings (drawing.h), summary.json. */
 lw_status lw_anneal_finish(lw_anneal *a, lw_error *err);
 
 void lw_anneal_free(lw_anneal *a);
