@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "linewise/drawing.h"
 #include "linewise/init.h"
 #include "linewise/json.h"
 #include "linewise/output.h"
@@ -257,7 +258,8 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   a->block = -1;
   lw_status s;
   double ladder[LW_TEMPERING_MAX];
-  if ((s = setup_ladder(a, ladder, err)) || (s = setup_schedule(a, err)) ||
+  if ((s = lw_params_resolve(&a->params, err)) || (s = setup_ladder(a, ladder, err)) ||
+      (s = setup_schedule(a, err)) ||
       (s = lw_scene_init(&a->scene, &a->params, err)))
     return s;
   lw_splines *sp;
@@ -815,6 +817,10 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
       if (lw_model_refresh(a->models[r], &drift) != LW_OK) return lw_error_set(err, LW_ENOMEM, "out of memory");
       if (drift > a->max_drift) a->max_drift = drift;
     }
+  /* Frames are extra files: they read the state and change nothing. */
+  if (p->frames_every && a->sweep % p->frames_every == 0 &&
+      lw_drawing_frame(p, &a->scene, a->model->sp, NULL, a->dir, a->sweep, err))
+    return err->code;
   if (a->sweep % p->checkpoint_every == 0) return lw_anneal_checkpoint(a, err);
   return LW_OK;
 }
@@ -860,6 +866,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     }
   lw_json_end_object(&j);
   lw_json_key(&j, "energy_initial"); lw_json_number(&j, a->energy_initial);
+  lw_drawing_report_json(&j, &a->drawing);
   lw_json_key(&j, "acceptance");
   lw_json_begin_object(&j);
   for (int k = 0; k < LW_MOVE_KINDS; k++) {
@@ -923,14 +930,8 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 {
   lw_status s;
   if ((s = lw_anneal_checkpoint(a, err))) return s;
-  lw_output_page page;
-  lw_output_page_init(&page, a->params.width, a->params.height);
-  page.stroke_mm = a->params.pen_width;
-  char path[LW_PATH_MAX + 32];
-  dir_file(path, sizeof path, a, "final.svg");
-  if ((s = lw_output_svg(a->model->sp, &page, path, err))) return s;
-  dir_file(path, sizeof path, a, "final.png");
-  if ((s = lw_output_png(a->model->sp, &page, a->params.png_scale, path, err))) return s;
+  /* NULL: the target tone raster, once scenes carry one (fidelity, underlay) */
+  if ((s = lw_drawing_write(&a->params, &a->scene, a->model->sp, NULL, a->dir, &a->drawing, err))) return s;
   return write_summary(a, err);
 }
 

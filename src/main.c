@@ -156,7 +156,15 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, lw_error *err)
     return 0;
   }
   if (lw_anneal_finish(a, err)) return fail(err);
-  if (!quiet) fprintf(stderr, "linewise: done: %s/final.svg, final.png, summary.json, trace.csv, state.lw\n", a->dir);
+  if (!quiet) {
+    const lw_drawing_report *d = &a->drawing;
+    fprintf(stderr, "linewise: %zu paths; pen-up travel %.1f mm in index order, %.1f mm as plotted\n", d->paths,
+            d->travel_before, d->travel_after);
+    if (d->has_fidelity)
+      fprintf(stderr, "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f\n", d->fidelity.sigma_mm, d->fidelity.mse,
+              d->fidelity.ssim);
+    fprintf(stderr, "linewise: done: %s/final.svg, final.png, summary.json, trace.csv, state.lw\n", a->dir);
+  }
   return 0;
 }
 

@@ -1,11 +1,15 @@
-/* output.c -- plotter SVG, PNG preview and atomic file writes (output.h). */
+/* output.c -- plotter SVG, PNG and PDF previews, frames and atomic file
+** writes (output.h). */
 #include "linewise/output.h"
 
+#include <cairo-pdf.h>
 #include <cairo.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdint.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 void lw_output_page_init(lw_output_page *page, double width_mm, double height_mm)
@@ -13,8 +17,40 @@ void lw_output_page_init(lw_output_page *page, double width_mm, double height_mm
   memset(page, 0, sizeof *page);
   page->width_mm = width_mm;
   page->height_mm = height_mm;
-  page->stroke_mm = LW_OUTPUT_PEN_DEFAULT;
-  snprintf(page->color, sizeof page->color, "black");
+  page->n_pens = 1;
+  page->pen[0].width_mm = LW_OUTPUT_PEN_DEFAULT;
+}
+
+static int hex_digit(char c)
+{
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+int lw_output_color_parse(const char *text, size_t len, unsigned char rgb[3])
+{
+  if ((len != 4 && len != 7) || text[0] != '#') return 0;
+  int d[6];
+  for (size_t k = 1; k < len; k++)
+    if ((d[k - 1] = hex_digit(text[k])) < 0) return 0;
+  for (int c = 0; c < 3; c++)
+    rgb[c] = (unsigned char)(len == 4 ? 17 * d[c] : 16 * d[2 * c] + d[2 * c + 1]);
+  return 1;
+}
+
+int lw_output_colors_parse(const char *list, unsigned char (*rgb)[3], int max)
+{
+  int n = 0;
+  for (const char *c = list;;) {
+    c += strspn(c, " \t,");
+    if (!*c) return n;
+    size_t len = strcspn(c, " \t,");
+    if (n == max || !lw_output_color_parse(c, len, rgb[n])) return -1;
+    n++;
+    c += len;
+  }
 }
 
 /* ---- atomic writes ---------------------------------------------------- */
@@ -66,33 +102,31 @@ void lw_output_abort(FILE *f, const char *tmp)
 
 static int positive(double x) { return isfinite(x) && x > 0; }
 
-/* The colour goes verbatim into an XML attribute, so only characters that
-** CSS colour syntax needs and XML does not escape are let through. */
-static int color_ok(const char *c)
-{
-  if (!c[0] || !memchr(c, '\0', LW_OUTPUT_COLOR_MAX)) return 0;
-  for (; *c; c++) {
-    char ch = *c;
-    int alnum = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9');
-    if (!alnum && !strchr("#(),.% -", ch)) return 0;
-  }
-  return 1;
-}
-
 /* Everything is checked before a temporary file exists, so bad input never
 ** costs a file operation. */
-static lw_status check_input(const lw_splines *sp, const lw_output_page *page, const char *path,
-                             lw_error *err)
+static lw_status check_input(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
+                             const lw_grid2d *tone, const char *path, lw_error *err)
 {
   if (!positive(page->width_mm) || !positive(page->height_mm))
     return lw_error_set(err, LW_EINPUT, "%s: page size %g x %g mm: expected positive numbers", path,
                         page->width_mm, page->height_mm);
-  if (!positive(page->stroke_mm))
-    return lw_error_set(err, LW_EINPUT, "%s: pen width %g mm: expected a positive number", path,
-                        page->stroke_mm);
-  if (!color_ok(page->color))
-    return lw_error_set(err, LW_EINPUT, "%s: stroke colour '%.*s': expected a name, #rrggbb or rgb(...)",
-                        path, LW_OUTPUT_COLOR_MAX - 1, page->color);
+  if (page->n_pens < 1 || page->n_pens > LW_PLOT_PENS_MAX)
+    return lw_error_set(err, LW_EINPUT, "%s: %d pens: expected 1 to %d", path, page->n_pens, LW_PLOT_PENS_MAX);
+  for (int k = 0; k < page->n_pens; k++)
+    if (!positive(page->pen[k].width_mm))
+      return lw_error_set(err, LW_EINPUT, "%s: pen %d width %g mm: expected a positive number", path, k + 1,
+                          page->pen[k].width_mm);
+  if (plot) {
+    if (plot->n_pens != page->n_pens || plot->pen_first[plot->n_pens] != plot->n)
+      return lw_error_set(err, LW_EINPUT, "%s: the plot has %d pens, the page %d", path, plot->n_pens,
+                          page->n_pens);
+    for (size_t k = 0; k < plot->n; k++)
+      if (plot->spline[k] >= sp->n_splines)
+        return lw_error_set(err, LW_EINPUT, "%s: the plot names spline %zu of %zu", path, plot->spline[k],
+                            sp->n_splines);
+  }
+  if (tone && (tone->ncomp != 1 || tone->nx < 1 || tone->ny < 1 || !positive(tone->hx) || !positive(tone->hy)))
+    return lw_error_set(err, LW_EINPUT, "%s: the tone raster must have one value per pixel", path);
   for (size_t i = 0; i < sp->n_splines; i++)
     for (size_t k = sp->first[i]; k < sp->first[i + 1]; k++) {
       const lw_node *nd = &sp->node[k];
@@ -103,30 +137,37 @@ static lw_status check_input(const lw_splines *sp, const lw_output_page *page, c
   return LW_OK;
 }
 
-/* 1 if every control point of spline i equals its first point: the curve is
-** then a single point (the Bernstein polynomials are independent, so any
-** other set of control points moves). */
-static int zero_length(const lw_splines *sp, size_t i)
+/* The paths of pen k in drawing order: a plot's, or without one every
+** spline that is not a point, forward, all pen 0's. */
+typedef struct {
+  const lw_splines *sp;
+  const lw_plot *plot;
+  size_t at, end;
+} path_walk;
+
+static void walk_pen(path_walk *w, const lw_splines *sp, const lw_plot *plot, int k)
 {
-  const lw_node *nd = &sp->node[sp->first[i]];
-  size_t nn = sp->first[i + 1] - sp->first[i];
-  for (size_t k = 0; k < nn; k++)
-    if (nd[k].px != nd[0].px || nd[k].py != nd[0].py || nd[k].vx != 0 || nd[k].vy != 0) return 0;
-  return 1;
+  w->sp = sp;
+  w->plot = plot;
+  w->at = plot ? plot->pen_first[k] : 0;
+  w->end = plot ? plot->pen_first[k + 1] : k == 0 ? sp->n_splines : 0;
 }
 
-/* The four control points of segment m of spline i: x0 y0 x1 y1 x2 y2 x3 y3. */
-static void control_points(const lw_splines *sp, size_t i, size_t m, double b[8])
+static int walk_next(path_walk *w, size_t *spline, int *reversed)
 {
-  const lw_node *a = &sp->node[sp->first[i] + m], *c = a + 1;
-  b[0] = a->px;
-  b[1] = a->py;
-  b[2] = a->px + a->vx;
-  b[3] = a->py + a->vy;
-  b[4] = c->px - c->vx;
-  b[5] = c->py - c->vy;
-  b[6] = c->px;
-  b[7] = c->py;
+  for (; w->at < w->end; w->at++) {
+    if (w->plot) {
+      *spline = w->plot->spline[w->at];
+      *reversed = w->plot->reversed[w->at];
+    } else {
+      if (lw_splines_is_point(w->sp, w->at)) continue;
+      *spline = w->at;
+      *reversed = 0;
+    }
+    w->at++;
+    return 1;
+  }
+  return 0;
 }
 
 /* ---- SVG -------------------------------------------------------------- */
@@ -146,10 +187,43 @@ static void put_mm(FILE *f, double v)
   fputs(strcmp(buf, "-0") ? buf : "0", f);
 }
 
-lw_status lw_output_svg(const lw_splines *sp, const lw_output_page *page, const char *path,
-                        lw_error *err)
+static void put_coords(FILE *f, const double *xy, int n)
 {
-  lw_status s = check_input(sp, page, path, err);
+  for (int c = 0; c < n; c++) {
+    fputc(' ', f);
+    put_mm(f, xy[2 * c]);
+    fputc(' ', f);
+    put_mm(f, xy[2 * c + 1]);
+  }
+}
+
+/* One path's d attribute.  Reversed, segment m's control points b3 b2 b1
+** b0 are written as they are, last segment first: the same numbers, so the
+** same curve to the last printed digit. */
+static void put_path_data(FILE *f, const lw_splines *sp, size_t i, int reversed)
+{
+  size_t n = lw_splines_segments(sp, i);
+  double b[8], r[8];
+  fputs("M", f);
+  for (size_t k = 0; k < n; k++) {
+    size_t m = reversed ? n - 1 - k : k;
+    lw_splines_bezier(sp, i, m, b);
+    if (reversed)
+      for (int c = 0; c < 4; c++) {
+        r[2 * c] = b[6 - 2 * c];
+        r[2 * c + 1] = b[7 - 2 * c];
+      }
+    const double *cp = reversed ? r : b;
+    if (!k) put_coords(f, cp, 1);
+    fputs(" C", f);
+    put_coords(f, cp + 2, 3);
+  }
+}
+
+lw_status lw_output_svg(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
+                        const char *path, lw_error *err)
+{
+  lw_status s = check_input(sp, page, plot, NULL, path, err);
   if (s) return s;
   char tmp[LW_OUTPUT_PATH_MAX];
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
@@ -166,34 +240,116 @@ lw_status lw_output_svg(const lw_splines *sp, const lw_output_page *page, const 
   put_mm(f, page->width_mm);
   fputc(' ', f);
   put_mm(f, page->height_mm);
-  fputs("\">\n  <g inkscape:groupmode=\"layer\" inkscape:label=\"pen 1\" id=\"pen1\">\n", f);
-  for (size_t i = 0; i < sp->n_splines; i++) {
-    if (zero_length(sp, i)) continue;
-    /* Style on every path rather than inherited from the group: simple
-    ** plotter tools read a path's own attributes only, and a closed curve
-    ** would otherwise be filled black. */
-    fprintf(f, "    <path id=\"spline%zu\" fill=\"none\" stroke=\"%s\" stroke-width=\"", i, page->color);
-    put_mm(f, page->stroke_mm);
-    fputs("\" stroke-linecap=\"round\" stroke-linejoin=\"round\"\n      d=\"M ", f);
-    size_t n = lw_splines_segments(sp, i);
-    double b[8];
-    for (size_t m = 0; m < n; m++) {
-      control_points(sp, i, m, b);
-      if (!m) {
-        put_mm(f, b[0]);
-        fputc(' ', f);
-        put_mm(f, b[1]);
-      }
-      fputs(" C", f);
-      for (int c = 2; c < 8; c++) {
-        fputc(' ', f);
-        put_mm(f, b[c]);
-      }
+  fputs("\">\n", f);
+  for (int k = 0; k < page->n_pens; k++) {
+    const lw_output_pen *pen = &page->pen[k];
+    char color[8];
+    snprintf(color, sizeof color, "#%02x%02x%02x", pen->rgb[0], pen->rgb[1], pen->rgb[2]);
+    fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"pen %d (", k + 1);
+    put_mm(f, pen->width_mm);
+    fprintf(f, " mm)\" id=\"pen%d\">\n", k + 1);
+    path_walk w;
+    walk_pen(&w, sp, plot, k);
+    size_t i;
+    int reversed;
+    while (walk_next(&w, &i, &reversed)) {
+      /* Style on every path rather than inherited from the group: simple
+      ** plotter tools read a path's own attributes only, and a closed curve
+      ** would otherwise be filled black. */
+      fprintf(f, "    <path id=\"spline%zu\" fill=\"none\" stroke=\"%s\" stroke-width=\"", i, color);
+      put_mm(f, pen->width_mm);
+      fputs("\" stroke-linecap=\"round\" stroke-linejoin=\"round\"\n      d=\"", f);
+      put_path_data(f, sp, i, reversed);
+      fputs("\"/>\n", f);
     }
-    fputs("\"/>\n", f);
+    fputs("  </g>\n", f);
   }
-  fputs("  </g>\n</svg>\n", f);
+  fputs("</svg>\n", f);
   return lw_output_commit(f, tmp, path, err);
+}
+
+/* ---- cairo drawings ----------------------------------------------------- */
+
+static void trace_spline(cairo_t *cr, const lw_splines *sp, size_t i)
+{
+  size_t n = lw_splines_segments(sp, i);
+  double b[8];
+  for (size_t m = 0; m < n; m++) {
+    lw_splines_bezier(sp, i, m, b);
+    if (!m) cairo_move_to(cr, b[0], b[1]);
+    cairo_curve_to(cr, b[2], b[3], b[4], b[5], b[6], b[7]);
+  }
+}
+
+void lw_output_cairo_splines(cairo_t *cr, const lw_splines *sp)
+{
+  for (size_t i = 0; i < sp->n_splines; i++) {
+    if (lw_splines_is_point(sp, i)) continue;
+    trace_spline(cr, sp, i);
+    /* One stroke per spline keeps cairo's path memory to one spline. */
+    cairo_stroke(cr);
+  }
+}
+
+/* The tone raster as grey pixels over its rectangle (mm), blended at
+** LW_OUTPUT_UNDERLAY_ALPHA.  The surface is cairo's own copy of the tone,
+** 8 bits per channel, which is all a preview shows. */
+static void paint_tone(cairo_t *cr, const lw_grid2d *tone)
+{
+  cairo_surface_t *img = cairo_image_surface_create(CAIRO_FORMAT_RGB24, tone->nx, tone->ny);
+  if (cairo_surface_status(img)) {
+    cairo_surface_destroy(img);
+    return;
+  }
+  cairo_surface_flush(img);
+  unsigned char *data = cairo_image_surface_get_data(img);
+  int stride = cairo_image_surface_get_stride(img);
+  for (int j = 0; j < tone->ny; j++) {
+    uint32_t *row = (uint32_t *)(data + (size_t)j * (size_t)stride);
+    for (int i = 0; i < tone->nx; i++) {
+      double v = tone->data[(size_t)j * (size_t)tone->nx + (size_t)i];
+      uint32_t g = (uint32_t)lround(255.0 * (v < 0 ? 0 : v > 1 ? 1 : v));
+      row[i] = g << 16 | g << 8 | g;
+    }
+  }
+  cairo_surface_mark_dirty(img);
+  cairo_save(cr);
+  /* pixel (i, j) covers [x0 + (i - 1/2) hx, x0 + (i + 1/2) hx] x ... */
+  cairo_translate(cr, tone->x0 - 0.5 * tone->hx, tone->y0 - 0.5 * tone->hy);
+  cairo_scale(cr, tone->hx, tone->hy);
+  cairo_set_source_surface(cr, img, 0, 0);
+  /* PAD inside the rectangle: the edge pixels keep their grey instead of
+  ** fading into the paper over half a pixel */
+  cairo_pattern_set_extend(cairo_get_source(cr), CAIRO_EXTEND_PAD);
+  cairo_rectangle(cr, 0, 0, tone->nx, tone->ny);
+  cairo_clip(cr);
+  cairo_paint_with_alpha(cr, LW_OUTPUT_UNDERLAY_ALPHA);
+  cairo_restore(cr);
+  cairo_surface_destroy(img);
+}
+
+/* The whole drawing on cr, whose user unit is 1 mm. */
+static void draw(cairo_t *cr, const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
+                 const lw_grid2d *tone)
+{
+  if (tone) paint_tone(cr, tone);
+  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+  for (int k = 0; k < page->n_pens; k++) {
+    const lw_output_pen *pen = &page->pen[k];
+    cairo_set_source_rgb(cr, pen->rgb[0] / 255.0, pen->rgb[1] / 255.0, pen->rgb[2] / 255.0);
+    cairo_set_line_width(cr, pen->width_mm);
+    path_walk w;
+    walk_pen(&w, sp, plot, k);
+    size_t i;
+    int reversed;
+    /* Drawn forward whatever the plot's direction: a stroke is the same
+    ** shape either way. */
+    while (walk_next(&w, &i, &reversed)) {
+      trace_spline(cr, sp, i);
+      cairo_stroke(cr);
+    }
+  }
 }
 
 /* ---- PNG -------------------------------------------------------------- */
@@ -214,15 +370,15 @@ int lw_output_png_size(const lw_output_page *page, double px_per_mm, int *width_
   return 1;
 }
 
-static cairo_status_t png_write(void *closure, const unsigned char *data, unsigned int length)
+static cairo_status_t file_write(void *closure, const unsigned char *data, unsigned int length)
 {
   return fwrite(data, 1, length, closure) == length ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
 }
 
-lw_status lw_output_png(const lw_splines *sp, const lw_output_page *page, double px_per_mm,
-                        const char *path, lw_error *err)
+lw_status lw_output_png(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
+                        const lw_grid2d *tone, double px_per_mm, const char *path, lw_error *err)
 {
-  lw_status s = check_input(sp, page, path, err);
+  lw_status s = check_input(sp, page, plot, tone, path, err);
   if (s) return s;
   int w, h;
   double k;
@@ -242,22 +398,7 @@ lw_status lw_output_png(const lw_splines *sp, const lw_output_page *page, double
   cairo_paint(cr);
   /* Draw in mm: the line width is then the pen width in page units. */
   cairo_scale(cr, k, k);
-  cairo_set_source_rgb(cr, 0, 0, 0);
-  cairo_set_line_width(cr, page->stroke_mm);
-  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
-  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
-  for (size_t i = 0; i < sp->n_splines; i++) {
-    if (zero_length(sp, i)) continue;
-    size_t n = lw_splines_segments(sp, i);
-    double b[8];
-    for (size_t m = 0; m < n; m++) {
-      control_points(sp, i, m, b);
-      if (!m) cairo_move_to(cr, b[0], b[1]);
-      cairo_curve_to(cr, b[2], b[3], b[4], b[5], b[6], b[7]);
-    }
-    /* One stroke per spline keeps cairo's path memory to one spline. */
-    cairo_stroke(cr);
-  }
+  draw(cr, sp, page, plot, tone);
   cairo_surface_flush(surf);
   if (cairo_status(cr)) {
     s = lw_error_set(err, LW_ERUN, "%s: drawing the preview failed: %s", path,
@@ -274,7 +415,7 @@ lw_status lw_output_png(const lw_splines *sp, const lw_output_page *page, double
     s = err ? err->code : LW_EIO;
     goto done;
   }
-  cairo_status_t cs = cairo_surface_write_to_png_stream(surf, png_write, f);
+  cairo_status_t cs = cairo_surface_write_to_png_stream(surf, file_write, f);
   if (cs) {
     lw_output_abort(f, tmp);
     s = lw_error_set(err, LW_EIO, "%s: writing the PNG failed: %s", path, cairo_status_to_string(cs));
@@ -285,4 +426,50 @@ done:
   cairo_destroy(cr);
   cairo_surface_destroy(surf);
   return s;
+}
+
+lw_status lw_output_frame(const char *dir, long sweep, const lw_splines *sp, const lw_output_page *page,
+                          const lw_plot *plot, const lw_grid2d *tone, double px_per_mm, lw_error *err)
+{
+  char path[LW_OUTPUT_PATH_MAX];
+  int n = snprintf(path, sizeof path, "%s/frames", dir);
+  if (n < 0 || (size_t)n >= sizeof path - 32)
+    return lw_error_set(err, LW_EIO, "%s: path too long for the frames", dir);
+  if (mkdir(path, 0777) && errno != EEXIST)
+    return lw_error_set(err, LW_EIO, "%s: cannot create directory: %s", path, strerror(errno));
+  snprintf(path + n, sizeof path - (size_t)n, "/frame-%06ld.png", sweep);
+  return lw_output_png(sp, page, plot, tone, px_per_mm, path, err);
+}
+
+/* ---- PDF -------------------------------------------------------------- */
+
+lw_status lw_output_pdf(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
+                        const lw_grid2d *tone, const char *path, lw_error *err)
+{
+  lw_status s = check_input(sp, page, plot, tone, path, err);
+  if (s) return s;
+  char tmp[LW_OUTPUT_PATH_MAX];
+  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
+  if (!f) return err ? err->code : LW_EIO;
+  const double pt_per_mm = 72.0 / 25.4;
+  cairo_surface_t *surf = cairo_pdf_surface_create_for_stream(file_write, f, page->width_mm * pt_per_mm,
+                                                              page->height_mm * pt_per_mm);
+  /* An empty date leaves /CreationDate out: otherwise every run would
+  ** differ from the last. */
+  cairo_pdf_surface_set_metadata(surf, CAIRO_PDF_METADATA_CREATE_DATE, "");
+  cairo_t *cr = cairo_create(surf);
+  cairo_scale(cr, pt_per_mm, pt_per_mm);
+  draw(cr, sp, page, plot, tone);
+  cairo_status_t cs = cairo_status(cr);
+  cairo_destroy(cr);
+  /* finishing writes the document; stream errors show up only now */
+  cairo_surface_finish(surf);
+  if (!cs) cs = cairo_surface_status(surf);
+  cairo_surface_destroy(surf);
+  if (cs) {
+    lw_output_abort(f, tmp);
+    return lw_error_set(err, cs == CAIRO_STATUS_WRITE_ERROR ? LW_EIO : LW_ERUN, "%s: writing the PDF failed: %s",
+                        path, cairo_status_to_string(cs));
+  }
+  return lw_output_commit(f, tmp, path, err);
 }

@@ -14,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/output.h"
+
 #define OFF(f) offsetof(lw_params, f)
 #define NUM(sec, key, T, f, def, unit, lo, hi, open, help) \
   {sec, key, T, OFF(f), def, unit, lo, hi, open, NULL, help}
@@ -23,10 +25,16 @@
   {sec, key, LW_PT_STRING, OFF(f), def, unit, 0, 0, 0, NULL, help}
 
 const lw_param_def lw_param_table[] = {
+  CHOICE("scene", "page", page, "custom", "custom|a4|a3|letter",
+         "Page size: `custom` takes `width` and `height`; a4 is 210 x 297 mm, a3 297 x 420 mm, "
+         "letter 215.9 x 279.4 mm (portrait). A named page sets width and height; setting "
+         "either as well is an error unless it agrees."),
+  CHOICE("scene", "orientation", orientation, "portrait", "portrait|landscape",
+         "Orientation of a named page: landscape swaps its width and height."),
   NUM("scene", "width", LW_PT_DOUBLE, width, "210", "mm", 0, 1e7, LW_MIN_OPEN,
-      "Page width."),
+      "Page width (set by a named `page`)."),
   NUM("scene", "height", LW_PT_DOUBLE, height, "297", "mm", 0, 1e7, LW_MIN_OPEN,
-      "Page height."),
+      "Page height (set by a named `page`)."),
   CHOICE("scene", "boundary", boundary, "rect", "rect|circle|polygon",
          "Shape of the frame the lines stay inside: the page rectangle inset by `margin`, "
          "the largest circle inside that rectangle, or `polygon`."),
@@ -162,9 +170,30 @@ const lw_param_def lw_param_table[] = {
   NUM("output", "trace_every", LW_PT_INT, trace_every, "1", "sweeps", 1, 2e9, 0,
       "Sweeps per row of trace.csv."),
   NUM("output", "pen_width", LW_PT_DOUBLE, pen_width, "0.3", "mm", 0, 100, LW_MIN_OPEN,
-      "Stroke width in final.svg and final.png: the pen's line width."),
+      "Stroke width of every pen in final.svg, the previews and the fidelity render: the pen's line width."),
+  NUM("output", "pens", LW_PT_INT, pens, "1", "", 1, 16, 0,
+      "Pens, each an Inkscape layer of final.svg. With a potential the splines are ranked by "
+      "their mean potential and cut into equal runs, darkest (lowest) to pen 1; otherwise "
+      "spline i goes to pen (i mod pens) + 1."),
+  STRING("output", "pen_colors", pen_colors, "", "",
+         "Colours of the pens as `#rrggbb` or `#rgb`, one per pen, separated by spaces; empty = all black."),
+  CHOICE("output", "order", order, "2opt", "none|greedy|2opt",
+         "Order of the paths of each pen in final.svg: index order, greedy nearest neighbour from "
+         "the page origin, or greedy improved by 2-opt; paths may be reversed. Reduces pen-up "
+         "travel (reported in summary.json)."),
   NUM("output", "png_scale", LW_PT_DOUBLE, png_scale, "4", "px/mm", 0, 100, LW_MIN_OPEN,
-      "Pixels per millimetre of final.png (the long side is capped at 4096 px)."),
+      "Pixels per millimetre of final.png and the frames (the long side is capped at 4096 px)."),
+  NUM("output", "pdf", LW_PT_INT, pdf, "0", "", 0, 1, 0,
+      "1 = also write final.pdf, a vector PDF of the page."),
+  NUM("output", "preview_image", LW_PT_INT, preview_image, "0", "", 0, 1, 0,
+      "1 = paint the source image's tone under the lines of final.png, final.pdf and the frames "
+      "(at half strength). Needs an image."),
+  NUM("output", "frames_every", LW_PT_INT, frames_every, "0", "sweeps", 0, 2e9, 0,
+      "Sweeps between animation frames frames/frame-SSSSSS.png (SSSSSS = the sweep). 0 = none."),
+  NUM("output", "fidelity_sigma", LW_PT_DOUBLE, fidelity_sigma, "1", "mm", 0, 1e4, LW_MIN_OPEN,
+      "Gaussian blur applied to both the rendered lines and the target tone before the fidelity "
+      "score (MSE, SSIM) compares them; about half the widest line spacing that should read as a "
+      "flat tone (docs/FORMATS.md)."),
 };
 const size_t lw_param_count = sizeof lw_param_table / sizeof lw_param_table[0];
 
@@ -359,6 +388,49 @@ lw_status lw_params_read(lw_params *p, const char *path, lw_error *err)
     return lw_error_set(err, LW_EINPUT,
                         "%s:%d: syntax error: expected '[section]', 'key = value' or a comment", path, r);
   if (r < 0) return lw_error_set(err, LW_ENOMEM, "%s: out of memory while reading", path);
+  return lw_params_resolve(p, err);
+}
+
+/* Named page sizes in mm, portrait, in the order of the choices of
+** scene.page (custom first, which has none). */
+static const double page_mm[][2] = {{0, 0}, {210, 297}, {297, 420}, {215.9, 279.4}};
+
+lw_status lw_params_resolve(lw_params *p, lw_error *err)
+{
+  char where[LW_PATH_MAX + 32], where_page[LW_PATH_MAX + 32];
+  if (p->page != LW_PAGE_CUSTOM) {
+    double w = page_mm[p->page][0], h = page_mm[p->page][1];
+    if (p->orientation == LW_ORIENT_LANDSCAPE) {
+      double t = w;
+      w = h;
+      h = t;
+    }
+    const lw_param_def *dp = lw_params_find("scene", "page");
+    const char *names[2] = {"width", "height"};
+    double *value[2] = {&p->width, &p->height}, want[2] = {w, h};
+    for (int k = 0; k < 2; k++) {
+      const lw_param_def *d = lw_params_find("scene", names[k]);
+      /* An explicit size must agree: a resolved scene.ini carries both. */
+      if (p->line[d - lw_param_table] && *value[k] != want[k]) {
+        lw_params_origin(p, d, where, sizeof where);
+        lw_params_origin(p, dp, where_page, sizeof where_page);
+        char page_name[16];
+        choice_name(dp->choices, p->page, page_name, sizeof page_name);
+        return lw_error_set(err, LW_EINPUT,
+                            "%s: key 'scene.%s' = %g mm conflicts with scene.page = %s (%g x %g mm, set at %s): "
+                            "expected %g or no %s",
+                            where, names[k], *value[k], page_name, w, h, where_page, want[k], names[k]);
+      }
+      *value[k] = want[k];
+    }
+  }
+  unsigned char rgb[LW_PLOT_PENS_MAX][3];
+  if (p->pen_colors[0] && lw_output_colors_parse(p->pen_colors, rgb, LW_PLOT_PENS_MAX) != p->pens) {
+    lw_params_origin(p, lw_params_find("output", "pen_colors"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT,
+                        "%s: key 'output.pen_colors': expected %d colours '#rrggbb' or '#rgb' (one per pen), got '%s'",
+                        where, p->pens, p->pen_colors);
+  }
   return LW_OK;
 }
 

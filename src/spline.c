@@ -63,6 +63,15 @@ lw_splines *lw_splines_clone(const lw_splines *sp)
   return c;
 }
 
+int lw_splines_is_point(const lw_splines *sp, size_t i)
+{
+  const lw_node *nd = &sp->node[sp->first[i]];
+  size_t nn = sp->first[i + 1] - sp->first[i];
+  for (size_t k = 0; k < nn; k++)
+    if (nd[k].px != nd[0].px || nd[k].py != nd[0].py || nd[k].vx != 0 || nd[k].vy != 0) return 0;
+  return 1;
+}
+
 void lw_segment_eval(const lw_node *a, const lw_node *b, double s,
                      double r[2], double d1[2], double d2[2])
 {

@@ -234,6 +234,17 @@ static const char scene[] =
 
 TestSuite(run, .init = make_dir, .fini = remove_dir);
 
+/* Writes dir/s.ini: the scene above, then extra (more [output] keys). */
+static void write_scene(const char *extra, char *path, size_t n)
+{
+  snprintf(path, n, "%s/s.ini", dir);
+  FILE *f = fopen(path, "w");
+  cr_assert_not_null(f);
+  fputs(scene, f);
+  fputs(extra, f);
+  fclose(f);
+}
+
 Test(run, resume_continues_bit_exactly)
 {
   const char *b = getenv("LW_BIN");
@@ -288,4 +299,56 @@ Test(run, bad_input_writes_nothing)
   cr_assert_eq(sh("grep -q 'energy.pair' %s/err.txt", dir), 0);
   cr_assert_eq(sh("%s resume %s/nothing-here 2>%s/err.txt", b, dir, dir), 2);
   cr_assert_eq(sh("grep -q 'state.lw' %s/err.txt", dir), 0);
+}
+
+/* Frames are extra files: a run that writes them (and a PDF) leaves the
+** same state, trace and drawings as one that does not, and a stopped and
+** resumed run writes the same frames. */
+Test(run, frames_and_pdf_change_nothing_else)
+{
+  const char *b = getenv("LW_BIN");
+  char path[128];
+  write_scene("", path, sizeof path);
+  const char *extra = "--set output.frames_every=40 --set output.pdf=1";
+  cr_assert_eq(sh("%s run %s --out %s/a --quiet", b, path, dir), 0);
+  cr_assert_eq(sh("%s run %s --out %s/c --quiet %s", b, path, dir, extra), 0);
+  cr_assert_eq(sh("%s run %s --out %s/d --quiet --stop-at 47 %s", b, path, dir, extra), 0);
+  cr_assert_eq(sh("%s resume %s/d --quiet", b, dir), 0);
+  const char *same[] = {"state.lw", "trace.csv", "final.svg", "final.png"};
+  for (int i = 0; i < 4; i++)
+    cr_assert_eq(sh("cmp -s %s/a/%s %s/c/%s", dir, same[i], dir, same[i]), 0, "%s differs", same[i]);
+  const char *frames[] = {"frame-000040.png", "frame-000080.png", "frame-000120.png"};
+  for (int i = 0; i < 3; i++)
+    cr_assert_eq(sh("cmp -s %s/c/frames/%s %s/d/frames/%s", dir, frames[i], dir, frames[i]), 0, "%s", frames[i]);
+  cr_assert_eq(sh("ls %s/c/frames | wc -l | grep -qx 3", dir), 0, "three frames");
+  cr_assert_eq(sh("cmp -s %s/c/final.pdf %s/d/final.pdf && head -c 5 %s/c/final.pdf | grep -q '%%PDF-'", dir, dir, dir),
+               0);
+  cr_assert_neq(sh("test -e %s/a/final.pdf", dir), 0, "no PDF unless asked");
+  /* the summary reports the pen-up travel, ordered no longer than before */
+  snprintf(path, sizeof path, "%s/c/summary.json", dir);
+  FILE *f = fopen(path, "r");
+  char line[256];
+  double before = NAN, after = NAN;
+  while (fgets(line, sizeof line, f)) {
+    sscanf(line, " \"before\": %lf", &before);
+    sscanf(line, " \"after\": %lf", &after);
+  }
+  fclose(f);
+  cr_assert(isfinite(before) && isfinite(after) && after <= before && after > 0, "travel %g -> %g", before, after);
+}
+
+/* Pens from the scene file: layers in final.svg; a bad colour list stops
+** the run before anything is written. */
+Test(run, pens_become_layers)
+{
+  const char *b = getenv("LW_BIN");
+  char path[128];
+  write_scene("pens = 2\npen_colors = #000 #c00\npen_width = 0.5\n", path, sizeof path);
+  cr_assert_eq(sh("%s run %s --out %s/p --quiet --set anneal.sweeps=5", b, path, dir), 0);
+  cr_assert_eq(sh("grep -c 'inkscape:groupmode=\"layer\"' %s/p/final.svg | grep -qx 2", dir), 0);
+  cr_assert_eq(sh("grep -q 'inkscape:label=\"pen 2 (0.5 mm)\" id=\"pen2\"' %s/p/final.svg", dir), 0);
+  cr_assert_eq(sh("grep -q 'stroke=\"#cc0000\"' %s/p/final.svg", dir), 0);
+  cr_assert_eq(sh("%s run %s --out %s/q --quiet --set output.pens=3 2>%s/err.txt", b, path, dir, dir), 2);
+  cr_assert_eq(sh("grep -q 's.ini:31: key .output.pen_colors.: expected 3 colours' %s/err.txt", dir), 0);
+  cr_assert_neq(sh("test -e %s/q", dir), 0);
 }

@@ -1,4 +1,5 @@
-/* test_output.c -- plotter SVG, PNG preview, atomic writes, JSON writer. */
+/* test_output.c -- plotter SVG with pens and order, PNG and PDF previews,
+** frames, atomic writes, JSON writer. */
 #include <cairo.h>
 #include <criterion/criterion.h>
 #include <dirent.h>
@@ -109,10 +110,10 @@ Test(output, svg_paths_are_the_exact_bezier_segments)
   lw_splines *sp = two_splines();
   lw_output_page page;
   lw_output_page_init(&page, 210, 297);
-  page.stroke_mm = 0.35;
+  page.pen[0].width_mm = 0.35;
   lw_error err;
   lw_error_clear(&err);
-  cr_assert_eq(lw_output_svg(sp, &page, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_output_svg(sp, &page, NULL, path, &err), LW_OK, "%s", err.msg);
   char *svg = slurp(path, NULL);
   cr_assert_not_null(svg);
 
@@ -123,7 +124,7 @@ Test(output, svg_paths_are_the_exact_bezier_segments)
   cr_assert_not_null(strstr(svg, " viewBox=\"0 0 210 297\""));
   /* Inkscape layer, namespace declared */
   cr_assert_not_null(strstr(svg, "xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\""));
-  const char *layer = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"pen 1\"");
+  const char *layer = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"pen 1 (0.35 mm)\" id=\"pen1\">");
   cr_assert_not_null(layer);
   cr_assert_not_null(strstr(layer, "</g>"));
 
@@ -195,15 +196,16 @@ Test(output, svg_rejects_non_finite_nodes_and_keeps_the_old_file)
   lw_output_page page;
   lw_output_page_init(&page, 210, 297);
   lw_error err;
-  cr_assert_eq(lw_output_svg(sp, &page, path, &err), LW_EINPUT);
+  cr_assert_eq(lw_output_svg(sp, &page, NULL, path, &err), LW_EINPUT);
   cr_assert_not_null(strstr(err.msg, "spline 1"), "%s", err.msg);
   char *s = slurp(path, NULL);
   cr_assert_str_eq(s, "old\n");
   cr_assert_eq(count_tmp(dir), 0);
-  /* a colour that would break the XML attribute */
+  /* a pen that draws nothing */
   sp->node[5].vy = 0;
-  snprintf(page.color, sizeof page.color, "red\" onload=\"x");
-  cr_assert_eq(lw_output_svg(sp, &page, path, &err), LW_EINPUT);
+  page.pen[0].width_mm = 0;
+  cr_assert_eq(lw_output_svg(sp, &page, NULL, path, &err), LW_EINPUT);
+  cr_assert_not_null(strstr(err.msg, "pen 1 width"), "%s", err.msg);
   free(s);
   lw_splines_free(sp);
   remove_dir(dir);
@@ -231,10 +233,10 @@ Test(output, png_preview_pixels)
   lw_test_circle(sp, 1, 80, 25, 10);
   lw_output_page page;
   lw_output_page_init(&page, 100, 50);
-  page.stroke_mm = 0.5;
+  page.pen[0].width_mm = 0.5;
   lw_error err;
   lw_error_clear(&err);
-  cr_assert_eq(lw_output_png(sp, &page, 4.0, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_output_png(sp, &page, NULL, NULL, 4.0, path, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(count_tmp(dir), 0);
 
   size_t len;
@@ -288,7 +290,7 @@ Test(output, png_size_is_capped)
   lw_test_straight(sp, 0, 0, 0, 1000, 500);
   lw_output_page_init(&page, 1000, 500);
   lw_error err;
-  cr_assert_eq(lw_output_png(sp, &page, 10.0, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_output_png(sp, &page, NULL, NULL, 10.0, path, &err), LW_OK, "%s", err.msg);
   cairo_surface_t *img = cairo_image_surface_create_from_png(path);
   cr_assert_eq(cairo_image_surface_get_width(img), 4096);
   cr_assert_eq(cairo_image_surface_get_height(img), 2048);
@@ -307,11 +309,11 @@ Test(output, atomic_write_missing_directory_fails_with_path)
   lw_output_page_init(&page, 210, 297);
   lw_error err;
   lw_error_clear(&err);
-  cr_assert_eq(lw_output_svg(sp, &page, path, &err), LW_EIO);
+  cr_assert_eq(lw_output_svg(sp, &page, NULL, path, &err), LW_EIO);
   cr_assert_not_null(strstr(err.msg, path), "message names the path: %s", err.msg);
   lw_error_clear(&err);
   snprintf(path, sizeof path, "%s/no/preview.png", dir);
-  cr_assert_eq(lw_output_png(sp, &page, 1.0, path, &err), LW_EIO);
+  cr_assert_eq(lw_output_png(sp, &page, NULL, NULL, 1.0, path, &err), LW_EIO);
   cr_assert_not_null(strstr(err.msg, path), "%s", err.msg);
   cr_assert_eq(count_tmp(dir), 0);
   lw_splines_free(sp);
@@ -328,7 +330,7 @@ Test(output, atomic_write_replaces_an_existing_file)
   lw_output_page page;
   lw_output_page_init(&page, 210, 297);
   lw_error err;
-  cr_assert_eq(lw_output_svg(sp, &page, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_output_svg(sp, &page, NULL, path, &err), LW_OK, "%s", err.msg);
   char *s = slurp(path, NULL);
   cr_assert(!strncmp(s, "<?xml", 5));
   cr_assert_null(strstr(s, "old content"));
@@ -352,7 +354,7 @@ Test(output, atomic_write_failed_rename_removes_tmp)
   lw_output_page_init(&page, 210, 297);
   lw_error err;
   lw_error_clear(&err);
-  cr_assert_eq(lw_output_svg(sp, &page, path, &err), LW_EIO);
+  cr_assert_eq(lw_output_svg(sp, &page, NULL, path, &err), LW_EIO);
   cr_assert_not_null(strstr(err.msg, path), "%s", err.msg);
   struct stat st;
   cr_assert_eq(stat(path, &st), 0);
@@ -552,4 +554,247 @@ Test(output, json_misuse_is_reported)
   lw_json_int(&b.j, 1);
   lw_json_int(&b.j, 2);
   free(json_close(&b, LW_ERUN));
+}
+
+/* ---- pens, order, PDF, frames ----------------------------------------- */
+
+/* The d attribute of the path with id="<id>" (caller frees). */
+static char *path_data(const char *svg, const char *id)
+{
+  char key[64];
+  snprintf(key, sizeof key, "<path id=\"%s\"", id);
+  const char *at = strstr(svg, key);
+  cr_assert_not_null(at, "path %s present", id);
+  const char *d = strstr(at, " d=\"");
+  cr_assert_not_null(d);
+  d += 4;
+  size_t n = strcspn(d, "\"");
+  char *s = malloc(n + 1);
+  memcpy(s, d, n);
+  s[n] = '\0';
+  return s;
+}
+
+/* The numbers of a path's data, commands dropped; returns the count. */
+static size_t path_numbers(char *d, char **tok, size_t max)
+{
+  size_t n = 0;
+  for (char *t = strtok(d, " "); t; t = strtok(NULL, " "))
+    if (strcmp(t, "M") && strcmp(t, "C")) {
+      cr_assert(n < max);
+      tok[n++] = t;
+    }
+  return n;
+}
+
+Test(output, svg_pens_are_layers_and_reversed_paths_are_exact)
+{
+  char dir[64], fwd_path[128], plot_path[128];
+  make_dir(dir);
+  snprintf(fwd_path, sizeof fwd_path, "%s/forward.svg", dir);
+  snprintf(plot_path, sizeof plot_path, "%s/plot.svg", dir);
+  lw_splines *sp = two_splines();
+  lw_output_page page;
+  lw_output_page_init(&page, 210, 297);
+  lw_error err;
+  cr_assert_eq(lw_output_svg(sp, &page, NULL, fwd_path, &err), LW_OK, "%s", err.msg);
+  /* pen 1: the circle reversed; pen 2: the straight line forward; pen 3
+  ** draws nothing and still has its layer */
+  page.n_pens = 3;
+  page.pen[0] = (lw_output_pen){0.35, {0, 0, 0}};
+  page.pen[1] = (lw_output_pen){0.7, {0xcc, 0x00, 0x11}};
+  page.pen[2] = (lw_output_pen){1.25, {0x12, 0xab, 0xef}};
+  size_t order[2] = {1, 0};
+  unsigned char rev[2] = {1, 0};
+  lw_plot pl = {.n = 2, .spline = order, .reversed = rev, .n_pens = 3, .pen_first = {0, 1, 2, 2}};
+  cr_assert_eq(lw_output_svg(sp, &page, &pl, plot_path, &err), LW_OK, "%s", err.msg);
+  char *fwd = slurp(fwd_path, NULL), *svg = slurp(plot_path, NULL);
+
+  const char *l1 = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"pen 1 (0.35 mm)\" id=\"pen1\">");
+  const char *l2 = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"pen 2 (0.7 mm)\" id=\"pen2\">");
+  const char *l3 = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"pen 3 (1.25 mm)\" id=\"pen3\">");
+  cr_assert(l1 && l2 && l3 && l1 < l2 && l2 < l3, "three layers in pen order:\n%s", svg);
+  const char *p1 = strstr(svg, "<path id=\"spline1\""), *p0 = strstr(svg, "<path id=\"spline0\"");
+  cr_assert(p1 > l1 && p1 < l2 && p0 > l2 && p0 < l3, "each path in its pen's layer");
+  cr_assert(!strncmp(strstr(l3, ">") + 1, "\n  </g>\n</svg>\n", 14), "pen 3's layer is empty");
+  cr_assert_not_null(strstr(p1, "stroke=\"#000000\" stroke-width=\"0.35\""));
+  cr_assert_not_null(strstr(p0, "stroke=\"#cc0011\" stroke-width=\"0.7\""));
+  cr_assert_null(strstr(svg, "spline2"), "the point is left out");
+
+  /* the straight line is unchanged, the circle's numbers come reversed
+  ** point by point, as the very same strings */
+  char *a = path_data(fwd, "spline0"), *b = path_data(svg, "spline0");
+  cr_assert_str_eq(a, b);
+  free(a);
+  free(b);
+  a = path_data(fwd, "spline1");
+  b = path_data(svg, "spline1");
+  cr_assert_eq(strncmp(b, "M ", 2), 0);
+  char *ta[64], *tb[64];
+  size_t na = path_numbers(a, ta, 64), nb = path_numbers(b, tb, 64);
+  cr_assert_eq(na, 2 * (3 * 8 + 1), "M point and 3 points per segment");
+  cr_assert_eq(na, nb);
+  for (size_t k = 0; k < na / 2; k++) {
+    size_t j = na / 2 - 1 - k;
+    cr_assert(!strcmp(ta[2 * j], tb[2 * k]) && !strcmp(ta[2 * j + 1], tb[2 * k + 1]),
+              "point %zu: %s %s vs %s %s", k, ta[2 * j], ta[2 * j + 1], tb[2 * k], tb[2 * k + 1]);
+  }
+  free(a);
+  free(b);
+
+  /* a plot with other pens than the page is refused */
+  page.n_pens = 2;
+  cr_assert_eq(lw_output_svg(sp, &page, &pl, plot_path, &err), LW_EINPUT);
+  free(fwd);
+  free(svg);
+  lw_splines_free(sp);
+  remove_dir(dir);
+}
+
+Test(output, colors_parse)
+{
+  unsigned char rgb[4][3];
+  cr_assert(lw_output_color_parse("#c01", 4, rgb[0]));
+  cr_assert(rgb[0][0] == 0xcc && rgb[0][1] == 0x00 && rgb[0][2] == 0x11);
+  cr_assert(lw_output_color_parse("#C0fFeE", 7, rgb[0]));
+  cr_assert(rgb[0][0] == 0xc0 && rgb[0][1] == 0xff && rgb[0][2] == 0xee);
+  cr_assert(!lw_output_color_parse("red", 3, rgb[0]));
+  cr_assert(!lw_output_color_parse("#12", 3, rgb[0]));
+  cr_assert(!lw_output_color_parse("#12345g", 7, rgb[0]));
+  cr_assert_eq(lw_output_colors_parse(" #000 #fff,#123456\t", rgb, 4), 3);
+  cr_assert(rgb[2][0] == 0x12 && rgb[2][1] == 0x34 && rgb[2][2] == 0x56 && rgb[1][1] == 0xff);
+  cr_assert_eq(lw_output_colors_parse("", rgb, 4), 0);
+  cr_assert_eq(lw_output_colors_parse("#000 #000 #000 #000 #000", rgb, 4), -1);
+  cr_assert_eq(lw_output_colors_parse("#000 black", rgb, 4), -1);
+}
+
+/* RGB of pixel (x, y). */
+static void pixel(cairo_surface_t *s, int x, int y, int rgb[3])
+{
+  const unsigned char *data = cairo_image_surface_get_data(s);
+  uint32_t px = *(const uint32_t *)(data + (size_t)y * cairo_image_surface_get_stride(s) + 4 * (size_t)x);
+  rgb[0] = (px >> 16) & 255;
+  rgb[1] = (px >> 8) & 255;
+  rgb[2] = px & 255;
+}
+
+Test(output, png_pen_colours_and_tone_underneath)
+{
+  char dir[64], path[128];
+  make_dir(dir);
+  snprintf(path, sizeof path, "%s/preview.png", dir);
+  /* page 100 x 50 mm at 4 px/mm; two horizontal lines through pixel row
+  ** centres (see png_preview_pixels): pen 1 black at y = 10.125 mm, pen 2
+  ** red at y = 40.125 mm */
+  size_t segs[2] = {1, 1};
+  lw_splines *sp = lw_splines_new(2, segs, NULL);
+  lw_test_straight(sp, 0, 5, 10.125, 95, 10.125);
+  lw_test_straight(sp, 1, 5, 40.125, 95, 40.125);
+  lw_output_page page;
+  lw_output_page_init(&page, 100, 50);
+  page.n_pens = 2;
+  page.pen[0] = (lw_output_pen){0.5, {0, 0, 0}};
+  page.pen[1] = (lw_output_pen){0.5, {255, 0, 0}};
+  size_t order[2] = {0, 1};
+  unsigned char rev[2] = {0, 1};
+  lw_plot pl = {.n = 2, .spline = order, .reversed = rev, .n_pens = 2, .pen_first = {0, 1, 2}};
+  /* tone: two pixels of 25 x 50 mm covering x in [0, 50] mm, black then
+  ** white; the right half of the page has no tone */
+  lw_grid2d *tone = lw_grid2d_new(2, 1, 1, 12.5, 25, 25, 50, NULL);
+  tone->data[0] = 0.0;
+  tone->data[1] = 1.0;
+  lw_error err;
+  cr_assert_eq(lw_output_png(sp, &page, &pl, tone, 4.0, path, &err), LW_OK, "%s", err.msg);
+  cairo_surface_t *img = cairo_image_surface_create_from_png(path);
+  cr_assert_eq(cairo_surface_status(img), CAIRO_STATUS_SUCCESS);
+  cairo_surface_flush(img);
+  int c[3];
+  pixel(img, 320, 40, c); /* on the black line, no tone there */
+  cr_assert(c[0] < 40 && c[1] < 40 && c[2] < 40, "black line %d %d %d", c[0], c[1], c[2]);
+  pixel(img, 320, 160, c); /* on the red line */
+  cr_assert(c[0] > 215 && c[1] < 40 && c[2] < 40, "red line %d %d %d", c[0], c[1], c[2]);
+  /* black tone at half strength: 255 (1 - 0.5) = 127.5 */
+  pixel(img, 40, 100, c);
+  cr_assert(abs(c[0] - 128) <= 1 && c[0] == c[1] && c[1] == c[2], "black tone under: %d", c[0]);
+  pixel(img, 0, 100, c); /* the raster's edge does not fade into the paper */
+  cr_assert(abs(c[0] - 128) <= 1, "edge of the tone: %d", c[0]);
+  pixel(img, 190, 100, c); /* white tone, past its pixel centre */
+  cr_assert_eq(c[0], 255);
+  pixel(img, 300, 100, c); /* no tone */
+  cr_assert_eq(c[0], 255);
+  cairo_surface_destroy(img);
+  lw_grid2d_free(tone);
+  lw_splines_free(sp);
+  remove_dir(dir);
+}
+
+/* needle in the n bytes at hay, which may hold NULs (memmem is not C11). */
+static const char *find_bytes(const char *hay, size_t n, const char *needle)
+{
+  size_t m = strlen(needle);
+  for (size_t k = 0; k + m <= n; k++)
+    if (!memcmp(hay + k, needle, m)) return hay + k;
+  return NULL;
+}
+
+Test(output, pdf_has_the_page_size_and_is_reproducible)
+{
+  char dir[64], a[128], b[128];
+  make_dir(dir);
+  snprintf(a, sizeof a, "%s/a.pdf", dir);
+  snprintf(b, sizeof b, "%s/b.pdf", dir);
+  lw_splines *sp = two_splines();
+  lw_output_page page;
+  lw_output_page_init(&page, 210, 297);
+  lw_error err;
+  cr_assert_eq(lw_output_pdf(sp, &page, NULL, NULL, a, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_output_pdf(sp, &page, NULL, NULL, b, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(count_tmp(dir), 0);
+  size_t la, lb;
+  char *pa = slurp(a, &la), *pb = slurp(b, &lb);
+  cr_assert(la > 200 && !strncmp(pa, "%PDF-", 5), "a PDF file");
+  cr_assert(la == lb && !memcmp(pa, pb, la), "the same drawing gives the same bytes");
+  cr_assert_null(find_bytes(pa, la, "/CreationDate"));
+  /* A4 in points: 210 and 297 mm times 72 / 25.4 */
+  const char *mb = find_bytes(pa, la, "/MediaBox ["); /* the file holds binary streams */
+  cr_assert_not_null(mb);
+  double x0, y0, x1, y1;
+  cr_assert_eq(sscanf(mb + 11, "%lf %lf %lf %lf", &x0, &y0, &x1, &y1), 4);
+  cr_assert(x0 == 0 && y0 == 0);
+  cr_assert(fabs(x1 - 210 * 72 / 25.4) < 1e-3 && fabs(y1 - 297 * 72 / 25.4) < 1e-3, "MediaBox %g %g", x1, y1);
+  free(pa);
+  free(pb);
+  /* bad input is refused before a file exists */
+  sp->node[2].px = INFINITY;
+  cr_assert_eq(lw_output_pdf(sp, &page, NULL, NULL, a, &err), LW_EINPUT);
+  snprintf(a, sizeof a, "%s/missing/a.pdf", dir);
+  sp->node[2].px = 1;
+  cr_assert_eq(lw_output_pdf(sp, &page, NULL, NULL, a, &err), LW_EIO);
+  lw_splines_free(sp);
+  remove_dir(dir);
+}
+
+Test(output, frames_are_numbered_by_sweep)
+{
+  char dir[64], path[192];
+  make_dir(dir);
+  lw_splines *sp = two_splines();
+  lw_output_page page;
+  lw_output_page_init(&page, 210, 297);
+  lw_error err;
+  cr_assert_eq(lw_output_frame(dir, 12, sp, &page, NULL, NULL, 0.5, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_output_frame(dir, 1234567, sp, &page, NULL, NULL, 0.5, &err), LW_OK, "%s", err.msg);
+  const char *names[2] = {"frame-000012.png", "frame-1234567.png"};
+  for (int k = 0; k < 2; k++) {
+    snprintf(path, sizeof path, "%s/frames/%s", dir, names[k]);
+    size_t len;
+    char *bytes = slurp(path, &len);
+    cr_assert(bytes && len > 8 && !memcmp(bytes, "\x89PNG", 4), "%s written", names[k]);
+    free(bytes);
+    remove(path);
+  }
+  snprintf(path, sizeof path, "%s/frames", dir);
+  rmdir(path);
+  lw_splines_free(sp);
+  remove_dir(dir);
 }

@@ -157,3 +157,50 @@ Test(params, bad_polygon_and_margin_name_the_key)
   cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT);
   cr_assert(strstr(err.msg, "scene.margin") && strstr(err.msg, ":3"), "%s", err.msg);
 }
+
+Test(params, named_pages_set_the_size)
+{
+  const struct {
+    const char *text;
+    double w, h;
+  } cases[] = {
+    {"[scene]\npage = a4\n", 210, 297},
+    {"[scene]\npage = a3\n", 297, 420},
+    {"[scene]\npage = letter\n", 215.9, 279.4},
+    {"[scene]\npage = a4\norientation = landscape\n", 297, 210},
+    {"[scene]\npage = letter\norientation = landscape\n", 279.4, 215.9},
+    /* an explicit size that agrees is fine (a resolved scene.ini has both) */
+    {"[scene]\npage = a3\nwidth = 297\nheight = 420\n", 297, 420},
+    /* custom keeps width and height; orientation does not touch them */
+    {"[scene]\npage = custom\norientation = landscape\nwidth = 100\nheight = 300\n", 100, 300},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+    lw_params p;
+    lw_error err;
+    cr_assert_eq(read_text(cases[k].text, &p, &err), LW_OK, "%s", err.msg);
+    cr_assert(p.width == cases[k].w && p.height == cases[k].h, "case %zu: %g x %g", k, p.width, p.height);
+  }
+  /* a size that disagrees names its line and the page's */
+  expect_error("[scene]\npage = a4\nheight = 300\n", ":3:", "scene.height", "conflicts with scene.page = a4");
+  expect_error("[scene]\nwidth = 200\n\npage = letter\n", ":2:", "scene.width", ":4)");
+  /* --set after the file: the page follows, a disagreeing size fails */
+  lw_params p;
+  lw_error err;
+  cr_assert_eq(read_text("[scene]\npage = a4\n", &p, &err), LW_OK);
+  cr_assert_eq(lw_params_set(&p, "scene.page=a3", &err), LW_OK);
+  cr_assert_eq(lw_params_set(&p, "scene.orientation=landscape", &err), LW_OK);
+  cr_assert_eq(lw_params_resolve(&p, &err), LW_OK);
+  cr_assert(p.width == 420 && p.height == 297);
+  cr_assert_eq(lw_params_set(&p, "scene.width=100", &err), LW_OK);
+  cr_assert_eq(lw_params_resolve(&p, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "--set: key 'scene.width'"), "%s", err.msg);
+}
+
+Test(params, pen_colours_match_the_pens)
+{
+  lw_params p;
+  lw_error err;
+  cr_assert_eq(read_text("[output]\npens = 3\npen_colors = #000 #c00 #0000ff\n", &p, &err), LW_OK, "%s", err.msg);
+  expect_error("[output]\npens = 3\npen_colors = #000 #c00\n", ":3:", "output.pen_colors", "expected 3 colours");
+  expect_error("[output]\npen_colors = red\n", ":2:", "output.pen_colors", "#rrggbb");
+}

@@ -5,7 +5,8 @@
 ** callbacks: the caller owns the loop (and the progress display).
 **
 ** Run directory: scene.ini (the resolved parameters), state.lw, trace.csv,
-** summary.json, final.svg, final.png; with parallel tempering also
+** summary.json, final.svg, final.png (and as asked final.pdf and frames/,
+** drawing.h); with parallel tempering also
 ** replica-K.lw, the replica at rung K >= 1 (state.lw holds rung 0, the
 ** coldest, and the data of every rung's chain), and ladder.ini after ladder
 ** tuning.  The rungs sweep in parallel (OpenMP), each with its own stream;
@@ -21,6 +22,7 @@
 
 #include <stdio.h>
 
+#include "linewise/drawing.h"
 #include "linewise/mc.h"
 #include "linewise/params.h"
 #include "linewise/scene.h"
@@ -55,6 +57,7 @@ typedef struct {
   double wall_start;           /* monotonic clock at start of this process */
   lw_move_stats trace_mark[LW_MOVE_KINDS]; /* stats at the last trace row */
   FILE *trace;
+  lw_drawing_report drawing;   /* pen-up travel and fidelity of the final drawing */
 } lw_anneal;
 
 /* A new run of the scene file (with overrides already applied to p) into
@@ -75,7 +78,7 @@ static inline int lw_anneal_done(const lw_anneal *a) { return a->sweep >= a->end
 /* Writes state.lw now (a clean stop). */
 lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err);
 
-/* The final files: state.lw, final.svg, final.png, summary.json. */
+/* The final files: state.lw, the drawings (drawing.h), summary.json. */
 lw_status lw_anneal_finish(lw_anneal *a, lw_error *err);
 
 void lw_anneal_free(lw_anneal *a);

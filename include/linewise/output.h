@@ -1,6 +1,6 @@
 /*
-** output.h -- the drawing files of a run directory: the plotter SVG, a PNG
-** preview, and the atomic-write helpers every text output shares.
+** output.h -- the drawing files: the plotter SVG, PNG and PDF previews,
+** animation frames, and the atomic-write helpers every output shares.
 **
 ** Coordinates are page millimetres with the origin at the top-left corner and
 ** y pointing down (field.h), which is SVG's own orientation, so nothing is
@@ -8,7 +8,7 @@
 ** Bezier C command per segment with the control points (spline.h)
 **     b0 = p_m,  b1 = p_m + v_m,  b2 = p_{m+1} - v_{m+1},  b3 = p_{m+1}.
 ** A spline whose control points all coincide has zero length and is skipped
-** (a plotter would only dab the paper).  A non-finite coordinate is an error:
+** (lw_splines_is_point).  A non-finite coordinate is an error:
 ** "nan" in a path would make the whole file unreadable.
 **
 ** SVG numbers are millimetres with 4 fixed decimals (0.1 um, far below any
@@ -25,38 +25,82 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include <cairo.h>
+
 #include "linewise/error.h"
+#include "linewise/field.h"
+#include "linewise/plot.h"
 #include "linewise/spline.h"
 
-#define LW_OUTPUT_COLOR_MAX 64
 #define LW_OUTPUT_PEN_DEFAULT 0.3     /* mm */
 #define LW_OUTPUT_PNG_MAX_PX 4096     /* longest side of a preview, pixels */
 #define LW_OUTPUT_PATH_MAX 4096       /* room for "<path>.tmp" in the writers here */
+#define LW_OUTPUT_UNDERLAY_ALPHA 0.5  /* strength of the source image under a preview */
+
+typedef struct {
+  double width_mm;                    /* stroke width, mm (> 0) */
+  unsigned char rgb[3];               /* colour, 0..255 per channel */
+} lw_output_pen;
 
 typedef struct {
   double width_mm, height_mm;         /* page, mm (> 0) */
-  double stroke_mm;                   /* pen width, mm (> 0) */
-  char color[LW_OUTPUT_COLOR_MAX];    /* SVG stroke colour: a name, #rgb, #rrggbb or
-                                         rgb(...); characters that would need XML
-                                         escaping are rejected */
+  int n_pens;                         /* 1 .. LW_PLOT_PENS_MAX */
+  lw_output_pen pen[LW_PLOT_PENS_MAX];
 } lw_output_page;
 
-/* A page of the given size with the default pen (0.3 mm, "black"). */
+/* A page of the given size with one pen: 0.3 mm, black. */
 void lw_output_page_init(lw_output_page *page, double width_mm, double height_mm);
 
-/* The plotter SVG (SVG 1.1, user units = mm, paths in the Inkscape layer
-** "pen 1"), written atomically.  LW_EINPUT for a bad page or a non-finite
-** coordinate, LW_EIO when the file cannot be written. */
-lw_status lw_output_svg(const lw_splines *sp, const lw_output_page *page, const char *path,
-                        lw_error *err);
+/* Reads a colour "#rgb" or "#rrggbb" (hex digits, either case) of len
+** characters; 1 on success. */
+int lw_output_color_parse(const char *text, size_t len, unsigned char rgb[3]);
 
-/* The preview PNG: white background, the exact Bezier curves stroked black
-** with the pen width (round caps and joins), antialiased.  The image is
-** ceil(page * px_per_mm) pixels, except that px_per_mm is lowered so that the
-** longer side is at most LW_OUTPUT_PNG_MAX_PX (memory stays below 64 MiB).
-** Written atomically; errors as for lw_output_svg. */
-lw_status lw_output_png(const lw_splines *sp, const lw_output_page *page, double px_per_mm,
+/* Reads up to max colours separated by spaces, tabs or commas into rgb[];
+** returns how many there are, or -1 if one is malformed or there are more
+** than max. */
+int lw_output_colors_parse(const char *list, unsigned char (*rgb)[3], int max);
+
+/* The drawings below take an optional plot (plot.h): with it, pen k's paths
+** are drawn with page->pen[k] in plotting order and direction; without it
+** (NULL) every path is pen 1's, in index order.  The plot must have as many
+** pens as the page.  An optional tone raster (field.h: ncomp 1, node (i, j)
+** the centre of pixel (i, j), tone 0 = black .. 1 = white) is painted under
+** the lines of the previews in grey at LW_OUTPUT_UNDERLAY_ALPHA, covering
+** its pixels' rectangle; NULL paints none. */
+
+/* The plotter SVG, written atomically: width and height in mm, viewBox in
+** mm (user unit = 1 mm), one Inkscape layer group per pen in pen order
+** (id "pen<k>", label "pen <k> (<width> mm)"), one path per spline with
+** M and C commands only.  A reversed path lists the control points of its
+** segments backwards, last segment first, so it is the same curve.
+** LW_EINPUT for a bad page or plot or a non-finite coordinate, LW_EIO when
+** the file cannot be written. */
+lw_status lw_output_svg(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
                         const char *path, lw_error *err);
+
+/* The preview PNG: white background, the tone underneath if given, the
+** exact Bezier curves stroked with their pen's colour and width (round caps
+** and joins), antialiased.  The image is ceil(page * px_per_mm) pixels,
+** except that px_per_mm is lowered so that the longer side is at most
+** LW_OUTPUT_PNG_MAX_PX (memory stays below 64 MiB).  Written atomically;
+** errors as for lw_output_svg. */
+lw_status lw_output_png(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
+                        const lw_grid2d *tone, double px_per_mm, const char *path, lw_error *err);
+
+/* The same drawing as a one-page vector PDF of the page's size (1 mm =
+** 72 / 25.4 pt); no creation date is stored, so equal drawings give equal
+** files.  Written atomically; errors as for lw_output_svg. */
+lw_status lw_output_pdf(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
+                        const lw_grid2d *tone, const char *path, lw_error *err);
+
+/* An animation frame: the preview PNG as DIR/frames/frame-SSSSSS.png (the
+** sweep, at least 6 digits), creating DIR/frames if needed. */
+lw_status lw_output_frame(const char *dir, long sweep, const lw_splines *sp, const lw_output_page *page,
+                          const lw_plot *plot, const lw_grid2d *tone, double px_per_mm, lw_error *err);
+
+/* Strokes every spline that is not a point with the current source, line
+** width and transformation of cr (for renderers elsewhere). */
+void lw_output_cairo_splines(cairo_t *cr, const lw_splines *sp);
 
 /* The pixel size lw_output_png uses, and the scale after the cap (px per mm).
 ** 0 if the page or px_per_mm are not positive and finite. */

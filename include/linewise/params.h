@@ -42,6 +42,8 @@ extern const lw_param_def lw_param_table[];
 extern const size_t lw_param_count;
 
 /* Choice indices (order of the choices strings in params.c). */
+enum { LW_PAGE_CUSTOM, LW_PAGE_A4, LW_PAGE_A3, LW_PAGE_LETTER };
+enum { LW_ORIENT_PORTRAIT, LW_ORIENT_LANDSCAPE };
 enum { LW_BND_RECT, LW_BND_CIRCLE, LW_BND_POLYGON };
 enum { LW_POT_CONSTANT, LW_POT_RAMP, LW_POT_RADIAL };
 enum { LW_FLD_CONSTANT, LW_FLD_RADIAL, LW_FLD_VORTEX, LW_FLD_WAVES };
@@ -51,6 +53,8 @@ enum { LW_LADDER_FIXED, LW_LADDER_EQUAL };
 
 typedef struct {
   /* [scene] */
+  int page;                   /* LW_PAGE_*: a named size sets width and height */
+  int orientation;            /* LW_ORIENT_* of a named page */
   double width, height;       /* page, mm */
   int boundary;               /* LW_BND_* */
   double margin;              /* rect and circle inset from the page edge, mm */
@@ -86,7 +90,7 @@ typedef struct {
   double target_spline;       /* acceptance the rigid steps tune toward */
   int tune_sweeps;            /* tuning sweeps at the start of each temperature */
   /* [anneal] */
-  char schedule[64];          /* a name from the schedule table */
+  char schedule[LW_PATH_MAX]; /* a name from the schedule table (STRING keys hold up to LW_PATH_MAX - 1) */
   double t_start, t_end;      /* temperatures, energy units */
   int sweeps;                 /* sweeps in all (one sweep = one proposal per node) */
   int steps;                  /* temperature steps */
@@ -104,8 +108,15 @@ typedef struct {
   /* [output] */
   int checkpoint_every;       /* sweeps between state.lw checkpoints */
   int trace_every;            /* sweeps per trace.csv row */
-  double pen_width;           /* SVG/PNG stroke, mm */
+  double pen_width;           /* stroke of every pen, mm */
+  int pens;                   /* pens (Inkscape layers), 1..16 */
+  char pen_colors[LW_PATH_MAX]; /* "#rrggbb ..." one per pen; empty = black */
+  int order;                  /* lw_plot_order: none, greedy, 2opt */
   double png_scale;           /* preview pixels per mm */
+  int pdf;                    /* 1 = write final.pdf */
+  int preview_image;          /* 1 = tone under the previews */
+  int frames_every;           /* sweeps between frames; 0 = none */
+  double fidelity_sigma;      /* blur before the fidelity score, mm */
 
   /* Where each value came from: the file and line (0 = default, -1 = --set). */
   char file[LW_PATH_MAX];
@@ -118,7 +129,14 @@ void lw_params_defaults(lw_params *p);
 /* Reads an INI scene file into p (defaults first). */
 lw_status lw_params_read(lw_params *p, const char *path, lw_error *err);
 
-/* Applies one "section.key=value" override. */
+/* Settles what depends on several keys, once all are known: a named page
+** sets width and height (an explicit width or height that disagrees is an
+** error naming its line), and pen_colors must hold one colour per pen.
+** lw_params_read calls it; call it again after overrides. */
+lw_status lw_params_resolve(lw_params *p, lw_error *err);
+
+/* Applies one "section.key=value" override (call lw_params_resolve after
+** the last one). */
 lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err);
 
 /* Writes every parameter as an INI file that reads back to the same values. */

@@ -59,6 +59,27 @@ static inline size_t lw_segment_index(const lw_splines *sp, size_t i, size_t m)
   return sp->first[i] - i + m;
 }
 
+/* The Bezier control points of segment m of spline i, b0 b1 b2 b3 as
+** x0 y0 x1 y1 x2 y2 x3 y3 (mm): p_m, p_m + v_m, p_{m+1} - v_{m+1}, p_{m+1}. */
+static inline void lw_splines_bezier(const lw_splines *sp, size_t i, size_t m, double b[8])
+{
+  const lw_node *a = &sp->node[sp->first[i] + m], *c = a + 1;
+  b[0] = a->px;
+  b[1] = a->py;
+  b[2] = a->px + a->vx;
+  b[3] = a->py + a->vy;
+  b[4] = c->px - c->vx;
+  b[5] = c->py - c->vy;
+  b[6] = c->px;
+  b[7] = c->py;
+}
+
+/* 1 if every control point of spline i equals its first point: the curve is
+** then a single point, which drawings leave out (a plotter would only dab
+** the paper).  The Bernstein polynomials are independent, so any other set
+** of control points moves. */
+int lw_splines_is_point(const lw_splines *sp, size_t i);
+
 /* r, r', r'' at parameter s in [0,1] of the segment from node a to node b;
 ** any output may be NULL. */
 void lw_segment_eval(const lw_node *a, const lw_node *b, double s,

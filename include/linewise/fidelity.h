@@ -1,0 +1,65 @@
+/*
+** fidelity.h -- how well the drawn lines reproduce a target tone.
+**
+** The target is a tone raster: an lw_grid2d (field.h) with one value per
+** pixel, node (i, j) at the centre of pixel (i, j), pixels hx x hy mm, tone
+** 0 = black .. 1 = white (values outside are clamped).  Its rectangle is
+** [x0 - hx/2, x0 + (nx - 1/2) hx] x [y0 - hy/2, y0 + (ny - 1/2) hy].
+**
+** 1. The lines are rendered over that rectangle at the raster's resolution
+**    (cairo, antialiased, the exact Bezier curves stroked with the pen
+**    width, round caps): ink = the covered fraction of each pixel, 0..1.
+**    The target's darkness is 1 - tone.
+** 2. Both are blurred with the same Gaussian of standard deviation sigma
+**    (mm; sigma / hx and sigma / hy pixels per axis), truncated at 4 sigma
+**    and renormalised by the weights that fall inside the raster, so a flat
+**    tone stays flat up to the edges.  The blur stands for the eye at
+**    viewing distance: hatching at spacing s averages to a flat grey once
+**    sigma is about s / 2 (the fundamental of the pattern is damped by
+**    exp(-2 pi^2 sigma^2 / s^2), below 1% at sigma = s / 2).  The default
+**    1 mm suits a 0.3 mm pen, whose lines run 0.6 to 3 mm apart for
+**    darkness 0.5 to 0.1.
+** 3. MSE = mean over pixels of (ink - darkness)^2, both blurred.
+**    SSIM (Wang, Bovik, Sheikh, Simoncelli 2004) with dynamic range L = 1,
+**    C1 = (0.01 L)^2, C2 = (0.03 L)^2, local statistics under the 11 x 11
+**    Gaussian window of sigma 1.5 pixels (renormalised at the edges like
+**    the blur), the SSIM map averaged over every pixel.  1 = identical.
+*/
+#ifndef LINEWISE_FIDELITY_H
+#define LINEWISE_FIDELITY_H
+
+#include "linewise/error.h"
+#include "linewise/field.h"
+#include "linewise/spline.h"
+
+#define LW_FIDELITY_TRUNCATE 4.0      /* blur kernel radius, in sigmas */
+#define LW_FIDELITY_SSIM_SIGMA 1.5    /* SSIM window, pixels */
+#define LW_FIDELITY_SSIM_RADIUS 5     /* SSIM window half width: 11 x 11 */
+
+typedef struct {
+  double mse;       /* mean squared difference of blurred ink and darkness */
+  double ssim;      /* mean structural similarity, -1..1 */
+  double sigma_mm;  /* the blur used, mm */
+} lw_fidelity;
+
+/* Steps 1-3 above for the splines against the tone raster, pen width and
+** blur sigma in mm.  LW_EINPUT for a raster that is not one value per
+** pixel or a width or sigma that is not positive, LW_ENOMEM. */
+lw_status lw_fidelity_compute(const lw_splines *sp, const lw_grid2d *tone, double pen_width_mm,
+                              double sigma_mm, lw_fidelity *out, lw_error *err);
+
+/* Step 1 alone: ink[j * nx + i] for the pixels of the tone raster. */
+lw_status lw_fidelity_render(const lw_splines *sp, const lw_grid2d *tone, double pen_width_mm, double *ink,
+                             lw_error *err);
+
+/* Steps 2-3 for two w x h images a and b (changed in place: blurred),
+** blur sigma sx, sy in pixels (0 = none); out->sigma_mm is left alone. */
+lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, double sy, lw_fidelity *out,
+                              lw_error *err);
+
+/* Gaussian blur of the w x h image v in place, sigma sx, sy pixels (0 =
+** none along that axis), kernel radius ceil(truncate * sigma) pixels,
+** renormalised at the edges.  LW_ENOMEM if the scratch row cannot be had. */
+lw_status lw_fidelity_blur(double *v, int w, int h, double sx, double sy, double truncate, lw_error *err);
+
+#endif

@@ -1,0 +1,509 @@
+/*
+** order.c -- greedy and 2-opt ordering of plotter paths (order.h).
+**
+** End points are numbered 2p (start of path p) and 2p + 1 (end of path p).
+** A uniform grid of them answers "nearest end point" for the greedy tour and
+** "K nearest end points" for the 2-opt candidate lists.
+*/
+#include "linewise/order.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- a grid of points with removal ------------------------------------ */
+
+/* Points sit in cells of side `side`; cell c holds item[start[c] ..
+** start[c] + count[c]), removal swaps a point with the last one of its
+** cell.  Search order inside a cell therefore changes as points go, which is
+** why every search breaks ties by point id explicitly. */
+typedef struct {
+  double x0, y0, side;
+  int nx, ny;
+  size_t *start, *count, *item;
+  double *ix, *iy;               /* coordinates of item[s], kept beside it so
+                                    that a search reads memory in order */
+  size_t *cell, *slot;           /* per point id */
+  size_t *ring;                  /* scratch: the cells of one ring */
+  size_t left;                   /* points still in */
+} point_grid;
+
+static void grid_free(point_grid *g)
+{
+  free(g->start);
+  free(g->count);
+  free(g->item);
+  free(g->ix);
+  free(g->iy);
+  free(g->cell);
+  free(g->slot);
+  free(g->ring);
+}
+
+static void grid_locate(const point_grid *g, double x, double y, int *cx, int *cy)
+{
+  double fx = (x - g->x0) / g->side, fy = (y - g->y0) / g->side;
+  *cx = fx >= 1.0 ? (fx < (double)g->nx ? (int)fx : g->nx - 1) : 0;
+  *cy = fy >= 1.0 ? (fy < (double)g->ny ? (int)fy : g->ny - 1) : 0;
+}
+
+/* Grid of the points ids[0..np) at (px[id], py[id]); the per-point arrays
+** are sized n_ids (the largest id + 1).  About two points per cell. */
+static int grid_build(point_grid *g, const double *px, const double *py, const size_t *ids, size_t np,
+                      size_t n_ids)
+{
+  memset(g, 0, sizeof *g);
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+  for (size_t k = 0; k < np; k++) {
+    size_t id = ids[k];
+    x0 = fmin(x0, px[id]);
+    x1 = fmax(x1, px[id]);
+    y0 = fmin(y0, py[id]);
+    y1 = fmax(y1, py[id]);
+  }
+  if (!np) x0 = y0 = x1 = y1 = 0;
+  double w = x1 - x0, h = y1 - y0, target = fmax(1.0, 0.5 * (double)np);
+  /* a square cell for `target` cells over the box; on a thin box the long
+  ** side alone decides (a zero area would give zero-sized cells) */
+  double side = fmax(sqrt(w * h / target), fmax(w, h) / target);
+  if (!(side > 0)) side = 1.0;
+  g->x0 = x0;
+  g->y0 = y0;
+  g->side = side;
+  g->nx = (int)fmin(floor(w / side) + 1, target + 1);
+  g->ny = (int)fmin(floor(h / side) + 1, target + 1);
+  size_t nc = (size_t)g->nx * (size_t)g->ny;
+  g->start = calloc(nc + 1, sizeof *g->start);
+  g->count = calloc(nc, sizeof *g->count);
+  g->item = malloc((np ? np : 1) * sizeof *g->item);
+  g->ix = malloc((np ? np : 1) * sizeof *g->ix);
+  g->iy = malloc((np ? np : 1) * sizeof *g->iy);
+  g->cell = malloc((n_ids ? n_ids : 1) * sizeof *g->cell);
+  g->slot = malloc((n_ids ? n_ids : 1) * sizeof *g->slot);
+  g->ring = malloc((2 * ((size_t)g->nx + (size_t)g->ny) + 1) * sizeof *g->ring);
+  if (!g->start || !g->count || !g->item || !g->ix || !g->iy || !g->cell || !g->slot || !g->ring) {
+    grid_free(g);
+    return 0;
+  }
+  for (size_t k = 0; k < np; k++) {
+    int cx, cy;
+    grid_locate(g, px[ids[k]], py[ids[k]], &cx, &cy);
+    g->cell[ids[k]] = (size_t)cy * (size_t)g->nx + (size_t)cx;
+    g->count[g->cell[ids[k]]]++;
+  }
+  for (size_t c = 0; c < nc; c++) g->start[c + 1] = g->start[c] + g->count[c];
+  memset(g->count, 0, nc * sizeof *g->count);
+  for (size_t k = 0; k < np; k++) {
+    size_t c = g->cell[ids[k]], s = g->start[c] + g->count[c]++;
+    g->item[s] = ids[k];
+    g->ix[s] = px[ids[k]];
+    g->iy[s] = py[ids[k]];
+    g->slot[ids[k]] = s;
+  }
+  g->left = np;
+  return 1;
+}
+
+static void grid_remove(point_grid *g, size_t id)
+{
+  size_t c = g->cell[id], last = g->start[c] + --g->count[c], s = g->slot[id];
+  size_t other = g->item[last];
+  double x = g->ix[s], y = g->iy[s];
+  g->item[s] = other;
+  g->ix[s] = g->ix[last];
+  g->iy[s] = g->iy[last];
+  g->slot[other] = s;
+  g->item[last] = id;
+  g->ix[last] = x;
+  g->iy[last] = y;
+  g->slot[id] = last;
+  g->left--;
+}
+
+/* (d2, id) ordering: the nearer point, on a tie the lower id. */
+static int before(double d2a, size_t ida, double d2b, size_t idb)
+{
+  return d2a < d2b || (d2a == d2b && ida < idb);
+}
+
+/* The cells of the grid at Chebyshev distance r from (cx, cy) into
+** cells[] (room for 2 (nx + ny) + 1); returns their number. */
+static size_t ring_cells(const point_grid *g, int cx, int cy, int r, size_t *cells)
+{
+  size_t n = 0;
+  int lo_x = cx - r, hi_x = cx + r, lo_y = cy - r, hi_y = cy + r;
+  for (int y = lo_y < 0 ? 0 : lo_y; y <= hi_y && y < g->ny; y++) {
+    /* the top and bottom rows whole, the rows between only at both ends */
+    int step = y == lo_y || y == hi_y ? 1 : hi_x - lo_x;
+    for (int x = lo_x; x <= hi_x; x += step)
+      if (x >= 0 && x < g->nx) cells[n++] = (size_t)y * (size_t)g->nx + (size_t)x;
+  }
+  return n;
+}
+
+/* Rings beyond r_max cover nothing. */
+static int ring_max(const point_grid *g, int cx, int cy)
+{
+  int r = cx > g->nx - 1 - cx ? cx : g->nx - 1 - cx;
+  int ry = cy > g->ny - 1 - cy ? cy : g->ny - 1 - cy;
+  return r > ry ? r : ry;
+}
+
+/* Points in ring r lie at least (r - 1) cell sides from (x, y): clamping
+** into the grid moves a point outside it by at most its true distance per
+** axis, so the bound holds for queries outside the grid too. */
+static double ring_bound2(const point_grid *g, int r)
+{
+  double b = r > 1 ? (double)(r - 1) * g->side : 0.0;
+  return b * b;
+}
+
+/* The nearest point still in the grid; SIZE_MAX when it is empty. */
+static size_t grid_nearest(const point_grid *g, double x, double y)
+{
+  size_t best = SIZE_MAX;
+  double best_d2 = INFINITY;
+  if (!g->left) return best;
+  int cx, cy;
+  grid_locate(g, x, y, &cx, &cy);
+  int rmax = ring_max(g, cx, cy);
+  for (int r = 0; r <= rmax; r++) {
+    if (best != SIZE_MAX && best_d2 <= ring_bound2(g, r)) break;
+    size_t nc = ring_cells(g, cx, cy, r, g->ring);
+    for (size_t i = 0; i < nc; i++)
+      for (size_t s = g->start[g->ring[i]], e = s + g->count[g->ring[i]]; s < e; s++) {
+        size_t id = g->item[s];
+        double dx = g->ix[s] - x, dy = g->iy[s] - y, d2 = dx * dx + dy * dy;
+        if (before(d2, id, best_d2, best)) {
+          best_d2 = d2;
+          best = id;
+        }
+      }
+  }
+  return best;
+}
+
+/* The k nearest points to point id at (x, y), other than id and its
+** partner id ^ 1, nearest first, into out[]; returns how many were found. */
+static size_t grid_knearest(const point_grid *g, size_t id, double x, double y, size_t k, size_t *out,
+                            double *d2s)
+{
+  size_t found = 0;
+  int cx, cy;
+  grid_locate(g, x, y, &cx, &cy);
+  int rmax = ring_max(g, cx, cy);
+  for (int r = 0; r <= rmax; r++) {
+    if (found == k && d2s[k - 1] <= ring_bound2(g, r)) break;
+    size_t nc = ring_cells(g, cx, cy, r, g->ring);
+    for (size_t i = 0; i < nc; i++)
+      for (size_t s = g->start[g->ring[i]], e = s + g->count[g->ring[i]]; s < e; s++) {
+        size_t q = g->item[s];
+        if ((q | 1) == (id | 1)) continue;
+        double dx = g->ix[s] - x, dy = g->iy[s] - y, d2 = dx * dx + dy * dy;
+        if (found == k && !before(d2, q, d2s[k - 1], out[k - 1])) continue;
+        size_t at = found < k ? found++ : k - 1;
+        while (at > 0 && before(d2, q, d2s[at - 1], out[at - 1])) {
+          d2s[at] = d2s[at - 1];
+          out[at] = out[at - 1];
+          at--;
+        }
+        d2s[at] = d2;
+        out[at] = q;
+      }
+  }
+  return found;
+}
+
+/* End point coordinates: px[2p], py[2p] the start of p, [2p + 1] its end;
+** room for `extra` more points after them. */
+static int end_points(const lw_order_path *path, size_t n, size_t extra, double **px, double **py)
+{
+  *px = malloc((2 * n + extra) * sizeof **px);
+  *py = malloc((2 * n + extra) * sizeof **py);
+  if (!*px || !*py) {
+    free(*px);
+    free(*py);
+    return 0;
+  }
+  for (size_t p = 0; p < n; p++) {
+    (*px)[2 * p] = path[p].x0;
+    (*py)[2 * p] = path[p].y0;
+    (*px)[2 * p + 1] = path[p].x1;
+    (*py)[2 * p + 1] = path[p].y1;
+  }
+  return 1;
+}
+
+/* ---- travel ------------------------------------------------------------ */
+
+double lw_order_travel(const lw_order_path *path, size_t n, const size_t *order,
+                       const unsigned char *reversed, double hx, double hy)
+{
+  double sum = 0.0, x = hx, y = hy;
+  for (size_t k = 0; k < n; k++) {
+    const lw_order_path *p = &path[order ? order[k] : k];
+    int r = reversed && reversed[k];
+    sum += hypot((r ? p->x1 : p->x0) - x, (r ? p->y1 : p->y0) - y);
+    x = r ? p->x0 : p->x1;
+    y = r ? p->y0 : p->y1;
+  }
+  return sum;
+}
+
+/* ---- greedy ------------------------------------------------------------ */
+
+lw_status lw_order_greedy(const lw_order_path *path, size_t n, double hx, double hy,
+                          size_t *order, unsigned char *reversed, lw_error *err)
+{
+  double *px, *py;
+  size_t *ids = malloc((2 * n + 1) * sizeof *ids);
+  if (!ids || !end_points(path, n, 0, &px, &py)) {
+    free(ids);
+    return lw_error_set(err, LW_ENOMEM, "out of memory ordering %zu paths", n);
+  }
+  for (size_t id = 0; id < 2 * n; id++) ids[id] = id;
+  point_grid g;
+  if (!grid_build(&g, px, py, ids, 2 * n, 2 * n)) {
+    free(ids);
+    free(px);
+    free(py);
+    return lw_error_set(err, LW_ENOMEM, "out of memory ordering %zu paths", n);
+  }
+  double x = hx, y = hy;
+  for (size_t k = 0; k < n; k++) {
+    size_t id = grid_nearest(&g, x, y);
+    size_t p = id / 2;
+    order[k] = p;
+    reversed[k] = (unsigned char)(id & 1);
+    grid_remove(&g, 2 * p);
+    grid_remove(&g, 2 * p + 1);
+    x = px[id ^ 1];
+    y = py[id ^ 1];
+  }
+  grid_free(&g);
+  free(ids);
+  free(px);
+  free(py);
+  return LW_OK;
+}
+
+/* ---- 2-opt ------------------------------------------------------------- */
+
+/* The tour as a cycle of m = n + 1 items: the paths and a virtual home
+** item n whose start is FREE (n * 2, at zero distance from everything) and
+** whose end is the home point (n * 2 + 1).  Forward, home leads the tour
+** and the leg back into it costs nothing, which is exactly the open tour
+** from home.  A cycle can be reversed as a whole without changing its
+** length (every leg is symmetric), so a cut may reverse either side. */
+typedef struct {
+  size_t n, m, free_pt;
+  const double *px, *py;
+  size_t *tour, *pos;           /* position -> item, item -> position */
+  unsigned char *rev;           /* per item */
+  size_t *nb;                   /* LW_ORDER_NEIGHBOURS candidates per point */
+  unsigned char *nbn;           /* how many each point has */
+  size_t *queue;                /* FIFO ring of items to look at */
+  unsigned char *queued;
+  size_t q_head, q_len;
+  unsigned long long work, budget;
+} two_opt;
+
+static double leg(const two_opt *t, size_t a, size_t b)
+{
+  if (a == t->free_pt || b == t->free_pt) return 0.0;
+  return hypot(t->px[a] - t->px[b], t->py[a] - t->py[b]);
+}
+
+static size_t entry_of(const two_opt *t, size_t item) { return 2 * item + t->rev[item]; }
+static size_t exit_of(const two_opt *t, size_t item) { return 2 * item + 1 - t->rev[item]; }
+static size_t succ(const two_opt *t, size_t item) { return t->tour[(t->pos[item] + 1) % t->m]; }
+static size_t pred(const two_opt *t, size_t item) { return t->tour[(t->pos[item] + t->m - 1) % t->m]; }
+
+static void push(two_opt *t, size_t item)
+{
+  if (t->queued[item]) return;
+  t->queued[item] = 1;
+  t->queue[(t->q_head + t->q_len++) % t->m] = item;
+}
+
+/* Reverses the stretch of the cycle from item `from` forward to item `to`,
+** or the rest of the cycle when that is shorter (the same tour read the
+** other way round). */
+static void reverse(two_opt *t, size_t from, size_t to)
+{
+  size_t m = t->m, i = t->pos[from], j = t->pos[to];
+  size_t len = (j + m - i) % m + 1;
+  if (2 * len > m) {
+    size_t ni = (j + 1) % m;
+    j = (i + m - 1) % m;
+    i = ni;
+    len = m - len;
+  }
+  for (size_t k = 0; k < len; k++) t->rev[t->tour[(i + k) % m]] ^= 1;
+  for (size_t k = 0; k < len / 2; k++) {
+    size_t a = (i + k) % m, b = (j + m - k) % m;
+    size_t ia = t->tour[a], ib = t->tour[b];
+    t->tour[a] = ib;
+    t->tour[b] = ia;
+    t->pos[ib] = a;
+    t->pos[ia] = b;
+  }
+  t->work += len;
+}
+
+/* One improving move around item a, if its candidate lists offer one. */
+static int improve(two_opt *t, size_t a)
+{
+  const size_t K = LW_ORDER_NEIGHBOURS;
+  /* Leg a -> b out of a's exit: a new leg exit(a) -> exit(c) for c whose
+  ** exit is near, reversing b .. c. */
+  size_t x = exit_of(t, a);
+  if (x != t->free_pt) {
+    size_t b = succ(t, a);
+    double old1 = leg(t, x, entry_of(t, b));
+    for (size_t k = 0; k < t->nbn[x]; k++) {
+      size_t q = t->nb[x * K + k], c = q / 2;
+      double new1 = leg(t, x, q);
+      t->work++;
+      if (new1 >= old1 - LW_ORDER_EPS) break;
+      if (q != exit_of(t, c)) continue;
+      size_t d = succ(t, c);
+      double gain = old1 + leg(t, q, entry_of(t, d)) - new1 - leg(t, entry_of(t, b), entry_of(t, d));
+      if (gain > LW_ORDER_EPS) {
+        reverse(t, b, c);
+        push(t, a);
+        push(t, b);
+        push(t, c);
+        push(t, d);
+        return 1;
+      }
+    }
+  }
+  /* Leg p -> a into a's entry: a new leg entry(a) -> entry(c) for c whose
+  ** entry is near, reversing a .. pred(c). */
+  size_t e = entry_of(t, a);
+  if (e != t->free_pt) {
+    size_t p = pred(t, a);
+    double old1 = leg(t, exit_of(t, p), e);
+    for (size_t k = 0; k < t->nbn[e]; k++) {
+      size_t q = t->nb[e * K + k], c = q / 2;
+      double new1 = leg(t, e, q);
+      t->work++;
+      if (new1 >= old1 - LW_ORDER_EPS) break;
+      if (q != entry_of(t, c)) continue;
+      size_t qc = pred(t, c);
+      double gain = old1 + leg(t, exit_of(t, qc), q) - new1 - leg(t, exit_of(t, p), exit_of(t, qc));
+      if (gain > LW_ORDER_EPS) {
+        reverse(t, a, qc);
+        push(t, a);
+        push(t, p);
+        push(t, c);
+        push(t, qc);
+        return 1;
+      }
+    }
+  }
+  return 0;
+}
+
+static void two_opt_free(two_opt *t)
+{
+  free(t->tour);
+  free(t->pos);
+  free(t->rev);
+  free(t->nb);
+  free(t->nbn);
+  free(t->queue);
+  free(t->queued);
+}
+
+lw_status lw_order_2opt(const lw_order_path *path, size_t n, double hx, double hy,
+                        size_t *order, unsigned char *reversed, lw_error *err)
+{
+  if (n == 1) {
+    /* one path: only its direction can change */
+    const lw_order_path *p = &path[order[0]];
+    double to_start = hypot(p->x0 - hx, p->y0 - hy), to_end = hypot(p->x1 - hx, p->y1 - hy);
+    double cur = reversed[0] ? to_end : to_start, other = reversed[0] ? to_start : to_end;
+    if (other < cur - LW_ORDER_EPS) reversed[0] ^= 1;
+  }
+  if (n < 2) return LW_OK;
+  const size_t K = LW_ORDER_NEIGHBOURS;
+  two_opt t = {.n = n, .m = n + 1, .free_pt = 2 * n};
+  double *px, *py;
+  if (!end_points(path, n, 2, &px, &py)) return lw_error_set(err, LW_ENOMEM, "out of memory ordering %zu paths", n);
+  px[2 * n] = py[2 * n] = 0.0;  /* FREE: never measured */
+  px[2 * n + 1] = hx;
+  py[2 * n + 1] = hy;
+  t.px = px;
+  t.py = py;
+  size_t npt = 2 * n + 2;
+  t.tour = malloc(t.m * sizeof *t.tour);
+  t.pos = malloc(t.m * sizeof *t.pos);
+  t.rev = calloc(t.m, 1);
+  t.nb = malloc(npt * K * sizeof *t.nb);
+  t.nbn = calloc(npt, 1);
+  t.queue = malloc(t.m * sizeof *t.queue);
+  t.queued = calloc(t.m, 1);
+  size_t *ids = malloc(npt * sizeof *ids);
+  double *d2s = malloc(K * sizeof *d2s);
+  point_grid g;
+  int ok = t.tour && t.pos && t.rev && t.nb && t.nbn && t.queue && t.queued && ids && d2s;
+  if (ok) {
+    /* every point but FREE */
+    for (size_t id = 0; id < 2 * n; id++) ids[id] = id;
+    ids[2 * n] = 2 * n + 1;
+    ok = grid_build(&g, px, py, ids, 2 * n + 1, npt);
+  }
+  if (!ok) {
+    two_opt_free(&t);
+    free(ids);
+    free(d2s);
+    free(px);
+    free(py);
+    return lw_error_set(err, LW_ENOMEM, "out of memory ordering %zu paths", n);
+  }
+  for (size_t k = 0; k < 2 * n + 1; k++)
+    t.nbn[ids[k]] = (unsigned char)grid_knearest(&g, ids[k], px[ids[k]], py[ids[k]], K, &t.nb[ids[k] * K], d2s);
+  grid_free(&g);
+  free(ids);
+  free(d2s);
+
+  t.tour[0] = n;
+  t.pos[n] = 0;
+  for (size_t k = 0; k < n; k++) {
+    t.tour[k + 1] = order[k];
+    t.pos[order[k]] = k + 1;
+    t.rev[order[k]] = reversed[k];
+  }
+  t.budget = (unsigned long long)LW_ORDER_WORK * t.m;
+  /* A reversal flips every path inside it, which can open a move for a
+  ** path whose own legs did not change and which is not queued; so when
+  ** the queue runs dry every item is looked at once more, until a whole
+  ** round finds nothing. */
+  for (int moved = 1; moved && t.work < t.budget;) {
+    moved = 0;
+    for (size_t k = 0; k < t.m; k++) push(&t, t.tour[k]);
+    while (t.q_len && t.work < t.budget) {
+      size_t a = t.queue[t.q_head];
+      t.q_head = (t.q_head + 1) % t.m;
+      t.q_len--;
+      t.queued[a] = 0;
+      while (t.work < t.budget && improve(&t, a)) moved = 1;
+    }
+  }
+
+  /* read the cycle from home in the direction in which home is forward */
+  size_t h = t.pos[n];
+  int back = t.rev[n];
+  for (size_t k = 0; k < n; k++) {
+    size_t item = t.tour[back ? (h + t.m - 1 - k) % t.m : (h + 1 + k) % t.m];
+    order[k] = item;
+    reversed[k] = (unsigned char)(t.rev[item] ^ back);
+  }
+  two_opt_free(&t);
+  free(px);
+  free(py);
+  return LW_OK;
+}

@@ -1,0 +1,175 @@
+/* test_fidelity.c -- ink rendering, blur, MSE and SSIM against a target tone. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "linewise/fidelity.h"
+#include "testutil.h"
+
+#define C1 (0.01 * 0.01)
+
+/* A dark disc of radius 10 px with a soft edge, centred at (cx, cy), on a
+** w x h image (darkness 0..1). */
+static void disc(double *v, int w, int h, double cx, double cy)
+{
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) {
+      double r = hypot(i - cx, j - cy);
+      v[j * w + i] = 0.9 / (1.0 + exp(r - 10.0));
+    }
+}
+
+Test(fidelity, identical_images_score_perfectly)
+{
+  enum { W = 40, H = 30 };
+  double a[W * H], b[W * H];
+  rng_seed(3);
+  for (int k = 0; k < W * H; k++) a[k] = b[k] = urand(0, 1);
+  lw_fidelity f;
+  cr_assert_eq(lw_fidelity_compare(a, b, W, H, 1.7, 2.2, &f, NULL), LW_OK);
+  cr_assert_eq(f.mse, 0.0);
+  cr_assert(fabs(f.ssim - 1.0) < 1e-12, "ssim %.17g", f.ssim);
+}
+
+/* SSIM falls and MSE grows as the copy moves further or gets blurrier. */
+Test(fidelity, ssim_falls_with_shift_and_blur)
+{
+  enum { W = 64, H = 64 };
+  static double ref[W * H], a[W * H], b[W * H];
+  disc(ref, W, H, 32, 32);
+  double last_ssim = 2, last_mse = -1;
+  for (int shift = 0; shift <= 5; shift++) {
+    memcpy(a, ref, sizeof a);
+    disc(b, W, H, 32 + shift, 32 + 0.5 * shift);
+    lw_fidelity f;
+    cr_assert_eq(lw_fidelity_compare(a, b, W, H, 1, 1, &f, NULL), LW_OK);
+    cr_assert(f.ssim < last_ssim && f.mse > last_mse, "shift %d: ssim %g (before %g), mse %g (before %g)", shift,
+              f.ssim, last_ssim, f.mse, last_mse);
+    last_ssim = f.ssim;
+    last_mse = f.mse;
+  }
+  last_ssim = 2;
+  last_mse = -1;
+  const double blur[] = {0, 0.5, 1, 2, 4};
+  for (int k = 0; k < 5; k++) {
+    memcpy(a, ref, sizeof a);
+    memcpy(b, ref, sizeof b);
+    cr_assert_eq(lw_fidelity_blur(b, W, H, blur[k], blur[k], 4, NULL), LW_OK);
+    lw_fidelity f;
+    cr_assert_eq(lw_fidelity_compare(a, b, W, H, 0, 0, &f, NULL), LW_OK);
+    cr_assert(f.ssim < last_ssim && f.mse > last_mse, "blur %g: ssim %g, mse %g", blur[k], f.ssim, f.mse);
+    last_ssim = f.ssim;
+    last_mse = f.mse;
+  }
+}
+
+/* No lines against a flat tone: the blur keeps the darkness c everywhere
+** (renormalised edges), so MSE = c^2 and SSIM = C1 / (c^2 + C1) (zero mean,
+** zero variance on the ink side, zero variance on the target side). */
+Test(fidelity, blank_render_against_flat_tone)
+{
+  lw_grid2d *tone = lw_grid2d_new(50, 40, 1, 0.25, 0.25, 0.5, 0.5, NULL);
+  for (int k = 0; k < 50 * 40; k++) tone->data[k] = 0.6;
+  lw_splines *sp = lw_splines_new(0, NULL, NULL);
+  lw_fidelity f;
+  lw_error err;
+  cr_assert_eq(lw_fidelity_compute(sp, tone, 0.3, 1.0, &f, &err), LW_OK, "%s", err.msg);
+  cr_assert(fabs(f.mse - 0.16) < 1e-12, "mse %.17g", f.mse);
+  cr_assert(fabs(f.ssim - C1 / (0.16 + C1)) < 1e-12, "ssim %.17g", f.ssim);
+  cr_assert_eq(f.sigma_mm, 1.0);
+  lw_splines_free(sp);
+  lw_grid2d_free(tone);
+}
+
+/* No lines against one black pixel in the middle of white paper: the
+** blurred darkness is the normalised Gaussian g, so MSE = sum g^2 / N, and
+** for sigma s pixels sum g^2 = 1 / (4 pi s^2) (the continuous integral; the
+** sampled sum agrees to far better than the 4-sigma truncation, ~1e-4). */
+Test(fidelity, blank_render_against_an_impulse)
+{
+  const int n = 121;
+  const double px = 0.5, sigma_mm = 2.0, s = sigma_mm / px;
+  lw_grid2d *tone = lw_grid2d_new(n, n, 1, 0, 0, px, px, NULL);
+  for (int k = 0; k < n * n; k++) tone->data[k] = 1.0;
+  tone->data[60 * n + 60] = 0.0;
+  lw_splines *sp = lw_splines_new(0, NULL, NULL);
+  lw_fidelity f;
+  cr_assert_eq(lw_fidelity_compute(sp, tone, 0.3, sigma_mm, &f, NULL), LW_OK);
+  double want = 1.0 / (4 * M_PI * s * s) / ((double)n * n);
+  cr_assert(fabs(f.mse / want - 1) < 1e-3, "mse %.9g, expected %.9g", f.mse, want);
+  lw_splines_free(sp);
+  lw_grid2d_free(tone);
+}
+
+/* The rendered ink covers the stroke's area: a 40 mm line with a 0.5 mm
+** pen and round caps covers 40 x 0.5 + pi 0.25^2 mm^2. */
+Test(fidelity, render_conserves_ink_area)
+{
+  const double px = 0.25;
+  lw_grid2d *tone = lw_grid2d_new(240, 80, 1, 0.5 * px, 0.5 * px, px, px, NULL);
+  size_t segs[1] = {3};
+  lw_splines *sp = lw_splines_new(1, segs, NULL);
+  lw_test_straight(sp, 0, 7.3, 10.37, 47.3, 10.37);
+  double *ink = malloc(240 * 80 * sizeof *ink);
+  cr_assert_eq(lw_fidelity_render(sp, tone, 0.5, ink, NULL), LW_OK);
+  double area = 0;
+  for (int k = 0; k < 240 * 80; k++) {
+    cr_assert(ink[k] >= 0 && ink[k] <= 1);
+    area += ink[k] * px * px;
+  }
+  double want = 40 * 0.5 + M_PI * 0.25 * 0.25;
+  cr_assert(fabs(area / want - 1) < 0.01, "ink %.6g mm^2, expected %.6g", area, want);
+  /* the ink lies on the line: pixel row 41 (y 10.25..10.5) is inked, row 30 not */
+  cr_assert(ink[41 * 240 + 100] > 0.4 && ink[30 * 240 + 100] == 0);
+  free(ink);
+  lw_splines_free(sp);
+  lw_grid2d_free(tone);
+}
+
+/* Hatching at 2 mm with a 0.4 mm pen is a grey of darkness 0.2 once blurred
+** by 1 mm (ripple damped by exp(-2 pi^2 / 4) < 1%): far closer to the flat
+** 0.2 target than blank paper (MSE 0.04), and structurally alike. */
+Test(fidelity, hatching_matches_its_grey)
+{
+  const double px = 0.2;
+  const int w = 200, h = 150; /* 40 x 30 mm */
+  lw_grid2d *tone = lw_grid2d_new(w, h, 1, 0.5 * px, 0.5 * px, px, px, NULL);
+  for (int k = 0; k < w * h; k++) tone->data[k] = 0.8;
+  const size_t n = 15;
+  size_t segs[15];
+  for (size_t i = 0; i < n; i++) segs[i] = 1;
+  lw_splines *sp = lw_splines_new(n, segs, NULL);
+  for (size_t i = 0; i < n; i++) lw_test_straight(sp, i, -5, 1 + 2.0 * (double)i, 45, 1 + 2.0 * (double)i);
+  lw_fidelity f;
+  cr_assert_eq(lw_fidelity_compute(sp, tone, 0.4, 1.0, &f, NULL), LW_OK);
+  cr_assert(f.mse < 1e-4, "mse %g", f.mse);
+  cr_assert(f.ssim > 0.95, "ssim %g", f.ssim);
+  /* a pen twice as wide draws darkness 0.4 against the 0.2 target: MSE
+  ** 0.2^2 in the interior.  Within about sigma of the top and bottom edges
+  ** the renormalised blur sees the hatching from one side only, which
+  ** darkens those rows by up to 0.03; on a raster 30 mm tall that adds a
+  ** few percent (2.3% measured), hence the 5% bound. */
+  lw_fidelity g;
+  cr_assert_eq(lw_fidelity_compute(sp, tone, 0.8, 1.0, &g, NULL), LW_OK);
+  cr_assert(fabs(g.mse / 0.04 - 1) < 0.05, "mse %g, expected 0.04", g.mse);
+  lw_splines_free(sp);
+  lw_grid2d_free(tone);
+}
+
+Test(fidelity, bad_input)
+{
+  lw_splines *sp = lw_splines_new(0, NULL, NULL);
+  lw_grid2d *field = lw_grid2d_new(4, 4, 2, 0, 0, 1, 1, NULL);
+  lw_fidelity f;
+  lw_error err;
+  cr_assert_eq(lw_fidelity_compute(sp, field, 0.3, 1, &f, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "tone raster"), "%s", err.msg);
+  lw_grid2d *tone = lw_grid2d_new(4, 4, 1, 0, 0, 1, 1, NULL);
+  cr_assert_eq(lw_fidelity_compute(sp, tone, 0.3, 0, &f, &err), LW_EINPUT);
+  cr_assert_eq(lw_fidelity_compute(sp, tone, -1, 1, &f, &err), LW_EINPUT);
+  cr_assert_eq(lw_fidelity_compute(sp, NULL, 0.3, 1, &f, &err), LW_EINPUT);
+  lw_grid2d_free(field);
+  lw_grid2d_free(tone);
+  lw_splines_free(sp);
+}

@@ -1,0 +1,271 @@
+/* test_order.c -- pen-up travel, greedy and 2-opt tours, pens of a plot. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "linewise/order.h"
+#include "linewise/plot.h"
+#include "testutil.h"
+
+/* n random paths of length up to 8 mm on an A4 page. */
+static lw_order_path *random_paths(size_t n, uint64_t seed)
+{
+  rng_seed(seed);
+  lw_order_path *p = malloc(n * sizeof *p);
+  cr_assert_not_null(p);
+  for (size_t i = 0; i < n; i++) {
+    double x = urand(0, 210), y = urand(0, 297), a = urand(0, 2 * M_PI), l = urand(0.1, 8);
+    p[i] = (lw_order_path){x, y, x + l * cos(a), y + l * sin(a)};
+  }
+  return p;
+}
+
+static void assert_permutation(const size_t *order, size_t n)
+{
+  unsigned char *seen = calloc(n ? n : 1, 1);
+  for (size_t k = 0; k < n; k++) {
+    cr_assert(order[k] < n, "entry %zu out of range", k);
+    cr_assert(!seen[order[k]], "path %zu twice", order[k]);
+    seen[order[k]] = 1;
+  }
+  free(seen);
+}
+
+Test(order, travel_of_a_hand_made_tour)
+{
+  const lw_order_path p[2] = {{3, 4, 10, 4}, {10, 10, 13, 14}};
+  /* home (0,0) -> (3,4): 5; (10,4) -> (10,10): 6 */
+  cr_assert_eq(lw_order_travel(p, 2, NULL, NULL, 0, 0), 11.0);
+  /* path 1 reversed first: (0,0) -> (13,14), then (10,10) -> (3,4) */
+  size_t order[2] = {1, 0};
+  unsigned char rev[2] = {1, 0};
+  double want = hypot(13, 14) + hypot(7, 6);
+  cr_assert_eq(lw_order_travel(p, 2, order, rev, 0, 0), want);
+  cr_assert_eq(lw_order_travel(p, 0, NULL, NULL, 5, 5), 0.0);
+}
+
+/* Travel is never worse after 2-opt than from the greedy tour it starts
+** from, every tour is a permutation, and equal input gives equal output. */
+Test(order, random_instances_improve_and_are_deterministic)
+{
+  const size_t sizes[] = {1, 2, 3, 7, 50, 400, 3000};
+  for (size_t s = 0; s < sizeof sizes / sizeof *sizes; s++) {
+    size_t n = sizes[s];
+    for (uint64_t seed = 1; seed <= 3; seed++) {
+      lw_order_path *p = random_paths(n, 1000 * seed + n);
+      size_t *o1 = malloc(n * sizeof *o1), *o2 = malloc(n * sizeof *o2);
+      unsigned char *r1 = malloc(n), *r2 = malloc(n);
+      cr_assert_eq(lw_order_greedy(p, n, 0, 0, o1, r1, NULL), LW_OK);
+      assert_permutation(o1, n);
+      double greedy = lw_order_travel(p, n, o1, r1, 0, 0);
+      cr_assert_eq(lw_order_2opt(p, n, 0, 0, o1, r1, NULL), LW_OK);
+      assert_permutation(o1, n);
+      double after = lw_order_travel(p, n, o1, r1, 0, 0);
+      cr_assert(after <= greedy, "n %zu seed %llu: 2-opt %.9g > greedy %.9g", n, (unsigned long long)seed, after,
+                greedy);
+      /* the random order of index 0..n-1 is far longer on 50+ paths */
+      if (n >= 50) cr_assert(after < 0.5 * lw_order_travel(p, n, NULL, NULL, 0, 0));
+      cr_assert_eq(lw_order_greedy(p, n, 0, 0, o2, r2, NULL), LW_OK);
+      cr_assert_eq(lw_order_2opt(p, n, 0, 0, o2, r2, NULL), LW_OK);
+      cr_assert(!memcmp(o1, o2, n * sizeof *o1) && !memcmp(r1, r2, n), "n %zu: not deterministic", n);
+      free(o1);
+      free(o2);
+      free(r1);
+      free(r2);
+      free(p);
+    }
+  }
+}
+
+/* The greedy step takes the nearest end point; on a tie the lower path,
+** start before end. */
+Test(order, greedy_picks_nearest_end_and_reverses)
+{
+  const lw_order_path p[3] = {
+    {50, 0, 40, 0},  /* end (40,0) nearer home than its start */
+    {5, 0, 9, 0},    /* start at 5: the first */
+    {39, 0, 20, 0},  /* from (9,0): start 39 is 30 away, end 20 is 11 */
+  };
+  size_t o[3];
+  unsigned char r[3];
+  cr_assert_eq(lw_order_greedy(p, 3, 0, 0, o, r, NULL), LW_OK);
+  cr_assert(o[0] == 1 && !r[0]);
+  cr_assert(o[1] == 2 && r[1], "path 2 reversed: %zu %d", o[1], r[1]);
+  /* at (39,0): path 0's end (40,0) is 1 away */
+  cr_assert(o[2] == 0 && r[2]);
+  cr_assert_eq(lw_order_travel(p, 3, o, r, 0, 0), 5 + 11 + 1);
+}
+
+/* Collinear unit paths 1 mm apart on y = 0, shuffled and randomly turned:
+** the best tour sweeps from the nearest end, travel = 1 (to x = 1) plus
+** n - 1 gaps of 1 mm.  2-opt must find it from a scrambled tour, not only
+** from the greedy one. */
+Test(order, collinear_paths_reach_the_optimum)
+{
+  const size_t n = 60;
+  lw_order_path p[60];
+  size_t o[60];
+  unsigned char r[60];
+  rng_seed(77);
+  for (size_t k = 0; k < n; k++) {
+    double x = 1 + 2 * (double)k;
+    p[k] = urand(0, 1) < 0.5 ? (lw_order_path){x, 0, x + 1, 0} : (lw_order_path){x + 1, 0, x, 0};
+    o[k] = k;
+    r[k] = urand(0, 1) < 0.5;
+  }
+  for (size_t k = n - 1; k > 0; k--) {
+    size_t j = (size_t)urand(0, (double)k + 1);
+    size_t t = o[k];
+    o[k] = o[j];
+    o[j] = t;
+  }
+  const double best = (double)n;
+  cr_assert(lw_order_travel(p, n, o, r, 0, 0) > 10 * best);
+  cr_assert_eq(lw_order_2opt(p, n, 0, 0, o, r, NULL), LW_OK);
+  assert_permutation(o, n);
+  cr_assert(fabs(lw_order_travel(p, n, o, r, 0, 0) - best) < 1e-9, "2-opt: %.12g, best %.12g",
+            lw_order_travel(p, n, o, r, 0, 0), best);
+  /* and so must greedy followed by 2-opt, starting from home (0, 5) */
+  cr_assert_eq(lw_order_greedy(p, n, 0, 5, o, r, NULL), LW_OK);
+  cr_assert_eq(lw_order_2opt(p, n, 0, 5, o, r, NULL), LW_OK);
+  cr_assert(fabs(lw_order_travel(p, n, o, r, 0, 5) - (hypot(1, 5) + (double)(n - 1))) < 1e-9);
+}
+
+/* ---- plots ---------------------------------------------------------- */
+
+/* n straight splines at random, two segments each; spline 3 a point. */
+static lw_splines *random_splines(size_t n, uint64_t seed)
+{
+  size_t *segs = calloc(n, sizeof *segs);
+  cr_assert_not_null(segs);
+  for (size_t i = 0; i < n; i++) segs[i] = 2;
+  lw_splines *sp = lw_splines_new(n, segs, NULL);
+  free(segs);
+  rng_seed(seed);
+  for (size_t i = 0; i < n; i++) {
+    double x = urand(10, 200), y = urand(10, 280);
+    lw_test_straight(sp, i, x, y, x + urand(-9, 9), y + urand(-9, 9));
+  }
+  for (size_t k = sp->first[3]; k < sp->first[4]; k++) sp->node[k] = (lw_node){50, 60, 0, 0};
+  return sp;
+}
+
+/* Each pen's paths are a permutation of its splines, points left out, and
+** the plot's travel sums match the tours it reports. */
+Test(plot, pens_by_rank_and_travel_never_grows)
+{
+  const size_t n = 300;
+  lw_splines *sp = random_splines(n, 5);
+  double key[300];
+  for (size_t i = 0; i < n; i++) key[i] = urand(0, 1);
+  key[7] = key[8]; /* a tie: index order decides */
+  for (int order = LW_PLOT_ORDER_NONE; order <= LW_PLOT_ORDER_2OPT; order++) {
+    lw_error err;
+    lw_plot *pl = lw_plot_new(sp, 3, key, (lw_plot_order)order, 0, 0, &err);
+    cr_assert_not_null(pl, "%s", err.msg);
+    cr_assert_eq(pl->n, n - 1);
+    /* 299 paths in 3 equal runs by rank: 100, 100, 99 (floor(r 3 / 299)) */
+    cr_assert(pl->pen_first[0] == 0 && pl->pen_first[1] == 100 && pl->pen_first[2] == 200 && pl->pen_first[3] == 299,
+              "%zu %zu %zu", pl->pen_first[1], pl->pen_first[2], pl->pen_first[3]);
+    double top[3] = {-INFINITY, -INFINITY, -INFINITY}, low[3] = {INFINITY, INFINITY, INFINITY};
+    unsigned char seen[300] = {0};
+    double sum_after = 0, sum_before = 0;
+    for (int k = 0; k < 3; k++) {
+      size_t a = pl->pen_first[k], b = pl->pen_first[k + 1];
+      lw_order_path *path = malloc((b - a) * sizeof *path);
+      size_t *sorted = malloc((b - a) * sizeof *sorted);
+      for (size_t j = a; j < b; j++) {
+        size_t i = pl->spline[j];
+        cr_assert(i != 3 && !seen[i]);
+        seen[i] = 1;
+        top[k] = fmax(top[k], key[i]);
+        low[k] = fmin(low[k], key[i]);
+        const lw_node *f = &sp->node[sp->first[i]], *l = &sp->node[sp->first[i + 1] - 1];
+        path[j - a] = (lw_order_path){f->px, f->py, l->px, l->py};
+        if (order == LW_PLOT_ORDER_NONE) cr_assert(!pl->reversed[j] && (j == a || pl->spline[j - 1] < i));
+      }
+      sum_after += lw_order_travel(path, b - a, NULL, pl->reversed + a, 0, 0);
+      /* before: the same splines in index order */
+      for (size_t j = a; j < b; j++) sorted[j - a] = pl->spline[j];
+      for (size_t x = 1; x < b - a; x++)
+        for (size_t y = x; y > 0 && sorted[y - 1] > sorted[y]; y--) {
+          size_t t = sorted[y];
+          sorted[y] = sorted[y - 1];
+          sorted[y - 1] = t;
+        }
+      for (size_t j = 0; j < b - a; j++) {
+        const lw_node *f = &sp->node[sp->first[sorted[j]]], *l = &sp->node[sp->first[sorted[j] + 1] - 1];
+        path[j] = (lw_order_path){f->px, f->py, l->px, l->py};
+      }
+      sum_before += lw_order_travel(path, b - a, NULL, NULL, 0, 0);
+      free(path);
+      free(sorted);
+    }
+    /* darker (lower key) pens first: the runs do not overlap */
+    cr_assert(top[0] <= low[1] && top[1] <= low[2]);
+    cr_assert(fabs(sum_after - pl->travel_after) <= 1e-9 * sum_after, "%.12g vs %.12g", sum_after, pl->travel_after);
+    cr_assert(fabs(sum_before - pl->travel_before) <= 1e-9 * sum_before);
+    cr_assert(pl->travel_after <= pl->travel_before);
+    if (order == LW_PLOT_ORDER_NONE) cr_assert_eq(pl->travel_after, pl->travel_before);
+    else cr_assert(pl->travel_after < 0.25 * pl->travel_before);
+    lw_plot_free(pl);
+  }
+  lw_splines_free(sp);
+}
+
+/* An input order that beats greedy: home at x = 0, short paths at x = -2,
+** 1, 5, 9.  Greedy goes to 1, back to -2, then out to 5 and 9; index order
+** sweeps -2, 1, 5, 9.  The plot keeps the input (travel after == before),
+** and 2-opt starts from it. */
+Test(plot, an_input_order_better_than_greedy_is_kept)
+{
+  size_t segs[4] = {1, 1, 1, 1};
+  lw_splines *sp = lw_splines_new(4, segs, NULL);
+  const double x[4] = {-2, 1, 5, 9};
+  lw_order_path p[4];
+  for (int i = 0; i < 4; i++) {
+    lw_test_straight(sp, (size_t)i, x[i], 0, x[i], 0.5);
+    p[i] = (lw_order_path){x[i], 0, x[i], 0.5};
+  }
+  size_t o[4];
+  unsigned char r[4];
+  cr_assert_eq(lw_order_greedy(p, 4, 0, 0, o, r, NULL), LW_OK);
+  double greedy = lw_order_travel(p, 4, o, r, 0, 0), index = lw_order_travel(p, 4, NULL, NULL, 0, 0);
+  cr_assert(greedy > index + 1, "the instance is a greedy trap: %g vs %g", greedy, index);
+  for (int order = LW_PLOT_ORDER_GREEDY; order <= LW_PLOT_ORDER_2OPT; order++) {
+    lw_plot *pl = lw_plot_new(sp, 1, NULL, (lw_plot_order)order, 0, 0, NULL);
+    cr_assert_not_null(pl);
+    cr_assert_eq(pl->travel_before, index);
+    if (order == LW_PLOT_ORDER_GREEDY) {
+      cr_assert_eq(pl->travel_after, index);
+      for (size_t j = 0; j < 4; j++) cr_assert(pl->spline[j] == j && !pl->reversed[j]);
+    } else {
+      cr_assert(pl->travel_after <= index);
+    }
+    lw_plot_free(pl);
+  }
+  lw_splines_free(sp);
+}
+
+Test(plot, round_robin_without_keys_and_bad_input)
+{
+  lw_splines *sp = random_splines(10, 9);
+  lw_plot *pl = lw_plot_new(sp, 4, NULL, LW_PLOT_ORDER_NONE, 0, 0, NULL);
+  cr_assert_not_null(pl);
+  /* spline i -> pen i mod 4; spline 3 (a point) is left out */
+  const size_t want[9] = {0, 4, 8, 1, 5, 9, 2, 6, 7};
+  const size_t first[5] = {0, 3, 6, 8, 9};
+  cr_assert_eq(pl->n, 9);
+  for (int k = 0; k <= 4; k++) cr_assert_eq(pl->pen_first[k], first[k]);
+  for (size_t j = 0; j < 9; j++) cr_assert_eq(pl->spline[j], want[j], "path %zu", j);
+  lw_plot_free(pl);
+  lw_error err;
+  cr_assert_null(lw_plot_new(sp, 0, NULL, LW_PLOT_ORDER_NONE, 0, 0, &err));
+  cr_assert_eq(err.code, LW_EINPUT);
+  cr_assert_null(lw_plot_new(sp, LW_PLOT_PENS_MAX + 1, NULL, LW_PLOT_ORDER_NONE, 0, 0, &err));
+  sp->node[5].vx = NAN;
+  cr_assert_null(lw_plot_new(sp, 1, NULL, LW_PLOT_ORDER_2OPT, 0, 0, &err));
+  cr_assert_eq(err.code, LW_EINPUT);
+  lw_splines_free(sp);
+}
