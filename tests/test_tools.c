@@ -15,20 +15,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "testutil.h"
+
 static char dir[64];
-
-static void make_dir(void)
-{
-  strcpy(dir, "/tmp/lw_tools_XXXXXX");
-  cr_assert_not_null(mkdtemp(dir));
-}
-
-static void remove_dir(void)
-{
-  char cmd[128];
-  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-  cr_assert_eq(system(cmd), 0);
-}
+static void make_dir(void) { cr_assert_eq(lw_test_dir_make(dir, "tools"), 0); }
+static void remove_dir(void) { cr_assert_eq(lw_test_dir_remove(dir), 0); }
 
 TestSuite(tools, .init = make_dir, .fini = remove_dir);
 
