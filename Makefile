@@ -21,6 +21,8 @@ LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_OBJ := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%.o)
 TEST_JOBS ?= 2
+# study tools (shell, gnuplot), installed as linewise-<name>
+TOOLS   := seed-sweep param-sweep plot-run plot-sweep
 
 .PHONY: all deps test asan run bench install clean docs
 all: $(BIN)/linewise
@@ -84,6 +86,8 @@ install: $(BIN)/linewise
 	install -m 644 params/*.ini $(DESTDIR)$(PREFIX)/share/linewise/params/
 	install -d $(DESTDIR)$(PREFIX)/share/man/man1
 	install -m 644 docs/linewise.1 $(DESTDIR)$(PREFIX)/share/man/man1/linewise.1
+	for t in $(TOOLS); do install -m 755 tools/$$t $(DESTDIR)$(PREFIX)/bin/linewise-$$t; done
+	install -m 644 tools/slurm-sweep.sbatch $(DESTDIR)$(PREFIX)/share/linewise/
 
 clean:
 	rm -rf build build-asan bin

@@ -5,6 +5,8 @@
 #include <gsl/gsl_math.h>
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 
 #include "linewise/spline.h"
 
@@ -58,6 +60,20 @@ static inline void lw_test_circle(lw_splines *sp, size_t i, double cx, double cy
     nd[k] = (lw_node){cx + R * cos(a), cy + R * sin(a), -h * sin(a), h * cos(a)};
   }
   sp->rest_length[i] = 2.0 * M_PI * R;
+}
+
+/* A fresh directory /tmp/lw_<tag>_XXXXXX for a suite's files, into dir
+** (64 chars); 0 on success.  lw_test_dir_remove deletes it and its files. */
+static inline int lw_test_dir_make(char dir[64], const char *tag)
+{
+  snprintf(dir, 64, "/tmp/lw_%s_XXXXXX", tag);
+  return mkdtemp(dir) ? 0 : -1;
+}
+static inline int lw_test_dir_remove(const char *dir)
+{
+  char cmd[96];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+  return system(cmd);
 }
 
 #endif

@@ -1,0 +1,565 @@
+/*
+** test_tools.c -- the study tools in tools/ (seed-sweep, param-sweep,
+** slurm-sweep.sbatch, plot-run, plot-sweep) run on params/minimal.ini made
+** tiny with --set, and what they wrote is checked against the runs' own
+** summary.json files.  Needs $LW_BIN and $LW_ROOT (make test sets them).
+*/
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "testutil.h"
+
+static char dir[64];
+static void make_dir(void) { cr_assert_eq(lw_test_dir_make(dir, "tools"), 0); }
+static void remove_dir(void) { cr_assert_eq(lw_test_dir_remove(dir), 0); }
+
+TestSuite(tools, .init = make_dir, .fini = remove_dir);
+
+static const char *env(const char *name)
+{
+  const char *v = getenv(name);
+  cr_assert_not_null(v, "$%s must be set (make test sets it)", name);
+  return v;
+}
+
+/* 20 sweeps of 5 splines: a run takes milliseconds. */
+#define TINY "--set anneal.sweeps=20 --set init.splines=5"
+
+/* Runs a shell command with stdout in dir/out.txt and stderr in dir/err.txt;
+** returns the exit status. */
+static int sh(const char *fmt, ...)
+{
+  char cmd[4096];
+  va_list ap;
+  va_start(ap, fmt);
+  int n = vsnprintf(cmd, sizeof cmd, fmt, ap);
+  va_end(ap);
+  cr_assert(n > 0 && (size_t)n + 64 < sizeof cmd);
+  snprintf(cmd + n, sizeof cmd - (size_t)n, " >%s/out.txt 2>%s/err.txt", dir, dir);
+  int st = system(cmd);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* The path of tools/<name> in the checkout. */
+static const char *tool(const char *name)
+{
+  static char buf[4][1024];
+  static int k;
+  k = (k + 1) % 4;
+  snprintf(buf[k], sizeof buf[k], "%s/tools/%s", env("LW_ROOT"), name);
+  return buf[k];
+}
+
+static const char *scene(void)
+{
+  static char buf[1024];
+  snprintf(buf, sizeof buf, "%s/params/minimal.ini", env("LW_ROOT"));
+  return buf;
+}
+
+/* The whole file (NUL-terminated, caller frees), or NULL. */
+static char *slurp(const char *fmt, ...)
+{
+  char path[512];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(path, sizeof path, fmt, ap);
+  va_end(ap);
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  size_t cap = 4096, n = 0;
+  char *s = malloc(cap);
+  size_t got;
+  while ((got = fread(s + n, 1, cap - n - 1, f)) > 0) {
+    n += got;
+    if (n + 1 == cap) s = realloc(s, cap *= 2);
+  }
+  fclose(f);
+  s[n] = '\0';
+  return s;
+}
+
+static char *out_txt(void) { return slurp("%s/out.txt", dir); }
+static char *err_txt(void) { return slurp("%s/err.txt", dir); }
+
+/* ---- sweep.csv and summary.json --------------------------------------- */
+
+#define MAXC 48
+#define MAXR 32
+typedef struct {
+  int ncol, nrow;
+  char *head[MAXC];
+  char *cell[MAXR][MAXC];
+  char *text;
+} csv;
+
+static int split(char *line, char **out)
+{
+  int n = 0;
+  for (char *c = line;; c++) {
+    out[n++] = c;
+    c = strchr(c, ',');
+    cr_assert(n < MAXC);
+    if (!c) break;
+    *c = '\0';
+  }
+  return n;
+}
+
+static void csv_read(csv *t, const char *path)
+{
+  memset(t, 0, sizeof *t);
+  t->text = slurp("%s", path);
+  cr_assert_not_null(t->text, "%s missing", path);
+  char *save, *line = strtok_r(t->text, "\n", &save);
+  cr_assert_not_null(line, "%s empty", path);
+  t->ncol = split(line, t->head);
+  while ((line = strtok_r(NULL, "\n", &save))) {
+    cr_assert(t->nrow < MAXR);
+    cr_assert_eq(split(line, t->cell[t->nrow]), t->ncol, "%s: row %d has another column count", path, t->nrow + 1);
+    t->nrow++;
+  }
+}
+
+static int col(const csv *t, const char *name)
+{
+  for (int c = 0; c < t->ncol; c++)
+    if (!strcmp(t->head[c], name)) return c;
+  return -1;
+}
+
+static const char *cell(const csv *t, int r, const char *name)
+{
+  int c = col(t, name);
+  cr_assert(c >= 0, "no column '%s'", name);
+  return t->cell[r][c];
+}
+
+/* The text of member key of summary.json, inside object obj (NULL: top
+** level), as written; "" when absent. */
+static void member(const char *json, const char *obj, const char *key, char *out, size_t n)
+{
+  char pat[96];
+  const char *from = json, *to = json + strlen(json);
+  out[0] = '\0';
+  if (obj) {
+    snprintf(pat, sizeof pat, "\n  \"%s\": {", obj);
+    if (!(from = strstr(json, pat))) return;
+    to = strstr(from, "\n  }");
+    snprintf(pat, sizeof pat, "\n    \"%s\": ", key);
+  } else {
+    snprintf(pat, sizeof pat, "\n  \"%s\": ", key);
+  }
+  const char *at = strstr(from, pat);
+  if (!at || at > to) return;
+  at += strlen(pat);
+  size_t len = strcspn(at, ",\n");
+  snprintf(out, n, "%.*s", (int)(len < n ? len : n - 1), at);
+}
+
+/* Every energy and acceptance cell of row r equals run/summary.json, text
+** for text (the gatherer copies values, so the CSV is exact). */
+static void row_matches_summary(const csv *t, int r, const char *run)
+{
+  char *js = slurp("%s/%s/summary.json", dir, run);
+  cr_assert_not_null(js, "%s/summary.json missing", run);
+  char want[64];
+  for (int c = 0; c < t->ncol; c++) {
+    const char *h = t->head[c];
+    if (!strncmp(h, "energy_", 7)) member(js, "energy", h + 7, want, sizeof want);
+    else if (!strncmp(h, "acceptance_", 11)) member(js, "acceptance", h + 11, want, sizeof want);
+    else if (!strcmp(h, "seed") || !strcmp(h, "proposals_per_second") || !strcmp(h, "wall_seconds"))
+      member(js, NULL, h, want, sizeof want);
+    else continue;
+    if (!strcmp(want, "null")) want[0] = '\0';
+    cr_assert_str_eq(t->cell[r][c], want, "%s: column %s", run, h);
+  }
+  free(js);
+}
+
+static double summary_total(const char *run)
+{
+  char *js = slurp("%s/%s/summary.json", dir, run);
+  cr_assert_not_null(js, "%s/summary.json missing", run);
+  char v[64];
+  member(js, "energy", "total", v, sizeof v);
+  free(js);
+  return strtod(v, NULL);
+}
+
+/* The number after "<label> " in text, or NAN. */
+static double number_after(const char *text, const char *label)
+{
+  const char *at = strstr(text, label);
+  return at ? strtod(at + strlen(label), NULL) : NAN;
+}
+
+/* ---- seed-sweep ------------------------------------------------------- */
+
+Test(tools, seed_sweep_gathers_every_summary_and_links_the_best)
+{
+  cr_assert_eq(sh("%s %s --seeds 1-4 -j 2 " TINY " --bin %s --out %s/s", tool("seed-sweep"), scene(), env("LW_BIN"), dir),
+               0, "%s", err_txt());
+  csv t;
+  char path[128];
+  snprintf(path, sizeof path, "%s/s/sweep.csv", dir);
+  csv_read(&t, path);
+  const char *want_cols[] = {"seed", "energy_total", "energy_strain", "energy_bending", "energy_pair",
+                             "energy_boundary", "acceptance_point", "acceptance_rotate",
+                             "proposals_per_second", "wall_seconds", "run"};
+  for (size_t i = 0; i < sizeof want_cols / sizeof *want_cols; i++)
+    cr_assert(col(&t, want_cols[i]) >= 0, "no column %s", want_cols[i]);
+  cr_assert_eq(col(&t, "seed"), 0);
+  cr_assert_eq(col(&t, "energy_total"), 1, "no key columns in a seed sweep");
+  cr_assert_eq(t.nrow, 4);
+  double e[4], sum = 0, best = INFINITY;
+  int best_seed = 0;
+  for (int r = 0; r < 4; r++) {
+    char run[32];
+    snprintf(run, sizeof run, "s/seed-%d", r + 1);
+    cr_assert_eq(atoi(cell(&t, r, "seed")), r + 1, "rows in seed order");
+    cr_assert_str_eq(cell(&t, r, "run"), run + 2);
+    row_matches_summary(&t, r, run);
+    e[r] = summary_total(run);
+    cr_assert(isfinite(e[r]));
+    sum += e[r];
+    if (e[r] < best) best = e[r], best_seed = r + 1;
+  }
+  /* each run got its own seed */
+  for (int a = 0; a < 4; a++)
+    for (int b = a + 1; b < 4; b++) cr_assert_neq(e[a], e[b], "seeds %d and %d ran the same chain", a + 1, b + 1);
+
+  char link[64] = {0}, want[32];
+  snprintf(path, sizeof path, "%s/s/best", dir);
+  cr_assert(readlink(path, link, sizeof link - 1) > 0, "no best link");
+  snprintf(want, sizeof want, "seed-%d", best_seed);
+  cr_assert_str_eq(link, want);
+
+  /* the printed statistics: values carry 10 significant digits */
+  double mean = sum / 4, ss = 0;
+  for (int r = 0; r < 4; r++) ss += (e[r] - mean) * (e[r] - mean);
+  double sd = sqrt(ss / 3);
+  char *out = out_txt();
+  cr_assert(fabs(number_after(out, "best ") - best) <= 1e-9 * fabs(best), "%s", out);
+  cr_assert(fabs(number_after(out, "mean ") - mean) <= 1e-9 * fabs(mean), "%s", out);
+  cr_assert(fabs(number_after(out, "std ") - sd) <= 1e-9 * sd, "sample std %.10g: %s", sd, out);
+  free(out);
+  free(t.text);
+}
+
+static void set_old_mtime(const char *path)
+{
+  struct timespec ts[2] = {{946684800, 0}, {946684800, 0}}; /* 2000-01-01 */
+  cr_assert_eq(utimensat(AT_FDCWD, path, ts, 0), 0, "%s", path);
+}
+
+static time_t mtime(const char *path)
+{
+  struct stat st;
+  cr_assert_eq(stat(path, &st), 0, "%s", path);
+  return st.st_mtime;
+}
+
+Test(tools, rerun_skips_finished_runs_and_redoes_missing_ones)
+{
+  const char *cmd = "%s %s --seeds 1-3 -j 2 " TINY " --bin %s --out %s/s";
+  cr_assert_eq(sh(cmd, tool("seed-sweep"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
+  double e2 = summary_total("s/seed-2");
+  const char *files[] = {"summary.json", "state.lw", "trace.csv", "final.svg"};
+  char path[128];
+  for (int i = 0; i < 4; i++) {
+    snprintf(path, sizeof path, "%s/s/seed-1/%s", dir, files[i]);
+    set_old_mtime(path);
+  }
+  char *before = slurp("%s/s/seed-1/summary.json", dir);
+  cr_assert_eq(sh("rm -r %s/s/seed-2", dir), 0);
+
+  cr_assert_eq(sh(cmd, tool("seed-sweep"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
+  for (int i = 0; i < 4; i++) {
+    snprintf(path, sizeof path, "%s/s/seed-1/%s", dir, files[i]);
+    cr_assert_eq(mtime(path), 946684800, "finished run rewritten: %s", files[i]);
+  }
+  char *after = slurp("%s/s/seed-1/summary.json", dir);
+  cr_assert_str_eq(after, before);
+  /* the deleted run is done again, to the same result (same seed) */
+  cr_assert_eq(summary_total("s/seed-2"), e2);
+  char *out = out_txt();
+  cr_assert(strstr(out, "seed-1: finished already") && strstr(out, "seed-3: finished already"), "%s", out);
+  cr_assert(strstr(out, "seed-2: ran"), "%s", out);
+  csv t;
+  snprintf(path, sizeof path, "%s/s/sweep.csv", dir);
+  csv_read(&t, path);
+  cr_assert_eq(t.nrow, 3);
+  free(out);
+  free(before);
+  free(after);
+  free(t.text);
+}
+
+Test(tools, interrupted_run_is_resumed_not_restarted)
+{
+  /* run seed-2 stopped at sweep 7 as a signal would, then the sweep */
+  cr_assert_eq(sh("%s run %s " TINY " --seed 2 --stop-at 7 --quiet --out %s/a/seed-2", env("LW_BIN"), scene(), dir), 0);
+  char path[128];
+  snprintf(path, sizeof path, "%s/a/seed-2/summary.json", dir);
+  cr_assert_neq(access(path, F_OK), 0);
+  cr_assert_eq(sh("%s %s --seeds 2 " TINY " --bin %s --out %s/a", tool("seed-sweep"), scene(), env("LW_BIN"), dir), 0,
+               "%s", err_txt());
+  char *out = out_txt(), *log = slurp("%s/a/seed-2/linewise.log", dir);
+  cr_assert(strstr(out, "seed-2: resumed"), "%s", out);
+  cr_assert(log && strstr(log, "at sweep 7 of 20"), "%s", log);
+  /* and ends where an uninterrupted run ends, bit for bit */
+  cr_assert_eq(sh("%s %s --seeds 2 " TINY " --bin %s --out %s/b", tool("seed-sweep"), scene(), env("LW_BIN"), dir), 0);
+  cr_assert_eq(sh("cmp %s/a/seed-2/state.lw %s/b/seed-2/state.lw", dir, dir), 0);
+  cr_assert_eq(sh("cmp %s/a/seed-2/trace.csv %s/b/seed-2/trace.csv", dir, dir), 0);
+  free(out);
+  free(log);
+}
+
+/* ---- param-sweep ------------------------------------------------------ */
+
+Test(tools, param_sweep_crosses_every_value_with_every_seed)
+{
+  const char *args = "%s %s --vary anneal.t_start=1,0.5 --vary energy.pair=0,0.02 --seeds 3-4 -j 2 " TINY
+                     " --bin %s --out %s/p";
+  cr_assert_eq(sh(args, tool("param-sweep"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
+  csv t;
+  char path[128];
+  snprintf(path, sizeof path, "%s/p/sweep.csv", dir);
+  csv_read(&t, path);
+  cr_assert_eq(col(&t, "seed"), 0);
+  cr_assert_eq(col(&t, "anneal.t_start"), 1);
+  cr_assert_eq(col(&t, "energy.pair"), 2);
+  cr_assert_eq(col(&t, "energy_total"), 3);
+  cr_assert_eq(t.nrow, 2 * 2 * 2);
+  int seen[2][2][2] = {{{0}}};
+  for (int r = 0; r < t.nrow; r++) {
+    const char *ts = cell(&t, r, "anneal.t_start"), *pair = cell(&t, r, "energy.pair");
+    int seed = atoi(cell(&t, r, "seed"));
+    int i = !strcmp(ts, "0.5"), j = !strcmp(pair, "0.02");
+    cr_assert(i || !strcmp(ts, "1"), "t_start %s", ts);
+    cr_assert(j || !strcmp(pair, "0"), "pair %s", pair);
+    cr_assert(seed == 3 || seed == 4);
+    seen[i][j][seed - 3]++;
+    char run[128];
+    snprintf(run, sizeof run, "anneal.t_start=%s__energy.pair=%s__seed-%d", ts, pair, seed);
+    cr_assert_str_eq(cell(&t, r, "run"), run);
+    char sub[160];
+    snprintf(sub, sizeof sub, "p/%s", run);
+    row_matches_summary(&t, r, sub);
+    /* the run really used the value: its resolved scene says so */
+    char *ini = slurp("%s/p/%s/scene.ini", dir, run);
+    char want[64];
+    snprintf(want, sizeof want, "\nt_start = %s\n", ts);
+    cr_assert(ini && strstr(ini, want), "%s: scene.ini lacks '%s'", run, want + 1);
+    free(ini);
+    /* pair = 0 switches the term off: an empty cell, not a zero */
+    cr_assert_eq(cell(&t, r, "energy_pair")[0] == '\0', !j, "%s: energy_pair '%s'", run, cell(&t, r, "energy_pair"));
+  }
+  for (int i = 0; i < 8; i++) cr_assert_eq(seen[i / 4][i / 2 % 2][i % 2], 1, "combination %d seen %d times", i, seen[i / 4][i / 2 % 2][i % 2]);
+  /* --list is the same plan */
+  cr_assert_eq(sh("%s %s --vary anneal.t_start=1,0.5 --vary energy.pair=0,0.02 --seeds 3-4 --list | wc -l",
+                  tool("param-sweep"), scene()), 0);
+  char *out = out_txt();
+  cr_assert_eq(atoi(out), 8);
+  free(out);
+  free(t.text);
+}
+
+Test(tools, failed_runs_are_reported_and_the_others_finish)
+{
+  int rc = sh("%s %s --vary init.splines=4,-1 --seeds 1-2 --set anneal.sweeps=20 --bin %s --out %s/f", tool("param-sweep"),
+              scene(), env("LW_BIN"), dir);
+  char *errs = err_txt();
+  cr_assert_eq(rc, 1, "%s", errs);
+  const char *first = strstr(errs, "FAILED (exit 2)");
+  cr_assert(first && strstr(first + 1, "FAILED (exit 2)"), "two failures reported: %s", errs);
+  cr_assert(strstr(errs, "init.splines"), "the reason is shown: %s", errs);
+  csv t;
+  char path[128];
+  snprintf(path, sizeof path, "%s/f/sweep.csv", dir);
+  csv_read(&t, path);
+  cr_assert_eq(t.nrow, 2);
+  for (int r = 0; r < 2; r++) cr_assert_str_eq(cell(&t, r, "init.splines"), "4");
+  free(errs);
+  free(t.text);
+}
+
+Test(tools, job_array_tasks_then_gather_only)
+{
+  /* what Slurm does: one task per array index, then a gathering job */
+  for (int i = 1; i <= 3; i++)
+    cr_assert_eq(sh("SLURM_ARRAY_TASK_ID=%d SLURM_SUBMIT_DIR=%s %s %s --seeds 5-7 " TINY " --bin %s --out %s/j", i,
+                    env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir),
+                 0, "task %d: %s", i, err_txt());
+  char path[128];
+  snprintf(path, sizeof path, "%s/j/sweep.csv", dir);
+  cr_assert_neq(access(path, F_OK), 0, "a task does not gather");
+  cr_assert_eq(sh("%s --gather-only %s/j", tool("seed-sweep"), dir), 0, "%s", err_txt());
+  csv t;
+  csv_read(&t, path);
+  cr_assert_eq(t.nrow, 3);
+  for (int r = 0; r < 3; r++) {
+    char run[32];
+    snprintf(run, sizeof run, "j/seed-%d", r + 5);
+    cr_assert_eq(atoi(cell(&t, r, "seed")), r + 5);
+    row_matches_summary(&t, r, run);
+  }
+  /* a task outside the plan is a usage error */
+  cr_assert_eq(sh("SLURM_ARRAY_TASK_ID=4 SLURM_SUBMIT_DIR=%s %s %s --seeds 5-7 " TINY " --bin %s --out %s/j",
+                  env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir),
+               2);
+  free(t.text);
+}
+
+Test(tools, bad_usage_exits_2_with_one_message_and_writes_nothing)
+{
+  const char *bad[][2] = {
+    {"--seeds 3-1", "backwards"},
+    {"--seeds 1,x", "'x'"},
+    {"", "--seeds"},
+    {"--seeds 1,1", "twice"},
+    {"--seeds 1 --vary anneal.seed=1,2", "--seeds"},
+    {"--seeds 1 --vary scene.width=a/b", "scene.width"},
+    {"--seeds 1 --vary width=3", "section.key"},
+    {"--seeds 1 -j 0", "-j"},
+    {"--seeds 1 --frobnicate", "frobnicate"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+    cr_assert_eq(sh("%s %s %s --bin %s --out %s/u", tool("param-sweep"), scene(), bad[i][0], env("LW_BIN"), dir), 2,
+                 "'%s'", bad[i][0]);
+    char *errs = err_txt();
+    cr_assert(strstr(errs, bad[i][1]), "'%s': %s", bad[i][0], errs);
+    cr_assert_eq(strchr(errs, '\n'), errs + strlen(errs) - 1, "one line: %s", errs);
+    free(errs);
+  }
+  char path[128];
+  snprintf(path, sizeof path, "%s/u", dir);
+  cr_assert_neq(access(path, F_OK), 0, "nothing written");
+  /* a directory made by another sweep is refused: its runs would be stale */
+  cr_assert_eq(sh("%s %s --seeds 1 " TINY " --bin %s --out %s/u", tool("seed-sweep"), scene(), env("LW_BIN"), dir), 0);
+  cr_assert_eq(sh("%s %s --seeds 1 --set anneal.sweeps=30 --bin %s --out %s/u", tool("seed-sweep"), scene(),
+                  env("LW_BIN"), dir), 2);
+  char *errs = err_txt();
+  cr_assert(strstr(errs, "sweep.conf"), "%s", errs);
+  free(errs);
+  cr_assert_eq(sh("%s --gather-only %s", tool("seed-sweep"), dir), 2, "not a sweep directory");
+}
+
+/* ---- plots ------------------------------------------------------------ */
+
+/* A PNG: signature, then the IHDR chunk with a non-zero size, and more than
+** a blank canvas's worth of bytes. */
+static void check_png(const char *name)
+{
+  char path[256];
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  FILE *f = fopen(path, "rb");
+  cr_assert_not_null(f, "%s missing", name);
+  unsigned char h[24];
+  cr_assert_eq(fread(h, 1, 24, f), 24);
+  fseek(f, 0, SEEK_END);
+  long size = ftell(f);
+  fclose(f);
+  cr_assert(!memcmp(h, "\x89PNG\r\n\x1a\n", 8), "%s: no PNG signature", name);
+  cr_assert(!memcmp(h + 12, "IHDR", 4));
+  unsigned w = (unsigned)h[16] << 24 | h[17] << 16 | h[18] << 8 | h[19];
+  unsigned ht = (unsigned)h[20] << 24 | h[21] << 16 | h[22] << 8 | h[23];
+  cr_assert(w >= 320 && ht >= 240, "%s: %ux%u", name, w, ht);
+  cr_assert(size > 8000, "%s: only %ld bytes", name, size);
+}
+
+static int exists(const char *name)
+{
+  char path[256];
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  return access(path, F_OK) == 0;
+}
+
+Test(tools, plot_run_draws_energy_temperature_and_acceptance)
+{
+  cr_assert_eq(sh("%s run %s " TINY " --quiet --out %s/r", env("LW_BIN"), scene(), dir), 0);
+  cr_assert_eq(sh("%s %s/r", tool("plot-run"), dir), 0, "%s", err_txt());
+  check_png("r/plots/energy.png");
+  check_png("r/plots/temperature.png");
+  check_png("r/plots/acceptance.png");
+  cr_assert(!exists("r/plots/replicas.png") && !exists("r/plots/swaps.png"), "no tempering, no tempering plots");
+  cr_assert_eq(sh("%s %s/nothing", tool("plot-run"), dir), 2);
+}
+
+static void write_text(const char *name, const char *text)
+{
+  char path[256];
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  FILE *f = fopen(path, "w");
+  cr_assert_not_null(f);
+  fputs(text, f);
+  fclose(f);
+}
+
+/* A tempering run as its files will look: replica and swap columns in the
+** trace, the ladder and swap acceptance in the summary. */
+static void write_tempering_run(const char *sub, int with_replica_columns)
+{
+  char name[128], row[256];
+  cr_assert_eq(sh("mkdir -p %s/%s", dir, sub), 0);
+  size_t cap = 1 << 14, n = 0;
+  char *trace = malloc(cap);
+  n += (size_t)snprintf(trace, cap, "sweep,temperature,bending,total,acc_point%s\n",
+                        with_replica_columns ? ",replica0_temperature,replica0_energy,replica1_temperature,"
+                                               "replica1_energy,swap0" : "");
+  for (int s = 1; s <= 40; s++) {
+    if (with_replica_columns)
+      snprintf(row, sizeof row, "%d,%g,%g,%g,%g,0.1,%g,0.5,%g,%g\n", s, 1.0 / s, 3.0 / s, 3.0 / s + 0.2, 0.45, 2.0 / s,
+               4.0 / s, 0.3 + 0.01 * s);
+    else
+      snprintf(row, sizeof row, "%d,%g,%g,%g,%g\n", s, 1.0 / s, 3.0 / s, 3.0 / s + 0.2, 0.45);
+    n += (size_t)snprintf(trace + n, cap - n, "%s", row);
+  }
+  snprintf(name, sizeof name, "%s/trace.csv", sub);
+  write_text(name, trace);
+  free(trace);
+  snprintf(name, sizeof name, "%s/summary.json", sub);
+  write_text(name, "{\n  \"seed\": 1,\n  \"energy\": {\n    \"total\": 0.275,\n    \"bending\": 0.075\n  },\n"
+                   "  \"replicas\": [\n    {\n      \"temperature\": 0.1,\n      \"energy\": 0.275\n    },\n"
+                   "    {\n      \"temperature\": 0.5,\n      \"energy\": 0.4\n    }\n  ],\n"
+                   "  \"swap_acceptance\": [\n    0.42\n  ],\n  \"round_trips\": 2\n}\n");
+}
+
+Test(tools, plot_run_draws_replicas_and_swaps_when_tempering)
+{
+  write_tempering_run("pt", 1);
+  cr_assert_eq(sh("%s %s/pt", tool("plot-run"), dir), 0, "%s", err_txt());
+  check_png("pt/plots/energy.png");
+  check_png("pt/plots/replicas.png");
+  check_png("pt/plots/swaps.png");
+  /* the summary alone (no replica columns in the trace) still gives both */
+  write_tempering_run("ps", 0);
+  cr_assert_eq(sh("%s %s/ps", tool("plot-run"), dir), 0, "%s", err_txt());
+  check_png("ps/plots/replicas.png");
+  check_png("ps/plots/swaps.png");
+}
+
+Test(tools, plot_sweep_draws_a_png_beside_the_csv)
+{
+  write_text("seeds.csv", "seed,energy_total,energy_bending,proposals_per_second,wall_seconds,run\n"
+                          "1,2.5,1.5,1000,0.1,seed-1\n2,1.75,1.25,1100,0.1,seed-2\n3,2.125,1,900,0.1,seed-3\n");
+  cr_assert_eq(sh("%s %s/seeds.csv", tool("plot-sweep"), dir), 0, "%s", err_txt());
+  check_png("seeds.png");
+  write_text("params.csv", "seed,energy.bending,energy_total,wall_seconds,run\n"
+                           "1,0.5,2.5,0.1,a\n2,0.5,1.5,0.1,b\n1,2,3.5,0.1,c\n2,2,3.25,0.1,d\n");
+  cr_assert_eq(sh("%s %s/params.csv --y wall_seconds", tool("plot-sweep"), dir), 0, "%s", err_txt());
+  check_png("params-wall_seconds.png");
+  write_text("words.csv", "seed,anneal.schedule,energy_total,run\n1,linear,2.5,a\n1,geometric,1.5,b\n");
+  cr_assert_eq(sh("%s %s/words.csv --out %s/w.png", tool("plot-sweep"), dir, dir), 0, "%s", err_txt());
+  check_png("w.png");
+  cr_assert_eq(sh("%s %s/seeds.csv --y nothing", tool("plot-sweep"), dir), 2);
+}
