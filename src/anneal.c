@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "linewise/fieldview.h"
 #include "linewise/init.h"
 #include "linewise/json.h"
 #include "linewise/output.h"
@@ -154,6 +155,8 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   a->params = *p;
   absolute_path(a->params.from, p->file);
   absolute_path(a->params.table, p->file);
+  absolute_path(a->params.image, p->file);
+  absolute_path(a->params.mask_image, p->file);
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   a->seed = (unsigned long)p->seed;
   a->block = -1;
@@ -167,10 +170,12 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
     st.sp = NULL;
     lw_state_clear(&st);
   } else {
+    size_t n;
+    if ((s = lw_init_count(&a->scene, p, &n, err))) return s;
     gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
     if (!r) return lw_error_set(err, LW_ENOMEM, "out of memory");
     gsl_rng_set(r, lw_stream_seed(a->seed, 0));
-    sp = lw_init_random(&a->scene, (size_t)p->splines, (size_t)p->segments, p->segment_length, r, err);
+    sp = lw_init_random(&a->scene, n, (size_t)p->segments, p->segment_length, r, err);
     gsl_rng_free(r);
     if (!sp) return err->code;
   }
@@ -188,6 +193,8 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   lw_params_write(&a->params, f);
   if ((s = lw_output_commit(f, tmp, path, err))) return s;
   if ((s = open_trace(a, 1, err))) return s;
+  dir_file(path, sizeof path, a, "field.png");
+  if (p->field_preview && (s = lw_fieldview_png(&a->scene, p->png_scale, path, err))) return s;
   return lw_anneal_checkpoint(a, err);
 }
 
