@@ -219,17 +219,21 @@ double lw_init_ink_area(const lw_scene *sc)
 
 lw_status lw_init_count(const lw_scene *sc, const lw_params *p, size_t *n, lw_error *err)
 {
+  const lw_param_def *cov = lw_params_find("init", "coverage"), *spl = lw_params_find("init", "splines");
+  char where[LW_PATH_MAX + 32];
+  lw_params_origin(p, cov, where, sizeof where);
+  /* a coverage beside the default count would be ignored without a word */
+  if (p->coverage > 0 && p->splines > 0 && p->line[spl - lw_param_table] == 0)
+    return lw_error_set(err, LW_EINPUT, "%s: key 'init.coverage': sets the number of splines only with "
+                        "init.splines = 0 (its default is %s)", where, spl->def);
   if (p->splines > 0 || !(p->coverage > 0)) {
     *n = (size_t)p->splines;
     return LW_OK;
   }
   double want = p->coverage * lw_init_ink_area(sc) / (p->pen_width * p->segments * p->segment_length);
-  if (!(want <= 1e8)) {
-    char where[LW_PATH_MAX + 32];
-    lw_params_origin(p, lw_params_find("init", "coverage"), where, sizeof where);
+  if (!(want <= 1e8))
     return lw_error_set(err, LW_EINPUT, "%s: key 'init.coverage': %g asks for %.3g splines, more than 1e8",
                         where, p->coverage, want);
-  }
   *n = (size_t)llround(want);
   return LW_OK;
 }

@@ -98,7 +98,7 @@ const lw_param_def lw_param_table[] = {
       "scene has an image, along the field when the field term is on). 0 with `coverage` > 0: "
       "as many as the coverage asks for."),
   NUM("init", "coverage", LW_PT_DOUBLE, coverage, "0", "", 0, 100, 0,
-      "Target ink coverage when splines = 0: splines = coverage * (sum of darkness (1 - tone) "
+      "Target ink coverage; needs splines = 0: splines = coverage * (sum of darkness (1 - tone) "
       "over the inside, mm^2) / (output.pen_width * segments * segment_length); without an "
       "image the darkness is 1. 0 = off."),
   NUM("init", "segments", LW_PT_INT, segments, "4", "", 1, 1e5, 0,

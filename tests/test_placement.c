@@ -151,16 +151,20 @@ Test(placement, coverage_gives_the_spline_count)
   cr_assert(fabs(lw_init_ink_area(&sc) - ink) < 1e-3, "%g vs %g", lw_init_ink_area(&sc), ink);
   cr_assert_eq(lw_init_count(&sc, &p, &n, NULL), LW_OK);
   cr_assert_eq(n, (size_t)llround(0.5 * ink / 6));
-  p.splines = 17; /* a count given wins */
+  p.splines = 17; /* a count given in the file wins */
+  p.line[lw_params_find("init", "splines") - lw_param_table] = 3;
   cr_assert_eq(lw_init_count(&sc, &p, &n, NULL), LW_OK);
   cr_assert_eq(n, 17);
+  lw_error err;
+  p.line[lw_params_find("init", "splines") - lw_param_table] = 0; /* left at its default */
+  cr_assert_eq(lw_init_count(&sc, &p, &n, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "init.coverage") && strstr(err.msg, "init.splines = 0"), "%s", err.msg);
   p.splines = 0;
   p.coverage = 0; /* neither: none, as always */
   cr_assert_eq(lw_init_count(&sc, &p, &n, NULL), LW_OK);
   cr_assert_eq(n, 0);
   p.coverage = 100;
   p.pen_width = 1e-6;
-  lw_error err;
   cr_assert_eq(lw_init_count(&sc, &p, &n, &err), LW_EINPUT);
   cr_assert(strstr(err.msg, "init.coverage"), "%s", err.msg);
   lw_scene_clear(&sc);

@@ -35,7 +35,8 @@ double lw_init_ink_area(const lw_scene *sc);
 ** init.coverage > 0, the count whose ink (output.pen_width wide, segments *
 ** segment_length long each) covers that fraction of the darkness:
 **     n = round(coverage * ink area / (pen_width * segments * segment_length)).
-** LW_EINPUT (naming init.coverage) above 1e8. */
+** LW_EINPUT (naming init.coverage) above 1e8, or when a coverage is given
+** but init.splines was left at its default (the coverage would be ignored). */
 lw_status lw_init_count(const lw_scene *sc, const lw_params *p, size_t *n, lw_error *err);
 
 /* A seed for stream `stream` of a run seeded with `seed` (SplitMix64 of
