@@ -23,6 +23,8 @@ TEST_OBJ := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%.o)
 TEST_JOBS ?= 2
 # study tools (shell, gnuplot), installed as linewise-<name>
 TOOLS   := seed-sweep param-sweep plot-run plot-sweep
+# The example picture is generated (no third-party images in the repository).
+PICTURE := params/picture.png
 
 .PHONY: all deps test asan run bench install clean docs
 all: $(BIN)/linewise
@@ -36,7 +38,7 @@ $(BUILD)/liblinewise.a: $(LIB_OBJ)
 $(BIN)/linewise: src/main.c $(BUILD)/liblinewise.a | $(BIN)
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) $< -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
 
-$(BUILD)/tests/%.o: tests/%.c tests/testutil.h $(wildcard include/linewise/*.h) | $(BUILD)/tests
+$(BUILD)/tests/%.o: tests/%.c $(wildcard tests/*.h) $(wildcard include/linewise/*.h) | $(BUILD)/tests
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -Itests -c $< -o $@
 
 $(BUILD)/tests/run: $(TEST_OBJ) $(BUILD)/liblinewise.a
@@ -45,8 +47,9 @@ $(BUILD)/tests/run: $(TEST_OBJ) $(BUILD)/liblinewise.a
 $(BUILD)/obj $(BUILD)/tests $(BIN):
 	mkdir -p $@
 
-# The suite runs the binary too (CLI tests), so both are built first.
-test: $(BIN)/linewise $(BUILD)/tests/run
+# The suite runs the binary too (CLI tests), so both are built first, and
+# it checks that every bundled scene builds, the image scene included.
+test: $(BIN)/linewise $(BUILD)/tests/run $(PICTURE)
 	LW_BIN=$(CURDIR)/$(BIN)/linewise LW_ROOT=$(CURDIR) $(BUILD)/tests/run --jobs $(TEST_JOBS)
 
 asan:
@@ -60,8 +63,14 @@ deps:
 	  echo "installing:$$missing"; apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
 	else echo "all build dependencies present"; fi
 
-run: bin/linewise
+run: bin/linewise $(PICTURE)
 	bin/linewise run params/example.ini --out out/example
+
+$(BUILD)/make-picture: tools/make-picture.c | $(BUILD)/obj
+	$(CC) $(WARN) $(CFLAGS) $(CPPFLAGS) $< -o $@ $(LDFLAGS) $(LDLIBS)
+
+$(PICTURE): $(BUILD)/make-picture
+	$(BUILD)/make-picture $@
 
 # The parameter reference is generated from the table the reader uses.
 docs: bin/linewise
@@ -80,14 +89,14 @@ bench: $(BUILD)/bench $(BUILD)/bench-tempering
 	  echo; $(BUILD)/bench 5; echo; $(BUILD)/bench-tempering 5; } > docs/PERFORMANCE.md.new
 	mv docs/PERFORMANCE.md.new docs/PERFORMANCE.md
 
-install: $(BIN)/linewise
+install: $(BIN)/linewise $(PICTURE)
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/linewise/params
 	install -m 755 bin/linewise $(DESTDIR)$(PREFIX)/bin/linewise
-	install -m 644 params/*.ini $(DESTDIR)$(PREFIX)/share/linewise/params/
+	install -m 644 params/*.ini $(PICTURE) $(DESTDIR)$(PREFIX)/share/linewise/params/
 	install -d $(DESTDIR)$(PREFIX)/share/man/man1
 	install -m 644 docs/linewise.1 $(DESTDIR)$(PREFIX)/share/man/man1/linewise.1
 	for t in $(TOOLS); do install -m 755 tools/$$t $(DESTDIR)$(PREFIX)/bin/linewise-$$t; done
 	install -m 644 tools/slurm-sweep.sbatch $(DESTDIR)$(PREFIX)/share/linewise/
 
 clean:
-	rm -rf build build-asan bin
+	rm -rf build build-asan bin $(PICTURE)

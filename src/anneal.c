@@ -15,6 +15,7 @@
 #include <time.h>
 
 #include "linewise/drawing.h"
+#include "linewise/fieldview.h"
 #include "linewise/init.h"
 #include "linewise/json.h"
 #include "linewise/output.h"
@@ -170,6 +171,14 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
   return LW_OK;
 }
 
+/* The target of the fidelity score and the previews' underlay. */
+static lw_status setup_tone(lw_anneal *a, lw_error *err)
+{
+  if (!a->scene.image) return LW_OK;
+  a->tone = lw_image_tone_grid(a->scene.image, &a->scene.image_place, err);
+  return a->tone ? LW_OK : err->code;
+}
+
 /* Chain of rung k: rung 0 draws from stream 1 (as a run without tempering
 ** does), the master exchange stream is 2, rung k >= 1 is stream 2 + k. */
 static unsigned long rung_stream(const lw_anneal *a, int k)
@@ -253,6 +262,8 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   a->params = *p;
   absolute_path(a->params.from, p->file);
   absolute_path(a->params.table, p->file);
+  absolute_path(a->params.image, p->file);
+  absolute_path(a->params.mask_image, p->file);
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   a->seed = (unsigned long)p->seed;
   a->block = -1;
@@ -260,7 +271,7 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   double ladder[LW_TEMPERING_MAX];
   if ((s = lw_params_resolve(&a->params, err)) || (s = setup_ladder(a, ladder, err)) ||
       (s = setup_schedule(a, err)) ||
-      (s = lw_scene_init(&a->scene, &a->params, err)))
+      (s = lw_scene_init(&a->scene, &a->params, err)) || (s = setup_tone(a, err)))
     return s;
   lw_splines *sp;
   if (a->params.from[0]) {
@@ -270,10 +281,12 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
     st.sp = NULL;
     lw_state_clear(&st);
   } else {
+    size_t n;
+    if ((s = lw_init_count(&a->scene, p, &n, err))) return s;
     gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
     if (!r) return lw_error_set(err, LW_ENOMEM, "out of memory");
     gsl_rng_set(r, lw_stream_seed(a->seed, 0));
-    sp = lw_init_random(&a->scene, (size_t)p->splines, (size_t)p->segments, p->segment_length, r, err);
+    sp = lw_init_random(&a->scene, n, (size_t)p->segments, p->segment_length, r, err);
     gsl_rng_free(r);
     if (!sp) return err->code;
   }
@@ -298,6 +311,8 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   lw_params_write(&a->params, f);
   if ((s = lw_output_commit(f, tmp, path, err))) return s;
   if ((s = open_trace(a, 1, err))) return s;
+  dir_file(path, sizeof path, a, "field.png");
+  if (p->field_preview && (s = lw_fieldview_png(&a->scene, p->png_scale, path, err))) return s;
   return lw_anneal_checkpoint(a, err);
 }
 
@@ -625,7 +640,8 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);
   double ladder[LW_TEMPERING_MAX];
   if ((s = lw_params_read(&a->params, scene_path, err)) || (s = setup_ladder(a, ladder, err)) ||
-      (s = setup_schedule(a, err)) || (s = lw_scene_init(&a->scene, &a->params, err))) {
+      (s = setup_schedule(a, err)) || (s = lw_scene_init(&a->scene, &a->params, err)) ||
+      (s = setup_tone(a, err))) {
     lw_state_clear(&st);
     return s;
   }
@@ -819,7 +835,7 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
     }
   /* Frames are extra files: they read the state and change nothing. */
   if (p->frames_every && a->sweep % p->frames_every == 0 &&
-      lw_drawing_frame(p, &a->scene, a->model->sp, NULL, a->dir, a->sweep, err))
+      lw_drawing_frame(p, &a->scene, a->model->sp, a->tone, a->dir, a->sweep, err))
     return err->code;
   if (a->sweep % p->checkpoint_every == 0) return lw_anneal_checkpoint(a, err);
   return LW_OK;
@@ -931,7 +947,7 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
   lw_status s;
   if ((s = lw_anneal_checkpoint(a, err))) return s;
   /* NULL: the target tone raster, once scenes carry one (fidelity, underlay) */
-  if ((s = lw_drawing_write(&a->params, &a->scene, a->model->sp, NULL, a->dir, &a->drawing, err))) return s;
+  if ((s = lw_drawing_write(&a->params, &a->scene, a->model->sp, a->tone, a->dir, &a->drawing, err))) return s;
   return write_summary(a, err);
 }
 
@@ -944,6 +960,7 @@ void lw_anneal_free(lw_anneal *a)
   }
   free(a->chains);
   free(a->models);
+  lw_grid2d_free(a->tone);
   lw_tempering_free(a->pt);
   lw_scene_clear(&a->scene);
   lw_schedule_clear(&a->sched);

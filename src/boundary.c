@@ -67,6 +67,8 @@ void lw_boundary_clear(lw_boundary *b)
   free(b->vy);
   b->vx = b->vy = NULL;
   b->n = 0;
+  lw_grid2d_free(b->sdt);
+  b->sdt = NULL;
 }
 
 /* Exact signed distance to an axis-aligned box: q is how far the point lies
@@ -133,6 +135,13 @@ double lw_boundary_distance(const lw_boundary *b, double x, double y)
   case LW_BOUNDARY_RECT: return rect_distance(b, x, y);
   case LW_BOUNDARY_CIRCLE: return circle_distance(b, x, y);
   case LW_BOUNDARY_POLYGON: return polygon_distance(b, x, y);
+  case LW_BOUNDARY_MASK: {
+    /* a cleared mask has no inside */
+    if (!b->sdt || b->sdt->ncomp != 1) return INFINITY;
+    double d;
+    lw_grid2d_eval(b->sdt, x, y, &d);
+    return d;
+  }
   case LW_BOUNDARY_NONE: break;
   }
   return -INFINITY;

@@ -199,6 +199,36 @@ void lw_field_eval(const lw_field *f, double x, double y, double *vx, double *vy
     *vy = v[1];
     return;
   }
+  case LW_FIELD_GRID_AXIAL: {
+    double q[2];
+    if (!f->grid || f->grid->ncomp != 2) {
+      *vx = *vy = 0.0;
+      return;
+    }
+    lw_grid2d_eval(f->grid, x, y, q);
+    double m = sqrt(q[0] * q[0] + q[1] * q[1]);
+    if (!(m > 0.0)) {
+      *vx = *vy = 0.0;
+      return;
+    }
+    /* Both (m + q0, q1) and (q1, m - q0) point along the half angle, with
+    ** lengths sqrt(2 m (m +- q0)); the one with the larger length has no
+    ** cancellation.  Scaled to length m, no trigonometry needed. */
+    double hx, hy, den;
+    if (q[0] >= 0.0) {
+      hx = m + q[0];
+      hy = q[1];
+      den = m + q[0];
+    } else {
+      hx = q[1];
+      hy = m - q[0];
+      den = m - q[0];
+    }
+    double s = sqrt(m / (2.0 * den));
+    *vx = hx * s;
+    *vy = hy * s;
+    return;
+  }
   }
   *vx = *vy = 0.0;
 }

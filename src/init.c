@@ -1,4 +1,16 @@
-/* init.c -- random initial placement and stream seeds (init.h). */
+/*
+** init.c -- initial placement, the number of splines, stream seeds (init.h).
+**
+** Where a spline goes: its centre is drawn uniformly over the page, or, when
+** the scene has a picture, with probability proportional to the darkness
+** 1 - tone of the pixel it falls in (a pixel is chosen from the cumulative
+** darkness of the rows and then along its row, the point uniformly inside
+** it).  Its shape: straight at a random angle, or, when the field term is
+** on, the streamline of the field through the centre, traced both ways by
+** the midpoint rule in steps of segment_length with the node vectors along
+** the field, so the splines start where the energy wants them.  A draw
+** whose spline leaves the boundary is drawn again.
+*/
 #include "linewise/init.h"
 
 #include <gsl/gsl_math.h>
@@ -29,6 +41,90 @@ static int fits(const lw_scene *sc, const lw_node *nd, size_t segments)
   return 1;
 }
 
+/* Darkness of the rows of the picture, cumulated: cum[j] is the sum over
+** rows before j, cum[height] the total.  NULL without a picture. */
+static double *row_darkness(const lw_image *img)
+{
+  if (!img) return NULL;
+  double *cum = malloc(((size_t)img->height + 1) * sizeof *cum);
+  if (!cum) return NULL;
+  cum[0] = 0.0;
+  for (int j = 0; j < img->height; j++) {
+    const float *t = img->tone + (size_t)j * (size_t)img->width;
+    double s = 0.0;
+    for (int i = 0; i < img->width; i++) s += 1.0 - t[i];
+    cum[j + 1] = cum[j] + s;
+  }
+  return cum;
+}
+
+/* A point drawn with density proportional to darkness. */
+static void dark_point(const lw_scene *sc, const double *cum, gsl_rng *rng, double *x, double *y)
+{
+  const lw_image *img = sc->image;
+  double r = gsl_rng_uniform(rng) * cum[img->height];
+  int lo = 0, hi = img->height - 1;
+  while (lo < hi) { /* the last row j with cum[j] <= r */
+    int mid = (lo + hi + 1) / 2;
+    if (cum[mid] <= r) lo = mid;
+    else hi = mid - 1;
+  }
+  /* walk the row; the last pixel with any darkness catches rounding */
+  const float *t = img->tone + (size_t)lo * (size_t)img->width;
+  double rest = r - cum[lo];
+  int pick = -1;
+  for (int i = 0; i < img->width; i++) {
+    double d = 1.0 - t[i];
+    if (d <= 0) continue;
+    pick = i;
+    if (rest < d) break;
+    rest -= d;
+  }
+  if (pick < 0) pick = img->width / 2; /* a row of no darkness: cannot be drawn */
+  const lw_image_place *pl = &sc->image_place;
+  *x = pl->x0 + (pick + gsl_rng_uniform(rng)) * pl->pixel;
+  *y = pl->y0 + (lo + gsl_rng_uniform(rng)) * pl->pixel;
+}
+
+/* The field's direction at (x, y) turned to agree with (dx, dy); (dx, dy)
+** itself where the field vanishes. */
+static void along(const lw_scene *sc, double x, double y, double dx, double dy, double *ux, double *uy)
+{
+  double vx, vy;
+  lw_field_eval(&sc->field, x, y, &vx, &vy);
+  double m = sqrt(vx * vx + vy * vy);
+  if (!(m > 1e-12)) {
+    *ux = dx;
+    *uy = dy;
+    return;
+  }
+  double s = vx * dx + vy * dy < 0 ? -1.0 / m : 1.0 / m;
+  *ux = vx * s;
+  *uy = vy * s;
+}
+
+/* The streamline through (cx, cy) leaving along (ux, uy): node segments/2
+** sits at the centre, the others follow in steps of h forward and backward. */
+static void trace(const lw_scene *sc, lw_node *nd, size_t segments, double h, double cx, double cy, double ux,
+                  double uy)
+{
+  const size_t kc = segments / 2;
+  nd[kc] = (lw_node){cx, cy, h * ux / 3.0, h * uy / 3.0};
+  for (int dir = 1; dir >= -1; dir -= 2) {
+    double px = cx, py = cy, dx = dir * ux, dy = dir * uy;
+    for (long k = (long)kc + dir; k >= 0 && k <= (long)segments; k += dir) {
+      double ax, ay, bx, by;
+      along(sc, px, py, dx, dy, &ax, &ay);
+      along(sc, px + 0.5 * h * ax, py + 0.5 * h * ay, ax, ay, &bx, &by);
+      px += h * bx;
+      py += h * by;
+      along(sc, px, py, bx, by, &dx, &dy);
+      /* node vectors point from node 0 toward node n whichever way we walk */
+      nd[k] = (lw_node){px, py, dir * h * dx / 3.0, dir * h * dy / 3.0};
+    }
+  }
+}
+
 lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double segment_length,
                            gsl_rng *rng, lw_error *err)
 {
@@ -41,17 +137,44 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
   lw_splines *sp = lw_splines_new(n, segs, err);
   free(segs);
   if (!sp) return NULL;
+  double *cum = row_darkness(sc->image);
+  if (sc->image && !cum) {
+    lw_splines_free(sp);
+    lw_error_set(err, LW_ENOMEM, "out of memory for the placement");
+    return NULL;
+  }
+  /* a white picture has nothing to draw toward: uniform, as without one */
+  const int weighted = cum && cum[sc->image->height] > 0;
+  const int follow = sc->on[LW_TERM_FIELD];
   const double L = segment_length * (double)segments;
   const int tries = 10000;
   for (size_t i = 0; i < n; i++) {
     lw_node *nd = &sp->node[sp->first[i]];
     int t;
     for (t = 0; t < tries; t++) {
-      double cx = gsl_rng_uniform(rng) * sc->width, cy = gsl_rng_uniform(rng) * sc->height;
+      double cx, cy;
+      if (weighted) dark_point(sc, cum, rng, &cx, &cy);
+      else {
+        cx = gsl_rng_uniform(rng) * sc->width;
+        cy = gsl_rng_uniform(rng) * sc->height;
+      }
       double a = 2.0 * M_PI * gsl_rng_uniform(rng), ux = cos(a), uy = sin(a);
-      for (size_t k = 0; k <= segments; k++) {
-        double u = ((double)k / (double)segments - 0.5) * L;
-        nd[k] = (lw_node){cx + u * ux, cy + u * uy, segment_length * ux / 3.0, segment_length * uy / 3.0};
+      if (follow) {
+        along(sc, cx, cy, ux, uy, &ux, &uy);
+        if (!sc->field_axial) { /* a signed field is followed forward */
+          double vx, vy;
+          lw_field_eval(&sc->field, cx, cy, &vx, &vy);
+          if (vx * ux + vy * uy < 0) {
+            ux = -ux;
+            uy = -uy;
+          }
+        }
+        trace(sc, nd, segments, segment_length, cx, cy, ux, uy);
+      } else {
+        for (size_t k = 0; k <= segments; k++) {
+          double u = ((double)k / (double)segments - 0.5) * L;
+          nd[k] = (lw_node){cx + u * ux, cy + u * uy, segment_length * ux / 3.0, segment_length * uy / 3.0};
+        }
       }
       if (fits(sc, nd, segments)) break;
     }
@@ -60,9 +183,57 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
                    "[init]: spline %zu of length %g mm did not fit inside the boundary in %d tries "
                    "(shorten init.segment_length or init.segments)", i, L, tries);
       lw_splines_free(sp);
+      free(cum);
       return NULL;
     }
     sp->rest_length[i] = L;
   }
+  free(cum);
   return sp;
+}
+
+double lw_init_ink_area(const lw_scene *sc)
+{
+  const lw_boundary *b = &sc->boundary;
+  double sum = 0.0;
+  if (sc->image) {
+    const lw_image *img = sc->image;
+    const lw_image_place *pl = &sc->image_place;
+    for (int j = 0; j < img->height; j++)
+      for (int i = 0; i < img->width; i++) {
+        double x = pl->x0 + (i + 0.5) * pl->pixel, y = pl->y0 + (j + 0.5) * pl->pixel;
+        if (lw_boundary_distance(b, x, y) < 0) sum += 1.0 - img->tone[(size_t)j * (size_t)img->width + (size_t)i];
+      }
+    return sum * pl->pixel * pl->pixel;
+  }
+  /* no picture: the area inside, counted on cells of at most 1/1024 of the
+  ** page's longer side (error below the perimeter times half a cell) */
+  double cell = fmax(sc->width, sc->height) / 1024.0;
+  int nx = (int)ceil(sc->width / cell), ny = (int)ceil(sc->height / cell);
+  double hx = sc->width / nx, hy = sc->height / ny;
+  for (int j = 0; j < ny; j++)
+    for (int i = 0; i < nx; i++)
+      if (lw_boundary_distance(b, (i + 0.5) * hx, (j + 0.5) * hy) < 0) sum += 1.0;
+  return sum * hx * hy;
+}
+
+lw_status lw_init_count(const lw_scene *sc, const lw_params *p, size_t *n, lw_error *err)
+{
+  const lw_param_def *cov = lw_params_find("init", "coverage"), *spl = lw_params_find("init", "splines");
+  char where[LW_PATH_MAX + 32];
+  lw_params_origin(p, cov, where, sizeof where);
+  /* a coverage beside the default count would be ignored without a word */
+  if (p->coverage > 0 && p->splines > 0 && p->line[spl - lw_param_table] == 0)
+    return lw_error_set(err, LW_EINPUT, "%s: key 'init.coverage': sets the number of splines only with "
+                        "init.splines = 0 (its default is %s)", where, spl->def);
+  if (p->splines > 0 || !(p->coverage > 0)) {
+    *n = (size_t)p->splines;
+    return LW_OK;
+  }
+  double want = p->coverage * lw_init_ink_area(sc) / (p->pen_width * p->segments * p->segment_length);
+  if (!(want <= 1e8))
+    return lw_error_set(err, LW_EINPUT, "%s: key 'init.coverage': %g asks for %.3g splines, more than 1e8",
+                        where, p->coverage, want);
+  *n = (size_t)llround(want);
+  return LW_OK;
 }

@@ -264,6 +264,7 @@ static int cmd_run(int argc, char **argv)
     return fail(&err);
   }
   if (!quiet) {
+    if (a.scene.note[0]) fprintf(stderr, "linewise: note: %s\n", a.scene.note);
     fprintf(stderr, "linewise: scene %s, seed %lu, %zu splines, %zu segments, into %s\n", scene, a.seed,
             a.model->sp->n_splines, a.model->sp->n_segments, dir);
     fprintf(stderr, "linewise: resolved parameters:\n");

@@ -35,17 +35,37 @@ const lw_param_def lw_param_table[] = {
       "Page width (set by a named `page`)."),
   NUM("scene", "height", LW_PT_DOUBLE, height, "297", "mm", 0, 1e7, LW_MIN_OPEN,
       "Page height (set by a named `page`)."),
-  CHOICE("scene", "boundary", boundary, "rect", "rect|circle|polygon",
+  CHOICE("scene", "boundary", boundary, "rect", "rect|circle|polygon|mask",
          "Shape of the frame the lines stay inside: the page rectangle inset by `margin`, "
-         "the largest circle inside that rectangle, or `polygon`."),
+         "the largest circle inside that rectangle, `polygon`, or `mask` (the inside of "
+         "`mask`, by its signed distance transform; docs/IMAGES.md)."),
   NUM("scene", "margin", LW_PT_DOUBLE, margin, "10", "mm", 0, 1e7, 0,
-      "Inset of the rect and circle boundaries from the page edge."),
+      "Inset of the rect and circle boundaries from the page edge; the picture of `image` "
+      "(and `mask_image`) is fitted into the page inset by it."),
   STRING("scene", "polygon", polygon, "", "mm",
          "Polygon boundary vertices as `x y x y ...` (at least 3 vertices; either orientation)."),
-  CHOICE("scene", "potential", potential, "constant", "constant|ramp|radial",
+  STRING("scene", "image", image, "", "path",
+         "A picture (PNG, JPEG, BMP, PGM/PPM; gray or colour, with or without alpha) relative to "
+         "the scene file. It is fitted into the page inset by `margin`, centred, aspect kept. "
+         "Its tone feeds potential = image, field = etf and gradient, mask = alpha, and the "
+         "placement of the splines (docs/IMAGES.md). Empty = none."),
+  NUM("scene", "image_max_pixels", LW_PT_DOUBLE, image_max_pixels, "4e6", "pixels", 1, 1e9, 0,
+      "Pictures with more pixels are box-filtered down to this many while they load (a note says so)."),
+  NUM("scene", "image_width", LW_PT_INT, image_width, "0", "pixels", 0, 1e5, 0,
+      "Resample the picture to this width, the height following the aspect ratio; 0 = as loaded."),
+  NUM("scene", "image_blur", LW_PT_DOUBLE, image_blur, "0", "mm", 0, 1e4, 0,
+      "Standard deviation of a Gaussian blur of the tone, in millimetres on the page. 0 = none."),
+  NUM("scene", "image_gamma", LW_PT_DOUBLE, image_gamma, "1", "", 0, 100, LW_MIN_OPEN,
+      "Tone curve t <- t^gamma (after `image_invert`): above 1 darkens the mid-tones."),
+  NUM("scene", "image_contrast", LW_PT_DOUBLE, image_contrast, "1", "", 0, 100, 0,
+      "Tone curve t <- 1/2 + contrast (t - 1/2), clipped to [0, 1] (after the gamma)."),
+  NUM("scene", "image_invert", LW_PT_INT, image_invert, "0", "", 0, 1, 0,
+      "1 = invert the tone first (t <- 1 - t): light parts of the picture get the ink."),
+  CHOICE("scene", "potential", potential, "constant", "constant|ramp|radial|image",
          "Potential Phi read by the potential term: constant `potential_value`; ramp "
          "Phi = 1/2 + 1/2 (r-c).u/h from 0 to 1 across the page along `potential_angle`; "
-         "radial Phi = |r-c|/h. Built only when [energy] potential is non-zero."),
+         "radial Phi = |r-c|/h; image Phi = tone (0 black .. 1 white, 1 beyond the picture). "
+         "Built only when [energy] potential is non-zero."),
   NUM("scene", "potential_value", LW_PT_DOUBLE, potential_value, "1", "", -1e12, 1e12, 0,
       "Phi of the constant potential."),
   NUM("scene", "potential_angle", LW_PT_DOUBLE, potential_angle, "0", "degrees", -360, 360, 0,
@@ -53,12 +73,20 @@ const lw_param_def lw_param_table[] = {
   NUM("scene", "potential_scale", LW_PT_DOUBLE, potential_scale, "0", "mm", 0, 1e7, 0,
       "h of the ramp and radial potentials; 0 = automatic (half the page extent along the ramp; "
       "half the page diagonal for radial)."),
-  CHOICE("scene", "field", field, "constant", "constant|radial|vortex|waves",
+  CHOICE("scene", "field", field, "constant", "constant|radial|vortex|waves|etf|gradient",
          "Vector field v read by the field term (unit length): constant along `field_angle`, "
-         "radial from the centre, vortex around it, or waves tangent to y = A sin(2 pi x / wavelength). "
+         "radial from the centre, vortex around it, waves tangent to y = A sin(2 pi x / wavelength), "
+         "etf (the picture's edge tangent flow: along edges and isophotes; needs field_mode = axial) "
+         "or gradient (the picture's tone gradient, toward lighter tone). "
          "Built only when [energy] field is non-zero."),
   NUM("scene", "field_angle", LW_PT_DOUBLE, field_angle, "0", "degrees", -360, 360, 0,
-      "Direction of the constant field (0 = +x, 90 = +y, down the page)."),
+      "Direction of the constant field, and of etf where the picture is flat (0 = +x, 90 = +y, down the page)."),
+  NUM("scene", "field_sigma", LW_PT_DOUBLE, field_sigma, "2", "mm", 0, 1e4, 0,
+      "etf: standard deviation of the Gaussian that smooths the structure tensor (the scale of "
+      "the structures the flow follows). 0 = none."),
+  NUM("scene", "field_flat", LW_PT_DOUBLE, field_flat, "0.01", "tone/mm", 0, 1e6, 0,
+      "Tone gradient below which the picture counts as flat: etf turns toward `field_angle` there, "
+      "gradient fades to 0."),
   NUM("scene", "field_wavelength", LW_PT_DOUBLE, field_wavelength, "50", "mm", 0, 1e7, LW_MIN_OPEN,
       "Wavelength of the waves field."),
   NUM("scene", "field_amplitude", LW_PT_DOUBLE, field_amplitude, "10", "mm", -1e7, 1e7, 0,
@@ -67,8 +95,20 @@ const lw_param_def lw_param_table[] = {
       "Centre of the radial and vortex presets and of the ramp; -1 = page centre."),
   NUM("scene", "center_y", LW_PT_DOUBLE, center_y, "-1", "mm", -1, 1e7, 0,
       "See center_x."),
+  CHOICE("scene", "mask", mask, "none", "none|alpha|image",
+         "Where the inside of boundary = mask comes from: the alpha channel of `image` "
+         "(opaque is inside), or the picture `mask_image` (opaque and dark is inside). "
+         "Threshold 1/2; fitted into the page like `image`."),
+  STRING("scene", "mask_image", mask_image, "", "path",
+         "The picture of mask = image, relative to the scene file."),
   NUM("init", "splines", LW_PT_INT, splines, "100", "", 0, 1e8, 0,
-      "Number of splines placed at random inside the boundary."),
+      "Number of splines placed at random inside the boundary (weighted by darkness when the "
+      "scene has an image, along the field when the field term is on). 0 with `coverage` > 0: "
+      "as many as the coverage asks for."),
+  NUM("init", "coverage", LW_PT_DOUBLE, coverage, "0", "", 0, 100, 0,
+      "Target ink coverage; needs splines = 0: splines = coverage * (sum of darkness (1 - tone) "
+      "over the inside, mm^2) / (output.pen_width * segments * segment_length); without an "
+      "image the darkness is 1. 0 = off."),
   NUM("init", "segments", LW_PT_INT, segments, "4", "", 1, 1e5, 0,
       "Cubic Bezier segments per spline."),
   NUM("init", "segment_length", LW_PT_DOUBLE, segment_length, "10", "mm", 0, 1e7, LW_MIN_OPEN,
@@ -194,6 +234,9 @@ const lw_param_def lw_param_table[] = {
       "Gaussian blur applied to both the rendered lines and the target tone before the fidelity "
       "score (MSE, SSIM) compares them; about half the widest line spacing that should read as a "
       "flat tone (docs/FORMATS.md)."),
+  NUM("output", "field_preview", LW_PT_INT, field_preview, "0", "", 0, 1, 0,
+      "1 = write field.png at the start of a run: the tone (white without an image) under "
+      "short strokes along the field (needs the field term)."),
 };
 const size_t lw_param_count = sizeof lw_param_table / sizeof lw_param_table[0];
 

@@ -3,16 +3,134 @@
 
 #include <gsl/gsl_math.h>
 #include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/imagefield.h"
+#include "linewise/sdt.h"
+#include "linewise/state.h"
+
 #define DEG (M_PI / 180.0)
+
+/* Every message about a key reads "file:line: key 'section.key': ...". */
+static lw_status bad_key(const lw_params *p, const char *section, const char *key, lw_status code,
+                         lw_error *err, const char *fmt, ...) __attribute__((format(printf, 6, 7)));
+static lw_status bad_key(const lw_params *p, const char *section, const char *key, lw_status code,
+                         lw_error *err, const char *fmt, ...)
+{
+  char where[LW_PATH_MAX + 32], what[LW_ERROR_MSG];
+  lw_params_origin(p, lw_params_find(section, key), where, sizeof where);
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(what, sizeof what, fmt, ap);
+  va_end(ap);
+  return lw_error_set(err, code, "%s: key '%s.%s': %s", where, section, key, what);
+}
+
+/* The margin box: the page inset by `margin`, which frames the rect and
+** circle boundaries and holds the picture. */
+static lw_status margin_ok(const lw_params *p, lw_error *err)
+{
+  if (2 * p->margin >= p->width || 2 * p->margin >= p->height)
+    return bad_key(p, "scene", "margin", LW_EINPUT, err, "expected less than half the page (%g x %g mm), got %g",
+                   p->width, p->height, p->margin);
+  return LW_OK;
+}
+
+/* Loads the picture of key (scene.image or scene.mask_image) at path,
+** relative to the scene file, and fits it into the margin box. */
+static lw_image *load_picture(lw_scene *sc, const lw_params *p, const char *key, const char *path,
+                              lw_image_place *pl, lw_error *err)
+{
+  char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
+  lw_path_dir(dir, sizeof dir, p->file);
+  lw_path_join(full, sizeof full, dir, path);
+  lw_image_info info;
+  lw_error e2;
+  lw_image *img = lw_image_load(full, p->image_max_pixels, &info, &e2);
+  if (!img) {
+    bad_key(p, "scene", key, e2.code, err, "%s", e2.msg);
+    return NULL;
+  }
+  if (img->width != info.width || img->height != info.height) {
+    size_t used = strlen(sc->note);
+    snprintf(sc->note + used, sizeof sc->note - used,
+             "%s%s: %d x %d pixels is more than scene.image_max_pixels (%.0f): downsampled to %d x %d",
+             used ? "; " : "", full, info.width, info.height, p->image_max_pixels, img->width, img->height);
+  }
+  *pl = lw_image_fit(img->width, img->height, p->margin, p->margin, p->width - p->margin,
+                     p->height - p->margin);
+  return img;
+}
+
+/* The picture pipeline after loading: resize, blur, tone curve. */
+static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
+{
+  lw_status st = margin_ok(p, err);
+  if (st) return st;
+  sc->image = load_picture(sc, p, "image", p->image, &sc->image_place, err);
+  if (!sc->image) return err->code;
+  if (p->image_width > 0 && p->image_width != sc->image->width) {
+    double h = (double)sc->image->height * p->image_width / sc->image->width;
+    int hh = h < 1 ? 1 : (int)lround(h);
+    if ((double)p->image_width * hh > p->image_max_pixels)
+      return bad_key(p, "scene", "image_width", LW_EINPUT, err,
+                     "%d x %d pixels is more than scene.image_max_pixels (%.0f)", p->image_width, hh,
+                     p->image_max_pixels);
+    lw_image *r = lw_image_resize(sc->image, p->image_width, hh, err);
+    if (!r) return err->code;
+    lw_image_free(sc->image);
+    sc->image = r;
+    sc->image_place = lw_image_fit(r->width, r->height, p->margin, p->margin, p->width - p->margin,
+                                   p->height - p->margin);
+  }
+  if ((st = lw_image_blur(sc->image, p->image_blur / sc->image_place.pixel, err))) return st;
+  lw_image_tone_curve(sc->image, p->image_gamma, p->image_contrast, p->image_invert);
+  return LW_OK;
+}
+
+/* boundary = mask: inside is alpha >= 1/2 of the picture (mask = alpha) or
+** tone < 1/2 of the mask picture composited over white (mask = image). */
+static lw_status build_mask(lw_scene *sc, const lw_params *p, lw_error *err)
+{
+  if (p->mask == LW_MASK_NONE)
+    return bad_key(p, "scene", "boundary", LW_EINPUT, err, "'mask' needs scene.mask = alpha or image");
+  const lw_image *img = sc->image;
+  lw_image_place pl = sc->image_place;
+  lw_image *own = NULL;
+  if (p->mask == LW_MASK_ALPHA) {
+    if (!img) return bad_key(p, "scene", "mask", LW_EINPUT, err, "'alpha' needs scene.image");
+    if (!img->alpha)
+      return bad_key(p, "scene", "mask", LW_EINPUT, err, "'alpha': %s has no alpha channel", p->image);
+  } else {
+    if (!p->mask_image[0]) return bad_key(p, "scene", "mask", LW_EINPUT, err, "'image' needs scene.mask_image");
+    lw_status st = margin_ok(p, err);
+    if (st) return st;
+    img = own = load_picture(sc, p, "mask_image", p->mask_image, &pl, err);
+    if (!own) return err->code;
+  }
+  size_t n = (size_t)img->width * (size_t)img->height;
+  unsigned char *inside = malloc(n);
+  if (!inside) {
+    lw_image_free(own);
+    return lw_error_set(err, LW_ENOMEM, "out of memory for the mask");
+  }
+  for (size_t k = 0; k < n; k++)
+    inside[k] = p->mask == LW_MASK_ALPHA ? img->alpha[k] >= 0.5f : img->tone[k] < 0.5f;
+  lw_error e2;
+  sc->boundary.kind = LW_BOUNDARY_MASK;
+  sc->boundary.sdt = lw_sdt_grid(inside, img->width, img->height, &pl, &e2);
+  free(inside);
+  lw_image_free(own);
+  if (!sc->boundary.sdt)
+    return bad_key(p, "scene", p->mask == LW_MASK_ALPHA ? "mask" : "mask_image", e2.code, err, "%s", e2.msg);
+  return LW_OK;
+}
 
 static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
 {
-  const lw_param_def *d = lw_params_find("scene", "polygon");
-  char where[LW_PATH_MAX + 32];
-  lw_params_origin(p, d, where, sizeof where);
   size_t cap = 16, n = 0;
   double *v = malloc(cap * sizeof *v);
   if (!v) return lw_error_set(err, LW_ENOMEM, "out of memory reading the polygon");
@@ -24,8 +142,7 @@ static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
     double x = strtod(c, &end);
     if (end == c || !isfinite(x)) {
       free(v);
-      return lw_error_set(err, LW_EINPUT, "%s: key 'scene.polygon': expected numbers 'x y x y ...', got '%s'",
-                          where, c);
+      return bad_key(p, "scene", "polygon", LW_EINPUT, err, "expected numbers 'x y x y ...', got '%s'", c);
     }
     if (n == cap) {
       double *nv = realloc(v, 2 * cap * sizeof *v);
@@ -38,8 +155,8 @@ static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
   }
   lw_status st = LW_OK;
   if (n % 2 || n < 6) {
-    st = lw_error_set(err, LW_EINPUT, "%s: key 'scene.polygon': expected at least 3 vertices as 'x y' pairs, got %zu numbers",
-                      where, n);
+    st = bad_key(p, "scene", "polygon", LW_EINPUT, err,
+                 "expected at least 3 vertices as 'x y' pairs, got %zu numbers", n);
   } else {
     double *xs = malloc(n / 2 * sizeof *xs), *ys = malloc(n / 2 * sizeof *ys);
     if (!xs || !ys) st = lw_error_set(err, LW_ENOMEM, "out of memory reading the polygon");
@@ -47,7 +164,7 @@ static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
       for (size_t i = 0; i < n / 2; i++) { xs[i] = v[2 * i]; ys[i] = v[2 * i + 1]; }
       lw_error e2;
       st = lw_boundary_polygon(&sc->boundary, n / 2, xs, ys, &e2);
-      if (st != LW_OK) lw_error_set(err, st, "%s: key 'scene.polygon': %s", where, e2.msg);
+      if (st != LW_OK) bad_key(p, "scene", "polygon", st, err, "%s", e2.msg);
     }
     free(xs);
     free(ys);
@@ -56,9 +173,8 @@ static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
   return st;
 }
 
-lw_status lw_scene_init(lw_scene *sc, const lw_params *p, lw_error *err)
+static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
 {
-  memset(sc, 0, sizeof *sc);
   sc->width = p->width;
   sc->height = p->height;
   const double coef[LW_TERM_COUNT] = {
@@ -90,6 +206,8 @@ lw_status lw_scene_init(lw_scene *sc, const lw_params *p, lw_error *err)
   double cx = p->center_x >= 0 ? p->center_x : 0.5 * p->width;
   double cy = p->center_y >= 0 ? p->center_y : 0.5 * p->height;
 
+  if (p->image[0] && (st = build_image(sc, p, err))) return st;
+
   if (sc->on[LW_TERM_POTENTIAL]) {
     lw_potential *f = &sc->potential;
     f->cx = cx;
@@ -111,6 +229,11 @@ lw_status lw_scene_init(lw_scene *sc, const lw_params *p, lw_error *err)
       f->kind = LW_POTENTIAL_RADIAL;
       f->scale = p->potential_scale > 0 ? p->potential_scale : 0.5 * hypot(p->width, p->height);
       break;
+    case LW_POT_IMAGE:
+      if (!sc->image) return bad_key(p, "scene", "potential", LW_EINPUT, err, "'image' needs scene.image");
+      f->kind = LW_POTENTIAL_GRID;
+      if (!(f->grid = lw_imagefield_potential(sc->image, &sc->image_place, err))) return err->code;
+      break;
     }
   }
   if (sc->on[LW_TERM_FIELD]) {
@@ -124,22 +247,32 @@ lw_status lw_scene_init(lw_scene *sc, const lw_params *p, lw_error *err)
     static const lw_field_kind kinds[] = {
       [LW_FLD_CONSTANT] = LW_FIELD_CONSTANT, [LW_FLD_RADIAL] = LW_FIELD_RADIAL,
       [LW_FLD_VORTEX] = LW_FIELD_VORTEX, [LW_FLD_WAVES] = LW_FIELD_WAVES,
+      [LW_FLD_ETF] = LW_FIELD_GRID_AXIAL, [LW_FLD_GRADIENT] = LW_FIELD_GRID,
     };
     f->kind = kinds[p->field];
+    if (p->field == LW_FLD_ETF || p->field == LW_FLD_GRADIENT) {
+      const char *name = p->field == LW_FLD_ETF ? "etf" : "gradient";
+      if (!sc->image) return bad_key(p, "scene", "field", LW_EINPUT, err, "'%s' needs scene.image", name);
+      /* the flow has no sign: r'.v would reward either direction at random */
+      if (p->field == LW_FLD_ETF && !sc->field_axial)
+        return bad_key(p, "scene", "field", LW_EINPUT, err,
+                       "'etf' is a direction without sign: it needs energy.field_mode = axial");
+      f->grid = p->field == LW_FLD_ETF
+                ? lw_imagefield_etf(sc->image, &sc->image_place, p->field_sigma, p->field_flat,
+                                    p->field_angle * DEG, err)
+                : lw_imagefield_gradient(sc->image, &sc->image_place, p->field_flat, err);
+      if (!f->grid) return err->code;
+    }
   }
+  if (p->field_preview && !sc->on[LW_TERM_FIELD])
+    return bad_key(p, "output", "field_preview", LW_EINPUT, err,
+                   "the scene has no field to preview (energy.field is 0)");
 
   lw_boundary *b = &sc->boundary;
   switch (p->boundary) {
   case LW_BND_RECT:
   case LW_BND_CIRCLE:
-    if (2 * p->margin >= p->width || 2 * p->margin >= p->height) {
-      const lw_param_def *d = lw_params_find("scene", "margin");
-      char where[LW_PATH_MAX + 32];
-      lw_params_origin(p, d, where, sizeof where);
-      return lw_error_set(err, LW_EINPUT,
-                          "%s: key 'scene.margin': expected less than half the page (%g x %g mm), got %g",
-                          where, p->width, p->height, p->margin);
-    }
+    if ((st = margin_ok(p, err))) return st;
     if (p->boundary == LW_BND_RECT) {
       b->kind = LW_BOUNDARY_RECT;
       b->x0 = p->margin;
@@ -157,8 +290,21 @@ lw_status lw_scene_init(lw_scene *sc, const lw_params *p, lw_error *err)
     st = build_polygon(sc, p, err);
     if (st) return st;
     break;
+  case LW_BND_MASK:
+    if ((st = build_mask(sc, p, err))) return st;
+    break;
   }
+  if (p->boundary != LW_BND_MASK && p->mask != LW_MASK_NONE)
+    return bad_key(p, "scene", "mask", LW_EINPUT, err, "a mask needs scene.boundary = mask");
   return LW_OK;
+}
+
+lw_status lw_scene_init(lw_scene *sc, const lw_params *p, lw_error *err)
+{
+  memset(sc, 0, sizeof *sc);
+  lw_status st = scene_build(sc, p, err);
+  if (st) lw_scene_clear(sc);
+  return st;
 }
 
 void lw_scene_clear(lw_scene *sc)
@@ -166,4 +312,6 @@ void lw_scene_clear(lw_scene *sc)
   lw_potential_clear(&sc->potential);
   lw_field_clear(&sc->field);
   lw_boundary_clear(&sc->boundary);
+  lw_image_free(sc->image);
+  sc->image = NULL;
 }

@@ -57,6 +57,7 @@ typedef struct {
   double wall_start;           /* monotonic clock at start of this process */
   lw_move_stats trace_mark[LW_MOVE_KINDS]; /* stats at the last trace row */
   FILE *trace;
+  lw_grid2d *tone;             /* the picture's tone on the page (fidelity, previews), or NULL */
   lw_drawing_report drawing;   /* pen-up travel and fidelity of the final drawing */
 } lw_anneal;
 

@@ -7,7 +7,10 @@
 **
 ** Kinds: rectangle [x0,x1] x [y0,y1]; circle (centre, radius); simple polygon
 ** (vertices in order, either orientation, closed implicitly; inside by the
-** even-odd rule).  LW_BOUNDARY_NONE means the term is off: distance -infinity.
+** even-odd rule); mask: a signed distance grid read by bilinear interpolation
+** (sdt.h builds it from a picture's mask; lookups beyond the grid read its
+** outermost ring, which is outside).  LW_BOUNDARY_NONE means the term is
+** off: distance -infinity.
 */
 #ifndef LINEWISE_BOUNDARY_H
 #define LINEWISE_BOUNDARY_H
@@ -15,12 +18,14 @@
 #include <stddef.h>
 
 #include "linewise/error.h"
+#include "linewise/field.h"
 
 typedef enum {
   LW_BOUNDARY_NONE,
   LW_BOUNDARY_RECT,
   LW_BOUNDARY_CIRCLE,
-  LW_BOUNDARY_POLYGON
+  LW_BOUNDARY_POLYGON,
+  LW_BOUNDARY_MASK
 } lw_boundary_kind;
 
 typedef struct {
@@ -29,6 +34,7 @@ typedef struct {
   double cx, cy, radius;  /* circle, mm; radius > 0 */
   size_t n;               /* polygon: vertex count (>= 3) */
   double *vx, *vy;        /* polygon: vertices, owned */
+  lw_grid2d *sdt;         /* mask: signed distances, mm, owned (ncomp 1) */
 } lw_boundary;
 
 /* Polygon from n >= 3 vertices (copied).  LW_EINPUT for fewer vertices,

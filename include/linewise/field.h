@@ -17,6 +17,14 @@
 **                       on a y-up page)
 **   field waves         v = (1, k A cos(k x)) / |(1, k A cos(k x))|, k = 2 pi / wavelength:
 **                       the tangents of the curves y = A sin(k x) + const
+**   field grid_axial    a grid of directions without sign (imagefield.h's edge tangent
+**                       flow): a node holds the doubled-angle vector
+**                       m (cos 2t, sin 2t) of the direction t with weight m; bilinear
+**                       interpolation of those, then back to the half angle, gives
+**                       m (cos t, sin t) up to sign.  Interpolating the vectors
+**                       themselves would cancel where neighbours differ only in
+**                       their arbitrary signs.  Only the axial field energy
+**                       (|r'.v|) reads it meaningfully.
 ** Grid values beyond the edge take the value at the nearest edge point, so a
 ** field is defined everywhere; grid data are sanitised on construction (a
 ** non-finite sample becomes 0) so no lookup returns NaN.
@@ -68,7 +76,8 @@ typedef enum {
   LW_FIELD_RADIAL,
   LW_FIELD_VORTEX,
   LW_FIELD_WAVES,
-  LW_FIELD_GRID
+  LW_FIELD_GRID,
+  LW_FIELD_GRID_AXIAL
 } lw_field_kind;
 
 typedef struct {
@@ -77,7 +86,7 @@ typedef struct {
   double cx, cy;       /* radial, vortex: centre, mm */
   double wavelength;   /* waves: mm (> 0) */
   double amplitude;    /* waves: mm */
-  lw_grid2d *grid;     /* grid: owned, ncomp = 2 */
+  lw_grid2d *grid;     /* grid, grid_axial: owned, ncomp = 2 */
 } lw_field;
 
 double lw_potential_eval(const lw_potential *f, double x, double y);

@@ -1,21 +1,43 @@
 /*
-** init.h -- initial states: straight splines placed at random inside the
-** boundary, and the seeds of independent random streams.
+** init.h -- initial states: splines placed at random inside the boundary
+** (weighted by the picture's darkness, shaped along the field), the number
+** of splines from a target ink coverage, and the seeds of independent
+** random streams.
 */
 #ifndef LINEWISE_INIT_H
 #define LINEWISE_INIT_H
 
 #include <gsl/gsl_rng.h>
 
+#include "linewise/params.h"
 #include "linewise/scene.h"
 #include "linewise/spline.h"
 
-/* n splines of `segments` straight segments of `segment_length` mm, each at
-** a uniformly random centre and direction, kept only if its nodes and its
-** quadrature samples lie inside the boundary; the rest length is the
-** spline's length.  LW_EINPUT if a spline does not fit after many tries. */
+/* n splines of `segments` segments of `segment_length` mm, kept only if
+** their nodes and quadrature samples lie inside the boundary; the rest
+** length is segments * segment_length.  The centre of each is uniform over
+** the page, or drawn with density proportional to darkness (1 - tone) when
+** the scene has a picture (uniform again if the picture is white).  Each is
+** straight at a uniformly random angle, or, when the scene's field term is
+** on, follows the streamline of the field through its centre (the random
+** angle then only picks the way along an axial field and stands in where
+** the field vanishes).  LW_EINPUT if a spline does not fit after many
+** tries. */
 lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double segment_length,
                            gsl_rng *rng, lw_error *err);
+
+/* Integral of darkness over the inside of the boundary, mm^2: sum over the
+** picture's pixels whose centre is inside of (1 - tone) * pixel area, or,
+** without a picture, the inside's area. */
+double lw_init_ink_area(const lw_scene *sc);
+
+/* How many splines a run starts with: init.splines, or when that is 0 and
+** init.coverage > 0, the count whose ink (output.pen_width wide, segments *
+** segment_length long each) covers that fraction of the darkness:
+**     n = round(coverage * ink area / (pen_width * segments * segment_length)).
+** LW_EINPUT (naming init.coverage) above 1e8, or when a coverage is given
+** but init.splines was left at its default (the coverage would be ignored). */
+lw_status lw_init_count(const lw_scene *sc, const lw_params *p, size_t *n, lw_error *err);
 
 /* A seed for stream `stream` of a run seeded with `seed` (SplitMix64 of
 ** both), so replicas and the placement get independent, reproducible

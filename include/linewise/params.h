@@ -44,9 +44,10 @@ extern const size_t lw_param_count;
 /* Choice indices (order of the choices strings in params.c). */
 enum { LW_PAGE_CUSTOM, LW_PAGE_A4, LW_PAGE_A3, LW_PAGE_LETTER };
 enum { LW_ORIENT_PORTRAIT, LW_ORIENT_LANDSCAPE };
-enum { LW_BND_RECT, LW_BND_CIRCLE, LW_BND_POLYGON };
-enum { LW_POT_CONSTANT, LW_POT_RAMP, LW_POT_RADIAL };
-enum { LW_FLD_CONSTANT, LW_FLD_RADIAL, LW_FLD_VORTEX, LW_FLD_WAVES };
+enum { LW_BND_RECT, LW_BND_CIRCLE, LW_BND_POLYGON, LW_BND_MASK };
+enum { LW_POT_CONSTANT, LW_POT_RAMP, LW_POT_RADIAL, LW_POT_IMAGE };
+enum { LW_FLD_CONSTANT, LW_FLD_RADIAL, LW_FLD_VORTEX, LW_FLD_WAVES, LW_FLD_ETF, LW_FLD_GRADIENT };
+enum { LW_MASK_NONE, LW_MASK_ALPHA, LW_MASK_IMAGE };
 enum { LW_STRAIN_SPLINE, LW_STRAIN_SEGMENT };
 enum { LW_FIELDMODE_AXIAL, LW_FIELDMODE_SIGNED };
 enum { LW_LADDER_FIXED, LW_LADDER_EQUAL };
@@ -59,17 +60,29 @@ typedef struct {
   int boundary;               /* LW_BND_* */
   double margin;              /* rect and circle inset from the page edge, mm */
   char polygon[LW_PATH_MAX];  /* "x y x y ..." mm, for boundary = polygon */
+  char image[LW_PATH_MAX];    /* picture, relative to the scene file, or empty */
+  double image_max_pixels;    /* downsampling budget, pixels */
+  int image_width;            /* resample to this width, pixels; 0 = keep */
+  double image_blur;          /* Gaussian sigma, mm on the page */
+  double image_gamma;         /* tone curve exponent */
+  double image_contrast;      /* tone curve slope about 1/2 */
+  int image_invert;           /* 1 = t <- 1 - t first */
   int potential;              /* LW_POT_* */
   double potential_value;     /* constant Phi */
   double potential_angle;     /* ramp direction, degrees */
   double potential_scale;     /* ramp half extent / radial radius, mm; 0 = automatic */
   int field;                  /* LW_FLD_* */
-  double field_angle;         /* constant field direction, degrees */
+  double field_angle;         /* constant field direction (etf fallback), degrees */
+  double field_sigma;         /* etf tensor smoothing, mm */
+  double field_flat;          /* etf/gradient flatness threshold, tone per mm */
   double field_wavelength;    /* waves, mm */
   double field_amplitude;     /* waves, mm */
   double center_x, center_y;  /* centre of radial/vortex presets, mm; -1 = page centre */
+  int mask;                   /* LW_MASK_* */
+  char mask_image[LW_PATH_MAX]; /* picture of mask = image */
   /* [init] */
-  int splines;                /* number of splines */
+  int splines;                /* number of splines; 0 with coverage > 0: from the coverage */
+  double coverage;            /* target ink coverage (fraction of the inside) */
   int segments;               /* segments per spline */
   double segment_length;      /* mm */
   char from[LW_PATH_MAX];     /* a state.lw to start from, or empty */
@@ -117,6 +130,7 @@ typedef struct {
   int preview_image;          /* 1 = tone under the previews */
   int frames_every;           /* sweeps between frames; 0 = none */
   double fidelity_sigma;      /* blur before the fidelity score, mm */
+  int field_preview;          /* 1 = write field.png */
 
   /* Where each value came from: the file and line (0 = default, -1 = --set). */
   char file[LW_PATH_MAX];

@@ -2,6 +2,11 @@
 ** scene.h -- everything the energy reads besides the splines: coefficients,
 ** quadrature, fields, boundary, pair settings; built from lw_params.
 **
+** A scene with [scene] image holds the processed picture and where it lies
+** on the page (docs/IMAGES.md has the pipeline: load, downsample, resize,
+** blur, tone curve); the potential, the field and the mask boundary are
+** built from it when the scene asks for them.
+**
 ** Only what the scene names is built: the potential exists only when its
 ** coefficient Q is non-zero, the vector field only when P is, and so on; a
 ** term that is off is never evaluated (lw_scene.local lists the per-segment
@@ -12,6 +17,7 @@
 
 #include "linewise/boundary.h"
 #include "linewise/field.h"
+#include "linewise/image.h"
 #include "linewise/pair.h"
 #include "linewise/params.h"
 #include "linewise/quad.h"
@@ -31,6 +37,10 @@ typedef struct lw_scene {
   lw_boundary boundary;         /* the frame (also used for placement) */
   int n_local;                  /* per-segment terms that are on ... */
   lw_term_id local[LW_TERM_COUNT]; /* ... and which */
+  lw_image *image;              /* the processed picture (owned), or NULL */
+  lw_image_place image_place;   /* where it lies on the page */
+  char note[LW_ERROR_MSG];      /* something the user should know (a picture was
+                                   downsampled), or empty; the CLI prints it */
 } lw_scene;
 
 /* Builds the scene; messages name the parameter's file and line. */

@@ -1,0 +1,105 @@
+/*
+** image.h -- a picture as a plane of tone: loading (stb_image), resampling,
+** Gaussian blur, the tone curve, and where the picture sits on the page.
+**
+** Tone is a float per pixel in [0, 1]: 0 black .. 1 white, row 0 at the top
+** (the page's y points down, so nothing is flipped).  Colour becomes tone by
+** the Rec. 709 luma weights applied to the stored (gamma-encoded) values,
+**     tone = 0.2126 R + 0.7152 G + 0.0722 B,
+** which is how bright the picture looks, not how much light it emits: ink
+** density should follow the look.  A picture with an alpha channel keeps it
+** in its own plane; its tone is composited over white paper first
+** (tone = a t + 1 - a), so a transparent pixel asks for no ink.
+**
+** Memory: loading holds the whole file, then stb_image's decoded buffer of
+** width * height * channels bytes (twice that for 16-bit PNG) -- the peak --
+** and builds the float planes from it row by row, already downsampled to the
+** pixel budget, so no full-size float plane of a huge picture ever exists.
+** Pictures above LW_IMAGE_MAX_PIXELS are refused before decoding.
+*/
+#ifndef LINEWISE_IMAGE_H
+#define LINEWISE_IMAGE_H
+
+#include <stddef.h>
+
+#include "linewise/error.h"
+#include "linewise/field.h"
+
+#define LW_IMAGE_MAX_PIXELS 1e9            /* refused before decoding */
+#define LW_IMAGE_MAX_FILE_BYTES (1L << 30) /* 1 GiB: refused before reading */
+
+typedef struct {
+  int width, height;  /* pixels, >= 1 */
+  float *tone;        /* width * height, row-major: 0 black .. 1 white */
+  float *alpha;       /* same layout, 0 transparent .. 1 opaque; NULL if none */
+} lw_image;
+
+/* What the file held before any downsampling. */
+typedef struct {
+  int width, height;  /* pixels */
+  int channels;       /* 1 gray, 2 gray+alpha, 3 RGB, 4 RGBA */
+  int bits;           /* 8 or 16 per channel */
+} lw_image_info;
+
+/* A w x h image with the tone plane white (1) and, if with_alpha, an alpha
+** plane that is opaque (1).  NULL and err set on failure. */
+lw_image *lw_image_new(int w, int h, int with_alpha, lw_error *err);
+void lw_image_free(lw_image *img);
+
+/* Decodes a PNG, JPEG, BMP or PGM/PPM file held in memory; `name` only
+** labels messages.  If the picture has more than max_pixels pixels it is
+** box-filtered down (same aspect ratio) to at most max_pixels while it is
+** converted.  info (may be NULL) receives what the file held.  LW_EINPUT for
+** anything that is not a decodable picture, naming `name` and the decoder's
+** reason. */
+lw_image *lw_image_decode(const unsigned char *data, size_t size, const char *name,
+                          double max_pixels, lw_image_info *info, lw_error *err);
+
+/* Reads path whole, then lw_image_decode.  An empty, unreadable or missing
+** file is LW_EINPUT with a message naming path. */
+lw_image *lw_image_load(const char *path, double max_pixels, lw_image_info *info,
+                        lw_error *err);
+
+/* A new w x h image resampled from src, each axis on its own: shrinking
+** averages the source area each new pixel covers (a box filter with
+** fractional edges: the mean tone is kept exactly), enlarging interpolates
+** linearly between pixel centres. */
+lw_image *lw_image_resize(const lw_image *src, int w, int h, lw_error *err);
+
+/* Gaussian blur of the tone plane with standard deviation sigma pixels
+** (<= 0: nothing), separable, the kernel cut at 4 sigma and normalised.  The
+** picture is mirrored at its edges (half-sample symmetric), which makes the
+** blur conserve the mean tone exactly. */
+lw_status lw_image_blur(lw_image *img, double sigma, lw_error *err);
+
+/* The same blur on any w x h float plane (the field code smooths its
+** structure tensor with it). */
+lw_status lw_image_blur_plane(float *plane, int w, int h, double sigma, lw_error *err);
+
+/* The tone curve, in this order:
+**     t <- 1 - t                         if invert
+**     t <- t^gamma                       (gamma > 1 darkens the mid-tones)
+**     t <- clamp(1/2 + contrast (t - 1/2), 0, 1)
+*/
+void lw_image_tone_curve(lw_image *img, double gamma, double contrast, int invert);
+
+/* Where the picture lies on the page: pixel (i, j) covers the square of side
+** `pixel` mm whose top-left corner is (x0 + i pixel, y0 + j pixel). */
+typedef struct {
+  double x0, y0;  /* top-left corner of the picture, mm */
+  double pixel;   /* side of a pixel, mm */
+} lw_image_place;
+
+/* The largest placement of a w x h picture inside the box [bx0, bx1] x
+** [by0, by1] that keeps its aspect ratio, centred in the box. */
+lw_image_place lw_image_fit(int w, int h, double bx0, double by0, double bx1, double by1);
+
+/* Tone at a page point by bilinear interpolation between pixel centres; 1
+** (white paper) outside the picture. */
+double lw_image_tone_at(const lw_image *img, const lw_image_place *pl, double x, double y);
+
+/* The tone as a raster on the page (fidelity.h): one node per pixel centre,
+** spacing pl->pixel.  NULL and err set when out of memory. */
+lw_grid2d *lw_image_tone_grid(const lw_image *img, const lw_image_place *pl, lw_error *err);
+
+#endif

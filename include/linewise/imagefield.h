@@ -1,0 +1,50 @@
+/*
+** imagefield.h -- what the energy reads, made from a picture placed on the
+** page (image.h): the potential grid, the edge tangent flow and the
+** gradient field.  Units: page millimetres; tone gradients in tone per mm.
+**
+** Potential: Phi = tone at the pixel centres (0 black .. 1 white, so dark
+** is low and attracts lines when Q > 0), with one ring of white (1) around
+** the picture: outside it the paper is white and lookups, which clamp to
+** the grid's edge, read 1.
+**
+** Gradient g = grad tone by the Sobel operator (3 x 3, the picture's edge
+** pixels repeated beyond it), pointing toward lighter tone.
+**
+** Edge tangent flow (ETF): the direction along edges and isophotes.  The
+** structure tensor J = g g^T is smoothed by a Gaussian of sigma_mm; its
+** eigenvector of the smaller eigenvalue is the direction in which the tone
+** changes least.  J's doubled-angle vector (J11 - J22, 2 J12) has the angle
+** 2 theta of the gradient direction and the length lambda1 - lambda2 (how
+** much one direction dominates), so the tangent's doubled angle is that
+** vector turned by 180 degrees.  Where the picture is flat the tensor
+** vanishes and the direction is undefined; there the tensor of a weak
+** fallback structure, flat^2 n n^T with n normal to the direction `angle`, takes
+** over:
+**     T = (J22 - J11 + flat^2 cos 2a,  -2 J12 + flat^2 sin 2a),
+** normalised, stored as an LW_FIELD_GRID_AXIAL grid of unit length.  Where
+** the image's anisotropy (in (tone/mm)^2) is well above flat^2 the image
+** decides, where it is well below the fallback does, and in between the two
+** blend smoothly.  The field thus has unit length everywhere: the field
+** energy weighs alignment equally on the whole page.  Beyond the picture
+** the grid's edge values continue (lookups clamp).
+**
+** Gradient field: v = g / max(|g|, flat), a signed LW_FIELD_GRID: unit
+** length where the tone changes faster than `flat` per mm, fading to 0
+** where the picture is flat (a gradient has no direction there).
+*/
+#ifndef LINEWISE_IMAGEFIELD_H
+#define LINEWISE_IMAGEFIELD_H
+
+#include "linewise/field.h"
+#include "linewise/image.h"
+
+lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, lw_error *err);
+
+/* angle: the fallback direction, radians (0 = +x, pi/2 = +y, down). */
+lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, double sigma_mm, double flat,
+                             double angle, lw_error *err);
+
+lw_grid2d *lw_imagefield_gradient(const lw_image *img, const lw_image_place *pl, double flat, lw_error *err);
+
+#endif

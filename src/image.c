@@ -1,0 +1,597 @@
+/*
+** image.c -- pictures as planes of tone: loading, resampling, blur and the
+** tone curve (image.h).
+**
+** Resampling is separable and streamed: every output pixel is a weighted sum
+** of source pixels, the weights ("taps") factor into a column part and a row
+** part, and source rows are fed one at a time.  A row is first resampled
+** along x, then added with its row weights into every output row it feeds.
+** The loader feeds rows straight from stb_image's buffer, so a picture far
+** above the pixel budget never exists as a full-size float plane.
+*/
+#include "linewise/image.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <stb/stb_image.h>
+
+static float *plane_alloc(int w, int h)
+{
+  size_t n = (size_t)w * (size_t)h;
+  if (w < 1 || h < 1 || n > SIZE_MAX / sizeof(float)) return NULL;
+  return malloc(n * sizeof(float));
+}
+
+static void plane_fill(float *p, size_t n, float v)
+{
+  for (size_t k = 0; k < n; k++) p[k] = v;
+}
+
+lw_image *lw_image_new(int w, int h, int with_alpha, lw_error *err)
+{
+  if (w < 1 || h < 1) {
+    lw_error_set(err, LW_EINPUT, "an image of %d x %d pixels is empty", w, h);
+    return NULL;
+  }
+  lw_image *img = calloc(1, sizeof *img);
+  if (!img) goto nomem;
+  img->width = w;
+  img->height = h;
+  img->tone = plane_alloc(w, h);
+  if (with_alpha) img->alpha = plane_alloc(w, h);
+  if (!img->tone || (with_alpha && !img->alpha)) {
+    lw_image_free(img);
+    goto nomem;
+  }
+  size_t n = (size_t)w * (size_t)h;
+  plane_fill(img->tone, n, 1.0f);
+  if (img->alpha) plane_fill(img->alpha, n, 1.0f);
+  return img;
+nomem:
+  lw_error_set(err, LW_ENOMEM, "out of memory for an image of %d x %d pixels", w, h);
+  return NULL;
+}
+
+void lw_image_free(lw_image *img)
+{
+  if (!img) return;
+  free(img->tone);
+  free(img->alpha);
+  free(img);
+}
+
+/* ---- separable resampling ------------------------------------------- */
+
+/* The taps of one axis: output k reads source idx[t] with weight w[t] for
+** t in [start[k], start[k + 1]). */
+typedef struct {
+  int *start, *idx;
+  float *w;
+} axis_taps;
+
+static void taps_free(axis_taps *t)
+{
+  free(t->start);
+  free(t->idx);
+  free(t->w);
+}
+
+/* Shrinking (n_out <= n_in): output k covers the source interval
+** [k r, (k + 1) r), r = n_in / n_out, and averages it, partial pixels at
+** its ends weighted by the overlap -- every source pixel then gives weight
+** 1/r in all, so the mean is kept.  Enlarging: linear interpolation at
+** the output pixel's centre, (k + 1/2) r - 1/2 in source pixel units,
+** clamped to the first and last source centres. */
+static int taps_build(axis_taps *t, int n_in, int n_out)
+{
+  const double r = (double)n_in / (double)n_out;
+  size_t per = r >= 1.0 ? (size_t)ceil(r) + 2 : 2, cap = per * (size_t)n_out;
+  t->start = malloc(((size_t)n_out + 1) * sizeof *t->start);
+  t->idx = malloc(cap * sizeof *t->idx);
+  t->w = malloc(cap * sizeof *t->w);
+  if (!t->start || !t->idx || !t->w) return 0;
+  int n = 0;
+  for (int k = 0; k < n_out; k++) {
+    t->start[k] = n;
+    if (r >= 1.0) {
+      double a = (double)k * n_in / n_out, b = (double)(k + 1) * n_in / n_out;
+      int last = (int)ceil(b) - 1;
+      if (last > n_in - 1) last = n_in - 1;
+      for (int i = (int)floor(a); i <= last; i++) {
+        double overlap = fmin(i + 1.0, b) - fmax((double)i, a);
+        if (overlap > 0) {
+          t->idx[n] = i;
+          t->w[n++] = (float)(overlap / r);
+        }
+      }
+    } else {
+      double u = (k + 0.5) * r - 0.5;
+      if (u < 0) u = 0;
+      if (u > n_in - 1) u = n_in - 1;
+      int i0 = (int)floor(u);
+      double f = u - i0;
+      t->idx[n] = i0;
+      t->w[n++] = (float)(1.0 - f);
+      if (i0 + 1 < n_in && f > 0) {
+        t->idx[n] = i0 + 1;
+        t->w[n++] = (float)f;
+      }
+    }
+  }
+  t->start[n_out] = n;
+  return 1;
+}
+
+typedef struct {
+  int w_in, h_in, w_out, h_out;
+  axis_taps x;           /* per output column */
+  int *rstart;       /* h_in + 1: source row j feeds the entries [rstart[j], rstart[j+1]) */
+  int *rout;         /* ... of output row rout[e] */
+  float *rw;         /* ... with weight rw[e] */
+  float *hrow;       /* w_out scratch */
+} resampler;
+
+static void resampler_free(resampler *rs)
+{
+  taps_free(&rs->x);
+  free(rs->rstart);
+  free(rs->rout);
+  free(rs->rw);
+  free(rs->hrow);
+}
+
+/* The row taps are built per output row, then turned around (a counting
+** sort by source row) so that each source row knows where it goes. */
+static lw_status resampler_init(resampler *rs, int w_in, int h_in, int w_out, int h_out, lw_error *err)
+{
+  memset(rs, 0, sizeof *rs);
+  rs->w_in = w_in;
+  rs->h_in = h_in;
+  rs->w_out = w_out;
+  rs->h_out = h_out;
+  axis_taps y = {0};
+  int ok = taps_build(&rs->x, w_in, w_out) && taps_build(&y, h_in, h_out);
+  if (ok) {
+    int n = y.start[h_out];
+    rs->rstart = calloc((size_t)h_in + 1, sizeof *rs->rstart);
+    rs->rout = malloc(((size_t)n + 1) * sizeof *rs->rout);
+    rs->rw = malloc(((size_t)n + 1) * sizeof *rs->rw);
+    rs->hrow = malloc((size_t)w_out * sizeof *rs->hrow);
+    ok = rs->rstart && rs->rout && rs->rw && rs->hrow;
+    if (ok) {
+      for (int e = 0; e < n; e++) rs->rstart[y.idx[e] + 1]++;
+      for (int j = 0; j < h_in; j++) rs->rstart[j + 1] += rs->rstart[j];
+      int *fill = malloc(((size_t)h_in + 1) * sizeof *fill);
+      ok = fill != NULL;
+      if (ok) {
+        memcpy(fill, rs->rstart, ((size_t)h_in + 1) * sizeof *fill);
+        for (int k = 0; k < h_out; k++)
+          for (int e = y.start[k]; e < y.start[k + 1]; e++) {
+            int slot = fill[y.idx[e]]++;
+            rs->rout[slot] = k;
+            rs->rw[slot] = y.w[e];
+          }
+        free(fill);
+      }
+    }
+  }
+  taps_free(&y);
+  if (!ok) {
+    resampler_free(rs);
+    return lw_error_set(err, LW_ENOMEM, "out of memory resampling %d x %d to %d x %d pixels", w_in, h_in,
+                        w_out, h_out);
+  }
+  return LW_OK;
+}
+
+/* Adds source row j (w_in values) into the output plane (w_out x h_out,
+** zeroed before the first row). */
+static void resampler_add_row(resampler *rs, int j, const float *row, float *out)
+{
+  const axis_taps *x = &rs->x;
+  for (int k = 0; k < rs->w_out; k++) {
+    float s = 0.0f;
+    for (int t = x->start[k]; t < x->start[k + 1]; t++) s += x->w[t] * row[x->idx[t]];
+    rs->hrow[k] = s;
+  }
+  for (int e = rs->rstart[j]; e < rs->rstart[j + 1]; e++) {
+    float *o = out + (size_t)rs->rout[e] * (size_t)rs->w_out, w = rs->rw[e];
+    for (int k = 0; k < rs->w_out; k++) o[k] += w * rs->hrow[k];
+  }
+}
+
+static void plane_clamp01(float *p, size_t n)
+{
+  for (size_t k = 0; k < n; k++) p[k] = p[k] < 0.0f ? 0.0f : (p[k] > 1.0f ? 1.0f : p[k]);
+}
+
+lw_image *lw_image_resize(const lw_image *src, int w, int h, lw_error *err)
+{
+  lw_image *img = lw_image_new(w, h, src->alpha != NULL, err);
+  if (!img) return NULL;
+  resampler rs;
+  if (resampler_init(&rs, src->width, src->height, w, h, err)) {
+    lw_image_free(img);
+    return NULL;
+  }
+  size_t n = (size_t)w * (size_t)h, sw = (size_t)src->width;
+  plane_fill(img->tone, n, 0.0f);
+  if (img->alpha) plane_fill(img->alpha, n, 0.0f);
+  for (int j = 0; j < src->height; j++) {
+    resampler_add_row(&rs, j, src->tone + (size_t)j * sw, img->tone);
+    if (img->alpha) resampler_add_row(&rs, j, src->alpha + (size_t)j * sw, img->alpha);
+  }
+  resampler_free(&rs);
+  /* float sums of weights that add to 1 can land a hair outside [0, 1] */
+  plane_clamp01(img->tone, n);
+  if (img->alpha) plane_clamp01(img->alpha, n);
+  return img;
+}
+
+/* ---- loading -------------------------------------------------------- */
+
+/* Source row j of a decoded buffer as tone and alpha in [0, 1]; alpha is
+** written only for 2 and 4 channels.  Tone is composited over white. */
+static void decoded_row(const void *pix, int bits, int w, int ch, int j, float *tone, float *alpha)
+{
+  const float scale = bits == 16 ? 1.0f / 65535.0f : 1.0f / 255.0f;
+  size_t base = (size_t)j * (size_t)w * (size_t)ch;
+  for (int i = 0; i < w; i++) {
+    float c[4] = {0, 0, 0, 0};
+    for (int k = 0; k < ch; k++) {
+      size_t at = base + (size_t)i * (size_t)ch + (size_t)k;
+      c[k] = scale * (bits == 16 ? (float)((const uint16_t *)pix)[at] : (float)((const unsigned char *)pix)[at]);
+    }
+    float g = ch >= 3 ? 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2] : c[0];
+    float a = ch == 2 ? c[1] : ch == 4 ? c[3] : 1.0f;
+    tone[i] = a * g + (1.0f - a);
+    if (ch == 2 || ch == 4) alpha[i] = a;
+  }
+}
+
+/* Decoded pixels: w x h samples of ch channels, 8 or 16 bits each. */
+typedef struct {
+  const void *pix;
+  void *owned;       /* what to free: stb's buffer, ours, or NULL (pix points into the file) */
+  int from_stb;
+  int w, h, ch, bits;
+} decoded;
+
+static void decoded_free(decoded *d)
+{
+  if (d->from_stb) stbi_image_free(d->owned);
+  else free(d->owned);
+}
+
+/* Binary netpbm (P5 gray, P6 RGB), read here rather than by stb_image,
+** whose version in Debian reads 16-bit samples in the wrong byte order,
+** ignores maxval and does not notice a truncated raster.  The header is
+** "P5" or "P6", then width, height and maxval separated by white space and
+** '#' comments, then one white space character and the raster, row 0 first,
+** 16-bit samples big-endian when maxval > 255. */
+static int pnm_number(const unsigned char *d, size_t n, size_t *at, long *v)
+{
+  for (;;) {
+    while (*at < n && strchr(" \t\r\n\v\f", d[*at]) && d[*at]) (*at)++;
+    if (*at < n && d[*at] == '#')
+      while (*at < n && d[*at] != '\n') (*at)++;
+    else break;
+  }
+  if (*at >= n || d[*at] < '0' || d[*at] > '9') return 0;
+  *v = 0;
+  while (*at < n && d[*at] >= '0' && d[*at] <= '9') {
+    *v = 10 * *v + (d[*at] - '0');
+    if (*v > 1L << 30) return 0;
+    (*at)++;
+  }
+  return 1;
+}
+
+static lw_status pnm_decode(const unsigned char *d, size_t n, const char *name, decoded *out, lw_error *err)
+{
+  size_t at = 2;
+  long w, h, maxval;
+  if (!pnm_number(d, n, &at, &w) || !pnm_number(d, n, &at, &h) || !pnm_number(d, n, &at, &maxval) || at >= n ||
+      !strchr(" \t\r\n\v\f", d[at]) || !d[at])
+    return lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads: a malformed PGM/PPM header", name);
+  at++;
+  if (w < 1 || h < 1 || maxval < 1 || maxval > 65535)
+    return lw_error_set(err, LW_EINPUT, "%s: PGM/PPM of %ld x %ld pixels, maxval %ld: expected sizes >= 1 and "
+                        "maxval 1 to 65535", name, w, h, maxval);
+  if ((double)w * (double)h > LW_IMAGE_MAX_PIXELS)
+    return lw_error_set(err, LW_EINPUT, "%s: %ld x %ld pixels is more than the %.0e pixels linewise decodes", name,
+                        w, h, LW_IMAGE_MAX_PIXELS);
+  int ch = d[1] == '6' ? 3 : 1, wide = maxval > 255;
+  size_t samples = (size_t)w * (size_t)h * (size_t)ch, bytes = samples * (wide ? 2 : 1);
+  if (n - at < bytes)
+    return lw_error_set(err, LW_EINPUT, "%s: truncated: %zu of the %zu bytes of pixels are there", name, n - at,
+                        bytes);
+  *out = (decoded){d + at, NULL, 0, (int)w, (int)h, ch, 8};
+  if (maxval == 255) return LW_OK; /* the raster is already what decoded_row reads */
+  uint16_t *v = malloc(samples * sizeof *v);
+  if (!v) return lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu samples", name, samples);
+  const unsigned char *r = d + at;
+  for (size_t k = 0; k < samples; k++) {
+    long x = wide ? (long)r[2 * k] << 8 | r[2 * k + 1] : (long)r[k];
+    if (x > maxval) x = maxval;
+    v[k] = (uint16_t)((x * 65535 + maxval / 2) / maxval);
+  }
+  *out = (decoded){v, v, 0, (int)w, (int)h, ch, 16};
+  return LW_OK;
+}
+
+static uint32_t le32(const unsigned char *p)
+{
+  return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+/* stb_image reads missing bytes at the end of a BMP as zeros; an
+** uncompressed one (BI_RGB or BI_BITFIELDS) must hold its whole raster:
+** |height| rows of width * bpp bits, padded to 4 bytes, after the offset. */
+static lw_status bmp_complete(const unsigned char *d, size_t n, const char *name, lw_error *err)
+{
+  if (n < 30 || d[0] != 'B' || d[1] != 'M' || le32(d + 14) < 40) return LW_OK;
+  uint32_t offset = le32(d + 10), compression = n >= 34 ? le32(d + 30) : 0;
+  int32_t w = (int32_t)le32(d + 18), h = (int32_t)le32(d + 22);
+  unsigned bpp = (unsigned)d[28] | (unsigned)d[29] << 8;
+  if (compression != 0 && compression != 3) return LW_OK;
+  double row = 4.0 * floor(((double)bpp * fabs((double)w) + 31) / 32), need = offset + row * fabs((double)h);
+  if ((double)n < need)
+    return lw_error_set(err, LW_EINPUT, "%s: truncated: the BMP needs %.0f bytes, the file has %zu", name, need, n);
+  return LW_OK;
+}
+
+static lw_status stb_decode(const unsigned char *data, size_t size, const char *name, decoded *out, lw_error *err)
+{
+  if (size > INT_MAX)
+    return lw_error_set(err, LW_EINPUT, "%s: a file of %zu bytes is too large for the image decoder", name, size);
+  int w, h, ch;
+  if (!stbi_info_from_memory(data, (int)size, &w, &h, &ch))
+    return lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, BMP, PGM/PPM): %s", name,
+                        stbi_failure_reason());
+  if ((double)w * (double)h > LW_IMAGE_MAX_PIXELS)
+    return lw_error_set(err, LW_EINPUT, "%s: %d x %d pixels is more than the %.0e pixels linewise decodes", name,
+                        w, h, LW_IMAGE_MAX_PIXELS);
+  lw_status st = bmp_complete(data, size, name, err);
+  if (st) return st;
+  int bits = stbi_is_16_bit_from_memory(data, (int)size) ? 16 : 8;
+  void *pix = bits == 16 ? (void *)stbi_load_16_from_memory(data, (int)size, &w, &h, &ch, 0)
+                         : (void *)stbi_load_from_memory(data, (int)size, &w, &h, &ch, 0);
+  if (!pix) return lw_error_set(err, LW_EINPUT, "%s: cannot decode the image: %s", name, stbi_failure_reason());
+  *out = (decoded){pix, pix, 1, w, h, ch, bits};
+  return LW_OK;
+}
+
+lw_image *lw_image_decode(const unsigned char *data, size_t size, const char *name,
+                          double max_pixels, lw_image_info *info, lw_error *err)
+{
+  if (size == 0) {
+    lw_error_set(err, LW_EINPUT, "%s: empty file (0 bytes), not an image", name);
+    return NULL;
+  }
+  decoded dec;
+  int pnm = size >= 2 && data[0] == 'P' && (data[1] == '5' || data[1] == '6');
+  if ((pnm ? pnm_decode : stb_decode)(data, size, name, &dec, err)) return NULL;
+  const int w = dec.w, h = dec.h, ch = dec.ch, bits = dec.bits;
+  if (info) *info = (lw_image_info){w, h, ch, bits};
+
+  int w2 = w, h2 = h;
+  if (max_pixels >= 1 && (double)w * (double)h > max_pixels) {
+    double f = sqrt(max_pixels / ((double)w * (double)h));
+    w2 = (int)floor(w * f);
+    h2 = (int)floor(h * f);
+    if (w2 < 1) w2 = 1;
+    if (h2 < 1) h2 = 1;
+  }
+  int has_alpha = ch == 2 || ch == 4;
+  lw_image *img = lw_image_new(w2, h2, has_alpha, err);
+  float *row = malloc(2 * (size_t)w * sizeof *row);
+  resampler rs;
+  int rs_ok = img && row && resampler_init(&rs, w, h, w2, h2, err) == LW_OK;
+  if (!rs_ok) {
+    if (img && !row) lw_error_set(err, LW_ENOMEM, "%s: out of memory converting the image", name);
+    free(row);
+    lw_image_free(img);
+    decoded_free(&dec);
+    return NULL;
+  }
+  size_t n = (size_t)w2 * (size_t)h2;
+  plane_fill(img->tone, n, 0.0f);
+  if (has_alpha) plane_fill(img->alpha, n, 0.0f);
+  for (int j = 0; j < h; j++) {
+    decoded_row(dec.pix, bits, w, ch, j, row, row + w);
+    resampler_add_row(&rs, j, row, img->tone);
+    if (has_alpha) resampler_add_row(&rs, j, row + w, img->alpha);
+  }
+  resampler_free(&rs);
+  free(row);
+  decoded_free(&dec);
+  plane_clamp01(img->tone, n);
+  if (has_alpha) plane_clamp01(img->alpha, n);
+  return img;
+}
+
+lw_image *lw_image_load(const char *path, double max_pixels, lw_image_info *info, lw_error *err)
+{
+  FILE *f = fopen(path, "rb");
+  if (!f) {
+    lw_error_set(err, LW_EINPUT, "%s: cannot open the image: %s", path, strerror(errno));
+    return NULL;
+  }
+  struct stat sb;
+  if (fstat(fileno(f), &sb) || !S_ISREG(sb.st_mode)) {
+    lw_error_set(err, LW_EINPUT, "%s: not a regular file, so not an image", path);
+    fclose(f);
+    return NULL;
+  }
+  if (sb.st_size > LW_IMAGE_MAX_FILE_BYTES) {
+    lw_error_set(err, LW_EINPUT, "%s: a file of %lld bytes is larger than the %ld bytes linewise reads", path,
+                 (long long)sb.st_size, LW_IMAGE_MAX_FILE_BYTES);
+    fclose(f);
+    return NULL;
+  }
+  size_t size = (size_t)sb.st_size;
+  unsigned char *data = malloc(size ? size : 1);
+  if (!data) {
+    lw_error_set(err, LW_ENOMEM, "%s: out of memory reading %zu bytes", path, size);
+    fclose(f);
+    return NULL;
+  }
+  size_t got = fread(data, 1, size, f);
+  int bad = ferror(f), e = errno;
+  fclose(f);
+  if (bad || got != size) {
+    lw_error_set(err, LW_EINPUT, "%s: cannot read the image: %s", path, bad ? strerror(e) : "file changed while read");
+    free(data);
+    return NULL;
+  }
+  lw_image *img = lw_image_decode(data, size, path, max_pixels, info, err);
+  free(data);
+  return img;
+}
+
+/* ---- blur ------------------------------------------------------------- */
+
+/* Half-sample symmetric reflection of index i onto [0, n): ... 1 0 | 0 1 ...
+** n-1 | n-1 n-2 ...; periodic with period 2n, so any offset is fine. */
+static int reflect(long i, int n)
+{
+  long m = i % (2L * n);
+  if (m < 0) m += 2L * n;
+  return (int)(m < n ? m : 2L * n - 1 - m);
+}
+
+/* One axis of the blur over `count` lines of length n: element i of line l
+** sits at p[l * lstride + i * estride], and
+**     out[x] = sum_t kern[t] ext[x + t],   ext[i] = line[reflect(i - off)].
+** The mirrored line is built in scratch first, so the inner loop is a plain
+** dot product and the line can be overwritten in place.  Lines are
+** independent, so threads share them out without changing a single value. */
+static lw_status blur_axis(float *p, int n, int count, size_t estride, size_t lstride, const double *kern,
+                           int taps, int off)
+{
+  int failed = 0;
+#pragma omp parallel reduction(| : failed)
+  {
+    float *ext = malloc(((size_t)n + (size_t)taps) * sizeof *ext);
+    failed = !ext;
+    if (ext) {
+#pragma omp for schedule(static)
+      for (int l = 0; l < count; l++) {
+        float *q = p + (size_t)l * lstride;
+        for (int i = 0; i < n + taps - 1; i++) ext[i] = q[(size_t)reflect((long)i - off, n) * estride];
+        for (int x = 0; x < n; x++) {
+          double s = 0.0;
+          for (int t = 0; t < taps; t++) s += kern[t] * ext[x + t];
+          q[(size_t)x * estride] = (float)s;
+        }
+      }
+    }
+    free(ext);
+  }
+  return failed ? LW_ENOMEM : LW_OK;
+}
+
+/* The kernel of one axis of length n.  Since the mirrored signal has
+** period 2n, a kernel wider than that folds onto 2n taps (weights whose
+** offsets agree mod 2n add up): the cost per pixel stays below 2n. */
+static double *blur_kernel(double sigma, int n, int *taps, int *off)
+{
+  long R = (long)ceil(4.0 * sigma);
+  double *g = malloc((2 * (size_t)R + 1) * sizeof *g);
+  if (!g) return NULL;
+  double sum = 0.0;
+  for (long d = -R; d <= R; d++) sum += g[d + R] = exp(-0.5 * (double)(d * d) / (sigma * sigma));
+  for (long d = 0; d <= 2 * R; d++) g[d] /= sum;
+  if (2 * R + 1 <= 2L * n) {
+    *taps = (int)(2 * R + 1);
+    *off = (int)R;
+    return g;
+  }
+  double *f = calloc(2 * (size_t)n, sizeof *f);
+  if (f)
+    for (long d = -R; d <= R; d++) {
+      long m = d % (2L * n);
+      f[m < 0 ? m + 2L * n : m] += g[d + R];
+    }
+  free(g);
+  *taps = 2 * n;
+  *off = 0;
+  return f;
+}
+
+lw_status lw_image_blur_plane(float *plane, int w, int h, double sigma, lw_error *err)
+{
+  if (!(sigma > 0)) return LW_OK;
+  if (!isfinite(sigma)) return lw_error_set(err, LW_EINPUT, "blur of sigma %g pixels", sigma);
+  int tx, ox, ty, oy;
+  double *kx = blur_kernel(sigma, w, &tx, &ox), *ky = blur_kernel(sigma, h, &ty, &oy);
+  lw_status s = kx && ky ? LW_OK : LW_ENOMEM;
+  if (!s) s = blur_axis(plane, w, h, 1, (size_t)w, kx, tx, ox); /* rows */
+  if (!s) s = blur_axis(plane, h, w, (size_t)w, 1, ky, ty, oy); /* columns */
+  free(kx);
+  free(ky);
+  if (s) lw_error_set(err, LW_ENOMEM, "out of memory blurring %d x %d pixels", w, h);
+  return s;
+}
+
+lw_status lw_image_blur(lw_image *img, double sigma, lw_error *err)
+{
+  return lw_image_blur_plane(img->tone, img->width, img->height, sigma, err);
+}
+
+/* ---- tone and page -------------------------------------------------- */
+
+void lw_image_tone_curve(lw_image *img, double gamma, double contrast, int invert)
+{
+  size_t n = (size_t)img->width * (size_t)img->height;
+  for (size_t k = 0; k < n; k++) {
+    double t = img->tone[k];
+    if (invert) t = 1.0 - t;
+    if (gamma != 1.0) t = pow(t > 0 ? t : 0, gamma);
+    t = 0.5 + contrast * (t - 0.5);
+    img->tone[k] = (float)(t < 0 ? 0 : (t > 1 ? 1 : t));
+  }
+}
+
+lw_image_place lw_image_fit(int w, int h, double bx0, double by0, double bx1, double by1)
+{
+  double bw = bx1 - bx0, bh = by1 - by0;
+  double px = fmin(bw / w, bh / h);
+  return (lw_image_place){bx0 + 0.5 * (bw - w * px), by0 + 0.5 * (bh - h * px), px};
+}
+
+double lw_image_tone_at(const lw_image *img, const lw_image_place *pl, double x, double y)
+{
+  double u = (x - pl->x0) / pl->pixel, v = (y - pl->y0) / pl->pixel;
+  if (!(u >= 0 && v >= 0 && u < img->width && v < img->height)) return 1.0;
+  /* between pixel centres, clamped to the outermost centres */
+  u -= 0.5;
+  v -= 0.5;
+  if (u < 0) u = 0;
+  if (v < 0) v = 0;
+  if (u > img->width - 1) u = img->width - 1;
+  if (v > img->height - 1) v = img->height - 1;
+  int i = (int)u, j = (int)v;
+  int i1 = i + 1 < img->width ? i + 1 : i, j1 = j + 1 < img->height ? j + 1 : j;
+  double fx = u - i, fy = v - j;
+  const float *t = img->tone;
+  size_t W = (size_t)img->width;
+  return (1 - fy) * ((1 - fx) * t[j * W + i] + fx * t[j * W + i1]) + fy * ((1 - fx) * t[j1 * W + i] + fx * t[j1 * W + i1]);
+}
+
+lw_grid2d *lw_image_tone_grid(const lw_image *img, const lw_image_place *pl, lw_error *err)
+{
+  lw_grid2d *g = lw_grid2d_new(img->width, img->height, 1, pl->x0 + 0.5 * pl->pixel, pl->y0 + 0.5 * pl->pixel,
+                               pl->pixel, pl->pixel, err);
+  if (!g) return NULL;
+  for (size_t i = 0; i < (size_t)img->width * (size_t)img->height; i++) g->data[i] = img->tone[i];
+  return g;
+}

@@ -1,0 +1,102 @@
+/* imagefield.c -- potential and vector fields from a picture (imagefield.h). */
+#include "linewise/imagefield.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, lw_error *err)
+{
+  const int w = img->width, h = img->height, W = w + 2, H = h + 2;
+  /* node (i, j) is the centre of pixel (i - 1, j - 1); the outer ring is white */
+  lw_grid2d *g = lw_grid2d_new(W, H, 1, pl->x0 - 0.5 * pl->pixel, pl->y0 - 0.5 * pl->pixel, pl->pixel,
+                               pl->pixel, err);
+  if (!g) return NULL;
+  for (int j = 0; j < H; j++)
+    for (int i = 0; i < W; i++) {
+      int inner = i >= 1 && i <= w && j >= 1 && j <= h;
+      g->data[(size_t)j * W + (size_t)i] =
+        inner ? img->tone[(size_t)(j - 1) * (size_t)w + (size_t)(i - 1)] : 1.0;
+    }
+  return g;
+}
+
+/* Sobel gradient of the tone at pixel (i, j), tone per mm; the picture's
+** edge pixels repeat beyond it, so its border is no edge. */
+static void sobel(const lw_image *img, double pixel, int i, int j, double *gx, double *gy)
+{
+  const int w = img->width, h = img->height;
+  const float *t = img->tone;
+  int i0 = i > 0 ? i - 1 : 0, i1 = i < w - 1 ? i + 1 : w - 1;
+  int j0 = j > 0 ? j - 1 : 0, j1 = j < h - 1 ? j + 1 : h - 1;
+#define T(a, b) ((double)t[(size_t)(b) * (size_t)w + (size_t)(a)])
+  *gx = (T(i1, j0) + 2 * T(i1, j) + T(i1, j1) - T(i0, j0) - 2 * T(i0, j) - T(i0, j1)) / (8.0 * pixel);
+  *gy = (T(i0, j1) + 2 * T(i, j1) + T(i1, j1) - T(i0, j0) - 2 * T(i, j0) - T(i1, j0)) / (8.0 * pixel);
+#undef T
+}
+
+/* A grid node at every pixel centre, two components. */
+static lw_grid2d *pixel_grid(const lw_image *img, const lw_image_place *pl, lw_error *err)
+{
+  return lw_grid2d_new(img->width, img->height, 2, pl->x0 + 0.5 * pl->pixel, pl->y0 + 0.5 * pl->pixel,
+                       pl->pixel, pl->pixel, err);
+}
+
+lw_grid2d *lw_imagefield_gradient(const lw_image *img, const lw_image_place *pl, double flat, lw_error *err)
+{
+  lw_grid2d *g = pixel_grid(img, pl, err);
+  if (!g) return NULL;
+  for (int j = 0; j < img->height; j++)
+    for (int i = 0; i < img->width; i++) {
+      double gx, gy;
+      sobel(img, pl->pixel, i, j, &gx, &gy);
+      double n = fmax(sqrt(gx * gx + gy * gy), flat);
+      double *d = g->data + 2 * ((size_t)j * (size_t)img->width + (size_t)i);
+      d[0] = n > 0 ? gx / n : 0.0;
+      d[1] = n > 0 ? gy / n : 0.0;
+    }
+  return g;
+}
+
+lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, double sigma_mm, double flat,
+                             double angle, lw_error *err)
+{
+  const int w = img->width, h = img->height;
+  const size_t n = (size_t)w * (size_t)h;
+  lw_grid2d *g = pixel_grid(img, pl, err);
+  if (!g) return NULL;
+  /* the three tensor planes in float: a third of the memory of doubles,
+  ** and the smoothing they get needs no more precision */
+  float *J = malloc(3 * n * sizeof *J);
+  if (!J) {
+    lw_grid2d_free(g);
+    lw_error_set(err, LW_ENOMEM, "out of memory for the structure tensor of %d x %d pixels", w, h);
+    return NULL;
+  }
+  float *J11 = J, *J12 = J + n, *J22 = J + 2 * n;
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) {
+      double gx, gy;
+      sobel(img, pl->pixel, i, j, &gx, &gy);
+      size_t k = (size_t)j * (size_t)w + (size_t)i;
+      J11[k] = (float)(gx * gx);
+      J12[k] = (float)(gx * gy);
+      J22[k] = (float)(gy * gy);
+    }
+  double sigma_px = sigma_mm / pl->pixel;
+  for (int c = 0; c < 3; c++)
+    if (lw_image_blur_plane(J + (size_t)c * n, w, h, sigma_px, err)) {
+      free(J);
+      lw_grid2d_free(g);
+      return NULL;
+    }
+  const double fc = flat * flat * cos(2 * angle), fs = flat * flat * sin(2 * angle);
+  const double uc = cos(2 * angle), us = sin(2 * angle);
+  for (size_t k = 0; k < n; k++) {
+    double tx = (double)J22[k] - J11[k] + fc, ty = -2.0 * J12[k] + fs;
+    double m = sqrt(tx * tx + ty * ty);
+    g->data[2 * k] = m > 0 ? tx / m : uc;
+    g->data[2 * k + 1] = m > 0 ? ty / m : us;
+  }
+  free(J);
+  return g;
+}

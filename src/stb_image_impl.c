@@ -1,0 +1,27 @@
+/*
+** stb_image_impl.c -- the one translation unit that compiles stb_image
+** (libstb-dev ships it as a header only).  Only PNG, JPEG and BMP are
+** built (image.c reads PGM/PPM itself), from memory only (image.c reads files itself so that it can
+** say why a file could not be read), with the decoder's user-facing
+** failure messages.  Warnings are the library's business: silenced here,
+** and only here.
+*/
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_NO_STDIO
+#define STBI_FAILURE_USERMSG
+#define STBI_ONLY_PNG
+#define STBI_ONLY_JPEG
+#define STBI_ONLY_BMP
+
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wtype-limits"
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+#endif
+#include <stb/stb_image.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif

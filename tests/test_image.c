@@ -1,0 +1,311 @@
+/*
+** test_image.c -- pictures: decoding (gray conversion, alpha, orientation,
+** formats, bad files), resampling, blur, the tone curve, page fitting.
+*/
+#include <criterion/criterion.h>
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "imageutil.h"
+#include "linewise/image.h"
+#include "testutil.h"
+
+TestSuite(image, .init = lw_image_dir_make, .fini = lw_image_dir_remove);
+
+
+static double mean_of(const float *p, size_t n)
+{
+  double s = 0;
+  for (size_t k = 0; k < n; k++) s += p[k];
+  return s / (double)n;
+}
+
+static lw_image *random_image(int w, int h)
+{
+  lw_image *img = lw_image_new(w, h, 0, NULL);
+  cr_assert_not_null(img);
+  for (size_t k = 0; k < (size_t)w * (size_t)h; k++) img->tone[k] = (float)urand(0, 1);
+  return img;
+}
+
+/* A 24-bit BMP written by hand: rows bottom-up, BGR, padded to 4 bytes. */
+static size_t bmp_bytes(unsigned char *b, int w, int h, const unsigned char *rgb)
+{
+  int pad = (4 - (3 * w) % 4) % 4;
+  size_t data = (size_t)(3 * w + pad) * (size_t)h, size = 54 + data;
+  memset(b, 0, 54);
+  b[0] = 'B';
+  b[1] = 'M';
+  for (int k = 0; k < 4; k++) {
+    b[2 + k] = (unsigned char)(size >> (8 * k));
+    b[18 + k] = (unsigned char)((unsigned)w >> (8 * k));
+    b[22 + k] = (unsigned char)((unsigned)h >> (8 * k));
+  }
+  b[10] = 54;
+  b[14] = 40;
+  b[26] = 1;
+  b[28] = 24;
+  unsigned char *p = b + 54;
+  for (int j = h - 1; j >= 0; j--) {
+    for (int i = 0; i < w; i++) {
+      const unsigned char *c = rgb + 3 * (j * w + i);
+      *p++ = c[2];
+      *p++ = c[1];
+      *p++ = c[0];
+    }
+    for (int k = 0; k < pad; k++) *p++ = 0;
+  }
+  return size;
+}
+
+Test(image, rgb_becomes_rec709_luma_with_row_0_at_the_top)
+{
+  /* pure red, green, blue on the top row, a mixed colour and gray below */
+  const unsigned char rgb[] = {255, 0, 0, 0, 255, 0, 0, 0, 255, 200, 100, 50, 64, 64, 64, 0, 0, 0};
+  unsigned char b[256];
+  size_t n = bmp_bytes(b, 3, 2, rgb);
+  lw_error err;
+  lw_image_info info;
+  lw_image *img = lw_image_decode(b, n, "t.bmp", 1e6, &info, &err);
+  cr_assert_not_null(img, "%s", err.msg);
+  cr_assert(info.width == 3 && info.height == 2 && info.channels == 3 && info.bits == 8);
+  cr_assert_null(img->alpha);
+  const double want[6] = {0.2126, 0.7152, 0.0722, (0.2126 * 200 + 0.7152 * 100 + 0.0722 * 50) / 255.0,
+                          64 / 255.0, 0};
+  for (int k = 0; k < 6; k++)
+    cr_assert(fabs(img->tone[k] - want[k]) < 1e-6, "pixel %d: %g, want %g", k, img->tone[k], want[k]);
+  lw_image_free(img);
+}
+
+Test(image, pgm_and_ppm_any_maxval_and_truncation)
+{
+  const unsigned char p8[] = "P5\n3 1\n255\n\x00\x80\xff";
+  lw_error err;
+  lw_image *img = lw_image_decode(p8, sizeof p8 - 1, "t.pgm", 1e6, NULL, &err);
+  cr_assert_not_null(img, "%s", err.msg);
+  cr_assert(img->tone[0] == 0.0f && fabs(img->tone[1] - 128 / 255.0) < 1e-6 && img->tone[2] == 1.0f);
+  lw_image_free(img);
+  /* 16 bits keep their precision: 1 / 65535 is not a multiple of 1/255 */
+  const unsigned char p16[] = "P5\n2 1\n65535\n\x00\x01\x80\x00";
+  lw_image_info info;
+  img = lw_image_decode(p16, sizeof p16 - 1, "t.pgm", 1e6, &info, &err);
+  cr_assert_not_null(img, "%s", err.msg);
+  cr_assert_eq(info.bits, 16);
+  cr_assert(fabs(img->tone[0] - 1 / 65535.0) < 1e-9, "%.9g", img->tone[0]);
+  cr_assert(fabs(img->tone[1] - 32768 / 65535.0) < 1e-7);
+  lw_image_free(img);
+  /* comments in the header, a maxval that is neither 255 nor 65535, RGB */
+  const unsigned char p6[] = "P6 # a comment\n2 1\n# another\n15\n\x0f\x00\x00\x05\x05\x05";
+  img = lw_image_decode(p6, sizeof p6 - 1, "t.ppm", 1e6, NULL, &err);
+  cr_assert_not_null(img, "%s", err.msg);
+  cr_assert(fabs(img->tone[0] - 0.2126) < 1e-6 && fabs(img->tone[1] - 1 / 3.0) < 1e-5);
+  lw_image_free(img);
+  /* a raster shorter than the header promises */
+  const unsigned char cut[] = "P5 4 4 255\nabcdefghij";
+  cr_assert_null(lw_image_decode(cut, sizeof cut - 1, "cut.pgm", 1e6, NULL, &err));
+  cr_assert(err.code == LW_EINPUT && strstr(err.msg, "cut.pgm") && strstr(err.msg, "truncated"), "%s", err.msg);
+  const unsigned char bad[] = "P5 4 x 255\n";
+  cr_assert_null(lw_image_decode(bad, sizeof bad - 1, "bad.pgm", 1e6, NULL, &err));
+  cr_assert(err.code == LW_EINPUT && strstr(err.msg, "bad.pgm"), "%s", err.msg);
+}
+
+Test(image, alpha_is_kept_and_the_tone_composited_over_white)
+{
+  const float g[4] = {0, 0, 0.5f, 1}, a[4] = {1, 0.5f, 0.2f, 0};
+  lw_test_png(lw_test_path("a.png"), 2, 2, g, a);
+  lw_error err;
+  lw_image_info info;
+  lw_image *img = lw_image_load(lw_test_path("a.png"), 1e6, &info, &err);
+  cr_assert_not_null(img, "%s", err.msg);
+  cr_assert_eq(info.channels, 4);
+  cr_assert_not_null(img->alpha);
+  for (int k = 0; k < 4; k++) {
+    double A = lround(255 * a[k]) / 255.0;
+    cr_assert(fabs(img->alpha[k] - A) < 1e-6, "alpha %d: %g", k, img->alpha[k]);
+    /* straight colour in the file is rounded to 8 bits: tolerance 1/255 */
+    cr_assert(fabs(img->tone[k] - (A * g[k] + 1 - A)) < 1.01 / 255, "tone %d: %g", k, img->tone[k]);
+  }
+  lw_image_free(img);
+}
+
+Test(image, bad_files_are_input_errors_naming_the_file)
+{
+  float g[64 * 64];
+  for (int k = 0; k < 64 * 64; k++) g[k] = (float)urand(0, 1); /* incompressible: a long IDAT */
+  lw_test_png(lw_test_path("good.png"), 64, 64, g, NULL);
+  FILE *f = fopen(lw_test_path("good.png"), "rb");
+  static unsigned char buf[65536];
+  size_t n = fread(buf, 1, sizeof buf, f);
+  fclose(f);
+  lw_test_write(lw_test_path("cut.png"), buf, n / 2);
+  lw_test_write(lw_test_path("empty.png"), "", 0);
+  lw_test_write(lw_test_path("text.png"), "hello, I am not a picture\n", 26);
+  static unsigned char rgb[3 * 20 * 10], bmp[1024];
+  size_t nb = bmp_bytes(bmp, 20, 10, rgb);
+  lw_test_write(lw_test_path("cut.bmp"), bmp, nb - 7);
+  const char *names[] = {"cut.png", "empty.png", "text.png", "missing.png", ".", "cut.bmp"};
+  for (int k = 0; k < 6; k++) {
+    lw_error err;
+    lw_error_clear(&err);
+    char path[128];
+    snprintf(path, sizeof path, "%s", lw_test_path(names[k]));
+    cr_assert_null(lw_image_load(path, 1e6, NULL, &err), "%s", names[k]);
+    cr_assert_eq(err.code, LW_EINPUT, "%s: %s", names[k], err.msg);
+    cr_assert(strstr(err.msg, path), "%s: message names the file: %s", names[k], err.msg);
+    cr_assert_null(strchr(err.msg, '\n'));
+  }
+  lw_image *img = lw_image_load(lw_test_path("good.png"), 1e6, NULL, NULL);
+  cr_assert_not_null(img);
+  lw_image_free(img);
+  img = lw_image_decode(bmp, nb, "whole.bmp", 1e6, NULL, NULL);
+  cr_assert_not_null(img, "the whole BMP decodes");
+  lw_image_free(img);
+}
+
+Test(image, pictures_above_the_budget_are_box_filtered_keeping_the_mean)
+{
+  int w = 203, h = 151;
+  float *g = malloc(sizeof(float) * w * h);
+  for (int k = 0; k < w * h; k++) g[k] = (float)urand(0, 1);
+  lw_test_png(lw_test_path("big.png"), w, h, g, NULL);
+  free(g);
+  lw_image_info info;
+  lw_image *full = lw_image_load(lw_test_path("big.png"), 1e9, &info, NULL);
+  lw_image *small = lw_image_load(lw_test_path("big.png"), 3000, NULL, NULL);
+  cr_assert(full && small);
+  cr_assert(full->width == w && full->height == h);
+  cr_assert(small->width * small->height <= 3000 && small->width * small->height > 2500,
+            "%d x %d", small->width, small->height);
+  cr_assert(fabs((double)small->width / small->height - (double)w / h) < 0.05, "aspect kept");
+  /* box filtering with fractional edges keeps the mean up to float rounding */
+  double m0 = mean_of(full->tone, (size_t)w * h), m1 = mean_of(small->tone, (size_t)small->width * small->height);
+  cr_assert(fabs(m1 - m0) < 1e-5, "mean %.8f vs %.8f", m1, m0);
+  lw_image_free(full);
+  lw_image_free(small);
+}
+
+Test(image, resize_keeps_the_mean_and_interpolates_when_enlarging)
+{
+  rng_seed(11);
+  lw_image *img = random_image(97, 61);
+  double m0 = mean_of(img->tone, 97 * 61);
+  lw_image *s = lw_image_resize(img, 40, 25, NULL);
+  cr_assert_not_null(s);
+  cr_assert(fabs(mean_of(s->tone, 40 * 25) - m0) < 1e-5);
+  lw_image_free(s);
+  /* enlarging a linear ramp by linear interpolation reproduces the ramp
+  ** between the outermost pixel centres */
+  lw_image *ramp = lw_image_new(10, 3, 0, NULL);
+  for (int j = 0; j < 3; j++)
+    for (int i = 0; i < 10; i++) ramp->tone[j * 10 + i] = (float)(0.05 + 0.1 * i);
+  lw_image *big = lw_image_resize(ramp, 40, 7, NULL);
+  cr_assert_not_null(big);
+  for (int i = 2; i < 38; i++) {
+    double u = (i + 0.5) * 10.0 / 40.0 - 0.5; /* source coordinate of the centre */
+    cr_assert(fabs(big->tone[3 * 40 + i] - (0.05 + 0.1 * u)) < 1e-6, "column %d", i);
+  }
+  lw_image_free(big);
+  lw_image_free(ramp);
+  lw_image_free(img);
+}
+
+Test(image, blur_keeps_the_mean_exactly_even_when_wider_than_the_picture)
+{
+  rng_seed(12);
+  double sigmas[] = {0.7, 2.3, 40};
+  for (int k = 0; k < 3; k++) {
+    lw_image *img = random_image(37, 23);
+    double m0 = mean_of(img->tone, 37 * 23);
+    cr_assert_eq(lw_image_blur(img, sigmas[k], NULL), LW_OK);
+    cr_assert(fabs(mean_of(img->tone, 37 * 23) - m0) < 1e-6, "sigma %g", sigmas[k]);
+    lw_image_free(img);
+  }
+}
+
+Test(image, blur_is_the_same_for_any_thread_count)
+{
+  rng_seed(13);
+  lw_image *a = random_image(83, 57), *b = lw_image_resize(a, 83, 57, NULL);
+  cr_assert(b && !memcmp(a->tone, b->tone, sizeof(float) * 83 * 57));
+  int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  cr_assert_eq(lw_image_blur(a, 3.3, NULL), LW_OK);
+  omp_set_num_threads(3);
+  cr_assert_eq(lw_image_blur(b, 3.3, NULL), LW_OK);
+  omp_set_num_threads(threads);
+  cr_assert(!memcmp(a->tone, b->tone, sizeof(float) * 83 * 57), "bit for bit");
+  lw_image_free(a);
+  lw_image_free(b);
+}
+
+Test(image, blurred_impulse_has_the_variance_sigma_squared)
+{
+  /* A unit impulse blurred by a Gaussian of sigma s spreads with variance
+  ** s^2 per axis.  The kernel is cut at 4 sigma (missing variance about
+  ** 1e-3 relative) and sampled (error exponentially small for s >= 1). */
+  const int n = 121, c = 60;
+  const double s = 3.7;
+  lw_image *img = lw_image_new(n, n, 0, NULL);
+  memset(img->tone, 0, sizeof(float) * n * n);
+  img->tone[c * n + c] = 1.0f;
+  cr_assert_eq(lw_image_blur(img, s, NULL), LW_OK);
+  double sum = 0, vx = 0, vy = 0, cxy = 0;
+  for (int j = 0; j < n; j++)
+    for (int i = 0; i < n; i++) {
+      double v = img->tone[j * n + i];
+      sum += v;
+      vx += v * (i - c) * (i - c);
+      vy += v * (j - c) * (j - c);
+      cxy += v * (i - c) * (j - c);
+    }
+  cr_assert(fabs(sum - 1) < 1e-5);
+  cr_assert(fabs(vx / sum - s * s) < 3e-3 * s * s, "var x %g, want %g", vx / sum, s * s);
+  cr_assert(fabs(vy / sum - s * s) < 3e-3 * s * s, "var y %g", vy / sum);
+  cr_assert(fabs(cxy / sum) < 1e-4, "no covariance");
+  lw_image_free(img);
+}
+
+Test(image, tone_curve_invert_gamma_contrast)
+{
+  lw_image *img = lw_image_new(5, 1, 0, NULL);
+  const float t[5] = {0, 0.25f, 0.5f, 0.8f, 1};
+  memcpy(img->tone, t, sizeof t);
+  lw_image_tone_curve(img, 2.0, 1.0, 0);
+  for (int k = 0; k < 5; k++) cr_assert(fabs(img->tone[k] - t[k] * t[k]) < 1e-6);
+  memcpy(img->tone, t, sizeof t);
+  lw_image_tone_curve(img, 1.0, 1.0, 1);
+  for (int k = 0; k < 5; k++) cr_assert(fabs(img->tone[k] - (1 - t[k])) < 1e-6);
+  memcpy(img->tone, t, sizeof t);
+  lw_image_tone_curve(img, 1.0, 3.0, 0);
+  const float c3[5] = {0, 0, 0.5f, 1, 1}; /* 0.5 + 3 (t - 0.5), clipped */
+  for (int k = 0; k < 5; k++) cr_assert(fabs(img->tone[k] - c3[k]) < 1e-6, "%d: %g", k, img->tone[k]);
+  /* the order: invert, then gamma, then contrast */
+  memcpy(img->tone, t, sizeof t);
+  lw_image_tone_curve(img, 0.5, 0.5, 1);
+  for (int k = 0; k < 5; k++) {
+    double want = 0.5 + 0.5 * (sqrt(1 - t[k]) - 0.5);
+    cr_assert(fabs(img->tone[k] - want) < 1e-6, "%d", k);
+  }
+  lw_image_free(img);
+}
+
+Test(image, fit_centres_and_keeps_the_aspect_ratio)
+{
+  lw_image_place pl = lw_image_fit(600, 800, 8, 8, 142, 192);
+  cr_assert(fabs(pl.pixel - 134.0 / 600) < 1e-12);
+  cr_assert(fabs(pl.x0 - 8) < 1e-12);
+  cr_assert(fabs(pl.y0 - (8 + 0.5 * (184 - 800 * pl.pixel))) < 1e-12);
+  /* tone lookups: white outside, pixel values at centres */
+  lw_image *img = lw_image_new(2, 1, 0, NULL);
+  img->tone[0] = 0.2f;
+  img->tone[1] = 0.6f;
+  lw_image_place q = {10, 20, 5};
+  cr_assert(fabs(lw_image_tone_at(img, &q, 12.5, 22.5) - 0.2) < 1e-6);
+  cr_assert(fabs(lw_image_tone_at(img, &q, 15, 22.5) - 0.4) < 1e-6);
+  cr_assert(lw_image_tone_at(img, &q, 9.9, 22) == 1.0 && lw_image_tone_at(img, &q, 20.1, 22) == 1.0);
+  cr_assert(lw_image_tone_at(img, &q, 15, 25.1) == 1.0);
+  lw_image_free(img);
+}

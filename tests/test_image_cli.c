@@ -1,0 +1,217 @@
+/*
+** test_image_cli.c -- image scenes on the command line: bad pictures exit
+** 2 with one line and write nothing, the downsampling note, runs that
+** resume and recompute from another directory, and the bundled scenes.
+*/
+#include <criterion/criterion.h>
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include "imageutil.h"
+#include "linewise/init.h"
+#include "linewise/scene.h"
+#include "testutil.h"
+
+TestSuite(image_cli, .init = lw_image_dir_make, .fini = lw_image_dir_remove);
+
+
+/* Runs "cd DIR && linewise <args>", capturing stderr; the exit status. */
+static int run(const char *args, char *errs, size_t nerr)
+{
+  const char *bin = getenv("LW_BIN");
+  cr_assert_not_null(bin, "LW_BIN must name bin/linewise (make test sets it)");
+  char cmd[2048];
+  snprintf(cmd, sizeof cmd, "cd %s && %s %s >/dev/null 2>%s", lw_test_dir, bin, args, lw_test_path("err.txt"));
+  int st = system(cmd);
+  FILE *f = fopen(lw_test_path("err.txt"), "r");
+  size_t n = fread(errs, 1, nerr - 1, f);
+  errs[n] = '\0';
+  fclose(f);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static void write_text(const char *name, const char *text)
+{
+  lw_test_write(lw_test_path(name), text, strlen(text));
+}
+
+static size_t count_entries(const char *path)
+{
+  DIR *d = opendir(path);
+  cr_assert_not_null(d, "%s", path);
+  size_t n = 0;
+  for (struct dirent *e; (e = readdir(d));) n += e->d_name[0] != '.';
+  closedir(d);
+  return n;
+}
+
+static const char scene_fmt[] =
+  "[scene]\nwidth = 60\nheight = 50\nimage = %s\npotential = image\nfield = etf\nmargin = 4\n"
+  "[init]\nsplines = 0\ncoverage = 0.2\nsegments = 3\nsegment_length = 4\n"
+  "[energy]\nstrain = 5\nbending = 1\npotential = 1\nfield = -0.5\npair = 0.01\nboundary = 0.1\n"
+  "[anneal]\nsweeps = 4\nsteps = 2\n[output]\nfield_preview = 1\n";
+
+static void write_scene(const char *image)
+{
+  char text[1024];
+  snprintf(text, sizeof text, scene_fmt, image);
+  write_text("scene.ini", text);
+}
+
+/* A picture with some structure: a dark disk on a light ramp. */
+static void write_picture(const char *name, int w, int h)
+{
+  float *g = malloc(sizeof(float) * w * h);
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++)
+      g[j * w + i] = hypot(i - 0.4 * w, j - 0.5 * h) < 0.25 * h ? 0.1f : (float)(0.5 + 0.5 * i / w);
+  lw_test_png(lw_test_path(name), w, h, g, NULL);
+  free(g);
+}
+
+Test(image_cli, bad_pictures_exit_2_with_one_line_and_touch_nothing)
+{
+  write_picture("good.png", 64, 48);
+  FILE *f = fopen(lw_test_path("good.png"), "rb");
+  static unsigned char buf[65536];
+  size_t n = fread(buf, 1, sizeof buf, f);
+  fclose(f);
+  lw_test_write(lw_test_path("cut.png"), buf, n - n / 3);
+  lw_test_write(lw_test_path("empty.png"), "", 0);
+  write_text("text.png", "<html>not a picture</html>\n");
+  cr_assert_eq(mkdir(lw_test_path("folder.png"), 0777), 0);
+  cr_assert_eq(mkdir(lw_test_path("out"), 0777), 0);
+  write_text("out/keep.txt", "precious\n");
+
+  const char *bad[] = {"cut.png", "empty.png", "text.png", "missing.png", "folder.png"};
+  for (int k = 0; k < 5; k++) {
+    write_scene(bad[k]);
+    char errs[2048];
+    cr_assert_eq(run("run scene.ini --out out", errs, sizeof errs), 2, "%s: %s", bad[k], errs);
+    cr_assert(strstr(errs, "scene.ini:4") && strstr(errs, "scene.image") && strstr(errs, bad[k]),
+              "%s: names the scene line, the key and the file: %s", bad[k], errs);
+    cr_assert_eq(strchr(errs, '\n'), errs + strlen(errs) - 1, "one line: %s", errs);
+    cr_assert_eq(count_entries(lw_test_path("out")), 1, "%s: nothing written", bad[k]);
+    f = fopen(lw_test_path("out/keep.txt"), "r");
+    char keep[32] = "";
+    cr_assert_not_null(fgets(keep, sizeof keep, f));
+    fclose(f);
+    cr_assert_str_eq(keep, "precious\n");
+  }
+  /* the same scene with the good picture runs */
+  write_scene("good.png");
+  char errs[8192];
+  cr_assert_eq(run("run scene.ini --out out --quiet", errs, sizeof errs), 0, "%s", errs);
+  cr_assert_str_eq(errs, "");
+  struct stat sb;
+  cr_assert_eq(stat(lw_test_path("out/field.png"), &sb), 0, "field.png written");
+  cr_assert_eq(stat(lw_test_path("out/final.svg"), &sb), 0);
+}
+
+Test(image_cli, a_large_picture_is_downsampled_with_a_note)
+{
+  write_picture("big.png", 120, 100);
+  write_scene("big.png");
+  char errs[16384];
+  cr_assert_eq(run("run scene.ini --out out --set scene.image_max_pixels=3000", errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "linewise: note: ") && strstr(errs, "big.png: 120 x 100 pixels") &&
+            strstr(errs, "downsampled to 60 x 50"), "%s", errs);
+  cr_assert_eq(run("run scene.ini --out out --quiet --set scene.image_max_pixels=3000", errs, sizeof errs), 0);
+  cr_assert_str_eq(errs, "", "--quiet says nothing");
+  /* no note when the picture fits */
+  cr_assert_eq(run("run scene.ini --out out", errs, sizeof errs), 0);
+  cr_assert_null(strstr(errs, "note:"), "%s", errs);
+}
+
+Test(image_cli, a_run_with_a_relative_picture_resumes_and_recomputes_anywhere)
+{
+  write_picture("pic.png", 50, 40);
+  write_scene("pic.png");
+  char errs[8192], args[512];
+  cr_assert_eq(run("run scene.ini --out out --quiet", errs, sizeof errs), 0, "%s", errs);
+  /* the run directory's scene.ini names the picture absolutely, so the run
+  ** can be continued and checked from any working directory */
+  snprintf(args, sizeof args, "resume %s --sweeps 2 --quiet && cd / && %s energy %s", lw_test_path("out"),
+           getenv("LW_BIN"), lw_test_path("out"));
+  cr_assert_eq(run(args, errs, sizeof errs), 0, "%s", errs);
+}
+
+Test(image_cli, scene_keys_that_need_a_picture_say_so)
+{
+  struct { const char *text, *key; } cases[] = {
+    {"[scene]\npotential = image\n[energy]\npotential = 1\n", "scene.potential"},
+    {"[scene]\nfield = etf\n[energy]\nfield = -1\n", "scene.field"},
+    {"[scene]\nimage = p.png\nfield = etf\n[energy]\nfield = -1\nfield_mode = signed\n", "scene.field"},
+    {"[scene]\nboundary = mask\n", "scene.boundary"},
+    {"[scene]\nmask = alpha\nboundary = mask\n", "scene.mask"},
+    {"[scene]\nimage = p.png\nmask = alpha\nboundary = mask\n", "scene.mask"},
+    {"[scene]\nimage = p.png\nmask = alpha\n", "scene.mask"},
+    {"[scene]\nmask = image\nboundary = mask\n", "scene.mask"},
+    {"[output]\nfield_preview = 1\n", "output.field_preview"},
+    {"[scene]\nmask = image\nmask_image = nowhere.png\nboundary = mask\n", "scene.mask_image"},
+  };
+  write_picture("p.png", 20, 16); /* no alpha channel */
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    write_text("scene.ini", cases[k].text);
+    lw_params p;
+    lw_scene sc;
+    lw_error err;
+    cr_assert_eq(lw_params_read(&p, lw_test_path("scene.ini"), &err), LW_OK, "%s", err.msg);
+    cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT, "case %zu", k);
+    cr_assert(strstr(err.msg, cases[k].key) && strstr(err.msg, "scene.ini:"), "case %zu: %s", k, err.msg);
+  }
+}
+
+Test(image_cli, an_alpha_mask_is_the_boundary)
+{
+  /* a picture opaque inside a disk of radius 15 px, 1 px = 1 mm */
+  const int w = 40, h = 40;
+  float g[40 * 40], a[40 * 40];
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) {
+      g[j * w + i] = 0.3f;
+      a[j * w + i] = hypot(i + 0.5 - 20, j + 0.5 - 20) < 15 ? 1.0f : 0.0f;
+    }
+  lw_test_png(lw_test_path("disk.png"), w, h, g, a);
+  write_text("scene.ini", "[scene]\nwidth = 40\nheight = 40\nmargin = 0\nimage = disk.png\nboundary = mask\n"
+                          "mask = alpha\n[init]\nsplines = 30\nsegments = 2\nsegment_length = 3\n");
+  lw_params p;
+  lw_scene sc;
+  lw_error err;
+  cr_assert_eq(lw_params_read(&p, lw_test_path("scene.ini"), &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
+  /* about 15 mm in; the pixel staircase of the disk costs up to a pixel */
+  cr_assert(fabs(lw_boundary_distance(&sc.boundary, 20, 20) + 15) < 1.5, "centre: %g",
+            lw_boundary_distance(&sc.boundary, 20, 20));
+  cr_assert(lw_boundary_distance(&sc.boundary, 20, 2) > 0 && lw_boundary_distance(&sc.boundary, 1, 1) > 0);
+  /* and the splines are placed inside it */
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  lw_splines *sp = lw_init_random(&sc, 30, 2, 3, r, &err);
+  cr_assert_not_null(sp, "%s", err.msg);
+  for (size_t k = 0; k < sp->n_nodes; k++)
+    cr_assert(hypot(sp->node[k].px - 20, sp->node[k].py - 20) < 15.5);
+  lw_splines_free(sp);
+  gsl_rng_free(r);
+  lw_scene_clear(&sc);
+}
+
+Test(image_cli, every_bundled_scene_builds)
+{
+  const char *root = getenv("LW_ROOT");
+  cr_assert_not_null(root);
+  const char *names[] = {"example.ini", "flow.ini", "minimal.ini"};
+  for (int k = 0; k < 3; k++) {
+    char path[1024];
+    snprintf(path, sizeof path, "%s/params/%s", root, names[k]);
+    lw_params p;
+    lw_scene sc;
+    lw_error err;
+    cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
+    cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s (make builds params/picture.png)", err.msg);
+    lw_scene_clear(&sc);
+  }
+}
