@@ -333,6 +333,8 @@ double lw_pair_kernel(const lw_pair_sample *a, const lw_pair_sample *b, const lw
   double r2 = dx * dx + dy * dy;
   double rc = ctx->cutoff;
   if (rc > 0.0 && r2 >= rc * rc) return 0.0;
+  /* a sample without length weighs nothing, even at r = 0 (0 * inf) */
+  if (a->dl == 0.0 || b->dl == 0.0) return 0.0;
   double dm = a->dl > b->dl ? a->dl : b->dl;
   double fo = PAIR_MID * ctx->near; /* outer radius of the element zone / dm */
   if (fo > 0.0 && fo < PAIR_TOUCH) fo = PAIR_TOUCH;
