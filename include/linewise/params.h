@@ -36,6 +36,7 @@ typedef struct {
   int open;             /* LW_MIN_OPEN | LW_MAX_OPEN */
   const char *choices;  /* choice: "a|b|c"; stored as the index */
   const char *help;
+  size_t size;          /* text: capacity of the field in lw_params, bytes */
 } lw_param_def;
 
 extern const lw_param_def lw_param_table[];
