@@ -302,13 +302,19 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
 
   lw_samples s;
   double dlen = 0.0;
+  int forbidden = 0, undefined = 0; /* a new local energy is +inf; a new value is NaN */
   for (size_t j = 0; j < p->n_seg; j++) {
     size_t m_loc = p->seg0 + j, g = g0 + m_loc;
     double *local = p->local + j * (size_t)nl;
     segment_eval(sc, proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1), spline, &s,
                  &p->len[j], local, m->ps ? p->ps + j * (size_t)np : NULL);
     const double *old = m->seg_local + g * (size_t)nl;
-    for (int t = 0; t < nl; t++) p->dterm[sc->local[t]] += local[t] - old[t];
+    for (int t = 0; t < nl; t++) {
+      p->dterm[sc->local[t]] += local[t] - old[t];
+      if (local[t] == INFINITY) forbidden = 1;
+      else if (isnan(local[t])) undefined = 1;
+    }
+    if (isnan(p->len[j])) undefined = 1;
     dlen += p->len[j] - m->seg_len[g];
   }
   p->new_spline_len = m->spline_len[spline] + dlen;
@@ -328,6 +334,10 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
 
   double dE = 0.0;
   for (int t = 0; t < LW_TERM_COUNT; t++) dE += p->dterm[t];
+  /* A forbidden new state is +inf whatever the old one was: from a forbidden
+  ** state the difference would be inf - inf, and NaN is kept for numerical
+  ** failures (a NaN energy, counted by the chain). */
+  if (forbidden && !undefined) dE = INFINITY;
   /* The pair sum is the costly part: skip it when the move is already
   ** forbidden (+inf) or undefined (NaN). */
   if (m->grid && !(dE == INFINITY) && !isnan(dE)) {

@@ -13,16 +13,17 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/types.h>
 
 #include "linewise/output.h"
 
 #define OFF(f) offsetof(lw_params, f)
 #define NUM(sec, key, T, f, def, unit, lo, hi, open, help) \
-  {sec, key, T, OFF(f), def, unit, lo, hi, open, NULL, help}
+  {sec, key, T, OFF(f), def, unit, lo, hi, open, NULL, help, 0}
 #define CHOICE(sec, key, f, def, choices, help) \
-  {sec, key, LW_PT_CHOICE, OFF(f), def, "", 0, 0, 0, choices, help}
+  {sec, key, LW_PT_CHOICE, OFF(f), def, "", 0, 0, 0, choices, help, 0}
 #define STRING(sec, key, f, def, unit, help) \
-  {sec, key, LW_PT_STRING, OFF(f), def, unit, 0, 0, 0, NULL, help}
+  {sec, key, LW_PT_STRING, OFF(f), def, unit, 0, 0, 0, NULL, help, sizeof ((lw_params *)0)->f}
 
 const lw_param_def lw_param_table[] = {
   CHOICE("scene", "page", page, "custom", "custom|a4|a3|letter",
@@ -337,13 +338,32 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     *(int *)base = idx;
     return 1;
   }
-  case LW_PT_STRING:
-    if (strlen(text) >= LW_PATH_MAX) {
-      snprintf(expected, n, "at most %d characters", LW_PATH_MAX - 1);
+  case LW_PT_STRING: {
+    /* Each text field has its own capacity (anneal.schedule is short), and
+    ** "key = value" must fit on one line of the INI reader (read_line), so
+    ** that scene.ini, written back by a run, reads again. */
+    size_t len = strlen(text), cap = INI_MAX_LINE - 5 - strlen(d->key);
+    if (cap > d->size - 1) cap = d->size - 1;
+    if (len > cap) {
+      snprintf(expected, n, "at most %zu characters", cap);
+      return 0;
+    }
+    /* A run writes its parameters back as INI (scene.ini, which resume
+    ** reads), where a ';' at the start of a value or after a blank begins a
+    ** comment and blanks at either end are trimmed: text like that would
+    ** come back different, so it is refused here. */
+    int ok = !len || (text[0] != ';' && text[0] != ' ' && text[0] != '\t' && text[len - 1] != ' ' &&
+                      text[len - 1] != '\t');
+    for (const char *c = text; ok && *c; c++)
+      ok = ((unsigned char)*c >= 0x20 || *c == '\t') && !((*c == ' ' || *c == '\t') && c[1] == ';');
+    if (!ok) {
+      snprintf(expected, n, "text without control characters, blanks at either end, or ';' at the "
+                            "start or after a blank");
       return 0;
     }
     strcpy(base, text);
     return 1;
+  }
   }
   return 0;
 }
@@ -369,14 +389,28 @@ typedef struct {
   int line;      /* lines handed to inih so far */
   lw_error *err;
   int failed;
+  char *buf;     /* getline's buffer */
+  size_t cap;
 } reader_ctx;
 
+/* inih holds num - 1 bytes of a line (INI_MAX_LINE - 1 with the newline)
+** and would read the rest of a longer line as a line of its own, so a long
+** line is an error here, with its true number. */
 static char *read_line(char *str, int num, void *stream)
 {
   reader_ctx *rc = stream;
-  char *s = fgets(str, num, rc->f);
-  if (s) rc->line++;
-  return s;
+  if (rc->failed) return NULL;
+  ssize_t len = getline(&rc->buf, &rc->cap, rc->f);
+  if (len < 0) return NULL;
+  rc->line++;
+  if (len >= num) {
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: line longer than %d characters (the limit of the INI reader)",
+                 rc->p->file, rc->line, num - 2);
+    rc->failed = 1;
+    return NULL;
+  }
+  memcpy(str, rc->buf, (size_t)len + 1);
+  return str;
 }
 
 static int on_key(void *user, const char *section, const char *key, const char *value)
@@ -421,10 +455,11 @@ lw_status lw_params_read(lw_params *p, const char *path, lw_error *err)
   ** typo onto the previous value. */
   ini_allow_multiline = false;
   ini_stop_on_first_error = true;
-  reader_ctx rc = {p, f, 0, err, 0};
+  reader_ctx rc = {p, f, 0, err, 0, NULL, 0};
   int r = ini_parse_stream(read_line, &rc, on_key, &rc);
   int read_error = ferror(f);
   fclose(f);
+  free(rc.buf);
   if (rc.failed) return LW_EINPUT;
   if (read_error) return lw_error_set(err, LW_EIO, "%s: read error", path);
   if (r > 0)

@@ -173,6 +173,28 @@ static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
   return st;
 }
 
+/* The per-segment terms that are on, in term order (the order sums run in). */
+static void list_local_terms(lw_scene *sc)
+{
+  sc->n_local = 0;
+  for (int t = 0; t < LW_TERM_COUNT; t++)
+    if (sc->on[t] && lw_term_types[t].segment) sc->local[sc->n_local++] = (lw_term_id)t;
+}
+
+lw_status lw_scene_set_user_term(lw_scene *sc, double coef, lw_user_term_fn fn, const void *data,
+                                 lw_error *err)
+{
+  if (!isfinite(coef) || (coef != 0.0 && !fn))
+    return lw_error_set(err, LW_EINPUT, "user term: expected a finite coefficient and a function, got %g and %s",
+                        coef, fn ? "a function" : "none");
+  sc->coef[LW_TERM_USER] = coef;
+  sc->on[LW_TERM_USER] = coef != 0.0;
+  sc->user_fn = coef != 0.0 ? fn : NULL;
+  sc->user_data = coef != 0.0 ? data : NULL;
+  list_local_terms(sc);
+  return LW_OK;
+}
+
 static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
 {
   sc->width = p->width;
@@ -185,8 +207,8 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     sc->coef[t] = coef[t];
     sc->on[t] = coef[t] != 0.0;
-    if (sc->on[t] && lw_term_types[t].segment) sc->local[sc->n_local++] = (lw_term_id)t;
   }
+  list_local_terms(sc);
   sc->strain_per_segment = p->strain_mode == LW_STRAIN_SEGMENT;
   sc->field_axial = p->field_mode == LW_FIELDMODE_AXIAL;
   lw_status st = lw_quad_init(&sc->quad, p->quadrature, err);

@@ -85,6 +85,11 @@ static double seg_boundary(const lw_samples *s, const lw_scene *sc)
   return sc->coef[LW_TERM_BOUNDARY] * lw_term_boundary(s, &sc->quad, &sc->boundary);
 }
 
+static double seg_user(const lw_samples *s, const lw_scene *sc)
+{
+  return sc->coef[LW_TERM_USER] * sc->user_fn(s, &sc->quad, sc->user_data);
+}
+
 const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_STRAIN, "strain", NULL},
   {LW_TERM_BENDING, "bending", seg_bending},
@@ -92,4 +97,5 @@ const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_FIELD, "field", seg_field},
   {LW_TERM_PAIR, "pair", NULL},
   {LW_TERM_BOUNDARY, "boundary", seg_boundary},
+  {LW_TERM_USER, "user", seg_user},
 };

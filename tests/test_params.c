@@ -50,7 +50,7 @@ Test(params, defaults_cover_every_key_and_read_back)
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
     const char *a = (const char *)&p + d->offset, *b = (const char *)&q + d->offset;
-    size_t n = d->type == LW_PT_DOUBLE ? sizeof(double) : d->type == LW_PT_STRING ? LW_PATH_MAX : sizeof(int);
+    size_t n = d->type == LW_PT_DOUBLE ? sizeof(double) : d->type == LW_PT_STRING ? d->size : sizeof(int);
     cr_assert(!memcmp(a, b, n), "%s.%s differs after a round trip", d->section, d->key);
   }
 }
@@ -203,4 +203,87 @@ Test(params, pen_colours_match_the_pens)
   cr_assert_eq(read_text("[output]\npens = 3\npen_colors = #000 #c00 #0000ff\n", &p, &err), LW_OK, "%s", err.msg);
   expect_error("[output]\npens = 3\npen_colors = #000 #c00\n", ":3:", "output.pen_colors", "expected 3 colours");
   expect_error("[output]\npen_colors = red\n", ":2:", "output.pen_colors", "#rrggbb");
+}
+
+Test(params, text_that_ini_cannot_hold_is_refused)
+{
+  /* Regression (found by tests/fuzz/fuzz_params.c): "polygon =;0 0 12" was
+  ** read as ';0 0 12', written to scene.ini as "polygon = ;0 0 12", which
+  ** reads back as a comment, so a resumed run saw other parameters. */
+  expect_error("[scene]\nboundary = polygon\npolygon =;0 0 12\n", ":3:", "scene.polygon", "';'");
+  lw_params p;
+  lw_error err;
+  lw_params_defaults(&p);
+  const char *bad[] = {"anneal.table=a ;b", "anneal.table=a\t;b", "anneal.table= a", "anneal.table=a ",
+                       "anneal.table=a\nb", "anneal.table=;a"};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    cr_assert_eq(lw_params_set(&p, bad[i], &err), LW_EUSAGE, "accepted %s", bad[i]);
+    cr_assert(strstr(err.msg, "anneal.table"), "%s", err.msg);
+  }
+  /* what INI does hold is still fine, and survives a write/read cycle */
+  cr_assert_eq(lw_params_set(&p, "anneal.table=dir with spaces/a;b #c.txt", &err), LW_OK, "%s", err.msg);
+  char path[] = "/tmp/lw_params_txt_XXXXXX";
+  FILE *f = fdopen(mkstemp(path), "w");
+  cr_assert_eq(lw_params_write(&p, f), 0);
+  fclose(f);
+  lw_params q;
+  cr_assert_eq(lw_params_read(&q, path, &err), LW_OK, "%s", err.msg);
+  unlink(path);
+  cr_assert_str_eq(q.table, "dir with spaces/a;b #c.txt");
+}
+
+Test(params, text_longer_than_its_field_is_refused)
+{
+  /* Regression (found by tests/fuzz/fuzz_params.c): every text key was
+  ** checked against LW_PATH_MAX, but anneal.schedule holds 64 bytes, so a
+  ** long schedule name overwrote the numbers stored after it. */
+  lw_params p;
+  lw_error err;
+  char text[300];
+  snprintf(text, sizeof text, "[anneal]\nschedule = %0100d\nt_start = 2\n", 0);
+  expect_error(text, ":2:", "anneal.schedule", "at most 63 characters");
+  lw_params_defaults(&p);
+  memset(text, 'g', 64);
+  strcpy(text + 64, "");
+  char set[400];
+  snprintf(set, sizeof set, "anneal.schedule=%s", text);
+  double t_start = p.t_start;
+  cr_assert_eq(lw_params_set(&p, set, &err), LW_EUSAGE);
+  cr_assert_eq(p.t_start, t_start, "the neighbouring field was overwritten");
+  text[63] = '\0';
+  snprintf(set, sizeof set, "anneal.schedule=%s", text);
+  cr_assert_eq(lw_params_set(&p, set, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(strlen(p.schedule), 63);
+  for (size_t i = 0; i < lw_param_count; i++)
+    if (lw_param_table[i].type == LW_PT_STRING)
+      cr_assert(lw_param_table[i].size >= 64, "%s.%s: capacity %zu", lw_param_table[i].section, lw_param_table[i].key,
+                lw_param_table[i].size);
+}
+
+Test(params, long_lines_are_refused_with_their_own_line_number)
+{
+  /* Regression (found by tests/fuzz/fuzz_params.c): inih holds 199
+  ** characters of a line and read the rest of a longer one as a line of its
+  ** own, so a polygon of 40 vertices gave "syntax error" on the next line. */
+  char text[1200] = "[scene]\nboundary = polygon\npolygon =";
+  for (int i = 0; i < 60; i++) snprintf(text + strlen(text), 20, " %d %d", 10 + i % 50, 10 + (i * 7) % 40);
+  strcat(text, "\nwidth = 100\n");
+  expect_error(text, ":3:", NULL, "line longer than 198 characters");
+  /* the longest value accepted is written on a line that reads back */
+  lw_params p, q;
+  lw_error err;
+  lw_params_defaults(&p);
+  char set[400] = "scene.polygon=";
+  size_t cap = 200 - 5 - strlen("polygon");
+  memset(set + strlen(set), '7', cap + 1);
+  cr_assert_eq(lw_params_set(&p, set, &err), LW_EUSAGE, "accepted %zu characters", cap + 1);
+  set[strlen(set) - 1] = '\0';
+  cr_assert_eq(lw_params_set(&p, set, &err), LW_OK, "%s", err.msg);
+  char path[] = "/tmp/lw_params_long_XXXXXX";
+  FILE *f = fdopen(mkstemp(path), "w");
+  cr_assert_eq(lw_params_write(&p, f), 0);
+  fclose(f);
+  cr_assert_eq(lw_params_read(&q, path, &err), LW_OK, "%s", err.msg);
+  unlink(path);
+  cr_assert_str_eq(q.polygon, p.polygon);
 }

@@ -360,3 +360,60 @@ Test(terms, energy_is_differentiable_in_every_dof)
   lw_scene_clear(&sc);
   gsl_rng_free(r);
 }
+
+/* A user term of the segment's end nodes: k |p_{m+1} - p_m|^2. */
+static double chord_spring(const lw_samples *s, const lw_quad *q, const void *data)
+{
+  double dx = s->end_x[1] - s->end_x[0], dy = s->end_y[1] - s->end_y[0];
+  return *(const double *)data * (dx * dx + dy * dy);
+}
+
+Test(terms, user_term_is_summed_cached_and_differenced_like_the_others)
+{
+  lw_params p = base_params();
+  p.bending = 1;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  static const double k = 0.75;
+  lw_error err;
+  cr_assert_eq(lw_scene_set_user_term(&sc, 2.0, NULL, &k, &err), LW_EINPUT);
+  cr_assert_eq(lw_scene_set_user_term(&sc, NAN, chord_spring, &k, &err), LW_EINPUT);
+  cr_assert(!sc.on[LW_TERM_USER] && sc.n_local == 1, "a refused term must stay off");
+  cr_assert_eq(lw_scene_set_user_term(&sc, 2.0, chord_spring, &k, &err), LW_OK, "%s", err.msg);
+  cr_assert(sc.on[LW_TERM_USER] && sc.n_local == 2 && sc.local[1] == LW_TERM_USER);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 21);
+  lw_splines *sp = splines(2, 3);
+  wiggly(sp, 0, r, 20, 30);
+  wiggly(sp, 1, r, 22, 40);
+  double want = 0.0, term[LW_TERM_COUNT], term1[LW_TERM_COUNT];
+  for (size_t i = 0; i < 2; i++)
+    for (size_t m = 0; m < 3; m++) {
+      const lw_node *a = &sp->node[sp->first[i] + m];
+      want += 2.0 * k * ((a[1].px - a[0].px) * (a[1].px - a[0].px) + (a[1].py - a[0].py) * (a[1].py - a[0].py));
+    }
+  lw_energy_compute(&sc, sp, term, NULL);
+  cr_assert(lw_close_rel(term[LW_TERM_USER], want, 1e-14, 0), "user %.17g, expected %.17g", term[LW_TERM_USER], want);
+  lw_model *m = lw_model_new(&sc, sp, NULL);
+  cr_assert(lw_close_rel(m->term[LW_TERM_USER], want, 1e-14, 0));
+  /* a move of an interior point changes two chords: the local difference
+  ** equals the recomputed one */
+  lw_proposal *pr = lw_proposal_new(m, NULL);
+  lw_node nd = m->sp->node[m->sp->first[1] + 2];
+  nd.px += 0.37;
+  nd.py -= 0.21;
+  lw_model_propose(m, pr, 1, 2, 1, &nd);
+  lw_splines *moved = lw_splines_clone(m->sp);
+  moved->node[moved->first[1] + 2] = nd;
+  lw_energy_compute(&sc, moved, term1, NULL);
+  cr_assert(lw_close_rel(pr->dterm[LW_TERM_USER], term1[LW_TERM_USER] - term[LW_TERM_USER], 1e-12, 1e-12));
+  cr_assert(pr->dterm[LW_TERM_USER] != 0.0);
+  lw_splines_free(moved);
+  lw_proposal_free(pr);
+  lw_model_free(m);
+  /* coefficient 0: off again, not evaluated */
+  cr_assert_eq(lw_scene_set_user_term(&sc, 0.0, chord_spring, &k, &err), LW_OK);
+  cr_assert(!sc.on[LW_TERM_USER] && sc.n_local == 1 && sc.user_fn == NULL);
+  lw_scene_clear(&sc);
+  gsl_rng_free(r);
+}

@@ -7,6 +7,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "linewise/spline.h"
 
@@ -25,6 +26,14 @@ static inline double urand(double lo, double hi)
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   z ^= z >> 31;
   return lo + (hi - lo) * ((double)(z >> 11) * 0x1.0p-53);
+}
+
+/* 1 when the long versions of the statistical and stress tests run
+** (`make test-long` sets LW_LONG=1); quick versions otherwise. */
+static inline int lw_test_long(void)
+{
+  const char *e = getenv("LW_LONG");
+  return e && *e && strcmp(e, "0") != 0;
 }
 
 /* |a - b| <= tol * max(|b|, floor) */

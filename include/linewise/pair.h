@@ -96,6 +96,8 @@ static inline double lw_pair_kernel(const lw_pair_sample *a, const lw_pair_sampl
   double dx = a->x - b->x, dy = a->y - b->y;
   double r2 = dx * dx + dy * dy;
   if (r2 >= ctx->cutoff2) return 0.0;
+  /* a sample without length weighs nothing, even at r = 0 (0 * inf) */
+  if (a->dl == 0.0f || b->dl == 0.0f) return 0.0;
   double dm = a->dl > b->dl ? a->dl : b->dl;
   double ro = ctx->zone_outer * dm;
   if (ro > ctx->zone_cap) ro = ctx->zone_cap;

@@ -36,6 +36,7 @@ typedef struct {
   int open;             /* LW_MIN_OPEN | LW_MAX_OPEN */
   const char *choices;  /* choice: "a|b|c"; stored as the index */
   const char *help;
+  size_t size;          /* text: capacity of the field in lw_params, bytes */
 } lw_param_def;
 
 extern const lw_param_def lw_param_table[];
@@ -103,7 +104,7 @@ typedef struct {
   double target_spline;       /* acceptance the rigid steps tune toward */
   int tune_sweeps;            /* tuning sweeps at the start of each temperature */
   /* [anneal] */
-  char schedule[LW_PATH_MAX]; /* a name from the schedule table (STRING keys hold up to LW_PATH_MAX - 1) */
+  char schedule[64];          /* a name from the schedule table */
   double t_start, t_end;      /* temperatures, energy units */
   int sweeps;                 /* sweeps in all (one sweep = one proposal per node) */
   int steps;                  /* temperature steps */

@@ -11,6 +11,14 @@
 ** coefficient Q is non-zero, the vector field only when P is, and so on; a
 ** term that is off is never evaluated (lw_scene.local lists the per-segment
 ** terms that are on, in a fixed order).
+**
+** Besides the terms a scene file names, a program (a test, a study) may
+** register one energy of its own, the user term: a function of a segment's
+** samples that the model caches, differences and sums exactly like the
+** built-in per-segment terms.  It is off unless set, so it costs nothing
+** otherwise.  Examples: a quadratic of the Gauss samples, which makes every
+** point coordinate an exactly Gaussian degree of freedom (the statistical
+** tests), or an energy of the segment's end nodes (s->end_x, s->end_y).
 */
 #ifndef LINEWISE_SCENE_H
 #define LINEWISE_SCENE_H
@@ -23,9 +31,15 @@
 #include "linewise/quad.h"
 #include "linewise/terms.h"
 
+/* A user term: the energy of one segment from its samples (coefficient not
+** applied).  It must be a pure function of its arguments, like the built-in
+** terms: replicas call it from several threads at once.  +infinity forbids a
+** state; it should never return NaN (a NaN dE is rejected and counted). */
+typedef double (*lw_user_term_fn)(const lw_samples *s, const lw_quad *q, const void *data);
+
 typedef struct lw_scene {
   double width, height;         /* page, mm */
-  double coef[LW_TERM_COUNT];   /* S B Q P C R; 0 = off */
+  double coef[LW_TERM_COUNT];   /* S B Q P C R and the user term's; 0 = off */
   int on[LW_TERM_COUNT];        /* coef != 0 */
   int strain_per_segment;       /* strain mode */
   int field_axial;              /* field mode */
@@ -35,6 +49,8 @@ typedef struct lw_scene {
   lw_potential potential;       /* valid when on[LW_TERM_POTENTIAL] */
   lw_field field;               /* valid when on[LW_TERM_FIELD] */
   lw_boundary boundary;         /* the frame (also used for placement) */
+  lw_user_term_fn user_fn;      /* valid when on[LW_TERM_USER] */
+  const void *user_data;        /* passed to user_fn; not owned */
   int n_local;                  /* per-segment terms that are on ... */
   lw_term_id local[LW_TERM_COUNT]; /* ... and which */
   lw_image *image;              /* the processed picture (owned), or NULL */
@@ -46,5 +62,13 @@ typedef struct lw_scene {
 /* Builds the scene; messages name the parameter's file and line. */
 lw_status lw_scene_init(lw_scene *sc, const lw_params *p, lw_error *err);
 void lw_scene_clear(lw_scene *sc);
+
+/* Registers fn as the user term with coefficient coef: its energy is
+** coef * fn(samples, quad, data) summed over all segments (term name
+** "user").  coef = 0 turns it off again.  Call it before building a model on
+** the scene (models cache the term list); data must outlive those models.
+** LW_EINPUT if coef is not finite or fn is NULL while coef != 0. */
+lw_status lw_scene_set_user_term(lw_scene *sc, double coef, lw_user_term_fn fn, const void *data,
+                                 lw_error *err);
 
 #endif

@@ -1,5 +1,5 @@
 /*
-** terms.h -- the six energy terms as pure functions of a segment's samples.
+** terms.h -- the energy terms as pure functions of a segment's samples.
 **
 ** Integrals run over the segment parameter s in [0,1] with the Gauss-Legendre
 ** weights of the scene's quadrature (w_q, sum 1).  Each function returns the
@@ -12,6 +12,8 @@
 **   field     P * int r' . v(r) ds      (signed)   or   P * int |r' . v(r)| ds (axial)
 **   pair      C * sum of sample-pair kernels between different splines (pair.h)
 **   boundary  R * int f(d(r)) |r'| ds,  f(d) = 1/d^2 for d < 0, +infinity for d >= 0
+**   user      coef * fn(samples), a per-segment energy registered by the caller
+**             (lw_scene_set_user_term in scene.h); never set from a scene file
 **
 ** Degenerate samples never produce NaN: a sample with r' = 0 contributes 0 to
 ** bending (r' = 0 forces the numerator to 0 as well; the curvature of a point
@@ -34,6 +36,7 @@ typedef enum {
   LW_TERM_FIELD,
   LW_TERM_PAIR,
   LW_TERM_BOUNDARY,
+  LW_TERM_USER,
   LW_TERM_COUNT
 } lw_term_id;
 

@@ -1,0 +1,438 @@
+/*
+** test_stats.c -- the sampler is correct: the real chain (lw_chain proposing
+** through lw_model) against exact statistical results.
+**
+**   1. acceptance of Gaussian point moves on a harmonic degree of freedom
+**      against the closed forms, for several step sizes;
+**   2. the sampled distribution of a small system against its Boltzmann
+**      distribution (chi-square), with the step tuning frozen, and a wrong
+**      temperature that the same test must reject;
+**   3. a free worm-like chain (bending, strain holding its length) against
+**      the 2-D Kratky-Porod results.
+**
+** Seeds are fixed, so each test is deterministic; every tolerance is derived
+** from the variance of the estimate and stated where it is used.  `make test`
+** runs quick versions; `make test-long` (LW_LONG=1) runs longer ones with
+** tighter statistics.  Derivations: docs/NUMERICS.md, "Statistical tests".
+*/
+#include <criterion/criterion.h>
+#include <gsl/gsl_cdf.h>
+#include <gsl/gsl_math.h>
+#include <math.h>
+#include <stdlib.h>
+
+#include "linewise/mc.h"
+#include "linewise/model.h"
+#include "linewise/scene.h"
+#include "testutil.h"
+
+/* ---- the harmonic well (a user term) ------------------------------------ */
+
+/*
+** E = 1/2 sum_q w_q [kx (x_q - cx)^2 + ky (y_q - cy)^2] per segment.  Each
+** sample x_q is linear in every point coordinate, x_q = a_q p + (rest), so E
+** is exactly quadratic in p: given all other coordinates, p is Gaussian with
+** variance T / K, K = kx sum_q w_q a_q^2 (summed over the segments holding p),
+** whatever the others are.  That is the harmonic degree of freedom of the
+** acceptance test, exact to rounding (no quadrature error enters: the
+** quadrature defines the energy).
+*/
+typedef struct {
+  double kx, ky, cx, cy;
+} well;
+
+static double well_energy(const lw_samples *s, const lw_quad *q, const void *data)
+{
+  const well *w = data;
+  double e = 0.0;
+  for (int i = 0; i < s->n; i++) {
+    double dx = s->x[i] - w->cx, dy = s->y[i] - w->cy;
+    e += q->w[i] * (w->kx * dx * dx + w->ky * dy * dy);
+  }
+  return 0.5 * e;
+}
+
+/* sum_q w_q c_q d_q for basis columns c, d of r (0: p0, 1: v0, 2: p1, 3: v1) */
+static double basis_dot(const lw_quad *q, int c, int d)
+{
+  double s = 0.0;
+  for (int i = 0; i < q->n; i++) s += q->w[i] * q->pos[i][c] * q->pos[i][d];
+  return s;
+}
+
+/* A scene with nothing but the well (every built-in term off). */
+static void well_scene(lw_scene *sc, const well *w)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  lw_error err;
+  cr_assert_eq(lw_scene_init(sc, &p, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_scene_set_user_term(sc, 1.0, well_energy, w, &err), LW_OK, "%s", err.msg);
+}
+
+/* n one-segment straight splines of length 1 at the well's centre. */
+static lw_splines *unit_splines(size_t n, double cx, double cy)
+{
+  size_t *segs = malloc(n * sizeof *segs);
+  for (size_t i = 0; i < n; i++) segs[i] = 1;
+  lw_splines *sp = lw_splines_new(n, segs, NULL);
+  free(segs);
+  cr_assert_not_null(sp);
+  for (size_t i = 0; i < n; i++) lw_test_straight(sp, i, cx - 0.5, cy, cx + 0.5, cy);
+  return sp;
+}
+
+static lw_chain *point_chain(lw_model *m, double step, unsigned long seed)
+{
+  double w[LW_MOVE_KINDS] = {1, 0, 0, 0}, st[LW_MOVE_KINDS] = {step, 1, 1, 0.1},
+         tg[LW_MOVE_KINDS] = {0.44, 0.44, 0.3, 0.3};
+  lw_error err;
+  lw_chain *c = lw_chain_new(m, w, st, tg, seed, &err);
+  cr_assert_not_null(c, "%s", err.msg);
+  c->temperature = 1.0;
+  return c;
+}
+
+/* ---- 1. acceptance rates ------------------------------------------------- */
+
+/*
+** Metropolis with a symmetric Gaussian step of std s on a Gaussian target of
+** std sigma, in d dimensions, at stationarity (docs/NUMERICS.md):
+**   d = 1:  a = (2 / pi) atan(2 sigma / s)
+**   d = 2:  a = 1 - s / sqrt(s^2 + 4 sigma^2)   (isotropic target and step)
+** A point move steps x and y together.  With ky = 0 the energy does not see
+** y, so the acceptance is that of the x step alone (d = 1); with kx = ky it
+** is the isotropic d = 2 case.
+*/
+static double acceptance_exact(int d, double sigma, double s)
+{
+  return d == 1 ? M_2_PI * atan(2.0 * sigma / s) : 1.0 - s / sqrt(s * s + 4.0 * sigma * sigma);
+}
+
+Test(stats, point_move_acceptance_matches_the_gaussian_closed_forms)
+{
+  const int longrun = lw_test_long();
+  const size_t n_spl = 50;
+  const long N = longrun ? 4000000 : 200000; /* proposals per step size */
+  const int B = 50;                            /* batches for the error estimate */
+  const double ratios[] = {0.3, 1.0, 2.4, 6.0}; /* s / sigma of the start points */
+  for (int d = 1; d <= 2; d++)
+    for (size_t r = 0; r < sizeof ratios / sizeof ratios[0]; r++) {
+      lw_scene sc;
+      well w = {1.0, 0.0, 100.0, 100.0};
+      well_scene(&sc, &w);
+      /* kx such that the start point's x has conditional sigma 1 at T = 1;
+      ** the end point's sigma follows from its own basis column (equal by
+      ** the symmetry of the Gauss nodes, but computed, not assumed). */
+      double k0 = basis_dot(&sc.quad, 0, 0), k1 = basis_dot(&sc.quad, 2, 2);
+      w.kx = 1.0 / k0;
+      w.ky = d == 1 ? 0.0 : w.kx;
+      double sig0 = 1.0, sig1 = sqrt(k0 / k1);
+      double s = ratios[r] * sig0;
+      /* half the proposals pick a start point, half an end point */
+      double a = 0.5 * (acceptance_exact(d, sig0, s) + acceptance_exact(d, sig1, s));
+
+      lw_model *m = lw_model_new(&sc, unit_splines(n_spl, w.cx, w.cy), NULL);
+      cr_assert_not_null(m);
+      lw_chain *c = point_chain(m, s, 1000 + 10 * (unsigned long)d + r);
+      for (int k = 0; k < 50; k++) lw_chain_sweep(c); /* reach stationarity */
+      cr_assert_eq(c->step[LW_MOVE_POINT], s, "tuning is off: the step must not move");
+
+      /* Batch means: successive proposals are correlated through the state,
+      ** so the standard error of the rate comes from the scatter of B batch
+      ** rates (batches of N/B = 4000+ proposals, ~40 per node, far longer
+      ** than the correlation time of a node's acceptance), floored at the
+      ** binomial value sqrt(a (1 - a) / N) that independent draws would give. */
+      double sum = 0.0, sum2 = 0.0;
+      long per = N / B, acc_all = 0;
+      for (int b = 0; b < B; b++) {
+        long acc = 0;
+        for (long k = 0; k < per; k++) acc += lw_chain_step(c, LW_MOVE_POINT) == 1;
+        double rb = (double)acc / (double)per;
+        sum += rb;
+        sum2 += rb * rb;
+        acc_all += acc;
+      }
+      double rate = (double)acc_all / (double)(per * B);
+      double var_b = (sum2 - sum * sum / B) / (B - 1);
+      double se = fmax(sqrt(var_b / B), sqrt(a * (1.0 - a) / (double)(per * B)));
+      cr_log_info("acceptance d=%d s/sigma=%.1f: %.5f exact %.5f se %.1e", d, ratios[r], rate, a, se);
+      /* 5 standard errors: a false failure has probability ~ 6e-7 */
+      cr_assert(fabs(rate - a) <= 5.0 * se,
+                "d=%d s/sigma=%.2f: acceptance %.5f, exact %.5f, standard error %.2g", d, ratios[r],
+                rate, a, se);
+      cr_assert_eq(c->stats[LW_MOVE_POINT].nan, 0);
+      lw_chain_free(c);
+      lw_model_free(m);
+      lw_scene_clear(&sc);
+    }
+}
+
+/* ---- 2. the Boltzmann distribution (chi-square) -------------------------- */
+
+/*
+** Integrated autocorrelation time (in records) of n_ser series of length n
+** stored series-major, from the averaged autocorrelation with Sokal's
+** self-consistent window W >= 5 tau.
+*/
+static double autocorrelation_time(const double *x, size_t n_ser, size_t n)
+{
+  double c0 = 0.0, tau = 0.5;
+  double *mean = malloc(n_ser * sizeof *mean);
+  for (size_t j = 0; j < n_ser; j++) {
+    double m = 0.0;
+    for (size_t t = 0; t < n; t++) m += x[j * n + t];
+    mean[j] = m / (double)n;
+    for (size_t t = 0; t < n; t++) c0 += (x[j * n + t] - mean[j]) * (x[j * n + t] - mean[j]);
+  }
+  for (size_t k = 1; k < n / 2; k++) {
+    double ck = 0.0;
+    for (size_t j = 0; j < n_ser; j++)
+      for (size_t t = 0; t + k < n; t++) ck += (x[j * n + t] - mean[j]) * (x[j * n + t + k] - mean[j]);
+    tau += ck / c0 * (double)n / (double)(n - k);
+    if ((double)k >= 5.0 * tau) break;
+  }
+  free(mean);
+  return tau;
+}
+
+/* Chi-square p-value of the samples against N(mu, sd^2) in nb bins of equal
+** probability (expected count n / nb each). */
+static double gaussian_chisq_p(const double *x, size_t n, double mu, double sd, int nb)
+{
+  long count[64] = {0};
+  for (size_t i = 0; i < n; i++) {
+    int b = (int)floor(gsl_cdf_ugaussian_P((x[i] - mu) / sd) * nb);
+    count[b < 0 ? 0 : b >= nb ? nb - 1 : b]++;
+  }
+  double e = (double)n / nb, chi2 = 0.0;
+  for (int b = 0; b < nb; b++) chi2 += (count[b] - e) * (count[b] - e) / e;
+  return gsl_cdf_chisq_Q(chi2, nb - 1);
+}
+
+/*
+** The small system: one-segment splines in the well (kx = ky), moved by
+** point moves with tuned, then frozen, steps.  The two point x-coordinates
+** of a spline are coupled through the samples: their joint density is
+** exp(-(kx / 2T) (u - mu)^T M (u - mu)) with M_cd = sum_q w_q a_qc a_qd (a the
+** basis columns of p0 and p1), mu solving M mu = sum_q w_q (cx - e_q) a_q
+** where e_q carries the fixed vectors.  So p0.x is exactly Gaussian with
+** variance (T / kx) (M^-1)_00 = (T / kx) M_11 / det M.
+*/
+Test(stats, sampled_coordinates_follow_the_boltzmann_distribution)
+{
+  const int longrun = lw_test_long();
+  const size_t n_spl = 50, n_keep = longrun ? 4000 : 400; /* records of every spline */
+  const double T = 0.7;
+  well w = {2.0, 2.0, 60.0, 40.0};
+  lw_scene sc;
+  well_scene(&sc, &w);
+  lw_model *m = lw_model_new(&sc, unit_splines(n_spl, w.cx, w.cy), NULL);
+  lw_chain *c = point_chain(m, 3.0, 4242);
+  c->temperature = T;
+
+  const lw_quad *q = &sc.quad;
+  const lw_node *nd = m->sp->node; /* the vectors never move under point moves */
+  double M00 = basis_dot(q, 0, 0), M01 = basis_dot(q, 0, 2), M11 = basis_dot(q, 2, 2);
+  double b0 = 0.0, b1 = 0.0;
+  for (int i = 0; i < q->n; i++) {
+    double rest = w.cx - q->pos[i][1] * nd[0].vx - q->pos[i][3] * nd[1].vx;
+    b0 += q->w[i] * rest * q->pos[i][0];
+    b1 += q->w[i] * rest * q->pos[i][2];
+  }
+  double det = M00 * M11 - M01 * M01;
+  double mu = (M11 * b0 - M01 * b1) / det, sd = sqrt(T / w.kx * M11 / det);
+
+  /* tune, then freeze: sampling must use a fixed step (detailed balance) */
+  c->tuning = 1;
+  for (int k = 0; k < 200; k++) lw_chain_sweep(c);
+  c->tuning = 0;
+  double step = c->step[LW_MOVE_POINT];
+
+  /* pilot run: the autocorrelation time of p0.x in sweeps */
+  const size_t n_pilot = 2000;
+  double *x = malloc(n_spl * (n_pilot > n_keep ? n_pilot : n_keep) * sizeof *x);
+  for (size_t t = 0; t < n_pilot; t++) {
+    lw_chain_sweep(c);
+    for (size_t j = 0; j < n_spl; j++) x[j * n_pilot + t] = m->sp->node[m->sp->first[j]].px;
+  }
+  double tau = autocorrelation_time(x, n_spl, n_pilot);
+  cr_assert(tau > 0.5 && tau < 50, "autocorrelation time %.2f sweeps is implausible", tau);
+  /* Records 3 tau apart: residual correlations inflate the chi-square by
+  ** about 1 + 2 sum_k exp(-3k) ~ 1.1, small against the 1e-3 threshold. */
+  long thin = (long)ceil(3.0 * tau);
+  for (size_t t = 0; t < n_keep; t++) {
+    for (long k = 0; k < thin; k++) lw_chain_sweep(c);
+    for (size_t j = 0; j < n_spl; j++) x[t * n_spl + j] = m->sp->node[m->sp->first[j]].px;
+  }
+  cr_assert_eq(c->step[LW_MOVE_POINT], step, "frozen step moved");
+  size_t n = n_keep * n_spl;
+  double p = gaussian_chisq_p(x, n, mu, sd, 20);
+  /* Power: the same samples against the Boltzmann distribution of a 10%
+  ** higher temperature (sd 5% wider) must fail the same test. */
+  double p_wrong_t = gaussian_chisq_p(x, n, mu, sd * sqrt(1.1), 20);
+  /* and against a mean off by 0.05 standard deviations */
+  double p_wrong_mu = gaussian_chisq_p(x, n, mu + 0.05 * sd, sd, 20);
+  cr_log_info("chi-square: tau %.2f sweeps, thin %ld, %zu samples: p %.3g, wrong T p %.3g, wrong mean p %.3g",
+              tau, thin, n, p, p_wrong_t, p_wrong_mu);
+  cr_assert(p > 1e-3, "p0.x does not follow its Boltzmann distribution: p = %.3g", p);
+  cr_assert(p_wrong_t < 1e-3, "the test cannot tell T from 1.1 T: p = %.3g", p_wrong_t);
+  cr_assert(p_wrong_mu < 1e-3, "the test cannot see a 0.05 sd shift: p = %.3g", p_wrong_mu);
+  free(x);
+  lw_chain_free(c);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+/* ---- 3. the worm-like chain ----------------------------------------------- */
+
+/*
+** E = B int kappa^2 dl makes the tangent angle a random walk in arc length
+** with variance 2 s / l_p, l_p = 4 B / T, so (docs/NUMERICS.md)
+**     <cos(theta(s) - theta(0))> = exp(-s / l_p)
+**     <R^2> = 2 l_p L [1 - (l_p / L)(1 - exp(-L / l_p))]        (Kratky-Porod, 2-D)
+**
+** The Bezier chain is this continuum chain seen at its nodes only if its
+** parametrisation is held: for a straight segment the handle lengths |v|
+** change nothing (any |v| up to the segment length gives the same line), so
+** they roam freely, and every curved shape then costs more bending than the
+** arc it approximates.  Left free they make the chain ~1.4 times stiffer at
+** any resolution (measured; docs/NUMERICS.md).  The test holds them with the
+** user term K int (|r'| - l0)^2 ds (uniform speed), next to the per-segment
+** strain that holds the length.
+**
+** Discretisation limits, measured at l0 / l_p = 0.05 to 0.2 with the
+** parameters below: (a) node tangents decorrelate as a chain with l_p 3 to 4%
+** longer at l0 / l_p <= 0.1 (8% at 0.2): the residual handle fluctuations;
+** (b) R^2 exceeds Kratky-Porod by ~0.17 l0 / l_p: a cubic cannot carry the
+** sub-segment wiggles of the continuum, which shorten R^2 at fixed L by up
+** to l0 / (3 l_p).  The bounds used are 6% for (a) and 0.33 l0 / l_p plus
+** the effect of (a) on R^2 for (b), each plus 4 standard errors.
+*/
+static double speed_hold(const lw_samples *s, const lw_quad *q, const void *data)
+{
+  double l0 = *(const double *)data, e = 0.0;
+  for (int i = 0; i < s->n; i++) e += q->w[i] * (s->speed[i] - l0) * (s->speed[i] - l0);
+  return e;
+}
+
+static double kratky_porod(double lp, double L)
+{
+  return 2.0 * lp * L * (1.0 - lp / L * (1.0 - exp(-L / lp)));
+}
+
+/* Mean and standard error over n independent values. */
+static void mean_se(const double *v, size_t n, double *mean, double *se)
+{
+  double s = 0.0, s2 = 0.0;
+  for (size_t i = 0; i < n; i++) s += v[i];
+  *mean = s / (double)n;
+  for (size_t i = 0; i < n; i++) s2 += (v[i] - *mean) * (v[i] - *mean);
+  *se = sqrt(s2 / (double)(n - 1) / (double)n);
+}
+
+Test(stats, free_chain_matches_the_worm_like_chain)
+{
+  const int longrun = lw_test_long();
+  /* quick: 4 segments (L / l_p = 0.4); long: 8 (L / l_p = 0.8) with ten
+  ** times the statistics.  Correlation times of the end-to-end tangent
+  ** measured: ~180 sweeps at 4 segments, ~600 at 8, growing ~ n^3 with
+  ** local moves (so 20 segments, L / l_p = 2, would need hours); burn-in is
+  ** > 20 of them, the sampled run > 100 per chain. */
+  const size_t n_seg = longrun ? 8 : 4, n_ch = 50;
+  const long burn = longrun ? 20000 : 4000, sweeps = longrun ? 400000 : 20000, every = 5;
+  const double T = 1.0, l0 = 1.0, lp = 10.0;
+  static const double l0_hold = 1.0;
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = p.height = 1000;
+  p.bending = lp * T / 4.0;
+  p.strain = 200.0 * T / l0; /* per segment: length sd ~ sqrt(T l0 / 2S) = 5% */
+  p.strain_mode = LW_STRAIN_SEGMENT;
+  lw_scene sc;
+  lw_error err;
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
+  /* K l0^2 = 100 T: speed sd ~10% per sample */
+  cr_assert_eq(lw_scene_set_user_term(&sc, 100.0 * T / (l0 * l0), speed_hold, &l0_hold, &err), LW_OK);
+  size_t *segs = malloc(n_ch * sizeof *segs);
+  for (size_t i = 0; i < n_ch; i++) segs[i] = n_seg;
+  lw_splines *sp = lw_splines_new(n_ch, segs, NULL);
+  free(segs);
+  for (size_t i = 0; i < n_ch; i++) lw_test_straight(sp, i, 500 - 0.5 * n_seg * l0, 500, 500 + 0.5 * n_seg * l0, 500);
+  lw_model *m = lw_model_new(&sc, sp, &err);
+  cr_assert_not_null(m, "%s", err.msg);
+  double w[LW_MOVE_KINDS] = {1, 1, 0, 0}, st[LW_MOVE_KINDS] = {0.1, 0.1, 1, 0.1},
+         tg[LW_MOVE_KINDS] = {0.44, 0.44, 0.3, 0.3};
+  lw_chain *c = lw_chain_new(m, w, st, tg, 31337, &err);
+  c->temperature = T;
+  c->tuning = 1;
+  for (int k = 0; k < 200; k++) lw_chain_sweep(c);
+  c->tuning = 0;
+  for (long k = 0; k < burn; k++) lw_chain_sweep(c);
+
+  /* per chain: time averages of cos at each lag, of R^2 and of L */
+  const size_t nl = n_seg + 1;
+  double *cosl = calloc(n_ch * nl, sizeof *cosl), *r2 = calloc(n_ch, sizeof *r2);
+  double *arc = calloc(nl, sizeof *arc), L = 0.0, theta[64], s[64];
+  long n_rec = 0;
+  for (long k = 0; k < sweeps; k++) {
+    lw_chain_sweep(c);
+    if (k % every) continue;
+    n_rec++;
+    for (size_t i = 0; i < n_ch; i++) {
+      const lw_node *nd = &m->sp->node[m->sp->first[i]];
+      size_t g0 = lw_segment_index(m->sp, i, 0);
+      s[0] = 0.0;
+      for (size_t j = 0; j <= n_seg; j++) {
+        theta[j] = atan2(nd[j].vy, nd[j].vx);
+        if (j < n_seg) s[j + 1] = s[j] + m->seg_len[g0 + j];
+      }
+      for (size_t d = 1; d <= n_seg; d++) {
+        double sum = 0.0;
+        for (size_t j = 0; j + d <= n_seg; j++) {
+          sum += cos(theta[j + d] - theta[j]);
+          arc[d] += s[j + d] - s[j];
+        }
+        cosl[i * nl + d] += sum / (double)(n_seg + 1 - d);
+      }
+      double dx = nd[n_seg].px - nd[0].px, dy = nd[n_seg].py - nd[0].py;
+      r2[i] += dx * dx + dy * dy;
+      L += s[n_seg];
+    }
+  }
+  /* Chains are independent: the scatter of their time averages gives honest
+  ** standard errors whatever the autocorrelation within a chain. */
+  double v[64], mean, se;
+  L /= (double)(n_rec * n_ch);
+  for (size_t d = 1; d <= n_seg; d++) {
+    for (size_t i = 0; i < n_ch; i++) v[i] = cosl[i * nl + d] / (double)n_rec;
+    mean_se(v, n_ch, &mean, &se);
+    double sd_arc = arc[d] / (double)(n_rec * n_ch * (n_seg + 1 - d));
+    /* l_p seen at this lag, and its standard error by the delta method */
+    double lp_d = -sd_arc / log(mean), lp_se = sd_arc * se / (mean * log(mean) * log(mean));
+    cr_log_info("wlc lag %zu: <cos> %.4f +- %.4f (exact %.4f), l_p %.3f +- %.3f", d, mean, se,
+                exp(-sd_arc / lp), lp_d, lp_se);
+    if (d == 1 || d == n_seg) {
+      cr_assert(fabs(lp_d / lp - 1.0) <= 0.06 + 4.0 * lp_se / lp,
+                "lag %zu: tangents decorrelate with l_p %.3f +- %.3f, expected %.3f", d, lp_d, lp_se, lp);
+    }
+    /* power: a 25% error in the stiffness lies outside the band at lag 1 */
+    if (d == 1)
+      cr_assert(fabs(lp_d / (1.25 * lp) - 1.0) > 0.06 + 4.0 * lp_se / lp, "no power to see l_p off by 25%%");
+  }
+  for (size_t i = 0; i < n_ch; i++) v[i] = r2[i] / (double)n_rec;
+  mean_se(v, n_ch, &mean, &se);
+  double kp = kratky_porod(lp, L);
+  /* bias bound: sub-segment wiggles (0.33 l0 / l_p) plus a 6% longer l_p */
+  double bias = 0.33 * l0 / lp + fabs(kratky_porod(1.06 * lp, L) / kp - 1.0);
+  cr_log_info("wlc R^2 %.4f +- %.4f, Kratky-Porod %.4f (L %.4f): %+.4f, bound %.4f", mean, se, kp, L,
+              mean / kp - 1.0, bias);
+  cr_assert(fabs(mean / kp - 1.0) <= bias + 4.0 * se / kp, "<R^2> %.4f +- %.4f against Kratky-Porod %.4f",
+            mean, se, kp);
+  free(cosl);
+  free(r2);
+  free(arc);
+  lw_chain_free(c);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
