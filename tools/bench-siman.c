@@ -191,7 +191,7 @@ static long run_linewise(bench_run *r, double T0, double T1, double seconds, tra
   trace_start(tr, lw_model_total(r->model));
   trace_add(tr, tr->best, 1);
   long n = 0;
-  int level = -1;
+  int level = -1, tuned = 0;
   double log_step = 0.0;
   for (;;) {
     double t = bench_now() - tr->t0;
@@ -205,13 +205,14 @@ static long run_linewise(bench_run *r, double T0, double T1, double seconds, tra
     if (c->tuning && t >= (level + 0.2) * seconds / LEVELS) {
       c->tuning = 0;
       log_step += 0.5 * (log(c->step[LW_MOVE_POINT]) + log(c->step[LW_MOVE_VECTOR]));
+      tuned++;
     }
     for (int k = 0; k < 64; k++) lw_chain_step(c, (lw_move_kind)(k & 1));
     n += 64;
     trace_add(tr, lw_model_total(r->model), 0);
   }
   trace_add(tr, tr->best, 1);
-  *mean_step = exp(log_step / LEVELS);
+  *mean_step = tuned ? exp(log_step / tuned) : c->step[LW_MOVE_POINT];
   return n;
 }
 
