@@ -118,15 +118,24 @@ docs: bin/linewise
 	{ sed '/^| schedule |/,$$d' docs/SCHEDULES.md | sed '$$d'; bin/linewise schedules; } > docs/SCHEDULES.md.new
 	mv docs/SCHEDULES.md.new docs/SCHEDULES.md
 
-$(BUILD)/bench $(BUILD)/bench-tempering: $(BUILD)/%: tools/%.c $(BUILD)/liblinewise.a
-	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) $< -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
+# The benchmark: tools/bench*.c with the shared pieces in tools/benchutil.c and
+# the two-curve reference of the tests (tests/pairref.h).
+BENCH_SRC := tools/bench.c tools/bench-accuracy.c tools/bench-siman.c tools/bench-tempering.c tools/benchutil.c
+BENCH_HDR := tools/benchutil.h tests/pairref.h tests/testutil.h $(wildcard include/linewise/*.h)
+TOOL_FLAGS = $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -Itools -Itests
 
-# Benchmarks rewrite docs/PERFORMANCE.md (machine and date recorded with them).
-bench: $(BUILD)/bench $(BUILD)/bench-tempering
-	{ echo "# Performance"; echo; \
-	  echo "Written by \`make bench\` on $$(date -u +%Y-%m-%d), $$(nproc) cores, $$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')."; \
-	  echo; $(BUILD)/bench 5; echo; $(BUILD)/bench-tempering 5; } > docs/PERFORMANCE.md.new
-	mv docs/PERFORMANCE.md.new docs/PERFORMANCE.md
+$(BUILD)/bench: $(BENCH_SRC) $(BENCH_HDR) $(BUILD)/liblinewise.a
+	$(CC) $(TOOL_FLAGS) -DBENCH_CFLAGS='"$(CFLAGS)"' $(BENCH_SRC) -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
+
+$(BUILD)/pair-accuracy: tools/pair-accuracy.c tools/benchutil.c $(BENCH_HDR) $(BUILD)/liblinewise.a
+	$(CC) $(TOOL_FLAGS) tools/pair-accuracy.c tools/benchutil.c -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
+
+# Benchmarks rewrite docs/PERFORMANCE.md and docs/ACCURACY.md (machine and date
+# recorded with them) and their plots docs/*.png; BENCH_QUICK=1 for a smoke run.
+bench: $(BUILD)/bench
+	mkdir -p $(BUILD)/bench-data
+	$(BUILD)/bench docs $(BUILD)/bench-data
+	gnuplot -e "data='$(BUILD)/bench-data'; out='docs'" tools/bench.gp
 
 install: $(BIN)/linewise $(PICTURE)
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/linewise/params

@@ -10,6 +10,7 @@
 #include "linewise/pair.h"
 #include "linewise/quad.h"
 #include "linewise/spline.h"
+#include "pairref.h"
 #include "testutil.h"
 
 /* The recommended default near-field radius (pair.h, tools/pair-accuracy.c). */
@@ -98,49 +99,10 @@ static double seg(const double p[8])
   return lw_pair_segseg(p, p + 2, p + 4, p + 6);
 }
 
-/* A straight spline from p to q: equally spaced points, v_k = (p_{k+1} - p_k)/3,
-** so the parametrisation is uniform and r' is constant. */
+/* A straight spline from p to q with uniform parametrisation (r' constant). */
 static void straight(lw_splines *sp, size_t i, const double p[2], const double q[2])
 {
-  size_t m = lw_splines_segments(sp, i);
-  for (size_t k = 0; k <= m; k++) {
-    lw_node *nd = &sp->node[sp->first[i] + k];
-    double t = (double)k / (double)m;
-    nd->px = p[0] + t * (q[0] - p[0]);
-    nd->py = p[1] + t * (q[1] - p[1]);
-    nd->vx = (q[0] - p[0]) / (3.0 * (double)m);
-    nd->vy = (q[1] - p[1]) / (3.0 * (double)m);
-  }
-}
-
-/* An arc of the circle (cx, cy, R) from angle t0 to t1 in the standard cubic
-** approximation (handles 4/3 tan(dt/4) R), one segment per equal angle step. */
-static void arc(lw_splines *sp, size_t i, double cx, double cy, double R, double t0, double t1)
-{
-  size_t m = lw_splines_segments(sp, i);
-  double dt = (t1 - t0) / (double)m, k = 4.0 / 3.0 * tan(dt / 4.0) * R;
-  for (size_t j = 0; j <= m; j++) {
-    double t = t0 + (double)j * dt;
-    lw_node *nd = &sp->node[sp->first[i] + j];
-    nd->px = cx + R * cos(t);
-    nd->py = cy + R * sin(t);
-    nd->vx = -k * sin(t);
-    nd->vy = k * cos(t);
-  }
-}
-
-/* All samples of spline i as the pair term sees them; returns the count. */
-static size_t spline_samples(const lw_splines *sp, const lw_quad *q, size_t i, lw_pair_sample *out)
-{
-  size_t n = 0;
-  for (size_t m = 0; m < lw_splines_segments(sp, i); m++) {
-    size_t g = lw_segment_index(sp, i, m), k = lw_segment_node(sp, g);
-    lw_samples s;
-    lw_segment_sample(q, &sp->node[k], &sp->node[k + 1], &s);
-    for (int j = 0; j < s.n; j++)
-      out[n++] = (lw_pair_sample){s.x[j], s.y[j], s.dx[j], s.dy[j], s.dl[j], (uint32_t)i, (uint32_t)j};
-  }
-  return n;
+  lw_test_straight(sp, i, p[0], p[1], q[0], q[1]);
 }
 
 /* The pair energy (no coefficient) between splines 0 and 1: the kernel
@@ -154,8 +116,8 @@ static double pair_energy(const lw_splines *sp, int nq, double cutoff, double ne
   size_t na = lw_splines_segments(sp, 0) * (size_t)nq, nb = lw_splines_segments(sp, 1) * (size_t)nq;
   lw_pair_sample *A = malloc(na * sizeof *A), *B = malloc(nb * sizeof *B);
   cr_assert(A && B);
-  cr_assert_eq(spline_samples(sp, &q, 0, A), na);
-  cr_assert_eq(spline_samples(sp, &q, 1, B), nb);
+  cr_assert_eq(lw_pairref_samples(sp, &q, 0, A), na);
+  cr_assert_eq(lw_pairref_samples(sp, &q, 1, B), nb);
   double e = 0.0;
   for (size_t i = 0; i < na; i++)
     for (size_t j = 0; j < nb; j++) e += lw_pair_kernel(&A[i], &B[j], &ctx);
@@ -520,63 +482,6 @@ Test(pair, near_field_off_is_the_product_rule)
 
 /* ---- the kernel: curved splines ------------------------------------------ */
 
-/* Brute-force pair energy of two splines over the exact Bezier curves:
-** nested qagp in the splines' global parameters, split at every segment
-** boundary (and the outer one at quarter segments). */
-typedef struct {
-  const lw_splines *sp;
-  double x, y;
-  gsl_integration_workspace *wi;
-} cv_ctx;
-
-static void spline_eval(const lw_splines *sp, size_t i, double u, double r[2], double d[2])
-{
-  size_t m = lw_splines_segments(sp, i), g = (size_t)floor(u);
-  if (g >= m) g = m - 1;
-  const lw_node *a = &sp->node[sp->first[i] + g];
-  lw_segment_eval(a, a + 1, u - (double)g, r, d, NULL);
-}
-
-static double cv_inner(double t, void *p)
-{
-  const cv_ctx *c = p;
-  double r[2], d[2];
-  spline_eval(c->sp, 1, t, r, d);
-  return hypot(d[0], d[1]) / hypot(r[0] - c->x, r[1] - c->y);
-}
-
-static double cv_outer(double s, void *p)
-{
-  cv_ctx *c = p;
-  double r[2], d[2], pts[65];
-  spline_eval(c->sp, 0, s, r, d);
-  c->x = r[0];
-  c->y = r[1];
-  size_t mb = lw_splines_segments(c->sp, 1);
-  for (size_t k = 0; k <= mb; k++) pts[k] = (double)k;
-  gsl_function F = {cv_inner, c};
-  double res, err;
-  gsl_integration_qagp(&F, pts, mb + 1, 0.0, 1e-12, 1000, c->wi, &res, &err);
-  return res * hypot(d[0], d[1]);
-}
-
-static double curve_reference(const lw_splines *sp)
-{
-  gsl_error_handler_t *old = gsl_set_error_handler_off();
-  cv_ctx c = {sp, 0, 0, gsl_integration_workspace_alloc(1000)};
-  gsl_integration_workspace *wo = gsl_integration_workspace_alloc(1000);
-  size_t ma = lw_splines_segments(sp, 0), n = 0;
-  double pts[257];
-  for (size_t k = 0; k <= 4 * ma; k++) pts[n++] = 0.25 * (double)k;
-  gsl_function F = {cv_outer, &c};
-  double res, err;
-  gsl_integration_qagp(&F, pts, n, 0.0, 1e-11, 1000, wo, &res, &err);
-  gsl_integration_workspace_free(wo);
-  gsl_integration_workspace_free(c.wi);
-  gsl_set_error_handler(old);
-  return res;
-}
-
 /*
 ** Quarter circles (4 segments each) of radii 3 and 2, one bulging down onto
 ** the other: touching tangentially at a spline node, crossing at a shallow
@@ -594,18 +499,18 @@ Test(pair, curved_arcs_touching_or_crossing_match_reference)
   } C[] = {{"touching", 0.0, 0.0, 5e-3}, {"crossing steeply", 0.4, 0.3, 1e-3}, {"crossing shallowly", 0.4, 0.05, 1e-3}};
   for (size_t k = 0; k < sizeof C / sizeof C[0]; k++) {
     lw_splines *sp = two_splines(4, 4);
-    arc(sp, 0, 0.0, 3.0, 3.0, -0.75 * PI, -0.25 * PI);                 /* bottom of a circle, r = 3 */
-    arc(sp, 1, C[k].cx, -2.0 + C[k].lift, 2.0, 0.25 * PI, 0.75 * PI); /* top of a circle, r = 2 */
-    double ref = curve_reference(sp), e = pair_energy(sp, 8, 0.0, NEAR_DEFAULT);
+    lw_test_arc(sp, 0, 0.0, 3.0, 3.0, -0.75 * PI, -0.25 * PI);                 /* bottom of a circle, r = 3 */
+    lw_test_arc(sp, 1, C[k].cx, -2.0 + C[k].lift, 2.0, 0.25 * PI, 0.75 * PI); /* top of a circle, r = 2 */
+    double ref = lw_pairref_energy(sp), e = pair_energy(sp, 8, 0.0, NEAR_DEFAULT);
     cr_assert(isfinite(e) && lw_close_rel(e, ref, C[k].tol, 0.0), "%s: %.10g vs %.10g (rel %.1e)", C[k].name, e,
               ref, fabs(e / ref - 1));
     lw_splines_free(sp);
   }
   /* touching, with the arcs cut into 16 segments each: error down ~4x */
   lw_splines *sp = two_splines(16, 16);
-  arc(sp, 0, 0.0, 3.0, 3.0, -0.75 * PI, -0.25 * PI);
-  arc(sp, 1, 0.0, -2.0, 2.0, 0.25 * PI, 0.75 * PI);
-  double ref = curve_reference(sp), e = pair_energy(sp, 8, 0.0, NEAR_DEFAULT);
+  lw_test_arc(sp, 0, 0.0, 3.0, 3.0, -0.75 * PI, -0.25 * PI);
+  lw_test_arc(sp, 1, 0.0, -2.0, 2.0, 0.25 * PI, 0.75 * PI);
+  double ref = lw_pairref_energy(sp), e = pair_energy(sp, 8, 0.0, NEAR_DEFAULT);
   cr_assert(lw_close_rel(e, ref, 1e-3, 0.0), "touching, 16 segments: %.10g vs %.10g (rel %.1e)", e, ref,
             fabs(e / ref - 1));
   lw_splines_free(sp);

@@ -85,4 +85,19 @@ static inline int lw_test_dir_remove(const char *dir)
   return system(cmd);
 }
 
+/* Spline i of sp becomes an arc of the circle (cx, cy, R) from angle t0 to t1
+** in the standard cubic approximation (handles 4/3 tan(dt/4) R), one segment
+** per equal angle step; the rest length is the arc's length. */
+static inline void lw_test_arc(lw_splines *sp, size_t i, double cx, double cy, double R, double t0, double t1)
+{
+  size_t m = lw_splines_segments(sp, i);
+  double dt = (t1 - t0) / (double)m, k = 4.0 / 3.0 * tan(dt / 4.0) * R;
+  lw_node *nd = &sp->node[sp->first[i]];
+  for (size_t j = 0; j <= m; j++) {
+    double t = t0 + (double)j * dt;
+    nd[j] = (lw_node){cx + R * cos(t), cy + R * sin(t), -k * sin(t), k * cos(t)};
+  }
+  sp->rest_length[i] = fabs(t1 - t0) * R;
+}
+
 #endif

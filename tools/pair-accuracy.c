@@ -1,9 +1,8 @@
 /*
 ** pair-accuracy.c -- error and cost of the pair term's near-field scheme.
 **
-** Build (after `make build/liblinewise.a`) and run:
-**   cc -O2 -Iinclude tools/pair-accuracy.c build/liblinewise.a $(pkg-config --libs gsl) -lm
-**   ./a.out [segments per line, default 6]
+** Build and run:
+**   make build/pair-accuracy && build/pair-accuracy [segments per line, default 6]
 **
 ** Prints the relative error of the pair energy of two straight splines of
 ** unit segments (parallel at distance d; crossing at an angle, at a generic
@@ -30,42 +29,20 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <time.h>
 
+#include "benchutil.h"
 #include "linewise/pair.h"
 #include "linewise/quad.h"
 #include "linewise/spline.h"
+#include "pairref.h"
+#include "testutil.h"
 
 #define MAXS 4096
 
-/* A straight spline from p to q with m segments, uniform parametrisation. */
+/* A straight spline from p to q, uniform parametrisation. */
 static void straight(lw_splines *sp, size_t i, const double p[2], const double q[2])
 {
-  size_t m = lw_splines_segments(sp, i);
-  for (size_t k = 0; k <= m; k++) {
-    lw_node *nd = &sp->node[sp->first[i] + k];
-    double t = (double)k / (double)m;
-    nd->px = p[0] + t * (q[0] - p[0]);
-    nd->py = p[1] + t * (q[1] - p[1]);
-    nd->vx = (q[0] - p[0]) / (3.0 * (double)m);
-    nd->vy = (q[1] - p[1]) / (3.0 * (double)m);
-  }
-}
-
-/* All samples of spline i. */
-static size_t samples(const lw_splines *sp, const lw_quad *q, size_t i, lw_pair_sample *out)
-{
-  size_t n = 0;
-  for (size_t m = 0; m < lw_splines_segments(sp, i); m++) {
-    size_t g = lw_segment_index(sp, i, m), k = lw_segment_node(sp, g);
-    lw_samples s;
-    lw_segment_sample(q, &sp->node[k], &sp->node[k + 1], &s);
-    for (int j = 0; j < s.n; j++) {
-      out[n] = (lw_pair_sample){s.x[j], s.y[j], s.dx[j], s.dy[j], s.dl[j], (uint32_t)i, (uint32_t)j};
-      n++;
-    }
-  }
-  return n;
+  lw_test_straight(sp, i, p[0], p[1], q[0], q[1]);
 }
 
 static double pair_energy(const lw_splines *sp, int nq, double near)
@@ -75,7 +52,7 @@ static double pair_energy(const lw_splines *sp, int nq, double near)
   lw_pair_ctx ctx;
   lw_quad_init(&q, nq, NULL);
   lw_pair_ctx_init(&ctx, &q, 0.0, near);
-  size_t na = samples(sp, &q, 0, A), nb = samples(sp, &q, 1, B);
+  size_t na = lw_pairref_samples(sp, &q, 0, A), nb = lw_pairref_samples(sp, &q, 1, B);
   double e = 0.0;
   for (size_t i = 0; i < na; i++)
     for (size_t j = 0; j < nb; j++) e += lw_pair_kernel(&A[i], &B[j], &ctx);
@@ -129,13 +106,6 @@ static void crossing_row(int nq, int m, double deg, double fa, double fb, const 
   lw_splines_free(sp);
 }
 
-static double now(void)
-{
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
 /* ns per kernel call over many sample pairs at node distance dist * dl (random
 ** directions), so that all of them take one branch of the kernel. */
 static double time_kernel(double near, double dist)
@@ -157,10 +127,10 @@ static double time_kernel(double near, double dist)
                             sin(t3) * dl / q.w[qb], dl, 1, (uint32_t)qb};
   }
   int reps = dist < near ? 300 : 30000;
-  double t0 = now(), s = 0;
+  double t0 = bench_now(), s = 0;
   for (int r = 0; r < reps; r++)
     for (int i = 0; i < N; i++) s += lw_pair_kernel(&a[i], &b[i], &ctx);
-  double t1 = now();
+  double t1 = bench_now();
   if (!(s > 0)) printf("(unexpected sum %g)\n", s);
   return (t1 - t0) / ((double)reps * N) * 1e9;
 }
@@ -179,10 +149,10 @@ static double time_segseg(void)
     for (int k = 0; k < 8; k++) P[i][k] = p[k];
   }
   int reps = 100;
-  double t0 = now(), s = 0;
+  double t0 = bench_now(), s = 0;
   for (int r = 0; r < reps; r++)
     for (int i = 0; i < N; i++) s += lw_pair_segseg(P[i], P[i] + 2, P[i] + 4, P[i] + 6);
-  double t1 = now();
+  double t1 = bench_now();
   if (!(s > 0)) printf("(unexpected sum %g)\n", s);
   return (t1 - t0) / ((double)reps * N) * 1e9;
 }
@@ -201,12 +171,12 @@ static void cost_row(const char *label, int nq, int m, double deg, double ratio)
   printf("n=%-2d %-17s", nq, label);
   for (int k = 0; k < NNEAR; k++) {
     int reps = 0;
-    double t0 = now(), t1;
+    double t0 = bench_now(), t1;
     do {
       volatile double e = pair_energy(sp, nq, NEARS[k]);
       (void)e;
       reps++;
-      t1 = now();
+      t1 = bench_now();
     } while (t1 - t0 < 0.05);
     printf(" %9.0f", (t1 - t0) / reps / (m * nq) * 1e9);
   }
