@@ -201,29 +201,9 @@ Test(anneal, greedy_at_zero_temperature_never_raises_the_energy)
 
 static char dir[64];
 
-static void make_dir(void)
-{
-  strcpy(dir, "/tmp/lw_anneal_XXXXXX");
-  cr_assert_not_null(mkdtemp(dir));
-}
-
-static void remove_dir(void)
-{
-  char cmd[128];
-  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-  cr_assert_eq(system(cmd), 0);
-}
-
-static int sh(const char *fmt, ...)
-{
-  char cmd[2048];
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(cmd, sizeof cmd, fmt, ap);
-  va_end(ap);
-  int st = system(cmd);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
+static void make_dir(void) { cr_assert_eq(lw_test_dir_make(dir, "anneal"), 0); }
+static void remove_dir(void) { cr_assert_eq(lw_test_dir_remove(dir), 0); }
+#define sh lw_test_sh
 
 static const char scene[] =
   "[scene]\nwidth = 60\nheight = 50\nmargin = 2\npotential = ramp\nfield = vortex\n"

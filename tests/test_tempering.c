@@ -19,6 +19,7 @@
 #include <sys/wait.h>
 
 #include "linewise/tempering.h"
+#include "testutil.h"
 
 /* ---- the exact swap acceptance --------------------------------------- */
 
@@ -246,29 +247,9 @@ Test(tempering, ladder_tuning_equalises_swap_acceptance)
 
 static char dir[64];
 
-static void make_dir(void)
-{
-  strcpy(dir, "/tmp/lw_pt_XXXXXX");
-  cr_assert_not_null(mkdtemp(dir));
-}
-
-static void remove_dir(void)
-{
-  char cmd[128];
-  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-  cr_assert_eq(system(cmd), 0);
-}
-
-static int sh(const char *fmt, ...)
-{
-  char cmd[2048];
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(cmd, sizeof cmd, fmt, ap);
-  va_end(ap);
-  int st = system(cmd);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
+static void make_dir(void) { cr_assert_eq(lw_test_dir_make(dir, "pt"), 0); }
+static void remove_dir(void) { cr_assert_eq(lw_test_dir_remove(dir), 0); }
+#define sh lw_test_sh
 
 static const char scene[] =
   "[scene]\nwidth = 50\nheight = 40\nmargin = 2\n"

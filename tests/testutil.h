@@ -4,10 +4,12 @@
 
 #include <gsl/gsl_math.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 
 #include "linewise/spline.h"
 
@@ -78,6 +80,19 @@ static inline int lw_test_dir_make(char dir[64], const char *tag)
   snprintf(dir, 64, "/tmp/lw_%s_XXXXXX", tag);
   return mkdtemp(dir) ? 0 : -1;
 }
+/* Runs a shell command built like printf; its exit status, or -1. */
+static inline int lw_test_sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static inline int lw_test_sh(const char *fmt, ...)
+{
+  char cmd[2048];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(cmd, sizeof cmd, fmt, ap);
+  va_end(ap);
+  int st = system(cmd);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
 static inline int lw_test_dir_remove(const char *dir)
 {
   char cmd[96];
