@@ -201,7 +201,7 @@ void bench_quadrature(bench_ctx *b)
   for (int i = 0; i < ref; i++) {
     double et = fabs(v[i].total - v[ref].total) / v[ref].magnitude;
     fprintf(d, "| %d | %.1e |", nodes[i], et);
-    for (int k = 0; k < LW_TERM_COUNT; k++) {
+    for (int k = 0; k <= LW_TERM_BOUNDARY; k++) { /* the six terms a scene can name */
       fprintf(d, " %.1e |", rel(v[i].term[k], v[ref].term[k]));
       if (k == LW_TERM_BENDING) fprintf(d, " %.1e |", rel(bu[i], bu[ref]));
     }
