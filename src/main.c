@@ -193,6 +193,21 @@ static int set_threads(const char *v, lw_error *err)
   return 1;
 }
 
+/* The options run and resume share (--stop-at, --threads, --quiet): how
+** many arguments the one at argv[i] takes (1 or 2), 0 if it is not one of
+** them, -1 on bad input (err set). */
+static int shared_option(char **argv, int argc, int i, long *stop_at, int *quiet, lw_error *err)
+{
+  const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+  if (!strcmp(argv[i], "--stop-at")) return parse_count("--stop-at", v, stop_at, err) ? 2 : -1;
+  if (!strcmp(argv[i], "--threads")) return set_threads(v, err) ? 2 : -1;
+  if (!strcmp(argv[i], "--quiet")) {
+    *quiet = 1;
+    return 1;
+  }
+  return 0;
+}
+
 static int cmd_run(int argc, char **argv)
 {
   lw_error err;
@@ -241,14 +256,10 @@ static int cmd_run(int argc, char **argv)
       snprintf(buf, sizeof buf, "anneal.seed=%ld", seed);
       if (lw_params_set(&p, buf, &err)) return fail(&err);
       i++;
-    } else if (!strcmp(argv[i], "--stop-at")) {
-      if (!parse_count("--stop-at", v, &stop_at, &err)) return fail(&err);
-      i++;
-    } else if (!strcmp(argv[i], "--threads")) {
-      if (!set_threads(v, &err)) return fail(&err);
-      i++;
-    } else if (!strcmp(argv[i], "--quiet")) {
-      quiet = 1;
+    } else {
+      int used = shared_option(argv, argc, i, &stop_at, &quiet, &err);
+      if (used < 0) return fail(&err);
+      if (used == 2) i++;
     }
   }
   char dir[LW_PATH_MAX];
@@ -281,20 +292,15 @@ static int cmd_resume(int argc, char **argv)
   lw_error_clear(&err);
   const char *dir = NULL;
   long more = -1, stop_at = -1;
-  int quiet = 0;
+  int quiet = 0, used;
   for (int i = 0; i < argc; i++) {
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
     if (!strcmp(argv[i], "--sweeps")) {
       if (!parse_count("--sweeps", v, &more, &err)) return fail(&err);
       i++;
-    } else if (!strcmp(argv[i], "--stop-at")) {
-      if (!parse_count("--stop-at", v, &stop_at, &err)) return fail(&err);
-      i++;
-    } else if (!strcmp(argv[i], "--threads")) {
-      if (!set_threads(v, &err)) return fail(&err);
-      i++;
-    } else if (!strcmp(argv[i], "--quiet")) {
-      quiet = 1;
+    } else if ((used = shared_option(argv, argc, i, &stop_at, &quiet, &err)) != 0) {
+      if (used < 0) return fail(&err);
+      if (used == 2) i++;
     } else if (argv[i][0] == '-' || dir) {
       lw_error_set(&err, LW_EUSAGE, "resume: unexpected '%s' (usage: linewise resume DIR [--sweeps N])", argv[i]);
       return fail(&err);

@@ -4,11 +4,9 @@
 */
 #include <criterion/criterion.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 
 #include "linewise/anneal.h"
 #include "linewise/init.h"
