@@ -4,6 +4,8 @@
 */
 #include "linewise/model.h"
 
+#include "linewise/pairnear.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,13 +30,33 @@ static void segment_eval(const lw_scene *sc, const lw_node *a, const lw_node *b,
                              (uint32_t)q};
 }
 
-/* Kernel sum of sample `me` (of spline `spline`) with every grid sample of
-** another spline whose index exceeds `after` (-1: all).  Cells and their
-** sorted entries are visited in a fixed order, so the sum depends on the
-** positions only. */
-static double neighbour_sum(const lw_cellgrid *g, const lw_pair_sample *all, const lw_pair_sample *me,
-                            uint32_t spline, long long after, const lw_pair_ctx *ctx)
+/* A growable list of sample indices: the near pairs a walk found. */
+static lw_status near_push(lw_near_list *l, uint32_t idx)
 {
+  if (l->n == l->cap) {
+    size_t cap = l->cap ? 2 * l->cap : 64;
+    uint32_t *v = realloc(l->idx, cap * sizeof *v);
+    if (!v) return LW_ENOMEM;
+    l->idx = v;
+    l->cap = cap;
+  }
+  l->idx[l->n++] = idx;
+  return LW_OK;
+}
+
+/*
+** Product-rule sum of sample `me` (of spline `spline`) with every grid sample
+** of another spline whose index exceeds `after` (-1: all), leaving out near
+** pairs (pairnear.h), whose partners go to `near` whatever their index: the
+** near field replaces whole segment pairs, so the caller needs all of them.
+** Cells and their sorted entries are visited in a fixed order, so the sum
+** depends on the positions only.  Returns NAN if the near list cannot grow.
+*/
+static double neighbour_sum(const lw_cellgrid *g, const lw_pair_sample *all, const lw_pair_sample *me,
+                            uint32_t spline, long long after, const lw_pair_ctx *ctx, lw_near_list *near)
+{
+  const double cut2 = ctx->cutoff2, inv = ctx->inv_cutoff;
+  const double dl_me = me->dl;
   double sum = 0.0;
   int cx, cy;
   lw_cellgrid_locate(g, me->x, me->y, &cx, &cy);
@@ -45,28 +67,124 @@ static double neighbour_sum(const lw_cellgrid *g, const lw_pair_sample *all, con
       const lw_cell *c = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
       for (uint32_t k = 0; k < c->n; k++) {
         const lw_pair_sample *o = &all[c->idx[k]];
-        if ((long long)c->idx[k] > after && o->spline != spline) sum += lw_pair_kernel(me, o, ctx);
+        if (o->spline == spline) continue;
+        double dx = me->x - o->x, dy = me->y - o->y, r2 = dx * dx + dy * dy;
+        if (r2 >= cut2) continue;
+        if (r2 < lw_pair_near_radius2(ctx, me->dl, o->dl)) {
+          if (near_push(near, c->idx[k]) != LW_OK) return NAN;
+        } else if ((long long)c->idx[k] > after && o->dl != 0.0f) {
+          sum += dl_me * (double)o->dl * (1.0 / sqrt(r2) - inv);
+        }
       }
     }
   }
   return sum;
 }
 
-/* Pair energy (no coefficient) between the n samples `mine` of spline
-** `spline` and every grid sample of another spline. */
-static double pair_against(const lw_cellgrid *g, const lw_pair_sample *all, const lw_pair_sample *mine,
-                           int n, uint32_t spline, const lw_pair_ctx *ctx)
+/* The Bezier control points of the segment from node a to node b. */
+static void node_bezier(const lw_node *a, const lw_node *b, double out[8])
+{
+  out[0] = a->px;
+  out[1] = a->py;
+  out[2] = a->px + a->vx;
+  out[3] = a->py + a->vy;
+  out[4] = b->px - b->vx;
+  out[5] = b->py - b->vy;
+  out[6] = b->px;
+  out[7] = b->py;
+}
+
+/* The Bezier control points of global segment g. */
+static void segment_bezier(const lw_splines *sp, size_t g, double b[8])
+{
+  const lw_node *a = &sp->node[lw_segment_node(sp, g)];
+  node_bezier(a, a + 1, b);
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+  uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+  return (x > y) - (x < y);
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+  uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+  return (x > y) - (x < y);
+}
+
+/* Sorts a list of segment numbers and drops repeats; returns the count. */
+static size_t unique_u32(uint32_t *v, size_t n)
+{
+  qsort(v, n, sizeof *v, cmp_u32);
+  size_t m = 0;
+  for (size_t i = 0; i < n; i++)
+    if (m == 0 || v[i] != v[m - 1]) v[m++] = v[i];
+  return m;
+}
+
+/* Pair energy (no coefficient) of one segment, with control points bez and
+** samples mine (np of them, spline `spline`), against every segment of
+** another spline in the grid: the product rule over far sample pairs plus
+** the near field of each near segment pair.  NAN if out of memory. */
+static double pair_against(const lw_cellgrid *g, const lw_splines *sp, const lw_pair_sample *all,
+                           const double bez[8], const lw_pair_sample *mine, int np, uint32_t spline,
+                           const lw_pair_ctx *ctx, lw_near_list *near)
 {
   double sum = 0.0;
-  for (int i = 0; i < n; i++) sum += neighbour_sum(g, all, &mine[i], spline, -1, ctx);
+  near->n = 0;
+  for (int i = 0; i < np; i++) sum += neighbour_sum(g, all, &mine[i], spline, -1, ctx, near);
+  if (near->n == 0 || isnan(sum)) return sum;
+  for (size_t k = 0; k < near->n; k++) near->idx[k] /= (uint32_t)np;
+  size_t nb = unique_u32(near->idx, near->n);
+  for (size_t k = 0; k < nb; k++) {
+    double b[8];
+    segment_bezier(sp, near->idx[k], b);
+    sum += lw_pair_near_correction(bez, mine, b, all + (size_t)near->idx[k] * (size_t)np, np, ctx);
+  }
   return sum;
 }
 
-/* Every pair of samples of different splines once (j > i). */
-static double pair_all(const lw_cellgrid *g, const lw_pair_sample *all, size_t n, const lw_pair_ctx *ctx)
+/* Every pair of samples of different splines once (j > i), and every near
+** segment pair once.  NAN if out of memory. */
+static double pair_all(const lw_cellgrid *g, const lw_splines *sp, const lw_pair_sample *all, int np,
+                       const lw_pair_ctx *ctx)
 {
+  size_t n = sp->n_segments * (size_t)np;
+  lw_near_list near = {0}, pairs = {0};
   double sum = 0.0;
-  for (size_t i = 0; i < n; i++) sum += neighbour_sum(g, all, &all[i], all[i].spline, (long long)i, ctx);
+  for (size_t i = 0; i < n; i++) {
+    near.n = 0;
+    sum += neighbour_sum(g, all, &all[i], all[i].spline, (long long)i, ctx, &near);
+    uint32_t ga = (uint32_t)(i / (size_t)np);
+    /* a segment pair is listed from its lower segment, as (a, b) in two slots */
+    for (size_t k = 0; k < near.n && !isnan(sum); k++) {
+      uint32_t gb = near.idx[k] / (uint32_t)np;
+      if (gb > ga && (near_push(&pairs, ga) != LW_OK || near_push(&pairs, gb) != LW_OK)) sum = NAN;
+    }
+    if (isnan(sum)) break;
+  }
+  if (!isnan(sum) && pairs.n) {
+    /* sort (a, b) pairs as 64-bit keys, then take each once */
+    size_t m = pairs.n / 2;
+    uint64_t *key = malloc(m * sizeof *key);
+    if (!key) sum = NAN;
+    else {
+      for (size_t k = 0; k < m; k++) key[k] = (uint64_t)pairs.idx[2 * k] << 32 | pairs.idx[2 * k + 1];
+      qsort(key, m, sizeof *key, cmp_u64);
+      for (size_t k = 0; k < m; k++) {
+        if (k > 0 && key[k] == key[k - 1]) continue;
+        size_t ga = (size_t)(key[k] >> 32), gb = (size_t)(key[k] & 0xffffffffu);
+        double a[8], b[8];
+        segment_bezier(sp, ga, a);
+        segment_bezier(sp, gb, b);
+        sum += lw_pair_near_correction(a, all + ga * (size_t)np, b, all + gb * (size_t)np, np, ctx);
+      }
+      free(key);
+    }
+  }
+  free(near.idx);
+  free(pairs.idx);
   return sum;
 }
 
@@ -135,9 +253,14 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
         lw_error_set(err, LW_ENOMEM, "out of memory filling the pair grid");
         return NAN;
       }
-    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pair_all(g, ps, n, &sc->pair);
+    double pe = pair_all(g, sp, ps, np, &sc->pair);
     lw_cellgrid_free(g);
     free(ps);
+    if (isnan(pe)) {
+      lw_error_set(err, LW_ENOMEM, "out of memory for the pair term's near field");
+      return NAN;
+    }
+    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pe;
   }
   double total = 0.0;
   for (int t = 0; t < LW_TERM_COUNT; t++) total += term[t];
@@ -231,7 +354,9 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
     lw_cellgrid_clear(m->grid);
     for (size_t i = 0; i < n; i++)
       if (lw_cellgrid_insert(m->grid, (uint32_t)i, m->ps[i].x, m->ps[i].y) != LW_OK) return LW_ENOMEM;
-    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pair_all(m->grid, m->ps, n, &sc->pair);
+    double pe = pair_all(m->grid, sp, m->ps, np, &sc->pair);
+    if (isnan(pe)) return LW_ENOMEM;
+    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pe;
   }
   double total = 0.0;
   for (int t = 0; t < LW_TERM_COUNT; t++) {
@@ -272,6 +397,7 @@ void lw_proposal_free(lw_proposal *p)
   free(p->len);
   free(p->local);
   free(p->ps);
+  free(p->near.idx);
   free(p);
 }
 
@@ -344,8 +470,11 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
     double pe = 0.0;
     for (size_t j = 0; j < p->n_seg; j++) {
       size_t g = g0 + p->seg0 + j;
-      pe += pair_against(m->grid, m->ps, p->ps + j * (size_t)np, np, spline, &sc->pair);
-      pe -= pair_against(m->grid, m->ps, m->ps + g * (size_t)np, np, spline, &sc->pair);
+      double bn[8], bo[8];
+      node_bezier(proposed_node(base, p, p->seg0 + j), proposed_node(base, p, p->seg0 + j + 1), bn);
+      node_bezier(&base[p->seg0 + j], &base[p->seg0 + j + 1], bo);
+      pe += pair_against(m->grid, sp, m->ps, bn, p->ps + j * (size_t)np, np, spline, &sc->pair, &p->near);
+      pe -= pair_against(m->grid, sp, m->ps, bo, m->ps + g * (size_t)np, np, spline, &sc->pair, &p->near);
     }
     p->dterm[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pe;
     dE += p->dterm[LW_TERM_PAIR];

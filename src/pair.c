@@ -297,6 +297,7 @@ void lw_pair_ctx_init(lw_pair_ctx *ctx, const lw_quad *q, double cutoff, double 
   ctx->cutoff2 = cutoff > 0.0 ? cutoff * cutoff : INFINITY;
   ctx->zone_cap = cutoff > 0.0 ? cutoff : INFINITY;
   ctx->near = near > 0.0 ? near : 0.0;
+  ctx->near_scale = ctx->near;
   ctx->zone_outer = PAIR_MID * ctx->near;
   if (ctx->zone_outer > 0.0 && ctx->zone_outer < PAIR_TOUCH) ctx->zone_outer = PAIR_TOUCH;
   ctx->zone_exact = ctx->near > PAIR_TOUCH ? ctx->near : PAIR_TOUCH;

@@ -36,6 +36,7 @@ static inline size_t lw_pairref_samples(const lw_splines *sp, const lw_quad *q, 
 typedef struct {
   const lw_splines *sp;
   double x, y;
+  double rc; /* cutoff, 0 = none */
   gsl_integration_workspace *wi;
 } lw_pairref_ctx;
 
@@ -53,7 +54,9 @@ static inline double lw_pairref_inner(double t, void *p)
   const lw_pairref_ctx *c = p;
   double r[2], d[2];
   lw_pairref_eval(c->sp, 1, t, r, d);
-  return hypot(d[0], d[1]) / hypot(r[0] - c->x, r[1] - c->y);
+  double k = 1.0 / hypot(r[0] - c->x, r[1] - c->y);
+  if (c->rc > 0.0) k = k > 1.0 / c->rc ? k - 1.0 / c->rc : 0.0;
+  return hypot(d[0], d[1]) * k;
 }
 
 static inline double lw_pairref_outer(double s, void *p)
@@ -71,11 +74,13 @@ static inline double lw_pairref_outer(double s, void *p)
   return res * hypot(d[0], d[1]);
 }
 
-/* The reference (no coefficient, no cutoff); splines of up to 64 segments. */
-static inline double lw_pairref_energy(const lw_splines *sp)
+/* The reference (no coefficient) with the kernel (1/r - 1/rc)+, rc > 0, or
+** 1/r (rc = 0); splines of up to 64 segments.  Adaptive bisection finds the
+** kink at the cutoff. */
+static inline double lw_pairref_energy_cut(const lw_splines *sp, double rc)
 {
   gsl_error_handler_t *old = gsl_set_error_handler_off();
-  lw_pairref_ctx c = {sp, 0, 0, gsl_integration_workspace_alloc(1000)};
+  lw_pairref_ctx c = {sp, 0, 0, rc, gsl_integration_workspace_alloc(1000)};
   gsl_integration_workspace *wo = gsl_integration_workspace_alloc(1000);
   size_t ma = lw_splines_segments(sp, 0), n = 0;
   double pts[257];
@@ -87,6 +92,12 @@ static inline double lw_pairref_energy(const lw_splines *sp)
   gsl_integration_workspace_free(c.wi);
   gsl_set_error_handler(old);
   return res;
+}
+
+/* The reference without a cutoff. */
+static inline double lw_pairref_energy(const lw_splines *sp)
+{
+  return lw_pairref_energy_cut(sp, 0.0);
 }
 
 #endif

@@ -44,6 +44,12 @@ double lw_model_total(const lw_model *m);
 ** new one, |new - old| / max(|new|, 1). */
 lw_status lw_model_refresh(lw_model *m, double *drift);
 
+/* Sample indices of near pairs found by a neighbour walk (growable). */
+typedef struct {
+  uint32_t *idx;
+  size_t n, cap;
+} lw_near_list;
+
 /* Scratch for one proposal: owned by one thread, sized for the model. */
 typedef struct {
   uint32_t spline;
@@ -57,6 +63,7 @@ typedef struct {
   double dterm[LW_TERM_COUNT];
   double dE;                  /* sum of dterm; +inf for a forbidden state, NaN never kept */
   size_t cap_seg;
+  lw_near_list near;          /* the pair walk's near pairs */
 } lw_proposal;
 
 lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err);

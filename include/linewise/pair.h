@@ -71,7 +71,18 @@ typedef struct {
   double zone_exact;    /* outer radius of the exact zone / dm */
   double elem_lo[LW_QUAD_MAX]; /* s_q - e_q: element start before the node, in s */
   double elem_hi[LW_QUAD_MAX]; /* e_{q+1} - s_q: element end after the node, in s */
+  double near_scale;    /* near radius in length elements (pairnear.h); 0 = none */
 } lw_pair_ctx;
+
+/* Squared near radius of a sample pair, min(near_scale max(dl_a, dl_b), rc)^2:
+** the walk and the near field decide with this one expression, so they agree
+** to the last bit on which pairs are near. */
+static inline double lw_pair_near_radius2(const lw_pair_ctx *ctx, float dla, float dlb)
+{
+  double r = ctx->near_scale * (double)(dla > dlb ? dla : dlb);
+  if (r > ctx->cutoff && ctx->cutoff > 0.0) r = ctx->cutoff;
+  return r * r;
+}
 
 void lw_pair_ctx_init(lw_pair_ctx *ctx, const lw_quad *q, double cutoff, double near);
 

@@ -1,0 +1,48 @@
+/*
+** pairnear.h -- the pair term's near field: the double integral of two
+** cubic segments that come close, and the correction that puts it in place
+** of the product rule.
+**
+** The product rule (pair.h) is spectrally accurate for two segments that
+** are farther apart than a few node spacings, and wrong where they come
+** closer (infinite where two samples coincide).  A pair of samples closer
+** than the near radius rho = min(near dm, rc) (dm: the larger of their two
+** length elements) marks their two segments A and B as a near pair.  For a
+** near pair the model uses
+**
+**     E_AB = (1 - W) P_AB + W X_AB
+**
+** P_AB: the product rule over all sample pairs of A x B; X_AB: the double
+** integral over the exact curves (lw_pair_segments_exact); W: the largest
+** of phi(r_ij / rho_ij) over the sample pairs, phi = 1 below half the near
+** radius, 0 from the radius on, C2 in between.  W is a continuous function
+** of the samples and vanishes exactly when no pair is near, so the energy is
+** continuous however curves approach, cross or part; and where W < 1 every
+** sample pair is at least rho / 2 apart, so P_AB is finite.
+**
+** Because the near pair is decided from whole segments, the product rule
+** keeps its global (spectral) accuracy wherever it is used: nothing mixes
+** element-local integrals into a Gauss sum, which is what left the previous
+** scheme with an error floor.
+*/
+#ifndef LINEWISE_PAIRNEAR_H
+#define LINEWISE_PAIRNEAR_H
+
+#include "linewise/pair.h"
+
+/* The double integral of |a'| |b'| (1/r - 1/rc)+ over two cubic Bezier
+** segments a and b (control points x0 y0 x1 y1 x2 y2 x3 y3, mm), or of
+** |a'| |b'| / r without a cutoff (cutoff <= 0).  Finite where the segments
+** cross or touch; +inf only where they overlap along a stretch.  Relative
+** accuracy about 1e-10 for the 1/r part (adaptive subdivision, see
+** pairnear.c); the cutoff part takes a fixed 16 x 16 rule, so it is a
+** continuous function of the control points. */
+double lw_pair_segments_exact(const double a[8], const double b[8], double cutoff);
+
+/* E_AB minus the product-rule terms of the sample pairs of A x B that are
+** not near (those the neighbour walk adds): what the model adds for a near
+** pair.  sa and sb: the n pair samples of each segment, as stored. */
+double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, const double b[8],
+                               const lw_pair_sample *sb, int n, const lw_pair_ctx *ctx);
+
+#endif
