@@ -127,9 +127,6 @@ TOOL_FLAGS = $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -Itools -Itests
 $(BUILD)/bench: $(BENCH_SRC) $(BENCH_HDR) $(BUILD)/liblinewise.a
 	$(CC) $(TOOL_FLAGS) -DBENCH_CFLAGS='"$(CFLAGS)"' $(BENCH_SRC) -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
 
-$(BUILD)/pair-accuracy: tools/pair-accuracy.c tools/benchutil.c $(BENCH_HDR) $(BUILD)/liblinewise.a
-	$(CC) $(TOOL_FLAGS) tools/pair-accuracy.c tools/benchutil.c -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
-
 # Benchmarks rewrite docs/PERFORMANCE.md and docs/ACCURACY.md (machine and date
 # recorded with them) and their plots docs/*.png; BENCH_QUICK=1 for a smoke run.
 bench: $(BUILD)/bench

@@ -262,109 +262,12 @@ double lw_pair_segseg(const double a0[2], const double a1[2],
   return segseg_frame(La, Lb, beta0, eta0, c, sn);
 }
 
-/* ---- the kernel --------------------------------------------------------- */
+/* ---- the context ------------------------------------------------------- */
 
-/*
-** Zones of a sample pair at node distance r, with dm = max(dl_a, dl_b):
-**   r <  near dm            exact integral over the two elements (segseg);
-**                           at least to PAIR_TOUCH dm
-**   r <  PAIR_MID near dm   2x2 Gauss-Legendre over the two elements; its outer
-**                           PAIR_BLEND part blends smoothly into the node rule
-**   beyond                  the node rule dl_a dl_b / r
-** Why the middle zone: a node is not the centre of its element, so the node
-** rule's error on one element pair has a first-order part (~ offset / r) that
-** the Gauss rule cancels only over whole segments.  Switching to element
-** integrals at a radius cuts that cancellation and leaves an error of ~
-** (1 / radius)^2 whatever the geometry (even for lines far apart, where the
-** node rule alone is exact to rounding); the cheap element rule pushes that
-** radius out at 4 inverse distances per pair, while the costly exact
-** integral is needed only where elements can touch.  See
-** tools/pair-accuracy.c for the measurements.
-*/
-#define PAIR_MID 6.0
-#define PAIR_BLEND 0.25
-/* A node lies within 0.6103 of its element's length from either end of the
-** element (the end elements; checked for n = 2..64), so two elements can
-** touch only if their nodes are closer than 1.2206 dm: the exact
-** zone always reaches that far, so that the element rule never meets
-** touching elements (where it would be inaccurate or infinite). */
-#define PAIR_TOUCH 1.25
-
-void lw_pair_ctx_init(lw_pair_ctx *ctx, const lw_quad *q, double cutoff, double near)
+void lw_pair_ctx_init(lw_pair_ctx *ctx, double cutoff, double near)
 {
   ctx->cutoff = cutoff > 0.0 ? cutoff : 0.0;
   ctx->inv_cutoff = cutoff > 0.0 ? 1.0 / cutoff : 0.0;
   ctx->cutoff2 = cutoff > 0.0 ? cutoff * cutoff : INFINITY;
-  ctx->zone_cap = cutoff > 0.0 ? cutoff : INFINITY;
-  ctx->near = near > 0.0 ? near : 0.0;
-  ctx->near_scale = ctx->near;
-  ctx->zone_outer = PAIR_MID * ctx->near;
-  if (ctx->zone_outer > 0.0 && ctx->zone_outer < PAIR_TOUCH) ctx->zone_outer = PAIR_TOUCH;
-  ctx->zone_exact = ctx->near > PAIR_TOUCH ? ctx->near : PAIR_TOUCH;
-  for (int i = 0; i < LW_QUAD_MAX; i++) {
-    ctx->elem_lo[i] = 0.0;
-    ctx->elem_hi[i] = 0.0;
-  }
-  for (int i = 0; i < q->n; i++) {
-    ctx->elem_lo[i] = q->s[i] - q->e[i];
-    ctx->elem_hi[i] = q->e[i + 1] - q->s[i];
-  }
-}
-
-/* 2x2 Gauss-Legendre over the elements of a and b: the element of a runs
-** over r_a + u r'_a, u in [-lo, hi], so its centre is at u = (hi - lo)/2. */
-static double element_rule(const lw_pair_sample *a, const lw_pair_sample *b, const lw_pair_ctx *ctx)
-{
-  const double g = 0.28867513459481288225; /* 1 / (2 sqrt 3) */
-  double la = ctx->elem_lo[a->q], ha = ctx->elem_hi[a->q];
-  double lb = ctx->elem_lo[b->q], hb = ctx->elem_hi[b->q];
-  double ca = 0.5 * (ha - la), wa = g * (ha + la);
-  double cb = 0.5 * (hb - lb), wb = g * (hb + lb);
-  /* centres and half-offsets of the Gauss points */
-  double ax = a->x + ca * a->dx, ay = a->y + ca * a->dy, ox = wa * a->dx, oy = wa * a->dy;
-  double bx = b->x + cb * b->dx, by = b->y + cb * b->dy, px = wb * b->dx, py = wb * b->dy;
-  double dx = ax - bx, dy = ay - by;
-  double s = 0.0;
-  for (int i = -1; i <= 1; i += 2)
-    for (int j = -1; j <= 1; j += 2) {
-      double ex = dx + i * ox - j * px, ey = dy + i * oy - j * py;
-      s += 1.0 / sqrt(ex * ex + ey * ey);
-    }
-  return 0.25 * s * ((double)a->dl * (double)b->dl);
-}
-
-double lw_pair_kernel_near(const lw_pair_sample *a, const lw_pair_sample *b, const lw_pair_ctx *ctx,
-                           double r2, double ro)
-{
-  double ll = (double)a->dl * (double)b->dl;
-  double dm = a->dl > b->dl ? a->dl : b->dl;
-  /* A fixed order of the two samples makes the kernel bitwise symmetric, so
-  ** sums over pairs taken in either order (whole energy, move deltas) agree
-  ** to the last bit; samples of different splines are never tied. */
-  if (a->x > b->x || (a->x == b->x && (a->y > b->y || (a->y == b->y && a->spline > b->spline)))) {
-    const lw_pair_sample *t = a;
-    a = b;
-    b = t;
-  }
-  double shift = ll * ctx->inv_cutoff;
-  double rn = ctx->zone_exact * dm;
-  if (r2 >= rn * rn) {
-    double v = element_rule(a, b, ctx) - shift;
-    double r = sqrt(r2), rb = (1.0 - PAIR_BLEND) * ro;
-    if (r > rb) {
-      /* C1 blend into the node rule over the outer part of the zone */
-      double t = (r - rb) / (ro - rb), w = t * t * (3.0 - 2.0 * t);
-      v += w * (ll * (1.0 / r - ctx->inv_cutoff) - v);
-    }
-    return v;
-  }
-  /* near field: the exact integral over the two tangent elements */
-  double lo = ctx->elem_lo[a->q], hi = ctx->elem_hi[a->q];
-  double a0[2] = {a->x - lo * a->dx, a->y - lo * a->dy};
-  double a1[2] = {a->x + hi * a->dx, a->y + hi * a->dy};
-  lo = ctx->elem_lo[b->q];
-  hi = ctx->elem_hi[b->q];
-  double b0[2] = {b->x - lo * b->dx, b->y - lo * b->dy};
-  double b1[2] = {b->x + hi * b->dx, b->y + hi * b->dy};
-  return lw_pair_segseg(a0, a1, b0, b1) - shift;
+  ctx->near_scale = near > 0.0 ? near : 0.0;
 }

@@ -171,8 +171,12 @@ static double inverse_distance(const cubic *ca, const cubic *cb)
       continue;
     }
     if (big < leaf || top + 2 > STACK_MAX) {
-      /* chords; their lengths stand in for the arcs (equal to O(leaf^2)) */
-      sum += lw_pair_segseg(pa.r0, pa.r1, pb.r0, pb.r1);
+      /* chords; their lengths stand in for the arcs (equal to O(leaf^2)).
+      ** Chords of curves that touch tangentially end to end can overlap by
+      ** a rounding error, which the exact integral reads as +inf; the
+      ** product rule's interior nodes keep such a leaf finite. */
+      double v = lw_pair_segseg(pa.r0, pa.r1, pb.r0, pb.r1);
+      sum += v < INFINITY ? v : product_pieces(ca, &pa, cb, &pb);
       continue;
     }
     if (pa.rad >= pb.rad) {
@@ -251,9 +255,26 @@ static inline double near_weight(double u)
   return t * t * t * (10.0 + t * (6.0 * t - 15.0));
 }
 
+/* 1 if a comes before b in the lexicographic order of the control points. */
+static int bezier_before(const double a[8], const double b[8])
+{
+  for (int k = 0; k < 8; k++)
+    if (a[k] != b[k]) return a[k] < b[k];
+  return 1;
+}
+
 double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, const double b[8],
                                const lw_pair_sample *sb, int n, const lw_pair_ctx *ctx)
 {
+  /* one order for the two segments, so that the value is bitwise symmetric */
+  if (!bezier_before(a, b)) {
+    const double *t = a;
+    const lw_pair_sample *u = sa;
+    a = b;
+    b = t;
+    sa = sb;
+    sb = u;
+  }
   double W = 0.0, far = 0.0, near = 0.0;
   const double cut2 = ctx->cutoff2, inv = ctx->inv_cutoff;
   for (int i = 0; i < n; i++) {

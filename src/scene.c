@@ -223,7 +223,7 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     }
     if ((st = lw_quad_init(&sc->pair_quad, p->pair_quadrature, err))) return st;
   }
-  lw_pair_ctx_init(&sc->pair, &sc->pair_quad, p->pair_cutoff, p->pair_near);
+  lw_pair_ctx_init(&sc->pair, p->pair_cutoff, p->pair_near);
 
   double cx = p->center_x >= 0 ? p->center_x : 0.5 * p->width;
   double cy = p->center_y >= 0 ? p->center_y : 0.5 * p->height;

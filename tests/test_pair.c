@@ -7,7 +7,10 @@
 #include <stdint.h>
 #include <stdlib.h>
 
+#include "linewise/model.h"
 #include "linewise/pair.h"
+#include "linewise/pairnear.h"
+#include "linewise/params.h"
 #include "linewise/quad.h"
 #include "linewise/spline.h"
 #include "pairref.h"
@@ -105,24 +108,24 @@ static void straight(lw_splines *sp, size_t i, const double p[2], const double q
   lw_test_straight(sp, i, p[0], p[1], q[0], q[1]);
 }
 
-/* The pair energy (no coefficient) between splines 0 and 1: the kernel
-** summed over every pair of their samples. */
+/* The pair energy (no coefficient) between splines 0 and 1 as the model
+** computes it: a scene with the pair term alone (C = 1). */
 static double pair_energy(const lw_splines *sp, int nq, double cutoff, double near)
 {
-  lw_quad q;
-  lw_pair_ctx ctx;
-  cr_assert_eq(lw_quad_init(&q, nq, NULL), LW_OK);
-  lw_pair_ctx_init(&ctx, &q, cutoff, near);
-  size_t na = lw_splines_segments(sp, 0) * (size_t)nq, nb = lw_splines_segments(sp, 1) * (size_t)nq;
-  lw_pair_sample *A = malloc(na * sizeof *A), *B = malloc(nb * sizeof *B);
-  cr_assert(A && B);
-  cr_assert_eq(lw_pairref_samples(sp, &q, 0, A), na);
-  cr_assert_eq(lw_pairref_samples(sp, &q, 1, B), nb);
-  double e = 0.0;
-  for (size_t i = 0; i < na; i++)
-    for (size_t j = 0; j < nb; j++) e += lw_pair_kernel(&A[i], &B[j], &ctx);
-  free(A);
-  free(B);
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = p.height = 20;
+  p.margin = 0;
+  p.strain = p.bending = p.potential_coef = p.field_coef = p.boundary_coef = 0;
+  p.pair = 1;
+  p.pair_cutoff = cutoff;
+  p.pair_near = near;
+  p.quadrature = nq;
+  lw_scene sc;
+  lw_error err;
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
+  double term[LW_TERM_COUNT], e = lw_energy_compute(&sc, sp, term, &err);
+  lw_scene_clear(&sc);
   return e;
 }
 
@@ -468,18 +471,6 @@ Test(pair, crossing_straight_splines_match_segseg)
     }
 }
 
-Test(pair, near_field_off_is_the_product_rule)
-{
-  lw_quad q;
-  lw_pair_ctx ctx;
-  lw_quad_init(&q, 8, NULL);
-  lw_pair_ctx_init(&ctx, &q, 0.0, 0.0);
-  lw_pair_sample a = {0, 0, 1, 0, 0.1, 0, 3}, b = {0.05, 0.02, 0, 1, 0.2, 1, 4};
-  double r = hypot(0.05, 0.02);
-  /* samples keep dl as float: the product is of the stored values */
-  cr_assert(lw_close_rel(lw_pair_kernel(&a, &b, &ctx), (double)a.dl * b.dl / r, 1e-15, 0.0));
-}
-
 /* ---- the kernel: curved splines ------------------------------------------ */
 
 /*
@@ -516,131 +507,169 @@ Test(pair, curved_arcs_touching_or_crossing_match_reference)
   lw_splines_free(sp);
 }
 
-/* ---- the kernel: cutoff and coincident samples --------------------------- */
+/* ---- the near field: exact segment pairs, product rule, continuity -------- */
 
-Test(pair, cutoff_shifts_and_truncates_the_kernel)
+/* Two quarter circles of 4 segments each (radius 3 below, 2 or 3 above):
+** the cases of docs/ACCURACY.md. */
+static lw_splines *two_arcs(int which)
+{
+  static const double CX[] = {0, 0.37, 0.4, 0.4, 0, 0, 0}, LIFT[] = {0, 0, 0.3, 0.05, -0.02, -0.3, -1};
+  lw_splines *sp = two_splines(4, 4);
+  lw_test_arc(sp, 0, 10, 13, 3, -0.75 * PI, -0.25 * PI);
+  if (which >= 4) lw_test_arc(sp, 1, 10, 13 + LIFT[which], 3, -0.75 * PI, -0.25 * PI); /* parallel */
+  else lw_test_arc(sp, 1, 10 + CX[which], 8 + LIFT[which], 2, 0.25 * PI, 0.75 * PI);
+  return sp;
+}
+static const char *const ARC_CASE[] = {"touching at a node", "touching mid-segment", "crossing at 40 degrees",
+                                       "crossing at 14 degrees", "parallel 0.02 apart", "parallel 0.3 apart",
+                                       "parallel 1 apart"};
+
+/*
+** lw_pair_segments_exact summed over the 16 segment pairs against the
+** brute-force reference.  Measured: 2e-11 to 2e-7; touching at a node 8e-4,
+** where leaves (LEAF_RATIO of the pair's size) meet at the contact and their
+** chords stand at a small angle the curves do not have (first order in the
+** leaf size; a node contact is a single point of measure zero for a chain).
+*/
+Test(pair, exact_segment_pairs_match_reference)
+{
+  for (int k = 0; k < 7; k++) {
+    lw_splines *sp = two_arcs(k);
+    double e = 0.0;
+    for (size_t m = 0; m < 4; m++)
+      for (size_t j = 0; j < 4; j++) {
+        double a[8], b[8];
+        lw_splines_bezier(sp, 0, m, a);
+        lw_splines_bezier(sp, 1, j, b);
+        e += lw_pair_segments_exact(a, b, 0.0);
+      }
+    double ref = lw_pairref_energy(sp), tol = k == 0 ? 2e-3 : 1e-6;
+    cr_assert(lw_close_rel(e, ref, tol, 0.0), "%s: %.12g vs %.12g (rel %.1e)", ARC_CASE[k], e, ref,
+              fabs(e / ref - 1));
+    lw_splines_free(sp);
+  }
+}
+
+/*
+** The model's pair energy against the reference at 4 to 32 nodes.  The
+** issue's bound is 1e-2 at 8 nodes on the touching and crossing cases;
+** measured at most 4e-5 (docs/ACCURACY.md).  Curves that neither touch nor
+** cross have no error floor: the error keeps falling and is below 1e-6 at 32
+** nodes (measured 2e-8 and 2e-9; what is left is the float rounding of the
+** stored length elements, 6e-8 each, which averages out over the sum).
+*/
+Test(pair, model_pair_energy_converges_without_floor)
+{
+  const int ns[] = {4, 8, 16, 32};
+  for (int k = 0; k < 7; k++) {
+    lw_splines *sp = two_arcs(k);
+    double ref = lw_pairref_energy(sp), err[4];
+    for (int i = 0; i < 4; i++) err[i] = fabs(pair_energy(sp, ns[i], 0.0, NEAR_DEFAULT) / ref - 1);
+    cr_log_info("%s: %.1e %.1e %.1e %.1e at 4 8 16 32 nodes", ARC_CASE[k], err[0], err[1], err[2], err[3]);
+    cr_assert(err[1] <= 1e-3, "%s: %.1e at 8 nodes", ARC_CASE[k], err[1]);
+    if (k >= 5) {
+      cr_assert(err[3] < 1e-6, "%s: %.1e at 32 nodes", ARC_CASE[k], err[3]);
+      cr_assert(err[3] < err[1], "%s: no gain from 8 to 32 nodes (%.1e, %.1e)", ARC_CASE[k], err[1], err[3]);
+    }
+    lw_splines_free(sp);
+  }
+}
+
+/*
+** The defined energy with a cutoff, C times the double integral of
+** (1/r - 1/rc)+, for cutoffs from 2 to 20 element lengths (element: segment
+** length / nodes) and curves closer than the cutoff.  Bound 1e-2 at 8 nodes
+** (measured at most 4e-3, at 2 element lengths; the kink at r = rc makes the
+** product rule converge algebraically, not spectrally).
+*/
+Test(pair, cutoff_energy_matches_the_defined_energy)
+{
+  const double gaps[] = {0.05, 0.15}, el = 3.0 * 0.5 * PI / 4.0 / 8.0; /* arc segment / 8 nodes */
+  const double rcs[] = {2, 3, 5, 10, 20};
+  for (int g = 0; g < 2; g++) {
+    lw_splines *sp = two_splines(4, 4);
+    lw_test_arc(sp, 0, 10, 13, 3, -0.75 * PI, -0.25 * PI);
+    lw_test_arc(sp, 1, 10.2, 13 - gaps[g], 3, -0.75 * PI, -0.25 * PI);
+    for (int r = 0; r < 5; r++) {
+      double rc = rcs[r] * el, ref = lw_pairref_energy_cut(sp, rc), e = pair_energy(sp, 8, rc, NEAR_DEFAULT);
+      cr_assert(lw_close_rel(e, ref, 1e-2, 0.0), "gap %g, rc %g elements: %.10g vs %.10g (rel %.1e)", gaps[g],
+                rcs[r], e, ref, fabs(e / ref - 1));
+    }
+    lw_splines_free(sp);
+  }
+}
+
+/*
+** Continuity: two arcs pulled apart through every zone boundary (the near
+** weight's knots at half the near radius and at the radius, the near radius
+** capped by the cutoff) and through the cutoff.  The samples of the two arcs
+** line up radially, so these pair distances are the gap itself.  Across
+** 2e-11 a continuous energy changes by |E'| 2e-11 (~1e-10 E here; at the
+** cutoff the energy has a kink, not a jump); a jump would stay.  Bound 1e-9 E.
+*/
+Test(pair, energy_is_continuous_through_every_zone)
+{
+  const double rc = 0.6, h = 1e-11;
+  lw_quad q;
+  lw_quad_init(&q, 8, NULL);
+  double wmax = 0.0;
+  for (int i = 0; i < 8; i++) wmax = fmax(wmax, q.w[i]);
+  /* the largest element: w_max times the speed, an arc segment's length */
+  double rho = fmin(NEAR_DEFAULT * wmax * 3.0 * 0.5 * PI / 4.0, rc);
+  const double at[] = {0.5 * rho, rho, rc, 0.3 * rho, 0.8 * rho};
+  for (size_t k = 0; k < sizeof at / sizeof at[0]; k++) {
+    double e[2];
+    for (int i = 0; i < 2; i++) {
+      lw_splines *sp = two_splines(4, 4);
+      lw_test_arc(sp, 0, 10, 13, 3, -0.75 * PI, -0.25 * PI);
+      lw_test_arc(sp, 1, 10, 13 - at[k] + (2 * i - 1) * h, 3, -0.75 * PI, -0.25 * PI);
+      e[i] = pair_energy(sp, 8, rc, NEAR_DEFAULT);
+      lw_splines_free(sp);
+    }
+    cr_assert(isfinite(e[0]) && fabs(e[1] - e[0]) <= 1e-9 * fabs(e[0]), "gap %g: E %.15g to %.15g (%.1e)", at[k],
+              e[0], e[1], fabs(e[1] / e[0] - 1));
+  }
+}
+
+/* A near segment pair gives the same correction whichever segment comes
+** first (bitwise): full sums and move deltas then agree to the last bit. */
+Test(pair, near_correction_is_bitwise_symmetric)
 {
   lw_quad q;
   lw_pair_ctx ctx;
   lw_quad_init(&q, 8, NULL);
-  const double rc = 1.0;
-  lw_pair_ctx_init(&ctx, &q, rc, NEAR_DEFAULT);
-  cr_assert(lw_close_rel(ctx.inv_cutoff, 1.0, 1e-15, 0.0));
-  /* small elements: the product rule zone reaches far inside rc */
-  const double dl = 0.01, sp_ = dl / q.w[3];
-  lw_pair_sample a = {0, 0, sp_, 0, dl, 0, 3};
-  const double rs[] = {0.2, 0.5, 0.9, 0.999};
-  for (size_t k = 0; k < sizeof rs / sizeof rs[0]; k++) {
-    lw_pair_sample b = {rs[k] * 0.6, rs[k] * 0.8, 0, sp_, dl, 1, 3};
-    double v = lw_pair_kernel(&a, &b, &ctx);
-    cr_assert(lw_close_rel(v, (double)a.dl * a.dl * (1.0 / rs[k] - 1.0 / rc), 1e-13, 0.0), "r = %g: %g", rs[k], v);
-  }
-  const double out[] = {1.0, 1.0 + 1e-15, 1.5, 100.0};
-  for (size_t k = 0; k < sizeof out / sizeof out[0]; k++) {
-    lw_pair_sample b = {out[k], 0, 0, sp_, dl, 1, 3};
-    cr_assert_eq(lw_pair_kernel(&a, &b, &ctx), 0.0, "r = %g", out[k]);
-  }
-  /* continuous at rc, for small elements and for elements so large that rc
-  ** falls inside the element zone (which then ends at rc) */
-  const double dls[] = {0.01, 0.15};
-  for (size_t k = 0; k < 2; k++) {
-    double s = dls[k] / q.w[0];
-    lw_pair_sample c = {0, 0, s * 0.6, s * 0.8, dls[k], 0, 0};
-    lw_pair_sample b = {1.0 - 1e-9, 0, 0, s, dls[k], 1, 7};
-    double v = lw_pair_kernel(&c, &b, &ctx);
-    cr_assert(fabs(v) <= 2e-9 * dls[k] * dls[k], "dl %g: kernel %g just inside rc", dls[k], v);
-  }
-  /* the exact and the element zone subtract the same dl dl / rc (|r'| = 0.1,
-  ** so dm = 0.1 w_4 = 0.018 and the nodes sit 0.56 dm, 3 dm apart) */
-  lw_pair_ctx ctx0;
-  lw_pair_ctx_init(&ctx0, &q, 0.0, NEAR_DEFAULT);
-  lw_pair_sample c = {0, 0, 0.1, 0, 0.1 * q.w[2], 0, 2};
-  const double at[][2] = {{0.004, 0.009}, {0.02, 0.05}};
-  for (int k = 0; k < 2; k++) {
-    lw_pair_sample d = {at[k][0], at[k][1], 0.06, 0.08, 0.1 * q.w[5], 1, 5};
-    double v0 = lw_pair_kernel(&c, &d, &ctx0), v1 = lw_pair_kernel(&c, &d, &ctx);
-    cr_assert(isfinite(v0) && lw_close_rel(v1, v0 - (double)c.dl * d.dl / rc, 1e-14, 0.0), "zone %d", k);
+  lw_pair_ctx_init(&ctx, 2.0, NEAR_DEFAULT);
+  rng_seed(4242);
+  for (int it = 0; it < 200; it++) {
+    double a[8], b[8];
+    for (int k = 0; k < 8; k++) a[k] = urand(0, 1), b[k] = urand(0, 1);
+    lw_node na[2] = {{a[0], a[1], a[2] - a[0], a[3] - a[1]}, {a[6], a[7], a[6] - a[4], a[7] - a[5]}};
+    lw_node nb[2] = {{b[0], b[1], b[2] - b[0], b[3] - b[1]}, {b[6], b[7], b[6] - b[4], b[7] - b[5]}};
+    lw_samples s;
+    lw_pair_sample pa[8], pb[8];
+    lw_segment_sample(&q, &na[0], &na[1], &s);
+    for (int i = 0; i < 8; i++) pa[i] = (lw_pair_sample){s.x[i], s.y[i], s.dx[i], s.dy[i], s.dl[i], 0, (uint32_t)i};
+    lw_segment_sample(&q, &nb[0], &nb[1], &s);
+    for (int i = 0; i < 8; i++) pb[i] = (lw_pair_sample){s.x[i], s.y[i], s.dx[i], s.dy[i], s.dl[i], 1, (uint32_t)i};
+    double u = lw_pair_near_correction(a, pa, b, pb, 8, &ctx), v = lw_pair_near_correction(b, pb, a, pa, 8, &ctx);
+    cr_assert(u == v && isfinite(u), "(a, b) %.17g, (b, a) %.17g", u, v);
   }
 }
 
-Test(pair, kernel_continuous_across_the_element_zone_edge)
-{
-  /* the element rule blends into the product rule: no jump at 6 near dm */
-  lw_quad q;
-  lw_pair_ctx ctx;
-  lw_quad_init(&q, 8, NULL);
-  lw_pair_ctx_init(&ctx, &q, 0.0, NEAR_DEFAULT);
-  const double dl = 0.1, ro = 6.0 * NEAR_DEFAULT * dl;
-  lw_pair_sample a = {0, 0, 0.6 * dl / q.w[1], 0.8 * dl / q.w[1], dl, 0, 1};
-  for (int side = 0; side < 2; side++) {
-    double r = side ? ro : 0.75 * ro; /* outer edge, start of the blend */
-    lw_pair_sample b0 = {r - 1e-12, 0, 0, dl / q.w[6], dl, 1, 6}, b1 = {r + 1e-12, 0, 0, dl / q.w[6], dl, 1, 6};
-    double v0 = lw_pair_kernel(&a, &b0, &ctx), v1 = lw_pair_kernel(&a, &b1, &ctx);
-    cr_assert(fabs(v0 - v1) < 1e-9 * v0, "jump %g at r = %g", v1 - v0, r);
-  }
-}
-
+/* Curves crossing exactly at a sample of each: the product rule alone is
+** infinite there (near = 0), the near field gives the exact double integral
+** of the two lines. */
 Test(pair, coincident_samples_are_finite_with_the_near_field)
 {
   lw_quad q;
-  lw_pair_ctx ctx;
   lw_quad_init(&q, 8, NULL);
-  lw_pair_ctx_init(&ctx, &q, 0.0, NEAR_DEFAULT);
-  /* two curves crossing exactly at a sample of each */
-  for (int qa = 0; qa < 8; qa++)
-    for (int qb = 0; qb < 8; qb++) {
-      double ang = 0.3 + 0.2 * qb;
-      lw_pair_sample a = {1, 2, 0.5, 0, 0.5 * q.w[qa], 0, (uint32_t)qa};
-      lw_pair_sample b = {1, 2, 0.4 * cos(ang), 0.4 * sin(ang), 0.4 * q.w[qb], 1, (uint32_t)qb};
-      double v = lw_pair_kernel(&a, &b, &ctx);
-      /* the exact integral over the two elements, which cross at the nodes */
-      double a0[2] = {1 - 0.5 * (q.s[qa] - q.e[qa]), 2}, a1[2] = {1 + 0.5 * (q.e[qa + 1] - q.s[qa]), 2};
-      double lo = q.s[qb] - q.e[qb], hi = q.e[qb + 1] - q.s[qb];
-      /* the element runs along the stored (float) derivative */
-      double b0[2] = {1 - lo * b.dx, 2 - lo * b.dy};
-      double b1[2] = {1 + hi * b.dx, 2 + hi * b.dy};
-      double ref = brute_segseg(a0, a1, b0, b1);
-      cr_assert(isfinite(v) && v > 0 && lw_close_rel(v, ref, 1e-11, 0.0), "q %d/%d: %g vs %g", qa, qb, v, ref);
-    }
-  /* the product rule alone is infinite there */
-  lw_pair_ctx off;
-  lw_pair_ctx_init(&off, &q, 0.0, 0.0);
-  lw_pair_sample a = {1, 2, 0.5, 0, 0.1, 0, 2}, b = {1, 2, 0, 0.5, 0.1, 1, 2};
-  cr_assert(isinf(lw_pair_kernel(&a, &b, &off)));
-}
-
-Test(pair, kernel_is_bitwise_symmetric)
-{
-  lw_quad q;
-  lw_pair_ctx ctx;
-  lw_quad_init(&q, 8, NULL);
-  lw_pair_ctx_init(&ctx, &q, 2.0, NEAR_DEFAULT);
-  rng_seed(4242);
-  for (int it = 0; it < 20000; it++) {
-    int qa = (int)urand(0, 8), qb = (int)urand(0, 8);
-    double ta = urand(0, 2 * PI), tb = urand(0, 2 * PI), sa = urand(0.1, 1), sb = urand(0.1, 1);
-    double r = urand(0, 2), t = urand(0, 2 * PI);
-    lw_pair_sample a = {0.3, -0.2, sa * cos(ta), sa * sin(ta), sa * q.w[qa], 0, (uint32_t)qa};
-    lw_pair_sample b = {0.3 + r * cos(t), -0.2 + r * sin(t), sb * cos(tb), sb * sin(tb), sb * q.w[qb], 1,
-                        (uint32_t)qb};
-    double u = lw_pair_kernel(&a, &b, &ctx), v = lw_pair_kernel(&b, &a, &ctx);
-    cr_assert(u == v, "kernel(a,b) = %.17g, kernel(b,a) = %.17g", u, v);
-  }
-}
-
-Test(pair, ctx_init_tabulates_elements)
-{
-  for (int n = LW_QUAD_MIN; n <= LW_QUAD_MAX; n += 7) {
-    lw_quad q;
-    lw_pair_ctx ctx;
-    lw_quad_init(&q, n, NULL);
-    lw_pair_ctx_init(&ctx, &q, -1.0, -2.0); /* negative: no cutoff, near field off */
-    cr_assert_eq(ctx.cutoff, 0.0);
-    cr_assert_eq(ctx.inv_cutoff, 0.0);
-    cr_assert_eq(ctx.near, 0.0);
-    for (int i = 0; i < n; i++) {
-      cr_assert(ctx.elem_lo[i] > 0 && ctx.elem_hi[i] > 0);
-      cr_assert(fabs(ctx.elem_lo[i] + ctx.elem_hi[i] - q.w[i]) < 1e-15, "element %d of %d has length w", i, n);
-    }
-  }
+  lw_splines *sp = two_splines(1, 1);
+  double p0[2] = {10 - 2 * q.s[3], 10}, p1[2] = {12 - 2 * q.s[3], 10};
+  double q0[2] = {10, 10 - 2 * q.s[5]}, q1[2] = {10, 12 - 2 * q.s[5]};
+  straight(sp, 0, p0, p1);
+  straight(sp, 1, q0, q1);
+  cr_assert(isinf(pair_energy(sp, 8, 0.0, 0.0)));
+  double e = pair_energy(sp, 8, 0.0, NEAR_DEFAULT), exact = lw_pair_segseg(p0, p1, q0, q1);
+  cr_assert(lw_close_rel(e, exact, 1e-9, 0.0), "%.12g vs %.12g", e, exact);
+  lw_splines_free(sp);
 }
