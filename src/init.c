@@ -219,6 +219,19 @@ double lw_init_ink_area(const lw_scene *sc)
 
 lw_status lw_init_count(const lw_scene *sc, const lw_params *p, size_t *n, lw_error *err)
 {
+  /* With the cutoff within two length elements of the placed segments the
+  ** kink of (1/r - 1/rc)+ falls between the samples of most pairs, and the
+  ** pair energy is off by more than 1e-2 (docs/ACCURACY.md). */
+  double element = p->segment_length / sc->pair_quad.n;
+  if (sc->on[LW_TERM_PAIR] && p->pair_cutoff > 0.0 && p->pair_cutoff < 2.0 * element) {
+    char at[LW_PATH_MAX + 32];
+    lw_params_origin(p, lw_params_find("energy", "pair_cutoff"), at, sizeof at);
+    return lw_error_set(err, LW_EINPUT,
+                        "%s: key 'energy.pair_cutoff': expected at least two length elements, %g mm "
+                        "(init.segment_length / nodes = %g mm), got %g mm; raise it, or the pair nodes "
+                        "(energy.pair_quadrature)",
+                        at, 2.0 * element, element, p->pair_cutoff);
+  }
   const lw_param_def *cov = lw_params_find("init", "coverage"), *spl = lw_params_find("init", "splines");
   char where[LW_PATH_MAX + 32];
   lw_params_origin(p, cov, where, sizeof where);

@@ -123,21 +123,29 @@ static size_t unique_u32(uint32_t *v, size_t n)
   return m;
 }
 
-/* Pair energy (no coefficient) of one segment, with control points bez and
-** samples mine (np of them, spline `spline`), against every segment of
-** another spline in the grid: the product rule over far sample pairs plus
-** the near field of each near segment pair.  NAN if out of memory. */
-static double pair_against(const lw_cellgrid *g, const lw_splines *sp, const lw_pair_sample *all,
-                           const double bez[8], const lw_pair_sample *mine, int np, uint32_t spline,
-                           const lw_pair_ctx *ctx, lw_near_list *near)
+/* The product-rule sum (no coefficient) of one segment's np samples `mine`
+** (spline `spline`) against every sample of another spline in the grid,
+** near pairs left out; `near` receives the segments of the near pairs,
+** sorted, each once.  NAN if out of memory. */
+static double pair_walk(const lw_cellgrid *g, const lw_pair_sample *all, const lw_pair_sample *mine, int np,
+                        uint32_t spline, const lw_pair_ctx *ctx, lw_near_list *near)
 {
   double sum = 0.0;
   near->n = 0;
   for (int i = 0; i < np; i++) sum += neighbour_sum(g, all, &mine[i], spline, -1, ctx, near);
   if (near->n == 0 || isnan(sum)) return sum;
   for (size_t k = 0; k < near->n; k++) near->idx[k] /= (uint32_t)np;
-  size_t nb = unique_u32(near->idx, near->n);
-  for (size_t k = 0; k < nb; k++) {
+  near->n = unique_u32(near->idx, near->n);
+  return sum;
+}
+
+/* The near field (no coefficient) of one segment, control points bez and
+** samples mine, with each segment of the list `near`. */
+static double pair_near_part(const lw_splines *sp, const lw_pair_sample *all, const double bez[8],
+                             const lw_pair_sample *mine, int np, const lw_pair_ctx *ctx, const lw_near_list *near)
+{
+  double sum = 0.0;
+  for (size_t k = 0; k < near->n; k++) {
     double b[8];
     segment_bezier(sp, near->idx[k], b);
     sum += lw_pair_near_correction(bez, mine, b, all + (size_t)near->idx[k] * (size_t)np, np, ctx);
@@ -291,7 +299,9 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
       return NULL;
     }
     m->ps = malloc((n ? n : 1) * sizeof *m->ps);
-    if (!m->ps) goto nomem;
+    m->near_cache = malloc(ns * sizeof *m->near_cache);
+    m->near_valid = calloc(ns, sizeof *m->near_valid);
+    if (!m->ps || !m->near_cache || !m->near_valid) goto nomem;
     m->grid = grid_for(sc, n, err);
     if (!m->grid) {
       lw_model_free(m);
@@ -316,6 +326,8 @@ void lw_model_free(lw_model *m)
   free(m->seg_local);
   free(m->spline_len);
   free(m->ps);
+  free(m->near_cache);
+  free(m->near_valid);
   lw_cellgrid_free(m->grid);
   free(m);
 }
@@ -351,6 +363,7 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
   }
   if (m->grid) {
     size_t n = sp->n_segments * (size_t)np;
+    memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);
     lw_cellgrid_clear(m->grid);
     for (size_t i = 0; i < n; i++)
       if (lw_cellgrid_insert(m->grid, (uint32_t)i, m->ps[i].x, m->ps[i].y) != LW_OK) return LW_ENOMEM;
@@ -381,8 +394,9 @@ lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err)
     p->len = malloc(cap * sizeof *p->len);
     p->local = malloc(cap * (size_t)nl * sizeof *p->local);
     p->ps = malloc(cap * (size_t)m->scene->pair_quad.n * sizeof *p->ps);
+    p->near_new = malloc(cap * sizeof *p->near_new);
   }
-  if (!p || !p->node || !p->len || !p->local || !p->ps) {
+  if (!p || !p->node || !p->len || !p->local || !p->ps || !p->near_new) {
     lw_proposal_free(p);
     lw_error_set(err, LW_ENOMEM, "out of memory for a proposal");
     return NULL;
@@ -398,6 +412,8 @@ void lw_proposal_free(lw_proposal *p)
   free(p->local);
   free(p->ps);
   free(p->near.idx);
+  free(p->partners.idx);
+  free(p->near_new);
   free(p);
 }
 
@@ -405,6 +421,48 @@ void lw_proposal_free(lw_proposal *p)
 static inline const lw_node *proposed_node(const lw_node *base, const lw_proposal *p, size_t k)
 {
   return (k >= p->node0 && k < p->node0 + p->n_node) ? &p->node[k - p->node0] : &base[k];
+}
+
+/*
+** The pair part of a proposal's dE (no coefficient).  New side: the walk and
+** the near field of each new segment.  Old side: the walk, and the near field
+** from the model's cache when valid.  The near field is the costly part, and
+** a chain at low temperature rejects most proposals, so caching the old side
+** halves it.  The cached value of a segment is what this code computes for it
+** from the current state (the same sum in the same order), so a cached and a
+** recomputed value are bitwise equal; commits invalidate every segment whose
+** near field the move changed (its near partners before and after).  The
+** partners of both sides are kept in p->partners for the commit.
+*/
+static double pair_delta(const lw_model *m, lw_proposal *p, const lw_node *base, size_t g0)
+{
+  const lw_scene *sc = m->scene;
+  const lw_splines *sp = m->sp;
+  const int np = sc->pair_quad.n;
+  double pe = 0.0;
+  p->partners.n = 0;
+  for (size_t j = 0; j < p->n_seg && !isnan(pe); j++) {
+    size_t g = g0 + p->seg0 + j;
+    double bez[8];
+    node_bezier(proposed_node(base, p, p->seg0 + j), proposed_node(base, p, p->seg0 + j + 1), bez);
+    const lw_pair_sample *mine = p->ps + j * (size_t)np;
+    pe += pair_walk(m->grid, m->ps, mine, np, p->spline, &sc->pair, &p->near);
+    p->near_new[j] = pair_near_part(sp, m->ps, bez, mine, np, &sc->pair, &p->near);
+    pe += p->near_new[j];
+    for (size_t k = 0; k < p->near.n; k++)
+      if (near_push(&p->partners, p->near.idx[k]) != LW_OK) return NAN;
+    mine = m->ps + g * (size_t)np;
+    pe -= pair_walk(m->grid, m->ps, mine, np, p->spline, &sc->pair, &p->near);
+    if (!m->near_valid[g]) {
+      node_bezier(&base[p->seg0 + j], &base[p->seg0 + j + 1], bez);
+      m->near_cache[g] = pair_near_part(sp, m->ps, bez, mine, np, &sc->pair, &p->near);
+      m->near_valid[g] = 1;
+    }
+    pe -= m->near_cache[g];
+    for (size_t k = 0; k < p->near.n; k++)
+      if (near_push(&p->partners, p->near.idx[k]) != LW_OK) return NAN;
+  }
+  return pe;
 }
 
 void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t node0,
@@ -466,16 +524,10 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   if (forbidden && !undefined) dE = INFINITY;
   /* The pair sum is the costly part: skip it when the move is already
   ** forbidden (+inf) or undefined (NaN). */
+  p->pair_done = 0;
   if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
-    double pe = 0.0;
-    for (size_t j = 0; j < p->n_seg; j++) {
-      size_t g = g0 + p->seg0 + j;
-      double bn[8], bo[8];
-      node_bezier(proposed_node(base, p, p->seg0 + j), proposed_node(base, p, p->seg0 + j + 1), bn);
-      node_bezier(&base[p->seg0 + j], &base[p->seg0 + j + 1], bo);
-      pe += pair_against(m->grid, sp, m->ps, bn, p->ps + j * (size_t)np, np, spline, &sc->pair, &p->near);
-      pe -= pair_against(m->grid, sp, m->ps, bo, m->ps + g * (size_t)np, np, spline, &sc->pair, &p->near);
-    }
+    double pe = pair_delta(m, p, base, g0);
+    p->pair_done = !isnan(pe);
     p->dterm[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pe;
     dE += p->dterm[LW_TERM_PAIR];
   }
@@ -501,6 +553,18 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
       }
   }
   memcpy(&sp->node[sp->first[p->spline] + p->node0], p->node, p->n_node * sizeof *p->node);
+  if (m->grid) {
+    if (p->pair_done) {
+      for (size_t k = 0; k < p->partners.n; k++) m->near_valid[p->partners.idx[k]] = 0;
+      for (size_t j = 0; j < p->n_seg; j++) {
+        m->near_cache[g0 + p->seg0 + j] = p->near_new[j];
+        m->near_valid[g0 + p->seg0 + j] = 1;
+      }
+    } else {
+      /* committed without a pair evaluation: its partners are unknown */
+      memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);
+    }
+  }
   int nonfinite = 0;
   for (size_t j = 0; j < p->n_seg; j++) {
     size_t g = g0 + p->seg0 + j;

@@ -107,13 +107,16 @@ static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
   piece_bound(hi);
 }
 
-#ifndef SEP_RATIO
-#define SEP_RATIO 1.5
+#ifndef SEP_LO
+#define SEP_LO 0.5
+#endif
+#ifndef SEP_HI
+#define SEP_HI 1.0
 #endif
 #ifndef LEAF_RATIO
-#define LEAF_RATIO 3e-3
+#define LEAF_RATIO 1e-2
 #endif
-#define STACK_MAX 512
+#define STACK_MAX 128
 
 /* Gauss-Legendre on [0, 1], 6 nodes (tabulated: the tree calls this per pair). */
 #define GAUSS_M 6
@@ -149,43 +152,67 @@ static double product_pieces(const cubic *ca, const piece *pa, const cubic *cb, 
   return sum;
 }
 
+/* 0 at x <= 0, 1 at x >= 1, C2 between. */
+static inline double smooth_step(double x)
+{
+  if (x <= 0.0) return 0.0;
+  if (x >= 1.0) return 1.0;
+  return x * x * x * (10.0 + x * (6.0 * x - 15.0));
+}
+
+/* A leaf: the chords, integrated exactly; their lengths stand in for the
+** arcs (equal to O(leaf^2)).  Chords of curves that touch tangentially end
+** to end can overlap by a rounding error, which the exact integral reads as
+** +inf; the product rule's interior nodes keep such a leaf finite. */
+static double leaf_value(const cubic *ca, const piece *pa, const cubic *cb, const piece *pb)
+{
+  double v = lw_pair_segseg(pa->r0, pa->r1, pb->r0, pb->r1);
+  return v < INFINITY ? v : product_pieces(ca, pa, cb, pb);
+}
+
 /* T: the 1/r double integral by subdivision (see the file comment). */
 static double inverse_distance(const cubic *ca, const cubic *cb)
 {
   piece sa[STACK_MAX], sb[STACK_MAX];
-  int top = 0;
+  double share[STACK_MAX];
+  int depth[STACK_MAX];
   piece_init(&sa[0], ca, 0.0, 1.0);
   piece_init(&sb[0], cb, 0.0, 1.0);
-  double size = sa[0].rad + sb[0].rad;
-  double leaf = LEAF_RATIO * size;
+  share[0] = 1.0;
+  depth[0] = 0;
+  const double leaf = LEAF_RATIO * (sa[0].rad + sb[0].rad);
   double sum = 0.0;
-  top = 1;
+  int top = 1;
   while (top > 0) {
     top--;
     piece pa = sa[top], pb = sb[top];
+    double f = share[top];
+    int d = depth[top];
     double dx = pa.cx - pb.cx, dy = pa.cy - pb.cy;
     double big = pa.rad > pb.rad ? pa.rad : pb.rad;
     double gap = sqrt(dx * dx + dy * dy) - pa.rad - pb.rad;
-    if (gap > SEP_RATIO * big) {
-      sum += product_pieces(ca, &pa, cb, &pb);
-      continue;
-    }
-    if (big < leaf || top + 2 > STACK_MAX) {
-      /* chords; their lengths stand in for the arcs (equal to O(leaf^2)).
-      ** Chords of curves that touch tangentially end to end can overlap by
-      ** a rounding error, which the exact integral reads as +inf; the
-      ** product rule's interior nodes keep such a leaf finite. */
-      double v = lw_pair_segseg(pa.r0, pa.r1, pb.r0, pb.r1);
-      sum += v < INFINITY ? v : product_pieces(ca, &pa, cb, &pb);
-      continue;
-    }
-    if (pa.rad >= pb.rad) {
+    /* accepted for the product rule: fully from SEP_HI, partly from SEP_LO */
+    double w = smooth_step((gap - SEP_LO * big) / ((SEP_HI - SEP_LO) * big));
+    if (!(big > 0.0)) w = 1.0;
+    if (w > 0.0) sum += f * w * product_pieces(ca, &pa, cb, &pb);
+    f *= 1.0 - w;
+    if (f == 0.0) continue;
+    /* a leaf: fully below the leaf size, partly below twice that */
+    w = top + 2 > STACK_MAX ? 1.0 : smooth_step((2.0 * leaf - big) / leaf);
+    if (w > 0.0) sum += f * w * leaf_value(ca, &pa, cb, &pb);
+    f *= 1.0 - w;
+    if (f == 0.0) continue;
+    /* split A and B in turn: a choice by size would flip between two
+    ** subtrees, whose values differ by their errors */
+    if (d % 2 == 0) {
       piece_split(&pa, ca, &sa[top], &sa[top + 1]);
       sb[top] = sb[top + 1] = pb;
     } else {
       piece_split(&pb, cb, &sb[top], &sb[top + 1]);
       sa[top] = sa[top + 1] = pa;
     }
+    share[top] = share[top + 1] = f;
+    depth[top] = depth[top + 1] = d + 1;
     top += 2;
   }
   return sum;

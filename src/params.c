@@ -132,11 +132,13 @@ const lw_param_def lw_param_table[] = {
       "C: pair repulsion C * double integral of dl dl / r between different splines. 0 = off."),
   NUM("energy", "pair_cutoff", LW_PT_DOUBLE, pair_cutoff, "5", "mm", 0, 1e7, 0,
       "Pair interaction range; the kernel is shifted to 1/r - 1/rc so the energy is continuous. "
+      "At least two length elements (init.segment_length / pair nodes). "
       "0 = no cutoff (all pairs; slow for large scenes)."),
   NUM("energy", "pair_near", LW_PT_DOUBLE, pair_near, "1.5", "element lengths", 0, 100, 0,
-      "Near field: sample pairs closer than this many element lengths use the exact integral "
-      "over straight elements (finite where curves touch or cross), pairs up to 6 times farther "
-      "a 2x2 Gauss rule over the elements blended into the far field. 0 = off (product rule only)."),
+      "Near field: two segments with a pair of samples closer than this many length elements "
+      "(the larger of the two; at most the cutoff) take the double integral over the exact curves, "
+      "blended smoothly into the product rule (finite where curves touch or cross). "
+      "0 = off (product rule only; infinite where samples coincide)."),
   NUM("energy", "boundary", LW_PT_DOUBLE, boundary_coef, "0", "energy mm", 0, 1e12, 0,
       "R: boundary R * integral of 1/d^2 dl keeps lines inside (+infinity outside). 0 = off."),
   NUM("energy", "quadrature", LW_PT_INT, quadrature, "8", "nodes", 2, 64, 0,

@@ -36,7 +36,9 @@ double lw_init_ink_area(const lw_scene *sc);
 ** segment_length long each) covers that fraction of the darkness:
 **     n = round(coverage * ink area / (pen_width * segments * segment_length)).
 ** LW_EINPUT (naming init.coverage) above 1e8, or when a coverage is given
-** but init.splines was left at its default (the coverage would be ignored). */
+** but init.splines was left at its default (the coverage would be ignored),
+** and (naming energy.pair_cutoff) for a cutoff shorter than two length
+** elements of the placed segments (segment_length / pair nodes). */
 lw_status lw_init_count(const lw_scene *sc, const lw_params *p, size_t *n, lw_error *err);
 
 /* A seed for stream `stream` of a run seeded with `seed` (SplitMix64 of

@@ -30,6 +30,8 @@ typedef struct {
   double term[LW_TERM_COUNT]; /* running totals (0 for terms that are off) */
   lw_pair_sample *ps;       /* n_segments * quad.n pair samples (pair on), else NULL */
   lw_cellgrid *grid;        /* over ps (pair on), else NULL */
+  double *near_cache;       /* n_segments: each segment's pair near field (pair on) */
+  uint8_t *near_valid;      /* n_segments: 1 where near_cache holds the current value */
   size_t max_segments;      /* longest spline, for sizing proposals */
 } lw_model;
 
@@ -64,15 +66,18 @@ typedef struct {
   double dE;                  /* sum of dterm; +inf for a forbidden state, NaN never kept */
   size_t cap_seg;
   lw_near_list near;          /* the pair walk's near pairs */
+  lw_near_list partners;      /* near partners of the changed segments, old and new */
+  double *near_new;           /* n_seg new near fields (no coefficient) */
+  int pair_done;              /* 1 if the pair part was evaluated */
 } lw_proposal;
 
 lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err);
 void lw_proposal_free(lw_proposal *p);
 
 /* Evaluates replacing n_node nodes of spline `spline` starting at local node
-** node0 with `nodes` (copied into p; NULL: they are already in p->node).  Fills p->dterm and p->dE; the model is
-** not changed.  Pure with respect to the model: several threads may propose
-** against one model if none commits meanwhile. */
+** node0 with `nodes` (copied into p; NULL: they are already in p->node).  Fills p->dterm and p->dE.  The
+** state is not changed, but the pair term's near-field cache may be filled
+** (model.c): one thread per model. */
 void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t node0,
                       size_t n_node, const lw_node *nodes);
 
