@@ -4,29 +4,45 @@
 ** lw_pair_segments_exact
 ** ----------------------
 ** T = double integral of |a'| |b'| / r by adaptive subdivision of the
-** parameter square.  A piece of a cubic is again a cubic: its Bezier
-** control points are r(t0), r(t0) + h r'(t0) / 3, r(t1) - h r'(t1) / 3,
-** r(t1) (h = t1 - t0), and it lies in their convex hull, so in the circle
-** about the chord's midpoint through the farthest of them.  A pair of pieces
-** whose circles are more than SEP_RATIO times the larger radius apart takes
-** the GAUSS_M x GAUSS_M product rule: 1/r is then analytic in a Bernstein
-** ellipse of parameter rho >= 1 + SEP_RATIO + sqrt((1 + SEP_RATIO)^2 - 1)
-** around each piece, and the rule's error is below rho^(-2 GAUSS_M) ~ 1e-10.
-** Other pairs are split (the piece with the larger circle, at its middle)
-** until both are shorter than LEAF_RATIO of the pair's size; such leaves are
-** replaced by their chords and integrated exactly (lw_pair_segseg), an error
-** of the order of the squared curvature times the leaf length squared.  The
-** subdivision follows the curves into the points where they cross or touch
-** (about log2(1 / LEAF_RATIO) levels) and along stretches where they run
-** closer than their length (pieces about as long as the distance).  A
-** decision of the test can flip with a small change of the curves; both
-** sides are accurate to ~1e-10, so the integral moves by no more than that.
+** parameter square.  A piece [t0, t1] of a cubic is again a cubic: its Bezier
+** control points are r(t0), r(t0) + h r'(t0) / 3, r(t1) - h r'(t1) / 3, r(t1)
+** (h = t1 - t0) and it lies in their convex hull.  Two bounds of how far apart
+** two pieces are follow from that:
+**   circle gap: the distance of the circles about the chords' midpoints
+**     through the farthest control point, less their radii; good for pieces
+**     side by side or end to end;
+**   chord gap: the distance of the two chords less how far each piece's
+**     control points stray from its chord; good for long pieces running
+**     alongside each other.
+** The two segments whose chord gap exceeds CHORD_HI times half the larger
+** size take the 16 x 16 rule (rho >= 0.5 + sqrt(1.25) = 1.6 in the worst
+** place, beside a segment's middle: error below 1.6^-32 ~ 3e-7): most near
+** pairs of a drawing, neighbouring lines about an element apart, end there.
+** Below it, a pair of pieces whose circle gap exceeds SEP_HI times the
+** larger radius takes the 6 x 6 rule (1/r is analytic in a Bernstein
+** ellipse rho >= 1 + SEP_HI + sqrt((1 + SEP_HI)^2 - 1) = 3.7 about each
+** piece: error below rho^-12 ~ 1e-7 of the pair).  Other pairs are split, A
+** and B in turn, until
+** both are shorter than LEAF_RATIO of the segment pair's size, where the
+** chords stand in for the pieces and are integrated exactly (lw_pair_segseg):
+** an error of order curvature^2 leaf^2 where curves cross, of order the leaf
+** where they touch tangentially.  The subdivision follows the curves into
+** the points where they cross or touch and along stretches where they run
+** closer than their length.
+**
+** Every decision is blended: between SEP_LO and SEP_HI (CHORD_LO and
+** CHORD_HI, leaf sizes 2 and 1) a pair takes a C2 weight of the product rule
+** and the rest from its children; and the split alternates between A and B
+** rather than following the larger piece.  So T is a continuous function of
+** the control points whatever the accuracy: curves pulled through the point
+** where a test flips see no jump.
 **
 ** The cutoff: (1/r - 1/rc)+ = 1/r - 1/rc + (1/rc - 1/r)+.  The first two
 ** parts are T - L_a L_b / rc; the last is bounded, vanishes where r < rc and
-** has only a kink where r = rc, so a fixed 16 x 16 Gauss rule over the whole
+** has only a kink where r = rc, so the fixed 16 x 16 rule over the whole
 ** square takes it (accuracy ~ (element / rc)^2 of that part; fixed nodes keep
-** it a continuous function of the curves).
+** it continuous).  Segments that the 16 x 16 rule takes whole take the
+** cutoff kernel in the same pass.
 */
 #include "linewise/pairnear.h"
 
@@ -107,47 +123,66 @@ static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
   piece_bound(hi);
 }
 
-#ifndef SEP_LO
 #define SEP_LO 0.5
-#endif
-#ifndef SEP_HI
 #define SEP_HI 1.0
-#endif
-#ifndef LEAF_RATIO
+#define CHORD_LO 0.35
+#define CHORD_HI 0.5
 #define LEAF_RATIO 1e-2
-#endif
 #define STACK_MAX 128
 
-/* Gauss-Legendre on [0, 1], 6 nodes (tabulated: the tree calls this per pair). */
-#define GAUSS_M 6
-static const double GM_S[GAUSS_M] = {0.033765242898423986, 0.16939530676686774, 0.38069040695840154,
+/* Gauss-Legendre on [0, 1]: 6 nodes for small pieces, 16 for large ones. */
+#define GAUSS_S 6
+static const double G6_S[GAUSS_S] = {0.033765242898423986, 0.16939530676686774, 0.38069040695840154,
                                      0.61930959304159846, 0.83060469323313226, 0.96623475710157601};
-static const double GM_W[GAUSS_M] = {0.085662246189585173, 0.18038078652406930, 0.23395696728634552,
+static const double G6_W[GAUSS_S] = {0.085662246189585173, 0.18038078652406930, 0.23395696728634552,
                                      0.23395696728634552, 0.18038078652406930, 0.085662246189585173};
+#define GAUSS_L 16
+static const double G16_S[GAUSS_L] = {
+    0.0052995325041750337, 0.027712488463383700, 0.067184398806084122, 0.12229779582249845,
+    0.19106187779867811,   0.27099161117138637,  0.35919822461037054,  0.45249374508118123,
+    0.54750625491881877,   0.64080177538962946,  0.72900838882861363,  0.80893812220132189,
+    0.87770220417750155,   0.93281560119391588,  0.97228751153661630,  0.99470046749582497};
+static const double G16_W[GAUSS_L] = {
+    0.013576229705877047, 0.031126761969323946, 0.047579255841246392, 0.062314485627766936,
+    0.074797994408288366, 0.084578259697501269, 0.091301707522461794, 0.094725305227534249,
+    0.094725305227534249, 0.091301707522461794, 0.084578259697501269, 0.074797994408288366,
+    0.062314485627766936, 0.047579255841246392, 0.031126761969323946, 0.013576229705877047};
 
-/* Product rule of |a'| |b'| / r over two separated pieces. */
-static double product_pieces(const cubic *ca, const piece *pa, const cubic *cb, const piece *pb)
+/* Positions and length weights of an m-node rule on a piece. */
+static void rule_nodes(const cubic *c, double t0, double t1, const double *s, const double *w, int m,
+                       double *x, double *y, double *wt)
 {
-  double ax[GAUSS_M], ay[GAUSS_M], aw[GAUSS_M], bx[GAUSS_M], by[GAUSS_M], bw[GAUSS_M];
-  double ha = pa->t1 - pa->t0, hb = pb->t1 - pb->t0, r[2], d[2];
-  for (int k = 0; k < GAUSS_M; k++) {
-    cubic_eval(ca, pa->t0 + ha * GM_S[k], r, d);
-    ax[k] = r[0];
-    ay[k] = r[1];
-    aw[k] = ha * GM_W[k] * sqrt(d[0] * d[0] + d[1] * d[1]);
-    cubic_eval(cb, pb->t0 + hb * GM_S[k], r, d);
-    bx[k] = r[0];
-    by[k] = r[1];
-    bw[k] = hb * GM_W[k] * sqrt(d[0] * d[0] + d[1] * d[1]);
+  double h = t1 - t0, r[2], d[2];
+  for (int k = 0; k < m; k++) {
+    cubic_eval(c, t0 + h * s[k], r, d);
+    x[k] = r[0];
+    y[k] = r[1];
+    wt[k] = h * w[k] * sqrt(d[0] * d[0] + d[1] * d[1]);
   }
+}
+
+typedef enum { KERNEL_INV, KERNEL_CUT, KERNEL_CUT_REST } kernel_kind;
+
+/* The product rule of an m-node rule on two pieces, for the kernel 1/r,
+** (1/r - 1/rc)+, or the bounded part of the latter, (1/rc - 1/r)+ - 1/rc. */
+static double product_rule(const cubic *ca, double a0, double a1, const cubic *cb, double b0, double b1, int m,
+                           kernel_kind kind, double rc)
+{
+  double ax[GAUSS_L], ay[GAUSS_L], aw[GAUSS_L], bx[GAUSS_L], by[GAUSS_L], bw[GAUSS_L];
+  const double *s = m == GAUSS_L ? G16_S : G6_S, *w = m == GAUSS_L ? G16_W : G6_W;
+  rule_nodes(ca, a0, a1, s, w, m, ax, ay, aw);
+  rule_nodes(cb, b0, b1, s, w, m, bx, by, bw);
+  const double inv = rc > 0.0 ? 1.0 / rc : 0.0, rc2 = rc > 0.0 ? rc * rc : INFINITY;
   double sum = 0.0;
-  for (int i = 0; i < GAUSS_M; i++) {
-    double s = 0.0;
-    for (int j = 0; j < GAUSS_M; j++) {
-      double dx = ax[i] - bx[j], dy = ay[i] - by[j];
-      s += bw[j] / sqrt(dx * dx + dy * dy);
+  for (int i = 0; i < m; i++) {
+    double acc = 0.0;
+    for (int j = 0; j < m; j++) {
+      double dx = ax[i] - bx[j], dy = ay[i] - by[j], r2 = dx * dx + dy * dy;
+      if (kind == KERNEL_INV) acc += bw[j] / sqrt(r2);
+      else if (kind == KERNEL_CUT) acc += r2 < rc2 ? bw[j] * (1.0 / sqrt(r2) - inv) : 0.0;
+      else acc -= r2 > rc2 ? bw[j] / sqrt(r2) : bw[j] * inv;
     }
-    sum += aw[i] * s;
+    sum += aw[i] * acc;
   }
   return sum;
 }
@@ -160,6 +195,49 @@ static inline double smooth_step(double x)
   return x * x * x * (10.0 + x * (6.0 * x - 15.0));
 }
 
+/* Distance from p to the segment a-b. */
+static double point_segment(const double p[2], const double a[2], const double b[2])
+{
+  double ux = b[0] - a[0], uy = b[1] - a[1], wx = p[0] - a[0], wy = p[1] - a[1];
+  double uu = ux * ux + uy * uy, t = uu > 0.0 ? (wx * ux + wy * uy) / uu : 0.0;
+  t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+  return hypot(wx - t * ux, wy - t * uy);
+}
+
+/* Which side of the line a-b the point p is on (sign of the cross product). */
+static int side(const double a[2], const double b[2], const double p[2])
+{
+  return (p[0] - a[0]) * (b[1] - a[1]) - (p[1] - a[1]) * (b[0] - a[0]) > 0.0;
+}
+
+/* The chord gap of two pieces (see the file comment); continuous in them. */
+static double chord_gap(const piece *a, const piece *b)
+{
+  double dev = 0.0;
+  const piece *pc[2] = {a, b};
+  for (int k = 0; k < 2; k++) {
+    const piece *p = pc[k];
+    double h3 = (p->t1 - p->t0) / 3.0;
+    double c1[2] = {p->r0[0] + h3 * p->d0[0], p->r0[1] + h3 * p->d0[1]};
+    double c2[2] = {p->r1[0] - h3 * p->d1[0], p->r1[1] - h3 * p->d1[1]};
+    dev += fmax(point_segment(c1, p->r0, p->r1), point_segment(c2, p->r0, p->r1));
+  }
+  double d = 0.0;
+  /* crossing chords are 0 apart; otherwise an end of one is nearest the other */
+  if (side(a->r0, a->r1, b->r0) == side(a->r0, a->r1, b->r1) || side(b->r0, b->r1, a->r0) == side(b->r0, b->r1, a->r1))
+    d = fmin(fmin(point_segment(a->r0, b->r0, b->r1), point_segment(a->r1, b->r0, b->r1)),
+             fmin(point_segment(b->r0, a->r0, a->r1), point_segment(b->r1, a->r0, a->r1)));
+  return d - dev;
+}
+
+/* Share of the 16 x 16 rule for a pair of pieces (chord gap). */
+static double chord_share(const piece *a, const piece *b)
+{
+  double half = a->rad > b->rad ? a->rad : b->rad;
+  if (!(half > 0.0)) return 1.0;
+  return smooth_step((chord_gap(a, b) / half - CHORD_LO) / (CHORD_HI - CHORD_LO));
+}
+
 /* A leaf: the chords, integrated exactly; their lengths stand in for the
 ** arcs (equal to O(leaf^2)).  Chords of curves that touch tangentially end
 ** to end can overlap by a rounding error, which the exact integral reads as
@@ -167,20 +245,22 @@ static inline double smooth_step(double x)
 static double leaf_value(const cubic *ca, const piece *pa, const cubic *cb, const piece *pb)
 {
   double v = lw_pair_segseg(pa->r0, pa->r1, pb->r0, pb->r1);
-  return v < INFINITY ? v : product_pieces(ca, pa, cb, pb);
+  return v < INFINITY ? v : product_rule(ca, pa->t0, pa->t1, cb, pb->t0, pb->t1, GAUSS_S, KERNEL_INV, 0.0);
 }
 
-/* T: the 1/r double integral by subdivision (see the file comment). */
-static double inverse_distance(const cubic *ca, const cubic *cb)
+/* T: the 1/r double integral by subdivision (see the file comment), times
+** root_rest: the root pair's 16 x 16 share is the caller's. */
+static double inverse_distance(const cubic *ca, const piece *root_a, const cubic *cb, const piece *root_b,
+                               double root_rest)
 {
   piece sa[STACK_MAX], sb[STACK_MAX];
   double share[STACK_MAX];
   int depth[STACK_MAX];
-  piece_init(&sa[0], ca, 0.0, 1.0);
-  piece_init(&sb[0], cb, 0.0, 1.0);
-  share[0] = 1.0;
+  sa[0] = *root_a;
+  sb[0] = *root_b;
+  share[0] = root_rest;
   depth[0] = 0;
-  const double leaf = LEAF_RATIO * (sa[0].rad + sb[0].rad);
+  const double leaf = LEAF_RATIO * (root_a->rad + root_b->rad);
   double sum = 0.0;
   int top = 1;
   while (top > 0) {
@@ -191,13 +271,10 @@ static double inverse_distance(const cubic *ca, const cubic *cb)
     double dx = pa.cx - pb.cx, dy = pa.cy - pb.cy;
     double big = pa.rad > pb.rad ? pa.rad : pb.rad;
     double gap = sqrt(dx * dx + dy * dy) - pa.rad - pb.rad;
-    /* accepted for the product rule: fully from SEP_HI, partly from SEP_LO */
-    double w = smooth_step((gap - SEP_LO * big) / ((SEP_HI - SEP_LO) * big));
-    if (!(big > 0.0)) w = 1.0;
-    if (w > 0.0) sum += f * w * product_pieces(ca, &pa, cb, &pb);
+    double w = big > 0.0 ? smooth_step((gap / big - SEP_LO) / (SEP_HI - SEP_LO)) : 1.0;
+    if (w > 0.0) sum += f * w * product_rule(ca, pa.t0, pa.t1, cb, pb.t0, pb.t1, GAUSS_S, KERNEL_INV, 0.0);
     f *= 1.0 - w;
     if (f == 0.0) continue;
-    /* a leaf: fully below the leaf size, partly below twice that */
     w = top + 2 > STACK_MAX ? 1.0 : smooth_step((2.0 * leaf - big) / leaf);
     if (w > 0.0) sum += f * w * leaf_value(ca, &pa, cb, &pb);
     f *= 1.0 - w;
@@ -218,49 +295,6 @@ static double inverse_distance(const cubic *ca, const cubic *cb)
   return sum;
 }
 
-/* Gauss-Legendre on [0, 1], 16 nodes, for the fixed rules. */
-#define GAUSS_F 16
-static const double GF_X[8] = {0.0950125098376374, 0.2816035507792589, 0.4580167776572274,
-                               0.6178762444026438, 0.7554044083550030, 0.8656312023878318,
-                               0.9445750230732326, 0.9894009349916499};
-static const double GF_W[8] = {0.1894506104550685, 0.1826034150449236, 0.1691565193950025,
-                               0.1495959888165767, 0.1246289712555339, 0.0951585116824928,
-                               0.0622535239386479, 0.0271524594117541};
-
-static void fixed_nodes(const cubic *c, double x[GAUSS_F], double y[GAUSS_F], double w[GAUSS_F])
-{
-  for (int k = 0; k < GAUSS_F; k++) {
-    int h = k < 8 ? 7 - k : k - 8;
-    double t = k < 8 ? 0.5 * (1.0 - GF_X[h]) : 0.5 * (1.0 + GF_X[h]), r[2], d[2];
-    cubic_eval(c, t, r, d);
-    x[k] = r[0];
-    y[k] = r[1];
-    w[k] = 0.5 * GF_W[h] * sqrt(d[0] * d[0] + d[1] * d[1]);
-  }
-}
-
-/* - L_a L_b / rc + double integral of |a'| |b'| (1/rc - 1/r)+ (fixed rule). */
-static double cutoff_part(const cubic *ca, const cubic *cb, double rc)
-{
-  double ax[GAUSS_F], ay[GAUSS_F], aw[GAUSS_F], bx[GAUSS_F], by[GAUSS_F], bw[GAUSS_F];
-  fixed_nodes(ca, ax, ay, aw);
-  fixed_nodes(cb, bx, by, bw);
-  double inv = 1.0 / rc, rc2 = rc * rc, la = 0.0, lb = 0.0, sum = 0.0;
-  for (int k = 0; k < GAUSS_F; k++) {
-    la += aw[k];
-    lb += bw[k];
-  }
-  for (int i = 0; i < GAUSS_F; i++) {
-    double s = 0.0;
-    for (int j = 0; j < GAUSS_F; j++) {
-      double dx = ax[i] - bx[j], dy = ay[i] - by[j], r2 = dx * dx + dy * dy;
-      if (r2 > rc2) s += bw[j] * (inv - 1.0 / sqrt(r2));
-    }
-    sum += aw[i] * s;
-  }
-  return sum - la * lb * inv;
-}
-
 double lw_pair_segments_exact(const double a[8], const double b[8], double cutoff)
 {
   cubic ca, cb;
@@ -268,8 +302,19 @@ double lw_pair_segments_exact(const double a[8], const double b[8], double cutof
   double ox = 0.25 * (a[0] + a[6] + b[0] + b[6]), oy = 0.25 * (a[1] + a[7] + b[1] + b[7]);
   cubic_from_bezier(a, ox, oy, &ca);
   cubic_from_bezier(b, ox, oy, &cb);
-  double v = inverse_distance(&ca, &cb);
-  if (cutoff > 0.0) v += cutoff_part(&ca, &cb, cutoff);
+  piece pa, pb;
+  piece_init(&pa, &ca, 0.0, 1.0);
+  piece_init(&pb, &cb, 0.0, 1.0);
+  /* The root's 16 x 16 share takes the whole kernel, cutoff included, in one
+  ** pass: most near pairs of a drawing (neighbouring lines about an element
+  ** apart) end there. */
+  double w = chord_share(&pa, &pb);
+  kernel_kind whole = cutoff > 0.0 ? KERNEL_CUT : KERNEL_INV;
+  double v = w > 0.0 ? w * product_rule(&ca, 0.0, 1.0, &cb, 0.0, 1.0, GAUSS_L, whole, cutoff) : 0.0;
+  if (w < 1.0) {
+    v += inverse_distance(&ca, &pa, &cb, &pb, 1.0 - w);
+    if (cutoff > 0.0) v += (1.0 - w) * product_rule(&ca, 0.0, 1.0, &cb, 0.0, 1.0, GAUSS_L, KERNEL_CUT_REST, cutoff);
+  }
   return v;
 }
 
