@@ -9,9 +9,12 @@
 ** on, the streamline of the field through the centre, traced both ways by
 ** the midpoint rule in steps of segment_length with the node vectors along
 ** the field, so the splines start where the energy wants them.  A draw
-** whose spline leaves the boundary is drawn again.
+** whose spline leaves the boundary, or has a segment the model forbids as
+** irregular (a streamline turning within one step folds it), is drawn again.
 */
 #include "linewise/init.h"
+
+#include "linewise/model.h"
 
 #include <gsl/gsl_math.h>
 #include <math.h>
@@ -33,6 +36,7 @@ static int fits(const lw_scene *sc, const lw_node *nd, size_t segments)
   lw_samples s;
   for (size_t m = 0; m < segments; m++) {
     lw_segment_sample(&sc->quad, &nd[m], &nd[m + 1], &s);
+    if (!lw_segment_allowed(sc, &nd[m], &nd[m + 1], s.length)) return 0;
     for (int q = 0; q < s.n; q++)
       if (!(lw_boundary_distance(&sc->boundary, s.x[q], s.y[q]) < 0)) return 0;
   }
@@ -180,8 +184,8 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
     }
     if (t == tries) {
       lw_error_set(err, LW_EINPUT,
-                   "[init]: spline %zu of length %g mm did not fit inside the boundary in %d tries "
-                   "(shorten init.segment_length or init.segments)", i, L, tries);
+                   "[init]: spline %zu of length %g mm did not fit inside the boundary with regular "
+                   "segments in %d tries (shorten init.segment_length or init.segments)", i, L, tries);
       lw_splines_free(sp);
       free(cum);
       return NULL;

@@ -1,6 +1,7 @@
 /* spline.c -- contiguous spline storage and segment evaluation (spline.h). */
 #include "linewise/spline.h"
 
+#include <gsl/gsl_poly.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -126,4 +127,71 @@ int lw_splines_finite(const lw_splines *sp)
       return 0;
   }
   return 1;
+}
+
+/* The hodograph's control points h0 h1 h2 (x, y each). */
+static void hodograph(const lw_node *a, const lw_node *b, double h[6])
+{
+  h[0] = 3.0 * a->vx;
+  h[1] = 3.0 * a->vy;
+  h[2] = 3.0 * ((b->px - b->vx) - (a->px + a->vx));
+  h[3] = 3.0 * ((b->py - b->vy) - (a->py + a->vy));
+  h[4] = 3.0 * b->vx;
+  h[5] = 3.0 * b->vy;
+}
+
+/* |h(t)|^2 of the quadratic Bezier h0 h1 h2. */
+static double speed2_at(const double h[6], double t)
+{
+  double u = 1.0 - t, b0 = u * u, b1 = 2.0 * u * t, b2 = t * t;
+  double x = b0 * h[0] + b1 * h[2] + b2 * h[4], y = b0 * h[1] + b1 * h[3] + b2 * h[5];
+  return x * x + y * y;
+}
+
+double lw_segment_min_speed(const lw_node *a, const lw_node *b)
+{
+  double h[6];
+  hodograph(a, b, h);
+  /* h(t) = A + 2 B t + C t^2 */
+  const double Ax = h[0], Ay = h[1], Bx = h[2] - h[0], By = h[3] - h[1];
+  const double Cx = h[0] - 2.0 * h[2] + h[4], Cy = h[1] - 2.0 * h[3] + h[5];
+  /* d|h|^2/dt / 4 = c3 t^3 + c2 t^2 + c1 t + c0 */
+  const double c3 = Cx * Cx + Cy * Cy, c2 = 3.0 * (Bx * Cx + By * Cy);
+  const double c1 = 2.0 * (Bx * Bx + By * By) + Ax * Cx + Ay * Cy, c0 = Ax * Bx + Ay * By;
+  double best = fmin(speed2_at(h, 0.0), speed2_at(h, 1.0));
+  double t[3];
+  int n;
+  /* A tiny leading coefficient makes the monic cubic's coefficients huge
+  ** and its roots inaccurate; then the quadratic (or linear) part holds the
+  ** roots that lie in [0, 1].  Newton steps below repair either choice. */
+  const double scale = fabs(c2) + fabs(c1) + fabs(c0);
+  if (c3 > 1e-9 * scale) n = gsl_poly_solve_cubic(c2 / c3, c1 / c3, c0 / c3, &t[0], &t[1], &t[2]);
+  else n = gsl_poly_solve_quadratic(c2, c1, c0, &t[0], &t[1]);
+  for (int i = 0; i < n; i++) {
+    double x = t[i];
+    for (int it = 0; it < 3; it++) {
+      double f = ((c3 * x + c2) * x + c1) * x + c0, df = (3.0 * c3 * x + 2.0 * c2) * x + c1;
+      if (!(df != 0.0)) break;
+      double nx = x - f / df;
+      if (!isfinite(nx)) break;
+      x = nx;
+    }
+    if (x > 0.0 && x < 1.0) best = fmin(best, speed2_at(h, x));
+  }
+  return sqrt(best);
+}
+
+int lw_segment_regular(const lw_node *a, const lw_node *b, double min_speed)
+{
+  double h[6];
+  hodograph(a, b, h);
+  /* |h|^2 = sum_k c_k b^4_k(t) with the Bernstein coefficients below; the
+  ** b^4_k are >= 0 and sum to 1, so |h|^2 >= min_k c_k everywhere. */
+  const double c0 = h[0] * h[0] + h[1] * h[1], c1 = h[0] * h[2] + h[1] * h[3];
+  const double c2 = (2.0 * (h[0] * h[4] + h[1] * h[5]) + 4.0 * (h[2] * h[2] + h[3] * h[3])) / 6.0;
+  const double c3 = h[2] * h[4] + h[3] * h[5], c4 = h[4] * h[4] + h[5] * h[5];
+  const double need = min_speed * min_speed;
+  if (fmin(fmin(c0, c4), fmin(fmin(c1, c2), c3)) >= need) return 1;
+  double m = lw_segment_min_speed(a, b);
+  return m >= min_speed;
 }

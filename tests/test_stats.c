@@ -65,6 +65,12 @@ static void well_scene(lw_scene *sc, const well *w)
 {
   lw_params p;
   lw_params_defaults(&p);
+  /* The closed forms below are those of an untruncated Gaussian: the
+  ** regularity check would cut off the states where a point crosses over
+  ** its neighbour (a fold), which these unit segments in a wide well reach
+  ** often, and so bias the very acceptance and distribution tested.  The
+  ** worm-like chain test keeps it on. */
+  p.min_speed = 0;
   lw_error err;
   cr_assert_eq(lw_scene_init(sc, &p, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(lw_scene_set_user_term(sc, 1.0, well_energy, w, &err), LW_OK, "%s", err.msg);

@@ -101,6 +101,28 @@ typedef struct {
 
 void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_samples *out);
 
+/*
+** Regularity: the hodograph r'(t) of a cubic segment is the quadratic Bezier
+** with control points h0 = 3 v_a, h1 = 3 (b2 - b1), h2 = 3 v_b.  Where
+** |r'| nearly stops the curvature is huge between quadrature nodes and a
+** fixed rule misses the bending there, so the model forbids segments whose
+** minimum speed falls below energy.min_speed times their mean speed (the
+** segment length: the parameter runs over [0, 1]).  docs/NUMERICS.md has the
+** derivation, docs/ACCURACY.md the table the default comes from.
+*/
+
+/* The exact minimum of |r'(t)| over t in [0, 1], mm per unit t: with
+** h(t) = A + 2 B t + C t^2 the stationary points of |h|^2 solve the cubic
+** (C.C) t^3 + 3 (B.C) t^2 + (2 B.B + A.C) t + A.B = 0 (GSL's polynomial
+** solvers, roots polished by Newton); the minimum over its roots in [0, 1]
+** and the two ends.  Not finite if a coordinate is not. */
+double lw_segment_min_speed(const lw_node *a, const lw_node *b);
+
+/* 1 if min |r'| >= min_speed: a cheap exact bound first (|r'|^2 is a quartic
+** whose Bernstein coefficients bound it from below), the cubic only for
+** segments the bound cannot clear.  0 for non-finite input. */
+int lw_segment_regular(const lw_node *a, const lw_node *b, double min_speed);
+
 /* 1 if every coordinate is finite. */
 int lw_splines_finite(const lw_splines *sp);
 
