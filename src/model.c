@@ -10,8 +10,10 @@
 
 int lw_segment_allowed(const lw_scene *sc, const lw_node *a, const lw_node *b, double length)
 {
-  if (sc->min_speed == 0.0) return 1;
-  return length > 0.0 && lw_segment_regular(a, b, sc->min_speed * length);
+  if (sc->min_speed == 0.0 && sc->regularity == 0.0) return 1;
+  if (!(length > 0.0)) return 0;
+  if (sc->min_speed > 0.0 && !lw_segment_regular(a, b, sc->min_speed * length)) return 0;
+  return sc->regularity == 0.0 || lw_segment_rho(a, b) >= sc->regularity;
 }
 
 /* Samples one segment and evaluates its length, its local terms and (if ps is
@@ -98,7 +100,7 @@ static double strain_of_spline(const lw_scene *sc, const lw_splines *sp, const d
 
 lw_status lw_model_check_regular(const lw_scene *sc, const lw_splines *sp, const char *path, lw_error *err)
 {
-  if (sc->min_speed == 0.0) return LW_OK;
+  if (sc->min_speed == 0.0 && sc->regularity == 0.0) return LW_OK;
   lw_samples s;
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
@@ -107,10 +109,11 @@ lw_status lw_model_check_regular(const lw_scene *sc, const lw_splines *sp, const
     size_t i = sp->seg_spline[g];
     double ratio = s.length > 0.0 ? lw_segment_min_speed(a, a + 1) / s.length : 0.0;
     return lw_error_set(err, LW_EINPUT,
-                        "%s: spline %zu, segment %zu is irregular: its speed falls to %.3g of its mean, "
-                        "below energy.min_speed = %g (a fold the quadrature cannot see); "
-                        "lower energy.min_speed to accept it", path, i, g - lw_segment_index(sp, i, 0),
-                        ratio, sc->min_speed);
+                        "%s: spline %zu, segment %zu is irregular: its speed falls to %.3g of its mean "
+                        "(energy.min_speed = %g) and its bending integrand is analytic within rho = %.3g "
+                        "(energy.regularity = %g), a fold the quadrature cannot see; lower these keys to "
+                        "accept it", path, i, g - lw_segment_index(sp, i, 0), ratio, sc->min_speed,
+                        lw_segment_rho(a, a + 1), sc->regularity);
   }
   return LW_OK;
 }

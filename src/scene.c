@@ -213,6 +213,7 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   sc->strain_per_segment = p->strain_mode == LW_STRAIN_SEGMENT;
   sc->field_axial = p->field_mode == LW_FIELDMODE_AXIAL;
   sc->min_speed = p->min_speed;
+  sc->regularity = p->regularity > 1.0 ? p->regularity : 0.0;
   lw_status st = lw_quad_init(&sc->quad, p->quadrature, err);
   if (st) return st;
   sc->pair_quad = sc->quad;

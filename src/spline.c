@@ -1,6 +1,7 @@
 /* spline.c -- contiguous spline storage and segment evaluation (spline.h). */
 #include "linewise/spline.h"
 
+#include <complex.h>
 #include <gsl/gsl_poly.h>
 #include <math.h>
 #include <stdlib.h>
@@ -194,4 +195,31 @@ int lw_segment_regular(const lw_node *a, const lw_node *b, double min_speed)
   if (fmin(fmin(c0, c4), fmin(fmin(c1, c2), c3)) >= need) return 1;
   double m = lw_segment_min_speed(a, b);
   return m >= min_speed;
+}
+
+/* Bernstein ellipse parameter of the point t (foci 0 and 1): with
+** z = 2t - 1, rho = |z + sqrt(z^2 - 1)| taken >= 1. */
+static double ellipse_rho(double complex t)
+{
+  double complex z = 2.0 * t - 1.0, w = z + csqrt(z * z - 1.0);
+  double r = cabs(w);
+  return r >= 1.0 ? r : 1.0 / r;
+}
+
+double lw_segment_rho(const lw_node *a, const lw_node *b)
+{
+  double h[6];
+  hodograph(a, b, h);
+  /* h_x + i h_y = A + 2 B t + C t^2 with complex A, B, C */
+  const double complex A = h[0] + I * h[1], B = (h[2] - h[0]) + I * (h[3] - h[1]);
+  const double complex C = (h[0] - 2.0 * h[2] + h[4]) + I * (h[1] - 2.0 * h[3] + h[5]);
+  if (!isfinite(creal(A) + cimag(A) + creal(B) + cimag(B) + creal(C) + cimag(C))) return NAN;
+  /* roots of C t^2 + 2 B t + A: q = -(B + s sqrt(B^2 - A C)) with the sign
+  ** that avoids cancellation, t1 = q / C, t2 = A / q (the stable pair;
+  ** C = 0 leaves the linear root A / q = -A / 2B) */
+  double complex d = csqrt(B * B - A * C), q = creal(conj(B) * d) >= 0.0 ? -(B + d) : -(B - d);
+  if (q == 0.0) return A == 0.0 ? 1.0 : INFINITY; /* B = 0 and A C = 0 */
+  double rho = ellipse_rho(A / q);
+  if (C != 0.0) rho = fmin(rho, ellipse_rho(q / C));
+  return rho;
 }

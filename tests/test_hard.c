@@ -68,6 +68,7 @@ static void unchecked_scene(lw_scene *sc)
 {
   lw_params p = every_term(1);
   p.min_speed = 0;
+  p.regularity = 0;
   scene_of(sc, &p);
 }
 
@@ -259,6 +260,7 @@ Test(hard, cusps_and_loops)
   lw_params p = every_term(1);
   p.quadrature = 5;
   p.min_speed = 0;
+  p.regularity = 0;
   lw_scene sc;
   scene_of(&sc, &p);
   lw_splines *sp = splines_of(3, 1);

@@ -71,6 +71,7 @@ static void well_scene(lw_scene *sc, const well *w)
   ** often, and so bias the very acceptance and distribution tested.  The
   ** worm-like chain test keeps it on. */
   p.min_speed = 0;
+  p.regularity = 0;
   lw_error err;
   cr_assert_eq(lw_scene_init(sc, &p, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(lw_scene_set_user_term(sc, 1.0, well_energy, w, &err), LW_OK, "%s", err.msg);

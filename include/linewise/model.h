@@ -13,8 +13,10 @@
 ** Invariant (tested): after any sequence of commits, the running totals equal
 ** lw_energy_compute of the state within 1e-9 relative.
 **
-** Regularity (scene->min_speed > 0): a segment whose speed falls below
-** min_speed times its length (spline.h) is forbidden.  The terms of a state
+** Regularity (lw_segment_allowed): a segment whose speed falls below
+** scene->min_speed times its length, or whose bending integrand has a
+** singularity inside the Bernstein ellipse scene->regularity (spline.h), is
+** forbidden.  The terms of a state
 ** with one stay what the quadrature gives, but its total is +infinity
 ** (lw_model_total, lw_energy_compute); a proposal that makes a segment
 ** irregular has dE = +inf and p->irregular set, one that leaves the last
@@ -86,13 +88,15 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p);
 
 /* 1 if the segment from a to b, of quadrature length `length`, is regular
 ** for the scene: its speed never falls below scene->min_speed times its
-** length, the mean speed (always 1 when min_speed is 0).  A segment without
-** length has no direction at all, so it is irregular whenever the check is
-** on. */
+** length, the mean speed, and its bending integrand is analytic inside the
+** Bernstein ellipse of parameter scene->regularity (spline.h; each test off
+** at 0).  A segment without length has no direction at all, so it is
+** irregular whenever a test is on. */
 int lw_segment_allowed(const lw_scene *sc, const lw_node *a, const lw_node *b, double length);
 
-/* LW_EINPUT naming path, the spline, the segment, its speed ratio and the
-** key energy.min_speed if a segment of sp is irregular for the scene: states
+/* LW_EINPUT naming path, the spline, the segment, its speed ratio and rho,
+** and the keys energy.min_speed and energy.regularity if a segment of sp is
+** irregular for the scene: states
 ** read from files (init.from, resume, energy) are refused rather than
 ** started in a forbidden state. */
 lw_status lw_model_check_regular(const lw_scene *sc, const lw_splines *sp, const char *path, lw_error *err);

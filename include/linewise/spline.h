@@ -123,6 +123,16 @@ double lw_segment_min_speed(const lw_node *a, const lw_node *b);
 ** segments the bound cannot clear.  0 for non-finite input. */
 int lw_segment_regular(const lw_node *a, const lw_node *b, double min_speed);
 
+/* How far the bending integrand (x'y'' - x''y')^2 / |r'|^5 stays analytic
+** around [0, 1]: its singularities are the complex zeros of |r'(t)|^2, the
+** roots of the complex quadratic h_x(t) + i h_y(t) (and their conjugates).
+** Returns the parameter rho >= 1 of the Bernstein ellipse (foci 0 and 1,
+** semi-axes summing to rho / 2) through the nearest one: Gauss-Legendre with
+** n nodes then errs by O(rho^-2n) (docs/NUMERICS.md).  1 where |r'| = 0 on
+** [0, 1] (a cusp), +inf where |r'| is constant and never 0.  NaN for
+** non-finite input. */
+double lw_segment_rho(const lw_node *a, const lw_node *b);
+
 /* 1 if every coordinate is finite. */
 int lw_splines_finite(const lw_splines *sp);
 
