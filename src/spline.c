@@ -192,6 +192,7 @@ int lw_segment_regular(const lw_node *a, const lw_node *b, double min_speed)
   const double c2 = (2.0 * (h[0] * h[4] + h[1] * h[5]) + 4.0 * (h[2] * h[2] + h[3] * h[3])) / 6.0;
   const double c3 = h[2] * h[4] + h[3] * h[5], c4 = h[4] * h[4] + h[5] * h[5];
   const double need = min_speed * min_speed;
+  if (!isfinite(c0 + c1 + c2 + c3 + c4)) return 0; /* fmin would pass over a NaN */
   if (fmin(fmin(c0, c4), fmin(fmin(c1, c2), c3)) >= need) return 1;
   double m = lw_segment_min_speed(a, b);
   return m >= min_speed;
