@@ -12,8 +12,7 @@ int lw_segment_allowed(const lw_scene *sc, const lw_node *a, const lw_node *b, d
 {
   if (sc->min_speed == 0.0 && sc->regularity == 0.0) return 1;
   if (!(length > 0.0)) return 0;
-  if (sc->min_speed > 0.0 && !lw_segment_regular(a, b, sc->min_speed * length)) return 0;
-  return sc->regularity == 0.0 || lw_segment_rho(a, b) >= sc->regularity;
+  return lw_segment_check(a, b, sc->min_speed * length, sc->regularity);
 }
 
 /* Samples one segment and evaluates its length, its local terms and (if ps is

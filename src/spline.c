@@ -182,20 +182,41 @@ double lw_segment_min_speed(const lw_node *a, const lw_node *b)
   return sqrt(best);
 }
 
+/* 1 if |h|^2 >= need on [0, 1] by the Bernstein bound, 0 if in doubt, -1
+** for non-finite input.  |h|^2 = sum_k c_k b^4_k(t) with the coefficients
+** below; the b^4_k are >= 0 and sum to 1, so |h|^2 >= min_k c_k. */
+static int speed_bound(const double h[6], double need)
+{
+  const double c0 = h[0] * h[0] + h[1] * h[1], c1 = h[0] * h[2] + h[1] * h[3];
+  const double c2 = ((h[0] * h[4] + h[1] * h[5]) + 2.0 * (h[2] * h[2] + h[3] * h[3])) * (1.0 / 3.0);
+  const double c3 = h[2] * h[4] + h[3] * h[5], c4 = h[4] * h[4] + h[5] * h[5];
+  if (!isfinite(c0 + c1 + c2 + c3 + c4)) return -1;
+  /* plain comparisons: this runs for every new segment of every proposal */
+  return c0 >= need && c1 >= need && c2 >= need && c3 >= need && c4 >= need;
+}
+
+/* 1 if h_x + i h_y has no zero in the disc |t - 1/2| <= R (R2 = R^2), 0 if
+** in doubt, -1 for non-finite input.  Around u = t - 1/2 it is
+** P0 + P1 u + C u^2, |P0| the speed at the middle, |P1| that of r'' there,
+** C = h0 - 2 h1 + h2; on |u| <= R it is at least |P0| - |P1| R - |C| R^2,
+** > 0 when |P0|^2 > 2 (|P1|^2 R^2 + |C|^2 R^4) ((x + y)^2 <= 2 x^2 + 2 y^2). */
+static int disc_bound(const double h[6], double R2)
+{
+  const double p0x = 0.25 * (h[0] + h[4]) + 0.5 * h[2], p0y = 0.25 * (h[1] + h[5]) + 0.5 * h[3];
+  const double p1x = h[4] - h[0], p1y = h[5] - h[1];
+  const double cx = h[0] - 2.0 * h[2] + h[4], cy = h[1] - 2.0 * h[3] + h[5];
+  const double p0 = p0x * p0x + p0y * p0y, p1 = p1x * p1x + p1y * p1y, c2 = cx * cx + cy * cy;
+  if (!isfinite(p0 + p1 + c2)) return -1;
+  return p0 > 2.0 * R2 * (p1 + c2 * R2);
+}
+
 int lw_segment_regular(const lw_node *a, const lw_node *b, double min_speed)
 {
   double h[6];
   hodograph(a, b, h);
-  /* |h|^2 = sum_k c_k b^4_k(t) with the Bernstein coefficients below; the
-  ** b^4_k are >= 0 and sum to 1, so |h|^2 >= min_k c_k everywhere. */
-  const double c0 = h[0] * h[0] + h[1] * h[1], c1 = h[0] * h[2] + h[1] * h[3];
-  const double c2 = (2.0 * (h[0] * h[4] + h[1] * h[5]) + 4.0 * (h[2] * h[2] + h[3] * h[3])) / 6.0;
-  const double c3 = h[2] * h[4] + h[3] * h[5], c4 = h[4] * h[4] + h[5] * h[5];
-  const double need = min_speed * min_speed;
-  if (!isfinite(c0 + c1 + c2 + c3 + c4)) return 0; /* fmin would pass over a NaN */
-  if (fmin(fmin(c0, c4), fmin(fmin(c1, c2), c3)) >= need) return 1;
-  double m = lw_segment_min_speed(a, b);
-  return m >= min_speed;
+  int clear = speed_bound(h, min_speed * min_speed);
+  if (clear) return clear > 0;
+  return lw_segment_min_speed(a, b) >= min_speed;
 }
 
 /* Bernstein ellipse parameter of the point t (foci 0 and 1): with
@@ -223,4 +244,27 @@ double lw_segment_rho(const lw_node *a, const lw_node *b)
   double rho = ellipse_rho(A / q);
   if (C != 0.0) rho = fmin(rho, ellipse_rho(q / C));
   return rho;
+}
+
+/* The Bernstein ellipse of parameter rho (foci 0 and 1) lies in the disc
+** |t - 1/2| <= (rho + 1/rho) / 4: its semi-major axis. */
+static double disc_radius2(double rho)
+{
+  double R = 0.25 * (rho + 1.0 / rho);
+  return R * R;
+}
+
+int lw_segment_check(const lw_node *a, const lw_node *b, double min_speed, double rho)
+{
+  double h[6];
+  hodograph(a, b, h);
+  if (min_speed > 0.0) {
+    int clear = speed_bound(h, min_speed * min_speed);
+    if (clear < 0 || (!clear && !(lw_segment_min_speed(a, b) >= min_speed))) return 0;
+  }
+  if (rho > 1.0) {
+    int clear = disc_bound(h, disc_radius2(rho));
+    if (clear < 0 || (!clear && !(lw_segment_rho(a, b) >= rho))) return 0;
+  }
+  return 1;
 }

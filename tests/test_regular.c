@@ -79,7 +79,7 @@ Test(regular, min_speed_finds_cusps_and_interior_minima)
   cr_assert(isnan(lw_segment_rho(&bad, &s1)));
 }
 
-Test(regular, the_bernstein_prefilter_never_disagrees_with_the_exact_minimum)
+Test(regular, the_cheap_bounds_never_disagree_with_the_exact_tests)
 {
   rng_seed(0x5eed2);
   for (int it = 0; it < 20000; it++) {
@@ -89,6 +89,11 @@ Test(regular, the_bernstein_prefilter_never_disagrees_with_the_exact_minimum)
     /* thresholds just below and just above the exact minimum */
     cr_assert(lw_segment_regular(&nd[0], &nd[1], m * (1 - 1e-9)), "case %d: min %.17g refused", it, m);
     cr_assert(!lw_segment_regular(&nd[0], &nd[1], m * (1 + 1e-9) + 1e-300), "case %d: min %.17g passed", it, m);
+    double rho = lw_segment_rho(&nd[0], &nd[1]);
+    if (rho > 1.0 + 1e-6 && isfinite(rho)) {
+      cr_assert(lw_segment_check(&nd[0], &nd[1], 0, rho * (1 - 1e-9)), "case %d: rho %.17g refused", it, rho);
+      cr_assert(!lw_segment_check(&nd[0], &nd[1], 0, rho * (1 + 1e-9)), "case %d: rho %.17g passed", it, rho);
+    }
   }
 }
 

@@ -133,6 +133,14 @@ int lw_segment_regular(const lw_node *a, const lw_node *b, double min_speed);
 ** non-finite input. */
 double lw_segment_rho(const lw_node *a, const lw_node *b);
 
+/* Both tests with one hodograph: 1 if min |r'| >= min_speed (mm per unit t;
+** 0 = no test) and lw_segment_rho >= rho (<= 1 = no test).  Each first tries
+** a cheap exact bound (the Bernstein one above; for rho, the ellipse lies in
+** the disc |t - 1/2| <= (rho + 1/rho) / 4, where Taylor's bound at t = 1/2
+** keeps |h_x + i h_y| away from 0) and solves only when that is in doubt.
+** 0 for non-finite input. */
+int lw_segment_check(const lw_node *a, const lw_node *b, double min_speed, double rho);
+
 /* 1 if every coordinate is finite. */
 int lw_splines_finite(const lw_splines *sp);
 
