@@ -423,7 +423,7 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
     size_t g = g0 + p->seg0 + j;
     m->seg_len[g] = p->len[j];
     memcpy(m->seg_local + g * (size_t)nl, p->local + j * (size_t)nl, (size_t)nl * sizeof *m->seg_local);
-    m->n_irregular += (size_t)p->seg_irregular[j] - (size_t)m->seg_irregular[g];
+    m->n_irregular = m->n_irregular - m->seg_irregular[g] + p->seg_irregular[j];
     m->seg_irregular[g] = p->seg_irregular[j];
     if (m->ps) memcpy(m->ps + g * (size_t)np, p->ps + j * (size_t)np, (size_t)np * sizeof *m->ps);
   }
