@@ -277,9 +277,14 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   if (a->params.from[0]) {
     lw_state st;
     if ((s = lw_state_read(&st, a->params.from, err))) return s;
+    s = lw_model_check_regular(&a->scene, st.sp, a->params.from, err);
     sp = st.sp;
     st.sp = NULL;
     lw_state_clear(&st);
+    if (s) {
+      lw_splines_free(sp);
+      return s;
+    }
   } else {
     size_t n;
     if ((s = lw_init_count(&a->scene, p, &n, err))) return s;
@@ -376,6 +381,10 @@ static lw_status add_chain(lw_state *st, const char *prefix, const lw_chain *c)
   }
   put_ulongs(buf, sizeof buf, v, 3 * LW_MOVE_KINDS);
   key_of(key, sizeof key, prefix, "moves");
+  bad = bad || lw_state_add(st, key, buf);
+  for (int k = 0; k < LW_MOVE_KINDS; k++) v[k] = c->stats[k].irregular;
+  put_ulongs(buf, sizeof buf, v, LW_MOVE_KINDS);
+  key_of(key, sizeof key, prefix, "moves_irregular");
   bad = bad || lw_state_add(st, key, buf);
   return bad ? LW_ENOMEM : LW_OK;
 }
@@ -566,7 +575,15 @@ static lw_status read_chain(const lw_state *st, const char *path, const char *pr
   key_of(key, sizeof key, prefix, "moves");
   if ((s = read_numbers(st, path, key, v, 3 * LW_MOVE_KINDS, err))) return s;
   for (int k = 0; k < LW_MOVE_KINDS; k++)
-    c->stats[k] = (lw_move_stats){(unsigned long)v[3 * k], (unsigned long)v[3 * k + 1], (unsigned long)v[3 * k + 2]};
+    c->stats[k] = (lw_move_stats){.proposed = (unsigned long)v[3 * k], .accepted = (unsigned long)v[3 * k + 1],
+                                  .nan = (unsigned long)v[3 * k + 2]};
+  /* A separate line, so states written before it was counted still resume
+  ** (with 0 rejections for irregularity so far). */
+  key_of(key, sizeof key, prefix, "moves_irregular");
+  if (lw_state_get(st, key)) {
+    if ((s = read_numbers(st, path, key, v, LW_MOVE_KINDS, err))) return s;
+    for (int k = 0; k < LW_MOVE_KINDS; k++) c->stats[k].irregular = (unsigned long)v[k];
+  }
   return LW_OK;
 }
 
@@ -575,7 +592,21 @@ static lw_status read_chain(const lw_state *st, const char *path, const char *pr
 ** run. */
 static lw_status read_energy(const lw_state *st, const char *path, lw_model *m, lw_error *err)
 {
-  return read_numbers(st, path, "energy", m->term, LW_TERM_COUNT, err);
+  /* States written before the parametrisation term (the last) hold one
+  ** number fewer; that term was off in them. */
+  const lw_state_extra *e = lw_state_get(st, "energy");
+  int n = LW_TERM_COUNT, words = 0;
+  for (const char *c = e ? e->value : ""; *c;) {
+    while (*c == ' ') c++;
+    if (!*c) break;
+    words++;
+    while (*c && *c != ' ') c++;
+  }
+  if (words == LW_TERM_COUNT - 1) {
+    n = LW_TERM_COUNT - 1;
+    m->term[LW_TERM_PARAM] = 0.0;
+  }
+  return read_numbers(st, path, "energy", m->term, n, err);
 }
 
 static lw_status read_tempering(lw_anneal *a, const lw_state *st, const char *path, lw_error *err)
@@ -645,6 +676,10 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
     lw_state_clear(&st);
     return s;
   }
+  if ((s = lw_model_check_regular(&a->scene, st.sp, path, err))) {
+    lw_state_clear(&st);
+    return s;
+  }
   a->seed = st.seed;
   a->sweep = st.sweep;
   lw_splines *all[LW_TEMPERING_MAX] = {st.sp};
@@ -654,6 +689,7 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
     snprintf(name, sizeof name, "replica-%d.lw", k);
     dir_file(rpath, sizeof rpath, a, name);
     s = lw_state_read(&rep[k], rpath, err);
+    if (!s) s = lw_model_check_regular(&a->scene, rep[k].sp, rpath, err);
     if (!s && rep[k].sweep != a->sweep)
       s = lw_error_set(err, LW_EINPUT, "%s: sweep %ld, but state.lw is at sweep %ld (an interrupted checkpoint?)",
                        rpath, rep[k].sweep, a->sweep);
@@ -677,7 +713,8 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
   NUMS("block_energy", 3); a->acc_n = v[0]; a->acc_sum = v[1]; a->acc_sumsq = v[2];
   NUMS("trace_mark", 3 * LW_MOVE_KINDS);
   for (int k = 0; k < LW_MOVE_KINDS; k++)
-    a->trace_mark[k] = (lw_move_stats){(unsigned long)v[3 * k], (unsigned long)v[3 * k + 1], (unsigned long)v[3 * k + 2]};
+    a->trace_mark[k] = (lw_move_stats){.proposed = (unsigned long)v[3 * k], .accepted = (unsigned long)v[3 * k + 1],
+                                       .nan = (unsigned long)v[3 * k + 2]};
   if ((s = read_energy(&st, path, a->model, err))) goto out;
   NUMS("energy_initial", 1); a->energy_initial = v[0];
   NUMS("max_drift", 1); a->max_drift = v[0];
@@ -865,6 +902,13 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json_key(&j, "proposals"); lw_json_int(&j, (long long)prop);
   lw_json_key(&j, "accepted"); lw_json_int(&j, (long long)acc);
   lw_json_key(&j, "rejected_nan"); lw_json_int(&j, (long long)nan);
+  lw_json_key(&j, "rejected_irregular");
+  lw_json_begin_object(&j);
+  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+    lw_json_key(&j, lw_move_names[k]);
+    lw_json_int(&j, (long long)c->stats[k].irregular);
+  }
+  lw_json_end_object(&j);
   lw_json_key(&j, "wall_seconds"); lw_json_number(&j, wall);
   double here = now_seconds() - a->wall_start;
   lw_json_key(&j, "proposals_per_second");

@@ -8,10 +8,15 @@
 ** it).  Its shape: straight at a random angle, or, when the field term is
 ** on, the streamline of the field through the centre, traced both ways by
 ** the midpoint rule in steps of segment_length with the node vectors along
-** the field, so the splines start where the energy wants them.  A draw
-** whose spline leaves the boundary is drawn again.
+** the field, so the splines start where the energy wants them.  Where the
+** streamline turns too fast for its segments to be regular (lw_segment_allowed:
+** near a vortex's centre, on short waves) the spline is straight along the
+** field at its centre instead, so no placement is ever forbidden for its
+** shape.  A draw whose spline leaves the boundary is drawn again.
 */
 #include "linewise/init.h"
+
+#include "linewise/model.h"
 
 #include <gsl/gsl_math.h>
 #include <math.h>
@@ -26,6 +31,29 @@ unsigned long lw_stream_seed(unsigned long seed, unsigned long stream)
   z ^= z >> 31;
   /* gsl_rng_set treats 0 as its default seed: keep streams apart from it */
   return (unsigned long)(z & 0xFFFFFFFFu) | 1u;
+}
+
+/* 1 if every segment is regular for the scene. */
+static int regular(const lw_scene *sc, const lw_node *nd, size_t segments)
+{
+  lw_samples s;
+  for (size_t m = 0; m < segments; m++) {
+    lw_segment_sample(&sc->quad, &nd[m], &nd[m + 1], &s);
+    if (!lw_segment_allowed(sc, &nd[m], &nd[m + 1], s.length)) return 0;
+  }
+  return 1;
+}
+
+/* Spline nodes on the straight line through (cx, cy) along (ux, uy), with
+** uniform speed (every segment regular). */
+static void straight(lw_node *nd, size_t segments, double segment_length, double cx, double cy, double ux,
+                     double uy)
+{
+  const double L = segment_length * (double)segments;
+  for (size_t k = 0; k <= segments; k++) {
+    double u = ((double)k / (double)segments - 0.5) * L;
+    nd[k] = (lw_node){cx + u * ux, cy + u * uy, segment_length * ux / 3.0, segment_length * uy / 3.0};
+  }
 }
 
 static int fits(const lw_scene *sc, const lw_node *nd, size_t segments)
@@ -170,11 +198,9 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
           }
         }
         trace(sc, nd, segments, segment_length, cx, cy, ux, uy);
+        if (!regular(sc, nd, segments)) straight(nd, segments, segment_length, cx, cy, ux, uy);
       } else {
-        for (size_t k = 0; k <= segments; k++) {
-          double u = ((double)k / (double)segments - 0.5) * L;
-          nd[k] = (lw_node){cx + u * ux, cy + u * uy, segment_length * ux / 3.0, segment_length * uy / 3.0};
-        }
+        straight(nd, segments, segment_length, cx, cy, ux, uy);
       }
       if (fits(sc, nd, segments)) break;
     }

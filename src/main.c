@@ -60,7 +60,11 @@ static lw_status load_run_dir(const char *dir, lw_params *p, lw_scene *sc, lw_st
     lw_state_clear(st);
     return s;
   }
-  return LW_OK;
+  if ((s = lw_model_check_regular(sc, st->sp, path, err))) {
+    lw_state_clear(st);
+    lw_scene_clear(sc);
+  }
+  return s;
 }
 
 static int cmd_energy(int argc, char **argv)

@@ -140,6 +140,9 @@ int lw_chain_step(lw_chain *c, lw_move_kind kind)
   if (isnan(dE)) {
     s->nan++;
     accept = 0;
+  } else if (c->prop->irregular) {
+    s->irregular++;
+    accept = 0;
   } else if (dE <= 0.0) {
     accept = 1;
   } else if (c->temperature > 0.0 && dE < INFINITY) {

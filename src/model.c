@@ -10,15 +10,24 @@
 #include <stdlib.h>
 #include <string.h>
 
+int lw_segment_allowed(const lw_scene *sc, const lw_node *a, const lw_node *b, double length)
+{
+  if (sc->min_speed == 0.0 && sc->regularity == 0.0) return 1;
+  if (!(length > 0.0)) return 0;
+  return lw_segment_check(a, b, sc->min_speed * length, sc->regularity);
+}
+
 /* Samples one segment and evaluates its length, its local terms and (if ps is
-** not NULL) its pair samples, at the pair term's own nodes when it has them. */
-static void segment_eval(const lw_scene *sc, const lw_node *a, const lw_node *b, uint32_t spline,
-                         lw_samples *s, double *len, double *local, lw_pair_sample *ps)
+** not NULL) its pair samples, at the pair term's own nodes when it has them.
+** Returns 1 if the segment is regular (lw_segment_allowed), 0 if forbidden. */
+static int segment_eval(const lw_scene *sc, const lw_node *a, const lw_node *b, uint32_t spline,
+                        lw_samples *s, double *len, double *local, lw_pair_sample *ps)
 {
   lw_segment_sample(&sc->quad, a, b, s);
   *len = s->length;
+  const int regular = lw_segment_allowed(sc, a, b, s->length);
   for (int t = 0; t < sc->n_local; t++) local[t] = lw_term_types[sc->local[t]].segment(s, sc);
-  if (!ps) return;
+  if (!ps) return regular;
   lw_samples pair_s;
   const lw_samples *ss = s;
   if (sc->pair_quad.n != sc->quad.n) {
@@ -28,6 +37,7 @@ static void segment_eval(const lw_scene *sc, const lw_node *a, const lw_node *b,
   for (int q = 0; q < ss->n; q++)
     ps[q] = (lw_pair_sample){ss->x[q], ss->y[q], (float)ss->dx[q], (float)ss->dy[q], (float)ss->dl[q], spline,
                              (uint32_t)q};
+  return regular;
 }
 
 /* A growable list of sample indices: the near pairs a walk found. */
@@ -213,6 +223,34 @@ static double strain_of_spline(const lw_scene *sc, const lw_splines *sp, const d
   return e;
 }
 
+lw_status lw_model_check_regular(const lw_scene *sc, const lw_splines *sp, const char *path, lw_error *err)
+{
+  if (sc->min_speed == 0.0 && sc->regularity == 0.0) return LW_OK;
+  lw_samples s;
+  for (size_t g = 0; g < sp->n_segments; g++) {
+    const lw_node *a = &sp->node[lw_segment_node(sp, g)];
+    lw_segment_sample(&sc->quad, a, a + 1, &s);
+    if (lw_segment_allowed(sc, a, a + 1, s.length)) continue;
+    size_t i = sp->seg_spline[g];
+    double ratio = s.length > 0.0 ? lw_segment_min_speed(a, a + 1) / s.length : 0.0;
+    return lw_error_set(err, LW_EINPUT,
+                        "%s: spline %zu, segment %zu is irregular: its speed falls to %.3g of its mean "
+                        "(energy.min_speed = %g) and its bending integrand is analytic within rho = %.3g "
+                        "(energy.regularity = %g), a fold the quadrature cannot see; lower these keys to "
+                        "accept it", path, i, g - lw_segment_index(sp, i, 0), ratio, sc->min_speed,
+                        lw_segment_rho(a, a + 1), sc->regularity);
+  }
+  return LW_OK;
+}
+
+/* The sum of the terms, +inf while a segment is irregular (forbidden). */
+static double total_of(const double term[LW_TERM_COUNT], size_t irregular)
+{
+  double total = 0.0;
+  for (int t = 0; t < LW_TERM_COUNT; t++) total += term[t];
+  return irregular ? INFINITY : total;
+}
+
 double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[LW_TERM_COUNT],
                          lw_error *err)
 {
@@ -234,9 +272,11 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
     lw_error_set(err, LW_ENOMEM, "out of memory for %zu segments", sp->n_segments);
     return NAN;
   }
+  size_t irregular = 0;
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
-    segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &seg_len[g], local, ps ? ps + g * (size_t)np : NULL);
+    irregular += !segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &seg_len[g], local,
+                               ps ? ps + g * (size_t)np : NULL);
     for (int t = 0; t < sc->n_local; t++) term[sc->local[t]] += local[t];
   }
   if (sc->on[LW_TERM_STRAIN])
@@ -270,9 +310,7 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
     }
     term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pe;
   }
-  double total = 0.0;
-  for (int t = 0; t < LW_TERM_COUNT; t++) total += term[t];
-  return total;
+  return total_of(term, irregular);
 }
 
 lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
@@ -289,7 +327,8 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
   m->seg_len = malloc(ns * sizeof *m->seg_len);
   m->seg_local = malloc(ns * (size_t)(sc->n_local ? sc->n_local : 1) * sizeof *m->seg_local);
   m->spline_len = malloc((sp->n_splines ? sp->n_splines : 1) * sizeof *m->spline_len);
-  if (!m->seg_len || !m->seg_local || !m->spline_len) goto nomem;
+  m->seg_irregular = calloc(ns, sizeof *m->seg_irregular);
+  if (!m->seg_len || !m->seg_local || !m->spline_len || !m->seg_irregular) goto nomem;
   if (sc->on[LW_TERM_PAIR]) {
     size_t n = sp->n_segments * (size_t)sc->pair_quad.n;
     if (n >= UINT32_MAX || sp->n_splines > LW_PAIR_MAX_SPLINES) {
@@ -325,6 +364,7 @@ void lw_model_free(lw_model *m)
   free(m->seg_len);
   free(m->seg_local);
   free(m->spline_len);
+  free(m->seg_irregular);
   free(m->ps);
   free(m->near_cache);
   free(m->near_valid);
@@ -334,9 +374,7 @@ void lw_model_free(lw_model *m)
 
 double lw_model_total(const lw_model *m)
 {
-  double total = 0.0;
-  for (int t = 0; t < LW_TERM_COUNT; t++) total += m->term[t];
-  return total;
+  return total_of(m->term, m->n_irregular);
 }
 
 lw_status lw_model_refresh(lw_model *m, double *drift)
@@ -347,11 +385,13 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
   double old_total = lw_model_total(m);
   double term[LW_TERM_COUNT] = {0};
   lw_samples s;
+  m->n_irregular = 0;
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
     double *local = m->seg_local + g * (size_t)nl;
-    segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &m->seg_len[g], local,
-                 m->ps ? m->ps + g * (size_t)np : NULL);
+    m->seg_irregular[g] = !segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &m->seg_len[g], local,
+                                        m->ps ? m->ps + g * (size_t)np : NULL);
+    m->n_irregular += m->seg_irregular[g];
     for (int t = 0; t < nl; t++) term[sc->local[t]] += local[t];
   }
   for (size_t i = 0; i < sp->n_splines; i++) {
@@ -371,11 +411,8 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
     if (isnan(pe)) return LW_ENOMEM;
     term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pe;
   }
-  double total = 0.0;
-  for (int t = 0; t < LW_TERM_COUNT; t++) {
-    m->term[t] = term[t];
-    total += term[t];
-  }
+  for (int t = 0; t < LW_TERM_COUNT; t++) m->term[t] = term[t];
+  double total = lw_model_total(m);
   if (drift) {
     if (!isfinite(total) || !isfinite(old_total)) *drift = total == old_total ? 0.0 : INFINITY;
     else *drift = fabs(total - old_total) / fmax(fabs(total), 1.0);
@@ -395,8 +432,9 @@ lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err)
     p->local = malloc(cap * (size_t)nl * sizeof *p->local);
     p->ps = malloc(cap * (size_t)m->scene->pair_quad.n * sizeof *p->ps);
     p->near_new = malloc(cap * sizeof *p->near_new);
+    p->seg_irregular = malloc(cap * sizeof *p->seg_irregular);
   }
-  if (!p || !p->node || !p->len || !p->local || !p->ps || !p->near_new) {
+  if (!p || !p->node || !p->len || !p->local || !p->ps || !p->near_new || !p->seg_irregular) {
     lw_proposal_free(p);
     lw_error_set(err, LW_ENOMEM, "out of memory for a proposal");
     return NULL;
@@ -414,6 +452,7 @@ void lw_proposal_free(lw_proposal *p)
   free(p->near.idx);
   free(p->partners.idx);
   free(p->near_new);
+  free(p->seg_irregular);
   free(p);
 }
 
@@ -487,11 +526,15 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   lw_samples s;
   double dlen = 0.0;
   int forbidden = 0, undefined = 0; /* a new local energy is +inf; a new value is NaN */
+  int was_irregular = 0;            /* an affected segment is irregular now */
+  p->irregular = 0;
   for (size_t j = 0; j < p->n_seg; j++) {
     size_t m_loc = p->seg0 + j, g = g0 + m_loc;
     double *local = p->local + j * (size_t)nl;
-    segment_eval(sc, proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1), spline, &s,
-                 &p->len[j], local, m->ps ? p->ps + j * (size_t)np : NULL);
+    p->seg_irregular[j] = !segment_eval(sc, proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1),
+                                        spline, &s, &p->len[j], local, m->ps ? p->ps + j * (size_t)np : NULL);
+    p->irregular |= p->seg_irregular[j];
+    was_irregular |= m->seg_irregular[g];
     const double *old = m->seg_local + g * (size_t)nl;
     for (int t = 0; t < nl; t++) {
       p->dterm[sc->local[t]] += local[t] - old[t];
@@ -521,7 +564,10 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   /* A forbidden new state is +inf whatever the old one was: from a forbidden
   ** state the difference would be inf - inf, and NaN is kept for numerical
   ** failures (a NaN energy, counted by the chain). */
-  if (forbidden && !undefined) dE = INFINITY;
+  if ((forbidden || p->irregular) && !undefined) dE = INFINITY;
+  /* Leaving an irregular state (+inf) for a regular one lowers the energy
+  ** without bound, whatever the terms do (like leaving a +inf local term). */
+  else if (was_irregular && !undefined) dE = -INFINITY;
   /* The pair sum is the costly part: skip it when the move is already
   ** forbidden (+inf) or undefined (NaN). */
   p->pair_done = 0;
@@ -570,6 +616,8 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
     size_t g = g0 + p->seg0 + j;
     m->seg_len[g] = p->len[j];
     memcpy(m->seg_local + g * (size_t)nl, p->local + j * (size_t)nl, (size_t)nl * sizeof *m->seg_local);
+    m->n_irregular = m->n_irregular - m->seg_irregular[g] + p->seg_irregular[j];
+    m->seg_irregular[g] = p->seg_irregular[j];
     if (m->ps) memcpy(m->ps + g * (size_t)np, p->ps + j * (size_t)np, (size_t)np * sizeof *m->ps);
   }
   /* Summed afresh in a fixed order rather than updated by += dlen, so the

@@ -141,6 +141,19 @@ const lw_param_def lw_param_table[] = {
       "0 = off (product rule only; infinite where samples coincide)."),
   NUM("energy", "boundary", LW_PT_DOUBLE, boundary_coef, "0", "energy mm", 0, 1e12, 0,
       "R: boundary R * integral of 1/d^2 dl keeps lines inside (+infinity outside). 0 = off."),
+  NUM("energy", "min_speed", LW_PT_DOUBLE, min_speed, "0.4", "fraction of the mean speed", 0, 1, LW_MAX_OPEN,
+      "Regularity: a segment whose speed |r'| falls anywhere below this fraction of its mean speed "
+      "(its length) is forbidden (+infinity, like leaving the frame), whatever the node count: "
+      "there it folds, and the quadrature cannot see its bending. With `regularity` it keeps the "
+      "bending integral at 8 nodes within 1e-3 on every allowed segment (docs/ACCURACY.md). "
+      "0 = no check."),
+  NUM("energy", "regularity", LW_PT_DOUBLE, regularity, "2.6", "Bernstein ellipse parameter", 0, 1e6, 0,
+      "Regularity: a segment whose bending integrand has a singularity (a complex zero of |r'|^2) "
+      "inside the Bernstein ellipse of this parameter around it is forbidden; Gauss-Legendre's "
+      "error falls like rho^-2n with it (docs/NUMERICS.md, docs/ACCURACY.md). 1 or less = no check."),
+  NUM("energy", "parametrisation", LW_PT_DOUBLE, parametrisation, "0", "energy / mm", 0, 1e12, 0,
+      "G: parametrisation G * integral of (|r'| - l)^2 ds / l per segment (l = its length) holds "
+      "the handle lengths that leave a segment's shape unchanged (docs/NUMERICS.md). 0 = off."),
   NUM("energy", "quadrature", LW_PT_INT, quadrature, "8", "nodes", 2, 64, 0,
       "Gauss-Legendre nodes per segment for every integral but the pair term's."),
   NUM("energy", "pair_quadrature", LW_PT_INT, pair_quadrature, "0", "nodes", 0, 64, 0,

@@ -203,6 +203,7 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     [LW_TERM_STRAIN] = p->strain, [LW_TERM_BENDING] = p->bending,
     [LW_TERM_POTENTIAL] = p->potential_coef, [LW_TERM_FIELD] = p->field_coef,
     [LW_TERM_PAIR] = p->pair, [LW_TERM_BOUNDARY] = p->boundary_coef,
+    [LW_TERM_PARAM] = p->parametrisation,
   };
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     sc->coef[t] = coef[t];
@@ -211,6 +212,8 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   list_local_terms(sc);
   sc->strain_per_segment = p->strain_mode == LW_STRAIN_SEGMENT;
   sc->field_axial = p->field_mode == LW_FIELDMODE_AXIAL;
+  sc->min_speed = p->min_speed;
+  sc->regularity = p->regularity > 1.0 ? p->regularity : 0.0;
   lw_status st = lw_quad_init(&sc->quad, p->quadrature, err);
   if (st) return st;
   sc->pair_quad = sc->quad;

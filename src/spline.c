@@ -1,6 +1,8 @@
 /* spline.c -- contiguous spline storage and segment evaluation (spline.h). */
 #include "linewise/spline.h"
 
+#include <complex.h>
+#include <gsl/gsl_poly.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -124,6 +126,145 @@ int lw_splines_finite(const lw_splines *sp)
     const lw_node *nd = &sp->node[k];
     if (!isfinite(nd->px) || !isfinite(nd->py) || !isfinite(nd->vx) || !isfinite(nd->vy))
       return 0;
+  }
+  return 1;
+}
+
+/* The hodograph's control points h0 h1 h2 (x, y each). */
+static void hodograph(const lw_node *a, const lw_node *b, double h[6])
+{
+  h[0] = 3.0 * a->vx;
+  h[1] = 3.0 * a->vy;
+  h[2] = 3.0 * ((b->px - b->vx) - (a->px + a->vx));
+  h[3] = 3.0 * ((b->py - b->vy) - (a->py + a->vy));
+  h[4] = 3.0 * b->vx;
+  h[5] = 3.0 * b->vy;
+}
+
+/* |h(t)|^2 of the quadratic Bezier h0 h1 h2. */
+static double speed2_at(const double h[6], double t)
+{
+  double u = 1.0 - t, b0 = u * u, b1 = 2.0 * u * t, b2 = t * t;
+  double x = b0 * h[0] + b1 * h[2] + b2 * h[4], y = b0 * h[1] + b1 * h[3] + b2 * h[5];
+  return x * x + y * y;
+}
+
+double lw_segment_min_speed(const lw_node *a, const lw_node *b)
+{
+  double h[6];
+  hodograph(a, b, h);
+  /* h(t) = A + 2 B t + C t^2 */
+  const double Ax = h[0], Ay = h[1], Bx = h[2] - h[0], By = h[3] - h[1];
+  const double Cx = h[0] - 2.0 * h[2] + h[4], Cy = h[1] - 2.0 * h[3] + h[5];
+  /* d|h|^2/dt / 4 = c3 t^3 + c2 t^2 + c1 t + c0 */
+  const double c3 = Cx * Cx + Cy * Cy, c2 = 3.0 * (Bx * Cx + By * Cy);
+  const double c1 = 2.0 * (Bx * Bx + By * By) + Ax * Cx + Ay * Cy, c0 = Ax * Bx + Ay * By;
+  double best = fmin(speed2_at(h, 0.0), speed2_at(h, 1.0));
+  double t[3];
+  int n;
+  /* A tiny leading coefficient makes the monic cubic's coefficients huge
+  ** and its roots inaccurate; then the quadratic (or linear) part holds the
+  ** roots that lie in [0, 1].  Newton steps below repair either choice. */
+  const double scale = fabs(c2) + fabs(c1) + fabs(c0);
+  if (c3 > 1e-9 * scale) n = gsl_poly_solve_cubic(c2 / c3, c1 / c3, c0 / c3, &t[0], &t[1], &t[2]);
+  else n = gsl_poly_solve_quadratic(c2, c1, c0, &t[0], &t[1]);
+  for (int i = 0; i < n; i++) {
+    double x = t[i];
+    for (int it = 0; it < 3; it++) {
+      double f = ((c3 * x + c2) * x + c1) * x + c0, df = (3.0 * c3 * x + 2.0 * c2) * x + c1;
+      if (!(df != 0.0)) break;
+      double nx = x - f / df;
+      if (!isfinite(nx)) break;
+      x = nx;
+    }
+    if (x > 0.0 && x < 1.0) best = fmin(best, speed2_at(h, x));
+  }
+  return sqrt(best);
+}
+
+/* 1 if |h|^2 >= need on [0, 1] by the Bernstein bound, 0 if in doubt, -1
+** for non-finite input.  |h|^2 = sum_k c_k b^4_k(t) with the coefficients
+** below; the b^4_k are >= 0 and sum to 1, so |h|^2 >= min_k c_k. */
+static int speed_bound(const double h[6], double need)
+{
+  const double c0 = h[0] * h[0] + h[1] * h[1], c1 = h[0] * h[2] + h[1] * h[3];
+  const double c2 = ((h[0] * h[4] + h[1] * h[5]) + 2.0 * (h[2] * h[2] + h[3] * h[3])) * (1.0 / 3.0);
+  const double c3 = h[2] * h[4] + h[3] * h[5], c4 = h[4] * h[4] + h[5] * h[5];
+  if (!isfinite(c0 + c1 + c2 + c3 + c4)) return -1;
+  /* plain comparisons: this runs for every new segment of every proposal */
+  return c0 >= need && c1 >= need && c2 >= need && c3 >= need && c4 >= need;
+}
+
+/* 1 if h_x + i h_y has no zero in the disc |t - 1/2| <= R (R2 = R^2), 0 if
+** in doubt, -1 for non-finite input.  Around u = t - 1/2 it is
+** P0 + P1 u + C u^2, |P0| the speed at the middle, |P1| that of r'' there,
+** C = h0 - 2 h1 + h2; on |u| <= R it is at least |P0| - |P1| R - |C| R^2,
+** > 0 when |P0|^2 > 2 (|P1|^2 R^2 + |C|^2 R^4) ((x + y)^2 <= 2 x^2 + 2 y^2). */
+static int disc_bound(const double h[6], double R2)
+{
+  const double p0x = 0.25 * (h[0] + h[4]) + 0.5 * h[2], p0y = 0.25 * (h[1] + h[5]) + 0.5 * h[3];
+  const double p1x = h[4] - h[0], p1y = h[5] - h[1];
+  const double cx = h[0] - 2.0 * h[2] + h[4], cy = h[1] - 2.0 * h[3] + h[5];
+  const double p0 = p0x * p0x + p0y * p0y, p1 = p1x * p1x + p1y * p1y, c2 = cx * cx + cy * cy;
+  if (!isfinite(p0 + p1 + c2)) return -1;
+  return p0 > 2.0 * R2 * (p1 + c2 * R2);
+}
+
+int lw_segment_regular(const lw_node *a, const lw_node *b, double min_speed)
+{
+  double h[6];
+  hodograph(a, b, h);
+  int clear = speed_bound(h, min_speed * min_speed);
+  if (clear) return clear > 0;
+  return lw_segment_min_speed(a, b) >= min_speed;
+}
+
+/* Bernstein ellipse parameter of the point t (foci 0 and 1): with
+** z = 2t - 1, rho = |z + sqrt(z^2 - 1)| taken >= 1. */
+static double ellipse_rho(double complex t)
+{
+  double complex z = 2.0 * t - 1.0, w = z + csqrt(z * z - 1.0);
+  double r = cabs(w);
+  return r >= 1.0 ? r : 1.0 / r;
+}
+
+double lw_segment_rho(const lw_node *a, const lw_node *b)
+{
+  double h[6];
+  hodograph(a, b, h);
+  /* h_x + i h_y = A + 2 B t + C t^2 with complex A, B, C */
+  const double complex A = h[0] + I * h[1], B = (h[2] - h[0]) + I * (h[3] - h[1]);
+  const double complex C = (h[0] - 2.0 * h[2] + h[4]) + I * (h[1] - 2.0 * h[3] + h[5]);
+  if (!isfinite(creal(A) + cimag(A) + creal(B) + cimag(B) + creal(C) + cimag(C))) return NAN;
+  /* roots of C t^2 + 2 B t + A: q = -(B + s sqrt(B^2 - A C)) with the sign
+  ** that avoids cancellation, t1 = q / C, t2 = A / q (the stable pair;
+  ** C = 0 leaves the linear root A / q = -A / 2B) */
+  double complex d = csqrt(B * B - A * C), q = creal(conj(B) * d) >= 0.0 ? -(B + d) : -(B - d);
+  if (q == 0.0) return A == 0.0 ? 1.0 : INFINITY; /* B = 0 and A C = 0 */
+  double rho = ellipse_rho(A / q);
+  if (C != 0.0) rho = fmin(rho, ellipse_rho(q / C));
+  return rho;
+}
+
+/* The Bernstein ellipse of parameter rho (foci 0 and 1) lies in the disc
+** |t - 1/2| <= (rho + 1/rho) / 4: its semi-major axis. */
+static double disc_radius2(double rho)
+{
+  double R = 0.25 * (rho + 1.0 / rho);
+  return R * R;
+}
+
+int lw_segment_check(const lw_node *a, const lw_node *b, double min_speed, double rho)
+{
+  double h[6];
+  hodograph(a, b, h);
+  if (min_speed > 0.0) {
+    int clear = speed_bound(h, min_speed * min_speed);
+    if (clear < 0 || (!clear && !(lw_segment_min_speed(a, b) >= min_speed))) return 0;
+  }
+  if (rho > 1.0) {
+    int clear = disc_bound(h, disc_radius2(rho));
+    if (clear < 0 || (!clear && !(lw_segment_rho(a, b) >= rho))) return 0;
   }
   return 1;
 }

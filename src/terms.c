@@ -65,6 +65,18 @@ double lw_term_boundary(const lw_samples *s, const lw_quad *q, const lw_boundary
   return sum;
 }
 
+double lw_term_parametrisation(const lw_samples *s, const lw_quad *q)
+{
+  const double l = s->length;
+  if (!(l > 0.0)) return 0.0; /* a point: every speed is 0, and so is the mean */
+  double sum = 0.0;
+  for (int i = 0; i < s->n; i++) {
+    double d = s->speed[i] - l;
+    sum += q->w[i] * d * d;
+  }
+  return sum / l;
+}
+
 static double seg_bending(const lw_samples *s, const lw_scene *sc)
 {
   return sc->coef[LW_TERM_BENDING] * lw_term_bending(s, &sc->quad);
@@ -90,6 +102,11 @@ static double seg_user(const lw_samples *s, const lw_scene *sc)
   return sc->coef[LW_TERM_USER] * sc->user_fn(s, &sc->quad, sc->user_data);
 }
 
+static double seg_param(const lw_samples *s, const lw_scene *sc)
+{
+  return sc->coef[LW_TERM_PARAM] * lw_term_parametrisation(s, &sc->quad);
+}
+
 const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_STRAIN, "strain", NULL},
   {LW_TERM_BENDING, "bending", seg_bending},
@@ -98,4 +115,5 @@ const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_PAIR, "pair", NULL},
   {LW_TERM_BOUNDARY, "boundary", seg_boundary},
   {LW_TERM_USER, "user", seg_user},
+  {LW_TERM_PARAM, "parametrisation", seg_param},
 };

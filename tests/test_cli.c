@@ -75,7 +75,7 @@ static const char scene_text[] =
 Test(cli, energy_prints_each_enabled_term_and_the_total)
 {
   write_file("scene.ini", scene_text);
-  size_t segs[2] = {3, 2};
+  size_t segs[2] = {3, 4}; /* quarter circles: half circles in one segment are irregular */
   lw_state st = {.scene = "scene.ini", .seed = 7, .sp = lw_splines_new(2, segs, NULL)};
   lw_test_straight(st.sp, 0, 20, 20, 70, 30);
   lw_test_circle(st.sp, 1, 50, 45, 12);
@@ -117,11 +117,43 @@ Test(cli, energy_lists_only_enabled_terms)
 {
   write_file("scene.ini", "[energy]\nbending = 1\n");
   write_file("state.lw", "linewise-state 1\nscene scene.ini\nseed 1\nsweep 0\nsplines 1\nspline 1 3\n"
-                         "10 10 1 0\n20 10 1 0\nend\n");
+                         "10 10 3 0\n20 10 3 0\nend\n");
   char out[1024], errs[1024], args[128];
   snprintf(args, sizeof args, "energy %s", dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   cr_assert_str_eq(out, "bending 0\ntotal 0\n");
+}
+
+Test(cli, a_state_with_an_irregular_segment_is_refused)
+{
+  /* Segment 1 of spline 1 folds: its handles (length 1) are short against
+  ** its chord (10 mm), so the speed dips to 3 / 10 = 0.3 of the mean at the
+  ** ends, and with handles 0.2 to 0.06 (below the default). */
+  write_file("scene.ini", "[energy]\nbending = 1\n");
+  write_file("state.lw", "linewise-state 1\nscene scene.ini\nseed 1\nsweep 0\nsplines 2\nspline 1 3\n"
+                         "10 10 3 0\n20 10 3 0\nspline 2 3\n10 20 3 0\n20 20 3 0\n30 20 0.2 0\nend\n");
+  char out[1024], errs[1024], args[512];
+  snprintf(args, sizeof args, "energy %s", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
+  cr_assert_str_eq(out, "", "nothing on stdout for a refused state");
+  cr_assert(strstr(errs, "state.lw") && strstr(errs, "spline 1, segment 1") && strstr(errs, "0.06") &&
+            strstr(errs, "energy.min_speed"), "the message must name the file, spline, segment, ratio "
+            "and key: %s", errs);
+  /* the keys relax it (the short handle also brings the integrand's
+  ** singularity close: rho 1.28) */
+  cr_assert(strstr(errs, "energy.regularity"), "%s", errs);
+  write_file("scene.ini", "[energy]\nbending = 1\nmin_speed = 0.05\nregularity = 1.2\n");
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  /* and a run starting from it (init.from) is refused the same way, writing nothing */
+  char scene[256];
+  snprintf(scene, sizeof scene, "%s/from.ini", dir);
+  write_file("from.ini", "[init]\nfrom = state.lw\n[energy]\nbending = 1\n[anneal]\nsweeps = 1\n");
+  snprintf(args, sizeof args, "run %s --out %s/run --quiet", scene, dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "spline 1, segment 1") && strstr(errs, "energy.min_speed"), "%s", errs);
+  char probe[256];
+  snprintf(probe, sizeof probe, "%s/run", dir);
+  cr_assert(access(probe, F_OK) != 0, "a refused run must not create its directory");
 }
 
 Test(cli, bad_input_exits_2_with_one_message)
@@ -182,4 +214,26 @@ Test(cli, generated_references_are_current)
 {
   check_generated_doc("params", "PARAMETERS.md");
   check_generated_doc("schedules", "SCHEDULES.md");
+}
+
+Test(cli, an_older_state_without_the_new_counters_resumes)
+{
+  /* A checkpoint written before rejections for irregularity were counted and
+  ** before the parametrisation term existed: no moves_irregular line, seven
+  ** running energies.  It must resume (those start at 0), and the summary then
+  ** counts the rejections of the rest of the run. */
+  const char *root = getenv("LW_ROOT");
+  cr_assert_not_null(root);
+  char out[1024], errs[1024], args[512];
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/old --set anneal.sweeps=40 --stop-at 20 --quiet",
+           root, dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(lw_test_sh("grep -q '^moves_irregular ' %s/old/state.lw", dir), 0, "state.lw must carry the counts");
+  cr_assert_eq(lw_test_sh("sed -i -e '/^moves_irregular /d' -e 's/^\\(energy .*\\) [^ ]*$/\\1/' %s/old/state.lw", dir), 0);
+  cr_assert_eq(lw_test_sh("grep '^energy ' %s/old/state.lw | awk '{exit NF == 8 ? 0 : 1}'", dir), 0,
+               "the edited energy line must hold seven numbers");
+  snprintf(args, sizeof args, "resume %s/old --quiet", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(lw_test_sh("grep -A1 '\"rejected_irregular\": {' %s/old/summary.json | grep -q '\"point\": [0-9]'", dir), 0,
+               "summary.json must count the rejections per move kind");
 }

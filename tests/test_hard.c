@@ -10,6 +10,9 @@
 **     1e-9 of the total (invariant 1; both +inf where the state is forbidden);
 **   - no proposal was rejected for a NaN dE: the terms are built so that
 **     degenerate geometry gives a number or +inf, never NaN.
+** The regularity cases (a loop, zero handles, handles of 100 chords, a
+** field driving toward a cusp) also check that such states are refused with
+** a message and their proposals counted as irregular (model.h).
 */
 #include <criterion/criterion.h>
 #include <gsl/gsl_rng.h>
@@ -62,6 +65,16 @@ static void plain_scene(lw_scene *sc)
   scene_of(sc, &p);
 }
 
+/* The same without the regularity check (energy.min_speed = 0, a user's
+** choice): the terms alone must then cope with degenerate segments. */
+static void unchecked_scene(lw_scene *sc)
+{
+  lw_params p = every_term(1);
+  p.min_speed = 0;
+  p.regularity = 0;
+  scene_of(sc, &p);
+}
+
 static lw_splines *splines_of(size_t n, size_t segments)
 {
   size_t *segs = malloc((n ? n : 1) * sizeof *segs);
@@ -89,6 +102,9 @@ static void check_state(const lw_model *m, const char *what)
   lw_error err;
   double full = lw_energy_compute(sc, m->sp, term, &err);
   cr_assert(!isnan(full), "%s: recomputed energy is NaN", what);
+  /* forbidden (+inf) in both or in neither: an irregular segment counts */
+  cr_assert(isinf(full) == isinf(lw_model_total(m)), "%s: running total %g, recomputed %g", what,
+            lw_model_total(m), full);
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     cr_assert(!isnan(m->term[t]), "%s: running %s is NaN", what, lw_term_types[t].name);
     if (isinf(term[t])) {
@@ -116,11 +132,12 @@ static lw_move_stats run(lw_model *m, double T, long n, const double step[LW_MOV
     while (kind < LW_MOVE_KINDS - 1 && u >= c->cum_weight[kind]) kind++;
     cr_assert_geq(lw_chain_step(c, (lw_move_kind)kind), 0, "a commit failed");
   }
-  lw_move_stats s = {0, 0, 0};
+  lw_move_stats s = {.proposed = 0};
   for (int k = 0; k < LW_MOVE_KINDS; k++) {
     s.proposed += c->stats[k].proposed;
     s.accepted += c->stats[k].accepted;
     s.nan += c->stats[k].nan;
+    s.irregular += c->stats[k].irregular;
   }
   lw_chain_free(c);
   return s;
@@ -163,9 +180,10 @@ Test(hard, coincident_control_points)
 {
   /* Two splines collapsed onto one point (all p equal, all v zero) and a
   ** third whose handles sit on its points: zero speed, zero length, samples
-  ** of different splines at distance 0. */
+  ** of different splines at distance 0.  Unchecked: with the regularity
+  ** check every such segment is forbidden and the chain could not move. */
   lw_scene sc;
-  plain_scene(&sc);
+  unchecked_scene(&sc);
   lw_splines *sp = splines_of(3, 3);
   for (size_t k = 0; k < 8; k++) sp->node[k] = (lw_node){30, 25, 0, 0};
   lw_test_straight(sp, 2, 20, 20, 40, 20);
@@ -189,6 +207,7 @@ Test(hard, zero_length_samples_weigh_nothing_in_the_pair_kernel)
       p.pair = 1;
       p.pair_near = nears[a];
       p.pair_cutoff = cuts[b];
+      p.min_speed = p.regularity = 0; /* collapsed splines are irregular: the pair term is what is tested */
       lw_scene sc;
       scene_of(&sc, &p);
       lw_splines *sp = splines_of(2, 1);
@@ -249,9 +268,12 @@ Test(hard, cusps_and_loops)
 {
   /* A cusp: b3 + b2 = b1 + b0 makes r'(1/2) = 0, and 5 Gauss nodes put a
   ** sample exactly there.  A loop: handles long enough to cross the curve
-  ** over itself. */
+  ** over itself.  Unchecked, so the terms meet them (with the check on both
+  ** are forbidden: hard::regularity_* below). */
   lw_params p = every_term(1);
   p.quadrature = 5;
+  p.min_speed = 0;
+  p.regularity = 0;
   lw_scene sc;
   scene_of(&sc, &p);
   lw_splines *sp = splines_of(3, 1);
@@ -270,6 +292,117 @@ Test(hard, cusps_and_loops)
   check_state(m, "cusp, before moving");
   cr_assert(isfinite(lw_model_total(m)), "a cusp must have finite energy");
   run_checked(m, "cusps and loops", 0.05, PROPOSALS, 0.3, 0.05, 0.95);
+  done(m, &sc);
+}
+
+/* ---- regularity (issue 12): states the quadrature cannot see are refused --- */
+
+/* A one-segment spline `bad` among two ordinary ones: the state must be
+** forbidden (+inf) and refused when read from a file, with a message naming
+** the segment; the chain then refuses every move that keeps it (counted as
+** irregular, never NaN) and accepts the first that leaves it (dE = -inf). */
+static void irregular_case(const lw_node bad[2], const char *what)
+{
+  lw_scene sc;
+  plain_scene(&sc);
+  size_t segs[3] = {2, 1, 2};
+  lw_splines *sp = lw_splines_new(3, segs, NULL);
+  lw_test_straight(sp, 0, 10, 10, 22, 10);
+  sp->node[3] = bad[0];
+  sp->node[4] = bad[1];
+  sp->rest_length[1] = 8;
+  lw_test_straight(sp, 2, 10, 45, 22, 45);
+  lw_error err;
+  cr_assert_eq(lw_model_check_regular(&sc, sp, "case.lw", &err), LW_EINPUT, "%s: not refused", what);
+  cr_assert(strstr(err.msg, "case.lw: spline 1, segment 0") && strstr(err.msg, "energy.min_speed") &&
+            strstr(err.msg, "energy.regularity"), "%s: %s", what, err.msg);
+  lw_model *m = lw_model_new(&sc, sp, NULL);
+  cr_assert_eq(m->n_irregular, 1, "%s", what);
+  cr_assert_eq(lw_model_total(m), INFINITY, "%s: the state must be forbidden", what);
+  check_state(m, what);
+  /* a move of the other splines is finite; one that keeps the segment as it
+  ** is (a rigid translation) is refused for irregularity */
+  lw_proposal *pr = lw_proposal_new(m, NULL);
+  lw_node mv[2] = {bad[0], bad[1]};
+  mv[0].px += 0.5;
+  mv[1].px += 0.5;
+  lw_model_propose(m, pr, 1, 0, 2, mv);
+  cr_assert(pr->dE == INFINITY && pr->irregular, "%s: dE %g", what, pr->dE);
+  lw_node nd = m->sp->node[1];
+  nd.py += 0.01;
+  lw_model_propose(m, pr, 0, 1, 1, &nd);
+  cr_assert(isfinite(pr->dE) && !pr->irregular, "%s: a move elsewhere has dE %g", what, pr->dE);
+  lw_proposal_free(pr);
+  double st[LW_MOVE_KINDS] = {0.3, 0.3, 0.3, 0.05};
+  lw_move_stats s = run(m, 0.05, PROPOSALS, st, 4711);
+  check_state(m, what);
+  cr_assert_eq(s.nan, 0, "%s: %lu proposals rejected for NaN", what, s.nan);
+  cr_assert(s.irregular > 0, "%s: no proposal refused for irregularity", what);
+  cr_assert(s.accepted > 0, "%s: nothing moved", what);
+  done(m, &sc);
+}
+
+Test(hard, regularity_a_loop)
+{
+  /* b0 = (30,30), b1 = (42,38), b2 = (24,38), b3 = (36,30): the segment
+  ** crosses itself, turning through a full circle in a tight knot */
+  const lw_node loop[2] = {{30, 30, 12, 8}, {36, 30, 12, -8}};
+  irregular_case(loop, "loop");
+}
+
+Test(hard, regularity_zero_length_handles)
+{
+  /* Refused: v = 0 stops the curve at its node, where the tangent is then
+  ** undefined, so two segments could meet at a sharp corner that costs no
+  ** bending at all, the very blind spot the check closes (docs/NUMERICS.md). */
+  const lw_node zero[2] = {{30, 30, 0, 0}, {38, 30, 8.0 / 3, 0}};
+  irregular_case(zero, "zero handle");
+}
+
+Test(hard, regularity_straight_with_handles_a_hundred_chords)
+{
+  /* a straight 6 mm segment whose handles are 600 mm long: the curve runs
+  ** out along the line, stops, turns back and stops again: two cusps on a
+  ** straight line, where bending is 0 at every node count but the tangent
+  ** flips (a corner when drawn with its neighbours) */
+  const lw_node longh[2] = {{30, 30, 600, 0}, {36, 30, 600, 0}};
+  irregular_case(longh, "handles of 100 chords");
+}
+
+Test(hard, regularity_a_strong_field_drives_toward_a_cusp)
+{
+  /* A strong axial field term of positive P penalises every bit of length
+  ** along the field (+x): the cheapest state shrinks the handles along x,
+  ** toward a cusp.  The checks must keep every accepted state regular, so
+  ** the chain presses against the wall: many refusals, no NaN. */
+  lw_params p = every_term(1);
+  p.field = LW_FLD_CONSTANT;
+  p.field_angle = 0;
+  p.field_coef = 50;
+  p.bending = 0.01;
+  p.strain = 0.1;
+  lw_scene sc;
+  scene_of(&sc, &p);
+  lw_model *m = random_model(&sc, 12, 3, 4, 99);
+  cr_assert_eq(m->n_irregular, 0, "placement is regular");
+  double st[LW_MOVE_KINDS] = {0.3, 0.3, 0.3, 0.05};
+  lw_move_stats s = run(m, 0.01, PROPOSALS, st, 4711);
+  check_state(m, "strong field");
+  cr_assert_eq(s.nan, 0);
+  cr_assert(s.irregular > s.proposed / 100, "the field must drive segments into the wall: %lu of %lu refused",
+            s.irregular, s.proposed);
+  cr_assert_eq(m->n_irregular, 0, "an accepted state is irregular");
+  cr_assert(isfinite(lw_model_total(m)));
+  /* the energy the chain sees is the curve's: 8 nodes against 64 on bending */
+  lw_scene s64;
+  p.quadrature = 64;
+  scene_of(&s64, &p);
+  double t8[LW_TERM_COUNT], t64[LW_TERM_COUNT];
+  lw_energy_compute(&sc, m->sp, t8, NULL);
+  lw_energy_compute(&s64, m->sp, t64, NULL);
+  cr_assert(lw_close_rel(t8[LW_TERM_BENDING], t64[LW_TERM_BENDING], 1e-3, 0), "bending %.9g at 8 nodes, %.9g at 64",
+            t8[LW_TERM_BENDING], t64[LW_TERM_BENDING]);
+  lw_scene_clear(&s64);
   done(m, &sc);
 }
 

@@ -14,7 +14,8 @@
 ** A section is one function and one entry in `sections`; it writes its
 ** Markdown into b->doc[its document].  This file holds the sections on
 ** throughput, scaling and the cost of each term; bench-accuracy.c the
-** accuracy studies, bench-siman.c the GSL baseline.
+** accuracy studies, bench-regularity.c the regularity threshold and its
+** cost, bench-siman.c the GSL baseline.
 */
 #include <math.h>
 #include <stdio.h>
@@ -36,6 +37,8 @@ void bench_near(bench_ctx *b);
 void bench_guide(bench_ctx *b);
 void bench_baseline(bench_ctx *b);
 void bench_tempering(bench_ctx *b);
+void bench_regularity(bench_ctx *b);
+void bench_regularity_cost(bench_ctx *b);
 
 /* ---- throughput and scaling ---------------------------------------------- */
 
@@ -290,8 +293,10 @@ static const bench_section sections[] = {
     {"throughput", BENCH_PERFORMANCE, bench_throughput},
     {"scaling", BENCH_PERFORMANCE, bench_scaling},
     {"terms", BENCH_PERFORMANCE, bench_terms},
+    {"regularity_cost", BENCH_PERFORMANCE, bench_regularity_cost},
     {"baseline", BENCH_PERFORMANCE, bench_baseline},
     {"tempering", BENCH_PERFORMANCE, bench_tempering},
+    {"regularity", BENCH_ACCURACY, bench_regularity},
     {"quadrature", BENCH_ACCURACY, bench_quadrature},
     {"cutoff", BENCH_ACCURACY, bench_cutoff},
     {"near", BENCH_ACCURACY, bench_near},

@@ -21,7 +21,7 @@ set logscale xy
 set format y '10^{%L}'
 set key bottom left
 plot f('quadrature.dat') using 3:(pos($5)) with linespoints pt 7 title 'pair energy', \
-     '' using 3:(pos($6)) with linespoints pt 5 title 'bending energy of unfolded segments', \
+     '' using 3:(pos($6)) with linespoints pt 5 title 'bending energy', \
      '' using 3:(pos($7)) with linespoints pt 13 title 'dE of proposals (median)', \
      '' using 3:(pos($9)) with linespoints pt 11 title 'share of decisions that differ', \
      '' using 3:(pos($7)):(sprintf('%d', $1)) with labels offset 0,1 notitle

@@ -5,7 +5,8 @@
 ** x and y, or moves a whole spline rigidly (translation, or rotation about
 ** the mean of its points, which the rotation leaves in place, so every
 ** proposal is symmetric).  Accept if dE <= 0, else with probability
-** exp(-dE / T); a NaN dE is rejected and counted, +inf is rejected.
+** exp(-dE / T); a NaN dE is rejected and counted, +inf is rejected (and
+** counted apart when an irregular segment made it so).
 **
 ** Steps adapt toward a target acceptance only while `tuning` is set (the
 ** annealer sets it at the start of each temperature); otherwise they are
@@ -26,6 +27,7 @@ extern const char *const lw_move_names[LW_MOVE_KINDS];
 
 typedef struct {
   unsigned long proposed, accepted, nan; /* nan: proposals rejected for a NaN dE */
+  unsigned long irregular;  /* proposals rejected for an irregular segment (model.h) */
 } lw_move_stats;
 
 /* How often tuning looks at the acceptance of a move kind (proposals):

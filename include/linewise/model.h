@@ -12,6 +12,15 @@
 **
 ** Invariant (tested): after any sequence of commits, the running totals equal
 ** lw_energy_compute of the state within 1e-9 relative.
+**
+** Regularity (lw_segment_allowed): a segment whose speed falls below
+** scene->min_speed times its length, or whose bending integrand has a
+** singularity inside the Bernstein ellipse scene->regularity (spline.h), is
+** forbidden.  The terms of a state
+** with one stay what the quadrature gives, but its total is +infinity
+** (lw_model_total, lw_energy_compute); a proposal that makes a segment
+** irregular has dE = +inf and p->irregular set, one that leaves the last
+** irregular segment among those it touches for regular ones has dE = -inf.
 */
 #ifndef LINEWISE_MODEL_H
 #define LINEWISE_MODEL_H
@@ -27,6 +36,8 @@ typedef struct {
   double *seg_len;          /* n_segments, mm */
   double *seg_local;        /* n_segments * scene->n_local: cached local energies */
   double *spline_len;       /* n_splines, mm: sum of seg_len in segment order */
+  unsigned char *seg_irregular; /* n_segments: 1 where a segment is irregular */
+  size_t n_irregular;       /* how many; the total is +inf while > 0 */
   double term[LW_TERM_COUNT]; /* running totals (0 for terms that are off) */
   lw_pair_sample *ps;       /* n_segments * quad.n pair samples (pair on), else NULL */
   lw_cellgrid *grid;        /* over ps (pair on), else NULL */
@@ -39,6 +50,7 @@ typedef struct {
 lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err);
 void lw_model_free(lw_model *m);
 
+/* The sum of the running terms; +inf while a segment is irregular. */
 double lw_model_total(const lw_model *m);
 
 /* Recomputes every cache and total from the state.  If drift is not NULL it
@@ -63,6 +75,8 @@ typedef struct {
   lw_pair_sample *ps;         /* n_seg * quad.n new pair samples */
   double new_spline_len;
   double dterm[LW_TERM_COUNT];
+  unsigned char *seg_irregular; /* n_seg: 1 where a new segment is irregular */
+  int irregular;              /* 1 if any is: the proposal is forbidden for that */
   double dE;                  /* sum of dterm; +inf for a forbidden state, NaN never kept */
   size_t cap_seg;
   lw_near_list near;          /* the pair walk's near pairs */
@@ -84,8 +98,23 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
 /* Applies an evaluated proposal.  LW_ENOMEM if the grid could not grow. */
 lw_status lw_model_commit(lw_model *m, const lw_proposal *p);
 
+/* 1 if the segment from a to b, of quadrature length `length`, is regular
+** for the scene: its speed never falls below scene->min_speed times its
+** length, the mean speed, and its bending integrand is analytic inside the
+** Bernstein ellipse of parameter scene->regularity (spline.h; each test off
+** at 0).  A segment without length has no direction at all, so it is
+** irregular whenever a test is on. */
+int lw_segment_allowed(const lw_scene *sc, const lw_node *a, const lw_node *b, double length);
+
+/* LW_EINPUT naming path, the spline, the segment, its speed ratio and rho,
+** and the keys energy.min_speed and energy.regularity if a segment of sp is
+** irregular for the scene: states
+** read from files (init.from, resume, energy) are refused rather than
+** started in a forbidden state. */
+lw_status lw_model_check_regular(const lw_scene *sc, const lw_splines *sp, const char *path, lw_error *err);
+
 /* Energy of a state computed from scratch, one value per term (0 for terms
-** that are off); returns the total. */
+** that are off); returns the total, +inf if a segment is irregular. */
 double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[LW_TERM_COUNT],
                          lw_error *err);
 

@@ -93,6 +93,9 @@ typedef struct {
   int field_mode;             /* LW_FIELDMODE_* */
   double pair_cutoff;         /* mm; 0 = none */
   double pair_near;           /* element lengths; 0 = off */
+  double min_speed;           /* regularity: fraction of the mean speed; 0 = none */
+  double regularity;          /* regularity: Bernstein ellipse parameter; <= 1 = none */
+  double parametrisation;     /* G, energy / mm; 0 = off */
   int quadrature;             /* nodes per segment */
   int pair_quadrature;        /* pair samples per segment; 0 = quadrature */
   /* [moves] */

@@ -43,6 +43,10 @@ typedef struct lw_scene {
   int on[LW_TERM_COUNT];        /* coef != 0 */
   int strain_per_segment;       /* strain mode */
   int field_axial;              /* field mode */
+  double min_speed;             /* regularity: fraction of a segment's mean speed its
+                                   speed must keep; 0 = no check (spline.h) */
+  double regularity;            /* regularity: the Bernstein ellipse its bending
+                                   integrand must be analytic in; 0 = no check */
   lw_quad quad;
   lw_quad pair_quad;            /* nodes of the pair samples (valid when pair is on) */
   lw_pair_ctx pair;

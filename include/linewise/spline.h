@@ -101,6 +101,46 @@ typedef struct {
 
 void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_samples *out);
 
+/*
+** Regularity: the hodograph r'(t) of a cubic segment is the quadratic Bezier
+** with control points h0 = 3 v_a, h1 = 3 (b2 - b1), h2 = 3 v_b.  Where
+** |r'| nearly stops the curvature is huge between quadrature nodes and a
+** fixed rule misses the bending there, so the model forbids segments whose
+** minimum speed falls below energy.min_speed times their mean speed (the
+** segment length: the parameter runs over [0, 1]).  docs/NUMERICS.md has the
+** derivation, docs/ACCURACY.md the table the default comes from.
+*/
+
+/* The exact minimum of |r'(t)| over t in [0, 1], mm per unit t: with
+** h(t) = A + 2 B t + C t^2 the stationary points of |h|^2 solve the cubic
+** (C.C) t^3 + 3 (B.C) t^2 + (2 B.B + A.C) t + A.B = 0 (GSL's polynomial
+** solvers, roots polished by Newton); the minimum over its roots in [0, 1]
+** and the two ends.  Not finite if a coordinate is not. */
+double lw_segment_min_speed(const lw_node *a, const lw_node *b);
+
+/* 1 if min |r'| >= min_speed: a cheap exact bound first (|r'|^2 is a quartic
+** whose Bernstein coefficients bound it from below), the cubic only for
+** segments the bound cannot clear.  0 for non-finite input. */
+int lw_segment_regular(const lw_node *a, const lw_node *b, double min_speed);
+
+/* How far the bending integrand (x'y'' - x''y')^2 / |r'|^5 stays analytic
+** around [0, 1]: its singularities are the complex zeros of |r'(t)|^2, the
+** roots of the complex quadratic h_x(t) + i h_y(t) (and their conjugates).
+** Returns the parameter rho >= 1 of the Bernstein ellipse (foci 0 and 1,
+** semi-axes summing to rho / 2) through the nearest one: Gauss-Legendre with
+** n nodes then errs by O(rho^-2n) (docs/NUMERICS.md).  1 where |r'| = 0 on
+** [0, 1] (a cusp), +inf where |r'| is constant and never 0.  NaN for
+** non-finite input. */
+double lw_segment_rho(const lw_node *a, const lw_node *b);
+
+/* Both tests with one hodograph: 1 if min |r'| >= min_speed (mm per unit t;
+** 0 = no test) and lw_segment_rho >= rho (<= 1 = no test).  Each first tries
+** a cheap exact bound (the Bernstein one above; for rho, the ellipse lies in
+** the disc |t - 1/2| <= (rho + 1/rho) / 4, where Taylor's bound at t = 1/2
+** keeps |h_x + i h_y| away from 0) and solves only when that is in doubt.
+** 0 for non-finite input. */
+int lw_segment_check(const lw_node *a, const lw_node *b, double min_speed, double rho);
+
 /* 1 if every coordinate is finite. */
 int lw_splines_finite(const lw_splines *sp);
 

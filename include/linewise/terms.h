@@ -14,6 +14,14 @@
 **   boundary  R * int f(d(r)) |r'| ds,  f(d) = 1/d^2 for d < 0, +infinity for d >= 0
 **   user      coef * fn(samples), a per-segment energy registered by the caller
 **             (lw_scene_set_user_term in scene.h); never set from a scene file
+**   parametrisation
+**             G * int (|r'| - l)^2 ds / l per segment, l = int |r'| ds (the
+**             segment's length = its mean speed): 0 for uniform speed, so it
+**             holds the handle lengths that do not change the shape
+**             (docs/NUMERICS.md); 0 for a segment of no length
+**
+** The term table's order is the order of trace.csv's and state.lw's energy
+** columns; a new term goes at the end so older state files still read.
 **
 ** Degenerate samples never produce NaN: a sample with r' = 0 contributes 0 to
 ** bending (r' = 0 forces the numerator to 0 as well; the curvature of a point
@@ -37,6 +45,7 @@ typedef enum {
   LW_TERM_PAIR,
   LW_TERM_BOUNDARY,
   LW_TERM_USER,
+  LW_TERM_PARAM,
   LW_TERM_COUNT
 } lw_term_id;
 
@@ -58,5 +67,6 @@ double lw_term_bending(const lw_samples *s, const lw_quad *q);
 double lw_term_potential(const lw_samples *s, const lw_quad *q, const lw_potential *f);
 double lw_term_field(const lw_samples *s, const lw_quad *q, const lw_field *f, int axial);
 double lw_term_boundary(const lw_samples *s, const lw_quad *q, const lw_boundary *b);
+double lw_term_parametrisation(const lw_samples *s, const lw_quad *q);
 
 #endif
