@@ -128,6 +128,8 @@ static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
 #define CHORD_LO 0.35
 #define CHORD_HI 0.5
 #define LEAF_RATIO 1e-2
+#define SINE_LO 0.1
+#define SINE_HI 0.2
 #define STACK_MAX 128
 
 /* Gauss-Legendre on [0, 1]: 6 nodes for small pieces, 16 for large ones. */
@@ -195,49 +197,6 @@ static inline double smooth_step(double x)
   return x * x * x * (10.0 + x * (6.0 * x - 15.0));
 }
 
-/* Distance from p to the segment a-b. */
-static double point_segment(const double p[2], const double a[2], const double b[2])
-{
-  double ux = b[0] - a[0], uy = b[1] - a[1], wx = p[0] - a[0], wy = p[1] - a[1];
-  double uu = ux * ux + uy * uy, t = uu > 0.0 ? (wx * ux + wy * uy) / uu : 0.0;
-  t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
-  return hypot(wx - t * ux, wy - t * uy);
-}
-
-/* Which side of the line a-b the point p is on (sign of the cross product). */
-static int side(const double a[2], const double b[2], const double p[2])
-{
-  return (p[0] - a[0]) * (b[1] - a[1]) - (p[1] - a[1]) * (b[0] - a[0]) > 0.0;
-}
-
-/* The chord gap of two pieces (see the file comment); continuous in them. */
-static double chord_gap(const piece *a, const piece *b)
-{
-  double dev = 0.0;
-  const piece *pc[2] = {a, b};
-  for (int k = 0; k < 2; k++) {
-    const piece *p = pc[k];
-    double h3 = (p->t1 - p->t0) / 3.0;
-    double c1[2] = {p->r0[0] + h3 * p->d0[0], p->r0[1] + h3 * p->d0[1]};
-    double c2[2] = {p->r1[0] - h3 * p->d1[0], p->r1[1] - h3 * p->d1[1]};
-    dev += fmax(point_segment(c1, p->r0, p->r1), point_segment(c2, p->r0, p->r1));
-  }
-  double d = 0.0;
-  /* crossing chords are 0 apart; otherwise an end of one is nearest the other */
-  if (side(a->r0, a->r1, b->r0) == side(a->r0, a->r1, b->r1) || side(b->r0, b->r1, a->r0) == side(b->r0, b->r1, a->r1))
-    d = fmin(fmin(point_segment(a->r0, b->r0, b->r1), point_segment(a->r1, b->r0, b->r1)),
-             fmin(point_segment(b->r0, a->r0, a->r1), point_segment(b->r1, a->r0, a->r1)));
-  return d - dev;
-}
-
-/* Share of the 16 x 16 rule for a pair of pieces (chord gap). */
-static double chord_share(const piece *a, const piece *b)
-{
-  double half = a->rad > b->rad ? a->rad : b->rad;
-  if (!(half > 0.0)) return 1.0;
-  return smooth_step((chord_gap(a, b) / half - CHORD_LO) / (CHORD_HI - CHORD_LO));
-}
-
 /* A leaf: the chords, integrated exactly; their lengths stand in for the
 ** arcs (equal to O(leaf^2)).  Chords of curves that touch tangentially end
 ** to end can overlap by a rounding error, which the exact integral reads as
@@ -295,6 +254,87 @@ static double inverse_distance(const cubic *ca, const piece *root_a, const cubic
   return sum;
 }
 
+/* r, r' and r'' of a cubic at t. */
+static inline void cubic_eval2(const cubic *c, double t, double r[2], double d[2], double dd[2])
+{
+  cubic_eval(c, t, r, d);
+  dd[0] = 2.0 * c->x[2] + 6.0 * c->x[3] * t;
+  dd[1] = 2.0 * c->y[2] + 6.0 * c->y[3] * t;
+}
+
+/* The parameters (s, t) of the closest points of two cubics: the best of a
+** 9 x 9 grid, then Newton on |a(s) - b(t)|^2 kept inside the square. */
+static void closest_points(const cubic *ca, const cubic *cb, double *ps, double *pt)
+{
+  double best = INFINITY, s = 0.0, t = 0.0, ra[9][2], rb[9][2], d[2];
+  for (int k = 0; k < 9; k++) {
+    cubic_eval(ca, k / 8.0, ra[k], d);
+    cubic_eval(cb, k / 8.0, rb[k], d);
+  }
+  for (int i = 0; i < 9; i++)
+    for (int j = 0; j < 9; j++) {
+      double dx = ra[i][0] - rb[j][0], dy = ra[i][1] - rb[j][1], q = dx * dx + dy * dy;
+      if (q < best) best = q, s = i / 8.0, t = j / 8.0;
+    }
+  for (int it = 0; it < 12; it++) {
+    double a[2], a1[2], a2[2], b[2], b1[2], b2[2];
+    cubic_eval2(ca, s, a, a1, a2);
+    cubic_eval2(cb, t, b, b1, b2);
+    double D[2] = {a[0] - b[0], a[1] - b[1]};
+    double gs = D[0] * a1[0] + D[1] * a1[1], gt = -(D[0] * b1[0] + D[1] * b1[1]);
+    double hss = a1[0] * a1[0] + a1[1] * a1[1] + D[0] * a2[0] + D[1] * a2[1];
+    double htt = b1[0] * b1[0] + b1[1] * b1[1] - D[0] * b2[0] - D[1] * b2[1];
+    double hst = -(a1[0] * b1[0] + a1[1] * b1[1]);
+    double det = hss * htt - hst * hst;
+    if (!(det > 0.0) || !(hss > 0.0)) break;
+    double ds = -(htt * gs - hst * gt) / det, dt = -(hss * gt - hst * gs) / det;
+    double ns = fmin(1.0, fmax(0.0, s + ds)), nt = fmin(1.0, fmax(0.0, t + dt));
+    if (ns == s && nt == t) break;
+    s = ns;
+    t = nt;
+  }
+  *ps = s;
+  *pt = t;
+}
+
+/*
+** Two segments that cross, or nearly meet, at an angle: the kernel minus its
+** straight-line model S, the 1/r of the tangent lines at the closest points
+** (s*, t*) with the same parameters, is bounded there, so the 16 x 16 rule
+** takes it; S over the square is the exact integral of two straight
+** segments (lw_pair_segseg).  With the cutoff's bounded part in the same pass.
+*/
+static double subtracted(const cubic *ca, const cubic *cb, double cutoff, double ss, double ts,
+                         const double a[2], const double a1[2], const double b[2], const double b1[2])
+{
+  double ax[GAUSS_L], ay[GAUSS_L], aw[GAUSS_L], bx[GAUSS_L], by[GAUSS_L], bw[GAUSS_L];
+  double lax[GAUSS_L], lay[GAUSS_L], lbx[GAUSS_L], lby[GAUSS_L];
+  rule_nodes(ca, 0.0, 1.0, G16_S, G16_W, GAUSS_L, ax, ay, aw);
+  rule_nodes(cb, 0.0, 1.0, G16_S, G16_W, GAUSS_L, bx, by, bw);
+  double va = hypot(a1[0], a1[1]), vb = hypot(b1[0], b1[1]);
+  for (int k = 0; k < GAUSS_L; k++) {
+    lax[k] = a[0] + a1[0] * (G16_S[k] - ss);
+    lay[k] = a[1] + a1[1] * (G16_S[k] - ss);
+    lbx[k] = b[0] + b1[0] * (G16_S[k] - ts);
+    lby[k] = b[1] + b1[1] * (G16_S[k] - ts);
+  }
+  const double inv = cutoff > 0.0 ? 1.0 / cutoff : 0.0, rc2 = cutoff > 0.0 ? cutoff * cutoff : INFINITY;
+  double sum = 0.0;
+  for (int i = 0; i < GAUSS_L; i++) {
+    double acc = 0.0, lin = 0.0;
+    for (int j = 0; j < GAUSS_L; j++) {
+      double dx = ax[i] - bx[j], dy = ay[i] - by[j], r2 = dx * dx + dy * dy;
+      double ex = lax[i] - lbx[j], ey = lay[i] - lby[j];
+      acc += bw[j] / sqrt(r2) - (r2 > rc2 ? bw[j] / sqrt(r2) : bw[j] * inv);
+      lin += G16_W[j] / sqrt(ex * ex + ey * ey);
+    }
+    sum += aw[i] * acc - va * vb * G16_W[i] * lin;
+  }
+  double l0[2] = {a[0] - a1[0] * ss, a[1] - a1[1] * ss}, l1[2] = {l0[0] + a1[0], l0[1] + a1[1]};
+  double m0[2] = {b[0] - b1[0] * ts, b[1] - b1[1] * ts}, m1[2] = {m0[0] + b1[0], m0[1] + b1[1]};
+  return sum + lw_pair_segseg(l0, l1, m0, m1);
+}
+
 double lw_pair_segments_exact(const double a[8], const double b[8], double cutoff)
 {
   cubic ca, cb;
@@ -305,15 +345,30 @@ double lw_pair_segments_exact(const double a[8], const double b[8], double cutof
   piece pa, pb;
   piece_init(&pa, &ca, 0.0, 1.0);
   piece_init(&pb, &cb, 0.0, 1.0);
-  /* The root's 16 x 16 share takes the whole kernel, cutoff included, in one
-  ** pass: most near pairs of a drawing (neighbouring lines about an element
-  ** apart) end there. */
-  double w = chord_share(&pa, &pb);
+  double ss, ts, ra[2], a1[2], rb[2], b1[2];
+  closest_points(&ca, &cb, &ss, &ts);
+  cubic_eval(&ca, ss, ra, a1);
+  cubic_eval(&cb, ts, rb, b1);
+  /* Segments farther apart than CHORD_HI times half the larger size take the
+  ** 16 x 16 rule, the whole kernel with the cutoff in one pass: most near
+  ** pairs of a drawing, neighbouring lines about an element apart, end
+  ** there.  (The distance is the least over the segments, a continuous
+  ** function of them wherever Newton lands.) */
+  double half = fmax(pa.rad, pb.rad), dist = hypot(ra[0] - rb[0], ra[1] - rb[1]);
+  double w = half > 0.0 ? smooth_step((dist / half - CHORD_LO) / (CHORD_HI - CHORD_LO)) : 1.0;
   kernel_kind whole = cutoff > 0.0 ? KERNEL_CUT : KERNEL_INV;
   double v = w > 0.0 ? w * product_rule(&ca, 0.0, 1.0, &cb, 0.0, 1.0, GAUSS_L, whole, cutoff) : 0.0;
-  if (w < 1.0) {
-    v += inverse_distance(&ca, &pa, &cb, &pb, 1.0 - w);
-    if (cutoff > 0.0) v += (1.0 - w) * product_rule(&ca, 0.0, 1.0, &cb, 0.0, 1.0, GAUSS_L, KERNEL_CUT_REST, cutoff);
+  double rest = 1.0 - w;
+  if (rest > 0.0) {
+    /* crossing or meeting at an angle: the subtraction; shallow: the tree */
+    double sine = fabs(a1[0] * b1[1] - a1[1] * b1[0]) / (hypot(a1[0], a1[1]) * hypot(b1[0], b1[1]));
+    double u = smooth_step((sine - SINE_LO) / (SINE_HI - SINE_LO));
+    if (u > 0.0) v += rest * u * subtracted(&ca, &cb, cutoff, ss, ts, ra, a1, rb, b1);
+    rest *= 1.0 - u;
+  }
+  if (rest > 0.0) {
+    v += inverse_distance(&ca, &pa, &cb, &pb, rest);
+    if (cutoff > 0.0) v += rest * product_rule(&ca, 0.0, 1.0, &cb, 0.0, 1.0, GAUSS_L, KERNEL_CUT_REST, cutoff);
   }
   return v;
 }
