@@ -130,6 +130,10 @@ static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
 #define LEAF_RATIO 1e-2
 #define SINE_LO 0.1
 #define SINE_HI 0.2
+#ifndef CLOSE_LO
+#define CLOSE_LO 0.05
+#define CLOSE_HI 0.1
+#endif
 #define STACK_MAX 128
 
 /* Gauss-Legendre on [0, 1]: 6 nodes for small pieces, 16 for large ones. */
@@ -276,6 +280,9 @@ static void closest_points(const cubic *ca, const cubic *cb, double *ps, double 
       double dx = ra[i][0] - rb[j][0], dy = ra[i][1] - rb[j][1], q = dx * dx + dy * dy;
       if (q < best) best = q, s = i / 8.0, t = j / 8.0;
     }
+  /* Newton, one variable held where the step would leave the square, and a
+  ** step kept only if it brings the curves closer (so the grid's best is
+  ** never lost) */
   for (int it = 0; it < 12; it++) {
     double a[2], a1[2], a2[2], b[2], b1[2], b2[2];
     cubic_eval2(ca, s, a, a1, a2);
@@ -285,11 +292,26 @@ static void closest_points(const cubic *ca, const cubic *cb, double *ps, double 
     double hss = a1[0] * a1[0] + a1[1] * a1[1] + D[0] * a2[0] + D[1] * a2[1];
     double htt = b1[0] * b1[0] + b1[1] * b1[1] - D[0] * b2[0] - D[1] * b2[1];
     double hst = -(a1[0] * b1[0] + a1[1] * b1[1]);
-    double det = hss * htt - hst * hst;
-    if (!(det > 0.0) || !(hss > 0.0)) break;
-    double ds = -(htt * gs - hst * gt) / det, dt = -(hss * gt - hst * gs) / det;
-    double ns = fmin(1.0, fmax(0.0, s + ds)), nt = fmin(1.0, fmax(0.0, t + dt));
-    if (ns == s && nt == t) break;
+    double det = hss * htt - hst * hst, ds = 0.0, dt = 0.0;
+    if (det > 0.0 && hss > 0.0) {
+      ds = -(htt * gs - hst * gt) / det;
+      dt = -(hss * gt - hst * gs) / det;
+    }
+    if (!(det > 0.0 && hss > 0.0) || s + ds < 0.0 || s + ds > 1.0) { /* hold s */
+      ds = 0.0;
+      dt = htt > 0.0 ? -gt / htt : 0.0;
+    }
+    if (t + dt < 0.0 || t + dt > 1.0) { /* hold t (and s too, if it was held) */
+      dt = 0.0;
+      ds = (ds != 0.0 || !(hss > 0.0)) ? ds : -gs / hss;
+      if (s + ds < 0.0 || s + ds > 1.0) ds = 0.0;
+    }
+    double ns = fmin(1.0, fmax(0.0, s + ds)), nt = fmin(1.0, fmax(0.0, t + dt)), r[2], q[2], d[2];
+    cubic_eval(ca, ns, r, d);
+    cubic_eval(cb, nt, q, d);
+    double f = (r[0] - q[0]) * (r[0] - q[0]) + (r[1] - q[1]) * (r[1] - q[1]);
+    if (!(f < best)) break;
+    best = f;
     s = ns;
     t = nt;
   }
@@ -362,7 +384,8 @@ double lw_pair_segments_exact(const double a[8], const double b[8], double cutof
   if (rest > 0.0) {
     /* crossing or meeting at an angle: the subtraction; shallow: the tree */
     double sine = fabs(a1[0] * b1[1] - a1[1] * b1[0]) / (hypot(a1[0], a1[1]) * hypot(b1[0], b1[1]));
-    double u = smooth_step((sine - SINE_LO) / (SINE_HI - SINE_LO));
+    double u = fmax(smooth_step((sine - SINE_LO) / (SINE_HI - SINE_LO)),
+                    smooth_step((dist / half - CLOSE_LO) / (CLOSE_HI - CLOSE_LO)));
     if (u > 0.0) v += rest * u * subtracted(&ca, &cb, cutoff, ss, ts, ra, a1, rb, b1);
     rest *= 1.0 - u;
   }
