@@ -28,46 +28,107 @@ static void segment_eval(const lw_scene *sc, const lw_node *a, const lw_node *b,
                              (uint32_t)q};
 }
 
-/* Kernel sum of sample `me` (of spline `spline`) with every grid sample of
-** another spline whose index exceeds `after` (-1: all).  Cells and their
-** sorted entries are visited in a fixed order, so the sum depends on the
-** positions only. */
-static double neighbour_sum(const lw_cellgrid *g, const lw_pair_sample *all, const lw_pair_sample *me,
-                            uint32_t spline, long long after, const lw_pair_ctx *ctx)
+#if defined(__GNUC__)
+#define l_unlikely(x) __builtin_expect(!!(x), 0)
+#else
+#define l_unlikely(x) (x)
+#endif
+
+static lw_pair_tangent tangent_of(const lw_pair_sample *s)
 {
-  double sum = 0.0;
-  int cx, cy;
-  lw_cellgrid_locate(g, me->x, me->y, &cx, &cy);
-  for (int y = cy - 1; y <= cy + 1; y++) {
-    if (y < 0 || y >= g->ny) continue;
-    for (int x = cx - 1; x <= cx + 1; x++) {
-      if (x < 0 || x >= g->nx) continue;
-      const lw_cell *c = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
-      for (uint32_t k = 0; k < c->n; k++) {
-        const lw_pair_sample *o = &all[c->idx[k]];
-        if ((long long)c->idx[k] > after && o->spline != spline) sum += lw_pair_kernel(me, o, ctx);
+  return (lw_pair_tangent){s->dx, s->dy};
+}
+
+/* Where the pair term looks things up: the grid, the tangents, and the
+** splines' sample ranges (np samples per segment). */
+typedef struct {
+  const lw_cellgrid *g;
+  const lw_pair_tangent *pt;
+  const lw_splines *sp;
+  uint32_t np;
+  const lw_pair_ctx *ctx;
+} pair_view;
+
+/* Sample i at (x, y) with weight dl: the rest from its index. */
+static lw_pair_sample sample_of(const pair_view *v, uint32_t i, double x, double y, float dl)
+{
+  return (lw_pair_sample){x, y, v->pt[i].dx, v->pt[i].dy, dl, v->sp->seg_spline[i / v->np], i % v->np};
+}
+
+/* Sample i from the grid. */
+static lw_pair_sample sample_at(const pair_view *v, uint32_t i)
+{
+  double x, y;
+  float dl;
+  lw_cellgrid_get(v->g, i, &x, &y, &dl);
+  return sample_of(v, i, x, y, dl);
+}
+
+/* ---- near-field glue: the near-field rewrite replaces this function ----
+** The walk reports as near exactly the pairs inside the kernel's element and
+** exact zones (near_scale = zone_outer, pair.c), so adding lw_pair_kernel
+** over them gives the energy of the kernel of pair.h, every zone included. */
+static double near_glue(const pair_view *v, const lw_pair_sample *s, const lw_pair_nearlist *near,
+                        uint32_t from)
+{
+  double e = 0.0;
+  for (size_t k = 0; k < near->n; k++) {
+    if (near->idx[k] < from) continue;
+    lw_pair_sample o = sample_at(v, near->idx[k]);
+    e += lw_pair_kernel(s, &o, v->ctx);
+  }
+  return e;
+}
+
+/* Pair energy (no coefficient) of sample s with every grid sample of another
+** spline whose index is at least `from`. */
+static lw_status sample_pair(const pair_view *v, const lw_pair_sample *s, uint32_t from, lw_pair_nearlist *near,
+                             double *e)
+{
+  size_t g0 = lw_segment_index(v->sp, s->spline, 0), n = lw_splines_segments(v->sp, s->spline);
+  lw_pair_probe P = {s->x, s->y, s->dl, (uint32_t)(g0 * v->np), (uint32_t)((g0 + n) * v->np), from};
+  near->n = 0;
+  if (lw_pair_walk(v->g, v->ctx, &P, e, near) != LW_OK) return LW_ENOMEM;
+  if (l_unlikely(near->n)) *e += near_glue(v, s, near, from);
+  return LW_OK;
+}
+
+/* Pair energy (no coefficient) between the n samples `mine` of one spline
+** and every grid sample of another spline. */
+static lw_status pair_against(const pair_view *v, const lw_pair_sample *mine, size_t n, lw_pair_nearlist *near,
+                              double *e)
+{
+  double sum = 0.0, t;
+  for (size_t i = 0; i < n; i++) {
+    if (sample_pair(v, &mine[i], 0, near, &t) != LW_OK) return LW_ENOMEM;
+    sum += t;
+  }
+  *e = sum;
+  return LW_OK;
+}
+
+/* Every pair of samples of different splines once (j > i), the samples
+** taken cell by cell, in the grid's order, which depends on positions only. */
+static lw_status pair_all(const pair_view *v, double *e)
+{
+  lw_pair_nearlist near = {0};
+  const lw_cellgrid *g = v->g;
+  double sum = 0.0, t;
+  for (size_t ci = 0; ci < (size_t)g->nx * (size_t)g->ny; ci++) {
+    const lw_cell *c = &g->cell[ci];
+    const uint32_t *idx = lw_cell_idx(c);
+    for (uint32_t k = 0; k < c->n; k++) {
+      lw_pair_sample s = sample_of(v, idx[k], c->x[k], lw_cell_y(c)[k], lw_cell_dl(c)[k]);
+      if (sample_pair(v, &s, idx[k] + 1, &near, &t) != LW_OK) {
+        lw_pair_nearlist_free(&near);
+        return LW_ENOMEM;
       }
+      sum += t;
     }
   }
-  return sum;
-}
-
-/* Pair energy (no coefficient) between the n samples `mine` of spline
-** `spline` and every grid sample of another spline. */
-static double pair_against(const lw_cellgrid *g, const lw_pair_sample *all, const lw_pair_sample *mine,
-                           int n, uint32_t spline, const lw_pair_ctx *ctx)
-{
-  double sum = 0.0;
-  for (int i = 0; i < n; i++) sum += neighbour_sum(g, all, &mine[i], spline, -1, ctx);
-  return sum;
-}
-
-/* Every pair of samples of different splines once (j > i). */
-static double pair_all(const lw_cellgrid *g, const lw_pair_sample *all, size_t n, const lw_pair_ctx *ctx)
-{
-  double sum = 0.0;
-  for (size_t i = 0; i < n; i++) sum += neighbour_sum(g, all, &all[i], all[i].spline, (long long)i, ctx);
-  return sum;
+  lw_pair_nearlist_free(&near);
+  *e = sum;
+  return LW_OK;
 }
 
 static lw_cellgrid *grid_for(const lw_scene *sc, size_t n_samples, lw_error *err)
@@ -87,6 +148,17 @@ static double strain_of_spline(const lw_scene *sc, const lw_splines *sp, const d
   return e;
 }
 
+/* Puts the np pair samples ps of segment g into the grid and the tangents. */
+static lw_status store_samples(lw_cellgrid *grid, lw_pair_tangent *pt, size_t g, int np, const lw_pair_sample *ps)
+{
+  for (int q = 0; q < np; q++) {
+    size_t i = g * (size_t)np + (size_t)q;
+    if (lw_cellgrid_insert(grid, (uint32_t)i, ps[q].x, ps[q].y, ps[q].dl) != LW_OK) return LW_ENOMEM;
+    pt[i] = tangent_of(&ps[q]);
+  }
+  return LW_OK;
+}
+
 double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[LW_TERM_COUNT],
                          lw_error *err)
 {
@@ -94,54 +166,49 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
   const int np = sc->pair_quad.n;
   lw_samples s;
   double local[LW_TERM_COUNT];
-  lw_pair_sample *ps = NULL;
-  if (sc->on[LW_TERM_PAIR]) {
-    ps = malloc((sp->n_segments ? sp->n_segments : 1) * (size_t)np * sizeof *ps);
-    if (!ps) {
-      lw_error_set(err, LW_ENOMEM, "out of memory for %zu pair samples", sp->n_segments * (size_t)np);
-      return NAN;
-    }
-  }
+  lw_pair_sample seg_ps[LW_QUAD_MAX];
+  lw_pair_tangent *pt = NULL;
+  lw_cellgrid *grid = NULL;
+  size_t n = sp->n_segments * (size_t)np;
   double *seg_len = malloc((sp->n_segments ? sp->n_segments : 1) * sizeof *seg_len);
-  if (!seg_len) {
-    free(ps);
-    lw_error_set(err, LW_ENOMEM, "out of memory for %zu segments", sp->n_segments);
-    return NAN;
+  if (!seg_len) goto nomem;
+  if (sc->on[LW_TERM_PAIR]) {
+    if (!(pt = malloc((n ? n : 1) * sizeof *pt))) goto nomem;
+    if (!(grid = grid_for(sc, n, err))) goto fail;
   }
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
-    segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &seg_len[g], local, ps ? ps + g * (size_t)np : NULL);
+    segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &seg_len[g], local, pt ? seg_ps : NULL);
     for (int t = 0; t < sc->n_local; t++) term[sc->local[t]] += local[t];
+    if (pt && store_samples(grid, pt, g, np, seg_ps) != LW_OK) goto nomem;
   }
   if (sc->on[LW_TERM_STRAIN])
     for (size_t i = 0; i < sp->n_splines; i++) {
       double L = 0.0;
-      size_t g0 = lw_segment_index(sp, i, 0), n = lw_splines_segments(sp, i);
-      for (size_t m = 0; m < n; m++) L += seg_len[g0 + m];
+      size_t g0 = lw_segment_index(sp, i, 0), ns = lw_splines_segments(sp, i);
+      for (size_t m = 0; m < ns; m++) L += seg_len[g0 + m];
       term[LW_TERM_STRAIN] += strain_of_spline(sc, sp, seg_len, i, L);
     }
-  free(seg_len);
-  if (ps) {
-    size_t n = sp->n_segments * (size_t)np;
-    lw_cellgrid *g = grid_for(sc, n, err);
-    if (!g) {
-      free(ps);
-      return NAN;
-    }
-    for (size_t i = 0; i < n; i++)
-      if (lw_cellgrid_insert(g, (uint32_t)i, ps[i].x, ps[i].y) != LW_OK) {
-        lw_cellgrid_free(g);
-        free(ps);
-        lw_error_set(err, LW_ENOMEM, "out of memory filling the pair grid");
-        return NAN;
-      }
-    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pair_all(g, ps, n, &sc->pair);
-    lw_cellgrid_free(g);
-    free(ps);
+  if (grid) {
+    pair_view v = {grid, pt, sp, (uint32_t)np, &sc->pair};
+    double e;
+    if (pair_all(&v, &e) != LW_OK) goto nomem;
+    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * e;
   }
+  free(seg_len);
+  free(pt);
+  lw_cellgrid_free(grid);
   double total = 0.0;
   for (int t = 0; t < LW_TERM_COUNT; t++) total += term[t];
   return total;
+nomem:
+  lw_error_set(err, LW_ENOMEM, "out of memory for the energy of %zu segments (%zu pair samples)",
+               sp->n_segments, n);
+fail:
+  free(seg_len);
+  free(pt);
+  lw_cellgrid_free(grid);
+  return NAN;
 }
 
 lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
@@ -167,8 +234,8 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
       lw_model_free(m);
       return NULL;
     }
-    m->ps = malloc((n ? n : 1) * sizeof *m->ps);
-    if (!m->ps) goto nomem;
+    m->pt = malloc((n ? n : 1) * sizeof *m->pt);
+    if (!m->pt) goto nomem;
     m->grid = grid_for(sc, n, err);
     if (!m->grid) {
       lw_model_free(m);
@@ -192,7 +259,7 @@ void lw_model_free(lw_model *m)
   free(m->seg_len);
   free(m->seg_local);
   free(m->spline_len);
-  free(m->ps);
+  free(m->pt);
   lw_cellgrid_free(m->grid);
   free(m);
 }
@@ -212,12 +279,14 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
   double old_total = lw_model_total(m);
   double term[LW_TERM_COUNT] = {0};
   lw_samples s;
+  lw_pair_sample seg_ps[LW_QUAD_MAX];
+  if (m->grid) lw_cellgrid_clear(m->grid);
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
     double *local = m->seg_local + g * (size_t)nl;
-    segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &m->seg_len[g], local,
-                 m->ps ? m->ps + g * (size_t)np : NULL);
+    segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &m->seg_len[g], local, m->grid ? seg_ps : NULL);
     for (int t = 0; t < nl; t++) term[sc->local[t]] += local[t];
+    if (m->grid && store_samples(m->grid, m->pt, g, np, seg_ps) != LW_OK) return LW_ENOMEM;
   }
   for (size_t i = 0; i < sp->n_splines; i++) {
     size_t g0 = lw_segment_index(sp, i, 0), n = lw_splines_segments(sp, i);
@@ -227,11 +296,11 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
     if (sc->on[LW_TERM_STRAIN]) term[LW_TERM_STRAIN] += strain_of_spline(sc, sp, m->seg_len, i, L);
   }
   if (m->grid) {
-    size_t n = sp->n_segments * (size_t)np;
-    lw_cellgrid_clear(m->grid);
-    for (size_t i = 0; i < n; i++)
-      if (lw_cellgrid_insert(m->grid, (uint32_t)i, m->ps[i].x, m->ps[i].y) != LW_OK) return LW_ENOMEM;
-    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pair_all(m->grid, m->ps, n, &sc->pair);
+    pair_view v = {m->grid, m->pt, sp, (uint32_t)np, &sc->pair};
+    double e;
+    lw_cellgrid_fit(m->grid);
+    if (pair_all(&v, &e) != LW_OK) return LW_ENOMEM;
+    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * e;
   }
   double total = 0.0;
   for (int t = 0; t < LW_TERM_COUNT; t++) {
@@ -256,8 +325,9 @@ lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err)
     p->len = malloc(cap * sizeof *p->len);
     p->local = malloc(cap * (size_t)nl * sizeof *p->local);
     p->ps = malloc(cap * (size_t)m->scene->pair_quad.n * sizeof *p->ps);
+    p->ps_old = malloc(cap * (size_t)m->scene->pair_quad.n * sizeof *p->ps_old);
   }
-  if (!p || !p->node || !p->len || !p->local || !p->ps) {
+  if (!p || !p->node || !p->len || !p->local || !p->ps || !p->ps_old) {
     lw_proposal_free(p);
     lw_error_set(err, LW_ENOMEM, "out of memory for a proposal");
     return NULL;
@@ -272,7 +342,15 @@ void lw_proposal_free(lw_proposal *p)
   free(p->len);
   free(p->local);
   free(p->ps);
+  free(p->ps_old);
+  lw_pair_nearlist_free(&p->near);
   free(p);
+}
+
+void lw_model_pair_sample(const lw_model *m, uint32_t i, lw_pair_sample *s)
+{
+  pair_view v = {m->grid, m->pt, m->sp, (uint32_t)m->scene->pair_quad.n, &m->scene->pair};
+  *s = sample_at(&v, i);
 }
 
 /* Node k of the spline as it would be after the proposal. */
@@ -307,7 +385,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
     size_t m_loc = p->seg0 + j, g = g0 + m_loc;
     double *local = p->local + j * (size_t)nl;
     segment_eval(sc, proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1), spline, &s,
-                 &p->len[j], local, m->ps ? p->ps + j * (size_t)np : NULL);
+                 &p->len[j], local, m->grid ? p->ps + j * (size_t)np : NULL);
     const double *old = m->seg_local + g * (size_t)nl;
     for (int t = 0; t < nl; t++) {
       p->dterm[sc->local[t]] += local[t] - old[t];
@@ -340,12 +418,21 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   if (forbidden && !undefined) dE = INFINITY;
   /* The pair sum is the costly part: skip it when the move is already
   ** forbidden (+inf) or undefined (NaN). */
+  if (m->grid) {
+    size_t first = (g0 + p->seg0) * (size_t)np, n = p->n_seg * (size_t)np;
+    for (size_t k = 0; k < n; k++) lw_model_pair_sample(m, (uint32_t)(first + k), &p->ps_old[k]);
+  }
   if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
-    double pe = 0.0;
+    pair_view v = {m->grid, m->pt, sp, (uint32_t)np, &sc->pair};
+    double pe = 0.0, e_new, e_old;
     for (size_t j = 0; j < p->n_seg; j++) {
-      size_t g = g0 + p->seg0 + j;
-      pe += pair_against(m->grid, m->ps, p->ps + j * (size_t)np, np, spline, &sc->pair);
-      pe -= pair_against(m->grid, m->ps, m->ps + g * (size_t)np, np, spline, &sc->pair);
+      if (pair_against(&v, p->ps + j * (size_t)np, (size_t)np, &p->near, &e_new) != LW_OK ||
+          pair_against(&v, p->ps_old + j * (size_t)np, (size_t)np, &p->near, &e_old) != LW_OK) {
+        pe = NAN;
+        break;
+      }
+      pe += e_new;
+      pe -= e_old;
     }
     p->dterm[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pe;
     dE += p->dterm[LW_TERM_PAIR];
@@ -361,15 +448,16 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
   const size_t g0 = lw_segment_index(sp, p->spline, 0);
   if (m->grid) {
     size_t first = (g0 + p->seg0) * (size_t)np, n = p->n_seg * (size_t)np;
-    const lw_pair_sample *old = m->ps + first;
+    const lw_pair_sample *old = p->ps_old, *now = p->ps;
     for (size_t k = 0; k < n; k++)
-      if (lw_cellgrid_move(m->grid, (uint32_t)(first + k), old[k].x, old[k].y, p->ps[k].x, p->ps[k].y) != LW_OK) {
+      if (lw_cellgrid_move(m->grid, (uint32_t)(first + k), now[k].x, now[k].y, now[k].dl) != LW_OK) {
         /* Put the moved ones back: their old cells kept their capacity, so
         ** this cannot fail, and the model is as before the call. */
         for (size_t b = 0; b < k; b++)
-          lw_cellgrid_move(m->grid, (uint32_t)(first + b), p->ps[b].x, p->ps[b].y, old[b].x, old[b].y);
+          lw_cellgrid_move(m->grid, (uint32_t)(first + b), old[b].x, old[b].y, old[b].dl);
         return LW_ENOMEM;
       }
+    for (size_t k = 0; k < n; k++) m->pt[first + k] = tangent_of(&now[k]);
   }
   memcpy(&sp->node[sp->first[p->spline] + p->node0], p->node, p->n_node * sizeof *p->node);
   int nonfinite = 0;
@@ -377,7 +465,6 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
     size_t g = g0 + p->seg0 + j;
     m->seg_len[g] = p->len[j];
     memcpy(m->seg_local + g * (size_t)nl, p->local + j * (size_t)nl, (size_t)nl * sizeof *m->seg_local);
-    if (m->ps) memcpy(m->ps + g * (size_t)np, p->ps + j * (size_t)np, (size_t)np * sizeof *m->ps);
   }
   /* Summed afresh in a fixed order rather than updated by += dlen, so the
   ** cached length is a function of the state alone and a resumed run sees

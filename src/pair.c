@@ -300,6 +300,7 @@ void lw_pair_ctx_init(lw_pair_ctx *ctx, const lw_quad *q, double cutoff, double 
   ctx->zone_outer = PAIR_MID * ctx->near;
   if (ctx->zone_outer > 0.0 && ctx->zone_outer < PAIR_TOUCH) ctx->zone_outer = PAIR_TOUCH;
   ctx->zone_exact = ctx->near > PAIR_TOUCH ? ctx->near : PAIR_TOUCH;
+  ctx->near_scale = ctx->zone_outer; /* glue: see lw_pair_ctx */
   for (int i = 0; i < LW_QUAD_MAX; i++) {
     ctx->elem_lo[i] = 0.0;
     ctx->elem_hi[i] = 0.0;

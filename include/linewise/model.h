@@ -20,6 +20,18 @@
 #include "linewise/pair.h"
 #include "linewise/scene.h"
 #include "linewise/spline.h"
+#include "linewise/walk.h"
+
+/* What the model keeps of a pair sample besides the grid's position and
+** weight (grid.h): its tangent, 8 bytes.  The grid holds x, y and dl once,
+** in the structure-of-arrays form the walk reads; the spline and node of
+** sample i follow from i (quad.n samples per segment, segments of a spline
+** consecutive).  lw_model_pair_sample puts the pieces together.  Per
+** segment at 8 nodes: 8 x (24 in a cell + 4 home + 8 tangent) = 288 bytes
+** of pair data plus the cells' spare room, against 8 x (32 + 4) before. */
+typedef struct {
+  float dx, dy;          /* r' at the node, mm per unit s */
+} lw_pair_tangent;
 
 typedef struct {
   const lw_scene *scene;
@@ -28,8 +40,8 @@ typedef struct {
   double *seg_local;        /* n_segments * scene->n_local: cached local energies */
   double *spline_len;       /* n_splines, mm: sum of seg_len in segment order */
   double term[LW_TERM_COUNT]; /* running totals (0 for terms that are off) */
-  lw_pair_sample *ps;       /* n_segments * quad.n pair samples (pair on), else NULL */
-  lw_cellgrid *grid;        /* over ps (pair on), else NULL */
+  lw_pair_tangent *pt;      /* n_segments * quad.n pair samples' tangents (pair on), else NULL */
+  lw_cellgrid *grid;        /* the pair samples' positions and weights (pair on), else NULL */
   size_t max_segments;      /* longest spline, for sizing proposals */
 } lw_model;
 
@@ -53,6 +65,9 @@ typedef struct {
   double *len;                /* n_seg new segment lengths */
   double *local;              /* n_seg * n_local new local energies */
   lw_pair_sample *ps;         /* n_seg * quad.n new pair samples */
+  lw_pair_sample *ps_old;     /* n_seg * quad.n pair samples before the move (pair on; the
+                              ** walk's old side, and the undo of a failed commit) */
+  lw_pair_nearlist near;      /* the walk's near neighbours (walk.h) */
   double new_spline_len;
   double dterm[LW_TERM_COUNT];
   double dE;                  /* sum of dterm; +inf for a forbidden state, NaN never kept */
@@ -65,9 +80,13 @@ void lw_proposal_free(lw_proposal *p);
 /* Evaluates replacing n_node nodes of spline `spline` starting at local node
 ** node0 with `nodes` (copied into p; NULL: they are already in p->node).  Fills p->dterm and p->dE; the model is
 ** not changed.  Pure with respect to the model: several threads may propose
-** against one model if none commits meanwhile. */
+** against one model if none commits meanwhile.  Should the near list fail to
+** grow, the pair term's difference and dE are NaN: the move is rejected. */
 void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t node0,
                       size_t n_node, const lw_node *nodes);
+
+/* Pair sample i of the model (grid position and weight, tangent). */
+void lw_model_pair_sample(const lw_model *m, uint32_t i, lw_pair_sample *s);
 
 /* Applies an evaluated proposal.  LW_ENOMEM if the grid could not grow. */
 lw_status lw_model_commit(lw_model *m, const lw_proposal *p);

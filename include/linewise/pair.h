@@ -69,6 +69,9 @@ typedef struct {
   double zone_cap;      /* rc, or +inf: the element zone ends by the cutoff */
   double zone_outer;    /* outer radius of the element zone / dm; 0 = no near field */
   double zone_exact;    /* outer radius of the exact zone / dm */
+  double near_scale;    /* pairs with r < near_scale * dm are near (walk.h); 0 = none.
+                        ** Glue until the near-field rewrite: the radius inside which
+                        ** lw_pair_kernel is not the product rule (zone_outer). */
   double elem_lo[LW_QUAD_MAX]; /* s_q - e_q: element start before the node, in s */
   double elem_hi[LW_QUAD_MAX]; /* e_{q+1} - s_q: element end after the node, in s */
 } lw_pair_ctx;
