@@ -7,6 +7,8 @@
 
 /* Bytes of one entry across the four arrays of a cell's block. */
 #define ENTRY_BYTES (2 * sizeof(double) + sizeof(uint32_t) + sizeof(float))
+/* The walk reads entries in groups of four, past the last one (grid.h). */
+#define BLOCK_PAD (3 * sizeof(float))
 
 lw_cellgrid *lw_cellgrid_new(double x0, double y0, double w, double h, double cell,
                              size_t n_samples, lw_error *err)
@@ -71,7 +73,8 @@ static uint32_t cell_of(const lw_cellgrid *g, double x, double y)
 ** realloc'ed. */
 static lw_status cell_resize(lw_cell *c, uint32_t cap)
 {
-  double *blk = malloc((size_t)cap * ENTRY_BYTES);
+  /* zeroed, so that what the walk reads past the entries is defined */
+  double *blk = calloc(1, (size_t)cap * ENTRY_BYTES + BLOCK_PAD);
   if (!blk) return LW_ENOMEM;
   lw_cell to = {blk, c->n, cap};
   if (c->n) {

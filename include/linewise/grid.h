@@ -31,7 +31,9 @@
 
 #include "linewise/error.h"
 
-/* One block of cap entries: x[cap], y[cap], then idx[cap], dl[cap]. */
+/* One block of cap entries: x[cap], y[cap], then idx[cap], dl[cap], and 3
+** floats of padding, so that reading any array in groups of four from
+** entry 0 stays within the block (walk.c masks the entries past n). */
 typedef struct {
   double *x;       /* the block; NULL while cap = 0 */
   uint32_t n, cap; /* entries used, allocated */
