@@ -64,46 +64,40 @@ static lw_pair_sample sample_at(const pair_view *v, uint32_t i)
   return sample_of(v, i, x, y, dl);
 }
 
+/* The filter of the samples of spline i: pairs with samples of index >= from. */
+static lw_pair_filter filter_of(const pair_view *v, uint32_t spline, uint32_t from)
+{
+  size_t g0 = lw_segment_index(v->sp, spline, 0), n = lw_splines_segments(v->sp, spline);
+  return (lw_pair_filter){(uint32_t)(g0 * v->np), (uint32_t)((g0 + n) * v->np), from};
+}
+
 /* ---- near-field glue: the near-field rewrite replaces this function ----
 ** The walk reports as near exactly the pairs inside the kernel's element and
 ** exact zones (near_scale = zone_outer, pair.c), so adding lw_pair_kernel
-** over them gives the energy of the kernel of pair.h, every zone included. */
-static double near_glue(const pair_view *v, const lw_pair_sample *s, const lw_pair_nearlist *near,
-                        uint32_t from)
+** over them gives the energy of the kernel of pair.h, every zone included.
+** Probe k is sample s[k] with its scale in P[k]. */
+static double near_glue(const pair_view *v, const lw_pair_sample *const *s, const lw_pair_probe *P,
+                        const lw_pair_nearlist *near, uint32_t from)
 {
   double e = 0.0;
   for (size_t k = 0; k < near->n; k++) {
     if (near->idx[k] < from) continue;
     lw_pair_sample o = sample_at(v, near->idx[k]);
-    e += lw_pair_kernel(s, &o, v->ctx);
+    e += P[near->probe[k]].scale * lw_pair_kernel(s[near->probe[k]], &o, v->ctx);
   }
   return e;
 }
 
-/* Pair energy (no coefficient) of sample s with every grid sample of another
-** spline whose index is at least `from`. */
-static lw_status sample_pair(const pair_view *v, const lw_pair_sample *s, uint32_t from, lw_pair_nearlist *near,
-                             double *e)
+/* Pair energy (no coefficient) of the n probes P (samples s, all of spline
+** `spline`) with every grid sample of another spline whose index is at
+** least `from`, each probe's pairs counted P[k].scale times. */
+static lw_status probes_pair(const pair_view *v, const lw_pair_probe *P, const lw_pair_sample *const *s, size_t n,
+                             uint32_t spline, uint32_t from, lw_pair_nearlist *near, double *e)
 {
-  size_t g0 = lw_segment_index(v->sp, s->spline, 0), n = lw_splines_segments(v->sp, s->spline);
-  lw_pair_probe P = {s->x, s->y, s->dl, (uint32_t)(g0 * v->np), (uint32_t)((g0 + n) * v->np), from};
+  lw_pair_filter f = filter_of(v, spline, from);
   near->n = 0;
-  if (lw_pair_walk(v->g, v->ctx, &P, e, near) != LW_OK) return LW_ENOMEM;
-  if (l_unlikely(near->n)) *e += near_glue(v, s, near, from);
-  return LW_OK;
-}
-
-/* Pair energy (no coefficient) between the n samples `mine` of one spline
-** and every grid sample of another spline. */
-static lw_status pair_against(const pair_view *v, const lw_pair_sample *mine, size_t n, lw_pair_nearlist *near,
-                              double *e)
-{
-  double sum = 0.0, t;
-  for (size_t i = 0; i < n; i++) {
-    if (sample_pair(v, &mine[i], 0, near, &t) != LW_OK) return LW_ENOMEM;
-    sum += t;
-  }
-  *e = sum;
+  if (lw_pair_walk(v->g, v->ctx, P, n, &f, e, near) != LW_OK) return LW_ENOMEM;
+  if (l_unlikely(near->n)) *e += near_glue(v, s, P, near, from);
   return LW_OK;
 }
 
@@ -119,7 +113,9 @@ static lw_status pair_all(const pair_view *v, double *e)
     const uint32_t *idx = lw_cell_idx(c);
     for (uint32_t k = 0; k < c->n; k++) {
       lw_pair_sample s = sample_of(v, idx[k], c->x[k], lw_cell_y(c)[k], lw_cell_dl(c)[k]);
-      if (sample_pair(v, &s, idx[k] + 1, &near, &t) != LW_OK) {
+      const lw_pair_sample *sp = &s;
+      lw_pair_probe P = {s.x, s.y, s.dl, 1.0};
+      if (probes_pair(v, &P, &sp, 1, s.spline, idx[k] + 1, &near, &t) != LW_OK) {
         lw_pair_nearlist_free(&near);
         return LW_ENOMEM;
       }
@@ -326,8 +322,10 @@ lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err)
     p->local = malloc(cap * (size_t)nl * sizeof *p->local);
     p->ps = malloc(cap * (size_t)m->scene->pair_quad.n * sizeof *p->ps);
     p->ps_old = malloc(cap * (size_t)m->scene->pair_quad.n * sizeof *p->ps_old);
+    p->probe = malloc(2 * cap * (size_t)m->scene->pair_quad.n * sizeof *p->probe);
+    p->probe_sample = malloc(2 * cap * (size_t)m->scene->pair_quad.n * sizeof *p->probe_sample);
   }
-  if (!p || !p->node || !p->len || !p->local || !p->ps || !p->ps_old) {
+  if (!p || !p->node || !p->len || !p->local || !p->ps || !p->ps_old || !p->probe || !p->probe_sample) {
     lw_proposal_free(p);
     lw_error_set(err, LW_ENOMEM, "out of memory for a proposal");
     return NULL;
@@ -343,6 +341,8 @@ void lw_proposal_free(lw_proposal *p)
   free(p->local);
   free(p->ps);
   free(p->ps_old);
+  free(p->probe);
+  free(p->probe_sample);
   lw_pair_nearlist_free(&p->near);
   free(p);
 }
@@ -423,17 +423,17 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
     for (size_t k = 0; k < n; k++) lw_model_pair_sample(m, (uint32_t)(first + k), &p->ps_old[k]);
   }
   if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
+    /* the new samples add their pairs, the old ones take theirs away: one
+    ** walk over both */
     pair_view v = {m->grid, m->pt, sp, (uint32_t)np, &sc->pair};
-    double pe = 0.0, e_new, e_old;
-    for (size_t j = 0; j < p->n_seg; j++) {
-      if (pair_against(&v, p->ps + j * (size_t)np, (size_t)np, &p->near, &e_new) != LW_OK ||
-          pair_against(&v, p->ps_old + j * (size_t)np, (size_t)np, &p->near, &e_old) != LW_OK) {
-        pe = NAN;
-        break;
-      }
-      pe += e_new;
-      pe -= e_old;
+    size_t n = p->n_seg * (size_t)np;
+    for (size_t k = 0; k < 2 * n; k++) {
+      const lw_pair_sample *ps_k = k < n ? &p->ps[k] : &p->ps_old[k - n];
+      p->probe[k] = (lw_pair_probe){ps_k->x, ps_k->y, ps_k->dl, k < n ? 1.0 : -1.0};
+      p->probe_sample[k] = ps_k;
     }
+    double pe;
+    if (probes_pair(&v, p->probe, p->probe_sample, 2 * n, spline, 0, &p->near, &pe) != LW_OK) pe = NAN;
     p->dterm[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pe;
     dE += p->dterm[LW_TERM_PAIR];
   }

@@ -102,95 +102,123 @@ static inline v2d hi2d(v4f v)
 static inline v2l lo2l(v4i m) { return (v2l)__builtin_shufflevector(m, m, 0, 0, 1, 1); }
 static inline v2l hi2l(v4i m) { return (v2l)__builtin_shufflevector(m, m, 2, 2, 3, 3); }
 
-/* What the scan of a cell reads besides the cell: the probe and the
-** kernel's constants in every lane, set up once per walk. */
+/* A probe's constants in every lane, set up once per batch. */
 typedef struct {
   v2d x, y;
   v2d rc2;        /* far pairs need r^2 < rc2; -1 for a weightless probe */
-  v2d ns;         /* near_scale */
   v4f dl;
+  double scale;   /* scale dl: the factor on this probe's far pairs' dl_j (1/r - 1/rc) */
+  double gx[3], gy[3]; /* squared gaps to the columns and rows of the block (axis_gaps) */
+} probe_ctx;
+
+/* What every probe of a walk shares: the index filter, the near scale. */
+typedef struct {
   /* own spline: idx - lo < span, unsigned; SSE2 compares signed 32-bit
   ** lanes, so both sides carry the sign bit flipped: idx - (lo + 2^31) and
   ** span - 2^31, as int */
   v4u lo_flip;
   v4i span_flip;
   v4i from_flip;  /* idx >= from, flipped alike: idx - 2^31 >= from - 2^31 */
-} scan_ctx;
+  v2d ns;         /* near_scale */
+} shared_ctx;
 
 #define FLIP 0x80000000u
 
+/* The far buffer of a walk: (r^2, scale dl_j) pairs, flushed into sum. */
+typedef struct {
+  _Alignas(16) double r2[BUF];
+  _Alignas(16) double w[BUF];
+  uint32_t m;
+  double ic;
+  double sum;
+} far_buf;
+
 /*
-** Entries [k0, k1) of cell c, k1 - k0 <= BLOCK: far candidates are appended
-** to (r2b, wb) from m on, near ones to nidx from *nn on (room for k1 - k0 is
-** there).  The tests run on four entries at a time (two SSE2 vectors of
-** doubles, one of 32-bit lanes) and leave one bit per entry; the kept
+** Entries [k0, k1) of cell c, k1 - k0 <= BLOCK, against the probes of
+** `mask` (bits into pc): far pairs go to fb, near ones to the near list
+** (room for (k1 - k0) times the probes is there).  The tests run on four
+** entries at a time (two SSE2 vectors of doubles, one of 32-bit lanes):
+** what depends on the entries alone (loads, index filter, weights) once,
+** the distances per probe, leaving one bit per entry and probe; the kept
 ** entries are then copied by walking the set bits, so the geometry costs
 ** no mispredicted branches.  Groups read past k1 (the cell's block is
 ** padded, grid.h); those lanes are masked off.  `with_near` and
 ** `with_from` are constants at each call, so the common scan carries
 ** neither test.
 */
-static inline __attribute__((always_inline)) uint32_t
-scan(const lw_cell *c, uint32_t k0, uint32_t k1, const scan_ctx *s, double *r2b, double *wb, uint32_t m,
-     uint32_t *nidx, size_t *nn, const int with_near, const int with_from)
+static inline __attribute__((always_inline)) void
+scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const probe_ctx *pc, unsigned mask,
+     const uint32_t *probe_id, far_buf *fb, lw_pair_nearlist *near, const int with_near, const int with_from)
 {
-  _Alignas(16) double r2t[BLOCK];
+  _Alignas(16) double r2t[LW_PAIR_BATCH][BLOCK];
+  uint64_t far_bits[LW_PAIR_BATCH] = {0}, near_bits[LW_PAIR_BATCH] = {0};
   const double *xs = c->x, *ys = lw_cell_y(c);
   const uint32_t *id = lw_cell_idx(c);
   const float *dls = lw_cell_dl(c);
-  const v2d px = s->x, py = s->y, rc2 = s->rc2, ns = s->ns;
-  const v4f dl = s->dl, zero = {0.0f, 0.0f, 0.0f, 0.0f};
-  const v4u lo = s->lo_flip, flip = {FLIP, FLIP, FLIP, FLIP};
-  const v4i span = s->span_flip, from = s->from_flip;
-  uint64_t far_bits = 0, near_bits = 0;
+  const v4f zero = {0.0f, 0.0f, 0.0f, 0.0f};
+  const v4u flip = {FLIP, FLIP, FLIP, FLIP};
   for (uint32_t k = k0, t = 0; k < k1; k += 4, t += 4) {
     v4u j;
     v4f dlj;
     memcpy(&j, id + k, sizeof j);
     memcpy(&dlj, dls + k, sizeof dlj);
-    v4i own = (v4i)(j - lo) < span;
+    v4i own = (v4i)(j - sh->lo_flip) < sh->span_flip;
     v4i ok = ~own & (v4i)(dlj > zero);
-    if (with_from) ok &= (v4i)(j ^ flip) >= from;
-    v2d dx0 = load2(xs + k) - px, dx1 = load2(xs + k + 2) - px;
-    v2d dy0 = load2(ys + k) - py, dy1 = load2(ys + k + 2) - py;
-    v2d r0 = dx0 * dx0 + dy0 * dy0, r1 = dx1 * dx1 + dy1 * dy1;
-    memcpy(r2t + t, &r0, sizeof r0);
-    memcpy(r2t + t + 2, &r1, sizeof r1);
-    v2l f0 = (r0 < rc2) & lo2l(ok), f1 = (r1 < rc2) & hi2l(ok);
-    if (with_near) {
-      /* the kernel's own test: max of the float weights, then in double */
-      v4i big = dlj > dl;
-      v4f dm = (v4f)(((v4i)dlj & big) | ((v4i)dl & ~big));
-      v2d l0 = ns * lo2d(dm), l1 = ns * hi2d(dm);
-      v2l n0 = (r0 < l0 * l0) & ~lo2l(own), n1 = (r1 < l1 * l1) & ~hi2l(own);
-      f0 &= ~n0;
-      f1 &= ~n1;
-      near_bits |= (uint64_t)(bits2(n0) | bits2(n1) << 2) << t;
+    if (with_from) ok &= (v4i)(j ^ flip) >= sh->from_flip;
+    const v2l ok0 = lo2l(ok), ok1 = hi2l(ok);
+    const v2d x0 = load2(xs + k), x1 = load2(xs + k + 2), y0 = load2(ys + k), y1 = load2(ys + k + 2);
+    for (unsigned left = mask; left; left &= left - 1) {
+      unsigned b = (unsigned)__builtin_ctz(left);
+      const probe_ctx *q = &pc[b];
+      v2d dx0 = x0 - q->x, dx1 = x1 - q->x, dy0 = y0 - q->y, dy1 = y1 - q->y;
+      v2d r0 = dx0 * dx0 + dy0 * dy0, r1 = dx1 * dx1 + dy1 * dy1;
+      memcpy(r2t[b] + t, &r0, sizeof r0);
+      memcpy(r2t[b] + t + 2, &r1, sizeof r1);
+      v2l f0 = (r0 < q->rc2) & ok0, f1 = (r1 < q->rc2) & ok1;
+      if (with_near) {
+        /* the kernel's own test: max of the float weights, then in double */
+        v4i big = dlj > q->dl;
+        v4f dm = (v4f)(((v4i)dlj & big) | ((v4i)q->dl & ~big));
+        v2d l0 = sh->ns * lo2d(dm), l1 = sh->ns * hi2d(dm);
+        v2l n0 = (r0 < l0 * l0) & ~lo2l(own), n1 = (r1 < l1 * l1) & ~hi2l(own);
+        f0 &= ~n0;
+        f1 &= ~n1;
+        near_bits[b] |= (uint64_t)(bits2(n0) | bits2(n1) << 2) << t;
+      }
+      far_bits[b] |= (uint64_t)(bits2(f0) | bits2(f1) << 2) << t;
     }
-    far_bits |= (uint64_t)(bits2(f0) | bits2(f1) << 2) << t;
   }
   /* the lanes past k1 of the last group */
-  uint64_t valid = k1 - k0 == BLOCK ? ~(uint64_t)0 : ((uint64_t)1 << (k1 - k0)) - 1;
-  far_bits &= valid;
-  near_bits &= valid;
-  for (; far_bits; far_bits &= far_bits - 1) {
-    unsigned t = (unsigned)__builtin_ctzll(far_bits);
-    r2b[m] = r2t[t];
-    wb[m] = (double)dls[k0 + t];
-    m++;
+  const uint64_t valid = k1 - k0 == BLOCK ? ~(uint64_t)0 : ((uint64_t)1 << (k1 - k0)) - 1;
+  for (unsigned left = mask; left; left &= left - 1) {
+    unsigned b = (unsigned)__builtin_ctz(left);
+    const double scale = pc[b].scale;
+    uint32_t m = fb->m;
+    for (uint64_t bits = far_bits[b] & valid; bits; bits &= bits - 1) {
+      unsigned t = (unsigned)__builtin_ctzll(bits);
+      fb->r2[m] = r2t[b][t];
+      fb->w[m] = scale * (double)dls[k0 + t];
+      m++;
+    }
+    if (m >= BLOCK) {
+      fb->sum += flush(fb->r2, fb->w, m, fb->ic);
+      m = 0;
+    }
+    fb->m = m;
+    if (with_near)
+      for (uint64_t bits = near_bits[b] & valid; bits; bits &= bits - 1) {
+        unsigned t = (unsigned)__builtin_ctzll(bits);
+        near->idx[near->n] = id[k0 + t];
+        near->probe[near->n++] = probe_id[b];
+      }
   }
-  if (with_near) {
-    size_t n_near = *nn;
-    for (; near_bits; near_bits &= near_bits - 1) nidx[n_near++] = id[k0 + (unsigned)__builtin_ctzll(near_bits)];
-    *nn = n_near;
-  }
-  return m;
 }
 
 void lw_pair_nearlist_free(lw_pair_nearlist *l)
 {
   free(l->idx);
-  l->idx = NULL;
+  free(l->probe);
+  l->idx = l->probe = NULL;
   l->n = l->cap = 0;
 }
 
@@ -202,6 +230,9 @@ static lw_status nearlist_reserve(lw_pair_nearlist *l, size_t more)
   uint32_t *idx = realloc(l->idx, cap * sizeof *idx);
   if (!idx) return LW_ENOMEM;
   l->idx = idx;
+  uint32_t *probe = realloc(l->probe, cap * sizeof *probe);
+  if (!probe) return LW_ENOMEM;
+  l->probe = probe;
   l->cap = cap;
   return LW_OK;
 }
@@ -223,51 +254,85 @@ static void axis_gaps(double a, double h, int c, double p, double gap[3])
 ** point sits in its cell up to the rounding of (x - x0) / h. */
 #define GAP_MARGIN (1.0 + 1e-9)
 
-lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pair_probe *P, double *far,
-                       lw_pair_nearlist *near)
+/* The probes sel[0..nb-1] of P, all in cell (cx, cy): one pass over its
+** 3 x 3 block. */
+static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const shared_ctx *sh,
+                            const lw_pair_probe *P, const uint32_t *sel, int nb, int cx, int cy, int with_from,
+                            far_buf *fb, lw_pair_nearlist *near)
 {
-  _Alignas(16) double r2b[BUF], wb[BUF];
-  /* a weightless probe has no far pairs (its kernel is 0, even at r = 0) */
-  const double rc2 = P->dl != 0.0f ? ctx->cutoff2 : -1.0, ns = ctx->near_scale;
-  const uint32_t lo = P->lo + FLIP;
-  const int span = (int)((P->hi - P->lo) ^ FLIP), from = (int)(P->from ^ FLIP);
-  const scan_ctx s = {{P->x, P->x}, {P->y, P->y}, {rc2, rc2}, {ns, ns}, {P->dl, P->dl, P->dl, P->dl},
-                      {lo, lo, lo, lo}, {span, span, span, span}, {from, from, from, from}};
-  const double ic = ctx->inv_cutoff, h = 1.0 / g->inv_h, skip2 = ctx->cutoff2 * GAP_MARGIN;
-  double gx[3], gy[3];
-  const int with_near = ns > 0.0, with_from = P->from > 0;
-  double sum = 0.0;
-  uint32_t m = 0;
-  *far = 0.0;
-  int cx, cy;
-  lw_cellgrid_locate(g, P->x, P->y, &cx, &cy);
+  probe_ctx pc[LW_PAIR_BATCH];
+  const double h = 1.0 / g->inv_h, skip2 = ctx->cutoff2 * GAP_MARGIN;
+  const int with_near = ctx->near_scale > 0.0;
+  for (int b = 0; b < nb; b++) {
+    const lw_pair_probe *p = &P[sel[b]];
+    /* a weightless probe has no far pairs (its kernel is 0, even at r = 0) */
+    double rc2 = p->dl != 0.0f ? ctx->cutoff2 : -1.0;
+    pc[b] = (probe_ctx){{p->x, p->x}, {p->y, p->y}, {rc2, rc2}, {p->dl, p->dl, p->dl, p->dl},
+                        p->scale * (double)p->dl, {0}, {0}};
+    axis_gaps(g->x0, h, cx, p->x, pc[b].gx);
+    axis_gaps(g->y0, h, cy, p->y, pc[b].gy);
+  }
   const int x0 = cx > 0 ? cx - 1 : 0, x1 = cx + 1 < g->nx ? cx + 1 : g->nx - 1;
   const int y0 = cy > 0 ? cy - 1 : 0, y1 = cy + 1 < g->ny ? cy + 1 : g->ny - 1;
-  axis_gaps(g->x0, h, cx, P->x, gx);
-  axis_gaps(g->y0, h, cy, P->y, gy);
   for (int y = y0; y <= y1; y++) {
     const lw_cell *row = g->cell + (size_t)y * (size_t)g->nx;
     for (int x = x0; x <= x1; x++) {
       const lw_cell *c = row + x;
-      if (!c->n || gx[x - cx + 1] + gy[y - cy + 1] > skip2) continue;
+      if (!c->n) continue;
+      unsigned mask = 0;
+      for (int b = 0; b < nb; b++)
+        if (pc[b].gx[x - cx + 1] + pc[b].gy[y - cy + 1] <= skip2) mask |= 1u << b;
+      if (!mask) continue;
       for (uint32_t k0 = 0; k0 < c->n; k0 += BLOCK) {
         uint32_t k1 = c->n - k0 > BLOCK ? k0 + BLOCK : c->n;
         if (with_near) {
-          if (l_unlikely(nearlist_reserve(near, k1 - k0) != LW_OK)) return LW_ENOMEM;
-          m = with_from ? scan(c, k0, k1, &s, r2b, wb, m, near->idx, &near->n, 1, 1)
-                        : scan(c, k0, k1, &s, r2b, wb, m, near->idx, &near->n, 1, 0);
+          if (l_unlikely(nearlist_reserve(near, (size_t)(k1 - k0) * (size_t)nb) != LW_OK)) return LW_ENOMEM;
+          if (with_from) scan(c, k0, k1, sh, pc, mask, sel, fb, near, 1, 1);
+          else scan(c, k0, k1, sh, pc, mask, sel, fb, near, 1, 0);
         } else {
-          m = with_from ? scan(c, k0, k1, &s, r2b, wb, m, NULL, NULL, 0, 1)
-                        : scan(c, k0, k1, &s, r2b, wb, m, NULL, NULL, 0, 0);
-        }
-        if (m >= BLOCK) {
-          sum += flush(r2b, wb, m, ic);
-          m = 0;
+          if (with_from) scan(c, k0, k1, sh, pc, mask, sel, fb, NULL, 0, 1);
+          else scan(c, k0, k1, sh, pc, mask, sel, fb, NULL, 0, 0);
         }
       }
     }
   }
-  sum += flush(r2b, wb, m, ic);
-  *far = (double)P->dl * sum;
+  return LW_OK;
+}
+
+lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pair_probe *P, size_t n,
+                       const lw_pair_filter *f, double *far, lw_pair_nearlist *near)
+{
+  const uint32_t lo = f->lo + FLIP;
+  const int span = (int)((f->hi - f->lo) ^ FLIP), from = (int)(f->from ^ FLIP);
+  const shared_ctx sh = {{lo, lo, lo, lo}, {span, span, span, span}, {from, from, from, from},
+                         {ctx->near_scale, ctx->near_scale}};
+  far_buf fb;
+  fb.m = 0;
+  fb.ic = ctx->inv_cutoff;
+  fb.sum = 0.0;
+  *far = 0.0;
+  for (size_t c0 = 0; c0 < n; c0 += LW_PAIR_CHUNK) {
+    /* the chunk's probes in order of their cell (stable), so that each run
+    ** of one cell is one batch */
+    uint32_t cell[LW_PAIR_CHUNK], sel[LW_PAIR_CHUNK];
+    int nc = n - c0 < LW_PAIR_CHUNK ? (int)(n - c0) : LW_PAIR_CHUNK;
+    for (int i = 0; i < nc; i++) {
+      int cx, cy;
+      lw_cellgrid_locate(g, P[c0 + i].x, P[c0 + i].y, &cx, &cy);
+      cell[i] = (uint32_t)cy * (uint32_t)g->nx + (uint32_t)cx;
+      int k = i;
+      for (; k > 0 && cell[sel[k - 1] - c0] > cell[i]; k--) sel[k] = sel[k - 1];
+      sel[k] = (uint32_t)(c0 + (size_t)i);
+    }
+    for (int b = 0; b < nc;) {
+      uint32_t here = cell[sel[b] - c0];
+      int e = b + 1;
+      while (e < nc && e - b < LW_PAIR_BATCH && cell[sel[e] - c0] == here) e++;
+      int cx = (int)(here % (uint32_t)g->nx), cy = (int)(here / (uint32_t)g->nx);
+      if (walk_batch(g, ctx, &sh, P, sel + b, e - b, cx, cy, f->from > 0, &fb, near) != LW_OK) return LW_ENOMEM;
+      b = e;
+    }
+  }
+  *far = fb.sum + flush(fb.r2, fb.w, fb.m, fb.ic);
   return LW_OK;
 }

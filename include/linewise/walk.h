@@ -1,28 +1,37 @@
 /*
-** walk.h -- the pair term's walk over the cell grid: the far sum of one
-** sample against its neighbours, and the list of its near neighbours.
+** walk.h -- the pair term's walk over the cell grid: the far sum of a set of
+** samples (probes) against their neighbours, and the list of their near
+** neighbours.
 **
-** For a sample P (position, weight dl_P, its spline's index range) the walk
-** visits the 3 x 3 cells around P in a fixed order and, within each cell,
-** the samples in increasing index order (grid.h), so its results depend on
-** the positions alone.  For each neighbour j of another spline, with
-** r = |P - j| and dm = max(dl_P, dl_j):
+** For a probe P (position, weight dl_P) of the spline whose samples are
+** [lo, hi), the walk visits the cells of the 3 x 3 block around P's cell
+** that come closer to P than the cutoff, in a fixed order, and within each
+** cell its samples in increasing index order (grid.h).  For each neighbour
+** j of another spline, with r = |P - j| and dm = max(dl_P, dl_j):
 **
-**   near   r^2 < (ctx->near_scale * dm)^2: j is appended to the near list
-**          (whatever `from` says, so the caller sees every near pair), and
-**          j adds nothing to the far sum;
+**   near   r^2 < (ctx->near_scale * dm)^2: (P, j) is appended to the near
+**          list (whatever `from` says, so the caller sees every near pair),
+**          and the pair adds nothing to the far sum;
 **   far    otherwise, if r < rc, j >= from and both weights are non-zero:
-**          the product rule dl_P dl_j (1/r - 1/rc) joins the far sum
-**          (1/rc = ctx->inv_cutoff, 0 without a cutoff).
+**          scale_P dl_P dl_j (1/r - 1/rc) joins the far sum (1/rc =
+**          ctx->inv_cutoff, 0 without a cutoff).
 **
-** How it runs: a scalar, branch-free pass over a cell's four arrays keeps
-** the far candidates (r^2 and dl_j) in a small buffer; a vector pass over
-** the buffer evaluates dl_j (1/r - 1/rc), two lanes (SSE2) at a time with two
-** accumulators.  Only about a third of the candidates lie within the
-** cutoff, so the square roots and divisions run on those alone.  The buffer
-** is flushed at fixed points of the visiting order, so the summation order
-** is a function of the positions only: the same on every thread, and the
-** same after a resume that rebuilds the grid.
+** Near pairs lie within the cutoff (the near scale is capped so), so the
+** cells beyond it are skipped for them too.
+**
+** How it runs: the probes of one call are grouped by cell (in chunks of
+** LW_PAIR_CHUNK, at most LW_PAIR_BATCH to a group); a group shares its 3 x 3
+** block, so each cell is read once for all its probes: four entries at a
+** time, the index filter and weights once, the distances per probe, in SSE2
+** lanes, leaving a bit per entry and probe.  The far pairs (r^2 and
+** scale_P dl_P dl_j) are copied out by those bits into a buffer, where a
+** vector pass evaluates 1/r - 1/rc, two lanes at a time with two
+** accumulators: only about a third of the candidates lie within the
+** cutoff, so the square roots and divisions run on those alone.  The
+** buffer is flushed at fixed points of the visiting order, so the
+** summation order is a function of the positions and the probes only: the
+** same on every thread, and the same after a resume that rebuilds the
+** grid.
 */
 #ifndef LINEWISE_WALK_H
 #define LINEWISE_WALK_H
@@ -34,29 +43,40 @@
 #include "linewise/grid.h"
 #include "linewise/pair.h"
 
-/* Indices of near neighbours, appended in walk order.  The caller owns it
+#define LW_PAIR_BATCH 16 /* probes of one cell walked together */
+#define LW_PAIR_CHUNK 32 /* probes sorted by cell together */
+
+/* Near pairs, appended in walk order: probe[k] is the index into the
+** walk's probes, idx[k] the neighbour's sample index.  The caller owns it
 ** (a workspace or a proposal), empties it (n = 0) when it likes, and frees
 ** it; the walk grows it (amortised, doubling). */
 typedef struct {
   uint32_t *idx;
+  uint32_t *probe;
   size_t n, cap;
 } lw_pair_nearlist;
 
 void lw_pair_nearlist_free(lw_pair_nearlist *l);
 
-/* The sample a walk is for. */
+/* A sample a walk is for. */
 typedef struct {
   double x, y;      /* mm */
   float dl;         /* w_q |r'_q|, mm */
-  uint32_t lo, hi;  /* its spline's sample indices [lo, hi): never paired */
-  uint32_t from;    /* far pairs only with samples of index >= from (0: all) */
+  double scale;     /* its far pairs count scale times: +1, or -1 for the old
+                    ** samples of a move, whose pairs the move takes away */
 } lw_pair_probe;
 
-/* Sets *far to the far sum of P (no coefficient C) and appends P's near
-** neighbours to `near` (may be NULL when ctx->near_scale is 0).  LW_ENOMEM
-** if the near list could not grow (*far is then 0 and the list holds what
-** was found so far). */
-lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pair_probe *P, double *far,
-                       lw_pair_nearlist *near);
+/* What every probe of a walk shares. */
+typedef struct {
+  uint32_t lo, hi;  /* the probes' spline's sample indices [lo, hi): never paired */
+  uint32_t from;    /* far pairs only with samples of index >= from (0: all) */
+} lw_pair_filter;
+
+/* Sets *far to the far sum of the n probes P (no coefficient C) and
+** appends their near pairs to `near` (may be NULL when ctx->near_scale is
+** 0).  LW_ENOMEM if the near list could not grow (*far is then 0 and the
+** list holds what was found so far). */
+lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pair_probe *P, size_t n,
+                       const lw_pair_filter *f, double *far, lw_pair_nearlist *near);
 
 #endif
