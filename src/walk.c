@@ -190,21 +190,22 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
   }
   /* the lanes past k1 of the last group */
   const uint64_t valid = k1 - k0 == BLOCK ? ~(uint64_t)0 : ((uint64_t)1 << (k1 - k0)) - 1;
+  const float *dlk = dls + k0;
+  double *r2o = fb->r2, *wo = fb->w;
+  uint32_t m = fb->m;
   for (unsigned left = mask; left; left &= left - 1) {
     unsigned b = (unsigned)__builtin_ctz(left);
-    const double scale = pc[b].scale;
-    uint32_t m = fb->m;
+    const double scale = pc[b].scale, *r2b = r2t[b];
     for (uint64_t bits = far_bits[b] & valid; bits; bits &= bits - 1) {
       unsigned t = (unsigned)__builtin_ctzll(bits);
-      fb->r2[m] = r2t[b][t];
-      fb->w[m] = scale * (double)dls[k0 + t];
+      r2o[m] = r2b[t];
+      wo[m] = scale * (double)dlk[t];
       m++;
     }
     if (m >= BLOCK) {
-      fb->sum += flush(fb->r2, fb->w, m, fb->ic);
+      fb->sum += flush(r2o, wo, m, fb->ic);
       m = 0;
     }
-    fb->m = m;
     if (with_near)
       for (uint64_t bits = near_bits[b] & valid; bits; bits &= bits - 1) {
         unsigned t = (unsigned)__builtin_ctzll(bits);
@@ -212,6 +213,7 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
         near->probe[near->n++] = probe_id[b];
       }
   }
+  fb->m = m;
 }
 
 void lw_pair_nearlist_free(lw_pair_nearlist *l)
