@@ -91,9 +91,9 @@ double lw_pair_kernel_near(const lw_pair_sample *a, const lw_pair_sample *b, con
                            double r2, double ro);
 
 /* The kernel of one sample pair (no coefficient C), cutoff and near field
-** applied.  The caller skips pairs of the same spline.  Inline because the
-** neighbour walk calls it for every candidate and most are beyond the cutoff
-** or in the far field, which costs a comparison or one square root. */
+** applied.  The caller skips pairs of the same spline.  The neighbour walk
+** (walk.h) evaluates the far field itself, vectorised, and calls this for
+** the pairs it reports as near. */
 static inline double lw_pair_kernel(const lw_pair_sample *a, const lw_pair_sample *b, const lw_pair_ctx *ctx)
 {
   double dx = a->x - b->x, dy = a->y - b->y;
