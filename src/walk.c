@@ -15,11 +15,8 @@
 #define l_unlikely(x) (x)
 #endif
 
-/* Candidates scanned between looks at the far buffer: a flush at BLOCK or
-** more entries leaves none, and a block adds at most BLOCK, so the buffer
-** never holds more than 2 BLOCK - 1 (plus 3 entries of padding). */
-#define BLOCK 64 /* the bits of a uint64_t */
-#define BUF (2 * BLOCK + 4)
+/* Entries scanned per call of scan: the bits of a uint64_t. */
+#define BLOCK 64
 
 typedef double v2d __attribute__((vector_size(16)));
 
@@ -39,28 +36,6 @@ static inline v2d load2(const double *p)
   v2d v;
   memcpy(&v, p, sizeof v);
   return v;
-}
-
-/*
-** Sum of w[k] (1/sqrt(r2[k]) - ic) over k < m: the only part of the walk
-** that needs square roots and divisions, on far pairs only.  Two
-** accumulators of two lanes hide the latency of the divider; the entries
-** are padded to a multiple of four with w = 0, which adds exact zeros.
-*/
-static double flush(double *r2, double *w, uint32_t m, double ic)
-{
-  for (; m & 3; m++) {
-    r2[m] = 1.0;
-    w[m] = 0.0;
-  }
-  const v2d one = {1.0, 1.0}, icv = {ic, ic};
-  v2d s0 = {0.0, 0.0}, s1 = {0.0, 0.0};
-  for (uint32_t k = 0; k < m; k += 4) {
-    s0 += load2(w + k) * (one / vsqrt(load2(r2 + k)) - icv);
-    s1 += load2(w + k + 2) * (one / vsqrt(load2(r2 + k + 2)) - icv);
-  }
-  v2d s = s0 + s1;
-  return s[0] + s[1];
 }
 
 typedef long long v2l __attribute__((vector_size(16)));
@@ -107,7 +82,7 @@ typedef struct {
   v2d x, y;
   v2d rc2;        /* far pairs need r^2 < rc2; -1 for a weightless probe */
   v4f dl;
-  double scale;   /* scale dl: the factor on this probe's far pairs' dl_j (1/r - 1/rc) */
+  v2d scale;      /* scale dl: the factor on this probe's far pairs' dl_j (1/r - 1/rc) */
   double gx[3], gy[3]; /* squared gaps to the columns and rows of the block (axis_gaps) */
 } probe_ctx;
 
@@ -124,56 +99,55 @@ typedef struct {
 
 #define FLIP 0x80000000u
 
-/* The far buffer of a walk: (r^2, scale dl_j) pairs, flushed into sum. */
+/* The far sum of a walk: two accumulators of two lanes (entries 0, 1 and
+** 2, 3 of each group of four), which hide the divider's latency. */
 typedef struct {
-  _Alignas(16) double r2[BUF];
-  _Alignas(16) double w[BUF];
-  uint32_t m;
-  double ic;
-  double sum;
-} far_buf;
+  v2d s0, s1;
+  v2d ic;
+} far_acc;
 
 /*
 ** Entries [k0, k1) of cell c, k1 - k0 <= BLOCK, against the probes of
-** `mask` (bits into pc): far pairs go to fb, near ones to the near list
-** (room for (k1 - k0) times the probes is there).  The tests run on four
-** entries at a time (two SSE2 vectors of doubles, one of 32-bit lanes):
-** what depends on the entries alone (loads, index filter, weights) once,
-** the distances per probe, leaving one bit per entry and probe; the kept
-** entries are then copied by walking the set bits, so the geometry costs
-** no mispredicted branches.  Groups read past k1 (the cell's block is
-** padded, grid.h); those lanes are masked off.  `with_near` and
-** `with_from` are constants at each call, so the common scan carries
-** neither test.
+** `mask` (bits into pc): far pairs go to fa, near ones to the near list
+** (room for (k1 - k0) times the probes is there).  Four entries at a time
+** (two SSE2 vectors of doubles, one of 32-bit lanes): what depends on the
+** entries alone (loads, index filter, weights) once, the distances per
+** probe.  The kernel runs on the four lanes of a probe and group only if
+** one of them is a far pair; the others are masked to +0.  Groups read past
+** k1 (the cell's block is padded, grid.h); those lanes are masked off.
+** `with_near` and `with_from` are constants at each call, so the common scan
+** carries neither test.
 */
 static inline __attribute__((always_inline)) void
 scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const probe_ctx *pc, unsigned mask,
-     const uint32_t *probe_id, far_buf *fb, lw_pair_nearlist *near, const int with_near, const int with_from)
+     const uint32_t *probe_id, far_acc *fa, lw_pair_nearlist *near, const int with_near, const int with_from)
 {
-  _Alignas(16) double r2t[LW_PAIR_BATCH][BLOCK];
-  uint64_t far_bits[LW_PAIR_BATCH] = {0}, near_bits[LW_PAIR_BATCH] = {0};
+  uint64_t near_bits[LW_PAIR_BATCH] = {0};
   const double *xs = c->x, *ys = lw_cell_y(c);
   const uint32_t *id = lw_cell_idx(c);
   const float *dls = lw_cell_dl(c);
   const v4f zero = {0.0f, 0.0f, 0.0f, 0.0f};
   const v4u flip = {FLIP, FLIP, FLIP, FLIP};
+  const v4i lane = {0, 1, 2, 3};
+  const v2d one = {1.0, 1.0};
+  v2d s0 = fa->s0, s1 = fa->s1;
   for (uint32_t k = k0, t = 0; k < k1; k += 4, t += 4) {
     v4u j;
     v4f dlj;
     memcpy(&j, id + k, sizeof j);
     memcpy(&dlj, dls + k, sizeof dlj);
-    v4i own = (v4i)(j - sh->lo_flip) < sh->span_flip;
+    const v4i left_in_block = {(int)(k1 - k), (int)(k1 - k), (int)(k1 - k), (int)(k1 - k)};
+    v4i own = ((v4i)(j - sh->lo_flip) < sh->span_flip) | (lane >= left_in_block);
     v4i ok = ~own & (v4i)(dlj > zero);
     if (with_from) ok &= (v4i)(j ^ flip) >= sh->from_flip;
     const v2l ok0 = lo2l(ok), ok1 = hi2l(ok);
     const v2d x0 = load2(xs + k), x1 = load2(xs + k + 2), y0 = load2(ys + k), y1 = load2(ys + k + 2);
+    const v2d w0 = lo2d(dlj), w1 = hi2d(dlj);
     for (unsigned left = mask; left; left &= left - 1) {
       unsigned b = (unsigned)__builtin_ctz(left);
       const probe_ctx *q = &pc[b];
       v2d dx0 = x0 - q->x, dx1 = x1 - q->x, dy0 = y0 - q->y, dy1 = y1 - q->y;
       v2d r0 = dx0 * dx0 + dy0 * dy0, r1 = dx1 * dx1 + dy1 * dy1;
-      memcpy(r2t[b] + t, &r0, sizeof r0);
-      memcpy(r2t[b] + t + 2, &r1, sizeof r1);
       v2l f0 = (r0 < q->rc2) & ok0, f1 = (r1 < q->rc2) & ok1;
       if (with_near) {
         /* the kernel's own test: max of the float weights, then in double */
@@ -185,35 +159,24 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
         f1 &= ~n1;
         near_bits[b] |= (uint64_t)(bits2(n0) | bits2(n1) << 2) << t;
       }
-      far_bits[b] |= (uint64_t)(bits2(f0) | bits2(f1) << 2) << t;
+      if (bits2(f0 | f1)) {
+        v2d v0 = (w0 * q->scale) * (one / vsqrt(r0) - fa->ic), v1 = (w1 * q->scale) * (one / vsqrt(r1) - fa->ic);
+        s0 += (v2d)((v2l)v0 & f0);
+        s1 += (v2d)((v2l)v1 & f1);
+      }
     }
   }
-  /* the lanes past k1 of the last group */
-  const uint64_t valid = k1 - k0 == BLOCK ? ~(uint64_t)0 : ((uint64_t)1 << (k1 - k0)) - 1;
-  const float *dlk = dls + k0;
-  double *r2o = fb->r2, *wo = fb->w;
-  uint32_t m = fb->m;
-  for (unsigned left = mask; left; left &= left - 1) {
-    unsigned b = (unsigned)__builtin_ctz(left);
-    const double scale = pc[b].scale, *r2b = r2t[b];
-    for (uint64_t bits = far_bits[b] & valid; bits; bits &= bits - 1) {
-      unsigned t = (unsigned)__builtin_ctzll(bits);
-      r2o[m] = r2b[t];
-      wo[m] = scale * (double)dlk[t];
-      m++;
-    }
-    if (m >= BLOCK) {
-      fb->sum += flush(r2o, wo, m, fb->ic);
-      m = 0;
-    }
-    if (with_near)
-      for (uint64_t bits = near_bits[b] & valid; bits; bits &= bits - 1) {
+  fa->s0 = s0;
+  fa->s1 = s1;
+  if (with_near)
+    for (unsigned left = mask; left; left &= left - 1) {
+      unsigned b = (unsigned)__builtin_ctz(left);
+      for (uint64_t bits = near_bits[b]; bits; bits &= bits - 1) {
         unsigned t = (unsigned)__builtin_ctzll(bits);
         near->idx[near->n] = id[k0 + t];
         near->probe[near->n++] = probe_id[b];
       }
-  }
-  fb->m = m;
+    }
 }
 
 void lw_pair_nearlist_free(lw_pair_nearlist *l)
@@ -260,7 +223,7 @@ static void axis_gaps(double a, double h, int c, double p, double gap[3])
 ** 3 x 3 block. */
 static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const shared_ctx *sh,
                             const lw_pair_probe *P, const uint32_t *sel, int nb, int cx, int cy, int with_from,
-                            far_buf *fb, lw_pair_nearlist *near)
+                            far_acc *fa, lw_pair_nearlist *near)
 {
   probe_ctx pc[LW_PAIR_BATCH];
   const double h = 1.0 / g->inv_h, skip2 = ctx->cutoff2 * GAP_MARGIN;
@@ -270,7 +233,7 @@ static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
     /* a weightless probe has no far pairs (its kernel is 0, even at r = 0) */
     double rc2 = p->dl != 0.0f ? ctx->cutoff2 : -1.0;
     pc[b] = (probe_ctx){{p->x, p->x}, {p->y, p->y}, {rc2, rc2}, {p->dl, p->dl, p->dl, p->dl},
-                        p->scale * (double)p->dl, {0}, {0}};
+                        {p->scale * (double)p->dl, p->scale * (double)p->dl}, {0}, {0}};
     axis_gaps(g->x0, h, cx, p->x, pc[b].gx);
     axis_gaps(g->y0, h, cy, p->y, pc[b].gy);
   }
@@ -289,11 +252,11 @@ static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
         uint32_t k1 = c->n - k0 > BLOCK ? k0 + BLOCK : c->n;
         if (with_near) {
           if (l_unlikely(nearlist_reserve(near, (size_t)(k1 - k0) * (size_t)nb) != LW_OK)) return LW_ENOMEM;
-          if (with_from) scan(c, k0, k1, sh, pc, mask, sel, fb, near, 1, 1);
-          else scan(c, k0, k1, sh, pc, mask, sel, fb, near, 1, 0);
+          if (with_from) scan(c, k0, k1, sh, pc, mask, sel, fa, near, 1, 1);
+          else scan(c, k0, k1, sh, pc, mask, sel, fa, near, 1, 0);
         } else {
-          if (with_from) scan(c, k0, k1, sh, pc, mask, sel, fb, NULL, 0, 1);
-          else scan(c, k0, k1, sh, pc, mask, sel, fb, NULL, 0, 0);
+          if (with_from) scan(c, k0, k1, sh, pc, mask, sel, fa, NULL, 0, 1);
+          else scan(c, k0, k1, sh, pc, mask, sel, fa, NULL, 0, 0);
         }
       }
     }
@@ -308,10 +271,7 @@ lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pa
   const int span = (int)((f->hi - f->lo) ^ FLIP), from = (int)(f->from ^ FLIP);
   const shared_ctx sh = {{lo, lo, lo, lo}, {span, span, span, span}, {from, from, from, from},
                          {ctx->near_scale, ctx->near_scale}};
-  far_buf fb;
-  fb.m = 0;
-  fb.ic = ctx->inv_cutoff;
-  fb.sum = 0.0;
+  far_acc fa = {{0.0, 0.0}, {0.0, 0.0}, {ctx->inv_cutoff, ctx->inv_cutoff}};
   *far = 0.0;
   for (size_t c0 = 0; c0 < n; c0 += LW_PAIR_CHUNK) {
     /* the chunk's probes in order of their cell (stable), so that each run
@@ -331,10 +291,11 @@ lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pa
       int e = b + 1;
       while (e < nc && e - b < LW_PAIR_BATCH && cell[sel[e] - c0] == here) e++;
       int cx = (int)(here % (uint32_t)g->nx), cy = (int)(here / (uint32_t)g->nx);
-      if (walk_batch(g, ctx, &sh, P, sel + b, e - b, cx, cy, f->from > 0, &fb, near) != LW_OK) return LW_ENOMEM;
+      if (walk_batch(g, ctx, &sh, P, sel + b, e - b, cx, cy, f->from > 0, &fa, near) != LW_OK) return LW_ENOMEM;
       b = e;
     }
   }
-  *far = fb.sum + flush(fb.r2, fb.w, fb.m, fb.ic);
+  v2d sum = fa.s0 + fa.s1;
+  *far = sum[0] + sum[1];
   return LW_OK;
 }
