@@ -1,4 +1,4 @@
-/* walk.c -- the far sum and the near list of one sample over the cell grid (walk.h). */
+/* walk.c -- the far sum and the near pairs of a set of samples over the cell grid (walk.h). */
 #include "linewise/walk.h"
 
 #include <math.h>
@@ -113,8 +113,9 @@ typedef struct {
 ** (two SSE2 vectors of doubles, one of 32-bit lanes): what depends on the
 ** entries alone (loads, index filter, weights) once, the distances per
 ** probe.  The kernel runs on the four lanes of a probe and group only if
-** one of them is a far pair; the others are masked to +0.  Groups read past
-** k1 (the cell's block is padded, grid.h); those lanes are masked off.
+** one of them is a far pair; the others are masked to +0 (whatever inf or
+** NaN they held).  Groups read past k1 (the cell's block is padded,
+** grid.h); those lanes are masked off.
 ** `with_near` and `with_from` are constants at each call, so the common scan
 ** carries neither test.
 */
@@ -137,8 +138,9 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
     memcpy(&j, id + k, sizeof j);
     memcpy(&dlj, dls + k, sizeof dlj);
     const v4i left_in_block = {(int)(k1 - k), (int)(k1 - k), (int)(k1 - k), (int)(k1 - k)};
-    v4i own = ((v4i)(j - sh->lo_flip) < sh->span_flip) | (lane >= left_in_block);
-    v4i ok = ~own & (v4i)(dlj > zero);
+    /* never paired: samples of the probes' own spline, lanes past k1 */
+    v4i skip = ((v4i)(j - sh->lo_flip) < sh->span_flip) | (lane >= left_in_block);
+    v4i ok = ~skip & (v4i)(dlj > zero);
     if (with_from) ok &= (v4i)(j ^ flip) >= sh->from_flip;
     const v2l ok0 = lo2l(ok), ok1 = hi2l(ok);
     const v2d x0 = load2(xs + k), x1 = load2(xs + k + 2), y0 = load2(ys + k), y1 = load2(ys + k + 2);
@@ -154,7 +156,7 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
         v4i big = dlj > q->dl;
         v4f dm = (v4f)(((v4i)dlj & big) | ((v4i)q->dl & ~big));
         v2d l0 = sh->ns * lo2d(dm), l1 = sh->ns * hi2d(dm);
-        v2l n0 = (r0 < l0 * l0) & ~lo2l(own), n1 = (r1 < l1 * l1) & ~hi2l(own);
+        v2l n0 = (r0 < l0 * l0) & ~lo2l(skip), n1 = (r1 < l1 * l1) & ~hi2l(skip);
         f0 &= ~n0;
         f1 &= ~n1;
         near_bits[b] |= (uint64_t)(bits2(n0) | bits2(n1) << 2) << t;
