@@ -81,9 +81,10 @@ static double near_glue(const pair_view *v, const lw_pair_sample *const *s, cons
 {
   double e = 0.0;
   for (size_t k = 0; k < near->n; k++) {
-    if (near->idx[k] < from) continue;
-    lw_pair_sample o = sample_at(v, near->idx[k]);
-    e += P[near->probe[k]].scale * lw_pair_kernel(s[near->probe[k]], &o, v->ctx);
+    const lw_pair_near *q = &near->pair[k];
+    if (q->idx < from) continue;
+    lw_pair_sample o = sample_of(v, q->idx, q->x, q->y, q->dl);
+    e += P[q->probe].scale * lw_pair_kernel(s[q->probe], &o, v->ctx);
   }
   return e;
 }

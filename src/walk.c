@@ -174,18 +174,16 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
     for (unsigned left = mask; left; left &= left - 1) {
       unsigned b = (unsigned)__builtin_ctz(left);
       for (uint64_t bits = near_bits[b]; bits; bits &= bits - 1) {
-        unsigned t = (unsigned)__builtin_ctzll(bits);
-        near->idx[near->n] = id[k0 + t];
-        near->probe[near->n++] = probe_id[b];
+        uint32_t k = k0 + (uint32_t)__builtin_ctzll(bits);
+        near->pair[near->n++] = (lw_pair_near){xs[k], ys[k], dls[k], id[k], probe_id[b]};
       }
     }
 }
 
 void lw_pair_nearlist_free(lw_pair_nearlist *l)
 {
-  free(l->idx);
-  free(l->probe);
-  l->idx = l->probe = NULL;
+  free(l->pair);
+  l->pair = NULL;
   l->n = l->cap = 0;
 }
 
@@ -194,12 +192,9 @@ static lw_status nearlist_reserve(lw_pair_nearlist *l, size_t more)
   if (l->cap - l->n >= more) return LW_OK;
   size_t cap = l->cap ? 2 * l->cap : 64;
   while (cap - l->n < more) cap *= 2;
-  uint32_t *idx = realloc(l->idx, cap * sizeof *idx);
-  if (!idx) return LW_ENOMEM;
-  l->idx = idx;
-  uint32_t *probe = realloc(l->probe, cap * sizeof *probe);
-  if (!probe) return LW_ENOMEM;
-  l->probe = probe;
+  lw_pair_near *pair = realloc(l->pair, cap * sizeof *pair);
+  if (!pair) return LW_ENOMEM;
+  l->pair = pair;
   l->cap = cap;
   return LW_OK;
 }

@@ -95,7 +95,11 @@ static void check(double near_scale, int with_from)
     cr_assert(lw_close_rel(far, far_want, 1e-12, 1e-12), "spline %u: far %.17g, brute force %.17g", spline, far,
               far_want);
     cr_assert_eq(near.n, n_want, "spline %u: %zu near pairs, brute force %zu", spline, near.n, n_want);
-    for (size_t k = 0; k < near.n; k++) got[k] = (uint64_t)near.probe[k] << 32 | near.idx[k];
+    for (size_t k = 0; k < near.n; k++) {
+      const lw_pair_near *q = &near.pair[k];
+      cr_assert(q->x == s.x[q->idx] && q->y == s.y[q->idx] && q->dl == s.dl[q->idx]);
+      got[k] = (uint64_t)q->probe << 32 | q->idx;
+    }
     qsort(got, near.n, sizeof *got, cmp_u64);
     qsort(want, n_want, sizeof *want, cmp_u64);
     for (size_t k = 0; k < n_want; k++) cr_assert_eq(got[k], want[k], "spline %u: near pair %zu", spline, k);
@@ -152,7 +156,8 @@ Test(walk, independent_of_insertion_history)
     cr_assert_eq(lw_pair_walk(b.g, &b.ctx, P, n, &f, &fb, &nb), LW_OK);
     cr_assert_eq(fa, fb, "spline %u: %.17g against %.17g", spline, fa, fb);
     cr_assert_eq(na.n, nb.n);
-    for (size_t k = 0; k < na.n; k++) cr_assert(na.idx[k] == nb.idx[k] && na.probe[k] == nb.probe[k]);
+    for (size_t k = 0; k < na.n; k++)
+      cr_assert(na.pair[k].idx == nb.pair[k].idx && na.pair[k].probe == nb.pair[k].probe);
   }
   lw_pair_nearlist_free(&na);
   lw_pair_nearlist_free(&nb);

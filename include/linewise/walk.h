@@ -10,8 +10,8 @@
 ** j of another spline, with r = |P - j| and dm = max(dl_P, dl_j):
 **
 **   near   r^2 < (ctx->near_scale * dm)^2: (P, j) is appended to the near
-**          list (whatever `from` says, so the caller sees every near pair),
-**          and the pair adds nothing to the far sum;
+**          list with j's position and weight (whatever `from` says, so the
+**          caller sees every near pair), and adds nothing to the far sum;
 **   far    otherwise, if r < rc, j >= from and both weights are non-zero:
 **          scale_P dl_P dl_j (1/r - 1/rc) joins the far sum (1/rc =
 **          ctx->inv_cutoff, 0 without a cutoff).
@@ -46,13 +46,19 @@
 #define LW_PAIR_BATCH 16 /* probes of one cell walked together */
 #define LW_PAIR_CHUNK 32 /* probes sorted by cell together */
 
-/* Near pairs, appended in walk order: probe[k] is the index into the
-** walk's probes, idx[k] the neighbour's sample index.  The caller owns it
-** (a workspace or a proposal), empties it (n = 0) when it likes, and frees
-** it; the walk grows it (amortised, doubling). */
+/* One near pair: the neighbour as the grid holds it, and the probe. */
 typedef struct {
-  uint32_t *idx;
-  uint32_t *probe;
+  double x, y;     /* the neighbour's position, mm */
+  float dl;        /* its weight, mm */
+  uint32_t idx;    /* its sample index */
+  uint32_t probe;  /* the probe's index in the walk's probes */
+} lw_pair_near;
+
+/* Near pairs, appended in walk order.  The caller owns the list (a
+** workspace or a proposal), empties it (n = 0) when it likes, and frees it;
+** the walk grows it (amortised, doubling). */
+typedef struct {
+  lw_pair_near *pair;
   size_t n, cap;
 } lw_pair_nearlist;
 
