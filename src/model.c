@@ -425,12 +425,13 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   }
   if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
     /* the new samples add their pairs, the old ones take theirs away: one
-    ** walk over both */
+    ** walk over both, each new sample next to its old self (usually in the
+    ** same cell: shorter moves in the walk's sort by cell) */
     pair_view v = {m->grid, m->pt, sp, (uint32_t)np, &sc->pair};
     size_t n = p->n_seg * (size_t)np;
     for (size_t k = 0; k < 2 * n; k++) {
-      const lw_pair_sample *ps_k = k < n ? &p->ps[k] : &p->ps_old[k - n];
-      p->probe[k] = (lw_pair_probe){ps_k->x, ps_k->y, ps_k->dl, k < n ? 1.0 : -1.0};
+      const lw_pair_sample *ps_k = k & 1 ? &p->ps_old[k / 2] : &p->ps[k / 2];
+      p->probe[k] = (lw_pair_probe){ps_k->x, ps_k->y, ps_k->dl, k & 1 ? -1.0 : 1.0};
       p->probe_sample[k] = ps_k;
     }
     double pe;

@@ -67,7 +67,7 @@ typedef struct {
   lw_pair_sample *ps;         /* n_seg * quad.n new pair samples */
   lw_pair_sample *ps_old;     /* n_seg * quad.n pair samples before the move (pair on; the
                               ** walk's old side, and the undo of a failed commit) */
-  lw_pair_probe *probe;       /* 2 n_seg quad.n: the new, then the old samples, as probes */
+  lw_pair_probe *probe;       /* 2 n_seg quad.n: each new sample, then its old self, as probes */
   const lw_pair_sample **probe_sample; /* the sample of each probe */
   lw_pair_nearlist near;      /* the walk's near pairs (walk.h) */
   double new_spline_len;
