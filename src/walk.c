@@ -95,6 +95,7 @@ typedef struct {
   v4i span_flip;
   v4i from_flip;  /* idx >= from, flipped alike: idx - 2^31 >= from - 2^31 */
   v2d ns;         /* near_scale */
+  v2d cut2;       /* rc^2: near pairs lie within the cutoff too */
 } shared_ctx;
 
 #define FLIP 0x80000000u
@@ -156,7 +157,8 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
         v4i big = dlj > q->dl;
         v4f dm = (v4f)(((v4i)dlj & big) | ((v4i)q->dl & ~big));
         v2d l0 = sh->ns * lo2d(dm), l1 = sh->ns * hi2d(dm);
-        v2l n0 = (r0 < l0 * l0) & ~lo2l(skip), n1 = (r1 < l1 * l1) & ~hi2l(skip);
+        v2l n0 = (r0 < l0 * l0) & (r0 < sh->cut2) & ~lo2l(skip);
+        v2l n1 = (r1 < l1 * l1) & (r1 < sh->cut2) & ~hi2l(skip);
         f0 &= ~n0;
         f1 &= ~n1;
         near_bits[b] |= (uint64_t)(bits2(n0) | bits2(n1) << 2) << t;
@@ -267,7 +269,7 @@ lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pa
   const uint32_t lo = f->lo + FLIP;
   const int span = (int)((f->hi - f->lo) ^ FLIP), from = (int)(f->from ^ FLIP);
   const shared_ctx sh = {{lo, lo, lo, lo}, {span, span, span, span}, {from, from, from, from},
-                         {ctx->near_scale, ctx->near_scale}};
+                         {ctx->near_scale, ctx->near_scale}, {ctx->cutoff2, ctx->cutoff2}};
   far_acc fa = {{0.0, 0.0}, {0.0, 0.0}, {ctx->inv_cutoff, ctx->inv_cutoff}};
   *far = 0.0;
   for (size_t c0 = 0; c0 < n; c0 += LW_PAIR_CHUNK) {

@@ -51,7 +51,7 @@ static double brute(const scene *s, const lw_pair_probe *P, size_t n, const lw_p
       if (j >= f->lo && j < f->hi) continue;
       double dx = s->x[j] - P[p].x, dy = s->y[j] - P[p].y, r2 = dx * dx + dy * dy;
       double lim = s->ctx.near_scale * (double)(P[p].dl > s->dl[j] ? P[p].dl : s->dl[j]);
-      if (r2 < lim * lim) near[(*n_near)++] = (uint64_t)p << 32 | j;
+      if (r2 < lim * lim && r2 < s->ctx.cutoff2) near[(*n_near)++] = (uint64_t)p << 32 | j;
       else if (r2 < s->ctx.cutoff2 && j >= f->from && P[p].dl != 0.0f && s->dl[j] != 0.0f)
         far += P[p].scale * (double)P[p].dl * (double)s->dl[j] * (1.0 / sqrt(r2) - s->ctx.inv_cutoff);
     }

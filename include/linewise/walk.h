@@ -9,15 +9,16 @@
 ** cell its samples in increasing index order (grid.h).  For each neighbour
 ** j of another spline, with r = |P - j| and dm = max(dl_P, dl_j):
 **
-**   near   r^2 < (ctx->near_scale * dm)^2: (P, j) is appended to the near
-**          list with j's position and weight (whatever `from` says, so the
-**          caller sees every near pair), and adds nothing to the far sum;
+**   near   r^2 < (ctx->near_scale * dm)^2 and r < rc: (P, j) is appended
+**          to the near list with j's position and weight (whatever `from`
+**          says, so the caller sees every near pair), and adds nothing to
+**          the far sum;
 **   far    otherwise, if r < rc, j >= from and both weights are non-zero:
 **          scale_P dl_P dl_j (1/r - 1/rc) joins the far sum (1/rc =
 **          ctx->inv_cutoff, 0 without a cutoff).
 **
-** Near pairs lie within the cutoff (the near scale is capped so), so the
-** cells beyond it are skipped for them too.
+** The near scale is meant to be capped so that near pairs lie within the
+** cutoff; the walk skips the cells beyond it and reports none beyond it.
 **
 ** How it runs: the probes of one call are grouped by cell (in chunks of
 ** LW_PAIR_CHUNK, at most LW_PAIR_BATCH to a group); a group shares its 3 x 3
