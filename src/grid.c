@@ -174,6 +174,14 @@ void lw_cellgrid_fit(lw_cellgrid *g)
   }
 }
 
+size_t lw_cellgrid_bytes(const lw_cellgrid *g)
+{
+  size_t b = sizeof *g + g->n_samples * sizeof *g->home;
+  for (size_t c = 0; c < (size_t)g->nx * (size_t)g->ny; c++)
+    b += sizeof *g->cell + (g->cell[c].cap ? g->cell[c].cap * ENTRY_BYTES + BLOCK_PAD : 0);
+  return b;
+}
+
 void lw_cellgrid_clear(lw_cellgrid *g)
 {
   for (size_t c = 0; c < (size_t)g->nx * (size_t)g->ny; c++) g->cell[c].n = 0;

@@ -73,13 +73,7 @@ static double bytes_per_segment(const lw_model *m)
              (double)sp->n_splines * (2 * sizeof(size_t) + sizeof(double) + sizeof(double)) +
              (double)sp->n_segments * (sizeof(uint32_t) + sizeof(double) +
                                        (double)m->scene->n_local * sizeof(double));
-  if (m->grid) {
-    const lw_cellgrid *g = m->grid;
-    /* tangents and home cells per sample; per cell its header and block */
-    b += (double)g->n_samples * (sizeof(lw_pair_tangent) + sizeof(uint32_t));
-    for (int c = 0; c < g->nx * g->ny; c++)
-      b += sizeof(lw_cell) + g->cell[c].cap * (2 * sizeof(double) + sizeof(uint32_t) + sizeof(float));
-  }
+  if (m->grid) b += (double)m->grid->n_samples * sizeof(lw_pair_tangent) + (double)lw_cellgrid_bytes(m->grid);
   return b / (double)(sp->n_segments ? sp->n_segments : 1);
 }
 

@@ -86,6 +86,10 @@ void lw_cellgrid_get(const lw_cellgrid *g, uint32_t i, double *x, double *y, flo
 ** refill, which grows cells one entry at a time. */
 void lw_cellgrid_fit(lw_cellgrid *g);
 
+/* Bytes the grid holds: its cells, their blocks (padding included) and the
+** home of every sample. */
+size_t lw_cellgrid_bytes(const lw_cellgrid *g);
+
 /* Empties every cell, keeping their capacity. */
 void lw_cellgrid_clear(lw_cellgrid *g);
 
