@@ -73,8 +73,9 @@ static lw_pair_filter filter_of(const pair_view *v, uint32_t spline, uint32_t fr
 
 /* ---- near-field glue: the near-field rewrite replaces this function ----
 ** The walk reports as near exactly the pairs inside the kernel's element and
-** exact zones (near_scale = zone_outer, pair.c), so adding lw_pair_kernel
-** over them gives the energy of the kernel of pair.h, every zone included.
+** exact zones (near_scale = zone_outer, pair.c) that lie within the cutoff
+** (beyond it the kernel is 0), so adding lw_pair_kernel over them gives the
+** energy of the kernel of pair.h, every zone included.
 ** Probe k is sample s[k] with its scale in P[k]. */
 static double near_glue(const pair_view *v, const lw_pair_sample *const *s, const lw_pair_probe *P,
                         const lw_pair_nearlist *near, uint32_t from)
@@ -114,9 +115,9 @@ static lw_status pair_all(const pair_view *v, double *e)
     const uint32_t *idx = lw_cell_idx(c);
     for (uint32_t k = 0; k < c->n; k++) {
       lw_pair_sample s = sample_of(v, idx[k], c->x[k], lw_cell_y(c)[k], lw_cell_dl(c)[k]);
-      const lw_pair_sample *sp = &s;
+      const lw_pair_sample *only = &s;
       lw_pair_probe P = {s.x, s.y, s.dl, 1.0};
-      if (probes_pair(v, &P, &sp, 1, s.spline, idx[k] + 1, &near, &t) != LW_OK) {
+      if (probes_pair(v, &P, &only, 1, s.spline, idx[k] + 1, &near, &t) != LW_OK) {
         lw_pair_nearlist_free(&near);
         return LW_ENOMEM;
       }
