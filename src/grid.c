@@ -1,9 +1,14 @@
-/* grid.c -- the uniform cell grid with sorted cells (grid.h). */
+/* grid.c -- the uniform cell grid with sorted structure-of-arrays cells (grid.h). */
 #include "linewise/grid.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* Bytes of one entry across the four arrays of a cell's block. */
+#define ENTRY_BYTES (2 * sizeof(double) + sizeof(uint32_t) + sizeof(float))
+/* The walk reads entries in groups of four, past the last one (grid.h). */
+#define BLOCK_PAD (3 * sizeof(float))
 
 lw_cellgrid *lw_cellgrid_new(double x0, double y0, double w, double h, double cell,
                              size_t n_samples, lw_error *err)
@@ -23,7 +28,8 @@ lw_cellgrid *lw_cellgrid_new(double x0, double y0, double w, double h, double ce
   if (g->nx < 1) g->nx = 1;
   if (g->ny < 1) g->ny = 1;
   g->cell = calloc((size_t)g->nx * (size_t)g->ny, sizeof *g->cell);
-  if (!g->cell) goto nomem;
+  g->home = malloc((n_samples ? n_samples : 1) * sizeof *g->home);
+  if (!g->cell || !g->home) goto nomem;
   g->n_samples = n_samples;
   return g;
 nomem:
@@ -36,18 +42,20 @@ void lw_cellgrid_free(lw_cellgrid *g)
 {
   if (!g) return;
   if (g->cell)
-    for (size_t c = 0; c < (size_t)g->nx * (size_t)g->ny; c++) free(g->cell[c].idx);
+    for (size_t c = 0; c < (size_t)g->nx * (size_t)g->ny; c++) free(g->cell[c].x);
   free(g->cell);
+  free(g->home);
   free(g);
 }
 
 /* Position of i in the sorted cell (or where it would go). */
 static uint32_t lower_bound(const lw_cell *c, uint32_t i)
 {
+  const uint32_t *idx = lw_cell_idx(c);
   uint32_t lo = 0, hi = c->n;
   while (lo < hi) {
     uint32_t mid = (lo + hi) / 2;
-    if (c->idx[mid] < i) lo = mid + 1;
+    if (idx[mid] < i) lo = mid + 1;
     else hi = mid;
   }
   return lo;
@@ -60,49 +68,118 @@ static uint32_t cell_of(const lw_cellgrid *g, double x, double y)
   return (uint32_t)cy * (uint32_t)g->nx + (uint32_t)cx;
 }
 
+/* Gives c a block of cap >= c->n entries.  The arrays' offsets depend on the
+** capacity, so the entries are copied into a new block rather than
+** realloc'ed. */
+static lw_status cell_resize(lw_cell *c, uint32_t cap)
+{
+  /* zeroed, so that what the walk reads past the entries is defined */
+  double *blk = calloc(1, (size_t)cap * ENTRY_BYTES + BLOCK_PAD);
+  if (!blk) return LW_ENOMEM;
+  lw_cell to = {blk, c->n, cap};
+  if (c->n) {
+    memcpy(to.x, c->x, c->n * sizeof(double));
+    memcpy(lw_cell_y(&to), lw_cell_y(c), c->n * sizeof(double));
+    memcpy(lw_cell_idx(&to), lw_cell_idx(c), c->n * sizeof(uint32_t));
+    memcpy(lw_cell_dl(&to), lw_cell_dl(c), c->n * sizeof(float));
+  }
+  free(c->x);
+  *c = to;
+  return LW_OK;
+}
+
+/* Spare room after a fit: a few moves into a cell before it must grow. */
+static uint32_t fitted(uint32_t n)
+{
+  return n + n / 8 + 2;
+}
+
+/* Room for one more entry.  A quarter more (at least 4) keeps the amortised
+** cost O(1) with little spare room. */
 static lw_status cell_reserve(lw_cell *c)
 {
   if (c->n < c->cap) return LW_OK;
-  uint32_t cap = c->cap ? 2 * c->cap : 8;
-  uint32_t *nidx = realloc(c->idx, cap * sizeof *nidx);
-  if (!nidx) return LW_ENOMEM;
-  c->idx = nidx;
-  c->cap = cap;
-  return LW_OK;
+  return cell_resize(c, c->cap + c->cap / 8 + 2);
 }
 
-static void cell_add(lw_cell *c, uint32_t i)
+/* Shifts entries [k, n) of every array of c by `by` (+1 or -1) entries. */
+static void cell_shift(lw_cell *c, uint32_t k, int by)
 {
-  uint32_t k = lower_bound(c, i);
-  memmove(c->idx + k + 1, c->idx + k, (c->n - k) * sizeof *c->idx);
-  c->idx[k] = i;
-  c->n++;
+  size_t m = c->n - k;
+  double *y = lw_cell_y(c);
+  uint32_t *idx = lw_cell_idx(c);
+  float *dl = lw_cell_dl(c);
+  memmove(c->x + k + by, c->x + k, m * sizeof *c->x);
+  memmove(y + k + by, y + k, m * sizeof *y);
+  memmove(idx + k + by, idx + k, m * sizeof *idx);
+  memmove(dl + k + by, dl + k, m * sizeof *dl);
 }
 
-static void cell_remove(lw_cell *c, uint32_t i)
+static void cell_set(lw_cell *c, uint32_t k, uint32_t i, double x, double y, float dl)
 {
-  uint32_t k = lower_bound(c, i);
-  if (k == c->n || c->idx[k] != i) return; /* not there: nothing to remove */
-  memmove(c->idx + k, c->idx + k + 1, (c->n - k - 1) * sizeof *c->idx);
-  c->n--;
+  c->x[k] = x;
+  lw_cell_y(c)[k] = y;
+  lw_cell_idx(c)[k] = i;
+  lw_cell_dl(c)[k] = dl;
 }
 
-lw_status lw_cellgrid_insert(lw_cellgrid *g, uint32_t i, double x, double y)
+lw_status lw_cellgrid_insert(lw_cellgrid *g, uint32_t i, double x, double y, float dl)
 {
-  lw_cell *c = &g->cell[cell_of(g, x, y)];
+  uint32_t to = cell_of(g, x, y);
+  lw_cell *c = &g->cell[to];
   if (cell_reserve(c) != LW_OK) return LW_ENOMEM;
-  cell_add(c, i);
+  uint32_t k = lower_bound(c, i);
+  cell_shift(c, k, 1);
+  c->n++;
+  cell_set(c, k, i, x, y, dl);
+  g->home[i] = to;
   return LW_OK;
 }
 
-lw_status lw_cellgrid_move(lw_cellgrid *g, uint32_t i, double ox, double oy, double x, double y)
+lw_status lw_cellgrid_move(lw_cellgrid *g, uint32_t i, double x, double y, float dl)
 {
-  uint32_t from = cell_of(g, ox, oy), to = cell_of(g, x, y);
-  if (from == to) return LW_OK;
+  uint32_t from = g->home[i], to = cell_of(g, x, y);
+  lw_cell *c = &g->cell[from];
+  uint32_t k = lower_bound(c, i);
+  if (from == to) {
+    cell_set(c, k, i, x, y, dl);
+    return LW_OK;
+  }
   if (cell_reserve(&g->cell[to]) != LW_OK) return LW_ENOMEM;
-  cell_remove(&g->cell[from], i);
-  cell_add(&g->cell[to], i);
-  return LW_OK;
+  cell_shift(c, k + 1, -1);
+  c->n--;
+  /* A cell that emptied gives its spare room back, so capacity follows the
+  ** occupancy instead of the largest it ever had; the gap between this and
+  ** the growth threshold keeps a cell from resizing back and forth.  A
+  ** failed shrink keeps the larger block, which is as good. */
+  if (c->cap - c->n > c->n / 4 + 4) (void)cell_resize(c, fitted(c->n));
+  return lw_cellgrid_insert(g, i, x, y, dl); /* cannot fail: room reserved */
+}
+
+void lw_cellgrid_get(const lw_cellgrid *g, uint32_t i, double *x, double *y, float *dl)
+{
+  const lw_cell *c = &g->cell[g->home[i]];
+  uint32_t k = lower_bound(c, i);
+  *x = c->x[k];
+  *y = lw_cell_y(c)[k];
+  *dl = lw_cell_dl(c)[k];
+}
+
+void lw_cellgrid_fit(lw_cellgrid *g)
+{
+  for (size_t c = 0; c < (size_t)g->nx * (size_t)g->ny; c++) {
+    lw_cell *cell = &g->cell[c];
+    /* a failed shrink keeps the larger block, which is as good */
+    if (cell->cap > fitted(cell->n)) (void)cell_resize(cell, fitted(cell->n));
+  }
+}
+
+size_t lw_cellgrid_bytes(const lw_cellgrid *g)
+{
+  size_t b = sizeof *g + g->n_samples * sizeof *g->home;
+  for (size_t c = 0; c < (size_t)g->nx * (size_t)g->ny; c++)
+    b += sizeof *g->cell + (g->cell[c].cap ? g->cell[c].cap * ENTRY_BYTES + BLOCK_PAD : 0);
+  return b;
 }
 
 void lw_cellgrid_clear(lw_cellgrid *g)

@@ -40,55 +40,55 @@ static int segment_eval(const lw_scene *sc, const lw_node *a, const lw_node *b, 
   return regular;
 }
 
-/* A growable list of sample indices: the near pairs a walk found. */
-static lw_status near_push(lw_near_list *l, uint32_t idx)
+/* Appends a segment number to a list.  LW_ENOMEM if it cannot grow. */
+static lw_status list_push(lw_near_list *l, uint32_t v)
 {
   if (l->n == l->cap) {
     size_t cap = l->cap ? 2 * l->cap : 64;
-    uint32_t *v = realloc(l->idx, cap * sizeof *v);
-    if (!v) return LW_ENOMEM;
-    l->idx = v;
+    uint32_t *nv = realloc(l->idx, cap * sizeof *nv);
+    if (!nv) return LW_ENOMEM;
+    l->idx = nv;
     l->cap = cap;
   }
-  l->idx[l->n++] = idx;
+  l->idx[l->n++] = v;
   return LW_OK;
 }
 
-/*
-** Product-rule sum of sample `me` (of spline `spline`) with every grid sample
-** of another spline whose index exceeds `after` (-1: all), leaving out near
-** pairs (pairnear.h), whose partners go to `near` whatever their index: the
-** near field replaces whole segment pairs, so the caller needs all of them.
-** Cells and their sorted entries are visited in a fixed order, so the sum
-** depends on the positions only.  Returns NAN if the near list cannot grow.
-*/
-static double neighbour_sum(const lw_cellgrid *g, const lw_pair_sample *all, const lw_pair_sample *me,
-                            uint32_t spline, long long after, const lw_pair_ctx *ctx, lw_near_list *near)
+static lw_pair_tangent tangent_of(const lw_pair_sample *s)
 {
-  const double cut2 = ctx->cutoff2, inv = ctx->inv_cutoff;
-  const double dl_me = me->dl;
-  double sum = 0.0;
-  int cx, cy;
-  lw_cellgrid_locate(g, me->x, me->y, &cx, &cy);
-  for (int y = cy - 1; y <= cy + 1; y++) {
-    if (y < 0 || y >= g->ny) continue;
-    for (int x = cx - 1; x <= cx + 1; x++) {
-      if (x < 0 || x >= g->nx) continue;
-      const lw_cell *c = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
-      for (uint32_t k = 0; k < c->n; k++) {
-        const lw_pair_sample *o = &all[c->idx[k]];
-        if (o->spline == spline) continue;
-        double dx = me->x - o->x, dy = me->y - o->y, r2 = dx * dx + dy * dy;
-        if (r2 >= cut2) continue;
-        if (r2 < lw_pair_near_radius2(ctx, me->dl, o->dl)) {
-          if (near_push(near, c->idx[k]) != LW_OK) return NAN;
-        } else if ((long long)c->idx[k] > after && o->dl != 0.0f) {
-          sum += dl_me * (double)o->dl * (1.0 / sqrt(r2) - inv);
-        }
-      }
-    }
-  }
-  return sum;
+  return (lw_pair_tangent){s->dx, s->dy};
+}
+
+/* Where the pair term looks things up: the grid, the tangents, and the
+** splines' sample ranges (np samples per segment). */
+typedef struct {
+  const lw_cellgrid *g;
+  const lw_pair_tangent *pt;
+  const lw_splines *sp;
+  uint32_t np;
+  const lw_pair_ctx *ctx;
+} pair_view;
+
+/* Sample i at (x, y) with weight dl: the rest from its index. */
+static lw_pair_sample sample_of(const pair_view *v, uint32_t i, double x, double y, float dl)
+{
+  return (lw_pair_sample){x, y, v->pt[i].dx, v->pt[i].dy, dl, v->sp->seg_spline[i / v->np], i % v->np};
+}
+
+/* Sample i from the grid. */
+static lw_pair_sample sample_at(const pair_view *v, uint32_t i)
+{
+  double x, y;
+  float dl;
+  lw_cellgrid_get(v->g, i, &x, &y, &dl);
+  return sample_of(v, i, x, y, dl);
+}
+
+/* The filter of the samples of spline i: pairs with samples of index >= from. */
+static lw_pair_filter filter_of(const pair_view *v, uint32_t spline, uint32_t from)
+{
+  size_t g0 = lw_segment_index(v->sp, spline, 0), n = lw_splines_segments(v->sp, spline);
+  return (lw_pair_filter){(uint32_t)(g0 * v->np), (uint32_t)((g0 + n) * v->np), from};
 }
 
 /* The Bezier control points of the segment from node a to node b. */
@@ -111,15 +111,15 @@ static void segment_bezier(const lw_splines *sp, size_t g, double b[8])
   node_bezier(a, a + 1, b);
 }
 
-static int cmp_u64(const void *a, const void *b)
-{
-  uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-  return (x > y) - (x < y);
-}
-
 static int cmp_u32(const void *a, const void *b)
 {
   uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+  return (x > y) - (x < y);
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+  uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
   return (x > y) - (x < y);
 }
 
@@ -133,77 +133,85 @@ static size_t unique_u32(uint32_t *v, size_t n)
   return m;
 }
 
-/* The product-rule sum (no coefficient) of one segment's np samples `mine`
-** (spline `spline`) against every sample of another spline in the grid,
-** near pairs left out; `near` receives the segments of the near pairs,
-** sorted, each once.  NAN if out of memory. */
-static double pair_walk(const lw_cellgrid *g, const lw_pair_sample *all, const lw_pair_sample *mine, int np,
-                        uint32_t spline, const lw_pair_ctx *ctx, lw_near_list *near)
-{
-  double sum = 0.0;
-  near->n = 0;
-  for (int i = 0; i < np; i++) sum += neighbour_sum(g, all, &mine[i], spline, -1, ctx, near);
-  if (near->n == 0 || isnan(sum)) return sum;
-  for (size_t k = 0; k < near->n; k++) near->idx[k] /= (uint32_t)np;
-  near->n = unique_u32(near->idx, near->n);
-  return sum;
-}
-
 /* The near field (no coefficient) of one segment, control points bez and
-** samples mine, with each segment of the list `near`. */
-static double pair_near_part(const lw_splines *sp, const lw_pair_sample *all, const double bez[8],
-                             const lw_pair_sample *mine, int np, const lw_pair_ctx *ctx, const lw_near_list *near)
+** samples mine, with each segment of the sorted list `segs` (pairnear.h).
+** Sums in the list's order, so the value is a function of the state. */
+static double near_part(const pair_view *v, const double bez[8], const lw_pair_sample *mine,
+                        const lw_near_list *segs)
 {
+  lw_pair_sample other[LW_QUAD_MAX];
   double sum = 0.0;
-  for (size_t k = 0; k < near->n; k++) {
+  for (size_t k = 0; k < segs->n; k++) {
     double b[8];
-    segment_bezier(sp, near->idx[k], b);
-    sum += lw_pair_near_correction(bez, mine, b, all + (size_t)near->idx[k] * (size_t)np, np, ctx);
+    uint32_t gb = segs->idx[k];
+    segment_bezier(v->sp, gb, b);
+    for (uint32_t q = 0; q < v->np; q++) other[q] = sample_at(v, gb * v->np + q);
+    sum += lw_pair_near_correction(bez, mine, b, other, (int)v->np, v->ctx);
   }
   return sum;
 }
 
-/* Every pair of samples of different splines once (j > i), and every near
-** segment pair once.  NAN if out of memory. */
-static double pair_all(const lw_cellgrid *g, const lw_splines *sp, const lw_pair_sample *all, int np,
-                       const lw_pair_ctx *ctx)
+/*
+** Every pair of samples of different splines once (j > i) by the walk, the
+** samples taken cell by cell in the grid's order, which depends on positions
+** only; then every near segment pair once (the walk reports near pairs in
+** both directions), in increasing order of (lower, higher) segment.
+*/
+static lw_status pair_all(const pair_view *v, double *e)
 {
-  size_t n = sp->n_segments * (size_t)np;
-  lw_near_list near = {0}, pairs = {0};
-  double sum = 0.0;
-  for (size_t i = 0; i < n; i++) {
-    near.n = 0;
-    sum += neighbour_sum(g, all, &all[i], all[i].spline, (long long)i, ctx, &near);
-    uint32_t ga = (uint32_t)(i / (size_t)np);
-    /* a segment pair is listed from its lower segment, as (a, b) in two slots */
-    for (size_t k = 0; k < near.n && !isnan(sum); k++) {
-      uint32_t gb = near.idx[k] / (uint32_t)np;
-      if (gb > ga && (near_push(&pairs, ga) != LW_OK || near_push(&pairs, gb) != LW_OK)) sum = NAN;
-    }
-    if (isnan(sum)) break;
-  }
-  if (!isnan(sum) && pairs.n) {
-    /* sort (a, b) pairs as 64-bit keys, then take each once */
-    size_t m = pairs.n / 2;
-    uint64_t *key = malloc(m * sizeof *key);
-    if (!key) sum = NAN;
-    else {
-      for (size_t k = 0; k < m; k++) key[k] = (uint64_t)pairs.idx[2 * k] << 32 | pairs.idx[2 * k + 1];
-      qsort(key, m, sizeof *key, cmp_u64);
-      for (size_t k = 0; k < m; k++) {
-        if (k > 0 && key[k] == key[k - 1]) continue;
-        size_t ga = (size_t)(key[k] >> 32), gb = (size_t)(key[k] & 0xffffffffu);
-        double a[8], b[8];
-        segment_bezier(sp, ga, a);
-        segment_bezier(sp, gb, b);
-        sum += lw_pair_near_correction(a, all + ga * (size_t)np, b, all + gb * (size_t)np, np, ctx);
+  lw_pair_nearlist near = {0};
+  uint64_t *key = NULL;
+  size_t n_key = 0, cap_key = 0;
+  const lw_cellgrid *g = v->g;
+  double sum = 0.0, t;
+  lw_status st = LW_OK;
+  for (size_t ci = 0; ci < (size_t)g->nx * (size_t)g->ny && st == LW_OK; ci++) {
+    const lw_cell *c = &g->cell[ci];
+    const uint32_t *idx = lw_cell_idx(c);
+    for (uint32_t k = 0; k < c->n && st == LW_OK; k++) {
+      uint32_t i = idx[k];
+      lw_pair_probe P = {c->x[k], lw_cell_y(c)[k], lw_cell_dl(c)[k], 1.0};
+      lw_pair_filter f = filter_of(v, v->sp->seg_spline[i / v->np], i + 1);
+      near.n = 0;
+      if ((st = lw_pair_walk(g, v->ctx, &P, 1, &f, &t, &near)) != LW_OK) break;
+      sum += t;
+      for (size_t q = 0; q < near.n; q++) {
+        uint32_t ga = i / v->np, gb = near.pair[q].idx / v->np;
+        if (gb <= ga) continue;
+        if (n_key == cap_key) {
+          size_t cap = cap_key ? 2 * cap_key : 256;
+          uint64_t *nk = realloc(key, cap * sizeof *nk);
+          if (!nk) {
+            st = LW_ENOMEM;
+            break;
+          }
+          key = nk;
+          cap_key = cap;
+        }
+        key[n_key++] = (uint64_t)ga << 32 | gb;
       }
-      free(key);
     }
   }
-  free(near.idx);
-  free(pairs.idx);
-  return sum;
+  if (st == LW_OK && n_key) {
+    qsort(key, n_key, sizeof *key, cmp_u64);
+    lw_pair_sample sa[LW_QUAD_MAX], sb[LW_QUAD_MAX];
+    for (size_t k = 0; k < n_key; k++) {
+      if (k > 0 && key[k] == key[k - 1]) continue;
+      uint32_t ga = (uint32_t)(key[k] >> 32), gb = (uint32_t)(key[k] & 0xffffffffu);
+      double a[8], b[8];
+      segment_bezier(v->sp, ga, a);
+      segment_bezier(v->sp, gb, b);
+      for (uint32_t q = 0; q < v->np; q++) {
+        sa[q] = sample_at(v, ga * v->np + q);
+        sb[q] = sample_at(v, gb * v->np + q);
+      }
+      sum += lw_pair_near_correction(a, sa, b, sb, (int)v->np, v->ctx);
+    }
+  }
+  free(key);
+  lw_pair_nearlist_free(&near);
+  *e = sum;
+  return st;
 }
 
 static lw_cellgrid *grid_for(const lw_scene *sc, size_t n_samples, lw_error *err)
@@ -251,6 +259,17 @@ static double total_of(const double term[LW_TERM_COUNT], size_t irregular)
   return irregular ? INFINITY : total;
 }
 
+/* Puts the np pair samples ps of segment g into the grid and the tangents. */
+static lw_status store_samples(lw_cellgrid *grid, lw_pair_tangent *pt, size_t g, int np, const lw_pair_sample *ps)
+{
+  for (int q = 0; q < np; q++) {
+    size_t i = g * (size_t)np + (size_t)q;
+    if (lw_cellgrid_insert(grid, (uint32_t)i, ps[q].x, ps[q].y, ps[q].dl) != LW_OK) return LW_ENOMEM;
+    pt[i] = tangent_of(&ps[q]);
+  }
+  return LW_OK;
+}
+
 double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[LW_TERM_COUNT],
                          lw_error *err)
 {
@@ -258,59 +277,47 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
   const int np = sc->pair_quad.n;
   lw_samples s;
   double local[LW_TERM_COUNT];
-  lw_pair_sample *ps = NULL;
-  if (sc->on[LW_TERM_PAIR]) {
-    ps = malloc((sp->n_segments ? sp->n_segments : 1) * (size_t)np * sizeof *ps);
-    if (!ps) {
-      lw_error_set(err, LW_ENOMEM, "out of memory for %zu pair samples", sp->n_segments * (size_t)np);
-      return NAN;
-    }
-  }
+  lw_pair_sample seg_ps[LW_QUAD_MAX];
+  lw_pair_tangent *pt = NULL;
+  lw_cellgrid *grid = NULL;
+  size_t n = sp->n_segments * (size_t)np, irregular = 0;
   double *seg_len = malloc((sp->n_segments ? sp->n_segments : 1) * sizeof *seg_len);
-  if (!seg_len) {
-    free(ps);
-    lw_error_set(err, LW_ENOMEM, "out of memory for %zu segments", sp->n_segments);
-    return NAN;
+  if (!seg_len) goto nomem;
+  if (sc->on[LW_TERM_PAIR]) {
+    if (!(pt = malloc((n ? n : 1) * sizeof *pt))) goto nomem;
+    if (!(grid = grid_for(sc, n, err))) goto fail;
   }
-  size_t irregular = 0;
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
-    irregular += !segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &seg_len[g], local,
-                               ps ? ps + g * (size_t)np : NULL);
+    irregular += !segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &seg_len[g], local, pt ? seg_ps : NULL);
     for (int t = 0; t < sc->n_local; t++) term[sc->local[t]] += local[t];
+    if (pt && store_samples(grid, pt, g, np, seg_ps) != LW_OK) goto nomem;
   }
   if (sc->on[LW_TERM_STRAIN])
     for (size_t i = 0; i < sp->n_splines; i++) {
       double L = 0.0;
-      size_t g0 = lw_segment_index(sp, i, 0), n = lw_splines_segments(sp, i);
-      for (size_t m = 0; m < n; m++) L += seg_len[g0 + m];
+      size_t g0 = lw_segment_index(sp, i, 0), ns = lw_splines_segments(sp, i);
+      for (size_t m = 0; m < ns; m++) L += seg_len[g0 + m];
       term[LW_TERM_STRAIN] += strain_of_spline(sc, sp, seg_len, i, L);
     }
-  free(seg_len);
-  if (ps) {
-    size_t n = sp->n_segments * (size_t)np;
-    lw_cellgrid *g = grid_for(sc, n, err);
-    if (!g) {
-      free(ps);
-      return NAN;
-    }
-    for (size_t i = 0; i < n; i++)
-      if (lw_cellgrid_insert(g, (uint32_t)i, ps[i].x, ps[i].y) != LW_OK) {
-        lw_cellgrid_free(g);
-        free(ps);
-        lw_error_set(err, LW_ENOMEM, "out of memory filling the pair grid");
-        return NAN;
-      }
-    double pe = pair_all(g, sp, ps, np, &sc->pair);
-    lw_cellgrid_free(g);
-    free(ps);
-    if (isnan(pe)) {
-      lw_error_set(err, LW_ENOMEM, "out of memory for the pair term's near field");
-      return NAN;
-    }
-    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pe;
+  if (grid) {
+    pair_view v = {grid, pt, sp, (uint32_t)np, &sc->pair};
+    double e;
+    if (pair_all(&v, &e) != LW_OK) goto nomem;
+    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * e;
   }
+  free(seg_len);
+  free(pt);
+  lw_cellgrid_free(grid);
   return total_of(term, irregular);
+nomem:
+  lw_error_set(err, LW_ENOMEM, "out of memory for the energy of %zu segments (%zu pair samples)",
+               sp->n_segments, n);
+fail:
+  free(seg_len);
+  free(pt);
+  lw_cellgrid_free(grid);
+  return NAN;
 }
 
 lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
@@ -337,10 +344,10 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
       lw_model_free(m);
       return NULL;
     }
-    m->ps = malloc((n ? n : 1) * sizeof *m->ps);
+    m->pt = malloc((n ? n : 1) * sizeof *m->pt);
     m->near_cache = malloc(ns * sizeof *m->near_cache);
     m->near_valid = calloc(ns, sizeof *m->near_valid);
-    if (!m->ps || !m->near_cache || !m->near_valid) goto nomem;
+    if (!m->pt || !m->near_cache || !m->near_valid) goto nomem;
     m->grid = grid_for(sc, n, err);
     if (!m->grid) {
       lw_model_free(m);
@@ -365,7 +372,7 @@ void lw_model_free(lw_model *m)
   free(m->seg_local);
   free(m->spline_len);
   free(m->seg_irregular);
-  free(m->ps);
+  free(m->pt);
   free(m->near_cache);
   free(m->near_valid);
   lw_cellgrid_free(m->grid);
@@ -385,14 +392,17 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
   double old_total = lw_model_total(m);
   double term[LW_TERM_COUNT] = {0};
   lw_samples s;
+  lw_pair_sample seg_ps[LW_QUAD_MAX];
   m->n_irregular = 0;
+  if (m->grid) lw_cellgrid_clear(m->grid);
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
     double *local = m->seg_local + g * (size_t)nl;
     m->seg_irregular[g] = !segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &m->seg_len[g], local,
-                                        m->ps ? m->ps + g * (size_t)np : NULL);
+                                        m->grid ? seg_ps : NULL);
     m->n_irregular += m->seg_irregular[g];
     for (int t = 0; t < nl; t++) term[sc->local[t]] += local[t];
+    if (m->grid && store_samples(m->grid, m->pt, g, np, seg_ps) != LW_OK) return LW_ENOMEM;
   }
   for (size_t i = 0; i < sp->n_splines; i++) {
     size_t g0 = lw_segment_index(sp, i, 0), n = lw_splines_segments(sp, i);
@@ -402,14 +412,12 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
     if (sc->on[LW_TERM_STRAIN]) term[LW_TERM_STRAIN] += strain_of_spline(sc, sp, m->seg_len, i, L);
   }
   if (m->grid) {
-    size_t n = sp->n_segments * (size_t)np;
+    pair_view v = {m->grid, m->pt, sp, (uint32_t)np, &sc->pair};
+    double e;
     memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);
-    lw_cellgrid_clear(m->grid);
-    for (size_t i = 0; i < n; i++)
-      if (lw_cellgrid_insert(m->grid, (uint32_t)i, m->ps[i].x, m->ps[i].y) != LW_OK) return LW_ENOMEM;
-    double pe = pair_all(m->grid, sp, m->ps, np, &sc->pair);
-    if (isnan(pe)) return LW_ENOMEM;
-    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pe;
+    lw_cellgrid_fit(m->grid);
+    if (pair_all(&v, &e) != LW_OK) return LW_ENOMEM;
+    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * e;
   }
   for (int t = 0; t < LW_TERM_COUNT; t++) m->term[t] = term[t];
   double total = lw_model_total(m);
@@ -430,11 +438,15 @@ lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err)
     p->node = malloc((cap + 1) * sizeof *p->node);
     p->len = malloc(cap * sizeof *p->len);
     p->local = malloc(cap * (size_t)nl * sizeof *p->local);
-    p->ps = malloc(cap * (size_t)m->scene->pair_quad.n * sizeof *p->ps);
+    size_t ns = cap * (size_t)m->scene->pair_quad.n;
+    p->ps = malloc(ns * sizeof *p->ps);
+    p->ps_old = malloc(ns * sizeof *p->ps_old);
+    p->probe = malloc(2 * ns * sizeof *p->probe);
     p->near_new = malloc(cap * sizeof *p->near_new);
     p->seg_irregular = malloc(cap * sizeof *p->seg_irregular);
   }
-  if (!p || !p->node || !p->len || !p->local || !p->ps || !p->near_new || !p->seg_irregular) {
+  if (!p || !p->node || !p->len || !p->local || !p->ps || !p->ps_old || !p->probe || !p->near_new ||
+      !p->seg_irregular) {
     lw_proposal_free(p);
     lw_error_set(err, LW_ENOMEM, "out of memory for a proposal");
     return NULL;
@@ -449,11 +461,20 @@ void lw_proposal_free(lw_proposal *p)
   free(p->len);
   free(p->local);
   free(p->ps);
-  free(p->near.idx);
+  free(p->ps_old);
+  free(p->probe);
+  lw_pair_nearlist_free(&p->near);
+  free(p->segs.idx);
   free(p->partners.idx);
   free(p->near_new);
   free(p->seg_irregular);
   free(p);
+}
+
+void lw_model_pair_sample(const lw_model *m, uint32_t i, lw_pair_sample *s)
+{
+  pair_view v = {m->grid, m->pt, m->sp, (uint32_t)m->scene->pair_quad.n, &m->scene->pair};
+  *s = sample_at(&v, i);
 }
 
 /* Node k of the spline as it would be after the proposal. */
@@ -462,44 +483,69 @@ static inline const lw_node *proposed_node(const lw_node *base, const lw_proposa
   return (k >= p->node0 && k < p->node0 + p->n_node) ? &p->node[k - p->node0] : &base[k];
 }
 
+/* The sorted segments of the near pairs of probes that are samples of
+** changed segment j on one side (old: 1, new: 0); probe k is new sample k/2
+** for even k, its old self for odd k. */
+static lw_status near_segments(const lw_proposal *p, uint32_t np, size_t j, int old, lw_near_list *segs)
+{
+  segs->n = 0;
+  for (size_t k = 0; k < p->near.n; k++) {
+    const lw_pair_near *q = &p->near.pair[k];
+    if ((int)(q->probe & 1) != old || (q->probe / 2) / np != j) continue;
+    if (list_push(segs, q->idx / np) != LW_OK) return LW_ENOMEM;
+  }
+  segs->n = unique_u32(segs->idx, segs->n);
+  return LW_OK;
+}
+
 /*
-** The pair part of a proposal's dE (no coefficient).  New side: the walk and
-** the near field of each new segment.  Old side: the walk, and the near field
-** from the model's cache when valid.  The near field is the costly part, and
-** a chain at low temperature rejects most proposals, so caching the old side
-** halves it.  The cached value of a segment is what this code computes for it
-** from the current state (the same sum in the same order), so a cached and a
-** recomputed value are bitwise equal; commits invalidate every segment whose
-** near field the move changed (its near partners before and after).  The
-** partners of both sides are kept in p->partners for the commit.
+** The pair part of a proposal's dE (no coefficient).  One walk over the new
+** samples (+1) and their old selves (-1) gives the far pairs; the near field
+** of each changed segment is added for the new side, and taken away for the
+** old side from the model's cache when valid.  The near field is the costly
+** part and a chain at low temperature rejects most proposals, so caching the
+** old side halves it.  The cached value of a segment is what this code
+** computes for it from the current state (the same sum in the same order), so
+** a cached and a recomputed value are bitwise equal; commits invalidate every
+** segment whose near field the move changed (its near partners before and
+** after), kept in p->partners.  NAN if out of memory.
 */
 static double pair_delta(const lw_model *m, lw_proposal *p, const lw_node *base, size_t g0)
 {
   const lw_scene *sc = m->scene;
-  const lw_splines *sp = m->sp;
-  const int np = sc->pair_quad.n;
-  double pe = 0.0;
+  const uint32_t np = (uint32_t)sc->pair_quad.n;
+  const pair_view v = {m->grid, m->pt, m->sp, np, &sc->pair};
+  const size_t n = p->n_seg * np;
+  /* the new samples add their pairs, the old ones take theirs away: one walk
+  ** over both, each new sample next to its old self (usually in the same
+  ** cell: shorter moves in the walk's sort by cell) */
+  for (size_t k = 0; k < 2 * n; k++) {
+    const lw_pair_sample *ps_k = k & 1 ? &p->ps_old[k / 2] : &p->ps[k / 2];
+    p->probe[k] = (lw_pair_probe){ps_k->x, ps_k->y, ps_k->dl, k & 1 ? -1.0 : 1.0};
+  }
+  lw_pair_filter f = filter_of(&v, p->spline, 0);
+  double pe;
+  p->near.n = 0;
   p->partners.n = 0;
-  for (size_t j = 0; j < p->n_seg && !isnan(pe); j++) {
+  if (lw_pair_walk(m->grid, &sc->pair, p->probe, 2 * n, &f, &pe, &p->near) != LW_OK) return NAN;
+  for (size_t j = 0; j < p->n_seg; j++) {
     size_t g = g0 + p->seg0 + j;
     double bez[8];
+    if (near_segments(p, np, j, 0, &p->segs) != LW_OK) return NAN;
     node_bezier(proposed_node(base, p, p->seg0 + j), proposed_node(base, p, p->seg0 + j + 1), bez);
-    const lw_pair_sample *mine = p->ps + j * (size_t)np;
-    pe += pair_walk(m->grid, m->ps, mine, np, p->spline, &sc->pair, &p->near);
-    p->near_new[j] = pair_near_part(sp, m->ps, bez, mine, np, &sc->pair, &p->near);
+    p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs);
     pe += p->near_new[j];
-    for (size_t k = 0; k < p->near.n; k++)
-      if (near_push(&p->partners, p->near.idx[k]) != LW_OK) return NAN;
-    mine = m->ps + g * (size_t)np;
-    pe -= pair_walk(m->grid, m->ps, mine, np, p->spline, &sc->pair, &p->near);
+    for (size_t k = 0; k < p->segs.n; k++)
+      if (list_push(&p->partners, p->segs.idx[k]) != LW_OK) return NAN;
+    if (near_segments(p, np, j, 1, &p->segs) != LW_OK) return NAN;
     if (!m->near_valid[g]) {
       node_bezier(&base[p->seg0 + j], &base[p->seg0 + j + 1], bez);
-      m->near_cache[g] = pair_near_part(sp, m->ps, bez, mine, np, &sc->pair, &p->near);
+      m->near_cache[g] = near_part(&v, bez, p->ps_old + j * np, &p->segs);
       m->near_valid[g] = 1;
     }
     pe -= m->near_cache[g];
-    for (size_t k = 0; k < p->near.n; k++)
-      if (near_push(&p->partners, p->near.idx[k]) != LW_OK) return NAN;
+    for (size_t k = 0; k < p->segs.n; k++)
+      if (list_push(&p->partners, p->segs.idx[k]) != LW_OK) return NAN;
   }
   return pe;
 }
@@ -532,7 +578,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
     size_t m_loc = p->seg0 + j, g = g0 + m_loc;
     double *local = p->local + j * (size_t)nl;
     p->seg_irregular[j] = !segment_eval(sc, proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1),
-                                        spline, &s, &p->len[j], local, m->ps ? p->ps + j * (size_t)np : NULL);
+                                        spline, &s, &p->len[j], local, m->grid ? p->ps + j * (size_t)np : NULL);
     p->irregular |= p->seg_irregular[j];
     was_irregular |= m->seg_irregular[g];
     const double *old = m->seg_local + g * (size_t)nl;
@@ -571,6 +617,12 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   /* The pair sum is the costly part: skip it when the move is already
   ** forbidden (+inf) or undefined (NaN). */
   p->pair_done = 0;
+  if (m->grid) {
+    /* the old samples, from the grid: the walk's old side and a failed commit's undo */
+    pair_view v = {m->grid, m->pt, sp, (uint32_t)np, &sc->pair};
+    size_t first = (g0 + p->seg0) * (size_t)np, n = p->n_seg * (size_t)np;
+    for (size_t k = 0; k < n; k++) p->ps_old[k] = sample_at(&v, (uint32_t)(first + k));
+  }
   if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
     double pe = pair_delta(m, p, base, g0);
     p->pair_done = !isnan(pe);
@@ -588,15 +640,16 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
   const size_t g0 = lw_segment_index(sp, p->spline, 0);
   if (m->grid) {
     size_t first = (g0 + p->seg0) * (size_t)np, n = p->n_seg * (size_t)np;
-    const lw_pair_sample *old = m->ps + first;
+    const lw_pair_sample *old = p->ps_old, *now = p->ps;
     for (size_t k = 0; k < n; k++)
-      if (lw_cellgrid_move(m->grid, (uint32_t)(first + k), old[k].x, old[k].y, p->ps[k].x, p->ps[k].y) != LW_OK) {
+      if (lw_cellgrid_move(m->grid, (uint32_t)(first + k), now[k].x, now[k].y, now[k].dl) != LW_OK) {
         /* Put the moved ones back: their old cells kept their capacity, so
         ** this cannot fail, and the model is as before the call. */
         for (size_t b = 0; b < k; b++)
-          lw_cellgrid_move(m->grid, (uint32_t)(first + b), p->ps[b].x, p->ps[b].y, old[b].x, old[b].y);
+          lw_cellgrid_move(m->grid, (uint32_t)(first + b), old[b].x, old[b].y, old[b].dl);
         return LW_ENOMEM;
       }
+    for (size_t k = 0; k < n; k++) m->pt[first + k] = tangent_of(&now[k]);
   }
   memcpy(&sp->node[sp->first[p->spline] + p->node0], p->node, p->n_node * sizeof *p->node);
   if (m->grid) {
@@ -618,7 +671,6 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
     memcpy(m->seg_local + g * (size_t)nl, p->local + j * (size_t)nl, (size_t)nl * sizeof *m->seg_local);
     m->n_irregular = m->n_irregular - m->seg_irregular[g] + p->seg_irregular[j];
     m->seg_irregular[g] = p->seg_irregular[j];
-    if (m->ps) memcpy(m->ps + g * (size_t)np, p->ps + j * (size_t)np, (size_t)np * sizeof *m->ps);
   }
   /* Summed afresh in a fixed order rather than updated by += dlen, so the
   ** cached length is a function of the state alone and a resumed run sees

@@ -306,9 +306,9 @@ static void closest_points(const cubic *ca, const cubic *cb, double *ps, double 
       ds = (ds != 0.0 || !(hss > 0.0)) ? ds : -gs / hss;
       if (s + ds < 0.0 || s + ds > 1.0) ds = 0.0;
     }
-    double ns = fmin(1.0, fmax(0.0, s + ds)), nt = fmin(1.0, fmax(0.0, t + dt)), r[2], q[2], d[2];
-    cubic_eval(ca, ns, r, d);
-    cubic_eval(cb, nt, q, d);
+    double ns = fmin(1.0, fmax(0.0, s + ds)), nt = fmin(1.0, fmax(0.0, t + dt)), r[2], q[2], dd[2];
+    cubic_eval(ca, ns, r, dd);
+    cubic_eval(cb, nt, q, dd);
     double f = (r[0] - q[0]) * (r[0] - q[0]) + (r[1] - q[1]) * (r[1] - q[1]);
     if (!(f < best)) break;
     best = f;

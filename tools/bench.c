@@ -50,16 +50,18 @@ static double mean_neighbours(const lw_model *m)
   size_t n = g->n_samples, step = n > 20000 ? n / 20000 : 1, count = 0, seen = 0;
   double rc2 = m->scene->pair.cutoff * m->scene->pair.cutoff;
   for (size_t i = 0; i < n; i += step, seen++) {
+    lw_pair_sample s;
+    lw_model_pair_sample(m, (uint32_t)i, &s);
     int cx, cy;
-    lw_cellgrid_locate(g, m->ps[i].x, m->ps[i].y, &cx, &cy);
+    lw_cellgrid_locate(g, s.x, s.y, &cx, &cy);
     for (int y = cy - 1; y <= cy + 1; y++)
       for (int x = cx - 1; x <= cx + 1; x++) {
         if (x < 0 || y < 0 || x >= g->nx || y >= g->ny) continue;
         const lw_cell *c = &g->cell[y * g->nx + x];
         for (uint32_t k = 0; k < c->n; k++) {
-          const lw_pair_sample *o = &m->ps[c->idx[k]];
-          double dx = o->x - m->ps[i].x, dy = o->y - m->ps[i].y;
-          if (o->spline != m->ps[i].spline && dx * dx + dy * dy < rc2) count++;
+          double dx = c->x[k] - s.x, dy = lw_cell_y(c)[k] - s.y;
+          uint32_t other = m->sp->seg_spline[lw_cell_idx(c)[k] / (uint32_t)m->scene->pair_quad.n];
+          if (other != s.spline && dx * dx + dy * dy < rc2) count++;
         }
       }
   }
@@ -74,11 +76,7 @@ static double bytes_per_segment(const lw_model *m)
              (double)sp->n_splines * (2 * sizeof(size_t) + sizeof(double) + sizeof(double)) +
              (double)sp->n_segments * (sizeof(uint32_t) + sizeof(double) +
                                        (double)m->scene->n_local * sizeof(double));
-  if (m->grid) {
-    const lw_cellgrid *g = m->grid;
-    b += (double)g->n_samples * sizeof(lw_pair_sample);
-    for (int c = 0; c < g->nx * g->ny; c++) b += sizeof(lw_cell) + g->cell[c].cap * sizeof(uint32_t);
-  }
+  if (m->grid) b += (double)m->grid->n_samples * sizeof(lw_pair_tangent) + (double)lw_cellgrid_bytes(m->grid);
   return b / (double)(sp->n_segments ? sp->n_segments : 1);
 }
 
@@ -92,39 +90,64 @@ static void tune_random(bench_run *r)
   bench_run_tune(r, 20000);
 }
 
+/* The throughput scenes: the pair term off, then near field off (the
+** product rule everywhere) and near pairs within 1.5 element lengths, each at
+** two densities. */
+#define N_THROUGHPUT 5
+static const struct {
+  double spacing;    /* mm */
+  int pair;
+  double near_scale; /* lw_pair_ctx.near_scale */
+} throughput[N_THROUGHPUT] = {{2.0, 0, 0.0}, {2.8, 1, 0.0}, {1.4, 1, 0.0}, {2.8, 1, 1.5}, {1.4, 1, 1.5}};
+
 static void bench_throughput(bench_ctx *b)
 {
   FILE *d = b->doc[BENCH_PERFORMANCE];
-  /* 2.8 mm gives the ~30 neighbours per sample the aim is stated for, 1.4 mm twice that */
-  const double spacing[3] = {2.0, 2.8, 1.4};
-  const int pair[3] = {0, 1, 1};
-  bench_run r[3];
+  bench_run r[N_THROUGHPUT];
   lw_params p;
-  for (int i = 0; i < 3; i++) {
-    bench_random_params(&p, 1000, pair[i], spacing[i]);
+  for (int i = 0; i < N_THROUGHPUT; i++) {
+    bench_random_params(&p, 1000, throughput[i].pair, throughput[i].spacing);
+    p.pair_near = 0.0;
     bench_run_init(&r[i], &p, NULL, BENCH_T, NULL);
+    /* near pairs without the kernel's element zone (pair.h): the near
+    ** field's own cost, the exact integral of the pairs the walk reports */
+    if (throughput[i].near_scale > 0.0) {
+      lw_pair_ctx_init(&r[i].scene.pair, &r[i].scene.pair_quad, p.pair_cutoff, throughput[i].near_scale);
+      r[i].scene.pair.near_scale = throughput[i].near_scale;
+      if (lw_model_refresh(r[i].model, NULL) != LW_OK) {
+        lw_error e = {.code = LW_ENOMEM, .msg = "out of memory"};
+        bench_die("throughput", &e);
+      }
+    }
     tune_random(&r[i]);
   }
-  double ns[3], ratio[3];
-  bench_time_runs(b, r, 3, 0, NULL, 0, ns, ratio, NULL);
+  double ns[N_THROUGHPUT], ratio[N_THROUGHPUT];
+  bench_time_runs(b, r, N_THROUGHPUT, 0, NULL, 0, ns, ratio, NULL);
   fprintf(d, "## Throughput\n\n"
              "1000 splines of 4 segments of 5 mm at random places and directions, at the stated mean\n"
              "spacing (page area / total length); every term on (radial potential, waves field,\n"
-             "boundary), quadrature 8, near field 1.5, T = %g after tuning.\n\n"
+             "boundary), quadrature 8, T = %g after tuning. Near field off: the product rule for every\n"
+             "pair; near 1.5: pairs closer than 1.5 element lengths are near (walk.h) and get the exact\n"
+             "element integral, the product rule the others.\n\n"
              "| scene | neighbours per sample | ns per proposal | proposals per second | x cost without pair | "
-             "acceptance |\n|---|---|---|---|---|---|\n",
+             "acceptance | bytes per segment |\n|---|---|---|---|---|---|---|\n",
           BENCH_T);
-  for (int i = 0; i < 3; i++) {
+  for (int i = 0; i < N_THROUGHPUT; i++) {
     char what[96];
-    if (pair[i]) snprintf(what, sizeof what, "every term, pair cutoff 4 mm, lines %.1f mm apart", spacing[i]);
-    else snprintf(what, sizeof what, "every term but pair");
+    if (!throughput[i].pair) snprintf(what, sizeof what, "every term but pair");
+    else if (throughput[i].near_scale > 0.0)
+      snprintf(what, sizeof what, "every term, pair cutoff 4 mm, lines %.1f mm apart, near %.1f",
+               throughput[i].spacing, throughput[i].near_scale);
+    else
+      snprintf(what, sizeof what, "every term, pair cutoff 4 mm, lines %.1f mm apart, near field off",
+               throughput[i].spacing);
     char nb[32] = "-";
-    if (pair[i]) snprintf(nb, sizeof nb, "%.1f", mean_neighbours(r[i].model));
-    fprintf(d, "| %s | %s | %.0f | %.0f | %.1f | %.2f |\n", what, nb, ns[i], 1e9 / ns[i], ratio[i],
-            bench_run_acceptance(&r[i]));
+    if (throughput[i].pair) snprintf(nb, sizeof nb, "%.1f", mean_neighbours(r[i].model));
+    fprintf(d, "| %s | %s | %.0f | %.0f | %.1f | %.2f | %.0f |\n", what, nb, ns[i], 1e9 / ns[i], ratio[i],
+            bench_run_acceptance(&r[i]), bytes_per_segment(r[i].model));
   }
   fprintf(d, "\n");
-  for (int i = 0; i < 3; i++) bench_run_free(&r[i]);
+  for (int i = 0; i < N_THROUGHPUT; i++) bench_run_free(&r[i]);
 }
 
 static void bench_scaling(bench_ctx *b)
@@ -137,13 +160,14 @@ static void bench_scaling(bench_ctx *b)
   for (int i = 0; i < n; i++) {
     bench_note("scaling: %zu splines", sizes[i]);
     bench_random_params(&p, sizes[i], 1, 2.8);
+    p.pair_near = 0.0;
     bench_run_init(&r[i], &p, NULL, BENCH_T, NULL);
     tune_random(&r[i]);
   }
   double ns[4], ratio[4], spread[4];
   bench_time_runs(b, r, n, ref, NULL, 0, ns, ratio, spread);
   fprintf(d, "## Scaling\n\n"
-             "The scene above with the pair term (lines 2.8 mm apart) at constant density, from 10^2 to\n"
+             "The scene above with the pair term (lines 2.8 mm apart, near field off) at constant density, from 10^2 to\n"
              "10^%d splines: a proposal touches two segments and their neighbours only, so its cost must\n"
              "not grow with the scene (beyond cache effects: the larger scenes no longer fit in cache).\n"
              "Ratios are to 1000 splines, block by block (+- the median absolute deviation).\n\n"

@@ -6,7 +6,17 @@
 ** the covered area fall into the nearest edge cell; clamping is monotone and
 ** 1-Lipschitz per axis, so the 3 x 3 rule still holds for them.
 **
-** Each cell keeps the indices of its samples in increasing order.  Sums over
+** The grid is where the samples' positions and weights live: each cell holds
+** what the far kernel reads of its samples as structure-of-arrays, x[], y[]
+** (double, mm), dl[] (float, mm) and idx[] (the sample index), in one block
+** per cell, so the walk over neighbours streams four flat arrays instead of
+** gathering scattered samples.  24 bytes a sample, plus 4 for the cell of
+** each sample (`home`, which finds a sample's data without its position).
+** Cells grow by a quarter (at least 4 entries) and are fitted to their
+** contents after a refill, so spare room stays small: memory is the
+** constraint here (docs/PERFORMANCE.md, bytes per segment).
+**
+** Each cell keeps its samples in increasing index order.  Sums over
 ** neighbours therefore run in an order that depends on the current positions
 ** only, never on the history of moves: a run resumed from a checkpoint (which
 ** rebuilds the grid) adds the same numbers in the same order as one that never
@@ -21,16 +31,24 @@
 
 #include "linewise/error.h"
 
+/* One block of cap entries: x[cap], y[cap], then idx[cap], dl[cap], and 3
+** floats of padding, so that reading any array in groups of four from
+** entry 0 stays within the block (walk.c masks the entries past n). */
 typedef struct {
-  uint32_t *idx;   /* sample indices, increasing */
-  uint32_t n, cap;
+  double *x;       /* the block; NULL while cap = 0 */
+  uint32_t n, cap; /* entries used, allocated */
 } lw_cell;
+
+static inline double *lw_cell_y(const lw_cell *c) { return c->x + c->cap; }
+static inline uint32_t *lw_cell_idx(const lw_cell *c) { return (uint32_t *)(c->x + 2 * (size_t)c->cap); }
+static inline float *lw_cell_dl(const lw_cell *c) { return (float *)(lw_cell_idx(c) + c->cap); }
 
 typedef struct {
   double x0, y0;     /* lower corner of the covered area, mm */
   double inv_h;      /* 1 / cell side */
   int nx, ny;        /* cells per axis */
   lw_cell *cell;     /* nx * ny */
+  uint32_t *home;    /* n_samples: the cell of each inserted sample */
   size_t n_samples;  /* indices run from 0 to n_samples - 1 */
 } lw_cellgrid;
 
@@ -52,14 +70,25 @@ static inline void lw_cellgrid_locate(const lw_cellgrid *g, double x, double y, 
   *cy = iy;
 }
 
-/* Inserts sample i at (x, y).  LW_ENOMEM if its cell cannot grow (the grid
-** is unchanged then).  Inserting in increasing index order appends. */
-lw_status lw_cellgrid_insert(lw_cellgrid *g, uint32_t i, double x, double y);
+/* Inserts sample i (not in the grid) at (x, y) with weight dl.  LW_ENOMEM if
+** its cell cannot grow (the grid is unchanged then).  Inserting in
+** increasing index order appends. */
+lw_status lw_cellgrid_insert(lw_cellgrid *g, uint32_t i, double x, double y, float dl);
 
-/* Moves sample i from (ox, oy), where it was inserted, to (x, y).  The grid
-** keeps no per-sample cell (4 bytes a sample): the caller knows the old
-** position.  LW_ENOMEM as for insert. */
-lw_status lw_cellgrid_move(lw_cellgrid *g, uint32_t i, double ox, double oy, double x, double y);
+/* Moves sample i (in the grid) to (x, y) with weight dl.  LW_ENOMEM as for
+** insert. */
+lw_status lw_cellgrid_move(lw_cellgrid *g, uint32_t i, double x, double y, float dl);
+
+/* Position and weight of sample i (in the grid): a binary search in its cell. */
+void lw_cellgrid_get(const lw_cellgrid *g, uint32_t i, double *x, double *y, float *dl);
+
+/* Shrinks every cell to its entries plus a little spare room: after a
+** refill, which grows cells one entry at a time. */
+void lw_cellgrid_fit(lw_cellgrid *g);
+
+/* Bytes the grid holds: its cells, their blocks (padding included) and the
+** home of every sample. */
+size_t lw_cellgrid_bytes(const lw_cellgrid *g);
 
 /* Empties every cell, keeping their capacity. */
 void lw_cellgrid_clear(lw_cellgrid *g);

@@ -29,6 +29,18 @@
 #include "linewise/pair.h"
 #include "linewise/scene.h"
 #include "linewise/spline.h"
+#include "linewise/walk.h"
+
+/* What the model keeps of a pair sample besides the grid's position and
+** weight (grid.h): its tangent, 8 bytes.  The grid holds x, y and dl once,
+** in the structure-of-arrays form the walk reads; the spline and node of
+** sample i follow from i (quad.n samples per segment, segments of a spline
+** consecutive).  lw_model_pair_sample puts the pieces together.  Per
+** segment at 8 nodes: 8 x (24 in a cell + 4 home + 8 tangent) = 288 bytes
+** of pair data plus the cells' spare room, against 8 x (32 + 4) before. */
+typedef struct {
+  float dx, dy;          /* r' at the node, mm per unit s */
+} lw_pair_tangent;
 
 typedef struct {
   const lw_scene *scene;
@@ -39,8 +51,8 @@ typedef struct {
   unsigned char *seg_irregular; /* n_segments: 1 where a segment is irregular */
   size_t n_irregular;       /* how many; the total is +inf while > 0 */
   double term[LW_TERM_COUNT]; /* running totals (0 for terms that are off) */
-  lw_pair_sample *ps;       /* n_segments * quad.n pair samples (pair on), else NULL */
-  lw_cellgrid *grid;        /* over ps (pair on), else NULL */
+  lw_pair_tangent *pt;      /* n_segments * quad.n pair samples' tangents (pair on), else NULL */
+  lw_cellgrid *grid;        /* the pair samples' positions and weights (pair on), else NULL */
   double *near_cache;       /* n_segments: each segment's pair near field (pair on) */
   uint8_t *near_valid;      /* n_segments: 1 where near_cache holds the current value */
   size_t max_segments;      /* longest spline, for sizing proposals */
@@ -58,7 +70,7 @@ double lw_model_total(const lw_model *m);
 ** new one, |new - old| / max(|new|, 1). */
 lw_status lw_model_refresh(lw_model *m, double *drift);
 
-/* Sample indices of near pairs found by a neighbour walk (growable). */
+/* A growable list of segment numbers (near partners). */
 typedef struct {
   uint32_t *idx;
   size_t n, cap;
@@ -73,13 +85,18 @@ typedef struct {
   double *len;                /* n_seg new segment lengths */
   double *local;              /* n_seg * n_local new local energies */
   lw_pair_sample *ps;         /* n_seg * quad.n new pair samples */
+  lw_pair_sample *ps_old;     /* n_seg * quad.n pair samples before the move (pair on; the
+                              ** walk's old side, and the undo of a failed commit) */
+  lw_pair_probe *probe;       /* 2 n_seg quad.n: each new sample, then its old self, as probes */
+  const lw_pair_sample **probe_sample; /* the sample of each probe */
+  lw_pair_nearlist near;      /* the walk's near pairs (walk.h) */
   double new_spline_len;
   double dterm[LW_TERM_COUNT];
   unsigned char *seg_irregular; /* n_seg: 1 where a new segment is irregular */
   int irregular;              /* 1 if any is: the proposal is forbidden for that */
   double dE;                  /* sum of dterm; +inf for a forbidden state, NaN never kept */
   size_t cap_seg;
-  lw_near_list near;          /* the pair walk's near pairs */
+  lw_near_list segs;          /* scratch: the near partners of one segment */
   lw_near_list partners;      /* near partners of the changed segments, old and new */
   double *near_new;           /* n_seg new near fields (no coefficient) */
   int pair_done;              /* 1 if the pair part was evaluated */
@@ -91,9 +108,13 @@ void lw_proposal_free(lw_proposal *p);
 /* Evaluates replacing n_node nodes of spline `spline` starting at local node
 ** node0 with `nodes` (copied into p; NULL: they are already in p->node).  Fills p->dterm and p->dE.  The
 ** state is not changed, but the pair term's near-field cache may be filled
-** (model.c): one thread per model. */
+** (model.c): one thread per model.  Should a near list fail to grow, the
+** pair term's difference and dE are NaN: the move is rejected. */
 void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t node0,
                       size_t n_node, const lw_node *nodes);
+
+/* Pair sample i of the model (grid position and weight, tangent). */
+void lw_model_pair_sample(const lw_model *m, uint32_t i, lw_pair_sample *s);
 
 /* Applies an evaluated proposal.  LW_ENOMEM if the grid could not grow. */
 lw_status lw_model_commit(lw_model *m, const lw_proposal *p);

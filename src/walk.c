@@ -1,0 +1,300 @@
+/* walk.c -- the far sum and the near pairs of a set of samples over the cell grid (walk.h). */
+#include "linewise/walk.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#if defined(__GNUC__)
+#define l_unlikely(x) __builtin_expect(!!(x), 0)
+#else
+#define l_unlikely(x) (x)
+#endif
+
+/* Entries scanned per call of scan: the bits of a uint64_t. */
+#define BLOCK 64
+
+typedef double v2d __attribute__((vector_size(16)));
+
+/* sqrt is correctly rounded in SSE2 and in C alike, so both branches give
+** the same bits. */
+static inline v2d vsqrt(v2d a)
+{
+#if defined(__SSE2__)
+  return (v2d)_mm_sqrt_pd((__m128d)a);
+#else
+  return (v2d){sqrt(a[0]), sqrt(a[1])};
+#endif
+}
+
+static inline v2d load2(const double *p)
+{
+  v2d v;
+  memcpy(&v, p, sizeof v);
+  return v;
+}
+
+typedef long long v2l __attribute__((vector_size(16)));
+typedef float v4f __attribute__((vector_size(16)));
+typedef int v4i __attribute__((vector_size(16)));
+typedef unsigned v4u __attribute__((vector_size(16)));
+
+/* One bit per lane of a comparison's result. */
+static inline unsigned bits2(v2l m)
+{
+#if defined(__SSE2__)
+  return (unsigned)_mm_movemask_pd((__m128d)m);
+#else
+  return (unsigned)(m[0] & 1) | (unsigned)(m[1] & 2);
+#endif
+}
+
+/* Lanes 0, 1 (lo) or 2, 3 (hi) of v as doubles (cvtps2pd; GCC's generic
+** conversion goes through the stack). */
+static inline v2d lo2d(v4f v)
+{
+#if defined(__SSE2__)
+  return (v2d)_mm_cvtps_pd((__m128)v);
+#else
+  return (v2d){v[0], v[1]};
+#endif
+}
+
+static inline v2d hi2d(v4f v)
+{
+#if defined(__SSE2__)
+  return (v2d)_mm_cvtps_pd(_mm_movehl_ps((__m128)v, (__m128)v));
+#else
+  return (v2d){v[2], v[3]};
+#endif
+}
+
+/* A 32-bit lane mask widened to 64-bit lanes: lanes 0, 1 (lo) or 2, 3 (hi). */
+static inline v2l lo2l(v4i m) { return (v2l)__builtin_shufflevector(m, m, 0, 0, 1, 1); }
+static inline v2l hi2l(v4i m) { return (v2l)__builtin_shufflevector(m, m, 2, 2, 3, 3); }
+
+/* A probe's constants in every lane, set up once per batch. */
+typedef struct {
+  v2d x, y;
+  v2d rc2;        /* far pairs need r^2 < rc2; -1 for a weightless probe */
+  v4f dl;
+  v2d scale;      /* scale dl: the factor on this probe's far pairs' dl_j (1/r - 1/rc) */
+  double gx[3], gy[3]; /* squared gaps to the columns and rows of the block (axis_gaps) */
+} probe_ctx;
+
+/* What every probe of a walk shares: the index filter, the near scale. */
+typedef struct {
+  /* own spline: idx - lo < span, unsigned; SSE2 compares signed 32-bit
+  ** lanes, so both sides carry the sign bit flipped: idx - (lo + 2^31) and
+  ** span - 2^31, as int */
+  v4u lo_flip;
+  v4i span_flip;
+  v4i from_flip;  /* idx >= from, flipped alike: idx - 2^31 >= from - 2^31 */
+  v2d ns;         /* near_scale */
+  v2d cut2;       /* rc^2: near pairs lie within the cutoff too */
+} shared_ctx;
+
+#define FLIP 0x80000000u
+
+/* The far sum of a walk: two accumulators of two lanes (entries 0, 1 and
+** 2, 3 of each group of four), which hide the divider's latency. */
+typedef struct {
+  v2d s0, s1;
+  v2d ic;
+} far_acc;
+
+/*
+** Entries [k0, k1) of cell c, k1 - k0 <= BLOCK, against the probes of
+** `mask` (bits into pc): far pairs go to fa, near ones to the near list
+** (room for (k1 - k0) times the probes is there).  Four entries at a time
+** (two SSE2 vectors of doubles, one of 32-bit lanes): what depends on the
+** entries alone (loads, index filter, weights) once, the distances per
+** probe.  The kernel runs on the four lanes of a probe and group only if
+** one of them is a far pair; the others are masked to +0 (whatever inf or
+** NaN they held).  Groups read past k1 (the cell's block is padded,
+** grid.h); those lanes are masked off.
+** `with_near` and `with_from` are constants at each call, so the common scan
+** carries neither test.
+*/
+static inline __attribute__((always_inline)) void
+scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const probe_ctx *pc, unsigned mask,
+     const uint32_t *probe_id, far_acc *fa, lw_pair_nearlist *near, const int with_near, const int with_from)
+{
+  uint64_t near_bits[LW_PAIR_BATCH] = {0};
+  const double *xs = c->x, *ys = lw_cell_y(c);
+  const uint32_t *id = lw_cell_idx(c);
+  const float *dls = lw_cell_dl(c);
+  const v4f zero = {0.0f, 0.0f, 0.0f, 0.0f};
+  const v4u flip = {FLIP, FLIP, FLIP, FLIP};
+  const v4i lane = {0, 1, 2, 3};
+  const v2d one = {1.0, 1.0};
+  v2d s0 = fa->s0, s1 = fa->s1;
+  for (uint32_t k = k0, t = 0; k < k1; k += 4, t += 4) {
+    v4u j;
+    v4f dlj;
+    memcpy(&j, id + k, sizeof j);
+    memcpy(&dlj, dls + k, sizeof dlj);
+    const v4i left_in_block = {(int)(k1 - k), (int)(k1 - k), (int)(k1 - k), (int)(k1 - k)};
+    /* never paired: samples of the probes' own spline, lanes past k1 */
+    v4i skip = ((v4i)(j - sh->lo_flip) < sh->span_flip) | (lane >= left_in_block);
+    v4i ok = ~skip & (v4i)(dlj > zero);
+    if (with_from) ok &= (v4i)(j ^ flip) >= sh->from_flip;
+    const v2l ok0 = lo2l(ok), ok1 = hi2l(ok);
+    const v2d x0 = load2(xs + k), x1 = load2(xs + k + 2), y0 = load2(ys + k), y1 = load2(ys + k + 2);
+    const v2d w0 = lo2d(dlj), w1 = hi2d(dlj);
+    for (unsigned left = mask; left; left &= left - 1) {
+      unsigned b = (unsigned)__builtin_ctz(left);
+      const probe_ctx *q = &pc[b];
+      v2d dx0 = x0 - q->x, dx1 = x1 - q->x, dy0 = y0 - q->y, dy1 = y1 - q->y;
+      v2d r0 = dx0 * dx0 + dy0 * dy0, r1 = dx1 * dx1 + dy1 * dy1;
+      v2l f0 = (r0 < q->rc2) & ok0, f1 = (r1 < q->rc2) & ok1;
+      if (with_near) {
+        /* the kernel's own test: max of the float weights, then in double */
+        v4i big = dlj > q->dl;
+        v4f dm = (v4f)(((v4i)dlj & big) | ((v4i)q->dl & ~big));
+        v2d l0 = sh->ns * lo2d(dm), l1 = sh->ns * hi2d(dm);
+        v2l n0 = (r0 < l0 * l0) & (r0 < sh->cut2) & ~lo2l(skip);
+        v2l n1 = (r1 < l1 * l1) & (r1 < sh->cut2) & ~hi2l(skip);
+        f0 &= ~n0;
+        f1 &= ~n1;
+        near_bits[b] |= (uint64_t)(bits2(n0) | bits2(n1) << 2) << t;
+      }
+      if (bits2(f0 | f1)) {
+        v2d v0 = (w0 * q->scale) * (one / vsqrt(r0) - fa->ic), v1 = (w1 * q->scale) * (one / vsqrt(r1) - fa->ic);
+        s0 += (v2d)((v2l)v0 & f0);
+        s1 += (v2d)((v2l)v1 & f1);
+      }
+    }
+  }
+  fa->s0 = s0;
+  fa->s1 = s1;
+  if (with_near)
+    for (unsigned left = mask; left; left &= left - 1) {
+      unsigned b = (unsigned)__builtin_ctz(left);
+      for (uint64_t bits = near_bits[b]; bits; bits &= bits - 1) {
+        uint32_t k = k0 + (uint32_t)__builtin_ctzll(bits);
+        near->pair[near->n++] = (lw_pair_near){xs[k], ys[k], dls[k], id[k], probe_id[b]};
+      }
+    }
+}
+
+void lw_pair_nearlist_free(lw_pair_nearlist *l)
+{
+  free(l->pair);
+  l->pair = NULL;
+  l->n = l->cap = 0;
+}
+
+static lw_status nearlist_reserve(lw_pair_nearlist *l, size_t more)
+{
+  if (l->cap - l->n >= more) return LW_OK;
+  size_t cap = l->cap ? 2 * l->cap : 64;
+  while (cap - l->n < more) cap *= 2;
+  lw_pair_near *pair = realloc(l->pair, cap * sizeof *pair);
+  if (!pair) return LW_ENOMEM;
+  l->pair = pair;
+  l->cap = cap;
+  return LW_OK;
+}
+
+/* Squared gaps along one axis between p, in cell c of the axis starting at
+** a with cells of side h, and the cells c - 1, c, c + 1: gap[0], 0, gap[2].
+** Only the sides facing p count, and those are true bounds even for edge
+** cells, which hold the points clamped from beyond the grid on their outer
+** sides. */
+static void axis_gaps(double a, double h, int c, double p, double gap[3])
+{
+  double below = p - (a + c * h), above = a + (c + 1) * h - p;
+  gap[0] = below * below;
+  gap[1] = 0.0;
+  gap[2] = above * above;
+}
+
+/* Cells are skipped when their gap exceeds the cutoff by this factor: a
+** point sits in its cell up to the rounding of (x - x0) / h. */
+#define GAP_MARGIN (1.0 + 1e-9)
+
+/* The probes sel[0..nb-1] of P, all in cell (cx, cy): one pass over its
+** 3 x 3 block. */
+static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const shared_ctx *sh,
+                            const lw_pair_probe *P, const uint32_t *sel, int nb, int cx, int cy, int with_from,
+                            far_acc *fa, lw_pair_nearlist *near)
+{
+  probe_ctx pc[LW_PAIR_BATCH];
+  const double h = 1.0 / g->inv_h, skip2 = ctx->cutoff2 * GAP_MARGIN;
+  const int with_near = ctx->near_scale > 0.0;
+  for (int b = 0; b < nb; b++) {
+    const lw_pair_probe *p = &P[sel[b]];
+    /* a weightless probe has no far pairs (its kernel is 0, even at r = 0) */
+    double rc2 = p->dl != 0.0f ? ctx->cutoff2 : -1.0;
+    pc[b] = (probe_ctx){{p->x, p->x}, {p->y, p->y}, {rc2, rc2}, {p->dl, p->dl, p->dl, p->dl},
+                        {p->scale * (double)p->dl, p->scale * (double)p->dl}, {0}, {0}};
+    axis_gaps(g->x0, h, cx, p->x, pc[b].gx);
+    axis_gaps(g->y0, h, cy, p->y, pc[b].gy);
+  }
+  const int x0 = cx > 0 ? cx - 1 : 0, x1 = cx + 1 < g->nx ? cx + 1 : g->nx - 1;
+  const int y0 = cy > 0 ? cy - 1 : 0, y1 = cy + 1 < g->ny ? cy + 1 : g->ny - 1;
+  for (int y = y0; y <= y1; y++) {
+    const lw_cell *row = g->cell + (size_t)y * (size_t)g->nx;
+    for (int x = x0; x <= x1; x++) {
+      const lw_cell *c = row + x;
+      if (!c->n) continue;
+      unsigned mask = 0;
+      for (int b = 0; b < nb; b++)
+        if (pc[b].gx[x - cx + 1] + pc[b].gy[y - cy + 1] <= skip2) mask |= 1u << b;
+      if (!mask) continue;
+      for (uint32_t k0 = 0; k0 < c->n; k0 += BLOCK) {
+        uint32_t k1 = c->n - k0 > BLOCK ? k0 + BLOCK : c->n;
+        if (with_near) {
+          if (l_unlikely(nearlist_reserve(near, (size_t)(k1 - k0) * (size_t)nb) != LW_OK)) return LW_ENOMEM;
+          if (with_from) scan(c, k0, k1, sh, pc, mask, sel, fa, near, 1, 1);
+          else scan(c, k0, k1, sh, pc, mask, sel, fa, near, 1, 0);
+        } else {
+          if (with_from) scan(c, k0, k1, sh, pc, mask, sel, fa, NULL, 0, 1);
+          else scan(c, k0, k1, sh, pc, mask, sel, fa, NULL, 0, 0);
+        }
+      }
+    }
+  }
+  return LW_OK;
+}
+
+lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pair_probe *P, size_t n,
+                       const lw_pair_filter *f, double *far, lw_pair_nearlist *near)
+{
+  const uint32_t lo = f->lo + FLIP;
+  const int span = (int)((f->hi - f->lo) ^ FLIP), from = (int)(f->from ^ FLIP);
+  const shared_ctx sh = {{lo, lo, lo, lo}, {span, span, span, span}, {from, from, from, from},
+                         {ctx->near_scale, ctx->near_scale}, {ctx->cutoff2, ctx->cutoff2}};
+  far_acc fa = {{0.0, 0.0}, {0.0, 0.0}, {ctx->inv_cutoff, ctx->inv_cutoff}};
+  *far = 0.0;
+  for (size_t c0 = 0; c0 < n; c0 += LW_PAIR_CHUNK) {
+    /* the chunk's probes in order of their cell (stable), so that each run
+    ** of one cell is one batch */
+    uint32_t cell[LW_PAIR_CHUNK], sel[LW_PAIR_CHUNK];
+    int nc = n - c0 < LW_PAIR_CHUNK ? (int)(n - c0) : LW_PAIR_CHUNK;
+    for (int i = 0; i < nc; i++) {
+      int cx, cy;
+      lw_cellgrid_locate(g, P[c0 + i].x, P[c0 + i].y, &cx, &cy);
+      cell[i] = (uint32_t)cy * (uint32_t)g->nx + (uint32_t)cx;
+      int k = i;
+      for (; k > 0 && cell[sel[k - 1] - c0] > cell[i]; k--) sel[k] = sel[k - 1];
+      sel[k] = (uint32_t)(c0 + (size_t)i);
+    }
+    for (int b = 0; b < nc;) {
+      uint32_t here = cell[sel[b] - c0];
+      int e = b + 1;
+      while (e < nc && e - b < LW_PAIR_BATCH && cell[sel[e] - c0] == here) e++;
+      int cx = (int)(here % (uint32_t)g->nx), cy = (int)(here / (uint32_t)g->nx);
+      if (walk_batch(g, ctx, &sh, P, sel + b, e - b, cx, cy, f->from > 0, &fa, near) != LW_OK) return LW_ENOMEM;
+      b = e;
+    }
+  }
+  v2d sum = fa.s0 + fa.s1;
+  *far = sum[0] + sum[1];
+  return LW_OK;
+}

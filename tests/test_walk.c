@@ -1,0 +1,163 @@
+/* test_walk.c -- the neighbour walk over the cell grid (walk.h) against brute force. */
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#include "linewise/grid.h"
+#include "linewise/pair.h"
+#include "linewise/quad.h"
+#include "linewise/walk.h"
+#include "testutil.h"
+
+#define N_SAMPLES 900
+#define PER_SPLINE 8
+#define PAGE 40.0
+#define CUTOFF 4.0
+
+typedef struct {
+  double x[N_SAMPLES], y[N_SAMPLES];
+  float dl[N_SAMPLES];
+  lw_cellgrid *g;
+  lw_pair_ctx ctx;
+} scene;
+
+/* Samples at random, some beyond the page (clamped into edge cells), some
+** weightless; spline i / PER_SPLINE, so a spline's samples are consecutive. */
+static void scene_init(scene *s, double near_scale)
+{
+  lw_pair_ctx_init(&s->ctx, CUTOFF, near_scale);
+  s->g = lw_cellgrid_new(0.0, 0.0, PAGE, PAGE, CUTOFF, N_SAMPLES, NULL);
+  cr_assert_not_null(s->g);
+  for (uint32_t i = 0; i < N_SAMPLES; i++) {
+    s->x[i] = urand(-3.0, PAGE + 3.0);
+    s->y[i] = urand(-3.0, PAGE + 3.0);
+    s->dl[i] = i % 37 == 5 ? 0.0f : (float)urand(0.1, 0.9);
+    cr_assert_eq(lw_cellgrid_insert(s->g, i, s->x[i], s->y[i], s->dl[i]), LW_OK);
+  }
+}
+
+/* The far sum and the near pairs of the walk's contract (walk.h), pair by pair. */
+static double brute(const scene *s, const lw_pair_probe *P, size_t n, const lw_pair_filter *f, uint64_t *near,
+                    size_t *n_near)
+{
+  double far = 0.0;
+  *n_near = 0;
+  for (size_t p = 0; p < n; p++)
+    for (uint32_t j = 0; j < N_SAMPLES; j++) {
+      if (j >= f->lo && j < f->hi) continue;
+      double dx = s->x[j] - P[p].x, dy = s->y[j] - P[p].y, r2 = dx * dx + dy * dy;
+      double lim = s->ctx.near_scale * (double)(P[p].dl > s->dl[j] ? P[p].dl : s->dl[j]);
+      if (r2 < lim * lim && r2 < s->ctx.cutoff2) near[(*n_near)++] = (uint64_t)p << 32 | j;
+      else if (r2 < s->ctx.cutoff2 && j >= f->from && P[p].dl != 0.0f && s->dl[j] != 0.0f)
+        far += P[p].scale * (double)P[p].dl * (double)s->dl[j] * (1.0 / sqrt(r2) - s->ctx.inv_cutoff);
+    }
+  return far;
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+  uint64_t u = *(const uint64_t *)a, v = *(const uint64_t *)b;
+  return u < v ? -1 : u > v;
+}
+
+/* Probes of spline `spline`: its own samples moved a little (as in a move),
+** scale +1, and the samples where they were, scale -1. */
+static size_t probes_of(const scene *s, uint32_t spline, lw_pair_probe *P)
+{
+  size_t n = 0;
+  for (uint32_t i = spline * PER_SPLINE; i < (spline + 1) * PER_SPLINE; i++) {
+    P[n++] = (lw_pair_probe){s->x[i] + urand(-0.3, 0.3), s->y[i] + urand(-0.3, 0.3), s->dl[i], 1.0};
+    P[n++] = (lw_pair_probe){s->x[i], s->y[i], s->dl[i], -1.0};
+  }
+  return n;
+}
+
+static void check(double near_scale, int with_from)
+{
+  static scene s;
+  rng_seed(0x5eed0000u + (uint64_t)(near_scale * 10) + (uint64_t)with_from);
+  scene_init(&s, near_scale);
+  lw_pair_nearlist near = {0};
+  lw_pair_probe P[2 * PER_SPLINE];
+  static uint64_t want[2 * PER_SPLINE * N_SAMPLES], got[2 * PER_SPLINE * N_SAMPLES];
+  for (uint32_t spline = 0; spline < N_SAMPLES / PER_SPLINE; spline++) {
+    size_t n = probes_of(&s, spline, P);
+    lw_pair_filter f = {spline * PER_SPLINE, (spline + 1) * PER_SPLINE,
+                        with_from ? (uint32_t)urand(0, N_SAMPLES) : 0};
+    size_t n_want;
+    double far_want = brute(&s, P, n, &f, want, &n_want), far;
+    near.n = 0;
+    cr_assert_eq(lw_pair_walk(s.g, &s.ctx, P, n, &f, &far, &near), LW_OK);
+    cr_assert(lw_close_rel(far, far_want, 1e-12, 1e-12), "spline %u: far %.17g, brute force %.17g", spline, far,
+              far_want);
+    cr_assert_eq(near.n, n_want, "spline %u: %zu near pairs, brute force %zu", spline, near.n, n_want);
+    for (size_t k = 0; k < near.n; k++) {
+      const lw_pair_near *q = &near.pair[k];
+      cr_assert(q->x == s.x[q->idx] && q->y == s.y[q->idx] && q->dl == s.dl[q->idx]);
+      got[k] = (uint64_t)q->probe << 32 | q->idx;
+    }
+    qsort(got, near.n, sizeof *got, cmp_u64);
+    qsort(want, n_want, sizeof *want, cmp_u64);
+    for (size_t k = 0; k < n_want; k++) cr_assert_eq(got[k], want[k], "spline %u: near pair %zu", spline, k);
+  }
+  lw_pair_nearlist_free(&near);
+  lw_cellgrid_free(s.g);
+}
+
+Test(walk, far_sum_matches_brute_force)
+{
+  check(0.0, 0);
+}
+
+Test(walk, far_sum_respects_from)
+{
+  check(0.0, 1);
+}
+
+Test(walk, near_pairs_whatever_from)
+{
+  check(1.5, 1);
+}
+
+Test(walk, near_pairs_without_from)
+{
+  check(1.5, 0);
+}
+
+/* Same positions, grids filled in different orders: the same bits. */
+Test(walk, independent_of_insertion_history)
+{
+  static scene a, b;
+  rng_seed(77);
+  scene_init(&a, 1.5);
+  lw_cellgrid_free(a.g);
+  b = a;
+  a.g = lw_cellgrid_new(0.0, 0.0, PAGE, PAGE, CUTOFF, N_SAMPLES, NULL);
+  b.g = lw_cellgrid_new(0.0, 0.0, PAGE, PAGE, CUTOFF, N_SAMPLES, NULL);
+  for (uint32_t i = 0; i < N_SAMPLES; i++) {
+    cr_assert_eq(lw_cellgrid_insert(a.g, i, a.x[i], a.y[i], a.dl[i]), LW_OK);
+    uint32_t k = N_SAMPLES - 1 - i;
+    /* b: inserted backwards, each first at a wrong place and then moved */
+    cr_assert_eq(lw_cellgrid_insert(b.g, k, b.y[k], b.x[k], 1.0f), LW_OK);
+    cr_assert_eq(lw_cellgrid_move(b.g, k, b.x[k], b.y[k], b.dl[k]), LW_OK);
+  }
+  lw_pair_probe P[2 * PER_SPLINE];
+  lw_pair_nearlist na = {0}, nb = {0};
+  for (uint32_t spline = 0; spline < N_SAMPLES / PER_SPLINE; spline += 7) {
+    size_t n = probes_of(&a, spline, P);
+    lw_pair_filter f = {spline * PER_SPLINE, (spline + 1) * PER_SPLINE, 0};
+    double fa, fb;
+    na.n = nb.n = 0;
+    cr_assert_eq(lw_pair_walk(a.g, &a.ctx, P, n, &f, &fa, &na), LW_OK);
+    cr_assert_eq(lw_pair_walk(b.g, &b.ctx, P, n, &f, &fb, &nb), LW_OK);
+    cr_assert_eq(fa, fb, "spline %u: %.17g against %.17g", spline, fa, fb);
+    cr_assert_eq(na.n, nb.n);
+    for (size_t k = 0; k < na.n; k++)
+      cr_assert(na.pair[k].idx == nb.pair[k].idx && na.pair[k].probe == nb.pair[k].probe);
+  }
+  lw_pair_nearlist_free(&na);
+  lw_pair_nearlist_free(&nb);
+  lw_cellgrid_free(a.g);
+  lw_cellgrid_free(b.g);
+}
