@@ -182,14 +182,13 @@ void bench_quadrature(bench_ctx *b)
   fprintf(d, "\nThe reference energies: total %.6g; strain %.4g, bending %.4g, potential %.4g, field %.4g,\n"
              "pair %.4g, boundary %.4g. The annealer ran with the regularity checks (energy.min_speed %g,\n"
              "energy.regularity %g: above); %zu of the %zu segments it left fail them, none is folded,\n"
-             "and bending converges like the other terms. The pair term converges only like 1/n^2: the\n"
-             "near field's element zone reaches 6 x near element lengths (%.1f mm here for a mean\n"
-             "element), past the cutoff, so most sample pairs within the cutoff go through the 2 x 2 rule\n"
-             "over straight tangent elements, which is second order in the element length; without the\n"
-             "near field the pair energy at 8 nodes is within about 1e-4 (below).\n\n",
+             "and bending converges like the other terms. The pair term's near field takes whole segment\n"
+             "pairs that come within %g length elements (%.2f mm here for a mean element, at most the\n"
+             "cutoff) to the double integral over the exact curves (NUMERICS.md); the others keep the\n"
+             "product rule, whose error left is mostly the kink of (1/r - 1/rc)+ at the cutoff.\n\n",
           v[ref].total, v[ref].term[0], v[ref].term[1], v[ref].term[2], v[ref].term[3], v[ref].term[4],
           v[ref].term[5], b->ann_params.min_speed, b->ann_params.regularity, irregular, sp->n_segments,
-          6 * b->ann_params.pair_near * b->ann_params.segment_length / b->ann_params.quadrature);
+          b->ann_params.pair_near, b->ann_params.pair_near * b->ann_params.segment_length / b->ann_params.quadrature);
   fprintf(d, "What the chain sees, and what it costs (proposals at T = %g on the annealed state):\n\n"
              "![error against ns per proposal for each node count](accuracy-quadrature.png)\n\n"
              "| nodes | dE | dE rms | decisions | ns per proposal | x cost of 8 |\n|---|---|---|---|---|---|\n",
@@ -272,8 +271,9 @@ void bench_cutoff(bench_ctx *b)
              "page edges that the shifted kernel 1/r - 1/rc leaves out. So the cutoff sets the range\n"
              "of the repulsion: a modelling choice whose cost grows with the number of neighbours, here\n"
              "as rc^%.2f (least squares from 2 mm up; the neighbours grow as rc^2, the fixed cost of a\n"
-             "proposal does not). A cutoff inside the exact near-field zone (%g element lengths, here\n"
-             "about %.2f mm) also leaves a jump in the kernel (pair.h).\n\n",
+             "proposal does not). A cutoff shorter than two length elements of the placed segments is\n"
+             "refused; a cutoff within the near radius (%g elements, here about %.2f mm) caps it, and\n"
+             "the energy stays continuous (NUMERICS.md).\n\n",
           v[ref].term[LW_TERM_PAIR], rc[time_ref], v[time_ref].term[LW_TERM_PAIR], b->cutoff_exponent,
           b->ann_params.pair_near, b->ann_params.pair_near * b->ann_params.segment_length / b->ann_params.quadrature);
 }
@@ -337,7 +337,8 @@ void bench_near(bench_ctx *b)
   fprintf(d, "## Near field\n\n"
              "Where curves touch or cross the double integral of 1/r is finite, but the Gauss product\n"
              "rule is not accurate there (and infinite where two samples coincide); the near field\n"
-             "integrates close sample pairs over straight elements instead (pair.h, NUMERICS.md).\n\n"
+             "integrates close segment pairs over the exact curves instead, blended smoothly into the\n"
+             "product rule (pairnear.h, NUMERICS.md).\n\n"
              "### Two curves\n\n"
              "Relative error of the pair energy of two curves (arcs of radius 3 and 2 of 4 segments\n"
              "each, units arbitrary) against a brute-force reference: nested adaptive Gauss-Kronrod\n"
@@ -360,8 +361,9 @@ void bench_near(bench_ctx *b)
     }
     lw_splines_free(sp);
   }
-  fprintf(d, "\nTouching curves keep an error of the order of the element length (the straight elements\n"
-             "of two curves that only touch cross each other); it halves with each doubling of nodes.\n\n");
+  fprintf(d, "\nWith the near field, curves that touch or cross are limited by the near field's own error,\n"
+             "which does not depend on the node count (largest where curves touch tangentially at a\n"
+             "shared node, NUMERICS.md); without it the product rule is off by up to the first column.\n\n");
 
   /* the annealed scene: near radii at 8 nodes against 64 nodes with near 1.5 */
   static const double scene_near[] = {0, 1, 1.5, 2, 3};
@@ -392,10 +394,9 @@ void bench_near(bench_ctx *b)
             v[i].spread);
     keep(&b->near, i, scene_near[i], e, &v[i]);
   }
-  fprintf(d, "\nWithout the near field the pair energy is closer to the reference, but close sample pairs\n"
-             "throw single proposals far off (dE rms) and more decisions differ; with it, the second-order\n"
-             "element rule handles most pairs within the cutoff (its zone reaches past it here), which\n"
-             "costs the 1e-2 in the energy and is why the pair term converges like 1/n^2 above.\n\n");
+  fprintf(d, "\nWithout the near field close sample pairs throw single proposals far off (dE rms) and more\n"
+             "decisions differ; the near field's cost grows with the share of segment pairs it takes\n"
+             "(ns per proposal).\n\n");
 }
 
 /* ---- the guide ---------------------------------------------------------- */
