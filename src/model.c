@@ -91,24 +91,11 @@ static lw_pair_filter filter_of(const pair_view *v, uint32_t spline, uint32_t fr
   return (lw_pair_filter){(uint32_t)(g0 * v->np), (uint32_t)((g0 + n) * v->np), from};
 }
 
-/* The Bezier control points of the segment from node a to node b. */
-static void node_bezier(const lw_node *a, const lw_node *b, double out[8])
-{
-  out[0] = a->px;
-  out[1] = a->py;
-  out[2] = a->px + a->vx;
-  out[3] = a->py + a->vy;
-  out[4] = b->px - b->vx;
-  out[5] = b->py - b->vy;
-  out[6] = b->px;
-  out[7] = b->py;
-}
-
 /* The Bezier control points of global segment g. */
 static void segment_bezier(const lw_splines *sp, size_t g, double b[8])
 {
   const lw_node *a = &sp->node[lw_segment_node(sp, g)];
-  node_bezier(a, a + 1, b);
+  lw_segment_bezier(a, a + 1, b);
 }
 
 static int cmp_u32(const void *a, const void *b)
@@ -532,14 +519,14 @@ static double pair_delta(const lw_model *m, lw_proposal *p, const lw_node *base,
     size_t g = g0 + p->seg0 + j;
     double bez[8];
     if (near_segments(p, np, j, 0, &p->segs) != LW_OK) return NAN;
-    node_bezier(proposed_node(base, p, p->seg0 + j), proposed_node(base, p, p->seg0 + j + 1), bez);
+    lw_segment_bezier(proposed_node(base, p, p->seg0 + j), proposed_node(base, p, p->seg0 + j + 1), bez);
     p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs);
     pe += p->near_new[j];
     for (size_t k = 0; k < p->segs.n; k++)
       if (list_push(&p->partners, p->segs.idx[k]) != LW_OK) return NAN;
     if (near_segments(p, np, j, 1, &p->segs) != LW_OK) return NAN;
     if (!m->near_valid[g]) {
-      node_bezier(&base[p->seg0 + j], &base[p->seg0 + j + 1], bez);
+      lw_segment_bezier(&base[p->seg0 + j], &base[p->seg0 + j + 1], bez);
       m->near_cache[g] = near_part(&v, bez, p->ps_old + j * np, &p->segs);
       m->near_valid[g] = 1;
     }

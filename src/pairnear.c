@@ -130,10 +130,8 @@ static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
 #define LEAF_RATIO 1e-2
 #define SINE_LO 0.1
 #define SINE_HI 0.2
-#ifndef CLOSE_LO
-#define CLOSE_LO 0.05
-#define CLOSE_HI 0.1
-#endif
+#define CLOSE_LO 0.1
+#define CLOSE_HI 0.2
 #define STACK_MAX 128
 
 /* Gauss-Legendre on [0, 1]: 6 nodes for small pieces, 16 for large ones. */
@@ -280,40 +278,41 @@ static void closest_points(const cubic *ca, const cubic *cb, double *ps, double 
       double dx = ra[i][0] - rb[j][0], dy = ra[i][1] - rb[j][1], q = dx * dx + dy * dy;
       if (q < best) best = q, s = i / 8.0, t = j / 8.0;
     }
-  /* Newton, one variable held where the step would leave the square, and a
-  ** step kept only if it brings the curves closer (so the grid's best is
-  ** never lost) */
-  for (int it = 0; it < 12; it++) {
+  /* Newton where the Hessian is positive definite, else steepest descent
+  ** scaled by the speeds; either step projected into the square and halved
+  ** until it brings the curves closer (so the grid's best is never lost) */
+  for (int it = 0; it < 30; it++) {
     double a[2], a1[2], a2[2], b[2], b1[2], b2[2];
     cubic_eval2(ca, s, a, a1, a2);
     cubic_eval2(cb, t, b, b1, b2);
     double D[2] = {a[0] - b[0], a[1] - b[1]};
     double gs = D[0] * a1[0] + D[1] * a1[1], gt = -(D[0] * b1[0] + D[1] * b1[1]);
-    double hss = a1[0] * a1[0] + a1[1] * a1[1] + D[0] * a2[0] + D[1] * a2[1];
-    double htt = b1[0] * b1[0] + b1[1] * b1[1] - D[0] * b2[0] - D[1] * b2[1];
+    double vs = a1[0] * a1[0] + a1[1] * a1[1], vt = b1[0] * b1[0] + b1[1] * b1[1];
+    double hss = vs + D[0] * a2[0] + D[1] * a2[1], htt = vt - D[0] * b2[0] - D[1] * b2[1];
     double hst = -(a1[0] * b1[0] + a1[1] * b1[1]);
-    double det = hss * htt - hst * hst, ds = 0.0, dt = 0.0;
-    if (det > 0.0 && hss > 0.0) {
+    double det = hss * htt - hst * hst, ds, dt;
+    if (det > 1e-12 * (vs * vt + 1e-300) && hss > 0.0) {
       ds = -(htt * gs - hst * gt) / det;
       dt = -(hss * gt - hst * gs) / det;
+    } else {
+      ds = vs > 0.0 ? -gs / vs : 0.0;
+      dt = vt > 0.0 ? -gt / vt : 0.0;
     }
-    if (!(det > 0.0 && hss > 0.0) || s + ds < 0.0 || s + ds > 1.0) { /* hold s */
-      ds = 0.0;
-      dt = htt > 0.0 ? -gt / htt : 0.0;
+    int moved = 0;
+    for (int half = 0; half < 20 && !moved; half++, ds *= 0.5, dt *= 0.5) {
+      double ns = fmin(1.0, fmax(0.0, s + ds)), nt = fmin(1.0, fmax(0.0, t + dt)), r[2], q[2], dd[2];
+      if (ns == s && nt == t) break;
+      cubic_eval(ca, ns, r, dd);
+      cubic_eval(cb, nt, q, dd);
+      double f = (r[0] - q[0]) * (r[0] - q[0]) + (r[1] - q[1]) * (r[1] - q[1]);
+      if (f < best) {
+        best = f;
+        s = ns;
+        t = nt;
+        moved = 1;
+      }
     }
-    if (t + dt < 0.0 || t + dt > 1.0) { /* hold t (and s too, if it was held) */
-      dt = 0.0;
-      ds = (ds != 0.0 || !(hss > 0.0)) ? ds : -gs / hss;
-      if (s + ds < 0.0 || s + ds > 1.0) ds = 0.0;
-    }
-    double ns = fmin(1.0, fmax(0.0, s + ds)), nt = fmin(1.0, fmax(0.0, t + dt)), r[2], q[2], dd[2];
-    cubic_eval(ca, ns, r, dd);
-    cubic_eval(cb, nt, q, dd);
-    double f = (r[0] - q[0]) * (r[0] - q[0]) + (r[1] - q[1]) * (r[1] - q[1]);
-    if (!(f < best)) break;
-    best = f;
-    s = ns;
-    t = nt;
+    if (!moved) break;
   }
   *ps = s;
   *pt = t;

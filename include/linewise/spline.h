@@ -59,11 +59,10 @@ static inline size_t lw_segment_index(const lw_splines *sp, size_t i, size_t m)
   return sp->first[i] - i + m;
 }
 
-/* The Bezier control points of segment m of spline i, b0 b1 b2 b3 as
-** x0 y0 x1 y1 x2 y2 x3 y3 (mm): p_m, p_m + v_m, p_{m+1} - v_{m+1}, p_{m+1}. */
-static inline void lw_splines_bezier(const lw_splines *sp, size_t i, size_t m, double b[8])
+/* The Bezier control points b0 b1 b2 b3 of the segment from node a to node
+** b, as x0 y0 x1 y1 x2 y2 x3 y3 (mm): p_a, p_a + v_a, p_b - v_b, p_b. */
+static inline void lw_segment_bezier(const lw_node *a, const lw_node *c, double b[8])
 {
-  const lw_node *a = &sp->node[sp->first[i] + m], *c = a + 1;
   b[0] = a->px;
   b[1] = a->py;
   b[2] = a->px + a->vx;
@@ -72,6 +71,13 @@ static inline void lw_splines_bezier(const lw_splines *sp, size_t i, size_t m, d
   b[5] = c->py - c->vy;
   b[6] = c->px;
   b[7] = c->py;
+}
+
+/* The Bezier control points of segment m of spline i (as above). */
+static inline void lw_splines_bezier(const lw_splines *sp, size_t i, size_t m, double b[8])
+{
+  const lw_node *a = &sp->node[sp->first[i] + m];
+  lw_segment_bezier(a, a + 1, b);
 }
 
 /* 1 if every control point of spline i equals its first point: the curve is
