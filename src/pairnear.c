@@ -3,46 +3,45 @@
 **
 ** lw_pair_segments_exact
 ** ----------------------
-** T = double integral of |a'| |b'| / r by adaptive subdivision of the
-** parameter square.  A piece [t0, t1] of a cubic is again a cubic: its Bezier
-** control points are r(t0), r(t0) + h r'(t0) / 3, r(t1) - h r'(t1) / 3, r(t1)
-** (h = t1 - t0) and it lies in their convex hull.  Two bounds of how far apart
-** two pieces are follow from that:
-**   circle gap: the distance of the circles about the chords' midpoints
-**     through the farthest control point, less their radii; good for pieces
-**     side by side or end to end;
-**   chord gap: the distance of the two chords less how far each piece's
-**     control points stray from its chord; good for long pieces running
-**     alongside each other.
-** The two segments whose chord gap exceeds CHORD_HI times half the larger
-** size take the 16 x 16 rule (rho >= 0.5 + sqrt(1.25) = 1.6 in the worst
-** place, beside a segment's middle: error below 1.6^-32 ~ 3e-7): most near
-** pairs of a drawing, neighbouring lines about an element apart, end there.
-** Below it, a pair of pieces whose circle gap exceeds SEP_HI times the
-** larger radius takes the 6 x 6 rule (1/r is analytic in a Bernstein
-** ellipse rho >= 1 + SEP_HI + sqrt((1 + SEP_HI)^2 - 1) = 3.7 about each
-** piece: error below rho^-12 ~ 1e-7 of the pair).  Other pairs are split, A
-** and B in turn, until
-** both are shorter than LEAF_RATIO of the segment pair's size, where the
-** chords stand in for the pieces and are integrated exactly (lw_pair_segseg):
-** an error of order curvature^2 leaf^2 where curves cross, of order the leaf
-** where they touch tangentially.  The subdivision follows the curves into
-** the points where they cross or touch and along stretches where they run
-** closer than their length.
+** The double integral of two cubic segments by the geometry of the pair
+** (derivation and measurements in docs/NUMERICS.md).  First the closest
+** points (s*, t*): the best of a 9 x 9 grid, then Newton (steepest descent
+** where the Hessian is not positive definite) projected into the square,
+** each step halved until it brings the curves closer.  With d their
+** distance, h the larger half-size of the two segments (bounding circles):
+**   apart, d / h >= APART_HI: the 16 x 16 Gauss rule of the whole kernel;
+**     the pole of 1/r is then at least 0.5 half-lengths from each segment,
+**     rho >= 0.5 + sqrt(1.25) = 1.6 beside its middle: error < 1.6^-32.
+**   meeting at an angle (the tangents at the closest points at a sine above
+**     SINE_HI) or running alongside at d / h >= CLOSE_HI: subtraction of
+**     S = 1/r of the tangent lines at the closest points, with the same
+**     parameters.  S has the kernel's singular point and leading behaviour,
+**     so K - S is bounded there and the 16 x 16 rule takes it; S over the
+**     square is the exact integral of two straight segments (lw_pair_segseg).
+**   otherwise (touching tangentially, shallow crossings): the subdivision
+**     below.
+** Between the thresholds (APART_LO, SINE_LO, CLOSE_LO) the methods are
+** blended by C2 weights, so the value is a continuous function of the
+** control points.
 **
-** Every decision is blended: between SEP_LO and SEP_HI (CHORD_LO and
-** CHORD_HI, leaf sizes 2 and 1) a pair takes a C2 weight of the product rule
-** and the rest from its children; and the split alternates between A and B
-** rather than following the larger piece.  So T is a continuous function of
-** the control points whatever the accuracy: curves pulled through the point
-** where a test flips see no jump.
+** The subdivision: a piece [t0, t1] of a cubic is again a cubic, with
+** control points r(t0), r(t0) + h r'(t0) / 3, r(t1) - h r'(t1) / 3, r(t1)
+** (h = t1 - t0), and lies in their convex hull, so in the circle about the
+** chord's midpoint through the farthest of them.  A pair of pieces whose
+** circles are more than SEP_HI times the larger radius apart takes the 6 x 6
+** rule (1/r is analytic in a Bernstein ellipse rho >= 1 + SEP_HI +
+** sqrt((1 + SEP_HI)^2 - 1) = 3.7 about each piece: error ~ 1e-7 of the
+** pair).  Other pairs are split, A and B in turn (a choice by size would flip
+** between two subtrees, whose values differ by their errors), down to
+** LEAF_RATIO of the pair's size, where the chords stand in for the pieces and
+** are integrated exactly: an error of order curvature^2 leaf^2 where curves
+** cross, of order the leaf where they touch tangentially.  Each decision is
+** blended too (SEP_LO to SEP_HI, leaf sizes 2 to 1).
 **
-** The cutoff: (1/r - 1/rc)+ = 1/r - 1/rc + (1/rc - 1/r)+.  The first two
-** parts are T - L_a L_b / rc; the last is bounded, vanishes where r < rc and
-** has only a kink where r = rc, so the fixed 16 x 16 rule over the whole
-** square takes it (accuracy ~ (element / rc)^2 of that part; fixed nodes keep
-** it continuous).  Segments that the 16 x 16 rule takes whole take the
-** cutoff kernel in the same pass.
+** The cutoff: (1/r - 1/rc)+ = 1/r - 1/rc + (1/rc - 1/r)+.  The last part is
+** bounded with a kink at r = rc; the fixed 16 x 16 rule takes it (accuracy ~
+** (element / rc)^2 of that part, continuous).  The 16 x 16 rule of the
+** apart case takes the whole cutoff kernel in the same pass.
 */
 #include "linewise/pairnear.h"
 
@@ -125,8 +124,8 @@ static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
 
 #define SEP_LO 0.5
 #define SEP_HI 1.0
-#define CHORD_LO 0.35
-#define CHORD_HI 0.5
+#define APART_LO 0.35
+#define APART_HI 0.5
 #define LEAF_RATIO 1e-2
 #define SINE_LO 0.1
 #define SINE_HI 0.2
@@ -370,13 +369,13 @@ double lw_pair_segments_exact(const double a[8], const double b[8], double cutof
   closest_points(&ca, &cb, &ss, &ts);
   cubic_eval(&ca, ss, ra, a1);
   cubic_eval(&cb, ts, rb, b1);
-  /* Segments farther apart than CHORD_HI times half the larger size take the
+  /* Segments farther apart than APART_HI times half the larger size take the
   ** 16 x 16 rule, the whole kernel with the cutoff in one pass: most near
   ** pairs of a drawing, neighbouring lines about an element apart, end
   ** there.  (The distance is the least over the segments, a continuous
   ** function of them wherever Newton lands.) */
   double half = fmax(pa.rad, pb.rad), dist = hypot(ra[0] - rb[0], ra[1] - rb[1]);
-  double w = half > 0.0 ? smooth_step((dist / half - CHORD_LO) / (CHORD_HI - CHORD_LO)) : 1.0;
+  double w = half > 0.0 ? smooth_step((dist / half - APART_LO) / (APART_HI - APART_LO)) : 1.0;
   kernel_kind whole = cutoff > 0.0 ? KERNEL_CUT : KERNEL_INV;
   double v = w > 0.0 ? w * product_rule(&ca, 0.0, 1.0, &cb, 0.0, 1.0, GAUSS_L, whole, cutoff) : 0.0;
   double rest = 1.0 - w;
