@@ -1,6 +1,6 @@
 /*
 ** pairref.h -- the pair energy of two curves two ways, shared by
-** tests/test_pair.c and the tools (bench-accuracy.c, pair-accuracy.c):
+** tests/test_pair.c and the benchmark (tools/bench-accuracy.c):
 ** the samples the kernel sums over, and a brute-force reference.
 **
 ** The reference is the double integral of |r0'| |r1'| / |r0 - r1| over splines 0 and 1 of sp,

@@ -16,7 +16,7 @@
 #include "pairref.h"
 #include "testutil.h"
 
-/* The recommended default near-field radius (pair.h, tools/pair-accuracy.c). */
+/* The default near-field radius (energy.pair_near; docs/NUMERICS.md). */
 #define NEAR_DEFAULT 1.5
 
 static const double PI = 3.14159265358979323846;

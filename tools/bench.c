@@ -119,7 +119,8 @@ static void bench_throughput(bench_ctx *b)
              "boundary), quadrature 8, T = %g after tuning. Near field off: the product rule for every\n"
              "pair; near 1.5: a sample pair closer than 1.5 length elements makes its two segments a near\n"
              "pair, which takes the near field (pairnear.h), the product rule the others. Random lines\n"
-             "cross: every crossing is a near pair, which an annealed drawing has few of.\n\n"
+             "cross, and every crossing is a near pair; crowded drawings have many near pairs too\n"
+             "(docs/ACCURACY.md, near field: 14 x the product rule's time on the annealed example).\n\n"
              "| scene | neighbours per sample | ns per proposal | proposals per second | x cost without pair | "
              "acceptance | bytes per segment |\n|---|---|---|---|---|---|---|\n",
           BENCH_T);
