@@ -113,6 +113,7 @@ static int cmp_u64(const void *a, const void *b)
 /* Sorts a list of segment numbers and drops repeats; returns the count. */
 static size_t unique_u32(uint32_t *v, size_t n)
 {
+  if (n < 2) return n; /* v may be NULL then, which qsort must not see */
   qsort(v, n, sizeof *v, cmp_u32);
   size_t m = 0;
   for (size_t i = 0; i < n; i++)
