@@ -429,13 +429,15 @@ double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, cons
     for (int j = 0; j < n; j++) {
       double dx = sa[i].x - sb[j].x, dy = sa[i].y - sb[j].y, r2 = dx * dx + dy * dy;
       double rho2 = lw_pair_near_radius2(ctx, sa[i].dl, sb[j].dl);
+      /* a sample without length weighs nothing, even at r = 0 (0 * inf) */
+      int weighs = sa[i].dl != 0.0f && sb[j].dl != 0.0f;
+      double k = weighs && r2 < cut2 ? (double)sa[i].dl * (double)sb[j].dl * (1.0 / sqrt(r2) - inv) : 0.0;
       if (r2 < rho2) {
         double w = near_weight(sqrt(r2 / rho2));
         if (w > W) W = w;
-        if (r2 < cut2 && sa[i].dl != 0.0f && sb[j].dl != 0.0f)
-          near += (double)sa[i].dl * (double)sb[j].dl * (1.0 / sqrt(r2) - inv);
-      } else if (r2 < cut2) {
-        far += (double)sa[i].dl * (double)sb[j].dl * (1.0 / sqrt(r2) - inv);
+        near += k;
+      } else {
+        far += k;
       }
     }
   }
