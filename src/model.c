@@ -20,8 +20,8 @@ int lw_segment_allowed(const lw_scene *sc, const lw_node *a, const lw_node *b, d
 /* Samples one segment and evaluates its length, its local terms and (if ps is
 ** not NULL) its pair samples, at the pair term's own nodes when it has them.
 ** Returns 1 if the segment is regular (lw_segment_allowed), 0 if forbidden. */
-static int segment_eval(const lw_scene *sc, const lw_node *a, const lw_node *b, uint32_t spline,
-                        lw_samples *s, double *len, double *local, lw_pair_sample *ps)
+static int segment_eval(const lw_scene *sc, const lw_node *a, const lw_node *b, lw_samples *s, double *len,
+                        double *local, lw_pair_sample *ps)
 {
   lw_segment_sample(&sc->quad, a, b, s);
   *len = s->length;
@@ -35,8 +35,7 @@ static int segment_eval(const lw_scene *sc, const lw_node *a, const lw_node *b, 
     ss = &pair_s;
   }
   for (int q = 0; q < ss->n; q++)
-    ps[q] = (lw_pair_sample){ss->x[q], ss->y[q], (float)ss->dx[q], (float)ss->dy[q], (float)ss->dl[q], spline,
-                             (uint32_t)q};
+    ps[q] = (lw_pair_sample){ss->x[q], ss->y[q], (float)ss->dl[q]};
   return regular;
 }
 
@@ -54,34 +53,21 @@ static lw_status list_push(lw_near_list *l, uint32_t v)
   return LW_OK;
 }
 
-static lw_pair_tangent tangent_of(const lw_pair_sample *s)
-{
-  return (lw_pair_tangent){s->dx, s->dy};
-}
-
-/* Where the pair term looks things up: the grid, the tangents, and the
-** splines' sample ranges (np samples per segment). */
+/* Where the pair term looks things up: the grid, and the splines' sample
+** ranges (np samples per segment). */
 typedef struct {
   const lw_cellgrid *g;
-  const lw_pair_tangent *pt;
   const lw_splines *sp;
   uint32_t np;
   const lw_pair_ctx *ctx;
 } pair_view;
 
-/* Sample i at (x, y) with weight dl: the rest from its index. */
-static lw_pair_sample sample_of(const pair_view *v, uint32_t i, double x, double y, float dl)
-{
-  return (lw_pair_sample){x, y, v->pt[i].dx, v->pt[i].dy, dl, v->sp->seg_spline[i / v->np], i % v->np};
-}
-
 /* Sample i from the grid. */
 static lw_pair_sample sample_at(const pair_view *v, uint32_t i)
 {
-  double x, y;
-  float dl;
-  lw_cellgrid_get(v->g, i, &x, &y, &dl);
-  return sample_of(v, i, x, y, dl);
+  lw_pair_sample s;
+  lw_cellgrid_get(v->g, i, &s.x, &s.y, &s.dl);
+  return s;
 }
 
 /* The filter of the samples of spline i: pairs with samples of index >= from. */
@@ -247,13 +233,12 @@ static double total_of(const double term[LW_TERM_COUNT], size_t irregular)
   return irregular ? INFINITY : total;
 }
 
-/* Puts the np pair samples ps of segment g into the grid and the tangents. */
-static lw_status store_samples(lw_cellgrid *grid, lw_pair_tangent *pt, size_t g, int np, const lw_pair_sample *ps)
+/* Puts the np pair samples ps of segment g into the grid. */
+static lw_status store_samples(lw_cellgrid *grid, size_t g, int np, const lw_pair_sample *ps)
 {
   for (int q = 0; q < np; q++) {
     size_t i = g * (size_t)np + (size_t)q;
     if (lw_cellgrid_insert(grid, (uint32_t)i, ps[q].x, ps[q].y, ps[q].dl) != LW_OK) return LW_ENOMEM;
-    pt[i] = tangent_of(&ps[q]);
   }
   return LW_OK;
 }
@@ -266,20 +251,18 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
   lw_samples s;
   double local[LW_TERM_COUNT];
   lw_pair_sample seg_ps[LW_QUAD_MAX];
-  lw_pair_tangent *pt = NULL;
   lw_cellgrid *grid = NULL;
   size_t n = sp->n_segments * (size_t)np, irregular = 0;
   double *seg_len = malloc((sp->n_segments ? sp->n_segments : 1) * sizeof *seg_len);
   if (!seg_len) goto nomem;
   if (sc->on[LW_TERM_PAIR]) {
-    if (!(pt = malloc((n ? n : 1) * sizeof *pt))) goto nomem;
     if (!(grid = grid_for(sc, n, err))) goto fail;
   }
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
-    irregular += !segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &seg_len[g], local, pt ? seg_ps : NULL);
+    irregular += !segment_eval(sc, a, a + 1, &s, &seg_len[g], local, grid ? seg_ps : NULL);
     for (int t = 0; t < sc->n_local; t++) term[sc->local[t]] += local[t];
-    if (pt && store_samples(grid, pt, g, np, seg_ps) != LW_OK) goto nomem;
+    if (grid && store_samples(grid, g, np, seg_ps) != LW_OK) goto nomem;
   }
   if (sc->on[LW_TERM_STRAIN])
     for (size_t i = 0; i < sp->n_splines; i++) {
@@ -289,13 +272,12 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
       term[LW_TERM_STRAIN] += strain_of_spline(sc, sp, seg_len, i, L);
     }
   if (grid) {
-    pair_view v = {grid, pt, sp, (uint32_t)np, &sc->pair};
+    pair_view v = {grid, sp, (uint32_t)np, &sc->pair};
     double e;
     if (pair_all(&v, &e) != LW_OK) goto nomem;
     term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * e;
   }
   free(seg_len);
-  free(pt);
   lw_cellgrid_free(grid);
   return total_of(term, irregular);
 nomem:
@@ -303,7 +285,6 @@ nomem:
                sp->n_segments, n);
 fail:
   free(seg_len);
-  free(pt);
   lw_cellgrid_free(grid);
   return NAN;
 }
@@ -326,16 +307,15 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
   if (!m->seg_len || !m->seg_local || !m->spline_len || !m->seg_irregular) goto nomem;
   if (sc->on[LW_TERM_PAIR]) {
     size_t n = sp->n_segments * (size_t)sc->pair_quad.n;
-    if (n >= UINT32_MAX || sp->n_splines > LW_PAIR_MAX_SPLINES) {
-      lw_error_set(err, LW_EINPUT, "%zu pair samples of %zu splines exceed the grid's limits "
-                   "(2^32 samples, 2^26 splines)", n, sp->n_splines);
+    if (n >= UINT32_MAX) {
+      lw_error_set(err, LW_EINPUT, "%zu pair samples of %zu splines exceed the grid's limit of 2^32 samples",
+                   n, sp->n_splines);
       lw_model_free(m);
       return NULL;
     }
-    m->pt = malloc((n ? n : 1) * sizeof *m->pt);
     m->near_cache = malloc(ns * sizeof *m->near_cache);
     m->near_valid = calloc(ns, sizeof *m->near_valid);
-    if (!m->pt || !m->near_cache || !m->near_valid) goto nomem;
+    if (!m->near_cache || !m->near_valid) goto nomem;
     m->grid = grid_for(sc, n, err);
     if (!m->grid) {
       lw_model_free(m);
@@ -360,7 +340,6 @@ void lw_model_free(lw_model *m)
   free(m->seg_local);
   free(m->spline_len);
   free(m->seg_irregular);
-  free(m->pt);
   free(m->near_cache);
   free(m->near_valid);
   lw_cellgrid_free(m->grid);
@@ -386,11 +365,11 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
     double *local = m->seg_local + g * (size_t)nl;
-    m->seg_irregular[g] = !segment_eval(sc, a, a + 1, sp->seg_spline[g], &s, &m->seg_len[g], local,
+    m->seg_irregular[g] = !segment_eval(sc, a, a + 1, &s, &m->seg_len[g], local,
                                         m->grid ? seg_ps : NULL);
     m->n_irregular += m->seg_irregular[g];
     for (int t = 0; t < nl; t++) term[sc->local[t]] += local[t];
-    if (m->grid && store_samples(m->grid, m->pt, g, np, seg_ps) != LW_OK) return LW_ENOMEM;
+    if (m->grid && store_samples(m->grid, g, np, seg_ps) != LW_OK) return LW_ENOMEM;
   }
   for (size_t i = 0; i < sp->n_splines; i++) {
     size_t g0 = lw_segment_index(sp, i, 0), n = lw_splines_segments(sp, i);
@@ -400,7 +379,7 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
     if (sc->on[LW_TERM_STRAIN]) term[LW_TERM_STRAIN] += strain_of_spline(sc, sp, m->seg_len, i, L);
   }
   if (m->grid) {
-    pair_view v = {m->grid, m->pt, sp, (uint32_t)np, &sc->pair};
+    pair_view v = {m->grid, sp, (uint32_t)np, &sc->pair};
     double e;
     memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);
     lw_cellgrid_fit(m->grid);
@@ -459,12 +438,6 @@ void lw_proposal_free(lw_proposal *p)
   free(p);
 }
 
-void lw_model_pair_sample(const lw_model *m, uint32_t i, lw_pair_sample *s)
-{
-  pair_view v = {m->grid, m->pt, m->sp, (uint32_t)m->scene->pair_quad.n, &m->scene->pair};
-  *s = sample_at(&v, i);
-}
-
 /* Node k of the spline as it would be after the proposal. */
 static inline const lw_node *proposed_node(const lw_node *base, const lw_proposal *p, size_t k)
 {
@@ -502,7 +475,7 @@ static double pair_delta(const lw_model *m, lw_proposal *p, const lw_node *base,
 {
   const lw_scene *sc = m->scene;
   const uint32_t np = (uint32_t)sc->pair_quad.n;
-  const pair_view v = {m->grid, m->pt, m->sp, np, &sc->pair};
+  const pair_view v = {m->grid, m->sp, np, &sc->pair};
   const size_t n = p->n_seg * np;
   /* the new samples add their pairs, the old ones take theirs away: one walk
   ** over both, each new sample next to its old self (usually in the same
@@ -566,7 +539,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
     size_t m_loc = p->seg0 + j, g = g0 + m_loc;
     double *local = p->local + j * (size_t)nl;
     p->seg_irregular[j] = !segment_eval(sc, proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1),
-                                        spline, &s, &p->len[j], local, m->grid ? p->ps + j * (size_t)np : NULL);
+                                        &s, &p->len[j], local, m->grid ? p->ps + j * (size_t)np : NULL);
     p->irregular |= p->seg_irregular[j];
     was_irregular |= m->seg_irregular[g];
     const double *old = m->seg_local + g * (size_t)nl;
@@ -607,7 +580,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   p->pair_done = 0;
   if (m->grid) {
     /* the old samples, from the grid: the walk's old side and a failed commit's undo */
-    pair_view v = {m->grid, m->pt, sp, (uint32_t)np, &sc->pair};
+    pair_view v = {m->grid, sp, (uint32_t)np, &sc->pair};
     size_t first = (g0 + p->seg0) * (size_t)np, n = p->n_seg * (size_t)np;
     for (size_t k = 0; k < n; k++) p->ps_old[k] = sample_at(&v, (uint32_t)(first + k));
   }
@@ -637,7 +610,6 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
           lw_cellgrid_move(m->grid, (uint32_t)(first + b), old[b].x, old[b].y, old[b].dl);
         return LW_ENOMEM;
       }
-    for (size_t k = 0; k < n; k++) m->pt[first + k] = tangent_of(&now[k]);
   }
   memcpy(&sp->node[sp->first[p->spline] + p->node0], p->node, p->n_node * sizeof *p->node);
   if (m->grid) {

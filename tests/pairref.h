@@ -28,7 +28,7 @@ static inline size_t lw_pairref_samples(const lw_splines *sp, const lw_quad *q, 
     lw_samples s;
     lw_segment_sample(q, &sp->node[k], &sp->node[k + 1], &s);
     for (int j = 0; j < s.n; j++)
-      out[n++] = (lw_pair_sample){s.x[j], s.y[j], s.dx[j], s.dy[j], s.dl[j], (uint32_t)i, (uint32_t)j};
+      out[n++] = (lw_pair_sample){s.x[j], s.y[j], (float)s.dl[j]};
   }
   return n;
 }

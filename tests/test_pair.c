@@ -611,9 +611,9 @@ Test(pair, near_correction_is_bitwise_symmetric)
     lw_samples s;
     lw_pair_sample pa[8], pb[8];
     lw_segment_sample(&q, &na[0], &na[1], &s);
-    for (int i = 0; i < 8; i++) pa[i] = (lw_pair_sample){s.x[i], s.y[i], s.dx[i], s.dy[i], s.dl[i], 0, (uint32_t)i};
+    for (int i = 0; i < 8; i++) pa[i] = (lw_pair_sample){s.x[i], s.y[i], (float)s.dl[i]};
     lw_segment_sample(&q, &nb[0], &nb[1], &s);
-    for (int i = 0; i < 8; i++) pb[i] = (lw_pair_sample){s.x[i], s.y[i], s.dx[i], s.dy[i], s.dl[i], 1, (uint32_t)i};
+    for (int i = 0; i < 8; i++) pb[i] = (lw_pair_sample){s.x[i], s.y[i], (float)s.dl[i]};
     double u = lw_pair_near_correction(a, pa, b, pb, 8, &ctx), v = lw_pair_near_correction(b, pb, a, pa, 8, &ctx);
     cr_assert(u == v && isfinite(u), "(a, b) %.17g, (b, a) %.17g", u, v);
   }

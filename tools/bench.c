@@ -50,18 +50,20 @@ static double mean_neighbours(const lw_model *m)
   size_t n = g->n_samples, step = n > 20000 ? n / 20000 : 1, count = 0, seen = 0;
   double rc2 = m->scene->pair.cutoff * m->scene->pair.cutoff;
   for (size_t i = 0; i < n; i += step, seen++) {
-    lw_pair_sample s;
-    lw_model_pair_sample(m, (uint32_t)i, &s);
+    double sx, sy;
+    float sdl;
+    lw_cellgrid_get(g, (uint32_t)i, &sx, &sy, &sdl);
+    uint32_t me = m->sp->seg_spline[i / (size_t)m->scene->pair_quad.n];
     int cx, cy;
-    lw_cellgrid_locate(g, s.x, s.y, &cx, &cy);
+    lw_cellgrid_locate(g, sx, sy, &cx, &cy);
     for (int y = cy - 1; y <= cy + 1; y++)
       for (int x = cx - 1; x <= cx + 1; x++) {
         if (x < 0 || y < 0 || x >= g->nx || y >= g->ny) continue;
         const lw_cell *c = &g->cell[y * g->nx + x];
         for (uint32_t k = 0; k < c->n; k++) {
-          double dx = c->x[k] - s.x, dy = lw_cell_y(c)[k] - s.y;
+          double dx = c->x[k] - sx, dy = lw_cell_y(c)[k] - sy;
           uint32_t other = m->sp->seg_spline[lw_cell_idx(c)[k] / (uint32_t)m->scene->pair_quad.n];
-          if (other != s.spline && dx * dx + dy * dy < rc2) count++;
+          if (other != me && dx * dx + dy * dy < rc2) count++;
         }
       }
   }
@@ -74,9 +76,11 @@ static double bytes_per_segment(const lw_model *m)
   const lw_splines *sp = m->sp;
   double b = sizeof *m + (double)sp->n_nodes * sizeof(lw_node) +
              (double)sp->n_splines * (2 * sizeof(size_t) + sizeof(double) + sizeof(double)) +
-             (double)sp->n_segments * (sizeof(uint32_t) + sizeof(double) +
+             (double)sp->n_segments * (sizeof(uint32_t) + sizeof(double) + sizeof *m->seg_irregular +
                                        (double)m->scene->n_local * sizeof(double));
-  if (m->grid) b += (double)m->grid->n_samples * sizeof(lw_pair_tangent) + (double)lw_cellgrid_bytes(m->grid);
+  if (m->grid)
+    b += (double)sp->n_segments * (sizeof *m->near_cache + sizeof *m->near_valid) +
+         (double)lw_cellgrid_bytes(m->grid);
   return b / (double)(sp->n_segments ? sp->n_segments : 1);
 }
 

@@ -31,16 +31,11 @@
 #include "linewise/spline.h"
 #include "linewise/walk.h"
 
-/* What the model keeps of a pair sample besides the grid's position and
-** weight (grid.h): its tangent, 8 bytes.  The grid holds x, y and dl once,
-** in the structure-of-arrays form the walk reads; the spline and node of
-** sample i follow from i (quad.n samples per segment, segments of a spline
-** consecutive).  lw_model_pair_sample puts the pieces together.  Per
-** segment at 8 nodes: 8 x (24 in a cell + 4 home + 8 tangent) = 288 bytes
-** of pair data plus the cells' spare room, against 8 x (32 + 4) before. */
-typedef struct {
-  float dx, dy;          /* r' at the node, mm per unit s */
-} lw_pair_tangent;
+/* The pair samples live in the grid only (grid.h: x, y and dl in the
+** structure-of-arrays form the walk reads); the spline and node of sample i
+** follow from i (quad.n samples per segment, the segments of a spline
+** consecutive).  Per segment at 8 nodes: 8 x (24 in a cell + 4 home) = 224
+** bytes of pair data plus the cells' spare room, against 8 x (32 + 4). */
 
 typedef struct {
   const lw_scene *scene;
@@ -51,7 +46,6 @@ typedef struct {
   unsigned char *seg_irregular; /* n_segments: 1 where a segment is irregular */
   size_t n_irregular;       /* how many; the total is +inf while > 0 */
   double term[LW_TERM_COUNT]; /* running totals (0 for terms that are off) */
-  lw_pair_tangent *pt;      /* n_segments * quad.n pair samples' tangents (pair on), else NULL */
   lw_cellgrid *grid;        /* the pair samples' positions and weights (pair on), else NULL */
   double *near_cache;       /* n_segments: each segment's pair near field (pair on) */
   uint8_t *near_valid;      /* n_segments: 1 where near_cache holds the current value */
@@ -88,7 +82,6 @@ typedef struct {
   lw_pair_sample *ps_old;     /* n_seg * quad.n pair samples before the move (pair on; the
                               ** walk's old side, and the undo of a failed commit) */
   lw_pair_probe *probe;       /* 2 n_seg quad.n: each new sample, then its old self, as probes */
-  const lw_pair_sample **probe_sample; /* the sample of each probe */
   lw_pair_nearlist near;      /* the walk's near pairs (walk.h) */
   double new_spline_len;
   double dterm[LW_TERM_COUNT];
@@ -112,9 +105,6 @@ void lw_proposal_free(lw_proposal *p);
 ** pair term's difference and dE are NaN: the move is rejected. */
 void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t node0,
                       size_t n_node, const lw_node *nodes);
-
-/* Pair sample i of the model (grid position and weight, tangent). */
-void lw_model_pair_sample(const lw_model *m, uint32_t i, lw_pair_sample *s);
 
 /* Applies an evaluated proposal.  LW_ENOMEM if the grid could not grow. */
 lw_status lw_model_commit(lw_model *m, const lw_proposal *p);

@@ -31,19 +31,16 @@
 
 #include "linewise/quad.h"
 
-/* One sample as the pair term (and the cell grid) sees it: 32 bytes, since
-** the walk over neighbours is bound by memory traffic.  Positions stay double
-** (a page of 1e6 mm must still resolve 1e-6 mm); the derivative and weight
-** are float, relative 6e-8, far below the quadrature's own error.  The
-** energy is defined by these stored values, so every sum (incremental or
-** from scratch) sees the same rounding. */
-#define LW_PAIR_MAX_SPLINES (1u << 26)
+/* One sample as the pair term sees it (the cell grid holds the same values
+** in structure-of-arrays form, grid.h).  Positions stay double (a page of
+** 1e6 mm must still resolve 1e-6 mm); the weight is float, relative 6e-8,
+** far below the quadrature's own error.  The energy is defined by these
+** stored values, so every sum (incremental or from scratch) sees the same
+** rounding.  The near field takes the curves from their control points, so
+** nothing else of a sample is kept. */
 typedef struct {
   double x, y;         /* r at the node, mm */
-  float dx, dy;        /* r' at the node, mm per unit s */
   float dl;            /* w_q |r'_q|, mm */
-  uint32_t spline : 26; /* owning spline (pairs within a spline do not count) */
-  uint32_t q : 6;      /* node index within its segment (LW_QUAD_MAX = 64) */
 } lw_pair_sample;
 
 typedef struct {
