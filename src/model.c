@@ -90,10 +90,11 @@ static int cmp_u32(const void *a, const void *b)
   return (x > y) - (x < y);
 }
 
-static int cmp_u64(const void *a, const void *b)
+/* Orders (lower, higher) segment pairs. */
+static int cmp_pair(const void *a, const void *b)
 {
-  uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-  return (x > y) - (x < y);
+  const uint32_t *x = a, *y = b;
+  return x[0] != y[0] ? (x[0] > y[0]) - (x[0] < y[0]) : (x[1] > y[1]) - (x[1] < y[1]);
 }
 
 /* Sorts a list of segment numbers and drops repeats; returns the count. */
@@ -134,8 +135,7 @@ static double near_part(const pair_view *v, const double bez[8], const lw_pair_s
 static lw_status pair_all(const pair_view *v, double *e)
 {
   lw_pair_nearlist near = {0};
-  uint64_t *key = NULL;
-  size_t n_key = 0, cap_key = 0;
+  lw_near_list pairs = {0}, segs = {0}; /* pairs: (lower, higher) segment, two entries each */
   const lw_cellgrid *g = v->g;
   double sum = 0.0, t;
   lw_status st = LW_OK;
@@ -143,46 +143,36 @@ static lw_status pair_all(const pair_view *v, double *e)
     const lw_cell *c = &g->cell[ci];
     const uint32_t *idx = lw_cell_idx(c);
     for (uint32_t k = 0; k < c->n && st == LW_OK; k++) {
-      uint32_t i = idx[k];
+      uint32_t i = idx[k], ga = i / v->np;
       lw_pair_probe P = {c->x[k], lw_cell_y(c)[k], lw_cell_dl(c)[k], 1.0};
-      lw_pair_filter f = filter_of(v, v->sp->seg_spline[i / v->np], i + 1);
+      lw_pair_filter f = filter_of(v, v->sp->seg_spline[ga], i + 1);
       near.n = 0;
       if ((st = lw_pair_walk(g, v->ctx, &P, 1, &f, &t, &near)) != LW_OK) break;
       sum += t;
-      for (size_t q = 0; q < near.n; q++) {
-        uint32_t ga = i / v->np, gb = near.pair[q].idx / v->np;
-        if (gb <= ga) continue;
-        if (n_key == cap_key) {
-          size_t cap = cap_key ? 2 * cap_key : 256;
-          uint64_t *nk = realloc(key, cap * sizeof *nk);
-          if (!nk) {
-            st = LW_ENOMEM;
-            break;
-          }
-          key = nk;
-          cap_key = cap;
-        }
-        key[n_key++] = (uint64_t)ga << 32 | gb;
+      for (size_t q = 0; q < near.n && st == LW_OK; q++) {
+        uint32_t gb = near.pair[q].idx / v->np;
+        if (gb > ga && (list_push(&pairs, ga) != LW_OK || list_push(&pairs, gb) != LW_OK)) st = LW_ENOMEM;
       }
     }
   }
-  if (st == LW_OK && n_key) {
-    qsort(key, n_key, sizeof *key, cmp_u64);
-    lw_pair_sample sa[LW_QUAD_MAX], sb[LW_QUAD_MAX];
-    for (size_t k = 0; k < n_key; k++) {
-      if (k > 0 && key[k] == key[k - 1]) continue;
-      uint32_t ga = (uint32_t)(key[k] >> 32), gb = (uint32_t)(key[k] & 0xffffffffu);
-      double a[8], b[8];
+  if (st == LW_OK && pairs.n) {
+    /* each lower segment with its sorted partners, in increasing order */
+    qsort(pairs.idx, pairs.n / 2, 2 * sizeof *pairs.idx, cmp_pair);
+    lw_pair_sample sa[LW_QUAD_MAX];
+    for (size_t k = 0; k < pairs.n && st == LW_OK; k += 2) {
+      uint32_t ga = pairs.idx[k];
+      if (k > 0 && ga == pairs.idx[k - 2]) continue;
+      segs.n = 0;
+      for (size_t j = k; j < pairs.n && pairs.idx[j] == ga && st == LW_OK; j += 2)
+        if (segs.n == 0 || segs.idx[segs.n - 1] != pairs.idx[j + 1]) st = list_push(&segs, pairs.idx[j + 1]);
+      double a[8];
       segment_bezier(v->sp, ga, a);
-      segment_bezier(v->sp, gb, b);
-      for (uint32_t q = 0; q < v->np; q++) {
-        sa[q] = sample_at(v, ga * v->np + q);
-        sb[q] = sample_at(v, gb * v->np + q);
-      }
-      sum += lw_pair_near_correction(a, sa, b, sb, (int)v->np, v->ctx);
+      for (uint32_t q = 0; q < v->np; q++) sa[q] = sample_at(v, ga * v->np + q);
+      sum += near_part(v, a, sa, &segs);
     }
   }
-  free(key);
+  free(pairs.idx);
+  free(segs.idx);
   lw_pair_nearlist_free(&near);
   *e = sum;
   return st;
