@@ -210,15 +210,6 @@ static int disc_bound(const double h[6], double R2)
   return p0 > 2.0 * R2 * (p1 + c2 * R2);
 }
 
-int lw_segment_regular(const lw_node *a, const lw_node *b, double min_speed)
-{
-  double h[6];
-  hodograph(a, b, h);
-  int clear = speed_bound(h, min_speed * min_speed);
-  if (clear) return clear > 0;
-  return lw_segment_min_speed(a, b) >= min_speed;
-}
-
 /* Bernstein ellipse parameter of the point t (foci 0 and 1): with
 ** z = 2t - 1, rho = |z + sqrt(z^2 - 1)| taken >= 1. */
 static double ellipse_rho(double complex t)

@@ -75,7 +75,7 @@ Test(regular, min_speed_finds_cusps_and_interior_minima)
   cr_assert(lw_segment_rho(&s0, &s1) == INFINITY);
   /* non-finite input is never regular */
   lw_node bad = {NAN, 0, 1, 0};
-  cr_assert(!lw_segment_regular(&bad, &s1, 0.1));
+  cr_assert(!lw_segment_check(&bad, &s1, 0.1, 0.0));
   cr_assert(isnan(lw_segment_rho(&bad, &s1)));
 }
 
@@ -87,8 +87,8 @@ Test(regular, the_cheap_bounds_never_disagree_with_the_exact_tests)
     random_segment(nd, it % 2 ? 1.0 : 4.0);
     double m = lw_segment_min_speed(&nd[0], &nd[1]);
     /* thresholds just below and just above the exact minimum */
-    cr_assert(lw_segment_regular(&nd[0], &nd[1], m * (1 - 1e-9)), "case %d: min %.17g refused", it, m);
-    cr_assert(!lw_segment_regular(&nd[0], &nd[1], m * (1 + 1e-9) + 1e-300), "case %d: min %.17g passed", it, m);
+    cr_assert(lw_segment_check(&nd[0], &nd[1], m * (1 - 1e-9), 0.0), "case %d: min %.17g refused", it, m);
+    cr_assert(!lw_segment_check(&nd[0], &nd[1], m * (1 + 1e-9) + 1e-300, 0.0), "case %d: min %.17g passed", it, m);
     double rho = lw_segment_rho(&nd[0], &nd[1]);
     if (rho > 1.0 + 1e-6 && isfinite(rho)) {
       cr_assert(lw_segment_check(&nd[0], &nd[1], 0, rho * (1 - 1e-9)), "case %d: rho %.17g refused", it, rho);

@@ -124,11 +124,6 @@ void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_
 ** and the two ends.  Not finite if a coordinate is not. */
 double lw_segment_min_speed(const lw_node *a, const lw_node *b);
 
-/* 1 if min |r'| >= min_speed: a cheap exact bound first (|r'|^2 is a quartic
-** whose Bernstein coefficients bound it from below), the cubic only for
-** segments the bound cannot clear.  0 for non-finite input. */
-int lw_segment_regular(const lw_node *a, const lw_node *b, double min_speed);
-
 /* How far the bending integrand (x'y'' - x''y')^2 / |r'|^5 stays analytic
 ** around [0, 1]: its singularities are the complex zeros of |r'(t)|^2, the
 ** roots of the complex quadratic h_x(t) + i h_y(t) (and their conjugates).
@@ -141,10 +136,10 @@ double lw_segment_rho(const lw_node *a, const lw_node *b);
 
 /* Both tests with one hodograph: 1 if min |r'| >= min_speed (mm per unit t;
 ** 0 = no test) and lw_segment_rho >= rho (<= 1 = no test).  Each first tries
-** a cheap exact bound (the Bernstein one above; for rho, the ellipse lies in
-** the disc |t - 1/2| <= (rho + 1/rho) / 4, where Taylor's bound at t = 1/2
-** keeps |h_x + i h_y| away from 0) and solves only when that is in doubt.
-** 0 for non-finite input. */
+** a cheap exact bound and solves only when that is in doubt: |r'|^2 is a
+** quartic whose Bernstein coefficients bound it from below; the ellipse rho
+** lies in the disc |t - 1/2| <= (rho + 1/rho) / 4, where Taylor's bound at
+** t = 1/2 keeps |h_x + i h_y| away from 0.  0 for non-finite input. */
 int lw_segment_check(const lw_node *a, const lw_node *b, double min_speed, double rho);
 
 /* 1 if every coordinate is finite. */
