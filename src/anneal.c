@@ -13,11 +13,14 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
+#include "linewise/checkpoint.h"
 #include "linewise/drawing.h"
 #include "linewise/fieldview.h"
 #include "linewise/init.h"
 #include "linewise/json.h"
+#include "linewise/number.h"
 #include "linewise/output.h"
 #include "linewise/state.h"
 
@@ -321,216 +324,27 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   return lw_anneal_checkpoint(a, err);
 }
 
-/* ---- checkpoints ---------------------------------------------------- */
+/* ---- checkpoints (checkpoint.c) ------------------------------------- */
 
-static char *fmt(const char *f, ...) __attribute__((format(printf, 1, 2)));
-static char *fmt(const char *f, ...)
-{
-  static char buf[1024];
-  va_list ap;
-  va_start(ap, f);
-  vsnprintf(buf, sizeof buf, f, ap);
-  va_end(ap);
-  return buf;
-}
+lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err) { return lw_checkpoint_write(a, err); }
 
-/* Appends "%lu"/"%.17g" lists to a buffer. */
-static int put_ulongs(char *buf, size_t cap, const unsigned long *v, int n)
-{
-  int k = 0;
-  for (int i = 0; i < n; i++) k += snprintf(buf + k, cap - (size_t)k, "%s%lu", i ? " " : "", v[i]);
-  return k;
-}
-
-static int put_doubles(char *buf, size_t cap, const double *v, int n)
-{
-  int k = 0;
-  for (int i = 0; i < n; i++) k += snprintf(buf + k, cap - (size_t)k, "%s%.17g", i ? " " : "", v[i]);
-  return k;
-}
-
-static void key_of(char *key, size_t n, const char *prefix, const char *name)
-{
-  snprintf(key, n, "%s%s", prefix, name);
-}
-
-/* What steers one rung's chain: its stream, steps, tuning window, counts. */
-static lw_status add_chain(lw_state *st, const char *prefix, const lw_chain *c)
-{
-  char key[64], buf[1024];
-  unsigned long v[3 * LW_MOVE_KINDS];
-  char *hex = lw_rng_save(c->rng);
-  if (!hex) return LW_ENOMEM;
-  key_of(key, sizeof key, prefix, "rng");
-  int bad = lw_state_add(st, key, hex);
-  free(hex);
-  put_doubles(buf, sizeof buf, c->step, LW_MOVE_KINDS);
-  key_of(key, sizeof key, prefix, "steps");
-  bad = bad || lw_state_add(st, key, buf);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
-    v[2 * k] = c->win_prop[k];
-    v[2 * k + 1] = c->win_acc[k];
-  }
-  put_ulongs(buf, sizeof buf, v, 2 * LW_MOVE_KINDS);
-  key_of(key, sizeof key, prefix, "tune_window");
-  bad = bad || lw_state_add(st, key, buf);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
-    v[3 * k] = c->stats[k].proposed;
-    v[3 * k + 1] = c->stats[k].accepted;
-    v[3 * k + 2] = c->stats[k].nan;
-  }
-  put_ulongs(buf, sizeof buf, v, 3 * LW_MOVE_KINDS);
-  key_of(key, sizeof key, prefix, "moves");
-  bad = bad || lw_state_add(st, key, buf);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) v[k] = c->stats[k].irregular;
-  put_ulongs(buf, sizeof buf, v, LW_MOVE_KINDS);
-  key_of(key, sizeof key, prefix, "moves_irregular");
-  bad = bad || lw_state_add(st, key, buf);
-  return bad ? LW_ENOMEM : LW_OK;
-}
-
-static lw_status add_energy(lw_state *st, const lw_model *m)
-{
-  char buf[1024];
-  put_doubles(buf, sizeof buf, m->term, LW_TERM_COUNT);
-  return lw_state_add(st, "energy", buf) ? LW_ENOMEM : LW_OK;
-}
-
-/* The exchange machinery: master stream, ladder, who is where, counts. */
-static lw_status add_tempering(lw_state *st, const lw_anneal *a)
-{
-  const lw_tempering *pt = a->pt;
-  int n = pt->n, bad = 0;
-  char buf[8192];
-  unsigned long v[2 * LW_TEMPERING_MAX];
-  char *hex = lw_rng_save(pt->rng);
-  if (!hex) return LW_ENOMEM;
-  bad = lw_state_add(st, "pt_rng", hex);
-  free(hex);
-  put_doubles(buf, sizeof buf, pt->ladder, n);
-  bad = bad || lw_state_add(st, "pt_ladder", buf);
-  for (int k = 0; k < n; k++) {
-    v[2 * k] = (unsigned long)pt->at[k];
-    v[2 * k + 1] = (unsigned long)(pt->label[k] + 1);
-  }
-  put_ulongs(buf, sizeof buf, v, 2 * n);
-  bad = bad || lw_state_add(st, "pt_at_label", buf);
-  for (int k = 0; k + 1 < n; k++) {
-    v[2 * k] = pt->tried[k];
-    v[2 * k + 1] = pt->accepted[k];
-  }
-  put_ulongs(buf, sizeof buf, v, 2 * (n - 1));
-  bad = bad || lw_state_add(st, "pt_swaps", buf);
-  for (int k = 0; k + 1 < n; k++) {
-    v[2 * k] = pt->win_tried[k];
-    v[2 * k + 1] = pt->win_accepted[k];
-  }
-  put_ulongs(buf, sizeof buf, v, 2 * (n - 1));
-  bad = bad || lw_state_add(st, "pt_window", buf);
-  put_ulongs(buf, sizeof buf, a->swap_mark, 2 * (n - 1));
-  bad = bad || lw_state_add(st, "pt_trace_mark", buf);
-  v[0] = pt->round_trips;
-  v[1] = pt->steps;
-  put_ulongs(buf, sizeof buf, v, 2);
-  bad = bad || lw_state_add(st, "pt_trips_steps", buf);
-  for (int k = 1; !bad && k < n; k++) {
-    char prefix[32];
-    snprintf(prefix, sizeof prefix, "rung%d_", k);
-    bad = add_chain(st, prefix, a->chains[k]) != LW_OK;
-  }
-  return bad ? LW_ENOMEM : LW_OK;
-}
-
-/* replica-K.lw: the state at rung K >= 1 and its running energies. */
-static lw_status write_replica(const lw_anneal *a, int k, lw_error *err)
-{
-  lw_state st = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep, .sp = a->chains[k]->model->sp};
-  char name[64], path[LW_PATH_MAX + 64];
-  snprintf(name, sizeof name, "replica-%d.lw", k);
-  dir_file(path, sizeof path, a, name);
-  lw_status s = add_energy(&st, a->chains[k]->model);
-  if (s) s = lw_error_set(err, LW_ENOMEM, "out of memory writing a checkpoint");
-  else s = lw_state_write(&st, path, err);
-  st.sp = NULL;
-  lw_state_clear(&st);
-  return s;
-}
-
-lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
-{
-  lw_chain *c = a->chain;
-  lw_state st = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep, .sp = a->model->sp};
-  lw_status s = LW_OK;
-  char buf[1024];
-  unsigned long v[3 * LW_MOVE_KINDS];
-  /* The replicas first: state.lw, written last, is what resume starts from,
-  ** and its sweep must match theirs. */
-  for (int k = 1; k < a->n_rep && !s; k++) s = write_replica(a, k, err);
-  if (s) return s;
-#define ADD(key, value) do { if (!s && lw_state_add(&st, key, value)) s = LW_ENOMEM; } while (0)
-  s = add_chain(&st, "", c);
-  ADD("temperature", fmt("%.17g", a->t_sched));
-  ADD("block", fmt("%ld", a->block));
-  ADD("t_prev", fmt("%.17g", a->t_prev));
-  ADD("prev_stats", fmt("%.17g %.17g %ld", a->prev.mean, a->prev.sd, a->prev.samples));
-  ADD("block_energy", fmt("%.17g %.17g %.17g", a->acc_n, a->acc_sum, a->acc_sumsq));
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
-    v[3 * k] = a->trace_mark[k].proposed;
-    v[3 * k + 1] = a->trace_mark[k].accepted;
-    v[3 * k + 2] = a->trace_mark[k].nan;
-  }
-  put_ulongs(buf, sizeof buf, v, 3 * LW_MOVE_KINDS);
-  ADD("trace_mark", buf);
-  if (!s) s = add_energy(&st, a->model);
-  ADD("energy_initial", fmt("%.17g", a->energy_initial));
-  ADD("max_drift", fmt("%.17g", a->max_drift));
-  if (!s && a->pt) s = add_tempering(&st, a);
-#undef ADD
-  char path[LW_PATH_MAX + 32];
-  dir_file(path, sizeof path, a, "state.lw");
-  if (!s) s = lw_state_write(&st, path, err);
-  else s = lw_error_set(err, LW_ENOMEM, "out of memory writing a checkpoint");
-  if (!s && a->trace && fflush(a->trace)) s = lw_error_set(err, LW_EIO, "%s/trace.csv: write failed", a->dir);
-  /* Wall time differs from run to run, so it lives beside the state, which
-  ** must be byte-identical for the same sweeps. */
-  if (!s) {
-    char tmp[LW_PATH_MAX + 64];
-    dir_file(path, sizeof path, a, "timing.txt");
-    FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
-    if (!f) s = err->code;
-    else {
-      fprintf(f, "wall_seconds %.6f\n", lw_anneal_seconds(a));
-      s = lw_output_commit(f, tmp, path, err);
-    }
-  }
-  st.sp = NULL; /* the model's */
-  lw_state_clear(&st);
-  return s;
-}
-
-/* Parses exactly n numbers of a run-data line. */
-static lw_status read_numbers(const lw_state *st, const char *path, const char *key, double *out, int n,
-                              lw_error *err)
-{
-  const lw_state_extra *e = lw_state_get(st, key);
-  if (!e) return lw_error_set(err, LW_EINPUT, "%s: %s: missing (not a checkpoint of a run?)", path, key);
-  const char *c = e->value;
-  for (int i = 0; i < n; i++) {
-    char *end;
-    out[i] = strtod(c, &end);
-    if (end == c || isnan(out[i]))
-      return lw_error_set(err, LW_EINPUT, "%s:%d: %s: expected %d numbers, got '%s'", path, e->line, key, n, e->value);
-    c = end;
-  }
-  while (*c == ' ') c++;
-  if (*c) return lw_error_set(err, LW_EINPUT, "%s:%d: %s: expected %d numbers, got '%s'", path, e->line, key, n, e->value);
-  return LW_OK;
-}
-
-static lw_status truncate_trace(lw_anneal *a, lw_error *err)
+/* trace.csv back to the checkpoint: rows written after it belong to sweeps
+** that will run again.  A format-2 checkpoint knows the length it synced;
+** a format-1 one only its sweep, so complete rows up to it are kept. */
+static lw_status truncate_trace(lw_anneal *a, long bytes, lw_error *err)
 {
   char path[LW_PATH_MAX + 32], tmp[LW_PATH_MAX + 64];
   dir_file(path, sizeof path, a, "trace.csv");
+  if (bytes >= 0) {
+    struct stat sb;
+    if (stat(path, &sb))
+      return lw_error_set(err, LW_EINPUT, "%s: %s, but state.lw counts %ld bytes of it", path, strerror(errno), bytes);
+    if (!S_ISREG(sb.st_mode) || sb.st_size < bytes)
+      return lw_error_set(err, LW_EINPUT, "%s: %lld bytes, but state.lw counts %ld (the trace was cut or replaced)",
+                          path, (long long)sb.st_size, bytes);
+    if (truncate(path, bytes)) return lw_error_set(err, LW_EIO, "%s: cannot truncate: %s", path, strerror(errno));
+    return open_trace(a, 0, err);
+  }
   FILE *in = fopen(path, "r");
   if (!in) return open_trace(a, 1, err);
   FILE *out = lw_output_open_tmp(path, tmp, sizeof tmp, err);
@@ -540,11 +354,19 @@ static lw_status truncate_trace(lw_anneal *a, lw_error *err)
   }
   char *line = NULL;
   size_t cap = 0;
-  int first = 1;
-  /* rows written after the checkpoint belong to sweeps that will run again */
-  while (getline(&line, &cap, in) >= 0) {
-    if (first || strtol(line, NULL, 10) <= a->sweep) fputs(line, out);
-    first = 0;
+  ssize_t len;
+  for (int first = 1; (len = getline(&line, &cap, in)) > 0; first = 0) {
+    /* a torn last row has no newline; its sweep may read as a smaller one */
+    long long sweep;
+    size_t nf = strcspn(line, ",");
+    if (line[len - 1] != '\n') break;
+    if (!first) {
+      line[nf] = '\0';
+      int ok = lw_number_parse_whole(line, 0, LW_STATE_SWEEP_MAX, &sweep) && sweep <= a->sweep;
+      line[nf] = ',';
+      if (!ok) break;
+    }
+    fputs(line, out);
   }
   free(line);
   fclose(in);
@@ -552,109 +374,33 @@ static lw_status truncate_trace(lw_anneal *a, lw_error *err)
   return s ? s : open_trace(a, 0, err);
 }
 
-static lw_status read_chain(const lw_state *st, const char *path, const char *prefix, lw_chain *c,
-                            lw_error *err)
+/* The splines of rung k: a section of state.lw, or (format 1) replica-K.lw,
+** whose document *rep keeps the replica's run data for the upgrade. */
+static lw_status rung_splines(lw_anneal *a, const lw_state *st, int k, lw_splines **sp, lw_ckpt **rep,
+                              lw_error *err)
 {
-  char key[64];
-  double v[3 * LW_MOVE_KINDS];
+  char name[64], path[LW_PATH_MAX + 64];
   lw_status s;
-  key_of(key, sizeof key, prefix, "rng");
-  const lw_state_extra *rng = lw_state_get(st, key);
-  if (!rng || !lw_rng_load(c->rng, rng->value))
-    return lw_error_set(err, LW_EINPUT, "%s:%d: %s: expected the generator state in hex", path, rng ? rng->line : 0,
-                        key);
-  key_of(key, sizeof key, prefix, "steps");
-  if ((s = read_numbers(st, path, key, v, LW_MOVE_KINDS, err))) return s;
-  for (int k = 0; k < LW_MOVE_KINDS; k++) c->step[k] = v[k];
-  key_of(key, sizeof key, prefix, "tune_window");
-  if ((s = read_numbers(st, path, key, v, 2 * LW_MOVE_KINDS, err))) return s;
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
-    c->win_prop[k] = (unsigned long)v[2 * k];
-    c->win_acc[k] = (unsigned long)v[2 * k + 1];
+  if (st->version != 1) {
+    snprintf(name, sizeof name, "system splines %d", k);
+    dir_file(path, sizeof path, a, "state.lw");
+    s = lw_state_get_splines(st->doc, name, sp, err);
+  } else {
+    lw_state r;
+    snprintf(name, sizeof name, "replica-%d.lw", k);
+    dir_file(path, sizeof path, a, name);
+    if ((s = lw_state_read(&r, path, err))) return s;
+    if (r.sweep != st->sweep || r.version != 1)
+      s = lw_error_set(err, LW_EINPUT, "%s: sweep %ld of format %d, but state.lw is at sweep %ld of format 1 (an "
+                       "interrupted checkpoint of an older release?)", path, r.sweep, r.version, st->sweep);
+    *sp = r.sp;
+    *rep = r.doc;
+    r.sp = NULL;
+    r.doc = NULL;
+    lw_state_clear(&r);
   }
-  key_of(key, sizeof key, prefix, "moves");
-  if ((s = read_numbers(st, path, key, v, 3 * LW_MOVE_KINDS, err))) return s;
-  for (int k = 0; k < LW_MOVE_KINDS; k++)
-    c->stats[k] = (lw_move_stats){.proposed = (unsigned long)v[3 * k], .accepted = (unsigned long)v[3 * k + 1],
-                                  .nan = (unsigned long)v[3 * k + 2]};
-  /* A separate line, so states written before it was counted still resume
-  ** (with 0 rejections for irregularity so far). */
-  key_of(key, sizeof key, prefix, "moves_irregular");
-  if (lw_state_get(st, key)) {
-    if ((s = read_numbers(st, path, key, v, LW_MOVE_KINDS, err))) return s;
-    for (int k = 0; k < LW_MOVE_KINDS; k++) c->stats[k].irregular = (unsigned long)v[k];
-  }
-  return LW_OK;
-}
-
-/* The running totals carry the rounding of the moves so far; restoring them
-** (rather than the fresh sums) keeps the trace identical to an uninterrupted
-** run. */
-static lw_status read_energy(const lw_state *st, const char *path, lw_model *m, lw_error *err)
-{
-  /* States written before the parametrisation term (the last) hold one
-  ** number fewer; that term was off in them. */
-  const lw_state_extra *e = lw_state_get(st, "energy");
-  int n = LW_TERM_COUNT, words = 0;
-  for (const char *c = e ? e->value : ""; *c;) {
-    while (*c == ' ') c++;
-    if (!*c) break;
-    words++;
-    while (*c && *c != ' ') c++;
-  }
-  if (words == LW_TERM_COUNT - 1) {
-    n = LW_TERM_COUNT - 1;
-    m->term[LW_TERM_PARAM] = 0.0;
-  }
-  return read_numbers(st, path, "energy", m->term, n, err);
-}
-
-static lw_status read_tempering(lw_anneal *a, const lw_state *st, const char *path, lw_error *err)
-{
-  lw_tempering *pt = a->pt;
-  int n = pt->n;
-  double v[2 * LW_TEMPERING_MAX];
-  lw_status s;
-  const lw_state_extra *rng = lw_state_get(st, "pt_rng");
-  if (!rng || !lw_rng_load(pt->rng, rng->value))
-    return lw_error_set(err, LW_EINPUT, "%s:%d: pt_rng: expected the generator state in hex", path,
-                        rng ? rng->line : 0);
-  if ((s = read_numbers(st, path, "pt_ladder", pt->ladder, n, err))) return s;
-  if ((s = read_numbers(st, path, "pt_at_label", v, 2 * n, err))) return s;
-  int seen[LW_TEMPERING_MAX] = {0};
-  for (int k = 0; k < n; k++) {
-    int r = (int)v[2 * k];
-    if (r < 0 || r >= n || seen[r] || v[2 * k + 1] < 0 || v[2 * k + 1] > 2)
-      return lw_error_set(err, LW_EINPUT, "%s: pt_at_label: expected a permutation of the replicas", path);
-    seen[r] = 1;
-    pt->at[k] = r;
-    pt->label[k] = (int)v[2 * k + 1] - 1;
-  }
-  if ((s = read_numbers(st, path, "pt_swaps", v, 2 * (n - 1), err))) return s;
-  for (int k = 0; k + 1 < n; k++) {
-    pt->tried[k] = (unsigned long)v[2 * k];
-    pt->accepted[k] = (unsigned long)v[2 * k + 1];
-  }
-  if ((s = read_numbers(st, path, "pt_window", v, 2 * (n - 1), err))) return s;
-  for (int k = 0; k + 1 < n; k++) {
-    pt->win_tried[k] = (unsigned long)v[2 * k];
-    pt->win_accepted[k] = (unsigned long)v[2 * k + 1];
-  }
-  if ((s = read_numbers(st, path, "pt_trace_mark", v, 2 * (n - 1), err))) return s;
-  for (int k = 0; k < 2 * (n - 1); k++) a->swap_mark[k] = (unsigned long)v[k];
-  if ((s = read_numbers(st, path, "pt_trips_steps", v, 2, err))) return s;
-  pt->round_trips = (unsigned long)v[0];
-  pt->steps = (unsigned long)v[1];
-  for (int k = 1; k < n; k++) {
-    char prefix[32];
-    snprintf(prefix, sizeof prefix, "rung%d_", k);
-    if ((s = read_chain(st, path, prefix, a->chains[k], err))) return s;
-  }
-  /* models[] is by replica: rung k holds replica at[k] */
-  lw_model *by_rung[LW_TEMPERING_MAX];
-  for (int k = 0; k < n; k++) by_rung[k] = a->models[k];
-  for (int k = 0; k < n; k++) a->models[pt->at[k]] = by_rung[k];
-  return LW_OK;
+  if (!s) s = lw_model_check_regular(&a->scene, *sp, path, err);
+  return s;
 }
 
 lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *err)
@@ -664,80 +410,43 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   char path[LW_PATH_MAX + 32], scene_path[2 * LW_PATH_MAX + 2];
   dir_file(path, sizeof path, a, "state.lw");
-  lw_state st, rep[LW_TEMPERING_MAX];
-  int n_read = 0;
+  lw_state st;
+  lw_splines *all[LW_TEMPERING_MAX] = {NULL};
+  lw_ckpt *rep[LW_TEMPERING_MAX] = {NULL};
   lw_status s = lw_state_read(&st, path, err);
   if (s) return s;
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);
   double ladder[LW_TEMPERING_MAX];
+  long trace_bytes = -1;
   if ((s = lw_params_read(&a->params, scene_path, err)) || (s = setup_ladder(a, ladder, err)) ||
       (s = setup_schedule(a, err)) || (s = lw_scene_init(&a->scene, &a->params, err)) ||
-      (s = setup_tone(a, err))) {
-    lw_state_clear(&st);
-    return s;
-  }
-  if ((s = lw_model_check_regular(&a->scene, st.sp, path, err))) {
-    lw_state_clear(&st);
-    return s;
-  }
+      (s = setup_tone(a, err)) || (s = lw_model_check_regular(&a->scene, st.sp, path, err)))
+    goto out;
   a->seed = st.seed;
   a->sweep = st.sweep;
-  lw_splines *all[LW_TEMPERING_MAX] = {st.sp};
+  all[0] = st.sp;
   st.sp = NULL;
-  for (int k = 1; k < a->n_rep; k++, n_read++) {
-    char name[64], rpath[LW_PATH_MAX + 64];
-    snprintf(name, sizeof name, "replica-%d.lw", k);
-    dir_file(rpath, sizeof rpath, a, name);
-    s = lw_state_read(&rep[k], rpath, err);
-    if (!s) s = lw_model_check_regular(&a->scene, rep[k].sp, rpath, err);
-    if (!s && rep[k].sweep != a->sweep)
-      s = lw_error_set(err, LW_EINPUT, "%s: sweep %ld, but state.lw is at sweep %ld (an interrupted checkpoint?)",
-                       rpath, rep[k].sweep, a->sweep);
-    if (s) {
-      lw_state_clear(&rep[k]);
-      for (int q = 0; q < k; q++) lw_splines_free(all[q]);
-      goto out;
-    }
-    all[k] = rep[k].sp;
-    rep[k].sp = NULL;
+  for (int k = 1; k < a->n_rep && !s; k++) s = rung_splines(a, &st, k, &all[k], &rep[k], err);
+  if (s) {
+    for (int k = 0; k < a->n_rep; k++) lw_splines_free(all[k]);
+    goto out;
   }
   if ((s = build(a, all, ladder, err))) goto out;
-  dir_file(path, sizeof path, a, "state.lw");
-  double v[3 * LW_MOVE_KINDS];
-  if ((s = read_chain(&st, path, "", a->chain, err))) goto out;
-#define NUMS(key, n) if ((s = read_numbers(&st, path, key, v, n, err))) goto out
-  NUMS("temperature", 1); a->t_sched = v[0];
-  NUMS("block", 1); a->block = (long)v[0];
-  NUMS("t_prev", 1); a->t_prev = v[0];
-  NUMS("prev_stats", 3); a->prev = (lw_block_stats){v[0], v[1], (long)v[2]};
-  NUMS("block_energy", 3); a->acc_n = v[0]; a->acc_sum = v[1]; a->acc_sumsq = v[2];
-  NUMS("trace_mark", 3 * LW_MOVE_KINDS);
-  for (int k = 0; k < LW_MOVE_KINDS; k++)
-    a->trace_mark[k] = (lw_move_stats){.proposed = (unsigned long)v[3 * k], .accepted = (unsigned long)v[3 * k + 1],
-                                       .nan = (unsigned long)v[3 * k + 2]};
-  if ((s = read_energy(&st, path, a->model, err))) goto out;
-  NUMS("energy_initial", 1); a->energy_initial = v[0];
-  NUMS("max_drift", 1); a->max_drift = v[0];
-#undef NUMS
-  for (int k = 1; k < a->n_rep; k++) {
-    char name[64], rpath[LW_PATH_MAX + 64];
-    snprintf(name, sizeof name, "replica-%d.lw", k);
-    dir_file(rpath, sizeof rpath, a, name);
-    if ((s = read_energy(&rep[k], rpath, a->chains[k]->model, err))) goto out;
-  }
-  if (a->pt && (s = read_tempering(a, &st, path, err))) goto out;
+  if (st.version == 1 && (s = lw_checkpoint_upgrade_v1(st.doc, rep, a->n_rep, err))) goto out;
+  if ((s = lw_checkpoint_restore(a, st.doc, &trace_bytes, err))) goto out;
   set_temperatures(a);
   dir_file(path, sizeof path, a, "timing.txt");
   FILE *tf = fopen(path, "r");
   if (tf) {
-    if (fscanf(tf, "wall_seconds %lf", &a->wall_before) != 1 || !(a->wall_before >= 0)) a->wall_before = 0;
+    if (fscanf(tf, "wall_seconds %lf", &a->wall_before) != 1 || !(a->wall_before >= 0 && a->wall_before < 1e12))
+      a->wall_before = 0;
     fclose(tf);
   }
   a->end_sweep = more >= 0 ? a->sweep + more : (a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep);
   for (int k = 0; k < LW_MOVE_KINDS; k++) a->proposals_before += a->chain->stats[k].proposed;
-  s = truncate_trace(a, err);
+  s = truncate_trace(a, trace_bytes, err);
 out:
-  for (int k = 1; k <= n_read && k < a->n_rep; k++) lw_state_clear(&rep[k]);
+  for (int k = 1; k < LW_TEMPERING_MAX; k++) lw_ckpt_free(rep[k]);
   lw_state_clear(&st);
   return s;
 }

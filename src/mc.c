@@ -183,15 +183,35 @@ char *lw_rng_save(const gsl_rng *r)
   return hex;
 }
 
+/* Strict: exactly the state's size in lower-case hex, and for mt19937 (the
+** generator of every stream) a position index and words GSL itself could
+** have left there, since it indexes its table with the one and returns the
+** others unmasked. */
 int lw_rng_load(gsl_rng *r, const char *hex)
 {
   size_t n = gsl_rng_size(r);
-  if (strlen(hex) != 2 * n) return 0;
-  unsigned char *b = gsl_rng_state(r);
+  if (strspn(hex, "0123456789abcdef") != 2 * n || hex[2 * n]) return 0;
+  unsigned char *b = gsl_rng_state(r), *copy = malloc(n);
+  if (!copy) return 0;
   for (size_t i = 0; i < n; i++) {
-    unsigned v;
-    if (sscanf(hex + 2 * i, "%2x", &v) != 1) return 0;
-    b[i] = (unsigned char)v;
+    unsigned hi = (unsigned)(hex[2 * i] <= '9' ? hex[2 * i] - '0' : hex[2 * i] - 'a' + 10);
+    unsigned lo = (unsigned)(hex[2 * i + 1] <= '9' ? hex[2 * i + 1] - '0' : hex[2 * i + 1] - 'a' + 10);
+    copy[i] = (unsigned char)(hi << 4 | lo);
   }
-  return 1;
+  int ok = 1;
+  if (r->type == gsl_rng_mt19937) {
+    enum { MT_N = 624 };
+    unsigned long mt[MT_N];
+    int mti;
+    ok = n >= sizeof mt + sizeof mti;
+    if (ok) {
+      memcpy(mt, copy, sizeof mt);
+      memcpy(&mti, copy + sizeof mt, sizeof mti);
+      ok = mti >= 0 && mti <= MT_N;
+      for (int i = 0; ok && i < MT_N; i++) ok = mt[i] <= 0xffffffffUL;
+    }
+  }
+  if (ok) memcpy(b, copy, n);
+  free(copy);
+  return ok;
 }

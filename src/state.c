@@ -1,7 +1,19 @@
 /*
 ** state.c -- reading and writing state.lw (state.h, docs/FORMATS.md).
 **
-** Layout: a header of "key value" lines, then one block per spline:
+** Format 2 (sections and keys, ckpt.h):
+**     linewise-state 2
+**     [run]
+**     scene = scene.ini
+**     seed = 42
+**     sweep = 1000
+**     ...                          (run data of a checkpoint, anneal.c)
+**     [system splines]
+**     splines = 2
+**     spline = <segments> <rest length L0, mm>
+**     node = <px> <py> <vx> <vy>   (segments + 1 lines per spline)
+**
+** Format 1 (the first release; still read, never written):
 **     linewise-state 1
 **     scene scene.ini
 **     seed 42
@@ -10,9 +22,7 @@
 **     splines 2
 **     spline <segments> <rest length L0, mm>
 **     <px> <py> <vx> <vy>          (segments + 1 node lines)
-**     ...
 **     end
-** Blank lines and lines starting with '#' are ignored.
 */
 #include "linewise/state.h"
 
@@ -21,7 +31,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
+
+#include "linewise/number.h"
 
 void lw_path_join(char *buf, size_t n, const char *dir, const char *name)
 {
@@ -41,46 +52,169 @@ void lw_state_clear(lw_state *st)
 {
   lw_splines_free(st->sp);
   st->sp = NULL;
-  for (size_t i = 0; i < st->n_extra; i++) {
-    free(st->extra[i].key);
-    free(st->extra[i].value);
+  lw_ckpt_free(st->doc);
+  st->doc = NULL;
+}
+
+/* ---- splines: shared checks ------------------------------------------------ */
+
+/* A spline header "segments rest-length"; 1 if good. */
+static int spline_header(const char *text, size_t *segs, double *rest)
+{
+  double h[2];
+  if (lw_number_list(text, 0, h, 2) != 2 || h[0] < 1 || h[0] > 1e6 || h[0] != floor(h[0]) || !(h[1] > 0)) return 0;
+  *segs = (size_t)h[0];
+  *rest = h[1];
+  return 1;
+}
+
+/* A node "px py vx vy", every coordinate within LW_STATE_COORD_MAX. */
+static int node_values(const char *text, lw_node *nd)
+{
+  double q[4];
+  if (lw_number_list(text, 0, q, 4) != 4) return 0;
+  for (int i = 0; i < 4; i++)
+    if (!(fabs(q[i]) <= LW_STATE_COORD_MAX)) return 0;
+  *nd = (lw_node){q[0], q[1], q[2], q[3]};
+  return 1;
+}
+
+/* Collects splines one by one (the segment counts are only known as they
+** come) and builds the lw_splines at the end. */
+typedef struct {
+  size_t ns, *segs;
+  double *rest;
+  lw_node *nodes;
+  size_t nn, cap;
+} collect;
+
+static int collect_init(collect *c, size_t ns)
+{
+  *c = (collect){.ns = ns, .cap = 1024};
+  c->segs = malloc((ns ? ns : 1) * sizeof *c->segs);
+  c->rest = malloc((ns ? ns : 1) * sizeof *c->rest);
+  c->nodes = malloc(c->cap * sizeof *c->nodes);
+  return c->segs && c->rest && c->nodes;
+}
+
+static int collect_node(collect *c, lw_node nd)
+{
+  if (c->nn == c->cap) {
+    lw_node *nb = realloc(c->nodes, 2 * c->cap * sizeof *nb);
+    if (!nb) return 0;
+    c->nodes = nb;
+    c->cap *= 2;
   }
-  free(st->extra);
-  st->extra = NULL;
-  st->n_extra = 0;
+  c->nodes[c->nn++] = nd;
+  return 1;
 }
 
-static lw_status add_line(lw_state *st, const char *key, size_t nkey, const char *value, int line)
+static lw_splines *collect_done(collect *c, lw_error *err)
 {
-  lw_state_extra *e = realloc(st->extra, (st->n_extra + 1) * sizeof *e);
-  if (!e) return LW_ENOMEM;
-  st->extra = e;
-  e = &st->extra[st->n_extra];
-  e->key = malloc(nkey + 1);
-  e->value = strdup(value);
-  if (!e->key || !e->value) {
-    free(e->key);
-    free(e->value);
-    return LW_ENOMEM;
+  lw_splines *sp = lw_splines_new(c->ns, c->segs, err);
+  if (sp) {
+    memcpy(sp->node, c->nodes, c->nn * sizeof *c->nodes);
+    memcpy(sp->rest_length, c->rest, c->ns * sizeof *c->rest);
   }
-  memcpy(e->key, key, nkey);
-  e->key[nkey] = '\0';
-  e->line = line;
-  st->n_extra++;
-  return LW_OK;
+  return sp;
 }
 
-lw_status lw_state_add(lw_state *st, const char *key, const char *value)
+static void collect_free(collect *c)
 {
-  return add_line(st, key, strlen(key), value, 0);
+  free(c->segs);
+  free(c->rest);
+  free(c->nodes);
 }
 
-const lw_state_extra *lw_state_get(const lw_state *st, const char *key)
+static const char node_expected[] = "4 numbers 'px py vx vy', each within +-1e9 mm";
+
+/* ---- format 2 ------------------------------------------------------------- */
+
+void lw_state_put_header(lw_ckpt_writer *w, const lw_state *st)
 {
-  for (size_t i = 0; i < st->n_extra; i++)
-    if (!strcmp(st->extra[i].key, key)) return &st->extra[i];
-  return NULL;
+  lw_ckpt_section(w, "run");
+  lw_ckpt_put(w, "scene", "%s", st->scene);
+  lw_ckpt_put(w, "seed", "%lu", st->seed);
+  lw_ckpt_put(w, "sweep", "%ld", st->sweep);
 }
+
+void lw_state_put_splines(lw_ckpt_writer *w, const char *section, const lw_splines *sp)
+{
+  lw_ckpt_section(w, section);
+  lw_ckpt_put(w, "splines", "%zu", sp->n_splines);
+  for (size_t i = 0; i < sp->n_splines; i++) {
+    lw_ckpt_put(w, "spline", "%zu %.17g", lw_splines_segments(sp, i), sp->rest_length[i]);
+    for (size_t k = sp->first[i]; k < sp->first[i + 1]; k++) {
+      const lw_node *nd = &sp->node[k];
+      lw_ckpt_put(w, "node", "%.17g %.17g %.17g %.17g", nd->px, nd->py, nd->vx, nd->vy);
+    }
+  }
+}
+
+lw_status lw_state_get_splines(lw_ckpt *c, const char *section, lw_splines **out, lw_error *err)
+{
+  *out = NULL;
+  const char *path = lw_ckpt_path(c), *key, *val;
+  int line = 0;
+  size_t pos = 0;
+  if (!lw_ckpt_has(c, section)) return lw_error_set(err, LW_EINPUT, "%s: section [%s]: missing", path, section);
+#define BAD(what, got)                                                                                     \
+  lw_error_set(err, LW_EINPUT, "%s:%d: [%s] %s: expected %s, got '%.60s'", path, line, section, key ? key : "", \
+               what, got)
+  key = NULL;
+  if (!lw_ckpt_next(c, section, &pos, &key, &val, &line) || strcmp(key, "splines"))
+    return BAD("'splines = <count>' first", key ? key : "end of section");
+  long long ns;
+  if (!lw_number_parse_whole(val, 0, 1e8, &ns)) return BAD("a whole number from 0 to 100000000", val);
+  collect col;
+  if (!collect_init(&col, (size_t)ns)) {
+    collect_free(&col);
+    return lw_error_set(err, LW_ENOMEM, "%s: out of memory for %lld splines", path, ns);
+  }
+  lw_status s = LW_OK;
+  for (size_t i = 0; i < (size_t)ns && !s; i++) {
+    key = NULL;
+    int more = lw_ckpt_next(c, section, &pos, &key, &val, &line);
+    if (!more || strcmp(key, "spline") || !spline_header(val, &col.segs[i], &col.rest[i])) {
+      s = BAD("'spline = <segments >= 1> <rest length > 0>'", more ? val : "end of section");
+      break;
+    }
+    for (size_t k = 0; k <= col.segs[i] && !s; k++) {
+      lw_node nd;
+      more = lw_ckpt_next(c, section, &pos, &key, &val, &line);
+      if (!more || strcmp(key, "node") || !node_values(val, &nd))
+        s = lw_error_set(err, LW_EINPUT, "%s:%d: [%s] spline %zu node %zu: expected 'node = ' and %s, got '%.60s'",
+                         path, line, section, i, k, node_expected, more ? val : "end of section");
+      else if (!collect_node(&col, nd))
+        s = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+    }
+  }
+  if (!s && lw_ckpt_next(c, section, &pos, &key, &val, &line)) s = BAD("nothing after the last spline's nodes", key);
+#undef BAD
+  if (!s && !(*out = collect_done(&col, err))) s = err ? err->code : LW_ENOMEM;
+  collect_free(&col);
+  return s;
+}
+
+static lw_status read_v2(lw_state *st, lw_ckpt *c, lw_error *err)
+{
+  const char *path = lw_ckpt_path(c);
+  int line = 0;
+  const char *scene = lw_ckpt_text(c, "run", "scene", &line);
+  if (!scene) return lw_error_set(err, LW_EINPUT, "%s: [run] scene: missing", path);
+  if (!*scene || strlen(scene) >= sizeof st->scene)
+    return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene: expected a file name, got '%.60s'", path, line, scene);
+  strcpy(st->scene, scene);
+  long seed;
+  lw_status s;
+  if ((s = lw_ckpt_whole(c, "run", "seed", &seed, 0, 4294967295L, 1, err)) ||
+      (s = lw_ckpt_whole(c, "run", "sweep", &st->sweep, 0, (long)LW_STATE_SWEEP_MAX, 1, err)))
+    return s;
+  st->seed = (unsigned long)seed;
+  return lw_state_get_splines(c, "system splines", &st->sp, err);
+}
+
+/* ---- format 1 ------------------------------------------------------------- */
 
 typedef struct {
   FILE *f;
@@ -88,13 +222,20 @@ typedef struct {
   int line;
   char *buf;    /* getline's buffer: run data lines (the RNG state) are long */
   size_t cap;
+  int nul;      /* the last line held a NUL byte */
 } reader;
 
-/* Next line that is not blank or a comment, without its newline; NULL at end. */
+/* Next line that is not blank or a comment, without its newline; NULL at
+** the end or at a line with a NUL byte (r->nul). */
 static char *next_line(reader *r)
 {
-  while (getline(&r->buf, &r->cap, r->f) >= 0) {
+  ssize_t len;
+  while ((len = getline(&r->buf, &r->cap, r->f)) >= 0) {
     r->line++;
+    if (memchr(r->buf, '\0', (size_t)len)) {
+      r->nul = 1;
+      return NULL;
+    }
     r->buf[strcspn(r->buf, "\r\n")] = '\0';
     char *c = r->buf;
     while (*c == ' ' || *c == '\t') c++;
@@ -105,8 +246,8 @@ static char *next_line(reader *r)
 
 static lw_status bad(reader *r, lw_error *err, const char *key, const char *expected, const char *got)
 {
-  return lw_error_set(err, LW_EINPUT, "%s:%d: %s: expected %s, got '%s'", r->path, r->line, key,
-                      expected, got ? got : "end of file");
+  return lw_error_set(err, LW_EINPUT, "%s:%d: %s: expected %s, got '%.60s'", r->path, r->line, key, expected,
+                      r->nul ? "a NUL byte" : got ? got : "end of file");
 }
 
 /* Reads a line "key <value>" with the given key; value points into r->buf. */
@@ -122,184 +263,104 @@ static lw_status expect_key(reader *r, const char *key, char **value, lw_error *
   return LW_OK;
 }
 
-static int parse_long(const char *s, long *out)
+static lw_status read_v1(lw_state *st, reader *r, lw_error *err)
 {
-  char *end;
-  errno = 0;
-  long v = strtol(s, &end, 10);
-  while (*end == ' ' || *end == '\t') end++;
-  if (end == s || *end || errno) return 0;
-  *out = v;
-  return 1;
+  const char *path = r->path;
+  long long v;
+  char *val, *c;
+  lw_status s;
+  if ((s = expect_key(r, "scene", &val, err))) return s;
+  if (!*val || strlen(val) >= sizeof st->scene) return bad(r, err, "scene", "a file name", val);
+  strcpy(st->scene, val);
+  if ((s = expect_key(r, "seed", &val, err))) return s;
+  if (!lw_number_parse_whole(val, 0, 4294967295.0, &v)) return bad(r, err, "seed", "a whole number from 0 to 2^32 - 1", val);
+  st->seed = (unsigned long)v;
+  if ((s = expect_key(r, "sweep", &val, err))) return s;
+  if (!lw_number_parse_whole(val, 0, LW_STATE_SWEEP_MAX, &v)) return bad(r, err, "sweep", "a whole number from 0 to 1e15", val);
+  st->sweep = (long)v;
+  /* run data lines until "splines", kept as section [v1] */
+  if (!(st->doc = lw_ckpt_new(path))) return lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+  for (;;) {
+    if (!(c = next_line(r))) return bad(r, err, "splines", "a line 'splines <count>'", c);
+    size_t nk = strcspn(c, " \t");
+    if (nk == 7 && !strncmp(c, "splines", 7)) break;
+    val = c + nk + strspn(c + nk, " \t");
+    c[nk] = '\0';
+    if (lw_ckpt_add(st->doc, "v1", c, val, r->line)) return lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+  }
+  val = c + 7 + strspn(c + 7, " \t");
+  if (!lw_number_parse_whole(val, 0, 1e8, &v)) return bad(r, err, "splines", "a whole number from 0 to 100000000", val);
+  collect col;
+  if (!collect_init(&col, (size_t)v)) {
+    collect_free(&col);
+    return lw_error_set(err, LW_ENOMEM, "%s: out of memory for %lld splines", path, v);
+  }
+  for (size_t i = 0; i < col.ns && !s; i++) {
+    if ((s = expect_key(r, "spline", &val, err))) break;
+    if (!spline_header(val, &col.segs[i], &col.rest[i])) {
+      s = bad(r, err, "spline", "'<segments >= 1> <rest length > 0>'", val);
+      break;
+    }
+    for (size_t k = 0; k <= col.segs[i] && !s; k++) {
+      c = next_line(r);
+      lw_node nd;
+      if (!c || !node_values(c, &nd)) {
+        char key[64];
+        snprintf(key, sizeof key, "spline %zu node %zu", i, k);
+        s = bad(r, err, key, node_expected, c);
+      } else if (!collect_node(&col, nd))
+        s = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+    }
+  }
+  if (!s) {
+    c = next_line(r);
+    if (!c || strcmp(c, "end")) s = bad(r, err, "end", "'end' after the last spline", c);
+    else if ((c = next_line(r)) || r->nul) s = bad(r, err, "end", "nothing after 'end'", c);
+  }
+  if (!s && !(st->sp = collect_done(&col, err))) s = err ? err->code : LW_ENOMEM;
+  collect_free(&col);
+  return s;
 }
 
-/* Reads exactly n finite doubles from s. */
-static int parse_doubles(const char *s, double *out, int n)
-{
-  char *end;
-  for (int i = 0; i < n; i++) {
-    errno = 0;
-    out[i] = strtod(s, &end);
-    if (end == s || errno == ERANGE || !isfinite(out[i])) return 0;
-    s = end;
-  }
-  while (*s == ' ' || *s == '\t') s++;
-  return *s == '\0';
-}
+/* ---- reading and writing ---------------------------------------------------- */
 
 lw_status lw_state_read(lw_state *st, const char *path, lw_error *err)
 {
   memset(st, 0, sizeof *st);
-  reader r = {fopen(path, "r"), path, 0, NULL, 0};
+  reader r = {fopen(path, "r"), path, 0, NULL, 0, 0};
   if (!r.f) return lw_error_set(err, LW_EINPUT, "%s: cannot open state file: %s", path, strerror(errno));
-  lw_status status = LW_OK;
-  size_t *segs = NULL;
-  double *rest = NULL;
-  long v;
-  char *val;
+  lw_status s = LW_OK;
+  errno = 0;
   char *c = next_line(&r);
-  if (!c || strncmp(c, "linewise-state ", 15) || !parse_long(c + 15, &v)) {
-    status = bad(&r, err, "header", "'linewise-state <version>'", c);
-    goto done;
+  long long version = 0;
+  if (!c && ferror(r.f)) /* a directory opens but does not read */
+    s = lw_error_set(err, LW_EINPUT, "%s: cannot read state file: %s", path, strerror(errno ? errno : EIO));
+  else if (!c || strncmp(c, "linewise-state ", 15) || !lw_number_parse_whole(c + 15, 0, 1e9, &version))
+    s = bad(&r, err, "header", "'linewise-state <version>'", c);
+  else if (version != 1 && version != LW_STATE_VERSION)
+    s = lw_error_set(err, LW_EINPUT, "%s:%d: header: version %lld is not supported (expected 1 or %d)", path, r.line,
+                     version, LW_STATE_VERSION);
+  else if (version == 1) {
+    st->version = 1;
+    s = read_v1(st, &r, err);
+    if (!s && ferror(r.f)) s = lw_error_set(err, LW_EIO, "%s: read error", path);
   }
-  if (v != LW_STATE_VERSION) {
-    status = lw_error_set(err, LW_EINPUT, "%s:%d: header: version %ld is not supported (expected %d)",
-                          path, r.line, v, LW_STATE_VERSION);
-    goto done;
-  }
-  if ((status = expect_key(&r, "scene", &val, err))) goto done;
-  if (!*val || strlen(val) >= sizeof st->scene) {
-    status = bad(&r, err, "scene", "a file name", val);
-    goto done;
-  }
-  strcpy(st->scene, val);
-  if ((status = expect_key(&r, "seed", &val, err))) goto done;
-  if (!parse_long(val, &v) || v < 0) {
-    status = bad(&r, err, "seed", "a whole number >= 0", val);
-    goto done;
-  }
-  st->seed = (unsigned long)v;
-  if ((status = expect_key(&r, "sweep", &val, err))) goto done;
-  if (!parse_long(val, &st->sweep) || st->sweep < 0) {
-    status = bad(&r, err, "sweep", "a whole number >= 0", val);
-    goto done;
-  }
-  /* run data lines until "splines" */
-  for (;;) {
-    c = next_line(&r);
-    if (!c) {
-      status = bad(&r, err, "splines", "a line 'splines <count>'", c);
-      goto done;
-    }
-    size_t nk = strcspn(c, " \t");
-    if (nk == 7 && !strncmp(c, "splines", 7)) break;
-    val = c + nk;
-    while (*val == ' ' || *val == '\t') val++;
-    if (add_line(st, c, nk, val, r.line)) {
-      status = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
-      goto done;
-    }
-  }
-  val = c + 7;
-  while (*val == ' ' || *val == '\t') val++;
-  if (!parse_long(val, &v) || v < 0 || v > 100000000L) {
-    status = bad(&r, err, "splines", "a whole number from 0 to 100000000", val);
-    goto done;
-  }
-  size_t ns = (size_t)v;
-  segs = malloc((ns ? ns : 1) * sizeof *segs);
-  rest = malloc((ns ? ns : 1) * sizeof *rest);
-  /* Nodes are read into a growing buffer first: the segment counts are only
-  ** known spline by spline. */
-  size_t cap = 1024, nn = 0;
-  lw_node *nodes = malloc(cap * sizeof *nodes);
-  if (!segs || !rest || !nodes) {
-    free(nodes);
-    status = lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu splines", path, ns);
-    goto done;
-  }
-  for (size_t i = 0; i < ns && !status; i++) {
-    if ((status = expect_key(&r, "spline", &val, err))) break;
-    double h[2];
-    if (!parse_doubles(val, h, 2) || h[0] < 1 || h[0] > 1e6 || h[0] != floor(h[0]) || !(h[1] > 0)) {
-      status = bad(&r, err, "spline", "'<segments >= 1> <rest length > 0>'", val);
-      break;
-    }
-    segs[i] = (size_t)h[0];
-    rest[i] = h[1];
-    for (size_t k = 0; k <= segs[i]; k++) {
-      c = next_line(&r);
-      double q[4];
-      if (!c || !parse_doubles(c, q, 4)) {
-        status = bad(&r, err, "node", "4 finite numbers 'px py vx vy'", c);
-        break;
-      }
-      if (nn == cap) {
-        lw_node *nb = realloc(nodes, 2 * cap * sizeof *nodes);
-        if (!nb) {
-          status = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
-          break;
-        }
-        nodes = nb;
-        cap *= 2;
-      }
-      nodes[nn++] = (lw_node){q[0], q[1], q[2], q[3]};
-    }
-  }
-  if (!status) {
-    c = next_line(&r);
-    if (!c || strcmp(c, "end")) status = bad(&r, err, "end", "'end' after the last spline", c);
-    else if ((c = next_line(&r))) status = bad(&r, err, "end", "nothing after 'end'", c);
-  }
-  if (!status) {
-    st->sp = lw_splines_new(ns, segs, err);
-    if (!st->sp) status = err ? err->code : LW_ENOMEM;
-    else {
-      memcpy(st->sp->node, nodes, nn * sizeof *nodes);
-      memcpy(st->sp->rest_length, rest, ns * sizeof *rest);
-    }
-  }
-  free(nodes);
-  if (!status && ferror(r.f)) status = lw_error_set(err, LW_EIO, "%s: read error", path);
-done:
-  free(segs);
-  free(rest);
   free(r.buf);
   fclose(r.f);
-  if (status) lw_state_clear(st);
-  return status;
+  if (!s && version == LW_STATE_VERSION) {
+    st->version = LW_STATE_VERSION;
+    if (!(s = lw_ckpt_read(&st->doc, path, err))) s = read_v2(st, st->doc, err);
+  }
+  if (s) lw_state_clear(st);
+  return s;
 }
 
 lw_status lw_state_write(const lw_state *st, const char *path, lw_error *err)
 {
-  char tmp[LW_PATH_MAX + 16];
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  FILE *f = fopen(tmp, "w");
-  if (!f) return lw_error_set(err, LW_EIO, "%s: cannot write: %s", tmp, strerror(errno));
-  const lw_splines *sp = st->sp;
-  fprintf(f, "linewise-state %d\nscene %s\nseed %lu\nsweep %ld\n", LW_STATE_VERSION, st->scene,
-          st->seed, st->sweep);
-  for (size_t i = 0; i < st->n_extra; i++) fprintf(f, "%s %s\n", st->extra[i].key, st->extra[i].value);
-  fprintf(f, "splines %zu\n", sp->n_splines);
-  for (size_t i = 0; i < sp->n_splines; i++) {
-    fprintf(f, "spline %zu %.17g\n", lw_splines_segments(sp, i), sp->rest_length[i]);
-    for (size_t k = sp->first[i]; k < sp->first[i + 1]; k++) {
-      const lw_node *nd = &sp->node[k];
-      fprintf(f, "%.17g %.17g %.17g %.17g\n", nd->px, nd->py, nd->vx, nd->vy);
-    }
-  }
-  fprintf(f, "end\n");
-  int bad_write = ferror(f);
-  if (fflush(f) || fsync(fileno(f))) bad_write = 1;
-  if (fclose(f)) bad_write = 1;
-  if (bad_write) {
-    remove(tmp);
-    return lw_error_set(err, LW_EIO, "%s: write failed", tmp);
-  }
-  if (rename(tmp, path)) {
-    int e = errno;
-    remove(tmp);
-    return lw_error_set(err, LW_EIO, "%s: cannot replace: %s", path, strerror(e));
-  }
-  return LW_OK;
+  lw_ckpt_writer w;
+  lw_status s = lw_ckpt_begin(&w, path, LW_STATE_HEADER, err);
+  if (s) return s;
+  lw_state_put_header(&w, st);
+  lw_state_put_splines(&w, "system splines", st->sp);
+  return lw_ckpt_commit(&w, err);
 }

@@ -1,0 +1,33 @@
+/*
+** number.h -- the one strict number parser of linewise: scene keys, the
+** command line, state files, schedule tables, ladders and polygons all read
+** numbers through it, so they all accept the same text.
+**
+** Accepted: an optional sign, decimal digits with an optional fraction and
+** an optional exponent ("12", "-0.5", ".5", "3e-4", "1E+6").  Refused: hex
+** ("0x10"), "inf", "nan", blanks inside, trailing characters, an empty
+** token, and values that overflow a double.  Results too small for a normal
+** double read as the nearest subnormal (or 0), so every %.17g a state
+** file writes reads back.
+*/
+#ifndef LINEWISE_NUMBER_H
+#define LINEWISE_NUMBER_H
+
+#include <stddef.h>
+
+/* The first len characters of s as a finite double; 1 on success. */
+int lw_number_parse_n(const char *s, size_t len, double *out);
+
+/* The whole string s as a finite double; 1 on success. */
+int lw_number_parse(const char *s, double *out);
+
+/* The whole string s as a whole number in [lo, hi] (|lo|, |hi| <= 2^53, so
+** every value is exact); "1e3" counts as 1000.  1 on success. */
+int lw_number_parse_whole(const char *s, double lo, double hi, long long *out);
+
+/* Splits s at blanks (and commas when `commas`) into at most max numbers;
+** returns how many tokens there were (more than max are counted but not
+** stored), or -1 if a token is not a number. */
+int lw_number_list(const char *s, int commas, double *out, int max);
+
+#endif

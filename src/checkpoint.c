@@ -1,0 +1,518 @@
+/*
+** checkpoint.c -- the run data of state.lw (checkpoint.h), by name:
+**
+**   [run]           scene, seed, sweep (state.h); the schedule's inputs
+**                   (temperature, block, t_prev, prev_stats, block_energy),
+**                   energy_initial, max_drift, trace_bytes and
+**                   trace_mark.<move kind>
+**   [chain], [chain K]   rung 0's and rung K's chain: rng, step.<move>,
+**                   window.<move>, moves.<move>, and energy.<term> (the
+**                   running totals of the replica at that rung)
+**   [tempering]     the exchange machinery
+**   [system splines], [system splines K]   the splines at each rung
+**
+** Keys per move kind and per term are optional on reading: a file written
+** before a term or a move kind existed resumes with 0 (energy, counts) or
+** the scene's initial step.  Anything unknown is refused (lw_ckpt_unread).
+*/
+#include "linewise/checkpoint.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "linewise/number.h"
+#include "linewise/output.h"
+#include "linewise/state.h"
+
+#define COUNT_MAX 9007199254740992.0 /* 2^53 */
+
+static void rung_section(char *buf, size_t n, const char *base, int k)
+{
+  if (k == 0) snprintf(buf, n, "%s", base);
+  else snprintf(buf, n, "%s %d", base, k);
+}
+
+static void dir_file(char *buf, size_t n, const lw_anneal *a, const char *name) { lw_path_join(buf, n, a->dir, name); }
+
+/* ---- writing ---------------------------------------------------------------- */
+
+static void put_chain(lw_ckpt_writer *w, int k, const lw_chain *c, lw_error *err, int *bad)
+{
+  char sec[32], key[64];
+  rung_section(sec, sizeof sec, "chain", k);
+  lw_ckpt_section(w, sec);
+  char *hex = lw_rng_save(c->rng);
+  if (!hex) *bad = 1;
+  else lw_ckpt_put(w, "rng", "%s", hex);
+  free(hex);
+  for (int m = 0; m < LW_MOVE_KINDS; m++) {
+    const char *name = lw_move_names[m];
+    const lw_move_stats *st = &c->stats[m];
+    snprintf(key, sizeof key, "step.%s", name);
+    lw_ckpt_put_numbers(w, key, &c->step[m], 1);
+    snprintf(key, sizeof key, "window.%s", name);
+    lw_ckpt_put_counts(w, key, (unsigned long[]){c->win_prop[m], c->win_acc[m]}, 2);
+    snprintf(key, sizeof key, "moves.%s", name);
+    lw_ckpt_put_counts(w, key, (unsigned long[]){st->proposed, st->accepted, st->nan, st->irregular}, 4);
+  }
+  for (int t = 0; t < LW_TERM_COUNT; t++) {
+    snprintf(key, sizeof key, "energy.%s", lw_term_types[t].name);
+    lw_ckpt_put_numbers(w, key, &c->model->term[t], 1);
+  }
+}
+
+static void put_tempering(lw_ckpt_writer *w, const lw_anneal *a, int *bad)
+{
+  const lw_tempering *pt = a->pt;
+  int n = pt->n;
+  unsigned long v[2 * LW_TEMPERING_MAX];
+  lw_ckpt_section(w, "tempering");
+  char *hex = lw_rng_save(pt->rng);
+  if (!hex) *bad = 1;
+  else lw_ckpt_put(w, "rng", "%s", hex);
+  free(hex);
+  lw_ckpt_put_numbers(w, "ladder", pt->ladder, n);
+  for (int k = 0; k < n; k++) {
+    v[2 * k] = (unsigned long)pt->at[k];
+    v[2 * k + 1] = (unsigned long)(pt->label[k] + 1);
+  }
+  lw_ckpt_put_counts(w, "at_label", v, 2 * n);
+  for (int k = 0; k + 1 < n; k++) {
+    v[2 * k] = pt->tried[k];
+    v[2 * k + 1] = pt->accepted[k];
+  }
+  lw_ckpt_put_counts(w, "swaps", v, 2 * (n - 1));
+  for (int k = 0; k + 1 < n; k++) {
+    v[2 * k] = pt->win_tried[k];
+    v[2 * k + 1] = pt->win_accepted[k];
+  }
+  lw_ckpt_put_counts(w, "window", v, 2 * (n - 1));
+  lw_ckpt_put_counts(w, "trace_mark", a->swap_mark, 2 * (n - 1));
+  lw_ckpt_put_counts(w, "round_trips", &pt->round_trips, 1);
+  lw_ckpt_put_counts(w, "steps", &pt->steps, 1);
+}
+
+/* replica-K.lw: a plain state of rung K for the user (init.from, energy). */
+static lw_status write_replica(const lw_anneal *a, int k, lw_error *err)
+{
+  lw_state st = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep, .sp = a->chains[k]->model->sp};
+  char name[64], path[LW_PATH_MAX + 64];
+  snprintf(name, sizeof name, "replica-%d.lw", k);
+  dir_file(path, sizeof path, a, name);
+  return lw_state_write(&st, path, err);
+}
+
+lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err)
+{
+  char path[LW_PATH_MAX + 32];
+  long trace_bytes = 0;
+  /* The trace first, on disk: the state that records its length must
+  ** never be newer than the rows it counts. */
+  if (a->trace) {
+    dir_file(path, sizeof path, a, "trace.csv");
+    if (fflush(a->trace) || fsync(fileno(a->trace)) || (trace_bytes = ftell(a->trace)) < 0)
+      return lw_error_set(err, LW_EIO, "%s: write failed: %s", path, strerror(errno));
+  }
+  dir_file(path, sizeof path, a, "state.lw");
+  lw_ckpt_writer w;
+  lw_status s = lw_ckpt_begin(&w, path, LW_STATE_HEADER, err);
+  if (s) return s;
+  lw_state head = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep};
+  lw_state_put_header(&w, &head);
+  lw_ckpt_put(&w, "temperature", "%.17g", a->t_sched);
+  lw_ckpt_put(&w, "block", "%ld", a->block);
+  lw_ckpt_put(&w, "t_prev", "%.17g", a->t_prev);
+  lw_ckpt_put(&w, "prev_stats", "%.17g %.17g %ld", a->prev.mean, a->prev.sd, a->prev.samples);
+  lw_ckpt_put(&w, "block_energy", "%.17g %.17g %.17g", a->acc_n, a->acc_sum, a->acc_sumsq);
+  lw_ckpt_put(&w, "energy_initial", "%.17g", a->energy_initial);
+  lw_ckpt_put(&w, "max_drift", "%.17g", a->max_drift);
+  lw_ckpt_put(&w, "trace_bytes", "%ld", trace_bytes);
+  for (int m = 0; m < LW_MOVE_KINDS; m++) {
+    char key[64];
+    const lw_move_stats *st = &a->trace_mark[m];
+    snprintf(key, sizeof key, "trace_mark.%s", lw_move_names[m]);
+    lw_ckpt_put_counts(&w, key, (unsigned long[]){st->proposed, st->accepted, st->nan}, 3);
+  }
+  int bad = 0;
+  for (int k = 0; k < a->n_rep; k++) put_chain(&w, k, a->chains[k], err, &bad);
+  if (a->pt) put_tempering(&w, a, &bad);
+  for (int k = 0; k < a->n_rep; k++) {
+    char sec[32];
+    rung_section(sec, sizeof sec, "system splines", k);
+    lw_state_put_splines(&w, sec, a->chains[k]->model->sp);
+  }
+  if (bad) {
+    lw_ckpt_abort(&w);
+    return lw_error_set(err, LW_ENOMEM, "out of memory writing a checkpoint");
+  }
+  if ((s = lw_ckpt_commit(&w, err))) return s;
+  for (int k = 1; k < a->n_rep && !s; k++) s = write_replica(a, k, err);
+  /* Wall time differs from run to run, so it lives beside the state, which
+  ** must be byte-identical for the same sweeps. */
+  if (!s) {
+    char tmp[LW_PATH_MAX + 64];
+    dir_file(path, sizeof path, a, "timing.txt");
+    FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
+    if (!f) return err->code;
+    fprintf(f, "wall_seconds %.6f\n", lw_anneal_seconds(a));
+    s = lw_output_commit(f, tmp, path, err);
+  }
+  return s;
+}
+
+/* ---- reading ---------------------------------------------------------------- */
+
+static lw_status get_rng(lw_ckpt *doc, const char *sec, gsl_rng *r, lw_error *err)
+{
+  int line = 0;
+  const char *hex = lw_ckpt_text(doc, sec, "rng", &line);
+  if (!hex) return lw_error_set(err, LW_EINPUT, "%s: [%s] rng: missing", lw_ckpt_path(doc), sec);
+  if (!lw_rng_load(r, hex))
+    return lw_error_set(err, LW_EINPUT, "%s:%d: [%s] rng: expected the state of a %s generator in hex (%zu digits)",
+                        lw_ckpt_path(doc), line, sec, gsl_rng_name(r), 2 * gsl_rng_size(r));
+  return LW_OK;
+}
+
+static lw_status get_chain(lw_ckpt *doc, int k, lw_chain *c, lw_error *err)
+{
+  char sec[32], key[64];
+  const char *path = lw_ckpt_path(doc);
+  rung_section(sec, sizeof sec, "chain", k);
+  lw_status s = get_rng(doc, sec, c->rng, err);
+  for (int m = 0; m < LW_MOVE_KINDS && !s; m++) {
+    const char *name = lw_move_names[m];
+    unsigned long v[4] = {0, 0, 0, 0};
+    snprintf(key, sizeof key, "step.%s", name);
+    /* tuning keeps steps in [1e-300, step_max] (mc.c) */
+    if ((s = lw_ckpt_numbers(doc, sec, key, &c->step[m], 1, 1e-300, c->step_max[m], 0, err))) break;
+    snprintf(key, sizeof key, "window.%s", name);
+    if ((s = lw_ckpt_counts(doc, sec, key, v, 2, 0, err))) break;
+    if (v[1] > v[0]) {
+      s = lw_error_set(err, LW_EINPUT, "%s: [%s] %s: more accepted (%lu) than proposed (%lu)", path, sec, key, v[1], v[0]);
+      break;
+    }
+    c->win_prop[m] = v[0];
+    c->win_acc[m] = v[1];
+    snprintf(key, sizeof key, "moves.%s", name);
+    v[0] = v[1] = v[2] = v[3] = 0;
+    if ((s = lw_ckpt_counts(doc, sec, key, v, 4, 0, err))) break;
+    if (v[1] > v[0] || v[2] > v[0] - v[1] || v[3] > v[0] - v[1] - v[2]) {
+      s = lw_error_set(err, LW_EINPUT, "%s: [%s] %s: expected 'proposed accepted nan irregular' with accepted + nan "
+                       "+ irregular <= proposed, got %lu %lu %lu %lu", path, sec, key, v[0], v[1], v[2], v[3]);
+      break;
+    }
+    c->stats[m] = (lw_move_stats){v[0], v[1], v[2], v[3]};
+  }
+  return s;
+}
+
+/* The running totals carry the rounding of the moves so far; restoring them
+** (rather than the fresh sums) keeps the trace identical to an uninterrupted
+** run.  They must still agree with the fresh sums to rounding, which also
+** makes a non-finite state or an edited total an error. */
+static lw_status get_energy(lw_ckpt *doc, int k, lw_model *m, lw_error *err)
+{
+  char sec[32], key[64];
+  rung_section(sec, sizeof sec, "chain", k);
+  double fresh[LW_TERM_COUNT], scale = 1.0;
+  memcpy(fresh, m->term, sizeof fresh);
+  for (int t = 0; t < LW_TERM_COUNT; t++) scale += fabs(fresh[t]);
+  for (int t = 0; t < LW_TERM_COUNT; t++) {
+    const char *name = lw_term_types[t].name;
+    if (!isfinite(fresh[t]))
+      return lw_error_set(err, LW_EINPUT, "%s: [system splines%s%.0d]: the %s energy of this state is not finite "
+                          "(a node outside the boundary, or coordinates too large?)", lw_ckpt_path(doc), k ? " " : "",
+                          k, name);
+    double v = 0.0; /* a term the writer did not know was off */
+    snprintf(key, sizeof key, "energy.%s", name);
+    lw_status s = lw_ckpt_numbers(doc, sec, key, &v, 1, -DBL_MAX, DBL_MAX, 0, err);
+    if (s) return s;
+    if (!(fabs(v - fresh[t]) <= 1e-6 * scale))
+      return lw_error_set(err, LW_EINPUT, "%s: [%s] %s: %.17g, but the state's %s energy is %.17g (the file was "
+                          "changed or damaged)", lw_ckpt_path(doc), sec, key, v, name, fresh[t]);
+    m->term[t] = v;
+  }
+  return LW_OK;
+}
+
+static lw_status get_tempering(lw_ckpt *doc, lw_anneal *a, lw_error *err)
+{
+  lw_tempering *pt = a->pt;
+  int n = pt->n;
+  const char *path = lw_ckpt_path(doc);
+  unsigned long v[2 * LW_TEMPERING_MAX];
+  lw_status s;
+  if ((s = get_rng(doc, "tempering", pt->rng, err)) ||
+      (s = lw_ckpt_numbers(doc, "tempering", "ladder", pt->ladder, n, DBL_MIN, 1e300, 1, err)))
+    return s;
+  for (int k = 1; k < n; k++)
+    if (!(pt->ladder[k] > pt->ladder[k - 1]))
+      return lw_error_set(err, LW_EINPUT, "%s: [tempering] ladder: expected increasing temperatures", path);
+  if ((s = lw_ckpt_counts(doc, "tempering", "at_label", v, 2 * n, 1, err))) return s;
+  int seen[LW_TEMPERING_MAX] = {0};
+  for (int k = 0; k < n; k++) {
+    unsigned long r = v[2 * k];
+    if (r >= (unsigned long)n || seen[r] || v[2 * k + 1] > 2)
+      return lw_error_set(err, LW_EINPUT, "%s: [tempering] at_label: expected a permutation of the replicas, each "
+                          "with a direction 0, 1 or 2", path);
+    seen[r] = 1;
+    pt->at[k] = (int)r;
+    pt->label[k] = (int)v[2 * k + 1] - 1;
+  }
+  static const char *const pairs[] = {"swaps", "window", "trace_mark"};
+  for (int q = 0; q < 3; q++) {
+    if ((s = lw_ckpt_counts(doc, "tempering", pairs[q], v, 2 * (n - 1), 1, err))) return s;
+    for (int k = 0; k + 1 < n; k++)
+      if (v[2 * k + 1] > v[2 * k])
+        return lw_error_set(err, LW_EINPUT, "%s: [tempering] %s: more accepted than tried at pair %d", path, pairs[q], k);
+    for (int k = 0; k + 1 < n; k++) {
+      unsigned long *tried = q == 0 ? pt->tried : q == 1 ? pt->win_tried : NULL;
+      unsigned long *acc = q == 0 ? pt->accepted : q == 1 ? pt->win_accepted : NULL;
+      if (tried) {
+        tried[k] = v[2 * k];
+        acc[k] = v[2 * k + 1];
+      } else {
+        a->swap_mark[2 * k] = v[2 * k];
+        a->swap_mark[2 * k + 1] = v[2 * k + 1];
+      }
+    }
+  }
+  for (int k = 0; k + 1 < n; k++)
+    if (a->swap_mark[2 * k] > pt->tried[k] || pt->win_tried[k] > pt->tried[k])
+      return lw_error_set(err, LW_EINPUT, "%s: [tempering]: window or trace mark beyond the swaps at pair %d", path, k);
+  if ((s = lw_ckpt_counts(doc, "tempering", "round_trips", &pt->round_trips, 1, 1, err)) ||
+      (s = lw_ckpt_counts(doc, "tempering", "steps", &pt->steps, 1, 1, err)))
+    return s;
+  /* models[] is by replica: rung k holds replica at[k] */
+  lw_model *by_rung[LW_TEMPERING_MAX];
+  for (int k = 0; k < n; k++) by_rung[k] = a->models[k];
+  for (int k = 0; k < n; k++) a->models[pt->at[k]] = by_rung[k];
+  return LW_OK;
+}
+
+lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, lw_error *err)
+{
+  const char *path = lw_ckpt_path(doc);
+  lw_status s = LW_OK;
+  for (int k = 0; k < a->n_rep && !s; k++)
+    if (!(s = get_chain(doc, k, a->chains[k], err))) s = get_energy(doc, k, a->chains[k]->model, err);
+  if (s) return s;
+  double v[3];
+  unsigned long u[3];
+  long block = 0, tb = -1;
+#define NUMS(key, n, lo, hi) if ((s = lw_ckpt_numbers(doc, "run", key, v, n, lo, hi, 1, err))) return s
+  NUMS("temperature", 1, 0, DBL_MAX); a->t_sched = v[0];
+  if ((s = lw_ckpt_whole(doc, "run", "block", &block, -1, a->params.steps - 1, 1, err))) return s;
+  a->block = block;
+  NUMS("t_prev", 1, 0, DBL_MAX); a->t_prev = v[0];
+  NUMS("prev_stats", 3, -DBL_MAX, DBL_MAX);
+  if (!(v[1] >= 0) || !(v[2] >= 0 && v[2] <= COUNT_MAX && v[2] == floor(v[2])))
+    return lw_error_set(err, LW_EINPUT, "%s: [run] prev_stats: expected 'mean sd samples' with sd >= 0 and a whole "
+                        "number of samples", path);
+  a->prev = (lw_block_stats){v[0], v[1], (long)v[2]};
+  NUMS("block_energy", 3, -DBL_MAX, DBL_MAX);
+  if (!(v[0] >= 0 && v[0] <= COUNT_MAX && v[0] == floor(v[0]) && v[2] >= 0))
+    return lw_error_set(err, LW_EINPUT, "%s: [run] block_energy: expected 'samples sum sum-of-squares' with a whole "
+                        "number of samples and a sum of squares >= 0", path);
+  a->acc_n = v[0]; a->acc_sum = v[1]; a->acc_sumsq = v[2];
+  NUMS("energy_initial", 1, -DBL_MAX, DBL_MAX); a->energy_initial = v[0];
+  NUMS("max_drift", 1, 0, DBL_MAX); a->max_drift = v[0];
+#undef NUMS
+  if ((s = lw_ckpt_whole(doc, "run", "trace_bytes", &tb, 0, (long)COUNT_MAX, 0, err))) return s;
+  *trace_bytes = tb;
+  for (int m = 0; m < LW_MOVE_KINDS; m++) {
+    char key[64];
+    snprintf(key, sizeof key, "trace_mark.%s", lw_move_names[m]);
+    u[0] = u[1] = u[2] = 0;
+    if ((s = lw_ckpt_counts(doc, "run", key, u, 3, 0, err))) return s;
+    const lw_move_stats *st = &a->chain->stats[m];
+    if (u[0] > st->proposed || u[1] > st->accepted || u[2] > st->nan)
+      return lw_error_set(err, LW_EINPUT, "%s: [run] %s: beyond the chain's counts (moves.%s)", path, key, lw_move_names[m]);
+    a->trace_mark[m] = (lw_move_stats){.proposed = u[0], .accepted = u[1], .nan = u[2]};
+  }
+  if (a->pt && (s = get_tempering(doc, a, err))) return s;
+  return lw_ckpt_unread(doc, err);
+}
+
+/* ---- format 1 ----------------------------------------------------------------- */
+
+typedef struct {
+  lw_ckpt *doc;
+  const char *path;
+  lw_error *err;
+  lw_status s;
+} upgrade;
+
+/* Splits value into exactly n blank-separated words (malloc'ed); 0 and the
+** error set otherwise. */
+static int words(upgrade *u, const char *key, int line, const char *value, int n, char **w)
+{
+  int k = 0;
+  for (const char *c = value + strspn(value, " \t"); *c; c += strspn(c, " \t")) {
+    size_t len = strcspn(c, " \t");
+    if (k == n || !(w[k] = strndup(c, len))) {
+      for (int i = 0; i < k; i++) free(w[i]);
+      if (k < n) u->s = lw_error_set(u->err, LW_ENOMEM, "%s: out of memory", u->path);
+      k = -1;
+      break;
+    }
+    k++;
+    c += len;
+  }
+  if (k == n) return 1;
+  if (k > 0)
+    for (int i = 0; i < k; i++) free(w[i]);
+  if (!u->s)
+    u->s = lw_error_set(u->err, LW_EINPUT, "%s:%d: %s: expected %d values, got '%.60s'", u->path, line, key, n, value);
+  return 0;
+}
+
+static void add(upgrade *u, const char *sec, const char *key, const char *value, int line)
+{
+  if (!u->s && lw_ckpt_add(u->doc, sec, key, value, line)) u->s = lw_error_set(u->err, LW_ENOMEM, "%s: out of memory", u->path);
+}
+
+/* key = the words at stride positions: word i * stride + j for j < per. */
+static void add_grouped(upgrade *u, const char *sec, const char *prefix, char **w, int groups, int per,
+                        const char *const *names, int line)
+{
+  for (int g = 0; g < groups; g++) {
+    char key[64], val[256] = "";
+    snprintf(key, sizeof key, "%s.%s", prefix, names[g]);
+    for (int j = 0; j < per; j++) {
+      size_t len = strlen(val);
+      snprintf(val + len, sizeof val - len, "%s%.60s", j ? " " : "", w[g * per + j]);
+    }
+    add(u, sec, key, val, line);
+  }
+}
+
+/* One [v1] line of a chain (prefix "" or "rungK_" stripped) into section sec. */
+static int upgrade_chain_key(upgrade *u, const char *sec, const char *key, const char *value, int line,
+                             const char *irregular)
+{
+  char *w[3 * LW_MOVE_KINDS + 4];
+  if (!strcmp(key, "rng")) add(u, sec, "rng", value, line);
+  else if (!strcmp(key, "steps")) {
+    if (!words(u, key, line, value, LW_MOVE_KINDS, w)) return 1;
+    add_grouped(u, sec, "step", w, LW_MOVE_KINDS, 1, lw_move_names, line);
+    for (int i = 0; i < LW_MOVE_KINDS; i++) free(w[i]);
+  } else if (!strcmp(key, "tune_window")) {
+    if (!words(u, key, line, value, 2 * LW_MOVE_KINDS, w)) return 1;
+    add_grouped(u, sec, "window", w, LW_MOVE_KINDS, 2, lw_move_names, line);
+    for (int i = 0; i < 2 * LW_MOVE_KINDS; i++) free(w[i]);
+  } else if (!strcmp(key, "moves")) {
+    char *irr[LW_MOVE_KINDS];
+    if (!words(u, key, line, value, 3 * LW_MOVE_KINDS, w)) return 1;
+    int have_irr = irregular && words(u, "moves_irregular", line, irregular, LW_MOVE_KINDS, irr);
+    for (int m = 0; m < LW_MOVE_KINDS && !u->s; m++) {
+      char k2[64], val[256];
+      snprintf(k2, sizeof k2, "moves.%s", lw_move_names[m]);
+      snprintf(val, sizeof val, "%.60s %.60s %.60s %.60s", w[3 * m], w[3 * m + 1], w[3 * m + 2],
+               have_irr ? irr[m] : "0");
+      add(u, sec, k2, val, line);
+    }
+    for (int i = 0; i < 3 * LW_MOVE_KINDS; i++) free(w[i]);
+    for (int i = 0; have_irr && i < LW_MOVE_KINDS; i++) free(irr[i]);
+  } else if (!strcmp(key, "moves_irregular")) {
+    /* folded into moves */
+  } else return 0;
+  return 1;
+}
+
+static void upgrade_energy(upgrade *u, const char *sec, const char *value, int line)
+{
+  /* States written before the parametrisation term (the last) hold one
+  ** number fewer: that term was off in them and takes its default. */
+  char *w[LW_TERM_COUNT];
+  int n = LW_TERM_COUNT;
+  double tmp[LW_TERM_COUNT + 1];
+  if (lw_number_list(value, 0, tmp, LW_TERM_COUNT + 1) == LW_TERM_COUNT - 1) n = LW_TERM_COUNT - 1;
+  if (!words(u, "energy", line, value, n, w)) return;
+  const char *names[LW_TERM_COUNT];
+  for (int t = 0; t < LW_TERM_COUNT; t++) names[t] = lw_term_types[t].name;
+  add_grouped(u, sec, "energy", w, n, 1, names, line);
+  for (int i = 0; i < n; i++) free(w[i]);
+}
+
+lw_status lw_checkpoint_upgrade_v1(lw_ckpt *doc, lw_ckpt *const *replicas, int n_rep, lw_error *err)
+{
+  upgrade u = {doc, lw_ckpt_path(doc), err, LW_OK};
+  static const char *const trace_names[] = {"point", "vector", "translate", "rotate"};
+  _Static_assert(LW_MOVE_KINDS == 4, "format 1 knew four move kinds");
+  size_t pos = 0;
+  const char *key, *value;
+  int line;
+  /* moves_irregular folds into moves: find it (and each rung's) first */
+  while (!u.s && lw_ckpt_next(doc, "v1", &pos, &key, &value, &line)) {
+    char sec[32], *w[3 * LW_MOVE_KINDS];
+    int rung = 0;
+    const char *k = key;
+    if (!strncmp(key, "rung", 4) && strchr(key, '_')) {
+      char *end;
+      long r = strtol(key + 4, &end, 10);
+      if (end == key + 4 || *end != '_' || r < 1 || r >= n_rep) {
+        u.s = lw_error_set(err, LW_EINPUT, "%s:%d: %s: a rung this run does not have", u.path, line, key);
+        break;
+      }
+      rung = (int)r;
+      k = end + 1;
+    }
+    rung_section(sec, sizeof sec, "chain", rung);
+    char irr_key[64];
+    snprintf(irr_key, sizeof irr_key, "%.*smoves_irregular", (int)(k - key), key);
+    size_t p2 = 0;
+    const char *k2, *v2, *irregular = NULL;
+    while (lw_ckpt_next(doc, "v1", &p2, &k2, &v2, NULL))
+      if (!strcmp(k2, irr_key)) irregular = v2;
+    if (upgrade_chain_key(&u, sec, k, value, line, irregular)) continue;
+    if (rung) {
+      u.s = lw_error_set(err, LW_EINPUT, "%s:%d: %s: not a run-data line of format 1", u.path, line, key);
+    } else if (!strcmp(key, "energy")) {
+      upgrade_energy(&u, "chain", value, line);
+    } else if (!strcmp(key, "trace_mark")) {
+      if (words(&u, key, line, value, 3 * LW_MOVE_KINDS, w)) {
+        add_grouped(&u, "run", "trace_mark", w, LW_MOVE_KINDS, 3, trace_names, line);
+        for (int i = 0; i < 3 * LW_MOVE_KINDS; i++) free(w[i]);
+      }
+    } else if (!strcmp(key, "temperature") || !strcmp(key, "block") || !strcmp(key, "t_prev") ||
+               !strcmp(key, "prev_stats") || !strcmp(key, "block_energy") || !strcmp(key, "energy_initial") ||
+               !strcmp(key, "max_drift")) {
+      add(&u, "run", key, value, line);
+    } else if (!strcmp(key, "pt_trips_steps")) {
+      if (words(&u, key, line, value, 2, w)) {
+        add(&u, "tempering", "round_trips", w[0], line);
+        add(&u, "tempering", "steps", w[1], line);
+        free(w[0]);
+        free(w[1]);
+      }
+    } else if (!strncmp(key, "pt_", 3) && (!strcmp(key + 3, "rng") || !strcmp(key + 3, "ladder") ||
+                                          !strcmp(key + 3, "at_label") || !strcmp(key + 3, "swaps") ||
+                                          !strcmp(key + 3, "window") || !strcmp(key + 3, "trace_mark"))) {
+      add(&u, "tempering", key + 3, value, line);
+    } else {
+      u.s = lw_error_set(err, LW_EINPUT, "%s:%d: %s: not a run-data line of format 1", u.path, line, key);
+    }
+  }
+  for (int k = 1; k < n_rep && !u.s; k++) {
+    char sec[32];
+    rung_section(sec, sizeof sec, "chain", k);
+    upgrade ur = {replicas[k], lw_ckpt_path(replicas[k]), err, LW_OK};
+    pos = 0;
+    while (!ur.s && lw_ckpt_next(replicas[k], "v1", &pos, &key, &value, &line)) {
+      if (strcmp(key, "energy")) {
+        ur.s = lw_error_set(err, LW_EINPUT, "%s:%d: %s: not a line of a format-1 replica file", ur.path, line, key);
+        break;
+      }
+      /* the replica's running totals belong to its rung's chain in doc */
+      upgrade ud = {doc, ur.path, err, LW_OK};
+      upgrade_energy(&ud, sec, value, line);
+      ur.s = ud.s;
+    }
+    u.s = ur.s;
+  }
+  return u.s;
+}

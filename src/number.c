@@ -1,0 +1,71 @@
+/*
+** number.c -- the strict number parser (number.h).
+**
+** The syntax is checked by hand before strtod sees the text: strtod alone
+** takes hex, "inf", "nan", leading blanks and stops silently at trailing
+** garbage, and under a C locale other than "C" it could read ',' as the
+** decimal point.  Within the checked syntax strtod does the rounding.
+*/
+#include "linewise/number.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int is_digit(char c) { return c >= '0' && c <= '9'; }
+
+int lw_number_parse_n(const char *s, size_t len, double *out)
+{
+  char buf[128];
+  size_t i = 0, digits = 0;
+  if (len == 0 || len >= sizeof buf) return 0; /* no real number needs more than 17 digits and an exponent */
+  if (s[i] == '+' || s[i] == '-') i++;
+  for (; i < len && is_digit(s[i]); i++) digits++;
+  if (i < len && s[i] == '.')
+    for (i++; i < len && is_digit(s[i]); i++) digits++;
+  if (!digits) return 0;
+  if (i < len && (s[i] == 'e' || s[i] == 'E')) {
+    size_t exp_digits = 0;
+    i++;
+    if (i < len && (s[i] == '+' || s[i] == '-')) i++;
+    for (; i < len && is_digit(s[i]); i++) exp_digits++;
+    if (!exp_digits) return 0;
+  }
+  if (i != len) return 0;
+  memcpy(buf, s, len);
+  buf[len] = '\0';
+  errno = 0;
+  char *end;
+  double v = strtod(buf, &end);
+  /* ERANGE also flags underflow, which is fine: only overflow is refused */
+  if (*end || !isfinite(v) || (errno == ERANGE && fabs(v) > 1.0)) return 0;
+  *out = v;
+  return 1;
+}
+
+int lw_number_parse(const char *s, double *out) { return lw_number_parse_n(s, strlen(s), out); }
+
+int lw_number_parse_whole(const char *s, double lo, double hi, long long *out)
+{
+  double v;
+  if (!lw_number_parse(s, &v) || v != floor(v) || v < lo || v > hi) return 0;
+  *out = (long long)v;
+  return 1;
+}
+
+int lw_number_list(const char *s, int commas, double *out, int max)
+{
+  const char *sep = commas ? " \t," : " \t";
+  int n = 0;
+  for (;;) {
+    s += strspn(s, sep);
+    if (!*s) return n;
+    size_t len = strcspn(s, sep);
+    double v;
+    if (!lw_number_parse_n(s, len, &v)) return -1;
+    if (n < max) out[n] = v;
+    n++;
+    s += len;
+  }
+}
