@@ -83,6 +83,17 @@ static lw_status make_dir(const char *dir, lw_error *err)
   return LW_OK;
 }
 
+/* Prefixes the message in err with where key was set and the key: input
+** read on behalf of a key (a table, a state, a placement) is reported as
+** that key's error. */
+static lw_status blame_key(const lw_params *p, const char *section, const char *key, lw_error *err)
+{
+  char where[LW_PATH_MAX + 32], msg[LW_ERROR_MSG];
+  lw_params_origin(p, lw_params_find(section, key), where, sizeof where);
+  snprintf(msg, sizeof msg, "%s", err->msg);
+  return lw_error_set(err, err->code, "%s: key '%s.%s': %s", where, section, key, msg);
+}
+
 /* Schedule and its table (relative to the scene file). */
 static lw_status setup_schedule(lw_anneal *a, lw_error *err)
 {
@@ -101,8 +112,7 @@ static lw_status setup_schedule(lw_anneal *a, lw_error *err)
   if (a->sched_type->needs & LW_SCHEDULE_USES_TABLE) {
     if (!p->table[0])
       return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.schedule': 'table' needs anneal.table (a file)", where);
-    lw_status s = lw_schedule_read_table(&a->sched, p->table, err);
-    if (s) return s;
+    if (lw_schedule_read_table(&a->sched, p->table, err)) return blame_key(p, "anneal", "table", err);
   }
   lw_error e2;
   if (lw_schedule_check(a->sched_type, &a->sched, &e2))
@@ -122,23 +132,6 @@ static void absolute_path(char *path, const char *scene_file)
   else if (strlen(joined) < LW_PATH_MAX) strcpy(path, joined);
 }
 
-/* The numbers of an explicit ladder (at most max are stored); returns how
-** many there are, or -1 if something else is in the text. */
-static int parse_ladder(const char *text, double *out, int max)
-{
-  int n = 0;
-  for (const char *c = text;;) {
-    while (*c == ' ' || *c == '\t' || *c == ',') c++;
-    if (!*c) return n;
-    char *end;
-    double v = strtod(c, &end);
-    if (end == c) return -1;
-    if (n < max) out[n] = v;
-    n++;
-    c = end;
-  }
-}
-
 /* Replicas of the run (the explicit ladder's length, or [tempering]
 ** replicas) and the base ladder; messages name the key's line. */
 static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
@@ -148,7 +141,7 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
   a->n_rep = p->replicas;
   if (p->ladder[0]) {
     lw_params_origin(p, lw_params_find("tempering", "ladder"), where, sizeof where);
-    int n = parse_ladder(p->ladder, ladder, LW_TEMPERING_MAX);
+    int n = lw_number_list(p->ladder, 1, ladder, LW_TEMPERING_MAX);
     if (n < 2 || n > LW_TEMPERING_MAX)
       return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%s'",
                           where, LW_TEMPERING_MAX, p->ladder);
@@ -279,8 +272,9 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   lw_splines *sp;
   if (a->params.from[0]) {
     lw_state st;
-    if ((s = lw_state_read(&st, a->params.from, err))) return s;
+    if ((s = lw_state_read(&st, a->params.from, err))) return blame_key(&a->params, "init", "from", err);
     s = lw_model_check_regular(&a->scene, st.sp, a->params.from, err);
+    if (s) blame_key(&a->params, "init", "from", err);
     sp = st.sp;
     st.sp = NULL;
     lw_state_clear(&st);
@@ -296,7 +290,7 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
     gsl_rng_set(r, lw_stream_seed(a->seed, 0));
     sp = lw_init_random(&a->scene, n, (size_t)p->segments, p->segment_length, r, err);
     gsl_rng_free(r);
-    if (!sp) return err->code;
+    if (!sp) return err->code == LW_EINPUT ? blame_key(&a->params, "init", "segment_length", err) : err->code;
   }
   /* every replica starts from the same state; their streams part them */
   lw_splines *all[LW_TEMPERING_MAX] = {sp};

@@ -209,30 +209,72 @@ static lw_status get_chain(lw_ckpt *doc, int k, lw_chain *c, lw_error *err)
   return s;
 }
 
+/* Spline i of sp alone, or from node m to m + 1 alone when m >= 0. */
+static lw_splines *part(const lw_splines *sp, size_t i, long m)
+{
+  size_t segs = m >= 0 ? 1 : lw_splines_segments(sp, i), off = sp->first[i] + (m >= 0 ? (size_t)m : 0);
+  lw_splines *one = lw_splines_new(1, &segs, NULL);
+  if (one) {
+    memcpy(one->node, sp->node + off, (segs + 1) * sizeof *one->node);
+    one->rest_length[0] = m >= 0 ? sp->rest_length[i] / (double)lw_splines_segments(sp, i) : sp->rest_length[i];
+  }
+  return one;
+}
+
+static int part_finite(const lw_scene *sc, const lw_splines *sp, size_t i, long m)
+{
+  double t[LW_TERM_COUNT];
+  lw_splines *one = part(sp, i, m);
+  int ok = !one || isfinite(lw_energy_compute(sc, one, t, NULL));
+  lw_splines_free(one);
+  return ok;
+}
+
+lw_status lw_checkpoint_check_finite(const lw_scene *sc, const lw_splines *sp, const double term[LW_TERM_COUNT],
+                                     const char *path, lw_error *err)
+{
+  int bad = -1;
+  for (int t = 0; t < LW_TERM_COUNT && bad < 0; t++)
+    if (!isfinite(term[t])) bad = t;
+  if (bad < 0) return LW_OK;
+  /* the culprit, searched only now that there is one */
+  for (size_t i = 0; i < sp->n_splines; i++) {
+    if (part_finite(sc, sp, i, -1)) continue;
+    for (size_t m = 0; m < lw_splines_segments(sp, i); m++)
+      if (!part_finite(sc, sp, i, (long)m))
+        return lw_error_set(err, LW_EINPUT, "%s: spline %zu segment %zu (nodes %zu and %zu): the %s energy is not "
+                            "finite (outside the boundary, or coordinates too large)", path, i, m, m, m + 1,
+                            lw_term_types[bad].name);
+    return lw_error_set(err, LW_EINPUT, "%s: spline %zu: the %s energy is not finite", path, i,
+                        lw_term_types[bad].name);
+  }
+  return lw_error_set(err, LW_EINPUT, "%s: the %s energy of this state is not finite (curves that coincide?)", path,
+                      lw_term_types[bad].name);
+}
+
 /* The running totals carry the rounding of the moves so far; restoring them
 ** (rather than the fresh sums) keeps the trace identical to an uninterrupted
 ** run.  They must still agree with the fresh sums to rounding, which also
 ** makes a non-finite state or an edited total an error. */
-static lw_status get_energy(lw_ckpt *doc, int k, lw_model *m, lw_error *err)
+static lw_status get_energy(lw_ckpt *doc, int k, const lw_scene *sc, lw_model *m, lw_error *err)
 {
   char sec[32], key[64];
   rung_section(sec, sizeof sec, "chain", k);
   double fresh[LW_TERM_COUNT], scale = 1.0;
   memcpy(fresh, m->term, sizeof fresh);
   for (int t = 0; t < LW_TERM_COUNT; t++) scale += fabs(fresh[t]);
+  char where[LW_PATH_MAX + 64];
+  snprintf(where, sizeof where, "%s: [system splines%s%.0d]", lw_ckpt_path(doc), k ? " " : "", k);
+  lw_status s = lw_checkpoint_check_finite(sc, m->sp, fresh, where, err);
+  if (s) return s;
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     const char *name = lw_term_types[t].name;
-    if (!isfinite(fresh[t]))
-      return lw_error_set(err, LW_EINPUT, "%s: [system splines%s%.0d]: the %s energy of this state is not finite "
-                          "(a node outside the boundary, or coordinates too large?)", lw_ckpt_path(doc), k ? " " : "",
-                          k, name);
     double v = 0.0; /* a term the writer did not know was off */
     snprintf(key, sizeof key, "energy.%s", name);
-    lw_status s = lw_ckpt_numbers(doc, sec, key, &v, 1, -DBL_MAX, DBL_MAX, 0, err);
-    if (s) return s;
+    if ((s = lw_ckpt_numbers(doc, sec, key, &v, 1, -DBL_MAX, DBL_MAX, 0, err))) return s;
     if (!(fabs(v - fresh[t]) <= 1e-6 * scale))
-      return lw_error_set(err, LW_EINPUT, "%s: [%s] %s: %.17g, but the state's %s energy is %.17g (the file was "
-                          "changed or damaged)", lw_ckpt_path(doc), sec, key, v, name, fresh[t]);
+      return lw_error_set(err, LW_EINPUT, "%s: [%s] %s: %.17g, but the state is at %.17g (the file was changed "
+                          "or damaged)", lw_ckpt_path(doc), sec, key, v, fresh[t]);
     m->term[t] = v;
   }
   return LW_OK;
@@ -298,7 +340,7 @@ lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, l
   const char *path = lw_ckpt_path(doc);
   lw_status s = LW_OK;
   for (int k = 0; k < a->n_rep && !s; k++)
-    if (!(s = get_chain(doc, k, a->chains[k], err))) s = get_energy(doc, k, a->chains[k]->model, err);
+    if (!(s = get_chain(doc, k, a->chains[k], err))) s = get_energy(doc, k, &a->scene, a->chains[k]->model, err);
   if (s) return s;
   double v[3];
   unsigned long u[3];

@@ -12,8 +12,10 @@
 #include <unistd.h>
 
 #include "linewise/anneal.h"
+#include "linewise/checkpoint.h"
 
 #include "linewise/model.h"
+#include "linewise/number.h"
 #include "linewise/params.h"
 #include "linewise/scene.h"
 #include "linewise/state.h"
@@ -82,7 +84,9 @@ static int cmd_energy(int argc, char **argv)
   double term[LW_TERM_COUNT];
   double total = lw_energy_compute(&sc, st.sp, term, &err);
   int rc = 0;
-  if (err.code) rc = fail(&err);
+  char path[LW_PATH_MAX + 32];
+  lw_path_join(path, sizeof path, argv[0], "state.lw");
+  if (err.code || lw_checkpoint_check_finite(&sc, st.sp, term, path, &err)) rc = fail(&err);
   else {
     for (int t = 0; t < LW_TERM_COUNT; t++)
       if (sc.on[t]) printf("%s %.17g\n", lw_term_types[t].name, term[t]);
@@ -136,20 +140,13 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
 ** the final files (or a checkpoint for a clean stop). */
 static int anneal_loop(lw_anneal *a, long stop_at, int quiet, lw_error *err)
 {
-  struct sigaction sa;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_signal;
-  sigaction(SIGINT, &sa, NULL);
-  sigaction(SIGTERM, &sa, NULL);
   progress pg = {quiet, isatty(2), a->sweep, a->sweep, -1};
-  int stopped = 0;
-  while (!lw_anneal_done(a)) {
+  /* a signal during start-up stops before the first sweep */
+  int stopped = stop_requested && !lw_anneal_done(a);
+  while (!stopped && !lw_anneal_done(a)) {
     if (lw_anneal_sweep(a, err)) return fail(err);
     progress_show(&pg, a, 0);
-    if (stop_requested || (stop_at >= 0 && a->sweep >= stop_at)) {
-      stopped = 1;
-      break;
-    }
+    stopped = stop_requested || (stop_at >= 0 && a->sweep >= stop_at);
   }
   progress_show(&pg, a, 1);
   if (stopped) {
@@ -172,15 +169,16 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, lw_error *err)
   return 0;
 }
 
-static int parse_count(const char *opt, const char *v, long *out, lw_error *err)
+/* A count on the command line, read by the parser of scene keys; at most
+** 1e15, so sweep + count cannot overflow. */
+static int parse_count(const char *opt, const char *v, double max, long *out, lw_error *err)
 {
-  char *end;
-  long n = strtol(v ? v : "", &end, 10);
-  if (!v || end == v || *end || n < 0) {
-    lw_error_set(err, LW_EUSAGE, "%s: expected a whole number >= 0, got '%s'", opt, v ? v : "");
+  long long n;
+  if (!v || !lw_number_parse_whole(v, 0, max, &n)) {
+    lw_error_set(err, LW_EUSAGE, "%s: expected a whole number from 0 to %.0f, got '%s'", opt, max, v ? v : "");
     return 0;
   }
-  *out = n;
+  *out = (long)n;
   return 1;
 }
 
@@ -189,7 +187,7 @@ static int parse_count(const char *opt, const char *v, long *out, lw_error *err)
 static int set_threads(const char *v, lw_error *err)
 {
   long t;
-  if (!parse_count("--threads", v, &t, err) || t < 1 || t > 4096) {
+  if (!parse_count("--threads", v, 4096, &t, err) || t < 1) {
     lw_error_set(err, LW_EUSAGE, "--threads: expected a whole number from 1 to 4096, got '%s'", v ? v : "");
     return 0;
   }
@@ -203,7 +201,7 @@ static int set_threads(const char *v, lw_error *err)
 static int shared_option(char **argv, int argc, int i, long *stop_at, int *quiet, lw_error *err)
 {
   const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-  if (!strcmp(argv[i], "--stop-at")) return parse_count("--stop-at", v, stop_at, err) ? 2 : -1;
+  if (!strcmp(argv[i], "--stop-at")) return parse_count("--stop-at", v, LW_STATE_SWEEP_MAX, stop_at, err) ? 2 : -1;
   if (!strcmp(argv[i], "--threads")) return set_threads(v, err) ? 2 : -1;
   if (!strcmp(argv[i], "--quiet")) {
     *quiet = 1;
@@ -251,11 +249,11 @@ static int cmd_run(int argc, char **argv)
       if (lw_params_set(&p, v, &err)) return fail(&err);
       i++;
     } else if (!strcmp(argv[i], "--out")) {
-      if (!v) { lw_error_set(&err, LW_EUSAGE, "--out: expected a directory"); return fail(&err); }
+      if (!v || !*v) { lw_error_set(&err, LW_EUSAGE, "--out: expected a directory, got '%s'", v ? v : ""); return fail(&err); }
       out = v;
       i++;
     } else if (!strcmp(argv[i], "--seed")) {
-      if (!parse_count("--seed", v, &seed, &err)) return fail(&err);
+      if (!parse_count("--seed", v, 4294967295.0, &seed, &err)) return fail(&err);
       char buf[64];
       snprintf(buf, sizeof buf, "anneal.seed=%ld", seed);
       if (lw_params_set(&p, buf, &err)) return fail(&err);
@@ -300,7 +298,7 @@ static int cmd_resume(int argc, char **argv)
   for (int i = 0; i < argc; i++) {
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
     if (!strcmp(argv[i], "--sweeps")) {
-      if (!parse_count("--sweeps", v, &more, &err)) return fail(&err);
+      if (!parse_count("--sweeps", v, LW_STATE_SWEEP_MAX, &more, &err)) return fail(&err);
       i++;
     } else if ((used = shared_option(argv, argc, i, &stop_at, &quiet, &err)) != 0) {
       if (used < 0) return fail(&err);
@@ -335,8 +333,24 @@ static int wants_help(int argc, char **argv)
   return 0;
 }
 
+/* From the first instruction: SIGINT and SIGTERM only ask for a clean stop
+** (a run started meanwhile finishes its start-up, writes its first
+** checkpoint and stops), and a file-size limit makes writes fail with EFBIG,
+** reported with the file, instead of killing the process. */
+static void install_signals(void)
+{
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+  signal(SIGXFSZ, SIG_IGN);
+}
+
 int main(int argc, char **argv)
 {
+  install_signals();
   if (argc >= 2 && wants_help(argc, argv)) {
     fputs(usage, stdout);
     return 0;

@@ -15,6 +15,7 @@
 #include <string.h>
 #include <sys/types.h>
 
+#include "linewise/number.h"
 #include "linewise/output.h"
 
 #define OFF(f) offsetof(lw_params, f)
@@ -321,12 +322,9 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
   switch (d->type) {
   case LW_PT_DOUBLE:
   case LW_PT_INT: {
-    char *end;
-    errno = 0;
-    double v = strtod(text, &end);
-    while (*end == ' ' || *end == '\t') end++;
+    double v;
     range_text(d, range, sizeof range);
-    if (end == text || *end || errno == ERANGE || !isfinite(v)) {
+    if (!lw_number_parse(text, &v)) {
       snprintf(expected, n, "a %s %s", d->type == LW_PT_INT ? "whole number" : "number", range);
       return 0;
     }
@@ -424,6 +422,12 @@ static char *read_line(char *str, int num, void *stream)
     rc->failed = 1;
     return NULL;
   }
+  /* inih would end the value at a NUL byte and drop the rest unseen */
+  if (memchr(rc->buf, '\0', (size_t)len)) {
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: a NUL byte inside the line", rc->p->file, rc->line);
+    rc->failed = 1;
+    return NULL;
+  }
   memcpy(str, rc->buf, (size_t)len + 1);
   return str;
 }
@@ -471,12 +475,14 @@ lw_status lw_params_read(lw_params *p, const char *path, lw_error *err)
   ini_allow_multiline = false;
   ini_stop_on_first_error = true;
   reader_ctx rc = {p, f, 0, err, 0, NULL, 0};
+  errno = 0;
   int r = ini_parse_stream(read_line, &rc, on_key, &rc);
-  int read_error = ferror(f);
+  int read_error = ferror(f) ? (errno ? errno : EIO) : 0;
   fclose(f);
   free(rc.buf);
   if (rc.failed) return LW_EINPUT;
-  if (read_error) return lw_error_set(err, LW_EIO, "%s: read error", path);
+  /* a directory opens but does not read: the user named the wrong thing */
+  if (read_error) return lw_error_set(err, LW_EINPUT, "%s: cannot read scene file: %s", path, strerror(read_error));
   if (r > 0)
     return lw_error_set(err, LW_EINPUT,
                         "%s:%d: syntax error: expected '[section]', 'key = value' or a comment", path, r);

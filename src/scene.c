@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "linewise/imagefield.h"
+#include "linewise/number.h"
 #include "linewise/sdt.h"
 #include "linewise/state.h"
 
@@ -131,28 +132,13 @@ static lw_status build_mask(lw_scene *sc, const lw_params *p, lw_error *err)
 
 static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
 {
-  size_t cap = 16, n = 0;
-  double *v = malloc(cap * sizeof *v);
+  int count = lw_number_list(p->polygon, 1, NULL, 0);
+  if (count < 0)
+    return bad_key(p, "scene", "polygon", LW_EINPUT, err, "expected numbers 'x y x y ...', got '%s'", p->polygon);
+  size_t n = (size_t)count;
+  double *v = malloc((n ? n : 1) * sizeof *v);
   if (!v) return lw_error_set(err, LW_ENOMEM, "out of memory reading the polygon");
-  const char *c = p->polygon;
-  for (;;) {
-    char *end;
-    while (*c == ' ' || *c == '\t' || *c == ',') c++;
-    if (!*c) break;
-    double x = strtod(c, &end);
-    if (end == c || !isfinite(x)) {
-      free(v);
-      return bad_key(p, "scene", "polygon", LW_EINPUT, err, "expected numbers 'x y x y ...', got '%s'", c);
-    }
-    if (n == cap) {
-      double *nv = realloc(v, 2 * cap * sizeof *v);
-      if (!nv) { free(v); return lw_error_set(err, LW_ENOMEM, "out of memory reading the polygon"); }
-      v = nv;
-      cap *= 2;
-    }
-    v[n++] = x;
-    c = end;
-  }
+  lw_number_list(p->polygon, 1, v, count);
   lw_status st = LW_OK;
   if (n % 2 || n < 6) {
     st = bad_key(p, "scene", "polygon", LW_EINPUT, err,

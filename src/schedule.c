@@ -14,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/number.h"
+
 /* ---- helpers ------------------------------------------------------------ */
 
 /* f = b / (B-1), with b clamped to 0 .. B-1 so that the temperature holds
@@ -223,12 +225,7 @@ void lw_schedule_clear(lw_schedule *s)
 }
 
 /* The whole token as a finite double. */
-static int parse_number(const char *tok, double *out)
-{
-  char *end;
-  *out = strtod(tok, &end);
-  return end != tok && *end == '\0' && isfinite(*out);
-}
+static int parse_number(const char *tok, double *out) { return lw_number_parse(tok, out); }
 
 /* Splits c (modified) into at most 3 whitespace-separated tokens; returns
 ** how many there were, 3 meaning "more than two". */

@@ -58,3 +58,79 @@ Test(checkpoint, format_1_tempering_run_resumes_to_the_uninterrupted_result)
                                       "final.png", "ladder.ini", NULL};
   resume_fixture_matches_fresh_run("tempering", files);
 }
+
+/* A run of the plain fixture's scene stopped at sweep 20, in dir/r. */
+static void stopped_run(void)
+{
+  cr_assert_eq(lw_test_sh("%s run %s/tests/fixtures/v1/plain.ini --out %s/r --stop-at 20 --quiet", bin(), root(), dir),
+               0);
+}
+
+/* Resumes a copy of dir/r whose state.lw went through the sed script; the
+** exit status, with stderr in dir/err.txt. */
+static int resume_edited(const char *sed)
+{
+  lw_test_sh("rm -rf %s/x && cp -r %s/r %s/x", dir, dir, dir);
+  cr_assert_eq(lw_test_sh("sed -i -e '%s' %s/x/state.lw", sed, dir), 0);
+  return lw_test_sh("%s resume %s/x --quiet --sweeps 2 2>%s/err.txt", bin(), dir, dir);
+}
+
+static int err_has(const char *text)
+{
+  return lw_test_sh("grep -qF -- '%s' %s/err.txt", text, dir) == 0;
+}
+
+Test(checkpoint, every_run_data_value_is_checked_on_resume)
+{
+  /* each edit was accepted (or crashed, or ran on NaN) before validation */
+  static const struct { const char *sed, *msg; } bad[] = {
+    {"s/^block = .*/block = 99999/", "[run] block: expected a whole number from -1 to 5"},
+    {"s/^block = .*/block = -7/", "[run] block"},
+    {"s/^moves.point = .*/moves.point = -1 0 0 0/", "[chain] moves.point"},
+    {"s/^moves.point = \\([0-9]*\\) .*/moves.point = \\1 99999999 0 0/", "accepted + nan + irregular <= proposed"},
+    {"s/^sweep = .*/sweep = 99999999999999999999/", "[run] sweep"},
+    {"s/^energy.strain = .*/energy.strain = inf/", "[chain] energy.strain"},
+    {"s/^energy.bending = .*/energy.bending = -1e308/", "but the state is at 0."},
+    {"s/^temperature = .*/temperature = -1/", "[run] temperature"},
+    {"s/^temperature = .*/temperature = inf/", "[run] temperature"},
+    {"s/^step.point = .*/step.point = -0.34/", "[chain] step.point"},
+    {"s/^step.point = .*/step.point = 0/", "[chain] step.point"},
+    {"s/^step.point = .*/step.point = inf/", "[chain] step.point"},
+    {"s/^step.point = .*/step.point = 0x1p-2/", "[chain] step.point"},
+    {"s/^rng = ../rng = r;/", "[chain] rng: expected the state of a mt19937 generator"},
+    {"s/^rng = \\(.*\\)$/rng = \\1ff/", "[chain] rng"},
+    /* the position index of mt19937 (bytes 4992..4995): 0xffff0000 */
+    {"s/^\\(rng = .\\{9984\\}\\)......../\\10000ffff/", "[chain] rng"},
+    {"s/^node = \\([^ ]*\\) /node = 1e200 /", "spline 0 node 0"},
+    {"s/^splines = .*/splines = 0x2/", "[system splines] splines"},
+    {"s/^trace_mark.point = .*/trace_mark.point = 99999999 0 0/", "[run] trace_mark.point: beyond"},
+    {"s/^max_drift = .*/max_drift = nan/", "[run] max_drift"},
+    {"s/^window.point = .*/window.point = 1 5/", "[chain] window.point: more accepted"},
+    {"/^trace_bytes = /d;s/^seed = .*/seed = 1 2/", "[run] seed"},
+    {"s/^\\[chain\\]$/[chain 7]/", "[chain] rng: missing"},
+    {"$s/$/\\nextra = 1/", "[system splines] extra: expected nothing after"},
+    {"s/^sweep = 20$/sweep = 20\\nsweep = 21/", "[run] sweep: unknown or repeated key"},
+    {"s/^block = 1$/block = 1\\o000/", "a NUL byte inside the line"},
+  };
+  stopped_run();
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    int rc = resume_edited(bad[i].sed);
+    cr_expect_eq(rc, 2, "edit '%s': exit %d", bad[i].sed, rc);
+    cr_expect(err_has(bad[i].msg), "edit '%s': message lacks '%s'", bad[i].sed, bad[i].msg);
+    cr_expect(err_has("x/state.lw"), "edit '%s': message lacks the file", bad[i].sed);
+  }
+  /* unedited, the copy resumes: the edits above are what was refused */
+  cr_assert_eq(resume_edited("s/^sweep = 20$/sweep = 20/"), 0);
+}
+
+Test(checkpoint, a_state_with_an_infinite_energy_is_refused_with_the_spline_and_segment)
+{
+  stopped_run();
+  /* spline 1 moved off the page as a whole: regular, but outside the boundary */
+  cr_assert_eq(lw_test_sh("rm -rf %s/x && cp -r %s/r %s/x && awk '/^spline = /{n++} /^node = /&&n==2{$3+=500} {print}' "
+                          "%s/r/state.lw > %s/x/state.lw", dir, dir, dir, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/x --quiet 2>%s/err.txt", bin(), dir, dir), 2);
+  cr_assert(err_has("spline 1 segment 0 (nodes 0 and 1): the boundary energy is not finite"));
+  cr_assert_eq(lw_test_sh("%s energy %s/x 2>%s/err.txt", bin(), dir, dir), 2);
+  cr_assert(err_has("spline 1 segment 0 (nodes 0 and 1): the boundary energy is not finite"));
+}

@@ -237,3 +237,83 @@ Test(cli, a_state_without_a_later_term_resumes_and_unknown_keys_are_refused)
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
   cr_assert(strstr(errs, "new/state.lw:") && strstr(errs, "[chain] energy.torsion: unknown"), "%s", errs);
 }
+
+/* Bad input of every kind exits 2 with one message naming the file, line
+** and key (issue 21: each of these exited 1, 0 or 139, or read garbage). */
+Test(cli, hostile_input_exits_2_naming_file_line_and_key)
+{
+  char out[1024], errs[2048], args[1024];
+  write_file("s.ini", scene_text);
+  write_file("hex.ini", "[scene]\nwidth = 0x10\n");
+  write_file("trail.ini", "[scene]\nwidth = 100mm\n");
+  write_file("tb.ini", "[anneal]\nschedule = table\ntable = t.txt\n");
+  write_file("t.txt", "0 1\n1 0x1\n");
+  write_file("fr.ini", "[init]\nfrom = fr.lw\n");
+  write_file("fr.lw", "linewise-state 2\n[run]\nscene = s.ini\nseed = 1\nsweep = 0\n[system splines]\nsplines = 1x\n");
+  write_file("pl.ini", "[scene]\nwidth = 100\nheight = 80\n[init]\nsegment_length = 500\n");
+  {
+    char path[128];
+    snprintf(path, sizeof path, "%s/nul.ini", dir);
+    FILE *f = fopen(path, "wb");
+    fwrite("[scene]\nwidth = 100\0garbage\n", 1, 28, f);
+    fclose(f);
+  }
+  static const struct { const char *args, *msg; } bad[] = {
+    {"run %s", "cannot read scene file: Is a directory"},
+    {"run %s/s.ini --out ''", "--out: expected a directory"},
+    {"run %s/s.ini --stop-at 99999999999999999999", "--stop-at: expected a whole number"},
+    {"run %s/s.ini --stop-at 0x10", "--stop-at: expected a whole number"},
+    {"run %s/s.ini --seed 1e300", "--seed: expected a whole number"},
+    {"run %s/s.ini --threads 2x", "--threads: expected a whole number"},
+    {"resume %s --sweeps 99999999999999999999", "--sweeps: expected a whole number"},
+    {"run %s/hex.ini", "hex.ini:2: key 'scene.width': expected a number"},
+    {"run %s/trail.ini", "trail.ini:2: key 'scene.width'"},
+    {"run %s/nul.ini", "nul.ini:2: a NUL byte inside the line"},
+    {"run %s/s.ini --set scene.width=0x10", "--set scene.width: expected a number"},
+    {"run %s/tb.ini", "tb.ini:3: key 'anneal.table': "},
+    {"run %s/fr.ini", "fr.ini:2: key 'init.from': "},
+    {"run %s/pl.ini", "pl.ini:5: key 'init.segment_length': "},
+    {"energy %s", "state.lw: cannot read state file: Is a directory"},
+  };
+  char sub[128];
+  snprintf(sub, sizeof sub, "%s/sd/state.lw", dir);
+  cr_assert_eq(lw_test_sh("mkdir -p %s", sub), 0);
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    /* energy and resume get the directory whose state.lw is a directory */
+    char where[128];
+    snprintf(where, sizeof where, "%s%s", dir, bad[i].args[0] == 'r' && bad[i].args[1] == 'u' ? "" : "/sd");
+    snprintf(args, sizeof args, bad[i].args, where);
+    if (bad[i].args[0] == 'r') strcat(args, " --quiet");
+    if (bad[i].args[1] == 'u' && !strstr(bad[i].args, "--out"))
+      snprintf(args + strlen(args), sizeof args - strlen(args), " --out %s/o%zu", dir, i);
+    int rc = run(args, out, sizeof out, errs, sizeof errs);
+    cr_expect_eq(rc, 2, "'%s': exit %d: %s", args, rc, errs);
+    cr_expect(strstr(errs, bad[i].msg) != NULL, "'%s': message '%s' lacks '%s'", args, errs, bad[i].msg);
+  }
+}
+
+/* SIGTERM during start-up (a scene that takes a while to place) leaves a
+** directory that resumes, and a file-size limit is a clean error that
+** names the file and leaves no temporary file. */
+Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_error)
+{
+  write_file("s.ini", scene_text);
+  cr_assert_eq(lw_test_sh("%s run %s/s.ini --out %s/sig --quiet --set init.splines=400 --set anneal.sweeps=50 & "
+                          "p=$!; sleep 0.05; kill -TERM $p; wait $p", bin(), dir, dir), 0);
+  cr_assert_eq(lw_test_sh("test -f %s/sig/state.lw && ! test -e %s/sig/state.lw.tmp", dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/sig --quiet", bin(), dir), 0);
+  char out[256], errs[1024], args[512];
+  snprintf(args, sizeof args, "run %s/s.ini --out %s/fz --quiet --set output.checkpoint_every=1", dir, dir);
+  char cmd[700];
+  snprintf(cmd, sizeof cmd, "sh -c 'ulimit -f 8; %s %s' >%s/out.txt 2>%s/err.txt", bin(), args, dir, dir);
+  int st = system(cmd);
+  cr_assert(WIFEXITED(st) && WEXITSTATUS(st) == 1, "a size limit must be an error (exit 1), got status %d", st);
+  (void)out;
+  snprintf(cmd, sizeof cmd, "%s/err.txt", dir);
+  FILE *f = fopen(cmd, "r");
+  size_t n = fread(errs, 1, sizeof errs - 1, f);
+  errs[n] = '\0';
+  fclose(f);
+  cr_assert(strstr(errs, "fz/state.lw: write failed: File too large"), "%s", errs);
+  cr_assert_neq(lw_test_sh("ls %s/fz/*.tmp 2>/dev/null | grep -q .", dir), 0, "a temporary file was left behind");
+}

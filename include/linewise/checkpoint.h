@@ -26,6 +26,13 @@ lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err);
 ** trace.csv at the checkpoint, or -1 if the file does not say (format 1). */
 lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, lw_error *err);
 
+/* LW_EINPUT if an energy of a state read from path is not finite (a node
+** outside the boundary, coordinates too large): the message names the term,
+** and the spline and segment where one alone is not finite.  term[] holds
+** the state's energies by term. */
+lw_status lw_checkpoint_check_finite(const lw_scene *sc, const lw_splines *sp, const double term[LW_TERM_COUNT],
+                                     const char *path, lw_error *err);
+
 /* Rewrites the [v1] section of a format-1 state (rung 0) and the [v1]
 ** sections of its replica files (rungs 1..n-1, NULL without tempering) as
 ** the keys of format 2, so one reader serves both. */
