@@ -1,5 +1,5 @@
 # linewise -- elastic Bezier curves annealed into line art.
-# Targets: all (bin/linewise), deps, test, test-long, asan, fuzz, run, bench, install, clean.
+# Targets: all (bin/linewise), deps, test, test-long, asan, fuzz, fuzz-build, run, bench, install, clean.
 
 CC      ?= cc
 PREFIX  ?= /usr/local
@@ -21,7 +21,7 @@ LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_OBJ := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%.o)
 # The fuzz harnesses, compiled with cc into the suite, which replays the corpus.
-FUZZ_NAMES := params state
+FUZZ_NAMES := params state resume energy
 FUZZ_REPLAY_OBJ := $(FUZZ_NAMES:%=$(BUILD)/tests/fuzz_%.o)
 TEST_JOBS ?= 2
 # study tools (shell, gnuplot), installed as linewise-<name>
@@ -29,7 +29,7 @@ TOOLS   := seed-sweep param-sweep plot-run plot-sweep
 # The example picture is generated (no third-party images in the repository).
 PICTURE := params/picture.png
 
-.PHONY: all deps test test-long asan fuzz run bench install clean docs
+.PHONY: all deps test test-long asan fuzz fuzz-build run bench install clean docs
 all: $(BIN)/linewise
 
 $(BUILD)/obj/%.o: src/%.c $(wildcard include/linewise/*.h) | $(BUILD)/obj
@@ -44,7 +44,7 @@ $(BIN)/linewise: src/main.c $(BUILD)/liblinewise.a | $(BIN)
 $(BUILD)/tests/%.o: tests/%.c $(wildcard tests/*.h) $(wildcard include/linewise/*.h) | $(BUILD)/tests
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -Itests -c $< -o $@
 
-$(BUILD)/tests/fuzz_%.o: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(wildcard include/linewise/*.h) | $(BUILD)/tests
+$(BUILD)/tests/fuzz_%.o: tests/fuzz/fuzz_%.c $(wildcard tests/fuzz/*.h) $(wildcard include/linewise/*.h) | $(BUILD)/tests
 	$(CC) $(WARN) $(CFLAGS) $(CPPFLAGS) -DLLVMFuzzerTestOneInput=lw_fuzz_$*_one -c $< -o $@
 
 $(BUILD)/tests/run: $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(BUILD)/liblinewise.a
@@ -59,9 +59,9 @@ test: $(BIN)/linewise $(BUILD)/tests/run $(PICTURE)
 	LW_BIN=$(CURDIR)/$(BIN)/linewise LW_ROOT=$(CURDIR) $(BUILD)/tests/run --jobs $(TEST_JOBS)
 
 # The long statistical and stress tests (LW_LONG=1 scales them up; minutes).
-test-long: $(BIN)/linewise $(BUILD)/tests/run
+test-long: $(BIN)/linewise $(BUILD)/tests/run $(PICTURE)
 	LW_LONG=1 LW_BIN=$(CURDIR)/$(BIN)/linewise LW_ROOT=$(CURDIR) $(BUILD)/tests/run --jobs $(TEST_JOBS) \
-	  --filter '@(stats|hard)/*'
+	  --filter '@(stats|hard|crash)/*'
 
 asan:
 	$(MAKE) BUILD=build-asan BIN=build-asan/bin OPT=-O1 \
@@ -70,18 +70,22 @@ asan:
 
 # Fuzzing (libFuzzer, needs clang): each harness runs FUZZ_TIME seconds on
 # its seed corpus; new inputs go to build-fuzz/corpus, crashes to
-# build-fuzz/crashes.  Only the modules the readers use are built.
+# build-fuzz/crashes.  The whole library is built (the resume harness
+# reaches most of it), so no module list can go stale; `fuzz-build` only
+# links the harnesses (CI runs it).  FUZZ_FLAGS adds libFuzzer options,
+# e.g. FUZZ_FLAGS=-runs=1000000.
 FUZZ_CC   ?= clang
 FUZZ_TIME ?= 60
-FUZZ_LIB  := error params scene state spline quad boundary field pair terms
-FUZZ_OBJ  := $(FUZZ_LIB:%=build-fuzz/obj/%.o)
+FUZZ_FLAGS ?=
+FUZZ_OBJ  := $(LIB_SRC:src/%.c=build-fuzz/obj/%.o)
 FUZZ_SAN  := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
+FUZZ_WARN := $(WARN) -Wno-unknown-pragmas
 
 build-fuzz/obj/%.o: src/%.c $(wildcard include/linewise/*.h) | build-fuzz/obj
-	$(FUZZ_CC) $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link $(CPPFLAGS) -c $< -o $@
+	$(FUZZ_CC) $(FUZZ_WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link $(CPPFLAGS) -c $< -o $@
 
-build-fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(FUZZ_OBJ)
-	$(FUZZ_CC) $(WARN) $(FUZZ_SAN) -fsanitize=fuzzer $(CPPFLAGS) $< $(FUZZ_OBJ) -o $@ $(LDLIBS)
+build-fuzz/fuzz_%: tests/fuzz/fuzz_%.c $(wildcard tests/fuzz/*.h) $(FUZZ_OBJ)
+	$(FUZZ_CC) $(FUZZ_WARN) $(FUZZ_SAN) -fsanitize=fuzzer $(CPPFLAGS) $< $(FUZZ_OBJ) -o $@ $(LDLIBS)
 
 # kept between runs (make would delete them as intermediates)
 .SECONDARY: $(FUZZ_OBJ)
@@ -89,10 +93,12 @@ build-fuzz/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/fuzz_util.h $(FUZZ_OBJ)
 build-fuzz/obj:
 	mkdir -p $@
 
-fuzz: $(FUZZ_NAMES:%=build-fuzz/fuzz_%)
+fuzz-build: $(FUZZ_NAMES:%=build-fuzz/fuzz_%)
+
+fuzz: fuzz-build
 	for t in $(FUZZ_NAMES); do \
 	  mkdir -p build-fuzz/corpus/$$t build-fuzz/crashes && \
-	  build-fuzz/fuzz_$$t -max_total_time=$(FUZZ_TIME) -timeout=10 -artifact_prefix=build-fuzz/crashes/$$t- \
+	  build-fuzz/fuzz_$$t -max_total_time=$(FUZZ_TIME) -timeout=10 $(FUZZ_FLAGS) -artifact_prefix=build-fuzz/crashes/$$t- \
 	    build-fuzz/corpus/$$t tests/fuzz/corpus/$$t || exit 1; \
 	done
 

@@ -13,6 +13,8 @@
 
 int lw_fuzz_params_one(const uint8_t *data, size_t size);
 int lw_fuzz_state_one(const uint8_t *data, size_t size);
+int lw_fuzz_resume_one(const uint8_t *data, size_t size);
+int lw_fuzz_energy_one(const uint8_t *data, size_t size);
 
 /* Feeds every file of tests/fuzz/corpus/<name> to fn; returns the count. */
 static int replay(const char *name, int (*fn)(const uint8_t *, size_t))
@@ -52,4 +54,14 @@ Test(fuzz, params_corpus_replays_clean)
 Test(fuzz, state_corpus_replays_clean)
 {
   cr_assert_geq(replay("state", lw_fuzz_state_one), 10, "the state corpus lost its seeds");
+}
+
+Test(fuzz, resume_corpus_replays_clean)
+{
+  cr_assert_geq(replay("resume", lw_fuzz_resume_one), 8, "the resume corpus lost its seeds");
+}
+
+Test(fuzz, energy_corpus_replays_clean)
+{
+  cr_assert_geq(replay("energy", lw_fuzz_energy_one), 4, "the energy corpus lost its seeds");
 }
