@@ -141,6 +141,7 @@ static lw_status pair_all(const pair_view *v, double *e)
   lw_status st = LW_OK;
   for (size_t ci = 0; ci < (size_t)g->nx * (size_t)g->ny && st == LW_OK; ci++) {
     const lw_cell *c = &g->cell[ci];
+    if (!c->n) continue; /* an empty cell may have no block: NULL + 0 is undefined */
     const uint32_t *idx = lw_cell_idx(c);
     for (uint32_t k = 0; k < c->n && st == LW_OK; k++) {
       uint32_t i = idx[k], ga = i / v->np;

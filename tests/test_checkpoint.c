@@ -37,6 +37,9 @@ static const char *root(void)
 static void resume_fixture_matches_fresh_run(const char *name, const char *const *files)
 {
   cr_assert_eq(lw_test_sh("cp -r %s/tests/fixtures/v1/%s %s/old", root(), name, dir), 0);
+  /* a row torn by a kill after the checkpoint, whose numeric prefix reads
+  ** as an earlier sweep (22 of "221,..."), must go, not stay */
+  cr_assert_eq(lw_test_sh("printf '26,0.1\n22' >> %s/old/trace.csv", dir), 0);
   cr_assert_eq(lw_test_sh("%s resume %s/old --quiet", bin(), dir), 0, "the old run directory does not resume");
   cr_assert_eq(lw_test_sh("%s run %s/old/scene.ini --out %s/fresh --quiet", bin(), dir, dir), 0);
   for (const char *const *f = files; *f; f++)
@@ -133,4 +136,19 @@ Test(checkpoint, a_state_with_an_infinite_energy_is_refused_with_the_spline_and_
   cr_assert(err_has("spline 1 segment 0 (nodes 0 and 1): the boundary energy is not finite"));
   cr_assert_eq(lw_test_sh("%s energy %s/x 2>%s/err.txt", bin(), dir, dir), 2);
   cr_assert(err_has("spline 1 segment 0 (nodes 0 and 1): the boundary energy is not finite"));
+}
+
+Test(checkpoint, rows_written_after_the_checkpoint_are_cut_back_on_resume)
+{
+  stopped_run();
+  /* what a kill between the checkpoint and the next leaves: later rows, the
+  ** last one torn */
+  cr_assert_eq(lw_test_sh("cp -r %s/r %s/x && printf '21,0.3,1\n22,0.3,1\n2' >> %s/x/trace.csv", dir, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/r --quiet && %s resume %s/x --quiet", bin(), dir, bin(), dir), 0);
+  cr_assert_eq(lw_test_sh("cmp -s %s/r/trace.csv %s/x/trace.csv", dir, dir), 0);
+  /* a trace shorter than the checkpoint says was cut or replaced: refused */
+  cr_assert_eq(lw_test_sh("rm -rf %s/r && %s run %s/tests/fixtures/v1/plain.ini --out %s/r --stop-at 20 --quiet && "
+                          "truncate -s 100 %s/r/trace.csv", dir, bin(), root(), dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/r --quiet 2>%s/err.txt", bin(), dir, dir), 2);
+  cr_assert(err_has("trace.csv: 100 bytes, but state.lw counts"));
 }

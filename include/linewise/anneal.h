@@ -7,8 +7,8 @@
 ** Run directory: scene.ini (the resolved parameters), state.lw, trace.csv,
 ** summary.json, final.svg, final.png (and as asked final.pdf and frames/,
 ** drawing.h); with parallel tempering also
-** replica-K.lw, the replica at rung K >= 1 (state.lw holds rung 0, the
-** coldest, and the data of every rung's chain), and ladder.ini after ladder
+** replica-K.lw, a copy of the replica at rung K >= 1 (state.lw holds every
+** rung and the data of every rung's chain; checkpoint.h), and ladder.ini after ladder
 ** tuning.  The rungs sweep in parallel (OpenMP), each with its own stream;
 ** exchanges are drawn serially from a master stream, so the result does not
 ** depend on the number of threads.  The state file carries everything
