@@ -236,7 +236,10 @@ static char *next_line(reader *r)
       r->nul = 1;
       return NULL;
     }
-    r->buf[strcspn(r->buf, "\r\n")] = '\0';
+    /* trailing blanks go, as format 2 trims them: a value reads the same in both */
+    size_t n = strcspn(r->buf, "\r\n");
+    while (n > 0 && (r->buf[n - 1] == ' ' || r->buf[n - 1] == '\t')) n--;
+    r->buf[n] = '\0';
     char *c = r->buf;
     while (*c == ' ' || *c == '\t') c++;
     if (*c && *c != '#') return c;
