@@ -8,6 +8,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "linewise/number.h"
 #include "linewise/state.h"
 
 static char dir[64];
@@ -108,4 +109,94 @@ Test(state, failed_write_keeps_the_old_file)
   cr_assert_eq(lw_state_write(&st, path, &err), LW_EIO);
   cr_assert(strstr(err.msg, "nodir"));
   lw_state_clear(&st);
+}
+
+Test(state, format_2_malformed_files_name_line_section_and_key)
+{
+  const char *head = "linewise-state 2\n[run]\nscene = s.ini\nseed = 1\nsweep = 0\n[system splines]\n";
+  char buf[512];
+  expect_bad("linewise-state 2\nscene = s.ini\n", ":2:", "section");
+  expect_bad("linewise-state 2\n[run]\nscene s.ini\n", ":3:", "key = value");
+  expect_bad("linewise-state 2\n[run]\n[run]\n", ":3:", "[run] repeated");
+  expect_bad("linewise-state 2\n[run\n", ":2:", "section");
+  expect_bad("linewise-state 2\n[run]\nscene = s.ini\nseed = 0x1\nsweep = 0\n", ":4:", "[run] seed");
+  expect_bad("linewise-state 2\n[run]\nscene = s.ini\nseed = 1\nsweep = 1e16\n", ":5:", "[run] sweep");
+  snprintf(buf, sizeof buf, "%ssplines = 1\nspline = 1 3\nnode = 0 0 1 0\nnode = 1 0 1 0x1\n", head);
+  expect_bad(buf, ":10:", "spline 0 node 1");
+  snprintf(buf, sizeof buf, "%ssplines = 1\nspline = 1 3\nnode = 0 0 1 0\nnode = 1 0 1 2e9\n", head);
+  expect_bad(buf, ":10:", "spline 0 node 1");
+  snprintf(buf, sizeof buf, "%ssplines = 1\nspline = 1 3\nnode = 0 0 1 0\n", head);
+  expect_bad(buf, ":9:", "spline 0 node 1");
+  snprintf(buf, sizeof buf, "%ssplines = 1\nspline = 1 3\nnode = 0 0 1 0\nnode = 1 0 1 0\nnode = 1 0 1 0\n", head);
+  expect_bad(buf, ":11:", "expected nothing after");
+  snprintf(buf, sizeof buf, "%ssplines = 1\nspline = 1 3\nnode = 0 0 1 0\nno\001de = 1 0 1 0\n", head);
+  expect_bad(buf, ":10:", "spline 0 node 1");
+}
+
+/* The sectioned file API as a system uses it: its own section written and
+** read back without knowing the rest; unknown keys and sections refused
+** only when the reader asks, missing optional keys keep their defaults. */
+Test(state, sections_and_keys_round_trip_and_refuse_what_is_unknown)
+{
+  char path[128];
+  snprintf(path, sizeof path, "%s/k.lw", dir);
+  lw_ckpt_writer w;
+  lw_error err;
+  cr_assert_eq(lw_ckpt_begin(&w, path, "linewise-test 1", &err), LW_OK);
+  lw_ckpt_section(&w, "system demo");
+  double v[3] = {M_PI, -1e-310, 6.02214076e23};
+  unsigned long u[2] = {0, 9007199254740992UL};
+  lw_ckpt_put_numbers(&w, "x", v, 3);
+  lw_ckpt_put_counts(&w, "n", u, 2);
+  lw_ckpt_put(&w, "item", "%d", 1);
+  lw_ckpt_put(&w, "item", "%d", 2);
+  lw_ckpt_section(&w, "later");
+  lw_ckpt_put(&w, "novel", "%s", "1");
+  cr_assert_eq(lw_ckpt_commit(&w, &err), LW_OK, "%s", err.msg);
+  lw_ckpt *c;
+  cr_assert_eq(lw_ckpt_read(&c, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_str_eq(lw_ckpt_header(c), "linewise-test 1");
+  double back[3], opt = 42;
+  unsigned long ub[2];
+  cr_assert_eq(lw_ckpt_numbers(c, "system demo", "x", back, 3, -1e300, 1e300, 1, &err), LW_OK, "%s", err.msg);
+  cr_assert(!memcmp(back, v, sizeof v), "numbers changed on a write/read cycle");
+  cr_assert_eq(lw_ckpt_counts(c, "system demo", "n", ub, 2, 1, &err), LW_OK, "%s", err.msg);
+  cr_assert(ub[0] == u[0] && ub[1] == u[1]);
+  cr_assert_eq(lw_ckpt_numbers(c, "system demo", "absent", &opt, 1, 0, 100, 0, &err), LW_OK);
+  cr_assert_eq(opt, 42, "a missing optional key must keep its default");
+  cr_assert_eq(lw_ckpt_numbers(c, "system demo", "absent", &opt, 1, 0, 100, 1, &err), LW_EINPUT);
+  cr_assert_eq(lw_ckpt_numbers(c, "system demo", "x", back, 3, 0, 1, 1, &err), LW_EINPUT, "range not checked");
+  cr_assert(strstr(err.msg, "k.lw:4: [system demo] x: expected 3 numbers"), "%s", err.msg);
+  size_t pos = 0;
+  const char *key, *val;
+  int items = 0;
+  while (lw_ckpt_next(c, "system demo", &pos, &key, &val, NULL))
+    if (!strcmp(key, "item")) cr_assert_eq(atoi(val), ++items, "bulk entries out of order");
+  cr_assert_eq(items, 2);
+  cr_assert_eq(lw_ckpt_unread(c, &err), LW_EINPUT, "an unknown section passed");
+  cr_assert(strstr(err.msg, "section [later] is unknown"), "%s", err.msg);
+  cr_assert(lw_ckpt_has(c, "later"));
+  cr_assert_eq(lw_ckpt_unread(c, &err), LW_EINPUT, "an unknown key passed");
+  cr_assert(strstr(err.msg, "k.lw:10: [later] novel: unknown"), "%s", err.msg);
+  cr_assert_not_null(lw_ckpt_text(c, "later", "novel", NULL));
+  cr_assert_eq(lw_ckpt_unread(c, &err), LW_OK, "%s", err.msg);
+  lw_ckpt_free(c);
+}
+
+Test(state, strict_numbers)
+{
+  static const char *good[] = {"0", "-0", "+12", "1.5", ".5", "5.", "1e3", "1E-3", "-2.5e+10", "4.9406564584124654e-324"};
+  static const char *bad[] = {"", " 1", "1 ", "0x10", "inf", "nan", "1e", "e3", ".", "-", "1.2.3", "100mm", "1e999",
+                              "1,5", "--1"};
+  double v;
+  for (size_t i = 0; i < sizeof good / sizeof *good; i++) cr_expect(lw_number_parse(good[i], &v), "refused '%s'", good[i]);
+  for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) cr_expect(!lw_number_parse(bad[i], &v), "accepted '%s'", bad[i]);
+  cr_assert(lw_number_parse_n("12\0garbage", 11, &v) == 0, "a NUL inside must not end the number");
+  long long n;
+  cr_assert(lw_number_parse_whole("1e3", 0, 1e15, &n) && n == 1000);
+  cr_assert(!lw_number_parse_whole("1.5", 0, 1e15, &n) && !lw_number_parse_whole("1e16", 0, 1e15, &n));
+  double list[4];
+  cr_assert_eq(lw_number_list("1, 2\t3 ,4", 1, list, 4), 4);
+  cr_assert_eq(lw_number_list("1 2 3 4 5", 0, list, 2), 5, "tokens past max are counted");
+  cr_assert_eq(lw_number_list("1 2x", 0, list, 4), -1);
 }
