@@ -73,7 +73,10 @@ asan:
 # build-fuzz/crashes.  The whole library is built (the resume harness
 # reaches most of it), so no module list can go stale; `fuzz-build` only
 # links the harnesses (CI runs it).  FUZZ_FLAGS adds libFuzzer options,
-# e.g. FUZZ_FLAGS=-runs=1000000.
+# e.g. FUZZ_FLAGS=-runs=1000000.  The harnesses write their inputs to files
+# (the readers take paths) in FUZZ_TMP, a RAM disk where there is one: the
+# writers fsync, which on a real disk costs 20 times the throughput.
+FUZZ_TMP  ?= $(if $(wildcard /dev/shm),/dev/shm,/tmp)
 FUZZ_CC   ?= clang
 FUZZ_TIME ?= 60
 FUZZ_FLAGS ?=
@@ -98,7 +101,7 @@ fuzz-build: $(FUZZ_NAMES:%=build-fuzz/fuzz_%)
 fuzz: fuzz-build
 	for t in $(FUZZ_NAMES); do \
 	  mkdir -p build-fuzz/corpus/$$t build-fuzz/crashes && \
-	  build-fuzz/fuzz_$$t -max_total_time=$(FUZZ_TIME) -timeout=10 $(FUZZ_FLAGS) -artifact_prefix=build-fuzz/crashes/$$t- \
+	  TMPDIR=$(FUZZ_TMP) build-fuzz/fuzz_$$t -max_total_time=$(FUZZ_TIME) -timeout=10 $(FUZZ_FLAGS) -artifact_prefix=build-fuzz/crashes/$$t- \
 	    build-fuzz/corpus/$$t tests/fuzz/corpus/$$t || exit 1; \
 	done
 
