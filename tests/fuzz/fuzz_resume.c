@@ -5,7 +5,7 @@
 ** lw_anneal_resume and swept once.
 **
 ** Properties beyond "no crash, no leak, no undefined behaviour":
-**   - a refused directory gets a message that names one of its files;
+**   - a refused directory gets a message that starts with a file's path;
 **   - an accepted one resumes at the state's sweep with finite running
 **     energies, and its sweep keeps them finite.
 **
@@ -30,8 +30,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
   static lw_anneal a;
   lw_error err = {LW_OK, ""};
   if (lw_anneal_resume(&a, dir, 1, &err) != LW_OK) {
-    LW_FUZZ_CHECK(strstr(err.msg, dir) != NULL || strstr(err.msg, "out of memory"), "message without the file: '%s'",
-                  err.msg);
+    /* the file may be outside dir: the scene a state names may be absolute */
+    size_t colon = strcspn(err.msg, ":");
+    LW_FUZZ_CHECK(memchr(err.msg, '/', colon) != NULL || strstr(err.msg, "out of memory"),
+                  "message without a file: '%s'", err.msg);
     lw_anneal_free(&a);
     return 0;
   }
