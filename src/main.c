@@ -169,8 +169,8 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, lw_error *err)
   return 0;
 }
 
-/* A count on the command line, read by the parser of scene keys; at most
-** 1e15, so sweep + count cannot overflow. */
+/* A count on the command line from 0 to max, read by the parser of scene
+** keys; sweep counts stop at 1e15, so sweep + count cannot overflow. */
 static int parse_count(const char *opt, const char *v, double max, long *out, lw_error *err)
 {
   long long n;
