@@ -298,7 +298,7 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
 Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_error)
 {
   write_file("s.ini", scene_text);
-  cr_assert_eq(lw_test_sh("%s run %s/s.ini --out %s/sig --quiet --set init.splines=400 --set anneal.sweeps=50 & "
+  cr_assert_eq(lw_test_sh("%s run %s/s.ini --out %s/sig --quiet --set init.splines=200 --set anneal.sweeps=1 & "
                           "p=$!; sleep 0.05; kill -TERM $p; wait $p", bin(), dir, dir), 0);
   cr_assert_eq(lw_test_sh("test -f %s/sig/state.lw && ! test -e %s/sig/state.lw.tmp", dir, dir), 0);
   cr_assert_eq(lw_test_sh("%s resume %s/sig --quiet", bin(), dir), 0);
