@@ -112,7 +112,7 @@ Test(crash, sigkill_at_random_moments_then_resume_gives_the_same_files)
 {
   const char *root = getenv("LW_ROOT");
   cr_assert_not_null(root);
-  int trials = lw_test_long() ? 60 : 1;
+  int trials = lw_test_long() ? 70 : 1;
   counts c[3] = {{0}};
   char scene[1024];
   snprintf(scene, sizeof scene, "%s/tests/fixtures/v1/plain.ini", root);
