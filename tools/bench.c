@@ -121,13 +121,13 @@ static void bench_throughput(bench_ctx *b)
   double ns[N_THROUGHPUT], ratio[N_THROUGHPUT];
   bench_time_runs(b, r, N_THROUGHPUT, 0, NULL, 0, ns, ratio, NULL);
   fprintf(d, "## Throughput\n\n"
-             "1000 splines of 4 segments of 5 mm at random places and directions, at the stated mean\n"
+             "1000 splines of 4 segments of 5 mm at random places, traced along the field, at the stated mean\n"
              "spacing (page area / total length); every term on (radial potential, waves field,\n"
              "boundary), quadrature 8, T = %g after tuning. Near field off: the product rule for every\n"
              "pair; near 1.5: a sample pair closer than 1.5 length elements makes its two segments a near\n"
-             "pair, which takes the near field (pairnear.h), the product rule the others. Random lines\n"
-             "cross, and every crossing is a near pair; crowded drawings have many near pairs too\n"
-             "(docs/ACCURACY.md, near field: 14 x the product rule's time on the annealed example).\n\n"
+             "pair, which takes the near field (pairnear.h), the product rule the others. Lines that\n"
+             "cross make near pairs, and so do neighbours running alongside closely, the near field's\n"
+             "costliest case (docs/NUMERICS.md).\n\n"
              "| scene | neighbours per sample | ns per proposal | proposals per second | x cost without pair | "
              "acceptance | bytes per segment |\n|---|---|---|---|---|---|---|\n",
           BENCH_T);
