@@ -326,8 +326,9 @@ static double inverse_distance(const cubic *ca, const piece *root_a, const cubic
     f *= 1.0 - w;
     if (f == 0.0) continue;
     w = top + 2 > STACK_MAX ? 1.0 : smooth_step((2.0 * leaf - big) / leaf);
-    /* pieces apart whose chords stand within FLAT_RATIO of their gap:
-    ** the chords' 1/r is within that of the curves' */
+    /* or pieces whose flatnesses are within FLAT_RATIO of the least
+    ** distance the curves can have there: the chords' 1/r is within that
+    ** share of the curves' */
     if (w < 1.0) {
       double cd = chord_distance(&pa, &pb) - pa.flat - pb.flat;
       if (cd > 0.0) w = fmax(w, smooth_step((2.0 * FLAT_RATIO * cd - pa.flat - pb.flat) / (FLAT_RATIO * cd)));

@@ -103,9 +103,9 @@ typedef struct {
 ** `mask` (bits into pc): far pairs go to fa, near ones to the near list
 ** (room for (k1 - k0) times the probes is there).  Four entries at a time
 ** (two SSE2 vectors of doubles, one of 32-bit lanes): what depends on the
-** entries alone (loads, weights) once, the distances per probe.  The kernel runs on the four lanes of a probe and group only if
-** one of them is a far pair; the others are masked to +0 (whatever inf or
-** NaN they held).  Groups read past k1 (the cell's block is padded,
+** entries alone (loads, weights) once, the distances per probe.  The
+** kernel runs on the four lanes of a probe and group only if one of them is
+** a far pair; the others are masked to +0 (whatever inf or NaN they held).  Groups read past k1 (the cell's block is padded,
 ** grid.h); those lanes are masked off.  The index filter is done before
 ** (cell_ranges), so the scan sees only samples it may pair.  `with_near` is
 ** a constant at each call, so the common scan carries no near test.
