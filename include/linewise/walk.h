@@ -28,9 +28,9 @@
 **
 ** How it runs: the probes of one call are grouped by cell (in chunks of
 ** LW_PAIR_CHUNK, at most LW_PAIR_BATCH to a group); a group shares its 3 x 3
-** block, so each cell is read once for all its probes: four entries at a
-** time, the index filter and weights once, the distances and tests per
-** probe, in SSE2 lanes.  Where a probe has a far pair among the four, the
+** block, so each cell is read once for all its probes: its runs of
+** entries the filter keeps, four entries at a time, the weights once, the
+** distances and tests per probe, in SSE2 lanes.  Where a probe has a far pair among the four, the
 ** kernel runs on all four lanes (square roots and divisions two at a time)
 ** and the others are masked to +0.  A little under half of the (probe,
 ** group) pairs need it (44 % in the benchmark scenes) against about a
