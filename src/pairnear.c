@@ -315,14 +315,16 @@ static double inverse_distance(const cubic *ca, const piece *root_a, const cubic
   int top = 1;
   while (top > 0) {
     top--;
-    piece pa = sa[top], pb = sb[top];
+    /* the pair in place on the stack (its nodes, once computed, stay with
+    ** it); only the piece that is split is copied out */
+    piece *pa = &sa[top], *pb = &sb[top];
     double f = share[top];
     int d = depth[top];
-    double dx = pa.cx - pb.cx, dy = pa.cy - pb.cy;
-    double big = pa.rad > pb.rad ? pa.rad : pb.rad;
-    double gap = sqrt(dx * dx + dy * dy) - pa.rad - pb.rad;
+    double dx = pa->cx - pb->cx, dy = pa->cy - pb->cy;
+    double big = pa->rad > pb->rad ? pa->rad : pb->rad;
+    double gap = sqrt(dx * dx + dy * dy) - pa->rad - pb->rad;
     double w = big > 0.0 ? smooth_step((gap / big - SEP_LO) / (SEP_HI - SEP_LO)) : 1.0;
-    if (w > 0.0) sum += f * w * piece_rule(ca, &pa, cb, &pb);
+    if (w > 0.0) sum += f * w * piece_rule(ca, pa, cb, pb);
     f *= 1.0 - w;
     if (f == 0.0) continue;
     w = top + 2 > STACK_MAX ? 1.0 : smooth_step((2.0 * leaf - big) / leaf);
@@ -330,20 +332,22 @@ static double inverse_distance(const cubic *ca, const piece *root_a, const cubic
     ** distance the curves can have there: the chords' 1/r is within that
     ** share of the curves' */
     if (w < 1.0) {
-      double cd = chord_distance(&pa, &pb) - pa.flat - pb.flat;
-      if (cd > 0.0) w = fmax(w, smooth_step((2.0 * FLAT_RATIO * cd - pa.flat - pb.flat) / (FLAT_RATIO * cd)));
+      double cd = chord_distance(pa, pb) - pa->flat - pb->flat;
+      if (cd > 0.0) w = fmax(w, smooth_step((2.0 * FLAT_RATIO * cd - pa->flat - pb->flat) / (FLAT_RATIO * cd)));
     }
-    if (w > 0.0) sum += f * w * leaf_value(ca, &pa, cb, &pb);
+    if (w > 0.0) sum += f * w * leaf_value(ca, pa, cb, pb);
     f *= 1.0 - w;
     if (f == 0.0) continue;
     /* split A and B in turn: a choice by size would flip between two
     ** subtrees, whose values differ by their errors */
     if (d % 2 == 0) {
-      piece_split(&pa, ca, &sa[top], &sa[top + 1]);
-      sb[top] = sb[top + 1] = pb;
+      piece whole = *pa;
+      piece_split(&whole, ca, &sa[top], &sa[top + 1]);
+      sb[top + 1] = sb[top];
     } else {
-      piece_split(&pb, cb, &sb[top], &sb[top + 1]);
-      sa[top] = sa[top + 1] = pa;
+      piece whole = *pb;
+      piece_split(&whole, cb, &sb[top], &sb[top + 1]);
+      sa[top + 1] = sa[top];
     }
     share[top] = share[top + 1] = f;
     depth[top] = depth[top + 1] = d + 1;
