@@ -129,8 +129,9 @@ static double near_part(const pair_view *v, const double bez[8], const lw_pair_s
 /*
 ** Every pair of samples of different splines once (j > i) by the walk, the
 ** samples taken cell by cell in the grid's order, which depends on positions
-** only; then every near segment pair once (the walk reports near pairs in
-** both directions), in increasing order of (lower, higher) segment.
+** only; then every near segment pair once (the walk reports those of
+** samples j > i, so of segments gb > ga), in increasing order of (lower,
+** higher) segment.
 */
 static lw_status pair_all(const pair_view *v, double *e)
 {
@@ -148,11 +149,11 @@ static lw_status pair_all(const pair_view *v, double *e)
       lw_pair_probe P = {c->x[k], lw_cell_y(c)[k], lw_cell_dl(c)[k], 1.0};
       lw_pair_filter f = filter_of(v, v->sp->seg_spline[ga], i + 1);
       near.n = 0;
-      if ((st = lw_pair_walk(g, v->ctx, &P, 1, &f, &t, &near)) != LW_OK) break;
+      if ((st = lw_pair_walk(g, v->ctx, &P, 1, &f, &t, &near, NULL)) != LW_OK) break;
       sum += t;
       for (size_t q = 0; q < near.n && st == LW_OK; q++) {
         uint32_t gb = near.pair[q].idx / v->np;
-        if (gb > ga && (list_push(&pairs, ga) != LW_OK || list_push(&pairs, gb) != LW_OK)) st = LW_ENOMEM;
+        if (list_push(&pairs, ga) != LW_OK || list_push(&pairs, gb) != LW_OK) st = LW_ENOMEM;
       }
     }
   }
@@ -479,7 +480,7 @@ static double pair_delta(const lw_model *m, lw_proposal *p, const lw_node *base,
   double pe;
   p->near.n = 0;
   p->partners.n = 0;
-  if (lw_pair_walk(m->grid, &sc->pair, p->probe, 2 * n, &f, &pe, &p->near) != LW_OK) return NAN;
+  if (lw_pair_walk(m->grid, &sc->pair, p->probe, 2 * n, &f, &pe, &p->near, NULL) != LW_OK) return NAN;
   for (size_t j = 0; j < p->n_seg; j++) {
     size_t g = g0 + p->seg0 + j;
     double bez[8];

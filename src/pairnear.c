@@ -32,11 +32,19 @@
 ** rule (1/r is analytic in a Bernstein ellipse rho >= 1 + SEP_HI +
 ** sqrt((1 + SEP_HI)^2 - 1) = 3.7 about each piece: error ~ 1e-7 of the
 ** pair).  Other pairs are split, A and B in turn (a choice by size would flip
-** between two subtrees, whose values differ by their errors), down to
-** LEAF_RATIO of the pair's size, where the chords stand in for the pieces and
-** are integrated exactly: an error of order curvature^2 leaf^2 where curves
-** cross, of order the leaf where they touch tangentially.  Each decision is
-** blended too (SEP_LO to SEP_HI, leaf sizes 2 to 1).
+** between two subtrees, whose values differ by their errors), down to a
+** leaf, where the chords stand in for the pieces and are integrated exactly.
+** A pair is a leaf when the pieces' flatnesses (each the larger distance of
+** its inner control points from its chord) add up to at most FLAT_RATIO of
+** the least distance the pieces can have (their chords' distance less the
+** flatnesses), so the chords' 1/r is within that share of the curves': this
+** ends curves running alongside at d apart with pieces of about
+** sqrt(8 FLAT_RATIO d / curvature) instead of going down to a fixed size.  Otherwise a pair
+** is a leaf at LEAF_RATIO of the pair's size: an error of order curvature^2
+** leaf^2 where curves cross, of order the leaf where they touch tangentially.
+** Each decision is blended too (SEP_LO to SEP_HI, flatness ratios 1 to 2,
+** leaf sizes 2 to 1).  A piece's 6-node rule is computed once and travels
+** with its copies down the tree.
 **
 ** The cutoff: (1/r - 1/rc)+ = 1/r - 1/rc + (1/rc - 1/r)+.  The last part is
 ** bounded with a kink at r = rc; the fixed 16 x 16 rule takes it (accuracy ~
@@ -46,6 +54,10 @@
 #include "linewise/pairnear.h"
 
 #include <math.h>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 /* A cubic in power form about a local origin: r(t) = c0 + c1 t + c2 t^2 + c3 t^3. */
 typedef struct {
@@ -80,6 +92,9 @@ typedef struct {
   double t0, t1;
   double r0[2], d0[2], r1[2], d1[2];
   double cx, cy, rad;
+  double flat;    /* bound of its distance from its chord (control points) */
+  int has_nodes;  /* x, y, w below hold its 6-node rule */
+  double x[6], y[6], w[6];
 } piece;
 
 static void piece_bound(piece *p)
@@ -96,6 +111,12 @@ static void piece_bound(piece *p)
   p->cx = cx;
   p->cy = cy;
   p->rad = sqrt(rad2);
+  /* the curve lies in the hull of its control points, so within the larger
+  ** of their two distances from the chord */
+  double chx = p->r1[0] - p->r0[0], chy = p->r1[1] - p->r0[1], ch = sqrt(chx * chx + chy * chy);
+  double fa = fabs((ax - ex) * chy - (ay - ey) * chx), fb = fabs((bx - ex) * chy - (by - ey) * chx);
+  p->flat = ch > 0.0 ? fmax(fa, fb) / ch : 2.0 * p->rad;
+  p->has_nodes = 0;
 }
 
 static void piece_init(piece *p, const cubic *c, double t0, double t1)
@@ -127,6 +148,7 @@ static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
 #define APART_LO 0.35
 #define APART_HI 0.5
 #define LEAF_RATIO 1e-2
+#define FLAT_RATIO 1e-2
 #define SINE_LO 0.1
 #define SINE_HI 0.2
 #define CLOSE_LO 0.1
@@ -198,14 +220,82 @@ static inline double smooth_step(double x)
   return x * x * x * (10.0 + x * (6.0 * x - 15.0));
 }
 
+/* The 6-node rule of a piece, computed once: copies of the piece on the
+** stack carry it. */
+static void piece_nodes(const cubic *c, piece *p)
+{
+  if (p->has_nodes) return;
+  rule_nodes(c, p->t0, p->t1, G6_S, G6_W, GAUSS_S, p->x, p->y, p->w);
+  p->has_nodes = 1;
+}
+
+typedef double v2d __attribute__((vector_size(16)));
+
+/* Two square roots at once (correctly rounded either way). */
+static inline v2d vsqrt2(v2d a)
+{
+#if defined(__SSE2__)
+  return (v2d)_mm_sqrt_pd((__m128d)a);
+#else
+  return (v2d){sqrt(a[0]), sqrt(a[1])};
+#endif
+}
+
+/* The 6 x 6 product rule of 1/r over two pieces, B's nodes two at a time. */
+static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb)
+{
+  piece_nodes(ca, pa);
+  piece_nodes(cb, pb);
+  v2d bx[GAUSS_S / 2], by[GAUSS_S / 2], bw[GAUSS_S / 2], sum = {0.0, 0.0};
+  for (int j = 0; j < GAUSS_S / 2; j++) {
+    bx[j] = (v2d){pb->x[2 * j], pb->x[2 * j + 1]};
+    by[j] = (v2d){pb->y[2 * j], pb->y[2 * j + 1]};
+    bw[j] = (v2d){pb->w[2 * j], pb->w[2 * j + 1]};
+  }
+  for (int i = 0; i < GAUSS_S; i++) {
+    const v2d ax = {pa->x[i], pa->x[i]}, ay = {pa->y[i], pa->y[i]}, aw = {pa->w[i], pa->w[i]};
+    v2d acc = {0.0, 0.0};
+    for (int j = 0; j < GAUSS_S / 2; j++) {
+      v2d dx = ax - bx[j], dy = ay - by[j];
+      acc += bw[j] / vsqrt2(dx * dx + dy * dy);
+    }
+    sum += aw * acc;
+  }
+  return sum[0] + sum[1];
+}
+
 /* A leaf: the chords, integrated exactly; their lengths stand in for the
 ** arcs (equal to O(leaf^2)).  Chords of curves that touch tangentially end
 ** to end can overlap by a rounding error, which the exact integral reads as
 ** +inf; the product rule's interior nodes keep such a leaf finite. */
-static double leaf_value(const cubic *ca, const piece *pa, const cubic *cb, const piece *pb)
+static double leaf_value(const cubic *ca, piece *pa, const cubic *cb, piece *pb)
 {
   double v = lw_pair_segseg(pa->r0, pa->r1, pb->r0, pb->r1);
-  return v < INFINITY ? v : product_rule(ca, pa->t0, pa->t1, cb, pb->t0, pb->t1, GAUSS_S, KERNEL_INV, 0.0);
+  return v < INFINITY ? v : piece_rule(ca, pa, cb, pb);
+}
+
+/* Distance of point p from segment [a, b]. */
+static double point_segment(const double p[2], const double a[2], const double b[2])
+{
+  double ux = b[0] - a[0], uy = b[1] - a[1], px = p[0] - a[0], py = p[1] - a[1];
+  double uu = ux * ux + uy * uy, t = uu > 0.0 ? (px * ux + py * uy) / uu : 0.0;
+  t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+  double dx = px - t * ux, dy = py - t * uy;
+  return sqrt(dx * dx + dy * dy);
+}
+
+/* Distance between the chords of two pieces (0 where they cross). */
+static double chord_distance(const piece *pa, const piece *pb)
+{
+  double ux = pa->r1[0] - pa->r0[0], uy = pa->r1[1] - pa->r0[1];
+  double vx = pb->r1[0] - pb->r0[0], vy = pb->r1[1] - pb->r0[1];
+  double s0 = ux * (pb->r0[1] - pa->r0[1]) - uy * (pb->r0[0] - pa->r0[0]);
+  double s1 = ux * (pb->r1[1] - pa->r0[1]) - uy * (pb->r1[0] - pa->r0[0]);
+  double t0 = vx * (pa->r0[1] - pb->r0[1]) - vy * (pa->r0[0] - pb->r0[0]);
+  double t1 = vx * (pa->r1[1] - pb->r0[1]) - vy * (pa->r1[0] - pb->r0[0]);
+  if (((s0 < 0.0) != (s1 < 0.0)) && ((t0 < 0.0) != (t1 < 0.0))) return 0.0;
+  double d = fmin(point_segment(pa->r0, pb->r0, pb->r1), point_segment(pa->r1, pb->r0, pb->r1));
+  return fmin(d, fmin(point_segment(pb->r0, pa->r0, pa->r1), point_segment(pb->r1, pa->r0, pa->r1)));
 }
 
 /* T: the 1/r double integral by subdivision (see the file comment), times
@@ -225,28 +315,39 @@ static double inverse_distance(const cubic *ca, const piece *root_a, const cubic
   int top = 1;
   while (top > 0) {
     top--;
-    piece pa = sa[top], pb = sb[top];
+    /* the pair in place on the stack (its nodes, once computed, stay with
+    ** it); only the piece that is split is copied out */
+    piece *pa = &sa[top], *pb = &sb[top];
     double f = share[top];
     int d = depth[top];
-    double dx = pa.cx - pb.cx, dy = pa.cy - pb.cy;
-    double big = pa.rad > pb.rad ? pa.rad : pb.rad;
-    double gap = sqrt(dx * dx + dy * dy) - pa.rad - pb.rad;
+    double dx = pa->cx - pb->cx, dy = pa->cy - pb->cy;
+    double big = pa->rad > pb->rad ? pa->rad : pb->rad;
+    double gap = sqrt(dx * dx + dy * dy) - pa->rad - pb->rad;
     double w = big > 0.0 ? smooth_step((gap / big - SEP_LO) / (SEP_HI - SEP_LO)) : 1.0;
-    if (w > 0.0) sum += f * w * product_rule(ca, pa.t0, pa.t1, cb, pb.t0, pb.t1, GAUSS_S, KERNEL_INV, 0.0);
+    if (w > 0.0) sum += f * w * piece_rule(ca, pa, cb, pb);
     f *= 1.0 - w;
     if (f == 0.0) continue;
     w = top + 2 > STACK_MAX ? 1.0 : smooth_step((2.0 * leaf - big) / leaf);
-    if (w > 0.0) sum += f * w * leaf_value(ca, &pa, cb, &pb);
+    /* or pieces whose flatnesses are within FLAT_RATIO of the least
+    ** distance the curves can have there: the chords' 1/r is within that
+    ** share of the curves' */
+    if (w < 1.0) {
+      double cd = chord_distance(pa, pb) - pa->flat - pb->flat;
+      if (cd > 0.0) w = fmax(w, smooth_step((2.0 * FLAT_RATIO * cd - pa->flat - pb->flat) / (FLAT_RATIO * cd)));
+    }
+    if (w > 0.0) sum += f * w * leaf_value(ca, pa, cb, pb);
     f *= 1.0 - w;
     if (f == 0.0) continue;
     /* split A and B in turn: a choice by size would flip between two
     ** subtrees, whose values differ by their errors */
     if (d % 2 == 0) {
-      piece_split(&pa, ca, &sa[top], &sa[top + 1]);
-      sb[top] = sb[top + 1] = pb;
+      piece whole = *pa;
+      piece_split(&whole, ca, &sa[top], &sa[top + 1]);
+      sb[top + 1] = sb[top];
     } else {
-      piece_split(&pb, cb, &sb[top], &sb[top + 1]);
-      sa[top] = sa[top + 1] = pa;
+      piece whole = *pb;
+      piece_split(&whole, cb, &sb[top], &sb[top + 1]);
+      sa[top + 1] = sa[top];
     }
     share[top] = share[top + 1] = f;
     depth[top] = depth[top + 1] = d + 1;

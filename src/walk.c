@@ -41,7 +41,6 @@ static inline v2d load2(const double *p)
 typedef long long v2l __attribute__((vector_size(16)));
 typedef float v4f __attribute__((vector_size(16)));
 typedef int v4i __attribute__((vector_size(16)));
-typedef unsigned v4u __attribute__((vector_size(16)));
 
 /* One bit per lane of a comparison's result. */
 static inline unsigned bits2(v2l m)
@@ -86,19 +85,11 @@ typedef struct {
   double gx[3], gy[3]; /* squared gaps to the columns and rows of the block (axis_gaps) */
 } probe_ctx;
 
-/* What every probe of a walk shares: the index filter, the near scale. */
+/* What every probe of a walk shares: the near scale and the cutoff. */
 typedef struct {
-  /* own spline: idx - lo < span, unsigned; SSE2 compares signed 32-bit
-  ** lanes, so both sides carry the sign bit flipped: idx - (lo + 2^31) and
-  ** span - 2^31, as int */
-  v4u lo_flip;
-  v4i span_flip;
-  v4i from_flip;  /* idx >= from, flipped alike: idx - 2^31 >= from - 2^31 */
   v2d ns;         /* near_scale */
   v2d cut2;       /* rc^2: near pairs lie within the cutoff too */
 } shared_ctx;
-
-#define FLIP 0x80000000u
 
 /* The far sum of a walk: two accumulators of two lanes (entries 0, 1 and
 ** 2, 3 of each group of four), which hide the divider's latency. */
@@ -112,37 +103,31 @@ typedef struct {
 ** `mask` (bits into pc): far pairs go to fa, near ones to the near list
 ** (room for (k1 - k0) times the probes is there).  Four entries at a time
 ** (two SSE2 vectors of doubles, one of 32-bit lanes): what depends on the
-** entries alone (loads, index filter, weights) once, the distances per
-** probe.  The kernel runs on the four lanes of a probe and group only if
-** one of them is a far pair; the others are masked to +0 (whatever inf or
-** NaN they held).  Groups read past k1 (the cell's block is padded,
-** grid.h); those lanes are masked off.
-** `with_near` and `with_from` are constants at each call, so the common scan
-** carries neither test.
+** entries alone (loads, weights) once, the distances per probe.  The
+** kernel runs on the four lanes of a probe and group only if one of them is
+** a far pair; the others are masked to +0 (whatever inf or NaN they held).  Groups read past k1 (the cell's block is padded,
+** grid.h); those lanes are masked off.  The index filter is done before
+** (cell_ranges), so the scan sees only samples it may pair.  `with_near` is
+** a constant at each call, so the common scan carries no near test.
 */
 static inline __attribute__((always_inline)) void
 scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const probe_ctx *pc, unsigned mask,
-     const uint32_t *probe_id, far_acc *fa, lw_pair_nearlist *near, const int with_near, const int with_from)
+     const uint32_t *probe_id, far_acc *fa, lw_pair_nearlist *near, const int with_near)
 {
   uint64_t near_bits[LW_PAIR_BATCH] = {0};
   const double *xs = c->x, *ys = lw_cell_y(c);
   const uint32_t *id = lw_cell_idx(c);
   const float *dls = lw_cell_dl(c);
   const v4f zero = {0.0f, 0.0f, 0.0f, 0.0f};
-  const v4u flip = {FLIP, FLIP, FLIP, FLIP};
   const v4i lane = {0, 1, 2, 3};
   const v2d one = {1.0, 1.0};
   v2d s0 = fa->s0, s1 = fa->s1;
   for (uint32_t k = k0, t = 0; k < k1; k += 4, t += 4) {
-    v4u j;
     v4f dlj;
-    memcpy(&j, id + k, sizeof j);
     memcpy(&dlj, dls + k, sizeof dlj);
     const v4i left_in_block = {(int)(k1 - k), (int)(k1 - k), (int)(k1 - k), (int)(k1 - k)};
-    /* never paired: samples of the probes' own spline, lanes past k1 */
-    v4i skip = ((v4i)(j - sh->lo_flip) < sh->span_flip) | (lane >= left_in_block);
+    const v4i skip = lane >= left_in_block; /* past k1 */
     v4i ok = ~skip & (v4i)(dlj > zero);
-    if (with_from) ok &= (v4i)(j ^ flip) >= sh->from_flip;
     const v2l ok0 = lo2l(ok), ok1 = hi2l(ok);
     const v2d x0 = load2(xs + k), x1 = load2(xs + k + 2), y0 = load2(ys + k), y1 = load2(ys + k + 2);
     const v2d w0 = lo2d(dlj), w1 = hi2d(dlj);
@@ -218,11 +203,45 @@ static void axis_gaps(double a, double h, int c, double p, double gap[3])
 ** point sits in its cell up to the rounding of (x - x0) / h. */
 #define GAP_MARGIN (1.0 + 1e-9)
 
+/* Position of the first entry of index >= i in the cell's sorted indices. */
+static uint32_t first_from(const uint32_t *idx, uint32_t n, uint32_t i)
+{
+  uint32_t lo = 0, hi = n;
+  while (lo < hi) {
+    uint32_t mid = lo + (hi - lo) / 2;
+    if (idx[mid] < i) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo;
+}
+
+/*
+** The entries of cell c a walk may pair, as at most two runs of positions
+** [r[0], r[1]) and [r[2], r[3]): indices >= from and outside [lo, hi).  A
+** cell keeps its indices sorted and a spline's samples have consecutive
+** indices, so the excluded ones are one run found by binary search: a
+** spline's own samples cost O(log n) per cell however many there are (a
+** long spline coiled into a few cells would otherwise be visited sample by
+** sample from each of its samples: quadratic).
+*/
+static void cell_ranges(const lw_cell *c, const lw_pair_filter *f, uint32_t r[4])
+{
+  const uint32_t *idx = lw_cell_idx(c);
+  uint32_t n = c->n, a = f->from ? first_from(idx, n, f->from) : 0;
+  r[0] = a;
+  r[1] = r[2] = r[3] = n;
+  if (a == n || idx[a] >= f->hi || idx[n - 1] < f->lo) return; /* nothing of the spline after from */
+  uint32_t l = idx[a] >= f->lo ? a : first_from(idx + a, n - a, f->lo) + a;
+  r[1] = l;
+  r[2] = idx[n - 1] < f->hi ? n : first_from(idx + l, n - l, f->hi) + l;
+}
+
 /* The probes sel[0..nb-1] of P, all in cell (cx, cy): one pass over its
-** 3 x 3 block. */
+** 3 x 3 block.  *visited counts entries scanned times the probes that
+** scan them. */
 static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const shared_ctx *sh,
-                            const lw_pair_probe *P, const uint32_t *sel, int nb, int cx, int cy, int with_from,
-                            far_acc *fa, lw_pair_nearlist *near)
+                            const lw_pair_probe *P, const uint32_t *sel, int nb, int cx, int cy,
+                            const lw_pair_filter *f, far_acc *fa, lw_pair_nearlist *near, uint64_t *visited)
 {
   probe_ctx pc[LW_PAIR_BATCH];
   const double h = 1.0 / g->inv_h, skip2 = ctx->cutoff2 * GAP_MARGIN;
@@ -247,15 +266,18 @@ static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
       for (int b = 0; b < nb; b++)
         if (pc[b].gx[x - cx + 1] + pc[b].gy[y - cy + 1] <= skip2) mask |= 1u << b;
       if (!mask) continue;
-      for (uint32_t k0 = 0; k0 < c->n; k0 += BLOCK) {
-        uint32_t k1 = c->n - k0 > BLOCK ? k0 + BLOCK : c->n;
-        if (with_near) {
-          if (l_unlikely(nearlist_reserve(near, (size_t)(k1 - k0) * (size_t)nb) != LW_OK)) return LW_ENOMEM;
-          if (with_from) scan(c, k0, k1, sh, pc, mask, sel, fa, near, 1, 1);
-          else scan(c, k0, k1, sh, pc, mask, sel, fa, near, 1, 0);
-        } else {
-          if (with_from) scan(c, k0, k1, sh, pc, mask, sel, fa, NULL, 0, 1);
-          else scan(c, k0, k1, sh, pc, mask, sel, fa, NULL, 0, 0);
+      uint32_t r[4];
+      cell_ranges(c, f, r);
+      for (int run = 0; run < 4; run += 2) {
+        *visited += (uint64_t)(r[run + 1] - r[run]) * (uint64_t)__builtin_popcount(mask);
+        for (uint32_t k0 = r[run]; k0 < r[run + 1]; k0 += BLOCK) {
+          uint32_t k1 = r[run + 1] - k0 > BLOCK ? k0 + BLOCK : r[run + 1];
+          if (with_near) {
+            if (l_unlikely(nearlist_reserve(near, (size_t)(k1 - k0) * (size_t)nb) != LW_OK)) return LW_ENOMEM;
+            scan(c, k0, k1, sh, pc, mask, sel, fa, near, 1);
+          } else {
+            scan(c, k0, k1, sh, pc, mask, sel, fa, NULL, 0);
+          }
         }
       }
     }
@@ -264,13 +286,11 @@ static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
 }
 
 lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pair_probe *P, size_t n,
-                       const lw_pair_filter *f, double *far, lw_pair_nearlist *near)
+                       const lw_pair_filter *f, double *far, lw_pair_nearlist *near, uint64_t *visited)
 {
-  const uint32_t lo = f->lo + FLIP;
-  const int span = (int)((f->hi - f->lo) ^ FLIP), from = (int)(f->from ^ FLIP);
-  const shared_ctx sh = {{lo, lo, lo, lo}, {span, span, span, span}, {from, from, from, from},
-                         {ctx->near_scale, ctx->near_scale}, {ctx->cutoff2, ctx->cutoff2}};
+  const shared_ctx sh = {{ctx->near_scale, ctx->near_scale}, {ctx->cutoff2, ctx->cutoff2}};
   far_acc fa = {{0.0, 0.0}, {0.0, 0.0}, {ctx->inv_cutoff, ctx->inv_cutoff}};
+  uint64_t seen = 0;
   *far = 0.0;
   for (size_t c0 = 0; c0 < n; c0 += LW_PAIR_CHUNK) {
     /* the chunk's probes in order of their cell (stable), so that each run
@@ -290,11 +310,12 @@ lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pa
       int e = b + 1;
       while (e < nc && e - b < LW_PAIR_BATCH && cell[sel[e] - c0] == here) e++;
       int cx = (int)(here % (uint32_t)g->nx), cy = (int)(here / (uint32_t)g->nx);
-      if (walk_batch(g, ctx, &sh, P, sel + b, e - b, cx, cy, f->from > 0, &fa, near) != LW_OK) return LW_ENOMEM;
+      if (walk_batch(g, ctx, &sh, P, sel + b, e - b, cx, cy, f, &fa, near, &seen) != LW_OK) return LW_ENOMEM;
       b = e;
     }
   }
   v2d sum = fa.s0 + fa.s1;
   *far = sum[0] + sum[1];
+  if (visited) *visited += seen;
   return LW_OK;
 }

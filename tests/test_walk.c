@@ -44,12 +44,12 @@ static double brute(const scene *s, const lw_pair_probe *P, size_t n, const lw_p
   double far = 0.0;
   *n_near = 0;
   for (size_t p = 0; p < n; p++)
-    for (uint32_t j = 0; j < N_SAMPLES; j++) {
+    for (uint32_t j = f->from; j < N_SAMPLES; j++) {
       if (j >= f->lo && j < f->hi) continue;
       double dx = s->x[j] - P[p].x, dy = s->y[j] - P[p].y, r2 = dx * dx + dy * dy;
       double lim = s->ctx.near_scale * (double)(P[p].dl > s->dl[j] ? P[p].dl : s->dl[j]);
       if (r2 < lim * lim && r2 < s->ctx.cutoff2) near[(*n_near)++] = (uint64_t)p << 32 | j;
-      else if (r2 < s->ctx.cutoff2 && j >= f->from && P[p].dl != 0.0f && s->dl[j] != 0.0f)
+      else if (r2 < s->ctx.cutoff2 && P[p].dl != 0.0f && s->dl[j] != 0.0f)
         far += P[p].scale * (double)P[p].dl * (double)s->dl[j] * (1.0 / sqrt(r2) - s->ctx.inv_cutoff);
     }
   return far;
@@ -88,7 +88,7 @@ static void check(double near_scale, int with_from)
     size_t n_want;
     double far_want = brute(&s, P, n, &f, want, &n_want), far;
     near.n = 0;
-    cr_assert_eq(lw_pair_walk(s.g, &s.ctx, P, n, &f, &far, &near), LW_OK);
+    cr_assert_eq(lw_pair_walk(s.g, &s.ctx, P, n, &f, &far, &near, NULL), LW_OK);
     cr_assert(lw_close_rel(far, far_want, 1e-12, 1e-12), "spline %u: far %.17g, brute force %.17g", spline, far,
               far_want);
     cr_assert_eq(near.n, n_want, "spline %u: %zu near pairs, brute force %zu", spline, near.n, n_want);
@@ -115,7 +115,7 @@ Test(walk, far_sum_respects_from)
   check(0.0, 1);
 }
 
-Test(walk, near_pairs_whatever_from)
+Test(walk, near_pairs_respect_from)
 {
   check(1.5, 1);
 }
@@ -149,8 +149,8 @@ Test(walk, independent_of_insertion_history)
     lw_pair_filter f = {spline * PER_SPLINE, (spline + 1) * PER_SPLINE, 0};
     double fa, fb;
     na.n = nb.n = 0;
-    cr_assert_eq(lw_pair_walk(a.g, &a.ctx, P, n, &f, &fa, &na), LW_OK);
-    cr_assert_eq(lw_pair_walk(b.g, &b.ctx, P, n, &f, &fb, &nb), LW_OK);
+    cr_assert_eq(lw_pair_walk(a.g, &a.ctx, P, n, &f, &fa, &na, NULL), LW_OK);
+    cr_assert_eq(lw_pair_walk(b.g, &b.ctx, P, n, &f, &fb, &nb, NULL), LW_OK);
     cr_assert_eq(fa, fb, "spline %u: %.17g against %.17g", spline, fa, fb);
     cr_assert_eq(na.n, nb.n);
     for (size_t k = 0; k < na.n; k++)
@@ -160,4 +160,51 @@ Test(walk, independent_of_insertion_history)
   lw_pair_nearlist_free(&nb);
   lw_cellgrid_free(a.g);
   lw_cellgrid_free(b.g);
+}
+
+/*
+** Issue 21, defect 12: a long spline coiled into one cell.  Its own samples
+** must not be visited one by one (quadratic in its length): each walk looks
+** at no more than the other splines' samples, whatever the spline's length,
+** both as a move (from = 0) and as the full sum does it (from = i + 1).  The
+** count of visited pairs is the walk's work, so this catches the quadratic
+** behaviour without timing anything.
+*/
+Test(walk, own_spline_not_visited)
+{
+  enum { OWN = 6000, OTHER = 40 };
+  lw_pair_ctx ctx;
+  lw_pair_ctx_init(&ctx, CUTOFF, 1.5);
+  lw_cellgrid *g = lw_cellgrid_new(0.0, 0.0, PAGE, PAGE, CUTOFF, OWN + 2 * OTHER, NULL);
+  cr_assert_not_null(g);
+  rng_seed(2112);
+  /* other splines below and above the long one's indices, all close by */
+  uint32_t i = 0;
+  for (; i < OTHER; i++) cr_assert_eq(lw_cellgrid_insert(g, i, urand(19, 22), urand(19, 22), 0.3f), LW_OK);
+  for (; i < OTHER + OWN; i++) {
+    double a = 0.01 * i; /* a circle of radius 1 wound round ~10 times */
+    cr_assert_eq(lw_cellgrid_insert(g, i, 20.5 + cos(a), 20.5 + sin(a), 0.3f), LW_OK);
+  }
+  for (; i < 2 * OTHER + OWN; i++) cr_assert_eq(lw_cellgrid_insert(g, i, urand(19, 22), urand(19, 22), 0.3f), LW_OK);
+  lw_pair_filter f = {OTHER, OTHER + OWN, 0};
+  lw_pair_nearlist near = {0};
+  uint64_t move = 0, full = 0;
+  double far;
+  for (uint32_t k = OTHER; k < OTHER + OWN; k++) {
+    double x, y;
+    float dl;
+    lw_cellgrid_get(g, k, &x, &y, &dl);
+    lw_pair_probe P = {x, y, dl, 1.0};
+    near.n = 0;
+    f.from = 0;
+    cr_assert_eq(lw_pair_walk(g, &ctx, &P, 1, &f, &far, &near, &move), LW_OK);
+    f.from = k + 1;
+    cr_assert_eq(lw_pair_walk(g, &ctx, &P, 1, &f, &far, &near, &full), LW_OK);
+  }
+  /* a move sees both groups of others, the full sum only those above */
+  cr_assert_leq(move, (uint64_t)OWN * 2 * OTHER, "%llu pairs visited", (unsigned long long)move);
+  cr_assert_geq(move, (uint64_t)OWN * OTHER, "%llu pairs visited", (unsigned long long)move);
+  cr_assert_leq(full, (uint64_t)OWN * OTHER, "%llu pairs visited", (unsigned long long)full);
+  lw_pair_nearlist_free(&near);
+  lw_cellgrid_free(g);
 }

@@ -25,6 +25,9 @@
 #include <unistd.h>
 
 #include "benchutil.h"
+#include <gsl/gsl_rng.h>
+
+#include "linewise/init.h"
 #include "linewise/output.h"
 
 #ifndef BENCH_CFLAGS
@@ -118,13 +121,13 @@ static void bench_throughput(bench_ctx *b)
   double ns[N_THROUGHPUT], ratio[N_THROUGHPUT];
   bench_time_runs(b, r, N_THROUGHPUT, 0, NULL, 0, ns, ratio, NULL);
   fprintf(d, "## Throughput\n\n"
-             "1000 splines of 4 segments of 5 mm at random places and directions, at the stated mean\n"
+             "1000 splines of 4 segments of 5 mm at random places, traced along the field, at the stated mean\n"
              "spacing (page area / total length); every term on (radial potential, waves field,\n"
              "boundary), quadrature 8, T = %g after tuning. Near field off: the product rule for every\n"
              "pair; near 1.5: a sample pair closer than 1.5 length elements makes its two segments a near\n"
-             "pair, which takes the near field (pairnear.h), the product rule the others. Random lines\n"
-             "cross, and every crossing is a near pair; crowded drawings have many near pairs too\n"
-             "(docs/ACCURACY.md, near field: 14 x the product rule's time on the annealed example).\n\n"
+             "pair, which takes the near field (pairnear.h), the product rule the others. Lines that\n"
+             "cross make near pairs, and so do neighbours running alongside closely, the near field's\n"
+             "costliest case (docs/NUMERICS.md).\n\n"
              "| scene | neighbours per sample | ns per proposal | proposals per second | x cost without pair | "
              "acceptance | bytes per segment |\n|---|---|---|---|---|---|---|\n",
           BENCH_T);
@@ -181,6 +184,79 @@ static void bench_scaling(bench_ctx *b)
     bench_run_free(&r[i]);
   }
   fclose(f);
+  fprintf(d, "\n");
+}
+
+/* ---- start-up of one long spline --------------------------------------- */
+
+/*
+** One spline of n segments of 2 mm traced along a vortex field on a page of
+** 100 mm, so it winds round one circle hundreds of times and most of its
+** samples share a few cells: the worst case for excluding a spline's own
+** samples (issue 21, defect 12).  Placement and the model (samples, grid,
+** the full pair sum) are timed; the pair term is on (cutoff 5 mm), so the
+** model's time is the start-up the defect was about.
+*/
+/* Seconds of this thread's CPU time: a shared machine's preemption does not count. */
+static double thread_seconds(void)
+{
+  struct timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void bench_startup(bench_ctx *b)
+{
+  FILE *d = b->doc[BENCH_PERFORMANCE];
+  const size_t sizes[3] = {1000, 10000, 100000};
+  const int n = b->quick ? 2 : 3, reps = b->quick ? 1 : 3;
+  fprintf(d, "## Start-up of one long spline\n\n"
+             "One spline of n segments of 2 mm traced along a vortex field on a 100 mm page: it winds\n"
+             "round one circle, so most of its samples share a few cells of the pair grid (cutoff\n"
+             "5 mm, quadrature 8). A walk excludes the spline's own samples by a binary search in each\n"
+             "cell's sorted indices (walk.h), so building the model (samples, grid, the full pair sum)\n"
+             "must grow linearly with n. Before that fix the walk visited every own sample from every\n"
+             "sample: 10^5 segments did not finish in 300 s. Medians of %d runs of thread CPU time (a\n"
+             "shared machine preempts, which does not count); the larger models no longer fit in cache.\n\n"
+             "| segments | placement s | model s | model us per segment |\n|---|---|---|---|\n",
+          reps);
+  for (int i = 0; i < n; i++) {
+    lw_params p;
+    lw_params_defaults(&p);
+    p.width = p.height = 100.0;
+    p.margin = 5.0;
+    p.splines = 1;
+    p.segments = (int)sizes[i];
+    p.segment_length = 2.0;
+    p.strain = 10;
+    p.bending = 1;
+    p.field = LW_FLD_VORTEX;
+    p.field_coef = -0.1;
+    p.pair = 0.02;
+    p.pair_cutoff = 5.0;
+    p.seed = 1;
+    lw_scene sc;
+    lw_error err;
+    if (lw_scene_init(&sc, &p, &err)) bench_die("scene", &err);
+    double tp[BENCH_MAX_REPS], tm[BENCH_MAX_REPS];
+    for (int k = 0; k < reps; k++) {
+      gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+      gsl_rng_set(rng, 1);
+      double t0 = thread_seconds();
+      lw_splines *sp = lw_init_random(&sc, 1, sizes[i], p.segment_length, rng, &err);
+      double t1 = thread_seconds();
+      gsl_rng_free(rng);
+      if (!sp) bench_die("placement", &err);
+      lw_model *m = lw_model_new(&sc, sp, &err);
+      tm[k] = thread_seconds() - t1;
+      tp[k] = t1 - t0;
+      if (!m) bench_die("model", &err);
+      lw_model_free(m);
+    }
+    double placed = bench_median(tp, reps), model = bench_median(tm, reps);
+    fprintf(d, "| %zu | %.3f | %.3f | %.2f |\n", sizes[i], placed, model, 1e6 * model / (double)sizes[i]);
+    lw_scene_clear(&sc);
+  }
   fprintf(d, "\n");
 }
 
@@ -312,6 +388,7 @@ typedef struct {
 static const bench_section sections[] = {
     {"throughput", BENCH_PERFORMANCE, bench_throughput},
     {"scaling", BENCH_PERFORMANCE, bench_scaling},
+    {"startup", BENCH_PERFORMANCE, bench_startup},
     {"terms", BENCH_PERFORMANCE, bench_terms},
     {"regularity_cost", BENCH_PERFORMANCE, bench_regularity_cost},
     {"baseline", BENCH_PERFORMANCE, bench_baseline},

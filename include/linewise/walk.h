@@ -7,24 +7,30 @@
 ** [lo, hi), the walk visits the cells of the 3 x 3 block around P's cell
 ** that come closer to P than the cutoff, in a fixed order, and within each
 ** cell its samples in increasing index order (grid.h).  For each neighbour
-** j of another spline, with r = |P - j| and dm = max(dl_P, dl_j):
+** j >= from of another spline, with r = |P - j| and dm = max(dl_P, dl_j):
 **
 **   near   r^2 < (ctx->near_scale * dm)^2 and r < rc: (P, j) is appended
-**          to the near list with j's position and weight (whatever `from`
-**          says, so the caller sees every near pair), and adds nothing to
-**          the far sum;
-**   far    otherwise, if r < rc, j >= from and both weights are non-zero:
+**          to the near list with j's position and weight, and adds nothing
+**          to the far sum;
+**   far    otherwise, if r < rc and both weights are non-zero:
 **          scale_P dl_P dl_j (1/r - 1/rc) joins the far sum (1/rc =
 **          ctx->inv_cutoff, 0 without a cutoff).
+**
+** The samples the filter excludes (the probes' own spline, indices below
+** `from`) are never visited: a cell keeps its indices sorted, so they are
+** one or two runs of its entries, found by binary search.  Excluding a
+** spline's own samples costs O(log n) per cell, so a long spline coiled
+** into a few cells costs no more than a short one (it used to be visited
+** sample by sample, quadratic in its length).
 **
 ** The near scale is meant to be capped so that near pairs lie within the
 ** cutoff; the walk skips the cells beyond it and reports none beyond it.
 **
 ** How it runs: the probes of one call are grouped by cell (in chunks of
 ** LW_PAIR_CHUNK, at most LW_PAIR_BATCH to a group); a group shares its 3 x 3
-** block, so each cell is read once for all its probes: four entries at a
-** time, the index filter and weights once, the distances and tests per
-** probe, in SSE2 lanes.  Where a probe has a far pair among the four, the
+** block, so each cell is read once for all its probes: its runs of
+** entries the filter keeps, four entries at a time, the weights once, the
+** distances and tests per probe, in SSE2 lanes.  Where a probe has a far pair among the four, the
 ** kernel runs on all four lanes (square roots and divisions two at a time)
 ** and the others are masked to +0.  A little under half of the (probe,
 ** group) pairs need it (44 % in the benchmark scenes) against about a
@@ -76,14 +82,16 @@ typedef struct {
 /* What every probe of a walk shares. */
 typedef struct {
   uint32_t lo, hi;  /* the probes' spline's sample indices [lo, hi): never paired */
-  uint32_t from;    /* far pairs only with samples of index >= from (0: all) */
+  uint32_t from;    /* pairs only with samples of index >= from (0: all) */
 } lw_pair_filter;
 
 /* Sets *far to the far sum of the n probes P (no coefficient C) and
 ** appends their near pairs to `near` (may be NULL when ctx->near_scale is
-** 0).  LW_ENOMEM if the near list could not grow (*far is then 0 and the
-** list holds what was found so far). */
+** 0).  visited (may be NULL): adds the number of (probe, sample) pairs the
+** walk looked at, the measure of its work.  LW_ENOMEM if the near list
+** could not grow (*far is then 0 and the list holds what was found so
+** far). */
 lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pair_probe *P, size_t n,
-                       const lw_pair_filter *f, double *far, lw_pair_nearlist *near);
+                       const lw_pair_filter *f, double *far, lw_pair_nearlist *near, uint64_t *visited);
 
 #endif
