@@ -14,8 +14,6 @@
 #include <sys/stat.h>
 #include <time.h>
 
-#include "linewise/drawing.h"
-#include "linewise/fieldview.h"
 #include "linewise/init.h"
 #include "linewise/json.h"
 #include "linewise/output.h"
@@ -35,7 +33,7 @@ double lw_anneal_temperature(const lw_anneal *a) { return a->chain ? a->chain->t
 double lw_anneal_acceptance(const lw_anneal *a)
 {
   unsigned long p = 0, acc = 0;
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+  for (int k = 0; k < a->chain->n_moves; k++) {
     p += a->chain->stats[k].proposed;
     acc += a->chain->stats[k].accepted;
   }
@@ -171,12 +169,19 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
   return LW_OK;
 }
 
-/* The target of the fidelity score and the previews' underlay. */
-static lw_status setup_tone(lw_anneal *a, lw_error *err)
+/* The system's row and its set-up of the scene. */
+static lw_status setup_system(lw_anneal *a, lw_error *err)
 {
-  if (!a->scene.image) return LW_OK;
-  a->tone = lw_image_tone_grid(a->scene.image, &a->scene.image_place, err);
-  return a->tone ? LW_OK : err->code;
+  const lw_params *p = &a->params;
+  a->sys_type = lw_system_find(p->system);
+  if (!a->sys_type) {
+    char where[LW_PATH_MAX + 32];
+    lw_params_origin(p, lw_params_find("scene", "system"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'scene.system': expected one of %s, got '%s'", where,
+                        lw_system_names(), p->system);
+  }
+  a->setup = a->sys_type->setup_new(p, err);
+  return a->setup ? LW_OK : err->code;
 }
 
 /* Chain of rung k: rung 0 draws from stream 1 (as a run without tempering
@@ -186,37 +191,37 @@ static unsigned long rung_stream(const lw_anneal *a, int k)
   return lw_stream_seed(a->seed, k == 0 ? 1 : 2 + (unsigned long)k);
 }
 
-/* Models for the n_rep states sp[] (ownership passes, also on failure),
+/* Systems for the n_rep states[] (ownership passes, also on failure),
 ** chains for the rungs, the exchange machinery on the base ladder. */
-static lw_status build(lw_anneal *a, lw_splines **sp, const double *ladder, lw_error *err)
+static lw_status build(lw_anneal *a, void **states, const double *ladder, lw_error *err)
 {
   const lw_params *p = &a->params;
+  const lw_system_type *t = a->sys_type;
   int n = a->n_rep;
-  a->models = calloc((size_t)n, sizeof *a->models);
+  a->systems = calloc((size_t)n, sizeof *a->systems);
   a->chains = calloc((size_t)n, sizeof *a->chains);
-  if (!a->models || !a->chains) {
-    for (int r = 0; r < n; r++) lw_splines_free(sp[r]);
+  if (!a->systems || !a->chains) {
+    for (int r = 0; r < n; r++) t->state_free(states[r]);
     return lw_error_set(err, LW_ENOMEM, "out of memory for %d replicas", n);
   }
   lw_status s = LW_OK;
   for (int r = 0; r < n; r++) {
     if (!s) {
-      a->models[r] = lw_model_new(&a->scene, sp[r], err);
-      if (!a->models[r]) s = err->code;
+      a->systems[r] = lw_system_wrap(t, states[r], err);
+      if (!a->systems[r]) s = err->code;
     } else {
-      lw_splines_free(sp[r]);
+      t->state_free(states[r]);
     }
   }
   if (s) return s;
-  double weight[LW_MOVE_KINDS] = {p->mix_point, p->mix_vector, p->mix_translate, p->mix_rotate};
-  double step[LW_MOVE_KINDS] = {p->step_point, p->step_vector, p->step_translate, p->step_rotate * M_PI / 180.0};
-  double target[LW_MOVE_KINDS] = {p->target, p->target, p->target_spline, p->target_spline};
+  double weight[LW_MOVES_MAX], step[LW_MOVES_MAX], target[LW_MOVES_MAX];
+  t->moves(p, weight, step, target);
   for (int k = 0; k < n; k++) {
-    a->chains[k] = lw_chain_new(a->models[k], weight, step, target, rung_stream(a, k), err);
+    a->chains[k] = lw_chain_new(a->systems[k], weight, step, target, rung_stream(a, k), err);
     if (!a->chains[k]) return err->code;
   }
   a->chain = a->chains[0];
-  a->model = a->models[0];
+  a->sys = a->systems[0];
   if (n > 1) {
     a->pt = lw_tempering_new(n, ladder, lw_stream_seed(a->seed, 2), err);
     if (!a->pt) return err->code;
@@ -243,11 +248,12 @@ static lw_status open_trace(lw_anneal *a, int fresh, lw_error *err)
   a->trace = fopen(path, fresh ? "w" : "a");
   if (!a->trace) return lw_error_set(err, LW_EIO, "%s: cannot write: %s", path, strerror(errno));
   if (fresh) {
+    const lw_system_type *t = a->sys_type;
     fprintf(a->trace, "sweep,temperature");
-    for (int t = 0; t < LW_TERM_COUNT; t++)
-      if (a->scene.on[t]) fprintf(a->trace, ",%s", lw_term_types[t].name);
+    for (int k = 0; k < t->n_terms; k++)
+      if (t->term_on(a->sys->state, k)) fprintf(a->trace, ",%s", t->term_names[k]);
     fprintf(a->trace, ",total");
-    for (int k = 0; k < LW_MOVE_KINDS; k++) fprintf(a->trace, ",acc_%s", lw_move_names[k]);
+    for (int k = 0; k < t->n_moves; k++) fprintf(a->trace, ",acc_%s", t->move_names[k]);
     for (int k = 0; a->pt && k < a->n_rep; k++) fprintf(a->trace, ",replica%d_temperature,replica%d_energy", k, k);
     for (int k = 0; a->pt && k + 1 < a->n_rep; k++) fprintf(a->trace, ",swap%d", k);
     fprintf(a->trace, "\n");
@@ -271,39 +277,19 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   double ladder[LW_TEMPERING_MAX];
   if ((s = lw_params_resolve(&a->params, err)) || (s = setup_ladder(a, ladder, err)) ||
       (s = setup_schedule(a, err)) ||
-      (s = lw_scene_init(&a->scene, &a->params, err)) || (s = setup_tone(a, err)))
+      (s = setup_system(a, err)))
     return s;
-  lw_splines *sp;
-  if (a->params.from[0]) {
-    lw_state st;
-    if ((s = lw_state_read(&st, a->params.from, err))) return s;
-    s = lw_model_check_regular(&a->scene, st.sp, a->params.from, err);
-    sp = st.sp;
-    st.sp = NULL;
-    lw_state_clear(&st);
-    if (s) {
-      lw_splines_free(sp);
-      return s;
-    }
-  } else {
-    size_t n;
-    if ((s = lw_init_count(&a->scene, p, &n, err))) return s;
-    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-    if (!r) return lw_error_set(err, LW_ENOMEM, "out of memory");
-    gsl_rng_set(r, lw_stream_seed(a->seed, 0));
-    sp = lw_init_random(&a->scene, n, (size_t)p->segments, p->segment_length, r, err);
-    gsl_rng_free(r);
-    if (!sp) return err->code;
-  }
+  const lw_system_type *t = a->sys_type;
+  void *all[LW_TEMPERING_MAX] = {t->state_new(a->setup, &a->params, lw_stream_seed(a->seed, 0), err)};
+  if (!all[0]) return err->code;
   /* every replica starts from the same state; their streams part them */
-  lw_splines *all[LW_TEMPERING_MAX] = {sp};
   for (int r = 1; r < a->n_rep; r++)
-    if (!(all[r] = lw_splines_clone(sp))) {
-      for (int q = 0; q < r; q++) lw_splines_free(all[q]);
-      return lw_error_set(err, LW_ENOMEM, "out of memory for %d replicas", a->n_rep);
+    if (!(all[r] = t->state_copy(all[0], err))) {
+      for (int q = 0; q < r; q++) t->state_free(all[q]);
+      return err->code;
     }
   if ((s = build(a, all, ladder, err))) return s;
-  a->energy_initial = lw_model_total(a->model);
+  a->energy_initial = lw_system_total(a->sys);
   a->end_sweep = p->sweeps;
   /* Everything above only read input: the directory appears once the run
   ** is known to be valid. */
@@ -316,8 +302,7 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   lw_params_write(&a->params, f);
   if ((s = lw_output_commit(f, tmp, path, err))) return s;
   if ((s = open_trace(a, 1, err))) return s;
-  dir_file(path, sizeof path, a, "field.png");
-  if (p->field_preview && (s = lw_fieldview_png(&a->scene, p->png_scale, path, err))) return s;
+  if ((s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_START, err))) return s;
   return lw_anneal_checkpoint(a, err);
 }
 
@@ -358,42 +343,35 @@ static void key_of(char *key, size_t n, const char *prefix, const char *name)
 static lw_status add_chain(lw_state *st, const char *prefix, const lw_chain *c)
 {
   char key[64], buf[1024];
-  unsigned long v[3 * LW_MOVE_KINDS];
+  unsigned long v[3 * LW_MOVES_MAX];
   char *hex = lw_rng_save(c->rng);
   if (!hex) return LW_ENOMEM;
   key_of(key, sizeof key, prefix, "rng");
   int bad = lw_state_add(st, key, hex);
   free(hex);
-  put_doubles(buf, sizeof buf, c->step, LW_MOVE_KINDS);
+  put_doubles(buf, sizeof buf, c->step, c->n_moves);
   key_of(key, sizeof key, prefix, "steps");
   bad = bad || lw_state_add(st, key, buf);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+  for (int k = 0; k < c->n_moves; k++) {
     v[2 * k] = c->win_prop[k];
     v[2 * k + 1] = c->win_acc[k];
   }
-  put_ulongs(buf, sizeof buf, v, 2 * LW_MOVE_KINDS);
+  put_ulongs(buf, sizeof buf, v, 2 * c->n_moves);
   key_of(key, sizeof key, prefix, "tune_window");
   bad = bad || lw_state_add(st, key, buf);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+  for (int k = 0; k < c->n_moves; k++) {
     v[3 * k] = c->stats[k].proposed;
     v[3 * k + 1] = c->stats[k].accepted;
     v[3 * k + 2] = c->stats[k].nan;
   }
-  put_ulongs(buf, sizeof buf, v, 3 * LW_MOVE_KINDS);
+  put_ulongs(buf, sizeof buf, v, 3 * c->n_moves);
   key_of(key, sizeof key, prefix, "moves");
   bad = bad || lw_state_add(st, key, buf);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) v[k] = c->stats[k].irregular;
-  put_ulongs(buf, sizeof buf, v, LW_MOVE_KINDS);
+  for (int k = 0; k < c->n_moves; k++) v[k] = c->stats[k].irregular;
+  put_ulongs(buf, sizeof buf, v, c->n_moves);
   key_of(key, sizeof key, prefix, "moves_irregular");
   bad = bad || lw_state_add(st, key, buf);
   return bad ? LW_ENOMEM : LW_OK;
-}
-
-static lw_status add_energy(lw_state *st, const lw_model *m)
-{
-  char buf[1024];
-  put_doubles(buf, sizeof buf, m->term, LW_TERM_COUNT);
-  return lw_state_add(st, "energy", buf) ? LW_ENOMEM : LW_OK;
 }
 
 /* The exchange machinery: master stream, ladder, who is where, counts. */
@@ -444,14 +422,13 @@ static lw_status add_tempering(lw_state *st, const lw_anneal *a)
 /* replica-K.lw: the state at rung K >= 1 and its running energies. */
 static lw_status write_replica(const lw_anneal *a, int k, lw_error *err)
 {
-  lw_state st = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep, .sp = a->chains[k]->model->sp};
+  lw_state st = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep};
   char name[64], path[LW_PATH_MAX + 64];
   snprintf(name, sizeof name, "replica-%d.lw", k);
   dir_file(path, sizeof path, a, name);
-  lw_status s = add_energy(&st, a->chains[k]->model);
-  if (s) s = lw_error_set(err, LW_ENOMEM, "out of memory writing a checkpoint");
-  else s = lw_state_write(&st, path, err);
-  st.sp = NULL;
+  const lw_system *sys = a->chains[k]->sys;
+  lw_status s = sys->type->save(sys->state, &st, err);
+  if (!s) s = lw_state_write(&st, path, err);
   lw_state_clear(&st);
   return s;
 }
@@ -459,10 +436,10 @@ static lw_status write_replica(const lw_anneal *a, int k, lw_error *err)
 lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
 {
   lw_chain *c = a->chain;
-  lw_state st = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep, .sp = a->model->sp};
+  lw_state st = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep};
   lw_status s = LW_OK;
   char buf[1024];
-  unsigned long v[3 * LW_MOVE_KINDS];
+  unsigned long v[3 * LW_MOVES_MAX];
   /* The replicas first: state.lw, written last, is what resume starts from,
   ** and its sweep must match theirs. */
   for (int k = 1; k < a->n_rep && !s; k++) s = write_replica(a, k, err);
@@ -474,14 +451,17 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
   ADD("t_prev", fmt("%.17g", a->t_prev));
   ADD("prev_stats", fmt("%.17g %.17g %ld", a->prev.mean, a->prev.sd, a->prev.samples));
   ADD("block_energy", fmt("%.17g %.17g %.17g", a->acc_n, a->acc_sum, a->acc_sumsq));
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+  for (int k = 0; k < c->n_moves; k++) {
     v[3 * k] = a->trace_mark[k].proposed;
     v[3 * k + 1] = a->trace_mark[k].accepted;
     v[3 * k + 2] = a->trace_mark[k].nan;
   }
-  put_ulongs(buf, sizeof buf, v, 3 * LW_MOVE_KINDS);
+  put_ulongs(buf, sizeof buf, v, 3 * c->n_moves);
   ADD("trace_mark", buf);
-  if (!s) s = add_energy(&st, a->model);
+  if (!s && (s = a->sys_type->save(a->sys->state, &st, err))) {
+    lw_state_clear(&st);
+    return s;
+  }
   ADD("energy_initial", fmt("%.17g", a->energy_initial));
   ADD("max_drift", fmt("%.17g", a->max_drift));
   if (!s && a->pt) s = add_tempering(&st, a);
@@ -503,7 +483,6 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
       s = lw_output_commit(f, tmp, path, err);
     }
   }
-  st.sp = NULL; /* the model's */
   lw_state_clear(&st);
   return s;
 }
@@ -556,7 +535,7 @@ static lw_status read_chain(const lw_state *st, const char *path, const char *pr
                             lw_error *err)
 {
   char key[64];
-  double v[3 * LW_MOVE_KINDS];
+  double v[3 * LW_MOVES_MAX];
   lw_status s;
   key_of(key, sizeof key, prefix, "rng");
   const lw_state_extra *rng = lw_state_get(st, key);
@@ -564,49 +543,27 @@ static lw_status read_chain(const lw_state *st, const char *path, const char *pr
     return lw_error_set(err, LW_EINPUT, "%s:%d: %s: expected the generator state in hex", path, rng ? rng->line : 0,
                         key);
   key_of(key, sizeof key, prefix, "steps");
-  if ((s = read_numbers(st, path, key, v, LW_MOVE_KINDS, err))) return s;
-  for (int k = 0; k < LW_MOVE_KINDS; k++) c->step[k] = v[k];
+  if ((s = read_numbers(st, path, key, v, c->n_moves, err))) return s;
+  for (int k = 0; k < c->n_moves; k++) c->step[k] = v[k];
   key_of(key, sizeof key, prefix, "tune_window");
-  if ((s = read_numbers(st, path, key, v, 2 * LW_MOVE_KINDS, err))) return s;
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+  if ((s = read_numbers(st, path, key, v, 2 * c->n_moves, err))) return s;
+  for (int k = 0; k < c->n_moves; k++) {
     c->win_prop[k] = (unsigned long)v[2 * k];
     c->win_acc[k] = (unsigned long)v[2 * k + 1];
   }
   key_of(key, sizeof key, prefix, "moves");
-  if ((s = read_numbers(st, path, key, v, 3 * LW_MOVE_KINDS, err))) return s;
-  for (int k = 0; k < LW_MOVE_KINDS; k++)
+  if ((s = read_numbers(st, path, key, v, 3 * c->n_moves, err))) return s;
+  for (int k = 0; k < c->n_moves; k++)
     c->stats[k] = (lw_move_stats){.proposed = (unsigned long)v[3 * k], .accepted = (unsigned long)v[3 * k + 1],
                                   .nan = (unsigned long)v[3 * k + 2]};
   /* A separate line, so states written before it was counted still resume
   ** (with 0 rejections for irregularity so far). */
   key_of(key, sizeof key, prefix, "moves_irregular");
   if (lw_state_get(st, key)) {
-    if ((s = read_numbers(st, path, key, v, LW_MOVE_KINDS, err))) return s;
-    for (int k = 0; k < LW_MOVE_KINDS; k++) c->stats[k].irregular = (unsigned long)v[k];
+    if ((s = read_numbers(st, path, key, v, c->n_moves, err))) return s;
+    for (int k = 0; k < c->n_moves; k++) c->stats[k].irregular = (unsigned long)v[k];
   }
   return LW_OK;
-}
-
-/* The running totals carry the rounding of the moves so far; restoring them
-** (rather than the fresh sums) keeps the trace identical to an uninterrupted
-** run. */
-static lw_status read_energy(const lw_state *st, const char *path, lw_model *m, lw_error *err)
-{
-  /* States written before the parametrisation term (the last) hold one
-  ** number fewer; that term was off in them. */
-  const lw_state_extra *e = lw_state_get(st, "energy");
-  int n = LW_TERM_COUNT, words = 0;
-  for (const char *c = e ? e->value : ""; *c;) {
-    while (*c == ' ') c++;
-    if (!*c) break;
-    words++;
-    while (*c && *c != ' ') c++;
-  }
-  if (words == LW_TERM_COUNT - 1) {
-    n = LW_TERM_COUNT - 1;
-    m->term[LW_TERM_PARAM] = 0.0;
-  }
-  return read_numbers(st, path, "energy", m->term, n, err);
 }
 
 static lw_status read_tempering(lw_anneal *a, const lw_state *st, const char *path, lw_error *err)
@@ -650,10 +607,10 @@ static lw_status read_tempering(lw_anneal *a, const lw_state *st, const char *pa
     snprintf(prefix, sizeof prefix, "rung%d_", k);
     if ((s = read_chain(st, path, prefix, a->chains[k], err))) return s;
   }
-  /* models[] is by replica: rung k holds replica at[k] */
-  lw_model *by_rung[LW_TEMPERING_MAX];
-  for (int k = 0; k < n; k++) by_rung[k] = a->models[k];
-  for (int k = 0; k < n; k++) a->models[pt->at[k]] = by_rung[k];
+  /* systems[] is by replica: rung k holds replica at[k] */
+  lw_system *by_rung[LW_TEMPERING_MAX];
+  for (int k = 0; k < n; k++) by_rung[k] = a->systems[k];
+  for (int k = 0; k < n; k++) a->systems[pt->at[k]] = by_rung[k];
   return LW_OK;
 }
 
@@ -671,39 +628,37 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);
   double ladder[LW_TEMPERING_MAX];
   if ((s = lw_params_read(&a->params, scene_path, err)) || (s = setup_ladder(a, ladder, err)) ||
-      (s = setup_schedule(a, err)) || (s = lw_scene_init(&a->scene, &a->params, err)) ||
-      (s = setup_tone(a, err))) {
+      (s = setup_schedule(a, err)) || (s = setup_system(a, err))) {
     lw_state_clear(&st);
     return s;
   }
-  if ((s = lw_model_check_regular(&a->scene, st.sp, path, err))) {
+  const lw_system_type *t = a->sys_type;
+  void *all[LW_TEMPERING_MAX] = {t->load(a->setup, &st, path, err)};
+  if (!all[0]) {
     lw_state_clear(&st);
-    return s;
+    return err->code;
   }
   a->seed = st.seed;
   a->sweep = st.sweep;
-  lw_splines *all[LW_TEMPERING_MAX] = {st.sp};
-  st.sp = NULL;
   for (int k = 1; k < a->n_rep; k++, n_read++) {
     char name[64], rpath[LW_PATH_MAX + 64];
     snprintf(name, sizeof name, "replica-%d.lw", k);
     dir_file(rpath, sizeof rpath, a, name);
     s = lw_state_read(&rep[k], rpath, err);
-    if (!s) s = lw_model_check_regular(&a->scene, rep[k].sp, rpath, err);
     if (!s && rep[k].sweep != a->sweep)
       s = lw_error_set(err, LW_EINPUT, "%s: sweep %ld, but state.lw is at sweep %ld (an interrupted checkpoint?)",
                        rpath, rep[k].sweep, a->sweep);
+    if (!s && !(all[k] = t->load(a->setup, &rep[k], rpath, err))) s = err->code;
     if (s) {
       lw_state_clear(&rep[k]);
-      for (int q = 0; q < k; q++) lw_splines_free(all[q]);
+      for (int q = 0; q < k; q++) t->state_free(all[q]);
       goto out;
     }
-    all[k] = rep[k].sp;
-    rep[k].sp = NULL;
   }
   if ((s = build(a, all, ladder, err))) goto out;
   dir_file(path, sizeof path, a, "state.lw");
-  double v[3 * LW_MOVE_KINDS];
+  double v[3 * LW_MOVES_MAX];
+  const int n_moves = a->chain->n_moves;
   if ((s = read_chain(&st, path, "", a->chain, err))) goto out;
 #define NUMS(key, n) if ((s = read_numbers(&st, path, key, v, n, err))) goto out
   NUMS("temperature", 1); a->t_sched = v[0];
@@ -711,20 +666,13 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
   NUMS("t_prev", 1); a->t_prev = v[0];
   NUMS("prev_stats", 3); a->prev = (lw_block_stats){v[0], v[1], (long)v[2]};
   NUMS("block_energy", 3); a->acc_n = v[0]; a->acc_sum = v[1]; a->acc_sumsq = v[2];
-  NUMS("trace_mark", 3 * LW_MOVE_KINDS);
-  for (int k = 0; k < LW_MOVE_KINDS; k++)
+  NUMS("trace_mark", 3 * n_moves);
+  for (int k = 0; k < n_moves; k++)
     a->trace_mark[k] = (lw_move_stats){.proposed = (unsigned long)v[3 * k], .accepted = (unsigned long)v[3 * k + 1],
                                        .nan = (unsigned long)v[3 * k + 2]};
-  if ((s = read_energy(&st, path, a->model, err))) goto out;
   NUMS("energy_initial", 1); a->energy_initial = v[0];
   NUMS("max_drift", 1); a->max_drift = v[0];
 #undef NUMS
-  for (int k = 1; k < a->n_rep; k++) {
-    char name[64], rpath[LW_PATH_MAX + 64];
-    snprintf(name, sizeof name, "replica-%d.lw", k);
-    dir_file(rpath, sizeof rpath, a, name);
-    if ((s = read_energy(&rep[k], rpath, a->chains[k]->model, err))) goto out;
-  }
   if (a->pt && (s = read_tempering(a, &st, path, err))) goto out;
   set_temperatures(a);
   dir_file(path, sizeof path, a, "timing.txt");
@@ -734,7 +682,7 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
     fclose(tf);
   }
   a->end_sweep = more >= 0 ? a->sweep + more : (a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) a->proposals_before += a->chain->stats[k].proposed;
+  for (int k = 0; k < n_moves; k++) a->proposals_before += a->chain->stats[k].proposed;
   s = truncate_trace(a, err);
 out:
   for (int k = 1; k <= n_read && k < a->n_rep; k++) lw_state_clear(&rep[k]);
@@ -747,11 +695,14 @@ out:
 static void trace_row(lw_anneal *a)
 {
   lw_chain *c = a->chain;
+  const lw_system_type *t = a->sys_type;
+  double term[LW_SYSTEM_TERMS_MAX];
+  t->terms(a->sys->state, term);
   fprintf(a->trace, "%ld,%.10g", a->sweep, c->temperature);
-  for (int t = 0; t < LW_TERM_COUNT; t++)
-    if (a->scene.on[t]) fprintf(a->trace, ",%.10g", a->model->term[t]);
-  fprintf(a->trace, ",%.10g", lw_model_total(a->model));
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+  for (int k = 0; k < t->n_terms; k++)
+    if (t->term_on(a->sys->state, k)) fprintf(a->trace, ",%.10g", term[k]);
+  fprintf(a->trace, ",%.10g", lw_system_total(a->sys));
+  for (int k = 0; k < c->n_moves; k++) {
     unsigned long p = c->stats[k].proposed - a->trace_mark[k].proposed;
     unsigned long acc = c->stats[k].accepted - a->trace_mark[k].accepted;
     if (p) fprintf(a->trace, ",%.6f", (double)acc / (double)p);
@@ -760,7 +711,7 @@ static void trace_row(lw_anneal *a)
   }
   if (a->pt) {
     for (int k = 0; k < a->n_rep; k++)
-      fprintf(a->trace, ",%.10g,%.10g", a->chains[k]->temperature, lw_model_total(a->chains[k]->model));
+      fprintf(a->trace, ",%.10g,%.10g", a->chains[k]->temperature, lw_system_total(a->chains[k]->sys));
     /* swap acceptance since the previous row */
     for (int k = 0; k + 1 < a->n_rep; k++) {
       unsigned long tried = a->pt->tried[k] - a->swap_mark[2 * k];
@@ -797,17 +748,17 @@ static lw_status exchange(lw_anneal *a, lw_error *err)
   int n = a->n_rep, swapped[LW_TEMPERING_MAX];
   double e[LW_TEMPERING_MAX] = {0}, t[LW_TEMPERING_MAX] = {0};
   for (int k = 0; k < n; k++) {
-    e[k] = lw_model_total(a->chains[k]->model);
+    e[k] = lw_system_total(a->chains[k]->sys);
     t[k] = a->chains[k]->temperature;
   }
   lw_tempering_exchange(pt, e, t, swapped);
   for (int k = 0; k + 1 < n; k++)
     if (swapped[k]) {
-      lw_model *m = a->chains[k]->model;
-      a->chains[k]->model = a->chains[k + 1]->model;
-      a->chains[k + 1]->model = m;
+      lw_system *sys = a->chains[k]->sys;
+      a->chains[k]->sys = a->chains[k + 1]->sys;
+      a->chains[k + 1]->sys = sys;
     }
-  a->model = a->chains[0]->model;
+  a->sys = a->chains[0]->sys;
   if (p->tune_ladder == LW_LADDER_EQUAL && a->sweep <= p->ladder_sweeps) {
     /* every pair has had ~20 attempts by then */
     if (pt->steps % 40 == 0) {
@@ -847,17 +798,17 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
   int tuning = a->sweep - block_start(a, b) < p->tune_sweeps && a->sweep < p->sweeps;
   int failed = 0;
   /* The rungs are independent between exchanges: each touches only its own
-  ** chain, stream and model, so the thread count cannot change the result. */
+  ** chain, stream and system, so the thread count cannot change the result. */
 #pragma omp parallel for schedule(static, 1) reduction(| : failed) if (n > 1)
   for (int k = 0; k < n; k++) {
     a->chains[k]->tuning = tuning;
     if (lw_chain_sweep(a->chains[k]) != LW_OK) failed = 1;
   }
-  if (failed) return lw_error_set(err, LW_ENOMEM, "out of memory growing the pair grid");
+  if (failed) return lw_error_set(err, LW_ENOMEM, "out of memory growing a system's caches");
   a->sweep++;
   lw_status s;
   if (a->pt && a->sweep % p->exchange_every == 0 && (s = exchange(a, err))) return s;
-  double e = lw_model_total(a->model);
+  double e = lw_system_total(a->sys);
   if (!tuning && isfinite(e)) {
     a->acc_n += 1.0;
     a->acc_sum += e;
@@ -867,12 +818,13 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
   if (a->sweep % p->check_every == 0)
     for (int r = 0; r < n; r++) {
       double drift;
-      if (lw_model_refresh(a->models[r], &drift) != LW_OK) return lw_error_set(err, LW_ENOMEM, "out of memory");
+      if (a->sys_type->refresh(a->systems[r]->state, &drift) != LW_OK)
+        return lw_error_set(err, LW_ENOMEM, "out of memory");
       if (drift > a->max_drift) a->max_drift = drift;
     }
   /* Frames are extra files: they read the state and change nothing. */
   if (p->frames_every && a->sweep % p->frames_every == 0 &&
-      lw_drawing_frame(p, &a->scene, a->model->sp, a->tone, a->dir, a->sweep, err))
+      a->sys_type->draw(a->sys->state, p, a->dir, a->sweep, err))
     return err->code;
   if (a->sweep % p->checkpoint_every == 0) return lw_anneal_checkpoint(a, err);
   return LW_OK;
@@ -885,8 +837,9 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
   if (!f) return err->code;
   lw_chain *c = a->chain;
+  const lw_system_type *t = a->sys_type;
   unsigned long prop = 0, acc = 0, nan = 0;
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+  for (int k = 0; k < c->n_moves; k++) {
     prop += c->stats[k].proposed;
     acc += c->stats[k].accepted;
     nan += c->stats[k].nan;
@@ -897,15 +850,15 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json_begin_object(&j);
   lw_json_key(&j, "seed"); lw_json_int(&j, (long long)a->seed);
   lw_json_key(&j, "sweeps"); lw_json_int(&j, a->sweep);
-  lw_json_key(&j, "splines"); lw_json_int(&j, (long long)a->model->sp->n_splines);
-  lw_json_key(&j, "segments"); lw_json_int(&j, (long long)a->model->sp->n_segments);
+  lw_json_key(&j, "system"); lw_json_string(&j, t->name);
+  t->summary(a->sys->state, &j);
   lw_json_key(&j, "proposals"); lw_json_int(&j, (long long)prop);
   lw_json_key(&j, "accepted"); lw_json_int(&j, (long long)acc);
   lw_json_key(&j, "rejected_nan"); lw_json_int(&j, (long long)nan);
   lw_json_key(&j, "rejected_irregular");
   lw_json_begin_object(&j);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
-    lw_json_key(&j, lw_move_names[k]);
+  for (int k = 0; k < c->n_moves; k++) {
+    lw_json_key(&j, t->move_names[k]);
     lw_json_int(&j, (long long)c->stats[k].irregular);
   }
   lw_json_end_object(&j);
@@ -918,35 +871,36 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json_key(&j, "schedule"); lw_json_string(&j, a->sched_type->name);
   lw_json_key(&j, "energy");
   lw_json_begin_object(&j);
-  lw_json_key(&j, "total"); lw_json_number(&j, lw_model_total(a->model));
-  for (int t = 0; t < LW_TERM_COUNT; t++)
-    if (a->scene.on[t]) {
-      lw_json_key(&j, lw_term_types[t].name);
-      lw_json_number(&j, a->model->term[t]);
+  lw_json_key(&j, "total"); lw_json_number(&j, lw_system_total(a->sys));
+  double term[LW_SYSTEM_TERMS_MAX];
+  t->terms(a->sys->state, term);
+  for (int k = 0; k < t->n_terms; k++)
+    if (t->term_on(a->sys->state, k)) {
+      lw_json_key(&j, t->term_names[k]);
+      lw_json_number(&j, term[k]);
     }
   lw_json_end_object(&j);
   lw_json_key(&j, "energy_initial"); lw_json_number(&j, a->energy_initial);
-  lw_drawing_report_json(&j, &a->drawing);
   lw_json_key(&j, "acceptance");
   lw_json_begin_object(&j);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
-    lw_json_key(&j, lw_move_names[k]);
+  for (int k = 0; k < c->n_moves; k++) {
+    lw_json_key(&j, t->move_names[k]);
     if (c->stats[k].proposed) lw_json_number(&j, (double)c->stats[k].accepted / (double)c->stats[k].proposed);
     else lw_json_null(&j);
   }
   lw_json_end_object(&j);
   lw_json_key(&j, "proposed");
   lw_json_begin_object(&j);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
-    lw_json_key(&j, lw_move_names[k]);
+  for (int k = 0; k < c->n_moves; k++) {
+    lw_json_key(&j, t->move_names[k]);
     lw_json_int(&j, (long long)c->stats[k].proposed);
   }
   lw_json_end_object(&j);
   lw_json_key(&j, "steps");
   lw_json_begin_object(&j);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
-    lw_json_key(&j, lw_move_names[k]);
-    lw_json_number(&j, k == LW_MOVE_ROTATE ? c->step[k] * 180.0 / M_PI : c->step[k]);
+  for (int k = 0; k < c->n_moves; k++) {
+    lw_json_key(&j, t->move_names[k]);
+    lw_json_number(&j, c->step[k] / t->move_unit[k]);
   }
   lw_json_end_object(&j);
   if (a->pt) {
@@ -956,7 +910,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     for (int k = 0; k < a->n_rep; k++) {
       lw_json_begin_object(&j);
       lw_json_key(&j, "temperature"); lw_json_number(&j, a->chains[k]->temperature);
-      lw_json_key(&j, "energy"); lw_json_number(&j, lw_model_total(a->chains[k]->model));
+      lw_json_key(&j, "energy"); lw_json_number(&j, lw_system_total(a->chains[k]->sys));
       lw_json_end_object(&j);
     }
     lw_json_end_array(&j);
@@ -990,8 +944,7 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 {
   lw_status s;
   if ((s = lw_anneal_checkpoint(a, err))) return s;
-  /* NULL: the target tone raster, once scenes carry one (fidelity, underlay) */
-  if ((s = lw_drawing_write(&a->params, &a->scene, a->model->sp, a->tone, a->dir, &a->drawing, err))) return s;
+  if ((s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_FINAL, err))) return s;
   return write_summary(a, err);
 }
 
@@ -1000,13 +953,12 @@ void lw_anneal_free(lw_anneal *a)
   if (a->trace) fclose(a->trace);
   for (int k = 0; k < a->n_rep; k++) {
     if (a->chains) lw_chain_free(a->chains[k]);
-    if (a->models) lw_model_free(a->models[k]);
+    if (a->systems) lw_system_free(a->systems[k]);
   }
   free(a->chains);
-  free(a->models);
-  lw_grid2d_free(a->tone);
+  free(a->systems);
+  if (a->setup) a->sys_type->setup_free(a->setup);
   lw_tempering_free(a->pt);
-  lw_scene_clear(&a->scene);
   lw_schedule_clear(&a->sched);
   memset(a, 0, sizeof *a);
 }

@@ -122,12 +122,12 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
     int width = 24, fill = total > 0 ? (int)(width * done / total) : width;
     fprintf(stderr, "\r[%.*s%*s] sweep %ld/%ld  T %.4g  E %.6g  acc %.3f  left %.0fs ", fill,
             "########################", width - fill, "", a->sweep, a->end_sweep, lw_anneal_temperature(a),
-            lw_model_total(a->model), lw_anneal_acceptance(a), left);
+            lw_anneal_energy(a), lw_anneal_acceptance(a), left);
     if (final) fputc('\n', stderr);
   } else if ((final && a->sweep != pg->last_plain) || a->sweep >= pg->next_plain) {
     pg->last_plain = a->sweep;
     fprintf(stderr, "sweep %ld/%ld T %.6g E %.10g acc %.4f elapsed %.1fs left %.1fs\n", a->sweep, a->end_sweep,
-            lw_anneal_temperature(a), lw_model_total(a->model), lw_anneal_acceptance(a), t, left);
+            lw_anneal_temperature(a), lw_anneal_energy(a), lw_anneal_acceptance(a), t, left);
     while (pg->next_plain <= a->sweep) pg->next_plain += total / 10 > 0 ? total / 10 : 1;
   }
 }
@@ -161,13 +161,10 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, lw_error *err)
   }
   if (lw_anneal_finish(a, err)) return fail(err);
   if (!quiet) {
-    const lw_drawing_report *d = &a->drawing;
-    fprintf(stderr, "linewise: %zu paths; pen-up travel %.1f mm in index order, %.1f mm as plotted\n", d->paths,
-            d->travel_before, d->travel_after);
-    if (d->has_fidelity)
-      fprintf(stderr, "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f\n", d->fidelity.sigma_mm, d->fidelity.mse,
-              d->fidelity.ssim);
-    fprintf(stderr, "linewise: done: %s/final.svg, final.png, summary.json, trace.csv, state.lw\n", a->dir);
+    char drawn[512];
+    a->sys_type->describe(a->sys->state, LW_DESCRIBE_DRAWING, drawn, sizeof drawn);
+    fprintf(stderr, "%s", drawn);
+    fprintf(stderr, "linewise: done: %s/%s, summary.json, trace.csv, state.lw\n", a->dir, a->sys_type->files);
   }
   return 0;
 }
@@ -279,9 +276,11 @@ static int cmd_run(int argc, char **argv)
     return fail(&err);
   }
   if (!quiet) {
-    if (a.scene.note[0]) fprintf(stderr, "linewise: note: %s\n", a.scene.note);
-    fprintf(stderr, "linewise: scene %s, seed %lu, %zu splines, %zu segments, into %s\n", scene, a.seed,
-            a.model->sp->n_splines, a.model->sp->n_segments, dir);
+    const char *note = a.sys_type->note(a.setup);
+    char size[128];
+    a.sys_type->describe(a.sys->state, LW_DESCRIBE_SIZE, size, sizeof size);
+    if (note[0]) fprintf(stderr, "linewise: note: %s\n", note);
+    fprintf(stderr, "linewise: scene %s, seed %lu, %s, into %s\n", scene, a.seed, size, dir);
     fprintf(stderr, "linewise: resolved parameters:\n");
     lw_params_write(&a.params, stderr);
   }
