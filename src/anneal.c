@@ -951,10 +951,9 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 void lw_anneal_free(lw_anneal *a)
 {
   if (a->trace) fclose(a->trace);
-  for (int k = 0; k < a->n_rep; k++) {
-    if (a->chains) lw_chain_free(a->chains[k]);
-    if (a->systems) lw_system_free(a->systems[k]);
-  }
+  /* the chains first: tempering swaps systems between them */
+  for (int k = 0; a->chains && k < a->n_rep; k++) lw_chain_free(a->chains[k]);
+  for (int k = 0; a->systems && k < a->n_rep; k++) lw_system_free(a->systems[k]);
   free(a->chains);
   free(a->systems);
   if (a->setup) a->sys_type->setup_free(a->setup);
