@@ -85,7 +85,7 @@ static int cmd_energy(int argc, char **argv)
   if (err.code) rc = fail(&err);
   else {
     for (int t = 0; t < LW_TERM_COUNT; t++)
-      if (sc.on[t]) printf("%s %.17g\n", lw_term_types[t].name, term[t]);
+      if (sc.on[t]) printf("%s %.17g\n", lw_term_names[t], term[t]);
     printf("total %.17g\n", total);
   }
   lw_state_clear(&st);

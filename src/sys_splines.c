@@ -335,16 +335,13 @@ static void describe(const void *state, int what, char *buf, size_t n)
              d->fidelity.mse, d->fidelity.ssim);
 }
 
-static const char *const term_names[LW_TERM_COUNT] = {"strain", "bending", "potential", "field",
-                                                      "pair", "boundary", "user", "parametrisation"};
-
 const lw_system_type lw_system_splines = {
     .name = "splines",
     .n_moves = LW_MOVE_KINDS,
     .move_names = lw_move_names,
     .move_unit = move_unit,
     .n_terms = LW_TERM_COUNT,
-    .term_names = term_names,
+    .term_names = lw_term_names,
     .setup_new = setup_new,
     .setup_free = setup_free,
     .note = note,

@@ -96,7 +96,7 @@ static void check_state(const lw_model *m, const char *what)
     cr_assert(!isnan(m->seg_len[g]), "%s: segment %zu length NaN", what, g);
     for (int t = 0; t < sc->n_local; t++)
       cr_assert(!isnan(m->seg_local[g * (size_t)sc->n_local + (size_t)t]), "%s: segment %zu cached %s NaN",
-                what, g, lw_term_types[sc->local[t]].name);
+                what, g, lw_term_names[sc->local[t]]);
   }
   double term[LW_TERM_COUNT];
   lw_error err;
@@ -106,14 +106,14 @@ static void check_state(const lw_model *m, const char *what)
   cr_assert(isinf(full) == isinf(lw_model_total(m)), "%s: running total %g, recomputed %g", what,
             lw_model_total(m), full);
   for (int t = 0; t < LW_TERM_COUNT; t++) {
-    cr_assert(!isnan(m->term[t]), "%s: running %s is NaN", what, lw_term_types[t].name);
+    cr_assert(!isnan(m->term[t]), "%s: running %s is NaN", what, lw_term_names[t]);
     if (isinf(term[t])) {
-      cr_assert_eq(m->term[t], term[t], "%s: %s is %g recomputed, %.17g running", what, lw_term_types[t].name,
+      cr_assert_eq(m->term[t], term[t], "%s: %s is %g recomputed, %.17g running", what, lw_term_names[t],
                    term[t], m->term[t]);
       continue;
     }
     cr_assert(fabs(m->term[t] - term[t]) <= 1e-9 * fmax(fabs(full), 1e-300), "%s: %s running %.17g, recomputed %.17g",
-              what, lw_term_types[t].name, m->term[t], term[t]);
+              what, lw_term_names[t], m->term[t], term[t]);
   }
 }
 
