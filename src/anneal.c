@@ -172,15 +172,8 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
 /* The system's row and its set-up of the scene. */
 static lw_status setup_system(lw_anneal *a, lw_error *err)
 {
-  const lw_params *p = &a->params;
-  a->sys_type = lw_system_find(p->system);
-  if (!a->sys_type) {
-    char where[LW_PATH_MAX + 32];
-    lw_params_origin(p, lw_params_find("scene", "system"), where, sizeof where);
-    return lw_error_set(err, LW_EINPUT, "%s: key 'scene.system': expected one of %s, got '%s'", where,
-                        lw_system_names(), p->system);
-  }
-  a->setup = a->sys_type->setup_new(p, err);
+  if (!(a->sys_type = lw_system_of(&a->params, err))) return err->code;
+  a->setup = a->sys_type->setup_new(&a->params, err);
   return a->setup ? LW_OK : err->code;
 }
 
@@ -251,7 +244,7 @@ static lw_status open_trace(lw_anneal *a, int fresh, lw_error *err)
     const lw_system_type *t = a->sys_type;
     fprintf(a->trace, "sweep,temperature");
     for (int k = 0; k < t->n_terms; k++)
-      if (t->term_on(a->sys->state, k)) fprintf(a->trace, ",%s", t->term_names[k]);
+      if (t->term_on(a->setup, k)) fprintf(a->trace, ",%s", t->term_names[k]);
     fprintf(a->trace, ",total");
     for (int k = 0; k < t->n_moves; k++) fprintf(a->trace, ",acc_%s", t->move_names[k]);
     for (int k = 0; a->pt && k < a->n_rep; k++) fprintf(a->trace, ",replica%d_temperature,replica%d_energy", k, k);
@@ -700,7 +693,7 @@ static void trace_row(lw_anneal *a)
   t->terms(a->sys->state, term);
   fprintf(a->trace, "%ld,%.10g", a->sweep, c->temperature);
   for (int k = 0; k < t->n_terms; k++)
-    if (t->term_on(a->sys->state, k)) fprintf(a->trace, ",%.10g", term[k]);
+    if (t->term_on(a->setup, k)) fprintf(a->trace, ",%.10g", term[k]);
   fprintf(a->trace, ",%.10g", lw_system_total(a->sys));
   for (int k = 0; k < c->n_moves; k++) {
     unsigned long p = c->stats[k].proposed - a->trace_mark[k].proposed;
@@ -875,7 +868,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   double term[LW_SYSTEM_TERMS_MAX];
   t->terms(a->sys->state, term);
   for (int k = 0; k < t->n_terms; k++)
-    if (t->term_on(a->sys->state, k)) {
+    if (t->term_on(a->setup, k)) {
       lw_json_key(&j, t->term_names[k]);
       lw_json_number(&j, term[k]);
     }

@@ -4,6 +4,7 @@
 ** stderr and an exit status: 2 for bad usage or input, 1 for failures while
 ** running.
 */
+#include <math.h>
 #include <omp.h>
 #include <signal.h>
 #include <stdio.h>
@@ -12,11 +13,9 @@
 #include <unistd.h>
 
 #include "linewise/anneal.h"
-
-#include "linewise/model.h"
 #include "linewise/params.h"
-#include "linewise/scene.h"
 #include "linewise/state.h"
+#include "linewise/system.h"
 
 static const char usage[] =
   "usage: linewise <command> [options]\n"
@@ -48,22 +47,16 @@ static int fail(const lw_error *err)
   return lw_error_exit_status(err->code);
 }
 
-/* Loads DIR/state.lw and the scene it names (relative to DIR). */
-static lw_status load_run_dir(const char *dir, lw_params *p, lw_scene *sc, lw_state *st, lw_error *err)
+/* Loads DIR/state.lw (its path into path) and the scene it names (relative
+** to DIR). */
+static lw_status load_run_dir(const char *dir, lw_params *p, lw_state *st, char *path, size_t n, lw_error *err)
 {
-  char path[LW_PATH_MAX + 32], scene_path[2 * LW_PATH_MAX + 2];
-  lw_path_join(path, sizeof path, dir, "state.lw");
+  char scene_path[2 * LW_PATH_MAX + 2];
+  lw_path_join(path, n, dir, "state.lw");
   lw_status s = lw_state_read(st, path, err);
   if (s) return s;
   lw_path_join(scene_path, sizeof scene_path, dir, st->scene);
-  if ((s = lw_params_read(p, scene_path, err)) || (s = lw_scene_init(sc, p, err))) {
-    lw_state_clear(st);
-    return s;
-  }
-  if ((s = lw_model_check_regular(sc, st->sp, path, err))) {
-    lw_state_clear(st);
-    lw_scene_clear(sc);
-  }
+  if ((s = lw_params_read(p, scene_path, err))) lw_state_clear(st);
   return s;
 }
 
@@ -76,20 +69,22 @@ static int cmd_energy(int argc, char **argv)
     return fail(&err);
   }
   static lw_params p;
-  lw_scene sc;
   lw_state st;
-  if (load_run_dir(argv[0], &p, &sc, &st, &err)) return fail(&err);
-  double term[LW_TERM_COUNT];
-  double total = lw_energy_compute(&sc, st.sp, term, &err);
+  char path[LW_PATH_MAX + 32];
+  if (load_run_dir(argv[0], &p, &st, path, sizeof path, &err)) return fail(&err);
+  const lw_system_type *t = lw_system_of(&p, &err);
+  void *setup = t ? t->setup_new(&p, &err) : NULL;
   int rc = 0;
+  double term[LW_SYSTEM_TERMS_MAX];
+  double total = setup ? t->energy(setup, &st, path, term, &err) : NAN;
   if (err.code) rc = fail(&err);
   else {
-    for (int t = 0; t < LW_TERM_COUNT; t++)
-      if (sc.on[t]) printf("%s %.17g\n", lw_term_names[t], term[t]);
+    for (int k = 0; k < t->n_terms; k++)
+      if (t->term_on(setup, k)) printf("%s %.17g\n", t->term_names[k], term[k]);
     printf("total %.17g\n", total);
   }
+  if (setup) t->setup_free(setup);
   lw_state_clear(&st);
-  lw_scene_clear(&sc);
   return rc;
 }
 

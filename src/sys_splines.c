@@ -235,9 +235,16 @@ static void terms(const void *state, double *term)
   memcpy(term, ((const spl_state *)state)->m->term, LW_TERM_COUNT * sizeof *term);
 }
 
-static int term_on(const void *state, int t) { return ((const spl_state *)state)->m->scene->on[t]; }
+static int term_on(const void *setup, int t) { return ((const spl_setup *)setup)->scene.on[t]; }
 
 static lw_status refresh(void *state, double *drift) { return lw_model_refresh(((spl_state *)state)->m, drift); }
+
+static double energy(const void *setup, const lw_state *st, const char *path, double *term, lw_error *err)
+{
+  const lw_scene *sc = &((const spl_setup *)setup)->scene;
+  if (lw_model_check_regular(sc, st->sp, path, err)) return NAN;
+  return lw_energy_compute(sc, st->sp, term, err);
+}
 
 static lw_status save(const void *state, lw_state *st, lw_error *err)
 {
@@ -359,6 +366,7 @@ const lw_system_type lw_system_splines = {
     .terms = terms,
     .term_on = term_on,
     .refresh = refresh,
+    .energy = energy,
     .save = save,
     .load = load,
     .files = "final.svg, final.png",

@@ -33,6 +33,18 @@ const char *lw_system_names(void)
   return names_buf;
 }
 
+const lw_system_type *lw_system_of(const lw_params *p, lw_error *err)
+{
+  const lw_system_type *t = lw_system_find(p->system);
+  if (!t) {
+    char where[LW_PATH_MAX + 32];
+    lw_params_origin(p, lw_params_find("scene", "system"), where, sizeof where);
+    lw_error_set(err, LW_EINPUT, "%s: key 'scene.system': expected one of %s, got '%s'", where, lw_system_names(),
+                 p->system);
+  }
+  return t;
+}
+
 lw_system *lw_system_wrap(const lw_system_type *type, void *state, lw_error *err)
 {
   if (!state) return NULL;

@@ -120,7 +120,7 @@ static double gs_total(const void *state)
 }
 
 static void gs_terms(const void *state, double *term) { memcpy(term, ((const gs_state *)state)->term, 2 * sizeof *term); }
-static int gs_term_on(const void *state, int t) { return 1; }
+static int gs_term_on(const void *setup, int t) { return 1; }
 
 static lw_status gs_refresh(void *state, double *drift)
 {
@@ -152,6 +152,17 @@ static void *gs_load(const void *setup, lw_state *st, const char *path, lw_error
   return s;
 }
 
+static double gs_energy_of(const void *setup, const lw_state *st, const char *path, double *term, lw_error *err)
+{
+  lw_state copy = *st;
+  gs_state *s = gs_load(setup, &copy, path, err);
+  if (!s) return NAN;
+  gs_terms(s, term);
+  double e = gs_total(s);
+  free(s);
+  return e;
+}
+
 static lw_status gs_draw(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err) { return LW_OK; }
 
 static void gs_summary(const void *state, lw_json *j)
@@ -177,7 +188,7 @@ static const lw_system_type gauss_type = {
     .moves = gs_moves, .sweep_size = gs_sweep_size, .step_max = gs_step_max,
     .proposal_new = gs_proposal_new, .proposal_free = gs_proposal_free,
     .propose = gs_propose, .commit = gs_commit,
-    .total = gs_total, .terms = gs_terms, .term_on = gs_term_on, .refresh = gs_refresh,
+    .total = gs_total, .terms = gs_terms, .term_on = gs_term_on, .refresh = gs_refresh, .energy = gs_energy_of,
     .save = gs_save, .load = gs_load,
     .files = "", .draw = gs_draw, .summary = gs_summary, .describe = gs_describe,
 };
@@ -363,5 +374,11 @@ Test(system, an_unknown_system_exits_2_naming_file_line_and_key)
   cr_assert_eq(lw_test_sh("grep -q 's.ini:3: key .scene.system.: expected one of splines, got .nurbs.' %s/err.txt",
                           dir), 0);
   cr_assert_neq(lw_test_sh("test -e %s/out", dir), 0, "nothing is written for a bad scene");
+  /* the energy command reads a run directory's system the same way */
+  cr_assert_eq(lw_test_sh("mkdir %s/r && cp %s/s.ini %s/r/scene.ini && printf 'linewise-state 1\nscene scene.ini\n"
+                          "seed 1\nsweep 0\nsplines 0\nend\n' > %s/r/state.lw", dir, dir, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s energy %s/r > %s/out.txt 2> %s/err.txt", getenv("LW_BIN"), dir, dir, dir), 2);
+  cr_assert_eq(lw_test_sh("grep -q 'scene.ini:3: key .scene.system.' %s/err.txt && ! test -s %s/out.txt", dir, dir),
+               0);
   lw_test_dir_remove(dir);
 }

@@ -93,13 +93,18 @@ struct lw_system_type {
   lw_status (*commit)(void *state, void *prop);
 
   /* Energies: the running total (+inf in a forbidden state), the running
-  ** value of each term (n_terms values, 0 when off), whether term t is on,
-  ** and a recomputation of every cache and total from the state (drift: the
-  ** relative change of the total, |new - old| / max(|new|, 1)). */
+  ** value of each term (n_terms values, 0 when off), whether term t is on
+  ** in the set-up, and a recomputation of every cache and total from the
+  ** state (drift: the relative change of the total, |new - old| /
+  ** max(|new|, 1)). */
   double (*total)(const void *state);
   void (*terms)(const void *state, double *term);
-  int (*term_on)(const void *state, int t);
+  int (*term_on)(const void *setup, int t);
   lw_status (*refresh)(void *state, double *drift);
+  /* The energy per term of a saved state (st, read from path) computed from
+  ** scratch, and the total; err set (naming path) when the state is refused
+  ** or memory runs out (`linewise energy`). */
+  double (*energy)(const void *setup, const lw_state *st, const char *path, double *term, lw_error *err);
 
   /* Checkpoints: save adds the state and its running energies to st (its own
   ** keys; st->sp for splines); load builds a state from st (taking what it
@@ -136,6 +141,10 @@ extern const lw_system_type *const lw_system_types[];
 /* The row of that name, or NULL; lw_system_names lists them for messages. */
 const lw_system_type *lw_system_find(const char *name);
 const char *lw_system_names(void);
+
+/* The row the parameters name ([scene] system); NULL and LW_EINPUT naming
+** the key's file and line if there is none of that name. */
+const lw_system_type *lw_system_of(const lw_params *p, lw_error *err);
 
 /* An instance owning `state` (freed on failure too). */
 lw_system *lw_system_wrap(const lw_system_type *type, void *state, lw_error *err);
