@@ -27,7 +27,12 @@
 **     final drawing reported (pen-up travel, fidelity) for summary(), which
 **     writes the system's own members of summary.json.
 **   - term_on(): a term that is off has no trace column or summary member
-**     (as before); its running value is 0.
+**     (as before); its running value is 0.  energy(): the energy per term
+**     of a saved state from scratch, for `linewise energy`.
+**   - propose() takes the state non-const: it may fill caches (the spline
+**     model's near-field cache), never the state itself.
+**   - note(), describe() and files give the command line its messages, so
+**     main.c names no system either.
 **
 ** An instance is an lw_system: the row plus the state.  The set-up (for
 ** splines the scene: fields, boundary, quadrature, the picture) is shared
