@@ -16,8 +16,6 @@
 #include <unistd.h>
 
 #include "linewise/checkpoint.h"
-#include "linewise/drawing.h"
-#include "linewise/fieldview.h"
 #include "linewise/init.h"
 #include "linewise/json.h"
 #include "linewise/number.h"
@@ -38,7 +36,7 @@ double lw_anneal_temperature(const lw_anneal *a) { return a->chain ? a->chain->t
 double lw_anneal_acceptance(const lw_anneal *a)
 {
   unsigned long p = 0, acc = 0;
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+  for (int k = 0; k < a->chain->n_moves; k++) {
     p += a->chain->stats[k].proposed;
     acc += a->chain->stats[k].accepted;
   }
@@ -167,12 +165,12 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
   return LW_OK;
 }
 
-/* The target of the fidelity score and the previews' underlay. */
-static lw_status setup_tone(lw_anneal *a, lw_error *err)
+/* The system's row and its set-up of the scene. */
+static lw_status setup_system(lw_anneal *a, lw_error *err)
 {
-  if (!a->scene.image) return LW_OK;
-  a->tone = lw_image_tone_grid(a->scene.image, &a->scene.image_place, err);
-  return a->tone ? LW_OK : err->code;
+  if (!(a->sys_type = lw_system_of(&a->params, err))) return err->code;
+  a->setup = a->sys_type->setup_new(&a->params, err);
+  return a->setup ? LW_OK : err->code;
 }
 
 /* Chain of rung k: rung 0 draws from stream 1 (as a run without tempering
@@ -182,37 +180,37 @@ static unsigned long rung_stream(const lw_anneal *a, int k)
   return lw_stream_seed(a->seed, k == 0 ? 1 : 2 + (unsigned long)k);
 }
 
-/* Models for the n_rep states sp[] (ownership passes, also on failure),
+/* Systems for the n_rep states[] (ownership passes, also on failure),
 ** chains for the rungs, the exchange machinery on the base ladder. */
-static lw_status build(lw_anneal *a, lw_splines **sp, const double *ladder, lw_error *err)
+static lw_status build(lw_anneal *a, void **states, const double *ladder, lw_error *err)
 {
   const lw_params *p = &a->params;
+  const lw_system_type *t = a->sys_type;
   int n = a->n_rep;
-  a->models = calloc((size_t)n, sizeof *a->models);
+  a->systems = calloc((size_t)n, sizeof *a->systems);
   a->chains = calloc((size_t)n, sizeof *a->chains);
-  if (!a->models || !a->chains) {
-    for (int r = 0; r < n; r++) lw_splines_free(sp[r]);
+  if (!a->systems || !a->chains) {
+    for (int r = 0; r < n; r++) t->state_free(states[r]);
     return lw_error_set(err, LW_ENOMEM, "out of memory for %d replicas", n);
   }
   lw_status s = LW_OK;
   for (int r = 0; r < n; r++) {
     if (!s) {
-      a->models[r] = lw_model_new(&a->scene, sp[r], err);
-      if (!a->models[r]) s = err->code;
+      a->systems[r] = lw_system_wrap(t, states[r], err);
+      if (!a->systems[r]) s = err->code;
     } else {
-      lw_splines_free(sp[r]);
+      t->state_free(states[r]);
     }
   }
   if (s) return s;
-  double weight[LW_MOVE_KINDS] = {p->mix_point, p->mix_vector, p->mix_translate, p->mix_rotate};
-  double step[LW_MOVE_KINDS] = {p->step_point, p->step_vector, p->step_translate, p->step_rotate * M_PI / 180.0};
-  double target[LW_MOVE_KINDS] = {p->target, p->target, p->target_spline, p->target_spline};
+  double weight[LW_MOVES_MAX], step[LW_MOVES_MAX], target[LW_MOVES_MAX];
+  t->moves(p, weight, step, target);
   for (int k = 0; k < n; k++) {
-    a->chains[k] = lw_chain_new(a->models[k], weight, step, target, rung_stream(a, k), err);
+    a->chains[k] = lw_chain_new(a->systems[k], weight, step, target, rung_stream(a, k), err);
     if (!a->chains[k]) return err->code;
   }
   a->chain = a->chains[0];
-  a->model = a->models[0];
+  a->sys = a->systems[0];
   if (n > 1) {
     a->pt = lw_tempering_new(n, ladder, lw_stream_seed(a->seed, 2), err);
     if (!a->pt) return err->code;
@@ -239,11 +237,12 @@ static lw_status open_trace(lw_anneal *a, int fresh, lw_error *err)
   a->trace = fopen(path, fresh ? "w" : "a");
   if (!a->trace) return lw_error_set(err, LW_EIO, "%s: cannot write: %s", path, strerror(errno));
   if (fresh) {
+    const lw_system_type *t = a->sys_type;
     fprintf(a->trace, "sweep,temperature");
-    for (int t = 0; t < LW_TERM_COUNT; t++)
-      if (a->scene.on[t]) fprintf(a->trace, ",%s", lw_term_types[t].name);
+    for (int k = 0; k < t->n_terms; k++)
+      if (t->term_on(a->setup, k)) fprintf(a->trace, ",%s", t->term_names[k]);
     fprintf(a->trace, ",total");
-    for (int k = 0; k < LW_MOVE_KINDS; k++) fprintf(a->trace, ",acc_%s", lw_move_names[k]);
+    for (int k = 0; k < t->n_moves; k++) fprintf(a->trace, ",acc_%s", t->move_names[k]);
     for (int k = 0; a->pt && k < a->n_rep; k++) fprintf(a->trace, ",replica%d_temperature,replica%d_energy", k, k);
     for (int k = 0; a->pt && k + 1 < a->n_rep; k++) fprintf(a->trace, ",swap%d", k);
     fprintf(a->trace, "\n");
@@ -267,40 +266,19 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   double ladder[LW_TEMPERING_MAX];
   if ((s = lw_params_resolve(&a->params, err)) || (s = setup_ladder(a, ladder, err)) ||
       (s = setup_schedule(a, err)) ||
-      (s = lw_scene_init(&a->scene, &a->params, err)) || (s = setup_tone(a, err)))
+      (s = setup_system(a, err)))
     return s;
-  lw_splines *sp;
-  if (a->params.from[0]) {
-    lw_state st;
-    if ((s = lw_state_read(&st, a->params.from, err))) return blame_key(&a->params, "init", "from", err);
-    s = lw_model_check_regular(&a->scene, st.sp, a->params.from, err);
-    if (s) blame_key(&a->params, "init", "from", err);
-    sp = st.sp;
-    st.sp = NULL;
-    lw_state_clear(&st);
-    if (s) {
-      lw_splines_free(sp);
-      return s;
-    }
-  } else {
-    size_t n;
-    if ((s = lw_init_count(&a->scene, p, &n, err))) return s;
-    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-    if (!r) return lw_error_set(err, LW_ENOMEM, "out of memory");
-    gsl_rng_set(r, lw_stream_seed(a->seed, 0));
-    sp = lw_init_random(&a->scene, n, (size_t)p->segments, p->segment_length, r, err);
-    gsl_rng_free(r);
-    if (!sp) return err->code == LW_EINPUT ? blame_key(&a->params, "init", "segment_length", err) : err->code;
-  }
+  const lw_system_type *t = a->sys_type;
+  void *all[LW_TEMPERING_MAX] = {t->state_new(a->setup, &a->params, lw_stream_seed(a->seed, 0), err)};
+  if (!all[0]) return err->code;
   /* every replica starts from the same state; their streams part them */
-  lw_splines *all[LW_TEMPERING_MAX] = {sp};
   for (int r = 1; r < a->n_rep; r++)
-    if (!(all[r] = lw_splines_clone(sp))) {
-      for (int q = 0; q < r; q++) lw_splines_free(all[q]);
-      return lw_error_set(err, LW_ENOMEM, "out of memory for %d replicas", a->n_rep);
+    if (!(all[r] = t->state_copy(all[0], err))) {
+      for (int q = 0; q < r; q++) t->state_free(all[q]);
+      return err->code;
     }
   if ((s = build(a, all, ladder, err))) return s;
-  a->energy_initial = lw_model_total(a->model);
+  a->energy_initial = lw_system_total(a->sys);
   a->end_sweep = p->sweeps;
   /* Everything above only read input: the directory appears once the run
   ** is known to be valid. */
@@ -313,8 +291,7 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   lw_params_write(&a->params, f);
   if ((s = lw_output_commit(f, tmp, path, err))) return s;
   if ((s = open_trace(a, 1, err))) return s;
-  dir_file(path, sizeof path, a, "field.png");
-  if (p->field_preview && (s = lw_fieldview_png(&a->scene, p->png_scale, path, err))) return s;
+  if ((s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_START, err))) return s;
   return lw_anneal_checkpoint(a, err);
 }
 
@@ -368,32 +345,35 @@ static lw_status truncate_trace(lw_anneal *a, long bytes, lw_error *err)
   return s ? s : open_trace(a, 0, err);
 }
 
-/* The splines of rung k: a section of state.lw, or (format 1) replica-K.lw,
-** whose document *rep keeps the replica's run data for the upgrade. */
-static lw_status rung_splines(lw_anneal *a, const lw_state *st, int k, lw_splines **sp, lw_ckpt **rep,
-                              lw_error *err)
+/* The state of rung k, loaded by the row from its section of state.lw
+** ([system <name>] or [system <name> K]), or (format 1, rungs K >= 1) from
+** replica-K.lw, whose document *rep keeps the replica's run data for the
+** upgrade. */
+static lw_status rung_state(lw_anneal *a, lw_state *st, int k, void **state, lw_ckpt **rep, lw_error *err)
 {
-  char name[64], path[LW_PATH_MAX + 64];
-  lw_status s;
-  if (st->version != 1) {
-    snprintf(name, sizeof name, "system splines %d", k);
+  const lw_system_type *t = a->sys_type;
+  char sec[64], path[LW_PATH_MAX + 64];
+  lw_status s = LW_OK;
+  *state = NULL;
+  if (st->version != 1 || k == 0) {
+    lw_checkpoint_system_section(sec, sizeof sec, t, k);
     dir_file(path, sizeof path, a, "state.lw");
-    s = lw_state_get_splines(st->doc, name, sp, err);
+    *state = t->load(a->setup, st, sec, path, err);
   } else {
     lw_state r;
-    snprintf(name, sizeof name, "replica-%d.lw", k);
-    dir_file(path, sizeof path, a, name);
+    snprintf(sec, sizeof sec, "replica-%d.lw", k);
+    dir_file(path, sizeof path, a, sec);
     if ((s = lw_state_read(&r, path, err))) return s;
     if (r.sweep != st->sweep || r.version != 1)
       s = lw_error_set(err, LW_EINPUT, "%s: sweep %ld of format %d, but state.lw is at sweep %ld of format 1 (an "
                        "interrupted checkpoint of an older release?)", path, r.sweep, r.version, st->sweep);
-    *sp = r.sp;
+    lw_checkpoint_system_section(sec, sizeof sec, t, 0);
+    if (!s) *state = t->load(a->setup, &r, sec, path, err);
     *rep = r.doc;
-    r.sp = NULL;
     r.doc = NULL;
     lw_state_clear(&r);
   }
-  if (!s) s = lw_model_check_regular(&a->scene, *sp, path, err);
+  if (!s && !*state) s = err->code;
   return s;
 }
 
@@ -405,7 +385,7 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
   char path[LW_PATH_MAX + 32], scene_path[2 * LW_PATH_MAX + 2];
   dir_file(path, sizeof path, a, "state.lw");
   lw_state st;
-  lw_splines *all[LW_TEMPERING_MAX] = {NULL};
+  void *all[LW_TEMPERING_MAX] = {NULL};
   lw_ckpt *rep[LW_TEMPERING_MAX] = {NULL};
   lw_status s = lw_state_read(&st, path, err);
   if (s) return s;
@@ -413,16 +393,14 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
   double ladder[LW_TEMPERING_MAX];
   long trace_bytes = -1;
   if ((s = lw_params_read(&a->params, scene_path, err)) || (s = setup_ladder(a, ladder, err)) ||
-      (s = setup_schedule(a, err)) || (s = lw_scene_init(&a->scene, &a->params, err)) ||
-      (s = setup_tone(a, err)) || (s = lw_model_check_regular(&a->scene, st.sp, path, err)))
+      (s = setup_schedule(a, err)) || (s = setup_system(a, err)))
     goto out;
   a->seed = st.seed;
   a->sweep = st.sweep;
-  all[0] = st.sp;
-  st.sp = NULL;
-  for (int k = 1; k < a->n_rep && !s; k++) s = rung_splines(a, &st, k, &all[k], &rep[k], err);
+  for (int k = 0; k < a->n_rep && !s; k++) s = rung_state(a, &st, k, &all[k], &rep[k], err);
   if (s) {
-    for (int k = 0; k < a->n_rep; k++) lw_splines_free(all[k]);
+    for (int k = 0; k < a->n_rep; k++)
+      if (all[k]) a->sys_type->state_free(all[k]);
     goto out;
   }
   if ((s = build(a, all, ladder, err))) goto out;
@@ -437,7 +415,7 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
     fclose(tf);
   }
   a->end_sweep = more >= 0 ? a->sweep + more : (a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) a->proposals_before += a->chain->stats[k].proposed;
+  for (int k = 0; k < a->chain->n_moves; k++) a->proposals_before += a->chain->stats[k].proposed;
   s = truncate_trace(a, trace_bytes, err);
 out:
   for (int k = 1; k < LW_TEMPERING_MAX; k++) lw_ckpt_free(rep[k]);
@@ -450,11 +428,14 @@ out:
 static void trace_row(lw_anneal *a)
 {
   lw_chain *c = a->chain;
+  const lw_system_type *t = a->sys_type;
+  double term[LW_SYSTEM_TERMS_MAX];
+  t->terms(a->sys->state, term);
   fprintf(a->trace, "%ld,%.10g", a->sweep, c->temperature);
-  for (int t = 0; t < LW_TERM_COUNT; t++)
-    if (a->scene.on[t]) fprintf(a->trace, ",%.10g", a->model->term[t]);
-  fprintf(a->trace, ",%.10g", lw_model_total(a->model));
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+  for (int k = 0; k < t->n_terms; k++)
+    if (t->term_on(a->setup, k)) fprintf(a->trace, ",%.10g", term[k]);
+  fprintf(a->trace, ",%.10g", lw_system_total(a->sys));
+  for (int k = 0; k < c->n_moves; k++) {
     unsigned long p = c->stats[k].proposed - a->trace_mark[k].proposed;
     unsigned long acc = c->stats[k].accepted - a->trace_mark[k].accepted;
     if (p) fprintf(a->trace, ",%.6f", (double)acc / (double)p);
@@ -463,7 +444,7 @@ static void trace_row(lw_anneal *a)
   }
   if (a->pt) {
     for (int k = 0; k < a->n_rep; k++)
-      fprintf(a->trace, ",%.10g,%.10g", a->chains[k]->temperature, lw_model_total(a->chains[k]->model));
+      fprintf(a->trace, ",%.10g,%.10g", a->chains[k]->temperature, lw_system_total(a->chains[k]->sys));
     /* swap acceptance since the previous row */
     for (int k = 0; k + 1 < a->n_rep; k++) {
       unsigned long tried = a->pt->tried[k] - a->swap_mark[2 * k];
@@ -500,17 +481,17 @@ static lw_status exchange(lw_anneal *a, lw_error *err)
   int n = a->n_rep, swapped[LW_TEMPERING_MAX];
   double e[LW_TEMPERING_MAX] = {0}, t[LW_TEMPERING_MAX] = {0};
   for (int k = 0; k < n; k++) {
-    e[k] = lw_model_total(a->chains[k]->model);
+    e[k] = lw_system_total(a->chains[k]->sys);
     t[k] = a->chains[k]->temperature;
   }
   lw_tempering_exchange(pt, e, t, swapped);
   for (int k = 0; k + 1 < n; k++)
     if (swapped[k]) {
-      lw_model *m = a->chains[k]->model;
-      a->chains[k]->model = a->chains[k + 1]->model;
-      a->chains[k + 1]->model = m;
+      lw_system *sys = a->chains[k]->sys;
+      a->chains[k]->sys = a->chains[k + 1]->sys;
+      a->chains[k + 1]->sys = sys;
     }
-  a->model = a->chains[0]->model;
+  a->sys = a->chains[0]->sys;
   if (p->tune_ladder == LW_LADDER_EQUAL && a->sweep <= p->ladder_sweeps) {
     /* every pair has had ~20 attempts by then */
     if (pt->steps % 40 == 0) {
@@ -550,17 +531,17 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
   int tuning = a->sweep - block_start(a, b) < p->tune_sweeps && a->sweep < p->sweeps;
   int failed = 0;
   /* The rungs are independent between exchanges: each touches only its own
-  ** chain, stream and model, so the thread count cannot change the result. */
+  ** chain, stream and system, so the thread count cannot change the result. */
 #pragma omp parallel for schedule(static, 1) reduction(| : failed) if (n > 1)
   for (int k = 0; k < n; k++) {
     a->chains[k]->tuning = tuning;
     if (lw_chain_sweep(a->chains[k]) != LW_OK) failed = 1;
   }
-  if (failed) return lw_error_set(err, LW_ENOMEM, "out of memory growing the pair grid");
+  if (failed) return lw_error_set(err, LW_ENOMEM, "out of memory growing a system's caches");
   a->sweep++;
   lw_status s;
   if (a->pt && a->sweep % p->exchange_every == 0 && (s = exchange(a, err))) return s;
-  double e = lw_model_total(a->model);
+  double e = lw_system_total(a->sys);
   if (!tuning && isfinite(e)) {
     a->acc_n += 1.0;
     a->acc_sum += e;
@@ -570,12 +551,13 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
   if (a->sweep % p->check_every == 0)
     for (int r = 0; r < n; r++) {
       double drift;
-      if (lw_model_refresh(a->models[r], &drift) != LW_OK) return lw_error_set(err, LW_ENOMEM, "out of memory");
+      if (a->sys_type->refresh(a->systems[r]->state, &drift) != LW_OK)
+        return lw_error_set(err, LW_ENOMEM, "out of memory");
       if (drift > a->max_drift) a->max_drift = drift;
     }
   /* Frames are extra files: they read the state and change nothing. */
   if (p->frames_every && a->sweep % p->frames_every == 0 &&
-      lw_drawing_frame(p, &a->scene, a->model->sp, a->tone, a->dir, a->sweep, err))
+      a->sys_type->draw(a->sys->state, p, a->dir, a->sweep, err))
     return err->code;
   if (a->sweep % p->checkpoint_every == 0) return lw_anneal_checkpoint(a, err);
   return LW_OK;
@@ -588,8 +570,9 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
   if (!f) return err->code;
   lw_chain *c = a->chain;
+  const lw_system_type *t = a->sys_type;
   unsigned long prop = 0, acc = 0, nan = 0;
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+  for (int k = 0; k < c->n_moves; k++) {
     prop += c->stats[k].proposed;
     acc += c->stats[k].accepted;
     nan += c->stats[k].nan;
@@ -600,15 +583,15 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json_begin_object(&j);
   lw_json_key(&j, "seed"); lw_json_int(&j, (long long)a->seed);
   lw_json_key(&j, "sweeps"); lw_json_int(&j, a->sweep);
-  lw_json_key(&j, "splines"); lw_json_int(&j, (long long)a->model->sp->n_splines);
-  lw_json_key(&j, "segments"); lw_json_int(&j, (long long)a->model->sp->n_segments);
+  lw_json_key(&j, "system"); lw_json_string(&j, t->name);
+  t->summary(a->sys->state, &j);
   lw_json_key(&j, "proposals"); lw_json_int(&j, (long long)prop);
   lw_json_key(&j, "accepted"); lw_json_int(&j, (long long)acc);
   lw_json_key(&j, "rejected_nan"); lw_json_int(&j, (long long)nan);
   lw_json_key(&j, "rejected_irregular");
   lw_json_begin_object(&j);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
-    lw_json_key(&j, lw_move_names[k]);
+  for (int k = 0; k < c->n_moves; k++) {
+    lw_json_key(&j, t->move_names[k]);
     lw_json_int(&j, (long long)c->stats[k].irregular);
   }
   lw_json_end_object(&j);
@@ -621,35 +604,36 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json_key(&j, "schedule"); lw_json_string(&j, a->sched_type->name);
   lw_json_key(&j, "energy");
   lw_json_begin_object(&j);
-  lw_json_key(&j, "total"); lw_json_number(&j, lw_model_total(a->model));
-  for (int t = 0; t < LW_TERM_COUNT; t++)
-    if (a->scene.on[t]) {
-      lw_json_key(&j, lw_term_types[t].name);
-      lw_json_number(&j, a->model->term[t]);
+  lw_json_key(&j, "total"); lw_json_number(&j, lw_system_total(a->sys));
+  double term[LW_SYSTEM_TERMS_MAX];
+  t->terms(a->sys->state, term);
+  for (int k = 0; k < t->n_terms; k++)
+    if (t->term_on(a->setup, k)) {
+      lw_json_key(&j, t->term_names[k]);
+      lw_json_number(&j, term[k]);
     }
   lw_json_end_object(&j);
   lw_json_key(&j, "energy_initial"); lw_json_number(&j, a->energy_initial);
-  lw_drawing_report_json(&j, &a->drawing);
   lw_json_key(&j, "acceptance");
   lw_json_begin_object(&j);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
-    lw_json_key(&j, lw_move_names[k]);
+  for (int k = 0; k < c->n_moves; k++) {
+    lw_json_key(&j, t->move_names[k]);
     if (c->stats[k].proposed) lw_json_number(&j, (double)c->stats[k].accepted / (double)c->stats[k].proposed);
     else lw_json_null(&j);
   }
   lw_json_end_object(&j);
   lw_json_key(&j, "proposed");
   lw_json_begin_object(&j);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
-    lw_json_key(&j, lw_move_names[k]);
+  for (int k = 0; k < c->n_moves; k++) {
+    lw_json_key(&j, t->move_names[k]);
     lw_json_int(&j, (long long)c->stats[k].proposed);
   }
   lw_json_end_object(&j);
   lw_json_key(&j, "steps");
   lw_json_begin_object(&j);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
-    lw_json_key(&j, lw_move_names[k]);
-    lw_json_number(&j, k == LW_MOVE_ROTATE ? c->step[k] * 180.0 / M_PI : c->step[k]);
+  for (int k = 0; k < c->n_moves; k++) {
+    lw_json_key(&j, t->move_names[k]);
+    lw_json_number(&j, c->step[k] / t->move_unit[k]);
   }
   lw_json_end_object(&j);
   if (a->pt) {
@@ -659,7 +643,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     for (int k = 0; k < a->n_rep; k++) {
       lw_json_begin_object(&j);
       lw_json_key(&j, "temperature"); lw_json_number(&j, a->chains[k]->temperature);
-      lw_json_key(&j, "energy"); lw_json_number(&j, lw_model_total(a->chains[k]->model));
+      lw_json_key(&j, "energy"); lw_json_number(&j, lw_system_total(a->chains[k]->sys));
       lw_json_end_object(&j);
     }
     lw_json_end_array(&j);
@@ -693,23 +677,20 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 {
   lw_status s;
   if ((s = lw_anneal_checkpoint(a, err))) return s;
-  /* NULL: the target tone raster, once scenes carry one (fidelity, underlay) */
-  if ((s = lw_drawing_write(&a->params, &a->scene, a->model->sp, a->tone, a->dir, &a->drawing, err))) return s;
+  if ((s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_FINAL, err))) return s;
   return write_summary(a, err);
 }
 
 void lw_anneal_free(lw_anneal *a)
 {
   if (a->trace) fclose(a->trace);
-  for (int k = 0; k < a->n_rep; k++) {
-    if (a->chains) lw_chain_free(a->chains[k]);
-    if (a->models) lw_model_free(a->models[k]);
-  }
+  /* the chains first: tempering swaps systems between them */
+  for (int k = 0; a->chains && k < a->n_rep; k++) lw_chain_free(a->chains[k]);
+  for (int k = 0; a->systems && k < a->n_rep; k++) lw_system_free(a->systems[k]);
   free(a->chains);
-  free(a->models);
-  lw_grid2d_free(a->tone);
+  free(a->systems);
+  if (a->setup) a->sys_type->setup_free(a->setup);
   lw_tempering_free(a->pt);
-  lw_scene_clear(&a->scene);
   lw_schedule_clear(&a->sched);
   memset(a, 0, sizeof *a);
 }

@@ -9,11 +9,17 @@
 **                   window.<move>, moves.<move>, and energy.<term> (the
 **                   running totals of the replica at that rung)
 **   [tempering]     the exchange machinery
-**   [system splines], [system splines K]   the splines at each rung
+**   [system <name>], [system <name> K]   the system's state at each rung,
+**                   written and read by the system's row (system.h; for
+**                   splines [system splines])
 **
-** Keys per move kind and per term are optional on reading: a file written
+** The run-level parts see the system only through its row: move kinds and
+** terms by the row's names, the chain's n_moves, the row's n_terms.  Keys
+** per move kind and per term are optional on reading: a file written
 ** before a term or a move kind existed resumes with 0 (energy, counts) or
 ** the scene's initial step.  Anything unknown is refused (lw_ckpt_unread).
+** Format 1 (the upgrade below) only ever held splines, so that part and
+** lw_checkpoint_check_finite are the spline system's.
 */
 #include "linewise/checkpoint.h"
 
@@ -23,9 +29,11 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "linewise/model.h"
 #include "linewise/number.h"
 #include "linewise/output.h"
 #include "linewise/state.h"
+#include "linewise/sys_splines.h"
 
 #define COUNT_MAX 9007199254740992.0 /* 2^53 */
 
@@ -37,19 +45,26 @@ static void rung_section(char *buf, size_t n, const char *base, int k)
 
 static void dir_file(char *buf, size_t n, const lw_anneal *a, const char *name) { lw_path_join(buf, n, a->dir, name); }
 
+void lw_checkpoint_system_section(char *buf, size_t n, const lw_system_type *t, int k)
+{
+  if (k == 0) snprintf(buf, n, "system %s", t->name);
+  else snprintf(buf, n, "system %s %d", t->name, k);
+}
+
 /* ---- writing ---------------------------------------------------------------- */
 
-static void put_chain(lw_ckpt_writer *w, int k, const lw_chain *c, lw_error *err, int *bad)
+static void put_chain(lw_ckpt_writer *w, int k, const lw_system_type *t, const lw_chain *c, int *bad)
 {
-  char sec[32], key[64];
+  char sec[32], key[96];
+  double term[LW_SYSTEM_TERMS_MAX];
   rung_section(sec, sizeof sec, "chain", k);
   lw_ckpt_section(w, sec);
   char *hex = lw_rng_save(c->rng);
   if (!hex) *bad = 1;
   else lw_ckpt_put(w, "rng", "%s", hex);
   free(hex);
-  for (int m = 0; m < LW_MOVE_KINDS; m++) {
-    const char *name = lw_move_names[m];
+  for (int m = 0; m < c->n_moves; m++) {
+    const char *name = t->move_names[m];
     const lw_move_stats *st = &c->stats[m];
     snprintf(key, sizeof key, "step.%s", name);
     lw_ckpt_put_numbers(w, key, &c->step[m], 1);
@@ -58,9 +73,10 @@ static void put_chain(lw_ckpt_writer *w, int k, const lw_chain *c, lw_error *err
     snprintf(key, sizeof key, "moves.%s", name);
     lw_ckpt_put_counts(w, key, (unsigned long[]){st->proposed, st->accepted, st->nan, st->irregular}, 4);
   }
-  for (int t = 0; t < LW_TERM_COUNT; t++) {
-    snprintf(key, sizeof key, "energy.%s", lw_term_types[t].name);
-    lw_ckpt_put_numbers(w, key, &c->model->term[t], 1);
+  t->terms(c->sys->state, term);
+  for (int q = 0; q < t->n_terms; q++) {
+    snprintf(key, sizeof key, "energy.%s", t->term_names[q]);
+    lw_ckpt_put_numbers(w, key, &term[q], 1);
   }
 }
 
@@ -95,14 +111,24 @@ static void put_tempering(lw_ckpt_writer *w, const lw_anneal *a, int *bad)
   lw_ckpt_put_counts(w, "steps", &pt->steps, 1);
 }
 
-/* replica-K.lw: a plain state of rung K for the user (init.from, energy). */
+/* replica-K.lw: a plain state of rung K for the user (init.from, energy):
+** the header and the system's section as for the coldest rung. */
 static lw_status write_replica(const lw_anneal *a, int k, lw_error *err)
 {
-  lw_state st = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep, .sp = a->chains[k]->model->sp};
+  lw_state head = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep};
   char name[64], path[LW_PATH_MAX + 64];
   snprintf(name, sizeof name, "replica-%d.lw", k);
   dir_file(path, sizeof path, a, name);
-  return lw_state_write(&st, path, err);
+  lw_ckpt_writer w;
+  lw_status s = lw_ckpt_begin(&w, path, LW_STATE_HEADER, err);
+  if (s) return s;
+  lw_state_put_header(&w, &head);
+  lw_checkpoint_system_section(name, sizeof name, a->sys_type, 0);
+  if ((s = a->sys_type->save(a->chains[k]->sys->state, &w, name, err))) {
+    lw_ckpt_abort(&w);
+    return s;
+  }
+  return lw_ckpt_commit(&w, err);
 }
 
 lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err)
@@ -130,19 +156,23 @@ lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err)
   lw_ckpt_put(&w, "energy_initial", "%.17g", a->energy_initial);
   lw_ckpt_put(&w, "max_drift", "%.17g", a->max_drift);
   lw_ckpt_put(&w, "trace_bytes", "%ld", trace_bytes);
-  for (int m = 0; m < LW_MOVE_KINDS; m++) {
-    char key[64];
+  const lw_system_type *t = a->sys_type;
+  for (int m = 0; m < a->chain->n_moves; m++) {
+    char key[96];
     const lw_move_stats *st = &a->trace_mark[m];
-    snprintf(key, sizeof key, "trace_mark.%s", lw_move_names[m]);
+    snprintf(key, sizeof key, "trace_mark.%s", t->move_names[m]);
     lw_ckpt_put_counts(&w, key, (unsigned long[]){st->proposed, st->accepted, st->nan}, 3);
   }
   int bad = 0;
-  for (int k = 0; k < a->n_rep; k++) put_chain(&w, k, a->chains[k], err, &bad);
+  for (int k = 0; k < a->n_rep; k++) put_chain(&w, k, t, a->chains[k], &bad);
   if (a->pt) put_tempering(&w, a, &bad);
   for (int k = 0; k < a->n_rep; k++) {
-    char sec[32];
-    rung_section(sec, sizeof sec, "system splines", k);
-    lw_state_put_splines(&w, sec, a->chains[k]->model->sp);
+    char sec[96];
+    lw_checkpoint_system_section(sec, sizeof sec, t, k);
+    if ((s = t->save(a->chains[k]->sys->state, &w, sec, err))) {
+      lw_ckpt_abort(&w);
+      return s;
+    }
   }
   if (bad) {
     lw_ckpt_abort(&w);
@@ -176,14 +206,14 @@ static lw_status get_rng(lw_ckpt *doc, const char *sec, gsl_rng *r, lw_error *er
   return LW_OK;
 }
 
-static lw_status get_chain(lw_ckpt *doc, int k, lw_chain *c, lw_error *err)
+static lw_status get_chain(lw_ckpt *doc, int k, const lw_system_type *t, lw_chain *c, lw_error *err)
 {
-  char sec[32], key[64];
+  char sec[32], key[96];
   const char *path = lw_ckpt_path(doc);
   rung_section(sec, sizeof sec, "chain", k);
   lw_status s = get_rng(doc, sec, c->rng, err);
-  for (int m = 0; m < LW_MOVE_KINDS && !s; m++) {
-    const char *name = lw_move_names[m];
+  for (int m = 0; m < c->n_moves && !s; m++) {
+    const char *name = t->move_names[m];
     unsigned long v[4] = {0, 0, 0, 0};
     snprintf(key, sizeof key, "step.%s", name);
     /* tuning keeps steps in [1e-300, step_max] (mc.c) */
@@ -244,39 +274,43 @@ lw_status lw_checkpoint_check_finite(const lw_scene *sc, const lw_splines *sp, c
       if (!part_finite(sc, sp, i, (long)m))
         return lw_error_set(err, LW_EINPUT, "%s: spline %zu segment %zu (nodes %zu and %zu): the %s energy is not "
                             "finite (outside the boundary, or coordinates too large)", path, i, m, m, m + 1,
-                            lw_term_types[bad].name);
+                            lw_term_names[bad]);
     return lw_error_set(err, LW_EINPUT, "%s: spline %zu: the %s energy is not finite", path, i,
-                        lw_term_types[bad].name);
+                        lw_term_names[bad]);
   }
   return lw_error_set(err, LW_EINPUT, "%s: the %s energy of this state is not finite (curves that coincide?)", path,
-                      lw_term_types[bad].name);
+                      lw_term_names[bad]);
 }
 
 /* The running totals carry the rounding of the moves so far; restoring them
 ** (rather than the fresh sums) keeps the trace identical to an uninterrupted
-** run.  They must still agree with the fresh sums to rounding, which also
-** makes a non-finite state or an edited total an error. */
-static lw_status get_energy(lw_ckpt *doc, int k, const lw_scene *sc, lw_model *m, lw_error *err)
+** run.  They must still agree with the fresh sums (the row's load computed
+** them, and refused a state whose energies are not finite) to rounding,
+** which also makes an edited total an error. */
+static lw_status get_energy(lw_ckpt *doc, int k, const lw_system_type *t, lw_system *sys, lw_error *err)
 {
-  char sec[32], key[64];
+  char sec[32], key[96];
   rung_section(sec, sizeof sec, "chain", k);
-  double fresh[LW_TERM_COUNT], scale = 1.0;
-  memcpy(fresh, m->term, sizeof fresh);
-  for (int t = 0; t < LW_TERM_COUNT; t++) scale += fabs(fresh[t]);
-  char where[LW_PATH_MAX + 64];
-  snprintf(where, sizeof where, "%s: [system splines%s%.0d]", lw_ckpt_path(doc), k ? " " : "", k);
-  lw_status s = lw_checkpoint_check_finite(sc, m->sp, fresh, where, err);
-  if (s) return s;
-  for (int t = 0; t < LW_TERM_COUNT; t++) {
-    const char *name = lw_term_types[t].name;
+  double fresh[LW_SYSTEM_TERMS_MAX], run[LW_SYSTEM_TERMS_MAX], scale = 1.0;
+  t->terms(sys->state, fresh);
+  for (int q = 0; q < t->n_terms; q++) {
+    if (!isfinite(fresh[q]))
+      return lw_error_set(err, LW_EINPUT, "%s: [system %s%s%.0d]: the %s energy of this state is not finite",
+                          lw_ckpt_path(doc), t->name, k ? " " : "", k, t->term_names[q]);
+    scale += fabs(fresh[q]);
+  }
+  lw_status s;
+  for (int q = 0; q < t->n_terms; q++) {
+    const char *name = t->term_names[q];
     double v = 0.0; /* a term the writer did not know was off */
     snprintf(key, sizeof key, "energy.%s", name);
     if ((s = lw_ckpt_numbers(doc, sec, key, &v, 1, -DBL_MAX, DBL_MAX, 0, err))) return s;
-    if (!(fabs(v - fresh[t]) <= 1e-6 * scale))
+    if (!(fabs(v - fresh[q]) <= 1e-6 * scale))
       return lw_error_set(err, LW_EINPUT, "%s: [%s] %s: %.17g, but the state is at %.17g (the file was changed "
-                          "or damaged)", lw_ckpt_path(doc), sec, key, v, fresh[t]);
-    m->term[t] = v;
+                          "or damaged)", lw_ckpt_path(doc), sec, key, v, fresh[q]);
+    run[q] = v;
   }
+  t->set_terms(sys->state, run);
   return LW_OK;
 }
 
@@ -328,10 +362,10 @@ static lw_status get_tempering(lw_ckpt *doc, lw_anneal *a, lw_error *err)
   if ((s = lw_ckpt_counts(doc, "tempering", "round_trips", &pt->round_trips, 1, 1, err)) ||
       (s = lw_ckpt_counts(doc, "tempering", "steps", &pt->steps, 1, 1, err)))
     return s;
-  /* models[] is by replica: rung k holds replica at[k] */
-  lw_model *by_rung[LW_TEMPERING_MAX];
-  for (int k = 0; k < n; k++) by_rung[k] = a->models[k];
-  for (int k = 0; k < n; k++) a->models[pt->at[k]] = by_rung[k];
+  /* systems[] is by replica: rung k holds replica at[k] */
+  lw_system *by_rung[LW_TEMPERING_MAX];
+  for (int k = 0; k < n; k++) by_rung[k] = a->systems[k];
+  for (int k = 0; k < n; k++) a->systems[pt->at[k]] = by_rung[k];
   return LW_OK;
 }
 
@@ -339,8 +373,9 @@ lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, l
 {
   const char *path = lw_ckpt_path(doc);
   lw_status s = LW_OK;
+  const lw_system_type *t = a->sys_type;
   for (int k = 0; k < a->n_rep && !s; k++)
-    if (!(s = get_chain(doc, k, a->chains[k], err))) s = get_energy(doc, k, &a->scene, a->chains[k]->model, err);
+    if (!(s = get_chain(doc, k, t, a->chains[k], err))) s = get_energy(doc, k, t, a->chains[k]->sys, err);
   if (s) return s;
   double v[3];
   unsigned long u[3];
@@ -365,14 +400,15 @@ lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, l
 #undef NUMS
   if ((s = lw_ckpt_whole(doc, "run", "trace_bytes", &tb, 0, (long)COUNT_MAX, 0, err))) return s;
   *trace_bytes = tb;
-  for (int m = 0; m < LW_MOVE_KINDS; m++) {
-    char key[64];
-    snprintf(key, sizeof key, "trace_mark.%s", lw_move_names[m]);
+  for (int m = 0; m < a->chain->n_moves; m++) {
+    char key[96];
+    snprintf(key, sizeof key, "trace_mark.%s", t->move_names[m]);
     u[0] = u[1] = u[2] = 0;
     if ((s = lw_ckpt_counts(doc, "run", key, u, 3, 0, err))) return s;
     const lw_move_stats *st = &a->chain->stats[m];
     if (u[0] > st->proposed || u[1] > st->accepted || u[2] > st->nan)
-      return lw_error_set(err, LW_EINPUT, "%s: [run] %s: beyond the chain's counts (moves.%s)", path, key, lw_move_names[m]);
+      return lw_error_set(err, LW_EINPUT, "%s: [run] %s: beyond the chain's counts (moves.%s)", path, key,
+                          t->move_names[m]);
     a->trace_mark[m] = (lw_move_stats){.proposed = u[0], .accepted = u[1], .nan = u[2]};
   }
   if (a->pt && (s = get_tempering(doc, a, err))) return s;
@@ -475,7 +511,7 @@ static void upgrade_energy(upgrade *u, const char *sec, const char *value, int l
   if (lw_number_list(value, 0, tmp, LW_TERM_COUNT + 1) == LW_TERM_COUNT - 1) n = LW_TERM_COUNT - 1;
   if (!words(u, "energy", line, value, n, w)) return;
   const char *names[LW_TERM_COUNT];
-  for (int t = 0; t < LW_TERM_COUNT; t++) names[t] = lw_term_types[t].name;
+  for (int t = 0; t < LW_TERM_COUNT; t++) names[t] = lw_term_names[t];
   add_grouped(u, sec, "energy", w, n, 1, names, line);
   for (int i = 0; i < n; i++) free(w[i]);
 }

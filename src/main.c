@@ -4,6 +4,7 @@
 ** stderr and an exit status: 2 for bad usage or input, 1 for failures while
 ** running.
 */
+#include <math.h>
 #include <omp.h>
 #include <signal.h>
 #include <stdio.h>
@@ -12,13 +13,10 @@
 #include <unistd.h>
 
 #include "linewise/anneal.h"
-#include "linewise/checkpoint.h"
-
-#include "linewise/model.h"
 #include "linewise/number.h"
 #include "linewise/params.h"
-#include "linewise/scene.h"
 #include "linewise/state.h"
+#include "linewise/system.h"
 
 static const char usage[] =
   "usage: linewise <command> [options]\n"
@@ -50,22 +48,16 @@ static int fail(const lw_error *err)
   return lw_error_exit_status(err->code);
 }
 
-/* Loads DIR/state.lw and the scene it names (relative to DIR). */
-static lw_status load_run_dir(const char *dir, lw_params *p, lw_scene *sc, lw_state *st, lw_error *err)
+/* Loads DIR/state.lw (its path into path) and the scene it names (relative
+** to DIR). */
+static lw_status load_run_dir(const char *dir, lw_params *p, lw_state *st, char *path, size_t n, lw_error *err)
 {
-  char path[LW_PATH_MAX + 32], scene_path[2 * LW_PATH_MAX + 2];
-  lw_path_join(path, sizeof path, dir, "state.lw");
+  char scene_path[2 * LW_PATH_MAX + 2];
+  lw_path_join(path, n, dir, "state.lw");
   lw_status s = lw_state_read(st, path, err);
   if (s) return s;
   lw_path_join(scene_path, sizeof scene_path, dir, st->scene);
-  if ((s = lw_params_read(p, scene_path, err)) || (s = lw_scene_init(sc, p, err))) {
-    lw_state_clear(st);
-    return s;
-  }
-  if ((s = lw_model_check_regular(sc, st->sp, path, err))) {
-    lw_state_clear(st);
-    lw_scene_clear(sc);
-  }
+  if ((s = lw_params_read(p, scene_path, err))) lw_state_clear(st);
   return s;
 }
 
@@ -78,22 +70,24 @@ static int cmd_energy(int argc, char **argv)
     return fail(&err);
   }
   static lw_params p;
-  lw_scene sc;
   lw_state st;
-  if (load_run_dir(argv[0], &p, &sc, &st, &err)) return fail(&err);
-  double term[LW_TERM_COUNT];
-  double total = lw_energy_compute(&sc, st.sp, term, &err);
-  int rc = 0;
   char path[LW_PATH_MAX + 32];
-  lw_path_join(path, sizeof path, argv[0], "state.lw");
-  if (err.code || lw_checkpoint_check_finite(&sc, st.sp, term, path, &err)) rc = fail(&err);
+  if (load_run_dir(argv[0], &p, &st, path, sizeof path, &err)) return fail(&err);
+  const lw_system_type *t = lw_system_of(&p, &err);
+  void *setup = t ? t->setup_new(&p, &err) : NULL;
+  int rc = 0;
+  double term[LW_SYSTEM_TERMS_MAX];
+  /* the row refuses a state it cannot place and names a term that is not
+  ** finite (for splines: the spline and segment) */
+  double total = setup ? t->energy(setup, &st, path, term, &err) : NAN;
+  if (err.code) rc = fail(&err);
   else {
-    for (int t = 0; t < LW_TERM_COUNT; t++)
-      if (sc.on[t]) printf("%s %.17g\n", lw_term_types[t].name, term[t]);
+    for (int k = 0; k < t->n_terms; k++)
+      if (t->term_on(setup, k)) printf("%s %.17g\n", t->term_names[k], term[k]);
     printf("total %.17g\n", total);
   }
+  if (setup) t->setup_free(setup);
   lw_state_clear(&st);
-  lw_scene_clear(&sc);
   return rc;
 }
 
@@ -126,12 +120,12 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
     int width = 24, fill = total > 0 ? (int)(width * done / total) : width;
     fprintf(stderr, "\r[%.*s%*s] sweep %ld/%ld  T %.4g  E %.6g  acc %.3f  left %.0fs ", fill,
             "########################", width - fill, "", a->sweep, a->end_sweep, lw_anneal_temperature(a),
-            lw_model_total(a->model), lw_anneal_acceptance(a), left);
+            lw_anneal_energy(a), lw_anneal_acceptance(a), left);
     if (final) fputc('\n', stderr);
   } else if ((final && a->sweep != pg->last_plain) || a->sweep >= pg->next_plain) {
     pg->last_plain = a->sweep;
     fprintf(stderr, "sweep %ld/%ld T %.6g E %.10g acc %.4f elapsed %.1fs left %.1fs\n", a->sweep, a->end_sweep,
-            lw_anneal_temperature(a), lw_model_total(a->model), lw_anneal_acceptance(a), t, left);
+            lw_anneal_temperature(a), lw_anneal_energy(a), lw_anneal_acceptance(a), t, left);
     while (pg->next_plain <= a->sweep) pg->next_plain += total / 10 > 0 ? total / 10 : 1;
   }
 }
@@ -158,13 +152,10 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, lw_error *err)
   }
   if (lw_anneal_finish(a, err)) return fail(err);
   if (!quiet) {
-    const lw_drawing_report *d = &a->drawing;
-    fprintf(stderr, "linewise: %zu paths; pen-up travel %.1f mm in index order, %.1f mm as plotted\n", d->paths,
-            d->travel_before, d->travel_after);
-    if (d->has_fidelity)
-      fprintf(stderr, "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f\n", d->fidelity.sigma_mm, d->fidelity.mse,
-              d->fidelity.ssim);
-    fprintf(stderr, "linewise: done: %s/final.svg, final.png, summary.json, trace.csv, state.lw\n", a->dir);
+    char drawn[512];
+    a->sys_type->describe(a->sys->state, LW_DESCRIBE_DRAWING, drawn, sizeof drawn);
+    fprintf(stderr, "%s", drawn);
+    fprintf(stderr, "linewise: done: %s/%s, summary.json, trace.csv, state.lw\n", a->dir, a->sys_type->files);
   }
   return 0;
 }
@@ -277,9 +268,11 @@ static int cmd_run(int argc, char **argv)
     return fail(&err);
   }
   if (!quiet) {
-    if (a.scene.note[0]) fprintf(stderr, "linewise: note: %s\n", a.scene.note);
-    fprintf(stderr, "linewise: scene %s, seed %lu, %zu splines, %zu segments, into %s\n", scene, a.seed,
-            a.model->sp->n_splines, a.model->sp->n_segments, dir);
+    const char *note = a.sys_type->note(a.setup);
+    char size[128];
+    a.sys_type->describe(a.sys->state, LW_DESCRIBE_SIZE, size, sizeof size);
+    if (note[0]) fprintf(stderr, "linewise: note: %s\n", note);
+    fprintf(stderr, "linewise: scene %s, seed %lu, %s, into %s\n", scene, a.seed, size, dir);
     fprintf(stderr, "linewise: resolved parameters:\n");
     lw_params_write(&a.params, stderr);
   }

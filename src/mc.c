@@ -3,42 +3,37 @@
 */
 #include "linewise/mc.h"
 
-#include <gsl/gsl_math.h>
-#include <gsl/gsl_randist.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-const char *const lw_move_names[LW_MOVE_KINDS] = {"point", "vector", "translate", "rotate"};
-
-lw_chain *lw_chain_new(lw_model *m, const double weight[LW_MOVE_KINDS], const double step[LW_MOVE_KINDS],
-                       const double target[LW_MOVE_KINDS], unsigned long seed, lw_error *err)
+lw_chain *lw_chain_new(lw_system *sys, const double *weight, const double *step, const double *target,
+                       unsigned long seed, lw_error *err)
 {
+  const lw_system_type *t = sys->type;
   double sum = 0.0;
-  for (int k = 0; k < LW_MOVE_KINDS; k++) sum += weight[k];
+  for (int k = 0; k < t->n_moves; k++) sum += weight[k];
   if (!(sum > 0)) {
     lw_error_set(err, LW_EINPUT, "[moves]: every move weight is 0; at least one must be > 0");
     return NULL;
   }
   lw_chain *c = calloc(1, sizeof *c);
   if (!c) goto nomem;
-  c->model = m;
-  c->prop = lw_proposal_new(m, err);
+  c->sys = sys;
+  c->n_moves = t->n_moves;
+  c->prop = t->proposal_new(sys->state, err);
   c->rng = gsl_rng_alloc(gsl_rng_mt19937);
   if (!c->prop || !c->rng) goto nomem;
   gsl_rng_set(c->rng, seed);
   double acc = 0.0;
-  /* Steps are capped at the page size: beyond that a Gaussian step only
-  ** throws nodes off the page. */
-  double page = fmax(m->scene->width, m->scene->height);
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+  for (int k = 0; k < t->n_moves; k++) {
     acc += weight[k] / sum;
     c->cum_weight[k] = acc;
     c->step[k] = step[k];
     c->target[k] = target[k];
-    c->step_max[k] = k == LW_MOVE_ROTATE ? M_PI : page;
+    c->step_max[k] = t->step_max(sys->state, k);
   }
-  c->cum_weight[LW_MOVE_KINDS - 1] = 1.0;
+  c->cum_weight[t->n_moves - 1] = 1.0;
   return c;
 nomem:
   lw_chain_free(c);
@@ -49,24 +44,12 @@ nomem:
 void lw_chain_free(lw_chain *c)
 {
   if (!c) return;
-  lw_proposal_free(c->prop);
+  if (c->prop) c->sys->type->proposal_free(c->prop);
   if (c->rng) gsl_rng_free(c->rng);
   free(c);
 }
 
-/* Spline that owns global node k (binary search over first[]). */
-static uint32_t spline_of_node(const lw_splines *sp, size_t k)
-{
-  size_t lo = 0, hi = sp->n_splines;
-  while (hi - lo > 1) {
-    size_t mid = (lo + hi) / 2;
-    if (sp->first[mid] <= k) lo = mid;
-    else hi = mid;
-  }
-  return (uint32_t)lo;
-}
-
-static void tune(lw_chain *c, lw_move_kind kind, int accepted)
+static void tune(lw_chain *c, int kind, int accepted)
 {
   c->win_prop[kind]++;
   c->win_acc[kind] += (unsigned long)accepted;
@@ -81,66 +64,20 @@ static void tune(lw_chain *c, lw_move_kind kind, int accepted)
   c->win_prop[kind] = c->win_acc[kind] = 0;
 }
 
-int lw_chain_step(lw_chain *c, lw_move_kind kind)
+int lw_chain_step(lw_chain *c, int kind)
 {
-  lw_model *m = c->model;
-  const lw_splines *sp = m->sp;
-  if (sp->n_nodes == 0) return 0;
-  uint32_t i;
-  size_t node0, n_node;
-  lw_node *nd = c->prop->node; /* proposals are built in place in the scratch */
-  const double st = c->step[kind];
-  if (kind == LW_MOVE_POINT || kind == LW_MOVE_VECTOR) {
-    size_t k = gsl_rng_uniform_int(c->rng, sp->n_nodes);
-    i = spline_of_node(sp, k);
-    node0 = k - sp->first[i];
-    n_node = 1;
-    nd[0] = sp->node[k];
-    double dx = gsl_ran_gaussian_ziggurat(c->rng, st), dy = gsl_ran_gaussian_ziggurat(c->rng, st);
-    if (kind == LW_MOVE_POINT) {
-      nd[0].px += dx;
-      nd[0].py += dy;
-    } else {
-      nd[0].vx += dx;
-      nd[0].vy += dy;
-    }
-  } else {
-    i = (uint32_t)gsl_rng_uniform_int(c->rng, sp->n_splines);
-    node0 = 0;
-    n_node = sp->first[i + 1] - sp->first[i];
-    const lw_node *src = &sp->node[sp->first[i]];
-    if (kind == LW_MOVE_TRANSLATE) {
-      double dx = gsl_ran_gaussian_ziggurat(c->rng, st), dy = gsl_ran_gaussian_ziggurat(c->rng, st);
-      for (size_t k = 0; k < n_node; k++) {
-        nd[k] = src[k];
-        nd[k].px += dx;
-        nd[k].py += dy;
-      }
-    } else {
-      double a = gsl_ran_gaussian_ziggurat(c->rng, st), ca = cos(a), sa = sin(a);
-      double cx = 0.0, cy = 0.0;
-      for (size_t k = 0; k < n_node; k++) {
-        cx += src[k].px;
-        cy += src[k].py;
-      }
-      cx /= (double)n_node;
-      cy /= (double)n_node;
-      for (size_t k = 0; k < n_node; k++) {
-        double x = src[k].px - cx, y = src[k].py - cy;
-        nd[k] = (lw_node){cx + ca * x - sa * y, cy + sa * x + ca * y,
-                          ca * src[k].vx - sa * src[k].vy, sa * src[k].vx + ca * src[k].vy};
-      }
-    }
-  }
-  lw_model_propose(m, c->prop, i, node0, n_node, NULL);
-  double dE = c->prop->dE;
+  const lw_system_type *t = c->sys->type;
+  void *state = c->sys->state;
+  if (t->sweep_size(state) == 0) return 0;
+  int forbidden = 0;
+  double dE = t->propose(state, c->prop, kind, c->step[kind], c->rng, &forbidden);
   int accept;
   lw_move_stats *s = &c->stats[kind];
   s->proposed++;
   if (isnan(dE)) {
     s->nan++;
     accept = 0;
-  } else if (c->prop->irregular) {
+  } else if (forbidden) {
     s->irregular++;
     accept = 0;
   } else if (dE <= 0.0) {
@@ -153,7 +90,7 @@ int lw_chain_step(lw_chain *c, lw_move_kind kind)
     accept = 0;
   }
   if (accept) {
-    if (lw_model_commit(m, c->prop) != LW_OK) accept = -1;
+    if (t->commit(state, c->prop) != LW_OK) accept = -1;
     else s->accepted++;
   }
   if (c->tuning && accept >= 0) tune(c, kind, accept);
@@ -162,12 +99,12 @@ int lw_chain_step(lw_chain *c, lw_move_kind kind)
 
 lw_status lw_chain_sweep(lw_chain *c)
 {
-  size_t n = c->model->sp->n_nodes;
+  size_t n = c->sys->type->sweep_size(c->sys->state);
   for (size_t k = 0; k < n; k++) {
     double u = gsl_rng_uniform(c->rng);
     int kind = 0;
-    while (kind < LW_MOVE_KINDS - 1 && u >= c->cum_weight[kind]) kind++;
-    if (lw_chain_step(c, (lw_move_kind)kind) < 0) return LW_ENOMEM;
+    while (kind < c->n_moves - 1 && u >= c->cum_weight[kind]) kind++;
+    if (lw_chain_step(c, kind) < 0) return LW_ENOMEM;
   }
   return LW_OK;
 }

@@ -17,21 +17,22 @@ int lw_segment_allowed(const lw_scene *sc, const lw_node *a, const lw_node *b, d
   return lw_segment_check(a, b, sc->min_speed * length, sc->regularity);
 }
 
-/* Samples one segment and evaluates its length, its local terms and (if ps is
-** not NULL) its pair samples, at the pair term's own nodes when it has them.
-** Returns 1 if the segment is regular (lw_segment_allowed), 0 if forbidden. */
-static int segment_eval(const lw_scene *sc, const lw_node *a, const lw_node *b, lw_samples *s, double *len,
-                        double *local, lw_pair_sample *ps)
+/* Samples one segment and evaluates its length, its segment terms (contexts
+** ctx) and (if ps is not NULL) its pair samples, at the pairwise term's own
+** nodes pq when they differ.  Returns 1 if the segment is regular
+** (lw_segment_allowed), 0 if forbidden. */
+static int segment_eval(const lw_scene *sc, const lw_term_ctx *ctx, const lw_node *a, const lw_node *b,
+                        lw_samples *s, double *len, double *local, const lw_quad *pq, lw_pair_sample *ps)
 {
   lw_segment_sample(&sc->quad, a, b, s);
   *len = s->length;
   const int regular = lw_segment_allowed(sc, a, b, s->length);
-  for (int t = 0; t < sc->n_local; t++) local[t] = lw_term_types[sc->local[t]].segment(s, sc);
+  for (int t = 0; t < sc->n_local; t++) local[t] = lw_term_types[sc->local[t]].segment(s, &ctx[sc->local[t]]);
   if (!ps) return regular;
   lw_samples pair_s;
   const lw_samples *ss = s;
-  if (sc->pair_quad.n != sc->quad.n) {
-    lw_segment_sample(&sc->pair_quad, a, b, &pair_s);
+  if (pq->n != sc->quad.n) {
+    lw_segment_sample(pq, a, b, &pair_s);
     ss = &pair_s;
   }
   for (int q = 0; q < ss->n; q++)
@@ -180,21 +181,35 @@ static lw_status pair_all(const pair_view *v, double *e)
   return st;
 }
 
-static lw_cellgrid *grid_for(const lw_scene *sc, size_t n_samples, lw_error *err)
+static void term_set_init(lw_term_set *ts, const lw_scene *sc)
 {
-  return lw_cellgrid_new(0.0, 0.0, sc->width, sc->height, sc->pair.cutoff, n_samples, err);
+  lw_scene_term_ctx(sc, ts->ctx);
+  ts->n_spline = 0;
+  ts->pair = -1;
+  for (int t = 0; t < LW_TERM_COUNT; t++) {
+    if (ts->ctx[t].coef == 0.0) continue;
+    if (lw_term_types[t].spline) ts->spline[ts->n_spline++] = (lw_term_id)t;
+    if (lw_term_types[t].pairwise && ts->pair < 0) ts->pair = t;
+  }
 }
 
-static double strain_of_spline(const lw_scene *sc, const lw_splines *sp, const double *seg_len,
-                               size_t i, double spline_len)
+/* The pairwise term's kernel settings and sample nodes. */
+static const lw_pair_ctx *pair_ctx(const lw_term_ctx *c) { return c->data; }
+
+static lw_cellgrid *grid_for(const lw_scene *sc, const lw_term_ctx *pair, size_t n_samples, lw_error *err)
 {
-  double S = sc->coef[LW_TERM_STRAIN];
-  double L0 = sp->rest_length[i];
-  if (!sc->strain_per_segment) return S * lw_term_strain(spline_len, L0);
+  return lw_cellgrid_new(0.0, 0.0, sc->width, sc->height, pair_ctx(pair)->cutoff, n_samples, err);
+}
+
+/* Adds the spline terms of spline i (segment lengths seg_len, length L) to term[]. */
+static void spline_terms(const lw_term_set *ts, const lw_splines *sp, const double *seg_len, size_t i, double L,
+                         double *term)
+{
   size_t n = lw_splines_segments(sp, i), g0 = lw_segment_index(sp, i, 0);
-  double l0 = L0 / (double)n, e = 0.0;
-  for (size_t m = 0; m < n; m++) e += S * lw_term_strain(seg_len[g0 + m], l0);
-  return e;
+  for (int k = 0; k < ts->n_spline; k++) {
+    int t = ts->spline[k];
+    term[t] += ts->ctx[t].coef * lw_term_types[t].spline(seg_len + g0, n, L, sp->rest_length[i], &ts->ctx[t]);
+  }
 }
 
 lw_status lw_model_check_regular(const lw_scene *sc, const lw_splines *sp, const char *path, lw_error *err)
@@ -239,7 +254,10 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
                          lw_error *err)
 {
   for (int t = 0; t < LW_TERM_COUNT; t++) term[t] = 0.0;
-  const int np = sc->pair_quad.n;
+  lw_term_set ts;
+  term_set_init(&ts, sc);
+  const lw_term_ctx *pc = ts.pair >= 0 ? &ts.ctx[ts.pair] : NULL;
+  const int np = pc ? pc->quad->n : sc->quad.n;
   lw_samples s;
   double local[LW_TERM_COUNT];
   lw_pair_sample seg_ps[LW_QUAD_MAX];
@@ -247,27 +265,26 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
   size_t n = sp->n_segments * (size_t)np, irregular = 0;
   double *seg_len = malloc((sp->n_segments ? sp->n_segments : 1) * sizeof *seg_len);
   if (!seg_len) goto nomem;
-  if (sc->on[LW_TERM_PAIR]) {
-    if (!(grid = grid_for(sc, n, err))) goto fail;
-  }
+  if (pc && !(grid = grid_for(sc, pc, n, err))) goto fail;
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
-    irregular += !segment_eval(sc, a, a + 1, &s, &seg_len[g], local, grid ? seg_ps : NULL);
+    irregular += !segment_eval(sc, ts.ctx, a, a + 1, &s, &seg_len[g], local, pc ? pc->quad : NULL,
+                               grid ? seg_ps : NULL);
     for (int t = 0; t < sc->n_local; t++) term[sc->local[t]] += local[t];
     if (grid && store_samples(grid, g, np, seg_ps) != LW_OK) goto nomem;
   }
-  if (sc->on[LW_TERM_STRAIN])
+  if (ts.n_spline)
     for (size_t i = 0; i < sp->n_splines; i++) {
       double L = 0.0;
       size_t g0 = lw_segment_index(sp, i, 0), ns = lw_splines_segments(sp, i);
       for (size_t m = 0; m < ns; m++) L += seg_len[g0 + m];
-      term[LW_TERM_STRAIN] += strain_of_spline(sc, sp, seg_len, i, L);
+      spline_terms(&ts, sp, seg_len, i, L, term);
     }
   if (grid) {
-    pair_view v = {grid, sp, (uint32_t)np, &sc->pair};
+    pair_view v = {grid, sp, (uint32_t)np, pair_ctx(pc)};
     double e;
     if (pair_all(&v, &e) != LW_OK) goto nomem;
-    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * e;
+    term[ts.pair] = pc->coef * e;
   }
   free(seg_len);
   lw_cellgrid_free(grid);
@@ -281,6 +298,13 @@ fail:
   return NAN;
 }
 
+/* Pair samples a segment: the pairwise term's nodes (the quadrature's when
+** there is none, for sizes only). */
+static int pair_nodes(const lw_model *m)
+{
+  return m->terms.pair >= 0 ? m->terms.ctx[m->terms.pair].quad->n : m->scene->quad.n;
+}
+
 lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
 {
   lw_model *m = calloc(1, sizeof *m);
@@ -291,14 +315,15 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
   }
   m->scene = sc;
   m->sp = sp;
+  term_set_init(&m->terms, sc);
   size_t ns = sp->n_segments ? sp->n_segments : 1;
   m->seg_len = malloc(ns * sizeof *m->seg_len);
   m->seg_local = malloc(ns * (size_t)(sc->n_local ? sc->n_local : 1) * sizeof *m->seg_local);
   m->spline_len = malloc((sp->n_splines ? sp->n_splines : 1) * sizeof *m->spline_len);
   m->seg_irregular = calloc(ns, sizeof *m->seg_irregular);
   if (!m->seg_len || !m->seg_local || !m->spline_len || !m->seg_irregular) goto nomem;
-  if (sc->on[LW_TERM_PAIR]) {
-    size_t n = sp->n_segments * (size_t)sc->pair_quad.n;
+  if (m->terms.pair >= 0) {
+    size_t n = sp->n_segments * (size_t)pair_nodes(m);
     if (n >= UINT32_MAX) {
       lw_error_set(err, LW_EINPUT, "%zu pair samples of %zu splines exceed the grid's limit of 2^32 samples",
                    n, sp->n_splines);
@@ -308,7 +333,7 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
     m->near_cache = malloc(ns * sizeof *m->near_cache);
     m->near_valid = calloc(ns, sizeof *m->near_valid);
     if (!m->near_cache || !m->near_valid) goto nomem;
-    m->grid = grid_for(sc, n, err);
+    m->grid = grid_for(sc, &m->terms.ctx[m->terms.pair], n, err);
     if (!m->grid) {
       lw_model_free(m);
       return NULL;
@@ -347,7 +372,9 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
 {
   const lw_scene *sc = m->scene;
   const lw_splines *sp = m->sp;
-  const int np = sc->pair_quad.n, nl = sc->n_local;
+  const lw_term_set *ts = &m->terms;
+  const lw_term_ctx *pc = ts->pair >= 0 ? &ts->ctx[ts->pair] : NULL;
+  const int np = pair_nodes(m), nl = sc->n_local;
   double old_total = lw_model_total(m);
   double term[LW_TERM_COUNT] = {0};
   lw_samples s;
@@ -357,7 +384,7 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
     double *local = m->seg_local + g * (size_t)nl;
-    m->seg_irregular[g] = !segment_eval(sc, a, a + 1, &s, &m->seg_len[g], local,
+    m->seg_irregular[g] = !segment_eval(sc, ts->ctx, a, a + 1, &s, &m->seg_len[g], local, pc ? pc->quad : NULL,
                                         m->grid ? seg_ps : NULL);
     m->n_irregular += m->seg_irregular[g];
     for (int t = 0; t < nl; t++) term[sc->local[t]] += local[t];
@@ -368,15 +395,15 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
     double L = 0.0;
     for (size_t k = 0; k < n; k++) L += m->seg_len[g0 + k];
     m->spline_len[i] = L;
-    if (sc->on[LW_TERM_STRAIN]) term[LW_TERM_STRAIN] += strain_of_spline(sc, sp, m->seg_len, i, L);
+    spline_terms(ts, sp, m->seg_len, i, L, term);
   }
   if (m->grid) {
-    pair_view v = {m->grid, sp, (uint32_t)np, &sc->pair};
+    pair_view v = {m->grid, sp, (uint32_t)np, pair_ctx(pc)};
     double e;
     memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);
     lw_cellgrid_fit(m->grid);
     if (pair_all(&v, &e) != LW_OK) return LW_ENOMEM;
-    term[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * e;
+    term[ts->pair] = pc->coef * e;
   }
   for (int t = 0; t < LW_TERM_COUNT; t++) m->term[t] = term[t];
   double total = lw_model_total(m);
@@ -397,15 +424,16 @@ lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err)
     p->node = malloc((cap + 1) * sizeof *p->node);
     p->len = malloc(cap * sizeof *p->len);
     p->local = malloc(cap * (size_t)nl * sizeof *p->local);
-    size_t ns = cap * (size_t)m->scene->pair_quad.n;
+    size_t ns = cap * (size_t)pair_nodes(m);
     p->ps = malloc(ns * sizeof *p->ps);
     p->ps_old = malloc(ns * sizeof *p->ps_old);
     p->probe = malloc(2 * ns * sizeof *p->probe);
     p->near_new = malloc(cap * sizeof *p->near_new);
     p->seg_irregular = malloc(cap * sizeof *p->seg_irregular);
+    p->spline_seg_len = malloc(cap * sizeof *p->spline_seg_len);
   }
   if (!p || !p->node || !p->len || !p->local || !p->ps || !p->ps_old || !p->probe || !p->near_new ||
-      !p->seg_irregular) {
+      !p->seg_irregular || !p->spline_seg_len) {
     lw_proposal_free(p);
     lw_error_set(err, LW_ENOMEM, "out of memory for a proposal");
     return NULL;
@@ -427,6 +455,7 @@ void lw_proposal_free(lw_proposal *p)
   free(p->partners.idx);
   free(p->near_new);
   free(p->seg_irregular);
+  free(p->spline_seg_len);
   free(p);
 }
 
@@ -508,7 +537,9 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
 {
   const lw_scene *sc = m->scene;
   const lw_splines *sp = m->sp;
-  const int np = sc->pair_quad.n, nl = sc->n_local;
+  const lw_term_set *ts = &m->terms;
+  const lw_term_ctx *pc = ts->pair >= 0 ? &ts->ctx[ts->pair] : NULL;
+  const int np = pair_nodes(m), nl = sc->n_local;
   const size_t nseg = lw_splines_segments(sp, spline);
   const lw_node *base = &sp->node[sp->first[spline]];
   const size_t g0 = lw_segment_index(sp, spline, 0);
@@ -530,8 +561,9 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   for (size_t j = 0; j < p->n_seg; j++) {
     size_t m_loc = p->seg0 + j, g = g0 + m_loc;
     double *local = p->local + j * (size_t)nl;
-    p->seg_irregular[j] = !segment_eval(sc, proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1),
-                                        &s, &p->len[j], local, m->grid ? p->ps + j * (size_t)np : NULL);
+    p->seg_irregular[j] = !segment_eval(sc, ts->ctx, proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1),
+                                        &s, &p->len[j], local, pc ? pc->quad : NULL,
+                                        m->grid ? p->ps + j * (size_t)np : NULL);
     p->irregular |= p->seg_irregular[j];
     was_irregular |= m->seg_irregular[g];
     const double *old = m->seg_local + g * (size_t)nl;
@@ -545,16 +577,17 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   }
   p->new_spline_len = m->spline_len[spline] + dlen;
 
-  if (sc->on[LW_TERM_STRAIN]) {
-    double S = sc->coef[LW_TERM_STRAIN], L0 = sp->rest_length[spline];
-    if (!sc->strain_per_segment) {
-      p->dterm[LW_TERM_STRAIN] = S * (lw_term_strain(p->new_spline_len, L0) -
-                                      lw_term_strain(m->spline_len[spline], L0));
-    } else {
-      double l0 = L0 / (double)nseg;
-      for (size_t j = 0; j < p->n_seg; j++)
-        p->dterm[LW_TERM_STRAIN] += S * (lw_term_strain(p->len[j], l0) -
-                                         lw_term_strain(m->seg_len[g0 + p->seg0 + j], l0));
+  if (ts->n_spline) {
+    /* the spline's segment lengths after the move, against the cached ones */
+    const double *old_len = m->seg_len + g0, L0 = sp->rest_length[spline];
+    memcpy(p->spline_seg_len, old_len, nseg * sizeof *old_len);
+    memcpy(p->spline_seg_len + p->seg0, p->len, p->n_seg * sizeof *p->len);
+    for (int k = 0; k < ts->n_spline; k++) {
+      const int t = ts->spline[k];
+      const lw_term_ctx *c = &ts->ctx[t];
+      double (*fn)(const double *, size_t, double, double, const lw_term_ctx *) = lw_term_types[t].spline;
+      p->dterm[t] = c->coef * (fn(p->spline_seg_len, nseg, p->new_spline_len, L0, c) -
+                               fn(old_len, nseg, m->spline_len[spline], L0, c));
     }
   }
 
@@ -572,24 +605,23 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   p->pair_done = 0;
   if (m->grid) {
     /* the old samples, from the grid: the walk's old side and a failed commit's undo */
-    pair_view v = {m->grid, sp, (uint32_t)np, &sc->pair};
+    pair_view v = {m->grid, sp, (uint32_t)np, pair_ctx(pc)};
     size_t first = (g0 + p->seg0) * (size_t)np, n = p->n_seg * (size_t)np;
     for (size_t k = 0; k < n; k++) p->ps_old[k] = sample_at(&v, (uint32_t)(first + k));
   }
   if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
     double pe = pair_delta(m, p, base, g0);
     p->pair_done = !isnan(pe);
-    p->dterm[LW_TERM_PAIR] = sc->coef[LW_TERM_PAIR] * pe;
-    dE += p->dterm[LW_TERM_PAIR];
+    p->dterm[ts->pair] = pc->coef * pe;
+    dE += p->dterm[ts->pair];
   }
   p->dE = dE;
 }
 
 lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
 {
-  const lw_scene *sc = m->scene;
   lw_splines *sp = m->sp;
-  const int np = sc->pair_quad.n, nl = sc->n_local;
+  const int np = pair_nodes(m), nl = m->scene->n_local;
   const size_t g0 = lw_segment_index(sp, p->spline, 0);
   if (m->grid) {
     size_t first = (g0 + p->seg0) * (size_t)np, n = p->n_seg * (size_t)np;

@@ -167,6 +167,20 @@ static void list_local_terms(lw_scene *sc)
     if (sc->on[t] && lw_term_types[t].segment) sc->local[sc->n_local++] = (lw_term_id)t;
 }
 
+void lw_scene_term_ctx(const lw_scene *sc, lw_term_ctx ctx[LW_TERM_COUNT])
+{
+  for (int t = 0; t < LW_TERM_COUNT; t++) ctx[t] = (lw_term_ctx){.coef = sc->coef[t], .quad = &sc->quad};
+  ctx[LW_TERM_STRAIN].mode = sc->strain_per_segment;
+  ctx[LW_TERM_POTENTIAL].data = &sc->potential;
+  ctx[LW_TERM_FIELD].data = &sc->field;
+  ctx[LW_TERM_FIELD].mode = sc->field_axial;
+  ctx[LW_TERM_BOUNDARY].data = &sc->boundary;
+  ctx[LW_TERM_PAIR].data = &sc->pair;
+  ctx[LW_TERM_PAIR].quad = &sc->pair_quad;
+  ctx[LW_TERM_USER].data = sc->user_data;
+  ctx[LW_TERM_USER].fn = sc->user_fn;
+}
+
 lw_status lw_scene_set_user_term(lw_scene *sc, double coef, lw_user_term_fn fn, const void *data,
                                  lw_error *err)
 {

@@ -8,8 +8,6 @@
 #include <math.h>
 #include <string.h>
 
-#include "linewise/scene.h"
-
 double lw_term_strain(double length, double rest_length)
 {
   double x = length - rest_length;
@@ -77,43 +75,57 @@ double lw_term_parametrisation(const lw_samples *s, const lw_quad *q)
   return sum / l;
 }
 
-static double seg_bending(const lw_samples *s, const lw_scene *sc)
+static double seg_bending(const lw_samples *s, const lw_term_ctx *c)
 {
-  return sc->coef[LW_TERM_BENDING] * lw_term_bending(s, &sc->quad);
+  return c->coef * lw_term_bending(s, c->quad);
 }
 
-static double seg_potential(const lw_samples *s, const lw_scene *sc)
+static double seg_potential(const lw_samples *s, const lw_term_ctx *c)
 {
-  return sc->coef[LW_TERM_POTENTIAL] * lw_term_potential(s, &sc->quad, &sc->potential);
+  return c->coef * lw_term_potential(s, c->quad, c->data);
 }
 
-static double seg_field(const lw_samples *s, const lw_scene *sc)
+static double seg_field(const lw_samples *s, const lw_term_ctx *c)
 {
-  return sc->coef[LW_TERM_FIELD] * lw_term_field(s, &sc->quad, &sc->field, sc->field_axial);
+  return c->coef * lw_term_field(s, c->quad, c->data, c->mode);
 }
 
-static double seg_boundary(const lw_samples *s, const lw_scene *sc)
+static double seg_boundary(const lw_samples *s, const lw_term_ctx *c)
 {
-  return sc->coef[LW_TERM_BOUNDARY] * lw_term_boundary(s, &sc->quad, &sc->boundary);
+  return c->coef * lw_term_boundary(s, c->quad, c->data);
 }
 
-static double seg_user(const lw_samples *s, const lw_scene *sc)
+static double seg_user(const lw_samples *s, const lw_term_ctx *c)
 {
-  return sc->coef[LW_TERM_USER] * sc->user_fn(s, &sc->quad, sc->user_data);
+  return c->coef * c->fn(s, c->quad, c->data);
 }
 
-static double seg_param(const lw_samples *s, const lw_scene *sc)
+static double seg_param(const lw_samples *s, const lw_term_ctx *c)
 {
-  return sc->coef[LW_TERM_PARAM] * lw_term_parametrisation(s, &sc->quad);
+  return c->coef * lw_term_parametrisation(s, c->quad);
 }
+
+/* The whole spline's length against its rest length, or (mode 1) each
+** segment's against an equal share of it. */
+static double spline_strain(const double *seg_len, size_t n_seg, double length, double rest_length,
+                            const lw_term_ctx *c)
+{
+  if (!c->mode) return lw_term_strain(length, rest_length);
+  double l0 = rest_length / (double)n_seg, e = 0.0;
+  for (size_t m = 0; m < n_seg; m++) e += lw_term_strain(seg_len[m], l0);
+  return e;
+}
+
+const char *const lw_term_names[LW_TERM_COUNT] = {"strain", "bending", "potential", "field",
+                                                  "pair", "boundary", "user", "parametrisation"};
 
 const lw_term_type lw_term_types[LW_TERM_COUNT] = {
-  {LW_TERM_STRAIN, "strain", NULL},
-  {LW_TERM_BENDING, "bending", seg_bending},
-  {LW_TERM_POTENTIAL, "potential", seg_potential},
-  {LW_TERM_FIELD, "field", seg_field},
-  {LW_TERM_PAIR, "pair", NULL},
-  {LW_TERM_BOUNDARY, "boundary", seg_boundary},
-  {LW_TERM_USER, "user", seg_user},
-  {LW_TERM_PARAM, "parametrisation", seg_param},
+  {LW_TERM_STRAIN, .spline = spline_strain},
+  {LW_TERM_BENDING, .segment = seg_bending},
+  {LW_TERM_POTENTIAL, .segment = seg_potential},
+  {LW_TERM_FIELD, .segment = seg_field},
+  {LW_TERM_PAIR, .pairwise = 1},
+  {LW_TERM_BOUNDARY, .segment = seg_boundary},
+  {LW_TERM_USER, .segment = seg_user},
+  {LW_TERM_PARAM, .segment = seg_param},
 };

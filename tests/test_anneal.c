@@ -50,7 +50,7 @@ Test(anneal, incremental_energy_matches_recomputation_after_a_million_proposals)
   lw_model *m = lw_model_new(&sc, sp, &err);
   double w[LW_MOVE_KINDS] = {0.4, 0.4, 0.1, 0.1}, st[LW_MOVE_KINDS] = {0.3, 0.3, 0.3, 0.05},
          tg[LW_MOVE_KINDS] = {0.44, 0.44, 0.3, 0.3};
-  lw_chain *c = lw_chain_new(m, w, st, tg, 77, &err);
+  lw_chain *c = model_chain(m, w, st, tg, 77, &err);
   c->temperature = 0.05;
   unsigned long acc = 0;
   const long N = 1000000;
@@ -58,17 +58,17 @@ Test(anneal, incremental_energy_matches_recomputation_after_a_million_proposals)
     double u = gsl_rng_uniform(c->rng);
     int kind = 0;
     while (kind < LW_MOVE_KINDS - 1 && u >= c->cum_weight[kind]) kind++;
-    acc += lw_chain_step(c, (lw_move_kind)kind) == 1;
+    acc += lw_chain_step(c, kind) == 1;
   }
   double term[LW_TERM_COUNT];
   double full = lw_energy_compute(&sc, m->sp, term, NULL);
   for (int t = 0; t < LW_TERM_COUNT; t++)
     cr_assert(fabs(m->term[t] - term[t]) <= 1e-9 * fmax(fabs(full), 1e-12),
-              "%s: running %.17g, recomputed %.17g", lw_term_types[t].name, m->term[t], term[t]);
+              "%s: running %.17g, recomputed %.17g", lw_term_names[t], m->term[t], term[t]);
   cr_assert(fabs(lw_model_total(m) - full) <= 1e-9 * fabs(full));
   cr_assert(acc > N / 10 && acc < 9 * N / 10, "acceptance %lu of %ld is not a useful test", acc, N);
   cr_assert(lw_splines_finite(m->sp));
-  lw_chain_free(c);
+  model_chain_free(c);
   lw_model_free(m);
   lw_scene_clear(&sc);
   gsl_rng_free(r);
@@ -92,20 +92,20 @@ Test(anneal, pair_samples_at_their_own_nodes_keep_the_invariant)
   lw_model *m = lw_model_new(&sc, sp, &err);
   double w[LW_MOVE_KINDS] = {0.4, 0.4, 0.1, 0.1}, st[LW_MOVE_KINDS] = {0.3, 0.3, 0.3, 0.05},
          tg[LW_MOVE_KINDS] = {0.44, 0.44, 0.3, 0.3};
-  lw_chain *c = lw_chain_new(m, w, st, tg, 78, &err);
+  lw_chain *c = model_chain(m, w, st, tg, 78, &err);
   c->temperature = 0.05;
   for (int k = 0; k < 200; k++) lw_chain_sweep(c);
   double term[LW_TERM_COUNT], term8[LW_TERM_COUNT];
   double full = lw_energy_compute(&sc, m->sp, term, NULL);
   for (int t = 0; t < LW_TERM_COUNT; t++)
-    cr_assert(fabs(m->term[t] - term[t]) <= 1e-9 * fmax(fabs(full), 1e-12), "%s", lw_term_types[t].name);
+    cr_assert(fabs(m->term[t] - term[t]) <= 1e-9 * fmax(fabs(full), 1e-12), "%s", lw_term_names[t]);
   p.pair_quadrature = 0;
   cr_assert_eq(lw_scene_init(&sc8, &p, &err), LW_OK);
   lw_energy_compute(&sc8, m->sp, term8, NULL);
   cr_assert(term[LW_TERM_PAIR] > 0 && fabs(term8[LW_TERM_PAIR] / term[LW_TERM_PAIR] - 1) > 1e-4,
             "pair energy with 3 nodes %.17g equals the 8-node one %.17g", term[LW_TERM_PAIR], term8[LW_TERM_PAIR]);
   cr_assert_eq(term8[LW_TERM_BENDING], term[LW_TERM_BENDING]);
-  lw_chain_free(c);
+  model_chain_free(c);
   lw_model_free(m);
   lw_scene_clear(&sc);
   lw_scene_clear(&sc8);
@@ -121,7 +121,7 @@ Test(anneal, nan_proposals_are_rejected_and_counted)
   lw_splines *sp = lw_init_random(&sc, 5, 3, 4, r, NULL);
   lw_model *m = lw_model_new(&sc, sp, NULL);
   double w[LW_MOVE_KINDS] = {1, 1, 1, 1}, st[LW_MOVE_KINDS] = {NAN, NAN, NAN, NAN}, tg[LW_MOVE_KINDS] = {.4, .4, .4, .4};
-  lw_chain *c = lw_chain_new(m, w, st, tg, 3, NULL);
+  lw_chain *c = model_chain(m, w, st, tg, 3, NULL);
   c->temperature = 1;
   double before = lw_model_total(m);
   lw_splines *copy = lw_splines_clone(m->sp);
@@ -134,7 +134,7 @@ Test(anneal, nan_proposals_are_rejected_and_counted)
   cr_assert(!memcmp(copy->node, m->sp->node, copy->n_nodes * sizeof(lw_node)), "state changed");
   cr_assert_eq(lw_model_total(m), before);
   lw_splines_free(copy);
-  lw_chain_free(c);
+  model_chain_free(c);
   lw_model_free(m);
   lw_scene_clear(&sc);
   gsl_rng_free(r);
@@ -150,7 +150,7 @@ Test(anneal, steps_tune_toward_the_target_then_freeze)
   lw_splines *sp = lw_init_random(&sc, 20, 3, 4, r, NULL);
   lw_model *m = lw_model_new(&sc, sp, NULL);
   double w[LW_MOVE_KINDS] = {1, 0, 0, 0}, st[LW_MOVE_KINDS] = {5, 5, 5, 1}, tg[LW_MOVE_KINDS] = {.44, .44, .3, .3};
-  lw_chain *c = lw_chain_new(m, w, st, tg, 9, NULL);
+  lw_chain *c = model_chain(m, w, st, tg, 9, NULL);
   c->temperature = 0.02;
   c->tuning = 1;
   for (int s = 0; s < 200; s++) lw_chain_sweep(c);
@@ -165,7 +165,7 @@ Test(anneal, steps_tune_toward_the_target_then_freeze)
   /* The rate of a tuned step sits near 0.44; the band is wide because the
   ** energy landscape drifts as the scene cools into its minimum. */
   cr_assert(rate > 0.25 && rate < 0.65, "acceptance %.3f after tuning", rate);
-  lw_chain_free(c);
+  model_chain_free(c);
   lw_model_free(m);
   lw_scene_clear(&sc);
   gsl_rng_free(r);
@@ -180,7 +180,7 @@ Test(anneal, greedy_at_zero_temperature_never_raises_the_energy)
   lw_splines *sp = lw_init_random(&sc, 10, 3, 4, r, NULL);
   lw_model *m = lw_model_new(&sc, sp, NULL);
   double w[LW_MOVE_KINDS] = {1, 1, 1, 1}, st[LW_MOVE_KINDS] = {.5, .5, .5, .1}, tg[LW_MOVE_KINDS] = {.4, .4, .4, .4};
-  lw_chain *c = lw_chain_new(m, w, st, tg, 5, NULL);
+  lw_chain *c = model_chain(m, w, st, tg, 5, NULL);
   c->temperature = 0;
   double e = lw_model_total(m);
   for (int s = 0; s < 50; s++) {
@@ -189,7 +189,7 @@ Test(anneal, greedy_at_zero_temperature_never_raises_the_energy)
     cr_assert(e2 <= e + 1e-12 * fabs(e), "energy rose at T=0: %.17g -> %.17g", e, e2);
     e = e2;
   }
-  lw_chain_free(c);
+  model_chain_free(c);
   lw_model_free(m);
   lw_scene_clear(&sc);
   gsl_rng_free(r);

@@ -96,7 +96,7 @@ static void check_state(const lw_model *m, const char *what)
     cr_assert(!isnan(m->seg_len[g]), "%s: segment %zu length NaN", what, g);
     for (int t = 0; t < sc->n_local; t++)
       cr_assert(!isnan(m->seg_local[g * (size_t)sc->n_local + (size_t)t]), "%s: segment %zu cached %s NaN",
-                what, g, lw_term_types[sc->local[t]].name);
+                what, g, lw_term_names[sc->local[t]]);
   }
   double term[LW_TERM_COUNT];
   lw_error err;
@@ -106,14 +106,14 @@ static void check_state(const lw_model *m, const char *what)
   cr_assert(isinf(full) == isinf(lw_model_total(m)), "%s: running total %g, recomputed %g", what,
             lw_model_total(m), full);
   for (int t = 0; t < LW_TERM_COUNT; t++) {
-    cr_assert(!isnan(m->term[t]), "%s: running %s is NaN", what, lw_term_types[t].name);
+    cr_assert(!isnan(m->term[t]), "%s: running %s is NaN", what, lw_term_names[t]);
     if (isinf(term[t])) {
-      cr_assert_eq(m->term[t], term[t], "%s: %s is %g recomputed, %.17g running", what, lw_term_types[t].name,
+      cr_assert_eq(m->term[t], term[t], "%s: %s is %g recomputed, %.17g running", what, lw_term_names[t],
                    term[t], m->term[t]);
       continue;
     }
     cr_assert(fabs(m->term[t] - term[t]) <= 1e-9 * fmax(fabs(full), 1e-300), "%s: %s running %.17g, recomputed %.17g",
-              what, lw_term_types[t].name, m->term[t], term[t]);
+              what, lw_term_names[t], m->term[t], term[t]);
   }
 }
 
@@ -123,14 +123,14 @@ static lw_move_stats run(lw_model *m, double T, long n, const double step[LW_MOV
 {
   double w[LW_MOVE_KINDS] = {0.4, 0.4, 0.1, 0.1}, tg[LW_MOVE_KINDS] = {0.44, 0.44, 0.3, 0.3};
   lw_error err;
-  lw_chain *c = lw_chain_new(m, w, step, tg, seed, &err);
+  lw_chain *c = model_chain(m, w, step, tg, seed, &err);
   cr_assert_not_null(c, "%s", err.msg);
   c->temperature = T;
   for (long k = 0; k < n; k++) {
     double u = gsl_rng_uniform(c->rng);
     int kind = 0;
     while (kind < LW_MOVE_KINDS - 1 && u >= c->cum_weight[kind]) kind++;
-    cr_assert_geq(lw_chain_step(c, (lw_move_kind)kind), 0, "a commit failed");
+    cr_assert_geq(lw_chain_step(c, kind), 0, "a commit failed");
   }
   lw_move_stats s = {.proposed = 0};
   for (int k = 0; k < LW_MOVE_KINDS; k++) {
@@ -139,7 +139,7 @@ static lw_move_stats run(lw_model *m, double T, long n, const double step[LW_MOV
     s.nan += c->stats[k].nan;
     s.irregular += c->stats[k].irregular;
   }
-  lw_chain_free(c);
+  model_chain_free(c);
   return s;
 }
 
@@ -542,9 +542,9 @@ Test(hard, scene_without_splines)
   /* nothing to move: every proposal is a no-op that is not even counted */
   cr_assert_eq(s.proposed, 0);
   double w[LW_MOVE_KINDS] = {1, 1, 1, 1}, tg[LW_MOVE_KINDS] = {0.4, 0.4, 0.4, 0.4};
-  lw_chain *c = lw_chain_new(m, w, st, tg, 3, NULL);
+  lw_chain *c = model_chain(m, w, st, tg, 3, NULL);
   cr_assert_eq(lw_chain_sweep(c), LW_OK);
-  lw_chain_free(c);
+  model_chain_free(c);
   check_state(m, "no splines");
   done(m, &sc);
 }

@@ -195,7 +195,7 @@ Test(regular, an_irregular_proposal_is_forbidden_and_counted)
 
   /* the chain counts these rejections per move kind */
   double w[LW_MOVE_KINDS] = {0, 1, 0, 0}, st[LW_MOVE_KINDS] = {30, 30, 1, 0.1}, tg[LW_MOVE_KINDS] = {0.4, 0.4, 0.3, 0.3};
-  lw_chain *c = lw_chain_new(m, w, st, tg, 17, NULL);
+  lw_chain *c = model_chain(m, w, st, tg, 17, NULL);
   c->temperature = 1e9; /* everything finite is accepted: only the check refuses */
   for (int k = 0; k < 300; k++) lw_chain_step(c, LW_MOVE_VECTOR);
   const lw_move_stats *s = &c->stats[LW_MOVE_VECTOR];
@@ -203,7 +203,7 @@ Test(regular, an_irregular_proposal_is_forbidden_and_counted)
   cr_assert_eq(s->proposed - s->accepted, s->irregular + s->nan, "every rejection here is for irregularity");
   cr_assert_eq(c->stats[LW_MOVE_POINT].irregular, 0);
   cr_assert_eq(m->n_irregular, 0, "no accepted state is irregular");
-  lw_chain_free(c);
+  model_chain_free(c);
   lw_model_free(m);
   lw_scene_clear(&sc);
 }

@@ -94,7 +94,7 @@ static lw_chain *point_chain(lw_model *m, double step, unsigned long seed)
   double w[LW_MOVE_KINDS] = {1, 0, 0, 0}, st[LW_MOVE_KINDS] = {step, 1, 1, 0.1},
          tg[LW_MOVE_KINDS] = {0.44, 0.44, 0.3, 0.3};
   lw_error err;
-  lw_chain *c = lw_chain_new(m, w, st, tg, seed, &err);
+  lw_chain *c = model_chain(m, w, st, tg, seed, &err);
   cr_assert_not_null(c, "%s", err.msg);
   c->temperature = 1.0;
   return c;
@@ -169,7 +169,7 @@ Test(stats, point_move_acceptance_matches_the_gaussian_closed_forms)
                 "d=%d s/sigma=%.2f: acceptance %.5f, exact %.5f, standard error %.2g", d, ratios[r],
                 rate, a, se);
       cr_assert_eq(c->stats[LW_MOVE_POINT].nan, 0);
-      lw_chain_free(c);
+      model_chain_free(c);
       lw_model_free(m);
       lw_scene_clear(&sc);
     }
@@ -286,7 +286,7 @@ Test(stats, sampled_coordinates_follow_the_boltzmann_distribution)
   cr_assert(p_wrong_t < 1e-3, "the test cannot tell T from 1.1 T: p = %.3g", p_wrong_t);
   cr_assert(p_wrong_mu < 1e-3, "the test cannot see a 0.05 sd shift: p = %.3g", p_wrong_mu);
   free(x);
-  lw_chain_free(c);
+  model_chain_free(c);
   lw_model_free(m);
   lw_scene_clear(&sc);
 }
@@ -369,7 +369,7 @@ Test(stats, free_chain_matches_the_worm_like_chain)
   cr_assert_not_null(m, "%s", err.msg);
   double w[LW_MOVE_KINDS] = {1, 1, 0, 0}, st[LW_MOVE_KINDS] = {0.1, 0.1, 1, 0.1},
          tg[LW_MOVE_KINDS] = {0.44, 0.44, 0.3, 0.3};
-  lw_chain *c = lw_chain_new(m, w, st, tg, 31337, &err);
+  lw_chain *c = model_chain(m, w, st, tg, 31337, &err);
   c->temperature = T;
   c->tuning = 1;
   for (int k = 0; k < 200; k++) lw_chain_sweep(c);
@@ -438,7 +438,7 @@ Test(stats, free_chain_matches_the_worm_like_chain)
   free(cosl);
   free(r2);
   free(arc);
-  lw_chain_free(c);
+  model_chain_free(c);
   lw_model_free(m);
   lw_scene_clear(&sc);
 }

@@ -268,7 +268,7 @@ Test(terms, degenerate_input_never_gives_nan)
   sp->node[10].vy = -5;
   double term[LW_TERM_COUNT];
   double total = lw_energy_compute(&sc, sp, term, NULL);
-  for (int t = 0; t < LW_TERM_COUNT; t++) cr_assert(!isnan(term[t]), "term %s is NaN", lw_term_types[t].name);
+  for (int t = 0; t < LW_TERM_COUNT; t++) cr_assert(!isnan(term[t]), "term %s is NaN", lw_term_names[t]);
   cr_assert(!isnan(total));
   cr_assert(term[LW_TERM_BENDING] >= 0);
   lw_splines_free(sp);
@@ -313,7 +313,7 @@ Test(terms, local_energy_change_equals_full_recomputation_for_every_dof)
             double d = term1[t] - term0[t];
             cr_assert(fabs(pr->dterm[t] - d) <= 1e-9 * fmax(fabs(term0[t]), 1e-3),
                       "spline %u node %zu dof %d term %s: local %.17g full %.17g", i, k, which,
-                      lw_term_types[t].name, pr->dterm[t], d);
+                      lw_term_names[t], pr->dterm[t], d);
           }
           cr_assert(fabs(pr->dE - (e1 - e0)) <= 1e-9 * fmax(fabs(e0), 1));
           /* and a smooth energy: dE/h agrees between h and h/2 to first order */
@@ -421,4 +421,56 @@ Test(terms, user_term_is_summed_cached_and_differenced_like_the_others)
   cr_assert(!sc.on[LW_TERM_USER] && sc.n_local == 1 && sc.user_fn == NULL);
   lw_scene_clear(&sc);
   gsl_rng_free(r);
+}
+
+Test(terms, every_row_reads_its_own_context_only)
+{
+  /* The table has exactly one shape a row; a segment row's value is its
+  ** context's coefficient times the pure function of the context's object,
+  ** and a context changed after the scene filled it changes the value
+  ** (the row never looks at the scene). */
+  lw_params p = all_terms();
+  p.strain_mode = LW_STRAIN_SEGMENT;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  lw_term_ctx ctx[LW_TERM_COUNT];
+  lw_scene_term_ctx(&sc, ctx);
+  for (int t = 0; t < LW_TERM_COUNT; t++) {
+    const lw_term_type *row = &lw_term_types[t];
+    cr_assert_eq(row->id, t);
+    cr_assert_eq(!!row->segment + !!row->spline + !!row->pairwise, 1, "%s: one shape", lw_term_names[t]);
+    cr_assert_eq(ctx[t].coef, sc.coef[t], "%s", lw_term_names[t]);
+  }
+  cr_assert(ctx[LW_TERM_PAIR].data == &sc.pair && ctx[LW_TERM_PAIR].quad == &sc.pair_quad);
+  lw_splines *sp = splines(1, 2);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 5);
+  wiggly(sp, 0, r, 40, 45);
+  lw_samples s;
+  samples_of(&sc.quad, sp, 0, &s);
+  const double pure[LW_TERM_COUNT] = {
+      [LW_TERM_BENDING] = lw_term_bending(&s, &sc.quad),
+      [LW_TERM_POTENTIAL] = lw_term_potential(&s, &sc.quad, &sc.potential),
+      [LW_TERM_FIELD] = lw_term_field(&s, &sc.quad, &sc.field, sc.field_axial),
+      [LW_TERM_BOUNDARY] = lw_term_boundary(&s, &sc.quad, &sc.boundary),
+      [LW_TERM_PARAM] = lw_term_parametrisation(&s, &sc.quad),
+  };
+  for (int t = 0; t < LW_TERM_COUNT; t++) {
+    if (!lw_term_types[t].segment || t == LW_TERM_USER) continue;
+    lw_term_ctx c = ctx[t];
+    cr_assert_eq(lw_term_types[t].segment(&s, &c), c.coef * pure[t], "%s", lw_term_names[t]);
+    c.coef *= 3.0;
+    cr_assert_eq(lw_term_types[t].segment(&s, &c), c.coef * pure[t], "%s with its own coefficient", lw_term_names[t]);
+  }
+  /* strain, a spline row: the whole length, or (mode 1) each segment against its share */
+  const double len[2] = {7.0, 5.0};
+  lw_term_ctx c = ctx[LW_TERM_STRAIN];
+  cr_assert_eq(c.mode, 1);
+  cr_assert_eq(lw_term_types[LW_TERM_STRAIN].spline(len, 2, 12.0, 10.0, &c),
+               lw_term_strain(7.0, 5.0) + lw_term_strain(5.0, 5.0));
+  c.mode = 0;
+  cr_assert_eq(lw_term_types[LW_TERM_STRAIN].spline(len, 2, 12.0, 10.0, &c), lw_term_strain(12.0, 10.0));
+  gsl_rng_free(r);
+  lw_splines_free(sp);
+  lw_scene_clear(&sc);
 }

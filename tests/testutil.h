@@ -11,7 +11,29 @@
 #include <string.h>
 #include <sys/wait.h>
 
+#include "linewise/mc.h"
 #include "linewise/spline.h"
+#include "linewise/sys_splines.h"
+
+/* A chain on a view of model m (the test keeps the model) through the
+** spline system's row; model_chain_free frees the chain and the view. */
+static inline lw_chain *model_chain(lw_model *m, const double *w, const double *st, const double *tg,
+                                    unsigned long seed, lw_error *err)
+{
+  lw_system *sys = lw_splines_view(m, err);
+  if (!sys) return NULL;
+  lw_chain *c = lw_chain_new(sys, w, st, tg, seed, err);
+  if (!c) lw_system_free(sys);
+  return c;
+}
+
+static inline void model_chain_free(lw_chain *c)
+{
+  if (!c) return;
+  lw_system *sys = c->sys;
+  lw_chain_free(c);
+  lw_system_free(sys);
+}
 
 /* splitmix64: a fixed seed per test keeps failures reproducible while the
 ** values carry full 53-bit mantissas (no round test numbers). */

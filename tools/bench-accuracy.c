@@ -67,7 +67,7 @@ static void run_variants(bench_ctx *b, variant *v, int n, int acc_ref, int time_
     for (int k = 0; k < nt; k++) {
       size_t at = (size_t)i * nt + (size_t)k;
       dE[at] = bench_run_propose(&r[i], &t[k]);
-      part[at] = term >= 0 ? r[i].chain->prop->dterm[term] : dE[at];
+      part[at] = term >= 0 ? ((lw_proposal *)r[i].chain->prop)->dterm[term] : dE[at];
     }
   }
   const double *ref = part + (size_t)acc_ref * nt;

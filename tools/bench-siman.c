@@ -207,7 +207,7 @@ static long run_linewise(bench_run *r, double T0, double T1, double seconds, tra
       log_step += 0.5 * (log(c->step[LW_MOVE_POINT]) + log(c->step[LW_MOVE_VECTOR]));
       tuned++;
     }
-    for (int k = 0; k < 64; k++) lw_chain_step(c, (lw_move_kind)(k & 1));
+    for (int k = 0; k < 64; k++) lw_chain_step(c, k & 1);
     n += 64;
     trace_add(tr, lw_model_total(r->model), 0);
   }

@@ -100,7 +100,9 @@ void bench_run_init(bench_run *r, const lw_params *p, lw_splines *sp, double T, 
   if (!r->model) bench_die("model", &err);
   const double w[LW_MOVE_KINDS] = {0.5, 0.5, 0, 0}, st0[LW_MOVE_KINDS] = {0.2, 0.2, 0.2, 0.05},
                tg[LW_MOVE_KINDS] = {0.44, 0.44, 0.3, 0.3};
-  r->chain = lw_chain_new(r->model, w, step ? step : st0, tg, 2, &err);
+  r->sys = lw_splines_view(r->model, &err);
+  if (!r->sys) bench_die("system", &err);
+  r->chain = lw_chain_new(r->sys, w, step ? step : st0, tg, 2, &err);
   if (!r->chain) bench_die("chain", &err);
   r->chain->temperature = T;
   r->chain->tuning = 0;
@@ -109,6 +111,7 @@ void bench_run_init(bench_run *r, const lw_params *p, lw_splines *sp, double T, 
 void bench_run_free(bench_run *r)
 {
   lw_chain_free(r->chain);
+  lw_system_free(r->sys);
   lw_model_free(r->model);
   lw_scene_clear(&r->scene);
   memset(r, 0, sizeof *r);
@@ -117,7 +120,7 @@ void bench_run_free(bench_run *r)
 void bench_run_tune(bench_run *r, long proposals)
 {
   r->chain->tuning = 1;
-  for (long k = 0; k < proposals; k++) lw_chain_step(r->chain, (lw_move_kind)(k & 1));
+  for (long k = 0; k < proposals; k++) lw_chain_step(r->chain, k & 1);
   r->chain->tuning = 0;
 }
 
@@ -153,8 +156,9 @@ bench_trial *bench_trials_new(const lw_splines *sp, const double step[2], int n)
 
 double bench_run_propose(bench_run *r, const bench_trial *t)
 {
-  lw_model_propose(r->model, r->chain->prop, t->spline, t->node, 1, &t->nd);
-  return r->chain->prop->dE;
+  lw_proposal *prop = r->chain->prop;
+  lw_model_propose(r->model, prop, t->spline, t->node, 1, &t->nd);
+  return prop->dE;
 }
 
 double bench_run_block(bench_run *r, double seconds, const bench_trial *trials, int n_trials)
@@ -166,7 +170,7 @@ double bench_run_block(bench_run *r, double seconds, const bench_trial *trials, 
     if (trials)
       for (int k = 0; k < 64; k++) bench_run_propose(r, &trials[(n + k) % n_trials]);
     else
-      for (int k = 0; k < 64; k++) lw_chain_step(r->chain, (lw_move_kind)(k & 1));
+      for (int k = 0; k < 64; k++) lw_chain_step(r->chain, k & 1);
     n += 64;
     t = bench_now() - t0;
   } while (t < seconds);
@@ -221,10 +225,11 @@ const lw_splines *bench_annealed(bench_ctx *b)
   if (lw_anneal_finish(&a, &err)) bench_die("anneal", &err);
   b->ann_seconds = bench_now() - t0;
   for (int k = 0; k < LW_MOVE_KINDS; k++) b->ann_step[k] = a.chain->step[k];
-  b->ann_splines = lw_splines_clone(a.model->sp);
+  const lw_model *m = lw_splines_model(a.sys);
+  b->ann_splines = lw_splines_clone(m->sp);
   if (!b->ann_splines) bench_die("out of memory", NULL);
   double length = 0.0;
-  for (size_t i = 0; i < a.model->sp->n_splines; i++) length += a.model->spline_len[i];
+  for (size_t i = 0; i < m->sp->n_splines; i++) length += m->spline_len[i];
   b->ann_spacing = (p->width - 2 * p->margin) * (p->height - 2 * p->margin) / length;
   lw_anneal_free(&a);
   return b->ann_splines;

@@ -16,6 +16,7 @@
 #include <stdio.h>
 
 #include "linewise/mc.h"
+#include "linewise/sys_splines.h"
 #include "linewise/params.h"
 #include "linewise/scene.h"
 
@@ -77,6 +78,7 @@ void bench_random_params(lw_params *p, size_t n, int pair, double spacing);
 typedef struct {
   lw_scene scene;
   lw_model *model;
+  lw_system *sys;   /* a view of the model: the chain goes through the row */
   lw_chain *chain;
 } bench_run;
 

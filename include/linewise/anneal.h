@@ -4,9 +4,11 @@
 ** checkpoints and the files of a run directory.  init / sweep / finish, no
 ** callbacks: the caller owns the loop (and the progress display).
 **
-** Run directory: scene.ini (the resolved parameters), state.lw, trace.csv,
-** summary.json, final.svg, final.png (and as asked final.pdf and frames/,
-** drawing.h); with parallel tempering also
+** The run sees its system ([scene] system, system.h) only through the
+** system's row.  Run directory: scene.ini (the resolved parameters),
+** state.lw, trace.csv, summary.json, the system's drawings (for splines
+** final.svg, final.png and as asked final.pdf and frames/, drawing.h); with
+** parallel tempering also
 ** replica-K.lw, a copy of the replica at rung K >= 1 (state.lw holds every
 ** rung and the data of every rung's chain; checkpoint.h), and ladder.ini after ladder
 ** tuning.  The rungs sweep in parallel (OpenMP), each with its own stream;
@@ -22,20 +24,20 @@
 
 #include <stdio.h>
 
-#include "linewise/drawing.h"
 #include "linewise/mc.h"
 #include "linewise/params.h"
-#include "linewise/scene.h"
 #include "linewise/schedule.h"
+#include "linewise/system.h"
 #include "linewise/tempering.h"
 
 typedef struct {
   lw_params params;
-  lw_scene scene;
-  lw_model *model;             /* the replica at the coldest rung (= chains[0]->model) */
+  const lw_system_type *sys_type; /* [scene] system */
+  void *setup;                 /* its set-up of the scene, shared by the replicas (owned) */
+  lw_system *sys;              /* the replica at the coldest rung (= chains[0]->sys) */
   lw_chain *chain;             /* the coldest rung's chain (= chains[0]) */
   int n_rep;                   /* replicas: 1, or the rungs of parallel tempering */
-  lw_model **models;           /* by replica (owned) */
+  lw_system **systems;         /* by replica (owned) */
   lw_chain **chains;           /* by rung (owned): each has its stream, steps, statistics */
   lw_tempering *pt;            /* NULL without tempering */
   double t_sched;              /* the schedule's temperature of this step */
@@ -55,10 +57,8 @@ typedef struct {
   double wall_before;          /* seconds spent before a resume */
   unsigned long proposals_before; /* proposals made before a resume */
   double wall_start;           /* monotonic clock at start of this process */
-  lw_move_stats trace_mark[LW_MOVE_KINDS]; /* stats at the last trace row */
+  lw_move_stats trace_mark[LW_MOVES_MAX]; /* stats at the last trace row */
   FILE *trace;
-  lw_grid2d *tone;             /* the picture's tone on the page (fidelity, previews), or NULL */
-  lw_drawing_report drawing;   /* pen-up travel and fidelity of the final drawing */
 } lw_anneal;
 
 /* A new run of the scene file (with overrides already applied to p) into
@@ -79,13 +79,14 @@ static inline int lw_anneal_done(const lw_anneal *a) { return a->sweep >= a->end
 /* Writes state.lw now (a clean stop). */
 lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err);
 
-/* The final files: state.lw, the drawings (drawing.h), summary.json. */
+/* The final files: state.lw, the system's drawings, summary.json. */
 lw_status lw_anneal_finish(lw_anneal *a, lw_error *err);
 
 void lw_anneal_free(lw_anneal *a);
 
-/* Current temperature and overall acceptance (for progress displays). */
+/* Current temperature, energy and overall acceptance (for progress displays). */
 double lw_anneal_temperature(const lw_anneal *a);
+static inline double lw_anneal_energy(const lw_anneal *a) { return lw_system_total(a->sys); }
 double lw_anneal_acceptance(const lw_anneal *a);
 double lw_anneal_seconds(const lw_anneal *a);
 

@@ -1,33 +1,32 @@
 /*
-** mc.h -- one Metropolis chain: move kinds, acceptance, step tuning.
+** mc.h -- one Metropolis chain on a system (system.h): move kinds by the
+** row's names, acceptance, step tuning.
 **
-** A proposal perturbs one point p_k or one vector v_k by a Gaussian step in
-** x and y, or moves a whole spline rigidly (translation, or rotation about
-** the mean of its points, which the rotation leaves in place, so every
-** proposal is symmetric).  Accept if dE <= 0, else with probability
-** exp(-dE / T); a NaN dE is rejected and counted, +inf is rejected (and
-** counted apart when an irregular segment made it so).
+** The system draws a proposal of the chosen kind from the chain's stream
+** with the kind's step and evaluates dE; every proposal of every system is
+** symmetric (for splines: Gaussian steps of one point or vector, rigid
+** translations and rotations about the mean of a spline's points).  Accept
+** if dE <= 0, else with probability exp(-dE / T); a NaN dE is rejected and
+** counted, +inf is rejected (and counted apart when the system says a
+** forbidden state made it so).
 **
 ** Steps adapt toward a target acceptance only while `tuning` is set (the
 ** annealer sets it at the start of each temperature); otherwise they are
 ** frozen so the chain obeys detailed balance.
 **
-** A sweep is as many proposals as the scene has nodes.
+** A sweep is as many proposals as the row's sweep_size (for splines: the
+** scene's nodes).
 */
 #ifndef LINEWISE_MC_H
 #define LINEWISE_MC_H
 
 #include <gsl/gsl_rng.h>
 
-#include "linewise/model.h"
-
-typedef enum { LW_MOVE_POINT, LW_MOVE_VECTOR, LW_MOVE_TRANSLATE, LW_MOVE_ROTATE, LW_MOVE_KINDS } lw_move_kind;
-
-extern const char *const lw_move_names[LW_MOVE_KINDS];
+#include "linewise/system.h"
 
 typedef struct {
   unsigned long proposed, accepted, nan; /* nan: proposals rejected for a NaN dE */
-  unsigned long irregular;  /* proposals rejected for an irregular segment (model.h) */
+  unsigned long irregular;  /* proposals rejected for a forbidden state (model.h) */
 } lw_move_stats;
 
 /* How often tuning looks at the acceptance of a move kind (proposals):
@@ -35,30 +34,32 @@ typedef struct {
 #define LW_TUNE_WINDOW 25
 
 typedef struct {
-  lw_model *model;               /* not owned */
-  lw_proposal *prop;             /* owned scratch */
+  lw_system *sys;                /* not owned; tempering swaps them between chains */
+  void *prop;                    /* owned scratch of sys's type */
   gsl_rng *rng;                  /* owned: this chain's stream */
   double temperature;            /* energy units; 0 = greedy descent */
-  double cum_weight[LW_MOVE_KINDS]; /* cumulative mix, normalised to 1 */
-  double step[LW_MOVE_KINDS];    /* mm, mm, mm, radians */
-  double target[LW_MOVE_KINDS];  /* acceptance targets */
-  double step_max[LW_MOVE_KINDS];/* tuning never grows a step past this */
+  int n_moves;                   /* the row's move kinds */
+  double cum_weight[LW_MOVES_MAX]; /* cumulative mix, normalised to 1 */
+  double step[LW_MOVES_MAX];     /* in the row's units (splines: mm, mm, mm, radians) */
+  double target[LW_MOVES_MAX];   /* acceptance targets */
+  double step_max[LW_MOVES_MAX]; /* tuning never grows a step past this */
   int tuning;
-  unsigned long win_prop[LW_MOVE_KINDS], win_acc[LW_MOVE_KINDS]; /* tuning window */
-  lw_move_stats stats[LW_MOVE_KINDS]; /* since the start of the run */
+  unsigned long win_prop[LW_MOVES_MAX], win_acc[LW_MOVES_MAX]; /* tuning window */
+  lw_move_stats stats[LW_MOVES_MAX]; /* since the start of the run */
 } lw_chain;
 
-/* A chain on model m with the mix, steps and targets of the parameters
-** (mix weights need not sum to 1; at least one must be > 0). */
-lw_chain *lw_chain_new(lw_model *m, const double weight[LW_MOVE_KINDS], const double step[LW_MOVE_KINDS],
-                       const double target[LW_MOVE_KINDS], unsigned long seed, lw_error *err);
+/* A chain on sys with the mix, steps and targets of its n_moves kinds (mix
+** weights need not sum to 1; at least one must be > 0). */
+lw_chain *lw_chain_new(lw_system *sys, const double *weight, const double *step, const double *target,
+                       unsigned long seed, lw_error *err);
 void lw_chain_free(lw_chain *c);
 
-/* One proposal of the given kind; returns 1 if accepted. */
-int lw_chain_step(lw_chain *c, lw_move_kind kind);
+/* One proposal of the given kind; returns 1 if accepted, 0 if rejected, -1
+** if the commit ran out of memory. */
+int lw_chain_step(lw_chain *c, int kind);
 
-/* One sweep: n_nodes proposals with kinds drawn from the mix.  LW_ENOMEM if a
-** commit could not grow the grid. */
+/* One sweep: sweep_size proposals with kinds drawn from the mix.  LW_ENOMEM
+** if a commit could not grow the system's caches. */
 lw_status lw_chain_sweep(lw_chain *c);
 
 /* A generator's state as hex text (malloc'ed) and back, for checkpoints;

@@ -4,11 +4,18 @@
 ** samples in a cell grid.  Proposals are evaluated from the affected
 ** segments only and committed in O(segments touched).
 **
+** The terms come from the term table (terms.h), each with its context,
+** and are treated by their shape, never by name: segment terms are cached
+** per segment, spline terms are evaluated from the cached segment and
+** spline lengths, and the pairwise term (one at most) keeps its samples in
+** a cell grid of its cutoff.
+**
 ** A proposal replaces a run of consecutive nodes of one spline (one node for
 ** a single point or vector move, all nodes for a rigid move).  The segments
 ** touching a changed node are re-sampled; their old energies come from the
-** cache.  The per-spline strain uses the cached spline length, so it costs
-** O(1); the pair term visits the 3 x 3 cells around each new and old sample.
+** cache.  A spline term sees the moved spline's cached lengths, so it costs
+** O(segments of a spline); the pairwise term visits the 3 x 3 cells around
+** each new and old sample.
 **
 ** Invariant (tested): after any sequence of commits, the running totals equal
 ** lw_energy_compute of the state within 1e-9 relative.
@@ -37,6 +44,16 @@
 ** consecutive).  Per segment at 8 nodes: 8 x (24 in a cell + 4 home) = 224
 ** bytes of pair data plus the cells' spare room, against 8 x (32 + 4). */
 
+/* The terms of a scene as the model uses them: every term's context
+** (lw_scene_term_ctx), the spline terms that are on, and the pairwise term
+** that is on (-1 if none). */
+typedef struct {
+  lw_term_ctx ctx[LW_TERM_COUNT];
+  int n_spline;
+  lw_term_id spline[LW_TERM_COUNT];
+  int pair;
+} lw_term_set;
+
 typedef struct {
   const lw_scene *scene;
   lw_splines *sp;           /* owned */
@@ -46,7 +63,8 @@ typedef struct {
   unsigned char *seg_irregular; /* n_segments: 1 where a segment is irregular */
   size_t n_irregular;       /* how many; the total is +inf while > 0 */
   double term[LW_TERM_COUNT]; /* running totals (0 for terms that are off) */
-  lw_cellgrid *grid;        /* the pair samples' positions and weights (pair on), else NULL */
+  lw_term_set terms;        /* the terms' contexts and shapes */
+  lw_cellgrid *grid;        /* the pair samples' positions and weights (pairwise term on), else NULL */
   double *near_cache;       /* n_segments: each segment's pair near field (pair on) */
   uint8_t *near_valid;      /* n_segments: 1 where near_cache holds the current value */
   size_t max_segments;      /* longest spline, for sizing proposals */
@@ -84,6 +102,7 @@ typedef struct {
   lw_pair_probe *probe;       /* 2 n_seg quad.n: each new sample, then its old self, as probes */
   lw_pair_nearlist near;      /* the walk's near pairs (walk.h) */
   double new_spline_len;
+  double *spline_seg_len;     /* the moved spline's segment lengths after the move (spline terms) */
   double dterm[LW_TERM_COUNT];
   unsigned char *seg_irregular; /* n_seg: 1 where a new segment is irregular */
   int irregular;              /* 1 if any is: the proposal is forbidden for that */

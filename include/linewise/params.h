@@ -55,6 +55,7 @@ enum { LW_LADDER_FIXED, LW_LADDER_EQUAL };
 
 typedef struct {
   /* [scene] */
+  char system[64];            /* a name from the system table (system.h) */
   int page;                   /* LW_PAGE_*: a named size sets width and height */
   int orientation;            /* LW_ORIENT_* of a named page */
   double width, height;       /* page, mm */

@@ -31,12 +31,6 @@
 #include "linewise/quad.h"
 #include "linewise/terms.h"
 
-/* A user term: the energy of one segment from its samples (coefficient not
-** applied).  It must be a pure function of its arguments, like the built-in
-** terms: replicas call it from several threads at once.  +infinity forbids a
-** state; it should never return NaN (a NaN dE is rejected and counted). */
-typedef double (*lw_user_term_fn)(const lw_samples *s, const lw_quad *q, const void *data);
-
 typedef struct lw_scene {
   double width, height;         /* page, mm */
   double coef[LW_TERM_COUNT];   /* S B Q P C R and the user term's; 0 = off */
@@ -66,6 +60,10 @@ typedef struct lw_scene {
 /* Builds the scene; messages name the parameter's file and line. */
 lw_status lw_scene_init(lw_scene *sc, const lw_params *p, lw_error *err);
 void lw_scene_clear(lw_scene *sc);
+
+/* The context of every term (terms.h): its coefficient and what it reads
+** of this scene.  The pointers are into sc: valid while sc is. */
+void lw_scene_term_ctx(const lw_scene *sc, lw_term_ctx ctx[LW_TERM_COUNT]);
 
 /* Registers fn as the user term with coefficient coef: its energy is
 ** coef * fn(samples, quad, data) summed over all segments (term name

@@ -7,7 +7,7 @@
 ** splines] the splines (of the coldest rung; [system splines K] those of
 ** rung K with parallel tempering).  Format 1, the positional format of the
 ** first release, still reads: its run-data lines come back as the keys of
-** a section [v1] for the run loop to upgrade (anneal.c).
+** a section [v1] for the run loop to upgrade (checkpoint.c).
 **
 ** Numbers are written with 17 significant digits, which read back to the
 ** same doubles, so a state survives a write/read cycle bit for bit.  Files

@@ -1,5 +1,6 @@
 /*
-** terms.h -- the energy terms as pure functions of a segment's samples.
+** terms.h -- the energy terms as pure functions of a segment's samples, and
+** the term table: one row a term, each with a context of its own.
 **
 ** Integrals run over the segment parameter s in [0,1] with the Gauss-Legendre
 ** weights of the scene's quadrature (w_q, sum 1).  Each function returns the
@@ -22,6 +23,25 @@
 **
 ** The term table's order is the order of trace.csv's and state.lw's energy
 ** columns; a new term goes at the end so older state files still read.
+**
+** A term sees only its context (lw_term_ctx): its coefficient, the nodes
+** its samples come from, and the one object it reads (a potential, a
+** field, the boundary, the pair kernel's settings, the user's data).  The
+** scene fills the contexts (lw_scene_term_ctx, scene.h); terms never see
+** the scene.  A row has one of three shapes, which the model (model.h)
+** treats alike for every term of that shape:
+**   segment   a sum over segments of a function of one segment's samples
+**             (cached per segment, differenced over the segments a move
+**             touches): bending, potential, field, boundary, user,
+**             parametrisation;
+**   spline    a sum over splines of a function of one spline's segment
+**             lengths and rest length (differenced over the moved spline):
+**             strain;
+**   pairwise  coef times the sum of the pair kernel (pair.h) over sample
+**             pairs of different splines, found in a cell grid of the
+**             kernel's cutoff; ctx.data is the lw_pair_ctx, ctx.quad the
+**             pair samples' nodes.  One pairwise term at most is on (the
+**             grid has one cutoff): pair.
 **
 ** Degenerate samples never produce NaN: a sample with r' = 0 contributes 0 to
 ** bending (r' = 0 forces the numerator to 0 as well; the curvature of a point
@@ -49,18 +69,36 @@ typedef enum {
   LW_TERM_COUNT
 } lw_term_id;
 
-struct lw_scene;
+/* A user term: the energy of one segment from its samples (coefficient not
+** applied).  It must be a pure function of its arguments, like the built-in
+** terms: replicas call it from several threads at once.  +infinity forbids a
+** state; it should never return NaN (a NaN dE is rejected and counted). */
+typedef double (*lw_user_term_fn)(const lw_samples *s, const lw_quad *q, const void *data);
 
-/* A term that is a sum over segments of a function of that segment's
-** samples has a `segment` function (coefficient applied); strain and pair
-** are not of that shape and have NULL there: the model treats them itself. */
+/* What one term reads.  Pointers are into the scene, which outlives every
+** model built on it. */
+typedef struct {
+  double coef;               /* 0 = off */
+  const lw_quad *quad;       /* the nodes of the samples it is given */
+  const void *data;          /* lw_potential, lw_field, lw_boundary, lw_pair_ctx, user data, or NULL */
+  lw_user_term_fn fn;        /* the user term's function */
+  int mode;                  /* field: 1 axial; strain: 1 per segment */
+} lw_term_ctx;
+
+/* One row: exactly one of segment, spline, pairwise.  segment returns the
+** energy of one segment with its coefficient; spline the energy of one
+** spline without it (the model multiplies, so differences round as
+** coef * (new - old)). */
 typedef struct {
   lw_term_id id;
-  const char *name;   /* as in scene files, traces and summaries */
-  double (*segment)(const lw_samples *s, const struct lw_scene *sc);
+  double (*segment)(const lw_samples *s, const lw_term_ctx *c);
+  double (*spline)(const double *seg_len, size_t n_seg, double length, double rest_length, const lw_term_ctx *c);
+  int pairwise;
 } lw_term_type;
 
 extern const lw_term_type lw_term_types[LW_TERM_COUNT];
+/* as in scene files, traces, summaries and the state's energy keys */
+extern const char *const lw_term_names[LW_TERM_COUNT];
 
 double lw_term_strain(double length, double rest_length);
 double lw_term_bending(const lw_samples *s, const lw_quad *q);

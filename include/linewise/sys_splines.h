@@ -1,0 +1,37 @@
+/*
+** sys_splines.h -- the spline system, the first row of lw_system_types
+** (system.h): cubic Bezier splines (spline.h) with their model (model.h) on
+** a scene (scene.h).
+**
+** Set-up: the scene built from the parameters and the picture's tone on the
+** page (fidelity, previews).  State: one model, which owns its splines.
+** Move kinds, in this order: point and vector (one node's p_k or v_k by a
+** Gaussian step in x and y), translate and rotate (a whole spline rigidly,
+** by a Gaussian offset, or by a Gaussian angle about the mean of its points,
+** which the rotation leaves in place, so every proposal is symmetric).  The
+** [moves] keys name them; the rotate step is given in degrees.
+**
+** In state.lw the system keeps the splines in its section [system splines]
+** ([system splines K] for rung K); the run loop keeps the running value of
+** every term by name (checkpoint.h).
+*/
+#ifndef LINEWISE_SYS_SPLINES_H
+#define LINEWISE_SYS_SPLINES_H
+
+#include "linewise/model.h"
+#include "linewise/system.h"
+
+typedef enum { LW_MOVE_POINT, LW_MOVE_VECTOR, LW_MOVE_TRANSLATE, LW_MOVE_ROTATE, LW_MOVE_KINDS } lw_move_kind;
+
+extern const char *const lw_move_names[LW_MOVE_KINDS];
+
+extern const lw_system_type lw_system_splines;
+
+/* An instance on a model the caller keeps (tests, benchmarks): freeing it
+** leaves the model; it has no set-up, so it does not draw. */
+lw_system *lw_splines_view(lw_model *m, lw_error *err);
+
+/* The model of a spline instance. */
+lw_model *lw_splines_model(const lw_system *s);
+
+#endif

@@ -1,0 +1,170 @@
+/*
+** system.h -- a system type as a table row (in the style of gsl_rng_type
+** and the schedule table): what the degrees of freedom are, and everything
+** the drivers need to know about them (DESIGN.md section 5).
+**
+** The drivers -- the Metropolis chain (mc.h), the tempering ladder, step
+** tuning, the run loop and its checkpoints, trace and summary (anneal.c) --
+** see a system only through its row.  The division of labour:
+**   the chain owns the random stream, the step of each move kind, its
+**     tuning, the acceptance decision and the statistics per move kind,
+**     which it knows by the row's names;
+**   the system owns its state and caches, its move kinds (it draws a
+**     proposal of kind k with step `step` from the chain's stream and
+**     evaluates dE), commit, the running energy per term, a from-scratch
+**     refresh, its part of state.lw, and its drawings.
+**
+** Differences from the first sketch, and why:
+**   - save/load work on a section of state.lw (ckpt.h) rather than a FILE:
+**     the run loop writes state.lw atomically as a whole (checkpoint.h),
+**     with its own sections beside the system's; a system writes its own
+**     section and reads it back.  The running energies are the run loop's
+**     (by term name, in each rung's chain section); set_terms restores them.
+**   - moves() reads the [moves] weights, steps and targets of the system's
+**     kinds from the parameters, and move_unit[] converts a step back to the
+**     unit of its key for summary.json (the rotate step is kept in radians,
+**     given and reported in degrees).
+**   - draw() also writes animation frames, and the state keeps what its
+**     final drawing reported (pen-up travel, fidelity) for summary(), which
+**     writes the system's own members of summary.json.
+**   - term_on(): a term that is off has no trace column or summary member
+**     (as before); its running value is 0.  energy(): the energy per term
+**     of a saved state from scratch, for `linewise energy`.
+**   - propose() takes the state non-const: it may fill caches (the spline
+**     model's near-field cache), never the state itself.
+**   - note(), describe() and files give the command line its messages, so
+**     main.c names no system either.
+**
+** An instance is an lw_system: the row plus the state.  The set-up (for
+** splines the scene: fields, boundary, quadrature, the picture) is shared
+** read-only by every replica and outlives them.
+**
+** Adding a system is local: new files with its functions and one entry in
+** lw_system_types[] (system.c); docs/SYSTEMS.md has the recipe.
+*/
+#ifndef LINEWISE_SYSTEM_H
+#define LINEWISE_SYSTEM_H
+
+#include <gsl/gsl_rng.h>
+#include <stddef.h>
+
+#include "linewise/error.h"
+#include "linewise/json.h"
+#include "linewise/params.h"
+#include "linewise/state.h"
+
+/* At most this many move kinds and terms a system (fixed arrays in the
+** chain and the run loop's trace marks). */
+#define LW_MOVES_MAX 8
+#define LW_SYSTEM_TERMS_MAX 16
+
+typedef struct lw_system_type lw_system_type;
+
+struct lw_system_type {
+  const char *name;                   /* [scene] system = name */
+  int n_moves;                        /* move kinds, <= LW_MOVES_MAX ... */
+  const char *const *move_names;      /* ... by name: trace, summary, state.lw */
+  const double *move_unit;            /* step in the chain's unit per unit of its key */
+  int n_terms;                        /* energy terms, <= LW_SYSTEM_TERMS_MAX ... */
+  const char *const *term_names;      /* ... by name: trace columns, summary, state.lw */
+
+  /* The shared set-up of a scene (NULL and err set on bad input, naming the
+  ** parameter's file and line), and a note for the user or "" (e.g. a
+  ** picture was downsampled). */
+  void *(*setup_new)(const lw_params *p, lw_error *err);
+  void (*setup_free)(void *setup);
+  const char *(*note)(const void *setup);
+
+  /* The initial state of a run: placed from `seed` (a stream of its own) or
+  ** read from the file the parameters name; copies for the replicas. */
+  void *(*state_new)(const void *setup, const lw_params *p, unsigned long seed, lw_error *err);
+  void *(*state_copy)(const void *state, lw_error *err);
+  void (*state_free)(void *state);
+
+  /* Monte Carlo.  moves(): the mix weights, initial steps and acceptance
+  ** targets of the n_moves kinds from the parameters.  sweep_size: proposals
+  ** a sweep (0: nothing to move).  step_max: tuning never grows a step of
+  ** kind k past it.  propose: draws one proposal of kind k with step `step`
+  ** from rng into prop (the chain's scratch) and returns dE (NaN: undefined,
+  ** rejected and counted; +inf forbidden), with *forbidden = 1 when it is
+  ** refused for a forbidden state (counted apart).  The state is not
+  ** changed, but caches may be filled: one thread per state.  commit applies
+  ** the last proposal (LW_ENOMEM leaves the state as it was). */
+  void (*moves)(const lw_params *p, double *weight, double *step, double *target);
+  size_t (*sweep_size)(const void *state);
+  double (*step_max)(const void *state, int kind);
+  void *(*proposal_new)(const void *state, lw_error *err);
+  void (*proposal_free)(void *prop);
+  double (*propose)(void *state, void *prop, int kind, double step, gsl_rng *rng, int *forbidden);
+  lw_status (*commit)(void *state, void *prop);
+
+  /* Energies: the running total (+inf in a forbidden state), the running
+  ** value of each term (n_terms values, 0 when off), whether term t is on
+  ** in the set-up, and a recomputation of every cache and total from the
+  ** state (drift: the relative change of the total, |new - old| /
+  ** max(|new|, 1)). */
+  double (*total)(const void *state);
+  void (*terms)(const void *state, double *term);
+  int (*term_on)(const void *setup, int t);
+  lw_status (*refresh)(void *state, double *drift);
+  /* The energy per term of a saved state (st, read from path) computed from
+  ** scratch, and the total; err set (naming path) when the state is refused
+  ** or memory runs out (`linewise energy`). */
+  double (*energy)(const void *setup, const lw_state *st, const char *path, double *term, lw_error *err);
+
+  /* Checkpoints (checkpoint.h): save writes the state into its own section
+  ** of state.lw with the writer of ckpt.h ([system <name>] for the coldest
+  ** rung, [system <name> K] for rung K); load builds a state from that
+  ** section of st->doc (for splines the coldest rung's splines, already
+  ** read into st->sp, are taken from there), with running energies summed
+  ** afresh, messages naming path; NULL and err set when the state is
+  ** refused (for splines also when an energy is not finite, naming the
+  ** spline and segment).  The run loop keeps the running energies by term
+  ** name in its own sections and hands them back with set_terms after
+  ** checking them against the fresh ones. */
+  lw_status (*save)(const void *state, lw_ckpt_writer *w, const char *section, lw_error *err);
+  void *(*load)(const void *setup, lw_state *st, const char *section, const char *path, lw_error *err);
+  void (*set_terms)(void *state, const double *term);
+
+  /* Outputs: into dir the files of a run's start (LW_DRAW_START: for
+  ** splines field.png, as asked), the final drawing files (LW_DRAW_FINAL),
+  ** or the animation frame of a sweep >= 0; summary() writes the system's members of
+  ** summary.json (sizes, what the final drawing reported); describe()
+  ** text for the command line: the size (LW_DESCRIBE_SIZE, "20 splines, 80
+  ** segments") or what the final drawing reported (LW_DESCRIBE_DRAWING,
+  ** whole lines "linewise: ...\n", or ""); files names the drawing files. */
+  const char *files;
+  lw_status (*draw)(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err);
+  void (*summary)(const void *state, lw_json *j);
+  void (*describe)(const void *state, int what, char *buf, size_t n);
+};
+
+#define LW_DRAW_START (-2)
+#define LW_DRAW_FINAL (-1)
+enum { LW_DESCRIBE_SIZE, LW_DESCRIBE_DRAWING };
+
+/* One instance: the row and a state (owned). */
+typedef struct {
+  const lw_system_type *type;
+  void *state;
+} lw_system;
+
+/* The table, NULL-terminated: splines first. */
+extern const lw_system_type *const lw_system_types[];
+
+/* The row of that name, or NULL; lw_system_names lists them for messages. */
+const lw_system_type *lw_system_find(const char *name);
+const char *lw_system_names(void);
+
+/* The row the parameters name ([scene] system); NULL and LW_EINPUT naming
+** the key's file and line if there is none of that name. */
+const lw_system_type *lw_system_of(const lw_params *p, lw_error *err);
+
+/* An instance owning `state` (freed on failure too). */
+lw_system *lw_system_wrap(const lw_system_type *type, void *state, lw_error *err);
+void lw_system_free(lw_system *s);
+
+/* The row's calls on an instance. */
+static inline double lw_system_total(const lw_system *s) { return s->type->total(s->state); }
+
+#endif

@@ -1,0 +1,385 @@
+/*
+** sys_splines.c -- the spline system's row (sys_splines.h): the model,
+** scene and placement behind the seam of system.h.
+*/
+#include "linewise/sys_splines.h"
+
+#include <gsl/gsl_math.h>
+#include <gsl/gsl_randist.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "linewise/checkpoint.h"
+#include "linewise/drawing.h"
+#include "linewise/fieldview.h"
+#include "linewise/init.h"
+
+const char *const lw_move_names[LW_MOVE_KINDS] = {"point", "vector", "translate", "rotate"};
+/* steps are kept in mm and radians; [moves] step_rotate is in degrees */
+static const double move_unit[LW_MOVE_KINDS] = {1.0, 1.0, 1.0, M_PI / 180.0};
+
+typedef struct {
+  lw_scene scene;
+  lw_grid2d *tone;               /* the picture's tone on the page, or NULL */
+} spl_setup;
+
+typedef struct {
+  const spl_setup *setup;        /* NULL for a view */
+  lw_model *m;
+  int owns_model;                /* 0 for a view */
+  lw_drawing_report drawing;     /* of the last final drawing */
+} spl_state;
+
+static void setup_free(void *setup)
+{
+  spl_setup *su = setup;
+  if (!su) return;
+  lw_grid2d_free(su->tone);
+  lw_scene_clear(&su->scene);
+  free(su);
+}
+
+static void *setup_new(const lw_params *p, lw_error *err)
+{
+  spl_setup *su = calloc(1, sizeof *su);
+  if (!su) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for a scene");
+    return NULL;
+  }
+  if (lw_scene_init(&su->scene, p, err)) goto fail;
+  /* the target of the fidelity score and the previews' underlay */
+  if (su->scene.image && !(su->tone = lw_image_tone_grid(su->scene.image, &su->scene.image_place, err)))
+    goto fail;
+  return su;
+fail:
+  setup_free(su);
+  return NULL;
+}
+
+static const char *note(const void *setup) { return ((const spl_setup *)setup)->scene.note; }
+
+/* A state owning model m (freed on failure). */
+static spl_state *state_of(const spl_setup *su, lw_model *m, int owns, lw_error *err)
+{
+  if (!m) return NULL;
+  spl_state *s = calloc(1, sizeof *s);
+  if (!s) {
+    if (owns) lw_model_free(m);
+    lw_error_set(err, LW_ENOMEM, "out of memory for a state");
+    return NULL;
+  }
+  s->setup = su;
+  s->m = m;
+  s->owns_model = owns;
+  return s;
+}
+
+static void state_free(void *state)
+{
+  spl_state *s = state;
+  if (!s) return;
+  if (s->owns_model) lw_model_free(s->m);
+  free(s);
+}
+
+/* Prefixes the message in err with where key was set and the key: input
+** read on behalf of a key (a state, a placement) is reported as that key's
+** error. */
+static lw_status blame_key(const lw_params *p, const char *section, const char *key, lw_error *err)
+{
+  char where[LW_PATH_MAX + 32], msg[LW_ERROR_MSG];
+  lw_params_origin(p, lw_params_find(section, key), where, sizeof where);
+  snprintf(msg, sizeof msg, "%s", err->msg);
+  return lw_error_set(err, err->code, "%s: key '%s.%s': %s", where, section, key, msg);
+}
+
+/* A model on sp (owned) after checking that the splines read from path are
+** allowed for the scene. */
+static spl_state *state_from_file(const spl_setup *su, lw_splines *sp, const char *path, lw_error *err)
+{
+  if (lw_model_check_regular(&su->scene, sp, path, err)) {
+    lw_splines_free(sp);
+    return NULL;
+  }
+  return state_of(su, lw_model_new(&su->scene, sp, err), 1, err);
+}
+
+static void *state_new(const void *setup, const lw_params *p, unsigned long seed, lw_error *err)
+{
+  const spl_setup *su = setup;
+  lw_splines *sp;
+  if (p->from[0]) {
+    lw_state st;
+    if (lw_state_read(&st, p->from, err)) {
+      blame_key(p, "init", "from", err);
+      return NULL;
+    }
+    sp = st.sp;
+    st.sp = NULL;
+    lw_state_clear(&st);
+    spl_state *s = state_from_file(su, sp, p->from, err);
+    if (!s && err->code == LW_EINPUT) blame_key(p, "init", "from", err);
+    return s;
+  }
+  size_t n;
+  if (lw_init_count(&su->scene, p, &n, err)) return NULL;
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  if (!r) {
+    lw_error_set(err, LW_ENOMEM, "out of memory");
+    return NULL;
+  }
+  gsl_rng_set(r, seed);
+  sp = lw_init_random(&su->scene, n, (size_t)p->segments, p->segment_length, r, err);
+  gsl_rng_free(r);
+  if (!sp) {
+    if (err->code == LW_EINPUT) blame_key(p, "init", "segment_length", err);
+    return NULL;
+  }
+  return state_of(su, lw_model_new(&su->scene, sp, err), 1, err);
+}
+
+static void *state_copy(const void *state, lw_error *err)
+{
+  const spl_state *s = state;
+  lw_splines *sp = lw_splines_clone(s->m->sp);
+  if (!sp) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for a replica");
+    return NULL;
+  }
+  return state_of(s->setup, lw_model_new(s->m->scene, sp, err), 1, err);
+}
+
+static void moves(const lw_params *p, double *weight, double *step, double *target)
+{
+  const double w[LW_MOVE_KINDS] = {p->mix_point, p->mix_vector, p->mix_translate, p->mix_rotate};
+  const double st[LW_MOVE_KINDS] = {p->step_point, p->step_vector, p->step_translate, p->step_rotate};
+  const double tg[LW_MOVE_KINDS] = {p->target, p->target, p->target_spline, p->target_spline};
+  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+    weight[k] = w[k];
+    step[k] = st[k] * move_unit[k];
+    target[k] = tg[k];
+  }
+}
+
+static size_t sweep_size(const void *state) { return ((const spl_state *)state)->m->sp->n_nodes; }
+
+/* Steps are capped at the page size: beyond that a Gaussian step only
+** throws nodes off the page; an angle at half a turn. */
+static double step_max(const void *state, int kind)
+{
+  const lw_scene *sc = ((const spl_state *)state)->m->scene;
+  return kind == LW_MOVE_ROTATE ? M_PI : fmax(sc->width, sc->height);
+}
+
+static void *proposal_new(const void *state, lw_error *err)
+{
+  return lw_proposal_new(((const spl_state *)state)->m, err);
+}
+
+static void proposal_free(void *prop) { lw_proposal_free(prop); }
+
+/* Spline that owns global node k (binary search over first[]). */
+static uint32_t spline_of_node(const lw_splines *sp, size_t k)
+{
+  size_t lo = 0, hi = sp->n_splines;
+  while (hi - lo > 1) {
+    size_t mid = (lo + hi) / 2;
+    if (sp->first[mid] <= k) lo = mid;
+    else hi = mid;
+  }
+  return (uint32_t)lo;
+}
+
+static double propose(void *state, void *prop, int kind, double st, gsl_rng *rng, int *forbidden)
+{
+  const lw_model *m = ((spl_state *)state)->m;
+  lw_proposal *p = prop;
+  const lw_splines *sp = m->sp;
+  uint32_t i;
+  size_t node0, n_node;
+  lw_node *nd = p->node; /* proposals are built in place in the scratch */
+  if (kind == LW_MOVE_POINT || kind == LW_MOVE_VECTOR) {
+    size_t k = gsl_rng_uniform_int(rng, sp->n_nodes);
+    i = spline_of_node(sp, k);
+    node0 = k - sp->first[i];
+    n_node = 1;
+    nd[0] = sp->node[k];
+    double dx = gsl_ran_gaussian_ziggurat(rng, st), dy = gsl_ran_gaussian_ziggurat(rng, st);
+    if (kind == LW_MOVE_POINT) {
+      nd[0].px += dx;
+      nd[0].py += dy;
+    } else {
+      nd[0].vx += dx;
+      nd[0].vy += dy;
+    }
+  } else {
+    i = (uint32_t)gsl_rng_uniform_int(rng, sp->n_splines);
+    node0 = 0;
+    n_node = sp->first[i + 1] - sp->first[i];
+    const lw_node *src = &sp->node[sp->first[i]];
+    if (kind == LW_MOVE_TRANSLATE) {
+      double dx = gsl_ran_gaussian_ziggurat(rng, st), dy = gsl_ran_gaussian_ziggurat(rng, st);
+      for (size_t k = 0; k < n_node; k++) {
+        nd[k] = src[k];
+        nd[k].px += dx;
+        nd[k].py += dy;
+      }
+    } else {
+      double a = gsl_ran_gaussian_ziggurat(rng, st), ca = cos(a), sa = sin(a);
+      double cx = 0.0, cy = 0.0;
+      for (size_t k = 0; k < n_node; k++) {
+        cx += src[k].px;
+        cy += src[k].py;
+      }
+      cx /= (double)n_node;
+      cy /= (double)n_node;
+      for (size_t k = 0; k < n_node; k++) {
+        double x = src[k].px - cx, y = src[k].py - cy;
+        nd[k] = (lw_node){cx + ca * x - sa * y, cy + sa * x + ca * y,
+                          ca * src[k].vx - sa * src[k].vy, sa * src[k].vx + ca * src[k].vy};
+      }
+    }
+  }
+  lw_model_propose(m, p, i, node0, n_node, NULL);
+  *forbidden = p->irregular;
+  return p->dE;
+}
+
+static lw_status commit(void *state, void *prop) { return lw_model_commit(((spl_state *)state)->m, prop); }
+
+static double total(const void *state) { return lw_model_total(((const spl_state *)state)->m); }
+
+static void terms(const void *state, double *term)
+{
+  memcpy(term, ((const spl_state *)state)->m->term, LW_TERM_COUNT * sizeof *term);
+}
+
+static int term_on(const void *setup, int t) { return ((const spl_setup *)setup)->scene.on[t]; }
+
+static lw_status refresh(void *state, double *drift) { return lw_model_refresh(((spl_state *)state)->m, drift); }
+
+static double energy(const void *setup, const lw_state *st, const char *path, double *term, lw_error *err)
+{
+  const lw_scene *sc = &((const spl_setup *)setup)->scene;
+  if (lw_model_check_regular(sc, st->sp, path, err)) return NAN;
+  double total = lw_energy_compute(sc, st->sp, term, err);
+  if (err->code || lw_checkpoint_check_finite(sc, st->sp, term, path, err)) return NAN;
+  return total;
+}
+
+static lw_status save(const void *state, lw_ckpt_writer *w, const char *section, lw_error *err)
+{
+  lw_state_put_splines(w, section, ((const spl_state *)state)->m->sp);
+  return LW_OK;
+}
+
+/* The coldest rung's splines were read with the header (st->sp); the
+** others come from their section.  A state whose energies are not finite is
+** refused here, naming the spline and segment. */
+static void *load(const void *setup, lw_state *st, const char *section, const char *path, lw_error *err)
+{
+  const spl_setup *su = setup;
+  lw_splines *sp = NULL;
+  if (st->sp && !strcmp(section, "system splines")) {
+    sp = st->sp;
+    st->sp = NULL;
+  } else if (lw_state_get_splines(st->doc, section, &sp, err)) {
+    return NULL;
+  }
+  spl_state *s = state_from_file(su, sp, path, err);
+  if (!s) return NULL;
+  char where[LW_PATH_MAX + 64];
+  snprintf(where, sizeof where, "%s: [%s]", path, section);
+  if (lw_checkpoint_check_finite(&su->scene, s->m->sp, s->m->term, where, err)) {
+    state_free(s);
+    return NULL;
+  }
+  return s;
+}
+
+static void set_terms(void *state, const double *term)
+{
+  memcpy(((spl_state *)state)->m->term, term, LW_TERM_COUNT * sizeof *term);
+}
+
+static lw_status draw(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err)
+{
+  spl_state *s = state;
+  const lw_scene *sc = &s->setup->scene;
+  if (sweep == LW_DRAW_START) {
+    if (!p->field_preview) return LW_OK;
+    char path[LW_PATH_MAX + 32];
+    lw_path_join(path, sizeof path, dir, "field.png");
+    return lw_fieldview_png(sc, p->png_scale, path, err);
+  }
+  if (sweep >= 0) return lw_drawing_frame(p, sc, s->m->sp, s->setup->tone, dir, sweep, err);
+  return lw_drawing_write(p, sc, s->m->sp, s->setup->tone, dir, &s->drawing, err);
+}
+
+static void summary(const void *state, lw_json *j)
+{
+  const spl_state *s = state;
+  lw_json_key(j, "splines");
+  lw_json_int(j, (long long)s->m->sp->n_splines);
+  lw_json_key(j, "segments");
+  lw_json_int(j, (long long)s->m->sp->n_segments);
+  lw_drawing_report_json(j, &s->drawing);
+}
+
+static void describe(const void *state, int what, char *buf, size_t n)
+{
+  const spl_state *s = state;
+  const lw_splines *sp = s->m->sp;
+  const lw_drawing_report *d = &s->drawing;
+  if (what == LW_DESCRIBE_SIZE) {
+    snprintf(buf, n, "%zu splines, %zu segments", sp->n_splines, sp->n_segments);
+    return;
+  }
+  int k = snprintf(buf, n, "linewise: %zu paths; pen-up travel %.1f mm in index order, %.1f mm as plotted\n",
+                   d->paths, d->travel_before, d->travel_after);
+  if (d->has_fidelity && k >= 0 && (size_t)k < n)
+    snprintf(buf + k, n - (size_t)k, "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f\n", d->fidelity.sigma_mm,
+             d->fidelity.mse, d->fidelity.ssim);
+}
+
+const lw_system_type lw_system_splines = {
+    .name = "splines",
+    .n_moves = LW_MOVE_KINDS,
+    .move_names = lw_move_names,
+    .move_unit = move_unit,
+    .n_terms = LW_TERM_COUNT,
+    .term_names = lw_term_names,
+    .setup_new = setup_new,
+    .setup_free = setup_free,
+    .note = note,
+    .state_new = state_new,
+    .state_copy = state_copy,
+    .state_free = state_free,
+    .moves = moves,
+    .sweep_size = sweep_size,
+    .step_max = step_max,
+    .proposal_new = proposal_new,
+    .proposal_free = proposal_free,
+    .propose = propose,
+    .commit = commit,
+    .total = total,
+    .terms = terms,
+    .term_on = term_on,
+    .refresh = refresh,
+    .energy = energy,
+    .save = save,
+    .load = load,
+    .set_terms = set_terms,
+    .files = "final.svg, final.png",
+    .draw = draw,
+    .summary = summary,
+    .describe = describe,
+};
+
+lw_system *lw_splines_view(lw_model *m, lw_error *err)
+{
+  return lw_system_wrap(&lw_system_splines, state_of(NULL, m, 0, err), err);
+}
+
+lw_model *lw_splines_model(const lw_system *s) { return ((const spl_state *)s->state)->m; }

@@ -1,0 +1,67 @@
+/* system.c -- the table of system types (system.h). */
+#include "linewise/system.h"
+
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "linewise/sys_splines.h"
+
+const lw_system_type *const lw_system_types[] = {&lw_system_splines, NULL};
+
+const lw_system_type *lw_system_find(const char *name)
+{
+  for (int k = 0; lw_system_types[k]; k++)
+    if (!strcmp(lw_system_types[k]->name, name)) return lw_system_types[k];
+  return NULL;
+}
+
+static char names_buf[256];
+static pthread_once_t names_once = PTHREAD_ONCE_INIT;
+
+static void build_names(void)
+{
+  size_t n = 0;
+  for (int k = 0; lw_system_types[k] && n < sizeof names_buf; k++)
+    n += (size_t)snprintf(names_buf + n, sizeof names_buf - n, "%s%s", k ? ", " : "", lw_system_types[k]->name);
+}
+
+const char *lw_system_names(void)
+{
+  pthread_once(&names_once, build_names);
+  return names_buf;
+}
+
+const lw_system_type *lw_system_of(const lw_params *p, lw_error *err)
+{
+  const lw_system_type *t = lw_system_find(p->system);
+  if (!t) {
+    char where[LW_PATH_MAX + 32];
+    lw_params_origin(p, lw_params_find("scene", "system"), where, sizeof where);
+    lw_error_set(err, LW_EINPUT, "%s: key 'scene.system': expected one of %s, got '%s'", where, lw_system_names(),
+                 p->system);
+  }
+  return t;
+}
+
+lw_system *lw_system_wrap(const lw_system_type *type, void *state, lw_error *err)
+{
+  if (!state) return NULL;
+  lw_system *s = malloc(sizeof *s);
+  if (!s) {
+    type->state_free(state);
+    lw_error_set(err, LW_ENOMEM, "out of memory for a system");
+    return NULL;
+  }
+  s->type = type;
+  s->state = state;
+  return s;
+}
+
+void lw_system_free(lw_system *s)
+{
+  if (!s) return;
+  s->type->state_free(s->state);
+  free(s);
+}

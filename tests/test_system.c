@@ -1,0 +1,396 @@
+/*
+** test_system.c -- the system seam (system.h): adding a system is local.
+**
+** A test-only row, `gauss`, holds a few independent variables x_i with the
+** energy k_i x_i^2 / 2, in two terms (even and odd i) and with two move
+** kinds (one variable, or all at once, each by a Gaussian step).  At
+** temperature T each x_i is exactly N(0, T / k_i).  The real Metropolis
+** chain (mc.h) and the real tempering exchanges (tempering.h) drive it
+** through the row alone, and must sample that distribution.
+**
+** Tolerances: the samples are correlated, so the standard error of a mean is
+** estimated by batch means (B batches of equal length, each much longer
+** than the correlation time): se = sd(batch means) / sqrt(B).  An estimate
+** passes within 5 se, and se must itself be small, so the check has power.
+*/
+#include <criterion/criterion.h>
+#include <gsl/gsl_randist.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "linewise/mc.h"
+#include "linewise/system.h"
+#include "linewise/tempering.h"
+#include "testutil.h"
+
+#define NV 3
+static const double stiffness[NV] = {1.0, 4.0, 0.25};
+
+typedef struct {
+  double x[NV];
+  double term[2]; /* running: even i, odd i */
+} gs_state;
+
+typedef struct {
+  int n, idx[NV];
+  double x[NV];
+  double dterm[2];
+} gs_prop;
+
+static double gs_energy(int i, double x) { return 0.5 * stiffness[i] * x * x; }
+
+static void *gs_setup_new(const lw_params *p, lw_error *err)
+{
+  static int setup; /* nothing to set up; a non-NULL token */
+  return &setup;
+}
+static void gs_setup_free(void *setup) {}
+static const char *gs_note(const void *setup) { return ""; }
+
+static void gs_sum(gs_state *s)
+{
+  s->term[0] = s->term[1] = 0.0;
+  for (int i = 0; i < NV; i++) s->term[i % 2] += gs_energy(i, s->x[i]);
+}
+
+static void *gs_state_new(const void *setup, const lw_params *p, unsigned long seed, lw_error *err)
+{
+  gs_state *s = calloc(1, sizeof *s);
+  if (!s) return NULL;
+  for (int i = 0; i < NV; i++) s->x[i] = 1.0 + i; /* far out: the burn-in must forget it */
+  gs_sum(s);
+  return s;
+}
+
+static void *gs_state_copy(const void *state, lw_error *err)
+{
+  gs_state *s = malloc(sizeof *s);
+  if (s) *s = *(const gs_state *)state;
+  return s;
+}
+
+static void gs_state_free(void *state) { free(state); }
+
+static void gs_moves(const lw_params *p, double *weight, double *step, double *target)
+{
+  weight[0] = 1.0, weight[1] = 0.25;
+  step[0] = 1.5, step[1] = 0.5;
+  target[0] = 0.4, target[1] = 0.3;
+}
+
+static size_t gs_sweep_size(const void *state) { return NV; }
+static double gs_step_max(const void *state, int kind) { return 10.0; }
+static void *gs_proposal_new(const void *state, lw_error *err) { return malloc(sizeof(gs_prop)); }
+static void gs_proposal_free(void *prop) { free(prop); }
+
+static double gs_propose(void *state, void *prop, int kind, double step, gsl_rng *rng, int *forbidden)
+{
+  const gs_state *s = state;
+  gs_prop *p = prop;
+  p->n = 0;
+  p->dterm[0] = p->dterm[1] = 0.0;
+  if (kind == 0) {
+    p->idx[p->n++] = (int)gsl_rng_uniform_int(rng, NV);
+  } else {
+    for (int i = 0; i < NV; i++) p->idx[p->n++] = i;
+  }
+  for (int k = 0; k < p->n; k++) {
+    int i = p->idx[k];
+    p->x[k] = s->x[i] + gsl_ran_gaussian_ziggurat(rng, step);
+    p->dterm[i % 2] += gs_energy(i, p->x[k]) - gs_energy(i, s->x[i]);
+  }
+  return p->dterm[0] + p->dterm[1];
+}
+
+static lw_status gs_commit(void *state, void *prop)
+{
+  gs_state *s = state;
+  const gs_prop *p = prop;
+  for (int k = 0; k < p->n; k++) s->x[p->idx[k]] = p->x[k];
+  s->term[0] += p->dterm[0];
+  s->term[1] += p->dterm[1];
+  return LW_OK;
+}
+
+static double gs_total(const void *state)
+{
+  const gs_state *s = state;
+  return s->term[0] + s->term[1];
+}
+
+static void gs_terms(const void *state, double *term) { memcpy(term, ((const gs_state *)state)->term, 2 * sizeof *term); }
+static int gs_term_on(const void *setup, int t) { return 1; }
+
+static lw_status gs_refresh(void *state, double *drift)
+{
+  gs_state *s = state;
+  double old = gs_total(s);
+  gs_sum(s);
+  if (drift) *drift = fabs(gs_total(s) - old) / fmax(fabs(gs_total(s)), 1.0);
+  return LW_OK;
+}
+
+static lw_status gs_save(const void *state, lw_ckpt_writer *w, const char *section, lw_error *err)
+{
+  const gs_state *s = state;
+  lw_ckpt_section(w, section);
+  lw_ckpt_put_numbers(w, "x", s->x, NV);
+  return LW_OK;
+}
+
+static void *gs_load(const void *setup, lw_state *st, const char *section, const char *path, lw_error *err)
+{
+  gs_state *s = calloc(1, sizeof *s);
+  if (!s) {
+    lw_error_set(err, LW_ENOMEM, "out of memory");
+    return NULL;
+  }
+  if (lw_ckpt_numbers(st->doc, section, "x", s->x, NV, -1e300, 1e300, 1, err)) {
+    free(s);
+    return NULL;
+  }
+  gs_sum(s);
+  return s;
+}
+
+static void gs_set_terms(void *state, const double *term) { memcpy(((gs_state *)state)->term, term, 2 * sizeof *term); }
+
+static double gs_energy_of(const void *setup, const lw_state *st, const char *path, double *term, lw_error *err)
+{
+  lw_state copy = *st;
+  gs_state *s = gs_load(setup, &copy, "system gauss", path, err);
+  if (!s) return NAN;
+  gs_terms(s, term);
+  double e = gs_total(s);
+  free(s);
+  return e;
+}
+
+static lw_status gs_draw(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err) { return LW_OK; }
+
+static void gs_summary(const void *state, lw_json *j)
+{
+  lw_json_key(j, "variables");
+  lw_json_int(j, NV);
+}
+
+static void gs_describe(const void *state, int what, char *buf, size_t n)
+{
+  snprintf(buf, n, what == LW_DESCRIBE_SIZE ? "%d variables" : "", NV);
+}
+
+static const char *const gs_move_names[] = {"one", "all"};
+static const double gs_move_unit[] = {1.0, 1.0};
+static const char *const gs_term_names[] = {"even", "odd"};
+
+static const lw_system_type gauss_type = {
+    .name = "gauss", .n_moves = 2, .move_names = gs_move_names, .move_unit = gs_move_unit,
+    .n_terms = 2, .term_names = gs_term_names,
+    .setup_new = gs_setup_new, .setup_free = gs_setup_free, .note = gs_note,
+    .state_new = gs_state_new, .state_copy = gs_state_copy, .state_free = gs_state_free,
+    .moves = gs_moves, .sweep_size = gs_sweep_size, .step_max = gs_step_max,
+    .proposal_new = gs_proposal_new, .proposal_free = gs_proposal_free,
+    .propose = gs_propose, .commit = gs_commit,
+    .total = gs_total, .terms = gs_terms, .term_on = gs_term_on, .refresh = gs_refresh, .energy = gs_energy_of,
+    .save = gs_save, .load = gs_load, .set_terms = gs_set_terms,
+    .files = "", .draw = gs_draw, .summary = gs_summary, .describe = gs_describe,
+};
+
+/* A system of the gauss row and a chain on it at temperature T. */
+static lw_chain *gauss_chain(double T, unsigned long seed)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  lw_error err;
+  const lw_system_type *t = &gauss_type;
+  void *setup = t->setup_new(&p, &err);
+  lw_system *sys = lw_system_wrap(t, t->state_new(setup, &p, 0, &err), &err);
+  cr_assert_not_null(sys);
+  double w[LW_MOVES_MAX], st[LW_MOVES_MAX], tg[LW_MOVES_MAX];
+  t->moves(&p, w, st, tg);
+  lw_chain *c = lw_chain_new(sys, w, st, tg, seed, &err);
+  cr_assert_not_null(c, "%s", err.msg);
+  c->temperature = T;
+  return c;
+}
+
+static void gauss_chain_free(lw_chain *c)
+{
+  lw_system *sys = c->sys;
+  lw_chain_free(c);
+  lw_system_free(sys);
+}
+
+/* Batch means of one observable: B batches of `per` samples each. */
+#define BATCHES 50
+typedef struct {
+  double batch[BATCHES];
+  long per, n;
+} batch_mean;
+
+static void bm_add(batch_mean *b, double v)
+{
+  b->batch[b->n / b->per] += v / (double)b->per;
+  b->n++;
+}
+
+/* The mean of the batch means and its standard error. */
+static double bm_mean(const batch_mean *b, double *se)
+{
+  double m = 0.0, ss = 0.0;
+  for (int k = 0; k < BATCHES; k++) m += b->batch[k] / BATCHES;
+  for (int k = 0; k < BATCHES; k++) ss += (b->batch[k] - m) * (b->batch[k] - m);
+  *se = sqrt(ss / (BATCHES - 1) / BATCHES);
+  return m;
+}
+
+/* x_i / sigma_i has mean 0 and x_i^2 / sigma_i^2 mean 1 at temperature T. */
+static void check_gaussian(const char *what, batch_mean *m1, batch_mean *m2, double T)
+{
+  for (int i = 0; i < NV; i++) {
+    double se1, se2;
+    double mean = bm_mean(&m1[i], &se1), var = bm_mean(&m2[i], &se2);
+    cr_assert(se1 < 0.01 && se2 < 0.01, "%s: x%d: standard errors %g, %g too large to test anything", what, i,
+              se1, se2);
+    cr_assert(fabs(mean) < 5 * se1, "%s: x%d / sigma has mean %g +- %g, expected 0", what, i, mean, se1);
+    cr_assert(fabs(var - 1.0) < 5 * se2, "%s: x%d^2 / sigma^2 has mean %g +- %g, expected 1 (T = %g, k = %g)",
+              what, i, var, se2, T, stiffness[i]);
+  }
+}
+
+Test(system, the_chain_samples_a_test_row_exactly)
+{
+  const double T = 0.7;
+  lw_chain *c = gauss_chain(T, 2024);
+  for (int s = 0; s < 2000; s++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  const long per = 20000;
+  batch_mean m1[NV], m2[NV];
+  memset(m1, 0, sizeof m1);
+  memset(m2, 0, sizeof m2);
+  for (int i = 0; i < NV; i++) m1[i].per = m2[i].per = per;
+  const gs_state *st = c->sys->state;
+  for (long s = 0; s < BATCHES * per; s++) {
+    lw_chain_sweep(c);
+    for (int i = 0; i < NV; i++) {
+      double z = st->x[i] / sqrt(T / stiffness[i]);
+      bm_add(&m1[i], z);
+      bm_add(&m2[i], z * z);
+    }
+  }
+  check_gaussian("chain", m1, m2, T);
+  /* both move kinds ran under their names, and the running terms are exact */
+  for (int k = 0; k < 2; k++) cr_assert(c->stats[k].accepted > 0 && c->stats[k].accepted < c->stats[k].proposed);
+  double drift;
+  cr_assert_eq(gauss_type.refresh(c->sys->state, &drift), LW_OK);
+  cr_assert(drift < 1e-9, "running energy drifted by %g", drift);
+  gauss_chain_free(c);
+}
+
+Test(system, tempering_samples_every_rung_of_a_test_row)
+{
+  enum { R = 4 };
+  double ladder[R] = {0.25, 0.5, 1.0, 2.0};
+  lw_error err;
+  lw_tempering *pt = lw_tempering_new(R, ladder, 77, &err);
+  cr_assert_not_null(pt);
+  lw_chain *c[R];
+  for (int k = 0; k < R; k++) c[k] = gauss_chain(ladder[k], 100 + (unsigned long)k);
+  const long per = 10000;
+  batch_mean m1[R][NV], m2[R][NV];
+  memset(m1, 0, sizeof m1);
+  memset(m2, 0, sizeof m2);
+  for (int k = 0; k < R; k++)
+    for (int i = 0; i < NV; i++) m1[k][i].per = m2[k][i].per = per;
+  for (long s = -1000; s < BATCHES * per; s++) {
+    double e[R], t[R];
+    int swapped[R - 1];
+    for (int k = 0; k < R; k++) {
+      lw_chain_sweep(c[k]);
+      e[k] = lw_system_total(c[k]->sys);
+      t[k] = c[k]->temperature;
+    }
+    /* what lw_anneal does: the rungs keep their chains, the systems move */
+    lw_tempering_exchange(pt, e, t, swapped);
+    for (int k = 0; k + 1 < R; k++)
+      if (swapped[k]) {
+        lw_system *x = c[k]->sys;
+        c[k]->sys = c[k + 1]->sys;
+        c[k + 1]->sys = x;
+      }
+    if (s < 0) continue;
+    for (int k = 0; k < R; k++) {
+      const gs_state *st = c[k]->sys->state;
+      for (int i = 0; i < NV; i++) {
+        double z = st->x[i] / sqrt(ladder[k] / stiffness[i]);
+        bm_add(&m1[k][i], z);
+        bm_add(&m2[k][i], z * z);
+      }
+    }
+  }
+  for (int k = 0; k < R; k++) {
+    char what[32];
+    snprintf(what, sizeof what, "rung %d", k);
+    check_gaussian(what, m1[k], m2[k], ladder[k]);
+  }
+  for (int k = 0; k + 1 < R; k++) cr_assert(pt->accepted[k] > 0, "rungs %d and %d never swapped", k, k + 1);
+  cr_assert(pt->round_trips > 10, "%lu round trips", pt->round_trips);
+  for (int k = 0; k < R; k++) gauss_chain_free(c[k]);
+  lw_tempering_free(pt);
+}
+
+Test(system, a_row_saves_and_loads_its_state)
+{
+  lw_chain *c = gauss_chain(1.0, 5);
+  for (int s = 0; s < 10; s++) lw_chain_sweep(c);
+  char dir[64], path[128];
+  cr_assert_eq(lw_test_dir_make(dir, "gsave"), 0);
+  snprintf(path, sizeof path, "%s/state.lw", dir);
+  lw_error err;
+  lw_ckpt_writer w;
+  cr_assert_eq(lw_ckpt_begin(&w, path, LW_STATE_HEADER, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(gauss_type.save(c->sys->state, &w, "system gauss", &err), LW_OK);
+  cr_assert_eq(lw_ckpt_commit(&w, &err), LW_OK, "%s", err.msg);
+  lw_state st = {.scene = "scene.ini"};
+  cr_assert_eq(lw_ckpt_read(&st.doc, path, &err), LW_OK, "%s", err.msg);
+  gs_state *back = gauss_type.load(NULL, &st, "system gauss", path, &err);
+  cr_assert_not_null(back, "%s", err.msg);
+  const gs_state *now = c->sys->state;
+  for (int i = 0; i < NV; i++) cr_assert_eq(back->x[i], now->x[i], "x%d does not survive a save and load", i);
+  gs_state_free(back);
+  lw_state_clear(&st);
+  lw_test_dir_remove(dir);
+  gauss_chain_free(c);
+}
+
+Test(system, the_table_starts_with_splines_and_finds_rows_by_name)
+{
+  cr_assert_eq(lw_system_types[0], lw_system_find("splines"));
+  cr_assert_str_eq(lw_system_types[0]->name, "splines");
+  cr_assert_null(lw_system_find("gauss"), "a test row is not in the library's table");
+  cr_assert_null(lw_system_find(""));
+  for (int k = 0; lw_system_types[k]; k++) {
+    const lw_system_type *t = lw_system_types[k];
+    cr_assert(t->n_moves >= 1 && t->n_moves <= LW_MOVES_MAX, "%s: %d move kinds", t->name, t->n_moves);
+    cr_assert(t->n_terms >= 1 && t->n_terms <= LW_SYSTEM_TERMS_MAX, "%s: %d terms", t->name, t->n_terms);
+    cr_assert(strstr(lw_system_names(), t->name));
+  }
+}
+
+Test(system, an_unknown_system_exits_2_naming_file_line_and_key)
+{
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "sys"), 0);
+  cr_assert_eq(lw_test_sh("printf '[scene]\\nwidth = 50\\nsystem = nurbs\\n' > %s/s.ini", dir), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/s.ini --out %s/out --quiet 2> %s/err.txt", getenv("LW_BIN"), dir, dir, dir), 2);
+  cr_assert_eq(lw_test_sh("grep -q 's.ini:3: key .scene.system.: expected one of splines, got .nurbs.' %s/err.txt",
+                          dir), 0);
+  cr_assert_neq(lw_test_sh("test -e %s/out", dir), 0, "nothing is written for a bad scene");
+  /* the energy command reads a run directory's system the same way */
+  cr_assert_eq(lw_test_sh("mkdir %s/r && cp %s/s.ini %s/r/scene.ini && printf 'linewise-state 1\nscene scene.ini\n"
+                          "seed 1\nsweep 0\nsplines 0\nend\n' > %s/r/state.lw", dir, dir, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s energy %s/r > %s/out.txt 2> %s/err.txt", getenv("LW_BIN"), dir, dir, dir), 2);
+  cr_assert_eq(lw_test_sh("grep -q 'scene.ini:3: key .scene.system.' %s/err.txt && ! test -s %s/out.txt", dir, dir),
+               0);
+  lw_test_dir_remove(dir);
+}
