@@ -55,9 +55,7 @@
 
 #include <math.h>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "linewise/vec2.h"
 
 /* A cubic in power form about a local origin: r(t) = c0 + c1 t + c2 t^2 + c3 t^3. */
 typedef struct {
@@ -229,17 +227,8 @@ static void piece_nodes(const cubic *c, piece *p)
   p->has_nodes = 1;
 }
 
-typedef double v2d __attribute__((vector_size(16)));
+typedef lw_v2d v2d;
 
-/* Two square roots at once (correctly rounded either way). */
-static inline v2d vsqrt2(v2d a)
-{
-#if defined(__SSE2__)
-  return (v2d)_mm_sqrt_pd((__m128d)a);
-#else
-  return (v2d){sqrt(a[0]), sqrt(a[1])};
-#endif
-}
 
 /* The 6 x 6 product rule of 1/r over two pieces, B's nodes two at a time. */
 static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb)
@@ -257,7 +246,7 @@ static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb)
     v2d acc = {0.0, 0.0};
     for (int j = 0; j < GAUSS_S / 2; j++) {
       v2d dx = ax - bx[j], dy = ay - by[j];
-      acc += bw[j] / vsqrt2(dx * dx + dy * dy);
+      acc += bw[j] / lw_vsqrt2(dx * dx + dy * dy);
     }
     sum += aw * acc;
   }

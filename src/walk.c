@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/vec2.h"
+
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -18,18 +20,8 @@
 /* Entries scanned per call of scan: the bits of a uint64_t. */
 #define BLOCK 64
 
-typedef double v2d __attribute__((vector_size(16)));
+typedef lw_v2d v2d;
 
-/* sqrt is correctly rounded in SSE2 and in C alike, so both branches give
-** the same bits. */
-static inline v2d vsqrt(v2d a)
-{
-#if defined(__SSE2__)
-  return (v2d)_mm_sqrt_pd((__m128d)a);
-#else
-  return (v2d){sqrt(a[0]), sqrt(a[1])};
-#endif
-}
 
 static inline v2d load2(const double *p)
 {
@@ -149,7 +141,7 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
         near_bits[b] |= (uint64_t)(bits2(n0) | bits2(n1) << 2) << t;
       }
       if (bits2(f0 | f1)) {
-        v2d v0 = (w0 * q->scale) * (one / vsqrt(r0) - fa->ic), v1 = (w1 * q->scale) * (one / vsqrt(r1) - fa->ic);
+        v2d v0 = (w0 * q->scale) * (one / lw_vsqrt2(r0) - fa->ic), v1 = (w1 * q->scale) * (one / lw_vsqrt2(r1) - fa->ic);
         s0 += (v2d)((v2l)v0 & f0);
         s1 += (v2d)((v2l)v1 & f1);
       }
