@@ -12,6 +12,7 @@
 ** deterministic run; the tolerances are the issue's, and the measured values
 ** they guard are noted beside them.
 */
+#include <cairo.h>
 #include <criterion/criterion.h>
 #include <gsl/gsl_eigen.h>
 #include <gsl/gsl_linalg.h>
@@ -716,6 +717,389 @@ Test(particles, incremental_equals_full_after_a_million_proposals)
   cr_assert_eq(lw_particles_refresh(p, &drift), LW_OK);
   cr_assert(fabs(drift - fabs(lw_particles_total(p) - before) / fmax(fabs(lw_particles_total(p)), 1)) < 1e-15);
   cr_assert_eq(drift_of(p), 0.0);
+  lw_particles_free(p);
+  lw_particles_setup_free(s);
+}
+
+/* ---- determinism, copies, checkpoints ----------------------------------- */
+
+static int same_state(const lw_particles *a, const lw_particles *b)
+{
+  return a->n == b->n && !memcmp(a->x, b->x, 3 * a->n * sizeof(double)) &&
+         !memcmp(a->q, b->q, 4 * a->n * sizeof(double)) && !memcmp(a->pin, b->pin, a->n) &&
+         !memcmp(a->term, b->term, sizeof a->term);
+}
+
+Test(particles, a_seed_fixes_the_run_and_a_copy_runs_on_identically)
+{
+  lw_params prm = scene(1, 1, 1, 0.5);
+  prm.pt_pattern = LW_PPATTERN_CLOUD;
+  prm.pt_count = 80;
+  lw_particles_setup *s = setup_of(&prm);
+  lw_particles *a = lw_particles_new(s, 4, NULL), *b = lw_particles_new(s, 4, NULL), *c = lw_particles_new(s, 5, NULL);
+  cr_assert(same_state(a, b));
+  cr_assert(!same_state(a, c), "another seed places the particles elsewhere");
+  anneal(a, 1, 30, 0.2, 0.2, 0);
+  lw_particles *copy = lw_particles_copy(a, NULL);
+  cr_assert(same_state(a, copy));
+  anneal(a, 2, 30, 0.2, 0.01, 5);
+  anneal(copy, 2, 30, 0.2, 0.01, 5);
+  cr_assert(same_state(a, copy), "a copy diverged");
+  lw_particles_free(copy);
+  lw_particles_free(a);
+  lw_particles_free(b);
+  lw_particles_free(c);
+  lw_particles_setup_free(s);
+}
+
+Test(particles, the_section_round_trips_bit_for_bit_and_resumes_identically)
+{
+  char path[128];
+  write_file("pins.xyz", "9 0 0 1 0 0\n", path, sizeof path);
+  lw_params prm = scene(1, 1, 1, 0.5);
+  prm.pt_pattern = LW_PPATTERN_SPHERE;
+  prm.pt_count = 60;
+  prm.pt_weight = LW_PWEIGHT_GAUSS;
+  strcpy(prm.pt_points, path);
+  prm.pt_pinned = 1;
+  lw_particles_setup *s = setup_of(&prm);
+  lw_particles *p = lw_particles_new(s, 3, NULL);
+  anneal(p, 1, 20, 0.1, 0.1, 0);
+  snprintf(path, sizeof path, "%s/section.txt", dir);
+  FILE *f = fopen(path, "w");
+  fputs("before\n", f);
+  cr_assert_eq(lw_particles_save(p, f, NULL), LW_OK);
+  fputs("after\n", f);
+  fclose(f);
+  f = fopen(path, "r");
+  char line[64];
+  cr_assert_not_null(fgets(line, sizeof line, f));
+  int ln = 1;
+  lw_error err;
+  lw_particles *back = lw_particles_load(s, f, path, &ln, &err);
+  cr_assert_not_null(back, "%s", err.msg);
+  cr_assert_eq(ln, 1 + 1 + LW_PTERM_COUNT + 61);
+  cr_assert_not_null(fgets(line, sizeof line, f));
+  cr_assert_str_eq(line, "after\n", "load read past its section");
+  fclose(f);
+  cr_assert(same_state(p, back));
+  cr_assert_eq(back->pin[0], LW_PIN_POSITION | LW_PIN_ORIENTATION);
+  /* the resumed state runs on exactly as the original */
+  anneal(p, 2, 20, 0.1, 0.01, 0);
+  anneal(back, 2, 20, 0.1, 0.01, 0);
+  cr_assert(same_state(p, back), "the resumed state diverged");
+  lw_particles_free(back);
+  lw_particles_free(p);
+  lw_particles_setup_free(s);
+}
+
+/* Loads text as a section whose first line is line 5 of its file; returns
+** the error (LW_OK with the state freed). */
+static lw_status load_text(const lw_particles_setup *s, const char *text, lw_error *err)
+{
+  char path[128];
+  write_file("bad.lw", text, path, sizeof path);
+  FILE *f = fopen(path, "r");
+  int ln = 4;
+  lw_particles *p = lw_particles_load(s, f, "state.lw", &ln, err);
+  fclose(f);
+  lw_particles_free(p);
+  return p ? LW_OK : err->code;
+}
+
+Test(particles, a_bad_section_is_refused_with_its_line)
+{
+  lw_params prm = scene(1, 0, 0, 0);
+  prm.pt_boundary = LW_PBOUNDARY_SPHERE;
+  prm.pt_boundary_radius = 5;
+  lw_particles_setup *s = setup_of(&prm);
+  /* two particles at r0: the LJ term is its (shifted) minimum */
+  char energies[512];
+  snprintf(energies, sizeof energies,
+           "energy.lj = %.17g\nenergy.coplanarity = 0\nenergy.conormality = 0\n"
+           "energy.cocircularity = 0\nenergy.gravity = 0\nenergy.boundary = 0\n",
+           -1 - (pow(1.6, -12) - 2 * pow(1.6, -6)));
+  char good[1024];
+  snprintf(good, sizeof good, "count = 2\n%s0 0 0 1 0 0 0 0\n1 0 0 1 0 0 0 1\n", energies);
+  lw_error err;
+  cr_assert_eq(load_text(s, good, &err), LW_OK, "%s", err.msg);
+  struct {
+    const char *text, *want;
+  } bad[] = {
+    {"count = 0\n", "state.lw:5: key 'count': expected a whole number"},
+    {"count = 2.5\n", "state.lw:5: key 'count'"},
+    {"cnt = 2\n", "state.lw:5: expected 'count = <number>'"},
+    {"count = 2\nenergy.lj = nan\n", "state.lw:6: key 'energy.lj': expected one finite number"},
+    {"count = 2\nenergy.coplanarity = 0\n", "state.lw:6: expected 'energy.lj = <number>'"},
+    {NULL, NULL},
+  };
+  for (int k = 0; bad[k].text; k++) {
+    cr_assert_eq(load_text(s, bad[k].text, &err), LW_EINPUT, "case %d", k);
+    cr_assert(strstr(err.msg, bad[k].want), "case %d: %s", k, err.msg);
+  }
+  const char *rows[][2] = {
+    {"0 0 0 1 0 0 0 0\n", "state.lw:13: expected particle 2 of 2"},
+    {"0 0 0 1 0 0 0 0\n1 0 0 1 0 0 0 4\n", "state.lw:13: expected 'x y z qw qx qy qz pin'"},
+    {"0 0 0 1 0 0 0 0\n1 0 0 1 0 0\n", "state.lw:13: expected 'x y z qw qx qy qz pin'"},
+    {"0 0 0 1 0 0 0 0\n1 0 inf 1 0 0 0 0\n", "state.lw:13: expected 'x y z qw qx qy qz pin'"},
+    {"0 0 0 1 0 0 0 0\n1 0 0 1 0.1 0 0 0\n", "state.lw:13: expected a unit quaternion"},
+    {"0 0 0 1 0 0 0 0\n6 0 0 1 0 0 0 0\n", "state.lw:13: expected a particle inside the boundary"},
+    {"0 0 0 1 0 0 0 0\n0 0 0 1 0 0 0 0\n", "state.lw:13: the lj energy of the particles is not finite"},
+    {"0 0 0 1 0 0 0 0\n1.01 0 0 1 0 0 0 0\n", "state.lw:6: key 'energy.lj' = -0.884343424"},
+  };
+  for (size_t k = 0; k < sizeof rows / sizeof rows[0]; k++) {
+    char text[1024];
+    snprintf(text, sizeof text, "count = 2\n%s%s", energies, rows[k][0]);
+    cr_assert_eq(load_text(s, text, &err), LW_EINPUT, "row case %zu", k);
+    cr_assert(strstr(err.msg, rows[k][1]), "row case %zu: %s", k, err.msg);
+  }
+  lw_particles_setup_free(s);
+}
+
+/* ---- point files, keys and errors --------------------------------------- */
+
+Test(particles, point_files_are_read_and_bad_ones_name_file_line_and_what_was_expected)
+{
+  char path[128];
+  write_file("ok.xyz", "# points\n\n1 2 3\n  4 5 6   0 0 -2  # a comment\n7e-1 -8 9.5\t0 3 4\n", path, sizeof path);
+  size_t n;
+  double *x, *nrm;
+  unsigned char *has;
+  lw_error err;
+  cr_assert_eq(lw_particles_read_points(path, &n, &x, &nrm, &has, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(n, 3);
+  cr_assert(x[0] == 1 && x[5] == 6 && x[6] == 0.7 && x[8] == 9.5);
+  cr_assert(nrm[2] == 1 && nrm[5] == -1 && nrm[7] == 0.6 && nrm[8] == 0.8);
+  cr_assert(!has[0] && has[1] && has[2]);
+  free(x);
+  free(nrm);
+  free(has);
+  struct {
+    const char *text, *want;
+  } bad[] = {
+    {"1 2 3\n1 2\n", "bad.xyz:2: expected 3 numbers (x y z) or 6 (x y z nx ny nz), got 2"},
+    {"1 2 3\n\n1 2 3 4\n", "bad.xyz:3: expected 3 numbers (x y z) or 6 (x y z nx ny nz), got 4"},
+    {"1 2 x\n", "bad.xyz:1: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got 'x'"},
+    {"1 2 nan\n", "bad.xyz:1: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got 'nan'"},
+    {"1 2 3 4 5 6 7\n", "bad.xyz:1: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got '7'"},
+    {"1 2 3 0 0 0\n", "bad.xyz:1: expected a normal nx ny nz with a direction, got length 0"},
+    {"# nothing\n\n", "bad.xyz:2: expected at least one point"},
+    {NULL, NULL},
+  };
+  for (int k = 0; bad[k].text; k++) {
+    write_file("bad.xyz", bad[k].text, path, sizeof path);
+    cr_assert_eq(lw_particles_read_points(path, &n, &x, &nrm, &has, &err), LW_EINPUT, "case %d", k);
+    cr_assert(strstr(err.msg, bad[k].want), "case %d: %s", k, err.msg);
+    cr_assert_eq(lw_error_exit_status(err.code), 2);
+    cr_assert(n == 0 && !x && !nrm && !has);
+  }
+  /* through the set-up, relative to the scene file */
+  lw_params prm = scene(1, 1, 1, 0);
+  snprintf(prm.file, sizeof prm.file, "%s/scene.ini", dir);
+  strcpy(prm.pt_points, "bad.xyz");
+  cr_assert_null(lw_particles_setup_new(&prm, &err));
+  cr_assert_eq(err.code, LW_EINPUT);
+  cr_assert(strstr(err.msg, "/bad.xyz:2: expected at least one point"), "%s", err.msg);
+  strcpy(prm.pt_points, "missing.xyz");
+  cr_assert_null(lw_particles_setup_new(&prm, &err));
+  cr_assert(strstr(err.msg, "missing.xyz: cannot open point file"), "%s", err.msg);
+}
+
+Test(particles, bad_keys_name_file_line_and_key)
+{
+  char path[128];
+  write_file("s.ini", "[scene]\nsystem = particles\n[particles]\ncount = 10\nalpha_q = 1\n", path, sizeof path);
+  lw_params prm;
+  lw_error err;
+  cr_assert_eq(lw_params_read(&prm, path, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "s.ini:5: key 'particles.alpha_q' is not a parameter"), "%s", err.msg);
+  write_file("s.ini", "[scene]\nsystem = particle\n", path, sizeof path);
+  cr_assert_eq(lw_params_read(&prm, path, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "s.ini:2: key 'scene.system': expected one of splines|particles"), "%s", err.msg);
+  write_file("s.ini", "[particles]\nr0 = 1\nweight = aniso\nrange = 0.5\n", path, sizeof path);
+  cr_assert_eq(lw_params_read(&prm, path, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "s.ini:4: key 'particles.range': expected a value > 1"), "%s", err.msg);
+  /* keys that disagree: named at the set-up, with where they were set */
+  write_file("s.ini", "[particles]\nweight = aniso\nsigma = 0.5\nsigma_normal = 0.8\n", path, sizeof path);
+  cr_assert_eq(lw_params_read(&prm, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_null(lw_particles_setup_new(&prm, &err));
+  cr_assert(strstr(err.msg, "s.ini:4: key 'particles.sigma_normal': expected sigma_normal <= sigma"), "%s", err.msg);
+  write_file("s.ini", "[particles]\ncount = 0\n", path, sizeof path);
+  cr_assert_eq(lw_params_read(&prm, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_null(lw_particles_setup_new(&prm, &err));
+  cr_assert(strstr(err.msg, "s.ini:2: key 'particles.count': expected at least 1 particle"), "%s", err.msg);
+  /* the command line reads the same table: exit status 2 and the message */
+  const char *bin = getenv("LW_BIN");
+  cr_assert_not_null(bin);
+  write_file("s.ini", "[particles]\ncount = 10\npattern = cube\n", path, sizeof path);
+  cr_assert_eq(lw_test_sh("%s run %s --out %s/o --quiet 2>%s/err.txt", bin, path, dir, dir), 2);
+  cr_assert_eq(lw_test_sh("grep -q \"s.ini:3: key 'particles.pattern': expected one of cloud|plane|sphere\" %s/err.txt",
+                          dir), 0);
+}
+
+/* ---- placement ---------------------------------------------------------- */
+
+Test(particles, the_patterns_place_what_they_promise)
+{
+  lw_params prm = scene(1, 1, 1, 0);
+  prm.pt_noise = 0;
+  prm.pt_normal_noise = 0;
+  prm.pt_r0 = 1.25;
+  /* plane: 19 sites = the centred hexagon of radius 2 at the spacing r0 */
+  prm.pt_count = 19;
+  lw_particles_setup *s = setup_of(&prm);
+  lw_particles *p = lw_particles_new(s, 1, NULL);
+  double c[3], nrm[3];
+  cr_assert_lt(fit_plane(p, c, nrm), 1e-15);
+  for (size_t i = 0; i < p->n; i++) {
+    cr_assert(p->x[3 * i + 2] == 0 && p->nrm[3 * i + 2] == 1);
+    cr_assert_lt(hypot(p->x[3 * i], p->x[3 * i + 1]), 2 * 1.25 + 1e-9);
+  }
+  cr_assert(fabs(mean_nearest(p) / 1.25 - 1) < 1e-3, "spacing %g", mean_nearest(p));
+  lw_particles_free(p);
+  lw_particles_setup_free(s);
+  /* sphere: on the sphere of diameter size, normals outward */
+  prm.pt_pattern = LW_PPATTERN_SPHERE;
+  prm.pt_count = 70;
+  prm.pt_size = 9;
+  s = setup_of(&prm);
+  p = lw_particles_new(s, 1, NULL);
+  for (size_t i = 0; i < p->n; i++) {
+    const double *x = p->x + 3 * i;
+    cr_assert(fabs(sqrt(lw_v3_dot(x, x)) - 4.5) < 1e-12);
+    for (int k = 0; k < 3; k++) cr_assert(fabs(p->nrm[3 * i + k] - x[k] / 4.5) < 1e-13);
+  }
+  lw_particles_free(p);
+  lw_particles_setup_free(s);
+  /* cloud: inside the cube, every orientation unit; noise of sd 0.3 */
+  prm.pt_pattern = LW_PPATTERN_CLOUD;
+  prm.pt_count = 2000;
+  prm.pt_size = 40;
+  s = setup_of(&prm);
+  p = lw_particles_new(s, 1, NULL);
+  double sum[3] = {0, 0, 0};
+  for (size_t i = 0; i < p->n; i++)
+    for (int k = 0; k < 3; k++) {
+      cr_assert(fabs(p->x[3 * i + k]) <= 20);
+      sum[k] += p->nrm[3 * i + k];
+    }
+  /* uniform orientations: the mean normal is 0 within 4 sd (1/sqrt(3 n) per axis) */
+  for (int k = 0; k < 3; k++) cr_assert_lt(fabs(sum[k] / 2000), 4 / sqrt(3 * 2000.0));
+  lw_particles_free(p);
+  lw_particles_setup_free(s);
+  prm.pt_pattern = LW_PPATTERN_PLANE;
+  prm.pt_count = 2000;
+  prm.pt_size = 0;
+  prm.pt_noise = 0.3;
+  s = setup_of(&prm);
+  p = lw_particles_new(s, 1, NULL);
+  double ss = 0;
+  for (size_t i = 0; i < p->n; i++) ss += p->x[3 * i + 2] * p->x[3 * i + 2];
+  /* the sd of z estimates 0.3 within 4 sd of the estimate, 1/sqrt(2 n) relative */
+  cr_assert_lt(fabs(sqrt(ss / 2000) / 0.3 - 1), 4 / sqrt(2 * 2000.0));
+  lw_particles_free(p);
+  lw_particles_setup_free(s);
+}
+
+Test(particles, pinned_everything_gives_the_identity_move)
+{
+  char path[128];
+  write_file("all.xyz", "0 0 0 0 0 1\n1 0 0 0 0 1\n", path, sizeof path);
+  lw_params prm = scene(1, 1, 1, 0);
+  strcpy(prm.pt_points, path);
+  prm.pt_pinned = 1;
+  prm.pt_count = 0;
+  lw_particles_setup *s = setup_of(&prm);
+  lw_particles *p = lw_particles_new(s, 1, NULL);
+  cr_assert_eq(lw_particles_sweep_size(p), 0);
+  lw_particles_prop *pr = lw_particles_prop_new(p, NULL);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  lw_particles *before = lw_particles_copy(p, NULL);
+  for (int kind = 0; kind < LW_PMOVE_KINDS; kind++) {
+    int forbidden = 1;
+    cr_assert_eq(lw_particles_propose(p, pr, kind, 0.5, r, &forbidden), 0.0);
+    cr_assert(pr->identity && !forbidden);
+    cr_assert_eq(lw_particles_commit(p, pr), LW_OK);
+  }
+  cr_assert(same_state(p, before));
+  cr_assert_eq(lw_particles_step_max(p, LW_PMOVE_ROTATE), M_PI);
+  gsl_rng_free(r);
+  lw_particles_prop_free(pr);
+  lw_particles_free(before);
+  lw_particles_free(p);
+  lw_particles_setup_free(s);
+}
+
+/* ---- drawings ----------------------------------------------------------- */
+
+/* The colour at the centre of a PNG: its red and blue. */
+static void centre_colour(const char *path, int size, double *red, double *blue)
+{
+  cairo_surface_t *img = cairo_image_surface_create_from_png(path);
+  cr_assert_eq(cairo_surface_status(img), CAIRO_STATUS_SUCCESS);
+  cr_assert_eq(cairo_image_surface_get_width(img), size);
+  cr_assert_eq(cairo_image_surface_get_height(img), size);
+  const unsigned char *d = cairo_image_surface_get_data(img);
+  uint32_t px = *(const uint32_t *)(d + (size_t)(size / 2) * (size_t)cairo_image_surface_get_stride(img) +
+                                    4 * (size_t)(size / 2));
+  *red = ((px >> 16) & 255) / 255.0;
+  *blue = (px & 255) / 255.0;
+  cairo_surface_destroy(img);
+}
+
+Test(particles, final_ply_and_final_png)
+{
+  lw_params prm = scene(1, 1, 1, 0);
+  prm.pt_count = 37;
+  prm.pt_png_size = 200;
+  prm.pt_view_elevation = 90; /* from +z: the sheet's normals face the viewer */
+  lw_particles_setup *s = setup_of(&prm);
+  lw_particles *p = lw_particles_new(s, 3, NULL);
+  lw_error err;
+  cr_assert_eq(lw_particles_draw(p, dir, &err), LW_OK, "%s", err.msg);
+  char path[128];
+  snprintf(path, sizeof path, "%s/final.ply", dir);
+  FILE *f = fopen(path, "r");
+  cr_assert_not_null(f);
+  char line[256];
+  const char *head[] = {"ply\n", "format ascii 1.0\n", NULL, "element vertex 37\n", "property float x\n",
+                        "property float y\n", "property float z\n", "property float nx\n", "property float ny\n",
+                        "property float nz\n", "end_header\n"};
+  for (int k = 0; k < 11; k++) {
+    cr_assert_not_null(fgets(line, sizeof line, f));
+    if (head[k]) cr_assert_str_eq(line, head[k]);
+    else cr_assert(!strncmp(line, "comment ", 8));
+  }
+  for (size_t i = 0; i < p->n; i++) {
+    float v[6];
+    cr_assert_eq(fscanf(f, "%f %f %f %f %f %f", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]), 6);
+    for (int k = 0; k < 3; k++) {
+      cr_assert_eq(v[k], (float)p->x[3 * i + k]);
+      cr_assert_eq(v[3 + k], (float)p->nrm[3 * i + k]);
+    }
+  }
+  cr_assert_eq(fscanf(f, "%255s", line), EOF);
+  fclose(f);
+  snprintf(path, sizeof path, "%s/final.png", dir);
+  double red, blue;
+  centre_colour(path, 200, &red, &blue);
+  cr_assert(blue > 0.5 && red < 0.4, "the front of the sheet is blue (%g, %g)", red, blue);
+  cr_assert_eq(lw_test_sh("cp %s/final.png %s/first.png && ls %s | grep -c tmp >/dev/null", dir, dir, dir), 1,
+               "a temporary file was left");
+  /* the same state draws the same bytes */
+  cr_assert_eq(lw_particles_draw(p, dir, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_test_sh("cmp -s %s/final.png %s/first.png", dir, dir), 0);
+  lw_particles_free(p);
+  lw_particles_setup_free(s);
+  /* from below the sheet shows its back: orange */
+  prm.pt_view_elevation = -90;
+  s = setup_of(&prm);
+  p = lw_particles_new(s, 3, NULL);
+  cr_assert_eq(lw_particles_write_png(p, path, &err), LW_OK, "%s", err.msg);
+  centre_colour(path, 200, &red, &blue);
+  cr_assert(red > 0.5 && blue < 0.4, "the back of the sheet is orange (%g, %g)", red, blue);
+  /* a directory that does not exist: an error, not a crash */
+  cr_assert_eq(lw_particles_draw(p, "/nonexistent/dir", &err), LW_EIO);
   lw_particles_free(p);
   lw_particles_setup_free(s);
 }
