@@ -1202,3 +1202,28 @@ Test(particles, the_corrected_forces_and_torques_match_central_differences)
     cr_assert_geq(tried, 8);
   }
 }
+
+/* ---- the bundled scenes ------------------------------------------------- */
+
+Test(particles, the_bundled_particle_scenes_read_build_and_anneal)
+{
+  const char *root = getenv("LW_ROOT");
+  cr_assert_not_null(root);
+  const char *names[] = {"particles-sheet.ini", "particles-sphere.ini"};
+  for (int k = 0; k < 2; k++) {
+    char path[1024];
+    snprintf(path, sizeof path, "%s/params/%s", root, names[k]);
+    lw_params prm;
+    lw_error err;
+    cr_assert_eq(lw_params_read(&prm, path, &err), LW_OK, "%s", err.msg);
+    cr_assert_eq(prm.system, LW_SYSTEM_PARTICLES);
+    lw_particles_setup *s = setup_of(&prm);
+    lw_particles *p = lw_particles_new(s, (unsigned long)prm.seed, &err);
+    cr_assert_not_null(p, "%s: %s", names[k], err.msg);
+    double e0 = lw_particles_total(p);
+    anneal(p, 1, 20, prm.t_start, prm.t_start, 5);
+    cr_assert_lt(lw_particles_total(p), e0, "%s: annealing lowers the energy", names[k]);
+    lw_particles_free(p);
+    lw_particles_setup_free(s);
+  }
+}
