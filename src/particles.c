@@ -153,22 +153,50 @@ int lw_particles_outside(const lw_particles_setup *s, const double x[3])
 ** their entries in index order (grid.h), so the sum's order is a function
 ** of the positions alone.
 */
+/* Squared distances along one axis from p, in cell c of the axis that starts
+** at a with cells of side h, to the cells c - 1 and c + 1 (0 to its own).
+** They bound the distance to every particle in those cells, clamped ones
+** included: clamping only moves particles outward. */
+static void axis_gaps(double a, double h, int c, double p, double gap[3])
+{
+  double below = p - (a + c * h), above = a + (c + 1) * h - p;
+  gap[0] = below * below;
+  gap[1] = 0.0;
+  gap[2] = above * above;
+}
+
+/*
+** The pair energies of a particle at x against its neighbours j != k with
+** j >= from, added per term to ea (with normal na) and, when nb is not NULL,
+** to eb (with normal nb): a rotation evaluates both orientations in one walk.
+** Cells are visited in a fixed order (z, then y, then x, each ascending) and
+** their entries in index order (grid.h), so the sum's order is a function
+** of the positions alone.  Cells wholly beyond the range hold no pair and
+** are skipped (with a margin for the rounding of the cell index).
+*/
 static void walk(const lw_particles *p, uint32_t k, uint32_t from, const double x[3], const double na[3],
                  const double nb[3], double ea[LW_PTERM_PAIRS], double eb[LW_PTERM_PAIRS])
 {
   const lw_cellgrid *g = p->grid;
   const lw_ppair_ctx *c = &p->setup->pair;
-  const double range2 = c->range2;
+  const double range2 = c->range2, skip2 = range2 * (1.0 + 1e-9), h = 1.0 / g->inv_h;
   const double *nrm = p->nrm;
   int cx, cy, cz;
   lw_cellgrid_locate3(g, x[0], x[1], x[2], &cx, &cy, &cz);
+  double gx[3], gy[3], gz[3];
+  axis_gaps(g->x0, h, cx, x[0], gx);
+  axis_gaps(g->y0, h, cy, x[1], gy);
+  axis_gaps(g->z0, h, cz, x[2], gz);
   int z0 = cz > 0 ? cz - 1 : 0, z1 = cz + 1 < g->nz ? cz + 1 : g->nz - 1;
   int y0 = cy > 0 ? cy - 1 : 0, y1 = cy + 1 < g->ny ? cy + 1 : g->ny - 1;
   int x0 = cx > 0 ? cx - 1 : 0, x1 = cx + 1 < g->nx ? cx + 1 : g->nx - 1;
   for (int zz = z0; zz <= z1; zz++)
     for (int yy = y0; yy <= y1; yy++) {
+      double gyz = gz[zz - cz + 1] + gy[yy - cy + 1];
+      if (gyz > skip2) continue;
       const lw_cell *row = g->cell + ((size_t)zz * (size_t)g->ny + (size_t)yy) * (size_t)g->nx;
       for (int xx = x0; xx <= x1; xx++) {
+        if (gyz + gx[xx - cx + 1] > skip2) continue;
         const lw_cell *cell = row + xx;
         const double *px = cell->x, *py = lw_cell_y(cell), *pz = lw_cell_z(cell);
         const uint32_t *id = lw_cell_idx(cell);
@@ -326,8 +354,8 @@ lw_particles *lw_particles_new(const lw_particles_setup *s, unsigned long seed, 
     lw_quat_from_normal(s->point_normal + 3 * i, q + 4 * i);
     pin[i] = s->point_pin[i];
   }
-  if (lw_particles_place(s->pattern, s->count, s->size, s->noise, s->normal_noise, seed, x + 3 * s->n_points,
-                         q + 4 * s->n_points, err))
+  if (lw_particles_place(s->pattern, s->count, s->size, s->noise, s->normal_noise, 0.5 * s->pair.r0, seed,
+                         x + 3 * s->n_points, q + 4 * s->n_points, err))
     goto out;
   p = lw_particles_new_from(s, n, x, q, pin, err);
 out:
@@ -387,6 +415,12 @@ double lw_particles_evaluate(const lw_particles *p, lw_particles_prop *pr, uint3
   memcpy(pr->x, x, sizeof pr->x);
   memcpy(pr->q, q, sizeof pr->q);
   lw_quat_normal(q, pr->n);
+  if (forbidden) *forbidden = 0;
+  /* a degenerate draw (an infinite step) never reaches the state: NaN, rejected */
+  if (!isfinite(x[0] + x[1] + x[2]) || !isfinite(pr->n[0] + pr->n[1] + pr->n[2])) {
+    for (int t = 0; t < LW_PTERM_COUNT; t++) pr->dterm[t] = NAN;
+    return pr->dE = NAN;
+  }
   double e_new[LW_PTERM_COUNT] = {0}, e_old[LW_PTERM_COUNT] = {0};
   int moved = x[0] != xo[0] || x[1] != xo[1] || x[2] != xo[2];
   if (moved) {
@@ -398,8 +432,8 @@ double lw_particles_evaluate(const lw_particles *p, lw_particles_prop *pr, uint3
     }
     external(s, xo, e_old);
   }
-  if (forbidden) *forbidden = 0;
-  if (s->pair.on) {
+  /* a turn leaves every distance, so without a weighted term it changes nothing */
+  if (s->pair.on && (moved || s->pair.weighted)) {
     if (moved) {
       walk(p, k, 0, xo, no, NULL, e_old, NULL);
       walk(p, k, 0, x, pr->n, NULL, e_new, NULL);

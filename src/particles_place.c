@@ -7,6 +7,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "linewise/grid.h"
 #include "linewise/params.h"
 #include "linewise/particles_geom.h"
 
@@ -60,21 +61,57 @@ static lw_status plane_sites(size_t count, double a, double *x, lw_error *err)
   return LW_OK;
 }
 
-lw_status lw_particles_place(int pattern, size_t count, double size, double noise, double normal_noise,
-                             unsigned long seed, double *x, double *q, lw_error *err)
+/* 1 if a particle of g (positions x) lies closer than d to p. */
+static int crowded(const lw_cellgrid *g, const double *x, const double p[3], double d)
 {
+  int cx, cy, cz;
+  lw_cellgrid_locate3(g, p[0], p[1], p[2], &cx, &cy, &cz);
+  for (int zz = cz > 0 ? cz - 1 : 0; zz <= cz + 1 && zz < g->nz; zz++)
+    for (int yy = cy > 0 ? cy - 1 : 0; yy <= cy + 1 && yy < g->ny; yy++)
+      for (int xx = cx > 0 ? cx - 1 : 0; xx <= cx + 1 && xx < g->nx; xx++) {
+        const lw_cell *c = &g->cell[((size_t)zz * (size_t)g->ny + (size_t)yy) * (size_t)g->nx + (size_t)xx];
+        const uint32_t *id = lw_cell_idx(c);
+        for (uint32_t e = 0; e < c->n; e++) {
+          const double *o = x + 3 * (size_t)id[e];
+          double r[3] = {o[0] - p[0], o[1] - p[1], o[2] - p[2]};
+          if (lw_v3_dot(r, r) < d * d) return 1;
+        }
+      }
+  return 0;
+}
+
+lw_status lw_particles_place(int pattern, size_t count, double size, double noise, double normal_noise,
+                             double min_dist, unsigned long seed, double *x, double *q, lw_error *err)
+{
+  lw_cellgrid *g = NULL;
   if (pattern == LW_PPATTERN_PLANE) {
     lw_status s = plane_sites(count, lw_particles_plane_spacing(count, size), x, err);
     if (s) return s;
+  } else if (pattern == LW_PPATTERN_CLOUD && min_dist > 0) {
+    const double lo[3] = {-0.5 * size, -0.5 * size, -0.5 * size}, ext[3] = {size, size, size};
+    if (!(g = lw_cellgrid_new3(lo, ext, min_dist, count, err))) return LW_ENOMEM;
   }
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-  if (!r) return lw_error_set(err, LW_ENOMEM, "out of memory for the placement's generator");
+  if (!r) {
+    lw_cellgrid_free(g);
+    return lw_error_set(err, LW_ENOMEM, "out of memory for the placement's generator");
+  }
   gsl_rng_set(r, seed);
   const double golden = M_PI * (3.0 - sqrt(5.0));
   for (size_t k = 0; k < count; k++) {
     double *xk = x + 3 * k, *qk = q + 4 * k;
     if (pattern == LW_PPATTERN_CLOUD) {
-      for (int c = 0; c < 3; c++) xk[c] = size * (gsl_rng_uniform(r) - 0.5);
+      /* random sequential addition: a few tries for a place min_dist clear
+      ** of the others, then the last try stands */
+      for (int tries = 0; tries < LW_PLACE_TRIES; tries++) {
+        for (int c = 0; c < 3; c++) xk[c] = size * (gsl_rng_uniform(r) - 0.5);
+        if (!g || !crowded(g, x, xk, min_dist)) break;
+      }
+      if (g && lw_cellgrid_insert3(g, (uint32_t)k, xk[0], xk[1], xk[2])) {
+        gsl_rng_free(r);
+        lw_cellgrid_free(g);
+        return lw_error_set(err, LW_ENOMEM, "out of memory for the cloud pattern");
+      }
       /* a Gaussian 4-vector has a uniform direction: a uniform rotation */
       for (int c = 0; c < 4; c++) qk[c] = gsl_ran_gaussian_ziggurat(r, 1.0);
       lw_quat_normalise(qk);
@@ -99,5 +136,6 @@ lw_status lw_particles_place(int pattern, size_t count, double size, double nois
     }
   }
   gsl_rng_free(r);
+  lw_cellgrid_free(g);
   return LW_OK;
 }

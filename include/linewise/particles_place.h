@@ -3,8 +3,13 @@
 ** cloud, a noisy plane or a noisy sphere (particles.pattern).
 **
 **   cloud   positions uniform in the cube of side `size` around the origin,
-**           orientations uniform over all rotations (a normalised 4-D
-**           Gaussian quaternion);
+**           no two closer than min_dist (r0/2: random sequential addition,
+**           LW_PLACE_TRIES draws for a clear place, then the last draw
+**           stands), orientations uniform over all rotations (a normalised
+**           4-D Gaussian quaternion).  Pure uniform placement puts some
+**           pairs so close that the Lennard-Jones energy reaches 1e20 and
+**           more, which no running total can later cancel to 1e-9 of
+**           what is left;
 **   plane   the `count` sites of a hexagonal lattice in z = 0 nearest the
 **           origin, spaced so that they fill a disc of diameter `size`,
 **           normals +z;
@@ -36,9 +41,11 @@ double lw_particles_auto_size(int pattern, size_t count, double r0);
 ** of diameter size. */
 double lw_particles_plane_spacing(size_t count, double size);
 
+#define LW_PLACE_TRIES 100
+
 /* Places count particles: x (3 count) and q (4 count, unit).  LW_ENOMEM
-** if the lattice cannot be built. */
+** if the lattice or the cloud's grid cannot be built. */
 lw_status lw_particles_place(int pattern, size_t count, double size, double noise, double normal_noise,
-                             unsigned long seed, double *x, double *q, lw_error *err);
+                             double min_dist, unsigned long seed, double *x, double *q, lw_error *err);
 
 #endif
