@@ -26,9 +26,9 @@
   {sec, key, LW_PT_STRING, OFF(f), def, unit, 0, 0, 0, NULL, help, sizeof ((lw_params *)0)->f}
 
 const lw_param_def lw_param_table[] = {
-  CHOICE("scene", "system", system, "splines", "splines|particles",
-         "What the scene anneals: Bezier splines on a page, or oriented particles in 3-D "
-         "(the [particles] section; README, docs/NUMERICS.md)."),
+  STRING("scene", "system", system, "splines", "",
+         "What is annealed: `splines` (cubic Bezier splines, the only system so far; "
+         "docs/SYSTEMS.md)."),
   CHOICE("scene", "page", page, "custom", "custom|a4|a3|letter",
          "Page size: `custom` takes `width` and `height`; a4 is 210 x 297 mm, a3 297 x 420 mm, "
          "letter 215.9 x 279.4 mm (portrait). A named page sets width and height; setting "

@@ -109,48 +109,123 @@ out:
   return s;
 }
 
-lw_status lw_particles_save(const lw_particles *p, FILE *f, lw_error *err)
+/* ---- the checkpoint section ---------------------------------------------
+** One body, two carriers: lines of a FILE, or the "particles" lines of an
+** lw_state (the run loop's in-memory state.lw).  The body is made and read
+** line by line through a sink and a source, so both carriers share one
+** format and one reader. */
+
+typedef lw_status (*line_sink)(void *ctx, const char *line);
+
+static lw_status emit(const lw_particles *p, line_sink put, void *ctx, lw_error *err)
 {
-  fprintf(f, "count = %zu\n", p->n);
-  for (int t = 0; t < LW_PTERM_COUNT; t++) fprintf(f, "energy.%s = %.17g\n", lw_pterm_names[t], p->term[t]);
+  char line[512];
+  lw_status s;
+  snprintf(line, sizeof line, "count = %zu", p->n);
+  if ((s = put(ctx, line))) goto fail;
+  for (int t = 0; t < LW_PTERM_COUNT; t++) {
+    snprintf(line, sizeof line, "energy.%s = %.17g", lw_pterm_names[t], p->term[t]);
+    if ((s = put(ctx, line))) goto fail;
+  }
   for (size_t i = 0; i < p->n; i++) {
     const double *x = p->x + 3 * i, *q = p->q + 4 * i;
-    fprintf(f, "%.17g %.17g %.17g %.17g %.17g %.17g %.17g %d\n", x[0], x[1], x[2], q[0], q[1], q[2], q[3],
-            p->pin[i]);
+    snprintf(line, sizeof line, "%.17g %.17g %.17g %.17g %.17g %.17g %.17g %d", x[0], x[1], x[2], q[0], q[1], q[2],
+             q[3], p->pin[i]);
+    if ((s = put(ctx, line))) goto fail;
   }
-  return ferror(f) ? lw_error_set(err, LW_EIO, "writing the particles failed") : LW_OK;
+  return LW_OK;
+fail:
+  return lw_error_set(err, s, s == LW_ENOMEM ? "out of memory for the particles' section" : "writing the particles failed");
 }
 
-/* Reads "key = value" (one finite number) on the next line into *v. */
-static lw_status read_key(FILE *f, const char *path, int *line, char **buf, size_t *cap, const char *key, double *v,
-                          lw_error *err)
+static lw_status put_file(void *ctx, const char *line)
 {
-  if (!next_line(f, buf, cap, line))
-    return lw_error_set(err, LW_EINPUT, "%s:%d: expected '%s = <number>', got the end of the file", path, *line + 1,
-                        key);
-  size_t n = strlen(key);
-  char *c = *buf, bad[48];
-  if (strncmp(c, key, n) || (c[n] != ' ' && c[n] != '=')) {
-    return lw_error_set(err, LW_EINPUT, "%s:%d: expected '%s = <number>', got '%.60s'", path, *line, key, c);
+  return fprintf(ctx, "%s\n", line) < 0 ? LW_EIO : LW_OK;
+}
+
+static lw_status put_state(void *ctx, const char *line)
+{
+  return lw_state_add(ctx, LW_PARTICLES_KEY, line) ? LW_ENOMEM : LW_OK;
+}
+
+lw_status lw_particles_save(const lw_particles *p, FILE *f, lw_error *err)
+{
+  lw_status s = emit(p, put_file, f, err);
+  if (!s && ferror(f)) s = lw_error_set(err, LW_EIO, "writing the particles failed");
+  return s;
+}
+
+lw_status lw_particles_save_state(const lw_particles *p, lw_state *st, lw_error *err)
+{
+  return emit(p, put_state, st, err);
+}
+
+/* The next line of the body and its number (*line), or NULL at its end. */
+typedef struct {
+  char *(*next)(void *ctx, int *line);
+  void *ctx;
+} line_source;
+
+typedef struct {
+  FILE *f;
+  char *buf;
+  size_t cap;
+} file_source;
+
+static char *next_file(void *ctx, int *line)
+{
+  file_source *fs = ctx;
+  char *text = next_line(fs->f, &fs->buf, &fs->cap, line);
+  if (!text) (*line)++; /* the line that is missing */
+  return text;
+}
+
+typedef struct {
+  const lw_state *st;
+  size_t i;
+} state_source;
+
+static char *next_state(void *ctx, int *line)
+{
+  state_source *ss = ctx;
+  while (ss->i < ss->st->n_extra) {
+    const lw_state_extra *e = &ss->st->extra[ss->i++];
+    if (strcmp(e->key, LW_PARTICLES_KEY)) continue;
+    *line = e->line;
+    return e->value;
   }
+  (*line)++;
+  return NULL;
+}
+
+/* Reads "key = value" (one finite number) from the next line into *v. */
+static lw_status read_key(line_source *src, const char *path, int *line, const char *key, double *v, lw_error *err)
+{
+  char *c = src->next(src->ctx, line), bad[48];
+  if (!c)
+    return lw_error_set(err, LW_EINPUT, "%s:%d: expected '%s = <number>', got the end of the particles", path, *line,
+                        key);
+  const char *text = c;
+  size_t n = strlen(key);
+  if (strncmp(c, key, n) || (c[n] != ' ' && c[n] != '='))
+    return lw_error_set(err, LW_EINPUT, "%s:%d: expected '%s = <number>', got '%.60s'", path, *line, key, text);
   c += n;
   while (*c == ' ') c++;
   if (*c++ != '=' || numbers(c, v, 1, bad, sizeof bad) != 1)
     return lw_error_set(err, LW_EINPUT, "%s:%d: key '%s': expected one finite number, got '%.60s'", path, *line, key,
-                        *buf);
+                        text);
   return LW_OK;
 }
 
-lw_particles *lw_particles_load(const lw_particles_setup *s, FILE *f, const char *path, int *line, lw_error *err)
+static lw_particles *load(const lw_particles_setup *s, line_source *src, const char *path, int *line, lw_error *err)
 {
-  char *buf = NULL, bad[48], key[64];
-  size_t cap = 0;
+  char bad[48], key[64];
   double count, energy[LW_PTERM_COUNT];
   int energy_line[LW_PTERM_COUNT];
   double *x = NULL, *q = NULL;
   unsigned char *pin = NULL;
   lw_particles *p = NULL;
-  if (read_key(f, path, line, &buf, &cap, "count", &count, err)) goto out;
+  if (read_key(src, path, line, "count", &count, err)) goto out;
   if (count != floor(count) || count < 1 || count > UINT32_MAX / 2) {
     lw_error_set(err, LW_EINPUT, "%s:%d: key 'count': expected a whole number from 1 to %u, got %.17g", path, *line,
                  UINT32_MAX / 2, count);
@@ -158,7 +233,7 @@ lw_particles *lw_particles_load(const lw_particles_setup *s, FILE *f, const char
   }
   for (int t = 0; t < LW_PTERM_COUNT; t++) {
     snprintf(key, sizeof key, "energy.%s", lw_pterm_names[t]);
-    if (read_key(f, path, line, &buf, &cap, key, &energy[t], err)) goto out;
+    if (read_key(src, path, line, key, &energy[t], err)) goto out;
     energy_line[t] = *line;
   }
   size_t n = (size_t)count;
@@ -170,16 +245,17 @@ lw_particles *lw_particles_load(const lw_particles_setup *s, FILE *f, const char
     goto out;
   }
   for (size_t i = 0; i < n; i++) {
-    if (!next_line(f, &buf, &cap, line)) {
-      lw_error_set(err, LW_EINPUT, "%s:%d: expected particle %zu of %zu 'x y z qw qx qy qz pin', got the end of the file",
-                   path, *line + 1, i + 1, n);
+    char *text = src->next(src->ctx, line);
+    if (!text) {
+      lw_error_set(err, LW_EINPUT, "%s:%d: expected particle %zu of %zu 'x y z qw qx qy qz pin', got the end of the "
+                   "particles", path, *line, i + 1, n);
       goto out;
     }
     double v[8];
-    int k = numbers(buf, v, 8, bad, sizeof bad);
+    int k = numbers(text, v, 8, bad, sizeof bad);
     if (k != 8 || (v[7] != 0 && v[7] != 1 && v[7] != 2 && v[7] != 3)) {
       lw_error_set(err, LW_EINPUT, "%s:%d: expected 'x y z qw qx qy qz pin' (8 finite numbers, pin 0 to 3), got '%.80s'",
-                   path, *line, buf);
+                   path, *line, text);
       goto out;
     }
     memcpy(x + 3 * i, v, 3 * sizeof *v);
@@ -215,9 +291,26 @@ lw_particles *lw_particles_load(const lw_particles_setup *s, FILE *f, const char
     p->term[t] = energy[t];
   }
 out:
-  free(buf);
   free(x);
   free(q);
   free(pin);
   return p;
+}
+
+lw_particles *lw_particles_load(const lw_particles_setup *s, FILE *f, const char *path, int *line, lw_error *err)
+{
+  file_source fs = {f, NULL, 0};
+  line_source src = {next_file, &fs};
+  lw_particles *p = load(s, &src, path, line, err);
+  free(fs.buf);
+  return p;
+}
+
+lw_particles *lw_particles_load_state(const lw_particles_setup *s, const lw_state *st, const char *path,
+                                      lw_error *err)
+{
+  state_source ss = {st, 0};
+  line_source src = {next_state, &ss};
+  int line = 0;
+  return load(s, &src, path, &line, err);
 }

@@ -51,7 +51,7 @@ static lw_params scene(double lj, double p, double n, double c)
 {
   lw_params prm;
   lw_params_defaults(&prm);
-  prm.system = LW_SYSTEM_PARTICLES;
+  strcpy(prm.system, "particles");
   prm.pt_alpha_lj = lj;
   prm.pt_alpha_p = p;
   prm.pt_alpha_n = n;
@@ -196,12 +196,6 @@ static double mean_nearest(const lw_particles *p)
   return sum / (double)p->n;
 }
 
-static double total_of(const double t[LW_PTERM_COUNT])
-{
-  double e = 0;
-  for (int k = 0; k < LW_PTERM_COUNT; k++) e += t[k];
-  return e;
-}
 
 /* ---- the 3-D grid ------------------------------------------------------- */
 
@@ -913,9 +907,6 @@ Test(particles, bad_keys_name_file_line_and_key)
   lw_error err;
   cr_assert_eq(lw_params_read(&prm, path, &err), LW_EINPUT);
   cr_assert(strstr(err.msg, "s.ini:5: key 'particles.alpha_q' is not a parameter"), "%s", err.msg);
-  write_file("s.ini", "[scene]\nsystem = particle\n", path, sizeof path);
-  cr_assert_eq(lw_params_read(&prm, path, &err), LW_EINPUT);
-  cr_assert(strstr(err.msg, "s.ini:2: key 'scene.system': expected one of splines|particles"), "%s", err.msg);
   write_file("s.ini", "[particles]\nr0 = 1\nweight = aniso\nrange = 0.5\n", path, sizeof path);
   cr_assert_eq(lw_params_read(&prm, path, &err), LW_EINPUT);
   cr_assert(strstr(err.msg, "s.ini:4: key 'particles.range': expected a value > 1"), "%s", err.msg);
@@ -1216,7 +1207,7 @@ Test(particles, the_bundled_particle_scenes_read_build_and_anneal)
     lw_params prm;
     lw_error err;
     cr_assert_eq(lw_params_read(&prm, path, &err), LW_OK, "%s", err.msg);
-    cr_assert_eq(prm.system, LW_SYSTEM_PARTICLES);
+    cr_assert_str_eq(prm.system, "particles");
     lw_particles_setup *s = setup_of(&prm);
     lw_particles *p = lw_particles_new(s, (unsigned long)prm.seed, &err);
     cr_assert_not_null(p, "%s: %s", names[k], err.msg);
@@ -1226,4 +1217,42 @@ Test(particles, the_bundled_particle_scenes_read_build_and_anneal)
     lw_particles_free(p);
     lw_particles_setup_free(s);
   }
+}
+
+Test(particles, the_section_also_travels_in_an_in_memory_state_file)
+{
+  lw_params prm = scene(1, 1, 1, 0.5);
+  prm.pt_count = 30;
+  lw_particles_setup *s = setup_of(&prm);
+  lw_particles *p = lw_particles_new(s, 3, NULL);
+  anneal(p, 1, 10, 0.1, 0.1, 0);
+  /* through state.lw on disk, as the run loop keeps it */
+  lw_state st = {.scene = "scene.ini", .seed = 3, .sweep = 10, .sp = lw_splines_new(0, NULL, NULL)};
+  cr_assert_not_null(st.sp);
+  cr_assert_eq(lw_state_add(&st, "rng", "abc"), LW_OK);
+  lw_error err;
+  cr_assert_eq(lw_particles_save_state(p, &st, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(st.n_extra, 1 + 1 + LW_PTERM_COUNT + 30);
+  char path[128];
+  snprintf(path, sizeof path, "%s/state.lw", dir);
+  cr_assert_eq(lw_state_write(&st, path, &err), LW_OK, "%s", err.msg);
+  lw_state back;
+  cr_assert_eq(lw_state_read(&back, path, &err), LW_OK, "%s", err.msg);
+  lw_particles *q = lw_particles_load_state(s, &back, path, &err);
+  cr_assert_not_null(q, "%s", err.msg);
+  cr_assert(same_state(p, q));
+  /* a bad line is named by its line in the file */
+  int bad_line = back.extra[9].line;
+  cr_assert_gt(bad_line, 0);
+  free(back.extra[9].value);
+  back.extra[9].value = strdup("1 2 3 4 5 6 7 0");
+  cr_assert_null(lw_particles_load_state(s, &back, path, &err));
+  char want[160];
+  snprintf(want, sizeof want, "state.lw:%d: expected a unit quaternion", bad_line);
+  cr_assert(strstr(err.msg, want), "%s", err.msg);
+  lw_particles_free(q);
+  lw_state_clear(&back);
+  lw_state_clear(&st);
+  lw_particles_free(p);
+  lw_particles_setup_free(s);
 }

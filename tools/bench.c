@@ -360,7 +360,7 @@ static void bench_particles(bench_ctx *b)
   for (int k = 0; k < N_PARTICLE_ROWS; k++) {
     lw_params prm;
     lw_params_defaults(&prm);
-    prm.system = LW_SYSTEM_PARTICLES;
+    strcpy(prm.system, "particles");
     prm.pt_pattern = LW_PPATTERN_CLOUD;
     prm.pt_count = (int)count;
     prm.pt_size = cbrt((double)count / density);

@@ -52,14 +52,13 @@ enum { LW_MASK_NONE, LW_MASK_ALPHA, LW_MASK_IMAGE };
 enum { LW_STRAIN_SPLINE, LW_STRAIN_SEGMENT };
 enum { LW_FIELDMODE_AXIAL, LW_FIELDMODE_SIGNED };
 enum { LW_LADDER_FIXED, LW_LADDER_EQUAL };
-enum { LW_SYSTEM_SPLINES, LW_SYSTEM_PARTICLES };
 enum { LW_PPATTERN_CLOUD, LW_PPATTERN_PLANE, LW_PPATTERN_SPHERE };
 enum { LW_PWEIGHT_POLY, LW_PWEIGHT_GAUSS, LW_PWEIGHT_ANISO };
 enum { LW_PBOUNDARY_NONE, LW_PBOUNDARY_PLANE, LW_PBOUNDARY_SPHERE };
 
 typedef struct {
   /* [scene] */
-  int system;                 /* LW_SYSTEM_*: what the scene anneals */
+  char system[64];            /* a name from the system table (system.h) */
   int page;                   /* LW_PAGE_*: a named size sets width and height */
   int orientation;            /* LW_ORIENT_* of a named page */
   double width, height;       /* page, mm */
