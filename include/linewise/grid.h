@@ -57,7 +57,7 @@ typedef struct {
   double x0, y0;     /* lower corner of the covered area, mm */
   double inv_h;      /* 1 / cell side */
   int nx, ny;        /* cells per axis */
-  lw_cell *cell;     /* nx * ny */
+  lw_cell *cell;     /* nx * ny * nz */
   uint32_t *home;    /* n_samples: the cell of each inserted sample */
   size_t n_samples;  /* indices run from 0 to n_samples - 1 */
   double z0;         /* 3-D: lower corner in z; 0 in 2-D */
