@@ -1258,3 +1258,28 @@ Test(particles, the_section_also_travels_in_an_in_memory_state_file)
   lw_particles_free(p);
   lw_particles_setup_free(s);
 }
+
+Test(particles, degenerate_draws_give_nan_and_a_turn_without_weights_changes_nothing)
+{
+  lw_params prm = scene(1, 0, 0, 0);
+  prm.pt_count = 19;
+  lw_particles_setup *s = setup_of(&prm);
+  lw_particles *p = lw_particles_new(s, 1, NULL);
+  lw_particles_prop *pr = lw_particles_prop_new(p, NULL);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  int forbidden;
+  /* Lennard-Jones alone sees distances only: every turn is free */
+  for (int k = 0; k < 20; k++) cr_assert_eq(lw_particles_propose(p, pr, LW_PMOVE_ROTATE, 0.7, r, &forbidden), 0.0);
+  /* an infinite step draws an infinite position or angle: NaN, never committed by a chain */
+  for (int kind = 0; kind < LW_PMOVE_KINDS; kind++) {
+    double dE = lw_particles_propose(p, pr, kind, INFINITY, r, &forbidden);
+    cr_assert(isnan(dE) && !forbidden, "kind %d: %g", kind, dE);
+  }
+  const double far[3] = {NAN, 0, 0}, q[4] = {1, 0, 0, 0};
+  cr_assert(isnan(lw_particles_evaluate(p, pr, 0, far, q, &forbidden)));
+  cr_assert_lt(drift_of(p), 1e-15);
+  gsl_rng_free(r);
+  lw_particles_prop_free(pr);
+  lw_particles_free(p);
+  lw_particles_setup_free(s);
+}
