@@ -145,14 +145,6 @@ int lw_particles_outside(const lw_particles_setup *s, const double x[3])
   return external(s, x, e);
 }
 
-/*
-** The pair energies of a particle at x against its neighbours j != k with
-** j >= from, added per term to ea (with normal na) and, when nb is not NULL,
-** to eb (with normal nb): a rotation evaluates both orientations in one walk.
-** Cells are visited in a fixed order (z, then y, then x, each ascending) and
-** their entries in index order (grid.h), so the sum's order is a function
-** of the positions alone.
-*/
 /* Squared distances along one axis from p, in cell c of the axis that starts
 ** at a with cells of side h, to the cells c - 1 and c + 1 (0 to its own).
 ** They bound the distance to every particle in those cells, clamped ones
