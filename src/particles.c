@@ -215,6 +215,15 @@ void lw_particles_energy(const lw_particles *p, double term[LW_PTERM_COUNT])
   }
 }
 
+int lw_particles_term_on(const lw_particles_setup *s, int t)
+{
+  switch (t) {
+  case LW_PTERM_GRAVITY: return s->gravity != 0.0;
+  case LW_PTERM_BOUNDARY: return s->boundary != LW_PBOUNDARY_NONE && s->alpha_b != 0.0;
+  default: return t >= 0 && t < LW_PTERM_PAIRS && s->pair.alpha[t] != 0.0;
+  }
+}
+
 void lw_particles_terms(const lw_particles *p, double term[LW_PTERM_COUNT])
 {
   memcpy(term, p->term, sizeof p->term);

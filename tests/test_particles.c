@@ -374,6 +374,9 @@ Test(particles, gravity_and_boundaries_match_their_closed_forms)
   lw_particles *p = lw_particles_new_from(s, 3, x, q, NULL, NULL);
   cr_assert_not_null(p);
   cr_assert(lw_close_rel(p->term[LW_PTERM_GRAVITY], 0.75 * (1 - 1.5 + 0.25), 1e-15, 0));
+  cr_assert(lw_particles_term_on(s, LW_PTERM_GRAVITY) && lw_particles_term_on(s, LW_PTERM_BOUNDARY));
+  cr_assert(!lw_particles_term_on(s, LW_PTERM_LJ) && !lw_particles_term_on(s, LW_PTERM_CIRCULAR));
+  cr_assert(p->term[LW_PTERM_LJ] == 0 && p->term[LW_PTERM_PLANAR] == 0);
   cr_assert(lw_close_rel(p->term[LW_PTERM_BOUNDARY], 0.5 * (1 / 9.0 + 1 / 0.25 + 1 / 5.0625), 1e-15, 0));
   /* a move through the floor is forbidden */
   lw_particles_prop *pr = lw_particles_prop_new(p, NULL);

@@ -34,10 +34,14 @@
 ** Invariant (tested): after any sequence of commits the running totals equal
 ** lw_particles_energy of the state within 1e-9 relative.
 **
-** The API maps one-to-one onto a row of the system table (issue 15): set-up
-** from parameters, state new / copy / free, sweep size, step cap, proposal
-** new / free, propose, commit, total, terms, refresh; save / load
-** (particles_io.h) and draw (particles_draw.h).
+** The API maps one-to-one onto a row of the system table (issue 15; the
+** seam's system.h): setup_new / setup_free, state_new (lw_particles_new),
+** state_copy / state_free, sweep_size, step_max, proposal_new / free,
+** propose, commit, total, terms, term_on, refresh; save / load as lines of
+** the in-memory state.lw and energy (load, then lw_particles_energy) in
+** particles_io.h; draw (final.ply, final.png) in particles_draw.h.  The move
+** kinds' [moves] keys are translate and rotate (step_translate, length;
+** step_rotate, degrees).
 */
 #ifndef LINEWISE_PARTICLES_H
 #define LINEWISE_PARTICLES_H
@@ -127,6 +131,10 @@ void lw_particles_free(lw_particles *p);
 /* The energy of the state from scratch, per term (pure; the order of the
 ** sums is fixed by the positions). */
 void lw_particles_energy(const lw_particles *p, double term[LW_PTERM_COUNT]);
+
+/* 1 if term t (lw_pterm) is on: its coefficient is not 0 (the boundary
+** term: alpha_b, on a plane or sphere wall). */
+int lw_particles_term_on(const lw_particles_setup *s, int t);
 
 /* The running totals and their sum. */
 void lw_particles_terms(const lw_particles *p, double term[LW_PTERM_COUNT]);
