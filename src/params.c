@@ -27,8 +27,9 @@
 
 const lw_param_def lw_param_table[] = {
   STRING("scene", "system", system, "splines", "",
-         "What is annealed: `splines` (cubic Bezier splines, the only system so far; "
-         "docs/SYSTEMS.md)."),
+         "What is annealed: `splines` (cubic Bezier splines on the page) or `particles` "
+         "(oriented particles in 3-D, set up by the [particles] section; README, "
+         "\"Oriented particles\"). docs/SYSTEMS.md."),
   CHOICE("scene", "page", page, "custom", "custom|a4|a3|letter",
          "Page size: `custom` takes `width` and `height`; a4 is 210 x 297 mm, a3 297 x 420 mm, "
          "letter 215.9 x 279.4 mm (portrait). A named page sets width and height; setting "
