@@ -5,9 +5,9 @@
 ** the checkpoint section, the drawings and the errors.
 **
 ** Annealing here uses a small Metropolis loop over the propose / commit API
-** (anneal() below): the run loop reaches the particles only through the
-** system seam (issue 15, part 1).  It cools geometrically and ends with
-** greedy sweeps at T = 0; steps tune toward 40 % acceptance throughout (it
+** (anneal() below), so these tests need no run directory; the run loop
+** drives the particles through the seam in tests/test_particles_cli.c.
+** anneal() cools geometrically and ends with greedy sweeps at T = 0; steps tune toward 40 % acceptance throughout (it
 ** is a minimiser here, not a sampler).  Seeds are fixed, so each test is one
 ** deterministic run; the tolerances are the issue's, and the measured values
 ** they guard are noted beside them.

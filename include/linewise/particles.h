@@ -34,8 +34,8 @@
 ** Invariant (tested): after any sequence of commits the running totals equal
 ** lw_particles_energy of the state within 1e-9 relative.
 **
-** The API maps one-to-one onto a row of the system table (issue 15; the
-** seam's system.h): setup_new / setup_free, state_new (lw_particles_new),
+** The API maps one-to-one onto the row of the system table
+** (src/sys_particles.c, system.h): setup_new / setup_free, state_new (lw_particles_new),
 ** state_copy / state_free, sweep_size, step_max, proposal_new / free,
 ** propose, commit, total, terms, term_on, refresh; save / load as lines of
 ** the in-memory state.lw and energy (load, then lw_particles_energy) in
