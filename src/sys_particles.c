@@ -25,7 +25,7 @@ static void setup_free(void *setup) { lw_particles_setup_free(setup); }
 
 static const char *note(const void *setup) { return ""; }
 
-/* The [scene] from state, if any, else the placement of the set-up. */
+/* The particles of the state [init] from names, if any, else the set-up's placement. */
 static void *state_new(const void *setup, const lw_params *p, unsigned long seed, lw_error *err)
 {
   if (!p->from[0]) return lw_particles_new(setup, seed, err);
@@ -167,5 +167,3 @@ const lw_system_type lw_system_particles = {
     .summary = summary,
     .describe = describe,
 };
-
-const lw_particles *lw_system_particles_of(const lw_system *s) { return s->state; }

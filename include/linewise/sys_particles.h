@@ -16,7 +16,4 @@
 
 extern const lw_system_type lw_system_particles;
 
-/* The particles of an instance of this row. */
-const lw_particles *lw_system_particles_of(const lw_system *s);
-
 #endif
