@@ -5,44 +5,66 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Bytes of one entry across the four arrays of a cell's block. */
+/* Bytes of one entry across the four arrays of a 2-D cell's block; a 3-D
+** block adds z. */
 #define ENTRY_BYTES (2 * sizeof(double) + sizeof(uint32_t) + sizeof(float))
+#define ENTRY_BYTES_OF(g) (ENTRY_BYTES + ((g)->dim == 3 ? sizeof(double) : 0))
 /* The walk reads entries in groups of four, past the last one (grid.h). */
 #define BLOCK_PAD (3 * sizeof(float))
 
-lw_cellgrid *lw_cellgrid_new(double x0, double y0, double w, double h, double cell,
+/* A grid of dim 2 or 3 over lo + [0, size] (size[2], lo[2] unused in 2-D). */
+static lw_cellgrid *grid_new(int dim, const double lo[3], const double size[3], double cell,
                              size_t n_samples, lw_error *err)
 {
   lw_cellgrid *g = calloc(1, sizeof *g);
   if (!g) goto nomem;
-  g->x0 = x0;
-  g->y0 = y0;
-  double side = cell > 0 ? cell : fmax(w, h) + 1.0;
+  g->dim = dim;
+  g->x0 = lo[0];
+  g->y0 = lo[1];
+  g->z0 = dim == 3 ? lo[2] : 0.0;
+  double w = size[0], h = size[1], d = dim == 3 ? size[2] : 0.0;
+  double side = cell > 0 ? cell : fmax(fmax(w, h), d) + 1.0;
   /* No more cells than samples (times a small factor): a tiny cutoff on a huge
   ** page would otherwise allocate mostly empty cells. */
   double max_cells = 4.0 * (double)n_samples + 16.0;
-  while ((ceil(w / side) + 1) * (ceil(h / side) + 1) > max_cells) side *= 1.5;
+  while ((ceil(w / side) + 1) * (ceil(h / side) + 1) * (dim == 3 ? ceil(d / side) + 1 : 1) > max_cells)
+    side *= 1.5;
   g->inv_h = 1.0 / side;
   g->nx = (int)ceil(w / side);
   g->ny = (int)ceil(h / side);
+  g->nz = (int)ceil(d / side);
   if (g->nx < 1) g->nx = 1;
   if (g->ny < 1) g->ny = 1;
-  g->cell = calloc((size_t)g->nx * (size_t)g->ny, sizeof *g->cell);
+  if (g->nz < 1) g->nz = 1;
+  g->cell = calloc(lw_cellgrid_cells(g), sizeof *g->cell);
   g->home = malloc((n_samples ? n_samples : 1) * sizeof *g->home);
   if (!g->cell || !g->home) goto nomem;
   g->n_samples = n_samples;
   return g;
 nomem:
   lw_cellgrid_free(g);
-  lw_error_set(err, LW_ENOMEM, "out of memory for the pair grid (%zu samples)", n_samples);
+  lw_error_set(err, LW_ENOMEM, "out of memory for the %s grid (%zu entries)", dim == 3 ? "particle" : "pair",
+               n_samples);
   return NULL;
+}
+
+lw_cellgrid *lw_cellgrid_new(double x0, double y0, double w, double h, double cell,
+                             size_t n_samples, lw_error *err)
+{
+  return grid_new(2, (const double[3]){x0, y0, 0.0}, (const double[3]){w, h, 0.0}, cell, n_samples, err);
+}
+
+lw_cellgrid *lw_cellgrid_new3(const double lo[3], const double size[3], double cell, size_t n_samples,
+                              lw_error *err)
+{
+  return grid_new(3, lo, size, cell, n_samples, err);
 }
 
 void lw_cellgrid_free(lw_cellgrid *g)
 {
   if (!g) return;
   if (g->cell)
-    for (size_t c = 0; c < (size_t)g->nx * (size_t)g->ny; c++) free(g->cell[c].x);
+    for (size_t c = 0; c < lw_cellgrid_cells(g); c++) free(g->cell[c].x);
   free(g->cell);
   free(g->home);
   free(g);
@@ -61,20 +83,20 @@ static uint32_t lower_bound(const lw_cell *c, uint32_t i)
   return lo;
 }
 
-static uint32_t cell_of(const lw_cellgrid *g, double x, double y)
+static uint32_t cell_of(const lw_cellgrid *g, double x, double y, double z)
 {
-  int cx, cy;
-  lw_cellgrid_locate(g, x, y, &cx, &cy);
-  return (uint32_t)cy * (uint32_t)g->nx + (uint32_t)cx;
+  int cx, cy, cz;
+  lw_cellgrid_locate3(g, x, y, z, &cx, &cy, &cz);
+  return ((uint32_t)cz * (uint32_t)g->ny + (uint32_t)cy) * (uint32_t)g->nx + (uint32_t)cx;
 }
 
 /* Gives c a block of cap >= c->n entries.  The arrays' offsets depend on the
 ** capacity, so the entries are copied into a new block rather than
 ** realloc'ed. */
-static lw_status cell_resize(lw_cell *c, uint32_t cap)
+static lw_status cell_resize(const lw_cellgrid *g, lw_cell *c, uint32_t cap)
 {
   /* zeroed, so that what the walk reads past the entries is defined */
-  double *blk = calloc(1, (size_t)cap * ENTRY_BYTES + BLOCK_PAD);
+  double *blk = calloc(1, (size_t)cap * ENTRY_BYTES_OF(g) + BLOCK_PAD);
   if (!blk) return LW_ENOMEM;
   lw_cell to = {blk, c->n, cap};
   if (c->n) {
@@ -82,6 +104,7 @@ static lw_status cell_resize(lw_cell *c, uint32_t cap)
     memcpy(lw_cell_y(&to), lw_cell_y(c), c->n * sizeof(double));
     memcpy(lw_cell_idx(&to), lw_cell_idx(c), c->n * sizeof(uint32_t));
     memcpy(lw_cell_dl(&to), lw_cell_dl(c), c->n * sizeof(float));
+    if (g->dim == 3) memcpy(lw_cell_z(&to), lw_cell_z(c), c->n * sizeof(double));
   }
   free(c->x);
   *c = to;
@@ -96,14 +119,14 @@ static uint32_t fitted(uint32_t n)
 
 /* Room for one more entry.  A quarter more (at least 4) keeps the amortised
 ** cost O(1) with little spare room. */
-static lw_status cell_reserve(lw_cell *c)
+static lw_status cell_reserve(const lw_cellgrid *g, lw_cell *c)
 {
   if (c->n < c->cap) return LW_OK;
-  return cell_resize(c, c->cap + c->cap / 8 + 2);
+  return cell_resize(g, c, c->cap + c->cap / 8 + 2);
 }
 
 /* Shifts entries [k, n) of every array of c by `by` (+1 or -1) entries. */
-static void cell_shift(lw_cell *c, uint32_t k, int by)
+static void cell_shift(const lw_cellgrid *g, lw_cell *c, uint32_t k, int by)
 {
   size_t m = c->n - k;
   double *y = lw_cell_y(c);
@@ -113,47 +136,74 @@ static void cell_shift(lw_cell *c, uint32_t k, int by)
   memmove(y + k + by, y + k, m * sizeof *y);
   memmove(idx + k + by, idx + k, m * sizeof *idx);
   memmove(dl + k + by, dl + k, m * sizeof *dl);
+  if (g->dim == 3) {
+    double *z = lw_cell_z(c);
+    memmove(z + k + by, z + k, m * sizeof *z);
+  }
 }
 
-static void cell_set(lw_cell *c, uint32_t k, uint32_t i, double x, double y, float dl)
+static void cell_set(const lw_cellgrid *g, lw_cell *c, uint32_t k, uint32_t i, double x, double y, double z,
+                     float dl)
 {
   c->x[k] = x;
   lw_cell_y(c)[k] = y;
   lw_cell_idx(c)[k] = i;
   lw_cell_dl(c)[k] = dl;
+  if (g->dim == 3) lw_cell_z(c)[k] = z;
 }
 
-lw_status lw_cellgrid_insert(lw_cellgrid *g, uint32_t i, double x, double y, float dl)
+/* Insert and move for both dimensions (z is ignored in 2-D). */
+static lw_status insert(lw_cellgrid *g, uint32_t i, double x, double y, double z, float dl)
 {
-  uint32_t to = cell_of(g, x, y);
+  uint32_t to = cell_of(g, x, y, z);
   lw_cell *c = &g->cell[to];
-  if (cell_reserve(c) != LW_OK) return LW_ENOMEM;
+  if (cell_reserve(g, c) != LW_OK) return LW_ENOMEM;
   uint32_t k = lower_bound(c, i);
-  cell_shift(c, k, 1);
+  cell_shift(g, c, k, 1);
   c->n++;
-  cell_set(c, k, i, x, y, dl);
+  cell_set(g, c, k, i, x, y, z, dl);
   g->home[i] = to;
   return LW_OK;
 }
 
-lw_status lw_cellgrid_move(lw_cellgrid *g, uint32_t i, double x, double y, float dl)
+static lw_status move(lw_cellgrid *g, uint32_t i, double x, double y, double z, float dl)
 {
-  uint32_t from = g->home[i], to = cell_of(g, x, y);
+  uint32_t from = g->home[i], to = cell_of(g, x, y, z);
   lw_cell *c = &g->cell[from];
   uint32_t k = lower_bound(c, i);
   if (from == to) {
-    cell_set(c, k, i, x, y, dl);
+    cell_set(g, c, k, i, x, y, z, dl);
     return LW_OK;
   }
-  if (cell_reserve(&g->cell[to]) != LW_OK) return LW_ENOMEM;
-  cell_shift(c, k + 1, -1);
+  if (cell_reserve(g, &g->cell[to]) != LW_OK) return LW_ENOMEM;
+  cell_shift(g, c, k + 1, -1);
   c->n--;
   /* A cell that emptied gives its spare room back, so capacity follows the
   ** occupancy instead of the largest it ever had; the gap between this and
   ** the growth threshold keeps a cell from resizing back and forth.  A
   ** failed shrink keeps the larger block, which is as good. */
-  if (c->cap - c->n > c->n / 4 + 4) (void)cell_resize(c, fitted(c->n));
-  return lw_cellgrid_insert(g, i, x, y, dl); /* cannot fail: room reserved */
+  if (c->cap - c->n > c->n / 4 + 4) (void)cell_resize(g, c, fitted(c->n));
+  return insert(g, i, x, y, z, dl); /* cannot fail: room reserved */
+}
+
+lw_status lw_cellgrid_insert(lw_cellgrid *g, uint32_t i, double x, double y, float dl)
+{
+  return insert(g, i, x, y, 0.0, dl);
+}
+
+lw_status lw_cellgrid_move(lw_cellgrid *g, uint32_t i, double x, double y, float dl)
+{
+  return move(g, i, x, y, 0.0, dl);
+}
+
+lw_status lw_cellgrid_insert3(lw_cellgrid *g, uint32_t i, double x, double y, double z)
+{
+  return insert(g, i, x, y, z, 0.0f);
+}
+
+lw_status lw_cellgrid_move3(lw_cellgrid *g, uint32_t i, double x, double y, double z)
+{
+  return move(g, i, x, y, z, 0.0f);
 }
 
 void lw_cellgrid_get(const lw_cellgrid *g, uint32_t i, double *x, double *y, float *dl)
@@ -167,22 +217,22 @@ void lw_cellgrid_get(const lw_cellgrid *g, uint32_t i, double *x, double *y, flo
 
 void lw_cellgrid_fit(lw_cellgrid *g)
 {
-  for (size_t c = 0; c < (size_t)g->nx * (size_t)g->ny; c++) {
+  for (size_t c = 0; c < lw_cellgrid_cells(g); c++) {
     lw_cell *cell = &g->cell[c];
     /* a failed shrink keeps the larger block, which is as good */
-    if (cell->cap > fitted(cell->n)) (void)cell_resize(cell, fitted(cell->n));
+    if (cell->cap > fitted(cell->n)) (void)cell_resize(g, cell, fitted(cell->n));
   }
 }
 
 size_t lw_cellgrid_bytes(const lw_cellgrid *g)
 {
   size_t b = sizeof *g + g->n_samples * sizeof *g->home;
-  for (size_t c = 0; c < (size_t)g->nx * (size_t)g->ny; c++)
-    b += sizeof *g->cell + (g->cell[c].cap ? g->cell[c].cap * ENTRY_BYTES + BLOCK_PAD : 0);
+  for (size_t c = 0; c < lw_cellgrid_cells(g); c++)
+    b += sizeof *g->cell + (g->cell[c].cap ? g->cell[c].cap * ENTRY_BYTES_OF(g) + BLOCK_PAD : 0);
   return b;
 }
 
 void lw_cellgrid_clear(lw_cellgrid *g)
 {
-  for (size_t c = 0; c < (size_t)g->nx * (size_t)g->ny; c++) g->cell[c].n = 0;
+  for (size_t c = 0; c < lw_cellgrid_cells(g); c++) g->cell[c].n = 0;
 }

@@ -28,8 +28,9 @@
 
 const lw_param_def lw_param_table[] = {
   STRING("scene", "system", system, "splines", "",
-         "What is annealed: `splines` (cubic Bezier splines, the only system so far; "
-         "docs/SYSTEMS.md)."),
+         "What is annealed: `splines` (cubic Bezier splines on the page) or `particles` "
+         "(oriented particles in 3-D, set up by the [particles] section; README, "
+         "\"Oriented particles\"). docs/SYSTEMS.md."),
   CHOICE("scene", "page", page, "custom", "custom|a4|a3|letter",
          "Page size: `custom` takes `width` and `height`; a4 is 210 x 297 mm, a3 297 x 420 mm, "
          "letter 215.9 x 279.4 mm (portrait). A named page sets width and height; setting "
@@ -257,6 +258,72 @@ const lw_param_def lw_param_table[] = {
   NUM("output", "field_preview", LW_PT_INT, field_preview, "0", "", 0, 1, 0,
       "1 = write field.png at the start of a run: the tone (white without an image) under "
       "short strokes along the field (needs the field term)."),
+  NUM("particles", "count", LW_PT_INT, pt_count, "100", "", 0, 1e7, 0,
+      "Particles placed by `pattern` (after those of `points`, if any)."),
+  CHOICE("particles", "pattern", pt_pattern, "plane", "cloud|plane|sphere",
+         "Initial placement: cloud = uniform in a cube with random orientations; plane = a "
+         "hexagonal patch in z = 0 with normals +z; sphere = a Fibonacci sphere around the "
+         "origin with outward normals. Then `noise` and `normal_noise`; drawn from anneal.seed."),
+  NUM("particles", "size", LW_PT_DOUBLE, pt_size, "0", "length", 0, 1e9, 0,
+      "Extent of the pattern: the cube's side, the patch's or the sphere's diameter. 0 = "
+      "automatic: the extent `count` particles fill at the spacing r0 (docs/NUMERICS.md)."),
+  NUM("particles", "noise", LW_PT_DOUBLE, pt_noise, "0.05", "length", 0, 1e9, 0,
+      "Standard deviation of the Gaussian noise added to each coordinate of a placed particle."),
+  NUM("particles", "normal_noise", LW_PT_DOUBLE, pt_normal_noise, "5", "degrees", 0, 180, 0,
+      "Standard deviation of the tilt of each placed orientation (a rotation about a uniform "
+      "random axis)."),
+  STRING("particles", "points", pt_points, "", "path",
+         "Point file relative to the scene file: one particle per line as `x y z` or "
+         "`x y z nx ny nz` (the normal need not be unit); `#` starts a comment. These particles "
+         "come first; without a normal a particle starts with normal +z. Empty = none."),
+  NUM("particles", "pinned", LW_PT_INT, pt_pinned, "0", "", 0, 1, 0,
+      "1 = the particles of `points` never move: their positions, and the orientations of "
+      "those given with a normal (the others still turn). Moves pick free particles only."),
+  NUM("particles", "r0", LW_PT_DOUBLE, pt_r0, "1", "length", 0, 1e9, LW_MIN_OPEN,
+      "r0: the spacing where the Lennard-Jones potential is lowest."),
+  NUM("particles", "range", LW_PT_DOUBLE, pt_range, "1.6", "r0", 1, 100, LW_MIN_OPEN,
+      "Interaction range R in units of r0: pairs farther apart do not interact; the weighting "
+      "function falls to 0 there and the Lennard-Jones potential is shifted to 0 there. 1.6 "
+      "keeps the first shell of a hexagonal sheet and drops the second (sqrt 3)."),
+  CHOICE("particles", "weight", pt_weight, "poly", "poly|gauss|aniso",
+         "Distance weighting w of the co-planarity, co-normality and co-circularity terms: "
+         "poly (1 - r^2/R^2)^3; gauss exp(-r^2 / 2 sigma^2); aniso the seed's "
+         "exp(-(x^2+y^2)/2a^2 - z^2/2b^2) in each particle's frame, a = sigma, b = "
+         "sigma_normal, averaged over the two ends; the Gaussians shifted to reach 0 at R "
+         "(docs/NUMERICS.md)."),
+  NUM("particles", "sigma", LW_PT_DOUBLE, pt_sigma, "1", "r0", 0, 100, LW_MIN_OPEN,
+      "sigma_r of weight = gauss, and the in-plane a of weight = aniso."),
+  NUM("particles", "sigma_normal", LW_PT_DOUBLE, pt_sigma_normal, "0.5", "r0", 0, 100, LW_MIN_OPEN,
+      "The normal b of weight = aniso; at most `sigma`."),
+  NUM("particles", "alpha_lj", LW_PT_DOUBLE, pt_alpha_lj, "1", "energy", 0, 1e12, 0,
+      "alpha_LJ: depth of the Lennard-Jones potential (r0/r)^12 - 2 (r0/r)^6 (shifted to 0 at "
+      "the range). 0 = off."),
+  NUM("particles", "alpha_p", LW_PT_DOUBLE, pt_alpha_p, "1", "energy / length^2", 0, 1e12, 0,
+      "alpha_P: co-planarity ((n_i.r_ij)^2 + (n_j.r_ij)^2) w per pair. 0 = off."),
+  NUM("particles", "alpha_n", LW_PT_DOUBLE, pt_alpha_n, "1", "energy", 0, 1e12, 0,
+      "alpha_N: co-normality |n_i - n_j|^2 w per pair. 0 = off."),
+  NUM("particles", "alpha_c", LW_PT_DOUBLE, pt_alpha_c, "0", "energy / length^2", 0, 1e12, 0,
+      "alpha_C: co-circularity ((n_i + n_j).r_ij)^2 w per pair, 0 on spheres and planes. 0 = off."),
+  NUM("particles", "gravity", LW_PT_DOUBLE, pt_gravity, "0", "energy / length", -1e12, 1e12, 0,
+      "Gravity: gravity * z per particle (pulls toward -z when positive). 0 = off."),
+  CHOICE("particles", "boundary", pt_boundary, "none", "none|plane|sphere",
+         "A wall: plane keeps particles above z = boundary_z (a floor), sphere inside the "
+         "sphere of boundary_radius around the origin; beyond it a move is forbidden."),
+  NUM("particles", "boundary_z", LW_PT_DOUBLE, pt_boundary_z, "0", "length", -1e9, 1e9, 0,
+      "Height of the plane boundary."),
+  NUM("particles", "boundary_radius", LW_PT_DOUBLE, pt_boundary_radius, "10", "length", 0, 1e9,
+      LW_MIN_OPEN, "Radius of the sphere boundary."),
+  NUM("particles", "alpha_b", LW_PT_DOUBLE, pt_alpha_b, "0", "energy length^2", 0, 1e12, 0,
+      "alpha_B: soft wall alpha_B / d^2 per particle, d its distance to the boundary. 0 = a "
+      "hard wall only."),
+  NUM("particles", "view_azimuth", LW_PT_DOUBLE, pt_view_azimuth, "30", "degrees", -360, 360, 0,
+      "Direction the preview final.png looks from: azimuth about +z from +x."),
+  NUM("particles", "view_elevation", LW_PT_DOUBLE, pt_view_elevation, "30", "degrees", -90, 90, 0,
+      "Elevation of the view direction above the xy plane (90 = from +z, looking down)."),
+  NUM("particles", "png_size", LW_PT_INT, pt_png_size, "800", "pixels", 16, 4096, 0,
+      "Width and height of final.png."),
+  NUM("particles", "disc", LW_PT_DOUBLE, pt_disc, "0.5", "r0", 0, 100, LW_MIN_OPEN,
+      "Radius of each particle's disc in final.png."),
 };
 const size_t lw_param_count = sizeof lw_param_table / sizeof lw_param_table[0];
 
@@ -397,6 +464,14 @@ void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size
   if (line > 0) snprintf(buf, n, "%s:%d", p->file, line);
   else if (line < 0) snprintf(buf, n, "--set");
   else snprintf(buf, n, "default");
+}
+
+lw_status lw_params_blame(const lw_params *p, const char *section, const char *key, lw_error *err)
+{
+  char where[LW_PATH_MAX + 32], msg[LW_ERROR_MSG];
+  lw_params_origin(p, lw_params_find(section, key), where, sizeof where);
+  snprintf(msg, sizeof msg, "%s", err->msg);
+  return lw_error_set(err, err->code, "%s: key '%s.%s': %s", where, section, key, msg);
 }
 
 typedef struct {

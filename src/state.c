@@ -211,6 +211,8 @@ static lw_status read_v2(lw_state *st, lw_ckpt *c, lw_error *err)
       (s = lw_ckpt_whole(c, "run", "sweep", &st->sweep, 0, (long)LW_STATE_SWEEP_MAX, 1, err)))
     return s;
   st->seed = (unsigned long)seed;
+  /* a state of another system has its own section instead (read by its row) */
+  if (!lw_ckpt_has(c, "system splines")) return LW_OK;
   return lw_state_get_splines(c, "system splines", &st->sp, err);
 }
 

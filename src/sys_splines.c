@@ -83,17 +83,6 @@ static void state_free(void *state)
   free(s);
 }
 
-/* Prefixes the message in err with where key was set and the key: input
-** read on behalf of a key (a state, a placement) is reported as that key's
-** error. */
-static lw_status blame_key(const lw_params *p, const char *section, const char *key, lw_error *err)
-{
-  char where[LW_PATH_MAX + 32], msg[LW_ERROR_MSG];
-  lw_params_origin(p, lw_params_find(section, key), where, sizeof where);
-  snprintf(msg, sizeof msg, "%s", err->msg);
-  return lw_error_set(err, err->code, "%s: key '%s.%s': %s", where, section, key, msg);
-}
-
 /* A model on sp (owned) after checking that the splines read from path are
 ** allowed for the scene. */
 static spl_state *state_from_file(const spl_setup *su, lw_splines *sp, const char *path, lw_error *err)
@@ -105,6 +94,21 @@ static spl_state *state_from_file(const spl_setup *su, lw_splines *sp, const cha
   return state_of(su, lw_model_new(&su->scene, sp, err), 1, err);
 }
 
+/* The coldest rung's splines, read with the header (st->sp, taken over);
+** a state without them (of another system) is refused naming the section. */
+static void no_splines(const char *path, lw_error *err)
+{
+  lw_error_set(err, LW_EINPUT, "%s: section [system splines]: missing (a state of another system?)", path);
+}
+
+static lw_splines *take_splines(lw_state *st, const char *path, lw_error *err)
+{
+  lw_splines *sp = st->sp;
+  st->sp = NULL;
+  if (!sp) no_splines(path, err);
+  return sp;
+}
+
 static void *state_new(const void *setup, const lw_params *p, unsigned long seed, lw_error *err)
 {
   const spl_setup *su = setup;
@@ -112,14 +116,17 @@ static void *state_new(const void *setup, const lw_params *p, unsigned long seed
   if (p->from[0]) {
     lw_state st;
     if (lw_state_read(&st, p->from, err)) {
-      blame_key(p, "init", "from", err);
+      lw_params_blame(p, "init", "from", err);
       return NULL;
     }
-    sp = st.sp;
-    st.sp = NULL;
+    sp = take_splines(&st, p->from, err);
     lw_state_clear(&st);
+    if (!sp) {
+      lw_params_blame(p, "init", "from", err);
+      return NULL;
+    }
     spl_state *s = state_from_file(su, sp, p->from, err);
-    if (!s && err->code == LW_EINPUT) blame_key(p, "init", "from", err);
+    if (!s && err->code == LW_EINPUT) lw_params_blame(p, "init", "from", err);
     return s;
   }
   size_t n;
@@ -133,7 +140,7 @@ static void *state_new(const void *setup, const lw_params *p, unsigned long seed
   sp = lw_init_random(&su->scene, n, (size_t)p->segments, p->segment_length, r, err);
   gsl_rng_free(r);
   if (!sp) {
-    if (err->code == LW_EINPUT) blame_key(p, "init", "segment_length", err);
+    if (err->code == LW_EINPUT) lw_params_blame(p, "init", "segment_length", err);
     return NULL;
   }
   return state_of(su, lw_model_new(&su->scene, sp, err), 1, err);
@@ -262,6 +269,10 @@ static lw_status refresh(void *state, double *drift) { return lw_model_refresh((
 static double energy(const void *setup, const lw_state *st, const char *path, double *term, lw_error *err)
 {
   const lw_scene *sc = &((const spl_setup *)setup)->scene;
+  if (!st->sp) {
+    no_splines(path, err);
+    return NAN;
+  }
   if (lw_model_check_regular(sc, st->sp, path, err)) return NAN;
   double total = lw_energy_compute(sc, st->sp, term, err);
   if (err->code || lw_checkpoint_check_finite(sc, st->sp, term, path, err)) return NAN;
@@ -281,9 +292,8 @@ static void *load(const void *setup, lw_state *st, const char *section, const ch
 {
   const spl_setup *su = setup;
   lw_splines *sp = NULL;
-  if (st->sp && !strcmp(section, "system splines")) {
-    sp = st->sp;
-    st->sp = NULL;
+  if (!strcmp(section, "system splines")) {
+    if (!(sp = take_splines(st, path, err))) return NULL;
   } else if (lw_state_get_splines(st->doc, section, &sp, err)) {
     return NULL;
   }

@@ -16,6 +16,13 @@
 ** contents after a refill, so spare room stays small: memory is the
 ** constraint here (docs/PERFORMANCE.md, bytes per segment).
 **
+** The same grid works in 3-D (the particle system, particles.h): cubes of
+** side >= the interaction range, so neighbours lie in the 3 x 3 x 3 block,
+** and a z[] array of doubles after dl[] in each cell's block (dl is then
+** unused).  z comes last so that a 2-D grid's block, the accessors below
+** and the cell index y * nx + x that walk.c uses stay exactly as they
+** were: a 2-D grid is a 3-D one with nz = 1 and no z array.
+**
 ** Each cell keeps its samples in increasing index order.  Sums over
 ** neighbours therefore run in an order that depends on the current positions
 ** only, never on the history of moves: a run resumed from a checkpoint (which
@@ -31,9 +38,10 @@
 
 #include "linewise/error.h"
 
-/* One block of cap entries: x[cap], y[cap], then idx[cap], dl[cap], and 3
-** floats of padding, so that reading any array in groups of four from
-** entry 0 stays within the block (walk.c masks the entries past n). */
+/* One block of cap entries: x[cap], y[cap], then idx[cap], dl[cap], in 3-D
+** z[cap], and 3 floats of padding, so that reading any array in groups of
+** four from entry 0 stays within the block (walk.c masks the entries past
+** n). */
 typedef struct {
   double *x;       /* the block; NULL while cap = 0 */
   uint32_t n, cap; /* entries used, allocated */
@@ -42,14 +50,19 @@ typedef struct {
 static inline double *lw_cell_y(const lw_cell *c) { return c->x + c->cap; }
 static inline uint32_t *lw_cell_idx(const lw_cell *c) { return (uint32_t *)(c->x + 2 * (size_t)c->cap); }
 static inline float *lw_cell_dl(const lw_cell *c) { return (float *)(lw_cell_idx(c) + c->cap); }
+/* 3-D grids only: idx and dl take one double's room per entry together. */
+static inline double *lw_cell_z(const lw_cell *c) { return c->x + 3 * (size_t)c->cap; }
 
 typedef struct {
   double x0, y0;     /* lower corner of the covered area, mm */
   double inv_h;      /* 1 / cell side */
   int nx, ny;        /* cells per axis */
-  lw_cell *cell;     /* nx * ny */
+  lw_cell *cell;     /* nx * ny * nz */
   uint32_t *home;    /* n_samples: the cell of each inserted sample */
   size_t n_samples;  /* indices run from 0 to n_samples - 1 */
+  double z0;         /* 3-D: lower corner in z; 0 in 2-D */
+  int nz;            /* cells along z: 1 in 2-D; cell (x, y, z) is (z ny + y) nx + x */
+  int dim;           /* 2 or 3 */
 } lw_cellgrid;
 
 /* A grid covering [x0, x0 + w] x [y0, y0 + h] with cells of side >= cell
@@ -92,5 +105,30 @@ size_t lw_cellgrid_bytes(const lw_cellgrid *g);
 
 /* Empties every cell, keeping their capacity. */
 void lw_cellgrid_clear(lw_cellgrid *g);
+
+/* Cells of the grid: nx ny nz. */
+static inline size_t lw_cellgrid_cells(const lw_cellgrid *g)
+{
+  return (size_t)g->nx * (size_t)g->ny * (size_t)g->nz;
+}
+
+/* ---- 3-D grids ------------------------------------------------------------
+** The same cells over the box lo + [0, size] with cubes of side >= cell
+** (the same cap on the cell count); entries hold x, y, z and idx. */
+lw_cellgrid *lw_cellgrid_new3(const double lo[3], const double size[3], double cell, size_t n_samples,
+                              lw_error *err);
+
+/* The cell holding (x, y, z) after clamping, per axis as in 2-D. */
+static inline void lw_cellgrid_locate3(const lw_cellgrid *g, double x, double y, double z, int *cx, int *cy,
+                                       int *cz)
+{
+  lw_cellgrid_locate(g, x, y, cx, cy);
+  double fz = (z - g->z0) * g->inv_h;
+  *cz = fz >= 1.0 ? (fz < (double)g->nz ? (int)fz : g->nz - 1) : 0;
+}
+
+/* Insert and move as in 2-D, for a 3-D grid. */
+lw_status lw_cellgrid_insert3(lw_cellgrid *g, uint32_t i, double x, double y, double z);
+lw_status lw_cellgrid_move3(lw_cellgrid *g, uint32_t i, double x, double y, double z);
 
 #endif

@@ -17,7 +17,7 @@
 #include "linewise/error.h"
 
 #define LW_PATH_MAX 1024
-#define LW_PARAM_MAX 96  /* capacity of lw_params.line; the table is checked against it */
+#define LW_PARAM_MAX 128 /* capacity of lw_params.line; the table is checked against it */
 
 typedef enum { LW_PT_DOUBLE, LW_PT_INT, LW_PT_CHOICE, LW_PT_STRING } lw_param_type;
 
@@ -52,6 +52,9 @@ enum { LW_MASK_NONE, LW_MASK_ALPHA, LW_MASK_IMAGE };
 enum { LW_STRAIN_SPLINE, LW_STRAIN_SEGMENT };
 enum { LW_FIELDMODE_AXIAL, LW_FIELDMODE_SIGNED };
 enum { LW_LADDER_FIXED, LW_LADDER_EQUAL };
+enum { LW_PPATTERN_CLOUD, LW_PPATTERN_PLANE, LW_PPATTERN_SPHERE };
+enum { LW_PWEIGHT_POLY, LW_PWEIGHT_GAUSS, LW_PWEIGHT_ANISO };
+enum { LW_PBOUNDARY_NONE, LW_PBOUNDARY_PLANE, LW_PBOUNDARY_SPHERE };
 
 typedef struct {
   /* [scene] */
@@ -136,6 +139,29 @@ typedef struct {
   int frames_every;           /* sweeps between frames; 0 = none */
   double fidelity_sigma;      /* blur before the fidelity score, mm */
   int field_preview;          /* 1 = write field.png */
+  /* [particles] (system = particles; particles.h) */
+  int pt_count;               /* particles placed by the pattern */
+  int pt_pattern;             /* LW_PPATTERN_* */
+  double pt_size;             /* pattern extent (cube side, disc or sphere diameter), length; 0 = automatic */
+  double pt_noise;            /* Gaussian noise of the placed positions, length */
+  double pt_normal_noise;     /* Gaussian tilt of the placed normals, degrees */
+  char pt_points[LW_PATH_MAX];/* point file "x y z [nx ny nz]" per line, or empty */
+  int pt_pinned;              /* 1 = the points of the file are pinned */
+  double pt_r0;               /* Lennard-Jones equilibrium spacing, length */
+  double pt_range;            /* interaction range, units of r0 */
+  int pt_weight;              /* LW_PWEIGHT_* */
+  double pt_sigma;            /* gauss sigma_r and aniso a, units of r0 */
+  double pt_sigma_normal;     /* aniso b (<= sigma), units of r0 */
+  double pt_alpha_lj, pt_alpha_p, pt_alpha_n, pt_alpha_c; /* pair coefficients */
+  double pt_gravity;          /* energy per length of height */
+  int pt_boundary;            /* LW_PBOUNDARY_* */
+  double pt_boundary_z;       /* plane boundary: particles stay above this height, length */
+  double pt_boundary_radius;  /* sphere boundary: particles stay inside it (centre 0), length */
+  double pt_alpha_b;          /* soft wall alpha_b / d^2, energy length^2; 0 = hard wall only */
+  double pt_view_azimuth;     /* preview view direction, degrees */
+  double pt_view_elevation;   /* degrees */
+  int pt_png_size;            /* preview pixels per side */
+  double pt_disc;             /* preview disc radius, units of r0 */
 
   /* Where each value came from: the file and line (0 = default, -1 = --set). */
   char file[LW_PATH_MAX];
@@ -169,5 +195,10 @@ const lw_param_def *lw_params_find(const char *section, const char *key);
 
 /* Where a parameter was set, for messages: "scene.ini:12", "--set" or "default". */
 void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size_t n);
+
+/* Prefixes the message in err with where section.key was set and the key:
+** input read on behalf of a key (a state, a point file) is reported as that
+** key's error.  Returns err->code. */
+lw_status lw_params_blame(const lw_params *p, const char *section, const char *key, lw_error *err);
 
 #endif

@@ -35,7 +35,7 @@ typedef struct {
   unsigned long seed;
   long sweep;               /* sweeps done */
   int version;              /* the format read: 1 or 2 */
-  lw_splines *sp;           /* owned: the splines ([system splines]) */
+  lw_splines *sp;           /* owned: the splines ([system splines]); NULL if none */
   lw_ckpt *doc;             /* owned: the whole file, for the run data; NULL if made in memory */
 } lw_state;
 

@@ -1,0 +1,19 @@
+/*
+** sys_particles.h -- the oriented-particle system's row of the system table
+** (system.h): the particle module (particles.h) behind the seam.
+**
+** Move kinds translate and rotate ([moves] translate / rotate weights,
+** step_translate in lengths, step_rotate in degrees, both tuned toward
+** target_spline: they move a whole body, as the spline system's translate
+** and rotate do).  Its part of state.lw is the particle module's section
+** (particles_io.h); save and load are thin wrappers around it.
+*/
+#ifndef LINEWISE_SYS_PARTICLES_H
+#define LINEWISE_SYS_PARTICLES_H
+
+#include "linewise/particles.h"
+#include "linewise/system.h"
+
+extern const lw_system_type lw_system_particles;
+
+#endif

@@ -1,0 +1,494 @@
+/*
+** particles.c -- the oriented-particle system: set-up, state, energies and
+** moves (particles.h).
+*/
+#include "linewise/particles.h"
+
+#include <gsl/gsl_math.h>
+#include <gsl/gsl_randist.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "linewise/particles_io.h"
+#include "linewise/particles_place.h"
+#include "linewise/state.h"
+
+const char *const lw_particles_move_names[LW_PMOVE_KINDS] = {"translate", "rotate"};
+
+/* ---- set-up ------------------------------------------------------------- */
+
+/* Widens [lo, hi] per axis to hold the box c +- h. */
+static void box_add(double lo[3], double hi[3], const double c[3], const double h[3])
+{
+  for (int k = 0; k < 3; k++) {
+    lo[k] = fmin(lo[k], c[k] - h[k]);
+    hi[k] = fmax(hi[k], c[k] + h[k]);
+  }
+}
+
+/* The grid's box: what the pattern, the points and a sphere boundary can
+** reach at the start, padded by the range (it needs no more: particles
+** beyond it fall into the edge cells). */
+static void setup_box(lw_particles_setup *s)
+{
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  const double o[3] = {0, 0, 0}, t = 4.0 * s->noise, half = 0.5 * s->size;
+  if (s->count) {
+    double h[3] = {half + t, half + t, (s->pattern == LW_PPATTERN_PLANE ? 0.0 : half) + t};
+    box_add(lo, hi, o, h);
+  }
+  for (size_t i = 0; i < s->n_points; i++) box_add(lo, hi, s->point + 3 * i, o);
+  if (s->boundary == LW_PBOUNDARY_SPHERE) {
+    const double h[3] = {s->boundary_radius, s->boundary_radius, s->boundary_radius};
+    box_add(lo, hi, o, h);
+  }
+  for (int k = 0; k < 3; k++) {
+    s->lo[k] = lo[k] - s->pair.range;
+    s->extent[k] = hi[k] - lo[k] + 2.0 * s->pair.range;
+  }
+}
+
+/* "file:line" (or "default", "--set") of particles.<key> into buf. */
+static void origin(const lw_params *p, const char *key, char *buf, size_t n)
+{
+  lw_params_origin(p, lw_params_find("particles", key), buf, n);
+}
+
+lw_particles_setup *lw_particles_setup_new(const lw_params *p, lw_error *err)
+{
+  lw_particles_setup *s = calloc(1, sizeof *s);
+  if (!s) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for the particle set-up");
+    return NULL;
+  }
+  const double alpha[LW_PTERM_PAIRS] = {p->pt_alpha_lj, p->pt_alpha_p, p->pt_alpha_n, p->pt_alpha_c};
+  char where[LW_PATH_MAX + 32];
+  lw_error e;
+  if (lw_ppair_init(&s->pair, p->pt_r0, p->pt_range, p->pt_weight, p->pt_sigma, p->pt_sigma_normal, alpha, &e)) {
+    origin(p, "sigma_normal", where, sizeof where);
+    lw_error_set(err, LW_EINPUT, "%s: key 'particles.sigma_normal': %s", where, e.msg);
+    goto fail;
+  }
+  s->gravity = p->pt_gravity;
+  s->boundary = p->pt_boundary;
+  s->boundary_z = p->pt_boundary_z;
+  s->boundary_radius = p->pt_boundary_radius;
+  s->alpha_b = p->pt_alpha_b;
+  s->pattern = p->pt_pattern;
+  s->count = (size_t)p->pt_count;
+  s->size = p->pt_size > 0 ? p->pt_size : lw_particles_auto_size(p->pt_pattern, s->count, p->pt_r0);
+  s->noise = p->pt_noise;
+  s->normal_noise = p->pt_normal_noise * M_PI / 180.0;
+  if (p->pt_points[0]) {
+    char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
+    lw_path_dir(dir, sizeof dir, p->file);
+    lw_path_join(full, sizeof full, dir, p->pt_points);
+    if (lw_particles_read_points(full, &s->n_points, &s->point, &s->point_normal, &s->point_pin, err)) goto fail;
+    /* has_normal becomes the pin flags: a given normal is pinned with its point */
+    for (size_t i = 0; i < s->n_points; i++)
+      s->point_pin[i] = p->pt_pinned ? (unsigned char)(LW_PIN_POSITION | (s->point_pin[i] ? LW_PIN_ORIENTATION : 0))
+                                     : 0;
+  }
+  if (s->n_points + s->count == 0) {
+    origin(p, "count", where, sizeof where);
+    lw_error_set(err, LW_EINPUT, "%s: key 'particles.count': expected at least 1 particle (no points file either)",
+                 where);
+    goto fail;
+  }
+  if (s->n_points + s->count > UINT32_MAX / 2) {
+    origin(p, "count", where, sizeof where);
+    lw_error_set(err, LW_EINPUT, "%s: key 'particles.count': expected fewer than %u particles in all", where,
+                 UINT32_MAX / 2);
+    goto fail;
+  }
+  double az = p->pt_view_azimuth * M_PI / 180.0, el = p->pt_view_elevation * M_PI / 180.0;
+  s->view[0] = cos(el) * cos(az);
+  s->view[1] = cos(el) * sin(az);
+  s->view[2] = sin(el);
+  s->png_size = p->pt_png_size;
+  s->disc = p->pt_disc * p->pt_r0;
+  setup_box(s);
+  return s;
+fail:
+  lw_particles_setup_free(s);
+  return NULL;
+}
+
+void lw_particles_setup_free(lw_particles_setup *s)
+{
+  if (!s) return;
+  free(s->point);
+  free(s->point_normal);
+  free(s->point_pin);
+  free(s);
+}
+
+/* ---- energies ----------------------------------------------------------- */
+
+/* The per-particle terms of a particle at x into e[GRAVITY], e[BOUNDARY]
+** (added); 1 if x is outside the boundary (forbidden). */
+static int external(const lw_particles_setup *s, const double x[3], double e[LW_PTERM_COUNT])
+{
+  if (s->gravity != 0.0) e[LW_PTERM_GRAVITY] += s->gravity * x[2];
+  if (s->boundary == LW_PBOUNDARY_NONE) return 0;
+  double d = s->boundary == LW_PBOUNDARY_PLANE ? x[2] - s->boundary_z
+                                               : s->boundary_radius - sqrt(lw_v3_dot(x, x));
+  if (!(d > 0.0)) return 1;
+  if (s->alpha_b != 0.0) e[LW_PTERM_BOUNDARY] += s->alpha_b / (d * d);
+  return 0;
+}
+
+int lw_particles_outside(const lw_particles_setup *s, const double x[3])
+{
+  double e[LW_PTERM_COUNT] = {0};
+  return external(s, x, e);
+}
+
+/* Squared distances along one axis from p, in cell c of the axis that starts
+** at a with cells of side h, to the cells c - 1 and c + 1 (0 to its own).
+** They bound the distance to every particle in those cells, clamped ones
+** included: clamping only moves particles outward. */
+static void axis_gaps(double a, double h, int c, double p, double gap[3])
+{
+  double below = p - (a + c * h), above = a + (c + 1) * h - p;
+  gap[0] = below * below;
+  gap[1] = 0.0;
+  gap[2] = above * above;
+}
+
+/*
+** The pair energies of a particle at x against its neighbours j != k with
+** j >= from, added per term to ea (with normal na) and, when nb is not NULL,
+** to eb (with normal nb): a rotation evaluates both orientations in one walk.
+** Cells are visited in a fixed order (z, then y, then x, each ascending) and
+** their entries in index order (grid.h), so the sum's order is a function
+** of the positions alone.  Cells wholly beyond the range hold no pair and
+** are skipped (with a margin for the rounding of the cell index).
+*/
+static void walk(const lw_particles *p, uint32_t k, uint32_t from, const double x[3], const double na[3],
+                 const double nb[3], double ea[LW_PTERM_PAIRS], double eb[LW_PTERM_PAIRS])
+{
+  const lw_cellgrid *g = p->grid;
+  const lw_ppair_ctx *c = &p->setup->pair;
+  const double range2 = c->range2, skip2 = range2 * (1.0 + 1e-9), h = 1.0 / g->inv_h;
+  const double *nrm = p->nrm;
+  int cx, cy, cz;
+  lw_cellgrid_locate3(g, x[0], x[1], x[2], &cx, &cy, &cz);
+  double gx[3], gy[3], gz[3];
+  axis_gaps(g->x0, h, cx, x[0], gx);
+  axis_gaps(g->y0, h, cy, x[1], gy);
+  axis_gaps(g->z0, h, cz, x[2], gz);
+  int z0 = cz > 0 ? cz - 1 : 0, z1 = cz + 1 < g->nz ? cz + 1 : g->nz - 1;
+  int y0 = cy > 0 ? cy - 1 : 0, y1 = cy + 1 < g->ny ? cy + 1 : g->ny - 1;
+  int x0 = cx > 0 ? cx - 1 : 0, x1 = cx + 1 < g->nx ? cx + 1 : g->nx - 1;
+  for (int zz = z0; zz <= z1; zz++)
+    for (int yy = y0; yy <= y1; yy++) {
+      double gyz = gz[zz - cz + 1] + gy[yy - cy + 1];
+      if (gyz > skip2) continue;
+      const lw_cell *row = g->cell + ((size_t)zz * (size_t)g->ny + (size_t)yy) * (size_t)g->nx;
+      for (int xx = x0; xx <= x1; xx++) {
+        if (gyz + gx[xx - cx + 1] > skip2) continue;
+        const lw_cell *cell = row + xx;
+        const double *px = cell->x, *py = lw_cell_y(cell), *pz = lw_cell_z(cell);
+        const uint32_t *id = lw_cell_idx(cell);
+        for (uint32_t e = 0; e < cell->n; e++) {
+          uint32_t j = id[e];
+          if (j == k || j < from) continue;
+          double r[3] = {px[e] - x[0], py[e] - x[1], pz[e] - x[2]};
+          double d2 = lw_v3_dot(r, r);
+          if (d2 >= range2) continue;
+          lw_ppair_add(c, r, d2, na, nrm + 3 * (size_t)j, ea);
+          if (nb) lw_ppair_add(c, r, d2, nb, nrm + 3 * (size_t)j, eb);
+        }
+      }
+    }
+}
+
+void lw_particles_energy(const lw_particles *p, double term[LW_PTERM_COUNT])
+{
+  for (int t = 0; t < LW_PTERM_COUNT; t++) term[t] = 0.0;
+  const lw_particles_setup *s = p->setup;
+  for (size_t i = 0; i < p->n; i++) {
+    if (s->pair.on) walk(p, (uint32_t)i, (uint32_t)i + 1, p->x + 3 * i, p->nrm + 3 * i, NULL, term, NULL);
+    if (external(s, p->x + 3 * i, term)) term[LW_PTERM_BOUNDARY] = INFINITY;
+  }
+}
+
+int lw_particles_term_on(const lw_particles_setup *s, int t)
+{
+  switch (t) {
+  case LW_PTERM_GRAVITY: return s->gravity != 0.0;
+  case LW_PTERM_BOUNDARY: return s->boundary != LW_PBOUNDARY_NONE && s->alpha_b != 0.0;
+  default: return t >= 0 && t < LW_PTERM_PAIRS && s->pair.alpha[t] != 0.0;
+  }
+}
+
+void lw_particles_terms(const lw_particles *p, double term[LW_PTERM_COUNT])
+{
+  memcpy(term, p->term, sizeof p->term);
+}
+
+double lw_particles_total(const lw_particles *p)
+{
+  double e = 0.0;
+  for (int t = 0; t < LW_PTERM_COUNT; t++) e += p->term[t];
+  return e;
+}
+
+lw_status lw_particles_refresh(lw_particles *p, double *drift)
+{
+  double old = lw_particles_total(p);
+  lw_particles_energy(p, p->term);
+  double e = lw_particles_total(p);
+  if (drift) *drift = fabs(e - old) / fmax(fabs(e), 1.0);
+  return LW_OK;
+}
+
+/* ---- states ------------------------------------------------------------- */
+
+void lw_particles_free(lw_particles *p)
+{
+  if (!p) return;
+  free(p->x);
+  free(p->q);
+  free(p->nrm);
+  free(p->pin);
+  for (int m = 0; m < LW_PMOVE_KINDS; m++) free(p->movable[m]);
+  lw_cellgrid_free(p->grid);
+  free(p);
+}
+
+static lw_particles *alloc_state(const lw_particles_setup *s, size_t n, lw_error *err)
+{
+  lw_particles *p = calloc(1, sizeof *p);
+  if (!p) goto nomem;
+  p->setup = s;
+  p->n = n;
+  size_t m = n ? n : 1;
+  p->x = malloc(3 * m * sizeof *p->x);
+  p->q = malloc(4 * m * sizeof *p->q);
+  p->nrm = malloc(3 * m * sizeof *p->nrm);
+  p->pin = calloc(m, 1);
+  for (int k = 0; k < LW_PMOVE_KINDS; k++) p->movable[k] = malloc(m * sizeof *p->movable[k]);
+  if (!p->x || !p->q || !p->nrm || !p->pin || !p->movable[0] || !p->movable[1]) goto nomem;
+  return p;
+nomem:
+  lw_particles_free(p);
+  lw_error_set(err, LW_ENOMEM, "out of memory for %zu particles", n);
+  return NULL;
+}
+
+/* Normals, the free lists and the grid of a state whose x, q and pin are
+** set. */
+static lw_status finish(lw_particles *p, lw_error *err)
+{
+  const lw_particles_setup *s = p->setup;
+  p->n_sweep = p->n_movable[0] = p->n_movable[1] = 0;
+  for (size_t i = 0; i < p->n; i++) {
+    lw_quat_normal(p->q + 4 * i, p->nrm + 3 * i);
+    if (!(p->pin[i] & LW_PIN_POSITION)) p->movable[LW_PMOVE_TRANSLATE][p->n_movable[LW_PMOVE_TRANSLATE]++] = (uint32_t)i;
+    if (!(p->pin[i] & LW_PIN_ORIENTATION)) p->movable[LW_PMOVE_ROTATE][p->n_movable[LW_PMOVE_ROTATE]++] = (uint32_t)i;
+    if ((p->pin[i] & (LW_PIN_POSITION | LW_PIN_ORIENTATION)) != (LW_PIN_POSITION | LW_PIN_ORIENTATION)) p->n_sweep++;
+  }
+  p->grid = lw_cellgrid_new3(s->lo, s->extent, s->pair.range, p->n, err);
+  if (!p->grid) return LW_ENOMEM;
+  for (size_t i = 0; i < p->n; i++)
+    if (lw_cellgrid_insert3(p->grid, (uint32_t)i, p->x[3 * i], p->x[3 * i + 1], p->x[3 * i + 2]))
+      return lw_error_set(err, LW_ENOMEM, "out of memory for the particle grid");
+  lw_cellgrid_fit(p->grid);
+  return LW_OK;
+}
+
+lw_particles *lw_particles_new_from(const lw_particles_setup *s, size_t n, const double *x, const double *q,
+                                    const unsigned char *pin, lw_error *err)
+{
+  for (size_t i = 0; i < n; i++) {
+    const double *xi = x + 3 * i, *qi = q + 4 * i;
+    if (!isfinite(xi[0]) || !isfinite(xi[1]) || !isfinite(xi[2]) || !isfinite(qi[0]) || !isfinite(qi[1]) ||
+        !isfinite(qi[2]) || !isfinite(qi[3])) {
+      lw_error_set(err, LW_EINPUT, "particle %zu: expected finite numbers", i);
+      return NULL;
+    }
+    double nq = sqrt(qi[0] * qi[0] + qi[1] * qi[1] + qi[2] * qi[2] + qi[3] * qi[3]);
+    if (!(fabs(nq - 1.0) <= 1e-9)) {
+      lw_error_set(err, LW_EINPUT, "particle %zu: expected a unit quaternion, got length %.17g", i, nq);
+      return NULL;
+    }
+    if (lw_particles_outside(s, xi)) {
+      lw_error_set(err, LW_EINPUT, "particle %zu at (%g, %g, %g) is outside the %s boundary", i, xi[0], xi[1],
+                   xi[2], s->boundary == LW_PBOUNDARY_PLANE ? "plane" : "sphere");
+      return NULL;
+    }
+  }
+  lw_particles *p = alloc_state(s, n, err);
+  if (!p) return NULL;
+  memcpy(p->x, x, 3 * n * sizeof *x);
+  memcpy(p->q, q, 4 * n * sizeof *q);
+  if (pin) memcpy(p->pin, pin, n);
+  if (finish(p, err)) goto fail;
+  lw_particles_energy(p, p->term);
+  for (int t = 0; t < LW_PTERM_COUNT; t++)
+    if (!isfinite(p->term[t])) {
+      lw_error_set(err, LW_EINPUT, "the %s energy of the particles is not finite: two of them (nearly) coincide",
+                   lw_pterm_names[t]);
+      goto fail;
+    }
+  return p;
+fail:
+  lw_particles_free(p);
+  return NULL;
+}
+
+lw_particles *lw_particles_new(const lw_particles_setup *s, unsigned long seed, lw_error *err)
+{
+  size_t n = s->n_points + s->count;
+  double *x = malloc(3 * n * sizeof *x), *q = malloc(4 * n * sizeof *q);
+  unsigned char *pin = calloc(n, 1);
+  lw_particles *p = NULL;
+  if (!x || !q || !pin) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for %zu particles", n);
+    goto out;
+  }
+  for (size_t i = 0; i < s->n_points; i++) {
+    memcpy(x + 3 * i, s->point + 3 * i, 3 * sizeof *x);
+    lw_quat_from_normal(s->point_normal + 3 * i, q + 4 * i);
+    pin[i] = s->point_pin[i];
+  }
+  if (lw_particles_place(s->pattern, s->count, s->size, s->noise, s->normal_noise, 0.5 * s->pair.r0, seed,
+                         x + 3 * s->n_points, q + 4 * s->n_points, err))
+    goto out;
+  p = lw_particles_new_from(s, n, x, q, pin, err);
+out:
+  free(x);
+  free(q);
+  free(pin);
+  return p;
+}
+
+lw_particles *lw_particles_copy(const lw_particles *src, lw_error *err)
+{
+  lw_particles *p = alloc_state(src->setup, src->n, err);
+  if (!p) return NULL;
+  memcpy(p->x, src->x, 3 * src->n * sizeof *p->x);
+  memcpy(p->q, src->q, 4 * src->n * sizeof *p->q);
+  memcpy(p->pin, src->pin, src->n);
+  if (finish(p, err)) {
+    lw_particles_free(p);
+    return NULL;
+  }
+  memcpy(p->term, src->term, sizeof p->term);
+  return p;
+}
+
+/* ---- moves -------------------------------------------------------------- */
+
+size_t lw_particles_sweep_size(const lw_particles *p)
+{
+  return p->n_sweep;
+}
+
+double lw_particles_step_max(const lw_particles *p, int kind)
+{
+  const double *e = p->setup->extent;
+  return kind == LW_PMOVE_ROTATE ? M_PI : sqrt(lw_v3_dot(e, e));
+}
+
+lw_particles_prop *lw_particles_prop_new(const lw_particles *p, lw_error *err)
+{
+  lw_particles_prop *pr = calloc(1, sizeof *pr);
+  if (!pr) lw_error_set(err, LW_ENOMEM, "out of memory for a particle proposal");
+  return pr;
+}
+
+void lw_particles_prop_free(lw_particles_prop *pr)
+{
+  free(pr);
+}
+
+double lw_particles_evaluate(const lw_particles *p, lw_particles_prop *pr, uint32_t k, const double x[3],
+                             const double q[4], int *forbidden)
+{
+  const lw_particles_setup *s = p->setup;
+  const double *xo = p->x + 3 * (size_t)k, *no = p->nrm + 3 * (size_t)k;
+  pr->identity = 0;
+  pr->k = k;
+  memcpy(pr->x, x, sizeof pr->x);
+  memcpy(pr->q, q, sizeof pr->q);
+  lw_quat_normal(q, pr->n);
+  if (forbidden) *forbidden = 0;
+  /* a degenerate draw (an infinite step) never reaches the state: NaN, rejected */
+  if (!isfinite(x[0] + x[1] + x[2]) || !isfinite(pr->n[0] + pr->n[1] + pr->n[2])) {
+    for (int t = 0; t < LW_PTERM_COUNT; t++) pr->dterm[t] = NAN;
+    return pr->dE = NAN;
+  }
+  double e_new[LW_PTERM_COUNT] = {0}, e_old[LW_PTERM_COUNT] = {0};
+  int moved = x[0] != xo[0] || x[1] != xo[1] || x[2] != xo[2];
+  if (moved) {
+    if (external(s, x, e_new)) {
+      for (int t = 0; t < LW_PTERM_COUNT; t++) pr->dterm[t] = 0.0;
+      pr->dterm[LW_PTERM_BOUNDARY] = INFINITY;
+      if (forbidden) *forbidden = 1;
+      return pr->dE = INFINITY;
+    }
+    external(s, xo, e_old);
+  }
+  /* a turn leaves every distance, so without a weighted term it changes nothing */
+  if (s->pair.on && (moved || s->pair.weighted)) {
+    if (moved) {
+      walk(p, k, 0, xo, no, NULL, e_old, NULL);
+      walk(p, k, 0, x, pr->n, NULL, e_new, NULL);
+    } else {
+      walk(p, k, 0, xo, no, pr->n, e_old, e_new);
+    }
+  }
+  double dE = 0.0;
+  for (int t = 0; t < LW_PTERM_COUNT; t++) {
+    pr->dterm[t] = e_new[t] - e_old[t];
+    dE += pr->dterm[t];
+  }
+  return pr->dE = dE;
+}
+
+double lw_particles_propose(const lw_particles *p, lw_particles_prop *pr, int kind, double step, gsl_rng *rng,
+                            int *forbidden)
+{
+  pr->kind = kind;
+  if (forbidden) *forbidden = 0;
+  size_t m = p->n_movable[kind];
+  if (m == 0) {
+    /* the identity: a symmetric proposal that changes nothing */
+    pr->identity = 1;
+    for (int t = 0; t < LW_PTERM_COUNT; t++) pr->dterm[t] = 0.0;
+    return pr->dE = 0.0;
+  }
+  uint32_t k = p->movable[kind][gsl_rng_uniform_int(rng, m)];
+  double x[3], q[4];
+  memcpy(x, p->x + 3 * (size_t)k, sizeof x);
+  memcpy(q, p->q + 4 * (size_t)k, sizeof q);
+  if (kind == LW_PMOVE_TRANSLATE) {
+    for (int c = 0; c < 3; c++) x[c] += gsl_ran_gaussian_ziggurat(rng, step);
+  } else {
+    double axis[3], dq[4];
+    gsl_ran_dir_3d(rng, &axis[0], &axis[1], &axis[2]);
+    lw_quat_axis_angle(axis, gsl_ran_gaussian_ziggurat(rng, step), dq);
+    lw_quat_mul(dq, p->q + 4 * (size_t)k, q);
+    lw_quat_normalise(q);
+  }
+  return lw_particles_evaluate(p, pr, k, x, q, forbidden);
+}
+
+lw_status lw_particles_commit(lw_particles *p, const lw_particles_prop *pr)
+{
+  if (pr->identity) return LW_OK;
+  size_t k = pr->k;
+  double *x = p->x + 3 * k;
+  if ((x[0] != pr->x[0] || x[1] != pr->x[1] || x[2] != pr->x[2]) &&
+      lw_cellgrid_move3(p->grid, pr->k, pr->x[0], pr->x[1], pr->x[2]))
+    return LW_ENOMEM;
+  memcpy(x, pr->x, sizeof pr->x);
+  memcpy(p->q + 4 * k, pr->q, sizeof pr->q);
+  memcpy(p->nrm + 3 * k, pr->n, sizeof pr->n);
+  for (int t = 0; t < LW_PTERM_COUNT; t++) p->term[t] += pr->dterm[t];
+  return LW_OK;
+}

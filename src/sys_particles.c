@@ -1,0 +1,179 @@
+/*
+** sys_particles.c -- the oriented-particle system's row (sys_particles.h):
+** the particle module behind the seam of system.h.  The module's API maps
+** one-to-one onto the row (particles.h), so most members only convert
+** between void pointers and the module's types.
+*/
+#include "linewise/sys_particles.h"
+
+#include <errno.h>
+#include <gsl/gsl_math.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "linewise/particles_draw.h"
+#include "linewise/particles_io.h"
+
+/* steps are kept in lengths and radians; [moves] step_rotate is in degrees */
+static const double move_unit[LW_PMOVE_KINDS] = {1.0, M_PI / 180.0};
+
+/* The coldest rung's section; [init] from and `linewise energy` read it. */
+#define SECTION "system particles"
+
+static void *setup_new(const lw_params *p, lw_error *err) { return lw_particles_setup_new(p, err); }
+
+static void setup_free(void *setup) { lw_particles_setup_free(setup); }
+
+static const char *note(const void *setup) { return ""; }
+
+/* The particles of the state [init] from names, if any, else the set-up's placement. */
+static void *state_new(const void *setup, const lw_params *p, unsigned long seed, lw_error *err)
+{
+  if (!p->from[0]) return lw_particles_new(setup, seed, err);
+  lw_state st;
+  lw_particles *s = NULL;
+  if (!lw_state_read(&st, p->from, err)) {
+    s = lw_particles_get(setup, st.doc, SECTION, err);
+    lw_state_clear(&st);
+  }
+  if (!s && err->code == LW_EINPUT) lw_params_blame(p, "init", "from", err);
+  return s;
+}
+
+static void *state_copy(const void *state, lw_error *err) { return lw_particles_copy(state, err); }
+
+static void state_free(void *state) { lw_particles_free(state); }
+
+static void moves(const lw_params *p, double *weight, double *step, double *target)
+{
+  const double w[LW_PMOVE_KINDS] = {p->mix_translate, p->mix_rotate};
+  const double st[LW_PMOVE_KINDS] = {p->step_translate, p->step_rotate};
+  for (int k = 0; k < LW_PMOVE_KINDS; k++) {
+    weight[k] = w[k];
+    step[k] = st[k] * move_unit[k];
+    target[k] = p->target_spline;
+  }
+}
+
+static size_t sweep_size(const void *state) { return lw_particles_sweep_size(state); }
+
+static double step_max(const void *state, int kind) { return lw_particles_step_max(state, kind); }
+
+static void *proposal_new(const void *state, lw_error *err) { return lw_particles_prop_new(state, err); }
+
+static void proposal_free(void *prop) { lw_particles_prop_free(prop); }
+
+static double propose(void *state, void *prop, int kind, double step, gsl_rng *rng, int *forbidden)
+{
+  *forbidden = 0;
+  return lw_particles_propose(state, prop, kind, step, rng, forbidden);
+}
+
+static lw_status commit(void *state, void *prop) { return lw_particles_commit(state, prop); }
+
+static double total(const void *state) { return lw_particles_total(state); }
+
+static void terms(const void *state, double *term) { lw_particles_terms(state, term); }
+
+static int term_on(const void *setup, int t) { return lw_particles_term_on(setup, t); }
+
+static lw_status refresh(void *state, double *drift) { return lw_particles_refresh(state, drift); }
+
+static double energy(const void *setup, const lw_state *st, const char *path, double *term, lw_error *err)
+{
+  lw_particles *p = lw_particles_get(setup, st->doc, SECTION, err);
+  if (!p) return NAN;
+  lw_particles_energy(p, term);
+  lw_particles_free(p);
+  double e = 0.0;
+  for (int t = 0; t < LW_PTERM_COUNT; t++) e += term[t];
+  return e;
+}
+
+static lw_status save(const void *state, lw_ckpt_writer *w, const char *section, lw_error *err)
+{
+  lw_particles_put(w, section, state);
+  return LW_OK;
+}
+
+static void *load(const void *setup, lw_state *st, const char *section, const char *path, lw_error *err)
+{
+  return lw_particles_get(setup, st->doc, section, err);
+}
+
+static void set_terms(void *state, const double *term)
+{
+  memcpy(((lw_particles *)state)->term, term, LW_PTERM_COUNT * sizeof *term);
+}
+
+static lw_status draw(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err)
+{
+  if (sweep == LW_DRAW_START) return LW_OK;
+  if (sweep == LW_DRAW_FINAL) return lw_particles_draw(state, dir, err);
+  char path[LW_PATH_MAX + 64];
+  int n = snprintf(path, sizeof path, "%s/frames", dir);
+  if (n < 0 || (size_t)n >= sizeof path - 32)
+    return lw_error_set(err, LW_EIO, "%s: path too long for the frames", dir);
+  if (mkdir(path, 0777) && errno != EEXIST) return lw_error_set(err, LW_EIO, "%s: %s", path, strerror(errno));
+  snprintf(path + n, sizeof path - (size_t)n, "/frame-%06ld.png", sweep);
+  return lw_particles_write_png(state, path, err);
+}
+
+static size_t pinned(const lw_particles *p)
+{
+  size_t k = 0;
+  for (size_t i = 0; i < p->n; i++) k += p->pin[i] != 0;
+  return k;
+}
+
+static void summary(const void *state, lw_json *j)
+{
+  const lw_particles *p = state;
+  lw_json_key(j, "particles");
+  lw_json_int(j, (long long)p->n);
+  lw_json_key(j, "pinned");
+  lw_json_int(j, (long long)pinned(p));
+}
+
+static void describe(const void *state, int what, char *buf, size_t n)
+{
+  const lw_particles *p = state;
+  if (what == LW_DESCRIBE_SIZE) snprintf(buf, n, "%zu particles, %zu pinned", p->n, pinned(p));
+  else if (n) buf[0] = '\0';
+}
+
+const lw_system_type lw_system_particles = {
+    .name = "particles",
+    .n_moves = LW_PMOVE_KINDS,
+    .move_names = lw_particles_move_names,
+    .move_unit = move_unit,
+    .n_terms = LW_PTERM_COUNT,
+    .term_names = lw_pterm_names,
+    .setup_new = setup_new,
+    .setup_free = setup_free,
+    .note = note,
+    .state_new = state_new,
+    .state_copy = state_copy,
+    .state_free = state_free,
+    .moves = moves,
+    .sweep_size = sweep_size,
+    .step_max = step_max,
+    .proposal_new = proposal_new,
+    .proposal_free = proposal_free,
+    .propose = propose,
+    .commit = commit,
+    .total = total,
+    .terms = terms,
+    .term_on = term_on,
+    .refresh = refresh,
+    .energy = energy,
+    .save = save,
+    .load = load,
+    .set_terms = set_terms,
+    .files = "final.ply, final.png",
+    .draw = draw,
+    .summary = summary,
+    .describe = describe,
+};

@@ -1,0 +1,227 @@
+/*
+** test_particles_cli.c -- the oriented-particle system through the seam, on
+** the command line: the bundled sheet anneals and writes a valid final.ply,
+** stop and resume give the bytes of an uninterrupted run, the outputs do
+** not depend on the thread count with tempering, and `linewise energy`
+** recomputes a particle run.
+*/
+#include <criterion/criterion.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "testutil.h"
+
+static char dir[64];
+
+static void make_dir(void) { cr_assert_eq(lw_test_dir_make(dir, "pcli"), 0); }
+static void remove_dir(void) { cr_assert_eq(lw_test_dir_remove(dir), 0); }
+#define sh lw_test_sh
+
+TestSuite(particles_cli, .init = make_dir, .fini = remove_dir);
+
+static const char *bin(void)
+{
+  const char *b = getenv("LW_BIN");
+  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
+  return b;
+}
+
+/* A small tempered sheet: 3 replicas, few sweeps, checkpoints inside. */
+static const char scene[] =
+  "[scene]\nsystem = particles\n"
+  "[particles]\ncount = 37\npattern = plane\nnoise = 0.1\nnormal_noise = 10\nalpha_p = 10\nalpha_n = 10\n"
+  "alpha_c = 0.5\ngravity = 0.01\nboundary = plane\nboundary_z = -3\nalpha_b = 0.1\npng_size = 64\n"
+  "[moves]\npoint = 0\nvector = 0\ntranslate = 1\nrotate = 1\nstep_translate = 0.1\nstep_rotate = 5\n"
+  "[anneal]\nschedule = geometric\nt_start = 0.05\nt_end = 0.001\nsweeps = 60\nsteps = 6\nseed = 5\n"
+  "check_every = 7\n"
+  "[tempering]\nreplicas = 3\nt_min = 0.05\nt_max = 0.5\n"
+  "[output]\ncheckpoint_every = 9\ntrace_every = 3\n";
+
+static void write_scene(void)
+{
+  char path[128];
+  snprintf(path, sizeof path, "%s/s.ini", dir);
+  FILE *f = fopen(path, "w");
+  cr_assert_not_null(f);
+  fputs(scene, f);
+  fclose(f);
+}
+
+static const char *const same[] = {"state.lw", "replica-1.lw", "replica-2.lw", "trace.csv", "final.ply", "final.png"};
+#define N_SAME (sizeof same / sizeof *same)
+
+/* One vertex line: six finite numbers, the last three a unit normal. */
+static int vertex_ok(const char *line)
+{
+  double v[6];
+  if (sscanf(line, "%lf %lf %lf %lf %lf %lf", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]) != 6) return 0;
+  for (int k = 0; k < 6; k++)
+    if (!isfinite(v[k])) return 0;
+  return fabs(v[3] * v[3] + v[4] * v[4] + v[5] * v[5] - 1.0) < 1e-6;
+}
+
+Test(particles_cli, the_sheet_example_runs_and_writes_a_valid_ply)
+{
+  const char *root = getenv("LW_ROOT");
+  cr_assert_not_null(root);
+  cr_assert_eq(sh("%s run %s/params/particles-sheet.ini --out %s/sheet --quiet --set anneal.sweeps=300", bin(), root,
+                  dir), 0);
+  char path[128];
+  snprintf(path, sizeof path, "%s/sheet/final.ply", dir);
+  FILE *f = fopen(path, "r");
+  cr_assert_not_null(f, "%s", path);
+  char line[256];
+  long vertices = -1, header = 0, read = 0;
+  const char *expect[] = {"ply", "format ascii 1.0"};
+  while (fgets(line, sizeof line, f)) {
+    if (header < 2) cr_assert_eq(strncmp(line, expect[header], strlen(expect[header])), 0, "header line %ld", header);
+    header++;
+    if (sscanf(line, "element vertex %ld", &vertices) == 1) continue;
+    if (!strcmp(line, "end_header\n")) break;
+  }
+  cr_assert_eq(vertices, 127, "the sheet's 127 particles");
+  while (fgets(line, sizeof line, f)) {
+    cr_assert(vertex_ok(line), "vertex %ld: %s", read, line);
+    read++;
+  }
+  fclose(f);
+  cr_assert_eq(read, vertices);
+  /* the other outputs, with the particle terms and move kinds by name */
+  cr_assert_eq(sh("head -1 %s/sheet/trace.csv | grep -q '^sweep,temperature,lj,coplanarity,conormality,total,"
+                  "acc_translate,acc_rotate$'", dir), 0);
+  cr_assert_eq(sh("grep -q '\"system\": \"particles\"' %s/sheet/summary.json", dir), 0);
+  cr_assert_eq(sh("grep -q '\"particles\": 127' %s/sheet/summary.json", dir), 0);
+  cr_assert_eq(sh("grep -q '\"rotate\": ' %s/sheet/summary.json", dir), 0);
+  cr_assert_eq(sh("grep -A1 '^\\[system particles\\]$' %s/sheet/state.lw | grep -q '^count = 127$'", dir), 0);
+  cr_assert_eq(sh("test -s %s/sheet/final.png", dir), 0);
+  /* the anneal lowered the energy well below the noisy start */
+  double e0 = NAN, e1 = NAN;
+  snprintf(path, sizeof path, "%s/sheet/summary.json", dir);
+  f = fopen(path, "r");
+  cr_assert_not_null(f);
+  int in_energy = 0;
+  while (fgets(line, sizeof line, f)) {
+    if (strstr(line, "\"energy\": {")) in_energy = 1;
+    if (in_energy && sscanf(line, " \"total\": %lf", &e1) == 1) in_energy = 0;
+    sscanf(line, " \"energy_initial\": %lf", &e0);
+  }
+  fclose(f);
+  cr_assert(isfinite(e0) && isfinite(e1), "energies %g %g", e0, e1);
+  cr_assert_lt(e1, e0, "annealing lowers the energy: %g -> %g", e0, e1);
+}
+
+Test(particles_cli, stop_and_resume_give_the_bytes_of_an_uninterrupted_run)
+{
+  write_scene();
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/a --quiet", bin(), dir, dir), 0);
+  /* stopped between checkpoints, then again later */
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/b --quiet --stop-at 22", bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s resume %s/b --quiet --stop-at 41", bin(), dir), 0);
+  cr_assert_eq(sh("%s resume %s/b --quiet", bin(), dir), 0);
+  for (size_t k = 0; k < N_SAME; k++)
+    cr_assert_eq(sh("cmp -s %s/a/%s %s/b/%s", dir, same[k], dir, same[k]), 0, "%s differs", same[k]);
+}
+
+Test(particles_cli, outputs_do_not_depend_on_the_thread_count_with_tempering)
+{
+  write_scene();
+  const int threads[3] = {1, 2, 4};
+  for (int i = 0; i < 3; i++)
+    cr_assert_eq(sh("OMP_NUM_THREADS=%d %s run %s/s.ini --out %s/t%d --quiet", threads[i], bin(), dir, dir, threads[i]),
+                 0);
+  for (int i = 1; i < 3; i++)
+    for (size_t k = 0; k < N_SAME; k++)
+      cr_assert_eq(sh("cmp -s %s/t1/%s %s/t%d/%s", dir, same[k], dir, threads[i], same[k]), 0,
+                   "%s differs with %d threads", same[k], threads[i]);
+  /* every term of the scene is on: a trace column each, and the ensemble */
+  cr_assert_eq(sh("head -1 %s/t1/trace.csv | grep -q "
+                  "'^sweep,temperature,lj,coplanarity,conormality,cocircularity,gravity,boundary,total,'", dir), 0);
+  cr_assert_eq(sh("grep -q '\"swap_acceptance\"' %s/t1/summary.json", dir), 0);
+}
+
+Test(particles_cli, energy_recomputes_a_particle_run)
+{
+  write_scene();
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/e --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s energy %s/e > %s/energy.txt", bin(), dir, dir), 0);
+  char path[128], line[256];
+  snprintf(path, sizeof path, "%s/energy.txt", dir);
+  FILE *f = fopen(path, "r");
+  cr_assert_not_null(f);
+  const char *names[] = {"lj", "coplanarity", "conormality", "cocircularity", "gravity", "boundary", "total"};
+  double v[7], sum = 0.0;
+  for (int k = 0; k < 7; k++) {
+    char name[32];
+    cr_assert_not_null(fgets(line, sizeof line, f), "line %d", k);
+    cr_assert_eq(sscanf(line, "%31s %lf", name, &v[k]), 2, "%s", line);
+    cr_assert_str_eq(name, names[k]);
+    if (k < 6) sum += v[k];
+  }
+  cr_assert_null(fgets(line, sizeof line, f), "nothing after the total");
+  fclose(f);
+  cr_assert(lw_close_rel(v[6], sum, 1e-12, 1.0), "total %.17g, sum %.17g", v[6], sum);
+  /* the same total as the run's running energy in summary.json */
+  snprintf(path, sizeof path, "%s/e/summary.json", dir);
+  f = fopen(path, "r");
+  cr_assert_not_null(f);
+  double run_total = NAN;
+  int in_energy = 0;
+  while (fgets(line, sizeof line, f)) {
+    if (strstr(line, "\"energy\": {")) in_energy = 1;
+    if (in_energy && sscanf(line, " \"total\": %lf", &run_total) == 1) break;
+  }
+  fclose(f);
+  cr_assert(lw_close_rel(v[6], run_total, 1e-9, 1.0), "recomputed %.17g, run %.17g", v[6], run_total);
+  /* a damaged particle line is refused with the file and its line */
+  cr_assert_eq(sh("sed -i '0,/^particle = /s/^particle = \\([^ ]*\\) /particle = nan /' %s/e/state.lw", dir), 0);
+  cr_assert_eq(sh("%s energy %s/e 2>%s/err.txt >/dev/null", bin(), dir, dir), 2);
+  cr_assert_eq(sh("grep -q 'e/state.lw:[0-9]*: \\[system particles\\] particle: expected' %s/err.txt", dir), 0);
+  /* a splines scene on a particle state: the missing section is named */
+  cr_assert_eq(sh("sed -i 's/^system = particles/system = splines/' %s/e/scene.ini", dir), 0);
+  cr_assert_eq(sh("%s energy %s/e 2>%s/err.txt >/dev/null", bin(), dir, dir), 2);
+  cr_assert_eq(sh("grep -q 'section \\[system splines\\]: missing' %s/err.txt", dir), 0);
+}
+
+/* The number after "key": in a JSON file (the first one). */
+static double json_number(const char *path, const char *key)
+{
+  FILE *f = fopen(path, "r");
+  cr_assert_not_null(f, "%s", path);
+  char line[512], pat[80];
+  snprintf(pat, sizeof pat, "\"%s\": ", key);
+  double v = NAN;
+  while (fgets(line, sizeof line, f)) {
+    char *at = strstr(line, pat);
+    if (at && sscanf(at + strlen(pat), "%lf", &v) == 1) break;
+  }
+  fclose(f);
+  return v;
+}
+
+Test(particles_cli, a_run_starts_from_the_particles_of_another_runs_state)
+{
+  write_scene();
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/a --quiet", bin(), dir, dir), 0);
+  /* from the hottest rung's state, without tempering */
+  cr_assert_eq(sh("sed -e 's/^replicas = 3/replicas = 1/' -e 's/^sweeps = 60/sweeps = 5/' %s/s.ini > %s/f.ini && "
+                  "printf '[init]\\nfrom = %s/a/replica-2.lw\\n' >> %s/f.ini", dir, dir, dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/f.ini --out %s/f --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s energy %s/a > /dev/null && cp %s/a/replica-2.lw %s/a/state.lw && %s energy %s/a | "
+                  "awk '$1 == \"total\" { print $2 }' > %s/e2.txt", bin(), dir, dir, dir, bin(), dir, dir), 0);
+  char path[160];
+  snprintf(path, sizeof path, "%s/e2.txt", dir);
+  FILE *f = fopen(path, "r");
+  cr_assert_not_null(f);
+  double e2 = NAN;
+  cr_assert_eq(fscanf(f, "%lf", &e2), 1);
+  fclose(f);
+  snprintf(path, sizeof path, "%s/f/summary.json", dir);
+  double e0 = json_number(path, "energy_initial");
+  cr_assert(lw_close_rel(e0, e2, 1e-12, 1.0), "started at %.17g, the state holds %.17g", e0, e2);
+  /* a splines state is refused naming [init] from and the section */
+  cr_assert_eq(sh("printf 'linewise-state 2\\n[run]\\nscene = s.ini\\nseed = 1\\nsweep = 0\\n[system splines]\\n"
+                  "splines = 0\\n' > %s/spl.lw && sed -i 's|^from = .*|from = %s/spl.lw|' %s/f.ini", dir, dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/f.ini --out %s/g --quiet 2>%s/err.txt", bin(), dir, dir, dir), 2);
+  cr_assert_eq(sh("grep -q 'spl.lw: section \\[system particles\\]: missing' %s/err.txt", dir), 0);
+}
