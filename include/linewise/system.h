@@ -133,6 +133,17 @@ struct lw_system_type {
   ** text for the command line: the size (LW_DESCRIBE_SIZE, "20 splines, 80
   ** segments") or what the final drawing reported (LW_DESCRIBE_DRAWING,
   ** whole lines "linewise: ...\n", or ""); files names the drawing files. */
+  /* Gradient-based drivers (dynamics, quench; gradient.h): the state as a
+  ** vector of n_coords() generalised coordinates (for splines the nodes'
+  ** px py vx vy in node order), set_coords() moves the state there and
+  ** recomputes every cache and running total, gradient() returns the total
+  ** energy and dE/dx (+inf, g undefined, in a forbidden state).  NULL when a
+  ** system has no gradient; a driver that needs one refuses such a scene. */
+  size_t (*n_coords)(const void *state);
+  void (*get_coords)(const void *state, double *x);
+  lw_status (*set_coords)(void *state, const double *x, lw_error *err);
+  double (*gradient)(void *state, double *g, lw_error *err);
+
   const char *files;
   lw_status (*draw)(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err);
   void (*summary)(const void *state, lw_json *j);
