@@ -551,6 +551,7 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
   if (a->sweep % p->check_every == 0)
     for (int r = 0; r < n; r++) {
       double drift;
+      if (a->sys_type->renumber && (s = a->sys_type->renumber(a->systems[r]->state, err))) return s;
       if (a->sys_type->refresh(a->systems[r]->state, &drift) != LW_OK)
         return lw_error_set(err, LW_ENOMEM, "out of memory");
       if (drift > a->max_drift) a->max_drift = drift;

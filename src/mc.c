@@ -64,13 +64,10 @@ static void tune(lw_chain *c, int kind, int accepted)
   c->win_prop[kind] = c->win_acc[kind] = 0;
 }
 
-int lw_chain_step(lw_chain *c, int kind)
+/* The Metropolis decision on an evaluated proposal, its commit and the
+** counts. */
+static int decide(lw_chain *c, int kind, double dE, int forbidden)
 {
-  const lw_system_type *t = c->sys->type;
-  void *state = c->sys->state;
-  if (t->sweep_size(state) == 0) return 0;
-  int forbidden = 0;
-  double dE = t->propose(state, c->prop, kind, c->step[kind], c->rng, &forbidden);
   int accept;
   lw_move_stats *s = &c->stats[kind];
   s->proposed++;
@@ -90,21 +87,57 @@ int lw_chain_step(lw_chain *c, int kind)
     accept = 0;
   }
   if (accept) {
-    if (t->commit(state, c->prop) != LW_OK) accept = -1;
+    if (c->sys->type->commit(c->sys->state, c->prop) != LW_OK) accept = -1;
     else s->accepted++;
   }
   if (c->tuning && accept >= 0) tune(c, kind, accept);
   return accept;
 }
 
+int lw_chain_step(lw_chain *c, int kind)
+{
+  const lw_system_type *t = c->sys->type;
+  void *state = c->sys->state;
+  if (t->sweep_size(state) == 0) return 0;
+  int forbidden = 0;
+  double dE = t->propose(state, c->prop, kind, c->step[kind], c->rng, &forbidden);
+  return decide(c, kind, dE, forbidden);
+}
+
+int lw_chain_step_at(lw_chain *c, int kind, size_t site)
+{
+  const lw_system_type *t = c->sys->type;
+  if (!t->propose_at) return lw_chain_step(c, kind);
+  int forbidden = 0;
+  double dE = t->propose_at(c->sys->state, c->prop, kind, site, c->step[kind], c->rng, &forbidden);
+  return decide(c, kind, dE, forbidden);
+}
+
+static int draw_kind(lw_chain *c)
+{
+  double u = gsl_rng_uniform(c->rng);
+  int kind = 0;
+  while (kind < c->n_moves - 1 && u >= c->cum_weight[kind]) kind++;
+  return kind;
+}
+
 lw_status lw_chain_sweep(lw_chain *c)
 {
-  size_t n = c->sys->type->sweep_size(c->sys->state);
+  const lw_system_type *t = c->sys->type;
+  size_t n = t->sweep_size(c->sys->state);
+  if (!t->propose_at) {
+    for (size_t k = 0; k < n; k++)
+      if (lw_chain_step(c, draw_kind(c)) < 0) return LW_ENOMEM;
+    return LW_OK;
+  }
+  if (n == 0) return LW_OK;
+  /* Sites in order, so that consecutive proposals share cache lines and
+  ** grid cells; the direction is drawn per sweep so that the sweep as a
+  ** whole is reversible (docs/NUMERICS.md, "Sweep order"). */
+  int backward = gsl_rng_uniform(c->rng) < 0.5;
   for (size_t k = 0; k < n; k++) {
-    double u = gsl_rng_uniform(c->rng);
-    int kind = 0;
-    while (kind < c->n_moves - 1 && u >= c->cum_weight[kind]) kind++;
-    if (lw_chain_step(c, kind) < 0) return LW_ENOMEM;
+    size_t site = backward ? n - 1 - k : k;
+    if (lw_chain_step_at(c, draw_kind(c), site) < 0) return LW_ENOMEM;
   }
   return LW_OK;
 }

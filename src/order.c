@@ -298,7 +298,8 @@ lw_status lw_order_greedy(const lw_order_path *path, size_t n, double hx, double
 ** length (every leg is symmetric), so a cut may reverse either side. */
 typedef struct {
   size_t n, m, free_pt;
-  const double *px, *py;
+  double *px, *py;              /* owned; by label after relabel() */
+  size_t *orig;                 /* label -> path (n: home) */
   size_t *tour, *pos;           /* position -> item, item -> position */
   unsigned char *rev;           /* per item */
   size_t *nb;                   /* LW_ORDER_NEIGHBOURS candidates per point */
@@ -312,13 +313,25 @@ typedef struct {
 static double leg(const two_opt *t, size_t a, size_t b)
 {
   if (a == t->free_pt || b == t->free_pt) return 0.0;
-  return hypot(t->px[a] - t->px[b], t->py[a] - t->py[b]);
+  /* not hypot(): no overflow is possible at page scale, and the square
+  ** root is several times cheaper */
+  double dx = t->px[a] - t->px[b], dy = t->py[a] - t->py[b];
+  return sqrt(dx * dx + dy * dy);
 }
 
 static size_t entry_of(const two_opt *t, size_t item) { return 2 * item + t->rev[item]; }
 static size_t exit_of(const two_opt *t, size_t item) { return 2 * item + 1 - t->rev[item]; }
-static size_t succ(const two_opt *t, size_t item) { return t->tour[(t->pos[item] + 1) % t->m]; }
-static size_t pred(const two_opt *t, size_t item) { return t->tour[(t->pos[item] + t->m - 1) % t->m]; }
+static size_t succ(const two_opt *t, size_t item)
+{
+  size_t i = t->pos[item] + 1;
+  return t->tour[i == t->m ? 0 : i];
+}
+
+static size_t pred(const two_opt *t, size_t item)
+{
+  size_t i = t->pos[item];
+  return t->tour[(i ? i : t->m) - 1];
+}
 
 static void push(two_opt *t, size_t item)
 {
@@ -340,15 +353,21 @@ static void reverse(two_opt *t, size_t from, size_t to)
     i = ni;
     len = m - len;
   }
-  for (size_t k = 0; k < len; k++) t->rev[t->tour[(i + k) % m]] ^= 1;
+  /* the two ends walk inwards, wrapping by comparison: a division per
+  ** entry (% m) cost more than the rest of the move */
+  size_t a = i, b = j;
   for (size_t k = 0; k < len / 2; k++) {
-    size_t a = (i + k) % m, b = (j + m - k) % m;
     size_t ia = t->tour[a], ib = t->tour[b];
     t->tour[a] = ib;
     t->tour[b] = ia;
     t->pos[ib] = a;
     t->pos[ia] = b;
+    t->rev[ia] ^= 1;
+    t->rev[ib] ^= 1;
+    a = a + 1 == m ? 0 : a + 1;
+    b = b == 0 ? m - 1 : b - 1;
   }
+  if (len & 1) t->rev[t->tour[a]] ^= 1;
   t->work += len;
 }
 
@@ -409,6 +428,9 @@ static int improve(two_opt *t, size_t a)
 
 static void two_opt_free(two_opt *t)
 {
+  free(t->px);
+  free(t->py);
+  free(t->orig);
   free(t->tour);
   free(t->pos);
   free(t->rev);
@@ -416,6 +438,60 @@ static void two_opt_free(two_opt *t)
   free(t->nbn);
   free(t->queue);
   free(t->queued);
+}
+
+/* Items are renumbered by their place in the starting tour, home first:
+** a reversal then rewrites pos[] and rev[] over a run of neighbouring
+** entries instead of entries scattered over the arrays, which made each
+** moved entry a cache miss (issue 14).  Point 2 l + e is end e of the item
+** labelled l, so FREE is 0 and home 1.  The candidate lists, found by path
+** index, are carried over, so the moves and the result are those without
+** the renumbering.  t->px, t->py, t->nb and t->nbn go from path index to
+** label. */
+static lw_status relabel(two_opt *t, const size_t *order, const unsigned char *reversed)
+{
+  const size_t K = LW_ORDER_NEIGHBOURS, n = t->n, m = t->m, npt = 2 * m;
+  size_t *lab = malloc(m * sizeof *lab), *nb = malloc(npt * K * sizeof *nb);
+  unsigned char *nbn = malloc(npt);
+  double *lx = malloc(npt * sizeof *lx), *ly = malloc(npt * sizeof *ly);
+  t->orig = malloc(m * sizeof *t->orig);
+  if (!lab || !nb || !nbn || !lx || !ly || !t->orig) {
+    free(lab);
+    free(nb);
+    free(nbn);
+    free(lx);
+    free(ly);
+    return LW_ENOMEM;
+  }
+  t->orig[0] = n;
+  for (size_t k = 0; k < n; k++) t->orig[k + 1] = order[k];
+  for (size_t l = 0; l < m; l++) lab[t->orig[l]] = l;
+  for (size_t l = 0; l < m; l++)
+    for (size_t e = 0; e < 2; e++) {
+      size_t q = 2 * t->orig[l] + e, to = 2 * l + e;
+      lx[to] = t->px[q];
+      ly[to] = t->py[q];
+      nbn[to] = t->nbn[q];
+      for (size_t k = 0; k < t->nbn[q]; k++) {
+        size_t r = t->nb[q * K + k];
+        nb[to * K + k] = 2 * lab[r / 2] + (r & 1);
+      }
+    }
+  free(lab);
+  free(t->nb);
+  free(t->nbn);
+  free(t->px);
+  free(t->py);
+  t->nb = nb;
+  t->nbn = nbn;
+  t->px = lx;
+  t->py = ly;
+  t->free_pt = 0;
+  for (size_t l = 0; l < m; l++) {
+    t->tour[l] = t->pos[l] = l;
+    t->rev[l] = l ? reversed[l - 1] : 0;
+  }
+  return LW_OK;
 }
 
 lw_status lw_order_2opt(const lw_order_path *path, size_t n, double hx, double hy,
@@ -460,8 +536,6 @@ lw_status lw_order_2opt(const lw_order_path *path, size_t n, double hx, double h
     two_opt_free(&t);
     free(ids);
     free(d2s);
-    free(px);
-    free(py);
     return lw_error_set(err, LW_ENOMEM, "out of memory ordering %zu paths", n);
   }
   for (size_t k = 0; k < 2 * n + 1; k++)
@@ -469,13 +543,9 @@ lw_status lw_order_2opt(const lw_order_path *path, size_t n, double hx, double h
   grid_free(&g);
   free(ids);
   free(d2s);
-
-  t.tour[0] = n;
-  t.pos[n] = 0;
-  for (size_t k = 0; k < n; k++) {
-    t.tour[k + 1] = order[k];
-    t.pos[order[k]] = k + 1;
-    t.rev[order[k]] = reversed[k];
+  if (relabel(&t, order, reversed) != LW_OK) {
+    two_opt_free(&t);
+    return lw_error_set(err, LW_ENOMEM, "out of memory ordering %zu paths", n);
   }
   t.budget = (unsigned long long)LW_ORDER_WORK * t.m;
   /* A reversal flips every path inside it, which can open a move for a
@@ -495,15 +565,13 @@ lw_status lw_order_2opt(const lw_order_path *path, size_t n, double hx, double h
   }
 
   /* read the cycle from home in the direction in which home is forward */
-  size_t h = t.pos[n];
-  int back = t.rev[n];
+  size_t h = t.pos[0];
+  int back = t.rev[0];
   for (size_t k = 0; k < n; k++) {
     size_t item = t.tour[back ? (h + t.m - 1 - k) % t.m : (h + 1 + k) % t.m];
-    order[k] = item;
+    order[k] = t.orig[item];
     reversed[k] = (unsigned char)(t.rev[item] ^ back);
   }
   two_opt_free(&t);
-  free(px);
-  free(py);
   return LW_OK;
 }

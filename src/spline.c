@@ -65,6 +65,27 @@ lw_splines *lw_splines_clone(const lw_splines *sp)
   return c;
 }
 
+lw_status lw_splines_permute(lw_splines *sp, const size_t *order, lw_error *err)
+{
+  size_t n = sp->n_splines;
+  size_t *segs = calloc(n ? n : 1, sizeof *segs);
+  if (!segs) return lw_error_set(err, LW_ENOMEM, "out of memory renumbering %zu splines", n);
+  for (size_t k = 0; k < n; k++) segs[k] = lw_splines_segments(sp, order[k]);
+  lw_splines *c = lw_splines_new(n, segs, err);
+  free(segs);
+  if (!c) return err ? err->code : LW_ENOMEM;
+  for (size_t k = 0; k < n; k++) {
+    size_t i = order[k];
+    memcpy(&c->node[c->first[k]], &sp->node[sp->first[i]], (sp->first[i + 1] - sp->first[i]) * sizeof *sp->node);
+    c->rest_length[k] = sp->rest_length[i];
+  }
+  lw_splines old = *sp;
+  *sp = *c;
+  *c = old;
+  lw_splines_free(c);
+  return LW_OK;
+}
+
 int lw_splines_is_point(const lw_splines *sp, size_t i)
 {
   const lw_node *nd = &sp->node[sp->first[i]];

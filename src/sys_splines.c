@@ -13,6 +13,7 @@
 #include "linewise/checkpoint.h"
 #include "linewise/drawing.h"
 #include "linewise/fieldview.h"
+#include "linewise/hilbert.h"
 #include "linewise/init.h"
 
 const char *const lw_move_names[LW_MOVE_KINDS] = {"point", "vector", "translate", "rotate"};
@@ -83,6 +84,22 @@ static void state_free(void *state)
   free(s);
 }
 
+/* Renumbers sp along the Hilbert curve of the page (hilbert.h): sweeps go
+** node after node (mc.h), so splines near on the page are then near in
+** memory too.  1 if the numbering changed, 0 if not, -1 out of memory. */
+static int along_curve(const lw_scene *sc, lw_splines *sp, lw_error *err)
+{
+  size_t *order = malloc((sp->n_splines ? sp->n_splines : 1) * sizeof *order);
+  if (!order) {
+    lw_error_set(err, LW_ENOMEM, "out of memory renumbering %zu splines", sp->n_splines);
+    return -1;
+  }
+  int moved = lw_hilbert_order(sp, 0.0, 0.0, sc->width, sc->height, order, err);
+  if (moved > 0 && lw_splines_permute(sp, order, err)) moved = -1;
+  free(order);
+  return moved;
+}
+
 /* A model on sp (owned) after checking that the splines read from path are
 ** allowed for the scene. */
 static spl_state *state_from_file(const spl_setup *su, lw_splines *sp, const char *path, lw_error *err)
@@ -125,6 +142,10 @@ static void *state_new(const void *setup, const lw_params *p, unsigned long seed
       lw_params_blame(p, "init", "from", err);
       return NULL;
     }
+    if (along_curve(&su->scene, sp, err) < 0) {
+      lw_splines_free(sp);
+      return NULL;
+    }
     spl_state *s = state_from_file(su, sp, p->from, err);
     if (!s && err->code == LW_EINPUT) lw_params_blame(p, "init", "from", err);
     return s;
@@ -141,6 +162,10 @@ static void *state_new(const void *setup, const lw_params *p, unsigned long seed
   gsl_rng_free(r);
   if (!sp) {
     if (err->code == LW_EINPUT) lw_params_blame(p, "init", "segment_length", err);
+    return NULL;
+  }
+  if (along_curve(&su->scene, sp, err) < 0) {
+    lw_splines_free(sp);
     return NULL;
   }
   return state_of(su, lw_model_new(&su->scene, sp, err), 1, err);
@@ -198,20 +223,30 @@ static uint32_t spline_of_node(const lw_splines *sp, size_t k)
   return (uint32_t)lo;
 }
 
-static double propose(void *state, void *prop, int kind, double st, gsl_rng *rng, int *forbidden)
+/* The same, trying first the spline of the last proposal and its
+** neighbours: a sweep goes node after node. */
+static uint32_t spline_near(const lw_splines *sp, uint32_t hint, size_t k)
 {
-  const lw_model *m = ((spl_state *)state)->m;
-  lw_proposal *p = prop;
+  if (hint < sp->n_splines) {
+    if (k >= sp->first[hint] && k < sp->first[hint + 1]) return hint;
+    if (hint + 1 < sp->n_splines && k >= sp->first[hint + 1] && k < sp->first[hint + 2]) return hint + 1;
+    if (hint > 0 && k >= sp->first[hint - 1] && k < sp->first[hint]) return hint - 1;
+  }
+  return spline_of_node(sp, k);
+}
+
+/* A proposal of the kind at global node k (a point or vector move) or on
+** its spline (a rigid move). */
+static double propose_on(const lw_model *m, lw_proposal *p, int kind, size_t at, uint32_t i, double st,
+                         gsl_rng *rng, int *forbidden)
+{
   const lw_splines *sp = m->sp;
-  uint32_t i;
   size_t node0, n_node;
   lw_node *nd = p->node; /* proposals are built in place in the scratch */
   if (kind == LW_MOVE_POINT || kind == LW_MOVE_VECTOR) {
-    size_t k = gsl_rng_uniform_int(rng, sp->n_nodes);
-    i = spline_of_node(sp, k);
-    node0 = k - sp->first[i];
+    node0 = at - sp->first[i];
     n_node = 1;
-    nd[0] = sp->node[k];
+    nd[0] = sp->node[at];
     double dx = gsl_ran_gaussian_ziggurat(rng, st), dy = gsl_ran_gaussian_ziggurat(rng, st);
     if (kind == LW_MOVE_POINT) {
       nd[0].px += dx;
@@ -221,7 +256,6 @@ static double propose(void *state, void *prop, int kind, double st, gsl_rng *rng
       nd[0].vy += dy;
     }
   } else {
-    i = (uint32_t)gsl_rng_uniform_int(rng, sp->n_splines);
     node0 = 0;
     n_node = sp->first[i + 1] - sp->first[i];
     const lw_node *src = &sp->node[sp->first[i]];
@@ -251,6 +285,38 @@ static double propose(void *state, void *prop, int kind, double st, gsl_rng *rng
   lw_model_propose(m, p, i, node0, n_node, NULL);
   *forbidden = p->irregular;
   return p->dE;
+}
+
+/* A node drawn uniformly for a point or vector move, a spline for a rigid
+** one. */
+static double propose(void *state, void *prop, int kind, double st, gsl_rng *rng, int *forbidden)
+{
+  const lw_model *m = ((spl_state *)state)->m;
+  const lw_splines *sp = m->sp;
+  if (kind == LW_MOVE_POINT || kind == LW_MOVE_VECTOR) {
+    size_t k = gsl_rng_uniform_int(rng, sp->n_nodes);
+    return propose_on(m, prop, kind, k, spline_of_node(sp, k), st, rng, forbidden);
+  }
+  uint32_t i = (uint32_t)gsl_rng_uniform_int(rng, sp->n_splines);
+  return propose_on(m, prop, kind, sp->first[i], i, st, rng, forbidden);
+}
+
+/* Site k is global node k; a rigid move there moves the node's spline, so a
+** spline of n nodes gets n chances a sweep, as many as its nodes get point
+** and vector moves. */
+static double propose_at(void *state, void *prop, int kind, size_t k, double st, gsl_rng *rng, int *forbidden)
+{
+  const lw_model *m = ((spl_state *)state)->m;
+  lw_proposal *p = prop;
+  return propose_on(m, p, kind, k, spline_near(m->sp, p->spline, k), st, rng, forbidden);
+}
+
+/* Between sweeps, before the run loop's refresh (which rebuilds every
+** cache from the renumbered state). */
+static lw_status renumber(void *state, lw_error *err)
+{
+  spl_state *s = state;
+  return along_curve(s->m->scene, s->m->sp, err) < 0 ? err->code : LW_OK;
 }
 
 static lw_status commit(void *state, void *prop) { return lw_model_commit(((spl_state *)state)->m, prop); }
@@ -372,6 +438,8 @@ const lw_system_type lw_system_splines = {
     .proposal_new = proposal_new,
     .proposal_free = proposal_free,
     .propose = propose,
+    .propose_at = propose_at,
+    .renumber = renumber,
     .commit = commit,
     .total = total,
     .terms = terms,

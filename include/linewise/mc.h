@@ -15,7 +15,7 @@
 ** frozen so the chain obeys detailed balance.
 **
 ** A sweep is as many proposals as the row's sweep_size (for splines: the
-** scene's nodes).
+** scene's nodes), site after site where the row numbers its sites.
 */
 #ifndef LINEWISE_MC_H
 #define LINEWISE_MC_H
@@ -58,8 +58,17 @@ void lw_chain_free(lw_chain *c);
 ** if the commit ran out of memory. */
 int lw_chain_step(lw_chain *c, int kind);
 
-/* One sweep: sweep_size proposals with kinds drawn from the mix.  LW_ENOMEM
-** if a commit could not grow the system's caches. */
+/* The same at site `site` of a row with propose_at (system.h); a row
+** without it draws its own site. */
+int lw_chain_step_at(lw_chain *c, int kind, size_t site);
+
+/* One sweep: sweep_size proposals with kinds drawn from the mix.  A row with
+** propose_at has every site visited once, in order, forward or backward
+** (one draw per sweep); each visit is a Metropolis update that leaves the
+** Boltzmann distribution stationary, and the two directions, equally
+** likely, make the sweep reversible (docs/NUMERICS.md, "Sweep order").  A
+** row without it draws each proposal's site at random.  LW_ENOMEM if a
+** commit could not grow the system's caches. */
 lw_status lw_chain_sweep(lw_chain *c);
 
 /* A generator's state as hex text (malloc'ed) and back, for checkpoints;

@@ -42,6 +42,12 @@ void lw_splines_free(lw_splines *sp);
 /* A deep copy (NULL on allocation failure). */
 lw_splines *lw_splines_clone(const lw_splines *sp);
 
+/* Renumbers sp in place: its spline k becomes what spline order[k] was (a
+** permutation of 0..n_splines-1), nodes and rest length with it.  The
+** arrays are rebuilt, so pointers into them go stale; sp itself stays.
+** LW_ENOMEM leaves sp as it was. */
+lw_status lw_splines_permute(lw_splines *sp, const size_t *order, lw_error *err);
+
 static inline size_t lw_splines_segments(const lw_splines *sp, size_t i)
 {
   return sp->first[i + 1] - sp->first[i] - 1;

@@ -96,7 +96,20 @@ struct lw_system_type {
   void *(*proposal_new)(const void *state, lw_error *err);
   void (*proposal_free)(void *prop);
   double (*propose)(void *state, void *prop, int kind, double step, gsl_rng *rng, int *forbidden);
+  /* Optional (NULL: sweeps draw their sites through propose): the same at a
+  ** given site, 0 <= site < sweep_size, whose sites the row numbers so that
+  ** neighbours in the numbering are near in memory (for splines: the node,
+  ** a rigid move taking the node's spline).  A sweep then visits every site
+  ** once, in order, forward or backward at random (mc.h, NUMERICS.md). */
+  double (*propose_at)(void *state, void *prop, int kind, size_t site, double step, gsl_rng *rng,
+                       int *forbidden);
   lw_status (*commit)(void *state, void *prop);
+  /* Optional (NULL: the numbering never changes): renumbers the state's
+  ** sites for locality in memory, as a function of the state alone, so that
+  ** a resumed run does the same.  The run loop calls it between sweeps,
+  ** every anneal.check_every sweeps, right before refresh, which rebuilds
+  ** the caches; the running energies are unchanged by it. */
+  lw_status (*renumber)(void *state, lw_error *err);
 
   /* Energies: the running total (+inf in a forbidden state), the running
   ** value of each term (n_terms values, 0 when off), whether term t is on
