@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "linewise/checkpoint.h"
+#include "linewise/phase.h"
 #include "linewise/init.h"
 #include "linewise/json.h"
 #include "linewise/number.h"
@@ -264,11 +265,13 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   a->block = -1;
   lw_status s;
   double ladder[LW_TEMPERING_MAX];
+  lw_phase_set("setting up the scene");
   if ((s = lw_params_resolve(&a->params, err)) || (s = setup_ladder(a, ladder, err)) ||
       (s = setup_schedule(a, err)) ||
       (s = setup_system(a, err)))
     return s;
   const lw_system_type *t = a->sys_type;
+  lw_phase_set("placing the initial state and building its energy");
   void *all[LW_TEMPERING_MAX] = {t->state_new(a->setup, &a->params, lw_stream_seed(a->seed, 0), err)};
   if (!all[0]) return err->code;
   /* every replica starts from the same state; their streams part them */
@@ -291,13 +294,23 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   lw_params_write(&a->params, f);
   if ((s = lw_output_commit(f, tmp, path, err))) return s;
   if ((s = open_trace(a, 1, err))) return s;
+  lw_phase_set("drawing the start files");
   if ((s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_START, err))) return s;
-  return lw_anneal_checkpoint(a, err);
+  s = lw_anneal_checkpoint(a, err);
+  lw_phase_set(NULL);
+  return s;
 }
 
 /* ---- checkpoints (checkpoint.c) ------------------------------------- */
 
-lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err) { return lw_checkpoint_write(a, err); }
+lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
+{
+  const char *was = lw_phase_get(NULL);
+  lw_phase_set("writing state.lw");
+  lw_status s = lw_checkpoint_write(a, err);
+  lw_phase_set(was);
+  return s;
+}
 
 /* trace.csv back to the checkpoint: rows written after it belong to sweeps
 ** that will run again.  A format-2 checkpoint knows the length it synced;
@@ -387,6 +400,7 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
   lw_state st;
   void *all[LW_TEMPERING_MAX] = {NULL};
   lw_ckpt *rep[LW_TEMPERING_MAX] = {NULL};
+  lw_phase_set("reading state.lw and rebuilding the energy");
   lw_status s = lw_state_read(&st, path, err);
   if (s) return s;
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);
@@ -418,6 +432,7 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
   for (int k = 0; k < a->chain->n_moves; k++) a->proposals_before += a->chain->stats[k].proposed;
   s = truncate_trace(a, trace_bytes, err);
 out:
+  lw_phase_set(NULL);
   for (int k = 1; k < LW_TEMPERING_MAX; k++) lw_ckpt_free(rep[k]);
   lw_state_clear(&st);
   return s;
@@ -678,8 +693,10 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 {
   lw_status s;
   if ((s = lw_anneal_checkpoint(a, err))) return s;
-  if ((s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_FINAL, err))) return s;
-  return write_summary(a, err);
+  lw_phase_set("drawing the final files (ordering the paths, then each file)");
+  if (!(s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_FINAL, err))) s = write_summary(a, err);
+  lw_phase_set(NULL);
+  return s;
 }
 
 void lw_anneal_free(lw_anneal *a)

@@ -6,7 +6,9 @@
 */
 #include <math.h>
 #include <omp.h>
+#include <pthread.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,6 +17,7 @@
 #include "linewise/anneal.h"
 #include "linewise/number.h"
 #include "linewise/params.h"
+#include "linewise/phase.h"
 #include "linewise/state.h"
 #include "linewise/system.h"
 
@@ -130,27 +133,88 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
   }
 }
 
+/* A watcher thread for the phases outside the sweeps (phase.h): one that
+** lasts over a second is named while it runs, and again with its time when
+** it ends, so a large scene's set-up and output never leave the terminal
+** silent.  It only reads the phase and writes stderr. */
+typedef struct {
+  pthread_t thread;
+  int running, tty;
+  atomic_int stop;
+} watcher;
+
+static void *watch(void *arg)
+{
+  watcher *w = arg;
+  const char *shown = NULL;
+  double last = 0.0, reported = 0.0;
+  const struct timespec tick = {0, 100000000};
+  while (!atomic_load(&w->stop)) {
+    nanosleep(&tick, NULL);
+    double t;
+    const char *what = lw_phase_get(&t);
+    if (shown && what != shown) {
+      fprintf(stderr, "%slinewise: %s: done in %.1f s\n", w->tty ? "\r\033[K" : "", shown, last);
+      shown = NULL;
+    }
+    if (what && t > 1.0 && (!shown || (w->tty && t - reported >= 1.0))) {
+      /* a terminal sees the seconds count up in place; a log gets one line */
+      if (w->tty) fprintf(stderr, "\r\033[Klinewise: %s... %.0f s", what, t);
+      else if (!shown) fprintf(stderr, "linewise: %s...\n", what);
+      shown = what;
+      reported = t;
+    }
+    if (what == shown) last = t;
+  }
+  if (shown) fprintf(stderr, "%slinewise: %s: done in %.1f s\n", w->tty ? "\r\033[K" : "", shown, last);
+  return NULL;
+}
+
+static void watcher_start(watcher *w, int quiet)
+{
+  w->running = 0;
+  w->tty = isatty(2);
+  atomic_init(&w->stop, 0);
+  if (!quiet) w->running = pthread_create(&w->thread, NULL, watch, w) == 0;
+}
+
+static void watcher_stop(watcher *w)
+{
+  if (!w->running) return;
+  atomic_store(&w->stop, 1);
+  pthread_join(w->thread, NULL);
+  w->running = 0;
+}
+
 /* The loop shared by run and resume: sweeps until done or a signal, then
 ** the final files (or a checkpoint for a clean stop). */
-static int anneal_loop(lw_anneal *a, long stop_at, int quiet, lw_error *err)
+static int watched_fail(watcher *w, const lw_error *err)
+{
+  watcher_stop(w);
+  return fail(err);
+}
+
+static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_error *err)
 {
   progress pg = {quiet, isatty(2), a->sweep, a->sweep, -1};
   /* a signal during start-up stops before the first sweep */
   int stopped = stop_requested && !lw_anneal_done(a);
   while (!stopped && !lw_anneal_done(a)) {
-    if (lw_anneal_sweep(a, err)) return fail(err);
+    if (lw_anneal_sweep(a, err)) return watched_fail(w, err);
     progress_show(&pg, a, 0);
     stopped = stop_requested || (stop_at >= 0 && a->sweep >= stop_at);
   }
   progress_show(&pg, a, 1);
   if (stopped) {
-    if (lw_anneal_checkpoint(a, err)) return fail(err);
+    if (lw_anneal_checkpoint(a, err)) return watched_fail(w, err);
+    watcher_stop(w);
     if (!quiet)
       fprintf(stderr, "linewise: stopped after sweep %ld; state saved in %s/state.lw ('linewise resume %s' continues)\n",
               a->sweep, a->dir, a->dir);
     return 0;
   }
-  if (lw_anneal_finish(a, err)) return fail(err);
+  if (lw_anneal_finish(a, err)) return watched_fail(w, err);
+  watcher_stop(w);
   if (!quiet) {
     char drawn[512];
     a->sys_type->describe(a->sys->state, LW_DESCRIBE_DRAWING, drawn, sizeof drawn);
@@ -263,9 +327,11 @@ static int cmd_run(int argc, char **argv)
     snprintf(dir, sizeof dir, "out/%.*s", (int)strcspn(base, "."), base);
   }
   static lw_anneal a;
+  watcher w;
+  watcher_start(&w, quiet);
   if (lw_anneal_start(&a, &p, dir, &err)) {
     lw_anneal_free(&a);
-    return fail(&err);
+    return watched_fail(&w, &err);
   }
   if (!quiet) {
     const char *note = a.sys_type->note(a.setup);
@@ -276,7 +342,7 @@ static int cmd_run(int argc, char **argv)
     fprintf(stderr, "linewise: resolved parameters:\n");
     lw_params_write(&a.params, stderr);
   }
-  int rc = anneal_loop(&a, stop_at, quiet, &err);
+  int rc = anneal_loop(&a, stop_at, quiet, &w, &err);
   lw_anneal_free(&a);
   return rc;
 }
@@ -308,12 +374,14 @@ static int cmd_resume(int argc, char **argv)
     return fail(&err);
   }
   static lw_anneal a;
+  watcher w;
+  watcher_start(&w, quiet);
   if (lw_anneal_resume(&a, dir, more, &err)) {
     lw_anneal_free(&a);
-    return fail(&err);
+    return watched_fail(&w, &err);
   }
   if (!quiet) fprintf(stderr, "linewise: resuming %s at sweep %ld of %ld\n", dir, a.sweep, a.end_sweep);
-  int rc = anneal_loop(&a, stop_at, quiet, &err);
+  int rc = anneal_loop(&a, stop_at, quiet, &w, &err);
   lw_anneal_free(&a);
   return rc;
 }

@@ -149,12 +149,17 @@ Test(stats, point_move_acceptance_matches_the_gaussian_closed_forms)
       ** so the standard error of the rate comes from the scatter of B batch
       ** rates (batches of N/B = 4000+ proposals, ~40 per node, far longer
       ** than the correlation time of a node's acceptance), floored at the
-      ** binomial value sqrt(a (1 - a) / N) that independent draws would give. */
+      ** binomial value sqrt(a (1 - a) / N) that independent draws would give.
+      ** Whole sweeps, as a run makes them: every node in order, forward or
+      ** backward (mc.h), so the rate is that of the sweep order in use. */
       double sum = 0.0, sum2 = 0.0;
       long per = N / B, acc_all = 0;
+      const long nodes = (long)m->sp->n_nodes;
+      per = (per + nodes - 1) / nodes * nodes;
       for (int b = 0; b < B; b++) {
-        long acc = 0;
-        for (long k = 0; k < per; k++) acc += lw_chain_step(c, LW_MOVE_POINT) == 1;
+        unsigned long acc0 = c->stats[LW_MOVE_POINT].accepted;
+        for (long k = 0; k < per / nodes; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+        long acc = (long)(c->stats[LW_MOVE_POINT].accepted - acc0);
         double rb = (double)acc / (double)per;
         sum += rb;
         sum2 += rb * rb;

@@ -62,8 +62,13 @@ set y2range [0:*]
 set y2tics
 set ytics nomirror
 set key bottom right
-plot f('scaling.dat') using 1:2 with linespoints pt 7 title 'ns per proposal', \
-     '' using 1:4 axes x1y2 with linespoints pt 5 title 'bytes per segment'
+set logscale y
+set yrange [*:*]
+plot f('scaling.dat') index 0 using 2:3 with linespoints pt 7 title 'ns per proposal, local terms', \
+     '' index 1 using 2:3 with linespoints pt 5 title 'ns per proposal, with the pair term', \
+     '' index 0 using 2:5 axes x1y2 with linespoints pt 4 dt 2 title 'bytes per segment, local terms', \
+     '' index 1 using 2:5 axes x1y2 with linespoints pt 6 dt 2 title 'bytes per segment, with the pair term'
+unset logscale y
 unset y2tics
 unset y2label
 set ytics mirror
