@@ -78,6 +78,43 @@ Test(order, random_instances_improve_and_are_deterministic)
   }
 }
 
+/* 2-opt numbers the paths by their place in the starting tour: the paths'
+** own numbering must not matter.  The same paths under another numbering,
+** from the same starting tour, give the same tour (paths in random places:
+** no equal distances, so no tie goes by number). */
+Test(order, two_opt_does_not_depend_on_the_numbering_of_the_paths)
+{
+  const size_t n = 2000;
+  lw_order_path *p = random_paths(n, 99), *q = malloc(n * sizeof *q);
+  size_t *perm = malloc(n * sizeof *perm), *o1 = malloc(n * sizeof *o1), *o2 = malloc(n * sizeof *o2);
+  unsigned char *r1 = malloc(n), *r2 = malloc(n);
+  for (size_t k = 0; k < n; k++) perm[k] = k;
+  for (size_t k = n - 1; k > 0; k--) {
+    size_t j = (size_t)urand(0, (double)k + 1), t = perm[k];
+    perm[k] = perm[j];
+    perm[j] = t;
+  }
+  /* path perm[i] of q is path i of p */
+  for (size_t i = 0; i < n; i++) q[perm[i]] = p[i];
+  cr_assert_eq(lw_order_greedy(p, n, 0, 0, o1, r1, NULL), LW_OK);
+  for (size_t k = 0; k < n; k++) {
+    o2[k] = perm[o1[k]];
+    r2[k] = r1[k];
+  }
+  cr_assert_eq(lw_order_2opt(p, n, 0, 0, o1, r1, NULL), LW_OK);
+  cr_assert_eq(lw_order_2opt(q, n, 0, 0, o2, r2, NULL), LW_OK);
+  for (size_t k = 0; k < n; k++)
+    cr_assert(perm[o1[k]] == o2[k] && r1[k] == r2[k], "tours part at position %zu", k);
+  cr_assert_eq(lw_order_travel(p, n, o1, r1, 0, 0), lw_order_travel(q, n, o2, r2, 0, 0));
+  free(p);
+  free(q);
+  free(perm);
+  free(o1);
+  free(o2);
+  free(r1);
+  free(r2);
+}
+
 /* The greedy step takes the nearest end point; on a tie the lower path,
 ** start before end. */
 Test(order, greedy_picks_nearest_end_and_reverses)

@@ -7,10 +7,12 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "linewise/hilbert.h"
 #include "linewise/mc.h"
 #include "linewise/model.h"
+#include "linewise/phase.h"
 #include "testutil.h"
 
 /* Every cell of the 2^k grid once, and consecutive positions side by side:
@@ -171,4 +173,19 @@ Test(sweep, a_sweep_moves_every_node_once)
   model_chain_free(c);
   lw_model_free(m);
   lw_scene_clear(&sc);
+}
+
+/* The phase a watcher reads: the name set last, and the time since. */
+Test(phase, the_current_phase_and_its_duration)
+{
+  static const char *const what = "writing state.lw";
+  lw_phase_set(what);
+  const struct timespec pause = {0, 20000000};
+  nanosleep(&pause, NULL);
+  double t;
+  cr_assert_eq(lw_phase_get(&t), what);
+  cr_assert(t >= 0.019 && t < 5.0, "phase lasted %g s", t);
+  lw_phase_set(NULL);
+  cr_assert_null(lw_phase_get(&t));
+  cr_assert_eq(t, 0.0);
 }
