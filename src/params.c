@@ -206,7 +206,8 @@ const lw_param_def lw_param_table[] = {
   NUM("anneal", "seed", LW_PT_DOUBLE, seed, "1", "", 0, 4294967295.0, 0,
       "Seed of the random number generator; the same scene and seed give the same run."),
   NUM("anneal", "check_every", LW_PT_INT, check_every, "100", "sweeps", 1, 2e9, 0,
-      "Sweeps between full recomputations of the energy (the drift check)."),
+      "Sweeps between full recomputations of the energy (the drift check); splines are "
+      "renumbered along a Hilbert curve of the page just before each, for locality in memory."),
   NUM("tempering", "replicas", LW_PT_INT, replicas, "1", "", 1, 256, 0,
       "Replicas on the temperature ladder (parallel tempering, run by OpenMP threads). 1 = off. "
       "The coldest replica gives final.svg and state.lw."),
