@@ -201,11 +201,14 @@ static lw_status orientation(const double *a, const double *b, int w, int h, dou
     free(m);
     return s;
   }
-  double num = 0.0, den = 0.0;
+  /* below LW_FIDELITY_FLAT a pixel has no direction: rounding in the blur
+  ** leaves gradients of ~1e-17 on a flat image */
+  double num = 0.0, den = 0.0, flat = LW_FIDELITY_FLAT * LW_FIDELITY_FLAT;
   for (size_t k = 0; k < n; k++) {
     double la = hypot(ua[k], ua[n + k]), lb = hypot(ub[k], ub[n + k]);
+    if (lb <= flat) continue;
     den += lb;
-    if (la > 0) num += (ua[k] * ub[k] + ua[n + k] * ub[n + k]) / la;
+    if (la > flat) num += (ua[k] * ub[k] + ua[n + k] * ub[n + k]) / la;
   }
   *out = den > 0 ? num / den : NAN;
   free(m);

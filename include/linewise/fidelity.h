@@ -32,7 +32,7 @@
 **    the two axes where the target has structure, 1 = every edge of the
 **    target matched by ink running the same way, 0 = no relation (or no
 **    ink), -1 = everywhere crosswise.  A pixel where the ink has no
-**    direction adds 0.  It ignores tone and contrast, and lines along the
+**    direction (gradient below LW_FIDELITY_FLAT) adds 0.  It ignores tone and contrast, and lines along the
 **    target's isophotes agree with it whether the blur has merged them
 **    into a tone (the tone's gradient) or not (each line's own gradient is
 **    across it, along the target's), which is why it depends far less on
@@ -52,6 +52,7 @@
 #define LW_FIDELITY_TRUNCATE 4.0      /* blur kernel radius, in sigmas */
 #define LW_FIDELITY_SSIM_SIGMA 1.5    /* SSIM window, pixels */
 #define LW_FIDELITY_SSIM_RADIUS 5     /* SSIM window half width: 11 x 11 */
+#define LW_FIDELITY_FLAT 1e-9         /* gradient (per pixel) below which a pixel has no direction */
 
 typedef struct {
   double mse;       /* mean squared difference of blurred ink and darkness */
