@@ -34,9 +34,11 @@ static double tone_at(const void *ctx, double x, double y)
   return v;
 }
 
-/* The plot of p's pens, ordered as `order`, home at the page origin. */
+/* Which pen draws each spline, in index order: the final drawing's
+** post-pass (strokes.h) orders the paths it makes, and frames are not
+** ordered. */
 static lw_plot *make_plot(const lw_params *p, const lw_scene *sc, const lw_splines *sp, const lw_grid2d *tone,
-                          lw_plot_order order, lw_error *err)
+                          lw_error *err)
 {
   double *key = NULL;
   if (p->pens > 1 && (sc->on[LW_TERM_POTENTIAL] || tone)) {
@@ -48,7 +50,7 @@ static lw_plot *make_plot(const lw_params *p, const lw_scene *sc, const lw_splin
     if (sc->on[LW_TERM_POTENTIAL]) lw_plot_mean_along(sp, &sc->quad, potential_at, &sc->potential, key);
     else lw_plot_mean_along(sp, &sc->quad, tone_at, tone, key);
   }
-  lw_plot *pl = lw_plot_new(sp, p->pens, key, order, 0.0, 0.0, err);
+  lw_plot *pl = lw_plot_new(sp, p->pens, key, LW_PLOT_ORDER_NONE, 0.0, 0.0, err);
   free(key);
   return pl;
 }
@@ -58,7 +60,8 @@ static void dir_file(char *buf, size_t n, const char *dir, const char *name)
   snprintf(buf, n, "%s/%s", dir, name);
 }
 
-void lw_drawing_options(const lw_params *p, const lw_scene *sc, lw_strokes_options *o)
+/* The post-pass options of p and sc (the crop rectangle from the picture). */
+static void options(const lw_params *p, const lw_scene *sc, lw_strokes_options *o)
 {
   o->join_dist = p->join_distance * p->pen_width;
   o->join_angle = p->join_angle * M_PI / 180.0;
@@ -97,11 +100,10 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   lw_output_page page;
   lw_status s = lw_drawing_page(p, &page, err);
   if (s) return s;
-  /* the plot gives the pens; the post-pass orders the paths it makes */
-  lw_plot *pl = make_plot(p, sc, sp, tone, LW_PLOT_ORDER_NONE, err);
+  lw_plot *pl = make_plot(p, sc, sp, tone, err);
   if (!pl) return err ? err->code : LW_ENOMEM;
   lw_strokes_options o;
-  lw_drawing_options(p, sc, &o);
+  options(p, sc, &o);
   lw_strokes *st = lw_strokes_prepare(sp, pl, &o, &rep->post, err);
   lw_plot_free(pl);
   if (!st) return err ? err->code : LW_ENOMEM;
@@ -135,7 +137,7 @@ lw_status lw_drawing_frame(const lw_params *p, const lw_scene *sc, const lw_spli
   lw_output_page page;
   lw_status s = lw_drawing_page(p, &page, err);
   if (s) return s;
-  lw_plot *pl = make_plot(p, sc, sp, tone, LW_PLOT_ORDER_NONE, err);
+  lw_plot *pl = make_plot(p, sc, sp, tone, err);
   if (!pl) return err ? err->code : LW_ENOMEM;
   s = lw_output_frame(dir, sweep, sp, &page, pl, p->preview_image ? tone : NULL, p->png_scale, err);
   lw_plot_free(pl);

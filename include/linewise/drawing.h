@@ -63,9 +63,6 @@ typedef struct {
 ** name the parameter's origin. */
 lw_status lw_drawing_page(const lw_params *p, lw_output_page *page, lw_error *err);
 
-/* The post-pass options of p and sc (the crop rectangle from the picture). */
-void lw_drawing_options(const lw_params *p, const lw_scene *sc, lw_strokes_options *o);
-
 /* Writes final.svg, final.png and (if asked) final.pdf into dir and fills
 ** rep.  tone: the target tone raster (fidelity.h) or NULL. */
 lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_splines *sp, const lw_grid2d *tone,
