@@ -232,7 +232,7 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
   clock_text(d->time_s, clock, sizeof clock);
   size_t k = 0;
   int w = snprintf(buf, n,
-                   "linewise: %zu paths (%zu strokes: %zu joins, %zu cut and %zu outside the picture, %zu too short); "
+                   "linewise: %zu paths (%zu strokes: %zu joins, %zu cut by the crop, %zu outside it, %zu too short); "
                    "pen-up travel %.1f mm in index order, %.1f mm as plotted\n"
                    "linewise: plot time about %s (%.0f s: %.0f mm pen down, %zu lifts)\n",
                    d->paths, r->lifts_before, r->joins, r->cut, r->outside, r->dropped, d->travel_before,
