@@ -351,7 +351,7 @@ static lw_status join_pen(const lw_strokes *in, int pen, size_t base, size_t n, 
       }
       cand[n_cand++] = (join_cand){d, a < b ? a : b, a < b ? b : a};
     }
-  qsort(cand, n_cand, sizeof *cand, by_gap);
+  if (n_cand) qsort(cand, n_cand, sizeof *cand, by_gap);
   for (size_t k = 0; k < n; k++) parent[k] = k;
   for (size_t c = 0; c < n_cand; c++) {
     size_t a = cand[c].a, b = cand[c].b, ra = find(parent, a / 2), rb = find(parent, b / 2);
