@@ -148,6 +148,20 @@ lw_status lw_fidelity_blur(double *v, int w, int h, double sx, double sy, double
   return blur(v, w, h, sx, sy, radius(sx, truncate, w), radius(sy, truncate, h), err);
 }
 
+/* The local averages under the SSIM window of `planes` w x h images stored
+** one after the other in m, in place. */
+static lw_status window(double *m, int planes, int w, int h, lw_error *err)
+{
+  size_t n = (size_t)w * (size_t)h;
+  int rx = LW_FIDELITY_SSIM_RADIUS < w ? LW_FIDELITY_SSIM_RADIUS : w;
+  int ry = LW_FIDELITY_SSIM_RADIUS < h ? LW_FIDELITY_SSIM_RADIUS : h;
+  for (int q = 0; q < planes; q++) {
+    lw_status s = blur(m + (size_t)q * n, w, h, LW_FIDELITY_SSIM_SIGMA, LW_FIDELITY_SSIM_SIGMA, rx, ry, err);
+    if (s) return s;
+  }
+  return LW_OK;
+}
+
 /* Central differences (one-sided at the edges) of v into gx, gy. */
 static void gradient(const double *v, int w, int h, double *gx, double *gy)
 {
@@ -173,13 +187,8 @@ static lw_status tensor(const double *v, int w, int h, double *u, double *t, lw_
     jxy[k] = gx[k] * gy[k];
     jyy[k] = gy[k] * gy[k];
   }
-  const double sw = LW_FIDELITY_SSIM_SIGMA;
-  int rx = LW_FIDELITY_SSIM_RADIUS < w ? LW_FIDELITY_SSIM_RADIUS : w;
-  int ry = LW_FIDELITY_SSIM_RADIUS < h ? LW_FIDELITY_SSIM_RADIUS : h;
-  for (int q = 0; q < 3; q++) {
-    lw_status s = blur(t + (size_t)q * n, w, h, sw, sw, rx, ry, err);
-    if (s) return s;
-  }
+  lw_status s = window(t, 3, w, h, err);
+  if (s) return s;
   for (size_t k = 0; k < n; k++) {
     u[k] = jxx[k] - jyy[k];
     u[n + k] = 2 * jxy[k];
@@ -239,14 +248,10 @@ lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, dou
     bb[k] = b[k] * b[k];
     ab[k] = a[k] * b[k];
   }
-  const double sw = LW_FIDELITY_SSIM_SIGMA;
-  int rx = LW_FIDELITY_SSIM_RADIUS < w ? LW_FIDELITY_SSIM_RADIUS : w;
-  int ry = LW_FIDELITY_SSIM_RADIUS < h ? LW_FIDELITY_SSIM_RADIUS : h;
-  for (int q = 0; q < 5; q++)
-    if ((s = blur(m + (size_t)q * n, w, h, sw, sw, rx, ry, err))) {
-      free(m);
-      return s;
-    }
+  if ((s = window(m, 5, w, h, err))) {
+    free(m);
+    return s;
+  }
   const double C1 = 0.01 * 0.01, C2 = 0.03 * 0.03; /* L = 1 */
   sum = 0.0;
   for (size_t k = 0; k < n; k++) {
