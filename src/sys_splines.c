@@ -13,7 +13,9 @@
 #include "linewise/checkpoint.h"
 #include "linewise/drawing.h"
 #include "linewise/fieldview.h"
+#include "linewise/gradient.h"
 #include "linewise/init.h"
+#include "linewise/splmass.h"
 
 const char *const lw_move_names[LW_MOVE_KINDS] = {"point", "vector", "translate", "rotate"};
 /* steps are kept in mm and radians; [moves] step_rotate is in degrees */
@@ -353,6 +355,71 @@ static void describe(const void *state, int what, char *buf, size_t n)
              d->fidelity.mse, d->fidelity.ssim);
 }
 
+/* ---- gradient-based drivers ------------------------------------------------
+** The coordinates are the node array itself: 4 doubles a node, px py vx vy. */
+
+static size_t n_coords(const void *state) { return 4 * ((const spl_state *)state)->m->sp->n_nodes; }
+
+static void get_coords(const void *state, double *x)
+{
+  const lw_splines *sp = ((const spl_state *)state)->m->sp;
+  memcpy(x, sp->node, sp->n_nodes * sizeof *sp->node);
+}
+
+static lw_status set_coords(void *state, const double *x, lw_error *err)
+{
+  lw_model *m = ((spl_state *)state)->m;
+  memcpy(m->sp->node, x, m->sp->n_nodes * sizeof *m->sp->node);
+  if (lw_model_refresh(m, NULL)) return lw_error_set(err, LW_ENOMEM, "out of memory");
+  return LW_OK;
+}
+
+static double gradient(void *state, double *g, lw_error *err)
+{
+  const lw_model *m = ((spl_state *)state)->m;
+  return lw_energy_gradient(m->scene, m->sp, LW_GRAD_ALL, (lw_node *)g, NULL, err);
+}
+
+/* [dynamics] pin and pin_vectors: which coordinates are held. */
+static void *mass_new(const void *state, const lw_params *p, double density, lw_error *err)
+{
+  const spl_state *s = state;
+  const lw_splines *sp = s->m->sp;
+  unsigned char *pin = calloc(4 * sp->n_nodes + 1, 1);
+  if (!pin) {
+    lw_error_set(err, LW_ENOMEM, "out of memory");
+    return NULL;
+  }
+  for (size_t i = 0; i < sp->n_splines; i++) {
+    size_t ends[2] = {sp->first[i], sp->first[i + 1] - 1};
+    for (int e = 0; e < 2; e++) {
+      int held = p->dyn_pin == LW_PIN_ENDS || (p->dyn_pin == LW_PIN_FIRST && e == 0) ||
+                 (p->dyn_pin == LW_PIN_LAST && e == 1);
+      if (!held) continue;
+      memset(pin + 4 * ends[e], 1, 2);
+      if (p->dyn_pin_vectors) memset(pin + 4 * ends[e] + 2, 1, 2);
+    }
+  }
+  lw_spline_mass *m = lw_spline_mass_new(sp, &s->m->scene->quad, density, pin, err);
+  free(pin);
+  return m;
+}
+
+static void mass_free(void *mass) { lw_spline_mass_free(mass); }
+
+static lw_status mass_at(void *mass, const double *x, lw_error *err) { return lw_spline_mass_at(mass, x, err); }
+
+static void mass_solve(const void *mass, const double *b, double *v) { lw_spline_mass_solve(mass, b, v); }
+
+static void mass_apply(const void *mass, const double *v, double *b) { lw_spline_mass_apply(mass, v, b); }
+
+static void mass_dx(const void *mass, const double *x, const double *v, double *out)
+{
+  lw_spline_mass_dx(mass, x, v, out);
+}
+
+static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinned(mass, i); }
+
 const lw_system_type lw_system_splines = {
     .name = "splines",
     .n_moves = LW_MOVE_KINDS,
@@ -381,6 +448,17 @@ const lw_system_type lw_system_splines = {
     .save = save,
     .load = load,
     .set_terms = set_terms,
+    .n_coords = n_coords,
+    .get_coords = get_coords,
+    .set_coords = set_coords,
+    .gradient = gradient,
+    .mass_new = mass_new,
+    .mass_free = mass_free,
+    .mass_at = mass_at,
+    .mass_solve = mass_solve,
+    .mass_apply = mass_apply,
+    .mass_dx = mass_dx,
+    .mass_pinned = mass_pinned,
     .files = "final.svg, final.png",
     .draw = draw,
     .summary = summary,

@@ -75,6 +75,13 @@ double lw_term_parametrisation(const lw_samples *s, const lw_quad *q)
   return sum / l;
 }
 
+double lw_term_load(const lw_samples *s, const double b[2])
+{
+  double sum = 0.0;
+  for (int i = 0; i < s->n; i++) sum -= s->dl[i] * (b[0] * s->x[i] + b[1] * s->y[i]);
+  return sum;
+}
+
 static double seg_bending(const lw_samples *s, const lw_term_ctx *c)
 {
   return c->coef * lw_term_bending(s, c->quad);
@@ -105,6 +112,11 @@ static double seg_param(const lw_samples *s, const lw_term_ctx *c)
   return c->coef * lw_term_parametrisation(s, c->quad);
 }
 
+static double seg_load(const lw_samples *s, const lw_term_ctx *c)
+{
+  return c->coef * lw_term_load(s, c->data);
+}
+
 /* The whole spline's length against its rest length, or (mode 1) each
 ** segment's against an equal share of it. */
 static double spline_strain(const double *seg_len, size_t n_seg, double length, double rest_length,
@@ -117,7 +129,8 @@ static double spline_strain(const double *seg_len, size_t n_seg, double length, 
 }
 
 const char *const lw_term_names[LW_TERM_COUNT] = {"strain", "bending", "potential", "field",
-                                                  "pair", "boundary", "user", "parametrisation"};
+                                                  "pair", "boundary", "user", "parametrisation",
+                                                  "load"};
 
 const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_STRAIN, .spline = spline_strain},
@@ -128,4 +141,5 @@ const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_BOUNDARY, .segment = seg_boundary},
   {LW_TERM_USER, .segment = seg_user},
   {LW_TERM_PARAM, .segment = seg_param},
+  {LW_TERM_LOAD, .segment = seg_load},
 };

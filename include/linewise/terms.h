@@ -20,6 +20,9 @@
 **             segment's length = its mean speed): 0 for uniform speed, so it
 **             holds the handle lengths that do not change the shape
 **             (docs/NUMERICS.md); 0 for a segment of no length
+**   load      -int b . r |r'| ds, b = rho g + f: gravity on the line density
+**             and a constant force per mm ([dynamics] gravity_x/_y, force_x/_y;
+**             on when b != 0, coefficient 1); data is b (2 doubles)
 **
 ** The term table's order is the order of trace.csv's and state.lw's energy
 ** columns; a new term goes at the end so older state files still read.
@@ -66,6 +69,7 @@ typedef enum {
   LW_TERM_BOUNDARY,
   LW_TERM_USER,
   LW_TERM_PARAM,
+  LW_TERM_LOAD,
   LW_TERM_COUNT
 } lw_term_id;
 
@@ -106,5 +110,6 @@ double lw_term_potential(const lw_samples *s, const lw_quad *q, const lw_potenti
 double lw_term_field(const lw_samples *s, const lw_quad *q, const lw_field *f, int axial);
 double lw_term_boundary(const lw_samples *s, const lw_quad *q, const lw_boundary *b);
 double lw_term_parametrisation(const lw_samples *s, const lw_quad *q);
+double lw_term_load(const lw_samples *s, const double b[2]);
 
 #endif
