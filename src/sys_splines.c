@@ -31,6 +31,8 @@ typedef struct {
   lw_model *m;
   int owns_model;                /* 0 for a view */
   lw_drawing_report drawing;     /* of the last final drawing */
+  lw_node *grad;                 /* the gradient's scratch, allocated by the first
+                                    gradient() call: none on a Monte Carlo run */
 } spl_state;
 
 static void setup_free(void *setup)
@@ -82,6 +84,7 @@ static void state_free(void *state)
   spl_state *s = state;
   if (!s) return;
   if (s->owns_model) lw_model_free(s->m);
+  free(s->grad);
   free(s);
 }
 
@@ -315,6 +318,55 @@ static void set_terms(void *state, const double *term)
   memcpy(((spl_state *)state)->m->term, term, LW_TERM_COUNT * sizeof *term);
 }
 
+/* The coordinates are the nodes' px py vx vy in node order (lw_node holds
+** exactly those four doubles). */
+static size_t n_coords(const void *state) { return 4 * ((const spl_state *)state)->m->sp->n_nodes; }
+
+static void get_coords(const void *state, double *x)
+{
+  const lw_splines *sp = ((const spl_state *)state)->m->sp;
+  for (size_t k = 0; k < sp->n_nodes; k++) {
+    const lw_node *nd = &sp->node[k];
+    x[4 * k] = nd->px;
+    x[4 * k + 1] = nd->py;
+    x[4 * k + 2] = nd->vx;
+    x[4 * k + 3] = nd->vy;
+  }
+}
+
+/* No NaN enters a state: coordinates that are not finite are refused and
+** the state is left as it was. */
+static lw_status set_coords(void *state, const double *x, lw_error *err)
+{
+  lw_model *m = ((spl_state *)state)->m;
+  lw_splines *sp = m->sp;
+  for (size_t i = 0; i < 4 * sp->n_nodes; i++)
+    if (!isfinite(x[i]))
+      return lw_error_set(err, LW_EINPUT, "coordinate %zu (node %zu) is not finite", i, i / 4);
+  for (size_t k = 0; k < sp->n_nodes; k++) sp->node[k] = (lw_node){x[4 * k], x[4 * k + 1], x[4 * k + 2], x[4 * k + 3]};
+  if (lw_model_refresh(m, NULL) != LW_OK)
+    return lw_error_set(err, LW_ENOMEM, "out of memory refreshing the model of %zu segments", sp->n_segments);
+  return LW_OK;
+}
+
+static double gradient(void *state, double *g, lw_error *err)
+{
+  spl_state *s = state;
+  const lw_splines *sp = s->m->sp;
+  if (!s->grad && !(s->grad = malloc((sp->n_nodes ? sp->n_nodes : 1) * sizeof *s->grad))) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for the gradient of %zu nodes", sp->n_nodes);
+    return NAN;
+  }
+  double e = lw_energy_gradient(s->m->scene, sp, LW_GRAD_ALL, s->grad, NULL, err);
+  for (size_t k = 0; k < sp->n_nodes; k++) {
+    g[4 * k] = s->grad[k].px;
+    g[4 * k + 1] = s->grad[k].py;
+    g[4 * k + 2] = s->grad[k].vx;
+    g[4 * k + 3] = s->grad[k].vy;
+  }
+  return e;
+}
+
 static lw_status draw(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err)
 {
   spl_state *s = state;
@@ -355,30 +407,7 @@ static void describe(const void *state, int what, char *buf, size_t n)
              d->fidelity.mse, d->fidelity.ssim);
 }
 
-/* ---- gradient-based drivers ------------------------------------------------
-** The coordinates are the node array itself: 4 doubles a node, px py vx vy. */
-
-static size_t n_coords(const void *state) { return 4 * ((const spl_state *)state)->m->sp->n_nodes; }
-
-static void get_coords(const void *state, double *x)
-{
-  const lw_splines *sp = ((const spl_state *)state)->m->sp;
-  memcpy(x, sp->node, sp->n_nodes * sizeof *sp->node);
-}
-
-static lw_status set_coords(void *state, const double *x, lw_error *err)
-{
-  lw_model *m = ((spl_state *)state)->m;
-  memcpy(m->sp->node, x, m->sp->n_nodes * sizeof *m->sp->node);
-  if (lw_model_refresh(m, NULL)) return lw_error_set(err, LW_ENOMEM, "out of memory");
-  return LW_OK;
-}
-
-static double gradient(void *state, double *g, lw_error *err)
-{
-  const lw_model *m = ((spl_state *)state)->m;
-  return lw_energy_gradient(m->scene, m->sp, LW_GRAD_ALL, (lw_node *)g, NULL, err);
-}
+/* ---- inertia (the dynamics driver) ------------------------------------------ */
 
 /* [dynamics] pin and pin_vectors: which coordinates are held. */
 static void *mass_new(const void *state, const lw_params *p, double density, lw_error *err)

@@ -46,6 +46,15 @@
 **             pair samples' nodes.  One pairwise term at most is on (the
 **             grid has one cutoff): pair.
 **
+** Gradients (gradient.h): a segment row's segment_grad ADDS the partials
+** of its energy (coefficient applied) with respect to the samples r, r',
+** r'' and the end points to an lw_samples_grad; a spline row's spline_grad
+** ADDS coef * dE/d(segment length) of one spline to dlen[0..n_seg-1] (a
+** segment's length is sum_q w_q |r'_q|, so it reaches r' only).  Where an
+** energy is not differentiable the gradient is a one-sided value or a
+** subgradient (docs/NUMERICS.md, "Gradients"): the axial field uses the
+** sign of r'.v, |r'| = 0 contributes 0.  The user term has none (NULL).
+**
 ** Degenerate samples never produce NaN: a sample with r' = 0 contributes 0 to
 ** bending (r' = 0 forces the numerator to 0 as well; the curvature of a point
 ** is taken as 0), and a sample on or outside the boundary gives +infinity
@@ -77,6 +86,17 @@ typedef enum {
 ** applied).  It must be a pure function of its arguments, like the built-in
 ** terms: replicas call it from several threads at once.  +infinity forbids a
 ** state; it should never return NaN (a NaN dE is rejected and counted). */
+/* dE/d(sample values) of one segment: per quadrature node the partials with
+** respect to r = (x, y), r' = (dx, dy) and r'' = (ddx, ddy), and the
+** partials with respect to the two end points r(0), r(1) (gradient.h). */
+typedef struct lw_samples_grad {
+  int n;
+  double x[LW_QUAD_MAX], y[LW_QUAD_MAX];
+  double dx[LW_QUAD_MAX], dy[LW_QUAD_MAX];
+  double ddx[LW_QUAD_MAX], ddy[LW_QUAD_MAX];
+  double end_x[2], end_y[2];
+} lw_samples_grad;
+
 typedef double (*lw_user_term_fn)(const lw_samples *s, const lw_quad *q, const void *data);
 
 /* What one term reads.  Pointers are into the scene, which outlives every
@@ -98,6 +118,9 @@ typedef struct {
   double (*segment)(const lw_samples *s, const lw_term_ctx *c);
   double (*spline)(const double *seg_len, size_t n_seg, double length, double rest_length, const lw_term_ctx *c);
   int pairwise;
+  void (*segment_grad)(const lw_samples *s, const lw_term_ctx *c, lw_samples_grad *g);
+  void (*spline_grad)(const double *seg_len, size_t n_seg, double length, double rest_length, const lw_term_ctx *c,
+                      double *dlen);
 } lw_term_type;
 
 extern const lw_term_type lw_term_types[LW_TERM_COUNT];
