@@ -21,13 +21,15 @@ static double max_abs(const double *a, size_t n)
   return m;
 }
 
-/* max |a - b| <= FIXED_TOL max(|a|, tiny) */
+/* max |a - b| <= FIXED_TOL max |a| (never for a value that is not finite) */
 static int converged(const double *a, const double *b, size_t n)
 {
   double d = 0.0;
-  for (size_t i = 0; i < n; i++)
+  for (size_t i = 0; i < n; i++) {
+    if (!isfinite(a[i])) return 0;
     if (fabs(a[i] - b[i]) > d) d = fabs(a[i] - b[i]);
-  return d <= FIXED_TOL * max_abs(a, n) || d == 0.0;
+  }
+  return d <= FIXED_TOL * max_abs(a, n);
 }
 
 void lw_dynamics_free(lw_dynamics *d)
@@ -171,14 +173,9 @@ static lw_status leapfrog(lw_dynamics *d, lw_error *err)
   for (it = 0;;) {
     if ((s = t->mass_at(d->mass, x1, err))) return s;
     t->mass_solve(d->mass, pih, d->v);
-    int done = 1;
-    double scale = max_abs(x1, n), worst = 0.0;
-    for (size_t i = 0; i < n; i++) {
-      double next = d->x[i] + 0.5 * h * (u0[i] + d->v[i]);
-      if (fabs(next - x1[i]) > worst) worst = fabs(next - x1[i]);
-      x1[i] = next;
-    }
-    done = worst <= FIXED_TOL * scale || worst == 0.0;
+    for (size_t i = 0; i < n; i++) d->tx[i] = d->x[i] + 0.5 * h * (u0[i] + d->v[i]);
+    int done = converged(d->tx, x1, n);
+    memcpy(x1, d->tx, n * sizeof *x1);
     if (done) break;
     if (++it == FIXED_MAX) return not_converged(d, "position step", err);
   }

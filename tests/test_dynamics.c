@@ -154,3 +154,237 @@ Test(splmass, held_coordinates_stay_held_and_the_rest_still_solve)
   free(back);
   lw_splines_free(sp);
 }
+
+/* ---- the driver ----------------------------------------------------------- */
+
+#include "linewise/dynamics.h"
+#include "linewise/gradient.h"
+#include "linewise/model.h"
+#include "linewise/params.h"
+
+typedef struct {
+  lw_params p;
+  void *setup;
+  lw_system *sys;
+  lw_model *m;
+  size_t n;
+} rig;
+
+/* One spline of n_seg segments on a 400 mm page, the terms set by the
+** caller, nodes from shape(k, node). */
+static void rig_open(rig *r, int n_seg, double strain, double bending, double potential)
+{
+  memset(r, 0, sizeof *r);
+  lw_params_defaults(&r->p);
+  r->p.width = r->p.height = 400;
+  r->p.splines = 1;
+  r->p.segments = n_seg;
+  r->p.segment_length = 20;
+  r->p.strain = strain;
+  r->p.bending = bending;
+  r->p.potential_coef = potential;
+  r->p.driver = LW_DRIVER_DYNAMICS;
+  /* The handle lengths are free of every other term: without this one the
+  ** tangential modes gather energy until a segment nearly stops, where the
+  ** quadrature loses the bending (the regularity walls then refuse it). */
+  r->p.parametrisation = 10;
+  lw_error err;
+  cr_assert_eq(lw_params_resolve(&r->p, &err), LW_OK, "%s", err.msg);
+  r->setup = lw_system_splines.setup_new(&r->p, &err);
+  cr_assert_not_null(r->setup, "%s", err.msg);
+  void *st = lw_system_splines.state_new(r->setup, &r->p, 1, &err);
+  cr_assert_not_null(st, "%s", err.msg);
+  r->sys = lw_system_wrap(&lw_system_splines, st, &err);
+  cr_assert_not_null(r->sys);
+  r->m = lw_splines_model(r->sys);
+  r->n = 4 * r->m->sp->n_nodes;
+}
+
+static void rig_close(rig *r)
+{
+  lw_system_free(r->sys);
+  lw_system_splines.setup_free(r->setup);
+}
+
+/* An arc of radius R and opening `angle` about (200, 200), its nodes' vectors
+** the tangents of a uniform parametrisation; rest length L0. */
+static void rig_arc(rig *r, double R, double angle, double L0)
+{
+  lw_splines *sp = r->m->sp;
+  size_t nseg = sp->n_nodes - 1;
+  double dphi = angle / (double)nseg, h = 4.0 / 3.0 * tan(dphi / 4) * R;
+  for (size_t k = 0; k < sp->n_nodes; k++) {
+    double phi = -angle / 2 + dphi * (double)k;
+    sp->node[k] = (lw_node){200 + R * sin(phi), 200 - R * cos(phi), h * cos(phi), h * sin(phi)};
+  }
+  sp->rest_length[0] = L0;
+  lw_error err;
+  cr_assert_eq(lw_system_splines.set_coords(r->sys->state, (double *)sp->node, &err), LW_OK);
+}
+
+/* K = the Hessian of E by central differences of the analytic gradient,
+** symmetrised; only the free coordinates (mask) are kept: returns how many. */
+static size_t hessian(rig *r, const unsigned char *held, gsl_matrix **K)
+{
+  size_t n = r->n, nf = 0, *idx = malloc(n * sizeof *idx);
+  for (size_t i = 0; i < n; i++)
+    if (!held || !held[i]) idx[nf++] = i;
+  double *x = malloc(n * sizeof *x), *gp = malloc(n * sizeof *gp), *gm = malloc(n * sizeof *gm);
+  lw_system_splines.get_coords(r->sys->state, x);
+  *K = gsl_matrix_alloc(nf, nf);
+  lw_error err;
+  for (size_t b = 0; b < nf; b++) {
+    size_t j = idx[b];
+    double keep = x[j], h = 1e-5 * fmax(1.0, fabs(keep));
+    x[j] = keep + h;
+    lw_system_splines.set_coords(r->sys->state, x, &err);
+    lw_system_splines.gradient(r->sys->state, gp, &err);
+    x[j] = keep - h;
+    lw_system_splines.set_coords(r->sys->state, x, &err);
+    lw_system_splines.gradient(r->sys->state, gm, &err);
+    x[j] = keep;
+    for (size_t a = 0; a < nf; a++) gsl_matrix_set(*K, a, b, (gp[idx[a]] - gm[idx[a]]) / (2 * h));
+  }
+  lw_system_splines.set_coords(r->sys->state, x, &err);
+  for (size_t a = 0; a < nf; a++)
+    for (size_t b = 0; b < a; b++) {
+      double v = 0.5 * (gsl_matrix_get(*K, a, b) + gsl_matrix_get(*K, b, a));
+      gsl_matrix_set(*K, a, b, v);
+      gsl_matrix_set(*K, b, a, v);
+    }
+  free(x);
+  free(gp);
+  free(gm);
+  free(idx);
+  return nf;
+}
+
+/* The dense mass matrix on the free coordinates (columns M e_j). */
+static gsl_matrix *mass_dense(lw_dynamics *d, const unsigned char *held, size_t nf)
+{
+  gsl_matrix *M = gsl_matrix_alloc(nf, nf);
+  double *e = calloc(d->n, sizeof *e), *col = malloc(d->n * sizeof *col);
+  size_t b = 0;
+  for (size_t j = 0; j < d->n; j++) {
+    if (held && held[j]) continue;
+    e[j] = 1.0;
+    d->type->mass_apply(d->mass, e, col);
+    e[j] = 0.0;
+    size_t a = 0;
+    for (size_t i = 0; i < d->n; i++)
+      if (!held || !held[i]) gsl_matrix_set(M, a++, b, col[i]);
+    b++;
+  }
+  free(e);
+  free(col);
+  return M;
+}
+
+/* Generalised eigenvalues K phi = lambda M phi, ascending, with vectors. */
+static void modes(gsl_matrix *K, gsl_matrix *M, gsl_vector *lambda, gsl_matrix *vec)
+{
+  size_t n = K->size1;
+  gsl_matrix *A = gsl_matrix_alloc(n, n), *B = gsl_matrix_alloc(n, n);
+  gsl_matrix_memcpy(A, K);
+  gsl_matrix_memcpy(B, M);
+  gsl_eigen_gensymmv_workspace *w = gsl_eigen_gensymmv_alloc(n);
+  cr_assert_eq(gsl_eigen_gensymmv(A, B, lambda, vec, w), 0);
+  gsl_eigen_gensymmv_sort(lambda, vec, GSL_EIGEN_SORT_VAL_ASC);
+  gsl_eigen_gensymmv_free(w);
+  gsl_matrix_free(A);
+  gsl_matrix_free(B);
+}
+
+/* The largest |E| the step h may err by: for a harmonic mode of frequency w
+** the leapfrog's energy oscillates by a relative (h w)^2 / 4 / (1 - (h w)^2 / 4)
+** (its modified energy); the widest mode bounds all, and a factor 2 covers
+** the anharmonic part at these amplitudes. */
+static double max_energy_error(lw_dynamics *d, size_t steps, double e0)
+{
+  double worst = 0.0;
+  for (size_t s = 0; s < steps; s++) {
+    lw_error err;
+    cr_assert_eq(lw_dynamics_step(d, &err), LW_OK, "%s", err.msg);
+    double h = d->energy + lw_dynamics_kinetic(d);
+    if (fabs(h - e0) > worst) worst = fabs(h - e0);
+  }
+  return worst;
+}
+
+Test(dynamics, energy_is_kept_to_second_order_within_the_derived_bound)
+{
+  rig r;
+  rig_open(&r, 3, 10, 20, 0);
+  rig_arc(&r, 40, 0.8, 0.95 * 32);
+  lw_error err;
+  r.p.dyn_dt = 0.02;
+  lw_dynamics *d = lw_dynamics_new(&lw_system_splines, r.sys->state, &r.p, &err);
+  cr_assert_not_null(d, "%s", err.msg);
+  double e0 = d->energy;
+  cr_assert_gt(e0, 1.0, "the arc is away from its rest: %g", e0);
+  gsl_matrix *K;
+  size_t nf = hessian(&r, NULL, &K);
+  gsl_matrix *M = mass_dense(d, NULL, nf);
+  gsl_vector *lambda = gsl_vector_alloc(nf);
+  gsl_matrix *vec = gsl_matrix_alloc(nf, nf);
+  modes(K, M, lambda, vec);
+  double wmax = sqrt(fmax(fabs(gsl_vector_get(lambda, 0)), fabs(gsl_vector_get(lambda, nf - 1))));
+  lw_dynamics_free(d);
+  /* three steps, the same span of time: 10^4 steps at the largest */
+  double h0 = 0.3 / wmax, err_h[3];
+  cr_log_info("lambda = %g .. %g", gsl_vector_get(lambda, 0), gsl_vector_get(lambda, nf - 1));
+  for (int k = 0; k < 3; k++) {
+    rig_arc(&r, 40, 0.8, 0.95 * 32);
+    r.p.dyn_dt = h0 / (1 << k);
+    d = lw_dynamics_new(&lw_system_splines, r.sys->state, &r.p, &err);
+    cr_assert_not_null(d, "%s", err.msg);
+    err_h[k] = max_energy_error(d, (size_t)10000 << k, e0);
+    double hw = r.p.dyn_dt * wmax, bound = 2 * e0 * hw * hw / 4 / (1 - hw * hw / 4);
+    cr_assert_leq(err_h[k], bound, "h = %g: energy error %g above the bound %g", r.p.dyn_dt, err_h[k], bound);
+    cr_log_info("h = %g (h w_max = %g): max |H - H0| = %.3g (bound %.3g)", r.p.dyn_dt, hw, err_h[k], bound);
+    lw_dynamics_free(d);
+  }
+  /* order 2: each halving divides the error by 4 */
+  for (int k = 1; k < 3; k++) {
+    double order = log2(err_h[k - 1] / err_h[k]);
+    cr_assert(order > 1.8 && order < 2.2, "observed order %g between h/%d and h/%d", order, 1 << (k - 1), 1 << k);
+  }
+  gsl_matrix_free(K);
+  gsl_matrix_free(M);
+  gsl_vector_free(lambda);
+  gsl_matrix_free(vec);
+  rig_close(&r);
+}
+
+Test(dynamics, free_splines_keep_their_momentum)
+{
+  rig r;
+  rig_open(&r, 4, 10, 5, 0);
+  rig_arc(&r, 50, 1.0, 0.8 * 50);
+  r.p.dyn_dt = 0.005;
+  lw_error err;
+  lw_dynamics *d = lw_dynamics_new(&lw_system_splines, r.sys->state, &r.p, &err);
+  cr_assert_not_null(d, "%s", err.msg);
+  rng_seed(21);
+  double *xdot = malloc(r.n * sizeof *xdot);
+  /* a drift and a small random part: large random handle velocities would
+  ** soon stop a segment (the regularity walls) */
+  for (size_t i = 0; i < r.n; i++) xdot[i] = urand(-0.3, 0.3) + (i % 4 == 0 ? 3.0 : i % 4 == 1 ? -2.0 : 0.0);
+  lw_dynamics_set_velocity(d, xdot);
+  /* the momentum conjugate to a translation: the p coordinates' momenta */
+  double P0[2] = {0, 0}, scale = 0.0;
+  for (size_t k = 0; k < r.n / 4; k++)
+    for (int c = 0; c < 2; c++) P0[c] += d->pi[4 * k + c];
+  for (size_t i = 0; i < r.n; i++) scale += fabs(d->pi[i]);
+  for (int s = 0; s < 2000; s++) cr_assert_eq(lw_dynamics_step(d, &err), LW_OK, "%s", err.msg);
+  double P[2] = {0, 0};
+  for (size_t k = 0; k < r.n / 4; k++)
+    for (int c = 0; c < 2; c++) P[c] += d->pi[4 * k + c];
+  /* rounding: each step adds eps times the momenta's size, a random walk */
+  for (int c = 0; c < 2; c++)
+    cr_assert(fabs(P[c] - P0[c]) <= 1e-11 * scale, "component %d: %.17g, was %.17g", c, P[c], P0[c]);
+  cr_assert_gt(d->time, 9.99);
+  free(xdot);
+  lw_dynamics_free(d);
+  rig_close(&r);
+}
