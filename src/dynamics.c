@@ -182,8 +182,8 @@ static lw_status leapfrog(lw_dynamics *d, lw_error *err)
   if (it > d->iterations_max) d->iterations_max = it;
   if ((s = t->mass_at(d->mass, x1, err)) || (s = evaluate(d, x1, err))) return s;
   if (!isfinite(d->energy))
-    return lw_error_set(err, LW_EINPUT, "the motion reached a forbidden state at t = %g s (a segment irregular or "
-                        "outside the boundary): lower dynamics.dt (now %g s)", d->time + h, h);
+    return lw_error_set(err, LW_EINPUT, "the motion reached a forbidden state at t = %g s (energy %g: a segment "
+                        "irregular or outside the boundary): lower dynamics.dt (now %g s)", d->time + h, d->energy, h);
   memcpy(d->x, x1, n * sizeof *x1);
   /* pi' = pi+ - h/2 dH/dx(x', pi+) */
   dh_dx(d, d->x, pih, d->u);

@@ -162,6 +162,9 @@ Test(splmass, held_coordinates_stay_held_and_the_rest_still_solve)
 #include "linewise/model.h"
 #include "linewise/params.h"
 
+/* A constant force per mm for the next rig (the load term), 0 = none. */
+static double rig_force[2];
+
 typedef struct {
   lw_params p;
   void *setup;
@@ -188,6 +191,8 @@ static void rig_open(rig *r, int n_seg, double strain, double bending, double po
   ** tangential modes gather energy until a segment nearly stops, where the
   ** quadrature loses the bending (the regularity walls then refuse it). */
   r->p.parametrisation = param;
+  r->p.dyn_force_x = rig_force[0];
+  r->p.dyn_force_y = rig_force[1];
   lw_error err;
   cr_assert_eq(lw_params_resolve(&r->p, &err), LW_OK, "%s", err.msg);
   r->setup = lw_system_splines.setup_new(&r->p, &err);
@@ -517,6 +522,73 @@ Test(dynamics, damped_motion_and_a_zero_temperature_quench_find_the_same_minimum
   cr_assert(fabs(e_mc - e_dyn) <= 1e-6 * e_dyn, "quench %.12g, dynamics %.12g", e_mc, e_dyn);
   lw_chain_free(c);
   lw_system_free(mc_sys);
+  lw_dynamics_free(d);
+  rig_close(&r);
+}
+
+Test(dynamics, the_load_term_and_its_gradient)
+{
+  rig r;
+  rig_force[0] = 0.3;
+  rig_force[1] = 7.0;
+  rig_open(&r, 3, 0, 0, 0, 0);
+  rig_force[0] = rig_force[1] = 0.0;
+  const lw_scene *sc = r.m->scene;
+  cr_assert(sc->on[LW_TERM_LOAD]);
+  rig_arc(&r, 40, 1.0, 40);
+  lw_splines *sp = r.m->sp;
+  /* the energy: -b . (centroid) times the length, against a fine sum */
+  double term[LW_TERM_COUNT], e = 0.0;
+  lw_error err;
+  lw_energy_compute(sc, sp, term, &err);
+  for (size_t k = 0; k + 1 < sp->n_nodes; k++)
+    for (int j = 0; j < 20000; j++) {
+      double s = (j + 0.5) / 20000, rr[2], d1[2];
+      lw_segment_eval(&sp->node[k], &sp->node[k + 1], s, rr, d1, NULL);
+      e -= (0.3 * rr[0] + 7.0 * rr[1]) * hypot(d1[0], d1[1]) / 20000;
+    }
+  cr_assert(fabs(term[LW_TERM_LOAD] - e) < 1e-6 * fabs(e), "load %.12g, midpoint sum %.12g", term[LW_TERM_LOAD], e);
+  /* the gradient against central differences (the energy is a smooth
+  ** polynomial-over-root sum: 1e-7 relative at h = 1e-5 mm is loose) */
+  lw_node *g = calloc(sp->n_nodes, sizeof *g);
+  lw_energy_gradient(sc, sp, 1u << LW_TERM_LOAD, g, NULL, &err);
+  double *x = (double *)sp->node, *gx = (double *)g, scale = 0.0;
+  for (size_t i = 0; i < r.n; i++) scale = fmax(scale, fabs(gx[i]));
+  for (size_t i = 0; i < r.n; i++) {
+    double keep = x[i], h = 1e-5;
+    x[i] = keep + h;
+    double ep = lw_energy_compute(sc, sp, term, &err);
+    x[i] = keep - h;
+    double em = lw_energy_compute(sc, sp, term, &err);
+    x[i] = keep;
+    cr_assert(fabs((ep - em) / (2 * h) - gx[i]) <= 1e-6 * scale, "coordinate %zu: %.10g vs %.10g", i, gx[i],
+              (ep - em) / (2 * h));
+  }
+  free(g);
+  rig_close(&r);
+}
+
+Test(dynamics, the_massless_flow_never_rises_and_reaches_the_minimum)
+{
+  const double S = 10, Q = 1, L0 = 0.95 * 32;
+  rig r;
+  rig_open(&r, 3, S, 0, Q, 3);
+  rig_arc(&r, 40, 0.8, L0);
+  double L = L0 * (2 + sqrt(1 - 3 * Q / S)) / 3, e_min = S * (L - L0) * (L - L0) * L / (L0 * L0) + Q * L;
+  r.p.dyn_rho = 0;
+  r.p.dyn_gamma = 1;
+  r.p.dyn_dt = 1;
+  lw_error err;
+  lw_dynamics *d = lw_dynamics_new(&lw_system_splines, r.sys->state, &r.p, &err);
+  cr_assert_not_null(d, "%s", err.msg);
+  double prev = d->energy;
+  for (int s = 0; s < 3000; s++) {
+    cr_assert_eq(lw_dynamics_step(d, &err), LW_OK, "%s", err.msg);
+    cr_assert_leq(d->energy, prev, "step %d: the energy rose from %.17g to %.17g", s, prev, d->energy);
+    prev = d->energy;
+  }
+  cr_assert_eq(lw_dynamics_kinetic(d), 0.0);
+  cr_assert(fabs(d->energy - e_min) <= 1e-6 * e_min, "the flow ends at %.12g, the minimum is %.12g", d->energy, e_min);
   lw_dynamics_free(d);
   rig_close(&r);
 }
