@@ -31,6 +31,11 @@ const lw_param_def lw_param_table[] = {
          "What is annealed: `splines` (cubic Bezier splines on the page) or `particles` "
          "(oriented particles in 3-D, set up by the [particles] section; README, "
          "\"Oriented particles\"). docs/SYSTEMS.md."),
+  CHOICE("scene", "driver", driver, "metropolis", "metropolis|dynamics",
+         "What moves the system: `metropolis` anneals it by Monte Carlo (the [anneal] schedule, "
+         "[tempering] with replicas); `dynamics` integrates its Lagrangian equations of motion "
+         "(the [dynamics] section; docs/NUMERICS.md, \"Dynamics\"): a sweep is then "
+         "`dynamics.steps_per_sweep` time steps and `anneal.sweeps` counts them."),
   CHOICE("scene", "page", page, "custom", "custom|a4|a3|letter",
          "Page size: `custom` takes `width` and `height`; a4 is 210 x 297 mm, a3 297 x 420 mm, "
          "letter 215.9 x 279.4 mm (portrait). A named page sets width and height; setting "
@@ -347,6 +352,28 @@ const lw_param_def lw_param_table[] = {
       "Width and height of final.png."),
   NUM("particles", "disc", LW_PT_DOUBLE, pt_disc, "0.5", "r0", 0, 100, LW_MIN_OPEN,
       "Radius of each particle's disc in final.png."),
+  NUM("dynamics", "rho", LW_PT_DOUBLE, dyn_rho, "1", "mass/mm", 0, 1e12, 0,
+      "Line density rho of the kinetic energy (rho/2) int |dr/dt|^2 dl. 0 = massless: the "
+      "motion is the gradient flow D(x) dx/dt = -grad E of the damping (needs gamma > 0)."),
+  NUM("dynamics", "gamma", LW_PT_DOUBLE, dyn_gamma, "0", "force s/mm^2", 0, 1e12, 0,
+      "Rayleigh damping: a force -gamma dr/dt per mm of line. 0 = none (energy is conserved)."),
+  NUM("dynamics", "dt", LW_PT_DOUBLE, dyn_dt, "0.001", "s", 0, 1e6, LW_MIN_OPEN,
+      "Time step of the integrator (massless: the first step tried; halved where the energy "
+      "would not fall)."),
+  NUM("dynamics", "steps_per_sweep", LW_PT_INT, dyn_steps_per_sweep, "1", "", 1, 1e9, 0,
+      "Time steps per sweep of the run loop (trace, frames and checkpoints count sweeps)."),
+  NUM("dynamics", "gravity_x", LW_PT_DOUBLE, dyn_gravity_x, "0", "mm/s^2", -1e12, 1e12, 0,
+      "x of the gravity g acting on the line density: energy -rho int g.r dl (the load term)."),
+  NUM("dynamics", "gravity_y", LW_PT_DOUBLE, dyn_gravity_y, "0", "mm/s^2", -1e12, 1e12, 0,
+      "y of g (y points down the page: 9810 is the Earth's gravity on a page held upright)."),
+  NUM("dynamics", "force_x", LW_PT_DOUBLE, dyn_force_x, "0", "force/mm", -1e12, 1e12, 0,
+      "x of a constant external force f per mm of line: energy -int f.r dl (the load term)."),
+  NUM("dynamics", "force_y", LW_PT_DOUBLE, dyn_force_y, "0", "force/mm", -1e12, 1e12, 0,
+      "y of the constant external force per mm."),
+  CHOICE("dynamics", "pin", dyn_pin, "none", "none|ends|first|last",
+         "End points held fixed: of both ends of every spline, the first node, the last node."),
+  NUM("dynamics", "pin_vectors", LW_PT_INT, dyn_pin_vectors, "0", "", 0, 1, 0,
+      "1 = a pinned node's vector is held too (a clamped end); 0 = it turns freely."),
 };
 const size_t lw_param_count = sizeof lw_param_table / sizeof lw_param_table[0];
 
