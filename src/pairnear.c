@@ -445,11 +445,33 @@ static double subtracted(const cubic *ca, const cubic *cb, double cutoff, double
   return sum + lw_pair_segseg(l0, l1, m0, m1);
 }
 
+const lw_pairnear_consts lw_pairnear_k = {SEP_LO,   SEP_HI,     APART_LO, APART_HI, LEAF_RATIO, FLAT_RATIO,
+                                          SINE_LO,  SINE_HI,    CLOSE_LO, CLOSE_HI, STACK_MAX,  G6_S,
+                                          G6_W,     GAUSS_S,    G16_S,    G16_W,    GAUSS_L};
+
+/* The local origin of a pair of segments (lw_pair_segments_exact). */
+static void pair_origin(const double a[8], const double b[8], double *ox, double *oy)
+{
+  *ox = 0.25 * (a[0] + a[6] + b[0] + b[6]);
+  *oy = 0.25 * (a[1] + a[7] + b[1] + b[7]);
+}
+
+void lw_pair_closest_params(const double a[8], const double b[8], double *s, double *t)
+{
+  cubic ca, cb;
+  double ox, oy;
+  pair_origin(a, b, &ox, &oy);
+  cubic_from_bezier(a, ox, oy, &ca);
+  cubic_from_bezier(b, ox, oy, &cb);
+  closest_points(&ca, &cb, s, t);
+}
+
 double lw_pair_segments_exact(const double a[8], const double b[8], double cutoff)
 {
   cubic ca, cb;
   /* a local origin keeps the power form's coefficients small */
-  double ox = 0.25 * (a[0] + a[6] + b[0] + b[6]), oy = 0.25 * (a[1] + a[7] + b[1] + b[7]);
+  double ox, oy;
+  pair_origin(a, b, &ox, &oy);
   cubic_from_bezier(a, ox, oy, &ca);
   cubic_from_bezier(b, ox, oy, &cb);
   piece pa, pb;
@@ -493,8 +515,7 @@ static inline double near_weight(double u)
   return t * t * t * (10.0 + t * (6.0 * t - 15.0));
 }
 
-/* 1 if a comes before b in the lexicographic order of the control points. */
-static int bezier_before(const double a[8], const double b[8])
+int lw_pair_bezier_before(const double a[8], const double b[8])
 {
   for (int k = 0; k < 8; k++)
     if (a[k] != b[k]) return a[k] < b[k];
@@ -505,7 +526,7 @@ double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, cons
                                const lw_pair_sample *sb, int n, const lw_pair_ctx *ctx)
 {
   /* one order for the two segments, so that the value is bitwise symmetric */
-  if (!bezier_before(a, b)) {
+  if (!lw_pair_bezier_before(a, b)) {
     const double *t = a;
     const lw_pair_sample *u = sa;
     a = b;
