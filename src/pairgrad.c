@@ -528,46 +528,95 @@ static jet inverse_distance(const jcubic *ca, const jpiece *root_a, const jcubic
   return sum;
 }
 
-/*
-** The closest points r_a(s*), r_b(t*) and tangents there, as jets.  (s*, t*)
-** move with the curves: where a parameter is inside (0, 1) it keeps the
-** distance stationary, g_s = D.r_a' = 0, g_t = -D.r_b' = 0 (D = r_a - r_b),
-** so by the implicit function theorem H (ds, dt) = -(dg_s, dg_t) at fixed
-** (s, t), H the Hessian of |D|^2 / 2; a parameter at an end stays there.
-*/
-static void closest(const jcubic *ca, const jcubic *cb, double ss, double ts, jet ra[2], jet a1[2], jet rb[2],
-                    jet b1[2], jet *js, jet *jt)
+/* r, r' and r'' at a parameter t that is itself a jet (the same operations
+** as pairnear.c's cubic_eval, so the same values to the bit). */
+static void jcubic_eval_at(const jcubic *c, jet t, jet r[2], jet d[2], jet dd[2])
 {
-  jet a2[2], b2[2];
-  jcubic_eval(ca, ss, ra, a1, a2);
-  jcubic_eval(cb, ts, rb, b1, b2);
-  jet D[2] = {jsub(ra[0], rb[0]), jsub(ra[1], rb[1])};
-  jet gs = jadd(jmul(D[0], a1[0]), jmul(D[1], a1[1]));
-  jet gt = jscale(jadd(jmul(D[0], b1[0]), jmul(D[1], b1[1])), -1.0);
-  double hss = a1[0].v * a1[0].v + a1[1].v * a1[1].v + D[0].v * a2[0].v + D[1].v * a2[1].v;
-  double htt = b1[0].v * b1[0].v + b1[1].v * b1[1].v - D[0].v * b2[0].v - D[1].v * b2[1].v;
-  double hst = -(a1[0].v * b1[0].v + a1[1].v * b1[1].v), det = hss * htt - hst * hst;
-  int si = ss > 0.0 && ss < 1.0, ti = ts > 0.0 && ts < 1.0;
-  jet ds = jc(0.0), dt = jc(0.0);
-  if (si && ti && det > 0.0 && hss > 0.0) {
-    ds = jscale(jsub(jscale(gs, htt), jscale(gt, hst)), -1.0 / det);
-    dt = jscale(jsub(jscale(gt, hss), jscale(gs, hst)), -1.0 / det);
-  } else if (si && hss > 0.0) {
-    ds = jscale(gs, -1.0 / hss);
-  } else if (ti && htt > 0.0) {
-    dt = jscale(gt, -1.0 / htt);
-  }
-  /* the totals: moving the parameter moves the point along the curve */
+  const jet *p[2] = {c->x, c->y};
   for (int i = 0; i < 2; i++) {
-    jacc(&ra[i], a1[i].v, &ds);
-    jacc(&a1[i], a2[i].v, &ds);
-    jacc(&rb[i], b1[i].v, &dt);
-    jacc(&b1[i], b2[i].v, &dt);
+    const jet *q = p[i];
+    r[i] = jadd(q[0], jmul(t, jadd(q[1], jmul(t, jadd(q[2], jmul(t, q[3]))))));
+    d[i] = jadd(q[1], jmul(t, jadd(jscale(q[2], 2.0), jmul(t, jscale(q[3], 3.0)))));
+    dd[i] = jadd(jscale(q[2], 2.0), jscale(jmul(q[3], t), 6.0));
   }
-  *js = ds;
-  js->v = ss;
-  *jt = dt;
-  jt->v = ts;
+}
+
+/* The position of a cubic at t, values only, as pairnear.c computes it. */
+static void value_at(const jcubic *c, double t, double r[2])
+{
+  r[0] = c->x[0].v + t * (c->x[1].v + t * (c->x[2].v + t * c->x[3].v));
+  r[1] = c->y[0].v + t * (c->y[1].v + t * (c->y[2].v + t * c->y[3].v));
+}
+
+/* A parameter moved by a step and kept in [0, 1]: where it is clamped it
+** no longer moves with the curves. */
+static jet clamp01(jet x)
+{
+  double v = fmin(1.0, fmax(0.0, x.v));
+  return v == x.v ? x : jc(v);
+}
+
+/*
+** pairnear.c's closest_points replayed in jets: the 9 x 9 grid's choice,
+** then the same Newton (or steepest descent) steps, halvings and
+** acceptances, each step's partials carried along.  The iteration stops
+** where a step no longer lowers the rounded distance, which can be short
+** of the exact closest points (where the minimum lies on the square's edge,
+** the projected steps converge slowly): the parameters the energy uses are
+** these iterates, so their derivative is the iteration's, not the implicit
+** one of the exact minimum.
+*/
+static void closest(const jcubic *ca, const jcubic *cb, jet *ps, jet *pt)
+{
+  double best = INFINITY, s0 = 0.0, t0 = 0.0, ra[9][2], rb[9][2];
+  for (int k = 0; k < 9; k++) {
+    value_at(ca, k / 8.0, ra[k]);
+    value_at(cb, k / 8.0, rb[k]);
+  }
+  for (int i = 0; i < 9; i++)
+    for (int j = 0; j < 9; j++) {
+      double dx = ra[i][0] - rb[j][0], dy = ra[i][1] - rb[j][1], q = dx * dx + dy * dy;
+      if (q < best) best = q, s0 = i / 8.0, t0 = j / 8.0;
+    }
+  jet s = jc(s0), t = jc(t0);
+  for (int it = 0; it < 30; it++) {
+    jet a[2], a1[2], a2[2], b[2], b1[2], b2[2];
+    jcubic_eval_at(ca, s, a, a1, a2);
+    jcubic_eval_at(cb, t, b, b1, b2);
+    jet D[2] = {jsub(a[0], b[0]), jsub(a[1], b[1])};
+    jet gs = jadd(jmul(D[0], a1[0]), jmul(D[1], a1[1]));
+    jet gt = jscale(jadd(jmul(D[0], b1[0]), jmul(D[1], b1[1])), -1.0);
+    jet vs = jadd(jmul(a1[0], a1[0]), jmul(a1[1], a1[1])), vt = jadd(jmul(b1[0], b1[0]), jmul(b1[1], b1[1]));
+    jet hss = jadd(jadd(vs, jmul(D[0], a2[0])), jmul(D[1], a2[1]));
+    jet htt = jsub(jsub(vt, jmul(D[0], b2[0])), jmul(D[1], b2[1]));
+    jet hst = jscale(jadd(jmul(a1[0], b1[0]), jmul(a1[1], b1[1])), -1.0);
+    jet det = jsub(jmul(hss, htt), jmul(hst, hst)), ds, dt;
+    if (det.v > 1e-12 * (vs.v * vt.v + 1e-300) && hss.v > 0.0) {
+      ds = jscale(jdiv(jsub(jmul(htt, gs), jmul(hst, gt)), det), -1.0);
+      dt = jscale(jdiv(jsub(jmul(hss, gt), jmul(hst, gs)), det), -1.0);
+    } else {
+      ds = vs.v > 0.0 ? jscale(jdiv(gs, vs), -1.0) : jc(0.0);
+      dt = vt.v > 0.0 ? jscale(jdiv(gt, vt), -1.0) : jc(0.0);
+    }
+    int moved = 0;
+    for (int half = 0; half < 20 && !moved; half++, ds = jscale(ds, 0.5), dt = jscale(dt, 0.5)) {
+      jet ns = clamp01(jadd(s, ds)), nt = clamp01(jadd(t, dt));
+      if (ns.v == s.v && nt.v == t.v) break;
+      double r[2], q[2];
+      value_at(ca, ns.v, r);
+      value_at(cb, nt.v, q);
+      double f = (r[0] - q[0]) * (r[0] - q[0]) + (r[1] - q[1]) * (r[1] - q[1]);
+      if (f < best) {
+        best = f;
+        s = ns;
+        t = nt;
+        moved = 1;
+      }
+    }
+    if (!moved) break;
+  }
+  *ps = s;
+  *pt = t;
 }
 
 /* pairnear.c's subtracted: K - S by the 16 x 16 rule, plus S exactly. */
@@ -617,10 +666,10 @@ static double segments_exact_grad(const double a[8], const double b[8], double c
   jpiece pa, pb;
   jpiece_init(&pa, &ca, 0.0, 1.0);
   jpiece_init(&pb, &cb, 0.0, 1.0);
-  double s0, t0;
-  lw_pair_closest_params(a, b, &s0, &t0);
-  jet ra[2], a1[2], rb[2], b1[2], ss, ts;
-  closest(&ca, &cb, s0, t0, ra, a1, rb, b1, &ss, &ts);
+  jet ra[2], a1[2], a2[2], rb[2], b1[2], b2[2], ss, ts;
+  closest(&ca, &cb, &ss, &ts);
+  jcubic_eval_at(&ca, ss, ra, a1, a2);
+  jcubic_eval_at(&cb, ts, rb, b1, b2);
   jet half = pa.rad.v >= pb.rad.v ? pa.rad : pb.rad, dist = jhypot(jsub(ra[0], rb[0]), jsub(ra[1], rb[1]));
   jet w = half.v > 0.0 ? jsmooth(jdivc(jaddc(jdiv(dist, half), -K.apart_lo), K.apart_hi - K.apart_lo)) : jc(1.0);
   kernel_kind whole = cutoff > 0.0 ? KERNEL_CUT : KERNEL_INV;

@@ -449,29 +449,11 @@ const lw_pairnear_consts lw_pairnear_k = {SEP_LO,   SEP_HI,     APART_LO, APART_
                                           SINE_LO,  SINE_HI,    CLOSE_LO, CLOSE_HI, STACK_MAX,  G6_S,
                                           G6_W,     GAUSS_S,    G16_S,    G16_W,    GAUSS_L};
 
-/* The local origin of a pair of segments (lw_pair_segments_exact). */
-static void pair_origin(const double a[8], const double b[8], double *ox, double *oy)
-{
-  *ox = 0.25 * (a[0] + a[6] + b[0] + b[6]);
-  *oy = 0.25 * (a[1] + a[7] + b[1] + b[7]);
-}
-
-void lw_pair_closest_params(const double a[8], const double b[8], double *s, double *t)
-{
-  cubic ca, cb;
-  double ox, oy;
-  pair_origin(a, b, &ox, &oy);
-  cubic_from_bezier(a, ox, oy, &ca);
-  cubic_from_bezier(b, ox, oy, &cb);
-  closest_points(&ca, &cb, s, t);
-}
-
 double lw_pair_segments_exact(const double a[8], const double b[8], double cutoff)
 {
   cubic ca, cb;
   /* a local origin keeps the power form's coefficients small */
-  double ox, oy;
-  pair_origin(a, b, &ox, &oy);
+  double ox = 0.25 * (a[0] + a[6] + b[0] + b[6]), oy = 0.25 * (a[1] + a[7] + b[1] + b[7]);
   cubic_from_bezier(a, ox, oy, &ca);
   cubic_from_bezier(b, ox, oy, &cb);
   piece pa, pb;

@@ -46,8 +46,7 @@ double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, cons
 
 /* ---- for the gradient (pairgrad.c) ----------------------------------------
 ** The derivative of lw_pair_segments_exact follows its computation step by
-** step, so it sees the same thresholds and rules, and the same closest
-** points. */
+** step, so it sees the same thresholds and rules. */
 typedef struct {
   double sep_lo, sep_hi;       /* pieces apart: 6 x 6 rule from sep_hi larger radii on */
   double apart_lo, apart_hi;   /* segments apart: 16 x 16 rule (distance / half size) */
@@ -62,10 +61,6 @@ typedef struct {
 } lw_pairnear_consts;
 
 extern const lw_pairnear_consts lw_pairnear_k;
-
-/* The parameters (s, t) of the closest points of two cubic segments as
-** lw_pair_segments_exact finds them. */
-void lw_pair_closest_params(const double a[8], const double b[8], double *s, double *t);
 
 /* 1 if a comes before b in the lexicographic order of the control points:
 ** the order lw_pair_near_correction takes a pair in, so that its value is
