@@ -256,15 +256,24 @@ static void jcubic_from_bezier(const jet b[8], double ox, double oy, jcubic *c)
   c->y[3] = jadd(jsub(y3, y0), jscale(jsub(y1, y2), 3.0));
 }
 
-/* r, r', r'' at a fixed parameter t (dd may be NULL) */
+/* r, r', r'' at a fixed parameter t (dd may be NULL): Horner on the value
+** and on each partial, in pairnear.c's order of operations. */
 static void jcubic_eval(const jcubic *c, double t, jet r[2], jet d[2], jet dd[2])
 {
   const jet *p[2] = {c->x, c->y};
+  const double t3 = 3.0 * t, t6 = 6.0 * t;
   for (int i = 0; i < 2; i++) {
     const jet *q = p[i];
-    r[i] = jadd(q[0], jscale(jadd(q[1], jscale(jadd(q[2], jscale(q[3], t)), t)), t));
-    d[i] = jadd(q[1], jscale(jadd(jscale(q[2], 2.0), jscale(q[3], 3.0 * t)), t));
-    if (dd) dd[i] = jadd(jscale(q[2], 2.0), jscale(q[3], 6.0 * t));
+    r[i].v = q[0].v + t * (q[1].v + t * (q[2].v + t * q[3].v));
+    d[i].v = q[1].v + t * (2.0 * q[2].v + t3 * q[3].v);
+    for (int k = 0; k < ND; k++) {
+      r[i].d[k] = q[0].d[k] + t * (q[1].d[k] + t * (q[2].d[k] + t * q[3].d[k]));
+      d[i].d[k] = q[1].d[k] + t * (2.0 * q[2].d[k] + t3 * q[3].d[k]);
+    }
+    if (dd) {
+      dd[i].v = 2.0 * q[2].v + t6 * q[3].v;
+      for (int k = 0; k < ND; k++) dd[i].d[k] = 2.0 * q[2].d[k] + t6 * q[3].d[k];
+    }
   }
 }
 

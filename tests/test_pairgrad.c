@@ -1,6 +1,7 @@
 /* test_pairgrad.c -- the pair term's gradient (gradient.h, pairgrad.h) against central differences. */
 #include <criterion/criterion.h>
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -408,6 +409,33 @@ Test(pairgrad, term_off_adds_nothing)
   for (size_t k = 0; k < sp->n_nodes; k++)
     cr_assert(g[k].px == 0.0 && g[k].py == 0.0 && g[k].vx == 0.0 && g[k].vy == 0.0);
   free(g);
+  lw_scene_clear(&sc);
+  lw_splines_free(sp);
+}
+
+/* The near pairs are evaluated in parallel and summed in their list's
+** order: the same bits for any number of threads. */
+Test(pairgrad, same_bits_for_any_thread_count)
+{
+  rng_seed(1604);
+  lw_splines *sp = two_arcs(3, 0.0);
+  for (size_t k = 0; k < sp->n_nodes; k++)
+    for (int q = 0; q < 4; q++) *node_coord(&sp->node[k], q) += urand(-2e-3, 2e-3);
+  lw_scene sc;
+  pair_scene(&sc, 1.0, 1.0, 1.5, 8);
+  lw_node *g[2] = {calloc(sp->n_nodes, sizeof *g[0]), calloc(sp->n_nodes, sizeof *g[1])};
+  double e[2];
+  lw_error err;
+  int threads = omp_get_max_threads();
+  for (int t = 0; t < 2; t++) {
+    omp_set_num_threads(t ? 3 : 1);
+    e[t] = lw_pair_gradient(&sc, sp, g[t], &err);
+  }
+  omp_set_num_threads(threads);
+  cr_assert(memcmp(&e[0], &e[1], sizeof e[0]) == 0, "energy %.17g vs %.17g", e[0], e[1]);
+  cr_assert(memcmp(g[0], g[1], sp->n_nodes * sizeof *g[0]) == 0, "the gradients differ");
+  free(g[0]);
+  free(g[1]);
   lw_scene_clear(&sc);
   lw_splines_free(sp);
 }
