@@ -406,12 +406,11 @@ static jet jsegseg(const jet a0[2], const jet a1[2], const jet b0[2], const jet 
 
 /* The subdivision's stack (pairnear.c, inverse_distance), on the heap: a
 ** jet piece is large. */
-struct lw_pairgrad_work {
+typedef struct {
   jpiece *sa, *sb;
   jet *share;
   int *depth;
-};
-typedef struct lw_pairgrad_work pairgrad_work;
+} pairgrad_work;
 
 static pairgrad_work *work_new(void)
 {
@@ -751,13 +750,13 @@ static double near_weight(double u, double *du)
 }
 
 /*
-** lw_pair_near_correction with its derivative: adds f times it to the
-** sample gradients gsa, gsb and to the control point gradients ga, gb, and
+** lw_pair_near_correction with its derivative: adds it to the sample
+** gradients gsa, gsb and to the control point gradients ga, gb, and
 ** returns it.  The same order of A and B as the energy, so the same X_AB.
 */
 static double near_correction_grad(const double a[8], const lw_pair_sample *sa, const double b[8],
                                    const lw_pair_sample *sb, int n, const lw_pair_ctx *ctx, pairgrad_work *wk,
-                                   double f, sample_grad *gsa, sample_grad *gsb, double ga[8], double gb[8])
+                                   sample_grad *gsa, sample_grad *gsb, double ga[8], double gb[8])
 {
   if (!lw_pair_bezier_before(a, b)) {
     const double *t = a;
@@ -799,14 +798,14 @@ static double near_correction_grad(const double a[8], const lw_pair_sample *sa, 
       double dx = sa[i].x - sb[j].x, dy = sa[i].y - sb[j].y, r2 = dx * dx + dy * dy;
       if (!(sa[i].dl != 0.0f && sb[j].dl != 0.0f && r2 < cut2)) continue;
       double rho2 = lw_pair_near_radius2(ctx, sa[i].dl, sb[j].dl);
-      kernel_grad(&sa[i], &sb[j], inv, f * (r2 < rho2 ? 1.0 - W : -W), &gsa[i], &gsb[j]);
+      kernel_grad(&sa[i], &sb[j], inv, r2 < rho2 ? 1.0 - W : -W, &gsa[i], &gsb[j]);
     }
   if (W < 1.0) {
     const lw_pair_sample *p = &sa[wi], *q = &sb[wj];
     double dx = p->x - q->x, dy = p->y - q->y, r = sqrt(dx * dx + dy * dy), du;
     double rho = sqrt(lw_pair_near_radius2(ctx, p->dl, q->dl)), u = r / rho;
     near_weight(u, &du);
-    double c = f * du * (X - (near + far)); /* f dE/du */
+    double c = du * (X - (near + far)); /* dE/du */
     if (r > 0.0) {
       gsa[wi].x += c * dx / (r * rho);
       gsa[wi].y += c * dy / (r * rho);
@@ -822,8 +821,8 @@ static double near_correction_grad(const double a[8], const lw_pair_sample *sa, 
     }
   }
   for (int k = 0; k < 8; k++) {
-    ga[k] += f * W * gxa[k];
-    gb[k] += f * W * gxb[k];
+    ga[k] += W * gxa[k];
+    gb[k] += W * gxb[k];
   }
   return e;
 }
@@ -900,8 +899,14 @@ static lw_status far_field(const lw_cellgrid *g, const lw_splines *sp, uint32_t 
   return LW_OK;
 }
 
+/* Near pairs evaluated together: their results wait in a buffer of this
+** many to be added in the list's order. */
+#define NEAR_CHUNK 1024
+
 /* The near segment pairs, sorted without repeats, each with its
-** correction; their sum in the list's order. */
+** correction; their sum in the list's order.  Threads take the pairs of a
+** chunk in any order; one thread then adds the chunk's results in order, so
+** the sums are the same for any thread count. */
 static lw_status near_field(const lw_splines *sp, const lw_pair_sample *smp, uint32_t np, const lw_pair_ctx *ctx,
                             uint32_t *pairs, size_t n, sample_grad *gs, double *gctrl, double *near)
 {
@@ -912,49 +917,55 @@ static lw_status near_field(const lw_splines *sp, const lw_pair_sample *smp, uin
       pairs[m++] = pairs[k];
       pairs[m++] = pairs[k + 1];
     }
-  const size_t np2 = (size_t)np * 2;
-  near_out *out = malloc((m ? m / 2 : 1) * sizeof *out);
-  sample_grad *sg = calloc((m ? m / 2 : 1) * np2, sizeof *sg);
+  const size_t np2 = (size_t)np * 2, n_near = m / 2;
+  near_out *out = malloc(NEAR_CHUNK * sizeof *out);
+  sample_grad *sg = malloc(NEAR_CHUNK * np2 * sizeof *sg);
   int failed = !out || !sg;
-  if (!failed) {
-#pragma omp parallel reduction(| : failed)
-    {
-      pairgrad_work *wk = work_new();
-      if (!wk) failed = 1;
+  double sum = 0.0;
+#pragma omp parallel if (!failed && n_near > 1)
+  {
+    pairgrad_work *wk = failed ? NULL : work_new();
+    if (!wk) {
+#pragma omp atomic write
+      failed = 1;
+    }
+    for (size_t c0 = 0; c0 < n_near; c0 += NEAR_CHUNK) {
+      const size_t c1 = c0 + NEAR_CHUNK < n_near ? c0 + NEAR_CHUNK : n_near;
 #pragma omp for schedule(dynamic, 4)
-      for (size_t p = 0; p < m / 2; p++) {
+      for (size_t p = c0; p < c1; p++) {
         if (!wk) continue;
         uint32_t ga = pairs[2 * p], gb = pairs[2 * p + 1];
         double a[8], b[8];
         const lw_node *na = &sp->node[lw_segment_node(sp, ga)], *nb = &sp->node[lw_segment_node(sp, gb)];
         lw_segment_bezier(na, na + 1, a);
         lw_segment_bezier(nb, nb + 1, b);
-        near_out *o = &out[p];
-        memset(o->ga, 0, sizeof o->ga);
-        memset(o->gb, 0, sizeof o->gb);
-        o->e = near_correction_grad(a, smp + (size_t)ga * np, b, smp + (size_t)gb * np, (int)np, ctx, wk, 1.0,
-                                    sg + p * np2, sg + p * np2 + np, o->ga, o->gb);
+        near_out *o = &out[p - c0];
+        sample_grad *d = sg + (p - c0) * np2;
+        memset(o, 0, sizeof *o);
+        memset(d, 0, np2 * sizeof *d);
+        o->e = near_correction_grad(a, smp + (size_t)ga * np, b, smp + (size_t)gb * np, (int)np, ctx, wk, d,
+                                    d + np, o->ga, o->gb);
       }
-      work_free(wk);
-    }
-  }
-  double sum = 0.0;
-  if (!failed)
-    for (size_t p = 0; p < m / 2; p++) {
-      uint32_t g2[2] = {pairs[2 * p], pairs[2 * p + 1]};
-      sum += out[p].e;
-      for (int s = 0; s < 2; s++) {
-        const double *gc = s ? out[p].gb : out[p].ga;
-        for (int k = 0; k < 8; k++) gctrl[(size_t)g2[s] * 8 + k] += gc[k];
-        for (uint32_t q = 0; q < np; q++) {
-          const sample_grad *d = &sg[p * np2 + s * np + q];
-          sample_grad *t = &gs[(size_t)g2[s] * np + q];
-          t->x += d->x;
-          t->y += d->y;
-          t->dl += d->dl;
+#pragma omp single
+      for (size_t p = c0; p < c1 && !failed; p++) {
+        const near_out *o = &out[p - c0];
+        sum += o->e;
+        for (int e = 0; e < 2; e++) {
+          size_t g = pairs[2 * p + (size_t)e];
+          const double *gc = e ? o->gb : o->ga;
+          for (int k = 0; k < 8; k++) gctrl[g * 8 + (size_t)k] += gc[k];
+          for (uint32_t q = 0; q < np; q++) {
+            const sample_grad *d = &sg[(p - c0) * np2 + (size_t)e * np + q];
+            sample_grad *t = &gs[g * np + q];
+            t->x += d->x;
+            t->y += d->y;
+            t->dl += d->dl;
+          }
         }
       }
     }
+    work_free(wk);
+  }
   free(out);
   free(sg);
   *near = sum;
