@@ -116,6 +116,21 @@ Test(pairgrad, segseg_derivative_matches_differences)
   }
 }
 
+/* Where an end point lies on the other segment the integral's slope is
+** infinite (it changes like e log e as the end point moves off): the
+** derivative says so rather than giving a finite number. */
+Test(pairgrad, segseg_derivative_is_not_finite_at_a_contact)
+{
+  const double T[8] = {0.0, 0.0, 1.0, 0.0, 0.4, 0.0, 0.45, 0.8}, L[8] = {0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 1.3, 0.7};
+  const double *C[2] = {T, L};
+  for (int c = 0; c < 2; c++) {
+    double g[8], v = lw_pair_segseg_grad(C[c], C[c] + 2, C[c] + 4, C[c] + 6, g);
+    int finite = 1;
+    for (int k = 0; k < 8; k++) finite &= isfinite(g[k]);
+    cr_assert(isfinite(v) && v > 0.0 && !finite, "%s contact: %g, gradient finite", c ? "L" : "T", v);
+  }
+}
+
 /* The derivative is the integral's, not an approximation to it: the
 ** derivative along a rigid motion is 0 and along a scaling the value
 ** (I(lambda x) = lambda I(x)), to rounding. */

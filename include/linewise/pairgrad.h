@@ -7,6 +7,9 @@
 ** Each is the derivative of the function as linewise computes it
 ** (docs/NUMERICS.md, "Gradient of the pair term"), analytic, so a
 ** minimiser or an integrator sees the same function the chain sees.
+** Where the energy's slope is infinite -- an end point of a near field
+** leaf's chord exactly on the other chord, as where two splines pass
+** through one node position -- the gradient is not finite (NaN).
 */
 #ifndef LINEWISE_PAIRGRAD_H
 #define LINEWISE_PAIRGRAD_H
