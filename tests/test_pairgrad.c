@@ -29,6 +29,8 @@ static const double PI = 3.14159265358979323846;
 ** 1e-7 of f / scale.  Components that nearly vanish are compared against
 ** FLOOR times the largest component: relative 1e-5 of a component that
 ** is 1e-3 of the largest asks more than the rounding of the others allows.
+** Kinks (docs/NUMERICS.md) are kept away the same way: the arcs are
+** displaced off their symmetry, whose ties of maxima are kinks.
 */
 #define REL 1e-5
 #define FLOOR 1e-3
