@@ -47,13 +47,22 @@ void lw_dynamics_free(lw_dynamics *d)
   free(d);
 }
 
-/* Moves the system to x (d->x), and takes E and its gradient there. */
+/* Moves the system to x, and takes E and its gradient there.  Where two
+** curves touch exactly the pair term's slope is infinite (pairgrad.h): a
+** gradient that is not finite in an allowed state stops the motion with
+** that reason rather than spreading NaN through the momenta. */
 static lw_status evaluate(lw_dynamics *d, const double *x, lw_error *err)
 {
   lw_status s = d->type->set_coords(d->state, x, err);
   if (s) return s;
   d->energy = d->type->gradient(d->state, d->g, err);
-  return err->code;
+  if (isnan(d->energy)) return err->code ? err->code : lw_error_set(err, LW_EINPUT, "the energy is not a number");
+  if (isfinite(d->energy))
+    for (size_t i = 0; i < d->n; i++)
+      if (!isfinite(d->g[i]))
+        return lw_error_set(err, LW_EINPUT, "the force on coordinate %zu is not finite at t = %g s (two lines "
+                            "touch?): lower dynamics.dt or raise the pair term's near field", i, d->time);
+  return LW_OK;
 }
 
 lw_status lw_dynamics_sync(lw_dynamics *d, lw_error *err)
