@@ -29,8 +29,10 @@ TOOLS   := seed-sweep param-sweep plot-run plot-sweep
 # The example picture is generated (no third-party images in the repository).
 PICTURE := params/picture.png
 
-.PHONY: all deps test test-long asan fuzz fuzz-build run bench install clean docs
-all: $(BIN)/linewise
+.PHONY: all deps deps-animation test test-long asan fuzz fuzz-build run bench install clean docs
+# The example picture too: params/example.ini, the scene a new user tries
+# first, needs it.
+all: $(BIN)/linewise $(PICTURE)
 
 $(BUILD)/obj/%.o: src/%.c $(wildcard include/linewise/*.h) | $(BUILD)/obj
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -c $< -o $@
@@ -110,6 +112,10 @@ deps:
 	if [ -n "$$missing" ]; then \
 	  echo "installing:$$missing"; apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
 	else echo "all build dependencies present"; fi
+
+# ffmpeg for tools/animate.sh only: not needed to build or test.
+deps-animation:
+	@dpkg -s ffmpeg >/dev/null 2>&1 || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ffmpeg; }
 
 run: bin/linewise $(PICTURE)
 	bin/linewise run params/example.ini --out out/example

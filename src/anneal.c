@@ -82,17 +82,6 @@ static lw_status make_dir(const char *dir, lw_error *err)
   return LW_OK;
 }
 
-/* Prefixes the message in err with where key was set and the key: input
-** read on behalf of a key (a table, a state, a placement) is reported as
-** that key's error. */
-static lw_status blame_key(const lw_params *p, const char *section, const char *key, lw_error *err)
-{
-  char where[LW_PATH_MAX + 32], msg[LW_ERROR_MSG];
-  lw_params_origin(p, lw_params_find(section, key), where, sizeof where);
-  snprintf(msg, sizeof msg, "%s", err->msg);
-  return lw_error_set(err, err->code, "%s: key '%s.%s': %s", where, section, key, msg);
-}
-
 /* Schedule and its table (relative to the scene file). */
 static lw_status setup_schedule(lw_anneal *a, lw_error *err)
 {
@@ -111,7 +100,7 @@ static lw_status setup_schedule(lw_anneal *a, lw_error *err)
   if (a->sched_type->needs & LW_SCHEDULE_USES_TABLE) {
     if (!p->table[0])
       return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.schedule': 'table' needs anneal.table (a file)", where);
-    if (lw_schedule_read_table(&a->sched, p->table, err)) return blame_key(p, "anneal", "table", err);
+    if (lw_schedule_read_table(&a->sched, p->table, err)) return lw_params_blame(p, "anneal", "table", err);
   }
   lw_error e2;
   if (lw_schedule_check(a->sched_type, &a->sched, &e2))
@@ -127,8 +116,20 @@ static void absolute_path(char *path, const char *scene_file)
   char dir[LW_PATH_MAX], joined[2 * LW_PATH_MAX + 2], real[4096];
   lw_path_dir(dir, sizeof dir, scene_file);
   lw_path_join(joined, sizeof joined, dir, path);
-  if (realpath(joined, real) && strlen(real) < LW_PATH_MAX) strcpy(path, real);
-  else if (strlen(joined) < LW_PATH_MAX) strcpy(path, joined);
+  if (realpath(joined, real) && strlen(real) < LW_PATH_MAX) {
+    strcpy(path, real);
+    return;
+  }
+  /* A missing file stays missing, but its name must still be absolute:
+  ** relative, the scene's directory would be joined to it a second time
+  ** when the picture is opened. */
+  if (joined[0] != '/' && getcwd(real, sizeof real)) {
+    size_t nc = strlen(real);
+    snprintf(real + nc, sizeof real - nc, "/%s", joined);
+    if (strlen(real) < LW_PATH_MAX) strcpy(path, real);
+  } else if (strlen(joined) < LW_PATH_MAX) {
+    strcpy(path, joined);
+  }
 }
 
 /* Replicas of the run (the explicit ladder's length, or [tempering]
@@ -158,6 +159,11 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
       return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.t_max': expected a value above t_min = %g, got %g",
                           where, p->t_min, p->t_max);
     lw_tempering_geometric(ladder, a->n_rep, p->t_min, p->t_max);
+  }
+  if (a->n_rep > 1 && p->driver == LW_DRIVER_DYNAMICS) {
+    lw_params_origin(p, lw_params_find("scene", "driver"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'scene.driver': the dynamics moves one system; parallel tempering "
+                        "(%d replicas) needs driver = metropolis", where, a->n_rep);
   }
   lw_params_origin(p, lw_params_find("anneal", "t_start"), where, sizeof where);
   if (a->n_rep > 1 && !(p->t_start > 0.0))
@@ -216,6 +222,7 @@ static lw_status build(lw_anneal *a, void **states, const double *ladder, lw_err
     a->pt = lw_tempering_new(n, ladder, lw_stream_seed(a->seed, 2), err);
     if (!a->pt) return err->code;
   }
+  if (p->driver == LW_DRIVER_DYNAMICS && !(a->dyn = lw_dynamics_new(t, a->sys->state, p, err))) return err->code;
   return LW_OK;
 }
 
@@ -237,7 +244,13 @@ static lw_status open_trace(lw_anneal *a, int fresh, lw_error *err)
   dir_file(path, sizeof path, a, "trace.csv");
   a->trace = fopen(path, fresh ? "w" : "a");
   if (!a->trace) return lw_error_set(err, LW_EIO, "%s: cannot write: %s", path, strerror(errno));
-  if (fresh) {
+  if (fresh && a->dyn) {
+    const lw_system_type *t = a->sys_type;
+    fprintf(a->trace, "sweep,time");
+    for (int k = 0; k < t->n_terms; k++)
+      if (t->term_on(a->setup, k)) fprintf(a->trace, ",%s", t->term_names[k]);
+    fprintf(a->trace, ",potential,kinetic,total\n");
+  } else if (fresh) {
     const lw_system_type *t = a->sys_type;
     fprintf(a->trace, "sweep,temperature");
     for (int k = 0; k < t->n_terms; k++)
@@ -446,6 +459,14 @@ static void trace_row(lw_anneal *a)
   const lw_system_type *t = a->sys_type;
   double term[LW_SYSTEM_TERMS_MAX];
   t->terms(a->sys->state, term);
+  if (a->dyn) {
+    double kin = lw_dynamics_kinetic(a->dyn), pot = lw_system_total(a->sys);
+    fprintf(a->trace, "%ld,%.10g", a->sweep, a->dyn->time);
+    for (int k = 0; k < t->n_terms; k++)
+      if (t->term_on(a->setup, k)) fprintf(a->trace, ",%.10g", term[k]);
+    fprintf(a->trace, ",%.17g,%.17g,%.17g\n", pot, kin, pot + kin);
+    return;
+  }
   fprintf(a->trace, "%ld,%.10g", a->sweep, c->temperature);
   for (int k = 0; k < t->n_terms; k++)
     if (t->term_on(a->setup, k)) fprintf(a->trace, ",%.10g", term[k]);
@@ -522,8 +543,36 @@ static lw_status exchange(lw_anneal *a, lw_error *err)
   return LW_OK;
 }
 
+/* Frames and checkpoints that fall due after a sweep.  Frames are extra
+** files: they read the state and change nothing. */
+static lw_status sweep_files(lw_anneal *a, lw_error *err)
+{
+  const lw_params *p = &a->params;
+  if (p->frames_every && a->sweep % p->frames_every == 0 &&
+      a->sys_type->draw(a->sys->state, p, a->dir, a->sweep, err))
+    return err->code;
+  if (a->sweep % p->checkpoint_every == 0) return lw_anneal_checkpoint(a, err);
+  return LW_OK;
+}
+
+/* A sweep of the dynamics: steps_per_sweep time steps.  The system's state
+** is recomputed from scratch at every step (set_coords), so there is no
+** drift to check. */
+static lw_status dynamics_sweep(lw_anneal *a, lw_error *err)
+{
+  const lw_params *p = &a->params;
+  for (int k = 0; k < p->dyn_steps_per_sweep; k++) {
+    lw_status s = lw_dynamics_step(a->dyn, err);
+    if (s) return s;
+  }
+  a->sweep++;
+  if (a->sweep % p->trace_every == 0 || lw_anneal_done(a)) trace_row(a);
+  return sweep_files(a, err);
+}
+
 lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
 {
+  if (a->dyn) return dynamics_sweep(a, err);
   const lw_params *p = &a->params;
   int n = a->n_rep;
   long b = block_of(a, a->sweep);
@@ -571,12 +620,7 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
         return lw_error_set(err, LW_ENOMEM, "out of memory");
       if (drift > a->max_drift) a->max_drift = drift;
     }
-  /* Frames are extra files: they read the state and change nothing. */
-  if (p->frames_every && a->sweep % p->frames_every == 0 &&
-      a->sys_type->draw(a->sys->state, p, a->dir, a->sweep, err))
-    return err->code;
-  if (a->sweep % p->checkpoint_every == 0) return lw_anneal_checkpoint(a, err);
-  return LW_OK;
+  return sweep_files(a, err);
 }
 
 static lw_status write_summary(lw_anneal *a, lw_error *err)
@@ -618,6 +662,18 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json_key(&j, "max_relative_drift"); lw_json_number(&j, a->max_drift);
   lw_json_key(&j, "temperature_final"); lw_json_number(&j, c->temperature);
   lw_json_key(&j, "schedule"); lw_json_string(&j, a->sched_type->name);
+  lw_json_key(&j, "driver"); lw_json_string(&j, a->dyn ? "dynamics" : "metropolis");
+  if (a->dyn) {
+    lw_dynamics *d = a->dyn;
+    lw_json_key(&j, "dynamics");
+    lw_json_begin_object(&j);
+    lw_json_key(&j, "time"); lw_json_number(&j, d->time);
+    lw_json_key(&j, "time_steps"); lw_json_int(&j, (long long)d->steps);
+    lw_json_key(&j, "kinetic"); lw_json_number(&j, lw_dynamics_kinetic(d));
+    lw_json_key(&j, "halvings"); lw_json_int(&j, (long long)d->halvings);
+    lw_json_key(&j, "fixed_point_iterations_max"); lw_json_int(&j, d->iterations_max);
+    lw_json_end_object(&j);
+  }
   lw_json_key(&j, "energy");
   lw_json_begin_object(&j);
   lw_json_key(&j, "total"); lw_json_number(&j, lw_system_total(a->sys));
@@ -702,6 +758,7 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 void lw_anneal_free(lw_anneal *a)
 {
   if (a->trace) fclose(a->trace);
+  lw_dynamics_free(a->dyn);
   /* the chains first: tempering swaps systems between them */
   for (int k = 0; a->chains && k < a->n_rep; k++) lw_chain_free(a->chains[k]);
   for (int k = 0; a->systems && k < a->n_rep; k++) lw_system_free(a->systems[k]);

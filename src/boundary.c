@@ -98,9 +98,10 @@ static double circle_distance(const lw_boundary *b, double x, double y)
 ** in y, so a vertex on that line is counted once) and cross it to the right of
 ** the point.  No orientation enters, so either vertex order works.  A polygon
 ** with no vertices (after lw_boundary_clear) has no inside: +INFINITY. */
-static double polygon_distance(const lw_boundary *b, double x, double y)
+static double polygon_nearest(const lw_boundary *b, double x, double y, double *ox, double *oy)
 {
   const size_t n = b->n;
+  *ox = *oy = 0.0;
   if (n == 0 || !b->vx || !b->vy) return INFINITY;
   const double *px = b->vx, *py = b->vy;
   double best = INFINITY;
@@ -116,7 +117,11 @@ static double polygon_distance(const lw_boundary *b, double x, double y)
       t = t < 0 ? 0 : (t > 1 ? 1 : t);
     }
     double dx = wx - t * ex, dy = wy - t * ey, d2 = dx * dx + dy * dy;
-    if (d2 < best) best = d2;
+    if (d2 < best) {
+      best = d2;
+      *ox = dx;
+      *oy = dy;
+    }
     if ((ay > y) != (py[i] > y)) {
       /* ey != 0 here, since the edge straddles y. */
       double xc = ax + ex * (y - ay) / ey;
@@ -125,6 +130,12 @@ static double polygon_distance(const lw_boundary *b, double x, double y)
   }
   double d = sqrt(best);
   return inside && d > 0 ? -d : d;
+}
+
+static double polygon_distance(const lw_boundary *b, double x, double y)
+{
+  double ox, oy;
+  return polygon_nearest(b, x, y, &ox, &oy);
 }
 
 double lw_boundary_distance(const lw_boundary *b, double x, double y)
@@ -145,6 +156,54 @@ double lw_boundary_distance(const lw_boundary *b, double x, double y)
   case LW_BOUNDARY_NONE: break;
   }
   return -INFINITY;
+}
+
+double lw_boundary_distance_grad(const lw_boundary *b, double x, double y, double g[2])
+{
+  g[0] = g[1] = 0.0;
+  double d = lw_boundary_distance(b, x, y);
+  if (!isfinite(d)) return d;
+  switch (b->kind) {
+  case LW_BOUNDARY_RECT: {
+    /* the side that fmax picked in rect_distance, or the offset outside */
+    double qx = fmax(b->x0 - x, x - b->x1), qy = fmax(b->y0 - y, y - b->y1);
+    if (qx > 0 || qy > 0) {
+      g[0] = qx > 0 ? qx / d : 0.0;
+      g[1] = qy > 0 ? qy / d : 0.0;
+      g[0] *= (x - b->x1 > b->x0 - x) ? 1.0 : -1.0;
+      g[1] *= (y - b->y1 > b->y0 - y) ? 1.0 : -1.0;
+    } else if (qx >= qy) {
+      g[0] = (x - b->x1 > b->x0 - x) ? 1.0 : -1.0;
+    } else {
+      g[1] = (y - b->y1 > b->y0 - y) ? 1.0 : -1.0;
+    }
+    break;
+  }
+  case LW_BOUNDARY_CIRCLE: {
+    double dx = x - b->cx, dy = y - b->cy, r = sqrt(dx * dx + dy * dy);
+    if (r > 0.0) {
+      g[0] = dx / r;
+      g[1] = dy / r;
+    }
+    break;
+  }
+  case LW_BOUNDARY_POLYGON: {
+    double ox, oy, e = polygon_nearest(b, x, y, &ox, &oy);
+    if (e != 0.0) { /* d = +-|o|: the gradient of |o| is o / |o|, negated inside */
+      g[0] = ox / e;
+      g[1] = oy / e;
+    }
+    break;
+  }
+  case LW_BOUNDARY_MASK: {
+    double v;
+    lw_grid2d_eval_grad(b->sdt, x, y, &v, &g[0], &g[1]);
+    break;
+  }
+  case LW_BOUNDARY_NONE:
+    break;
+  }
+  return d;
 }
 
 int lw_boundary_inside(const lw_boundary *b, double x, double y)

@@ -111,6 +111,16 @@ static void put_tempering(lw_ckpt_writer *w, const lw_anneal *a, int *bad)
   lw_ckpt_put_counts(w, "steps", &pt->steps, 1);
 }
 
+/* [dynamics]: the clock, the counters and the momenta (the positions are
+** the system's state); four momenta a line. */
+static void put_dynamics(lw_ckpt_writer *w, const lw_dynamics *d)
+{
+  lw_ckpt_section(w, "dynamics");
+  lw_ckpt_put_numbers(w, "time", &d->time, 1);
+  lw_ckpt_put_counts(w, "steps", (unsigned long[]){d->steps, d->halvings, (unsigned long)d->iterations_max}, 3);
+  for (size_t i = 0; i < d->n; i += 4) lw_ckpt_put_numbers(w, "momentum", d->pi + i, d->n - i < 4 ? (int)(d->n - i) : 4);
+}
+
 /* replica-K.lw: a plain state of rung K for the user (init.from, energy):
 ** the header and the system's section as for the coldest rung. */
 static lw_status write_replica(const lw_anneal *a, int k, lw_error *err)
@@ -166,6 +176,7 @@ lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err)
   int bad = 0;
   for (int k = 0; k < a->n_rep; k++) put_chain(&w, k, t, a->chains[k], &bad);
   if (a->pt) put_tempering(&w, a, &bad);
+  if (a->dyn) put_dynamics(&w, a->dyn);
   for (int k = 0; k < a->n_rep; k++) {
     char sec[96];
     lw_checkpoint_system_section(sec, sizeof sec, t, k);
@@ -369,6 +380,34 @@ static lw_status get_tempering(lw_ckpt *doc, lw_anneal *a, lw_error *err)
   return LW_OK;
 }
 
+static lw_status get_dynamics(lw_ckpt *doc, lw_dynamics *d, lw_error *err)
+{
+  const char *path = lw_ckpt_path(doc), *key, *val;
+  lw_status s;
+  unsigned long u[3];
+  if ((s = lw_ckpt_numbers(doc, "dynamics", "time", &d->time, 1, 0, DBL_MAX, 1, err)) ||
+      (s = lw_ckpt_counts(doc, "dynamics", "steps", u, 3, 1, err)))
+    return s;
+  d->steps = u[0];
+  d->halvings = u[1];
+  d->iterations_max = (int)(u[2] < 1000 ? u[2] : 1000);
+  size_t pos = 0, i = 0;
+  int line = 0;
+  while (lw_ckpt_next(doc, "dynamics", &pos, &key, &val, &line)) {
+    if (strcmp(key, "momentum")) continue;
+    double v[5];
+    int want = d->n - i < 4 ? (int)(d->n - i) : 4, got = i < d->n ? lw_number_list(val, 0, v, 5) : -2;
+    if (got != want)
+      return lw_error_set(err, LW_EINPUT, "%s:%d: [dynamics] momentum: expected %d numbers (coordinates %zu of %zu), "
+                          "got '%.60s'", path, line, want, i, d->n, val);
+    memcpy(d->pi + i, v, (size_t)want * sizeof *v);
+    i += (size_t)want;
+  }
+  if (i != d->n)
+    return lw_error_set(err, LW_EINPUT, "%s: [dynamics] momentum: %zu of the system's %zu coordinates", path, i, d->n);
+  return LW_OK;
+}
+
 lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, lw_error *err)
 {
   const char *path = lw_ckpt_path(doc);
@@ -412,6 +451,7 @@ lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, l
     a->trace_mark[m] = (lw_move_stats){.proposed = u[0], .accepted = u[1], .nan = u[2]};
   }
   if (a->pt && (s = get_tempering(doc, a, err))) return s;
+  if (a->dyn && (s = get_dynamics(doc, a->dyn, err))) return s;
   return lw_ckpt_unread(doc, err);
 }
 
@@ -503,15 +543,17 @@ static int upgrade_chain_key(upgrade *u, const char *sec, const char *key, const
 
 static void upgrade_energy(upgrade *u, const char *sec, const char *value, int line)
 {
-  /* States written before the parametrisation term (the last) hold one
-  ** number fewer: that term was off in them and takes its default. */
-  char *w[LW_TERM_COUNT];
-  int n = LW_TERM_COUNT;
-  double tmp[LW_TERM_COUNT + 1];
-  if (lw_number_list(value, 0, tmp, LW_TERM_COUNT + 1) == LW_TERM_COUNT - 1) n = LW_TERM_COUNT - 1;
+  /* Format 1 knew the terms up to parametrisation; states written before
+  ** that term hold one number fewer: it was off in them.  Later terms are
+  ** missing, which reads as off. */
+  enum { V1_TERMS = LW_TERM_PARAM + 1 };
+  char *w[V1_TERMS];
+  int n = V1_TERMS;
+  double tmp[V1_TERMS + 1];
+  if (lw_number_list(value, 0, tmp, V1_TERMS + 1) == V1_TERMS - 1) n = V1_TERMS - 1;
   if (!words(u, "energy", line, value, n, w)) return;
-  const char *names[LW_TERM_COUNT];
-  for (int t = 0; t < LW_TERM_COUNT; t++) names[t] = lw_term_names[t];
+  const char *names[V1_TERMS];
+  for (int t = 0; t < V1_TERMS; t++) names[t] = lw_term_names[t];
   add_grouped(u, sec, "energy", w, n, 1, names, line);
   for (int i = 0; i < n; i++) free(w[i]);
 }

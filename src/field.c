@@ -95,21 +95,29 @@ size_t lw_grid2d_sanitize(lw_grid2d *g)
 /* Locates coordinate x on an axis of n nodes: the cell index *i (0 <= *i <=
 ** n - 2, or 0 when n == 1) and the fraction *t in [0, 1] inside it.  The
 ** coordinate is clamped to the node range first, so points beyond the edge
-** read the edge value; "!(u > 0)" also sends NaN to the first node. */
-static inline void locate(double x, double x0, double h, int n, int *i, double *t)
+** read the edge value; "!(u > 0)" also sends NaN to the first node.
+** Returns 1 where x was not clamped (the value moves with x there). */
+static inline int locate(double x, double x0, double h, int n, int *i, double *t)
 {
   if (n < 2) {
     *i = 0;
     *t = 0.0;
-    return;
+    return 0;
   }
   double u = (x - x0) / h, top = (double)(n - 1);
-  if (!(u > 0.0)) u = 0.0;
-  else if (u > top) u = top;
+  int inside = 1;
+  if (!(u > 0.0)) {
+    u = 0.0;
+    inside = 0;
+  } else if (u > top) {
+    u = top;
+    inside = 0;
+  }
   int k = (int)u; /* u >= 0, so truncation is floor */
   if (k > n - 2) k = n - 2; /* u == top: last cell at t = 1 */
   *i = k;
   *t = u - (double)k;
+  return inside;
 }
 
 void lw_grid2d_eval(const lw_grid2d *g, double x, double y, double *out)
@@ -128,6 +136,29 @@ void lw_grid2d_eval(const lw_grid2d *g, double x, double y, double *out)
   const double w01 = (1.0 - tx) * ty, w11 = tx * ty;
   for (int c = 0; c < nc; c++)
     out[c] = w00 * p[c] + w10 * p[di + c] + w01 * p[dj + c] + w11 * p[dj + di + c];
+}
+
+/* The bilinear value as lw_grid2d_eval computes it, and its partials: in
+** x, (1 - ty)(p10 - p00) + ty (p11 - p01) per unit of tx, 0 across a
+** clamped edge. */
+void lw_grid2d_eval_grad(const lw_grid2d *g, double x, double y, double *out, double *dx, double *dy)
+{
+  int i, j;
+  double tx, ty;
+  const int in_x = locate(x, g->x0, g->hx, g->nx, &i, &tx);
+  const int in_y = locate(y, g->y0, g->hy, g->ny, &j, &ty);
+  const int nc = g->ncomp;
+  const size_t di = g->nx > 1 ? (size_t)nc : 0;
+  const size_t dj = g->ny > 1 ? (size_t)g->nx * (size_t)nc : 0;
+  const double *p = g->data + ((size_t)j * (size_t)g->nx + (size_t)i) * (size_t)nc;
+  const double w00 = (1.0 - tx) * (1.0 - ty), w10 = tx * (1.0 - ty);
+  const double w01 = (1.0 - tx) * ty, w11 = tx * ty;
+  for (int c = 0; c < nc; c++) {
+    const double p00 = p[c], p10 = p[di + c], p01 = p[dj + c], p11 = p[dj + di + c];
+    out[c] = w00 * p00 + w10 * p10 + w01 * p01 + w11 * p11;
+    dx[c] = in_x ? ((1.0 - ty) * (p10 - p00) + ty * (p11 - p01)) / g->hx : 0.0;
+    dy[c] = in_y ? ((1.0 - tx) * (p01 - p00) + tx * (p11 - p10)) / g->hy : 0.0;
+  }
 }
 
 double lw_potential_eval(const lw_potential *f, double x, double y)
@@ -231,6 +262,108 @@ void lw_field_eval(const lw_field *f, double x, double y, double *vx, double *vy
   }
   }
   *vx = *vy = 0.0;
+}
+
+double lw_potential_grad(const lw_potential *f, double x, double y, double g[2])
+{
+  g[0] = g[1] = 0.0;
+  switch (f->kind) {
+  case LW_POTENTIAL_CONSTANT:
+    break;
+  case LW_POTENTIAL_RAMP:
+    g[0] = 0.5 * f->ux / f->scale;
+    g[1] = 0.5 * f->uy / f->scale;
+    break;
+  case LW_POTENTIAL_RADIAL: {
+    double dx = x - f->cx, dy = y - f->cy, r = sqrt(dx * dx + dy * dy);
+    if (r > 0.0) { /* the cone's tip has no gradient: 0, a subgradient */
+      g[0] = dx / (r * f->scale);
+      g[1] = dy / (r * f->scale);
+    }
+    break;
+  }
+  case LW_POTENTIAL_GRID:
+    if (!f->grid || f->grid->ncomp != 1) return 0.0;
+    double v;
+    lw_grid2d_eval_grad(f->grid, x, y, &v, &g[0], &g[1]);
+    return v;
+  }
+  return lw_potential_eval(f, x, y);
+}
+
+/* The half-angle map of grid_axial, v = |q|^(1/2) q^(1/2) in complex
+** notation (q the interpolated doubled-angle vector, |v| = |q| = m), has
+** dv = v (q.dq) / (2 m^2) + conj(v) dq / (2 m): with the chain rule
+** through the bilinear q(x, y) that is J.  Whichever branch lw_field_eval
+** takes, J is that branch's derivative (both branches are +-v, and so
+** are their derivatives). */
+static void axial_jacobian(const lw_grid2d *g, double x, double y, const double v[2], double J[2][2])
+{
+  double q[2], qx[2], qy[2];
+  lw_grid2d_eval_grad(g, x, y, q, qx, qy);
+  double m2 = q[0] * q[0] + q[1] * q[1];
+  if (!(m2 > 0.0)) return;
+  double b = 1.0 / (2.0 * sqrt(m2)), c0 = q[0] / (2.0 * m2), c1 = q[1] / (2.0 * m2);
+  /* dv/dq0 and dv/dq1 */
+  double d0x = v[0] * c0 + v[0] * b, d0y = v[1] * c0 - v[1] * b;
+  double d1x = v[0] * c1 + v[1] * b, d1y = v[1] * c1 + v[0] * b;
+  J[0][0] = d0x * qx[0] + d1x * qx[1];
+  J[0][1] = d0x * qy[0] + d1x * qy[1];
+  J[1][0] = d0y * qx[0] + d1y * qx[1];
+  J[1][1] = d0y * qy[0] + d1y * qy[1];
+}
+
+void lw_field_jacobian(const lw_field *f, double x, double y, double v[2], double J[2][2])
+{
+  lw_field_eval(f, x, y, &v[0], &v[1]);
+  J[0][0] = J[0][1] = J[1][0] = J[1][1] = 0.0;
+  switch (f->kind) {
+  case LW_FIELD_CONSTANT:
+    return;
+  case LW_FIELD_RADIAL:
+  case LW_FIELD_VORTEX: {
+    /* n = (r - c) / |r - c| has dn = (I - n n^T) / |r - c|; the vortex is n
+    ** turned by a quarter, so its rows are radial's turned likewise. */
+    double dx = x - f->cx, dy = y - f->cy, r = sqrt(dx * dx + dy * dy);
+    if (!(r > 0.0)) return;
+    double nx = dx / r, ny = dy / r;
+    double a = (1.0 - nx * nx) / r, b = -nx * ny / r, c = (1.0 - ny * ny) / r;
+    if (f->kind == LW_FIELD_RADIAL) {
+      J[0][0] = a;
+      J[0][1] = J[1][0] = b;
+      J[1][1] = c;
+    } else { /* v = (-n_y, n_x) */
+      J[0][0] = -b;
+      J[0][1] = -c;
+      J[1][0] = a;
+      J[1][1] = b;
+    }
+    return;
+  }
+  case LW_FIELD_WAVES: {
+    /* v = (1, s) / sqrt(1 + s^2), s = k A cos(k x): dv/ds = (-s, 1) (1 + s^2)^(-3/2) */
+    double k = 2.0 * M_PI / f->wavelength;
+    double s = k * f->amplitude * cos(k * x), ds = -k * k * f->amplitude * sin(k * x);
+    double c = 1.0 / ((1.0 + s * s) * sqrt(1.0 + s * s));
+    J[0][0] = -s * c * ds;
+    J[1][0] = c * ds;
+    return;
+  }
+  case LW_FIELD_GRID: {
+    if (!f->grid || f->grid->ncomp != 2) return;
+    double out[2], gx[2], gy[2];
+    lw_grid2d_eval_grad(f->grid, x, y, out, gx, gy);
+    J[0][0] = gx[0];
+    J[0][1] = gy[0];
+    J[1][0] = gx[1];
+    J[1][1] = gy[1];
+    return;
+  }
+  case LW_FIELD_GRID_AXIAL:
+    if (!f->grid || f->grid->ncomp != 2) return;
+    axial_jacobian(f->grid, x, y, v, J);
+    return;
+  }
 }
 
 void lw_potential_clear(lw_potential *f)

@@ -109,6 +109,18 @@ typedef struct {
   long start_sweep, next_plain, last_plain;
 } progress;
 
+/* What moves: the temperature and acceptance of the chain, or the clock
+** and kinetic energy of the dynamics. */
+static void progress_state(const lw_anneal *a, int digits, char *buf, size_t n)
+{
+  if (a->dyn)
+    snprintf(buf, n, "t %.*g  E %.*g  K %.*g", digits, a->dyn->time, digits + 2, lw_anneal_energy(a), digits,
+             lw_dynamics_kinetic(a->dyn));
+  else
+    snprintf(buf, n, "T %.*g  E %.*g  acc %.*f", digits, lw_anneal_temperature(a), digits + 2, lw_anneal_energy(a),
+             digits - 1, lw_anneal_acceptance(a));
+}
+
 static void progress_show(progress *pg, const lw_anneal *a, int final)
 {
   if (pg->quiet) return;
@@ -121,14 +133,16 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
     if (!final && t - shown < 0.2) return;
     shown = t;
     int width = 24, fill = total > 0 ? (int)(width * done / total) : width;
-    fprintf(stderr, "\r[%.*s%*s] sweep %ld/%ld  T %.4g  E %.6g  acc %.3f  left %.0fs ", fill,
-            "########################", width - fill, "", a->sweep, a->end_sweep, lw_anneal_temperature(a),
-            lw_anneal_energy(a), lw_anneal_acceptance(a), left);
+    char state[160];
+    progress_state(a, 4, state, sizeof state);
+    fprintf(stderr, "\r[%.*s%*s] sweep %ld/%ld  %s  left %.0fs ", fill, "########################", width - fill, "",
+            a->sweep, a->end_sweep, state, left);
     if (final) fputc('\n', stderr);
   } else if ((final && a->sweep != pg->last_plain) || a->sweep >= pg->next_plain) {
     pg->last_plain = a->sweep;
-    fprintf(stderr, "sweep %ld/%ld T %.6g E %.10g acc %.4f elapsed %.1fs left %.1fs\n", a->sweep, a->end_sweep,
-            lw_anneal_temperature(a), lw_anneal_energy(a), lw_anneal_acceptance(a), t, left);
+    char state[160];
+    progress_state(a, 6, state, sizeof state);
+    fprintf(stderr, "sweep %ld/%ld %s elapsed %.1fs left %.1fs\n", a->sweep, a->end_sweep, state, t, left);
     while (pg->next_plain <= a->sweep) pg->next_plain += total / 10 > 0 ? total / 10 : 1;
   }
 }

@@ -127,8 +127,7 @@ static double xlogx(double x)
   return x > 0.0 ? x * log(x) : 0.0;
 }
 
-/* Potential of the segment (0,0)-(L,0) at (x, y): integral of 1/|p - q|. */
-static double seg_potential(double L, double x, double y)
+double lw_pair_seg_potential(double L, double x, double y)
 {
   double r0 = sqrt(x * x + y * y), r1 = sqrt((x - L) * (x - L) + y * y);
   double y2 = y * y;
@@ -171,8 +170,8 @@ static double far_gl(double La, double Lb, double beta0, double eta0, double c, 
   double sum = 0.0;
   for (int k = 0; k < 5; k++) {
     double x = GL10_X[k];
-    sum += GL10_W[k] * (seg_potential(La, mx + x * hx, my + x * hy) +
-                        seg_potential(La, mx - x * hx, my - x * hy));
+    sum += GL10_W[k] * (lw_pair_seg_potential(La, mx + x * hx, my + x * hy) +
+                        lw_pair_seg_potential(La, mx - x * hx, my - x * hy));
   }
   return 0.5 * Lb * sum;
 }

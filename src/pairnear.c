@@ -445,6 +445,10 @@ static double subtracted(const cubic *ca, const cubic *cb, double cutoff, double
   return sum + lw_pair_segseg(l0, l1, m0, m1);
 }
 
+const lw_pairnear_consts lw_pairnear_k = {SEP_LO,   SEP_HI,     APART_LO, APART_HI, LEAF_RATIO, FLAT_RATIO,
+                                          SINE_LO,  SINE_HI,    CLOSE_LO, CLOSE_HI, STACK_MAX,  G6_S,
+                                          G6_W,     GAUSS_S,    G16_S,    G16_W,    GAUSS_L};
+
 double lw_pair_segments_exact(const double a[8], const double b[8], double cutoff)
 {
   cubic ca, cb;
@@ -493,8 +497,7 @@ static inline double near_weight(double u)
   return t * t * t * (10.0 + t * (6.0 * t - 15.0));
 }
 
-/* 1 if a comes before b in the lexicographic order of the control points. */
-static int bezier_before(const double a[8], const double b[8])
+int lw_pair_bezier_before(const double a[8], const double b[8])
 {
   for (int k = 0; k < 8; k++)
     if (a[k] != b[k]) return a[k] < b[k];
@@ -505,7 +508,7 @@ double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, cons
                                const lw_pair_sample *sb, int n, const lw_pair_ctx *ctx)
 {
   /* one order for the two segments, so that the value is bitwise symmetric */
-  if (!bezier_before(a, b)) {
+  if (!lw_pair_bezier_before(a, b)) {
     const double *t = a;
     const lw_pair_sample *u = sa;
     a = b;

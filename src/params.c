@@ -31,6 +31,11 @@ const lw_param_def lw_param_table[] = {
          "What is annealed: `splines` (cubic Bezier splines on the page) or `particles` "
          "(oriented particles in 3-D, set up by the [particles] section; README, "
          "\"Oriented particles\"). docs/SYSTEMS.md."),
+  CHOICE("scene", "driver", driver, "metropolis", "metropolis|dynamics",
+         "What moves the system: `metropolis` anneals it by Monte Carlo (the [anneal] schedule, "
+         "[tempering] with replicas); `dynamics` integrates its Lagrangian equations of motion "
+         "(the [dynamics] section; docs/NUMERICS.md, \"Dynamics\"): a sweep is then "
+         "`dynamics.steps_per_sweep` time steps and `anneal.sweeps` counts them."),
   CHOICE("scene", "page", page, "custom", "custom|a4|a3|letter",
          "Page size: `custom` takes `width` and `height`; a4 is 210 x 297 mm, a3 297 x 420 mm, "
          "letter 215.9 x 279.4 mm (portrait). A named page sets width and height; setting "
@@ -259,6 +264,29 @@ const lw_param_def lw_param_table[] = {
   NUM("output", "field_preview", LW_PT_INT, field_preview, "0", "", 0, 1, 0,
       "1 = write field.png at the start of a run: the tone (white without an image) under "
       "short strokes along the field (needs the field term)."),
+  NUM("plot", "join_distance", LW_PT_DOUBLE, join_distance, "1", "pen widths", 0, 1000, 0,
+      "Strokes of one pen whose ends lie at most this far apart (in widths of the pen: a gap "
+      "the ink closes anyway) and align within `join_angle` become one path, bridged by a short "
+      "curve along both tangents: one pen lift fewer. 0 = no joining."),
+  NUM("plot", "join_angle", LW_PT_DOUBLE, join_angle, "30", "degrees", 0, 180, 0,
+      "Largest turn at a join: between the direction out of the one stroke's end and into the "
+      "other's. 30 degrees reads as one bending line; 180 joins any two ends that are close."),
+  NUM("plot", "crop", LW_PT_INT, crop, "1", "", 0, 1, 0,
+      "1 = cut every path at the edge of the picture's rectangle (without a picture: the page "
+      "inset by scene.margin) and keep the pieces inside, split exactly at the crossing; 0 = "
+      "draw strokes as they lie, margins included."),
+  NUM("plot", "min_length", LW_PT_DOUBLE, min_length, "3", "pen widths", 0, 1e6, 0,
+      "Paths shorter than this (in widths of the pen), after joining and cropping, are left "
+      "out: below about three widths a stroke prints as a dot and costs a whole pen lift. 0 = "
+      "keep all."),
+  NUM("plot", "speed_down", LW_PT_DOUBLE, speed_down, "50", "mm/s", 0, 1e5, LW_MIN_OPEN,
+      "Pen-down speed for the plot time estimate. The default is an AxiDraw's at its default "
+      "settings (speed_pendown 25 % of the 8.6979 in/s high-resolution limit, scaled by 1/110)."),
+  NUM("plot", "speed_up", LW_PT_DOUBLE, speed_up, "150", "mm/s", 0, 1e5, LW_MIN_OPEN,
+      "Pen-up (travel) speed for the plot time estimate; AxiDraw default speed_penup 75 %."),
+  NUM("plot", "lift_time", LW_PT_DOUBLE, lift_time, "0.2", "s", 0, 1e3, 0,
+      "Time of one pen lift and lowering for the plot time estimate; an AxiDraw's servo at its "
+      "default rates (raise 75 %, lower 50 %, over 30 % of a 200 ms sweep) takes about 0.2 s."),
   NUM("particles", "count", LW_PT_INT, pt_count, "100", "", 0, 1e7, 0,
       "Particles placed by `pattern` (after those of `points`, if any)."),
   CHOICE("particles", "pattern", pt_pattern, "plane", "cloud|plane|sphere",
@@ -325,6 +353,28 @@ const lw_param_def lw_param_table[] = {
       "Width and height of final.png."),
   NUM("particles", "disc", LW_PT_DOUBLE, pt_disc, "0.5", "r0", 0, 100, LW_MIN_OPEN,
       "Radius of each particle's disc in final.png."),
+  NUM("dynamics", "rho", LW_PT_DOUBLE, dyn_rho, "1", "mass/mm", 0, 1e12, 0,
+      "Line density rho of the kinetic energy (rho/2) int |dr/dt|^2 dl. 0 = massless: the "
+      "motion is the gradient flow D(x) dx/dt = -grad E of the damping (needs gamma > 0)."),
+  NUM("dynamics", "gamma", LW_PT_DOUBLE, dyn_gamma, "0", "force s/mm^2", 0, 1e12, 0,
+      "Rayleigh damping: a force -gamma dr/dt per mm of line. 0 = none (energy is conserved)."),
+  NUM("dynamics", "dt", LW_PT_DOUBLE, dyn_dt, "0.001", "s", 0, 1e6, LW_MIN_OPEN,
+      "Time step of the integrator (massless: the first step tried; halved where the energy "
+      "would not fall)."),
+  NUM("dynamics", "steps_per_sweep", LW_PT_INT, dyn_steps_per_sweep, "1", "", 1, 1e9, 0,
+      "Time steps per sweep of the run loop (trace, frames and checkpoints count sweeps)."),
+  NUM("dynamics", "gravity_x", LW_PT_DOUBLE, dyn_gravity_x, "0", "mm/s^2", -1e12, 1e12, 0,
+      "x of the gravity g acting on the line density: energy -rho int g.r dl (the load term)."),
+  NUM("dynamics", "gravity_y", LW_PT_DOUBLE, dyn_gravity_y, "0", "mm/s^2", -1e12, 1e12, 0,
+      "y of g (y points down the page: 9810 is the Earth's gravity on a page held upright)."),
+  NUM("dynamics", "force_x", LW_PT_DOUBLE, dyn_force_x, "0", "force/mm", -1e12, 1e12, 0,
+      "x of a constant external force f per mm of line: energy -int f.r dl (the load term)."),
+  NUM("dynamics", "force_y", LW_PT_DOUBLE, dyn_force_y, "0", "force/mm", -1e12, 1e12, 0,
+      "y of the constant external force per mm."),
+  CHOICE("dynamics", "pin", dyn_pin, "none", "none|ends|first|last",
+         "End points held fixed: of both ends of every spline, the first node, the last node."),
+  NUM("dynamics", "pin_vectors", LW_PT_INT, dyn_pin_vectors, "0", "", 0, 1, 0,
+      "1 = a pinned node's vector is held too (a clamped end); 0 = it turns freely."),
 };
 const size_t lw_param_count = sizeof lw_param_table / sizeof lw_param_table[0];
 

@@ -179,6 +179,7 @@ void lw_scene_term_ctx(const lw_scene *sc, lw_term_ctx ctx[LW_TERM_COUNT])
   ctx[LW_TERM_PAIR].quad = &sc->pair_quad;
   ctx[LW_TERM_USER].data = sc->user_data;
   ctx[LW_TERM_USER].fn = sc->user_fn;
+  ctx[LW_TERM_LOAD].data = sc->load;
 }
 
 lw_status lw_scene_set_user_term(lw_scene *sc, double coef, lw_user_term_fn fn, const void *data,
@@ -199,12 +200,15 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
 {
   sc->width = p->width;
   sc->height = p->height;
-  const double coef[LW_TERM_COUNT] = {
+  double coef[LW_TERM_COUNT] = {
     [LW_TERM_STRAIN] = p->strain, [LW_TERM_BENDING] = p->bending,
     [LW_TERM_POTENTIAL] = p->potential_coef, [LW_TERM_FIELD] = p->field_coef,
     [LW_TERM_PAIR] = p->pair, [LW_TERM_BOUNDARY] = p->boundary_coef,
     [LW_TERM_PARAM] = p->parametrisation,
   };
+  sc->load[0] = p->dyn_rho * p->dyn_gravity_x + p->dyn_force_x;
+  sc->load[1] = p->dyn_rho * p->dyn_gravity_y + p->dyn_force_y;
+  coef[LW_TERM_LOAD] = sc->load[0] != 0.0 || sc->load[1] != 0.0;
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     sc->coef[t] = coef[t];
     sc->on[t] = coef[t] != 0.0;

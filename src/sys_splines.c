@@ -13,8 +13,10 @@
 #include "linewise/checkpoint.h"
 #include "linewise/drawing.h"
 #include "linewise/fieldview.h"
+#include "linewise/gradient.h"
 #include "linewise/hilbert.h"
 #include "linewise/init.h"
+#include "linewise/splmass.h"
 
 const char *const lw_move_names[LW_MOVE_KINDS] = {"point", "vector", "translate", "rotate"};
 /* steps are kept in mm and radians; [moves] step_rotate is in degrees */
@@ -30,6 +32,8 @@ typedef struct {
   lw_model *m;
   int owns_model;                /* 0 for a view */
   lw_drawing_report drawing;     /* of the last final drawing */
+  lw_node *grad;                 /* the gradient's scratch, allocated by the first
+                                    gradient() call: none on a Monte Carlo run */
 } spl_state;
 
 static void setup_free(void *setup)
@@ -81,6 +85,7 @@ static void state_free(void *state)
   spl_state *s = state;
   if (!s) return;
   if (s->owns_model) lw_model_free(s->m);
+  free(s->grad);
   free(s);
 }
 
@@ -379,6 +384,55 @@ static void set_terms(void *state, const double *term)
   memcpy(((spl_state *)state)->m->term, term, LW_TERM_COUNT * sizeof *term);
 }
 
+/* The coordinates are the nodes' px py vx vy in node order (lw_node holds
+** exactly those four doubles). */
+static size_t n_coords(const void *state) { return 4 * ((const spl_state *)state)->m->sp->n_nodes; }
+
+static void get_coords(const void *state, double *x)
+{
+  const lw_splines *sp = ((const spl_state *)state)->m->sp;
+  for (size_t k = 0; k < sp->n_nodes; k++) {
+    const lw_node *nd = &sp->node[k];
+    x[4 * k] = nd->px;
+    x[4 * k + 1] = nd->py;
+    x[4 * k + 2] = nd->vx;
+    x[4 * k + 3] = nd->vy;
+  }
+}
+
+/* No NaN enters a state: coordinates that are not finite are refused and
+** the state is left as it was. */
+static lw_status set_coords(void *state, const double *x, lw_error *err)
+{
+  lw_model *m = ((spl_state *)state)->m;
+  lw_splines *sp = m->sp;
+  for (size_t i = 0; i < 4 * sp->n_nodes; i++)
+    if (!isfinite(x[i]))
+      return lw_error_set(err, LW_EINPUT, "coordinate %zu (node %zu) is not finite", i, i / 4);
+  for (size_t k = 0; k < sp->n_nodes; k++) sp->node[k] = (lw_node){x[4 * k], x[4 * k + 1], x[4 * k + 2], x[4 * k + 3]};
+  if (lw_model_refresh(m, NULL) != LW_OK)
+    return lw_error_set(err, LW_ENOMEM, "out of memory refreshing the model of %zu segments", sp->n_segments);
+  return LW_OK;
+}
+
+static double gradient(void *state, double *g, lw_error *err)
+{
+  spl_state *s = state;
+  const lw_splines *sp = s->m->sp;
+  if (!s->grad && !(s->grad = malloc((sp->n_nodes ? sp->n_nodes : 1) * sizeof *s->grad))) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for the gradient of %zu nodes", sp->n_nodes);
+    return NAN;
+  }
+  double e = lw_energy_gradient(s->m->scene, sp, LW_GRAD_ALL, s->grad, NULL, err);
+  for (size_t k = 0; k < sp->n_nodes; k++) {
+    g[4 * k] = s->grad[k].px;
+    g[4 * k + 1] = s->grad[k].py;
+    g[4 * k + 2] = s->grad[k].vx;
+    g[4 * k + 3] = s->grad[k].vy;
+  }
+  return e;
+}
+
 static lw_status draw(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err)
 {
   spl_state *s = state;
@@ -412,12 +466,50 @@ static void describe(const void *state, int what, char *buf, size_t n)
     snprintf(buf, n, "%zu splines, %zu segments", sp->n_splines, sp->n_segments);
     return;
   }
-  int k = snprintf(buf, n, "linewise: %zu paths; pen-up travel %.1f mm in index order, %.1f mm as plotted\n",
-                   d->paths, d->travel_before, d->travel_after);
-  if (d->has_fidelity && k >= 0 && (size_t)k < n)
-    snprintf(buf + k, n - (size_t)k, "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f\n", d->fidelity.sigma_mm,
-             d->fidelity.mse, d->fidelity.ssim);
+  lw_drawing_report_text(d, buf, n);
 }
+
+/* ---- inertia (the dynamics driver) ------------------------------------------ */
+
+/* [dynamics] pin and pin_vectors: which coordinates are held. */
+static void *mass_new(const void *state, const lw_params *p, double density, lw_error *err)
+{
+  const spl_state *s = state;
+  const lw_splines *sp = s->m->sp;
+  unsigned char *pin = calloc(4 * sp->n_nodes + 1, 1);
+  if (!pin) {
+    lw_error_set(err, LW_ENOMEM, "out of memory");
+    return NULL;
+  }
+  for (size_t i = 0; i < sp->n_splines; i++) {
+    size_t ends[2] = {sp->first[i], sp->first[i + 1] - 1};
+    for (int e = 0; e < 2; e++) {
+      int held = p->dyn_pin == LW_PIN_ENDS || (p->dyn_pin == LW_PIN_FIRST && e == 0) ||
+                 (p->dyn_pin == LW_PIN_LAST && e == 1);
+      if (!held) continue;
+      memset(pin + 4 * ends[e], 1, 2);
+      if (p->dyn_pin_vectors) memset(pin + 4 * ends[e] + 2, 1, 2);
+    }
+  }
+  lw_spline_mass *m = lw_spline_mass_new(sp, &s->m->scene->quad, density, pin, err);
+  free(pin);
+  return m;
+}
+
+static void mass_free(void *mass) { lw_spline_mass_free(mass); }
+
+static lw_status mass_at(void *mass, const double *x, lw_error *err) { return lw_spline_mass_at(mass, x, err); }
+
+static void mass_solve(const void *mass, const double *b, double *v) { lw_spline_mass_solve(mass, b, v); }
+
+static void mass_apply(const void *mass, const double *v, double *b) { lw_spline_mass_apply(mass, v, b); }
+
+static void mass_dx(const void *mass, const double *x, const double *v, double *out)
+{
+  lw_spline_mass_dx(mass, x, v, out);
+}
+
+static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinned(mass, i); }
 
 const lw_system_type lw_system_splines = {
     .name = "splines",
@@ -449,6 +541,17 @@ const lw_system_type lw_system_splines = {
     .save = save,
     .load = load,
     .set_terms = set_terms,
+    .n_coords = n_coords,
+    .get_coords = get_coords,
+    .set_coords = set_coords,
+    .gradient = gradient,
+    .mass_new = mass_new,
+    .mass_free = mass_free,
+    .mass_at = mass_at,
+    .mass_solve = mass_solve,
+    .mass_apply = mass_apply,
+    .mass_dx = mass_dx,
+    .mass_pinned = mass_pinned,
     .files = "final.svg, final.png",
     .draw = draw,
     .summary = summary,

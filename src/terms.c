@@ -75,6 +75,13 @@ double lw_term_parametrisation(const lw_samples *s, const lw_quad *q)
   return sum / l;
 }
 
+double lw_term_load(const lw_samples *s, const double b[2])
+{
+  double sum = 0.0;
+  for (int i = 0; i < s->n; i++) sum -= s->dl[i] * (b[0] * s->x[i] + b[1] * s->y[i]);
+  return sum;
+}
+
 static double seg_bending(const lw_samples *s, const lw_term_ctx *c)
 {
   return c->coef * lw_term_bending(s, c->quad);
@@ -105,6 +112,11 @@ static double seg_param(const lw_samples *s, const lw_term_ctx *c)
   return c->coef * lw_term_parametrisation(s, c->quad);
 }
 
+static double seg_load(const lw_samples *s, const lw_term_ctx *c)
+{
+  return c->coef * lw_term_load(s, c->data);
+}
+
 /* The whole spline's length against its rest length, or (mode 1) each
 ** segment's against an equal share of it. */
 static double spline_strain(const double *seg_len, size_t n_seg, double length, double rest_length,
@@ -116,16 +128,151 @@ static double spline_strain(const double *seg_len, size_t n_seg, double length, 
   return e;
 }
 
+/*
+** Gradients (terms.h): each adds coef * dE/d(sample) to g.  The energies
+** above are sums over the nodes of w_q f(r_q, r'_q, r''_q), so each node's
+** partials are those of its own summand.  With s = |r'| the length element
+** w s has d(w s)/dr' = w r' / s; a node with s = 0 has no gradient of s and
+** contributes 0 (a subgradient of |r'|), as it contributes 0 energy to
+** bending and potential.
+*/
+
+/* bending: w c^2 / s^5 with c = x'y'' - x''y' */
+static void grad_bending(const lw_samples *s, const lw_term_ctx *ctx, lw_samples_grad *g)
+{
+  const lw_quad *q = ctx->quad;
+  for (int i = 0; i < s->n; i++) {
+    double sp2 = s->speed[i] * s->speed[i];
+    if (sp2 == 0.0) continue;
+    double c = s->dx[i] * s->ddy[i] - s->ddx[i] * s->dy[i];
+    double inv5 = 1.0 / (sp2 * sp2 * s->speed[i]);
+    double a = ctx->coef * q->w[i] * 2.0 * c * inv5;       /* d/dc */
+    double b = -ctx->coef * q->w[i] * 5.0 * c * c * inv5 / sp2; /* d/d(s^2) times 2 */
+    g->dx[i] += a * s->ddy[i] + b * s->dx[i];
+    g->dy[i] += -a * s->ddx[i] + b * s->dy[i];
+    g->ddx[i] += -a * s->dy[i];
+    g->ddy[i] += a * s->dx[i];
+  }
+}
+
+/* potential: Phi(r) w s */
+static void grad_potential(const lw_samples *s, const lw_term_ctx *ctx, lw_samples_grad *g)
+{
+  const lw_quad *q = ctx->quad;
+  for (int i = 0; i < s->n; i++) {
+    if (s->dl[i] == 0.0) continue;
+    double dphi[2], phi = lw_potential_grad(ctx->data, s->x[i], s->y[i], dphi);
+    double k = ctx->coef * q->w[i];
+    g->x[i] += k * s->speed[i] * dphi[0];
+    g->y[i] += k * s->speed[i] * dphi[1];
+    g->dx[i] += k * phi * s->dx[i] / s->speed[i];
+    g->dy[i] += k * phi * s->dy[i] / s->speed[i];
+  }
+}
+
+/* field: w r'.v(r), or w |r'.v(r)| with the sign of r'.v (0 at r'.v = 0, a
+** subgradient of the kink) */
+static void grad_field(const lw_samples *s, const lw_term_ctx *ctx, lw_samples_grad *g)
+{
+  const lw_quad *q = ctx->quad;
+  for (int i = 0; i < s->n; i++) {
+    double v[2], J[2][2];
+    lw_field_jacobian(ctx->data, s->x[i], s->y[i], v, J);
+    double dot = s->dx[i] * v[0] + s->dy[i] * v[1];
+    double k = ctx->coef * q->w[i];
+    if (ctx->mode) k *= dot > 0.0 ? 1.0 : (dot < 0.0 ? -1.0 : 0.0);
+    g->dx[i] += k * v[0];
+    g->dy[i] += k * v[1];
+    g->x[i] += k * (s->dx[i] * J[0][0] + s->dy[i] * J[1][0]);
+    g->y[i] += k * (s->dx[i] * J[0][1] + s->dy[i] * J[1][1]);
+  }
+}
+
+/* boundary: w s / d(r)^2 inside; +inf states have no gradient (the end
+** points only gate the energy, so their partials are 0) */
+static void grad_boundary(const lw_samples *s, const lw_term_ctx *ctx, lw_samples_grad *g)
+{
+  const lw_quad *q = ctx->quad;
+  for (int i = 0; i < s->n; i++) {
+    double dd[2], d = lw_boundary_distance_grad(ctx->data, s->x[i], s->y[i], dd);
+    if (!(d < 0.0)) return;
+    double k = ctx->coef * q->w[i] / (d * d);
+    g->x[i] += -2.0 * k * s->speed[i] / d * dd[0];
+    g->y[i] += -2.0 * k * s->speed[i] / d * dd[1];
+    if (s->speed[i] > 0.0) {
+      g->dx[i] += k * s->dx[i] / s->speed[i];
+      g->dy[i] += k * s->dy[i] / s->speed[i];
+    }
+  }
+}
+
+/* parametrisation: D / l with D = sum w (s - l)^2, l = sum w s; with
+** sum w = 1, dD/ds_k = 2 w_k (s_k - l) (the l-derivative 2 sum w (s - l)
+** vanishes), so dE/ds_k = 2 w_k (s_k - l) / l - D w_k / l^2 */
+static void grad_param(const lw_samples *s, const lw_term_ctx *ctx, lw_samples_grad *g)
+{
+  const lw_quad *q = ctx->quad;
+  const double l = s->length;
+  if (!(l > 0.0)) return;
+  double D = 0.0;
+  for (int i = 0; i < s->n; i++) {
+    double d = s->speed[i] - l;
+    D += q->w[i] * d * d;
+  }
+  for (int i = 0; i < s->n; i++) {
+    if (!(s->speed[i] > 0.0)) continue;
+    double dEds = ctx->coef * q->w[i] * (2.0 * (s->speed[i] - l) / l - D / (l * l));
+    g->dx[i] += dEds * s->dx[i] / s->speed[i];
+    g->dy[i] += dEds * s->dy[i] / s->speed[i];
+  }
+}
+
+/* d/dL of (L - L0)^2 / L0^2 * L */
+static double strain_slope(double length, double rest_length)
+{
+  double x = length - rest_length;
+  return (2.0 * x * length + x * x) / (rest_length * rest_length);
+}
+
+static void grad_strain(const double *seg_len, size_t n_seg, double length, double rest_length,
+                        const lw_term_ctx *c, double *dlen)
+{
+  if (!c->mode) {
+    double k = c->coef * strain_slope(length, rest_length);
+    for (size_t m = 0; m < n_seg; m++) dlen[m] += k;
+    return;
+  }
+  double l0 = rest_length / (double)n_seg;
+  for (size_t m = 0; m < n_seg; m++) dlen[m] += c->coef * strain_slope(seg_len[m], l0);
+}
+
+/* load: -w s b.r */
+static void grad_load(const lw_samples *s, const lw_term_ctx *ctx, lw_samples_grad *g)
+{
+  const double *b = ctx->data;
+  for (int i = 0; i < s->n; i++) {
+    double k = -ctx->coef * ctx->quad->w[i];
+    g->x[i] += k * s->speed[i] * b[0];
+    g->y[i] += k * s->speed[i] * b[1];
+    if (s->speed[i] == 0.0) continue;
+    double f = k * (b[0] * s->x[i] + b[1] * s->y[i]) / s->speed[i];
+    g->dx[i] += f * s->dx[i];
+    g->dy[i] += f * s->dy[i];
+  }
+}
+
 const char *const lw_term_names[LW_TERM_COUNT] = {"strain", "bending", "potential", "field",
-                                                  "pair", "boundary", "user", "parametrisation"};
+                                                  "pair", "boundary", "user", "parametrisation",
+                                                  "load"};
 
 const lw_term_type lw_term_types[LW_TERM_COUNT] = {
-  {LW_TERM_STRAIN, .spline = spline_strain},
-  {LW_TERM_BENDING, .segment = seg_bending},
-  {LW_TERM_POTENTIAL, .segment = seg_potential},
-  {LW_TERM_FIELD, .segment = seg_field},
-  {LW_TERM_PAIR, .pairwise = 1},
-  {LW_TERM_BOUNDARY, .segment = seg_boundary},
-  {LW_TERM_USER, .segment = seg_user},
-  {LW_TERM_PARAM, .segment = seg_param},
+  {LW_TERM_STRAIN, .spline = spline_strain, .spline_grad = grad_strain},
+  {LW_TERM_BENDING, .segment = seg_bending, .segment_grad = grad_bending},
+  {LW_TERM_POTENTIAL, .segment = seg_potential, .segment_grad = grad_potential},
+  {LW_TERM_FIELD, .segment = seg_field, .segment_grad = grad_field},
+  {LW_TERM_PAIR, .pairwise = 1}, /* lw_pair_gradient (gradient.h) */
+  {LW_TERM_BOUNDARY, .segment = seg_boundary, .segment_grad = grad_boundary},
+  {LW_TERM_USER, .segment = seg_user}, /* no gradient: the caller's function is opaque */
+  {LW_TERM_PARAM, .segment = seg_param, .segment_grad = grad_param},
+  {LW_TERM_LOAD, .segment = seg_load, .segment_grad = grad_load},
 };

@@ -24,6 +24,7 @@
 
 #include <stdio.h>
 
+#include "linewise/dynamics.h"
 #include "linewise/mc.h"
 #include "linewise/params.h"
 #include "linewise/schedule.h"
@@ -40,6 +41,7 @@ typedef struct {
   lw_system **systems;         /* by replica (owned) */
   lw_chain **chains;           /* by rung (owned): each has its stream, steps, statistics */
   lw_tempering *pt;            /* NULL without tempering */
+  lw_dynamics *dyn;            /* [scene] driver = dynamics: moves the system instead of the chain; else NULL */
   double t_sched;              /* the schedule's temperature of this step */
   unsigned long swap_mark[2 * LW_TEMPERING_MAX]; /* tried, accepted per pair at the last trace row */
   const lw_schedule_type *sched_type;

@@ -45,6 +45,13 @@ void lw_boundary_clear(lw_boundary *b);
 
 double lw_boundary_distance(const lw_boundary *b, double x, double y);
 
+/* d(x, y) as lw_boundary_distance gives it, and its gradient g (the
+** boundary term's derivative, gradient.h): the unit vector away from the
+** nearest boundary point (rect, circle, polygon), the bilinear gradient of
+** the mask's grid; 0 where d has no gradient (the medial axis of a rect
+** takes one side, a circle's centre gives 0) and for LW_BOUNDARY_NONE. */
+double lw_boundary_distance_grad(const lw_boundary *b, double x, double y, double g[2]);
+
 /* Is (x, y) strictly inside? (d < 0) */
 int lw_boundary_inside(const lw_boundary *b, double x, double y);
 

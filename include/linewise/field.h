@@ -92,6 +92,17 @@ typedef struct {
 double lw_potential_eval(const lw_potential *f, double x, double y);
 void lw_field_eval(const lw_field *f, double x, double y, double *vx, double *vy);
 
+/* Derivatives (the gradient of the energy, gradient.h): the same values as
+** the _eval functions and the derivatives of exactly those functions --
+** bilinear within a cell, 0 across a clamped edge, one-sided on a cell
+** line; 0 where a preset sets its value to 0 (a centre).
+** lw_grid2d_eval_grad: out[c] and its partials dx[c], dy[c].
+** lw_potential_grad: Phi, and g = (dPhi/dx, dPhi/dy).
+** lw_field_jacobian: v, and J[i][j] = dv_i / dx_j. */
+void lw_grid2d_eval_grad(const lw_grid2d *g, double x, double y, double *out, double *dx, double *dy);
+double lw_potential_grad(const lw_potential *f, double x, double y, double g[2]);
+void lw_field_jacobian(const lw_field *f, double x, double y, double v[2], double J[2][2]);
+
 /* Free the grid a field owns (if any) and reset it; the struct itself is the
 ** caller's. */
 void lw_potential_clear(lw_potential *f);

@@ -27,16 +27,8 @@
 #include "linewise/scene.h"
 #include "linewise/spline.h"
 
-/* dE/d(sample values) of one segment: per quadrature node the partials with
-** respect to r = (x, y), r' = (dx, dy) and r'' = (ddx, ddy), and the
-** partials with respect to the two end points r(0), r(1). */
-typedef struct {
-  int n;
-  double x[LW_QUAD_MAX], y[LW_QUAD_MAX];
-  double dx[LW_QUAD_MAX], dy[LW_QUAD_MAX];
-  double ddx[LW_QUAD_MAX], ddy[LW_QUAD_MAX];
-  double end_x[2], end_y[2];
-} lw_samples_grad;
+/* lw_samples_grad, dE/d(sample values) of one segment, is declared in
+** terms.h beside the term rows that fill it. */
 
 /* Sets every partial of g to 0 for n nodes. */
 void lw_samples_grad_zero(lw_samples_grad *g, int n);

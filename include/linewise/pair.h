@@ -69,4 +69,10 @@ void lw_pair_ctx_init(lw_pair_ctx *ctx, double cutoff, double near);
 double lw_pair_segseg(const double a0[2], const double a1[2],
                       const double b0[2], const double b1[2]);
 
+/* The potential of the segment (0,0)-(L,0) at (x, y): the integral of
+** 1/|p - q| over it, log((r0 + r1 + L) / (r0 + r1 - L)), written without
+** cancellation; +inf on the segment.  What lw_pair_segseg integrates far
+** segments with, and its derivative's tangential part (pairgrad.c). */
+double lw_pair_seg_potential(double L, double x, double y);
+
 #endif

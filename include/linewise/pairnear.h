@@ -44,4 +44,27 @@ double lw_pair_segments_exact(const double a[8], const double b[8], double cutof
 double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, const double b[8],
                                const lw_pair_sample *sb, int n, const lw_pair_ctx *ctx);
 
+/* ---- for the gradient (pairgrad.c) ----------------------------------------
+** The derivative of lw_pair_segments_exact follows its computation step by
+** step, so it sees the same thresholds and rules. */
+typedef struct {
+  double sep_lo, sep_hi;       /* pieces apart: 6 x 6 rule from sep_hi larger radii on */
+  double apart_lo, apart_hi;   /* segments apart: 16 x 16 rule (distance / half size) */
+  double leaf_ratio, flat_ratio;
+  double sine_lo, sine_hi;     /* subtraction where the tangents meet at this sine */
+  double close_lo, close_hi;   /* ... or the curves are this far apart */
+  int stack_max;
+  const double *g6_s, *g6_w;   /* Gauss-Legendre on [0, 1] */
+  int g6_n;
+  const double *g16_s, *g16_w;
+  int g16_n;
+} lw_pairnear_consts;
+
+extern const lw_pairnear_consts lw_pairnear_k;
+
+/* 1 if a comes before b in the lexicographic order of the control points:
+** the order lw_pair_near_correction takes a pair in, so that its value is
+** bitwise symmetric. */
+int lw_pair_bezier_before(const double a[8], const double b[8]);
+
 #endif

@@ -17,7 +17,7 @@
 #include "linewise/error.h"
 
 #define LW_PATH_MAX 1024
-#define LW_PARAM_MAX 128 /* capacity of lw_params.line; the table is checked against it */
+#define LW_PARAM_MAX 256 /* capacity of lw_params.line; the table is checked against it */
 
 typedef enum { LW_PT_DOUBLE, LW_PT_INT, LW_PT_CHOICE, LW_PT_STRING } lw_param_type;
 
@@ -55,6 +55,8 @@ enum { LW_LADDER_FIXED, LW_LADDER_EQUAL };
 enum { LW_PPATTERN_CLOUD, LW_PPATTERN_PLANE, LW_PPATTERN_SPHERE };
 enum { LW_PWEIGHT_POLY, LW_PWEIGHT_GAUSS, LW_PWEIGHT_ANISO };
 enum { LW_PBOUNDARY_NONE, LW_PBOUNDARY_PLANE, LW_PBOUNDARY_SPHERE };
+enum { LW_DRIVER_METROPOLIS, LW_DRIVER_DYNAMICS };
+enum { LW_PIN_NONE, LW_PIN_ENDS, LW_PIN_FIRST, LW_PIN_LAST };
 
 typedef struct {
   /* [scene] */
@@ -85,6 +87,7 @@ typedef struct {
   double center_x, center_y;  /* centre of radial/vortex presets, mm; -1 = page centre */
   int mask;                   /* LW_MASK_* */
   char mask_image[LW_PATH_MAX]; /* picture of mask = image */
+  int driver;                 /* LW_DRIVER_* */
   /* [init] */
   int splines;                /* number of splines; 0 with coverage > 0: from the coverage */
   double coverage;            /* target ink coverage (fraction of the inside) */
@@ -139,6 +142,13 @@ typedef struct {
   int frames_every;           /* sweeps between frames; 0 = none */
   double fidelity_sigma;      /* blur before the fidelity score, mm */
   int field_preview;          /* 1 = write field.png */
+  /* [plot] (strokes.h) */
+  double join_distance;       /* pen widths; 0 = no joining */
+  double join_angle;          /* degrees */
+  int crop;                   /* 1 = crop to the picture's rectangle */
+  double min_length;          /* pen widths; 0 = keep all */
+  double speed_down, speed_up; /* plot time estimate, mm/s */
+  double lift_time;           /* s per pen lift */
   /* [particles] (system = particles; particles.h) */
   int pt_count;               /* particles placed by the pattern */
   int pt_pattern;             /* LW_PPATTERN_* */
@@ -162,6 +172,15 @@ typedef struct {
   double pt_view_elevation;   /* degrees */
   int pt_png_size;            /* preview pixels per side */
   double pt_disc;             /* preview disc radius, units of r0 */
+  /* [dynamics] (driver = dynamics; dynamics.h) */
+  double dyn_rho;             /* line density, mass per mm; 0 = massless (gradient flow) */
+  double dyn_gamma;           /* Rayleigh damping, force per (mm/s) per mm */
+  double dyn_dt;              /* time step, s */
+  double dyn_gravity_x, dyn_gravity_y; /* g, mm/s^2 (y down the page) */
+  double dyn_force_x, dyn_force_y;     /* constant force per mm of line */
+  int dyn_pin;                /* LW_PIN_*: which end nodes are held */
+  int dyn_pin_vectors;        /* 1 = a pinned node's vector is held too */
+  int dyn_steps_per_sweep;    /* time steps per sweep of the run loop */
 
   /* Where each value came from: the file and line (0 = default, -1 = --set). */
   char file[LW_PATH_MAX];

@@ -49,6 +49,7 @@ typedef struct lw_scene {
   lw_boundary boundary;         /* the frame (also used for placement) */
   lw_user_term_fn user_fn;      /* valid when on[LW_TERM_USER] */
   const void *user_data;        /* passed to user_fn; not owned */
+  double load[2];               /* b of the load term: rho g + f, force per mm */
   int n_local;                  /* per-segment terms that are on ... */
   lw_term_id local[LW_TERM_COUNT]; /* ... and which */
   lw_image *image;              /* the processed picture (owned), or NULL */

@@ -156,6 +156,20 @@ struct lw_system_type {
   void (*get_coords)(const void *state, double *x);
   lw_status (*set_coords)(void *state, const double *x, lw_error *err);
   double (*gradient)(void *state, double *g, lw_error *err);
+  /* Inertia (the dynamics driver, dynamics.h): the mass matrix M(x) of the
+  ** kinetic energy T = 1/2 xdot' M(x) xdot for a density (mass per unit
+  ** of the system's measure), with the coordinates the scene pins held:
+  ** mass_at assembles and factors it at x, mass_solve gives v = M^-1 b (0 at
+  ** held coordinates), mass_apply b = M v, mass_dx d/dx (1/2 v' M(x) v) at
+  ** fixed v, mass_pinned 1 at a held coordinate.  NULL when the system has
+  ** no inertia. */
+  void *(*mass_new)(const void *state, const lw_params *p, double density, lw_error *err);
+  void (*mass_free)(void *mass);
+  lw_status (*mass_at)(void *mass, const double *x, lw_error *err);
+  void (*mass_solve)(const void *mass, const double *b, double *v);
+  void (*mass_apply)(const void *mass, const double *v, double *b);
+  void (*mass_dx)(const void *mass, const double *x, const double *v, double *out);
+  int (*mass_pinned)(const void *mass, size_t i);
 
   const char *files;
   lw_status (*draw)(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err);

@@ -20,6 +20,9 @@
 **             segment's length = its mean speed): 0 for uniform speed, so it
 **             holds the handle lengths that do not change the shape
 **             (docs/NUMERICS.md); 0 for a segment of no length
+**   load      -int b . r |r'| ds, b = rho g + f: gravity on the line density
+**             and a constant force per mm ([dynamics] gravity_x/_y, force_x/_y;
+**             on when b != 0, coefficient 1); data is b (2 doubles)
 **
 ** The term table's order is the order of trace.csv's and state.lw's energy
 ** columns; a new term goes at the end so older state files still read.
@@ -42,6 +45,15 @@
 **             kernel's cutoff; ctx.data is the lw_pair_ctx, ctx.quad the
 **             pair samples' nodes.  One pairwise term at most is on (the
 **             grid has one cutoff): pair.
+**
+** Gradients (gradient.h): a segment row's segment_grad ADDS the partials
+** of its energy (coefficient applied) with respect to the samples r, r',
+** r'' and the end points to an lw_samples_grad; a spline row's spline_grad
+** ADDS coef * dE/d(segment length) of one spline to dlen[0..n_seg-1] (a
+** segment's length is sum_q w_q |r'_q|, so it reaches r' only).  Where an
+** energy is not differentiable the gradient is a one-sided value or a
+** subgradient (docs/NUMERICS.md, "Gradients"): the axial field uses the
+** sign of r'.v, |r'| = 0 contributes 0.  The user term has none (NULL).
 **
 ** Degenerate samples never produce NaN: a sample with r' = 0 contributes 0 to
 ** bending (r' = 0 forces the numerator to 0 as well; the curvature of a point
@@ -66,6 +78,7 @@ typedef enum {
   LW_TERM_BOUNDARY,
   LW_TERM_USER,
   LW_TERM_PARAM,
+  LW_TERM_LOAD,
   LW_TERM_COUNT
 } lw_term_id;
 
@@ -73,6 +86,17 @@ typedef enum {
 ** applied).  It must be a pure function of its arguments, like the built-in
 ** terms: replicas call it from several threads at once.  +infinity forbids a
 ** state; it should never return NaN (a NaN dE is rejected and counted). */
+/* dE/d(sample values) of one segment: per quadrature node the partials with
+** respect to r = (x, y), r' = (dx, dy) and r'' = (ddx, ddy), and the
+** partials with respect to the two end points r(0), r(1) (gradient.h). */
+typedef struct lw_samples_grad {
+  int n;
+  double x[LW_QUAD_MAX], y[LW_QUAD_MAX];
+  double dx[LW_QUAD_MAX], dy[LW_QUAD_MAX];
+  double ddx[LW_QUAD_MAX], ddy[LW_QUAD_MAX];
+  double end_x[2], end_y[2];
+} lw_samples_grad;
+
 typedef double (*lw_user_term_fn)(const lw_samples *s, const lw_quad *q, const void *data);
 
 /* What one term reads.  Pointers are into the scene, which outlives every
@@ -94,6 +118,9 @@ typedef struct {
   double (*segment)(const lw_samples *s, const lw_term_ctx *c);
   double (*spline)(const double *seg_len, size_t n_seg, double length, double rest_length, const lw_term_ctx *c);
   int pairwise;
+  void (*segment_grad)(const lw_samples *s, const lw_term_ctx *c, lw_samples_grad *g);
+  void (*spline_grad)(const double *seg_len, size_t n_seg, double length, double rest_length, const lw_term_ctx *c,
+                      double *dlen);
 } lw_term_type;
 
 extern const lw_term_type lw_term_types[LW_TERM_COUNT];
@@ -106,5 +133,6 @@ double lw_term_potential(const lw_samples *s, const lw_quad *q, const lw_potenti
 double lw_term_field(const lw_samples *s, const lw_quad *q, const lw_field *f, int axial);
 double lw_term_boundary(const lw_samples *s, const lw_quad *q, const lw_boundary *b);
 double lw_term_parametrisation(const lw_samples *s, const lw_quad *q);
+double lw_term_load(const lw_samples *s, const double b[2]);
 
 #endif

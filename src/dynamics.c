@@ -1,0 +1,241 @@
+/* dynamics.c -- the Lagrangian driver (dynamics.h). */
+#include "linewise/dynamics.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A fixed point has converged when an iteration changes no coordinate by
+** more than this relative to the largest: a few ulps above rounding. */
+#define FIXED_TOL 1e-13
+#define FIXED_MAX 200
+/* Massless steps: the Armijo fraction and the most halvings of a step. */
+#define ARMIJO 1e-4
+#define HALVINGS_MAX 60
+
+static double max_abs(const double *a, size_t n)
+{
+  double m = 0.0;
+  for (size_t i = 0; i < n; i++)
+    if (fabs(a[i]) > m) m = fabs(a[i]);
+  return m;
+}
+
+/* max |a - b| <= FIXED_TOL max |a| (never for a value that is not finite) */
+static int converged(const double *a, const double *b, size_t n)
+{
+  double d = 0.0;
+  for (size_t i = 0; i < n; i++) {
+    if (!isfinite(a[i])) return 0;
+    if (fabs(a[i] - b[i]) > d) d = fabs(a[i] - b[i]);
+  }
+  return d <= FIXED_TOL * max_abs(a, n);
+}
+
+void lw_dynamics_free(lw_dynamics *d)
+{
+  if (!d) return;
+  if (d->mass) d->type->mass_free(d->mass);
+  free(d->x);
+  free(d->pi);
+  free(d->g);
+  free(d->v);
+  free(d->tx);
+  free(d->x1);
+  free(d->pi1);
+  free(d->u);
+  free(d);
+}
+
+/* Moves the system to x, and takes E and its gradient there.  Where two
+** curves touch exactly the pair term's slope is infinite (pairgrad.h): a
+** gradient that is not finite in an allowed state stops the motion with
+** that reason rather than spreading NaN through the momenta. */
+static lw_status evaluate(lw_dynamics *d, const double *x, lw_error *err)
+{
+  lw_status s = d->type->set_coords(d->state, x, err);
+  if (s) return s;
+  d->energy = d->type->gradient(d->state, d->g, err);
+  if (isnan(d->energy)) return err->code ? err->code : lw_error_set(err, LW_EINPUT, "the energy is not a number");
+  if (isfinite(d->energy))
+    for (size_t i = 0; i < d->n; i++)
+      if (!isfinite(d->g[i]))
+        return lw_error_set(err, LW_EINPUT, "the force on coordinate %zu is not finite at t = %g s (two lines "
+                            "touch?): lower dynamics.dt or raise the pair term's near field", i, d->time);
+  return LW_OK;
+}
+
+lw_status lw_dynamics_sync(lw_dynamics *d, lw_error *err)
+{
+  d->type->get_coords(d->state, d->x);
+  lw_status s = evaluate(d, d->x, err);
+  if (s) return s;
+  if (!isfinite(d->energy))
+    return lw_error_set(err, LW_EINPUT, "the dynamics starts in a forbidden state (a segment irregular or outside "
+                        "the boundary)");
+  return d->type->mass_at(d->mass, d->x, err);
+}
+
+lw_dynamics *lw_dynamics_new(const lw_system_type *t, void *state, const lw_params *p, lw_error *err)
+{
+  char where[LW_PATH_MAX + 32];
+  if (!t->mass_new || !t->gradient) {
+    lw_params_origin(p, lw_params_find("scene", "driver"), where, sizeof where);
+    lw_error_set(err, LW_EINPUT, "%s: key 'scene.driver': the system '%s' has no equations of motion (no mass "
+                 "matrix or gradient); use driver = metropolis", where, t->name);
+    return NULL;
+  }
+  if (p->dyn_rho == 0.0 && p->dyn_gamma == 0.0) {
+    lw_params_origin(p, lw_params_find("dynamics", "gamma"), where, sizeof where);
+    lw_error_set(err, LW_EINPUT, "%s: key 'dynamics.gamma': a massless motion (rho = 0) is the gradient flow of "
+                 "the damping, so gamma must be > 0", where);
+    return NULL;
+  }
+  lw_dynamics *d = calloc(1, sizeof *d);
+  if (!d) {
+    lw_error_set(err, LW_ENOMEM, "out of memory");
+    return NULL;
+  }
+  d->type = t;
+  d->state = state;
+  d->n = t->n_coords(state);
+  d->rho = p->dyn_rho;
+  d->gamma = p->dyn_gamma;
+  d->dt = p->dyn_dt;
+  double **arrays[] = {&d->x, &d->pi, &d->g, &d->v, &d->tx, &d->x1, &d->pi1, &d->u};
+  for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)
+    if (!(*arrays[k] = calloc(d->n + 1, sizeof(double)))) {
+      lw_dynamics_free(d);
+      lw_error_set(err, LW_ENOMEM, "out of memory for the dynamics of %zu coordinates", d->n);
+      return NULL;
+    }
+  /* massless: the matrix of the flow is the damping's, gamma per unit density */
+  d->mass = t->mass_new(state, p, d->rho > 0.0 ? d->rho : d->gamma, err);
+  if (!d->mass || lw_dynamics_sync(d, err)) {
+    lw_dynamics_free(d);
+    return NULL;
+  }
+  return d;
+}
+
+double lw_dynamics_kinetic(lw_dynamics *d)
+{
+  if (d->rho == 0.0) return 0.0;
+  d->type->mass_solve(d->mass, d->pi, d->v);
+  double t = 0.0;
+  for (size_t i = 0; i < d->n; i++) t += d->pi[i] * d->v[i];
+  return 0.5 * t;
+}
+
+void lw_dynamics_set_velocity(lw_dynamics *d, const double *xdot)
+{
+  d->type->mass_apply(d->mass, xdot, d->pi);
+  for (size_t i = 0; i < d->n; i++)
+    if (d->type->mass_pinned(d->mass, i)) d->pi[i] = 0.0;
+}
+
+/* out = dH/dx(x, pi) = grad E - dT/dx(x, M(x)^-1 pi), with g = grad E(x) and
+** the mass matrix factored at x. */
+static void dh_dx(lw_dynamics *d, const double *x, const double *pi, double *out)
+{
+  d->type->mass_solve(d->mass, pi, d->v);
+  d->type->mass_dx(d->mass, x, d->v, d->tx);
+  for (size_t i = 0; i < d->n; i++) out[i] = d->g[i] - d->tx[i];
+}
+
+static lw_status not_converged(const lw_dynamics *d, const char *what, lw_error *err)
+{
+  return lw_error_set(err, LW_EINPUT, "the dynamics' %s did not converge at t = %g s (step %lu): lower dynamics.dt "
+                      "(now %g s)", what, d->time, d->steps, d->dt);
+}
+
+static void damp(lw_dynamics *d, double h)
+{
+  if (d->gamma == 0.0) return;
+  double f = exp(-d->gamma / d->rho * h);
+  for (size_t i = 0; i < d->n; i++) d->pi[i] *= f;
+}
+
+static lw_status leapfrog(lw_dynamics *d, lw_error *err)
+{
+  const lw_system_type *t = d->type;
+  size_t n = d->n;
+  double h = d->dt, *pih = d->pi1, *x1 = d->x1;
+  lw_status s;
+  damp(d, 0.5 * h);
+  /* pi+ = pi - h/2 dH/dx(x, pi+), M factored at x */
+  memcpy(pih, d->pi, n * sizeof *pih);
+  int it = 0;
+  for (;;) {
+    dh_dx(d, d->x, pih, d->u);
+    for (size_t i = 0; i < n; i++) d->u[i] = d->pi[i] - 0.5 * h * d->u[i];
+    int done = converged(d->u, pih, n);
+    memcpy(pih, d->u, n * sizeof *pih);
+    if (done) break;
+    if (++it == FIXED_MAX) return not_converged(d, "momentum half step", err);
+  }
+  if (it > d->iterations_max) d->iterations_max = it;
+  /* x' = x + h/2 (M(x)^-1 + M(x')^-1) pi+ */
+  double *u0 = d->u;
+  t->mass_solve(d->mass, pih, u0);
+  for (size_t i = 0; i < n; i++) x1[i] = d->x[i] + h * u0[i];
+  for (it = 0;;) {
+    if ((s = t->mass_at(d->mass, x1, err))) return s;
+    t->mass_solve(d->mass, pih, d->v);
+    for (size_t i = 0; i < n; i++) d->tx[i] = d->x[i] + 0.5 * h * (u0[i] + d->v[i]);
+    int done = converged(d->tx, x1, n);
+    memcpy(x1, d->tx, n * sizeof *x1);
+    if (done) break;
+    if (++it == FIXED_MAX) return not_converged(d, "position step", err);
+  }
+  if (it > d->iterations_max) d->iterations_max = it;
+  if ((s = t->mass_at(d->mass, x1, err)) || (s = evaluate(d, x1, err))) return s;
+  if (!isfinite(d->energy))
+    return lw_error_set(err, LW_EINPUT, "the motion reached a forbidden state at t = %g s (energy %g: a segment "
+                        "irregular or outside the boundary): lower dynamics.dt (now %g s)", d->time + h, d->energy, h);
+  memcpy(d->x, x1, n * sizeof *x1);
+  /* pi' = pi+ - h/2 dH/dx(x', pi+) */
+  dh_dx(d, d->x, pih, d->u);
+  for (size_t i = 0; i < n; i++) d->pi[i] = t->mass_pinned(d->mass, i) ? 0.0 : pih[i] - 0.5 * h * d->u[i];
+  damp(d, 0.5 * h);
+  d->time += h;
+  return LW_OK;
+}
+
+/* One Armijo-limited Euler step of the gradient flow; M (the damping
+** matrix) is factored at x on entry and on exit. */
+static lw_status flow(lw_dynamics *d, lw_error *err)
+{
+  const lw_system_type *t = d->type;
+  size_t n = d->n;
+  double *dir = d->u, e0 = d->energy, slope = 0.0;
+  t->mass_solve(d->mass, d->g, dir);
+  for (size_t i = 0; i < n; i++) {
+    dir[i] = -dir[i];
+    slope += d->g[i] * dir[i];
+  }
+  memcpy(d->pi1, d->g, n * sizeof *d->g); /* grad E at x, should every trial fail */
+  double h = d->dt;
+  lw_status s;
+  for (int k = 0; k <= HALVINGS_MAX; k++, h *= 0.5) {
+    for (size_t i = 0; i < n; i++) d->x1[i] = d->x[i] + h * dir[i];
+    if ((s = evaluate(d, d->x1, err))) return s;
+    if (d->energy <= e0 + ARMIJO * h * slope) {
+      memcpy(d->x, d->x1, n * sizeof *d->x);
+      d->time += h;
+      return t->mass_at(d->mass, d->x, err);
+    }
+    d->halvings++;
+  }
+  /* at a minimum to rounding: stay */
+  memcpy(d->g, d->pi1, n * sizeof *d->g);
+  d->energy = e0;
+  return t->set_coords(d->state, d->x, err);
+}
+
+lw_status lw_dynamics_step(lw_dynamics *d, lw_error *err)
+{
+  lw_status s = d->rho > 0.0 ? leapfrog(d, err) : flow(d, err);
+  if (!s) d->steps++;
+  return s;
+}

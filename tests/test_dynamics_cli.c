@@ -1,0 +1,109 @@
+/*
+** test_dynamics_cli.c -- the dynamics driver from the command line: the
+** bundled examples, bit-exact resume, the run directory, bad input.
+*/
+#include <criterion/criterion.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "testutil.h"
+
+static char dir[64];
+
+static void make_dir(void) { cr_assert_eq(lw_test_dir_make(dir, "dcli"), 0); }
+static void remove_dir(void) { cr_assert_eq(lw_test_dir_remove(dir), 0); }
+
+TestSuite(dynamics_cli, .init = make_dir, .fini = remove_dir);
+
+#define sh lw_test_sh
+
+static const char *bin(void)
+{
+  const char *b = getenv("LW_BIN");
+  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
+  return b;
+}
+
+static const char *root(void)
+{
+  const char *r = getenv("LW_ROOT");
+  cr_assert_not_null(r);
+  return r;
+}
+
+Test(dynamics_cli, the_hanging_lines_settle_and_resume_gives_the_same_bytes)
+{
+  /* 60 sweeps of 20 steps: 12 s of motion, checkpoints inside */
+  const char *set = "--set anneal.sweeps=60 --set output.checkpoint_every=7 --set output.frames_every=0";
+  cr_assert_eq(sh("%s run %s/params/hanging.ini --out %s/a --quiet %s", bin(), root(), dir, set), 0);
+  cr_assert_eq(sh("%s run %s/params/hanging.ini --out %s/b --quiet %s --stop-at 23", bin(), root(), dir, set), 0);
+  cr_assert_eq(sh("%s resume %s/b --quiet --stop-at 41", bin(), dir), 0);
+  cr_assert_eq(sh("%s resume %s/b --quiet", bin(), dir), 0);
+  const char *same[] = {"state.lw", "trace.csv", "final.svg"};
+  for (int k = 0; k < 3; k++)
+    cr_assert_eq(sh("cmp -s %s/a/%s %s/b/%s", dir, same[k], dir, same[k]), 0, "%s differs after a resume", same[k]);
+  /* the trace has the clock and the energies, and the motion dies down */
+  cr_assert_eq(sh("head -1 %s/a/trace.csv | grep -q '^sweep,time,strain,bending,parametrisation,load,potential,"
+                  "kinetic,total$'", dir), 0);
+  char path[160];
+  snprintf(path, sizeof path, "%s/a/trace.csv", dir);
+  FILE *f = fopen(path, "r");
+  cr_assert_not_null(f);
+  char line[512];
+  double first_k = -1, last_k = -1, first_h = 0, last_h = 0, t = 0;
+  cr_assert_not_null(fgets(line, sizeof line, f));
+  while (fgets(line, sizeof line, f)) {
+    double v[10];
+    long sweep;
+    cr_assert_eq(sscanf(line, "%ld,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &sweep, &t, &v[0], &v[1], &v[2], &v[3], &v[4],
+                        &v[5], &v[6]), 9, "%s", line);
+    cr_assert(fabs(v[4] - (v[0] + v[1] + v[2] + v[3])) <= 1e-9 * fabs(v[4]), "potential is the terms' sum: %s", line);
+    cr_assert(fabs(v[6] - (v[4] + v[5])) <= 1e-9 * fabs(v[6]), "total = potential + kinetic: %s", line);
+    if (first_k < 0) {
+      first_k = v[5];
+      first_h = v[6];
+    }
+    last_k = v[5];
+    last_h = v[6];
+  }
+  fclose(f);
+  cr_assert(fabs(t - 12.0) < 1e-9, "60 sweeps of 20 steps of 0.01 s end at %g s", t);
+  cr_assert_lt(last_k, 1e-3 * first_k, "damping: kinetic %g at the end, %g after the first sweep", last_k, first_k);
+  cr_assert_lt(last_h, first_h, "damping removes energy");
+  cr_assert_eq(sh("grep -q '\"driver\": \"dynamics\"' %s/a/summary.json && grep -q '\"time_steps\": 1200' "
+                  "%s/a/summary.json", dir, dir), 0);
+  /* the momenta travel in state.lw */
+  cr_assert_eq(sh("grep -q '^\\[dynamics\\]$' %s/a/state.lw && grep -c '^momentum = ' %s/a/state.lw | grep -q '^102$'",
+                  dir, dir), 0);
+}
+
+Test(dynamics_cli, the_whip_writes_frames)
+{
+  cr_assert_eq(sh("%s run %s/params/whip.ini --out %s/w --quiet --set anneal.sweeps=10", bin(), root(), dir), 0);
+  cr_assert_eq(sh("test -s %s/w/frames/frame-000010.png && test -s %s/w/final.png", dir, dir), 0);
+}
+
+Test(dynamics_cli, scenes_the_driver_cannot_move_are_refused_with_the_key)
+{
+  struct {
+    const char *set, *want;
+  } bad[] = {
+    {"--set dynamics.rho=0 --set dynamics.gamma=0", "key 'dynamics.gamma': a massless motion"},
+    {"--set tempering.replicas=3", "key 'scene.driver': the dynamics moves one system"},
+    {"--set energy.quadrature=3", "at least 4 quadrature nodes"},
+    {"--set dynamics.dt=0", "dynamics.dt"},
+    {"--set dynamics.pin=both", "dynamics.pin"},
+  };
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+    cr_assert_eq(sh("%s run %s/params/hanging.ini --out %s/x%zu --quiet %s 2>%s/err.txt", bin(), root(), dir, k,
+                    bad[k].set, dir), 2, "case %zu", k);
+    cr_assert_eq(sh("grep -q \"%s\" %s/err.txt", bad[k].want, dir), 0, "case %zu: %s", k, bad[k].set);
+    cr_assert_eq(sh("test ! -e %s/x%zu", dir, k), 0, "case %zu: a run directory was made", k);
+  }
+  /* the particle system has no equations of motion */
+  cr_assert_eq(sh("%s run %s/params/particles-sheet.ini --out %s/p --quiet --set scene.driver=dynamics 2>%s/err.txt",
+                  bin(), root(), dir, dir), 2);
+  cr_assert_eq(sh("grep -q \"key 'scene.driver': the system 'particles' has no equations of motion\" %s/err.txt", dir),
+               0);
+}

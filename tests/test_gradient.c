@@ -1,0 +1,466 @@
+/*
+** test_gradient.c -- every term's gradient (gradient.h) against central
+** differences of lw_energy_compute, one term at a time, on random regular
+** splines and every kind of potential, field and boundary.
+**
+** Tolerance, in the style of HOOMD's force/energy test: coordinate x_i is
+** stepped by h_i = 1e-6 max(|x_i|, l) (l the mean segment length, the scale
+** of the shapes) and the central difference g_fd = (E(x+h) - E(x-h)) / 2h
+** is compared with the analytic g as |g - g_fd| <= 1e-5 max(|g|, scale),
+** scale the root mean square of the analytic gradient (the typical size of
+** a component, |E_segment| / l).  The difference errs by
+**   truncation  h^2 |E'''| / 6 ~ 1e-12 (l^2 / l^3) |E_seg| = 1e-12 scale, and
+**   rounding    ~ eps |E| / h ~ 1e-16 N_seg |E_seg| / (1e-6 l) = 1e-10 N_seg scale
+** (N_seg ~ 20 segments here), both far below 1e-5 scale; a wrong formula
+** errs by the size of the gradient itself.  Points within h of a kink (a
+** grid's cell line, a rect's medial axis, r'.v = 0 of the axial field) make
+** the difference straddle two slopes; there the step is shortened until the
+** differences at h and h/4 agree (check_term).
+*/
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdlib.h>
+
+#include "linewise/gradient.h"
+#include "linewise/model.h"
+#include "linewise/scene.h"
+#include "testutil.h"
+
+static lw_params base_params(void)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = 120;
+  p.height = 100;
+  p.margin = 5;
+  return p;
+}
+
+static void scene_with(lw_scene *sc, const lw_params *p)
+{
+  lw_error err;
+  cr_assert_eq(lw_scene_init(sc, p, &err), LW_OK, "%s", err.msg);
+}
+
+/* n random smooth splines of segs segments inside [30, 90] x [25, 75]:
+** a walk of slowly turning chords, handles near a third of the chord with
+** random length and angle; regular for the scene (asserted). */
+static lw_splines *random_splines(const lw_scene *sc, size_t n, size_t segs, uint64_t seed)
+{
+  size_t s[16];
+  for (size_t i = 0; i < n; i++) s[i] = segs;
+  rng_seed(seed);
+  for (int attempt = 0; attempt < 100; attempt++) {
+    lw_splines *sp = lw_splines_new(n, s, NULL);
+    cr_assert_not_null(sp);
+    for (size_t i = 0; i < n; i++) {
+      lw_node *nd = &sp->node[sp->first[i]];
+      double x = urand(40, 80), y = urand(35, 65), th = urand(0, 2 * M_PI), L = 0;
+      for (size_t k = 0; k <= segs; k++) {
+        double c = urand(4, 7);
+        nd[k].px = x;
+        nd[k].py = y;
+        th += urand(-0.5, 0.5);
+        x += c * cos(th);
+        y += c * sin(th);
+        L += c;
+      }
+      /* handles along the neighbours' chord, a third of a segment long, with
+      ** random length and a small random turn */
+      for (size_t k = 0; k <= segs; k++) {
+        const lw_node *a = &nd[k > 0 ? k - 1 : k], *b = &nd[k < segs ? k + 1 : k];
+        double dx = b->px - a->px, dy = b->py - a->py, f = (k > 0 && k < segs ? 6.0 : 3.0) / urand(0.8, 1.2);
+        double t = urand(-0.2, 0.2);
+        nd[k].vx = (cos(t) * dx - sin(t) * dy) / f;
+        nd[k].vy = (sin(t) * dx + cos(t) * dy) / f;
+      }
+      sp->rest_length[i] = L * urand(0.6, 1.4);
+    }
+    lw_error err;
+    if (lw_model_check_regular(sc, sp, "test", &err) == LW_OK) return sp;
+    lw_splines_free(sp);
+  }
+  cr_assert_fail("no regular random splines");
+  return NULL;
+}
+
+static double mean_segment_length(const lw_scene *sc, const lw_splines *sp)
+{
+  lw_samples s;
+  double L = 0;
+  for (size_t g = 0; g < sp->n_segments; g++) {
+    const lw_node *a = &sp->node[lw_segment_node(sp, g)];
+    lw_segment_sample(&sc->quad, a, a + 1, &s);
+    L += s.length;
+  }
+  return L / (double)sp->n_segments;
+}
+
+static double term_energy(const lw_scene *sc, const lw_splines *sp, int t)
+{
+  double term[LW_TERM_COUNT];
+  lw_energy_compute(sc, sp, term, NULL);
+  return term[t];
+}
+
+/* The central difference of term t in coordinate c of x (a node's px py vx vy) */
+static double central(const lw_scene *sc, const lw_splines *sp, int t, double *x, int c, double h)
+{
+  double x0 = x[c];
+  x[c] = x0 + h;
+  double ep = term_energy(sc, sp, t);
+  x[c] = x0 - h;
+  double em = term_energy(sc, sp, t);
+  x[c] = x0;
+  return (ep - em) / (2 * h);
+}
+
+/* Term t's gradient against central differences at every coordinate;
+** returns how many coordinates disagree (and reports the first few). */
+static int check_term(const lw_scene *sc, lw_splines *sp, int t, const char *what)
+{
+  lw_error err = {0};
+  lw_node *g = calloc(sp->n_nodes, sizeof *g);
+  double term[LW_TERM_COUNT];
+  double e = lw_energy_gradient(sc, sp, 1u << t, g, term, &err);
+  cr_assert(isfinite(e), "%s: energy %g (%s)", what, e, err.msg);
+  cr_assert_eq(e, term[t], "%s: the total is the selected term's", what);
+  cr_assert_eq(term[t], term_energy(sc, sp, t), "%s: the same energy as lw_energy_compute", what);
+  const double l = mean_segment_length(sc, sp);
+  double rms = 0;
+  for (size_t k = 0; k < sp->n_nodes; k++) {
+    const double *gk = &g[k].px;
+    for (int c = 0; c < 4; c++) rms += gk[c] * gk[c];
+  }
+  rms = sqrt(rms / (4.0 * (double)sp->n_nodes));
+  cr_assert(rms > 0, "%s: a gradient of zero tests nothing", what);
+  int bad = 0;
+  for (size_t k = 0; k < sp->n_nodes; k++) {
+    double *x = &sp->node[k].px;
+    const double *gk = &g[k].px;
+    for (int c = 0; c < 4; c++) {
+      double x0 = x[c], h = 1e-6 * fmax(fabs(x0), l), tol = 1e-5 * fmax(fabs(gk[c]), rms);
+      double fd = central(sc, sp, t, x, c, h);
+      /* A kink of an interpolation within h of a sample: the differences
+      ** at h and h/4 disagree.  Shorter steps until two agree leave the
+      ** kink outside (a wrong gradient disagrees at every step). */
+      for (int r = 0; r < 6; r++) {
+        double fq = central(sc, sp, t, x, c, h / 4);
+        if (fabs(fq - fd) <= 0.1 * tol) break;
+        fd = fq;
+        h /= 4;
+      }
+      if (!(fabs(gk[c] - fd) <= tol)) {
+        if (bad < 4)
+          cr_log_error("%s: node %zu coordinate %d: analytic %.12g, central difference %.12g (scale %.3g)", what, k,
+                       c, gk[c], fd, rms);
+        bad++;
+      }
+    }
+  }
+  free(g);
+  return bad;
+}
+
+/* Term t alone on three sets of random splines. */
+static void check_scene(const lw_scene *sc, int t, const char *what)
+{
+  for (uint64_t seed = 1; seed <= 3; seed++) {
+    lw_splines *sp = random_splines(sc, 3, 5, 0x9e3779b9u * seed + (uint64_t)t);
+    int bad = check_term(sc, sp, t, what);
+    cr_expect_eq(bad, 0, "%s (seed %llu): %d coordinates off", what, (unsigned long long)seed, bad);
+    lw_splines_free(sp);
+  }
+}
+
+Test(gradient, strain_both_modes)
+{
+  for (int mode = 0; mode < 2; mode++) {
+    lw_params p = base_params();
+    p.strain = 2.5;
+    p.strain_mode = mode;
+    lw_scene sc;
+    scene_with(&sc, &p);
+    check_scene(&sc, LW_TERM_STRAIN, mode ? "strain per segment" : "strain per spline");
+    lw_scene_clear(&sc);
+  }
+}
+
+Test(gradient, bending)
+{
+  lw_params p = base_params();
+  p.bending = 1.7;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  check_scene(&sc, LW_TERM_BENDING, "bending");
+  lw_scene_clear(&sc);
+}
+
+Test(gradient, parametrisation)
+{
+  lw_params p = base_params();
+  p.parametrisation = 0.9;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  check_scene(&sc, LW_TERM_PARAM, "parametrisation");
+  lw_scene_clear(&sc);
+}
+
+/* A grid of random values over the page (spacing ~ 7 mm: several cells per
+** segment), ncomp values a node. */
+static lw_grid2d *random_grid(int ncomp, uint64_t seed)
+{
+  lw_grid2d *g = lw_grid2d_new(17, 15, ncomp, 0.0, 0.0, 7.5, 7.1, NULL);
+  cr_assert_not_null(g);
+  rng_seed(seed);
+  for (int k = 0; k < 17 * 15 * ncomp; k++) g->data[k] = urand(-1, 1);
+  return g;
+}
+
+Test(gradient, potential_every_kind)
+{
+  const int kinds[] = {LW_POT_CONSTANT, LW_POT_RAMP, LW_POT_RADIAL};
+  const char *names[] = {"potential constant", "potential ramp", "potential radial"};
+  for (int k = 0; k < 4; k++) {
+    lw_params p = base_params();
+    p.potential_coef = 0.8;
+    p.potential = kinds[k < 3 ? k : 0];
+    p.potential_value = 1.3;
+    p.potential_angle = 37;
+    p.center_x = 11;
+    p.center_y = 93;
+    lw_scene sc;
+    scene_with(&sc, &p);
+    if (k == 3) { /* the image potential's kind: a bilinear grid */
+      lw_potential_clear(&sc.potential);
+      sc.potential.kind = LW_POTENTIAL_GRID;
+      sc.potential.grid = random_grid(1, 77);
+    }
+    check_scene(&sc, LW_TERM_POTENTIAL, k < 3 ? names[k] : "potential grid");
+    lw_scene_clear(&sc);
+  }
+}
+
+Test(gradient, field_every_kind_signed_and_axial)
+{
+  const int kinds[] = {LW_FLD_CONSTANT, LW_FLD_RADIAL, LW_FLD_VORTEX, LW_FLD_WAVES};
+  char what[96];
+  for (int k = 0; k < 6; k++)
+    for (int mode = 0; mode < 2; mode++) {
+      lw_params p = base_params();
+      p.field_coef = -0.6;
+      p.field = kinds[k < 4 ? k : 0];
+      p.field_mode = mode ? LW_FIELDMODE_AXIAL : LW_FIELDMODE_SIGNED;
+      p.field_angle = 23;
+      p.field_wavelength = 31;
+      p.field_amplitude = 4;
+      p.center_x = 13;
+      p.center_y = 9;
+      lw_scene sc;
+      scene_with(&sc, &p);
+      if (k >= 4) { /* the picture's fields: gradient (grid) and etf (grid_axial) */
+        lw_field_clear(&sc.field);
+        sc.field.kind = k == 4 ? LW_FIELD_GRID : LW_FIELD_GRID_AXIAL;
+        sc.field.grid = random_grid(2, 91 + (uint64_t)k);
+      }
+      snprintf(what, sizeof what, "field kind %d %s", k, mode ? "axial" : "signed");
+      check_scene(&sc, LW_TERM_FIELD, what);
+      lw_scene_clear(&sc);
+    }
+}
+
+Test(gradient, boundary_every_kind)
+{
+  for (int k = 0; k < 4; k++) {
+    lw_params p = base_params();
+    p.boundary_coef = 3.0;
+    p.boundary = k == 1 ? LW_BND_CIRCLE : LW_BND_RECT;
+    lw_scene sc;
+    scene_with(&sc, &p);
+    if (k == 2) { /* a pentagon around the splines' region */
+      double x[5], y[5];
+      for (int v = 0; v < 5; v++) {
+        x[v] = 60 + 58 * cos(0.3 + 2 * M_PI * v / 5);
+        y[v] = 50 + 58 * sin(0.3 + 2 * M_PI * v / 5);
+      }
+      lw_boundary_clear(&sc.boundary);
+      cr_assert_eq(lw_boundary_polygon(&sc.boundary, 5, x, y, NULL), LW_OK);
+    } else if (k == 3) { /* a mask: signed distances of an ellipse-like blob, on a grid */
+      lw_boundary_clear(&sc.boundary);
+      lw_grid2d *g = lw_grid2d_new(25, 21, 1, 0.0, 0.0, 5.0, 5.0, NULL);
+      cr_assert_not_null(g);
+      for (int j = 0; j < 21; j++)
+        for (int i = 0; i < 25; i++) {
+          double dx = 5.0 * i - 60, dy = 5.0 * j - 50;
+          g->data[j * 25 + i] = sqrt(dx * dx + 1.4 * dy * dy) - 57 + 2 * sin(0.1 * dx * dy / 10);
+        }
+      sc.boundary.kind = LW_BOUNDARY_MASK;
+      sc.boundary.sdt = g;
+    }
+    const char *names[] = {"boundary rect", "boundary circle", "boundary polygon", "boundary mask"};
+    check_scene(&sc, LW_TERM_BOUNDARY, names[k]);
+    lw_scene_clear(&sc);
+  }
+}
+
+/* The picture's potential, edge tangent flow and mask through the image
+** pipeline: the same interpolations the energy reads. */
+Test(gradient, image_scene)
+{
+  const char *root = getenv("LW_ROOT");
+  char path[512];
+  snprintf(path, sizeof path, "%s/params/picture.png", root ? root : ".");
+  lw_params p = base_params();
+  snprintf(p.image, sizeof p.image, "%s", path);
+  p.potential = LW_POT_IMAGE;
+  p.potential_coef = 2.0;
+  p.field = LW_FLD_ETF;
+  p.field_coef = -1.0;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  check_scene(&sc, LW_TERM_POTENTIAL, "image potential");
+  check_scene(&sc, LW_TERM_FIELD, "image etf field");
+  lw_scene_clear(&sc);
+}
+
+/* The sum over every term equals lw_energy_compute's total and each term's
+** value, and the gradient of the sum is the sum of the gradients. */
+Test(gradient, total_matches_energy_compute)
+{
+  lw_params p = base_params();
+  p.strain = 2;
+  p.bending = 0.5;
+  p.potential_coef = 0.3;
+  p.potential = LW_POT_RADIAL;
+  p.field_coef = 0.4;
+  p.field = LW_FLD_VORTEX;
+  p.boundary_coef = 1.5;
+  p.parametrisation = 0.2;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  lw_splines *sp = random_splines(&sc, 4, 6, 12345);
+  double t1[LW_TERM_COUNT], t2[LW_TERM_COUNT];
+  lw_node *g = calloc(sp->n_nodes, sizeof *g), *gt = calloc(sp->n_nodes, sizeof *gt);
+  lw_error err = {0};
+  double e = lw_energy_gradient(&sc, sp, LW_GRAD_ALL, g, t1, &err);
+  double ref = lw_energy_compute(&sc, sp, t2, NULL);
+  cr_assert_eq(e, ref, "total %.17g, lw_energy_compute %.17g", e, ref);
+  for (int t = 0; t < LW_TERM_COUNT; t++) cr_assert_eq(t1[t], t2[t], "term %s", lw_term_names[t]);
+  lw_node *sum = calloc(sp->n_nodes, sizeof *sum);
+  for (int t = 0; t < LW_TERM_COUNT; t++) {
+    if (!sc.on[t]) continue;
+    lw_energy_gradient(&sc, sp, 1u << t, gt, NULL, &err);
+    for (size_t k = 0; k < sp->n_nodes; k++) {
+      sum[k].px += gt[k].px;
+      sum[k].py += gt[k].py;
+      sum[k].vx += gt[k].vx;
+      sum[k].vy += gt[k].vy;
+    }
+  }
+  for (size_t k = 0; k < sp->n_nodes; k++) {
+    cr_assert(lw_close_rel(g[k].px, sum[k].px, 1e-12, 1e-9));
+    cr_assert(lw_close_rel(g[k].vy, sum[k].vy, 1e-12, 1e-9));
+  }
+  free(sum);
+  free(g);
+  free(gt);
+  lw_splines_free(sp);
+  lw_scene_clear(&sc);
+}
+
+/* Forbidden states: outside the boundary or irregular, the energy is +inf. */
+Test(gradient, forbidden_states_are_infinite)
+{
+  lw_params p = base_params();
+  p.boundary_coef = 1;
+  p.bending = 1;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  lw_splines *sp = random_splines(&sc, 2, 3, 5);
+  lw_node *g = calloc(sp->n_nodes, sizeof *g);
+  sp->node[0].px = -3; /* an end point off the page */
+  cr_assert(isinf(lw_energy_gradient(&sc, sp, LW_GRAD_ALL, g, NULL, NULL)));
+  lw_splines_free(sp);
+  sp = random_splines(&sc, 2, 3, 5);
+  sp->node[1].vx = sp->node[1].vy = 0; /* speed 0 at a node: irregular */
+  cr_assert(isinf(lw_energy_gradient(&sc, sp, 1u << LW_TERM_BENDING, g, NULL, NULL)));
+  free(g);
+  lw_splines_free(sp);
+  lw_scene_clear(&sc);
+}
+
+static double user_fn(const lw_samples *s, const lw_quad *q, const void *data)
+{
+  (void)q;
+  (void)data;
+  return s->x[0];
+}
+
+/* The user term has no gradient: a mask selecting it is refused; the pair
+** term is delegated to lw_pair_gradient. */
+Test(gradient, user_term_refused)
+{
+  lw_params p = base_params();
+  p.bending = 1;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  lw_error err = {0};
+  cr_assert_eq(lw_scene_set_user_term(&sc, 1.0, user_fn, NULL, &err), LW_OK);
+  lw_splines *sp = random_splines(&sc, 1, 3, 9);
+  lw_node *g = calloc(sp->n_nodes, sizeof *g);
+  cr_assert(isnan(lw_energy_gradient(&sc, sp, LW_GRAD_ALL, g, NULL, &err)));
+  cr_assert_eq(err.code, LW_EINPUT);
+  cr_assert(strstr(err.msg, "user term"), "%s", err.msg);
+  err.code = LW_OK;
+  cr_assert(isfinite(lw_energy_gradient(&sc, sp, 1u << LW_TERM_BENDING, g, NULL, &err)));
+  free(g);
+  lw_splines_free(sp);
+  lw_scene_clear(&sc);
+}
+
+/* The splines row: coordinates are the nodes in order, set_coords moves the
+** state and refreshes every running total, gradient() is the gradient of
+** every term; non-finite coordinates are refused. */
+Test(gradient, splines_row_coordinates_and_gradient)
+{
+  lw_params p = base_params();
+  p.strain = 1;
+  p.bending = 0.5;
+  p.boundary_coef = 1;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  lw_splines *sp = random_splines(&sc, 2, 4, 44);
+  lw_splines *ref = lw_splines_clone(sp);
+  lw_error err = {0};
+  lw_model *m = lw_model_new(&sc, sp, &err);
+  cr_assert_not_null(m, "%s", err.msg);
+  lw_system *sys = lw_splines_view(m, &err);
+  const lw_system_type *t = sys->type;
+  size_t n = t->n_coords(sys->state);
+  cr_assert_eq(n, 4 * ref->n_nodes);
+  double *x = malloc(n * sizeof *x), *g = malloc(n * sizeof *g);
+  t->get_coords(sys->state, x);
+  cr_assert_eq(x[4 * 3 + 2], ref->node[3].vx);
+  lw_node *gr = calloc(ref->n_nodes, sizeof *gr);
+  double e = t->gradient(sys->state, g, &err);
+  cr_assert_eq(e, lw_energy_gradient(&sc, ref, LW_GRAD_ALL, gr, NULL, &err));
+  cr_assert_eq(g[4 * 5 + 1], gr[5].py);
+  cr_assert_eq(e, lw_system_total(sys));
+  x[4 * 2] += 0.3; /* move one point */
+  cr_assert_eq(t->set_coords(sys->state, x, &err), LW_OK);
+  ref->node[2].px += 0.3;
+  double term[LW_TERM_COUNT];
+  double e2 = lw_energy_compute(&sc, ref, term, NULL);
+  cr_assert(e2 != e);
+  cr_assert(lw_close_rel(lw_system_total(sys), e2, 1e-12, 1e-12), "%.17g %.17g", lw_system_total(sys), e2);
+  x[7] = NAN;
+  cr_assert_eq(t->set_coords(sys->state, x, &err), LW_EINPUT);
+  cr_assert_eq(m->sp->node[1].vy, ref->node[1].vy, "a refused set leaves the state");
+  free(x);
+  free(g);
+  free(gr);
+  lw_system_free(sys);
+  lw_model_free(m);
+  lw_splines_free(ref);
+  lw_scene_clear(&sc);
+}

@@ -1,0 +1,16 @@
+#!/bin/sh
+# animate.sh RUN_DIR [FPS] -- the frames of a run (output.frames_every) as
+# RUN_DIR/animation.mp4 (H.264, yuv420p: plays in browsers and players).
+# Needs ffmpeg: `make deps-animation` installs it.
+set -eu
+dir=${1:?usage: tools/animate.sh RUN_DIR [FPS]}
+fps=${2:-25}
+if [ ! -d "$dir/frames" ] || [ -z "$(ls "$dir/frames" 2>/dev/null | grep '^frame-.*\.png$')" ]; then
+  echo "animate.sh: $dir/frames has no frames (set output.frames_every in the scene)" >&2
+  exit 2
+fi
+command -v ffmpeg >/dev/null 2>&1 || { echo "animate.sh: ffmpeg not found (make deps-animation)" >&2; exit 2; }
+# the frames are numbered by sweep, not consecutively: a glob, in order
+ffmpeg -loglevel error -y -framerate "$fps" -pattern_type glob -i "$dir/frames/frame-*.png" \
+  -vf "pad=ceil(iw/2)*2:ceil(ih/2)*2:color=white" -c:v libx264 -pix_fmt yuv420p "$dir/animation.mp4"
+echo "$dir/animation.mp4"
