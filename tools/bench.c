@@ -224,6 +224,32 @@ static double scale_block(scale_run *r, double seconds)
   return 1e9 * t / ((double)sweeps * (double)r->nodes);
 }
 
+/* The same with the sites drawn at random, as every sweep drew them before
+** issue 14: proposals of the run's chain through lw_chain_step, point and
+** vector alternating, a sweep's worth at a time. */
+static double random_block(scale_run *r, double seconds)
+{
+  lw_chain *c = r->a.chain;
+  double done = 0.0, t0 = thread_seconds(), t;
+  do {
+    for (size_t k = 0; k < r->nodes; k++)
+      if (lw_chain_step(c, (int)(k & 1)) < 0) bench_die("scaling", &(lw_error){.code = LW_ENOMEM, .msg = "commit"});
+    done += (double)r->nodes;
+  } while ((t = thread_seconds() - t0) < seconds);
+  return 1e9 * t / done;
+}
+
+/* Median of v[0..n) and the median absolute deviation from it (v kept). */
+static double median_mad(const double *v, int n, double *mad)
+{
+  double w[BENCH_MAX_REPS], dev[BENCH_MAX_REPS];
+  memcpy(w, v, (size_t)n * sizeof *w);
+  double m = bench_median(w, n);
+  for (int k = 0; k < n; k++) dev[k] = fabs(v[k] - m);
+  *mad = bench_median(dev, n);
+  return m;
+}
+
 /* One renumbering and refresh, as a check every anneal.check_every sweeps runs them. */
 static void scale_renumber(scale_run *r)
 {
@@ -239,30 +265,44 @@ static void scaling_table(bench_ctx *b, int pair, int n, const char *dir, FILE *
   FILE *d = b->doc[BENCH_PERFORMANCE];
   const int ref = 0, reps = SCALE_REPS(b);
   scale_run r[N_SCALE];
+  /* random selection beside the sweep order: for local terms only, where a
+  ** sweep of 10^6 splines takes seconds, not a minute */
+  const int with_random = !pair;
   double t[N_SCALE][BENCH_MAX_REPS], q[N_SCALE][BENCH_MAX_REPS];
+  double tr[N_SCALE][BENCH_MAX_REPS], qr[N_SCALE][BENCH_MAX_REPS];
   for (int i = 0; i < n; i++) {
     bench_note("scaling: %zu splines, pair %s", scale_sizes[i], pair ? "on" : "off");
     scale_start(&r[i], scale_sizes[i], pair, dir);
   }
   for (int k = 0; k < reps; k++)
-    for (int i = 0; i < n; i++) t[i][k] = scale_block(&r[i], b->block);
+    for (int i = 0; i < n; i++) {
+      t[i][k] = scale_block(&r[i], b->block);
+      if (with_random) tr[i][k] = random_block(&r[i], b->block);
+    }
   fprintf(d, "%s:\n\n"
              "| splines | segments | ns per proposal | ratio to 1000 | set-up s | ms per sweep | renumber + refresh s "
-             "| bytes per segment | acceptance |\n|---|---|---|---|---|---|---|---|---|\n",
-          pair ? "With the pair term (cutoff 4 mm, near field off)" : "Local terms only (the pair term off)");
+             "| bytes per segment | acceptance |%s\n|---|---|---|---|---|---|---|---|---|%s\n",
+          pair ? "With the pair term (cutoff 4 mm, near field off)" : "Local terms only (the pair term off)",
+          with_random ? " random selection: ns per proposal | its ratio to 1000 |" : "",
+          with_random ? "---|---|" : "");
   for (int i = 0; i < n; i++) {
-    for (int k = 0; k < reps; k++) q[i][k] = t[i][k] / t[ref][k];
-    double ns_i[BENCH_MAX_REPS], dev[BENCH_MAX_REPS];
-    memcpy(ns_i, t[i], sizeof ns_i);
-    double ns = bench_median(ns_i, reps), ratio = bench_median(q[i], reps);
-    for (int k = 0; k < reps; k++) dev[k] = fabs(q[i][k] - ratio);
-    double mad = bench_median(dev, reps);
+    for (int k = 0; k < reps; k++) {
+      q[i][k] = t[i][k] / t[ref][k];
+      if (with_random) qr[i][k] = tr[i][k] / tr[ref][k];
+    }
+    double mad, unused;
+    double ns = median_mad(t[i], reps, &unused), ratio = median_mad(q[i], reps, &mad);
     scale_renumber(&r[i]);
     const lw_model *m = lw_splines_model(r[i].a.sys);
     double bps = bytes_per_segment(m);
-    fprintf(d, "| %zu | %zu | %.0f | %.2f +- %.2f | %.1f | %.0f | %.2f | %.0f | %.2f |\n", scale_sizes[i],
+    fprintf(d, "| %zu | %zu | %.0f | %.2f +- %.2f | %.1f | %.0f | %.2f | %.0f | %.2f |", scale_sizes[i],
             m->sp->n_segments, ns, ratio, mad, r[i].setup_s, 1e-6 * ns * (double)r[i].nodes, r[i].renumber_s, bps,
             lw_anneal_acceptance(&r[i].a));
+    if (with_random) {
+      double rmad, ns_r = median_mad(tr[i], reps, &unused), ratio_r = median_mad(qr[i], reps, &rmad);
+      fprintf(d, " %.0f | %.2f +- %.2f |", ns_r, ratio_r, rmad);
+    }
+    fprintf(d, "\n");
     fprintf(f, "%d %zu %.1f %.4f %.1f\n", pair, scale_sizes[i], ns, ratio, bps);
     lw_anneal_free(&r[i].a);
   }

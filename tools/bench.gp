@@ -61,7 +61,7 @@ set yrange [0:*]
 set y2range [0:*]
 set y2tics
 set ytics nomirror
-set key bottom right
+set key center right
 set logscale y
 set yrange [*:*]
 plot f('scaling.dat') index 0 using 2:3 with linespoints pt 7 title 'ns per proposal, local terms', \
