@@ -16,11 +16,11 @@
 #include <unistd.h>
 
 #include "linewise/checkpoint.h"
-#include "linewise/phase.h"
 #include "linewise/init.h"
 #include "linewise/json.h"
 #include "linewise/number.h"
 #include "linewise/output.h"
+#include "linewise/phase.h"
 #include "linewise/state.h"
 
 static double now_seconds(void)

@@ -180,7 +180,9 @@ static void *watch(void *arg)
     }
     if (what == shown) last = t;
   }
-  if (shown) fprintf(stderr, "%slinewise: %s: done in %.1f s\n", w->tty ? "\r\033[K" : "", shown, last);
+  if (shown)
+    fprintf(stderr, "%slinewise: %s: %s %.1f s\n", w->tty ? "\r\033[K" : "", shown,
+            atomic_load(&w->stop) > 1 ? "failed after" : "done in", last);
   return NULL;
 }
 
@@ -192,10 +194,11 @@ static void watcher_start(watcher *w, int quiet)
   if (!quiet) w->running = pthread_create(&w->thread, NULL, watch, w) == 0;
 }
 
-static void watcher_stop(watcher *w)
+/* failed: the phase shown last ended in an error (reported next). */
+static void watcher_stop(watcher *w, int failed)
 {
   if (!w->running) return;
-  atomic_store(&w->stop, 1);
+  atomic_store(&w->stop, failed ? 2 : 1);
   pthread_join(w->thread, NULL);
   w->running = 0;
 }
@@ -204,7 +207,7 @@ static void watcher_stop(watcher *w)
 ** the final files (or a checkpoint for a clean stop). */
 static int watched_fail(watcher *w, const lw_error *err)
 {
-  watcher_stop(w);
+  watcher_stop(w, 1);
   return fail(err);
 }
 
@@ -221,14 +224,14 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_err
   progress_show(&pg, a, 1);
   if (stopped) {
     if (lw_anneal_checkpoint(a, err)) return watched_fail(w, err);
-    watcher_stop(w);
+    watcher_stop(w, 0);
     if (!quiet)
       fprintf(stderr, "linewise: stopped after sweep %ld; state saved in %s/state.lw ('linewise resume %s' continues)\n",
               a->sweep, a->dir, a->dir);
     return 0;
   }
   if (lw_anneal_finish(a, err)) return watched_fail(w, err);
-  watcher_stop(w);
+  watcher_stop(w, 0);
   if (!quiet) {
     char drawn[512];
     a->sys_type->describe(a->sys->state, LW_DESCRIBE_DRAWING, drawn, sizeof drawn);
