@@ -334,7 +334,11 @@ static void bench_scaling(bench_ctx *b)
              "order\"), so consecutive proposals share grid cells and cache lines. Ratios are to 1000\n"
              "splines, block by block over %d interleaved blocks (+- the median absolute deviation).\n"
              "Set-up: lw_anneal_start (placement, model, the first state.lw). Renumber + refresh: the\n"
-             "work a drift check (every anneal.check_every = 100 sweeps by default) adds.\n\n"
+             "work a drift check (every anneal.check_every = 100 sweeps by default) adds, under 1%%\n"
+             "of the sweeps between two checks. Random selection (local terms): the same runs, in the\n"
+             "same blocks, with proposals at nodes drawn at random (lw_chain_step), as every sweep\n"
+             "made them before; the splines keep their curve numbering, which random selection\n"
+             "cannot use.\n\n"
              "![ns per proposal against splines](scaling.png)\n\n",
           n + 2, BENCH_T, b->block, SCALE_REPS(b));
   FILE *f = bench_data(b, "scaling.dat");
