@@ -503,12 +503,14 @@ static int upgrade_chain_key(upgrade *u, const char *sec, const char *key, const
 
 static void upgrade_energy(upgrade *u, const char *sec, const char *value, int line)
 {
-  /* States written before the parametrisation term (the last) hold one
-  ** number fewer: that term was off in them and takes its default. */
-  char *w[LW_TERM_COUNT];
-  int n = LW_TERM_COUNT;
-  double tmp[LW_TERM_COUNT + 1];
-  if (lw_number_list(value, 0, tmp, LW_TERM_COUNT + 1) == LW_TERM_COUNT - 1) n = LW_TERM_COUNT - 1;
+  /* Format 1 knew the terms up to parametrisation; states written before
+  ** that term hold one number fewer: it was off in them and takes its
+  ** default, as every term added since does. */
+  enum { V1_TERMS = LW_TERM_PARAM + 1 };
+  char *w[V1_TERMS];
+  int n = V1_TERMS;
+  double tmp[V1_TERMS + 1];
+  if (lw_number_list(value, 0, tmp, V1_TERMS + 1) == V1_TERMS - 1) n = V1_TERMS - 1;
   if (!words(u, "energy", line, value, n, w)) return;
   const char *names[LW_TERM_COUNT];
   for (int t = 0; t < LW_TERM_COUNT; t++) names[t] = lw_term_names[t];

@@ -117,7 +117,7 @@ static double spline_strain(const double *seg_len, size_t n_seg, double length, 
 }
 
 const char *const lw_term_names[LW_TERM_COUNT] = {"strain", "bending", "potential", "field",
-                                                  "pair", "boundary", "user", "parametrisation"};
+                                                  "pair", "boundary", "user", "parametrisation", "tone"};
 
 const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_STRAIN, .spline = spline_strain},
@@ -128,4 +128,5 @@ const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_BOUNDARY, .segment = seg_boundary},
   {LW_TERM_USER, .segment = seg_user},
   {LW_TERM_PARAM, .segment = seg_param},
+  {LW_TERM_TONE, .raster = 1},
 };

@@ -20,6 +20,9 @@
 **             segment's length = its mean speed): 0 for uniform speed, so it
 **             holds the handle lengths that do not change the shape
 **             (docs/NUMERICS.md); 0 for a segment of no length
+**   tone      T * sum over pixels of A (G * ink - D)^2: the lines splatted
+**             into a blurred ink raster against the picture's darkness
+**             (tone.h)
 **
 ** The term table's order is the order of trace.csv's and state.lw's energy
 ** columns; a new term goes at the end so older state files still read.
@@ -28,7 +31,7 @@
 ** its samples come from, and the one object it reads (a potential, a
 ** field, the boundary, the pair kernel's settings, the user's data).  The
 ** scene fills the contexts (lw_scene_term_ctx, scene.h); terms never see
-** the scene.  A row has one of three shapes, which the model (model.h)
+** the scene.  A row has one of four shapes, which the model (model.h)
 ** treats alike for every term of that shape:
 **   segment   a sum over segments of a function of one segment's samples
 **             (cached per segment, differenced over the segments a move
@@ -42,6 +45,13 @@
 **             kernel's cutoff; ctx.data is the lw_pair_ctx, ctx.quad the
 **             pair samples' nodes.  One pairwise term at most is on (the
 **             grid has one cutoff): pair.
+**   raster    coef times a function of a raster into which every sample
+**             (at ctx.quad's nodes) splats a footprint; not a sum over
+**             segments (a pixel sees every line near it), but a move
+**             changes only its samples' footprints, so the model keeps
+**             one raster a term and differences a box around the move
+**             (tone.h); ctx.data is the lw_tone.  Any number may be on:
+**             tone.
 **
 ** Degenerate samples never produce NaN: a sample with r' = 0 contributes 0 to
 ** bending (r' = 0 forces the numerator to 0 as well; the curvature of a point
@@ -66,6 +76,7 @@ typedef enum {
   LW_TERM_BOUNDARY,
   LW_TERM_USER,
   LW_TERM_PARAM,
+  LW_TERM_TONE,
   LW_TERM_COUNT
 } lw_term_id;
 
@@ -80,12 +91,12 @@ typedef double (*lw_user_term_fn)(const lw_samples *s, const lw_quad *q, const v
 typedef struct {
   double coef;               /* 0 = off */
   const lw_quad *quad;       /* the nodes of the samples it is given */
-  const void *data;          /* lw_potential, lw_field, lw_boundary, lw_pair_ctx, user data, or NULL */
+  const void *data;          /* lw_potential, lw_field, lw_boundary, lw_pair_ctx, user data, lw_tone, or NULL */
   lw_user_term_fn fn;        /* the user term's function */
   int mode;                  /* field: 1 axial; strain: 1 per segment */
 } lw_term_ctx;
 
-/* One row: exactly one of segment, spline, pairwise.  segment returns the
+/* One row: exactly one of segment, spline, pairwise, raster.  segment returns the
 ** energy of one segment with its coefficient; spline the energy of one
 ** spline without it (the model multiplies, so differences round as
 ** coef * (new - old)). */
@@ -94,6 +105,7 @@ typedef struct {
   double (*segment)(const lw_samples *s, const lw_term_ctx *c);
   double (*spline)(const double *seg_len, size_t n_seg, double length, double rest_length, const lw_term_ctx *c);
   int pairwise;
+  int raster;
 } lw_term_type;
 
 extern const lw_term_type lw_term_types[LW_TERM_COUNT];
