@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/spacing.h"
+
 lw_status lw_drawing_page(const lw_params *p, lw_output_page *page, lw_error *err)
 {
   lw_output_page_init(page, p->width, p->height);
@@ -79,6 +81,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
     s = lw_output_pdf(sp, &page, pl, under, path, err);
   }
   lw_plot_free(pl);
+  if (!s) s = lw_close_share(sp, p->pen_width, &rep->close_share, err);
   if (!s && tone) {
     s = lw_fidelity_compute(sp, tone, p->pen_width, p->fidelity_sigma, &rep->fidelity, err);
     rep->has_fidelity = !s;
@@ -110,6 +113,8 @@ void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep)
   lw_json_key(j, "after");
   lw_json_number(j, rep->travel_after);
   lw_json_end_object(j);
+  lw_json_key(j, "close_share");
+  lw_json_number(j, rep->close_share);
   if (rep->has_fidelity) {
     lw_json_key(j, "fidelity");
     lw_json_begin_object(j);

@@ -33,7 +33,12 @@ lw_status lw_tone_init(lw_tone *t, const lw_image *img, const lw_image_place *pl
     for (int i = 0; i < img->width; i++)
       t->dark[(size_t)(j + t->pad) * (size_t)t->w + (size_t)(i + t->pad)] =
           1.0f - img->tone[(size_t)j * (size_t)img->width + (size_t)i];
-  return LW_OK;
+  /* The same blur on both sides: G * ink cannot be sharper than G, so a
+  ** sharp target would ask for ink piled along every edge (the picture's
+  ** rim included) to make up for the blur. */
+  lw_status st = lw_image_blur_plane(t->dark, t->w, t->h, sigma / pl->pixel, err);
+  if (st) lw_tone_clear(t);
+  return st;
 }
 
 void lw_tone_clear(lw_tone *t)

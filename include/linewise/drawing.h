@@ -16,8 +16,11 @@
 **
 ** The report holds the pen-up travel before and after ordering and, with a
 ** target tone, the fidelity score (fidelity.h) with [output] fidelity_sigma;
+** The report also holds the close share (spacing.h): the share of the line
+** length with another stroke within one output.pen_width.
 ** lw_drawing_report_json writes them into summary.json as
 **     "pen_up_travel_mm": {"before": ..., "after": ...},
+**     "close_share": ...,
 **     "fidelity": {"mse": ..., "ssim": ..., "sigma_mm": ...}   (with a target)
 */
 #ifndef LINEWISE_DRAWING_H
@@ -32,6 +35,7 @@
 typedef struct {
   size_t paths;                       /* paths drawn */
   double travel_before, travel_after; /* pen-up travel, mm (plot.h) */
+  double close_share;                 /* share of the length within a pen width of another stroke */
   int has_fidelity;                   /* a target tone was given */
   lw_fidelity fidelity;
 } lw_drawing_report;

@@ -6,9 +6,12 @@
 **   E_tone = T * sum over pixels p of A (B_p - D_p)^2,
 **   B = G * ink,   ink = pen width times the lines' length per area,
 **
-** A = pixel^2 (mm^2), D = 1 - tone in [0, 1] (0 in a ring of white paper
-** around the picture, as wide as a footprint), G a Gaussian of standard
-** deviation sigma (mm).  B is kept directly: blurring is linear, so each
+** A = pixel^2 (mm^2), D = G * (1 - tone) the picture's darkness in [0, 1]
+** blurred by the same G (with a ring of white paper, 0, around the picture
+** as wide as a footprint), G a Gaussian of standard deviation sigma (mm).
+** Blurring the target too keeps the minimum within reach: without it the
+** lines would pile up along every edge of the picture to make the blurred
+** ink as sharp as the target.  B is kept directly: blurring is linear, so each
 ** quadrature sample (position r_q, length element dl_q) adds the blurred
 ** footprint of its ink area a_q = pen dl_q,
 **
@@ -59,7 +62,7 @@ typedef struct {
   double sigma;     /* blur G, mm */
   double pen;       /* ink area per mm of line, mm */
   int radius;       /* footprint half-width, pixels */
-  float *dark;      /* w * h target darkness D in [0, 1], row-major */
+  float *dark;      /* w * h target D = G * darkness in [0, 1], row-major */
 } lw_tone;
 
 /* Builds the target from the processed picture img placed at pl.  sigma >
