@@ -60,17 +60,23 @@ static int nearest(double c, double c0, double pixel, int radius, int n, int *k)
   return 1;
 }
 
-/* The normalised Gaussian weights of the 2 radius + 1 pixel centres around
-** pixel k for a sample at c. */
+/* The normalised weights of the 2 radius + 1 pixel centres around pixel k
+** for a sample at c: the Gaussian less its value at rho = radius pixels,
+** 0 beyond.  Every centre outside the window is farther than rho from c, so
+** the footprint is continuous in c as the window moves with the sample (a
+** Gaussian cut at the window would jump by e^-4.5 of its peak there). */
 static void weights(const lw_tone *t, double c, double c0, int k, double *g)
 {
   const int R = t->radius;
-  const double inv = 1.0 / (2.0 * t->sigma * t->sigma);
+  const double inv = 1.0 / (2.0 * t->sigma * t->sigma), rho = R * t->pixel, floor_ = exp(-rho * rho * inv);
   double sum = 0.0;
   for (int m = 0; m <= 2 * R; m++) {
     double d = c0 + (k - R + m + 0.5) * t->pixel - c;
-    g[m] = exp(-d * d * inv);
+    g[m] = fmax(exp(-d * d * inv) - floor_, 0.0);
     sum += g[m];
+  }
+  if (!(sum > 0.0)) { /* a blur far below a pixel: all of it in the sample's own pixel */
+    g[R] = sum = 1.0;
   }
   for (int m = 0; m <= 2 * R; m++) g[m] /= sum;
 }

@@ -398,8 +398,10 @@ static size_t close_pairs(const lw_scene *sc, const lw_splines *sp, double d)
     }
   }
   for (size_t i = 0; i < n; i++)
-    for (size_t j = i + 1; j < n; j++)
-      count += owner[i] != owner[j] && hypot(x[i] - x[j], y[i] - y[j]) < d;
+    for (size_t j = i + 1; j < n; j++) {
+      double dx = x[i] - x[j], dy = y[i] - y[j];
+      count += owner[i] != owner[j] && dx * dx + dy * dy < d * d;
+    }
   free(x);
   free(y);
   free(owner);

@@ -17,10 +17,11 @@
 **
 **   B_p += a_q gx_i(r_q) gy_j(r_q) / A,
 **
-** gx, gy the Gaussian sampled at the pixel centres within `radius` pixels
-** of the sample's nearest pixel (ceil(3 sigma / pixel)) and normalised to
-** sum 1 per axis, so a sample inside the raster deposits exactly its ink
-** area: sum_p A B_p = pen * (length of line in the raster).  Derivation
+** gx, gy the Gaussian less its value at rho = `radius` pixels (ceil(3 sigma
+** / pixel)), 0 beyond, sampled at the pixel centres and normalised to sum 1
+** per axis: the footprint is continuous in the sample's position, and a
+** sample inside the raster deposits exactly its ink area, sum_p A B_p =
+** pen * (length of line in the raster).  Derivation
 ** and the choice of footprint in docs/NUMERICS.md.
 **
 ** Exact sums: B is stored in fixed point (LW_TONE_ONE units per unit of ink
