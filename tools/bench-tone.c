@@ -122,8 +122,9 @@ void bench_tone_accuracy(bench_ctx *b)
   }
   fprintf(d, "\nThe error is small once the samples are closer than about the blur: a footprint wider\n"
              "than the gaps between samples sees a line, not a row of dots. Keep\n"
-             "segment_length / quadrature below tone_blur. The fixed-point raster adds at most\n"
-             "2^-33 of full ink per pixel and footprint value, far below these. The annealed scene's\n"
+             "segment_length / quadrature below tone_blur. Below about 1e-7 the errors stop falling:\n"
+             "the fixed-point raster rounds each footprint value to 2^-32 of full ink, some 1e-9 of\n"
+             "a pixel's value summed over its footprints, 1e-8 to 1e-7 of (B - D). The annealed scene's\n"
              "close share (the share of its line length within one pen width, %.2f mm, of another\n"
              "stroke; summary.json's close_share) is %.3f.\n\n",
           b->ann_params.pen_width, share);
