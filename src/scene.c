@@ -294,7 +294,8 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     if (!sc->image) return bad_key(p, "energy", "tone", LW_EINPUT, err, "the tone term needs scene.image");
     lw_error e2;
     if ((st = lw_tone_init(&sc->tone, sc->image, &sc->image_place, p->tone_blur, p->pen_width, &e2)))
-      return bad_key(p, "energy", "tone_blur", st, err, "%s", e2.msg);
+      return st == LW_EINPUT ? bad_key(p, "energy", "tone_blur", st, err, "%s", e2.msg)
+                             : lw_error_set(err, st, "%s", e2.msg);
   }
   if (p->min_spacing > 0.0) {
     if (!sc->on[LW_TERM_PAIR])

@@ -34,6 +34,10 @@
 ** sample that alone inks a pixel 65536 times over is a degenerate state,
 ** not a drawing), so a pixel overflows only past 2^15 such samples.
 **
+** Memory: the target, 4 bytes a raster pixel, shared by the replicas; the
+** raster, 8 bytes a pixel, in each replica's model; a proposal's box, 8
+** bytes a pixel of the largest box it has needed.
+**
 ** A move: lw_tone_box_cover() grows a box over the footprints of the
 ** affected segments (old and new), lw_tone_box_ready() zeroes it, the old
 ** samples splat -1 and the new ones +1 into it, lw_tone_delta() gives
