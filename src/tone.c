@@ -68,12 +68,28 @@ static int nearest(double c, double c0, double pixel, int radius, int n, int *k)
 static void weights(const lw_tone *t, double c, double c0, int k, double *g)
 {
   const int R = t->radius;
-  const double inv = 1.0 / (2.0 * t->sigma * t->sigma), rho = R * t->pixel, floor_ = exp(-rho * rho * inv);
+  const double p = t->pixel, inv = 1.0 / (2.0 * t->sigma * t->sigma), rho = R * p, floor_ = exp(-rho * rho * inv);
+  const double d0 = c0 + (k - R + 0.5) * p - c, a0 = (2.0 * d0 * p + p * p) * inv;
   double sum = 0.0;
-  for (int m = 0; m <= 2 * R; m++) {
-    double d = c0 + (k - R + m + 0.5) * t->pixel - c;
-    g[m] = fmax(exp(-d * d * inv) - floor_, 0.0);
-    sum += g[m];
+  if (fabs(a0) < 600.0 && d0 * d0 * inv < 600.0) {
+    /* exp(-d_m^2 inv) for d_m = d0 + m p by products: the ratio of
+    ** neighbours is exp(-(2 d_m p + p^2) inv), itself falling by
+    ** exp(-2 p^2 inv) a step.  Three exps an axis instead of 2 R + 1. */
+    double e = exp(-d0 * d0 * inv), r = exp(-a0);
+    const double c2 = exp(-2.0 * p * p * inv);
+    for (int m = 0; m <= 2 * R; m++) {
+      g[m] = e > floor_ ? e - floor_ : 0.0;
+      sum += g[m];
+      e *= r;
+      r *= c2;
+    }
+  } else { /* a blur well below a pixel: the products would overflow */
+    for (int m = 0; m <= 2 * R; m++) {
+      double d = d0 + m * p;
+      double e = exp(-d * d * inv);
+      g[m] = e > floor_ ? e - floor_ : 0.0;
+      sum += g[m];
+    }
   }
   if (!(sum > 0.0)) { /* a blur far below a pixel: all of it in the sample's own pixel */
     g[R] = sum = 1.0;
@@ -107,8 +123,9 @@ void lw_tone_splat(const lw_tone *t, int64_t *r, int wx, int wy, int ww, int wh,
     int64_t *row = r + (size_t)(j - wy) * (size_t)ww;
     for (int i = i0; i < i1; i++) {
       double v = ay * gx[i - ci + R];
-      /* rounded from the sample alone: its +1 and -1 cancel exactly */
-      int64_t q = (int64_t)llrint((v < LW_TONE_CAP ? v : LW_TONE_CAP) * LW_TONE_ONE);
+      /* rounded (half up: v >= 0) from the sample alone, so its +1 and -1
+      ** cancel exactly; a cast, not llrint, which is a call into libm */
+      int64_t q = (int64_t)((v < LW_TONE_CAP ? v : LW_TONE_CAP) * LW_TONE_ONE + 0.5);
       /* unsigned: wrap-around is defined and exact sums come out right */
       row[i - wx] = (int64_t)((uint64_t)row[i - wx] + (uint64_t)(sign > 0 ? q : -q));
     }
