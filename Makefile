@@ -30,7 +30,9 @@ TOOLS   := seed-sweep param-sweep plot-run plot-sweep
 PICTURE := params/picture.png
 
 .PHONY: all deps test test-long asan fuzz fuzz-build run bench install clean docs
-all: $(BIN)/linewise
+# The example picture too: params/example.ini, the scene a new user tries
+# first, needs it.
+all: $(BIN)/linewise $(PICTURE)
 
 $(BUILD)/obj/%.o: src/%.c $(wildcard include/linewise/*.h) | $(BUILD)/obj
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -c $< -o $@

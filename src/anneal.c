@@ -126,8 +126,20 @@ static void absolute_path(char *path, const char *scene_file)
   char dir[LW_PATH_MAX], joined[2 * LW_PATH_MAX + 2], real[4096];
   lw_path_dir(dir, sizeof dir, scene_file);
   lw_path_join(joined, sizeof joined, dir, path);
-  if (realpath(joined, real) && strlen(real) < LW_PATH_MAX) strcpy(path, real);
-  else if (strlen(joined) < LW_PATH_MAX) strcpy(path, joined);
+  if (realpath(joined, real) && strlen(real) < LW_PATH_MAX) {
+    strcpy(path, real);
+    return;
+  }
+  /* A missing file stays missing, but its name must still be absolute:
+  ** relative, the scene's directory would be joined to it a second time
+  ** when the picture is opened. */
+  if (joined[0] != '/' && getcwd(real, sizeof real)) {
+    size_t nc = strlen(real);
+    snprintf(real + nc, sizeof real - nc, "/%s", joined);
+    if (strlen(real) < LW_PATH_MAX) strcpy(path, real);
+  } else if (strlen(joined) < LW_PATH_MAX) {
+    strcpy(path, joined);
+  }
 }
 
 /* Replicas of the run (the explicit ladder's length, or [tempering]

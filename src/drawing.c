@@ -1,6 +1,9 @@
 /* drawing.c -- a run's drawing files from its parameters (drawing.h). */
 #include "linewise/drawing.h"
 
+#include <gsl/gsl_math.h>
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -33,9 +36,11 @@ static double tone_at(const void *ctx, double x, double y)
   return v;
 }
 
-/* The plot of p's pens, ordered as `order`, home at the page origin. */
+/* Which pen draws each spline, in index order: the final drawing's
+** post-pass (strokes.h) orders the paths it makes, and frames are not
+** ordered. */
 static lw_plot *make_plot(const lw_params *p, const lw_scene *sc, const lw_splines *sp, const lw_grid2d *tone,
-                          lw_plot_order order, lw_error *err)
+                          lw_error *err)
 {
   double *key = NULL;
   if (p->pens > 1 && (sc->on[LW_TERM_POTENTIAL] || tone)) {
@@ -47,7 +52,7 @@ static lw_plot *make_plot(const lw_params *p, const lw_scene *sc, const lw_splin
     if (sc->on[LW_TERM_POTENTIAL]) lw_plot_mean_along(sp, &sc->quad, potential_at, &sc->potential, key);
     else lw_plot_mean_along(sp, &sc->quad, tone_at, tone, key);
   }
-  lw_plot *pl = lw_plot_new(sp, p->pens, key, order, 0.0, 0.0, err);
+  lw_plot *pl = lw_plot_new(sp, p->pens, key, LW_PLOT_ORDER_NONE, 0.0, 0.0, err);
   free(key);
   return pl;
 }
@@ -57,6 +62,51 @@ static void dir_file(char *buf, size_t n, const char *dir, const char *name)
   snprintf(buf, n, "%s/%s", dir, name);
 }
 
+/* The post-pass options of p and sc (the crop rectangle from the picture). */
+static void options(const lw_params *p, const lw_scene *sc, lw_strokes_options *o)
+{
+  o->join_dist = p->join_distance * p->pen_width;
+  o->join_angle = p->join_angle * M_PI / 180.0;
+  o->min_length = p->min_length * p->pen_width;
+  o->order = (lw_plot_order)p->order;
+  o->crop = p->crop;
+  if (sc->image) {
+    const lw_image_place *pl = &sc->image_place;
+    o->x0 = pl->x0;
+    o->y0 = pl->y0;
+    o->x1 = pl->x0 + sc->image->width * pl->pixel;
+    o->y1 = pl->y0 + sc->image->height * pl->pixel;
+  } else {
+    o->x0 = p->margin;
+    o->y0 = p->margin;
+    o->x1 = p->width - p->margin;
+    o->y1 = p->height - p->margin;
+  }
+}
+
+/* The fidelity scores of the drawing, overall and per pen. */
+static lw_status score(const lw_params *p, const lw_strokes *st, const lw_grid2d *tone, lw_drawing_report *rep,
+                       lw_error *err)
+{
+  lw_status s = lw_fidelity_compute_strokes(st, -1, tone, p->pen_width, p->fidelity_sigma, &rep->fidelity, err);
+  for (int k = 0; !s && st->n_pens > 1 && k < st->n_pens; k++)
+    s = lw_fidelity_compute_strokes(st, k, tone, p->pen_width, p->fidelity_sigma, &rep->pen_fidelity[k], err);
+  rep->has_fidelity = !s;
+  return s;
+}
+
+/* The close share of the paths as plotted, each path a stroke (spacing.h). */
+static lw_status close_share(const lw_params *p, const lw_strokes *st, lw_drawing_report *rep, lw_error *err)
+{
+  size_t *owner = malloc((st->n_segs ? st->n_segs : 1) * sizeof *owner);
+  if (!owner) return lw_error_set(err, LW_ENOMEM, "out of memory for the close share");
+  for (size_t k = 0; k < st->n; k++)
+    for (size_t g = st->first[k]; g < st->first[k + 1]; g++) owner[g] = k;
+  lw_status s = lw_close_share(st->b, owner, st->n_segs, p->pen_width, &rep->close_share, err);
+  free(owner);
+  return s;
+}
+
 lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_splines *sp, const lw_grid2d *tone,
                            const char *dir, lw_drawing_report *rep, lw_error *err)
 {
@@ -64,28 +114,35 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   lw_output_page page;
   lw_status s = lw_drawing_page(p, &page, err);
   if (s) return s;
-  lw_plot *pl = make_plot(p, sc, sp, tone, (lw_plot_order)p->order, err);
+  lw_plot *pl = make_plot(p, sc, sp, tone, err);
   if (!pl) return err ? err->code : LW_ENOMEM;
-  rep->paths = pl->n;
-  rep->travel_before = pl->travel_before;
-  rep->travel_after = pl->travel_after;
+  lw_strokes_options o;
+  options(p, sc, &o);
+  lw_strokes *st = lw_strokes_prepare(sp, pl, &o, &rep->post, err);
+  lw_plot_free(pl);
+  if (!st) return err ? err->code : LW_ENOMEM;
+  rep->paths = st->n;
+  rep->n_pens = st->n_pens;
+  rep->travel_before = rep->post.travel_before;
+  rep->travel_after = rep->post.travel_after;
+  rep->cropped = o.crop;
+  memcpy(rep->crop_mm, (double[4]){o.x0, o.y0, o.x1, o.y1}, sizeof rep->crop_mm);
+  rep->pen_down_mm = lw_strokes_total_length(st);
+  rep->time_s = lw_strokes_time(st, rep->travel_after, p->speed_down, p->speed_up, p->lift_time);
   const lw_grid2d *under = p->preview_image ? tone : NULL;
   char path[LW_OUTPUT_PATH_MAX];
   dir_file(path, sizeof path, dir, "final.svg");
-  if (!(s = lw_output_svg(sp, &page, pl, path, err))) {
+  if (!(s = lw_output_svg_strokes(st, &page, path, err))) {
     dir_file(path, sizeof path, dir, "final.png");
-    s = lw_output_png(sp, &page, pl, under, p->png_scale, path, err);
+    s = lw_output_png_strokes(st, &page, under, p->png_scale, path, err);
   }
   if (!s && p->pdf) {
     dir_file(path, sizeof path, dir, "final.pdf");
-    s = lw_output_pdf(sp, &page, pl, under, path, err);
+    s = lw_output_pdf_strokes(st, &page, under, path, err);
   }
-  lw_plot_free(pl);
-  if (!s) s = lw_close_share(sp, p->pen_width, &rep->close_share, err);
-  if (!s && tone) {
-    s = lw_fidelity_compute(sp, tone, p->pen_width, p->fidelity_sigma, &rep->fidelity, err);
-    rep->has_fidelity = !s;
-  }
+  if (!s) s = close_share(p, st, rep, err);
+  if (!s && tone) s = score(p, st, tone, rep, err);
+  lw_strokes_free(st);
   return s;
 }
 
@@ -95,17 +152,32 @@ lw_status lw_drawing_frame(const lw_params *p, const lw_scene *sc, const lw_spli
   lw_output_page page;
   lw_status s = lw_drawing_page(p, &page, err);
   if (s) return s;
-  lw_plot *pl = make_plot(p, sc, sp, tone, LW_PLOT_ORDER_NONE, err);
+  lw_plot *pl = make_plot(p, sc, sp, tone, err);
   if (!pl) return err ? err->code : LW_ENOMEM;
   s = lw_output_frame(dir, sweep, sp, &page, pl, p->preview_image ? tone : NULL, p->png_scale, err);
   lw_plot_free(pl);
   return s;
 }
 
+static void fidelity_members(lw_json *j, const lw_fidelity *f)
+{
+  lw_json_key(j, "mse");
+  lw_json_number(j, f->mse);
+  lw_json_key(j, "ssim");
+  lw_json_number(j, f->ssim);
+  lw_json_key(j, "orientation");
+  lw_json_number(j, f->orientation);
+}
+
+static void count(lw_json *j, const char *key, size_t v)
+{
+  lw_json_key(j, key);
+  lw_json_int(j, (long long)v);
+}
+
 void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep)
 {
-  lw_json_key(j, "paths");
-  lw_json_int(j, (long long)rep->paths);
+  count(j, "paths", rep->paths);
   lw_json_key(j, "pen_up_travel_mm");
   lw_json_begin_object(j);
   lw_json_key(j, "before");
@@ -115,15 +187,76 @@ void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep)
   lw_json_end_object(j);
   lw_json_key(j, "close_share");
   lw_json_number(j, rep->close_share);
+  const lw_strokes_report *r = &rep->post;
+  lw_json_key(j, "plot");
+  lw_json_begin_object(j);
+  lw_json_key(j, "lifts");
+  lw_json_begin_object(j);
+  count(j, "before", r->lifts_before);
+  count(j, "after", r->lifts_after);
+  lw_json_end_object(j);
+  count(j, "joins", r->joins);
+  count(j, "cut", r->cut);
+  count(j, "outside", r->outside);
+  count(j, "dropped", r->dropped);
+  lw_json_key(j, "crop_mm");
+  if (rep->cropped) {
+    lw_json_begin_array(j);
+    for (int k = 0; k < 4; k++) lw_json_number(j, rep->crop_mm[k]);
+    lw_json_end_array(j);
+  } else {
+    lw_json_null(j);
+  }
+  lw_json_key(j, "pen_down_mm");
+  lw_json_number(j, rep->pen_down_mm);
+  lw_json_key(j, "pen_up_mm");
+  lw_json_number(j, rep->travel_after);
+  lw_json_key(j, "time_s");
+  lw_json_number(j, rep->time_s);
+  lw_json_end_object(j);
   if (rep->has_fidelity) {
     lw_json_key(j, "fidelity");
     lw_json_begin_object(j);
-    lw_json_key(j, "mse");
-    lw_json_number(j, rep->fidelity.mse);
-    lw_json_key(j, "ssim");
-    lw_json_number(j, rep->fidelity.ssim);
+    fidelity_members(j, &rep->fidelity);
     lw_json_key(j, "sigma_mm");
     lw_json_number(j, rep->fidelity.sigma_mm);
+    if (rep->n_pens > 1) {
+      lw_json_key(j, "pens");
+      lw_json_begin_array(j);
+      for (int k = 0; k < rep->n_pens; k++) {
+        lw_json_begin_object(j);
+        fidelity_members(j, &rep->pen_fidelity[k]);
+        lw_json_end_object(j);
+      }
+      lw_json_end_array(j);
+    }
     lw_json_end_object(j);
   }
+}
+
+/* h:mm:ss, or m:ss under an hour */
+static void clock_text(double s, char *buf, size_t n)
+{
+  long t = lround(s), h = t / 3600, m = t / 60 % 60, sec = t % 60;
+  if (h) snprintf(buf, n, "%ld:%02ld:%02ld", h, m, sec);
+  else snprintf(buf, n, "%ld:%02ld", m, sec);
+}
+
+void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
+{
+  const lw_strokes_report *r = &d->post;
+  char clock[32];
+  clock_text(d->time_s, clock, sizeof clock);
+  size_t k = 0;
+  int w = snprintf(buf, n,
+                   "linewise: %zu paths (%zu strokes: %zu joins, %zu cut by the crop, %zu outside it, %zu too short); "
+                   "pen-up travel %.1f mm in index order, %.1f mm as plotted\n"
+                   "linewise: plot time about %s (%.0f s: %.0f mm pen down, %zu lifts)\n",
+                   d->paths, r->lifts_before, r->joins, r->cut, r->outside, r->dropped, d->travel_before,
+                   d->travel_after, clock, d->time_s, d->pen_down_mm, r->lifts_after);
+  if (w < 0 || (size_t)w >= n) return;
+  k = (size_t)w;
+  if (d->has_fidelity)
+    snprintf(buf + k, n - k, "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f, orientation %.4f\n",
+             d->fidelity.sigma_mm, d->fidelity.mse, d->fidelity.ssim, d->fidelity.orientation);
 }

@@ -18,14 +18,34 @@ static lw_status check_raster(const lw_grid2d *t, lw_error *err)
   return LW_OK;
 }
 
+/* The splines as paths of one pen (strokes.h); NULL and err set when one is
+** not finite. */
+static lw_strokes *as_strokes(const lw_splines *sp, lw_error *err)
+{
+  if (!lw_splines_finite(sp)) {
+    lw_error_set(err, LW_EINPUT, "fidelity: a spline is not finite");
+    return NULL;
+  }
+  return lw_strokes_from_plot(sp, NULL, err);
+}
+
 lw_status lw_fidelity_render(const lw_splines *sp, const lw_grid2d *tone, double pen_width_mm, double *ink,
                              lw_error *err)
+{
+  lw_strokes *st = as_strokes(sp, err);
+  if (!st) return err ? err->code : LW_EINPUT;
+  lw_status s = lw_fidelity_render_strokes(st, -1, tone, pen_width_mm, ink, err);
+  lw_strokes_free(st);
+  return s;
+}
+
+lw_status lw_fidelity_render_strokes(const lw_strokes *st, int pen, const lw_grid2d *tone, double pen_width_mm,
+                                     double *ink, lw_error *err)
 {
   lw_status s = check_raster(tone, err);
   if (s) return s;
   if (!positive(pen_width_mm))
     return lw_error_set(err, LW_EINPUT, "fidelity: pen width %g mm: expected a positive number", pen_width_mm);
-  if (!lw_splines_finite(sp)) return lw_error_set(err, LW_EINPUT, "fidelity: a spline is not finite");
   /* A8: the alpha channel alone is the ink coverage. */
   cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_A8, tone->nx, tone->ny);
   cairo_t *cr = cairo_create(surf);
@@ -40,7 +60,7 @@ lw_status lw_fidelity_render(const lw_splines *sp, const lw_grid2d *tone, double
   cairo_set_line_width(cr, pen_width_mm);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
   cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
-  lw_output_cairo_splines(cr, sp);
+  lw_output_cairo_strokes(cr, st, pen);
   cairo_surface_flush(surf);
   if (cairo_status(cr)) {
     s = lw_error_set(err, LW_ERUN, "fidelity: rendering failed: %s", cairo_status_to_string(cairo_status(cr)));
@@ -128,6 +148,82 @@ lw_status lw_fidelity_blur(double *v, int w, int h, double sx, double sy, double
   return blur(v, w, h, sx, sy, radius(sx, truncate, w), radius(sy, truncate, h), err);
 }
 
+/* The local averages under the SSIM window of `planes` w x h images stored
+** one after the other in m, in place. */
+static lw_status window(double *m, int planes, int w, int h, lw_error *err)
+{
+  size_t n = (size_t)w * (size_t)h;
+  int rx = LW_FIDELITY_SSIM_RADIUS < w ? LW_FIDELITY_SSIM_RADIUS : w;
+  int ry = LW_FIDELITY_SSIM_RADIUS < h ? LW_FIDELITY_SSIM_RADIUS : h;
+  for (int q = 0; q < planes; q++) {
+    lw_status s = blur(m + (size_t)q * n, w, h, LW_FIDELITY_SSIM_SIGMA, LW_FIDELITY_SSIM_SIGMA, rx, ry, err);
+    if (s) return s;
+  }
+  return LW_OK;
+}
+
+/* Central differences (one-sided at the edges) of v into gx, gy. */
+static void gradient(const double *v, int w, int h, double *gx, double *gy)
+{
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) {
+      size_t k = (size_t)j * (size_t)w + (size_t)i;
+      int il = i > 0 ? i - 1 : i, ir = i + 1 < w ? i + 1 : i, jd = j > 0 ? j - 1 : j, ju = j + 1 < h ? j + 1 : j;
+      gx[k] = ir > il ? (v[(size_t)j * w + ir] - v[(size_t)j * w + il]) / (ir - il) : 0.0;
+      gy[k] = ju > jd ? (v[(size_t)ju * w + i] - v[(size_t)jd * w + i]) / (ju - jd) : 0.0;
+    }
+}
+
+/* The doubled-angle vector (Jxx - Jyy, 2 Jxy) of the structure tensor of v
+** under the SSIM window into u[0 .. 2n): its angle is twice the dominant
+** gradient direction, its length the anisotropy. */
+static lw_status tensor(const double *v, int w, int h, double *u, double *t, lw_error *err)
+{
+  size_t n = (size_t)w * (size_t)h;
+  double *gx = u, *gy = u + n, *jxx = t, *jxy = t + n, *jyy = t + 2 * n;
+  gradient(v, w, h, gx, gy);
+  for (size_t k = 0; k < n; k++) {
+    jxx[k] = gx[k] * gx[k];
+    jxy[k] = gx[k] * gy[k];
+    jyy[k] = gy[k] * gy[k];
+  }
+  lw_status s = window(t, 3, w, h, err);
+  if (s) return s;
+  for (size_t k = 0; k < n; k++) {
+    u[k] = jxx[k] - jyy[k];
+    u[n + k] = 2 * jxy[k];
+  }
+  return LW_OK;
+}
+
+/* Orientation agreement of a with b (the target): the mean of cos 2 dtheta
+** between their dominant gradient axes, weighted by b's anisotropy; a pixel
+** where a has no direction counts 0.  NaN where b has no structure. */
+static lw_status orientation(const double *a, const double *b, int w, int h, double *out, lw_error *err)
+{
+  size_t n = (size_t)w * (size_t)h;
+  double *m = malloc(7 * n * sizeof *m);
+  if (!m) return lw_error_set(err, LW_ENOMEM, "fidelity: out of memory for %d x %d pixels", w, h);
+  double *ua = m, *ub = m + 2 * n, *t = m + 4 * n;
+  lw_status s;
+  if ((s = tensor(a, w, h, ua, t, err)) || (s = tensor(b, w, h, ub, t, err))) {
+    free(m);
+    return s;
+  }
+  /* below LW_FIDELITY_FLAT a pixel has no direction: rounding in the blur
+  ** leaves gradients of ~1e-17 on a flat image */
+  double num = 0.0, den = 0.0, flat = LW_FIDELITY_FLAT * LW_FIDELITY_FLAT;
+  for (size_t k = 0; k < n; k++) {
+    double la = hypot(ua[k], ua[n + k]), lb = hypot(ub[k], ub[n + k]);
+    if (lb <= flat) continue;
+    den += lb;
+    if (la > flat) num += (ua[k] * ub[k] + ua[n + k] * ub[n + k]) / la;
+  }
+  *out = den > 0 ? num / den : NAN;
+  free(m);
+  return LW_OK;
+}
+
 lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, double sy, lw_fidelity *out,
                               lw_error *err)
 {
@@ -152,14 +248,10 @@ lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, dou
     bb[k] = b[k] * b[k];
     ab[k] = a[k] * b[k];
   }
-  const double sw = LW_FIDELITY_SSIM_SIGMA;
-  int rx = LW_FIDELITY_SSIM_RADIUS < w ? LW_FIDELITY_SSIM_RADIUS : w;
-  int ry = LW_FIDELITY_SSIM_RADIUS < h ? LW_FIDELITY_SSIM_RADIUS : h;
-  for (int q = 0; q < 5; q++)
-    if ((s = blur(m + (size_t)q * n, w, h, sw, sw, rx, ry, err))) {
-      free(m);
-      return s;
-    }
+  if ((s = window(m, 5, w, h, err))) {
+    free(m);
+    return s;
+  }
   const double C1 = 0.01 * 0.01, C2 = 0.03 * 0.03; /* L = 1 */
   sum = 0.0;
   for (size_t k = 0; k < n; k++) {
@@ -169,11 +261,21 @@ lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, dou
   }
   out->ssim = sum / (double)n;
   free(m);
-  return LW_OK;
+  return orientation(a, b, w, h, &out->orientation, err);
 }
 
 lw_status lw_fidelity_compute(const lw_splines *sp, const lw_grid2d *tone, double pen_width_mm,
                               double sigma_mm, lw_fidelity *out, lw_error *err)
+{
+  lw_strokes *st = as_strokes(sp, err);
+  if (!st) return err ? err->code : LW_EINPUT;
+  lw_status s = lw_fidelity_compute_strokes(st, -1, tone, pen_width_mm, sigma_mm, out, err);
+  lw_strokes_free(st);
+  return s;
+}
+
+lw_status lw_fidelity_compute_strokes(const lw_strokes *st, int pen, const lw_grid2d *tone, double pen_width_mm,
+                                      double sigma_mm, lw_fidelity *out, lw_error *err)
 {
   lw_status s = check_raster(tone, err);
   if (s) return s;
@@ -190,7 +292,7 @@ lw_status lw_fidelity_compute(const lw_splines *sp, const lw_grid2d *tone, doubl
     double t = tone->data[k];
     dark[k] = 1.0 - (t < 0 ? 0 : t > 1 ? 1 : t);
   }
-  if (!(s = lw_fidelity_render(sp, tone, pen_width_mm, ink, err)))
+  if (!(s = lw_fidelity_render_strokes(st, pen, tone, pen_width_mm, ink, err)))
     s = lw_fidelity_compare(ink, dark, tone->nx, tone->ny, sigma_mm / tone->hx, sigma_mm / tone->hy, out, err);
   out->sigma_mm = sigma_mm;
   free(ink);

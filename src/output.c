@@ -102,10 +102,11 @@ void lw_output_abort(FILE *f, const char *tmp)
 
 static int positive(double x) { return isfinite(x) && x > 0; }
 
-/* Everything is checked before a temporary file exists, so bad input never
-** costs a file operation. */
-static lw_status check_input(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
-                             const lw_grid2d *tone, const char *path, lw_error *err)
+/* The page and tone of a drawing with n_pens pens.  Everything is checked
+** before a temporary file exists, so bad input never costs a file
+** operation. */
+static lw_status check_page(const lw_output_page *page, int n_pens, const lw_grid2d *tone, const char *path,
+                            lw_error *err)
 {
   if (!positive(page->width_mm) || !positive(page->height_mm))
     return lw_error_set(err, LW_EINPUT, "%s: page size %g x %g mm: expected positive numbers", path,
@@ -116,58 +117,57 @@ static lw_status check_input(const lw_splines *sp, const lw_output_page *page, c
     if (!positive(page->pen[k].width_mm))
       return lw_error_set(err, LW_EINPUT, "%s: pen %d width %g mm: expected a positive number", path, k + 1,
                           page->pen[k].width_mm);
-  if (plot) {
-    if (plot->n_pens != page->n_pens || plot->pen_first[plot->n_pens] != plot->n)
-      return lw_error_set(err, LW_EINPUT, "%s: the plot has %d pens, the page %d", path, plot->n_pens,
-                          page->n_pens);
-    for (size_t k = 0; k < plot->n; k++)
-      if (plot->spline[k] >= sp->n_splines)
-        return lw_error_set(err, LW_EINPUT, "%s: the plot names spline %zu of %zu", path, plot->spline[k],
-                            sp->n_splines);
-  }
+  if (n_pens != page->n_pens)
+    return lw_error_set(err, LW_EINPUT, "%s: the plot has %d pens, the page %d", path, n_pens, page->n_pens);
   if (tone && (tone->ncomp != 1 || tone->nx < 1 || tone->ny < 1 || !positive(tone->hx) || !positive(tone->hy)))
     return lw_error_set(err, LW_EINPUT, "%s: the tone raster must have one value per pixel", path);
-  for (size_t i = 0; i < sp->n_splines; i++)
-    for (size_t k = sp->first[i]; k < sp->first[i + 1]; k++) {
-      const lw_node *nd = &sp->node[k];
-      if (!isfinite(nd->px) || !isfinite(nd->py) || !isfinite(nd->vx) || !isfinite(nd->vy))
-        return lw_error_set(err, LW_EINPUT, "%s: spline %zu node %zu is not finite", path, i,
-                            k - sp->first[i]);
-    }
   return LW_OK;
 }
 
-/* The paths of pen k in drawing order: a plot's, or without one every
-** spline that is not a point, forward, all pen 0's. */
-typedef struct {
-  const lw_splines *sp;
-  const lw_plot *plot;
-  size_t at, end;
-} path_walk;
-
-static void walk_pen(path_walk *w, const lw_splines *sp, const lw_plot *plot, int k)
+/* The splines and plot of a drawing as paths (strokes.h), after checking
+** them; NULL and err set when they are bad. */
+static lw_strokes *checked_strokes(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
+                                   const lw_grid2d *tone, const char *path, lw_error *err)
 {
-  w->sp = sp;
-  w->plot = plot;
-  w->at = plot ? plot->pen_first[k] : 0;
-  w->end = plot ? plot->pen_first[k + 1] : k == 0 ? sp->n_splines : 0;
+  if (check_page(page, plot ? plot->n_pens : page->n_pens, tone, path, err)) return NULL;
+  if (plot) {
+    if (plot->pen_first[plot->n_pens] != plot->n) {
+      lw_error_set(err, LW_EINPUT, "%s: the plot's pens hold %zu paths of %zu", path, plot->pen_first[plot->n_pens],
+                   plot->n);
+      return NULL;
+    }
+    for (size_t k = 0; k < plot->n; k++)
+      if (plot->spline[k] >= sp->n_splines) {
+        lw_error_set(err, LW_EINPUT, "%s: the plot names spline %zu of %zu", path, plot->spline[k], sp->n_splines);
+        return NULL;
+      }
+  }
+  for (size_t i = 0; i < sp->n_splines; i++)
+    for (size_t k = sp->first[i]; k < sp->first[i + 1]; k++) {
+      const lw_node *nd = &sp->node[k];
+      if (!isfinite(nd->px) || !isfinite(nd->py) || !isfinite(nd->vx) || !isfinite(nd->vy)) {
+        lw_error_set(err, LW_EINPUT, "%s: spline %zu node %zu is not finite", path, i, k - sp->first[i]);
+        return NULL;
+      }
+    }
+  lw_strokes *s = lw_strokes_from_plot(sp, plot, err);
+  if (s && !plot) {
+    /* without a plot every path is pen 1's, whatever the page holds */
+    s->n_pens = page->n_pens;
+    for (int k = 1; k <= page->n_pens; k++) s->pen_first[k] = s->n;
+  }
+  return s;
 }
 
-static int walk_next(path_walk *w, size_t *spline, int *reversed)
+static lw_status check_strokes(const lw_strokes *s, const lw_output_page *page, const lw_grid2d *tone,
+                               const char *path, lw_error *err)
 {
-  for (; w->at < w->end; w->at++) {
-    if (w->plot) {
-      *spline = w->plot->spline[w->at];
-      *reversed = w->plot->reversed[w->at];
-    } else {
-      if (lw_splines_is_point(w->sp, w->at)) continue;
-      *spline = w->at;
-      *reversed = 0;
-    }
-    w->at++;
-    return 1;
-  }
-  return 0;
+  lw_status st = check_page(page, s->n_pens, tone, path, err);
+  if (st) return st;
+  for (size_t k = 0; k < 8 * s->n_segs; k++)
+    if (!isfinite(s->b[k]))
+      return lw_error_set(err, LW_EINPUT, "%s: a control point of segment %zu is not finite", path, k / 8);
+  return LW_OK;
 }
 
 /* ---- SVG -------------------------------------------------------------- */
@@ -200,31 +200,38 @@ static void put_coords(FILE *f, const double *xy, int n)
 /* One path's d attribute.  Reversed, segment m's control points b3 b2 b1
 ** b0 are written as they are, last segment first: the same numbers, so the
 ** same curve to the last printed digit. */
-static void put_path_data(FILE *f, const lw_splines *sp, size_t i, int reversed)
+static void put_path_data(FILE *f, const lw_strokes *s, size_t k)
 {
-  size_t n = lw_splines_segments(sp, i);
-  double b[8], r[8];
+  size_t a = s->first[k], n = s->first[k + 1] - a;
+  int reversed = s->reversed[k];
+  double r[8];
   fputs("M", f);
-  for (size_t k = 0; k < n; k++) {
-    size_t m = reversed ? n - 1 - k : k;
-    lw_splines_bezier(sp, i, m, b);
+  for (size_t j = 0; j < n; j++) {
+    const double *b = s->b + 8 * (reversed ? a + n - 1 - j : a + j);
     if (reversed)
       for (int c = 0; c < 4; c++) {
         r[2 * c] = b[6 - 2 * c];
         r[2 * c + 1] = b[7 - 2 * c];
       }
     const double *cp = reversed ? r : b;
-    if (!k) put_coords(f, cp, 1);
+    if (!j) put_coords(f, cp, 1);
     fputs(" C", f);
     put_coords(f, cp + 2, 3);
   }
 }
 
-lw_status lw_output_svg(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
-                        const char *path, lw_error *err)
+/* The first and one-past-last path of pen k. */
+static void pen_range(const lw_strokes *s, int k, size_t *a, size_t *z)
 {
-  lw_status s = check_input(sp, page, plot, NULL, path, err);
-  if (s) return s;
+  *a = s->pen_first[k];
+  *z = k + 1 < s->n_pens ? s->pen_first[k + 1] : s->n;
+}
+
+lw_status lw_output_svg_strokes(const lw_strokes *s, const lw_output_page *page, const char *path,
+                                lw_error *err)
+{
+  lw_status st = check_strokes(s, page, NULL, path, err);
+  if (st) return st;
   char tmp[LW_OUTPUT_PATH_MAX];
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
   if (!f) return err ? err->code : LW_EIO;
@@ -248,18 +255,18 @@ lw_status lw_output_svg(const lw_splines *sp, const lw_output_page *page, const 
     fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"pen %d (", k + 1);
     put_mm(f, pen->width_mm);
     fprintf(f, " mm)\" id=\"pen%d\">\n", k + 1);
-    path_walk w;
-    walk_pen(&w, sp, plot, k);
-    size_t i;
-    int reversed;
-    while (walk_next(&w, &i, &reversed)) {
+    size_t a, z;
+    pen_range(s, k, &a, &z);
+    for (size_t j = a; j < z; j++) {
       /* Style on every path rather than inherited from the group: simple
       ** plotter tools read a path's own attributes only, and a closed curve
       ** would otherwise be filled black. */
-      fprintf(f, "    <path id=\"spline%zu\" fill=\"none\" stroke=\"%s\" stroke-width=\"", i, color);
+      fprintf(f, "    <path id=\"spline%zu", s->src[j]);
+      if (s->part[j]) fprintf(f, "-%u", s->part[j]);
+      fprintf(f, "\" fill=\"none\" stroke=\"%s\" stroke-width=\"", color);
       put_mm(f, pen->width_mm);
       fputs("\" stroke-linecap=\"round\" stroke-linejoin=\"round\"\n      d=\"", f);
-      put_path_data(f, sp, i, reversed);
+      put_path_data(f, s, j);
       fputs("\"/>\n", f);
     }
     fputs("  </g>\n", f);
@@ -268,25 +275,36 @@ lw_status lw_output_svg(const lw_splines *sp, const lw_output_page *page, const 
   return lw_output_commit(f, tmp, path, err);
 }
 
+lw_status lw_output_svg(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
+                        const char *path, lw_error *err)
+{
+  lw_strokes *s = checked_strokes(sp, page, plot, NULL, path, err);
+  if (!s) return err ? err->code : LW_EINPUT;
+  lw_status st = lw_output_svg_strokes(s, page, path, err);
+  lw_strokes_free(s);
+  return st;
+}
+
 /* ---- cairo drawings ----------------------------------------------------- */
 
-static void trace_spline(cairo_t *cr, const lw_splines *sp, size_t i)
+/* Path k of s as a cairo path, forward: a stroke is the same shape either
+** way. */
+static void trace_path(cairo_t *cr, const lw_strokes *s, size_t k)
 {
-  size_t n = lw_splines_segments(sp, i);
-  double b[8];
-  for (size_t m = 0; m < n; m++) {
-    lw_splines_bezier(sp, i, m, b);
-    if (!m) cairo_move_to(cr, b[0], b[1]);
+  for (size_t m = s->first[k]; m < s->first[k + 1]; m++) {
+    const double *b = s->b + 8 * m;
+    if (m == s->first[k]) cairo_move_to(cr, b[0], b[1]);
     cairo_curve_to(cr, b[2], b[3], b[4], b[5], b[6], b[7]);
   }
 }
 
-void lw_output_cairo_splines(cairo_t *cr, const lw_splines *sp)
+void lw_output_cairo_strokes(cairo_t *cr, const lw_strokes *s, int pen)
 {
-  for (size_t i = 0; i < sp->n_splines; i++) {
-    if (lw_splines_is_point(sp, i)) continue;
-    trace_spline(cr, sp, i);
-    /* One stroke per spline keeps cairo's path memory to one spline. */
+  size_t a = 0, z = s->n;
+  if (pen >= 0) pen_range(s, pen, &a, &z);
+  for (size_t k = a; k < z; k++) {
+    trace_path(cr, s, k);
+    /* One stroke per path keeps cairo's path memory to one path. */
     cairo_stroke(cr);
   }
 }
@@ -329,8 +347,7 @@ static void paint_tone(cairo_t *cr, const lw_grid2d *tone)
 }
 
 /* The whole drawing on cr, whose user unit is 1 mm. */
-static void draw(cairo_t *cr, const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
-                 const lw_grid2d *tone)
+static void draw(cairo_t *cr, const lw_strokes *s, const lw_output_page *page, const lw_grid2d *tone)
 {
   if (tone) paint_tone(cr, tone);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
@@ -339,16 +356,7 @@ static void draw(cairo_t *cr, const lw_splines *sp, const lw_output_page *page, 
     const lw_output_pen *pen = &page->pen[k];
     cairo_set_source_rgb(cr, pen->rgb[0] / 255.0, pen->rgb[1] / 255.0, pen->rgb[2] / 255.0);
     cairo_set_line_width(cr, pen->width_mm);
-    path_walk w;
-    walk_pen(&w, sp, plot, k);
-    size_t i;
-    int reversed;
-    /* Drawn forward whatever the plot's direction: a stroke is the same
-    ** shape either way. */
-    while (walk_next(&w, &i, &reversed)) {
-      trace_spline(cr, sp, i);
-      cairo_stroke(cr);
-    }
+    lw_output_cairo_strokes(cr, s, k);
   }
 }
 
@@ -375,10 +383,10 @@ static cairo_status_t file_write(void *closure, const unsigned char *data, unsig
   return fwrite(data, 1, length, closure) == length ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
 }
 
-lw_status lw_output_png(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
-                        const lw_grid2d *tone, double px_per_mm, const char *path, lw_error *err)
+lw_status lw_output_png_strokes(const lw_strokes *st, const lw_output_page *page, const lw_grid2d *tone,
+                                double px_per_mm, const char *path, lw_error *err)
 {
-  lw_status s = check_input(sp, page, plot, tone, path, err);
+  lw_status s = check_strokes(st, page, tone, path, err);
   if (s) return s;
   int w, h;
   double k;
@@ -398,7 +406,7 @@ lw_status lw_output_png(const lw_splines *sp, const lw_output_page *page, const 
   cairo_paint(cr);
   /* Draw in mm: the line width is then the pen width in page units. */
   cairo_scale(cr, k, k);
-  draw(cr, sp, page, plot, tone);
+  draw(cr, st, page, tone);
   cairo_surface_flush(surf);
   if (cairo_status(cr)) {
     s = lw_error_set(err, LW_ERUN, "%s: drawing the preview failed: %s", path,
@@ -428,6 +436,16 @@ done:
   return s;
 }
 
+lw_status lw_output_png(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
+                        const lw_grid2d *tone, double px_per_mm, const char *path, lw_error *err)
+{
+  lw_strokes *s = checked_strokes(sp, page, plot, tone, path, err);
+  if (!s) return err ? err->code : LW_EINPUT;
+  lw_status st = lw_output_png_strokes(s, page, tone, px_per_mm, path, err);
+  lw_strokes_free(s);
+  return st;
+}
+
 lw_status lw_output_frame(const char *dir, long sweep, const lw_splines *sp, const lw_output_page *page,
                           const lw_plot *plot, const lw_grid2d *tone, double px_per_mm, lw_error *err)
 {
@@ -443,10 +461,10 @@ lw_status lw_output_frame(const char *dir, long sweep, const lw_splines *sp, con
 
 /* ---- PDF -------------------------------------------------------------- */
 
-lw_status lw_output_pdf(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
-                        const lw_grid2d *tone, const char *path, lw_error *err)
+lw_status lw_output_pdf_strokes(const lw_strokes *st, const lw_output_page *page, const lw_grid2d *tone,
+                                const char *path, lw_error *err)
 {
-  lw_status s = check_input(sp, page, plot, tone, path, err);
+  lw_status s = check_strokes(st, page, tone, path, err);
   if (s) return s;
   char tmp[LW_OUTPUT_PATH_MAX];
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
@@ -459,7 +477,7 @@ lw_status lw_output_pdf(const lw_splines *sp, const lw_output_page *page, const 
   cairo_pdf_surface_set_metadata(surf, CAIRO_PDF_METADATA_CREATE_DATE, "");
   cairo_t *cr = cairo_create(surf);
   cairo_scale(cr, pt_per_mm, pt_per_mm);
-  draw(cr, sp, page, plot, tone);
+  draw(cr, st, page, tone);
   cairo_status_t cs = cairo_status(cr);
   cairo_destroy(cr);
   /* finishing writes the document; stream errors show up only now */
@@ -472,4 +490,14 @@ lw_status lw_output_pdf(const lw_splines *sp, const lw_output_page *page, const 
                         path, cairo_status_to_string(cs));
   }
   return lw_output_commit(f, tmp, path, err);
+}
+
+lw_status lw_output_pdf(const lw_splines *sp, const lw_output_page *page, const lw_plot *plot,
+                        const lw_grid2d *tone, const char *path, lw_error *err)
+{
+  lw_strokes *s = checked_strokes(sp, page, plot, tone, path, err);
+  if (!s) return err ? err->code : LW_EINPUT;
+  lw_status st = lw_output_pdf_strokes(s, page, tone, path, err);
+  lw_strokes_free(s);
+  return st;
 }

@@ -273,6 +273,29 @@ const lw_param_def lw_param_table[] = {
   NUM("output", "field_preview", LW_PT_INT, field_preview, "0", "", 0, 1, 0,
       "1 = write field.png at the start of a run: the tone (white without an image) under "
       "short strokes along the field (needs the field term)."),
+  NUM("plot", "join_distance", LW_PT_DOUBLE, join_distance, "1", "pen widths", 0, 1000, 0,
+      "Strokes of one pen whose ends lie at most this far apart (in widths of the pen: a gap "
+      "the ink closes anyway) and align within `join_angle` become one path, bridged by a short "
+      "curve along both tangents: one pen lift fewer. 0 = no joining."),
+  NUM("plot", "join_angle", LW_PT_DOUBLE, join_angle, "30", "degrees", 0, 180, 0,
+      "Largest turn at a join: between the direction out of the one stroke's end and into the "
+      "other's. 30 degrees reads as one bending line; 180 joins any two ends that are close."),
+  NUM("plot", "crop", LW_PT_INT, crop, "1", "", 0, 1, 0,
+      "1 = cut every path at the edge of the picture's rectangle (without a picture: the page "
+      "inset by scene.margin) and keep the pieces inside, split exactly at the crossing; 0 = "
+      "draw strokes as they lie, margins included."),
+  NUM("plot", "min_length", LW_PT_DOUBLE, min_length, "3", "pen widths", 0, 1e6, 0,
+      "Paths shorter than this (in widths of the pen), after joining and cropping, are left "
+      "out: below about three widths a stroke prints as a dot and costs a whole pen lift. 0 = "
+      "keep all."),
+  NUM("plot", "speed_down", LW_PT_DOUBLE, speed_down, "50", "mm/s", 0, 1e5, LW_MIN_OPEN,
+      "Pen-down speed for the plot time estimate. The default is an AxiDraw's at its default "
+      "settings (speed_pendown 25 % of the 8.6979 in/s high-resolution limit, scaled by 1/110)."),
+  NUM("plot", "speed_up", LW_PT_DOUBLE, speed_up, "150", "mm/s", 0, 1e5, LW_MIN_OPEN,
+      "Pen-up (travel) speed for the plot time estimate; AxiDraw default speed_penup 75 %."),
+  NUM("plot", "lift_time", LW_PT_DOUBLE, lift_time, "0.2", "s", 0, 1e3, 0,
+      "Time of one pen lift and lowering for the plot time estimate; an AxiDraw's servo at its "
+      "default rates (raise 75 %, lower 50 %, over 30 % of a 200 ms sweep) takes about 0.2 s."),
   NUM("particles", "count", LW_PT_INT, pt_count, "100", "", 0, 1e7, 0,
       "Particles placed by `pattern` (after those of `points`, if any)."),
   CHOICE("particles", "pattern", pt_pattern, "plane", "cloud|plane|sphere",

@@ -56,6 +56,28 @@ static void ends(const lw_splines *sp, const size_t *spline, size_t n, lw_order_
   }
 }
 
+lw_status lw_plot_order_paths(const lw_order_path *path, size_t n, lw_plot_order order, double hx, double hy,
+                              size_t *tour, unsigned char *rev, double *before, double *after, lw_error *err)
+{
+  for (size_t k = 0; k < n; k++) tour[k] = k;
+  memset(rev, 0, n);
+  *before = *after = lw_order_travel(path, n, NULL, NULL, hx, hy);
+  if (order == LW_PLOT_ORDER_NONE) return LW_OK;
+  lw_status s = lw_order_greedy(path, n, hx, hy, tour, rev, err);
+  if (s) return s;
+  *after = lw_order_travel(path, n, tour, rev, hx, hy);
+  if (*after > *before) {
+    for (size_t k = 0; k < n; k++) tour[k] = k;
+    memset(rev, 0, n);
+    *after = *before;
+  }
+  if (order == LW_PLOT_ORDER_2OPT) {
+    if ((s = lw_order_2opt(path, n, hx, hy, tour, rev, err))) return s;
+    *after = lw_order_travel(path, n, tour, rev, hx, hy);
+  }
+  return LW_OK;
+}
+
 /* Orders the n paths spline[] / rev[] of one pen in place; adds the travel
 ** before and after to the plot's sums. */
 static lw_status order_pen(lw_plot *pl, const lw_splines *sp, size_t *spline, unsigned char *rev, size_t n,
@@ -70,24 +92,12 @@ static lw_status order_pen(lw_plot *pl, const lw_splines *sp, size_t *spline, un
     goto done;
   }
   ends(sp, spline, n, path);
-  double before = lw_order_travel(path, n, NULL, NULL, hx, hy), after = before;
-  if (order != LW_PLOT_ORDER_NONE) {
-    if ((s = lw_order_greedy(path, n, hx, hy, tour, trev, err))) goto done;
-    after = lw_order_travel(path, n, tour, trev, hx, hy);
-    if (after > before) {
-      for (size_t k = 0; k < n; k++) tour[k] = k;
-      memset(trev, 0, n);
-      after = before;
-    }
-    if (order == LW_PLOT_ORDER_2OPT) {
-      if ((s = lw_order_2opt(path, n, hx, hy, tour, trev, err))) goto done;
-      after = lw_order_travel(path, n, tour, trev, hx, hy);
-    }
-    /* tour[] indexes this pen's list: map it back to splines */
-    for (size_t k = 0; k < n; k++) tour[k] = spline[tour[k]];
-    memcpy(spline, tour, n * sizeof *spline);
-    memcpy(rev, trev, n);
-  }
+  double before, after;
+  if ((s = lw_plot_order_paths(path, n, order, hx, hy, tour, trev, &before, &after, err))) goto done;
+  /* tour[] indexes this pen's list: map it back to splines */
+  for (size_t k = 0; k < n; k++) tour[k] = spline[tour[k]];
+  memcpy(spline, tour, n * sizeof *spline);
+  memcpy(rev, trev, n);
   pl->travel_before += before;
   pl->travel_after += after;
 done:

@@ -2,6 +2,7 @@
 #include "linewise/spacing.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 
 #include "linewise/grid.h"
@@ -28,39 +29,37 @@ static size_t pieces(const double b[8], double h)
   return k > LW_SPACING_POINTS_MAX ? LW_SPACING_POINTS_MAX : (size_t)k;
 }
 
-lw_status lw_close_share(const lw_splines *sp, double d, double *share, lw_error *err)
+lw_status lw_close_share(const double *b, const size_t *owner, size_t n_seg, double d, double *share, lw_error *err)
 {
   *share = 0.0;
   const double h = 0.5 * d;
   size_t n = 0;
-  double b[8], x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-  for (size_t g = 0; g < sp->n_segments; g++) {
-    const lw_node *a = &sp->node[lw_segment_node(sp, g)];
-    lw_segment_bezier(a, a + 1, b);
-    n += pieces(b, h);
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+  for (size_t g = 0; g < n_seg; g++) {
+    const double *z = b + 8 * g;
+    n += pieces(z, h);
     for (int k = 0; k < 8; k += 2) {
-      x0 = fmin(x0, b[k]);
-      x1 = fmax(x1, b[k]);
-      y0 = fmin(y0, b[k + 1]);
-      y1 = fmax(y1, b[k + 1]);
+      x0 = fmin(x0, z[k]);
+      x1 = fmax(x1, z[k]);
+      y0 = fmin(y0, z[k + 1]);
+      y1 = fmax(y1, z[k + 1]);
     }
   }
   if (n == 0) return LW_OK;
   if (n >= UINT32_MAX)
     return lw_error_set(err, LW_EINPUT, "close share: %zu points exceed the grid's limit of 2^32", n);
-  uint32_t *owner = malloc(n * sizeof *owner);
+  size_t *who = malloc(n * sizeof *who);
   float *w = malloc(n * sizeof *w);
-  lw_cellgrid *grid = owner && w ? lw_cellgrid_new(x0, y0, x1 - x0, y1 - y0, d, n, err) : NULL;
+  lw_cellgrid *grid = who && w ? lw_cellgrid_new(x0, y0, x1 - x0, y1 - y0, d, n, err) : NULL;
   lw_status st = grid ? LW_OK : LW_ENOMEM;
   size_t i = 0;
-  for (size_t g = 0; g < sp->n_segments && st == LW_OK; g++) {
-    const lw_node *a = &sp->node[lw_segment_node(sp, g)];
-    lw_segment_bezier(a, a + 1, b);
-    size_t k = pieces(b, h);
+  for (size_t g = 0; g < n_seg && st == LW_OK; g++) {
+    const double *z = b + 8 * g;
+    size_t k = pieces(z, h);
     for (size_t q = 0; q < k && st == LW_OK; q++, i++) {
       double x, y, speed;
-      bezier_at(b, ((double)q + 0.5) / (double)k, &x, &y, &speed);
-      owner[i] = sp->seg_spline[g];
+      bezier_at(z, ((double)q + 0.5) / (double)k, &x, &y, &speed);
+      who[i] = owner[g];
       w[i] = (float)(speed / (double)k);
       st = lw_cellgrid_insert(grid, (uint32_t)i, x, y, w[i]);
     }
@@ -77,10 +76,11 @@ lw_status lw_close_share(const lw_splines *sp, double d, double *share, lw_error
       for (int y = cy > 0 ? cy - 1 : 0; !found && y <= cy + 1 && y < grid->ny; y++)
         for (int x = cx > 0 ? cx - 1 : 0; !found && x <= cx + 1 && x < grid->nx; x++) {
           const lw_cell *o = &grid->cell[(size_t)y * (size_t)grid->nx + (size_t)x];
+          if (!o->n) continue; /* an empty cell may have no block */
           const uint32_t *idx = lw_cell_idx(o);
           for (uint32_t f = 0; f < o->n; f++) {
             double dx = o->x[f] - px, dy = lw_cell_y(o)[f] - py;
-            if (owner[idx[f]] != owner[me] && dx * dx + dy * dy < d2) {
+            if (who[idx[f]] != who[me] && dx * dx + dy * dy < d2) {
               found = 1;
               break;
             }
@@ -93,7 +93,28 @@ lw_status lw_close_share(const lw_splines *sp, double d, double *share, lw_error
   if (st == LW_OK) *share = all > 0.0 ? close / all : 0.0;
   else lw_error_set(err, LW_ENOMEM, "out of memory for the close share of %zu points", n);
   lw_cellgrid_free(grid);
-  free(owner);
+  free(who);
   free(w);
   return st;
+}
+
+lw_status lw_close_share_splines(const lw_splines *sp, double d, double *share, lw_error *err)
+{
+  size_t n = sp->n_segments ? sp->n_segments : 1;
+  double *b = malloc(8 * n * sizeof *b);
+  size_t *owner = malloc(n * sizeof *owner);
+  lw_status s = LW_ENOMEM;
+  if (b && owner) {
+    for (size_t g = 0; g < sp->n_segments; g++) {
+      const lw_node *a = &sp->node[lw_segment_node(sp, g)];
+      lw_segment_bezier(a, a + 1, b + 8 * g);
+      owner[g] = sp->seg_spline[g];
+    }
+    s = lw_close_share(b, owner, sp->n_segments, d, share, err);
+  } else {
+    lw_error_set(err, LW_ENOMEM, "out of memory for the close share of %zu segments", sp->n_segments);
+  }
+  free(b);
+  free(owner);
+  return s;
 }

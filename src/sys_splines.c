@@ -346,11 +346,7 @@ static void describe(const void *state, int what, char *buf, size_t n)
     snprintf(buf, n, "%zu splines, %zu segments", sp->n_splines, sp->n_segments);
     return;
   }
-  int k = snprintf(buf, n, "linewise: %zu paths; pen-up travel %.1f mm in index order, %.1f mm as plotted\n",
-                   d->paths, d->travel_before, d->travel_after);
-  if (d->has_fidelity && k >= 0 && (size_t)k < n)
-    snprintf(buf + k, n - (size_t)k, "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f\n", d->fidelity.sigma_mm,
-             d->fidelity.mse, d->fidelity.ssim);
+  lw_drawing_report_text(d, buf, n);
 }
 
 const lw_system_type lw_system_splines = {

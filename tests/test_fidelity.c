@@ -173,3 +173,70 @@ Test(fidelity, bad_input)
   lw_grid2d_free(tone);
   lw_splines_free(sp);
 }
+
+/* A target whose darkness varies across x only (isophotes run along y),
+** 60 x 40 mm at 0.2 mm pixels, and two drawings with the same ink: lines
+** along the isophotes spaced so that their density follows the darkness
+** (pen / spacing = darkness), and evenly spaced lines across them.  Every
+** score, at every blur, ranks the first above the second. */
+static double ramp_dark(double x) { return 0.05 + 0.3 * (0.5 + 0.5 * sin(2 * M_PI * x / 30.0)); }
+
+Test(fidelity, scores_rank_a_better_drawing_above_a_worse_one)
+{
+  const double px = 0.2, pen = 0.4;
+  const int w = 300, h = 200;
+  lw_grid2d *tone = lw_grid2d_new(w, h, 1, 0.5 * px, 0.5 * px, px, px, NULL);
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) tone->data[j * w + i] = 1.0 - ramp_dark((i + 0.5) * px);
+  size_t segs[200];
+  for (int k = 0; k < 200; k++) segs[k] = 1;
+  /* along: x_{k+1} = x_k + pen / darkness at the midpoint */
+  double xs[200];
+  size_t na = 0;
+  for (double x = 0.0; x < 60.0 && na < 200;) {
+    double step = pen / ramp_dark(x + 0.5 * pen / ramp_dark(x));
+    xs[na++] = x + 0.5 * step;
+    x += step;
+  }
+  lw_splines *good = lw_splines_new(na, segs, NULL);
+  for (size_t k = 0; k < na; k++) lw_test_straight(good, k, xs[k], -5, xs[k], 45);
+  /* across: the mean darkness 0.2 is a spacing of pen / 0.2 = 2 mm */
+  const size_t nb = 20;
+  lw_splines *bad = lw_splines_new(nb, segs, NULL);
+  for (size_t k = 0; k < nb; k++) lw_test_straight(bad, k, -5, 1 + 2.0 * k, 65, 1 + 2.0 * k);
+  const double sigma[3] = {0.5, 1.0, 2.0};
+  for (int s = 0; s < 3; s++) {
+    lw_fidelity a, b;
+    cr_assert_eq(lw_fidelity_compute(good, tone, pen, sigma[s], &a, NULL), LW_OK);
+    cr_assert_eq(lw_fidelity_compute(bad, tone, pen, sigma[s], &b, NULL), LW_OK);
+    cr_assert(a.mse < b.mse, "sigma %g: mse %g vs %g", sigma[s], a.mse, b.mse);
+    cr_assert(a.ssim > b.ssim, "sigma %g: ssim %g vs %g", sigma[s], a.ssim, b.ssim);
+    cr_assert(a.orientation > b.orientation + 0.5, "sigma %g: orientation %g vs %g", sigma[s], a.orientation,
+              b.orientation);
+    cr_assert(a.orientation > 0.8 && b.orientation < 0.1, "sigma %g: orientation %g vs %g", sigma[s], a.orientation,
+              b.orientation);
+  }
+  lw_splines_free(good);
+  lw_splines_free(bad);
+  lw_grid2d_free(tone);
+}
+
+Test(fidelity, orientation_of_a_flat_target_is_undefined_and_of_no_ink_zero)
+{
+  const int w = 40, h = 30;
+  double a[40 * 30], b[40 * 30];
+  lw_fidelity f;
+  for (int k = 0; k < w * h; k++) a[k] = b[k] = 0.3;
+  cr_assert_eq(lw_fidelity_compare(a, b, w, h, 1, 1, &f, NULL), LW_OK);
+  cr_assert(isnan(f.orientation));
+  disc(b, w, h, 20, 15);
+  for (int k = 0; k < w * h; k++) a[k] = 0.0;
+  cr_assert_eq(lw_fidelity_compare(a, b, w, h, 1, 1, &f, NULL), LW_OK);
+  cr_assert_eq(f.orientation, 0.0);
+  /* the same disc, fainter: structure alike, tone not */
+  disc(a, w, h, 20, 15);
+  for (int k = 0; k < w * h; k++) a[k] *= 0.3;
+  disc(b, w, h, 20, 15);
+  cr_assert_eq(lw_fidelity_compare(a, b, w, h, 1, 1, &f, NULL), LW_OK);
+  cr_assert(fabs(f.orientation - 1) < 1e-12, "%g", f.orientation);
+}

@@ -507,7 +507,7 @@ Test(tone, close_share_of_known_layouts)
     lw_test_straight(sp, 0, 10, 10, 30, 10);
     lw_test_straight(sp, 1, 10, 10 + gap[k], 30, 10 + gap[k]);
     double share;
-    cr_assert_eq(lw_close_share(sp, d, &share, NULL), LW_OK);
+    cr_assert_eq(lw_close_share_splines(sp, d, &share, NULL), LW_OK);
     cr_assert(fabs(share - want[k]) < 1e-12, "gap %g: share %g", gap[k], share);
     lw_splines_free(sp);
   }
@@ -516,7 +516,7 @@ Test(tone, close_share_of_known_layouts)
   lw_test_straight(sp, 0, 10, 20, 30, 20);
   lw_test_straight(sp, 1, 20.013, 10, 20.013, 30);
   double share;
-  cr_assert_eq(lw_close_share(sp, d, &share, NULL), LW_OK);
+  cr_assert_eq(lw_close_share_splines(sp, d, &share, NULL), LW_OK);
   cr_assert(fabs(share - 0.6 / 20) <= 0.5 * d / 20, "crossing: share %g, want %g", share, 0.6 / 20);
   lw_splines_free(sp);
 }

@@ -26,25 +26,22 @@ static lw_params tone_scene(bench_ctx *b, double T, double sigma, double spacing
   return p;
 }
 
-void bench_tone(bench_ctx *b)
+/* Times the rows' scenes interleaved (ratios to the first) and writes a table. */
+typedef struct {
+  const char *name;
+  double T, sigma, spacing;
+  int pair;
+} tone_row;
+
+/* Returns the raster's pixel, mm (0 without a tone row). */
+static double tone_table(bench_ctx *b, const tone_row *row, int n)
 {
   FILE *d = b->doc[BENCH_PERFORMANCE];
-  enum { N = 7 };
-  struct {
-    const char *name;
-    double T, sigma, spacing;
-  } row[N] = {
-      {"the scene's terms, tone off", 0, 1, 0},
-      {"tone named with coefficient 0 (off)", 0, 2, 0},
-      {"tone, blur 0.5 mm", 1, 0.5, 0},
-      {"tone, blur 1 mm", 1, 1, 0},
-      {"tone, blur 2 mm", 1, 2, 0},
-      {"the scene's terms, min_spacing 0.35 mm", 0, 1, 0.35},
-      {"tone blur 1 mm and min_spacing 0.35 mm", 1, 1, 0.35},
-  };
-  bench_run r[N];
-  for (int i = 0; i < N; i++) {
+  enum { MAXR = 8 };
+  bench_run r[MAXR];
+  for (int i = 0; i < n; i++) {
     lw_params p = tone_scene(b, row[i].T, row[i].sigma, row[i].spacing);
+    if (!row[i].pair) p.pair = 0;
     lw_splines *sp = lw_splines_clone(b->ann_splines);
     if (!sp) bench_die("out of memory", NULL);
     bench_run_init(&r[i], &p, sp, 0.002, b->ann_step);
@@ -52,21 +49,13 @@ void bench_tone(bench_ctx *b)
   const double step[2] = {0.2, 0.2};
   const int nt = 4096;
   bench_trial *trials = bench_trials_new(r[0].model->sp, step, nt);
-  double ev[N], ratio[N], spread[N], ns[N], unused[N];
-  bench_time_runs(b, r, N, 0, trials, nt, ev, ratio, spread);
-  bench_time_runs(b, r, N, 0, NULL, 0, ns, unused, NULL);
+  double ev[MAXR], ratio[MAXR], spread[MAXR], ns[MAXR], unused[MAXR];
+  bench_time_runs(b, r, n, 0, trials, nt, ev, ratio, spread);
+  bench_time_runs(b, r, n, 0, NULL, 0, ns, unused, NULL);
   free(trials);
-  fprintf(d, "## The tone term and the spacing constraint\n\n"
-             "The accuracy scene (params/example.ini annealed, %zu splines, its picture 300 pixels of\n"
-             "%.2f mm) with the tone term added (coefficient 1; docs/NUMERICS.md) at three blurs, and\n"
-             "with the spacing constraint (energy.min_spacing, which needs the scene's pair term).\n"
-             "Evaluation: the same %d point and vector moves of 0.2 mm, evaluated and never\n"
-             "committed; ratio to the first row block by block (+- the median absolute deviation).\n"
-             "Chain: the Metropolis walk at T = 0.002 with the anneal's final steps.\n\n"
-             "| scene | footprint pixels | ns per evaluation | extra ns | ratio | ns per chain proposal | acceptance |\n"
-             "|---|---|---|---|---|---|---|\n",
-          b->ann_splines->n_splines, r[2].scene.tone.pixel, nt);
-  for (int i = 0; i < N; i++) {
+  fprintf(d, "| scene | footprint pixels | ns per evaluation | extra ns | ratio | ns per chain proposal | acceptance |\n"
+             "|---|---|---|---|---|---|---|\n");
+  for (int i = 0; i < n; i++) {
     char fp[32] = "-", extra[32] = "-";
     int side = 2 * r[i].scene.tone.radius + 1;
     if (row[i].T > 0) snprintf(fp, sizeof fp, "%d x %d", side, side);
@@ -74,12 +63,48 @@ void bench_tone(bench_ctx *b)
     fprintf(d, "| %s | %s | %.0f | %s | %.3f +- %.3f | %.0f | %.2f |\n", row[i].name, fp, ev[i], extra, ratio[i],
             spread[i], ns[i], bench_run_acceptance(&r[i]));
   }
-  fprintf(d, "\nA move splats the old and new samples of its segments (2 x 2 x %d for a point\n"
-             "move) into a box of changes and sums the box: the cost grows with the footprint's\n"
-             "area, (2 ceil(3 sigma / pixel) + 1)^2 pixels a sample. Named with coefficient 0 the\n"
-             "term builds nothing (no target, no raster, no box) and costs nothing.\n\n",
-          r[0].scene.quad.n);
-  for (int i = 0; i < N; i++) bench_run_free(&r[i]);
+  fprintf(d, "\n");
+  double pixel = 0.0;
+  for (int i = 0; i < n; i++) {
+    if (row[i].T > 0) pixel = r[i].scene.tone.pixel;
+    bench_run_free(&r[i]);
+  }
+  return pixel;
+}
+
+void bench_tone(bench_ctx *b)
+{
+  FILE *d = b->doc[BENCH_PERFORMANCE];
+  bench_annealed(b);
+  static const tone_row alone[] = {
+      {"the scene's terms but pair, tone off", 0, 1, 0, 0},
+      {"tone named with coefficient 0 (off)", 0, 2, 0, 0},
+      {"tone, blur 0.5 mm", 1, 0.5, 0, 0},
+      {"tone, blur 1 mm", 1, 1, 0, 0},
+      {"tone, blur 2 mm", 1, 2, 0, 0},
+  };
+  static const tone_row spaced[] = {
+      {"the scene's terms (pair cutoff 2 mm, near field)", 0, 1, 0, 1},
+      {"and min_spacing 0.35 mm", 0, 1, 0.35, 1},
+      {"and tone, blur 1 mm", 1, 1, 0, 1},
+  };
+  fprintf(d, "## The tone term and the spacing constraint\n\n"
+             "The accuracy scene (params/example.ini annealed, %zu splines) with the tone term added\n"
+             "(coefficient 1; docs/NUMERICS.md) at three blurs.\n"
+             "Evaluation: the same point and vector moves of 0.2 mm, evaluated and never committed;\n"
+             "ratio to the first row block by block (+- the median absolute deviation). Chain: the\n"
+             "Metropolis walk at T = 0.002 with the anneal's final steps. First without the pair term,\n"
+             "whose near field would hide the rest:\n\n",
+          b->ann_splines->n_splines);
+  double pixel = tone_table(b, alone, (int)(sizeof alone / sizeof alone[0]));
+  fprintf(d, "The picture's pixel, and the raster's, is %.2f mm. A move splats the old and new samples of its segments (2 x 2 x %d for a point move)\n"
+             "into a box of changes and sums the box: the cost grows with the footprint's area,\n"
+             "(2 ceil(3 sigma / pixel) + 1)^2 pixels a sample. Named with coefficient 0 the term\n"
+             "builds nothing (no target, no raster, no box) and costs nothing.\n\n"
+             "With the scene's pair term, and the spacing constraint (energy.min_spacing), which counts\n"
+             "the neighbours closer than 0.35 mm in the pair grid's cells:\n\n",
+          pixel, b->ann_params.quadrature);
+  tone_table(b, spaced, (int)(sizeof spaced / sizeof spaced[0]));
 }
 
 void bench_tone_accuracy(bench_ctx *b)
@@ -103,7 +128,7 @@ void bench_tone_accuracy(bench_ctx *b)
       lw_scene_clear(&sc);
     }
   double share;
-  if (lw_close_share(b->ann_splines, b->ann_params.pen_width, &share, &err)) bench_die("close share", &err);
+  if (lw_close_share_splines(b->ann_splines, b->ann_params.pen_width, &share, &err)) bench_die("close share", &err);
   fprintf(d, "## Tone term: quadrature nodes\n\n"
              "The tone term splats each quadrature sample as a Gaussian footprint (tone.h), so its\n"
              "value depends on how finely the samples cover the line: a sample stands for dl of ink\n"

@@ -14,14 +14,28 @@
 ** a target, else round robin.  Frames use the same pens but no ordering (a
 ** frame is a picture, not a plot).
 **
-** The report holds the pen-up travel before and after ordering and, with a
-** target tone, the fidelity score (fidelity.h) with [output] fidelity_sigma;
-** The report also holds the close share (spacing.h): the share of the line
-** length with another stroke within one output.pen_width.
-** lw_drawing_report_json writes them into summary.json as
-**     "pen_up_travel_mm": {"before": ..., "after": ...},
-**     "close_share": ...,
-**     "fidelity": {"mse": ..., "ssim": ..., "sigma_mm": ...}   (with a target)
+** The final drawing goes through the plotter post-pass of strokes.h with
+** the [plot] keys: join (join_distance pen widths, join_angle), crop to
+** the picture's rectangle (without a picture the margin box), drop paths
+** shorter than min_length pen widths, order.  SVG, PNG, PDF and the
+** fidelity score all show that drawing; the state is not changed, and
+** frames show the state's splines as they are.
+**
+** The report holds what the post-pass did, the pen-up travel before and
+** after ordering, the plot time estimate and, with a target tone, the
+** fidelity scores (fidelity.h) with [output] fidelity_sigma, overall and
+** per pen when there are several; lw_drawing_report_json writes them into
+** summary.json as
+**     "paths": ..., "pen_up_travel_mm": {"before": ..., "after": ...},
+**     "plot": {"lifts": {"before": ..., "after": ...}, "joins": ...,
+**              "cut": ..., "outside": ..., "dropped": ...,
+**              "crop_mm": [x0, y0, x1, y1] or null,
+**              "pen_down_mm": ..., "pen_up_mm": ..., "time_s": ...},
+**     "close_share": ...,   (the paths' length within a pen width of
+**                            another path: spacing.h)
+**     "fidelity": {"mse": ..., "ssim": ..., "orientation": ...,
+**                  "sigma_mm": ..., "pens": [{"mse", "ssim",
+**                  "orientation"}, ...]}   (with a target; pens if > 1)
 */
 #ifndef LINEWISE_DRAWING_H
 #define LINEWISE_DRAWING_H
@@ -31,13 +45,21 @@
 #include "linewise/output.h"
 #include "linewise/params.h"
 #include "linewise/scene.h"
+#include "linewise/strokes.h"
 
 typedef struct {
   size_t paths;                       /* paths drawn */
   double travel_before, travel_after; /* pen-up travel, mm (plot.h) */
-  double close_share;                 /* share of the length within a pen width of another stroke */
+  lw_strokes_report post;             /* what the post-pass did */
+  double close_share;                 /* share of the length within a pen width of another path */
+  int cropped;                        /* crop_mm holds the rectangle */
+  double crop_mm[4];                  /* x0 y0 x1 y1 */
+  double pen_down_mm;                 /* ink length */
+  double time_s;                      /* plot time estimate */
   int has_fidelity;                   /* a target tone was given */
-  lw_fidelity fidelity;
+  lw_fidelity fidelity;               /* of all pens */
+  int n_pens;
+  lw_fidelity pen_fidelity[LW_PLOT_PENS_MAX]; /* per pen, when n_pens > 1 */
 } lw_drawing_report;
 
 /* The page and pens of p: size from [scene], pens from [output].  Errors
@@ -55,5 +77,9 @@ lw_status lw_drawing_frame(const lw_params *p, const lw_scene *sc, const lw_spli
 
 /* The report's members of summary.json (into the open object of j). */
 void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep);
+
+/* The report's lines for the command line ("linewise: ...\n" each) into
+** buf[n]. */
+void lw_drawing_report_text(const lw_drawing_report *rep, char *buf, size_t n);
 
 #endif

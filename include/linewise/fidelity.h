@@ -24,6 +24,22 @@
 **    C1 = (0.01 L)^2, C2 = (0.03 L)^2, local statistics under the 11 x 11
 **    Gaussian window of sigma 1.5 pixels (renormalised at the edges like
 **    the blur), the SSIM map averaged over every pixel.  1 = identical.
+** 4. Orientation agreement: the structure tensor J = G * (grad grad^T) of
+**    each blurred image (central differences, the SSIM window as G) gives
+**    per pixel a dominant gradient axis as the doubled-angle vector
+**    u = (Jxx - Jyy, 2 Jxy), whose length is the anisotropy.  The score is
+**    sum |u_target| cos(2 dtheta) / sum |u_target|: the mean agreement of
+**    the two axes where the target has structure, 1 = every edge of the
+**    target matched by ink running the same way, 0 = no relation (or no
+**    ink), -1 = everywhere crosswise.  A pixel where the ink has no
+**    direction (gradient below LW_FIDELITY_FLAT) adds 0.  It ignores tone and contrast, and lines along the
+**    target's isophotes agree with it whether the blur has merged them
+**    into a tone (the tone's gradient) or not (each line's own gradient is
+**    across it, along the target's), which is why it depends far less on
+**    sigma than MSE and SSIM do (docs/IMAGES.md).  NaN for a flat target.
+**
+** The drawing is scored as plotted (strokes.h: joined, cropped, dropped);
+** a pen's score renders that pen's paths alone against the same target.
 */
 #ifndef LINEWISE_FIDELITY_H
 #define LINEWISE_FIDELITY_H
@@ -31,14 +47,17 @@
 #include "linewise/error.h"
 #include "linewise/field.h"
 #include "linewise/spline.h"
+#include "linewise/strokes.h"
 
 #define LW_FIDELITY_TRUNCATE 4.0      /* blur kernel radius, in sigmas */
 #define LW_FIDELITY_SSIM_SIGMA 1.5    /* SSIM window, pixels */
 #define LW_FIDELITY_SSIM_RADIUS 5     /* SSIM window half width: 11 x 11 */
+#define LW_FIDELITY_FLAT 1e-9         /* gradient (per pixel) below which a pixel has no direction */
 
 typedef struct {
   double mse;       /* mean squared difference of blurred ink and darkness */
   double ssim;      /* mean structural similarity, -1..1 */
+  double orientation; /* orientation agreement, -1..1 (NaN: flat target) */
   double sigma_mm;  /* the blur used, mm */
 } lw_fidelity;
 
@@ -48,11 +67,17 @@ typedef struct {
 lw_status lw_fidelity_compute(const lw_splines *sp, const lw_grid2d *tone, double pen_width_mm,
                               double sigma_mm, lw_fidelity *out, lw_error *err);
 
+/* The same for the paths of pen `pen` of a drawing (0-based; -1: all). */
+lw_status lw_fidelity_compute_strokes(const lw_strokes *s, int pen, const lw_grid2d *tone, double pen_width_mm,
+                                      double sigma_mm, lw_fidelity *out, lw_error *err);
+
 /* Step 1 alone: ink[j * nx + i] for the pixels of the tone raster. */
 lw_status lw_fidelity_render(const lw_splines *sp, const lw_grid2d *tone, double pen_width_mm, double *ink,
                              lw_error *err);
+lw_status lw_fidelity_render_strokes(const lw_strokes *s, int pen, const lw_grid2d *tone, double pen_width_mm,
+                                     double *ink, lw_error *err);
 
-/* Steps 2-3 for two w x h images a and b (changed in place: blurred),
+/* Steps 2-4 for two w x h images a and b (changed in place: blurred),
 ** blur sigma sx, sy in pixels (0 = none); out->sigma_mm is left alone. */
 lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, double sy, lw_fidelity *out,
                               lw_error *err);

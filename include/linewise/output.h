@@ -31,6 +31,7 @@
 #include "linewise/field.h"
 #include "linewise/plot.h"
 #include "linewise/spline.h"
+#include "linewise/strokes.h"
 
 #define LW_OUTPUT_PEN_DEFAULT 0.3     /* mm */
 #define LW_OUTPUT_PNG_MAX_PX 4096     /* longest side of a preview, pixels */
@@ -62,7 +63,9 @@ int lw_output_colors_parse(const char *list, unsigned char (*rgb)[3], int max);
 
 /* The drawings below take an optional plot (plot.h): with it, pen k's paths
 ** are drawn with page->pen[k] in plotting order and direction; without it
-** (NULL) every path is pen 1's, in index order.  The plot must have as many
+** (NULL) every path is pen 1's, in index order.  A path's id in the SVG is
+** "spline<i>", i the spline of its first piece, with "-<k>" added for the
+** k-th further piece of a cropped spline (strokes.h).  The plot must have as many
 ** pens as the page.  An optional tone raster (field.h: ncomp 1, node (i, j)
 ** the centre of pixel (i, j), tone 0 = black .. 1 = white) is painted under
 ** the lines of the previews in grey at LW_OUTPUT_UNDERLAY_ALPHA, covering
@@ -98,9 +101,19 @@ lw_status lw_output_pdf(const lw_splines *sp, const lw_output_page *page, const 
 lw_status lw_output_frame(const char *dir, long sweep, const lw_splines *sp, const lw_output_page *page,
                           const lw_plot *plot, const lw_grid2d *tone, double px_per_mm, lw_error *err);
 
-/* Strokes every spline that is not a point with the current source, line
-** width and transformation of cr (for renderers elsewhere). */
-void lw_output_cairo_splines(cairo_t *cr, const lw_splines *sp);
+/* The same three drawings of paths (strokes.h) as they are: their pens,
+** order and directions; the calls above turn the splines and plot into
+** paths and call these. */
+lw_status lw_output_svg_strokes(const lw_strokes *s, const lw_output_page *page, const char *path,
+                                lw_error *err);
+lw_status lw_output_png_strokes(const lw_strokes *s, const lw_output_page *page, const lw_grid2d *tone,
+                                double px_per_mm, const char *path, lw_error *err);
+lw_status lw_output_pdf_strokes(const lw_strokes *s, const lw_output_page *page, const lw_grid2d *tone,
+                                const char *path, lw_error *err);
+
+/* Strokes every path of pen `pen` (0-based; -1: every pen) with the current
+** source, line width and transformation of cr (for renderers elsewhere). */
+void lw_output_cairo_strokes(cairo_t *cr, const lw_strokes *s, int pen);
 
 /* The pixel size lw_output_png uses, and the scale after the cap (px per mm).
 ** 0 if the page or px_per_mm are not positive and finite. */

@@ -142,6 +142,13 @@ typedef struct {
   int frames_every;           /* sweeps between frames; 0 = none */
   double fidelity_sigma;      /* blur before the fidelity score, mm */
   int field_preview;          /* 1 = write field.png */
+  /* [plot] (strokes.h) */
+  double join_distance;       /* pen widths; 0 = no joining */
+  double join_angle;          /* degrees */
+  int crop;                   /* 1 = crop to the picture's rectangle */
+  double min_length;          /* pen widths; 0 = keep all */
+  double speed_down, speed_up; /* plot time estimate, mm/s */
+  double lift_time;           /* s per pen lift */
   /* [particles] (system = particles; particles.h) */
   int pt_count;               /* particles placed by the pattern */
   int pt_pattern;             /* LW_PPATTERN_* */

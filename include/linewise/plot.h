@@ -28,6 +28,7 @@
 #include <stddef.h>
 
 #include "linewise/error.h"
+#include "linewise/order.h"
 #include "linewise/spline.h"
 
 #define LW_PLOT_PENS_MAX 16
@@ -53,6 +54,12 @@ typedef struct {
 lw_plot *lw_plot_new(const lw_splines *sp, int n_pens, const double *key, lw_plot_order order,
                      double hx, double hy, lw_error *err);
 void lw_plot_free(lw_plot *pl);
+
+/* The ordering above for n paths known by their end points: tour[k] the
+** k-th path drawn, rev[k] its direction; *before the travel in index order,
+** *after as ordered (never longer).  LW_ENOMEM (err set). */
+lw_status lw_plot_order_paths(const lw_order_path *path, size_t n, lw_plot_order order, double hx, double hy,
+                              size_t *tour, unsigned char *rev, double *before, double *after, lw_error *err);
 
 /* key[i] = the length-weighted mean of f along spline i (quadrature q); 0
 ** for a spline of zero length.  f is called as f(ctx, x, y) with mm. */
