@@ -185,8 +185,6 @@ void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep)
   lw_json_key(j, "after");
   lw_json_number(j, rep->travel_after);
   lw_json_end_object(j);
-  lw_json_key(j, "close_share");
-  lw_json_number(j, rep->close_share);
   const lw_strokes_report *r = &rep->post;
   lw_json_key(j, "plot");
   lw_json_begin_object(j);
@@ -214,6 +212,8 @@ void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep)
   lw_json_key(j, "time_s");
   lw_json_number(j, rep->time_s);
   lw_json_end_object(j);
+  lw_json_key(j, "close_share");
+  lw_json_number(j, rep->close_share);
   if (rep->has_fidelity) {
     lw_json_key(j, "fidelity");
     lw_json_begin_object(j);
