@@ -170,6 +170,21 @@ const lw_param_def lw_param_table[] = {
       "Gauss-Legendre nodes per segment for the pair term (its samples in the cell grid); "
       "0 = the same as `quadrature`. The pair sum costs about the square of this number per "
       "proposal; docs/ACCURACY.md shows what fewer nodes cost in accuracy."),
+  NUM("energy", "tone", LW_PT_DOUBLE, tone, "0", "energy / mm^2", 0, 1e12, 0,
+      "T: tone T * sum over pixels of A (G * ink - darkness)^2: the lines, as ink of "
+      "output.pen_width, blurred by a Gaussian of `tone_blur` and compared with the picture's "
+      "darkness (1 - tone) pixel by pixel (A = pixel area). Unlike the potential it saturates: "
+      "lines stop gathering once a place is as dark as the picture. Needs scene.image "
+      "(docs/NUMERICS.md). 0 = off."),
+  NUM("energy", "tone_blur", LW_PT_DOUBLE, tone_blur, "1", "mm", 0, 1e4, LW_MIN_OPEN,
+      "Standard deviation of the tone term's blur: the scale at which ink is averaged into tone. "
+      "Keep it above the distance between quadrature samples (segment_length / quadrature) so "
+      "a line reads as a line, not a row of dots; its cost grows as its square in pixels."),
+  NUM("energy", "min_spacing", LW_PT_DOUBLE, min_spacing, "0", "mm", 0, 1e7, 0,
+      "Least distance between pair samples of different splines, a hard constraint: a move that "
+      "brings more of its samples closer than this to another spline than it had is refused "
+      "(+infinity), so a drawing that keeps it never loses it. Needs the pair term (it looks in "
+      "its cell grid) and at most pair_cutoff. Typically the pen width. 0 = off."),
   NUM("moves", "point", LW_PT_DOUBLE, mix_point, "0.5", "", 0, 1e6, 0,
       "Relative frequency of moves of one point p_k (Gaussian step in x and y)."),
   NUM("moves", "vector", LW_PT_DOUBLE, mix_vector, "0.4", "", 0, 1e6, 0,

@@ -105,6 +105,9 @@ typedef struct {
   double parametrisation;     /* G, energy / mm; 0 = off */
   int quadrature;             /* nodes per segment */
   int pair_quadrature;        /* pair samples per segment; 0 = quadrature */
+  double tone;                /* T, energy / mm^2; 0 = off */
+  double tone_blur;           /* sigma of the tone term's blur, mm */
+  double min_spacing;         /* least distance between samples of different splines, mm; 0 = none */
   /* [moves] */
   double mix_point, mix_vector, mix_translate, mix_rotate; /* relative frequencies */
   double step_point, step_vector;  /* initial Gaussian step, mm */
