@@ -204,3 +204,75 @@ lw_status lw_nurbs_insert_knot(lw_nurbs *c, double u, lw_error *err)
   c->n = n + 1;
   return attach_basis(c, err);
 }
+
+/* Beziers deeper than this many bisections are kept as they are (and their
+** distance reported): a span is then 2^-24 of its length. */
+#define BEZIER_DEPTH 24
+#define BEZIER_SAMPLES 32
+
+/* The curve run backwards, c~(-u) = c(u): GSL evaluates at a knot on the
+** span to its right, so the derivative at the right end of a span, which
+** jumps at a knot of multiplicity k - 1, is -c~'(-b) on c~'s span to the
+** right of -b. */
+static lw_nurbs *reversed(const lw_nurbs *c)
+{
+  size_t n = c->n, k = (size_t)c->order;
+  double *knot = malloc((n + k) * sizeof *knot), *P = malloc(2 * n * sizeof *P), *w = malloc(n * sizeof *w);
+  lw_nurbs *r = NULL;
+  if (knot && P && w) {
+    for (size_t i = 0; i < n + k; i++) knot[i] = -c->knot[n + k - 1 - i];
+    for (size_t i = 0; i < n; i++) {
+      P[2 * i] = c->P[2 * (n - 1 - i)];
+      P[2 * i + 1] = c->P[2 * (n - 1 - i) + 1];
+      w[i] = c->w[n - 1 - i];
+    }
+    lw_error err;
+    r = lw_nurbs_new(c->order, n, knot, P, w, &err);
+  }
+  free(knot), free(P), free(w);
+  return r;
+}
+
+static double bezier_piece(const lw_nurbs *c, const lw_nurbs *rev, double a, double b, double tol, int depth,
+                           void (*emit)(const double B[8], void *ctx), void *ctx)
+{
+  double pa[2], da[2], pb[2], db[2], B[8];
+  lw_nurbs_eval(c, a, pa, da, NULL);
+  lw_nurbs_eval(rev, -b, pb, db, NULL);
+  db[0] = -db[0];
+  db[1] = -db[1];
+  double h = b - a;
+  for (int q = 0; q < 2; q++) {
+    B[q] = pa[q];
+    B[2 + q] = pa[q] + h / 3 * da[q];
+    B[4 + q] = pb[q] - h / 3 * db[q];
+    B[6 + q] = pb[q];
+  }
+  double worst = 0.0;
+  for (int s = 1; s < BEZIER_SAMPLES; s++) {
+    double t = (double)s / BEZIER_SAMPLES, m = 1 - t, pt[2];
+    lw_nurbs_eval(c, a + t * h, pt, NULL, NULL);
+    double x = m * m * m * B[0] + 3 * m * m * t * B[2] + 3 * m * t * t * B[4] + t * t * t * B[6];
+    double y = m * m * m * B[1] + 3 * m * m * t * B[3] + 3 * m * t * t * B[5] + t * t * t * B[7];
+    worst = fmax(worst, hypot(x - pt[0], y - pt[1]));
+  }
+  if (worst <= tol || depth == BEZIER_DEPTH) {
+    emit(B, ctx);
+    return worst;
+  }
+  double mid = 0.5 * (a + b);
+  double w0 = bezier_piece(c, rev, a, mid, tol, depth + 1, emit, ctx);
+  return fmax(w0, bezier_piece(c, rev, mid, b, tol, depth + 1, emit, ctx));
+}
+
+double lw_nurbs_beziers(const lw_nurbs *c, double tol, void (*emit)(const double B[8], void *ctx), void *ctx)
+{
+  lw_nurbs *rev = reversed(c);
+  if (!rev) return NAN;
+  double worst = 0.0;
+  for (size_t s = (size_t)c->order - 1; s < c->n; s++)
+    if (c->knot[s + 1] > c->knot[s])
+      worst = fmax(worst, bezier_piece(c, rev, c->knot[s], c->knot[s + 1], tol, 0, emit, ctx));
+  lw_nurbs_free(rev);
+  return worst;
+}

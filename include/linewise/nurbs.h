@@ -61,4 +61,15 @@ int lw_nurbs_polynomial(const lw_nurbs *c);
 ** is unchanged for rational curves too: one control point more. */
 lw_status lw_nurbs_insert_knot(lw_nurbs *c, double u, lw_error *err);
 
+/* The curve as cubic Beziers for SVG: each knot span by the cubic Hermite
+** interpolant of its end points and end derivatives, bisected while it is
+** farther than tol from the curve at 32 parameter samples (a parametric
+** distance, which bounds the geometric one).  A polynomial span of degree
+** <= 3 is its own Hermite cubic, so those come out exact (one Bezier a
+** span, degree elevation included); rational and higher-degree spans are
+** approximated.  Calls emit(B, ctx) with 4 points (8 numbers) per Bezier
+** in curve order; returns the largest distance found (NaN: out of
+** memory). */
+double lw_nurbs_beziers(const lw_nurbs *c, double tol, void (*emit)(const double B[8], void *ctx), void *ctx);
+
 #endif

@@ -174,6 +174,16 @@ typedef struct {
   int dyn_pin;                /* LW_PIN_*: which end nodes are held */
   int dyn_pin_vectors;        /* 1 = a pinned node's vector is held too */
   int dyn_steps_per_sweep;    /* time steps per sweep of the run loop */
+  /* [nurbs] (system = nurbs; sys_nurbs.h) */
+  int nb_order;               /* k */
+  char nb_points[4096];       /* "x y x y ..." */
+  char nb_weights[2048];      /* "w w ...", empty = all 1 */
+  char nb_knots[2048];        /* n + k knots, empty = open uniform */
+  double nb_alpha, nb_beta;   /* energy coefficients */
+  int nb_gauss;               /* Gauss points per knot span */
+  int nb_fixed;               /* control points held at each end */
+  double nb_svg_tolerance;    /* rational curves in final.svg, length */
+  double nb_png_scale;        /* pixels per length */
 
   /* Where each value came from: the file and line (0 = default, -1 = --set). */
   char file[LW_PATH_MAX];
