@@ -352,6 +352,10 @@ const lw_param_def lw_param_table[] = {
          "End points held fixed: of both ends of every spline, the first node, the last node."),
   NUM("dynamics", "pin_vectors", LW_PT_INT, dyn_pin_vectors, "0", "", 0, 1, 0,
       "1 = a pinned node's vector is held too (a clamped end); 0 = it turns freely."),
+  CHOICE("dynamics", "integrator", dyn_integrator, "leapfrog", "leapfrog|review",
+         "`leapfrog`: the generalised leapfrog (order 2, symplectic). `review`: the implicit scheme of "
+         "the D-NURBS review (its eqs. 90 and 104; backward in the stiffness, so it damps high "
+         "frequencies; needs rho > 0). docs/NUMERICS.md, \"D-NURBS\"."),
   NUM("nurbs", "order", LW_PT_INT, nb_order, "4", "", 2, 8, 0,
       "Order k of the NURBS curve (degree k - 1; 4 = cubic). docs/NURBS.md."),
   STRING("nurbs", "points", nb_points, "", "length",

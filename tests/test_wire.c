@@ -481,3 +481,52 @@ Test(wire, at_a_fixed_temperature_the_free_points_sample_t_times_k_inverse)
   free(P);
   wire_close(&w);
 }
+
+/* ---- the review's implicit scheme ----------------------------------------- */
+
+Test(wire, the_review_scheme_has_its_derived_amplification_and_rests_at_the_equilibrium)
+{
+  /* A mode of frequency omega: (1 + h c/2 + h^2 omega^2) z^2 - 2 z + (1 - h c/2) = 0
+  ** (c = gamma / mu) gives the growth z per step; the midpoint then decays
+  ** at -ln|z| / h and turns at arg z / h, undamped or not. */
+  for (int damped = 0; damped < 2; damped++) {
+    wire w;
+    wire_open(&w, damped ? 5 : 0);
+    w.p.dyn_integrator = LW_INTEGRATOR_REVIEW;
+    double *Peq = malloc(2 * w.n * sizeof *Peq);
+    equilibrium(&w, Peq);
+    gsl_vector *lambda = gsl_vector_alloc(w.nf);
+    gsl_matrix *vec = gsl_matrix_alloc(w.nf, w.nf);
+    modes(&w, lambda, vec);
+    double h = 0.008, c = w.p.dyn_gamma / MU, omega = sqrt(gsl_vector_get(lambda, 0));
+    double a = 1 + h * c / 2 + h * h * omega * omega, b = -2, cc = 1 - h * c / 2;
+    double re = -b / (2 * a), im = sqrt(4 * a * cc - b * b) / (2 * a);
+    double rate = -log(hypot(re, im)) / h, freq = atan2(im, re) / h, measured, decay;
+    midpoint_motion(&w, Peq, vec, 0, h, 3000, &measured, &decay);
+    cr_log_info("review scheme, gamma %g: decay %.8g (derived %.8g), frequency %.8g (derived %.8g, exact %.8g)",
+                w.p.dyn_gamma, decay, rate, measured, freq, omega);
+    cr_assert(fabs(decay / rate - 1) < 0.01, "decay %g, derived %g", decay, rate);
+    cr_assert(fabs(measured / freq - 1) < 0.005, "frequency %g, derived %g", measured, freq);
+    /* and it damps what the physics does not: faster than gamma / 2 mu */
+    cr_assert_gt(decay, c / 2 + 0.5 * omega * omega * h * 0.9);
+    free(Peq);
+    gsl_vector_free(lambda);
+    gsl_matrix_free(vec);
+    wire_close(&w);
+  }
+  /* from the straight start it comes to rest at K p = f */
+  wire w;
+  wire_open(&w, 5);
+  w.p.dyn_integrator = LW_INTEGRATOR_REVIEW;
+  double *P = malloc(2 * w.n * sizeof *P);
+  equilibrium(&w, P);
+  lw_error err = {0};
+  lw_dynamics *d = lw_dynamics_new(&lw_system_nurbs, w.st, &w.p, &err);
+  cr_assert_not_null(d, "%s", err.msg);
+  for (int s = 0; s < 40000; s++) cr_assert_eq(lw_dynamics_step(d, &err), LW_OK, "%s", err.msg);
+  double r = rel_dist(w.st->c->P, P, 2 * w.n);
+  cr_assert_lt(r, 1e-9, "the review scheme rests %g from the equilibrium", r);
+  lw_dynamics_free(d);
+  free(P);
+  wire_close(&w);
+}

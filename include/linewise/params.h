@@ -57,6 +57,7 @@ enum { LW_PWEIGHT_POLY, LW_PWEIGHT_GAUSS, LW_PWEIGHT_ANISO };
 enum { LW_PBOUNDARY_NONE, LW_PBOUNDARY_PLANE, LW_PBOUNDARY_SPHERE };
 enum { LW_DRIVER_METROPOLIS, LW_DRIVER_DYNAMICS };
 enum { LW_PIN_NONE, LW_PIN_ENDS, LW_PIN_FIRST, LW_PIN_LAST };
+enum { LW_INTEGRATOR_LEAPFROG, LW_INTEGRATOR_REVIEW };
 
 typedef struct {
   /* [scene] */
@@ -174,6 +175,7 @@ typedef struct {
   int dyn_pin;                /* LW_PIN_*: which end nodes are held */
   int dyn_pin_vectors;        /* 1 = a pinned node's vector is held too */
   int dyn_steps_per_sweep;    /* time steps per sweep of the run loop */
+  int dyn_integrator;         /* LW_INTEGRATOR_* */
   /* [nurbs] (system = nurbs; sys_nurbs.h) */
   int nb_order;               /* k */
   char nb_points[4096];       /* "x y x y ..." */
