@@ -7,8 +7,8 @@
 
 /* Conjugate gradients stop at this relative residual, or after a number of
 ** iterations proportional to the size (exact arithmetic needs n). */
-#define CG_TOL 1e-13
-#define CG_ITER(n) (4 * (n) + 100)
+#define CG_TOL 1e-11
+#define CG_ITER(n) (10 * (n) + 100)
 
 enum { W_DELTA, W_R, W_Z, W_S, W_AS, W_G, W_COUNT };
 

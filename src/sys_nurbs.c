@@ -104,14 +104,16 @@ out:
   return c;
 }
 
-static void *setup_new(const lw_params *p, lw_error *err)
+lw_nurbs_setup *lw_nurbs_setup_new(const lw_params *p, lw_nurbs *curve, lw_error *err)
 {
+  if (!curve) return NULL;
   lw_nurbs_setup *su = calloc(1, sizeof *su);
   if (!su) {
+    lw_nurbs_free(curve);
     lw_error_set(err, LW_ENOMEM, "out of memory for a scene");
     return NULL;
   }
-  if (!(su->curve = curve_of(p, err))) goto fail;
+  su->curve = curve;
   size_t n = su->curve->n;
   if (2 * (size_t)p->nb_fixed > n) {
     lw_error_set(err, LW_EINPUT, "expected at most half of the %zu control points, got %d at each end", n,
@@ -151,6 +153,8 @@ fail:
   setup_free(su);
   return NULL;
 }
+
+static void *setup_new(const lw_params *p, lw_error *err) { return lw_nurbs_setup_new(p, curve_of(p, err), err); }
 
 static const char *note(const void *setup) { return ""; }
 

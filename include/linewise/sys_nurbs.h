@@ -41,4 +41,9 @@ typedef struct {
   size_t beziers;
 } lw_nurbs_state;
 
+/* The set-up of a curve built in memory (taken over, freed on failure; NULL
+** passes through) with the other [nurbs] and [dynamics] keys of p: what the
+** row's setup_new does after reading the curve's keys. */
+lw_nurbs_setup *lw_nurbs_setup_new(const lw_params *p, lw_nurbs *curve, lw_error *err);
+
 #endif
