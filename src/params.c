@@ -360,6 +360,10 @@ const lw_param_def lw_param_table[] = {
       "Order k of the NURBS curve (degree k - 1; 4 = cubic). docs/NURBS.md."),
   STRING("nurbs", "points", nb_points, "", "length",
          "The control points as numbers `x y x y ...` (y up; at least `order` points)."),
+  STRING("nurbs", "file", nb_file, "", "path",
+         "A file of control points, one `x y` or `x y w` a line (`#` starts a comment), relative "
+         "to the scene file; used instead of `points` and `weights` (a scene line holds about a "
+         "dozen points: the INI reader stops at 198 characters)."),
   STRING("nurbs", "weights", nb_weights, "", "",
          "One weight > 0 per control point; empty = all 1 (a polynomial spline)."),
   STRING("nurbs", "knots", nb_knots, "", "",

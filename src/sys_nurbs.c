@@ -58,19 +58,74 @@ static double *numbers(const lw_params *p, const char *key, const char *text, si
   return v;
 }
 
+/* Appends v to the array *a of *n (capacity *cap). */
+static int push(double **a, size_t *n, size_t *cap, double v)
+{
+  if (*n == *cap) {
+    size_t c = *cap ? 2 * *cap : 64;
+    double *b = realloc(*a, c * sizeof *b);
+    if (!b) return 0;
+    *a = b;
+    *cap = c;
+  }
+  (*a)[(*n)++] = v;
+  return 1;
+}
+
+/* The control points (and weights, if the lines have three numbers) of
+** nurbs.file; messages name the file and line, blamed on the key. */
+static lw_status read_file(const lw_params *p, double **P, size_t *np, double **w, size_t *nw, lw_error *err)
+{
+  char dir[LW_PATH_MAX], path[2 * LW_PATH_MAX + 2], line[1024];
+  lw_path_dir(dir, sizeof dir, p->file);
+  lw_path_join(path, sizeof path, dir, p->nb_file);
+  FILE *f = fopen(path, "r");
+  if (!f) {
+    lw_error_set(err, LW_EINPUT, "%s: cannot read: %s", path, strerror(errno));
+    return lw_params_blame(p, "nurbs", "file", err);
+  }
+  size_t cap_p = 0, cap_w = 0;
+  int lineno = 0, per = 0;
+  while (fgets(line, sizeof line, f)) {
+    lineno++;
+    line[strcspn(line, "#\r\n")] = '\0';
+    double v[4];
+    int k = lw_number_list(line, 0, v, 4);
+    if (k == 0) continue;
+    if ((k != 2 && k != 3) || (per && k != per) || (k == 3 && !(v[2] > 0.0))) {
+      lw_error_set(err, LW_EINPUT, "%s:%d: expected %s, got '%.60s'", path, lineno,
+                   per == 2 ? "'x y' like the lines before" : per == 3 ? "'x y w' (w > 0) like the lines before"
+                                                                      : "'x y' or 'x y w' (w > 0)", line);
+      fclose(f);
+      return lw_params_blame(p, "nurbs", "file", err);
+    }
+    per = k;
+    if (!push(P, np, &cap_p, v[0]) || !push(P, np, &cap_p, v[1]) || (k == 3 && !push(w, nw, &cap_w, v[2]))) {
+      fclose(f);
+      return lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+    }
+  }
+  fclose(f);
+  return LW_OK;
+}
+
 static lw_nurbs *curve_of(const lw_params *p, lw_error *err)
 {
   size_t np = 0, nw = 0, nk = 0, k = (size_t)p->nb_order;
-  double *P = numbers(p, "points", p->nb_points, &np, err), *w = NULL, *knot = NULL;
+  double *P = NULL, *w = NULL, *knot = NULL;
   lw_nurbs *c = NULL;
-  if (!P) return NULL;
+  if (p->nb_file[0]) {
+    if (read_file(p, &P, &np, &w, &nw, err)) goto out;
+  } else if (!(P = numbers(p, "points", p->nb_points, &np, err)) ||
+             !(w = numbers(p, "weights", p->nb_weights, &nw, err))) {
+    goto out;
+  }
   size_t n = np / 2;
   if (np % 2 || n < k) {
     lw_error_set(err, LW_EINPUT, "expected x y pairs of at least order = %zu control points, got %zu numbers", k, np);
-    lw_params_blame(p, "nurbs", "points", err);
+    lw_params_blame(p, "nurbs", p->nb_file[0] ? "file" : "points", err);
     goto out;
   }
-  if (!(w = numbers(p, "weights", p->nb_weights, &nw, err))) goto out;
   if (nw && nw != n) {
     lw_error_set(err, LW_EINPUT, "expected one weight per control point (%zu), got %zu", n, nw);
     lw_params_blame(p, "nurbs", "weights", err);

@@ -96,5 +96,21 @@ Test(nurbs_cli, bad_knots_and_weights_exit_2_naming_file_line_and_key)
   snprintf(body, sizeof body, "%sweights = 1 1 1\\n", pts);
   refused(body, "bad.ini:5: key .nurbs.weights.: expected one weight per control point (7), got 3");
   refused("points = 0 0 1 1 2\\n", "bad.ini:4: key .nurbs.points.: expected x y pairs");
+  /* the points file: its own line named, behind the key's */
+  cr_assert_eq(sh("printf '# wire\\n0 0 1\\n1 1 1\\n2 0\\n' > %s/p.txt", dir), 0);
+  refused("file = p.txt\\n", "bad.ini:4: key .nurbs.file.: .*p.txt:4: expected .x y w. (w > 0) like the lines before");
+  refused("file = none.txt\\n", "bad.ini:4: key .nurbs.file.: .*none.txt: cannot read");
+}
+
+Test(nurbs_cli, a_points_file_holds_a_long_curve)
+{
+  /* 60 points and weights: far beyond one scene line */
+  cr_assert_eq(sh("awk 'BEGIN { for (i = 0; i < 60; i++) printf \"%%g %%g %%g\\n\", i, (i %% 7) / 3.0, 1 + (i %% 3) / 4.0 }' "
+                  "> %s/long.txt", dir), 0);
+  cr_assert_eq(sh("printf '[scene]\\nsystem = nurbs\\n[nurbs]\\nfile = long.txt\\nalpha = 1\\nbeta = 0.1\\nfixed = 2\\n"
+                  "[anneal]\\nsweeps = 20\\n' > %s/long.ini", dir), 0);
+  cr_assert_eq(sh("%s run %s/long.ini --out %s/long --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(sh("grep -q '\"control_points\": 60' %s/long/summary.json && grep -q '\"fixed\": 4' "
+                  "%s/long/summary.json", dir, dir), 0);
   refused("points = 0 0 1 x\\n", "bad.ini:4: key .nurbs.points.: expected numbers");
 }

@@ -181,6 +181,7 @@ typedef struct {
   char nb_points[4096];       /* "x y x y ..." */
   char nb_weights[2048];      /* "w w ...", empty = all 1 */
   char nb_knots[2048];        /* n + k knots, empty = open uniform */
+  char nb_file[LW_PATH_MAX];  /* "x y [w]" a line instead of points/weights, or empty */
   double nb_alpha, nb_beta;   /* energy coefficients */
   int nb_gauss;               /* Gauss points per knot span */
   int nb_fixed;               /* control points held at each end */
