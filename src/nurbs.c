@@ -26,6 +26,9 @@ lw_status lw_nurbs_check_knots(int order, size_t n, const double *knot, size_t n
       return lw_error_set(err, LW_EINPUT, "not an open knot vector: the first %d and the last %d knots must be equal",
                           order, order);
   if (!(knot[n] > knot[k - 1])) return lw_error_set(err, LW_EINPUT, "the knots span an empty parameter range");
+  if (n > k && (knot[k] == knot[k - 1] || knot[n - 1] == knot[n]))
+    return lw_error_set(err, LW_EINPUT, "not an open knot vector: an end value is repeated more than k = %d times",
+                        order);
   for (size_t i = k, run = 1; i < n; i++) {
     run = knot[i] == knot[i - 1] ? run + 1 : 1;
     if (run > k - 1)
@@ -35,18 +38,35 @@ lw_status lw_nurbs_check_knots(int order, size_t n, const double *knot, size_t n
   return LW_OK;
 }
 
-/* The GSL workspace of the curve's knots.  Its knot vector is set directly:
-** gsl_bspline_knots() takes breakpoints and cannot repeat an inner knot,
-** while the evaluation itself handles any multiplicity below k. */
+/* A GSL workspace of one knot span: the k basis functions nonzero on span
+** s depend only on the 2k knots t[s-k+1 .. s+k], which rational() copies
+** into it.  So GSL's search for the span, a linear scan of its knots, never
+** sees more than one span (O(1) rather than O(n) an evaluation), and inner
+** knots may repeat (gsl_bspline_knots() takes breakpoints, which cannot). */
 static lw_status attach_basis(lw_nurbs *c, lw_error *err)
 {
-  if (c->ws) gsl_bspline_free(c->ws);
-  if (c->dB) gsl_matrix_free(c->dB);
-  c->ws = gsl_bspline_alloc((size_t)c->order, c->n - (size_t)c->order + 2);
-  c->dB = gsl_matrix_alloc((size_t)c->order, 3);
+  if (!c->ws) c->ws = gsl_bspline_alloc((size_t)c->order, 2);
+  if (!c->dB) c->dB = gsl_matrix_alloc((size_t)c->order, 3);
   if (!c->ws || !c->dB) return lw_error_set(err, LW_ENOMEM, "out of memory for a NURBS basis");
-  for (size_t i = 0; i < c->n + (size_t)c->order; i++) gsl_vector_set(c->ws->knots, i, c->knot[i]);
   return LW_OK;
+}
+
+/* The span s in [k-1, n-1] with knot[s] <= u < knot[s+1] (the last one at
+** the end of the range), by bisection. */
+static size_t span_of(const lw_nurbs *c, double u)
+{
+  size_t lo = (size_t)c->order - 1, hi = c->n;
+  if (u >= c->knot[c->n]) {
+    size_t s = c->n - 1;
+    while (c->knot[s] == c->knot[s + 1]) s--;
+    return s;
+  }
+  while (hi - lo > 1) {
+    size_t mid = lo + (hi - lo) / 2;
+    if (u < c->knot[mid]) hi = mid;
+    else lo = mid;
+  }
+  return lo;
 }
 
 void lw_nurbs_free(lw_nurbs *c)
@@ -116,8 +136,11 @@ size_t lw_nurbs_rational(const lw_nurbs *c, double u, double *R)
   size_t first, last;
   /* the second derivative of an order-2 basis is 0; GSL wants nderiv < k there */
   size_t nd = k > 2 ? 2 : 1;
+  size_t s = span_of(c, u);
+  for (size_t i = 0; i < 2 * (size_t)k; i++) gsl_vector_set(c->ws->knots, i, c->knot[s + 1 - (size_t)k + i]);
   gsl_matrix_set_zero(c->dB);
   gsl_bspline_deriv_eval_nonzero(u, nd, c->dB, &first, &last, c->ws);
+  first = s + 1 - (size_t)k;
   double W[3] = {0.0, 0.0, 0.0};
   for (int j = 0; j < k; j++)
     for (int d = 0; d < 3; d++) W[d] += c->w[first + (size_t)j] * gsl_matrix_get(c->dB, (size_t)j, (size_t)d);
@@ -202,7 +225,7 @@ lw_status lw_nurbs_insert_knot(lw_nurbs *c, double u, lw_error *err)
   c->P = P;
   c->w = w;
   c->n = n + 1;
-  return attach_basis(c, err);
+  return LW_OK;
 }
 
 /* Beziers deeper than this many bisections are kept as they are (and their

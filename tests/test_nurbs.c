@@ -194,6 +194,9 @@ Test(nurbs, bad_knots_and_weights_are_refused_with_the_reason)
   cr_assert(strstr(err.msg, "must not decrease"), "%s", err.msg);
   cr_assert_eq(lw_nurbs_check_knots(4, 7, shut, 11, &err), LW_EINPUT);
   cr_assert(strstr(err.msg, "open knot vector"), "%s", err.msg);
+  double five[11] = {0, 0, 0, 0, 0, 0.5, 0.75, 1, 1, 1, 1};
+  cr_assert_eq(lw_nurbs_check_knots(4, 7, five, 11, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "repeated more than k = 4 times"), "%s", err.msg);
   cr_assert_eq(lw_nurbs_check_knots(4, 7, good, 11, &err), LW_OK);
   cr_assert_null(lw_nurbs_new(4, 7, good, P, w, &err));
   cr_assert(strstr(err.msg, "weight 3 is 0"), "%s", err.msg);
