@@ -8,7 +8,6 @@
 
 #include <cairo.h>
 #include <errno.h>
-#include <gsl/gsl_randist.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -39,7 +38,7 @@ static void setup_free(void *setup)
   free(su);
 }
 
-/* The numbers of [nurbs] key (at most max; *n how many), blaming the key. */
+/* The numbers in the text of [nurbs] key (malloc'ed; *n how many), blaming the key. */
 static double *numbers(const lw_params *p, const char *key, const char *text, size_t *n, lw_error *err)
 {
   int count = lw_number_list(text, 1, NULL, 0);
@@ -327,7 +326,7 @@ typedef struct {
 
 static void moves(const lw_params *p, double *weight, double *step, double *target)
 {
-  weight[0] = p->mix_point > 0 ? p->mix_point : 1.0;
+  weight[0] = 1.0; /* the only kind */
   step[0] = p->step_point;
   target[0] = p->target;
 }

@@ -6,7 +6,7 @@
 ** Terms: `elastic` (1/2 int alpha |c_u|^2 + beta |c_uu|^2 du) and `gravity`
 ** (-int mu g . c du with mu = dynamics.rho and g = dynamics.gravity_x,
 ** gravity_y).  Move kind: `point` (one free control point by a uniform step
-** in a square of half side `step`; [moves] point, step_point, target).
+** in a square of half side `step`; [moves] step_point and target).
 ** nurbs.fixed control points at each end are held by Monte Carlo and the
 ** dynamics alike.  The mass matrix is dynamics.rho times M1, constant.
 ** In state.lw: [system nurbs] with `count` and a `point = x y` line per
