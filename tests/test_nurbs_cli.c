@@ -114,3 +114,16 @@ Test(nurbs_cli, a_points_file_holds_a_long_curve)
                   "%s/long/summary.json", dir, dir), 0);
   refused("points = 0 0 1 x\\n", "bad.ini:4: key .nurbs.points.: expected numbers");
 }
+
+Test(nurbs_cli, tempering_replicas_give_the_same_bytes_for_any_thread_count)
+{
+  cr_assert_eq(sh("printf '[scene]\\nsystem = nurbs\\n[nurbs]\\norder = 3\\npoints = 2 0 2 2 0 2 -2 2 -2 0\\n"
+                  "weights = 1 0.7 1 0.7 1\\nknots = 0 0 0 0.5 0.5 1 1 1\\nfixed = 1\\n[anneal]\\nsweeps = 100\\n"
+                  "[tempering]\\nreplicas = 4\\n' > %s/t.ini", dir), 0);
+  cr_assert_eq(sh("OMP_NUM_THREADS=1 %s run %s/t.ini --out %s/t1 --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(sh("OMP_NUM_THREADS=3 %s run %s/t.ini --out %s/t3 --quiet", bin(), dir, dir), 0);
+  const char *same[] = {"state.lw", "trace.csv", "final.svg"};
+  for (int k = 0; k < 3; k++)
+    cr_assert_eq(sh("cmp -s %s/t1/%s %s/t3/%s", dir, same[k], dir, same[k]), 0, "%s differs with the threads", same[k]);
+  cr_assert_eq(sh("grep -c '^\\[system nurbs' %s/t1/state.lw | grep -q '^4$'", dir), 0, "one section a rung");
+}
