@@ -42,6 +42,7 @@ void bench_near(bench_ctx *b);
 void bench_guide(bench_ctx *b);
 void bench_baseline(bench_ctx *b);
 void bench_tempering(bench_ctx *b);
+void bench_nurbs(bench_ctx *b);
 void bench_regularity(bench_ctx *b);
 void bench_regularity_cost(bench_ctx *b);
 void bench_tone(bench_ctx *b);
@@ -501,6 +502,7 @@ static const bench_section sections[] = {
     {"tempering", BENCH_PERFORMANCE, bench_tempering},
     {"particles", BENCH_PERFORMANCE, bench_particles},
     {"tone", BENCH_PERFORMANCE, bench_tone},
+    {"nurbs", BENCH_PERFORMANCE, bench_nurbs},
     {"regularity", BENCH_ACCURACY, bench_regularity},
     {"quadrature", BENCH_ACCURACY, bench_quadrature},
     {"cutoff", BENCH_ACCURACY, bench_cutoff},
