@@ -1,5 +1,5 @@
 # linewise -- elastic Bezier curves annealed into line art.
-# Targets: all (bin/linewise), deps, test, test-long, asan, fuzz, fuzz-build, run, bench, install, clean.
+# Targets: all (bin/linewise), deps, test, test-long, asan, fuzz, fuzz-build, run, bench, wire-figures, install, clean.
 
 CC      ?= cc
 PREFIX  ?= /usr/local
@@ -29,7 +29,7 @@ TOOLS   := seed-sweep param-sweep plot-run plot-sweep
 # The example picture is generated (no third-party images in the repository).
 PICTURE := params/picture.png
 
-.PHONY: all deps deps-animation test test-long asan fuzz fuzz-build run bench install clean docs
+.PHONY: all deps deps-animation test test-long asan fuzz fuzz-build run bench install clean docs wire-figures
 # The example picture too: params/example.ini, the scene a new user tries
 # first, needs it.
 all: $(BIN)/linewise $(PICTURE)
@@ -135,7 +135,7 @@ docs: bin/linewise
 
 # The benchmark: tools/bench*.c with the shared pieces in tools/benchutil.c and
 # the two-curve reference of the tests (tests/pairref.h).
-BENCH_SRC := tools/bench.c tools/bench-accuracy.c tools/bench-order.c tools/bench-regularity.c tools/bench-siman.c tools/bench-tempering.c tools/benchutil.c
+BENCH_SRC := tools/bench.c tools/bench-accuracy.c tools/bench-order.c tools/bench-regularity.c tools/bench-siman.c tools/bench-tempering.c tools/bench-tone.c tools/bench-nurbs.c tools/benchutil.c
 BENCH_HDR := tools/benchutil.h tests/pairref.h tests/testutil.h $(wildcard include/linewise/*.h)
 TOOL_FLAGS = $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -Itools -Itests
 
@@ -148,6 +148,24 @@ bench: $(BUILD)/bench
 	mkdir -p $(BUILD)/bench-data
 	$(BUILD)/bench docs $(BUILD)/bench-data
 	gnuplot -e "data='$(BUILD)/bench-data'; out='docs'" tools/bench.gp
+
+# The elastic wire of the D-NURBS review: its Figures 8 and 9 as
+# docs/nurbs-figure8.png and docs/nurbs-figure9.png (docs/NURBS.md).
+WIRE_DATA := $(BUILD)/wire-data
+$(BUILD)/wire-midpoint: tools/wire-midpoint.c $(BUILD)/liblinewise.a
+	$(CC) $(TOOL_FLAGS) $< -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
+
+wire-figures: $(BUILD)/wire-midpoint
+	mkdir -p $(WIRE_DATA)
+	$(BUILD)/wire-midpoint params/wire.ini 20 > $(WIRE_DATA)/gamma0.dat
+	$(BUILD)/wire-midpoint params/wire.ini 20 dynamics.gamma=5 > $(WIRE_DATA)/gamma5.dat
+	$(BUILD)/wire-midpoint params/wire.ini 20 dynamics.integrator=review > $(WIRE_DATA)/gamma0-review.dat
+	$(BUILD)/wire-midpoint params/wire.ini 20 dynamics.gamma=5 dynamics.integrator=review > $(WIRE_DATA)/gamma5-review.dat
+	$(BUILD)/wire-midpoint params/wire.ini 20 nurbs.alpha=10 > $(WIRE_DATA)/alpha10.dat
+	$(BUILD)/wire-midpoint params/wire.ini 20 nurbs.alpha=100 > $(WIRE_DATA)/alpha100.dat
+	$(BUILD)/wire-midpoint params/wire.ini 20 nurbs.beta=1 > $(WIRE_DATA)/beta1.dat
+	$(BUILD)/wire-midpoint params/wire.ini 20 nurbs.beta=50 dynamics.dt=0.004 > $(WIRE_DATA)/beta50.dat
+	gnuplot -e "data='$(WIRE_DATA)'; out='docs'" tools/wire-figures.gp
 
 install: $(BIN)/linewise $(PICTURE)
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/linewise/params

@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/spacing.h"
+
 lw_status lw_drawing_page(const lw_params *p, lw_output_page *page, lw_error *err)
 {
   lw_output_page_init(page, p->width, p->height);
@@ -93,6 +95,18 @@ static lw_status score(const lw_params *p, const lw_strokes *st, const lw_grid2d
   return s;
 }
 
+/* The close share of the paths as plotted, each path a stroke (spacing.h). */
+static lw_status close_share(const lw_params *p, const lw_strokes *st, lw_drawing_report *rep, lw_error *err)
+{
+  size_t *owner = malloc((st->n_segs ? st->n_segs : 1) * sizeof *owner);
+  if (!owner) return lw_error_set(err, LW_ENOMEM, "out of memory for the close share");
+  for (size_t k = 0; k < st->n; k++)
+    for (size_t g = st->first[k]; g < st->first[k + 1]; g++) owner[g] = k;
+  lw_status s = lw_close_share(st->b, owner, st->n_segs, p->pen_width, &rep->close_share, err);
+  free(owner);
+  return s;
+}
+
 lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_splines *sp, const lw_grid2d *tone,
                            const char *dir, lw_drawing_report *rep, lw_error *err)
 {
@@ -126,6 +140,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
     dir_file(path, sizeof path, dir, "final.pdf");
     s = lw_output_pdf_strokes(st, &page, under, path, err);
   }
+  if (!s) s = close_share(p, st, rep, err);
   if (!s && tone) s = score(p, st, tone, rep, err);
   lw_strokes_free(st);
   return s;
@@ -197,6 +212,8 @@ void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep)
   lw_json_key(j, "time_s");
   lw_json_number(j, rep->time_s);
   lw_json_end_object(j);
+  lw_json_key(j, "close_share");
+  lw_json_number(j, rep->close_share);
   if (rep->has_fidelity) {
     lw_json_key(j, "fidelity");
     lw_json_begin_object(j);

@@ -1,6 +1,8 @@
 /* dynamics.c -- the Lagrangian driver (dynamics.h). */
 #include "linewise/dynamics.h"
 
+#include "linewise/dyn_review.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,6 +46,7 @@ void lw_dynamics_free(lw_dynamics *d)
   free(d->x1);
   free(d->pi1);
   free(d->u);
+  free(d->work);
   free(d);
 }
 
@@ -102,6 +105,11 @@ lw_dynamics *lw_dynamics_new(const lw_system_type *t, void *state, const lw_para
   d->rho = p->dyn_rho;
   d->gamma = p->dyn_gamma;
   d->dt = p->dyn_dt;
+  d->integrator = p->dyn_integrator;
+  if (d->integrator == LW_INTEGRATOR_REVIEW && lw_dyn_review_init(d, p, err)) {
+    lw_dynamics_free(d);
+    return NULL;
+  }
   double **arrays[] = {&d->x, &d->pi, &d->g, &d->v, &d->tx, &d->x1, &d->pi1, &d->u};
   for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)
     if (!(*arrays[k] = calloc(d->n + 1, sizeof(double)))) {
@@ -235,7 +243,9 @@ static lw_status flow(lw_dynamics *d, lw_error *err)
 
 lw_status lw_dynamics_step(lw_dynamics *d, lw_error *err)
 {
-  lw_status s = d->rho > 0.0 ? leapfrog(d, err) : flow(d, err);
+  lw_status s = d->rho == 0.0                             ? flow(d, err)
+                : d->integrator == LW_INTEGRATOR_REVIEW ? lw_dyn_review_step(d, err)
+                                                        : leapfrog(d, err);
   if (!s) d->steps++;
   return s;
 }

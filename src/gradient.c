@@ -53,9 +53,14 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
 {
   double e[LW_TERM_COUNT] = {0};
   memset(grad, 0, sp->n_nodes * sizeof *grad);
-  if (sc->on[LW_TERM_USER] && selected(term_mask, LW_TERM_USER)) {
-    lw_error_set(err, LW_EINPUT, "the user term has no gradient: leave it out of the mask");
-    return NAN;
+  /* the user term (an opaque function) and the tone term have none */
+  for (int t = 0; t < LW_TERM_COUNT; t++) {
+    const lw_term_type *r = &lw_term_types[t];
+    if (sc->on[t] && selected(term_mask, t) && !r->segment_grad && !r->spline_grad && !r->pairwise) {
+      lw_error_set(err, LW_EINPUT, "the %s term has no gradient (energy.%s): the dynamics and the quench need "
+                   "one; leave the term out", lw_term_names[t], lw_term_names[t]);
+      return NAN;
+    }
   }
   lw_term_ctx ctx[LW_TERM_COUNT];
   lw_scene_term_ctx(sc, ctx);

@@ -185,10 +185,12 @@ static void term_set_init(lw_term_set *ts, const lw_scene *sc)
 {
   lw_scene_term_ctx(sc, ts->ctx);
   ts->n_spline = 0;
+  ts->n_raster = 0;
   ts->pair = -1;
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     if (ts->ctx[t].coef == 0.0) continue;
     if (lw_term_types[t].spline) ts->spline[ts->n_spline++] = (lw_term_id)t;
+    if (lw_term_types[t].raster) ts->raster[ts->n_raster++] = (lw_term_id)t;
     if (lw_term_types[t].pairwise && ts->pair < 0) ts->pair = t;
   }
 }
@@ -210,6 +212,43 @@ static void spline_terms(const lw_term_set *ts, const lw_splines *sp, const doub
     int t = ts->spline[k];
     term[t] += ts->ctx[t].coef * lw_term_types[t].spline(seg_len + g0, n, L, sp->rest_length[i], &ts->ctx[t]);
   }
+}
+
+/* Splats every sample of sp (at the raster term's nodes) into r, zeroed
+** first.  The sum is exact (tone.h), so any order gives the same raster. */
+static void raster_fill(const lw_term_ctx *c, const lw_splines *sp, int64_t *r)
+{
+  const lw_tone *t = c->data;
+  lw_samples s;
+  memset(r, 0, (size_t)t->w * (size_t)t->h * sizeof *r);
+  for (size_t g = 0; g < sp->n_segments; g++) {
+    const lw_node *a = &sp->node[lw_segment_node(sp, g)];
+    lw_segment_sample(c->quad, a, a + 1, &s);
+    for (int q = 0; q < s.n; q++) lw_tone_splat(t, r, 0, 0, t->w, t->h, s.x[q], s.y[q], s.dl[q], 1);
+  }
+}
+
+/* Grows box b over the segment from a to c: its control points bound it. */
+static void raster_cover(const lw_tone *t, lw_tone_box *b, const lw_node *a, const lw_node *c)
+{
+  double z[8];
+  lw_segment_bezier(a, c, z);
+  double x0 = z[0], x1 = z[0], y0 = z[1], y1 = z[1];
+  for (int k = 2; k < 8; k += 2) {
+    x0 = fmin(x0, z[k]);
+    x1 = fmax(x1, z[k]);
+    y0 = fmin(y0, z[k + 1]);
+    y1 = fmax(y1, z[k + 1]);
+  }
+  lw_tone_box_cover(t, b, x0, y0, x1, y1);
+}
+
+/* Splats the samples of the segment from a to c into box b with sign. */
+static void raster_segment(const lw_term_ctx *c, lw_tone_box *b, const lw_node *a, const lw_node *e, int sign)
+{
+  lw_samples s;
+  lw_segment_sample(c->quad, a, e, &s);
+  for (int q = 0; q < s.n; q++) lw_tone_box_splat(c->data, b, s.x[q], s.y[q], s.dl[q], sign);
 }
 
 lw_status lw_model_check_regular(const lw_scene *sc, const lw_splines *sp, const char *path, lw_error *err)
@@ -286,6 +325,14 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
     if (pair_all(&v, &e) != LW_OK) goto nomem;
     term[ts.pair] = pc->coef * e;
   }
+  for (int k = 0; k < ts.n_raster; k++) {
+    const lw_term_ctx *c = &ts.ctx[ts.raster[k]];
+    int64_t *r = lw_tone_raster_new(c->data);
+    if (!r) goto nomem;
+    raster_fill(c, sp, r);
+    term[ts.raster[k]] = c->coef * lw_tone_energy(c->data, r);
+    free(r);
+  }
   free(seg_len);
   lw_cellgrid_free(grid);
   return total_of(term, irregular);
@@ -339,6 +386,8 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
       return NULL;
     }
   }
+  for (int k = 0; k < m->terms.n_raster; k++)
+    if (!(m->raster[m->terms.raster[k]] = lw_tone_raster_new(m->terms.ctx[m->terms.raster[k]].data))) goto nomem;
   for (size_t i = 0; i < sp->n_splines; i++)
     if (lw_splines_segments(sp, i) > m->max_segments) m->max_segments = lw_splines_segments(sp, i);
   if (lw_model_refresh(m, NULL) != LW_OK) goto nomem;
@@ -360,6 +409,7 @@ void lw_model_free(lw_model *m)
   free(m->near_cache);
   free(m->near_valid);
   lw_cellgrid_free(m->grid);
+  for (int t = 0; t < LW_TERM_COUNT; t++) free(m->raster[t]);
   free(m);
 }
 
@@ -404,6 +454,11 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
     lw_cellgrid_fit(m->grid);
     if (pair_all(&v, &e) != LW_OK) return LW_ENOMEM;
     term[ts->pair] = pc->coef * e;
+  }
+  for (int k = 0; k < ts->n_raster; k++) {
+    const int t = ts->raster[k];
+    raster_fill(&ts->ctx[t], sp, m->raster[t]);
+    term[t] = ts->ctx[t].coef * lw_tone_energy(ts->ctx[t].data, m->raster[t]);
   }
   for (int t = 0; t < LW_TERM_COUNT; t++) m->term[t] = term[t];
   double total = lw_model_total(m);
@@ -456,6 +511,7 @@ void lw_proposal_free(lw_proposal *p)
   free(p->near_new);
   free(p->seg_irregular);
   free(p->spline_seg_len);
+  for (int t = 0; t < LW_TERM_COUNT; t++) lw_tone_box_free(&p->box[t]);
   free(p);
 }
 
@@ -530,6 +586,53 @@ static double pair_delta(const lw_model *m, lw_proposal *p, const lw_node *base,
       if (list_push(&p->partners, p->segs.idx[k]) != LW_OK) return NAN;
   }
   return pe;
+}
+
+/* How many pairs of one of the n samples ps and a sample of another spline
+** (an index outside [lo, hi)) are closer than sqrt(d2): the 3 x 3 cells
+** around each (cells are at least the cutoff >= min_spacing wide). */
+static size_t crowding(const lw_cellgrid *g, const lw_pair_sample *ps, size_t n, uint32_t lo, uint32_t hi, double d2)
+{
+  size_t count = 0;
+  for (size_t k = 0; k < n; k++) {
+    int cx, cy;
+    lw_cellgrid_locate(g, ps[k].x, ps[k].y, &cx, &cy);
+    for (int y = cy > 0 ? cy - 1 : 0; y <= cy + 1 && y < g->ny; y++)
+      for (int x = cx > 0 ? cx - 1 : 0; x <= cx + 1 && x < g->nx; x++) {
+        const lw_cell *c = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
+        if (!c->n) continue; /* an empty cell may have no block */
+        const double *xs = c->x, *ys = lw_cell_y(c);
+        const uint32_t *idx = lw_cell_idx(c);
+        for (uint32_t e = 0; e < c->n; e++) {
+          if (idx[e] >= lo && idx[e] < hi) continue; /* its own spline */
+          double dx = xs[e] - ps[k].x, dy = ys[e] - ps[k].y;
+          count += dx * dx + dy * dy < d2;
+        }
+      }
+  }
+  return count;
+}
+
+/* A raster term's part of dE (no coefficient): the affected segments' old
+** samples splatted out of and their new ones into a box of changes, and
+** the energy difference over the box.  NAN if the box cannot grow. */
+static double raster_delta(const lw_model *m, lw_proposal *p, int t, const lw_node *base)
+{
+  const lw_term_ctx *c = &m->terms.ctx[t];
+  lw_tone_box *b = &p->box[t];
+  lw_tone_box_reset(b);
+  for (size_t j = 0; j < p->n_seg; j++) {
+    const size_t k = p->seg0 + j;
+    raster_cover(c->data, b, &base[k], &base[k + 1]);
+    raster_cover(c->data, b, proposed_node(base, p, k), proposed_node(base, p, k + 1));
+  }
+  if (lw_tone_box_ready(b) != LW_OK) return NAN;
+  for (size_t j = 0; j < p->n_seg; j++) {
+    const size_t k = p->seg0 + j;
+    raster_segment(c, b, &base[k], &base[k + 1], -1);
+    raster_segment(c, b, proposed_node(base, p, k), proposed_node(base, p, k + 1), 1);
+  }
+  return lw_tone_delta(c->data, m->raster[t], b);
 }
 
 void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t node0,
@@ -609,11 +712,33 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
     size_t first = (g0 + p->seg0) * (size_t)np, n = p->n_seg * (size_t)np;
     for (size_t k = 0; k < n; k++) p->ps_old[k] = sample_at(&v, (uint32_t)(first + k));
   }
+  p->crowded = 0;
+  if (sc->min_spacing > 0.0 && !(dE == INFINITY) && !isnan(dE)) {
+    const size_t n = p->n_seg * (size_t)np;
+    const uint32_t lo = (uint32_t)(g0 * (size_t)np), hi = (uint32_t)((g0 + nseg) * (size_t)np);
+    const double d2 = sc->min_spacing * sc->min_spacing;
+    size_t now = crowding(m->grid, p->ps, n, lo, hi, d2);
+    /* the old side only when it matters: a move into free room is the rule */
+    if (now > 0 && now > crowding(m->grid, p->ps_old, n, lo, hi, d2)) {
+      p->crowded = 1;
+      dE = INFINITY;
+    }
+  }
   if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
     double pe = pair_delta(m, p, base, g0);
     p->pair_done = !isnan(pe);
     p->dterm[ts->pair] = pc->coef * pe;
     dE += p->dterm[ts->pair];
+  }
+  p->raster_done = 0;
+  if (ts->n_raster && !(dE == INFINITY) && !isnan(dE)) {
+    for (int k = 0; k < ts->n_raster; k++) {
+      const int t = ts->raster[k];
+      const double re = raster_delta(m, p, t, base);
+      p->dterm[t] = ts->ctx[t].coef * re;
+      dE += p->dterm[t];
+    }
+    p->raster_done = !isnan(dE);
   }
   p->dE = dE;
 }
@@ -663,12 +788,17 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
   double L = 0.0;
   for (size_t k = 0; k < n; k++) L += m->seg_len[g0 + k];
   m->spline_len[p->spline] = L;
+  for (int k = 0; p->raster_done && k < m->terms.n_raster; k++) {
+    const int t = m->terms.raster[k];
+    lw_tone_apply(m->terms.ctx[t].data, m->raster[t], &p->box[t]);
+  }
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     m->term[t] += p->dterm[t];
     if (!isfinite(m->term[t])) nonfinite = 1;
   }
   /* inf - inf leaves NaN in a running total: leaving a forbidden state is
-  ** legal, so rebuild the totals from the caches when that happens. */
-  if (nonfinite) return lw_model_refresh(m, NULL);
+  ** legal, so rebuild the totals from the caches when that happens; the
+  ** same when a raster was not evaluated (its changes are unknown). */
+  if (nonfinite || (m->terms.n_raster && !p->raster_done)) return lw_model_refresh(m, NULL);
   return LW_OK;
 }

@@ -28,9 +28,10 @@
 
 const lw_param_def lw_param_table[] = {
   STRING("scene", "system", system, "splines", "",
-         "What is annealed: `splines` (cubic Bezier splines on the page) or `particles` "
+         "What is annealed: `splines` (cubic Bezier splines on the page), `particles` "
          "(oriented particles in 3-D, set up by the [particles] section; README, "
-         "\"Oriented particles\"). docs/SYSTEMS.md."),
+         "\"Oriented particles\") or `nurbs` (one D-NURBS curve, the [nurbs] section; "
+         "docs/NURBS.md). docs/SYSTEMS.md."),
   CHOICE("scene", "driver", driver, "metropolis", "metropolis|dynamics",
          "What moves the system: `metropolis` anneals it by Monte Carlo (the [anneal] schedule, "
          "[tempering] with replicas); `dynamics` integrates its Lagrangian equations of motion "
@@ -170,6 +171,21 @@ const lw_param_def lw_param_table[] = {
       "Gauss-Legendre nodes per segment for the pair term (its samples in the cell grid); "
       "0 = the same as `quadrature`. The pair sum costs about the square of this number per "
       "proposal; docs/ACCURACY.md shows what fewer nodes cost in accuracy."),
+  NUM("energy", "tone", LW_PT_DOUBLE, tone, "0", "energy / mm^2", 0, 1e12, 0,
+      "T: tone T * sum over pixels of A (G * ink - darkness)^2: the lines, as ink of "
+      "output.pen_width, blurred by a Gaussian of `tone_blur` and compared with the picture's "
+      "darkness (1 - tone) pixel by pixel (A = pixel area). Unlike the potential it saturates: "
+      "lines stop gathering once a place is as dark as the picture. Needs scene.image "
+      "(docs/NUMERICS.md). 0 = off."),
+  NUM("energy", "tone_blur", LW_PT_DOUBLE, tone_blur, "1", "mm", 0, 1e4, LW_MIN_OPEN,
+      "Standard deviation of the tone term's blur: the scale at which ink is averaged into tone. "
+      "Keep it above the distance between quadrature samples (segment_length / quadrature) so "
+      "a line reads as a line, not a row of dots; its cost grows as its square in pixels."),
+  NUM("energy", "min_spacing", LW_PT_DOUBLE, min_spacing, "0", "mm", 0, 1e7, 0,
+      "Least distance between pair samples of different splines, a hard constraint: a move that "
+      "brings more of its samples closer than this to another spline than it had is refused "
+      "(+infinity), so a drawing that keeps it never loses it. Needs the pair term (it looks in "
+      "its cell grid) and at most pair_cutoff. Typically the pen width. 0 = off."),
   NUM("moves", "point", LW_PT_DOUBLE, mix_point, "0.5", "", 0, 1e6, 0,
       "Relative frequency of moves of one point p_k (Gaussian step in x and y)."),
   NUM("moves", "vector", LW_PT_DOUBLE, mix_vector, "0.4", "", 0, 1e6, 0,
@@ -375,6 +391,38 @@ const lw_param_def lw_param_table[] = {
          "End points held fixed: of both ends of every spline, the first node, the last node."),
   NUM("dynamics", "pin_vectors", LW_PT_INT, dyn_pin_vectors, "0", "", 0, 1, 0,
       "1 = a pinned node's vector is held too (a clamped end); 0 = it turns freely."),
+  CHOICE("dynamics", "integrator", dyn_integrator, "leapfrog", "leapfrog|review",
+         "`leapfrog`: the generalised leapfrog (order 2, symplectic). `review`: the implicit scheme of "
+         "the D-NURBS review (its eqs. 90 and 104; backward in the stiffness, so it damps high "
+         "frequencies; needs rho > 0). docs/NUMERICS.md, \"D-NURBS\"."),
+  NUM("nurbs", "order", LW_PT_INT, nb_order, "4", "", 2, 8, 0,
+      "Order k of the NURBS curve (degree k - 1; 4 = cubic). docs/NURBS.md."),
+  STRING("nurbs", "points", nb_points, "", "length",
+         "The control points as numbers `x y x y ...` (y up; at least `order` points)."),
+  STRING("nurbs", "file", nb_file, "", "path",
+         "A file of control points, one `x y` or `x y w` a line (`#` starts a comment), relative "
+         "to the scene file; used instead of `points` and `weights` (a scene line holds about a "
+         "dozen points: the INI reader stops at 198 characters)."),
+  STRING("nurbs", "weights", nb_weights, "", "",
+         "One weight > 0 per control point; empty = all 1 (a polynomial spline)."),
+  STRING("nurbs", "knots", nb_knots, "", "",
+         "The open knot vector: n + k nondecreasing numbers, the first k equal and the last k "
+         "equal; empty = uniform inner knots on [0, 1]."),
+  NUM("nurbs", "alpha", LW_PT_DOUBLE, nb_alpha, "1", "energy", 0, 1e12, 0,
+      "Tension alpha of the energy 1/2 int alpha |c_u|^2 + beta |c_uu|^2 du (over the parameter u)."),
+  NUM("nurbs", "beta", LW_PT_DOUBLE, nb_beta, "0", "energy", 0, 1e12, 0,
+      "Rigidity beta of that energy."),
+  NUM("nurbs", "gauss", LW_PT_INT, nb_gauss, "10", "", 1, 64, 0,
+      "Gauss-Legendre points per knot span for the matrices M, D and K."),
+  NUM("nurbs", "fixed", LW_PT_INT, nb_fixed, "0", "", 0, 1e9, 0,
+      "Control points held at each end (1 = the ends of the curve; 2 = its end tangents too). "
+      "Monte Carlo and the dynamics move only the others. Gravity is the [dynamics] "
+      "rho times gravity_x, gravity_y."),
+  NUM("nurbs", "svg_tolerance", LW_PT_DOUBLE, nb_svg_tolerance, "1e-4", "length", 0, 1e6, LW_MIN_OPEN,
+      "Largest distance of final.svg's cubic Beziers from a rational curve (a polynomial one of "
+      "order <= 4 is exact); the largest found is reported in summary.json."),
+  NUM("nurbs", "png_scale", LW_PT_DOUBLE, nb_png_scale, "50", "pixels/length", 0, 1e6, LW_MIN_OPEN,
+      "Scale of final.png and the frames."),
 };
 const size_t lw_param_count = sizeof lw_param_table / sizeof lw_param_table[0];
 

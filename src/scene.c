@@ -180,6 +180,7 @@ void lw_scene_term_ctx(const lw_scene *sc, lw_term_ctx ctx[LW_TERM_COUNT])
   ctx[LW_TERM_USER].data = sc->user_data;
   ctx[LW_TERM_USER].fn = sc->user_fn;
   ctx[LW_TERM_LOAD].data = sc->load;
+  ctx[LW_TERM_TONE].data = &sc->tone;
 }
 
 lw_status lw_scene_set_user_term(lw_scene *sc, double coef, lw_user_term_fn fn, const void *data,
@@ -204,7 +205,7 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     [LW_TERM_STRAIN] = p->strain, [LW_TERM_BENDING] = p->bending,
     [LW_TERM_POTENTIAL] = p->potential_coef, [LW_TERM_FIELD] = p->field_coef,
     [LW_TERM_PAIR] = p->pair, [LW_TERM_BOUNDARY] = p->boundary_coef,
-    [LW_TERM_PARAM] = p->parametrisation,
+    [LW_TERM_PARAM] = p->parametrisation, [LW_TERM_TONE] = p->tone,
   };
   sc->load[0] = p->dyn_rho * p->dyn_gravity_x + p->dyn_force_x;
   sc->load[1] = p->dyn_rho * p->dyn_gravity_y + p->dyn_force_y;
@@ -293,6 +294,22 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
       if (!f->grid) return err->code;
     }
   }
+  if (sc->on[LW_TERM_TONE]) {
+    if (!sc->image) return bad_key(p, "energy", "tone", LW_EINPUT, err, "the tone term needs scene.image");
+    lw_error e2;
+    if ((st = lw_tone_init(&sc->tone, sc->image, &sc->image_place, p->tone_blur, p->pen_width, &e2)))
+      return st == LW_EINPUT ? bad_key(p, "energy", "tone_blur", st, err, "%s", e2.msg)
+                             : lw_error_set(err, st, "%s", e2.msg);
+  }
+  if (p->min_spacing > 0.0) {
+    if (!sc->on[LW_TERM_PAIR])
+      return bad_key(p, "energy", "min_spacing", LW_EINPUT, err,
+                     "the spacing constraint looks in the pair term's cell grid: it needs energy.pair");
+    if (p->pair_cutoff > 0.0 && p->min_spacing > p->pair_cutoff)
+      return bad_key(p, "energy", "min_spacing", LW_EINPUT, err, "expected at most energy.pair_cutoff (%g mm), got %g",
+                     p->pair_cutoff, p->min_spacing);
+    sc->min_spacing = p->min_spacing;
+  }
   if (p->field_preview && !sc->on[LW_TERM_FIELD])
     return bad_key(p, "output", "field_preview", LW_EINPUT, err,
                    "the scene has no field to preview (energy.field is 0)");
@@ -341,6 +358,7 @@ void lw_scene_clear(lw_scene *sc)
   lw_potential_clear(&sc->potential);
   lw_field_clear(&sc->field);
   lw_boundary_clear(&sc->boundary);
+  lw_tone_clear(&sc->tone);
   lw_image_free(sc->image);
   sc->image = NULL;
 }

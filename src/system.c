@@ -6,10 +6,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/sys_nurbs.h"
 #include "linewise/sys_particles.h"
 #include "linewise/sys_splines.h"
 
-const lw_system_type *const lw_system_types[] = {&lw_system_splines, &lw_system_particles, NULL};
+const lw_system_type *const lw_system_types[] = {&lw_system_splines, &lw_system_particles, &lw_system_nurbs, NULL};
 
 const lw_system_type *lw_system_find(const char *name)
 {

@@ -263,7 +263,7 @@ static void grad_load(const lw_samples *s, const lw_term_ctx *ctx, lw_samples_gr
 
 const char *const lw_term_names[LW_TERM_COUNT] = {"strain", "bending", "potential", "field",
                                                   "pair", "boundary", "user", "parametrisation",
-                                                  "load"};
+                                                  "load", "tone"};
 
 const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_STRAIN, .spline = spline_strain, .spline_grad = grad_strain},
@@ -275,4 +275,5 @@ const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_USER, .segment = seg_user}, /* no gradient: the caller's function is opaque */
   {LW_TERM_PARAM, .segment = seg_param, .segment_grad = grad_param},
   {LW_TERM_LOAD, .segment = seg_load, .segment_grad = grad_load},
+  {LW_TERM_TONE, .raster = 1}, /* no gradient yet (gradient.h refuses it) */
 };

@@ -381,9 +381,9 @@ Test(system, an_unknown_system_exits_2_naming_file_line_and_key)
 {
   char dir[64];
   cr_assert_eq(lw_test_dir_make(dir, "sys"), 0);
-  cr_assert_eq(lw_test_sh("printf '[scene]\\nwidth = 50\\nsystem = nurbs\\n' > %s/s.ini", dir), 0);
+  cr_assert_eq(lw_test_sh("printf '[scene]\\nwidth = 50\\nsystem = cloth\\n' > %s/s.ini", dir), 0);
   cr_assert_eq(lw_test_sh("%s run %s/s.ini --out %s/out --quiet 2> %s/err.txt", getenv("LW_BIN"), dir, dir, dir), 2);
-  cr_assert_eq(lw_test_sh("grep -q 's.ini:3: key .scene.system.: expected one of splines, particles, got .nurbs.' %s/err.txt",
+  cr_assert_eq(lw_test_sh("grep -q 's.ini:3: key .scene.system.: expected one of splines, particles, nurbs, got .cloth.' %s/err.txt",
                           dir), 0);
   cr_assert_neq(lw_test_sh("test -e %s/out", dir), 0, "nothing is written for a bad scene");
   /* the energy command reads a run directory's system the same way */

@@ -438,10 +438,12 @@ Test(terms, every_row_reads_its_own_context_only)
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     const lw_term_type *row = &lw_term_types[t];
     cr_assert_eq(row->id, t);
-    cr_assert_eq(!!row->segment + !!row->spline + !!row->pairwise, 1, "%s: one shape", lw_term_names[t]);
+    cr_assert_eq(!!row->segment + !!row->spline + !!row->pairwise + !!row->raster, 1, "%s: one shape",
+                 lw_term_names[t]);
     cr_assert_eq(ctx[t].coef, sc.coef[t], "%s", lw_term_names[t]);
   }
   cr_assert(ctx[LW_TERM_PAIR].data == &sc.pair && ctx[LW_TERM_PAIR].quad == &sc.pair_quad);
+  cr_assert(ctx[LW_TERM_TONE].data == &sc.tone && ctx[LW_TERM_TONE].quad == &sc.quad);
   lw_splines *sp = splines(1, 2);
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
   gsl_rng_set(r, 5);

@@ -43,9 +43,12 @@ void bench_near(bench_ctx *b);
 void bench_guide(bench_ctx *b);
 void bench_baseline(bench_ctx *b);
 void bench_tempering(bench_ctx *b);
+void bench_nurbs(bench_ctx *b);
 void bench_regularity(bench_ctx *b);
 void bench_regularity_cost(bench_ctx *b);
 void bench_order(bench_ctx *b);
+void bench_tone(bench_ctx *b);
+void bench_tone_accuracy(bench_ctx *b);
 
 /* ---- throughput and scaling ---------------------------------------------- */
 
@@ -654,10 +657,13 @@ static const bench_section sections[] = {
     {"baseline", BENCH_PERFORMANCE, bench_baseline},
     {"tempering", BENCH_PERFORMANCE, bench_tempering},
     {"particles", BENCH_PERFORMANCE, bench_particles},
+    {"tone", BENCH_PERFORMANCE, bench_tone},
+    {"nurbs", BENCH_PERFORMANCE, bench_nurbs},
     {"regularity", BENCH_ACCURACY, bench_regularity},
     {"quadrature", BENCH_ACCURACY, bench_quadrature},
     {"cutoff", BENCH_ACCURACY, bench_cutoff},
     {"near", BENCH_ACCURACY, bench_near},
+    {"tone_accuracy", BENCH_ACCURACY, bench_tone_accuracy},
     {"guide", BENCH_ACCURACY, bench_guide},
 };
 #define N_SECTIONS (int)(sizeof sections / sizeof sections[0])

@@ -31,6 +31,8 @@
 **              "cut": ..., "outside": ..., "dropped": ...,
 **              "crop_mm": [x0, y0, x1, y1] or null,
 **              "pen_down_mm": ..., "pen_up_mm": ..., "time_s": ...},
+**     "close_share": ...,   (the paths' length within a pen width of
+**                            another path: spacing.h)
 **     "fidelity": {"mse": ..., "ssim": ..., "orientation": ...,
 **                  "sigma_mm": ..., "pens": [{"mse", "ssim",
 **                  "orientation"}, ...]}   (with a target; pens if > 1)
@@ -49,6 +51,7 @@ typedef struct {
   size_t paths;                       /* paths drawn */
   double travel_before, travel_after; /* pen-up travel, mm (plot.h) */
   lw_strokes_report post;             /* what the post-pass did */
+  double close_share;                 /* share of the length within a pen width of another path */
   int cropped;                        /* crop_mm holds the rectangle */
   double crop_mm[4];                  /* x0 y0 x1 y1 */
   double pen_down_mm;                 /* ink length */

@@ -54,6 +54,8 @@ typedef struct {
   unsigned long steps;       /* time steps done */
   unsigned long halvings;    /* massless: step halvings so far */
   int iterations_max;        /* most fixed-point iterations a step needed */
+  int integrator;            /* LW_INTEGRATOR_* */
+  double *work;              /* the review scheme's scratch (dyn_review.h), or NULL */
 } lw_dynamics;
 
 /* A driver for `state` (a system of row t) with the [dynamics] parameters;

@@ -15,7 +15,17 @@
 ** touching a changed node are re-sampled; their old energies come from the
 ** cache.  A spline term sees the moved spline's cached lengths, so it costs
 ** O(segments of a spline); the pairwise term visits the 3 x 3 cells around
-** each new and old sample.
+** each new and old sample; a raster term splats the old samples out of and
+** the new ones into a box of changes, O(samples x footprint + box).
+**
+** Spacing (scene->min_spacing > 0, with the pair term): a hard constraint
+** between pair samples of different splines.  A proposal whose new samples
+** have more neighbours of other splines closer than min_spacing than its
+** old samples had is forbidden (dE = +inf, p->crowded set).  A state that
+** keeps the constraint thus never loses it, and one that starts without it
+** (a random placement) can only come closer to it: the pairs too close are
+** never more after a move than before.  The 3 x 3 cells of the pair grid
+** hold every neighbour within the cutoff >= min_spacing.
 **
 ** Invariant (tested): after any sequence of commits, the running totals equal
 ** lw_energy_compute of the state within 1e-9 relative.
@@ -36,6 +46,7 @@
 #include "linewise/pair.h"
 #include "linewise/scene.h"
 #include "linewise/spline.h"
+#include "linewise/tone.h"
 #include "linewise/walk.h"
 
 /* The pair samples live in the grid only (grid.h: x, y and dl in the
@@ -52,6 +63,8 @@ typedef struct {
   int n_spline;
   lw_term_id spline[LW_TERM_COUNT];
   int pair;
+  int n_raster;             /* the raster terms that are on */
+  lw_term_id raster[LW_TERM_COUNT];
 } lw_term_set;
 
 typedef struct {
@@ -67,6 +80,7 @@ typedef struct {
   lw_cellgrid *grid;        /* the pair samples' positions and weights (pairwise term on), else NULL */
   double *near_cache;       /* n_segments: each segment's pair near field (pair on) */
   uint8_t *near_valid;      /* n_segments: 1 where near_cache holds the current value */
+  int64_t *raster[LW_TERM_COUNT]; /* each raster term's raster (tone.h) while on, else NULL */
   size_t max_segments;      /* longest spline, for sizing proposals */
 } lw_model;
 
@@ -112,6 +126,9 @@ typedef struct {
   lw_near_list partners;      /* near partners of the changed segments, old and new */
   double *near_new;           /* n_seg new near fields (no coefficient) */
   int pair_done;              /* 1 if the pair part was evaluated */
+  lw_tone_box box[LW_TERM_COUNT]; /* each raster term's changes */
+  int raster_done;            /* 1 if the raster terms were evaluated */
+  int crowded;                /* 1 if refused by the spacing constraint */
 } lw_proposal;
 
 lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err);

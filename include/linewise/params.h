@@ -57,6 +57,7 @@ enum { LW_PWEIGHT_POLY, LW_PWEIGHT_GAUSS, LW_PWEIGHT_ANISO };
 enum { LW_PBOUNDARY_NONE, LW_PBOUNDARY_PLANE, LW_PBOUNDARY_SPHERE };
 enum { LW_DRIVER_METROPOLIS, LW_DRIVER_DYNAMICS };
 enum { LW_PIN_NONE, LW_PIN_ENDS, LW_PIN_FIRST, LW_PIN_LAST };
+enum { LW_INTEGRATOR_LEAPFROG, LW_INTEGRATOR_REVIEW };
 
 typedef struct {
   /* [scene] */
@@ -105,6 +106,9 @@ typedef struct {
   double parametrisation;     /* G, energy / mm; 0 = off */
   int quadrature;             /* nodes per segment */
   int pair_quadrature;        /* pair samples per segment; 0 = quadrature */
+  double tone;                /* T, energy / mm^2; 0 = off */
+  double tone_blur;           /* sigma of the tone term's blur, mm */
+  double min_spacing;         /* least distance between samples of different splines, mm; 0 = none */
   /* [moves] */
   double mix_point, mix_vector, mix_translate, mix_rotate; /* relative frequencies */
   double step_point, step_vector;  /* initial Gaussian step, mm */
@@ -181,6 +185,18 @@ typedef struct {
   int dyn_pin;                /* LW_PIN_*: which end nodes are held */
   int dyn_pin_vectors;        /* 1 = a pinned node's vector is held too */
   int dyn_steps_per_sweep;    /* time steps per sweep of the run loop */
+  int dyn_integrator;         /* LW_INTEGRATOR_* */
+  /* [nurbs] (system = nurbs; sys_nurbs.h) */
+  int nb_order;               /* k */
+  char nb_points[4096];       /* "x y x y ..." */
+  char nb_weights[2048];      /* "w w ...", empty = all 1 */
+  char nb_knots[2048];        /* n + k knots, empty = open uniform */
+  char nb_file[LW_PATH_MAX];  /* "x y [w]" a line instead of points/weights, or empty */
+  double nb_alpha, nb_beta;   /* energy coefficients */
+  int nb_gauss;               /* Gauss points per knot span */
+  int nb_fixed;               /* control points held at each end */
+  double nb_svg_tolerance;    /* rational curves in final.svg, length */
+  double nb_png_scale;        /* pixels per length */
 
   /* Where each value came from: the file and line (0 = default, -1 = --set). */
   char file[LW_PATH_MAX];

@@ -30,10 +30,11 @@
 #include "linewise/params.h"
 #include "linewise/quad.h"
 #include "linewise/terms.h"
+#include "linewise/tone.h"
 
 typedef struct lw_scene {
   double width, height;         /* page, mm */
-  double coef[LW_TERM_COUNT];   /* S B Q P C R and the user term's; 0 = off */
+  double coef[LW_TERM_COUNT];   /* S B Q P C R, the user term's, G, T; 0 = off */
   int on[LW_TERM_COUNT];        /* coef != 0 */
   int strain_per_segment;       /* strain mode */
   int field_axial;              /* field mode */
@@ -47,6 +48,9 @@ typedef struct lw_scene {
   lw_potential potential;       /* valid when on[LW_TERM_POTENTIAL] */
   lw_field field;               /* valid when on[LW_TERM_FIELD] */
   lw_boundary boundary;         /* the frame (also used for placement) */
+  lw_tone tone;                 /* valid when on[LW_TERM_TONE]: target and footprint */
+  double min_spacing;           /* least distance between pair samples of different
+                                   splines, mm (a hard constraint, model.h); 0 = none */
   lw_user_term_fn user_fn;      /* valid when on[LW_TERM_USER] */
   const void *user_data;        /* passed to user_fn; not owned */
   double load[2];               /* b of the load term: rho g + f, force per mm */

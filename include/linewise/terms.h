@@ -23,6 +23,9 @@
 **   load      -int b . r |r'| ds, b = rho g + f: gravity on the line density
 **             and a constant force per mm ([dynamics] gravity_x/_y, force_x/_y;
 **             on when b != 0, coefficient 1); data is b (2 doubles)
+**   tone      T * sum over pixels of A (G * ink - D)^2: the lines splatted
+**             into a blurred ink raster against the picture's darkness
+**             (tone.h)
 **
 ** The term table's order is the order of trace.csv's and state.lw's energy
 ** columns; a new term goes at the end so older state files still read.
@@ -31,7 +34,7 @@
 ** its samples come from, and the one object it reads (a potential, a
 ** field, the boundary, the pair kernel's settings, the user's data).  The
 ** scene fills the contexts (lw_scene_term_ctx, scene.h); terms never see
-** the scene.  A row has one of three shapes, which the model (model.h)
+** the scene.  A row has one of four shapes, which the model (model.h)
 ** treats alike for every term of that shape:
 **   segment   a sum over segments of a function of one segment's samples
 **             (cached per segment, differenced over the segments a move
@@ -45,6 +48,13 @@
 **             kernel's cutoff; ctx.data is the lw_pair_ctx, ctx.quad the
 **             pair samples' nodes.  One pairwise term at most is on (the
 **             grid has one cutoff): pair.
+**   raster    coef times a function of a raster into which every sample
+**             (at ctx.quad's nodes) splats a footprint; not a sum over
+**             segments (a pixel sees every line near it), but a move
+**             changes only its samples' footprints, so the model keeps
+**             one raster a term and differences a box around the move
+**             (tone.h); ctx.data is the lw_tone.  Any number may be on:
+**             tone.
 **
 ** Gradients (gradient.h): a segment row's segment_grad ADDS the partials
 ** of its energy (coefficient applied) with respect to the samples r, r',
@@ -79,6 +89,7 @@ typedef enum {
   LW_TERM_USER,
   LW_TERM_PARAM,
   LW_TERM_LOAD,
+  LW_TERM_TONE,
   LW_TERM_COUNT
 } lw_term_id;
 
@@ -104,12 +115,12 @@ typedef double (*lw_user_term_fn)(const lw_samples *s, const lw_quad *q, const v
 typedef struct {
   double coef;               /* 0 = off */
   const lw_quad *quad;       /* the nodes of the samples it is given */
-  const void *data;          /* lw_potential, lw_field, lw_boundary, lw_pair_ctx, user data, or NULL */
+  const void *data;          /* lw_potential, lw_field, lw_boundary, lw_pair_ctx, user data, lw_tone, or NULL */
   lw_user_term_fn fn;        /* the user term's function */
   int mode;                  /* field: 1 axial; strain: 1 per segment */
 } lw_term_ctx;
 
-/* One row: exactly one of segment, spline, pairwise.  segment returns the
+/* One row: exactly one of segment, spline, pairwise, raster.  segment returns the
 ** energy of one segment with its coefficient; spline the energy of one
 ** spline without it (the model multiplies, so differences round as
 ** coef * (new - old)). */
@@ -121,6 +132,7 @@ typedef struct {
   void (*segment_grad)(const lw_samples *s, const lw_term_ctx *c, lw_samples_grad *g);
   void (*spline_grad)(const double *seg_len, size_t n_seg, double length, double rest_length, const lw_term_ctx *c,
                       double *dlen);
+  int raster;
 } lw_term_type;
 
 extern const lw_term_type lw_term_types[LW_TERM_COUNT];

@@ -1,0 +1,48 @@
+/*
+** dnurbs.h -- the D-NURBS matrices of a curve with frozen weights
+** (Terzopoulos and Qin 1994; docs/NURBS.md, docs/NUMERICS.md "D-NURBS").
+**
+** With c(u) = sum_i R_i(u) P_i (the rational basis of nurbs.h, weights
+** held), and integrals over the parameter u as in the review:
+**
+**     E_el = 1/2 int alpha |c_u|^2 + beta |c_uu|^2 du = 1/2 sum_xy P' K P
+**     T    = 1/2 int mu |c_t|^2 du                 = 1/2 sum_xy Pdot' (mu M1) Pdot
+**     E_g  = - int mu g . c du                     = - sum_i mu (g . P_i) b_i
+**
+** K = int alpha R' R'^T + beta R'' R''^T du, M1 = int R R^T du and
+** b_i = int R_i du, by Gauss-Legendre quadrature on every knot span.  The
+** 1/2 is the review's (its eq. 54): K p is the elastic force.  R_i and R_j
+** overlap only when |i - j| < k, so K and M1 are banded with k - 1
+** off-diagonals; the x and y coordinates share them.  Band storage is
+** GSL's for its banded Cholesky: band[i * k + d] = A(i + d, i).
+*/
+#ifndef LINEWISE_DNURBS_H
+#define LINEWISE_DNURBS_H
+
+#include "linewise/nurbs.h"
+
+typedef struct {
+  size_t n;     /* control points */
+  int k;        /* order: the band has k columns */
+  double *K;    /* n x k: stiffness */
+  double *M1;   /* n x k: mass per unit density */
+  double *b;    /* n: int R_i du */
+} lw_dnurbs;
+
+/* The matrices of curve c (its weights frozen) with `gauss` points a span. */
+lw_dnurbs *lw_dnurbs_new(lw_nurbs *c, double alpha, double beta, int gauss, lw_error *err);
+void lw_dnurbs_free(lw_dnurbs *d);
+
+/* y = A x for a band A (n x k) on interleaved xy vectors (2 n). */
+void lw_band_apply(const double *A, size_t n, int k, const double *x, double *y);
+
+/* Factors the band A (n x k) into L (same size) with the coordinates where
+** pin[i] != 0 (i a control point) held: identity rows and columns.
+** LW_EINPUT when it is not positive definite. */
+lw_status lw_band_factor(const double *A, const unsigned char *pin, size_t n, int k, double *L, lw_error *err);
+
+/* x = A^-1 r on interleaved xy vectors, 0 at held points (L from
+** lw_band_factor; r and x may be the same array). */
+void lw_band_solve(const double *L, const unsigned char *pin, size_t n, int k, const double *r, double *x);
+
+#endif

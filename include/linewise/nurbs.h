@@ -1,0 +1,75 @@
+/*
+** nurbs.h -- NURBS curves in the plane: order k, an open knot vector,
+** control points and positive weights (docs/NURBS.md).
+**
+**     c(u) = sum_i N_i,k(u) w_i P_i / sum_i N_i,k(u) w_i = sum_i R_i(u) P_i
+**
+** The B-spline basis N_i,k and its derivatives come from GSL (gsl_bspline);
+** the rational part R_i is ours.  A curve owns a GSL workspace (scratch), so
+** a curve belongs to one thread; lw_nurbs_copy gives another thread its own.
+*/
+#ifndef LINEWISE_NURBS_H
+#define LINEWISE_NURBS_H
+
+#include <gsl/gsl_bspline.h>
+#include <stddef.h>
+
+#include "linewise/error.h"
+
+/* orders 2 (polyline) to this */
+#define LW_NURBS_ORDER_MAX 8
+
+typedef struct {
+  int order;      /* k: degree k - 1 */
+  size_t n;       /* control points */
+  double *knot;   /* n + k, open: k equal values at either end */
+  double *P;      /* 2 n: x y of each control point */
+  double *w;      /* n weights, > 0 */
+  gsl_bspline_workspace *ws; /* the basis (scratch) */
+  gsl_matrix *dB; /* k x 3 scratch: N, N', N'' of the nonzero functions */
+} lw_nurbs;
+
+/* Checks a knot vector for n control points of order k: n + k knots,
+** nondecreasing, k equal values at either end and none inside repeated more
+** than k - 1 times (the curve stays continuous).  LW_EINPUT with a message
+** saying what is wrong (the caller names the file, line and key). */
+lw_status lw_nurbs_check_knots(int order, size_t n, const double *knot, size_t n_knots, lw_error *err);
+
+/* A curve of n control points (copied; weights NULL = all 1), checked as
+** above and for weights > 0. */
+lw_nurbs *lw_nurbs_new(int order, size_t n, const double *knot, const double *P, const double *w, lw_error *err);
+lw_nurbs *lw_nurbs_copy(const lw_nurbs *c, lw_error *err);
+void lw_nurbs_free(lw_nurbs *c);
+
+/* The parameter range [knot[k-1], knot[n]]. */
+double lw_nurbs_u0(const lw_nurbs *c);
+double lw_nurbs_u1(const lw_nurbs *c);
+
+/* The k rational basis functions that can be nonzero at u, and their first
+** and second derivatives in u: R[d * k + j] is d^d R_{first+j} / du^d.
+** Returns first. */
+size_t lw_nurbs_rational(const lw_nurbs *c, double u, double *R);
+
+/* The point and derivatives c(u), c'(u), c''(u) (any of them NULL). */
+void lw_nurbs_eval(const lw_nurbs *c, double u, double pt[2], double d1[2], double d2[2]);
+
+/* 1 when every weight is equal: the curve is then a polynomial spline. */
+int lw_nurbs_polynomial(const lw_nurbs *c);
+
+/* Boehm's knot insertion of u (in the parameter range, any multiplicity up
+** to k - 1 after insertion), in homogeneous coordinates so that the curve
+** is unchanged for rational curves too: one control point more. */
+lw_status lw_nurbs_insert_knot(lw_nurbs *c, double u, lw_error *err);
+
+/* The curve as cubic Beziers for SVG: each knot span by the cubic Hermite
+** interpolant of its end points and end derivatives, bisected while it is
+** farther than tol from the curve at 32 parameter samples (a parametric
+** distance, which bounds the geometric one).  A polynomial span of degree
+** <= 3 is its own Hermite cubic, so those come out exact (one Bezier a
+** span, degree elevation included); rational and higher-degree spans are
+** approximated.  Calls emit(B, ctx) with 4 points (8 numbers) per Bezier
+** in curve order; returns the largest distance found (NaN: out of
+** memory). */
+double lw_nurbs_beziers(const lw_nurbs *c, double tol, void (*emit)(const double B[8], void *ctx), void *ctx);
+
+#endif

@@ -1,0 +1,36 @@
+/*
+** spacing.h -- how crowded a drawing is: the share of its line length that
+** has a point of another stroke (spline) closer than a given distance,
+** reported as summary.json's close_share with the pen width as distance.
+**
+** Each segment is cut into k = ceil(length / (d / 2)) pieces of equal
+** parameter (at most LW_SPACING_POINTS_MAX), each piece stands for its
+** midpoint with the length |r'(t)| / k, and the points go into a cell grid
+** (grid.h) of side d.  A point counts as close when a point of another
+** spline lies within d of it.  Points are at most d / 2 apart along a
+** line, so the nearest point of a line at true distance x < d is within
+** sqrt(x^2 + d^2 / 16) of it: only lines between 0.968 d and d apart can be
+** miscounted (as close).  The stroke's own points never count: a stroke
+** that folds onto itself is not two strokes.
+*/
+#ifndef LINEWISE_SPACING_H
+#define LINEWISE_SPACING_H
+
+#include <stddef.h>
+
+#include "linewise/error.h"
+#include "linewise/spline.h"
+
+#define LW_SPACING_POINTS_MAX 4096 /* points per segment */
+
+/* The n cubic Bezier segments b (8 doubles each: b0 b1 b2 b3 as x y pairs,
+** mm), segment k part of stroke owner[k]: *share = (length with another
+** stroke within d) / (length), 0 for a drawing without length.  d > 0, mm.
+** LW_ENOMEM, or LW_EINPUT when the points would exceed 2^32. */
+lw_status lw_close_share(const double *b, const size_t *owner, size_t n, double d, double *share, lw_error *err);
+
+/* The same for splines, each spline a stroke (the state before the
+** plotter post-pass). */
+lw_status lw_close_share_splines(const lw_splines *sp, double d, double *share, lw_error *err);
+
+#endif

@@ -1,0 +1,726 @@
+/*
+** sys_nurbs.c -- the D-NURBS system's row (sys_nurbs.h): a curve with
+** frozen weights is a quadratic energy E = 1/2 P'KP - f'P of its control
+** points, so a move's dE is local (the band of K) and the dynamics is
+** linear with a constant mass matrix.
+*/
+#include "linewise/sys_nurbs.h"
+
+#include <cairo.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "linewise/number.h"
+#include "linewise/output.h"
+
+static const char *const move_names[1] = {"point"};
+static const double move_unit[1] = {1.0};
+static const char *const term_names[2] = {"elastic", "gravity"};
+enum { T_ELASTIC, T_GRAVITY };
+
+#define SECTION "system nurbs"
+
+/* ---- set-up --------------------------------------------------------------- */
+
+static void setup_free(void *setup)
+{
+  lw_nurbs_setup *su = setup;
+  if (!su) return;
+  lw_nurbs_free(su->curve);
+  lw_dnurbs_free(su->mat);
+  free(su->pin);
+  free(su->f);
+  free(su->free_idx);
+  free(su);
+}
+
+/* The numbers in the text of [nurbs] key (malloc'ed; *n how many), blaming the key. */
+static double *numbers(const lw_params *p, const char *key, const char *text, size_t *n, lw_error *err)
+{
+  int count = lw_number_list(text, 1, NULL, 0);
+  if (count < 0) {
+    lw_error_set(err, LW_EINPUT, "expected numbers separated by blanks or commas, got '%.60s'", text);
+    lw_params_blame(p, "nurbs", key, err);
+    return NULL;
+  }
+  double *v = malloc(((size_t)count + 1) * sizeof *v);
+  if (!v) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for %d numbers", count);
+    return NULL;
+  }
+  lw_number_list(text, 1, v, count);
+  *n = (size_t)count;
+  return v;
+}
+
+/* Appends v to the array *a of *n (capacity *cap). */
+static int push(double **a, size_t *n, size_t *cap, double v)
+{
+  if (*n == *cap) {
+    size_t c = *cap ? 2 * *cap : 64;
+    double *b = realloc(*a, c * sizeof *b);
+    if (!b) return 0;
+    *a = b;
+    *cap = c;
+  }
+  (*a)[(*n)++] = v;
+  return 1;
+}
+
+/* The control points (and weights, if the lines have three numbers) of
+** nurbs.file; messages name the file and line, blamed on the key. */
+static lw_status read_file(const lw_params *p, double **P, size_t *np, double **w, size_t *nw, lw_error *err)
+{
+  char dir[LW_PATH_MAX], path[2 * LW_PATH_MAX + 2], line[1024];
+  lw_path_dir(dir, sizeof dir, p->file);
+  lw_path_join(path, sizeof path, dir, p->nb_file);
+  FILE *f = fopen(path, "r");
+  if (!f) {
+    lw_error_set(err, LW_EINPUT, "%s: cannot read: %s", path, strerror(errno));
+    return lw_params_blame(p, "nurbs", "file", err);
+  }
+  size_t cap_p = 0, cap_w = 0;
+  int lineno = 0, per = 0;
+  while (fgets(line, sizeof line, f)) {
+    lineno++;
+    line[strcspn(line, "#\r\n")] = '\0';
+    double v[4];
+    int k = lw_number_list(line, 0, v, 4);
+    if (k == 0) continue;
+    if ((k != 2 && k != 3) || (per && k != per) || (k == 3 && !(v[2] > 0.0))) {
+      lw_error_set(err, LW_EINPUT, "%s:%d: expected %s, got '%.60s'", path, lineno,
+                   per == 2 ? "'x y' like the lines before" : per == 3 ? "'x y w' (w > 0) like the lines before"
+                                                                      : "'x y' or 'x y w' (w > 0)", line);
+      fclose(f);
+      return lw_params_blame(p, "nurbs", "file", err);
+    }
+    per = k;
+    if (!push(P, np, &cap_p, v[0]) || !push(P, np, &cap_p, v[1]) || (k == 3 && !push(w, nw, &cap_w, v[2]))) {
+      fclose(f);
+      return lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+    }
+  }
+  fclose(f);
+  return LW_OK;
+}
+
+static lw_nurbs *curve_of(const lw_params *p, lw_error *err)
+{
+  size_t np = 0, nw = 0, nk = 0, k = (size_t)p->nb_order;
+  double *P = NULL, *w = NULL, *knot = NULL;
+  lw_nurbs *c = NULL;
+  if (p->nb_file[0]) {
+    if (read_file(p, &P, &np, &w, &nw, err)) goto out;
+  } else if (!(P = numbers(p, "points", p->nb_points, &np, err)) ||
+             !(w = numbers(p, "weights", p->nb_weights, &nw, err))) {
+    goto out;
+  }
+  size_t n = np / 2;
+  if (np % 2 || n < k) {
+    lw_error_set(err, LW_EINPUT, "expected x y pairs of at least order = %zu control points, got %zu numbers", k, np);
+    lw_params_blame(p, "nurbs", p->nb_file[0] ? "file" : "points", err);
+    goto out;
+  }
+  if (nw && nw != n) {
+    lw_error_set(err, LW_EINPUT, "expected one weight per control point (%zu), got %zu", n, nw);
+    lw_params_blame(p, "nurbs", "weights", err);
+    goto out;
+  }
+  for (size_t i = 0; i < nw; i++)
+    if (!(w[i] > 0.0)) {
+      lw_error_set(err, LW_EINPUT, "weight %zu is %g: weights must be > 0", i, w[i]);
+      lw_params_blame(p, "nurbs", "weights", err);
+      goto out;
+    }
+  if (!(knot = numbers(p, "knots", p->nb_knots, &nk, err))) goto out;
+  if (!nk) {
+    /* open uniform: k zeros, n - k inner knots, k ones */
+    free(knot);
+    if (!(knot = malloc((n + k) * sizeof *knot))) {
+      lw_error_set(err, LW_ENOMEM, "out of memory");
+      goto out;
+    }
+    for (size_t i = 0; i < n + k; i++)
+      knot[i] = i < k ? 0.0 : i >= n ? 1.0 : (double)(i - k + 1) / (double)(n - k + 1);
+    nk = n + k;
+  }
+  if (lw_nurbs_check_knots(p->nb_order, n, knot, nk, err)) {
+    lw_params_blame(p, "nurbs", "knots", err);
+    goto out;
+  }
+  c = lw_nurbs_new(p->nb_order, n, knot, P, nw ? w : NULL, err);
+out:
+  free(P), free(w), free(knot);
+  return c;
+}
+
+lw_nurbs_setup *lw_nurbs_setup_new(const lw_params *p, lw_nurbs *curve, lw_error *err)
+{
+  if (!curve) return NULL;
+  lw_nurbs_setup *su = calloc(1, sizeof *su);
+  if (!su) {
+    lw_nurbs_free(curve);
+    lw_error_set(err, LW_ENOMEM, "out of memory for a scene");
+    return NULL;
+  }
+  su->curve = curve;
+  size_t n = su->curve->n;
+  if (2 * (size_t)p->nb_fixed > n) {
+    lw_error_set(err, LW_EINPUT, "expected at most half of the %zu control points, got %d at each end", n,
+                 p->nb_fixed);
+    lw_params_blame(p, "nurbs", "fixed", err);
+    goto fail;
+  }
+  if (!(su->mat = lw_dnurbs_new(su->curve, p->nb_alpha, p->nb_beta, p->nb_gauss, err))) goto fail;
+  su->pin = calloc(n, 1);
+  su->f = calloc(2 * n, sizeof *su->f);
+  su->free_idx = calloc(n, sizeof *su->free_idx);
+  if (!su->pin || !su->f || !su->free_idx) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for a scene");
+    goto fail;
+  }
+  for (size_t i = 0; i < (size_t)p->nb_fixed; i++) su->pin[i] = su->pin[n - 1 - i] = 1;
+  for (size_t i = 0; i < n; i++) {
+    su->f[2 * i] = p->dyn_rho * p->dyn_gravity_x * su->mat->b[i];
+    su->f[2 * i + 1] = p->dyn_rho * p->dyn_gravity_y * su->mat->b[i];
+    if (!su->pin[i]) su->free_idx[su->n_free++] = i;
+  }
+  /* the frames' view: the control polygon's box, grown by half its larger side */
+  double *v = su->view, *P = su->curve->P;
+  v[0] = v[2] = P[0];
+  v[1] = v[3] = P[1];
+  for (size_t i = 1; i < n; i++) {
+    v[0] = fmin(v[0], P[2 * i]), v[2] = fmax(v[2], P[2 * i]);
+    v[1] = fmin(v[1], P[2 * i + 1]), v[3] = fmax(v[3], P[2 * i + 1]);
+  }
+  double grow = 0.5 * fmax(fmax(v[2] - v[0], v[3] - v[1]), 1e-9);
+  v[0] -= grow, v[1] -= grow, v[2] += grow, v[3] += grow;
+  su->step_max = v[2] - v[0];
+  su->tolerance = p->nb_svg_tolerance;
+  su->png_scale = p->nb_png_scale;
+  return su;
+fail:
+  setup_free(su);
+  return NULL;
+}
+
+static void *setup_new(const lw_params *p, lw_error *err) { return lw_nurbs_setup_new(p, curve_of(p, err), err); }
+
+static const char *note(const void *setup) { return ""; }
+
+/* ---- state ---------------------------------------------------------------- */
+
+static void state_free(void *state)
+{
+  lw_nurbs_state *s = state;
+  if (!s) return;
+  lw_nurbs_free(s->c);
+  free(s->KP);
+  free(s);
+}
+
+/* K P and the terms from scratch. */
+static void recompute(lw_nurbs_state *s)
+{
+  const lw_nurbs_setup *su = s->su;
+  size_t n = s->c->n;
+  lw_band_apply(su->mat->K, n, su->mat->k, s->c->P, s->KP);
+  double el = 0.0, g = 0.0;
+  for (size_t i = 0; i < 2 * n; i++) {
+    el += 0.5 * s->c->P[i] * s->KP[i];
+    g -= su->f[i] * s->c->P[i];
+  }
+  s->term[T_ELASTIC] = el;
+  s->term[T_GRAVITY] = g;
+}
+
+/* A state on control points P (2 n numbers; NULL: the set-up's). */
+static lw_nurbs_state *state_at(const lw_nurbs_setup *su, const double *P, lw_error *err)
+{
+  lw_nurbs_state *s = calloc(1, sizeof *s);
+  if (!s || !(s->c = lw_nurbs_copy(su->curve, err)) || !(s->KP = malloc(2 * su->curve->n * sizeof *s->KP))) {
+    state_free(s);
+    lw_error_set(err, LW_ENOMEM, "out of memory for a NURBS state");
+    return NULL;
+  }
+  s->su = su;
+  if (P) memcpy(s->c->P, P, 2 * su->curve->n * sizeof *P);
+  recompute(s);
+  return s;
+}
+
+/* The control points of a saved state's section; messages name path. */
+static lw_nurbs_state *state_get(const lw_nurbs_setup *su, lw_ckpt *doc, const char *section, lw_error *err)
+{
+  const char *path = lw_ckpt_path(doc);
+  if (!lw_ckpt_has(doc, section))
+    return lw_error_set(err, LW_EINPUT, "%s: section [%s]: missing (a state of another system?)", path, section), NULL;
+  size_t n = su->curve->n, i = 0, pos = 0;
+  long count;
+  if (lw_ckpt_whole(doc, section, "count", &count, (long)n, (long)n, 1, err)) return NULL;
+  double *P = malloc(2 * n * sizeof *P);
+  if (!P) return lw_error_set(err, LW_ENOMEM, "out of memory"), NULL;
+  const char *key, *val;
+  int line;
+  lw_nurbs_state *s = NULL;
+  while (lw_ckpt_next(doc, section, &pos, &key, &val, &line)) {
+    if (!strcmp(key, "count")) continue;
+    double v[3];
+    if (i == n || strcmp(key, "point") || lw_number_list(val, 0, v, 3) != 2) {
+      lw_error_set(err, LW_EINPUT, "%s:%d: [%s] %s: expected %s, got '%s = %.80s'", path, line, section,
+                   i == n ? "after the last point" : "point",
+                   i == n ? "nothing (count is the number of control points)" : "'point = x y' (2 numbers)", key, val);
+      goto out;
+    }
+    if (su->pin[i] && (v[0] != su->curve->P[2 * i] || v[1] != su->curve->P[2 * i + 1])) {
+      lw_error_set(err, LW_EINPUT, "%s:%d: [%s] point: control point %zu is held by nurbs.fixed at (%.17g, %.17g), "
+                   "got (%.17g, %.17g)", path, line, section, i, su->curve->P[2 * i], su->curve->P[2 * i + 1], v[0], v[1]);
+      goto out;
+    }
+    P[2 * i] = v[0];
+    P[2 * i + 1] = v[1];
+    i++;
+  }
+  if (i < n) {
+    lw_error_set(err, LW_EINPUT, "%s: [%s]: count = %zu, but %zu point lines", path, section, n, i);
+    goto out;
+  }
+  s = state_at(su, P, err);
+out:
+  free(P);
+  return s;
+}
+
+static void *state_new(const void *setup, const lw_params *p, unsigned long seed, lw_error *err)
+{
+  if (!p->from[0]) return state_at(setup, NULL, err);
+  lw_state st;
+  lw_nurbs_state *s = NULL;
+  if (!lw_state_read(&st, p->from, err)) {
+    s = state_get(setup, st.doc, SECTION, err);
+    lw_state_clear(&st);
+  }
+  if (!s && err->code == LW_EINPUT) lw_params_blame(p, "init", "from", err);
+  return s;
+}
+
+static void *state_copy(const void *state, lw_error *err)
+{
+  const lw_nurbs_state *s = state;
+  lw_nurbs_state *c = state_at(s->su, s->c->P, err);
+  if (c) memcpy(c->term, s->term, sizeof c->term);
+  return c;
+}
+
+/* ---- Monte Carlo ---------------------------------------------------------- */
+
+typedef struct {
+  size_t i;
+  double d[2];
+  double de[2]; /* elastic, gravity */
+} nb_prop;
+
+static void moves(const lw_params *p, double *weight, double *step, double *target)
+{
+  weight[0] = 1.0; /* the only kind */
+  step[0] = p->step_point;
+  target[0] = p->target;
+}
+
+static size_t sweep_size(const void *state) { return ((const lw_nurbs_state *)state)->su->n_free; }
+
+static double step_max(const void *state, int kind) { return ((const lw_nurbs_state *)state)->su->step_max; }
+
+static void *proposal_new(const void *state, lw_error *err)
+{
+  nb_prop *p = calloc(1, sizeof *p);
+  if (!p) lw_error_set(err, LW_ENOMEM, "out of memory");
+  return p;
+}
+
+static void proposal_free(void *prop) { free(prop); }
+
+/* dE of P_i + d: (K P)_i . d + 1/2 K_ii |d|^2 - f_i . d, from the band. */
+static double propose(void *state, void *prop, int kind, double step, gsl_rng *rng, int *forbidden)
+{
+  lw_nurbs_state *s = state;
+  const lw_nurbs_setup *su = s->su;
+  nb_prop *q = prop;
+  *forbidden = 0;
+  q->i = su->free_idx[gsl_rng_uniform_int(rng, su->n_free)];
+  q->d[0] = step * (2.0 * gsl_rng_uniform(rng) - 1.0);
+  q->d[1] = step * (2.0 * gsl_rng_uniform(rng) - 1.0);
+  size_t i = q->i;
+  double kii = su->mat->K[i * (size_t)su->mat->k];
+  q->de[T_ELASTIC] = s->KP[2 * i] * q->d[0] + s->KP[2 * i + 1] * q->d[1] +
+                     0.5 * kii * (q->d[0] * q->d[0] + q->d[1] * q->d[1]);
+  q->de[T_GRAVITY] = -(su->f[2 * i] * q->d[0] + su->f[2 * i + 1] * q->d[1]);
+  return q->de[T_ELASTIC] + q->de[T_GRAVITY];
+}
+
+static lw_status commit(void *state, void *prop)
+{
+  lw_nurbs_state *s = state;
+  const nb_prop *q = prop;
+  const lw_dnurbs *m = s->su->mat;
+  size_t i = q->i, n = m->n, k = (size_t)m->k;
+  s->c->P[2 * i] += q->d[0];
+  s->c->P[2 * i + 1] += q->d[1];
+  /* column i of K: K(i + d, i) below, K(i, i - d) = K(i - d, i) above */
+  for (size_t d = 0; d < k; d++) {
+    if (i + d < n) {
+      s->KP[2 * (i + d)] += m->K[i * k + d] * q->d[0];
+      s->KP[2 * (i + d) + 1] += m->K[i * k + d] * q->d[1];
+    }
+    if (d > 0 && i >= d) {
+      s->KP[2 * (i - d)] += m->K[(i - d) * k + d] * q->d[0];
+      s->KP[2 * (i - d) + 1] += m->K[(i - d) * k + d] * q->d[1];
+    }
+  }
+  s->term[T_ELASTIC] += q->de[T_ELASTIC];
+  s->term[T_GRAVITY] += q->de[T_GRAVITY];
+  return LW_OK;
+}
+
+/* ---- energies ------------------------------------------------------------- */
+
+static double total(const void *state)
+{
+  const lw_nurbs_state *s = state;
+  return s->term[T_ELASTIC] + s->term[T_GRAVITY];
+}
+
+static void terms(const void *state, double *term) { memcpy(term, ((const lw_nurbs_state *)state)->term, 2 * sizeof *term); }
+
+static int term_on(const void *setup, int t)
+{
+  const lw_nurbs_setup *su = setup;
+  if (t == T_ELASTIC) return 1;
+  for (size_t i = 0; i < 2 * su->curve->n; i++)
+    if (su->f[i] != 0.0) return 1;
+  return 0;
+}
+
+static lw_status refresh(void *state, double *drift)
+{
+  lw_nurbs_state *s = state;
+  double old = total(s);
+  recompute(s);
+  if (drift) *drift = fabs(total(s) - old) / fmax(fabs(total(s)), 1.0);
+  return LW_OK;
+}
+
+static double energy(const void *setup, const lw_state *st, const char *path, double *term, lw_error *err)
+{
+  lw_nurbs_state *s = state_get(setup, st->doc, SECTION, err);
+  if (!s) return NAN;
+  memcpy(term, s->term, sizeof s->term);
+  double e = total(s);
+  state_free(s);
+  return e;
+}
+
+static lw_status save(const void *state, lw_ckpt_writer *w, const char *section, lw_error *err)
+{
+  const lw_nurbs_state *s = state;
+  lw_ckpt_section(w, section);
+  lw_ckpt_put(w, "count", "%zu", s->c->n);
+  for (size_t i = 0; i < s->c->n; i++) lw_ckpt_put(w, "point", "%.17g %.17g", s->c->P[2 * i], s->c->P[2 * i + 1]);
+  return LW_OK;
+}
+
+static void *load(const void *setup, lw_state *st, const char *section, const char *path, lw_error *err)
+{
+  return state_get(setup, st->doc, section, err);
+}
+
+static void set_terms(void *state, const double *term) { memcpy(((lw_nurbs_state *)state)->term, term, 2 * sizeof *term); }
+
+/* ---- gradient and inertia ------------------------------------------------- */
+
+static size_t n_coords(const void *state) { return 2 * ((const lw_nurbs_state *)state)->c->n; }
+
+static void get_coords(const void *state, double *x)
+{
+  const lw_nurbs_state *s = state;
+  memcpy(x, s->c->P, 2 * s->c->n * sizeof *x);
+}
+
+static lw_status set_coords(void *state, const double *x, lw_error *err)
+{
+  lw_nurbs_state *s = state;
+  for (size_t i = 0; i < 2 * s->c->n; i++)
+    if (!isfinite(x[i])) return lw_error_set(err, LW_EINPUT, "coordinate %zu (control point %zu) is not finite", i, i / 2);
+  memcpy(s->c->P, x, 2 * s->c->n * sizeof *x);
+  recompute(s);
+  return LW_OK;
+}
+
+/* dE/dP = K P - f */
+static double gradient(void *state, double *g, lw_error *err)
+{
+  lw_nurbs_state *s = state;
+  for (size_t i = 0; i < 2 * s->c->n; i++) g[i] = s->KP[i] - s->su->f[i];
+  return total(s);
+}
+
+typedef struct {
+  const lw_nurbs_setup *su;
+  double *M, *L; /* density M1 and its factor (held points as identity) */
+} nb_mass;
+
+static void mass_free(void *mass)
+{
+  nb_mass *m = mass;
+  if (!m) return;
+  free(m->M);
+  free(m->L);
+  free(m);
+}
+
+static void *mass_new(const void *state, const lw_params *p, double density, lw_error *err)
+{
+  const lw_nurbs_setup *su = ((const lw_nurbs_state *)state)->su;
+  size_t nk = su->mat->n * (size_t)su->mat->k;
+  nb_mass *m = calloc(1, sizeof *m);
+  if (!m || !(m->M = malloc(nk * sizeof *m->M)) || !(m->L = malloc(nk * sizeof *m->L))) {
+    mass_free(m);
+    lw_error_set(err, LW_ENOMEM, "out of memory for the mass matrix");
+    return NULL;
+  }
+  m->su = su;
+  for (size_t i = 0; i < nk; i++) m->M[i] = density * su->mat->M1[i];
+  if (lw_band_factor(m->M, su->pin, su->mat->n, su->mat->k, m->L, err)) {
+    mass_free(m);
+    return NULL;
+  }
+  return m;
+}
+
+/* frozen weights: the matrix is constant, factored once */
+static lw_status mass_at(void *mass, const double *x, lw_error *err) { return LW_OK; }
+
+static void mass_solve(const void *mass, const double *b, double *v)
+{
+  const nb_mass *m = mass;
+  lw_band_solve(m->L, m->su->pin, m->su->mat->n, m->su->mat->k, b, v);
+}
+
+static void mass_apply(const void *mass, const double *v, double *b)
+{
+  const nb_mass *m = mass;
+  lw_band_apply(m->M, m->su->mat->n, m->su->mat->k, v, b);
+}
+
+static void mass_dx(const void *mass, const double *x, const double *v, double *out)
+{
+  const nb_mass *m = mass;
+  memset(out, 0, 2 * m->su->mat->n * sizeof *out);
+}
+
+static int mass_pinned(const void *mass, size_t i) { return ((const nb_mass *)mass)->su->pin[i / 2]; }
+
+/* ---- drawings ------------------------------------------------------------- */
+
+typedef struct {
+  FILE *f;
+  cairo_t *cr;
+  size_t count;
+} bz_sink;
+
+static void svg_bezier(const double B[8], void *ctx)
+{
+  bz_sink *k = ctx;
+  if (!k->count++) fprintf(k->f, "M %.17g %.17g", B[0], -B[1]);
+  fprintf(k->f, " C %.17g %.17g %.17g %.17g %.17g %.17g", B[2], -B[3], B[4], -B[5], B[6], -B[7]);
+}
+
+static void cairo_bezier(const double B[8], void *ctx)
+{
+  bz_sink *k = ctx;
+  if (!k->count++) cairo_move_to(k->cr, B[0], B[1]);
+  cairo_curve_to(k->cr, B[2], B[3], B[4], B[5], B[6], B[7]);
+}
+
+/* The box of the control polygon (the curve lies inside it). */
+static void box_of(const lw_nurbs *c, double b[4])
+{
+  b[0] = b[2] = c->P[0];
+  b[1] = b[3] = c->P[1];
+  for (size_t i = 1; i < c->n; i++) {
+    b[0] = fmin(b[0], c->P[2 * i]), b[2] = fmax(b[2], c->P[2 * i]);
+    b[1] = fmin(b[1], c->P[2 * i + 1]), b[3] = fmax(b[3], c->P[2 * i + 1]);
+  }
+  double m = 0.05 * fmax(fmax(b[2] - b[0], b[3] - b[1]), 1e-9);
+  b[0] -= m, b[1] -= m, b[2] += m, b[3] += m;
+}
+
+/* final.svg: y up in the curve's coordinates, so the page flips it. */
+static lw_status write_svg(lw_nurbs_state *s, const char *path, lw_error *err)
+{
+  char tmp[LW_OUTPUT_PATH_MAX];
+  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
+  if (!f) return err->code;
+  double b[4];
+  box_of(s->c, b);
+  double w = b[2] - b[0], h = b[3] - b[1];
+  fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" "
+          "viewBox=\"%.17g %.17g %.17g %.17g\">\n<path fill=\"none\" stroke=\"black\" stroke-width=\"%.6g\" d=\"",
+          b[0], -b[3], w, h, 0.005 * fmax(w, h));
+  bz_sink k = {f, NULL, 0};
+  s->deviation = lw_nurbs_beziers(s->c, s->su->tolerance, svg_bezier, &k);
+  s->beziers = k.count;
+  fprintf(f, "\"/>\n</svg>\n");
+  if (isnan(s->deviation)) {
+    lw_output_abort(f, tmp);
+    return lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+  }
+  return lw_output_commit(f, tmp, path, err);
+}
+
+static cairo_status_t png_write(void *closure, const unsigned char *data, unsigned int len)
+{
+  return fwrite(data, 1, len, closure) == len ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
+}
+
+/* A PNG of the curve (black) and its control polygon (grey) in box b. */
+static lw_status write_png(const lw_nurbs_state *s, const double b[4], const char *path, lw_error *err)
+{
+  double scale = s->su->png_scale;
+  int W = (int)ceil((b[2] - b[0]) * scale), H = (int)ceil((b[3] - b[1]) * scale);
+  if (W < 1 || H < 1 || W > 20000 || H > 20000)
+    return lw_error_set(err, LW_EINPUT, "%s: a picture of %d x %d pixels: change nurbs.png_scale (now %g)", path, W, H,
+                        scale);
+  cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);
+  cairo_t *cr = cairo_create(surf);
+  cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo_paint(cr);
+  cairo_translate(cr, 0, H);
+  cairo_scale(cr, scale, -scale);
+  cairo_translate(cr, -b[0], -b[1]);
+  cairo_set_line_width(cr, 1.0 / scale);
+  cairo_set_source_rgb(cr, 0.6, 0.6, 0.6);
+  for (size_t i = 0; i < s->c->n; i++) {
+    cairo_line_to(cr, s->c->P[2 * i], s->c->P[2 * i + 1]);
+    cairo_rectangle(cr, s->c->P[2 * i] - 2 / scale, s->c->P[2 * i + 1] - 2 / scale, 4 / scale, 4 / scale);
+    cairo_move_to(cr, s->c->P[2 * i], s->c->P[2 * i + 1]);
+  }
+  cairo_stroke(cr);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  cairo_set_line_width(cr, 2.0 / scale);
+  bz_sink k = {NULL, cr, 0};
+  lw_nurbs_beziers(s->c, s->su->tolerance, cairo_bezier, &k);
+  cairo_stroke(cr);
+  cairo_surface_flush(surf);
+  lw_status st = LW_OK;
+  char tmp[LW_OUTPUT_PATH_MAX];
+  FILE *f = NULL;
+  if (cairo_status(cr)) {
+    st = lw_error_set(err, LW_ERUN, "%s: drawing failed: %s", path, cairo_status_to_string(cairo_status(cr)));
+  } else if (!(f = lw_output_open_tmp(path, tmp, sizeof tmp, err))) {
+    st = err->code;
+  } else if (cairo_surface_write_to_png_stream(surf, png_write, f)) {
+    lw_output_abort(f, tmp);
+    st = lw_error_set(err, LW_EIO, "%s: writing the PNG failed", path);
+  } else {
+    st = lw_output_commit(f, tmp, path, err);
+  }
+  cairo_destroy(cr);
+  cairo_surface_destroy(surf);
+  return st;
+}
+
+static lw_status draw(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err)
+{
+  lw_nurbs_state *s = state;
+  char path[LW_PATH_MAX + 64];
+  if (sweep == LW_DRAW_START) return LW_OK;
+  if (sweep == LW_DRAW_FINAL) {
+    double b[4];
+    box_of(s->c, b);
+    lw_path_join(path, sizeof path, dir, "final.svg");
+    lw_status st = write_svg(s, path, err);
+    if (st) return st;
+    lw_path_join(path, sizeof path, dir, "final.png");
+    return write_png(s, b, path, err);
+  }
+  int n = snprintf(path, sizeof path, "%s/frames", dir);
+  if (n < 0 || (size_t)n >= sizeof path - 32) return lw_error_set(err, LW_EIO, "%s: path too long for the frames", dir);
+  if (mkdir(path, 0777) && errno != EEXIST) return lw_error_set(err, LW_EIO, "%s: %s", path, strerror(errno));
+  snprintf(path + n, sizeof path - (size_t)n, "/frame-%06ld.png", sweep);
+  return write_png(s, s->su->view, path, err);
+}
+
+static void summary(const void *state, lw_json *j)
+{
+  const lw_nurbs_state *s = state;
+  lw_json_key(j, "control_points");
+  lw_json_int(j, (long long)s->c->n);
+  lw_json_key(j, "order");
+  lw_json_int(j, s->c->order);
+  lw_json_key(j, "fixed");
+  lw_json_int(j, (long long)(s->c->n - s->su->n_free));
+  lw_json_key(j, "svg_beziers");
+  lw_json_int(j, (long long)s->beziers);
+  lw_json_key(j, "svg_max_deviation");
+  lw_json_number(j, s->deviation);
+}
+
+static void describe(const void *state, int what, char *buf, size_t n)
+{
+  const lw_nurbs_state *s = state;
+  if (what == LW_DESCRIBE_SIZE)
+    snprintf(buf, n, "a NURBS curve of order %d, %zu control points, %zu free", s->c->order, s->c->n, s->su->n_free);
+  else
+    snprintf(buf, n, "linewise: final.svg: %zu cubic Beziers, at most %.3g from the curve%s\n", s->beziers,
+             s->deviation, lw_nurbs_polynomial(s->c) && s->c->order <= 4 ? " (exact)" : "");
+}
+
+const lw_system_type lw_system_nurbs = {
+    .name = "nurbs",
+    .n_moves = 1,
+    .move_names = move_names,
+    .move_unit = move_unit,
+    .n_terms = 2,
+    .term_names = term_names,
+    .setup_new = setup_new,
+    .setup_free = setup_free,
+    .note = note,
+    .state_new = state_new,
+    .state_copy = state_copy,
+    .state_free = state_free,
+    .moves = moves,
+    .sweep_size = sweep_size,
+    .step_max = step_max,
+    .proposal_new = proposal_new,
+    .proposal_free = proposal_free,
+    .propose = propose,
+    .commit = commit,
+    .total = total,
+    .terms = terms,
+    .term_on = term_on,
+    .refresh = refresh,
+    .energy = energy,
+    .save = save,
+    .load = load,
+    .set_terms = set_terms,
+    .n_coords = n_coords,
+    .get_coords = get_coords,
+    .set_coords = set_coords,
+    .gradient = gradient,
+    .mass_new = mass_new,
+    .mass_free = mass_free,
+    .mass_at = mass_at,
+    .mass_solve = mass_solve,
+    .mass_apply = mass_apply,
+    .mass_dx = mass_dx,
+    .mass_pinned = mass_pinned,
+    .files = "final.svg, final.png",
+    .draw = draw,
+    .summary = summary,
+    .describe = describe,
+};

@@ -1,0 +1,230 @@
+/*
+** tone.c -- the tone term's raster (tone.h): footprints in fixed point, the
+** energy of a raster and the difference of a box of changes.
+*/
+#include "linewise/tone.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+lw_status lw_tone_init(lw_tone *t, const lw_image *img, const lw_image_place *pl, double sigma, double pen,
+                       lw_error *err)
+{
+  memset(t, 0, sizeof *t);
+  double r = ceil(3.0 * sigma / pl->pixel);
+  if (!(r <= LW_TONE_RADIUS_MAX))
+    return lw_error_set(err, LW_EINPUT, "tone: a blur of %g mm is %.0f pixels of %g mm, more than the %d the "
+                        "footprint allows; blur the picture (scene.image_blur) or lower its resolution",
+                        sigma, r, pl->pixel, LW_TONE_RADIUS_MAX);
+  t->radius = r < 1.0 ? 1 : (int)r;
+  t->pad = t->radius;
+  t->w = img->width + 2 * t->pad;
+  t->h = img->height + 2 * t->pad;
+  t->pixel = pl->pixel;
+  t->area = pl->pixel * pl->pixel;
+  t->x0 = pl->x0 - t->pad * pl->pixel;
+  t->y0 = pl->y0 - t->pad * pl->pixel;
+  t->sigma = sigma;
+  t->pen = pen;
+  t->dark = calloc((size_t)t->w * (size_t)t->h, sizeof *t->dark);
+  if (!t->dark) return lw_error_set(err, LW_ENOMEM, "out of memory for the tone raster (%d x %d)", t->w, t->h);
+  for (int j = 0; j < img->height; j++)
+    for (int i = 0; i < img->width; i++)
+      t->dark[(size_t)(j + t->pad) * (size_t)t->w + (size_t)(i + t->pad)] =
+          1.0f - img->tone[(size_t)j * (size_t)img->width + (size_t)i];
+  /* The same blur on both sides: G * ink cannot be sharper than G, so a
+  ** sharp target would ask for ink piled along every edge (the picture's
+  ** rim included) to make up for the blur. */
+  lw_status st = lw_image_blur_plane(t->dark, t->w, t->h, sigma / pl->pixel, err);
+  if (st) lw_tone_clear(t);
+  return st;
+}
+
+void lw_tone_clear(lw_tone *t)
+{
+  free(t->dark);
+  t->dark = NULL;
+}
+
+int64_t *lw_tone_raster_new(const lw_tone *t) { return calloc((size_t)t->w * (size_t)t->h, sizeof(int64_t)); }
+
+/* The pixel column (or row) nearest to page coordinate c, in *k; 0 when the
+** footprint around it misses [0, n) or c is not finite.  Decided in doubles
+** so that no huge coordinate is converted to int. */
+static int nearest(double c, double c0, double pixel, int radius, int n, int *k)
+{
+  double u = floor((c - c0) / pixel);
+  if (!(u >= -radius && u < (double)n + radius)) return 0;
+  *k = (int)u;
+  return 1;
+}
+
+/* The normalised weights of the 2 radius + 1 pixel centres around pixel k
+** for a sample at c: the Gaussian less its value at rho = radius pixels,
+** 0 beyond.  Every centre outside the window is farther than rho from c, so
+** the footprint is continuous in c as the window moves with the sample (a
+** Gaussian cut at the window would jump by e^-4.5 of its peak there). */
+static void weights(const lw_tone *t, double c, double c0, int k, double *g)
+{
+  const int R = t->radius;
+  const double p = t->pixel, inv = 1.0 / (2.0 * t->sigma * t->sigma), rho = R * p, floor_ = exp(-rho * rho * inv);
+  const double d0 = c0 + (k - R + 0.5) * p - c, a0 = (2.0 * d0 * p + p * p) * inv;
+  double sum = 0.0;
+  if (fabs(a0) < 600.0 && d0 * d0 * inv < 600.0) {
+    /* exp(-d_m^2 inv) for d_m = d0 + m p by products: the ratio of
+    ** neighbours is exp(-(2 d_m p + p^2) inv), itself falling by
+    ** exp(-2 p^2 inv) a step.  Three exps an axis instead of 2 R + 1. */
+    double e = exp(-d0 * d0 * inv), r = exp(-a0);
+    const double c2 = exp(-2.0 * p * p * inv);
+    for (int m = 0; m <= 2 * R; m++) {
+      g[m] = e > floor_ ? e - floor_ : 0.0;
+      sum += g[m];
+      e *= r;
+      r *= c2;
+    }
+  } else { /* a blur well below a pixel: the products would overflow */
+    for (int m = 0; m <= 2 * R; m++) {
+      double d = d0 + m * p;
+      double e = exp(-d * d * inv);
+      g[m] = e > floor_ ? e - floor_ : 0.0;
+      sum += g[m];
+    }
+  }
+  if (!(sum > 0.0)) { /* a blur far below a pixel: all of it in the sample's own pixel */
+    g[R] = sum = 1.0;
+  }
+  for (int m = 0; m <= 2 * R; m++) g[m] /= sum;
+}
+
+void lw_tone_splat(const lw_tone *t, int64_t *r, int wx, int wy, int ww, int wh, double x, double y, double dl,
+                   int sign)
+{
+  const int R = t->radius;
+  int ci, cj;
+  if (!(dl > 0.0) || !nearest(x, t->x0, t->pixel, R, t->w, &ci) || !nearest(y, t->y0, t->pixel, R, t->h, &cj))
+    return;
+  double gx[2 * LW_TONE_RADIUS_MAX + 1], gy[2 * LW_TONE_RADIUS_MAX + 1];
+  weights(t, x, t->x0, ci, gx);
+  weights(t, y, t->y0, cj, gy);
+  /* the window within the raster, in raster pixels */
+  int i0 = ci - R, i1 = ci + R + 1, j0 = cj - R, j1 = cj + R + 1;
+  if (i0 < wx) i0 = wx;
+  if (j0 < wy) j0 = wy;
+  if (i1 > wx + ww) i1 = wx + ww;
+  if (j1 > wy + wh) j1 = wy + wh;
+  if (i0 < 0) i0 = 0;
+  if (j0 < 0) j0 = 0;
+  if (i1 > t->w) i1 = t->w;
+  if (j1 > t->h) j1 = t->h;
+  const double a = t->pen * dl / t->area;
+  for (int j = j0; j < j1; j++) {
+    const double ay = a * gy[j - cj + R];
+    int64_t *row = r + (size_t)(j - wy) * (size_t)ww;
+    for (int i = i0; i < i1; i++) {
+      double v = ay * gx[i - ci + R];
+      /* rounded (half up: v >= 0) from the sample alone, so its +1 and -1
+      ** cancel exactly; a cast, not llrint, which is a call into libm */
+      int64_t q = (int64_t)((v < LW_TONE_CAP ? v : LW_TONE_CAP) * LW_TONE_ONE + 0.5);
+      /* unsigned: wrap-around is defined and exact sums come out right */
+      row[i - wx] = (int64_t)((uint64_t)row[i - wx] + (uint64_t)(sign > 0 ? q : -q));
+    }
+  }
+}
+
+double lw_tone_energy(const lw_tone *t, const int64_t *r)
+{
+  const size_t n = (size_t)t->w * (size_t)t->h;
+  double sum = 0.0;
+  for (size_t k = 0; k < n; k++) {
+    double e = (double)r[k] / LW_TONE_ONE - t->dark[k];
+    sum += e * e;
+  }
+  return t->area * sum;
+}
+
+void lw_tone_box_reset(lw_tone_box *b) { b->x0 = b->y0 = b->x1 = b->y1 = 0; }
+
+/* Pixels [*k0, *k1) of an axis of n pixels that the footprints of samples
+** in [c0, c1] can reach, one to spare on each side; decided in doubles so
+** that no huge coordinate is converted to int. */
+static void reach(double c0, double c1, double origin, double pixel, int radius, int n, int *k0, int *k1)
+{
+  double u0 = floor((c0 - origin) / pixel) - radius - 1, u1 = floor((c1 - origin) / pixel) + radius + 2;
+  if (!(u0 > 0.0)) u0 = 0.0; /* NaN too */
+  if (!(u1 < (double)n)) u1 = (double)n;
+  if (!(u0 < u1)) u0 = u1 = 0.0;
+  *k0 = (int)u0;
+  *k1 = (int)u1;
+}
+
+void lw_tone_box_cover(const lw_tone *t, lw_tone_box *b, double x0, double y0, double x1, double y1)
+{
+  int i0, i1, j0, j1;
+  reach(x0, x1, t->x0, t->pixel, t->radius, t->w, &i0, &i1);
+  reach(y0, y1, t->y0, t->pixel, t->radius, t->h, &j0, &j1);
+  if (i0 >= i1 || j0 >= j1) return;
+  if (b->x0 >= b->x1 || b->y0 >= b->y1) {
+    *b = (lw_tone_box){i0, j0, i1, j1, b->d, b->cap};
+    return;
+  }
+  if (i0 < b->x0) b->x0 = i0;
+  if (j0 < b->y0) b->y0 = j0;
+  if (i1 > b->x1) b->x1 = i1;
+  if (j1 > b->y1) b->y1 = j1;
+}
+
+lw_status lw_tone_box_ready(lw_tone_box *b)
+{
+  size_t n = b->x0 < b->x1 && b->y0 < b->y1 ? (size_t)(b->x1 - b->x0) * (size_t)(b->y1 - b->y0) : 0;
+  if (n > b->cap) {
+    size_t cap = b->cap ? b->cap : 256;
+    while (cap < n) cap *= 2;
+    int64_t *d = realloc(b->d, cap * sizeof *d);
+    if (!d) return LW_ENOMEM;
+    b->d = d;
+    b->cap = cap;
+  }
+  if (n) memset(b->d, 0, n * sizeof *b->d);
+  return LW_OK;
+}
+
+void lw_tone_box_free(lw_tone_box *b)
+{
+  free(b->d);
+  b->d = NULL;
+  b->cap = 0;
+}
+
+void lw_tone_box_splat(const lw_tone *t, lw_tone_box *b, double x, double y, double dl, int sign)
+{
+  if (b->x0 < b->x1 && b->y0 < b->y1) lw_tone_splat(t, b->d, b->x0, b->y0, b->x1 - b->x0, b->y1 - b->y0, x, y, dl, sign);
+}
+
+double lw_tone_delta(const lw_tone *t, const int64_t *r, const lw_tone_box *b)
+{
+  const int bw = b->x1 - b->x0;
+  double sum = 0.0;
+  for (int j = b->y0; j < b->y1; j++) {
+    const int64_t *d = b->d + (size_t)(j - b->y0) * (size_t)bw;
+    const int64_t *row = r + (size_t)j * (size_t)t->w + b->x0;
+    const float *dark = t->dark + (size_t)j * (size_t)t->w + b->x0;
+    for (int i = 0; i < bw; i++) {
+      if (!d[i]) continue; /* most of a box around a moved segment */
+      double e = (double)row[i] / LW_TONE_ONE - dark[i], db = (double)d[i] / LW_TONE_ONE;
+      /* (e + db)^2 - e^2 without the cancellation of two large squares */
+      sum += db * (2.0 * e + db);
+    }
+  }
+  return t->area * sum;
+}
+
+void lw_tone_apply(const lw_tone *t, int64_t *r, const lw_tone_box *b)
+{
+  const int bw = b->x1 - b->x0;
+  for (int j = b->y0; j < b->y1; j++) {
+    const int64_t *d = b->d + (size_t)(j - b->y0) * (size_t)bw;
+    int64_t *row = r + (size_t)j * (size_t)t->w + b->x0;
+    for (int i = 0; i < bw; i++) row[i] = (int64_t)((uint64_t)row[i] + (uint64_t)d[i]);
+  }
+}

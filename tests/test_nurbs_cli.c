@@ -1,0 +1,129 @@
+/*
+** test_nurbs_cli.c -- the D-NURBS system from the command line: the wire
+** example under the dynamics (bit-exact resume, the trace's energies,
+** exact Beziers), Monte Carlo on a rational curve, and bad [nurbs] input.
+*/
+#include <criterion/criterion.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "testutil.h"
+
+static char dir[64];
+
+static void make_dir(void) { cr_assert_eq(lw_test_dir_make(dir, "ncli"), 0); }
+static void remove_dir(void) { cr_assert_eq(lw_test_dir_remove(dir), 0); }
+
+TestSuite(nurbs_cli, .init = make_dir, .fini = remove_dir);
+
+#define sh lw_test_sh
+
+static const char *bin(void)
+{
+  const char *b = getenv("LW_BIN");
+  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
+  return b;
+}
+
+static const char *root(void)
+{
+  const char *r = getenv("LW_ROOT");
+  cr_assert_not_null(r);
+  return r;
+}
+
+Test(nurbs_cli, the_wire_runs_and_resumes_to_the_same_bytes)
+{
+  const char *set = "--set anneal.sweeps=40 --set output.checkpoint_every=7 --set output.frames_every=20";
+  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/a --quiet %s", bin(), root(), dir, set), 0);
+  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/b --quiet %s --stop-at 13", bin(), root(), dir, set), 0);
+  cr_assert_eq(sh("%s resume %s/b --quiet", bin(), dir), 0);
+  const char *same[] = {"state.lw", "trace.csv", "final.svg", "final.png"};
+  for (int k = 0; k < 4; k++)
+    cr_assert_eq(sh("cmp -s %s/a/%s %s/b/%s", dir, same[k], dir, same[k]), 0, "%s differs after a resume", same[k]);
+  cr_assert_eq(sh("head -1 %s/a/trace.csv | grep -q '^sweep,time,elastic,gravity,potential,kinetic,total$'", dir), 0);
+  /* undamped: the total energy is kept (leapfrog: bounded error) */
+  cr_assert_eq(sh("awk -F, 'NR == 2 { h = $7 } NR > 2 { d = $7 - h; if (d < 0) d = -d; if (d > 1e-3 * h) bad = 1 } "
+                  "END { exit bad }' %s/a/trace.csv", dir), 0);
+  /* a polynomial cubic is written exactly: one Bezier a span */
+  cr_assert_eq(sh("grep -q '\"svg_beziers\": 4' %s/a/summary.json && grep -q '\"control_points\": 7' "
+                  "%s/a/summary.json", dir, dir), 0);
+  cr_assert_eq(sh("test -s %s/a/frames/frame-000020.png && test -s %s/a/final.png", dir, dir), 0);
+  cr_assert_eq(sh("grep -c '^point = ' %s/a/state.lw | grep -q '^7$'", dir), 0);
+}
+
+Test(nurbs_cli, monte_carlo_anneals_a_rational_curve_and_bounds_its_svg)
+{
+  cr_assert_eq(sh("printf '[scene]\\nsystem = nurbs\\n[nurbs]\\norder = 3\\npoints = 2 0 2 2 0 2 -2 2 -2 0\\n"
+                  "weights = 1 0.7071067811865476 1 0.7071067811865476 1\\nknots = 0 0 0 0.5 0.5 1 1 1\\n"
+                  "alpha = 1\\nfixed = 1\\nsvg_tolerance = 1e-5\\n[anneal]\\nsweeps = 300\\nseed = 3\\n' > %s/c.ini",
+                  dir), 0);
+  cr_assert_eq(sh("%s run %s/c.ini --out %s/c --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(sh("grep -q '\"system\": \"nurbs\"' %s/c/summary.json", dir), 0);
+  /* the rational curve is approximated within the tolerance */
+  cr_assert_eq(sh("awk -F': ' '/svg_max_deviation/ { d = $2 + 0; found = 1 } END { exit !(found && d <= 1e-5 && d > "
+                  "0) }' %s/c/summary.json", dir), 0);
+  /* the energy command recomputes the saved state's energy */
+  cr_assert_eq(sh("%s energy %s/c > %s/e.txt", bin(), dir, dir), 0);
+  cr_assert_eq(sh("grep -q elastic %s/e.txt", dir), 0);
+}
+
+/* A scene's [nurbs] key with a bad value: exit 2, the file, line and key
+** and what was expected; no run directory. */
+static void refused(const char *body, const char *pattern)
+{
+  cr_assert_eq(sh("printf '[scene]\\nsystem = nurbs\\n[nurbs]\\n%s' > %s/bad.ini", body, dir), 0);
+  cr_assert_eq(sh("%s run %s/bad.ini --out %s/bad --quiet 2> %s/err.txt", bin(), dir, dir, dir), 2, "%s", body);
+  cr_assert_eq(sh("grep -q '%s' %s/err.txt", pattern, dir), 0, "%s: message does not match '%s'", body, pattern);
+  cr_assert_neq(sh("test -e %s/bad", dir), 0);
+}
+
+Test(nurbs_cli, bad_knots_and_weights_exit_2_naming_file_line_and_key)
+{
+  const char *pts = "points = 0 0 1 1 2 0 3 1 4 0 5 1 6 0\\n";
+  char body[512];
+  snprintf(body, sizeof body, "%sknots = 0 0 0 0 0.25 0.5 0.75 1 1 1 1 1\\n", pts);
+  refused(body, "bad.ini:5: key .nurbs.knots.: 12 knots: 7 control points of order 4 need n + k = 11");
+  snprintf(body, sizeof body, "%sknots = 0 0 0 0 0.5 0.25 0.75 1 1 1 1\\n", pts);
+  refused(body, "bad.ini:5: key .nurbs.knots.: knot 5 (0.25) is less than knot 4 (0.5)");
+  snprintf(body, sizeof body, "order = 3\\n%sknots = 0 0 0.1 0.25 0.4 0.5 0.75 1 1 1\\n", pts);
+  refused(body, "bad.ini:6: key .nurbs.knots.: not an open knot vector");
+  snprintf(body, sizeof body, "%sweights = 1 1 1 0 1 1 1\\n", pts);
+  refused(body, "bad.ini:5: key .nurbs.weights.: weight 3 is 0: weights must be > 0");
+  snprintf(body, sizeof body, "%sweights = 1 1 1 -2 1 1 1\\n", pts);
+  refused(body, "bad.ini:5: key .nurbs.weights.: weight 3 is -2");
+  snprintf(body, sizeof body, "%sweights = 1 1 1\\n", pts);
+  refused(body, "bad.ini:5: key .nurbs.weights.: expected one weight per control point (7), got 3");
+  refused("points = 0 0 1 1 2\\n", "bad.ini:4: key .nurbs.points.: expected x y pairs");
+  /* the points file: its own line named, behind the key's */
+  cr_assert_eq(sh("printf '# wire\\n0 0 1\\n1 1 1\\n2 0\\n' > %s/p.txt", dir), 0);
+  refused("file = p.txt\\n", "bad.ini:4: key .nurbs.file.: .*p.txt:4: expected .x y w. (w > 0) like the lines before");
+  refused("file = none.txt\\n", "bad.ini:4: key .nurbs.file.: .*none.txt: cannot read");
+}
+
+Test(nurbs_cli, a_points_file_holds_a_long_curve)
+{
+  /* 60 points and weights: far beyond one scene line */
+  cr_assert_eq(sh("awk 'BEGIN { for (i = 0; i < 60; i++) printf \"%%g %%g %%g\\n\", i, (i %% 7) / 3.0, 1 + (i %% 3) / 4.0 }' "
+                  "> %s/long.txt", dir), 0);
+  cr_assert_eq(sh("printf '[scene]\\nsystem = nurbs\\n[nurbs]\\nfile = long.txt\\nalpha = 1\\nbeta = 0.1\\nfixed = 2\\n"
+                  "[anneal]\\nsweeps = 20\\n' > %s/long.ini", dir), 0);
+  cr_assert_eq(sh("%s run %s/long.ini --out %s/long --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(sh("grep -q '\"control_points\": 60' %s/long/summary.json && grep -q '\"fixed\": 4' "
+                  "%s/long/summary.json", dir, dir), 0);
+  refused("points = 0 0 1 x\\n", "bad.ini:4: key .nurbs.points.: expected numbers");
+}
+
+Test(nurbs_cli, tempering_replicas_give_the_same_bytes_for_any_thread_count)
+{
+  cr_assert_eq(sh("printf '[scene]\\nsystem = nurbs\\n[nurbs]\\norder = 3\\npoints = 2 0 2 2 0 2 -2 2 -2 0\\n"
+                  "weights = 1 0.7 1 0.7 1\\nknots = 0 0 0 0.5 0.5 1 1 1\\nfixed = 1\\n[anneal]\\nsweeps = 100\\n"
+                  "[tempering]\\nreplicas = 4\\n' > %s/t.ini", dir), 0);
+  cr_assert_eq(sh("OMP_NUM_THREADS=1 %s run %s/t.ini --out %s/t1 --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(sh("OMP_NUM_THREADS=3 %s run %s/t.ini --out %s/t3 --quiet", bin(), dir, dir), 0);
+  const char *same[] = {"state.lw", "trace.csv", "final.svg"};
+  for (int k = 0; k < 3; k++)
+    cr_assert_eq(sh("cmp -s %s/t1/%s %s/t3/%s", dir, same[k], dir, same[k]), 0, "%s differs with the threads", same[k]);
+  cr_assert_eq(sh("grep -c '^\\[system nurbs' %s/t1/state.lw | grep -q '^4$'", dir), 0, "one section a rung");
+}

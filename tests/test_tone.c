@@ -1,0 +1,557 @@
+/*
+** test_tone.c -- the tone term (tone.h): its local differences against the
+** full recomputation, its raster after many moves, what it draws on a flat
+** and a graded picture; the spacing constraint and the close share
+** (spacing.h).
+*/
+#include <criterion/criterion.h>
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
+#include <math.h>
+
+#include "imageutil.h"
+#include "linewise/init.h"
+#include "linewise/model.h"
+#include "linewise/scene.h"
+#include "linewise/spacing.h"
+#include "testutil.h"
+
+TestSuite(tone, .init = lw_image_dir_make, .fini = lw_image_dir_remove);
+
+/* A page of side `page` mm (margin 2) with a w x w picture of tone f(u, v),
+** u, v in [0, 1] across it, and the tone term at T with blur sigma. */
+static lw_params tone_params(double page, int w, double (*f)(double, double), double T, double sigma)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = p.height = page;
+  p.margin = 2;
+  p.tone = T;
+  p.tone_blur = sigma;
+  p.pen_width = 0.3;
+  p.min_speed = 0;
+  p.regularity = 0;
+  float *g = malloc((size_t)w * (size_t)w * sizeof *g);
+  for (int j = 0; j < w; j++)
+    for (int i = 0; i < w; i++) g[j * w + i] = (float)f((i + 0.5) / w, (j + 0.5) / w);
+  static int k;
+  char name[32];
+  snprintf(name, sizeof name, "pic%d.png", k++);
+  snprintf(p.image, sizeof p.image, "%s", lw_test_path(name));
+  lw_test_png(p.image, w, w, g, NULL);
+  free(g);
+  return p;
+}
+
+static double blotches(double u, double v) { return 0.5 + 0.4 * sin(7 * u + 2 * v) * cos(5 * v - 3 * u * u); }
+static double grey(double u, double v) { (void)u; (void)v; return 0.7; }
+static double ramp(double u, double v) { (void)v; return 1.0 - u; } /* white at the left, black at the right */
+
+static void scene_of(lw_scene *sc, const lw_params *p)
+{
+  lw_error err;
+  cr_assert_eq(lw_scene_init(sc, p, &err), LW_OK, "%s", err.msg);
+}
+
+static lw_model *model_of(const lw_scene *sc, size_t n, size_t segs, double len, unsigned long seed)
+{
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, seed);
+  lw_error err;
+  lw_splines *sp = lw_init_random(sc, n, segs, len, r, &err);
+  cr_assert_not_null(sp, "%s", err.msg);
+  gsl_rng_free(r);
+  lw_model *m = lw_model_new(sc, sp, &err);
+  cr_assert_not_null(m, "%s", err.msg);
+  return m;
+}
+
+/* A chain over m at temperature T with the default mix. */
+static lw_chain *chain_of(lw_model *m, double T, unsigned long seed)
+{
+  const double w[4] = {0.5, 0.4, 0.05, 0.05}, st[4] = {0.3, 0.3, 0.3, 0.05}, tg[4] = {0.44, 0.44, 0.3, 0.3};
+  lw_error err;
+  lw_chain *c = model_chain(m, w, st, tg, seed, &err);
+  cr_assert_not_null(c, "%s", err.msg);
+  c->temperature = T;
+  return c;
+}
+
+static void anneal(lw_chain *c, double t0, double t1, int sweeps)
+{
+  for (int s = 0; s < sweeps; s++) {
+    c->temperature = t0 * pow(t1 / t0, (double)s / (sweeps - 1));
+    c->tuning = s < sweeps / 2;
+    cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  }
+}
+
+Test(tone, a_move_changes_the_energy_by_the_full_recomputation)
+{
+  /* Random moves of every kind (one point, one vector, a whole spline),
+  ** with the other terms on as well: each term's local difference against
+  ** two recomputations from scratch, and the running totals after the
+  ** accepted half of them. */
+  lw_params p = tone_params(40, 50, blotches, 3.0, 0.8);
+  p.potential_coef = 0.5;
+  p.potential = LW_POT_IMAGE;
+  p.bending = 0.3;
+  p.pair = 0.02;
+  p.pair_cutoff = 2;
+  lw_scene sc;
+  scene_of(&sc, &p);
+  lw_model *m = model_of(&sc, 60, 3, 3, 11);
+  lw_proposal *pr = lw_proposal_new(m, NULL);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 12);
+  double term0[LW_TERM_COUNT], term1[LW_TERM_COUNT];
+  double e0 = lw_energy_compute(&sc, m->sp, term0, NULL);
+  cr_assert(term0[LW_TERM_TONE] > 0.0);
+  lw_node nd[8];
+  for (int trial = 0; trial < 300; trial++) {
+    uint32_t i = (uint32_t)gsl_rng_uniform_int(r, m->sp->n_splines);
+    size_t nn = m->sp->first[i + 1] - m->sp->first[i], node0 = 0, n_node = nn;
+    const lw_node *src = &m->sp->node[m->sp->first[i]];
+    int kind = trial % 3;
+    if (kind < 2) {
+      node0 = gsl_rng_uniform_int(r, nn);
+      n_node = 1;
+    }
+    double dx = gsl_ran_gaussian(r, 0.7), dy = gsl_ran_gaussian(r, 0.7);
+    for (size_t k = 0; k < n_node; k++) {
+      nd[k] = src[node0 + k];
+      if (kind == 1) {
+        nd[k].vx += dx;
+        nd[k].vy += dy;
+      } else {
+        nd[k].px += dx;
+        nd[k].py += dy;
+      }
+    }
+    lw_model_propose(m, pr, i, node0, n_node, nd);
+    lw_splines *moved = lw_splines_clone(m->sp);
+    memcpy(&moved->node[moved->first[i] + node0], nd, n_node * sizeof *nd);
+    double e1 = lw_energy_compute(&sc, moved, term1, NULL);
+    lw_splines_free(moved);
+    if (!isfinite(e1) || !isfinite(pr->dE)) continue; /* left the frame: +inf either way */
+    for (int t = 0; t < LW_TERM_COUNT; t++)
+      cr_assert(fabs(pr->dterm[t] - (term1[t] - term0[t])) <= 1e-9 * fmax(fabs(term0[t]), 1e-3),
+                "trial %d term %s: local %.17g, full %.17g", trial, lw_term_names[t], pr->dterm[t],
+                term1[t] - term0[t]);
+    cr_assert(fabs(pr->dE - (e1 - e0)) <= 1e-9 * fmax(fabs(e0), 1.0));
+    if (trial % 2) {
+      cr_assert_eq(lw_model_commit(m, pr), LW_OK);
+      e0 = e1;
+      memcpy(term0, term1, sizeof term0);
+    }
+  }
+  for (int t = 0; t < LW_TERM_COUNT; t++)
+    cr_assert(fabs(m->term[t] - term0[t]) <= 1e-9 * fmax(fabs(term0[t]), 1e-3), "%s", lw_term_names[t]);
+  gsl_rng_free(r);
+  lw_proposal_free(pr);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+Test(tone, the_raster_after_many_moves_is_the_one_built_from_scratch)
+{
+  /* A dense scene (twice the ink the picture asks for, lines crossing
+  ** everywhere) and 40 sweeps: the running total equals the recomputation
+  ** to 1e-9, and the raster is bit for bit the one a fresh model of the
+  ** final state builds (the fixed-point sums are exact), which is what
+  ** makes a resumed run identical to an unbroken one. */
+  lw_params p = tone_params(30, 40, blotches, 2.0, 0.7);
+  p.strain = 5;
+  p.bending = 0.2;
+  lw_scene sc;
+  scene_of(&sc, &p);
+  lw_model *m = model_of(&sc, 300, 3, 2, 21);
+  lw_chain *c = chain_of(m, 0.05, 22);
+  for (int s = 0; s < 40; s++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  unsigned long acc = 0;
+  for (int k = 0; k < 4; k++) acc += c->stats[k].accepted;
+  cr_assert(acc > 10000, "only %lu accepted moves", acc);
+  double term[LW_TERM_COUNT];
+  lw_energy_compute(&sc, m->sp, term, NULL);
+  cr_assert(fabs(m->term[LW_TERM_TONE] - term[LW_TERM_TONE]) <= 1e-9 * fabs(term[LW_TERM_TONE]),
+            "running %.17g, recomputed %.17g", m->term[LW_TERM_TONE], term[LW_TERM_TONE]);
+  lw_model *fresh = lw_model_new(&sc, lw_splines_clone(m->sp), NULL);
+  cr_assert_not_null(fresh);
+  cr_assert_eq(memcmp(m->raster[LW_TERM_TONE], fresh->raster[LW_TERM_TONE],
+                      (size_t)sc.tone.w * (size_t)sc.tone.h * sizeof(int64_t)), 0);
+  cr_assert_eq(fresh->term[LW_TERM_TONE], term[LW_TERM_TONE], "a fresh model sums as the recomputation does");
+  lw_model_free(fresh);
+  model_chain_free(c);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+Test(tone, off_it_holds_no_raster)
+{
+  lw_params p = tone_params(30, 20, grey, 0.0, 1.0);
+  p.bending = 1;
+  lw_scene sc;
+  scene_of(&sc, &p);
+  cr_assert_null(sc.tone.dark, "no target is built for a term that is off");
+  lw_model *m = model_of(&sc, 20, 2, 3, 5);
+  lw_proposal *pr = lw_proposal_new(m, NULL);
+  lw_node nd = m->sp->node[1];
+  nd.px += 0.3;
+  lw_model_propose(m, pr, 0, 1, 1, &nd);
+  cr_assert_eq(lw_model_commit(m, pr), LW_OK);
+  for (int t = 0; t < LW_TERM_COUNT; t++) {
+    cr_assert_null(m->raster[t]);
+    cr_assert_eq(pr->box[t].cap, 0, "a proposal grows no box");
+  }
+  cr_assert_eq(m->term[LW_TERM_TONE], 0.0);
+  lw_proposal_free(pr);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+Test(tone, a_sample_deposits_its_ink_area)
+{
+  /* The footprint is normalised per axis: inside the raster a sample adds
+  ** pen * dl to sum_p A B_p, up to the rounding of each pixel (2^-32). */
+  lw_params p = tone_params(30, 30, grey, 1.0, 0.9);
+  lw_scene sc;
+  scene_of(&sc, &p);
+  const lw_tone *t = &sc.tone;
+  int64_t *r = lw_tone_raster_new(t);
+  cr_assert_not_null(r);
+  rng_seed(3);
+  double want = 0.0;
+  for (int k = 0; k < 50; k++) {
+    double dl = urand(0.1, 0.6);
+    lw_tone_splat(t, r, 0, 0, t->w, t->h, urand(4, 26), urand(4, 26), dl, 1);
+    want += t->pen * dl;
+  }
+  double sum = 0.0;
+  for (size_t k = 0; k < (size_t)t->w * (size_t)t->h; k++) sum += (double)r[k] / LW_TONE_ONE * t->area;
+  size_t px = (size_t)(2 * t->radius + 1) * (size_t)(2 * t->radius + 1);
+  cr_assert(fabs(sum - want) <= 50 * px * 0.5 / LW_TONE_ONE * t->area + 1e-12 * want, "deposited %.17g, want %.17g",
+            sum, want);
+  free(r);
+  lw_scene_clear(&sc);
+}
+
+/* Mean and variance of the blurred ink B over the raster pixels at least
+** `rim` pixels inside the picture, in a bx x bx grid of blocks: block
+** means into bm. */
+static void ink_stats(const lw_model *m, int rim, int bx, double *mean, double *var, double *bm, int *block_px)
+{
+  const lw_tone *t = &m->scene->tone;
+  const int64_t *r = m->raster[LW_TERM_TONE];
+  int i0 = t->pad + rim, n = t->w - 2 * (t->pad + rim), side = n / bx;
+  double s = 0, s2 = 0;
+  for (int b = 0; b < bx * bx; b++) bm[b] = 0;
+  for (int j = 0; j < side * bx; j++)
+    for (int i = 0; i < side * bx; i++) {
+      double v = (double)r[(size_t)(i0 + j) * (size_t)t->w + (size_t)(i0 + i)] / LW_TONE_ONE;
+      s += v;
+      s2 += v * v;
+      bm[(j / side) * bx + i / side] += v;
+    }
+  double N = (double)(side * bx) * (side * bx);
+  *mean = s / N;
+  *var = s2 / N - *mean * *mean;
+  for (int b = 0; b < bx * bx; b++) bm[b] /= (double)side * side;
+  *block_px = side * side;
+}
+
+Test(tone, a_flat_grey_picture_gets_uniform_ink_at_its_darkness)
+{
+  /* Tone 0.7 everywhere: darkness D = 0.3.  The lines are free to stretch
+  ** (no strain) and start with half the ink D asks for; the tone term
+  ** alone decides how much line there is.
+  **
+  ** Expected ink fraction: B = G * ink cannot be flat (the lines are
+  ** lines), and at the minimum the energy cannot fall by scaling all ink
+  ** by (1 + e): d/de sum (B(1 + e) - D)^2 = 0 gives mean(B^2) = D mean(B),
+  ** so mean(B) = D - var(B) / mean(B), a little below D by the texture's
+  ** variance.  Tolerance: the thermal and texture noise of the mean over
+  ** the interior, whose B is correlated over the area 4 pi sigma^2 of a
+  ** Gaussian-blurred field: n_eff = area / (4 pi sigma^2) independent
+  ** values, standard error sqrt(var / n_eff); 4 of them, plus 0.01 for
+  ** the scaling argument holding only approximately (stretching lines
+  ** moves ink as well as adding it).
+  **
+  ** Uniform: each of 3 x 3 blocks has the overall mean within 4 standard
+  ** errors sqrt(var / n_eff(block)). */
+  const double D = 0.3, sigma = 0.8;
+  lw_params p = tone_params(30, 40, grey, 20.0, sigma);
+  p.bending = 0.3;
+  p.boundary_coef = 0.05;
+  lw_scene sc;
+  scene_of(&sc, &p);
+  double area = 26.0 * 26.0, half = 0.5 * D * area / p.pen_width;
+  lw_model *m = model_of(&sc, (size_t)(half / 6.0), 3, 2, 31);
+  lw_chain *c = chain_of(m, 0.01, 32);
+  anneal(c, 0.05, 0.0005, 120);
+  int rim = (int)ceil(3 * sigma / sc.tone.pixel), bpx;
+  double mean, var, bm[9];
+  ink_stats(m, rim, 3, &mean, &var, bm, &bpx);
+  double cell = 4 * M_PI * sigma * sigma / sc.tone.area; /* pixels per independent value */
+  double n_eff = 9.0 * bpx / cell, want = D - var / mean;
+  cr_log_info("flat grey: mean ink %.4f (D %.2f, expected %.4f), sd %.4f, blocks of %d px", mean, D, want,
+              sqrt(var), bpx);
+  cr_assert(fabs(mean - want) <= 4 * sqrt(var / n_eff) + 0.01, "mean ink %g, expected %g (sd %g, n_eff %g)", mean,
+            want, sqrt(var), n_eff);
+  for (int b = 0; b < 9; b++)
+    cr_assert(fabs(bm[b] - mean) <= 4 * sqrt(var * cell / bpx), "block %d: ink %g against the mean %g", b, bm[b],
+              mean);
+  model_chain_free(c);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+/* Share of the line length (at the quadrature samples) over the darkest
+** tenth of a ramp picture (its right tenth, x beyond 90 % of it). */
+static double darkest_tenth_share(const lw_model *m)
+{
+  const lw_image_place *pl = &m->scene->image_place;
+  double x9 = pl->x0 + 0.9 * m->scene->image->width * pl->pixel, in = 0, all = 0;
+  lw_samples s;
+  for (size_t g = 0; g < m->sp->n_segments; g++) {
+    const lw_node *a = &m->sp->node[lw_segment_node(m->sp, g)];
+    lw_segment_sample(&m->scene->quad, a, a + 1, &s);
+    for (int q = 0; q < s.n; q++) {
+      all += s.dl[q];
+      if (s.x[q] > x9) in += s.dl[q];
+    }
+  }
+  return in / all;
+}
+
+Test(tone, density_follows_tone_instead_of_piling_into_the_darks)
+{
+  /* A ramp from white (left) to black (right) and as much line as the
+  ** picture's darkness asks for (strain holds the lengths).  Darkness
+  ** D(u) = u over u in [0, 1]: ink in proportion to it puts
+  ** int_0.9^1 u du / int_0^1 u du = 19 % of the length in the darkest
+  ** tenth.  The potential alone (Phi = tone) has its minimum with every
+  ** line in the darkest place, and piles them there; the tone term stops
+  ** adding ink where the blurred ink reaches the darkness. */
+  double share[2];
+  for (int with_tone = 0; with_tone < 2; with_tone++) {
+    lw_params p = tone_params(30, 40, ramp, with_tone ? 20.0 : 0.0, 0.8);
+    if (!with_tone) {
+      p.potential = LW_POT_IMAGE;
+      p.potential_coef = 1.0;
+    }
+    p.strain = 20;
+    p.bending = 0.3;
+    p.boundary_coef = 0.05;
+    lw_scene sc;
+    scene_of(&sc, &p);
+    double ink = 0.5 * 26.0 * 26.0 / p.pen_width; /* mm of line the darkness asks for */
+    lw_model *m = model_of(&sc, (size_t)(ink / 6.0), 3, 2, 41);
+    lw_chain *c = chain_of(m, 0.01, 42);
+    anneal(c, 0.05, 0.0005, 100);
+    share[with_tone] = darkest_tenth_share(m);
+    model_chain_free(c);
+    lw_model_free(m);
+    lw_scene_clear(&sc);
+  }
+  cr_log_info("darkest tenth: %.3f of the length with the potential, %.3f with the tone term", share[0], share[1]);
+  cr_assert(share[0] > 0.4, "the potential piles lines into the darks: %g", share[0]);
+  cr_assert(fabs(share[1] - 0.19) < 0.06, "the tone term follows the ramp: %g of the length in the darkest tenth",
+            share[1]);
+}
+
+Test(tone, bad_keys_are_named)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  p.tone = 1;
+  lw_scene sc;
+  lw_error err;
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "energy.tone") && strstr(err.msg, "scene.image"), "%s", err.msg);
+  lw_params_defaults(&p);
+  p.min_spacing = 0.3;
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "energy.min_spacing") && strstr(err.msg, "energy.pair"), "%s", err.msg);
+  p.pair = 1;
+  p.pair_cutoff = 0.2;
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "energy.min_spacing") && strstr(err.msg, "pair_cutoff"), "%s", err.msg);
+  p = tone_params(30, 20, grey, 1.0, 2000.0);
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "energy.tone_blur"), "%s", err.msg);
+}
+
+/* Pairs of pair samples of different splines closer than d, from scratch. */
+static size_t close_pairs(const lw_scene *sc, const lw_splines *sp, double d)
+{
+  size_t n = sp->n_segments * (size_t)sc->pair_quad.n, count = 0, k = 0;
+  double *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y);
+  uint32_t *owner = malloc(n * sizeof *owner);
+  lw_samples s;
+  for (size_t g = 0; g < sp->n_segments; g++) {
+    const lw_node *a = &sp->node[lw_segment_node(sp, g)];
+    lw_segment_sample(&sc->pair_quad, a, a + 1, &s);
+    for (int q = 0; q < s.n; q++, k++) {
+      x[k] = s.x[q];
+      y[k] = s.y[q];
+      owner[k] = sp->seg_spline[g];
+    }
+  }
+  for (size_t i = 0; i < n; i++)
+    for (size_t j = i + 1; j < n; j++) {
+      double dx = x[i] - x[j], dy = y[i] - y[j];
+      count += owner[i] != owner[j] && dx * dx + dy * dy < d * d;
+    }
+  free(x);
+  free(y);
+  free(owner);
+  return count;
+}
+
+/* Rows of straight strokes 0.45 mm apart (3 strokes of 6 mm a row, 1.5 mm
+** gaps): crowded, but no pair of samples of different strokes closer than
+** 0.3 mm (at 8 pair nodes on 2 mm segments the samples along a row are at
+** most 0.4 mm apart; across rows 0.45 mm). */
+static lw_splines *rows(int n_rows)
+{
+  size_t n = 3 * (size_t)n_rows, segs[256];
+  for (size_t i = 0; i < n; i++) segs[i] = 3;
+  lw_splines *sp = lw_splines_new(n, segs, NULL);
+  for (size_t i = 0; i < n; i++) {
+    double x = 4.5 + 7.5 * (double)(i % 3), y = 4.5 + 0.45 * (double)(i / 3);
+    lw_test_straight(sp, i, x, y, x + 6, y);
+  }
+  return sp;
+}
+
+Test(tone, the_spacing_constraint_holds_once_kept)
+{
+  /* From a crowded layout that keeps 0.3 mm, the tone term of a picture
+  ** with darker blotches pulls strokes together: without the constraint
+  ** pairs come closer than 0.3 mm within a few sweeps, with it none ever
+  ** does (checked from scratch after every sweep). */
+  size_t worst[2] = {0, 0};
+  unsigned long accepted = 0;
+  for (int on = 0; on < 2; on++) {
+    lw_params p = tone_params(30, 30, blotches, 20.0, 0.8);
+    p.pair = 0.001;
+    p.pair_cutoff = 1.0;
+    p.min_spacing = on ? 0.3 : 0.0;
+    p.strain = 10;
+    p.bending = 0.3;
+    lw_scene sc;
+    scene_of(&sc, &p);
+    lw_splines *sp = rows(40);
+    cr_assert_eq(close_pairs(&sc, sp, 0.3), 0, "the start keeps the spacing");
+    lw_model *m = lw_model_new(&sc, sp, NULL);
+    cr_assert_not_null(m);
+    lw_chain *c = chain_of(m, 0.02, 52);
+    for (int s = 0; s < 20; s++) {
+      cr_assert_eq(lw_chain_sweep(c), LW_OK);
+      size_t k = close_pairs(&sc, m->sp, 0.3);
+      if (k > worst[on]) worst[on] = k;
+    }
+    if (on)
+      for (int k = 0; k < 4; k++) accepted += c->stats[k].accepted;
+    model_chain_free(c);
+    lw_model_free(m);
+    lw_scene_clear(&sc);
+  }
+  cr_log_info("spacing: up to %zu pairs closer than 0.3 mm without the constraint, %zu with it", worst[0], worst[1]);
+  cr_assert(worst[0] > 0, "the tone term pulls strokes together when nothing stops it");
+  cr_assert_eq(worst[1], 0, "%zu pairs closer than min_spacing", worst[1]);
+  cr_assert(accepted > 1000, "the chain kept moving: %lu accepted", accepted);
+}
+
+Test(tone, a_crowded_start_only_gets_less_crowded)
+{
+  /* A random placement breaks the spacing everywhere; no move may add a
+  ** pair too close, so the count never grows from sweep to sweep, and the
+  ** pair repulsion lowers it. */
+  lw_params p = tone_params(30, 30, blotches, 5.0, 0.8);
+  p.pair = 0.05;
+  p.pair_cutoff = 1.5;
+  p.min_spacing = 0.3;
+  p.strain = 10;
+  p.bending = 0.3;
+  lw_scene sc;
+  scene_of(&sc, &p);
+  lw_model *m = model_of(&sc, 120, 3, 2, 51);
+  size_t before = close_pairs(&sc, m->sp, 0.3), now = before;
+  cr_assert(before > 20, "the start is crowded: %zu pairs", before);
+  lw_chain *c = chain_of(m, 0.02, 52);
+  for (int s = 0; s < 20; s++) {
+    cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    size_t k = close_pairs(&sc, m->sp, 0.3);
+    cr_assert(k <= now, "sweep %d: %zu pairs too close after %zu", s, k, now);
+    now = k;
+  }
+  cr_log_info("spacing: %zu pairs too close at the start, %zu after 20 sweeps", before, now);
+  cr_assert(now < before / 2, "%zu of %zu pairs still too close", now, before);
+  model_chain_free(c);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+Test(tone, close_share_of_known_layouts)
+{
+  /* Straight strokes 20 mm long: parallel at 0.2 mm are close over their
+  ** whole length, at 0.4 mm not at all, with pen 0.3; two crossing at right
+  ** angles are close where |s| < 0.3 from the crossing, 0.6 mm of each
+  ** 20 mm (the points are d / 2 apart: the band is resolved to d / 2). */
+  const double d = 0.3;
+  const double gap[2] = {0.2, 0.4}, want[2] = {1.0, 0.0};
+  for (int k = 0; k < 2; k++) {
+    size_t segs[2] = {4, 4};
+    lw_splines *sp = lw_splines_new(2, segs, NULL);
+    lw_test_straight(sp, 0, 10, 10, 30, 10);
+    lw_test_straight(sp, 1, 10, 10 + gap[k], 30, 10 + gap[k]);
+    double share;
+    cr_assert_eq(lw_close_share_splines(sp, d, &share, NULL), LW_OK);
+    cr_assert(fabs(share - want[k]) < 1e-12, "gap %g: share %g", gap[k], share);
+    lw_splines_free(sp);
+  }
+  size_t segs[2] = {4, 4};
+  lw_splines *sp = lw_splines_new(2, segs, NULL);
+  lw_test_straight(sp, 0, 10, 20, 30, 20);
+  lw_test_straight(sp, 1, 20.013, 10, 20.013, 30);
+  double share;
+  cr_assert_eq(lw_close_share_splines(sp, d, &share, NULL), LW_OK);
+  cr_assert(fabs(share - 0.6 / 20) <= 0.5 * d / 20, "crossing: share %g, want %g", share, 0.6 / 20);
+  lw_splines_free(sp);
+}
+
+Test(tone, runs_resume_and_thread_counts_give_the_same_bytes)
+{
+  /* Through the binary: a scene with the tone term and the spacing
+  ** constraint, two replicas.  On 1 and 2 threads, and stopped halfway and
+  ** resumed, the run ends with the same state.lw (the raster is rebuilt on
+  ** resume: its exact sums make that invisible), and summary.json has the
+  ** close share. */
+  const char *b = getenv("LW_BIN");
+  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
+  lw_params p = tone_params(30, 30, blotches, 5.0, 0.8); /* writes the picture */
+  FILE *f = fopen(lw_test_path("s.ini"), "w");
+  cr_assert_not_null(f);
+  fprintf(f, "[scene]\nwidth = 30\nheight = 30\nmargin = 2\nimage = %s\n"
+             "[init]\nsplines = 40\nsegments = 3\nsegment_length = 2\n"
+             "[energy]\ntone = 5\ntone_blur = 0.8\nstrain = 10\nbending = 0.3\npair = 0.05\npair_cutoff = 1.5\n"
+             "min_spacing = 0.3\nboundary = 0.1\n"
+             "[anneal]\nsweeps = 12\nsteps = 3\nt_start = 0.05\nt_end = 0.005\nseed = 9\n"
+             "[tempering]\nreplicas = 2\nt_max = 0.1\n"
+             "[output]\npen_width = 0.3\ncheckpoint_every = 3\n",
+          strrchr(p.image, '/') + 1);
+  fclose(f);
+  const char *dir = lw_test_dir;
+  cr_assert_eq(lw_test_sh("%s run %s/s.ini --out %s/a --threads 1 --quiet", b, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/s.ini --out %s/b --threads 2 --quiet", b, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/s.ini --out %s/c --stop-at 6 --quiet && %s resume %s/c --quiet", b, dir, dir,
+                          b, dir),
+               0);
+  cr_assert_eq(lw_test_sh("cmp -s %s/a/state.lw %s/b/state.lw", dir, dir), 0, "1 and 2 threads differ");
+  cr_assert_eq(lw_test_sh("cmp -s %s/a/state.lw %s/c/state.lw", dir, dir), 0, "the resumed run differs");
+  cr_assert_eq(lw_test_sh("cmp -s %s/a/trace.csv %s/c/trace.csv", dir, dir), 0, "the resumed trace differs");
+  cr_assert_eq(lw_test_sh("grep -q '\"close_share\": 0' %s/a/summary.json && grep -q '\"tone\":' %s/a/summary.json",
+                          dir, dir),
+               0, "summary.json names the tone term and the close share");
+}
