@@ -165,10 +165,17 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
   return LW_OK;
 }
 
-/* The system's row and its set-up of the scene. */
+/* The system's row and its set-up of the scene; a quench needs a row with
+** a gradient. */
 static lw_status setup_system(lw_anneal *a, lw_error *err)
 {
   if (!(a->sys_type = lw_system_of(&a->params, err))) return err->code;
+  if (a->params.quench != LW_QUENCH_NONE && !a->sys_type->gradient) {
+    char where[LW_PATH_MAX + 32];
+    lw_params_origin(&a->params, lw_params_find("anneal", "quench"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.quench': the %s system has no gradient to quench with; "
+                        "expected none", where, a->sys_type->name);
+  }
   a->setup = a->sys_type->setup_new(&a->params, err);
   return a->setup ? LW_OK : err->code;
 }
@@ -614,6 +621,22 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     }
   lw_json_end_object(&j);
   lw_json_key(&j, "energy_initial"); lw_json_number(&j, a->energy_initial);
+  if (a->quenched) {
+    const lw_quench_report *q = &a->quench;
+    lw_json_key(&j, "quench");
+    lw_json_begin_object(&j);
+    lw_json_key(&j, "method"); lw_json_string(&j, "bfgs");
+    lw_json_key(&j, "energy_before"); lw_json_number(&j, q->energy_before);
+    lw_json_key(&j, "energy_after"); lw_json_number(&j, q->energy_after);
+    lw_json_key(&j, "gradient_before"); lw_json_number(&j, q->gradient_before);
+    lw_json_key(&j, "gradient_after"); lw_json_number(&j, q->gradient_after);
+    lw_json_key(&j, "converged"); lw_json_bool(&j, q->converged);
+    lw_json_key(&j, "iterations"); lw_json_int(&j, q->iterations);
+    lw_json_key(&j, "evaluations"); lw_json_int(&j, q->evaluations);
+    lw_json_key(&j, "forbidden"); lw_json_int(&j, q->forbidden);
+    lw_json_key(&j, "seconds"); lw_json_number(&j, q->seconds);
+    lw_json_end_object(&j);
+  }
   lw_json_key(&j, "acceptance");
   lw_json_begin_object(&j);
   for (int k = 0; k < c->n_moves; k++) {
@@ -677,6 +700,10 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 {
   lw_status s;
   if ((s = lw_anneal_checkpoint(a, err))) return s;
+  if (a->params.quench == LW_QUENCH_BFGS && !a->quenched) {
+    if ((s = lw_quench_run(a->sys, a->params.quench_tol, a->params.quench_iterations, &a->quench, err))) return s;
+    a->quenched = 1;
+  }
   if ((s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_FINAL, err))) return s;
   return write_summary(a, err);
 }
