@@ -15,7 +15,7 @@
 ** Markdown into b->doc[its document].  This file holds the sections on
 ** throughput, scaling, the cost of each term and the oriented particles; bench-accuracy.c the
 ** accuracy studies, bench-regularity.c the regularity threshold and its
-** cost, bench-siman.c the GSL baseline.
+** cost, bench-siman.c the GSL baseline, bench-quench.c the quench.
 */
 #include <gsl/gsl_math.h>
 #include <math.h>
@@ -44,6 +44,7 @@ void bench_baseline(bench_ctx *b);
 void bench_tempering(bench_ctx *b);
 void bench_regularity(bench_ctx *b);
 void bench_regularity_cost(bench_ctx *b);
+void bench_quench(bench_ctx *b);
 
 /* ---- throughput and scaling ---------------------------------------------- */
 
@@ -503,6 +504,7 @@ static const bench_section sections[] = {
     {"cutoff", BENCH_ACCURACY, bench_cutoff},
     {"near", BENCH_ACCURACY, bench_near},
     {"guide", BENCH_ACCURACY, bench_guide},
+    {"quench", BENCH_ACCURACY, bench_quench},
 };
 #define N_SECTIONS (int)(sizeof sections / sizeof sections[0])
 
