@@ -180,6 +180,28 @@ static lw_status setup_system(lw_anneal *a, lw_error *err)
   return a->setup ? LW_OK : err->code;
 }
 
+/* A scene that asks for a quench must have a gradient of every term it
+** names (a term without one refuses with LW_EINPUT, gradient.h): one
+** evaluation on the start state finds out now rather than after the run.
+** Only when the quench is asked for, so a plain run allocates nothing. */
+static lw_status check_quench(const lw_anneal *a, lw_error *err)
+{
+  if (a->params.quench == LW_QUENCH_NONE) return LW_OK;
+  const lw_system_type *t = a->sys_type;
+  size_t n = t->n_coords(a->sys->state);
+  double *g = malloc((n ? n : 1) * sizeof *g);
+  if (!g) return lw_error_set(err, LW_ENOMEM, "out of memory for the gradient of %zu coordinates", n);
+  lw_error e2 = {0};
+  double e = t->gradient(a->sys->state, g, &e2);
+  free(g);
+  if (!isnan(e)) return LW_OK;
+  if (e2.code != LW_EINPUT) return lw_error_set(err, e2.code ? e2.code : LW_ENOMEM, "%s", e2.msg);
+  char where[LW_PATH_MAX + 32];
+  lw_params_origin(&a->params, lw_params_find("anneal", "quench"), where, sizeof where);
+  return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.quench': this scene has no gradient to quench with (%s); "
+                      "expected none", where, e2.msg);
+}
+
 /* Chain of rung k: rung 0 draws from stream 1 (as a run without tempering
 ** does), the master exchange stream is 2, rung k >= 1 is stream 2 + k. */
 static unsigned long rung_stream(const lw_anneal *a, int k)
@@ -284,7 +306,7 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
       for (int q = 0; q < r; q++) t->state_free(all[q]);
       return err->code;
     }
-  if ((s = build(a, all, ladder, err))) return s;
+  if ((s = build(a, all, ladder, err)) || (s = check_quench(a, err))) return s;
   a->energy_initial = lw_system_total(a->sys);
   a->end_sweep = p->sweeps;
   /* Everything above only read input: the directory appears once the run
@@ -410,7 +432,7 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
       if (all[k]) a->sys_type->state_free(all[k]);
     goto out;
   }
-  if ((s = build(a, all, ladder, err))) goto out;
+  if ((s = build(a, all, ladder, err)) || (s = check_quench(a, err))) goto out;
   if (st.version == 1 && (s = lw_checkpoint_upgrade_v1(st.doc, rep, a->n_rep, err))) goto out;
   if ((s = lw_checkpoint_restore(a, st.doc, &trace_bytes, err))) goto out;
   set_temperatures(a);
