@@ -172,12 +172,41 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
   return LW_OK;
 }
 
-/* The system's row and its set-up of the scene. */
+/* The system's row and its set-up of the scene; a quench needs a row with
+** a gradient. */
 static lw_status setup_system(lw_anneal *a, lw_error *err)
 {
   if (!(a->sys_type = lw_system_of(&a->params, err))) return err->code;
+  if (a->params.quench != LW_QUENCH_NONE && !a->sys_type->gradient) {
+    char where[LW_PATH_MAX + 32];
+    lw_params_origin(&a->params, lw_params_find("anneal", "quench"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.quench': the %s system has no gradient to quench with; "
+                        "expected none", where, a->sys_type->name);
+  }
   a->setup = a->sys_type->setup_new(&a->params, err);
   return a->setup ? LW_OK : err->code;
+}
+
+/* A scene that asks for a quench must have a gradient of every term it
+** names (a term without one refuses with LW_EINPUT, gradient.h): one
+** evaluation on the start state finds out now rather than after the run.
+** Only when the quench is asked for, so a plain run allocates nothing. */
+static lw_status check_quench(const lw_anneal *a, lw_error *err)
+{
+  if (a->params.quench == LW_QUENCH_NONE) return LW_OK;
+  const lw_system_type *t = a->sys_type;
+  size_t n = t->n_coords(a->sys->state);
+  double *g = malloc((n ? n : 1) * sizeof *g);
+  if (!g) return lw_error_set(err, LW_ENOMEM, "out of memory for the gradient of %zu coordinates", n);
+  lw_error e2 = {0};
+  double e = t->gradient(a->sys->state, g, &e2);
+  free(g);
+  if (!isnan(e)) return LW_OK;
+  if (e2.code != LW_EINPUT) return lw_error_set(err, e2.code ? e2.code : LW_ENOMEM, "%s", e2.msg);
+  char where[LW_PATH_MAX + 32];
+  lw_params_origin(&a->params, lw_params_find("anneal", "quench"), where, sizeof where);
+  return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.quench': this scene has no gradient to quench with (%s); "
+                      "expected none", where, e2.msg);
 }
 
 /* Chain of rung k: rung 0 draws from stream 1 (as a run without tempering
@@ -293,7 +322,7 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
       for (int q = 0; q < r; q++) t->state_free(all[q]);
       return err->code;
     }
-  if ((s = build(a, all, ladder, err))) return s;
+  if ((s = build(a, all, ladder, err)) || (s = check_quench(a, err))) return s;
   a->energy_initial = lw_system_total(a->sys);
   a->end_sweep = p->sweeps;
   /* Everything above only read input: the directory appears once the run
@@ -430,7 +459,7 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
       if (all[k]) a->sys_type->state_free(all[k]);
     goto out;
   }
-  if ((s = build(a, all, ladder, err))) goto out;
+  if ((s = build(a, all, ladder, err)) || (s = check_quench(a, err))) goto out;
   if (st.version == 1 && (s = lw_checkpoint_upgrade_v1(st.doc, rep, a->n_rep, err))) goto out;
   if ((s = lw_checkpoint_restore(a, st.doc, &trace_bytes, err))) goto out;
   set_temperatures(a);
@@ -686,6 +715,22 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     }
   lw_json_end_object(&j);
   lw_json_key(&j, "energy_initial"); lw_json_number(&j, a->energy_initial);
+  if (a->quenched) {
+    const lw_quench_report *q = &a->quench;
+    lw_json_key(&j, "quench");
+    lw_json_begin_object(&j);
+    lw_json_key(&j, "method"); lw_json_string(&j, "bfgs");
+    lw_json_key(&j, "energy_before"); lw_json_number(&j, q->energy_before);
+    lw_json_key(&j, "energy_after"); lw_json_number(&j, q->energy_after);
+    lw_json_key(&j, "gradient_before"); lw_json_number(&j, q->gradient_before);
+    lw_json_key(&j, "gradient_after"); lw_json_number(&j, q->gradient_after);
+    lw_json_key(&j, "converged"); lw_json_bool(&j, q->converged);
+    lw_json_key(&j, "iterations"); lw_json_int(&j, q->iterations);
+    lw_json_key(&j, "evaluations"); lw_json_int(&j, q->evaluations);
+    lw_json_key(&j, "forbidden"); lw_json_int(&j, q->forbidden);
+    lw_json_key(&j, "seconds"); lw_json_number(&j, q->seconds);
+    lw_json_end_object(&j);
+  }
   lw_json_key(&j, "acceptance");
   lw_json_begin_object(&j);
   for (int k = 0; k < c->n_moves; k++) {
@@ -749,6 +794,13 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 {
   lw_status s;
   if ((s = lw_anneal_checkpoint(a, err))) return s;
+  if (a->params.quench == LW_QUENCH_BFGS && !a->quenched) {
+    lw_phase_set("quenching to the nearest minimum");
+    s = lw_quench_run(a->sys, a->params.quench_tol, a->params.quench_iterations, &a->quench, err);
+    lw_phase_set(NULL);
+    if (s) return s;
+    a->quenched = 1;
+  }
   lw_phase_set("drawing the final files (ordering the paths, then each file)");
   if (!(s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_FINAL, err))) s = write_summary(a, err);
   lw_phase_set(NULL);

@@ -97,7 +97,8 @@ static double circle_distance(const lw_boundary *b, double x, double y)
 ** counts edges that straddle the horizontal line through the point (half-open
 ** in y, so a vertex on that line is counted once) and cross it to the right of
 ** the point.  No orientation enters, so either vertex order works.  A polygon
-** with no vertices (after lw_boundary_clear) has no inside: +INFINITY. */
+** with no vertices (after lw_boundary_clear) has no inside: +INFINITY.
+** (*ox, *oy) receives the point minus its nearest boundary point. */
 static double polygon_nearest(const lw_boundary *b, double x, double y, double *ox, double *oy)
 {
   const size_t n = b->n;

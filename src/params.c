@@ -229,6 +229,16 @@ const lw_param_def lw_param_table[] = {
   NUM("anneal", "check_every", LW_PT_INT, check_every, "100", "sweeps", 1, 2e9, 0,
       "Sweeps between full recomputations of the energy (the drift check); splines are "
       "renumbered along a Hilbert curve of the page just before each, for locality in memory."),
+  CHOICE("anneal", "quench", quench, "none", "none|bfgs",
+         "After the last sweep: none, or bfgs, which takes the coldest replica to the nearest local "
+         "minimum of its energy (GSL's vector_bfgs2 on the system's gradient; docs/ACCURACY.md). "
+         "The drawings and summary.json show the quenched state; state.lw keeps the annealed one, so "
+         "a resumed or longer run continues the chain. Needs a system with a gradient (splines)."),
+  NUM("anneal", "quench_tol", LW_PT_DOUBLE, quench_tol, "1e-6", "energy/mm", 0, 1e300, LW_MIN_OPEN,
+      "The quench stops when the gradient's Euclidean norm falls to this."),
+  NUM("anneal", "quench_iterations", LW_PT_INT, quench_iterations, "2000", "", 1, 1e9, 0,
+      "The quench stops after this many minimiser iterations (or earlier when a line search "
+      "makes no progress: the minimum to rounding)."),
   NUM("tempering", "replicas", LW_PT_INT, replicas, "1", "", 1, 256, 0,
       "Replicas on the temperature ladder (parallel tempering, run by OpenMP threads). 1 = off. "
       "The coldest replica gives final.svg and state.lw."),

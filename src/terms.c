@@ -146,8 +146,8 @@ static void grad_bending(const lw_samples *s, const lw_term_ctx *ctx, lw_samples
     if (sp2 == 0.0) continue;
     double c = s->dx[i] * s->ddy[i] - s->ddx[i] * s->dy[i];
     double inv5 = 1.0 / (sp2 * sp2 * s->speed[i]);
-    double a = ctx->coef * q->w[i] * 2.0 * c * inv5;       /* d/dc */
-    double b = -ctx->coef * q->w[i] * 5.0 * c * c * inv5 / sp2; /* d/d(s^2) times 2 */
+    double a = ctx->coef * q->w[i] * 2.0 * c * inv5;            /* dE/dc */
+    double b = -ctx->coef * q->w[i] * 5.0 * c * c * inv5 / sp2; /* dE/dr' = b r' through s^-5 */
     g->dx[i] += a * s->ddy[i] + b * s->dx[i];
     g->dy[i] += -a * s->ddx[i] + b * s->dy[i];
     g->ddx[i] += -a * s->dy[i];

@@ -464,3 +464,159 @@ Test(gradient, splines_row_coordinates_and_gradient)
   lw_splines_free(ref);
   lw_scene_clear(&sc);
 }
+
+/* ---- the quench (quench.h) ------------------------------------------ */
+
+#include "linewise/quench.h"
+#include "linewise/sys_splines.h"
+
+/* Quenches random splines on sc through the splines row; returns the
+** report, the model left in *out (the caller frees it). */
+static lw_quench_report quench_splines(const lw_scene *sc, size_t n, size_t segs, uint64_t seed, lw_model **out)
+{
+  lw_error err = {0};
+  lw_model *m = lw_model_new(sc, random_splines(sc, n, segs, seed), &err);
+  cr_assert_not_null(m, "%s", err.msg);
+  lw_system *sys = lw_splines_view(m, &err);
+  cr_assert_not_null(sys);
+  lw_quench_report r;
+  cr_assert_eq(lw_quench_run(sys, 1e-6, 5000, &r, &err), LW_OK, "%s", err.msg);
+  lw_system_free(sys);
+  *out = m;
+  return r;
+}
+
+/* The state a quench leaves is allowed: finite from scratch (inside the
+** boundary, end points too), regular, and its running totals are fresh. */
+static void assert_allowed(const lw_scene *sc, const lw_model *m, double e)
+{
+  double term[LW_TERM_COUNT];
+  double ref = lw_energy_compute(sc, m->sp, term, NULL);
+  cr_assert(isfinite(ref), "the quenched state is forbidden");
+  cr_assert_eq(lw_model_check_regular(sc, m->sp, "quenched", NULL), LW_OK);
+  cr_assert(lw_close_rel(e, ref, 1e-9, 1e-9), "reported %.17g, from scratch %.17g", e, ref);
+  cr_assert(lw_close_rel(lw_model_total(m), ref, 1e-9, 1e-9));
+}
+
+Test(quench, lowers_the_energy_to_a_small_gradient)
+{
+  lw_params p = base_params();
+  p.strain = 2;
+  p.bending = 0.5;
+  p.potential_coef = 0.05; /* a smooth pull against the boundary's barrier */
+  p.potential = LW_POT_RAMP;
+  p.potential_angle = 30;
+  p.boundary = LW_BND_CIRCLE; /* smooth: the rect's distance has a kink on its medial axis */
+  p.boundary_coef = 0.5;
+  p.parametrisation = 0.2;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  lw_model *m;
+  lw_quench_report r = quench_splines(&sc, 3, 4, 2024, &m);
+  cr_log_info("quench: %.10g -> %.10g, |g| %.3g -> %.3g, %ld iterations, %ld evaluations", r.energy_before,
+              r.energy_after, r.gradient_before, r.gradient_after, r.iterations, r.evaluations);
+  cr_assert(r.energy_after < r.energy_before - 1e-3 * fabs(r.energy_before), "%g -> %g", r.energy_before,
+            r.energy_after);
+  cr_assert(r.converged && r.gradient_after <= 1e-6, "|g| = %g after %ld iterations", r.gradient_after, r.iterations);
+  cr_assert(r.gradient_before > 1e3 * r.gradient_after);
+  assert_allowed(&sc, m, r.energy_after);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+/* A potential that pulls the splines toward the circle's edge against a
+** weak boundary term, and a tight min_speed with strain pulling the splines
+** short: the minimiser's trial steps run into the walls (counted) and are
+** shortened; the state it ends in is allowed. */
+Test(quench, never_leaves_the_allowed_set)
+{
+  lw_params p = base_params();
+  p.strain = 5;
+  p.bending = 0.5;
+  p.potential_coef = 3;
+  p.potential = LW_POT_RAMP;
+  p.potential_angle = 180; /* Phi falls toward +x */
+  p.boundary = LW_BND_CIRCLE;
+  p.boundary_coef = 1e-4;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  lw_model *m;
+  lw_quench_report r = quench_splines(&sc, 3, 4, 77, &m);
+  cr_log_info("boundary: %.10g -> %.10g, %ld iterations, %ld of %ld trials forbidden", r.energy_before, r.energy_after,
+              r.iterations, r.forbidden, r.evaluations);
+  cr_assert(r.energy_after < r.energy_before);
+  cr_assert(r.forbidden > 0, "the steps never met a wall: the test tests nothing");
+  assert_allowed(&sc, m, r.energy_after);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+
+  p = base_params();
+  p.strain = 5;
+  p.min_speed = 0.7;
+  p.regularity = 0;
+  scene_with(&sc, &p);
+  r = quench_splines(&sc, 3, 4, 78, &m);
+  cr_log_info("min_speed: %.10g -> %.10g, %ld iterations, %ld of %ld trials forbidden", r.energy_before,
+              r.energy_after, r.iterations, r.forbidden, r.evaluations);
+  cr_assert(r.energy_after < r.energy_before);
+  cr_assert(r.forbidden > 0, "the steps never met a wall: the test tests nothing");
+  assert_allowed(&sc, m, r.energy_after);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+static char qdir[64];
+static void qsetup(void) { cr_assert_eq(lw_test_dir_make(qdir, "quench"), 0); }
+static void qteardown(void) { lw_test_dir_remove(qdir); }
+
+static const char *bin(void)
+{
+  const char *b = getenv("LW_BIN");
+  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
+  return b;
+}
+
+static const char *root(void)
+{
+  const char *r = getenv("LW_ROOT");
+  return r ? r : ".";
+}
+
+Test(quench, refused_for_a_system_without_gradient, .init = qsetup, .fini = qteardown)
+{
+  cr_assert_eq(lw_test_sh("sed 's/^sweeps = .*/sweeps = 5/' %s/params/particles-sheet.ini > %s/p.ini && "
+                          "printf 'quench = bfgs\\n' >> %s/p.ini", root(), qdir, qdir), 0);
+  int rc = lw_test_sh("%s run %s/p.ini --out %s/run --quiet 2> %s/err.txt", bin(), qdir, qdir, qdir);
+  cr_assert_eq(rc, 2);
+  cr_assert_eq(lw_test_sh("grep -q \"p.ini:[0-9]*: key 'anneal.quench': the particles system has no gradient\" "
+                          "%s/err.txt", qdir), 0);
+  cr_assert_neq(lw_test_sh("test -e %s/run", qdir), 0, "nothing is written for a refused scene");
+}
+
+/* Same scene and seed: the same bytes for any thread count (tempering,
+** two replicas: the coldest is quenched), and a run stopped and resumed
+** quenches to the bytes of an uninterrupted one. */
+Test(quench, deterministic_and_resumable, .init = qsetup, .fini = qteardown)
+{
+  const char *set = "--set anneal.quench=bfgs --set tempering.replicas=2 --set tempering.t_min=0.001 "
+                    "--set tempering.t_max=0.01 --set anneal.sweeps=40";
+  const char *sc = "tests/fixtures/v1/plain.ini";
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=1 %s run %s/%s %s --out %s/a --quiet", bin(), root(), sc, set, qdir), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=2 %s run %s/%s %s --out %s/b --quiet", bin(), root(), sc, set, qdir), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/%s %s --out %s/c --stop-at 17 --quiet && %s resume %s/c --quiet", bin(), root(),
+                          sc, set, qdir, bin(), qdir), 0);
+  const char *files[] = {"final.svg", "state.lw", "trace.csv"};
+  for (int f = 0; f < 3; f++) {
+    cr_expect_eq(lw_test_sh("cmp -s %s/a/%s %s/b/%s", qdir, files[f], qdir, files[f]), 0, "%s: threads", files[f]);
+    cr_expect_eq(lw_test_sh("cmp -s %s/a/%s %s/c/%s", qdir, files[f], qdir, files[f]), 0, "%s: resume", files[f]);
+  }
+  /* the summary's quench, less the seconds */
+  for (const char *o = "abc"; *o; o++)
+    cr_assert_eq(lw_test_sh("python3 -c \"import json; q=json.load(open('%s/%c/summary.json'))['quench']; "
+                            "q.pop('seconds'); print(sorted(q.items()))\" > %s/q%c.txt", qdir, *o, qdir, *o), 0);
+  cr_expect_eq(lw_test_sh("cmp -s %s/qa.txt %s/qb.txt", qdir, qdir), 0, "summary quench: threads");
+  cr_expect_eq(lw_test_sh("cmp -s %s/qa.txt %s/qc.txt", qdir, qdir), 0, "summary quench: resume");
+  /* and it lowered the energy */
+  cr_assert_eq(lw_test_sh("python3 -c \"import json,sys; q=json.load(open('%s/a/summary.json'))['quench']; "
+                          "sys.exit(0 if q['energy_after'] < q['energy_before'] else 1)\"", qdir), 0);
+}

@@ -15,7 +15,7 @@
 ** Markdown into b->doc[its document].  This file holds the sections on
 ** throughput, scaling, the cost of each term and the oriented particles; bench-accuracy.c the
 ** accuracy studies, bench-regularity.c the regularity threshold and its
-** cost, bench-siman.c the GSL baseline.
+** cost, bench-siman.c the GSL baseline, bench-quench.c the quench.
 */
 #include <gsl/gsl_math.h>
 #include <math.h>
@@ -49,6 +49,7 @@ void bench_regularity_cost(bench_ctx *b);
 void bench_order(bench_ctx *b);
 void bench_tone(bench_ctx *b);
 void bench_tone_accuracy(bench_ctx *b);
+void bench_quench(bench_ctx *b);
 
 /* ---- throughput and scaling ---------------------------------------------- */
 
@@ -665,6 +666,7 @@ static const bench_section sections[] = {
     {"near", BENCH_ACCURACY, bench_near},
     {"tone_accuracy", BENCH_ACCURACY, bench_tone_accuracy},
     {"guide", BENCH_ACCURACY, bench_guide},
+    {"quench", BENCH_ACCURACY, bench_quench},
 };
 #define N_SECTIONS (int)(sizeof sections / sizeof sections[0])
 

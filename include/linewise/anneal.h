@@ -27,6 +27,7 @@
 #include "linewise/dynamics.h"
 #include "linewise/mc.h"
 #include "linewise/params.h"
+#include "linewise/quench.h"
 #include "linewise/schedule.h"
 #include "linewise/system.h"
 #include "linewise/tempering.h"
@@ -60,6 +61,8 @@ typedef struct {
   unsigned long proposals_before; /* proposals made before a resume */
   double wall_start;           /* monotonic clock at start of this process */
   lw_move_stats trace_mark[LW_MOVES_MAX]; /* stats at the last trace row */
+  int quenched;                /* 1 once lw_anneal_finish has quenched (anneal.quench) */
+  lw_quench_report quench;     /* what the quench did */
   FILE *trace;
 } lw_anneal;
 
@@ -81,7 +84,12 @@ static inline int lw_anneal_done(const lw_anneal *a) { return a->sweep >= a->end
 /* Writes state.lw now (a clean stop). */
 lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err);
 
-/* The final files: state.lw, the system's drawings, summary.json. */
+/* The final files: state.lw, then (anneal.quench = bfgs) the quench of the
+** coldest replica (quench.h), the system's drawings and summary.json of
+** the quenched state.  state.lw keeps the annealed state: the quench is a
+** function of it, so a resumed run quenches to the same bytes, and a run
+** resumed for more sweeps continues the chain as an uninterrupted longer
+** run would. */
 lw_status lw_anneal_finish(lw_anneal *a, lw_error *err);
 
 void lw_anneal_free(lw_anneal *a);

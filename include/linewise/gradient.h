@@ -40,7 +40,8 @@ void lw_segment_grad_nodes(const lw_quad *q, const lw_samples_grad *g, lw_node *
 /* The gradient of the scene's energy at sp: grad (sp->n_nodes, overwritten)
 ** is the sum over the terms selected in term_mask (bit t for term t;
 ** LW_GRAD_ALL for every term that is on), and term[] (if not NULL) receives
-** each term's energy as lw_energy_compute gives it.  Returns the total of
+** each selected term's energy as lw_energy_compute gives it (bitwise; 0 for
+** the others).  Returns the total of
 ** the selected terms; +inf (grad then undefined) if a segment is irregular
 ** or a sample is outside the boundary.  LW_ENOMEM through err.  The user
 ** and tone terms have no gradient: a mask that selects one while it is on

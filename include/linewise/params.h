@@ -52,6 +52,7 @@ enum { LW_MASK_NONE, LW_MASK_ALPHA, LW_MASK_IMAGE };
 enum { LW_STRAIN_SPLINE, LW_STRAIN_SEGMENT };
 enum { LW_FIELDMODE_AXIAL, LW_FIELDMODE_SIGNED };
 enum { LW_LADDER_FIXED, LW_LADDER_EQUAL };
+enum { LW_QUENCH_NONE, LW_QUENCH_BFGS };
 enum { LW_PPATTERN_CLOUD, LW_PPATTERN_PLANE, LW_PPATTERN_SPHERE };
 enum { LW_PWEIGHT_POLY, LW_PWEIGHT_GAUSS, LW_PWEIGHT_ANISO };
 enum { LW_PBOUNDARY_NONE, LW_PBOUNDARY_PLANE, LW_PBOUNDARY_SPHERE };
@@ -126,6 +127,9 @@ typedef struct {
   char table[LW_PATH_MAX];    /* table schedule file */
   double seed;                /* RNG seed (a whole number, stored as double for the table) */
   int check_every;            /* sweeps between drift checks */
+  int quench;                 /* LW_QUENCH_*: after the last sweep, to the nearest local minimum */
+  double quench_tol;          /* stop at this gradient norm, energy/mm */
+  int quench_iterations;      /* at most this many minimiser iterations */
   /* [tempering] */
   int replicas;               /* 1 = no tempering */
   double t_min, t_max;        /* geometric ladder, energy units */

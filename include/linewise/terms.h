@@ -93,10 +93,6 @@ typedef enum {
   LW_TERM_COUNT
 } lw_term_id;
 
-/* A user term: the energy of one segment from its samples (coefficient not
-** applied).  It must be a pure function of its arguments, like the built-in
-** terms: replicas call it from several threads at once.  +infinity forbids a
-** state; it should never return NaN (a NaN dE is rejected and counted). */
 /* dE/d(sample values) of one segment: per quadrature node the partials with
 ** respect to r = (x, y), r' = (dx, dy) and r'' = (ddx, ddy), and the
 ** partials with respect to the two end points r(0), r(1) (gradient.h). */
@@ -108,6 +104,10 @@ typedef struct lw_samples_grad {
   double end_x[2], end_y[2];
 } lw_samples_grad;
 
+/* A user term: the energy of one segment from its samples (coefficient not
+** applied).  It must be a pure function of its arguments, like the built-in
+** terms: replicas call it from several threads at once.  +infinity forbids a
+** state; it should never return NaN (a NaN dE is rejected and counted). */
 typedef double (*lw_user_term_fn)(const lw_samples *s, const lw_quad *q, const void *data);
 
 /* What one term reads.  Pointers are into the scene, which outlives every
