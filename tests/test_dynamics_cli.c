@@ -111,3 +111,18 @@ Test(dynamics_cli, scenes_the_driver_cannot_move_are_refused_with_the_key)
   cr_assert_eq(sh("grep -q \"key 'scene.driver': the system 'particles' has no equations of motion\" %s/err.txt", dir),
                0);
 }
+
+Test(dynamics_cli, the_motion_does_not_depend_on_the_thread_count)
+{
+  /* the pair term's gradient runs its near pairs on threads (pairgrad.c) */
+  const char *set = "--set anneal.sweeps=10 --set energy.pair=0.5 --set energy.pair_cutoff=30 "
+                    "--set output.frames_every=0";
+  for (int t = 1; t <= 2; t++)
+    cr_assert_eq(sh("OMP_NUM_THREADS=%d %s run %s/params/hanging.ini --out %s/t%d --quiet %s", t, bin(), root(), dir, t,
+                    set), 0);
+  cr_assert_eq(sh("grep -q '^[0-9]*,[0-9.e+-]*,[0-9.e+-]*,[0-9.e+-]*,[1-9]' %s/t1/trace.csv", dir), 0,
+               "the pair term is on and not 0");
+  const char *same[] = {"state.lw", "trace.csv", "final.svg"};
+  for (int k = 0; k < 3; k++)
+    cr_assert_eq(sh("cmp -s %s/t1/%s %s/t2/%s", dir, same[k], dir, same[k]), 0, "%s differs", same[k]);
+}
