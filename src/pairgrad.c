@@ -456,7 +456,7 @@ static jet leaf_value(const jcubic *ca, const jpiece *pa, const jcubic *cb, cons
   return v.v < INFINITY ? v : piece_rule(ca, pa, cb, pb);
 }
 
-static jet point_segment(const jet p[2], const jet a[2], const jet b[2])
+static jet point_segment(const jet *p, const jet *a, const jet *b)
 {
   jet ux = jsub(b[0], a[0]), uy = jsub(b[1], a[1]), px = jsub(p[0], a[0]), py = jsub(p[1], a[1]);
   jet uu = jadd(jmul(ux, ux), jmul(uy, uy));
