@@ -25,33 +25,20 @@ static void teardown(void) { lw_test_dir_remove(dir); }
 
 TestSuite(checkpoint, .init = setup, .fini = teardown);
 
-static const char *bin(void)
-{
-  const char *b = getenv("LW_BIN");
-  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
-  return b;
-}
-
-static const char *root(void)
-{
-  const char *r = getenv("LW_ROOT");
-  return r ? r : ".";
-}
-
 /* Resumes a copy of fixture `name` and compares it with a fresh run. */
 static void resume_fixture_matches_fresh_run(const char *name, const char *const *files)
 {
-  cr_assert_eq(lw_test_sh("cp -r %s/tests/fixtures/v1/%s %s/old", root(), name, dir), 0);
+  cr_assert_eq(lw_test_sh("cp -r %s/tests/fixtures/v1/%s %s/old", lw_test_root(), name, dir), 0);
   /* a row torn by a kill after the checkpoint, whose numeric prefix reads
   ** as an earlier sweep (22 of "221,..."), must go, not stay */
   cr_assert_eq(lw_test_sh("printf '26,0.1\n22' >> %s/old/trace.csv", dir), 0);
-  cr_assert_eq(lw_test_sh("%s resume %s/old --quiet", bin(), dir), 0, "the old run directory does not resume");
-  cr_assert_eq(lw_test_sh("%s run %s/old/scene.ini --out %s/fresh --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/old --quiet", lw_test_bin(), dir), 0, "the old run directory does not resume");
+  cr_assert_eq(lw_test_sh("%s run %s/old/scene.ini --out %s/fresh --quiet", lw_test_bin(), dir, dir), 0);
   for (const char *const *f = files; *f; f++)
     cr_expect_eq(lw_test_sh("cmp -s %s/old/%s %s/fresh/%s", dir, *f, dir, *f), 0,
                  "%s: %s differs from an uninterrupted run", name, *f);
   /* and the resumed state reads back through `linewise energy` */
-  cr_assert_eq(lw_test_sh("%s energy %s/old > %s/energy.txt", bin(), dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s energy %s/old > %s/energy.txt", lw_test_bin(), dir, dir), 0);
 }
 
 Test(checkpoint, format_1_plain_run_resumes_to_the_uninterrupted_result)
@@ -70,7 +57,7 @@ Test(checkpoint, format_1_tempering_run_resumes_to_the_uninterrupted_result)
 /* A run of the plain fixture's scene stopped at sweep 20, in dir/r. */
 static void stopped_run(void)
 {
-  cr_assert_eq(lw_test_sh("%s run %s/tests/fixtures/v1/plain.ini --out %s/r --stop-at 20 --quiet", bin(), root(), dir),
+  cr_assert_eq(lw_test_sh("%s run %s/tests/fixtures/v1/plain.ini --out %s/r --stop-at 20 --quiet", lw_test_bin(), lw_test_root(), dir),
                0);
 }
 
@@ -80,7 +67,7 @@ static int resume_edited(const char *sed)
 {
   lw_test_sh("rm -rf %s/x && cp -r %s/r %s/x", dir, dir, dir);
   cr_assert_eq(lw_test_sh("sed -i -e '%s' %s/x/state.lw", sed, dir), 0);
-  return lw_test_sh("%s resume %s/x --quiet --sweeps 2 2>%s/err.txt", bin(), dir, dir);
+  return lw_test_sh("%s resume %s/x --quiet --sweeps 2 2>%s/err.txt", lw_test_bin(), dir, dir);
 }
 
 static int err_has(const char *text)
@@ -137,9 +124,9 @@ Test(checkpoint, a_state_with_an_infinite_energy_is_refused_with_the_spline_and_
   /* spline 1 moved off the page as a whole: regular, but outside the boundary */
   cr_assert_eq(lw_test_sh("rm -rf %s/x && cp -r %s/r %s/x && awk '/^spline = /{n++} /^node = /&&n==2{$3+=500} {print}' "
                           "%s/r/state.lw > %s/x/state.lw", dir, dir, dir, dir, dir), 0);
-  cr_assert_eq(lw_test_sh("%s resume %s/x --quiet 2>%s/err.txt", bin(), dir, dir), 2);
+  cr_assert_eq(lw_test_sh("%s resume %s/x --quiet 2>%s/err.txt", lw_test_bin(), dir, dir), 2);
   cr_assert(err_has("spline 1 segment 0 (nodes 0 and 1): the boundary energy is not finite"));
-  cr_assert_eq(lw_test_sh("%s energy %s/x 2>%s/err.txt", bin(), dir, dir), 2);
+  cr_assert_eq(lw_test_sh("%s energy %s/x 2>%s/err.txt", lw_test_bin(), dir, dir), 2);
   cr_assert(err_has("spline 1 segment 0 (nodes 0 and 1): the boundary energy is not finite"));
 }
 
@@ -149,11 +136,11 @@ Test(checkpoint, rows_written_after_the_checkpoint_are_cut_back_on_resume)
   /* what a kill between the checkpoint and the next leaves: later rows, the
   ** last one torn */
   cr_assert_eq(lw_test_sh("cp -r %s/r %s/x && printf '21,0.3,1\n22,0.3,1\n2' >> %s/x/trace.csv", dir, dir, dir), 0);
-  cr_assert_eq(lw_test_sh("%s resume %s/r --quiet && %s resume %s/x --quiet", bin(), dir, bin(), dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/r --quiet && %s resume %s/x --quiet", lw_test_bin(), dir, lw_test_bin(), dir), 0);
   cr_assert_eq(lw_test_sh("cmp -s %s/r/trace.csv %s/x/trace.csv", dir, dir), 0);
   /* a trace shorter than the checkpoint says was cut or replaced: refused */
   cr_assert_eq(lw_test_sh("rm -rf %s/r && %s run %s/tests/fixtures/v1/plain.ini --out %s/r --stop-at 20 --quiet && "
-                          "truncate -s 100 %s/r/trace.csv", dir, bin(), root(), dir, dir), 0);
-  cr_assert_eq(lw_test_sh("%s resume %s/r --quiet 2>%s/err.txt", bin(), dir, dir), 2);
+                          "truncate -s 100 %s/r/trace.csv", dir, lw_test_bin(), lw_test_root(), dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/r --quiet 2>%s/err.txt", lw_test_bin(), dir, dir), 2);
   cr_assert(err_has("trace.csv: 100 bytes, but state.lw counts"));
 }

@@ -31,18 +31,11 @@ static void remove_dir(void)
 
 TestSuite(cli, .init = make_dir, .fini = remove_dir);
 
-static const char *bin(void)
-{
-  const char *b = getenv("LW_BIN");
-  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
-  return b;
-}
-
 /* Runs "linewise <args>" capturing stdout and stderr; returns the exit status. */
 static int run(const char *args, char *out, size_t nout, char *errs, size_t nerr)
 {
   char cmd[1024];
-  snprintf(cmd, sizeof cmd, "%s %s >%s/out.txt 2>%s/err.txt", bin(), args, dir, dir);
+  snprintf(cmd, sizeof cmd, "%s %s >%s/out.txt 2>%s/err.txt", lw_test_bin(), args, dir, dir);
   int st = system(cmd);
   char path[128];
   FILE *f;
@@ -299,13 +292,13 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
 {
   write_file("s.ini", scene_text);
   cr_assert_eq(lw_test_sh("%s run %s/s.ini --out %s/sig --quiet --set init.splines=200 --set anneal.sweeps=1 & "
-                          "p=$!; sleep 0.05; kill -TERM $p; wait $p", bin(), dir, dir), 0);
+                          "p=$!; sleep 0.05; kill -TERM $p; wait $p", lw_test_bin(), dir, dir), 0);
   cr_assert_eq(lw_test_sh("test -f %s/sig/state.lw && ! test -e %s/sig/state.lw.tmp", dir, dir), 0);
-  cr_assert_eq(lw_test_sh("%s resume %s/sig --quiet", bin(), dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/sig --quiet", lw_test_bin(), dir), 0);
   char out[256], errs[1024], args[512];
   snprintf(args, sizeof args, "run %s/s.ini --out %s/fz --quiet --set output.checkpoint_every=1", dir, dir);
   char cmd[700];
-  snprintf(cmd, sizeof cmd, "sh -c 'ulimit -f 8; %s %s' >%s/out.txt 2>%s/err.txt", bin(), args, dir, dir);
+  snprintf(cmd, sizeof cmd, "sh -c 'ulimit -f 8; %s %s' >%s/out.txt 2>%s/err.txt", lw_test_bin(), args, dir, dir);
   int st = system(cmd);
   cr_assert(WIFEXITED(st) && WEXITSTATUS(st) == 1, "a size limit must be an error (exit 1), got status %d", st);
   (void)out;

@@ -24,13 +24,6 @@ static void teardown(void) { lw_test_dir_remove(dir); }
 
 TestSuite(crash, .init = setup, .fini = teardown, .timeout = 1200);
 
-static const char *bin(void)
-{
-  const char *b = getenv("LW_BIN");
-  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
-  return b;
-}
-
 static double now(void)
 {
   struct timespec ts;
@@ -42,7 +35,7 @@ static double now(void)
 ** first; returns its exit status (137 when the kill got it). */
 static int run_killed(const char *cmd, double delay)
 {
-  return lw_test_sh("exec 2>/dev/null; %s %s --quiet 2>>%s/err.txt & p=$!; sleep %.4f; kill -9 $p; wait $p", bin(),
+  return lw_test_sh("exec 2>/dev/null; %s %s --quiet 2>>%s/err.txt & p=$!; sleep %.4f; kill -9 $p; wait $p", lw_test_bin(),
                     cmd, dir, delay);
 }
 
@@ -71,7 +64,7 @@ static void kill_and_resume(const char *scene, const char *set, int replicas, in
   snprintf(got, sizeof got, "%s/got", dir);
   lw_test_sh("rm -rf %s %s", ref, got);
   double t0 = now();
-  snprintf(cmd, sizeof cmd, "%s run %s %s --out %s --quiet", bin(), scene, set, ref);
+  snprintf(cmd, sizeof cmd, "%s run %s %s --out %s --quiet", lw_test_bin(), scene, set, ref);
   cr_assert_eq(lw_test_sh("%s", cmd), 0, "the reference run failed");
   double span = 1.2 * (now() - t0);
   rng_seed(seed);
@@ -100,7 +93,7 @@ static void kill_and_resume(const char *scene, const char *set, int replicas, in
           c->kills_resume++;
         }
       } else {
-        rc = lw_test_sh("%s %s --quiet 2>>%s/err.txt", bin(), res, dir);
+        rc = lw_test_sh("%s %s --quiet 2>>%s/err.txt", lw_test_bin(), res, dir);
         cr_assert_eq(rc, 0, "resume failed after a kill (see %s/err.txt)", dir);
       }
     }

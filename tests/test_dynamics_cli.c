@@ -18,28 +18,14 @@ TestSuite(dynamics_cli, .init = make_dir, .fini = remove_dir);
 
 #define sh lw_test_sh
 
-static const char *bin(void)
-{
-  const char *b = getenv("LW_BIN");
-  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
-  return b;
-}
-
-static const char *root(void)
-{
-  const char *r = getenv("LW_ROOT");
-  cr_assert_not_null(r);
-  return r;
-}
-
 Test(dynamics_cli, the_hanging_lines_settle_and_resume_gives_the_same_bytes)
 {
   /* 60 sweeps of 20 steps: 12 s of motion, checkpoints inside */
   const char *set = "--set anneal.sweeps=60 --set output.checkpoint_every=7 --set output.frames_every=0";
-  cr_assert_eq(sh("%s run %s/params/hanging.ini --out %s/a --quiet %s", bin(), root(), dir, set), 0);
-  cr_assert_eq(sh("%s run %s/params/hanging.ini --out %s/b --quiet %s --stop-at 23", bin(), root(), dir, set), 0);
-  cr_assert_eq(sh("%s resume %s/b --quiet --stop-at 41", bin(), dir), 0);
-  cr_assert_eq(sh("%s resume %s/b --quiet", bin(), dir), 0);
+  cr_assert_eq(sh("%s run %s/params/hanging.ini --out %s/a --quiet %s", lw_test_bin(), lw_test_root(), dir, set), 0);
+  cr_assert_eq(sh("%s run %s/params/hanging.ini --out %s/b --quiet %s --stop-at 23", lw_test_bin(), lw_test_root(), dir, set), 0);
+  cr_assert_eq(sh("%s resume %s/b --quiet --stop-at 41", lw_test_bin(), dir), 0);
+  cr_assert_eq(sh("%s resume %s/b --quiet", lw_test_bin(), dir), 0);
   const char *same[] = {"state.lw", "trace.csv", "final.svg"};
   for (int k = 0; k < 3; k++)
     cr_assert_eq(sh("cmp -s %s/a/%s %s/b/%s", dir, same[k], dir, same[k]), 0, "%s differs after a resume", same[k]);
@@ -80,7 +66,7 @@ Test(dynamics_cli, the_hanging_lines_settle_and_resume_gives_the_same_bytes)
 
 Test(dynamics_cli, the_whip_writes_frames)
 {
-  cr_assert_eq(sh("%s run %s/params/whip.ini --out %s/w --quiet --set anneal.sweeps=10", bin(), root(), dir), 0);
+  cr_assert_eq(sh("%s run %s/params/whip.ini --out %s/w --quiet --set anneal.sweeps=10", lw_test_bin(), lw_test_root(), dir), 0);
   cr_assert_eq(sh("test -s %s/w/frames/frame-000010.png && test -s %s/w/final.png", dir, dir), 0);
 }
 
@@ -96,18 +82,18 @@ Test(dynamics_cli, scenes_the_driver_cannot_move_are_refused_with_the_key)
     {"--set dynamics.pin=both", "dynamics.pin"},
   };
   for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
-    cr_assert_eq(sh("%s run %s/params/hanging.ini --out %s/x%zu --quiet %s 2>%s/err.txt", bin(), root(), dir, k,
+    cr_assert_eq(sh("%s run %s/params/hanging.ini --out %s/x%zu --quiet %s 2>%s/err.txt", lw_test_bin(), lw_test_root(), dir, k,
                     bad[k].set, dir), 2, "case %zu", k);
     cr_assert_eq(sh("grep -q \"%s\" %s/err.txt", bad[k].want, dir), 0, "case %zu: %s", k, bad[k].set);
     cr_assert_eq(sh("test ! -e %s/x%zu", dir, k), 0, "case %zu: a run directory was made", k);
   }
   /* a term without a gradient (the tone term) is named */
   cr_assert_eq(sh("%s run %s/params/example.ini --out %s/t --quiet --set scene.driver=dynamics --set energy.tone=1 "
-                  "--set energy.pair=0 2>%s/err.txt", bin(), root(), dir, dir), 2);
+                  "--set energy.pair=0 2>%s/err.txt", lw_test_bin(), lw_test_root(), dir, dir), 2);
   cr_assert_eq(sh("grep -q 'the tone term has no gradient (energy.tone)' %s/err.txt && test ! -e %s/t", dir, dir), 0);
   /* the particle system has no equations of motion */
   cr_assert_eq(sh("%s run %s/params/particles-sheet.ini --out %s/p --quiet --set scene.driver=dynamics 2>%s/err.txt",
-                  bin(), root(), dir, dir), 2);
+                  lw_test_bin(), lw_test_root(), dir, dir), 2);
   cr_assert_eq(sh("grep -q \"key 'scene.driver': the system 'particles' has no equations of motion\" %s/err.txt", dir),
                0);
 }
@@ -118,7 +104,7 @@ Test(dynamics_cli, the_motion_does_not_depend_on_the_thread_count)
   const char *set = "--set anneal.sweeps=10 --set energy.pair=0.5 --set energy.pair_cutoff=30 "
                     "--set output.frames_every=0";
   for (int t = 1; t <= 2; t++)
-    cr_assert_eq(sh("OMP_NUM_THREADS=%d %s run %s/params/hanging.ini --out %s/t%d --quiet %s", t, bin(), root(), dir, t,
+    cr_assert_eq(sh("OMP_NUM_THREADS=%d %s run %s/params/hanging.ini --out %s/t%d --quiet %s", t, lw_test_bin(), lw_test_root(), dir, t,
                     set), 0);
   cr_assert_eq(sh("grep -q '^[0-9]*,[0-9.e+-]*,[0-9.e+-]*,[0-9.e+-]*,[1-9]' %s/t1/trace.csv", dir), 0,
                "the pair term is on and not 0");

@@ -569,24 +569,11 @@ static char qdir[64];
 static void qsetup(void) { cr_assert_eq(lw_test_dir_make(qdir, "quench"), 0); }
 static void qteardown(void) { lw_test_dir_remove(qdir); }
 
-static const char *bin(void)
-{
-  const char *b = getenv("LW_BIN");
-  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
-  return b;
-}
-
-static const char *root(void)
-{
-  const char *r = getenv("LW_ROOT");
-  return r ? r : ".";
-}
-
 Test(quench, refused_for_a_system_without_gradient, .init = qsetup, .fini = qteardown)
 {
   cr_assert_eq(lw_test_sh("sed 's/^sweeps = .*/sweeps = 5/' %s/params/particles-sheet.ini > %s/p.ini && "
-                          "printf 'quench = bfgs\\n' >> %s/p.ini", root(), qdir, qdir), 0);
-  int rc = lw_test_sh("%s run %s/p.ini --out %s/run --quiet 2> %s/err.txt", bin(), qdir, qdir, qdir);
+                          "printf 'quench = bfgs\\n' >> %s/p.ini", lw_test_root(), qdir, qdir), 0);
+  int rc = lw_test_sh("%s run %s/p.ini --out %s/run --quiet 2> %s/err.txt", lw_test_bin(), qdir, qdir, qdir);
   cr_assert_eq(rc, 2);
   cr_assert_eq(lw_test_sh("grep -q \"p.ini:[0-9]*: key 'anneal.quench': the particles system has no gradient\" "
                           "%s/err.txt", qdir), 0);
@@ -601,10 +588,10 @@ Test(quench, deterministic_and_resumable, .init = qsetup, .fini = qteardown)
   const char *set = "--set anneal.quench=bfgs --set tempering.replicas=2 --set tempering.t_min=0.001 "
                     "--set tempering.t_max=0.01 --set anneal.sweeps=40";
   const char *sc = "tests/fixtures/v1/plain.ini";
-  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=1 %s run %s/%s %s --out %s/a --quiet", bin(), root(), sc, set, qdir), 0);
-  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=2 %s run %s/%s %s --out %s/b --quiet", bin(), root(), sc, set, qdir), 0);
-  cr_assert_eq(lw_test_sh("%s run %s/%s %s --out %s/c --stop-at 17 --quiet && %s resume %s/c --quiet", bin(), root(),
-                          sc, set, qdir, bin(), qdir), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=1 %s run %s/%s %s --out %s/a --quiet", lw_test_bin(), lw_test_root(), sc, set, qdir), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=2 %s run %s/%s %s --out %s/b --quiet", lw_test_bin(), lw_test_root(), sc, set, qdir), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/%s %s --out %s/c --stop-at 17 --quiet && %s resume %s/c --quiet", lw_test_bin(), lw_test_root(),
+                          sc, set, qdir, lw_test_bin(), qdir), 0);
   const char *files[] = {"final.svg", "state.lw", "trace.csv"};
   for (int f = 0; f < 3; f++) {
     cr_expect_eq(lw_test_sh("cmp -s %s/a/%s %s/b/%s", qdir, files[f], qdir, files[f]), 0, "%s: threads", files[f]);

@@ -19,26 +19,12 @@ TestSuite(nurbs_cli, .init = make_dir, .fini = remove_dir);
 
 #define sh lw_test_sh
 
-static const char *bin(void)
-{
-  const char *b = getenv("LW_BIN");
-  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
-  return b;
-}
-
-static const char *root(void)
-{
-  const char *r = getenv("LW_ROOT");
-  cr_assert_not_null(r);
-  return r;
-}
-
 Test(nurbs_cli, the_wire_runs_and_resumes_to_the_same_bytes)
 {
   const char *set = "--set anneal.sweeps=40 --set output.checkpoint_every=7 --set output.frames_every=20";
-  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/a --quiet %s", bin(), root(), dir, set), 0);
-  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/b --quiet %s --stop-at 13", bin(), root(), dir, set), 0);
-  cr_assert_eq(sh("%s resume %s/b --quiet", bin(), dir), 0);
+  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/a --quiet %s", lw_test_bin(), lw_test_root(), dir, set), 0);
+  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/b --quiet %s --stop-at 13", lw_test_bin(), lw_test_root(), dir, set), 0);
+  cr_assert_eq(sh("%s resume %s/b --quiet", lw_test_bin(), dir), 0);
   const char *same[] = {"state.lw", "trace.csv", "final.svg", "final.png"};
   for (int k = 0; k < 4; k++)
     cr_assert_eq(sh("cmp -s %s/a/%s %s/b/%s", dir, same[k], dir, same[k]), 0, "%s differs after a resume", same[k]);
@@ -59,13 +45,13 @@ Test(nurbs_cli, monte_carlo_anneals_a_rational_curve_and_bounds_its_svg)
                   "weights = 1 0.7071067811865476 1 0.7071067811865476 1\\nknots = 0 0 0 0.5 0.5 1 1 1\\n"
                   "alpha = 1\\nfixed = 1\\nsvg_tolerance = 1e-5\\n[anneal]\\nsweeps = 300\\nseed = 3\\n' > %s/c.ini",
                   dir), 0);
-  cr_assert_eq(sh("%s run %s/c.ini --out %s/c --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/c.ini --out %s/c --quiet", lw_test_bin(), dir, dir), 0);
   cr_assert_eq(sh("grep -q '\"system\": \"nurbs\"' %s/c/summary.json", dir), 0);
   /* the rational curve is approximated within the tolerance */
   cr_assert_eq(sh("awk -F': ' '/svg_max_deviation/ { d = $2 + 0; found = 1 } END { exit !(found && d <= 1e-5 && d > "
                   "0) }' %s/c/summary.json", dir), 0);
   /* the energy command recomputes the saved state's energy */
-  cr_assert_eq(sh("%s energy %s/c > %s/e.txt", bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s energy %s/c > %s/e.txt", lw_test_bin(), dir, dir), 0);
   cr_assert_eq(sh("grep -q elastic %s/e.txt", dir), 0);
 }
 
@@ -74,7 +60,7 @@ Test(nurbs_cli, monte_carlo_anneals_a_rational_curve_and_bounds_its_svg)
 static void refused(const char *body, const char *pattern)
 {
   cr_assert_eq(sh("printf '[scene]\\nsystem = nurbs\\n[nurbs]\\n%s' > %s/bad.ini", body, dir), 0);
-  cr_assert_eq(sh("%s run %s/bad.ini --out %s/bad --quiet 2> %s/err.txt", bin(), dir, dir, dir), 2, "%s", body);
+  cr_assert_eq(sh("%s run %s/bad.ini --out %s/bad --quiet 2> %s/err.txt", lw_test_bin(), dir, dir, dir), 2, "%s", body);
   cr_assert_eq(sh("grep -q '%s' %s/err.txt", pattern, dir), 0, "%s: message does not match '%s'", body, pattern);
   cr_assert_neq(sh("test -e %s/bad", dir), 0);
 }
@@ -109,7 +95,7 @@ Test(nurbs_cli, a_points_file_holds_a_long_curve)
                   "> %s/long.txt", dir), 0);
   cr_assert_eq(sh("printf '[scene]\\nsystem = nurbs\\n[nurbs]\\nfile = long.txt\\nalpha = 1\\nbeta = 0.1\\nfixed = 2\\n"
                   "[anneal]\\nsweeps = 20\\n' > %s/long.ini", dir), 0);
-  cr_assert_eq(sh("%s run %s/long.ini --out %s/long --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/long.ini --out %s/long --quiet", lw_test_bin(), dir, dir), 0);
   cr_assert_eq(sh("grep -q '\"control_points\": 60' %s/long/summary.json && grep -q '\"fixed\": 4' "
                   "%s/long/summary.json", dir, dir), 0);
   refused("points = 0 0 1 x\\n", "bad.ini:4: key .nurbs.points.: expected numbers");
@@ -120,8 +106,8 @@ Test(nurbs_cli, tempering_replicas_give_the_same_bytes_for_any_thread_count)
   cr_assert_eq(sh("printf '[scene]\\nsystem = nurbs\\n[nurbs]\\norder = 3\\npoints = 2 0 2 2 0 2 -2 2 -2 0\\n"
                   "weights = 1 0.7 1 0.7 1\\nknots = 0 0 0 0.5 0.5 1 1 1\\nfixed = 1\\n[anneal]\\nsweeps = 100\\n"
                   "[tempering]\\nreplicas = 4\\n' > %s/t.ini", dir), 0);
-  cr_assert_eq(sh("OMP_NUM_THREADS=1 %s run %s/t.ini --out %s/t1 --quiet", bin(), dir, dir), 0);
-  cr_assert_eq(sh("OMP_NUM_THREADS=3 %s run %s/t.ini --out %s/t3 --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(sh("OMP_NUM_THREADS=1 %s run %s/t.ini --out %s/t1 --quiet", lw_test_bin(), dir, dir), 0);
+  cr_assert_eq(sh("OMP_NUM_THREADS=3 %s run %s/t.ini --out %s/t3 --quiet", lw_test_bin(), dir, dir), 0);
   const char *same[] = {"state.lw", "trace.csv", "final.svg"};
   for (int k = 0; k < 3; k++)
     cr_assert_eq(sh("cmp -s %s/t1/%s %s/t3/%s", dir, same[k], dir, same[k]), 0, "%s differs with the threads", same[k]);

@@ -20,13 +20,6 @@ static void remove_dir(void) { cr_assert_eq(lw_test_dir_remove(dir), 0); }
 
 TestSuite(particles_cli, .init = make_dir, .fini = remove_dir);
 
-static const char *bin(void)
-{
-  const char *b = getenv("LW_BIN");
-  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
-  return b;
-}
-
 /* A small tempered sheet: 3 replicas, few sweeps, checkpoints inside. */
 static const char scene[] =
   "[scene]\nsystem = particles\n"
@@ -65,7 +58,7 @@ Test(particles_cli, the_sheet_example_runs_and_writes_a_valid_ply)
 {
   const char *root = getenv("LW_ROOT");
   cr_assert_not_null(root);
-  cr_assert_eq(sh("%s run %s/params/particles-sheet.ini --out %s/sheet --quiet --set anneal.sweeps=300", bin(), root,
+  cr_assert_eq(sh("%s run %s/params/particles-sheet.ini --out %s/sheet --quiet --set anneal.sweeps=300", lw_test_bin(), root,
                   dir), 0);
   char path[128];
   snprintf(path, sizeof path, "%s/sheet/final.ply", dir);
@@ -114,11 +107,11 @@ Test(particles_cli, the_sheet_example_runs_and_writes_a_valid_ply)
 Test(particles_cli, stop_and_resume_give_the_bytes_of_an_uninterrupted_run)
 {
   write_scene();
-  cr_assert_eq(sh("%s run %s/s.ini --out %s/a --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/a --quiet", lw_test_bin(), dir, dir), 0);
   /* stopped between checkpoints, then again later */
-  cr_assert_eq(sh("%s run %s/s.ini --out %s/b --quiet --stop-at 22", bin(), dir, dir), 0);
-  cr_assert_eq(sh("%s resume %s/b --quiet --stop-at 41", bin(), dir), 0);
-  cr_assert_eq(sh("%s resume %s/b --quiet", bin(), dir), 0);
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/b --quiet --stop-at 22", lw_test_bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s resume %s/b --quiet --stop-at 41", lw_test_bin(), dir), 0);
+  cr_assert_eq(sh("%s resume %s/b --quiet", lw_test_bin(), dir), 0);
   for (size_t k = 0; k < N_SAME; k++)
     cr_assert_eq(sh("cmp -s %s/a/%s %s/b/%s", dir, same[k], dir, same[k]), 0, "%s differs", same[k]);
 }
@@ -128,7 +121,7 @@ Test(particles_cli, outputs_do_not_depend_on_the_thread_count_with_tempering)
   write_scene();
   const int threads[3] = {1, 2, 4};
   for (int i = 0; i < 3; i++)
-    cr_assert_eq(sh("OMP_NUM_THREADS=%d %s run %s/s.ini --out %s/t%d --quiet", threads[i], bin(), dir, dir, threads[i]),
+    cr_assert_eq(sh("OMP_NUM_THREADS=%d %s run %s/s.ini --out %s/t%d --quiet", threads[i], lw_test_bin(), dir, dir, threads[i]),
                  0);
   for (int i = 1; i < 3; i++)
     for (size_t k = 0; k < N_SAME; k++)
@@ -143,8 +136,8 @@ Test(particles_cli, outputs_do_not_depend_on_the_thread_count_with_tempering)
 Test(particles_cli, energy_recomputes_a_particle_run)
 {
   write_scene();
-  cr_assert_eq(sh("%s run %s/s.ini --out %s/e --quiet", bin(), dir, dir), 0);
-  cr_assert_eq(sh("%s energy %s/e > %s/energy.txt", bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/e --quiet", lw_test_bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s energy %s/e > %s/energy.txt", lw_test_bin(), dir, dir), 0);
   char path[128], line[256];
   snprintf(path, sizeof path, "%s/energy.txt", dir);
   FILE *f = fopen(path, "r");
@@ -175,11 +168,11 @@ Test(particles_cli, energy_recomputes_a_particle_run)
   cr_assert(lw_close_rel(v[6], run_total, 1e-9, 1.0), "recomputed %.17g, run %.17g", v[6], run_total);
   /* a damaged particle line is refused with the file and its line */
   cr_assert_eq(sh("sed -i '0,/^particle = /s/^particle = \\([^ ]*\\) /particle = nan /' %s/e/state.lw", dir), 0);
-  cr_assert_eq(sh("%s energy %s/e 2>%s/err.txt >/dev/null", bin(), dir, dir), 2);
+  cr_assert_eq(sh("%s energy %s/e 2>%s/err.txt >/dev/null", lw_test_bin(), dir, dir), 2);
   cr_assert_eq(sh("grep -q 'e/state.lw:[0-9]*: \\[system particles\\] particle: expected' %s/err.txt", dir), 0);
   /* a splines scene on a particle state: the missing section is named */
   cr_assert_eq(sh("sed -i 's/^system = particles/system = splines/' %s/e/scene.ini", dir), 0);
-  cr_assert_eq(sh("%s energy %s/e 2>%s/err.txt >/dev/null", bin(), dir, dir), 2);
+  cr_assert_eq(sh("%s energy %s/e 2>%s/err.txt >/dev/null", lw_test_bin(), dir, dir), 2);
   cr_assert_eq(sh("grep -q 'section \\[system splines\\]: missing' %s/err.txt", dir), 0);
 }
 
@@ -202,13 +195,13 @@ static double json_number(const char *path, const char *key)
 Test(particles_cli, a_run_starts_from_the_particles_of_another_runs_state)
 {
   write_scene();
-  cr_assert_eq(sh("%s run %s/s.ini --out %s/a --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/a --quiet", lw_test_bin(), dir, dir), 0);
   /* from the hottest rung's state, without tempering */
   cr_assert_eq(sh("sed -e 's/^replicas = 3/replicas = 1/' -e 's/^sweeps = 60/sweeps = 5/' %s/s.ini > %s/f.ini && "
                   "printf '[init]\\nfrom = %s/a/replica-2.lw\\n' >> %s/f.ini", dir, dir, dir, dir), 0);
-  cr_assert_eq(sh("%s run %s/f.ini --out %s/f --quiet", bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/f.ini --out %s/f --quiet", lw_test_bin(), dir, dir), 0);
   cr_assert_eq(sh("%s energy %s/a > /dev/null && cp %s/a/replica-2.lw %s/a/state.lw && %s energy %s/a | "
-                  "awk '$1 == \"total\" { print $2 }' > %s/e2.txt", bin(), dir, dir, dir, bin(), dir, dir), 0);
+                  "awk '$1 == \"total\" { print $2 }' > %s/e2.txt", lw_test_bin(), dir, dir, dir, lw_test_bin(), dir, dir), 0);
   char path[160];
   snprintf(path, sizeof path, "%s/e2.txt", dir);
   FILE *f = fopen(path, "r");
@@ -222,6 +215,6 @@ Test(particles_cli, a_run_starts_from_the_particles_of_another_runs_state)
   /* a splines state is refused naming [init] from and the section */
   cr_assert_eq(sh("printf 'linewise-state 2\\n[run]\\nscene = s.ini\\nseed = 1\\nsweep = 0\\n[system splines]\\n"
                   "splines = 0\\n' > %s/spl.lw && sed -i 's|^from = .*|from = %s/spl.lw|' %s/f.ini", dir, dir, dir), 0);
-  cr_assert_eq(sh("%s run %s/f.ini --out %s/g --quiet 2>%s/err.txt", bin(), dir, dir, dir), 2);
+  cr_assert_eq(sh("%s run %s/f.ini --out %s/g --quiet 2>%s/err.txt", lw_test_bin(), dir, dir, dir), 2);
   cr_assert_eq(sh("grep -q 'spl.lw: section \\[system particles\\]: missing' %s/err.txt", dir), 0);
 }

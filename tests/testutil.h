@@ -2,6 +2,7 @@
 #ifndef LINEWISE_TESTUTIL_H
 #define LINEWISE_TESTUTIL_H
 
+#include <criterion/criterion.h>
 #include <gsl/gsl_math.h>
 #include <math.h>
 #include <stdarg.h>
@@ -42,6 +43,21 @@ static inline uint64_t *lw_test_rng_state(void)
   static uint64_t state;
   return &state;
 }
+/* bin/linewise and the repository root, as `make test` sets them (LW_BIN,
+** LW_ROOT) for the tests that run the binary or read bundled files. */
+static inline const char *lw_test_bin(void)
+{
+  const char *b = getenv("LW_BIN");
+  cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
+  return b;
+}
+
+static inline const char *lw_test_root(void)
+{
+  const char *r = getenv("LW_ROOT");
+  return r ? r : ".";
+}
+
 static inline void rng_seed(uint64_t s) { *lw_test_rng_state() = s; }
 static inline double urand(double lo, double hi)
 {
