@@ -56,6 +56,38 @@ lw_dnurbs *lw_dnurbs_new(lw_nurbs *c, double alpha, double beta, int gauss, lw_e
   return d;
 }
 
+lw_status lw_dnurbs_grad_w(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, double *gw, lw_error *err)
+{
+  const size_t n = c->n, k = (size_t)c->order;
+  gsl_integration_glfixed_table *gl = gsl_integration_glfixed_table_alloc((size_t)gauss);
+  if (!gl) return lw_error_set(err, LW_ENOMEM, "out of memory for a Gauss table of %d points", gauss);
+  memset(gw, 0, n * sizeof *gw);
+  double R[3 * LW_NURBS_ORDER_MAX];
+  for (size_t s = k - 1; s < n; s++) {
+    double a = c->knot[s], bb = c->knot[s + 1];
+    if (!(bb > a)) continue;
+    for (size_t q = 0; q < (size_t)gauss; q++) {
+      double u, wq, pt[2], d1[2], d2[2];
+      gsl_integration_glfixed_point(a, bb, q, &u, &wq, gl);
+      size_t first = lw_nurbs_rational(c, u, R);
+      lw_nurbs_eval(c, u, pt, d1, d2);
+      for (size_t i = 0; i < k; i++) {
+        size_t j = first + i;
+        double r0 = R[i], r1 = R[k + i], r2 = R[2 * k + i], acc = 0.0;
+        for (int x = 0; x < 2; x++) {
+          double dp = c->P[2 * j + x] - pt[x];
+          /* q_j and its u-derivatives, times w_j (product rule on R_j (P_j - c)) */
+          double q0 = r0 * dp, q1 = r1 * dp - r0 * d1[x], q2 = r2 * dp - 2.0 * r1 * d1[x] - r0 * d2[x];
+          acc += alpha * d1[x] * q1 + beta * d2[x] * q2 - mug[x] * q0;
+        }
+        gw[j] += wq * acc / c->w[j];
+      }
+    }
+  }
+  gsl_integration_glfixed_table_free(gl);
+  return LW_OK;
+}
+
 void lw_band_apply(const double *A, size_t n, int k, const double *x, double *y)
 {
   memset(y, 0, 2 * n * sizeof *y);

@@ -178,6 +178,41 @@ Test(wire, the_banded_matrices_give_the_energies_of_the_curve)
   wire_close(&w);
 }
 
+/* E_el + E_g of the curve itself (24 Gauss points), mu g = (0, -294) */
+static double wire_energy(lw_nurbs *c) { return integral(c, elastic_density) + 294 * integral(c, height); }
+
+Test(wire, the_weight_gradient_matches_central_differences)
+{
+  wire w;
+  wire_open(&w, 0);
+  rng_seed(5);
+  lw_nurbs *c = w.st->c;
+  for (size_t i = 0; i < w.n; i++) {
+    c->P[2 * i] = urand(-5, 5), c->P[2 * i + 1] = urand(-5, 5);
+    c->w[i] = urand(0.5, 2);
+  }
+  const double mug[2] = {0, -294};
+  double *gw = malloc(w.n * sizeof *gw), big = 0;
+  lw_error err = {0};
+  /* the same 24 points as the curve's integral: only the difference's own
+  ** error is left, h^2 E^(3) ~ 1e-10 and rounding eps E / h ~ 1e-11 */
+  cr_assert_eq(lw_dnurbs_grad_w(c, 35, 10, mug, 24, gw, &err), LW_OK);
+  for (size_t j = 0; j < w.n; j++) big = fmax(big, fabs(gw[j]));
+  cr_assert(big > 1.0, "a gradient that vanishes would test nothing: %g", big);
+  for (size_t j = 0; j < w.n; j++) {
+    double w0 = c->w[j], h = 1e-5 * w0;
+    c->w[j] = w0 + h;
+    double ep = wire_energy(c);
+    c->w[j] = w0 - h;
+    double em = wire_energy(c);
+    c->w[j] = w0;
+    double fd = (ep - em) / (2 * h);
+    cr_assert(fabs(gw[j] - fd) < 1e-6 * big, "dE/dw_%zu = %.12g, central difference %.12g", j, gw[j], fd);
+  }
+  free(gw);
+  wire_close(&w);
+}
+
 /* ---- statics and dynamics ------------------------------------------------- */
 
 Test(wire, damped_motion_comes_to_rest_at_the_solution_of_k_p_equals_f)

@@ -33,6 +33,12 @@ typedef struct {
 lw_dnurbs *lw_dnurbs_new(lw_nurbs *c, double alpha, double beta, int gauss, lw_error *err);
 void lw_dnurbs_free(lw_dnurbs *d);
 
+/* The gradient gw (n) of E_el + E_g in the weights, with mug = mu g:
+** dE/dw_j = int alpha c_u . q_j' + beta c_uu . q_j'' - mug . q_j du, where
+** q_j = dc/dw_j = R_j (P_j - c) / w_j (docs/NUMERICS.md "Free weights").
+** The first step towards free weights; nothing calls it in a run yet. */
+lw_status lw_dnurbs_grad_w(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, double *gw, lw_error *err);
+
 /* y = A x for a band A (n x k) on interleaved xy vectors (2 n). */
 void lw_band_apply(const double *A, size_t n, int k, const double *x, double *y);
 
