@@ -199,6 +199,10 @@ Test(wire, the_weight_gradient_matches_central_differences)
   cr_assert_eq(lw_dnurbs_grad_w(c, 35, 10, mug, 24, gw, &err), LW_OK);
   for (size_t j = 0; j < w.n; j++) big = fmax(big, fabs(gw[j]));
   cr_assert(big > 1.0, "a gradient that vanishes would test nothing: %g", big);
+  /* the scale gauge: sum_j w_j q_j = 0, so scaling every weight costs nothing */
+  double scale = 0;
+  for (size_t j = 0; j < w.n; j++) scale += c->w[j] * gw[j];
+  cr_assert(fabs(scale) < 1e-10 * big, "sum w_j dE/dw_j = %g, should vanish", scale);
   for (size_t j = 0; j < w.n; j++) {
     double w0 = c->w[j], h = 1e-5 * w0;
     c->w[j] = w0 + h;
