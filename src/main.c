@@ -155,10 +155,6 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, lw_error *err)
     char drawn[512];
     a->sys_type->describe(a->sys->state, LW_DESCRIBE_DRAWING, drawn, sizeof drawn);
     fprintf(stderr, "%s", drawn);
-    if (a->quenched)
-      fprintf(stderr, "linewise: quench: energy %.10g -> %.10g, gradient norm %.3g -> %.3g, %ld iterations, %.2f s\n",
-              a->quench.energy_before, a->quench.energy_after, a->quench.gradient_before, a->quench.gradient_after,
-              a->quench.iterations, a->quench.seconds);
     fprintf(stderr, "linewise: done: %s/%s, summary.json, trace.csv, state.lw\n", a->dir, a->sys_type->files);
   }
   return 0;
