@@ -34,6 +34,10 @@
 ** explicit Euler step dx = -h D^-1 grad E, halved until the energy falls by
 ** at least 1e-4 of what the slope promises (Armijo), so the flow never
 ** leaves the allowed set and its energy never rises.
+**
+** `dynamics.integrator = review` replaces the leapfrog by the implicit
+** scheme of the D-NURBS review (dyn_review.h): backward in the stiffness, so
+** it damps high frequencies; meant for the quadratic D-NURBS energy.
 */
 #ifndef LINEWISE_DYNAMICS_H
 #define LINEWISE_DYNAMICS_H
