@@ -222,29 +222,6 @@ static void gauss_chain_free(lw_chain *c)
   lw_system_free(sys);
 }
 
-/* Batch means of one observable: B batches of `per` samples each. */
-#define BATCHES 50
-typedef struct {
-  double batch[BATCHES];
-  long per, n;
-} batch_mean;
-
-static void bm_add(batch_mean *b, double v)
-{
-  b->batch[b->n / b->per] += v / (double)b->per;
-  b->n++;
-}
-
-/* The mean of the batch means and its standard error. */
-static double bm_mean(const batch_mean *b, double *se)
-{
-  double m = 0.0, ss = 0.0;
-  for (int k = 0; k < BATCHES; k++) m += b->batch[k] / BATCHES;
-  for (int k = 0; k < BATCHES; k++) ss += (b->batch[k] - m) * (b->batch[k] - m);
-  *se = sqrt(ss / (BATCHES - 1) / BATCHES);
-  return m;
-}
-
 /* x_i / sigma_i has mean 0 and x_i^2 / sigma_i^2 mean 1 at temperature T. */
 static void check_gaussian(const char *what, batch_mean *m1, batch_mean *m2, double T)
 {

@@ -441,28 +441,6 @@ Test(wire, annealing_to_zero_temperature_reaches_the_equilibrium)
   wire_close(&w);
 }
 
-/* Batch means of one observable. */
-#define BATCHES 50
-typedef struct {
-  double batch[BATCHES];
-  long per, n;
-} batch_mean;
-
-static void bm_add(batch_mean *b, double v)
-{
-  b->batch[b->n / b->per] += v / (double)b->per;
-  b->n++;
-}
-
-static double bm_mean(const batch_mean *b, double *se)
-{
-  double m = 0.0, ss = 0.0;
-  for (int k = 0; k < BATCHES; k++) m += b->batch[k] / BATCHES;
-  for (int k = 0; k < BATCHES; k++) ss += (b->batch[k] - m) * (b->batch[k] - m);
-  *se = sqrt(ss / (BATCHES - 1) / BATCHES);
-  return m;
-}
-
 Test(wire, at_a_fixed_temperature_the_free_points_sample_t_times_k_inverse)
 {
   /* exp(-E/T) with E = 1/2 p'Kp - f'p is the Gaussian of mean p_eq and

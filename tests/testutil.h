@@ -58,6 +58,30 @@ static inline const char *lw_test_root(void)
   return r ? r : ".";
 }
 
+/* Batch means of one observable (statistical tests): BATCHES batches of
+** `per` samples each, added in order; the mean of the batch means and its
+** standard error. */
+#define BATCHES 50
+typedef struct {
+  double batch[BATCHES];
+  long per, n;
+} batch_mean;
+
+static inline void bm_add(batch_mean *b, double v)
+{
+  b->batch[b->n / b->per] += v / (double)b->per;
+  b->n++;
+}
+
+static inline double bm_mean(const batch_mean *b, double *se)
+{
+  double m = 0.0, ss = 0.0;
+  for (int k = 0; k < BATCHES; k++) m += b->batch[k] / BATCHES;
+  for (int k = 0; k < BATCHES; k++) ss += (b->batch[k] - m) * (b->batch[k] - m);
+  *se = sqrt(ss / (BATCHES - 1) / BATCHES);
+  return m;
+}
+
 static inline void rng_seed(uint64_t s) { *lw_test_rng_state() = s; }
 static inline double urand(double lo, double hi)
 {
