@@ -9,6 +9,7 @@
 #include <gsl/gsl_math.h>
 #include <stdarg.h>
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -16,6 +17,7 @@
 #include <unistd.h>
 
 #include "linewise/checkpoint.h"
+#include "linewise/domains.h"
 #include "linewise/init.h"
 #include "linewise/json.h"
 #include "linewise/number.h"
@@ -244,6 +246,7 @@ static lw_status build(lw_anneal *a, void **states, const double *ladder, lw_err
   for (int k = 0; k < n; k++) {
     a->chains[k] = lw_chain_new(a->systems[k], weight, step, target, rung_stream(a, k), err);
     if (!a->chains[k]) return err->code;
+    if (p->driver != LW_DRIVER_DYNAMICS && lw_domains_attach(a->chains[k], p, n, err)) return err->code;
   }
   a->chain = a->chains[0];
   a->sys = a->systems[0];
@@ -625,7 +628,9 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
   int failed = 0;
   /* The rungs are independent between exchanges: each touches only its own
   ** chain, stream and system, so the thread count cannot change the result. */
-#pragma omp parallel for schedule(static, 1) reduction(| : failed) if (n > 1)
+  /* Threads go to the rungs first; a rung split into domains runs its
+  ** share of the rest there (domains.h). */
+#pragma omp parallel for schedule(static, 1) reduction(| : failed) num_threads(n < omp_get_max_threads() ? n : omp_get_max_threads()) if (n > 1)
   for (int k = 0; k < n; k++) {
     a->chains[k]->tuning = tuning;
     if (lw_chain_sweep(a->chains[k]) != LW_OK) failed = 1;

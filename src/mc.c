@@ -3,6 +3,8 @@
 */
 #include "linewise/mc.h"
 
+#include "linewise/domains.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,15 +46,15 @@ nomem:
 void lw_chain_free(lw_chain *c)
 {
   if (!c) return;
+  lw_domains_free(c->domains);
   if (c->prop) c->sys->type->proposal_free(c->prop);
   if (c->rng) gsl_rng_free(c->rng);
   free(c);
 }
 
-static void tune(lw_chain *c, int kind, int accepted)
+/* A step update once the window of a kind is full. */
+static void tune_window(lw_chain *c, int kind)
 {
-  c->win_prop[kind]++;
-  c->win_acc[kind] += (unsigned long)accepted;
   if (c->win_prop[kind] < LW_TUNE_WINDOW) return;
   double rate = (double)c->win_acc[kind] / (double)c->win_prop[kind];
   /* multiplicative update: a step that accepts too often grows, one that
@@ -64,6 +66,13 @@ static void tune(lw_chain *c, int kind, int accepted)
   c->win_prop[kind] = c->win_acc[kind] = 0;
 }
 
+static void tune(lw_chain *c, int kind, int accepted)
+{
+  c->win_prop[kind]++;
+  c->win_acc[kind] += (unsigned long)accepted;
+  tune_window(c, kind);
+}
+
 /* The Metropolis decision on an evaluated proposal, its commit and the
 ** counts. */
 static int decide(lw_chain *c, int kind, double dE, int forbidden)
@@ -73,6 +82,9 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
   s->proposed++;
   if (isnan(dE)) {
     s->nan++;
+    accept = 0;
+  } else if (forbidden == 2) {
+    c->outside++;
     accept = 0;
   } else if (forbidden) {
     s->irregular++;
@@ -87,7 +99,8 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
     accept = 0;
   }
   if (accept) {
-    if (c->sys->type->commit(c->sys->state, c->prop) != LW_OK) accept = -1;
+    const lw_system_type *t = c->sys->type;
+    if ((c->part ? t->commit_part : t->commit)(c->sys->state, c->prop) != LW_OK) accept = -1;
     else s->accepted++;
   }
   if (c->tuning && accept >= 0) tune(c, kind, accept);
@@ -121,8 +134,35 @@ static int draw_kind(lw_chain *c)
   return kind;
 }
 
+int lw_chain_visit_in(lw_chain *c, size_t site, const double box[4])
+{
+  int kind = draw_kind(c), forbidden = 0;
+  double dE = c->sys->type->propose_in(c->sys->state, c->prop, kind, site, c->step[kind], c->rng, &forbidden, box);
+  return decide(c, kind, dE, forbidden);
+}
+
+void lw_chain_absorb(lw_chain *c, lw_chain *from)
+{
+  for (int k = 0; k < c->n_moves; k++) {
+    lw_move_stats *a = &c->stats[k], *b = &from->stats[k];
+    a->proposed += b->proposed;
+    a->accepted += b->accepted;
+    a->nan += b->nan;
+    a->irregular += b->irregular;
+    if (c->tuning) {
+      c->win_prop[k] += b->proposed;
+      c->win_acc[k] += b->accepted;
+      tune_window(c, k);
+    }
+    *b = (lw_move_stats){0};
+  }
+  c->outside += from->outside;
+  from->outside = 0;
+}
+
 lw_status lw_chain_sweep(lw_chain *c)
 {
+  if (c->domains) return lw_domains_sweep(c->domains, c);
   const lw_system_type *t = c->sys->type;
   size_t n = t->sweep_size(c->sys->state);
   if (!t->propose_at) {

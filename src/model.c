@@ -486,6 +486,7 @@ lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err)
     p->near_new = malloc(cap * sizeof *p->near_new);
     p->seg_irregular = malloc(cap * sizeof *p->seg_irregular);
     p->spline_seg_len = malloc(cap * sizeof *p->spline_seg_len);
+    for (int t = 0; t < LW_TERM_COUNT; t++) p->sum_term[t] = -0.0;
   }
   if (!p || !p->node || !p->len || !p->local || !p->ps || !p->ps_old || !p->probe || !p->near_new ||
       !p->seg_irregular || !p->spline_seg_len) {
@@ -743,7 +744,9 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   p->dE = dE;
 }
 
-lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
+/* The commit without the running totals (model.h): everything but m->term
+** and m->n_irregular, whose changes go into p's own sums. */
+lw_status lw_model_commit_part(lw_model *m, lw_proposal *p)
 {
   lw_splines *sp = m->sp;
   const int np = pair_nodes(m), nl = m->scene->n_local;
@@ -763,7 +766,10 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
   memcpy(&sp->node[sp->first[p->spline] + p->node0], p->node, p->n_node * sizeof *p->node);
   if (m->grid) {
     if (p->pair_done) {
-      for (size_t k = 0; k < p->partners.n; k++) m->near_valid[p->partners.idx[k]] = 0;
+      /* A partner may be shared with a move in another domain (domains.h):
+      ** both only clear its flag, as relaxed atomic stores. */
+      for (size_t k = 0; k < p->partners.n; k++)
+        __atomic_store_n(&m->near_valid[p->partners.idx[k]], 0, __ATOMIC_RELAXED);
       for (size_t j = 0; j < p->n_seg; j++) {
         m->near_cache[g0 + p->seg0 + j] = p->near_new[j];
         m->near_valid[g0 + p->seg0 + j] = 1;
@@ -773,12 +779,11 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
       memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);
     }
   }
-  int nonfinite = 0;
   for (size_t j = 0; j < p->n_seg; j++) {
     size_t g = g0 + p->seg0 + j;
     m->seg_len[g] = p->len[j];
     memcpy(m->seg_local + g * (size_t)nl, p->local + j * (size_t)nl, (size_t)nl * sizeof *m->seg_local);
-    m->n_irregular = m->n_irregular - m->seg_irregular[g] + p->seg_irregular[j];
+    p->sum_irregular += (long)p->seg_irregular[j] - (long)m->seg_irregular[g];
     m->seg_irregular[g] = p->seg_irregular[j];
   }
   /* Summed afresh in a fixed order rather than updated by += dlen, so the
@@ -792,13 +797,32 @@ lw_status lw_model_commit(lw_model *m, const lw_proposal *p)
     const int t = m->terms.raster[k];
     lw_tone_apply(m->terms.ctx[t].data, m->raster[t], &p->box[t]);
   }
+  for (int t = 0; t < LW_TERM_COUNT; t++) p->sum_term[t] += p->dterm[t];
+  if (m->terms.n_raster && !p->raster_done) p->sum_stale = 1;
+  return LW_OK;
+}
+
+lw_status lw_model_merge(lw_model *m, lw_proposal *p)
+{
+  int nonfinite = 0;
+  m->n_irregular = (size_t)((long)m->n_irregular + p->sum_irregular);
   for (int t = 0; t < LW_TERM_COUNT; t++) {
-    m->term[t] += p->dterm[t];
+    m->term[t] += p->sum_term[t];
     if (!isfinite(m->term[t])) nonfinite = 1;
+    p->sum_term[t] = -0.0;
   }
+  int stale = p->sum_stale;
+  p->sum_irregular = 0;
+  p->sum_stale = 0;
   /* inf - inf leaves NaN in a running total: leaving a forbidden state is
   ** legal, so rebuild the totals from the caches when that happens; the
   ** same when a raster was not evaluated (its changes are unknown). */
-  if (nonfinite || (m->terms.n_raster && !p->raster_done)) return lw_model_refresh(m, NULL);
+  if (nonfinite || stale) return lw_model_refresh(m, NULL);
   return LW_OK;
+}
+
+lw_status lw_model_commit(lw_model *m, lw_proposal *p)
+{
+  lw_status s = lw_model_commit_part(m, p);
+  return s != LW_OK ? s : lw_model_merge(m, p);
 }

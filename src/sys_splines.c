@@ -240,17 +240,16 @@ static uint32_t spline_near(const lw_splines *sp, uint32_t hint, size_t k)
   return spline_of_node(sp, k);
 }
 
-/* A proposal of the kind at global node k (a point or vector move) or on
-** its spline (a rigid move). */
-static double propose_on(const lw_model *m, lw_proposal *p, int kind, size_t at, uint32_t i, double st,
-                         gsl_rng *rng, int *forbidden)
+/* Builds in p->node the new nodes of a move of the kind at global node k
+** (a point or vector move) or on its spline (a rigid move); *node0 and
+** *n_node say which of the spline's nodes they replace. */
+static void build_move(const lw_splines *sp, lw_proposal *p, int kind, size_t at, uint32_t i, double st,
+                       gsl_rng *rng, size_t *node0, size_t *n_node)
 {
-  const lw_splines *sp = m->sp;
-  size_t node0, n_node;
   lw_node *nd = p->node; /* proposals are built in place in the scratch */
   if (kind == LW_MOVE_POINT || kind == LW_MOVE_VECTOR) {
-    node0 = at - sp->first[i];
-    n_node = 1;
+    *node0 = at - sp->first[i];
+    *n_node = 1;
     nd[0] = sp->node[at];
     double dx = gsl_ran_gaussian_ziggurat(rng, st), dy = gsl_ran_gaussian_ziggurat(rng, st);
     if (kind == LW_MOVE_POINT) {
@@ -260,33 +259,42 @@ static double propose_on(const lw_model *m, lw_proposal *p, int kind, size_t at,
       nd[0].vx += dx;
       nd[0].vy += dy;
     }
-  } else {
-    node0 = 0;
-    n_node = sp->first[i + 1] - sp->first[i];
-    const lw_node *src = &sp->node[sp->first[i]];
-    if (kind == LW_MOVE_TRANSLATE) {
-      double dx = gsl_ran_gaussian_ziggurat(rng, st), dy = gsl_ran_gaussian_ziggurat(rng, st);
-      for (size_t k = 0; k < n_node; k++) {
-        nd[k] = src[k];
-        nd[k].px += dx;
-        nd[k].py += dy;
-      }
-    } else {
-      double a = gsl_ran_gaussian_ziggurat(rng, st), ca = cos(a), sa = sin(a);
-      double cx = 0.0, cy = 0.0;
-      for (size_t k = 0; k < n_node; k++) {
-        cx += src[k].px;
-        cy += src[k].py;
-      }
-      cx /= (double)n_node;
-      cy /= (double)n_node;
-      for (size_t k = 0; k < n_node; k++) {
-        double x = src[k].px - cx, y = src[k].py - cy;
-        nd[k] = (lw_node){cx + ca * x - sa * y, cy + sa * x + ca * y,
-                          ca * src[k].vx - sa * src[k].vy, sa * src[k].vx + ca * src[k].vy};
-      }
-    }
+    return;
   }
+  *node0 = 0;
+  *n_node = sp->first[i + 1] - sp->first[i];
+  const size_t n = *n_node;
+  const lw_node *src = &sp->node[sp->first[i]];
+  if (kind == LW_MOVE_TRANSLATE) {
+    double dx = gsl_ran_gaussian_ziggurat(rng, st), dy = gsl_ran_gaussian_ziggurat(rng, st);
+    for (size_t k = 0; k < n; k++) {
+      nd[k] = src[k];
+      nd[k].px += dx;
+      nd[k].py += dy;
+    }
+    return;
+  }
+  double a = gsl_ran_gaussian_ziggurat(rng, st), ca = cos(a), sa = sin(a);
+  double cx = 0.0, cy = 0.0;
+  for (size_t k = 0; k < n; k++) {
+    cx += src[k].px;
+    cy += src[k].py;
+  }
+  cx /= (double)n;
+  cy /= (double)n;
+  for (size_t k = 0; k < n; k++) {
+    double x = src[k].px - cx, y = src[k].py - cy;
+    nd[k] = (lw_node){cx + ca * x - sa * y, cy + sa * x + ca * y, ca * src[k].vx - sa * src[k].vy,
+                      sa * src[k].vx + ca * src[k].vy};
+  }
+}
+
+/* A proposal of the kind at global node k or on its spline. */
+static double propose_on(const lw_model *m, lw_proposal *p, int kind, size_t at, uint32_t i, double st,
+                         gsl_rng *rng, int *forbidden)
+{
+  size_t node0, n_node;
+  build_move(m->sp, p, kind, at, i, st, rng, &node0, &n_node);
   lw_model_propose(m, p, i, node0, n_node, NULL);
   *forbidden = p->irregular;
   return p->dE;
@@ -315,6 +323,93 @@ static double propose_at(void *state, void *prop, int kind, size_t k, double st,
   lw_proposal *p = prop;
   return propose_on(m, p, kind, k, spline_near(m->sp, p->spline, k), st, rng, forbidden);
 }
+
+/* ---- domain decomposition (system.h, domains.h) ---- */
+
+/* Grows box b (x0, y0, x1, y1) over spline i with nodes [node0, node0 + n)
+** replaced by nd (n = 0: as it is): the Bezier control points of its
+** segments, whose convex hull holds every sample of every term. */
+static void spline_box(const lw_splines *sp, uint32_t i, size_t node0, size_t n, const lw_node *nd, double b[4])
+{
+  const lw_node *base = &sp->node[sp->first[i]];
+  const size_t nn = sp->first[i + 1] - sp->first[i];
+  for (size_t k = 0; k < nn; k++) {
+    const lw_node *a = k >= node0 && k < node0 + n ? &nd[k - node0] : &base[k];
+    double z[8];
+    lw_node next = *a;
+    if (k + 1 < nn) next = k + 1 >= node0 && k + 1 < node0 + n ? nd[k + 1 - node0] : base[k + 1];
+    lw_segment_bezier(a, &next, z);
+    for (int c = 0; c < (k + 1 < nn ? 8 : 2); c += 2) {
+      b[0] = fmin(b[0], z[c]);
+      b[1] = fmin(b[1], z[c + 1]);
+      b[2] = fmax(b[2], z[c]);
+      b[3] = fmax(b[3], z[c + 1]);
+    }
+  }
+}
+
+/* Every term of the spline model is local: segment and spline terms read
+** the moved spline only, the pair term the 3 x 3 grid cells around each
+** sample (cells at least the cutoff wide, min_spacing too), a raster term
+** the pixels its box covers (the footprint plus the rounding of
+** lw_tone_box_cover). */
+static const char *split(const void *state, double page[4], double *reach)
+{
+  const lw_model *m = ((const spl_state *)state)->m;
+  const lw_scene *sc = m->scene;
+  page[0] = 0.0;
+  page[1] = 0.0;
+  page[2] = sc->width;
+  page[3] = sc->height;
+  double r = 0.0;
+  if (m->grid) r = fmax(r, 2.0 / m->grid->inv_h);
+  for (int k = 0; k < m->terms.n_raster; k++) {
+    const lw_tone *t = m->terms.ctx[m->terms.raster[k]].data;
+    r = fmax(r, (t->radius + 3) * t->pixel);
+  }
+  *reach = r;
+  return NULL;
+}
+
+/* Site k starts its spline's group: rigid moves at any of its nodes move
+** the whole spline, and the spline terms read all of it. */
+static size_t group(const void *state, size_t site, double box[4])
+{
+  const lw_splines *sp = ((const spl_state *)state)->m->sp;
+  uint32_t i = spline_of_node(sp, site);
+  box[0] = box[1] = INFINITY;
+  box[2] = box[3] = -INFINITY;
+  spline_box(sp, i, 0, 0, NULL, box);
+  return sp->first[i + 1] - site;
+}
+
+static double propose_in(void *state, void *prop, int kind, size_t k, double st, gsl_rng *rng, int *forbidden,
+                         const double box[4])
+{
+  const lw_model *m = ((spl_state *)state)->m;
+  lw_proposal *p = prop;
+  uint32_t i = spline_near(m->sp, p->spline, k);
+  size_t node0, n_node;
+  build_move(m->sp, p, kind, k, i, st, rng, &node0, &n_node);
+  double b[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+  spline_box(m->sp, i, node0, n_node, p->node, b);
+  /* NaN fails every comparison: outside, so rejected */
+  if (!(b[0] >= box[0] && b[1] >= box[1] && b[2] <= box[2] && b[3] <= box[3])) {
+    p->spline = i;
+    *forbidden = 2;
+    return INFINITY;
+  }
+  lw_model_propose(m, p, i, node0, n_node, NULL);
+  *forbidden = p->irregular;
+  return p->dE;
+}
+
+static lw_status commit_part(void *state, void *prop)
+{
+  return lw_model_commit_part(((spl_state *)state)->m, prop);
+}
+
+static lw_status merge(void *state, void *prop) { return lw_model_merge(((spl_state *)state)->m, prop); }
 
 /* Between sweeps, before the run loop's refresh (which rebuilds every
 ** cache from the renumbered state). */
@@ -533,6 +628,11 @@ const lw_system_type lw_system_splines = {
     .propose_at = propose_at,
     .renumber = renumber,
     .commit = commit,
+    .split = split,
+    .group = group,
+    .propose_in = propose_in,
+    .commit_part = commit_part,
+    .merge = merge,
     .total = total,
     .terms = terms,
     .term_on = term_on,

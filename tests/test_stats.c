@@ -19,8 +19,10 @@
 #include <gsl/gsl_cdf.h>
 #include <gsl/gsl_math.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
+#include "linewise/domains.h"
 #include "linewise/mc.h"
 #include "linewise/model.h"
 #include "linewise/scene.h"
@@ -39,14 +41,22 @@
 */
 typedef struct {
   double kx, ky, cx, cy;
+  double period; /* > 0: a well at every (cx, cy) + period (i, j), the nearest counts */
 } well;
+
+/* The offset of v from the nearest well centre c + period k. */
+static double well_offset(double v, double c, double period)
+{
+  double d = v - c;
+  return period > 0.0 ? d - period * round(d / period) : d;
+}
 
 static double well_energy(const lw_samples *s, const lw_quad *q, const void *data)
 {
   const well *w = data;
   double e = 0.0;
   for (int i = 0; i < s->n; i++) {
-    double dx = s->x[i] - w->cx, dy = s->y[i] - w->cy;
+    double dx = well_offset(s->x[i], w->cx, w->period), dy = well_offset(s->y[i], w->cy, w->period);
     e += q->w[i] * (w->kx * dx * dx + w->ky * dy * dy);
   }
   return 0.5 * e;
@@ -77,17 +87,41 @@ static void well_scene(lw_scene *sc, const well *w)
   cr_assert_eq(lw_scene_set_user_term(sc, 1.0, well_energy, w, &err), LW_OK, "%s", err.msg);
 }
 
-/* n one-segment straight splines of length 1 at the well's centre. */
-static lw_splines *unit_splines(size_t n, double cx, double cy)
+/* n one-segment straight splines of length 1 at the well's centre, or for
+** a periodic well one at each of its centres, rows of 8 from (cx, cy). */
+static lw_splines *unit_splines(size_t n, const well *w)
 {
   size_t *segs = malloc(n * sizeof *segs);
   for (size_t i = 0; i < n; i++) segs[i] = 1;
   lw_splines *sp = lw_splines_new(n, segs, NULL);
   free(segs);
   cr_assert_not_null(sp);
-  for (size_t i = 0; i < n; i++) lw_test_straight(sp, i, cx - 0.5, cy, cx + 0.5, cy);
+  for (size_t i = 0; i < n; i++) {
+    double x = w->cx + w->period * (double)(i % 8), y = w->cy + w->period * (double)(i / 8);
+    lw_test_straight(sp, i, x - 0.5, y, x + 0.5, y);
+  }
   return sp;
 }
+
+/* With domains (NULL: none): the chain's sweeps split as [anneal] domains
+** = `domains` splits them (domains.h), on `threads` threads. */
+static void split_chain(lw_chain *c, const char *domains, int threads)
+{
+  if (!domains) return;
+  lw_params p;
+  lw_params_defaults(&p);
+  snprintf(p.domains, sizeof p.domains, "%s", domains);
+  lw_error err;
+  cr_assert_eq(lw_domains_attach(c, &p, 1, &err), LW_OK, "%s", err.msg);
+  cr_assert_not_null(c->domains, "domains = %s did not split", domains);
+  c->domains->threads = threads;
+  c->domains->min_parallel = 0; /* these sweeps are small: split them anyway */
+}
+
+/* The wells of the domain cases: 50 splines 24 mm apart, on the default
+** page split 2 x 2 (domains 105 x 148.5 mm, a 3 x 3 lattice once shifted):
+** the four sub-lattices hold 4, 2, 2 and 1 cells, so 4 threads have work. */
+#define DOMAIN_PERIOD 24.0
 
 static lw_chain *point_chain(lw_model *m, double step, unsigned long seed)
 {
@@ -116,68 +150,96 @@ static double acceptance_exact(int d, double sigma, double s)
   return d == 1 ? M_2_PI * atan(2.0 * sigma / s) : 1.0 - s / sqrt(s * s + 4.0 * sigma * sigma);
 }
 
+/* The acceptance of point moves in d dimensions at step ratio * sigma
+** against the closed form, N proposals in whole sweeps; wells of the given
+** period, the sweeps split by `domains` on `threads` threads. */
+static void acceptance_case(int d, double ratio, unsigned long seed, long N, double period, const char *domains,
+                            int threads)
+{
+  const size_t n_spl = 50;
+  const int B = 50; /* batches for the error estimate */
+  lw_scene sc;
+  well w = {1.0, 0.0, period > 0.0 ? 20.0 : 100.0, period > 0.0 ? 20.0 : 100.0, period};
+  well_scene(&sc, &w);
+  /* kx such that the start point's x has conditional sigma 1 at T = 1;
+  ** the end point's sigma follows from its own basis column (equal by
+  ** the symmetry of the Gauss nodes, but computed, not assumed). */
+  double k0 = basis_dot(&sc.quad, 0, 0), k1 = basis_dot(&sc.quad, 2, 2);
+  w.kx = 1.0 / k0;
+  w.ky = d == 1 ? 0.0 : w.kx;
+  double sig0 = 1.0, sig1 = sqrt(k0 / k1);
+  double s = ratio * sig0;
+  /* half the proposals pick a start point, half an end point */
+  double a = 0.5 * (acceptance_exact(d, sig0, s) + acceptance_exact(d, sig1, s));
+
+  lw_model *m = lw_model_new(&sc, unit_splines(n_spl, &w), NULL);
+  cr_assert_not_null(m);
+  lw_chain *c = point_chain(m, s, seed);
+  split_chain(c, domains, threads);
+  for (int k = 0; k < 50; k++) lw_chain_sweep(c); /* reach stationarity */
+  cr_assert_eq(c->step[LW_MOVE_POINT], s, "tuning is off: the step must not move");
+
+  /* Batch means: successive proposals are correlated through the state,
+  ** so the standard error of the rate comes from the scatter of B batch
+  ** rates (batches of N/B = 4000+ proposals, ~40 per node, far longer
+  ** than the correlation time of a node's acceptance), floored at the
+  ** binomial value sqrt(a (1 - a) / N) that independent draws would give.
+  ** Whole sweeps, as a run makes them: every node in order, forward or
+  ** backward (mc.h), so the rate is that of the sweep order in use.  With
+  ** domains a sweep proposes fewer moves (a spline on a domain boundary
+  ** waits for the next sweep), so batches count proposals, and a move
+  ** rejected for leaving its domain is not one of the Metropolis kernel's
+  ** (docs/NUMERICS.md, "Domains"). */
+  double sum = 0.0, sum2 = 0.0;
+  long per = N / B, acc_all = 0, prop_all = 0;
+  for (int b = 0; b < B; b++) {
+    unsigned long acc0 = c->stats[LW_MOVE_POINT].accepted, prop0 = c->stats[LW_MOVE_POINT].proposed - c->outside;
+    long prop = 0;
+    while (prop < per) {
+      cr_assert_eq(lw_chain_sweep(c), LW_OK);
+      prop = (long)(c->stats[LW_MOVE_POINT].proposed - c->outside - prop0);
+    }
+    long acc = (long)(c->stats[LW_MOVE_POINT].accepted - acc0);
+    double rb = (double)acc / (double)prop;
+    sum += rb;
+    sum2 += rb * rb;
+    acc_all += acc;
+    prop_all += prop;
+  }
+  double rate = (double)acc_all / (double)prop_all;
+  double var_b = (sum2 - sum * sum / B) / (B - 1);
+  double se = fmax(sqrt(var_b / B), sqrt(a * (1.0 - a) / (double)prop_all));
+  cr_log_info("acceptance d=%d s/sigma=%.1f domains %s threads %d: %.5f exact %.5f se %.1e (outside %lu)", d, ratio,
+              domains ? domains : "off", threads, rate, a, se, c->outside);
+  /* 5 standard errors: a false failure has probability ~ 6e-7 */
+  cr_assert(fabs(rate - a) <= 5.0 * se,
+            "d=%d s/sigma=%.2f domains %s threads %d: acceptance %.5f, exact %.5f, standard error %.2g", d, ratio,
+            domains ? domains : "off", threads, rate, a, se);
+  cr_assert_eq(c->stats[LW_MOVE_POINT].nan, 0);
+  model_chain_free(c);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
 Test(stats, point_move_acceptance_matches_the_gaussian_closed_forms)
 {
-  const int longrun = lw_test_long();
-  const size_t n_spl = 50;
-  const long N = longrun ? 4000000 : 200000; /* proposals per step size */
-  const int B = 50;                            /* batches for the error estimate */
+  const long N = lw_test_long() ? 4000000 : 200000; /* proposals per step size */
   const double ratios[] = {0.3, 1.0, 2.4, 6.0}; /* s / sigma of the start points */
   for (int d = 1; d <= 2; d++)
-    for (size_t r = 0; r < sizeof ratios / sizeof ratios[0]; r++) {
-      lw_scene sc;
-      well w = {1.0, 0.0, 100.0, 100.0};
-      well_scene(&sc, &w);
-      /* kx such that the start point's x has conditional sigma 1 at T = 1;
-      ** the end point's sigma follows from its own basis column (equal by
-      ** the symmetry of the Gauss nodes, but computed, not assumed). */
-      double k0 = basis_dot(&sc.quad, 0, 0), k1 = basis_dot(&sc.quad, 2, 2);
-      w.kx = 1.0 / k0;
-      w.ky = d == 1 ? 0.0 : w.kx;
-      double sig0 = 1.0, sig1 = sqrt(k0 / k1);
-      double s = ratios[r] * sig0;
-      /* half the proposals pick a start point, half an end point */
-      double a = 0.5 * (acceptance_exact(d, sig0, s) + acceptance_exact(d, sig1, s));
+    for (size_t r = 0; r < sizeof ratios / sizeof ratios[0]; r++)
+      acceptance_case(d, ratios[r], 1000 + 10 * (unsigned long)d + r, N, 0.0, NULL, 1);
+}
 
-      lw_model *m = lw_model_new(&sc, unit_splines(n_spl, w.cx, w.cy), NULL);
-      cr_assert_not_null(m);
-      lw_chain *c = point_chain(m, s, 1000 + 10 * (unsigned long)d + r);
-      for (int k = 0; k < 50; k++) lw_chain_sweep(c); /* reach stationarity */
-      cr_assert_eq(c->step[LW_MOVE_POINT], s, "tuning is off: the step must not move");
-
-      /* Batch means: successive proposals are correlated through the state,
-      ** so the standard error of the rate comes from the scatter of B batch
-      ** rates (batches of N/B = 4000+ proposals, ~40 per node, far longer
-      ** than the correlation time of a node's acceptance), floored at the
-      ** binomial value sqrt(a (1 - a) / N) that independent draws would give.
-      ** Whole sweeps, as a run makes them: every node in order, forward or
-      ** backward (mc.h), so the rate is that of the sweep order in use. */
-      double sum = 0.0, sum2 = 0.0;
-      long per = N / B, acc_all = 0;
-      const long nodes = (long)m->sp->n_nodes;
-      per = (per + nodes - 1) / nodes * nodes;
-      for (int b = 0; b < B; b++) {
-        unsigned long acc0 = c->stats[LW_MOVE_POINT].accepted;
-        for (long k = 0; k < per / nodes; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
-        long acc = (long)(c->stats[LW_MOVE_POINT].accepted - acc0);
-        double rb = (double)acc / (double)per;
-        sum += rb;
-        sum2 += rb * rb;
-        acc_all += acc;
-      }
-      double rate = (double)acc_all / (double)(per * B);
-      double var_b = (sum2 - sum * sum / B) / (B - 1);
-      double se = fmax(sqrt(var_b / B), sqrt(a * (1.0 - a) / (double)(per * B)));
-      cr_log_info("acceptance d=%d s/sigma=%.1f: %.5f exact %.5f se %.1e", d, ratios[r], rate, a, se);
-      /* 5 standard errors: a false failure has probability ~ 6e-7 */
-      cr_assert(fabs(rate - a) <= 5.0 * se,
-                "d=%d s/sigma=%.2f: acceptance %.5f, exact %.5f, standard error %.2g", d, ratios[r],
-                rate, a, se);
-      cr_assert_eq(c->stats[LW_MOVE_POINT].nan, 0);
-      model_chain_free(c);
-      lw_model_free(m);
-      lw_scene_clear(&sc);
-    }
+/* The same with the sweeps split into domains, on 1, 2 and 4 threads: the
+** same seed gives the same chain on each, so the rate is checked on one and
+** the chains compared through it. */
+Test(stats, point_move_acceptance_with_domains_on_1_2_4_threads)
+{
+  const long N = lw_test_long() ? 4000000 : 200000;
+  const double ratios[] = {1.0, 2.4};
+  const int threads[] = {1, 2, 4};
+  for (size_t r = 0; r < sizeof ratios / sizeof ratios[0]; r++)
+    for (int k = 0; k < 3; k++) acceptance_case(2, ratios[r], 2000 + r, N, DOMAIN_PERIOD, "2", threads[k]);
 }
 
 /* ---- 2. the Boltzmann distribution (chi-square) -------------------------- */
@@ -231,16 +293,20 @@ static double gaussian_chisq_p(const double *x, size_t n, double mu, double sd, 
 ** where e_q carries the fixed vectors.  So p0.x is exactly Gaussian with
 ** variance (T / kx) (M^-1)_00 = (T / kx) M_11 / det M.
 */
-Test(stats, sampled_coordinates_follow_the_boltzmann_distribution)
+/* The chi-square test on wells of the given period (p0.x of spline j is
+** recorded from its own well's centre), the sweeps split by `domains` on
+** `threads` threads. */
+static void boltzmann_case(double period, const char *domains, int threads)
 {
   const int longrun = lw_test_long();
   const size_t n_spl = 50, n_keep = longrun ? 4000 : 400; /* records of every spline */
   const double T = 0.7;
-  well w = {2.0, 2.0, 60.0, 40.0};
+  well w = {2.0, 2.0, period > 0.0 ? 20.0 : 60.0, period > 0.0 ? 20.0 : 40.0, period};
   lw_scene sc;
   well_scene(&sc, &w);
-  lw_model *m = lw_model_new(&sc, unit_splines(n_spl, w.cx, w.cy), NULL);
+  lw_model *m = lw_model_new(&sc, unit_splines(n_spl, &w), NULL);
   lw_chain *c = point_chain(m, 3.0, 4242);
+  split_chain(c, domains, threads);
   c->temperature = T;
 
   const lw_quad *q = &sc.quad;
@@ -266,7 +332,7 @@ Test(stats, sampled_coordinates_follow_the_boltzmann_distribution)
   double *x = malloc(n_spl * (n_pilot > n_keep ? n_pilot : n_keep) * sizeof *x);
   for (size_t t = 0; t < n_pilot; t++) {
     lw_chain_sweep(c);
-    for (size_t j = 0; j < n_spl; j++) x[j * n_pilot + t] = m->sp->node[m->sp->first[j]].px;
+    for (size_t j = 0; j < n_spl; j++) x[j * n_pilot + t] = m->sp->node[m->sp->first[j]].px - period * (double)(j % 8);
   }
   double tau = autocorrelation_time(x, n_spl, n_pilot);
   cr_assert(tau > 0.5 && tau < 50, "autocorrelation time %.2f sweeps is implausible", tau);
@@ -275,7 +341,7 @@ Test(stats, sampled_coordinates_follow_the_boltzmann_distribution)
   long thin = (long)ceil(3.0 * tau);
   for (size_t t = 0; t < n_keep; t++) {
     for (long k = 0; k < thin; k++) lw_chain_sweep(c);
-    for (size_t j = 0; j < n_spl; j++) x[t * n_spl + j] = m->sp->node[m->sp->first[j]].px;
+    for (size_t j = 0; j < n_spl; j++) x[t * n_spl + j] = m->sp->node[m->sp->first[j]].px - period * (double)(j % 8);
   }
   cr_assert_eq(c->step[LW_MOVE_POINT], step, "frozen step moved");
   size_t n = n_keep * n_spl;
@@ -285,8 +351,8 @@ Test(stats, sampled_coordinates_follow_the_boltzmann_distribution)
   double p_wrong_t = gaussian_chisq_p(x, n, mu, sd * sqrt(1.1), 20);
   /* and against a mean off by 0.05 standard deviations */
   double p_wrong_mu = gaussian_chisq_p(x, n, mu + 0.05 * sd, sd, 20);
-  cr_log_info("chi-square: tau %.2f sweeps, thin %ld, %zu samples: p %.3g, wrong T p %.3g, wrong mean p %.3g",
-              tau, thin, n, p, p_wrong_t, p_wrong_mu);
+  cr_log_info("chi-square (domains %s, %d threads): tau %.2f sweeps, thin %ld, %zu samples: p %.3g, wrong T p %.3g, "
+              "wrong mean p %.3g", domains ? domains : "off", threads, tau, thin, n, p, p_wrong_t, p_wrong_mu);
   cr_assert(p > 1e-3, "p0.x does not follow its Boltzmann distribution: p = %.3g", p);
   cr_assert(p_wrong_t < 1e-3, "the test cannot tell T from 1.1 T: p = %.3g", p_wrong_t);
   cr_assert(p_wrong_mu < 1e-3, "the test cannot see a 0.05 sd shift: p = %.3g", p_wrong_mu);
@@ -294,6 +360,19 @@ Test(stats, sampled_coordinates_follow_the_boltzmann_distribution)
   model_chain_free(c);
   lw_model_free(m);
   lw_scene_clear(&sc);
+}
+
+Test(stats, sampled_coordinates_follow_the_boltzmann_distribution)
+{
+  boltzmann_case(0.0, NULL, 1);
+}
+
+/* Split into domains, each phase a product of Metropolis kernels on
+** disjoint domains (docs/NUMERICS.md, "Domains"), on 1, 2 and 4 threads. */
+Test(stats, sampled_coordinates_follow_the_boltzmann_distribution_with_domains)
+{
+  const int threads[] = {1, 2, 4};
+  for (int k = 0; k < 3; k++) boltzmann_case(DOMAIN_PERIOD, "2", threads[k]);
 }
 
 /* ---- 3. the worm-like chain ----------------------------------------------- */

@@ -33,6 +33,8 @@ typedef struct {
 ** small enough that rare rigid moves get tuned within a few sweeps. */
 #define LW_TUNE_WINDOW 25
 
+struct lw_domains;
+
 typedef struct {
   lw_system *sys;                /* not owned; tempering swaps them between chains */
   void *prop;                    /* owned scratch of sys's type */
@@ -46,6 +48,9 @@ typedef struct {
   int tuning;
   unsigned long win_prop[LW_MOVES_MAX], win_acc[LW_MOVES_MAX]; /* tuning window */
   lw_move_stats stats[LW_MOVES_MAX]; /* since the start of the run */
+  struct lw_domains *domains;    /* owned; not NULL: sweeps are split into domains (domains.h) */
+  int part;                      /* 1 for a domain's chain: commits through commit_part */
+  unsigned long outside;         /* proposals rejected for leaving their domain (not saved) */
 } lw_chain;
 
 /* A chain on sys with the mix, steps and targets of its n_moves kinds (mix
@@ -62,13 +67,24 @@ int lw_chain_step(lw_chain *c, int kind);
 ** without it draws its own site. */
 int lw_chain_step_at(lw_chain *c, int kind, size_t site);
 
+/* A domain's chain (domains.h): one proposal at `site` of a kind drawn
+** from the mix, rejected if what it moves leaves box (x0, y0, x1, y1);
+** returns as lw_chain_step. */
+int lw_chain_visit_in(lw_chain *c, size_t site, const double box[4]);
+
+/* Adds the statistics of a domain's chain `from` to c's and clears them;
+** while c tunes, they fill c's tuning windows as c's own proposals would,
+** one step update per full window at most. */
+void lw_chain_absorb(lw_chain *c, lw_chain *from);
+
 /* One sweep: sweep_size proposals with kinds drawn from the mix.  A row with
 ** propose_at has every site visited once, in order, forward or backward
 ** (one draw per sweep); each visit is a Metropolis update that leaves the
 ** Boltzmann distribution stationary, and the two directions, equally
 ** likely, make the sweep reversible (docs/NUMERICS.md, "Sweep order").  A
-** row without it draws each proposal's site at random.  LW_ENOMEM if a
-** commit could not grow the system's caches. */
+** row without it draws each proposal's site at random.  A chain with
+** domains sweeps them instead (domains.h).  LW_ENOMEM if a commit could
+** not grow the system's caches. */
 lw_status lw_chain_sweep(lw_chain *c);
 
 /* A generator's state as hex text (malloc'ed) and back, for checkpoints;

@@ -129,6 +129,12 @@ typedef struct {
   lw_tone_box box[LW_TERM_COUNT]; /* each raster term's changes */
   int raster_done;            /* 1 if the raster terms were evaluated */
   int crowded;                /* 1 if refused by the spacing constraint */
+  /* Changes of the running totals committed through this scratch and not
+  ** yet merged into the model (lw_model_commit_part); -0.0 when none, the
+  ** identity of +, so a merged single commit adds exactly dterm. */
+  double sum_term[LW_TERM_COUNT];
+  long sum_irregular;
+  int sum_stale;              /* a raster term's change is unknown: refresh on merge */
 } lw_proposal;
 
 lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err);
@@ -143,7 +149,16 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
                       size_t n_node, const lw_node *nodes);
 
 /* Applies an evaluated proposal.  LW_ENOMEM if the grid could not grow. */
-lw_status lw_model_commit(lw_model *m, const lw_proposal *p);
+lw_status lw_model_commit(lw_model *m, lw_proposal *p);
+
+/* The same in two halves, for moves made in parallel in disjoint domains
+** (domains.h): commit_part changes the state and its caches but keeps the
+** changes of the running totals in p; merge adds them to the model's (a
+** full refresh when a total is no longer finite, as lw_model_commit does)
+** and clears them.  commit = commit_part then merge.  Merging the domains'
+** scratches in a fixed order keeps the totals independent of the threads. */
+lw_status lw_model_commit_part(lw_model *m, lw_proposal *p);
+lw_status lw_model_merge(lw_model *m, lw_proposal *p);
 
 /* 1 if the segment from a to b, of quadrature length `length`, is regular
 ** for the scene: its speed never falls below scene->min_speed times its

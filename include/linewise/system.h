@@ -104,6 +104,24 @@ struct lw_system_type {
   double (*propose_at)(void *state, void *prop, int kind, size_t site, double step, gsl_rng *rng,
                        int *forbidden);
   lw_status (*commit)(void *state, void *prop);
+  /* Optional (NULL: a sweep is never split; domains.h, [anneal] domains):
+  ** domain decomposition within a replica.  split() gives the page
+  ** (x0, y0, x1, y1) and the reach of a move, the distance beyond the
+  ** bounding box of what it moves (old and new) within which it reads or
+  ** writes anything (pair cutoff cells, a raster's footprint), or returns why
+  ** the scene cannot be split (a term that is not local).  group() gives
+  ** the box of the sites that move together from `site` on (for splines
+  ** the node's spline) and their count.  propose_in() is propose_at()
+  ** rejecting (dE = +inf, *forbidden = 2) a move whose box leaves `box`;
+  ** commit_part() commits keeping the running totals' changes in prop,
+  ** merge() adds them to the state's.  Moves in disjoint domains, more than
+  ** twice the reach apart, may then run in parallel, each with its own prop. */
+  const char *(*split)(const void *state, double page[4], double *reach);
+  size_t (*group)(const void *state, size_t site, double box[4]);
+  double (*propose_in)(void *state, void *prop, int kind, size_t site, double step, gsl_rng *rng,
+                       int *forbidden, const double box[4]);
+  lw_status (*commit_part)(void *state, void *prop);
+  lw_status (*merge)(void *state, void *prop);
   /* Optional (NULL: the numbering never changes): renumbers the state's
   ** sites for locality in memory, as a function of the state alone, so that
   ** a resumed run does the same.  The run loop calls it between sweeps,

@@ -1,0 +1,252 @@
+/*
+** domains.c -- checkerboard domain decomposition of a sweep (domains.h).
+*/
+#include "linewise/domains.h"
+
+#include <errno.h>
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define DOMAINS_MAX 1024 /* per side: far more than cores, far fewer than splines */
+
+void lw_domains_free(lw_domains *d)
+{
+  if (!d) return;
+  for (int k = 0; d->cell && k < d->n; k++) lw_chain_free(d->cell[k]);
+  free(d->cell);
+  free(d->cell_of);
+  free(d->site);
+  free(d->start);
+  free(d->active);
+  free(d->seed);
+  free(d);
+}
+
+/* A chain like c for one cell: the same system, mix and targets, its own
+** scratch and stream, committing into the scratch; never tuning itself
+** (its statistics fill c's windows, lw_chain_absorb). */
+static lw_chain *cell_chain(const lw_chain *c, lw_error *err)
+{
+  lw_chain *dc = calloc(1, sizeof *dc);
+  if (!dc) return NULL;
+  *dc = *c;
+  dc->domains = NULL;
+  dc->prop = NULL;
+  dc->rng = NULL;
+  dc->part = 1;
+  dc->tuning = 0;
+  dc->outside = 0;
+  memset(dc->stats, 0, sizeof dc->stats);
+  memset(dc->win_prop, 0, sizeof dc->win_prop);
+  memset(dc->win_acc, 0, sizeof dc->win_acc);
+  dc->prop = c->sys->type->proposal_new(c->sys->state, err);
+  dc->rng = gsl_rng_alloc(gsl_rng_mt19937);
+  if (!dc->prop || !dc->rng) {
+    lw_chain_free(dc);
+    return NULL;
+  }
+  return dc;
+}
+
+static lw_status bad_key(const lw_params *p, lw_error *err, const char *fmt, const char *what)
+{
+  lw_error_set(err, LW_EINPUT, fmt, p->domains, what);
+  return lw_params_blame(p, "anneal", "domains", err);
+}
+
+lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_error *err)
+{
+  const lw_system_type *t = c->sys->type;
+  if (!strcmp(p->domains, "off")) return LW_OK;
+  long side = 0;
+  int is_auto = !strcmp(p->domains, "auto");
+  if (!is_auto) {
+    char *end;
+    errno = 0;
+    side = strtol(p->domains, &end, 10);
+    if (errno || end == p->domains || *end || side < 1 || side > DOMAINS_MAX)
+      return bad_key(p, err, "'%s': expected off, auto or a count of domains per side from 1 to 1024%s", "");
+  }
+  if (!t->split || !t->group || !t->propose_in || !t->commit_part || !t->merge)
+    return bad_key(p, err, "'%s': the system '%s' cannot split its sweeps into domains; expected off", t->name);
+  double page[4], reach;
+  const char *why = t->split(c->sys->state, page, &reach);
+  if (why) return bad_key(p, err, "'%s': this scene cannot be split into domains (%s); expected off", why);
+  double w = page[2] - page[0], h = page[3] - page[1];
+  int nx, ny;
+  if (is_auto) {
+    /* Wider than twice the reach with room to spare, and wide against a
+    ** spline, so few sit on a boundary (those are not moved that sweep);
+    ** from the parameters alone, so a resumed run splits the same way. */
+    double l = fmax(2.5 * reach, 16.0 * p->segments * p->segment_length);
+    nx = (int)fmin(floor(w / l), DOMAINS_MAX);
+    ny = (int)fmin(floor(h / l), DOMAINS_MAX);
+    if (nx < 2 || ny < 2) return LW_OK; /* nothing to gain: sweeps stay serial */
+  } else {
+    nx = ny = (int)side;
+    if (!(w / nx > 2.0 * reach) || !(h / ny > 2.0 * reach)) {
+      char what[160];
+      snprintf(what, sizeof what, " (domains %.4g x %.4g mm against a reach of %.4g mm)", w / nx, h / ny, reach);
+      return bad_key(p, err, "'%s': domains must be wider than twice the reach of a move%s; expected fewer", what);
+    }
+  }
+  lw_domains *d = calloc(1, sizeof *d);
+  if (!d) goto nomem;
+  d->nx = nx;
+  d->ny = ny;
+  d->n = (nx + 1) * (ny + 1);
+  memcpy(d->page, page, sizeof page);
+  d->lx = w / nx;
+  d->ly = h / ny;
+  d->reach = reach;
+  /* threads go to the replicas first (anneal.c), the rest to each one's cells */
+  d->threads = omp_get_max_threads() / (replicas > 0 ? replicas : 1);
+  if (d->threads < 1) d->threads = 1;
+  if (replicas > 1 && d->threads > 1 && omp_get_max_active_levels() < 2) omp_set_max_active_levels(2);
+  d->cell = calloc((size_t)d->n, sizeof *d->cell);
+  d->start = calloc((size_t)d->n + 1, sizeof *d->start);
+  d->active = calloc((size_t)d->n, sizeof *d->active);
+  d->seed = calloc((size_t)d->n, sizeof *d->seed);
+  if (!d->cell || !d->start || !d->active || !d->seed) goto nomem;
+  d->min_parallel = LW_DOMAINS_MIN_PARALLEL;
+  for (int k = 0; k < d->n; k++)
+    if (!(d->cell[k] = cell_chain(c, err))) goto nomem;
+  c->domains = d;
+  return LW_OK;
+nomem:
+  lw_domains_free(d);
+  return lw_error_set(err, LW_ENOMEM, "out of memory for %d domains", (nx + 1) * (ny + 1));
+}
+
+/* The cell along one axis holding coordinate v for the lattice shifted by o:
+** 0 below lo + o, n from lo + o + (n - 1) l on. */
+static int axis_cell(double v, double lo, double o, double l, int n)
+{
+  double u = floor((v - lo - o) / l) + 1.0;
+  if (!(u > 0.0)) return 0;
+  return u >= (double)n ? n : (int)u;
+}
+
+static void axis_bounds(int i, double lo, double o, double l, int n, double *a, double *b)
+{
+  *a = i == 0 ? -INFINITY : lo + o + (i - 1) * l;
+  *b = i == n ? INFINITY : lo + o + i * l;
+}
+
+static void cell_box(const lw_domains *d, int k, double ox, double oy, double box[4])
+{
+  int i = k % (d->nx + 1), j = k / (d->nx + 1);
+  axis_bounds(i, d->page[0], ox, d->lx, d->nx, &box[0], &box[2]);
+  axis_bounds(j, d->page[1], oy, d->ly, d->ny, &box[1], &box[3]);
+}
+
+/* The cell whose box holds b, or UINT32_MAX (on a boundary, or NaN). */
+static uint32_t cell_holding(const lw_domains *d, const double b[4], double ox, double oy)
+{
+  int i = axis_cell(b[0], d->page[0], ox, d->lx, d->nx), j = axis_cell(b[1], d->page[1], oy, d->ly, d->ny);
+  int k = j * (d->nx + 1) + i;
+  double box[4];
+  cell_box(d, k, ox, oy, box);
+  /* the test propose_in makes: a group held here stays held by its moves */
+  if (!(b[0] >= box[0] && b[1] >= box[1] && b[2] <= box[2] && b[3] <= box[3])) return UINT32_MAX;
+  return (uint32_t)k;
+}
+
+/* Sorts the sites into their cells, storage order kept within each. */
+static lw_status assign(lw_domains *d, const lw_chain *c, size_t n, double ox, double oy)
+{
+  const lw_system_type *t = c->sys->type;
+  const void *state = c->sys->state;
+  if (n > d->cap) {
+    uint32_t *co = realloc(d->cell_of, n * sizeof *co);
+    if (co) d->cell_of = co;
+    size_t *st = realloc(d->site, n * sizeof *st);
+    if (st) d->site = st;
+    if (!co || !st) return LW_ENOMEM;
+    d->cap = n;
+  }
+  memset(d->start, 0, ((size_t)d->n + 1) * sizeof *d->start);
+  for (size_t s = 0; s < n;) {
+    double b[4];
+    size_t g = t->group(state, s, b);
+    if (g == 0 || g > n - s) g = n - s; /* a row's bug must not hang the sweep */
+    uint32_t k = cell_holding(d, b, ox, oy);
+    for (size_t q = 0; q < g; q++) d->cell_of[s + q] = k;
+    if (k != UINT32_MAX) d->start[k + 1] += g;
+    else d->frozen += g;
+    s += g;
+  }
+  for (int k = 0; k < d->n; k++) d->start[k + 1] += d->start[k];
+  /* start[k] is cell k's next free slot while filling, then restored */
+  for (size_t s = 0; s < n; s++)
+    if (d->cell_of[s] != UINT32_MAX) d->site[d->start[d->cell_of[s]]++] = s;
+  for (int k = d->n; k > 0; k--) d->start[k] = d->start[k - 1];
+  d->start[0] = 0;
+  d->visits += n;
+  return LW_OK;
+}
+
+/* One cell's sites through its chain; 0, or -1 when a commit ran out of memory. */
+static int sweep_cell(const lw_domains *d, int k, int backward, double ox, double oy)
+{
+  lw_chain *dc = d->cell[k];
+  /* seeded here, by whichever thread runs the cell: only cells with sites
+  ** pay for it */
+  gsl_rng_set(dc->rng, d->seed[k]);
+  double box[4];
+  cell_box(d, k, ox, oy, box);
+  const size_t s0 = d->start[k], s1 = d->start[k + 1];
+  for (size_t q = 0; q < s1 - s0; q++)
+    if (lw_chain_visit_in(dc, d->site[backward ? s1 - 1 - q : s0 + q], box) < 0) return -1;
+  return 0;
+}
+
+lw_status lw_domains_sweep(lw_domains *d, lw_chain *c)
+{
+  const lw_system_type *t = c->sys->type;
+  void *state = c->sys->state;
+  size_t n = t->sweep_size(state);
+  if (n == 0) return LW_OK;
+  /* Everything random about the sweep's plan comes from the chain's
+  ** stream, in this order; each cell's moves from its own stream. */
+  double ox = gsl_rng_uniform(c->rng) * d->lx, oy = gsl_rng_uniform(c->rng) * d->ly;
+  int backward = gsl_rng_uniform(c->rng) < 0.5;
+  for (int k = 0; k < d->n; k++) {
+    lw_chain *dc = d->cell[k];
+    d->seed[k] = gsl_rng_get(c->rng);
+    /* tempering swaps systems between chains, and the run loop sets the
+    ** temperature and tunes the steps: the cells follow their chain */
+    dc->sys = c->sys;
+    dc->temperature = c->temperature;
+    memcpy(dc->step, c->step, sizeof dc->step);
+  }
+  if (assign(d, c, n, ox, oy) != LW_OK) return LW_ENOMEM;
+  lw_status st = LW_OK;
+  for (int ph = 0; ph < 4 && st == LW_OK; ph++) {
+    const int colour = backward ? 3 - ph : ph;
+    int n_act = 0;
+    for (int k = 0; k < d->n; k++) {
+      int i = k % (d->nx + 1), j = k / (d->nx + 1);
+      if ((i & 1) + 2 * (j & 1) == colour && d->start[k + 1] > d->start[k]) d->active[n_act++] = k;
+    }
+    int failed = 0;
+    size_t work = 0;
+    for (int a = 0; a < n_act; a++) work += d->start[d->active[a] + 1] - d->start[d->active[a]];
+    /* Cells of one phase touch disjoint data (domains.h): any thread may
+    ** run any cell, in any order. */
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed) num_threads(d->threads) \
+    if (n_act > 1 && d->threads > 1 && work >= d->min_parallel)
+    for (int a = 0; a < n_act; a++)
+      if (sweep_cell(d, d->active[a], backward, ox, oy) < 0) failed = 1;
+    /* in cell order, whatever ran where */
+    for (int a = 0; a < n_act; a++) {
+      lw_chain *dc = d->cell[d->active[a]];
+      if (t->merge(state, dc->prop) != LW_OK) st = LW_ENOMEM;
+      lw_chain_absorb(c, dc);
+    }
+    if (failed) st = LW_ENOMEM;
+  }
+  return st;
+}

@@ -1,0 +1,182 @@
+/*
+** test_domains.c -- sweeps split into domains (domains.h): the same result
+** for any thread count, with tempering too; bit-exact resume; running
+** totals equal to the energy from scratch; bad values of the key refused.
+** The statistical tests with domains on are in test_stats.c.
+*/
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "linewise/anneal.h"
+#include "linewise/domains.h"
+#include "linewise/sys_splines.h"
+#include "testutil.h"
+
+#define sh lw_test_sh
+
+/* Every kind of term a split must respect: segment terms, spline terms,
+** the pair term with its spacing constraint (grid cells), the tone raster
+** (footprints); 300 mm split 3 x 3 (100 mm domains, reach about 8 mm). */
+static void write_scene(const char *dir, const char *extra)
+{
+  char path[128];
+  snprintf(path, sizeof path, "%s/s.ini", dir);
+  FILE *f = fopen(path, "w");
+  cr_assert_not_null(f);
+  fprintf(f,
+          "[scene]\nwidth = 300\nheight = 300\nmargin = 5\nimage = %s/params/picture.png\nimage_width = 120\n"
+          "potential = radial\nfield = waves\n"
+          "[init]\nsplines = 400\nsegments = 3\nsegment_length = 4\n"
+          "[energy]\nstrain = 10\nbending = 1\npotential = 0.3\nfield = -0.3\npair = 0.01\npair_cutoff = 2\n"
+          "min_spacing = 0.2\ntone = 0.5\ntone_blur = 1\nboundary = 0.1\n"
+          "[anneal]\nschedule = geometric\nt_start = 0.3\nt_end = 0.01\nsweeps = 30\nsteps = 3\n"
+          "check_every = 7\ndomains = 3\n%s",
+          lw_test_root(), extra);
+  fclose(f);
+}
+
+static int same(const char *dir, const char *a, const char *b, const char *file)
+{
+  return sh("cmp -s %s/%s/%s %s/%s/%s", dir, a, file, dir, b, file) == 0;
+}
+
+Test(domains, same_result_on_1_2_and_4_threads_and_not_the_unsplit_one)
+{
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "domains"), 0);
+  write_scene(dir, "");
+  const char *b = lw_test_bin();
+  for (int t = 1; t <= 4; t *= 2)
+    cr_assert_eq(sh("%s run %s/s.ini --out %s/t%d --threads %d --quiet", b, dir, dir, t, t), 0);
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/off --set anneal.domains=off --quiet", b, dir, dir), 0);
+  const char *files[] = {"state.lw", "trace.csv", "final.svg"};
+  for (int i = 0; i < 3; i++) {
+    cr_assert(same(dir, "t1", "t2", files[i]), "%s differs between 1 and 2 threads", files[i]);
+    cr_assert(same(dir, "t1", "t4", files[i]), "%s differs between 1 and 4 threads", files[i]);
+  }
+  /* the key is read: a split run is another chain */
+  cr_assert(!same(dir, "t1", "off", "state.lw"), "domains = 3 changed nothing");
+  lw_test_dir_remove(dir);
+}
+
+Test(domains, tempering_replicas_then_domains_same_on_any_threads)
+{
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "domains_pt"), 0);
+  write_scene(dir, "[tempering]\nreplicas = 2\nt_min = 0.01\nt_max = 0.1\n");
+  const char *b = lw_test_bin();
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/t1 --threads 1 --quiet", b, dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/t4 --threads 4 --quiet", b, dir, dir), 0);
+  cr_assert(same(dir, "t1", "t4", "state.lw"), "state.lw differs between 1 and 4 threads");
+  cr_assert(same(dir, "t1", "t4", "trace.csv"), "trace.csv differs between 1 and 4 threads");
+  lw_test_dir_remove(dir);
+}
+
+Test(domains, resume_continues_bit_exactly)
+{
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "domains_resume"), 0);
+  write_scene(dir, "");
+  const char *b = lw_test_bin();
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/a --threads 2 --quiet", b, dir, dir), 0);
+  /* stopped mid-tuning and between drift checks, resumed on other thread counts */
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/b --threads 1 --quiet --stop-at 4", b, dir, dir), 0);
+  cr_assert_eq(sh("%s resume %s/b --threads 2 --quiet --stop-at 17", b, dir), 0);
+  cr_assert_eq(sh("%s resume %s/b --threads 4 --quiet", b, dir), 0);
+  const char *files[] = {"state.lw", "trace.csv", "final.svg"};
+  for (int i = 0; i < 3; i++) cr_assert(same(dir, "a", "b", files[i]), "%s differs after resume", files[i]);
+  lw_test_dir_remove(dir);
+}
+
+/* Regression for the split commits: the running totals are merged from the
+** domains' own sums, and must still equal the energy from scratch. */
+Test(domains, running_totals_equal_the_energy_from_scratch)
+{
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "domains_inc"), 0);
+  write_scene(dir, "");
+  lw_params p;
+  lw_error err;
+  char path[128];
+  snprintf(path, sizeof path, "%s/s.ini", dir);
+  cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
+  p.check_every = 1000000; /* no refresh between: the totals run on their own */
+  p.sweeps = 40;
+  lw_anneal a;
+  snprintf(path, sizeof path, "%s/run", dir);
+  cr_assert_eq(lw_anneal_start(&a, &p, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_not_null(a.chain->domains, "domains = 3 did not split");
+  unsigned long accepted = 0;
+  while (!lw_anneal_done(&a)) cr_assert_eq(lw_anneal_sweep(&a, &err), LW_OK, "%s", err.msg);
+  for (int k = 0; k < LW_MOVE_KINDS; k++) accepted += a.chain->stats[k].accepted;
+  const lw_model *m = lw_splines_model(a.sys);
+  cr_assert_gt(accepted, 10 * m->sp->n_nodes, "too few moves to test: %lu", accepted);
+  double term[LW_TERM_COUNT];
+  double full = lw_energy_compute(m->scene, m->sp, term, &err);
+  double run = lw_model_total(m);
+  cr_assert(isfinite(full), "%s", err.msg);
+  for (int t = 0; t < LW_TERM_COUNT; t++)
+    cr_assert(fabs(m->term[t] - term[t]) <= 1e-9 * fmax(fabs(full), 1.0), "term %s: running %.17g, scratch %.17g",
+              lw_term_names[t], m->term[t], term[t]);
+  cr_assert(fabs(run - full) <= 1e-9 * fmax(fabs(full), 1.0), "running %.17g, scratch %.17g", run, full);
+  /* and the split left some splines unmoved each sweep, but not most */
+  const lw_domains *d = a.chain->domains;
+  cr_assert(d->frozen < d->visits / 4, "%lu of %lu site visits frozen", d->frozen, d->visits);
+  lw_anneal_free(&a);
+  lw_test_dir_remove(dir);
+}
+
+/* One clear message naming the file, line and key, exit status 2, nothing written. */
+static void refused(const char *dir, const char *value, const char *system_extra, const char *expect)
+{
+  char extra[256];
+  snprintf(extra, sizeof extra, "%s", system_extra);
+  write_scene(dir, extra);
+  const char *b = lw_test_bin();
+  int st = sh("%s run %s/s.ini --out %s/bad --set anneal.domains=%s --quiet 2> %s/err.txt", b, dir, dir, value, dir);
+  cr_assert_eq(st, 2, "domains = %s: exit status %d", value, st);
+  cr_assert_eq(sh("grep -q \"key 'anneal.domains'\" %s/err.txt", dir), 0, "domains = %s: key not named", value);
+  cr_assert_eq(sh("grep -q -- '%s' %s/err.txt", expect, dir), 0, "domains = %s: expected '%s'", value, expect);
+  cr_assert_neq(sh("test -e %s/bad/state.lw", dir), 0, "domains = %s: a state was written", value);
+}
+
+Test(domains, bad_values_are_refused_naming_the_key)
+{
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "domains_bad"), 0);
+  refused(dir, "banana", "", "expected off, auto or a count");
+  refused(dir, "0", "", "expected off, auto or a count");
+  refused(dir, "3x", "", "expected off, auto or a count");
+  /* 300 mm in 40 domains is 7.5 mm, under twice the reach of the pair grid and tone */
+  refused(dir, "40", "", "wider than twice the reach");
+  lw_test_dir_remove(dir);
+}
+
+/* auto splits only where domains can be wide against a spline: not the
+** small scene, but a page 16 x 16 splines' arc wide at least twice over. */
+Test(domains, auto_splits_large_pages_only)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  strcpy(p.domains, "auto");
+  p.splines = 50;
+  lw_anneal a;
+  lw_error err;
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "domains_auto"), 0);
+  char path[128];
+  snprintf(path, sizeof path, "%s/small", dir);
+  cr_assert_eq(lw_anneal_start(&a, &p, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_null(a.chain->domains, "a 210 x 297 page of 40 mm splines was split");
+  lw_anneal_free(&a);
+  p.width = p.height = 2000; /* 16 x 4 x 10 mm = 640 mm: 3 domains a side */
+  snprintf(path, sizeof path, "%s/large", dir);
+  cr_assert_eq(lw_anneal_start(&a, &p, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_not_null(a.chain->domains, "a 2 m page was not split");
+  cr_assert_eq(a.chain->domains->nx, 3);
+  lw_anneal_free(&a);
+  lw_test_dir_remove(dir);
+}
