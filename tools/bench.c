@@ -43,6 +43,7 @@ void bench_near(bench_ctx *b);
 void bench_guide(bench_ctx *b);
 void bench_baseline(bench_ctx *b);
 void bench_tempering(bench_ctx *b);
+void bench_domains(bench_ctx *b);
 void bench_nurbs(bench_ctx *b);
 void bench_regularity(bench_ctx *b);
 void bench_regularity_cost(bench_ctx *b);
@@ -657,6 +658,7 @@ static const bench_section sections[] = {
     {"regularity_cost", BENCH_PERFORMANCE, bench_regularity_cost},
     {"baseline", BENCH_PERFORMANCE, bench_baseline},
     {"tempering", BENCH_PERFORMANCE, bench_tempering},
+    {"domains", BENCH_PERFORMANCE, bench_domains},
     {"particles", BENCH_PERFORMANCE, bench_particles},
     {"tone", BENCH_PERFORMANCE, bench_tone},
     {"nurbs", BENCH_PERFORMANCE, bench_nurbs},

@@ -1,0 +1,166 @@
+/*
+** bench-domains.c -- the domains section of the benchmark (`bench --only
+** domains`): wall-time speed-up of one replica whose sweeps are split into
+** domains (domains.h), against the same split run on one thread and the
+** unsplit sweep.
+**
+** The scaling section's 10^5-spline scene (lines 2.8 mm apart, every local
+** term, with and without the pair term) annealed at constant T by
+** lw_anneal with [anneal] domains = auto.  The thread count of a split run
+** changes nothing in its result, so one run is timed block by block with 1,
+** 2, 4 ... threads in turn (interleaved, so a change in the machine's load
+** hits them alike), and the unsplit run beside it; ratios are taken block by
+** block, then the median.  Wall time, since the point is the cores.
+*/
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "benchutil.h"
+#include "linewise/anneal.h"
+#include "linewise/domains.h"
+
+#define DOMAIN_SPLINES 100000
+#define MAX_THREADS 5 /* 1, 2, 4, 8, 16 */
+
+typedef struct {
+  lw_anneal a;
+  double setup_s;
+} dom_run;
+
+static void dom_start(dom_run *r, int pair, const char *domains, const char *dir)
+{
+  lw_params p;
+  lw_error err;
+  bench_random_params(&p, DOMAIN_SPLINES, pair, 2.8);
+  p.pair_near = 0.0;
+  /* as the scaling table: point and vector moves */
+  p.mix_point = p.mix_vector = 0.5;
+  p.mix_translate = p.mix_rotate = 0.0;
+  strcpy(p.schedule, "constant");
+  p.t_start = 0.05;
+  p.tune_sweeps = 1;
+  p.sweeps = 1000000;
+  p.checkpoint_every = 1000000;
+  p.trace_every = 1000000;
+  snprintf(p.domains, sizeof p.domains, "%s", domains);
+  double t0 = bench_now();
+  if (lw_anneal_start(&r->a, &p, dir, &err)) bench_die("domains", &err);
+  r->setup_s = bench_now() - t0;
+  /* the tuning sweep, untimed */
+  if (lw_anneal_sweep(&r->a, &err)) bench_die("domains", &err);
+}
+
+static unsigned long proposed(const lw_chain *c)
+{
+  unsigned long n = 0;
+  for (int k = 0; k < c->n_moves; k++) n += c->stats[k].proposed;
+  return n;
+}
+
+/* Wall ns per proposal made over whole sweeps lasting at least `seconds`;
+** *ms_sweep the wall ms per sweep. */
+static double dom_block(dom_run *r, int threads, double seconds, double *ms_sweep)
+{
+  lw_error err;
+  if (r->a.chain->domains) r->a.chain->domains->threads = threads;
+  unsigned long p0 = proposed(r->a.chain);
+  long sweeps = 0;
+  double t0 = bench_now(), t;
+  do {
+    if (lw_anneal_sweep(&r->a, &err)) bench_die("domains", &err);
+    sweeps++;
+  } while ((t = bench_now() - t0) < seconds);
+  *ms_sweep = 1e3 * t / (double)sweeps;
+  return 1e9 * t / (double)(proposed(r->a.chain) - p0);
+}
+
+static void domains_table(bench_ctx *b, int pair, const char *dir, FILE *data)
+{
+  FILE *d = b->doc[BENCH_PERFORMANCE];
+  int cores = (int)sysconf(_SC_NPROCESSORS_ONLN), n_th = 0, th[MAX_THREADS];
+  for (int t = 1; t <= 16 && n_th < MAX_THREADS; t *= 2)
+    if (t == 1 || t <= cores) th[n_th++] = t;
+  char sub[LW_PATH_MAX];
+  dom_run off, split;
+  bench_note("domains: %d splines, pair %s, unsplit", DOMAIN_SPLINES, pair ? "on" : "off");
+  snprintf(sub, sizeof sub, "%s/off-%d", dir, pair);
+  dom_start(&off, pair, "off", sub);
+  bench_note("domains: %d splines, pair %s, domains = auto", DOMAIN_SPLINES, pair ? "on" : "off");
+  snprintf(sub, sizeof sub, "%s/auto-%d", dir, pair);
+  dom_start(&split, pair, "auto", sub);
+  const lw_domains *dm = split.a.chain->domains;
+  if (!dm) {
+    lw_error err = {.code = LW_EINPUT};
+    snprintf(err.msg, sizeof err.msg, "domains = auto did not split the scene");
+    bench_die("domains", &err);
+  }
+  const int reps = b->reps;
+  double ns_off[BENCH_MAX_REPS], ms_off[BENCH_MAX_REPS];
+  double ns[MAX_THREADS][BENCH_MAX_REPS], ms[MAX_THREADS][BENCH_MAX_REPS];
+  for (int k = 0; k < reps; k++) {
+    ns_off[k] = dom_block(&off, 1, b->block, &ms_off[k]);
+    for (int i = 0; i < n_th; i++) ns[i][k] = dom_block(&split, th[i], b->block, &ms[i][k]);
+  }
+  double frozen = dm->visits ? (double)dm->frozen / (double)dm->visits : 0.0;
+  const lw_chain *c = split.a.chain;
+  double outside = (double)c->outside / (double)proposed(c);
+  fprintf(d, "%s: %d x %d domains of %.0f mm (reach %.1f mm), %.1f %% of site visits skipped (splines on a "
+             "boundary), %.2f %% of proposals rejected for leaving their domain; set-up %.1f s.\n\n",
+          pair ? "With the pair term (cutoff 4 mm, near field off)" : "Local terms only (the pair term off)",
+          dm->nx, dm->ny, dm->lx, dm->reach, 100.0 * frozen, 100.0 * outside, split.setup_s);
+  fprintf(d, "| sweep | threads | ms per sweep | wall ns per proposal | speed-up over 1 thread | "
+             "over the unsplit sweep |\n|---|---|---|---|---|---|\n");
+  double w[BENCH_MAX_REPS];
+  memcpy(w, ms_off, sizeof w);
+  double ms_o = bench_median(w, reps);
+  memcpy(w, ns_off, sizeof w);
+  fprintf(d, "| unsplit | 1 | %.0f | %.0f | | |\n", ms_o, bench_median(w, reps));
+  for (int i = 0; i < n_th; i++) {
+    double q1[BENCH_MAX_REPS], qo[BENCH_MAX_REPS];
+    for (int k = 0; k < reps; k++) {
+      q1[k] = ns[0][k] / ns[i][k];
+      qo[k] = ns_off[k] / ns[i][k];
+    }
+    memcpy(w, ms[i], sizeof w);
+    double msm = bench_median(w, reps);
+    memcpy(w, ns[i], sizeof w);
+    double nsm = bench_median(w, reps);
+    double s1 = bench_median(q1, reps), so = bench_median(qo, reps);
+    fprintf(d, "| domains = auto | %d | %.0f | %.0f | %.2f | %.2f |\n", th[i], msm, nsm, s1, so);
+    fprintf(data, "%d %d %.1f %.4f %.4f\n", pair, th[i], nsm, s1, so);
+  }
+  fprintf(d, "\n");
+  fprintf(data, "\n\n");
+  lw_anneal_free(&off.a);
+  lw_anneal_free(&split.a);
+}
+
+void bench_domains(bench_ctx *b)
+{
+  FILE *d = b->doc[BENCH_PERFORMANCE];
+  char dir[] = "/tmp/lw_bench_domains_XXXXXX";
+  if (!mkdtemp(dir)) {
+    lw_error err = {.code = LW_EIO};
+    snprintf(err.msg, sizeof err.msg, "cannot make a scratch directory");
+    bench_die("domains", &err);
+  }
+  fprintf(d, "## Domains: one replica on every core\n\n"
+             "The scaling section's scene at %d splines, annealed at constant T = 0.05 by lw_anneal with\n"
+             "`[anneal] domains = auto` (docs/NUMERICS.md, \"Domains\"): each sweep shifts the lattice of\n"
+             "domains at random and runs its four sub-lattices in turn, the domains of each in parallel.\n"
+             "The result does not depend on the threads, so one run is timed with 1, 2, 4 ... threads\n"
+             "in turn, block by block, beside the unsplit run (wall time, %d blocks of %.0f s or one\n"
+             "sweep). A split sweep skips the splines that sit on a domain boundary, so the figure of\n"
+             "merit is wall time per proposal made; ms per sweep is the sweep's wall time.\n\n",
+          DOMAIN_SPLINES, b->reps, b->block);
+  FILE *f = bench_data(b, "domains.dat");
+  domains_table(b, 0, dir, f);
+  domains_table(b, 1, dir, f);
+  fclose(f);
+  char cmd[96];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+  if (system(cmd) != 0) bench_note("domains: could not remove %s", dir);
+}
