@@ -216,11 +216,10 @@ lw_status lw_domains_sweep(lw_domains *d, lw_chain *c)
   for (int k = 0; k < d->n; k++) {
     lw_chain *dc = d->cell[k];
     d->seed[k] = gsl_rng_get(c->rng);
-    /* tempering swaps systems between chains, and the run loop sets the
-    ** temperature and tunes the steps: the cells follow their chain */
+    /* tempering swaps systems between chains and the run loop sets the
+    ** temperature: the cells follow their chain */
     dc->sys = c->sys;
     dc->temperature = c->temperature;
-    memcpy(dc->step, c->step, sizeof dc->step);
   }
   if (assign(d, c, n, ox, oy) != LW_OK) return LW_ENOMEM;
   lw_status st = LW_OK;
@@ -231,6 +230,9 @@ lw_status lw_domains_sweep(lw_domains *d, lw_chain *c)
       int i = k % (d->nx + 1), j = k / (d->nx + 1);
       if ((i & 1) + 2 * (j & 1) == colour && d->start[k + 1] > d->start[k]) d->active[n_act++] = k;
     }
+    /* the steps as tuned after the last phase: a window must see the step
+    ** it tunes, or four updates a sweep on the same evidence overshoot */
+    for (int a = 0; a < n_act; a++) memcpy(d->cell[d->active[a]]->step, c->step, sizeof c->step);
     int failed = 0;
     size_t work = 0;
     for (int a = 0; a < n_act; a++) work += d->start[d->active[a] + 1] - d->start[d->active[a]];

@@ -44,6 +44,8 @@ typedef struct {
   double period; /* > 0: a well at every (cx, cy) + period (i, j), the nearest counts */
 } well;
 
+#define WELL_ROW 20 /* periodic wells: a page of WELL_ROW x WELL_ROW */
+
 /* The offset of v from the nearest well centre c + period k. */
 static double well_offset(double v, double c, double period)
 {
@@ -75,6 +77,7 @@ static void well_scene(lw_scene *sc, const well *w)
 {
   lw_params p;
   lw_params_defaults(&p);
+  if (w->period > 0.0) p.width = p.height = WELL_ROW * w->period; /* the wells of unit_splines */
   /* The closed forms below are those of an untruncated Gaussian: the
   ** regularity check would cut off the states where a point crosses over
   ** its neighbour (a fold), which these unit segments in a wide well reach
@@ -88,7 +91,7 @@ static void well_scene(lw_scene *sc, const well *w)
 }
 
 /* n one-segment straight splines of length 1 at the well's centre, or for
-** a periodic well one at each of its centres, rows of 8 from (cx, cy). */
+** a periodic well one at each of its centres, rows of WELL_ROW from (cx, cy). */
 static lw_splines *unit_splines(size_t n, const well *w)
 {
   size_t *segs = malloc(n * sizeof *segs);
@@ -97,7 +100,7 @@ static lw_splines *unit_splines(size_t n, const well *w)
   free(segs);
   cr_assert_not_null(sp);
   for (size_t i = 0; i < n; i++) {
-    double x = w->cx + w->period * (double)(i % 8), y = w->cy + w->period * (double)(i / 8);
+    double x = w->cx + w->period * (double)(i % WELL_ROW), y = w->cy + w->period * (double)(i / WELL_ROW);
     lw_test_straight(sp, i, x - 0.5, y, x + 0.5, y);
   }
   return sp;
@@ -118,10 +121,14 @@ static void split_chain(lw_chain *c, const char *domains, int threads)
   c->domains->min_parallel = 0; /* these sweeps are small: split them anyway */
 }
 
-/* The wells of the domain cases: 50 splines 24 mm apart, on the default
-** page split 2 x 2 (domains 105 x 148.5 mm, a 3 x 3 lattice once shifted):
-** the four sub-lattices hold 4, 2, 2 and 1 cells, so 4 threads have work. */
-#define DOMAIN_PERIOD 24.0
+/* The wells of the domain cases: 400 splines 480 mm apart on a page of 20
+** periods split 2 x 2 (many splines, so that a sweep is worth its threads) (a 3 x 3 lattice once shifted: the four sub-lattices
+** hold 4, 2, 2 and 1 cells, so 4 threads have work).  Wide domains against
+** the steps: a spline within a step of a boundary is rare (moves rejected
+** for leaving their domain are about 0.1 % of proposals), since those
+** proposals are left out of the acceptance, which biases it by about their
+** share times the difference in acceptance they would have had. */
+#define DOMAIN_PERIOD 480.0
 
 static lw_chain *point_chain(lw_model *m, double step, unsigned long seed)
 {
@@ -156,10 +163,10 @@ static double acceptance_exact(int d, double sigma, double s)
 static void acceptance_case(int d, double ratio, unsigned long seed, long N, double period, const char *domains,
                             int threads)
 {
-  const size_t n_spl = 50;
+  const size_t n_spl = period > 0.0 ? 400 : 50;
   const int B = 50; /* batches for the error estimate */
   lw_scene sc;
-  well w = {1.0, 0.0, period > 0.0 ? 20.0 : 100.0, period > 0.0 ? 20.0 : 100.0, period};
+  well w = {1.0, 0.0, period > 0.0 ? period / 2 : 100.0, period > 0.0 ? period / 2 : 100.0, period};
   well_scene(&sc, &w);
   /* kx such that the start point's x has conditional sigma 1 at T = 1;
   ** the end point's sigma follows from its own basis column (equal by
@@ -299,9 +306,11 @@ static double gaussian_chisq_p(const double *x, size_t n, double mu, double sd, 
 static void boltzmann_case(double period, const char *domains, int threads)
 {
   const int longrun = lw_test_long();
-  const size_t n_spl = 50, n_keep = longrun ? 4000 : 400; /* records of every spline */
+  /* records of every spline; with domains 8 times the splines for an eighth
+  ** of the sweeps, the same samples */
+  const size_t n_spl = period > 0.0 ? 400 : 50, n_keep = (longrun ? 4000 : 400) * 50 / n_spl;
   const double T = 0.7;
-  well w = {2.0, 2.0, period > 0.0 ? 20.0 : 60.0, period > 0.0 ? 20.0 : 40.0, period};
+  well w = {2.0, 2.0, period > 0.0 ? period / 2 : 60.0, period > 0.0 ? period / 2 : 40.0, period};
   lw_scene sc;
   well_scene(&sc, &w);
   lw_model *m = lw_model_new(&sc, unit_splines(n_spl, &w), NULL);
@@ -328,11 +337,11 @@ static void boltzmann_case(double period, const char *domains, int threads)
   double step = c->step[LW_MOVE_POINT];
 
   /* pilot run: the autocorrelation time of p0.x in sweeps */
-  const size_t n_pilot = 2000;
+  const size_t n_pilot = 2000 * 50 / n_spl;
   double *x = malloc(n_spl * (n_pilot > n_keep ? n_pilot : n_keep) * sizeof *x);
   for (size_t t = 0; t < n_pilot; t++) {
     lw_chain_sweep(c);
-    for (size_t j = 0; j < n_spl; j++) x[j * n_pilot + t] = m->sp->node[m->sp->first[j]].px - period * (double)(j % 8);
+    for (size_t j = 0; j < n_spl; j++) x[j * n_pilot + t] = m->sp->node[m->sp->first[j]].px - period * (double)(j % WELL_ROW);
   }
   double tau = autocorrelation_time(x, n_spl, n_pilot);
   cr_assert(tau > 0.5 && tau < 50, "autocorrelation time %.2f sweeps is implausible", tau);
@@ -341,7 +350,7 @@ static void boltzmann_case(double period, const char *domains, int threads)
   long thin = (long)ceil(3.0 * tau);
   for (size_t t = 0; t < n_keep; t++) {
     for (long k = 0; k < thin; k++) lw_chain_sweep(c);
-    for (size_t j = 0; j < n_spl; j++) x[t * n_spl + j] = m->sp->node[m->sp->first[j]].px - period * (double)(j % 8);
+    for (size_t j = 0; j < n_spl; j++) x[t * n_spl + j] = m->sp->node[m->sp->first[j]].px - period * (double)(j % WELL_ROW);
   }
   cr_assert_eq(c->step[LW_MOVE_POINT], step, "frozen step moved");
   size_t n = n_keep * n_spl;

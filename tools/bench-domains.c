@@ -152,7 +152,7 @@ void bench_domains(bench_ctx *b)
              "`[anneal] domains = auto` (docs/NUMERICS.md, \"Domains\"): each sweep shifts the lattice of\n"
              "domains at random and runs its four sub-lattices in turn, the domains of each in parallel.\n"
              "The result does not depend on the threads, so one run is timed with 1, 2, 4 ... threads\n"
-             "in turn, block by block, beside the unsplit run (wall time, %d blocks of %.0f s or one\n"
+             "in turn, block by block, beside the unsplit run (wall time, %d blocks of %.2g s or one\n"
              "sweep). A split sweep skips the splines that sit on a domain boundary, so the figure of\n"
              "merit is wall time per proposal made; ms per sweep is the sweep's wall time.\n\n",
           DOMAIN_SPLINES, b->reps, b->block);
