@@ -240,16 +240,20 @@ static uint32_t spline_near(const lw_splines *sp, uint32_t hint, size_t k)
   return spline_of_node(sp, k);
 }
 
-/* Builds in p->node the new nodes of a move of the kind at global node k
-** (a point or vector move) or on its spline (a rigid move); *node0 and
-** *n_node say which of the spline's nodes they replace. */
-static void build_move(const lw_splines *sp, lw_proposal *p, int kind, size_t at, uint32_t i, double st,
-                       gsl_rng *rng, size_t *node0, size_t *n_node)
+static void spline_box(const lw_splines *sp, uint32_t i, size_t node0, size_t n, const lw_node *nd, double b[4]);
+
+/* A proposal of the kind at global node k (a point or vector move) or on
+** its spline (a rigid move); with a box (domains.h), rejected (+inf,
+** *forbidden = 2) if the spline would leave it. */
+static double propose_on(const lw_model *m, lw_proposal *p, int kind, size_t at, uint32_t i, double st,
+                         gsl_rng *rng, int *forbidden, const double *box)
 {
+  const lw_splines *sp = m->sp;
+  size_t node0, n_node;
   lw_node *nd = p->node; /* proposals are built in place in the scratch */
   if (kind == LW_MOVE_POINT || kind == LW_MOVE_VECTOR) {
-    *node0 = at - sp->first[i];
-    *n_node = 1;
+    node0 = at - sp->first[i];
+    n_node = 1;
     nd[0] = sp->node[at];
     double dx = gsl_ran_gaussian_ziggurat(rng, st), dy = gsl_ran_gaussian_ziggurat(rng, st);
     if (kind == LW_MOVE_POINT) {
@@ -259,42 +263,43 @@ static void build_move(const lw_splines *sp, lw_proposal *p, int kind, size_t at
       nd[0].vx += dx;
       nd[0].vy += dy;
     }
-    return;
-  }
-  *node0 = 0;
-  *n_node = sp->first[i + 1] - sp->first[i];
-  const size_t n = *n_node;
-  const lw_node *src = &sp->node[sp->first[i]];
-  if (kind == LW_MOVE_TRANSLATE) {
-    double dx = gsl_ran_gaussian_ziggurat(rng, st), dy = gsl_ran_gaussian_ziggurat(rng, st);
-    for (size_t k = 0; k < n; k++) {
-      nd[k] = src[k];
-      nd[k].px += dx;
-      nd[k].py += dy;
+  } else {
+    node0 = 0;
+    n_node = sp->first[i + 1] - sp->first[i];
+    const lw_node *src = &sp->node[sp->first[i]];
+    if (kind == LW_MOVE_TRANSLATE) {
+      double dx = gsl_ran_gaussian_ziggurat(rng, st), dy = gsl_ran_gaussian_ziggurat(rng, st);
+      for (size_t k = 0; k < n_node; k++) {
+        nd[k] = src[k];
+        nd[k].px += dx;
+        nd[k].py += dy;
+      }
+    } else {
+      double a = gsl_ran_gaussian_ziggurat(rng, st), ca = cos(a), sa = sin(a);
+      double cx = 0.0, cy = 0.0;
+      for (size_t k = 0; k < n_node; k++) {
+        cx += src[k].px;
+        cy += src[k].py;
+      }
+      cx /= (double)n_node;
+      cy /= (double)n_node;
+      for (size_t k = 0; k < n_node; k++) {
+        double x = src[k].px - cx, y = src[k].py - cy;
+        nd[k] = (lw_node){cx + ca * x - sa * y, cy + sa * x + ca * y,
+                          ca * src[k].vx - sa * src[k].vy, sa * src[k].vx + ca * src[k].vy};
+      }
     }
-    return;
   }
-  double a = gsl_ran_gaussian_ziggurat(rng, st), ca = cos(a), sa = sin(a);
-  double cx = 0.0, cy = 0.0;
-  for (size_t k = 0; k < n; k++) {
-    cx += src[k].px;
-    cy += src[k].py;
+  if (box) {
+    double b[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+    spline_box(sp, i, node0, n_node, nd, b);
+    /* NaN fails every comparison: outside, so rejected */
+    if (!(b[0] >= box[0] && b[1] >= box[1] && b[2] <= box[2] && b[3] <= box[3])) {
+      p->spline = i;
+      *forbidden = 2;
+      return INFINITY;
+    }
   }
-  cx /= (double)n;
-  cy /= (double)n;
-  for (size_t k = 0; k < n; k++) {
-    double x = src[k].px - cx, y = src[k].py - cy;
-    nd[k] = (lw_node){cx + ca * x - sa * y, cy + sa * x + ca * y, ca * src[k].vx - sa * src[k].vy,
-                      sa * src[k].vx + ca * src[k].vy};
-  }
-}
-
-/* A proposal of the kind at global node k or on its spline. */
-static double propose_on(const lw_model *m, lw_proposal *p, int kind, size_t at, uint32_t i, double st,
-                         gsl_rng *rng, int *forbidden)
-{
-  size_t node0, n_node;
-  build_move(m->sp, p, kind, at, i, st, rng, &node0, &n_node);
   lw_model_propose(m, p, i, node0, n_node, NULL);
   *forbidden = p->irregular;
   return p->dE;
@@ -308,10 +313,10 @@ static double propose(void *state, void *prop, int kind, double st, gsl_rng *rng
   const lw_splines *sp = m->sp;
   if (kind == LW_MOVE_POINT || kind == LW_MOVE_VECTOR) {
     size_t k = gsl_rng_uniform_int(rng, sp->n_nodes);
-    return propose_on(m, prop, kind, k, spline_of_node(sp, k), st, rng, forbidden);
+    return propose_on(m, prop, kind, k, spline_of_node(sp, k), st, rng, forbidden, NULL);
   }
   uint32_t i = (uint32_t)gsl_rng_uniform_int(rng, sp->n_splines);
-  return propose_on(m, prop, kind, sp->first[i], i, st, rng, forbidden);
+  return propose_on(m, prop, kind, sp->first[i], i, st, rng, forbidden, NULL);
 }
 
 /* Site k is global node k; a rigid move there moves the node's spline, so a
@@ -321,7 +326,7 @@ static double propose_at(void *state, void *prop, int kind, size_t k, double st,
 {
   const lw_model *m = ((spl_state *)state)->m;
   lw_proposal *p = prop;
-  return propose_on(m, p, kind, k, spline_near(m->sp, p->spline, k), st, rng, forbidden);
+  return propose_on(m, p, kind, k, spline_near(m->sp, p->spline, k), st, rng, forbidden, NULL);
 }
 
 /* ---- domain decomposition (system.h, domains.h) ---- */
@@ -388,20 +393,7 @@ static double propose_in(void *state, void *prop, int kind, size_t k, double st,
 {
   const lw_model *m = ((spl_state *)state)->m;
   lw_proposal *p = prop;
-  uint32_t i = spline_near(m->sp, p->spline, k);
-  size_t node0, n_node;
-  build_move(m->sp, p, kind, k, i, st, rng, &node0, &n_node);
-  double b[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
-  spline_box(m->sp, i, node0, n_node, p->node, b);
-  /* NaN fails every comparison: outside, so rejected */
-  if (!(b[0] >= box[0] && b[1] >= box[1] && b[2] <= box[2] && b[3] <= box[3])) {
-    p->spline = i;
-    *forbidden = 2;
-    return INFINITY;
-  }
-  lw_model_propose(m, p, i, node0, n_node, NULL);
-  *forbidden = p->irregular;
-  return p->dE;
+  return propose_on(m, p, kind, k, spline_near(m->sp, p->spline, k), st, rng, forbidden, box);
 }
 
 static lw_status commit_part(void *state, void *prop)
