@@ -43,35 +43,38 @@ static int same(const char *dir, const char *a, const char *b, const char *file)
   return sh("cmp -s %s/%s/%s %s/%s/%s", dir, a, file, dir, b, file) == 0;
 }
 
-Test(domains, same_result_on_1_2_and_4_threads_and_not_the_unsplit_one)
+/* Runs the scene (with `extra`) on 1, 2 and 4 threads into t1, t2, t4 and
+** checks that they wrote the same files. */
+static void same_on_1_2_4_threads(const char *dir, const char *extra)
 {
-  char dir[64];
-  cr_assert_eq(lw_test_dir_make(dir, "domains"), 0);
-  write_scene(dir, "");
+  write_scene(dir, extra);
   const char *b = lw_test_bin();
   for (int t = 1; t <= 4; t *= 2)
     cr_assert_eq(sh("%s run %s/s.ini --out %s/t%d --threads %d --quiet", b, dir, dir, t, t), 0);
-  cr_assert_eq(sh("%s run %s/s.ini --out %s/off --set anneal.domains=off --quiet", b, dir, dir), 0);
   const char *files[] = {"state.lw", "trace.csv", "final.svg"};
   for (int i = 0; i < 3; i++) {
     cr_assert(same(dir, "t1", "t2", files[i]), "%s differs between 1 and 2 threads", files[i]);
     cr_assert(same(dir, "t1", "t4", files[i]), "%s differs between 1 and 4 threads", files[i]);
   }
+}
+
+Test(domains, same_result_on_1_2_and_4_threads_and_not_the_unsplit_one)
+{
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "domains"), 0);
+  same_on_1_2_4_threads(dir, "");
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/off --set anneal.domains=off --quiet", lw_test_bin(), dir, dir), 0);
   /* the key is read: a split run is another chain */
   cr_assert(!same(dir, "t1", "off", "state.lw"), "domains = 3 changed nothing");
   lw_test_dir_remove(dir);
 }
 
+/* Threads go to the replicas first, then to each one's domains. */
 Test(domains, tempering_replicas_then_domains_same_on_any_threads)
 {
   char dir[64];
   cr_assert_eq(lw_test_dir_make(dir, "domains_pt"), 0);
-  write_scene(dir, "[tempering]\nreplicas = 2\nt_min = 0.01\nt_max = 0.1\n");
-  const char *b = lw_test_bin();
-  cr_assert_eq(sh("%s run %s/s.ini --out %s/t1 --threads 1 --quiet", b, dir, dir), 0);
-  cr_assert_eq(sh("%s run %s/s.ini --out %s/t4 --threads 4 --quiet", b, dir, dir), 0);
-  cr_assert(same(dir, "t1", "t4", "state.lw"), "state.lw differs between 1 and 4 threads");
-  cr_assert(same(dir, "t1", "t4", "trace.csv"), "trace.csv differs between 1 and 4 threads");
+  same_on_1_2_4_threads(dir, "[tempering]\nreplicas = 2\nt_min = 0.01\nt_max = 0.1\n");
   lw_test_dir_remove(dir);
 }
 
@@ -129,14 +132,19 @@ Test(domains, running_totals_equal_the_energy_from_scratch)
   lw_test_dir_remove(dir);
 }
 
-/* One clear message naming the file, line and key, exit status 2, nothing written. */
-static void refused(const char *dir, const char *value, const char *system_extra, const char *expect)
+/* One clear message naming the key, exit status 2, nothing written: the
+** scene s.ini in dir, or `scene` when not NULL. */
+static void refused(const char *dir, const char *scene, const char *value, const char *expect)
 {
-  char extra[256];
-  snprintf(extra, sizeof extra, "%s", system_extra);
-  write_scene(dir, extra);
-  const char *b = lw_test_bin();
-  int st = sh("%s run %s/s.ini --out %s/bad --set anneal.domains=%s --quiet 2> %s/err.txt", b, dir, dir, value, dir);
+  char path[160];
+  if (!scene) {
+    write_scene(dir, "");
+    snprintf(path, sizeof path, "%s/s.ini", dir);
+  } else {
+    snprintf(path, sizeof path, "%s/%s", lw_test_root(), scene);
+  }
+  int st = sh("%s run %s --out %s/bad --set anneal.domains=%s --quiet 2> %s/err.txt", lw_test_bin(), path, dir,
+              value, dir);
   cr_assert_eq(st, 2, "domains = %s: exit status %d", value, st);
   cr_assert_eq(sh("grep -q \"key 'anneal.domains'\" %s/err.txt", dir), 0, "domains = %s: key not named", value);
   cr_assert_eq(sh("grep -q -- '%s' %s/err.txt", expect, dir), 0, "domains = %s: expected '%s'", value, expect);
@@ -147,11 +155,13 @@ Test(domains, bad_values_are_refused_naming_the_key)
 {
   char dir[64];
   cr_assert_eq(lw_test_dir_make(dir, "domains_bad"), 0);
-  refused(dir, "banana", "", "expected off, auto or a count");
-  refused(dir, "0", "", "expected off, auto or a count");
-  refused(dir, "3x", "", "expected off, auto or a count");
+  refused(dir, NULL, "banana", "expected off, auto or a count");
+  refused(dir, NULL, "0", "expected off, auto or a count");
+  refused(dir, NULL, "3x", "expected off, auto or a count");
   /* 300 mm in 40 domains is 7.5 mm, under twice the reach of the pair grid and tone */
-  refused(dir, "40", "", "wider than twice the reach");
+  refused(dir, NULL, "40", "wider than twice the reach");
+  /* a system whose row cannot split: refused, not run serially behind the user's back */
+  refused(dir, "params/particles-sheet.ini", "2", "cannot split its sweeps");
   lw_test_dir_remove(dir);
 }
 
