@@ -8,8 +8,9 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
-#define DOMAINS_MAX 1024 /* per side: far more than cores, far fewer than splines */
+#define DOMAINS_MAX 64 /* per side: 4225 cells, each with a stream and a scratch, are plenty */
 
 void lw_domains_free(lw_domains *d)
 {
@@ -21,6 +22,7 @@ void lw_domains_free(lw_domains *d)
   free(d->start);
   free(d->active);
   free(d->seed);
+  free(d->cell_cpu);
   free(d);
 }
 
@@ -67,7 +69,7 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
     errno = 0;
     side = strtol(p->domains, &end, 10);
     if (errno || end == p->domains || *end || side < 1 || side > DOMAINS_MAX)
-      return bad_key(p, err, "'%s': expected off, auto or a count of domains per side from 1 to 1024%s", "");
+      return bad_key(p, err, "'%s': expected off, auto or a count of domains per side from 1 to 64%s", "");
   }
   if (!t->split || !t->group || !t->propose_in || !t->commit_part || !t->merge)
     return bad_key(p, err, "'%s': the system '%s' cannot split its sweeps into domains; expected off", t->name);
@@ -188,9 +190,18 @@ static lw_status assign(lw_domains *d, const lw_chain *c, size_t n, double ox, d
   return LW_OK;
 }
 
+/* This thread's CPU seconds (the profile: preemption does not count). */
+static double cpu_now(void)
+{
+  struct timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 /* One cell's sites through its chain; 0, or -1 when a commit ran out of memory. */
 static int sweep_cell(const lw_domains *d, int k, int backward, double ox, double oy)
 {
+  const double t0 = d->cell_cpu ? cpu_now() : 0.0;
   lw_chain *dc = d->cell[k];
   /* seeded here, by whichever thread runs the cell: only cells with sites
   ** pay for it */
@@ -200,6 +211,7 @@ static int sweep_cell(const lw_domains *d, int k, int backward, double ox, doubl
   const size_t s0 = d->start[k], s1 = d->start[k + 1];
   for (size_t q = 0; q < s1 - s0; q++)
     if (lw_chain_visit_in(dc, d->site[backward ? s1 - 1 - q : s0 + q], box) < 0) return -1;
+  if (d->cell_cpu) d->cell_cpu[k] = cpu_now() - t0;
   return 0;
 }
 
@@ -209,6 +221,9 @@ lw_status lw_domains_sweep(lw_domains *d, lw_chain *c)
   void *state = c->sys->state;
   size_t n = t->sweep_size(state);
   if (n == 0) return LW_OK;
+  double t0 = d->cell_cpu ? cpu_now() : 0.0;
+  if (d->cell_cpu) memset(d->cell_cpu, 0, (size_t)d->n * sizeof *d->cell_cpu);
+  d->serial_cpu = 0.0;
   /* Everything random about the sweep's plan comes from the chain's
   ** stream, in this order; each cell's moves from its own stream. */
   double ox = gsl_rng_uniform(c->rng) * d->lx, oy = gsl_rng_uniform(c->rng) * d->ly;
@@ -233,6 +248,7 @@ lw_status lw_domains_sweep(lw_domains *d, lw_chain *c)
     /* the steps as tuned after the last phase: a window must see the step
     ** it tunes, or four updates a sweep on the same evidence overshoot */
     for (int a = 0; a < n_act; a++) memcpy(d->cell[d->active[a]]->step, c->step, sizeof c->step);
+    if (d->cell_cpu) d->serial_cpu += cpu_now() - t0;
     int failed = 0;
     size_t work = 0;
     for (int a = 0; a < n_act; a++) work += d->start[d->active[a] + 1] - d->start[d->active[a]];
@@ -242,6 +258,7 @@ lw_status lw_domains_sweep(lw_domains *d, lw_chain *c)
     if (n_act > 1 && d->threads > 1 && work >= d->min_parallel)
     for (int a = 0; a < n_act; a++)
       if (sweep_cell(d, d->active[a], backward, ox, oy) < 0) failed = 1;
+    if (d->cell_cpu) t0 = cpu_now();
     /* in cell order, whatever ran where */
     for (int a = 0; a < n_act; a++) {
       lw_chain *dc = d->cell[d->active[a]];
@@ -250,5 +267,6 @@ lw_status lw_domains_sweep(lw_domains *d, lw_chain *c)
     }
     if (failed) st = LW_ENOMEM;
   }
+  if (d->cell_cpu) d->serial_cpu += cpu_now() - t0;
   return st;
 }

@@ -230,11 +230,11 @@ const lw_param_def lw_param_table[] = {
       "Sweeps between full recomputations of the energy (the drift check); splines are "
       "renumbered along a Hilbert curve of the page just before each, for locality in memory."),
   STRING("anneal", "domains", domains, "off", "",
-         "Domain decomposition of each replica's sweeps (docs/NUMERICS.md, \"Domains\"): `off`; `N`, "
-         "an N x N lattice of domains over the page, shifted at random each sweep, whose four "
+         "Domain decomposition of each replica's sweeps (docs/NUMERICS.md, \"Domains\"): `off`; `N` "
+         "(1 to 64), an N x N lattice of domains over the page, shifted at random each sweep, whose four "
          "sub-lattices are swept in turn, the domains of each in parallel (OpenMP); `auto`, domains "
-         "of side max(2.5 reach, 16 init.segments init.segment_length), not split when fewer than 2 "
-         "fit a side. The result depends on this key, never on the threads. docs/SCALING.md."),
+         "of side max(2.5 reach, 16 init.segments init.segment_length), at most 64 a side, not split "
+         "when fewer than 2 fit a side. The result depends on this key, never on the threads. docs/SCALING.md."),
   CHOICE("anneal", "quench", quench, "none", "none|bfgs",
          "After the last sweep: none, or bfgs, which takes the coldest replica to the nearest local "
          "minimum of its energy (GSL's vector_bfgs2 on the system's gradient; docs/ACCURACY.md). "

@@ -51,6 +51,11 @@ typedef struct lw_domains {
   int *active;          /* scratch: the cells of a phase */
   unsigned long *seed;  /* scratch: each cell's seed this sweep */
   size_t min_parallel;  /* a phase of fewer sites runs on one thread (no effect on results) */
+  /* Profile for the benchmark (tools/bench-domains.c), off while cell_cpu
+  ** is NULL: each cell's thread CPU seconds in the last sweep (0 if it had
+  ** no sites), and the last sweep's own seconds outside the cells. */
+  double *cell_cpu;
+  double serial_cpu;
   unsigned long frozen; /* site visits skipped for a group on a cell boundary, since the start */
   unsigned long visits; /* sites swept, since the start */
 } lw_domains;
@@ -58,7 +63,7 @@ typedef struct lw_domains {
 /* Reads [anneal] domains and, unless it is off (or auto finds fewer than 2
 ** domains a side), attaches domains to chain c (c->domains), for a run of
 ** `replicas` replicas sharing the threads.  LW_EINPUT naming the key's file
-** and line when the value is not off, auto or a count from 1 to 1024, when
+** and line when the value is not off, auto or a count from 1 to 64, when
 ** the domains would not be wider than twice the reach, or when the system
 ** cannot split (no row functions, or a term that is not local). */
 lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_error *err);
