@@ -265,6 +265,7 @@ lw_status lw_domains_sweep(lw_domains *d, lw_chain *c)
       if (t->merge(state, dc->prop) != LW_OK) st = LW_ENOMEM;
       lw_chain_absorb(c, dc);
     }
+    lw_chain_tune(c);
     if (failed) st = LW_ENOMEM;
   }
   if (d->cell_cpu) d->serial_cpu += cpu_now() - t0;

@@ -152,12 +152,16 @@ void lw_chain_absorb(lw_chain *c, lw_chain *from)
     if (c->tuning) {
       c->win_prop[k] += b->proposed;
       c->win_acc[k] += b->accepted;
-      tune_window(c, k);
     }
     *b = (lw_move_stats){0};
   }
   c->outside += from->outside;
   from->outside = 0;
+}
+
+void lw_chain_tune(lw_chain *c)
+{
+  for (int k = 0; c->tuning && k < c->n_moves; k++) tune_window(c, k);
 }
 
 lw_status lw_chain_sweep(lw_chain *c)

@@ -73,9 +73,13 @@ int lw_chain_step_at(lw_chain *c, int kind, size_t site);
 int lw_chain_visit_in(lw_chain *c, size_t site, const double box[4]);
 
 /* Adds the statistics of a domain's chain `from` to c's and clears them;
-** while c tunes, they fill c's tuning windows as c's own proposals would,
-** one step update per full window at most. */
+** while c tunes, they fill c's tuning windows as c's own proposals would. */
 void lw_chain_absorb(lw_chain *c, lw_chain *from);
+
+/* While c tunes, one step update for each kind whose window is full: after
+** absorbing every domain of a phase, whose proposals all used the same
+** steps, so that one body of evidence moves a step once. */
+void lw_chain_tune(lw_chain *c);
 
 /* One sweep: sweep_size proposals with kinds drawn from the mix.  A row with
 ** propose_at has every site visited once, in order, forward or backward
