@@ -22,7 +22,9 @@
 ** needs nothing more than the chain's stream.  Each cell commits into its
 ** own scratch (commit_part); after a phase the scratches are merged into
 ** the running totals, and their statistics into the chain's, in cell
-** order.  Why this samples exp(-E/T): docs/NUMERICS.md, "Domains".
+** order; while the chain tunes, its steps move once a phase (each cell
+** takes them at the start of a phase).  Why this samples exp(-E/T):
+** docs/NUMERICS.md, "Domains".
 */
 #ifndef LINEWISE_DOMAINS_H
 #define LINEWISE_DOMAINS_H
