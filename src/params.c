@@ -233,9 +233,7 @@ const lw_param_def lw_param_table[] = {
          "After the last sweep: none, or bfgs, which takes the coldest replica to the nearest local "
          "minimum of its energy (GSL's vector_bfgs2 on the system's gradient; docs/ACCURACY.md). "
          "The drawings and summary.json show the quenched state; state.lw keeps the annealed one, so "
-         "a resumed or longer run continues the chain. Needs a system with a gradient (splines). "
-         "Not yet with the pair term: it can reach states whose computed pair energy is negative "
-         "(an open near-field defect, docs/ACCURACY.md)."),
+         "a resumed or longer run continues the chain. Needs a system with a gradient (splines)."),
   NUM("anneal", "quench_tol", LW_PT_DOUBLE, quench_tol, "1e-6", "energy/mm", 0, 1e300, LW_MIN_OPEN,
       "The quench stops when the gradient's Euclidean norm falls to this."),
   NUM("anneal", "quench_iterations", LW_PT_INT, quench_iterations, "2000", "", 1, 1e9, 0,
