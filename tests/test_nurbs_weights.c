@@ -176,3 +176,111 @@ Test(nurbs_weights, the_mass_matrix_is_the_kinetic_energy_of_the_curve_and_mass_
   t->mass_free(mass);
   fwire_close(&w);
 }
+
+/* ---- the wire in motion: log weights against the review's reset ----------- */
+
+typedef struct {
+  double h0, dh;          /* H = T + E at the start, largest |H - h0| */
+  double h_end;
+  double s_lo, s_hi;      /* range of the free log weights */
+} motion;
+
+/* steps of dt from rest (the weights as the scene has them); reset: the
+** review's w = 1 (and wdot = 0) after every step, the motion of the points
+** carried on as it is. */
+static motion move_wire(fwire *w, double dt, int steps, int reset)
+{
+  lw_error err = {0};
+  w->p.dyn_dt = dt;
+  lw_dynamics *d = lw_dynamics_new(&lw_system_nurbs, w->st, &w->p, &err);
+  cr_assert_not_null(d, "%s", err.msg);
+  motion m = {d->energy, 0.0, d->energy, 0.0, 0.0};
+  double x[32];
+  for (int k = 0; k < steps; k++) {
+    cr_assert_eq(lw_dynamics_step(d, &err), LW_OK, "step %d: %s", k, err.msg);
+    if (reset) {
+      lw_system_nurbs.get_coords(w->st, x);
+      for (size_t i = 2; i < w->nc; i += 3) x[i] = d->pi[i] = 0.0;
+      cr_assert_eq(lw_system_nurbs.set_coords(w->st, x, &err), LW_OK);
+      cr_assert_eq(lw_dynamics_sync(d, &err), LW_OK, "%s", err.msg);
+    }
+    double h = d->energy + lw_dynamics_kinetic(d);
+    m.dh = fmax(m.dh, fabs(h - m.h0));
+    m.h_end = h;
+    for (size_t i = 0; i < w->su->curve->n; i++)
+      if (!w->su->pin[i]) m.s_lo = fmin(m.s_lo, w->st->s[i]), m.s_hi = fmax(m.s_hi, w->st->s[i]);
+  }
+  lw_dynamics_free(d);
+  return m;
+}
+
+#define START "1 1.2 1 0.8 1 1.2 1"
+
+Test(nurbs_weights, undamped_free_weights_keep_the_energy_the_reset_to_1_does_not)
+{
+  fwire w;
+  fwire_open(&w, START, 0, 10);
+  /* 2 s at dt = 1 ms: the weights' fast modes need it (docs/NURBS.md) */
+  motion m = move_wire(&w, 0.001, 2000, 0);
+  fwire_close(&w);
+  fwire_open(&w, START, 0, 10);
+  motion r = move_wire(&w, 0.001, 2000, 1);
+  fwire_close(&w);
+  cr_log_info("free weights: H %g, |dH| %g, s in [%g, %g]; reset: |dH| %g, H(2 s) %g", m.h0, m.dh, m.s_lo, m.s_hi,
+              r.dh, r.h_end);
+  /* the leapfrog's energy error is bounded, O(dt^2): measured 0.32 % */
+  cr_assert_lt(m.dh, 0.01 * m.h0, "free weights: H %g changed by %g", m.h0, m.dh);
+  /* kept near 1 by the spring on s (measured: w in [0.56, 1.30]); without
+  ** it the middle weight falls to 1e-15 in these 2 s (docs/NURBS.md) */
+  cr_assert(m.s_lo > -1.0 && m.s_hi < 1.0 && m.s_hi > m.s_lo, "s in [%g, %g]", m.s_lo, m.s_hi);
+  /* the reset is no motion of a Hamiltonian: H drops to the unit weights'
+  ** energy at the first step and is pumped up after (measured: x 3.3) */
+  cr_assert_gt(r.dh, 0.5 * m.h0, "the reset changed H by %g only (free weights: %g)", r.dh, m.dh);
+}
+
+Test(nurbs_weights, damped_free_weights_lose_energy_and_stay_positive_and_bounded)
+{
+  fwire w;
+  fwire_open(&w, START, 5, 10);
+  motion m = move_wire(&w, 0.001, 2000, 0);
+  fwire_close(&w);
+  cr_log_info("damped free weights: H %g -> %g, s in [%g, %g]", m.h0, m.h_end, m.s_lo, m.s_hi);
+  cr_assert_lt(m.h_end, 0.95 * m.h0, "H %g -> %g", m.h0, m.h_end);
+  cr_assert(m.s_lo > -1.0 && m.s_hi < 1.0, "s in [%g, %g]", m.s_lo, m.s_hi);
+}
+
+/* ---- Monte Carlo's weight move -------------------------------------------- */
+
+Test(nurbs_weights, annealing_with_weight_moves_ends_where_the_gradient_vanishes)
+{
+  fwire w;
+  fwire_open(&w, START, 0, 10);
+  double wt[LW_MOVES_MAX], st[LW_MOVES_MAX], tg[LW_MOVES_MAX], g[32];
+  w.p.step_point = 0.05;
+  lw_system_nurbs.moves(&w.p, wt, st, tg);
+  cr_assert_gt(wt[1], 0.0, "free weights: the weight move is on");
+  lw_error err = {0};
+  lw_chain *c = lw_chain_new(w.sys, wt, st, tg, 7, &err);
+  cr_assert_not_null(c, "%s", err.msg);
+  c->tuning = 1;
+  lw_system_nurbs.gradient(w.st, g, &err);
+  double g0 = 0.0, g1 = 0.0;
+  for (size_t i = 0; i < w.nc; i++)
+    if (!w.su->pin[i / 3]) g0 = fmax(g0, fabs(g[i]));
+  int sweeps = 20000;
+  for (int s = 0; s < sweeps; s++) {
+    c->temperature = pow(1e-12, (double)s / (sweeps - 1));
+    cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  }
+  cr_assert_gt(c->stats[1].accepted, 100, "weight moves accepted: %lu", c->stats[1].accepted);
+  double drift, before = lw_system_total(w.sys);
+  cr_assert_eq(lw_system_nurbs.refresh(w.st, &drift), LW_OK);
+  cr_assert(fabs(lw_system_total(w.sys) - before) <= 1e-9 * fabs(before), "running energy drifted by %g", drift);
+  lw_system_nurbs.gradient(w.st, g, &err);
+  for (size_t i = 0; i < w.nc; i++)
+    if (!w.su->pin[i / 3]) g1 = fmax(g1, fabs(g[i]));
+  cr_log_info("annealed with weights: max |dE/dx| %g (start %g)", g1, g0);
+  cr_assert_lt(g1, 1e-4 * g0, "max |dE/dx| %g at the end, %g at the start", g1, g0);
+  lw_chain_free(c);
+  fwire_close(&w);
+}
