@@ -183,9 +183,9 @@ lw_nurbs_setup *lw_nurbs_setup_new(const lw_params *p, lw_nurbs *curve, lw_error
   ** and b are assembled on has w = exp(s) to the last bit, as every state */
   su->free_weights = p->nb_free_weights;
   if (su->free_weights && p->nb_fixed < 1) {
-    lw_error_set(err, LW_EINPUT, "expected fixed >= 1 with free_weights = 1 (the held end weights fix the scale of "
-                 "the weights, which leaves the curve unchanged), got 0");
-    lw_params_blame(p, "nurbs", "fixed", err);
+    lw_error_set(err, LW_EINPUT, "free weights need nurbs.fixed >= 1 (the held end weights fix the scale of the "
+                 "weights, which leaves the curve unchanged), got fixed = 0");
+    lw_params_blame(p, "nurbs", "free_weights", err);
     goto fail;
   }
   if (!(su->s0 = malloc(n * sizeof *su->s0))) {
