@@ -89,16 +89,17 @@ lw_dnurbs *lw_dnurbs_new(lw_nurbs *c, double alpha, double beta, int gauss, lw_e
   return d;
 }
 
+/* The energy density's coefficients, and where its integrals go. */
 typedef struct {
   double alpha, beta, mug[2];
   double *out;
-} grad_ctx;
+} density_ctx;
 
 /* dE/ds_j = w_j dE/dw_j = int alpha c_u . r_j' + beta c_uu . r_j'' - mug . r_j du
 ** with r_j = w_j q_j = R_j (P_j - c), by the product rule. */
 static void add_grad_s(void *ctx, lw_nurbs *c, double u, double wq, size_t first, const double *R)
 {
-  grad_ctx *g = ctx;
+  density_ctx *g = ctx;
   size_t k = (size_t)c->order;
   double pt[2], d1[2], d2[2];
   lw_nurbs_eval(c, u, pt, d1, d2);
@@ -116,7 +117,7 @@ static void add_grad_s(void *ctx, lw_nurbs *c, double u, double wq, size_t first
 
 lw_status lw_dnurbs_grad_s(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, double *gs, lw_error *err)
 {
-  grad_ctx g = {alpha, beta, {mug[0], mug[1]}, gs};
+  density_ctx g = {alpha, beta, {mug[0], mug[1]}, gs};
   memset(gs, 0, c->n * sizeof *gs);
   return each_point(c, gauss, 0, c->n, add_grad_s, &g, err);
 }
@@ -130,7 +131,7 @@ lw_status lw_dnurbs_grad_w(lw_nurbs *c, double alpha, double beta, const double 
 
 static void add_energy(void *ctx, lw_nurbs *c, double u, double wq, size_t first, const double *R)
 {
-  grad_ctx *g = ctx;
+  density_ctx *g = ctx;
   double pt[2], d1[2], d2[2];
   lw_nurbs_eval(c, u, pt, d1, d2);
   g->out[0] += wq * 0.5 * (g->alpha * (d1[0] * d1[0] + d1[1] * d1[1]) + g->beta * (d2[0] * d2[0] + d2[1] * d2[1]));
@@ -140,7 +141,7 @@ static void add_energy(void *ctx, lw_nurbs *c, double u, double wq, size_t first
 lw_status lw_dnurbs_energy_near(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, size_t j,
                                 double term[2], lw_error *err)
 {
-  grad_ctx g = {alpha, beta, {mug[0], mug[1]}, term};
+  density_ctx g = {alpha, beta, {mug[0], mug[1]}, term};
   term[0] = term[1] = 0.0;
   return each_point(c, gauss, j, j + (size_t)c->order, add_energy, &g, err);
 }
