@@ -439,7 +439,7 @@ const lw_param_def lw_param_table[] = {
       "Free weights: the inertia of each log weight s, per unit density, added to the mass "
       "matrix (T gains 1/2 rho weight_inertia sdot^2). A straight polynomial curve moves the "
       "same way under its weights as under its points, so without it the mass matrix is "
-      "singular there (docs/NUMERICS.md, \"Free weights\"). 0 = the review's kinetic energy alone."),
+      "(nearly) singular there (docs/NUMERICS.md, \"Free weights\"). 0 = the review's kinetic energy alone."),
   NUM("nurbs", "weight_stiffness", LW_PT_DOUBLE, nb_weight_stiffness, "1000", "energy", 0, 1e12, 0,
       "Free weights: the term `weights` = 1/2 weight_stiffness sum (log w)^2, a spring that "
       "pulls every weight toward 1 (the review's reset to 1, made smooth and conservative). "
