@@ -2,6 +2,7 @@
 #include "linewise/mpi_tempering.h"
 
 #include <mpi.h>
+#include <omp.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -376,6 +377,20 @@ lw_anneal_net *lw_mpi_init(int *argc, char ***argv, volatile sig_atomic_t *stop)
   MPI_Comm_rank(comm, &my_rank);
   m.net.rank = my_rank;
   MPI_Comm_size(comm, &m.net.size);
+  /* Threads: the node's cores shared among its processes, unless
+  ** OMP_NUM_THREADS or --threads says otherwise.  OpenMP's default (all
+  ** cores in every process) oversubscribes the node P times, and spinning
+  ** threads of one process then starve the others at each reduction. */
+  MPI_Comm node;
+  int on_node = 1;
+  if (MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node) == MPI_SUCCESS) {
+    MPI_Comm_size(node, &on_node);
+    MPI_Comm_free(&node);
+  }
+  if (!getenv("OMP_NUM_THREADS")) {
+    int t = omp_get_num_procs() / on_node;
+    omp_set_num_threads(t > 0 ? t : 1);
+  }
   m.net.share = share;
   m.net.moved = moved;
   m.net.drift = drift;
