@@ -164,9 +164,9 @@ $(BUILD)/bench: $(BENCH_SRC) $(BENCH_HDR) $(BUILD)/liblinewise.a
 
 # Benchmarks rewrite docs/PERFORMANCE.md and docs/ACCURACY.md (machine and date
 # recorded with them) and their plots docs/*.png; BENCH_QUICK=1 for a smoke run.
-bench: $(BUILD)/bench
+bench: $(BUILD)/bench $(MPI_BIN)
 	mkdir -p $(BUILD)/bench-data
-	$(BUILD)/bench docs $(BUILD)/bench-data
+	LW_MPI_BIN=$(MPI_BIN) $(BUILD)/bench docs $(BUILD)/bench-data
 	gnuplot -e "data='$(BUILD)/bench-data'; out='docs'" tools/bench.gp
 
 # The elastic wire of the D-NURBS review: its Figures 8 and 9 as
@@ -194,7 +194,8 @@ install: $(BIN)/linewise $(PICTURE)
 	install -d $(DESTDIR)$(PREFIX)/share/man/man1
 	install -m 644 docs/linewise.1 $(DESTDIR)$(PREFIX)/share/man/man1/linewise.1
 	for t in $(TOOLS); do install -m 755 tools/$$t $(DESTDIR)$(PREFIX)/bin/linewise-$$t; done
-	install -m 644 tools/slurm-sweep.sbatch $(DESTDIR)$(PREFIX)/share/linewise/
+	install -m 644 tools/slurm-sweep.sbatch tools/slurm-tempering.sbatch $(DESTDIR)$(PREFIX)/share/linewise/
+	if [ -x $(BIN)/linewise-mpi ]; then install -m 755 $(BIN)/linewise-mpi $(DESTDIR)$(PREFIX)/bin/linewise-mpi; fi
 
 clean:
 	rm -rf build build-asan build-fuzz bin $(PICTURE)

@@ -661,13 +661,15 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
     }
   }
   int tuning = a->sweep - block_start(a, b) < p->tune_sweeps && a->sweep < p->sweeps;
-  int failed = 0;
+  int failed = 0, here[LW_TEMPERING_MAX], m = 0;
+  for (int k = 0; k < n; k++)
+    if (rung_here(a, k)) here[m++] = k; /* all of them in one process */
   /* The rungs are independent between exchanges: each touches only its own
   ** chain, stream and system, so the thread count cannot change the result. */
-#pragma omp parallel for schedule(static, 1) reduction(| : failed) if (n > 1)
-  for (int k = 0; k < n; k++) {
-    a->chains[k]->tuning = tuning;
-    if (rung_here(a, k) && lw_chain_sweep(a->chains[k]) != LW_OK) failed = 1;
+#pragma omp parallel for schedule(static, 1) reduction(| : failed) if (m > 1)
+  for (int i = 0; i < m; i++) {
+    a->chains[here[i]]->tuning = tuning;
+    if (lw_chain_sweep(a->chains[here[i]]) != LW_OK) failed = 1;
   }
   lw_status s;
   if (a->net && (s = a->net->share(a->net, a, failed, err))) return s;

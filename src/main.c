@@ -243,6 +243,9 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_err
     stopped = (net ? net->stop_agreed : stop_requested) || (stop_at >= 0 && a->sweep >= stop_at);
   }
   progress_show(&pg, a, 1);
+#ifdef LW_MPI
+  lw_mpi_report(net, a, quiet);
+#endif
   if (stopped) {
     if (lw_anneal_checkpoint(a, err)) return watched_fail(w, err);
     watcher_stop(w, 0);

@@ -73,6 +73,9 @@ Test(mpi, two_and_four_processes_write_the_bytes_of_the_one_process_run)
   /* the replicas did change process: with one each, every swap crosses */
   cr_assert_eq(sh("grep -q '^at_label = 0 ' %s/p4/state.lw", dir), 1, "no replica left rung 0");
   cr_assert_eq(sh("grep -q '\"round_trips\"' %s/p4/summary.json", dir), 0);
+  /* the study tools read it as any run */
+  cr_assert_eq(sh("%s/tools/plot-run %s/p4 >/dev/null 2>&1", lw_test_root(), dir), 0);
+  cr_assert_eq(sh("test -s %s/p4/plots/replicas.png && test -s %s/p4/plots/swaps.png", dir, dir), 0);
 }
 
 Test(mpi, resume_with_other_process_counts_continues_bit_exactly)

@@ -43,6 +43,14 @@ lw_status lw_mpi_agree(lw_anneal_net *net, lw_status s, lw_error *err);
 ** process has it); a failure that was not must end the job (lw_mpi_abort). */
 int lw_mpi_agreed(void);
 
+/* Collective, at the end of a run or a stop: process 0 prints (unless
+** quiet) the wall time per sweep and the time per sweep spent in the
+** exchange steps' messages (the reduction after each sweep, the chain
+** moves, the drift checks), the least over the processes (the messages'
+** own cost) and the most (with the wait for the slowest process). */
+struct lw_anneal;
+void lw_mpi_report(lw_anneal_net *net, const struct lw_anneal *a, int quiet);
+
 /* Ends the whole job at once with exit status code (a failure the other
 ** processes cannot learn of by themselves). */
 void lw_mpi_abort(int code);

@@ -17,6 +17,10 @@ typedef struct {
   volatile sig_atomic_t *stop;
   uint64_t *buf;              /* share()'s words */
   size_t buf_len;
+  /* for lw_mpi_report: seconds inside the per-sweep steps' MPI calls, from
+  ** the first share() on */
+  double t_first, t_comm;
+  long sweeps, moves;
 } mpi_net;
 
 static MPI_Comm comm = MPI_COMM_NULL;
@@ -123,7 +127,10 @@ static lw_status share(lw_anneal_net *net, lw_anneal *a, int failed, lw_error *e
       uint64_t v[4] = {s->proposed, s->accepted, s->nan, s->irregular};
       memcpy(st + 4 * k, v, sizeof v);
     }
+  double t0 = MPI_Wtime();
+  if (!m->sweeps++) m->t_first = t0;
   MPI_Allreduce(MPI_IN_PLACE, w, (int)len, MPI_UINT64_T, MPI_BOR, comm);
+  m->t_comm += MPI_Wtime() - t0;
   net->stop_agreed = w[net->size] != 0;
   for (int r = 0; r < n; r++) {
     memcpy(term, w + net->size + 1 + (size_t)r * (size_t)per, (size_t)per * sizeof *term);
@@ -202,7 +209,10 @@ static lw_status moved(lw_anneal_net *net, lw_anneal *a, const int *swapped, lw_
     }
     int send = net->rank == A ? k : k + 1, recv = net->rank == A ? k + 1 : k, peer = net->rank == A ? B : A;
     chain_pack(a->chains[send], out);
+    double t0 = MPI_Wtime();
     MPI_Sendrecv(out, (int)len, MPI_BYTE, peer, k, in, (int)len, MPI_BYTE, peer, k, comm, MPI_STATUS_IGNORE);
+    ((mpi_net *)net)->t_comm += MPI_Wtime() - t0;
+    ((mpi_net *)net)->moves++;
     chain_unpack(a->chains[recv], in);
   }
   free(out);
@@ -212,8 +222,30 @@ static lw_status moved(lw_anneal_net *net, lw_anneal *a, const int *swapped, lw_
 
 static lw_status drift(lw_anneal_net *net, lw_anneal *a, lw_status s, lw_error *err)
 {
+  double t0 = MPI_Wtime();
   MPI_Allreduce(MPI_IN_PLACE, &a->max_drift, 1, MPI_DOUBLE, MPI_MAX, comm);
-  return lw_mpi_agree(net, s, err);
+  s = lw_mpi_agree(net, s, err);
+  ((mpi_net *)net)->t_comm += MPI_Wtime() - t0;
+  return s;
+}
+
+void lw_mpi_report(lw_anneal_net *net, const lw_anneal *a, int quiet)
+{
+  mpi_net *m = (mpi_net *)net;
+  double wall = m->sweeps ? MPI_Wtime() - m->t_first : 0.0, per = m->sweeps ? m->t_comm / (double)m->sweeps : 0.0;
+  double lo = 0.0, hi = 0.0;
+  long moves = 0;
+  MPI_Reduce(&per, &lo, 1, MPI_DOUBLE, MPI_MIN, 0, comm);
+  MPI_Reduce(&per, &hi, 1, MPI_DOUBLE, MPI_MAX, 0, comm);
+  MPI_Reduce(&m->moves, &moves, 1, MPI_LONG, MPI_SUM, 0, comm);
+  if (quiet || net->rank || m->sweeps < 2) return;
+  double sweep = wall / (double)(m->sweeps - 1); /* from the end of the first sweep */
+  /* each move was counted by both of its processes */
+  fprintf(stderr, "linewise: MPI: %d processes, %d replicas, %d threads each: %.3f ms a sweep; exchange steps %.3f "
+          "ms a sweep (%.1f %%) on the quickest process, %.3f ms (%.1f %%) on the one that waited longest; %.2f "
+          "chain moves a sweep of %zu bytes\n", net->size, a->n_rep, omp_get_max_threads(), 1e3 * sweep, 1e3 * lo,
+          100.0 * lo / sweep, 1e3 * hi, 100.0 * hi / sweep, (double)moves / 2.0 / (double)m->sweeps,
+          chain_bytes(a->chains[0]));
 }
 
 /* ---- checkpoints ------------------------------------------------------ */
