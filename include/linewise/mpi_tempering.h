@@ -46,8 +46,9 @@ int lw_mpi_agreed(void);
 /* Collective, at the end of a run or a stop: process 0 prints (unless
 ** quiet) the wall time per sweep and the time per sweep spent in the
 ** exchange steps' messages (the reduction after each sweep, the chain
-** moves, the drift checks), the least over the processes (the messages'
-** own cost) and the most (with the wait for the slowest process). */
+** moves, the drift checks), the least over the processes and the most
+** (with the wait for the slowest process); then, timed alone in a loop,
+** one reduction and one chain move (the messages' own cost). */
 struct lw_anneal;
 void lw_mpi_report(lw_anneal_net *net, const struct lw_anneal *a, int quiet);
 

@@ -229,6 +229,56 @@ static lw_status drift(lw_anneal_net *net, lw_anneal *a, lw_status s, lw_error *
   return s;
 }
 
+static int cmp_double(const void *x, const void *y)
+{
+  double a = *(const double *)x, b = *(const double *)y;
+  return (a > b) - (a < b);
+}
+
+/* The messages' own cost, away from the sweeps: seconds for one reduction
+** of share()'s words and for one chain move (processes 0 and 1), each the
+** median of a loop (a busy machine stretches some of them by whole time
+** slices). */
+enum { LOOPS = 201 };
+
+static double median(double *t)
+{
+  qsort(t, LOOPS, sizeof *t, cmp_double);
+  return t[LOOPS / 2];
+}
+
+static void message_cost(mpi_net *m, const lw_anneal *a, double *reduce, double *move)
+{
+  double t[LOOPS];
+  size_t words = m->buf_len, bytes = chain_bytes(a->chains[0]);
+  unsigned char *b = malloc(bytes), *c = malloc(bytes);
+  int ok = b && c && m->buf, all = 0;
+  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, comm);
+  *reduce = *move = 0.0;
+  if (all) {
+    MPI_Barrier(comm);
+    for (int i = 0; i < LOOPS; i++) {
+      double t0 = MPI_Wtime();
+      MPI_Allreduce(MPI_IN_PLACE, m->buf, (int)words, MPI_UINT64_T, MPI_BOR, comm);
+      t[i] = MPI_Wtime() - t0;
+    }
+    *reduce = median(t);
+    memset(b, 0, bytes);
+    MPI_Barrier(comm);
+    if (m->net.rank < 2 && m->net.size > 1) {
+      for (int i = 0; i < LOOPS; i++) {
+        double t0 = MPI_Wtime();
+        MPI_Sendrecv(b, (int)bytes, MPI_BYTE, 1 - m->net.rank, 0, c, (int)bytes, MPI_BYTE, 1 - m->net.rank, 0, comm,
+                     MPI_STATUS_IGNORE);
+        t[i] = MPI_Wtime() - t0;
+      }
+      *move = median(t);
+    }
+  }
+  free(b);
+  free(c);
+}
+
 void lw_mpi_report(lw_anneal_net *net, const lw_anneal *a, int quiet)
 {
   mpi_net *m = (mpi_net *)net;
@@ -238,14 +288,17 @@ void lw_mpi_report(lw_anneal_net *net, const lw_anneal *a, int quiet)
   MPI_Reduce(&per, &lo, 1, MPI_DOUBLE, MPI_MIN, 0, comm);
   MPI_Reduce(&per, &hi, 1, MPI_DOUBLE, MPI_MAX, 0, comm);
   MPI_Reduce(&m->moves, &moves, 1, MPI_LONG, MPI_SUM, 0, comm);
+  double reduce = 0.0, move = 0.0;
+  if (m->sweeps >= 2) message_cost(m, a, &reduce, &move);
   if (quiet || net->rank || m->sweeps < 2) return;
   double sweep = wall / (double)(m->sweeps - 1); /* from the end of the first sweep */
   /* each move was counted by both of its processes */
   fprintf(stderr, "linewise: MPI: %d processes, %d replicas, %d threads each: %.3f ms a sweep; exchange steps %.3f "
           "ms a sweep (%.1f %%) on the quickest process, %.3f ms (%.1f %%) on the one that waited longest; %.2f "
-          "chain moves a sweep of %zu bytes\n", net->size, a->n_rep, omp_get_max_threads(), 1e3 * sweep, 1e3 * lo,
-          100.0 * lo / sweep, 1e3 * hi, 100.0 * hi / sweep, (double)moves / 2.0 / (double)m->sweeps,
-          chain_bytes(a->chains[0]));
+          "chain moves a sweep of %zu bytes; alone, one reduction of %zu words %.1f us, one chain move %.1f us\n",
+          net->size, a->n_rep, omp_get_max_threads(), 1e3 * sweep, 1e3 * lo, 100.0 * lo / sweep, 1e3 * hi,
+          100.0 * hi / sweep, (double)moves / 2.0 / (double)m->sweeps, chain_bytes(a->chains[0]), m->buf_len,
+          1e6 * reduce, 1e6 * move);
 }
 
 /* ---- checkpoints ------------------------------------------------------ */
