@@ -357,7 +357,11 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   a->end_sweep = p->sweeps;
   /* Everything above only read input: the directory appears once the run
   ** is known to be valid. */
-  if ((s = make_dir(dir, err)) || !writes_files(a)) return s;
+  if ((s = make_dir(dir, err))) return s;
+  if (!writes_files(a)) {
+    lw_phase_set(NULL);
+    return LW_OK;
+  }
   char path[LW_PATH_MAX + 32], tmp[LW_PATH_MAX + 64];
   dir_file(path, sizeof path, a, "scene.ini");
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);

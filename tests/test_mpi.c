@@ -111,8 +111,8 @@ static int signal_rank_mid_run(const char *m, const char *name, const char *sig,
   return sh("cd %s && { timeout 120 sh -c '" MPIRUN " -n 2 %s run s.ini --out %s --quiet --set anneal.sweeps=1000000 "
             "--set output.checkpoint_every=20 2>%s.err; echo $? > %s.rc' & } && "
             "for i in $(seq 600); do grep -q '^sweep = [1-9]' %s/state.lw 2>/dev/null && break; sleep 0.1; done && "
-            "for p in $(pgrep -f 'linewise-mpi run s.ini --out %s '); do "
-            "  tr '\\0' '\\n' < /proc/$p/environ | grep -qx OMPI_COMM_WORLD_RANK=%d && kill -%s $p; done; "
+            "for p in /proc/[0-9]*; do tr '\\0' ' ' < $p/cmdline 2>/dev/null | grep -q 'linewise-mpi run s.ini --out %s ' && "
+            "  tr '\\0' '\\n' < $p/environ 2>/dev/null | grep -qx OMPI_COMM_WORLD_RANK=%d && kill -%s ${p#/proc/}; done; "
             "for i in $(seq 1200); do test -s %s.rc && exit 0; sleep 0.1; done; exit 1",
             dir, m, name, name, name, name, name, rank, sig, name);
 }

@@ -31,9 +31,6 @@
 ** NULL if MPI could not start (the message printed). */
 lw_anneal_net *lw_mpi_init(int *argc, char ***argv, volatile sig_atomic_t *stop);
 
-/* This process's rank (0 before lw_mpi_init). */
-int lw_mpi_rank(void);
-
 /* Collective: every process returns the status of the first process whose
 ** s is not LW_OK, with its message, or LW_OK; also agrees on the stop
 ** flag (net->stop_agreed). */

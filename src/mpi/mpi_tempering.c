@@ -27,8 +27,6 @@ static MPI_Comm comm = MPI_COMM_NULL;
 static int my_rank;
 static int agreed_failure; /* the last error returned came from an agreement */
 
-int lw_mpi_rank(void) { return my_rank; }
-
 int lw_mpi_agreed(void) { return agreed_failure; }
 
 void lw_mpi_abort(int code) { MPI_Abort(comm != MPI_COMM_NULL ? comm : MPI_COMM_WORLD, code); }
