@@ -10,7 +10,8 @@
 ** the previous or the new state.lw, each with the trace length it belongs
 ** to (resume cuts trace.csv back to it).  The system's state goes through
 ** its row (system.h): each rung's [system <name>] section is the row's.  replica-K.lw files are copies
-** for the user, written after state.lw; resume does not read them.
+** for the user, written after state.lw (before it, by their
+** processes, in a run over MPI: mpi_tempering.h); resume does not read them.
 */
 #ifndef LINEWISE_CHECKPOINT_H
 #define LINEWISE_CHECKPOINT_H
