@@ -115,6 +115,123 @@ Test(order, two_opt_does_not_depend_on_the_numbering_of_the_paths)
   free(r2);
 }
 
+/* ---- 2-opt's local optimum, checked by brute force ------------------ */
+
+/* Point e of the open tour: e = 2 k is the entry of the k-th path drawn, 2 k
+** + 1 its exit; e = -1 is home. */
+static void tour_point(const lw_order_path *p, const size_t *o, const unsigned char *r, long e, double hx, double hy,
+                       double *x, double *y)
+{
+  if (e < 0) {
+    *x = hx;
+    *y = hy;
+    return;
+  }
+  const lw_order_path *q = &p[o[e / 2]];
+  int end = (int)(e & 1) ^ r[e / 2]; /* 0: the path's start, 1: its end */
+  *x = end ? q->x1 : q->x0;
+  *y = end ? q->y1 : q->y0;
+}
+
+/* Whether end point b (2 path + end, or 2 n for home) is among the
+** LW_ORDER_NEIGHBOURS nearest of end point a, its own path's other end
+** left out (order.h: the candidates of a 2-opt move). */
+static int is_candidate(const lw_order_path *p, size_t n, double hx, double hy, size_t a, size_t b)
+{
+  double ax, ay, bx, by;
+  const lw_order_path *pa = &p[a / 2], *pb = &p[b / 2];
+  ax = a == 2 * n ? hx : (a & 1) ? pa->x1 : pa->x0;
+  ay = a == 2 * n ? hy : (a & 1) ? pa->y1 : pa->y0;
+  bx = b == 2 * n ? hx : (b & 1) ? pb->x1 : pb->x0;
+  by = b == 2 * n ? hy : (b & 1) ? pb->y1 : pb->y0;
+  double d = hypot(bx - ax, by - ay);
+  size_t nearer = 0;
+  for (size_t c = 0; c <= 2 * n; c++) {
+    if (c == a || c == b || (c < 2 * n && a < 2 * n && c / 2 == a / 2)) continue;
+    const lw_order_path *pc = &p[c / 2];
+    double cx = c == 2 * n ? hx : (c & 1) ? pc->x1 : pc->x0, cy = c == 2 * n ? hy : (c & 1) ? pc->y1 : pc->y0;
+    if (hypot(cx - ax, cy - ay) < d && ++nearer >= LW_ORDER_NEIGHBOURS) return 0;
+  }
+  return 1;
+}
+
+/* The end point id (2 path + end, 2 n for home) at tour point e. */
+static size_t tour_id(size_t n, const size_t *o, const unsigned char *r, long e)
+{
+  return e < 0 ? 2 * n : 2 * o[e / 2] + (size_t)((e & 1) ^ r[e / 2]);
+}
+
+/* Dense paths (lines about 0.5 mm apart) from a scrambled tour: 2-opt makes
+** thousands of long reversals, which split and relay the two-level list
+** many times.  Where it stops, no 2-opt move that it could have seen is
+** left: reversing tour places i..j swaps legs X -> U and Y -> V (X the exit
+** before i, U the entry of i, Y the exit of j, V the entry after j) for X ->
+** Y and U -> V, and a move that gains is seen from any of X, Y, U, V whose
+** new leg is shorter than its old one and goes to one of its candidates.
+** Every pair (i, j) is checked by brute force; a succ/pred/orientation slip
+** in the list shows up as such a move, or as a tour that is not a
+** permutation or is longer than the start. */
+Test(order, two_opt_stops_at_a_local_optimum_of_its_candidate_moves)
+{
+  const size_t n = 1500;
+  const double hx = 0, hy = 0;
+  rng_seed(4242);
+  lw_order_path *p = malloc(n * sizeof *p);
+  size_t *o = malloc(n * sizeof *o), *o2 = malloc(n * sizeof *o2);
+  unsigned char *r = malloc(n), *r2 = malloc(n);
+  for (size_t i = 0; i < n; i++) {
+    double x = urand(0, 30), y = urand(0, 30), a = urand(0, 2 * M_PI), l = urand(0.2, 6);
+    p[i] = (lw_order_path){x, y, x + l * cos(a), y + l * sin(a)};
+    o[i] = i;
+    r[i] = urand(0, 1) < 0.5;
+  }
+  for (size_t k = n - 1; k > 0; k--) {
+    size_t j = (size_t)urand(0, (double)k + 1), t = o[k];
+    o[k] = o[j];
+    o[j] = t;
+  }
+  memcpy(o2, o, n * sizeof *o);
+  memcpy(r2, r, n);
+  double start = lw_order_travel(p, n, o, r, hx, hy);
+  cr_assert_eq(lw_order_2opt(p, n, hx, hy, o, r, NULL), LW_OK);
+  assert_permutation(o, n);
+  double after = lw_order_travel(p, n, o, r, hx, hy);
+  cr_assert(after < 0.1 * start, "2-opt %.6g from %.6g", after, start);
+  cr_assert_eq(lw_order_2opt(p, n, hx, hy, o2, r2, NULL), LW_OK);
+  cr_assert(!memcmp(o, o2, n * sizeof *o) && !memcmp(r, r2, n), "not deterministic");
+
+  for (long i = 0; i < (long)n; i++) {
+    double Xx, Xy, Ux, Uy;
+    tour_point(p, o, r, 2 * i - 1, hx, hy, &Xx, &Xy);
+    tour_point(p, o, r, 2 * i, hx, hy, &Ux, &Uy);
+    double xu = hypot(Ux - Xx, Uy - Xy);
+    for (long j = i; j < (long)n; j++) {
+      double Yx, Yy, Vx = 0, Vy = 0;
+      tour_point(p, o, r, 2 * j + 1, hx, hy, &Yx, &Yy);
+      int last = j == (long)n - 1; /* V is the free end of the open tour */
+      if (!last) tour_point(p, o, r, 2 * j + 2, hx, hy, &Vx, &Vy);
+      double yv = last ? 0 : hypot(Vx - Yx, Vy - Yy), xy = hypot(Yx - Xx, Yy - Xy);
+      double uv = last ? 0 : hypot(Vx - Ux, Vy - Uy);
+      double gain = xu + yv - xy - uv;
+      if (gain <= 1e-6) continue;
+      size_t X = tour_id(n, o, r, 2 * i - 1), U = tour_id(n, o, r, 2 * i), Y = tour_id(n, o, r, 2 * j + 1);
+      int seen = (xy < xu - 1e-9 && is_candidate(p, n, hx, hy, X, Y)) ||
+                 (xy < yv - 1e-9 && is_candidate(p, n, hx, hy, Y, X));
+      if (!last) {
+        size_t V = tour_id(n, o, r, 2 * j + 2);
+        seen = seen || (uv < xu - 1e-9 && is_candidate(p, n, hx, hy, U, V)) ||
+               (uv < yv - 1e-9 && is_candidate(p, n, hx, hy, V, U));
+      }
+      cr_assert(!seen, "a move reversing places %ld..%ld gains %.3g mm and was in reach", i, j, gain);
+    }
+  }
+  free(p);
+  free(o);
+  free(o2);
+  free(r);
+  free(r2);
+}
+
 /* The greedy step takes the nearest end point; on a tie the lower path,
 ** start before end. */
 Test(order, greedy_picks_nearest_end_and_reverses)
