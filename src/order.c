@@ -490,6 +490,78 @@ static void push(two_opt *t, size_t item)
   t->queue[(t->q_head + t->q_len++) % t->m] = item;
 }
 
+/* Moves the stretch s1 .. s2 (at most a few items, p before it, nx after)
+** to between c and d = succ(c), drawn the other way round if `flip`, by
+** three reversals at most: s1 .. c, then c .. nx (which puts the stretch
+** reversed between c and d and the items between back as they were), then
+** the stretch itself unless it is to be flipped.  Each reversal may read the
+** cycle the other way round (reverse()), so each step finds its ends by
+** looking at the cycle again.  c is none of p, pred(p), the stretch and nx. */
+static void move_stretch(two_opt *t, size_t p, size_t s1, size_t s2, size_t nx, size_t c, int flip)
+{
+  reverse(t, s1, c);
+  if (succ(t, p) == c) reverse(t, c, nx);
+  else reverse(t, nx, c);
+  if (!flip) {
+    if (succ(t, c) == s2) reverse(t, s2, s1);
+    else reverse(t, s1, s2);
+  }
+}
+
+/* An Or-opt move for the stretch of 1 to LW_ORDER_OR_MAX items from a
+** forward: taken out (its neighbours p and nx joined) and put between two
+** items c and d elsewhere, either way round.  Candidates are the end points
+** near the stretch's two ends (entry e1 of its first item, exit x2 of its
+** last): an exit near one of them is a c, an entry a d.  As in 2-opt, a new
+** leg that is not shorter than what taking the stretch out saves ends the
+** search in that list. */
+static int or_opt(two_opt *t, size_t a)
+{
+  const size_t K = LW_ORDER_NEIGHBOURS;
+  if (t->m < 2 * LW_ORDER_OR_MAX + 4) return 0;
+  size_t p = pred(t, a), s[LW_ORDER_OR_MAX];
+  size_t xp = exit_of(t, p), e1 = entry_of(t, a);
+  s[0] = a;
+  for (size_t len = 1; len <= LW_ORDER_OR_MAX; len++) {
+    if (len > 1) s[len - 1] = succ(t, s[len - 2]);
+    size_t s2 = s[len - 1], nx = succ(t, s2), x2 = exit_of(t, s2), en = entry_of(t, nx);
+    if (nx == p) return 0;
+    double removed = leg(t, xp, e1) + leg(t, x2, en) - leg(t, xp, en);
+    if (removed <= LW_ORDER_EPS) continue;
+    for (int end = 0; end < 2; end++) {
+      size_t z = end ? x2 : e1;
+      if (z == t->free_pt) continue;
+      for (size_t k = 0; k < t->nbn[z]; k++) {
+        size_t q = t->nb[z * K + k], item = q / 2;
+        double new1 = leg(t, z, q);
+        t->work++;
+        if (new1 >= removed - LW_ORDER_EPS) break;
+        /* q an exit: c = its item, d after it; q an entry: d = its item */
+        size_t c = q == exit_of(t, item) ? item : pred(t, item), d = succ(t, c);
+        int skip = c == p || c == nx || d == p;
+        for (size_t i = 0; i < len; i++) skip |= c == s[i];
+        if (skip) continue;
+        size_t xc = exit_of(t, c), ed = entry_of(t, d);
+        /* forward: c -> s1 ... s2 -> d; flipped: c -> s2 ... s1 -> d */
+        double fwd = leg(t, xc, e1) + leg(t, x2, ed), flp = leg(t, xc, x2) + leg(t, e1, ed);
+        int flip = flp < fwd;
+        double gain = removed + leg(t, xc, ed) - (flip ? flp : fwd);
+        if (gain > LW_ORDER_EPS) {
+          move_stretch(t, p, a, s2, nx, c, flip);
+          push(t, p);
+          push(t, nx);
+          push(t, c);
+          push(t, d);
+          push(t, a);
+          push(t, s2);
+          return 1;
+        }
+      }
+    }
+  }
+  return 0;
+}
+
 /* One improving move around item a, if its candidate lists offer one. */
 static int improve(two_opt *t, size_t a)
 {
@@ -542,7 +614,7 @@ static int improve(two_opt *t, size_t a)
       }
     }
   }
-  return 0;
+  return or_opt(t, a);
 }
 
 static void two_opt_free(two_opt *t)

@@ -133,23 +133,27 @@ static void tour_point(const lw_order_path *p, const size_t *o, const unsigned c
   *y = end ? q->y1 : q->y0;
 }
 
-/* Whether end point b (2 path + end, or 2 n for home) is among the
-** LW_ORDER_NEIGHBOURS nearest of end point a, its own path's other end
-** left out (order.h: the candidates of a 2-opt move). */
+/* End point id: 2 path + end, 2 n for home. */
+static void end_xy(const lw_order_path *p, size_t n, double hx, double hy, size_t id, double *x, double *y)
+{
+  const lw_order_path *q = &p[id / 2];
+  *x = id == 2 * n ? hx : (id & 1) ? q->x1 : q->x0;
+  *y = id == 2 * n ? hy : (id & 1) ? q->y1 : q->y0;
+}
+
+/* Whether end point b is among the LW_ORDER_NEIGHBOURS nearest of end point
+** a, its own path's other end left out (order.h: the candidates of a move). */
 static int is_candidate(const lw_order_path *p, size_t n, double hx, double hy, size_t a, size_t b)
 {
   double ax, ay, bx, by;
-  const lw_order_path *pa = &p[a / 2], *pb = &p[b / 2];
-  ax = a == 2 * n ? hx : (a & 1) ? pa->x1 : pa->x0;
-  ay = a == 2 * n ? hy : (a & 1) ? pa->y1 : pa->y0;
-  bx = b == 2 * n ? hx : (b & 1) ? pb->x1 : pb->x0;
-  by = b == 2 * n ? hy : (b & 1) ? pb->y1 : pb->y0;
+  end_xy(p, n, hx, hy, a, &ax, &ay);
+  end_xy(p, n, hx, hy, b, &bx, &by);
   double d = hypot(bx - ax, by - ay);
   size_t nearer = 0;
   for (size_t c = 0; c <= 2 * n; c++) {
     if (c == a || c == b || (c < 2 * n && a < 2 * n && c / 2 == a / 2)) continue;
-    const lw_order_path *pc = &p[c / 2];
-    double cx = c == 2 * n ? hx : (c & 1) ? pc->x1 : pc->x0, cy = c == 2 * n ? hy : (c & 1) ? pc->y1 : pc->y0;
+    double cx, cy;
+    end_xy(p, n, hx, hy, c, &cx, &cy);
     if (hypot(cx - ax, cy - ay) < d && ++nearer >= LW_ORDER_NEIGHBOURS) return 0;
   }
   return 1;
@@ -159,6 +163,60 @@ static int is_candidate(const lw_order_path *p, size_t n, double hx, double hy, 
 static size_t tour_id(size_t n, const size_t *o, const unsigned char *r, long e)
 {
   return e < 0 ? 2 * n : 2 * o[e / 2] + (size_t)((e & 1) ^ r[e / 2]);
+}
+
+/* The tour as order.h's cycle: item 0 is home, entered at FREE (SIZE_MAX,
+** at no distance from anything) and left at the home point; item k + 1 is
+** the k-th path.  in[] and out[] are end point ids. */
+static double cycle_leg(const lw_order_path *p, size_t n, double hx, double hy, size_t a, size_t b)
+{
+  if (a == SIZE_MAX || b == SIZE_MAX) return 0.0;
+  double ax, ay, bx, by;
+  end_xy(p, n, hx, hy, a, &ax, &ay);
+  end_xy(p, n, hx, hy, b, &bx, &by);
+  return hypot(bx - ax, by - ay);
+}
+
+/* No Or-opt move in reach is left either: a stretch of 1 to
+** LW_ORDER_OR_MAX paths taken out (its neighbours joined, saving `removed`)
+** and put between c and d either way round, seen from the stretch's end z
+** when a new leg from z is shorter than `removed` and goes to one of z's
+** candidates.  Moves next to the stretch's own place are not Or-opt moves
+** (order.c leaves them to 2-opt or to a neighbour's stretch), nor, here,
+** stretches through home. */
+static void assert_no_or_opt_in_reach(const lw_order_path *p, size_t n, double hx, double hy, const size_t *o,
+                                      const unsigned char *r)
+{
+  size_t m = n + 1, *in = malloc(m * sizeof *in), *out = malloc(m * sizeof *out);
+  in[0] = SIZE_MAX;
+  out[0] = 2 * n;
+  for (size_t k = 0; k < n; k++) {
+    in[k + 1] = 2 * o[k] + r[k];
+    out[k + 1] = 2 * o[k] + 1 - r[k];
+  }
+  for (size_t s1 = 1; s1 < m; s1++)
+    for (size_t len = 1; len <= LW_ORDER_OR_MAX && s1 + len <= m; len++) {
+      size_t s2 = s1 + len - 1, pv = s1 - 1, nx = (s2 + 1) % m, e1 = in[s1], x2 = out[s2];
+      double removed = cycle_leg(p, n, hx, hy, out[pv], e1) + cycle_leg(p, n, hx, hy, x2, in[nx]) -
+                       cycle_leg(p, n, hx, hy, out[pv], in[nx]);
+      for (size_t c = 0; c < m; c++) {
+        size_t d = (c + 1) % m;
+        if ((c >= s1 && c <= s2) || c == pv || c == nx || d == pv) continue;
+        double fwd = cycle_leg(p, n, hx, hy, out[c], e1) + cycle_leg(p, n, hx, hy, x2, in[d]);
+        double flp = cycle_leg(p, n, hx, hy, out[c], x2) + cycle_leg(p, n, hx, hy, e1, in[d]);
+        double gain = removed + cycle_leg(p, n, hx, hy, out[c], in[d]) - fmin(fwd, flp);
+        if (gain <= 1e-6) continue;
+        const size_t z[2] = {e1, x2}, q[2] = {out[c], in[d]};
+        for (int i = 0; i < 2; i++)
+          for (int j = 0; j < 2; j++)
+            cr_assert(q[j] == SIZE_MAX || cycle_leg(p, n, hx, hy, z[i], q[j]) >= removed - 1e-9 ||
+                          !is_candidate(p, n, hx, hy, z[i], q[j]),
+                      "moving places %zu..%zu of the tour after %zu gains %.3g mm and was in reach", s1 - 1, s2 - 1,
+                      c, gain);
+      }
+    }
+  free(in);
+  free(out);
 }
 
 /* Dense paths (lines about 0.5 mm apart) from a scrambled tour: 2-opt makes
@@ -171,7 +229,7 @@ static size_t tour_id(size_t n, const size_t *o, const unsigned char *r, long e)
 ** Every pair (i, j) is checked by brute force; a succ/pred/orientation slip
 ** in the list shows up as such a move, or as a tour that is not a
 ** permutation or is longer than the start. */
-Test(order, two_opt_stops_at_a_local_optimum_of_its_candidate_moves)
+Test(order, two_opt_and_or_opt_stop_at_a_local_optimum_of_their_candidate_moves)
 {
   const size_t n = 1500;
   const double hx = 0, hy = 0;
@@ -225,6 +283,7 @@ Test(order, two_opt_stops_at_a_local_optimum_of_its_candidate_moves)
       cr_assert(!seen, "a move reversing places %ld..%ld gains %.3g mm and was in reach", i, j, gain);
     }
   }
+  assert_no_or_opt_in_reach(p, n, hx, hy, o, r);
   free(p);
   free(o);
   free(o2);

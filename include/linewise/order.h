@@ -28,9 +28,13 @@
 **           changed decides what is looked at next.  The tour is kept as a
 **           cycle through a virtual "home" item whose incoming leg is free,
 **           so either side of a cut may be reversed (the shorter one is).
+**           The cycle is a two-level list: blocks of about sqrt(n) paths,
+**           each read forwards or backwards, so a reversal rewrites
+**           O(sqrt n) entries where an array rewrote up to n / 2.
 **           The work is capped at LW_ORDER_WORK per path (candidate checks
-**           plus moved array entries), which bounds the time on any input
-**           while giving the same answer on every machine.
+**           plus entries a reversal or a re-layout of the list rewrites),
+**           which bounds the time on any input while giving the same answer
+**           on every machine.
 ** A move is made only when it shortens the tour by more than
 ** LW_ORDER_EPS mm, so the travel never grows.
 */
@@ -42,7 +46,8 @@
 #include "linewise/error.h"
 
 #define LW_ORDER_NEIGHBOURS 10 /* candidate end points per end point in 2-opt */
-#define LW_ORDER_WORK 10000    /* 2-opt work cap per path (checks + moved entries) */
+#define LW_ORDER_WORK 10000    /* 2-opt work cap per path (checks + rewritten entries) */
+#define LW_ORDER_OR_MAX 3      /* longest stretch an Or-opt move carries, paths */
 #define LW_ORDER_EPS 1e-9      /* mm: smallest gain that counts as an improvement */
 
 typedef struct {
