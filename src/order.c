@@ -380,16 +380,18 @@ static void cut_blocks(two_opt *t)
 ** block), each drawn as before with its block's reading folded into rev. */
 static void lay_out(two_opt *t)
 {
-  size_t a = block_first(t, t->border[0]);
-  for (size_t k = 0; k < t->m; k++) {
-    t->scratch[k] = a;
-    a = succ(t, a);
+  size_t k = 0;
+  for (size_t p = 0; p < t->nblk; p++) {
+    size_t b = t->border[p];
+    if (t->brev[b])
+      for (size_t s = t->hi[b]; s-- > t->lo[b];) {
+        t->scratch[k++] = t->item[s];
+        t->rev[t->item[s]] ^= 1;
+      }
+    else
+      for (size_t s = t->lo[b]; s < t->hi[b]; s++) t->scratch[k++] = t->item[s];
   }
-  for (size_t k = 0; k < t->m; k++) {
-    a = t->scratch[k];
-    t->rev[a] = (unsigned char)orient(t, a);
-  }
-  for (size_t k = 0; k < t->m; k++) {
+  for (k = 0; k < t->m; k++) {
     t->item[k] = t->scratch[k];
     t->slot[t->scratch[k]] = k;
   }
