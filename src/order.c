@@ -1,5 +1,5 @@
 /*
-** order.c -- greedy and 2-opt ordering of plotter paths (order.h).
+** order.c -- greedy, 2-opt and Or-opt ordering of plotter paths (order.h).
 **
 ** End points are numbered 2p (start of path p) and 2p + 1 (end of path p).
 ** A uniform grid of them answers "nearest end point" for the greedy tour and
@@ -485,6 +485,7 @@ static void reverse(two_opt *t, size_t from, size_t to)
   }
   t->work += len;
 }
+
 static void push(two_opt *t, size_t item)
 {
   if (t->queued[item]) return;
