@@ -60,10 +60,10 @@ void bench_order(bench_ctx *b)
              "Random paths in random directions, home at a corner: at a drawing's density (0.5 to 4.5 mm\n"
              "long on a square page, 9 mm^2 a path) and on the dense A4 page of docs/FORMATS.md (5 mm\n"
              "long, lines 0.12 mm apart). The greedy tour, then lw_order_2opt (2-opt and Or-opt moves,\n"
-             "order.h) within its counted budget. Times are medians of %d runs, in thread CPU time (what a quiet machine's wall clock\n"
-             "shows) and in wall time on the machine as it was (its load is in the note under Scaling,\n"
-             "or at the top). 2-opt's time includes its candidate lists. Travel: the pen-up travel in\n"
-             "index order, after greedy and after 2-opt.\n\n"
+             "order.h) within its counted budget. Times are medians of %d runs, in thread CPU time\n"
+             "(what a quiet machine's wall clock shows) and in wall time on the machine as it was\n"
+             "(its load is in the note under Scaling, or at the top). 2-opt's time includes its\n"
+             "candidate lists. Travel: the pen-up travel in index order, after greedy and after 2-opt.\n\n"
              "| paths | page | greedy s (CPU) | 2-opt s (CPU) | 2-opt s (wall) | travel in index order, m | "
              "greedy, m | 2-opt, m |\n|---|---|---|---|---|---|---|---|\n",
           reps);
@@ -103,7 +103,8 @@ void bench_order(bench_ctx *b)
              "list) count 1.0 x 10^8 steps of work, a tenth of the budget of LW_ORDER_WORK per path.\n"
              "Before, the tour was an array, a reversal moved up to n / 2 entries, and 2-opt alone\n"
              "(no Or-opt) made 43,500 reversals there that moved 9.6 x 10^8 entries, just within the\n"
-             "budget (10^9), in 2.4 to 3.0 s of CPU time (0.56 to 0.67 s at a drawing's density), for\n"
+             "budget (10^9), in 2.9 to 3.5 s of CPU time at a load of 9 to 15 (0.67 s at a drawing's\n"
+             "density; about 2.4 and 0.56 s on a quiet machine), for\n"
              "tours of 39.2 m on the dense page and 169.9 m at a drawing's density (10^5 paths, the\n"
              "instances of this table; 17.1 m at 10^4).\n\n");
 }
