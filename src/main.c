@@ -180,29 +180,16 @@ typedef struct {
 static void *watch(void *arg)
 {
   watcher *w = arg;
-  const char *shown = NULL;
-  double last = 0.0, reported = 0.0;
+  lw_phase_watch pw = {.tty = w->tty};
+  char line[512];
   const struct timespec tick = {0, 100000000};
   while (!atomic_load(&w->stop)) {
     nanosleep(&tick, NULL);
     double t;
     const char *what = lw_phase_get(&t);
-    if (shown && what != shown) {
-      fprintf(stderr, "%slinewise: %s: done in %.1f s\n", w->tty ? "\r\033[K" : "", shown, last);
-      shown = NULL;
-    }
-    if (what && t > 1.0 && (!shown || (w->tty && t - reported >= 1.0))) {
-      /* a terminal sees the seconds count up in place; a log gets one line */
-      if (w->tty) fprintf(stderr, "\r\033[Klinewise: %s... %.0f s", what, t);
-      else if (!shown) fprintf(stderr, "linewise: %s...\n", what);
-      shown = what;
-      reported = t;
-    }
-    if (what == shown) last = t;
+    fputs(lw_phase_watch_tick(&pw, what, t, line, sizeof line), stderr);
   }
-  if (shown)
-    fprintf(stderr, "%slinewise: %s: %s %.1f s\n", w->tty ? "\r\033[K" : "", shown,
-            atomic_load(&w->stop) > 1 ? "failed after" : "done in", last);
+  fputs(lw_phase_watch_end(&pw, atomic_load(&w->stop) > 1, line, sizeof line), stderr);
   return NULL;
 }
 

@@ -272,7 +272,7 @@ const lw_param_def lw_param_table[] = {
          "Colours of the pens as `#rrggbb` or `#rgb`, one per pen, separated by spaces; empty = all black."),
   CHOICE("output", "order", order, "2opt", "none|greedy|2opt",
          "Order of the paths of each pen in final.svg: index order, greedy nearest neighbour from "
-         "the page origin, or greedy improved by 2-opt; paths may be reversed. Reduces pen-up "
+         "the page origin, or greedy improved by 2-opt and Or-opt moves; paths may be reversed. Reduces pen-up "
          "travel (reported in summary.json)."),
   NUM("output", "png_scale", LW_PT_DOUBLE, png_scale, "4", "px/mm", 0, 100, LW_MIN_OPEN,
       "Pixels per millimetre of final.png and the frames (the long side is capped at 4096 px)."),
