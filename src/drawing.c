@@ -24,6 +24,16 @@ lw_status lw_drawing_page(const lw_params *p, lw_output_page *page, lw_error *er
     page->pen[k].width_mm = p->pen_width;
     memcpy(page->pen[k].rgb, rgb[k], 3);
   }
+  lw_layers_spec ls;
+  lw_status s = lw_layers_read(p, &ls, err);
+  if (s || !ls.n) return s;
+  /* a pen a layer, and inks that darken what they cross, as on paper */
+  page->n_pens = ls.n;
+  page->multiply = 1;
+  for (int k = 0; k < ls.n; k++) {
+    page->pen[k].width_mm = ls.spec[k].pen_width;
+    memcpy(page->pen[k].rgb, ls.spec[k].rgb, 3);
+  }
   return LW_OK;
 }
 
@@ -43,6 +53,8 @@ static lw_plot *make_plot(const lw_params *p, const lw_scene *sc, const lw_splin
                           lw_error *err)
 {
   double *key = NULL;
+  if (sc->layers.n) /* layer k is pen k + 1: round robin, as lw_layers_of */
+    return lw_plot_new(sp, sc->layers.n, NULL, LW_PLOT_ORDER_NONE, 0.0, 0.0, err);
   if (p->pens > 1 && (sc->on[LW_TERM_POTENTIAL] || tone)) {
     key = malloc((sp->n_splines ? sp->n_splines : 1) * sizeof *key);
     if (!key) {
@@ -84,13 +96,24 @@ static void options(const lw_params *p, const lw_scene *sc, lw_strokes_options *
   }
 }
 
-/* The fidelity scores of the drawing, overall and per pen. */
-static lw_status score(const lw_params *p, const lw_strokes *st, const lw_grid2d *tone, lw_drawing_report *rep,
-                       lw_error *err)
+/* The fidelity scores of the drawing, overall and per pen; a layer's pen
+** against the layer's own target, drawn with its own width. */
+static lw_status score(const lw_params *p, const lw_scene *sc, const lw_strokes *st, const lw_grid2d *tone,
+                       lw_drawing_report *rep, lw_error *err)
 {
   lw_status s = lw_fidelity_compute_strokes(st, -1, tone, p->pen_width, p->fidelity_sigma, &rep->fidelity, err);
-  for (int k = 0; !s && st->n_pens > 1 && k < st->n_pens; k++)
-    s = lw_fidelity_compute_strokes(st, k, tone, p->pen_width, p->fidelity_sigma, &rep->pen_fidelity[k], err);
+  for (int k = 0; !s && st->n_pens > 1 && k < st->n_pens; k++) {
+    const lw_image *target = k < sc->layers.n ? sc->layer[k].target : NULL;
+    if (!target) {
+      s = lw_fidelity_compute_strokes(st, k, tone, p->pen_width, p->fidelity_sigma, &rep->pen_fidelity[k], err);
+      continue;
+    }
+    lw_grid2d *g = lw_image_tone_grid(target, &sc->image_place, err);
+    if (!g) return err ? err->code : LW_ENOMEM;
+    s = lw_fidelity_compute_strokes(st, k, g, sc->layers.spec[k].pen_width, p->fidelity_sigma,
+                                    &rep->pen_fidelity[k], err);
+    lw_grid2d_free(g);
+  }
   rep->has_fidelity = !s;
   return s;
 }
@@ -141,7 +164,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
     s = lw_output_pdf_strokes(st, &page, under, path, err);
   }
   if (!s) s = close_share(p, st, rep, err);
-  if (!s && tone) s = score(p, st, tone, rep, err);
+  if (!s && tone) s = score(p, sc, st, tone, rep, err);
   lw_strokes_free(st);
   return s;
 }

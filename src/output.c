@@ -352,6 +352,7 @@ static void draw(cairo_t *cr, const lw_strokes *s, const lw_output_page *page, c
   if (tone) paint_tone(cr, tone);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
   cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+  if (page->multiply) cairo_set_operator(cr, CAIRO_OPERATOR_MULTIPLY);
   for (int k = 0; k < page->n_pens; k++) {
     const lw_output_pen *pen = &page->pen[k];
     cairo_set_source_rgb(cr, pen->rgb[0] / 255.0, pen->rgb[1] / 255.0, pen->rgb[2] / 255.0);

@@ -47,6 +47,9 @@ typedef struct {
   double width_mm, height_mm;         /* page, mm (> 0) */
   int n_pens;                         /* 1 .. LW_PLOT_PENS_MAX */
   lw_output_pen pen[LW_PLOT_PENS_MAX];
+  int multiply;                       /* 1: the previews lay each pen's ink over the
+                                         others by multiplying colours (cyan over yellow
+                                         is green); 0: each paints over */
 } lw_output_page;
 
 /* A page of the given size with one pen: 0.3 mm, black. */
