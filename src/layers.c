@@ -1,7 +1,7 @@
 /* layers.c -- the [layers] keys and colour separation (layers.h). */
 #include "linewise/layers.h"
 
-#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_math.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -124,7 +124,8 @@ typedef struct {
 } normal;
 
 /* Solves M_FF z_F = b_F - M_FB a_B for the free set F (free[j] = 1) into
-** z (entries of F only) by Cholesky: M_FF is positive definite. */
+** z (entries of F only) by Cholesky: M_FF is positive definite (the ridge
+** keeps its pivots >= lambda), and at most 16 x 16. */
 static void solve_free(const normal *nm, const double *b, const double *a, const int *free_, double *z)
 {
   int idx[LW_LAYERS_MAX], nf = 0;
@@ -137,10 +138,27 @@ static void solve_free(const normal *nm, const double *b, const double *a, const
       if (!free_[j]) r[i] -= nm->M[idx[i]][j] * a[j];
     for (int j = 0; j < nf; j++) m[i * nf + j] = nm->M[idx[i]][idx[j]];
   }
-  gsl_matrix_view mv = gsl_matrix_view_array(m, (size_t)nf, (size_t)nf);
-  gsl_vector_view rv = gsl_vector_view_array(r, (size_t)nf), xv = gsl_vector_view_array(x, (size_t)nf);
-  gsl_linalg_cholesky_decomp1(&mv.matrix);
-  gsl_linalg_cholesky_solve(&mv.matrix, &rv.vector, &xv.vector);
+  /* Cholesky m = L L^T in place (lower triangle), then two triangular solves */
+  for (int j = 0; j < nf; j++) {
+    double d = m[j * nf + j];
+    for (int q = 0; q < j; q++) d -= m[j * nf + q] * m[j * nf + q];
+    m[j * nf + j] = sqrt(d);
+    for (int i = j + 1; i < nf; i++) {
+      double v = m[i * nf + j];
+      for (int q = 0; q < j; q++) v -= m[i * nf + q] * m[j * nf + q];
+      m[i * nf + j] = v / m[j * nf + j];
+    }
+  }
+  for (int i = 0; i < nf; i++) {
+    double v = r[i];
+    for (int q = 0; q < i; q++) v -= m[i * nf + q] * x[q];
+    x[i] = v / m[i * nf + i];
+  }
+  for (int i = nf - 1; i >= 0; i--) {
+    double v = x[i];
+    for (int q = i + 1; q < nf; q++) v -= m[q * nf + i] * x[q];
+    x[i] = v / m[i * nf + i];
+  }
   for (int i = 0; i < nf; i++) z[idx[i]] = x[i];
 }
 
@@ -204,7 +222,7 @@ void lw_layers_separate(const float *r, const float *g, const float *b, size_t n
       nm.M[i][j] = u[i][0] * u[j][0] + u[i][1] * u[j][1] + u[i][2] * u[j][2] + (i == j ? LW_LAYERS_RIDGE : 0.0);
   for (size_t p = 0; p < n; p++) {
     double d[3] = {1.0 - r[p], 1.0 - g[p], 1.0 - b[p]}, rhs[LW_LAYERS_MAX], x[LW_LAYERS_MAX];
-    for (int j = 0; j < k; j++) rhs[j] = u[j][0] * d[0] + u[j][1] * d[1] + u[j][2] * d[2];
+    for (int j = 0; j < k; j++) rhs[j] = u[j][0] * d[0] + u[j][1] * d[1] + u[j][2] * d[2] - LW_LAYERS_INK;
     bounded_qp(&nm, rhs, x);
     for (int j = 0; j < k; j++) a[(size_t)j * n + p] = (float)(x[j] < 0.0 ? 0.0 : x[j] > 1.0 ? 1.0 : x[j]);
   }

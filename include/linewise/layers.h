@@ -33,13 +33,18 @@
 ** fraction a_k reflects c = 1 - sum_k a_k u_k, u_k = 1 - p_k (exact while
 ** inks do not overlap, first order in the coverage when they do).  Per
 ** pixel of colour c the coverages minimise
-**     |U a - (1 - c)|^2 + lambda |a|^2   subject to 0 <= a_k <= 1,
-** U the 3 x K matrix of the u_k, lambda = LW_LAYERS_RIDGE: a strictly
-** convex quadratic, solved exactly by a bounded active-set method (each
-** step a Cholesky solve of the free variables' normal equations, GSL).  The
-** ridge makes the solution unique when pens are dependent (K > 3, as CMYK)
-** and then prefers the least ink: a grey is drawn in black rather than in
-** cyan, magenta and yellow at once.
+**     1/2 |U a - (1 - c)|^2 + 1/2 lambda |a|^2 + mu sum_k a_k
+**     subject to 0 <= a_k <= 1,
+** U the 3 x K matrix of the u_k, lambda = LW_LAYERS_RIDGE, mu =
+** LW_LAYERS_INK: a strictly convex quadratic, solved exactly by a bounded
+** active-set method (each step a Cholesky solve of the free variables'
+** normal equations).  When pens are dependent (K > 3, as CMYK) many
+** coverages fit equally well; mu picks the one with the least ink (a grey
+** in black alone rather than in cyan, magenta and yellow at once: 1 unit
+** against 3), and lambda, far smaller, keeps the problem strictly convex.
+** Both pull a fit that is exact by at most (lambda |a| + mu sqrt(K)) /
+** s_min, s_min the smallest eigenvalue of U^T U: 2e-4 for pens as
+** independent as the process colours, below an 8-bit step (4e-3).
 */
 #ifndef LINEWISE_LAYERS_H
 #define LINEWISE_LAYERS_H
@@ -55,6 +60,7 @@
 
 #define LW_LAYERS_MAX LW_PLOT_PENS_MAX
 #define LW_LAYERS_RIDGE 1e-6   /* lambda of the separation */
+#define LW_LAYERS_INK 1e-5     /* mu of the separation */
 
 /* One layer as the scene file describes it. */
 typedef struct {
