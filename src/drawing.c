@@ -53,8 +53,17 @@ static lw_plot *make_plot(const lw_params *p, const lw_scene *sc, const lw_splin
                           lw_error *err)
 {
   double *key = NULL;
-  if (sc->layers.n) /* layer k is pen k + 1: round robin, as lw_layers_of */
-    return lw_plot_new(sp, sc->layers.n, NULL, LW_PLOT_ORDER_NONE, 0.0, 0.0, err);
+  if (sc->layers.n) { /* layer k is pen k + 1 */
+    int *pen = malloc((sp->n_splines ? sp->n_splines : 1) * sizeof *pen);
+    if (!pen) {
+      lw_error_set(err, LW_ENOMEM, "out of memory for the pens of %zu splines", sp->n_splines);
+      return NULL;
+    }
+    for (size_t i = 0; i < sp->n_splines; i++) pen[i] = lw_layers_of(&sc->layers, i);
+    lw_plot *pl = lw_plot_new_pens(sp, sc->layers.n, pen, LW_PLOT_ORDER_NONE, 0.0, 0.0, err);
+    free(pen);
+    return pl;
+  }
   if (p->pens > 1 && (sc->on[LW_TERM_POTENTIAL] || tone)) {
     key = malloc((sp->n_splines ? sp->n_splines : 1) * sizeof *key);
     if (!key) {

@@ -105,6 +105,7 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
   } else if (ls->source == LW_LSRC_PALETTE) {
     return bad(p, "source", err, "'palette' needs layers.colors: the pens to separate the picture into");
   }
+  lw_layers_share(ls, NULL);
   for (int k = 0; k < n; k++) {
     ls->spec[k].turn = turn[k] * M_PI / 180.0;
     ls->spec[k].tone_min = lo[k];
@@ -113,6 +114,19 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
     memcpy(ls->spec[k].rgb, rgb[k], 3);
   }
   return LW_OK;
+}
+
+void lw_layers_share(lw_layers_spec *ls, const lw_image *const *target)
+{
+  double ink[LW_LAYERS_MAX] = {0}, total = 0.0;
+  for (int k = 0; target && k < ls->n; k++) {
+    const size_t n = (size_t)target[k]->width * (size_t)target[k]->height;
+    for (size_t q = 0; q < n; q++) ink[k] += 1.0 - target[k]->tone[q];
+    total += ink[k];
+  }
+  ls->cum[0] = 0.0;
+  for (int k = 0; k < ls->n; k++) ls->cum[k + 1] = total > 0.0 ? ls->cum[k] + ink[k] / total : (k + 1.0) / ls->n;
+  ls->cum[ls->n] = 1.0;
 }
 
 /* ---- separation ---------------------------------------------------------- */

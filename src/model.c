@@ -185,6 +185,7 @@ static void term_set_init(lw_term_set *ts, const lw_scene *sc)
 {
   lw_scene_term_ctx(sc, ts->ctx);
   ts->n_layers = sc->layers.n;
+  ts->layers = &sc->layers;
   for (int k = 0; k < ts->n_layers; k++) lw_scene_layer_ctx(sc, k, ts->layer_ctx[k]);
   ts->n_spline = 0;
   ts->n_raster = 0;
@@ -200,13 +201,13 @@ static void term_set_init(lw_term_set *ts, const lw_scene *sc)
 /* The term contexts of spline i: its layer's, or the scene's. */
 static const lw_term_ctx *ctx_of(const lw_term_set *ts, size_t i)
 {
-  return ts->n_layers ? ts->layer_ctx[lw_layers_of(i, ts->n_layers)] : ts->ctx;
+  return ts->n_layers ? ts->layer_ctx[lw_layers_of(ts->layers, i)] : ts->ctx;
 }
 
 /* Where spline i's plane of a raster term's raster starts. */
 static size_t plane_of(const lw_term_set *ts, size_t i, const lw_tone *t)
 {
-  return ts->n_layers ? (size_t)lw_layers_of(i, ts->n_layers) * (size_t)t->w * (size_t)t->h : 0;
+  return ts->n_layers ? (size_t)lw_layers_of(ts->layers, i) * (size_t)t->w * (size_t)t->h : 0;
 }
 
 /* A zeroed raster of term t: a plane a layer (every layer's is as large). */

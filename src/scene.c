@@ -274,8 +274,11 @@ static lw_status build_layers(lw_scene *sc, const lw_params *p, lw_error *err)
   if (!sc->image) {
     if (sc->layers.source != LW_LSRC_TONE)
       return bad_key(p, "layers", "source", LW_EINPUT, err, "a separation needs a colour picture in scene.image");
-  } else if ((st = layer_targets(sc, p, err))) {
-    return st;
+  } else {
+    if ((st = layer_targets(sc, p, err))) return st;
+    const lw_image *t[LW_LAYERS_MAX];
+    for (int k = 0; k < sc->layers.n; k++) t[k] = sc->layer[k].target;
+    lw_layers_share(&sc->layers, t);
   }
   for (int k = 0; k < sc->layers.n; k++) {
     lw_layer *l = &sc->layer[k];

@@ -2,11 +2,18 @@
 ** layers.h -- hatching layers and colour pens: a scene split into layers,
 ** each a pen of its own with its own target, field, width and colour.
 **
-** A scene with [layers] names = "a b ..." has L layers; spline i belongs to
-** layer i mod L (lw_layers_of), which needs no per-spline storage and is
-** what the plot's round-robin pens do (plot.h), so layer k is pen k + 1 of
-** the drawing.  A move that renumbered splines would move them between
-** layers: the moves keep indices, so a spline's layer is fixed for a run.
+** A scene with [layers] names = "a b ..." has L layers, and each spline
+** belongs to one, a function of its index alone (lw_layers_of): with the
+** layers' shares s_k (the ink of each target over the ink of all, equal
+** shares without a picture) and the golden-ratio sequence
+** x_i = frac((i + 1) phi), phi = (sqrt 5 - 1) / 2, spline i is of the
+** layer k with s_0 + .. + s_(k-1) <= x_i < s_0 + .. + s_k.  The sequence
+** is evenly spread for every count, so each layer gets its share of any
+** number of splines (to O(log n) splines), and a layer without ink gets
+** none.  Nothing is stored per spline: a state file needs no new data,
+** and a spline added at the end of the list finds its layer as well.  A
+** move that renumbered splines would move them between layers.  Layer k
+** is pen k + 1 of the drawing.
 **
 ** What a layer changes: the terms that read the picture or the field read
 ** the layer's own (scene.h, lw_scene_layer_ctx):
@@ -49,6 +56,7 @@
 #ifndef LINEWISE_LAYERS_H
 #define LINEWISE_LAYERS_H
 
+#include <math.h>
 #include <stddef.h>
 
 #include "linewise/error.h"
@@ -75,6 +83,7 @@ typedef struct {
   int n;                     /* 0 = no layers */
   int source;                /* LW_LSRC_* */
   lw_layer_spec spec[LW_LAYERS_MAX];
+  double cum[LW_LAYERS_MAX + 1]; /* cumulated shares: cum[0] = 0, cum[n] = 1 */
 } lw_layers_spec;
 
 /* What a layer's terms read, built by the scene from its spec. */
@@ -89,8 +98,19 @@ typedef struct {
 ** file, line and key and what was expected. */
 lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err);
 
-/* The layer of spline i among n layers (n > 0). */
-static inline int lw_layers_of(size_t i, int n) { return (int)(i % (size_t)n); }
+/* The shares of the layers from the ink (1 - tone) of their targets, or
+** equal shares when there is no ink at all. */
+void lw_layers_share(lw_layers_spec *ls, const lw_image *const *target);
+
+/* The layer of spline i (ls->n > 0; see above). */
+static inline int lw_layers_of(const lw_layers_spec *ls, size_t i)
+{
+  double x = (double)(i + 1) * 0.6180339887498949;
+  x -= floor(x);
+  int k = 0;
+  while (k < ls->n - 1 && x >= ls->cum[k + 1]) k++;
+  return k;
+}
 
 /* Separates n pixels of colour (r, g, b) into the k pens of colours rgb:
 ** a[j * n + p] = coverage of pen j at pixel p, in [0, 1] (see above).

@@ -66,6 +66,7 @@ typedef struct {
   int n_raster;             /* the raster terms that are on */
   lw_term_id raster[LW_TERM_COUNT];
   int n_layers;             /* the scene's layers (layers.h), 0 = none: then ctx serves every spline */
+  const lw_layers_spec *layers; /* the scene's, with n_layers */
   lw_term_ctx layer_ctx[LW_LAYERS_MAX][LW_TERM_COUNT]; /* each layer's contexts */
 } lw_term_set;
 
