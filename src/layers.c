@@ -24,9 +24,13 @@ static lw_status bad(const lw_params *p, const char *key, lw_error *err, const c
   return lw_error_set(err, LW_EINPUT, "%s: key 'layers.%s': %s", where, key, what);
 }
 
-static int was_set(const lw_params *p, const char *key)
+/* 1 if key holds something other than its default (a run's scene.ini
+** writes every key back, so where a key was set says nothing). */
+static int given(const lw_params *p, const char *key)
 {
-  return p->line[lw_params_find("layers", key) - lw_param_table] != 0;
+  if (!strcmp(key, "source")) return p->ly_source != LW_LSRC_TONE;
+  const lw_param_def *d = lw_params_find("layers", key);
+  return ((const char *)p + d->offset)[0] != '\0';
 }
 
 /* One number a layer from text into v[n] (empty: leave the defaults);
@@ -57,7 +61,7 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
   static const char *const keys[] = {"source", "colors", "turn", "tone_min", "tone_max", "pen_width"};
   if (!p->ly_names[0]) {
     for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++)
-      if (was_set(p, keys[k])) return bad(p, keys[k], err, "needs layers.names (the layers it describes)");
+      if (given(p, keys[k])) return bad(p, keys[k], err, "needs layers.names (the layers it describes)");
     return LW_OK;
   }
   int n = 0;
@@ -89,10 +93,10 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
     return st;
   for (int k = 0; k < n; k++)
     if (!(lo[k] < hi[k]))
-      return bad(p, was_set(p, "tone_max") ? "tone_max" : "tone_min", err,
+      return bad(p, given(p, "tone_max") ? "tone_max" : "tone_min", err,
                  "expected layers.tone_min < layers.tone_max, got %g and %g for layer %d", lo[k], hi[k], k + 1);
-  if (ls->source != LW_LSRC_TONE && (was_set(p, "tone_min") || was_set(p, "tone_max")))
-    return bad(p, was_set(p, "tone_min") ? "tone_min" : "tone_max", err,
+  if (ls->source != LW_LSRC_TONE && (given(p, "tone_min") || given(p, "tone_max")))
+    return bad(p, given(p, "tone_min") ? "tone_min" : "tone_max", err,
                "a tone range needs layers.source = tone (a separation sets each pen's target)");
   unsigned char rgb[LW_LAYERS_MAX][3] = {{0}};
   if (p->ly_colors[0]) {
