@@ -318,8 +318,10 @@ const lw_param_def lw_param_table[] = {
   STRING("layers", "names", ly_names, "", "",
          "Hatching layers or colour pens: one name a layer, separated by blanks (at most 16). Each "
          "layer is a pen of its own (one SVG group) with its own target, field, width and colour; "
-         "spline i belongs to layer i mod (number of layers). Empty = no layers: one target, one "
-         "field, the pens of [output]. docs/IMAGES.md, \"Hatching layers and colour\"."),
+         "each spline belongs to one, by its index, the layers getting splines in proportion to "
+         "the ink of their targets. Needs output.pens = 1 (the layers are the pens). Empty = no "
+         "layers: one target, one field, the pens of [output]. docs/IMAGES.md, \"Hatching layers "
+         "and colour\"."),
   CHOICE("layers", "source", ly_source, "tone", "tone|cmyk|palette",
          "Each layer's target: `tone` = the picture's darkness through the layer's `tone_min` .. "
          "`tone_max`; `cmyk` = the cyan, magenta, yellow and black separation of the colour picture "
