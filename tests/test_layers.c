@@ -19,6 +19,7 @@
 #include <sys/wait.h>
 
 #include "imageutil.h"
+#include "linewise/gradient.h"
 #include "linewise/init.h"
 #include "linewise/layers.h"
 #include "linewise/model.h"
@@ -307,6 +308,51 @@ Test(layers, each_layer_gets_splines_by_its_share_of_the_ink)
     cr_assert_eq(count[1], 0);
     cr_assert(fabs((double)count[0] - 0.7 * n) <= 2 + log((double)n), "n %zu: %zu in layer 0", n, count[0]);
   }
+}
+
+Test(layers, the_gradient_reads_each_layers_field_and_potential)
+{
+  /* Layers with turned fields and their own potentials: the gradient of
+  ** field + potential + bending matches central differences of
+  ** lw_energy_compute (which reads each spline's layer) for every
+  ** coordinate of a few splines of each layer. */
+  lw_params p = colour_params(40, 40, blotch_colours);
+  snprintf(p.ly_names, sizeof p.ly_names, "a b");
+  p.ly_source = LW_LSRC_PALETTE;
+  snprintf(p.ly_colors, sizeof p.ly_colors, "#20a0c0 #c02060");
+  snprintf(p.ly_turn, sizeof p.ly_turn, "30 100");
+  p.potential = LW_POT_IMAGE;
+  p.potential_coef = 0.5;
+  p.field = LW_FLD_CONSTANT;
+  p.field_angle = 10;
+  p.field_mode = LW_FIELDMODE_SIGNED;
+  p.field_coef = -0.7;
+  p.bending = 0.3;
+  lw_scene sc;
+  scene_of(&sc, &p);
+  lw_model *m = model_of(&sc, 8, 2, 3, 3);
+  lw_splines *sp = lw_splines_clone(m->sp);
+  lw_node *g = calloc(sp->n_nodes, sizeof *g);
+  lw_error err;
+  double term[LW_TERM_COUNT];
+  cr_assert(isfinite(lw_energy_gradient(&sc, sp, LW_GRAD_ALL, g, term, &err)), "%s", err.msg);
+  const double h = 1e-6;
+  for (size_t k = 0; k < sp->n_nodes; k++)
+    for (int c = 0; c < 4; c++) {
+      double *x = &sp->node[k].px + c, x0 = *x, tp[LW_TERM_COUNT], tm[LW_TERM_COUNT];
+      *x = x0 + h;
+      double ep = lw_energy_compute(&sc, sp, tp, NULL);
+      *x = x0 - h;
+      double em = lw_energy_compute(&sc, sp, tm, NULL);
+      *x = x0;
+      double fd = (ep - em) / (2 * h), an = (&g[k].px)[c];
+      cr_assert(fabs(fd - an) <= 1e-4 * fmax(1.0, fabs(fd)), "node %zu coordinate %d: analytic %g, differences %g", k,
+                c, an, fd);
+    }
+  free(g);
+  lw_splines_free(sp);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
 }
 
 /* ---- separation --------------------------------------------------------- */
