@@ -234,20 +234,25 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
   return sp;
 }
 
+/* The darkness of img (placed as the picture) over the inside, mm^2. */
+static double ink_area_of(const lw_scene *sc, const lw_image *img)
+{
+  const lw_boundary *b = &sc->boundary;
+  double sum = 0.0;
+  const lw_image_place *pl = &sc->image_place;
+  for (int j = 0; j < img->height; j++)
+    for (int i = 0; i < img->width; i++) {
+      double x = pl->x0 + (i + 0.5) * pl->pixel, y = pl->y0 + (j + 0.5) * pl->pixel;
+      if (lw_boundary_distance(b, x, y) < 0) sum += 1.0 - img->tone[(size_t)j * (size_t)img->width + (size_t)i];
+    }
+  return sum * pl->pixel * pl->pixel;
+}
+
 double lw_init_ink_area(const lw_scene *sc)
 {
   const lw_boundary *b = &sc->boundary;
   double sum = 0.0;
-  if (sc->image) {
-    const lw_image *img = sc->image;
-    const lw_image_place *pl = &sc->image_place;
-    for (int j = 0; j < img->height; j++)
-      for (int i = 0; i < img->width; i++) {
-        double x = pl->x0 + (i + 0.5) * pl->pixel, y = pl->y0 + (j + 0.5) * pl->pixel;
-        if (lw_boundary_distance(b, x, y) < 0) sum += 1.0 - img->tone[(size_t)j * (size_t)img->width + (size_t)i];
-      }
-    return sum * pl->pixel * pl->pixel;
-  }
+  if (sc->image) return ink_area_of(sc, sc->image);
   /* no picture: the area inside, counted on cells of at most 1/1024 of the
   ** page's longer side (error below the perimeter times half a cell) */
   double cell = fmax(sc->width, sc->height) / 1024.0;
@@ -286,6 +291,12 @@ lw_status lw_init_count(const lw_scene *sc, const lw_params *p, size_t *n, lw_er
     return LW_OK;
   }
   double want = p->coverage * lw_init_ink_area(sc) / (p->pen_width * p->segments * p->segment_length);
+  if (sc->layers.n && sc->layer[0].target) { /* each layer's ink in its own pen (layers.h) */
+    want = 0.0;
+    for (int k = 0; k < sc->layers.n; k++)
+      want += p->coverage * ink_area_of(sc, sc->layer[k].target) /
+              (sc->layers.spec[k].pen_width * p->segments * p->segment_length);
+  }
   if (!(want <= 1e8))
     return lw_error_set(err, LW_EINPUT, "%s: key 'init.coverage': %g asks for %.3g splines, more than 1e8",
                         where, p->coverage, want);

@@ -210,6 +210,22 @@ Test(layers, one_whole_range_layer_is_the_scene_without_layers)
   double ea = lw_energy_compute(&plain, m->sp, a, NULL), eb = lw_energy_compute(&one, m->sp, b, NULL);
   for (int t = 0; t < LW_TERM_COUNT; t++) cr_assert_eq(a[t], b[t], "%s: %.17g and %.17g", lw_term_names[t], a[t], b[t]);
   cr_assert_eq(ea, eb);
+  /* the same number of splines from a coverage, and twice as many for two
+  ** such layers (each layer's ink in its own pen) */
+  p.splines = 0;
+  p.coverage = 0.4;
+  size_t n_plain, n_one, n_two;
+  lw_error err;
+  cr_assert_eq(lw_init_count(&plain, &p, &n_plain, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_init_count(&one, &p, &n_one, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(n_plain, n_one);
+  lw_scene two;
+  snprintf(p.ly_names, sizeof p.ly_names, "all again");
+  scene_of(&two, &p);
+  cr_assert_eq(lw_init_count(&two, &p, &n_two, &err), LW_OK, "%s", err.msg);
+  cr_assert(n_two >= 2 * n_one - 1 && n_two <= 2 * n_one + 1, "%zu and %zu", n_one, n_two);
+  lw_scene_clear(&two);
+  snprintf(p.ly_names, sizeof p.ly_names, "all");
   /* and a narrower range asks for less ink: the tone term sees it */
   lw_scene half;
   snprintf(p.ly_tone_max, sizeof p.ly_tone_max, "0.5");
