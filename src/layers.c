@@ -1,6 +1,7 @@
 /* layers.c -- the [layers] keys and colour separation (layers.h). */
 #include "linewise/layers.h"
 
+#include <ctype.h>
 #include <gsl/gsl_math.h>
 #include <math.h>
 #include <stdarg.h>
@@ -72,6 +73,10 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
     if (n == LW_LAYERS_MAX) return bad(p, "names", err, "expected at most %d layers", LW_LAYERS_MAX);
     if (len >= sizeof ls->spec[n].name)
       return bad(p, "names", err, "expected names of at most %zu characters", sizeof ls->spec[n].name - 1);
+    /* the name labels the pen's SVG layer: nothing XML would read as markup */
+    for (size_t q = 0; q < len; q++)
+      if (!isalnum((unsigned char)c[q]) && !strchr("-_.", c[q]))
+        return bad(p, "names", err, "expected names of letters, digits, '-', '_' and '.', got '%.*s'", (int)len, c);
     memcpy(ls->spec[n].name, c, len);
     ls->spec[n].name[len] = '\0';
     n++;

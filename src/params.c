@@ -316,7 +316,8 @@ const lw_param_def lw_param_table[] = {
       "Time of one pen lift and lowering for the plot time estimate; an AxiDraw's servo at its "
       "default rates (raise 75 %, lower 50 %, over 30 % of a 200 ms sweep) takes about 0.2 s."),
   STRING("layers", "names", ly_names, "", "",
-         "Hatching layers or colour pens: one name a layer, separated by blanks (at most 16). Each "
+         "Hatching layers or colour pens: one name a layer (letters, digits, `-`, `_`, `.`; it labels "
+         "the pen's SVG layer), separated by blanks (at most 16). Each "
          "layer is a pen of its own (one SVG group) with its own target, field, width and colour; "
          "each spline belongs to one, by its index, the layers getting splines in proportion to "
          "the ink of their targets. Needs output.pens = 1 (the layers are the pens). Empty = no "

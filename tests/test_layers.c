@@ -587,7 +587,7 @@ Test(layers, the_svg_has_one_group_a_pen_with_its_colour_and_width)
     snprintf(id, sizeof id, "id=\"pen%d\"", k + 1);
     const char *g = strstr(svg, id), *next = k < 3 ? strstr(svg, (snprintf(head, sizeof head, "id=\"pen%d\"", k + 2), head)) : svg + strlen(svg);
     cr_assert_not_null(g, "%s", id);
-    snprintf(head, sizeof head, "pen %d (%s mm)", k + 1, width[k]);
+    snprintf(head, sizeof head, "inkscape:label=\"%c (%s mm)\" id=\"pen%d\"", "cmyk"[k], width[k], k + 1);
     cr_assert_not_null(strstr(svg, head), "%s", head);
     /* every path of the group in the pen's colour and width */
     snprintf(stroke, sizeof stroke, "stroke=\"%s\" stroke-width=\"%s\"", colour[k], width[k]);
@@ -623,6 +623,7 @@ Test(layers, bad_layer_keys_give_one_line_with_file_line_and_key_and_exit_2)
     {"[layers]\nturn = 0 90\n", "scene.ini:9: key 'layers.turn': needs layers.names"},
     {"[layers]\nnames = a b\npen_width = 0.3 -1\n", "scene.ini:10: key 'layers.pen_width': expected values"},
     {"[layers]\nnames = a b\n[output]\npens = 3\n", "scene.ini:11: key 'output.pens': layers set the pens"},
+    {"[layers]\nnames = a <b>\n", "scene.ini:9: key 'layers.names': expected names of letters"},
   };
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
     char text[1024], errs[4096];

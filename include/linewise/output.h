@@ -41,6 +41,7 @@
 typedef struct {
   double width_mm;                    /* stroke width, mm (> 0) */
   unsigned char rgb[3];               /* colour, 0..255 per channel */
+  char name[64];                      /* the SVG layer's label, or empty: "pen <k>" */
 } lw_output_pen;
 
 typedef struct {
@@ -76,7 +77,8 @@ int lw_output_colors_parse(const char *list, unsigned char (*rgb)[3], int max);
 
 /* The plotter SVG, written atomically: width and height in mm, viewBox in
 ** mm (user unit = 1 mm), one Inkscape layer group per pen in pen order
-** (id "pen<k>", label "pen <k> (<width> mm)"), one path per spline with
+** (id "pen<k>", label "pen <k> (<width> mm)", or "<name> (<width> mm)" for a
+** named pen), one path per spline with
 ** M and C commands only.  A reversed path lists the control points of its
 ** segments backwards, last segment first, so it is the same curve.
 ** LW_EINPUT for a bad page or plot or a non-finite coordinate, LW_EIO when
