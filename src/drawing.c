@@ -33,7 +33,7 @@ lw_status lw_drawing_page(const lw_params *p, lw_output_page *page, lw_error *er
   for (int k = 0; k < ls.n; k++) {
     page->pen[k].width_mm = ls.spec[k].pen_width;
     memcpy(page->pen[k].rgb, ls.spec[k].rgb, 3);
-    memcpy(page->pen[k].name, ls.spec[k].name, sizeof page->pen[k].name);
+    memcpy(page->pen_name[k], ls.spec[k].name, sizeof page->pen_name[k]);
   }
   return LW_OK;
 }

@@ -252,7 +252,7 @@ lw_status lw_output_svg_strokes(const lw_strokes *s, const lw_output_page *page,
     const lw_output_pen *pen = &page->pen[k];
     char color[8];
     snprintf(color, sizeof color, "#%02x%02x%02x", pen->rgb[0], pen->rgb[1], pen->rgb[2]);
-    if (pen->name[0]) fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"%s (", pen->name);
+    if (page->pen_name[k][0]) fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"%s (", page->pen_name[k]);
     else fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"pen %d (", k + 1);
     put_mm(f, pen->width_mm);
     fprintf(f, " mm)\" id=\"pen%d\">\n", k + 1);

@@ -41,13 +41,13 @@
 typedef struct {
   double width_mm;                    /* stroke width, mm (> 0) */
   unsigned char rgb[3];               /* colour, 0..255 per channel */
-  char name[64];                      /* the SVG layer's label, or empty: "pen <k>" */
 } lw_output_pen;
 
 typedef struct {
   double width_mm, height_mm;         /* page, mm (> 0) */
   int n_pens;                         /* 1 .. LW_PLOT_PENS_MAX */
   lw_output_pen pen[LW_PLOT_PENS_MAX];
+  char pen_name[LW_PLOT_PENS_MAX][64]; /* each pen's SVG layer label, or empty: "pen <k>" */
   int multiply;                       /* 1: the previews lay each pen's ink over the
                                          others by multiplying colours (cyan over yellow
                                          is green); 0: each paints over */
