@@ -7,6 +7,10 @@
 ** blur, tone curve); the potential, the field and the mask boundary are
 ** built from it when the scene asks for them.
 **
+** With [layers] (layers.h) each layer has its own target, field,
+** potential and tone raster besides the scene's; lw_scene_layer_ctx gives
+** the term contexts a layer's splines read.
+**
 ** Only what the scene names is built: the potential exists only when its
 ** coefficient Q is non-zero, the vector field only when P is, and so on; a
 ** term that is off is never evaluated (lw_scene.local lists the per-segment
