@@ -396,10 +396,10 @@ static double smallest_eigen(const unsigned char (*rgb)[3], int k)
 Test(layers, a_palette_separation_recovers_the_pen_coverages_a_picture_was_mixed_from)
 {
   /* Pixels mixed from three pens at known coverages a (c = 1 - U a): the
-  ** separation gives a back, up to the ridge's pull lambda |a| / s_min
-  ** and the ink's, (lambda |a| + mu sqrt(3)) / s_min (s_min the smallest
-  ** eigenvalue of U^T U), and the float rounding of c
-  ** (6e-8 a channel, amplified by at most 1 / sqrt(s_min)). */
+  ** separation gives a back, up to the pull of the ridge and the ink
+  ** penalty, (lambda |a| + mu sqrt(3)) / s_min (s_min the smallest
+  ** eigenvalue of U^T U), and the float rounding of c (6e-8 a channel,
+  ** amplified by at most 1 / sqrt(s_min)). */
   const unsigned char pens[3][3] = {{0x20, 0x90, 0xc0}, {0xc0, 0x30, 0x70}, {0xe0, 0xc0, 0x20}};
   const double smin = smallest_eigen(pens, 3);
   cr_assert(smin > 0.01, "an independent palette");

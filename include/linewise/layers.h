@@ -49,9 +49,10 @@
 ** coverages fit equally well; mu picks the one with the least ink (a grey
 ** in black alone rather than in cyan, magenta and yellow at once: 1 unit
 ** against 3), and lambda, far smaller, keeps the problem strictly convex.
-** Both pull a fit that is exact by at most (lambda |a| + mu sqrt(K)) /
-** s_min, s_min the smallest eigenvalue of U^T U: 2e-4 for pens as
-** independent as the process colours, below an 8-bit step (4e-3).
+** For independent pens both pull a fit that is exact by at most
+** (lambda |a| + mu sqrt(K)) / s_min, s_min the smallest eigenvalue of
+** U^T U: 2e-5 for cyan, magenta and yellow (s_min = 1), far below an 8-bit
+** step (4e-3).
 */
 #ifndef LINEWISE_LAYERS_H
 #define LINEWISE_LAYERS_H
