@@ -82,6 +82,7 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
     n++;
     c += len;
   }
+  if (!n) return bad(p, "names", err, "expected at least one name, got '%s'", p->ly_names);
   ls->n = n;
   if (ls->source == LW_LSRC_CMYK && n != 4)
     return bad(p, "source", err, "'cmyk' needs 4 layers (cyan magenta yellow black), layers.names has %d", n);
