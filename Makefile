@@ -1,5 +1,5 @@
 # linewise -- elastic Bezier curves annealed into line art.
-# Targets: all (bin/linewise), deps, test, test-long, asan, fuzz, fuzz-build, run, bench, wire-figures, install, clean.
+# Targets: all (bin/linewise), deps, deps-mpi, mpi (bin/linewise-mpi), test, test-long, asan, fuzz, fuzz-build, run, bench, wire-figures, install, clean.
 
 CC      ?= cc
 PREFIX  ?= /usr/local
@@ -17,6 +17,12 @@ DEBS    := build-essential pkg-config libgsl-dev libcairo2-dev libinih-dev libst
            libcriterion-dev gnuplot-nox clang libclang-rt-dev
 
 LIB_SRC := $(filter-out src/main.c,$(wildcard src/*.c))
+# The MPI build (make mpi): main.c with -DLW_MPI and src/mpi/, through
+# mpicc; the plain build never needs MPI.  make test builds and runs it too
+# where mpicc is installed (make deps-mpi), and skips its tests otherwise.
+MPICC   ?= mpicc
+MPI_DEBS := libopenmpi-dev openmpi-bin
+MPI_BIN := $(if $(shell command -v $(MPICC) 2>/dev/null),$(BIN)/linewise-mpi)
 LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_OBJ := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%.o)
@@ -29,7 +35,7 @@ TOOLS   := seed-sweep param-sweep plot-run plot-sweep
 # The example picture is generated (no third-party images in the repository).
 PICTURE := params/picture.png
 
-.PHONY: all deps deps-animation test test-long asan fuzz fuzz-build run bench install clean docs wire-figures
+.PHONY: all deps deps-mpi mpi deps-animation test test-long asan fuzz fuzz-build run bench install clean docs wire-figures
 # The example picture too: params/example.ini, the scene a new user tries
 # first, needs it.
 all: $(BIN)/linewise $(PICTURE)
@@ -42,6 +48,12 @@ $(BUILD)/liblinewise.a: $(LIB_OBJ)
 
 $(BIN)/linewise: src/main.c $(BUILD)/liblinewise.a | $(BIN)
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) $< -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
+
+mpi: $(BIN)/linewise-mpi
+
+$(BIN)/linewise-mpi: src/main.c $(wildcard src/mpi/*.c) $(BUILD)/liblinewise.a | $(BIN)
+	$(MPICC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -DLW_MPI src/main.c $(wildcard src/mpi/*.c) -o $@ \
+	  $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
 
 $(BUILD)/tests/%.o: tests/%.c $(wildcard tests/*.h) $(wildcard include/linewise/*.h) | $(BUILD)/tests
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -Itests -c $< -o $@
@@ -57,8 +69,9 @@ $(BUILD)/obj $(BUILD)/tests $(BIN):
 
 # The suite runs the binary too (CLI tests), so both are built first, and
 # it checks that every bundled scene builds, the image scene included.
-test: $(BIN)/linewise $(BUILD)/tests/run $(PICTURE)
-	LW_BIN=$(CURDIR)/$(BIN)/linewise LW_ROOT=$(CURDIR) $(BUILD)/tests/run --jobs $(TEST_JOBS)
+test: $(BIN)/linewise $(MPI_BIN) $(BUILD)/tests/run $(PICTURE)
+	LW_BIN=$(CURDIR)/$(BIN)/linewise LW_MPI_BIN=$(if $(MPI_BIN),$(CURDIR)/$(MPI_BIN)) LW_ROOT=$(CURDIR) \
+	  $(BUILD)/tests/run --jobs $(TEST_JOBS)
 
 # The long statistical and stress tests (LW_LONG=1 scales them up; minutes).
 test-long: $(BIN)/linewise $(BUILD)/tests/run $(PICTURE)
@@ -113,6 +126,13 @@ deps:
 	  echo "installing:$$missing"; apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
 	else echo "all build dependencies present"; fi
 
+# Open MPI for the MPI build (make mpi) only.
+deps-mpi:
+	@missing=""; for p in $(MPI_DEBS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing:$$missing"; apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
+	else echo "all MPI dependencies present"; fi
+
 # ffmpeg for tools/animate.sh only: not needed to build or test.
 deps-animation:
 	@dpkg -s ffmpeg >/dev/null 2>&1 || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ffmpeg; }
@@ -144,9 +164,9 @@ $(BUILD)/bench: $(BENCH_SRC) $(BENCH_HDR) $(BUILD)/liblinewise.a
 
 # Benchmarks rewrite docs/PERFORMANCE.md and docs/ACCURACY.md (machine and date
 # recorded with them) and their plots docs/*.png; BENCH_QUICK=1 for a smoke run.
-bench: $(BUILD)/bench
+bench: $(BUILD)/bench $(MPI_BIN)
 	mkdir -p $(BUILD)/bench-data
-	$(BUILD)/bench docs $(BUILD)/bench-data
+	LW_MPI_BIN=$(MPI_BIN) $(BUILD)/bench docs $(BUILD)/bench-data
 	gnuplot -e "data='$(BUILD)/bench-data'; out='docs'" tools/bench.gp
 
 # The elastic wire of the D-NURBS review: its Figures 8 and 9 as
@@ -174,7 +194,8 @@ install: $(BIN)/linewise $(PICTURE)
 	install -d $(DESTDIR)$(PREFIX)/share/man/man1
 	install -m 644 docs/linewise.1 $(DESTDIR)$(PREFIX)/share/man/man1/linewise.1
 	for t in $(TOOLS); do install -m 755 tools/$$t $(DESTDIR)$(PREFIX)/bin/linewise-$$t; done
-	install -m 644 tools/slurm-sweep.sbatch $(DESTDIR)$(PREFIX)/share/linewise/
+	install -m 644 tools/slurm-sweep.sbatch tools/slurm-tempering.sbatch $(DESTDIR)$(PREFIX)/share/linewise/
+	if [ -x $(BIN)/linewise-mpi ]; then install -m 755 $(BIN)/linewise-mpi $(DESTDIR)$(PREFIX)/bin/linewise-mpi; fi
 
 clean:
 	rm -rf build build-asan build-fuzz bin $(PICTURE)

@@ -64,6 +64,25 @@ static void dir_file(char *buf, size_t n, const lw_anneal *a, const char *name)
   lw_path_join(buf, n, a->dir, name);
 }
 
+/* A run spread over processes (anneal_net.h): process 0 writes the run's
+** files, and each replica is swept by the process that owns it. */
+static int writes_files(const lw_anneal *a) { return !a->net || a->net->rank == 0; }
+
+static int replica_here(const lw_anneal *a, int r)
+{
+  return !a->net || lw_anneal_net_owner(r, a->n_rep, a->net->size) == a->net->rank;
+}
+
+static int rung_here(const lw_anneal *a, int k) { return replica_here(a, a->pt ? a->pt->at[k] : 0); }
+
+/* The energy of the replica at rung k; a stand-in's is its owner's. */
+static double rung_energy(const lw_anneal *a, int k)
+{
+  return rung_here(a, k) ? lw_system_total(a->chains[k]->sys) : a->net->energy[a->pt->at[k]];
+}
+
+double lw_anneal_energy(const lw_anneal *a) { return rung_energy(a, 0); }
+
 /* mkdir -p */
 static lw_status make_dir(const char *dir, lw_error *err)
 {
@@ -164,6 +183,11 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
     lw_params_origin(p, lw_params_find("scene", "driver"), where, sizeof where);
     return lw_error_set(err, LW_EINPUT, "%s: key 'scene.driver': the dynamics moves one system; parallel tempering "
                         "(%d replicas) needs driver = metropolis", where, a->n_rep);
+  }
+  if (a->net && a->n_rep < a->net->size) {
+    lw_params_origin(p, lw_params_find("tempering", "replicas"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.replicas': %d replicas for %d processes; expected at "
+                        "least one replica per process", where, a->n_rep, a->net->size);
   }
   lw_params_origin(p, lw_params_find("anneal", "t_start"), where, sizeof where);
   if (a->n_rep > 1 && !(p->t_start > 0.0))
@@ -295,7 +319,13 @@ static lw_status open_trace(lw_anneal *a, int fresh, lw_error *err)
 
 lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_error *err)
 {
+  return lw_anneal_start_net(a, p, dir, NULL, err);
+}
+
+lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir, lw_anneal_net *net, lw_error *err)
+{
   memset(a, 0, sizeof *a);
+  a->net = net;
   a->wall_start = now_seconds();
   a->params = *p;
   absolute_path(a->params.from, p->file);
@@ -328,6 +358,10 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   /* Everything above only read input: the directory appears once the run
   ** is known to be valid. */
   if ((s = make_dir(dir, err))) return s;
+  if (!writes_files(a)) {
+    lw_phase_set(NULL);
+    return LW_OK;
+  }
   char path[LW_PATH_MAX + 32], tmp[LW_PATH_MAX + 64];
   dir_file(path, sizeof path, a, "scene.ini");
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
@@ -338,7 +372,7 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   if ((s = open_trace(a, 1, err))) return s;
   lw_phase_set("drawing the start files");
   if ((s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_START, err))) return s;
-  s = lw_anneal_checkpoint(a, err);
+  s = net ? LW_OK : lw_anneal_checkpoint(a, err);
   lw_phase_set(NULL);
   return s;
 }
@@ -349,7 +383,7 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
 {
   const char *was = lw_phase_get(NULL);
   lw_phase_set("writing state.lw");
-  lw_status s = lw_checkpoint_write(a, err);
+  lw_status s = a->net ? a->net->checkpoint(a->net, a, err) : lw_checkpoint_write(a, err);
   lw_phase_set(was);
   return s;
 }
@@ -434,7 +468,13 @@ static lw_status rung_state(lw_anneal *a, lw_state *st, int k, void **state, lw_
 
 lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *err)
 {
+  return lw_anneal_resume_net(a, dir, more, NULL, err);
+}
+
+lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anneal_net *net, lw_error *err)
+{
   memset(a, 0, sizeof *a);
+  a->net = net;
   a->wall_start = now_seconds();
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   char path[LW_PATH_MAX + 32], scene_path[2 * LW_PATH_MAX + 2];
@@ -472,7 +512,7 @@ lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *e
   }
   a->end_sweep = more >= 0 ? a->sweep + more : (a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep);
   for (int k = 0; k < a->chain->n_moves; k++) a->proposals_before += a->chain->stats[k].proposed;
-  s = truncate_trace(a, trace_bytes, err);
+  if (writes_files(a)) s = truncate_trace(a, trace_bytes, err);
 out:
   lw_phase_set(NULL);
   for (int k = 1; k < LW_TEMPERING_MAX; k++) lw_ckpt_free(rep[k]);
@@ -484,6 +524,7 @@ out:
 
 static void trace_row(lw_anneal *a)
 {
+  if (!a->trace) return; /* another process writes it */
   lw_chain *c = a->chain;
   const lw_system_type *t = a->sys_type;
   double term[LW_SYSTEM_TERMS_MAX];
@@ -499,7 +540,7 @@ static void trace_row(lw_anneal *a)
   fprintf(a->trace, "%ld,%.10g", a->sweep, c->temperature);
   for (int k = 0; k < t->n_terms; k++)
     if (t->term_on(a->setup, k)) fprintf(a->trace, ",%.10g", term[k]);
-  fprintf(a->trace, ",%.10g", lw_system_total(a->sys));
+  fprintf(a->trace, ",%.10g", rung_energy(a, 0));
   for (int k = 0; k < c->n_moves; k++) {
     unsigned long p = c->stats[k].proposed - a->trace_mark[k].proposed;
     unsigned long acc = c->stats[k].accepted - a->trace_mark[k].accepted;
@@ -509,7 +550,7 @@ static void trace_row(lw_anneal *a)
   }
   if (a->pt) {
     for (int k = 0; k < a->n_rep; k++)
-      fprintf(a->trace, ",%.10g,%.10g", a->chains[k]->temperature, lw_system_total(a->chains[k]->sys));
+      fprintf(a->trace, ",%.10g,%.10g", a->chains[k]->temperature, rung_energy(a, k));
     /* swap acceptance since the previous row */
     for (int k = 0; k + 1 < a->n_rep; k++) {
       unsigned long tried = a->pt->tried[k] - a->swap_mark[2 * k];
@@ -546,7 +587,7 @@ static lw_status exchange(lw_anneal *a, lw_error *err)
   int n = a->n_rep, swapped[LW_TEMPERING_MAX];
   double e[LW_TEMPERING_MAX] = {0}, t[LW_TEMPERING_MAX] = {0};
   for (int k = 0; k < n; k++) {
-    e[k] = lw_system_total(a->chains[k]->sys);
+    e[k] = rung_energy(a, k);
     t[k] = a->chains[k]->temperature;
   }
   lw_tempering_exchange(pt, e, t, swapped);
@@ -557,6 +598,8 @@ static lw_status exchange(lw_anneal *a, lw_error *err)
       a->chains[k + 1]->sys = sys;
     }
   a->sys = a->chains[0]->sys;
+  lw_status s;
+  if (a->net && (s = a->net->moved(a->net, a, swapped, err))) return s;
   if (p->tune_ladder == LW_LADDER_EQUAL && a->sweep <= p->ladder_sweeps) {
     /* every pair has had ~20 attempts by then */
     if (pt->steps % 40 == 0) {
@@ -566,7 +609,7 @@ static lw_status exchange(lw_anneal *a, lw_error *err)
     if (a->sweep + p->exchange_every > p->ladder_sweeps) {
       lw_tempering_reset_stats(pt);
       memset(a->swap_mark, 0, sizeof a->swap_mark);
-      return write_ladder(a, err);
+      return writes_files(a) ? write_ladder(a, err) : LW_OK;
     }
   }
   return LW_OK;
@@ -577,7 +620,7 @@ static lw_status exchange(lw_anneal *a, lw_error *err)
 static lw_status sweep_files(lw_anneal *a, lw_error *err)
 {
   const lw_params *p = &a->params;
-  if (p->frames_every && a->sweep % p->frames_every == 0 &&
+  if (p->frames_every && a->sweep % p->frames_every == 0 && rung_here(a, 0) &&
       a->sys_type->draw(a->sys->state, p, a->dir, a->sweep, err))
     return err->code;
   if (a->sweep % p->checkpoint_every == 0) return lw_anneal_checkpoint(a, err);
@@ -622,33 +665,41 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
     }
   }
   int tuning = a->sweep - block_start(a, b) < p->tune_sweeps && a->sweep < p->sweeps;
-  int failed = 0;
+  int failed = 0, here[LW_TEMPERING_MAX], m = 0;
+  for (int k = 0; k < n; k++)
+    if (rung_here(a, k)) here[m++] = k; /* all of them in one process */
   /* The rungs are independent between exchanges: each touches only its own
   ** chain, stream and system, so the thread count cannot change the result. */
-#pragma omp parallel for schedule(static, 1) reduction(| : failed) if (n > 1)
-  for (int k = 0; k < n; k++) {
-    a->chains[k]->tuning = tuning;
-    if (lw_chain_sweep(a->chains[k]) != LW_OK) failed = 1;
+#pragma omp parallel for schedule(static, 1) reduction(| : failed) if (m > 1)
+  for (int i = 0; i < m; i++) {
+    a->chains[here[i]]->tuning = tuning;
+    if (lw_chain_sweep(a->chains[here[i]]) != LW_OK) failed = 1;
   }
+  lw_status s;
+  if (a->net && (s = a->net->share(a->net, a, failed, err))) return s;
   if (failed) return lw_error_set(err, LW_ENOMEM, "out of memory growing a system's caches");
   a->sweep++;
-  lw_status s;
   if (a->pt && a->sweep % p->exchange_every == 0 && (s = exchange(a, err))) return s;
-  double e = lw_system_total(a->sys);
+  double e = rung_energy(a, 0);
   if (!tuning && isfinite(e)) {
     a->acc_n += 1.0;
     a->acc_sum += e;
     a->acc_sumsq += e * e;
   }
   if (a->sweep % p->trace_every == 0 || lw_anneal_done(a)) trace_row(a);
-  if (a->sweep % p->check_every == 0)
-    for (int r = 0; r < n; r++) {
+  if (a->sweep % p->check_every == 0) {
+    s = LW_OK;
+    for (int r = 0; r < n && !s; r++) {
       double drift;
-      if (a->sys_type->renumber && (s = a->sys_type->renumber(a->systems[r]->state, err))) return s;
+      if (!replica_here(a, r)) continue;
+      if (a->sys_type->renumber && (s = a->sys_type->renumber(a->systems[r]->state, err))) break;
       if (a->sys_type->refresh(a->systems[r]->state, &drift) != LW_OK)
-        return lw_error_set(err, LW_ENOMEM, "out of memory");
-      if (drift > a->max_drift) a->max_drift = drift;
+        s = lw_error_set(err, LW_ENOMEM, "out of memory");
+      else if (drift > a->max_drift) a->max_drift = drift;
     }
+    if (a->net) s = a->net->drift(a->net, a, s, err);
+    if (s) return s;
+  }
   return sweep_files(a, err);
 }
 
@@ -760,7 +811,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     for (int k = 0; k < a->n_rep; k++) {
       lw_json_begin_object(&j);
       lw_json_key(&j, "temperature"); lw_json_number(&j, a->chains[k]->temperature);
-      lw_json_key(&j, "energy"); lw_json_number(&j, lw_system_total(a->chains[k]->sys));
+      lw_json_key(&j, "energy"); lw_json_number(&j, rung_energy(a, k));
       lw_json_end_object(&j);
     }
     lw_json_end_array(&j);
@@ -794,6 +845,7 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 {
   lw_status s;
   if ((s = lw_anneal_checkpoint(a, err))) return s;
+  if (!rung_here(a, 0)) return LW_OK; /* the process of the coldest replica draws it */
   if (a->params.quench == LW_QUENCH_BFGS && !a->quenched) {
     lw_phase_set("quenching to the nearest minimum");
     s = lw_quench_run(a->sys, a->params.quench_tol, a->params.quench_iterations, &a->quench, err);

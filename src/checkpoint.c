@@ -53,8 +53,10 @@ void lw_checkpoint_system_section(char *buf, size_t n, const lw_system_type *t, 
 
 /* ---- writing ---------------------------------------------------------------- */
 
-static void put_chain(lw_ckpt_writer *w, int k, const lw_system_type *t, const lw_chain *c, int *bad)
+void lw_checkpoint_put_chain(lw_ckpt_writer *w, const lw_anneal *a, int k, int *bad)
 {
+  const lw_system_type *t = a->sys_type;
+  const lw_chain *c = a->chains[k];
   char sec[32], key[96];
   double term[LW_SYSTEM_TERMS_MAX];
   rung_section(sec, sizeof sec, "chain", k);
@@ -123,7 +125,7 @@ static void put_dynamics(lw_ckpt_writer *w, const lw_dynamics *d)
 
 /* replica-K.lw: a plain state of rung K for the user (init.from, energy):
 ** the header and the system's section as for the coldest rung. */
-static lw_status write_replica(const lw_anneal *a, int k, lw_error *err)
+lw_status lw_checkpoint_write_replica(const lw_anneal *a, int k, lw_error *err)
 {
   lw_state head = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep};
   char name[64], path[LW_PATH_MAX + 64];
@@ -141,67 +143,90 @@ static lw_status write_replica(const lw_anneal *a, int k, lw_error *err)
   return lw_ckpt_commit(&w, err);
 }
 
+lw_status lw_checkpoint_sync_trace(lw_anneal *a, long *bytes, lw_error *err)
+{
+  char path[LW_PATH_MAX + 32];
+  *bytes = 0;
+  if (!a->trace) return LW_OK;
+  dir_file(path, sizeof path, a, "trace.csv");
+  if (fflush(a->trace) || fsync(fileno(a->trace)) || (*bytes = ftell(a->trace)) < 0)
+    return lw_error_set(err, LW_EIO, "%s: write failed: %s", path, strerror(errno));
+  return LW_OK;
+}
+
+void lw_checkpoint_put_run(lw_ckpt_writer *w, const lw_anneal *a, long trace_bytes)
+{
+  lw_state head = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep};
+  lw_state_put_header(w, &head);
+  lw_ckpt_put(w, "temperature", "%.17g", a->t_sched);
+  lw_ckpt_put(w, "block", "%ld", a->block);
+  lw_ckpt_put(w, "t_prev", "%.17g", a->t_prev);
+  lw_ckpt_put(w, "prev_stats", "%.17g %.17g %ld", a->prev.mean, a->prev.sd, a->prev.samples);
+  lw_ckpt_put(w, "block_energy", "%.17g %.17g %.17g", a->acc_n, a->acc_sum, a->acc_sumsq);
+  lw_ckpt_put(w, "energy_initial", "%.17g", a->energy_initial);
+  lw_ckpt_put(w, "max_drift", "%.17g", a->max_drift);
+  lw_ckpt_put(w, "trace_bytes", "%ld", trace_bytes);
+  const lw_system_type *t = a->sys_type;
+  for (int m = 0; m < a->chain->n_moves; m++) {
+    char key[96];
+    const lw_move_stats *st = &a->trace_mark[m];
+    snprintf(key, sizeof key, "trace_mark.%s", t->move_names[m]);
+    lw_ckpt_put_counts(w, key, (unsigned long[]){st->proposed, st->accepted, st->nan}, 3);
+  }
+}
+
+void lw_checkpoint_put_ensemble(lw_ckpt_writer *w, const lw_anneal *a, int *bad)
+{
+  if (a->pt) put_tempering(w, a, bad);
+  if (a->dyn) put_dynamics(w, a->dyn);
+}
+
+lw_status lw_checkpoint_put_system(lw_ckpt_writer *w, const lw_anneal *a, int k, lw_error *err)
+{
+  char sec[96];
+  lw_checkpoint_system_section(sec, sizeof sec, a->sys_type, k);
+  return a->sys_type->save(a->chains[k]->sys->state, w, sec, err);
+}
+
+lw_status lw_checkpoint_write_timing(const lw_anneal *a, lw_error *err)
+{
+  char path[LW_PATH_MAX + 32], tmp[LW_PATH_MAX + 64];
+  dir_file(path, sizeof path, a, "timing.txt");
+  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
+  if (!f) return err->code;
+  fprintf(f, "wall_seconds %.6f\n", lw_anneal_seconds(a));
+  return lw_output_commit(f, tmp, path, err);
+}
+
 lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err)
 {
   char path[LW_PATH_MAX + 32];
   long trace_bytes = 0;
   /* The trace first, on disk: the state that records its length must
   ** never be newer than the rows it counts. */
-  if (a->trace) {
-    dir_file(path, sizeof path, a, "trace.csv");
-    if (fflush(a->trace) || fsync(fileno(a->trace)) || (trace_bytes = ftell(a->trace)) < 0)
-      return lw_error_set(err, LW_EIO, "%s: write failed: %s", path, strerror(errno));
-  }
+  lw_status s = lw_checkpoint_sync_trace(a, &trace_bytes, err);
+  if (s) return s;
   dir_file(path, sizeof path, a, "state.lw");
   lw_ckpt_writer w;
-  lw_status s = lw_ckpt_begin(&w, path, LW_STATE_HEADER, err);
-  if (s) return s;
-  lw_state head = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep};
-  lw_state_put_header(&w, &head);
-  lw_ckpt_put(&w, "temperature", "%.17g", a->t_sched);
-  lw_ckpt_put(&w, "block", "%ld", a->block);
-  lw_ckpt_put(&w, "t_prev", "%.17g", a->t_prev);
-  lw_ckpt_put(&w, "prev_stats", "%.17g %.17g %ld", a->prev.mean, a->prev.sd, a->prev.samples);
-  lw_ckpt_put(&w, "block_energy", "%.17g %.17g %.17g", a->acc_n, a->acc_sum, a->acc_sumsq);
-  lw_ckpt_put(&w, "energy_initial", "%.17g", a->energy_initial);
-  lw_ckpt_put(&w, "max_drift", "%.17g", a->max_drift);
-  lw_ckpt_put(&w, "trace_bytes", "%ld", trace_bytes);
-  const lw_system_type *t = a->sys_type;
-  for (int m = 0; m < a->chain->n_moves; m++) {
-    char key[96];
-    const lw_move_stats *st = &a->trace_mark[m];
-    snprintf(key, sizeof key, "trace_mark.%s", t->move_names[m]);
-    lw_ckpt_put_counts(&w, key, (unsigned long[]){st->proposed, st->accepted, st->nan}, 3);
-  }
+  if ((s = lw_ckpt_begin(&w, path, LW_STATE_HEADER, err))) return s;
+  lw_checkpoint_put_run(&w, a, trace_bytes);
   int bad = 0;
-  for (int k = 0; k < a->n_rep; k++) put_chain(&w, k, t, a->chains[k], &bad);
-  if (a->pt) put_tempering(&w, a, &bad);
-  if (a->dyn) put_dynamics(&w, a->dyn);
-  for (int k = 0; k < a->n_rep; k++) {
-    char sec[96];
-    lw_checkpoint_system_section(sec, sizeof sec, t, k);
-    if ((s = t->save(a->chains[k]->sys->state, &w, sec, err))) {
+  for (int k = 0; k < a->n_rep; k++) lw_checkpoint_put_chain(&w, a, k, &bad);
+  lw_checkpoint_put_ensemble(&w, a, &bad);
+  for (int k = 0; k < a->n_rep; k++)
+    if ((s = lw_checkpoint_put_system(&w, a, k, err))) {
       lw_ckpt_abort(&w);
       return s;
     }
-  }
   if (bad) {
     lw_ckpt_abort(&w);
     return lw_error_set(err, LW_ENOMEM, "out of memory writing a checkpoint");
   }
   if ((s = lw_ckpt_commit(&w, err))) return s;
-  for (int k = 1; k < a->n_rep && !s; k++) s = write_replica(a, k, err);
+  for (int k = 1; k < a->n_rep && !s; k++) s = lw_checkpoint_write_replica(a, k, err);
   /* Wall time differs from run to run, so it lives beside the state, which
   ** must be byte-identical for the same sweeps. */
-  if (!s) {
-    char tmp[LW_PATH_MAX + 64];
-    dir_file(path, sizeof path, a, "timing.txt");
-    FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
-    if (!f) return err->code;
-    fprintf(f, "wall_seconds %.6f\n", lw_anneal_seconds(a));
-    s = lw_output_commit(f, tmp, path, err);
-  }
-  return s;
+  return s ? s : lw_checkpoint_write_timing(a, err);
 }
 
 /* ---- reading ---------------------------------------------------------------- */

@@ -7,6 +7,31 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* What one Gauss point adds: u, its weight wq, the first of the k nonzero
+** rational basis functions and R as lw_nurbs_rational gives it. */
+typedef void gauss_fn(void *ctx, lw_nurbs *c, double u, double wq, size_t first, const double *R);
+
+/* Calls at() on every Gauss point of the knot spans s0 <= s < s1 (clipped
+** to the curve's spans k - 1 .. n - 1), span by span, in order. */
+static lw_status each_point(lw_nurbs *c, int gauss, size_t s0, size_t s1, gauss_fn *at, void *ctx, lw_error *err)
+{
+  const size_t n = c->n, k = (size_t)c->order;
+  gsl_integration_glfixed_table *gl = gsl_integration_glfixed_table_alloc((size_t)gauss);
+  if (!gl) return lw_error_set(err, LW_ENOMEM, "out of memory for a Gauss table of %d points", gauss);
+  double R[3 * LW_NURBS_ORDER_MAX];
+  for (size_t s = s0 > k - 1 ? s0 : k - 1; s < n && s < s1; s++) {
+    double a = c->knot[s], bb = c->knot[s + 1];
+    if (!(bb > a)) continue; /* a repeated knot: no span */
+    for (size_t q = 0; q < (size_t)gauss; q++) {
+      double u, wq;
+      gsl_integration_glfixed_point(a, bb, q, &u, &wq, gl);
+      at(ctx, c, u, wq, lw_nurbs_rational(c, u, R), R);
+    }
+  }
+  gsl_integration_glfixed_table_free(gl);
+  return LW_OK;
+}
+
 void lw_dnurbs_free(lw_dnurbs *d)
 {
   if (!d) return;
@@ -16,94 +41,197 @@ void lw_dnurbs_free(lw_dnurbs *d)
   free(d);
 }
 
+static void add_matrices(void *ctx, lw_nurbs *c, double u, double wq, size_t first, const double *R)
+{
+  lw_dnurbs *d = ctx;
+  size_t k = (size_t)d->k;
+  for (size_t i = 0; i < k; i++) {
+    d->b[first + i] += wq * R[i];
+    for (size_t j = 0; j <= i; j++) {
+      double *Kb = d->K + (first + j) * k + (i - j), *Mb = d->M1 + (first + j) * k + (i - j);
+      *Kb += wq * (d->alpha * R[k + i] * R[k + j] + d->beta * R[2 * k + i] * R[2 * k + j]);
+      *Mb += wq * R[i] * R[j];
+    }
+  }
+}
+
+lw_status lw_dnurbs_assemble(lw_dnurbs *d, lw_nurbs *c, lw_error *err)
+{
+  memset(d->K, 0, d->n * (size_t)d->k * sizeof *d->K);
+  memset(d->M1, 0, d->n * (size_t)d->k * sizeof *d->M1);
+  memset(d->b, 0, d->n * sizeof *d->b);
+  return each_point(c, d->gauss, 0, c->n, add_matrices, d, err);
+}
+
 lw_dnurbs *lw_dnurbs_new(lw_nurbs *c, double alpha, double beta, int gauss, lw_error *err)
 {
   const size_t n = c->n, k = (size_t)c->order;
   lw_dnurbs *d = calloc(1, sizeof *d);
-  gsl_integration_glfixed_table *gl = gsl_integration_glfixed_table_alloc((size_t)gauss);
   if (d) {
     d->n = n;
     d->k = c->order;
-    d->K = calloc(n * k, sizeof *d->K);
-    d->M1 = calloc(n * k, sizeof *d->M1);
-    d->b = calloc(n, sizeof *d->b);
+    d->alpha = alpha;
+    d->beta = beta;
+    d->gauss = gauss;
+    d->K = malloc(n * k * sizeof *d->K);
+    d->M1 = malloc(n * k * sizeof *d->M1);
+    d->b = malloc(n * sizeof *d->b);
   }
-  if (!d || !gl || !d->K || !d->M1 || !d->b) {
+  if (!d || !d->K || !d->M1 || !d->b) {
     lw_dnurbs_free(d);
-    if (gl) gsl_integration_glfixed_table_free(gl);
     lw_error_set(err, LW_ENOMEM, "out of memory for the D-NURBS matrices of %zu control points", n);
     return NULL;
   }
-  double R[3 * LW_NURBS_ORDER_MAX];
-  for (size_t s = k - 1; s < n; s++) {
-    double a = c->knot[s], bb = c->knot[s + 1];
-    if (!(bb > a)) continue; /* a repeated knot: no span */
-    for (size_t q = 0; q < (size_t)gauss; q++) {
-      double u, wq;
-      gsl_integration_glfixed_point(a, bb, q, &u, &wq, gl);
-      size_t first = lw_nurbs_rational(c, u, R);
-      for (size_t i = 0; i < k; i++) {
-        d->b[first + i] += wq * R[i];
-        for (size_t j = 0; j <= i; j++) {
-          double *Kb = d->K + (first + j) * k + (i - j), *Mb = d->M1 + (first + j) * k + (i - j);
-          *Kb += wq * (alpha * R[k + i] * R[k + j] + beta * R[2 * k + i] * R[2 * k + j]);
-          *Mb += wq * R[i] * R[j];
-        }
-      }
-    }
+  if (lw_dnurbs_assemble(d, c, err)) {
+    lw_dnurbs_free(d);
+    return NULL;
   }
-  gsl_integration_glfixed_table_free(gl);
   return d;
+}
+
+/* The energy density's coefficients, and where its integrals go. */
+typedef struct {
+  double alpha, beta, mug[2];
+  double *out;
+} density_ctx;
+
+/* dE/ds_j = w_j dE/dw_j = int alpha c_u . r_j' + beta c_uu . r_j'' - mug . r_j du
+** with r_j = w_j q_j = R_j (P_j - c), by the product rule. */
+static void add_grad_s(void *ctx, lw_nurbs *c, double u, double wq, size_t first, const double *R)
+{
+  density_ctx *g = ctx;
+  size_t k = (size_t)c->order;
+  double pt[2], d1[2], d2[2];
+  lw_nurbs_eval(c, u, pt, d1, d2);
+  for (size_t i = 0; i < k; i++) {
+    size_t j = first + i;
+    double r0 = R[i], r1 = R[k + i], r2 = R[2 * k + i], acc = 0.0;
+    for (int x = 0; x < 2; x++) {
+      double dp = c->P[2 * j + x] - pt[x];
+      double q0 = r0 * dp, q1 = r1 * dp - r0 * d1[x], q2 = r2 * dp - 2.0 * r1 * d1[x] - r0 * d2[x];
+      acc += g->alpha * d1[x] * q1 + g->beta * d2[x] * q2 - g->mug[x] * q0;
+    }
+    g->out[j] += wq * acc;
+  }
+}
+
+lw_status lw_dnurbs_grad_s(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, double *gs, lw_error *err)
+{
+  density_ctx g = {alpha, beta, {mug[0], mug[1]}, gs};
+  memset(gs, 0, c->n * sizeof *gs);
+  return each_point(c, gauss, 0, c->n, add_grad_s, &g, err);
 }
 
 lw_status lw_dnurbs_grad_w(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, double *gw, lw_error *err)
 {
-  const size_t n = c->n, k = (size_t)c->order;
-  gsl_integration_glfixed_table *gl = gsl_integration_glfixed_table_alloc((size_t)gauss);
-  if (!gl) return lw_error_set(err, LW_ENOMEM, "out of memory for a Gauss table of %d points", gauss);
-  memset(gw, 0, n * sizeof *gw);
-  double R[3 * LW_NURBS_ORDER_MAX];
-  for (size_t s = k - 1; s < n; s++) {
-    double a = c->knot[s], bb = c->knot[s + 1];
-    if (!(bb > a)) continue;
-    for (size_t q = 0; q < (size_t)gauss; q++) {
-      double u, wq, pt[2], d1[2], d2[2];
-      gsl_integration_glfixed_point(a, bb, q, &u, &wq, gl);
-      size_t first = lw_nurbs_rational(c, u, R);
-      lw_nurbs_eval(c, u, pt, d1, d2);
-      for (size_t i = 0; i < k; i++) {
-        size_t j = first + i;
-        double r0 = R[i], r1 = R[k + i], r2 = R[2 * k + i], acc = 0.0;
-        for (int x = 0; x < 2; x++) {
-          double dp = c->P[2 * j + x] - pt[x];
-          /* q_j and its u-derivatives, times w_j (product rule on R_j (P_j - c)) */
-          double q0 = r0 * dp, q1 = r1 * dp - r0 * d1[x], q2 = r2 * dp - 2.0 * r1 * d1[x] - r0 * d2[x];
-          acc += alpha * d1[x] * q1 + beta * d2[x] * q2 - mug[x] * q0;
-        }
-        gw[j] += wq * acc / c->w[j];
+  lw_status s = lw_dnurbs_grad_s(c, alpha, beta, mug, gauss, gw, err);
+  for (size_t j = 0; j < c->n; j++) gw[j] /= c->w[j];
+  return s;
+}
+
+static void add_energy(void *ctx, lw_nurbs *c, double u, double wq, size_t first, const double *R)
+{
+  density_ctx *g = ctx;
+  double pt[2], d1[2], d2[2];
+  lw_nurbs_eval(c, u, pt, d1, d2);
+  g->out[0] += wq * 0.5 * (g->alpha * (d1[0] * d1[0] + d1[1] * d1[1]) + g->beta * (d2[0] * d2[0] + d2[1] * d2[1]));
+  g->out[1] -= wq * (g->mug[0] * pt[0] + g->mug[1] * pt[1]);
+}
+
+lw_status lw_dnurbs_energy_near(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, size_t j,
+                                double term[2], lw_error *err)
+{
+  density_ctx g = {alpha, beta, {mug[0], mug[1]}, term};
+  term[0] = term[1] = 0.0;
+  return each_point(c, gauss, j, j + (size_t)c->order, add_energy, &g, err);
+}
+
+typedef struct {
+  const double *v;
+  double *out;
+} mass_ctx;
+
+/* The columns of J = dc/dx at u for the k control points from first:
+** J[3 i + a] for a = x, y (R_i e_a) and s (r_i = R_i (P_i - c)), as
+** 2-vectors; c(u) into pt. */
+static void jacobian(const lw_nurbs *c, size_t first, const double *R, double pt[2], double J[][2])
+{
+  size_t k = (size_t)c->order;
+  pt[0] = pt[1] = 0.0;
+  for (size_t i = 0; i < k; i++)
+    for (int x = 0; x < 2; x++) pt[x] += R[i] * c->P[2 * (first + i) + x];
+  for (size_t i = 0; i < k; i++) {
+    J[3 * i][0] = R[i], J[3 * i][1] = 0.0;
+    J[3 * i + 1][0] = 0.0, J[3 * i + 1][1] = R[i];
+    for (int x = 0; x < 2; x++) J[3 * i + 2][x] = R[i] * (c->P[2 * (first + i) + x] - pt[x]);
+  }
+}
+
+static void add_mass_s(void *ctx, lw_nurbs *c, double u, double wq, size_t first, const double *R)
+{
+  mass_ctx *m = ctx;
+  size_t k3 = 3 * (size_t)c->order;
+  double pt[2], J[3 * LW_NURBS_ORDER_MAX][2];
+  jacobian(c, first, R, pt, J);
+  for (size_t a = 0; a < k3; a++)
+    for (size_t b = 0; b <= a; b++) m->out[(3 * first + b) * k3 + (a - b)] += wq * (J[a][0] * J[b][0] + J[a][1] * J[b][1]);
+}
+
+lw_status lw_dnurbs_mass_s(lw_nurbs *c, int gauss, double *M, lw_error *err)
+{
+  mass_ctx m = {NULL, M};
+  memset(M, 0, 9 * c->n * (size_t)c->order * sizeof *M);
+  return each_point(c, gauss, 0, c->n, add_mass_s, &m, err);
+}
+
+/* With cv = J v = c_t, S = sum R_i sdot_i, dR_i/ds_l = R_i (delta_il - R_l)
+** and dc/dP_l = R_l, dc/ds_l = r_l (docs/NUMERICS.md "Free weights"):
+**   d cv / dP_l = R_l (sdot_l - S),  d cv / ds_l = R_l (V_l - cv) + (sdot_l - S) r_l,
+** and d/dx (1/2 |cv|^2) = cv . d cv / dx. */
+static void add_mass_s_dx(void *ctx, lw_nurbs *c, double u, double wq, size_t first, const double *R)
+{
+  mass_ctx m = *(mass_ctx *)ctx;
+  size_t k = (size_t)c->order;
+  double pt[2], J[3 * LW_NURBS_ORDER_MAX][2], cv[2] = {0.0, 0.0}, S = 0.0;
+  jacobian(c, first, R, pt, J);
+  const double *v = m.v + 3 * first;
+  for (size_t a = 0; a < 3 * k; a++) cv[0] += J[a][0] * v[a], cv[1] += J[a][1] * v[a];
+  for (size_t i = 0; i < k; i++) S += R[i] * v[3 * i + 2];
+  double *out = m.out + 3 * first;
+  for (size_t i = 0; i < k; i++) {
+    double ds = v[3 * i + 2] - S;
+    out[3 * i] += wq * cv[0] * R[i] * ds;
+    out[3 * i + 1] += wq * cv[1] * R[i] * ds;
+    out[3 * i + 2] += wq * (R[i] * (cv[0] * (v[3 * i] - cv[0]) + cv[1] * (v[3 * i + 1] - cv[1])) +
+                            ds * (cv[0] * J[3 * i + 2][0] + cv[1] * J[3 * i + 2][1]));
+  }
+}
+
+lw_status lw_dnurbs_mass_s_dx(lw_nurbs *c, int gauss, const double *v, double *out, lw_error *err)
+{
+  mass_ctx m = {v, out};
+  memset(out, 0, 3 * c->n * sizeof *out);
+  return each_point(c, gauss, 0, c->n, add_mass_s_dx, &m, err);
+}
+
+void lw_band_apply_dim(const double *A, size_t n, int k, int dim, const double *x, double *y)
+{
+  size_t m = (size_t)dim;
+  memset(y, 0, m * n * sizeof *y);
+  for (size_t j = 0; j < n; j++) {
+    const double *col = A + j * (size_t)k;
+    for (size_t c = 0; c < m; c++) y[m * j + c] += col[0] * x[m * j + c];
+    for (size_t d = 1; d < (size_t)k && j + d < n; d++) {
+      size_t i = j + d; /* A(i, j) = A(j, i) */
+      for (size_t c = 0; c < m; c++) {
+        y[m * i + c] += col[d] * x[m * j + c];
+        y[m * j + c] += col[d] * x[m * i + c];
       }
     }
   }
-  gsl_integration_glfixed_table_free(gl);
-  return LW_OK;
 }
 
-void lw_band_apply(const double *A, size_t n, int k, const double *x, double *y)
-{
-  memset(y, 0, 2 * n * sizeof *y);
-  for (size_t j = 0; j < n; j++) {
-    const double *col = A + j * (size_t)k;
-    y[2 * j] += col[0] * x[2 * j];
-    y[2 * j + 1] += col[0] * x[2 * j + 1];
-    for (size_t d = 1; d < (size_t)k && j + d < n; d++) {
-      size_t i = j + d; /* A(i, j) = A(j, i) */
-      y[2 * i] += col[d] * x[2 * j];
-      y[2 * i + 1] += col[d] * x[2 * j + 1];
-      y[2 * j] += col[d] * x[2 * i];
-      y[2 * j + 1] += col[d] * x[2 * i + 1];
-    }
-  }
-}
+void lw_band_apply(const double *A, size_t n, int k, const double *x, double *y) { lw_band_apply_dim(A, n, k, 2, x, y); }
 
 lw_status lw_band_factor(const double *A, const unsigned char *pin, size_t n, int k, double *L, lw_error *err)
 {
@@ -125,15 +253,21 @@ lw_status lw_band_factor(const double *A, const unsigned char *pin, size_t n, in
   return LW_OK;
 }
 
-void lw_band_solve(const double *L, const unsigned char *pin, size_t n, int k, const double *r, double *x)
+void lw_band_solve_dim(const double *L, const unsigned char *pin, size_t n, int k, int dim, const double *r, double *x)
 {
   gsl_matrix_const_view v = gsl_matrix_const_view_array(L, n, (size_t)k);
-  for (size_t c = 0; c < 2; c++) {
-    gsl_vector_const_view rv = gsl_vector_const_view_array_with_stride(r + c, 2, n);
-    gsl_vector_view xv = gsl_vector_view_array_with_stride(x + c, 2, n);
+  size_t m = (size_t)dim;
+  for (size_t c = 0; c < m; c++) {
+    gsl_vector_const_view rv = gsl_vector_const_view_array_with_stride(r + c, m, n);
+    gsl_vector_view xv = gsl_vector_view_array_with_stride(x + c, m, n);
     if (r != x) gsl_vector_memcpy(&xv.vector, &rv.vector);
     for (size_t i = 0; i < n; i++)
-      if (pin && pin[i]) x[2 * i + c] = 0.0;
+      if (pin && pin[i]) x[m * i + c] = 0.0;
     gsl_linalg_cholesky_band_svx(&v.matrix, &xv.vector);
   }
+}
+
+void lw_band_solve(const double *L, const unsigned char *pin, size_t n, int k, const double *r, double *x)
+{
+  lw_band_solve_dim(L, pin, n, k, 2, r, x);
 }

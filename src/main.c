@@ -20,6 +20,18 @@
 #include "linewise/phase.h"
 #include "linewise/state.h"
 #include "linewise/system.h"
+#ifdef LW_MPI
+#include "linewise/mpi_tempering.h"
+#endif
+
+/* The processes of an MPI run (make mpi; NULL in the plain build). */
+static lw_anneal_net *net;
+#ifdef LW_MPI
+/* Set once every process has started the run: a failure after that is one
+** process's unless it was agreed; before it, every process read the same
+** input and fails the same way. */
+static int started;
+#endif
 
 static const char usage[] =
   "usage: linewise <command> [options]\n"
@@ -47,6 +59,14 @@ static const char usage[] =
 
 static int fail(const lw_error *err)
 {
+#ifdef LW_MPI
+  if (net && net->size > 1 && started && !lw_mpi_agreed()) {
+    /* the others would wait for this process at their next step */
+    fprintf(stderr, "linewise: process %d: %s\n", net->rank, err->msg);
+    lw_mpi_abort(lw_error_exit_status(err->code));
+  }
+#endif
+  if (net && net->rank) return lw_error_exit_status(err->code); /* process 0 says it */
   fprintf(stderr, "linewise: %s\n", err->msg);
   return lw_error_exit_status(err->code);
 }
@@ -160,29 +180,16 @@ typedef struct {
 static void *watch(void *arg)
 {
   watcher *w = arg;
-  const char *shown = NULL;
-  double last = 0.0, reported = 0.0;
+  lw_phase_watch pw = {.tty = w->tty};
+  char line[512];
   const struct timespec tick = {0, 100000000};
   while (!atomic_load(&w->stop)) {
     nanosleep(&tick, NULL);
     double t;
     const char *what = lw_phase_get(&t);
-    if (shown && what != shown) {
-      fprintf(stderr, "%slinewise: %s: done in %.1f s\n", w->tty ? "\r\033[K" : "", shown, last);
-      shown = NULL;
-    }
-    if (what && t > 1.0 && (!shown || (w->tty && t - reported >= 1.0))) {
-      /* a terminal sees the seconds count up in place; a log gets one line */
-      if (w->tty) fprintf(stderr, "\r\033[Klinewise: %s... %.0f s", what, t);
-      else if (!shown) fprintf(stderr, "linewise: %s...\n", what);
-      shown = what;
-      reported = t;
-    }
-    if (what == shown) last = t;
+    fputs(lw_phase_watch_tick(&pw, what, t, line, sizeof line), stderr);
   }
-  if (shown)
-    fprintf(stderr, "%slinewise: %s: %s %.1f s\n", w->tty ? "\r\033[K" : "", shown,
-            atomic_load(&w->stop) > 1 ? "failed after" : "done in", last);
+  fputs(lw_phase_watch_end(&pw, atomic_load(&w->stop) > 1, line, sizeof line), stderr);
   return NULL;
 }
 
@@ -214,14 +221,18 @@ static int watched_fail(watcher *w, const lw_error *err)
 static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_error *err)
 {
   progress pg = {quiet, isatty(2), a->sweep, a->sweep, -1};
-  /* a signal during start-up stops before the first sweep */
-  int stopped = stop_requested && !lw_anneal_done(a);
+  /* a signal during start-up stops before the first sweep; the processes
+  ** of an MPI run stop together, at the sweep where one of them was asked */
+  int stopped = (net ? net->stop_agreed : stop_requested) && !lw_anneal_done(a);
   while (!stopped && !lw_anneal_done(a)) {
     if (lw_anneal_sweep(a, err)) return watched_fail(w, err);
     progress_show(&pg, a, 0);
-    stopped = stop_requested || (stop_at >= 0 && a->sweep >= stop_at);
+    stopped = (net ? net->stop_agreed : stop_requested) || (stop_at >= 0 && a->sweep >= stop_at);
   }
   progress_show(&pg, a, 1);
+#ifdef LW_MPI
+  lw_mpi_report(net, a, quiet);
+#endif
   if (stopped) {
     if (lw_anneal_checkpoint(a, err)) return watched_fail(w, err);
     watcher_stop(w, 0);
@@ -230,12 +241,20 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_err
               a->sweep, a->dir, a->dir);
     return 0;
   }
-  if (lw_anneal_finish(a, err)) return watched_fail(w, err);
+  lw_status s = lw_anneal_finish(a, err);
+#ifdef LW_MPI
+  /* only the process of the coldest replica drew and quenched it */
+  int drew = !net || lw_anneal_net_owner(a->pt ? a->pt->at[0] : 0, a->n_rep, net->size) == net->rank;
+  if (net) s = lw_mpi_agree(net, s, err);
+#else
+  int drew = 1;
+#endif
+  if (s) return watched_fail(w, err);
   watcher_stop(w, 0);
   if (!quiet) {
     char drawn[2048]; /* a line a pen of a layered drawing */
-    a->sys_type->describe(a->sys->state, LW_DESCRIBE_DRAWING, drawn, sizeof drawn);
-    fprintf(stderr, "%s", drawn);
+    if (drew) a->sys_type->describe(a->sys->state, LW_DESCRIBE_DRAWING, drawn, sizeof drawn);
+    if (drew) fprintf(stderr, "%s", drawn);
     if (a->quenched)
       fprintf(stderr, "linewise: quench: energy %.10g -> %.10g, gradient norm %.3g -> %.3g, %ld iterations, %.2f s\n",
               a->quench.energy_before, a->quench.energy_after, a->quench.gradient_before, a->quench.gradient_after,
@@ -284,6 +303,19 @@ static int shared_option(char **argv, int argc, int i, long *stop_at, int *quiet
     return 1;
   }
   return 0;
+}
+
+/* An MPI run: the processes agree that all of them started (or take the
+** first one's failure), then write the first checkpoint together. */
+static lw_status spread_start(lw_status s, lw_anneal *a, int fresh, lw_error *err)
+{
+#ifdef LW_MPI
+  if (!net) return s;
+  if ((s = lw_mpi_agree(net, s, err))) return s;
+  started = 1;
+  if (fresh) s = lw_anneal_checkpoint(a, err);
+#endif
+  return s;
 }
 
 static int cmd_run(int argc, char **argv)
@@ -349,8 +381,9 @@ static int cmd_run(int argc, char **argv)
   }
   static lw_anneal a;
   watcher w;
+  if (net && net->rank) quiet = 1;
   watcher_start(&w, quiet);
-  if (lw_anneal_start(&a, &p, dir, &err)) {
+  if (spread_start(lw_anneal_start_net(&a, &p, dir, net, &err), &a, 1, &err)) {
     lw_anneal_free(&a);
     return watched_fail(&w, &err);
   }
@@ -396,8 +429,9 @@ static int cmd_resume(int argc, char **argv)
   }
   static lw_anneal a;
   watcher w;
+  if (net && net->rank) quiet = 1;
   watcher_start(&w, quiet);
-  if (lw_anneal_resume(&a, dir, more, &err)) {
+  if (spread_start(lw_anneal_resume_net(&a, dir, more, net, &err), &a, 0, &err)) {
     lw_anneal_free(&a);
     return watched_fail(&w, &err);
   }
@@ -430,9 +464,25 @@ static void install_signals(void)
   signal(SIGXFSZ, SIG_IGN);
 }
 
+static int command(int argc, char **argv);
+
 int main(int argc, char **argv)
 {
   install_signals();
+#ifdef LW_MPI
+  if (!(net = lw_mpi_init(&argc, &argv, &stop_requested))) return 1;
+  /* the commands other than run and resume are one process's */
+  int spread = argc >= 2 && (!strcmp(argv[1], "run") || !strcmp(argv[1], "resume"));
+  int rc = spread || net->rank == 0 ? command(argc, argv) : 0;
+  lw_mpi_finish();
+  return rc;
+#else
+  return command(argc, argv);
+#endif
+}
+
+static int command(int argc, char **argv)
+{
   if (argc >= 2 && wants_help(argc, argv)) {
     fputs(usage, stdout);
     return 0;

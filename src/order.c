@@ -1,5 +1,5 @@
 /*
-** order.c -- greedy and 2-opt ordering of plotter paths (order.h).
+** order.c -- greedy, 2-opt and Or-opt ordering of plotter paths (order.h).
 **
 ** End points are numbered 2p (start of path p) and 2p + 1 (end of path p).
 ** A uniform grid of them answers "nearest end point" for the greedy tour and
@@ -295,13 +295,31 @@ lw_status lw_order_greedy(const lw_order_path *path, size_t n, double hx, double
 ** whose end is the home point (n * 2 + 1).  Forward, home leads the tour
 ** and the leg back into it costs nothing, which is exactly the open tour
 ** from home.  A cycle can be reversed as a whole without changing its
-** length (every leg is symmetric), so a cut may reverse either side. */
+** length (every leg is symmetric), so a cut may reverse either side.
+**
+** The cycle is a two-level list (Fredman, Johnson, McGeoch and Ostheimer
+** 1995): the items lie in slots item[0..m), cut into blocks of neighbouring
+** slots, each read forwards or backwards (brev); the tour is the blocks in
+** the order of border[].  An array tour moved up to m / 2 entries per
+** reversal, and at 10^5 dense paths the reversals were nearly all of the
+** time (issue 14).  Here a stretch inside one block is reversed in its
+** slots (at most `group` entries); any other is first cut at its two ends,
+** which splits at most two blocks, and is then a run of whole blocks whose
+** order and reading direction are reversed: O(sqrt m) entries a move.
+** Splits only make blocks smaller and more numerous; when they would pass
+** max_blk, the tour is laid out afresh in blocks of `group` slots. */
 typedef struct {
   size_t n, m, free_pt;
   double *px, *py;              /* owned; by label after relabel() */
   size_t *orig;                 /* label -> path (n: home) */
-  size_t *tour, *pos;           /* position -> item, item -> position */
-  unsigned char *rev;           /* per item */
+  size_t *item, *slot;          /* slot -> item, item -> slot */
+  unsigned char *rev;           /* per item: reversed within its block's reading */
+  size_t *blk;                  /* item -> block */
+  size_t *lo, *hi;              /* per block: its slots [lo, hi) */
+  unsigned char *brev;          /* per block: read from hi - 1 down to lo */
+  size_t *border, *bpos;        /* place in the tour -> block, block -> place */
+  size_t nblk, max_blk, group;
+  size_t *scratch;              /* m items: the tour while it is laid out afresh */
   size_t *nb;                   /* LW_ORDER_NEIGHBOURS candidates per point */
   unsigned char *nbn;           /* how many each point has */
   size_t *queue;                /* FIFO ring of items to look at */
@@ -319,18 +337,153 @@ static double leg(const two_opt *t, size_t a, size_t b)
   return sqrt(dx * dx + dy * dy);
 }
 
-static size_t entry_of(const two_opt *t, size_t item) { return 2 * item + t->rev[item]; }
-static size_t exit_of(const two_opt *t, size_t item) { return 2 * item + 1 - t->rev[item]; }
+/* Whether the item is drawn backwards in the tour. */
+static int orient(const two_opt *t, size_t item) { return t->rev[item] ^ t->brev[t->blk[item]]; }
+static size_t entry_of(const two_opt *t, size_t item) { return 2 * item + (size_t)orient(t, item); }
+static size_t exit_of(const two_opt *t, size_t item) { return 2 * item + 1 - (size_t)orient(t, item); }
+
+/* The first and the last item of block b in tour order. */
+static size_t block_first(const two_opt *t, size_t b) { return t->item[t->brev[b] ? t->hi[b] - 1 : t->lo[b]]; }
+static size_t block_last(const two_opt *t, size_t b) { return t->item[t->brev[b] ? t->lo[b] : t->hi[b] - 1]; }
+
 static size_t succ(const two_opt *t, size_t item)
 {
-  size_t i = t->pos[item] + 1;
-  return t->tour[i == t->m ? 0 : i];
+  size_t b = t->blk[item], s = t->slot[item];
+  if (t->brev[b] ? s > t->lo[b] : s + 1 < t->hi[b]) return t->item[t->brev[b] ? s - 1 : s + 1];
+  size_t p = t->bpos[b] + 1;
+  return block_first(t, t->border[p == t->nblk ? 0 : p]);
 }
 
 static size_t pred(const two_opt *t, size_t item)
 {
-  size_t i = t->pos[item];
-  return t->tour[(i ? i : t->m) - 1];
+  size_t b = t->blk[item], s = t->slot[item];
+  if (t->brev[b] ? s + 1 < t->hi[b] : s > t->lo[b]) return t->item[t->brev[b] ? s + 1 : s - 1];
+  size_t p = t->bpos[b];
+  return block_last(t, t->border[(p ? p : t->nblk) - 1]);
+}
+
+/* Blocks of `group` slots over item[], each read forwards, in slot order. */
+static void cut_blocks(two_opt *t)
+{
+  size_t g = t->group;
+  t->nblk = (t->m + g - 1) / g;
+  for (size_t b = 0; b < t->nblk; b++) {
+    t->lo[b] = b * g;
+    t->hi[b] = t->m < (b + 1) * g ? t->m : (b + 1) * g;
+    t->brev[b] = 0;
+    t->border[b] = t->bpos[b] = b;
+    for (size_t s = t->lo[b]; s < t->hi[b]; s++) t->blk[t->item[s]] = b;
+  }
+}
+
+/* The tour laid out afresh: slot k holds its k-th item (from the first
+** block), each drawn as before with its block's reading folded into rev. */
+static void lay_out(two_opt *t)
+{
+  size_t k = 0;
+  for (size_t p = 0; p < t->nblk; p++) {
+    size_t b = t->border[p];
+    if (t->brev[b])
+      for (size_t s = t->hi[b]; s-- > t->lo[b];) {
+        t->scratch[k++] = t->item[s];
+        t->rev[t->item[s]] ^= 1;
+      }
+    else
+      for (size_t s = t->lo[b]; s < t->hi[b]; s++) t->scratch[k++] = t->item[s];
+  }
+  for (k = 0; k < t->m; k++) {
+    t->item[k] = t->scratch[k];
+    t->slot[t->scratch[k]] = k;
+  }
+  cut_blocks(t);
+  t->work += 3 * t->m;
+}
+
+/* Splits block b into its slots [lo, c) and [c, hi), lo < c < hi; the
+** smaller part becomes a new block, placed before or after b in the tour
+** as b's reading direction says. */
+static void split(two_opt *t, size_t b, size_t c)
+{
+  size_t nw = t->nblk++;
+  int low_new = c - t->lo[b] < t->hi[b] - c;
+  if (low_new) {
+    t->lo[nw] = t->lo[b];
+    t->hi[nw] = t->lo[b] = c;
+  } else {
+    t->lo[nw] = c;
+    t->hi[nw] = t->hi[b];
+    t->hi[b] = c;
+  }
+  t->brev[nw] = t->brev[b];
+  for (size_t s = t->lo[nw]; s < t->hi[nw]; s++) t->blk[t->item[s]] = nw;
+  /* the low slots come first in the tour when b reads forwards */
+  size_t at = t->bpos[b] + (low_new ^ t->brev[b] ? 0 : 1);
+  memmove(&t->border[at + 1], &t->border[at], (t->nblk - 1 - at) * sizeof *t->border);
+  t->border[at] = nw;
+  for (size_t p = at; p < t->nblk; p++) t->bpos[t->border[p]] = p;
+  t->work += (t->hi[nw] - t->lo[nw]) + (t->nblk - at);
+}
+
+/* Makes the item the first (cut_before) or the last (cut_after) of its
+** block in tour order. */
+static void cut_before(two_opt *t, size_t item)
+{
+  size_t b = t->blk[item], c = t->slot[item] + (t->brev[b] ? 1 : 0);
+  if (c > t->lo[b] && c < t->hi[b]) split(t, b, c);
+}
+
+static void cut_after(two_opt *t, size_t item)
+{
+  size_t b = t->blk[item], c = t->slot[item] + (t->brev[b] ? 0 : 1);
+  if (c > t->lo[b] && c < t->hi[b]) split(t, b, c);
+}
+
+/* Reverses the stretch of the cycle from item `from` forward to item `to`,
+** or the rest of the cycle when that has fewer blocks (the same tour read
+** the other way round). */
+static void reverse(two_opt *t, size_t from, size_t to)
+{
+  size_t b = t->blk[from];
+  if (b == t->blk[to] && (t->brev[b] ? t->slot[from] >= t->slot[to] : t->slot[from] <= t->slot[to])) {
+    /* inside one block: its slots, whichever way it reads */
+    size_t i = t->slot[from] < t->slot[to] ? t->slot[from] : t->slot[to];
+    size_t j = t->slot[from] ^ t->slot[to] ^ i;
+    t->work += j - i + 1;
+    for (; i < j; i++, j--) {
+      size_t ia = t->item[i], ib = t->item[j];
+      t->item[i] = ib;
+      t->item[j] = ia;
+      t->slot[ib] = i;
+      t->slot[ia] = j;
+      t->rev[ia] ^= 1;
+      t->rev[ib] ^= 1;
+    }
+    if (i == j) t->rev[t->item[i]] ^= 1;
+    return;
+  }
+  if (t->nblk + 2 > t->max_blk) lay_out(t);
+  cut_before(t, from);
+  cut_after(t, to);
+  size_t nb = t->nblk, i = t->bpos[t->blk[from]], j = t->bpos[t->blk[to]];
+  size_t len = (j + nb - i) % nb + 1;
+  if (2 * len > nb) {
+    size_t ni = j + 1 == nb ? 0 : j + 1;
+    j = (i ? i : nb) - 1;
+    i = ni;
+    len = nb - len;
+  }
+  for (size_t k = 0; k < (len + 1) / 2; k++) {
+    size_t ba = t->border[i], bb = t->border[j];
+    t->border[i] = bb;
+    t->border[j] = ba;
+    t->bpos[bb] = i;
+    t->bpos[ba] = j;
+    t->brev[ba] ^= 1;
+    if (bb != ba) t->brev[bb] ^= 1;
+    i = i + 1 == nb ? 0 : i + 1;
+    j = j == 0 ? nb - 1 : j - 1;
+  }
+  t->work += len;
 }
 
 static void push(two_opt *t, size_t item)
@@ -340,35 +493,76 @@ static void push(two_opt *t, size_t item)
   t->queue[(t->q_head + t->q_len++) % t->m] = item;
 }
 
-/* Reverses the stretch of the cycle from item `from` forward to item `to`,
-** or the rest of the cycle when that is shorter (the same tour read the
-** other way round). */
-static void reverse(two_opt *t, size_t from, size_t to)
+/* Moves the stretch s1 .. s2 (at most a few items, p before it, nx after)
+** to between c and d = succ(c), drawn the other way round if `flip`, by
+** three reversals at most: s1 .. c, then c .. nx (which puts the stretch
+** reversed between c and d and the items between back as they were), then
+** the stretch itself unless it is to be flipped.  Each reversal may read the
+** cycle the other way round (reverse()), so each step finds its ends by
+** looking at the cycle again.  c is none of p, pred(p), the stretch and nx. */
+static void move_stretch(two_opt *t, size_t p, size_t s1, size_t s2, size_t nx, size_t c, int flip)
 {
-  size_t m = t->m, i = t->pos[from], j = t->pos[to];
-  size_t len = (j + m - i) % m + 1;
-  if (2 * len > m) {
-    size_t ni = (j + 1) % m;
-    j = (i + m - 1) % m;
-    i = ni;
-    len = m - len;
+  reverse(t, s1, c);
+  if (succ(t, p) == c) reverse(t, c, nx);
+  else reverse(t, nx, c);
+  if (!flip) {
+    if (succ(t, c) == s2) reverse(t, s2, s1);
+    else reverse(t, s1, s2);
   }
-  /* the two ends walk inwards, wrapping by comparison: a division per
-  ** entry (% m) cost more than the rest of the move */
-  size_t a = i, b = j;
-  for (size_t k = 0; k < len / 2; k++) {
-    size_t ia = t->tour[a], ib = t->tour[b];
-    t->tour[a] = ib;
-    t->tour[b] = ia;
-    t->pos[ib] = a;
-    t->pos[ia] = b;
-    t->rev[ia] ^= 1;
-    t->rev[ib] ^= 1;
-    a = a + 1 == m ? 0 : a + 1;
-    b = b == 0 ? m - 1 : b - 1;
+}
+
+/* An Or-opt move for the stretch of 1 to LW_ORDER_OR_MAX items from a
+** forward: taken out (its neighbours p and nx joined) and put between two
+** items c and d elsewhere, either way round.  Candidates are the end points
+** near the stretch's two ends (entry e1 of its first item, exit x2 of its
+** last): an exit near one of them is a c, an entry a d.  As in 2-opt, a new
+** leg that is not shorter than what taking the stretch out saves ends the
+** search in that list. */
+static int or_opt(two_opt *t, size_t a)
+{
+  const size_t K = LW_ORDER_NEIGHBOURS;
+  if (t->m < 2 * LW_ORDER_OR_MAX + 4) return 0;
+  size_t p = pred(t, a), s[LW_ORDER_OR_MAX];
+  size_t xp = exit_of(t, p), e1 = entry_of(t, a);
+  s[0] = a;
+  for (size_t len = 1; len <= LW_ORDER_OR_MAX; len++) {
+    if (len > 1) s[len - 1] = succ(t, s[len - 2]);
+    size_t s2 = s[len - 1], nx = succ(t, s2), x2 = exit_of(t, s2), en = entry_of(t, nx);
+    if (nx == p) return 0;
+    double removed = leg(t, xp, e1) + leg(t, x2, en) - leg(t, xp, en);
+    if (removed <= LW_ORDER_EPS) continue;
+    for (int end = 0; end < 2; end++) {
+      size_t z = end ? x2 : e1;
+      if (z == t->free_pt) continue;
+      for (size_t k = 0; k < t->nbn[z]; k++) {
+        size_t q = t->nb[z * K + k], item = q / 2;
+        double new1 = leg(t, z, q);
+        t->work++;
+        if (new1 >= removed - LW_ORDER_EPS) break;
+        /* q an exit: c = its item, d after it; q an entry: d = its item */
+        size_t c = q == exit_of(t, item) ? item : pred(t, item), d = succ(t, c);
+        int skip = c == p || c == nx || d == p;
+        for (size_t i = 0; i < len; i++) skip |= c == s[i];
+        if (skip) continue;
+        size_t xc = exit_of(t, c), ed = entry_of(t, d);
+        /* forward: c -> s1 ... s2 -> d; flipped: c -> s2 ... s1 -> d */
+        double fwd = leg(t, xc, e1) + leg(t, x2, ed), flp = leg(t, xc, x2) + leg(t, e1, ed);
+        int flip = flp < fwd;
+        double gain = removed + leg(t, xc, ed) - (flip ? flp : fwd);
+        if (gain > LW_ORDER_EPS) {
+          move_stretch(t, p, a, s2, nx, c, flip);
+          push(t, p);
+          push(t, nx);
+          push(t, c);
+          push(t, d);
+          push(t, a);
+          push(t, s2);
+          return 1;
+        }
+      }
+    }
   }
-  if (len & 1) t->rev[t->tour[a]] ^= 1;
-  t->work += len;
+  return 0;
 }
 
 /* One improving move around item a, if its candidate lists offer one. */
@@ -423,7 +617,7 @@ static int improve(two_opt *t, size_t a)
       }
     }
   }
-  return 0;
+  return or_opt(t, a);
 }
 
 static void two_opt_free(two_opt *t)
@@ -431,23 +625,29 @@ static void two_opt_free(two_opt *t)
   free(t->px);
   free(t->py);
   free(t->orig);
-  free(t->tour);
-  free(t->pos);
+  free(t->item);
+  free(t->slot);
   free(t->rev);
+  free(t->blk);
+  free(t->lo);
+  free(t->hi);
+  free(t->brev);
+  free(t->border);
+  free(t->bpos);
+  free(t->scratch);
   free(t->nb);
   free(t->nbn);
   free(t->queue);
   free(t->queued);
 }
 
-/* Items are renumbered by their place in the starting tour, home first:
-** a reversal then rewrites pos[] and rev[] over a run of neighbouring
-** entries instead of entries scattered over the arrays, which made each
-** moved entry a cache miss (issue 14).  Point 2 l + e is end e of the item
-** labelled l, so FREE is 0 and home 1.  The candidate lists, found by path
-** index, are carried over, so the moves and the result are those without
-** the renumbering.  t->px, t->py, t->nb and t->nbn go from path index to
-** label. */
+/* Items are renumbered by their place in the starting tour, home first, and
+** laid out in that order: a reversal then rewrites neighbouring entries
+** instead of entries scattered over the arrays, each of which was a cache
+** miss (issue 14).  Point 2 l + e is end e of the item labelled l, so FREE
+** is 0 and home 1.  The candidate lists, found by path index, are carried
+** over, so the moves and the result do not depend on the paths' numbering.
+** t->px, t->py, t->nb and t->nbn go from path index to label. */
 static lw_status relabel(two_opt *t, const size_t *order, const unsigned char *reversed)
 {
   const size_t K = LW_ORDER_NEIGHBOURS, n = t->n, m = t->m, npt = 2 * m;
@@ -488,9 +688,10 @@ static lw_status relabel(two_opt *t, const size_t *order, const unsigned char *r
   t->py = ly;
   t->free_pt = 0;
   for (size_t l = 0; l < m; l++) {
-    t->tour[l] = t->pos[l] = l;
+    t->item[l] = t->slot[l] = l;
     t->rev[l] = l ? reversed[l - 1] : 0;
   }
+  cut_blocks(t);
   return LW_OK;
 }
 
@@ -507,6 +708,11 @@ lw_status lw_order_2opt(const lw_order_path *path, size_t n, double hx, double h
   if (n < 2) return LW_OK;
   const size_t K = LW_ORDER_NEIGHBOURS;
   two_opt t = {.n = n, .m = n + 1, .free_pt = 2 * n};
+  /* blocks of about sqrt(m) slots, and a fresh lay-out once splits have
+  ** doubled their number: a move then costs O(sqrt m) entries, and so,
+  ** spread over the moves between two, does a lay-out */
+  t.group = (size_t)ceil(sqrt((double)t.m));
+  t.max_blk = 2 * ((t.m + t.group - 1) / t.group) + 2;
   double *px, *py;
   if (!end_points(path, n, 2, &px, &py)) return lw_error_set(err, LW_ENOMEM, "out of memory ordering %zu paths", n);
   px[2 * n] = py[2 * n] = 0.0;  /* FREE: never measured */
@@ -515,9 +721,16 @@ lw_status lw_order_2opt(const lw_order_path *path, size_t n, double hx, double h
   t.px = px;
   t.py = py;
   size_t npt = 2 * n + 2;
-  t.tour = malloc(t.m * sizeof *t.tour);
-  t.pos = malloc(t.m * sizeof *t.pos);
+  t.item = malloc(t.m * sizeof *t.item);
+  t.slot = malloc(t.m * sizeof *t.slot);
   t.rev = calloc(t.m, 1);
+  t.blk = malloc(t.m * sizeof *t.blk);
+  t.scratch = malloc(t.m * sizeof *t.scratch);
+  t.lo = malloc(t.max_blk * sizeof *t.lo);
+  t.hi = malloc(t.max_blk * sizeof *t.hi);
+  t.brev = calloc(t.max_blk, 1);
+  t.border = malloc(t.max_blk * sizeof *t.border);
+  t.bpos = malloc(t.max_blk * sizeof *t.bpos);
   t.nb = malloc(npt * K * sizeof *t.nb);
   t.nbn = calloc(npt, 1);
   t.queue = malloc(t.m * sizeof *t.queue);
@@ -525,7 +738,8 @@ lw_status lw_order_2opt(const lw_order_path *path, size_t n, double hx, double h
   size_t *ids = malloc(npt * sizeof *ids);
   double *d2s = malloc(K * sizeof *d2s);
   point_grid g;
-  int ok = t.tour && t.pos && t.rev && t.nb && t.nbn && t.queue && t.queued && ids && d2s;
+  int ok = t.item && t.slot && t.rev && t.blk && t.scratch && t.lo && t.hi && t.brev && t.border && t.bpos && t.nb &&
+           t.nbn && t.queue && t.queued && ids && d2s;
   if (ok) {
     /* every point but FREE */
     for (size_t id = 0; id < 2 * n; id++) ids[id] = id;
@@ -550,11 +764,11 @@ lw_status lw_order_2opt(const lw_order_path *path, size_t n, double hx, double h
   t.budget = (unsigned long long)LW_ORDER_WORK * t.m;
   /* A reversal flips every path inside it, which can open a move for a
   ** path whose own legs did not change and which is not queued; so when
-  ** the queue runs dry every item is looked at once more, until a whole
-  ** round finds nothing. */
+  ** the queue runs dry every item is looked at once more, in tour order,
+  ** until a whole round finds nothing. */
   for (int moved = 1; moved && t.work < t.budget;) {
     moved = 0;
-    for (size_t k = 0; k < t.m; k++) push(&t, t.tour[k]);
+    for (size_t k = 0, a = 0; k < t.m; k++, a = succ(&t, a)) push(&t, a);
     while (t.q_len && t.work < t.budget) {
       size_t a = t.queue[t.q_head];
       t.q_head = (t.q_head + 1) % t.m;
@@ -565,12 +779,11 @@ lw_status lw_order_2opt(const lw_order_path *path, size_t n, double hx, double h
   }
 
   /* read the cycle from home in the direction in which home is forward */
-  size_t h = t.pos[0];
-  int back = t.rev[0];
-  for (size_t k = 0; k < n; k++) {
-    size_t item = t.tour[back ? (h + t.m - 1 - k) % t.m : (h + 1 + k) % t.m];
+  int back = orient(&t, 0);
+  for (size_t k = 0, item = 0; k < n; k++) {
+    item = back ? pred(&t, item) : succ(&t, item);
     order[k] = t.orig[item];
-    reversed[k] = (unsigned char)(t.rev[item] ^ back);
+    reversed[k] = (unsigned char)(orient(&t, item) ^ back);
   }
   two_opt_free(&t);
   return LW_OK;

@@ -15,8 +15,8 @@
 **                  respect to the control points of A and B (a "jet"),
 **                  taken step by step through the same branches, blends,
 **                  subdivision and closest points, and the exact
-**                  segment-segment integrals of its leaves and of the
-**                  subtraction by lw_pair_segseg_grad.
+**                  segment-segment integrals of its leaves by
+**                  lw_pair_segseg_grad.
 **
 ** The samples' weights are stored as float (pair.h); the derivative is that
 ** of the formula with the weights exact, whose float rounding is a step
@@ -349,11 +349,11 @@ static void jrule_nodes(const jcubic *c, double t0, double t1, const double *s, 
   }
 }
 
-typedef enum { KERNEL_INV, KERNEL_CUT, KERNEL_CUT_REST } kernel_kind;
+typedef enum { KERNEL_INV, KERNEL_CUT } kernel_kind;
 
 /* The product rule over two node sets for the kernels of pairnear.c (1/r;
-** (1/r - 1/rc)+; (1/rc - 1/r)+ - 1/rc), its partials gathered per node
-** first (reverse mode inside, which costs O(m^2 + m ND)). */
+** (1/r - 1/rc)+), its partials gathered per node first (reverse mode
+** inside, which costs O(m^2 + m ND)). */
 static jet jproduct(const jnodes *A, const jnodes *B, kernel_kind kind, double rc)
 {
   const double inv = rc > 0.0 ? 1.0 / rc : 0.0, rc2 = rc > 0.0 ? rc * rc : INFINITY;
@@ -364,8 +364,7 @@ static jet jproduct(const jnodes *A, const jnodes *B, kernel_kind kind, double r
       double dx = A->x[i].v - B->x[j].v, dy = A->y[i].v - B->y[j].v, r2 = dx * dx + dy * dy, r = sqrt(r2);
       double k, kr; /* k(r) and k'(r) / r */
       if (kind == KERNEL_INV) k = 1.0 / r, kr = -1.0 / (r2 * r);
-      else if (kind == KERNEL_CUT) k = r2 < rc2 ? 1.0 / r - inv : 0.0, kr = r2 < rc2 ? -1.0 / (r2 * r) : 0.0;
-      else k = r2 > rc2 ? -1.0 / r : -inv, kr = r2 > rc2 ? 1.0 / (r2 * r) : 0.0;
+      else k = r2 < rc2 ? 1.0 / r - inv : 0.0, kr = r2 < rc2 ? -1.0 / (r2 * r) : 0.0;
       double wj = B->w[j].v, f = wi * wj * kr;
       acc += wj * k;
       bw[j] += wi * k;
@@ -442,18 +441,40 @@ static void work_free(pairgrad_work *w)
   free(w);
 }
 
-static jet piece_rule(const jcubic *ca, const jpiece *pa, const jcubic *cb, const jpiece *pb)
+/* The kernel of the subdivision (pairnear.c): 1/r, or (1/r - 1/rc)+ where on. */
+typedef struct {
+  int on;
+  double rc, inv;
+} cut;
+
+static jet piece_rule(const jcubic *ca, const jpiece *pa, const jcubic *cb, const jpiece *pb, const cut *k)
 {
   jnodes na, nb;
   jrule_nodes(ca, pa->t0, pa->t1, K.g6_s, K.g6_w, K.g6_n, &na);
   jrule_nodes(cb, pb->t0, pb->t1, K.g6_s, K.g6_w, K.g6_n, &nb);
-  return jproduct(&na, &nb, KERNEL_INV, 0.0);
+  return jproduct(&na, &nb, k->on ? KERNEL_CUT : KERNEL_INV, k->rc);
 }
 
-static jet leaf_value(const jcubic *ca, const jpiece *pa, const jcubic *cb, const jpiece *pb)
+/* pairnear.c's leaf_value: the chords' exact integral, with the cutoff
+** blended into the product rule where the pieces reach past it. */
+static jet leaf_value(const jcubic *ca, const jpiece *pa, const jcubic *cb, const jpiece *pb, const cut *k)
 {
-  jet v = jsegseg(pa->r0, pa->r1, pb->r0, pb->r1);
-  return v.v < INFINITY ? v : piece_rule(ca, pa, cb, pb);
+  jet m = jc(1.0);
+  if (k->on) {
+    jet big = pa->rad.v > pb->rad.v ? pa->rad : pb->rad;
+    jet far = jadd(jadd(jhypot(jsub(pa->cx, pb->cx), jsub(pa->cy, pb->cy)), pa->rad), pb->rad);
+    m = big.v > 0.0 ? jsmooth(jdiv(jaddc(jscale(far, -1.0), k->rc), big)) : jc(0.0);
+  }
+  jet v = m.v > 0.0 ? jsegseg(pa->r0, pa->r1, pb->r0, pb->r1) : jc(0.0);
+  if (!(v.v < INFINITY)) return piece_rule(ca, pa, cb, pb, k);
+  if (k->on && m.v > 0.0) {
+    jet la = jhypot(jsub(pa->r1[0], pa->r0[0]), jsub(pa->r1[1], pa->r0[1]));
+    jet lb = jhypot(jsub(pb->r1[0], pb->r0[0]), jsub(pb->r1[1], pb->r0[1]));
+    v = jsub(v, jscale(jmul(la, lb), k->inv));
+    if (!(v.v > 0.0)) v = jc(0.0);
+  }
+  if (m.v < 1.0) v = jadd(jmul(m, v), jmul(jaddc(jscale(m, -1.0), 1.0), piece_rule(ca, pa, cb, pb, k)));
+  return v;
 }
 
 static jet point_segment(const jet *p, const jet *a, const jet *b)
@@ -481,10 +502,10 @@ static jet chord_distance(const jpiece *pa, const jpiece *pb)
   return jmin(d, jmin(point_segment(pb->r0, pa->r0, pa->r1), point_segment(pb->r1, pa->r0, pa->r1)));
 }
 
-/* pairnear.c's inverse_distance, in jets: the shares carry their partials
-** too, since the blend weights that form them move with the curves. */
-static jet inverse_distance(const jcubic *ca, const jpiece *root_a, const jcubic *cb, const jpiece *root_b,
-                            jet root_rest, pairgrad_work *wk)
+/* pairnear.c's subdivided, in jets: the shares carry their partials too,
+** since the blend weights that form them move with the curves. */
+static jet subdivided(const jcubic *ca, const jpiece *root_a, const jcubic *cb, const jpiece *root_b,
+                      jet root_rest, const cut *k, pairgrad_work *wk)
 {
   jpiece *sa = wk->sa, *sb = wk->sb;
   jet *share = wk->share;
@@ -504,8 +525,9 @@ static jet inverse_distance(const jcubic *ca, const jpiece *root_a, const jcubic
     jet dx = jsub(pa->cx, pb->cx), dy = jsub(pa->cy, pb->cy);
     jet big = pa->rad.v > pb->rad.v ? pa->rad : pb->rad;
     jet gap = jsub(jsub(jhypot(dx, dy), pa->rad), pb->rad);
+    if (k->on && gap.v >= k->rc) continue;
     jet w = big.v > 0.0 ? jsmooth(jdivc(jaddc(jdiv(gap, big), -K.sep_lo), K.sep_hi - K.sep_lo)) : jc(1.0);
-    if (w.v > 0.0) sum = jadd(sum, jmul(jmul(f, w), piece_rule(ca, pa, cb, pb)));
+    if (w.v > 0.0) sum = jadd(sum, jmul(jmul(f, w), piece_rule(ca, pa, cb, pb, k)));
     f = jmul(f, jaddc(jscale(w, -1.0), 1.0));
     if (f.v == 0.0) continue;
     w = top + 2 > K.stack_max ? jc(1.0) : jsmooth(jdiv(jsub(jscale(leaf, 2.0), big), leaf));
@@ -517,7 +539,7 @@ static jet inverse_distance(const jcubic *ca, const jpiece *root_a, const jcubic
         if (v.v > w.v) w = v;
       }
     }
-    if (w.v > 0.0) sum = jadd(sum, jmul(jmul(f, w), leaf_value(ca, pa, cb, pb)));
+    if (w.v > 0.0) sum = jadd(sum, jmul(jmul(f, w), leaf_value(ca, pa, cb, pb, k)));
     f = jmul(f, jaddc(jscale(w, -1.0), 1.0));
     if (f.v == 0.0) continue;
     if (d % 2 == 0) {
@@ -627,34 +649,6 @@ static void closest(const jcubic *ca, const jcubic *cb, jet *ps, jet *pt)
   *pt = t;
 }
 
-/* pairnear.c's subtracted: K - S by the 16 x 16 rule, plus S exactly. */
-static jet subtracted(const jnodes *na, const jnodes *nb, double cutoff, jet ss, jet ts, const jet a[2],
-                      const jet a1[2], const jet b[2], const jet b1[2])
-{
-  jnodes la, lb;
-  jet va = jhypot(a1[0], a1[1]), vb = jhypot(b1[0], b1[1]);
-  la.m = lb.m = K.g16_n;
-  for (int k = 0; k < K.g16_n; k++) {
-    jet sa = jaddc(jscale(ss, -1.0), K.g16_s[k]), sb = jaddc(jscale(ts, -1.0), K.g16_s[k]);
-    la.x[k] = jadd(a[0], jmul(a1[0], sa));
-    la.y[k] = jadd(a[1], jmul(a1[1], sa));
-    la.w[k] = jscale(va, K.g16_w[k]);
-    lb.x[k] = jadd(b[0], jmul(b1[0], sb));
-    lb.y[k] = jadd(b[1], jmul(b1[1], sb));
-    lb.w[k] = jscale(vb, K.g16_w[k]);
-  }
-  jet sum = jsub(jproduct(na, nb, cutoff > 0.0 ? KERNEL_CUT : KERNEL_INV, cutoff),
-                 jproduct(&la, &lb, KERNEL_INV, 0.0));
-  jet l0[2], l1[2], m0[2], m1[2];
-  for (int i = 0; i < 2; i++) {
-    l0[i] = jsub(a[i], jmul(a1[i], ss));
-    l1[i] = jadd(l0[i], a1[i]);
-    m0[i] = jsub(b[i], jmul(b1[i], ts));
-    m1[i] = jadd(m0[i], b1[i]);
-  }
-  return jadd(sum, jsegseg(l0, l1, m0, m1));
-}
-
 /* lw_pair_segments_exact in jets: the same steps, the same branches. */
 static double segments_exact_grad(const double a[8], const double b[8], double cutoff, pairgrad_work *wk,
                                   double ga[8], double gb[8])
@@ -685,19 +679,9 @@ static double segments_exact_grad(const double a[8], const double b[8], double c
   jrule_nodes(&ca, 0.0, 1.0, K.g16_s, K.g16_w, K.g16_n, &na);
   jrule_nodes(&cb, 0.0, 1.0, K.g16_s, K.g16_w, K.g16_n, &nb);
   jet v = w.v > 0.0 ? jmul(w, jproduct(&na, &nb, whole, cutoff)) : jc(0.0);
-  jet rest = jaddc(jscale(w, -1.0), 1.0);
-  if (rest.v > 0.0) {
-    jet sine = jdiv(jabs(jsub(jmul(a1[0], b1[1]), jmul(a1[1], b1[0]))),
-                    jmul(jhypot(a1[0], a1[1]), jhypot(b1[0], b1[1])));
-    jet u1 = jsmooth(jdivc(jaddc(sine, -K.sine_lo), K.sine_hi - K.sine_lo));
-    jet u2 = jsmooth(jdivc(jaddc(jdiv(dist, half), -K.close_lo), K.close_hi - K.close_lo));
-    jet u = u2.v > u1.v ? u2 : u1;
-    if (u.v > 0.0) v = jadd(v, jmul(jmul(rest, u), subtracted(&na, &nb, cutoff, ss, ts, ra, a1, rb, b1)));
-    rest = jmul(rest, jaddc(jscale(u, -1.0), 1.0));
-  }
-  if (rest.v > 0.0) {
-    v = jadd(v, inverse_distance(&ca, &pa, &cb, &pb, rest, wk));
-    if (cutoff > 0.0) v = jadd(v, jmul(rest, jproduct(&na, &nb, KERNEL_CUT_REST, cutoff)));
+  if (w.v < 1.0) {
+    const cut k = {cutoff > 0.0, cutoff, cutoff > 0.0 ? 1.0 / cutoff : 0.0};
+    v = jadd(v, subdivided(&ca, &pa, &cb, &pb, jaddc(jscale(w, -1.0), 1.0), &k, wk));
   }
   for (int k = 0; k < 8; k++) {
     ga[k] = v.d[k];

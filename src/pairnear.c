@@ -12,17 +12,18 @@
 **   apart, d / h >= APART_HI: the 16 x 16 Gauss rule of the whole kernel;
 **     the pole of 1/r is then at least 0.5 half-lengths from each segment,
 **     rho >= 0.5 + sqrt(1.25) = 1.6 beside its middle: error < 1.6^-32.
-**   meeting at an angle (the tangents at the closest points at a sine above
-**     SINE_HI) or running alongside at d / h >= CLOSE_HI: subtraction of
-**     S = 1/r of the tangent lines at the closest points, with the same
-**     parameters.  S has the kernel's singular point and leading behaviour,
-**     so K - S is bounded there and the 16 x 16 rule takes it; S over the
-**     square is the exact integral of two straight segments (lw_pair_segseg).
-**   otherwise (touching tangentially, shallow crossings): the subdivision
-**     below.
-** Between the thresholds (APART_LO, SINE_LO, CLOSE_LO) the methods are
-** blended by C2 weights, so the value is a continuous function of the
-** control points.
+**   otherwise (crossing, touching, running close alongside): the
+**     subdivision below.
+** Between APART_LO and APART_HI the two are blended by a C2 weight, so the
+** value is a continuous function of the control points.
+**
+** Every part of it is >= 0, as the kernel is: Gauss rules of a non-negative
+** kernel, exact integrals of chords, convex blends.  A former singularity
+** subtraction (the kernel less 1/r of the tangent lines at the closest
+** points) was not: where the curves did not meet, the lines' pole still lay
+** inside the square, and the 16 x 16 rule of K - S met -1/|S| beside a node
+** pair.  A quench found such a state and drove the energy to -1e8 per pair
+** (tests/test_pair.c, exact_integral_is_never_negative).
 **
 ** The subdivision: a piece [t0, t1] of a cubic is again a cubic, with
 ** control points r(t0), r(t0) + h r'(t0) / 3, r(t1) - h r'(t1) / 3, r(t1)
@@ -46,10 +47,13 @@
 ** leaf sizes 2 to 1).  A piece's 6-node rule is computed once and travels
 ** with its copies down the tree.
 **
-** The cutoff: (1/r - 1/rc)+ = 1/r - 1/rc + (1/rc - 1/r)+.  The last part is
-** bounded with a kink at r = rc; the fixed 16 x 16 rule takes it (accuracy ~
-** (element / rc)^2 of that part, continuous).  The 16 x 16 rule of the
-** apart case takes the whole cutoff kernel in the same pass.
+** The cutoff: the subdivision integrates (1/r - 1/rc)+ itself.  A pair of
+** pieces whose circles lie wholly beyond rc adds nothing (every rule below
+** would give 0 there, so it is not split further); the 6 x 6 rule takes the
+** cut kernel, kink and all (it is continuous, only its derivative jumps);
+** a leaf wholly inside rc takes the chords' exact 1/r less their lengths'
+** product over rc, which is >= 0, blended into the cut product rule over one
+** piece size as the leaf reaches the cutoff.
 */
 #include "linewise/pairnear.h"
 
@@ -145,12 +149,8 @@ static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
 #define SEP_HI 1.0
 #define APART_LO 0.35
 #define APART_HI 0.5
-#define LEAF_RATIO 1e-2
+#define LEAF_RATIO 5e-3
 #define FLAT_RATIO 1e-2
-#define SINE_LO 0.1
-#define SINE_HI 0.2
-#define CLOSE_LO 0.1
-#define CLOSE_HI 0.2
 #define STACK_MAX 128
 
 /* Gauss-Legendre on [0, 1]: 6 nodes for small pieces, 16 for large ones. */
@@ -184,10 +184,10 @@ static void rule_nodes(const cubic *c, double t0, double t1, const double *s, co
   }
 }
 
-typedef enum { KERNEL_INV, KERNEL_CUT, KERNEL_CUT_REST } kernel_kind;
+typedef enum { KERNEL_INV, KERNEL_CUT } kernel_kind;
 
-/* The product rule of an m-node rule on two pieces, for the kernel 1/r,
-** (1/r - 1/rc)+, or the bounded part of the latter, (1/rc - 1/r)+ - 1/rc. */
+/* The product rule of an m-node rule on two pieces, for the kernel 1/r or
+** (1/r - 1/rc)+. */
 static double product_rule(const cubic *ca, double a0, double a1, const cubic *cb, double b0, double b1, int m,
                            kernel_kind kind, double rc)
 {
@@ -202,8 +202,7 @@ static double product_rule(const cubic *ca, double a0, double a1, const cubic *c
     for (int j = 0; j < m; j++) {
       double dx = ax[i] - bx[j], dy = ay[i] - by[j], r2 = dx * dx + dy * dy;
       if (kind == KERNEL_INV) acc += bw[j] / sqrt(r2);
-      else if (kind == KERNEL_CUT) acc += r2 < rc2 ? bw[j] * (1.0 / sqrt(r2) - inv) : 0.0;
-      else acc -= r2 > rc2 ? bw[j] / sqrt(r2) : bw[j] * inv;
+      else acc += r2 < rc2 ? bw[j] * (1.0 / sqrt(r2) - inv) : 0.0;
     }
     sum += aw[i] * acc;
   }
@@ -229,9 +228,16 @@ static void piece_nodes(const cubic *c, piece *p)
 
 typedef lw_v2d v2d;
 
+/* The kernel of the subdivision: 1/r, or (1/r - 1/rc)+ where on. */
+typedef struct {
+  int on;
+  double rc, rc2, inv;
+} cut;
 
-/* The 6 x 6 product rule of 1/r over two pieces, B's nodes two at a time. */
-static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb)
+
+/* The 6 x 6 product rule over two pieces of 1/r (cut: no cutoff) or of
+** (1/r - 1/rc)+, B's nodes two at a time.  Every term is >= 0. */
+static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb, const cut *k)
 {
   piece_nodes(ca, pa);
   piece_nodes(cb, pb);
@@ -245,8 +251,10 @@ static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb)
     const v2d ax = {pa->x[i], pa->x[i]}, ay = {pa->y[i], pa->y[i]}, aw = {pa->w[i], pa->w[i]};
     v2d acc = {0.0, 0.0};
     for (int j = 0; j < GAUSS_S / 2; j++) {
-      v2d dx = ax - bx[j], dy = ay - by[j];
-      acc += bw[j] / lw_vsqrt2(dx * dx + dy * dy);
+      v2d dx = ax - bx[j], dy = ay - by[j], r2 = dx * dx + dy * dy, q = bw[j] / lw_vsqrt2(r2);
+      if (k->on)
+        for (int l = 0; l < 2; l++) q[l] = r2[l] < k->rc2 ? q[l] - bw[j][l] * k->inv : 0.0;
+      acc += q;
     }
     sum += aw * acc;
   }
@@ -256,11 +264,28 @@ static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb)
 /* A leaf: the chords, integrated exactly; their lengths stand in for the
 ** arcs (equal to O(leaf^2)).  Chords of curves that touch tangentially end
 ** to end can overlap by a rounding error, which the exact integral reads as
-** +inf; the product rule's interior nodes keep such a leaf finite. */
-static double leaf_value(const cubic *ca, piece *pa, const cubic *cb, piece *pb)
+** +inf; the product rule's interior nodes keep such a leaf finite.
+** With the cutoff: where the pieces lie wholly inside it (their farthest
+** points closer than rc), 1/r - 1/rc of the chords exactly, which is >= 0
+** since every chord point is within rc of the other chord; where they reach
+** past it, the product rule of the cut kernel; C2-blended over one piece
+** size below rc, so the value is continuous and never negative. */
+static double leaf_value(const cubic *ca, piece *pa, const cubic *cb, piece *pb, const cut *k)
 {
-  double v = lw_pair_segseg(pa->r0, pa->r1, pb->r0, pb->r1);
-  return v < INFINITY ? v : piece_rule(ca, pa, cb, pb);
+  double m = 1.0;
+  if (k->on) {
+    double dx = pa->cx - pb->cx, dy = pa->cy - pb->cy, big = fmax(pa->rad, pb->rad);
+    double far = sqrt(dx * dx + dy * dy) + pa->rad + pb->rad;
+    m = big > 0.0 ? smooth_step((k->rc - far) / big) : 0.0;
+  }
+  double v = m > 0.0 ? lw_pair_segseg(pa->r0, pa->r1, pb->r0, pb->r1) : 0.0;
+  if (!(v < INFINITY)) return piece_rule(ca, pa, cb, pb, k);
+  if (k->on && m > 0.0) {
+    double la = hypot(pa->r1[0] - pa->r0[0], pa->r1[1] - pa->r0[1]);
+    double lb = hypot(pb->r1[0] - pb->r0[0], pb->r1[1] - pb->r0[1]);
+    v = fmax(0.0, v - la * lb * k->inv);
+  }
+  return m < 1.0 ? m * v + (1.0 - m) * piece_rule(ca, pa, cb, pb, k) : v;
 }
 
 /* Distance of point p from segment [a, b]. */
@@ -287,10 +312,10 @@ static double chord_distance(const piece *pa, const piece *pb)
   return fmin(d, fmin(point_segment(pb->r0, pa->r0, pa->r1), point_segment(pb->r1, pa->r0, pa->r1)));
 }
 
-/* T: the 1/r double integral by subdivision (see the file comment), times
-** root_rest: the root pair's 16 x 16 share is the caller's. */
-static double inverse_distance(const cubic *ca, const piece *root_a, const cubic *cb, const piece *root_b,
-                               double root_rest)
+/* The double integral of the kernel by subdivision (see the file comment),
+** times root_rest: the root pair's 16 x 16 share is the caller's. */
+static double subdivided(const cubic *ca, const piece *root_a, const cubic *cb, const piece *root_b,
+                         double root_rest, const cut *k)
 {
   piece sa[STACK_MAX], sb[STACK_MAX];
   double share[STACK_MAX];
@@ -312,8 +337,10 @@ static double inverse_distance(const cubic *ca, const piece *root_a, const cubic
     double dx = pa->cx - pb->cx, dy = pa->cy - pb->cy;
     double big = pa->rad > pb->rad ? pa->rad : pb->rad;
     double gap = sqrt(dx * dx + dy * dy) - pa->rad - pb->rad;
+    /* pieces wholly beyond the cutoff: every rule below would give 0 */
+    if (k->on && gap >= k->rc) continue;
     double w = big > 0.0 ? smooth_step((gap / big - SEP_LO) / (SEP_HI - SEP_LO)) : 1.0;
-    if (w > 0.0) sum += f * w * piece_rule(ca, pa, cb, pb);
+    if (w > 0.0) sum += f * w * piece_rule(ca, pa, cb, pb, k);
     f *= 1.0 - w;
     if (f == 0.0) continue;
     w = top + 2 > STACK_MAX ? 1.0 : smooth_step((2.0 * leaf - big) / leaf);
@@ -324,7 +351,7 @@ static double inverse_distance(const cubic *ca, const piece *root_a, const cubic
       double cd = chord_distance(pa, pb) - pa->flat - pb->flat;
       if (cd > 0.0) w = fmax(w, smooth_step((2.0 * FLAT_RATIO * cd - pa->flat - pb->flat) / (FLAT_RATIO * cd)));
     }
-    if (w > 0.0) sum += f * w * leaf_value(ca, pa, cb, pb);
+    if (w > 0.0) sum += f * w * leaf_value(ca, pa, cb, pb, k);
     f *= 1.0 - w;
     if (f == 0.0) continue;
     /* split A and B in turn: a choice by size would flip between two
@@ -407,46 +434,8 @@ static void closest_points(const cubic *ca, const cubic *cb, double *ps, double 
   *pt = t;
 }
 
-/*
-** Two segments that cross, or nearly meet, at an angle: the kernel minus its
-** straight-line model S, the 1/r of the tangent lines at the closest points
-** (s*, t*) with the same parameters, is bounded there, so the 16 x 16 rule
-** takes it; S over the square is the exact integral of two straight
-** segments (lw_pair_segseg).  With the cutoff's bounded part in the same pass.
-*/
-static double subtracted(const cubic *ca, const cubic *cb, double cutoff, double ss, double ts,
-                         const double a[2], const double a1[2], const double b[2], const double b1[2])
-{
-  double ax[GAUSS_L], ay[GAUSS_L], aw[GAUSS_L], bx[GAUSS_L], by[GAUSS_L], bw[GAUSS_L];
-  double lax[GAUSS_L], lay[GAUSS_L], lbx[GAUSS_L], lby[GAUSS_L];
-  rule_nodes(ca, 0.0, 1.0, G16_S, G16_W, GAUSS_L, ax, ay, aw);
-  rule_nodes(cb, 0.0, 1.0, G16_S, G16_W, GAUSS_L, bx, by, bw);
-  double va = hypot(a1[0], a1[1]), vb = hypot(b1[0], b1[1]);
-  for (int k = 0; k < GAUSS_L; k++) {
-    lax[k] = a[0] + a1[0] * (G16_S[k] - ss);
-    lay[k] = a[1] + a1[1] * (G16_S[k] - ss);
-    lbx[k] = b[0] + b1[0] * (G16_S[k] - ts);
-    lby[k] = b[1] + b1[1] * (G16_S[k] - ts);
-  }
-  const double inv = cutoff > 0.0 ? 1.0 / cutoff : 0.0, rc2 = cutoff > 0.0 ? cutoff * cutoff : INFINITY;
-  double sum = 0.0;
-  for (int i = 0; i < GAUSS_L; i++) {
-    double acc = 0.0, lin = 0.0;
-    for (int j = 0; j < GAUSS_L; j++) {
-      double dx = ax[i] - bx[j], dy = ay[i] - by[j], r2 = dx * dx + dy * dy;
-      double ex = lax[i] - lbx[j], ey = lay[i] - lby[j];
-      acc += bw[j] / sqrt(r2) - (r2 > rc2 ? bw[j] / sqrt(r2) : bw[j] * inv);
-      lin += G16_W[j] / sqrt(ex * ex + ey * ey);
-    }
-    sum += aw[i] * acc - va * vb * G16_W[i] * lin;
-  }
-  double l0[2] = {a[0] - a1[0] * ss, a[1] - a1[1] * ss}, l1[2] = {l0[0] + a1[0], l0[1] + a1[1]};
-  double m0[2] = {b[0] - b1[0] * ts, b[1] - b1[1] * ts}, m1[2] = {m0[0] + b1[0], m0[1] + b1[1]};
-  return sum + lw_pair_segseg(l0, l1, m0, m1);
-}
-
 const lw_pairnear_consts lw_pairnear_k = {SEP_LO,   SEP_HI,     APART_LO, APART_HI, LEAF_RATIO, FLAT_RATIO,
-                                          SINE_LO,  SINE_HI,    CLOSE_LO, CLOSE_HI, STACK_MAX,  G6_S,
+                                          STACK_MAX,  G6_S,
                                           G6_W,     GAUSS_S,    G16_S,    G16_W,    GAUSS_L};
 
 double lw_pair_segments_exact(const double a[8], const double b[8], double cutoff)
@@ -472,18 +461,9 @@ double lw_pair_segments_exact(const double a[8], const double b[8], double cutof
   double w = half > 0.0 ? smooth_step((dist / half - APART_LO) / (APART_HI - APART_LO)) : 1.0;
   kernel_kind whole = cutoff > 0.0 ? KERNEL_CUT : KERNEL_INV;
   double v = w > 0.0 ? w * product_rule(&ca, 0.0, 1.0, &cb, 0.0, 1.0, GAUSS_L, whole, cutoff) : 0.0;
-  double rest = 1.0 - w;
-  if (rest > 0.0) {
-    /* crossing or meeting at an angle: the subtraction; shallow: the tree */
-    double sine = fabs(a1[0] * b1[1] - a1[1] * b1[0]) / (hypot(a1[0], a1[1]) * hypot(b1[0], b1[1]));
-    double u = fmax(smooth_step((sine - SINE_LO) / (SINE_HI - SINE_LO)),
-                    smooth_step((dist / half - CLOSE_LO) / (CLOSE_HI - CLOSE_LO)));
-    if (u > 0.0) v += rest * u * subtracted(&ca, &cb, cutoff, ss, ts, ra, a1, rb, b1);
-    rest *= 1.0 - u;
-  }
-  if (rest > 0.0) {
-    v += inverse_distance(&ca, &pa, &cb, &pb, rest);
-    if (cutoff > 0.0) v += rest * product_rule(&ca, 0.0, 1.0, &cb, 0.0, 1.0, GAUSS_L, KERNEL_CUT_REST, cutoff);
+  if (w < 1.0) {
+    const cut k = {cutoff > 0.0, cutoff, cutoff * cutoff, cutoff > 0.0 ? 1.0 / cutoff : 0.0};
+    v += subdivided(&ca, &pa, &cb, &pb, 1.0 - w, &k);
   }
   return v;
 }

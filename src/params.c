@@ -233,9 +233,7 @@ const lw_param_def lw_param_table[] = {
          "After the last sweep: none, or bfgs, which takes the coldest replica to the nearest local "
          "minimum of its energy (GSL's vector_bfgs2 on the system's gradient; docs/ACCURACY.md). "
          "The drawings and summary.json show the quenched state; state.lw keeps the annealed one, so "
-         "a resumed or longer run continues the chain. Needs a system with a gradient (splines). "
-         "Not yet with the pair term: it can reach states whose computed pair energy is negative "
-         "(an open near-field defect, docs/ACCURACY.md)."),
+         "a resumed or longer run continues the chain. Needs a system with a gradient (splines)."),
   NUM("anneal", "quench_tol", LW_PT_DOUBLE, quench_tol, "1e-6", "energy/mm", 0, 1e300, LW_MIN_OPEN,
       "The quench stops when the gradient's Euclidean norm falls to this."),
   NUM("anneal", "quench_iterations", LW_PT_INT, quench_iterations, "2000", "", 1, 1e9, 0,
@@ -274,7 +272,7 @@ const lw_param_def lw_param_table[] = {
          "Colours of the pens as `#rrggbb` or `#rgb`, one per pen, separated by spaces; empty = all black."),
   CHOICE("output", "order", order, "2opt", "none|greedy|2opt",
          "Order of the paths of each pen in final.svg: index order, greedy nearest neighbour from "
-         "the page origin, or greedy improved by 2-opt; paths may be reversed. Reduces pen-up "
+         "the page origin, or greedy improved by 2-opt and Or-opt moves; paths may be reversed. Reduces pen-up "
          "travel (reported in summary.json)."),
   NUM("output", "png_scale", LW_PT_DOUBLE, png_scale, "4", "px/mm", 0, 100, LW_MIN_OPEN,
       "Pixels per millimetre of final.png and the frames (the long side is capped at 4096 px)."),
@@ -457,6 +455,24 @@ const lw_param_def lw_param_table[] = {
       "Control points held at each end (1 = the ends of the curve; 2 = its end tangents too). "
       "Monte Carlo and the dynamics move only the others. Gravity is the [dynamics] "
       "rho times gravity_x, gravity_y."),
+  NUM("nurbs", "free_weights", LW_PT_INT, nb_free_weights, "0", "", 0, 1, 0,
+      "1 = the weights move too, as coordinates s = log w (so they stay > 0; the held control "
+      "points' weights are held, which fixes their common scale): the dynamics' mass matrix "
+      "then depends on the curve, Monte Carlo adds the move kind `weight`. Needs fixed >= 1 "
+      "and the leapfrog. 0 = frozen weights, a linear system. docs/NURBS.md, \"Free weights\"."),
+  NUM("nurbs", "weight_inertia", LW_PT_DOUBLE, nb_weight_inertia, "0.1", "", 0, 1e12, 0,
+      "Free weights: the inertia of each log weight s, per unit density, added to the mass "
+      "matrix (T gains 1/2 rho weight_inertia sdot^2). A straight polynomial curve moves the "
+      "same way under its weights as under its points, so without it the mass matrix is "
+      "(nearly) singular there (docs/NUMERICS.md, \"Free weights\"). 0 = the review's kinetic energy alone."),
+  NUM("nurbs", "weight_stiffness", LW_PT_DOUBLE, nb_weight_stiffness, "1000", "energy", 0, 1e12, 0,
+      "Free weights: the term `weights` = 1/2 weight_stiffness sum (log w)^2, a spring that "
+      "pulls every weight toward 1 (the review's reset to 1, made smooth and conservative). "
+      "The elastic energy alone lowers as a weight goes to 0, so without it a weight can fall "
+      "without bound (docs/NUMERICS.md, \"Free weights\"). 0 = off."),
+  NUM("nurbs", "step_weight", LW_PT_DOUBLE, nb_step_weight, "0.05", "", 0, 10, LW_MIN_OPEN,
+      "Initial half width of a `weight` move's uniform step in s = log w (free weights; tuned "
+      "toward [moves] target like step_point)."),
   NUM("nurbs", "svg_tolerance", LW_PT_DOUBLE, nb_svg_tolerance, "1e-4", "length", 0, 1e6, LW_MIN_OPEN,
       "Largest distance of final.svg's cubic Beziers from a rational curve (a polynomial one of "
       "order <= 4 is exact); the largest found is reported in summary.json."),

@@ -4,6 +4,7 @@
 #include "linewise/phase.h"
 
 #include <stdatomic.h>
+#include <stdio.h>
 #include <time.h>
 
 /* The name and its start time are two values: a reader may see a new name
@@ -29,4 +30,36 @@ const char *lw_phase_get(double *seconds)
   const char *what = atomic_load(&phase_what);
   if (seconds) *seconds = what ? now() - atomic_load(&phase_since) : 0.0;
   return what;
+}
+
+/* A terminal line is cleared before it is rewritten, so the seconds and the
+** final line replace the progress bar's line instead of trailing it. */
+const char *lw_phase_watch_tick(lw_phase_watch *w, const char *what, double seconds, char *buf, size_t n)
+{
+  const char *clear = w->tty ? "\r\033[K" : "";
+  size_t used = 0;
+  buf[0] = '\0';
+  if (w->shown && what != w->shown) {
+    used = (size_t)snprintf(buf, n, "%slinewise: %s: done in %.1f s\n", clear, w->shown, w->last);
+    if (used >= n) used = n - 1;
+    w->shown = NULL;
+  }
+  if (what && seconds > LW_PHASE_QUIET && (!w->shown || (w->tty && seconds - w->reported >= 1.0))) {
+    if (w->tty) snprintf(buf + used, n - used, "%slinewise: %s... %.0f s", clear, what, seconds);
+    else if (!w->shown) snprintf(buf + used, n - used, "linewise: %s...\n", what);
+    w->shown = what;
+    w->reported = seconds;
+  }
+  if (what && what == w->shown) w->last = seconds;
+  return buf;
+}
+
+const char *lw_phase_watch_end(lw_phase_watch *w, int failed, char *buf, size_t n)
+{
+  buf[0] = '\0';
+  if (w->shown)
+    snprintf(buf, n, "%slinewise: %s: %s %.1f s\n", w->tty ? "\r\033[K" : "", w->shown,
+             failed ? "failed after" : "done in", w->last);
+  w->shown = NULL;
+  return buf;
 }

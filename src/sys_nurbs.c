@@ -1,8 +1,10 @@
 /*
-** sys_nurbs.c -- the D-NURBS system's row (sys_nurbs.h): a curve with
-** frozen weights is a quadratic energy E = 1/2 P'KP - f'P of its control
-** points, so a move's dE is local (the band of K) and the dynamics is
-** linear with a constant mass matrix.
+** sys_nurbs.c -- the D-NURBS system's row (sys_nurbs.h): at given weights
+** the energy is quadratic, E = 1/2 P'K(w)P - f(w)'P, so a point move's dE
+** is local (the band of K) and, with frozen weights, the dynamics is linear
+** with a constant mass matrix.  Free weights (s = log w) make K, f and the
+** mass matrix functions of the state: they are assembled again whenever
+** the weights change.
 */
 #include "linewise/sys_nurbs.h"
 
@@ -17,10 +19,11 @@
 #include "linewise/number.h"
 #include "linewise/output.h"
 
-static const char *const move_names[1] = {"point"};
-static const double move_unit[1] = {1.0};
-static const char *const term_names[2] = {"elastic", "gravity"};
-enum { T_ELASTIC, T_GRAVITY };
+static const char *const move_names[2] = {"point", "weight"};
+static const double move_unit[2] = {1.0, 1.0};
+enum { K_POINT, K_WEIGHT };
+static const char *const term_names[3] = {"elastic", "gravity", "weights"};
+enum { T_ELASTIC, T_GRAVITY, T_WEIGHTS, N_TERMS };
 
 #define SECTION "system nurbs"
 
@@ -35,6 +38,7 @@ static void setup_free(void *setup)
   free(su->pin);
   free(su->f);
   free(su->free_idx);
+  free(su->s0);
   free(su);
 }
 
@@ -175,6 +179,27 @@ lw_nurbs_setup *lw_nurbs_setup_new(const lw_params *p, lw_nurbs *curve, lw_error
     lw_params_blame(p, "nurbs", "fixed", err);
     goto fail;
   }
+  /* free weights: the coordinates are s = log w, and the curve that K, M1
+  ** and b are assembled on has w = exp(s) to the last bit, as every state */
+  su->free_weights = p->nb_free_weights;
+  if (su->free_weights && p->nb_fixed < 1) {
+    lw_error_set(err, LW_EINPUT, "free weights need nurbs.fixed >= 1 (the held end weights fix the scale of the "
+                 "weights, which leaves the curve unchanged), got fixed = 0");
+    lw_params_blame(p, "nurbs", "free_weights", err);
+    goto fail;
+  }
+  if (!(su->s0 = malloc(n * sizeof *su->s0))) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for a scene");
+    goto fail;
+  }
+  for (size_t i = 0; i < n; i++) {
+    su->s0[i] = log(curve->w[i]);
+    if (su->free_weights) curve->w[i] = exp(su->s0[i]);
+  }
+  su->weight_inertia = p->nb_weight_inertia;
+  su->weight_stiffness = p->nb_weight_stiffness;
+  su->mug[0] = p->dyn_rho * p->dyn_gravity_x;
+  su->mug[1] = p->dyn_rho * p->dyn_gravity_y;
   if (!(su->mat = lw_dnurbs_new(su->curve, p->nb_alpha, p->nb_beta, p->nb_gauss, err))) goto fail;
   su->pin = calloc(n, 1);
   su->f = calloc(2 * n, sizeof *su->f);
@@ -185,8 +210,8 @@ lw_nurbs_setup *lw_nurbs_setup_new(const lw_params *p, lw_nurbs *curve, lw_error
   }
   for (size_t i = 0; i < (size_t)p->nb_fixed; i++) su->pin[i] = su->pin[n - 1 - i] = 1;
   for (size_t i = 0; i < n; i++) {
-    su->f[2 * i] = p->dyn_rho * p->dyn_gravity_x * su->mat->b[i];
-    su->f[2 * i + 1] = p->dyn_rho * p->dyn_gravity_y * su->mat->b[i];
+    su->f[2 * i] = su->mug[0] * su->mat->b[i];
+    su->f[2 * i + 1] = su->mug[1] * su->mat->b[i];
     if (!su->pin[i]) su->free_idx[su->n_free++] = i;
   }
   /* the frames' view: the control polygon's box, grown by half its larger side */
@@ -219,50 +244,88 @@ static void state_free(void *state)
   lw_nurbs_state *s = state;
   if (!s) return;
   lw_nurbs_free(s->c);
+  lw_dnurbs_free(s->own);
+  free(s->s);
+  free(s->f);
   free(s->KP);
   free(s);
 }
 
-/* K P and the terms from scratch. */
-static void recompute(lw_nurbs_state *s)
+/* K, f and K P at the present weights (with free weights, K and f from
+** scratch: they depend on every weight near a changed one). */
+static lw_status rebuild(lw_nurbs_state *s, lw_error *err)
 {
   const lw_nurbs_setup *su = s->su;
   size_t n = s->c->n;
-  lw_band_apply(su->mat->K, n, su->mat->k, s->c->P, s->KP);
+  if (s->own) {
+    lw_status st = lw_dnurbs_assemble(s->own, s->c, err);
+    if (st) return st;
+    for (size_t i = 0; i < n; i++) {
+      s->f[2 * i] = su->mug[0] * s->own->b[i];
+      s->f[2 * i + 1] = su->mug[1] * s->own->b[i];
+    }
+  }
+  lw_band_apply(s->mat->K, n, s->mat->k, s->c->P, s->KP);
+  return LW_OK;
+}
+
+/* K P and the terms from scratch. */
+static lw_status recompute(lw_nurbs_state *s, lw_error *err)
+{
+  lw_status st = rebuild(s, err);
+  if (st) return st;
   double el = 0.0, g = 0.0;
-  for (size_t i = 0; i < 2 * n; i++) {
+  for (size_t i = 0; i < 2 * s->c->n; i++) {
     el += 0.5 * s->c->P[i] * s->KP[i];
-    g -= su->f[i] * s->c->P[i];
+    g -= s->f[i] * s->c->P[i];
   }
   s->term[T_ELASTIC] = el;
   s->term[T_GRAVITY] = g;
+  s->term[T_WEIGHTS] = 0.0;
+  for (size_t i = 0; s->s && i < s->c->n; i++) s->term[T_WEIGHTS] += 0.5 * s->su->weight_stiffness * s->s[i] * s->s[i];
+  return LW_OK;
 }
 
-/* A state on control points P (2 n numbers; NULL: the set-up's). */
-static lw_nurbs_state *state_at(const lw_nurbs_setup *su, const double *P, lw_error *err)
+/* A state on control points P (2 n numbers; NULL: the set-up's) and, with
+** free weights, log weights lw (n; NULL: the set-up's). */
+static lw_nurbs_state *state_at(const lw_nurbs_setup *su, const double *P, const double *lw, lw_error *err)
 {
+  size_t n = su->curve->n;
   lw_nurbs_state *s = calloc(1, sizeof *s);
-  if (!s || !(s->c = lw_nurbs_copy(su->curve, err)) || !(s->KP = malloc(2 * su->curve->n * sizeof *s->KP))) {
+  if (!s || !(s->c = lw_nurbs_copy(su->curve, err)) || !(s->KP = malloc(2 * n * sizeof *s->KP)) ||
+      !(s->f = malloc(2 * n * sizeof *s->f)) ||
+      (su->free_weights && (!(s->s = malloc(n * sizeof *s->s)) ||
+                            !(s->own = lw_dnurbs_new(s->c, su->mat->alpha, su->mat->beta, su->mat->gauss, err))))) {
     state_free(s);
     lw_error_set(err, LW_ENOMEM, "out of memory for a NURBS state");
     return NULL;
   }
   s->su = su;
-  if (P) memcpy(s->c->P, P, 2 * su->curve->n * sizeof *P);
-  recompute(s);
+  s->mat = s->own ? s->own : su->mat;
+  memcpy(s->f, su->f, 2 * n * sizeof *s->f);
+  if (P) memcpy(s->c->P, P, 2 * n * sizeof *P);
+  if (s->s) {
+    memcpy(s->s, lw ? lw : su->s0, n * sizeof *s->s);
+    for (size_t i = 0; i < n; i++) s->c->w[i] = exp(s->s[i]);
+  }
+  if (recompute(s, err)) {
+    state_free(s);
+    return NULL;
+  }
   return s;
 }
 
-/* The control points of a saved state's section; messages name path. */
+/* The control points (and log weights) of a saved state's section;
+** messages name path. */
 static lw_nurbs_state *state_get(const lw_nurbs_setup *su, lw_ckpt *doc, const char *section, lw_error *err)
 {
   const char *path = lw_ckpt_path(doc);
   if (!lw_ckpt_has(doc, section))
     return lw_error_set(err, LW_EINPUT, "%s: section [%s]: missing (a state of another system?)", path, section), NULL;
-  size_t n = su->curve->n, i = 0, pos = 0;
+  size_t n = su->curve->n, i = 0, j = 0, pos = 0;
   long count;
   if (lw_ckpt_whole(doc, section, "count", &count, (long)n, (long)n, 1, err)) return NULL;
-  double *P = malloc(2 * n * sizeof *P);
+  double *P = malloc(3 * n * sizeof *P), *lw = P + 2 * n;
   if (!P) return lw_error_set(err, LW_ENOMEM, "out of memory"), NULL;
   const char *key, *val;
   int line;
@@ -270,6 +333,22 @@ static lw_nurbs_state *state_get(const lw_nurbs_setup *su, lw_ckpt *doc, const c
   while (lw_ckpt_next(doc, section, &pos, &key, &val, &line)) {
     if (!strcmp(key, "count")) continue;
     double v[3];
+    if (!strcmp(key, "log_weight")) {
+      if (!su->free_weights || j == n || lw_number_list(val, 0, v, 2) != 1) {
+        lw_error_set(err, LW_EINPUT, "%s:%d: [%s] log_weight: expected %s, got '%.80s'", path, line, section,
+                     !su->free_weights ? "no log weights (nurbs.free_weights = 0 freezes the scene's weights)"
+                     : j == n          ? "nothing (count is the number of control points)"
+                                       : "one number, log w", val);
+        goto out;
+      }
+      if (su->pin[j] && v[0] != su->s0[j]) {
+        lw_error_set(err, LW_EINPUT, "%s:%d: [%s] log_weight: control point %zu is held by nurbs.fixed with log "
+                     "weight %.17g, got %.17g", path, line, section, j, su->s0[j], v[0]);
+        goto out;
+      }
+      lw[j++] = v[0];
+      continue;
+    }
     if (i == n || strcmp(key, "point") || lw_number_list(val, 0, v, 3) != 2) {
       lw_error_set(err, LW_EINPUT, "%s:%d: [%s] %s: expected %s, got '%s = %.80s'", path, line, section,
                    i == n ? "after the last point" : "point",
@@ -285,11 +364,13 @@ static lw_nurbs_state *state_get(const lw_nurbs_setup *su, lw_ckpt *doc, const c
     P[2 * i + 1] = v[1];
     i++;
   }
-  if (i < n) {
-    lw_error_set(err, LW_EINPUT, "%s: [%s]: count = %zu, but %zu point lines", path, section, n, i);
+  if (i < n || (j && j < n)) {
+    lw_error_set(err, LW_EINPUT, "%s: [%s]: count = %zu, but %zu %s lines", path, section, n, i < n ? i : j,
+                 i < n ? "point" : "log_weight");
     goto out;
   }
-  s = state_at(su, P, err);
+  /* a state of a frozen-weight run starts free weights at the scene's */
+  s = state_at(su, P, j ? lw : NULL, err);
 out:
   free(P);
   return s;
@@ -297,7 +378,7 @@ out:
 
 static void *state_new(const void *setup, const lw_params *p, unsigned long seed, lw_error *err)
 {
-  if (!p->from[0]) return state_at(setup, NULL, err);
+  if (!p->from[0]) return state_at(setup, NULL, NULL, err);
   lw_state st;
   lw_nurbs_state *s = NULL;
   if (!lw_state_read(&st, p->from, err)) {
@@ -311,7 +392,7 @@ static void *state_new(const void *setup, const lw_params *p, unsigned long seed
 static void *state_copy(const void *state, lw_error *err)
 {
   const lw_nurbs_state *s = state;
-  lw_nurbs_state *c = state_at(s->su, s->c->P, err);
+  lw_nurbs_state *c = state_at(s->su, s->c->P, s->s, err);
   if (c) memcpy(c->term, s->term, sizeof c->term);
   return c;
 }
@@ -319,21 +400,28 @@ static void *state_copy(const void *state, lw_error *err)
 /* ---- Monte Carlo ---------------------------------------------------------- */
 
 typedef struct {
+  int kind;
   size_t i;
-  double d[2];
-  double de[2]; /* elastic, gravity */
+  double d[2];  /* point: the step in x y; weight: d[0] the step in s */
+  double de[N_TERMS];
 } nb_prop;
 
 static void moves(const lw_params *p, double *weight, double *step, double *target)
 {
-  weight[0] = 1.0; /* the only kind */
-  step[0] = p->step_point;
-  target[0] = p->target;
+  weight[K_POINT] = 1.0;
+  step[K_POINT] = p->step_point;
+  weight[K_WEIGHT] = p->nb_free_weights ? 1.0 : 0.0;
+  step[K_WEIGHT] = p->nb_step_weight;
+  target[K_POINT] = target[K_WEIGHT] = p->target;
 }
 
 static size_t sweep_size(const void *state) { return ((const lw_nurbs_state *)state)->su->n_free; }
 
-static double step_max(const void *state, int kind) { return ((const lw_nurbs_state *)state)->su->step_max; }
+/* a step in s of 2 multiplies a weight by up to e^2 */
+static double step_max(const void *state, int kind)
+{
+  return kind == K_WEIGHT ? 2.0 : ((const lw_nurbs_state *)state)->su->step_max;
+}
 
 static void *proposal_new(const void *state, lw_error *err)
 {
@@ -344,21 +432,44 @@ static void *proposal_new(const void *state, lw_error *err)
 
 static void proposal_free(void *prop) { free(prop); }
 
-/* dE of P_i + d: (K P)_i . d + 1/2 K_ii |d|^2 - f_i . d, from the band. */
+/* dE of w_j exp(d): the energy of the k spans around j at both weights
+** (the weight is put back: the state is unchanged). NaN when out of memory. */
+static double propose_weight(lw_nurbs_state *s, nb_prop *q)
+{
+  const lw_nurbs_setup *su = s->su;
+  const lw_dnurbs *m = s->mat;
+  double e0[2], e1[2], w = s->c->w[q->i];
+  lw_error err = {0};
+  lw_dnurbs_energy_near(s->c, m->alpha, m->beta, su->mug, m->gauss, q->i, e0, &err);
+  s->c->w[q->i] = exp(s->s[q->i] + q->d[0]);
+  lw_dnurbs_energy_near(s->c, m->alpha, m->beta, su->mug, m->gauss, q->i, e1, &err);
+  s->c->w[q->i] = w;
+  if (err.code) return NAN;
+  double s0 = s->s[q->i], s1 = s0 + q->d[0];
+  q->de[T_ELASTIC] = e1[0] - e0[0];
+  q->de[T_GRAVITY] = e1[1] - e0[1];
+  q->de[T_WEIGHTS] = 0.5 * su->weight_stiffness * (s1 * s1 - s0 * s0);
+  return q->de[T_ELASTIC] + q->de[T_GRAVITY] + q->de[T_WEIGHTS];
+}
+
+/* point: dE of P_i + d = (K P)_i . d + 1/2 K_ii |d|^2 - f_i . d, from the band. */
 static double propose(void *state, void *prop, int kind, double step, gsl_rng *rng, int *forbidden)
 {
   lw_nurbs_state *s = state;
   const lw_nurbs_setup *su = s->su;
   nb_prop *q = prop;
   *forbidden = 0;
+  q->kind = kind;
   q->i = su->free_idx[gsl_rng_uniform_int(rng, su->n_free)];
   q->d[0] = step * (2.0 * gsl_rng_uniform(rng) - 1.0);
+  if (kind == K_WEIGHT) return propose_weight(s, q);
   q->d[1] = step * (2.0 * gsl_rng_uniform(rng) - 1.0);
   size_t i = q->i;
-  double kii = su->mat->K[i * (size_t)su->mat->k];
+  double kii = s->mat->K[i * (size_t)s->mat->k];
   q->de[T_ELASTIC] = s->KP[2 * i] * q->d[0] + s->KP[2 * i + 1] * q->d[1] +
                      0.5 * kii * (q->d[0] * q->d[0] + q->d[1] * q->d[1]);
-  q->de[T_GRAVITY] = -(su->f[2 * i] * q->d[0] + su->f[2 * i + 1] * q->d[1]);
+  q->de[T_GRAVITY] = -(s->f[2 * i] * q->d[0] + s->f[2 * i + 1] * q->d[1]);
+  q->de[T_WEIGHTS] = 0.0;
   return q->de[T_ELASTIC] + q->de[T_GRAVITY];
 }
 
@@ -366,23 +477,36 @@ static lw_status commit(void *state, void *prop)
 {
   lw_nurbs_state *s = state;
   const nb_prop *q = prop;
-  const lw_dnurbs *m = s->su->mat;
+  const lw_dnurbs *m = s->mat;
   size_t i = q->i, n = m->n, k = (size_t)m->k;
-  s->c->P[2 * i] += q->d[0];
-  s->c->P[2 * i + 1] += q->d[1];
-  /* column i of K: K(i + d, i) below, K(i, i - d) = K(i - d, i) above */
-  for (size_t d = 0; d < k; d++) {
-    if (i + d < n) {
-      s->KP[2 * (i + d)] += m->K[i * k + d] * q->d[0];
-      s->KP[2 * (i + d) + 1] += m->K[i * k + d] * q->d[1];
+  if (q->kind == K_WEIGHT) {
+    /* K and f change over 2k - 1 control points: assembled again, O(n) */
+    lw_error err = {0};
+    double s0 = s->s[i];
+    s->s[i] += q->d[0];
+    s->c->w[i] = exp(s->s[i]);
+    if (rebuild(s, &err)) {
+      s->s[i] = s0;
+      s->c->w[i] = exp(s0);
+      rebuild(s, &err);
+      return LW_ENOMEM;
     }
-    if (d > 0 && i >= d) {
-      s->KP[2 * (i - d)] += m->K[(i - d) * k + d] * q->d[0];
-      s->KP[2 * (i - d) + 1] += m->K[(i - d) * k + d] * q->d[1];
+  } else {
+    s->c->P[2 * i] += q->d[0];
+    s->c->P[2 * i + 1] += q->d[1];
+    /* column i of K: K(i + d, i) below, K(i, i - d) = K(i - d, i) above */
+    for (size_t d = 0; d < k; d++) {
+      if (i + d < n) {
+        s->KP[2 * (i + d)] += m->K[i * k + d] * q->d[0];
+        s->KP[2 * (i + d) + 1] += m->K[i * k + d] * q->d[1];
+      }
+      if (d > 0 && i >= d) {
+        s->KP[2 * (i - d)] += m->K[(i - d) * k + d] * q->d[0];
+        s->KP[2 * (i - d) + 1] += m->K[(i - d) * k + d] * q->d[1];
+      }
     }
   }
-  s->term[T_ELASTIC] += q->de[T_ELASTIC];
-  s->term[T_GRAVITY] += q->de[T_GRAVITY];
+  for (int t = 0; t < N_TERMS; t++) s->term[t] += q->de[t];
   return LW_OK;
 }
 
@@ -391,15 +515,16 @@ static lw_status commit(void *state, void *prop)
 static double total(const void *state)
 {
   const lw_nurbs_state *s = state;
-  return s->term[T_ELASTIC] + s->term[T_GRAVITY];
+  return s->term[T_ELASTIC] + s->term[T_GRAVITY] + s->term[T_WEIGHTS];
 }
 
-static void terms(const void *state, double *term) { memcpy(term, ((const lw_nurbs_state *)state)->term, 2 * sizeof *term); }
+static void terms(const void *state, double *term) { memcpy(term, ((const lw_nurbs_state *)state)->term, N_TERMS * sizeof *term); }
 
 static int term_on(const void *setup, int t)
 {
   const lw_nurbs_setup *su = setup;
   if (t == T_ELASTIC) return 1;
+  if (t == T_WEIGHTS) return su->free_weights && su->weight_stiffness > 0.0;
   for (size_t i = 0; i < 2 * su->curve->n; i++)
     if (su->f[i] != 0.0) return 1;
   return 0;
@@ -409,7 +534,8 @@ static lw_status refresh(void *state, double *drift)
 {
   lw_nurbs_state *s = state;
   double old = total(s);
-  recompute(s);
+  lw_error err = {0};
+  if (recompute(s, &err)) return err.code;
   if (drift) *drift = fabs(total(s) - old) / fmax(fabs(total(s)), 1.0);
   return LW_OK;
 }
@@ -430,6 +556,7 @@ static lw_status save(const void *state, lw_ckpt_writer *w, const char *section,
   lw_ckpt_section(w, section);
   lw_ckpt_put(w, "count", "%zu", s->c->n);
   for (size_t i = 0; i < s->c->n; i++) lw_ckpt_put(w, "point", "%.17g %.17g", s->c->P[2 * i], s->c->P[2 * i + 1]);
+  for (size_t i = 0; s->s && i < s->c->n; i++) lw_ckpt_put(w, "log_weight", "%.17g", s->s[i]);
   return LW_OK;
 }
 
@@ -438,39 +565,85 @@ static void *load(const void *setup, lw_state *st, const char *section, const ch
   return state_get(setup, st->doc, section, err);
 }
 
-static void set_terms(void *state, const double *term) { memcpy(((lw_nurbs_state *)state)->term, term, 2 * sizeof *term); }
+static void set_terms(void *state, const double *term) { memcpy(((lw_nurbs_state *)state)->term, term, N_TERMS * sizeof *term); }
 
 /* ---- gradient and inertia ------------------------------------------------- */
 
-static size_t n_coords(const void *state) { return 2 * ((const lw_nurbs_state *)state)->c->n; }
+/* Coordinates per control point: x y, and s = log w with free weights. */
+static size_t per_point(const lw_nurbs_setup *su) { return su->free_weights ? 3 : 2; }
+
+static size_t n_coords(const void *state)
+{
+  const lw_nurbs_state *s = state;
+  return per_point(s->su) * s->c->n;
+}
 
 static void get_coords(const void *state, double *x)
 {
   const lw_nurbs_state *s = state;
-  memcpy(x, s->c->P, 2 * s->c->n * sizeof *x);
+  size_t m = per_point(s->su);
+  for (size_t i = 0; i < s->c->n; i++) {
+    x[m * i] = s->c->P[2 * i];
+    x[m * i + 1] = s->c->P[2 * i + 1];
+    if (s->s) x[m * i + 2] = s->s[i];
+  }
+}
+
+/* Moves curve c to x (m coordinates a point); LW_EINPUT for a coordinate
+** that is not finite or a weight exp(s) outside the doubles' range. */
+static lw_status curve_to(lw_nurbs *c, size_t m, const double *x, lw_error *err)
+{
+  for (size_t i = 0; i < m * c->n; i++)
+    if (!isfinite(x[i])) return lw_error_set(err, LW_EINPUT, "coordinate %zu (control point %zu) is not finite", i, i / m);
+  for (size_t i = 0; i < c->n; i++) {
+    c->P[2 * i] = x[m * i];
+    c->P[2 * i + 1] = x[m * i + 1];
+    if (m == 3 && fabs(x[3 * i + 2]) > 700.0)
+      return lw_error_set(err, LW_EINPUT, "the log weight of control point %zu is %g: the weights span more than "
+                          "the doubles do", i, x[3 * i + 2]);
+    if (m == 3) c->w[i] = exp(x[3 * i + 2]);
+  }
+  return LW_OK;
 }
 
 static lw_status set_coords(void *state, const double *x, lw_error *err)
 {
   lw_nurbs_state *s = state;
-  for (size_t i = 0; i < 2 * s->c->n; i++)
-    if (!isfinite(x[i])) return lw_error_set(err, LW_EINPUT, "coordinate %zu (control point %zu) is not finite", i, i / 2);
-  memcpy(s->c->P, x, 2 * s->c->n * sizeof *x);
-  recompute(s);
-  return LW_OK;
+  size_t m = per_point(s->su);
+  lw_status st = curve_to(s->c, m, x, err);
+  if (st) return st;
+  for (size_t i = 0; s->s && i < s->c->n; i++) s->s[i] = x[3 * i + 2];
+  return recompute(s, err);
 }
 
-/* dE/dP = K P - f */
+/* dE/dP = K P - f; with free weights dE/ds_j too (dnurbs.h). */
 static double gradient(void *state, double *g, lw_error *err)
 {
   lw_nurbs_state *s = state;
-  for (size_t i = 0; i < 2 * s->c->n; i++) g[i] = s->KP[i] - s->su->f[i];
+  size_t n = s->c->n, m = per_point(s->su);
+  for (size_t i = 0; i < n; i++)
+    for (size_t c = 0; c < 2; c++) g[m * i + c] = s->KP[2 * i + c] - s->f[2 * i + c];
+  if (s->s) {
+    const lw_dnurbs *d = s->mat;
+    double *gs = malloc(n * sizeof *gs);
+    if (!gs || lw_dnurbs_grad_s(s->c, d->alpha, d->beta, s->su->mug, d->gauss, gs, err)) {
+      free(gs);
+      if (!err->code) lw_error_set(err, LW_ENOMEM, "out of memory for the gradient");
+      return NAN;
+    }
+    for (size_t i = 0; i < n; i++) g[3 * i + 2] = gs[i] + s->su->weight_stiffness * s->s[i];
+    free(gs);
+  }
   return total(s);
 }
 
 typedef struct {
   const lw_nurbs_setup *su;
-  double *M, *L; /* density M1 and its factor (held points as identity) */
+  size_t n, k;      /* the band: rows and columns (3 n, 3 k with free weights) */
+  double density;
+  double *M, *L;    /* the mass matrix and its factor (held coordinates as identity) */
+  unsigned char *pin;  /* n: held coordinates (free weights; else su->pin a point) */
+  lw_nurbs *c;      /* free weights: the curve at the last x */
 } nb_mass;
 
 static void mass_free(void *mass)
@@ -479,50 +652,99 @@ static void mass_free(void *mass)
   if (!m) return;
   free(m->M);
   free(m->L);
+  free(m->pin);
+  lw_nurbs_free(m->c);
   free(m);
 }
 
 static void *mass_new(const void *state, const lw_params *p, double density, lw_error *err)
 {
-  const lw_nurbs_setup *su = ((const lw_nurbs_state *)state)->su;
-  size_t nk = su->mat->n * (size_t)su->mat->k;
-  nb_mass *m = calloc(1, sizeof *m);
-  if (!m || !(m->M = malloc(nk * sizeof *m->M)) || !(m->L = malloc(nk * sizeof *m->L))) {
-    mass_free(m);
-    lw_error_set(err, LW_ENOMEM, "out of memory for the mass matrix");
+  const lw_nurbs_state *s = state;
+  const lw_nurbs_setup *su = s->su;
+  if (su->free_weights && p->dyn_integrator == LW_INTEGRATOR_REVIEW) {
+    lw_error_set(err, LW_EINPUT, "the review's scheme takes a constant mass matrix; with nurbs.free_weights = 1 "
+                 "use integrator = leapfrog");
+    lw_params_blame(p, "dynamics", "integrator", err);
     return NULL;
   }
+  nb_mass *m = calloc(1, sizeof *m);
+  if (!m) goto nomem;
   m->su = su;
-  for (size_t i = 0; i < nk; i++) m->M[i] = density * su->mat->M1[i];
-  if (lw_band_factor(m->M, su->pin, su->mat->n, su->mat->k, m->L, err)) {
+  m->density = density;
+  m->n = su->mat->n;
+  m->k = (size_t)su->mat->k;
+  if (su->free_weights) {
+    m->n *= 3;
+    m->k *= 3;
+    if (!(m->pin = malloc(m->n)) || !(m->c = lw_nurbs_copy(s->c, err))) goto nomem;
+    for (size_t i = 0; i < m->n; i++) m->pin[i] = su->pin[i / 3];
+  }
+  if (!(m->M = malloc(m->n * m->k * sizeof *m->M)) || !(m->L = malloc(m->n * m->k * sizeof *m->L))) goto nomem;
+  if (su->free_weights) return m; /* assembled by mass_at */
+  for (size_t i = 0; i < m->n * m->k; i++) m->M[i] = density * su->mat->M1[i];
+  if (lw_band_factor(m->M, su->pin, m->n, (int)m->k, m->L, err)) {
     mass_free(m);
     return NULL;
   }
   return m;
+nomem:
+  mass_free(m);
+  lw_error_set(err, LW_ENOMEM, "out of memory for the mass matrix");
+  return NULL;
 }
 
-/* frozen weights: the matrix is constant, factored once */
-static lw_status mass_at(void *mass, const double *x, lw_error *err) { return LW_OK; }
+/* frozen weights: the matrix is constant, factored once; free weights: it
+** is assembled and factored again at x */
+static lw_status mass_at(void *mass, const double *x, lw_error *err)
+{
+  nb_mass *m = mass;
+  if (!m->c) return LW_OK;
+  lw_status st = curve_to(m->c, 3, x, err);
+  if (!st) st = lw_dnurbs_mass_s(m->c, m->su->mat->gauss, m->M, err);
+  if (st) return st;
+  for (size_t i = 2; i < m->n; i += 3) m->M[i * m->k] += m->su->weight_inertia;
+  for (size_t i = 0; i < m->n * m->k; i++) m->M[i] *= m->density;
+  return lw_band_factor(m->M, m->pin, m->n, (int)m->k, m->L, err);
+}
 
 static void mass_solve(const void *mass, const double *b, double *v)
 {
   const nb_mass *m = mass;
-  lw_band_solve(m->L, m->su->pin, m->su->mat->n, m->su->mat->k, b, v);
+  if (m->c)
+    lw_band_solve_dim(m->L, m->pin, m->n, (int)m->k, 1, b, v);
+  else
+    lw_band_solve(m->L, m->su->pin, m->n, (int)m->k, b, v);
 }
 
 static void mass_apply(const void *mass, const double *v, double *b)
 {
   const nb_mass *m = mass;
-  lw_band_apply(m->M, m->su->mat->n, m->su->mat->k, v, b);
+  lw_band_apply_dim(m->M, m->n, (int)m->k, m->c ? 1 : 2, v, b);
 }
 
+/* frozen weights: M is constant, so 0; free weights: dnurbs.h (NaN where
+** the curve cannot be evaluated, so that the motion stops) */
 static void mass_dx(const void *mass, const double *x, const double *v, double *out)
 {
   const nb_mass *m = mass;
-  memset(out, 0, 2 * m->su->mat->n * sizeof *out);
+  size_t nc = m->c ? m->n : 2 * m->n;
+  lw_error err = {0};
+  if (!m->c) {
+    memset(out, 0, nc * sizeof *out);
+    return;
+  }
+  if (curve_to(m->c, 3, x, &err) || lw_dnurbs_mass_s_dx(m->c, m->su->mat->gauss, v, out, &err)) {
+    for (size_t i = 0; i < nc; i++) out[i] = NAN;
+    return;
+  }
+  for (size_t i = 0; i < nc; i++) out[i] *= m->density;
 }
 
-static int mass_pinned(const void *mass, size_t i) { return ((const nb_mass *)mass)->su->pin[i / 2]; }
+static int mass_pinned(const void *mass, size_t i)
+{
+  const nb_mass *m = mass;
+  return m->c ? m->pin[i] : m->su->pin[i / 2];
+}
 
 /* ---- drawings ------------------------------------------------------------- */
 
@@ -664,6 +886,14 @@ static void summary(const void *state, lw_json *j)
   lw_json_int(j, s->c->order);
   lw_json_key(j, "fixed");
   lw_json_int(j, (long long)(s->c->n - s->su->n_free));
+  if (s->s) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < s->c->n; i++) lo = fmin(lo, s->c->w[i]), hi = fmax(hi, s->c->w[i]);
+    lw_json_key(j, "weight_min");
+    lw_json_number(j, lo);
+    lw_json_key(j, "weight_max");
+    lw_json_number(j, hi);
+  }
   lw_json_key(j, "svg_beziers");
   lw_json_int(j, (long long)s->beziers);
   lw_json_key(j, "svg_max_deviation");
@@ -674,7 +904,8 @@ static void describe(const void *state, int what, char *buf, size_t n)
 {
   const lw_nurbs_state *s = state;
   if (what == LW_DESCRIBE_SIZE)
-    snprintf(buf, n, "a NURBS curve of order %d, %zu control points, %zu free", s->c->order, s->c->n, s->su->n_free);
+    snprintf(buf, n, "a NURBS curve of order %d, %zu control points, %zu free%s", s->c->order, s->c->n, s->su->n_free,
+             s->s ? ", free weights" : "");
   else
     snprintf(buf, n, "linewise: final.svg: %zu cubic Beziers, at most %.3g from the curve%s\n", s->beziers,
              s->deviation, lw_nurbs_polynomial(s->c) && s->c->order <= 4 ? " (exact)" : "");
@@ -682,10 +913,10 @@ static void describe(const void *state, int what, char *buf, size_t n)
 
 const lw_system_type lw_system_nurbs = {
     .name = "nurbs",
-    .n_moves = 1,
+    .n_moves = 2,
     .move_names = move_names,
     .move_unit = move_unit,
-    .n_terms = 2,
+    .n_terms = N_TERMS,
     .term_names = term_names,
     .setup_new = setup_new,
     .setup_free = setup_free,

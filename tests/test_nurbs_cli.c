@@ -113,3 +113,38 @@ Test(nurbs_cli, tempering_replicas_give_the_same_bytes_for_any_thread_count)
     cr_assert_eq(sh("cmp -s %s/t1/%s %s/t3/%s", dir, same[k], dir, same[k]), 0, "%s differs with the threads", same[k]);
   cr_assert_eq(sh("grep -c '^\\[system nurbs' %s/t1/state.lw | grep -q '^4$'", dir), 0, "one section a rung");
 }
+
+Test(nurbs_cli, free_weights_resume_to_the_same_bytes_under_dynamics_and_monte_carlo)
+{
+  const char *set = "--set nurbs.free_weights=1 --set 'nurbs.weights=1 1.2 1 0.8 1 1.2 1' --set dynamics.dt=0.001 "
+                    "--set anneal.sweeps=30 --set output.checkpoint_every=7 --set output.frames_every=0";
+  const char *drivers[] = {"dynamics", "metropolis"};
+  for (int k = 0; k < 2; k++) {
+    const char *d = drivers[k];
+    cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/fa%d --quiet %s --set scene.driver=%s", lw_test_bin(),
+                    lw_test_root(), dir, k, set, d), 0);
+    cr_assert_eq(sh("OMP_NUM_THREADS=1 %s run %s/params/wire.ini --out %s/fb%d --quiet %s --set scene.driver=%s "
+                    "--stop-at 13", lw_test_bin(), lw_test_root(), dir, k, set, d), 0);
+    cr_assert_eq(sh("%s resume %s/fb%d --quiet", lw_test_bin(), dir, k), 0);
+    const char *same[] = {"state.lw", "trace.csv", "final.svg"};
+    for (int f = 0; f < 3; f++)
+      cr_assert_eq(sh("cmp -s %s/fa%d/%s %s/fb%d/%s", dir, k, same[f], dir, k, same[f]), 0, "%s: %s differs", d,
+                   same[f]);
+    /* the log weights are in the state, and they moved */
+    cr_assert_eq(sh("grep -c '^log_weight = ' %s/fa%d/state.lw | grep -q '^7$'", dir, k), 0, "%s", d);
+    cr_assert_eq(sh("grep '^log_weight = ' %s/fa%d/state.lw | sed -n 2p | grep -vq '= 0.18232155679395459$'", dir, k), 0,
+                 "%s: the second weight stayed", d);
+    cr_assert_eq(sh("head -1 %s/fa%d/trace.csv | grep -q ',weights,'", dir, k), 0, "%s", d);
+  }
+}
+
+Test(nurbs_cli, free_weights_refuse_a_free_scale_and_the_review_scheme)
+{
+  refused("points = 0 0 1 1 2 0 3 1 4 0 5 1 6 0\\nfree_weights = 1\\n",
+          "bad.ini:5: key .nurbs.free_weights.: free weights need nurbs.fixed >= 1");
+  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/rv --quiet --set nurbs.free_weights=1 "
+                  "--set dynamics.integrator=review 2> %s/err.txt", lw_test_bin(), lw_test_root(), dir, dir), 2);
+  cr_assert_eq(sh("grep -q \"key 'dynamics.integrator': the review's scheme takes a constant mass matrix\" %s/err.txt",
+                  dir), 0);
+  cr_assert_neq(sh("test -e %s/rv", dir), 0);
+}

@@ -189,3 +189,47 @@ Test(phase, the_current_phase_and_its_duration)
   cr_assert_null(lw_phase_get(&t));
   cr_assert_eq(t, 0.0);
 }
+
+/* The watcher's rule on a made-up clock: a phase is named once it has
+** lasted over a second (a log: one line; a terminal: its seconds counted in
+** place), its time is given when it ends or another starts, and shorter
+** phases print nothing. */
+Test(phase, the_watcher_names_phases_over_a_second_and_their_time)
+{
+  static const char *const a = "placing", *const b = "drawing the final files", *const c = "writing state.lw";
+  char buf[256];
+  lw_phase_watch log = {.tty = 0};
+  const struct {
+    const char *what;
+    double t;
+    const char *want;
+  } steps[] = {
+    {NULL, 0.0, ""},
+    {a, 0.5, ""},
+    {a, 0.95, ""},
+    {b, 0.1, ""}, /* a ended unannounced */
+    {b, 1.05, "linewise: drawing the final files...\n"},
+    {b, 2.0, ""}, /* a log gets one line */
+    {b, 3.44, ""},
+    {c, 0.2, "linewise: drawing the final files: done in 3.4 s\n"},
+    {NULL, 0.0, ""},
+    {c, 1.5, "linewise: writing state.lw...\n"},
+  };
+  for (size_t k = 0; k < sizeof steps / sizeof *steps; k++)
+    cr_assert_str_eq(lw_phase_watch_tick(&log, steps[k].what, steps[k].t, buf, sizeof buf), steps[k].want,
+                     "log, step %zu", k);
+  cr_assert_str_eq(lw_phase_watch_end(&log, 1, buf, sizeof buf), "linewise: writing state.lw: failed after 1.5 s\n");
+  cr_assert_str_eq(lw_phase_watch_end(&log, 0, buf, sizeof buf), "");
+
+  lw_phase_watch tty = {.tty = 1};
+  cr_assert_str_eq(lw_phase_watch_tick(&tty, b, 0.9, buf, sizeof buf), "");
+  cr_assert_str_eq(lw_phase_watch_tick(&tty, b, 1.05, buf, sizeof buf), "\r\033[Klinewise: drawing the final files... 1 s");
+  cr_assert_str_eq(lw_phase_watch_tick(&tty, b, 1.6, buf, sizeof buf), "");
+  cr_assert_str_eq(lw_phase_watch_tick(&tty, b, 2.06, buf, sizeof buf), "\r\033[Klinewise: drawing the final files... 2 s");
+  /* another long phase seen first at 1.3 s: the old one's time, then it */
+  cr_assert_str_eq(lw_phase_watch_tick(&tty, c, 1.3, buf, sizeof buf),
+                   "\r\033[Klinewise: drawing the final files: done in 2.1 s\n\r\033[Klinewise: writing state.lw... 1 s");
+  cr_assert_str_eq(lw_phase_watch_tick(&tty, NULL, 0.0, buf, sizeof buf),
+                   "\r\033[Klinewise: writing state.lw: done in 1.3 s\n");
+  cr_assert_str_eq(lw_phase_watch_end(&tty, 0, buf, sizeof buf), "");
+}

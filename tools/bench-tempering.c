@@ -9,11 +9,17 @@
 ** run.  The exchange overhead is the time of one exchange step (energies,
 ** the Metropolis draws, the pointer swaps) against the time of one sweep of
 ** the ensemble, at the default interval (every sweep).
+**
+** Across processes (bin/linewise-mpi, where make mpi built it and mpirun is
+** installed): the same scene as a scene file, run by mpirun on P processes
+** of cores / P threads, and the binary's own report of the time its
+** processes spent in the exchange steps' messages (mpi_tempering.h).
 */
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "benchutil.h"
 #include "linewise/anneal.h"
@@ -79,6 +85,99 @@ static double time_exchange(int n)
   return sink >= 0 ? t : 0.0;
 }
 
+/* The scene of time_sweeps as a file for the MPI binary, on a ladder narrow
+** enough (0.05 to 0.0525) that replicas swap and chain data moves. */
+static void write_scene(const char *path, int replicas, int sweeps)
+{
+  FILE *f = fopen(path, "w");
+  if (!f) {
+    lw_error err = {.code = LW_EIO};
+    snprintf(err.msg, sizeof err.msg, "%s: cannot write", path);
+    bench_die("tempering", &err);
+  }
+  fprintf(f, "[scene]\nwidth = 120\nheight = 120\nmargin = 5\n"
+             "[init]\nsplines = 150\nsegments = 4\nsegment_length = 5\n"
+             "[energy]\nstrain = 10\nbending = 1\npair = 0.01\npair_cutoff = 4\nboundary = 0.1\n"
+             "[anneal]\nschedule = constant\nt_start = 0.05\nsweeps = %d\n"
+             "[tempering]\nreplicas = %d\nt_min = 0.05\nt_max = 0.0525\n"
+             "[output]\ncheckpoint_every = 1000000\ntrace_every = 1000000\n", sweeps, replicas);
+  fclose(f);
+}
+
+/* One MPI run of R replicas on P processes: its report line's numbers
+** (ms a sweep, ms in the exchange steps on the quickest and the slowest
+** process, chain moves a sweep, us for one reduction and one chain move
+** alone); 0 if it did not run. */
+enum { MPI_VALUES = 6 };
+static int mpi_run(const char *bin, const char *dir, int R, int P, int threads, int sweeps, double v[MPI_VALUES])
+{
+  char cmd[1024], path[128], line[1024];
+  snprintf(path, sizeof path, "%s/mpi.ini", dir);
+  write_scene(path, R, sweeps);
+  snprintf(cmd, sizeof cmd, "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=%d "
+           "mpirun --oversubscribe -n %d %s run %s --out %s/mpi-run 2>%s/mpi.log >/dev/null",
+           threads, P, bin, path, dir, dir);
+  if (system(cmd) != 0) return 0;
+  snprintf(path, sizeof path, "%s/mpi.log", dir);
+  FILE *f = fopen(path, "r");
+  int got = 0;
+  while (f && fgets(line, sizeof line, f))
+    if (sscanf(line, "linewise: MPI: %*d processes, %*d replicas, %*d threads each: %lf ms a sweep; exchange "
+               "steps %lf ms a sweep (%*f %%) on the quickest process, %lf ms (%*f %%) on the one that waited "
+               "longest; %lf chain moves a sweep of %*d bytes; alone, one reduction of %*d words %lf us, one chain "
+               "move %lf", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]) == MPI_VALUES)
+      got = 1;
+  if (f) fclose(f);
+  return got;
+}
+
+/* The MPI table, where the MPI build and mpirun are there. */
+static void bench_mpi(bench_ctx *b, FILE *d, const char *dir, int cores)
+{
+  const char *bin = getenv("LW_MPI_BIN");
+  if (!bin || !*bin) bin = "bin/linewise-mpi";
+  if (access(bin, X_OK) || system("command -v mpirun >/dev/null 2>&1")) {
+    fprintf(d, "### Across processes (MPI)\n\nNot measured: no %s or no mpirun (make deps-mpi && make mpi).\n\n", bin);
+    return;
+  }
+  int sweeps = b->quick ? 10 : 30, reps = b->quick ? 1 : 3;
+  fprintf(d, "### Across processes (MPI)\n\n"
+             "The same scene on a ladder from 0.05 to 0.0525 (so that replicas swap), run by\n"
+             "`mpirun -n P bin/linewise-mpi` for %d sweeps, each process with %d / P threads, as\n"
+             "the binary reports it (the run of median sweep time of %d): wall milliseconds per\n"
+             "sweep (start-up excluded); the milliseconds per sweep that processes spent in the\n"
+             "exchange steps (the reduction of every replica's energy terms after each sweep, the\n"
+             "chain data of swaps that cross processes, the drift checks), on the process that\n"
+             "spent least and on the one that spent most, both including the wait for the other\n"
+             "processes to finish their sweep; and, timed alone after the run (median of 201), one\n"
+             "reduction and one chain move (about 5 kB between two processes): the messages' own\n"
+             "cost. P = 1 runs the same code with no peer.\n\n"
+             "| replicas | processes | threads each | ms per sweep | exchange, least | exchange, most | "
+             "chain moves per sweep | one reduction | one chain move |\n|---|---|---|---|---|---|---|---|---|\n",
+             sweeps, cores, reps);
+  const int rs[2] = {4, 8};
+  for (int i = 0; i < 2; i++)
+    for (int P = 1; P <= cores && P <= rs[i]; P *= 2) {
+      double run[3][MPI_VALUES], t[3];
+      int threads = cores / P > 0 ? cores / P : 1, ok = 1;
+      bench_note("tempering: MPI, %d replicas on %d processes", rs[i], P);
+      for (int r = 0; r < reps && ok; r++) {
+        ok = mpi_run(bin, dir, rs[i], P, threads, sweeps, run[r]);
+        t[r] = run[r][0];
+      }
+      if (!ok) {
+        fprintf(d, "| %d | %d | %d | failed (%s/mpi.log) | | | | | |\n", rs[i], P, threads, dir);
+        continue;
+      }
+      double mid = bench_median(t, reps), *v = run[0];
+      for (int r = 0; r < reps; r++)
+        if (run[r][0] == mid) v = run[r];
+      fprintf(d, "| %d | %d | %d | %.1f | %.3f ms (%.1f %%) | %.3f ms (%.1f %%) | %.2f | %.1f us | %.1f us |\n", rs[i],
+              P, threads, v[0], v[1], 100 * v[1] / v[0], v[2], 100 * v[2] / v[0], v[3], v[4], v[5]);
+    }
+  fprintf(d, "\n");
+}
+
 void bench_tempering(bench_ctx *b)
 {
   FILE *d = b->doc[BENCH_PERFORMANCE];
@@ -108,6 +207,7 @@ void bench_tempering(bench_ctx *b)
     fprintf(d, "| %d | %.1f | %.1f | %.2f | %.1e |\n", R, 1e3 * t1, 1e3 * tn, t1 / tn, tx / tn);
   }
   fprintf(d, "\n");
+  bench_mpi(b, d, dir, cores);
   omp_set_num_threads(cores);
   char cmd[64];
   snprintf(cmd, sizeof cmd, "rm -rf %s", dir);

@@ -24,6 +24,7 @@
 
 #include <stdio.h>
 
+#include "linewise/anneal_net.h"
 #include "linewise/dynamics.h"
 #include "linewise/mc.h"
 #include "linewise/params.h"
@@ -32,7 +33,7 @@
 #include "linewise/system.h"
 #include "linewise/tempering.h"
 
-typedef struct {
+typedef struct lw_anneal {
   lw_params params;
   const lw_system_type *sys_type; /* [scene] system */
   void *setup;                 /* its set-up of the scene, shared by the replicas (owned) */
@@ -63,7 +64,8 @@ typedef struct {
   lw_move_stats trace_mark[LW_MOVES_MAX]; /* stats at the last trace row */
   int quenched;                /* 1 once lw_anneal_finish has quenched (anneal.quench) */
   lw_quench_report quench;     /* what the quench did */
-  FILE *trace;
+  FILE *trace;                 /* NULL on the processes other than the first (anneal_net.h) */
+  lw_anneal_net *net;          /* NULL in one process; else the hooks of a spread run (not owned) */
 } lw_anneal;
 
 /* A new run of the scene file (with overrides already applied to p) into
@@ -71,9 +73,15 @@ typedef struct {
 ** before anything is written). */
 lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_error *err);
 
+/* The same for one process of a run spread by net (anneal_net.h; NULL:
+** lw_anneal_start): process 0 writes the run's files, and the first
+** checkpoint is left to the caller, who agrees on the start first. */
+lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir, lw_anneal_net *net, lw_error *err);
+
 /* Continues the run in dir for `more` sweeps (< 0: to the end of the
 ** schedule; past the end the last temperature holds). */
 lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *err);
+lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anneal_net *net, lw_error *err);
 
 /* One sweep with everything that falls due after it (trace row, drift check,
 ** checkpoint). */
@@ -96,7 +104,7 @@ void lw_anneal_free(lw_anneal *a);
 
 /* Current temperature, energy and overall acceptance (for progress displays). */
 double lw_anneal_temperature(const lw_anneal *a);
-static inline double lw_anneal_energy(const lw_anneal *a) { return lw_system_total(a->sys); }
+double lw_anneal_energy(const lw_anneal *a);
 double lw_anneal_acceptance(const lw_anneal *a);
 double lw_anneal_seconds(const lw_anneal *a);
 

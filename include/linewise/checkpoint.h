@@ -10,7 +10,8 @@
 ** the previous or the new state.lw, each with the trace length it belongs
 ** to (resume cuts trace.csv back to it).  The system's state goes through
 ** its row (system.h): each rung's [system <name>] section is the row's.  replica-K.lw files are copies
-** for the user, written after state.lw; resume does not read them.
+** for the user, written after state.lw (before it, by their
+** processes, in a run over MPI: mpi_tempering.h); resume does not read them.
 */
 #ifndef LINEWISE_CHECKPOINT_H
 #define LINEWISE_CHECKPOINT_H
@@ -25,6 +26,21 @@ void lw_checkpoint_system_section(char *buf, size_t n, const lw_system_type *t, 
 
 /* Writes the checkpoint of a (trace.csv synced, state.lw, replica-K.lw). */
 lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err);
+
+/* The parts of the checkpoint, for a writer that assembles state.lw from
+** several processes (mpi_tempering.c) in the same order as
+** lw_checkpoint_write: [run] (with the header), [chain K] for every rung,
+** the ensemble ([tempering], [dynamics]), [system <name> K] for every rung.
+** sync_trace flushes and syncs trace.csv (if this process has it open) and
+** gives its length; the writers set *bad when out of memory. */
+lw_status lw_checkpoint_sync_trace(lw_anneal *a, long *bytes, lw_error *err);
+void lw_checkpoint_put_run(lw_ckpt_writer *w, const lw_anneal *a, long trace_bytes);
+void lw_checkpoint_put_chain(lw_ckpt_writer *w, const lw_anneal *a, int k, int *bad);
+void lw_checkpoint_put_ensemble(lw_ckpt_writer *w, const lw_anneal *a, int *bad);
+lw_status lw_checkpoint_put_system(lw_ckpt_writer *w, const lw_anneal *a, int k, lw_error *err);
+lw_status lw_checkpoint_write_replica(const lw_anneal *a, int k, lw_error *err);
+/* timing.txt: the wall time so far (not part of the state: it differs run to run). */
+lw_status lw_checkpoint_write_timing(const lw_anneal *a, lw_error *err);
 
 /* Restores the run data of doc into a, whose systems and chains are built:
 ** every value checked (ranges, counts, the generator states, the running

@@ -1,6 +1,6 @@
 /*
-** dnurbs.h -- the D-NURBS matrices of a curve with frozen weights
-** (Terzopoulos and Qin 1994; docs/NURBS.md, docs/NUMERICS.md "D-NURBS").
+** dnurbs.h -- the D-NURBS matrices of a curve (Terzopoulos and Qin 1994;
+** docs/NURBS.md, docs/NUMERICS.md "D-NURBS"), and what free weights add.
 **
 ** With c(u) = sum_i R_i(u) P_i (the rational basis of nurbs.h, weights
 ** held), and integrals over the parameter u as in the review:
@@ -24,6 +24,8 @@
 typedef struct {
   size_t n;     /* control points */
   int k;        /* order: the band has k columns */
+  double alpha, beta;
+  int gauss;    /* Gauss points a span */
   double *K;    /* n x k: stiffness */
   double *M1;   /* n x k: mass per unit density */
   double *b;    /* n: int R_i du */
@@ -33,14 +35,34 @@ typedef struct {
 lw_dnurbs *lw_dnurbs_new(lw_nurbs *c, double alpha, double beta, int gauss, lw_error *err);
 void lw_dnurbs_free(lw_dnurbs *d);
 
+/* K, M1 and b again at c's present weights (free weights; d from c). */
+lw_status lw_dnurbs_assemble(lw_dnurbs *d, lw_nurbs *c, lw_error *err);
+
 /* The gradient gw (n) of E_el + E_g in the weights, with mug = mu g:
 ** dE/dw_j = int alpha c_u . q_j' + beta c_uu . q_j'' - mug . q_j du, where
 ** q_j = dc/dw_j = R_j (P_j - c) / w_j (docs/NUMERICS.md "Free weights").
-** The first step towards free weights; nothing calls it in a run yet. */
+** lw_dnurbs_grad_s: the same in s_j = log w_j, dE/ds_j = w_j dE/dw_j, the
+** coordinates of nurbs.free_weights. */
 lw_status lw_dnurbs_grad_w(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, double *gw, lw_error *err);
+lw_status lw_dnurbs_grad_s(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, double *gs, lw_error *err);
 
-/* y = A x for a band A (n x k) on interleaved xy vectors (2 n). */
+/* term[0] elastic, term[1] gravity, integrated over the k knot spans where
+** basis function j lives: all of E that a change of w_j changes. */
+lw_status lw_dnurbs_energy_near(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, size_t j,
+                                double term[2], lw_error *err);
+
+/* The mass matrix per unit density over the free-weight coordinates
+** x = (x_i, y_i, s_i) of each control point, s_i = log w_i: M = int J'J du
+** with J = dc/dx = [R_i e_x, R_i e_y, R_i (P_i - c)].  It depends on P and
+** w.  Band of 3 n rows and 3 k columns (M must hold 9 n k numbers).
+** lw_dnurbs_mass_s_dx: out (3 n) = d/dx (1/2 v' M(x) v) at fixed v. */
+lw_status lw_dnurbs_mass_s(lw_nurbs *c, int gauss, double *M, lw_error *err);
+lw_status lw_dnurbs_mass_s_dx(lw_nurbs *c, int gauss, const double *v, double *out, lw_error *err);
+
+/* y = A x for a band A (n x k) on interleaved xy vectors (2 n); _dim on
+** vectors of dim interleaved components sharing A (dim n numbers). */
 void lw_band_apply(const double *A, size_t n, int k, const double *x, double *y);
+void lw_band_apply_dim(const double *A, size_t n, int k, int dim, const double *x, double *y);
 
 /* Factors the band A (n x k) into L (same size) with the coordinates where
 ** pin[i] != 0 (i a control point) held: identity rows and columns.
@@ -50,5 +72,6 @@ lw_status lw_band_factor(const double *A, const unsigned char *pin, size_t n, in
 /* x = A^-1 r on interleaved xy vectors, 0 at held points (L from
 ** lw_band_factor; r and x may be the same array). */
 void lw_band_solve(const double *L, const unsigned char *pin, size_t n, int k, const double *r, double *x);
+void lw_band_solve_dim(const double *L, const unsigned char *pin, size_t n, int k, int dim, const double *r, double *x);
 
 #endif

@@ -19,7 +19,7 @@
 **           points come from a uniform cell grid (about two end points per
 **           cell) searched ring by ring, so a tour costs O(n) expected on
 **           spread-out paths.
-**   2-opt   improves a tour by reversing a contiguous stretch of it (order
+**   2-opt   (with Or-opt) improves a tour by reversing a contiguous stretch of it (order
 **           reversed, and every path in it reversed too), which swaps two
 **           pen-up legs for two others: legs exit_a -> entry_b and
 **           exit_c -> entry_d become exit_a -> exit_c and entry_b -> entry_d.
@@ -27,10 +27,18 @@
 **           (LW_ORDER_NEIGHBOURS); a queue of paths whose neighbourhood
 **           changed decides what is looked at next.  The tour is kept as a
 **           cycle through a virtual "home" item whose incoming leg is free,
-**           so either side of a cut may be reversed (the shorter one is).
+**           so either side of a cut may be reversed (the one that spans
+**           fewer blocks, below, is).  Or-opt moves join in: a stretch of
+**           1 to LW_ORDER_OR_MAX paths is taken out and put between two
+**           others, either way round, when a candidate of one of its ends
+**           makes that shorter (three reversals at most).
+**           The cycle is a two-level list: blocks of about sqrt(n) paths,
+**           each read forwards or backwards, so a reversal rewrites
+**           O(sqrt n) entries where an array rewrote up to n / 2.
 **           The work is capped at LW_ORDER_WORK per path (candidate checks
-**           plus moved array entries), which bounds the time on any input
-**           while giving the same answer on every machine.
+**           plus entries a reversal or a re-layout of the list rewrites),
+**           which bounds the time on any input while giving the same answer
+**           on every machine.
 ** A move is made only when it shortens the tour by more than
 ** LW_ORDER_EPS mm, so the travel never grows.
 */
@@ -42,7 +50,8 @@
 #include "linewise/error.h"
 
 #define LW_ORDER_NEIGHBOURS 10 /* candidate end points per end point in 2-opt */
-#define LW_ORDER_WORK 10000    /* 2-opt work cap per path (checks + moved entries) */
+#define LW_ORDER_WORK 10000    /* 2-opt work cap per path (checks + rewritten entries) */
+#define LW_ORDER_OR_MAX 3      /* longest stretch an Or-opt move carries, paths */
 #define LW_ORDER_EPS 1e-9      /* mm: smallest gain that counts as an improvement */
 
 typedef struct {
@@ -61,9 +70,10 @@ double lw_order_travel(const lw_order_path *path, size_t n, const size_t *order,
 lw_status lw_order_greedy(const lw_order_path *path, size_t n, double hx, double hy,
                           size_t *order, unsigned char *reversed, lw_error *err);
 
-/* Improves the tour in order[] / reversed[] by 2-opt moves (see above); the
-** result is again a permutation with its reversal flags.  LW_ENOMEM (err
-** set, tour unchanged) if the work space cannot be allocated. */
+/* Improves the tour in order[] / reversed[] by 2-opt and Or-opt moves (see
+** above), never lengthening it; the result is again a permutation with its
+** reversal flags.  LW_ENOMEM (err set, tour unchanged) if the work space
+** cannot be allocated. */
 lw_status lw_order_2opt(const lw_order_path *path, size_t n, double hx, double hy,
                         size_t *order, unsigned char *reversed, lw_error *err);
 

@@ -33,9 +33,10 @@
 /* The double integral of |a'| |b'| (1/r - 1/rc)+ over two cubic Bezier
 ** segments a and b (control points x0 y0 x1 y1 x2 y2 x3 y3, mm), or of
 ** |a'| |b'| / r without a cutoff (cutoff <= 0).  Finite where the segments
-** cross or touch.  A continuous function of the control points; relative
-** error 3e-7 for segments apart, 3e-5 to 5e-4 where they cross, up to 5e-3
-** where they touch tangentially at an end (pairnear.c, docs/NUMERICS.md). */
+** cross or touch, and never negative.  A continuous function of the control
+** points; relative error 3e-7 for segments apart, 1e-5 to 4e-5 where they
+** cross, up to 3e-3 where they touch tangentially at an end (pairnear.c,
+** docs/NUMERICS.md). */
 double lw_pair_segments_exact(const double a[8], const double b[8], double cutoff);
 
 /* E_AB minus the product-rule terms of the sample pairs of A x B that are
@@ -51,8 +52,6 @@ typedef struct {
   double sep_lo, sep_hi;       /* pieces apart: 6 x 6 rule from sep_hi larger radii on */
   double apart_lo, apart_hi;   /* segments apart: 16 x 16 rule (distance / half size) */
   double leaf_ratio, flat_ratio;
-  double sine_lo, sine_hi;     /* subtraction where the tangents meet at this sine */
-  double close_lo, close_hi;   /* ... or the curves are this far apart */
   int stack_max;
   const double *g6_s, *g6_w;   /* Gauss-Legendre on [0, 1] */
   int g6_n;

@@ -207,6 +207,10 @@ typedef struct {
   double nb_alpha, nb_beta;   /* energy coefficients */
   int nb_gauss;               /* Gauss points per knot span */
   int nb_fixed;               /* control points held at each end */
+  int nb_free_weights;        /* 1: the weights are coordinates (s = log w) */
+  double nb_step_weight;      /* weight move's half width in s */
+  double nb_weight_inertia;   /* free weights: added inertia of s per unit density */
+  double nb_weight_stiffness; /* free weights: spring on log w, energy */
   double nb_svg_tolerance;    /* rational curves in final.svg, length */
   double nb_png_scale;        /* pixels per length */
 

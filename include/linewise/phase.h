@@ -14,10 +14,34 @@
 #ifndef LINEWISE_PHASE_H
 #define LINEWISE_PHASE_H
 
+#include <stddef.h>
+
 /* Names the phase starting now (a static string), or ends it (NULL). */
 void lw_phase_set(const char *what);
 
 /* The current phase (NULL: none) and, in *seconds, how long it has lasted. */
 const char *lw_phase_get(double *seconds);
+
+/* What a watcher prints, decided from what it reads at each tick, so that
+** the rule can be tested with a made-up clock.  A phase is named once it has
+** lasted over LW_PHASE_QUIET seconds: on a terminal (tty) in place, its
+** seconds counting up every second; in a log, one line.  When it ends (or
+** another starts) a line gives its time.  Shorter phases print nothing. */
+#define LW_PHASE_QUIET 1.0 /* s: the longest a phase may run unannounced */
+
+typedef struct {
+  int tty;            /* 1: rewrite one terminal line; 0: whole lines for a log */
+  const char *shown;  /* the phase being shown, NULL: none */
+  double last;        /* s: how long it had lasted at the last tick */
+  double reported;    /* s: its time when last printed */
+} lw_phase_watch;
+
+/* One look at the phase: `what` (NULL: none) has lasted `seconds`.  Writes
+** the text to print into buf[n] ("" for nothing) and returns buf. */
+const char *lw_phase_watch_tick(lw_phase_watch *w, const char *what, double seconds, char *buf, size_t n);
+
+/* The watcher stops: the end of a phase still shown, "failed after" if the
+** run ended in an error, into buf[n] ("" for nothing); returns buf. */
+const char *lw_phase_watch_end(lw_phase_watch *w, int failed, char *buf, size_t n);
 
 #endif

@@ -1,0 +1,158 @@
+/*
+** test_mpi.c -- parallel tempering over MPI processes (bin/linewise-mpi,
+** make mpi): the same bytes as the one-process run on 2 and 4 processes,
+** resume with another process count, a stop asked of one process, a killed
+** process, and a ladder too short for the processes.  Skipped, saying why,
+** where the MPI build or mpirun is missing (make deps-mpi installs them).
+*/
+#include <criterion/criterion.h>
+#include <stdlib.h>
+
+#include "testutil.h"
+
+static char dir[64];
+#define sh lw_test_sh
+
+static void make_dir(void) { cr_assert_eq(lw_test_dir_make(dir, "mpi"), 0); }
+static void remove_dir(void) { cr_assert_eq(lw_test_dir_remove(dir), 0); }
+
+TestSuite(mpi, .init = make_dir, .fini = remove_dir);
+
+/* mpirun with what a root container needs and room for 4 processes on 2
+** cores; the processes default to cores / processes threads.  Under make
+** asan, LeakSanitizer is told of Open MPI's own leaks (tests/lsan-mpi.supp),
+** which it can only match with full stacks. */
+#define MPIRUN                                                                                            \
+  "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "                                             \
+  "LSAN_OPTIONS=suppressions=${LW_ROOT:-.}/tests/lsan-mpi.supp:print_suppressions=0 "                      \
+  "ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}fast_unwind_on_malloc=0 mpirun --oversubscribe"
+
+/* The MPI binary, or skips the test saying what is missing. */
+static const char *mpi_bin(void)
+{
+  const char *b = getenv("LW_MPI_BIN");
+  if (!b || !*b) cr_skip_test("no MPI build: LW_MPI_BIN is not set (make test sets it where mpicc exists; make deps-mpi)");
+  if (sh("command -v mpirun >/dev/null 2>&1")) cr_skip_test("mpirun is not installed (make deps-mpi)");
+  return b;
+}
+
+/* The ensemble of test_tempering.c: 4 replicas, ladder tuning, checkpoints,
+** drift checks and trace rows at sweeps that do not line up. */
+static const char scene[] =
+  "[scene]\nwidth = 50\nheight = 40\nmargin = 2\n"
+  "[init]\nsplines = 8\nsegments = 3\nsegment_length = 4\n"
+  "[energy]\nstrain = 5\nbending = 0.5\npair = 0.05\npair_cutoff = 4\nboundary = 0.1\n"
+  "[anneal]\nschedule = geometric\nt_start = 0.5\nt_end = 0.05\nsweeps = 90\nsteps = 5\nseed = 8\ncheck_every = 11\n"
+  "[tempering]\nreplicas = 4\nt_min = 0.5\nt_max = 4\ntune_ladder = equal\nladder_sweeps = 40\n"
+  "[output]\ncheckpoint_every = 13\ntrace_every = 4\n";
+
+static void write_scene(void)
+{
+  char path[128];
+  snprintf(path, sizeof path, "%s/s.ini", dir);
+  FILE *f = fopen(path, "w");
+  cr_assert_not_null(f);
+  fputs(scene, f);
+  fclose(f);
+}
+
+static const char *const same[] = {"state.lw", "replica-1.lw", "replica-2.lw", "replica-3.lw",
+                                   "trace.csv", "final.svg", "final.png", "ladder.ini"};
+
+static void assert_same(const char *a, const char *b)
+{
+  for (int k = 0; k < 8; k++)
+    cr_assert_eq(sh("cmp -s %s/%s/%s %s/%s/%s", dir, a, same[k], dir, b, same[k]), 0, "%s differs between %s and %s",
+                 same[k], a, b);
+}
+
+Test(mpi, two_and_four_processes_write_the_bytes_of_the_one_process_run)
+{
+  const char *m = mpi_bin(), *b = lw_test_bin();
+  write_scene();
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/ref --quiet", b, dir, dir), 0);
+  cr_assert_eq(sh(MPIRUN " -n 2 %s run %s/s.ini --out %s/p2 --quiet", m, dir, dir), 0);
+  cr_assert_eq(sh(MPIRUN " -n 4 %s run %s/s.ini --out %s/p4 --quiet", m, dir, dir), 0);
+  assert_same("ref", "p2");
+  assert_same("ref", "p4");
+  /* the replicas did change process: with one each, every swap crosses */
+  cr_assert_eq(sh("grep -q '^at_label = 0 ' %s/p4/state.lw", dir), 1, "replica 0 never left rung 0");
+  cr_assert_eq(sh("grep -q '\"round_trips\"' %s/p4/summary.json", dir), 0);
+  /* the study tools read it as any run */
+  cr_assert_eq(sh("%s/tools/plot-run %s/p4 >/dev/null 2>&1", lw_test_root(), dir), 0);
+  cr_assert_eq(sh("test -s %s/p4/plots/replicas.png && test -s %s/p4/plots/swaps.png", dir, dir), 0);
+}
+
+Test(mpi, resume_with_other_process_counts_continues_bit_exactly)
+{
+  const char *m = mpi_bin(), *b = lw_test_bin();
+  write_scene();
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/ref --quiet", b, dir, dir), 0);
+  /* stopped inside the ladder warm-up, then 4, 1 and 3 processes */
+  cr_assert_eq(sh(MPIRUN " -n 2 %s run %s/s.ini --out %s/r --quiet --stop-at 23", m, dir, dir), 0);
+  cr_assert_eq(sh(MPIRUN " -n 4 %s resume %s/r --quiet --stop-at 61", m, dir), 0);
+  cr_assert_eq(sh("%s resume %s/r --quiet --stop-at 70", b, dir), 0);
+  cr_assert_eq(sh(MPIRUN " -n 3 %s resume %s/r --quiet", m, dir), 0);
+  assert_same("ref", "r");
+}
+
+Test(mpi, more_processes_than_replicas_is_refused_before_anything_is_written)
+{
+  const char *m = mpi_bin();
+  write_scene();
+  cr_assert_eq(sh(MPIRUN " -n 3 %s run %s/s.ini --set tempering.replicas=2 --out %s/x --quiet 2>%s/err.txt", m, dir,
+                  dir, dir), 2);
+  cr_assert_eq(sh("grep -q '^linewise: --set: key .tempering.replicas.: 2 replicas for 3 processes' %s/err.txt", dir), 0);
+  /* said once, by process 0 */
+  cr_assert_eq(sh("test $(grep -c 'replicas for 3 processes' %s/err.txt) -eq 1", dir), 0);
+  cr_assert_neq(sh("test -e %s/x", dir), 0, "an output directory was created for bad input");
+}
+
+/* Starts a long run on 2 processes in the background (mpirun's status into
+** DIR/NAME.rc, its output into DIR/NAME.err), waits for a checkpoint past
+** sweep 0 and sends sig to the process of the given rank alone. */
+static int signal_rank_mid_run(const char *m, const char *name, const char *sig, int rank)
+{
+  return sh("cd %s && { timeout 120 sh -c '" MPIRUN " -n 2 %s run s.ini --out %s --quiet --set anneal.sweeps=1000000 "
+            "--set output.checkpoint_every=20 2>%s.err; echo $? > %s.rc' & } && "
+            "for i in $(seq 600); do grep -q '^sweep = [1-9]' %s/state.lw 2>/dev/null && break; sleep 0.1; done && "
+            "for p in /proc/[0-9]*; do { tr '\\0' ' ' < $p/cmdline; } 2>/dev/null | grep -q 'linewise-mpi run s.ini --out %s ' && "
+            "  { tr '\\0' '\\n' < $p/environ; } 2>/dev/null | grep -qx OMPI_COMM_WORLD_RANK=%d && kill -%s ${p#/proc/}; done; "
+            "for i in $(seq 1200); do test -s %s.rc && exit 0; sleep 0.1; done; exit 1",
+            dir, m, name, name, name, name, name, rank, sig, name);
+}
+
+/* DIR/NAME/state.lw against a one-process run stopped at its sweep (into
+** DIR/NAME-ref): the bytes are the same. */
+static void assert_state_is_the_run_at_its_sweep(const char *b, const char *name)
+{
+  cr_assert_eq(sh("cd %s && s=$(sed -n 's/^sweep = //p' %s/state.lw) && "
+                  "%s run s.ini --out %s-ref --quiet --set anneal.sweeps=1000000 --set output.checkpoint_every=20 "
+                  "--stop-at $s && cmp -s %s/state.lw %s-ref/state.lw", dir, name, b, name, name, name),
+               0, "%s/state.lw is not the one-process run's at its sweep", name);
+}
+
+Test(mpi, a_stop_asked_of_one_process_stops_all_at_the_same_sweep, .timeout = 300)
+{
+  const char *m = mpi_bin(), *b = lw_test_bin();
+  write_scene();
+  cr_assert_eq(signal_rank_mid_run(m, "stop", "TERM", 1), 0, "the run did not end after SIGTERM to process 1");
+  cr_assert_eq(sh("test $(cat %s/stop.rc) -eq 0", dir), 0, "a clean stop exits 0");
+  assert_state_is_the_run_at_its_sweep(b, "stop");
+  cr_assert_eq(sh("cmp -s %s/stop/trace.csv %s/stop-ref/trace.csv", dir, dir), 0);
+}
+
+Test(mpi, a_killed_process_ends_the_run_with_a_message_and_leaves_it_resumable, .timeout = 300)
+{
+  const char *m = mpi_bin(), *b = lw_test_bin();
+  write_scene();
+  cr_assert_eq(signal_rank_mid_run(m, "kill", "KILL", 1), 0, "the run hung after process 1 was killed");
+  cr_assert_eq(sh("test $(cat %s/kill.rc) -ne 0 && test $(cat %s/kill.rc) -ne 124", dir, dir), 0,
+               "a killed process must fail the run, not time out");
+  cr_assert_eq(sh("grep -q 'rank 1 .*signal 9' %s/kill.err", dir), 0, "no message names the killed process");
+  /* the last checkpoint is whole, and resumes on any process count */
+  assert_state_is_the_run_at_its_sweep(b, "kill");
+  cr_assert_eq(sh(MPIRUN " -n 2 %s resume %s/kill --quiet --sweeps 7", m, dir), 0);
+  cr_assert_eq(sh("cd %s && %s resume kill-ref --quiet --sweeps 7 && "
+                  "cmp -s kill/state.lw kill-ref/state.lw && cmp -s kill/trace.csv kill-ref/trace.csv", dir, b), 0);
+}
