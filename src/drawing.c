@@ -24,6 +24,17 @@ lw_status lw_drawing_page(const lw_params *p, lw_output_page *page, lw_error *er
     page->pen[k].width_mm = p->pen_width;
     memcpy(page->pen[k].rgb, rgb[k], 3);
   }
+  lw_layers_spec ls;
+  lw_status s = lw_layers_read(p, &ls, err);
+  if (s || !ls.n) return s;
+  /* a pen a layer, and inks that darken what they cross, as on paper */
+  page->n_pens = ls.n;
+  page->multiply = 1;
+  for (int k = 0; k < ls.n; k++) {
+    page->pen[k].width_mm = ls.spec[k].pen_width;
+    memcpy(page->pen[k].rgb, ls.spec[k].rgb, 3);
+    memcpy(page->pen_name[k], ls.spec[k].name, sizeof page->pen_name[k]);
+  }
   return LW_OK;
 }
 
@@ -43,6 +54,17 @@ static lw_plot *make_plot(const lw_params *p, const lw_scene *sc, const lw_splin
                           lw_error *err)
 {
   double *key = NULL;
+  if (sc->layers.n) { /* layer k is pen k + 1 */
+    int *pen = malloc((sp->n_splines ? sp->n_splines : 1) * sizeof *pen);
+    if (!pen) {
+      lw_error_set(err, LW_ENOMEM, "out of memory for the pens of %zu splines", sp->n_splines);
+      return NULL;
+    }
+    for (size_t i = 0; i < sp->n_splines; i++) pen[i] = lw_layers_of(&sc->layers, i);
+    lw_plot *pl = lw_plot_new_pens(sp, sc->layers.n, pen, LW_PLOT_ORDER_NONE, 0.0, 0.0, err);
+    free(pen);
+    return pl;
+  }
   if (p->pens > 1 && (sc->on[LW_TERM_POTENTIAL] || tone)) {
     key = malloc((sp->n_splines ? sp->n_splines : 1) * sizeof *key);
     if (!key) {
@@ -84,13 +106,24 @@ static void options(const lw_params *p, const lw_scene *sc, lw_strokes_options *
   }
 }
 
-/* The fidelity scores of the drawing, overall and per pen. */
-static lw_status score(const lw_params *p, const lw_strokes *st, const lw_grid2d *tone, lw_drawing_report *rep,
-                       lw_error *err)
+/* The fidelity scores of the drawing, overall and per pen; a layer's pen
+** against the layer's own target, drawn with its own width. */
+static lw_status score(const lw_params *p, const lw_scene *sc, const lw_strokes *st, const lw_grid2d *tone,
+                       lw_drawing_report *rep, lw_error *err)
 {
   lw_status s = lw_fidelity_compute_strokes(st, -1, tone, p->pen_width, p->fidelity_sigma, &rep->fidelity, err);
-  for (int k = 0; !s && st->n_pens > 1 && k < st->n_pens; k++)
-    s = lw_fidelity_compute_strokes(st, k, tone, p->pen_width, p->fidelity_sigma, &rep->pen_fidelity[k], err);
+  for (int k = 0; !s && st->n_pens > 1 && k < st->n_pens; k++) {
+    const lw_image *target = k < sc->layers.n ? sc->layer[k].target : NULL;
+    if (!target) {
+      s = lw_fidelity_compute_strokes(st, k, tone, p->pen_width, p->fidelity_sigma, &rep->pen_fidelity[k], err);
+      continue;
+    }
+    lw_grid2d *g = lw_image_tone_grid(target, &sc->image_place, err);
+    if (!g) return err ? err->code : LW_ENOMEM;
+    s = lw_fidelity_compute_strokes(st, k, g, sc->layers.spec[k].pen_width, p->fidelity_sigma,
+                                    &rep->pen_fidelity[k], err);
+    lw_grid2d_free(g);
+  }
   rep->has_fidelity = !s;
   return s;
 }
@@ -141,7 +174,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
     s = lw_output_pdf_strokes(st, &page, under, path, err);
   }
   if (!s) s = close_share(p, st, rep, err);
-  if (!s && tone) s = score(p, st, tone, rep, err);
+  if (!s && tone) s = score(p, sc, st, tone, rep, err);
   lw_strokes_free(st);
   return s;
 }
@@ -256,7 +289,10 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
                    d->travel_after, clock, d->time_s, d->pen_down_mm, r->lifts_after);
   if (w < 0 || (size_t)w >= n) return;
   k = (size_t)w;
-  if (d->has_fidelity)
-    snprintf(buf + k, n - k, "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f, orientation %.4f\n",
-             d->fidelity.sigma_mm, d->fidelity.mse, d->fidelity.ssim, d->fidelity.orientation);
+  if (!d->has_fidelity) return;
+  w = snprintf(buf + k, n - k, "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f, orientation %.4f\n",
+               d->fidelity.sigma_mm, d->fidelity.mse, d->fidelity.ssim, d->fidelity.orientation);
+  for (int p = 0; d->n_pens > 1 && p < d->n_pens && w >= 0 && (k += (size_t)w) < n; p++)
+    w = snprintf(buf + k, n - k, "linewise: fidelity of pen %d: MSE %.6g, SSIM %.4f, orientation %.4f\n", p + 1,
+                 d->pen_fidelity[p].mse, d->pen_fidelity[p].ssim, d->pen_fidelity[p].orientation);
 }

@@ -185,7 +185,7 @@ double lw_potential_eval(const lw_potential *f, double x, double y)
   return 0.0;
 }
 
-void lw_field_eval(const lw_field *f, double x, double y, double *vx, double *vy)
+static void eval_raw(const lw_field *f, double x, double y, double *vx, double *vy)
 {
   switch (f->kind) {
   case LW_FIELD_CONSTANT:
@@ -313,9 +313,9 @@ static void axial_jacobian(const lw_grid2d *g, double x, double y, const double 
   J[1][1] = d0y * qy[0] + d1y * qy[1];
 }
 
-void lw_field_jacobian(const lw_field *f, double x, double y, double v[2], double J[2][2])
+static void jacobian_raw(const lw_field *f, double x, double y, double v[2], double J[2][2])
 {
-  lw_field_eval(f, x, y, &v[0], &v[1]);
+  eval_raw(f, x, y, &v[0], &v[1]);
   J[0][0] = J[0][1] = J[1][0] = J[1][1] = 0.0;
   switch (f->kind) {
   case LW_FIELD_CONSTANT:
@@ -363,6 +363,33 @@ void lw_field_jacobian(const lw_field *f, double x, double y, double v[2], doubl
     if (!f->grid || f->grid->ncomp != 2) return;
     axial_jacobian(f->grid, x, y, v, J);
     return;
+  }
+}
+
+/* A turned field (a hatching layer's, layers.h) is R v with R the turn:
+** its Jacobian is R J, the rotation being constant. */
+void lw_field_eval(const lw_field *f, double x, double y, double *vx, double *vy)
+{
+  eval_raw(f, x, y, vx, vy);
+  if (!f->turned) return;
+  double a = *vx, b = *vy;
+  *vx = f->turn_c * a - f->turn_s * b;
+  *vy = f->turn_s * a + f->turn_c * b;
+}
+
+void lw_field_jacobian(const lw_field *f, double x, double y, double v[2], double J[2][2])
+{
+  jacobian_raw(f, x, y, v, J);
+  if (!f->turned) return;
+  const double c = f->turn_c, s = f->turn_s;
+  double a = v[0], b = v[1];
+  v[0] = c * a - s * b;
+  v[1] = s * a + c * b;
+  for (int j = 0; j < 2; j++) {
+    a = J[0][j];
+    b = J[1][j];
+    J[0][j] = c * a - s * b;
+    J[1][j] = s * a + c * b;
   }
 }
 

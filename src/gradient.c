@@ -62,8 +62,9 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
       return NAN;
     }
   }
-  lw_term_ctx ctx[LW_TERM_COUNT];
+  lw_term_ctx ctx[LW_TERM_COUNT], layer_ctx[LW_LAYERS_MAX][LW_TERM_COUNT];
   lw_scene_term_ctx(sc, ctx);
+  for (int k = 0; k < sc->layers.n; k++) lw_scene_layer_ctx(sc, k, layer_ctx[k]);
   int strain = 0; /* spline terms that are on and selected */
   for (int t = 0; t < LW_TERM_COUNT; t++)
     if (lw_term_types[t].spline_grad && sc->on[t] && selected(term_mask, t)) strain = 1;
@@ -105,11 +106,12 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
     lw_segment_sample(&sc->quad, a, a + 1, &s);
     irregular += !lw_segment_allowed(sc, a, a + 1, s.length);
     lw_samples_grad_zero(&sg, s.n);
+    const lw_term_ctx *c = sc->layers.n ? layer_ctx[lw_layers_of(&sc->layers, sp->seg_spline[g])] : ctx;
     for (int j = 0; j < sc->n_local; j++) {
       const int t = sc->local[j];
       if (!selected(term_mask, t)) continue;
-      e[t] += lw_term_types[t].segment(&s, &ctx[t]);
-      lw_term_types[t].segment_grad(&s, &ctx[t], &sg);
+      e[t] += lw_term_types[t].segment(&s, &c[t]);
+      lw_term_types[t].segment_grad(&s, &c[t], &sg);
     }
     if (strain)
       for (int q = 0; q < s.n; q++) {

@@ -237,9 +237,11 @@ lw_image *lw_image_resize(const lw_image *src, int w, int h, lw_error *err)
 
 /* ---- loading -------------------------------------------------------- */
 
-/* Source row j of a decoded buffer as tone and alpha in [0, 1]; alpha is
-** written only for 2 and 4 channels.  Tone is composited over white. */
-static void decoded_row(const void *pix, int bits, int w, int ch, int j, float *tone, float *alpha)
+/* Source row j of a decoded buffer as tone (the luma, or one colour
+** channel) and alpha in [0, 1]; alpha is written only for 2 and 4
+** channels.  Tone is composited over white. */
+static void decoded_row(const void *pix, int bits, int w, int ch, int j, lw_image_channel which, float *tone,
+                        float *alpha)
 {
   const float scale = bits == 16 ? 1.0f / 65535.0f : 1.0f / 255.0f;
   size_t base = (size_t)j * (size_t)w * (size_t)ch;
@@ -249,7 +251,8 @@ static void decoded_row(const void *pix, int bits, int w, int ch, int j, float *
       size_t at = base + (size_t)i * (size_t)ch + (size_t)k;
       c[k] = scale * (bits == 16 ? (float)((const uint16_t *)pix)[at] : (float)((const unsigned char *)pix)[at]);
     }
-    float g = ch >= 3 ? 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2] : c[0];
+    float g = ch < 3 ? c[0] : which == LW_IMAGE_LUMA ? 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]
+                                                     : c[which - LW_IMAGE_RED];
     float a = ch == 2 ? c[1] : ch == 4 ? c[3] : 1.0f;
     tone[i] = a * g + (1.0f - a);
     if (ch == 2 || ch == 4) alpha[i] = a;
@@ -372,6 +375,12 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
 lw_image *lw_image_decode(const unsigned char *data, size_t size, const char *name,
                           double max_pixels, lw_image_info *info, lw_error *err)
 {
+  return lw_image_decode_channel(data, size, name, max_pixels, LW_IMAGE_LUMA, info, err);
+}
+
+lw_image *lw_image_decode_channel(const unsigned char *data, size_t size, const char *name, double max_pixels,
+                                  lw_image_channel which, lw_image_info *info, lw_error *err)
+{
   if (size == 0) {
     lw_error_set(err, LW_EINPUT, "%s: empty file (0 bytes), not an image", name);
     return NULL;
@@ -406,7 +415,7 @@ lw_image *lw_image_decode(const unsigned char *data, size_t size, const char *na
   plane_fill(img->tone, n, 0.0f);
   if (has_alpha) plane_fill(img->alpha, n, 0.0f);
   for (int j = 0; j < h; j++) {
-    decoded_row(dec.pix, bits, w, ch, j, row, row + w);
+    decoded_row(dec.pix, bits, w, ch, j, which, row, row + w);
     resampler_add_row(&rs, j, row, img->tone);
     if (has_alpha) resampler_add_row(&rs, j, row + w, img->alpha);
   }
@@ -419,6 +428,12 @@ lw_image *lw_image_decode(const unsigned char *data, size_t size, const char *na
 }
 
 lw_image *lw_image_load(const char *path, double max_pixels, lw_image_info *info, lw_error *err)
+{
+  return lw_image_load_channel(path, max_pixels, LW_IMAGE_LUMA, info, err);
+}
+
+lw_image *lw_image_load_channel(const char *path, double max_pixels, lw_image_channel which, lw_image_info *info,
+                                lw_error *err)
 {
   FILE *f = fopen(path, "rb");
   if (!f) {
@@ -452,7 +467,7 @@ lw_image *lw_image_load(const char *path, double max_pixels, lw_image_info *info
     free(data);
     return NULL;
   }
-  lw_image *img = lw_image_decode(data, size, path, max_pixels, info, err);
+  lw_image *img = lw_image_decode_channel(data, size, path, max_pixels, which, info, err);
   free(data);
   return img;
 }

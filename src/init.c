@@ -12,7 +12,9 @@
 ** streamline turns too fast for its segments to be regular (lw_segment_allowed:
 ** near a vortex's centre, on short waves) the spline is straight along the
 ** field at its centre instead, so no placement is ever forbidden for its
-** shape.  A draw whose spline leaves the boundary is drawn again.
+** shape.  A draw whose spline leaves the boundary is drawn again.  With
+** layers (layers.h) a spline's darkness is its layer's target's and its
+** field its layer's.
 */
 #include "linewise/init.h"
 
@@ -86,10 +88,11 @@ static double *row_darkness(const lw_image *img)
   return cum;
 }
 
-/* A point drawn with density proportional to darkness. */
-static void dark_point(const lw_scene *sc, const double *cum, gsl_rng *rng, double *x, double *y)
+/* A point drawn with density proportional to the darkness of img (the
+** picture or a layer's target, placed alike). */
+static void dark_point(const lw_scene *sc, const lw_image *img, const double *cum, gsl_rng *rng, double *x,
+                       double *y)
 {
-  const lw_image *img = sc->image;
   double r = gsl_rng_uniform(rng) * cum[img->height];
   int lo = 0, hi = img->height - 1;
   while (lo < hi) { /* the last row j with cum[j] <= r */
@@ -116,10 +119,10 @@ static void dark_point(const lw_scene *sc, const double *cum, gsl_rng *rng, doub
 
 /* The field's direction at (x, y) turned to agree with (dx, dy); (dx, dy)
 ** itself where the field vanishes. */
-static void along(const lw_scene *sc, double x, double y, double dx, double dy, double *ux, double *uy)
+static void along(const lw_field *f, double x, double y, double dx, double dy, double *ux, double *uy)
 {
   double vx, vy;
-  lw_field_eval(&sc->field, x, y, &vx, &vy);
+  lw_field_eval(f, x, y, &vx, &vy);
   double m = sqrt(vx * vx + vy * vy);
   if (!(m > 1e-12)) {
     *ux = dx;
@@ -133,7 +136,7 @@ static void along(const lw_scene *sc, double x, double y, double dx, double dy, 
 
 /* The streamline through (cx, cy) leaving along (ux, uy): node segments/2
 ** sits at the centre, the others follow in steps of h forward and backward. */
-static void trace(const lw_scene *sc, lw_node *nd, size_t segments, double h, double cx, double cy, double ux,
+static void trace(const lw_field *f, lw_node *nd, size_t segments, double h, double cx, double cy, double ux,
                   double uy)
 {
   const size_t kc = segments / 2;
@@ -142,11 +145,11 @@ static void trace(const lw_scene *sc, lw_node *nd, size_t segments, double h, do
     double px = cx, py = cy, dx = dir * ux, dy = dir * uy;
     for (long k = (long)kc + dir; k >= 0 && k <= (long)segments; k += dir) {
       double ax, ay, bx, by;
-      along(sc, px, py, dx, dy, &ax, &ay);
-      along(sc, px + 0.5 * h * ax, py + 0.5 * h * ay, ax, ay, &bx, &by);
+      along(f, px, py, dx, dy, &ax, &ay);
+      along(f, px + 0.5 * h * ax, py + 0.5 * h * ay, ax, ay, &bx, &by);
       px += h * bx;
       py += h * by;
-      along(sc, px, py, bx, by, &dx, &dy);
+      along(f, px, py, bx, by, &dx, &dy);
       /* node vectors point from node 0 toward node n whichever way we walk */
       nd[k] = (lw_node){px, py, dir * h * dx / 3.0, dir * h * dy / 3.0};
     }
@@ -165,39 +168,52 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
   lw_splines *sp = lw_splines_new(n, segs, err);
   free(segs);
   if (!sp) return NULL;
-  double *cum = row_darkness(sc->image);
-  if (sc->image && !cum) {
+  /* with layers, each spline is placed in its layer's ink along its
+  ** layer's field (layers.h); a layer's cum follows the picture's */
+  const int by_layer = sc->layers.n && sc->layer[0].target, nl = by_layer ? sc->layers.n : 1;
+  double *cums[LW_LAYERS_MAX] = {NULL};
+  int nomem = 0;
+  for (int k = 0; k < nl; k++) {
+    cums[k] = row_darkness(by_layer ? sc->layer[k].target : sc->image);
+    nomem |= sc->image && !cums[k];
+  }
+  if (nomem) {
+    for (int k = 0; k < nl; k++) free(cums[k]);
     lw_splines_free(sp);
     lw_error_set(err, LW_ENOMEM, "out of memory for the placement");
     return NULL;
   }
-  /* a white picture has nothing to draw toward: uniform, as without one */
-  const int weighted = cum && cum[sc->image->height] > 0;
   const int follow = sc->on[LW_TERM_FIELD];
   const double L = segment_length * (double)segments;
   const int tries = 10000;
   for (size_t i = 0; i < n; i++) {
     lw_node *nd = &sp->node[sp->first[i]];
+    const int layer = sc->layers.n ? lw_layers_of(&sc->layers, i) : 0;
+    const lw_image *img = by_layer ? sc->layer[layer].target : sc->image;
+    const lw_field *field = sc->layers.n ? &sc->layer[layer].field : &sc->field;
+    const double *cum = cums[by_layer ? layer : 0];
+    /* a white picture has nothing to draw toward: uniform, as without one */
+    const int weighted = cum && cum[img->height] > 0;
     int t;
     for (t = 0; t < tries; t++) {
       double cx, cy;
-      if (weighted) dark_point(sc, cum, rng, &cx, &cy);
+      if (weighted) dark_point(sc, img, cum, rng, &cx, &cy);
       else {
         cx = gsl_rng_uniform(rng) * sc->width;
         cy = gsl_rng_uniform(rng) * sc->height;
       }
       double a = 2.0 * M_PI * gsl_rng_uniform(rng), ux = cos(a), uy = sin(a);
       if (follow) {
-        along(sc, cx, cy, ux, uy, &ux, &uy);
+        along(field, cx, cy, ux, uy, &ux, &uy);
         if (!sc->field_axial) { /* a signed field is followed forward */
           double vx, vy;
-          lw_field_eval(&sc->field, cx, cy, &vx, &vy);
+          lw_field_eval(field, cx, cy, &vx, &vy);
           if (vx * ux + vy * uy < 0) {
             ux = -ux;
             uy = -uy;
           }
         }
-        trace(sc, nd, segments, segment_length, cx, cy, ux, uy);
+        trace(field, nd, segments, segment_length, cx, cy, ux, uy);
         if (!regular(sc, nd, segments)) straight(nd, segments, segment_length, cx, cy, ux, uy);
       } else {
         straight(nd, segments, segment_length, cx, cy, ux, uy);
@@ -209,29 +225,34 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
                    "[init]: spline %zu of length %g mm did not fit inside the boundary in %d tries "
                    "(shorten init.segment_length or init.segments)", i, L, tries);
       lw_splines_free(sp);
-      free(cum);
+      for (int k = 0; k < nl; k++) free(cums[k]);
       return NULL;
     }
     sp->rest_length[i] = L;
   }
-  free(cum);
+  for (int k = 0; k < nl; k++) free(cums[k]);
   return sp;
+}
+
+/* The darkness of img (placed as the picture) over the inside, mm^2. */
+static double ink_area_of(const lw_scene *sc, const lw_image *img)
+{
+  const lw_boundary *b = &sc->boundary;
+  double sum = 0.0;
+  const lw_image_place *pl = &sc->image_place;
+  for (int j = 0; j < img->height; j++)
+    for (int i = 0; i < img->width; i++) {
+      double x = pl->x0 + (i + 0.5) * pl->pixel, y = pl->y0 + (j + 0.5) * pl->pixel;
+      if (lw_boundary_distance(b, x, y) < 0) sum += 1.0 - img->tone[(size_t)j * (size_t)img->width + (size_t)i];
+    }
+  return sum * pl->pixel * pl->pixel;
 }
 
 double lw_init_ink_area(const lw_scene *sc)
 {
   const lw_boundary *b = &sc->boundary;
   double sum = 0.0;
-  if (sc->image) {
-    const lw_image *img = sc->image;
-    const lw_image_place *pl = &sc->image_place;
-    for (int j = 0; j < img->height; j++)
-      for (int i = 0; i < img->width; i++) {
-        double x = pl->x0 + (i + 0.5) * pl->pixel, y = pl->y0 + (j + 0.5) * pl->pixel;
-        if (lw_boundary_distance(b, x, y) < 0) sum += 1.0 - img->tone[(size_t)j * (size_t)img->width + (size_t)i];
-      }
-    return sum * pl->pixel * pl->pixel;
-  }
+  if (sc->image) return ink_area_of(sc, sc->image);
   /* no picture: the area inside, counted on cells of at most 1/1024 of the
   ** page's longer side (error below the perimeter times half a cell) */
   double cell = fmax(sc->width, sc->height) / 1024.0;
@@ -270,6 +291,12 @@ lw_status lw_init_count(const lw_scene *sc, const lw_params *p, size_t *n, lw_er
     return LW_OK;
   }
   double want = p->coverage * lw_init_ink_area(sc) / (p->pen_width * p->segments * p->segment_length);
+  if (sc->layers.n && sc->layer[0].target) { /* each layer's ink in its own pen (layers.h) */
+    want = 0.0;
+    for (int k = 0; k < sc->layers.n; k++)
+      want += p->coverage * ink_area_of(sc, sc->layer[k].target) /
+              (sc->layers.spec[k].pen_width * p->segments * p->segment_length);
+  }
   if (!(want <= 1e8))
     return lw_error_set(err, LW_EINPUT, "%s: key 'init.coverage': %g asks for %.3g splines, more than 1e8",
                         where, p->coverage, want);

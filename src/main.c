@@ -252,7 +252,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_err
   if (s) return watched_fail(w, err);
   watcher_stop(w, 0);
   if (!quiet) {
-    char drawn[512];
+    char drawn[2048]; /* a line a pen of a layered drawing */
     if (drew) a->sys_type->describe(a->sys->state, LW_DESCRIBE_DRAWING, drawn, sizeof drawn);
     if (drew) fprintf(stderr, "%s", drawn);
     if (a->quenched)

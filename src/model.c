@@ -184,6 +184,9 @@ static lw_status pair_all(const pair_view *v, double *e)
 static void term_set_init(lw_term_set *ts, const lw_scene *sc)
 {
   lw_scene_term_ctx(sc, ts->ctx);
+  ts->n_layers = sc->layers.n;
+  ts->layers = &sc->layers;
+  for (int k = 0; k < ts->n_layers; k++) lw_scene_layer_ctx(sc, k, ts->layer_ctx[k]);
   ts->n_spline = 0;
   ts->n_raster = 0;
   ts->pair = -1;
@@ -193,6 +196,26 @@ static void term_set_init(lw_term_set *ts, const lw_scene *sc)
     if (lw_term_types[t].raster) ts->raster[ts->n_raster++] = (lw_term_id)t;
     if (lw_term_types[t].pairwise && ts->pair < 0) ts->pair = t;
   }
+}
+
+/* The term contexts of spline i: its layer's, or the scene's. */
+static const lw_term_ctx *ctx_of(const lw_term_set *ts, size_t i)
+{
+  return ts->n_layers ? ts->layer_ctx[lw_layers_of(ts->layers, i)] : ts->ctx;
+}
+
+/* Where spline i's plane of a raster term's raster starts. */
+static size_t plane_of(const lw_term_set *ts, size_t i, const lw_tone *t)
+{
+  return ts->n_layers ? (size_t)lw_layers_of(ts->layers, i) * (size_t)t->w * (size_t)t->h : 0;
+}
+
+/* A zeroed raster of term t: a plane a layer (every layer's is as large). */
+static int64_t *raster_new(const lw_term_set *ts, int t)
+{
+  const lw_tone *tn = ts->ctx[t].data;
+  size_t planes = ts->n_layers ? (size_t)ts->n_layers : 1;
+  return calloc(planes * (size_t)tn->w * (size_t)tn->h, sizeof(int64_t));
 }
 
 /* The pairwise term's kernel settings and sample nodes. */
@@ -214,18 +237,28 @@ static void spline_terms(const lw_term_set *ts, const lw_splines *sp, const doub
   }
 }
 
-/* Splats every sample of sp (at the raster term's nodes) into r, zeroed
-** first.  The sum is exact (tone.h), so any order gives the same raster. */
-static void raster_fill(const lw_term_ctx *c, const lw_splines *sp, int64_t *r)
+/* Splats every sample of sp (at the raster term's nodes) into the plane
+** of its layer of r, zeroed first, and returns the energy of raster term
+** t with its coefficient.  The sum is exact (tone.h), so any order gives
+** the same raster. */
+static double raster_fill(const lw_term_set *ts, int t, const lw_splines *sp, int64_t *r)
 {
-  const lw_tone *t = c->data;
+  const lw_tone *t0 = ts->ctx[t].data;
+  const size_t plane = (size_t)t0->w * (size_t)t0->h, planes = ts->n_layers ? (size_t)ts->n_layers : 1;
   lw_samples s;
-  memset(r, 0, (size_t)t->w * (size_t)t->h * sizeof *r);
+  memset(r, 0, planes * plane * sizeof *r);
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
+    const lw_term_ctx *c = &ctx_of(ts, sp->seg_spline[g])[t];
+    const lw_tone *tn = c->data;
+    int64_t *rp = r + plane_of(ts, sp->seg_spline[g], tn);
     lw_segment_sample(c->quad, a, a + 1, &s);
-    for (int q = 0; q < s.n; q++) lw_tone_splat(t, r, 0, 0, t->w, t->h, s.x[q], s.y[q], s.dl[q], 1);
+    for (int q = 0; q < s.n; q++) lw_tone_splat(tn, rp, 0, 0, tn->w, tn->h, s.x[q], s.y[q], s.dl[q], 1);
   }
+  if (!ts->n_layers) return ts->ctx[t].coef * lw_tone_energy(t0, r);
+  double e = 0.0;
+  for (int k = 0; k < ts->n_layers; k++) e += lw_tone_energy(ts->layer_ctx[k][t].data, r + (size_t)k * plane);
+  return ts->ctx[t].coef * e;
 }
 
 /* Grows box b over the segment from a to c: its control points bound it. */
@@ -307,8 +340,8 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
   if (pc && !(grid = grid_for(sc, pc, n, err))) goto fail;
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
-    irregular += !segment_eval(sc, ts.ctx, a, a + 1, &s, &seg_len[g], local, pc ? pc->quad : NULL,
-                               grid ? seg_ps : NULL);
+    irregular += !segment_eval(sc, ctx_of(&ts, sp->seg_spline[g]), a, a + 1, &s, &seg_len[g], local,
+                               pc ? pc->quad : NULL, grid ? seg_ps : NULL);
     for (int t = 0; t < sc->n_local; t++) term[sc->local[t]] += local[t];
     if (grid && store_samples(grid, g, np, seg_ps) != LW_OK) goto nomem;
   }
@@ -326,11 +359,9 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
     term[ts.pair] = pc->coef * e;
   }
   for (int k = 0; k < ts.n_raster; k++) {
-    const lw_term_ctx *c = &ts.ctx[ts.raster[k]];
-    int64_t *r = lw_tone_raster_new(c->data);
+    int64_t *r = raster_new(&ts, ts.raster[k]);
     if (!r) goto nomem;
-    raster_fill(c, sp, r);
-    term[ts.raster[k]] = c->coef * lw_tone_energy(c->data, r);
+    term[ts.raster[k]] = raster_fill(&ts, ts.raster[k], sp, r);
     free(r);
   }
   free(seg_len);
@@ -387,7 +418,7 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
     }
   }
   for (int k = 0; k < m->terms.n_raster; k++)
-    if (!(m->raster[m->terms.raster[k]] = lw_tone_raster_new(m->terms.ctx[m->terms.raster[k]].data))) goto nomem;
+    if (!(m->raster[m->terms.raster[k]] = raster_new(&m->terms, m->terms.raster[k]))) goto nomem;
   for (size_t i = 0; i < sp->n_splines; i++)
     if (lw_splines_segments(sp, i) > m->max_segments) m->max_segments = lw_splines_segments(sp, i);
   if (lw_model_refresh(m, NULL) != LW_OK) goto nomem;
@@ -434,8 +465,8 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
     double *local = m->seg_local + g * (size_t)nl;
-    m->seg_irregular[g] = !segment_eval(sc, ts->ctx, a, a + 1, &s, &m->seg_len[g], local, pc ? pc->quad : NULL,
-                                        m->grid ? seg_ps : NULL);
+    m->seg_irregular[g] = !segment_eval(sc, ctx_of(ts, sp->seg_spline[g]), a, a + 1, &s, &m->seg_len[g], local,
+                                        pc ? pc->quad : NULL, m->grid ? seg_ps : NULL);
     m->n_irregular += m->seg_irregular[g];
     for (int t = 0; t < nl; t++) term[sc->local[t]] += local[t];
     if (m->grid && store_samples(m->grid, g, np, seg_ps) != LW_OK) return LW_ENOMEM;
@@ -457,8 +488,7 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
   }
   for (int k = 0; k < ts->n_raster; k++) {
     const int t = ts->raster[k];
-    raster_fill(&ts->ctx[t], sp, m->raster[t]);
-    term[t] = ts->ctx[t].coef * lw_tone_energy(ts->ctx[t].data, m->raster[t]);
+    term[t] = raster_fill(ts, t, sp, m->raster[t]);
   }
   for (int t = 0; t < LW_TERM_COUNT; t++) m->term[t] = term[t];
   double total = lw_model_total(m);
@@ -619,7 +649,7 @@ static size_t crowding(const lw_cellgrid *g, const lw_pair_sample *ps, size_t n,
 ** the energy difference over the box.  NAN if the box cannot grow. */
 static double raster_delta(const lw_model *m, lw_proposal *p, int t, const lw_node *base)
 {
-  const lw_term_ctx *c = &m->terms.ctx[t];
+  const lw_term_ctx *c = &ctx_of(&m->terms, p->spline)[t];
   lw_tone_box *b = &p->box[t];
   lw_tone_box_reset(b);
   for (size_t j = 0; j < p->n_seg; j++) {
@@ -633,7 +663,7 @@ static double raster_delta(const lw_model *m, lw_proposal *p, int t, const lw_no
     raster_segment(c, b, &base[k], &base[k + 1], -1);
     raster_segment(c, b, proposed_node(base, p, k), proposed_node(base, p, k + 1), 1);
   }
-  return lw_tone_delta(c->data, m->raster[t], b);
+  return lw_tone_delta(c->data, m->raster[t] + plane_of(&m->terms, p->spline, c->data), b);
 }
 
 void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t node0,
@@ -665,7 +695,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   for (size_t j = 0; j < p->n_seg; j++) {
     size_t m_loc = p->seg0 + j, g = g0 + m_loc;
     double *local = p->local + j * (size_t)nl;
-    p->seg_irregular[j] = !segment_eval(sc, ts->ctx, proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1),
+    p->seg_irregular[j] = !segment_eval(sc, ctx_of(ts, spline), proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1),
                                         &s, &p->len[j], local, pc ? pc->quad : NULL,
                                         m->grid ? p->ps + j * (size_t)np : NULL);
     p->irregular |= p->seg_irregular[j];
@@ -795,7 +825,8 @@ lw_status lw_model_commit_part(lw_model *m, lw_proposal *p)
   m->spline_len[p->spline] = L;
   for (int k = 0; p->raster_done && k < m->terms.n_raster; k++) {
     const int t = m->terms.raster[k];
-    lw_tone_apply(m->terms.ctx[t].data, m->raster[t], &p->box[t]);
+    const lw_tone *tn = ctx_of(&m->terms, p->spline)[t].data;
+    lw_tone_apply(tn, m->raster[t] + plane_of(&m->terms, p->spline, tn), &p->box[t]);
   }
   for (int t = 0; t < LW_TERM_COUNT; t++) p->sum_term[t] += p->dterm[t];
   if (m->terms.n_raster && !p->raster_done) p->sum_stale = 1;

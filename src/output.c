@@ -252,7 +252,8 @@ lw_status lw_output_svg_strokes(const lw_strokes *s, const lw_output_page *page,
     const lw_output_pen *pen = &page->pen[k];
     char color[8];
     snprintf(color, sizeof color, "#%02x%02x%02x", pen->rgb[0], pen->rgb[1], pen->rgb[2]);
-    fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"pen %d (", k + 1);
+    if (page->pen_name[k][0]) fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"%s (", page->pen_name[k]);
+    else fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"pen %d (", k + 1);
     put_mm(f, pen->width_mm);
     fprintf(f, " mm)\" id=\"pen%d\">\n", k + 1);
     size_t a, z;
@@ -352,6 +353,7 @@ static void draw(cairo_t *cr, const lw_strokes *s, const lw_output_page *page, c
   if (tone) paint_tone(cr, tone);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
   cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+  if (page->multiply) cairo_set_operator(cr, CAIRO_OPERATOR_MULTIPLY);
   for (int k = 0; k < page->n_pens; k++) {
     const lw_output_pen *pen = &page->pen[k];
     cairo_set_source_rgb(cr, pen->rgb[0] / 255.0, pen->rgb[1] / 255.0, pen->rgb[2] / 255.0);

@@ -319,6 +319,33 @@ const lw_param_def lw_param_table[] = {
   NUM("plot", "lift_time", LW_PT_DOUBLE, lift_time, "0.2", "s", 0, 1e3, 0,
       "Time of one pen lift and lowering for the plot time estimate; an AxiDraw's servo at its "
       "default rates (raise 75 %, lower 50 %, over 30 % of a 200 ms sweep) takes about 0.2 s."),
+  STRING("layers", "names", ly_names, "", "",
+         "Hatching layers or colour pens: one name a layer (letters, digits, `-`, `_`, `.`; it labels "
+         "the pen's SVG layer), separated by blanks (at most 16). Each "
+         "layer is a pen of its own (one SVG group) with its own target, field, width and colour; "
+         "each spline belongs to one, by its index, the layers getting splines in proportion to "
+         "the ink of their targets. Needs output.pens = 1 (the layers are the pens). Empty = no "
+         "layers: one target, one field, the pens of [output]. docs/IMAGES.md, \"Hatching layers "
+         "and colour\"."),
+  CHOICE("layers", "source", ly_source, "tone", "tone|cmyk|palette",
+         "Each layer's target: `tone` = the picture's darkness through the layer's `tone_min` .. "
+         "`tone_max`; `cmyk` = the cyan, magenta, yellow and black separation of the colour picture "
+         "(4 layers, in that order); `palette` = the least-squares separation of the colour picture "
+         "into the pens of `colors` (docs/NUMERICS.md, \"Colour separation\")."),
+  STRING("layers", "colors", ly_colors, "", "",
+         "Pen colour of each layer, `#rrggbb` or `#rgb`; empty = black (tone) or cyan, magenta, "
+         "yellow, black (cmyk). `palette` needs them: they are the pens the picture is separated into."),
+  STRING("layers", "turn", ly_turn, "", "degrees",
+         "Each layer's field is the scene's field (scene.field) turned by this angle, e.g. `0 90` "
+         "for cross-hatching along and across the flow. Empty = 0 for every layer."),
+  STRING("layers", "tone_min", ly_tone_min, "", "",
+         "source = tone: tone (0 black .. 1 white) at and below which a layer's target is full "
+         "ink; one a layer, empty = 0 each."),
+  STRING("layers", "tone_max", ly_tone_max, "", "",
+         "source = tone: tone at and above which a layer's target is no ink (above tone_min); "
+         "one a layer, empty = 1 each. The target falls linearly in between."),
+  STRING("layers", "pen_width", ly_pen_width, "", "mm",
+         "Pen width of each layer (its SVG stroke and its tone footprint); empty = output.pen_width each."),
   NUM("particles", "count", LW_PT_INT, pt_count, "100", "", 0, 1e7, 0,
       "Particles placed by `pattern` (after those of `points`, if any)."),
   CHOICE("particles", "pattern", pt_pattern, "plane", "cloud|plane|sphere",

@@ -107,8 +107,9 @@ done:
   return s;
 }
 
-lw_plot *lw_plot_new(const lw_splines *sp, int n_pens, const double *key, lw_plot_order order,
-                     double hx, double hy, lw_error *err)
+/* lw_plot_new with keys, or lw_plot_new_pens with given pens (pens not NULL). */
+static lw_plot *plot_new(const lw_splines *sp, int n_pens, const double *key, const int *pens, lw_plot_order order,
+                         double hx, double hy, lw_error *err)
 {
   if (n_pens < 1 || n_pens > LW_PLOT_PENS_MAX) {
     lw_error_set(err, LW_EINPUT, "%d pens: expected 1 to %d", n_pens, LW_PLOT_PENS_MAX);
@@ -135,7 +136,18 @@ lw_plot *lw_plot_new(const lw_splines *sp, int n_pens, const double *key, lw_plo
   /* pen of each path, then a stable bucket pass keeps index order per pen */
   int *pen = malloc((n ? n : 1) * sizeof *pen);
   if (!pen) goto nomem;
-  if (key && n_pens > 1) {
+  if (pens) {
+    for (size_t r = 0; r < n; r++) {
+      pen[r] = pens[rk[r].spline];
+      if (pen[r] < 0 || pen[r] >= n_pens) {
+        lw_error_set(err, LW_EINPUT, "spline %zu has pen %d: expected 0 to %d", rk[r].spline, pen[r], n_pens - 1);
+        free(pen);
+        free(rk);
+        lw_plot_free(pl);
+        return NULL;
+      }
+    }
+  } else if (key && n_pens > 1) {
     qsort(rk, n, sizeof *rk, by_key);
     for (size_t r = 0; r < n; r++) pen[r] = (int)(r * (size_t)n_pens / n);
     /* back to index order with the pens attached */
@@ -168,4 +180,16 @@ nomem:
   lw_plot_free(pl);
   lw_error_set(err, LW_ENOMEM, "out of memory planning %zu splines", sp->n_splines);
   return NULL;
+}
+
+lw_plot *lw_plot_new(const lw_splines *sp, int n_pens, const double *key, lw_plot_order order, double hx, double hy,
+                     lw_error *err)
+{
+  return plot_new(sp, n_pens, key, NULL, order, hx, hy, err);
+}
+
+lw_plot *lw_plot_new_pens(const lw_splines *sp, int n_pens, const int *pen, lw_plot_order order, double hx,
+                          double hy, lw_error *err)
+{
+  return plot_new(sp, n_pens, NULL, pen, order, hx, hy, err);
 }

@@ -183,6 +183,15 @@ void lw_scene_term_ctx(const lw_scene *sc, lw_term_ctx ctx[LW_TERM_COUNT])
   ctx[LW_TERM_TONE].data = &sc->tone;
 }
 
+void lw_scene_layer_ctx(const lw_scene *sc, int k, lw_term_ctx ctx[LW_TERM_COUNT])
+{
+  lw_scene_term_ctx(sc, ctx);
+  if (!sc->layers.n) return;
+  ctx[LW_TERM_POTENTIAL].data = &sc->layer[k].potential;
+  ctx[LW_TERM_FIELD].data = &sc->layer[k].field;
+  ctx[LW_TERM_TONE].data = &sc->layer[k].tone;
+}
+
 lw_status lw_scene_set_user_term(lw_scene *sc, double coef, lw_user_term_fn fn, const void *data,
                                  lw_error *err)
 {
@@ -194,6 +203,106 @@ lw_status lw_scene_set_user_term(lw_scene *sc, double coef, lw_user_term_fn fn, 
   sc->user_fn = coef != 0.0 ? fn : NULL;
   sc->user_data = coef != 0.0 ? data : NULL;
   list_local_terms(sc);
+  return LW_OK;
+}
+
+/* One colour channel of the picture, through the luma's resize and blur
+** (not its tone curve, which shapes the luma), at sc->image's size. */
+static lw_image *load_channel(lw_scene *sc, const lw_params *p, lw_image_channel which, lw_error *err)
+{
+  char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
+  lw_path_dir(dir, sizeof dir, p->file);
+  lw_path_join(full, sizeof full, dir, p->image);
+  lw_image *img = lw_image_load_channel(full, p->image_max_pixels, which, NULL, err);
+  if (!img) return NULL;
+  if (img->width != sc->image->width || img->height != sc->image->height) {
+    lw_image *r = lw_image_resize(img, sc->image->width, sc->image->height, err);
+    lw_image_free(img);
+    if (!(img = r)) return NULL;
+  }
+  if (lw_image_blur(img, p->image_blur / sc->image_place.pixel, err)) {
+    lw_image_free(img);
+    return NULL;
+  }
+  return img;
+}
+
+/* Each layer's target tone from the picture (layers.h). */
+static lw_status layer_targets(lw_scene *sc, const lw_params *p, lw_error *err)
+{
+  const lw_layers_spec *ls = &sc->layers;
+  const size_t n = (size_t)sc->image->width * (size_t)sc->image->height;
+  for (int k = 0; k < ls->n; k++)
+    if (!(sc->layer[k].target = lw_image_new(sc->image->width, sc->image->height, 0, err))) return err->code;
+  if (ls->source == LW_LSRC_TONE) {
+    for (int k = 0; k < ls->n; k++) {
+      const double lo = ls->spec[k].tone_min, hi = ls->spec[k].tone_max;
+      for (size_t q = 0; q < n; q++) {
+        double a = (hi - sc->image->tone[q]) / (hi - lo);
+        sc->layer[k].target->tone[q] = (float)(1.0 - (a < 0.0 ? 0.0 : a > 1.0 ? 1.0 : a));
+      }
+    }
+    return LW_OK;
+  }
+  lw_image *ch[3] = {NULL, NULL, NULL};
+  float *a = malloc((size_t)ls->n * n * sizeof *a);
+  lw_status st = a ? LW_OK : lw_error_set(err, LW_ENOMEM, "out of memory separating the picture");
+  for (int c = 0; !st && c < 3; c++)
+    if (!(ch[c] = load_channel(sc, p, (lw_image_channel)(LW_IMAGE_RED + c), err))) st = err->code;
+  if (!st) {
+    unsigned char rgb[LW_LAYERS_MAX][3];
+    for (int k = 0; k < ls->n; k++) memcpy(rgb[k], ls->spec[k].rgb, 3);
+    lw_layers_separate(ch[0]->tone, ch[1]->tone, ch[2]->tone, n, ls->n, (const unsigned char (*)[3])rgb, a);
+    for (int k = 0; k < ls->n; k++)
+      for (size_t q = 0; q < n; q++) sc->layer[k].target->tone[q] = 1.0f - a[(size_t)k * n + q];
+  }
+  for (int c = 0; c < 3; c++) lw_image_free(ch[c]);
+  free(a);
+  return st;
+}
+
+/* The layers' targets, fields, potentials and tone rasters (layers.h). */
+static lw_status build_layers(lw_scene *sc, const lw_params *p, lw_error *err)
+{
+  lw_status st = lw_layers_read(p, &sc->layers, err);
+  if (st || !sc->layers.n) return st;
+  if (p->pens != 1)
+    return bad_key(p, "output", "pens", LW_EINPUT, err, "layers set the pens (one a layer): expected 1, got %d",
+                   p->pens);
+  if (p->pen_colors[0])
+    return bad_key(p, "output", "pen_colors", LW_EINPUT, err, "layers set the pens' colours: use layers.colors");
+  if (!sc->image) {
+    if (sc->layers.source != LW_LSRC_TONE)
+      return bad_key(p, "layers", "source", LW_EINPUT, err, "a separation needs a colour picture in scene.image");
+  } else {
+    if ((st = layer_targets(sc, p, err))) return st;
+    const lw_image *t[LW_LAYERS_MAX];
+    for (int k = 0; k < sc->layers.n; k++) t[k] = sc->layer[k].target;
+    lw_layers_share(&sc->layers, t);
+  }
+  for (int k = 0; k < sc->layers.n; k++) {
+    lw_layer *l = &sc->layer[k];
+    if (sc->on[LW_TERM_FIELD]) {
+      l->field = sc->field; /* the grid is borrowed: the scene frees it */
+      l->field.turned = 1;
+      l->field.turn_c = cos(sc->layers.spec[k].turn);
+      l->field.turn_s = sin(sc->layers.spec[k].turn);
+    }
+    if (sc->on[LW_TERM_POTENTIAL]) {
+      l->potential = sc->potential;
+      l->potential.grid = NULL;
+      if (sc->potential.kind == LW_POTENTIAL_GRID &&
+          !(l->potential.grid = lw_imagefield_potential(l->target, &sc->image_place, err)))
+        return err->code;
+    }
+    if (sc->on[LW_TERM_TONE]) {
+      lw_error e2;
+      if ((st = lw_tone_init(&l->tone, l->target, &sc->image_place, p->tone_blur, sc->layers.spec[k].pen_width,
+                             &e2)))
+        return st == LW_EINPUT ? bad_key(p, "energy", "tone_blur", st, err, "%s", e2.msg)
+                               : lw_error_set(err, st, "%s", e2.msg);
+    }
+  }
   return LW_OK;
 }
 
@@ -342,7 +451,7 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   }
   if (p->boundary != LW_BND_MASK && p->mask != LW_MASK_NONE)
     return bad_key(p, "scene", "mask", LW_EINPUT, err, "a mask needs scene.boundary = mask");
-  return LW_OK;
+  return build_layers(sc, p, err);
 }
 
 lw_status lw_scene_init(lw_scene *sc, const lw_params *p, lw_error *err)
@@ -359,6 +468,12 @@ void lw_scene_clear(lw_scene *sc)
   lw_field_clear(&sc->field);
   lw_boundary_clear(&sc->boundary);
   lw_tone_clear(&sc->tone);
+  for (int k = 0; k < LW_LAYERS_MAX; k++) {
+    lw_potential_clear(&sc->layer[k].potential);
+    lw_tone_clear(&sc->layer[k].tone);
+    lw_image_free(sc->layer[k].target);
+    sc->layer[k].target = NULL;
+  }
   lw_image_free(sc->image);
   sc->image = NULL;
 }

@@ -87,6 +87,9 @@ typedef struct {
   double wavelength;   /* waves: mm (> 0) */
   double amplitude;    /* waves: mm */
   lw_grid2d *grid;     /* grid, grid_axial: owned, ncomp = 2 */
+  int turned;          /* 1: every value is turned by the angle (cos, sin) below:
+                          a hatching layer's field (layers.h) */
+  double turn_c, turn_s;
 } lw_field;
 
 double lw_potential_eval(const lw_potential *f, double x, double y);

@@ -55,10 +55,19 @@ void lw_image_free(lw_image *img);
 lw_image *lw_image_decode(const unsigned char *data, size_t size, const char *name,
                           double max_pixels, lw_image_info *info, lw_error *err);
 
+/* What becomes the tone plane: the luma above, or one colour channel as
+** stored (a gray picture gives its gray for each), for colour separation
+** (layers.h).  Everything else -- alpha, downsampling -- is the same. */
+typedef enum { LW_IMAGE_LUMA, LW_IMAGE_RED, LW_IMAGE_GREEN, LW_IMAGE_BLUE } lw_image_channel;
+lw_image *lw_image_decode_channel(const unsigned char *data, size_t size, const char *name, double max_pixels,
+                                  lw_image_channel which, lw_image_info *info, lw_error *err);
+
 /* Reads path whole, then lw_image_decode.  An empty, unreadable or missing
 ** file is LW_EINPUT with a message naming path. */
 lw_image *lw_image_load(const char *path, double max_pixels, lw_image_info *info,
                         lw_error *err);
+lw_image *lw_image_load_channel(const char *path, double max_pixels, lw_image_channel which, lw_image_info *info,
+                                lw_error *err);
 
 /* A new w x h image resampled from src, each axis on its own: shrinking
 ** averages the source area each new pixel covers (a box filter with

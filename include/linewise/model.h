@@ -65,6 +65,9 @@ typedef struct {
   int pair;
   int n_raster;             /* the raster terms that are on */
   lw_term_id raster[LW_TERM_COUNT];
+  int n_layers;             /* the scene's layers (layers.h), 0 = none: then ctx serves every spline */
+  const lw_layers_spec *layers; /* the scene's, with n_layers */
+  lw_term_ctx layer_ctx[LW_LAYERS_MAX][LW_TERM_COUNT]; /* each layer's contexts */
 } lw_term_set;
 
 typedef struct {
@@ -80,7 +83,8 @@ typedef struct {
   lw_cellgrid *grid;        /* the pair samples' positions and weights (pairwise term on), else NULL */
   double *near_cache;       /* n_segments: each segment's pair near field (pair on) */
   uint8_t *near_valid;      /* n_segments: 1 where near_cache holds the current value */
-  int64_t *raster[LW_TERM_COUNT]; /* each raster term's raster (tone.h) while on, else NULL */
+  int64_t *raster[LW_TERM_COUNT]; /* each raster term's raster (tone.h) while on, else NULL;
+                                     with layers one plane a layer, layer k at k w h */
   size_t max_segments;      /* longest spline, for sizing proposals */
 } lw_model;
 

@@ -47,6 +47,10 @@ typedef struct {
   double width_mm, height_mm;         /* page, mm (> 0) */
   int n_pens;                         /* 1 .. LW_PLOT_PENS_MAX */
   lw_output_pen pen[LW_PLOT_PENS_MAX];
+  char pen_name[LW_PLOT_PENS_MAX][64]; /* each pen's SVG layer label, or empty: "pen <k>" */
+  int multiply;                       /* 1: the previews lay each pen's ink over the
+                                         others by multiplying colours (cyan over yellow
+                                         is green); 0: each paints over */
 } lw_output_page;
 
 /* A page of the given size with one pen: 0.3 mm, black. */
@@ -73,7 +77,8 @@ int lw_output_colors_parse(const char *list, unsigned char (*rgb)[3], int max);
 
 /* The plotter SVG, written atomically: width and height in mm, viewBox in
 ** mm (user unit = 1 mm), one Inkscape layer group per pen in pen order
-** (id "pen<k>", label "pen <k> (<width> mm)"), one path per spline with
+** (id "pen<k>", label "pen <k> (<width> mm)", or "<name> (<width> mm)" for a
+** named pen), one path per spline with
 ** M and C commands only.  A reversed path lists the control points of its
 ** segments backwards, last segment first, so it is the same curve.
 ** LW_EINPUT for a bad page or plot or a non-finite coordinate, LW_EIO when

@@ -59,6 +59,7 @@ enum { LW_PBOUNDARY_NONE, LW_PBOUNDARY_PLANE, LW_PBOUNDARY_SPHERE };
 enum { LW_DRIVER_METROPOLIS, LW_DRIVER_DYNAMICS };
 enum { LW_PIN_NONE, LW_PIN_ENDS, LW_PIN_FIRST, LW_PIN_LAST };
 enum { LW_INTEGRATOR_LEAPFROG, LW_INTEGRATOR_REVIEW };
+enum { LW_LSRC_TONE, LW_LSRC_CMYK, LW_LSRC_PALETTE };
 
 typedef struct {
   /* [scene] */
@@ -158,6 +159,13 @@ typedef struct {
   double min_length;          /* pen widths; 0 = keep all */
   double speed_down, speed_up; /* plot time estimate, mm/s */
   double lift_time;           /* s per pen lift */
+  /* [layers] (layers.h) */
+  char ly_names[LW_PATH_MAX]; /* layer names; empty = no layers */
+  int ly_source;              /* LW_LSRC_* */
+  char ly_colors[LW_PATH_MAX]; /* a colour a layer, or empty */
+  char ly_turn[LW_PATH_MAX];  /* degrees a layer, or empty */
+  char ly_tone_min[LW_PATH_MAX], ly_tone_max[LW_PATH_MAX]; /* a tone a layer, or empty */
+  char ly_pen_width[LW_PATH_MAX]; /* mm a layer, or empty */
   /* [particles] (system = particles; particles.h) */
   int pt_count;               /* particles placed by the pattern */
   int pt_pattern;             /* LW_PPATTERN_* */

@@ -53,6 +53,10 @@ typedef struct {
 ** memory. */
 lw_plot *lw_plot_new(const lw_splines *sp, int n_pens, const double *key, lw_plot_order order,
                      double hx, double hy, lw_error *err);
+/* The same with the pen of each spline given: pen[i] in 0 .. n_pens - 1
+** (LW_EINPUT otherwise), as a scene's layers assign them (layers.h). */
+lw_plot *lw_plot_new_pens(const lw_splines *sp, int n_pens, const int *pen, lw_plot_order order, double hx,
+                          double hy, lw_error *err);
 void lw_plot_free(lw_plot *pl);
 
 /* The ordering above for n paths known by their end points: tour[k] the

@@ -7,6 +7,10 @@
 ** blur, tone curve); the potential, the field and the mask boundary are
 ** built from it when the scene asks for them.
 **
+** With [layers] (layers.h) each layer has its own target, field,
+** potential and tone raster besides the scene's; lw_scene_layer_ctx gives
+** the term contexts a layer's splines read.
+**
 ** Only what the scene names is built: the potential exists only when its
 ** coefficient Q is non-zero, the vector field only when P is, and so on; a
 ** term that is off is never evaluated (lw_scene.local lists the per-segment
@@ -26,6 +30,7 @@
 #include "linewise/boundary.h"
 #include "linewise/field.h"
 #include "linewise/image.h"
+#include "linewise/layers.h"
 #include "linewise/pair.h"
 #include "linewise/params.h"
 #include "linewise/quad.h"
@@ -58,6 +63,8 @@ typedef struct lw_scene {
   lw_term_id local[LW_TERM_COUNT]; /* ... and which */
   lw_image *image;              /* the processed picture (owned), or NULL */
   lw_image_place image_place;   /* where it lies on the page */
+  lw_layers_spec layers;        /* [layers]; layers.n = 0: none (layers.h) */
+  lw_layer layer[LW_LAYERS_MAX]; /* what each layer's terms read */
   char note[LW_ERROR_MSG];      /* something the user should know (a picture was
                                    downsampled), or empty; the CLI prints it */
 } lw_scene;
@@ -69,6 +76,11 @@ void lw_scene_clear(lw_scene *sc);
 /* The context of every term (terms.h): its coefficient and what it reads
 ** of this scene.  The pointers are into sc: valid while sc is. */
 void lw_scene_term_ctx(const lw_scene *sc, lw_term_ctx ctx[LW_TERM_COUNT]);
+
+/* The contexts of the terms of a spline of layer k (layers.h): as
+** lw_scene_term_ctx, with the layer's field, potential and tone.  Without
+** layers, lw_scene_term_ctx's. */
+void lw_scene_layer_ctx(const lw_scene *sc, int k, lw_term_ctx ctx[LW_TERM_COUNT]);
 
 /* Registers fn as the user term with coefficient coef: its energy is
 ** coef * fn(samples, quad, data) summed over all segments (term name

@@ -35,7 +35,8 @@
 ** not a drawing), so a pixel overflows only past 2^15 such samples.
 **
 ** Memory: the target, 4 bytes a raster pixel, shared by the replicas; the
-** raster, 8 bytes a pixel, in each replica's model; a proposal's box, 8
+** raster, 8 bytes a pixel, in each replica's model (with layers, layers.h,
+** a target and a raster plane a layer); a proposal's box, 8
 ** bytes a pixel of the largest box it has needed.
 **
 ** A move: lw_tone_box_cover() grows a box over the footprints of the

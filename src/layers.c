@@ -1,0 +1,253 @@
+/* layers.c -- the [layers] keys and colour separation (layers.h). */
+#include "linewise/layers.h"
+
+#include <ctype.h>
+#include <gsl/gsl_math.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "linewise/number.h"
+#include "linewise/output.h"
+
+/* "file:line: key 'layers.key': ..." */
+static lw_status bad(const lw_params *p, const char *key, lw_error *err, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static lw_status bad(const lw_params *p, const char *key, lw_error *err, const char *fmt, ...)
+{
+  char where[LW_PATH_MAX + 32], what[LW_ERROR_MSG];
+  lw_params_origin(p, lw_params_find("layers", key), where, sizeof where);
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(what, sizeof what, fmt, ap);
+  va_end(ap);
+  return lw_error_set(err, LW_EINPUT, "%s: key 'layers.%s': %s", where, key, what);
+}
+
+/* 1 if key holds something other than its default (a run's scene.ini
+** writes every key back, so where a key was set says nothing). */
+static int given(const lw_params *p, const char *key)
+{
+  if (!strcmp(key, "source")) return p->ly_source != LW_LSRC_TONE;
+  const lw_param_def *d = lw_params_find("layers", key);
+  return ((const char *)p + d->offset)[0] != '\0';
+}
+
+/* One number a layer from text into v[n] (empty: leave the defaults);
+** within [lo, hi]. */
+static lw_status per_layer(const lw_params *p, const char *key, const char *text, int n, double lo, double hi,
+                           double *v, lw_error *err)
+{
+  if (!text[0]) return LW_OK;
+  double got[LW_LAYERS_MAX];
+  int count = lw_number_list(text, 1, got, LW_LAYERS_MAX);
+  if (count < 0) return bad(p, key, err, "expected %d numbers (one a layer), got '%s'", n, text);
+  if (count != n)
+    return bad(p, key, err, "expected %d numbers (one a layer of layers.names), got %d", n, count);
+  for (int k = 0; k < n; k++) {
+    if (!(got[k] >= lo && got[k] <= hi))
+      return bad(p, key, err, "expected values from %g to %g, got %g for layer %d", lo, hi, got[k], k + 1);
+    v[k] = got[k];
+  }
+  return LW_OK;
+}
+
+static const unsigned char process[4][3] = {{0, 255, 255}, {255, 0, 255}, {255, 255, 0}, {0, 0, 0}};
+
+lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
+{
+  memset(ls, 0, sizeof *ls);
+  ls->source = p->ly_source;
+  static const char *const keys[] = {"source", "colors", "turn", "tone_min", "tone_max", "pen_width"};
+  if (!p->ly_names[0]) {
+    for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++)
+      if (given(p, keys[k])) return bad(p, keys[k], err, "needs layers.names (the layers it describes)");
+    return LW_OK;
+  }
+  int n = 0;
+  for (const char *c = p->ly_names;;) {
+    c += strspn(c, " \t,");
+    if (!*c) break;
+    size_t len = strcspn(c, " \t,");
+    if (n == LW_LAYERS_MAX) return bad(p, "names", err, "expected at most %d layers", LW_LAYERS_MAX);
+    if (len >= sizeof ls->spec[n].name)
+      return bad(p, "names", err, "expected names of at most %zu characters", sizeof ls->spec[n].name - 1);
+    /* the name labels the pen's SVG layer: nothing XML would read as markup */
+    for (size_t q = 0; q < len; q++)
+      if (!isalnum((unsigned char)c[q]) && !strchr("-_.", c[q]))
+        return bad(p, "names", err, "expected names of letters, digits, '-', '_' and '.', got '%.*s'", (int)len, c);
+    memcpy(ls->spec[n].name, c, len);
+    ls->spec[n].name[len] = '\0';
+    n++;
+    c += len;
+  }
+  if (!n) return bad(p, "names", err, "expected at least one name, got '%s'", p->ly_names);
+  ls->n = n;
+  if (ls->source == LW_LSRC_CMYK && n != 4)
+    return bad(p, "source", err, "'cmyk' needs 4 layers (cyan magenta yellow black), layers.names has %d", n);
+  double turn[LW_LAYERS_MAX] = {0}, lo[LW_LAYERS_MAX] = {0}, hi[LW_LAYERS_MAX], width[LW_LAYERS_MAX];
+  for (int k = 0; k < n; k++) {
+    hi[k] = 1.0;
+    width[k] = p->pen_width;
+  }
+  lw_status st;
+  if ((st = per_layer(p, "turn", p->ly_turn, n, -360, 360, turn, err)) ||
+      (st = per_layer(p, "tone_min", p->ly_tone_min, n, 0, 1, lo, err)) ||
+      (st = per_layer(p, "tone_max", p->ly_tone_max, n, 0, 1, hi, err)) ||
+      (st = per_layer(p, "pen_width", p->ly_pen_width, n, 1e-6, 1e3, width, err)))
+    return st;
+  for (int k = 0; k < n; k++)
+    if (!(lo[k] < hi[k]))
+      return bad(p, given(p, "tone_max") ? "tone_max" : "tone_min", err,
+                 "expected layers.tone_min < layers.tone_max, got %g and %g for layer %d", lo[k], hi[k], k + 1);
+  if (ls->source != LW_LSRC_TONE && (given(p, "tone_min") || given(p, "tone_max")))
+    return bad(p, given(p, "tone_min") ? "tone_min" : "tone_max", err,
+               "a tone range needs layers.source = tone (a separation sets each pen's target)");
+  unsigned char rgb[LW_LAYERS_MAX][3] = {{0}};
+  if (p->ly_colors[0]) {
+    int count = lw_output_colors_parse(p->ly_colors, rgb, LW_LAYERS_MAX);
+    if (count != n)
+      return bad(p, "colors", err, "expected %d colours '#rrggbb' or '#rgb' (one a layer), got '%s'", n,
+                 p->ly_colors);
+  } else if (ls->source == LW_LSRC_CMYK) {
+    memcpy(rgb, process, sizeof process);
+  } else if (ls->source == LW_LSRC_PALETTE) {
+    return bad(p, "source", err, "'palette' needs layers.colors: the pens to separate the picture into");
+  }
+  lw_layers_share(ls, NULL);
+  for (int k = 0; k < n; k++) {
+    ls->spec[k].turn = turn[k] * M_PI / 180.0;
+    ls->spec[k].tone_min = lo[k];
+    ls->spec[k].tone_max = hi[k];
+    ls->spec[k].pen_width = width[k];
+    memcpy(ls->spec[k].rgb, rgb[k], 3);
+  }
+  return LW_OK;
+}
+
+void lw_layers_share(lw_layers_spec *ls, const lw_image *const *target)
+{
+  double ink[LW_LAYERS_MAX] = {0}, total = 0.0;
+  for (int k = 0; target && k < ls->n; k++) {
+    const size_t n = (size_t)target[k]->width * (size_t)target[k]->height;
+    for (size_t q = 0; q < n; q++) ink[k] += 1.0 - target[k]->tone[q];
+    total += ink[k];
+  }
+  ls->cum[0] = 0.0;
+  for (int k = 0; k < ls->n; k++) ls->cum[k + 1] = total > 0.0 ? ls->cum[k] + ink[k] / total : (k + 1.0) / ls->n;
+  ls->cum[ls->n] = 1.0;
+}
+
+/* ---- separation ---------------------------------------------------------- */
+
+/* The normal equations of one pixel: M = U^T U + lambda I, b = U^T d. */
+typedef struct {
+  int k;
+  double M[LW_LAYERS_MAX][LW_LAYERS_MAX];
+} normal;
+
+/* Solves M_FF z_F = b_F - M_FB a_B for the free set F (free[j] = 1) into
+** z (entries of F only) by Cholesky: M_FF is positive definite (the ridge
+** keeps its pivots >= lambda), and at most 16 x 16. */
+static void solve_free(const normal *nm, const double *b, const double *a, const int *free_, double *z)
+{
+  int idx[LW_LAYERS_MAX], nf = 0;
+  for (int j = 0; j < nm->k; j++)
+    if (free_[j]) idx[nf++] = j;
+  double m[LW_LAYERS_MAX * LW_LAYERS_MAX], r[LW_LAYERS_MAX], x[LW_LAYERS_MAX];
+  for (int i = 0; i < nf; i++) {
+    r[i] = b[idx[i]];
+    for (int j = 0; j < nm->k; j++)
+      if (!free_[j]) r[i] -= nm->M[idx[i]][j] * a[j];
+    for (int j = 0; j < nf; j++) m[i * nf + j] = nm->M[idx[i]][idx[j]];
+  }
+  /* Cholesky m = L L^T in place (lower triangle), then two triangular solves */
+  for (int j = 0; j < nf; j++) {
+    double d = m[j * nf + j];
+    for (int q = 0; q < j; q++) d -= m[j * nf + q] * m[j * nf + q];
+    m[j * nf + j] = sqrt(d);
+    for (int i = j + 1; i < nf; i++) {
+      double v = m[i * nf + j];
+      for (int q = 0; q < j; q++) v -= m[i * nf + q] * m[j * nf + q];
+      m[i * nf + j] = v / m[j * nf + j];
+    }
+  }
+  for (int i = 0; i < nf; i++) {
+    double v = r[i];
+    for (int q = 0; q < i; q++) v -= m[i * nf + q] * x[q];
+    x[i] = v / m[i * nf + i];
+  }
+  for (int i = nf - 1; i >= 0; i--) {
+    double v = x[i];
+    for (int q = i + 1; q < nf; q++) v -= m[q * nf + i] * x[q];
+    x[i] = v / m[i * nf + i];
+  }
+  for (int i = 0; i < nf; i++) z[idx[i]] = x[i];
+}
+
+/* min 1/2 a^T M a - b^T a over 0 <= a <= 1: a primal active-set method
+** from a = 0.  Outer step: free the bound variable whose gradient most
+** wants it inside; inner steps: move toward the minimiser over the free
+** set, stopping at the first bound crossed (that variable is bound again),
+** until the free minimiser is feasible.  Each outer step lowers the
+** objective strictly, so no active set repeats; the cap is a guard. */
+static void bounded_qp(const normal *nm, const double *b, double *a)
+{
+  const int k = nm->k;
+  int free_[LW_LAYERS_MAX] = {0};
+  for (int j = 0; j < k; j++) a[j] = 0.0;
+  for (int outer = 0; outer < 8 * LW_LAYERS_MAX; outer++) {
+    int pick = -1;
+    double worst = 1e-12;
+    for (int j = 0; j < k; j++) {
+      if (free_[j]) continue;
+      double g = -b[j];
+      for (int i = 0; i < k; i++) g += nm->M[j][i] * a[i];
+      double want = a[j] == 0.0 ? -g : g; /* > 0: moving inside lowers the objective */
+      if (want > worst) {
+        worst = want;
+        pick = j;
+      }
+    }
+    if (pick < 0) return;
+    free_[pick] = 1;
+    for (int inner = 0; inner < LW_LAYERS_MAX + 1; inner++) {
+      double z[LW_LAYERS_MAX];
+      solve_free(nm, b, a, free_, z);
+      double step = 1.0;
+      int block = -1;
+      for (int j = 0; j < k; j++) {
+        if (!free_[j] || (z[j] >= 0.0 && z[j] <= 1.0)) continue;
+        double bound = z[j] < 0.0 ? 0.0 : 1.0, t = (bound - a[j]) / (z[j] - a[j]);
+        if (t < step) {
+          step = t;
+          block = j;
+        }
+      }
+      for (int j = 0; j < k; j++)
+        if (free_[j]) a[j] += step * (z[j] - a[j]);
+      if (block < 0) break;
+      a[block] = z[block] < 0.0 ? 0.0 : 1.0;
+      free_[block] = 0;
+    }
+  }
+}
+
+void lw_layers_separate(const float *r, const float *g, const float *b, size_t n, int k,
+                        const unsigned char (*rgb)[3], float *a)
+{
+  double u[LW_LAYERS_MAX][3];
+  normal nm = {.k = k};
+  for (int j = 0; j < k; j++)
+    for (int c = 0; c < 3; c++) u[j][c] = 1.0 - rgb[j][c] / 255.0;
+  for (int i = 0; i < k; i++)
+    for (int j = 0; j < k; j++)
+      nm.M[i][j] = u[i][0] * u[j][0] + u[i][1] * u[j][1] + u[i][2] * u[j][2] + (i == j ? LW_LAYERS_RIDGE : 0.0);
+  for (size_t p = 0; p < n; p++) {
+    double d[3] = {1.0 - r[p], 1.0 - g[p], 1.0 - b[p]}, rhs[LW_LAYERS_MAX], x[LW_LAYERS_MAX];
+    for (int j = 0; j < k; j++) rhs[j] = u[j][0] * d[0] + u[j][1] * d[1] + u[j][2] * d[2] - LW_LAYERS_INK;
+    bounded_qp(&nm, rhs, x);
+    for (int j = 0; j < k; j++) a[(size_t)j * n + p] = (float)(x[j] < 0.0 ? 0.0 : x[j] > 1.0 ? 1.0 : x[j]);
+  }
+}

@@ -1,0 +1,645 @@
+/*
+** test_layers.c -- hatching layers and colour pens (layers.h): the local
+** differences of layered terms against the full recomputation, a single
+** whole-range layer that is the scene without layers, layers that follow
+** their own fields, the colour separation against pictures mixed from
+** known pen coverages, the drawing's pens and the previews' colour, and
+** bad [layers] keys on the command line.
+*/
+#include <cairo.h>
+#include <criterion/criterion.h>
+#include <gsl/gsl_eigen.h>
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include "imageutil.h"
+#include "linewise/gradient.h"
+#include "linewise/init.h"
+#include "linewise/layers.h"
+#include "linewise/model.h"
+#include "linewise/output.h"
+#include "linewise/scene.h"
+#include "testutil.h"
+
+TestSuite(layers, .init = lw_image_dir_make, .fini = lw_image_dir_remove);
+
+/* A w x h RGB picture, colour f(u, v, rgb) with u, v in [0, 1] across it. */
+static void write_colour_png(const char *path, int w, int h, void (*f)(double, double, double *))
+{
+  cairo_surface_t *s = cairo_image_surface_create(CAIRO_FORMAT_RGB24, w, h);
+  unsigned char *d = cairo_image_surface_get_data(s);
+  int stride = cairo_image_surface_get_stride(s);
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) {
+      double c[3];
+      f((i + 0.5) / w, (j + 0.5) / h, c);
+      uint32_t px = 0;
+      for (int k = 0; k < 3; k++) px = px << 8 | (uint32_t)lround(255.0 * c[k]);
+      *(uint32_t *)(d + (size_t)j * (size_t)stride + 4 * (size_t)i) = px;
+    }
+  cairo_surface_mark_dirty(s);
+  cr_assert_eq(cairo_surface_write_to_png(s, path), CAIRO_STATUS_SUCCESS);
+  cairo_surface_destroy(s);
+}
+
+static void blotch_colours(double u, double v, double *c)
+{
+  c[0] = 0.5 + 0.4 * sin(7 * u + 2 * v);
+  c[1] = 0.5 + 0.4 * cos(5 * v - 3 * u * u);
+  c[2] = 0.6 + 0.3 * sin(4 * u * v + 1);
+}
+
+static void cyan_yellow(double u, double v, double *c)
+{
+  (void)v;
+  c[0] = 0.0;
+  c[1] = 1.0;
+  c[2] = u < 0.5 ? 1.0 : 0.0;
+  if (u >= 0.5) c[0] = 1.0;
+}
+
+/* A page of side `page` mm (margin 2) with a colour picture. */
+static lw_params colour_params(double page, int w, void (*f)(double, double, double *))
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = p.height = page;
+  p.margin = 2;
+  p.pen_width = 0.3;
+  p.min_speed = 0;
+  p.regularity = 0;
+  static int k;
+  char name[32];
+  snprintf(name, sizeof name, "col%d.png", k++);
+  snprintf(p.image, sizeof p.image, "%s", lw_test_path(name));
+  write_colour_png(p.image, w, w, f);
+  return p;
+}
+
+static void scene_of(lw_scene *sc, const lw_params *p)
+{
+  lw_error err;
+  cr_assert_eq(lw_scene_init(sc, p, &err), LW_OK, "%s", err.msg);
+}
+
+static lw_model *model_of(const lw_scene *sc, size_t n, size_t segs, double len, unsigned long seed)
+{
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, seed);
+  lw_error err;
+  lw_splines *sp = lw_init_random(sc, n, segs, len, r, &err);
+  cr_assert_not_null(sp, "%s", err.msg);
+  gsl_rng_free(r);
+  lw_model *m = lw_model_new(sc, sp, &err);
+  cr_assert_not_null(m, "%s", err.msg);
+  return m;
+}
+
+Test(layers, a_move_changes_the_energy_by_the_full_recomputation)
+{
+  /* Three pens of a palette, each with its own tone raster, potential and
+  ** turned field, and the pair term across them: every term's local
+  ** difference against the recomputation, and the running totals after
+  ** the accepted half of the moves. */
+  lw_params p = colour_params(40, 40, blotch_colours);
+  snprintf(p.ly_names, sizeof p.ly_names, "a b c");
+  p.ly_source = LW_LSRC_PALETTE;
+  snprintf(p.ly_colors, sizeof p.ly_colors, "#20a0c0 #c02060 #e0c020");
+  snprintf(p.ly_turn, sizeof p.ly_turn, "0 60 120");
+  snprintf(p.ly_pen_width, sizeof p.ly_pen_width, "0.3 0.5 0.4");
+  p.tone = 3;
+  p.tone_blur = 0.8;
+  p.potential = LW_POT_IMAGE;
+  p.potential_coef = 0.5;
+  p.field = LW_FLD_ETF;
+  p.field_coef = -0.7;
+  p.bending = 0.3;
+  p.pair = 0.02;
+  p.pair_cutoff = 2;
+  lw_scene sc;
+  scene_of(&sc, &p);
+  cr_assert_eq(sc.layers.n, 3);
+  lw_model *m = model_of(&sc, 45, 3, 3, 11);
+  lw_proposal *pr = lw_proposal_new(m, NULL);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 12);
+  double term0[LW_TERM_COUNT], term1[LW_TERM_COUNT];
+  double e0 = lw_energy_compute(&sc, m->sp, term0, NULL);
+  cr_assert(term0[LW_TERM_TONE] > 0.0 && term0[LW_TERM_FIELD] != 0.0);
+  lw_node nd[8];
+  int checked = 0;
+  for (int trial = 0; trial < 240; trial++) {
+    uint32_t i = (uint32_t)gsl_rng_uniform_int(r, m->sp->n_splines);
+    size_t nn = m->sp->first[i + 1] - m->sp->first[i], node0 = 0, n_node = nn;
+    const lw_node *src = &m->sp->node[m->sp->first[i]];
+    int kind = trial % 3;
+    if (kind < 2) {
+      node0 = gsl_rng_uniform_int(r, nn);
+      n_node = 1;
+    }
+    double dx = gsl_ran_gaussian(r, 0.7), dy = gsl_ran_gaussian(r, 0.7);
+    for (size_t k = 0; k < n_node; k++) {
+      nd[k] = src[node0 + k];
+      if (kind == 1) {
+        nd[k].vx += dx;
+        nd[k].vy += dy;
+      } else {
+        nd[k].px += dx;
+        nd[k].py += dy;
+      }
+    }
+    lw_model_propose(m, pr, i, node0, n_node, nd);
+    lw_splines *moved = lw_splines_clone(m->sp);
+    memcpy(&moved->node[moved->first[i] + node0], nd, n_node * sizeof *nd);
+    double e1 = lw_energy_compute(&sc, moved, term1, NULL);
+    lw_splines_free(moved);
+    if (!isfinite(e1) || !isfinite(pr->dE)) continue;
+    checked++;
+    for (int t = 0; t < LW_TERM_COUNT; t++)
+      cr_assert(fabs(pr->dterm[t] - (term1[t] - term0[t])) <= 1e-9 * fmax(fabs(term0[t]), 1e-3),
+                "trial %d term %s: local %.17g, full %.17g", trial, lw_term_names[t], pr->dterm[t],
+                term1[t] - term0[t]);
+    if (trial % 2) {
+      cr_assert_eq(lw_model_commit(m, pr), LW_OK);
+      e0 = e1;
+      memcpy(term0, term1, sizeof term0);
+    }
+  }
+  cr_assert(checked > 100, "only %d finite moves", checked);
+  cr_assert(fabs(lw_model_total(m) - e0) <= 1e-9 * fabs(e0));
+  gsl_rng_free(r);
+  lw_proposal_free(pr);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+static double blotches(double u, double v) { return 0.5 + 0.4 * sin(7 * u + 2 * v) * cos(5 * v - 3 * u * u); }
+
+Test(layers, one_whole_range_layer_is_the_scene_without_layers)
+{
+  /* tone_min 0, tone_max 1, no turn, the output pen: the layer's target is
+  ** the picture's tone bit for bit, so every term is the same double. */
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = p.height = 40;
+  p.margin = 2;
+  p.min_speed = p.regularity = 0;
+  float g[30 * 30];
+  for (int j = 0; j < 30; j++)
+    for (int i = 0; i < 30; i++) g[j * 30 + i] = (float)blotches((i + 0.5) / 30, (j + 0.5) / 30);
+  snprintf(p.image, sizeof p.image, "%s", lw_test_path("grey.png"));
+  lw_test_png(p.image, 30, 30, g, NULL);
+  p.tone = 2;
+  p.potential = LW_POT_IMAGE;
+  p.potential_coef = 0.4;
+  p.field = LW_FLD_ETF;
+  p.field_coef = -0.5;
+  p.bending = 0.2;
+  lw_scene plain, one;
+  scene_of(&plain, &p);
+  snprintf(p.ly_names, sizeof p.ly_names, "all");
+  scene_of(&one, &p);
+  lw_model *m = model_of(&plain, 40, 3, 3, 4);
+  double a[LW_TERM_COUNT], b[LW_TERM_COUNT];
+  double ea = lw_energy_compute(&plain, m->sp, a, NULL), eb = lw_energy_compute(&one, m->sp, b, NULL);
+  for (int t = 0; t < LW_TERM_COUNT; t++) cr_assert_eq(a[t], b[t], "%s: %.17g and %.17g", lw_term_names[t], a[t], b[t]);
+  cr_assert_eq(ea, eb);
+  /* the same number of splines from a coverage, and twice as many for two
+  ** such layers (each layer's ink in its own pen) */
+  p.splines = 0;
+  p.coverage = 0.4;
+  size_t n_plain, n_one, n_two;
+  lw_error err;
+  cr_assert_eq(lw_init_count(&plain, &p, &n_plain, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_init_count(&one, &p, &n_one, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(n_plain, n_one);
+  lw_scene two;
+  snprintf(p.ly_names, sizeof p.ly_names, "all again");
+  scene_of(&two, &p);
+  cr_assert_eq(lw_init_count(&two, &p, &n_two, &err), LW_OK, "%s", err.msg);
+  cr_assert(n_two >= 2 * n_one - 1 && n_two <= 2 * n_one + 1, "%zu and %zu", n_one, n_two);
+  lw_scene_clear(&two);
+  snprintf(p.ly_names, sizeof p.ly_names, "all");
+  /* and a narrower range asks for less ink: the tone term sees it */
+  lw_scene half;
+  snprintf(p.ly_tone_max, sizeof p.ly_tone_max, "0.5");
+  scene_of(&half, &p);
+  lw_energy_compute(&half, m->sp, b, NULL);
+  cr_assert_neq(a[LW_TERM_TONE], b[LW_TERM_TONE]);
+  lw_model_free(m);
+  lw_scene_clear(&plain);
+  lw_scene_clear(&one);
+  lw_scene_clear(&half);
+}
+
+/* Mean |cos| between the tangents of layer k's splines and (ux, uy),
+** weighted by length. */
+static double alignment(const lw_model *m, int k, double ux, double uy)
+{
+  double s = 0.0, w = 0.0;
+  lw_samples smp;
+  for (size_t g = 0; g < m->sp->n_segments; g++) {
+    if (lw_layers_of(&m->scene->layers, m->sp->seg_spline[g]) != k) continue;
+    const lw_node *a = &m->sp->node[lw_segment_node(m->sp, g)];
+    lw_segment_sample(&m->scene->quad, a, a + 1, &smp);
+    for (int q = 0; q < smp.n; q++) {
+      if (!(smp.speed[q] > 0)) continue;
+      s += smp.dl[q] * fabs(smp.dx[q] * ux + smp.dy[q] * uy) / smp.speed[q];
+      w += smp.dl[q];
+    }
+  }
+  return s / w;
+}
+
+Test(layers, hatching_layers_follow_their_own_fields)
+{
+  /* A constant field along x; layer `across` turns it by 90 degrees.  The
+  ** splines start at random angles (placed by a scene without the field),
+  ** so the layers must turn them: after annealing each layer lies along
+  ** its own direction (mean |cos| > 0.95, where a random direction gives
+  ** 2 / pi = 0.64) and across the other's. */
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = p.height = 60;
+  p.margin = 3;
+  p.strain = 5;
+  p.bending = 0.5;
+  p.boundary_coef = 0.05;
+  p.min_speed = p.regularity = 0;
+  lw_scene plain, sc;
+  scene_of(&plain, &p);
+  p.field = LW_FLD_CONSTANT;
+  p.field_angle = 0;
+  p.field_coef = -2;
+  snprintf(p.ly_names, sizeof p.ly_names, "along across");
+  snprintf(p.ly_turn, sizeof p.ly_turn, "0 90");
+  scene_of(&sc, &p);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 9);
+  lw_error err;
+  lw_splines *sp = lw_init_random(&plain, 30, 3, 4, r, &err);
+  cr_assert_not_null(sp, "%s", err.msg);
+  gsl_rng_free(r);
+  lw_model *m = lw_model_new(&sc, sp, &err);
+  cr_assert_not_null(m, "%s", err.msg);
+  cr_assert(alignment(m, 1, 0, 1) < 0.85 && alignment(m, 0, 1, 0) < 0.85, "the start is at random angles");
+  const double w[4] = {0.4, 0.3, 0.1, 0.2}, st[4] = {0.5, 0.5, 0.5, 0.3}, tg[4] = {0.44, 0.44, 0.3, 0.3};
+  lw_chain *c = model_chain(m, w, st, tg, 5, &err);
+  cr_assert_not_null(c, "%s", err.msg);
+  for (int s = 0; s < 300; s++) {
+    c->temperature = 0.5 * pow(0.002 / 0.5, s / 299.0);
+    c->tuning = s < 150;
+    cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  }
+  double a0 = alignment(m, 0, 1, 0), a1 = alignment(m, 1, 0, 1);
+  cr_assert(a0 > 0.95, "layer along: %g", a0);
+  cr_assert(a1 > 0.95, "layer across: %g", a1);
+  cr_assert(alignment(m, 1, 1, 0) < 0.3, "layer across is not along x");
+  model_chain_free(c);
+  lw_model_free(m);
+  /* and the placement starts each layer along its own field already */
+  m = model_of(&sc, 30, 3, 4, 9);
+  cr_assert(alignment(m, 0, 1, 0) > 0.99 && alignment(m, 1, 0, 1) > 0.99, "%g %g", alignment(m, 0, 1, 0),
+            alignment(m, 1, 0, 1));
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+  lw_scene_clear(&plain);
+}
+
+Test(layers, each_layer_gets_splines_by_its_share_of_the_ink)
+{
+  /* Shares 0.7, 0, 0.3: the golden-ratio sequence gives layer k its share
+  ** of any number of splines to within a few splines, none to a layer
+  ** without ink. */
+  lw_layers_spec ls = {.n = 3, .cum = {0, 0.7, 0.7, 1.0}};
+  for (size_t n = 10; n <= 10000; n *= 10) {
+    size_t count[3] = {0};
+    for (size_t i = 0; i < n; i++) count[lw_layers_of(&ls, i)]++;
+    cr_assert_eq(count[1], 0);
+    cr_assert(fabs((double)count[0] - 0.7 * n) <= 2 + log((double)n), "n %zu: %zu in layer 0", n, count[0]);
+  }
+}
+
+Test(layers, the_gradient_reads_each_layers_field_and_potential)
+{
+  /* Layers with turned fields and their own potentials: the gradient of
+  ** field + potential + bending matches central differences of
+  ** lw_energy_compute (which reads each spline's layer) for every
+  ** coordinate of a few splines of each layer. */
+  lw_params p = colour_params(40, 40, blotch_colours);
+  snprintf(p.ly_names, sizeof p.ly_names, "a b");
+  p.ly_source = LW_LSRC_PALETTE;
+  snprintf(p.ly_colors, sizeof p.ly_colors, "#20a0c0 #c02060");
+  snprintf(p.ly_turn, sizeof p.ly_turn, "30 100");
+  p.potential = LW_POT_IMAGE;
+  p.potential_coef = 0.5;
+  p.field = LW_FLD_CONSTANT;
+  p.field_angle = 10;
+  p.field_mode = LW_FIELDMODE_SIGNED;
+  p.field_coef = -0.7;
+  p.bending = 0.3;
+  lw_scene sc;
+  scene_of(&sc, &p);
+  lw_model *m = model_of(&sc, 8, 2, 3, 3);
+  lw_splines *sp = lw_splines_clone(m->sp);
+  lw_node *g = calloc(sp->n_nodes, sizeof *g);
+  lw_error err;
+  double term[LW_TERM_COUNT];
+  cr_assert(isfinite(lw_energy_gradient(&sc, sp, LW_GRAD_ALL, g, term, &err)), "%s", err.msg);
+  const double h = 1e-6;
+  for (size_t k = 0; k < sp->n_nodes; k++)
+    for (int c = 0; c < 4; c++) {
+      double *x = &sp->node[k].px + c, x0 = *x, tp[LW_TERM_COUNT], tm[LW_TERM_COUNT];
+      *x = x0 + h;
+      double ep = lw_energy_compute(&sc, sp, tp, NULL);
+      *x = x0 - h;
+      double em = lw_energy_compute(&sc, sp, tm, NULL);
+      *x = x0;
+      double fd = (ep - em) / (2 * h), an = (&g[k].px)[c];
+      cr_assert(fabs(fd - an) <= 1e-4 * fmax(1.0, fabs(fd)), "node %zu coordinate %d: analytic %g, differences %g", k,
+                c, an, fd);
+    }
+  free(g);
+  lw_splines_free(sp);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+/* ---- separation --------------------------------------------------------- */
+
+/* Smallest eigenvalue of U^T U for the pens rgb (k <= 3, independent). */
+static double smallest_eigen(const unsigned char (*rgb)[3], int k)
+{
+  gsl_matrix *M = gsl_matrix_alloc((size_t)k, (size_t)k);
+  for (int i = 0; i < k; i++)
+    for (int j = 0; j < k; j++) {
+      double s = 0;
+      for (int c = 0; c < 3; c++) s += (1 - rgb[i][c] / 255.0) * (1 - rgb[j][c] / 255.0);
+      gsl_matrix_set(M, (size_t)i, (size_t)j, s);
+    }
+  gsl_vector *ev = gsl_vector_alloc((size_t)k);
+  gsl_eigen_symm_workspace *ws = gsl_eigen_symm_alloc((size_t)k);
+  gsl_eigen_symm(M, ev, ws);
+  double mn = gsl_vector_min(ev);
+  gsl_eigen_symm_free(ws);
+  gsl_vector_free(ev);
+  gsl_matrix_free(M);
+  return mn;
+}
+
+Test(layers, a_palette_separation_recovers_the_pen_coverages_a_picture_was_mixed_from)
+{
+  /* Pixels mixed from three pens at known coverages a (c = 1 - U a): the
+  ** separation gives a back, up to the pull of the ridge and the ink
+  ** penalty, (lambda |a| + mu sqrt(3)) / s_min (s_min the smallest
+  ** eigenvalue of U^T U), and the float rounding of c (6e-8 a channel,
+  ** amplified by at most 1 / sqrt(s_min)). */
+  const unsigned char pens[3][3] = {{0x20, 0x90, 0xc0}, {0xc0, 0x30, 0x70}, {0xe0, 0xc0, 0x20}};
+  const double smin = smallest_eigen(pens, 3);
+  cr_assert(smin > 0.01, "an independent palette");
+  enum { N = 2000 };
+  static float r[N], g[N], b[N], got[3 * N], want[3 * N];
+  rng_seed(17);
+  for (int p = 0; p < N; p++) {
+    double a[3], c[3] = {1, 1, 1};
+    for (int k = 0; k < 3; k++) a[k] = want[k * N + p] = (float)urand(0, 0.45);
+    for (int k = 0; k < 3; k++)
+      for (int ch = 0; ch < 3; ch++) c[ch] -= a[k] * (1 - pens[k][ch] / 255.0);
+    r[p] = (float)c[0];
+    g[p] = (float)c[1];
+    b[p] = (float)c[2];
+    cr_assert(c[0] >= 0 && c[1] >= 0 && c[2] >= 0);
+  }
+  lw_layers_separate(r, g, b, N, 3, pens, got);
+  const double tol = (LW_LAYERS_RIDGE * sqrt(3) * 0.45 + LW_LAYERS_INK * sqrt(3)) / smin + 4 * 6e-8 / sqrt(smin) + 1e-7;
+  double worst = 0;
+  for (int k = 0; k < 3 * N; k++) worst = fmax(worst, fabs(got[k] - want[k]));
+  cr_assert(worst <= tol, "largest error %g, bound %g", worst, tol);
+}
+
+Test(layers, the_separation_is_the_bounded_least_squares_minimum)
+{
+  /* Five pens (dependent: more pens than channels) and colours no mix
+  ** reaches: the coverages satisfy the optimality conditions of
+  ** min |U a - d|^2 + lambda |a|^2 over [0, 1]^5 -- gradient 0 where
+  ** 0 < a < 1, pointing outward where a sits on a bound (layers.h). */
+  const unsigned char pens[5][3] = {{0, 255, 255}, {255, 0, 255}, {255, 255, 0}, {0, 0, 0}, {200, 40, 40}};
+  enum { N = 500 };
+  static float r[N], g[N], b[N], a[5 * N];
+  rng_seed(23);
+  for (int p = 0; p < N; p++) {
+    r[p] = (float)urand(0, 1);
+    g[p] = (float)urand(0, 1);
+    b[p] = (float)urand(0, 1);
+  }
+  lw_layers_separate(r, g, b, N, 5, pens, a);
+  for (int p = 0; p < N; p++) {
+    double d[3] = {1 - r[p], 1 - g[p], 1 - b[p]}, res[3];
+    for (int ch = 0; ch < 3; ch++) {
+      res[ch] = -d[ch];
+      for (int k = 0; k < 5; k++) res[ch] += (1 - pens[k][ch] / 255.0) * a[k * N + p];
+    }
+    for (int k = 0; k < 5; k++) {
+      double grad = LW_LAYERS_RIDGE * a[k * N + p] + LW_LAYERS_INK;
+      for (int ch = 0; ch < 3; ch++) grad += (1 - pens[k][ch] / 255.0) * res[ch];
+      double ak = a[k * N + p];
+      /* float storage of a moves the gradient by at most |U^T U| 6e-8 */
+      const double tol = 1e-6;
+      if (ak > 1e-6 && ak < 1 - 1e-6) cr_assert(fabs(grad) <= tol, "pixel %d pen %d: a %g, gradient %g", p, k, ak, grad);
+      else if (ak <= 1e-6) cr_assert(grad >= -tol, "pixel %d pen %d at 0: gradient %g", p, k, grad);
+      else cr_assert(grad <= tol, "pixel %d pen %d at 1: gradient %g", p, k, grad);
+    }
+  }
+}
+
+Test(layers, cmyk_draws_a_grey_in_black_and_a_colour_in_its_process_inks)
+{
+  const unsigned char cmyk[4][3] = {{0, 255, 255}, {255, 0, 255}, {255, 255, 0}, {0, 0, 0}};
+  float r[2] = {0.4f, 0.0f}, g[2] = {0.4f, 1.0f}, b[2] = {0.4f, 1.0f}, a[8];
+  lw_layers_separate(r, g, b, 2, 4, cmyk, a);
+  /* grey 0.4: black 0.6, no colour (the ink penalty prefers one unit of
+  ** black to three of colour) */
+  cr_assert(fabs(a[3 * 2 + 0] - 0.6) < 1e-4 && a[0] < 1e-4 && a[2] < 1e-4 && a[4] < 1e-4, "%g %g %g %g", a[0],
+            a[2], a[4], a[6]);
+  /* cyan: all cyan */
+  cr_assert(fabs(a[1] - 1.0) < 1e-4 && a[3] < 1e-4 && a[5] < 1e-4 && a[7] < 1e-4);
+}
+
+Test(layers, a_cmyk_scene_gives_each_pen_its_separation_as_target)
+{
+  /* Cyan on the left half, yellow on the right: the cyan layer's target
+  ** is full ink (tone 0) on the left and none on the right, the yellow
+  ** one's the other way round, magenta and black none anywhere. */
+  lw_params p = colour_params(40, 32, cyan_yellow);
+  snprintf(p.ly_names, sizeof p.ly_names, "c m y k");
+  p.ly_source = LW_LSRC_CMYK;
+  p.tone = 1;
+  lw_scene sc;
+  scene_of(&sc, &p);
+  cr_assert_eq(sc.layers.n, 4);
+  cr_assert_eq(sc.layers.spec[0].rgb[0], 0);
+  cr_assert_eq(sc.layers.spec[2].rgb[2], 0);
+  const lw_image *t[4];
+  for (int k = 0; k < 4; k++) t[k] = sc.layer[k].target;
+  size_t left = 16 * 32 + 4, right = 16 * 32 + 27;
+  cr_assert(t[0]->tone[left] < 1e-3 && t[0]->tone[right] > 1 - 1e-3);
+  cr_assert(t[2]->tone[left] > 1 - 1e-3 && t[2]->tone[right] < 1e-3);
+  cr_assert(t[1]->tone[left] > 1 - 1e-3 && t[3]->tone[right] > 1 - 1e-3);
+  /* each layer's tone target is its own */
+  cr_assert_neq(sc.layer[0].tone.dark[(size_t)(sc.layer[0].tone.pad + 16) * (size_t)sc.layer[0].tone.w +
+                                      (size_t)sc.layer[0].tone.pad + 4],
+                sc.layer[2].tone.dark[(size_t)(sc.layer[2].tone.pad + 16) * (size_t)sc.layer[2].tone.w +
+                                      (size_t)sc.layer[2].tone.pad + 4]);
+  lw_scene_clear(&sc);
+}
+
+/* ---- drawing ------------------------------------------------------------ */
+
+Test(layers, the_preview_lays_inks_over_each_other)
+{
+  /* A cyan line across a yellow one: with multiply the crossing is green,
+  ** as inks on paper, where painting over would leave it yellow. */
+  size_t segs[2] = {1, 1};
+  lw_splines *sp = lw_splines_new(2, segs, NULL);
+  lw_test_straight(sp, 0, 2, 10, 18, 10);
+  lw_test_straight(sp, 1, 10, 2, 10, 18);
+  lw_output_page page;
+  lw_output_page_init(&page, 20, 20);
+  page.n_pens = 2;
+  page.multiply = 1;
+  unsigned char cy[3] = {0, 255, 255}, ye[3] = {255, 255, 0};
+  page.pen[0] = (lw_output_pen){1.0, {cy[0], cy[1], cy[2]}};
+  page.pen[1] = (lw_output_pen){1.0, {ye[0], ye[1], ye[2]}};
+  lw_plot *pl = lw_plot_new(sp, 2, NULL, LW_PLOT_ORDER_NONE, 0, 0, NULL);
+  cr_assert_not_null(pl);
+  const char *path = lw_test_path("cross.png");
+  lw_error err;
+  cr_assert_eq(lw_output_png(sp, &page, pl, NULL, 10, path, &err), LW_OK, "%s", err.msg);
+  cairo_surface_t *s = cairo_image_surface_create_from_png(path);
+  cr_assert_eq(cairo_surface_status(s), CAIRO_STATUS_SUCCESS);
+  const unsigned char *d = cairo_image_surface_get_data(s);
+  int stride = cairo_image_surface_get_stride(s);
+#define PX(x, y, c) d[(size_t)(y) * (size_t)stride + 4 * (size_t)(x) + (2 - (c))]
+  cr_assert(PX(100, 100, 0) < 30 && PX(100, 100, 1) > 225 && PX(100, 100, 2) < 30, "crossing %d %d %d",
+            PX(100, 100, 0), PX(100, 100, 1), PX(100, 100, 2));
+  cr_assert(PX(50, 100, 0) < 30 && PX(50, 100, 2) > 225, "cyan alone");
+  cr_assert(PX(100, 50, 0) > 225 && PX(100, 50, 2) < 30, "yellow alone");
+#undef PX
+  cairo_surface_destroy(s);
+  lw_plot_free(pl);
+  lw_splines_free(sp);
+}
+
+/* Runs "cd DIR && linewise <args>", stderr into errs; the exit status. */
+static int run(const char *args, char *errs, size_t nerr)
+{
+  char cmd[2048];
+  snprintf(cmd, sizeof cmd, "cd %s && %s %s >/dev/null 2>%s", lw_test_dir, lw_test_bin(), args,
+           lw_test_path("err.txt"));
+  int st = system(cmd);
+  FILE *f = fopen(lw_test_path("err.txt"), "r");
+  size_t n = fread(errs, 1, nerr - 1, f);
+  errs[n] = '\0';
+  fclose(f);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static const char colour_scene[] =
+  "[scene]\nwidth = 40\nheight = 40\nmargin = 2\nimage = colour.png\nfield = etf\n"
+  "[init]\nsplines = 40\nsegments = 2\nsegment_length = 3\n"
+  "[energy]\nstrain = 5\nbending = 1\nfield = -0.5\ntone = 2\nboundary = 0.1\n"
+  "[anneal]\nsweeps = 3\nsteps = 1\n[plot]\nmin_length = 0\n"
+  "[layers]\nnames = c m y k\nsource = cmyk\npen_width = 0.3 0.3 0.3 0.5\n";
+
+static char *slurp(const char *path)
+{
+  FILE *f = fopen(path, "rb");
+  cr_assert_not_null(f, "%s", path);
+  static char buf[1 << 20];
+  size_t n = fread(buf, 1, sizeof buf - 1, f);
+  buf[n] = '\0';
+  fclose(f);
+  return buf;
+}
+
+Test(layers, the_svg_has_one_group_a_pen_with_its_colour_and_width)
+{
+  write_colour_png(lw_test_path("colour.png"), 32, 32, blotch_colours);
+  lw_test_write(lw_test_path("scene.ini"), colour_scene, strlen(colour_scene));
+  char errs[4096];
+  cr_assert_eq(run("run scene.ini --out out --quiet", errs, sizeof errs), 0, "%s", errs);
+  char path[512];
+  snprintf(path, sizeof path, "%s", lw_test_path("out/final.svg"));
+  const char *svg = slurp(path);
+  static const char *const colour[4] = {"#00ffff", "#ff00ff", "#ffff00", "#000000"};
+  static const char *const width[4] = {"0.3", "0.3", "0.3", "0.5"};
+  int groups = 0;
+  for (const char *c = svg; (c = strstr(c, "<g ")); c++) groups++;
+  cr_assert_eq(groups, 4, "one group a pen");
+  for (int k = 0; k < 4; k++) {
+    char id[32], head[64], stroke[64];
+    snprintf(id, sizeof id, "id=\"pen%d\"", k + 1);
+    const char *g = strstr(svg, id), *next = k < 3 ? strstr(svg, (snprintf(head, sizeof head, "id=\"pen%d\"", k + 2), head)) : svg + strlen(svg);
+    cr_assert_not_null(g, "%s", id);
+    snprintf(head, sizeof head, "inkscape:label=\"%c (%s mm)\" id=\"pen%d\"", "cmyk"[k], width[k], k + 1);
+    cr_assert_not_null(strstr(svg, head), "%s", head);
+    /* every path of the group in the pen's colour and width */
+    snprintf(stroke, sizeof stroke, "stroke=\"%s\" stroke-width=\"%s\"", colour[k], width[k]);
+    int paths = 0;
+    for (const char *c = g; (c = strstr(c, "<path")) && c < next; c++) {
+      const char *end = strstr(c, "/>");
+      cr_assert(strstr(c, stroke) && strstr(c, stroke) < end, "pen %d: a path without %s", k + 1, stroke);
+      paths++;
+    }
+    if (k < 3) cr_assert(paths > 0, "pen %d draws", k + 1);
+  }
+  snprintf(path, sizeof path, "%s", lw_test_path("out/summary.json"));
+  const char *js = slurp(path);
+  const char *pens = strstr(js, "\"pens\"");
+  cr_assert_not_null(pens, "fidelity per layer");
+  int n = 0;
+  for (const char *c = pens; (c = strstr(c, "\"ssim\"")); c++) n++;
+  cr_assert_eq(n, 4, "one score a layer");
+}
+
+Test(layers, bad_layer_keys_give_one_line_with_file_line_and_key_and_exit_2)
+{
+  write_colour_png(lw_test_path("colour.png"), 16, 16, blotch_colours);
+  static const struct {
+    const char *text, *want;
+  } cases[] = {
+    {"[layers]\nnames = a b\nturn = 0 90 45\n", "scene.ini:10: key 'layers.turn': expected 2 numbers"},
+    {"[layers]\nnames = a b\ncolors = #000 #12\n", "scene.ini:10: key 'layers.colors': expected 2 colours"},
+    {"[layers]\nnames = a b c\nsource = cmyk\n", "scene.ini:10: key 'layers.source': 'cmyk' needs 4 layers"},
+    {"[layers]\nnames = a\nsource = palette\n", "scene.ini:10: key 'layers.source': 'palette' needs layers.colors"},
+    {"[layers]\nnames = a b\ntone_min = 0 0.6\ntone_max = 1 0.5\n",
+     "scene.ini:11: key 'layers.tone_max': expected layers.tone_min < layers.tone_max"},
+    {"[layers]\nturn = 0 90\n", "scene.ini:9: key 'layers.turn': needs layers.names"},
+    {"[layers]\nnames = a b\npen_width = 0.3 -1\n", "scene.ini:10: key 'layers.pen_width': expected values"},
+    {"[layers]\nnames = a b\n[output]\npens = 3\n", "scene.ini:11: key 'output.pens': layers set the pens"},
+    {"[layers]\nnames = a <b>\n", "scene.ini:9: key 'layers.names': expected names of letters"},
+    {"[layers]\nnames = ,\n", "scene.ini:9: key 'layers.names': expected at least one name"},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    char text[1024], errs[4096];
+    snprintf(text, sizeof text,
+             "[scene]\nwidth = 30\nheight = 30\nimage = colour.png\n[init]\nsplines = 5\n\n%s", cases[k].text);
+    lw_test_write(lw_test_path("bad.ini"), text, strlen(text));
+    char args[256];
+    snprintf(args, sizeof args, "run bad.ini --out bad%zu", k);
+    cr_assert_eq(run(args, errs, sizeof errs), 2, "case %zu: %s", k, errs);
+    cr_assert_not_null(strstr(errs, cases[k].want + strlen("scene.ini")), "case %zu: %s", k, errs);
+    cr_assert_not_null(strstr(errs, "bad.ini:"), "case %zu names the file: %s", k, errs);
+    cr_assert_eq(strchr(errs, '\n'), errs + strlen(errs) - 1, "case %zu: one line: %s", k, errs);
+    char dir[256];
+    struct stat sb;
+    snprintf(dir, sizeof dir, "%s/bad%zu/final.svg", lw_test_dir, k);
+    cr_assert_neq(stat(dir, &sb), 0, "case %zu wrote nothing", k);
+  }
+}
