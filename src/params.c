@@ -37,6 +37,11 @@ const lw_param_def lw_param_table[] = {
          "[tempering] with replicas); `dynamics` integrates its Lagrangian equations of motion "
          "(the [dynamics] section; docs/NUMERICS.md, \"Dynamics\"): a sweep is then "
          "`dynamics.steps_per_sweep` time steps and `anneal.sweeps` counts them."),
+  CHOICE("scene", "preset", preset, "none", "none|photo",
+         "Settings that fill every key the scene leaves unset: `photo` draws a picture as a "
+         "tone of lines, sized from output.pen_width and the page rather than in fixed "
+         "millimetres, so one scene works from A6 to A3 (docs/IMAGES.md, \"Photographs\", lists "
+         "what it sets). Keys the scene or --set gives win."),
   CHOICE("scene", "page", page, "custom", "custom|a4|a3|letter",
          "Page size: `custom` takes `width` and `height`; a4 is 210 x 297 mm, a3 297 x 420 mm, "
          "letter 215.9 x 279.4 mm (portrait). A named page sets width and height; setting "
@@ -181,6 +186,10 @@ const lw_param_def lw_param_table[] = {
       "Standard deviation of the tone term's blur: the scale at which ink is averaged into tone. "
       "Keep it above the distance between quadrature samples (segment_length / quadrature) so "
       "a line reads as a line, not a row of dots; its cost grows as its square in pixels."),
+  NUM("energy", "tone_ink", LW_PT_DOUBLE, tone_ink, "1", "", 0, 1, LW_MIN_OPEN,
+      "The share of the paper that ink covers where the picture is black: the tone term's "
+      "target is tone_ink * darkness. Below 1 the darks are drawn as dense lines rather than "
+      "solid ink, so lines keep their own width apart (1/tone_ink pen widths at black)."),
   NUM("energy", "min_spacing", LW_PT_DOUBLE, min_spacing, "0", "mm", 0, 1e7, 0,
       "Least distance between pair samples of different splines, a hard constraint: a move that "
       "brings more of its samples closer than this to another spline than it had is refused "
@@ -732,6 +741,64 @@ lw_status lw_params_read(lw_params *p, const char *path, lw_error *err)
 ** scene.page (custom first, which has none). */
 static const double page_mm[][2] = {{0, 0}, {210, 297}, {297, 420}, {215.9, 279.4}};
 
+/*
+** scene.preset = photo: lengths in pen widths w (the line's own scale), the
+** domain lattice from the page.  Found on the bundled picture on A4 at
+** w = 0.35 (docs/IMAGES.md, "Photographs"): segments of 8 w keep a line
+** supple at the picture's detail; tone_ink 0.5 with coverage 0.4 draws black
+** as lines two pen widths apart, so strokes keep apart (close_share under
+** 10 %), and the hard min_spacing of one pen width keeps them from merging;
+** the near field is off (the constraint keeps samples apart, and it costs
+** most of a proposal).
+*/
+static const struct {
+  const char *section, *key, *text; /* text, or NULL: pens * w */
+  double pens;
+} photo_preset[] = {
+    {"scene", "field", "etf", 0},          {"scene", "field_sigma", NULL, 4},
+    {"init", "splines", "0", 0},           {"init", "coverage", "0.4", 0},
+    {"init", "segments", "5", 0},          {"init", "segment_length", NULL, 8},
+    {"energy", "strain", "20", 0},         {"energy", "bending", "2", 0},
+    {"energy", "field", "-1", 0},          {"energy", "field_mode", "axial", 0},
+    {"energy", "tone", "5", 0},            {"energy", "tone_blur", NULL, 3},
+    {"energy", "tone_ink", "0.5", 0},      {"energy", "pair", "0.01", 0},
+    {"energy", "pair_cutoff", NULL, 3},    {"energy", "pair_near", "0", 0},
+    {"energy", "min_spacing", NULL, 1},    {"energy", "quadrature", "6", 0},
+    {"energy", "boundary", "0.2", 0},      {"anneal", "schedule", "geometric", 0},
+    {"anneal", "t_start", "0.5", 0},       {"anneal", "t_end", "0.002", 0},
+    {"anneal", "sweeps", "120", 0},        {"anneal", "steps", "5", 0},
+};
+
+/* Sets an unset key from text; the key stays unset (line 0), so a later
+** resolve recomputes it from the pen width and page then current. */
+static void preset_key(lw_params *p, const char *section, const char *key, const char *text)
+{
+  const lw_param_def *d = lw_params_find(section, key);
+  char expected[256];
+  if (d && !p->line[d - lw_param_table]) assign(p, d, text, expected, sizeof expected);
+}
+
+static void apply_preset(lw_params *p)
+{
+  if (p->preset != LW_PRESET_PHOTO) return;
+  const double w = p->pen_width;
+  char text[64];
+  for (size_t k = 0; k < sizeof photo_preset / sizeof photo_preset[0]; k++) {
+    const char *t = photo_preset[k].text;
+    if (!t) {
+      snprintf(text, sizeof text, "%.17g", photo_preset[k].pens * w);
+      t = text;
+    }
+    preset_key(p, photo_preset[k].section, photo_preset[k].key, t);
+  }
+  /* domains of at least 140 w (3.5 splines of 5 segments of 8 w: a move's
+  ** reach is one spline and the cutoff), so few splines wait on their edges */
+  double side = fmin(p->width, p->height) - 2.0 * p->margin;
+  int n = (int)floor(side / (140.0 * w));
+  snprintf(text, sizeof text, "%d", n < 1 ? 1 : (n > 64 ? 64 : n));
+  preset_key(p, "anneal", "domains", n < 2 ? "off" : text);
+}
+
 lw_status lw_params_resolve(lw_params *p, lw_error *err)
 {
   char where[LW_PATH_MAX + 32], where_page[LW_PATH_MAX + 32];
@@ -761,6 +828,7 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
       *value[k] = want[k];
     }
   }
+  apply_preset(p);
   unsigned char rgb[LW_PLOT_PENS_MAX][3];
   if (p->pen_colors[0] && lw_output_colors_parse(p->pen_colors, rgb, LW_PLOT_PENS_MAX) != p->pens) {
     lw_params_origin(p, lw_params_find("output", "pen_colors"), where, sizeof where);

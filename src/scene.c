@@ -298,7 +298,7 @@ static lw_status build_layers(lw_scene *sc, const lw_params *p, lw_error *err)
     if (sc->on[LW_TERM_TONE]) {
       lw_error e2;
       if ((st = lw_tone_init(&l->tone, l->target, &sc->image_place, p->tone_blur, sc->layers.spec[k].pen_width,
-                             &e2)))
+                             p->tone_ink, &e2)))
         return st == LW_EINPUT ? bad_key(p, "energy", "tone_blur", st, err, "%s", e2.msg)
                                : lw_error_set(err, st, "%s", e2.msg);
     }
@@ -406,7 +406,7 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   if (sc->on[LW_TERM_TONE]) {
     if (!sc->image) return bad_key(p, "energy", "tone", LW_EINPUT, err, "the tone term needs scene.image");
     lw_error e2;
-    if ((st = lw_tone_init(&sc->tone, sc->image, &sc->image_place, p->tone_blur, p->pen_width, &e2)))
+    if ((st = lw_tone_init(&sc->tone, sc->image, &sc->image_place, p->tone_blur, p->pen_width, p->tone_ink, &e2)))
       return st == LW_EINPUT ? bad_key(p, "energy", "tone_blur", st, err, "%s", e2.msg)
                              : lw_error_set(err, st, "%s", e2.msg);
   }

@@ -9,7 +9,7 @@
 #include <string.h>
 
 lw_status lw_tone_init(lw_tone *t, const lw_image *img, const lw_image_place *pl, double sigma, double pen,
-                       lw_error *err)
+                       double ink, lw_error *err)
 {
   memset(t, 0, sizeof *t);
   double r = ceil(3.0 * sigma / pl->pixel);
@@ -32,7 +32,7 @@ lw_status lw_tone_init(lw_tone *t, const lw_image *img, const lw_image_place *pl
   for (int j = 0; j < img->height; j++)
     for (int i = 0; i < img->width; i++)
       t->dark[(size_t)(j + t->pad) * (size_t)t->w + (size_t)(i + t->pad)] =
-          1.0f - img->tone[(size_t)j * (size_t)img->width + (size_t)i];
+          (float)(ink * (1.0 - img->tone[(size_t)j * (size_t)img->width + (size_t)i]));
   /* The same blur on both sides: G * ink cannot be sharper than G, so a
   ** sharp target would ask for ink piled along every edge (the picture's
   ** rim included) to make up for the blur. */

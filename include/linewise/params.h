@@ -57,6 +57,7 @@ enum { LW_PPATTERN_CLOUD, LW_PPATTERN_PLANE, LW_PPATTERN_SPHERE };
 enum { LW_PWEIGHT_POLY, LW_PWEIGHT_GAUSS, LW_PWEIGHT_ANISO };
 enum { LW_PBOUNDARY_NONE, LW_PBOUNDARY_PLANE, LW_PBOUNDARY_SPHERE };
 enum { LW_DRIVER_METROPOLIS, LW_DRIVER_DYNAMICS };
+enum { LW_PRESET_NONE, LW_PRESET_PHOTO };
 enum { LW_PIN_NONE, LW_PIN_ENDS, LW_PIN_FIRST, LW_PIN_LAST };
 enum { LW_INTEGRATOR_LEAPFROG, LW_INTEGRATOR_REVIEW };
 enum { LW_LSRC_TONE, LW_LSRC_CMYK, LW_LSRC_PALETTE };
@@ -91,6 +92,7 @@ typedef struct {
   int mask;                   /* LW_MASK_* */
   char mask_image[LW_PATH_MAX]; /* picture of mask = image */
   int driver;                 /* LW_DRIVER_* */
+  int preset;                 /* LW_PRESET_*: fills the keys a scene leaves unset */
   /* [init] */
   int splines;                /* number of splines; 0 with coverage > 0: from the coverage */
   double coverage;            /* target ink coverage (fraction of the inside) */
@@ -110,6 +112,7 @@ typedef struct {
   int pair_quadrature;        /* pair samples per segment; 0 = quadrature */
   double tone;                /* T, energy / mm^2; 0 = off */
   double tone_blur;           /* sigma of the tone term's blur, mm */
+  double tone_ink;            /* ink fraction the darkest tone asks for */
   double min_spacing;         /* least distance between samples of different splines, mm; 0 = none */
   /* [moves] */
   double mix_point, mix_vector, mix_translate, mix_rotate; /* relative frequencies */

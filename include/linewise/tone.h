@@ -71,12 +71,12 @@ typedef struct {
   float *dark;      /* w * h target D = G * darkness in [0, 1], row-major */
 } lw_tone;
 
-/* Builds the target from the processed picture img placed at pl.  sigma >
-** 0 and pen > 0, mm.  LW_ENOMEM, or LW_EINPUT when the footprint would be
+/* Builds the target, ink times the darkness, from the processed picture img
+** placed at pl.  sigma > 0 and pen > 0, mm; 0 < ink <= 1.  LW_ENOMEM, or LW_EINPUT when the footprint would be
 ** wider than 2 LW_TONE_RADIUS_MAX + 1 pixels (sigma above 170 pixels: blur
 ** the picture instead). */
 lw_status lw_tone_init(lw_tone *t, const lw_image *img, const lw_image_place *pl, double sigma, double pen,
-                       lw_error *err);
+                       double ink, lw_error *err);
 void lw_tone_clear(lw_tone *t);
 
 /* A zeroed w * h raster, or NULL. */
