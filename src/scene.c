@@ -181,6 +181,7 @@ void lw_scene_term_ctx(const lw_scene *sc, lw_term_ctx ctx[LW_TERM_COUNT])
   ctx[LW_TERM_USER].fn = sc->user_fn;
   ctx[LW_TERM_LOAD].data = sc->load;
   ctx[LW_TERM_TONE].data = &sc->tone;
+  ctx[LW_TERM_CHEMICAL].data = sc->chem;
 }
 
 lw_status lw_scene_set_user_term(lw_scene *sc, double coef, lw_user_term_fn fn, const void *data,
@@ -210,6 +211,11 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   sc->load[0] = p->dyn_rho * p->dyn_gravity_x + p->dyn_force_x;
   sc->load[1] = p->dyn_rho * p->dyn_gravity_y + p->dyn_force_y;
   coef[LW_TERM_LOAD] = sc->load[0] != 0.0 || sc->load[1] != 0.0;
+  sc->chem[0] = p->chem_spline;
+  sc->chem[1] = p->chem_length;
+  coef[LW_TERM_CHEMICAL] = sc->chem[0] != 0.0 || sc->chem[1] != 0.0;
+  sc->transdim = !p->fixed_count;
+  sc->max_segments = (size_t)p->max_segments;
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     sc->coef[t] = coef[t];
     sc->on[t] = coef[t] != 0.0;
