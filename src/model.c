@@ -659,6 +659,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   const size_t g0 = lw_segment_index(sp, spline, 0);
 
   p->splice = 0;
+  p->log_ratio = 0.0;
   p->spline = spline;
   p->node0 = node0;
   p->n_node = n_node;

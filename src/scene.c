@@ -215,7 +215,7 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   sc->chem[1] = p->chem_length;
   coef[LW_TERM_CHEMICAL] = sc->chem[0] != 0.0 || sc->chem[1] != 0.0;
   sc->transdim = !p->fixed_count;
-  sc->max_segments = (size_t)p->max_segments;
+  sc->max_segments = (size_t)(p->max_segments > p->segments ? p->max_segments : p->segments);
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     sc->coef[t] = coef[t];
     sc->on[t] = coef[t] != 0.0;

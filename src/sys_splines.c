@@ -17,14 +17,21 @@
 #include "linewise/hilbert.h"
 #include "linewise/init.h"
 #include "linewise/splmass.h"
+#include "linewise/transdim.h"
 
 const char *const lw_move_names[LW_MOVE_KINDS] = {"point", "vector", "translate", "rotate"};
-/* steps are kept in mm and radians; [moves] step_rotate is in degrees */
-static const double move_unit[LW_MOVE_KINDS] = {1.0, 1.0, 1.0, M_PI / 180.0};
+static const char *const move_names_td[LW_MOVE_KINDS_TD] = {"point", "vector", "translate", "rotate",
+                                                            "birth", "death", "grow", "shrink"};
+/* steps are kept in mm and radians; [moves] step_rotate is in degrees; the
+** trans-dimensional kinds have no step (their proposals are transdim.h's) */
+static const double move_unit[LW_MOVE_KINDS_TD] = {1.0, 1.0, 1.0, M_PI / 180.0, 1.0, 1.0, 1.0, 1.0};
 
 typedef struct {
   lw_scene scene;
   lw_grid2d *tone;               /* the picture's tone on the page, or NULL */
+  lw_td td;                      /* the trans-dimensional proposals (scene.transdim) */
+  double log_w[4];               /* log of the birth, death, grow, shrink weights: the
+                                    Hastings factors need their ratios */
 } spl_setup;
 
 typedef struct {
@@ -56,6 +63,9 @@ static void *setup_new(const lw_params *p, lw_error *err)
   /* the target of the fidelity score and the previews' underlay */
   if (su->scene.image && !(su->tone = lw_image_tone_grid(su->scene.image, &su->scene.image_place, err)))
     goto fail;
+  lw_td_init(&su->td, &su->scene, (size_t)p->segments, p->segment_length, su->scene.max_segments);
+  const double w[4] = {p->mix_birth, p->mix_death, p->mix_grow, p->mix_shrink};
+  for (int k = 0; k < 4; k++) su->log_w[k] = log(w[k]);
   return su;
 fail:
   setup_free(su);
@@ -189,24 +199,35 @@ static void *state_copy(const void *state, lw_error *err)
 
 static void moves(const lw_params *p, double *weight, double *step, double *target)
 {
-  const double w[LW_MOVE_KINDS] = {p->mix_point, p->mix_vector, p->mix_translate, p->mix_rotate};
+  const double w[LW_MOVE_KINDS_TD] = {p->mix_point, p->mix_vector, p->mix_translate, p->mix_rotate,
+                                      p->mix_birth, p->mix_death, p->mix_grow, p->mix_shrink};
   const double st[LW_MOVE_KINDS] = {p->step_point, p->step_vector, p->step_translate, p->step_rotate};
   const double tg[LW_MOVE_KINDS] = {p->target, p->target, p->target_spline, p->target_spline};
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+  const int n = p->fixed_count ? LW_MOVE_KINDS : LW_MOVE_KINDS_TD;
+  for (int k = 0; k < n; k++) {
     weight[k] = w[k];
-    step[k] = st[k] * move_unit[k];
-    target[k] = tg[k];
+    /* a trans-dimensional kind has no step: tuning may change it, nothing reads it */
+    step[k] = k < LW_MOVE_KINDS ? st[k] * move_unit[k] : 1.0;
+    target[k] = k < LW_MOVE_KINDS ? tg[k] : p->target_spline;
   }
 }
 
-static size_t sweep_size(const void *state) { return ((const spl_state *)state)->m->sp->n_nodes; }
+/* With trans-dimensional moves a sweep is never empty: an empty page must
+** still get its births. */
+static size_t sweep_size(const void *state)
+{
+  const spl_state *s = state;
+  size_t n = s->m->sp->n_nodes;
+  if (s->m->scene->transdim && s->setup && n < s->setup->td.birth_segments + 1) n = s->setup->td.birth_segments + 1;
+  return n;
+}
 
 /* Steps are capped at the page size: beyond that a Gaussian step only
 ** throws nodes off the page; an angle at half a turn. */
 static double step_max(const void *state, int kind)
 {
   const lw_scene *sc = ((const spl_state *)state)->m->scene;
-  return kind == LW_MOVE_ROTATE ? M_PI : fmax(sc->width, sc->height);
+  return kind == LW_MOVE_ROTATE ? M_PI : kind >= LW_MOVE_KINDS ? 1.0 : fmax(sc->width, sc->height);
 }
 
 static void *proposal_new(const void *state, lw_error *err)
@@ -242,8 +263,8 @@ static uint32_t spline_near(const lw_splines *sp, uint32_t hint, size_t k)
 
 /* A proposal of the kind at global node k (a point or vector move) or on
 ** its spline (a rigid move). */
-static double propose_on(const lw_model *m, lw_proposal *p, int kind, size_t at, uint32_t i, double st,
-                         gsl_rng *rng, int *forbidden)
+static double propose_on(const lw_model *m, const lw_td *td, lw_proposal *p, int kind, size_t at, uint32_t i,
+                         double st, gsl_rng *rng, int *forbidden)
 {
   const lw_splines *sp = m->sp;
   size_t node0, n_node;
@@ -287,7 +308,87 @@ static double propose_on(const lw_model *m, lw_proposal *p, int kind, size_t at,
       }
     }
   }
+  if (m->scene->transdim && td && !lw_td_in_support(td, nd, n_node)) {
+    /* outside the reference measure's support (transdim.h): density 0 */
+    p->splice = 0;
+    p->log_ratio = 0.0;
+    *forbidden = 1;
+    return INFINITY;
+  }
   lw_model_propose(m, p, i, node0, n_node, NULL);
+  *forbidden = p->irregular;
+  return p->dE;
+}
+
+/* The trans-dimensional proposals of spl_setup (NULL for a view). */
+static const lw_td *td_of(const spl_state *s)
+{
+  return s->setup && s->m->scene->transdim ? &s->setup->td : NULL;
+}
+
+/* A refused trans-dimensional proposal (no spline to remove, a spline at its
+** longest or shortest, a node outside the support): rejected, dE = +inf. */
+static double refuse(lw_proposal *p)
+{
+  p->splice = 0;
+  p->log_ratio = 0.0;
+  return INFINITY;
+}
+
+/*
+** Birth, death, grow and shrink (transdim.h; docs/NUMERICS.md has the
+** derivation of each Hastings factor).  A birth appends a spline, a death
+** removes one chosen uniformly: the state is a set, and its numbering
+** plays no part in any density.  A death removes only splines a birth
+** could have made (birth_segments segments): for the others the reverse
+** proposal has density 0.  Rest lengths are n l (init's rule), so a
+** grown or shrunk spline's rest length is a function of its size.
+*/
+static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, int *forbidden)
+{
+  const spl_setup *su = s->setup;
+  const lw_td *td = &su->td;
+  const lw_model *m = s->m;
+  const lw_splines *sp = m->sp;
+  const size_t N = sp->n_splines, nb = td->birth_segments;
+  const double lv = td->log_node_volume, *lw = su->log_w;
+  *forbidden = 0;
+  if (kind == LW_MOVE_BIRTH) {
+    double lq = lw_td_birth_draw(td, rng, p->node);
+    if (!lw_td_in_support(td, p->node, nb + 1)) return refuse(p);
+    lw_model_propose_splice(m, p, (uint32_t)N, 0, NULL, nb + 1, (double)nb * td->length);
+    p->log_ratio = lw[1] - lw[0] - log((double)(N + 1)) - lq - (double)(nb + 1) * lv;
+  } else if (kind == LW_MOVE_DEATH) {
+    if (N == 0) return refuse(p);
+    uint32_t j = (uint32_t)gsl_rng_uniform_int(rng, N);
+    if (lw_splines_segments(sp, j) != nb) return refuse(p);
+    double lq = lw_td_birth_log(td, &sp->node[sp->first[j]]);
+    lw_model_propose_splice(m, p, j, 1, NULL, 0, 0.0);
+    p->log_ratio = lw[0] - lw[1] + log((double)N) + lq + (double)(nb + 1) * lv;
+  } else {
+    if (N == 0) return refuse(p);
+    uint32_t i = (uint32_t)gsl_rng_uniform_int(rng, N);
+    int dir = gsl_rng_uniform(rng) < 0.5 ? 1 : -1;
+    const size_t n = lw_splines_segments(sp, i);
+    const lw_node *src = &sp->node[sp->first[i]];
+    if (kind == LW_MOVE_GROW) {
+      if (n >= td->max_segments) return refuse(p);
+      /* the old nodes after a new first one, or before a new last one */
+      lw_node *keep = dir > 0 ? p->node : p->node + 1, *add = dir > 0 ? p->node + n + 1 : p->node;
+      memcpy(keep, src, (n + 1) * sizeof *src);
+      double lg = lw_td_next_draw(td, dir > 0 ? &keep[n] : &keep[0], dir, rng, add);
+      if (!lw_td_in_support(td, add, 1)) return refuse(p);
+      lw_model_propose_splice(m, p, i, 1, NULL, n + 2, (double)(n + 1) * td->length);
+      p->log_ratio = lw[3] - lw[2] - lg - lv;
+    } else {
+      if (n <= 1) return refuse(p);
+      const lw_node *gone = dir > 0 ? &src[n] : &src[0], *end = dir > 0 ? &src[n - 1] : &src[1];
+      double lg = lw_td_next_log(td, end, dir, gone);
+      memcpy(p->node, dir > 0 ? src : src + 1, n * sizeof *src);
+      lw_model_propose_splice(m, p, i, 1, NULL, n, (double)(n - 1) * td->length);
+      p->log_ratio = lw[2] - lw[3] + lg + lv;
+    }
+  }
   *forbidden = p->irregular;
   return p->dE;
 }
@@ -296,24 +397,39 @@ static double propose_on(const lw_model *m, lw_proposal *p, int kind, size_t at,
 ** one. */
 static double propose(void *state, void *prop, int kind, double st, gsl_rng *rng, int *forbidden)
 {
-  const lw_model *m = ((spl_state *)state)->m;
+  spl_state *s = state;
+  const lw_model *m = s->m;
   const lw_splines *sp = m->sp;
+  if (kind >= LW_MOVE_KINDS) return propose_td(s, prop, kind, rng, forbidden);
+  if (sp->n_splines == 0) {
+    *forbidden = 0;
+    return refuse(prop);
+  }
   if (kind == LW_MOVE_POINT || kind == LW_MOVE_VECTOR) {
     size_t k = gsl_rng_uniform_int(rng, sp->n_nodes);
-    return propose_on(m, prop, kind, k, spline_of_node(sp, k), st, rng, forbidden);
+    return propose_on(m, td_of(s), prop, kind, k, spline_of_node(sp, k), st, rng, forbidden);
   }
   uint32_t i = (uint32_t)gsl_rng_uniform_int(rng, sp->n_splines);
-  return propose_on(m, prop, kind, sp->first[i], i, st, rng, forbidden);
+  return propose_on(m, td_of(s), prop, kind, sp->first[i], i, st, rng, forbidden);
 }
 
 /* Site k is global node k; a rigid move there moves the node's spline, so a
 ** spline of n nodes gets n chances a sweep, as many as its nodes get point
-** and vector moves. */
+** and vector moves.  Trans-dimensional kinds draw their own spline, and
+** the count of sites may change within a sweep: a site past the end wraps
+** around (each proposal is still a Metropolis update of one node). */
 static double propose_at(void *state, void *prop, int kind, size_t k, double st, gsl_rng *rng, int *forbidden)
 {
-  const lw_model *m = ((spl_state *)state)->m;
+  spl_state *s = state;
+  const lw_model *m = s->m;
   lw_proposal *p = prop;
-  return propose_on(m, p, kind, k, spline_near(m->sp, p->spline, k), st, rng, forbidden);
+  if (kind >= LW_MOVE_KINDS) return propose_td(s, p, kind, rng, forbidden);
+  if (m->sp->n_nodes == 0) {
+    *forbidden = 0;
+    return refuse(p);
+  }
+  if (k >= m->sp->n_nodes) k %= m->sp->n_nodes;
+  return propose_on(m, td_of(s), p, kind, k, spline_near(m->sp, p->spline, k), st, rng, forbidden);
 }
 
 /* Between sweeps, before the run loop's refresh (which rebuilds every
@@ -325,6 +441,8 @@ static lw_status renumber(void *state, lw_error *err)
 }
 
 static lw_status commit(void *state, void *prop) { return lw_model_commit(((spl_state *)state)->m, prop); }
+
+static double log_ratio(const void *prop) { return ((const lw_proposal *)prop)->log_ratio; }
 
 static double total(const void *state) { return lw_model_total(((const spl_state *)state)->m); }
 
@@ -511,51 +629,64 @@ static void mass_dx(const void *mass, const double *x, const double *v, double *
 
 static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinned(mass, i); }
 
+/* The two rows differ only in their move kinds (sys_splines.h). */
+#define SPLINES_ROW \
+  .n_terms = LW_TERM_COUNT, \
+  .term_names = lw_term_names, \
+  .setup_new = setup_new, \
+  .setup_free = setup_free, \
+  .note = note, \
+  .state_new = state_new, \
+  .state_copy = state_copy, \
+  .state_free = state_free, \
+  .moves = moves, \
+  .sweep_size = sweep_size, \
+  .step_max = step_max, \
+  .proposal_new = proposal_new, \
+  .proposal_free = proposal_free, \
+  .propose = propose, \
+  .propose_at = propose_at, \
+  .renumber = renumber, \
+  .commit = commit, \
+  .log_ratio = log_ratio, \
+  .total = total, \
+  .terms = terms, \
+  .term_on = term_on, \
+  .refresh = refresh, \
+  .energy = energy, \
+  .save = save, \
+  .load = load, \
+  .set_terms = set_terms, \
+  .n_coords = n_coords, \
+  .get_coords = get_coords, \
+  .set_coords = set_coords, \
+  .gradient = gradient, \
+  .mass_new = mass_new, \
+  .mass_free = mass_free, \
+  .mass_at = mass_at, \
+  .mass_solve = mass_solve, \
+  .mass_apply = mass_apply, \
+  .mass_dx = mass_dx, \
+  .mass_pinned = mass_pinned, \
+  .files = "final.svg, final.png", \
+  .draw = draw, \
+  .summary = summary, \
+  .describe = describe,
+
 const lw_system_type lw_system_splines = {
     .name = "splines",
     .n_moves = LW_MOVE_KINDS,
     .move_names = lw_move_names,
     .move_unit = move_unit,
-    .n_terms = LW_TERM_COUNT,
-    .term_names = lw_term_names,
-    .setup_new = setup_new,
-    .setup_free = setup_free,
-    .note = note,
-    .state_new = state_new,
-    .state_copy = state_copy,
-    .state_free = state_free,
-    .moves = moves,
-    .sweep_size = sweep_size,
-    .step_max = step_max,
-    .proposal_new = proposal_new,
-    .proposal_free = proposal_free,
-    .propose = propose,
-    .propose_at = propose_at,
-    .renumber = renumber,
-    .commit = commit,
-    .total = total,
-    .terms = terms,
-    .term_on = term_on,
-    .refresh = refresh,
-    .energy = energy,
-    .save = save,
-    .load = load,
-    .set_terms = set_terms,
-    .n_coords = n_coords,
-    .get_coords = get_coords,
-    .set_coords = set_coords,
-    .gradient = gradient,
-    .mass_new = mass_new,
-    .mass_free = mass_free,
-    .mass_at = mass_at,
-    .mass_solve = mass_solve,
-    .mass_apply = mass_apply,
-    .mass_dx = mass_dx,
-    .mass_pinned = mass_pinned,
-    .files = "final.svg, final.png",
-    .draw = draw,
-    .summary = summary,
-    .describe = describe,
+    SPLINES_ROW
+};
+
+const lw_system_type lw_system_splines_td = {
+    .name = "splines",
+    .n_moves = LW_MOVE_KINDS_TD,
+    .move_names = move_names_td,
+    .move_unit = move_unit,
+    SPLINES_ROW
 };
 
 lw_system *lw_splines_view(lw_model *m, lw_error *err)

@@ -137,6 +137,8 @@ typedef struct {
   int splice, remove;
   size_t n_old_seg;
   double new_rest;            /* the new spline's rest length, mm */
+  double log_ratio;           /* the Hastings factor of a trans-dimensional kind (system.h);
+                              ** 0 for the symmetric ones */
 } lw_proposal;
 
 lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err);
