@@ -32,6 +32,7 @@ typedef struct {
   lw_td td;                      /* the trans-dimensional proposals (scene.transdim) */
   double log_w[4];               /* log of the birth, death, grow, shrink weights: the
                                     Hastings factors need their ratios */
+  size_t td_sweep;               /* proposals a sweep with trans-dimensional moves */
 } spl_setup;
 
 typedef struct {
@@ -66,6 +67,12 @@ static void *setup_new(const lw_params *p, lw_error *err)
   lw_td_init(&su->td, &su->scene, (size_t)p->segments, p->segment_length, su->scene.max_segments);
   const double w[4] = {p->mix_birth, p->mix_death, p->mix_grow, p->mix_shrink};
   for (int k = 0; k < 4; k++) su->log_w[k] = log(w[k]);
+  if (su->scene.transdim) {
+    size_t n = 0;
+    if (lw_init_count(&su->scene, p, &n, err)) goto fail;
+    su->td_sweep = n * (size_t)(p->segments + 1);
+    if (su->td_sweep < (size_t)p->segments + 1) su->td_sweep = (size_t)p->segments + 1;
+  }
   return su;
 fail:
   setup_free(su);
@@ -212,14 +219,16 @@ static void moves(const lw_params *p, double *weight, double *step, double *targ
   }
 }
 
-/* With trans-dimensional moves a sweep is never empty: an empty page must
-** still get its births. */
+/* With trans-dimensional moves a sweep is a fixed number of proposals, the
+** nodes the placement would make: a sweep as long as the state's nodes
+** would observe the chain at times that depend on its state, which biases
+** what a sweep's end sees toward the states that make long sweeps (the
+** ideal-gas tests catch that); and an empty page still gets its births. */
 static size_t sweep_size(const void *state)
 {
   const spl_state *s = state;
-  size_t n = s->m->sp->n_nodes;
-  if (s->m->scene->transdim && s->setup && n < s->setup->td.birth_segments + 1) n = s->setup->td.birth_segments + 1;
-  return n;
+  if (s->m->scene->transdim && s->setup) return s->setup->td_sweep;
+  return s->m->sp->n_nodes;
 }
 
 /* Steps are capped at the page size: beyond that a Gaussian step only
@@ -308,14 +317,15 @@ static double propose_on(const lw_model *m, const lw_td *td, lw_proposal *p, int
       }
     }
   }
-  if (m->scene->transdim && td && !lw_td_in_support(td, nd, n_node)) {
-    /* outside the reference measure's support (transdim.h): density 0 */
-    p->splice = 0;
-    p->log_ratio = 0.0;
-    *forbidden = 1;
-    return INFINITY;
-  }
   lw_model_propose(m, p, i, node0, n_node, NULL);
+  /* the prior of the shapes is part of the target with trans-dimensional
+  ** moves (transdim.h): its ratio is these moves' Hastings factor */
+  if (td) {
+    const lw_node *src = &sp->node[sp->first[i]];
+    const size_t nn = sp->first[i + 1] - sp->first[i];
+    p->log_ratio = n_node == 1 ? lw_td_prior_change(td, src, nn, node0, &nd[0])
+                               : lw_td_prior(td, nd, nn) - lw_td_prior(td, src, nn);
+  }
   *forbidden = p->irregular;
   return p->dE;
 }
@@ -327,7 +337,7 @@ static const lw_td *td_of(const spl_state *s)
 }
 
 /* A refused trans-dimensional proposal (no spline to remove, a spline at its
-** longest or shortest, a node outside the support): rejected, dE = +inf. */
+** longest or shortest): rejected, dE = +inf. */
 static double refuse(lw_proposal *p)
 {
   p->splice = 0;
@@ -337,9 +347,9 @@ static double refuse(lw_proposal *p)
 
 /*
 ** Birth, death, grow and shrink (transdim.h; docs/NUMERICS.md has the
-** derivation of each Hastings factor).  A birth appends a spline, a death
-** removes one chosen uniformly: the state is a set, and its numbering
-** plays no part in any density.  A death removes only splines a birth
+** derivation of each Hastings factor).  A birth appends a spline drawn
+** from the prior, a death removes one chosen uniformly: the state is a
+** set, and its numbering plays no part in any density.  A death removes only splines a birth
 ** could have made (birth_segments segments): for the others the reverse
 ** proposal has density 0.  Rest lengths are n l (init's rule), so a
 ** grown or shrunk spline's rest length is a function of its size.
@@ -351,42 +361,44 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
   const lw_model *m = s->m;
   const lw_splines *sp = m->sp;
   const size_t N = sp->n_splines, nb = td->birth_segments;
-  const double lv = td->log_node_volume, *lw = su->log_w;
+  const double *lw = su->log_w;
   *forbidden = 0;
   if (kind == LW_MOVE_BIRTH) {
-    double lq = lw_td_birth_draw(td, rng, p->node);
-    if (!lw_td_in_support(td, p->node, nb + 1)) return refuse(p);
+    lw_td_birth_draw(td, rng, p->node);
     lw_model_propose_splice(m, p, (uint32_t)N, 0, NULL, nb + 1, (double)nb * td->length);
-    p->log_ratio = lw[1] - lw[0] - log((double)(N + 1)) - lq - (double)(nb + 1) * lv;
+    p->log_ratio = lw[1] - lw[0] - log((double)(N + 1));
   } else if (kind == LW_MOVE_DEATH) {
     if (N == 0) return refuse(p);
     uint32_t j = (uint32_t)gsl_rng_uniform_int(rng, N);
     if (lw_splines_segments(sp, j) != nb) return refuse(p);
-    double lq = lw_td_birth_log(td, &sp->node[sp->first[j]]);
     lw_model_propose_splice(m, p, j, 1, NULL, 0, 0.0);
-    p->log_ratio = lw[0] - lw[1] + log((double)N) + lq + (double)(nb + 1) * lv;
+    p->log_ratio = lw[0] - lw[1] + log((double)N);
   } else {
     if (N == 0) return refuse(p);
     uint32_t i = (uint32_t)gsl_rng_uniform_int(rng, N);
-    int dir = gsl_rng_uniform(rng) < 0.5 ? 1 : -1;
+    int tail = gsl_rng_uniform(rng) < 0.5;
     const size_t n = lw_splines_segments(sp, i);
     const lw_node *src = &sp->node[sp->first[i]];
+    double lr;
     if (kind == LW_MOVE_GROW) {
       if (n >= td->max_segments) return refuse(p);
-      /* the old nodes after a new first one, or before a new last one */
-      lw_node *keep = dir > 0 ? p->node : p->node + 1, *add = dir > 0 ? p->node + n + 1 : p->node;
+      /* the old nodes before a new last one, or after a new first one */
+      lw_node *keep = tail ? p->node : p->node + 1, *add = tail ? p->node + n + 1 : p->node;
       memcpy(keep, src, (n + 1) * sizeof *src);
-      double lg = lw_td_next_draw(td, dir > 0 ? &keep[n] : &keep[0], dir, rng, add);
-      if (!lw_td_in_support(td, add, 1)) return refuse(p);
+      double lg = lw_td_next_draw(td, tail ? &keep[n] : &keep[0], tail ? 1 : -1, rng, add);
+      /* at the tail the prior's new factor is the proposal itself */
+      lr = tail ? 0.0
+                : lw_td_first_log(td, add) + lw_td_next_log(td, add, 1, &keep[0]) - lw_td_first_log(td, &keep[0]) - lg;
       lw_model_propose_splice(m, p, i, 1, NULL, n + 2, (double)(n + 1) * td->length);
-      p->log_ratio = lw[3] - lw[2] - lg - lv;
+      p->log_ratio = lw[3] - lw[2] + lr;
     } else {
       if (n <= 1) return refuse(p);
-      const lw_node *gone = dir > 0 ? &src[n] : &src[0], *end = dir > 0 ? &src[n - 1] : &src[1];
-      double lg = lw_td_next_log(td, end, dir, gone);
-      memcpy(p->node, dir > 0 ? src : src + 1, n * sizeof *src);
+      memcpy(p->node, tail ? src : src + 1, n * sizeof *src);
+      lr = tail ? 0.0
+                : lw_td_first_log(td, &src[1]) - lw_td_first_log(td, &src[0]) - lw_td_next_log(td, &src[0], 1, &src[1]) +
+                      lw_td_next_log(td, &src[1], -1, &src[0]);
       lw_model_propose_splice(m, p, i, 1, NULL, n, (double)(n - 1) * td->length);
-      p->log_ratio = lw[2] - lw[3] + lg + lv;
+      p->log_ratio = lw[2] - lw[3] + lr;
     }
   }
   *forbidden = p->irregular;

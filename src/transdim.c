@@ -17,21 +17,8 @@ void lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double len
   td->length = length;
   td->sigma_p = length / 4.0;
   td->sigma_v = length / 12.0;
-  td->v_max = fmax(sc->width, sc->height);
-  td->log_node_volume = log(sc->width * sc->height * M_PI * td->v_max * td->v_max);
   td->birth_segments = birth_segments;
   td->max_segments = max_segments;
-}
-
-int lw_td_in_support(const lw_td *td, const lw_node *nd, size_t n)
-{
-  const lw_scene *sc = td->scene;
-  const double v2 = td->v_max * td->v_max;
-  for (size_t k = 0; k < n; k++)
-    if (!(nd[k].px >= 0.0 && nd[k].px <= sc->width && nd[k].py >= 0.0 && nd[k].py <= sc->height &&
-          nd[k].vx * nd[k].vx + nd[k].vy * nd[k].vy <= v2))
-      return 0;
-  return 1;
 }
 
 /* log of the isotropic 2-D Gaussian density N(d; 0, s^2) at offset d. */
@@ -100,10 +87,12 @@ static int first_axis(const lw_td *td, const lw_node *n0, double *ux, double *uy
   return direction(td->scene, n0->px, n0->py, fx, fy, ux, uy);
 }
 
-static double first_log(const lw_td *td, const lw_node *n0)
+double lw_td_first_log(const lw_td *td, const lw_node *n0)
 {
   const double r = td->length / 3.0, s = td->sigma_v;
-  double ux, uy, lp = -log(td->scene->width * td->scene->height);
+  const lw_scene *sc = td->scene;
+  if (!(n0->px >= 0.0 && n0->px <= sc->width && n0->py >= 0.0 && n0->py <= sc->height)) return -INFINITY;
+  double ux, uy, lp = -log(sc->width * sc->height);
   if (first_axis(td, n0, &ux, &uy)) {
     double a = log_gauss2(n0->vx - r * ux, n0->vy - r * uy, s), b = log_gauss2(n0->vx + r * ux, n0->vy + r * uy, s);
     double hi = fmax(a, b);
@@ -114,7 +103,7 @@ static double first_log(const lw_td *td, const lw_node *n0)
   return lp - log(2.0 * M_PI * s * s) - 0.5 * (v - r) * (v - r) / (s * s) + log(gsl_sf_bessel_I0_scaled(z));
 }
 
-double lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd)
+void lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd)
 {
   const double r = td->length / 3.0;
   double ux, uy;
@@ -133,12 +122,25 @@ double lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd)
   nd[0].vx = r * ux + gsl_ran_gaussian_ziggurat(rng, td->sigma_v);
   nd[0].vy = r * uy + gsl_ran_gaussian_ziggurat(rng, td->sigma_v);
   for (size_t k = 1; k <= td->birth_segments; k++) lw_td_next_draw(td, &nd[k - 1], 1, rng, &nd[k]);
-  return lw_td_birth_log(td, nd);
 }
 
-double lw_td_birth_log(const lw_td *td, const lw_node *nd)
+double lw_td_prior(const lw_td *td, const lw_node *nd, size_t n)
 {
-  double lq = first_log(td, &nd[0]);
-  for (size_t k = 1; k <= td->birth_segments; k++) lq += lw_td_next_log(td, &nd[k - 1], 1, &nd[k]);
+  double lq = lw_td_first_log(td, &nd[0]);
+  for (size_t k = 1; k < n; k++) lq += lw_td_next_log(td, &nd[k - 1], 1, &nd[k]);
   return lq;
+}
+
+/* The factors of the prior that node k of nd takes part in, with node k
+** read from at. */
+static double factors(const lw_td *td, const lw_node *nd, size_t n, size_t k, const lw_node *at)
+{
+  double f = k == 0 ? lw_td_first_log(td, at) : lw_td_next_log(td, &nd[k - 1], 1, at);
+  if (k + 1 < n) f += lw_td_next_log(td, at, 1, &nd[k + 1]);
+  return f;
+}
+
+double lw_td_prior_change(const lw_td *td, const lw_node *nd, size_t n, size_t k, const lw_node *to)
+{
+  return factors(td, nd, n, k, to) - factors(td, nd, n, k, &nd[k]);
 }

@@ -5,16 +5,21 @@
 ** "Trans-dimensional moves", has the derivation).
 **
 ** Target: a state is a set of N splines; spline i with n_i segments has
-** n_i + 1 nodes, each a point p in the page [0, W] x [0, H] and a vector v
-** with |v| <= v_max (the support S_node).  The density is
-**     pi(x) = (1/N!) prod_i nu_{n_i}(x_i) exp(-E(x) / T),
-** nu_n the uniform probability density on S_node^(n+1), so each node's
-** reference is 1 / |S_node|, |S_node| = W H pi v_max^2.  Moves that keep
-** the count (point, vector, translate, rotate) are unchanged by this
-** choice, except that leaving the support is forbidden.  With only the
+** n_i + 1 nodes.  Its density, against the Poisson reference measure of
+** sets (docs/NUMERICS.md), is
+**     f(x) = prod_i q_{n_i}(x_i) exp(-E(x) / T),
+** where q_n, the prior of a spline's shape, is the density of the
+** placement kernel below: node 0 as a birth draws it, each later node from
+** the one before as a grow at the tail draws it.  Each q_n is a probability
+** density (a product of normalised conditionals), so with only the
 ** chemical potential mu_s on, N is Poisson with mean K exp(-mu_s / T), K
 ** the number of segment counts the chain can reach (1 without grow and
-** shrink, max_segments with them), and n_i uniform over them.
+** shrink, max_segments with them), and each n_i is uniform over them.
+** The prior is part of the target: the moves that keep the count (point,
+** vector, translate, rotate) carry its ratio q(x') / q(x) as their
+** Hastings factor, births and tail grows propose from it exactly (it
+** cancels), head grows and shrinks carry what is left.  It is what the
+** drawing would be without its energy: lines along the field.
 **
 ** Proposals (each node from the last, "along the field"):
 **   birth  p_0 uniform on the page; v_0 = (l/3) u + N(0, s_v^2) with u the
@@ -43,21 +48,24 @@ typedef struct {
   const lw_scene *scene;
   double length;          /* l: mm */
   double sigma_p, sigma_v; /* mm */
-  double v_max;           /* mm: the support's bound on |v| */
-  double log_node_volume; /* log |S_node|, log mm^4 */
   size_t birth_segments;  /* segments of a born spline */
   size_t max_segments;    /* grow stops here */
 } lw_td;
 
 void lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double length, size_t max_segments);
 
-/* 1 if the n nodes lie in the support. */
-int lw_td_in_support(const lw_td *td, const lw_node *nd, size_t n);
+/* log q_{n-1} of the n >= 1 nodes nd (-inf when node 0 is off the page). */
+double lw_td_prior(const lw_td *td, const lw_node *nd, size_t n);
 
-/* Draws a born spline of birth_segments + 1 nodes into nd; returns log q. */
-double lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd);
-/* log q of the spline of birth_segments + 1 nodes nd. */
-double lw_td_birth_log(const lw_td *td, const lw_node *nd);
+/* log of node 0's factor of the prior: p uniform on the page, v as a
+** birth draws it. */
+double lw_td_first_log(const lw_td *td, const lw_node *n0);
+
+/* The change of log q when node k of the n nodes nd becomes *to. */
+double lw_td_prior_change(const lw_td *td, const lw_node *nd, size_t n, size_t k, const lw_node *to);
+
+/* Draws a born spline of birth_segments + 1 nodes into nd from the prior. */
+void lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd);
 
 /* Draws the node beyond `end` (dir +1: after it, -1: before it) into out;
 ** returns log g.  lw_td_next_log: log g of a given node. */
