@@ -159,6 +159,35 @@ Test(transdim, ideal_gas_segments_are_uniform)
   double pv = chisq_p(sc + 1, prob + 1, 5, ns);
   cr_assert(pv > 1e-3, "segments per spline vs uniform 1..5: chi-square p = %g (%lu %lu %lu %lu %lu)", pv, sc[1],
             sc[2], sc[3], sc[4], sc[5]);
+  /* the prior's first node is uniform on the page, however the head has
+  ** grown and shrunk: what the head moves' Hastings factor is for.  Its
+  ** moments by batch means (the samples are correlated): E u = 1/2,
+  ** E u^2 = 1/3 for u = x / W and y / H. */
+  batch_mean mom[4];
+  memset(mom, 0, sizeof mom);
+  const long per = n / BATCHES;
+  for (int k = 0; k < 4; k++) mom[k].per = per;
+  const lw_model *m = lw_splines_model(c->sys);
+  for (long s = 0; s < BATCHES * per; s++) {
+    for (int k = 0; k < 2; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    double a[4] = {0};
+    for (size_t i = 0; i < m->sp->n_splines; i++) {
+      const lw_node *n0 = &m->sp->node[m->sp->first[i]];
+      double u = n0->px / p.width, v = n0->py / p.height;
+      cr_assert(u >= 0 && u <= 1 && v >= 0 && v <= 1, "a first node left the page: (%g, %g)", n0->px, n0->py);
+      a[0] += u / 6;
+      a[1] += v / 6;
+      a[2] += u * u / 6;
+      a[3] += v * v / 6;
+    }
+    for (int k = 0; k < 4; k++) bm_add(&mom[k], a[k]);
+  }
+  const double want[4] = {0.5, 0.5, 1.0 / 3.0, 1.0 / 3.0};
+  for (int k = 0; k < 4; k++) {
+    double se, mean = bm_mean(&mom[k], &se);
+    cr_assert(se < 0.02, "moment %d: standard error %g too large to test anything", k, se);
+    cr_assert(fabs(mean - want[k]) < 5 * se, "first node, moment %d: %g +- %g, expected %g", k, mean, se, want[k]);
+  }
   td_chain_free(c, setup);
 }
 
