@@ -297,3 +297,83 @@ Test(transdim, incremental_equals_full_with_births_and_deaths)
   lw_model_free(f);
   td_chain_free(c, setup);
 }
+
+/* A small scene with every kind of term a splice differences (segment,
+** spline, pair with its near field, boundary, chemical) and the eight move
+** kinds, annealed cold enough that births, deaths, grows and shrinks all
+** happen; tempered with two replicas. */
+static const char *cli_scene = "[scene]\nwidth = 60\nheight = 50\nmargin = 2\nfield = waves\n"
+                               "potential = radial\n"
+                               "[init]\nsplines = 10\nsegments = 3\nsegment_length = 4\n"
+                               "[energy]\nstrain = 2\nbending = 0.3\npotential = 0.3\nfield = -0.2\npair = 0.05\n"
+                               "pair_cutoff = 4\nboundary = 0.1\nchem_spline = -1\nchem_length = 0.02\n"
+                               "[moves]\nfixed_count = 0\nmax_segments = 6\nbirth = 0.05\ndeath = 0.05\n"
+                               "grow = 0.05\nshrink = 0.05\n"
+                               "[anneal]\nschedule = geometric\nt_start = 3\nt_end = 0.05\nsweeps = 60\nsteps = 6\n"
+                               "seed = 5\ncheck_every = 7\n"
+                               "[tempering]\nreplicas = 2\nt_min = 0.05\nt_max = 3\n";
+
+/* The number under key `kind` in the object `obj` of dir/a/summary.json,
+** NAN if there is none. */
+static double summary_value(const char *dir, const char *obj, const char *kind)
+{
+  char path[128], line[256], open[64], key[64];
+  snprintf(path, sizeof path, "%s/a/summary.json", dir);
+  snprintf(open, sizeof open, "\"%s\": {", obj);
+  snprintf(key, sizeof key, "\"%s\":", kind);
+  FILE *f = fopen(path, "r");
+  cr_assert_not_null(f);
+  int in = 0;
+  double v = NAN;
+  while (fgets(line, sizeof line, f) && isnan(v)) {
+    if (strstr(line, open)) in = 1;
+    else if (in && strchr(line, '}')) in = 0;
+    else if (in && strstr(line, key)) v = strtod(strchr(line, ':') + 1, NULL);
+  }
+  fclose(f);
+  return v;
+}
+
+static void write_cli_scene(const char *dir)
+{
+  char path[128];
+  snprintf(path, sizeof path, "%s/s.ini", dir);
+  FILE *f = fopen(path, "w");
+  cr_assert_not_null(f);
+  fputs(cli_scene, f);
+  fclose(f);
+}
+
+/* Same scene and seed => byte-identical outputs for any thread count, and a
+** run stopped and resumed twice ends where the uninterrupted one does. */
+Test(transdim, runs_are_deterministic_and_resume_bit_exactly, .timeout = 300)
+{
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "transdim"), 0);
+  write_cli_scene(dir);
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=1 %s run %s/s.ini --out %s/a --quiet", b, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=3 %s run %s/s.ini --out %s/b --quiet", b, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=2 %s run %s/s.ini --out %s/c --quiet --stop-at 23", b, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=1 %s resume %s/c --quiet --stop-at 41", b, dir), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=2 %s resume %s/c --quiet", b, dir), 0);
+  const char *same[] = {"state.lw", "trace.csv", "final.svg"};
+  for (int i = 0; i < 3; i++) {
+    cr_assert_eq(lw_test_sh("cmp -s %s/a/%s %s/b/%s", dir, same[i], dir, same[i]), 0, "%s differs by threads", same[i]);
+    cr_assert_eq(lw_test_sh("cmp -s %s/a/%s %s/c/%s", dir, same[i], dir, same[i]), 0, "%s differs after resume",
+                 same[i]);
+  }
+  /* every trans-dimensional kind was accepted, and the count changed */
+  const char *kinds[] = {"birth", "death", "grow", "shrink"};
+  for (int k = 0; k < 4; k++) {
+    double a = summary_value(dir, "acceptance", kinds[k]);
+    cr_assert(a > 0 && a < 1, "%s: acceptance %g", kinds[k], a);
+  }
+  cr_assert_eq(lw_test_sh("head -1 %s/a/trace.csv | grep -q ',acc_birth,acc_death,acc_grow,acc_shrink'", dir), 0);
+  cr_assert_neq(lw_test_sh("grep -q '\"splines\": 10,' %s/a/summary.json", dir), 0, "the count never changed");
+  /* and the default keeps the four kinds, columns and keys of before */
+  cr_assert_eq(lw_test_sh("%s run %s/s.ini --set moves.fixed_count=1 --set anneal.sweeps=4 --out %s/d --quiet", b, dir,
+                          dir), 0);
+  cr_assert_neq(lw_test_sh("grep -q birth %s/d/trace.csv %s/d/summary.json %s/d/state.lw", dir, dir, dir), 0);
+  lw_test_dir_remove(dir);
+}
