@@ -547,6 +547,28 @@ static lw_status near_segments(const lw_proposal *p, uint32_t np, size_t j, int 
   return LW_OK;
 }
 
+/* The near field of old segment g (from node a to a + 1, samples ps, near
+** partners segs) from the model's cache, filled first when not valid. */
+static double old_near(const lw_model *m, const pair_view *v, size_t g, const lw_node *a, const lw_pair_sample *ps,
+                       const lw_near_list *segs)
+{
+  if (!m->near_valid[g]) {
+    double bez[8];
+    lw_segment_bezier(a, a + 1, bez);
+    m->near_cache[g] = near_part(v, bez, ps, segs);
+    m->near_valid[g] = 1;
+  }
+  return m->near_cache[g];
+}
+
+/* Adds p->segs to p->partners (the near fields a commit invalidates). */
+static lw_status add_partners(lw_proposal *p)
+{
+  for (size_t k = 0; k < p->segs.n; k++)
+    if (list_push(&p->partners, p->segs.idx[k]) != LW_OK) return LW_ENOMEM;
+  return LW_OK;
+}
+
 /*
 ** The pair part of a proposal's dE (no coefficient).  One walk over the new
 ** samples (+1) and their old selves (-1) gives the far pairs; the near field
@@ -584,17 +606,9 @@ static double pair_delta(const lw_model *m, lw_proposal *p, const lw_node *base,
     lw_segment_bezier(proposed_node(base, p, p->seg0 + j), proposed_node(base, p, p->seg0 + j + 1), bez);
     p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs);
     pe += p->near_new[j];
-    for (size_t k = 0; k < p->segs.n; k++)
-      if (list_push(&p->partners, p->segs.idx[k]) != LW_OK) return NAN;
-    if (near_segments(p, np, j, 1, &p->segs) != LW_OK) return NAN;
-    if (!m->near_valid[g]) {
-      lw_segment_bezier(&base[p->seg0 + j], &base[p->seg0 + j + 1], bez);
-      m->near_cache[g] = near_part(&v, bez, p->ps_old + j * np, &p->segs);
-      m->near_valid[g] = 1;
-    }
-    pe -= m->near_cache[g];
-    for (size_t k = 0; k < p->segs.n; k++)
-      if (list_push(&p->partners, p->segs.idx[k]) != LW_OK) return NAN;
+    if (add_partners(p) != LW_OK || near_segments(p, np, j, 1, &p->segs) != LW_OK) return NAN;
+    pe -= old_near(m, &v, g, &base[p->seg0 + j], p->ps_old + j * np, &p->segs);
+    if (add_partners(p) != LW_OK) return NAN;
   }
   return pe;
 }
@@ -861,21 +875,13 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p, size_t g0)
     lw_segment_bezier(&p->node[j], &p->node[j + 1], bez);
     p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs);
     pe += p->near_new[j];
-    for (size_t k = 0; k < p->segs.n; k++)
-      if (list_push(&p->partners, p->segs.idx[k]) != LW_OK) return NAN;
+    if (add_partners(p) != LW_OK) return NAN;
   }
   for (size_t j = 0; j < p->n_old_seg; j++) {
     const size_t g = g0 + j;
     if (near_of_probes(p, np, nn + j * np, &p->segs) != LW_OK) return NAN;
-    if (!m->near_valid[g]) {
-      double bez[8];
-      segment_bezier(m->sp, g, bez);
-      m->near_cache[g] = near_part(&v, bez, p->ps_old + j * np, &p->segs);
-      m->near_valid[g] = 1;
-    }
-    pe -= m->near_cache[g];
-    for (size_t k = 0; k < p->segs.n; k++)
-      if (list_push(&p->partners, p->segs.idx[k]) != LW_OK) return NAN;
+    pe -= old_near(m, &v, g, &m->sp->node[lw_segment_node(m->sp, g)], p->ps_old + j * np, &p->segs);
+    if (add_partners(p) != LW_OK) return NAN;
   }
   return pe;
 }
@@ -1010,6 +1016,7 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
   const size_t k_new = p->n_node ? 1 : 0, n_seg = sp->n_segments - no + nn;
   const size_t n_spl = sp->n_splines - (size_t)p->remove + k_new, old_segs = sp->n_segments;
   /* every allocation first, so that running out of memory leaves the model as it was */
+  if ((uint64_t)n_seg * (uint64_t)np >= UINT32_MAX) return LW_ENOMEM; /* the grid's sample indices */
   if (n_seg > m->cap_seg) {
     size_t c = m->cap_seg + m->cap_seg / 2 + 16;
     if (c < n_seg) c = n_seg;

@@ -349,9 +349,9 @@ static double refuse(lw_proposal *p)
 ** Birth, death, grow and shrink (transdim.h; docs/NUMERICS.md has the
 ** derivation of each Hastings factor).  A birth appends a spline drawn
 ** from the prior, a death removes one chosen uniformly: the state is a
-** set, and its numbering plays no part in any density.  A death removes only splines a birth
-** could have made (birth_segments segments): for the others the reverse
-** proposal has density 0.  Rest lengths are n l (init's rule), so a
+** set, and its numbering plays no part in any density.  A death removes
+** only splines a birth could have made (birth_segments segments): for the
+** others the reverse proposal has density 0.  Rest lengths are n l (init's rule), so a
 ** grown or shrunk spline's rest length is a function of its size.
 */
 static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, int *forbidden)
