@@ -373,3 +373,46 @@ Test(transdim, runs_are_deterministic_and_resume_bit_exactly, .timeout = 300)
   cr_assert_neq(lw_test_sh("grep -q birth %s/d/trace.csv %s/d/summary.json %s/d/state.lw", dir, dir, dir), 0);
   lw_test_dir_remove(dir);
 }
+
+/* Hard cases: a page a kilometre wide with lines of a micrometre, and one
+** with the regularity tests on where births and grows propose folded
+** segments: every move kind runs, nothing NaN enters the state, and the
+** running energy stays the recomputed one. */
+Test(transdim, hard_scales_keep_the_state_finite)
+{
+  const double widths[2] = {1e6, 100}, lengths[2] = {1e-3, 8};
+  for (int h = 0; h < 2; h++) {
+    lw_params p;
+    lw_params_defaults(&p);
+    p.width = widths[h];
+    p.height = widths[h] / 2;
+    p.margin = 0;
+    p.splines = 20;
+    p.segments = 2;
+    p.segment_length = lengths[h];
+    p.bending = 1;
+    p.strain = 1;
+    p.pair = 0.05;
+    p.pair_cutoff = 4 * lengths[h];
+    p.chem_spline = -2;
+    p.chem_length = 1 / lengths[h];
+    p.max_segments = 5;
+    p.mix_birth = p.mix_death = p.mix_grow = p.mix_shrink = 0.2;
+    void *setup;
+    lw_chain *c = td_chain(&p, 2.0, 21 + (unsigned long)h, &setup);
+    const lw_model *m = lw_splines_model(c->sys);
+    for (int s = 0; s < 300; s++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    cr_assert(lw_splines_finite(m->sp), "case %d: a coordinate is not finite", h);
+    unsigned long nan = 0, acc = 0;
+    for (int k = 0; k < c->n_moves; k++) nan += c->stats[k].nan;
+    for (int k = LW_MOVE_BIRTH; k < LW_MOVE_KINDS_TD; k++) acc += c->stats[k].accepted;
+    cr_assert_eq(nan, 0, "case %d: %lu proposals with a NaN dE", h, nan);
+    cr_assert(acc > 0, "case %d: no trans-dimensional move accepted", h);
+    double term[LW_TERM_COUNT];
+    lw_error err = {0};
+    double full = lw_energy_compute(m->scene, m->sp, term, &err), run = lw_model_total(m);
+    cr_assert(isfinite(full) && fabs(run - full) <= 1e-9 * fmax(fabs(full), 1.0), "case %d: running %.17g, full %.17g",
+              h, run, full);
+    td_chain_free(c, setup);
+  }
+}
