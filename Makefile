@@ -76,7 +76,7 @@ test: $(BIN)/linewise $(MPI_BIN) $(BUILD)/tests/run $(PICTURE)
 # The long statistical and stress tests (LW_LONG=1 scales them up; minutes).
 test-long: $(BIN)/linewise $(BUILD)/tests/run $(PICTURE)
 	LW_LONG=1 LW_BIN=$(CURDIR)/$(BIN)/linewise LW_ROOT=$(CURDIR) $(BUILD)/tests/run --jobs $(TEST_JOBS) \
-	  --filter '@(stats|hard|crash)/*'
+	  --filter '@(stats|hard|crash|transdim)/*'
 
 asan:
 	$(MAKE) BUILD=build-asan BIN=build-asan/bin OPT=-O1 \

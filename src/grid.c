@@ -14,7 +14,7 @@
 
 /* A grid of dim 2 or 3 over lo + [0, size] (size[2], lo[2] unused in 2-D). */
 static lw_cellgrid *grid_new(int dim, const double lo[3], const double size[3], double cell,
-                             size_t n_samples, lw_error *err)
+                             size_t n_samples, size_t room, lw_error *err)
 {
   lw_cellgrid *g = calloc(1, sizeof *g);
   if (!g) goto nomem;
@@ -26,7 +26,7 @@ static lw_cellgrid *grid_new(int dim, const double lo[3], const double size[3], 
   double side = cell > 0 ? cell : fmax(fmax(w, h), d) + 1.0;
   /* No more cells than samples (times a small factor): a tiny cutoff on a huge
   ** page would otherwise allocate mostly empty cells. */
-  double max_cells = 4.0 * (double)n_samples + 16.0;
+  double max_cells = 4.0 * (double)(room > n_samples ? room : n_samples) + 16.0;
   while ((ceil(w / side) + 1) * (ceil(h / side) + 1) * (dim == 3 ? ceil(d / side) + 1 : 1) > max_cells)
     side *= 1.5;
   g->inv_h = 1.0 / side;
@@ -40,6 +40,7 @@ static lw_cellgrid *grid_new(int dim, const double lo[3], const double size[3], 
   g->home = malloc((n_samples ? n_samples : 1) * sizeof *g->home);
   if (!g->cell || !g->home) goto nomem;
   g->n_samples = n_samples;
+  g->home_cap = n_samples;
   return g;
 nomem:
   lw_cellgrid_free(g);
@@ -51,13 +52,19 @@ nomem:
 lw_cellgrid *lw_cellgrid_new(double x0, double y0, double w, double h, double cell,
                              size_t n_samples, lw_error *err)
 {
-  return grid_new(2, (const double[3]){x0, y0, 0.0}, (const double[3]){w, h, 0.0}, cell, n_samples, err);
+  return grid_new(2, (const double[3]){x0, y0, 0.0}, (const double[3]){w, h, 0.0}, cell, n_samples, 0, err);
+}
+
+lw_cellgrid *lw_cellgrid_new_room(double x0, double y0, double w, double h, double cell,
+                                  size_t n_samples, size_t room, lw_error *err)
+{
+  return grid_new(2, (const double[3]){x0, y0, 0.0}, (const double[3]){w, h, 0.0}, cell, n_samples, room, err);
 }
 
 lw_cellgrid *lw_cellgrid_new3(const double lo[3], const double size[3], double cell, size_t n_samples,
                               lw_error *err)
 {
-  return grid_new(3, lo, size, cell, n_samples, err);
+  return grid_new(3, lo, size, cell, n_samples, 0, err);
 }
 
 void lw_cellgrid_free(lw_cellgrid *g)
@@ -235,4 +242,43 @@ size_t lw_cellgrid_bytes(const lw_cellgrid *g)
 void lw_cellgrid_clear(lw_cellgrid *g)
 {
   for (size_t c = 0; c < lw_cellgrid_cells(g); c++) g->cell[c].n = 0;
+}
+
+lw_status lw_cellgrid_reserve(lw_cellgrid *g, size_t n)
+{
+  if (n <= g->home_cap) return LW_OK;
+  size_t c = g->home_cap + g->home_cap / 2 + 64;
+  if (c < n) c = n;
+  uint32_t *h = realloc(g->home, c * sizeof *h);
+  if (!h) return LW_ENOMEM;
+  g->home = h;
+  g->home_cap = c;
+  return LW_OK;
+}
+
+lw_status lw_cellgrid_splice(lw_cellgrid *g, size_t from, size_t n_old, size_t n_new)
+{
+  const size_t n = g->n_samples - n_old + n_new;
+  if (lw_cellgrid_reserve(g, n) != LW_OK) return LW_ENOMEM;
+  const uint32_t lo = (uint32_t)from, hi = (uint32_t)(from + n_old);
+  for (size_t ci = 0; ci < lw_cellgrid_cells(g); ci++) {
+    lw_cell *c = &g->cell[ci];
+    if (!c->n) continue; /* an empty cell may have no block */
+    double *x = c->x, *y = lw_cell_y(c), *z = g->dim == 3 ? lw_cell_z(c) : NULL;
+    uint32_t *idx = lw_cell_idx(c);
+    float *dl = lw_cell_dl(c);
+    uint32_t k = lower_bound(c, lo), w = k;
+    for (; k < c->n; k++) {
+      if (idx[k] < hi) continue; /* leaves */
+      x[w] = x[k];
+      y[w] = y[k];
+      dl[w] = dl[k];
+      if (z) z[w] = z[k];
+      idx[w++] = (uint32_t)(idx[k] - n_old + n_new);
+    }
+    c->n = w;
+  }
+  memmove(g->home + from + n_new, g->home + from + n_old, (g->n_samples - from - n_old) * sizeof *g->home);
+  g->n_samples = n;
+  return LW_OK;
 }

@@ -78,6 +78,7 @@ static void tune(lw_chain *c, int kind, int accepted)
 static int decide(lw_chain *c, int kind, double dE, int forbidden)
 {
   int accept;
+  const double lr = c->sys->type->log_ratio ? c->sys->type->log_ratio(c->prop) : 0.0;
   lw_move_stats *s = &c->stats[kind];
   s->proposed++;
   if (isnan(dE)) {
@@ -89,6 +90,16 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
   } else if (forbidden) {
     s->irregular++;
     accept = 0;
+  } else if (lr != 0.0) {
+    /* Metropolis-Hastings in logs, so that no ratio of densities over- or
+    ** underflows: accept if log u < lr - dE / T (docs/NUMERICS.md) */
+    if (isnan(lr) || lr == -INFINITY || dE == INFINITY) accept = 0;
+    else if (c->temperature > 0.0) {
+      double x = lr - dE / c->temperature;
+      accept = x >= 0.0 || (x > -745.0 && gsl_rng_uniform(c->rng) < exp(x));
+    } else {
+      accept = dE < 0.0 || (dE == 0.0 && lr > 0.0);
+    }
   } else if (dE <= 0.0) {
     accept = 1;
   } else if (c->temperature > 0.0 && dE < INFINITY) {

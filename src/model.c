@@ -221,8 +221,16 @@ static int64_t *raster_new(const lw_term_set *ts, int t)
 /* The pairwise term's kernel settings and sample nodes. */
 static const lw_pair_ctx *pair_ctx(const lw_term_ctx *c) { return c->data; }
 
+/* With trans-dimensional moves the sample count changes, and with it the
+** cells lw_cellgrid_new would choose; a fixed room keeps them a function of
+** the scene (grid.h), at most 4 M cells. */
+#define TRANSDIM_GRID_ROOM ((size_t)1 << 20)
+
 static lw_cellgrid *grid_for(const lw_scene *sc, const lw_term_ctx *pair, size_t n_samples, lw_error *err)
 {
+  if (sc->transdim)
+    return lw_cellgrid_new_room(0.0, 0.0, sc->width, sc->height, pair_ctx(pair)->cutoff, n_samples,
+                                TRANSDIM_GRID_ROOM, err);
   return lw_cellgrid_new(0.0, 0.0, sc->width, sc->height, pair_ctx(pair)->cutoff, n_samples, err);
 }
 
@@ -421,6 +429,9 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
     if (!(m->raster[m->terms.raster[k]] = raster_new(&m->terms, m->terms.raster[k]))) goto nomem;
   for (size_t i = 0; i < sp->n_splines; i++)
     if (lw_splines_segments(sp, i) > m->max_segments) m->max_segments = lw_splines_segments(sp, i);
+  if (sc->transdim && sc->max_segments > m->max_segments) m->max_segments = sc->max_segments;
+  m->cap_seg = ns;
+  m->cap_spl = sp->n_splines ? sp->n_splines : 1;
   if (lw_model_refresh(m, NULL) != LW_OK) goto nomem;
   return m;
 nomem:
@@ -567,6 +578,28 @@ static lw_status near_segments(const lw_proposal *p, uint32_t np, size_t j, int 
   return LW_OK;
 }
 
+/* The near field of old segment g (from node a to a + 1, samples ps, near
+** partners segs) from the model's cache, filled first when not valid. */
+static double old_near(const lw_model *m, const pair_view *v, size_t g, const lw_node *a, const lw_pair_sample *ps,
+                       const lw_near_list *segs)
+{
+  if (!m->near_valid[g]) {
+    double bez[8];
+    lw_segment_bezier(a, a + 1, bez);
+    m->near_cache[g] = near_part(v, bez, ps, segs);
+    m->near_valid[g] = 1;
+  }
+  return m->near_cache[g];
+}
+
+/* Adds p->segs to p->partners (the near fields a commit invalidates). */
+static lw_status add_partners(lw_proposal *p)
+{
+  for (size_t k = 0; k < p->segs.n; k++)
+    if (list_push(&p->partners, p->segs.idx[k]) != LW_OK) return LW_ENOMEM;
+  return LW_OK;
+}
+
 /*
 ** The pair part of a proposal's dE (no coefficient).  One walk over the new
 ** samples (+1) and their old selves (-1) gives the far pairs; the near field
@@ -604,17 +637,9 @@ static double pair_delta(const lw_model *m, lw_proposal *p, const lw_node *base,
     lw_segment_bezier(proposed_node(base, p, p->seg0 + j), proposed_node(base, p, p->seg0 + j + 1), bez);
     p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs);
     pe += p->near_new[j];
-    for (size_t k = 0; k < p->segs.n; k++)
-      if (list_push(&p->partners, p->segs.idx[k]) != LW_OK) return NAN;
-    if (near_segments(p, np, j, 1, &p->segs) != LW_OK) return NAN;
-    if (!m->near_valid[g]) {
-      lw_segment_bezier(&base[p->seg0 + j], &base[p->seg0 + j + 1], bez);
-      m->near_cache[g] = near_part(&v, bez, p->ps_old + j * np, &p->segs);
-      m->near_valid[g] = 1;
-    }
-    pe -= m->near_cache[g];
-    for (size_t k = 0; k < p->segs.n; k++)
-      if (list_push(&p->partners, p->segs.idx[k]) != LW_OK) return NAN;
+    if (add_partners(p) != LW_OK || near_segments(p, np, j, 1, &p->segs) != LW_OK) return NAN;
+    pe -= old_near(m, &v, g, &base[p->seg0 + j], p->ps_old + j * np, &p->segs);
+    if (add_partners(p) != LW_OK) return NAN;
   }
   return pe;
 }
@@ -678,6 +703,8 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   const lw_node *base = &sp->node[sp->first[spline]];
   const size_t g0 = lw_segment_index(sp, spline, 0);
 
+  p->splice = 0;
+  p->log_ratio = 0.0;
   p->spline = spline;
   p->node0 = node0;
   p->n_node = n_node;
@@ -774,8 +801,11 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   p->dE = dE;
 }
 
+static lw_status commit_splice(lw_model *m, const lw_proposal *p);
+
 /* The commit without the running totals (model.h): everything but m->term
-** and m->n_irregular, whose changes go into p's own sums. */
+** and m->n_irregular, whose changes go into p's own sums.  Moves only: a
+** splice is committed whole by lw_model_commit. */
 lw_status lw_model_commit_part(lw_model *m, lw_proposal *p)
 {
   lw_splines *sp = m->sp;
@@ -854,6 +884,255 @@ lw_status lw_model_merge(lw_model *m, lw_proposal *p)
 
 lw_status lw_model_commit(lw_model *m, lw_proposal *p)
 {
+  if (p->splice) return commit_splice(m, p);
   lw_status s = lw_model_commit_part(m, p);
   return s != LW_OK ? s : lw_model_merge(m, p);
+}
+
+/* ---- trans-dimensional proposals (splices) --------------------------------
+** The spline replaced (its n_old_seg segments from global segment g0) and
+** the new one (p->n_seg segments from p->node) are whole splines: every
+** term is differenced over them alone, as lw_model_propose does over the
+** segments a move touches.  The walk's probes are the new samples (+1)
+** followed by the old ones (-1). */
+
+/* The sorted segments of the near pairs of probes [lo, lo + np). */
+static lw_status near_of_probes(const lw_proposal *p, uint32_t np, size_t lo, lw_near_list *segs)
+{
+  segs->n = 0;
+  for (size_t k = 0; k < p->near.n; k++) {
+    const lw_pair_near *q = &p->near.pair[k];
+    if (q->probe < lo || q->probe >= lo + np) continue;
+    if (list_push(segs, q->idx / np) != LW_OK) return LW_ENOMEM;
+  }
+  segs->n = unique_u32(segs->idx, segs->n);
+  return LW_OK;
+}
+
+/* The pair part of a splice's dE (no coefficient); NAN if out of memory. */
+static double splice_pair_delta(const lw_model *m, lw_proposal *p, size_t g0)
+{
+  const lw_scene *sc = m->scene;
+  const uint32_t np = (uint32_t)sc->pair_quad.n;
+  const pair_view v = {m->grid, m->sp, np, &sc->pair};
+  const size_t nn = p->n_seg * np, no = p->n_old_seg * np;
+  for (size_t k = 0; k < nn; k++) p->probe[k] = (lw_pair_probe){p->ps[k].x, p->ps[k].y, p->ps[k].dl, 1.0};
+  for (size_t k = 0; k < no; k++)
+    p->probe[nn + k] = (lw_pair_probe){p->ps_old[k].x, p->ps_old[k].y, p->ps_old[k].dl, -1.0};
+  /* an inserted spline has no samples in the grid yet: nothing to leave out */
+  lw_pair_filter f = p->remove ? filter_of(&v, p->spline, 0) : (lw_pair_filter){0, 0, 0};
+  double pe;
+  p->near.n = 0;
+  p->partners.n = 0;
+  if (lw_pair_walk(m->grid, &sc->pair, p->probe, nn + no, &f, &pe, &p->near, NULL) != LW_OK) return NAN;
+  for (size_t j = 0; j < p->n_seg; j++) {
+    double bez[8];
+    if (near_of_probes(p, np, j * np, &p->segs) != LW_OK) return NAN;
+    lw_segment_bezier(&p->node[j], &p->node[j + 1], bez);
+    p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs);
+    pe += p->near_new[j];
+    if (add_partners(p) != LW_OK) return NAN;
+  }
+  for (size_t j = 0; j < p->n_old_seg; j++) {
+    const size_t g = g0 + j;
+    if (near_of_probes(p, np, nn + j * np, &p->segs) != LW_OK) return NAN;
+    pe -= old_near(m, &v, g, &m->sp->node[lw_segment_node(m->sp, g)], p->ps_old + j * np, &p->segs);
+    if (add_partners(p) != LW_OK) return NAN;
+  }
+  return pe;
+}
+
+/* A raster term's part of a splice's dE (no coefficient); NAN if the box
+** cannot grow. */
+static double splice_raster_delta(const lw_model *m, lw_proposal *p, int t, const lw_node *old)
+{
+  const lw_term_ctx *c = &m->terms.ctx[t];
+  lw_tone_box *b = &p->box[t];
+  lw_tone_box_reset(b);
+  for (size_t j = 0; j < p->n_old_seg; j++) raster_cover(c->data, b, &old[j], &old[j + 1]);
+  for (size_t j = 0; j < p->n_seg; j++) raster_cover(c->data, b, &p->node[j], &p->node[j + 1]);
+  if (lw_tone_box_ready(b) != LW_OK) return NAN;
+  for (size_t j = 0; j < p->n_old_seg; j++) raster_segment(c, b, &old[j], &old[j + 1], -1);
+  for (size_t j = 0; j < p->n_seg; j++) raster_segment(c, b, &p->node[j], &p->node[j + 1], 1);
+  return lw_tone_delta(c->data, m->raster[t], b);
+}
+
+void lw_model_propose_splice(const lw_model *m, lw_proposal *p, uint32_t at, int remove, const lw_node *nodes,
+                             size_t n_new, double rest)
+{
+  const lw_scene *sc = m->scene;
+  const lw_splines *sp = m->sp;
+  const lw_term_set *ts = &m->terms;
+  const lw_term_ctx *pc = ts->pair >= 0 ? &ts->ctx[ts->pair] : NULL;
+  const int np = pair_nodes(m), nl = sc->n_local;
+  const size_t g0 = lw_segment_index(sp, at, 0), no = remove ? lw_splines_segments(sp, at) : 0;
+  const lw_node *old = remove ? &sp->node[sp->first[at]] : NULL;
+
+  p->splice = 1;
+  p->remove = remove;
+  p->spline = at;
+  p->node0 = p->seg0 = 0;
+  p->n_node = n_new;
+  p->n_seg = n_new ? n_new - 1 : 0;
+  p->n_old_seg = no;
+  p->new_rest = rest;
+  if (nodes && nodes != p->node) memcpy(p->node, nodes, n_new * sizeof *nodes);
+  for (int t = 0; t < LW_TERM_COUNT; t++) p->dterm[t] = 0.0;
+
+  lw_samples s;
+  int forbidden = 0, undefined = 0, was_irregular = 0;
+  double L = 0.0;
+  p->irregular = 0;
+  for (size_t j = 0; j < p->n_seg; j++) {
+    double *local = p->local + j * (size_t)nl;
+    p->seg_irregular[j] = !segment_eval(sc, ts->ctx, &p->node[j], &p->node[j + 1], &s, &p->len[j], local,
+                                        pc ? pc->quad : NULL, m->grid ? p->ps + j * (size_t)np : NULL);
+    p->irregular |= p->seg_irregular[j];
+    for (int t = 0; t < nl; t++) {
+      p->dterm[sc->local[t]] += local[t];
+      if (local[t] == INFINITY) forbidden = 1;
+      else if (isnan(local[t])) undefined = 1;
+    }
+    if (isnan(p->len[j])) undefined = 1;
+    L += p->len[j];
+  }
+  for (size_t j = 0; j < no; j++) {
+    const double *ol = m->seg_local + (g0 + j) * (size_t)nl;
+    for (int t = 0; t < nl; t++) p->dterm[sc->local[t]] -= ol[t];
+    was_irregular |= m->seg_irregular[g0 + j];
+  }
+  p->new_spline_len = L;
+  for (int k = 0; k < ts->n_spline; k++) {
+    const int t = ts->spline[k];
+    const lw_term_ctx *c = &ts->ctx[t];
+    double (*fn)(const double *, size_t, double, double, const lw_term_ctx *) = lw_term_types[t].spline;
+    if (p->n_seg) p->dterm[t] += c->coef * fn(p->len, p->n_seg, L, rest, c);
+    if (no) p->dterm[t] -= c->coef * fn(m->seg_len + g0, no, m->spline_len[at], sp->rest_length[at], c);
+  }
+  double dE = 0.0;
+  for (int t = 0; t < LW_TERM_COUNT; t++) dE += p->dterm[t];
+  if ((forbidden || p->irregular) && !undefined) dE = INFINITY;
+  else if (was_irregular && !undefined) dE = -INFINITY;
+  p->pair_done = 0;
+  if (m->grid) {
+    pair_view v = {m->grid, sp, (uint32_t)np, pair_ctx(pc)};
+    for (size_t k = 0; k < no * (size_t)np; k++) p->ps_old[k] = sample_at(&v, (uint32_t)(g0 * (size_t)np + k));
+  }
+  p->crowded = 0;
+  if (sc->min_spacing > 0.0 && p->n_seg && !(dE == INFINITY) && !isnan(dE)) {
+    const uint32_t lo = (uint32_t)(g0 * (size_t)np), hi = (uint32_t)((g0 + no) * (size_t)np);
+    const double d2 = sc->min_spacing * sc->min_spacing;
+    size_t now = crowding(m->grid, p->ps, p->n_seg * (size_t)np, lo, hi, d2);
+    if (now > 0 && now > crowding(m->grid, p->ps_old, no * (size_t)np, lo, hi, d2)) {
+      p->crowded = 1;
+      dE = INFINITY;
+    }
+  }
+  if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
+    double pe = splice_pair_delta(m, p, g0);
+    p->pair_done = !isnan(pe);
+    p->dterm[ts->pair] = pc->coef * pe;
+    dE += p->dterm[ts->pair];
+  }
+  p->raster_done = 0;
+  if (ts->n_raster && !(dE == INFINITY) && !isnan(dE)) {
+    for (int k = 0; k < ts->n_raster; k++) {
+      const int t = ts->raster[k];
+      p->dterm[t] = ts->ctx[t].coef * splice_raster_delta(m, p, t, old);
+      dE += p->dterm[t];
+    }
+    p->raster_done = !isnan(dE);
+  }
+  p->dE = dE;
+}
+
+/* Room for n elements of size sz in *a (cap elements now); 0 if out of
+** memory (*a unchanged). */
+static int room(void *a, size_t cap, size_t n, size_t sz)
+{
+  if (n <= cap) return 1;
+  void *q = realloc(*(void **)a, n * sz);
+  if (!q) return 0;
+  *(void **)a = q;
+  return 1;
+}
+
+/* Moves the tail of a per-item array from index `from + n_old` to `from + n_new`. */
+static void shift(void *a, size_t len, size_t from, size_t n_old, size_t n_new, size_t sz)
+{
+  char *b = a;
+  memmove(b + (from + n_new) * sz, b + (from + n_old) * sz, (len - from - n_old) * sz);
+}
+
+static lw_status commit_splice(lw_model *m, const lw_proposal *p)
+{
+  lw_splines *sp = m->sp;
+  const int np = pair_nodes(m), nl = m->scene->n_local, nls = nl ? nl : 1;
+  const size_t at = p->spline, g0 = lw_segment_index(sp, at, 0), nn = p->n_seg, no = p->n_old_seg;
+  const size_t k_new = p->n_node ? 1 : 0, n_seg = sp->n_segments - no + nn;
+  const size_t n_spl = sp->n_splines - (size_t)p->remove + k_new, old_segs = sp->n_segments;
+  /* every allocation first, so that running out of memory leaves the model as it was */
+  if ((uint64_t)n_seg * (uint64_t)np >= UINT32_MAX) return LW_ENOMEM; /* the grid's sample indices */
+  if (n_seg > m->cap_seg) {
+    size_t c = m->cap_seg + m->cap_seg / 2 + 16;
+    if (c < n_seg) c = n_seg;
+    if (!room(&m->seg_len, m->cap_seg, c, sizeof *m->seg_len) ||
+        !room(&m->seg_local, m->cap_seg * (size_t)nls, c * (size_t)nls, sizeof *m->seg_local) ||
+        !room(&m->seg_irregular, m->cap_seg, c, sizeof *m->seg_irregular) ||
+        (m->grid && (!room(&m->near_cache, m->cap_seg, c, sizeof *m->near_cache) ||
+                     !room(&m->near_valid, m->cap_seg, c, sizeof *m->near_valid))))
+      return LW_ENOMEM;
+    m->cap_seg = c;
+  }
+  if (n_spl > m->cap_spl) {
+    size_t c = m->cap_spl + m->cap_spl / 2 + 8;
+    if (!room(&m->spline_len, m->cap_spl, c, sizeof *m->spline_len)) return LW_ENOMEM;
+    m->cap_spl = c;
+  }
+  if (m->grid && lw_cellgrid_reserve(m->grid, n_seg * (size_t)np) != LW_OK) return LW_ENOMEM;
+  /* the near fields the splice changes, in the numbering before it */
+  if (m->grid && p->pair_done)
+    for (size_t k = 0; k < p->partners.n; k++) m->near_valid[p->partners.idx[k]] = 0;
+  if (lw_splines_splice(sp, at, p->remove, p->node, p->n_node, p->new_rest) != LW_OK) return LW_ENOMEM;
+
+  for (size_t j = 0; j < no; j++) m->n_irregular -= m->seg_irregular[g0 + j];
+  for (size_t j = 0; j < nn; j++) m->n_irregular += p->seg_irregular[j];
+  shift(m->seg_len, old_segs, g0, no, nn, sizeof *m->seg_len);
+  shift(m->seg_local, old_segs * (size_t)nl, g0 * (size_t)nl, no * (size_t)nl, nn * (size_t)nl,
+        sizeof *m->seg_local);
+  shift(m->seg_irregular, old_segs, g0, no, nn, sizeof *m->seg_irregular);
+  memcpy(m->seg_len + g0, p->len, nn * sizeof *p->len);
+  memcpy(m->seg_local + g0 * (size_t)nl, p->local, nn * (size_t)nl * sizeof *p->local);
+  memcpy(m->seg_irregular + g0, p->seg_irregular, nn * sizeof *p->seg_irregular);
+  shift(m->spline_len, sp->n_splines - k_new + (size_t)p->remove, at, (size_t)p->remove, k_new, sizeof *m->spline_len);
+  if (k_new) m->spline_len[at] = p->new_spline_len;
+  if (nn > m->max_segments) m->max_segments = nn;
+
+  lw_status st = LW_OK;
+  if (m->grid) {
+    shift(m->near_cache, old_segs, g0, no, nn, sizeof *m->near_cache);
+    shift(m->near_valid, old_segs, g0, no, nn, sizeof *m->near_valid);
+    for (size_t j = 0; j < nn; j++) {
+      m->near_cache[g0 + j] = p->near_new[j];
+      m->near_valid[g0 + j] = (uint8_t)p->pair_done;
+    }
+    if (!p->pair_done) memset(m->near_valid, 0, n_seg * sizeof *m->near_valid);
+    (void)lw_cellgrid_splice(m->grid, g0 * (size_t)np, no * (size_t)np, nn * (size_t)np); /* room reserved */
+    for (size_t j = 0; j < nn && st == LW_OK; j++) st = store_samples(m->grid, g0 + j, np, p->ps + j * (size_t)np);
+  }
+  for (int k = 0; p->raster_done && k < m->terms.n_raster; k++) {
+    const int t = m->terms.raster[k];
+    lw_tone_apply(m->terms.ctx[t].data, m->raster[t], &p->box[t]);
+  }
+  int nonfinite = 0;
+  for (int t = 0; t < LW_TERM_COUNT; t++) {
+    m->term[t] += p->dterm[t];
+    if (!isfinite(m->term[t])) nonfinite = 1;
+  }
+  if (st != LW_OK) {
+    (void)lw_model_refresh(m, NULL);
+    return st;
+  }
+  if (nonfinite || (m->terms.n_raster && !p->raster_done)) return lw_model_refresh(m, NULL);
+  return LW_OK;
 }

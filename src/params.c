@@ -195,6 +195,14 @@ const lw_param_def lw_param_table[] = {
       "brings more of its samples closer than this to another spline than it had is refused "
       "(+infinity), so a drawing that keeps it never loses it. Needs the pair term (it looks in "
       "its cell grid) and at most pair_cutoff. Typically the pen width. 0 = off."),
+  NUM("energy", "chem_spline", LW_PT_DOUBLE, chem_spline, "0", "energy", -1e12, 1e12, 0,
+      "Chemical potential per spline: the energy a spline costs just by being there (term "
+      "'chemical', with chem_length). With moves.fixed_count = 0 it sets how many lines the "
+      "drawing gets; negative values reward lines (docs/NUMERICS.md, 'Trans-dimensional moves'). "
+      "0 = none."),
+  NUM("energy", "chem_length", LW_PT_DOUBLE, chem_length, "0", "energy / mm", -1e12, 1e12, 0,
+      "Chemical potential per unit length: the energy a millimetre of line costs (a line "
+      "tension; with moves.fixed_count = 0 it prices growth). 0 = none."),
   NUM("moves", "point", LW_PT_DOUBLE, mix_point, "0.5", "", 0, 1e6, 0,
       "Relative frequency of moves of one point p_k (Gaussian step in x and y)."),
   NUM("moves", "vector", LW_PT_DOUBLE, mix_vector, "0.4", "", 0, 1e6, 0,
@@ -218,6 +226,25 @@ const lw_param_def lw_param_table[] = {
   NUM("moves", "tune_sweeps", LW_PT_INT, tune_sweeps, "10", "sweeps", 0, 1e9, 0,
       "Sweeps at the start of each temperature step during which steps adapt; afterwards "
       "they are frozen so sampling obeys detailed balance. 0 = never tune."),
+  NUM("moves", "fixed_count", LW_PT_INT, fixed_count, "1", "", 0, 1, 0,
+      "1 keeps the number of splines and of their segments as placed; 0 adds the "
+      "trans-dimensional moves birth, death, grow and shrink (reversible jump, "
+      "docs/NUMERICS.md), so the chemical potential and the other terms decide how many lines "
+      "a drawing needs. Splines system only."),
+  NUM("moves", "birth", LW_PT_DOUBLE, mix_birth, "0.01", "", 0, 1e6, 0,
+      "Relative frequency of births: a new spline of init.segments segments placed along the "
+      "field (fixed_count = 0)."),
+  NUM("moves", "death", LW_PT_DOUBLE, mix_death, "0.01", "", 0, 1e6, 0,
+      "Relative frequency of deaths: a spline chosen uniformly is removed (fixed_count = 0)."),
+  NUM("moves", "grow", LW_PT_DOUBLE, mix_grow, "0.02", "", 0, 1e6, 0,
+      "Relative frequency of grow moves: a segment added at either end of a spline, along the "
+      "field (fixed_count = 0)."),
+  NUM("moves", "shrink", LW_PT_DOUBLE, mix_shrink, "0.02", "", 0, 1e6, 0,
+      "Relative frequency of shrink moves: the segment at either end of a spline removed "
+      "(fixed_count = 0)."),
+  NUM("moves", "max_segments", LW_PT_INT, max_segments, "16", "", 1, 1e5, 0,
+      "Grow never makes a spline longer than this many segments (fixed_count = 0); shrink never "
+      "below one."),
   STRING("anneal", "schedule", schedule, "geometric", "",
          "Temperature schedule: constant, linear, geometric, logarithmic, adaptive or table "
          "(formulas in docs/SCHEDULES.md)."),

@@ -181,6 +181,7 @@ void lw_scene_term_ctx(const lw_scene *sc, lw_term_ctx ctx[LW_TERM_COUNT])
   ctx[LW_TERM_USER].fn = sc->user_fn;
   ctx[LW_TERM_LOAD].data = sc->load;
   ctx[LW_TERM_TONE].data = &sc->tone;
+  ctx[LW_TERM_CHEMICAL].data = sc->chem;
 }
 
 void lw_scene_layer_ctx(const lw_scene *sc, int k, lw_term_ctx ctx[LW_TERM_COUNT])
@@ -319,6 +320,20 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   sc->load[0] = p->dyn_rho * p->dyn_gravity_x + p->dyn_force_x;
   sc->load[1] = p->dyn_rho * p->dyn_gravity_y + p->dyn_force_y;
   coef[LW_TERM_LOAD] = sc->load[0] != 0.0 || sc->load[1] != 0.0;
+  sc->chem[0] = p->chem_spline;
+  sc->chem[1] = p->chem_length;
+  coef[LW_TERM_CHEMICAL] = sc->chem[0] != 0.0 || sc->chem[1] != 0.0;
+  sc->transdim = !p->fixed_count;
+  /* a spline's layer follows its index, and a domain's scratch holds a fixed
+  ** set of splines: births and deaths would move splines between them */
+  if (sc->transdim && p->ly_names[0])
+    return bad_key(p, "moves", "fixed_count", LW_EINPUT, err,
+                   "trans-dimensional moves (0) do not combine with [layers] yet; expected 1");
+  if (sc->transdim && strcmp(p->domains, "off"))
+    return bad_key(p, "moves", "fixed_count", LW_EINPUT, err,
+                   "trans-dimensional moves (0) do not combine with anneal.domains = %s yet; expected 1",
+                   p->domains);
+  sc->max_segments = (size_t)(p->max_segments > p->segments ? p->max_segments : p->segments);
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     sc->coef[t] = coef[t];
     sc->on[t] = coef[t] != 0.0;

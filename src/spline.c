@@ -35,6 +35,8 @@ lw_splines *lw_splines_new(size_t n_splines, const size_t *segments, lw_error *e
     sp->rest_length[i] = 1.0;
   }
   sp->first[n_splines] = k;
+  sp->cap_nodes = n_nodes;
+  sp->cap_splines = n_splines;
   return sp;
 nomem:
   lw_splines_free(sp);
@@ -83,6 +85,63 @@ lw_status lw_splines_permute(lw_splines *sp, const size_t *order, lw_error *err)
   *sp = *c;
   *c = old;
   lw_splines_free(c);
+  return LW_OK;
+}
+
+/* The room for need elements after growth: half again as much, so that a
+** run of single insertions costs amortised O(1) each. */
+static size_t grown(size_t cap, size_t need)
+{
+  size_t c = cap + cap / 2 + 8;
+  return c < need ? need : c;
+}
+
+lw_status lw_splines_splice(lw_splines *sp, size_t at, int remove, const lw_node *nodes, size_t n_new, double rest)
+{
+  const size_t k_new = n_new ? 1 : 0, old_nodes = remove ? sp->first[at + 1] - sp->first[at] : 0;
+  const size_t n_nodes = sp->n_nodes - old_nodes + n_new, n_splines = sp->n_splines - (size_t)remove + k_new;
+  /* all growth first, so that a failure leaves sp as it was; an array that
+  ** grew while its partner failed is only larger than its cap says */
+  if (n_nodes > sp->cap_nodes) {
+    size_t c = grown(sp->cap_nodes, n_nodes);
+    lw_node *nd = realloc(sp->node, c * sizeof *nd);
+    if (!nd) return LW_ENOMEM;
+    sp->node = nd;
+    uint32_t *ss = realloc(sp->seg_spline, c * sizeof *ss);
+    if (!ss) return LW_ENOMEM;
+    sp->seg_spline = ss;
+    sp->cap_nodes = c;
+  }
+  if (n_splines > sp->cap_splines) {
+    size_t c = grown(sp->cap_splines, n_splines);
+    double *r = realloc(sp->rest_length, c * sizeof *r);
+    if (!r) return LW_ENOMEM;
+    sp->rest_length = r;
+    size_t *fi = realloc(sp->first, (c + 1) * sizeof *fi);
+    if (!fi) return LW_ENOMEM;
+    sp->first = fi;
+    sp->cap_splines = c;
+  }
+
+  const size_t f = sp->first[at], tail = sp->n_nodes - f - old_nodes;
+  memmove(sp->node + f + n_new, sp->node + f + old_nodes, tail * sizeof *sp->node);
+  if (n_new) memcpy(sp->node + f, nodes, n_new * sizeof *nodes);
+  const size_t after = sp->n_splines - at - (size_t)remove; /* splines behind */
+  memmove(sp->first + at + k_new, sp->first + at + remove, (after + 1) * sizeof *sp->first);
+  memmove(sp->rest_length + at + k_new, sp->rest_length + at + remove, after * sizeof *sp->rest_length);
+  if (k_new) {
+    sp->first[at] = f;
+    sp->rest_length[at] = rest;
+  }
+  for (size_t i = at + k_new; i <= after + at + k_new; i++) sp->first[i] = sp->first[i] - old_nodes + n_new;
+  sp->n_nodes = n_nodes;
+  sp->n_splines = n_splines;
+  sp->n_segments = n_nodes - n_splines;
+  /* the segments from spline `at` on belong to other indices now */
+  for (size_t i = at; i < n_splines; i++) {
+    size_t g = lw_segment_index(sp, i, 0), n = lw_splines_segments(sp, i);
+    for (size_t m = 0; m < n; m++) sp->seg_spline[g + m] = (uint32_t)i;
+  }
   return LW_OK;
 }
 

@@ -17,14 +17,22 @@
 #include "linewise/hilbert.h"
 #include "linewise/init.h"
 #include "linewise/splmass.h"
+#include "linewise/transdim.h"
 
 const char *const lw_move_names[LW_MOVE_KINDS] = {"point", "vector", "translate", "rotate"};
-/* steps are kept in mm and radians; [moves] step_rotate is in degrees */
-static const double move_unit[LW_MOVE_KINDS] = {1.0, 1.0, 1.0, M_PI / 180.0};
+static const char *const move_names_td[LW_MOVE_KINDS_TD] = {"point", "vector", "translate", "rotate",
+                                                            "birth", "death", "grow", "shrink"};
+/* steps are kept in mm and radians; [moves] step_rotate is in degrees; the
+** trans-dimensional kinds have no step (their proposals are transdim.h's) */
+static const double move_unit[LW_MOVE_KINDS_TD] = {1.0, 1.0, 1.0, M_PI / 180.0, 1.0, 1.0, 1.0, 1.0};
 
 typedef struct {
   lw_scene scene;
   lw_grid2d *tone;               /* the picture's tone on the page, or NULL */
+  lw_td td;                      /* the trans-dimensional proposals (scene.transdim) */
+  double log_w[4];               /* log of the birth, death, grow, shrink weights: the
+                                    Hastings factors need their ratios */
+  size_t td_sweep;               /* proposals a sweep with trans-dimensional moves */
 } spl_setup;
 
 typedef struct {
@@ -56,6 +64,15 @@ static void *setup_new(const lw_params *p, lw_error *err)
   /* the target of the fidelity score and the previews' underlay */
   if (su->scene.image && !(su->tone = lw_image_tone_grid(su->scene.image, &su->scene.image_place, err)))
     goto fail;
+  lw_td_init(&su->td, &su->scene, (size_t)p->segments, p->segment_length, su->scene.max_segments);
+  const double w[4] = {p->mix_birth, p->mix_death, p->mix_grow, p->mix_shrink};
+  for (int k = 0; k < 4; k++) su->log_w[k] = log(w[k]);
+  if (su->scene.transdim) {
+    size_t n = 0;
+    if (lw_init_count(&su->scene, p, &n, err)) goto fail;
+    su->td_sweep = n * (size_t)(p->segments + 1);
+    if (su->td_sweep < (size_t)p->segments + 1) su->td_sweep = (size_t)p->segments + 1;
+  }
   return su;
 fail:
   setup_free(su);
@@ -189,24 +206,37 @@ static void *state_copy(const void *state, lw_error *err)
 
 static void moves(const lw_params *p, double *weight, double *step, double *target)
 {
-  const double w[LW_MOVE_KINDS] = {p->mix_point, p->mix_vector, p->mix_translate, p->mix_rotate};
+  const double w[LW_MOVE_KINDS_TD] = {p->mix_point, p->mix_vector, p->mix_translate, p->mix_rotate,
+                                      p->mix_birth, p->mix_death, p->mix_grow, p->mix_shrink};
   const double st[LW_MOVE_KINDS] = {p->step_point, p->step_vector, p->step_translate, p->step_rotate};
   const double tg[LW_MOVE_KINDS] = {p->target, p->target, p->target_spline, p->target_spline};
-  for (int k = 0; k < LW_MOVE_KINDS; k++) {
+  const int n = p->fixed_count ? LW_MOVE_KINDS : LW_MOVE_KINDS_TD;
+  for (int k = 0; k < n; k++) {
     weight[k] = w[k];
-    step[k] = st[k] * move_unit[k];
-    target[k] = tg[k];
+    /* a trans-dimensional kind has no step: tuning may change it, nothing reads it */
+    step[k] = k < LW_MOVE_KINDS ? st[k] * move_unit[k] : 1.0;
+    target[k] = k < LW_MOVE_KINDS ? tg[k] : p->target_spline;
   }
 }
 
-static size_t sweep_size(const void *state) { return ((const spl_state *)state)->m->sp->n_nodes; }
+/* With trans-dimensional moves a sweep is a fixed number of proposals, the
+** nodes the placement would make: a sweep as long as the state's nodes
+** would observe the chain at times that depend on its state, which biases
+** what a sweep's end sees toward the states that make long sweeps (the
+** ideal-gas tests catch that); and an empty page still gets its births. */
+static size_t sweep_size(const void *state)
+{
+  const spl_state *s = state;
+  if (s->m->scene->transdim && s->setup) return s->setup->td_sweep;
+  return s->m->sp->n_nodes;
+}
 
 /* Steps are capped at the page size: beyond that a Gaussian step only
 ** throws nodes off the page; an angle at half a turn. */
 static double step_max(const void *state, int kind)
 {
   const lw_scene *sc = ((const spl_state *)state)->m->scene;
-  return kind == LW_MOVE_ROTATE ? M_PI : fmax(sc->width, sc->height);
+  return kind == LW_MOVE_ROTATE ? M_PI : kind >= LW_MOVE_KINDS ? 1.0 : fmax(sc->width, sc->height);
 }
 
 static void *proposal_new(const void *state, lw_error *err)
@@ -245,8 +275,8 @@ static void spline_box(const lw_splines *sp, uint32_t i, size_t node0, size_t n,
 /* A proposal of the kind at global node k (a point or vector move) or on
 ** its spline (a rigid move); with a box (domains.h), rejected (+inf,
 ** *forbidden = 2) if the spline would leave it. */
-static double propose_on(const lw_model *m, lw_proposal *p, int kind, size_t at, uint32_t i, double st,
-                         gsl_rng *rng, int *forbidden, const double *box)
+static double propose_on(const lw_model *m, const lw_td *td, lw_proposal *p, int kind, size_t at, uint32_t i,
+                         double st, gsl_rng *rng, int *forbidden, const double *box)
 {
   const lw_splines *sp = m->sp;
   size_t node0, n_node;
@@ -301,6 +331,89 @@ static double propose_on(const lw_model *m, lw_proposal *p, int kind, size_t at,
     }
   }
   lw_model_propose(m, p, i, node0, n_node, NULL);
+  /* the prior of the shapes is part of the target with trans-dimensional
+  ** moves (transdim.h): its ratio is these moves' Hastings factor */
+  if (td) {
+    const lw_node *src = &sp->node[sp->first[i]];
+    const size_t nn = sp->first[i + 1] - sp->first[i];
+    p->log_ratio = n_node == 1 ? lw_td_prior_change(td, src, nn, node0, &nd[0])
+                               : lw_td_prior(td, nd, nn) - lw_td_prior(td, src, nn);
+  }
+  *forbidden = p->irregular;
+  return p->dE;
+}
+
+/* The trans-dimensional proposals of spl_setup (NULL for a view). */
+static const lw_td *td_of(const spl_state *s)
+{
+  return s->setup && s->m->scene->transdim ? &s->setup->td : NULL;
+}
+
+/* A refused trans-dimensional proposal (no spline to remove, a spline at its
+** longest or shortest): rejected, dE = +inf. */
+static double refuse(lw_proposal *p)
+{
+  p->splice = 0;
+  p->log_ratio = 0.0;
+  return INFINITY;
+}
+
+/*
+** Birth, death, grow and shrink (transdim.h; docs/NUMERICS.md has the
+** derivation of each Hastings factor).  A birth appends a spline drawn
+** from the prior, a death removes one chosen uniformly: the state is a
+** set, and its numbering plays no part in any density.  A death removes
+** only splines a birth could have made (birth_segments segments): for the
+** others the reverse proposal has density 0.  Rest lengths are n l (init's rule), so a
+** grown or shrunk spline's rest length is a function of its size.
+*/
+static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, int *forbidden)
+{
+  const spl_setup *su = s->setup;
+  const lw_td *td = &su->td;
+  const lw_model *m = s->m;
+  const lw_splines *sp = m->sp;
+  const size_t N = sp->n_splines, nb = td->birth_segments;
+  const double *lw = su->log_w;
+  *forbidden = 0;
+  if (kind == LW_MOVE_BIRTH) {
+    lw_td_birth_draw(td, rng, p->node);
+    lw_model_propose_splice(m, p, (uint32_t)N, 0, NULL, nb + 1, (double)nb * td->length);
+    p->log_ratio = lw[1] - lw[0] - log((double)(N + 1));
+  } else if (kind == LW_MOVE_DEATH) {
+    if (N == 0) return refuse(p);
+    uint32_t j = (uint32_t)gsl_rng_uniform_int(rng, N);
+    if (lw_splines_segments(sp, j) != nb) return refuse(p);
+    lw_model_propose_splice(m, p, j, 1, NULL, 0, 0.0);
+    p->log_ratio = lw[0] - lw[1] + log((double)N);
+  } else {
+    if (N == 0) return refuse(p);
+    uint32_t i = (uint32_t)gsl_rng_uniform_int(rng, N);
+    int tail = gsl_rng_uniform(rng) < 0.5;
+    const size_t n = lw_splines_segments(sp, i);
+    const lw_node *src = &sp->node[sp->first[i]];
+    double lr;
+    if (kind == LW_MOVE_GROW) {
+      if (n >= td->max_segments) return refuse(p);
+      /* the old nodes before a new last one, or after a new first one */
+      lw_node *keep = tail ? p->node : p->node + 1, *add = tail ? p->node + n + 1 : p->node;
+      memcpy(keep, src, (n + 1) * sizeof *src);
+      double lg = lw_td_next_draw(td, tail ? &keep[n] : &keep[0], tail ? 1 : -1, rng, add);
+      /* at the tail the prior's new factor is the proposal itself */
+      lr = tail ? 0.0
+                : lw_td_first_log(td, add) + lw_td_next_log(td, add, 1, &keep[0]) - lw_td_first_log(td, &keep[0]) - lg;
+      lw_model_propose_splice(m, p, i, 1, NULL, n + 2, (double)(n + 1) * td->length);
+      p->log_ratio = lw[3] - lw[2] + lr;
+    } else {
+      if (n <= 1) return refuse(p);
+      memcpy(p->node, tail ? src : src + 1, n * sizeof *src);
+      lr = tail ? 0.0
+                : lw_td_first_log(td, &src[1]) - lw_td_first_log(td, &src[0]) - lw_td_next_log(td, &src[0], 1, &src[1]) +
+                      lw_td_next_log(td, &src[1], -1, &src[0]);
+      lw_model_propose_splice(m, p, i, 1, NULL, n, (double)(n - 1) * td->length);
+      p->log_ratio = lw[2] - lw[3] + lr;
+    }
+  }
   *forbidden = p->irregular;
   return p->dE;
 }
@@ -309,24 +422,39 @@ static double propose_on(const lw_model *m, lw_proposal *p, int kind, size_t at,
 ** one. */
 static double propose(void *state, void *prop, int kind, double st, gsl_rng *rng, int *forbidden)
 {
-  const lw_model *m = ((spl_state *)state)->m;
+  spl_state *s = state;
+  const lw_model *m = s->m;
   const lw_splines *sp = m->sp;
+  if (kind >= LW_MOVE_KINDS) return propose_td(s, prop, kind, rng, forbidden);
+  if (sp->n_splines == 0) {
+    *forbidden = 0;
+    return refuse(prop);
+  }
   if (kind == LW_MOVE_POINT || kind == LW_MOVE_VECTOR) {
     size_t k = gsl_rng_uniform_int(rng, sp->n_nodes);
-    return propose_on(m, prop, kind, k, spline_of_node(sp, k), st, rng, forbidden, NULL);
+    return propose_on(m, td_of(s), prop, kind, k, spline_of_node(sp, k), st, rng, forbidden, NULL);
   }
   uint32_t i = (uint32_t)gsl_rng_uniform_int(rng, sp->n_splines);
-  return propose_on(m, prop, kind, sp->first[i], i, st, rng, forbidden, NULL);
+  return propose_on(m, td_of(s), prop, kind, sp->first[i], i, st, rng, forbidden, NULL);
 }
 
 /* Site k is global node k; a rigid move there moves the node's spline, so a
 ** spline of n nodes gets n chances a sweep, as many as its nodes get point
-** and vector moves. */
+** and vector moves.  Trans-dimensional kinds draw their own spline, and
+** the count of sites may change within a sweep: a site past the end wraps
+** around (each proposal is still a Metropolis update of one node). */
 static double propose_at(void *state, void *prop, int kind, size_t k, double st, gsl_rng *rng, int *forbidden)
 {
-  const lw_model *m = ((spl_state *)state)->m;
+  spl_state *s = state;
+  const lw_model *m = s->m;
   lw_proposal *p = prop;
-  return propose_on(m, p, kind, k, spline_near(m->sp, p->spline, k), st, rng, forbidden, NULL);
+  if (kind >= LW_MOVE_KINDS) return propose_td(s, p, kind, rng, forbidden);
+  if (m->sp->n_nodes == 0) {
+    *forbidden = 0;
+    return refuse(p);
+  }
+  if (k >= m->sp->n_nodes) k %= m->sp->n_nodes;
+  return propose_on(m, td_of(s), p, kind, k, spline_near(m->sp, p->spline, k), st, rng, forbidden, NULL);
 }
 
 /* ---- domain decomposition (system.h, domains.h) ---- */
@@ -391,9 +519,9 @@ static size_t group(const void *state, size_t site, double box[4])
 static double propose_in(void *state, void *prop, int kind, size_t k, double st, gsl_rng *rng, int *forbidden,
                          const double box[4])
 {
-  const lw_model *m = ((spl_state *)state)->m;
+  const spl_state *s = state;
   lw_proposal *p = prop;
-  return propose_on(m, p, kind, k, spline_near(m->sp, p->spline, k), st, rng, forbidden, box);
+  return propose_on(s->m, td_of(s), p, kind, k, spline_near(s->m->sp, p->spline, k), st, rng, forbidden, box);
 }
 
 static lw_status commit_part(void *state, void *prop)
@@ -412,6 +540,8 @@ static lw_status renumber(void *state, lw_error *err)
 }
 
 static lw_status commit(void *state, void *prop) { return lw_model_commit(((spl_state *)state)->m, prop); }
+
+static double log_ratio(const void *prop) { return ((const lw_proposal *)prop)->log_ratio; }
 
 static double total(const void *state) { return lw_model_total(((const spl_state *)state)->m); }
 
@@ -598,56 +728,71 @@ static void mass_dx(const void *mass, const double *x, const double *v, double *
 
 static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinned(mass, i); }
 
+/* The two rows differ only in their move kinds (sys_splines.h). */
+#define SPLINES_ROW \
+  .n_terms = LW_TERM_COUNT, \
+  .term_names = lw_term_names, \
+  .setup_new = setup_new, \
+  .setup_free = setup_free, \
+  .note = note, \
+  .state_new = state_new, \
+  .state_copy = state_copy, \
+  .state_free = state_free, \
+  .moves = moves, \
+  .sweep_size = sweep_size, \
+  .step_max = step_max, \
+  .proposal_new = proposal_new, \
+  .proposal_free = proposal_free, \
+  .propose = propose, \
+  .propose_at = propose_at, \
+  .renumber = renumber, \
+  .commit = commit, \
+  .log_ratio = log_ratio, \
+  .total = total, \
+  .terms = terms, \
+  .term_on = term_on, \
+  .refresh = refresh, \
+  .energy = energy, \
+  .save = save, \
+  .load = load, \
+  .set_terms = set_terms, \
+  .n_coords = n_coords, \
+  .get_coords = get_coords, \
+  .set_coords = set_coords, \
+  .gradient = gradient, \
+  .mass_new = mass_new, \
+  .mass_free = mass_free, \
+  .mass_at = mass_at, \
+  .mass_solve = mass_solve, \
+  .mass_apply = mass_apply, \
+  .mass_dx = mass_dx, \
+  .mass_pinned = mass_pinned, \
+  .files = "final.svg, final.png", \
+  .draw = draw, \
+  .summary = summary, \
+  .describe = describe,
+
 const lw_system_type lw_system_splines = {
     .name = "splines",
     .n_moves = LW_MOVE_KINDS,
     .move_names = lw_move_names,
     .move_unit = move_unit,
-    .n_terms = LW_TERM_COUNT,
-    .term_names = lw_term_names,
-    .setup_new = setup_new,
-    .setup_free = setup_free,
-    .note = note,
-    .state_new = state_new,
-    .state_copy = state_copy,
-    .state_free = state_free,
-    .moves = moves,
-    .sweep_size = sweep_size,
-    .step_max = step_max,
-    .proposal_new = proposal_new,
-    .proposal_free = proposal_free,
-    .propose = propose,
-    .propose_at = propose_at,
-    .renumber = renumber,
-    .commit = commit,
+    SPLINES_ROW
+    /* domains only for a fixed count: births and deaths would move splines
+    ** between the domains' scratches */
     .split = split,
     .group = group,
     .propose_in = propose_in,
     .commit_part = commit_part,
     .merge = merge,
-    .total = total,
-    .terms = terms,
-    .term_on = term_on,
-    .refresh = refresh,
-    .energy = energy,
-    .save = save,
-    .load = load,
-    .set_terms = set_terms,
-    .n_coords = n_coords,
-    .get_coords = get_coords,
-    .set_coords = set_coords,
-    .gradient = gradient,
-    .mass_new = mass_new,
-    .mass_free = mass_free,
-    .mass_at = mass_at,
-    .mass_solve = mass_solve,
-    .mass_apply = mass_apply,
-    .mass_dx = mass_dx,
-    .mass_pinned = mass_pinned,
-    .files = "final.svg, final.png",
-    .draw = draw,
-    .summary = summary,
-    .describe = describe,
+};
+
+const lw_system_type lw_system_splines_td = {
+    .name = "splines",
+    .n_moves = LW_MOVE_KINDS_TD,
+    .move_names = move_names_td,
+    .move_unit = move_unit,
+    SPLINES_ROW
 };
 
 lw_system *lw_splines_view(lw_model *m, lw_error *err)

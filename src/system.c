@@ -44,6 +44,8 @@ const lw_system_type *lw_system_of(const lw_params *p, lw_error *err)
     lw_error_set(err, LW_EINPUT, "%s: key 'scene.system': expected one of %s, got '%s'", where, lw_system_names(),
                  p->system);
   }
+  /* the same system with its trans-dimensional move kinds (sys_splines.h) */
+  if (t == &lw_system_splines && !p->fixed_count) t = &lw_system_splines_td;
   return t;
 }
 

@@ -261,9 +261,26 @@ static void grad_load(const lw_samples *s, const lw_term_ctx *ctx, lw_samples_gr
   }
 }
 
+/* The chemical potential of one spline: data is {mu_s, mu_l}. */
+static double spline_chemical(const double *seg_len, size_t n_seg, double length, double rest_length,
+                              const lw_term_ctx *c)
+{
+  (void)seg_len, (void)n_seg, (void)rest_length;
+  const double *mu = c->data;
+  return mu[0] + mu[1] * length;
+}
+
+static void grad_chemical(const double *seg_len, size_t n_seg, double length, double rest_length,
+                          const lw_term_ctx *c, double *dlen)
+{
+  (void)seg_len, (void)length, (void)rest_length;
+  const double *mu = c->data;
+  for (size_t m = 0; m < n_seg; m++) dlen[m] += c->coef * mu[1];
+}
+
 const char *const lw_term_names[LW_TERM_COUNT] = {"strain", "bending", "potential", "field",
                                                   "pair", "boundary", "user", "parametrisation",
-                                                  "load", "tone"};
+                                                  "load", "tone", "chemical"};
 
 const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_STRAIN, .spline = spline_strain, .spline_grad = grad_strain},
@@ -276,4 +293,5 @@ const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_PARAM, .segment = seg_param, .segment_grad = grad_param},
   {LW_TERM_LOAD, .segment = seg_load, .segment_grad = grad_load},
   {LW_TERM_TONE, .raster = 1}, /* no gradient yet (gradient.h refuses it) */
+  {LW_TERM_CHEMICAL, .spline = spline_chemical, .spline_grad = grad_chemical},
 };

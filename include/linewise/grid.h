@@ -63,6 +63,7 @@ typedef struct {
   double z0;         /* 3-D: lower corner in z; 0 in 2-D */
   int nz;            /* cells along z: 1 in 2-D; cell (x, y, z) is (z ny + y) nx + x */
   int dim;           /* 2 or 3 */
+  size_t home_cap;   /* room in home (lw_cellgrid_splice grows it) */
 } lw_cellgrid;
 
 /* A grid covering [x0, x0 + w] x [y0, y0 + h] with cells of side >= cell
@@ -71,6 +72,26 @@ typedef struct {
 lw_cellgrid *lw_cellgrid_new(double x0, double y0, double w, double h, double cell,
                              size_t n_samples, lw_error *err);
 void lw_cellgrid_free(lw_cellgrid *g);
+
+/* The same with cells sized as if for max(n_samples, room) samples: a grid
+** whose sample count changes (trans-dimensional moves) keeps the cells of
+** a fixed room, so that its geometry, and with it the order of every sum
+** over cells, depends on the scene alone and a resumed run adds in the
+** same order as one that never stopped. */
+lw_cellgrid *lw_cellgrid_new_room(double x0, double y0, double w, double h, double cell,
+                                  size_t n_samples, size_t room, lw_error *err);
+
+/* Renumbers the samples for a change of the index space: the samples
+** [from, from + n_old) leave the grid, those from from + n_old on take
+** index - n_old + n_new, and [from, from + n_new) is left free for
+** lw_cellgrid_insert; n_samples changes by n_new - n_old.  A pass over
+** every cell, O(samples) memory traffic and no search; cells stay sorted
+** (the renumbering is monotone).  LW_ENOMEM (home could not grow) leaves
+** the grid as it was. */
+lw_status lw_cellgrid_splice(lw_cellgrid *g, size_t from, size_t n_old, size_t n_new);
+
+/* Room in home for n samples, so that a splice up to n cannot fail. */
+lw_status lw_cellgrid_reserve(lw_cellgrid *g, size_t n);
 
 /* The cell holding (x, y) after clamping. */
 static inline void lw_cellgrid_locate(const lw_cellgrid *g, double x, double y, int *cx, int *cy)

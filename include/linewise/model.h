@@ -85,7 +85,9 @@ typedef struct {
   uint8_t *near_valid;      /* n_segments: 1 where near_cache holds the current value */
   int64_t *raster[LW_TERM_COUNT]; /* each raster term's raster (tone.h) while on, else NULL;
                                      with layers one plane a layer, layer k at k w h */
-  size_t max_segments;      /* longest spline, for sizing proposals */
+  size_t max_segments;      /* longest spline, for sizing proposals (with trans-dimensional
+                              moves at least scene->max_segments) */
+  size_t cap_seg, cap_spl;  /* room in the per-segment and per-spline caches (splices) */
 } lw_model;
 
 /* Builds the caches for sp (ownership passes to the model, also on failure). */
@@ -139,6 +141,14 @@ typedef struct {
   double sum_term[LW_TERM_COUNT];
   long sum_irregular;
   int sum_stale;              /* a raster term's change is unknown: refresh on merge */
+  /* a splice (lw_model_propose_splice): spline `spline` replaced (remove = 1)
+  ** or a spline inserted at index `spline` (remove = 0) by the n_node nodes
+  ** in node (0: none); node0 = seg0 = 0, n_seg new segments, n_old_seg old */
+  int splice, remove;
+  size_t n_old_seg;
+  double new_rest;            /* the new spline's rest length, mm */
+  double log_ratio;           /* the Hastings factor of a trans-dimensional kind (system.h);
+                              ** 0 for the symmetric ones */
 } lw_proposal;
 
 lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err);
@@ -152,7 +162,25 @@ void lw_proposal_free(lw_proposal *p);
 void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t node0,
                       size_t n_node, const lw_node *nodes);
 
-/* Applies an evaluated proposal.  LW_ENOMEM if the grid could not grow. */
+/*
+** Trans-dimensional proposals: replaces spline `at` (remove = 1) or inserts
+** a spline at index `at` <= n_splines (remove = 0) by the n_new nodes
+** `nodes` (NULL: already in p->node) with rest length `rest`, or by nothing
+** (n_new = 0, remove = 1: a death).  The new spline has n_new - 1 <=
+** m->max_segments segments.  dE is the new spline's energy less the old
+** one's: its segment and spline terms, its pair sums with every other
+** spline (one walk over the new samples, +1, and the old ones, -1, the
+** old spline's samples left out), its raster changes; forbidden and
+** crowded as for lw_model_propose.  Birth, death, grow and shrink are all
+** this one operation (sys_splines.c draws them, transdim.h has the
+** proposal densities).
+*/
+void lw_model_propose_splice(const lw_model *m, lw_proposal *p, uint32_t at, int remove, const lw_node *nodes,
+                             size_t n_new, double rest);
+
+/* Applies an evaluated proposal (either kind).  LW_ENOMEM if the grid could
+** not grow: for a move the model is as before; for a splice the caches are
+** rebuilt when they can be, and the run should stop. */
 lw_status lw_model_commit(lw_model *m, lw_proposal *p);
 
 /* The same in two halves, for moves made in parallel in disjoint domains

@@ -114,6 +114,8 @@ typedef struct {
   double tone_blur;           /* sigma of the tone term's blur, mm */
   double tone_ink;            /* ink fraction the darkest tone asks for */
   double min_spacing;         /* least distance between samples of different splines, mm; 0 = none */
+  double chem_spline;         /* chemical potential: energy per spline; 0 = none */
+  double chem_length;         /* chemical potential: energy per mm of line; 0 = none */
   /* [moves] */
   double mix_point, mix_vector, mix_translate, mix_rotate; /* relative frequencies */
   double step_point, step_vector;  /* initial Gaussian step, mm */
@@ -122,6 +124,9 @@ typedef struct {
   double target;              /* acceptance the single-DOF steps tune toward */
   double target_spline;       /* acceptance the rigid steps tune toward */
   int tune_sweeps;            /* tuning sweeps at the start of each temperature */
+  int fixed_count;            /* 1: no trans-dimensional moves (the count stays as placed) */
+  double mix_birth, mix_death, mix_grow, mix_shrink; /* relative frequencies (fixed_count = 0) */
+  int max_segments;           /* grow never makes a spline longer than this, segments */
   /* [anneal] */
   char schedule[64];          /* a name from the schedule table */
   double t_start, t_end;      /* temperatures, energy units */

@@ -59,6 +59,9 @@ typedef struct lw_scene {
   lw_user_term_fn user_fn;      /* valid when on[LW_TERM_USER] */
   const void *user_data;        /* passed to user_fn; not owned */
   double load[2];               /* b of the load term: rho g + f, force per mm */
+  double chem[2];               /* the chemical term's mu_s (energy) and mu_l (energy/mm) */
+  int transdim;                 /* 1: trans-dimensional moves on (moves.fixed_count = 0) */
+  size_t max_segments;          /* then: the longest a spline may grow, segments */
   int n_local;                  /* per-segment terms that are on ... */
   lw_term_id local[LW_TERM_COUNT]; /* ... and which */
   lw_image *image;              /* the processed picture (owned), or NULL */

@@ -9,7 +9,9 @@
 ** Gaussian step in x and y), translate and rotate (a whole spline rigidly,
 ** by a Gaussian offset, or by a Gaussian angle about the mean of its points,
 ** which the rotation leaves in place, so every proposal is symmetric).  The
-** [moves] keys name them; the rotate step is given in degrees.
+** [moves] keys name them; the rotate step is given in degrees.  With
+** moves.fixed_count = 0 four more: birth, death, grow and shrink
+** (transdim.h), whose acceptance carries a Hastings factor (log_ratio).
 **
 ** In state.lw the system keeps the splines in its section [system splines]
 ** ([system splines K] for rung K); the run loop keeps the running value of
@@ -23,9 +25,16 @@
 
 typedef enum { LW_MOVE_POINT, LW_MOVE_VECTOR, LW_MOVE_TRANSLATE, LW_MOVE_ROTATE, LW_MOVE_KINDS } lw_move_kind;
 
+/* The trans-dimensional kinds (transdim.h), after the four: a scene with
+** moves.fixed_count = 0 gets the row lw_system_splines_td, which has all
+** eight; the default row keeps four, so that traces, summaries and
+** state.lw stay as they were. */
+enum { LW_MOVE_BIRTH = LW_MOVE_KINDS, LW_MOVE_DEATH, LW_MOVE_GROW, LW_MOVE_SHRINK, LW_MOVE_KINDS_TD };
+
 extern const char *const lw_move_names[LW_MOVE_KINDS];
 
 extern const lw_system_type lw_system_splines;
+extern const lw_system_type lw_system_splines_td;
 
 /* An instance on a model the caller keeps (tests, benchmarks): freeing it
 ** leaves the model; it has no set-up, so it does not draw. */

@@ -122,6 +122,12 @@ struct lw_system_type {
                        int *forbidden, const double box[4]);
   lw_status (*commit_part)(void *state, void *prop);
   lw_status (*merge)(void *state, void *prop);
+  /* Optional (NULL: every proposal is symmetric): the log of the last
+  ** proposal's Hastings factor, log [q(x' -> x) / q(x -> x')] with the
+  ** reference measures' change folded in; the chain then accepts with
+  ** probability min(1, exp(log_ratio - dE / T)).  Exactly 0 for the
+  ** symmetric kinds, whose decision then stays what it always was. */
+  double (*log_ratio)(const void *prop);
   /* Optional (NULL: the numbering never changes): renumbers the state's
   ** sites for locality in memory, as a function of the state alone, so that
   ** a resumed run does the same.  The run loop calls it between sweeps,

@@ -26,6 +26,10 @@
 **   tone      T * sum over pixels of A (G * ink - D)^2: the lines splatted
 **             into a blurred ink raster against the picture's darkness
 **             (tone.h)
+**   chemical  mu_s + mu_l L per spline: the chemical potential, a cost per
+**             spline and per mm of line ([energy] chem_spline, chem_length;
+**             on when either is != 0, coefficient 1); data is {mu_s, mu_l}.
+**             What trans-dimensional moves weigh a line's existence against
 **
 ** The term table's order is the order of trace.csv's and state.lw's energy
 ** columns; a new term goes at the end so older state files still read.
@@ -42,7 +46,7 @@
 **             parametrisation;
 **   spline    a sum over splines of a function of one spline's segment
 **             lengths and rest length (differenced over the moved spline):
-**             strain;
+**             strain, chemical;
 **   pairwise  coef times the sum of the pair kernel (pair.h) over sample
 **             pairs of different splines, found in a cell grid of the
 **             kernel's cutoff; ctx.data is the lw_pair_ctx, ctx.quad the
@@ -90,6 +94,7 @@ typedef enum {
   LW_TERM_PARAM,
   LW_TERM_LOAD,
   LW_TERM_TONE,
+  LW_TERM_CHEMICAL,
   LW_TERM_COUNT
 } lw_term_id;
 

@@ -1,0 +1,75 @@
+/*
+** transdim.h -- the proposal densities of the trans-dimensional moves
+** (birth, death, grow, shrink) of the spline system, and the reference
+** measure their acceptance is taken against (docs/NUMERICS.md,
+** "Trans-dimensional moves", has the derivation).
+**
+** Target: a state is a set of N splines; spline i with n_i segments has
+** n_i + 1 nodes.  Its density, against the Poisson reference measure of
+** sets (docs/NUMERICS.md), is
+**     f(x) = prod_i q_{n_i}(x_i) exp(-E(x) / T),
+** where q_n, the prior of a spline's shape, is the density of the
+** placement kernel below: node 0 as a birth draws it, each later node from
+** the one before as a grow at the tail draws it.  Each q_n is a probability
+** density (a product of normalised conditionals), so with only the
+** chemical potential mu_s on, N is Poisson with mean K exp(-mu_s / T), K
+** the number of segment counts the chain can reach (1 without grow and
+** shrink, max_segments with them), and each n_i is uniform over them.
+** The prior is part of the target: the moves that keep the count (point,
+** vector, translate, rotate) carry its ratio q(x') / q(x) as their
+** Hastings factor, births and tail grows propose from it exactly (it
+** cancels), head grows and shrinks carry what is left.  It is what the
+** drawing would be without its energy: lines along the field.
+**
+** Proposals (each node from the last, "along the field"):
+**   birth  p_0 uniform on the page; v_0 = (l/3) u + N(0, s_v^2) with u the
+**          field's direction at p_0 either way (probability 1/2 each), or,
+**          where there is no field, a uniform direction (v_0 then has the
+**          density of a Gaussian ring, with a Bessel I0); then node k+1
+**          from node k as for grow at the tail.
+**   grow   at the tail (dir = +1) after node a: p ~ N(p_a + 3 v_a, s_p^2),
+**          v ~ N((l/3) u(p), s_v^2), u the field's direction at p turned
+**          to agree with v_a (the direction of v_a where the field is off
+**          or vanishes, 0 where v_a is 0 too); at the head (dir = -1)
+**          before node a: p ~ N(p_a - 3 v_a, s_p^2), v likewise (vectors
+**          keep pointing from node 0 to node n).
+**   l = init.segment_length, s_p = l / 4, s_v = l / 12.  Every density is
+**   returned as a logarithm, so nothing under- or overflows.
+*/
+#ifndef LINEWISE_TRANSDIM_H
+#define LINEWISE_TRANSDIM_H
+
+#include <gsl/gsl_rng.h>
+
+#include "linewise/scene.h"
+#include "linewise/spline.h"
+
+typedef struct {
+  const lw_scene *scene;
+  double length;          /* l: mm */
+  double sigma_p, sigma_v; /* mm */
+  size_t birth_segments;  /* segments of a born spline */
+  size_t max_segments;    /* grow stops here */
+} lw_td;
+
+void lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double length, size_t max_segments);
+
+/* log q_{n-1} of the n >= 1 nodes nd (-inf when node 0 is off the page). */
+double lw_td_prior(const lw_td *td, const lw_node *nd, size_t n);
+
+/* log of node 0's factor of the prior: p uniform on the page, v as a
+** birth draws it. */
+double lw_td_first_log(const lw_td *td, const lw_node *n0);
+
+/* The change of log q when node k of the n nodes nd becomes *to. */
+double lw_td_prior_change(const lw_td *td, const lw_node *nd, size_t n, size_t k, const lw_node *to);
+
+/* Draws a born spline of birth_segments + 1 nodes into nd from the prior. */
+void lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd);
+
+/* Draws the node beyond `end` (dir +1: after it, -1: before it) into out;
+** returns log g.  lw_td_next_log: log g of a given node. */
+double lw_td_next_draw(const lw_td *td, const lw_node *end, int dir, gsl_rng *rng, lw_node *out);
+double lw_td_next_log(const lw_td *td, const lw_node *end, int dir, const lw_node *nd);
+
+#endif

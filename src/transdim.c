@@ -1,0 +1,146 @@
+/*
+** transdim.c -- proposal densities of the trans-dimensional moves
+** (transdim.h).  Each draw and its log density are written side by side
+** from one description of the kernel, so that the two cannot drift apart;
+** a test integrates every density numerically.
+*/
+#include "linewise/transdim.h"
+
+#include <gsl/gsl_math.h>
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_sf_bessel.h>
+#include <math.h>
+
+void lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double length, size_t max_segments)
+{
+  td->scene = sc;
+  td->length = length;
+  td->sigma_p = length / 4.0;
+  td->sigma_v = length / 12.0;
+  td->birth_segments = birth_segments;
+  td->max_segments = max_segments;
+}
+
+/* log of the isotropic 2-D Gaussian density N(d; 0, s^2) at offset d. */
+static double log_gauss2(double dx, double dy, double s)
+{
+  return -log(2.0 * M_PI * s * s) - 0.5 * (dx * dx + dy * dy) / (s * s);
+}
+
+/* The field's unit direction at (x, y) turned to agree with (ax, ay); the
+** unit (ax, ay) where the field is off or vanishes; 0 if that is 0 too. */
+static int direction(const lw_scene *sc, double x, double y, double ax, double ay, double *ux, double *uy)
+{
+  double fx = 0.0, fy = 0.0;
+  if (sc->on[LW_TERM_FIELD]) lw_field_eval(&sc->field, x, y, &fx, &fy);
+  double f = hypot(fx, fy);
+  if (!(f > 0.0) || !isfinite(f)) {
+    fx = ax;
+    fy = ay;
+    f = hypot(fx, fy);
+    if (!(f > 0.0) || !isfinite(f)) {
+      *ux = *uy = 0.0;
+      return 0;
+    }
+  }
+  double s = fx * ax + fy * ay < 0.0 ? -1.0 : 1.0;
+  *ux = s * fx / f;
+  *uy = s * fy / f;
+  return 1;
+}
+
+/* The mean of the next node's point beyond `end`. */
+static void next_point(const lw_node *end, int dir, double *x, double *y)
+{
+  *x = end->px + dir * 3.0 * end->vx;
+  *y = end->py + dir * 3.0 * end->vy;
+}
+
+double lw_td_next_draw(const lw_td *td, const lw_node *end, int dir, gsl_rng *rng, lw_node *out)
+{
+  double mx, my, ux, uy;
+  next_point(end, dir, &mx, &my);
+  out->px = mx + gsl_ran_gaussian_ziggurat(rng, td->sigma_p);
+  out->py = my + gsl_ran_gaussian_ziggurat(rng, td->sigma_p);
+  direction(td->scene, out->px, out->py, end->vx, end->vy, &ux, &uy);
+  out->vx = td->length / 3.0 * ux + gsl_ran_gaussian_ziggurat(rng, td->sigma_v);
+  out->vy = td->length / 3.0 * uy + gsl_ran_gaussian_ziggurat(rng, td->sigma_v);
+  return lw_td_next_log(td, end, dir, out);
+}
+
+double lw_td_next_log(const lw_td *td, const lw_node *end, int dir, const lw_node *nd)
+{
+  double mx, my, ux, uy;
+  next_point(end, dir, &mx, &my);
+  direction(td->scene, nd->px, nd->py, end->vx, end->vy, &ux, &uy);
+  const double r = td->length / 3.0;
+  return log_gauss2(nd->px - mx, nd->py - my, td->sigma_p) +
+         log_gauss2(nd->vx - r * ux, nd->vy - r * uy, td->sigma_v);
+}
+
+/* The first node's vector: along the field either way, or a ring. */
+static int first_axis(const lw_td *td, const lw_node *n0, double *ux, double *uy)
+{
+  /* the field itself, not turned: (fx, fy) agrees with itself */
+  double fx = 0.0, fy = 0.0;
+  if (td->scene->on[LW_TERM_FIELD]) lw_field_eval(&td->scene->field, n0->px, n0->py, &fx, &fy);
+  return direction(td->scene, n0->px, n0->py, fx, fy, ux, uy);
+}
+
+double lw_td_first_log(const lw_td *td, const lw_node *n0)
+{
+  const double r = td->length / 3.0, s = td->sigma_v;
+  const lw_scene *sc = td->scene;
+  if (!(n0->px >= 0.0 && n0->px <= sc->width && n0->py >= 0.0 && n0->py <= sc->height)) return -INFINITY;
+  double ux, uy, lp = -log(sc->width * sc->height);
+  if (first_axis(td, n0, &ux, &uy)) {
+    double a = log_gauss2(n0->vx - r * ux, n0->vy - r * uy, s), b = log_gauss2(n0->vx + r * ux, n0->vy + r * uy, s);
+    double hi = fmax(a, b);
+    return lp + hi + log(0.5 * (exp(a - hi) + exp(b - hi)));
+  }
+  /* a uniform angle: the ring density, I0 scaled so it cannot overflow */
+  double v = hypot(n0->vx, n0->vy), z = v * r / (s * s);
+  return lp - log(2.0 * M_PI * s * s) - 0.5 * (v - r) * (v - r) / (s * s) + log(gsl_sf_bessel_I0_scaled(z));
+}
+
+void lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd)
+{
+  const double r = td->length / 3.0;
+  double ux, uy;
+  nd[0].px = gsl_rng_uniform(rng) * td->scene->width;
+  nd[0].py = gsl_rng_uniform(rng) * td->scene->height;
+  if (first_axis(td, &nd[0], &ux, &uy)) {
+    if (gsl_rng_uniform(rng) < 0.5) {
+      ux = -ux;
+      uy = -uy;
+    }
+  } else {
+    double a = 2.0 * M_PI * gsl_rng_uniform(rng);
+    ux = cos(a);
+    uy = sin(a);
+  }
+  nd[0].vx = r * ux + gsl_ran_gaussian_ziggurat(rng, td->sigma_v);
+  nd[0].vy = r * uy + gsl_ran_gaussian_ziggurat(rng, td->sigma_v);
+  for (size_t k = 1; k <= td->birth_segments; k++) lw_td_next_draw(td, &nd[k - 1], 1, rng, &nd[k]);
+}
+
+double lw_td_prior(const lw_td *td, const lw_node *nd, size_t n)
+{
+  double lq = lw_td_first_log(td, &nd[0]);
+  for (size_t k = 1; k < n; k++) lq += lw_td_next_log(td, &nd[k - 1], 1, &nd[k]);
+  return lq;
+}
+
+/* The factors of the prior that node k of nd takes part in, with node k
+** read from at. */
+static double factors(const lw_td *td, const lw_node *nd, size_t n, size_t k, const lw_node *at)
+{
+  double f = k == 0 ? lw_td_first_log(td, at) : lw_td_next_log(td, &nd[k - 1], 1, at);
+  if (k + 1 < n) f += lw_td_next_log(td, at, 1, &nd[k + 1]);
+  return f;
+}
+
+double lw_td_prior_change(const lw_td *td, const lw_node *nd, size_t n, size_t k, const lw_node *to)
+{
+  return factors(td, nd, n, k, to) - factors(td, nd, n, k, &nd[k]);
+}

@@ -1,0 +1,417 @@
+/*
+** test_transdim.c -- trans-dimensional moves (issue 18): the ideal gas,
+** whose spline count and segment counts follow laws derived in
+** docs/NUMERICS.md ("Trans-dimensional moves"), tested by chi-square at
+** fixed seeds; incremental == full after many mixed proposals with births
+** and deaths; the splices of storage and grid; determinism across thread
+** counts and bit-exact resume through the command line.
+*/
+#include <criterion/criterion.h>
+#include <gsl/gsl_cdf.h>
+#include <gsl/gsl_randist.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "linewise/mc.h"
+#include "linewise/sys_splines.h"
+#include "linewise/transdim.h"
+#include "testutil.h"
+
+/* A chain on the spline system with fixed_count = 0 and the parameters p
+** (placed from `seed`), at temperature T. */
+static lw_chain *td_chain(lw_params *p, double T, unsigned long seed, void **setup)
+{
+  lw_error err = {0};
+  p->fixed_count = 0;
+  const lw_system_type *t = lw_system_of(p, &err);
+  cr_assert_eq(t, &lw_system_splines_td, "fixed_count = 0 selects the row with eight move kinds");
+  *setup = t->setup_new(p, &err);
+  cr_assert_not_null(*setup, "%s", err.msg);
+  lw_system *sys = lw_system_wrap(t, t->state_new(*setup, p, seed, &err), &err);
+  cr_assert_not_null(sys, "%s", err.msg);
+  double w[LW_MOVES_MAX], st[LW_MOVES_MAX], tg[LW_MOVES_MAX];
+  t->moves(p, w, st, tg);
+  lw_chain *c = lw_chain_new(sys, w, st, tg, seed + 1, &err);
+  cr_assert_not_null(c, "%s", err.msg);
+  c->temperature = T;
+  return c;
+}
+
+static void td_chain_free(lw_chain *c, void *setup)
+{
+  const lw_system_type *t = c->sys->type;
+  lw_system *sys = c->sys;
+  lw_chain_free(c);
+  lw_system_free(sys);
+  t->setup_free(setup);
+}
+
+/* The ideal gas: every interaction off, no regularity test (it would cut
+** the support by an unknown measure), the chemical potential per spline
+** mu_s on. */
+static void ideal_gas(lw_params *p, double mu_s)
+{
+  lw_params_defaults(p);
+  p->width = 60;
+  p->height = 40;
+  p->splines = 3;
+  p->segments = 2;
+  p->segment_length = 5;
+  p->min_speed = 0;
+  p->regularity = 0;
+  p->chem_spline = mu_s;
+  p->mix_point = p->mix_vector = p->mix_translate = p->mix_rotate = 0;
+  p->mix_birth = p->mix_death = p->mix_grow = p->mix_shrink = 0;
+}
+
+/* Chi-square p-value of counts[0..n) against probabilities prob[0..n)
+** (summing to 1 over all values: the tail past n - 1 is pooled into the
+** last bin), after merging neighbouring bins until each expects >= 5. */
+static double chisq_p(const unsigned long *counts, const double *prob, int n, unsigned long total)
+{
+  double chi2 = 0.0, e = 0.0, o = 0.0, tail = 1.0;
+  int bins = 0;
+  for (int k = 0; k < n; k++) {
+    double pk = k == n - 1 ? tail : prob[k];
+    tail -= prob[k];
+    e += pk * (double)total;
+    o += (double)counts[k];
+    if (e >= 5.0 || k == n - 1) {
+      chi2 += (o - e) * (o - e) / e;
+      bins++;
+      e = o = 0.0;
+    }
+  }
+  cr_assert(bins >= 4, "too few bins (%d) to test anything", bins);
+  return gsl_cdf_chisq_Q(chi2, bins - 1);
+}
+
+#define NMAX 64
+
+/* Sweeps the chain and tallies the spline count every `thin` sweeps, and
+** each spline's segment count. */
+static void tally(lw_chain *c, long samples, int thin, unsigned long *nc, unsigned long *sc, unsigned long *nseg)
+{
+  const lw_model *m = lw_splines_model(c->sys);
+  for (long s = 0; s < samples; s++) {
+    for (int k = 0; k < thin; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    size_t N = m->sp->n_splines;
+    nc[N < NMAX ? N : NMAX - 1]++;
+    for (size_t i = 0; i < N; i++) {
+      size_t n = lw_splines_segments(m->sp, i);
+      sc[n < NMAX ? n : NMAX - 1]++;
+      (*nseg)++;
+    }
+  }
+}
+
+/* Births and deaths alone: N is Poisson with mean exp(-mu_s / T), whatever
+** the shapes the births draw (NUMERICS.md). */
+Test(transdim, ideal_gas_count_is_poisson)
+{
+  lw_params p;
+  const double T = 1.3, lambda = 7.0;
+  ideal_gas(&p, -T * log(lambda));
+  p.mix_birth = p.mix_death = 1;
+  void *setup;
+  lw_chain *c = td_chain(&p, T, 11, &setup);
+  unsigned long nc[NMAX] = {0}, sc[NMAX] = {0}, ns = 0;
+  tally(c, 500, 4, nc, sc, &ns); /* burn-in */
+  memset(nc, 0, sizeof nc);
+  const long n = lw_test_long() ? 200000 : 20000;
+  tally(c, n, 4, nc, sc, &ns);
+  double prob[NMAX];
+  for (int k = 0; k < NMAX; k++) prob[k] = gsl_ran_poisson_pdf((unsigned)k, lambda);
+  double pv = chisq_p(nc, prob, 25, (unsigned long)n);
+  cr_assert(pv > 1e-3, "spline count vs Poisson(%g): chi-square p = %g", lambda, pv);
+  /* the test can fail: the same counts against a mean 5%% off */
+  for (int k = 0; k < NMAX; k++) prob[k] = gsl_ran_poisson_pdf((unsigned)k, 1.05 * lambda);
+  cr_assert(chisq_p(nc, prob, 25, (unsigned long)n) < 1e-3, "the chi-square test cannot tell a 5%% shift");
+  for (int k = LW_MOVE_BIRTH; k <= LW_MOVE_DEATH; k++)
+    cr_assert(c->stats[k].accepted > 1000, "kind %d accepted %lu", k, c->stats[k].accepted);
+  td_chain_free(c, setup);
+}
+
+/* Grow and shrink at a fixed count, with point and vector moves: each
+** spline's segment count is uniform over 1..max_segments. */
+Test(transdim, ideal_gas_segments_are_uniform)
+{
+  lw_params p;
+  ideal_gas(&p, 0.0);
+  p.splines = 6;
+  p.max_segments = 5;
+  p.mix_grow = p.mix_shrink = 1;
+  p.mix_point = p.mix_vector = 0.5;
+  void *setup;
+  lw_chain *c = td_chain(&p, 0.8, 12, &setup);
+  unsigned long nc[NMAX] = {0}, sc[NMAX] = {0}, ns = 0;
+  tally(c, 500, 2, nc, sc, &ns);
+  /* The fraction of splines with k segments (expected 1/5 each) and the
+  ** first node's moments, by batch means: a spline's segment count and
+  ** shape change a little per sweep, so the samples are correlated and a
+  ** chi-square over them would overstate its evidence (the long run showed
+  ** it). The prior's first node is uniform on the page however the head has
+  ** grown and shrunk -- what the head moves' Hastings factor is for: E u =
+  ** 1/2, E u^2 = 1/3 for u = x / W and y / H. */
+  enum { NB = 5 + 4 };
+  batch_mean mom[NB];
+  memset(mom, 0, sizeof mom);
+  const long per = (lw_test_long() ? 100000 : 10000) / BATCHES;
+  for (int k = 0; k < NB; k++) mom[k].per = per;
+  const lw_model *m = lw_splines_model(c->sys);
+  for (long s = 0; s < BATCHES * per; s++) {
+    for (int k = 0; k < 2; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    cr_assert_eq(m->sp->n_splines, 6, "grow and shrink never change the count");
+    double a[NB] = {0};
+    for (size_t i = 0; i < m->sp->n_splines; i++) {
+      const lw_node *n0 = &m->sp->node[m->sp->first[i]];
+      double u = n0->px / p.width, v = n0->py / p.height;
+      cr_assert(u >= 0 && u <= 1 && v >= 0 && v <= 1, "a first node left the page: (%g, %g)", n0->px, n0->py);
+      a[lw_splines_segments(m->sp, i) - 1] += 1.0 / 6;
+      a[5] += u / 6;
+      a[6] += v / 6;
+      a[7] += u * u / 6;
+      a[8] += v * v / 6;
+    }
+    for (int k = 0; k < NB; k++) bm_add(&mom[k], a[k]);
+  }
+  const double want[NB] = {0.2, 0.2, 0.2, 0.2, 0.2, 0.5, 0.5, 1.0 / 3.0, 1.0 / 3.0};
+  for (int k = 0; k < NB; k++) {
+    double se, mean = bm_mean(&mom[k], &se);
+    cr_assert(se < 0.02, "observable %d: standard error %g too large to test anything", k, se);
+    cr_assert(fabs(mean - want[k]) < 5 * se, "%s %d: %g +- %g, expected %g", k < 5 ? "fraction with segments" :
+              "first node, moment", k < 5 ? k + 1 : k - 5, mean, se, want[k]);
+  }
+  td_chain_free(c, setup);
+}
+
+/* Everything at once: N is Poisson with mean K exp(-mu_s / T), K = 4
+** reachable segment counts, and the segment counts stay uniform. */
+Test(transdim, ideal_gas_all_moves_together)
+{
+  lw_params p;
+  const double T = 0.9, lambda = 3.0;
+  ideal_gas(&p, -T * log(lambda));
+  p.splines = 12; /* sets the sweep: 36 proposals */
+  p.max_segments = 4;
+  p.mix_birth = p.mix_death = p.mix_grow = p.mix_shrink = 1;
+  p.mix_point = p.mix_vector = p.mix_translate = p.mix_rotate = 0.5;
+  void *setup;
+  lw_chain *c = td_chain(&p, T, 13, &setup);
+  unsigned long nc[NMAX] = {0}, sc[NMAX] = {0}, ns = 0;
+  tally(c, 500, 4, nc, sc, &ns);
+  memset(nc, 0, sizeof nc);
+  memset(sc, 0, sizeof sc);
+  ns = 0;
+  const long n = lw_test_long() ? 100000 : 12000;
+  tally(c, n, 8, nc, sc, &ns);
+  double prob[NMAX];
+  for (int k = 0; k < NMAX; k++) prob[k] = gsl_ran_poisson_pdf((unsigned)k, 4 * lambda);
+  double pv = chisq_p(nc, prob, 30, (unsigned long)n);
+  cr_assert(pv > 1e-3, "spline count vs Poisson(%g): chi-square p = %g", 4 * lambda, pv);
+  double pu[NMAX] = {0};
+  for (int k = 1; k <= 4; k++) pu[k] = 0.25;
+  pv = chisq_p(sc + 1, pu + 1, 4, ns);
+  cr_assert(pv > 1e-3, "segments vs uniform 1..4: p = %g", pv);
+  td_chain_free(c, setup);
+}
+
+/* Every term a splice touches on (segment, spline, pair with its near
+** field, boundary, chemical both ways), births and deaths accepted often at
+** a high temperature: the running terms equal a recomputation from scratch
+** within 1e-9 after many mixed proposals, and the caches a fresh model
+** builds. */
+Test(transdim, incremental_equals_full_with_births_and_deaths)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = 80;
+  p.height = 60;
+  p.splines = 12;
+  p.segments = 3;
+  p.segment_length = 4;
+  p.strain = 2;
+  p.bending = 0.5;
+  p.pair = 0.05;
+  p.pair_cutoff = 4;
+  p.boundary_coef = 0.1;
+  p.chem_spline = -3;
+  p.chem_length = 0.05;
+  p.max_segments = 6;
+  p.mix_birth = p.mix_death = 0.3;
+  p.mix_grow = p.mix_shrink = 0.3;
+  void *setup;
+  lw_chain *c = td_chain(&p, 30.0, 14, &setup);
+  const lw_model *m = lw_splines_model(c->sys);
+  const unsigned long total = lw_test_long() ? 1000000 : 100000;
+  unsigned long props = 0;
+  int checks = 0;
+  while (props < total) {
+    for (int k = 0; k < 10; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    props = 0;
+    for (int k = 0; k < c->n_moves; k++) props += c->stats[k].proposed;
+    double term[LW_TERM_COUNT];
+    lw_error err = {0};
+    double full = lw_energy_compute(m->scene, m->sp, term, &err), run = lw_model_total(m);
+    cr_assert(isfinite(full), "%s", err.msg);
+    const double scale = fmax(fabs(full), 1.0);
+    cr_assert(fabs(run - full) <= 1e-9 * scale, "after %lu proposals: running %.17g, full %.17g", props, run, full);
+    for (int t = 0; t < LW_TERM_COUNT; t++)
+      cr_assert(fabs(m->term[t] - term[t]) <= 1e-9 * scale, "after %lu proposals: term %s running %.17g, full %.17g",
+                props, lw_term_names[t], m->term[t], term[t]);
+    checks++;
+  }
+  for (int k = LW_MOVE_BIRTH; k < LW_MOVE_KINDS_TD; k++)
+    cr_assert(c->stats[k].accepted > 200, "%s accepted only %lu of %lu", c->sys->type->move_names[k],
+              c->stats[k].accepted, c->stats[k].proposed);
+  /* the spliced caches and grid are what a model built afresh holds */
+  lw_error err = {0};
+  lw_model *f = lw_model_new(m->scene, lw_splines_clone(m->sp), &err);
+  cr_assert_not_null(f, "%s", err.msg);
+  cr_assert_eq(f->sp->n_segments, m->sp->n_segments);
+  const int np = m->scene->pair_quad.n, nl = m->scene->n_local;
+  for (size_t g = 0; g < m->sp->n_segments; g++) {
+    cr_assert_eq(f->seg_len[g], m->seg_len[g], "segment %zu: length %.17g vs %.17g", g, m->seg_len[g], f->seg_len[g]);
+    cr_assert_eq(f->sp->seg_spline[g], m->sp->seg_spline[g], "segment %zu: spline", g);
+    for (int t = 0; t < nl; t++) cr_assert_eq(f->seg_local[g * nl + t], m->seg_local[g * nl + t]);
+    for (int q = 0; q < np; q++) {
+      double x0, y0, x1, y1;
+      float d0, d1;
+      lw_cellgrid_get(m->grid, (uint32_t)(g * np + q), &x0, &y0, &d0);
+      lw_cellgrid_get(f->grid, (uint32_t)(g * np + q), &x1, &y1, &d1);
+      cr_assert(x0 == x1 && y0 == y1 && d0 == d1, "segment %zu: pair sample %d differs", g, q);
+    }
+  }
+  for (size_t i = 0; i < m->sp->n_splines; i++) {
+    cr_assert_eq(f->spline_len[i], m->spline_len[i], "spline %zu: length", i);
+    cr_assert_eq(f->sp->first[i], m->sp->first[i]);
+  }
+  cr_assert_eq(f->grid->n_samples, m->grid->n_samples);
+  cr_assert(checks > 10);
+  lw_model_free(f);
+  td_chain_free(c, setup);
+}
+
+/* A small scene with every kind of term a splice differences (segment,
+** spline, pair with its near field, boundary, chemical) and the eight move
+** kinds, annealed cold enough that births, deaths, grows and shrinks all
+** happen; tempered with two replicas. */
+static const char *cli_scene = "[scene]\nwidth = 60\nheight = 50\nmargin = 2\nfield = waves\n"
+                               "potential = radial\n"
+                               "[init]\nsplines = 10\nsegments = 3\nsegment_length = 4\n"
+                               "[energy]\nstrain = 2\nbending = 0.3\npotential = 0.3\nfield = -0.2\npair = 0.05\n"
+                               "pair_cutoff = 4\nboundary = 0.1\nchem_spline = -1\nchem_length = 0.02\n"
+                               "[moves]\nfixed_count = 0\nmax_segments = 6\nbirth = 0.05\ndeath = 0.05\n"
+                               "grow = 0.05\nshrink = 0.05\n"
+                               "[anneal]\nschedule = geometric\nt_start = 3\nt_end = 0.05\nsweeps = 60\nsteps = 6\n"
+                               "seed = 5\ncheck_every = 7\n"
+                               "[tempering]\nreplicas = 2\nt_min = 0.05\nt_max = 3\n";
+
+/* The number under key `kind` in the object `obj` of dir/a/summary.json,
+** NAN if there is none. */
+static double summary_value(const char *dir, const char *obj, const char *kind)
+{
+  char path[128], line[256], open[64], key[64];
+  snprintf(path, sizeof path, "%s/a/summary.json", dir);
+  snprintf(open, sizeof open, "\"%s\": {", obj);
+  snprintf(key, sizeof key, "\"%s\":", kind);
+  FILE *f = fopen(path, "r");
+  cr_assert_not_null(f);
+  int in = 0;
+  double v = NAN;
+  while (fgets(line, sizeof line, f) && isnan(v)) {
+    if (strstr(line, open)) in = 1;
+    else if (in && strchr(line, '}')) in = 0;
+    else if (in && strstr(line, key)) v = strtod(strchr(line, ':') + 1, NULL);
+  }
+  fclose(f);
+  return v;
+}
+
+static void write_cli_scene(const char *dir)
+{
+  char path[128];
+  snprintf(path, sizeof path, "%s/s.ini", dir);
+  FILE *f = fopen(path, "w");
+  cr_assert_not_null(f);
+  fputs(cli_scene, f);
+  fclose(f);
+}
+
+/* Same scene and seed => byte-identical outputs for any thread count, and a
+** run stopped and resumed twice ends where the uninterrupted one does. */
+Test(transdim, runs_are_deterministic_and_resume_bit_exactly, .timeout = 300)
+{
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "transdim"), 0);
+  write_cli_scene(dir);
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=1 %s run %s/s.ini --out %s/a --quiet", b, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=3 %s run %s/s.ini --out %s/b --quiet", b, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=2 %s run %s/s.ini --out %s/c --quiet --stop-at 23", b, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=1 %s resume %s/c --quiet --stop-at 41", b, dir), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=2 %s resume %s/c --quiet", b, dir), 0);
+  const char *same[] = {"state.lw", "trace.csv", "final.svg"};
+  for (int i = 0; i < 3; i++) {
+    cr_assert_eq(lw_test_sh("cmp -s %s/a/%s %s/b/%s", dir, same[i], dir, same[i]), 0, "%s differs by threads", same[i]);
+    cr_assert_eq(lw_test_sh("cmp -s %s/a/%s %s/c/%s", dir, same[i], dir, same[i]), 0, "%s differs after resume",
+                 same[i]);
+  }
+  /* every trans-dimensional kind was accepted, and the count changed */
+  const char *kinds[] = {"birth", "death", "grow", "shrink"};
+  for (int k = 0; k < 4; k++) {
+    double a = summary_value(dir, "acceptance", kinds[k]);
+    cr_assert(a > 0 && a < 1, "%s: acceptance %g", kinds[k], a);
+  }
+  cr_assert_eq(lw_test_sh("head -1 %s/a/trace.csv | grep -q ',acc_birth,acc_death,acc_grow,acc_shrink'", dir), 0);
+  cr_assert_neq(lw_test_sh("grep -q '\"splines\": 10,' %s/a/summary.json", dir), 0, "the count never changed");
+  /* and the default keeps the four kinds, columns and keys of before */
+  cr_assert_eq(lw_test_sh("%s run %s/s.ini --set moves.fixed_count=1 --set anneal.sweeps=4 --out %s/d --quiet", b, dir,
+                          dir), 0);
+  cr_assert_neq(lw_test_sh("grep -q birth %s/d/trace.csv %s/d/summary.json %s/d/state.lw", dir, dir, dir), 0);
+  lw_test_dir_remove(dir);
+}
+
+/* Hard cases: a page a kilometre wide with lines of a micrometre, and one
+** with the regularity tests on where births and grows propose folded
+** segments: every move kind runs, nothing NaN enters the state, and the
+** running energy stays the recomputed one. */
+Test(transdim, hard_scales_keep_the_state_finite)
+{
+  const double widths[2] = {1e6, 100}, lengths[2] = {1e-3, 8};
+  for (int h = 0; h < 2; h++) {
+    lw_params p;
+    lw_params_defaults(&p);
+    p.width = widths[h];
+    p.height = widths[h] / 2;
+    p.margin = 0;
+    p.splines = 20;
+    p.segments = 2;
+    p.segment_length = lengths[h];
+    p.bending = 1;
+    p.strain = 1;
+    p.pair = 0.05;
+    p.pair_cutoff = 4 * lengths[h];
+    p.chem_spline = -2;
+    p.chem_length = 1 / lengths[h];
+    p.max_segments = 5;
+    p.mix_birth = p.mix_death = p.mix_grow = p.mix_shrink = 0.2;
+    void *setup;
+    lw_chain *c = td_chain(&p, 2.0, 21 + (unsigned long)h, &setup);
+    const lw_model *m = lw_splines_model(c->sys);
+    for (int s = 0; s < 300; s++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    cr_assert(lw_splines_finite(m->sp), "case %d: a coordinate is not finite", h);
+    unsigned long nan = 0, acc = 0;
+    for (int k = 0; k < c->n_moves; k++) nan += c->stats[k].nan;
+    for (int k = LW_MOVE_BIRTH; k < LW_MOVE_KINDS_TD; k++) acc += c->stats[k].accepted;
+    cr_assert_eq(nan, 0, "case %d: %lu proposals with a NaN dE", h, nan);
+    cr_assert(acc > 0, "case %d: no trans-dimensional move accepted", h);
+    double term[LW_TERM_COUNT];
+    lw_error err = {0};
+    double full = lw_energy_compute(m->scene, m->sp, term, &err), run = lw_model_total(m);
+    cr_assert(isfinite(full) && fabs(run - full) <= 1e-9 * fmax(fabs(full), 1.0), "case %d: running %.17g, full %.17g",
+              h, run, full);
+    td_chain_free(c, setup);
+  }
+}
