@@ -42,9 +42,9 @@ const lw_param_def lw_param_table[] = {
          "tone of lines, sized from output.pen_width and the page rather than in fixed "
          "millimetres, so one scene works from A6 to A3 (docs/IMAGES.md, \"Photographs\", lists "
          "what it sets). Keys the scene or --set gives win."),
-  CHOICE("scene", "page", page, "custom", "custom|a4|a3|letter",
+  CHOICE("scene", "page", page, "custom", "custom|a4|a3|letter|a5|a6",
          "Page size: `custom` takes `width` and `height`; a4 is 210 x 297 mm, a3 297 x 420 mm, "
-         "letter 215.9 x 279.4 mm (portrait). A named page sets width and height; setting "
+         "letter 215.9 x 279.4 mm, a5 148 x 210 mm, a6 105 x 148 mm (portrait). A named page sets width and height; setting "
          "either as well is an error unless it agrees."),
   CHOICE("scene", "orientation", orientation, "portrait", "portrait|landscape",
          "Orientation of a named page: landscape swaps its width and height."),
@@ -766,7 +766,7 @@ lw_status lw_params_read(lw_params *p, const char *path, lw_error *err)
 
 /* Named page sizes in mm, portrait, in the order of the choices of
 ** scene.page (custom first, which has none). */
-static const double page_mm[][2] = {{0, 0}, {210, 297}, {297, 420}, {215.9, 279.4}};
+static const double page_mm[][2] = {{0, 0}, {210, 297}, {297, 420}, {215.9, 279.4}, {148, 210}, {105, 148}};
 
 /*
 ** scene.preset = photo: lengths in pen widths w (the line's own scale), the
@@ -793,7 +793,7 @@ static const struct {
     {"energy", "min_spacing", NULL, 1},    {"energy", "quadrature", "6", 0},
     {"energy", "boundary", "0.2", 0},      {"anneal", "schedule", "geometric", 0},
     {"anneal", "t_start", "0.5", 0},       {"anneal", "t_end", "0.002", 0},
-    {"anneal", "sweeps", "120", 0},        {"anneal", "steps", "5", 0},
+    {"anneal", "sweeps", "400", 0},        {"anneal", "steps", "5", 0},
 };
 
 /* Sets an unset key from text; the key stays unset (line 0), so a later
@@ -818,10 +818,11 @@ static void apply_preset(lw_params *p)
     }
     preset_key(p, photo_preset[k].section, photo_preset[k].key, t);
   }
-  /* domains of at least 140 w (3.5 splines of 5 segments of 8 w: a move's
-  ** reach is one spline and the cutoff), so few splines wait on their edges */
-  double side = fmin(p->width, p->height) - 2.0 * p->margin;
-  int n = (int)floor(side / (140.0 * w));
+  /* domains of 90 w: more than twice a move's reach (a spline of 40 w and
+  ** the cutoff), and small enough that each of the four phases has work
+  ** for every core where the picture's ink is uneven (3 a side on A4 used
+  ** 1.3 of 2 cores, 6 a side 1.8; docs/IMAGES.md) */
+  int n = (int)floor((fmin(p->width, p->height) - 2.0 * p->margin) / (90.0 * w));
   snprintf(text, sizeof text, "%d", n < 1 ? 1 : (n > 64 ? 64 : n));
   preset_key(p, "anneal", "domains", n < 2 ? "off" : text);
 }

@@ -167,6 +167,8 @@ Test(params, named_pages_set_the_size)
     {"[scene]\npage = a4\n", 210, 297},
     {"[scene]\npage = a3\n", 297, 420},
     {"[scene]\npage = letter\n", 215.9, 279.4},
+    {"[scene]\npage = a5\n", 148, 210},
+    {"[scene]\npage = a6\norientation = landscape\n", 148, 105},
     {"[scene]\npage = a4\norientation = landscape\n", 297, 210},
     {"[scene]\npage = letter\norientation = landscape\n", 279.4, 215.9},
     /* an explicit size that agrees is fine (a resolved scene.ini has both) */
@@ -286,4 +288,44 @@ Test(params, long_lines_are_refused_with_their_own_line_number)
   cr_assert_eq(lw_params_read(&q, path, &err), LW_OK, "%s", err.msg);
   unlink(path);
   cr_assert_str_eq(q.polygon, p.polygon);
+}
+
+/*
+** scene.preset = photo fills the keys a scene leaves unset, lengths in pen
+** widths and the domain lattice from the page; keys the file or --set give
+** win, and a later resolve follows a changed pen width.
+*/
+Test(params, photo_preset_scales_with_the_pen_and_the_page)
+{
+  lw_params p;
+  lw_error err;
+  cr_assert_eq(read_text("[scene]\npreset = photo\npage = a4\n[output]\npen_width = 0.35\n", &p, &err), LW_OK,
+               "%s", err.msg);
+  cr_assert(fabs(p.segment_length - 8 * 0.35) < 1e-12 && fabs(p.pair_cutoff - 3 * 0.35) < 1e-12 &&
+                fabs(p.min_spacing - 0.35) < 1e-12 && fabs(p.tone_blur - 3 * 0.35) < 1e-12,
+            "segment %g, cutoff %g, spacing %g, blur %g", p.segment_length, p.pair_cutoff, p.min_spacing,
+            p.tone_blur);
+  cr_assert(p.tone == 5 && p.tone_ink == 0.5 && p.coverage == 0.4 && p.splines == 0 && p.sweeps == 400);
+  /* A4 less 10 mm margins: 190 mm / (90 x 0.35 mm) = 6 domains a side */
+  cr_assert_str_eq(p.domains, "6");
+  /* --set of the pen width: the preset's keys follow, a set key stays */
+  cr_assert_eq(lw_params_set(&p, "output.pen_width=0.5", &err), LW_OK);
+  cr_assert_eq(lw_params_set(&p, "energy.pair_cutoff=4", &err), LW_OK);
+  cr_assert_eq(lw_params_resolve(&p, &err), LW_OK);
+  cr_assert(fabs(p.segment_length - 4.0) < 1e-12 && p.pair_cutoff == 4.0, "%g %g", p.segment_length,
+            p.pair_cutoff);
+  cr_assert_str_eq(p.domains, "4");
+  /* the file's keys win; A6 at the default pen of 0.3 mm: 85 mm / 27 mm = 3
+  ** domains a side, and with a 1 mm pen fewer than 2, so not split */
+  cr_assert_eq(read_text("[scene]\npreset = photo\npage = a6\n[init]\ncoverage = 0.3\n", &p, &err), LW_OK);
+  cr_assert(p.coverage == 0.3 && fabs(p.segment_length - 8 * 0.3) < 1e-12);
+  cr_assert_str_eq(p.domains, "3");
+  cr_assert_eq(lw_params_set(&p, "output.pen_width=1", &err), LW_OK);
+  cr_assert_eq(lw_params_resolve(&p, &err), LW_OK);
+  cr_assert_str_eq(p.domains, "off");
+  /* without the preset nothing changes */
+  lw_params d;
+  lw_params_defaults(&d);
+  cr_assert_eq(read_text("[scene]\npage = a4\n", &p, &err), LW_OK);
+  cr_assert(p.segment_length == d.segment_length && p.tone == d.tone && !strcmp(p.domains, d.domains));
 }

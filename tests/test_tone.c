@@ -555,3 +555,25 @@ Test(tone, runs_resume_and_thread_counts_give_the_same_bytes)
                           dir, dir),
                0, "summary.json names the tone term and the close share");
 }
+
+/* energy.tone_ink scales the target: black asks for that share of ink, so
+** every pixel of the target is exactly tone_ink times the full one (halving
+** is exact in floating point). */
+Test(tone, tone_ink_scales_the_target)
+{
+  lw_params p = tone_params(30, 20, grey, 1.0, 1.0), q = p;
+  q.tone_ink = 0.5;
+  lw_scene a, b;
+  scene_of(&a, &p);
+  scene_of(&b, &q);
+  cr_assert(a.tone.w == b.tone.w && a.tone.h == b.tone.h);
+  double most = 0.0;
+  for (size_t k = 0; k < (size_t)a.tone.w * (size_t)a.tone.h; k++) {
+    cr_assert_eq(b.tone.dark[k], 0.5f * a.tone.dark[k], "pixel %zu: %g against %g", k, b.tone.dark[k],
+                 a.tone.dark[k]);
+    if (a.tone.dark[k] > most) most = a.tone.dark[k];
+  }
+  cr_assert(most > 0.25, "the target has no ink to scale (%g)", most);
+  lw_scene_clear(&a);
+  lw_scene_clear(&b);
+}

@@ -43,7 +43,7 @@ extern const lw_param_def lw_param_table[];
 extern const size_t lw_param_count;
 
 /* Choice indices (order of the choices strings in params.c). */
-enum { LW_PAGE_CUSTOM, LW_PAGE_A4, LW_PAGE_A3, LW_PAGE_LETTER };
+enum { LW_PAGE_CUSTOM, LW_PAGE_A4, LW_PAGE_A3, LW_PAGE_LETTER, LW_PAGE_A5, LW_PAGE_A6 };
 enum { LW_ORIENT_PORTRAIT, LW_ORIENT_LANDSCAPE };
 enum { LW_BND_RECT, LW_BND_CIRCLE, LW_BND_POLYGON, LW_BND_MASK };
 enum { LW_POT_CONSTANT, LW_POT_RAMP, LW_POT_RADIAL, LW_POT_IMAGE };
