@@ -234,9 +234,8 @@ typedef struct {
   double rc, rc2, inv;
 } cut;
 
-
-/* The 6 x 6 product rule over two pieces of 1/r (cut: no cutoff) or of
-** (1/r - 1/rc)+, B's nodes two at a time.  Every term is >= 0. */
+/* The 6 x 6 product rule over two pieces of the kernel k, B's nodes two at
+** a time.  Every term is >= 0. */
 static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb, const cut *k)
 {
   piece_nodes(ca, pa);
