@@ -109,25 +109,9 @@ Test(tone, a_move_changes_the_energy_by_the_full_recomputation)
   cr_assert(term0[LW_TERM_TONE] > 0.0);
   lw_node nd[8];
   for (int trial = 0; trial < 300; trial++) {
-    uint32_t i = (uint32_t)gsl_rng_uniform_int(r, m->sp->n_splines);
-    size_t nn = m->sp->first[i + 1] - m->sp->first[i], node0 = 0, n_node = nn;
-    const lw_node *src = &m->sp->node[m->sp->first[i]];
-    int kind = trial % 3;
-    if (kind < 2) {
-      node0 = gsl_rng_uniform_int(r, nn);
-      n_node = 1;
-    }
-    double dx = gsl_ran_gaussian(r, 0.7), dy = gsl_ran_gaussian(r, 0.7);
-    for (size_t k = 0; k < n_node; k++) {
-      nd[k] = src[node0 + k];
-      if (kind == 1) {
-        nd[k].vx += dx;
-        nd[k].vy += dy;
-      } else {
-        nd[k].px += dx;
-        nd[k].py += dy;
-      }
-    }
+    uint32_t i;
+    size_t node0, n_node;
+    lw_test_random_move(m->sp, r, trial % 3, 0.7, nd, &i, &node0, &n_node);
     lw_model_propose(m, pr, i, node0, n_node, nd);
     lw_splines *moved = lw_splines_clone(m->sp);
     memcpy(&moved->node[moved->first[i] + node0], nd, n_node * sizeof *nd);

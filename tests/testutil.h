@@ -4,6 +4,8 @@
 
 #include <criterion/criterion.h>
 #include <gsl/gsl_math.h>
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -175,6 +177,36 @@ static inline void lw_test_arc(lw_splines *sp, size_t i, double cx, double cy, d
     nd[j] = (lw_node){cx + R * cos(t), cy + R * sin(t), -k * sin(t), k * cos(t)};
   }
   sp->rest_length[i] = fabs(t1 - t0) * R;
+}
+
+/* A random move of sp for checks of dE against recomputation: kind 0 moves
+** one point p, 1 one vector v, 2 the whole spline, by a Gaussian step of
+** standard deviation sd (x then y drawn from r).  The new nodes go to nd
+** (room for the longest spline), the spline, first node and count to *i,
+** *node0, *n_node, as lw_model_propose takes them. */
+static inline void lw_test_random_move(const lw_splines *sp, gsl_rng *r, int kind, double sd, lw_node *nd,
+                                       uint32_t *i, size_t *node0, size_t *n_node)
+{
+  *i = (uint32_t)gsl_rng_uniform_int(r, sp->n_splines);
+  size_t nn = sp->first[*i + 1] - sp->first[*i];
+  const lw_node *src = &sp->node[sp->first[*i]];
+  *node0 = 0;
+  *n_node = nn;
+  if (kind < 2) {
+    *node0 = gsl_rng_uniform_int(r, nn);
+    *n_node = 1;
+  }
+  double dx = gsl_ran_gaussian(r, sd), dy = gsl_ran_gaussian(r, sd);
+  for (size_t k = 0; k < *n_node; k++) {
+    nd[k] = src[*node0 + k];
+    if (kind == 1) {
+      nd[k].vx += dx;
+      nd[k].vy += dy;
+    } else {
+      nd[k].px += dx;
+      nd[k].py += dy;
+    }
+  }
 }
 
 #endif
