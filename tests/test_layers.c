@@ -82,24 +82,6 @@ static lw_params colour_params(double page, int w, void (*f)(double, double, dou
   return p;
 }
 
-static void scene_of(lw_scene *sc, const lw_params *p)
-{
-  lw_error err;
-  cr_assert_eq(lw_scene_init(sc, p, &err), LW_OK, "%s", err.msg);
-}
-
-static lw_model *model_of(const lw_scene *sc, size_t n, size_t segs, double len, unsigned long seed)
-{
-  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-  gsl_rng_set(r, seed);
-  lw_error err;
-  lw_splines *sp = lw_init_random(sc, n, segs, len, r, &err);
-  cr_assert_not_null(sp, "%s", err.msg);
-  gsl_rng_free(r);
-  lw_model *m = lw_model_new(sc, sp, &err);
-  cr_assert_not_null(m, "%s", err.msg);
-  return m;
-}
 
 Test(layers, a_move_changes_the_energy_by_the_full_recomputation)
 {
@@ -123,9 +105,9 @@ Test(layers, a_move_changes_the_energy_by_the_full_recomputation)
   p.pair = 0.02;
   p.pair_cutoff = 2;
   lw_scene sc;
-  scene_of(&sc, &p);
+  lw_test_scene(&sc, &p);
   cr_assert_eq(sc.layers.n, 3);
-  lw_model *m = model_of(&sc, 45, 3, 3, 11);
+  lw_model *m = lw_test_model_random(&sc, 45, 3, 3, 11);
   lw_proposal *pr = lw_proposal_new(m, NULL);
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
   gsl_rng_set(r, 12);
@@ -186,10 +168,10 @@ Test(layers, one_whole_range_layer_is_the_scene_without_layers)
   p.field_coef = -0.5;
   p.bending = 0.2;
   lw_scene plain, one;
-  scene_of(&plain, &p);
+  lw_test_scene(&plain, &p);
   snprintf(p.ly_names, sizeof p.ly_names, "all");
-  scene_of(&one, &p);
-  lw_model *m = model_of(&plain, 40, 3, 3, 4);
+  lw_test_scene(&one, &p);
+  lw_model *m = lw_test_model_random(&plain, 40, 3, 3, 4);
   double a[LW_TERM_COUNT], b[LW_TERM_COUNT];
   double ea = lw_energy_compute(&plain, m->sp, a, NULL), eb = lw_energy_compute(&one, m->sp, b, NULL);
   for (int t = 0; t < LW_TERM_COUNT; t++) cr_assert_eq(a[t], b[t], "%s: %.17g and %.17g", lw_term_names[t], a[t], b[t]);
@@ -205,7 +187,7 @@ Test(layers, one_whole_range_layer_is_the_scene_without_layers)
   cr_assert_eq(n_plain, n_one);
   lw_scene two;
   snprintf(p.ly_names, sizeof p.ly_names, "all again");
-  scene_of(&two, &p);
+  lw_test_scene(&two, &p);
   cr_assert_eq(lw_init_count(&two, &p, &n_two, &err), LW_OK, "%s", err.msg);
   cr_assert(n_two >= 2 * n_one - 1 && n_two <= 2 * n_one + 1, "%zu and %zu", n_one, n_two);
   lw_scene_clear(&two);
@@ -213,7 +195,7 @@ Test(layers, one_whole_range_layer_is_the_scene_without_layers)
   /* and a narrower range asks for less ink: the tone term sees it */
   lw_scene half;
   snprintf(p.ly_tone_max, sizeof p.ly_tone_max, "0.5");
-  scene_of(&half, &p);
+  lw_test_scene(&half, &p);
   lw_energy_compute(&half, m->sp, b, NULL);
   cr_assert_neq(a[LW_TERM_TONE], b[LW_TERM_TONE]);
   lw_model_free(m);
@@ -257,13 +239,13 @@ Test(layers, hatching_layers_follow_their_own_fields)
   p.boundary_coef = 0.05;
   p.min_speed = p.regularity = 0;
   lw_scene plain, sc;
-  scene_of(&plain, &p);
+  lw_test_scene(&plain, &p);
   p.field = LW_FLD_CONSTANT;
   p.field_angle = 0;
   p.field_coef = -2;
   snprintf(p.ly_names, sizeof p.ly_names, "along across");
   snprintf(p.ly_turn, sizeof p.ly_turn, "0 90");
-  scene_of(&sc, &p);
+  lw_test_scene(&sc, &p);
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
   gsl_rng_set(r, 9);
   lw_error err;
@@ -288,7 +270,7 @@ Test(layers, hatching_layers_follow_their_own_fields)
   model_chain_free(c);
   lw_model_free(m);
   /* and the placement starts each layer along its own field already */
-  m = model_of(&sc, 30, 3, 4, 9);
+  m = lw_test_model_random(&sc, 30, 3, 4, 9);
   cr_assert(alignment(m, 0, 1, 0) > 0.99 && alignment(m, 1, 0, 1) > 0.99, "%g %g", alignment(m, 0, 1, 0),
             alignment(m, 1, 0, 1));
   lw_model_free(m);
@@ -329,8 +311,8 @@ Test(layers, the_gradient_reads_each_layers_field_and_potential)
   p.field_coef = -0.7;
   p.bending = 0.3;
   lw_scene sc;
-  scene_of(&sc, &p);
-  lw_model *m = model_of(&sc, 8, 2, 3, 3);
+  lw_test_scene(&sc, &p);
+  lw_model *m = lw_test_model_random(&sc, 8, 2, 3, 3);
   lw_splines *sp = lw_splines_clone(m->sp);
   lw_node *g = calloc(sp->n_nodes, sizeof *g);
   lw_error err;
@@ -465,7 +447,7 @@ Test(layers, a_cmyk_scene_gives_each_pen_its_separation_as_target)
   p.ly_source = LW_LSRC_CMYK;
   p.tone = 1;
   lw_scene sc;
-  scene_of(&sc, &p);
+  lw_test_scene(&sc, &p);
   cr_assert_eq(sc.layers.n, 4);
   cr_assert_eq(sc.layers.spec[0].rgb[0], 0);
   cr_assert_eq(sc.layers.spec[2].rgb[2], 0);

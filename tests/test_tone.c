@@ -47,24 +47,6 @@ static double blotches(double u, double v) { return 0.5 + 0.4 * sin(7 * u + 2 * 
 static double grey(double u, double v) { (void)u; (void)v; return 0.7; }
 static double ramp(double u, double v) { (void)v; return 1.0 - u; } /* white at the left, black at the right */
 
-static void scene_of(lw_scene *sc, const lw_params *p)
-{
-  lw_error err;
-  cr_assert_eq(lw_scene_init(sc, p, &err), LW_OK, "%s", err.msg);
-}
-
-static lw_model *model_of(const lw_scene *sc, size_t n, size_t segs, double len, unsigned long seed)
-{
-  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-  gsl_rng_set(r, seed);
-  lw_error err;
-  lw_splines *sp = lw_init_random(sc, n, segs, len, r, &err);
-  cr_assert_not_null(sp, "%s", err.msg);
-  gsl_rng_free(r);
-  lw_model *m = lw_model_new(sc, sp, &err);
-  cr_assert_not_null(m, "%s", err.msg);
-  return m;
-}
 
 /* A chain over m at temperature T with the default mix. */
 static lw_chain *chain_of(lw_model *m, double T, unsigned long seed)
@@ -99,8 +81,8 @@ Test(tone, a_move_changes_the_energy_by_the_full_recomputation)
   p.pair = 0.02;
   p.pair_cutoff = 2;
   lw_scene sc;
-  scene_of(&sc, &p);
-  lw_model *m = model_of(&sc, 60, 3, 3, 11);
+  lw_test_scene(&sc, &p);
+  lw_model *m = lw_test_model_random(&sc, 60, 3, 3, 11);
   lw_proposal *pr = lw_proposal_new(m, NULL);
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
   gsl_rng_set(r, 12);
@@ -148,8 +130,8 @@ Test(tone, the_raster_after_many_moves_is_the_one_built_from_scratch)
   p.strain = 5;
   p.bending = 0.2;
   lw_scene sc;
-  scene_of(&sc, &p);
-  lw_model *m = model_of(&sc, 300, 3, 2, 21);
+  lw_test_scene(&sc, &p);
+  lw_model *m = lw_test_model_random(&sc, 300, 3, 2, 21);
   lw_chain *c = chain_of(m, 0.05, 22);
   for (int s = 0; s < 40; s++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
   unsigned long acc = 0;
@@ -175,9 +157,9 @@ Test(tone, off_it_holds_no_raster)
   lw_params p = tone_params(30, 20, grey, 0.0, 1.0);
   p.bending = 1;
   lw_scene sc;
-  scene_of(&sc, &p);
+  lw_test_scene(&sc, &p);
   cr_assert_null(sc.tone.dark, "no target is built for a term that is off");
-  lw_model *m = model_of(&sc, 20, 2, 3, 5);
+  lw_model *m = lw_test_model_random(&sc, 20, 2, 3, 5);
   lw_proposal *pr = lw_proposal_new(m, NULL);
   lw_node nd = m->sp->node[1];
   nd.px += 0.3;
@@ -199,7 +181,7 @@ Test(tone, a_sample_deposits_its_ink_area)
   ** pen * dl to sum_p A B_p, up to the rounding of each pixel (2^-32). */
   lw_params p = tone_params(30, 30, grey, 1.0, 0.9);
   lw_scene sc;
-  scene_of(&sc, &p);
+  lw_test_scene(&sc, &p);
   const lw_tone *t = &sc.tone;
   int64_t *r = lw_tone_raster_new(t);
   cr_assert_not_null(r);
@@ -267,9 +249,9 @@ Test(tone, a_flat_grey_picture_gets_uniform_ink_at_its_darkness)
   p.bending = 0.3;
   p.boundary_coef = 0.05;
   lw_scene sc;
-  scene_of(&sc, &p);
+  lw_test_scene(&sc, &p);
   double area = 26.0 * 26.0, half = 0.5 * D * area / p.pen_width;
-  lw_model *m = model_of(&sc, (size_t)(half / 6.0), 3, 2, 31);
+  lw_model *m = lw_test_model_random(&sc, (size_t)(half / 6.0), 3, 2, 31);
   lw_chain *c = chain_of(m, 0.01, 32);
   anneal(c, 0.05, 0.0005, 120);
   int rim = (int)ceil(3 * sigma / sc.tone.pixel), bpx;
@@ -327,9 +309,9 @@ Test(tone, density_follows_tone_instead_of_piling_into_the_darks)
     p.bending = 0.3;
     p.boundary_coef = 0.05;
     lw_scene sc;
-    scene_of(&sc, &p);
+    lw_test_scene(&sc, &p);
     double ink = 0.5 * 26.0 * 26.0 / p.pen_width; /* mm of line the darkness asks for */
-    lw_model *m = model_of(&sc, (size_t)(ink / 6.0), 3, 2, 41);
+    lw_model *m = lw_test_model_random(&sc, (size_t)(ink / 6.0), 3, 2, 41);
     lw_chain *c = chain_of(m, 0.01, 42);
     anneal(c, 0.05, 0.0005, 100);
     share[with_tone] = darkest_tenth_share(m);
@@ -424,7 +406,7 @@ Test(tone, the_spacing_constraint_holds_once_kept)
     p.strain = 10;
     p.bending = 0.3;
     lw_scene sc;
-    scene_of(&sc, &p);
+    lw_test_scene(&sc, &p);
     lw_splines *sp = rows(40);
     cr_assert_eq(close_pairs(&sc, sp, 0.3), 0, "the start keeps the spacing");
     lw_model *m = lw_model_new(&sc, sp, NULL);
@@ -459,8 +441,8 @@ Test(tone, a_crowded_start_only_gets_less_crowded)
   p.strain = 10;
   p.bending = 0.3;
   lw_scene sc;
-  scene_of(&sc, &p);
-  lw_model *m = model_of(&sc, 120, 3, 2, 51);
+  lw_test_scene(&sc, &p);
+  lw_model *m = lw_test_model_random(&sc, 120, 3, 2, 51);
   size_t before = close_pairs(&sc, m->sp, 0.3), now = before;
   cr_assert(before > 20, "the start is crowded: %zu pairs", before);
   lw_chain *c = chain_of(m, 0.02, 52);
@@ -548,8 +530,8 @@ Test(tone, tone_ink_scales_the_target)
   lw_params p = tone_params(30, 20, grey, 1.0, 1.0), q = p;
   q.tone_ink = 0.5;
   lw_scene a, b;
-  scene_of(&a, &p);
-  scene_of(&b, &q);
+  lw_test_scene(&a, &p);
+  lw_test_scene(&b, &q);
   cr_assert(a.tone.w == b.tone.w && a.tone.h == b.tone.h);
   double most = 0.0;
   for (size_t k = 0; k < (size_t)a.tone.w * (size_t)a.tone.h; k++) {

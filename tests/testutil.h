@@ -14,7 +14,10 @@
 #include <string.h>
 #include <sys/wait.h>
 
+#include "linewise/init.h"
 #include "linewise/mc.h"
+#include "linewise/model.h"
+#include "linewise/scene.h"
 #include "linewise/spline.h"
 #include "linewise/sys_splines.h"
 
@@ -207,6 +210,29 @@ static inline void lw_test_random_move(const lw_splines *sp, gsl_rng *r, int kin
       nd[k].py += dy;
     }
   }
+}
+
+/* A scene from p, asserting that it builds. */
+static inline void lw_test_scene(lw_scene *sc, const lw_params *p)
+{
+  lw_error err;
+  cr_assert_eq(lw_scene_init(sc, p, &err), LW_OK, "%s", err.msg);
+}
+
+/* A model of n random splines of segs segments of length len (lw_init_random,
+** stream seeded with seed) on sc, asserting that it builds. */
+static inline lw_model *lw_test_model_random(const lw_scene *sc, size_t n, size_t segs, double len,
+                                            unsigned long seed)
+{
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, seed);
+  lw_error err;
+  lw_splines *sp = lw_init_random(sc, n, segs, len, r, &err);
+  cr_assert_not_null(sp, "%s", err.msg);
+  gsl_rng_free(r);
+  lw_model *m = lw_model_new(sc, sp, &err);
+  cr_assert_not_null(m, "%s", err.msg);
+  return m;
 }
 
 #endif
