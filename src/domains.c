@@ -5,10 +5,14 @@
 
 #include <errno.h>
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+/* the fuzz build compiles without OpenMP: the pragmas drop out, and so must the calls */
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #define DOMAINS_MAX 64 /* per side: 4225 cells, each with a stream and a scratch, are plenty */
 
@@ -104,9 +108,13 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
   d->ly = h / ny;
   d->reach = reach;
   /* threads go to the replicas first (anneal.c), the rest to each one's cells */
+#ifdef _OPENMP
   d->threads = omp_get_max_threads() / (replicas > 0 ? replicas : 1);
   if (d->threads < 1) d->threads = 1;
   if (replicas > 1 && d->threads > 1 && omp_get_max_active_levels() < 2) omp_set_max_active_levels(2);
+#else
+  d->threads = 1;
+#endif
   d->cell = calloc((size_t)d->n, sizeof *d->cell);
   d->start = calloc((size_t)d->n + 1, sizeof *d->start);
   d->active = calloc((size_t)d->n, sizeof *d->active);
