@@ -297,7 +297,9 @@ static int pnm_number(const unsigned char *d, size_t n, size_t *at, long *v)
   return 1;
 }
 
-static lw_status pnm_decode(const unsigned char *d, size_t n, const char *name, decoded *out, lw_error *err)
+/* The P5/P6 header: sizes, maxval and where the raster starts (*at). */
+static lw_status pnm_header(const unsigned char *d, size_t n, const char *name, long *w_out, long *h_out,
+                            long *maxval_out, size_t *at_out, lw_error *err)
 {
   size_t at = 2;
   long w, h, maxval;
@@ -311,6 +313,19 @@ static lw_status pnm_decode(const unsigned char *d, size_t n, const char *name, 
   if ((double)w * (double)h > LW_IMAGE_MAX_PIXELS)
     return lw_error_set(err, LW_EINPUT, "%s: %ld x %ld pixels is more than the %.0e pixels linewise decodes", name,
                         w, h, LW_IMAGE_MAX_PIXELS);
+  *w_out = w;
+  *h_out = h;
+  *maxval_out = maxval;
+  *at_out = at;
+  return LW_OK;
+}
+
+static lw_status pnm_decode(const unsigned char *d, size_t n, const char *name, decoded *out, lw_error *err)
+{
+  size_t at;
+  long w, h, maxval;
+  lw_status st = pnm_header(d, n, name, &w, &h, &maxval, &at, err);
+  if (st) return st;
   int ch = d[1] == '6' ? 3 : 1, wide = maxval > 255;
   size_t samples = (size_t)w * (size_t)h * (size_t)ch, bytes = samples * (wide ? 2 : 1);
   if (n - at < bytes)
@@ -432,8 +447,9 @@ lw_image *lw_image_load(const char *path, double max_pixels, lw_image_info *info
   return lw_image_load_channel(path, max_pixels, LW_IMAGE_LUMA, info, err);
 }
 
-lw_image *lw_image_load_channel(const char *path, double max_pixels, lw_image_channel which, lw_image_info *info,
-                                lw_error *err)
+/* The whole file at path, malloc'd, into *size; NULL and err set if it
+** cannot be an image linewise reads. */
+static unsigned char *read_picture_file(const char *path, size_t *size_out, lw_error *err)
 {
   FILE *f = fopen(path, "rb");
   if (!f) {
@@ -467,9 +483,42 @@ lw_image *lw_image_load_channel(const char *path, double max_pixels, lw_image_ch
     free(data);
     return NULL;
   }
+  *size_out = size;
+  return data;
+}
+
+lw_image *lw_image_load_channel(const char *path, double max_pixels, lw_image_channel which, lw_image_info *info,
+                                lw_error *err)
+{
+  size_t size;
+  unsigned char *data = read_picture_file(path, &size, err);
+  if (!data) return NULL;
   lw_image *img = lw_image_decode_channel(data, size, path, max_pixels, which, info, err);
   free(data);
   return img;
+}
+
+lw_status lw_image_probe(const char *path, lw_image_info *info, lw_error *err)
+{
+  size_t size;
+  unsigned char *data = read_picture_file(path, &size, err);
+  if (!data) return err->code;
+  lw_status st = LW_OK;
+  long w, h, maxval;
+  size_t at;
+  if (size >= 2 && data[0] == 'P' && (data[1] == '5' || data[1] == '6')) {
+    if ((st = pnm_header(data, size, path, &w, &h, &maxval, &at, err)) == LW_OK)
+      *info = (lw_image_info){(int)w, (int)h, data[1] == '6' ? 3 : 1, maxval > 255 ? 16 : 8};
+  } else {
+    int iw, ih, ch;
+    if (size == 0 || size > INT_MAX || !stbi_info_from_memory(data, (int)size, &iw, &ih, &ch))
+      st = lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, BMP, PGM/PPM): %s", path,
+                        size == 0 ? "empty file" : stbi_failure_reason());
+    else
+      *info = (lw_image_info){iw, ih, ch, stbi_is_16_bit_from_memory(data, (int)size) ? 16 : 8};
+  }
+  free(data);
+  return st;
 }
 
 /* ---- blur ------------------------------------------------------------- */

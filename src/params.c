@@ -15,8 +15,10 @@
 #include <string.h>
 #include <sys/types.h>
 
+#include "linewise/image.h"
 #include "linewise/number.h"
 #include "linewise/output.h"
+#include "linewise/state.h"
 
 #define OFF(f) offsetof(lw_params, f)
 #define NUM(sec, key, T, f, def, unit, lo, hi, open, help) \
@@ -46,8 +48,9 @@ const lw_param_def lw_param_table[] = {
          "Page size: `custom` takes `width` and `height`; a4 is 210 x 297 mm, a3 297 x 420 mm, "
          "letter 215.9 x 279.4 mm, a5 148 x 210 mm, a6 105 x 148 mm (portrait). A named page sets width and height; setting "
          "either as well is an error unless it agrees."),
-  CHOICE("scene", "orientation", orientation, "portrait", "portrait|landscape",
-         "Orientation of a named page: landscape swaps its width and height."),
+  CHOICE("scene", "orientation", orientation, "portrait", "portrait|landscape|auto",
+         "Orientation of a named page: landscape swaps its width and height; auto is landscape when the picture "
+         "(`image`) is wider than tall, else portrait. The photo preset sets auto."),
   NUM("scene", "width", LW_PT_DOUBLE, width, "210", "mm", 0, 1e7, LW_MIN_OPEN,
       "Page width (set by a named `page`)."),
   NUM("scene", "height", LW_PT_DOUBLE, height, "297", "mm", 0, 1e7, LW_MIN_OPEN,
@@ -827,12 +830,39 @@ static void apply_preset(lw_params *p)
   preset_key(p, "anneal", "domains", n < 2 ? "off" : text);
 }
 
+/* orientation = auto: the picture's header says which way it lies.  A
+** scene without a picture is portrait. */
+static lw_status landscape_picture(const lw_params *p, int *landscape, lw_error *err)
+{
+  *landscape = 0;
+  if (!p->image[0]) return LW_OK;
+  char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2], where[LW_PATH_MAX + 32];
+  lw_path_dir(dir, sizeof dir, p->file);
+  lw_path_join(full, sizeof full, dir, p->image);
+  lw_image_info info;
+  lw_error probe;
+  if (lw_image_probe(full, &info, &probe)) {
+    lw_params_origin(p, lw_params_find("scene", "orientation"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'scene.orientation' = auto needs the picture's size: %s", where,
+                        probe.msg);
+  }
+  *landscape = info.width > info.height;
+  return LW_OK;
+}
+
 lw_status lw_params_resolve(lw_params *p, lw_error *err)
 {
   char where[LW_PATH_MAX + 32], where_page[LW_PATH_MAX + 32];
+  /* before the page is sized, which the orientation decides */
+  if (p->preset == LW_PRESET_PHOTO) preset_key(p, "scene", "orientation", "auto");
   if (p->page != LW_PAGE_CUSTOM) {
     double w = page_mm[p->page][0], h = page_mm[p->page][1];
-    if (p->orientation == LW_ORIENT_LANDSCAPE) {
+    int landscape = p->orientation == LW_ORIENT_LANDSCAPE;
+    if (p->orientation == LW_ORIENT_AUTO) {
+      lw_status st = landscape_picture(p, &landscape, err);
+      if (st) return st;
+    }
+    if (landscape) {
       double t = w;
       w = h;
       h = t;

@@ -7,6 +7,7 @@
 
 #include "linewise/params.h"
 #include "linewise/scene.h"
+#include "testutil.h"
 
 /* Writes text to a fresh temporary file; returns its path (static buffer). */
 static const char *ini(const char *text)
@@ -328,4 +329,44 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
   lw_params_defaults(&d);
   cr_assert_eq(read_text("[scene]\npage = a4\n", &p, &err), LW_OK);
   cr_assert(p.segment_length == d.segment_length && p.tone == d.tone && !strcmp(p.domains, d.domains));
+}
+
+/* orientation = auto turns a named page to the picture, which the photo
+** preset asks for: a landscape photograph on a portrait page would leave
+** half of it blank.  The header alone decides (the raster here is short). */
+Test(params, auto_orientation_follows_the_picture)
+{
+  char dir[64], wide[128], tall[128], text[512];
+  cr_assert_eq(lw_test_dir_make(dir, "orient"), 0);
+  snprintf(wide, sizeof wide, "%s/wide.pgm", dir);
+  snprintf(tall, sizeof tall, "%s/tall.pgm", dir);
+  FILE *f = fopen(wide, "w");
+  fprintf(f, "P5\n# a comment\n30 20\n255\n");
+  fclose(f);
+  f = fopen(tall, "w");
+  fprintf(f, "P5 20 30 255\n");
+  fclose(f);
+  lw_params p;
+  lw_error err;
+  static const struct {
+    const char *image, *extra;
+    double width;
+  } cases[] = {
+      {"wide.pgm", "orientation = auto\n", 297}, {"tall.pgm", "orientation = auto\n", 210},
+      {"wide.pgm", "preset = photo\n", 297},     {"wide.pgm", "preset = photo\norientation = portrait\n", 210},
+      {"wide.pgm", "", 210},                     {"", "orientation = auto\n", 210},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    char image[192] = "";
+    if (cases[k].image[0]) snprintf(image, sizeof image, "image = %s/%s\n", dir, cases[k].image);
+    snprintf(text, sizeof text, "[scene]\npage = a4\n%s%s", cases[k].extra, image);
+    cr_assert_eq(read_text(text, &p, &err), LW_OK, "case %zu: %s", k, err.msg);
+    cr_assert(p.width == cases[k].width && p.height == (cases[k].width == 297 ? 210 : 297), "case %zu: %g x %g", k,
+              p.width, p.height);
+  }
+  /* a picture that is not there: one message naming the key */
+  snprintf(text, sizeof text, "[scene]\npage = a4\norientation = auto\nimage = %s/none.png\n", dir);
+  cr_assert_eq(read_text(text, &p, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "key 'scene.orientation' = auto needs the picture's size") && strstr(err.msg, "none.png"),
+            "%s", err.msg);
 }

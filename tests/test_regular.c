@@ -271,9 +271,9 @@ Test(regular, placement_never_creates_an_irregular_segment)
       gsl_rng_free(r);
       lw_scene_clear(&sc);
     }
-  static const char *const scenes[] = {"params/example.ini", "params/flow.ini", "params/minimal.ini"};
+  static const char *const scenes[] = {"params/example.ini", "params/study.ini", "params/flow.ini", "params/minimal.ini"};
   const char *root = getenv("LW_ROOT");
-  for (size_t k = 0; k < 3; k++) {
+  for (size_t k = 0; k < sizeof scenes / sizeof scenes[0]; k++) {
     char path[512];
     snprintf(path, sizeof path, "%s/%s", root ? root : ".", scenes[k]);
     lw_params p;

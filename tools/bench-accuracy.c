@@ -1,6 +1,6 @@
 /*
 ** bench-accuracy.c -- accuracy against time (docs/ACCURACY.md): quadrature
-** nodes, pair cutoff and near field on the annealed example scene, the near
+** nodes, pair cutoff and near field on the annealed study scene, the near
 ** field on touching and crossing curves against a brute-force reference, and
 ** the guide drawn from them.
 **
@@ -122,7 +122,7 @@ static void scene_note(bench_ctx *b, FILE *d)
   const lw_params *p = &b->ann_params;
   const lw_splines *sp = bench_annealed(b);
   fprintf(d, "## The scene\n\n"
-             "params/example.ini (%zu splines of %d segments of %g mm on %g x %g mm, a waves field,\n"
+             "params/study.ini (%zu splines of %d segments of %g mm on %g x %g mm, a waves field,\n"
              "pair C = %g with cutoff %g mm, quadrature %d, near field %g) with a radial potential\n"
              "(Q = %g) added so that every term is on, annealed by the annealer itself for %d sweeps\n"
              "from T = %g to %g (%.0f s; the run is in build/bench-data/anneal): the curves are bent,\n"

@@ -1,6 +1,6 @@
 /*
 ** bench-quench.c -- what the quench after annealing removes and costs
-** (section "quench", docs/ACCURACY.md): params/example.ini annealed and then
+** (section "quench", docs/ACCURACY.md): params/study.ini annealed and then
 ** quenched (anneal.quench = bfgs), as is and without the Bernstein-ellipse
 ** regularity test (the wall the quench meets most), three runs each; the
 ** energies are the same in every run (same seed), the times are medians.
@@ -26,7 +26,7 @@ static int pair_gradient_built(void)
   lw_params p;
   lw_error err;
   lw_scene sc;
-  if (lw_params_read(&p, "params/example.ini", &err) || lw_scene_init(&sc, &p, &err)) bench_die("example.ini", &err);
+  if (lw_params_read(&p, "params/study.ini", &err) || lw_scene_init(&sc, &p, &err)) bench_die("study.ini", &err);
   size_t segs[2] = {2, 2};
   lw_splines *sp = lw_splines_new(2, segs, &err);
   if (!sp) bench_die("splines", &err);
@@ -45,7 +45,7 @@ static void run_once(const bench_ctx *b, const char *const *set, int n_set, int 
 {
   lw_error e, *err = &e;
   lw_params p;
-  if (lw_params_read(&p, "params/example.ini", err)) bench_die("params/example.ini", err);
+  if (lw_params_read(&p, "params/study.ini", err)) bench_die("params/study.ini", err);
   for (int k = 0; k < n_set; k++)
     if (lw_params_set(&p, set[k], err)) bench_die(set[k], err);
   if (lw_params_set(&p, "anneal.quench=bfgs", err)) bench_die("anneal.quench", err);
@@ -76,11 +76,11 @@ void bench_quench(bench_ctx *b)
   for (int r = 0; r < 2; r++)
     for (int k = 0; k < RUNS; k++) {
       const char *set[1] = {rows[r][1]};
-      bench_note("quench: example.ini %s, run %d of %d", rows[r][0], k + 1, RUNS);
+      bench_note("quench: study.ini %s, run %d of %d", rows[r][0], k + 1, RUNS);
       run_once(b, set, rows[r][1] ? 1 : 0, pair, &res[r][k]);
     }
   fprintf(d, "## Quench after annealing\n\n");
-  fprintf(d, "`anneal.quench = bfgs` (src/quench.c) takes the annealed state of params/example.ini%s to the\n"
+  fprintf(d, "`anneal.quench = bfgs` (src/quench.c) takes the annealed state of params/study.ini%s to the\n"
              "nearest local minimum with GSL's vector_bfgs2 on the gradient of docs/NUMERICS.md (\"Gradients\").\n"
              "Same seed in every run, so the energies are exact; the times are medians of %d runs (one\n"
              "thread; `anneal` is the start and the %d sweeps, `quench` the minimiser alone).\n\n",
@@ -103,7 +103,7 @@ void bench_quench(bench_ctx *b)
             q->iterations, q->evaluations, q->forbidden, mq, ma, mq / ma);
   }
   fprintf(d, "\n");
-  const double t_end = 0.002; /* params/example.ini */
+  const double t_end = 0.002; /* params/study.ini */
   fprintf(d,
           "The annealed state is close to a minimum: at t_end = %g a harmonic minimum holds about\n"
           "(n/2) t_end = %.3g of thermal energy in its n = %zu coordinates (equipartition), the scale\n"

@@ -95,7 +95,7 @@ void bench_tone(bench_ctx *b)
       {"and tone, blur 1 mm", 1, 1, 0, 1},
   };
   fprintf(d, "## The tone term and the spacing constraint\n\n"
-             "The accuracy scene (params/example.ini annealed, %zu splines) with the tone term added\n"
+             "The accuracy scene (params/study.ini annealed, %zu splines) with the tone term added\n"
              "(coefficient 1; docs/NUMERICS.md) at three blurs.\n"
              "Evaluation: the same point and vector moves of 0.2 mm, evaluated and never committed;\n"
              "ratio to the first row block by block (+- the median absolute deviation). Chain: the\n"

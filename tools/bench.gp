@@ -14,7 +14,7 @@ set key top right
 # cost as the time ratio to 8 nodes, which is robust on a shared machine.
 pos(x) = x > 0 ? x : NaN
 set output sprintf('%s/accuracy-quadrature.png', out)
-set title 'Quadrature nodes per segment: error against cost (annealed example scene; labels: nodes)'
+set title 'Quadrature nodes per segment: error against cost (annealed study scene; labels: nodes)'
 set xlabel 'time per proposal, relative to 8 nodes'
 set ylabel 'relative error against 64 nodes'
 set logscale xy
@@ -28,7 +28,7 @@ plot f('quadrature.dat') using 3:(pos($5)) with linespoints pt 7 title 'pair ene
 
 # The cutoff: errors against no cutoff (left) and cost (right) against the cutoff.
 set output sprintf('%s/accuracy-cutoff.png', out)
-set title 'Pair cutoff: difference from no cutoff, and cost (annealed example scene)'
+set title 'Pair cutoff: difference from no cutoff, and cost (annealed study scene)'
 set xlabel 'cutoff, line spacings'
 set ylabel 'relative difference from no cutoff'
 set y2label 'time per proposal, relative to a 4 mm cutoff'

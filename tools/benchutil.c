@@ -209,7 +209,7 @@ const lw_splines *bench_annealed(bench_ctx *b)
   if (b->ann_splines) return b->ann_splines;
   lw_params *p = &b->ann_params;
   lw_error err;
-  if (lw_params_read(p, "params/example.ini", &err)) bench_die("the accuracy scene", &err);
+  if (lw_params_read(p, "params/study.ini", &err)) bench_die("the accuracy scene", &err);
   static const char *const extra[] = {"scene.potential=radial", "energy.potential=0.3"};
   for (size_t k = 0; k < sizeof extra / sizeof extra[0]; k++)
     if (lw_params_set(p, extra[k], &err)) bench_die("the accuracy scene", &err);

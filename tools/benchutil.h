@@ -122,7 +122,7 @@ void bench_time_runs(const bench_ctx *b, bench_run *runs, int n, int ref, const 
 /* Acceptance of the point and vector moves since the chain began. */
 double bench_run_acceptance(const bench_run *r);
 
-/* The scene of the accuracy study, built once: params/example.ini with a
+/* The scene of the accuracy study, built once: params/study.ini with a
 ** radial potential added (every term on), annealed by the annealer itself
 ** (lw_anneal, its files in datadir/anneal) so the curves are bent and close
 ** together.  Returns the splines; the parameters, the final steps and the

@@ -69,6 +69,10 @@ lw_image *lw_image_load(const char *path, double max_pixels, lw_image_info *info
 lw_image *lw_image_load_channel(const char *path, double max_pixels, lw_image_channel which, lw_image_info *info,
                                 lw_error *err);
 
+/* What the file at path holds (its header only: nothing is decoded), for
+** choices made before the scene is built (scene.orientation = auto). */
+lw_status lw_image_probe(const char *path, lw_image_info *info, lw_error *err);
+
 /* A new w x h image resampled from src, each axis on its own: shrinking
 ** averages the source area each new pixel covers (a box filter with
 ** fractional edges: the mean tone is kept exactly), enlarging interpolates
