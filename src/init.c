@@ -15,6 +15,13 @@
 ** shape.  A draw whose spline leaves the boundary is drawn again.  With
 ** layers (layers.h) a spline's darkness is its layer's target's and its
 ** field its layer's.
+**
+** With energy.min_spacing d the draws also keep apart: a spline whose pair
+** samples come closer than d to those of one placed before is drawn again,
+** up to SPACING_TRIES fitting draws, and then the one with the fewest close
+** samples is kept.  The spacing constraint refuses only moves that add
+** close samples (model.c), so what the placement leaves crowded -- lines
+** crossing where the field is noisy, as on photographs -- would stay.
 */
 #include "linewise/init.h"
 
@@ -24,6 +31,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 unsigned long lw_stream_seed(unsigned long seed, unsigned long stream)
 {
@@ -156,6 +164,96 @@ static void trace(const lw_field *f, lw_node *nd, size_t segments, double h, dou
   }
 }
 
+/* Fitting draws per spline while looking for room; past them the least
+** crowded is kept, so a page fuller than random packing allows still fills. */
+#define SPACING_TRIES 64
+
+/* The pair samples of the splines placed so far in buckets of side >= d:
+** a chained hash over the page's cells (head per cell, next per sample). */
+typedef struct {
+  double d2, side, x0, y0;
+  long nx, ny;
+  int32_t *head, *next;
+  double *x, *y;
+  size_t n, cap;
+} placed_samples;
+
+static void placed_free(placed_samples *ps)
+{
+  free(ps->head);
+  free(ps->next);
+  free(ps->x);
+  free(ps->y);
+}
+
+static int placed_init(placed_samples *ps, const lw_scene *sc, double d, size_t cap)
+{
+  *ps = (placed_samples){.d2 = d * d, .cap = cap};
+  double w = sc->width + 2 * d, h = sc->height + 2 * d;
+  /* cells at least d wide, and not many more than samples (a wide page) */
+  ps->side = fmax(d, sqrt(w * h / (4.0 * (double)cap + 1024.0)));
+  ps->nx = (long)ceil(w / ps->side);
+  ps->ny = (long)ceil(h / ps->side);
+  ps->x0 = -d;
+  ps->y0 = -d;
+  if (cap > INT32_MAX) return 0;
+  ps->head = malloc((size_t)(ps->nx * ps->ny) * sizeof *ps->head);
+  ps->next = malloc((cap ? cap : 1) * sizeof *ps->next);
+  ps->x = malloc((cap ? cap : 1) * sizeof *ps->x);
+  ps->y = malloc((cap ? cap : 1) * sizeof *ps->y);
+  if (!ps->head || !ps->next || !ps->x || !ps->y) return 0;
+  for (long c = 0; c < ps->nx * ps->ny; c++) ps->head[c] = -1;
+  return 1;
+}
+
+/* The cell of (x, y), clamped: the boundary keeps samples on the page, and
+** a clamped one is only compared with more samples, never fewer. */
+static void placed_cell(const placed_samples *ps, double x, double y, long *cx, long *cy)
+{
+  double fx = floor((x - ps->x0) / ps->side), fy = floor((y - ps->y0) / ps->side);
+  *cx = fx < 0 ? 0 : (fx >= (double)ps->nx ? ps->nx - 1 : (long)fx);
+  *cy = fy < 0 ? 0 : (fy >= (double)ps->ny ? ps->ny - 1 : (long)fy);
+}
+
+/* How many of the spline's pair samples have a placed sample within d. */
+static size_t placed_crowding(const placed_samples *ps, const lw_scene *sc, const lw_node *nd, size_t segments)
+{
+  size_t count = 0;
+  lw_samples s;
+  for (size_t m = 0; m < segments; m++) {
+    lw_segment_sample(&sc->pair_quad, &nd[m], &nd[m + 1], &s);
+    for (int q = 0; q < s.n; q++) {
+      long cx, cy, hit = 0;
+      placed_cell(ps, s.x[q], s.y[q], &cx, &cy);
+      for (long y = cy > 0 ? cy - 1 : 0; y <= cy + 1 && y < ps->ny && !hit; y++)
+        for (long x = cx > 0 ? cx - 1 : 0; x <= cx + 1 && x < ps->nx && !hit; x++)
+          for (int32_t e = ps->head[y * ps->nx + x]; e >= 0 && !hit; e = ps->next[e]) {
+            double dx = ps->x[e] - s.x[q], dy = ps->y[e] - s.y[q];
+            hit = dx * dx + dy * dy < ps->d2;
+          }
+      count += (size_t)hit;
+    }
+  }
+  return count;
+}
+
+static void placed_add(placed_samples *ps, const lw_scene *sc, const lw_node *nd, size_t segments)
+{
+  lw_samples s;
+  for (size_t m = 0; m < segments; m++) {
+    lw_segment_sample(&sc->pair_quad, &nd[m], &nd[m + 1], &s);
+    for (int q = 0; q < s.n && ps->n < ps->cap; q++) {
+      long cx, cy;
+      placed_cell(ps, s.x[q], s.y[q], &cx, &cy);
+      ps->x[ps->n] = s.x[q];
+      ps->y[ps->n] = s.y[q];
+      ps->next[ps->n] = ps->head[cy * ps->nx + cx];
+      ps->head[cy * ps->nx + cx] = (int32_t)ps->n;
+      ps->n++;
+    }
+  }
+}
+
 lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double segment_length,
                            gsl_rng *rng, lw_error *err)
 {
@@ -177,8 +275,15 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
     cums[k] = row_darkness(by_layer ? sc->layer[k].target : sc->image);
     nomem |= sc->image && !cums[k];
   }
+  const int spaced = sc->min_spacing > 0.0 && sc->pair_quad.n > 0;
+  placed_samples placed = {0};
+  if (spaced) nomem |= !placed_init(&placed, sc, sc->min_spacing, n * segments * (size_t)sc->pair_quad.n);
+  lw_node *best = spaced ? malloc((segments + 1) * sizeof *best) : NULL;
+  nomem |= spaced && !best;
   if (nomem) {
     for (int k = 0; k < nl; k++) free(cums[k]);
+    placed_free(&placed);
+    free(best);
     lw_splines_free(sp);
     lw_error_set(err, LW_ENOMEM, "out of memory for the placement");
     return NULL;
@@ -194,7 +299,8 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
     const double *cum = cums[by_layer ? layer : 0];
     /* a white picture has nothing to draw toward: uniform, as without one */
     const int weighted = cum && cum[img->height] > 0;
-    int t;
+    int t, fitting = 0;
+    size_t least = SIZE_MAX;
     for (t = 0; t < tries; t++) {
       double cx, cy;
       if (weighted) dark_point(sc, img, cum, rng, &cx, &cy);
@@ -218,7 +324,19 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
       } else {
         straight(nd, segments, segment_length, cx, cy, ux, uy);
       }
-      if (fits(sc, nd, segments)) break;
+      if (!fits(sc, nd, segments)) continue;
+      if (!spaced) break;
+      size_t crowded = placed_crowding(&placed, sc, nd, segments);
+      if (crowded < least) {
+        least = crowded;
+        memcpy(best, nd, (segments + 1) * sizeof *best);
+      }
+      if (crowded == 0 || ++fitting == SPACING_TRIES) break;
+    }
+    if (spaced && least != SIZE_MAX) {
+      memcpy(nd, best, (segments + 1) * sizeof *best);
+      placed_add(&placed, sc, nd, segments);
+      t = 0; /* placed, if never in room */
     }
     if (t == tries) {
       lw_error_set(err, LW_EINPUT,
@@ -226,11 +344,15 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
                    "(shorten init.segment_length or init.segments)", i, L, tries);
       lw_splines_free(sp);
       for (int k = 0; k < nl; k++) free(cums[k]);
+      placed_free(&placed);
+      free(best);
       return NULL;
     }
     sp->rest_length[i] = L;
   }
   for (int k = 0; k < nl; k++) free(cums[k]);
+  placed_free(&placed);
+  free(best);
   return sp;
 }
 

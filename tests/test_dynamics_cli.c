@@ -88,7 +88,7 @@ Test(dynamics_cli, scenes_the_driver_cannot_move_are_refused_with_the_key)
     cr_assert_eq(sh("test ! -e %s/x%zu", dir, k), 0, "case %zu: a run directory was made", k);
   }
   /* a term without a gradient (the tone term) is named */
-  cr_assert_eq(sh("%s run %s/params/example.ini --out %s/t --quiet --set scene.driver=dynamics --set energy.tone=1 "
+  cr_assert_eq(sh("%s run %s/params/study.ini --out %s/t --quiet --set scene.driver=dynamics --set energy.tone=1 "
                   "--set energy.pair=0 2>%s/err.txt", lw_test_bin(), lw_test_root(), dir, dir), 2);
   cr_assert_eq(sh("grep -q 'the tone term has no gradient (energy.tone)' %s/err.txt && test ! -e %s/t", dir, dir), 0);
   /* the particle system has no equations of motion */
