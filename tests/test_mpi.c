@@ -46,15 +46,7 @@ static const char scene[] =
   "[tempering]\nreplicas = 4\nt_min = 0.5\nt_max = 4\ntune_ladder = equal\nladder_sweeps = 40\n"
   "[output]\ncheckpoint_every = 13\ntrace_every = 4\n";
 
-static void write_scene(void)
-{
-  char path[128];
-  snprintf(path, sizeof path, "%s/s.ini", dir);
-  FILE *f = fopen(path, "w");
-  cr_assert_not_null(f);
-  fputs(scene, f);
-  fclose(f);
-}
+static void write_scene(void) { cr_assert_eq(lw_test_write_text(dir, "s.ini", scene), 0); }
 
 static const char *const same[] = {"state.lw", "replica-1.lw", "replica-2.lw", "replica-3.lw",
                                    "trace.csv", "final.svg", "final.png", "ladder.ini"};

@@ -31,15 +31,7 @@ static const char scene[] =
   "[tempering]\nreplicas = 3\nt_min = 0.05\nt_max = 0.5\n"
   "[output]\ncheckpoint_every = 9\ntrace_every = 3\n";
 
-static void write_scene(void)
-{
-  char path[128];
-  snprintf(path, sizeof path, "%s/s.ini", dir);
-  FILE *f = fopen(path, "w");
-  cr_assert_not_null(f);
-  fputs(scene, f);
-  fclose(f);
-}
+static void write_scene(void) { cr_assert_eq(lw_test_write_text(dir, "s.ini", scene), 0); }
 
 static const char *const same[] = {"state.lw", "replica-1.lw", "replica-2.lw", "trace.csv", "final.ply", "final.png"};
 #define N_SAME (sizeof same / sizeof *same)

@@ -160,6 +160,17 @@ static inline int lw_test_sh(const char *fmt, ...)
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+/* dir/name holds text afterwards (a scene file); 0 on success. */
+static inline int lw_test_write_text(const char *dir, const char *name, const char *text)
+{
+  char path[256];
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  FILE *f = fopen(path, "w");
+  if (!f) return -1;
+  int bad = fputs(text, f) < 0;
+  return fclose(f) || bad ? -1 : 0;
+}
+
 static inline int lw_test_dir_remove(const char *dir)
 {
   char cmd[96];
