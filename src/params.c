@@ -779,18 +779,21 @@ static const double page_mm[][2] = {{0, 0}, {210, 297}, {297, 420}, {215.9, 279.
 ** as lines two pen widths apart, so strokes keep apart (close_share under
 ** 10 %), and the hard min_spacing of one pen width keeps them from merging;
 ** the near field is off (the constraint keeps samples apart, and it costs
-** most of a proposal).
+** most of a proposal).  Tried on four standard test photographs: the edge
+** tangent flow at 4 w followed the grain of every texture and lines crossed
+** (close share 0.10 to 0.17); at 10 w it follows forms, and tone 10 against
+** the field's -1 lets density follow tone.
 */
 static const struct {
   const char *section, *key, *text; /* text, or NULL: pens * w */
   double pens;
 } photo_preset[] = {
-    {"scene", "field", "etf", 0},          {"scene", "field_sigma", NULL, 4},
+    {"scene", "field", "etf", 0},          {"scene", "field_sigma", NULL, 10},
     {"init", "splines", "0", 0},           {"init", "coverage", "0.4", 0},
     {"init", "segments", "5", 0},          {"init", "segment_length", NULL, 8},
     {"energy", "strain", "20", 0},         {"energy", "bending", "2", 0},
     {"energy", "field", "-1", 0},          {"energy", "field_mode", "axial", 0},
-    {"energy", "tone", "5", 0},            {"energy", "tone_blur", NULL, 3},
+    {"energy", "tone", "10", 0},           {"energy", "tone_blur", NULL, 3},
     {"energy", "tone_ink", "0.5", 0},      {"energy", "pair", "0.01", 0},
     {"energy", "pair_cutoff", NULL, 3},    {"energy", "pair_near", "0", 0},
     {"energy", "min_spacing", NULL, 1},    {"energy", "quadrature", "6", 0},
