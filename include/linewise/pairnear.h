@@ -50,13 +50,16 @@ double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, cons
 ** step, so it sees the same thresholds and rules. */
 typedef struct {
   double sep_lo, sep_hi;       /* pieces apart: 6 x 6 rule from sep_hi larger radii on */
-  double apart_lo, apart_hi;   /* segments apart: 16 x 16 rule (distance / half size) */
   double leaf_ratio, flat_ratio;
   int stack_max;
   const double *g6_s, *g6_w;   /* Gauss-Legendre on [0, 1] */
   int g6_n;
-  const double *g16_s, *g16_w;
-  int g16_n;
+  /* segments apart: the whole-square rules of whole_m[r] nodes, from
+  ** distance / half size whole_lo[r] (blended in up to whole_hi[r]) */
+  int n_whole;
+  const int *whole_m;
+  const double *const *whole_s, *const *whole_w;
+  const double *whole_lo, *whole_hi;
 } lw_pairnear_consts;
 
 extern const lw_pairnear_consts lw_pairnear_k;
