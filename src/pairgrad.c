@@ -461,6 +461,23 @@ static jet piece_rule(const jcubic *ca, const jpiece *pa, const jcubic *cb, cons
 
 /* pairnear.c's leaf_value: the chords' exact integral, with the cutoff
 ** blended into the product rule where the pieces reach past it. */
+/* pairnear.c's mean_chord: the chord moved across itself by the piece's
+** mean distance from it. */
+static void mean_chord(const jpiece *p, jet e0[2], jet e1[2])
+{
+  double h3 = (p->t1 - p->t0) / 3.0;
+  jet ux = jsub(p->r1[0], p->r0[0]), uy = jsub(p->r1[1], p->r0[1]);
+  jet ox = jscale(jscale(jsub(p->d0[0], p->d1[0]), h3), 0.25), oy = jscale(jscale(jsub(p->d0[1], p->d1[1]), h3), 0.25);
+  jet uu = jadd(jmul(ux, ux), jmul(uy, uy));
+  jet f = uu.v > 0.0 ? jdiv(jadd(jmul(ox, ux), jmul(oy, uy)), uu) : jc(0.0);
+  ox = jsub(ox, jmul(f, ux));
+  oy = jsub(oy, jmul(f, uy));
+  e0[0] = jadd(p->r0[0], ox);
+  e0[1] = jadd(p->r0[1], oy);
+  e1[0] = jadd(p->r1[0], ox);
+  e1[1] = jadd(p->r1[1], oy);
+}
+
 static jet leaf_value(const jcubic *ca, const jpiece *pa, const jcubic *cb, const jpiece *pb, const cut *k)
 {
   jet m = jc(1.0);
@@ -469,7 +486,10 @@ static jet leaf_value(const jcubic *ca, const jpiece *pa, const jcubic *cb, cons
     jet far = jadd(jadd(jhypot(jsub(pa->cx, pb->cx), jsub(pa->cy, pb->cy)), pa->rad), pb->rad);
     m = big.v > 0.0 ? jsmooth(jdiv(jaddc(jscale(far, -1.0), k->rc), big)) : jc(0.0);
   }
-  jet v = m.v > 0.0 ? jsegseg(pa->r0, pa->r1, pb->r0, pb->r1) : jc(0.0);
+  jet a0[2], a1[2], b0[2], b1[2];
+  mean_chord(pa, a0, a1);
+  mean_chord(pb, b0, b1);
+  jet v = m.v > 0.0 ? jsegseg(a0, a1, b0, b1) : jc(0.0);
   if (!(v.v < INFINITY)) return piece_rule(ca, pa, cb, pb, k);
   if (k->on && m.v > 0.0) {
     jet la = jhypot(jsub(pa->r1[0], pa->r0[0]), jsub(pa->r1[1], pa->r0[1]));

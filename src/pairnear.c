@@ -147,18 +147,10 @@ static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
   piece_bound(hi);
 }
 
-#ifndef SEP_LO
 #define SEP_LO 0.5
-#endif
-#ifndef SEP_HI
 #define SEP_HI 1.0
-#endif
-#ifndef LEAF_RATIO
 #define LEAF_RATIO 5e-3
-#endif
-#ifndef FLAT_RATIO
-#define FLAT_RATIO 1e-2
-#endif
+#define FLAT_RATIO 5e-2
 #define STACK_MAX 128
 
 /* Gauss-Legendre on [0, 1]: 6 nodes for small pieces, 16 for large ones. */
@@ -401,6 +393,22 @@ static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb,
 ** since every chord point is within rc of the other chord; where they reach
 ** past it, the product rule of the cut kernel; C2-blended over one piece
 ** size below rc, so the value is continuous and never negative. */
+/* The chord of a piece moved across itself by the piece's mean distance
+** from it, (p1 + p2 - p0 - p3) / 4 for control points p0..p3 (the mean of
+** the cubic less the chord's mean), normal part. */
+static void mean_chord(const piece *p, double e0[2], double e1[2])
+{
+  double h3 = (p->t1 - p->t0) / 3.0, ux = p->r1[0] - p->r0[0], uy = p->r1[1] - p->r0[1];
+  double ox = 0.25 * (h3 * (p->d0[0] - p->d1[0])), oy = 0.25 * (h3 * (p->d0[1] - p->d1[1]));
+  double uu = ux * ux + uy * uy, f = uu > 0.0 ? (ox * ux + oy * uy) / uu : 0.0;
+  ox -= f * ux;
+  oy -= f * uy;
+  e0[0] = p->r0[0] + ox;
+  e0[1] = p->r0[1] + oy;
+  e1[0] = p->r1[0] + ox;
+  e1[1] = p->r1[1] + oy;
+}
+
 static double leaf_value(const cubic *ca, piece *pa, const cubic *cb, piece *pb, const cut *k)
 {
   double m = 1.0;
@@ -409,7 +417,10 @@ static double leaf_value(const cubic *ca, piece *pa, const cubic *cb, piece *pb,
     double far = sqrt(dx * dx + dy * dy) + pa->rad + pb->rad;
     m = big > 0.0 ? smooth_step((k->rc - far) / big) : 0.0;
   }
-  double v = m > 0.0 ? lw_pair_segseg(pa->r0, pa->r1, pb->r0, pb->r1) : 0.0;
+  double a0[2], a1[2], b0[2], b1[2];
+  mean_chord(pa, a0, a1);
+  mean_chord(pb, b0, b1);
+  double v = m > 0.0 ? lw_pair_segseg(a0, a1, b0, b1) : 0.0;
   if (!(v < INFINITY)) return piece_rule(ca, pa, cb, pb, k);
   if (k->on && m > 0.0) {
     double la = hypot(pa->r1[0] - pa->r0[0], pa->r1[1] - pa->r0[1]);
