@@ -9,13 +9,19 @@
 ** where the Hessian is not positive definite) projected into the square,
 ** each step halved until it brings the curves closer.  With d their
 ** distance, h the larger half-size of the two segments (bounding circles):
-**   apart, d / h >= APART_HI: the 16 x 16 Gauss rule of the whole kernel;
-**     the pole of 1/r is then at least 0.5 half-lengths from each segment,
-**     rho >= 0.5 + sqrt(1.25) = 1.6 beside its middle: error < 1.6^-32.
-**   otherwise (crossing, touching, running close alongside): the
+**   apart, d / h >= 0.35: Gauss rules of the whole kernel over the whole
+**     square, 16 nodes each way, and 24, 32, 48, 64 as d / h falls to
+**     0.24, 0.18, 0.12, 0.09 (WHOLE_LO).  The pole of 1/r is then at least
+**     d / h half-lengths from each segment, in a Bernstein ellipse
+**     rho >= d / h + sqrt(1 + (d / h)^2) beside its middle: error about
+**     rho^-2m, 1e-5 at each threshold.  Most near pairs of a drawing,
+**     neighbouring lines under an element apart, end here, and 64 x 64
+**     kernels cost less than the subdivision that would resolve them;
+**   otherwise (crossing, touching, running alongside closer): the
 **     subdivision below.
-** Between APART_LO and APART_HI the two are blended by a C2 weight, so the
-** value is a continuous function of the control points.
+** Each rule is blended into the next closer one by a C2 weight of d / h
+** (WHOLE_LO to WHOLE_HI), so the value is a continuous function of the
+** control points.
 **
 ** Every part of it is >= 0, as the kernel is: Gauss rules of a non-negative
 ** kernel, exact integrals of chords, convex blends.  A former singularity
@@ -34,15 +40,21 @@
 ** sqrt((1 + SEP_HI)^2 - 1) = 3.7 about each piece: error ~ 1e-7 of the
 ** pair).  Other pairs are split, A and B in turn (a choice by size would flip
 ** between two subtrees, whose values differ by their errors), down to a
-** leaf, where the chords stand in for the pieces and are integrated exactly.
+** leaf, where the pieces' mean chords stand in for them and are integrated
+** exactly: each chord moved across itself by its piece's mean distance from
+** it, (p1 + p2 - p0 - p3) / 4 of the control points, normal part.  Moving
+** a piece to its chord shifts every distance by up to its flatness f; to
+** its mean chord, by a deviation of mean zero along the piece, so the first-
+** order error cancels along curves alongside (it is left at the pieces'
+** ends) and the leaf errs by about (f / d)^2.
 ** A pair is a leaf when the pieces' flatnesses (each the larger distance of
 ** its inner control points from its chord) add up to at most FLAT_RATIO of
 ** the least distance the pieces can have (their chords' distance less the
-** flatnesses), so the chords' 1/r is within that share of the curves': this
-** ends curves running alongside at d apart with pieces of about
-** sqrt(8 FLAT_RATIO d / curvature) instead of going down to a fixed size.  Otherwise a pair
-** is a leaf at LEAF_RATIO of the pair's size: an error of order curvature^2
-** leaf^2 where curves cross, of order the leaf where they touch tangentially.
+** flatnesses): this ends curves running alongside at d apart with pieces of
+** about sqrt(8 FLAT_RATIO d / curvature) instead of going down to a fixed
+** size.  Otherwise a pair is a leaf at LEAF_RATIO of the pair's size: an
+** error of order curvature^2 leaf^2 where curves cross, of order the leaf
+** where they touch tangentially.
 ** Each decision is blended too (SEP_LO to SEP_HI, flatness ratios 1 to 2,
 ** leaf sizes 2 to 1).  A piece's 6-node rule is computed once and travels
 ** with its copies down the tree.
@@ -51,9 +63,11 @@
 ** pieces whose circles lie wholly beyond rc adds nothing (every rule below
 ** would give 0 there, so it is not split further); the 6 x 6 rule takes the
 ** cut kernel, kink and all (it is continuous, only its derivative jumps);
-** a leaf wholly inside rc takes the chords' exact 1/r less their lengths'
-** product over rc, which is >= 0, blended into the cut product rule over one
-** piece size as the leaf reaches the cutoff.
+** a leaf wholly inside rc takes the mean chords' exact 1/r less their
+** lengths' product over rc, clamped at 0 (it is >= 0 wherever the chords
+** lie inside the pieces' circles; a mean chord can leave its circle by
+** f^2 / length), blended into the cut product rule over one piece size as
+** the leaf reaches the cutoff.
 */
 #include "linewise/pairnear.h"
 
@@ -370,13 +384,14 @@ static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb,
     by[j] = (v2d){pb->y[2 * j], pb->y[2 * j + 1]};
     bw[j] = (v2d){pb->w[2 * j], pb->w[2 * j + 1]};
   }
+  const v2d inv = {k->inv, k->inv}, rc2 = {k->rc2, k->rc2};
   for (int i = 0; i < GAUSS_S; i++) {
     const v2d ax = {pa->x[i], pa->x[i]}, ay = {pa->y[i], pa->y[i]}, aw = {pa->w[i], pa->w[i]};
     v2d acc = {0.0, 0.0};
     for (int j = 0; j < GAUSS_S / 2; j++) {
       v2d dx = ax - bx[j], dy = ay - by[j], r2 = dx * dx + dy * dy, q = bw[j] / lw_vsqrt2(r2);
-      if (k->on)
-        for (int l = 0; l < 2; l++) q[l] = r2[l] < k->rc2 ? q[l] - bw[j][l] * k->inv : 0.0;
+      /* beyond rc the term is masked to 0 (a comparison gives all ones or 0) */
+      if (k->on) q = (v2d)((lw_v2l)(q - bw[j] * inv) & (r2 < rc2));
       acc += q;
     }
     sum += aw * acc;
@@ -384,15 +399,6 @@ static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb,
   return sum[0] + sum[1];
 }
 
-/* A leaf: the chords, integrated exactly; their lengths stand in for the
-** arcs (equal to O(leaf^2)).  Chords of curves that touch tangentially end
-** to end can overlap by a rounding error, which the exact integral reads as
-** +inf; the product rule's interior nodes keep such a leaf finite.
-** With the cutoff: where the pieces lie wholly inside it (their farthest
-** points closer than rc), 1/r - 1/rc of the chords exactly, which is >= 0
-** since every chord point is within rc of the other chord; where they reach
-** past it, the product rule of the cut kernel; C2-blended over one piece
-** size below rc, so the value is continuous and never negative. */
 /* The chord of a piece moved across itself by the piece's mean distance
 ** from it, (p1 + p2 - p0 - p3) / 4 for control points p0..p3 (the mean of
 ** the cubic less the chord's mean), normal part. */
@@ -409,6 +415,15 @@ static void mean_chord(const piece *p, double e0[2], double e1[2])
   e1[1] = p->r1[1] + oy;
 }
 
+/* A leaf: the mean chords, integrated exactly; their lengths stand in for
+** the arcs (equal to O(leaf^2)).  Chords of curves that touch tangentially end
+** to end can overlap by a rounding error, which the exact integral reads as
+** +inf; the product rule's interior nodes keep such a leaf finite.
+** With the cutoff: where the pieces lie wholly inside it (their farthest
+** points closer than rc), 1/r - 1/rc of the chords exactly, clamped at 0
+** (see the file comment); where they reach past it, the product rule of
+** the cut kernel; C2-blended over one piece
+** size below rc, so the value is continuous and never negative. */
 static double leaf_value(const cubic *ca, piece *pa, const cubic *cb, piece *pb, const cut *k)
 {
   double m = 1.0;
@@ -455,7 +470,7 @@ static double chord_distance(const piece *pa, const piece *pb)
 }
 
 /* The double integral of the kernel by subdivision (see the file comment),
-** times root_rest: the root pair's 16 x 16 share is the caller's. */
+** times root_rest: the whole-square rules' shares are the caller's. */
 static double subdivided(const cubic *ca, const piece *root_a, const cubic *cb, const piece *root_b,
                          double root_rest, const cut *k)
 {

@@ -34,9 +34,10 @@
 ** segments a and b (control points x0 y0 x1 y1 x2 y2 x3 y3, mm), or of
 ** |a'| |b'| / r without a cutoff (cutoff <= 0).  Finite where the segments
 ** cross or touch, and never negative.  A continuous function of the control
-** points; relative error 3e-7 for segments apart, 1e-5 to 4e-5 where they
-** cross, up to 3e-3 where they touch tangentially at an end (pairnear.c,
-** docs/NUMERICS.md). */
+** points; relative error 1e-5 or less for segments apart (without a
+** cutoff; its kink adds up to ~1e-3), 1e-4 to 1e-3 where they cross or run
+** alongside closely, up to 3e-3 where they touch tangentially at an end
+** (pairnear.c, docs/NUMERICS.md, docs/ACCURACY.md). */
 double lw_pair_segments_exact(const double a[8], const double b[8], double cutoff);
 
 /* E_AB minus the product-rule terms of the sample pairs of A x B that are
