@@ -459,8 +459,6 @@ static jet piece_rule(const jcubic *ca, const jpiece *pa, const jcubic *cb, cons
   return jproduct(&na, &nb, k->on ? KERNEL_CUT : KERNEL_INV, k->rc);
 }
 
-/* pairnear.c's leaf_value: the chords' exact integral, with the cutoff
-** blended into the product rule where the pieces reach past it. */
 /* pairnear.c's mean_chord: the chord moved across itself by the piece's
 ** mean distance from it. */
 static void mean_chord(const jpiece *p, jet e0[2], jet e1[2])
@@ -478,6 +476,8 @@ static void mean_chord(const jpiece *p, jet e0[2], jet e1[2])
   e1[1] = jadd(p->r1[1], oy);
 }
 
+/* pairnear.c's leaf_value: the mean chords' exact integral, with the cutoff
+** blended into the product rule where the pieces reach past it. */
 static jet leaf_value(const jcubic *ca, const jpiece *pa, const jcubic *cb, const jpiece *pb, const cut *k)
 {
   jet m = jc(1.0);

@@ -286,8 +286,8 @@ static const double G64_W[64] = {
 ** the larger half-size h.  The pole of 1/r is then at least lo half-lengths
 ** from each segment, in a Bernstein ellipse rho = lo + sqrt(1 + lo^2) beside
 ** its middle, and the rule errs by about rho^-2m: 1.6e-5 (16 nodes at 0.35),
-** 1.1e-5 (24 at 0.24, 32 at 0.18), 1.0e-5 (48 at 0.12, 64 at 0.09).  Closer pairs take the
-** subdivision. */
+** 1.1e-5 (24 at 0.24, 32 at 0.18), 1.0e-5 (48 at 0.12, 64 at 0.09).  Closer
+** pairs take the subdivision. */
 #define N_WHOLE 5
 static const int WHOLE_M[N_WHOLE] = {16, 24, 32, 48, 64};
 static const double *const WHOLE_S[N_WHOLE] = {G16_S, G24_S, G32_S, G48_S, G64_S};
