@@ -293,7 +293,7 @@ static const int WHOLE_M[N_WHOLE] = {16, 24, 32, 48, 64};
 static const double *const WHOLE_S[N_WHOLE] = {G16_S, G24_S, G32_S, G48_S, G64_S};
 static const double *const WHOLE_W[N_WHOLE] = {G16_W, G24_W, G32_W, G48_W, G64_W};
 static const double WHOLE_LO[N_WHOLE] = {0.35, 0.24, 0.18, 0.12, 0.09};
-static const double WHOLE_HI[N_WHOLE] = {0.42, 0.28, 0.21, 0.14, 0.105};
+static const double WHOLE_HI[N_WHOLE] = {0.37, 0.252, 0.189, 0.126, 0.0945};
 
 /* Positions and length weights of an m-node rule on a piece. */
 static void rule_nodes(const cubic *c, double t0, double t1, const double *s, const double *w, int m,
