@@ -167,7 +167,8 @@ static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
 #define FLAT_RATIO 5e-2
 #define STACK_MAX 128
 
-/* Gauss-Legendre on [0, 1]: 6 nodes for small pieces, 16 for large ones. */
+/* Gauss-Legendre on [0, 1]: 6 nodes for pieces, 16 (and 24 to 64 below) for
+** whole segments. */
 #define GAUSS_S 6
 static const double G6_S[GAUSS_S] = {0.033765242898423986, 0.16939530676686774, 0.38069040695840154,
                                      0.61930959304159846, 0.83060469323313226, 0.96623475710157601};
