@@ -722,11 +722,11 @@ Test(pair, exact_segment_pairs_match_reference_when_close)
 ** bent cubics of 5 mm, the second a copy turned by up to 3.4 degrees and
 ** moved 0.03 to 0.6 mm sideways and up to 4 mm along, against the
 ** brute-force reference.  The subdivision ends such pairs at flatness
-** leaves (pairnear.c), whose chords move every distance by at most 1 % of
-** itself, and by much less where both curves bend alike.  Bound 2e-3
-** (measured at most 8.5e-4, the same without flatness leaves: the worst
-** pairs take the singularity subtraction; with leaves 30 times looser,
-** 5.3e-3).
+** leaves (pairnear.c) of 5 % of the distance, whose mean chords err at
+** second order in that ratio; the farther pairs take the whole-square
+** rules.  Bound 2e-3 (measured at most 2.5e-4; with plain chords at the
+** same flatness this test fails, and so do exact_segment_pairs_match_reference
+** and exact_integral_is_never_negative).
 */
 Test(pair, exact_segment_pairs_match_reference_alongside)
 {
