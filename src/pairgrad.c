@@ -330,9 +330,11 @@ static void jpiece_split(const jpiece *p, const jcubic *c, jpiece *lo, jpiece *h
 }
 
 /* The nodes of a rule on a piece: positions and length weights. */
+#define JNODES_MAX 64
+
 typedef struct {
   int m;
-  jet x[16], y[16], w[16];
+  jet x[JNODES_MAX], y[JNODES_MAX], w[JNODES_MAX];
 } jnodes;
 
 static void jrule_nodes(const jcubic *c, double t0, double t1, const double *s, const double *w, int m,
@@ -357,7 +359,8 @@ typedef enum { KERNEL_INV, KERNEL_CUT } kernel_kind;
 static jet jproduct(const jnodes *A, const jnodes *B, kernel_kind kind, double rc)
 {
   const double inv = rc > 0.0 ? 1.0 / rc : 0.0, rc2 = rc > 0.0 ? rc * rc : INFINITY;
-  double aw[16] = {0}, ax[16] = {0}, ay[16] = {0}, bw[16] = {0}, bx[16] = {0}, by[16] = {0}, sum = 0.0;
+  double aw[JNODES_MAX] = {0}, ax[JNODES_MAX] = {0}, ay[JNODES_MAX] = {0}, bw[JNODES_MAX] = {0}, bx[JNODES_MAX] = {0},
+         by[JNODES_MAX] = {0}, sum = 0.0;
   for (int i = 0; i < A->m; i++) {
     double acc = 0.0, wi = A->w[i].v;
     for (int j = 0; j < B->m; j++) {
@@ -409,6 +412,7 @@ typedef struct {
   jpiece *sa, *sb;
   jet *share;
   int *depth;
+  jnodes na, nb; /* the whole-square rules' nodes (64 jets each way) */
 } pairgrad_work;
 
 static pairgrad_work *work_new(void)
@@ -455,7 +459,24 @@ static jet piece_rule(const jcubic *ca, const jpiece *pa, const jcubic *cb, cons
   return jproduct(&na, &nb, k->on ? KERNEL_CUT : KERNEL_INV, k->rc);
 }
 
-/* pairnear.c's leaf_value: the chords' exact integral, with the cutoff
+/* pairnear.c's mean_chord: the chord moved across itself by the piece's
+** mean distance from it. */
+static void mean_chord(const jpiece *p, jet e0[2], jet e1[2])
+{
+  double h3 = (p->t1 - p->t0) / 3.0;
+  jet ux = jsub(p->r1[0], p->r0[0]), uy = jsub(p->r1[1], p->r0[1]);
+  jet ox = jscale(jscale(jsub(p->d0[0], p->d1[0]), h3), 0.25), oy = jscale(jscale(jsub(p->d0[1], p->d1[1]), h3), 0.25);
+  jet uu = jadd(jmul(ux, ux), jmul(uy, uy));
+  jet f = uu.v > 0.0 ? jdiv(jadd(jmul(ox, ux), jmul(oy, uy)), uu) : jc(0.0);
+  ox = jsub(ox, jmul(f, ux));
+  oy = jsub(oy, jmul(f, uy));
+  e0[0] = jadd(p->r0[0], ox);
+  e0[1] = jadd(p->r0[1], oy);
+  e1[0] = jadd(p->r1[0], ox);
+  e1[1] = jadd(p->r1[1], oy);
+}
+
+/* pairnear.c's leaf_value: the mean chords' exact integral, with the cutoff
 ** blended into the product rule where the pieces reach past it. */
 static jet leaf_value(const jcubic *ca, const jpiece *pa, const jcubic *cb, const jpiece *pb, const cut *k)
 {
@@ -465,7 +486,10 @@ static jet leaf_value(const jcubic *ca, const jpiece *pa, const jcubic *cb, cons
     jet far = jadd(jadd(jhypot(jsub(pa->cx, pb->cx), jsub(pa->cy, pb->cy)), pa->rad), pb->rad);
     m = big.v > 0.0 ? jsmooth(jdiv(jaddc(jscale(far, -1.0), k->rc), big)) : jc(0.0);
   }
-  jet v = m.v > 0.0 ? jsegseg(pa->r0, pa->r1, pb->r0, pb->r1) : jc(0.0);
+  jet a0[2], a1[2], b0[2], b1[2];
+  mean_chord(pa, a0, a1);
+  mean_chord(pb, b0, b1);
+  jet v = m.v > 0.0 ? jsegseg(a0, a1, b0, b1) : jc(0.0);
   if (!(v.v < INFINITY)) return piece_rule(ca, pa, cb, pb, k);
   if (k->on && m.v > 0.0) {
     jet la = jhypot(jsub(pa->r1[0], pa->r0[0]), jsub(pa->r1[1], pa->r0[1]));
@@ -673,15 +697,22 @@ static double segments_exact_grad(const double a[8], const double b[8], double c
   jcubic_eval_at(&ca, ss, ra, a1, a2);
   jcubic_eval_at(&cb, ts, rb, b1, b2);
   jet half = pa.rad.v >= pb.rad.v ? pa.rad : pb.rad, dist = jhypot(jsub(ra[0], rb[0]), jsub(ra[1], rb[1]));
-  jet w = half.v > 0.0 ? jsmooth(jdivc(jaddc(jdiv(dist, half), -K.apart_lo), K.apart_hi - K.apart_lo)) : jc(1.0);
   kernel_kind whole = cutoff > 0.0 ? KERNEL_CUT : KERNEL_INV;
-  jnodes na, nb;
-  jrule_nodes(&ca, 0.0, 1.0, K.g16_s, K.g16_w, K.g16_n, &na);
-  jrule_nodes(&cb, 0.0, 1.0, K.g16_s, K.g16_w, K.g16_n, &nb);
-  jet v = w.v > 0.0 ? jmul(w, jproduct(&na, &nb, whole, cutoff)) : jc(0.0);
-  if (w.v < 1.0) {
+  jet v = jc(0.0), rest = jc(1.0);
+  for (int r = 0; r < K.n_whole && rest.v > 0.0; r++) {
+    double lo = K.whole_lo[r], hi = K.whole_hi[r];
+    jet w = half.v > 0.0 ? jsmooth(jdivc(jaddc(jdiv(dist, half), -lo), hi - lo)) : jc(1.0);
+    if (w.v > 0.0) {
+      jnodes *na = &wk->na, *nb = &wk->nb;
+      jrule_nodes(&ca, 0.0, 1.0, K.whole_s[r], K.whole_w[r], K.whole_m[r], na);
+      jrule_nodes(&cb, 0.0, 1.0, K.whole_s[r], K.whole_w[r], K.whole_m[r], nb);
+      v = jadd(v, jmul(jmul(rest, w), jproduct(na, nb, whole, cutoff)));
+    }
+    rest = jmul(rest, jaddc(jscale(w, -1.0), 1.0));
+  }
+  if (rest.v > 0.0) {
     const cut k = {cutoff > 0.0, cutoff, cutoff > 0.0 ? 1.0 / cutoff : 0.0};
-    v = jadd(v, subdivided(&ca, &pa, &cb, &pb, jaddc(jscale(w, -1.0), 1.0), &k, wk));
+    v = jadd(v, subdivided(&ca, &pa, &cb, &pb, rest, &k, wk));
   }
   for (int k = 0; k < 8; k++) {
     ga[k] = v.d[k];

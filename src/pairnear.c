@@ -9,13 +9,19 @@
 ** where the Hessian is not positive definite) projected into the square,
 ** each step halved until it brings the curves closer.  With d their
 ** distance, h the larger half-size of the two segments (bounding circles):
-**   apart, d / h >= APART_HI: the 16 x 16 Gauss rule of the whole kernel;
-**     the pole of 1/r is then at least 0.5 half-lengths from each segment,
-**     rho >= 0.5 + sqrt(1.25) = 1.6 beside its middle: error < 1.6^-32.
-**   otherwise (crossing, touching, running close alongside): the
+**   apart, d / h >= 0.35: Gauss rules of the whole kernel over the whole
+**     square, 16 nodes each way, and 24, 32, 48, 64 as d / h falls to
+**     0.24, 0.18, 0.12, 0.09 (WHOLE_LO).  The pole of 1/r is then at least
+**     d / h half-lengths from each segment, in a Bernstein ellipse
+**     rho >= d / h + sqrt(1 + (d / h)^2) beside its middle: error about
+**     rho^-2m, 1e-5 at each threshold.  Most near pairs of a drawing,
+**     neighbouring lines under an element apart, end here, and 64 x 64
+**     kernels cost less than the subdivision that would resolve them;
+**   otherwise (crossing, touching, running alongside closer): the
 **     subdivision below.
-** Between APART_LO and APART_HI the two are blended by a C2 weight, so the
-** value is a continuous function of the control points.
+** Each rule is blended into the next closer one by a C2 weight of d / h
+** (WHOLE_LO to WHOLE_HI), so the value is a continuous function of the
+** control points.
 **
 ** Every part of it is >= 0, as the kernel is: Gauss rules of a non-negative
 ** kernel, exact integrals of chords, convex blends.  A former singularity
@@ -34,15 +40,21 @@
 ** sqrt((1 + SEP_HI)^2 - 1) = 3.7 about each piece: error ~ 1e-7 of the
 ** pair).  Other pairs are split, A and B in turn (a choice by size would flip
 ** between two subtrees, whose values differ by their errors), down to a
-** leaf, where the chords stand in for the pieces and are integrated exactly.
+** leaf, where the pieces' mean chords stand in for them and are integrated
+** exactly: each chord moved across itself by its piece's mean distance from
+** it, (p1 + p2 - p0 - p3) / 4 of the control points, normal part.  Moving
+** a piece to its chord shifts every distance by up to its flatness f; to
+** its mean chord, by a deviation of mean zero along the piece, so the first-
+** order error cancels along curves alongside (it is left at the pieces'
+** ends) and the leaf errs by about (f / d)^2.
 ** A pair is a leaf when the pieces' flatnesses (each the larger distance of
 ** its inner control points from its chord) add up to at most FLAT_RATIO of
 ** the least distance the pieces can have (their chords' distance less the
-** flatnesses), so the chords' 1/r is within that share of the curves': this
-** ends curves running alongside at d apart with pieces of about
-** sqrt(8 FLAT_RATIO d / curvature) instead of going down to a fixed size.  Otherwise a pair
-** is a leaf at LEAF_RATIO of the pair's size: an error of order curvature^2
-** leaf^2 where curves cross, of order the leaf where they touch tangentially.
+** flatnesses): this ends curves running alongside at d apart with pieces of
+** about sqrt(8 FLAT_RATIO d / curvature) instead of going down to a fixed
+** size.  Otherwise a pair is a leaf at LEAF_RATIO of the pair's size: an
+** error of order curvature^2 leaf^2 where curves cross, of order the leaf
+** where they touch tangentially.
 ** Each decision is blended too (SEP_LO to SEP_HI, flatness ratios 1 to 2,
 ** leaf sizes 2 to 1).  A piece's 6-node rule is computed once and travels
 ** with its copies down the tree.
@@ -51,15 +63,19 @@
 ** pieces whose circles lie wholly beyond rc adds nothing (every rule below
 ** would give 0 there, so it is not split further); the 6 x 6 rule takes the
 ** cut kernel, kink and all (it is continuous, only its derivative jumps);
-** a leaf wholly inside rc takes the chords' exact 1/r less their lengths'
-** product over rc, which is >= 0, blended into the cut product rule over one
-** piece size as the leaf reaches the cutoff.
+** a leaf wholly inside rc takes the mean chords' exact 1/r less their
+** lengths' product over rc, clamped at 0 (it is >= 0 wherever the chords
+** lie inside the pieces' circles; a mean chord can leave its circle by
+** f^2 / length), blended into the cut product rule over one piece size as
+** the leaf reaches the cutoff.
 */
 #include "linewise/pairnear.h"
 
 #include <math.h>
 
 #include "linewise/vec2.h"
+
+typedef lw_v2d v2d;
 
 /* A cubic in power form about a local origin: r(t) = c0 + c1 t + c2 t^2 + c3 t^3. */
 typedef struct {
@@ -147,19 +163,19 @@ static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
 
 #define SEP_LO 0.5
 #define SEP_HI 1.0
-#define APART_LO 0.35
-#define APART_HI 0.5
 #define LEAF_RATIO 5e-3
-#define FLAT_RATIO 1e-2
+#define FLAT_RATIO 5e-2
 #define STACK_MAX 128
 
-/* Gauss-Legendre on [0, 1]: 6 nodes for small pieces, 16 for large ones. */
+/* Gauss-Legendre on [0, 1]: 6 nodes for pieces, 16 (and 24 to 64 below) for
+** whole segments. */
 #define GAUSS_S 6
 static const double G6_S[GAUSS_S] = {0.033765242898423986, 0.16939530676686774, 0.38069040695840154,
                                      0.61930959304159846, 0.83060469323313226, 0.96623475710157601};
 static const double G6_W[GAUSS_S] = {0.085662246189585173, 0.18038078652406930, 0.23395696728634552,
                                      0.23395696728634552, 0.18038078652406930, 0.085662246189585173};
 #define GAUSS_L 16
+#define GAUSS_MAX 64
 static const double G16_S[GAUSS_L] = {
     0.0052995325041750337, 0.027712488463383700, 0.067184398806084122, 0.12229779582249845,
     0.19106187779867811,   0.27099161117138637,  0.35919822461037054,  0.45249374508118123,
@@ -170,6 +186,115 @@ static const double G16_W[GAUSS_L] = {
     0.074797994408288366, 0.084578259697501269, 0.091301707522461794, 0.094725305227534249,
     0.094725305227534249, 0.091301707522461794, 0.084578259697501269, 0.074797994408288366,
     0.062314485627766936, 0.047579255841246392, 0.031126761969323946, 0.013576229705877047};
+
+/* 24 to 64 nodes: the whole-square rules for segments closer than the
+** 16-node rule resolves (lw_quad_init's nodes, polished to rounding level). */
+static const double G24_S[24] = {
+    0.00240639000148932, 0.012635722014345251, 0.030862723998633622, 0.056792236497799485,
+    0.08999900701304854, 0.12993790421072282, 0.17595317403151223, 0.22728926430558022,
+    0.28310324618697741, 0.3424786601519183, 0.40444056626319186, 0.46797155356869719,
+    0.53202844643130276, 0.5955594337368082, 0.6575213398480817, 0.71689675381302254,
+    0.77271073569441973, 0.82404682596848777, 0.87006209578927718, 0.91000099298695147,
+    0.94320776350220048, 0.96913727600136634, 0.98736427798565474, 0.99759360999851066};
+static const double G24_W[24] = {
+    0.0061706148999936001, 0.014265694314466832, 0.022138719408709904, 0.029649292457718392,
+    0.03667324070554015, 0.043095080765976637, 0.048809326052056942, 0.053722135057982817,
+    0.0577528340268628, 0.060835236463901696, 0.062918728173414151, 0.06396909767337608,
+    0.06396909767337608, 0.062918728173414151, 0.060835236463901696, 0.0577528340268628,
+    0.053722135057982817, 0.048809326052056942, 0.043095080765976637, 0.03667324070554015,
+    0.029649292457718392, 0.022138719408709904, 0.014265694314466832, 0.0061706148999936001};
+static const double G32_S[32] = {
+    0.0013680690752592183, 0.0071942442273658326, 0.017618872206246784, 0.032546962031130153,
+    0.051839422116973941, 0.075316193133715015, 0.10275810201602879, 0.13390894062985517,
+    0.16847786653489241, 0.20614212137961885, 0.24655004553388529, 0.28932436193468231,
+    0.33406569885893617, 0.38035631887393145, 0.42776401920860174, 0.47584616715613082,
+    0.52415383284386918, 0.57223598079139826, 0.61964368112606849, 0.66593430114106378,
+    0.71067563806531764, 0.75344995446611474, 0.79385787862038115, 0.83152213346510762,
+    0.86609105937014486, 0.89724189798397125, 0.92468380686628493, 0.9481605778830261,
+    0.96745303796886983, 0.98238112779375319, 0.99280575577263419, 0.99863193092474078};
+static const double G32_W[32] = {
+    0.0035093050047350482, 0.0081371973654528352, 0.012696032654631029, 0.017136931456510716,
+    0.021417949011113342, 0.025499029631188087, 0.029342046739267772, 0.032911111388180925,
+    0.036172897054424252, 0.039096947893535156, 0.041655962113473374, 0.043826046502201906,
+    0.045586939347881945, 0.046922199540402283, 0.04781936003963743, 0.048270044257363899,
+    0.048270044257363899, 0.04781936003963743, 0.046922199540402283, 0.045586939347881945,
+    0.043826046502201906, 0.041655962113473374, 0.039096947893535156, 0.036172897054424252,
+    0.032911111388180925, 0.029342046739267772, 0.025499029631188087, 0.021417949011113342,
+    0.017136931456510716, 0.012696032654631029, 0.0081371973654528352, 0.0035093050047350482};
+static const double G48_S[48] = {
+    0.00061449637378694071, 0.003234913866824621, 0.007937708138586571, 0.014704203726876374,
+    0.023506148419784569, 0.034306654646722834, 0.047060431642215163, 0.061713989862876059,
+    0.078205869187803229, 0.096466897985278688, 0.11642048374212983, 0.13798293453809268,
+    0.16106381018366805, 0.1855663016117432, 0.21138763695801366, 0.23841951263888347,
+    0.26654854762452079, 0.29565675900464161, 0.32562205685391965, 0.35631875632227222,
+    0.38761810480265546, 0.41938882196555416, 0.45149765039526862, 0.48380991451856531,
+    0.51619008548143464, 0.54850234960473132, 0.58061117803444584, 0.61238189519734454,
+    0.64368124367772783, 0.67437794314608035, 0.70434324099535839, 0.73345145237547915,
+    0.7615804873611165, 0.78861236304198634, 0.81443369838825685, 0.838936189816332,
+    0.86201706546190737, 0.88357951625787012, 0.90353310201472137, 0.92179413081219674,
+    0.93828601013712398, 0.95293956835778482, 0.96569334535327722, 0.9764938515802154,
+    0.98529579627312358, 0.99206229186141348, 0.99676508613317538, 0.99938550362621303};
+static const double G48_W[48] = {
+    0.0015766730261529192, 0.0036637769506381312, 0.0057386172896172699, 0.0077896578614719244,
+    0.0098080802286777645, 0.01178538041966219, 0.013713254854178474, 0.015583613916399045,
+    0.017388611282385221, 0.019120675532915354, 0.020772541471732374, 0.02233728042834714,
+    0.023808329246245239, 0.025179517776927236, 0.026445094742596834, 0.027599751849992082,
+    0.028638646050201607, 0.029557419849197818, 0.03035221958294694, 0.031019711579946332,
+    0.03155709614312701, 0.031962119292324093, 0.032233082217975044, 0.032368848406341959,
+    0.032368848406341959, 0.032233082217975044, 0.031962119292324093, 0.03155709614312701,
+    0.031019711579946332, 0.03035221958294694, 0.029557419849197818, 0.028638646050201607,
+    0.027599751849992082, 0.026445094742596834, 0.025179517776927236, 0.023808329246245239,
+    0.02233728042834714, 0.020772541471732374, 0.019120675532915354, 0.017388611282385221,
+    0.015583613916399045, 0.013713254854178474, 0.01178538041966219, 0.0098080802286777645,
+    0.0077896578614719244, 0.0057386172896172699, 0.0036637769506381312, 0.0015766730261529192};
+static const double G64_S[64] = {
+    0.00034747913211393029, 0.0018299416140223604, 0.00449331426162784, 0.0083318730576870219,
+    0.013336586105044517, 0.01949560017397314, 0.026794312570798593, 0.035215413934030215,
+    0.044738931460748595, 0.055342277002442944, 0.067000300922953587, 0.079685351873709814,
+    0.093367342438601217, 0.10801382052832929, 0.12359004636973406, 0.14005907491419459,
+    0.15738184347288336, 0.17551726437267132, 0.19442232241380336, 0.21405217689868297,
+    0.23436026799005272, 0.25529842714647349, 0.27681699137326793, 0.29886492101800421,
+    0.32138992083116596, 0.34433856400489454, 0.36765641889561629, 0.39128817812999644,
+    0.41517778978800357, 0.43926859035193971, 0.46350343910610048, 0.48782485366828776,
+    0.51217514633171224, 0.53649656089389952, 0.56073140964806023, 0.58482221021199643,
+    0.6087118218700035, 0.63234358110438371, 0.65566143599510551, 0.67861007916883409,
+    0.70113507898199579, 0.72318300862673202, 0.74470157285352645, 0.76563973200994728,
+    0.78594782310131706, 0.80557767758619658, 0.82448273562732866, 0.84261815652711658,
+    0.85994092508580544, 0.87640995363026597, 0.89198617947167069, 0.90663265756139877,
+    0.92031464812629016, 0.93299969907704638, 0.94465772299755701, 0.95526106853925141,
+    0.96478458606596984, 0.97320568742920144, 0.98050439982602688, 0.98666341389495549,
+    0.99166812694231299, 0.9955066857383722, 0.99817005838597761, 0.99965252086788603};
+static const double G64_W[64] = {
+    0.00089164036084821651, 0.002073516630281234, 0.0032522289844891814, 0.0044233799131819735,
+    0.0055840697300655641, 0.0067315239483593213, 0.0078630152380123591, 0.0089758578878486716,
+    0.010067411576765104, 0.011135086904191627, 0.012176351284355437, 0.013188734857527329,
+    0.014169836307129742, 0.015117328536201239, 0.016028964177425775, 0.016902580918570803,
+    0.017736106628441193, 0.018527564270120023, 0.019275076589307813, 0.019976870566360171,
+    0.020631281621311764, 0.021236757561826795, 0.021791862264661725, 0.022295279081878283,
+    0.022745813963709071, 0.023142398290657208, 0.02348409140810501, 0.023770082857415154,
+    0.023999694298229155, 0.024172381117401477, 0.024287733720751714, 0.024345478504569862,
+    0.024345478504569862, 0.024287733720751714, 0.024172381117401477, 0.023999694298229155,
+    0.023770082857415154, 0.02348409140810501, 0.023142398290657208, 0.022745813963709071,
+    0.022295279081878283, 0.021791862264661725, 0.021236757561826795, 0.020631281621311764,
+    0.019976870566360171, 0.019275076589307813, 0.018527564270120023, 0.017736106628441193,
+    0.016902580918570803, 0.016028964177425775, 0.015117328536201239, 0.014169836307129742,
+    0.013188734857527329, 0.012176351284355437, 0.011135086904191627, 0.010067411576765104,
+    0.0089758578878486716, 0.0078630152380123591, 0.0067315239483593213, 0.0055840697300655641,
+    0.0044233799131819735, 0.0032522289844891814, 0.002073516630281234, 0.00089164036084821651};
+
+/* The whole-square rules, in the order they are tried: m nodes each way for
+** segments whose least distance d is at least lo (blended in up to hi) times
+** the larger half-size h.  The pole of 1/r is then at least lo half-lengths
+** from each segment, in a Bernstein ellipse rho = lo + sqrt(1 + lo^2) beside
+** its middle, and the rule errs by about rho^-2m: 1.6e-5 (16 nodes at 0.35),
+** 1.1e-5 (24 at 0.24, 32 at 0.18), 1.0e-5 (48 at 0.12, 64 at 0.09).  Closer
+** pairs take the subdivision. */
+#define N_WHOLE 5
+static const int WHOLE_M[N_WHOLE] = {16, 24, 32, 48, 64};
+static const double *const WHOLE_S[N_WHOLE] = {G16_S, G24_S, G32_S, G48_S, G64_S};
+static const double *const WHOLE_W[N_WHOLE] = {G16_W, G24_W, G32_W, G48_W, G64_W};
+static const double WHOLE_LO[N_WHOLE] = {0.35, 0.24, 0.18, 0.12, 0.09};
+static const double WHOLE_HI[N_WHOLE] = {0.37, 0.252, 0.189, 0.126, 0.0945};
 
 /* Positions and length weights of an m-node rule on a piece. */
 static void rule_nodes(const cubic *c, double t0, double t1, const double *s, const double *w, int m,
@@ -186,27 +311,42 @@ static void rule_nodes(const cubic *c, double t0, double t1, const double *s, co
 
 typedef enum { KERNEL_INV, KERNEL_CUT } kernel_kind;
 
-/* The product rule of an m-node rule on two pieces, for the kernel 1/r or
-** (1/r - 1/rc)+. */
-static double product_rule(const cubic *ca, double a0, double a1, const cubic *cb, double b0, double b1, int m,
+/* The product rule of an m-node rule (m even, at most GAUSS_MAX) over the
+** whole of two segments, for the kernel 1/r or (1/r - 1/rc)+, B's nodes two
+** at a time. */
+static double product_rule(const cubic *ca, const cubic *cb, const double *s, const double *w, int m,
                            kernel_kind kind, double rc)
 {
-  double ax[GAUSS_L], ay[GAUSS_L], aw[GAUSS_L], bx[GAUSS_L], by[GAUSS_L], bw[GAUSS_L];
-  const double *s = m == GAUSS_L ? G16_S : G6_S, *w = m == GAUSS_L ? G16_W : G6_W;
-  rule_nodes(ca, a0, a1, s, w, m, ax, ay, aw);
-  rule_nodes(cb, b0, b1, s, w, m, bx, by, bw);
-  const double inv = rc > 0.0 ? 1.0 / rc : 0.0, rc2 = rc > 0.0 ? rc * rc : INFINITY;
-  double sum = 0.0;
-  for (int i = 0; i < m; i++) {
-    double acc = 0.0;
-    for (int j = 0; j < m; j++) {
-      double dx = ax[i] - bx[j], dy = ay[i] - by[j], r2 = dx * dx + dy * dy;
-      if (kind == KERNEL_INV) acc += bw[j] / sqrt(r2);
-      else acc += r2 < rc2 ? bw[j] * (1.0 / sqrt(r2) - inv) : 0.0;
-    }
-    sum += aw[i] * acc;
+  double ax[GAUSS_MAX], ay[GAUSS_MAX], aw[GAUSS_MAX], bx[GAUSS_MAX], by[GAUSS_MAX], bw[GAUSS_MAX];
+  rule_nodes(ca, 0.0, 1.0, s, w, m, ax, ay, aw);
+  rule_nodes(cb, 0.0, 1.0, s, w, m, bx, by, bw);
+  v2d vx[GAUSS_MAX / 2], vy[GAUSS_MAX / 2], vw[GAUSS_MAX / 2], sum = {0.0, 0.0};
+  for (int j = 0; j < m / 2; j++) {
+    vx[j] = (v2d){bx[2 * j], bx[2 * j + 1]};
+    vy[j] = (v2d){by[2 * j], by[2 * j + 1]};
+    vw[j] = (v2d){bw[2 * j], bw[2 * j + 1]};
   }
-  return sum;
+  const double inv = rc > 0.0 ? 1.0 / rc : 0.0, rc2 = rc > 0.0 ? rc * rc : INFINITY;
+  const v2d vinv = {inv, inv}, vrc2 = {rc2, rc2};
+  for (int i = 0; i < m; i++) {
+    const v2d x = {ax[i], ax[i]}, y = {ay[i], ay[i]};
+    v2d acc = {0.0, 0.0};
+    if (kind == KERNEL_INV) {
+      for (int j = 0; j < m / 2; j++) {
+        v2d dx = x - vx[j], dy = y - vy[j];
+        acc += vw[j] / lw_vsqrt2(dx * dx + dy * dy);
+      }
+    } else {
+      /* beyond rc the term is masked to 0 (a comparison gives all ones or 0) */
+      for (int j = 0; j < m / 2; j++) {
+        v2d dx = x - vx[j], dy = y - vy[j], r2 = dx * dx + dy * dy;
+        v2d q = vw[j] * (1.0 / lw_vsqrt2(r2) - vinv);
+        acc += (v2d)((lw_v2l)q & (r2 < vrc2));
+      }
+    }
+    sum += (v2d){aw[i], aw[i]} * acc;
+  }
+  return sum[0] + sum[1];
 }
 
 /* 0 at x <= 0, 1 at x >= 1, C2 between. */
@@ -226,7 +366,6 @@ static void piece_nodes(const cubic *c, piece *p)
   p->has_nodes = 1;
 }
 
-typedef lw_v2d v2d;
 
 /* The kernel of the subdivision: 1/r, or (1/r - 1/rc)+ where on. */
 typedef struct {
@@ -246,13 +385,14 @@ static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb,
     by[j] = (v2d){pb->y[2 * j], pb->y[2 * j + 1]};
     bw[j] = (v2d){pb->w[2 * j], pb->w[2 * j + 1]};
   }
+  const v2d inv = {k->inv, k->inv}, rc2 = {k->rc2, k->rc2};
   for (int i = 0; i < GAUSS_S; i++) {
     const v2d ax = {pa->x[i], pa->x[i]}, ay = {pa->y[i], pa->y[i]}, aw = {pa->w[i], pa->w[i]};
     v2d acc = {0.0, 0.0};
     for (int j = 0; j < GAUSS_S / 2; j++) {
       v2d dx = ax - bx[j], dy = ay - by[j], r2 = dx * dx + dy * dy, q = bw[j] / lw_vsqrt2(r2);
-      if (k->on)
-        for (int l = 0; l < 2; l++) q[l] = r2[l] < k->rc2 ? q[l] - bw[j][l] * k->inv : 0.0;
+      /* beyond rc the term is masked to 0 (a comparison gives all ones or 0) */
+      if (k->on) q = (v2d)((lw_v2l)(q - bw[j] * inv) & (r2 < rc2));
       acc += q;
     }
     sum += aw * acc;
@@ -260,14 +400,30 @@ static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb,
   return sum[0] + sum[1];
 }
 
-/* A leaf: the chords, integrated exactly; their lengths stand in for the
-** arcs (equal to O(leaf^2)).  Chords of curves that touch tangentially end
+/* The chord of a piece moved across itself by the piece's mean distance
+** from it, (p1 + p2 - p0 - p3) / 4 for control points p0..p3 (the mean of
+** the cubic less the chord's mean), normal part. */
+static void mean_chord(const piece *p, double e0[2], double e1[2])
+{
+  double h3 = (p->t1 - p->t0) / 3.0, ux = p->r1[0] - p->r0[0], uy = p->r1[1] - p->r0[1];
+  double ox = 0.25 * (h3 * (p->d0[0] - p->d1[0])), oy = 0.25 * (h3 * (p->d0[1] - p->d1[1]));
+  double uu = ux * ux + uy * uy, f = uu > 0.0 ? (ox * ux + oy * uy) / uu : 0.0;
+  ox -= f * ux;
+  oy -= f * uy;
+  e0[0] = p->r0[0] + ox;
+  e0[1] = p->r0[1] + oy;
+  e1[0] = p->r1[0] + ox;
+  e1[1] = p->r1[1] + oy;
+}
+
+/* A leaf: the mean chords, integrated exactly; their lengths stand in for
+** the arcs (equal to O(leaf^2)).  Chords of curves that touch tangentially end
 ** to end can overlap by a rounding error, which the exact integral reads as
 ** +inf; the product rule's interior nodes keep such a leaf finite.
 ** With the cutoff: where the pieces lie wholly inside it (their farthest
-** points closer than rc), 1/r - 1/rc of the chords exactly, which is >= 0
-** since every chord point is within rc of the other chord; where they reach
-** past it, the product rule of the cut kernel; C2-blended over one piece
+** points closer than rc), 1/r - 1/rc of the chords exactly, clamped at 0
+** (see the file comment); where they reach past it, the product rule of
+** the cut kernel; C2-blended over one piece
 ** size below rc, so the value is continuous and never negative. */
 static double leaf_value(const cubic *ca, piece *pa, const cubic *cb, piece *pb, const cut *k)
 {
@@ -277,7 +433,10 @@ static double leaf_value(const cubic *ca, piece *pa, const cubic *cb, piece *pb,
     double far = sqrt(dx * dx + dy * dy) + pa->rad + pb->rad;
     m = big > 0.0 ? smooth_step((k->rc - far) / big) : 0.0;
   }
-  double v = m > 0.0 ? lw_pair_segseg(pa->r0, pa->r1, pb->r0, pb->r1) : 0.0;
+  double a0[2], a1[2], b0[2], b1[2];
+  mean_chord(pa, a0, a1);
+  mean_chord(pb, b0, b1);
+  double v = m > 0.0 ? lw_pair_segseg(a0, a1, b0, b1) : 0.0;
   if (!(v < INFINITY)) return piece_rule(ca, pa, cb, pb, k);
   if (k->on && m > 0.0) {
     double la = hypot(pa->r1[0] - pa->r0[0], pa->r1[1] - pa->r0[1]);
@@ -312,7 +471,7 @@ static double chord_distance(const piece *pa, const piece *pb)
 }
 
 /* The double integral of the kernel by subdivision (see the file comment),
-** times root_rest: the root pair's 16 x 16 share is the caller's. */
+** times root_rest: the whole-square rules' shares are the caller's. */
 static double subdivided(const cubic *ca, const piece *root_a, const cubic *cb, const piece *root_b,
                          double root_rest, const cut *k)
 {
@@ -433,9 +592,9 @@ static void closest_points(const cubic *ca, const cubic *cb, double *ps, double 
   *pt = t;
 }
 
-const lw_pairnear_consts lw_pairnear_k = {SEP_LO,   SEP_HI,     APART_LO, APART_HI, LEAF_RATIO, FLAT_RATIO,
-                                          STACK_MAX,  G6_S,
-                                          G6_W,     GAUSS_S,    G16_S,    G16_W,    GAUSS_L};
+const lw_pairnear_consts lw_pairnear_k = {SEP_LO,     SEP_HI,     LEAF_RATIO, FLAT_RATIO, STACK_MAX, G6_S,
+                                          G6_W,       GAUSS_S,    N_WHOLE,    WHOLE_M,    WHOLE_S,   WHOLE_W,
+                                          WHOLE_LO,   WHOLE_HI};
 
 double lw_pair_segments_exact(const double a[8], const double b[8], double cutoff)
 {
@@ -451,18 +610,21 @@ double lw_pair_segments_exact(const double a[8], const double b[8], double cutof
   closest_points(&ca, &cb, &ss, &ts);
   cubic_eval(&ca, ss, ra, a1);
   cubic_eval(&cb, ts, rb, b1);
-  /* Segments farther apart than APART_HI times half the larger size take the
-  ** 16 x 16 rule, the whole kernel with the cutoff in one pass: most near
-  ** pairs of a drawing, neighbouring lines about an element apart, end
-  ** there.  (The distance is the least over the segments, a continuous
-  ** function of them wherever Newton lands.) */
+  /* The whole-square rules, each blended into the next closer one by a C2
+  ** weight of the distance (the least over the segments, a continuous
+  ** function of them wherever Newton lands): most near pairs of a drawing,
+  ** neighbouring lines under an element apart, end there. */
   double half = fmax(pa.rad, pb.rad), dist = hypot(ra[0] - rb[0], ra[1] - rb[1]);
-  double w = half > 0.0 ? smooth_step((dist / half - APART_LO) / (APART_HI - APART_LO)) : 1.0;
   kernel_kind whole = cutoff > 0.0 ? KERNEL_CUT : KERNEL_INV;
-  double v = w > 0.0 ? w * product_rule(&ca, 0.0, 1.0, &cb, 0.0, 1.0, GAUSS_L, whole, cutoff) : 0.0;
-  if (w < 1.0) {
+  double v = 0.0, rest = 1.0;
+  for (int r = 0; r < N_WHOLE && rest > 0.0; r++) {
+    double w = half > 0.0 ? smooth_step((dist / half - WHOLE_LO[r]) / (WHOLE_HI[r] - WHOLE_LO[r])) : 1.0;
+    if (w > 0.0) v += rest * w * product_rule(&ca, &cb, WHOLE_S[r], WHOLE_W[r], WHOLE_M[r], whole, cutoff);
+    rest *= 1.0 - w;
+  }
+  if (rest > 0.0) {
     const cut k = {cutoff > 0.0, cutoff, cutoff * cutoff, cutoff > 0.0 ? 1.0 / cutoff : 0.0};
-    v += subdivided(&ca, &pa, &cb, &pb, 1.0 - w, &k);
+    v += subdivided(&ca, &pa, &cb, &pb, rest, &k);
   }
   return v;
 }

@@ -34,9 +34,10 @@
 ** segments a and b (control points x0 y0 x1 y1 x2 y2 x3 y3, mm), or of
 ** |a'| |b'| / r without a cutoff (cutoff <= 0).  Finite where the segments
 ** cross or touch, and never negative.  A continuous function of the control
-** points; relative error 3e-7 for segments apart, 1e-5 to 4e-5 where they
-** cross, up to 3e-3 where they touch tangentially at an end (pairnear.c,
-** docs/NUMERICS.md). */
+** points; relative error 1e-5 or less for segments apart (without a
+** cutoff; its kink adds up to ~1e-3), 1e-4 to 1e-3 where they cross or run
+** alongside closely, up to 3e-3 where they touch tangentially at an end
+** (pairnear.c, docs/NUMERICS.md, docs/ACCURACY.md). */
 double lw_pair_segments_exact(const double a[8], const double b[8], double cutoff);
 
 /* E_AB minus the product-rule terms of the sample pairs of A x B that are
@@ -50,13 +51,16 @@ double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, cons
 ** step, so it sees the same thresholds and rules. */
 typedef struct {
   double sep_lo, sep_hi;       /* pieces apart: 6 x 6 rule from sep_hi larger radii on */
-  double apart_lo, apart_hi;   /* segments apart: 16 x 16 rule (distance / half size) */
   double leaf_ratio, flat_ratio;
   int stack_max;
   const double *g6_s, *g6_w;   /* Gauss-Legendre on [0, 1] */
   int g6_n;
-  const double *g16_s, *g16_w;
-  int g16_n;
+  /* segments apart: the whole-square rules of whole_m[r] nodes, from
+  ** distance / half size whole_lo[r] (blended in up to whole_hi[r]) */
+  int n_whole;
+  const int *whole_m;
+  const double *const *whole_s, *const *whole_w;
+  const double *whole_lo, *whole_hi;
 } lw_pairnear_consts;
 
 extern const lw_pairnear_consts lw_pairnear_k;

@@ -12,6 +12,8 @@
 #endif
 
 typedef double lw_v2d __attribute__((vector_size(16)));
+/* What a comparison of two lw_v2d gives: all ones where true, 0 where false. */
+typedef long long lw_v2l __attribute__((vector_size(16)));
 
 /* Two square roots at once.  sqrt is correctly rounded in SSE2 and in C
 ** alike, so both branches give the same bits. */
