@@ -519,7 +519,7 @@ void bench_guide(bench_ctx *b)
              "%d and pair_near %g. Every sample then sees about %.0f samples of other lines within the\n"
              "cutoff (pi rc^2 x nodes / segment_length / s), as in the measured scene, so a proposal costs\n"
              "about what it cost there, %.0f us on this machine, whatever the page; a sweep is one\n"
-             "proposal per node, and the example needs a few hundred sweeps. Splines of 5 segments,\n"
+             "proposal per node, and the study scene needs a few hundred sweeps. Splines of 5 segments,\n"
              "lines filling the page inside a 10 mm margin at spacing s:\n\n"
              "| page | pen mm | s mm | segment_length mm | pair_cutoff mm | splines | nodes | time for 400 sweeps |\n"
              "|---|---|---|---|---|---|---|---|\n",
