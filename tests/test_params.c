@@ -307,7 +307,7 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
             "segment %g, cutoff %g, spacing %g, blur %g", p.segment_length, p.pair_cutoff, p.min_spacing,
             p.tone_blur);
   cr_assert(fabs(p.field_sigma - 10 * 0.35) < 1e-12);
-  cr_assert(p.tone == 10 && p.tone_ink == 0.5 && p.coverage == 0.4 && p.splines == 0 && p.sweeps == 400);
+  cr_assert(p.tone == 40 && p.tone_ink == 0.5 && p.coverage == 0.4 && p.splines == 0 && p.sweeps == 400);
   /* A4 less 10 mm margins: 190 mm / (90 x 0.35 mm) = 6 domains a side */
   cr_assert_str_eq(p.domains, "6");
   /* --set of the pen width: the preset's keys follow, a set key stays */
