@@ -145,6 +145,27 @@ lw_status lw_splines_splice(lw_splines *sp, size_t at, int remove, const lw_node
   return LW_OK;
 }
 
+void lw_splines_compact(lw_splines *sp, const unsigned char *dead)
+{
+  size_t k = 0, w = 0;
+  for (size_t i = 0; i < sp->n_splines; i++) {
+    /* first[i + 1] is read before first[w <= i] is written */
+    const size_t f = sp->first[i], nn = sp->first[i + 1] - f;
+    if (dead[i]) continue;
+    memmove(sp->node + k, sp->node + f, nn * sizeof *sp->node);
+    sp->first[w] = k;
+    sp->rest_length[w] = sp->rest_length[i];
+    k += nn;
+    w++;
+  }
+  sp->first[w] = k;
+  sp->n_splines = w;
+  sp->n_nodes = k;
+  sp->n_segments = k - w;
+  for (size_t i = 0, g = 0; i < w; i++)
+    for (size_t m = lw_splines_segments(sp, i); m > 0; m--) sp->seg_spline[g++] = (uint32_t)i;
+}
+
 int lw_splines_is_point(const lw_splines *sp, size_t i)
 {
   const lw_node *nd = &sp->node[sp->first[i]];

@@ -217,6 +217,57 @@ Test(transdim, ideal_gas_all_moves_together)
   td_chain_free(c, setup);
 }
 
+/* The caches and pair grid of m (no ghosts) are, bit for bit, what a
+** model built afresh from its state holds. */
+static void same_as_fresh(const lw_model *m)
+{
+  lw_error err = {0};
+  cr_assert_eq(lw_model_count(m), m->sp->n_splines, "no ghosts are left");
+  lw_model *f = lw_model_new(m->scene, lw_splines_clone(m->sp), &err);
+  cr_assert_not_null(f, "%s", err.msg);
+  cr_assert_eq(f->sp->n_segments, m->sp->n_segments);
+  const int np = m->scene->pair_quad.n, nl = m->scene->n_local;
+  for (size_t g = 0; g < m->sp->n_segments; g++) {
+    cr_assert_eq(f->seg_len[g], m->seg_len[g], "segment %zu: length %.17g vs %.17g", g, m->seg_len[g], f->seg_len[g]);
+    cr_assert_eq(f->sp->seg_spline[g], m->sp->seg_spline[g], "segment %zu: spline", g);
+    for (int t = 0; t < nl; t++) cr_assert_eq(f->seg_local[g * nl + t], m->seg_local[g * nl + t]);
+    for (int q = 0; m->grid && q < np; q++) {
+      double x0, y0, x1, y1;
+      float d0, d1;
+      lw_cellgrid_get(m->grid, (uint32_t)(g * np + q), &x0, &y0, &d0);
+      lw_cellgrid_get(f->grid, (uint32_t)(g * np + q), &x1, &y1, &d1);
+      cr_assert(x0 == x1 && y0 == y1 && d0 == d1, "segment %zu: pair sample %d differs", g, q);
+    }
+  }
+  for (size_t i = 0; i < m->sp->n_splines; i++) {
+    cr_assert_eq(f->spline_len[i], m->spline_len[i], "spline %zu: length", i);
+    cr_assert_eq(f->sp->first[i], m->sp->first[i]);
+  }
+  if (m->grid) {
+    cr_assert_eq(f->grid->n_samples, m->grid->n_samples);
+    /* every cell holds the same samples in the same order: the sums over it too */
+    for (size_t c = 0; c < lw_cellgrid_cells(m->grid); c++) {
+      cr_assert_eq(f->grid->cell[c].n, m->grid->cell[c].n, "cell %zu", c);
+      for (uint32_t k = 0; k < m->grid->cell[c].n; k++)
+        cr_assert_eq(lw_cell_idx(&f->grid->cell[c])[k], lw_cell_idx(&m->grid->cell[c])[k], "cell %zu", c);
+    }
+  }
+  lw_model_free(f);
+}
+
+/* The running total of m equals a recomputation within 1e-9. */
+static void total_is_full(const lw_model *m, const char *when)
+{
+  lw_error err = {0};
+  double term[LW_TERM_COUNT];
+  lw_splines *live = lw_splines_clone(m->sp);
+  cr_assert_not_null(live);
+  lw_splines_compact(live, m->slots->ghost);
+  double full = lw_energy_compute(m->scene, live, term, &err), run = lw_model_total(m);
+  lw_splines_free(live);
+  cr_assert(fabs(run - full) <= 1e-9 * fmax(fabs(full), 1.0), "%s: running %.17g, full %.17g", when, run, full);
+}
+
 /* Every term a splice touches on (segment, spline, pair with its near
 ** field, boundary, chemical both ways), births and deaths accepted often at
 ** a high temperature: the running terms equal a recomputation from scratch
@@ -266,47 +317,103 @@ Test(transdim, incremental_equals_full_with_births_and_deaths)
     cr_assert(c->stats[k].accepted > 200, "%s accepted only %lu of %lu", c->sys->type->move_names[k],
               c->stats[k].accepted, c->stats[k].proposed);
   /* the spliced caches and grid are what a model built afresh holds */
-  lw_error err = {0};
-  lw_model *f = lw_model_new(m->scene, lw_splines_clone(m->sp), &err);
-  cr_assert_not_null(f, "%s", err.msg);
-  cr_assert_eq(f->sp->n_segments, m->sp->n_segments);
-  const int np = m->scene->pair_quad.n, nl = m->scene->n_local;
-  for (size_t g = 0; g < m->sp->n_segments; g++) {
-    cr_assert_eq(f->seg_len[g], m->seg_len[g], "segment %zu: length %.17g vs %.17g", g, m->seg_len[g], f->seg_len[g]);
-    cr_assert_eq(f->sp->seg_spline[g], m->sp->seg_spline[g], "segment %zu: spline", g);
-    for (int t = 0; t < nl; t++) cr_assert_eq(f->seg_local[g * nl + t], m->seg_local[g * nl + t]);
-    for (int q = 0; q < np; q++) {
-      double x0, y0, x1, y1;
-      float d0, d1;
-      lw_cellgrid_get(m->grid, (uint32_t)(g * np + q), &x0, &y0, &d0);
-      lw_cellgrid_get(f->grid, (uint32_t)(g * np + q), &x1, &y1, &d1);
-      cr_assert(x0 == x1 && y0 == y1 && d0 == d1, "segment %zu: pair sample %d differs", g, q);
-    }
-  }
-  for (size_t i = 0; i < m->sp->n_splines; i++) {
-    cr_assert_eq(f->spline_len[i], m->spline_len[i], "spline %zu: length", i);
-    cr_assert_eq(f->sp->first[i], m->sp->first[i]);
-  }
-  cr_assert_eq(f->grid->n_samples, m->grid->n_samples);
+  same_as_fresh(m);
   cr_assert(checks > 10);
-  lw_model_free(f);
   td_chain_free(c, setup);
+}
+
+/* Storage (issue 18: a birth or a death must not cost O(N)): a death leaves
+** its slot as a ghost and moves no other spline, the next spline of its
+** segment count takes that slot, one of another count is appended; the
+** sweep's end compacts the ghosts away, keeping the order of the others,
+** into the model a fresh build gives.  Before the ghost slots every index
+** behind a death moved down. */
+Test(transdim, deaths_leave_ghosts_that_births_fill)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = 80;
+  p.height = 60;
+  p.segment_length = 4;
+  p.strain = 2;
+  p.bending = 0.5;
+  p.pair = 0.05;
+  p.pair_cutoff = 4;
+  p.boundary_coef = 0.1;
+  p.chem_spline = -3;
+  p.chem_length = 0.05;
+  p.fixed_count = 0;
+  lw_scene sc;
+  lw_test_scene(&sc, &p);
+  lw_model *m = lw_test_model_random(&sc, 20, 3, 4.0, 31);
+  lw_error err = {0};
+  lw_proposal *pr = lw_proposal_new(m, &err);
+  cr_assert_not_null(pr, "%s", err.msg);
+  lw_splines *before = lw_splines_clone(m->sp);
+  cr_assert_not_null(before);
+  /* a death of spline 5: 20 slots, 19 alive, nothing else moved */
+  lw_model_propose_splice(m, pr, 5, 1, NULL, 0, 0.0);
+  cr_assert_eq(lw_model_commit(m, pr), LW_OK);
+  cr_assert_eq(m->sp->n_splines, 20);
+  cr_assert_eq(lw_model_count(m), 19);
+  cr_assert(lw_model_ghost(m, 5) && !lw_model_ghost(m, 6));
+  cr_assert_eq(memcmp(m->sp->node, before->node, before->n_nodes * sizeof *before->node), 0);
+  total_is_full(m, "after a death");
+  /* a birth of 3 segments takes slot 5 */
+  lw_node nd[8];
+  for (int k = 0; k < 4; k++) nd[k] = (lw_node){30.0 + 3.0 * k, 20.0 + 0.5 * k, 1.0, 0.2};
+  lw_model_propose_splice(m, pr, 0, 0, nd, 4, 12.0);
+  cr_assert_eq(lw_model_commit(m, pr), LW_OK);
+  cr_assert_eq(m->sp->n_splines, 20);
+  cr_assert(!lw_model_ghost(m, 5));
+  cr_assert_eq(memcmp(&m->sp->node[m->sp->first[5]], nd, 4 * sizeof *nd), 0);
+  cr_assert_eq(m->sp->rest_length[5], 12.0);
+  total_is_full(m, "after a birth into a ghost");
+  /* spline 2 grows by a segment: its slot is left, the grown one appended */
+  memcpy(nd, &m->sp->node[m->sp->first[2]], 4 * sizeof *nd);
+  nd[4] = (lw_node){nd[3].px + 3.0, nd[3].py, 1.0, 0.0};
+  lw_model_propose_splice(m, pr, 2, 1, nd, 5, 16.0);
+  cr_assert_eq(lw_model_commit(m, pr), LW_OK);
+  cr_assert_eq(m->sp->n_splines, 21);
+  cr_assert(lw_model_ghost(m, 2));
+  cr_assert_eq(lw_splines_segments(m->sp, 20), 4);
+  total_is_full(m, "after a grow");
+  /* and two deaths, then the sweep's end */
+  for (uint32_t j = 11; j <= 12; j++) {
+    lw_model_propose_splice(m, pr, j, 1, NULL, 0, 0.0);
+    cr_assert_eq(lw_model_commit(m, pr), LW_OK);
+  }
+  cr_assert_eq(lw_model_count(m), 18);
+  lw_node first3 = m->sp->node[m->sp->first[3]], last = m->sp->node[m->sp->first[20]];
+  cr_assert_eq(lw_model_compact(m), LW_OK);
+  cr_assert_eq(m->sp->n_splines, 18);
+  /* the order of the others kept: old 3 is now 2, old 20 is now 17 */
+  cr_assert_eq(memcmp(&m->sp->node[m->sp->first[2]], &first3, sizeof first3), 0);
+  cr_assert_eq(memcmp(&m->sp->node[m->sp->first[17]], &last, sizeof last), 0);
+  total_is_full(m, "after the compaction");
+  same_as_fresh(m);
+  lw_splines_free(before);
+  lw_proposal_free(pr);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
 }
 
 /* A small scene with every kind of term a splice differences (segment,
 ** spline, pair with its near field, boundary, chemical) and the eight move
-** kinds, annealed cold enough that births, deaths, grows and shrinks all
-** happen; tempered with two replicas. */
+** kinds, warm enough and with trans-dimensional kinds often enough that
+** births, deaths, grows and shrinks happen by the dozen (several seeds gave
+** 6 to 60 of each kind), so that ghost slots are filled, left and
+** compacted many times; tempered with two replicas. */
 static const char *cli_scene = "[scene]\nwidth = 60\nheight = 50\nmargin = 2\nfield = waves\n"
                                "potential = radial\n"
                                "[init]\nsplines = 10\nsegments = 3\nsegment_length = 4\n"
                                "[energy]\nstrain = 2\nbending = 0.3\npotential = 0.3\nfield = -0.2\npair = 0.05\n"
-                               "pair_cutoff = 4\nboundary = 0.1\nchem_spline = -1\nchem_length = 0.02\n"
-                               "[moves]\nfixed_count = 0\nmax_segments = 6\nbirth = 0.05\ndeath = 0.05\n"
-                               "grow = 0.05\nshrink = 0.05\n"
-                               "[anneal]\nschedule = geometric\nt_start = 3\nt_end = 0.05\nsweeps = 60\nsteps = 6\n"
+                               "pair_cutoff = 4\nboundary = 0.1\nchem_spline = 0\nchem_length = 0.02\n"
+                               "[moves]\nfixed_count = 0\nmax_segments = 6\nbirth = 0.5\ndeath = 0.5\n"
+                               "grow = 0.3\nshrink = 0.3\n"
+                               "[anneal]\nschedule = geometric\nt_start = 3\nt_end = 0.5\nsweeps = 60\nsteps = 6\n"
                                "seed = 5\ncheck_every = 7\n"
-                               "[tempering]\nreplicas = 2\nt_min = 0.05\nt_max = 3\n";
+                               "[tempering]\nreplicas = 2\nt_min = 0.5\nt_max = 3\n";
 
 /* The number under key `kind` in the object `obj` of dir/a/summary.json,
 ** NAN if there is none. */

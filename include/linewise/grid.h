@@ -86,9 +86,20 @@ lw_cellgrid *lw_cellgrid_new_room(double x0, double y0, double w, double h, doub
 ** index - n_old + n_new, and [from, from + n_new) is left free for
 ** lw_cellgrid_insert; n_samples changes by n_new - n_old.  A pass over
 ** every cell, O(samples) memory traffic and no search; cells stay sorted
-** (the renumbering is monotone).  LW_ENOMEM (home could not grow) leaves
+** (the renumbering is monotone).  Room at the end (from = n_samples,
+** n_old = 0) renumbers nothing and costs no pass.  LW_ENOMEM (home could not grow) leaves
 ** the grid as it was. */
 lw_status lw_cellgrid_splice(lw_cellgrid *g, size_t from, size_t n_old, size_t n_new);
+
+/* Renumbers the samples in groups of `per` (a segment's pair samples):
+** group k becomes group to[k] for the groups in the grid, to increasing
+** over them and to[k] <= k (a compaction: cells stay sorted, one pass over
+** every cell); n_samples becomes n.  to[k] = UINT32_MAX for the groups
+** with no samples in the grid. */
+void lw_cellgrid_renumber(lw_cellgrid *g, const uint32_t *to, uint32_t per, size_t n);
+
+/* Takes sample i (in the grid) out of it; its index stays counted. */
+void lw_cellgrid_remove(lw_cellgrid *g, uint32_t i);
 
 /* Room in home for n samples, so that a splice up to n cannot fail. */
 lw_status lw_cellgrid_reserve(lw_cellgrid *g, size_t n);

@@ -59,6 +59,11 @@ lw_status lw_splines_permute(lw_splines *sp, const size_t *order, lw_error *err)
 ** (trans-dimensional moves, model.h).  LW_ENOMEM leaves sp as it was. */
 lw_status lw_splines_splice(lw_splines *sp, size_t at, int remove, const lw_node *nodes, size_t n_new, double rest);
 
+/* Removes the splines i with dead[i] != 0, in place: the others keep their
+** order and move down over the holes (the ghost slots of trans-dimensional
+** storage, slots.h).  O(nodes), no allocation. */
+void lw_splines_compact(lw_splines *sp, const unsigned char *dead);
+
 static inline size_t lw_splines_segments(const lw_splines *sp, size_t i)
 {
   return sp->first[i + 1] - sp->first[i] - 1;
