@@ -1107,7 +1107,7 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
   if (cache_room(m, n_seg, n_spl) != LW_OK) return LW_ENOMEM;
   if (p->remove && lw_slots_reserve(m->slots, n_spl, no) != LW_OK) return LW_ENOMEM;
   if (m->grid && lw_cellgrid_reserve(m->grid, n_seg * (size_t)np) != LW_OK) return LW_ENOMEM;
-  if (append && lw_splines_splice(sp, sp->n_splines, 0, p->node, p->n_node, p->new_rest) != LW_OK)
+  if (append && lw_splines_append(sp, p->node, p->n_node, p->new_rest) != LW_OK)
     return LW_ENOMEM;
   /* the near fields the splice changes */
   if (m->grid && p->pair_done)
@@ -1146,7 +1146,7 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
         m->near_cache[g0 + j] = p->near_new[j];
         m->near_valid[g0 + j] = (uint8_t)p->pair_done;
       }
-      if (append) (void)lw_cellgrid_splice(m->grid, g0 * (size_t)np, 0, nn * (size_t)np); /* room reserved */
+      if (append) lw_cellgrid_extend(m->grid, nn * (size_t)np);
       for (size_t j = 0; j < nn && st == LW_OK; j++) st = store_samples(m->grid, g0 + j, np, p->ps + j * (size_t)np);
     }
   }
