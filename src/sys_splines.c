@@ -49,6 +49,7 @@ static void setup_free(void *setup)
   spl_setup *su = setup;
   if (!su) return;
   lw_grid2d_free(su->tone);
+  lw_td_clear(&su->td);
   lw_scene_clear(&su->scene);
   free(su);
 }
@@ -64,7 +65,11 @@ static void *setup_new(const lw_params *p, lw_error *err)
   /* the target of the fidelity score and the previews' underlay */
   if (su->scene.image && !(su->tone = lw_image_tone_grid(su->scene.image, &su->scene.image_place, err)))
     goto fail;
-  lw_td_init(&su->td, &su->scene, (size_t)p->segments, p->segment_length, su->scene.max_segments);
+  if (lw_td_init(&su->td, &su->scene, (size_t)p->segments, p->segment_length, su->scene.max_segments,
+                 p->birth_uniform)) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for the birth prior's darkness table");
+    goto fail;
+  }
   const double w[4] = {p->mix_birth, p->mix_death, p->mix_grow, p->mix_shrink};
   for (int k = 0; k < 4; k++) su->log_w[k] = log(w[k]);
   if (su->scene.transdim) {

@@ -16,6 +16,7 @@
 #include "linewise/mc.h"
 #include "linewise/sys_splines.h"
 #include "linewise/transdim.h"
+#include "imageutil.h"
 #include "testutil.h"
 
 /* A chain on the spline system with fixed_count = 0 and the parameters p
@@ -215,6 +216,99 @@ Test(transdim, ideal_gas_all_moves_together)
   pv = chisq_p(sc + 1, pu + 1, 4, ns);
   cr_assert(pv > 1e-3, "segments vs uniform 1..4: p = %g", pv);
   td_chain_free(c, setup);
+}
+
+/* The birth prior follows the picture (transdim.h): with every move kind on
+** and a ramp picture (white at its left edge, black at its right), N is
+** still Poisson with mean K exp(-mu_s / T), the prior being normalised, and
+** the first nodes follow pi = b / (W H) + (1 - b) d / (D a^2), whose
+** moments the test sums pixel by pixel from the scene's own picture and
+** placement.  The same moments of a uniform first node (0.5, 1/3) are more
+** than 8 standard errors off, so the test tells the two priors apart; and
+** so it does a density that the Hastings factors of the moves that keep
+** ** the count get wrong (uniform there while births draw by darkness: 0.551
+** +- 0.003 against 0.571 for E x / W, 6 standard errors). */
+Test(transdim, ideal_gas_first_nodes_follow_the_darkness)
+{
+  lw_image_dir_make();
+  lw_params p;
+  const double T = 0.9, lambda = 2.0;
+  ideal_gas(&p, -T * log(lambda));
+  p.splines = 10;
+  p.max_segments = 3;
+  p.margin = 4;
+  /* steps that carry a first node across the picture within a spline's
+  ** life: the moves that keep the count must hold pi too (their Hastings
+  ** factor), not only the births that draw from it */
+  p.mix_birth = p.mix_death = p.mix_grow = p.mix_shrink = 0.5;
+  p.mix_point = p.mix_vector = p.mix_translate = p.mix_rotate = 1;
+  p.step_point = p.step_translate = 8;
+  p.birth_uniform = 0.2;
+  enum { PW = 24 };
+  float g[PW * PW];
+  for (int j = 0; j < PW; j++)
+    for (int i = 0; i < PW; i++) g[j * PW + i] = (float)(1.0 - (i + 0.5) / PW);
+  snprintf(p.image, sizeof p.image, "%s", lw_test_path("ramp.png"));
+  lw_test_png(p.image, PW, PW, g, NULL);
+  void *setup;
+  lw_chain *c = td_chain(&p, T, 15, &setup);
+  const lw_model *m = lw_splines_model(c->sys);
+  const lw_scene *sc = m->scene;
+  cr_assert_not_null(sc->image);
+  /* the moments of pi over the page: E x / W, E (x / W)^2, E y / H, E (y / H)^2 */
+  const lw_image *img = sc->image;
+  const lw_image_place *pl = &sc->image_place;
+  double D = 0.0, want[4] = {0};
+  for (int j = 0; j < img->height; j++)
+    for (int i = 0; i < img->width; i++) {
+      const double d = fmax(1.0 - img->tone[j * img->width + i], 0.0);
+      const double x0 = (pl->x0 + i * pl->pixel) / sc->width, x1 = x0 + pl->pixel / sc->width;
+      const double y0 = (pl->y0 + j * pl->pixel) / sc->height, y1 = y0 + pl->pixel / sc->height;
+      D += d;
+      want[0] += d * 0.5 * (x0 + x1);
+      want[1] += d * (x0 * x0 + x0 * x1 + x1 * x1) / 3.0;
+      want[2] += d * 0.5 * (y0 + y1);
+      want[3] += d * (y0 * y0 + y0 * y1 + y1 * y1) / 3.0;
+    }
+  const double b = p.birth_uniform, flat[4] = {0.5, 1.0 / 3.0, 0.5, 1.0 / 3.0};
+  for (int k = 0; k < 4; k++) want[k] = b * flat[k] + (1.0 - b) * want[k] / D;
+  unsigned long nc[NMAX] = {0}, sgc[NMAX] = {0}, ns = 0;
+  tally(c, 500, 4, nc, sgc, &ns);
+  memset(nc, 0, sizeof nc);
+  batch_mean mom[4];
+  memset(mom, 0, sizeof mom);
+  const long per = (lw_test_long() ? 300000 : 30000) / BATCHES;
+  for (int k = 0; k < 4; k++) mom[k].per = per;
+  for (long s = 0; s < BATCHES * per; s++) {
+    tally(c, 1, 6, nc, sgc, &ns);
+    /* the mean over the splines present, each spline a sample: weight by count */
+    double a[4] = {0};
+    const size_t N = m->sp->n_splines;
+    for (size_t i = 0; i < N; i++) {
+      const lw_node *n0 = &m->sp->node[m->sp->first[i]];
+      const double u = n0->px / sc->width, v = n0->py / sc->height;
+      cr_assert(u >= 0 && u <= 1 && v >= 0 && v <= 1, "a first node left the page: (%g, %g)", n0->px, n0->py);
+      a[0] += u;
+      a[1] += u * u;
+      a[2] += v;
+      a[3] += v * v;
+    }
+    /* E[sum over splines of f] = E N * E f: divide by the Poisson mean */
+    for (int k = 0; k < 4; k++) bm_add(&mom[k], a[k] / (3.0 * lambda));
+  }
+  double prob[NMAX];
+  for (int k = 0; k < NMAX; k++) prob[k] = gsl_ran_poisson_pdf((unsigned)k, 3.0 * lambda);
+  double pv = chisq_p(nc, prob, 25, (unsigned long)(BATCHES * per));
+  cr_assert(pv > 1e-3, "spline count vs Poisson(%g): chi-square p = %g", 3.0 * lambda, pv);
+  for (int k = 0; k < 4; k++) {
+    double se, mean = bm_mean(&mom[k], &se);
+    cr_assert(fabs(mean - want[k]) < 5 * se, "first node, moment %d: %g +- %g, expected %g", k, mean, se, want[k]);
+    if (k < 2) /* along the ramp: the uniform prior's value is far off */
+      cr_assert(fabs(flat[k] - want[k]) > 8 * se, "moment %d: %g +- %g cannot tell %g from uniform %g", k, mean, se,
+                want[k], flat[k]);
+  }
+  td_chain_free(c, setup);
+  lw_image_dir_remove();
 }
 
 /* The caches and pair grid of m (no ghosts) are, bit for bit, what a

@@ -22,7 +22,13 @@
 ** drawing would be without its energy: lines along the field.
 **
 ** Proposals (each node from the last, "along the field"):
-**   birth  p_0 uniform on the page; v_0 = (l/3) u + N(0, s_v^2) with u the
+**   birth  p_0 from pi: with a picture (scene.image, not white) the mixture
+**          pi(p) = b / (W H) + (1 - b) d(p) / (D a^2), b =
+**          moves.birth_uniform, d(p) = 1 - tone of p's pixel, D the sum of
+**          d over the pixels, a the pixel side: a uniform point on the page
+**          with probability b, else a point drawn as placement draws a
+**          centre (lw_init_dark_point); without one pi = 1 / (W H);
+**          v_0 = (l/3) u + N(0, s_v^2) with u the
 **          field's direction at p_0 either way (probability 1/2 each), or,
 **          where there is no field, a uniform direction (v_0 then has the
 **          density of a Gaussian ring, with a Bessel I0); then node k+1
@@ -46,19 +52,26 @@
 
 typedef struct {
   const lw_scene *scene;
+  double *cum;            /* the picture's cumulated row darkness (lw_init_darkness; owned),
+                             NULL without a picture or for a white one: pi uniform */
+  double uniform;         /* b: the share of uniform first points with a picture */
+  double dark_scale;      /* (1 - b) / (D a^2), 1 / mm^2 */
   double length;          /* l: mm */
   double sigma_p, sigma_v; /* mm */
   size_t birth_segments;  /* segments of a born spline */
   size_t max_segments;    /* grow stops here */
 } lw_td;
 
-void lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double length, size_t max_segments);
+/* LW_ENOMEM if the picture's darkness table cannot be had. */
+lw_status lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double length, size_t max_segments,
+                     double uniform);
+void lw_td_clear(lw_td *td);
 
 /* log q_{n-1} of the n >= 1 nodes nd (-inf when node 0 is off the page). */
 double lw_td_prior(const lw_td *td, const lw_node *nd, size_t n);
 
-/* log of node 0's factor of the prior: p uniform on the page, v as a
-** birth draws it. */
+/* log of node 0's factor of the prior: log pi(p) + log of v's density as
+** a birth draws it. */
 double lw_td_first_log(const lw_td *td, const lw_node *n0);
 
 /* The change of log q when node k of the n nodes nd becomes *to. */
