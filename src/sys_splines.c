@@ -387,10 +387,10 @@ static uint32_t live_spline(const lw_model *m, gsl_rng *rng)
 ** derivation of each Hastings factor).  A birth adds a spline drawn from
 ** the prior, a death removes one chosen uniformly: the state is a set, and
 ** its numbering (where the model puts a new spline, slots.h) plays no part
-** in any density.  A death removes
-** only splines a birth could have made (birth_segments segments): for the
-** others the reverse proposal has density 0.  Rest lengths are n l (init's rule), so a
-** grown or shrunk spline's rest length is a function of its size.
+** in any density.  A death removes only splines a birth could have made
+** (lw_td_mortal): for the others the reverse proposal has density 0.  A
+** grow or shrink moves the rest length by l and keeps its excess over n l
+** (lw_td_rest), so that each undoes the other for any rest length.
 */
 static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, int *forbidden)
 {
@@ -408,7 +408,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
   } else if (kind == LW_MOVE_DEATH) {
     if (N == 0) return refuse(p);
     uint32_t j = live_spline(m, rng);
-    if (lw_splines_segments(sp, j) != nb) return refuse(p);
+    if (!lw_td_mortal(td, lw_splines_segments(sp, j), sp->rest_length[j])) return refuse(p);
     lw_model_propose_splice(m, p, j, 1, NULL, 0, 0.0);
     p->log_ratio = lw[0] - lw[1] + log((double)N);
   } else {
@@ -418,6 +418,8 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
     const size_t n = lw_splines_segments(sp, i);
     const lw_node *src = &sp->node[sp->first[i]];
     double lr;
+    const double rest = lw_td_rest(td, sp->rest_length[i], n, kind == LW_MOVE_GROW ? n + 1 : n - 1);
+    if (isnan(rest)) return refuse(p);
     if (kind == LW_MOVE_GROW) {
       if (n >= td->max_segments) return refuse(p);
       /* the old nodes before a new last one, or after a new first one */
@@ -427,7 +429,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
       /* at the tail the prior's new factor is the proposal itself */
       lr = tail ? 0.0
                 : lw_td_first_log(td, add) + lw_td_next_log(td, add, 1, &keep[0]) - lw_td_first_log(td, &keep[0]) - lg;
-      lw_model_propose_splice(m, p, i, 1, NULL, n + 2, (double)(n + 1) * td->length);
+      lw_model_propose_splice(m, p, i, 1, NULL, n + 2, rest);
       p->log_ratio = lw[3] - lw[2] + lr;
     } else {
       if (n <= 1) return refuse(p);
@@ -435,7 +437,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
       lr = tail ? 0.0
                 : lw_td_first_log(td, &src[1]) - lw_td_first_log(td, &src[0]) - lw_td_next_log(td, &src[0], 1, &src[1]) +
                       lw_td_next_log(td, &src[1], -1, &src[0]);
-      lw_model_propose_splice(m, p, i, 1, NULL, n, (double)(n - 1) * td->length);
+      lw_model_propose_splice(m, p, i, 1, NULL, n, rest);
       p->log_ratio = lw[2] - lw[3] + lr;
     }
   }

@@ -45,6 +45,17 @@ void lw_td_clear(lw_td *td)
   td->cum = NULL;
 }
 
+double lw_td_rest(const lw_td *td, double rest, size_t n_old, size_t n_new)
+{
+  const double r = (double)n_new * td->length + (rest - (double)n_old * td->length);
+  return r > 0.0 ? r : NAN;
+}
+
+int lw_td_mortal(const lw_td *td, size_t n, double rest)
+{
+  return n == td->birth_segments && rest == (double)td->birth_segments * td->length;
+}
+
 /* log pi(x, y) (transdim.h): -inf off the page. */
 static double log_first_point(const lw_td *td, double x, double y)
 {

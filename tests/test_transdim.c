@@ -311,6 +311,37 @@ Test(transdim, ideal_gas_first_nodes_follow_the_darkness)
   lw_image_dir_remove();
 }
 
+/* Grow and shrink move the rest length by one segment's l and keep its
+** excess over n l, so each undoes the other for a spline loaded with any
+** rest length (before, both reset it to n l: a grow and a shrink took a
+** rest length of 17.3 mm to 15); births' rest lengths come back exactly;
+** a shrink that would leave no positive rest length is refused; a death
+** only takes what a birth makes. */
+Test(transdim, grow_and_shrink_keep_a_rest_length_reversible)
+{
+  lw_params p;
+  ideal_gas(&p, 0.0);
+  lw_scene sc;
+  lw_test_scene(&sc, &p);
+  lw_td td;
+  cr_assert_eq(lw_td_init(&td, &sc, 2, 5.0, 8, 0.1), LW_OK);
+  cr_assert_eq(lw_td_rest(&td, 15.0, 3, 4), 20.0);
+  cr_assert_eq(lw_td_rest(&td, lw_td_rest(&td, 15.0, 3, 4), 4, 3), 15.0);
+  cr_assert_eq(lw_td_rest(&td, lw_td_rest(&td, 10.0, 2, 1), 1, 2), 10.0);
+  const double odd[] = {17.3, 3.7, 1e3 / 7.0};
+  for (int k = 0; k < 3; k++) {
+    double up = lw_td_rest(&td, odd[k], 3, 4), back = lw_td_rest(&td, up, 4, 3);
+    cr_assert(fabs(up - odd[k] - 5.0) <= 1e-14 * up, "grow: %.17g from %.17g", up, odd[k]);
+    cr_assert(fabs(back - odd[k]) <= 1e-14 * odd[k], "grow then shrink: %.17g from %.17g", back, odd[k]);
+  }
+  cr_assert(isnan(lw_td_rest(&td, 4.0, 2, 1)), "a shrink to a rest length of -1 mm");
+  cr_assert(lw_td_mortal(&td, 2, 10.0));
+  cr_assert(!lw_td_mortal(&td, 2, 10.5), "no birth makes a rest length of 10.5 mm for 2 segments");
+  cr_assert(!lw_td_mortal(&td, 3, 15.0));
+  lw_td_clear(&td);
+  lw_scene_clear(&sc);
+}
+
 /* The caches and pair grid of m (no ghosts) are, bit for bit, what a
 ** model built afresh from its state holds. */
 static void same_as_fresh(const lw_model *m)

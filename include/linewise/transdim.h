@@ -80,6 +80,20 @@ double lw_td_prior_change(const lw_td *td, const lw_node *nd, size_t n, size_t k
 /* Draws a born spline of birth_segments + 1 nodes into nd from the prior. */
 void lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd);
 
+/* The rest length of a spline of n_old segments and rest length `rest`
+** after a grow or shrink to n_new: n_new l plus the spline's own excess
+** rest - n_old l, so that a grow undone by a shrink gives the rest length
+** back whatever it was (loaded splines may have any), exactly when the
+** excess is 0 (births: n l).  NAN if it would not be positive: the move is
+** refused, and its reverse, from a rest length that is not positive,
+** cannot happen either. */
+double lw_td_rest(const lw_td *td, double rest, size_t n_old, size_t n_new);
+
+/* 1 if a death may remove a spline of n segments and rest length `rest`:
+** a birth could have made it (birth_segments segments, rest length
+** birth_segments l exactly); the reverse density is 0 for the others. */
+int lw_td_mortal(const lw_td *td, size_t n, double rest);
+
 /* Draws the node beyond `end` (dir +1: after it, -1: before it) into out;
 ** returns log g.  lw_td_next_log: log g of a given node. */
 double lw_td_next_draw(const lw_td *td, const lw_node *end, int dir, gsl_rng *rng, lw_node *out);
