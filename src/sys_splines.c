@@ -370,7 +370,6 @@ static const lw_td *td_of(const spl_state *s)
   return s->setup && s->m->scene->transdim ? &s->setup->td : NULL;
 }
 
-
 /* A live spline drawn uniformly (some must be): slots drawn until one is
 ** not a ghost, an exact uniform draw over the live ones whose expected
 ** cost is the slots over the live splines, about 1 (ghosts last a sweep). */
