@@ -256,29 +256,31 @@ lw_status lw_cellgrid_reserve(lw_cellgrid *g, size_t n)
   return LW_OK;
 }
 
-lw_status lw_cellgrid_splice(lw_cellgrid *g, size_t from, size_t n_old, size_t n_new)
+void lw_cellgrid_extend(lw_cellgrid *g, size_t n)
 {
-  const size_t n = g->n_samples - n_old + n_new;
-  if (lw_cellgrid_reserve(g, n) != LW_OK) return LW_ENOMEM;
-  const uint32_t lo = (uint32_t)from, hi = (uint32_t)(from + n_old);
+  g->n_samples += n;
+}
+
+void lw_cellgrid_renumber(lw_cellgrid *g, const uint32_t *to, uint32_t per, size_t n)
+{
   for (size_t ci = 0; ci < lw_cellgrid_cells(g); ci++) {
     lw_cell *c = &g->cell[ci];
-    if (!c->n) continue; /* an empty cell may have no block */
-    double *x = c->x, *y = lw_cell_y(c), *z = g->dim == 3 ? lw_cell_z(c) : NULL;
-    uint32_t *idx = lw_cell_idx(c);
-    float *dl = lw_cell_dl(c);
-    uint32_t k = lower_bound(c, lo), w = k;
-    for (; k < c->n; k++) {
-      if (idx[k] < hi) continue; /* leaves */
-      x[w] = x[k];
-      y[w] = y[k];
-      dl[w] = dl[k];
-      if (z) z[w] = z[k];
-      idx[w++] = (uint32_t)(idx[k] - n_old + n_new);
-    }
-    c->n = w;
+    uint32_t *idx = c->n ? lw_cell_idx(c) : NULL;
+    for (uint32_t k = 0; k < c->n; k++) idx[k] = to[idx[k] / per] * per + idx[k] % per;
   }
-  memmove(g->home + from + n_new, g->home + from + n_old, (g->n_samples - from - n_old) * sizeof *g->home);
+  /* home moves down with its samples: to[k] <= k, so forward is safe */
+  const size_t groups = g->n_samples / per;
+  for (size_t k = 0; k < groups; k++)
+    if (to[k] != UINT32_MAX && to[k] != k) memmove(g->home + (size_t)to[k] * per, g->home + k * per, per * sizeof *g->home);
   g->n_samples = n;
-  return LW_OK;
+}
+
+void lw_cellgrid_remove(lw_cellgrid *g, uint32_t i)
+{
+  lw_cell *c = &g->cell[g->home[i]];
+  uint32_t k = lower_bound(c, i);
+  cell_shift(g, c, k + 1, -1);
+  c->n--;
+  /* as in move: an emptied cell gives its room back (a failed shrink keeps it) */
+  if (c->cap - c->n > c->n / 4 + 4) (void)cell_resize(g, c, fitted(c->n));
 }

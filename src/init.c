@@ -79,9 +79,7 @@ static int fits(const lw_scene *sc, const lw_node *nd, size_t segments)
   return 1;
 }
 
-/* Darkness of the rows of the picture, cumulated: cum[j] is the sum over
-** rows before j, cum[height] the total.  NULL without a picture. */
-static double *row_darkness(const lw_image *img)
+double *lw_init_darkness(const lw_image *img)
 {
   if (!img) return NULL;
   double *cum = malloc(((size_t)img->height + 1) * sizeof *cum);
@@ -96,10 +94,9 @@ static double *row_darkness(const lw_image *img)
   return cum;
 }
 
-/* A point drawn with density proportional to the darkness of img (the
-** picture or a layer's target, placed alike). */
-static void dark_point(const lw_scene *sc, const lw_image *img, const double *cum, gsl_rng *rng, double *x,
-                       double *y)
+/* img is the picture or a layer's target, placed alike. */
+void lw_init_dark_point(const lw_scene *sc, const lw_image *img, const double *cum, gsl_rng *rng, double *x,
+                        double *y)
 {
   double r = gsl_rng_uniform(rng) * cum[img->height];
   int lo = 0, hi = img->height - 1;
@@ -272,7 +269,7 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
   double *cums[LW_LAYERS_MAX] = {NULL};
   int nomem = 0;
   for (int k = 0; k < nl; k++) {
-    cums[k] = row_darkness(by_layer ? sc->layer[k].target : sc->image);
+    cums[k] = lw_init_darkness(by_layer ? sc->layer[k].target : sc->image);
     nomem |= sc->image && !cums[k];
   }
   const int spaced = sc->min_spacing > 0.0 && sc->pair_quad.n > 0;
@@ -303,7 +300,7 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
     size_t least = SIZE_MAX;
     for (t = 0; t < tries; t++) {
       double cx, cy;
-      if (weighted) dark_point(sc, img, cum, rng, &cx, &cy);
+      if (weighted) lw_init_dark_point(sc, img, cum, rng, &cx, &cy);
       else {
         cx = gsl_rng_uniform(rng) * sc->width;
         cy = gsl_rng_uniform(rng) * sc->height;

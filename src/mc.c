@@ -183,18 +183,17 @@ lw_status lw_chain_sweep(lw_chain *c)
   if (!t->propose_at) {
     for (size_t k = 0; k < n; k++)
       if (lw_chain_step(c, draw_kind(c)) < 0) return LW_ENOMEM;
-    return LW_OK;
+  } else if (n > 0) {
+    /* Sites in order, so that consecutive proposals share cache lines and
+    ** grid cells; the direction is drawn per sweep so that the sweep as a
+    ** whole is reversible (docs/NUMERICS.md, "Sweep order"). */
+    int backward = gsl_rng_uniform(c->rng) < 0.5;
+    for (size_t k = 0; k < n; k++) {
+      size_t site = backward ? n - 1 - k : k;
+      if (lw_chain_step_at(c, draw_kind(c), site) < 0) return LW_ENOMEM;
+    }
   }
-  if (n == 0) return LW_OK;
-  /* Sites in order, so that consecutive proposals share cache lines and
-  ** grid cells; the direction is drawn per sweep so that the sweep as a
-  ** whole is reversible (docs/NUMERICS.md, "Sweep order"). */
-  int backward = gsl_rng_uniform(c->rng) < 0.5;
-  for (size_t k = 0; k < n; k++) {
-    size_t site = backward ? n - 1 - k : k;
-    if (lw_chain_step_at(c, draw_kind(c), site) < 0) return LW_ENOMEM;
-  }
-  return LW_OK;
+  return t->sweep_end ? t->sweep_end(c->sys->state) : LW_OK;
 }
 
 char *lw_rng_save(const gsl_rng *r)

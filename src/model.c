@@ -432,6 +432,7 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
   if (sc->transdim && sc->max_segments > m->max_segments) m->max_segments = sc->max_segments;
   m->cap_seg = ns;
   m->cap_spl = sp->n_splines ? sp->n_splines : 1;
+  if (!(m->slots = lw_slots_new())) goto nomem;
   if (lw_model_refresh(m, NULL) != LW_OK) goto nomem;
   return m;
 nomem:
@@ -452,6 +453,7 @@ void lw_model_free(lw_model *m)
   free(m->near_valid);
   lw_cellgrid_free(m->grid);
   for (int t = 0; t < LW_TERM_COUNT; t++) free(m->raster[t]);
+  lw_slots_free(m->slots);
   free(m);
 }
 
@@ -462,6 +464,7 @@ double lw_model_total(const lw_model *m)
 
 lw_status lw_model_refresh(lw_model *m, double *drift)
 {
+  if (lw_model_compact(m) != LW_OK) return LW_ENOMEM;
   const lw_scene *sc = m->scene;
   const lw_splines *sp = m->sp;
   const lw_term_set *ts = &m->terms;
@@ -965,6 +968,7 @@ void lw_model_propose_splice(const lw_model *m, lw_proposal *p, uint32_t at, int
   const lw_term_set *ts = &m->terms;
   const lw_term_ctx *pc = ts->pair >= 0 ? &ts->ctx[ts->pair] : NULL;
   const int np = pair_nodes(m), nl = sc->n_local;
+  if (!remove) at = (uint32_t)sp->n_splines; /* where the commit puts it is its own choice */
   const size_t g0 = lw_segment_index(sp, at, 0), no = remove ? lw_splines_segments(sp, at) : 0;
   const lw_node *old = remove ? &sp->node[sp->first[at]] : NULL;
 
@@ -1057,22 +1061,11 @@ static int room(void *a, size_t cap, size_t n, size_t sz)
   return 1;
 }
 
-/* Moves the tail of a per-item array from index `from + n_old` to `from + n_new`. */
-static void shift(void *a, size_t len, size_t from, size_t n_old, size_t n_new, size_t sz)
+/* Room in the per-segment caches for n_seg segments and in the per-spline
+** ones for n_spl splines; LW_ENOMEM leaves the model as it was (only larger). */
+static lw_status cache_room(lw_model *m, size_t n_seg, size_t n_spl)
 {
-  char *b = a;
-  memmove(b + (from + n_new) * sz, b + (from + n_old) * sz, (len - from - n_old) * sz);
-}
-
-static lw_status commit_splice(lw_model *m, const lw_proposal *p)
-{
-  lw_splines *sp = m->sp;
-  const int np = pair_nodes(m), nl = m->scene->n_local, nls = nl ? nl : 1;
-  const size_t at = p->spline, g0 = lw_segment_index(sp, at, 0), nn = p->n_seg, no = p->n_old_seg;
-  const size_t k_new = p->n_node ? 1 : 0, n_seg = sp->n_segments - no + nn;
-  const size_t n_spl = sp->n_splines - (size_t)p->remove + k_new, old_segs = sp->n_segments;
-  /* every allocation first, so that running out of memory leaves the model as it was */
-  if ((uint64_t)n_seg * (uint64_t)np >= UINT32_MAX) return LW_ENOMEM; /* the grid's sample indices */
+  const int nl = m->scene->n_local, nls = nl ? nl : 1;
   if (n_seg > m->cap_seg) {
     size_t c = m->cap_seg + m->cap_seg / 2 + 16;
     if (c < n_seg) c = n_seg;
@@ -1086,40 +1079,78 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
   }
   if (n_spl > m->cap_spl) {
     size_t c = m->cap_spl + m->cap_spl / 2 + 8;
+    if (c < n_spl) c = n_spl;
     if (!room(&m->spline_len, m->cap_spl, c, sizeof *m->spline_len)) return LW_ENOMEM;
     m->cap_spl = c;
   }
+  return LW_OK;
+}
+
+/*
+** A splice commits in O(the segments of the two splines): the replaced
+** spline becomes a ghost where it is (its samples leave the grid, its
+** caches are zeroed so that nothing counts it), and the new one takes a
+** ghost slot of its segment count in place, or is appended (slots.h).  No
+** other index moves, so the grid's keys and every cached near field of
+** the splines not involved stay as they were.
+*/
+static lw_status commit_splice(lw_model *m, const lw_proposal *p)
+{
+  lw_splines *sp = m->sp;
+  const int np = pair_nodes(m), nl = m->scene->n_local;
+  const size_t at = p->spline, nn = p->n_seg, no = p->n_old_seg;
+  const long hole = nn ? lw_slots_peek(m->slots, nn) : -1;
+  const int append = nn && hole < 0;
+  const size_t n_seg = sp->n_segments + (append ? nn : 0), n_spl = sp->n_splines + (size_t)append;
+  /* every allocation first, so that running out of memory leaves the model as it was */
+  if ((uint64_t)n_seg * (uint64_t)np >= UINT32_MAX) return LW_ENOMEM; /* the grid's sample indices */
+  if (cache_room(m, n_seg, n_spl) != LW_OK) return LW_ENOMEM;
+  if (p->remove && lw_slots_reserve(m->slots, n_spl, no) != LW_OK) return LW_ENOMEM;
   if (m->grid && lw_cellgrid_reserve(m->grid, n_seg * (size_t)np) != LW_OK) return LW_ENOMEM;
-  /* the near fields the splice changes, in the numbering before it */
+  if (append && lw_splines_append(sp, p->node, p->n_node, p->new_rest) != LW_OK)
+    return LW_ENOMEM;
+  /* the near fields the splice changes */
   if (m->grid && p->pair_done)
     for (size_t k = 0; k < p->partners.n; k++) m->near_valid[p->partners.idx[k]] = 0;
-  if (lw_splines_splice(sp, at, p->remove, p->node, p->n_node, p->new_rest) != LW_OK) return LW_ENOMEM;
 
-  for (size_t j = 0; j < no; j++) m->n_irregular -= m->seg_irregular[g0 + j];
-  for (size_t j = 0; j < nn; j++) m->n_irregular += p->seg_irregular[j];
-  shift(m->seg_len, old_segs, g0, no, nn, sizeof *m->seg_len);
-  shift(m->seg_local, old_segs * (size_t)nl, g0 * (size_t)nl, no * (size_t)nl, nn * (size_t)nl,
-        sizeof *m->seg_local);
-  shift(m->seg_irregular, old_segs, g0, no, nn, sizeof *m->seg_irregular);
-  memcpy(m->seg_len + g0, p->len, nn * sizeof *p->len);
-  memcpy(m->seg_local + g0 * (size_t)nl, p->local, nn * (size_t)nl * sizeof *p->local);
-  memcpy(m->seg_irregular + g0, p->seg_irregular, nn * sizeof *p->seg_irregular);
-  shift(m->spline_len, sp->n_splines - k_new + (size_t)p->remove, at, (size_t)p->remove, k_new, sizeof *m->spline_len);
-  if (k_new) m->spline_len[at] = p->new_spline_len;
-  if (nn > m->max_segments) m->max_segments = nn;
-
-  lw_status st = LW_OK;
-  if (m->grid) {
-    shift(m->near_cache, old_segs, g0, no, nn, sizeof *m->near_cache);
-    shift(m->near_valid, old_segs, g0, no, nn, sizeof *m->near_valid);
-    for (size_t j = 0; j < nn; j++) {
-      m->near_cache[g0 + j] = p->near_new[j];
-      m->near_valid[g0 + j] = (uint8_t)p->pair_done;
+  if (p->remove) {
+    const size_t g0 = lw_segment_index(sp, at, 0);
+    for (size_t j = 0; j < no; j++) {
+      m->n_irregular -= m->seg_irregular[g0 + j];
+      m->seg_irregular[g0 + j] = 0;
+      m->seg_len[g0 + j] = 0.0;
+      for (int t = 0; t < nl; t++) m->seg_local[(g0 + j) * (size_t)nl + (size_t)t] = 0.0;
+      if (m->grid) m->near_valid[g0 + j] = 0;
     }
-    if (!p->pair_done) memset(m->near_valid, 0, n_seg * sizeof *m->near_valid);
-    (void)lw_cellgrid_splice(m->grid, g0 * (size_t)np, no * (size_t)np, nn * (size_t)np); /* room reserved */
-    for (size_t j = 0; j < nn && st == LW_OK; j++) st = store_samples(m->grid, g0 + j, np, p->ps + j * (size_t)np);
+    m->spline_len[at] = 0.0;
+    for (size_t k = 0; m->grid && k < no * (size_t)np; k++) lw_cellgrid_remove(m->grid, (uint32_t)(g0 * (size_t)np + k));
+    lw_slots_kill(m->slots, at, no);
   }
+  lw_status st = LW_OK;
+  if (nn) {
+    const size_t s = append ? sp->n_splines - 1 : (size_t)hole;
+    if (!append) {
+      lw_slots_take(m->slots, nn);
+      memcpy(&sp->node[sp->first[s]], p->node, p->n_node * sizeof *p->node);
+      sp->rest_length[s] = p->new_rest;
+    }
+    const size_t g0 = lw_segment_index(sp, s, 0);
+    memcpy(m->seg_len + g0, p->len, nn * sizeof *p->len);
+    memcpy(m->seg_local + g0 * (size_t)nl, p->local, nn * (size_t)nl * sizeof *p->local);
+    memcpy(m->seg_irregular + g0, p->seg_irregular, nn * sizeof *p->seg_irregular);
+    for (size_t j = 0; j < nn; j++) m->n_irregular += p->seg_irregular[j];
+    m->spline_len[s] = p->new_spline_len;
+    if (nn > m->max_segments) m->max_segments = nn;
+    if (m->grid) {
+      for (size_t j = 0; j < nn; j++) {
+        m->near_cache[g0 + j] = p->near_new[j];
+        m->near_valid[g0 + j] = (uint8_t)p->pair_done;
+      }
+      if (append) lw_cellgrid_extend(m->grid, nn * (size_t)np);
+      for (size_t j = 0; j < nn && st == LW_OK; j++) st = store_samples(m->grid, g0 + j, np, p->ps + j * (size_t)np);
+    }
+  }
+  if (m->grid && !p->pair_done) memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);
   for (int k = 0; p->raster_done && k < m->terms.n_raster; k++) {
     const int t = m->terms.raster[k];
     lw_tone_apply(m->terms.ctx[t].data, m->raster[t], &p->box[t]);
@@ -1134,5 +1165,40 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
     return st;
   }
   if (nonfinite || (m->terms.n_raster && !p->raster_done)) return lw_model_refresh(m, NULL);
+  return LW_OK;
+}
+
+lw_status lw_model_compact(lw_model *m)
+{
+  if (!m->slots || !m->slots->n_ghost) return LW_OK;
+  lw_splines *sp = m->sp;
+  const size_t ns = sp->n_segments, n_old = sp->n_splines;
+  const int np = pair_nodes(m), nl = m->scene->n_local;
+  uint32_t *to = malloc((ns ? ns : 1) * sizeof *to);
+  if (!to) return LW_ENOMEM;
+  size_t w = 0, ws = 0;
+  for (size_t i = 0; i < n_old; i++) {
+    const size_t g0 = lw_segment_index(sp, i, 0), n = lw_splines_segments(sp, i);
+    const int dead = lw_slots_ghost(m->slots, i);
+    for (size_t k = 0; k < n; k++) {
+      const size_t g = g0 + k;
+      to[g] = dead ? UINT32_MAX : (uint32_t)w;
+      if (dead) continue;
+      /* w <= g: the caches move down in place */
+      m->seg_len[w] = m->seg_len[g];
+      memmove(m->seg_local + w * (size_t)nl, m->seg_local + g * (size_t)nl, (size_t)nl * sizeof *m->seg_local);
+      m->seg_irregular[w] = m->seg_irregular[g];
+      if (m->grid) {
+        m->near_cache[w] = m->near_cache[g];
+        m->near_valid[w] = m->near_valid[g];
+      }
+      w++;
+    }
+    if (!dead) m->spline_len[ws++] = m->spline_len[i];
+  }
+  if (m->grid) lw_cellgrid_renumber(m->grid, to, (uint32_t)np, w * (size_t)np);
+  free(to);
+  lw_splines_compact(sp, m->slots->ghost);
+  lw_slots_clear(m->slots, n_old);
   return LW_OK;
 }

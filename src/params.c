@@ -236,7 +236,11 @@ const lw_param_def lw_param_table[] = {
       "a drawing needs. Splines system only."),
   NUM("moves", "birth", LW_PT_DOUBLE, mix_birth, "0.01", "", 0, 1e6, 0,
       "Relative frequency of births: a new spline of init.segments segments placed along the "
-      "field (fixed_count = 0)."),
+      "field, starting where the picture is dark (fixed_count = 0)."),
+  NUM("moves", "birth_uniform", LW_PT_DOUBLE, birth_uniform, "0.1", "", 1e-3, 1, 0,
+      "With a picture, the share of born splines whose first point is uniform on the page; the "
+      "others start where placement starts a spline, by darkness. It keeps every point "
+      "possible for a first node (fixed_count = 0; docs/NUMERICS.md)."),
   NUM("moves", "death", LW_PT_DOUBLE, mix_death, "0.01", "", 0, 1e6, 0,
       "Relative frequency of deaths: a spline chosen uniformly is removed (fixed_count = 0)."),
   NUM("moves", "grow", LW_PT_DOUBLE, mix_grow, "0.02", "", 0, 1e6, 0,

@@ -96,10 +96,9 @@ static size_t grown(size_t cap, size_t need)
   return c < need ? need : c;
 }
 
-lw_status lw_splines_splice(lw_splines *sp, size_t at, int remove, const lw_node *nodes, size_t n_new, double rest)
+lw_status lw_splines_append(lw_splines *sp, const lw_node *nodes, size_t n_new, double rest)
 {
-  const size_t k_new = n_new ? 1 : 0, old_nodes = remove ? sp->first[at + 1] - sp->first[at] : 0;
-  const size_t n_nodes = sp->n_nodes - old_nodes + n_new, n_splines = sp->n_splines - (size_t)remove + k_new;
+  const size_t n_nodes = sp->n_nodes + n_new, n_splines = sp->n_splines + 1;
   /* all growth first, so that a failure leaves sp as it was; an array that
   ** grew while its partner failed is only larger than its cap says */
   if (n_nodes > sp->cap_nodes) {
@@ -122,27 +121,35 @@ lw_status lw_splines_splice(lw_splines *sp, size_t at, int remove, const lw_node
     sp->first = fi;
     sp->cap_splines = c;
   }
-
-  const size_t f = sp->first[at], tail = sp->n_nodes - f - old_nodes;
-  memmove(sp->node + f + n_new, sp->node + f + old_nodes, tail * sizeof *sp->node);
-  if (n_new) memcpy(sp->node + f, nodes, n_new * sizeof *nodes);
-  const size_t after = sp->n_splines - at - (size_t)remove; /* splines behind */
-  memmove(sp->first + at + k_new, sp->first + at + remove, (after + 1) * sizeof *sp->first);
-  memmove(sp->rest_length + at + k_new, sp->rest_length + at + remove, after * sizeof *sp->rest_length);
-  if (k_new) {
-    sp->first[at] = f;
-    sp->rest_length[at] = rest;
-  }
-  for (size_t i = at + k_new; i <= after + at + k_new; i++) sp->first[i] = sp->first[i] - old_nodes + n_new;
+  memcpy(sp->node + sp->n_nodes, nodes, n_new * sizeof *nodes);
+  for (size_t g = sp->n_segments; g < sp->n_segments + n_new - 1; g++) sp->seg_spline[g] = (uint32_t)sp->n_splines;
+  sp->rest_length[sp->n_splines] = rest;
+  sp->first[n_splines] = n_nodes;
   sp->n_nodes = n_nodes;
   sp->n_splines = n_splines;
   sp->n_segments = n_nodes - n_splines;
-  /* the segments from spline `at` on belong to other indices now */
-  for (size_t i = at; i < n_splines; i++) {
-    size_t g = lw_segment_index(sp, i, 0), n = lw_splines_segments(sp, i);
-    for (size_t m = 0; m < n; m++) sp->seg_spline[g + m] = (uint32_t)i;
-  }
   return LW_OK;
+}
+
+void lw_splines_compact(lw_splines *sp, const unsigned char *dead)
+{
+  size_t k = 0, w = 0;
+  for (size_t i = 0; i < sp->n_splines; i++) {
+    /* first[i + 1] is read before first[w <= i] is written */
+    const size_t f = sp->first[i], nn = sp->first[i + 1] - f;
+    if (dead[i]) continue;
+    memmove(sp->node + k, sp->node + f, nn * sizeof *sp->node);
+    sp->first[w] = k;
+    sp->rest_length[w] = sp->rest_length[i];
+    k += nn;
+    w++;
+  }
+  sp->first[w] = k;
+  sp->n_splines = w;
+  sp->n_nodes = k;
+  sp->n_segments = k - w;
+  for (size_t i = 0, g = 0; i < w; i++)
+    for (size_t m = lw_splines_segments(sp, i); m > 0; m--) sp->seg_spline[g++] = (uint32_t)i;
 }
 
 int lw_splines_is_point(const lw_splines *sp, size_t i)

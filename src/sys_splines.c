@@ -49,6 +49,7 @@ static void setup_free(void *setup)
   spl_setup *su = setup;
   if (!su) return;
   lw_grid2d_free(su->tone);
+  lw_td_clear(&su->td);
   lw_scene_clear(&su->scene);
   free(su);
 }
@@ -64,7 +65,11 @@ static void *setup_new(const lw_params *p, lw_error *err)
   /* the target of the fidelity score and the previews' underlay */
   if (su->scene.image && !(su->tone = lw_image_tone_grid(su->scene.image, &su->scene.image_place, err)))
     goto fail;
-  lw_td_init(&su->td, &su->scene, (size_t)p->segments, p->segment_length, su->scene.max_segments);
+  if (lw_td_init(&su->td, &su->scene, (size_t)p->segments, p->segment_length, su->scene.max_segments,
+                 p->birth_uniform)) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for the birth prior's darkness table");
+    goto fail;
+  }
   const double w[4] = {p->mix_birth, p->mix_death, p->mix_grow, p->mix_shrink};
   for (int k = 0; k < 4; k++) su->log_w[k] = log(w[k]);
   if (su->scene.transdim) {
@@ -272,6 +277,15 @@ static uint32_t spline_near(const lw_splines *sp, uint32_t hint, size_t k)
 
 static void spline_box(const lw_splines *sp, uint32_t i, size_t node0, size_t n, const lw_node *nd, double b[4]);
 
+/* A refused proposal (no spline to remove, a spline at its longest or
+** shortest, a ghost's site): rejected, dE = +inf. */
+static double refuse(lw_proposal *p)
+{
+  p->splice = 0;
+  p->log_ratio = 0.0;
+  return INFINITY;
+}
+
 /* A proposal of the kind at global node k (a point or vector move) or on
 ** its spline (a rigid move); with a box (domains.h), rejected (+inf,
 ** *forbidden = 2) if the spline would leave it. */
@@ -281,6 +295,13 @@ static double propose_on(const lw_model *m, const lw_td *td, lw_proposal *p, int
   const lw_splines *sp = m->sp;
   size_t node0, n_node;
   lw_node *nd = p->node; /* proposals are built in place in the scratch */
+  if (lw_model_ghost(m, i)) {
+    /* a site in a ghost slot (slots.h) until the sweep's end: no move, which
+    ** keeps balance (the site is the state's own, like a wrapped one) */
+    p->spline = i;
+    *forbidden = 0;
+    return refuse(p);
+  }
   if (kind == LW_MOVE_POINT || kind == LW_MOVE_VECTOR) {
     node0 = at - sp->first[i];
     n_node = 1;
@@ -349,23 +370,26 @@ static const lw_td *td_of(const spl_state *s)
   return s->setup && s->m->scene->transdim ? &s->setup->td : NULL;
 }
 
-/* A refused trans-dimensional proposal (no spline to remove, a spline at its
-** longest or shortest): rejected, dE = +inf. */
-static double refuse(lw_proposal *p)
+/* A live spline drawn uniformly (some must be): slots drawn until one is
+** not a ghost, an exact uniform draw over the live ones whose expected
+** cost is the slots over the live splines, about 1 (ghosts last a sweep). */
+static uint32_t live_spline(const lw_model *m, gsl_rng *rng)
 {
-  p->splice = 0;
-  p->log_ratio = 0.0;
-  return INFINITY;
+  uint32_t i;
+  do i = (uint32_t)gsl_rng_uniform_int(rng, m->sp->n_splines);
+  while (lw_model_ghost(m, i));
+  return i;
 }
 
 /*
 ** Birth, death, grow and shrink (transdim.h; docs/NUMERICS.md has the
-** derivation of each Hastings factor).  A birth appends a spline drawn
-** from the prior, a death removes one chosen uniformly: the state is a
-** set, and its numbering plays no part in any density.  A death removes
-** only splines a birth could have made (birth_segments segments): for the
-** others the reverse proposal has density 0.  Rest lengths are n l (init's rule), so a
-** grown or shrunk spline's rest length is a function of its size.
+** derivation of each Hastings factor).  A birth adds a spline drawn from
+** the prior, a death removes one chosen uniformly: the state is a set, and
+** its numbering (where the model puts a new spline, slots.h) plays no part
+** in any density.  A death removes only splines a birth could have made
+** (lw_td_mortal): for the others the reverse proposal has density 0.  A
+** grow or shrink moves the rest length by l and keeps its excess over n l
+** (lw_td_rest), so that each undoes the other for any rest length.
 */
 static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, int *forbidden)
 {
@@ -373,26 +397,28 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
   const lw_td *td = &su->td;
   const lw_model *m = s->m;
   const lw_splines *sp = m->sp;
-  const size_t N = sp->n_splines, nb = td->birth_segments;
+  const size_t N = lw_model_count(m), nb = td->birth_segments;
   const double *lw = su->log_w;
   *forbidden = 0;
   if (kind == LW_MOVE_BIRTH) {
     lw_td_birth_draw(td, rng, p->node);
-    lw_model_propose_splice(m, p, (uint32_t)N, 0, NULL, nb + 1, (double)nb * td->length);
+    lw_model_propose_splice(m, p, 0, 0, NULL, nb + 1, (double)nb * td->length);
     p->log_ratio = lw[1] - lw[0] - log((double)(N + 1));
   } else if (kind == LW_MOVE_DEATH) {
     if (N == 0) return refuse(p);
-    uint32_t j = (uint32_t)gsl_rng_uniform_int(rng, N);
-    if (lw_splines_segments(sp, j) != nb) return refuse(p);
+    uint32_t j = live_spline(m, rng);
+    if (!lw_td_mortal(td, lw_splines_segments(sp, j), sp->rest_length[j])) return refuse(p);
     lw_model_propose_splice(m, p, j, 1, NULL, 0, 0.0);
     p->log_ratio = lw[0] - lw[1] + log((double)N);
   } else {
     if (N == 0) return refuse(p);
-    uint32_t i = (uint32_t)gsl_rng_uniform_int(rng, N);
+    uint32_t i = live_spline(m, rng);
     int tail = gsl_rng_uniform(rng) < 0.5;
     const size_t n = lw_splines_segments(sp, i);
     const lw_node *src = &sp->node[sp->first[i]];
     double lr;
+    const double rest = lw_td_rest(td, sp->rest_length[i], n, kind == LW_MOVE_GROW ? n + 1 : n - 1);
+    if (isnan(rest)) return refuse(p);
     if (kind == LW_MOVE_GROW) {
       if (n >= td->max_segments) return refuse(p);
       /* the old nodes before a new last one, or after a new first one */
@@ -402,7 +428,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
       /* at the tail the prior's new factor is the proposal itself */
       lr = tail ? 0.0
                 : lw_td_first_log(td, add) + lw_td_next_log(td, add, 1, &keep[0]) - lw_td_first_log(td, &keep[0]) - lg;
-      lw_model_propose_splice(m, p, i, 1, NULL, n + 2, (double)(n + 1) * td->length);
+      lw_model_propose_splice(m, p, i, 1, NULL, n + 2, rest);
       p->log_ratio = lw[3] - lw[2] + lr;
     } else {
       if (n <= 1) return refuse(p);
@@ -410,7 +436,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
       lr = tail ? 0.0
                 : lw_td_first_log(td, &src[1]) - lw_td_first_log(td, &src[0]) - lw_td_next_log(td, &src[0], 1, &src[1]) +
                       lw_td_next_log(td, &src[1], -1, &src[0]);
-      lw_model_propose_splice(m, p, i, 1, NULL, n, (double)(n - 1) * td->length);
+      lw_model_propose_splice(m, p, i, 1, NULL, n, rest);
       p->log_ratio = lw[2] - lw[3] + lr;
     }
   }
@@ -540,6 +566,8 @@ static lw_status renumber(void *state, lw_error *err)
 }
 
 static lw_status commit(void *state, void *prop) { return lw_model_commit(((spl_state *)state)->m, prop); }
+
+static lw_status sweep_end(void *state) { return lw_model_compact(((spl_state *)state)->m); }
 
 static double log_ratio(const void *prop) { return ((const lw_proposal *)prop)->log_ratio; }
 
@@ -746,6 +774,7 @@ static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinne
   .propose = propose, \
   .propose_at = propose_at, \
   .renumber = renumber, \
+  .sweep_end = sweep_end, \
   .commit = commit, \
   .log_ratio = log_ratio, \
   .total = total, \

@@ -10,15 +10,68 @@
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_sf_bessel.h>
 #include <math.h>
+#include <stdlib.h>
 
-void lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double length, size_t max_segments)
+#include "linewise/init.h"
+
+lw_status lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double length, size_t max_segments,
+                     double uniform)
 {
   td->scene = sc;
+  td->cum = NULL;
+  td->uniform = uniform;
+  td->dark_scale = 0.0;
+  if (sc->image) {
+    if (!(td->cum = lw_init_darkness(sc->image))) return LW_ENOMEM;
+    const double total = td->cum[sc->image->height], a = sc->image_place.pixel;
+    if (total > 0) {
+      td->dark_scale = (1.0 - uniform) / (total * a * a);
+    } else { /* a white picture: nothing to follow, as placement does */
+      free(td->cum);
+      td->cum = NULL;
+    }
+  }
   td->length = length;
   td->sigma_p = length / 4.0;
   td->sigma_v = length / 12.0;
   td->birth_segments = birth_segments;
   td->max_segments = max_segments;
+  return LW_OK;
+}
+
+void lw_td_clear(lw_td *td)
+{
+  free(td->cum);
+  td->cum = NULL;
+}
+
+double lw_td_rest(const lw_td *td, double rest, size_t n_old, size_t n_new)
+{
+  const double r = (double)n_new * td->length + (rest - (double)n_old * td->length);
+  return r > 0.0 ? r : NAN;
+}
+
+int lw_td_mortal(const lw_td *td, size_t n, double rest)
+{
+  return n == td->birth_segments && rest == (double)td->birth_segments * td->length;
+}
+
+/* log pi(x, y) (transdim.h): -inf off the page. */
+static double log_first_point(const lw_td *td, double x, double y)
+{
+  const lw_scene *sc = td->scene;
+  if (!(x >= 0.0 && x <= sc->width && y >= 0.0 && y <= sc->height)) return -INFINITY;
+  const double lp = -log(sc->width * sc->height);
+  if (!td->cum) return lp;
+  const lw_image *img = sc->image;
+  const lw_image_place *pl = &sc->image_place;
+  const double fi = floor((x - pl->x0) / pl->pixel), fj = floor((y - pl->y0) / pl->pixel);
+  double d = 0.0;
+  if (fi >= 0 && fi < img->width && fj >= 0 && fj < img->height)
+    d = 1.0 - img->tone[(size_t)fj * (size_t)img->width + (size_t)fi];
+  /* as lw_init_dark_point, which never draws a pixel without darkness */
+  if (!(d > 0.0)) d = 0.0;
+  return log(td->uniform * exp(lp) + td->dark_scale * d);
 }
 
 /* log of the isotropic 2-D Gaussian density N(d; 0, s^2) at offset d. */
@@ -90,9 +143,8 @@ static int first_axis(const lw_td *td, const lw_node *n0, double *ux, double *uy
 double lw_td_first_log(const lw_td *td, const lw_node *n0)
 {
   const double r = td->length / 3.0, s = td->sigma_v;
-  const lw_scene *sc = td->scene;
-  if (!(n0->px >= 0.0 && n0->px <= sc->width && n0->py >= 0.0 && n0->py <= sc->height)) return -INFINITY;
-  double ux, uy, lp = -log(sc->width * sc->height);
+  double ux, uy, lp = log_first_point(td, n0->px, n0->py);
+  if (lp == -INFINITY) return lp;
   if (first_axis(td, n0, &ux, &uy)) {
     double a = log_gauss2(n0->vx - r * ux, n0->vy - r * uy, s), b = log_gauss2(n0->vx + r * ux, n0->vy + r * uy, s);
     double hi = fmax(a, b);
@@ -107,8 +159,12 @@ void lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd)
 {
   const double r = td->length / 3.0;
   double ux, uy;
-  nd[0].px = gsl_rng_uniform(rng) * td->scene->width;
-  nd[0].py = gsl_rng_uniform(rng) * td->scene->height;
+  if (td->cum && gsl_rng_uniform(rng) >= td->uniform) {
+    lw_init_dark_point(td->scene, td->scene->image, td->cum, rng, &nd[0].px, &nd[0].py);
+  } else {
+    nd[0].px = gsl_rng_uniform(rng) * td->scene->width;
+    nd[0].py = gsl_rng_uniform(rng) * td->scene->height;
+  }
   if (first_axis(td, &nd[0], &ux, &uy)) {
     if (gsl_rng_uniform(rng) < 0.5) {
       ux = -ux;

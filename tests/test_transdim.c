@@ -16,6 +16,7 @@
 #include "linewise/mc.h"
 #include "linewise/sys_splines.h"
 #include "linewise/transdim.h"
+#include "imageutil.h"
 #include "testutil.h"
 
 /* A chain on the spline system with fixed_count = 0 and the parameters p
@@ -217,6 +218,181 @@ Test(transdim, ideal_gas_all_moves_together)
   td_chain_free(c, setup);
 }
 
+/* The birth prior follows the picture (transdim.h): with every move kind on
+** and a ramp picture (white at its left edge, black at its right), N is
+** still Poisson with mean K exp(-mu_s / T), the prior being normalised, and
+** the first nodes follow pi = b / (W H) + (1 - b) d / (D a^2), whose
+** moments the test sums pixel by pixel from the scene's own picture and
+** placement.  The same moments of a uniform first node (0.5, 1/3) are more
+** than 8 standard errors off, so the test tells the two priors apart; and
+** so it does a density that the Hastings factors of the moves that keep
+** ** the count get wrong (uniform there while births draw by darkness: 0.551
+** +- 0.003 against 0.571 for E x / W, 6 standard errors). */
+Test(transdim, ideal_gas_first_nodes_follow_the_darkness)
+{
+  lw_image_dir_make();
+  lw_params p;
+  const double T = 0.9, lambda = 2.0;
+  ideal_gas(&p, -T * log(lambda));
+  p.splines = 10;
+  p.max_segments = 3;
+  p.margin = 4;
+  /* steps that carry a first node across the picture within a spline's
+  ** life: the moves that keep the count must hold pi too (their Hastings
+  ** factor), not only the births that draw from it */
+  p.mix_birth = p.mix_death = p.mix_grow = p.mix_shrink = 0.5;
+  p.mix_point = p.mix_vector = p.mix_translate = p.mix_rotate = 1;
+  p.step_point = p.step_translate = 8;
+  p.birth_uniform = 0.2;
+  enum { PW = 24 };
+  float g[PW * PW];
+  for (int j = 0; j < PW; j++)
+    for (int i = 0; i < PW; i++) g[j * PW + i] = (float)(1.0 - (i + 0.5) / PW);
+  snprintf(p.image, sizeof p.image, "%s", lw_test_path("ramp.png"));
+  lw_test_png(p.image, PW, PW, g, NULL);
+  void *setup;
+  lw_chain *c = td_chain(&p, T, 15, &setup);
+  const lw_model *m = lw_splines_model(c->sys);
+  const lw_scene *sc = m->scene;
+  cr_assert_not_null(sc->image);
+  /* the moments of pi over the page: E x / W, E (x / W)^2, E y / H, E (y / H)^2 */
+  const lw_image *img = sc->image;
+  const lw_image_place *pl = &sc->image_place;
+  double D = 0.0, want[4] = {0};
+  for (int j = 0; j < img->height; j++)
+    for (int i = 0; i < img->width; i++) {
+      const double d = fmax(1.0 - img->tone[j * img->width + i], 0.0);
+      const double x0 = (pl->x0 + i * pl->pixel) / sc->width, x1 = x0 + pl->pixel / sc->width;
+      const double y0 = (pl->y0 + j * pl->pixel) / sc->height, y1 = y0 + pl->pixel / sc->height;
+      D += d;
+      want[0] += d * 0.5 * (x0 + x1);
+      want[1] += d * (x0 * x0 + x0 * x1 + x1 * x1) / 3.0;
+      want[2] += d * 0.5 * (y0 + y1);
+      want[3] += d * (y0 * y0 + y0 * y1 + y1 * y1) / 3.0;
+    }
+  const double b = p.birth_uniform, flat[4] = {0.5, 1.0 / 3.0, 0.5, 1.0 / 3.0};
+  for (int k = 0; k < 4; k++) want[k] = b * flat[k] + (1.0 - b) * want[k] / D;
+  unsigned long nc[NMAX] = {0}, sgc[NMAX] = {0}, ns = 0;
+  tally(c, 500, 4, nc, sgc, &ns);
+  memset(nc, 0, sizeof nc);
+  batch_mean mom[4];
+  memset(mom, 0, sizeof mom);
+  const long per = (lw_test_long() ? 300000 : 30000) / BATCHES;
+  for (int k = 0; k < 4; k++) mom[k].per = per;
+  for (long s = 0; s < BATCHES * per; s++) {
+    tally(c, 1, 6, nc, sgc, &ns);
+    /* the mean over the splines present, each spline a sample: weight by count */
+    double a[4] = {0};
+    const size_t N = m->sp->n_splines;
+    for (size_t i = 0; i < N; i++) {
+      const lw_node *n0 = &m->sp->node[m->sp->first[i]];
+      const double u = n0->px / sc->width, v = n0->py / sc->height;
+      cr_assert(u >= 0 && u <= 1 && v >= 0 && v <= 1, "a first node left the page: (%g, %g)", n0->px, n0->py);
+      a[0] += u;
+      a[1] += u * u;
+      a[2] += v;
+      a[3] += v * v;
+    }
+    /* E[sum over splines of f] = E N * E f: divide by the Poisson mean */
+    for (int k = 0; k < 4; k++) bm_add(&mom[k], a[k] / (3.0 * lambda));
+  }
+  double prob[NMAX];
+  for (int k = 0; k < NMAX; k++) prob[k] = gsl_ran_poisson_pdf((unsigned)k, 3.0 * lambda);
+  double pv = chisq_p(nc, prob, 25, (unsigned long)(BATCHES * per));
+  cr_assert(pv > 1e-3, "spline count vs Poisson(%g): chi-square p = %g", 3.0 * lambda, pv);
+  for (int k = 0; k < 4; k++) {
+    double se, mean = bm_mean(&mom[k], &se);
+    cr_assert(fabs(mean - want[k]) < 5 * se, "first node, moment %d: %g +- %g, expected %g", k, mean, se, want[k]);
+    if (k < 2) /* along the ramp: the uniform prior's value is far off */
+      cr_assert(fabs(flat[k] - want[k]) > 8 * se, "moment %d: %g +- %g cannot tell %g from uniform %g", k, mean, se,
+                want[k], flat[k]);
+  }
+  td_chain_free(c, setup);
+  lw_image_dir_remove();
+}
+
+/* Grow and shrink move the rest length by one segment's l and keep its
+** excess over n l, so each undoes the other for a spline loaded with any
+** rest length (before, both reset it to n l: a grow and a shrink took a
+** rest length of 17.3 mm to 15); births' rest lengths come back exactly;
+** a shrink that would leave no positive rest length is refused; a death
+** only takes what a birth makes. */
+Test(transdim, grow_and_shrink_keep_a_rest_length_reversible)
+{
+  lw_params p;
+  ideal_gas(&p, 0.0);
+  lw_scene sc;
+  lw_test_scene(&sc, &p);
+  lw_td td;
+  cr_assert_eq(lw_td_init(&td, &sc, 2, 5.0, 8, 0.1), LW_OK);
+  cr_assert_eq(lw_td_rest(&td, 15.0, 3, 4), 20.0);
+  cr_assert_eq(lw_td_rest(&td, lw_td_rest(&td, 15.0, 3, 4), 4, 3), 15.0);
+  cr_assert_eq(lw_td_rest(&td, lw_td_rest(&td, 10.0, 2, 1), 1, 2), 10.0);
+  const double odd[] = {17.3, 3.7, 1e3 / 7.0};
+  for (int k = 0; k < 3; k++) {
+    double up = lw_td_rest(&td, odd[k], 3, 4), back = lw_td_rest(&td, up, 4, 3);
+    cr_assert(fabs(up - odd[k] - 5.0) <= 1e-14 * up, "grow: %.17g from %.17g", up, odd[k]);
+    cr_assert(fabs(back - odd[k]) <= 1e-14 * odd[k], "grow then shrink: %.17g from %.17g", back, odd[k]);
+  }
+  cr_assert(isnan(lw_td_rest(&td, 4.0, 2, 1)), "a shrink to a rest length of -1 mm");
+  cr_assert(lw_td_mortal(&td, 2, 10.0));
+  cr_assert(!lw_td_mortal(&td, 2, 10.5), "no birth makes a rest length of 10.5 mm for 2 segments");
+  cr_assert(!lw_td_mortal(&td, 3, 15.0));
+  lw_td_clear(&td);
+  lw_scene_clear(&sc);
+}
+
+/* The caches and pair grid of m (no ghosts) are, bit for bit, what a
+** model built afresh from its state holds. */
+static void same_as_fresh(const lw_model *m)
+{
+  lw_error err = {0};
+  cr_assert_eq(lw_model_count(m), m->sp->n_splines, "no ghosts are left");
+  lw_model *f = lw_model_new(m->scene, lw_splines_clone(m->sp), &err);
+  cr_assert_not_null(f, "%s", err.msg);
+  cr_assert_eq(f->sp->n_segments, m->sp->n_segments);
+  const int np = m->scene->pair_quad.n, nl = m->scene->n_local;
+  for (size_t g = 0; g < m->sp->n_segments; g++) {
+    cr_assert_eq(f->seg_len[g], m->seg_len[g], "segment %zu: length %.17g vs %.17g", g, m->seg_len[g], f->seg_len[g]);
+    cr_assert_eq(f->sp->seg_spline[g], m->sp->seg_spline[g], "segment %zu: spline", g);
+    for (int t = 0; t < nl; t++) cr_assert_eq(f->seg_local[g * nl + t], m->seg_local[g * nl + t]);
+    for (int q = 0; m->grid && q < np; q++) {
+      double x0, y0, x1, y1;
+      float d0, d1;
+      lw_cellgrid_get(m->grid, (uint32_t)(g * np + q), &x0, &y0, &d0);
+      lw_cellgrid_get(f->grid, (uint32_t)(g * np + q), &x1, &y1, &d1);
+      cr_assert(x0 == x1 && y0 == y1 && d0 == d1, "segment %zu: pair sample %d differs", g, q);
+    }
+  }
+  for (size_t i = 0; i < m->sp->n_splines; i++) {
+    cr_assert_eq(f->spline_len[i], m->spline_len[i], "spline %zu: length", i);
+    cr_assert_eq(f->sp->first[i], m->sp->first[i]);
+  }
+  if (m->grid) {
+    cr_assert_eq(f->grid->n_samples, m->grid->n_samples);
+    /* every cell holds the same samples in the same order: the sums over it too */
+    for (size_t c = 0; c < lw_cellgrid_cells(m->grid); c++) {
+      cr_assert_eq(f->grid->cell[c].n, m->grid->cell[c].n, "cell %zu", c);
+      for (uint32_t k = 0; k < m->grid->cell[c].n; k++)
+        cr_assert_eq(lw_cell_idx(&f->grid->cell[c])[k], lw_cell_idx(&m->grid->cell[c])[k], "cell %zu", c);
+    }
+  }
+  lw_model_free(f);
+}
+
+/* The running total of m equals a recomputation within 1e-9. */
+static void total_is_full(const lw_model *m, const char *when)
+{
+  lw_error err = {0};
+  double term[LW_TERM_COUNT];
+  lw_splines *live = lw_splines_clone(m->sp);
+  cr_assert_not_null(live);
+  lw_splines_compact(live, m->slots->ghost);
+  double full = lw_energy_compute(m->scene, live, term, &err), run = lw_model_total(m);
+  lw_splines_free(live);
+  cr_assert(fabs(run - full) <= 1e-9 * fmax(fabs(full), 1.0), "%s: running %.17g, full %.17g", when, run, full);
+}
+
 /* Every term a splice touches on (segment, spline, pair with its near
 ** field, boundary, chemical both ways), births and deaths accepted often at
 ** a high temperature: the running terms equal a recomputation from scratch
@@ -266,47 +442,103 @@ Test(transdim, incremental_equals_full_with_births_and_deaths)
     cr_assert(c->stats[k].accepted > 200, "%s accepted only %lu of %lu", c->sys->type->move_names[k],
               c->stats[k].accepted, c->stats[k].proposed);
   /* the spliced caches and grid are what a model built afresh holds */
-  lw_error err = {0};
-  lw_model *f = lw_model_new(m->scene, lw_splines_clone(m->sp), &err);
-  cr_assert_not_null(f, "%s", err.msg);
-  cr_assert_eq(f->sp->n_segments, m->sp->n_segments);
-  const int np = m->scene->pair_quad.n, nl = m->scene->n_local;
-  for (size_t g = 0; g < m->sp->n_segments; g++) {
-    cr_assert_eq(f->seg_len[g], m->seg_len[g], "segment %zu: length %.17g vs %.17g", g, m->seg_len[g], f->seg_len[g]);
-    cr_assert_eq(f->sp->seg_spline[g], m->sp->seg_spline[g], "segment %zu: spline", g);
-    for (int t = 0; t < nl; t++) cr_assert_eq(f->seg_local[g * nl + t], m->seg_local[g * nl + t]);
-    for (int q = 0; q < np; q++) {
-      double x0, y0, x1, y1;
-      float d0, d1;
-      lw_cellgrid_get(m->grid, (uint32_t)(g * np + q), &x0, &y0, &d0);
-      lw_cellgrid_get(f->grid, (uint32_t)(g * np + q), &x1, &y1, &d1);
-      cr_assert(x0 == x1 && y0 == y1 && d0 == d1, "segment %zu: pair sample %d differs", g, q);
-    }
-  }
-  for (size_t i = 0; i < m->sp->n_splines; i++) {
-    cr_assert_eq(f->spline_len[i], m->spline_len[i], "spline %zu: length", i);
-    cr_assert_eq(f->sp->first[i], m->sp->first[i]);
-  }
-  cr_assert_eq(f->grid->n_samples, m->grid->n_samples);
+  same_as_fresh(m);
   cr_assert(checks > 10);
-  lw_model_free(f);
   td_chain_free(c, setup);
+}
+
+/* Storage (issue 18: a birth or a death must not cost O(N)): a death leaves
+** its slot as a ghost and moves no other spline, the next spline of its
+** segment count takes that slot, one of another count is appended; the
+** sweep's end compacts the ghosts away, keeping the order of the others,
+** into the model a fresh build gives.  Before the ghost slots every index
+** behind a death moved down. */
+Test(transdim, deaths_leave_ghosts_that_births_fill)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = 80;
+  p.height = 60;
+  p.segment_length = 4;
+  p.strain = 2;
+  p.bending = 0.5;
+  p.pair = 0.05;
+  p.pair_cutoff = 4;
+  p.boundary_coef = 0.1;
+  p.chem_spline = -3;
+  p.chem_length = 0.05;
+  p.fixed_count = 0;
+  lw_scene sc;
+  lw_test_scene(&sc, &p);
+  lw_model *m = lw_test_model_random(&sc, 20, 3, 4.0, 31);
+  lw_error err = {0};
+  lw_proposal *pr = lw_proposal_new(m, &err);
+  cr_assert_not_null(pr, "%s", err.msg);
+  lw_splines *before = lw_splines_clone(m->sp);
+  cr_assert_not_null(before);
+  /* a death of spline 5: 20 slots, 19 alive, nothing else moved */
+  lw_model_propose_splice(m, pr, 5, 1, NULL, 0, 0.0);
+  cr_assert_eq(lw_model_commit(m, pr), LW_OK);
+  cr_assert_eq(m->sp->n_splines, 20);
+  cr_assert_eq(lw_model_count(m), 19);
+  cr_assert(lw_model_ghost(m, 5) && !lw_model_ghost(m, 6));
+  cr_assert_eq(memcmp(m->sp->node, before->node, before->n_nodes * sizeof *before->node), 0);
+  total_is_full(m, "after a death");
+  /* a birth of 3 segments takes slot 5 */
+  lw_node nd[8];
+  for (int k = 0; k < 4; k++) nd[k] = (lw_node){30.0 + 3.0 * k, 20.0 + 0.5 * k, 1.0, 0.2};
+  lw_model_propose_splice(m, pr, 0, 0, nd, 4, 12.0);
+  cr_assert_eq(lw_model_commit(m, pr), LW_OK);
+  cr_assert_eq(m->sp->n_splines, 20);
+  cr_assert(!lw_model_ghost(m, 5));
+  cr_assert_eq(memcmp(&m->sp->node[m->sp->first[5]], nd, 4 * sizeof *nd), 0);
+  cr_assert_eq(m->sp->rest_length[5], 12.0);
+  total_is_full(m, "after a birth into a ghost");
+  /* spline 2 grows by a segment: its slot is left, the grown one appended */
+  memcpy(nd, &m->sp->node[m->sp->first[2]], 4 * sizeof *nd);
+  nd[4] = (lw_node){nd[3].px + 3.0, nd[3].py, 1.0, 0.0};
+  lw_model_propose_splice(m, pr, 2, 1, nd, 5, 16.0);
+  cr_assert_eq(lw_model_commit(m, pr), LW_OK);
+  cr_assert_eq(m->sp->n_splines, 21);
+  cr_assert(lw_model_ghost(m, 2));
+  cr_assert_eq(lw_splines_segments(m->sp, 20), 4);
+  total_is_full(m, "after a grow");
+  /* and two deaths, then the sweep's end */
+  for (uint32_t j = 11; j <= 12; j++) {
+    lw_model_propose_splice(m, pr, j, 1, NULL, 0, 0.0);
+    cr_assert_eq(lw_model_commit(m, pr), LW_OK);
+  }
+  cr_assert_eq(lw_model_count(m), 18);
+  lw_node first3 = m->sp->node[m->sp->first[3]], last = m->sp->node[m->sp->first[20]];
+  cr_assert_eq(lw_model_compact(m), LW_OK);
+  cr_assert_eq(m->sp->n_splines, 18);
+  /* the order of the others kept: old 3 is now 2, old 20 is now 17 */
+  cr_assert_eq(memcmp(&m->sp->node[m->sp->first[2]], &first3, sizeof first3), 0);
+  cr_assert_eq(memcmp(&m->sp->node[m->sp->first[17]], &last, sizeof last), 0);
+  total_is_full(m, "after the compaction");
+  same_as_fresh(m);
+  lw_splines_free(before);
+  lw_proposal_free(pr);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
 }
 
 /* A small scene with every kind of term a splice differences (segment,
 ** spline, pair with its near field, boundary, chemical) and the eight move
-** kinds, annealed cold enough that births, deaths, grows and shrinks all
-** happen; tempered with two replicas. */
+** kinds, warm enough and with trans-dimensional kinds often enough that
+** births, deaths, grows and shrinks happen by the dozen (several seeds gave
+** 6 to 60 of each kind), so that ghost slots are filled, left and
+** compacted many times; tempered with two replicas. */
 static const char *cli_scene = "[scene]\nwidth = 60\nheight = 50\nmargin = 2\nfield = waves\n"
                                "potential = radial\n"
                                "[init]\nsplines = 10\nsegments = 3\nsegment_length = 4\n"
                                "[energy]\nstrain = 2\nbending = 0.3\npotential = 0.3\nfield = -0.2\npair = 0.05\n"
-                               "pair_cutoff = 4\nboundary = 0.1\nchem_spline = -1\nchem_length = 0.02\n"
-                               "[moves]\nfixed_count = 0\nmax_segments = 6\nbirth = 0.05\ndeath = 0.05\n"
-                               "grow = 0.05\nshrink = 0.05\n"
-                               "[anneal]\nschedule = geometric\nt_start = 3\nt_end = 0.05\nsweeps = 60\nsteps = 6\n"
+                               "pair_cutoff = 4\nboundary = 0.1\nchem_spline = 0\nchem_length = 0.02\n"
+                               "[moves]\nfixed_count = 0\nmax_segments = 6\nbirth = 0.5\ndeath = 0.5\n"
+                               "grow = 0.3\nshrink = 0.3\n"
+                               "[anneal]\nschedule = geometric\nt_start = 3\nt_end = 0.5\nsweeps = 60\nsteps = 6\n"
                                "seed = 5\ncheck_every = 7\n"
-                               "[tempering]\nreplicas = 2\nt_min = 0.05\nt_max = 3\n";
+                               "[tempering]\nreplicas = 2\nt_min = 0.5\nt_max = 3\n";
 
 /* The number under key `kind` in the object `obj` of dir/a/summary.json,
 ** NAN if there is none. */

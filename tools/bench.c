@@ -51,6 +51,7 @@ void bench_order(bench_ctx *b);
 void bench_tone(bench_ctx *b);
 void bench_tone_accuracy(bench_ctx *b);
 void bench_quench(bench_ctx *b);
+void bench_splice(bench_ctx *b);
 
 /* ---- throughput and scaling ---------------------------------------------- */
 
@@ -662,6 +663,7 @@ static const bench_section sections[] = {
     {"particles", BENCH_PERFORMANCE, bench_particles},
     {"tone", BENCH_PERFORMANCE, bench_tone},
     {"nurbs", BENCH_PERFORMANCE, bench_nurbs},
+    {"splice", BENCH_PERFORMANCE, bench_splice},
     {"regularity", BENCH_ACCURACY, bench_regularity},
     {"quadrature", BENCH_ACCURACY, bench_quadrature},
     {"cutoff", BENCH_ACCURACY, bench_cutoff},

@@ -63,7 +63,7 @@ typedef struct {
   double z0;         /* 3-D: lower corner in z; 0 in 2-D */
   int nz;            /* cells along z: 1 in 2-D; cell (x, y, z) is (z ny + y) nx + x */
   int dim;           /* 2 or 3 */
-  size_t home_cap;   /* room in home (lw_cellgrid_splice grows it) */
+  size_t home_cap;   /* room in home (lw_cellgrid_reserve grows it) */
 } lw_cellgrid;
 
 /* A grid covering [x0, x0 + w] x [y0, y0 + h] with cells of side >= cell
@@ -81,16 +81,21 @@ void lw_cellgrid_free(lw_cellgrid *g);
 lw_cellgrid *lw_cellgrid_new_room(double x0, double y0, double w, double h, double cell,
                                   size_t n_samples, size_t room, lw_error *err);
 
-/* Renumbers the samples for a change of the index space: the samples
-** [from, from + n_old) leave the grid, those from from + n_old on take
-** index - n_old + n_new, and [from, from + n_new) is left free for
-** lw_cellgrid_insert; n_samples changes by n_new - n_old.  A pass over
-** every cell, O(samples) memory traffic and no search; cells stay sorted
-** (the renumbering is monotone).  LW_ENOMEM (home could not grow) leaves
-** the grid as it was. */
-lw_status lw_cellgrid_splice(lw_cellgrid *g, size_t from, size_t n_old, size_t n_new);
+/* Counts n more sample indices at the end, free for lw_cellgrid_insert
+** (after lw_cellgrid_reserve for them). */
+void lw_cellgrid_extend(lw_cellgrid *g, size_t n);
 
-/* Room in home for n samples, so that a splice up to n cannot fail. */
+/* Renumbers the samples in groups of `per` (a segment's pair samples):
+** group k becomes group to[k] for the groups in the grid, to increasing
+** over them and to[k] <= k (a compaction: cells stay sorted, one pass over
+** every cell); n_samples becomes n.  to[k] = UINT32_MAX for the groups
+** with no samples in the grid. */
+void lw_cellgrid_renumber(lw_cellgrid *g, const uint32_t *to, uint32_t per, size_t n);
+
+/* Takes sample i (in the grid) out of it; its index stays counted. */
+void lw_cellgrid_remove(lw_cellgrid *g, uint32_t i);
+
+/* Room in home for n samples, so that an extension up to n cannot fail. */
 lw_status lw_cellgrid_reserve(lw_cellgrid *g, size_t n);
 
 /* The cell holding (x, y) after clamping. */

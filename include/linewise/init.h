@@ -26,6 +26,18 @@
 lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double segment_length,
                            gsl_rng *rng, lw_error *err);
 
+/* The picture's darkness (1 - tone) summed per row and cumulated, for
+** lw_init_dark_point: cum[j] sums the rows before j, cum[height] is the
+** total.  Malloc'ed; NULL without a picture or memory. */
+double *lw_init_darkness(const lw_image *img);
+
+/* A point drawn as placement draws a centre (sc's image_place, cum from
+** lw_init_darkness, total > 0): a pixel with probability proportional to
+** its darkness, then uniformly inside it.  Its density is therefore
+** (1 - tone of its pixel) / (cum[height] pixel^2) per mm^2. */
+void lw_init_dark_point(const lw_scene *sc, const lw_image *img, const double *cum, gsl_rng *rng, double *x,
+                        double *y);
+
 /* Integral of darkness over the inside of the boundary, mm^2: sum over the
 ** picture's pixels whose centre is inside of (1 - tone) * pixel area, or,
 ** without a picture, the inside's area. */

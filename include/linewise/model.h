@@ -45,6 +45,7 @@
 #include "linewise/grid.h"
 #include "linewise/pair.h"
 #include "linewise/scene.h"
+#include "linewise/slots.h"
 #include "linewise/spline.h"
 #include "linewise/tone.h"
 #include "linewise/walk.h"
@@ -88,7 +89,27 @@ typedef struct {
   size_t max_segments;      /* longest spline, for sizing proposals (with trans-dimensional
                               moves at least scene->max_segments) */
   size_t cap_seg, cap_spl;  /* room in the per-segment and per-spline caches (splices) */
+  lw_slots *slots;          /* the ghosts that splices leave (slots.h); none between sweeps */
 } lw_model;
+
+/* Splines alive: those of m->sp less the ghosts. */
+static inline size_t lw_model_count(const lw_model *m)
+{
+  return m->sp->n_splines - (m->slots ? m->slots->n_ghost : 0);
+}
+
+/* 1 if spline slot i is a ghost (slots.h): no proposal touches it. */
+static inline int lw_model_ghost(const lw_model *m, size_t i)
+{
+  return lw_slots_ghost(m->slots, i);
+}
+
+/* Removes the ghosts: the live splines keep their order and are numbered
+** 0 .. N-1, with their caches and pair samples (one pass over the arrays
+** and the grid's cells; every cached value stays what a fresh computation
+** gives, the renumbering being monotone).  Nothing to do without ghosts.
+** LW_ENOMEM (the segment map) leaves the model as it was. */
+lw_status lw_model_compact(lw_model *m);
 
 /* Builds the caches for sp (ownership passes to the model, also on failure). */
 lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err);
@@ -97,7 +118,8 @@ void lw_model_free(lw_model *m);
 /* The sum of the running terms; +inf while a segment is irregular. */
 double lw_model_total(const lw_model *m);
 
-/* Recomputes every cache and total from the state.  If drift is not NULL it
+/* Recomputes every cache and total from the state (after compacting its
+** ghosts away).  If drift is not NULL it
 ** receives the relative difference between the old running total and the
 ** new one, |new - old| / max(|new|, 1). */
 lw_status lw_model_refresh(lw_model *m, double *drift);
@@ -164,7 +186,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
 
 /*
 ** Trans-dimensional proposals: replaces spline `at` (remove = 1) or inserts
-** a spline at index `at` <= n_splines (remove = 0) by the n_new nodes
+** a spline (remove = 0; `at` is not read) by the n_new nodes
 ** `nodes` (NULL: already in p->node) with rest length `rest`, or by nothing
 ** (n_new = 0, remove = 1: a death).  The new spline has n_new - 1 <=
 ** m->max_segments segments.  dE is the new spline's energy less the old
@@ -173,7 +195,9 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
 ** old spline's samples left out), its raster changes; forbidden and
 ** crowded as for lw_model_propose.  Birth, death, grow and shrink are all
 ** this one operation (sys_splines.c draws them, transdim.h has the
-** proposal densities).
+** proposal densities).  The commit leaves the replaced spline as a ghost
+** and puts the new one into a ghost slot of its segment count, or at the
+** end if there is none (slots.h): O(their segments), nothing else moves.
 */
 void lw_model_propose_splice(const lw_model *m, lw_proposal *p, uint32_t at, int remove, const lw_node *nodes,
                              size_t n_new, double rest);

@@ -126,6 +126,7 @@ typedef struct {
   int tune_sweeps;            /* tuning sweeps at the start of each temperature */
   int fixed_count;            /* 1: no trans-dimensional moves (the count stays as placed) */
   double mix_birth, mix_death, mix_grow, mix_shrink; /* relative frequencies (fixed_count = 0) */
+  double birth_uniform;       /* share of births placed uniformly rather than by darkness */
   int max_segments;           /* grow never makes a spline longer than this, segments */
   /* [anneal] */
   char schedule[64];          /* a name from the schedule table */

@@ -32,7 +32,7 @@ typedef struct {
   size_t *first;          /* n_splines + 1 node offsets; first[n_splines] = n_nodes */
   uint32_t *seg_spline;   /* n_segments: the spline of each segment */
   double *rest_length;    /* n_splines: L0, mm (> 0) */
-  size_t cap_nodes;       /* room in node and seg_spline (lw_splines_splice grows it) */
+  size_t cap_nodes;       /* room in node and seg_spline (lw_splines_append grows it) */
   size_t cap_splines;     /* room in rest_length, and first (plus one) */
 } lw_splines;
 
@@ -50,14 +50,15 @@ lw_splines *lw_splines_clone(const lw_splines *sp);
 ** LW_ENOMEM leaves sp as it was. */
 lw_status lw_splines_permute(lw_splines *sp, const size_t *order, lw_error *err);
 
-/* Replaces `remove` (0 or 1) splines at index `at` by one spline of the
-** n_new nodes `nodes` and rest length `rest` (n_new >= 2), or by none
-** (n_new = 0): a removal, an insertion (remove = 0) or a new shape of
-** spline `at`.  Later splines keep their order, their indices move by the
-** change of count, and their nodes and segments by the change of nodes:
-** memmoves of the arrays behind, no allocation but amortised growth
-** (trans-dimensional moves, model.h).  LW_ENOMEM leaves sp as it was. */
-lw_status lw_splines_splice(lw_splines *sp, size_t at, int remove, const lw_node *nodes, size_t n_new, double rest);
+/* Appends a spline of the n_new >= 2 nodes `nodes` and rest length `rest`:
+** amortised O(n_new) (trans-dimensional moves, model.h and slots.h).
+** LW_ENOMEM leaves sp as it was. */
+lw_status lw_splines_append(lw_splines *sp, const lw_node *nodes, size_t n_new, double rest);
+
+/* Removes the splines i with dead[i] != 0, in place: the others keep their
+** order and move down over the holes (the ghost slots of trans-dimensional
+** storage, slots.h).  O(nodes), no allocation. */
+void lw_splines_compact(lw_splines *sp, const unsigned char *dead);
 
 static inline size_t lw_splines_segments(const lw_splines *sp, size_t i)
 {

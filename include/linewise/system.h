@@ -134,6 +134,11 @@ struct lw_system_type {
   ** every anneal.check_every sweeps, right before refresh, which rebuilds
   ** the caches; the running energies are unchanged by it. */
   lw_status (*renumber)(void *state, lw_error *err);
+  /* Optional (NULL: nothing to do): called at the end of every sweep
+  ** (lw_chain_sweep), before anything else reads the state; for splines
+  ** with trans-dimensional moves it compacts the ghost slots away
+  ** (slots.h).  LW_ENOMEM stops the run. */
+  lw_status (*sweep_end)(void *state);
 
   /* Energies: the running total (+inf in a forbidden state), the running
   ** value of each term (n_terms values, 0 when off), whether term t is on

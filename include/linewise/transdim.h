@@ -22,7 +22,13 @@
 ** drawing would be without its energy: lines along the field.
 **
 ** Proposals (each node from the last, "along the field"):
-**   birth  p_0 uniform on the page; v_0 = (l/3) u + N(0, s_v^2) with u the
+**   birth  p_0 from pi: with a picture (scene.image, not white) the mixture
+**          pi(p) = b / (W H) + (1 - b) d(p) / (D a^2), b =
+**          moves.birth_uniform, d(p) = 1 - tone of p's pixel, D the sum of
+**          d over the pixels, a the pixel side: a uniform point on the page
+**          with probability b, else a point drawn as placement draws a
+**          centre (lw_init_dark_point); without one pi = 1 / (W H);
+**          v_0 = (l/3) u + N(0, s_v^2) with u the
 **          field's direction at p_0 either way (probability 1/2 each), or,
 **          where there is no field, a uniform direction (v_0 then has the
 **          density of a Gaussian ring, with a Bessel I0); then node k+1
@@ -46,19 +52,26 @@
 
 typedef struct {
   const lw_scene *scene;
+  double *cum;            /* the picture's cumulated row darkness (lw_init_darkness; owned),
+                             NULL without a picture or for a white one: pi uniform */
+  double uniform;         /* b: the share of uniform first points with a picture */
+  double dark_scale;      /* (1 - b) / (D a^2), 1 / mm^2 */
   double length;          /* l: mm */
   double sigma_p, sigma_v; /* mm */
   size_t birth_segments;  /* segments of a born spline */
   size_t max_segments;    /* grow stops here */
 } lw_td;
 
-void lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double length, size_t max_segments);
+/* LW_ENOMEM if the picture's darkness table cannot be had. */
+lw_status lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double length, size_t max_segments,
+                     double uniform);
+void lw_td_clear(lw_td *td);
 
 /* log q_{n-1} of the n >= 1 nodes nd (-inf when node 0 is off the page). */
 double lw_td_prior(const lw_td *td, const lw_node *nd, size_t n);
 
-/* log of node 0's factor of the prior: p uniform on the page, v as a
-** birth draws it. */
+/* log of node 0's factor of the prior: log pi(p) + log of v's density as
+** a birth draws it. */
 double lw_td_first_log(const lw_td *td, const lw_node *n0);
 
 /* The change of log q when node k of the n nodes nd becomes *to. */
@@ -66,6 +79,20 @@ double lw_td_prior_change(const lw_td *td, const lw_node *nd, size_t n, size_t k
 
 /* Draws a born spline of birth_segments + 1 nodes into nd from the prior. */
 void lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd);
+
+/* The rest length of a spline of n_old segments and rest length `rest`
+** after a grow or shrink to n_new: n_new l plus the spline's own excess
+** rest - n_old l, so that a grow undone by a shrink gives the rest length
+** back whatever it was (loaded splines may have any), exactly when the
+** excess is 0 (births: n l).  NAN if it would not be positive: the move is
+** refused, and its reverse, from a rest length that is not positive,
+** cannot happen either. */
+double lw_td_rest(const lw_td *td, double rest, size_t n_old, size_t n_new);
+
+/* 1 if a death may remove a spline of n segments and rest length `rest`:
+** a birth could have made it (birth_segments segments, rest length
+** birth_segments l exactly); the reverse density is 0 for the others. */
+int lw_td_mortal(const lw_td *td, size_t n, double rest);
 
 /* Draws the node beyond `end` (dir +1: after it, -1: before it) into out;
 ** returns log g.  lw_td_next_log: log g of a given node. */
