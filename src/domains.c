@@ -260,6 +260,7 @@ lw_status lw_domains_sweep(lw_domains *d, lw_chain *c)
     int failed = 0;
     size_t work = 0;
     for (int a = 0; a < n_act; a++) work += d->start[d->active[a] + 1] - d->start[d->active[a]];
+    (void)work; /* read only by the pragma, which a build without OpenMP drops */
     /* Cells of one phase touch disjoint data (domains.h): any thread may
     ** run any cell, in any order. */
 #pragma omp parallel for schedule(dynamic, 1) reduction(| : failed) num_threads(d->threads) \
