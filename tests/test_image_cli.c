@@ -157,17 +157,6 @@ Test(image_cli, a_missing_picture_is_named_with_the_scene_directory_once)
   cr_assert_null(strstr(errs, "sub/sub/"), "%s", errs);
 }
 
-static char *read_all(const char *path)
-{
-  FILE *f = fopen(path, "r");
-  cr_assert_not_null(f, "%s", path);
-  static char buf[1 << 16];
-  size_t n = fread(buf, 1, sizeof buf - 1, f);
-  buf[n] = '\0';
-  fclose(f);
-  return buf;
-}
-
 /* The plot report and both fidelity scores, per pen too, reach
 ** summary.json and stderr; crop = 0 reports no rectangle. */
 Test(image_cli, the_plot_and_fidelity_reports)
@@ -179,7 +168,7 @@ Test(image_cli, the_plot_and_fidelity_reports)
   cr_assert(strstr(errs, "linewise: plot time about "), "%s", errs);
   cr_assert(strstr(errs, " lifts)\n"), "%s", errs);
   cr_assert(strstr(errs, ", orientation "), "%s", errs);
-  const char *js = read_all(lw_test_path("out/summary.json"));
+  const char *js = lw_test_read_text(lw_test_path("out/summary.json"));
   const char *want[] = {"\"plot\": {", "\"lifts\": {", "\"joins\": ", "\"cut\": ", "\"outside\": ",
                         "\"dropped\": ", "\"crop_mm\": [", "\"pen_down_mm\": ", "\"pen_up_mm\": ",
                         "\"time_s\": ", "\"orientation\": ", "\"pens\": ["};
@@ -189,7 +178,7 @@ Test(image_cli, the_plot_and_fidelity_reports)
   for (const char *c = js; (c = strstr(c, "\"orientation\": ")); c++) n++;
   cr_assert_eq(n, 3, "%s", js);
   cr_assert_eq(run("run scene.ini --out out2 --set plot.crop=0", errs, sizeof errs), 0, "%s", errs);
-  js = read_all(lw_test_path("out2/summary.json"));
+  js = lw_test_read_text(lw_test_path("out2/summary.json"));
   cr_assert(strstr(js, "\"crop_mm\": null"), "%s", js);
   cr_assert_null(strstr(js, "\"pens\""), "%s", js);
 }

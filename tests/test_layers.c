@@ -523,17 +523,6 @@ static const char colour_scene[] =
   "[anneal]\nsweeps = 3\nsteps = 1\n[plot]\nmin_length = 0\n"
   "[layers]\nnames = c m y k\nsource = cmyk\npen_width = 0.3 0.3 0.3 0.5\n";
 
-static char *slurp(const char *path)
-{
-  FILE *f = fopen(path, "rb");
-  cr_assert_not_null(f, "%s", path);
-  static char buf[1 << 20];
-  size_t n = fread(buf, 1, sizeof buf - 1, f);
-  buf[n] = '\0';
-  fclose(f);
-  return buf;
-}
-
 Test(layers, the_svg_has_one_group_a_pen_with_its_colour_and_width)
 {
   write_colour_png(lw_test_path("colour.png"), 32, 32, blotch_colours);
@@ -542,7 +531,7 @@ Test(layers, the_svg_has_one_group_a_pen_with_its_colour_and_width)
   cr_assert_eq(run("run scene.ini --out out --quiet", errs, sizeof errs), 0, "%s", errs);
   char path[512];
   snprintf(path, sizeof path, "%s", lw_test_path("out/final.svg"));
-  const char *svg = slurp(path);
+  const char *svg = lw_test_read_text(path);
   static const char *const colour[4] = {"#00ffff", "#ff00ff", "#ffff00", "#000000"};
   static const char *const width[4] = {"0.3", "0.3", "0.3", "0.5"};
   int groups = 0;
@@ -566,7 +555,7 @@ Test(layers, the_svg_has_one_group_a_pen_with_its_colour_and_width)
     if (k < 3) cr_assert(paths > 0, "pen %d draws", k + 1);
   }
   snprintf(path, sizeof path, "%s", lw_test_path("out/summary.json"));
-  const char *js = slurp(path);
+  const char *js = lw_test_read_text(path);
   const char *pens = strstr(js, "\"pens\"");
   cr_assert_not_null(pens, "fidelity per layer");
   int n = 0;

@@ -393,6 +393,23 @@ static void total_is_full(const lw_model *m, const char *when)
   cr_assert(fabs(run - full) <= 1e-9 * fmax(fabs(full), 1.0), "%s: running %.17g, full %.17g", when, run, full);
 }
 
+/* The scene of the splice tests: every term a splice touches on (segment,
+** spline, pair with its near field, boundary, chemical both ways). */
+static void splice_scene(lw_params *p)
+{
+  lw_params_defaults(p);
+  p->width = 80;
+  p->height = 60;
+  p->segment_length = 4;
+  p->strain = 2;
+  p->bending = 0.5;
+  p->pair = 0.05;
+  p->pair_cutoff = 4;
+  p->boundary_coef = 0.1;
+  p->chem_spline = -3;
+  p->chem_length = 0.05;
+}
+
 /* Every term a splice touches on (segment, spline, pair with its near
 ** field, boundary, chemical both ways), births and deaths accepted often at
 ** a high temperature: the running terms equal a recomputation from scratch
@@ -401,19 +418,9 @@ static void total_is_full(const lw_model *m, const char *when)
 Test(transdim, incremental_equals_full_with_births_and_deaths)
 {
   lw_params p;
-  lw_params_defaults(&p);
-  p.width = 80;
-  p.height = 60;
+  splice_scene(&p);
   p.splines = 12;
   p.segments = 3;
-  p.segment_length = 4;
-  p.strain = 2;
-  p.bending = 0.5;
-  p.pair = 0.05;
-  p.pair_cutoff = 4;
-  p.boundary_coef = 0.1;
-  p.chem_spline = -3;
-  p.chem_length = 0.05;
   p.max_segments = 6;
   p.mix_birth = p.mix_death = 0.3;
   p.mix_grow = p.mix_shrink = 0.3;
@@ -456,17 +463,7 @@ Test(transdim, incremental_equals_full_with_births_and_deaths)
 Test(transdim, deaths_leave_ghosts_that_births_fill)
 {
   lw_params p;
-  lw_params_defaults(&p);
-  p.width = 80;
-  p.height = 60;
-  p.segment_length = 4;
-  p.strain = 2;
-  p.bending = 0.5;
-  p.pair = 0.05;
-  p.pair_cutoff = 4;
-  p.boundary_coef = 0.1;
-  p.chem_spline = -3;
-  p.chem_length = 0.05;
+  splice_scene(&p);
   p.fixed_count = 0;
   lw_scene sc;
   lw_test_scene(&sc, &p);

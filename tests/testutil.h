@@ -160,6 +160,19 @@ static inline int lw_test_sh(const char *fmt, ...)
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+/* The text of the file at path, in a static buffer of 1 MiB (cut there): one
+** file at a time, valid until the next call. */
+static inline char *lw_test_read_text(const char *path)
+{
+  static char buf[1 << 20];
+  FILE *f = fopen(path, "rb");
+  cr_assert_not_null(f, "%s", path);
+  size_t n = fread(buf, 1, sizeof buf - 1, f);
+  buf[n] = '\0';
+  fclose(f);
+  return buf;
+}
+
 /* dir/name holds text afterwards (a scene file); 0 on success. */
 static inline int lw_test_write_text(const char *dir, const char *name, const char *text)
 {
