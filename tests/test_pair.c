@@ -817,3 +817,40 @@ Test(pair, exact_integral_is_never_negative)
   cr_log_info("adversarial segment pairs: worst relative error %.1e", worst);
   lw_splines_free(sp);
 }
+
+/* The near field's Gauss-Legendre tables (pairnear.c) are written out in
+** full, as the kernel wants them constant; each node and weight must be
+** the rule's to the last few bits.  The reference is Newton on the Legendre
+** recurrence in long double, not GSL: gsl_integration_glfixed computes the
+** orders it does not tabulate in double, and its 48-node weights are off by
+** up to 1.3e-12.  One mistyped digit (a node off by 1e-10 makes a whole-
+** square rule err by about that, far under what the accuracy tests resolve)
+** fails here. */
+static void assert_gauss_table(const double *s, const double *w, int m)
+{
+  for (int i = 0; i < m; i++) {
+    /* the i-th root from the top, then its weight on [0, 1] */
+    long double x = cosl(3.14159265358979323846264L * (i + 0.75L) / (m + 0.5L)), p0 = 0, p1 = 0, dp = 0;
+    for (int it = 0; it < 8; it++) {
+      p0 = 1;
+      p1 = x;
+      for (int k = 2; k <= m; k++) {
+        long double p2 = ((2 * k - 1) * x * p1 - (k - 1) * p0) / k;
+        p0 = p1;
+        p1 = p2;
+      }
+      dp = m * (x * p1 - p0) / (x * x - 1);
+      if (it < 7) x -= p1 / dp;
+    }
+    double node = (double)((1 - x) / 2), weight = (double)(1 / ((1 - x * x) * dp * dp));
+    cr_assert(fabs(s[i] - node) <= 2 * DBL_EPSILON && fabs(w[i] - weight) <= 4 * DBL_EPSILON * weight,
+              "%d-node rule, node %d: (%.17g, %.17g), expected (%.17g, %.17g)", m, i, s[i], w[i], node, weight);
+  }
+}
+
+Test(pair, near_field_gauss_tables_are_exact)
+{
+  const lw_pairnear_consts *k = &lw_pairnear_k;
+  assert_gauss_table(k->g6_s, k->g6_w, k->g6_n);
+  for (int r = 0; r < k->n_whole; r++) assert_gauss_table(k->whole_s[r], k->whole_w[r], k->whole_m[r]);
+}
