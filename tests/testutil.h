@@ -259,4 +259,53 @@ static inline lw_model *lw_test_model_random(const lw_scene *sc, size_t n, size_
   return m;
 }
 
+/* Random moves of every kind (one point, one vector, a whole spline; steps
+** of sd, stream seeded with seed) on model m of scene sc: each term's local
+** difference against a recomputation from scratch within 1e-9, and after
+** the accepted half of them (every odd trial is committed) the model's
+** running terms and total.  Returns how many moves had a finite energy
+** (a move off the frame is +inf either way and is skipped). */
+static inline int lw_test_moves_match_full(const lw_scene *sc, lw_model *m, int trials, double sd,
+                                           unsigned long seed)
+{
+  lw_proposal *pr = lw_proposal_new(m, NULL);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, seed);
+  double term0[LW_TERM_COUNT], term1[LW_TERM_COUNT];
+  double e0 = lw_energy_compute(sc, m->sp, term0, NULL);
+  lw_node *nd = malloc(m->sp->n_nodes * sizeof *nd);
+  cr_assert_not_null(nd);
+  int checked = 0;
+  for (int trial = 0; trial < trials; trial++) {
+    uint32_t i;
+    size_t node0, n_node;
+    lw_test_random_move(m->sp, r, trial % 3, sd, nd, &i, &node0, &n_node);
+    lw_model_propose(m, pr, i, node0, n_node, nd);
+    lw_splines *moved = lw_splines_clone(m->sp);
+    memcpy(&moved->node[moved->first[i] + node0], nd, n_node * sizeof *nd);
+    double e1 = lw_energy_compute(sc, moved, term1, NULL);
+    lw_splines_free(moved);
+    if (!isfinite(e1) || !isfinite(pr->dE)) continue;
+    checked++;
+    for (int t = 0; t < LW_TERM_COUNT; t++)
+      cr_assert(fabs(pr->dterm[t] - (term1[t] - term0[t])) <= 1e-9 * fmax(fabs(term0[t]), 1e-3),
+                "trial %d term %s: local %.17g, full %.17g", trial, lw_term_names[t], pr->dterm[t],
+                term1[t] - term0[t]);
+    cr_assert(fabs(pr->dE - (e1 - e0)) <= 1e-9 * fmax(fabs(e0), 1.0), "trial %d: dE %.17g, full %.17g", trial,
+              pr->dE, e1 - e0);
+    if (trial % 2) {
+      cr_assert_eq(lw_model_commit(m, pr), LW_OK);
+      e0 = e1;
+      memcpy(term0, term1, sizeof term0);
+    }
+  }
+  for (int t = 0; t < LW_TERM_COUNT; t++)
+    cr_assert(fabs(m->term[t] - term0[t]) <= 1e-9 * fmax(fabs(term0[t]), 1e-3), "%s", lw_term_names[t]);
+  cr_assert(fabs(lw_model_total(m) - e0) <= 1e-9 * fmax(fabs(e0), 1.0));
+  free(nd);
+  gsl_rng_free(r);
+  lw_proposal_free(pr);
+  return checked;
+}
+
 #endif
