@@ -366,6 +366,83 @@ static lw_status bmp_complete(const unsigned char *d, size_t n, const char *name
   return LW_OK;
 }
 
+static uint32_t tiff32(const unsigned char *p, int be)
+{
+  return be ? (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3] : le32(p);
+}
+
+/*
+** The EXIF orientation of a JPEG (1 to 8; 1 when there is none or it cannot
+** be read): a camera stores the sensor's rows and says in IFD0's tag 0x0112
+** how to turn them for display, so a phone's portrait photograph is stored
+** on its side.  The markers before the first scan are walked to an APP1
+** segment "Exif\0\0", whose TIFF header gives the byte order and IFD0.
+** Every offset is checked against the segment: a bad one means "none".
+*/
+static int jpeg_orientation(const unsigned char *d, size_t n)
+{
+  if (n < 4 || d[0] != 0xFF || d[1] != 0xD8) return 1;
+  size_t at = 2;
+  while (at + 4 <= n && d[at] == 0xFF) {
+    unsigned marker = d[at + 1];
+    size_t len = (size_t)d[at + 2] << 8 | d[at + 3];
+    if (marker == 0xDA || marker == 0xD9 || len < 2 || at + 2 + len > n) break;
+    const unsigned char *seg = d + at + 4;
+    size_t sn = len - 2;
+    if (marker == 0xE1 && sn >= 14 && !memcmp(seg, "Exif\0\0", 6)) {
+      const unsigned char *t = seg + 6;
+      size_t tn = sn - 6;
+      int be = t[0] == 'M' && t[1] == 'M';
+      if (!be && !(t[0] == 'I' && t[1] == 'I')) return 1;
+      uint32_t ifd = tiff32(t + 4, be);
+      if (ifd > tn || tn - ifd < 2) return 1;
+      unsigned count = be ? (unsigned)t[ifd] << 8 | t[ifd + 1] : (unsigned)t[ifd] | (unsigned)t[ifd + 1] << 8;
+      for (unsigned e = 0; e < count && (size_t)ifd + 2 + 12 * ((size_t)e + 1) <= tn; e++) {
+        const unsigned char *q = t + ifd + 2 + 12 * e;
+        unsigned tag = be ? (unsigned)q[0] << 8 | q[1] : (unsigned)q[0] | (unsigned)q[1] << 8;
+        if (tag != 0x0112) continue;
+        unsigned v = be ? (unsigned)q[8] << 8 | q[9] : (unsigned)q[8] | (unsigned)q[9] << 8;
+        return v >= 1 && v <= 8 ? (int)v : 1;
+      }
+      return 1;
+    }
+    at += 2 + len;
+  }
+  return 1;
+}
+
+/* The raster of dec turned for display by EXIF orientation o (2 to 8): a
+** copy the decoder owns, w and h swapped for the quarter turns (5 to 8).
+** Displayed pixel (X, Y) comes from stored pixel (x, y) as the EXIF table
+** says: 2 mirrors, 3 turns half round, 4 flips, 5 transposes, 6 turns a
+** quarter clockwise, 7 transposes across the other diagonal, 8 turns a
+** quarter anticlockwise. */
+static lw_status decoded_orient(decoded *dec, int o, const char *name, lw_error *err)
+{
+  const int w = dec->w, h = dec->h, turn = o >= 5, W = turn ? h : w, H = turn ? w : h;
+  const size_t px = (size_t)dec->ch * (size_t)(dec->bits / 8);
+  unsigned char *out = malloc((size_t)w * (size_t)h * px);
+  if (!out) return lw_error_set(err, LW_ENOMEM, "%s: out of memory turning the image upright", name);
+  const unsigned char *in = dec->pix;
+  for (int Y = 0; Y < H; Y++)
+    for (int X = 0; X < W; X++) {
+      int x, y;
+      switch (o) {
+      case 2: x = w - 1 - X, y = Y; break;
+      case 3: x = w - 1 - X, y = h - 1 - Y; break;
+      case 4: x = X, y = h - 1 - Y; break;
+      case 5: x = Y, y = X; break;
+      case 6: x = Y, y = h - 1 - X; break;
+      case 7: x = w - 1 - Y, y = h - 1 - X; break;
+      default: x = w - 1 - Y, y = X; break; /* 8 */
+      }
+      memcpy(out + ((size_t)Y * (size_t)W + (size_t)X) * px, in + ((size_t)y * (size_t)w + (size_t)x) * px, px);
+    }
+  decoded_free(dec);
+  *dec = (decoded){out, out, 0, W, H, dec->ch, dec->bits};
+  return LW_OK;
+}
+
 static lw_status stb_decode(const unsigned char *data, size_t size, const char *name, decoded *out, lw_error *err)
 {
   if (size > INT_MAX)
@@ -384,7 +461,9 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
                          : (void *)stbi_load_from_memory(data, (int)size, &w, &h, &ch, 0);
   if (!pix) return lw_error_set(err, LW_EINPUT, "%s: cannot decode the image: %s", name, stbi_failure_reason());
   *out = (decoded){pix, pix, 1, w, h, ch, bits};
-  return LW_OK;
+  int o = jpeg_orientation(data, size);
+  if (o != 1 && (st = decoded_orient(out, o, name, err)) != LW_OK) decoded_free(out);
+  return st;
 }
 
 lw_image *lw_image_decode(const unsigned char *data, size_t size, const char *name,
@@ -514,6 +593,8 @@ lw_status lw_image_probe(const char *path, lw_image_info *info, lw_error *err)
     if (size == 0 || size > INT_MAX || !stbi_info_from_memory(data, (int)size, &iw, &ih, &ch))
       st = lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, BMP, PGM/PPM): %s", path,
                         size == 0 ? "empty file" : stbi_failure_reason());
+    else if (jpeg_orientation(data, size) >= 5) /* stored on its side */
+      *info = (lw_image_info){ih, iw, ch, 8};
     else
       *info = (lw_image_info){iw, ih, ch, stbi_is_16_bit_from_memory(data, (int)size) ? 16 : 8};
   }

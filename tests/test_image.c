@@ -309,3 +309,125 @@ Test(image, fit_centres_and_keeps_the_aspect_ratio)
   cr_assert(lw_image_tone_at(img, &q, 15, 25.1) == 1.0);
   lw_image_free(img);
 }
+
+/* ---- EXIF orientation ------------------------------------------------------ */
+
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#define STBI_WRITE_NO_STDIO
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#endif
+#include <stb/stb_image_write.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+
+typedef struct {
+  unsigned char b[8192];
+  size_t n;
+} jpeg_buf;
+
+static void jpeg_put(void *ctx, void *data, int size)
+{
+  jpeg_buf *j = ctx;
+  cr_assert(j->n + (size_t)size <= sizeof j->b);
+  memcpy(j->b + j->n, data, (size_t)size);
+  j->n += (size_t)size;
+}
+
+/* A 32 x 16 JPEG, light with a dark 8 x 8 block in its stored top-left
+** corner, and an APP1 "Exif" segment with orientation o (0: none) in big-
+** or little-endian TIFF order right after SOI; bad_ifd points IFD0 past
+** the segment. */
+static size_t exif_jpeg(unsigned char *out, int o, int big_endian, int bad_ifd)
+{
+  unsigned char px[32 * 16];
+  for (int y = 0; y < 16; y++)
+    for (int x = 0; x < 32; x++) px[y * 32 + x] = x < 8 && y < 8 ? 20 : 230;
+  jpeg_buf j = {.n = 0};
+  cr_assert(stbi_write_jpg_to_func(jpeg_put, &j, 32, 16, 1, px, 100));
+  unsigned char app[36] = {0xFF, 0xE1, 0, 34, 'E', 'x', 'i', 'f', 0, 0};
+  unsigned char *t = app + 10;
+  if (big_endian) {
+    const unsigned char tiff[] = {'M', 'M', 0, 42, 0, 0, 0, 8, 0, 1, 0x01, 0x12, 0, 3, 0, 0, 0, 1, 0, (unsigned char)o, 0, 0};
+    memcpy(t, tiff, sizeof tiff);
+    if (bad_ifd) t[7] = 200;
+  } else {
+    const unsigned char tiff[] = {'I', 'I', 42, 0, 8, 0, 0, 0, 1, 0, 0x12, 0x01, 3, 0, 1, 0, 0, 0, (unsigned char)o, 0, 0, 0};
+    memcpy(t, tiff, sizeof tiff);
+    if (bad_ifd) t[4] = 200;
+  }
+  memcpy(out, j.b, 2);
+  size_t n = 2;
+  if (o) {
+    memcpy(out + n, app, sizeof app);
+    n += sizeof app;
+  }
+  memcpy(out + n, j.b + 2, j.n - 2);
+  return n + j.n - 2;
+}
+
+/* Which corner of img holds the dark block: 0 top-left, 1 top-right,
+** 2 bottom-right, 3 bottom-left; -1 unless exactly one 8 x 8 corner is dark. */
+static int dark_corner(const lw_image *img)
+{
+  int found = -1, dark = 0;
+  for (int c = 0; c < 4; c++) {
+    int x0 = c == 1 || c == 2 ? img->width - 8 : 0, y0 = c >= 2 ? img->height - 8 : 0;
+    double s = 0;
+    for (int y = y0; y < y0 + 8; y++)
+      for (int x = x0; x < x0 + 8; x++) s += img->tone[(size_t)y * (size_t)img->width + (size_t)x];
+    if (s / 64 < 0.3) found = c, dark++;
+  }
+  return dark == 1 ? found : -1;
+}
+
+/* A camera stores its rows as the sensor reads them and says in EXIF how
+** to turn them; each of the eight orientations is a distinct pair of
+** (upright size, corner the stored top-left lands in), from the EXIF
+** table: 2 mirror, 3 half turn, 4 flip, 5 mirror then a quarter turn
+** anticlockwise (a transpose), 6 a quarter turn clockwise, 7 mirror then a
+** quarter turn clockwise, 8 a quarter turn anticlockwise.  Ignoring the tag
+** (the old decoder) fails every orientation but 1; a broken IFD offset
+** means "as stored", not an error.  lw_image_probe, which sizes the page
+** of scene.orientation = auto, reports the upright size too. */
+Test(image, jpeg_exif_orientation_is_turned_upright)
+{
+  static const int corner[9] = {0, 0, 1, 2, 3, 0, 1, 2, 3};
+  unsigned char jpg[8300];
+  lw_error err;
+  for (int o = 0; o <= 8; o++)
+    for (int be = 0; be < 2; be++) {
+      size_t n = exif_jpeg(jpg, o, be, 0);
+      lw_image_info info;
+      lw_image *img = lw_image_decode(jpg, n, "t.jpg", 1e6, &info, &err);
+      cr_assert_not_null(img, "orientation %d: %s", o, err.msg);
+      int turned = o >= 5;
+      cr_assert(img->width == (turned ? 16 : 32) && img->height == (turned ? 32 : 16) &&
+                    info.width == img->width && info.height == img->height,
+                "orientation %d: %d x %d", o, img->width, img->height);
+      cr_assert_eq(dark_corner(img), corner[o], "orientation %d (%s-endian): dark corner %d, expected %d", o,
+                   be ? "big" : "little", dark_corner(img), corner[o]);
+      lw_image_free(img);
+    }
+  for (int be = 0; be < 2; be++) {
+    size_t n = exif_jpeg(jpg, 6, be, 1);
+    lw_image *img = lw_image_decode(jpg, n, "t.jpg", 1e6, NULL, &err);
+    cr_assert_not_null(img, "%s", err.msg);
+    cr_assert(img->width == 32 && dark_corner(img) == 0);
+    lw_image_free(img);
+  }
+  const char *path = lw_test_path("side.jpg");
+  FILE *f = fopen(path, "wb");
+  cr_assert_not_null(f);
+  size_t n = exif_jpeg(jpg, 6, 1, 0);
+  cr_assert_eq(fwrite(jpg, 1, n, f), n);
+  fclose(f);
+  lw_image_info info;
+  cr_assert_eq(lw_image_probe(path, &info, &err), LW_OK, "%s", err.msg);
+  cr_assert(info.width == 16 && info.height == 32, "probe: %d x %d", info.width, info.height);
+}
