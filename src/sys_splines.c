@@ -236,6 +236,8 @@ static size_t sweep_size(const void *state)
   return s->m->sp->n_nodes;
 }
 
+static size_t sites(const void *state) { return ((const spl_state *)state)->m->sp->n_nodes; }
+
 /* Steps are capped at the page size: beyond that a Gaussian step only
 ** throws nodes off the page; an angle at half a turn. */
 static double step_max(const void *state, int kind)
@@ -799,7 +801,12 @@ static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinne
   .files = "final.svg, final.png", \
   .draw = draw, \
   .summary = summary, \
-  .describe = describe,
+  .describe = describe, \
+  .split = split, \
+  .group = group, \
+  .propose_in = propose_in, \
+  .commit_part = commit_part, \
+  .merge = merge,
 
 const lw_system_type lw_system_splines = {
     .name = "splines",
@@ -807,21 +814,19 @@ const lw_system_type lw_system_splines = {
     .move_names = lw_move_names,
     .move_unit = move_unit,
     SPLINES_ROW
-    /* domains only for a fixed count: births and deaths would move splines
-    ** between the domains' scratches */
-    .split = split,
-    .group = group,
-    .propose_in = propose_in,
-    .commit_part = commit_part,
-    .merge = merge,
 };
 
+/* Births, deaths, grows and shrinks draw their own spline anywhere on the
+** page and change the storage: with domains they run after the phases
+** (mc.h), and the domains visit the nodes, not sweep_size's fixed count. */
 const lw_system_type lw_system_splines_td = {
     .name = "splines",
     .n_moves = LW_MOVE_KINDS_TD,
     .move_names = move_names_td,
     .move_unit = move_unit,
     SPLINES_ROW
+    .n_domain_moves = LW_MOVE_KINDS,
+    .sites = sites,
 };
 
 lw_system *lw_splines_view(lw_model *m, lw_error *err)
