@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/domains.h"
 #include "linewise/mc.h"
 #include "linewise/sys_splines.h"
 #include "linewise/transdim.h"
@@ -228,7 +229,21 @@ Test(transdim, ideal_gas_all_moves_together)
 ** so it does a density that the Hastings factors of the moves that keep
 ** ** the count get wrong (uniform there while births draw by darkness: 0.551
 ** +- 0.003 against 0.571 for E x / W, 6 standard errors). */
-Test(transdim, ideal_gas_first_nodes_follow_the_darkness)
+static void darkness_law(const char *domains, unsigned long seed);
+
+Test(transdim, ideal_gas_first_nodes_follow_the_darkness) { darkness_law("off", 15); }
+
+/* The same law with the page split into 2 x 2 domains (domains.h): the
+** moves that keep the count run in the domains' phases, rejected when they
+** leave their domain, and births, deaths, grows and shrinks a fixed number
+** a sweep after them (docs/NUMERICS.md, "Trans-dimensional moves with
+** domains").  Catches a number of those that follows the state (their
+** share of the nodes rather than of the fixed sweep: an empty page never
+** gets a birth again, chi-square p = 0) and the domains' moves without the
+** prior's Hastings factor (a first node soon leaves the page). */
+Test(transdim, ideal_gas_laws_hold_with_domains) { darkness_law("2", 16); }
+
+static void darkness_law(const char *domains, unsigned long seed)
 {
   lw_image_dir_make();
   lw_params p;
@@ -251,10 +266,14 @@ Test(transdim, ideal_gas_first_nodes_follow_the_darkness)
   snprintf(p.image, sizeof p.image, "%s", lw_test_path("ramp.png"));
   lw_test_png(p.image, PW, PW, g, NULL);
   void *setup;
-  lw_chain *c = td_chain(&p, T, 15, &setup);
+  lw_chain *c = td_chain(&p, T, seed, &setup);
   const lw_model *m = lw_splines_model(c->sys);
   const lw_scene *sc = m->scene;
   cr_assert_not_null(sc->image);
+  snprintf(p.domains, sizeof p.domains, "%s", domains);
+  lw_error err = {0};
+  cr_assert_eq(lw_domains_attach(c, &p, 1, &err), LW_OK, "%s", err.msg);
+  cr_assert((c->domains != NULL) == (strcmp(domains, "off") != 0), "domains = %s not as asked", domains);
   /* the moments of pi over the page: E x / W, E (x / W)^2, E y / H, E (y / H)^2 */
   const lw_image *img = sc->image;
   const lw_image_place *pl = &sc->image_place;
@@ -307,6 +326,12 @@ Test(transdim, ideal_gas_first_nodes_follow_the_darkness)
       cr_assert(fabs(flat[k] - want[k]) > 8 * se, "moment %d: %g +- %g cannot tell %g from uniform %g", k, mean, se,
                 want[k], flat[k]);
   }
+  /* the domains moved many splines: the law was theirs to keep too (half
+  ** of the visits find a spline across a boundary: domains of 30 x 20 mm,
+  ** splines up to 15 mm long) */
+  if (c->domains)
+    cr_assert(c->domains->frozen < c->domains->visits * 3 / 4, "%lu of %lu site visits frozen", c->domains->frozen,
+              c->domains->visits);
   td_chain_free(c, setup);
   lw_image_dir_remove();
 }
