@@ -131,7 +131,7 @@ static int along_curve(const lw_scene *sc, lw_splines *sp, lw_error *err)
 ** allowed for the scene. */
 static spl_state *state_from_file(const spl_setup *su, lw_splines *sp, const char *path, lw_error *err)
 {
-  if (lw_model_check_regular(&su->scene, sp, path, err)) {
+  if (lw_model_check_regular(&su->scene, sp, path, err) || lw_model_check_layers(&su->scene, sp, path, err)) {
     lw_splines_free(sp);
     return NULL;
   }
@@ -404,13 +404,17 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
   *forbidden = 0;
   if (kind == LW_MOVE_BIRTH) {
     lw_td_birth_draw(td, rng, p->node);
-    lw_model_propose_splice(m, p, 0, 0, NULL, nb + 1, (double)nb * td->length);
+    /* its layer by the layers' shares, the prior's own law of a layer:
+    ** the factors cancel (docs/NUMERICS.md) */
+    const lw_layers_spec *ls = &m->scene->layers;
+    const int layer = ls->n ? lw_layers_at(ls, gsl_rng_uniform(rng)) : 0;
+    lw_model_propose_splice(m, p, 0, 0, NULL, nb + 1, (double)nb * td->length, layer);
     p->log_ratio = lw[1] - lw[0] - log((double)(N + 1));
   } else if (kind == LW_MOVE_DEATH) {
     if (N == 0) return refuse(p);
     uint32_t j = live_spline(m, rng);
     if (!lw_td_mortal(td, lw_splines_segments(sp, j), sp->rest_length[j])) return refuse(p);
-    lw_model_propose_splice(m, p, j, 1, NULL, 0, 0.0);
+    lw_model_propose_splice(m, p, j, 1, NULL, 0, 0.0, 0);
     p->log_ratio = lw[0] - lw[1] + log((double)N);
   } else {
     if (N == 0) return refuse(p);
@@ -430,7 +434,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
       /* at the tail the prior's new factor is the proposal itself */
       lr = tail ? 0.0
                 : lw_td_first_log(td, add) + lw_td_next_log(td, add, 1, &keep[0]) - lw_td_first_log(td, &keep[0]) - lg;
-      lw_model_propose_splice(m, p, i, 1, NULL, n + 2, rest);
+      lw_model_propose_splice(m, p, i, 1, NULL, n + 2, rest, 0);
       p->log_ratio = lw[3] - lw[2] + lr;
     } else {
       if (n <= 1) return refuse(p);
@@ -438,7 +442,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
       lr = tail ? 0.0
                 : lw_td_first_log(td, &src[1]) - lw_td_first_log(td, &src[0]) - lw_td_next_log(td, &src[0], 1, &src[1]) +
                       lw_td_next_log(td, &src[1], -1, &src[0]);
-      lw_model_propose_splice(m, p, i, 1, NULL, n, rest);
+      lw_model_propose_splice(m, p, i, 1, NULL, n, rest, 0);
       p->log_ratio = lw[2] - lw[3] + lr;
     }
   }
@@ -591,7 +595,7 @@ static double energy(const void *setup, const lw_state *st, const char *path, do
     no_splines(path, err);
     return NAN;
   }
-  if (lw_model_check_regular(sc, st->sp, path, err)) return NAN;
+  if (lw_model_check_regular(sc, st->sp, path, err) || lw_model_check_layers(sc, st->sp, path, err)) return NAN;
   double total = lw_energy_compute(sc, st->sp, term, err);
   if (err->code || lw_checkpoint_check_finite(sc, st->sp, term, path, err)) return NAN;
   return total;

@@ -499,7 +499,7 @@ Test(transdim, deaths_leave_ghosts_that_births_fill)
   lw_splines *before = lw_splines_clone(m->sp);
   cr_assert_not_null(before);
   /* a death of spline 5: 20 slots, 19 alive, nothing else moved */
-  lw_model_propose_splice(m, pr, 5, 1, NULL, 0, 0.0);
+  lw_model_propose_splice(m, pr, 5, 1, NULL, 0, 0.0, 0);
   cr_assert_eq(lw_model_commit(m, pr), LW_OK);
   cr_assert_eq(m->sp->n_splines, 20);
   cr_assert_eq(lw_model_count(m), 19);
@@ -509,7 +509,7 @@ Test(transdim, deaths_leave_ghosts_that_births_fill)
   /* a birth of 3 segments takes slot 5 */
   lw_node nd[8];
   for (int k = 0; k < 4; k++) nd[k] = (lw_node){30.0 + 3.0 * k, 20.0 + 0.5 * k, 1.0, 0.2};
-  lw_model_propose_splice(m, pr, 0, 0, nd, 4, 12.0);
+  lw_model_propose_splice(m, pr, 0, 0, nd, 4, 12.0, 0);
   cr_assert_eq(lw_model_commit(m, pr), LW_OK);
   cr_assert_eq(m->sp->n_splines, 20);
   cr_assert(!lw_model_ghost(m, 5));
@@ -519,7 +519,7 @@ Test(transdim, deaths_leave_ghosts_that_births_fill)
   /* spline 2 grows by a segment: its slot is left, the grown one appended */
   memcpy(nd, &m->sp->node[m->sp->first[2]], 4 * sizeof *nd);
   nd[4] = (lw_node){nd[3].px + 3.0, nd[3].py, 1.0, 0.0};
-  lw_model_propose_splice(m, pr, 2, 1, nd, 5, 16.0);
+  lw_model_propose_splice(m, pr, 2, 1, nd, 5, 16.0, 0);
   cr_assert_eq(lw_model_commit(m, pr), LW_OK);
   cr_assert_eq(m->sp->n_splines, 21);
   cr_assert(lw_model_ghost(m, 2));
@@ -527,7 +527,7 @@ Test(transdim, deaths_leave_ghosts_that_births_fill)
   total_is_full(m, "after a grow");
   /* and two deaths, then the sweep's end */
   for (uint32_t j = 11; j <= 12; j++) {
-    lw_model_propose_splice(m, pr, j, 1, NULL, 0, 0.0);
+    lw_model_propose_splice(m, pr, j, 1, NULL, 0, 0.0, 0);
     cr_assert_eq(lw_model_commit(m, pr), LW_OK);
   }
   cr_assert_eq(lw_model_count(m), 18);
