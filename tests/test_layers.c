@@ -712,3 +712,45 @@ Test(layers, bad_layer_keys_give_one_line_with_file_line_and_key_and_exit_2)
     cr_assert_neq(stat(dir, &sb), 0, "case %zu wrote nothing", k);
   }
 }
+
+/* A CMYK scene whose splines are born and die in their layers: the layer
+** goes into state.lw with each spline, so a run stopped and resumed ends
+** where the uninterrupted one does, on 1 and 3 threads alike; a state of
+** the older kind, without layers, still loads (the index rule gives
+** them), and a layer the scene does not have is refused naming the spline. */
+Test(layers, born_splines_keep_their_layers_through_checkpoints)
+{
+  write_colour_png(lw_test_path("colour.png"), 32, 32, blotch_colours);
+  char text[2048];
+  snprintf(text, sizeof text, "%s%s", colour_scene,
+           "[moves]\nfixed_count = 0\nbirth = 0.3\ndeath = 0.3\ngrow = 0.2\nshrink = 0.2\nmax_segments = 5\n");
+  lw_test_write(lw_test_path("scene.ini"), text, strlen(text));
+  char errs[4096];
+  const char *set = "--set anneal.sweeps=30 --set anneal.t_start=1 --set anneal.seed=3 --quiet";
+  char cmd[512];
+  snprintf(cmd, sizeof cmd, "run scene.ini --out a --threads 1 %s", set);
+  cr_assert_eq(run(cmd, errs, sizeof errs), 0, "%s", errs);
+  snprintf(cmd, sizeof cmd, "run scene.ini --out b --threads 3 %s --stop-at 11", set);
+  cr_assert_eq(run(cmd, errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(run("resume b --threads 2 --quiet", errs, sizeof errs), 0, "%s", errs);
+  char dir[512];
+  snprintf(dir, sizeof dir, "%s", lw_test_path(""));
+  const char *files[] = {"state.lw", "trace.csv", "final.svg"};
+  for (int i = 0; i < 3; i++)
+    cr_assert_eq(lw_test_sh("cmp -s %s/a/%s %s/b/%s", dir, files[i], dir, files[i]), 0, "%s differs", files[i]);
+  /* births and deaths happened, and every spline line holds a layer */
+  cr_assert_neq(lw_test_sh("grep -q '\"splines\": 40,' %s/a/summary.json", dir), 0, "the count never changed");
+  cr_assert_eq(lw_test_sh("grep '^spline = ' %s/a/state.lw | grep -qv '^spline = [0-9]* [-0-9.e+]* [0-3]$'", dir), 1,
+               "a spline line without its layer");
+  /* the older kind of state: no layers */
+  cr_assert_eq(lw_test_sh("mkdir -p %s/old && sed 's/^\\(spline = [0-9]* [^ ]*\\) [0-9]*$/\\1/' %s/a/state.lw > "
+                          "%s/old/state.lw && cp %s/a/scene.ini %s/old && grep -q '^spline = [0-9]* [^ ]*$' %s/old/state.lw",
+                          dir, dir, dir, dir, dir, dir), 0);
+  cr_assert_eq(run("energy a", errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(run("energy old", errs, sizeof errs), 0, "%s", errs);
+  /* a layer past the scene's four */
+  cr_assert_eq(lw_test_sh("mkdir -p %s/bad && sed '0,/^spline = /s/^\\(spline = [0-9]* [^ ]*\\) [0-9]*$/\\1 7/' "
+                          "%s/a/state.lw > %s/bad/state.lw && cp %s/a/scene.ini %s/bad", dir, dir, dir, dir, dir), 0);
+  cr_assert_eq(run("energy bad", errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "spline 0 is of layer 7, but the scene has 4 layers"), "%s", errs);
+}
