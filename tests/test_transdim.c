@@ -669,3 +669,47 @@ Test(transdim, hard_scales_keep_the_state_finite)
     td_chain_free(c, setup);
   }
 }
+
+/* With layers a spline's layer is a mark of the target with prior s_k, the
+** layers' shares (docs/NUMERICS.md, "Layers"): in the ideal gas each
+** layer's count is Poisson with mean s_k times the whole count's, so
+** N_0 - s_0 N has mean 0.  Two layers on a ramp picture, one inking the
+** whole range and one only its darker half, so s_0 is far from 1/2: a
+** birth that drew its layer uniformly gives a mean of (1/2 - s_0) E N,
+** more than 10 standard errors off. */
+Test(transdim, ideal_gas_layers_take_their_shares)
+{
+  lw_image_dir_make();
+  lw_params p;
+  const double T = 1.0, lambda = 8.0;
+  ideal_gas(&p, -T * log(lambda));
+  p.splines = 8;
+  p.mix_birth = p.mix_death = 1;
+  enum { PW = 16 };
+  float g[PW * PW];
+  for (int j = 0; j < PW; j++)
+    for (int i = 0; i < PW; i++) g[j * PW + i] = (float)((i + 0.5) / PW);
+  snprintf(p.image, sizeof p.image, "%s", lw_test_path("ramp2.png"));
+  lw_test_png(p.image, PW, PW, g, NULL);
+  snprintf(p.ly_names, sizeof p.ly_names, "half all");
+  snprintf(p.ly_tone_max, sizeof p.ly_tone_max, "0.5 1");
+  void *setup;
+  lw_chain *c = td_chain(&p, T, 17, &setup);
+  const lw_model *m = lw_splines_model(c->sys);
+  const double s0 = m->scene->layers.cum[1];
+  cr_assert(fabs(s0 - 0.5) > 0.1, "the shares %g and %g cannot tell a uniform draw", s0, 1 - s0);
+  for (int k = 0; k < 500; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  batch_mean bm = {.per = (lw_test_long() ? 200000 : 20000) / BATCHES};
+  for (long s = 0; s < BATCHES * bm.per; s++) {
+    for (int k = 0; k < 2; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    double n0 = 0.0;
+    cr_assert_not_null(m->sp->layer);
+    for (size_t i = 0; i < m->sp->n_splines; i++) n0 += m->sp->layer[i] == 0;
+    bm_add(&bm, n0 - s0 * (double)m->sp->n_splines);
+  }
+  double se, mean = bm_mean(&bm, &se);
+  cr_assert(fabs(mean) < 5 * se, "N_0 - s_0 N: %g +- %g, expected 0 (s_0 = %g)", mean, se, s0);
+  cr_assert(fabs(0.5 - s0) * lambda > 10 * se, "a uniform layer draw would be within 10 standard errors");
+  td_chain_free(c, setup);
+  lw_image_dir_remove();
+}
