@@ -676,7 +676,7 @@ Test(transdim, hard_scales_keep_the_state_finite)
 ** N_0 - s_0 N has mean 0.  Two layers on a ramp picture, one inking the
 ** whole range and one only its darker half, so s_0 is far from 1/2: a
 ** birth that drew its layer uniformly gives a mean of (1/2 - s_0) E N,
-** more than 10 standard errors off. */
+** more than 10 standard errors off (116 measured). */
 Test(transdim, ideal_gas_layers_take_their_shares)
 {
   lw_image_dir_make();
