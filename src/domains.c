@@ -51,7 +51,8 @@ static lw_chain *cell_chain(const lw_chain *c, lw_error *err)
   ** lw_domains_attach checks that their share is not 0) */
   const int nd = c->sys->type->n_domain_moves;
   if (nd > 0 && nd < c->n_moves)
-    for (int k = 0; k < c->n_moves; k++) dc->cum_weight[k] = k < nd - 1 ? c->cum_weight[k] / c->cum_weight[nd - 1] : 1.0;
+    for (int k = 0; k < c->n_moves; k++)
+      dc->cum_weight[k] = k < nd - 1 ? c->cum_weight[k] / c->cum_weight[nd - 1] : 1.0;
   dc->prop = c->sys->type->proposal_new(c->sys->state, err);
   dc->rng = gsl_rng_alloc(gsl_rng_mt19937);
   if (!dc->prop || !dc->rng) {

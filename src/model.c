@@ -756,9 +756,9 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   for (size_t j = 0; j < p->n_seg; j++) {
     size_t m_loc = p->seg0 + j, g = g0 + m_loc;
     double *local = p->local + j * (size_t)nl;
-    p->seg_irregular[j] = !segment_eval(sc, ctx_of(ts, sp, spline), proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1),
-                                        &s, &p->len[j], local, pc ? pc->quad : NULL,
-                                        m->grid ? p->ps + j * (size_t)np : NULL);
+    p->seg_irregular[j] = !segment_eval(sc, ctx_of(ts, sp, spline), proposed_node(base, p, m_loc),
+                                        proposed_node(base, p, m_loc + 1), &s, &p->len[j], local,
+                                        pc ? pc->quad : NULL, m->grid ? p->ps + j * (size_t)np : NULL);
     p->irregular |= p->seg_irregular[j];
     was_irregular |= m->seg_irregular[g];
     const double *old = m->seg_local + g * (size_t)nl;

@@ -250,8 +250,9 @@ Test(layers, births_and_deaths_in_layers_change_the_energy_by_the_full_recomputa
   cr_assert_not_null(f, "%s", err.msg);
   const lw_tone *tn = sc.layer[0].tone.w ? &sc.layer[0].tone : NULL;
   cr_assert_not_null(tn);
-  cr_assert_eq(memcmp(f->raster[LW_TERM_TONE], m->raster[LW_TERM_TONE], 3 * (size_t)tn->w * (size_t)tn->h * sizeof(int64_t)),
-               0, "a layer's raster plane differs from a fresh one");
+  const size_t bytes = 3 * (size_t)tn->w * (size_t)tn->h * sizeof(int64_t);
+  cr_assert_eq(memcmp(f->raster[LW_TERM_TONE], m->raster[LW_TERM_TONE], bytes), 0,
+               "a layer's raster plane differs from a fresh one");
   lw_model_free(f);
   gsl_rng_free(r);
   lw_proposal_free(pr);
@@ -744,8 +745,8 @@ Test(layers, born_splines_keep_their_layers_through_checkpoints)
                "a spline line without its layer");
   /* the older kind of state: no layers */
   cr_assert_eq(lw_test_sh("mkdir -p %s/old && sed 's/^\\(spline = [0-9]* [^ ]*\\) [0-9]*$/\\1/' %s/a/state.lw > "
-                          "%s/old/state.lw && cp %s/a/scene.ini %s/old && grep -q '^spline = [0-9]* [^ ]*$' %s/old/state.lw",
-                          dir, dir, dir, dir, dir, dir), 0);
+                          "%s/old/state.lw && cp %s/a/scene.ini %s/old && "
+                          "grep -q '^spline = [0-9]* [^ ]*$' %s/old/state.lw", dir, dir, dir, dir, dir, dir), 0);
   cr_assert_eq(run("energy a", errs, sizeof errs), 0, "%s", errs);
   cr_assert_eq(run("energy old", errs, sizeof errs), 0, "%s", errs);
   /* a layer past the scene's four */

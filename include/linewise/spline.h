@@ -32,9 +32,8 @@ typedef struct {
   size_t *first;          /* n_splines + 1 node offsets; first[n_splines] = n_nodes */
   uint32_t *seg_spline;   /* n_segments: the spline of each segment */
   double *rest_length;    /* n_splines: L0, mm (> 0) */
-  uint8_t *layer;         /* n_splines: each spline's layer (layers.h), or NULL: the
-                             index rule lw_layers_of gives it (every scene but one
-                             whose splines are born and die in layers) */
+  uint8_t *layer;         /* n_splines: each spline's layer (layers.h) where splines are
+                             born and die in layers, or NULL: the index rule gives it */
   size_t cap_nodes;       /* room in node and seg_spline (lw_splines_append grows it) */
   size_t cap_splines;     /* room in rest_length, layer, and first (plus one) */
 } lw_splines;
