@@ -101,15 +101,18 @@ Test(domains, resume_continues_bit_exactly)
 static const char *td_extra = "[moves]\nfixed_count = 0\nmax_segments = 6\nbirth = 0.05\ndeath = 0.05\n"
                               "grow = 0.05\nshrink = 0.05\n";
 
-/* The same bytes on 1 and 3 threads, and after a run stopped twice and
-** resumed on other thread counts.  Catches a domain sweep that skips the
+/* The same bytes on 1 and 3 threads (two tempering replicas), and after a
+** run stopped twice and resumed on other thread counts.  Catches a domain
+** sweep that skips the
 ** compaction of the sweep's ghosts (sweep_end): the run then fails, its
 ** domains grouping ghosts as splines. */
 Test(domains, trans_dimensional_same_on_1_and_3_threads_and_resume, .timeout = 300)
 {
-  char dir[64];
+  char dir[64], extra[512];
   cr_assert_eq(lw_test_dir_make(dir, "domains_td"), 0);
-  write_scene(dir, td_extra);
+  /* two replicas: threads go to the rungs first, then to each one's domains */
+  snprintf(extra, sizeof extra, "%s[tempering]\nreplicas = 2\nt_min = 0.01\nt_max = 0.1\n", td_extra);
+  write_scene(dir, extra);
   const char *b = lw_test_bin();
   cr_assert_eq(sh("%s run %s/s.ini --out %s/t1 --threads 1 --quiet", b, dir, dir), 0);
   cr_assert_eq(sh("%s run %s/s.ini --out %s/t3 --threads 3 --quiet", b, dir, dir), 0);
@@ -142,7 +145,7 @@ static void running_totals_are_full(const char *name, int td)
   snprintf(path, sizeof path, "%s/s.ini", dir);
   cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
   p.check_every = 1000000; /* no refresh between: the totals run on their own */
-  p.sweeps = 40;
+  p.sweeps = lw_test_long() ? 600 : 40; /* long: about 10^6 proposals */
   lw_anneal a;
   snprintf(path, sizeof path, "%s/run", dir);
   cr_assert_eq(lw_anneal_start(&a, &p, path, &err), LW_OK, "%s", err.msg);
