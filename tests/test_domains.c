@@ -103,9 +103,8 @@ static const char *td_extra = "[moves]\nfixed_count = 0\nmax_segments = 6\nbirth
 
 /* The same bytes on 1 and 3 threads (two tempering replicas), and after a
 ** run stopped twice and resumed on other thread counts.  Catches a domain
-** sweep that skips the
-** compaction of the sweep's ghosts (sweep_end): the run then fails, its
-** domains grouping ghosts as splines. */
+** sweep that skips the compaction of the sweep's ghosts (sweep_end): the
+** run then fails, its domains grouping ghosts as splines. */
 Test(domains, trans_dimensional_same_on_1_and_3_threads_and_resume, .timeout = 300)
 {
   char dir[64], extra[512];
