@@ -47,6 +47,12 @@ static lw_chain *cell_chain(const lw_chain *c, lw_error *err)
   memset(dc->stats, 0, sizeof dc->stats);
   memset(dc->win_prop, 0, sizeof dc->win_prop);
   memset(dc->win_acc, 0, sizeof dc->win_acc);
+  /* only the kinds a domain can run, in their proportions (system.h;
+  ** lw_domains_attach checks that their share is not 0) */
+  const int nd = c->sys->type->n_domain_moves;
+  if (nd > 0 && nd < c->n_moves)
+    for (int k = 0; k < c->n_moves; k++)
+      dc->cum_weight[k] = k < nd - 1 ? c->cum_weight[k] / c->cum_weight[nd - 1] : 1.0;
   dc->prop = c->sys->type->proposal_new(c->sys->state, err);
   dc->rng = gsl_rng_alloc(gsl_rng_mt19937);
   if (!dc->prop || !dc->rng) {
@@ -77,6 +83,9 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
   }
   if (!t->split || !t->group || !t->propose_in || !t->commit_part || !t->merge)
     return bad_key(p, err, "'%s': the system '%s' cannot split its sweeps into domains; expected off", t->name);
+  /* every kind with weight runs serially (mc.h): nothing for the domains */
+  if (t->n_domain_moves > 0 && t->n_domain_moves < c->n_moves && !(c->cum_weight[t->n_domain_moves - 1] > 0.0))
+    return LW_OK;
   double page[4], reach;
   const char *why = t->split(c->sys->state, page, &reach);
   if (why) return bad_key(p, err, "'%s': this scene cannot be split into domains (%s); expected off", why);
@@ -227,7 +236,7 @@ lw_status lw_domains_sweep(lw_domains *d, lw_chain *c)
 {
   const lw_system_type *t = c->sys->type;
   void *state = c->sys->state;
-  size_t n = t->sweep_size(state);
+  size_t n = t->sites ? t->sites(state) : t->sweep_size(state);
   if (n == 0) return LW_OK;
   double t0 = d->cell_cpu ? cpu_now() : 0.0;
   if (d->cell_cpu) memset(d->cell_cpu, 0, (size_t)d->n * sizeof *d->cell_cpu);

@@ -60,7 +60,7 @@ static lw_plot *make_plot(const lw_params *p, const lw_scene *sc, const lw_splin
       lw_error_set(err, LW_ENOMEM, "out of memory for the pens of %zu splines", sp->n_splines);
       return NULL;
     }
-    for (size_t i = 0; i < sp->n_splines; i++) pen[i] = lw_layers_of(&sc->layers, i);
+    for (size_t i = 0; i < sp->n_splines; i++) pen[i] = lw_splines_layer(&sc->layers, sp, i);
     lw_plot *pl = lw_plot_new_pens(sp, sc->layers.n, pen, LW_PLOT_ORDER_NONE, 0.0, 0.0, err);
     free(pen);
     return pl;

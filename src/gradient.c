@@ -106,7 +106,7 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
     lw_segment_sample(&sc->quad, a, a + 1, &s);
     irregular += !lw_segment_allowed(sc, a, a + 1, s.length);
     lw_samples_grad_zero(&sg, s.n);
-    const lw_term_ctx *c = sc->layers.n ? layer_ctx[lw_layers_of(&sc->layers, sp->seg_spline[g])] : ctx;
+    const lw_term_ctx *c = sc->layers.n ? layer_ctx[lw_splines_layer(&sc->layers, sp, sp->seg_spline[g])] : ctx;
     for (int j = 0; j < sc->n_local; j++) {
       const int t = sc->local[j];
       if (!selected(term_mask, t)) continue;

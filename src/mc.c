@@ -137,13 +137,15 @@ int lw_chain_step_at(lw_chain *c, int kind, size_t site)
   return decide(c, kind, dE, forbidden);
 }
 
-static int draw_kind(lw_chain *c)
+/* The kind whose slice of the cumulative mix holds u in [0, 1). */
+static int kind_at(const lw_chain *c, double u)
 {
-  double u = gsl_rng_uniform(c->rng);
   int kind = 0;
   while (kind < c->n_moves - 1 && u >= c->cum_weight[kind]) kind++;
   return kind;
 }
+
+static int draw_kind(lw_chain *c) { return kind_at(c, gsl_rng_uniform(c->rng)); }
 
 int lw_chain_visit_in(lw_chain *c, size_t site, const double box[4])
 {
@@ -175,12 +177,35 @@ void lw_chain_tune(lw_chain *c)
   for (int k = 0; c->tuning && k < c->n_moves; k++) tune_window(c, k);
 }
 
+/*
+** The kinds a domain cannot run (system.h, n_domain_moves), after a domain
+** sweep's phases: serially, from the chain's stream, their share of the mix
+** of sweep_size proposals, a count that the state does not change (the
+** sweep stays a fixed product of kernels that each fix the target; a count
+** that followed the state would observe the chain at times that depend on
+** it, docs/NUMERICS.md, "Trans-dimensional moves with domains").
+*/
+static lw_status global_moves(lw_chain *c)
+{
+  const lw_system_type *t = c->sys->type;
+  const int first = t->n_domain_moves;
+  if (first <= 0 || first >= c->n_moves) return LW_OK;
+  const double lo = c->cum_weight[first - 1];
+  const size_t n = (size_t)llround((1.0 - lo) * (double)t->sweep_size(c->sys->state));
+  for (size_t k = 0; k < n; k++)
+    if (lw_chain_step(c, kind_at(c, lo + (1.0 - lo) * gsl_rng_uniform(c->rng))) < 0) return LW_ENOMEM;
+  return LW_OK;
+}
+
 lw_status lw_chain_sweep(lw_chain *c)
 {
-  if (c->domains) return lw_domains_sweep(c->domains, c);
   const lw_system_type *t = c->sys->type;
   size_t n = t->sweep_size(c->sys->state);
-  if (!t->propose_at) {
+  if (c->domains) {
+    lw_status st = lw_domains_sweep(c->domains, c);
+    if (st == LW_OK) st = global_moves(c);
+    if (st != LW_OK) return st;
+  } else if (!t->propose_at) {
     for (size_t k = 0; k < n; k++)
       if (lw_chain_step(c, draw_kind(c)) < 0) return LW_ENOMEM;
   } else if (n > 0) {

@@ -198,17 +198,25 @@ static void term_set_init(lw_term_set *ts, const lw_scene *sc)
   }
 }
 
-/* The term contexts of spline i: its layer's, or the scene's. */
-static const lw_term_ctx *ctx_of(const lw_term_set *ts, size_t i)
+/* The layer of spline i of sp, 0 without layers. */
+static int layer_of(const lw_term_set *ts, const lw_splines *sp, size_t i)
 {
-  return ts->n_layers ? ts->layer_ctx[lw_layers_of(ts->layers, i)] : ts->ctx;
+  return ts->n_layers ? lw_splines_layer(ts->layers, sp, i) : 0;
 }
 
-/* Where spline i's plane of a raster term's raster starts. */
-static size_t plane_of(const lw_term_set *ts, size_t i, const lw_tone *t)
+/* The term contexts of a layer's splines: its own, or the scene's. */
+static const lw_term_ctx *ctx_in(const lw_term_set *ts, int layer)
 {
-  return ts->n_layers ? (size_t)lw_layers_of(ts->layers, i) * (size_t)t->w * (size_t)t->h : 0;
+  return ts->n_layers ? ts->layer_ctx[layer] : ts->ctx;
 }
+
+static const lw_term_ctx *ctx_of(const lw_term_set *ts, const lw_splines *sp, size_t i)
+{
+  return ctx_in(ts, layer_of(ts, sp, i));
+}
+
+/* Where a layer's plane of a raster term's raster starts. */
+static size_t plane_in(int layer, const lw_tone *t) { return (size_t)layer * (size_t)t->w * (size_t)t->h; }
 
 /* A zeroed raster of term t: a plane a layer (every layer's is as large). */
 static int64_t *raster_new(const lw_term_set *ts, int t)
@@ -257,9 +265,10 @@ static double raster_fill(const lw_term_set *ts, int t, const lw_splines *sp, in
   memset(r, 0, planes * plane * sizeof *r);
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
-    const lw_term_ctx *c = &ctx_of(ts, sp->seg_spline[g])[t];
+    const int layer = layer_of(ts, sp, sp->seg_spline[g]);
+    const lw_term_ctx *c = &ctx_in(ts, layer)[t];
     const lw_tone *tn = c->data;
-    int64_t *rp = r + plane_of(ts, sp->seg_spline[g], tn);
+    int64_t *rp = r + plane_in(layer, tn);
     lw_segment_sample(c->quad, a, a + 1, &s);
     for (int q = 0; q < s.n; q++) lw_tone_splat(tn, rp, 0, 0, tn->w, tn->h, s.x[q], s.y[q], s.dl[q], 1);
   }
@@ -312,6 +321,21 @@ lw_status lw_model_check_regular(const lw_scene *sc, const lw_splines *sp, const
   return LW_OK;
 }
 
+lw_status lw_model_check_layers(const lw_scene *sc, lw_splines *sp, const char *path, lw_error *err)
+{
+  if (!sp->layer) return LW_OK;
+  if (!sc->layers.n) {
+    free(sp->layer);
+    sp->layer = NULL;
+    return LW_OK;
+  }
+  for (size_t i = 0; i < sp->n_splines; i++)
+    if (sp->layer[i] >= sc->layers.n)
+      return lw_error_set(err, LW_EINPUT, "%s: spline %zu is of layer %d, but the scene has %d layers ([layers] names)",
+                          path, i, sp->layer[i], sc->layers.n);
+  return LW_OK;
+}
+
 /* The sum of the terms, +inf while a segment is irregular (forbidden). */
 static double total_of(const double term[LW_TERM_COUNT], size_t irregular)
 {
@@ -348,7 +372,7 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
   if (pc && !(grid = grid_for(sc, pc, n, err))) goto fail;
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
-    irregular += !segment_eval(sc, ctx_of(&ts, sp->seg_spline[g]), a, a + 1, &s, &seg_len[g], local,
+    irregular += !segment_eval(sc, ctx_of(&ts, sp, sp->seg_spline[g]), a, a + 1, &s, &seg_len[g], local,
                                pc ? pc->quad : NULL, grid ? seg_ps : NULL);
     for (int t = 0; t < sc->n_local; t++) term[sc->local[t]] += local[t];
     if (grid && store_samples(grid, g, np, seg_ps) != LW_OK) goto nomem;
@@ -432,6 +456,12 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
   if (sc->transdim && sc->max_segments > m->max_segments) m->max_segments = sc->max_segments;
   m->cap_seg = ns;
   m->cap_spl = sp->n_splines ? sp->n_splines : 1;
+  /* where splines are born in layers a layer is state: placed or loaded
+  ** without one, each spline keeps the one the index rule gives it now */
+  if (sc->transdim && sc->layers.n && !sp->layer) {
+    if (lw_splines_layers_alloc(sp) != LW_OK) goto nomem;
+    for (size_t i = 0; i < sp->n_splines; i++) sp->layer[i] = (uint8_t)lw_layers_of(&sc->layers, i);
+  }
   if (!(m->slots = lw_slots_new())) goto nomem;
   if (lw_model_refresh(m, NULL) != LW_OK) goto nomem;
   return m;
@@ -479,7 +509,7 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
     double *local = m->seg_local + g * (size_t)nl;
-    m->seg_irregular[g] = !segment_eval(sc, ctx_of(ts, sp->seg_spline[g]), a, a + 1, &s, &m->seg_len[g], local,
+    m->seg_irregular[g] = !segment_eval(sc, ctx_of(ts, sp, sp->seg_spline[g]), a, a + 1, &s, &m->seg_len[g], local,
                                         pc ? pc->quad : NULL, m->grid ? seg_ps : NULL);
     m->n_irregular += m->seg_irregular[g];
     for (int t = 0; t < nl; t++) term[sc->local[t]] += local[t];
@@ -677,7 +707,8 @@ static size_t crowding(const lw_cellgrid *g, const lw_pair_sample *ps, size_t n,
 ** the energy difference over the box.  NAN if the box cannot grow. */
 static double raster_delta(const lw_model *m, lw_proposal *p, int t, const lw_node *base)
 {
-  const lw_term_ctx *c = &ctx_of(&m->terms, p->spline)[t];
+  const int layer = layer_of(&m->terms, m->sp, p->spline);
+  const lw_term_ctx *c = &ctx_in(&m->terms, layer)[t];
   lw_tone_box *b = &p->box[t];
   lw_tone_box_reset(b);
   for (size_t j = 0; j < p->n_seg; j++) {
@@ -691,7 +722,7 @@ static double raster_delta(const lw_model *m, lw_proposal *p, int t, const lw_no
     raster_segment(c, b, &base[k], &base[k + 1], -1);
     raster_segment(c, b, proposed_node(base, p, k), proposed_node(base, p, k + 1), 1);
   }
-  return lw_tone_delta(c->data, m->raster[t] + plane_of(&m->terms, p->spline, c->data), b);
+  return lw_tone_delta(c->data, m->raster[t] + plane_in(layer, c->data), b);
 }
 
 void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t node0,
@@ -725,9 +756,9 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   for (size_t j = 0; j < p->n_seg; j++) {
     size_t m_loc = p->seg0 + j, g = g0 + m_loc;
     double *local = p->local + j * (size_t)nl;
-    p->seg_irregular[j] = !segment_eval(sc, ctx_of(ts, spline), proposed_node(base, p, m_loc), proposed_node(base, p, m_loc + 1),
-                                        &s, &p->len[j], local, pc ? pc->quad : NULL,
-                                        m->grid ? p->ps + j * (size_t)np : NULL);
+    p->seg_irregular[j] = !segment_eval(sc, ctx_of(ts, sp, spline), proposed_node(base, p, m_loc),
+                                        proposed_node(base, p, m_loc + 1), &s, &p->len[j], local,
+                                        pc ? pc->quad : NULL, m->grid ? p->ps + j * (size_t)np : NULL);
     p->irregular |= p->seg_irregular[j];
     was_irregular |= m->seg_irregular[g];
     const double *old = m->seg_local + g * (size_t)nl;
@@ -858,8 +889,9 @@ lw_status lw_model_commit_part(lw_model *m, lw_proposal *p)
   m->spline_len[p->spline] = L;
   for (int k = 0; p->raster_done && k < m->terms.n_raster; k++) {
     const int t = m->terms.raster[k];
-    const lw_tone *tn = ctx_of(&m->terms, p->spline)[t].data;
-    lw_tone_apply(tn, m->raster[t] + plane_of(&m->terms, p->spline, tn), &p->box[t]);
+    const int layer = layer_of(&m->terms, sp, p->spline);
+    const lw_tone *tn = ctx_in(&m->terms, layer)[t].data;
+    lw_tone_apply(tn, m->raster[t] + plane_in(layer, tn), &p->box[t]);
   }
   for (int t = 0; t < LW_TERM_COUNT; t++) p->sum_term[t] += p->dterm[t];
   if (m->terms.n_raster && !p->raster_done) p->sum_stale = 1;
@@ -949,7 +981,7 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p, size_t g0)
 ** cannot grow. */
 static double splice_raster_delta(const lw_model *m, lw_proposal *p, int t, const lw_node *old)
 {
-  const lw_term_ctx *c = &m->terms.ctx[t];
+  const lw_term_ctx *c = &ctx_in(&m->terms, p->layer)[t];
   lw_tone_box *b = &p->box[t];
   lw_tone_box_reset(b);
   for (size_t j = 0; j < p->n_old_seg; j++) raster_cover(c->data, b, &old[j], &old[j + 1]);
@@ -957,11 +989,11 @@ static double splice_raster_delta(const lw_model *m, lw_proposal *p, int t, cons
   if (lw_tone_box_ready(b) != LW_OK) return NAN;
   for (size_t j = 0; j < p->n_old_seg; j++) raster_segment(c, b, &old[j], &old[j + 1], -1);
   for (size_t j = 0; j < p->n_seg; j++) raster_segment(c, b, &p->node[j], &p->node[j + 1], 1);
-  return lw_tone_delta(c->data, m->raster[t], b);
+  return lw_tone_delta(c->data, m->raster[t] + plane_in(p->layer, c->data), b);
 }
 
 void lw_model_propose_splice(const lw_model *m, lw_proposal *p, uint32_t at, int remove, const lw_node *nodes,
-                             size_t n_new, double rest)
+                             size_t n_new, double rest, int layer)
 {
   const lw_scene *sc = m->scene;
   const lw_splines *sp = m->sp;
@@ -980,6 +1012,8 @@ void lw_model_propose_splice(const lw_model *m, lw_proposal *p, uint32_t at, int
   p->n_seg = n_new ? n_new - 1 : 0;
   p->n_old_seg = no;
   p->new_rest = rest;
+  /* a replaced spline's successor stays in its layer: one plane of each raster changes */
+  p->layer = remove ? layer_of(ts, sp, at) : layer;
   if (nodes && nodes != p->node) memcpy(p->node, nodes, n_new * sizeof *nodes);
   for (int t = 0; t < LW_TERM_COUNT; t++) p->dterm[t] = 0.0;
 
@@ -989,7 +1023,7 @@ void lw_model_propose_splice(const lw_model *m, lw_proposal *p, uint32_t at, int
   p->irregular = 0;
   for (size_t j = 0; j < p->n_seg; j++) {
     double *local = p->local + j * (size_t)nl;
-    p->seg_irregular[j] = !segment_eval(sc, ts->ctx, &p->node[j], &p->node[j + 1], &s, &p->len[j], local,
+    p->seg_irregular[j] = !segment_eval(sc, ctx_in(ts, p->layer), &p->node[j], &p->node[j + 1], &s, &p->len[j], local,
                                         pc ? pc->quad : NULL, m->grid ? p->ps + j * (size_t)np : NULL);
     p->irregular |= p->seg_irregular[j];
     for (int t = 0; t < nl; t++) {
@@ -1107,7 +1141,7 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
   if (cache_room(m, n_seg, n_spl) != LW_OK) return LW_ENOMEM;
   if (p->remove && lw_slots_reserve(m->slots, n_spl, no) != LW_OK) return LW_ENOMEM;
   if (m->grid && lw_cellgrid_reserve(m->grid, n_seg * (size_t)np) != LW_OK) return LW_ENOMEM;
-  if (append && lw_splines_append(sp, p->node, p->n_node, p->new_rest) != LW_OK)
+  if (append && lw_splines_append(sp, p->node, p->n_node, p->new_rest, p->layer) != LW_OK)
     return LW_ENOMEM;
   /* the near fields the splice changes */
   if (m->grid && p->pair_done)
@@ -1133,6 +1167,7 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
       lw_slots_take(m->slots, nn);
       memcpy(&sp->node[sp->first[s]], p->node, p->n_node * sizeof *p->node);
       sp->rest_length[s] = p->new_rest;
+      if (sp->layer) sp->layer[s] = (uint8_t)p->layer;
     }
     const size_t g0 = lw_segment_index(sp, s, 0);
     memcpy(m->seg_len + g0, p->len, nn * sizeof *p->len);
@@ -1153,7 +1188,8 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
   if (m->grid && !p->pair_done) memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);
   for (int k = 0; p->raster_done && k < m->terms.n_raster; k++) {
     const int t = m->terms.raster[k];
-    lw_tone_apply(m->terms.ctx[t].data, m->raster[t], &p->box[t]);
+    const lw_tone *tn = ctx_in(&m->terms, p->layer)[t].data;
+    lw_tone_apply(tn, m->raster[t] + plane_in(p->layer, tn), &p->box[t]);
   }
   int nonfinite = 0;
   for (int t = 0; t < LW_TERM_COUNT; t++) {

@@ -324,15 +324,6 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   sc->chem[1] = p->chem_length;
   coef[LW_TERM_CHEMICAL] = sc->chem[0] != 0.0 || sc->chem[1] != 0.0;
   sc->transdim = !p->fixed_count;
-  /* a spline's layer follows its index, and a domain's scratch holds a fixed
-  ** set of splines: births and deaths would move splines between them */
-  if (sc->transdim && p->ly_names[0])
-    return bad_key(p, "moves", "fixed_count", LW_EINPUT, err,
-                   "trans-dimensional moves (0) do not combine with [layers] yet; expected 1");
-  if (sc->transdim && strcmp(p->domains, "off"))
-    return bad_key(p, "moves", "fixed_count", LW_EINPUT, err,
-                   "trans-dimensional moves (0) do not combine with anneal.domains = %s yet; expected 1",
-                   p->domains);
   sc->max_segments = (size_t)(p->max_segments > p->segments ? p->max_segments : p->segments);
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     sc->coef[t] = coef[t];

@@ -51,6 +51,7 @@ void lw_splines_free(lw_splines *sp)
   free(sp->first);
   free(sp->seg_spline);
   free(sp->rest_length);
+  free(sp->layer);
   free(sp);
 }
 
@@ -64,6 +65,13 @@ lw_splines *lw_splines_clone(const lw_splines *sp)
   if (!c) return NULL;
   memcpy(c->node, sp->node, sp->n_nodes * sizeof *sp->node);
   memcpy(c->rest_length, sp->rest_length, sp->n_splines * sizeof *sp->rest_length);
+  if (sp->layer) {
+    if (lw_splines_layers_alloc(c) != LW_OK) {
+      lw_splines_free(c);
+      return NULL;
+    }
+    memcpy(c->layer, sp->layer, sp->n_splines * sizeof *sp->layer);
+  }
   return c;
 }
 
@@ -76,10 +84,15 @@ lw_status lw_splines_permute(lw_splines *sp, const size_t *order, lw_error *err)
   lw_splines *c = lw_splines_new(n, segs, err);
   free(segs);
   if (!c) return err ? err->code : LW_ENOMEM;
+  if (sp->layer && lw_splines_layers_alloc(c) != LW_OK) {
+    lw_splines_free(c);
+    return lw_error_set(err, LW_ENOMEM, "out of memory renumbering %zu splines", n);
+  }
   for (size_t k = 0; k < n; k++) {
     size_t i = order[k];
     memcpy(&c->node[c->first[k]], &sp->node[sp->first[i]], (sp->first[i + 1] - sp->first[i]) * sizeof *sp->node);
     c->rest_length[k] = sp->rest_length[i];
+    if (sp->layer) c->layer[k] = sp->layer[i];
   }
   lw_splines old = *sp;
   *sp = *c;
@@ -96,7 +109,14 @@ static size_t grown(size_t cap, size_t need)
   return c < need ? need : c;
 }
 
-lw_status lw_splines_append(lw_splines *sp, const lw_node *nodes, size_t n_new, double rest)
+lw_status lw_splines_layers_alloc(lw_splines *sp)
+{
+  if (sp->layer) return LW_OK;
+  sp->layer = calloc(sp->cap_splines ? sp->cap_splines : 1, sizeof *sp->layer);
+  return sp->layer ? LW_OK : LW_ENOMEM;
+}
+
+lw_status lw_splines_append(lw_splines *sp, const lw_node *nodes, size_t n_new, double rest, int layer)
 {
   const size_t n_nodes = sp->n_nodes + n_new, n_splines = sp->n_splines + 1;
   /* all growth first, so that a failure leaves sp as it was; an array that
@@ -119,11 +139,17 @@ lw_status lw_splines_append(lw_splines *sp, const lw_node *nodes, size_t n_new, 
     size_t *fi = realloc(sp->first, (c + 1) * sizeof *fi);
     if (!fi) return LW_ENOMEM;
     sp->first = fi;
+    if (sp->layer) {
+      uint8_t *ly = realloc(sp->layer, c * sizeof *ly);
+      if (!ly) return LW_ENOMEM;
+      sp->layer = ly;
+    }
     sp->cap_splines = c;
   }
   memcpy(sp->node + sp->n_nodes, nodes, n_new * sizeof *nodes);
   for (size_t g = sp->n_segments; g < sp->n_segments + n_new - 1; g++) sp->seg_spline[g] = (uint32_t)sp->n_splines;
   sp->rest_length[sp->n_splines] = rest;
+  if (sp->layer) sp->layer[sp->n_splines] = (uint8_t)layer;
   sp->first[n_splines] = n_nodes;
   sp->n_nodes = n_nodes;
   sp->n_splines = n_splines;
@@ -141,6 +167,7 @@ void lw_splines_compact(lw_splines *sp, const unsigned char *dead)
     memmove(sp->node + k, sp->node + f, nn * sizeof *sp->node);
     sp->first[w] = k;
     sp->rest_length[w] = sp->rest_length[i];
+    if (sp->layer) sp->layer[w] = sp->layer[i];
     k += nn;
     w++;
   }

@@ -10,8 +10,9 @@
 **     ...                          (run data of a checkpoint, anneal.c)
 **     [system splines]
 **     splines = 2
-**     spline = <segments> <rest length L0, mm>
+**     spline = <segments> <rest length L0, mm> [<layer>]
 **     node = <px> <py> <vx> <vy>   (segments + 1 lines per spline)
+** (the layer on every spline or on none: splines born in layers, layers.h)
 **
 ** Format 1 (the first release; still read, never written):
 **     linewise-state 1
@@ -58,13 +59,17 @@ void lw_state_clear(lw_state *st)
 
 /* ---- splines: shared checks ------------------------------------------------ */
 
-/* A spline header "segments rest-length"; 1 if good. */
-static int spline_header(const char *text, size_t *segs, double *rest)
+/* A spline header "segments rest-length [layer]" (*layer = -1 without
+** one; format 1 never has one); 1 if good. */
+static int spline_header(const char *text, size_t *segs, double *rest, int *layer)
 {
-  double h[2];
-  if (lw_number_list(text, 0, h, 2) != 2 || h[0] < 1 || h[0] > 1e6 || h[0] != floor(h[0]) || !(h[1] > 0)) return 0;
+  double h[3];
+  int n = lw_number_list(text, 0, h, 3);
+  if ((n != 2 && !(n == 3 && layer)) || h[0] < 1 || h[0] > 1e6 || h[0] != floor(h[0]) || !(h[1] > 0)) return 0;
+  if (n == 3 && !(h[2] >= 0 && h[2] <= 255 && h[2] == floor(h[2]))) return 0;
   *segs = (size_t)h[0];
   *rest = h[1];
+  if (layer) *layer = n == 3 ? (int)h[2] : -1;
   return 1;
 }
 
@@ -84,6 +89,7 @@ static int node_values(const char *text, lw_node *nd)
 typedef struct {
   size_t ns, *segs;
   double *rest;
+  int *layer;             /* -1: none (every spline alike) */
   lw_node *nodes;
   size_t nn, cap;
 } collect;
@@ -93,8 +99,10 @@ static int collect_init(collect *c, size_t ns)
   *c = (collect){.ns = ns, .cap = 1024};
   c->segs = malloc((ns ? ns : 1) * sizeof *c->segs);
   c->rest = malloc((ns ? ns : 1) * sizeof *c->rest);
+  c->layer = malloc((ns ? ns : 1) * sizeof *c->layer);
   c->nodes = malloc(c->cap * sizeof *c->nodes);
-  return c->segs && c->rest && c->nodes;
+  if (c->layer && !ns) c->layer[0] = -1;
+  return c->segs && c->rest && c->layer && c->nodes;
 }
 
 static int collect_node(collect *c, lw_node nd)
@@ -115,6 +123,14 @@ static lw_splines *collect_done(collect *c, lw_error *err)
   if (sp) {
     memcpy(sp->node, c->nodes, c->nn * sizeof *c->nodes);
     memcpy(sp->rest_length, c->rest, c->ns * sizeof *c->rest);
+    if (c->ns && c->layer[0] >= 0) {
+      if (lw_splines_layers_alloc(sp) != LW_OK) {
+        lw_splines_free(sp);
+        lw_error_set(err, LW_ENOMEM, "out of memory for %zu splines", c->ns);
+        return NULL;
+      }
+      for (size_t i = 0; i < c->ns; i++) sp->layer[i] = (uint8_t)c->layer[i];
+    }
   }
   return sp;
 }
@@ -123,6 +139,7 @@ static void collect_free(collect *c)
 {
   free(c->segs);
   free(c->rest);
+  free(c->layer);
   free(c->nodes);
 }
 
@@ -143,7 +160,10 @@ void lw_state_put_splines(lw_ckpt_writer *w, const char *section, const lw_splin
   lw_ckpt_section(w, section);
   lw_ckpt_put(w, "splines", "%zu", sp->n_splines);
   for (size_t i = 0; i < sp->n_splines; i++) {
-    lw_ckpt_put(w, "spline", "%zu %.17g", lw_splines_segments(sp, i), sp->rest_length[i]);
+    if (sp->layer)
+      lw_ckpt_put(w, "spline", "%zu %.17g %d", lw_splines_segments(sp, i), sp->rest_length[i], sp->layer[i]);
+    else
+      lw_ckpt_put(w, "spline", "%zu %.17g", lw_splines_segments(sp, i), sp->rest_length[i]);
     for (size_t k = sp->first[i]; k < sp->first[i + 1]; k++) {
       const lw_node *nd = &sp->node[k];
       lw_ckpt_put(w, "node", "%.17g %.17g %.17g %.17g", nd->px, nd->py, nd->vx, nd->vy);
@@ -175,8 +195,12 @@ lw_status lw_state_get_splines(lw_ckpt *c, const char *section, lw_splines **out
   for (size_t i = 0; i < (size_t)ns && !s; i++) {
     key = NULL;
     int more = lw_ckpt_next(c, section, &pos, &key, &val, &line);
-    if (!more || strcmp(key, "spline") || !spline_header(val, &col.segs[i], &col.rest[i])) {
-      s = BAD("'spline = <segments >= 1> <rest length > 0>'", more ? val : "end of section");
+    if (!more || strcmp(key, "spline") || !spline_header(val, &col.segs[i], &col.rest[i], &col.layer[i])) {
+      s = BAD("'spline = <segments >= 1> <rest length > 0> [<layer 0 to 255>]'", more ? val : "end of section");
+      break;
+    }
+    if (i > 0 && (col.layer[i] < 0) != (col.layer[0] < 0)) {
+      s = BAD(col.layer[0] < 0 ? "no layer, as the first spline" : "a layer, as the first spline has", val);
       break;
     }
     for (size_t k = 0; k <= col.segs[i] && !s; k++) {
@@ -302,7 +326,8 @@ static lw_status read_v1(lw_state *st, reader *r, lw_error *err)
   }
   for (size_t i = 0; i < col.ns && !s; i++) {
     if ((s = expect_key(r, "spline", &val, err))) break;
-    if (!spline_header(val, &col.segs[i], &col.rest[i])) {
+    col.layer[i] = -1;
+    if (!spline_header(val, &col.segs[i], &col.rest[i], NULL)) {
       s = bad(r, err, "spline", "'<segments >= 1> <rest length > 0>'", val);
       break;
     }

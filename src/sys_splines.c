@@ -131,7 +131,7 @@ static int along_curve(const lw_scene *sc, lw_splines *sp, lw_error *err)
 ** allowed for the scene. */
 static spl_state *state_from_file(const spl_setup *su, lw_splines *sp, const char *path, lw_error *err)
 {
-  if (lw_model_check_regular(&su->scene, sp, path, err)) {
+  if (lw_model_check_regular(&su->scene, sp, path, err) || lw_model_check_layers(&su->scene, sp, path, err)) {
     lw_splines_free(sp);
     return NULL;
   }
@@ -235,6 +235,8 @@ static size_t sweep_size(const void *state)
   if (s->m->scene->transdim && s->setup) return s->setup->td_sweep;
   return s->m->sp->n_nodes;
 }
+
+static size_t sites(const void *state) { return ((const spl_state *)state)->m->sp->n_nodes; }
 
 /* Steps are capped at the page size: beyond that a Gaussian step only
 ** throws nodes off the page; an angle at half a turn. */
@@ -402,13 +404,17 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
   *forbidden = 0;
   if (kind == LW_MOVE_BIRTH) {
     lw_td_birth_draw(td, rng, p->node);
-    lw_model_propose_splice(m, p, 0, 0, NULL, nb + 1, (double)nb * td->length);
+    /* its layer by the layers' shares, the prior's own law of a layer:
+    ** the factors cancel (docs/NUMERICS.md) */
+    const lw_layers_spec *ls = &m->scene->layers;
+    const int layer = ls->n ? lw_layers_at(ls, gsl_rng_uniform(rng)) : 0;
+    lw_model_propose_splice(m, p, 0, 0, NULL, nb + 1, (double)nb * td->length, layer);
     p->log_ratio = lw[1] - lw[0] - log((double)(N + 1));
   } else if (kind == LW_MOVE_DEATH) {
     if (N == 0) return refuse(p);
     uint32_t j = live_spline(m, rng);
     if (!lw_td_mortal(td, lw_splines_segments(sp, j), sp->rest_length[j])) return refuse(p);
-    lw_model_propose_splice(m, p, j, 1, NULL, 0, 0.0);
+    lw_model_propose_splice(m, p, j, 1, NULL, 0, 0.0, 0);
     p->log_ratio = lw[0] - lw[1] + log((double)N);
   } else {
     if (N == 0) return refuse(p);
@@ -428,7 +434,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
       /* at the tail the prior's new factor is the proposal itself */
       lr = tail ? 0.0
                 : lw_td_first_log(td, add) + lw_td_next_log(td, add, 1, &keep[0]) - lw_td_first_log(td, &keep[0]) - lg;
-      lw_model_propose_splice(m, p, i, 1, NULL, n + 2, rest);
+      lw_model_propose_splice(m, p, i, 1, NULL, n + 2, rest, 0);
       p->log_ratio = lw[3] - lw[2] + lr;
     } else {
       if (n <= 1) return refuse(p);
@@ -436,7 +442,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
       lr = tail ? 0.0
                 : lw_td_first_log(td, &src[1]) - lw_td_first_log(td, &src[0]) - lw_td_next_log(td, &src[0], 1, &src[1]) +
                       lw_td_next_log(td, &src[1], -1, &src[0]);
-      lw_model_propose_splice(m, p, i, 1, NULL, n, rest);
+      lw_model_propose_splice(m, p, i, 1, NULL, n, rest, 0);
       p->log_ratio = lw[2] - lw[3] + lr;
     }
   }
@@ -589,7 +595,7 @@ static double energy(const void *setup, const lw_state *st, const char *path, do
     no_splines(path, err);
     return NAN;
   }
-  if (lw_model_check_regular(sc, st->sp, path, err)) return NAN;
+  if (lw_model_check_regular(sc, st->sp, path, err) || lw_model_check_layers(sc, st->sp, path, err)) return NAN;
   double total = lw_energy_compute(sc, st->sp, term, err);
   if (err->code || lw_checkpoint_check_finite(sc, st->sp, term, path, err)) return NAN;
   return total;
@@ -799,7 +805,12 @@ static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinne
   .files = "final.svg, final.png", \
   .draw = draw, \
   .summary = summary, \
-  .describe = describe,
+  .describe = describe, \
+  .split = split, \
+  .group = group, \
+  .propose_in = propose_in, \
+  .commit_part = commit_part, \
+  .merge = merge,
 
 const lw_system_type lw_system_splines = {
     .name = "splines",
@@ -807,21 +818,19 @@ const lw_system_type lw_system_splines = {
     .move_names = lw_move_names,
     .move_unit = move_unit,
     SPLINES_ROW
-    /* domains only for a fixed count: births and deaths would move splines
-    ** between the domains' scratches */
-    .split = split,
-    .group = group,
-    .propose_in = propose_in,
-    .commit_part = commit_part,
-    .merge = merge,
 };
 
+/* Births, deaths, grows and shrinks draw their own spline anywhere on the
+** page and change the storage: with domains they run after the phases
+** (mc.h), and the domains visit the nodes, not sweep_size's fixed count. */
 const lw_system_type lw_system_splines_td = {
     .name = "splines",
     .n_moves = LW_MOVE_KINDS_TD,
     .move_names = move_names_td,
     .move_unit = move_unit,
     SPLINES_ROW
+    .n_domain_moves = LW_MOVE_KINDS,
+    .sites = sites,
 };
 
 lw_system *lw_splines_view(lw_model *m, lw_error *err)

@@ -117,6 +117,121 @@ Test(layers, a_move_changes_the_energy_by_the_full_recomputation)
   lw_scene_clear(&sc);
 }
 
+/* sp without its splines i where dead[i], and with the n nodes nd of
+** rest length `rest` in layer `layer` appended when n > 0. */
+static lw_splines *spliced(const lw_splines *sp, const unsigned char *dead, const lw_node *nd, size_t n,
+                           double rest, int layer)
+{
+  lw_splines *c = lw_splines_clone(sp);
+  cr_assert_not_null(c);
+  lw_splines_compact(c, dead);
+  if (n) cr_assert_eq(lw_splines_append(c, nd, n, rest, layer), LW_OK);
+  return c;
+}
+
+Test(layers, births_and_deaths_in_layers_change_the_energy_by_the_full_recomputation)
+{
+  /* With trans-dimensional moves a spline's layer is state (layers.h).
+  ** The three pens of the test above, each with its own tone raster,
+  ** potential and turned field: a birth into each layer, a death and a
+  ** grow of splines of every layer, each term's difference against the
+  ** recomputation (1e-9); the committed half keeps the running totals and
+  ** each layer's raster plane what a fresh model of the state builds.
+  ** Catches a splice evaluated with the scene's contexts or raster plane
+  ** rather than its layer's (the tone term off by a whole layer's share). */
+  lw_params p = colour_params(40, 40, blotch_colours);
+  snprintf(p.ly_names, sizeof p.ly_names, "a b c");
+  p.ly_source = LW_LSRC_PALETTE;
+  snprintf(p.ly_colors, sizeof p.ly_colors, "#20a0c0 #c02060 #e0c020");
+  snprintf(p.ly_turn, sizeof p.ly_turn, "0 60 120");
+  snprintf(p.ly_pen_width, sizeof p.ly_pen_width, "0.3 0.5 0.4");
+  p.tone = 3;
+  p.tone_blur = 0.8;
+  p.potential = LW_POT_IMAGE;
+  p.potential_coef = 0.5;
+  p.field = LW_FLD_ETF;
+  p.field_coef = -0.7;
+  p.bending = 0.3;
+  p.strain = 1;
+  p.pair = 0.02;
+  p.pair_cutoff = 2;
+  p.fixed_count = 0;
+  lw_scene sc;
+  lw_test_scene(&sc, &p);
+  lw_model *m = lw_test_model_random(&sc, 45, 3, 3, 11);
+  cr_assert_not_null(m->sp->layer, "a scene whose splines are born in layers stores them");
+  for (size_t i = 0; i < m->sp->n_splines; i++) cr_assert_eq(m->sp->layer[i], lw_layers_of(&sc.layers, i));
+  lw_proposal *pr = lw_proposal_new(m, NULL);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 13);
+  double term0[LW_TERM_COUNT], term1[LW_TERM_COUNT];
+  lw_model_compact(m);
+  double e0 = lw_energy_compute(&sc, m->sp, term0, NULL);
+  unsigned char dead[128];
+  lw_node nd[8];
+  int checked[3] = {0};
+  for (int trial = 0; trial < 150; trial++) {
+    /* the state as it is: the ghosts of the last commit compacted away */
+    cr_assert_eq(lw_model_compact(m), LW_OK);
+    const lw_splines *sp = m->sp;
+    cr_assert(sp->n_splines < sizeof dead);
+    memset(dead, 0, sizeof dead);
+    const uint32_t i = (uint32_t)gsl_rng_uniform_int(r, sp->n_splines);
+    const size_t n = lw_splines_segments(sp, i) + 1;
+    const lw_node *src = &sp->node[sp->first[i]];
+    const int kind = trial % 3, layer = (trial / 3) % 3;
+    lw_splines *after;
+    if (kind == 0) { /* a birth into `layer`: spline i's shape moved by up to 10 mm */
+      const double dx = gsl_ran_flat(r, -10, 10), dy = gsl_ran_flat(r, -10, 10);
+      for (size_t k = 0; k < n; k++) nd[k] = (lw_node){src[k].px + dx, src[k].py + dy, src[k].vx, src[k].vy};
+      lw_model_propose_splice(m, pr, 0, 0, nd, n, 7.0, layer);
+      after = spliced(sp, dead, nd, n, 7.0, layer);
+    } else if (kind == 1) { /* a death */
+      lw_model_propose_splice(m, pr, i, 1, NULL, 0, 0.0, 0);
+      dead[i] = 1;
+      after = spliced(sp, dead, NULL, 0, 0.0, 0);
+    } else { /* a grow at the tail: spline i replaced, in its own layer */
+      memcpy(nd, src, n * sizeof *nd);
+      nd[n] = (lw_node){src[n - 1].px + 2.0 * src[n - 1].vx, src[n - 1].py + 2.0 * src[n - 1].vy, src[n - 1].vx,
+                        src[n - 1].vy};
+      lw_model_propose_splice(m, pr, i, 1, nd, n + 1, sp->rest_length[i] + 3.0, 0);
+      cr_assert_eq(pr->layer, sp->layer[i], "a grown spline keeps its layer");
+      dead[i] = 1;
+      after = spliced(sp, dead, nd, n + 1, sp->rest_length[i] + 3.0, sp->layer[i]);
+    }
+    double e1 = lw_energy_compute(&sc, after, term1, NULL);
+    lw_splines_free(after);
+    if (!isfinite(e1) || !isfinite(pr->dE)) continue;
+    checked[kind]++;
+    for (int t = 0; t < LW_TERM_COUNT; t++)
+      cr_assert(fabs(pr->dterm[t] - (term1[t] - term0[t])) <= 1e-9 * fmax(fabs(term0[t]), 1e-3),
+                "trial %d (kind %d, layer %d) term %s: local %.17g, full %.17g", trial, kind, layer, lw_term_names[t],
+                pr->dterm[t], term1[t] - term0[t]);
+    if (trial % 2) {
+      cr_assert_eq(lw_model_commit(m, pr), LW_OK);
+      e0 = e1;
+      memcpy(term0, term1, sizeof term0);
+    }
+  }
+  for (int k = 0; k < 3; k++) cr_assert(checked[k] > 30, "kind %d: only %d finite splices", k, checked[k]);
+  cr_assert_eq(lw_model_compact(m), LW_OK);
+  cr_assert(fabs(lw_model_total(m) - e0) <= 1e-9 * fabs(e0));
+  /* each layer's plane of the tone raster is what the state gives afresh */
+  lw_error err;
+  lw_model *f = lw_model_new(&sc, lw_splines_clone(m->sp), &err);
+  cr_assert_not_null(f, "%s", err.msg);
+  const lw_tone *tn = sc.layer[0].tone.w ? &sc.layer[0].tone : NULL;
+  cr_assert_not_null(tn);
+  const size_t bytes = 3 * (size_t)tn->w * (size_t)tn->h * sizeof(int64_t);
+  cr_assert_eq(memcmp(f->raster[LW_TERM_TONE], m->raster[LW_TERM_TONE], bytes), 0,
+               "a layer's raster plane differs from a fresh one");
+  lw_model_free(f);
+  gsl_rng_free(r);
+  lw_proposal_free(pr);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
 static double blotches(double u, double v) { return 0.5 + 0.4 * sin(7 * u + 2 * v) * cos(5 * v - 3 * u * u); }
 
 Test(layers, one_whole_range_layer_is_the_scene_without_layers)
@@ -183,7 +298,7 @@ static double alignment(const lw_model *m, int k, double ux, double uy)
   double s = 0.0, w = 0.0;
   lw_samples smp;
   for (size_t g = 0; g < m->sp->n_segments; g++) {
-    if (lw_layers_of(&m->scene->layers, m->sp->seg_spline[g]) != k) continue;
+    if (lw_splines_layer(&m->scene->layers, m->sp, m->sp->seg_spline[g]) != k) continue;
     const lw_node *a = &m->sp->node[lw_segment_node(m->sp, g)];
     lw_segment_sample(&m->scene->quad, a, a + 1, &smp);
     for (int q = 0; q < smp.n; q++) {
@@ -569,4 +684,46 @@ Test(layers, bad_layer_keys_give_one_line_with_file_line_and_key_and_exit_2)
     snprintf(dir, sizeof dir, "%s/bad%zu/final.svg", lw_test_dir, k);
     cr_assert_neq(stat(dir, &sb), 0, "case %zu wrote nothing", k);
   }
+}
+
+/* A CMYK scene whose splines are born and die in their layers: the layer
+** goes into state.lw with each spline, so a run stopped and resumed ends
+** where the uninterrupted one does, on 1 and 3 threads alike; a state of
+** the older kind, without layers, still loads (the index rule gives
+** them), and a layer the scene does not have is refused naming the spline. */
+Test(layers, born_splines_keep_their_layers_through_checkpoints)
+{
+  write_colour_png(lw_test_path("colour.png"), 32, 32, blotch_colours);
+  char text[2048];
+  snprintf(text, sizeof text, "%s%s", colour_scene,
+           "[moves]\nfixed_count = 0\nbirth = 0.3\ndeath = 0.3\ngrow = 0.2\nshrink = 0.2\nmax_segments = 5\n");
+  lw_test_write(lw_test_path("scene.ini"), text, strlen(text));
+  char errs[4096];
+  const char *set = "--set anneal.sweeps=30 --set anneal.t_start=1 --set anneal.seed=3 --quiet";
+  char cmd[512];
+  snprintf(cmd, sizeof cmd, "run scene.ini --out a --threads 1 %s", set);
+  cr_assert_eq(run(cmd, errs, sizeof errs), 0, "%s", errs);
+  snprintf(cmd, sizeof cmd, "run scene.ini --out b --threads 3 %s --stop-at 11", set);
+  cr_assert_eq(run(cmd, errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(run("resume b --threads 2 --quiet", errs, sizeof errs), 0, "%s", errs);
+  char dir[512];
+  snprintf(dir, sizeof dir, "%s", lw_test_path(""));
+  const char *files[] = {"state.lw", "trace.csv", "final.svg"};
+  for (int i = 0; i < 3; i++)
+    cr_assert_eq(lw_test_sh("cmp -s %s/a/%s %s/b/%s", dir, files[i], dir, files[i]), 0, "%s differs", files[i]);
+  /* births and deaths happened, and every spline line holds a layer */
+  cr_assert_neq(lw_test_sh("grep -q '\"splines\": 40,' %s/a/summary.json", dir), 0, "the count never changed");
+  cr_assert_eq(lw_test_sh("grep '^spline = ' %s/a/state.lw | grep -qv '^spline = [0-9]* [-0-9.e+]* [0-3]$'", dir), 1,
+               "a spline line without its layer");
+  /* the older kind of state: no layers */
+  cr_assert_eq(lw_test_sh("mkdir -p %s/old && sed 's/^\\(spline = [0-9]* [^ ]*\\) [0-9]*$/\\1/' %s/a/state.lw > "
+                          "%s/old/state.lw && cp %s/a/scene.ini %s/old && "
+                          "grep -q '^spline = [0-9]* [^ ]*$' %s/old/state.lw", dir, dir, dir, dir, dir, dir), 0);
+  cr_assert_eq(run("energy a", errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(run("energy old", errs, sizeof errs), 0, "%s", errs);
+  /* a layer past the scene's four */
+  cr_assert_eq(lw_test_sh("mkdir -p %s/bad && sed '0,/^spline = /s/^\\(spline = [0-9]* [^ ]*\\) [0-9]*$/\\1 7/' "
+                          "%s/a/state.lw > %s/bad/state.lw && cp %s/a/scene.ini %s/bad", dir, dir, dir, dir, dir), 0);
+  cr_assert_eq(run("energy bad", errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "spline 0 is of layer 7, but the scene has 4 layers"), "%s", errs);
 }

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/domains.h"
 #include "linewise/mc.h"
 #include "linewise/sys_splines.h"
 #include "linewise/transdim.h"
@@ -228,7 +229,21 @@ Test(transdim, ideal_gas_all_moves_together)
 ** so it does a density that the Hastings factors of the moves that keep
 ** ** the count get wrong (uniform there while births draw by darkness: 0.551
 ** +- 0.003 against 0.571 for E x / W, 6 standard errors). */
-Test(transdim, ideal_gas_first_nodes_follow_the_darkness)
+static void darkness_law(const char *domains, unsigned long seed);
+
+Test(transdim, ideal_gas_first_nodes_follow_the_darkness) { darkness_law("off", 15); }
+
+/* The same law with the page split into 2 x 2 domains (domains.h): the
+** moves that keep the count run in the domains' phases, rejected when they
+** leave their domain, and births, deaths, grows and shrinks a fixed number
+** a sweep after them (docs/NUMERICS.md, "Trans-dimensional moves with
+** domains").  Catches a number of those that follows the state (their
+** share of the nodes rather than of the fixed sweep: an empty page never
+** gets a birth again, chi-square p = 0) and the domains' moves without the
+** prior's Hastings factor (a first node soon leaves the page). */
+Test(transdim, ideal_gas_laws_hold_with_domains) { darkness_law("2", 16); }
+
+static void darkness_law(const char *domains, unsigned long seed)
 {
   lw_image_dir_make();
   lw_params p;
@@ -251,10 +266,14 @@ Test(transdim, ideal_gas_first_nodes_follow_the_darkness)
   snprintf(p.image, sizeof p.image, "%s", lw_test_path("ramp.png"));
   lw_test_png(p.image, PW, PW, g, NULL);
   void *setup;
-  lw_chain *c = td_chain(&p, T, 15, &setup);
+  lw_chain *c = td_chain(&p, T, seed, &setup);
   const lw_model *m = lw_splines_model(c->sys);
   const lw_scene *sc = m->scene;
   cr_assert_not_null(sc->image);
+  snprintf(p.domains, sizeof p.domains, "%s", domains);
+  lw_error err = {0};
+  cr_assert_eq(lw_domains_attach(c, &p, 1, &err), LW_OK, "%s", err.msg);
+  cr_assert((c->domains != NULL) == (strcmp(domains, "off") != 0), "domains = %s not as asked", domains);
   /* the moments of pi over the page: E x / W, E (x / W)^2, E y / H, E (y / H)^2 */
   const lw_image *img = sc->image;
   const lw_image_place *pl = &sc->image_place;
@@ -307,6 +326,12 @@ Test(transdim, ideal_gas_first_nodes_follow_the_darkness)
       cr_assert(fabs(flat[k] - want[k]) > 8 * se, "moment %d: %g +- %g cannot tell %g from uniform %g", k, mean, se,
                 want[k], flat[k]);
   }
+  /* the domains moved many splines: the law was theirs to keep too (half
+  ** of the visits find a spline across a boundary: domains of 30 x 20 mm,
+  ** splines up to 15 mm long) */
+  if (c->domains)
+    cr_assert(c->domains->frozen < c->domains->visits * 3 / 4, "%lu of %lu site visits frozen", c->domains->frozen,
+              c->domains->visits);
   td_chain_free(c, setup);
   lw_image_dir_remove();
 }
@@ -474,7 +499,7 @@ Test(transdim, deaths_leave_ghosts_that_births_fill)
   lw_splines *before = lw_splines_clone(m->sp);
   cr_assert_not_null(before);
   /* a death of spline 5: 20 slots, 19 alive, nothing else moved */
-  lw_model_propose_splice(m, pr, 5, 1, NULL, 0, 0.0);
+  lw_model_propose_splice(m, pr, 5, 1, NULL, 0, 0.0, 0);
   cr_assert_eq(lw_model_commit(m, pr), LW_OK);
   cr_assert_eq(m->sp->n_splines, 20);
   cr_assert_eq(lw_model_count(m), 19);
@@ -484,7 +509,7 @@ Test(transdim, deaths_leave_ghosts_that_births_fill)
   /* a birth of 3 segments takes slot 5 */
   lw_node nd[8];
   for (int k = 0; k < 4; k++) nd[k] = (lw_node){30.0 + 3.0 * k, 20.0 + 0.5 * k, 1.0, 0.2};
-  lw_model_propose_splice(m, pr, 0, 0, nd, 4, 12.0);
+  lw_model_propose_splice(m, pr, 0, 0, nd, 4, 12.0, 0);
   cr_assert_eq(lw_model_commit(m, pr), LW_OK);
   cr_assert_eq(m->sp->n_splines, 20);
   cr_assert(!lw_model_ghost(m, 5));
@@ -494,7 +519,7 @@ Test(transdim, deaths_leave_ghosts_that_births_fill)
   /* spline 2 grows by a segment: its slot is left, the grown one appended */
   memcpy(nd, &m->sp->node[m->sp->first[2]], 4 * sizeof *nd);
   nd[4] = (lw_node){nd[3].px + 3.0, nd[3].py, 1.0, 0.0};
-  lw_model_propose_splice(m, pr, 2, 1, nd, 5, 16.0);
+  lw_model_propose_splice(m, pr, 2, 1, nd, 5, 16.0, 0);
   cr_assert_eq(lw_model_commit(m, pr), LW_OK);
   cr_assert_eq(m->sp->n_splines, 21);
   cr_assert(lw_model_ghost(m, 2));
@@ -502,7 +527,7 @@ Test(transdim, deaths_leave_ghosts_that_births_fill)
   total_is_full(m, "after a grow");
   /* and two deaths, then the sweep's end */
   for (uint32_t j = 11; j <= 12; j++) {
-    lw_model_propose_splice(m, pr, j, 1, NULL, 0, 0.0);
+    lw_model_propose_splice(m, pr, j, 1, NULL, 0, 0.0, 0);
     cr_assert_eq(lw_model_commit(m, pr), LW_OK);
   }
   cr_assert_eq(lw_model_count(m), 18);
@@ -643,4 +668,48 @@ Test(transdim, hard_scales_keep_the_state_finite)
               h, run, full);
     td_chain_free(c, setup);
   }
+}
+
+/* With layers a spline's layer is a mark of the target with prior s_k, the
+** layers' shares (docs/NUMERICS.md, "Layers"): in the ideal gas each
+** layer's count is Poisson with mean s_k times the whole count's, so
+** N_0 - s_0 N has mean 0.  Two layers on a ramp picture, one inking the
+** whole range and one only its darker half, so s_0 is far from 1/2: a
+** birth that drew its layer uniformly gives a mean of (1/2 - s_0) E N,
+** more than 10 standard errors off (116 measured). */
+Test(transdim, ideal_gas_layers_take_their_shares)
+{
+  lw_image_dir_make();
+  lw_params p;
+  const double T = 1.0, lambda = 8.0;
+  ideal_gas(&p, -T * log(lambda));
+  p.splines = 8;
+  p.mix_birth = p.mix_death = 1;
+  enum { PW = 16 };
+  float g[PW * PW];
+  for (int j = 0; j < PW; j++)
+    for (int i = 0; i < PW; i++) g[j * PW + i] = (float)((i + 0.5) / PW);
+  snprintf(p.image, sizeof p.image, "%s", lw_test_path("ramp2.png"));
+  lw_test_png(p.image, PW, PW, g, NULL);
+  snprintf(p.ly_names, sizeof p.ly_names, "half all");
+  snprintf(p.ly_tone_max, sizeof p.ly_tone_max, "0.5 1");
+  void *setup;
+  lw_chain *c = td_chain(&p, T, 17, &setup);
+  const lw_model *m = lw_splines_model(c->sys);
+  const double s0 = m->scene->layers.cum[1];
+  cr_assert(fabs(s0 - 0.5) > 0.1, "the shares %g and %g cannot tell a uniform draw", s0, 1 - s0);
+  for (int k = 0; k < 500; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  batch_mean bm = {.per = (lw_test_long() ? 200000 : 20000) / BATCHES};
+  for (long s = 0; s < BATCHES * bm.per; s++) {
+    for (int k = 0; k < 2; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    double n0 = 0.0;
+    cr_assert_not_null(m->sp->layer);
+    for (size_t i = 0; i < m->sp->n_splines; i++) n0 += m->sp->layer[i] == 0;
+    bm_add(&bm, n0 - s0 * (double)m->sp->n_splines);
+  }
+  double se, mean = bm_mean(&bm, &se);
+  cr_assert(fabs(mean) < 5 * se, "N_0 - s_0 N: %g +- %g, expected 0 (s_0 = %g)", mean, se, s0);
+  cr_assert(fabs(0.5 - s0) * lambda > 10 * se, "a uniform layer draw would be within 10 standard errors");
+  td_chain_free(c, setup);
+  lw_image_dir_remove();
 }

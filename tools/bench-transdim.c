@@ -55,23 +55,23 @@ static void splice_measure(size_t n, int reps, splice_cost *out)
     memcpy(nodes, &m->sp->node[m->sp->first[j]], nn * sizeof *nodes);
     const double rest = m->sp->rest_length[j];
     double t0 = cpu_now();
-    lw_model_propose_splice(m, pr, j, 1, NULL, 0, 0.0);
+    lw_model_propose_splice(m, pr, j, 1, NULL, 0, 0.0, 0);
     double t1 = cpu_now();
     if (lw_model_commit(m, pr) != LW_OK) bench_die("death", &(lw_error){.code = LW_ENOMEM, .msg = "commit"});
     double t2 = cpu_now();
-    lw_model_propose_splice(m, pr, (uint32_t)m->sp->n_splines, 0, nodes, nn, rest);
+    lw_model_propose_splice(m, pr, (uint32_t)m->sp->n_splines, 0, nodes, nn, rest, 0);
     double t3 = cpu_now();
     if (lw_model_commit(m, pr) != LW_OK) bench_die("birth", &(lw_error){.code = LW_ENOMEM, .msg = "commit"});
     double t4 = cpu_now();
     /* a sweep's end: the ghost of a death that no birth filled */
     j = (uint32_t)gsl_rng_uniform_int(rng, m->sp->n_splines);
     memcpy(nodes, &m->sp->node[m->sp->first[j]], (m->sp->first[j + 1] - m->sp->first[j]) * sizeof *nodes);
-    lw_model_propose_splice(m, pr, j, 1, NULL, 0, 0.0);
+    lw_model_propose_splice(m, pr, j, 1, NULL, 0, 0.0, 0);
     if (lw_model_commit(m, pr) != LW_OK) bench_die("death", &(lw_error){.code = LW_ENOMEM, .msg = "commit"});
     double t5 = cpu_now();
     if (lw_model_compact(m) != LW_OK) bench_die("compact", &(lw_error){.code = LW_ENOMEM, .msg = "compact"});
     double t6 = cpu_now();
-    lw_model_propose_splice(m, pr, (uint32_t)m->sp->n_splines, 0, nodes, nn, rest);
+    lw_model_propose_splice(m, pr, (uint32_t)m->sp->n_splines, 0, nodes, nn, rest, 0);
     if (lw_model_commit(m, pr) != LW_OK) bench_die("birth", &(lw_error){.code = LW_ENOMEM, .msg = "commit"});
     t_prop[r] = 0.5 * ((t1 - t0) + (t3 - t2));
     t_death[r] = t2 - t1;

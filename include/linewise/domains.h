@@ -25,6 +25,11 @@
 ** order; while the chain tunes, its steps move once a phase (each cell
 ** takes them at the start of a phase).  Why this samples exp(-E/T):
 ** docs/NUMERICS.md, "Domains".
+**
+** The cells run only the kinds of the row's n_domain_moves (system.h), in
+** the proportions of their weights; kinds that draw their own object
+** anywhere (births and deaths) run after the phases, serially (mc.h;
+** docs/NUMERICS.md, "Trans-dimensional moves with domains").
 */
 #ifndef LINEWISE_DOMAINS_H
 #define LINEWISE_DOMAINS_H

@@ -10,10 +10,13 @@
 ** layer k with s_0 + .. + s_(k-1) <= x_i < s_0 + .. + s_k.  The sequence
 ** is evenly spread for every count, so each layer gets its share of any
 ** number of splines (to O(log n) splines), and a layer without ink gets
-** none.  Nothing is stored per spline: a state file needs no new data,
-** and a spline added at the end of the list finds its layer as well.  A
-** move that renumbered splines would move them between layers.  Layer k
-** is pen k + 1 of the drawing.
+** none.  With a fixed count nothing is stored per spline: a state file
+** needs no new data.  With trans-dimensional moves (moves.fixed_count = 0)
+** the layer is part of each spline's state (spline.h, sp->layer), set by
+** the index rule when the state is placed or loaded from a file without
+** it, drawn by the shares for a born spline (layer k with probability
+** s_k), kept by grow, shrink, compaction and renumbering, and saved in
+** state.lw (docs/FORMATS.md).  Layer k is pen k + 1 of the drawing.
 **
 ** What a layer changes: the terms that read the picture or the field read
 ** the layer's own (scene.h, lw_scene_layer_ctx):
@@ -65,6 +68,7 @@
 #include "linewise/image.h"
 #include "linewise/params.h"
 #include "linewise/plot.h"
+#include "linewise/spline.h"
 #include "linewise/tone.h"
 
 #define LW_LAYERS_MAX LW_PLOT_PENS_MAX
@@ -103,14 +107,28 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err);
 ** equal shares when there is no ink at all. */
 void lw_layers_share(lw_layers_spec *ls, const lw_image *const *target);
 
-/* The layer of spline i (ls->n > 0; see above). */
+/* The layer whose share holds u in [0, 1): a birth's layer for u uniform
+** (ls->n > 0). */
+static inline int lw_layers_at(const lw_layers_spec *ls, double u)
+{
+  int k = 0;
+  while (k < ls->n - 1 && u >= ls->cum[k + 1]) k++;
+  return k;
+}
+
+/* The layer of spline i by the index rule (ls->n > 0; see above). */
 static inline int lw_layers_of(const lw_layers_spec *ls, size_t i)
 {
   double x = (double)(i + 1) * 0.6180339887498949;
-  x -= floor(x);
-  int k = 0;
-  while (k < ls->n - 1 && x >= ls->cum[k + 1]) k++;
-  return k;
+  return lw_layers_at(ls, x - floor(x));
+}
+
+/* The layer of spline i of sp (ls->n > 0): stored with the spline where
+** splines are born and die (sp->layer, trans-dimensional moves), else the
+** index rule. */
+static inline int lw_splines_layer(const lw_layers_spec *ls, const lw_splines *sp, size_t i)
+{
+  return sp->layer ? sp->layer[i] : lw_layers_of(ls, i);
 }
 
 /* Separates n pixels of colour (r, g, b) into the k pens of colours rgb:

@@ -87,8 +87,10 @@ void lw_chain_tune(lw_chain *c);
 ** Boltzmann distribution stationary, and the two directions, equally
 ** likely, make the sweep reversible (docs/NUMERICS.md, "Sweep order").  A
 ** row without it draws each proposal's site at random.  A chain with
-** domains sweeps them instead (domains.h).  Then the row's sweep_end, if
-** any.  LW_ENOMEM if a commit could not grow the system's caches. */
+** domains sweeps them instead (domains.h), with the kinds they can run,
+** then the others (system.h, n_domain_moves) serially: their share of the
+** mix of sweep_size proposals.  Then the row's sweep_end, if any.
+** LW_ENOMEM if a commit could not grow the system's caches. */
 lw_status lw_chain_sweep(lw_chain *c);
 
 /* A generator's state as hex text (malloc'ed) and back, for checkpoints;

@@ -169,6 +169,7 @@ typedef struct {
   int splice, remove;
   size_t n_old_seg;
   double new_rest;            /* the new spline's rest length, mm */
+  int layer;                  /* the new spline's layer (layers.h; 0 without layers) */
   double log_ratio;           /* the Hastings factor of a trans-dimensional kind (system.h);
                               ** 0 for the symmetric ones */
 } lw_proposal;
@@ -188,7 +189,9 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
 ** Trans-dimensional proposals: replaces spline `at` (remove = 1) or inserts
 ** a spline (remove = 0; `at` is not read) by the n_new nodes
 ** `nodes` (NULL: already in p->node) with rest length `rest`, or by nothing
-** (n_new = 0, remove = 1: a death).  The new spline has n_new - 1 <=
+** (n_new = 0, remove = 1: a death).  An inserted spline is of layer
+** `layer` (layers.h; 0 without layers), a replacing one of the replaced
+** spline's (`layer` not read).  The new spline has n_new - 1 <=
 ** m->max_segments segments.  dE is the new spline's energy less the old
 ** one's: its segment and spline terms, its pair sums with every other
 ** spline (one walk over the new samples, +1, and the old ones, -1, the
@@ -200,7 +203,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
 ** end if there is none (slots.h): O(their segments), nothing else moves.
 */
 void lw_model_propose_splice(const lw_model *m, lw_proposal *p, uint32_t at, int remove, const lw_node *nodes,
-                             size_t n_new, double rest);
+                             size_t n_new, double rest, int layer);
 
 /* Applies an evaluated proposal (either kind).  LW_ENOMEM if the grid could
 ** not grow: for a move the model is as before; for a splice the caches are
@@ -230,6 +233,11 @@ int lw_segment_allowed(const lw_scene *sc, const lw_node *a, const lw_node *b, d
 ** read from files (init.from, resume, energy) are refused rather than
 ** started in a forbidden state. */
 lw_status lw_model_check_regular(const lw_scene *sc, const lw_splines *sp, const char *path, lw_error *err);
+
+/* Fits the layers stored with splines read from path (spline.h) to the
+** scene: dropped when it has no layers, else each checked against its
+** count (LW_EINPUT naming path, the spline and [layers] names). */
+lw_status lw_model_check_layers(const lw_scene *sc, lw_splines *sp, const char *path, lw_error *err);
 
 /* Energy of a state computed from scratch, one value per term (0 for terms
 ** that are off); returns the total, +inf if a segment is irregular. */

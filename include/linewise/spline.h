@@ -32,8 +32,10 @@ typedef struct {
   size_t *first;          /* n_splines + 1 node offsets; first[n_splines] = n_nodes */
   uint32_t *seg_spline;   /* n_segments: the spline of each segment */
   double *rest_length;    /* n_splines: L0, mm (> 0) */
+  uint8_t *layer;         /* n_splines: each spline's layer (layers.h) where splines are
+                             born and die in layers, or NULL: the index rule gives it */
   size_t cap_nodes;       /* room in node and seg_spline (lw_splines_append grows it) */
-  size_t cap_splines;     /* room in rest_length, and first (plus one) */
+  size_t cap_splines;     /* room in rest_length, layer, and first (plus one) */
 } lw_splines;
 
 /* Allocates n_splines splines with segments[i] >= 1 segments each; nodes are
@@ -50,10 +52,14 @@ lw_splines *lw_splines_clone(const lw_splines *sp);
 ** LW_ENOMEM leaves sp as it was. */
 lw_status lw_splines_permute(lw_splines *sp, const size_t *order, lw_error *err);
 
-/* Appends a spline of the n_new >= 2 nodes `nodes` and rest length `rest`:
-** amortised O(n_new) (trans-dimensional moves, model.h and slots.h).
-** LW_ENOMEM leaves sp as it was. */
-lw_status lw_splines_append(lw_splines *sp, const lw_node *nodes, size_t n_new, double rest);
+/* Appends a spline of the n_new >= 2 nodes `nodes`, rest length `rest`
+** and layer `layer` (not read when sp->layer is NULL): amortised O(n_new)
+** (trans-dimensional moves, model.h and slots.h).  LW_ENOMEM leaves sp as
+** it was. */
+lw_status lw_splines_append(lw_splines *sp, const lw_node *nodes, size_t n_new, double rest, int layer);
+
+/* Gives sp a layer array (zeroed) if it has none.  LW_ENOMEM: none. */
+lw_status lw_splines_layers_alloc(lw_splines *sp);
 
 /* Removes the splines i with dead[i] != 0, in place: the others keep their
 ** order and move down over the holes (the ghost slots of trans-dimensional

@@ -122,6 +122,15 @@ struct lw_system_type {
                        int *forbidden, const double box[4]);
   lw_status (*commit_part)(void *state, void *prop);
   lw_status (*merge)(void *state, void *prop);
+  /* With split: kinds 0 .. n_domain_moves-1 run inside the domains; the
+  ** others (for splines birth, death, grow, shrink, which draw their own
+  ** spline anywhere and change the storage) run serially from the chain's
+  ** stream after a sweep's phases, their share of the mix of sweep_size
+  ** proposals (mc.h).  0: every kind runs inside.  sites(): the sites a
+  ** domain sweep visits (NULL: sweep_size), for a row whose sweep_size is
+  ** a fixed count of proposals rather than its sites. */
+  int n_domain_moves;
+  size_t (*sites)(const void *state);
   /* Optional (NULL: every proposal is symmetric): the log of the last
   ** proposal's Hastings factor, log [q(x' -> x) / q(x -> x')] with the
   ** reference measures' change folded in; the chain then accepts with
