@@ -55,6 +55,11 @@ lw_status lw_splines_permute(lw_splines *sp, const size_t *order, lw_error *err)
 ** LW_ENOMEM leaves sp as it was. */
 lw_status lw_splines_append(lw_splines *sp, const lw_node *nodes, size_t n_new, double rest);
 
+/* Room for more_nodes more nodes in more_splines more splines, so that
+** the appends that follow cannot fail.  LW_ENOMEM leaves sp as it was
+** (only larger). */
+lw_status lw_splines_reserve(lw_splines *sp, size_t more_nodes, size_t more_splines);
+
 /* Removes the splines i with dead[i] != 0, in place: the others keep their
 ** order and move down over the holes (the ghost slots of trans-dimensional
 ** storage, slots.h).  O(nodes), no allocation. */
