@@ -26,7 +26,8 @@ static lw_chain *td_chain(lw_params *p, double T, unsigned long seed, void **set
   lw_error err = {0};
   p->fixed_count = 0;
   const lw_system_type *t = lw_system_of(p, &err);
-  cr_assert_eq(t, &lw_system_splines_td, "fixed_count = 0 selects the row with eight move kinds");
+  cr_assert_eq(t, p->mix_split > 0 || p->mix_join > 0 ? &lw_system_splines_tdj : &lw_system_splines_td,
+               "fixed_count = 0 selects the row with eight move kinds, ten with split or join");
   *setup = t->setup_new(p, &err);
   cr_assert_not_null(*setup, "%s", err.msg);
   lw_system *sys = lw_system_wrap(t, t->state_new(*setup, p, seed, &err), &err);
@@ -88,7 +89,7 @@ static double chisq_p(const unsigned long *counts, const double *prob, int n, un
   return gsl_cdf_chisq_Q(chi2, bins - 1);
 }
 
-#define NMAX 64
+#define NMAX 1024
 
 /* Sweeps the chain and tallies the spline count every `thin` sweeps, and
 ** each spline's segment count. */
@@ -643,4 +644,110 @@ Test(transdim, hard_scales_keep_the_state_finite)
               h, run, full);
     td_chain_free(c, setup);
   }
+}
+
+/* EXPERIMENT */
+Test(transdim, split_join_explore)
+{
+  lw_params p;
+  const double T = 1.0, lambda = atof(getenv("LAM") ? getenv("LAM") : "5");
+  ideal_gas(&p, -T * log(lambda));
+  p.width = p.height = atof(getenv("PAGE") ? getenv("PAGE") : "20");
+  p.margin = 0;
+  p.segment_length = atof(getenv("SL") ? getenv("SL") : "5");
+  p.splines = 12;
+  p.max_segments = atoi(getenv("KMAX") ? getenv("KMAX") : "5");
+  p.join_radius = atof(getenv("JR") ? getenv("JR") : "2");
+  p.mix_birth = p.mix_death = p.mix_grow = p.mix_shrink = getenv("ONLY") ? 0 : 0.5;
+  if (getenv("NSPL")) p.splines = atoi(getenv("NSPL"));
+  if (getenv("NSEG")) p.segments = atoi(getenv("NSEG"));
+  p.mix_split = p.mix_join = atof(getenv("SJ") ? getenv("SJ") : "1");
+  p.mix_point = p.mix_vector = p.mix_translate = p.mix_rotate = 0.5;
+  void *setup;
+  lw_chain *c = td_chain(&p, T, atol(getenv("SEED") ? getenv("SEED") : "13"), &setup);
+  unsigned long nc[NMAX] = {0}, sc[NMAX] = {0}, ns = 0;
+  tally(c, 500, 4, nc, sc, &ns);
+  memset(nc, 0, sizeof nc);
+  memset(sc, 0, sizeof sc);
+  ns = 0;
+  const long n = atol(getenv("NS") ? getenv("NS") : "5000");
+  tally(c, n, 4, nc, sc, &ns);
+  double mean = 0;
+  for (int k = 0; k < NMAX; k++) mean += k * (double)nc[k] / n;
+  fprintf(stderr, "mean N %g expected %g\n", mean, p.max_segments * lambda);
+  for (int k = 0; k < 40; k++) if (nc[k]) fprintf(stderr, "N %d: %lu\n", k, nc[k]);
+  for (int k = 1; k <= p.max_segments; k++) fprintf(stderr, "seg %d: %g\n", k, (double)sc[k] / ns);
+  for (int k = 0; k < c->n_moves; k++)
+    fprintf(stderr, "%s: %lu / %lu = %g\n", c->sys->type->move_names[k], c->stats[k].accepted, c->stats[k].proposed,
+            (double)c->stats[k].accepted / c->stats[k].proposed);
+  td_chain_free(c, setup);
+}
+
+/* DEBUG: measured join frequency vs the split's claim */
+Test(transdim, split_claims_the_join_frequency)
+{
+  lw_params p;
+  ideal_gas(&p, 0.0);
+  p.width = p.height = 8;
+  p.margin = 0;
+  p.segment_length = 1;
+  p.splines = 6;
+  p.segments = atoi(getenv("NSEG") ? getenv("NSEG") : "3");
+  p.max_segments = 8;
+  p.mix_split = p.mix_join = 1;
+  void *setup;
+  lw_chain *c = td_chain(&p, 1.0, 41, &setup);
+  const lw_system_type *t = c->sys->type;
+  lw_model *m = lw_splines_model(c->sys);
+  lw_proposal *pr = c->prop;
+  gsl_rng *rng = c->rng;
+  lw_td td;
+  lw_td_init(&td, m->scene, (size_t)p.segments, 1.0, 8, 0.1);
+  for (int trial = 0; trial < 6; trial++) {
+    int forb;
+    double lr;
+    do {
+      t->propose(c->sys->state, pr, LW_MOVE_SPLIT, 1.0, rng, &forb);
+      lr = pr->log_ratio;
+    } while (!pr->splice || !isfinite(lr));
+    const uint32_t j = pr->old[0];
+    const size_t n = lw_splines_segments(m->sp, j), N = lw_model_count(m);
+    lw_node J[16], F[16], B[16];
+    memcpy(J, &m->sp->node[m->sp->first[j]], (n + 1) * sizeof *J);
+    const size_t nf = pr->new_node[0], nb = pr->new_node[1];
+    memcpy(F, pr->node, nf * sizeof *F);
+    memcpy(B, pr->node + nf, nb * sizeof *B);
+    const double lq = lw_td_prior(&td, F, nf) + lw_td_prior(&td, B, nb) - lw_td_prior(&td, J, n + 1);
+    {
+      long sh = 0, SM = 400000;
+      lw_node keep[16];
+      memcpy(keep, pr->node, (nf + nb) * sizeof *keep);
+      const double lr_keep = lr;
+      for (long k = 0; k < SM; k++) {
+        t->propose(c->sys->state, pr, LW_MOVE_SPLIT, 1.0, rng, &forb);
+        if (pr->splice && pr->n_new == 2 && pr->old[0] == j && pr->new_node[0] == nf && !memcmp(pr->node, keep, (nf + nb) * sizeof *keep)) sh++;
+      }
+      fprintf(stderr, "split freq %g expected %g\n", (double)sh / SM, 1.0 / (N * (n - 2) * 3.0));
+      t->propose(c->sys->state, pr, LW_MOVE_SPLIT, 1.0, rng, &forb);
+      /* restore the proposal */
+      do t->propose(c->sys->state, pr, LW_MOVE_SPLIT, 1.0, rng, &forb);
+      while (!(pr->splice && pr->n_new == 2 && pr->old[0] == j && pr->new_node[0] == nf && !memcmp(pr->node, keep, (nf + nb) * sizeof *keep)));
+      cr_assert_eq(pr->log_ratio, lr_keep);
+    }
+    const double claim = lr - lq - log((double)N) - log((double)(n - 2)) - log(3.0);
+    cr_assert_eq(t->commit(c->sys->state, pr), LW_OK);
+    long hits = 0, M = 400000;
+    for (long k = 0; k < M; k++) {
+      t->propose(c->sys->state, pr, LW_MOVE_JOIN, 1.0, rng, &forb);
+      if (pr->splice && pr->n_new == 1 && pr->n_node == n + 1 && !memcmp(pr->node, J, (n + 1) * sizeof *J)) {
+        if (!hits) fprintf(stderr, "join lr %.12g vs -split lr %.12g\n", pr->log_ratio, -lr);
+        hits++;
+      }
+    }
+    fprintf(stderr, "n %zu N %zu: claimed P_join %g, measured %g +- %g\n", n, N, exp(claim), (double)hits / M,
+            sqrt((double)hits) / M);
+    cr_assert_eq(lw_model_compact(m), LW_OK);
+  }
+  lw_td_clear(&td);
+  td_chain_free(c, setup);
 }
