@@ -641,24 +641,32 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
 }
 
 /* A node drawn uniformly for a point or vector move, a spline for a rigid
-** one. */
+** one, among the live ones: drawn again while in a ghost (slots.h), an
+** exact uniform draw.  The row with split and join sweeps this way rather
+** than site by site (propose_at): there a site's node depends on where the
+** sweep's earlier splices left the splines, so which node a step updates
+** would depend on what the chain did before it in the sweep, and the
+** stationary law is lost (docs/NUMERICS.md, "Split and join": measured). */
 static double propose(void *state, void *prop, int kind, double st, gsl_rng *rng, int *forbidden)
 {
   spl_state *s = state;
   const lw_model *m = s->m;
   const lw_splines *sp = m->sp;
   if (kind >= LW_MOVE_KINDS) return propose_td(s, prop, kind, rng, forbidden);
-  if (sp->n_splines == 0) {
+  if (lw_model_count(m) == 0) {
     *forbidden = 0;
     return refuse(prop);
   }
   if (kind == LW_MOVE_POINT || kind == LW_MOVE_VECTOR) {
     size_t k;
-    do k = gsl_rng_uniform_int(rng, sp->n_nodes); while (lw_model_ghost(m, spline_of_node(sp, k)));
-    return propose_on(m, td_of(s), prop, kind, k, spline_of_node(sp, k), st, rng, forbidden, NULL);
+    uint32_t i;
+    do {
+      k = gsl_rng_uniform_int(rng, sp->n_nodes);
+      i = spline_of_node(sp, k);
+    } while (lw_model_ghost(m, i));
+    return propose_on(m, td_of(s), prop, kind, k, i, st, rng, forbidden, NULL);
   }
-  uint32_t i;
-  do i = (uint32_t)gsl_rng_uniform_int(rng, sp->n_splines); while (lw_model_ghost(m, i));
+  const uint32_t i = live_spline(m, rng);
   return propose_on(m, td_of(s), prop, kind, sp->first[i], i, st, rng, forbidden, NULL);
 }
 
