@@ -7,6 +7,7 @@
 #include <gsl/gsl_math.h>
 #include <gsl/gsl_randist.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -465,7 +466,8 @@ static double join_scan(const spl_state *s, const lw_node *en, int te, uint32_t 
 ** The log Hastings factor of splitting spline J (n segments, nodes jn) after
 ** segment c into F (nodes fp, c segments) and B (nodes bp, n - 1 - c), as
 ** they are in the state x after the split: r = 0 both as in J, 1 F run the
-** other way, 2 B.  n_with_j is the count with J.  The reverse, a join in x,
+** other way, 2 B.  n_x is the count of live splines in x, n_split the
+** count of those that may split in x' (with J).  The reverse, a join in x,
 ** reaches J from end e = F's tail (if F runs as in J) or e = B's head (if
 ** B does), each with probability 1/(2 N_x) times its weight over the sum
 ** Z_e of its partners' weights; both weights are the factor g(B_0 | F_c)
@@ -475,7 +477,8 @@ static double join_scan(const spl_state *s, const lw_node *en, int te, uint32_t 
 ** and B's own slots.  The join's factor is minus this one.
 */
 static double split_log_ratio(const spl_state *s, const lw_node *jn, size_t n, size_t c, int r, const lw_node *fp,
-                              const lw_node *bp, size_t n_with_j, uint32_t skip_f, uint32_t skip_b, int pieces_live)
+                              const lw_node *bp, size_t n_x, size_t n_split, uint32_t skip_f, uint32_t skip_b,
+                              int pieces_live)
 {
   const spl_setup *su = s->setup;
   const lw_td *td = &su->td;
@@ -491,29 +494,50 @@ static double split_log_ratio(const spl_state *s, const lw_node *jn, size_t n, s
     log_add(lg - join_scan(s, &bp[0], 0, skip_b, pieces_live ? NULL : ends, -1.0, 0.0, NULL, NULL), &mx, &sum);
   }
   const double lq = lw_td_prior(td, fp, c + 1) + lw_td_prior(td, bp, nb + 1) - lw_td_prior(td, jn, n + 1);
-  const double join = su->log_w[5] - log(2.0 * (double)(n_with_j + 1)) + mx + log(sum);
-  const double split = su->log_w[4] - log((double)n_with_j) - log((double)(n - 2)) - log(3.0);
+  const double join = su->log_w[5] - log(2.0 * (double)n_x) + mx + log(sum);
+  const double split = su->log_w[4] - log((double)n_split) - log((double)(n - 2)) - log(3.0);
   return lq + join - split;
 }
 
+/* 1 if spline i may split: 3 .. max_segments segments (each piece keeps
+** one, and a join could make it) and rest length n l (lw_td_plain). */
+static int splittable(const lw_td *td, const lw_splines *sp, uint32_t i)
+{
+  const size_t n = lw_splines_segments(sp, i);
+  return n >= 3 && n <= td->max_segments && lw_td_plain(td, n, sp->rest_length[i]);
+}
+
+/* How many live splines may split; with pick < that count, the pick-th of
+** them (in slot order) into *which.  O(N), as a join's partner scan. */
+static size_t count_splittable(const spl_state *s, size_t pick, uint32_t *which)
+{
+  const lw_model *m = s->m;
+  size_t count = 0;
+  for (uint32_t i = 0; i < m->sp->n_splines; i++) {
+    if (lw_model_ghost(m, i) || !splittable(&s->setup->td, m->sp, i)) continue;
+    if (count++ == pick) *which = i;
+  }
+  return count;
+}
+
 /*
-** A split removes inner segment c of a live spline of n >= 3 segments
-** (c = 1 .. n - 2 uniformly, so that each piece keeps one), and runs one
-** piece or none the other way (1/3 each): the nodes stay as they were, so
-** the dimension match is the identity and the Jacobian 1.  Refused where no
-** join could undo it: segment ends farther apart than the join radius, a
-** rest length other than n l, more than max_segments.
+** A split removes inner segment c of a spline drawn uniformly among those
+** that may split (c = 1 .. n - 2 uniformly, so that each piece keeps one),
+** and runs one piece or none the other way (1/3 each): the nodes stay as
+** they were, so the dimension match is the identity and the Jacobian 1.
+** Refused where no join could undo it: segment ends farther apart than the
+** join radius.
 */
 static double propose_split(spl_state *s, lw_proposal *p, gsl_rng *rng)
 {
   const lw_td *td = &s->setup->td;
   const lw_model *m = s->m;
   const lw_splines *sp = m->sp;
-  const size_t N = lw_model_count(m);
-  if (N == 0) return refuse(p);
-  const uint32_t j = live_spline(m, rng);
+  uint32_t j = 0;
+  const size_t n_split = count_splittable(s, SIZE_MAX, NULL);
+  if (n_split == 0) return refuse(p);
+  count_splittable(s, gsl_rng_uniform_int(rng, n_split), &j);
   const size_t n = lw_splines_segments(sp, j);
-  if (n < 3 || n > td->max_segments || !lw_td_plain(td, n, sp->rest_length[j])) return refuse(p);
   const size_t c = 1 + gsl_rng_uniform_int(rng, n - 2);
   const int r = (int)gsl_rng_uniform_int(rng, 3);
   const lw_node *src = &sp->node[sp->first[j]];
@@ -521,7 +545,7 @@ static double propose_split(spl_state *s, lw_proposal *p, gsl_rng *rng)
   lw_node *fp = p->node, *bp = p->node + c + 1;
   copy_nodes(fp, src, c + 1, r == 1);
   copy_nodes(bp, src + c + 1, n - c, r == 2);
-  const double lr = split_log_ratio(s, src, n, c, r, fp, bp, N, j, j, 0);
+  const double lr = split_log_ratio(s, src, n, c, r, fp, bp, lw_model_count(m) + 1, n_split, j, j, 0);
   const size_t nodes[2] = {c + 1, n - c};
   const double rest[2] = {(double)c * td->length, (double)(n - 1 - c) * td->length};
   lw_model_propose_regroup(m, p, &j, 1, NULL, nodes, 2, rest);
@@ -563,7 +587,10 @@ static double propose_join(spl_state *s, lw_proposal *p, gsl_rng *rng)
   copy_nodes(p->node, fp, c + 1, !te && y_turned);
   copy_nodes(p->node + c + 1, bp, n - c, te && y_turned);
   const int r = y_turned ? (te ? 2 : 1) : 0;
-  const double lr = -split_log_ratio(s, p->node, n, c, r, fp, bp, N - 1, f, b, 1);
+  /* the splines that may split after the join: F and B leave, J comes */
+  const size_t n_split = count_splittable(s, SIZE_MAX, NULL) - (size_t)splittable(td, sp, f) -
+                         (size_t)splittable(td, sp, b) + 1;
+  const double lr = -split_log_ratio(s, p->node, n, c, r, fp, bp, N, n_split, f, b, 1);
   const uint32_t old[2] = {x, y};
   const size_t nodes = n + 1;
   const double rest = (double)n * td->length;
