@@ -75,7 +75,7 @@ static lw_pair_sample sample_at(const pair_view *v, uint32_t i)
 static lw_pair_filter filter_of(const pair_view *v, uint32_t spline, uint32_t from)
 {
   size_t g0 = lw_segment_index(v->sp, spline, 0), n = lw_splines_segments(v->sp, spline);
-  return (lw_pair_filter){(uint32_t)(g0 * v->np), (uint32_t)((g0 + n) * v->np), from};
+  return (lw_pair_filter){.lo = (uint32_t)(g0 * v->np), .hi = (uint32_t)((g0 + n) * v->np), .from = from};
 }
 
 /* The Bezier control points of global segment g. */
@@ -678,9 +678,10 @@ static double pair_delta(const lw_model *m, lw_proposal *p, const lw_node *base,
 }
 
 /* How many pairs of one of the n samples ps and a sample of another spline
-** (an index outside [lo, hi)) are closer than sqrt(d2): the 3 x 3 cells
-** around each (cells are at least the cutoff >= min_spacing wide). */
-static size_t crowding(const lw_cellgrid *g, const lw_pair_sample *ps, size_t n, uint32_t lo, uint32_t hi, double d2)
+** (an index outside f's ranges [lo, hi) and [lo2, hi2)) are closer than
+** sqrt(d2): the 3 x 3 cells around each (cells are at least the cutoff >=
+** min_spacing wide). */
+static size_t crowding(const lw_cellgrid *g, const lw_pair_sample *ps, size_t n, const lw_pair_filter *f, double d2)
 {
   size_t count = 0;
   for (size_t k = 0; k < n; k++) {
@@ -693,7 +694,7 @@ static size_t crowding(const lw_cellgrid *g, const lw_pair_sample *ps, size_t n,
         const double *xs = c->x, *ys = lw_cell_y(c);
         const uint32_t *idx = lw_cell_idx(c);
         for (uint32_t e = 0; e < c->n; e++) {
-          if (idx[e] >= lo && idx[e] < hi) continue; /* its own spline */
+          if ((idx[e] >= f->lo && idx[e] < f->hi) || (idx[e] >= f->lo2 && idx[e] < f->hi2)) continue; /* its own */
           double dx = xs[e] - ps[k].x, dy = ys[e] - ps[k].y;
           count += dx * dx + dy * dy < d2;
         }
@@ -809,9 +810,10 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
     const size_t n = p->n_seg * (size_t)np;
     const uint32_t lo = (uint32_t)(g0 * (size_t)np), hi = (uint32_t)((g0 + nseg) * (size_t)np);
     const double d2 = sc->min_spacing * sc->min_spacing;
-    size_t now = crowding(m->grid, p->ps, n, lo, hi, d2);
+    const lw_pair_filter own = {.lo = lo, .hi = hi};
+    size_t now = crowding(m->grid, p->ps, n, &own, d2);
     /* the old side only when it matters: a move into free room is the rule */
-    if (now > 0 && now > crowding(m->grid, p->ps_old, n, lo, hi, d2)) {
+    if (now > 0 && now > crowding(m->grid, p->ps_old, n, &own, d2)) {
       p->crowded = 1;
       dE = INFINITY;
     }
@@ -925,11 +927,11 @@ lw_status lw_model_commit(lw_model *m, lw_proposal *p)
 }
 
 /* ---- trans-dimensional proposals (splices) --------------------------------
-** The spline replaced (its n_old_seg segments from global segment g0) and
-** the new one (p->n_seg segments from p->node) are whole splines: every
-** term is differenced over them alone, as lw_model_propose does over the
-** segments a move touches.  The walk's probes are the new samples (+1)
-** followed by the old ones (-1). */
+** The splines replaced (p->n_old, their samples from the grid) and the new
+** ones (p->n_new, from p->node) are whole splines: every term is differenced
+** over them alone, as lw_model_propose does over the segments a move
+** touches.  The walk's probes are the new samples (+1) followed by the old
+** ones (-1). */
 
 /* The sorted segments of the near pairs of probes [lo, lo + np). */
 static lw_status near_of_probes(const lw_proposal *p, uint32_t np, size_t lo, lw_near_list *segs)
@@ -944,8 +946,93 @@ static lw_status near_of_probes(const lw_proposal *p, uint32_t np, size_t lo, lw
   return LW_OK;
 }
 
-/* The pair part of a splice's dE (no coefficient); NAN if out of memory. */
-static double splice_pair_delta(const lw_model *m, lw_proposal *p, size_t g0)
+/* The node where new segment j of a splice starts: the new splines' nodes
+** lie one after the other, so a second spline's segments skip one node. */
+static size_t splice_seg_node(const lw_proposal *p, size_t j)
+{
+  return j + (p->n_new == 2 && j + 1 >= p->new_node[0]);
+}
+
+/* The old splines' sample ranges, in increasing order as the walk wants
+** them: what a splice's pair sums and spacing leave out. */
+static lw_pair_filter old_filter(const pair_view *v, const lw_proposal *p)
+{
+  if (!p->n_old) return (lw_pair_filter){0};
+  lw_pair_filter f = filter_of(v, p->old[0], 0);
+  if (p->n_old == 2) {
+    lw_pair_filter g = filter_of(v, p->old[1], 0);
+    if (g.lo < f.lo) {
+      const lw_pair_filter t = f;
+      f = g;
+      g = t;
+    }
+    f.lo2 = g.lo;
+    f.hi2 = g.hi;
+  }
+  return f;
+}
+
+/*
+** The pair energy (no coefficient) of spline a (na segments from the nodes
+** a, pair samples sa) with spline b, as the walk and the near field count
+** it together (pair.h): every far sample pair by the product rule, and the
+** near correction of every segment pair with a near sample pair.  The two
+** pieces of a split and the two halves of a join are not in the grid as
+** separate splines, so no walk sees their pairs.  O(na nb np^2): a splice's
+** own splines only.
+*/
+static double pair_between(const lw_pair_ctx *ctx, uint32_t np, const lw_node *a, const lw_pair_sample *sa, size_t na,
+                           const lw_node *b, const lw_pair_sample *sb, size_t nb)
+{
+  const double ic = ctx->inv_cutoff, rc2 = ctx->cutoff2;
+  const int with_near = ctx->near_scale > 0.0;
+  double far = 0.0, near = 0.0;
+  for (size_t i = 0; i < na; i++)
+    for (size_t j = 0; j < nb; j++) {
+      const lw_pair_sample *x = sa + i * np, *y = sb + j * np;
+      int is_near = 0;
+      for (uint32_t q = 0; q < np; q++)
+        for (uint32_t r = 0; r < np; r++) {
+          const double dx = x[q].x - y[r].x, dy = x[q].y - y[r].y, r2 = dx * dx + dy * dy;
+          if (with_near && r2 < lw_pair_near_radius2(ctx, x[q].dl, y[r].dl)) is_near = 1;
+          else if (r2 < rc2 && x[q].dl > 0.0f && y[r].dl > 0.0f)
+            far += (double)x[q].dl * (double)y[r].dl * (1.0 / sqrt(r2) - ic);
+        }
+      if (is_near) {
+        double ba[8], bb[8];
+        lw_segment_bezier(&a[i], &a[i + 1], ba);
+        lw_segment_bezier(&b[j], &b[j + 1], bb);
+        near += lw_pair_near_correction(ba, x, bb, y, (int)np, ctx);
+      }
+    }
+  return far + near;
+}
+
+/* How many pairs of a sample of a (na) and one of b (nb) are closer than
+** sqrt(d2): the spacing between a splice's two new or two old splines. */
+static size_t crowded_pairs(const lw_pair_sample *a, size_t na, const lw_pair_sample *b, size_t nb, double d2)
+{
+  size_t count = 0;
+  for (size_t i = 0; i < na; i++)
+    for (size_t j = 0; j < nb; j++) {
+      const double dx = a[i].x - b[j].x, dy = a[i].y - b[j].y;
+      count += dx * dx + dy * dy < d2;
+    }
+  return count;
+}
+
+/* The old nodes of old spline k of a splice. */
+static const lw_node *splice_old_nodes(const lw_model *m, const lw_proposal *p, int k)
+{
+  return &m->sp->node[m->sp->first[p->old[k]]];
+}
+
+/* The pair part of a splice's dE (no coefficient); NAN if out of memory.
+** With one old spline its near field comes from the cache as for a move;
+** with two (a join) each one's cached near field holds the other too, so
+** both are summed afresh from the walk, which leaves both out, and their
+** pair with each other is taken away whole. */
+static double splice_pair_delta(const lw_model *m, lw_proposal *p)
 {
   const lw_scene *sc = m->scene;
   const uint32_t np = (uint32_t)sc->pair_quad.n;
@@ -955,119 +1042,183 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p, size_t g0)
   for (size_t k = 0; k < no; k++)
     p->probe[nn + k] = (lw_pair_probe){p->ps_old[k].x, p->ps_old[k].y, p->ps_old[k].dl, -1.0};
   /* an inserted spline has no samples in the grid yet: nothing to leave out */
-  lw_pair_filter f = p->remove ? filter_of(&v, p->spline, 0) : (lw_pair_filter){0, 0, 0};
+  const lw_pair_filter f = old_filter(&v, p);
   double pe;
   p->near.n = 0;
   p->partners.n = 0;
   if (lw_pair_walk(m->grid, &sc->pair, p->probe, nn + no, &f, &pe, &p->near, NULL) != LW_OK) return NAN;
   for (size_t j = 0; j < p->n_seg; j++) {
     double bez[8];
+    const size_t a = splice_seg_node(p, j);
     if (near_of_probes(p, np, j * np, &p->segs) != LW_OK) return NAN;
-    lw_segment_bezier(&p->node[j], &p->node[j + 1], bez);
+    lw_segment_bezier(&p->node[a], &p->node[a + 1], bez);
     p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs);
     pe += p->near_new[j];
     if (add_partners(p) != LW_OK) return NAN;
   }
-  for (size_t j = 0; j < p->n_old_seg; j++) {
-    const size_t g = g0 + j;
-    if (near_of_probes(p, np, nn + j * np, &p->segs) != LW_OK) return NAN;
-    pe -= old_near(m, &v, g, &m->sp->node[lw_segment_node(m->sp, g)], p->ps_old + j * np, &p->segs);
-    if (add_partners(p) != LW_OK) return NAN;
+  for (int k = 0, o = 0; k < p->n_old; k++) {
+    const size_t g0 = lw_segment_index(m->sp, p->old[k], 0);
+    const lw_node *nd = splice_old_nodes(m, p, k);
+    for (size_t j = 0; j < p->old_seg[k]; j++, o++) {
+      const lw_pair_sample *ps = p->ps_old + (size_t)o * np;
+      if (near_of_probes(p, np, nn + (size_t)o * np, &p->segs) != LW_OK) return NAN;
+      if (p->n_old == 1) {
+        pe -= old_near(m, &v, g0 + j, &nd[j], ps, &p->segs);
+      } else {
+        double bez[8];
+        lw_segment_bezier(&nd[j], &nd[j + 1], bez);
+        pe -= near_part(&v, bez, ps, &p->segs);
+      }
+      if (add_partners(p) != LW_OK) return NAN;
+    }
   }
+  if (p->n_new == 2) {
+    const size_t n0 = p->new_node[0] - 1;
+    pe += pair_between(v.ctx, np, p->node, p->ps, n0, p->node + n0 + 1, p->ps + n0 * np, p->new_node[1] - 1);
+  }
+  if (p->n_old == 2)
+    pe -= pair_between(v.ctx, np, splice_old_nodes(m, p, 0), p->ps_old, p->old_seg[0], splice_old_nodes(m, p, 1),
+                       p->ps_old + p->old_seg[0] * np, p->old_seg[1]);
   return pe;
 }
 
 /* A raster term's part of a splice's dE (no coefficient); NAN if the box
 ** cannot grow. */
-static double splice_raster_delta(const lw_model *m, lw_proposal *p, int t, const lw_node *old)
+static double splice_raster_delta(const lw_model *m, lw_proposal *p, int t)
 {
   const lw_term_ctx *c = &ctx_in(&m->terms, p->layer)[t];
   lw_tone_box *b = &p->box[t];
   lw_tone_box_reset(b);
-  for (size_t j = 0; j < p->n_old_seg; j++) raster_cover(c->data, b, &old[j], &old[j + 1]);
-  for (size_t j = 0; j < p->n_seg; j++) raster_cover(c->data, b, &p->node[j], &p->node[j + 1]);
+  for (int k = 0; k < p->n_old; k++)
+    for (size_t j = 0; j < p->old_seg[k]; j++) raster_cover(c->data, b, &splice_old_nodes(m, p, k)[j], &splice_old_nodes(m, p, k)[j + 1]);
+  for (size_t j = 0; j < p->n_seg; j++) {
+    const size_t a = splice_seg_node(p, j);
+    raster_cover(c->data, b, &p->node[a], &p->node[a + 1]);
+  }
   if (lw_tone_box_ready(b) != LW_OK) return NAN;
-  for (size_t j = 0; j < p->n_old_seg; j++) raster_segment(c, b, &old[j], &old[j + 1], -1);
-  for (size_t j = 0; j < p->n_seg; j++) raster_segment(c, b, &p->node[j], &p->node[j + 1], 1);
+  for (int k = 0; k < p->n_old; k++)
+    for (size_t j = 0; j < p->old_seg[k]; j++)
+      raster_segment(c, b, &splice_old_nodes(m, p, k)[j], &splice_old_nodes(m, p, k)[j + 1], -1);
+  for (size_t j = 0; j < p->n_seg; j++) {
+    const size_t a = splice_seg_node(p, j);
+    raster_segment(c, b, &p->node[a], &p->node[a + 1], 1);
+  }
   return lw_tone_delta(c->data, m->raster[t] + plane_in(p->layer, c->data), b);
 }
 
-void lw_model_propose_splice(const lw_model *m, lw_proposal *p, uint32_t at, int remove, const lw_node *nodes,
-                             size_t n_new, double rest, int layer)
+/* The new splines' segments: their caches in p and their share of dterm;
+** sets *forbidden and *undefined as lw_model_propose does. */
+static void splice_new_segments(const lw_model *m, lw_proposal *p, int *forbidden, int *undefined)
+{
+  const lw_scene *sc = m->scene;
+  const lw_term_set *ts = &m->terms;
+  const lw_term_ctx *pc = ts->pair >= 0 ? &ts->ctx[ts->pair] : NULL;
+  const int np = pair_nodes(m), nl = sc->n_local;
+  lw_samples s;
+  p->irregular = 0;
+  for (int k = 0, j = 0, a = 0; k < p->n_new; a += (int)p->new_node[k++]) {
+    double L = 0.0;
+    for (size_t i = 0; i + 1 < p->new_node[k]; i++, j++) {
+      double *local = p->local + (size_t)j * (size_t)nl;
+      p->seg_irregular[j] = !segment_eval(sc, ctx_in(ts, p->layer), &p->node[(size_t)a + i], &p->node[(size_t)a + i + 1], &s,
+                                          &p->len[j], local, pc ? pc->quad : NULL,
+                                          m->grid ? p->ps + (size_t)j * (size_t)np : NULL);
+      p->irregular |= p->seg_irregular[j];
+      for (int t = 0; t < nl; t++) {
+        p->dterm[sc->local[t]] += local[t];
+        if (local[t] == INFINITY) *forbidden = 1;
+        else if (isnan(local[t])) *undefined = 1;
+      }
+      if (isnan(p->len[j])) *undefined = 1;
+      L += p->len[j];
+    }
+    p->new_len[k] = L;
+  }
+}
+
+void lw_model_propose_regroup(const lw_model *m, lw_proposal *p, const uint32_t *old, int n_old,
+                              const lw_node *nodes, const size_t *new_node, int n_new, const double *rest,
+                              int layer)
 {
   const lw_scene *sc = m->scene;
   const lw_splines *sp = m->sp;
   const lw_term_set *ts = &m->terms;
   const lw_term_ctx *pc = ts->pair >= 0 ? &ts->ctx[ts->pair] : NULL;
   const int np = pair_nodes(m), nl = sc->n_local;
-  if (!remove) at = (uint32_t)sp->n_splines; /* where the commit puts it is its own choice */
-  const size_t g0 = lw_segment_index(sp, at, 0), no = remove ? lw_splines_segments(sp, at) : 0;
-  const lw_node *old = remove ? &sp->node[sp->first[at]] : NULL;
 
   p->splice = 1;
-  p->remove = remove;
-  p->spline = at;
+  p->n_old = n_old;
+  p->n_new = n_new;
+  p->spline = n_old ? old[0] : (uint32_t)sp->n_splines;
   p->node0 = p->seg0 = 0;
-  p->n_node = n_new;
-  p->n_seg = n_new ? n_new - 1 : 0;
-  p->n_old_seg = no;
-  p->new_rest = rest;
-  /* a replaced spline's successor stays in its layer: one plane of each raster changes */
-  p->layer = remove ? layer_of(ts, sp, at) : layer;
-  if (nodes && nodes != p->node) memcpy(p->node, nodes, n_new * sizeof *nodes);
+  p->n_node = p->n_seg = p->n_old_seg = 0;
+  for (int k = 0; k < n_old; k++) {
+    p->old[k] = old[k];
+    p->old_seg[k] = lw_splines_segments(sp, old[k]);
+    p->n_old_seg += p->old_seg[k];
+  }
+  for (int k = 0; k < n_new; k++) {
+    p->new_node[k] = new_node[k];
+    p->new_rest[k] = rest[k];
+    p->n_node += new_node[k];
+    p->n_seg += new_node[k] - 1;
+  }
+  /* every spline of a splice is of one layer (a split's pieces keep the
+  ** cut spline's, a join links splines of one layer, sys_splines.c), so one
+  ** plane of each raster changes */
+  p->layer = n_old ? layer_of(ts, sp, old[0]) : layer;
+  if (nodes && nodes != p->node) memcpy(p->node, nodes, p->n_node * sizeof *nodes);
   for (int t = 0; t < LW_TERM_COUNT; t++) p->dterm[t] = 0.0;
 
-  lw_samples s;
   int forbidden = 0, undefined = 0, was_irregular = 0;
-  double L = 0.0;
-  p->irregular = 0;
-  for (size_t j = 0; j < p->n_seg; j++) {
-    double *local = p->local + j * (size_t)nl;
-    p->seg_irregular[j] = !segment_eval(sc, ctx_in(ts, p->layer), &p->node[j], &p->node[j + 1], &s, &p->len[j], local,
-                                        pc ? pc->quad : NULL, m->grid ? p->ps + j * (size_t)np : NULL);
-    p->irregular |= p->seg_irregular[j];
-    for (int t = 0; t < nl; t++) {
-      p->dterm[sc->local[t]] += local[t];
-      if (local[t] == INFINITY) forbidden = 1;
-      else if (isnan(local[t])) undefined = 1;
+  splice_new_segments(m, p, &forbidden, &undefined);
+  for (int k = 0; k < n_old; k++) {
+    const size_t g0 = lw_segment_index(sp, old[k], 0);
+    for (size_t j = 0; j < p->old_seg[k]; j++) {
+      const double *ol = m->seg_local + (g0 + j) * (size_t)nl;
+      for (int t = 0; t < nl; t++) p->dterm[sc->local[t]] -= ol[t];
+      was_irregular |= m->seg_irregular[g0 + j];
     }
-    if (isnan(p->len[j])) undefined = 1;
-    L += p->len[j];
   }
-  for (size_t j = 0; j < no; j++) {
-    const double *ol = m->seg_local + (g0 + j) * (size_t)nl;
-    for (int t = 0; t < nl; t++) p->dterm[sc->local[t]] -= ol[t];
-    was_irregular |= m->seg_irregular[g0 + j];
-  }
-  p->new_spline_len = L;
-  for (int k = 0; k < ts->n_spline; k++) {
-    const int t = ts->spline[k];
+  for (int q = 0; q < ts->n_spline; q++) {
+    const int t = ts->spline[q];
     const lw_term_ctx *c = &ts->ctx[t];
     double (*fn)(const double *, size_t, double, double, const lw_term_ctx *) = lw_term_types[t].spline;
-    if (p->n_seg) p->dterm[t] += c->coef * fn(p->len, p->n_seg, L, rest, c);
-    if (no) p->dterm[t] -= c->coef * fn(m->seg_len + g0, no, m->spline_len[at], sp->rest_length[at], c);
+    for (int k = 0, j = 0; k < n_new; j += (int)new_node[k++] - 1)
+      p->dterm[t] += c->coef * fn(p->len + j, new_node[k] - 1, p->new_len[k], rest[k], c);
+    for (int k = 0; k < n_old; k++)
+      p->dterm[t] -= c->coef * fn(m->seg_len + lw_segment_index(sp, old[k], 0), p->old_seg[k], m->spline_len[old[k]],
+                                  sp->rest_length[old[k]], c);
   }
   double dE = 0.0;
   for (int t = 0; t < LW_TERM_COUNT; t++) dE += p->dterm[t];
   if ((forbidden || p->irregular) && !undefined) dE = INFINITY;
   else if (was_irregular && !undefined) dE = -INFINITY;
   p->pair_done = 0;
-  if (m->grid) {
-    pair_view v = {m->grid, sp, (uint32_t)np, pair_ctx(pc)};
-    for (size_t k = 0; k < no * (size_t)np; k++) p->ps_old[k] = sample_at(&v, (uint32_t)(g0 * (size_t)np + k));
-  }
+  const pair_view v = {m->grid, sp, (uint32_t)np, pc ? pair_ctx(pc) : NULL};
+  if (m->grid)
+    for (int k = 0, o = 0; k < n_old; k++) {
+      const size_t first = lw_segment_index(sp, old[k], 0) * (size_t)np;
+      for (size_t i = 0; i < p->old_seg[k] * (size_t)np; i++) p->ps_old[o++] = sample_at(&v, (uint32_t)(first + i));
+    }
   p->crowded = 0;
   if (sc->min_spacing > 0.0 && p->n_seg && !(dE == INFINITY) && !isnan(dE)) {
-    const uint32_t lo = (uint32_t)(g0 * (size_t)np), hi = (uint32_t)((g0 + no) * (size_t)np);
+    const lw_pair_filter own = old_filter(&v, p);
     const double d2 = sc->min_spacing * sc->min_spacing;
-    size_t now = crowding(m->grid, p->ps, p->n_seg * (size_t)np, lo, hi, d2);
-    if (now > 0 && now > crowding(m->grid, p->ps_old, no * (size_t)np, lo, hi, d2)) {
-      p->crowded = 1;
-      dE = INFINITY;
+    const size_t n0 = n_new == 2 ? (new_node[0] - 1) * (size_t)np : 0, o0 = n_old == 2 ? p->old_seg[0] * (size_t)np : 0;
+    size_t now = crowding(m->grid, p->ps, p->n_seg * (size_t)np, &own, d2);
+    if (n0) now += crowded_pairs(p->ps, n0, p->ps + n0, p->n_seg * (size_t)np - n0, d2);
+    if (now > 0) {
+      size_t before = crowding(m->grid, p->ps_old, p->n_old_seg * (size_t)np, &own, d2);
+      if (o0) before += crowded_pairs(p->ps_old, o0, p->ps_old + o0, p->n_old_seg * (size_t)np - o0, d2);
+      if (now > before) {
+        p->crowded = 1;
+        dE = INFINITY;
+      }
     }
   }
   if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
-    double pe = splice_pair_delta(m, p, g0);
+    double pe = splice_pair_delta(m, p);
     p->pair_done = !isnan(pe);
     p->dterm[ts->pair] = pc->coef * pe;
     dE += p->dterm[ts->pair];
@@ -1076,12 +1227,18 @@ void lw_model_propose_splice(const lw_model *m, lw_proposal *p, uint32_t at, int
   if (ts->n_raster && !(dE == INFINITY) && !isnan(dE)) {
     for (int k = 0; k < ts->n_raster; k++) {
       const int t = ts->raster[k];
-      p->dterm[t] = ts->ctx[t].coef * splice_raster_delta(m, p, t, old);
+      p->dterm[t] = ts->ctx[t].coef * splice_raster_delta(m, p, t);
       dE += p->dterm[t];
     }
     p->raster_done = !isnan(dE);
   }
   p->dE = dE;
+}
+
+void lw_model_propose_splice(const lw_model *m, lw_proposal *p, uint32_t at, int remove, const lw_node *nodes,
+                             size_t n_new, double rest, int layer)
+{
+  lw_model_propose_regroup(m, p, &at, remove != 0, nodes, &n_new, n_new > 0, &rest, layer);
 }
 
 /* Room for n elements of size sz in *a (cap elements now); 0 if out of
@@ -1121,34 +1278,47 @@ static lw_status cache_room(lw_model *m, size_t n_seg, size_t n_spl)
 }
 
 /*
-** A splice commits in O(the segments of the two splines): the replaced
-** spline becomes a ghost where it is (its samples leave the grid, its
-** caches are zeroed so that nothing counts it), and the new one takes a
-** ghost slot of its segment count in place, or is appended (slots.h).  No
-** other index moves, so the grid's keys and every cached near field of
-** the splines not involved stay as they were.
+** A splice commits in O(the segments of its splines): each replaced spline
+** becomes a ghost where it is (its samples leave the grid, its caches are
+** zeroed so that nothing counts it), and each new one takes a ghost slot of
+** its segment count in place, or is appended (slots.h).  No other index
+** moves, so the grid's keys and every cached near field of the splines not
+** involved stay as they were.  An old and a new spline never have the same
+** segment count (no move makes one), so a new one never takes a slot that
+** the same splice left.  The near fields of two new splines (a split) hold
+** each other, which the walk did not see: they are left to be recomputed.
 */
 static lw_status commit_splice(lw_model *m, const lw_proposal *p)
 {
   lw_splines *sp = m->sp;
   const int np = pair_nodes(m), nl = m->scene->n_local;
-  const size_t at = p->spline, nn = p->n_seg, no = p->n_old_seg;
-  const long hole = nn ? lw_slots_peek(m->slots, nn) : -1;
-  const int append = nn && hole < 0;
-  const size_t n_seg = sp->n_segments + (append ? nn : 0), n_spl = sp->n_splines + (size_t)append;
+  long slot[2] = {-1, -1};
+  size_t n_append = 0, append_nodes = 0;
+  for (int k = 0; k < p->n_new; k++) {
+    /* a second new spline of the first's count takes the ghost below its */
+    slot[k] = lw_slots_peek(m->slots, p->new_node[k] - 1, k == 1 && p->new_node[0] == p->new_node[1]);
+    if (slot[k] < 0) {
+      n_append++;
+      append_nodes += p->new_node[k];
+    }
+  }
+  const size_t n_seg = sp->n_segments + append_nodes - n_append, n_spl = sp->n_splines + n_append;
   /* every allocation first, so that running out of memory leaves the model as it was */
   if ((uint64_t)n_seg * (uint64_t)np >= UINT32_MAX) return LW_ENOMEM; /* the grid's sample indices */
   if (cache_room(m, n_seg, n_spl) != LW_OK) return LW_ENOMEM;
-  if (p->remove && lw_slots_reserve(m->slots, n_spl, no) != LW_OK) return LW_ENOMEM;
+  for (int k = 0; k < p->n_old; k++)
+    if (lw_slots_reserve(m->slots, n_spl, p->old_seg[k], (size_t)p->n_old) != LW_OK) return LW_ENOMEM;
   if (m->grid && lw_cellgrid_reserve(m->grid, n_seg * (size_t)np) != LW_OK) return LW_ENOMEM;
-  if (append && lw_splines_append(sp, p->node, p->n_node, p->new_rest, p->layer) != LW_OK)
-    return LW_ENOMEM;
+  if (n_append && lw_splines_reserve(sp, append_nodes, n_append) != LW_OK) return LW_ENOMEM;
+  size_t appended = sp->n_splines;
+  for (int k = 0, a = 0; k < p->n_new; a += (int)p->new_node[k++])
+    if (slot[k] < 0) (void)lw_splines_append(sp, p->node + a, p->new_node[k], p->new_rest[k], p->layer); /* reserved */
   /* the near fields the splice changes */
   if (m->grid && p->pair_done)
     for (size_t k = 0; k < p->partners.n; k++) m->near_valid[p->partners.idx[k]] = 0;
 
-  if (p->remove) {
-    const size_t g0 = lw_segment_index(sp, at, 0);
+  for (int k = 0; k < p->n_old; k++) {
+    const size_t at = p->old[k], no = p->old_seg[k], g0 = lw_segment_index(sp, at, 0);
     for (size_t j = 0; j < no; j++) {
       m->n_irregular -= m->seg_irregular[g0 + j];
       m->seg_irregular[g0 + j] = 0;
@@ -1157,32 +1327,33 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
       if (m->grid) m->near_valid[g0 + j] = 0;
     }
     m->spline_len[at] = 0.0;
-    for (size_t k = 0; m->grid && k < no * (size_t)np; k++) lw_cellgrid_remove(m->grid, (uint32_t)(g0 * (size_t)np + k));
+    for (size_t i = 0; m->grid && i < no * (size_t)np; i++) lw_cellgrid_remove(m->grid, (uint32_t)(g0 * (size_t)np + i));
     lw_slots_kill(m->slots, at, no);
   }
   lw_status st = LW_OK;
-  if (nn) {
-    const size_t s = append ? sp->n_splines - 1 : (size_t)hole;
-    if (!append) {
+  for (int k = 0, a = 0, j0 = 0; k < p->n_new; j0 += (int)p->new_node[k] - 1, a += (int)p->new_node[k++]) {
+    const size_t nn = p->new_node[k] - 1, s = slot[k] >= 0 ? (size_t)slot[k] : appended++;
+    if (slot[k] >= 0) {
       lw_slots_take(m->slots, nn);
-      memcpy(&sp->node[sp->first[s]], p->node, p->n_node * sizeof *p->node);
-      sp->rest_length[s] = p->new_rest;
+      memcpy(&sp->node[sp->first[s]], p->node + a, p->new_node[k] * sizeof *p->node);
+      sp->rest_length[s] = p->new_rest[k];
       if (sp->layer) sp->layer[s] = (uint8_t)p->layer;
     }
     const size_t g0 = lw_segment_index(sp, s, 0);
-    memcpy(m->seg_len + g0, p->len, nn * sizeof *p->len);
-    memcpy(m->seg_local + g0 * (size_t)nl, p->local, nn * (size_t)nl * sizeof *p->local);
-    memcpy(m->seg_irregular + g0, p->seg_irregular, nn * sizeof *p->seg_irregular);
-    for (size_t j = 0; j < nn; j++) m->n_irregular += p->seg_irregular[j];
-    m->spline_len[s] = p->new_spline_len;
+    memcpy(m->seg_len + g0, p->len + j0, nn * sizeof *p->len);
+    memcpy(m->seg_local + g0 * (size_t)nl, p->local + (size_t)j0 * (size_t)nl, nn * (size_t)nl * sizeof *p->local);
+    memcpy(m->seg_irregular + g0, p->seg_irregular + j0, nn * sizeof *p->seg_irregular);
+    for (size_t j = 0; j < nn; j++) m->n_irregular += p->seg_irregular[j0 + j];
+    m->spline_len[s] = p->new_len[k];
     if (nn > m->max_segments) m->max_segments = nn;
     if (m->grid) {
       for (size_t j = 0; j < nn; j++) {
-        m->near_cache[g0 + j] = p->near_new[j];
-        m->near_valid[g0 + j] = (uint8_t)p->pair_done;
+        m->near_cache[g0 + j] = p->near_new[j0 + j];
+        m->near_valid[g0 + j] = (uint8_t)(p->pair_done && p->n_new == 1);
       }
-      if (append) lw_cellgrid_extend(m->grid, nn * (size_t)np);
-      for (size_t j = 0; j < nn && st == LW_OK; j++) st = store_samples(m->grid, g0 + j, np, p->ps + j * (size_t)np);
+      if (slot[k] < 0) lw_cellgrid_extend(m->grid, nn * (size_t)np);
+      for (size_t j = 0; j < nn && st == LW_OK; j++)
+        st = store_samples(m->grid, g0 + j, np, p->ps + ((size_t)j0 + j) * (size_t)np);
     }
   }
   if (m->grid && !p->pair_done) memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);

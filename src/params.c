@@ -253,6 +253,17 @@ const lw_param_def lw_param_table[] = {
   NUM("moves", "max_segments", LW_PT_INT, max_segments, "16", "", 1, 1e5, 0,
       "Grow never makes a spline longer than this many segments (fixed_count = 0); shrink never "
       "below one."),
+  NUM("moves", "split", LW_PT_DOUBLE, mix_split, "0", "", 0, 1e6, 0,
+      "Relative frequency of splits: an inner segment of a spline of 3 or more segments removed, "
+      "leaving two splines with the nodes as they were (fixed_count = 0; 0 = none)."),
+  NUM("moves", "join", LW_PT_DOUBLE, mix_join, "0", "", 0, 1e6, 0,
+      "Relative frequency of joins: an end of a spline and an end of another within join_radius "
+      "linked by a new segment, one of the two reversed where their directions disagree; the "
+      "partner is drawn by how well the new segment continues the first (fixed_count = 0; "
+      "0 = none)."),
+  NUM("moves", "join_radius", LW_PT_DOUBLE, join_radius, "2", "segment lengths", 0, 1e3, LW_MIN_OPEN,
+      "Ends at most this far apart may join, in units of init.segment_length (a joined "
+      "segment is about one long); a split cuts only segments whose end points are this close."),
   STRING("anneal", "schedule", schedule, "geometric", "",
          "Temperature schedule: constant, linear, geometric, logarithmic, adaptive or table "
          "(formulas in docs/SCHEDULES.md)."),

@@ -18,7 +18,7 @@ void lw_slots_free(lw_slots *s)
   free(s);
 }
 
-lw_status lw_slots_reserve(lw_slots *s, size_t n_slots, size_t n_seg)
+lw_status lw_slots_reserve(lw_slots *s, size_t n_slots, size_t n_seg, size_t more)
 {
   if (n_slots > s->cap) {
     size_t c = s->cap + s->cap / 2 + 64;
@@ -37,8 +37,9 @@ lw_status lw_slots_reserve(lw_slots *s, size_t n_slots, size_t n_seg)
     s->n_free = n_seg + 1;
   }
   lw_slot_stack *st = &s->free[n_seg];
-  if (st->n == st->cap) {
+  if (st->n + more > st->cap) {
     size_t c = st->cap ? 2 * st->cap : 16;
+    if (c < st->n + more) c = st->n + more;
     uint32_t *v = realloc(st->slot, c * sizeof *v);
     if (!v) return LW_ENOMEM;
     st->slot = v;
@@ -55,11 +56,11 @@ void lw_slots_kill(lw_slots *s, size_t i, size_t n_seg)
   st->slot[st->n++] = (uint32_t)i;
 }
 
-long lw_slots_peek(const lw_slots *s, size_t n_seg)
+long lw_slots_peek(const lw_slots *s, size_t n_seg, size_t depth)
 {
-  if (!s || n_seg >= s->n_free || !s->free[n_seg].n) return -1;
+  if (!s || n_seg >= s->n_free || s->free[n_seg].n <= depth) return -1;
   const lw_slot_stack *st = &s->free[n_seg];
-  return (long)st->slot[st->n - 1];
+  return (long)st->slot[st->n - 1 - depth];
 }
 
 void lw_slots_take(lw_slots *s, size_t n_seg)

@@ -116,11 +116,10 @@ lw_status lw_splines_layers_alloc(lw_splines *sp)
   return sp->layer ? LW_OK : LW_ENOMEM;
 }
 
-lw_status lw_splines_append(lw_splines *sp, const lw_node *nodes, size_t n_new, double rest, int layer)
+lw_status lw_splines_reserve(lw_splines *sp, size_t more_nodes, size_t more_splines)
 {
-  const size_t n_nodes = sp->n_nodes + n_new, n_splines = sp->n_splines + 1;
-  /* all growth first, so that a failure leaves sp as it was; an array that
-  ** grew while its partner failed is only larger than its cap says */
+  const size_t n_nodes = sp->n_nodes + more_nodes, n_splines = sp->n_splines + more_splines;
+  /* an array that grew while its partner failed is only larger than its cap says */
   if (n_nodes > sp->cap_nodes) {
     size_t c = grown(sp->cap_nodes, n_nodes);
     lw_node *nd = realloc(sp->node, c * sizeof *nd);
@@ -146,6 +145,14 @@ lw_status lw_splines_append(lw_splines *sp, const lw_node *nodes, size_t n_new, 
     }
     sp->cap_splines = c;
   }
+  return LW_OK;
+}
+
+lw_status lw_splines_append(lw_splines *sp, const lw_node *nodes, size_t n_new, double rest, int layer)
+{
+  const size_t n_nodes = sp->n_nodes + n_new, n_splines = sp->n_splines + 1;
+  /* all growth first, so that a failure leaves sp as it was */
+  if (lw_splines_reserve(sp, n_new, 1) != LW_OK) return LW_ENOMEM;
   memcpy(sp->node + sp->n_nodes, nodes, n_new * sizeof *nodes);
   for (size_t g = sp->n_segments; g < sp->n_segments + n_new - 1; g++) sp->seg_spline[g] = (uint32_t)sp->n_splines;
   sp->rest_length[sp->n_splines] = rest;

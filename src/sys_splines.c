@@ -7,6 +7,7 @@
 #include <gsl/gsl_math.h>
 #include <gsl/gsl_randist.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -20,18 +21,19 @@
 #include "linewise/transdim.h"
 
 const char *const lw_move_names[LW_MOVE_KINDS] = {"point", "vector", "translate", "rotate"};
-static const char *const move_names_td[LW_MOVE_KINDS_TD] = {"point", "vector", "translate", "rotate",
-                                                            "birth", "death", "grow", "shrink"};
+static const char *const move_names_td[LW_MOVE_KINDS_TDJ] = {"point", "vector", "translate", "rotate", "birth",
+                                                             "death", "grow",  "shrink", "split",  "join"};
 /* steps are kept in mm and radians; [moves] step_rotate is in degrees; the
 ** trans-dimensional kinds have no step (their proposals are transdim.h's) */
-static const double move_unit[LW_MOVE_KINDS_TD] = {1.0, 1.0, 1.0, M_PI / 180.0, 1.0, 1.0, 1.0, 1.0};
+static const double move_unit[LW_MOVE_KINDS_TDJ] = {1.0, 1.0, 1.0, M_PI / 180.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0};
 
 typedef struct {
   lw_scene scene;
   lw_grid2d *tone;               /* the picture's tone on the page, or NULL */
   lw_td td;                      /* the trans-dimensional proposals (scene.transdim) */
-  double log_w[4];               /* log of the birth, death, grow, shrink weights: the
-                                    Hastings factors need their ratios */
+  double log_w[6];               /* log of the birth, death, grow, shrink, split, join
+                                    weights: the Hastings factors need their ratios */
+  double join_r2;                /* the join radius squared, mm^2 */
   size_t td_sweep;               /* proposals a sweep with trans-dimensional moves */
 } spl_setup;
 
@@ -70,8 +72,9 @@ static void *setup_new(const lw_params *p, lw_error *err)
     lw_error_set(err, LW_ENOMEM, "out of memory for the birth prior's darkness table");
     goto fail;
   }
-  const double w[4] = {p->mix_birth, p->mix_death, p->mix_grow, p->mix_shrink};
-  for (int k = 0; k < 4; k++) su->log_w[k] = log(w[k]);
+  const double w[6] = {p->mix_birth, p->mix_death, p->mix_grow, p->mix_shrink, p->mix_split, p->mix_join};
+  for (int k = 0; k < 6; k++) su->log_w[k] = log(w[k]);
+  su->join_r2 = gsl_pow_2(p->join_radius * p->segment_length);
   if (su->scene.transdim) {
     size_t n = 0;
     if (lw_init_count(&su->scene, p, &n, err)) goto fail;
@@ -211,11 +214,12 @@ static void *state_copy(const void *state, lw_error *err)
 
 static void moves(const lw_params *p, double *weight, double *step, double *target)
 {
-  const double w[LW_MOVE_KINDS_TD] = {p->mix_point, p->mix_vector, p->mix_translate, p->mix_rotate,
-                                      p->mix_birth, p->mix_death, p->mix_grow, p->mix_shrink};
+  const double w[LW_MOVE_KINDS_TDJ] = {p->mix_point, p->mix_vector, p->mix_translate, p->mix_rotate,
+                                       p->mix_birth, p->mix_death, p->mix_grow,      p->mix_shrink,
+                                       p->mix_split, p->mix_join};
   const double st[LW_MOVE_KINDS] = {p->step_point, p->step_vector, p->step_translate, p->step_rotate};
   const double tg[LW_MOVE_KINDS] = {p->target, p->target, p->target_spline, p->target_spline};
-  const int n = p->fixed_count ? LW_MOVE_KINDS : LW_MOVE_KINDS_TD;
+  const int n = lw_splines_row(p)->n_moves;
   for (int k = 0; k < n; k++) {
     weight[k] = w[k];
     /* a trans-dimensional kind has no step: tuning may change it, nothing reads it */
@@ -383,6 +387,231 @@ static uint32_t live_spline(const lw_model *m, gsl_rng *rng)
   return i;
 }
 
+/* ---- split and join (docs/NUMERICS.md, "Split and join") ---- */
+
+/* Node a run the other way: the same point, the vector turned round. */
+static lw_node reversed_node(const lw_node *a) { return (lw_node){a->px, a->py, -a->vx, -a->vy}; }
+
+/* The n nodes src into dst, run the other way if rev (the same curve; a
+** spline's vectors point from node 0 to node n). */
+static void copy_nodes(lw_node *dst, const lw_node *src, size_t n, int rev)
+{
+  for (size_t k = 0; k < n; k++) dst[k] = rev ? reversed_node(&src[n - 1 - k]) : src[k];
+}
+
+/* 1 if ends at nodes a and b are close enough to join. */
+static int joinable(const spl_setup *su, const lw_node *a, const lw_node *b)
+{
+  return gsl_pow_2(a->px - b->px) + gsl_pow_2(a->py - b->py) <= su->join_r2;
+}
+
+/* log of the weight of joining end e (node e, te = 1 at its spline's tail)
+** to end f of another spline: the prior's factor g(after | before) of the
+** segment the join adds (transdim.h), e's spline keeping its direction and
+** f's turned round where the two ends are of the same kind (tail to tail,
+** head to head). */
+static double join_log(const lw_td *td, const lw_node *e, int te, const lw_node *f, int tf)
+{
+  const lw_node fo = tf == te ? reversed_node(f) : *f;
+  return te ? lw_td_next_log(td, e, 1, &fo) : lw_td_next_log(td, &fo, 1, e);
+}
+
+/* Adds log weight lw to the running log-sum (*mx, *sum), sum relative to
+** exp(mx), so that nothing over- or underflows. */
+static void log_add(double lw, double *mx, double *sum)
+{
+  if (!(lw > -INFINITY)) return;
+  if (lw > *mx) {
+    *sum = *sum * exp(*mx - lw) + 1.0;
+    *mx = lw;
+  } else {
+    *sum += exp(lw - *mx);
+  }
+}
+
+/* The layer of spline i (layers.h): a join links splines of one layer
+** only, and a split's pieces keep the cut spline's, so that each undoes
+** the other with the layers as state. */
+static int spline_layer(const lw_splines *sp, uint32_t i) { return sp->layer ? sp->layer[i] : 0; }
+
+/* The partners of end e (node en, tail te) of a spline of layer `layer` for
+** a join: the ends within the join radius of every live spline of that
+** layer but `skip`, in slot order, then the ends
+** `extra[0]` (head) and `extra[1]` (tail) of a spline not in the state yet
+** (NULL: none; a split's other piece).  With u < 0 returns log Z, the log
+** of the sum of their join weights (-inf if there are none); with u in
+** [0, 1) and log_z that sum, picks the partner whose cumulative share
+** first exceeds u into *pick (its spline) and *pick_tail. */
+static double join_scan(const spl_state *s, const lw_node *en, int te, int layer, uint32_t skip, const lw_node *extra,
+                        double u, double log_z, uint32_t *pick, int *pick_tail)
+{
+  const lw_model *m = s->m;
+  const lw_splines *sp = m->sp;
+  const spl_setup *su = s->setup;
+  double mx = -INFINITY, sum = 0.0, cum = 0.0;
+  for (uint32_t i = 0; i < sp->n_splines; i++) {
+    if (i == skip || lw_model_ghost(m, i) || spline_layer(sp, i) != layer) continue;
+    for (int t = 0; t < 2; t++) {
+      const lw_node *f = &sp->node[t ? sp->first[i + 1] - 1 : sp->first[i]];
+      if (!joinable(su, en, f)) continue;
+      const double lw = join_log(&su->td, en, te, f, t);
+      if (u < 0.0) {
+        log_add(lw, &mx, &sum);
+      } else if (lw > -INFINITY) {
+        /* the last partner with a weight, should rounding leave cum below u */
+        *pick = i;
+        *pick_tail = t;
+        if (u < (cum += exp(lw - log_z))) return log_z;
+      }
+    }
+  }
+  for (int t = 0; extra && u < 0.0 && t < 2; t++)
+    if (joinable(su, en, &extra[t])) log_add(join_log(&su->td, en, te, &extra[t], t), &mx, &sum);
+  return u < 0.0 ? mx + log(sum) : log_z;
+}
+
+/*
+** The log Hastings factor of splitting spline J (n segments, nodes jn) after
+** segment c into F (nodes fp, c segments) and B (nodes bp, n - 1 - c), as
+** they are in the state x after the split: r = 0 both as in J, 1 F run the
+** other way, 2 B.  n_x is the count of live splines in x, n_split the
+** count of those that may split in x' (with J).  The reverse, a join in x,
+** reaches J from end e = F's tail (if F runs as in J) or e = B's head (if
+** B does), each with probability 1/(2 N_x) times its weight over the sum
+** Z_e of its partners' weights; both weights are the factor g(B_0 | F_c)
+** that J's prior has and F's and B's lack.  For a split the pieces are not
+** in the state (pieces_live = 0): the ends of the other piece join each
+** scan, and J's are left out (skip_f = skip_b = J); for a join they are F's
+** and B's own slots.  `layer` is J's (and so F's and B's).  The join's
+** factor is minus this one.
+*/
+static double split_log_ratio(const spl_state *s, const lw_node *jn, size_t n, size_t c, int r, const lw_node *fp,
+                              const lw_node *bp, size_t n_x, size_t n_split, uint32_t skip_f, uint32_t skip_b,
+                              int pieces_live, int layer)
+{
+  const spl_setup *su = s->setup;
+  const lw_td *td = &su->td;
+  const size_t nb = n - 1 - c;
+  const double lg = lw_td_next_log(td, &jn[c], 1, &jn[c + 1]);
+  double mx = -INFINITY, sum = 0.0;
+  if (r != 1) {
+    const lw_node ends[2] = {bp[0], bp[nb]};
+    log_add(lg - join_scan(s, &fp[c], 1, layer, skip_f, pieces_live ? NULL : ends, -1.0, 0.0, NULL, NULL), &mx, &sum);
+  }
+  if (r != 2) {
+    const lw_node ends[2] = {fp[0], fp[c]};
+    log_add(lg - join_scan(s, &bp[0], 0, layer, skip_b, pieces_live ? NULL : ends, -1.0, 0.0, NULL, NULL), &mx, &sum);
+  }
+  double lq = lw_td_prior(td, fp, c + 1) + lw_td_prior(td, bp, nb + 1) - lw_td_prior(td, jn, n + 1);
+  /* with layers the target has the layer's share s_k per spline: one more */
+  const lw_layers_spec *ls = &s->m->scene->layers;
+  if (ls->n) lq += log(ls->cum[layer + 1] - ls->cum[layer]);
+  const double join = su->log_w[5] - log(2.0 * (double)n_x) + mx + log(sum);
+  const double split = su->log_w[4] - log((double)n_split) - log((double)(n - 2)) - log(3.0);
+  return lq + join - split;
+}
+
+/* 1 if spline i may split: 3 .. max_segments segments (each piece keeps
+** one, and a join could make it) and rest length n l (lw_td_plain). */
+static int splittable(const lw_td *td, const lw_splines *sp, uint32_t i)
+{
+  const size_t n = lw_splines_segments(sp, i);
+  return n >= 3 && n <= td->max_segments && lw_td_plain(td, n, sp->rest_length[i]);
+}
+
+/* How many live splines may split; with pick < that count, the pick-th of
+** them (in slot order) into *which.  O(N), as a join's partner scan. */
+static size_t count_splittable(const spl_state *s, size_t pick, uint32_t *which)
+{
+  const lw_model *m = s->m;
+  size_t count = 0;
+  for (uint32_t i = 0; i < m->sp->n_splines; i++) {
+    if (lw_model_ghost(m, i) || !splittable(&s->setup->td, m->sp, i)) continue;
+    if (count++ == pick) *which = i;
+  }
+  return count;
+}
+
+/*
+** A split removes inner segment c of a spline drawn uniformly among those
+** that may split (c = 1 .. n - 2 uniformly, so that each piece keeps one),
+** and runs one piece or none the other way (1/3 each): the nodes stay as
+** they were, so the dimension match is the identity and the Jacobian 1.
+** Refused where no join could undo it: segment ends farther apart than the
+** join radius.
+*/
+static double propose_split(spl_state *s, lw_proposal *p, gsl_rng *rng)
+{
+  const lw_td *td = &s->setup->td;
+  const lw_model *m = s->m;
+  const lw_splines *sp = m->sp;
+  uint32_t j = 0;
+  const size_t n_split = count_splittable(s, SIZE_MAX, NULL);
+  if (n_split == 0) return refuse(p);
+  count_splittable(s, gsl_rng_uniform_int(rng, n_split), &j);
+  const size_t n = lw_splines_segments(sp, j);
+  const size_t c = 1 + gsl_rng_uniform_int(rng, n - 2);
+  const int r = (int)gsl_rng_uniform_int(rng, 3);
+  const lw_node *src = &sp->node[sp->first[j]];
+  if (!joinable(s->setup, &src[c], &src[c + 1])) return refuse(p);
+  lw_node *fp = p->node, *bp = p->node + c + 1;
+  copy_nodes(fp, src, c + 1, r == 1);
+  copy_nodes(bp, src + c + 1, n - c, r == 2);
+  const double lr = split_log_ratio(s, src, n, c, r, fp, bp, lw_model_count(m) + 1, n_split, j, j, 0, spline_layer(sp, j));
+  const size_t nodes[2] = {c + 1, n - c};
+  const double rest[2] = {(double)c * td->length, (double)(n - 1 - c) * td->length};
+  lw_model_propose_regroup(m, p, &j, 1, NULL, nodes, 2, rest, 0);
+  p->log_ratio = lr;
+  return p->dE;
+}
+
+/*
+** A join picks an end e of a live spline X (1/(2N)) and a partner end f of
+** another, Y, within the join radius with probability w(e, f) / Z_e
+** (join_scan), and links them by a segment: X keeps its direction, Y runs
+** the other way where f is of e's kind.  Refused where no split could undo
+** it: a rest length other than n l, more than max_segments together.
+*/
+static double propose_join(spl_state *s, lw_proposal *p, gsl_rng *rng)
+{
+  const lw_td *td = &s->setup->td;
+  const lw_model *m = s->m;
+  const lw_splines *sp = m->sp;
+  const size_t N = lw_model_count(m);
+  if (N < 2) return refuse(p);
+  const uint32_t x = live_spline(m, rng);
+  const int te = gsl_rng_uniform(rng) < 0.5;
+  const size_t nx = lw_splines_segments(sp, x);
+  const lw_node *xn = &sp->node[sp->first[x]], *en = &xn[te ? nx : 0];
+  const int layer = spline_layer(sp, x);
+  const double log_z = join_scan(s, en, te, layer, x, NULL, -1.0, 0.0, NULL, NULL);
+  if (!(log_z > -INFINITY)) return refuse(p);
+  uint32_t y = x;
+  int tf = 0;
+  join_scan(s, en, te, layer, x, NULL, gsl_rng_uniform(rng), log_z, &y, &tf);
+  const size_t ny = lw_splines_segments(sp, y), n = nx + ny + 1;
+  if (n > td->max_segments || !lw_td_plain(td, nx, sp->rest_length[x]) || !lw_td_plain(td, ny, sp->rest_length[y]))
+    return refuse(p);
+  /* F, the first piece of the joined spline, and B as they are now */
+  const int y_turned = tf == te;
+  const uint32_t f = te ? x : y, b = te ? y : x;
+  const size_t c = lw_splines_segments(sp, f);
+  const lw_node *fp = &sp->node[sp->first[f]], *bp = &sp->node[sp->first[b]];
+  copy_nodes(p->node, fp, c + 1, !te && y_turned);
+  copy_nodes(p->node + c + 1, bp, n - c, te && y_turned);
+  const int r = y_turned ? (te ? 2 : 1) : 0;
+  /* the splines that may split after the join: F and B leave, J comes */
+  const size_t n_split = count_splittable(s, SIZE_MAX, NULL) - (size_t)splittable(td, sp, f) -
+                         (size_t)splittable(td, sp, b) + 1;
+  const double lr = -split_log_ratio(s, p->node, n, c, r, fp, bp, N, n_split, f, b, 1, layer);
+  const uint32_t old[2] = {x, y};
+  const size_t nodes = n + 1;
+  const double rest = (double)n * td->length;
+  lw_model_propose_regroup(m, p, old, 2, NULL, &nodes, 1, &rest, 0);
+  p->log_ratio = lr;
+  return p->dE;
+}
+
 /*
 ** Birth, death, grow and shrink (transdim.h; docs/NUMERICS.md has the
 ** derivation of each Hastings factor).  A birth adds a spline drawn from
@@ -402,6 +631,11 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
   const size_t N = lw_model_count(m), nb = td->birth_segments;
   const double *lw = su->log_w;
   *forbidden = 0;
+  if (kind == LW_MOVE_SPLIT || kind == LW_MOVE_JOIN) {
+    const double dE = kind == LW_MOVE_SPLIT ? propose_split(s, p, rng) : propose_join(s, p, rng);
+    *forbidden = p->splice && p->irregular;
+    return dE;
+  }
   if (kind == LW_MOVE_BIRTH) {
     lw_td_birth_draw(td, rng, p->node);
     /* its layer by the layers' shares, the prior's own law of a layer:
@@ -451,22 +685,32 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
 }
 
 /* A node drawn uniformly for a point or vector move, a spline for a rigid
-** one. */
+** one, among the live ones: drawn again while in a ghost (slots.h), an
+** exact uniform draw.  The row with split and join sweeps this way rather
+** than site by site (propose_at): there a site's node depends on where the
+** sweep's earlier splices left the splines, so which node a step updates
+** would depend on what the chain did before it in the sweep, and the
+** stationary law is lost (docs/NUMERICS.md, "Split and join": measured). */
 static double propose(void *state, void *prop, int kind, double st, gsl_rng *rng, int *forbidden)
 {
   spl_state *s = state;
   const lw_model *m = s->m;
   const lw_splines *sp = m->sp;
   if (kind >= LW_MOVE_KINDS) return propose_td(s, prop, kind, rng, forbidden);
-  if (sp->n_splines == 0) {
+  if (lw_model_count(m) == 0) {
     *forbidden = 0;
     return refuse(prop);
   }
   if (kind == LW_MOVE_POINT || kind == LW_MOVE_VECTOR) {
-    size_t k = gsl_rng_uniform_int(rng, sp->n_nodes);
-    return propose_on(m, td_of(s), prop, kind, k, spline_of_node(sp, k), st, rng, forbidden, NULL);
+    size_t k;
+    uint32_t i;
+    do {
+      k = gsl_rng_uniform_int(rng, sp->n_nodes);
+      i = spline_of_node(sp, k);
+    } while (lw_model_ghost(m, i));
+    return propose_on(m, td_of(s), prop, kind, k, i, st, rng, forbidden, NULL);
   }
-  uint32_t i = (uint32_t)gsl_rng_uniform_int(rng, sp->n_splines);
+  const uint32_t i = live_spline(m, rng);
   return propose_on(m, td_of(s), prop, kind, sp->first[i], i, st, rng, forbidden, NULL);
 }
 
@@ -762,7 +1006,7 @@ static void mass_dx(const void *mass, const double *x, const double *v, double *
 
 static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinned(mass, i); }
 
-/* The two rows differ only in their move kinds (sys_splines.h). */
+/* The rows differ only in their move kinds (sys_splines.h). */
 #define SPLINES_ROW \
   .n_terms = LW_TERM_COUNT, \
   .term_names = lw_term_names, \
@@ -778,7 +1022,6 @@ static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinne
   .proposal_new = proposal_new, \
   .proposal_free = proposal_free, \
   .propose = propose, \
-  .propose_at = propose_at, \
   .renumber = renumber, \
   .sweep_end = sweep_end, \
   .commit = commit, \
@@ -818,6 +1061,7 @@ const lw_system_type lw_system_splines = {
     .move_names = lw_move_names,
     .move_unit = move_unit,
     SPLINES_ROW
+    .propose_at = propose_at,
 };
 
 /* Births, deaths, grows and shrinks draw their own spline anywhere on the
@@ -829,9 +1073,26 @@ const lw_system_type lw_system_splines_td = {
     .move_names = move_names_td,
     .move_unit = move_unit,
     SPLINES_ROW
+    .propose_at = propose_at,
     .n_domain_moves = LW_MOVE_KINDS,
     .sites = sites,
 };
+
+const lw_system_type lw_system_splines_tdj = {
+    .name = "splines",
+    .n_moves = LW_MOVE_KINDS_TDJ,
+    .move_names = move_names_td,
+    .move_unit = move_unit,
+    SPLINES_ROW
+    .n_domain_moves = LW_MOVE_KINDS,
+    .sites = sites,
+};
+
+const lw_system_type *lw_splines_row(const lw_params *p)
+{
+  if (p->fixed_count) return &lw_system_splines;
+  return p->mix_split > 0.0 || p->mix_join > 0.0 ? &lw_system_splines_tdj : &lw_system_splines_td;
+}
 
 lw_system *lw_splines_view(lw_model *m, lw_error *err)
 {

@@ -45,7 +45,7 @@ const lw_system_type *lw_system_of(const lw_params *p, lw_error *err)
                  p->system);
   }
   /* the same system with its trans-dimensional move kinds (sys_splines.h) */
-  if (t == &lw_system_splines && !p->fixed_count) t = &lw_system_splines_td;
+  if (t == &lw_system_splines) t = lw_splines_row(p);
   return t;
 }
 

@@ -51,9 +51,14 @@ double lw_td_rest(const lw_td *td, double rest, size_t n_old, size_t n_new)
   return r > 0.0 ? r : NAN;
 }
 
+int lw_td_plain(const lw_td *td, size_t n, double rest)
+{
+  return rest == (double)n * td->length;
+}
+
 int lw_td_mortal(const lw_td *td, size_t n, double rest)
 {
-  return n == td->birth_segments && rest == (double)td->birth_segments * td->length;
+  return n == td->birth_segments && lw_td_plain(td, n, rest);
 }
 
 /* log pi(x, y) (transdim.h): -inf off the page. */

@@ -208,20 +208,30 @@ static uint32_t first_from(const uint32_t *idx, uint32_t n, uint32_t i)
 }
 
 /*
-** The entries of cell c a walk may pair, as at most two runs of positions
-** [r[0], r[1]) and [r[2], r[3]): indices >= from and outside [lo, hi).  A
+** The entries of cell c a walk may pair, as at most three runs of positions
+** [r[0], r[1]), [r[2], r[3]) and [r[4], r[5]): indices >= from and outside
+** [lo, hi) and [lo2, hi2).  A
 ** cell keeps its indices sorted and a spline's samples have consecutive
 ** indices, so the excluded ones are one run found by binary search: a
 ** spline's own samples cost O(log n) per cell however many there are (a
 ** long spline coiled into a few cells would otherwise be visited sample by
 ** sample from each of its samples: quadratic).
 */
-static void cell_ranges(const lw_cell *c, const lw_pair_filter *f, uint32_t r[4])
+static void cell_ranges(const lw_cell *c, const lw_pair_filter *f, uint32_t r[6])
 {
   const uint32_t *idx = lw_cell_idx(c);
   uint32_t n = c->n, a = f->from ? first_from(idx, n, f->from) : 0;
   r[0] = a;
-  r[1] = r[2] = r[3] = n;
+  r[1] = r[2] = r[3] = r[4] = r[5] = n;
+  if (f->hi2 > f->lo2) {
+    /* two splines left out (a join): three runs, each bound by binary search */
+    const uint32_t bound[4] = {f->lo, f->hi, f->lo2, f->hi2};
+    for (int k = 0; k < 4; k++) {
+      uint32_t at = first_from(idx, n, bound[k]);
+      r[k + 1] = at > a ? at : a;
+    }
+    return;
+  }
   if (a == n || idx[a] >= f->hi || idx[n - 1] < f->lo) return; /* nothing of the spline after from */
   uint32_t l = idx[a] >= f->lo ? a : first_from(idx + a, n - a, f->lo) + a;
   r[1] = l;
@@ -258,9 +268,9 @@ static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
       for (int b = 0; b < nb; b++)
         if (pc[b].gx[x - cx + 1] + pc[b].gy[y - cy + 1] <= skip2) mask |= 1u << b;
       if (!mask) continue;
-      uint32_t r[4];
+      uint32_t r[6];
       cell_ranges(c, f, r);
-      for (int run = 0; run < 4; run += 2) {
+      for (int run = 0; run < 6; run += 2) {
         *visited += (uint64_t)(r[run + 1] - r[run]) * (uint64_t)__builtin_popcount(mask);
         for (uint32_t k0 = r[run]; k0 < r[run + 1]; k0 += BLOCK) {
           uint32_t k1 = r[run + 1] - k0 > BLOCK ? k0 + BLOCK : r[run + 1];

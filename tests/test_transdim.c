@@ -9,6 +9,7 @@
 #include <criterion/criterion.h>
 #include <gsl/gsl_cdf.h>
 #include <gsl/gsl_randist.h>
+#include <gsl/gsl_sf_gamma.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,7 +28,8 @@ static lw_chain *td_chain(lw_params *p, double T, unsigned long seed, void **set
   lw_error err = {0};
   p->fixed_count = 0;
   const lw_system_type *t = lw_system_of(p, &err);
-  cr_assert_eq(t, &lw_system_splines_td, "fixed_count = 0 selects the row with eight move kinds");
+  cr_assert_eq(t, p->mix_split > 0 || p->mix_join > 0 ? &lw_system_splines_tdj : &lw_system_splines_td,
+               "fixed_count = 0 selects the row with eight move kinds, ten with split or join");
   *setup = t->setup_new(p, &err);
   cr_assert_not_null(*setup, "%s", err.msg);
   lw_system *sys = lw_system_wrap(t, t->state_new(*setup, p, seed, &err), &err);
@@ -89,7 +91,7 @@ static double chisq_p(const unsigned long *counts, const double *prob, int n, un
   return gsl_cdf_chisq_Q(chi2, bins - 1);
 }
 
-#define NMAX 64
+#define NMAX 1024
 
 /* Sweeps the chain and tallies the spline count every `thin` sweeps, and
 ** each spline's segment count. */
@@ -583,14 +585,32 @@ static double summary_value(const char *dir, const char *obj, const char *kind)
   return v;
 }
 
-static void write_cli_scene(const char *dir)
+static void write_cli_scene(const char *dir, const char *scene)
 {
   char path[128];
   snprintf(path, sizeof path, "%s/s.ini", dir);
   FILE *f = fopen(path, "w");
   cr_assert_not_null(f);
-  fputs(cli_scene, f);
+  fputs(scene, f);
   fclose(f);
+}
+
+/* Runs dir/s.ini with 1 and 3 threads and stopped at sweeps s1 and s2 and
+** resumed: the same state.lw, trace.csv and final.svg every time. */
+static void same_bytes_by_threads_and_resume(const char *dir, int s1, int s2)
+{
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=1 %s run %s/s.ini --out %s/a --quiet", b, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=3 %s run %s/s.ini --out %s/b --quiet", b, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=2 %s run %s/s.ini --out %s/c --quiet --stop-at %d", b, dir, dir, s1), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=1 %s resume %s/c --quiet --stop-at %d", b, dir, s2), 0);
+  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=2 %s resume %s/c --quiet", b, dir), 0);
+  const char *same[] = {"state.lw", "trace.csv", "final.svg"};
+  for (int i = 0; i < 3; i++) {
+    cr_assert_eq(lw_test_sh("cmp -s %s/a/%s %s/b/%s", dir, same[i], dir, same[i]), 0, "%s differs by threads", same[i]);
+    cr_assert_eq(lw_test_sh("cmp -s %s/a/%s %s/c/%s", dir, same[i], dir, same[i]), 0, "%s differs after resume",
+                 same[i]);
+  }
 }
 
 /* Same scene and seed => byte-identical outputs for any thread count, and a
@@ -599,19 +619,9 @@ Test(transdim, runs_are_deterministic_and_resume_bit_exactly, .timeout = 300)
 {
   char dir[64];
   cr_assert_eq(lw_test_dir_make(dir, "transdim"), 0);
-  write_cli_scene(dir);
+  write_cli_scene(dir, cli_scene);
   const char *b = lw_test_bin();
-  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=1 %s run %s/s.ini --out %s/a --quiet", b, dir, dir), 0);
-  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=3 %s run %s/s.ini --out %s/b --quiet", b, dir, dir), 0);
-  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=2 %s run %s/s.ini --out %s/c --quiet --stop-at 23", b, dir, dir), 0);
-  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=1 %s resume %s/c --quiet --stop-at 41", b, dir), 0);
-  cr_assert_eq(lw_test_sh("OMP_NUM_THREADS=2 %s resume %s/c --quiet", b, dir), 0);
-  const char *same[] = {"state.lw", "trace.csv", "final.svg"};
-  for (int i = 0; i < 3; i++) {
-    cr_assert_eq(lw_test_sh("cmp -s %s/a/%s %s/b/%s", dir, same[i], dir, same[i]), 0, "%s differs by threads", same[i]);
-    cr_assert_eq(lw_test_sh("cmp -s %s/a/%s %s/c/%s", dir, same[i], dir, same[i]), 0, "%s differs after resume",
-                 same[i]);
-  }
+  same_bytes_by_threads_and_resume(dir, 23, 41);
   /* every trans-dimensional kind was accepted, and the count changed */
   const char *kinds[] = {"birth", "death", "grow", "shrink"};
   for (int k = 0; k < 4; k++) {
@@ -619,6 +629,8 @@ Test(transdim, runs_are_deterministic_and_resume_bit_exactly, .timeout = 300)
     cr_assert(a > 0 && a < 1, "%s: acceptance %g", kinds[k], a);
   }
   cr_assert_eq(lw_test_sh("head -1 %s/a/trace.csv | grep -q ',acc_birth,acc_death,acc_grow,acc_shrink'", dir), 0);
+  cr_assert_neq(lw_test_sh("grep -q split %s/a/trace.csv %s/a/summary.json", dir, dir), 0,
+                "split and join off: the eight kinds' columns and keys only");
   cr_assert_neq(lw_test_sh("grep -q '\"splines\": 10,' %s/a/summary.json", dir), 0, "the count never changed");
   /* and the default keeps the four kinds, columns and keys of before */
   cr_assert_eq(lw_test_sh("%s run %s/s.ini --set moves.fixed_count=1 --set anneal.sweeps=4 --out %s/d --quiet", b, dir,
@@ -627,9 +639,39 @@ Test(transdim, runs_are_deterministic_and_resume_bit_exactly, .timeout = 300)
   lw_test_dir_remove(dir);
 }
 
+/* The same with split and join (the ten-kind row): a crowded page of short
+** lines with the pair term, strain, bending and both chemical potentials,
+** tempered with two replicas, where splits and joins happen by the hundred,
+** so that both fill and leave ghost slots within sweeps; a scene without
+** them keeps the eight kinds' columns. */
+static const char *cli_scene_sj = "[scene]\nwidth = 8\nheight = 8\nmargin = 0\n"
+                                  "[init]\nsplines = 30\nsegments = 3\nsegment_length = 1\n"
+                                  "[energy]\nstrain = 0.1\nbending = 0.002\npair = 0.01\npair_cutoff = 1\n"
+                                  "min_speed = 0\nregularity = 0\nchem_spline = -3\nchem_length = 0.05\n"
+                                  "[moves]\nfixed_count = 0\nmax_segments = 6\nbirth = 0.3\ndeath = 0.3\n"
+                                  "grow = 0.3\nshrink = 0.3\nsplit = 1\njoin = 1\n"
+                                  "[anneal]\nschedule = geometric\nt_start = 1.5\nt_end = 0.8\nsweeps = 24\n"
+                                  "steps = 4\nseed = 7\ncheck_every = 5\n"
+                                  "[tempering]\nreplicas = 2\nt_min = 0.8\nt_max = 1.5\n";
+
+Test(transdim, split_and_join_runs_are_deterministic_and_resume_bit_exactly, .timeout = 300)
+{
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "transdim_sj"), 0);
+  write_cli_scene(dir, cli_scene_sj);
+  same_bytes_by_threads_and_resume(dir, 9, 17);
+  const char *kinds[] = {"split", "join"};
+  for (int k = 0; k < 2; k++) {
+    double a = summary_value(dir, "acceptance", kinds[k]);
+    cr_assert(a > 0.01 && a < 1, "%s: acceptance %g", kinds[k], a);
+  }
+  cr_assert_eq(lw_test_sh("head -1 %s/a/trace.csv | grep -q ',acc_shrink,acc_split,acc_join'", dir), 0);
+  lw_test_dir_remove(dir);
+}
+
 /* Hard cases: a page a kilometre wide with lines of a micrometre, and one
 ** with the regularity tests on where births and grows propose folded
-** segments: every move kind runs, nothing NaN enters the state, and the
+** segments: every move kind runs, split and join too, nothing NaN enters the state, and the
 ** running energy stays the recomputed one. */
 Test(transdim, hard_scales_keep_the_state_finite)
 {
@@ -651,6 +693,7 @@ Test(transdim, hard_scales_keep_the_state_finite)
     p.chem_length = 1 / lengths[h];
     p.max_segments = 5;
     p.mix_birth = p.mix_death = p.mix_grow = p.mix_shrink = 0.2;
+    p.mix_split = p.mix_join = 0.2;
     void *setup;
     lw_chain *c = td_chain(&p, 2.0, 21 + (unsigned long)h, &setup);
     const lw_model *m = lw_splines_model(c->sys);
@@ -658,7 +701,7 @@ Test(transdim, hard_scales_keep_the_state_finite)
     cr_assert(lw_splines_finite(m->sp), "case %d: a coordinate is not finite", h);
     unsigned long nan = 0, acc = 0;
     for (int k = 0; k < c->n_moves; k++) nan += c->stats[k].nan;
-    for (int k = LW_MOVE_BIRTH; k < LW_MOVE_KINDS_TD; k++) acc += c->stats[k].accepted;
+    for (int k = LW_MOVE_BIRTH; k < LW_MOVE_KINDS_TDJ; k++) acc += c->stats[k].accepted;
     cr_assert_eq(nan, 0, "case %d: %lu proposals with a NaN dE", h, nan);
     cr_assert(acc > 0, "case %d: no trans-dimensional move accepted", h);
     double term[LW_TERM_COUNT];
@@ -712,4 +755,304 @@ Test(transdim, ideal_gas_layers_take_their_shares)
   cr_assert(fabs(0.5 - s0) * lambda > 10 * se, "a uniform layer draw would be within 10 standard errors");
   td_chain_free(c, setup);
   lw_image_dir_remove();
+}
+
+/* ---- split and join (docs/NUMERICS.md, "Split and join") ---- */
+
+/* The ideal gas of split and join: a page a few segment lengths wide, so
+** that ends meet partners within the join radius and a split's pieces keep
+** their first nodes on the page (their prior is 0 off it). */
+static void split_join_gas(lw_params *p, double mu_s, double page)
+{
+  ideal_gas(p, mu_s);
+  p->width = p->height = page;
+  p->margin = 0;
+  p->segment_length = 1;
+  p->mix_split = p->mix_join = 1;
+  p->mix_point = p->mix_vector = p->mix_translate = p->mix_rotate = 0.25;
+}
+
+/* Sokal's integrated autocorrelation time of x[0..n) (window: the smallest
+** W >= 6 tau(W)), in samples. */
+static double tau_int(const double *x, long n)
+{
+  double mean = 0.0, c0 = 0.0, tau = 0.5;
+  for (long k = 0; k < n; k++) mean += x[k] / (double)n;
+  for (long k = 0; k < n; k++) c0 += (x[k] - mean) * (x[k] - mean);
+  if (!(c0 > 0.0)) return 0.5;
+  for (long t = 1; t < n / 4; t++) {
+    double c = 0.0;
+    for (long k = 0; k + t < n; k++) c += (x[k] - mean) * (x[k + t] - mean);
+    tau += c / c0;
+    if ((double)t >= 6.0 * tau) break;
+  }
+  return tau;
+}
+
+/* Spline counts, `samples` of them `*spacing` sweeps apart, after a pilot
+** run of `pilot` sweeps that sets the spacing: 4 integrated
+** autocorrelation times of N measured on it, at which the correlation left
+** between samples (about e^-4 for an exponential decay) no longer inflates
+** the chi-square. */
+static void thinned_counts(lw_chain *c, long pilot, long samples, unsigned long *nc, long *spacing)
+{
+  const lw_model *m = lw_splines_model(c->sys);
+  double *x = malloc((size_t)pilot * sizeof *x);
+  cr_assert_not_null(x);
+  for (long s = 0; s < pilot; s++) {
+    cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    x[s] = (double)m->sp->n_splines;
+  }
+  *spacing = (long)ceil(4.0 * tau_int(x, pilot));
+  free(x);
+  for (long s = 0; s < samples; s++) {
+    for (long k = 0; k < *spacing; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    const size_t N = m->sp->n_splines;
+    nc[N < NMAX ? N : NMAX - 1]++;
+  }
+}
+
+/* The acceptance of kind k so far. */
+static double acceptance(const lw_chain *c, int k)
+{
+  return (double)c->stats[k].accepted / (double)c->stats[k].proposed;
+}
+
+/* Every move kind at once, split and join with them: N is Poisson with
+** mean K exp(-mu_s / T), K = 4 reachable segment counts, by chi-square on
+** counts thinned to 4 autocorrelation times; each segment count holds a
+** quarter of the splines, by batch means within 5 standard errors.  The
+** same counts against a Poisson of a 10 % larger mean fail, so the test can
+** tell.  It does not tell a split that drops the reversal count (p = 0.66
+** with it: births and deaths set the count too); the two tests below do.  Quick: 20 splines on 6 x 6 l (split and join accept 3 % of their
+** proposals); long: 200 splines on 8 x 8 l, where they accept more (in the
+** ideal gas a split trades the prior's
+** continuation density of the segment it removes for the page's density
+** of a first node, which only a crowded page pays back). */
+Test(transdim, ideal_gas_with_split_and_join, .timeout = 600)
+{
+  lw_params p;
+  const int lng = lw_test_long();
+  const double T = 1.0, lambda = lng ? 50.0 : 5.0;
+  split_join_gas(&p, -T * log(lambda), lng ? 8.0 : 6.0);
+  p.splines = lng ? 200 : 20; /* starts at the mean, and sets the sweep */
+  p.max_segments = 4;
+  p.mix_birth = p.mix_death = 1;
+  p.mix_grow = p.mix_shrink = 0.5;
+  void *setup;
+  lw_chain *c = td_chain(&p, T, 17, &setup);
+  unsigned long nc[NMAX] = {0}, sc[NMAX] = {0}, ns = 0;
+  tally(c, 300, 4, nc, sc, &ns); /* burn-in */
+  memset(nc, 0, sizeof nc);
+  long spacing;
+  const long n = 1000;
+  thinned_counts(c, 4000, n, nc, &spacing);
+  double prob[NMAX];
+  for (int k = 0; k < NMAX; k++) prob[k] = gsl_ran_poisson_pdf((unsigned)k, 4 * lambda);
+  double pv = chisq_p(nc, prob, lng ? 400 : 40, (unsigned long)n);
+  cr_assert(pv > 1e-3, "spline count vs Poisson(%g), %ld sweeps apart: chi-square p = %g", 4 * lambda, spacing, pv);
+  for (int k = 0; k < NMAX; k++) prob[k] = gsl_ran_poisson_pdf((unsigned)k, 1.1 * 4 * lambda);
+  cr_assert(chisq_p(nc, prob, lng ? 400 : 40, (unsigned long)n) < 1e-3, "the chi-square test cannot tell a 10%% shift");
+  batch_mean frac[4];
+  memset(frac, 0, sizeof frac);
+  const long per = 4000 / BATCHES;
+  for (int k = 0; k < 4; k++) frac[k].per = per;
+  const lw_model *m = lw_splines_model(c->sys);
+  for (long s = 0; s < BATCHES * per; s++) {
+    cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    double a[4] = {0};
+    for (size_t i = 0; i < m->sp->n_splines; i++) a[lw_splines_segments(m->sp, i) - 1] += 1.0 / (4 * lambda);
+    for (int k = 0; k < 4; k++) bm_add(&frac[k], a[k]);
+  }
+  for (int k = 0; k < 4; k++) {
+    double se, mean = bm_mean(&frac[k], &se);
+    cr_assert(fabs(mean - 0.25) < 5 * se, "splines of %d segments per Poisson mean: %g +- %g, expected 0.25", k + 1,
+              mean, se);
+  }
+  cr_log_info("ideal gas: N sampled %ld sweeps apart, split and join accepted %.4f and %.4f, p = %.3g", spacing,
+              acceptance(c, LW_MOVE_SPLIT), acceptance(c, LW_MOVE_JOIN), pv);
+  for (int k = LW_MOVE_SPLIT; k <= LW_MOVE_JOIN; k++)
+    cr_assert(acceptance(c, k) > (lng ? 0.05 : 0.02), "%s accepted %g of its proposals", c->sys->type->move_names[k],
+              acceptance(c, k));
+  td_chain_free(c, setup);
+}
+
+/* The number of ordered segment counts (n_1 .. n_N), each 1 .. K, whose
+** splines hold m nodes together (n_i + 1 each). */
+static double compositions(int N, int m, int K)
+{
+  if (N == 0) return m == 0;
+  double c = 0.0;
+  for (int n = 1; n <= K && n + 1 <= m; n++) c += compositions(N - 1, m - n - 1, K);
+  return c;
+}
+
+/* Split and join with the moves that keep a spline's nodes (point, vector,
+** translate, rotate) keep the total number of nodes M: the ideal gas then
+** puts the weight z^N / N! (z = exp(-mu_s / T)) on each ordered tuple of
+** segment counts 1 .. K with sum (n_i + 1) = M (docs/NUMERICS.md), a law
+** in which only split and join change the count.  Chi-square at a
+** thinning of 4 autocorrelation times; a split that drops the reversal
+** count (one join path where there are two) gives p = 5e-7.  Before the row with split and join
+** drew its nodes at random, the sweep went site by site and gave N = 1
+** with frequency 0.432 for 0.375 at M = 6, and this test failed. */
+Test(transdim, split_and_join_keep_the_law_at_a_fixed_node_count)
+{
+  lw_params p;
+  const double T = 1.0, lambda = 30.0;
+  split_join_gas(&p, -T * log(lambda), 6.0);
+  enum { M = 20, K = 5 };
+  p.splines = 4;
+  p.segments = 4;
+  p.max_segments = K;
+  p.mix_point = p.mix_vector = p.mix_translate = p.mix_rotate = 0.5; /* shapes relax between joins */
+  void *setup;
+  lw_chain *c = td_chain(&p, T, 19, &setup);
+  double prob[NMAX] = {0}, sum = 0.0;
+  for (int N = 1; N <= M / 2; N++) sum += prob[N] = compositions(N, M, K) * pow(lambda, N) / gsl_sf_fact((unsigned)N);
+  for (int N = 1; N <= M / 2; N++) prob[N] /= sum;
+  unsigned long nc[NMAX] = {0}, sc[NMAX] = {0}, ns = 0;
+  tally(c, 200, 4, nc, sc, &ns);
+  memset(nc, 0, sizeof nc);
+  long spacing;
+  const long n = lw_test_long() ? 4000 : 600;
+  thinned_counts(c, 4000, n, nc, &spacing);
+  double pv = chisq_p(nc + 1, prob + 1, M / 2, (unsigned long)n);
+  cr_log_info("fixed node count: N sampled %ld sweeps apart, split and join accepted %.4f and %.4f, p = %.3g", spacing,
+              acceptance(c, LW_MOVE_SPLIT), acceptance(c, LW_MOVE_JOIN), pv);
+  cr_assert(pv > 1e-3, "spline count at %d nodes, %ld sweeps apart: chi-square p = %g", M, spacing, pv);
+  td_chain_free(c, setup);
+}
+
+/* The reversal a split made of J (n segments, nodes jn) after segment c:
+** 0 if both pieces f and b run as in J, 1 if f runs the other way, 2 if b. */
+static int reversal_of(const lw_node *jn, size_t c, const lw_node *f, const lw_node *b)
+{
+  if (memcmp(f, jn, (c + 1) * sizeof *f)) return 1;
+  return memcmp(b, jn + c + 1, sizeof *b) ? 2 : 0;
+}
+
+/*
+** The Hastings factor of a split holds the probability of the join that
+** undoes it: lr_split = log q(F) + log q(B) - log q(J) + log P_join(x -> x')
+** - log P_split(x' -> x).  From splits of every reversal r, the test takes
+** P_join out of lr_split, commits the split, and counts how often the join
+** proposal rebuilds J exactly: the two agree within 5 binomial standard
+** errors; so does the frequency of the split itself with 1 / (3 N_s (n - 2))
+** (N_s: the splines that may split),
+** and the join that rebuilds J carries minus the split's factor.  A factor
+** without the reversal count (one join path where r = 0 has two) claims
+** half the measured frequency, and fails.
+*/
+Test(transdim, split_claims_the_frequency_of_its_join)
+{
+  lw_params p;
+  split_join_gas(&p, 0.0, 8.0);
+  p.splines = 6;
+  p.segments = 5;
+  p.max_segments = 8;
+  void *setup;
+  lw_chain *c = td_chain(&p, 1.0, 41, &setup);
+  const lw_system_type *t = c->sys->type;
+  lw_model *m = lw_splines_model(c->sys);
+  lw_proposal *pr = c->prop;
+  lw_td td;
+  cr_assert_eq(lw_td_init(&td, m->scene, (size_t)p.segments, p.segment_length, 8, 0.1), LW_OK);
+  const long draws = 200000;
+  int seen[3] = {0};
+  for (int trial = 0; trial < 40 && !(seen[0] && seen[1] && seen[2]); trial++) {
+    int forb;
+    do t->propose(c->sys->state, pr, LW_MOVE_SPLIT, 1.0, c->rng, &forb);
+    while (!pr->splice || !isfinite(pr->log_ratio));
+    const uint32_t j = pr->old[0];
+    const size_t n = lw_splines_segments(m->sp, j), nf = pr->new_node[0];
+    size_t n_split = 0; /* live, 3 .. max_segments segments: all plain here */
+    for (size_t i = 0; i < m->sp->n_splines; i++)
+      n_split += !lw_model_ghost(m, i) && lw_splines_segments(m->sp, i) >= 3 && lw_splines_segments(m->sp, i) <= 8;
+    lw_node J[16], FB[16];
+    memcpy(J, &m->sp->node[m->sp->first[j]], (n + 1) * sizeof *J);
+    memcpy(FB, pr->node, (n + 1) * sizeof *FB);
+    const int r = reversal_of(J, nf - 1, FB, FB + nf);
+    if (seen[r]++) continue;
+    const double lr = pr->log_ratio;
+    const double lq = lw_td_prior(&td, FB, nf) + lw_td_prior(&td, FB + nf, n + 1 - nf) - lw_td_prior(&td, J, n + 1);
+    const double p_split = 1.0 / (3.0 * (double)n_split * (double)(n - 2)), p_join = exp(lr - lq) * p_split;
+    long hits = 0;
+    for (long k = 0; k < draws; k++) {
+      t->propose(c->sys->state, pr, LW_MOVE_SPLIT, 1.0, c->rng, &forb);
+      hits += pr->splice && pr->old[0] == j && pr->new_node[0] == nf && !memcmp(pr->node, FB, (n + 1) * sizeof *FB);
+    }
+    double se = sqrt(p_split * (1 - p_split) / draws);
+    cr_assert(fabs((double)hits / draws - p_split) < 5 * se, "r = %d: split frequency %g, expected %g", r,
+              (double)hits / draws, p_split);
+    /* the split itself, committed */
+    do t->propose(c->sys->state, pr, LW_MOVE_SPLIT, 1.0, c->rng, &forb);
+    while (!(pr->splice && pr->old[0] == j && pr->new_node[0] == nf && !memcmp(pr->node, FB, (n + 1) * sizeof *FB)));
+    cr_assert_eq(t->commit(c->sys->state, pr), LW_OK);
+    hits = 0;
+    for (long k = 0; k < draws; k++) {
+      t->propose(c->sys->state, pr, LW_MOVE_JOIN, 1.0, c->rng, &forb);
+      if (!(pr->splice && pr->n_new == 1 && pr->n_node == n + 1 && !memcmp(pr->node, J, (n + 1) * sizeof *J))) continue;
+      cr_assert(fabs(pr->log_ratio + lr) <= 1e-9 * fmax(1.0, fabs(lr)), "join %.17g, split %.17g", pr->log_ratio, lr);
+      hits++;
+    }
+    se = sqrt(p_join * (1 - p_join) / draws);
+    cr_assert(fabs((double)hits / draws - p_join) < 5 * se, "r = %d: join frequency %g, the split claims %g", r,
+              (double)hits / draws, p_join);
+    cr_assert_eq(lw_model_compact(m), LW_OK);
+  }
+  cr_assert(seen[0] && seen[1] && seen[2], "reversals seen: %d %d %d", seen[0], seen[1], seen[2]);
+  lw_td_clear(&td);
+  td_chain_free(c, setup);
+}
+
+/* Split and join with every term a splice touches on, the pair term with
+** its near field among them (the pieces of a split and the halves of a
+** join pair with each other, which no walk sees): after many mixed
+** proposals of all ten kinds the running terms equal a recomputation from
+** scratch within 1e-9, and the compacted caches and grid are those a fresh
+** model builds: the ideal gas of split and join (page 8 l) with 60
+** splines, the pair term (cutoff l, near field on), strain, bending and a
+** chemical potential per length on, where split and join accept 7 % of
+** their proposals.  Wrong code caught: a split that forgot the pieces' pair
+** with each other, or a join that took the halves' cached near fields,
+** fails at the first check. */
+Test(transdim, incremental_equals_full_with_split_and_join)
+{
+  lw_params p;
+  const double T = 1.0;
+  split_join_gas(&p, -T * log(20.0), 8.0);
+  p.splines = 60;
+  p.segments = 3;
+  p.max_segments = 6;
+  p.mix_birth = p.mix_death = p.mix_grow = p.mix_shrink = 0.3;
+  p.pair = 0.01;
+  p.pair_cutoff = 1;
+  p.strain = 0.1;
+  p.bending = 0.002;
+  p.chem_length = 0.05;
+  void *setup;
+  lw_chain *c = td_chain(&p, T, 24, &setup);
+  const lw_model *m = lw_splines_model(c->sys);
+  const unsigned long total = lw_test_long() ? 1000000 : 20000;
+  unsigned long props = 0;
+  while (props < total) {
+    for (int k = 0; k < 10; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    props = 0;
+    for (int k = 0; k < c->n_moves; k++) props += c->stats[k].proposed;
+    double term[LW_TERM_COUNT];
+    lw_error err = {0};
+    double full = lw_energy_compute(m->scene, m->sp, term, &err), run = lw_model_total(m);
+    cr_assert(isfinite(full), "%s", err.msg);
+    const double scale = fmax(fabs(full), 1.0);
+    for (int t = 0; t < LW_TERM_COUNT; t++)
+      cr_assert(fabs(m->term[t] - term[t]) <= 1e-9 * scale, "after %lu proposals: term %s running %.17g, full %.17g",
+                props, lw_term_names[t], m->term[t], term[t]);
+    cr_assert(fabs(run - full) <= 1e-9 * scale, "after %lu proposals: running %.17g, full %.17g", props, run, full);
+  }
+  for (int k = LW_MOVE_SPLIT; k <= LW_MOVE_JOIN; k++)
+    cr_assert(c->stats[k].accepted > 300, "%s accepted only %lu of %lu", c->sys->type->move_names[k],
+              c->stats[k].accepted, c->stats[k].proposed);
+  same_as_fresh(m);
+  td_chain_free(c, setup);
 }

@@ -45,7 +45,7 @@ static double brute(const scene *s, const lw_pair_probe *P, size_t n, const lw_p
   *n_near = 0;
   for (size_t p = 0; p < n; p++)
     for (uint32_t j = f->from; j < N_SAMPLES; j++) {
-      if (j >= f->lo && j < f->hi) continue;
+      if ((j >= f->lo && j < f->hi) || (j >= f->lo2 && j < f->hi2)) continue;
       double dx = s->x[j] - P[p].x, dy = s->y[j] - P[p].y, r2 = dx * dx + dy * dy;
       double lim = s->ctx.near_scale * (double)(P[p].dl > s->dl[j] ? P[p].dl : s->dl[j]);
       if (r2 < lim * lim && r2 < s->ctx.cutoff2) near[(*n_near)++] = (uint64_t)p << 32 | j;
@@ -73,18 +73,28 @@ static size_t probes_of(const scene *s, uint32_t spline, lw_pair_probe *P)
   return n;
 }
 
-static void check(double near_scale, int with_from)
+/* with_two: a second spline left out as well, later in the index order (a
+** join's two old splines); a walk that ignored it would pair with its
+** samples and disagree with the brute force on every spline near it. */
+static void check(double near_scale, int with_from, int with_two)
 {
   static scene s;
-  rng_seed(0x5eed0000u + (uint64_t)(near_scale * 10) + (uint64_t)with_from);
+  rng_seed(0x5eed0000u + (uint64_t)(near_scale * 10) + (uint64_t)with_from + 100u * (uint64_t)with_two);
   scene_init(&s, near_scale);
   lw_pair_nearlist near = {0};
   lw_pair_probe P[2 * PER_SPLINE];
   static uint64_t want[2 * PER_SPLINE * N_SAMPLES], got[2 * PER_SPLINE * N_SAMPLES];
   for (uint32_t spline = 0; spline < N_SAMPLES / PER_SPLINE; spline++) {
     size_t n = probes_of(&s, spline, P);
-    lw_pair_filter f = {spline * PER_SPLINE, (spline + 1) * PER_SPLINE,
-                        with_from ? (uint32_t)urand(0, N_SAMPLES) : 0};
+    lw_pair_filter f = {.lo = spline * PER_SPLINE, .hi = (spline + 1) * PER_SPLINE,
+                        .from = with_from ? (uint32_t)urand(0, N_SAMPLES) : 0};
+    if (with_two) {
+      const uint32_t other = spline + 1 + (uint32_t)urand(0, N_SAMPLES / PER_SPLINE - 1 - spline);
+      if (other < N_SAMPLES / PER_SPLINE) {
+        f.lo2 = other * PER_SPLINE;
+        f.hi2 = (other + 1) * PER_SPLINE;
+      }
+    }
     size_t n_want;
     double far_want = brute(&s, P, n, &f, want, &n_want), far;
     near.n = 0;
@@ -107,22 +117,28 @@ static void check(double near_scale, int with_from)
 
 Test(walk, far_sum_matches_brute_force)
 {
-  check(0.0, 0);
+  check(0.0, 0, 0);
 }
 
 Test(walk, far_sum_respects_from)
 {
-  check(0.0, 1);
+  check(0.0, 1, 0);
 }
 
 Test(walk, near_pairs_respect_from)
 {
-  check(1.5, 1);
+  check(1.5, 1, 0);
 }
 
 Test(walk, near_pairs_without_from)
 {
-  check(1.5, 0);
+  check(1.5, 0, 0);
+}
+
+Test(walk, two_splines_left_out)
+{
+  check(1.5, 0, 1);
+  check(0.0, 1, 1);
 }
 
 /* Same positions, grids filled in different orders: the same bits. */
@@ -146,7 +162,7 @@ Test(walk, independent_of_insertion_history)
   lw_pair_nearlist na = {0}, nb = {0};
   for (uint32_t spline = 0; spline < N_SAMPLES / PER_SPLINE; spline += 7) {
     size_t n = probes_of(&a, spline, P);
-    lw_pair_filter f = {spline * PER_SPLINE, (spline + 1) * PER_SPLINE, 0};
+    lw_pair_filter f = {.lo = spline * PER_SPLINE, .hi = (spline + 1) * PER_SPLINE};
     double fa, fb;
     na.n = nb.n = 0;
     cr_assert_eq(lw_pair_walk(a.g, &a.ctx, P, n, &f, &fa, &na, NULL), LW_OK);
@@ -186,7 +202,7 @@ Test(walk, own_spline_not_visited)
     cr_assert_eq(lw_cellgrid_insert(g, i, 20.5 + cos(a), 20.5 + sin(a), 0.3f), LW_OK);
   }
   for (; i < 2 * OTHER + OWN; i++) cr_assert_eq(lw_cellgrid_insert(g, i, urand(19, 22), urand(19, 22), 0.3f), LW_OK);
-  lw_pair_filter f = {OTHER, OTHER + OWN, 0};
+  lw_pair_filter f = {.lo = OTHER, .hi = OTHER + OWN};
   lw_pair_nearlist near = {0};
   uint64_t move = 0, full = 0;
   double far;

@@ -163,13 +163,18 @@ typedef struct {
   double sum_term[LW_TERM_COUNT];
   long sum_irregular;
   int sum_stale;              /* a raster term's change is unknown: refresh on merge */
-  /* a splice (lw_model_propose_splice): spline `spline` replaced (remove = 1)
-  ** or a spline inserted at index `spline` (remove = 0) by the n_node nodes
-  ** in node (0: none); node0 = seg0 = 0, n_seg new segments, n_old_seg old */
-  int splice, remove;
-  size_t n_old_seg;
-  double new_rest;            /* the new spline's rest length, mm */
-  int layer;                  /* the new spline's layer (layers.h; 0 without layers) */
+  /* a splice (lw_model_propose_regroup): the n_old splines old[] (old_seg[]
+  ** segments each, n_old_seg in all) replaced by n_new new ones, whose
+  ** new_node[] nodes lie one after the other in node (n_node in all, n_seg
+  ** new segments); node0 = seg0 = 0; spline = old[0] */
+  int splice;
+  int n_old, n_new;
+  uint32_t old[2];
+  size_t old_seg[2], n_old_seg;
+  size_t new_node[2];
+  double new_rest[2];         /* the new splines' rest lengths, mm */
+  double new_len[2];          /* and lengths, mm */
+  int layer;                  /* the layer of every spline involved (layers.h; 0 without layers) */
   double log_ratio;           /* the Hastings factor of a trans-dimensional kind (system.h);
                               ** 0 for the symmetric ones */
 } lw_proposal;
@@ -186,22 +191,31 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
                       size_t n_node, const lw_node *nodes);
 
 /*
-** Trans-dimensional proposals: replaces spline `at` (remove = 1) or inserts
-** a spline (remove = 0; `at` is not read) by the n_new nodes
-** `nodes` (NULL: already in p->node) with rest length `rest`, or by nothing
-** (n_new = 0, remove = 1: a death).  An inserted spline is of layer
-** `layer` (layers.h; 0 without layers), a replacing one of the replaced
-** spline's (`layer` not read).  The new spline has n_new - 1 <=
-** m->max_segments segments.  dE is the new spline's energy less the old
-** one's: its segment and spline terms, its pair sums with every other
-** spline (one walk over the new samples, +1, and the old ones, -1, the
-** old spline's samples left out), its raster changes; forbidden and
-** crowded as for lw_model_propose.  Birth, death, grow and shrink are all
-** this one operation (sys_splines.c draws them, transdim.h has the
-** proposal densities).  The commit leaves the replaced spline as a ghost
-** and puts the new one into a ghost slot of its segment count, or at the
-** end if there is none (slots.h): O(their segments), nothing else moves.
+** Trans-dimensional proposals: replaces the n_old <= 2 splines old[] (none
+** for a birth) by n_new <= 2 new ones (none for a death), new one k of
+** new_node[k] >= 2 nodes and rest length rest[k], their nodes one after the
+** other in `nodes` (NULL: already in p->node), at most m->max_segments + 1
+** nodes in all and as many old segments.  Every spline involved is of one
+** layer (layers.h): the old ones', or `layer` for a birth.  dE is the new
+** splines' energy less the old ones': their segment and spline terms, their pair sums with every other spline
+** (one walk over the new samples, +1, and the old ones, -1, the old
+** splines' samples left out) and with each other, their raster changes;
+** forbidden and crowded as for lw_model_propose.  Birth, death, grow,
+** shrink, split and join are all this one operation (sys_splines.c draws
+** them, transdim.h has the proposal densities).  The commit leaves the
+** replaced splines as ghosts and puts each new one into a ghost slot of its
+** segment count, or at the end if there is none (slots.h): O(their
+** segments), nothing else moves.
 */
+void lw_model_propose_regroup(const lw_model *m, lw_proposal *p, const uint32_t *old, int n_old,
+                              const lw_node *nodes, const size_t *new_node, int n_new, const double *rest,
+                              int layer);
+
+/* The one-for-one case: replaces spline `at` (remove = 1) or inserts a
+** spline (remove = 0; `at` is not read) by the n_new nodes `nodes` with
+** rest length `rest`, or by nothing (n_new = 0, remove = 1: a death).  An
+** inserted spline is of layer `layer`, a replacing one of the replaced
+** spline's (`layer` not read). */
 void lw_model_propose_splice(const lw_model *m, lw_proposal *p, uint32_t at, int remove, const lw_node *nodes,
                              size_t n_new, double rest, int layer);
 

@@ -128,6 +128,8 @@ typedef struct {
   double mix_birth, mix_death, mix_grow, mix_shrink; /* relative frequencies (fixed_count = 0) */
   double birth_uniform;       /* share of births placed uniformly rather than by darkness */
   int max_segments;           /* grow never makes a spline longer than this, segments */
+  double mix_split, mix_join; /* relative frequencies of split and join (fixed_count = 0) */
+  double join_radius;         /* ends closer than this join, in init.segment_length */
   /* [anneal] */
   char schedule[64];          /* a name from the schedule table */
   double t_start, t_end;      /* temperatures, energy units */

@@ -40,10 +40,10 @@ typedef struct {
 lw_slots *lw_slots_new(void);
 void lw_slots_free(lw_slots *s);
 
-/* Room for slots 0 .. n_slots-1 and for one more ghost of n_seg segments,
-** so that the lw_slots_kill that follows cannot fail.  LW_ENOMEM leaves s
-** as it was (only larger). */
-lw_status lw_slots_reserve(lw_slots *s, size_t n_slots, size_t n_seg);
+/* Room for slots 0 .. n_slots-1 and for `more` more ghosts of n_seg
+** segments, so that the lw_slots_kill calls that follow cannot fail.
+** LW_ENOMEM leaves s as it was (only larger). */
+lw_status lw_slots_reserve(lw_slots *s, size_t n_slots, size_t n_seg, size_t more);
 
 /* 1 if slot i is a ghost (s may be NULL: no ghosts). */
 static inline int lw_slots_ghost(const lw_slots *s, size_t i)
@@ -54,8 +54,9 @@ static inline int lw_slots_ghost(const lw_slots *s, size_t i)
 /* Slot i, of n_seg segments, becomes a ghost (after lw_slots_reserve). */
 void lw_slots_kill(lw_slots *s, size_t i, size_t n_seg);
 
-/* The ghost that a spline of n_seg segments would take, or -1 if none. */
-long lw_slots_peek(const lw_slots *s, size_t n_seg);
+/* The ghost that a spline of n_seg segments would take after `depth`
+** others of its count took theirs (0: the next one), or -1 if none. */
+long lw_slots_peek(const lw_slots *s, size_t n_seg, size_t depth);
 
 /* Takes that ghost: it is a live slot again. */
 void lw_slots_take(lw_slots *s, size_t n_seg);

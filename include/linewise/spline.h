@@ -61,6 +61,11 @@ lw_status lw_splines_append(lw_splines *sp, const lw_node *nodes, size_t n_new, 
 /* Gives sp a layer array (zeroed) if it has none.  LW_ENOMEM: none. */
 lw_status lw_splines_layers_alloc(lw_splines *sp);
 
+/* Room for more_nodes more nodes in more_splines more splines, so that
+** the appends that follow cannot fail.  LW_ENOMEM leaves sp as it was
+** (only larger). */
+lw_status lw_splines_reserve(lw_splines *sp, size_t more_nodes, size_t more_splines);
+
 /* Removes the splines i with dead[i] != 0, in place: the others keep their
 ** order and move down over the holes (the ghost slots of trans-dimensional
 ** storage, slots.h).  O(nodes), no allocation. */

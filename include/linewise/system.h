@@ -55,7 +55,7 @@
 
 /* At most this many move kinds and terms a system (fixed arrays in the
 ** chain and the run loop's trace marks). */
-#define LW_MOVES_MAX 8
+#define LW_MOVES_MAX 10
 #define LW_SYSTEM_TERMS_MAX 16
 
 typedef struct lw_system_type lw_system_type;

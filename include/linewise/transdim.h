@@ -89,6 +89,12 @@ void lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd);
 ** cannot happen either. */
 double lw_td_rest(const lw_td *td, double rest, size_t n_old, size_t n_new);
 
+/* 1 if a spline of n segments has rest length n l exactly, as births, and
+** the grows and shrinks of what they make, leave it: only those split and
+** join (docs/NUMERICS.md), so that a split's pieces (n l each) joined
+** again give the rest length back, and a join of two undone likewise. */
+int lw_td_plain(const lw_td *td, size_t n, double rest);
+
 /* 1 if a death may remove a spline of n segments and rest length `rest`:
 ** a birth could have made it (birth_segments segments, rest length
 ** birth_segments l exactly); the reverse density is 0 for the others. */

@@ -16,8 +16,8 @@
 **          scale_P dl_P dl_j (1/r - 1/rc) joins the far sum (1/rc =
 **          ctx->inv_cutoff, 0 without a cutoff).
 **
-** The samples the filter excludes (the probes' own spline, indices below
-** `from`) are never visited: a cell keeps its indices sorted, so they are
+** The samples the filter excludes (the probes' own spline or two, indices
+** below `from`) are never visited: a cell keeps its indices sorted, so they are
 ** one or two runs of its entries, found by binary search.  Excluding a
 ** spline's own samples costs O(log n) per cell, so a long spline coiled
 ** into a few cells costs no more than a short one (it used to be visited
@@ -83,6 +83,7 @@ typedef struct {
 typedef struct {
   uint32_t lo, hi;  /* the probes' spline's sample indices [lo, hi): never paired */
   uint32_t from;    /* pairs only with samples of index >= from (0: all) */
+  uint32_t lo2, hi2; /* a second spline's, hi2 >= lo2 >= hi (a join's two; lo2 = hi2: none) */
 } lw_pair_filter;
 
 /* Sets *far to the far sum of the n probes P (no coefficient C) and
