@@ -100,17 +100,23 @@ Test(domains, resume_continues_bit_exactly)
 ** ghosts are filled and compacted between the domains' phases. */
 static const char *td_extra = "[moves]\nfixed_count = 0\nmax_segments = 6\nbirth = 0.05\ndeath = 0.05\n"
                               "grow = 0.05\nshrink = 0.05\n";
+/* ... and splits and joins, which run in the same serial block; a split
+** pays the first-node density of its new piece on a large page, so a
+** chemical potential per spline gets some accepted */
+static const char *sj_extra = "[moves]\nfixed_count = 0\nmax_segments = 6\nbirth = 0.05\ndeath = 0.05\n"
+                              "grow = 0.05\nshrink = 0.05\nsplit = 0.1\njoin = 0.1\n"
+                              "[energy]\nchem_spline = -1\n";
 
 /* The same bytes on 1 and 3 threads (two tempering replicas), and after a
 ** run stopped twice and resumed on other thread counts.  Catches a domain
 ** sweep that skips the compaction of the sweep's ghosts (sweep_end): the
 ** run then fails, its domains grouping ghosts as splines. */
-Test(domains, trans_dimensional_same_on_1_and_3_threads_and_resume, .timeout = 300)
+static void td_same_on_threads_and_resume(const char *moves)
 {
   char dir[64], extra[512];
   cr_assert_eq(lw_test_dir_make(dir, "domains_td"), 0);
   /* two replicas: threads go to the rungs first, then to each one's domains */
-  snprintf(extra, sizeof extra, "%s[tempering]\nreplicas = 2\nt_min = 0.01\nt_max = 0.1\n", td_extra);
+  snprintf(extra, sizeof extra, "%s[tempering]\nreplicas = 2\nt_min = 0.01\nt_max = 0.1\n", moves);
   write_scene(dir, extra);
   const char *b = lw_test_bin();
   cr_assert_eq(sh("%s run %s/s.ini --out %s/t1 --threads 1 --quiet", b, dir, dir), 0);
@@ -128,6 +134,16 @@ Test(domains, trans_dimensional_same_on_1_and_3_threads_and_resume, .timeout = 3
   lw_test_dir_remove(dir);
 }
 
+Test(domains, trans_dimensional_same_on_1_and_3_threads_and_resume, .timeout = 300)
+{
+  td_same_on_threads_and_resume(td_extra);
+}
+
+Test(domains, split_and_join_same_on_1_and_3_threads_and_resume, .timeout = 300)
+{
+  td_same_on_threads_and_resume(sj_extra);
+}
+
 /* Regression for the split commits: the running totals are merged from the
 ** domains' own sums, and must still equal the energy from scratch; with
 ** trans-dimensional moves (td = 1) also after the splices between the
@@ -137,7 +153,7 @@ static void running_totals_are_full(const char *name, int td)
 {
   char dir[64];
   cr_assert_eq(lw_test_dir_make(dir, name), 0);
-  write_scene(dir, td ? td_extra : "");
+  write_scene(dir, td == 2 ? sj_extra : td ? td_extra : "");
   lw_params p;
   lw_error err;
   char path[128];
@@ -154,9 +170,11 @@ static void running_totals_are_full(const char *name, int td)
   for (int k = 0; k < LW_MOVE_KINDS; k++) accepted += a.chain->stats[k].accepted;
   const lw_model *m = lw_splines_model(a.sys);
   cr_assert_gt(accepted, 10 * m->sp->n_nodes, "too few moves to test: %lu", accepted);
-  for (int k = LW_MOVE_KINDS; td && k < LW_MOVE_KINDS_TD; k++)
-    cr_assert_gt(a.chain->stats[k].accepted, 20, "%s accepted %lu times", a.chain->sys->type->move_names[k],
-                 a.chain->stats[k].accepted);
+  /* births and deaths (td = 1), or splits and joins (td = 2), happened */
+  const int k0 = td == 2 ? LW_MOVE_SPLIT : LW_MOVE_KINDS, k1 = td == 2 ? LW_MOVE_KINDS_TDJ : LW_MOVE_KINDS_TD;
+  for (int k = k0; td && k < k1; k++)
+    cr_assert_gt(a.chain->stats[k].accepted, td == 2 ? 5 : 20, "%s accepted %lu of %lu times",
+                 a.chain->sys->type->move_names[k], a.chain->stats[k].accepted, a.chain->stats[k].proposed);
   double term[LW_TERM_COUNT];
   double full = lw_energy_compute(m->scene, m->sp, term, &err);
   double run = lw_model_total(m);
@@ -179,6 +197,11 @@ Test(domains, running_totals_equal_the_energy_from_scratch) { running_totals_are
 Test(domains, running_totals_equal_the_energy_from_scratch_with_births_and_deaths)
 {
   running_totals_are_full("domains_inc_td", 1);
+}
+
+Test(domains, running_totals_equal_the_energy_from_scratch_with_splits_and_joins)
+{
+  running_totals_are_full("domains_inc_sj", 2);
 }
 
 /* One clear message naming the key, exit status 2, nothing written: the
