@@ -456,9 +456,10 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
   if (sc->transdim && sc->max_segments > m->max_segments) m->max_segments = sc->max_segments;
   m->cap_seg = ns;
   m->cap_spl = sp->n_splines ? sp->n_splines : 1;
-  /* where splines are born in layers a layer is state: placed or loaded
+  /* with layers a layer is state, since births and deaths, and the drift
+  ** checks' renumbering, move splines to other indices: placed or loaded
   ** without one, each spline keeps the one the index rule gives it now */
-  if (sc->transdim && sc->layers.n && !sp->layer) {
+  if (sc->layers.n && !sp->layer) {
     if (lw_splines_layers_alloc(sp) != LW_OK) goto nomem;
     for (size_t i = 0; i < sp->n_splines; i++) sp->layer[i] = (uint8_t)lw_layers_of(&sc->layers, i);
   }

@@ -129,6 +129,57 @@ static lw_splines *spliced(const lw_splines *sp, const unsigned char *dead, cons
   return c;
 }
 
+/* The drift checks renumber the splines along a curve of the page (every
+** anneal.check_every sweeps).  With a fixed count a spline's layer came
+** from its index, so a renumbering moved splines into other layers: their
+** field, potential and tone target changed and the energy jumped (here
+** from 1152 to 1360).  A layer is state now, so renumbering keeps every spline's
+** layer and the energy. */
+Test(layers, renumbering_keeps_every_splines_layer_and_the_energy)
+{
+  lw_params p = colour_params(40, 40, blotch_colours);
+  snprintf(p.ly_names, sizeof p.ly_names, "a b c");
+  p.ly_source = LW_LSRC_PALETTE;
+  snprintf(p.ly_colors, sizeof p.ly_colors, "#20a0c0 #c02060 #e0c020");
+  snprintf(p.ly_turn, sizeof p.ly_turn, "0 60 120");
+  p.tone = 3;
+  p.tone_blur = 0.8;
+  p.field = LW_FLD_ETF;
+  p.field_coef = -0.7;
+  lw_scene sc;
+  lw_test_scene(&sc, &p);
+  lw_model *m = lw_test_model_random(&sc, 45, 3, 3, 11);
+  const size_t n = m->sp->n_splines;
+  double *x0 = malloc(n * sizeof *x0);
+  int *layer = malloc(n * sizeof *layer);
+  cr_assert(x0 && layer);
+  for (size_t i = 0; i < n; i++) {
+    x0[i] = m->sp->node[m->sp->first[i]].px;
+    layer[i] = lw_splines_layer(&sc.layers, m->sp, i);
+  }
+  double term[LW_TERM_COUNT], e0 = lw_energy_compute(&sc, m->sp, term, NULL);
+  lw_error err;
+  lw_system *sys = lw_splines_view(m, &err);
+  cr_assert_not_null(sys, "%s", err.msg);
+  cr_assert_eq(sys->type->renumber(sys->state, &err), LW_OK, "%s", err.msg);
+  size_t moved = 0;
+  for (size_t i = 0; i < n; i++) {
+    size_t k = 0;
+    while (k < n && x0[k] != m->sp->node[m->sp->first[i]].px) k++;
+    cr_assert(k < n, "spline %zu is not one of the splines before", i);
+    moved += k != i;
+    cr_assert_eq(lw_splines_layer(&sc.layers, m->sp, i), layer[k], "spline %zu (was %zu) changed its layer", i, k);
+  }
+  cr_assert(moved > n / 2, "the renumbering moved only %zu of %zu splines", moved, n);
+  double e1 = lw_energy_compute(&sc, m->sp, term, NULL);
+  cr_assert(fabs(e1 - e0) <= 1e-9 * fabs(e0), "energy %.17g before the renumbering, %.17g after", e0, e1);
+  lw_system_free(sys);
+  free(x0);
+  free(layer);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
 Test(layers, births_and_deaths_in_layers_change_the_energy_by_the_full_recomputation)
 {
   /* With trans-dimensional moves a spline's layer is state (layers.h).

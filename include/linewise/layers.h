@@ -10,12 +10,11 @@
 ** layer k with s_0 + .. + s_(k-1) <= x_i < s_0 + .. + s_k.  The sequence
 ** is evenly spread for every count, so each layer gets its share of any
 ** number of splines (to O(log n) splines), and a layer without ink gets
-** none.  With a fixed count nothing is stored per spline: a state file
-** needs no new data.  With trans-dimensional moves (moves.fixed_count = 0)
-** the layer is part of each spline's state (spline.h, sp->layer), set by
-** the index rule when the state is placed or loaded from a file without
-** it, drawn by the shares for a born spline (layer k with probability
-** s_k), kept by grow, shrink, compaction and renumbering, and saved in
+** none.  The layer is part of each spline's state (spline.h, sp->layer),
+** set by the index rule when the state is placed or loaded from a file
+** without it, drawn by the shares for a born spline (layer k with
+** probability s_k; moves.fixed_count = 0), kept by grow, shrink, split,
+** join, compaction and the drift checks' renumbering, and saved in
 ** state.lw (docs/FORMATS.md).  Layer k is pen k + 1 of the drawing.
 **
 ** What a layer changes: the terms that read the picture or the field read
