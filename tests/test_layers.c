@@ -83,12 +83,10 @@ static lw_params colour_params(double page, int w, void (*f)(double, double, dou
 }
 
 
-Test(layers, a_move_changes_the_energy_by_the_full_recomputation)
+/* Three pens of a palette over blotches of colour, each with its own tone
+** raster, image potential and field turned by 0, 60 and 120 degrees. */
+static lw_params three_pens(void)
 {
-  /* Three pens of a palette, each with its own tone raster, potential and
-  ** turned field, and the pair term across them: every term's local
-  ** difference against the recomputation, and the running totals after
-  ** the accepted half of the moves. */
   lw_params p = colour_params(40, 40, blotch_colours);
   snprintf(p.ly_names, sizeof p.ly_names, "a b c");
   p.ly_source = LW_LSRC_PALETTE;
@@ -102,6 +100,16 @@ Test(layers, a_move_changes_the_energy_by_the_full_recomputation)
   p.field = LW_FLD_ETF;
   p.field_coef = -0.7;
   p.bending = 0.3;
+  return p;
+}
+
+Test(layers, a_move_changes_the_energy_by_the_full_recomputation)
+{
+  /* Three pens of a palette, each with its own tone raster, potential and
+  ** turned field, and the pair term across them: every term's local
+  ** difference against the recomputation, and the running totals after
+  ** the accepted half of the moves. */
+  lw_params p = three_pens();
   p.pair = 0.02;
   p.pair_cutoff = 2;
   lw_scene sc;
@@ -137,15 +145,7 @@ static lw_splines *spliced(const lw_splines *sp, const unsigned char *dead, cons
 ** layer and the energy. */
 Test(layers, renumbering_keeps_every_splines_layer_and_the_energy)
 {
-  lw_params p = colour_params(40, 40, blotch_colours);
-  snprintf(p.ly_names, sizeof p.ly_names, "a b c");
-  p.ly_source = LW_LSRC_PALETTE;
-  snprintf(p.ly_colors, sizeof p.ly_colors, "#20a0c0 #c02060 #e0c020");
-  snprintf(p.ly_turn, sizeof p.ly_turn, "0 60 120");
-  p.tone = 3;
-  p.tone_blur = 0.8;
-  p.field = LW_FLD_ETF;
-  p.field_coef = -0.7;
+  lw_params p = three_pens();
   lw_scene sc;
   lw_test_scene(&sc, &p);
   lw_model *m = lw_test_model_random(&sc, 45, 3, 3, 11);
@@ -190,19 +190,7 @@ Test(layers, births_and_deaths_in_layers_change_the_energy_by_the_full_recomputa
   ** each layer's raster plane what a fresh model of the state builds.
   ** Catches a splice evaluated with the scene's contexts or raster plane
   ** rather than its layer's (the tone term off by a whole layer's share). */
-  lw_params p = colour_params(40, 40, blotch_colours);
-  snprintf(p.ly_names, sizeof p.ly_names, "a b c");
-  p.ly_source = LW_LSRC_PALETTE;
-  snprintf(p.ly_colors, sizeof p.ly_colors, "#20a0c0 #c02060 #e0c020");
-  snprintf(p.ly_turn, sizeof p.ly_turn, "0 60 120");
-  snprintf(p.ly_pen_width, sizeof p.ly_pen_width, "0.3 0.5 0.4");
-  p.tone = 3;
-  p.tone_blur = 0.8;
-  p.potential = LW_POT_IMAGE;
-  p.potential_coef = 0.5;
-  p.field = LW_FLD_ETF;
-  p.field_coef = -0.7;
-  p.bending = 0.3;
+  lw_params p = three_pens();
   p.strain = 1;
   p.pair = 0.02;
   p.pair_cutoff = 2;
