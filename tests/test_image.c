@@ -312,19 +312,8 @@ Test(image, fit_centres_and_keeps_the_aspect_ratio)
 
 /* ---- EXIF orientation ------------------------------------------------------ */
 
-#define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STBI_WRITE_NO_STDIO
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-#endif
-#include <stb/stb_image_write.h>
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
+#include <stb/stb_image_write.h> /* compiled in tests/stb_write.c */
 
 typedef struct {
   unsigned char b[8192];
