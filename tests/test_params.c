@@ -307,7 +307,10 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
             "segment %g, cutoff %g, spacing %g, blur %g", p.segment_length, p.pair_cutoff, p.min_spacing,
             p.tone_blur);
   cr_assert(fabs(p.field_sigma - 10 * 0.35) < 1e-12);
-  cr_assert(p.tone == 40 && p.tone_ink == 0.5 && p.coverage == 0.4 && p.splines == 0 && p.sweeps == 400);
+  cr_assert(p.tone == 40 && p.tone_ink == 0.5 && p.coverage == 0.6 && p.splines == 0 && p.sweeps == 300);
+  /* the annealer chooses the count, its price per mm scaling with the pen */
+  cr_assert(p.fixed_count == 0 && fabs(p.chem_length + 2.5) < 1e-12 && p.mix_grow == 0.05 && p.mix_shrink == 0.05,
+            "fixed_count %d, chem_length %.17g", p.fixed_count, p.chem_length);
   /* A4 less 10 mm margins: 190 mm / (90 x 0.35 mm) = 6 domains a side */
   cr_assert_str_eq(p.domains, "6");
   /* --set of the pen width: the preset's keys follow, a set key stays */
@@ -316,6 +319,7 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
   cr_assert_eq(lw_params_resolve(&p, &err), LW_OK);
   cr_assert(fabs(p.segment_length - 4.0) < 1e-12 && p.pair_cutoff == 4.0, "%g %g", p.segment_length,
             p.pair_cutoff);
+  cr_assert(fabs(p.chem_length + 2.5 / 0.35 * 0.5) < 1e-12, "chem_length %.17g", p.chem_length);
   cr_assert_str_eq(p.domains, "4");
   /* the file's keys win; A6 at the default pen of 0.3 mm: 85 mm / 27 mm = 3
   ** domains a side, and with a 1 mm pen fewer than 2, so not split */
