@@ -1066,14 +1066,17 @@ const lw_system_type lw_system_splines = {
 
 /* Births, deaths, grows and shrinks draw their own spline anywhere on the
 ** page and change the storage: with domains they run after the phases
-** (mc.h), and the domains visit the nodes, not sweep_size's fixed count. */
+** (mc.h), and the domains visit the nodes, not sweep_size's fixed count.
+** Neither row has propose_at: with splices inside a sweep, which node a
+** site holds would depend on the sweep's own past (docs/NUMERICS.md,
+** "Split and join", "Sweeps"), so a sweep without domains draws each
+** node or spline at random among the live ones. */
 const lw_system_type lw_system_splines_td = {
     .name = "splines",
     .n_moves = LW_MOVE_KINDS_TD,
     .move_names = move_names_td,
     .move_unit = move_unit,
     SPLINES_ROW
-    .propose_at = propose_at,
     .n_domain_moves = LW_MOVE_KINDS,
     .sites = sites,
 };
