@@ -102,29 +102,105 @@ static int cmp_pair(const void *a, const void *b)
 static size_t unique_u32(uint32_t *v, size_t n)
 {
   if (n < 2) return n; /* v may be NULL then, which qsort must not see */
-  qsort(v, n, sizeof *v, cmp_u32);
+  if (n <= 32) {
+    /* a proposal's lists are this short: insertion sort costs less than
+    ** qsort's call and comparator overhead (8 % of a near-field run) */
+    for (size_t i = 1; i < n; i++) {
+      uint32_t x = v[i];
+      size_t j = i;
+      for (; j > 0 && v[j - 1] > x; j--) v[j] = v[j - 1];
+      v[j] = x;
+    }
+  } else {
+    qsort(v, n, sizeof *v, cmp_u32);
+  }
   size_t m = 0;
   for (size_t i = 0; i < n; i++)
     if (m == 0 || v[i] != v[m - 1]) v[m++] = v[i];
   return m;
 }
 
-/* The near field (no coefficient) of one segment, control points bez and
-** samples mine, with each segment of the sorted list `segs` (pairnear.h).
-** Sums in the list's order, so the value is a function of the state. */
-static double near_part(const pair_view *v, const double bez[8], const lw_pair_sample *mine,
-                        const lw_near_list *segs)
+/* The near correction (pairnear.h, no coefficient) of the segment with
+** control points bez and samples mine with segment gb. */
+static double near_one(const pair_view *v, const double bez[8], const lw_pair_sample *mine, uint32_t gb)
 {
   lw_pair_sample other[LW_QUAD_MAX];
+  double b[8];
+  segment_bezier(v->sp, gb, b);
+  for (uint32_t q = 0; q < v->np; q++) other[q] = sample_at(v, gb * v->np + q);
+  return lw_pair_near_correction(bez, mine, b, other, (int)v->np, v->ctx);
+}
+
+/* Appends a pair's value to out; a value that finds no memory is dropped,
+** which costs only its recomputation (the pair slots are a cache). */
+static void values_push(lw_near_values *out, uint32_t seg, uint32_t partner, double x)
+{
+  if (out->n == out->cap) {
+    size_t cap = out->cap ? 2 * out->cap : 64;
+    lw_near_value *nv = realloc(out->v, cap * sizeof *nv);
+    if (!nv) return;
+    out->v = nv;
+    out->cap = cap;
+  }
+  out->v[out->n++] = (lw_near_value){seg, partner, x};
+}
+
+/* The near field (no coefficient) of one segment, control points bez and
+** samples mine, with each segment of the sorted list `segs` (pairnear.h).
+** Sums in the list's order, so the value is a function of the state.  With
+** out, each pair's value goes there too, as segment self's. */
+static double near_part(const pair_view *v, const double bez[8], const lw_pair_sample *mine,
+                        const lw_near_list *segs, uint32_t self, lw_near_values *out)
+{
   double sum = 0.0;
   for (size_t k = 0; k < segs->n; k++) {
-    double b[8];
-    uint32_t gb = segs->idx[k];
-    segment_bezier(v->sp, gb, b);
-    for (uint32_t q = 0; q < v->np; q++) other[q] = sample_at(v, gb * v->np + q);
-    sum += lw_pair_near_correction(bez, mine, b, other, (int)v->np, v->ctx);
+    double x = near_one(v, bez, mine, segs->idx[k]);
+    if (out) values_push(out, self, segs->idx[k], x);
+    sum += x;
   }
   return sum;
+}
+
+/* ---- the pair slots (lw_model.near_pid) ------------------------------------
+** A segment's slot ids are read and cleared by the commits of its partners,
+** which with domains may run in two cells at once (the segment then moves in
+** neither): ids are atomic and a free slot is claimed by compare-and-swap.
+** Which pairs find a slot may then depend on timing, never a value: a slot
+** holds what a recomputation gives, bit for bit. */
+
+/* The slot of segment g that holds partner h, or -1. */
+static int slot_find(const lw_model *m, size_t g, uint32_t h)
+{
+  const uint32_t *id = m->near_pid + g * LW_NEAR_SLOTS;
+  for (int k = 0; k < LW_NEAR_SLOTS; k++)
+    if (__atomic_load_n(&id[k], __ATOMIC_RELAXED) == h) return k;
+  return -1;
+}
+
+/* Keeps x as the value of pair (g, h) in g's slots, if one is free. */
+static void slot_store(const lw_model *m, size_t g, uint32_t h, double x)
+{
+  uint32_t *id = m->near_pid + g * LW_NEAR_SLOTS;
+  int k = slot_find(m, g, h);
+  for (int s = 0; k < 0 && s < LW_NEAR_SLOTS; s++) {
+    uint32_t none = LW_NEAR_FREE;
+    if (__atomic_compare_exchange_n(&id[s], &none, h, 0, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) k = s;
+  }
+  if (k >= 0) m->near_pval[g * LW_NEAR_SLOTS + (size_t)k] = x;
+}
+
+/* Forgets pair (g, h) in g's slots. */
+static void slot_clear(const lw_model *m, size_t g, uint32_t h)
+{
+  int k = slot_find(m, g, h);
+  if (k >= 0) __atomic_store_n(&m->near_pid[g * LW_NEAR_SLOTS + (size_t)k], LW_NEAR_FREE, __ATOMIC_RELAXED);
+}
+
+/* Empties the slots of segments [g, g + n). */
+static void slots_reset(const lw_model *m, size_t g, size_t n)
+{
+  for (size_t k = g * LW_NEAR_SLOTS; k < (g + n) * LW_NEAR_SLOTS; k++)
+    __atomic_store_n(&m->near_pid[k], LW_NEAR_FREE, __ATOMIC_RELAXED);
 }
 
 /*
@@ -132,9 +208,9 @@ static double near_part(const pair_view *v, const double bez[8], const lw_pair_s
 ** samples taken cell by cell in the grid's order, which depends on positions
 ** only; then every near segment pair once (the walk reports those of
 ** samples j > i, so of segments gb > ga), in increasing order of (lower,
-** higher) segment.
+** higher) segment.  With out, every near pair's value goes there too.
 */
-static lw_status pair_all(const pair_view *v, double *e)
+static lw_status pair_all(const pair_view *v, double *e, lw_near_values *out)
 {
   lw_pair_nearlist near = {0};
   lw_near_list pairs = {0}, segs = {0}; /* pairs: (lower, higher) segment, two entries each */
@@ -171,7 +247,7 @@ static lw_status pair_all(const pair_view *v, double *e)
       double a[8];
       segment_bezier(v->sp, ga, a);
       for (uint32_t q = 0; q < v->np; q++) sa[q] = sample_at(v, ga * v->np + q);
-      sum += near_part(v, a, sa, &segs);
+      sum += near_part(v, a, sa, &segs, ga, out);
     }
   }
   free(pairs.idx);
@@ -387,7 +463,7 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
   if (grid) {
     pair_view v = {grid, sp, (uint32_t)np, pair_ctx(pc)};
     double e;
-    if (pair_all(&v, &e) != LW_OK) goto nomem;
+    if (pair_all(&v, &e, NULL) != LW_OK) goto nomem;
     term[ts.pair] = pc->coef * e;
   }
   for (int k = 0; k < ts.n_raster; k++) {
@@ -442,7 +518,10 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
     }
     m->near_cache = malloc(ns * sizeof *m->near_cache);
     m->near_valid = calloc(ns, sizeof *m->near_valid);
-    if (!m->near_cache || !m->near_valid) goto nomem;
+    m->near_pid = malloc(ns * LW_NEAR_SLOTS * sizeof *m->near_pid);
+    m->near_pval = malloc(ns * LW_NEAR_SLOTS * sizeof *m->near_pval);
+    if (!m->near_cache || !m->near_valid || !m->near_pid || !m->near_pval) goto nomem;
+    slots_reset(m, 0, ns);
     m->grid = grid_for(sc, &m->terms.ctx[m->terms.pair], n, err);
     if (!m->grid) {
       lw_model_free(m);
@@ -482,6 +561,8 @@ void lw_model_free(lw_model *m)
   free(m->seg_irregular);
   free(m->near_cache);
   free(m->near_valid);
+  free(m->near_pid);
+  free(m->near_pval);
   lw_cellgrid_free(m->grid);
   for (int t = 0; t < LW_TERM_COUNT; t++) free(m->raster[t]);
   lw_slots_free(m->slots);
@@ -526,9 +607,18 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
   if (m->grid) {
     pair_view v = {m->grid, sp, (uint32_t)np, pair_ctx(pc)};
     double e;
+    lw_near_values vals = {0};
     memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);
+    slots_reset(m, 0, sp->n_segments);
     lw_cellgrid_fit(m->grid);
-    if (pair_all(&v, &e) != LW_OK) return LW_ENOMEM;
+    lw_status st = pair_all(&v, &e, &vals);
+    /* every pair's value warms both segments' slots */
+    for (size_t k = 0; k < vals.n; k++) {
+      slot_store(m, vals.v[k].seg, vals.v[k].partner, vals.v[k].value);
+      slot_store(m, vals.v[k].partner, vals.v[k].seg, vals.v[k].value);
+    }
+    free(vals.v);
+    if (st != LW_OK) return LW_ENOMEM;
     term[ts->pair] = pc->coef * e;
   }
   for (int k = 0; k < ts->n_raster; k++) {
@@ -585,6 +675,7 @@ void lw_proposal_free(lw_proposal *p)
   free(p->segs.idx);
   free(p->partners.idx);
   free(p->near_new);
+  free(p->near_vals.v);
   free(p->seg_irregular);
   free(p->spline_seg_len);
   for (int t = 0; t < LW_TERM_COUNT; t++) lw_tone_box_free(&p->box[t]);
@@ -613,14 +704,27 @@ static lw_status near_segments(const lw_proposal *p, uint32_t np, size_t j, int 
 }
 
 /* The near field of old segment g (from node a to a + 1, samples ps, near
-** partners segs) from the model's cache, filled first when not valid. */
+** partners segs) from the model's cache; when that is not valid, summed
+** again as near_part sums it, each pair from g's slots where one holds it. */
 static double old_near(const lw_model *m, const pair_view *v, size_t g, const lw_node *a, const lw_pair_sample *ps,
                        const lw_near_list *segs)
 {
   if (!m->near_valid[g]) {
-    double bez[8];
+    double bez[8], sum = 0.0;
     lw_segment_bezier(a, a + 1, bez);
-    m->near_cache[g] = near_part(v, bez, ps, segs);
+    for (size_t k = 0; k < segs->n; k++) {
+      const uint32_t h = segs->idx[k];
+      const int s = slot_find(m, g, h);
+      double x;
+      if (s >= 0) {
+        x = m->near_pval[g * LW_NEAR_SLOTS + (size_t)s];
+      } else {
+        x = near_one(v, bez, ps, h);
+        slot_store(m, g, h, x);
+      }
+      sum += x;
+    }
+    m->near_cache[g] = sum;
     m->near_valid[g] = 1;
   }
   return m->near_cache[g];
@@ -663,13 +767,14 @@ static double pair_delta(const lw_model *m, lw_proposal *p, const lw_node *base,
   double pe;
   p->near.n = 0;
   p->partners.n = 0;
+  p->near_vals.n = 0;
   if (lw_pair_walk(m->grid, &sc->pair, p->probe, 2 * n, &f, &pe, &p->near, NULL) != LW_OK) return NAN;
   for (size_t j = 0; j < p->n_seg; j++) {
     size_t g = g0 + p->seg0 + j;
     double bez[8];
     if (near_segments(p, np, j, 0, &p->segs) != LW_OK) return NAN;
     lw_segment_bezier(proposed_node(base, p, p->seg0 + j), proposed_node(base, p, p->seg0 + j + 1), bez);
-    p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs);
+    p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs, (uint32_t)g, &p->near_vals);
     pe += p->near_new[j];
     if (add_partners(p) != LW_OK || near_segments(p, np, j, 1, &p->segs) != LW_OK) return NAN;
     pe -= old_near(m, &v, g, &base[p->seg0 + j], p->ps_old + j * np, &p->segs);
@@ -864,16 +969,27 @@ lw_status lw_model_commit_part(lw_model *m, lw_proposal *p)
   if (m->grid) {
     if (p->pair_done) {
       /* A partner may be shared with a move in another domain (domains.h):
-      ** both only clear its flag, as relaxed atomic stores. */
-      for (size_t k = 0; k < p->partners.n; k++)
+      ** both only clear its flag, as relaxed atomic stores, and forget or
+      ** rewrite their own pairs in its slots. */
+      const size_t g1 = g0 + p->seg0;
+      for (size_t k = 0; k < p->partners.n; k++) {
         __atomic_store_n(&m->near_valid[p->partners.idx[k]], 0, __ATOMIC_RELAXED);
+        for (size_t j = 0; j < p->n_seg; j++) slot_clear(m, p->partners.idx[k], (uint32_t)(g1 + j));
+      }
+      slots_reset(m, g1, p->n_seg);
       for (size_t j = 0; j < p->n_seg; j++) {
-        m->near_cache[g0 + p->seg0 + j] = p->near_new[j];
-        m->near_valid[g0 + p->seg0 + j] = 1;
+        m->near_cache[g1 + j] = p->near_new[j];
+        m->near_valid[g1 + j] = 1;
+      }
+      for (size_t k = 0; k < p->near_vals.n; k++) {
+        const lw_near_value *q = &p->near_vals.v[k];
+        slot_store(m, q->seg, q->partner, q->value);
+        slot_store(m, q->partner, q->seg, q->value);
       }
     } else {
       /* committed without a pair evaluation: its partners are unknown */
       memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);
+      slots_reset(m, 0, sp->n_segments);
     }
   }
   for (size_t j = 0; j < p->n_seg; j++) {
@@ -1053,7 +1169,7 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p)
     const size_t a = splice_seg_node(p, j);
     if (near_of_probes(p, np, j * np, &p->segs) != LW_OK) return NAN;
     lw_segment_bezier(&p->node[a], &p->node[a + 1], bez);
-    p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs);
+    p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs, 0, NULL);
     pe += p->near_new[j];
     if (add_partners(p) != LW_OK) return NAN;
   }
@@ -1068,7 +1184,7 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p)
       } else {
         double bez[8];
         lw_segment_bezier(&nd[j], &nd[j + 1], bez);
-        pe -= near_part(&v, bez, ps, &p->segs);
+        pe -= near_part(&v, bez, ps, &p->segs, 0, NULL);
       }
       if (add_partners(p) != LW_OK) return NAN;
     }
@@ -1265,7 +1381,9 @@ static lw_status cache_room(lw_model *m, size_t n_seg, size_t n_spl)
         !room(&m->seg_local, m->cap_seg * (size_t)nls, c * (size_t)nls, sizeof *m->seg_local) ||
         !room(&m->seg_irregular, m->cap_seg, c, sizeof *m->seg_irregular) ||
         (m->grid && (!room(&m->near_cache, m->cap_seg, c, sizeof *m->near_cache) ||
-                     !room(&m->near_valid, m->cap_seg, c, sizeof *m->near_valid))))
+                     !room(&m->near_valid, m->cap_seg, c, sizeof *m->near_valid) ||
+                     !room(&m->near_pid, m->cap_seg * LW_NEAR_SLOTS, c * LW_NEAR_SLOTS, sizeof *m->near_pid) ||
+                     !room(&m->near_pval, m->cap_seg * LW_NEAR_SLOTS, c * LW_NEAR_SLOTS, sizeof *m->near_pval))))
       return LW_ENOMEM;
     m->cap_seg = c;
   }
@@ -1314,9 +1432,13 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
   size_t appended = sp->n_splines;
   for (int k = 0, a = 0; k < p->n_new; a += (int)p->new_node[k++])
     if (slot[k] < 0) (void)lw_splines_append(sp, p->node + a, p->new_node[k], p->new_rest[k], p->layer); /* reserved */
-  /* the near fields the splice changes */
+  /* the near fields the splice changes; slots of the old segments, whose
+  ** numbers new splines may take, go with them */
   if (m->grid && p->pair_done)
-    for (size_t k = 0; k < p->partners.n; k++) m->near_valid[p->partners.idx[k]] = 0;
+    for (size_t k = 0; k < p->partners.n; k++) {
+      m->near_valid[p->partners.idx[k]] = 0;
+      slots_reset(m, p->partners.idx[k], 1);
+    }
 
   for (int k = 0; k < p->n_old; k++) {
     const size_t at = p->old[k], no = p->old_seg[k], g0 = lw_segment_index(sp, at, 0);
@@ -1325,7 +1447,10 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
       m->seg_irregular[g0 + j] = 0;
       m->seg_len[g0 + j] = 0.0;
       for (int t = 0; t < nl; t++) m->seg_local[(g0 + j) * (size_t)nl + (size_t)t] = 0.0;
-      if (m->grid) m->near_valid[g0 + j] = 0;
+      if (m->grid) {
+        m->near_valid[g0 + j] = 0;
+        slots_reset(m, g0 + j, 1);
+      }
     }
     m->spline_len[at] = 0.0;
     for (size_t i = 0; m->grid && i < no * (size_t)np; i++) lw_cellgrid_remove(m->grid, (uint32_t)(g0 * (size_t)np + i));
@@ -1352,12 +1477,16 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
         m->near_cache[g0 + j] = p->near_new[j0 + j];
         m->near_valid[g0 + j] = (uint8_t)(p->pair_done && p->n_new == 1);
       }
+      slots_reset(m, g0, nn);
       if (slot[k] < 0) lw_cellgrid_extend(m->grid, nn * (size_t)np);
       for (size_t j = 0; j < nn && st == LW_OK; j++)
         st = store_samples(m->grid, g0 + j, np, p->ps + ((size_t)j0 + j) * (size_t)np);
     }
   }
-  if (m->grid && !p->pair_done) memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);
+  if (m->grid && !p->pair_done) {
+    memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);
+    slots_reset(m, 0, sp->n_segments);
+  }
   for (int k = 0; p->raster_done && k < m->terms.n_raster; k++) {
     const int t = m->terms.raster[k];
     const lw_tone *tn = ctx_in(&m->terms, p->layer)[t].data;
@@ -1399,11 +1528,17 @@ lw_status lw_model_compact(lw_model *m)
       if (m->grid) {
         m->near_cache[w] = m->near_cache[g];
         m->near_valid[w] = m->near_valid[g];
+        memmove(m->near_pid + w * LW_NEAR_SLOTS, m->near_pid + g * LW_NEAR_SLOTS, LW_NEAR_SLOTS * sizeof *m->near_pid);
+        memmove(m->near_pval + w * LW_NEAR_SLOTS, m->near_pval + g * LW_NEAR_SLOTS,
+                LW_NEAR_SLOTS * sizeof *m->near_pval);
       }
       w++;
     }
     if (!dead) m->spline_len[ws++] = m->spline_len[i];
   }
+  /* the partners by their new numbers (a dead one has no pairs left) */
+  for (size_t k = 0; m->grid && k < w * LW_NEAR_SLOTS; k++)
+    if (m->near_pid[k] != LW_NEAR_FREE) m->near_pid[k] = to[m->near_pid[k]];
   if (m->grid) lw_cellgrid_renumber(m->grid, to, (uint32_t)np, w * (size_t)np);
   free(to);
   lw_splines_compact(sp, m->slots->ghost);

@@ -848,6 +848,32 @@ static void assert_gauss_table(const double *s, const double *w, int m)
   }
 }
 
+/* The pair slots (model.h) are a cache of near corrections: filled by the
+** build, written by commits into both segments of a pair, read by the old
+** side of a move.  After commits of moves that carry lines across each other,
+** every full slot holds what a recomputation gives, bit for bit, and every
+** move still equals a recomputation from scratch. */
+Test(pair, pair_slots_hold_what_a_recomputation_gives)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = p.height = 40;
+  p.margin = 1;
+  p.strain = 1;
+  p.bending = 0.1;
+  p.pair = 0.01;
+  p.pair_cutoff = 3;
+  p.pair_near = 1.5;
+  lw_scene sc;
+  lw_test_scene(&sc, &p);
+  lw_model *m = lw_test_model_random(&sc, 40, 4, 5.0, 3);
+  cr_assert_gt(lw_test_pair_slots_hold_current(m), 20, "the build fills the slots of crossing lines");
+  cr_assert_gt(lw_test_moves_match_full(&sc, m, 400, 0.7, 5), 200);
+  cr_assert_gt(lw_test_pair_slots_hold_current(m), 20);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
 Test(pair, near_field_gauss_tables_are_exact)
 {
   const lw_pairnear_consts *k = &lw_pairnear_k;

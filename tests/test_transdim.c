@@ -378,6 +378,7 @@ static void same_as_fresh(const lw_model *m)
   lw_model *f = lw_model_new(m->scene, lw_splines_clone(m->sp), &err);
   cr_assert_not_null(f, "%s", err.msg);
   cr_assert_eq(f->sp->n_segments, m->sp->n_segments);
+  lw_test_pair_slots_hold_current(m);
   const int np = m->scene->pair_quad.n, nl = m->scene->n_local;
   for (size_t g = 0; g < m->sp->n_segments; g++) {
     cr_assert_eq(f->seg_len[g], m->seg_len[g], "segment %zu: length %.17g vs %.17g", g, m->seg_len[g], f->seg_len[g]);

@@ -17,6 +17,7 @@
 #include "linewise/init.h"
 #include "linewise/mc.h"
 #include "linewise/model.h"
+#include "linewise/pairnear.h"
 #include "linewise/scene.h"
 #include "linewise/spline.h"
 #include "linewise/sys_splines.h"
@@ -259,6 +260,37 @@ static inline lw_model *lw_test_model_random(const lw_scene *sc, size_t n, size_
   return m;
 }
 
+/* Every pair slot of m (model.h) holds what lw_pair_near_correction gives its
+** pair now, bit for bit, and no segment holds a partner twice; returns how
+** many slots were full, so a caller can see that the check saw something. */
+static inline size_t lw_test_pair_slots_hold_current(const lw_model *m)
+{
+  if (!m->grid) return 0;
+  const int np = m->scene->pair_quad.n;
+  size_t full = 0;
+  for (size_t g = 0; g < m->sp->n_segments; g++) {
+    const uint32_t *id = m->near_pid + g * LW_NEAR_SLOTS;
+    for (int k = 0; k < LW_NEAR_SLOTS; k++) {
+      if (id[k] == LW_NEAR_FREE) continue;
+      for (int j = 0; j < k; j++) cr_assert_neq(id[j], id[k], "segment %zu holds partner %u twice", g, id[k]);
+      const uint32_t h = id[k];
+      double a[8], b[8];
+      lw_pair_sample sa[LW_QUAD_MAX], sb[LW_QUAD_MAX];
+      lw_segment_bezier(&m->sp->node[lw_segment_node(m->sp, g)], &m->sp->node[lw_segment_node(m->sp, g) + 1], a);
+      lw_segment_bezier(&m->sp->node[lw_segment_node(m->sp, h)], &m->sp->node[lw_segment_node(m->sp, h) + 1], b);
+      for (int q = 0; q < np; q++) {
+        lw_cellgrid_get(m->grid, (uint32_t)(g * (size_t)np + (size_t)q), &sa[q].x, &sa[q].y, &sa[q].dl);
+        lw_cellgrid_get(m->grid, (uint32_t)(h * (size_t)np + (size_t)q), &sb[q].x, &sb[q].y, &sb[q].dl);
+      }
+      double now = lw_pair_near_correction(a, sa, b, sb, np, &m->scene->pair);
+      cr_assert(now == m->near_pval[g * LW_NEAR_SLOTS + (size_t)k], "segment %zu, partner %u: slot %.17g, now %.17g",
+                g, h, m->near_pval[g * LW_NEAR_SLOTS + (size_t)k], now);
+      full++;
+    }
+  }
+  return full;
+}
+
 /* Random moves of every kind (one point, one vector, a whole spline; steps
 ** of sd, stream seeded with seed) on model m of scene sc: each term's local
 ** difference against a recomputation from scratch within 1e-9, and after
@@ -302,6 +334,7 @@ static inline int lw_test_moves_match_full(const lw_scene *sc, lw_model *m, int 
   for (int t = 0; t < LW_TERM_COUNT; t++)
     cr_assert(fabs(m->term[t] - term0[t]) <= 1e-9 * fmax(fabs(term0[t]), 1e-3), "%s", lw_term_names[t]);
   cr_assert(fabs(lw_model_total(m) - e0) <= 1e-9 * fmax(fabs(e0), 1.0));
+  lw_test_pair_slots_hold_current(m);
   free(nd);
   gsl_rng_free(r);
   lw_proposal_free(pr);

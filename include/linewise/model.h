@@ -84,6 +84,14 @@ typedef struct {
   lw_cellgrid *grid;        /* the pair samples' positions and weights (pairwise term on), else NULL */
   double *near_cache;       /* n_segments: each segment's pair near field (pair on) */
   uint8_t *near_valid;      /* n_segments: 1 where near_cache holds the current value */
+  /* Segment g's corrections with up to LW_NEAR_SLOTS of its near partners
+  ** (pair on): near_pid[g LW_NEAR_SLOTS + k] the partner (LW_NEAR_FREE: an
+  ** empty slot) and near_pval the value lw_pair_near_correction gives the
+  ** pair in the current state.  A commit writes a move's new pair values
+  ** into both segments' slots, so a segment whose near_cache a partner's
+  ** move invalidated sums it again without recomputing its other pairs. */
+  uint32_t *near_pid;
+  double *near_pval;
   int64_t *raster[LW_TERM_COUNT]; /* each raster term's raster (tone.h) while on, else NULL;
                                      with layers one plane a layer, layer k at k w h */
   size_t max_segments;      /* longest spline, for sizing proposals (with trans-dimensional
@@ -124,6 +132,22 @@ double lw_model_total(const lw_model *m);
 ** new one, |new - old| / max(|new|, 1). */
 lw_status lw_model_refresh(lw_model *m, double *drift);
 
+/* Pair slots a segment keeps (lw_model.near_pid): as many as a segment of a
+** drawing usually has near partners; more are recomputed when needed. */
+#define LW_NEAR_SLOTS 6
+#define LW_NEAR_FREE UINT32_MAX
+
+/* One segment pair's near correction, as a proposal computed it. */
+typedef struct {
+  uint32_t seg, partner; /* the changed segment (global index) and its partner */
+  double value;
+} lw_near_value;
+
+typedef struct {
+  lw_near_value *v;
+  size_t n, cap;
+} lw_near_values;
+
 /* A growable list of segment numbers (near partners). */
 typedef struct {
   uint32_t *idx;
@@ -153,6 +177,7 @@ typedef struct {
   lw_near_list segs;          /* scratch: the near partners of one segment */
   lw_near_list partners;      /* near partners of the changed segments, old and new */
   double *near_new;           /* n_seg new near fields (no coefficient) */
+  lw_near_values near_vals;   /* the pairs that make up near_new, for the pair slots */
   int pair_done;              /* 1 if the pair part was evaluated */
   lw_tone_box box[LW_TERM_COUNT]; /* each raster term's changes */
   int raster_done;            /* 1 if the raster terms were evaluated */
