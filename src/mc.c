@@ -109,13 +109,32 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
   } else {
     accept = 0;
   }
+  const lw_system_type *t = c->sys->type;
+  if (accept && t->finish) {
+    /* the second stage of delayed acceptance (system.h): the part of dE
+    ** the first one saw only a stand-in for */
+    const double d2 = t->finish(c->sys->state, c->prop);
+    if (isnan(d2)) {
+      s->nan++;
+      accept = 0;
+    } else if (d2 > 0.0) {
+      const double x = -d2 / c->temperature; /* defer is off at T = 0 */
+      accept = x > -745.0 && gsl_rng_uniform(c->rng) < exp(x);
+    }
+  }
   if (accept) {
-    const lw_system_type *t = c->sys->type;
     if ((c->part ? t->commit_part : t->commit)(c->sys->state, c->prop) != LW_OK) accept = -1;
     else s->accepted++;
   }
   if (c->tuning && accept >= 0) tune(c, kind, accept);
   return accept;
+}
+
+/* Delayed acceptance (system.h) where there is a temperature: at T = 0 the
+** chain decides on the sign of the whole dE. */
+static void stage(lw_chain *c)
+{
+  if (c->sys->type->defer) c->sys->type->defer(c->prop, c->temperature > 0.0);
 }
 
 int lw_chain_step(lw_chain *c, int kind)
@@ -124,6 +143,7 @@ int lw_chain_step(lw_chain *c, int kind)
   void *state = c->sys->state;
   if (t->sweep_size(state) == 0) return 0;
   int forbidden = 0;
+  stage(c);
   double dE = t->propose(state, c->prop, kind, c->step[kind], c->rng, &forbidden);
   return decide(c, kind, dE, forbidden);
 }
@@ -133,6 +153,7 @@ int lw_chain_step_at(lw_chain *c, int kind, size_t site)
   const lw_system_type *t = c->sys->type;
   if (!t->propose_at) return lw_chain_step(c, kind);
   int forbidden = 0;
+  stage(c);
   double dE = t->propose_at(c->sys->state, c->prop, kind, site, c->step[kind], c->rng, &forbidden);
   return decide(c, kind, dE, forbidden);
 }
@@ -150,6 +171,7 @@ static int draw_kind(lw_chain *c) { return kind_at(c, gsl_rng_uniform(c->rng)); 
 int lw_chain_visit_in(lw_chain *c, size_t site, const double box[4])
 {
   int kind = draw_kind(c), forbidden = 0;
+  stage(c);
   double dE = c->sys->type->propose_in(c->sys->state, c->prop, kind, site, c->step[kind], c->rng, &forbidden, box);
   return decide(c, kind, dE, forbidden);
 }

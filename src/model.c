@@ -739,18 +739,21 @@ static lw_status add_partners(lw_proposal *p)
 }
 
 /*
-** The pair part of a proposal's dE (no coefficient).  One walk over the new
-** samples (+1) and their old selves (-1) gives the far pairs; the near field
-** of each changed segment is added for the new side, and taken away for the
-** old side from the model's cache when valid.  The near field is the costly
-** part and a chain at low temperature rejects most proposals, so caching the
-** old side halves it.  The cached value of a segment is what this code
-** computes for it from the current state (the same sum in the same order), so
-** a cached and a recomputed value are bitwise equal; commits invalidate every
+** The pair part of a proposal's dE (no coefficient) comes in two steps.
+** pair_walk: one walk over the new samples (+1) and their old selves (-1)
+** gives the far pairs and lists the near ones in p->near.  pair_near_delta:
+** the near field of each changed segment is added for the new side, and
+** taken away for the old side from the model's cache when valid.  The near
+** field is the costly part and a chain at low temperature rejects most
+** proposals, so caching the old side halves it, and delayed acceptance
+** (lw_model_propose_finish) leaves the new side to the proposals that pass
+** a first test.  The cached value of a segment is what this code computes
+** for it from the current state (the same sum in the same order), so a
+** cached and a recomputed value are bitwise equal; commits invalidate every
 ** segment whose near field the move changed (its near partners before and
 ** after), kept in p->partners.  NAN if out of memory.
 */
-static double pair_delta(const lw_model *m, lw_proposal *p, const lw_node *base, size_t g0)
+static double pair_walk(const lw_model *m, lw_proposal *p)
 {
   const lw_scene *sc = m->scene;
   const uint32_t np = (uint32_t)sc->pair_quad.n;
@@ -766,9 +769,18 @@ static double pair_delta(const lw_model *m, lw_proposal *p, const lw_node *base,
   lw_pair_filter f = filter_of(&v, p->spline, 0);
   double pe;
   p->near.n = 0;
+  if (lw_pair_walk(m->grid, &sc->pair, p->probe, 2 * n, &f, &pe, &p->near, NULL) != LW_OK) return NAN;
+  return pe;
+}
+
+/* pe, the walk's far sum, with the near fields added (see pair_walk). */
+static double pair_near_delta(const lw_model *m, lw_proposal *p, const lw_node *base, size_t g0, double pe)
+{
+  const lw_scene *sc = m->scene;
+  const uint32_t np = (uint32_t)sc->pair_quad.n;
+  const pair_view v = {m->grid, m->sp, np, &sc->pair};
   p->partners.n = 0;
   p->near_vals.n = 0;
-  if (lw_pair_walk(m->grid, &sc->pair, p->probe, 2 * n, &f, &pe, &p->near, NULL) != LW_OK) return NAN;
   for (size_t j = 0; j < p->n_seg; j++) {
     size_t g = g0 + p->seg0 + j;
     double bez[8];
@@ -781,6 +793,31 @@ static double pair_delta(const lw_model *m, lw_proposal *p, const lw_node *base,
     if (add_partners(p) != LW_OK) return NAN;
   }
   return pe;
+}
+
+/*
+** What the first stage of delayed acceptance sees in place of a move's near
+** field: the walk's near sample pairs as the product rule sums them, each
+** distance held at half its near radius or more (so it stays finite where
+** samples meet), new pairs added and old ones taken away.  No curve
+** integrals; a function of the two states, which is all the first stage
+** needs: how closely it follows the near field only sets how few of the
+** moves that pass it the second stage refuses.
+*/
+static double near_stand_in(const lw_pair_ctx *ctx, const lw_pair_probe *probe, const lw_pair_nearlist *near)
+{
+  double sum = 0.0;
+  for (size_t k = 0; k < near->n; k++) {
+    const lw_pair_near *q = &near->pair[k];
+    const lw_pair_probe *P = &probe[q->probe];
+    const double dx = P->x - q->x, dy = P->y - q->y;
+    double r2 = dx * dx + dy * dy;
+    if (P->dl == 0.0f || q->dl == 0.0f || r2 >= ctx->cutoff2) continue;
+    const double floor2 = 0.25 * lw_pair_near_radius2(ctx, P->dl, q->dl);
+    if (r2 < floor2) r2 = floor2;
+    sum += P->scale * (double)P->dl * (double)q->dl * (1.0 / sqrt(r2) - ctx->inv_cutoff);
+  }
+  return sum;
 }
 
 /* How many pairs of one of the n samples ps and a sample of another spline
@@ -924,10 +961,20 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
       dE = INFINITY;
     }
   }
+  p->near_pending = 0;
   if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
-    double pe = pair_delta(m, p, base, g0);
-    p->pair_done = !isnan(pe);
-    p->dterm[ts->pair] = pc->coef * pe;
+    double pe = pair_walk(m, p);
+    if (p->defer_near && p->near.n && !isnan(pe)) {
+      /* the near field waits for lw_model_propose_finish: a stand-in here */
+      p->near_pending = 1;
+      p->pe_walk = pe;
+      p->dE_pre_pair = dE;
+      p->dterm[ts->pair] = pc->coef * (pe + near_stand_in(&sc->pair, p->probe, &p->near));
+    } else {
+      if (!isnan(pe)) pe = pair_near_delta(m, p, base, g0, pe);
+      p->pair_done = !isnan(pe);
+      p->dterm[ts->pair] = pc->coef * pe;
+    }
     dE += p->dterm[ts->pair];
   }
   p->raster_done = 0;
@@ -943,6 +990,24 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   p->dE = dE;
 }
 
+double lw_model_propose_finish(const lw_model *m, lw_proposal *p)
+{
+  if (!p->near_pending) return 0.0;
+  const lw_term_set *ts = &m->terms;
+  const lw_splines *sp = m->sp;
+  const double before = p->dE;
+  p->near_pending = 0;
+  double pe = pair_near_delta(m, p, &sp->node[sp->first[p->spline]], lw_segment_index(sp, p->spline, 0),
+                              p->pe_walk);
+  p->pair_done = !isnan(pe);
+  p->dterm[ts->pair] = ts->ctx[ts->pair].coef * pe;
+  /* the same sum in the same order as a proposal that did not wait */
+  double dE = p->dE_pre_pair + p->dterm[ts->pair];
+  for (int k = 0; p->raster_done && k < ts->n_raster; k++) dE += p->dterm[ts->raster[k]];
+  p->dE = dE;
+  return dE - before;
+}
+
 static lw_status commit_splice(lw_model *m, const lw_proposal *p);
 
 /* The commit without the running totals (model.h): everything but m->term
@@ -950,6 +1015,7 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p);
 ** splice is committed whole by lw_model_commit. */
 lw_status lw_model_commit_part(lw_model *m, lw_proposal *p)
 {
+  if (p->near_pending) (void)lw_model_propose_finish(m, p);
   lw_splines *sp = m->sp;
   const int np = pair_nodes(m), nl = m->scene->n_local;
   const size_t g0 = lw_segment_index(sp, p->spline, 0);
@@ -1264,6 +1330,7 @@ void lw_model_propose_regroup(const lw_model *m, lw_proposal *p, const uint32_t 
   const int np = pair_nodes(m), nl = sc->n_local;
 
   p->splice = 1;
+  p->near_pending = 0;
   p->n_old = n_old;
   p->n_new = n_new;
   p->spline = n_old ? old[0] : (uint32_t)sp->n_splines;

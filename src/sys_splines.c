@@ -288,6 +288,7 @@ static void spline_box(const lw_splines *sp, uint32_t i, size_t node0, size_t n,
 static double refuse(lw_proposal *p)
 {
   p->splice = 0;
+  p->near_pending = 0;
   p->log_ratio = 0.0;
   return INFINITY;
 }
@@ -817,6 +818,13 @@ static lw_status renumber(void *state, lw_error *err)
 
 static lw_status commit(void *state, void *prop) { return lw_model_commit(((spl_state *)state)->m, prop); }
 
+static void defer(void *prop, int on) { ((lw_proposal *)prop)->defer_near = on; }
+
+static double finish(void *state, void *prop)
+{
+  return lw_model_propose_finish(((spl_state *)state)->m, prop);
+}
+
 static lw_status sweep_end(void *state) { return lw_model_compact(((spl_state *)state)->m); }
 
 static double log_ratio(const void *prop) { return ((const lw_proposal *)prop)->log_ratio; }
@@ -1025,6 +1033,8 @@ static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinne
   .renumber = renumber, \
   .sweep_end = sweep_end, \
   .commit = commit, \
+  .defer = defer, \
+  .finish = finish, \
   .log_ratio = log_ratio, \
   .total = total, \
   .terms = terms, \

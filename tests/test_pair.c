@@ -874,6 +874,77 @@ Test(pair, pair_slots_hold_what_a_recomputation_gives)
   lw_scene_clear(&sc);
 }
 
+/* Delayed acceptance (model.h): a deferred move's first-stage dE is the
+** difference of a function of the state (a cycle of moves of one node that
+** ends where it began sums to zero), and finishing it gives bitwise the dE
+** and pair term of a move that did not wait. */
+Test(pair, deferred_near_field_is_a_state_function_and_finishes_exactly)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = p.height = 30;
+  p.margin = 1;
+  p.strain = 1;
+  p.bending = 0.1;
+  p.pair = 0.01;
+  p.pair_cutoff = 3;
+  p.pair_near = 1.5;
+  lw_scene sc;
+  lw_test_scene(&sc, &p);
+  lw_model *m = lw_test_model_random(&sc, 30, 3, 5.0, 9);
+  lw_proposal *a = lw_proposal_new(m, NULL), *b = lw_proposal_new(m, NULL);
+  cr_assert(a && b);
+  rng_seed(77);
+  int deferred = 0, cycles = 0;
+  for (int trial = 0; trial < 300; trial++) {
+    uint32_t i = (uint32_t)(urand(0, 1) * (double)m->sp->n_splines);
+    size_t k = (size_t)(urand(0, 1) * (double)(m->sp->first[i + 1] - m->sp->first[i]));
+    const lw_node n0 = m->sp->node[m->sp->first[i] + k];
+    lw_node nd[3] = {n0, n0, n0};
+    nd[1].px += urand(-0.5, 0.5);
+    nd[1].py += urand(-0.5, 0.5);
+    nd[2].px += urand(-0.5, 0.5);
+    nd[2].py += urand(-0.5, 0.5);
+    double sum = 0.0, scale = 0.0;
+    int finite = 1;
+    for (int step = 0; step < 3 && finite; step++) {
+      const lw_node *to = &nd[(step + 1) % 3];
+      a->defer_near = 1;
+      b->defer_near = 0;
+      lw_model_propose(m, a, i, k, 1, to);
+      lw_model_propose(m, b, i, k, 1, to);
+      const double first = a->dE;
+      deferred += a->near_pending;
+      const double rest = lw_model_propose_finish(m, a);
+      if (!isfinite(b->dE)) {
+        finite = 0;
+        break;
+      }
+      cr_assert(a->dE == b->dE && a->dterm[LW_TERM_PAIR] == b->dterm[LW_TERM_PAIR],
+                "finished %.17g, whole %.17g", a->dE, b->dE);
+      cr_assert(first + rest == a->dE || fabs(first + rest - a->dE) <= 1e-12 * fabs(a->dE));
+      sum += first;
+      scale = fmax(scale, fabs(first));
+      cr_assert_eq(lw_model_commit(m, a), LW_OK);
+    }
+    if (!finite) {
+      /* put the node back where it began */
+      lw_model_propose(m, b, i, k, 1, &n0);
+      cr_assert_eq(lw_model_commit(m, b), LW_OK);
+      continue;
+    }
+    cycles++;
+    cr_assert(fabs(sum) <= 1e-9 * fmax(scale, 1e-6), "trial %d: first stages sum to %.3g over a cycle", trial, sum);
+  }
+  cr_assert_gt(cycles, 150);
+  cr_assert_gt(deferred, 100, "only %d moves deferred their near field", deferred);
+  lw_test_pair_slots_hold_current(m);
+  lw_proposal_free(a);
+  lw_proposal_free(b);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
 Test(pair, near_field_gauss_tables_are_exact)
 {
   const lw_pairnear_consts *k = &lw_pairnear_k;

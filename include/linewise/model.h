@@ -176,6 +176,10 @@ typedef struct {
   size_t cap_seg;
   lw_near_list segs;          /* scratch: the near partners of one segment */
   lw_near_list partners;      /* near partners of the changed segments, old and new */
+  /* delayed acceptance (lw_model_propose_finish) */
+  int defer_near;             /* set by the caller: a move may leave its near field for later */
+  int near_pending;           /* the last move did: dterm and dE hold a stand-in for it */
+  double pe_walk, dE_pre_pair; /* what the finish starts from */
   double *near_new;           /* n_seg new near fields (no coefficient) */
   lw_near_values near_vals;   /* the pairs that make up near_new, for the pair slots */
   int pair_done;              /* 1 if the pair part was evaluated */
@@ -214,6 +218,14 @@ void lw_proposal_free(lw_proposal *p);
 ** pair term's difference and dE are NaN: the move is rejected. */
 void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t node0,
                       size_t n_node, const lw_node *nodes);
+
+/* Delayed acceptance (docs/NUMERICS.md).  With p->defer_near set, a move
+** whose walk found near pairs leaves their near field out: dterm and dE hold
+** a cheap stand-in (near_pending = 1).  lw_model_propose_finish computes it
+** and returns what it adds to dE (0 when nothing was left out), leaving
+** dterm and dE bitwise what a proposal without deferral gives.  A commit
+** finishes a pending proposal first. */
+double lw_model_propose_finish(const lw_model *m, lw_proposal *p);
 
 /*
 ** Trans-dimensional proposals: replaces the n_old <= 2 splines old[] (none

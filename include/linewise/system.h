@@ -104,6 +104,17 @@ struct lw_system_type {
   double (*propose_at)(void *state, void *prop, int kind, size_t site, double step, gsl_rng *rng,
                        int *forbidden);
   lw_status (*commit)(void *state, void *prop);
+  /* Optional (NULL: dE comes whole): delayed acceptance.  defer(prop, on)
+  ** lets the following proposals leave a costly part of dE out, returning a
+  ** cheap stand-in for it; finish() replaces the stand-in of the last one by
+  ** the part itself and returns the difference (0 where nothing was left
+  ** out).  The chain (mc.c) turns it on at temperatures above 0, decides on
+  ** propose's dE and calls finish only for a proposal that passed, deciding
+  ** on what it returns a second time: the chain keeps exp(-E/T) exactly
+  ** whatever the stand-in, as long as it is a function of the two states
+  ** (docs/NUMERICS.md, "Delayed acceptance"). */
+  void (*defer)(void *prop, int on);
+  double (*finish)(void *state, void *prop);
   /* Optional (NULL: a sweep is never split; domains.h, [anneal] domains):
   ** domain decomposition within a replica.  split() gives the page
   ** (x0, y0, x1, y1) and the reach of a move, the distance beyond the
