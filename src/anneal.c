@@ -270,6 +270,7 @@ static lw_status build(lw_anneal *a, void **states, const double *ladder, lw_err
   for (int k = 0; k < n; k++) {
     a->chains[k] = lw_chain_new(a->systems[k], weight, step, target, rung_stream(a, k), err);
     if (!a->chains[k]) return err->code;
+    a->chains[k]->delayed = p->delayed_acceptance; /* before the domains copy the chain */
     if (p->driver != LW_DRIVER_DYNAMICS && lw_domains_attach(a->chains[k], p, n, err)) return err->code;
   }
   a->chain = a->chains[0];

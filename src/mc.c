@@ -23,6 +23,7 @@ lw_chain *lw_chain_new(lw_system *sys, const double *weight, const double *step,
   if (!c) goto nomem;
   c->sys = sys;
   c->n_moves = t->n_moves;
+  c->delayed = 1;
   c->prop = t->proposal_new(sys->state, err);
   c->rng = gsl_rng_alloc(gsl_rng_mt19937);
   if (!c->prop || !c->rng) goto nomem;
@@ -134,7 +135,7 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
 ** chain decides on the sign of the whole dE. */
 static void stage(lw_chain *c)
 {
-  if (c->sys->type->defer) c->sys->type->defer(c->prop, c->temperature > 0.0);
+  if (c->sys->type->defer) c->sys->type->defer(c->prop, c->delayed && c->temperature > 0.0);
 }
 
 int lw_chain_step(lw_chain *c, int kind)

@@ -85,12 +85,6 @@ static void segment_bezier(const lw_splines *sp, size_t g, double b[8])
   lw_segment_bezier(a, a + 1, b);
 }
 
-static int cmp_u32(const void *a, const void *b)
-{
-  uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-  return (x > y) - (x < y);
-}
-
 /* Orders (lower, higher) segment pairs. */
 static int cmp_pair(const void *a, const void *b)
 {
@@ -98,26 +92,18 @@ static int cmp_pair(const void *a, const void *b)
   return x[0] != y[0] ? (x[0] > y[0]) - (x[0] < y[0]) : (x[1] > y[1]) - (x[1] < y[1]);
 }
 
-/* Sorts a list of segment numbers and drops repeats; returns the count. */
-static size_t unique_u32(uint32_t *v, size_t n)
+/* Adds v to the sorted list l unless it holds it already: a segment's near
+** partners are few (its near sample pairs many, and repeating), so a scan
+** from the end beats sorting the repeats.  LW_ENOMEM if l cannot grow. */
+static lw_status set_insert(lw_near_list *l, uint32_t v)
 {
-  if (n < 2) return n; /* v may be NULL then, which qsort must not see */
-  if (n <= 32) {
-    /* a proposal's lists are this short: insertion sort costs less than
-    ** qsort's call and comparator overhead (8 % of a near-field run) */
-    for (size_t i = 1; i < n; i++) {
-      uint32_t x = v[i];
-      size_t j = i;
-      for (; j > 0 && v[j - 1] > x; j--) v[j] = v[j - 1];
-      v[j] = x;
-    }
-  } else {
-    qsort(v, n, sizeof *v, cmp_u32);
-  }
-  size_t m = 0;
-  for (size_t i = 0; i < n; i++)
-    if (m == 0 || v[i] != v[m - 1]) v[m++] = v[i];
-  return m;
+  size_t k = l->n;
+  while (k > 0 && l->idx[k - 1] > v) k--;
+  if (k > 0 && l->idx[k - 1] == v) return LW_OK;
+  if (list_push(l, v) != LW_OK) return LW_ENOMEM;
+  memmove(l->idx + k + 1, l->idx + k, (l->n - 1 - k) * sizeof *l->idx);
+  l->idx[k] = v;
+  return LW_OK;
 }
 
 /* The near correction (pairnear.h, no coefficient) of the segment with
@@ -168,9 +154,11 @@ static double near_part(const pair_view *v, const double bez[8], const lw_pair_s
 ** Which pairs find a slot may then depend on timing, never a value: a slot
 ** holds what a recomputation gives, bit for bit. */
 
-/* The slot of segment g that holds partner h, or -1. */
+/* The slot of segment g that holds partner h, or -1 (also without slots:
+** the near field off). */
 static int slot_find(const lw_model *m, size_t g, uint32_t h)
 {
+  if (!m->near_pid) return -1;
   const uint32_t *id = m->near_pid + g * LW_NEAR_SLOTS;
   for (int k = 0; k < LW_NEAR_SLOTS; k++)
     if (__atomic_load_n(&id[k], __ATOMIC_RELAXED) == h) return k;
@@ -180,6 +168,7 @@ static int slot_find(const lw_model *m, size_t g, uint32_t h)
 /* Keeps x as the value of pair (g, h) in g's slots, if one is free. */
 static void slot_store(const lw_model *m, size_t g, uint32_t h, double x)
 {
+  if (!m->near_pid) return;
   uint32_t *id = m->near_pid + g * LW_NEAR_SLOTS;
   int k = slot_find(m, g, h);
   for (int s = 0; k < 0 && s < LW_NEAR_SLOTS; s++) {
@@ -199,6 +188,7 @@ static void slot_clear(const lw_model *m, size_t g, uint32_t h)
 /* Empties the slots of segments [g, g + n). */
 static void slots_reset(const lw_model *m, size_t g, size_t n)
 {
+  if (!m->near_pid) return;
   for (size_t k = g * LW_NEAR_SLOTS; k < (g + n) * LW_NEAR_SLOTS; k++)
     __atomic_store_n(&m->near_pid[k], LW_NEAR_FREE, __ATOMIC_RELAXED);
 }
@@ -518,9 +508,12 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
     }
     m->near_cache = malloc(ns * sizeof *m->near_cache);
     m->near_valid = calloc(ns, sizeof *m->near_valid);
-    m->near_pid = malloc(ns * LW_NEAR_SLOTS * sizeof *m->near_pid);
-    m->near_pval = malloc(ns * LW_NEAR_SLOTS * sizeof *m->near_pval);
-    if (!m->near_cache || !m->near_valid || !m->near_pid || !m->near_pval) goto nomem;
+    if (!m->near_cache || !m->near_valid) goto nomem;
+    if (sc->pair.near_scale > 0.0) {
+      m->near_pid = malloc(ns * LW_NEAR_SLOTS * sizeof *m->near_pid);
+      m->near_pval = malloc(ns * LW_NEAR_SLOTS * sizeof *m->near_pval);
+      if (!m->near_pid || !m->near_pval) goto nomem;
+    }
     slots_reset(m, 0, ns);
     m->grid = grid_for(sc, &m->terms.ctx[m->terms.pair], n, err);
     if (!m->grid) {
@@ -697,9 +690,8 @@ static lw_status near_segments(const lw_proposal *p, uint32_t np, size_t j, int 
   for (size_t k = 0; k < p->near.n; k++) {
     const lw_pair_near *q = &p->near.pair[k];
     if ((int)(q->probe & 1) != old || (q->probe / 2) / np != j) continue;
-    if (list_push(segs, q->idx / np) != LW_OK) return LW_ENOMEM;
+    if (set_insert(segs, q->idx / np) != LW_OK) return LW_ENOMEM;
   }
-  segs->n = unique_u32(segs->idx, segs->n);
   return LW_OK;
 }
 
@@ -1123,9 +1115,8 @@ static lw_status near_of_probes(const lw_proposal *p, uint32_t np, size_t lo, lw
   for (size_t k = 0; k < p->near.n; k++) {
     const lw_pair_near *q = &p->near.pair[k];
     if (q->probe < lo || q->probe >= lo + np) continue;
-    if (list_push(segs, q->idx / np) != LW_OK) return LW_ENOMEM;
+    if (set_insert(segs, q->idx / np) != LW_OK) return LW_ENOMEM;
   }
-  segs->n = unique_u32(segs->idx, segs->n);
   return LW_OK;
 }
 
@@ -1449,8 +1440,9 @@ static lw_status cache_room(lw_model *m, size_t n_seg, size_t n_spl)
         !room(&m->seg_irregular, m->cap_seg, c, sizeof *m->seg_irregular) ||
         (m->grid && (!room(&m->near_cache, m->cap_seg, c, sizeof *m->near_cache) ||
                      !room(&m->near_valid, m->cap_seg, c, sizeof *m->near_valid) ||
-                     !room(&m->near_pid, m->cap_seg * LW_NEAR_SLOTS, c * LW_NEAR_SLOTS, sizeof *m->near_pid) ||
-                     !room(&m->near_pval, m->cap_seg * LW_NEAR_SLOTS, c * LW_NEAR_SLOTS, sizeof *m->near_pval))))
+                     (m->near_pid &&
+                      (!room(&m->near_pid, m->cap_seg * LW_NEAR_SLOTS, c * LW_NEAR_SLOTS, sizeof *m->near_pid) ||
+                       !room(&m->near_pval, m->cap_seg * LW_NEAR_SLOTS, c * LW_NEAR_SLOTS, sizeof *m->near_pval))))))
       return LW_ENOMEM;
     m->cap_seg = c;
   }
@@ -1595,6 +1587,8 @@ lw_status lw_model_compact(lw_model *m)
       if (m->grid) {
         m->near_cache[w] = m->near_cache[g];
         m->near_valid[w] = m->near_valid[g];
+      }
+      if (m->near_pid) {
         memmove(m->near_pid + w * LW_NEAR_SLOTS, m->near_pid + g * LW_NEAR_SLOTS, LW_NEAR_SLOTS * sizeof *m->near_pid);
         memmove(m->near_pval + w * LW_NEAR_SLOTS, m->near_pval + g * LW_NEAR_SLOTS,
                 LW_NEAR_SLOTS * sizeof *m->near_pval);
@@ -1604,7 +1598,7 @@ lw_status lw_model_compact(lw_model *m)
     if (!dead) m->spline_len[ws++] = m->spline_len[i];
   }
   /* the partners by their new numbers (a dead one has no pairs left) */
-  for (size_t k = 0; m->grid && k < w * LW_NEAR_SLOTS; k++)
+  for (size_t k = 0; m->near_pid && k < w * LW_NEAR_SLOTS; k++)
     if (m->near_pid[k] != LW_NEAR_FREE) m->near_pid[k] = to[m->near_pid[k]];
   if (m->grid) lw_cellgrid_renumber(m->grid, to, (uint32_t)np, w * (size_t)np);
   free(to);

@@ -284,6 +284,11 @@ const lw_param_def lw_param_table[] = {
   NUM("anneal", "check_every", LW_PT_INT, check_every, "100", "sweeps", 1, 2e9, 0,
       "Sweeps between full recomputations of the energy (the drift check); splines are "
       "renumbered along a Hilbert curve of the page just before each, for locality in memory."),
+  NUM("anneal", "delayed_acceptance", LW_PT_INT, delayed_acceptance, "1", "", 0, 1, 0,
+      "1: a proposal is first tested on a cheap stand-in for the pair term's near field, and the "
+      "near field is computed only for proposals that pass (delayed acceptance; the chain samples "
+      "the same distribution, docs/NUMERICS.md); 0: plain Metropolis on the whole dE, for studies "
+      "of acceptance rates. Nothing changes without a near field (energy.pair_near = 0)."),
   STRING("anneal", "domains", domains, "off", "",
          "Domain decomposition of each replica's sweeps (docs/NUMERICS.md, \"Domains\"): `off`; `N` "
          "(1 to 64), an N x N lattice of domains over the page, shifted at random each sweep, whose four "

@@ -73,6 +73,7 @@ typedef struct {
   v2d x, y;
   v2d rc2;        /* far pairs need r^2 < rc2; -1 for a weightless probe */
   v4f dl;
+  v2d near2;      /* (near_scale dl)^2: a pair is near within the larger of its two */
   v2d scale;      /* scale dl: the factor on this probe's far pairs' dl_j (1/r - 1/rc) */
   double gx[3], gy[3]; /* squared gaps to the columns and rows of the block (axis_gaps) */
 } probe_ctx;
@@ -123,19 +124,20 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
     const v2l ok0 = lo2l(ok), ok1 = hi2l(ok);
     const v2d x0 = load2(xs + k), x1 = load2(xs + k + 2), y0 = load2(ys + k), y1 = load2(ys + k + 2);
     const v2d w0 = lo2d(dlj), w1 = hi2d(dlj);
+    /* the entries' own near radii: rounding is monotone, so the square of
+    ** near_scale times the larger weight is the larger of the two squares,
+    ** bit for bit the kernel's lw_pair_near_radius2 */
+    const v2d e0 = sh->ns * w0, e1 = sh->ns * w1, m0 = e0 * e0, m1 = e1 * e1;
     for (unsigned left = mask; left; left &= left - 1) {
       unsigned b = (unsigned)__builtin_ctz(left);
       const probe_ctx *q = &pc[b];
       v2d dx0 = x0 - q->x, dx1 = x1 - q->x, dy0 = y0 - q->y, dy1 = y1 - q->y;
       v2d r0 = dx0 * dx0 + dy0 * dy0, r1 = dx1 * dx1 + dy1 * dy1;
       v2l f0 = (r0 < q->rc2) & ok0, f1 = (r1 < q->rc2) & ok1;
-      if (with_near) {
-        /* the kernel's own test: max of the float weights, then in double */
-        v4i big = dlj > q->dl;
-        v4f dm = (v4f)(((v4i)dlj & big) | ((v4i)q->dl & ~big));
-        v2d l0 = sh->ns * lo2d(dm), l1 = sh->ns * hi2d(dm);
-        v2l n0 = (r0 < l0 * l0) & (r0 < sh->cut2) & ~lo2l(skip);
-        v2l n1 = (r1 < l1 * l1) & (r1 < sh->cut2) & ~hi2l(skip);
+      /* near pairs lie within the cutoff too: most groups have none */
+      if (with_near && bits2((r0 < sh->cut2) | (r1 < sh->cut2))) {
+        v2l n0 = ((r0 < m0) | (r0 < q->near2)) & (r0 < sh->cut2) & ~lo2l(skip);
+        v2l n1 = ((r1 < m1) | (r1 < q->near2)) & (r1 < sh->cut2) & ~hi2l(skip);
         f0 &= ~n0;
         f1 &= ~n1;
         near_bits[b] |= (uint64_t)(bits2(n0) | bits2(n1) << 2) << t;
@@ -252,7 +254,8 @@ static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
     const lw_pair_probe *p = &P[sel[b]];
     /* a weightless probe has no far pairs (its kernel is 0, even at r = 0) */
     double rc2 = p->dl != 0.0f ? ctx->cutoff2 : -1.0;
-    pc[b] = (probe_ctx){{p->x, p->x}, {p->y, p->y}, {rc2, rc2}, {p->dl, p->dl, p->dl, p->dl},
+    const double l = ctx->near_scale * (double)p->dl;
+    pc[b] = (probe_ctx){{p->x, p->x}, {p->y, p->y}, {rc2, rc2}, {p->dl, p->dl, p->dl, p->dl}, {l * l, l * l},
                         {p->scale * (double)p->dl, p->scale * (double)p->dl}, {0}, {0}};
     axis_gaps(g->x0, h, cx, p->x, pc[b].gx);
     axis_gaps(g->y0, h, cy, p->y, pc[b].gy);

@@ -576,8 +576,8 @@ static double da_mean(int mode, long sweeps, unsigned long seed, double *acc)
   cr_assert_not_null(c, "%s", err.msg);
   c->temperature = 0.05;
   c->tuning = 0;
+  c->delayed = mode != 1;
   lw_system_type row = *c->sys->type;
-  if (mode == 1) row.defer = NULL, row.finish = NULL;
   if (mode == 2) row.finish = stand_in_only;
   c->sys->type = &row;
   for (long k = 0; k < sweeps / 4; k++) lw_chain_sweep(c);

@@ -265,7 +265,7 @@ static inline lw_model *lw_test_model_random(const lw_scene *sc, size_t n, size_
 ** many slots were full, so a caller can see that the check saw something. */
 static inline size_t lw_test_pair_slots_hold_current(const lw_model *m)
 {
-  if (!m->grid) return 0;
+  if (!m->near_pid) return 0;
   const int np = m->scene->pair_quad.n;
   size_t full = 0;
   for (size_t g = 0; g < m->sp->n_segments; g++) {

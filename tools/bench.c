@@ -100,8 +100,9 @@ static double bytes_per_segment(const lw_model *m)
              (double)sp->n_segments * (sizeof(uint32_t) + sizeof(double) + sizeof *m->seg_irregular +
                                        (double)m->scene->n_local * sizeof(double));
   if (m->grid)
-    b += (double)sp->n_segments * (sizeof *m->near_cache + sizeof *m->near_valid +
-                                   LW_NEAR_SLOTS * (sizeof *m->near_pid + sizeof *m->near_pval)) +
+    b += (double)sp->n_segments *
+             (sizeof *m->near_cache + sizeof *m->near_valid +
+              (m->near_pid ? LW_NEAR_SLOTS * (sizeof *m->near_pid + sizeof *m->near_pval) : 0)) +
          (double)lw_cellgrid_bytes(m->grid);
   return b / (double)(sp->n_segments ? sp->n_segments : 1);
 }

@@ -50,6 +50,8 @@ typedef struct {
   lw_move_stats stats[LW_MOVES_MAX]; /* since the start of the run */
   struct lw_domains *domains;    /* owned; not NULL: sweeps are split into domains (domains.h) */
   int part;                      /* 1 for a domain's chain: commits through commit_part */
+  int delayed;                   /* 1 (the default): delayed acceptance where the row offers it
+                                 ** (system.h, defer and finish) and T > 0 */
   unsigned long outside;         /* proposals rejected for leaving their domain (not saved) */
 } lw_chain;
 

@@ -85,7 +85,7 @@ typedef struct {
   double *near_cache;       /* n_segments: each segment's pair near field (pair on) */
   uint8_t *near_valid;      /* n_segments: 1 where near_cache holds the current value */
   /* Segment g's corrections with up to LW_NEAR_SLOTS of its near partners
-  ** (pair on): near_pid[g LW_NEAR_SLOTS + k] the partner (LW_NEAR_FREE: an
+  ** (pair and near field on, else NULL): near_pid[g LW_NEAR_SLOTS + k] the partner (LW_NEAR_FREE: an
   ** empty slot) and near_pval the value lw_pair_near_correction gives the
   ** pair in the current state.  A commit writes a move's new pair values
   ** into both segments' slots, so a segment whose near_cache a partner's

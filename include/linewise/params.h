@@ -139,6 +139,7 @@ typedef struct {
   char table[LW_PATH_MAX];    /* table schedule file */
   double seed;                /* RNG seed (a whole number, stored as double for the table) */
   int check_every;            /* sweeps between drift checks */
+  int delayed_acceptance;     /* 1: two-stage Metropolis where the row offers it (mc.h) */
   char domains[64];           /* off, auto or domains per side (domains.h) */
   int quench;                 /* LW_QUENCH_*: after the last sweep, to the nearest local minimum */
   double quench_tol;          /* stop at this gradient norm, energy/mm */
