@@ -64,6 +64,17 @@ static inline v2d hi2d(v4f v)
 #endif
 }
 
+/* The larger of a and b in each lane (neither is NaN here). */
+static inline v2d vmax(v2d a, v2d b)
+{
+#if defined(__SSE2__)
+  return (v2d)_mm_max_pd((__m128d)a, (__m128d)b);
+#else
+  const v2l g = a > b;
+  return (v2d)(((v2l)a & g) | ((v2l)b & ~g));
+#endif
+}
+
 /* A 32-bit lane mask widened to 64-bit lanes: lanes 0, 1 (lo) or 2, 3 (hi). */
 static inline v2l lo2l(v4i m) { return (v2l)__builtin_shufflevector(m, m, 0, 0, 1, 1); }
 static inline v2l hi2l(v4i m) { return (v2l)__builtin_shufflevector(m, m, 2, 2, 3, 3); }
@@ -128,14 +139,19 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
     ** near_scale times the larger weight is the larger of the two squares,
     ** bit for bit the kernel's lw_pair_near_radius2 */
     const v2d e0 = sh->ns * w0, e1 = sh->ns * w1, m0 = e0 * e0, m1 = e1 * e1;
+    /* the group's largest of them (lanes past k1, whose weights may be
+    ** anything, as 0): a probe farther from all four than this and its own
+    ** radius has no near pair among them, which is most groups */
+    const v2d a0 = (v2d)((v2l)m0 & ~lo2l(skip)), a1 = (v2d)((v2l)m1 & ~hi2l(skip));
+    const v2d a = vmax(a0, a1), mg = vmax(a, (v2d){a[1], a[0]});
     for (unsigned left = mask; left; left &= left - 1) {
       unsigned b = (unsigned)__builtin_ctz(left);
       const probe_ctx *q = &pc[b];
       v2d dx0 = x0 - q->x, dx1 = x1 - q->x, dy0 = y0 - q->y, dy1 = y1 - q->y;
       v2d r0 = dx0 * dx0 + dy0 * dy0, r1 = dx1 * dx1 + dy1 * dy1;
       v2l f0 = (r0 < q->rc2) & ok0, f1 = (r1 < q->rc2) & ok1;
-      /* near pairs lie within the cutoff too: most groups have none */
-      if (with_near && bits2((r0 < sh->cut2) | (r1 < sh->cut2))) {
+      const v2d G = vmax(mg, q->near2);
+      if (with_near && bits2((r0 < G) | (r1 < G))) {
         v2l n0 = ((r0 < m0) | (r0 < q->near2)) & (r0 < sh->cut2) & ~lo2l(skip);
         v2l n1 = ((r1 < m1) | (r1 < q->near2)) & (r1 < sh->cut2) & ~hi2l(skip);
         f0 &= ~n0;
