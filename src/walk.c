@@ -82,7 +82,7 @@ static inline v2l hi2l(v4i m) { return (v2l)__builtin_shufflevector(m, m, 2, 2, 
 /* A probe's constants in every lane, set up once per batch. */
 typedef struct {
   v2d x, y;
-  v2l weighs;     /* all ones, or 0 for a weightless probe (no far pairs) */
+  v2d rc2;        /* far pairs need r^2 < rc2; -1 for a weightless probe */
   v4f dl;
   v2d near2;      /* (near_scale dl)^2: a pair is near within the larger of its two */
   v2d scale;      /* scale dl: the factor on this probe's far pairs' dl_j (1/r - 1/rc) */
@@ -149,14 +149,11 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
       const probe_ctx *q = &pc[b];
       v2d dx0 = x0 - q->x, dx1 = x1 - q->x, dy0 = y0 - q->y, dy1 = y1 - q->y;
       v2d r0 = dx0 * dx0 + dy0 * dy0, r1 = dx1 * dx1 + dy1 * dy1;
-      /* near and far pairs alike lie within the cutoff: most groups have none */
-      const v2l c0 = r0 < sh->cut2, c1 = r1 < sh->cut2;
-      if (!bits2(c0 | c1)) continue;
-      v2l f0 = c0 & ok0 & q->weighs, f1 = c1 & ok1 & q->weighs;
+      v2l f0 = (r0 < q->rc2) & ok0, f1 = (r1 < q->rc2) & ok1;
       const v2d G = vmax(mg, q->near2);
       if (with_near && bits2((r0 < G) | (r1 < G))) {
-        v2l n0 = ((r0 < m0) | (r0 < q->near2)) & c0 & ~lo2l(skip);
-        v2l n1 = ((r1 < m1) | (r1 < q->near2)) & c1 & ~hi2l(skip);
+        v2l n0 = ((r0 < m0) | (r0 < q->near2)) & (r0 < sh->cut2) & ~lo2l(skip);
+        v2l n1 = ((r1 < m1) | (r1 < q->near2)) & (r1 < sh->cut2) & ~hi2l(skip);
         f0 &= ~n0;
         f1 &= ~n1;
         near_bits[b] |= (uint64_t)(bits2(n0) | bits2(n1) << 2) << t;
@@ -272,9 +269,8 @@ static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
   for (int b = 0; b < nb; b++) {
     const lw_pair_probe *p = &P[sel[b]];
     /* a weightless probe has no far pairs (its kernel is 0, even at r = 0) */
-    const long long w = p->dl != 0.0f ? -1 : 0;
-    const double l = ctx->near_scale * (double)p->dl;
-    pc[b] = (probe_ctx){{p->x, p->x}, {p->y, p->y}, {w, w}, {p->dl, p->dl, p->dl, p->dl}, {l * l, l * l},
+    const double rc2 = p->dl != 0.0f ? ctx->cutoff2 : -1.0, l = ctx->near_scale * (double)p->dl;
+    pc[b] = (probe_ctx){{p->x, p->x}, {p->y, p->y}, {rc2, rc2}, {p->dl, p->dl, p->dl, p->dl}, {l * l, l * l},
                         {p->scale * (double)p->dl, p->scale * (double)p->dl}, {0}, {0}};
     axis_gaps(g->x0, h, cx, p->x, pc[b].gx);
     axis_gaps(g->y0, h, cy, p->y, pc[b].gy);
