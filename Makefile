@@ -84,6 +84,7 @@ test-long: $(BIN)/linewise $(BUILD)/tests/run $(PICTURE)
 	  --filter '@(stats|hard|crash|transdim)/*'
 
 asan:
+	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan-criterion.supp:print_suppressions=0 \
 	$(MAKE) BUILD=build-asan BIN=build-asan/bin OPT=-O1 \
 	  CFLAGS="-O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer" \
 	  LDFLAGS="-fsanitize=address,undefined" test

@@ -956,7 +956,9 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   p->near_pending = 0;
   if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
     double pe = pair_walk(m, p);
-    if (p->defer_near && p->near.n && !isnan(pe)) {
+    /* (a move out of an irregular state, dE = -inf, is taken whatever the
+    ** pair part: nothing to defer) */
+    if (p->defer_near && p->near.n && !isnan(pe) && isfinite(dE)) {
       /* the near field waits for lw_model_propose_finish: a stand-in here */
       p->near_pending = 1;
       p->pe_walk = pe;

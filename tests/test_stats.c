@@ -8,7 +8,9 @@
 **      distribution (chi-square), with the step tuning frozen, and a wrong
 **      temperature that the same test must reject;
 **   3. a free worm-like chain (bending, strain holding its length) against
-**      the 2-D Kratky-Porod results.
+**      the 2-D Kratky-Porod results;
+**   4. delayed acceptance against plain Metropolis, and its first stage
+**      alone, which the same test must reject.
 **
 ** Seeds are fixed, so each test is deterministic; every tolerance is derived
 ** from the variance of the estimate and stated where it is used.  `make test`
