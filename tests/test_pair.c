@@ -853,19 +853,26 @@ static void assert_gauss_table(const double *s, const double *w, int m)
 ** side of a move.  After commits of moves that carry lines across each other,
 ** every full slot holds what a recomputation gives, bit for bit, and every
 ** move still equals a recomputation from scratch. */
-Test(pair, pair_slots_hold_what_a_recomputation_gives)
+/* A square page of side `side` with the pair term's near field on (cutoff 3
+** mm), where random lines of 5 mm cross and crowd each other. */
+static void crossing_lines(lw_scene *sc, double side)
 {
   lw_params p;
   lw_params_defaults(&p);
-  p.width = p.height = 40;
+  p.width = p.height = side;
   p.margin = 1;
   p.strain = 1;
   p.bending = 0.1;
   p.pair = 0.01;
   p.pair_cutoff = 3;
   p.pair_near = 1.5;
+  lw_test_scene(sc, &p);
+}
+
+Test(pair, pair_slots_hold_what_a_recomputation_gives)
+{
   lw_scene sc;
-  lw_test_scene(&sc, &p);
+  crossing_lines(&sc, 40);
   lw_model *m = lw_test_model_random(&sc, 40, 4, 5.0, 3);
   cr_assert_gt(lw_test_pair_slots_hold_current(m), 20, "the build fills the slots of crossing lines");
   cr_assert_gt(lw_test_moves_match_full(&sc, m, 400, 0.7, 5), 200);
@@ -880,17 +887,8 @@ Test(pair, pair_slots_hold_what_a_recomputation_gives)
 ** and pair term of a move that did not wait. */
 Test(pair, deferred_near_field_is_a_state_function_and_finishes_exactly)
 {
-  lw_params p;
-  lw_params_defaults(&p);
-  p.width = p.height = 30;
-  p.margin = 1;
-  p.strain = 1;
-  p.bending = 0.1;
-  p.pair = 0.01;
-  p.pair_cutoff = 3;
-  p.pair_near = 1.5;
   lw_scene sc;
-  lw_test_scene(&sc, &p);
+  crossing_lines(&sc, 30);
   lw_model *m = lw_test_model_random(&sc, 30, 3, 5.0, 9);
   lw_proposal *a = lw_proposal_new(m, NULL), *b = lw_proposal_new(m, NULL);
   cr_assert(a && b);
