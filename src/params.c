@@ -182,13 +182,16 @@ const lw_param_def lw_param_table[] = {
   NUM("energy", "tone", LW_PT_DOUBLE, tone, "0", "energy / mm^2", 0, 1e12, 0,
       "T: tone T * sum over pixels of A (G * ink - darkness)^2: the lines, as ink of "
       "output.pen_width, blurred by a Gaussian of `tone_blur` and compared with the picture's "
-      "darkness (1 - tone) pixel by pixel (A = pixel area). Unlike the potential it saturates: "
+      "darkness (1 - tone) pixel by pixel (A = pixel area; the pixels are the picture's, or "
+      "blocks of them up to tone_blur / 1.5 wide). Unlike the potential it saturates: "
       "lines stop gathering once a place is as dark as the picture. Needs scene.image "
       "(docs/NUMERICS.md). 0 = off."),
   NUM("energy", "tone_blur", LW_PT_DOUBLE, tone_blur, "1", "mm", 0, 1e4, LW_MIN_OPEN,
       "Standard deviation of the tone term's blur: the scale at which ink is averaged into tone. "
       "Keep it above the distance between quadrature samples (segment_length / quadrature) so "
-      "a line reads as a line, not a row of dots; its cost grows as its square in pixels."),
+      "a line reads as a line, not a row of dots. Its cost does not grow with the picture's "
+      "resolution: the tone raster's pixels are blocks of the picture's up to tone_blur / 1.5 "
+      "wide, which represent the blurred ink exactly (docs/NUMERICS.md)."),
   NUM("energy", "tone_ink", LW_PT_DOUBLE, tone_ink, "1", "", 0, 1, LW_MIN_OPEN,
       "The share of the paper that ink covers where the picture is black: the tone term's "
       "target is tone_ink * darkness. Below 1 the darks are drawn as dense lines rather than "

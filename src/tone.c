@@ -8,35 +8,77 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Picture pixels a side of a raster pixel: the most whose side stays within
+** sigma / LW_TONE_SIGMA_PIXELS (1 where the picture's pixels are coarser). */
+static int tone_block(double sigma, double pixel)
+{
+  double k = floor(sigma / (LW_TONE_SIGMA_PIXELS * pixel));
+  return k >= 1.0 ? (int)k : 1; /* below LW_TONE_BLUR_MAX / 4.5 */
+}
+
 lw_status lw_tone_init(lw_tone *t, const lw_image *img, const lw_image_place *pl, double sigma, double pen,
                        double ink, lw_error *err)
 {
   memset(t, 0, sizeof *t);
-  double r = ceil(3.0 * sigma / pl->pixel);
-  if (!(r <= LW_TONE_RADIUS_MAX))
+  /* the target is blurred at the picture's pixels, with a ring of white
+  ** paper 3 sigma wide, before it is read at the raster's */
+  if (!(ceil(3.0 * sigma / pl->pixel) <= LW_TONE_BLUR_MAX))
     return lw_error_set(err, LW_EINPUT, "tone: a blur of %g mm is %.0f pixels of %g mm, more than the %d the "
-                        "footprint allows; blur the picture (scene.image_blur) or lower its resolution",
-                        sigma, r, pl->pixel, LW_TONE_RADIUS_MAX);
+                        "target allows; lower the picture's resolution (scene.image_max_pixels) or the blur",
+                        sigma, ceil(3.0 * sigma / pl->pixel), pl->pixel, LW_TONE_BLUR_MAX);
+  const int k = tone_block(sigma, pl->pixel);
+  const double px = k * pl->pixel, r = ceil(3.0 * sigma / px);
   t->radius = r < 1.0 ? 1 : (int)r;
   t->pad = t->radius;
-  t->w = img->width + 2 * t->pad;
-  t->h = img->height + 2 * t->pad;
-  t->pixel = pl->pixel;
-  t->area = pl->pixel * pl->pixel;
-  t->x0 = pl->x0 - t->pad * pl->pixel;
-  t->y0 = pl->y0 - t->pad * pl->pixel;
+  t->w = (img->width + k - 1) / k + 2 * t->pad;
+  t->h = (img->height + k - 1) / k + 2 * t->pad;
+  t->pixel = px;
+  t->area = px * px;
+  t->x0 = pl->x0 - t->pad * px;
+  t->y0 = pl->y0 - t->pad * px;
   t->sigma = sigma;
   t->pen = pen;
   t->dark = calloc((size_t)t->w * (size_t)t->h, sizeof *t->dark);
-  if (!t->dark) return lw_error_set(err, LW_ENOMEM, "out of memory for the tone raster (%d x %d)", t->w, t->h);
+  /* The target at the picture's own pixels, with a ring of white paper
+  ** that reaches past every raster pixel centre, blurred there; then read
+  ** at the raster's pixel centres (below). */
+  const int fp = k == 1 ? t->pad : k * (t->pad + 1) + 1, fw = img->width + 2 * fp, fh = img->height + 2 * fp;
+  float *fine = k == 1 ? t->dark : calloc((size_t)fw * (size_t)fh, sizeof *fine);
+  if (!t->dark || !fine) {
+    if (fine != t->dark) free(fine);
+    lw_tone_clear(t);
+    return lw_error_set(err, LW_ENOMEM, "out of memory for the tone raster (%d x %d)", fw, fh);
+  }
   for (int j = 0; j < img->height; j++)
     for (int i = 0; i < img->width; i++)
-      t->dark[(size_t)(j + t->pad) * (size_t)t->w + (size_t)(i + t->pad)] =
+      fine[(size_t)(j + fp) * (size_t)fw + (size_t)(i + fp)] =
           (float)(ink * (1.0 - img->tone[(size_t)j * (size_t)img->width + (size_t)i]));
   /* The same blur on both sides: G * ink cannot be sharper than G, so a
   ** sharp target would ask for ink piled along every edge (the picture's
   ** rim included) to make up for the blur. */
-  lw_status st = lw_image_blur_plane(t->dark, t->w, t->h, sigma / pl->pixel, err);
+  lw_status st = lw_image_blur_plane(fine, fw, fh, sigma / pl->pixel, err);
+  if (!st && k > 1) {
+    /* Raster pixel I's centre is picture pixel k (I - pad) + (k - 1) / 2: a
+    ** pixel centre for odd k, and for even k the middle of two, where the
+    ** blurred target (smooth over sigma, 3 pixels and more) is read by the
+    ** four-point midpoint rule (-1 9 9 -1) / 16 on each axis, exact for
+    ** cubics: a mean of two would blur it by (pixel / 2)^2 more. */
+    static const double mid[4] = {-1.0 / 16, 9.0 / 16, 9.0 / 16, -1.0 / 16};
+    const int lo = fp - k * t->pad + (k - 1) / 2, even = k % 2 == 0;
+    for (int J = 0; J < t->h; J++)
+      for (int I = 0; I < t->w; I++) {
+        const size_t u = (size_t)(lo + k * I), v = (size_t)(lo + k * J), W = (size_t)fw;
+        double d = fine[v * W + u];
+        if (even) {
+          d = 0.0;
+          for (int b = 0; b < 4; b++)
+            for (int a = 0; a < 4; a++) d += mid[b] * mid[a] * fine[(v - 1 + (size_t)b) * W + u - 1 + (size_t)a];
+          d = d > 0.0 ? d : 0.0; /* it may undershoot a little where the target falls to white */
+        }
+        t->dark[(size_t)J * (size_t)t->w + (size_t)I] = (float)d;
+      }
+  }
+  if (fine != t->dark) free(fine);
   if (st) lw_tone_clear(t);
   return st;
 }

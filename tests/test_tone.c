@@ -91,23 +91,24 @@ Test(tone, a_move_changes_the_energy_by_the_full_recomputation)
   lw_scene_clear(&sc);
 }
 
-Test(tone, the_raster_after_many_moves_is_the_one_built_from_scratch)
+/* A dense scene (twice the ink the picture asks for, lines crossing
+** everywhere) on a picture of w pixels a side and 40 sweeps: the running
+** total equals the recomputation to 1e-9, and the raster is bit for bit the
+** one a fresh model of the final state builds (the fixed-point sums are
+** exact), which is what makes a resumed run identical to an unbroken one. */
+static void raster_after_sweeps_is_fresh(int w, int k)
 {
-  /* A dense scene (twice the ink the picture asks for, lines crossing
-  ** everywhere) and 40 sweeps: the running total equals the recomputation
-  ** to 1e-9, and the raster is bit for bit the one a fresh model of the
-  ** final state builds (the fixed-point sums are exact), which is what
-  ** makes a resumed run identical to an unbroken one. */
-  lw_params p = tone_params(30, 40, blotches, 2.0, 0.7);
+  lw_params p = tone_params(30, w, blotches, 2.0, 0.7);
   p.strain = 5;
   p.bending = 0.2;
   lw_scene sc;
   lw_test_scene(&sc, &p);
+  cr_assert(fabs(sc.tone.pixel - k * sc.image_place.pixel) < 1e-12, "raster pixel %g", sc.tone.pixel);
   lw_model *m = lw_test_model_random(&sc, 300, 3, 2, 21);
   lw_chain *c = chain_of(m, 0.05, 22);
   for (int s = 0; s < 40; s++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
   unsigned long acc = 0;
-  for (int k = 0; k < 4; k++) acc += c->stats[k].accepted;
+  for (int q = 0; q < 4; q++) acc += c->stats[q].accepted;
   cr_assert(acc > 10000, "only %lu accepted moves", acc);
   double term[LW_TERM_COUNT];
   lw_energy_compute(&sc, m->sp, term, NULL);
@@ -122,6 +123,12 @@ Test(tone, the_raster_after_many_moves_is_the_one_built_from_scratch)
   model_chain_free(c);
   lw_model_free(m);
   lw_scene_clear(&sc);
+}
+
+Test(tone, the_raster_after_many_moves_is_the_one_built_from_scratch)
+{
+  raster_after_sweeps_is_fresh(40, 1);
+  raster_after_sweeps_is_fresh(160, 2);
 }
 
 Test(tone, off_it_holds_no_raster)
@@ -171,6 +178,49 @@ Test(tone, a_sample_deposits_its_ink_area)
             sum, want);
   free(r);
   lw_scene_clear(&sc);
+}
+
+/* A white picture with a dark square: pixels [48, 96) x [120, 144) of 240. */
+static double dark_square(double u, double v) { return u >= 0.2 && u < 0.4 && v >= 0.5 && v < 0.6 ? 0.25 : 1.0; }
+
+Test(tone, the_raster_is_coarser_than_a_fine_picture_and_keeps_its_target)
+{
+  /* A 240-pixel picture over 26 mm (0.108 mm a pixel): a blur of sigma
+  ** takes raster pixels of k picture pixels, the most within sigma / 1.5
+  ** (LW_TONE_SIGMA_PIXELS), here 1, 2, 5 and 7, and the target D, read at their centres, keeps the
+  ** square's ink (tone_ink 0.75 times its darkness, 1 - 64 / 255 in 8 bits,
+** over 5.2 x 2.6 mm)
+  ** and its centre of mass: a raster shifted by a pixel, or half of one,
+  ** would move that by 0.05 mm or more.  What is left is the blur's
+  ** truncation at 4 sigma and the rounding of float. */
+  const double sigma[] = {0.2, 0.4, 0.9, 1.2};
+  const int want_k[] = {1, 2, 5, 7};
+  for (int c = 0; c < 4; c++) {
+    lw_params p = tone_params(30, 240, dark_square, 1.0, sigma[c]);
+    p.tone_ink = 0.75;
+    lw_scene sc;
+    lw_test_scene(&sc, &p);
+    const lw_tone *t = &sc.tone;
+    const double px = sc.image_place.pixel;
+    cr_assert(fabs(t->pixel - want_k[c] * px) < 1e-12, "sigma %g: raster pixel %g, picture pixel %g", sigma[c],
+              t->pixel, px);
+    cr_assert(want_k[c] == 1 || (t->pixel <= sigma[c] / LW_TONE_SIGMA_PIXELS && t->pixel > 0.5 * sigma[c] / LW_TONE_SIGMA_PIXELS));
+    double mass = 0, mx = 0, my = 0;
+    for (int j = 0; j < t->h; j++)
+      for (int i = 0; i < t->w; i++) {
+        double d = t->dark[(size_t)j * (size_t)t->w + (size_t)i] * t->area;
+        mass += d;
+        mx += d * (t->x0 + (i + 0.5) * t->pixel);
+        my += d * (t->y0 + (j + 0.5) * t->pixel);
+      }
+    const double side = 240 * px, want = 0.75 * (191.0 / 255.0) * (0.2 * side) * (0.1 * side);
+    const double cx = sc.image_place.x0 + 0.3 * side, cy = sc.image_place.y0 + 0.55 * side;
+    cr_assert(fabs(mass / want - 1) < 1e-5, "sigma %g: ink %.8g, want %.8g", sigma[c], mass, want);
+    cr_assert(fabs(mx / mass - cx) < 1e-4 && fabs(my / mass - cy) < 1e-4,
+              "sigma %g (k %d): centre (%.6f, %.6f), want (%.6f, %.6f)", sigma[c], want_k[c], mx / mass, my / mass,
+              cx, cy);
+    lw_scene_clear(&sc);
+  }
 }
 
 /* Mean and variance of the blurred ink B over the raster pixels at least

@@ -1,13 +1,18 @@
 /*
 ** tone.h -- the tone term's raster: the lines splatted into a blurred ink
-** raster at the target picture's resolution, compared with the picture's
-** darkness (in the spirit of Turk and Banks 1996).
+** raster, compared with the picture's darkness (in the spirit of Turk and
+** Banks 1996).  The raster's pixels are blocks of k x k picture pixels, k
+** the most that keeps them within sigma / LW_TONE_SIGMA_PIXELS (1 where the
+** picture is coarser): sampled that finely, the blurred fields are exact to
+** their aliases, 1e-10 and below (docs/NUMERICS.md), and a footprint is at
+** most 19 x 19 pixels whatever the picture's resolution.
 **
 **   E_tone = T * sum over pixels p of A (B_p - D_p)^2,
 **   B = G * ink,   ink = pen width times the lines' length per area,
 **
-** A = pixel^2 (mm^2), D = G * (1 - tone) the picture's darkness in [0, 1]
-** blurred by the same G (with a ring of white paper, 0, around the picture
+** A = pixel^2 (mm^2, the raster's pixel), D = G * (1 - tone) the picture's
+** darkness in [0, 1] blurred by the same G at the picture's pixels and read
+** at the raster's pixel centres (with a ring of white paper, 0, around the picture
 ** as wide as a footprint), G a Gaussian of standard deviation sigma (mm).
 ** Blurring the target too keeps the minimum within reach: without it the
 ** lines would pile up along every edge of the picture to make the blurred
@@ -17,8 +22,8 @@
 **
 **   B_p += a_q gx_i(r_q) gy_j(r_q) / A,
 **
-** gx, gy the Gaussian less its value at rho = `radius` pixels (ceil(3 sigma
-** / pixel)), 0 beyond, sampled at the pixel centres and normalised to sum 1
+** gx, gy the Gaussian less its value at rho = `radius` raster pixels
+** (ceil(3 sigma / pixel)), 0 beyond, sampled at the pixel centres and normalised to sum 1
 ** per axis: the footprint is continuous in the sample's position, and a
 ** sample inside the raster deposits exactly its ink area, sum_p A B_p =
 ** pen * (length of line in the raster).  Derivation
@@ -56,11 +61,13 @@
 
 #define LW_TONE_ONE 4294967296.0 /* 2^32 raster units per unit of ink fraction */
 #define LW_TONE_CAP 65536.0      /* largest footprint value, ink fractions */
-#define LW_TONE_RADIUS_MAX 512   /* footprint half-width limit, pixels */
+#define LW_TONE_RADIUS_MAX 16    /* footprint half-width limit, raster pixels (9 reached) */
+#define LW_TONE_BLUR_MAX 512     /* 3 sigma in picture pixels, at most */
+#define LW_TONE_SIGMA_PIXELS 1.5 /* raster pixels per sigma, at least (above) */
 
 /* What the tone term reads (its context's data); built by the scene. */
 typedef struct {
-  int w, h;         /* raster pixels: the picture's and `pad` on every side */
+  int w, h;         /* raster pixels: the picture's blocks and `pad` on every side */
   int pad;          /* ring of white paper, pixels (= radius) */
   double x0, y0;    /* top-left corner of raster pixel (0, 0), mm */
   double pixel;     /* side of a pixel, mm */
@@ -72,9 +79,9 @@ typedef struct {
 } lw_tone;
 
 /* Builds the target, ink times the darkness, from the processed picture img
-** placed at pl.  sigma > 0 and pen > 0, mm; 0 < ink <= 1.  LW_ENOMEM, or LW_EINPUT when the footprint would be
-** wider than 2 LW_TONE_RADIUS_MAX + 1 pixels (sigma above 170 pixels: blur
-** the picture instead). */
+** placed at pl.  sigma > 0 and pen > 0, mm; 0 < ink <= 1.  LW_ENOMEM, or
+** LW_EINPUT when 3 sigma is more than LW_TONE_BLUR_MAX picture pixels (the
+** target is blurred at the picture's resolution). */
 lw_status lw_tone_init(lw_tone *t, const lw_image *img, const lw_image_place *pl, double sigma, double pen,
                        double ink, lw_error *err);
 void lw_tone_clear(lw_tone *t);
