@@ -33,7 +33,7 @@ typedef struct {
   int pair;
 } tone_row;
 
-/* Returns the raster's pixel, mm (0 without a tone row). */
+/* Returns the picture's pixel, mm (0 without a tone row). */
 static double tone_table(const bench_ctx *b, const tone_row *row, int n)
 {
   FILE *d = b->doc[BENCH_PERFORMANCE];
@@ -56,9 +56,9 @@ static double tone_table(const bench_ctx *b, const tone_row *row, int n)
   fprintf(d, "| scene | footprint pixels | ns per evaluation | extra ns | ratio | ns per chain proposal | acceptance |\n"
              "|---|---|---|---|---|---|---|\n");
   for (int i = 0; i < n; i++) {
-    char fp[32] = "-", extra[32] = "-";
+    char fp[64] = "-", extra[32] = "-";
     int side = 2 * r[i].scene.tone.radius + 1;
-    if (row[i].T > 0) snprintf(fp, sizeof fp, "%d x %d", side, side);
+    if (row[i].T > 0) snprintf(fp, sizeof fp, "%d x %d of %.2f mm", side, side, r[i].scene.tone.pixel);
     if (i) snprintf(extra, sizeof extra, "%.0f", ev[i] - ev[0]);
     fprintf(d, "| %s | %s | %.0f | %s | %.3f +- %.3f | %.0f | %.2f |\n", row[i].name, fp, ev[i], extra, ratio[i],
             spread[i], ns[i], bench_run_acceptance(&r[i]));
@@ -66,7 +66,7 @@ static double tone_table(const bench_ctx *b, const tone_row *row, int n)
   fprintf(d, "\n");
   double pixel = 0.0;
   for (int i = 0; i < n; i++) {
-    if (row[i].T > 0) pixel = r[i].scene.tone.pixel;
+    if (row[i].T > 0) pixel = r[i].scene.image_place.pixel;
     bench_run_free(&r[i]);
   }
   return pixel;
@@ -106,10 +106,12 @@ void bench_tone(bench_ctx *b)
   fine.reps = BENCH_MAX_REPS;
   fine.block = b->block * b->reps / BENCH_MAX_REPS;
   double pixel = tone_table(b, alone, (int)(sizeof alone / sizeof alone[0]));
-  fprintf(d, "The picture's pixel, and the raster's, is %.2f mm. A move splats the old and new\n"
-             "samples of its segments (2 x 2 x %d for a point move) into a box of changes and sums\n"
-             "the box: the cost grows with the footprint's area, (2 ceil(3 sigma / pixel) + 1)^2\n"
-             "pixels a sample. Named with coefficient 0 the term builds nothing (no target, no\n"
+  fprintf(d, "The picture's pixel is %.2f mm; the raster's is k of them, the most within sigma / 1.5\n"
+             "(docs/NUMERICS.md). A move splats the old and new samples of its segments (2 x 2 x %d\n"
+             "for a point move) into a box of changes and sums the box: the cost grows with the\n"
+             "footprint's area, (2 ceil(3 sigma / h) + 1)^2 pixels a sample for the raster's pixel h,\n"
+             "as sigma^2 while h is the picture's pixel and no further (19 x 19 at most).\n"
+             "Named with coefficient 0 the term builds nothing (no target, no\n"
              "raster, no box) and costs nothing: the scene without it, with it at coefficient 0, and\n"
              "without it again (the noise), in %d blocks of %.3f s:\n\n",
           pixel, b->ann_params.quadrature, fine.reps, fine.block);
@@ -145,7 +147,8 @@ void bench_tone_accuracy(bench_ctx *b)
              "The tone term splats each quadrature sample as a Gaussian footprint (tone.h), so its\n"
              "value depends on how finely the samples cover the line: a sample stands for dl of ink\n"
              "at one point. The annealed accuracy scene's tone energy at each node count, against 32\n"
-             "nodes (segments of %.0f mm, blur sigma as given; the picture's pixel is 0.45 mm):\n\n"
+             "nodes (segments of %.0f mm, blur sigma as given; the picture's pixel is 0.45 mm, the\n"
+             "raster's the same but at sigma 2 mm, where it is two of them):\n\n"
              "| nodes | sample spacing mm |",
           b->ann_params.segment_length);
   for (int k = 0; k < S; k++) fprintf(d, " error, sigma %g mm |", sigmas[k]);
