@@ -1258,26 +1258,60 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p)
   return pe;
 }
 
+/* Marks in kept_old and kept_new (bit per segment, old ones numbered through
+** the old splines in order) the segments a splice keeps as they were, the
+** same two nodes bit for bit: a grow's or a shrink's, a split's or a join's
+** pieces that keep their direction.  Nothing is marked past 64 of either. */
+static void splice_kept(const lw_model *m, const lw_proposal *p, uint64_t *kept_old, uint64_t *kept_new)
+{
+  const lw_node *old[64];
+  size_t n = 0;
+  *kept_old = *kept_new = 0;
+  for (int k = 0; k < p->n_old; k++)
+    for (size_t j = 0; j < p->old_seg[k]; j++) {
+      if (n == 64) return;
+      old[n++] = &splice_old_nodes(m, p, k)[j];
+    }
+  for (size_t j = 0; j < p->n_seg && j < 64; j++) {
+    const lw_node *q = &p->node[splice_seg_node(p, j)];
+    for (size_t o = 0; o < n; o++)
+      if (!(*kept_old >> o & 1) && !memcmp(old[o], q, 2 * sizeof *q)) {
+        *kept_old |= 1ull << o;
+        *kept_new |= 1ull << j;
+        break;
+      }
+  }
+}
+
 /* A raster term's part of a splice's dE (no coefficient); NAN if the box
-** cannot grow. */
+** cannot grow.  A segment the splice keeps splats the same footprints with
+** -1 and +1, which cancel exactly in fixed point (tone.h): it is neither
+** covered nor splatted, and dE and the committed raster are bit for bit
+** what they would be with it.  A grow then splats one segment, not the
+** spline's 2 n + 1. */
 static double splice_raster_delta(const lw_model *m, lw_proposal *p, int t)
 {
   const lw_term_ctx *c = &ctx_in(&m->terms, p->layer)[t];
   lw_tone_box *b = &p->box[t];
+  uint64_t kept_old, kept_new;
+  splice_kept(m, p, &kept_old, &kept_new);
   lw_tone_box_reset(b);
-  for (int k = 0; k < p->n_old; k++)
-    for (size_t j = 0; j < p->old_seg[k]; j++) raster_cover(c->data, b, &splice_old_nodes(m, p, k)[j], &splice_old_nodes(m, p, k)[j + 1]);
-  for (size_t j = 0; j < p->n_seg; j++) {
-    const size_t a = splice_seg_node(p, j);
-    raster_cover(c->data, b, &p->node[a], &p->node[a + 1]);
-  }
-  if (lw_tone_box_ready(b) != LW_OK) return NAN;
-  for (int k = 0; k < p->n_old; k++)
-    for (size_t j = 0; j < p->old_seg[k]; j++)
-      raster_segment(c, b, &splice_old_nodes(m, p, k)[j], &splice_old_nodes(m, p, k)[j + 1], -1);
-  for (size_t j = 0; j < p->n_seg; j++) {
-    const size_t a = splice_seg_node(p, j);
-    raster_segment(c, b, &p->node[a], &p->node[a + 1], 1);
+  for (int pass = 0; pass < 2; pass++) {
+    if (pass && lw_tone_box_ready(b) != LW_OK) return NAN;
+    size_t o = 0;
+    for (int k = 0; k < p->n_old; k++)
+      for (size_t j = 0; j < p->old_seg[k]; j++, o++) {
+        if (o < 64 && kept_old >> o & 1) continue;
+        const lw_node *nd = &splice_old_nodes(m, p, k)[j];
+        if (pass) raster_segment(c, b, nd, nd + 1, -1);
+        else raster_cover(c->data, b, nd, nd + 1);
+      }
+    for (size_t j = 0; j < p->n_seg; j++) {
+      if (j < 64 && kept_new >> j & 1) continue;
+      const lw_node *nd = &p->node[splice_seg_node(p, j)];
+      if (pass) raster_segment(c, b, nd, nd + 1, 1);
+      else raster_cover(c->data, b, nd, nd + 1);
+    }
   }
   return lw_tone_delta(c->data, m->raster[t] + plane_in(p->layer, c->data), b);
 }

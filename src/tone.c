@@ -38,6 +38,9 @@ lw_status lw_tone_init(lw_tone *t, const lw_image *img, const lw_image_place *pl
   t->y0 = pl->y0 - t->pad * px;
   t->sigma = sigma;
   t->pen = pen;
+  t->inv = 1.0 / (2.0 * sigma * sigma);
+  t->floor = exp(-(t->radius * px) * (t->radius * px) * t->inv);
+  t->fall = exp(-2.0 * px * px * t->inv);
   t->dark = calloc((size_t)t->w * (size_t)t->h, sizeof *t->dark);
   /* The target at the picture's own pixels, with a ring of white paper
   ** that reaches past every raster pixel centre, blurred there; then read
@@ -110,15 +113,15 @@ static int nearest(double c, double c0, double pixel, int radius, int n, int *k)
 static void weights(const lw_tone *t, double c, double c0, int k, double *g)
 {
   const int R = t->radius;
-  const double p = t->pixel, inv = 1.0 / (2.0 * t->sigma * t->sigma), rho = R * p, floor_ = exp(-rho * rho * inv);
+  const double p = t->pixel, inv = t->inv, floor_ = t->floor;
   const double d0 = c0 + (k - R + 0.5) * p - c, a0 = (2.0 * d0 * p + p * p) * inv;
   double sum = 0.0;
   if (fabs(a0) < 600.0 && d0 * d0 * inv < 600.0) {
     /* exp(-d_m^2 inv) for d_m = d0 + m p by products: the ratio of
     ** neighbours is exp(-(2 d_m p + p^2) inv), itself falling by
-    ** exp(-2 p^2 inv) a step.  Three exps an axis instead of 2 R + 1. */
+    ** exp(-2 p^2 inv) (t->fall) a step.  Two exps an axis instead of 2 R + 1. */
     double e = exp(-d0 * d0 * inv), r = exp(-a0);
-    const double c2 = exp(-2.0 * p * p * inv);
+    const double c2 = t->fall;
     for (int m = 0; m <= 2 * R; m++) {
       g[m] = e > floor_ ? e - floor_ : 0.0;
       sum += g[m];

@@ -75,6 +75,9 @@ typedef struct {
   double sigma;     /* blur G, mm */
   double pen;       /* ink area per mm of line, mm */
   int radius;       /* footprint half-width, pixels */
+  double inv;       /* 1 / (2 sigma^2), mm^-2 */
+  double floor;     /* the Gaussian at radius pixels: exp(-(radius pixel)^2 inv) */
+  double fall;      /* exp(-2 pixel^2 inv), by which the ratio of neighbours falls */
   float *dark;      /* w * h target D = G * darkness in [0, 1], row-major */
 } lw_tone;
 
