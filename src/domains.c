@@ -101,6 +101,13 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
     if (nx < 2 || ny < 2) return LW_OK; /* nothing to gain: sweeps stay serial */
   } else {
     nx = ny = (int)side;
+    /* a count the photo preset chose from the page alone (the key unset:
+    ** line 0) gives way to the reach as auto does: a picture of a few
+    ** pixels has tone footprints centimetres wide */
+    if (!p->line[lw_params_find("anneal", "domains") - lw_param_table]) {
+      while (nx > 1 && !(w / nx > 2.0 * reach && h / ny > 2.0 * reach)) nx = ny = nx - 1;
+      if (nx < 2) return LW_OK;
+    }
     if (!(w / nx > 2.0 * reach) || !(h / ny > 2.0 * reach)) {
       char what[160];
       snprintf(what, sizeof what, " (domains %.4g x %.4g mm against a reach of %.4g mm)", w / nx, h / ny, reach);

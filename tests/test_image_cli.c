@@ -328,6 +328,27 @@ Test(image_cli, photo_preset_works_on_every_page)
   cr_assert(fabs(ratio / area - 1) < 0.25, "A5 / A6 splines %g against areas %g", ratio, area);
 }
 
+/* The photo preset chooses its domains from the page alone, 6 a side on A4;
+** a picture of a few pixels has pixels of 10 cm there, and tone footprints
+** as wide, so a move reaches farther than half a domain.  The preset's count
+** gives way as anneal.domains = auto does (here to none) and the run draws;
+** the same count set by the user is refused with the reach named. */
+Test(image_cli, the_photo_preset_takes_a_picture_of_a_few_pixels)
+{
+  const float g[6] = {0.2f, 0.5f, 0.8f, 0.9f, 0.4f, 0.1f};
+  lw_test_png(lw_test_path("tiny.png"), 3, 2, g, NULL);
+  char errs[2048], args[1024], pic[256];
+  snprintf(pic, sizeof pic, "%s", lw_test_path("tiny.png"));
+  snprintf(args, sizeof args, "run %s/params/photo.ini --out tiny --set scene.image=%s --set anneal.sweeps=2 --quiet",
+           lw_test_root(), pic);
+  cr_assert_eq(run(args, errs, sizeof errs), 0, "%s", errs);
+  cr_assert(summary_number(lw_test_path("tiny"), "splines") > 0);
+  snprintf(args, sizeof args, "run %s/params/photo.ini --out tiny6 --set scene.image=%s --set anneal.domains=6 --quiet",
+           lw_test_root(), pic);
+  cr_assert_eq(run(args, errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "--set: key 'anneal.domains'") && strstr(errs, "reach"), "%s", errs);
+}
+
 /* A photograph's textures, made here: a light sky over a dark figure and a
 ** field of grass, each pixel of the grass its own random grey (the grain a
 ** camera sees).  The edge tangent flow of such a picture turns from pixel to
