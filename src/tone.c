@@ -28,6 +28,10 @@ lw_status lw_tone_init(lw_tone *t, const lw_image *img, const lw_image_place *pl
                         sigma, ceil(3.0 * sigma / pl->pixel), pl->pixel, LW_TONE_BLUR_MAX);
   const int k = tone_block(sigma, pl->pixel);
   const double px = k * pl->pixel, r = ceil(3.0 * sigma / px);
+  /* px > sigma / (2 LW_TONE_SIGMA_PIXELS), so r < 6 LW_TONE_SIGMA_PIXELS = 9:
+  ** the footprint's weights fit weights()'s arrays */
+  if (!(r <= LW_TONE_RADIUS_MAX))
+    return lw_error_set(err, LW_ERUN, "tone: a footprint radius of %.0f raster pixels", r);
   t->radius = r < 1.0 ? 1 : (int)r;
   t->pad = t->radius;
   t->w = (img->width + k - 1) / k + 2 * t->pad;
