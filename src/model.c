@@ -815,17 +815,24 @@ static double near_stand_in(const lw_pair_ctx *ctx, const lw_pair_probe *probe, 
 /* How many pairs of one of the n samples ps and a sample of another spline
 ** (an index outside f's ranges [lo, hi) and [lo2, hi2)) are closer than
 ** sqrt(d2): the 3 x 3 cells around each (cells are at least the cutoff >=
-** min_spacing wide). */
+** min_spacing wide), less those whose side facing the sample is farther
+** than that, with a margin for the rounding of a point's cell (most of
+** them: min_spacing is a fraction of the cell).  Edge cells hold the points
+** clamped from beyond the grid on their outer sides only, so the facing
+** sides bound them too. */
 static size_t crowding(const lw_cellgrid *g, const lw_pair_sample *ps, size_t n, const lw_pair_filter *f, double d2)
 {
+  const double side = 1.0 / g->inv_h, far2 = d2 * (1.0 + 1e-8);
   size_t count = 0;
   for (size_t k = 0; k < n; k++) {
     int cx, cy;
     lw_cellgrid_locate(g, ps[k].x, ps[k].y, &cx, &cy);
+    const double u = ps[k].x - (g->x0 + cx * side), v = ps[k].y - (g->y0 + cy * side);
+    const double gx[3] = {u * u, 0.0, (side - u) * (side - u)}, gy[3] = {v * v, 0.0, (side - v) * (side - v)};
     for (int y = cy > 0 ? cy - 1 : 0; y <= cy + 1 && y < g->ny; y++)
       for (int x = cx > 0 ? cx - 1 : 0; x <= cx + 1 && x < g->nx; x++) {
         const lw_cell *c = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
-        if (!c->n) continue; /* an empty cell may have no block */
+        if (!c->n || gx[x - cx + 1] + gy[y - cy + 1] > far2) continue; /* an empty cell may have no block */
         const double *xs = c->x, *ys = lw_cell_y(c);
         const uint32_t *idx = lw_cell_idx(c);
         for (uint32_t e = 0; e < c->n; e++) {
