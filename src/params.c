@@ -191,7 +191,7 @@ const lw_param_def lw_param_table[] = {
       "Keep it above the distance between quadrature samples (segment_length / quadrature) so "
       "a line reads as a line, not a row of dots. Its cost does not grow with the picture's "
       "resolution: the tone raster's pixels are blocks of the picture's up to tone_blur / 1.5 "
-      "wide, which represent the blurred ink exactly (docs/NUMERICS.md)."),
+      "wide, fine enough for a blurred field (docs/NUMERICS.md)."),
   NUM("energy", "tone_ink", LW_PT_DOUBLE, tone_ink, "1", "", 0, 1, LW_MIN_OPEN,
       "The share of the paper that ink covers where the picture is black: the tone term's "
       "target is tone_ink * darkness. Below 1 the darks are drawn as dense lines rather than "

@@ -3,9 +3,9 @@
 ** raster, compared with the picture's darkness (in the spirit of Turk and
 ** Banks 1996).  The raster's pixels are blocks of k x k picture pixels, k
 ** the most that keeps them within sigma / LW_TONE_SIGMA_PIXELS (1 where the
-** picture is coarser): sampled that finely, the blurred fields are exact to
-** their aliases, 1e-10 and below (docs/NUMERICS.md), and a footprint is at
-** most 19 x 19 pixels whatever the picture's resolution.
+** picture is coarser): sampled that finely a footprint keeps its centre
+** within 2e-4 sigma (docs/NUMERICS.md), and it is at most 19 x 19 pixels
+** whatever the picture's resolution.
 **
 **   E_tone = T * sum over pixels p of A (B_p - D_p)^2,
 **   B = G * ink,   ink = pen width times the lines' length per area,
