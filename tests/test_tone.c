@@ -187,12 +187,12 @@ Test(tone, the_raster_is_coarser_than_a_fine_picture_and_keeps_its_target)
 {
   /* A 240-pixel picture over 26 mm (0.108 mm a pixel): a blur of sigma
   ** takes raster pixels of k picture pixels, the most within sigma / 1.5
-  ** (LW_TONE_SIGMA_PIXELS), here 1, 2, 5 and 7, and the target D, read at their centres, keeps the
-  ** square's ink (tone_ink 0.75 times its darkness, 1 - 64 / 255 in 8 bits,
-** over 5.2 x 2.6 mm)
-  ** and its centre of mass: a raster shifted by a pixel, or half of one,
-  ** would move that by 0.05 mm or more.  What is left is the blur's
-  ** truncation at 4 sigma and the rounding of float. */
+  ** (LW_TONE_SIGMA_PIXELS), here 1, 2, 5 and 7.  The target D, read at
+  ** their centres, keeps the square's ink (tone_ink 0.75 times its
+  ** darkness, 1 - 64 / 255 in 8 bits, over 5.2 x 2.6 mm) and its centre of
+  ** mass: a raster shifted by a pixel, or half of one, would move that by
+  ** 0.05 mm or more.  What is left is the blur's truncation at 4 sigma and
+  ** the rounding of float. */
   const double sigma[] = {0.2, 0.4, 0.9, 1.2};
   const int want_k[] = {1, 2, 5, 7};
   for (int c = 0; c < 4; c++) {
@@ -204,7 +204,9 @@ Test(tone, the_raster_is_coarser_than_a_fine_picture_and_keeps_its_target)
     const double px = sc.image_place.pixel;
     cr_assert(fabs(t->pixel - want_k[c] * px) < 1e-12, "sigma %g: raster pixel %g, picture pixel %g", sigma[c],
               t->pixel, px);
-    cr_assert(want_k[c] == 1 || (t->pixel <= sigma[c] / LW_TONE_SIGMA_PIXELS && t->pixel > 0.5 * sigma[c] / LW_TONE_SIGMA_PIXELS));
+    const double most = sigma[c] / LW_TONE_SIGMA_PIXELS;
+    cr_assert(want_k[c] == 1 || (t->pixel <= most && t->pixel > 0.5 * most), "sigma %g: raster pixel %g", sigma[c],
+              t->pixel);
     double mass = 0, mx = 0, my = 0;
     for (int j = 0; j < t->h; j++)
       for (int i = 0; i < t->w; i++) {
