@@ -111,7 +111,10 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
     if (!(w / nx > 2.0 * reach) || !(h / ny > 2.0 * reach)) {
       char what[160];
       snprintf(what, sizeof what, " (domains %.4g x %.4g mm against a reach of %.4g mm)", w / nx, h / ny, reach);
-      return bad_key(p, err, "'%s': domains must be wider than twice the reach of a move%s; expected fewer", what);
+      return bad_key(p, err,
+                     "'%s': domains must be wider than twice the reach of a move%s; expected fewer, or auto, "
+                     "which picks a count that fits",
+                     what);
     }
   }
   lw_domains *d = calloc(1, sizeof *d);
