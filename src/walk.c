@@ -102,6 +102,25 @@ typedef struct {
   v2d ic;
 } far_acc;
 
+/* The near pairs a scan of entries k0 on of cell c marked (bit t of
+** near_bits[b]: entry k0 + t with probe b), in the order of the probes and
+** then of the entries. */
+static inline __attribute__((always_inline)) void append_near(const lw_cell *c, uint32_t k0, unsigned mask,
+                                                               const uint32_t *probe_id, const uint64_t *near_bits,
+                                                               lw_pair_nearlist *near)
+{
+  const double *xs = c->x, *ys = lw_cell_y(c);
+  const uint32_t *id = lw_cell_idx(c);
+  const float *dls = lw_cell_dl(c);
+  for (unsigned left = mask; left; left &= left - 1) {
+    unsigned b = (unsigned)__builtin_ctz(left);
+    for (uint64_t bits = near_bits[b]; bits; bits &= bits - 1) {
+      uint32_t k = k0 + (uint32_t)__builtin_ctzll(bits);
+      near->pair[near->n++] = (lw_pair_near){xs[k], ys[k], dls[k], id[k], probe_id[b]};
+    }
+  }
+}
+
 /*
 ** Entries [k0, k1) of cell c, k1 - k0 <= BLOCK, against the probes of
 ** `mask` (bits into pc): far pairs go to fa, near ones to the near list
@@ -120,7 +139,6 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
 {
   uint64_t near_bits[LW_PAIR_BATCH] = {0};
   const double *xs = c->x, *ys = lw_cell_y(c);
-  const uint32_t *id = lw_cell_idx(c);
   const float *dls = lw_cell_dl(c);
   const v4f zero = {0.0f, 0.0f, 0.0f, 0.0f};
   const v4i lane = {0, 1, 2, 3};
@@ -167,15 +185,81 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
   }
   fa->s0 = s0;
   fa->s1 = s1;
-  if (with_near)
+  if (with_near) append_near(c, k0, mask, probe_id, near_bits, near);
+}
+
+#if LW_VEC_HAVE_WIDE
+#include <immintrin.h>
+
+/*
+** scan four entries a vector (AVX2): each lane computed as scan computes it,
+** and the far terms of entries 0, 1 and 2, 3 added to fa's accumulators s0
+** and s1 as there, so the same bits (vec2.h).  A maximum over lanes is
+** exact in any order.
+*/
+static inline __attribute__((always_inline, target("avx2"))) void
+scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const probe_ctx *pc, unsigned mask,
+               const uint32_t *probe_id, far_acc *fa, lw_pair_nearlist *near, const int with_near)
+{
+  uint64_t near_bits[LW_PAIR_BATCH] = {0};
+  const double *xs = c->x, *ys = lw_cell_y(c);
+  const float *dls = lw_cell_dl(c);
+  const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
+  const __m256d one = _mm256_set1_pd(1.0), ns = _mm256_set1_pd(sh->ns[0]), cut2 = _mm256_set1_pd(sh->cut2[0]);
+  const __m256d ic = _mm256_set1_pd(fa->ic[0]);
+  __m128d s0 = (__m128d)fa->s0, s1 = (__m128d)fa->s1;
+  for (uint32_t k = k0, t = 0; k < k1; k += 4, t += 4) {
+    const __m128 dlj = _mm_loadu_ps(dls + k);
+    const __m128i in_block = _mm_cmpgt_epi32(_mm_set1_epi32((int)(k1 - k)), lane); /* not past k1 */
+    const __m128i pos = _mm_castps_si128(_mm_cmpgt_ps(dlj, _mm_setzero_ps()));
+    const __m256d ok = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_and_si128(in_block, pos)));
+    const __m256d kept = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(in_block));
+    const __m256d x = _mm256_loadu_pd(xs + k), y = _mm256_loadu_pd(ys + k), w = _mm256_cvtps_pd(dlj);
+    const __m256d e = _mm256_mul_pd(ns, w), m = _mm256_mul_pd(e, e);
+    const __m256d a = _mm256_and_pd(m, kept), a2 = _mm256_max_pd(a, _mm256_permute4x64_pd(a, 0x4e));
+    const __m256d mg = _mm256_max_pd(a2, _mm256_permute_pd(a2, 0x5));
     for (unsigned left = mask; left; left &= left - 1) {
       unsigned b = (unsigned)__builtin_ctz(left);
-      for (uint64_t bits = near_bits[b]; bits; bits &= bits - 1) {
-        uint32_t k = k0 + (uint32_t)__builtin_ctzll(bits);
-        near->pair[near->n++] = (lw_pair_near){xs[k], ys[k], dls[k], id[k], probe_id[b]};
+      const probe_ctx *q = &pc[b];
+      const __m256d dx = _mm256_sub_pd(x, _mm256_set1_pd(q->x[0])), dy = _mm256_sub_pd(y, _mm256_set1_pd(q->y[0]));
+      const __m256d r = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
+      const __m256d near2 = _mm256_set1_pd(q->near2[0]);
+      __m256d f = _mm256_and_pd(_mm256_cmp_pd(r, _mm256_set1_pd(q->rc2[0]), _CMP_LT_OQ), ok);
+      const __m256d G = _mm256_max_pd(mg, near2);
+      if (with_near && _mm256_movemask_pd(_mm256_cmp_pd(r, G, _CMP_LT_OQ))) {
+        __m256d n = _mm256_or_pd(_mm256_cmp_pd(r, m, _CMP_LT_OQ), _mm256_cmp_pd(r, near2, _CMP_LT_OQ));
+        n = _mm256_and_pd(_mm256_and_pd(n, _mm256_cmp_pd(r, cut2, _CMP_LT_OQ)), kept);
+        f = _mm256_andnot_pd(n, f);
+        near_bits[b] |= (uint64_t)(unsigned)_mm256_movemask_pd(n) << t;
+      }
+      if (_mm256_movemask_pd(f)) {
+        const __m256d inv = _mm256_sub_pd(_mm256_div_pd(one, _mm256_sqrt_pd(r)), ic);
+        const __m256d v = _mm256_and_pd(_mm256_mul_pd(_mm256_mul_pd(w, _mm256_set1_pd(q->scale[0])), inv), f);
+        s0 = _mm_add_pd(s0, _mm256_castpd256_pd128(v));
+        s1 = _mm_add_pd(s1, _mm256_extractf128_pd(v, 1));
       }
     }
+  }
+  fa->s0 = (v2d)s0;
+  fa->s1 = (v2d)s1;
+  if (with_near) append_near(c, k0, mask, probe_id, near_bits, near);
 }
+
+__attribute__((target("avx2"))) static void scan_wide_near(const lw_cell *c, uint32_t k0, uint32_t k1,
+                                                           const shared_ctx *sh, const probe_ctx *pc, unsigned mask,
+                                                           const uint32_t *probe_id, far_acc *fa,
+                                                           lw_pair_nearlist *near)
+{
+  scan_wide_body(c, k0, k1, sh, pc, mask, probe_id, fa, near, 1);
+}
+
+__attribute__((target("avx2"))) static void scan_wide_far(const lw_cell *c, uint32_t k0, uint32_t k1,
+                                                          const shared_ctx *sh, const probe_ctx *pc, unsigned mask,
+                                                          const uint32_t *probe_id, far_acc *fa)
+{
+  scan_wide_body(c, k0, k1, sh, pc, mask, probe_id, fa, NULL, 0);
+}
+#endif
 
 void lw_pair_nearlist_free(lw_pair_nearlist *l)
 {
@@ -261,7 +345,8 @@ static void cell_ranges(const lw_cell *c, const lw_pair_filter *f, uint32_t r[6]
 ** scan them. */
 static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const shared_ctx *sh,
                             const lw_pair_probe *P, const uint32_t *sel, int nb, int cx, int cy,
-                            const lw_pair_filter *f, far_acc *fa, lw_pair_nearlist *near, uint64_t *visited)
+                            const lw_pair_filter *f, int wide, far_acc *fa, lw_pair_nearlist *near,
+                            uint64_t *visited)
 {
   probe_ctx pc[LW_PAIR_BATCH];
   const double h = 1.0 / g->inv_h, skip2 = ctx->cutoff2 * GAP_MARGIN;
@@ -292,12 +377,17 @@ static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
         if (visited) *visited += (uint64_t)(r[run + 1] - r[run]) * (uint64_t)__builtin_popcount(mask);
         for (uint32_t k0 = r[run]; k0 < r[run + 1]; k0 += BLOCK) {
           uint32_t k1 = r[run + 1] - k0 > BLOCK ? k0 + BLOCK : r[run + 1];
-          if (with_near) {
-            if (l_unlikely(nearlist_reserve(near, (size_t)(k1 - k0) * (size_t)nb) != LW_OK)) return LW_ENOMEM;
-            scan(c, k0, k1, sh, pc, mask, sel, fa, near, 1);
-          } else {
-            scan(c, k0, k1, sh, pc, mask, sel, fa, NULL, 0);
+          if (with_near && l_unlikely(nearlist_reserve(near, (size_t)(k1 - k0) * (size_t)nb) != LW_OK))
+            return LW_ENOMEM;
+#if LW_VEC_HAVE_WIDE
+          if (wide) {
+            if (with_near) scan_wide_near(c, k0, k1, sh, pc, mask, sel, fa, near);
+            else scan_wide_far(c, k0, k1, sh, pc, mask, sel, fa);
+            continue;
           }
+#endif
+          if (with_near) scan(c, k0, k1, sh, pc, mask, sel, fa, near, 1);
+          else scan(c, k0, k1, sh, pc, mask, sel, fa, NULL, 0);
         }
       }
     }
@@ -311,6 +401,7 @@ lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pa
   const shared_ctx sh = {{ctx->near_scale, ctx->near_scale}, {ctx->cutoff2, ctx->cutoff2}};
   far_acc fa = {{0.0, 0.0}, {0.0, 0.0}, {ctx->inv_cutoff, ctx->inv_cutoff}};
   uint64_t seen = 0;
+  const int wide = lw_vec_wide();
   *far = 0.0;
   for (size_t c0 = 0; c0 < n; c0 += LW_PAIR_CHUNK) {
     /* the chunk's probes in order of their cell (stable), so that each run
@@ -330,7 +421,7 @@ lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pa
       int e = b + 1;
       while (e < nc && e - b < LW_PAIR_BATCH && cell[sel[e] - c0] == here) e++;
       int cx = (int)(here % (uint32_t)g->nx), cy = (int)(here / (uint32_t)g->nx);
-      if (walk_batch(g, ctx, &sh, P, sel + b, e - b, cx, cy, f, &fa, near, visited ? &seen : NULL) != LW_OK)
+      if (walk_batch(g, ctx, &sh, P, sel + b, e - b, cx, cy, f, wide, &fa, near, visited ? &seen : NULL) != LW_OK)
         return LW_ENOMEM;
       b = e;
     }
