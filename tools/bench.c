@@ -32,6 +32,7 @@
 #include "linewise/init.h"
 #include "linewise/output.h"
 #include "linewise/particles.h"
+#include "linewise/vec2.h"
 
 #ifndef BENCH_CFLAGS
 #define BENCH_CFLAGS "(not recorded)"
@@ -130,16 +131,20 @@ static const struct {
 static void bench_throughput(bench_ctx *b)
 {
   FILE *d = b->doc[BENCH_PERFORMANCE];
-  bench_run r[N_THROUGHPUT];
+  /* the pair rows again with the two-wide kernels, timed interleaved with the rest */
+  enum { N_RUNS = 2 * N_THROUGHPUT - 1 };
+  bench_run r[N_RUNS];
   lw_params p;
-  for (int i = 0; i < N_THROUGHPUT; i++) {
-    bench_random_params(&p, 1000, throughput[i].pair, throughput[i].spacing);
-    p.pair_near = throughput[i].near_scale;
+  for (int i = 0; i < N_RUNS; i++) {
+    int k = i < N_THROUGHPUT ? i : i - N_THROUGHPUT + 1;
+    bench_random_params(&p, 1000, throughput[k].pair, throughput[k].spacing);
+    p.pair_near = throughput[k].near_scale;
     bench_run_init(&r[i], &p, NULL, BENCH_T, NULL);
+    r[i].narrow = i >= N_THROUGHPUT;
     tune_random(&r[i]);
   }
-  double ns[N_THROUGHPUT], ratio[N_THROUGHPUT];
-  bench_time_runs(b, r, N_THROUGHPUT, 0, NULL, 0, ns, ratio, NULL);
+  double ns[N_RUNS], ratio[N_RUNS];
+  bench_time_runs(b, r, N_RUNS, 0, NULL, 0, ns, ratio, NULL);
   fprintf(d, "## Throughput\n\n"
              "1000 splines of 4 segments of 5 mm at random places, traced along the field, at the stated mean\n"
              "spacing (page area / total length); every term on (radial potential, waves field,\n"
@@ -147,10 +152,12 @@ static void bench_throughput(bench_ctx *b)
              "pair; near 1.5: a sample pair closer than 1.5 length elements makes its two segments a near\n"
              "pair, which takes the near field (pairnear.h), the product rule the others. Lines that\n"
              "cross make near pairs, and so do neighbours running alongside closely, the near field's\n"
-             "costliest case (docs/NUMERICS.md).\n\n"
+             "costliest case (docs/NUMERICS.md). The pair kernels run four lanes at a time where the\n"
+             "processor has AVX2 (%s here); the last column times the same scene with the two-wide\n"
+             "(SSE2) kernels, interleaved with the rest, as a ratio. Both give the same bits.\n\n"
              "| scene | neighbours per sample | ns per proposal | proposals per second | x cost without pair | "
-             "acceptance | bytes per segment |\n|---|---|---|---|---|---|---|\n",
-          BENCH_T);
+             "acceptance | bytes per segment | two-wide kernels, x time |\n|---|---|---|---|---|---|---|---|\n",
+          BENCH_T, lw_vec_wide() ? "it has" : "it has not");
   for (int i = 0; i < N_THROUGHPUT; i++) {
     char what[96];
     if (!throughput[i].pair) snprintf(what, sizeof what, "every term but pair");
@@ -160,13 +167,16 @@ static void bench_throughput(bench_ctx *b)
     else
       snprintf(what, sizeof what, "every term, pair cutoff 4 mm, lines %.1f mm apart, near field off",
                throughput[i].spacing);
-    char nb[32] = "-";
-    if (throughput[i].pair) snprintf(nb, sizeof nb, "%.1f", mean_neighbours(r[i].model));
-    fprintf(d, "| %s | %s | %.0f | %.0f | %.1f | %.2f | %.0f |\n", what, nb, ns[i], 1e9 / ns[i], ratio[i],
-            bench_run_acceptance(&r[i]), bytes_per_segment(r[i].model));
+    char nb[32] = "-", two[32] = "-";
+    if (throughput[i].pair) {
+      snprintf(nb, sizeof nb, "%.1f", mean_neighbours(r[i].model));
+      snprintf(two, sizeof two, "%.2f", ratio[i + N_THROUGHPUT - 1] / ratio[i]);
+    }
+    fprintf(d, "| %s | %s | %.0f | %.0f | %.1f | %.2f | %.0f | %s |\n", what, nb, ns[i], 1e9 / ns[i], ratio[i],
+            bench_run_acceptance(&r[i]), bytes_per_segment(r[i].model), two);
   }
   fprintf(d, "\n");
-  for (int i = 0; i < N_THROUGHPUT; i++) bench_run_free(&r[i]);
+  for (int i = 0; i < N_RUNS; i++) bench_run_free(&r[i]);
 }
 
 /*

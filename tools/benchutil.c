@@ -1,12 +1,13 @@
 /* benchutil.c -- shared pieces of the benchmark (benchutil.h). */
 #include "benchutil.h"
-
 #include <gsl/gsl_randist.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+#include "linewise/vec2.h"
 
 #include "linewise/anneal.h"
 #include "linewise/init.h"
@@ -165,6 +166,7 @@ double bench_run_block(bench_run *r, double seconds, const bench_trial *trials, 
 {
   /* the clock is read every 64 proposals: ~1 ns a proposal, under the noise */
   long n = 0;
+  lw_vec_set_wide(!r->narrow);
   double t0 = bench_now(), t;
   do {
     if (trials)
@@ -174,6 +176,7 @@ double bench_run_block(bench_run *r, double seconds, const bench_trial *trials, 
     n += 64;
     t = bench_now() - t0;
   } while (t < seconds);
+  lw_vec_set_wide(1);
   return t / (double)n * 1e9;
 }
 

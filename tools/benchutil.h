@@ -80,6 +80,7 @@ typedef struct {
   lw_model *model;
   lw_system *sys;   /* a view of the model: the chain goes through the row */
   lw_chain *chain;
+  int narrow;       /* its blocks run the two-wide kernels even where AVX2 is there (vec2.h) */
 } bench_run;
 
 /* Builds the scene of p, a model on sp (owned; NULL: p->splines random lines
