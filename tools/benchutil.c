@@ -7,10 +7,9 @@
 #include <string.h>
 #include <time.h>
 
-#include "linewise/vec2.h"
-
 #include "linewise/anneal.h"
 #include "linewise/init.h"
+#include "linewise/vec2.h"
 
 double bench_now(void)
 {
