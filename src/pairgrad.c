@@ -556,10 +556,14 @@ static jet subdivided(const jcubic *ca, const jpiece *root_a, const jcubic *cb, 
     if (f.v == 0.0) continue;
     w = top + 2 > K.stack_max ? jc(1.0) : jsmooth(jdiv(jsub(jscale(leaf, 2.0), big), leaf));
     if (w.v < 1.0) {
-      jet cd = jsub(jsub(chord_distance(pa, pb), pa->flat), pb->flat);
-      if (cd.v > 0.0) {
-        jet v = jsmooth(jdiv(jsub(jsub(jscale(cd, 2.0 * K.flat_ratio), pa->flat), pb->flat),
-                             jscale(cd, K.flat_ratio)));
+      jet cd = jsub(jsub(chord_distance(pa, pb), pa->flat), pb->flat), inside = jc(1.0);
+      if (k->on) {
+        jet far = jadd(jadd(jhypot(dx, dy), pa->rad), pb->rad);
+        inside = jsmooth(jaddc(jdiv(jaddc(jscale(far, -1.0), k->rc), big), -1.0));
+      }
+      if (cd.v > 0.0 && inside.v > 0.0) {
+        jet v = jmul(inside, jsmooth(jdiv(jsub(jsub(jscale(cd, 2.0 * K.flat_ratio), pa->flat), pb->flat),
+                                          jscale(cd, K.flat_ratio))));
         if (v.v > w.v) w = v;
       }
     }
