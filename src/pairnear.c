@@ -67,7 +67,10 @@
 ** lengths' product over rc, clamped at 0 (it is >= 0 wherever the chords
 ** lie inside the pieces' circles; a mean chord can leave its circle by
 ** f^2 / length), blended into the cut product rule over one piece size as
-** the leaf reaches the cutoff.
+** the leaf reaches the cutoff.  A flat leaf is taken only inside the cutoff
+** with a piece size to spare (flat leaves can be long, and the blend's
+** product rule cannot resolve curves alongside); the tiny leaves keep the
+** blend.
 */
 #include "linewise/pairnear.h"
 
