@@ -891,7 +891,7 @@ Test(pair, exact_segment_pairs_with_a_cutoff_match_reference_alongside)
     if (it < 0) {
       memcpy(a, A, sizeof a);
       memcpy(b, B, sizeof b);
-      rc = it == -3 ? 2.0 : it == -2 ? 3.0 : 4.0;
+      rc = 5.0 + it; /* 2, 3 and 4 mm */
     } else {
       double len = 5, bend = urand(-0.3, 0.3), d = urand(0.02, 0.4), off = urand(-3, 3), rot = urand(-0.05, 0.05);
       double c = cos(rot), sn = sin(rot), P[8] = {0, 0, len / 3, bend * len / 3, 2 * len / 3, bend * len / 3, len, 0};
