@@ -615,7 +615,7 @@ static jet clamp01(jet x)
 }
 
 /*
-** pairnear.c's closest_points replayed in jets: the 9 x 9 grid's choice,
+** pairnear.c's closest_points replayed in jets: the grid's choice,
 ** then the same Newton (or steepest descent) steps, halvings and
 ** acceptances, each step's partials carried along.  The iteration stops
 ** where a step no longer lowers the rounded distance, which can be short
@@ -626,15 +626,17 @@ static jet clamp01(jet x)
 */
 static void closest(const jcubic *ca, const jcubic *cb, jet *ps, jet *pt)
 {
-  double best = INFINITY, s0 = 0.0, t0 = 0.0, ra[9][2], rb[9][2];
-  for (int k = 0; k < 9; k++) {
-    value_at(ca, k / 8.0, ra[k]);
-    value_at(cb, k / 8.0, rb[k]);
+  enum { G = 64 }; /* room for pairnear.c's grid, which is 16 */
+  const int g = K.cp_grid < G ? K.cp_grid : G;
+  double best = INFINITY, s0 = 0.0, t0 = 0.0, ra[G + 1][2], rb[G + 1][2];
+  for (int k = 0; k <= g; k++) {
+    value_at(ca, k / (double)g, ra[k]);
+    value_at(cb, k / (double)g, rb[k]);
   }
-  for (int i = 0; i < 9; i++)
-    for (int j = 0; j < 9; j++) {
+  for (int i = 0; i <= g; i++)
+    for (int j = 0; j <= g; j++) {
       double dx = ra[i][0] - rb[j][0], dy = ra[i][1] - rb[j][1], q = dx * dx + dy * dy;
-      if (q < best) best = q, s0 = i / 8.0, t0 = j / 8.0;
+      if (q < best) best = q, s0 = i / (double)g, t0 = j / (double)g;
     }
   jet s = jc(s0), t = jc(t0);
   for (int it = 0; it < 30; it++) {

@@ -5,7 +5,7 @@
 ** ----------------------
 ** The double integral of two cubic segments by the geometry of the pair
 ** (derivation and measurements in docs/NUMERICS.md).  First the closest
-** points (s*, t*): the best of a 9 x 9 grid, then Newton (steepest descent
+** points (s*, t*): the best of a 17 x 17 grid, then Newton (steepest descent
 ** where the Hessian is not positive definite) projected into the square,
 ** each step halved until it brings the curves closer.  With d their
 ** distance, h the larger half-size of the two segments (bounding circles):
@@ -591,19 +591,27 @@ static inline void cubic_eval2(const cubic *c, double t, double r[2], double d[2
   dd[1] = 2.0 * c->y[2] + 6.0 * c->y[3] * t;
 }
 
-/* The parameters (s, t) of the closest points of two cubics: the best of a
-** 9 x 9 grid, then Newton on |a(s) - b(t)|^2 kept inside the square. */
+/* The closest points' grid: CP_GRID + 1 points a segment.  A 9 x 9 grid
+** (CP_GRID 8) lost shallow crossings: between its points the ridge of
+** near approach ran unseen, Newton went to a minimum on the square's edge,
+** and a pair 0.0014 half-sizes apart was taken 0.106 apart, by the 48-node
+** rule, 2 % off.  On 20,000 recorded calls 17 x 17 finds every approach
+** to within half the distance it reports (9 x 9: 69 did not). */
+#define CP_GRID 16
+
+/* The parameters (s, t) of the closest points of two cubics: the best of
+** the grid, then Newton on |a(s) - b(t)|^2 kept inside the square. */
 static void closest_points(const cubic *ca, const cubic *cb, double *ps, double *pt)
 {
-  double best = INFINITY, s = 0.0, t = 0.0, ra[9][2], rb[9][2], d[2];
-  for (int k = 0; k < 9; k++) {
-    cubic_eval(ca, k / 8.0, ra[k], d);
-    cubic_eval(cb, k / 8.0, rb[k], d);
+  double best = INFINITY, s = 0.0, t = 0.0, ra[CP_GRID + 1][2], rb[CP_GRID + 1][2], d[2];
+  for (int k = 0; k <= CP_GRID; k++) {
+    cubic_eval(ca, k / (double)CP_GRID, ra[k], d);
+    cubic_eval(cb, k / (double)CP_GRID, rb[k], d);
   }
-  for (int i = 0; i < 9; i++)
-    for (int j = 0; j < 9; j++) {
+  for (int i = 0; i <= CP_GRID; i++)
+    for (int j = 0; j <= CP_GRID; j++) {
       double dx = ra[i][0] - rb[j][0], dy = ra[i][1] - rb[j][1], q = dx * dx + dy * dy;
-      if (q < best) best = q, s = i / 8.0, t = j / 8.0;
+      if (q < best) best = q, s = i / (double)CP_GRID, t = j / (double)CP_GRID;
     }
   /* Newton where the Hessian is positive definite, else steepest descent
   ** scaled by the speeds; either step projected into the square and halved
@@ -645,9 +653,9 @@ static void closest_points(const cubic *ca, const cubic *cb, double *ps, double 
   *pt = t;
 }
 
-const lw_pairnear_consts lw_pairnear_k = {SEP_LO,     SEP_HI,     LEAF_RATIO, FLAT_RATIO, STACK_MAX, G6_S,
-                                          G6_W,       GAUSS_S,    N_WHOLE,    WHOLE_M,    WHOLE_S,   WHOLE_W,
-                                          WHOLE_LO,   WHOLE_HI};
+const lw_pairnear_consts lw_pairnear_k = {SEP_LO, SEP_HI,  LEAF_RATIO, FLAT_RATIO, STACK_MAX, CP_GRID,  G6_S,
+                                          G6_W,   GAUSS_S, N_WHOLE,    WHOLE_M,    WHOLE_S,   WHOLE_W,  WHOLE_LO,
+                                          WHOLE_HI};
 
 double lw_pair_segments_exact(const double a[8], const double b[8], double cutoff)
 {

@@ -53,6 +53,7 @@ typedef struct {
   double sep_lo, sep_hi;       /* pieces apart: 6 x 6 rule from sep_hi larger radii on */
   double leaf_ratio, flat_ratio;
   int stack_max;
+  int cp_grid;                 /* closest points: the best of (cp_grid + 1)^2 points, then Newton */
   const double *g6_s, *g6_w;   /* Gauss-Legendre on [0, 1] */
   int g6_n;
   /* segments apart: the whole-square rules of whole_m[r] nodes, from
