@@ -599,20 +599,99 @@ static inline void cubic_eval2(const cubic *c, double t, double r[2], double d[2
 ** to within half the distance it reports (9 x 9: 69 did not). */
 #define CP_GRID 16
 
+/* The grid's points of A and of B, B's padded to whole four-lane vectors
+** with NaN: its q compares false, so a padding lane never wins. */
+#define CP_COLS ((CP_GRID + 4) / 4 * 4)
+typedef struct {
+  double ax[CP_GRID + 1], ay[CP_GRID + 1], bx[CP_COLS], by[CP_COLS];
+} cp_points;
+
+static void cp_points_eval(const cubic *ca, const cubic *cb, cp_points *g)
+{
+  double r[2], d[2];
+  for (int k = 0; k <= CP_GRID; k++) {
+    cubic_eval(ca, k / (double)CP_GRID, r, d);
+    g->ax[k] = r[0];
+    g->ay[k] = r[1];
+    cubic_eval(cb, k / (double)CP_GRID, r, d);
+    g->bx[k] = r[0];
+    g->by[k] = r[1];
+  }
+  for (int k = CP_GRID + 1; k < CP_COLS; k++) g->bx[k] = g->by[k] = NAN;
+}
+
+/* The grid's best pair: the first in row-major order with the least
+** squared distance, as i * (CP_GRID + 1) + j, and that distance in *best;
+** -1 where none is below infinity (NaN never is). */
+static int cp_grid_best2(const cp_points *g, double *best)
+{
+  double low = INFINITY;
+  int at = -1;
+  for (int i = 0; i <= CP_GRID; i++)
+    for (int j = 0; j <= CP_GRID; j++) {
+      double dx = g->ax[i] - g->bx[j], dy = g->ay[i] - g->by[j], q = dx * dx + dy * dy;
+      if (q < low) low = q, at = i * (CP_GRID + 1) + j;
+    }
+  *best = low;
+  return at;
+}
+
+#if LW_VEC_HAVE_WIDE
+/* cp_grid_best2 four columns at a time, each q by the same operations (no
+** fused multiply-add), so the same bits.  Each lane keeps its column's
+** first strict minimum and its row (min_pd keeps the old value where q is
+** NaN, as q < low does); the pair is then the least key i * (CP_GRID + 1)
+** + j of the columns at the overall minimum, so ties go to the first in
+** row-major order as in the scalar loop. */
+__attribute__((target("avx2"))) static int cp_grid_best4(const cp_points *g, double *best)
+{
+  enum { V = CP_COLS / 4 };
+  __m256d low[V], row[V];
+  for (int c = 0; c < V; c++) low[c] = _mm256_set1_pd(INFINITY), row[c] = _mm256_setzero_pd();
+  for (int i = 0; i <= CP_GRID; i++) {
+    const __m256d x = _mm256_set1_pd(g->ax[i]), y = _mm256_set1_pd(g->ay[i]), vi = _mm256_set1_pd(i);
+    /* unrolled, so that low and row stay in registers (GCC -O2 does not) */
+#pragma GCC unroll 8
+    for (int c = 0; c < V; c++) {
+      __m256d dx = _mm256_sub_pd(x, _mm256_loadu_pd(g->bx + 4 * c));
+      __m256d dy = _mm256_sub_pd(y, _mm256_loadu_pd(g->by + 4 * c));
+      __m256d q = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
+      row[c] = _mm256_blendv_pd(row[c], vi, _mm256_cmp_pd(q, low[c], _CMP_LT_OQ));
+      low[c] = _mm256_min_pd(q, low[c]);
+    }
+  }
+  /* no lane of low is NaN, so min_pd is an exact minimum in any order */
+  __m256d m = low[0];
+  for (int c = 1; c < V; c++) m = _mm256_min_pd(m, low[c]);
+  m = _mm256_min_pd(m, _mm256_permute2f128_pd(m, m, 1));
+  m = _mm256_min_pd(m, _mm256_permute_pd(m, 5));
+  *best = _mm256_cvtsd_f64(m);
+  if (!(*best < INFINITY)) return -1;
+  const __m256d none = _mm256_set1_pd(INFINITY), n = _mm256_set1_pd(CP_GRID + 1);
+  __m256d key = none;
+  for (int c = 0; c < V; c++) {
+    __m256d k = _mm256_add_pd(_mm256_mul_pd(row[c], n), _mm256_set_pd(4 * c + 3, 4 * c + 2, 4 * c + 1, 4 * c));
+    key = _mm256_min_pd(key, _mm256_blendv_pd(none, k, _mm256_cmp_pd(low[c], m, _CMP_EQ_OQ)));
+  }
+  key = _mm256_min_pd(key, _mm256_permute2f128_pd(key, key, 1));
+  key = _mm256_min_pd(key, _mm256_permute_pd(key, 5));
+  return (int)_mm256_cvtsd_f64(key);
+}
+#endif
+
 /* The parameters (s, t) of the closest points of two cubics: the best of
 ** the grid, then Newton on |a(s) - b(t)|^2 kept inside the square. */
 static void closest_points(const cubic *ca, const cubic *cb, double *ps, double *pt)
 {
-  double best = INFINITY, s = 0.0, t = 0.0, ra[CP_GRID + 1][2], rb[CP_GRID + 1][2], d[2];
-  for (int k = 0; k <= CP_GRID; k++) {
-    cubic_eval(ca, k / (double)CP_GRID, ra[k], d);
-    cubic_eval(cb, k / (double)CP_GRID, rb[k], d);
-  }
-  for (int i = 0; i <= CP_GRID; i++)
-    for (int j = 0; j <= CP_GRID; j++) {
-      double dx = ra[i][0] - rb[j][0], dy = ra[i][1] - rb[j][1], q = dx * dx + dy * dy;
-      if (q < best) best = q, s = i / (double)CP_GRID, t = j / (double)CP_GRID;
-    }
+  cp_points g;
+  cp_points_eval(ca, cb, &g);
+  double best, s = 0.0, t = 0.0;
+#if LW_VEC_HAVE_WIDE
+  int at = lw_vec_wide() ? cp_grid_best4(&g, &best) : cp_grid_best2(&g, &best);
+#else
+  int at = cp_grid_best2(&g, &best);
+#endif
+  if (at >= 0) s = at / (CP_GRID + 1) / (double)CP_GRID, t = at % (CP_GRID + 1) / (double)CP_GRID;
   /* Newton where the Hessian is positive definite, else steepest descent
   ** scaled by the speeds; either step projected into the square and halved
   ** until it brings the curves closer (so the grid's best is never lost) */

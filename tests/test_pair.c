@@ -1060,3 +1060,145 @@ Test(pair, wide_and_narrow_kernels_give_the_same_bits)
   lw_vec_set_wide(1);
   cr_assert(differ == 0, "%d of 800 integrals differ between the wide and the narrow kernels", differ);
 }
+
+/* ---- the closest points' grid at both widths ---------------------------- */
+
+/*
+** Pairs whose grid minimum is tied between two of their points, every
+** coordinate exact.  The curve C (x = 18 t - 9, y = h - 384 (t - 1/4)
+** (t - 9/32) (t - 1)) is at height h at t = 1/4 and t = 1 and dips between
+** the grid's points after t = 1/4 to 22.93.  Variants 0-15: the line y = 0
+** and C, a tie at (4, 4) and (16, 16); 16-31: C and a short vertical
+** segment under it at x = 2.25, as far from C(1/4) as from C(1), a tie at
+** (4, 0) and (16, 0), within a column.  Newton from the point by the dip
+** finds the dip, from the other it stays at the end, and both distances lie
+** where two Gauss rules blend (0.36 and 0.24 half-sizes), so the value shows
+** which point the grid chose.  Bits of the variant: the first segment
+** reversed (the tie's order turns), x and y swapped, scaled and moved
+** (exactly, by powers of two), the segments swapped (a tie within a row).
+*/
+static void tied_pair(int variant, double A[8], double B[8])
+{
+  const double h = 23.0, line[8] = {-9, 0, -3, 0, 3, 0, 9, 0};
+  const double curve[8] = {-9, h + 27, -3, h - 50, 3, h + 69, 9, h};
+  const double below[8] = {2.25, h - 14, 2.25, h - 16, 2.25, h - 18, 2.25, h - 20};
+  const double *a = variant & 16 ? curve : line, *b = variant & 16 ? below : curve;
+  for (int k = 0; k < 8; k += 2) {
+    int ka = variant & 1 ? 6 - k : k;
+    double p[2][2] = {{a[ka], a[ka + 1]}, {b[k], b[k + 1]}};
+    for (int c = 0; c < 2; c++) {
+      double x = p[c][variant & 2 ? 1 : 0], y = p[c][variant & 2 ? 0 : 1];
+      if (variant & 4) x = 0.125 * x + 5.25, y = 0.125 * y - 1.5;
+      double *q = (variant & 8) == (c ? 8 : 0) ? A : B;
+      q[k] = x;
+      q[k + 1] = y;
+    }
+  }
+}
+
+/* The segment p0 p1 as a cubic, its inner control points moved across it
+** by bend times its length. */
+static void bent_cubic(const double p0[2], const double p1[2], double bend, double c[8])
+{
+  double dx = p1[0] - p0[0], dy = p1[1] - p0[1];
+  for (int k = 0; k < 4; k++) {
+    double f = k / 3.0, up = k == 1 || k == 2 ? bend : 0.0;
+    c[2 * k] = p0[0] + f * dx - up * dy;
+    c[2 * k + 1] = p0[1] + f * dy + up * dx;
+  }
+}
+
+/* B as A moved by (tx, ty), exactly where all three are short dyadic numbers:
+** then every grid point of A is as far from its twin on B, a tie along the
+** diagonal. */
+static void translate(const double A[8], double tx, double ty, double B[8])
+{
+  for (int k = 0; k < 8; k += 2) B[k] = A[k] + tx, B[k + 1] = A[k + 1] + ty;
+}
+
+/* Case it of the random pairs: the segseg kinds, straight or bent, then
+** pairs tied along a diagonal or the antidiagonal. */
+static void grid_case(int it, double A[8], double B[8])
+{
+  int kind = it % (N_KINDS + 2), round = it / (N_KINDS + 2);
+  if (kind < N_KINDS) {
+    double p[8];
+    random_config(kind, p);
+    bent_cubic(p, p + 2, it % 3 ? urand(-0.4, 0.4) : 0.0, A);
+    bent_cubic(p + 4, p + 6, it % 5 ? urand(-0.4, 0.4) : 0.0, B);
+    return;
+  }
+  if (kind == N_KINDS) {
+    /* integer control points over 8: identical, reversed, or moved by a
+    ** multiple of 1/16 */
+    for (int k = 0; k < 8; k++) A[k] = floor(urand(-40, 40)) / 8;
+    if (round % 3 == 0) translate(A, 0.0, 0.0, B);
+    if (round % 3 == 1)
+      for (int k = 0; k < 8; k += 2) B[k] = A[6 - k], B[k + 1] = A[7 - k];
+    if (round % 3 == 2) translate(A, floor(urand(-8, 8)) / 16, floor(urand(-8, 8)) / 16, B);
+    return;
+  }
+  /* straight along x (power form exact), moved along itself by whole grid
+  ** steps and across by d (or not: collinear, overlapping): a tie on a
+  ** diagonal i - j = m */
+  double x0 = floor(urand(-8, 8)) / 4, y0 = floor(urand(-8, 8)) / 4, u = 0.25 * (1 + round % 4);
+  for (int k = 0; k < 4; k++) A[2 * k] = x0 + 6 * k * u, A[2 * k + 1] = y0;
+  translate(A, floor(urand(-16, 17)) * 18 * u / 16, round % 3 ? floor(urand(-8, 8)) / 8 : 0.0, B);
+}
+
+/* The larger side of the pair's control points' bounding box: a cutoff
+** that cuts within the pair. */
+static double reach(const double A[8], const double B[8])
+{
+  double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+  for (int k = 0; k < 8; k++) {
+    lo[k % 2] = fmin(lo[k % 2], fmin(A[k], B[k]));
+    hi[k % 2] = fmax(hi[k % 2], fmax(A[k], B[k]));
+  }
+  return fmax(hi[0] - lo[0], hi[1] - lo[1]);
+}
+
+/*
+** The closest points' grid search of lw_pair_segments_exact at four lanes
+** (AVX2) chooses the grid point of the scalar loop: the same least distance
+** and, among tied points, the first in row-major order, so the same (s, t)
+** and the same bits.  Random pairs of every kind (crossing, touching,
+** parallel, collinear), identical segments and exact translates (ties along
+** a diagonal), degenerate (zero-length) segments, and tied_pair, where the
+** last tied point instead of the first changes the value.
+*/
+Test(pair, wide_and_narrow_grid_search_give_the_same_bits)
+{
+  if (!lw_vec_wide()) cr_skip_test("this processor has no AVX2: only the narrow grid search runs here");
+  rng_seed(47);
+  enum { N_RANDOM = 540, N_TIED = 32, N_ZERO = 4 };
+  int differ = 0, first = -1, n = 0;
+  for (int it = 0; it < N_RANDOM + N_TIED + N_ZERO; it++) {
+    double A[8], B[8];
+    if (it < N_RANDOM) {
+      grid_case(it, A, B);
+    } else if (it < N_RANDOM + N_TIED) {
+      tied_pair(it - N_RANDOM, A, B);
+    } else {
+      /* zero length: a point on a segment and beside it, two points at one
+      ** place and apart */
+      int z = it - N_RANDOM - N_TIED;
+      double P[2] = {0.5, 0.25}, Q[2] = {1.5, 0.25 + (z & 1)}, R[2] = {2.5, 0.25};
+      bent_cubic(P, R, 0.0, A);
+      if (z & 2) bent_cubic(Q, Q, 0.0, A), Q[0] += (z & 1) * 0.5;
+      bent_cubic(Q, Q, 0.0, B);
+    }
+    for (int cut = 0; cut < 2; cut++) {
+      double rc = cut ? reach(A, B) : 0.0, v[2];
+      for (int w = 0; w < 2; w++) {
+        lw_vec_set_wide(w);
+        v[w] = lw_pair_segments_exact(A, B, rc);
+      }
+      n++;
+      if (memcmp(&v[0], &v[1], sizeof v[0]) != 0 && differ++ == 0) first = it;
+    }
+  }
+  lw_vec_set_wide(1);
+  cr_assert(differ == 0, "%d of %d integrals differ between the wide and the narrow grid search (first: case %d)",
+            differ, n, first);
+}
