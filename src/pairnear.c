@@ -75,6 +75,7 @@
 #include "linewise/pairnear.h"
 
 #include <math.h>
+#include <string.h>
 
 #include "linewise/vec2.h"
 
@@ -149,17 +150,25 @@ static void piece_init(piece *p, const cubic *c, double t0, double t1)
   piece_bound(p);
 }
 
-static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
+/* The halves of piece p, which may be lo itself: only the ends are copied
+** (a copy of the whole would carry the node arrays, which no half keeps). */
+static void piece_split(piece *p, const cubic *c, piece *lo, piece *hi)
 {
-  double tm = 0.5 * (p->t0 + p->t1), rm[2], dm[2];
+  const double t0 = p->t0, t1 = p->t1, tm = 0.5 * (t0 + t1);
+  double rm[2], dm[2];
   cubic_eval(c, tm, rm, dm);
-  *lo = *p;
-  *hi = *p;
-  lo->t1 = hi->t0 = tm;
-  lo->r1[0] = hi->r0[0] = rm[0];
-  lo->r1[1] = hi->r0[1] = rm[1];
-  lo->d1[0] = hi->d0[0] = dm[0];
-  lo->d1[1] = hi->d0[1] = dm[1];
+  hi->t0 = tm;
+  hi->t1 = t1;
+  memcpy(hi->r0, rm, sizeof rm);
+  memcpy(hi->d0, dm, sizeof dm);
+  memcpy(hi->r1, p->r1, sizeof rm);
+  memcpy(hi->d1, p->d1, sizeof dm);
+  lo->t0 = t0;
+  lo->t1 = tm;
+  memcpy(lo->r0, p->r0, sizeof rm);
+  memcpy(lo->d0, p->d0, sizeof dm);
+  memcpy(lo->r1, rm, sizeof rm);
+  memcpy(lo->d1, dm, sizeof dm);
   piece_bound(lo);
   piece_bound(hi);
 }
@@ -536,15 +545,17 @@ static double leaf_value(const cubic *ca, piece *pa, const cubic *cb, piece *pb,
   return m < 1.0 ? m * v + (1.0 - m) * piece_rule(ca, pa, cb, pb, k) : v;
 }
 
-/* Distance of point p from segment [a, b]. */
-static double point_segment(const double p[2], const double a[2], const double b[2])
+/* Squared distance of point p from segment [a, b]. */
+static double point_segment2(const double p[2], const double a[2], const double b[2])
 {
   double ux = b[0] - a[0], uy = b[1] - a[1], px = p[0] - a[0], py = p[1] - a[1];
   double uu = ux * ux + uy * uy, t = uu > 0.0 ? (px * ux + py * uy) / uu : 0.0;
   t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
   double dx = px - t * ux, dy = py - t * uy;
-  return sqrt(dx * dx + dy * dy);
+  return dx * dx + dy * dy;
 }
+
+static inline double min2(double a, double b) { return b < a ? b : a; }
 
 /* Distance between the chords of two pieces (0 where they cross). */
 static double chord_distance(const piece *pa, const piece *pb)
@@ -556,8 +567,10 @@ static double chord_distance(const piece *pa, const piece *pb)
   double t0 = vx * (pa->r0[1] - pb->r0[1]) - vy * (pa->r0[0] - pb->r0[0]);
   double t1 = vx * (pa->r1[1] - pb->r0[1]) - vy * (pa->r1[0] - pb->r0[0]);
   if (((s0 < 0.0) != (s1 < 0.0)) && ((t0 < 0.0) != (t1 < 0.0))) return 0.0;
-  double d = fmin(point_segment(pa->r0, pb->r0, pb->r1), point_segment(pa->r1, pb->r0, pb->r1));
-  return fmin(d, fmin(point_segment(pb->r0, pa->r0, pa->r1), point_segment(pb->r1, pa->r0, pa->r1)));
+  /* the least of the squares, then one root: sqrt is monotone and
+  ** correctly rounded, so the root of the least is the least root */
+  double d2 = min2(point_segment2(pa->r0, pb->r0, pb->r1), point_segment2(pa->r1, pb->r0, pb->r1));
+  return sqrt(min2(d2, min2(point_segment2(pb->r0, pa->r0, pa->r1), point_segment2(pb->r1, pa->r0, pa->r1))));
 }
 
 /* The double integral of the kernel by subdivision (see the file comment),
@@ -610,12 +623,10 @@ static double subdivided(const cubic *ca, const piece *root_a, const cubic *cb, 
     /* split A and B in turn: a choice by size would flip between two
     ** subtrees, whose values differ by their errors */
     if (d % 2 == 0) {
-      piece whole = *pa;
-      piece_split(&whole, ca, &sa[top], &sa[top + 1]);
+      piece_split(pa, ca, &sa[top], &sa[top + 1]);
       sb[top + 1] = sb[top];
     } else {
-      piece whole = *pb;
-      piece_split(&whole, cb, &sb[top], &sb[top + 1]);
+      piece_split(pb, cb, &sb[top], &sb[top + 1]);
       sa[top + 1] = sa[top];
     }
     share[top] = share[top + 1] = f;
@@ -632,6 +643,9 @@ static inline void cubic_eval2(const cubic *c, double t, double r[2], double d[2
   dd[0] = 2.0 * c->x[2] + 6.0 * c->x[3] * t;
   dd[1] = 2.0 * c->y[2] + 6.0 * c->y[3] * t;
 }
+
+/* fmin(1, fmax(0, x)) for the x here, never NaN, without the calls. */
+static inline double clamp01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
 
 /* The closest points' grid: CP_GRID + 1 points a segment.  A 9 x 9 grid
 ** (CP_GRID 8) lost shallow crossings: between its points the ridge of
@@ -756,7 +770,7 @@ static void closest_points(const cubic *ca, const cubic *cb, double *ps, double 
     }
     int moved = 0;
     for (int half = 0; half < 20 && !moved; half++, ds *= 0.5, dt *= 0.5) {
-      double ns = fmin(1.0, fmax(0.0, s + ds)), nt = fmin(1.0, fmax(0.0, t + dt)), r[2], q[2], dd[2];
+      double ns = clamp01(s + ds), nt = clamp01(t + dt), r[2], q[2], dd[2];
       if (ns == s && nt == t) break;
       cubic_eval(ca, ns, r, dd);
       cubic_eval(cb, nt, q, dd);
