@@ -326,8 +326,9 @@ static void rule_nodes_from(const cubic *c, double t0, double t1, const double *
 #include <immintrin.h>
 
 /* rule_nodes_from four nodes at a time: each lane by cubic_eval's operations
-** in its order (no fused multiply-add), so the same bits.  Returns the
-** nodes done, a multiple of 4. */
+** in its order (no fused multiply-add), so the same bits.  An m that is not
+** a multiple of 4 ends with the last four nodes, some done twice to the same
+** bits.  Returns the nodes done: m, or 0 for m < 4. */
 __attribute__((target("avx2"))) static int rule_nodes4(const cubic *c, double t0, double t1, const double *s,
                                                        const double *w, int m, double *x, double *y, double *wt)
 {
@@ -337,8 +338,9 @@ __attribute__((target("avx2"))) static int rule_nodes4(const cubic *c, double t0
   const __m256d x3 = _mm256_set1_pd(c->x[3]), x22 = _mm256_set1_pd(2.0 * c->x[2]);
   const __m256d y0 = _mm256_set1_pd(c->y[0]), y1 = _mm256_set1_pd(c->y[1]), y2 = _mm256_set1_pd(c->y[2]);
   const __m256d y3 = _mm256_set1_pd(c->y[3]), y22 = _mm256_set1_pd(2.0 * c->y[2]);
-  int k = 0;
-  for (; k + 4 <= m; k += 4) {
+  if (m < 4) return 0;
+  for (int next = 0, k = 0; next < m; next = k + 4) {
+    k = next + 4 <= m ? next : m - 4;
     const __m256d t = _mm256_add_pd(vt0, _mm256_mul_pd(vh, _mm256_loadu_pd(s + k))), t3 = _mm256_mul_pd(t, three);
     const __m256d rx = _mm256_add_pd(x0, _mm256_mul_pd(t, _mm256_add_pd(x1, _mm256_mul_pd(t, _mm256_add_pd(x2, _mm256_mul_pd(t, x3))))));
     const __m256d ry = _mm256_add_pd(y0, _mm256_mul_pd(t, _mm256_add_pd(y1, _mm256_mul_pd(t, _mm256_add_pd(y2, _mm256_mul_pd(t, y3))))));
@@ -349,7 +351,7 @@ __attribute__((target("avx2"))) static int rule_nodes4(const cubic *c, double t0
     _mm256_storeu_pd(y + k, ry);
     _mm256_storeu_pd(wt + k, _mm256_mul_pd(_mm256_mul_pd(vh, _mm256_loadu_pd(w + k)), sp));
   }
-  return k;
+  return m;
 }
 #endif
 
@@ -472,12 +474,48 @@ typedef struct {
   double rc, rc2, inv;
 } cut;
 
+#if LW_VEC_HAVE_WIDE
+/* piece_rule's sum with B's nodes 0 to 3 in one four-lane vector and 4, 5 in
+** a two-lane one, each lane as there and added to the accumulator in its
+** order (0, 1, then 2, 3, then 4, 5), so the same bits. */
+__attribute__((target("avx2"))) static double piece_sum4(const piece *pa, const piece *pb, const cut *k)
+{
+  const __m256d bx = _mm256_loadu_pd(pb->x), by = _mm256_loadu_pd(pb->y), bw = _mm256_loadu_pd(pb->w);
+  const __m128d bx2 = _mm_loadu_pd(pb->x + 4), by2 = _mm_loadu_pd(pb->y + 4), bw2 = _mm_loadu_pd(pb->w + 4);
+  const __m256d inv = _mm256_set1_pd(k->inv), rc2 = _mm256_set1_pd(k->rc2);
+  __m128d sum = _mm_setzero_pd();
+  for (int i = 0; i < GAUSS_S; i++) {
+    const __m256d ax = _mm256_set1_pd(pa->x[i]), ay = _mm256_set1_pd(pa->y[i]);
+    const __m256d dx = _mm256_sub_pd(ax, bx), dy = _mm256_sub_pd(ay, by);
+    const __m256d r2 = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
+    __m256d q = _mm256_div_pd(bw, _mm256_sqrt_pd(r2));
+    const __m128d dx2 = _mm_sub_pd(_mm256_castpd256_pd128(ax), bx2), dy2 = _mm_sub_pd(_mm256_castpd256_pd128(ay), by2);
+    const __m128d r22 = _mm_add_pd(_mm_mul_pd(dx2, dx2), _mm_mul_pd(dy2, dy2));
+    __m128d q2 = _mm_div_pd(bw2, _mm_sqrt_pd(r22));
+    if (k->on) {
+      q = _mm256_and_pd(_mm256_sub_pd(q, _mm256_mul_pd(bw, inv)), _mm256_cmp_pd(r2, rc2, _CMP_LT_OQ));
+      q2 = _mm_and_pd(_mm_sub_pd(q2, _mm_mul_pd(bw2, _mm256_castpd256_pd128(inv))),
+                      _mm_cmplt_pd(r22, _mm256_castpd256_pd128(rc2)));
+    }
+    __m128d acc = _mm_add_pd(_mm_setzero_pd(), _mm256_castpd256_pd128(q));
+    acc = _mm_add_pd(_mm_add_pd(acc, _mm256_extractf128_pd(q, 1)), q2);
+    sum = _mm_add_pd(sum, _mm_mul_pd(_mm_set1_pd(pa->w[i]), acc));
+  }
+  double lanes[2];
+  _mm_storeu_pd(lanes, sum);
+  return lanes[0] + lanes[1];
+}
+#endif
+
 /* The 6 x 6 product rule over two pieces of the kernel k, B's nodes two at
 ** a time.  Every term is >= 0. */
 static double piece_rule(const cubic *ca, piece *pa, const cubic *cb, piece *pb, const cut *k)
 {
   piece_nodes(ca, pa);
   piece_nodes(cb, pb);
+#if LW_VEC_HAVE_WIDE
+  if (lw_vec_wide()) return piece_sum4(pa, pb, k);
+#endif
   v2d bx[GAUSS_S / 2], by[GAUSS_S / 2], bw[GAUSS_S / 2], sum = {0.0, 0.0};
   for (int j = 0; j < GAUSS_S / 2; j++) {
     bx[j] = (v2d){pb->x[2 * j], pb->x[2 * j + 1]};
@@ -841,6 +879,89 @@ int lw_pair_bezier_before(const double a[8], const double b[8])
   return 1;
 }
 
+/* What lw_pair_near_correction sums over the sample pairs: the largest
+** near weight, and the product rule's terms of the near and the far pairs. */
+typedef struct {
+  double W, near, far;
+} near_sums;
+
+/* Sample p against B's samples j0 to j1 - 1, added to *ns in order. */
+static void near_row(const lw_pair_sample *p, const lw_pair_sample *sb, int j0, int j1, const lw_pair_ctx *ctx,
+                     near_sums *ns)
+{
+  const double cut2 = ctx->cutoff2, inv = ctx->inv_cutoff;
+  for (int j = j0; j < j1; j++) {
+    double dx = p->x - sb[j].x, dy = p->y - sb[j].y, r2 = dx * dx + dy * dy;
+    double rho2 = lw_pair_near_radius2(ctx, p->dl, sb[j].dl);
+    /* a sample without length weighs nothing, even at r = 0 (0 * inf) */
+    int weighs = p->dl != 0.0f && sb[j].dl != 0.0f;
+    double k = weighs && r2 < cut2 ? (double)p->dl * (double)sb[j].dl * (1.0 / sqrt(r2) - inv) : 0.0;
+    if (r2 < rho2) {
+      double w = near_weight(sqrt(r2 / rho2));
+      if (w > ns->W) ns->W = w;
+      ns->near += k;
+    } else {
+      ns->far += k;
+    }
+  }
+}
+
+#if LW_VEC_HAVE_WIDE
+/* near_row over all of A's samples, B's four at a time: each lane's kernel,
+** near radius and weight by near_row's operations, then the terms added to
+** near and far one by one in near_row's order (the other sum takes +0, which
+** changes no sum here: every term is >= 0), so the same bits; the largest
+** weight is exact in any order. */
+__attribute__((target("avx2"))) static void near_sums4(const lw_pair_sample *sa, const lw_pair_sample *sb, int n,
+                                                        const lw_pair_ctx *ctx, near_sums *ns)
+{
+  double bx[LW_QUAD_MAX], by[LW_QUAD_MAX], bdl[LW_QUAD_MAX];
+  for (int j = 0; j < n; j++) bx[j] = sb[j].x, by[j] = sb[j].y, bdl[j] = sb[j].dl;
+  const int n4 = n / 4 * 4;
+  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), half = _mm256_set1_pd(0.5);
+  const __m256d cut2 = _mm256_set1_pd(ctx->cutoff2), inv = _mm256_set1_pd(ctx->inv_cutoff);
+  const __m256d scale = _mm256_set1_pd(ctx->near_scale), rc = _mm256_set1_pd(ctx->cutoff);
+  const __m256d clip = ctx->cutoff > 0.0 ? _mm256_castsi256_pd(_mm256_set1_epi64x(-1)) : zero;
+  for (int i = 0; i < n; i++) {
+    const __m256d ax = _mm256_set1_pd(sa[i].x), ay = _mm256_set1_pd(sa[i].y), adl = _mm256_set1_pd(sa[i].dl);
+    const __m256d a_weighs = _mm256_cmp_pd(adl, zero, _CMP_NEQ_OQ);
+    for (int j = 0; j < n4; j += 4) {
+      const __m256d dx = _mm256_sub_pd(ax, _mm256_loadu_pd(bx + j)), dy = _mm256_sub_pd(ay, _mm256_loadu_pd(by + j));
+      const __m256d r2 = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)), dl = _mm256_loadu_pd(bdl + j);
+      /* lw_pair_near_radius2: the larger weight (exact as floats or as
+      ** doubles) times the scale, clipped to rc */
+      __m256d r = _mm256_mul_pd(scale, _mm256_max_pd(adl, dl));
+      r = _mm256_blendv_pd(r, rc, _mm256_and_pd(clip, _mm256_cmp_pd(r, rc, _CMP_GT_OQ)));
+      const __m256d rho2 = _mm256_mul_pd(r, r);
+      const __m256d use = _mm256_and_pd(_mm256_and_pd(a_weighs, _mm256_cmp_pd(dl, zero, _CMP_NEQ_OQ)),
+                                        _mm256_cmp_pd(r2, cut2, _CMP_LT_OQ));
+      const __m256d k = _mm256_and_pd(
+          use, _mm256_mul_pd(_mm256_mul_pd(adl, dl), _mm256_sub_pd(_mm256_div_pd(one, _mm256_sqrt_pd(r2)), inv)));
+      const __m256d is_near = _mm256_cmp_pd(r2, rho2, _CMP_LT_OQ);
+      if (_mm256_movemask_pd(is_near)) {
+        /* near_weight(sqrt(r2 / rho2)) where near: 1 to u = 0.5, 0 from 1 */
+        const __m256d u = _mm256_sqrt_pd(_mm256_div_pd(r2, rho2)), t = _mm256_mul_pd(_mm256_set1_pd(2.0), _mm256_sub_pd(one, u));
+        const __m256d poly = _mm256_add_pd(_mm256_set1_pd(10.0),
+                                           _mm256_mul_pd(t, _mm256_sub_pd(_mm256_mul_pd(_mm256_set1_pd(6.0), t),
+                                                                          _mm256_set1_pd(15.0))));
+        __m256d w = _mm256_mul_pd(_mm256_mul_pd(_mm256_mul_pd(t, t), t), poly);
+        w = _mm256_blendv_pd(w, one, _mm256_cmp_pd(u, half, _CMP_LE_OQ));
+        w = _mm256_and_pd(w, _mm256_and_pd(is_near, _mm256_cmp_pd(u, one, _CMP_LT_OQ)));
+        __m256d m = _mm256_max_pd(w, _mm256_permute2f128_pd(w, w, 1));
+        m = _mm256_max_pd(m, _mm256_permute_pd(m, 5));
+        const double wm = _mm256_cvtsd_f64(m);
+        if (wm > ns->W) ns->W = wm;
+      }
+      double kn[4], kf[4];
+      _mm256_storeu_pd(kn, _mm256_and_pd(is_near, k));
+      _mm256_storeu_pd(kf, _mm256_andnot_pd(is_near, k));
+      for (int l = 0; l < 4; l++) ns->near += kn[l], ns->far += kf[l];
+    }
+    near_row(&sa[i], sb, n4, n, ctx, ns);
+  }
+}
+#endif
+
 double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, const double b[8],
                                const lw_pair_sample *sb, int n, const lw_pair_ctx *ctx)
 {
@@ -853,24 +974,13 @@ double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, cons
     sa = sb;
     sb = u;
   }
-  double W = 0.0, far = 0.0, near = 0.0;
-  const double cut2 = ctx->cutoff2, inv = ctx->inv_cutoff;
-  for (int i = 0; i < n; i++) {
-    for (int j = 0; j < n; j++) {
-      double dx = sa[i].x - sb[j].x, dy = sa[i].y - sb[j].y, r2 = dx * dx + dy * dy;
-      double rho2 = lw_pair_near_radius2(ctx, sa[i].dl, sb[j].dl);
-      /* a sample without length weighs nothing, even at r = 0 (0 * inf) */
-      int weighs = sa[i].dl != 0.0f && sb[j].dl != 0.0f;
-      double k = weighs && r2 < cut2 ? (double)sa[i].dl * (double)sb[j].dl * (1.0 / sqrt(r2) - inv) : 0.0;
-      if (r2 < rho2) {
-        double w = near_weight(sqrt(r2 / rho2));
-        if (w > W) W = w;
-        near += k;
-      } else {
-        far += k;
-      }
-    }
-  }
+  near_sums ns = {0.0, 0.0, 0.0};
+#if LW_VEC_HAVE_WIDE
+  if (lw_vec_wide()) near_sums4(sa, sb, n, ctx, &ns);
+  else
+#endif
+    for (int i = 0; i < n; i++) near_row(&sa[i], sb, 0, n, ctx, &ns);
+  const double W = ns.W, far = ns.far, near = ns.near;
   if (W == 0.0) return 0.0;
   double e = W * lw_pair_segments_exact(a, b, ctx->cutoff);
   if (W < 1.0) e += (1.0 - W) * (near + far);

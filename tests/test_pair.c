@@ -1202,3 +1202,52 @@ Test(pair, wide_and_narrow_grid_search_give_the_same_bits)
   cr_assert(differ == 0, "%d of %d integrals differ between the wide and the narrow grid search (first: case %d)",
             differ, n, first);
 }
+
+/* The samples of segment a (control points) at the nodes of q. */
+static void pair_samples_of(const lw_quad *q, const double a[8], lw_pair_sample *out)
+{
+  lw_node na[2] = {{a[0], a[1], a[2] - a[0], a[3] - a[1]}, {a[6], a[7], a[6] - a[4], a[7] - a[5]}};
+  lw_samples s;
+  lw_segment_sample(q, &na[0], &na[1], &s);
+  for (int i = 0; i < q->n; i++) out[i] = (lw_pair_sample){s.x[i], s.y[i], (float)s.dl[i]};
+}
+
+/*
+** lw_pair_near_correction's sum over the sample pairs runs four of B's
+** samples at a time where the processor has AVX2, and gives the scalar
+** loop's bits: node counts that are and are not multiples of 4, with and
+** without a cutoff (one that clips the near radius too), samples without
+** length, pairs near and far.
+*/
+Test(pair, wide_and_narrow_near_corrections_give_the_same_bits)
+{
+  if (!lw_vec_wide()) cr_skip_test("this processor has no AVX2: only the narrow near correction runs here");
+  static const int nodes[] = {5, 6, 8, 10};
+  static const double cuts[] = {0.0, 0.3, 2.0};
+  rng_seed(48);
+  int differ = 0, n = 0, nonzero = 0;
+  for (int it = 0; it < 240; it++) {
+    lw_quad q;
+    lw_pair_ctx ctx;
+    lw_quad_init(&q, nodes[it % 4], NULL);
+    lw_pair_ctx_init(&ctx, cuts[it / 4 % 3], it % 2 ? NEAR_DEFAULT : 3.0);
+    double a[8], b[8], size = it % 5 ? 1.0 : 0.1;
+    for (int k = 0; k < 8; k++) a[k] = urand(0, size), b[k] = urand(0, size);
+    if (it % 7 == 0)
+      for (int k = 2; k < 8; k += 2) b[k] = b[0], b[k + 1] = b[1]; /* a point: samples without length */
+    lw_pair_sample pa[LW_QUAD_MAX], pb[LW_QUAD_MAX];
+    pair_samples_of(&q, a, pa);
+    pair_samples_of(&q, b, pb);
+    double v[2];
+    for (int w = 0; w < 2; w++) {
+      lw_vec_set_wide(w);
+      v[w] = lw_pair_near_correction(a, pa, b, pb, q.n, &ctx);
+    }
+    n++;
+    nonzero += v[1] != 0.0;
+    differ += memcmp(&v[0], &v[1], sizeof v[0]) != 0;
+  }
+  lw_vec_set_wide(1);
+  cr_assert(nonzero > n / 2, "only %d of %d corrections are not 0: the test sees too few near pairs", nonzero, n);
+  cr_assert(differ == 0, "%d of %d near corrections differ between the wide and the narrow sums", differ, n);
+}
