@@ -222,6 +222,24 @@ void lw_cellgrid_get(const lw_cellgrid *g, uint32_t i, double *x, double *y, flo
   *dl = lw_cell_dl(c)[k];
 }
 
+void lw_cellgrid_get_run(const lw_cellgrid *g, uint32_t i0, uint32_t n, double *x, double *y, float *dl)
+{
+  const lw_cell *c = NULL;
+  uint32_t k = 0;
+  for (uint32_t q = 0; q < n; q++) {
+    const uint32_t i = i0 + q;
+    const lw_cell *ci = &g->cell[g->home[i]];
+    /* a segment's samples are consecutive indices, mostly in one cell: the
+    ** entry after the last one found, where it is i, saves the search */
+    if (!(ci == c && k + 1 < c->n && lw_cell_idx(c)[k + 1] == i)) k = lower_bound(ci, i);
+    else k++;
+    c = ci;
+    x[q] = c->x[k];
+    y[q] = lw_cell_y(c)[k];
+    dl[q] = lw_cell_dl(c)[k];
+  }
+}
+
 void lw_cellgrid_fit(lw_cellgrid *g)
 {
   for (size_t c = 0; c < lw_cellgrid_cells(g); c++) {

@@ -64,11 +64,17 @@ typedef struct {
 } pair_view;
 
 /* Sample i from the grid. */
-static lw_pair_sample sample_at(const pair_view *v, uint32_t i)
+/* Samples i0 to i0 + n - 1 of the grid. */
+static void samples_at(const pair_view *v, uint32_t i0, size_t n, lw_pair_sample *out)
 {
-  lw_pair_sample s;
-  lw_cellgrid_get(v->g, i, &s.x, &s.y, &s.dl);
-  return s;
+  enum { RUN = 64 };
+  double x[RUN], y[RUN];
+  float dl[RUN];
+  for (size_t q0 = 0; q0 < n; q0 += RUN) {
+    const uint32_t m = (uint32_t)(n - q0 < RUN ? n - q0 : RUN);
+    lw_cellgrid_get_run(v->g, i0 + (uint32_t)q0, m, x, y, dl);
+    for (uint32_t q = 0; q < m; q++) out[q0 + q] = (lw_pair_sample){x[q], y[q], dl[q]};
+  }
 }
 
 /* The filter of the samples of spline i: pairs with samples of index >= from. */
@@ -113,7 +119,7 @@ static double near_one(const pair_view *v, const double bez[8], const lw_pair_sa
   lw_pair_sample other[LW_QUAD_MAX];
   double b[8];
   segment_bezier(v->sp, gb, b);
-  for (uint32_t q = 0; q < v->np; q++) other[q] = sample_at(v, gb * v->np + q);
+  samples_at(v, gb * v->np, v->np, other);
   return lw_pair_near_correction(bez, mine, b, other, (int)v->np, v->ctx);
 }
 
@@ -236,7 +242,7 @@ static lw_status pair_all(const pair_view *v, double *e, lw_near_values *out)
         if (segs.n == 0 || segs.idx[segs.n - 1] != pairs.idx[j + 1]) st = list_push(&segs, pairs.idx[j + 1]);
       double a[8];
       segment_bezier(v->sp, ga, a);
-      for (uint32_t q = 0; q < v->np; q++) sa[q] = sample_at(v, ga * v->np + q);
+      samples_at(v, ga * v->np, v->np, sa);
       sum += near_part(v, a, sa, &segs, ga, out);
     }
   }
@@ -686,10 +692,13 @@ static inline const lw_node *proposed_node(const lw_node *base, const lw_proposa
 ** for even k, its old self for odd k. */
 static lw_status near_segments(const lw_proposal *p, uint32_t np, size_t j, int old, lw_near_list *segs)
 {
+  /* probe 2 (j np + q) + old is sample q of segment j, new (0) or old (1):
+  ** a range test, no division, for the pairs of other segments */
+  const uint32_t lo = 2 * (uint32_t)j * np, hi = lo + 2 * np;
   segs->n = 0;
   for (size_t k = 0; k < p->near.n; k++) {
     const lw_pair_near *q = &p->near.pair[k];
-    if ((int)(q->probe & 1) != old || (q->probe / 2) / np != j) continue;
+    if ((int)(q->probe & 1) != old || q->probe < lo || q->probe >= hi) continue;
     if (set_insert(segs, q->idx / np) != LW_OK) return LW_ENOMEM;
   }
   return LW_OK;
@@ -945,7 +954,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
     /* the old samples, from the grid: the walk's old side and a failed commit's undo */
     pair_view v = {m->grid, sp, (uint32_t)np, pair_ctx(pc)};
     size_t first = (g0 + p->seg0) * (size_t)np, n = p->n_seg * (size_t)np;
-    for (size_t k = 0; k < n; k++) p->ps_old[k] = sample_at(&v, (uint32_t)(first + k));
+    samples_at(&v, (uint32_t)first, n, p->ps_old);
   }
   p->crowded = 0;
   if (sc->min_spacing > 0.0 && !(dE == INFINITY) && !isnan(dE)) {
@@ -1415,9 +1424,10 @@ void lw_model_propose_regroup(const lw_model *m, lw_proposal *p, const uint32_t 
   p->pair_done = 0;
   const pair_view v = {m->grid, sp, (uint32_t)np, pc ? pair_ctx(pc) : NULL};
   if (m->grid)
-    for (int k = 0, o = 0; k < n_old; k++) {
-      const size_t first = lw_segment_index(sp, old[k], 0) * (size_t)np;
-      for (size_t i = 0; i < p->old_seg[k] * (size_t)np; i++) p->ps_old[o++] = sample_at(&v, (uint32_t)(first + i));
+    for (size_t k = 0, o = 0; k < (size_t)n_old; k++) {
+      const size_t first = lw_segment_index(sp, old[k], 0) * (size_t)np, run = p->old_seg[k] * (size_t)np;
+      samples_at(&v, (uint32_t)first, run, p->ps_old + o);
+      o += run;
     }
   p->crowded = 0;
   if (sc->min_spacing > 0.0 && p->n_seg && !(dE == INFINITY) && !isnan(dE)) {

@@ -138,6 +138,7 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
      const uint32_t *probe_id, far_acc *fa, lw_pair_nearlist *near, const int with_near)
 {
   uint64_t near_bits[LW_PAIR_BATCH] = {0};
+  unsigned any = 0; /* some near pair: append_near has work */
   const double *xs = c->x, *ys = lw_cell_y(c);
   const float *dls = lw_cell_dl(c);
   const v4f zero = {0.0f, 0.0f, 0.0f, 0.0f};
@@ -174,7 +175,9 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
         v2l n1 = ((r1 < m1) | (r1 < q->near2)) & (r1 < sh->cut2) & ~hi2l(skip);
         f0 &= ~n0;
         f1 &= ~n1;
-        near_bits[b] |= (uint64_t)(bits2(n0) | bits2(n1) << 2) << t;
+        const unsigned found = bits2(n0) | bits2(n1) << 2;
+        near_bits[b] |= (uint64_t)found << t;
+        any |= found;
       }
       if (bits2(f0 | f1)) {
         v2d v0 = (w0 * q->scale) * (one / lw_vsqrt2(r0) - fa->ic), v1 = (w1 * q->scale) * (one / lw_vsqrt2(r1) - fa->ic);
@@ -185,7 +188,7 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
   }
   fa->s0 = s0;
   fa->s1 = s1;
-  if (with_near) append_near(c, k0, mask, probe_id, near_bits, near);
+  if (with_near && any) append_near(c, k0, mask, probe_id, near_bits, near);
 }
 
 #if LW_VEC_HAVE_WIDE
@@ -202,6 +205,7 @@ scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh,
                const uint32_t *probe_id, far_acc *fa, lw_pair_nearlist *near, const int with_near)
 {
   uint64_t near_bits[LW_PAIR_BATCH] = {0};
+  unsigned any = 0;
   const double *xs = c->x, *ys = lw_cell_y(c);
   const float *dls = lw_cell_dl(c);
   const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
@@ -230,7 +234,9 @@ scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh,
         __m256d n = _mm256_or_pd(_mm256_cmp_pd(r, m, _CMP_LT_OQ), _mm256_cmp_pd(r, near2, _CMP_LT_OQ));
         n = _mm256_and_pd(_mm256_and_pd(n, _mm256_cmp_pd(r, cut2, _CMP_LT_OQ)), kept);
         f = _mm256_andnot_pd(n, f);
-        near_bits[b] |= (uint64_t)(unsigned)_mm256_movemask_pd(n) << t;
+        const unsigned found = (unsigned)_mm256_movemask_pd(n);
+        near_bits[b] |= (uint64_t)found << t;
+        any |= found;
       }
       if (_mm256_movemask_pd(f)) {
         const __m256d inv = _mm256_sub_pd(_mm256_div_pd(one, _mm256_sqrt_pd(r)), ic);
@@ -242,7 +248,7 @@ scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh,
   }
   fa->s0 = (v2d)s0;
   fa->s1 = (v2d)s1;
-  if (with_near) append_near(c, k0, mask, probe_id, near_bits, near);
+  if (with_near && any) append_near(c, k0, mask, probe_id, near_bits, near);
 }
 
 __attribute__((target("avx2"))) static void scan_wide_near(const lw_cell *c, uint32_t k0, uint32_t k1,

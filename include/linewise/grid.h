@@ -121,6 +121,10 @@ lw_status lw_cellgrid_move(lw_cellgrid *g, uint32_t i, double x, double y, float
 /* Position and weight of sample i (in the grid): a binary search in its cell. */
 void lw_cellgrid_get(const lw_cellgrid *g, uint32_t i, double *x, double *y, float *dl);
 
+/* Samples i0 to i0 + n - 1, as lw_cellgrid_get gives each: one search for a
+** run that shares a cell. */
+void lw_cellgrid_get_run(const lw_cellgrid *g, uint32_t i0, uint32_t n, double *x, double *y, float *dl);
+
 /* Shrinks every cell to its entries plus a little spare room: after a
 ** refill, which grows cells one entry at a time. */
 void lw_cellgrid_fit(lw_cellgrid *g);
