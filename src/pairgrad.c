@@ -554,7 +554,8 @@ static jet subdivided(const jcubic *ca, const jpiece *root_a, const jcubic *cb, 
     if (w.v > 0.0) sum = jadd(sum, jmul(jmul(f, w), piece_rule(ca, pa, cb, pb, k)));
     f = jmul(f, jaddc(jscale(w, -1.0), 1.0));
     if (f.v == 0.0) continue;
-    w = top + 2 > K.stack_max ? jc(1.0) : jsmooth(jdiv(jsub(jscale(leaf, 2.0), big), leaf));
+    w = top + 2 > K.stack_max ? jc(1.0)
+                              : jsmooth(jdiv(jsub(jscale(leaf, K.leaf_band), big), jscale(leaf, K.leaf_band - 1.0)));
     if (w.v < 1.0) {
       jet cd = jsub(jsub(chord_distance(pa, pb), pa->flat), pb->flat), inside = jc(1.0);
       if (k->on) {
@@ -562,8 +563,8 @@ static jet subdivided(const jcubic *ca, const jpiece *root_a, const jcubic *cb, 
         inside = jsmooth(jaddc(jdiv(jaddc(jscale(far, -1.0), k->rc), big), -1.0));
       }
       if (cd.v > 0.0 && inside.v > 0.0) {
-        jet v = jmul(inside, jsmooth(jdiv(jsub(jsub(jscale(cd, 2.0 * K.flat_ratio), pa->flat), pb->flat),
-                                          jscale(cd, K.flat_ratio))));
+        jet v = jmul(inside, jsmooth(jdiv(jsub(jsub(jscale(cd, K.flat_band * K.flat_ratio), pa->flat), pb->flat),
+                                          jscale(cd, (K.flat_band - 1.0) * K.flat_ratio))));
         if (v.v > w.v) w = v;
       }
     }

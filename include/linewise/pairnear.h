@@ -52,6 +52,7 @@ double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, cons
 typedef struct {
   double sep_lo, sep_hi;       /* pieces apart: 6 x 6 rule from sep_hi larger radii on */
   double leaf_ratio, flat_ratio;
+  double leaf_band, flat_band; /* a leaf blends out up to these times its size and flatness limits */
   int stack_max;
   int cp_grid;                 /* closest points: the best of (cp_grid + 1)^2 points, then Newton */
   const double *g6_s, *g6_w;   /* Gauss-Legendre on [0, 1] */
