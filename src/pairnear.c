@@ -658,7 +658,12 @@ static double subdivided(const cubic *ca, const piece *root_a, const cubic *cb, 
     ** piece size to spare: a flat leaf may be long, and one that reached
     ** past rc would take leaf_value's product rule over a ridge it cannot
     ** resolve (4 % off for lines alongside 0.1 mm apart, rc 2 mm) */
-    if (w < 1.0) {
+    /* The chords are no farther apart than their midpoints, the circles'
+    ** centres: where the flatnesses are too large even for that distance
+    ** (with a margin for the roundings), the flat weight is 0 without the
+    ** chords' distance, which is most pairs that are split. */
+    const double centres = sqrt(dx * dx + dy * dy), flats = pa->flat + pb->flat;
+    if (w < 1.0 && flats < FLAT_BAND * FLAT_RATIO * (centres * (1.0 + 1e-12) - flats)) {
       double cd = chord_distance(pa, pb) - pa->flat - pb->flat, inside = 1.0;
       if (k->on) inside = smooth_step((k->rc - (sqrt(dx * dx + dy * dy) + pa->rad + pb->rad)) / big - 1.0);
       if (cd > 0.0 && inside > 0.0)
@@ -682,14 +687,6 @@ static double subdivided(const cubic *ca, const piece *root_a, const cubic *cb, 
     top += 2;
   }
   return sum;
-}
-
-/* r, r' and r'' of a cubic at t. */
-static inline void cubic_eval2(const cubic *c, double t, double r[2], double d[2], double dd[2])
-{
-  cubic_eval(c, t, r, d);
-  dd[0] = 2.0 * c->x[2] + 6.0 * c->x[3] * t;
-  dd[1] = 2.0 * c->y[2] + 6.0 * c->y[3] * t;
 }
 
 /* fmin(1, fmax(0, x)) for the x here, never NaN, without the calls. */
@@ -799,10 +796,14 @@ static void closest_points(const cubic *ca, const cubic *cb, double *ps, double 
   /* Newton where the Hessian is positive definite, else steepest descent
   ** scaled by the speeds; either step projected into the square and halved
   ** until it brings the curves closer (so the grid's best is never lost) */
+  /* each curve's point and first derivative at (s, t) come from the step
+  ** that moved there, the second derivative from the power form */
+  double a[2], a1[2], b[2], b1[2];
+  cubic_eval(ca, s, a, a1);
+  cubic_eval(cb, t, b, b1);
   for (int it = 0; it < 30; it++) {
-    double a[2], a1[2], a2[2], b[2], b1[2], b2[2];
-    cubic_eval2(ca, s, a, a1, a2);
-    cubic_eval2(cb, t, b, b1, b2);
+    const double a2[2] = {2.0 * ca->x[2] + 6.0 * ca->x[3] * s, 2.0 * ca->y[2] + 6.0 * ca->y[3] * s};
+    const double b2[2] = {2.0 * cb->x[2] + 6.0 * cb->x[3] * t, 2.0 * cb->y[2] + 6.0 * cb->y[3] * t};
     double D[2] = {a[0] - b[0], a[1] - b[1]};
     double gs = D[0] * a1[0] + D[1] * a1[1], gt = -(D[0] * b1[0] + D[1] * b1[1]);
     double vs = a1[0] * a1[0] + a1[1] * a1[1], vt = b1[0] * b1[0] + b1[1] * b1[1];
@@ -818,15 +819,19 @@ static void closest_points(const cubic *ca, const cubic *cb, double *ps, double 
     }
     int moved = 0;
     for (int half = 0; half < 20 && !moved; half++, ds *= 0.5, dt *= 0.5) {
-      double ns = clamp01(s + ds), nt = clamp01(t + dt), r[2], q[2], dd[2];
+      double ns = clamp01(s + ds), nt = clamp01(t + dt), r[2], r1[2], q[2], q1[2];
       if (ns == s && nt == t) break;
-      cubic_eval(ca, ns, r, dd);
-      cubic_eval(cb, nt, q, dd);
+      cubic_eval(ca, ns, r, r1);
+      cubic_eval(cb, nt, q, q1);
       double f = (r[0] - q[0]) * (r[0] - q[0]) + (r[1] - q[1]) * (r[1] - q[1]);
       if (f < best) {
         best = f;
         s = ns;
         t = nt;
+        memcpy(a, r, sizeof a);
+        memcpy(a1, r1, sizeof a1);
+        memcpy(b, q, sizeof b);
+        memcpy(b1, q1, sizeof b1);
         moved = 1;
       }
     }
