@@ -585,8 +585,10 @@ static double leaf_value(const cubic *ca, piece *pa, const cubic *cb, piece *pb,
   double v = m > 0.0 ? lw_pair_segseg(a0, a1, b0, b1) : 0.0;
   if (!(v < INFINITY)) return piece_rule(ca, pa, cb, pb, k);
   if (k->on && m > 0.0) {
-    double la = hypot(pa->r1[0] - pa->r0[0], pa->r1[1] - pa->r0[1]);
-    double lb = hypot(pb->r1[0] - pb->r0[0], pb->r1[1] - pb->r0[1]);
+    /* the chords' lengths (no hypot: nothing here under- or overflows) */
+    double ax = pa->r1[0] - pa->r0[0], ay = pa->r1[1] - pa->r0[1], bx = pb->r1[0] - pb->r0[0],
+           by = pb->r1[1] - pb->r0[1];
+    double la = sqrt(ax * ax + ay * ay), lb = sqrt(bx * bx + by * by);
     v = fmax(0.0, v - la * lb * k->inv);
   }
   return m < 1.0 ? m * v + (1.0 - m) * piece_rule(ca, pa, cb, pb, k) : v;
@@ -863,7 +865,8 @@ double lw_pair_segments_exact(const double a[8], const double b[8], double cutof
   ** weight of the distance (the least over the segments, a continuous
   ** function of them wherever Newton lands): most near pairs of a drawing,
   ** neighbouring lines under an element apart, end there. */
-  double half = fmax(pa.rad, pb.rad), dist = hypot(ra[0] - rb[0], ra[1] - rb[1]);
+  const double ex = ra[0] - rb[0], ey = ra[1] - rb[1];
+  double half = fmax(pa.rad, pb.rad), dist = sqrt(ex * ex + ey * ey);
   kernel_kind whole = cutoff > 0.0 ? KERNEL_CUT : KERNEL_INV;
   double v = 0.0, rest = 1.0;
   for (int r = 0; r < N_WHOLE && rest > 0.0; r++) {
