@@ -63,7 +63,6 @@ typedef struct {
   const lw_pair_ctx *ctx;
 } pair_view;
 
-/* Sample i from the grid. */
 /* Samples i0 to i0 + n - 1 of the grid. */
 static void samples_at(const pair_view *v, uint32_t i0, size_t n, lw_pair_sample *out)
 {
