@@ -56,8 +56,8 @@
 ** error of order curvature^2 leaf^2 where curves cross, of order the leaf
 ** where they touch tangentially.
 ** Each decision is blended too (SEP_LO to SEP_HI, flatness ratios 1 to
-** FLAT_BAND, leaf sizes LEAF_BAND to 1).  A piece's 6-node rule is computed once and travels
-** with its copies down the tree.
+** FLAT_BAND, leaf sizes LEAF_BAND to 1).  A piece's 6-node rule is computed
+** once and travels with its copies down the tree.
 **
 ** The cutoff: the subdivision integrates (1/r - 1/rc)+ itself.  A pair of
 ** pieces whose circles lie wholly beyond rc adds nothing (every rule below
@@ -150,27 +150,30 @@ static void piece_init(piece *p, const cubic *c, double t0, double t1)
   piece_bound(p);
 }
 
+/* Piece [t0, t1] of a cubic from its ends, bound; its nodes not yet computed. */
+static void piece_set(piece *p, double t0, double t1, const double r0[2], const double d0[2], const double r1[2],
+                      const double d1[2])
+{
+  p->t0 = t0;
+  p->t1 = t1;
+  memcpy(p->r0, r0, sizeof p->r0);
+  memcpy(p->d0, d0, sizeof p->d0);
+  memcpy(p->r1, r1, sizeof p->r1);
+  memcpy(p->d1, d1, sizeof p->d1);
+  piece_bound(p);
+}
+
 /* The halves of piece p, which may be lo itself: only the ends are copied
 ** (a copy of the whole would carry the node arrays, which no half keeps). */
-static void piece_split(piece *p, const cubic *c, piece *lo, piece *hi)
+static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
 {
   const double t0 = p->t0, t1 = p->t1, tm = 0.5 * (t0 + t1);
+  const double r0[2] = {p->r0[0], p->r0[1]}, d0[2] = {p->d0[0], p->d0[1]};
+  const double r1[2] = {p->r1[0], p->r1[1]}, d1[2] = {p->d1[0], p->d1[1]};
   double rm[2], dm[2];
   cubic_eval(c, tm, rm, dm);
-  hi->t0 = tm;
-  hi->t1 = t1;
-  memcpy(hi->r0, rm, sizeof rm);
-  memcpy(hi->d0, dm, sizeof dm);
-  memcpy(hi->r1, p->r1, sizeof rm);
-  memcpy(hi->d1, p->d1, sizeof dm);
-  lo->t0 = t0;
-  lo->t1 = tm;
-  memcpy(lo->r0, p->r0, sizeof rm);
-  memcpy(lo->d0, p->d0, sizeof dm);
-  memcpy(lo->r1, rm, sizeof rm);
-  memcpy(lo->d1, dm, sizeof dm);
-  piece_bound(lo);
-  piece_bound(hi);
+  piece_set(lo, t0, tm, r0, d0, rm, dm);
+  piece_set(hi, tm, t1, rm, dm, r1, d1);
 }
 
 /* Each decision blends from its limit to these times it (SEP_LO to SEP_HI
@@ -351,8 +354,10 @@ __attribute__((target("avx2"))) static int rule_nodes4(const cubic *c, double t0
   for (int next = 0, k = 0; next < m; next = k + 4) {
     k = next + 4 <= m ? next : m - 4;
     const __m256d t = _mm256_add_pd(vt0, _mm256_mul_pd(vh, _mm256_loadu_pd(s + k))), t3 = _mm256_mul_pd(t, three);
-    const __m256d rx = _mm256_add_pd(x0, _mm256_mul_pd(t, _mm256_add_pd(x1, _mm256_mul_pd(t, _mm256_add_pd(x2, _mm256_mul_pd(t, x3))))));
-    const __m256d ry = _mm256_add_pd(y0, _mm256_mul_pd(t, _mm256_add_pd(y1, _mm256_mul_pd(t, _mm256_add_pd(y2, _mm256_mul_pd(t, y3))))));
+    const __m256d rx =
+        _mm256_add_pd(x0, _mm256_mul_pd(t, _mm256_add_pd(x1, _mm256_mul_pd(t, _mm256_add_pd(x2, _mm256_mul_pd(t, x3))))));
+    const __m256d ry =
+        _mm256_add_pd(y0, _mm256_mul_pd(t, _mm256_add_pd(y1, _mm256_mul_pd(t, _mm256_add_pd(y2, _mm256_mul_pd(t, y3))))));
     const __m256d dx = _mm256_add_pd(x1, _mm256_mul_pd(t, _mm256_add_pd(x22, _mm256_mul_pd(t3, x3))));
     const __m256d dy = _mm256_add_pd(y1, _mm256_mul_pd(t, _mm256_add_pd(y22, _mm256_mul_pd(t3, y3))));
     const __m256d sp = _mm256_sqrt_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)));
@@ -659,8 +664,8 @@ static double subdivided(const cubic *ca, const piece *root_a, const cubic *cb, 
     ** share of the curves'.  With the cutoff only pieces inside it, with a
     ** piece size to spare: a flat leaf may be long, and one that reached
     ** past rc would take leaf_value's product rule over a ridge it cannot
-    ** resolve (4 % off for lines alongside 0.1 mm apart, rc 2 mm) */
-    /* The chords are no farther apart than their midpoints, the circles'
+    ** resolve (4 % off for lines alongside 0.1 mm apart, rc 2 mm).  The
+    ** chords are no farther apart than their midpoints, the circles'
     ** centres: where the flatnesses are too large even for that distance
     ** (with a margin for the roundings), the flat weight is 0 without the
     ** chords' distance, which is most pairs that are split. */
@@ -797,9 +802,9 @@ static void closest_points(const cubic *ca, const cubic *cb, double *ps, double 
   if (at >= 0) s = at / (CP_GRID + 1) / (double)CP_GRID, t = at % (CP_GRID + 1) / (double)CP_GRID;
   /* Newton where the Hessian is positive definite, else steepest descent
   ** scaled by the speeds; either step projected into the square and halved
-  ** until it brings the curves closer (so the grid's best is never lost) */
-  /* each curve's point and first derivative at (s, t) come from the step
-  ** that moved there, the second derivative from the power form */
+  ** until it brings the curves closer (so the grid's best is never lost).
+  ** Each curve's point and first derivative at (s, t) come from the step
+  ** that moved there, the second derivative from the power form. */
   double a[2], a1[2], b[2], b1[2];
   cubic_eval(ca, s, a, a1);
   cubic_eval(cb, t, b, b1);
@@ -958,7 +963,8 @@ __attribute__((target("avx2"))) static void near_sums4(const lw_pair_sample *sa,
       const __m256d is_near = _mm256_cmp_pd(r2, rho2, _CMP_LT_OQ);
       if (_mm256_movemask_pd(is_near)) {
         /* near_weight(sqrt(r2 / rho2)) where near: 1 to u = 0.5, 0 from 1 */
-        const __m256d u = _mm256_sqrt_pd(_mm256_div_pd(r2, rho2)), t = _mm256_mul_pd(_mm256_set1_pd(2.0), _mm256_sub_pd(one, u));
+        const __m256d u = _mm256_sqrt_pd(_mm256_div_pd(r2, rho2));
+        const __m256d t = _mm256_mul_pd(_mm256_set1_pd(2.0), _mm256_sub_pd(one, u));
         const __m256d poly = _mm256_add_pd(_mm256_set1_pd(10.0),
                                            _mm256_mul_pd(t, _mm256_sub_pd(_mm256_mul_pd(_mm256_set1_pd(6.0), t),
                                                                           _mm256_set1_pd(15.0))));
