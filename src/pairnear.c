@@ -183,10 +183,10 @@ static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
 ** leaves only where they are more accurate.  Narrower flatness and leaf
 ** bands steepen the blends until a central difference at 1e-6 of the
 ** scale no longer follows X's derivative (tests/test_pairgrad.c). */
-#define SEP_LO 0.9
-#define SEP_HI 1.0
-#define LEAF_RATIO 5e-3
-#define FLAT_RATIO 5e-2
+#define SEP_LO 0.6
+#define SEP_HI 0.7
+#define LEAF_RATIO 1e-2
+#define FLAT_RATIO 0.2
 #define LEAF_BAND 1.5
 #define FLAT_BAND 1.5
 #define STACK_MAX 128
@@ -317,8 +317,8 @@ static const double G64_W[64] = {
 static const int WHOLE_M[N_WHOLE] = {16, 24, 32, 48, 64};
 static const double *const WHOLE_S[N_WHOLE] = {G16_S, G24_S, G32_S, G48_S, G64_S};
 static const double *const WHOLE_W[N_WHOLE] = {G16_W, G24_W, G32_W, G48_W, G64_W};
-static const double WHOLE_LO[N_WHOLE] = {0.35, 0.24, 0.18, 0.12, 0.09};
-static const double WHOLE_HI[N_WHOLE] = {0.37, 0.252, 0.189, 0.126, 0.0945};
+static const double WHOLE_LO[N_WHOLE] = {0.29, 0.193, 0.144, 0.096, 0.072};
+static const double WHOLE_HI[N_WHOLE] = {0.3045, 0.20265, 0.1512, 0.1008, 0.0756};
 
 /* Positions and length weights of nodes k0 to m - 1 of an m-node rule on a
 ** piece. */
