@@ -54,6 +54,13 @@ static lw_status list_push(lw_near_list *l, uint32_t v)
   return LW_OK;
 }
 
+/* Moves the model's serial on (lw_model.serial); returns the new one.  Moves
+** in two domains may commit at once. */
+static uint64_t state_changed(lw_model *m)
+{
+  return __atomic_add_fetch(&m->serial, 1, __ATOMIC_RELAXED);
+}
+
 /* Where the pair term looks things up: the grid, and the splines' sample
 ** ranges (np samples per segment). */
 typedef struct {
@@ -221,7 +228,7 @@ static lw_status pair_all(const pair_view *v, double *e, lw_near_values *out)
       lw_pair_probe P = {c->x[k], lw_cell_y(c)[k], lw_cell_dl(c)[k], 1.0};
       lw_pair_filter f = filter_of(v, v->sp->seg_spline[ga], i + 1);
       near.n = 0;
-      if ((st = lw_pair_walk(g, v->ctx, &P, 1, &f, &t, &near, NULL)) != LW_OK) break;
+      if ((st = lw_pair_walk(g, v->ctx, &P, 1, &f, &t, NULL, &near, NULL)) != LW_OK) break;
       sum += t;
       for (size_t q = 0; q < near.n && st == LW_OK; q++) {
         uint32_t gb = near.pair[q].idx / v->np;
@@ -496,6 +503,9 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
   }
   m->scene = sc;
   m->sp = sp;
+  /* serials unique among models: a proposal's memo names model and serial */
+  static uint64_t models_made;
+  m->serial = __atomic_add_fetch(&models_made, 1, __ATOMIC_RELAXED) << 40;
   term_set_init(&m->terms, sc);
   size_t ns = sp->n_segments ? sp->n_segments : 1;
   m->seg_len = malloc(ns * sizeof *m->seg_len);
@@ -575,6 +585,7 @@ double lw_model_total(const lw_model *m)
 lw_status lw_model_refresh(lw_model *m, double *drift)
 {
   if (lw_model_compact(m) != LW_OK) return LW_ENOMEM;
+  state_changed(m);
   const lw_scene *sc = m->scene;
   const lw_splines *sp = m->sp;
   const lw_term_set *ts = &m->terms;
@@ -646,13 +657,25 @@ lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err)
     p->ps = malloc(ns * sizeof *p->ps);
     p->ps_old = malloc(ns * sizeof *p->ps_old);
     p->probe = malloc(2 * ns * sizeof *p->probe);
+    p->walked = malloc(2 * ns * sizeof *p->walked);
+    p->walked_id = malloc(2 * ns * sizeof *p->walked_id);
+    p->each = malloc(2 * ns * sizeof *p->each);
+    p->stand = malloc(2 * ns * sizeof *p->stand);
+    p->seg_sum = malloc(4 * cap * sizeof *p->seg_sum);
+    p->memo.spline = UINT32_MAX;
+    p->memo.ok = calloc(cap, sizeof *p->memo.ok);
+    p->memo.far = malloc(cap * sizeof *p->memo.far);
+    p->memo.stand = malloc(cap * sizeof *p->memo.stand);
+    p->memo.partners = calloc(cap, sizeof *p->memo.partners);
+    p->side = calloc(2 * cap, sizeof *p->side);
     p->near_new = malloc(cap * sizeof *p->near_new);
     p->seg_irregular = malloc(cap * sizeof *p->seg_irregular);
     p->spline_seg_len = malloc(cap * sizeof *p->spline_seg_len);
     for (int t = 0; t < LW_TERM_COUNT; t++) p->sum_term[t] = -0.0;
   }
-  if (!p || !p->node || !p->len || !p->local || !p->ps || !p->ps_old || !p->probe || !p->near_new ||
-      !p->seg_irregular || !p->spline_seg_len) {
+  if (!p || !p->node || !p->len || !p->local || !p->ps || !p->ps_old || !p->probe || !p->walked ||
+      !p->walked_id || !p->each || !p->stand || !p->seg_sum || !p->memo.ok || !p->memo.far || !p->memo.stand ||
+      !p->memo.partners || !p->side || !p->near_new || !p->seg_irregular || !p->spline_seg_len) {
     lw_proposal_free(p);
     lw_error_set(err, LW_ENOMEM, "out of memory for a proposal");
     return NULL;
@@ -669,6 +692,18 @@ void lw_proposal_free(lw_proposal *p)
   free(p->ps);
   free(p->ps_old);
   free(p->probe);
+  free(p->walked);
+  free(p->walked_id);
+  free(p->each);
+  free(p->stand);
+  free(p->seg_sum);
+  for (size_t k = 0; p->memo.partners && k < p->cap_seg; k++) free(p->memo.partners[k].idx);
+  free(p->memo.partners);
+  for (size_t k = 0; p->side && k < 2 * p->cap_seg; k++) free(p->side[k].idx);
+  free(p->side);
+  free(p->memo.ok);
+  free(p->memo.far);
+  free(p->memo.stand);
   lw_pair_nearlist_free(&p->near);
   free(p->segs.idx);
   free(p->partners.idx);
@@ -686,21 +721,25 @@ static inline const lw_node *proposed_node(const lw_node *base, const lw_proposa
   return (k >= p->node0 && k < p->node0 + p->n_node) ? &p->node[k - p->node0] : &base[k];
 }
 
-/* The sorted segments of the near pairs of probes that are samples of
-** changed segment j on one side (old: 1, new: 0); probe k is new sample k/2
-** for even k, its old self for odd k. */
-static lw_status near_segments(const lw_proposal *p, uint32_t np, size_t j, int old, lw_near_list *segs)
+/* p->side: the sorted segments of the near pairs of each changed segment j,
+** new (2j) and old (2j + 1); probe k is new sample k/2 for even k, its old
+** self for odd k, so probe / np is just that list's number. */
+static lw_status side_partners(lw_proposal *p, uint32_t np)
 {
-  /* probe 2 (j np + q) + old is sample q of segment j, new (0) or old (1):
-  ** a range test, no division, for the pairs of other segments */
-  const uint32_t lo = 2 * (uint32_t)j * np, hi = lo + 2 * np;
-  segs->n = 0;
+  for (size_t j = 0; j < 2 * p->n_seg; j++) p->side[j].n = 0;
   for (size_t k = 0; k < p->near.n; k++) {
     const lw_pair_near *q = &p->near.pair[k];
-    if ((int)(q->probe & 1) != old || q->probe < lo || q->probe >= hi) continue;
-    if (set_insert(segs, q->idx / np) != LW_OK) return LW_ENOMEM;
+    const uint32_t js = 2 * (q->probe / 2 / np) + (q->probe & 1);
+    if (set_insert(&p->side[js], q->idx / np) != LW_OK) return LW_ENOMEM;
   }
   return LW_OK;
+}
+
+static void list_swap(lw_near_list *a, lw_near_list *b)
+{
+  const lw_near_list t = *a;
+  *a = *b;
+  *b = t;
 }
 
 /* The near field of old segment g (from node a to a + 1, samples ps, near
@@ -730,28 +769,64 @@ static double old_near(const lw_model *m, const pair_view *v, size_t g, const lw
   return m->near_cache[g];
 }
 
-/* Adds p->segs to p->partners (the near fields a commit invalidates). */
-static lw_status add_partners(lw_proposal *p)
+/* Adds segs to p->partners (the near fields a commit invalidates). */
+static lw_status add_partners(lw_proposal *p, const lw_near_list *segs)
 {
-  for (size_t k = 0; k < p->segs.n; k++)
-    if (list_push(&p->partners, p->segs.idx[k]) != LW_OK) return LW_ENOMEM;
+  for (size_t k = 0; k < segs->n; k++)
+    if (list_push(&p->partners, segs->idx[k]) != LW_OK) return LW_ENOMEM;
   return LW_OK;
 }
 
 /*
+** What the first stage of delayed acceptance sees in place of a move's near
+** field: the walk's near sample pairs as the product rule sums them, each
+** distance held at half its near radius or more (so it stays finite where
+** samples meet), new pairs added and old ones taken away.  No curve
+** integrals; a function of the two states, which is all the first stage
+** needs: how closely it follows the near field only sets how few of the
+** moves that pass it the second stage refuses.  One near pair's term (+1):
+*/
+static double near_stand_in(const lw_pair_ctx *ctx, const lw_pair_probe *P, const lw_pair_near *q)
+{
+  const double dx = P->x - q->x, dy = P->y - q->y;
+  double r2 = dx * dx + dy * dy;
+  if (P->dl == 0.0f || q->dl == 0.0f || r2 >= ctx->cutoff2) return 0.0;
+  const double floor2 = 0.25 * lw_pair_near_radius2(ctx, P->dl, q->dl);
+  if (r2 < floor2) r2 = floor2;
+  return (double)P->dl * (double)q->dl * (1.0 / sqrt(r2) - ctx->inv_cutoff);
+}
+
+/* Starts p's memo afresh for spline s of m in its current state. */
+static void memo_reset(lw_far_memo *mo, const lw_model *m, uint32_t s)
+{
+  mo->model = m;
+  mo->spline = s;
+  mo->serial = __atomic_load_n(&m->serial, __ATOMIC_RELAXED);
+  memset(mo->ok, 0, m->max_segments * sizeof *mo->ok);
+}
+
+/*
 ** The pair part of a proposal's dE (no coefficient) comes in two steps.
-** pair_walk: one walk over the new samples (+1) and their old selves (-1)
-** gives the far pairs and lists the near ones in p->near.  pair_near_delta:
-** the near field of each changed segment is added for the new side, and
-** taken away for the old side from the model's cache when valid.  The near
-** field is the costly part and a chain at low temperature rejects most
-** proposals, so caching the old side halves it, and delayed acceptance
+** pair_walk: one walk over the new samples and their old selves gives each
+** sample's far sum (with the sample's weight, +1 either side) and lists the
+** near sample pairs in p->near; each changed segment's far sum and stand-in
+** are summed from its samples', new less old.  pair_near_delta: the near
+** field of each changed segment is added for the new side, and taken away
+** for the old side from the model's cache when valid.  The near field is the
+** costly part and a chain at low temperature rejects most proposals, so
+** caching the old side halves it, and delayed acceptance
 ** (lw_model_propose_finish) leaves the new side to the proposals that pass
 ** a first test.  The cached value of a segment is what this code computes
 ** for it from the current state (the same sum in the same order), so a
 ** cached and a recomputed value are bitwise equal; commits invalidate every
 ** segment whose near field the move changed (its near partners before and
-** after), kept in p->partners.  NAN if out of memory.
+** after), kept in p->partners.
+**
+** The old side's walk is skipped for a segment the memo holds (lw_far_memo:
+** in a sweep, the one the previous move shared): a sample's far sum and the
+** order of its near pairs depend on it and the other splines' samples only
+** (walk.h), so the memo's sums are bit for bit what the walk would give.
+** NAN if out of memory.
 */
 static double pair_walk(const lw_model *m, lw_proposal *p)
 {
@@ -759,17 +834,72 @@ static double pair_walk(const lw_model *m, lw_proposal *p)
   const uint32_t np = (uint32_t)sc->pair_quad.n;
   const pair_view v = {m->grid, m->sp, np, &sc->pair};
   const size_t n = p->n_seg * np;
-  /* the new samples add their pairs, the old ones take theirs away: one walk
-  ** over both, each new sample next to its old self (usually in the same
-  ** cell: shorter moves in the walk's sort by cell) */
+  lw_far_memo *mo = &p->memo;
+  p->walk_done = 0;
+  if (mo->model != m || mo->spline != p->spline || mo->serial != __atomic_load_n(&m->serial, __ATOMIC_RELAXED))
+    memo_reset(mo, m, p->spline);
+  /* each new sample next to its old self (usually in the same cell: shorter
+  ** moves in the walk's sort by cell), the old ones of the memo's segments
+  ** left out */
+  size_t nw = 0;
   for (size_t k = 0; k < 2 * n; k++) {
     const lw_pair_sample *ps_k = k & 1 ? &p->ps_old[k / 2] : &p->ps[k / 2];
-    p->probe[k] = (lw_pair_probe){ps_k->x, ps_k->y, ps_k->dl, k & 1 ? -1.0 : 1.0};
+    p->probe[k] = (lw_pair_probe){ps_k->x, ps_k->y, ps_k->dl, 1.0};
+    if ((k & 1) && mo->ok[p->seg0 + k / 2 / np]) continue;
+    p->walked[nw] = p->probe[k];
+    p->walked_id[nw++] = (uint32_t)k;
   }
+  p->n_walked = nw;
   lw_pair_filter f = filter_of(&v, p->spline, 0);
-  double pe;
+  double all;
   p->near.n = 0;
-  if (lw_pair_walk(m->grid, &sc->pair, p->probe, 2 * n, &f, &pe, &p->near, NULL) != LW_OK) return NAN;
+  if (lw_pair_walk(m->grid, &sc->pair, p->walked, nw, &f, &all, p->stand, &p->near, NULL) != LW_OK) {
+    memo_reset(mo, m, p->spline);
+    return NAN;
+  }
+  for (size_t i = nw; i-- > 0;) p->each[p->walked_id[i]] = p->stand[i]; /* walked_id[i] >= i */
+  for (size_t i = 0; i < nw; i++) p->stand[p->walked_id[i]] = 0.0;
+  for (size_t k = 0; k < p->near.n; k++) {
+    lw_pair_near *q = &p->near.pair[k];
+    q->probe = p->walked_id[q->probe];
+    p->stand[q->probe] += near_stand_in(&sc->pair, &p->probe[q->probe], q);
+  }
+  if (side_partners(p, np) != LW_OK) {
+    memo_reset(mo, m, p->spline);
+    return NAN;
+  }
+  double pe = 0.0, stand = 0.0;
+  p->any_near = p->near.n > 0;
+  for (size_t j = 0; j < p->n_seg; j++) {
+    const size_t k = p->seg0 + j;
+    double *sum = p->seg_sum + 4 * j;
+    for (int side = 0; side < 2; side++) {
+      if (side && mo->ok[k]) {
+        sum[2] = mo->far[k];
+        sum[3] = mo->stand[k];
+        p->any_near |= mo->partners[k].n > 0;
+        continue;
+      }
+      double fs = 0.0, ss = 0.0;
+      for (size_t q = 0; q < np; q++) {
+        fs += p->each[2 * (j * np + q) + (size_t)side];
+        ss += p->stand[2 * (j * np + q) + (size_t)side];
+      }
+      sum[2 * side] = fs;
+      sum[2 * side + 1] = ss;
+    }
+    if (!mo->ok[k]) {
+      /* the old side, for the moves to come while the state stays */
+      list_swap(&mo->partners[k], &p->side[2 * j + 1]);
+      mo->far[k] = sum[2];
+      mo->stand[k] = sum[3];
+      mo->ok[k] = 1;
+    }
+    pe += sum[0] - sum[2];
+    stand += sum[1] - sum[3];
+  }
+  p->stand_in = stand;
+  p->walk_done = 1;
   return pe;
 }
 
@@ -784,40 +914,17 @@ static double pair_near_delta(const lw_model *m, lw_proposal *p, const lw_node *
   for (size_t j = 0; j < p->n_seg; j++) {
     size_t g = g0 + p->seg0 + j;
     double bez[8];
-    if (near_segments(p, np, j, 0, &p->segs) != LW_OK) return NAN;
+    const lw_near_list *now = &p->side[2 * j];
     lw_segment_bezier(proposed_node(base, p, p->seg0 + j), proposed_node(base, p, p->seg0 + j + 1), bez);
-    p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs, (uint32_t)g, &p->near_vals);
+    p->near_new[j] = near_part(&v, bez, p->ps + j * np, now, (uint32_t)g, &p->near_vals);
     pe += p->near_new[j];
-    if (add_partners(p) != LW_OK || near_segments(p, np, j, 1, &p->segs) != LW_OK) return NAN;
-    pe -= old_near(m, &v, g, &base[p->seg0 + j], p->ps_old + j * np, &p->segs);
-    if (add_partners(p) != LW_OK) return NAN;
+    if (add_partners(p, now) != LW_OK) return NAN;
+    /* the old side's partners: the memo's (pair_walk filled it) */
+    const lw_near_list *old = &p->memo.partners[p->seg0 + j];
+    pe -= old_near(m, &v, g, &base[p->seg0 + j], p->ps_old + j * np, old);
+    if (add_partners(p, old) != LW_OK) return NAN;
   }
   return pe;
-}
-
-/*
-** What the first stage of delayed acceptance sees in place of a move's near
-** field: the walk's near sample pairs as the product rule sums them, each
-** distance held at half its near radius or more (so it stays finite where
-** samples meet), new pairs added and old ones taken away.  No curve
-** integrals; a function of the two states, which is all the first stage
-** needs: how closely it follows the near field only sets how few of the
-** moves that pass it the second stage refuses.
-*/
-static double near_stand_in(const lw_pair_ctx *ctx, const lw_pair_probe *probe, const lw_pair_nearlist *near)
-{
-  double sum = 0.0;
-  for (size_t k = 0; k < near->n; k++) {
-    const lw_pair_near *q = &near->pair[k];
-    const lw_pair_probe *P = &probe[q->probe];
-    const double dx = P->x - q->x, dy = P->y - q->y;
-    double r2 = dx * dx + dy * dy;
-    if (P->dl == 0.0f || q->dl == 0.0f || r2 >= ctx->cutoff2) continue;
-    const double floor2 = 0.25 * lw_pair_near_radius2(ctx, P->dl, q->dl);
-    if (r2 < floor2) r2 = floor2;
-    sum += P->scale * (double)P->dl * (double)q->dl * (1.0 / sqrt(r2) - ctx->inv_cutoff);
-  }
-  return sum;
 }
 
 /* How many pairs of one of the n samples ps and a sample of another spline
@@ -973,12 +1080,12 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
     double pe = pair_walk(m, p);
     /* (a move out of an irregular state, dE = -inf, is taken whatever the
     ** pair part: nothing to defer) */
-    if (p->defer_near && p->near.n && !isnan(pe) && isfinite(dE)) {
+    if (p->defer_near && !isnan(pe) && p->any_near && isfinite(dE)) {
       /* the near field waits for lw_model_propose_finish: a stand-in here */
       p->near_pending = 1;
       p->pe_walk = pe;
       p->dE_pre_pair = dE;
-      p->dterm[ts->pair] = pc->coef * (pe + near_stand_in(&sc->pair, p->probe, &p->near));
+      p->dterm[ts->pair] = pc->coef * (pe + p->stand_in);
     } else {
       if (!isnan(pe)) pe = pair_near_delta(m, p, base, g0, pe);
       p->pair_done = !isnan(pe);
@@ -1019,6 +1126,23 @@ double lw_model_propose_finish(const lw_model *m, lw_proposal *p)
 
 static lw_status commit_splice(lw_model *m, const lw_proposal *p);
 
+/* The memo after p's move, committed as serial: the moved segments hold the
+** walk's new side; the spline's others keep theirs if no other change came
+** between (serial - 1 is the state the move was proposed in). */
+static void memo_commit(const lw_model *m, lw_proposal *p, uint64_t serial)
+{
+  lw_far_memo *mo = &p->memo;
+  if (mo->model != m || mo->spline != p->spline || mo->serial != serial - 1) memo_reset(mo, m, p->spline);
+  mo->serial = serial;
+  for (size_t j = 0; j < p->n_seg; j++) {
+    const size_t k = p->seg0 + j;
+    mo->ok[k] = (unsigned char)p->walk_done;
+    list_swap(&mo->partners[k], &p->side[2 * j]);
+    mo->far[k] = p->seg_sum[4 * j];
+    mo->stand[k] = p->seg_sum[4 * j + 1];
+  }
+}
+
 /* The commit without the running totals (model.h): everything but m->term
 ** and m->n_irregular, whose changes go into p's own sums.  Moves only: a
 ** splice is committed whole by lw_model_commit. */
@@ -1041,6 +1165,8 @@ lw_status lw_model_commit_part(lw_model *m, lw_proposal *p)
       }
   }
   memcpy(&sp->node[sp->first[p->spline] + p->node0], p->node, p->n_node * sizeof *p->node);
+  const uint64_t serial = state_changed(m);
+  if (m->grid) memo_commit(m, p, serial);
   if (m->grid) {
     if (p->pair_done) {
       /* A partner may be shared with a move in another domain (domains.h):
@@ -1237,7 +1363,7 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p)
   double pe;
   p->near.n = 0;
   p->partners.n = 0;
-  if (lw_pair_walk(m->grid, &sc->pair, p->probe, nn + no, &f, &pe, &p->near, NULL) != LW_OK) return NAN;
+  if (lw_pair_walk(m->grid, &sc->pair, p->probe, nn + no, &f, &pe, NULL, &p->near, NULL) != LW_OK) return NAN;
   for (size_t j = 0; j < p->n_seg; j++) {
     double bez[8];
     const size_t a = splice_seg_node(p, j);
@@ -1245,7 +1371,7 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p)
     lw_segment_bezier(&p->node[a], &p->node[a + 1], bez);
     p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs, 0, NULL);
     pe += p->near_new[j];
-    if (add_partners(p) != LW_OK) return NAN;
+    if (add_partners(p, &p->segs) != LW_OK) return NAN;
   }
   for (int k = 0, o = 0; k < p->n_old; k++) {
     const size_t g0 = lw_segment_index(m->sp, p->old[k], 0);
@@ -1260,7 +1386,7 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p)
         lw_segment_bezier(&nd[j], &nd[j + 1], bez);
         pe -= near_part(&v, bez, ps, &p->segs, 0, NULL);
       }
-      if (add_partners(p) != LW_OK) return NAN;
+      if (add_partners(p, &p->segs) != LW_OK) return NAN;
     }
   }
   if (p->n_new == 2) {
@@ -1520,6 +1646,7 @@ static lw_status cache_room(lw_model *m, size_t n_seg, size_t n_spl)
 */
 static lw_status commit_splice(lw_model *m, const lw_proposal *p)
 {
+  state_changed(m);
   lw_splines *sp = m->sp;
   const int np = pair_nodes(m), nl = m->scene->n_local;
   long slot[2] = {-1, -1};
@@ -1619,6 +1746,7 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
 lw_status lw_model_compact(lw_model *m)
 {
   if (!m->slots || !m->slots->n_ghost) return LW_OK;
+  state_changed(m);
   lw_splines *sp = m->sp;
   const size_t ns = sp->n_segments, n_old = sp->n_splines;
   const int np = pair_nodes(m), nl = m->scene->n_local;

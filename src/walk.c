@@ -87,20 +87,16 @@ typedef struct {
   v2d near2;      /* (near_scale dl)^2: a pair is near within the larger of its two */
   v2d scale;      /* scale dl: the factor on this probe's far pairs' dl_j (1/r - 1/rc) */
   double gx[3], gy[3]; /* squared gaps to the columns and rows of the block (axis_gaps) */
+  v2d s0, s1;     /* its far sum: entries 0, 1 and 2, 3 of each group of four */
 } probe_ctx;
 
 /* What every probe of a walk shares: the near scale and the cutoff. */
 typedef struct {
   v2d ns;         /* near_scale */
   v2d cut2;       /* rc^2: near pairs lie within the cutoff too */
+  v2d ic;         /* 1 / rc (0 without a cutoff) */
 } shared_ctx;
 
-/* The far sum of a walk: two accumulators of two lanes (entries 0, 1 and
-** 2, 3 of each group of four), which hide the divider's latency. */
-typedef struct {
-  v2d s0, s1;
-  v2d ic;
-} far_acc;
 
 /* The near pairs a scan of entries k0 on of cell c marked (bit t of
 ** near_bits[b]: entry k0 + t with probe b), in the order of the probes and
@@ -123,7 +119,7 @@ static inline __attribute__((always_inline)) void append_near(const lw_cell *c, 
 
 /*
 ** Entries [k0, k1) of cell c, k1 - k0 <= BLOCK, against the probes of
-** `mask` (bits into pc): far pairs go to fa, near ones to the near list
+** `mask` (bits into pc): far pairs go to each probe's sums, near ones to the near list
 ** (room for (k1 - k0) times the probes is there).  Four entries at a time
 ** (two SSE2 vectors of doubles, one of 32-bit lanes): what depends on the
 ** entries alone (loads, weights) once, the distances per probe.  The
@@ -134,17 +130,18 @@ static inline __attribute__((always_inline)) void append_near(const lw_cell *c, 
 ** a constant at each call, so the common scan carries no near test.
 */
 static inline __attribute__((always_inline)) void
-scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const probe_ctx *pc, unsigned mask,
-     const uint32_t *probe_id, far_acc *fa, lw_pair_nearlist *near, const int with_near)
+scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx *pc, unsigned mask,
+     const uint32_t *probe_id, lw_pair_nearlist *near, const int with_near)
 {
-  uint64_t near_bits[LW_PAIR_BATCH] = {0};
+  uint64_t near_bits[LW_PAIR_CHUNK]; /* those of the probes in mask only */
+  if (with_near)
+    for (unsigned left = mask; left; left &= left - 1) near_bits[__builtin_ctz(left)] = 0;
   unsigned any = 0; /* some near pair: append_near has work */
   const double *xs = c->x, *ys = lw_cell_y(c);
   const float *dls = lw_cell_dl(c);
   const v4f zero = {0.0f, 0.0f, 0.0f, 0.0f};
   const v4i lane = {0, 1, 2, 3};
   const v2d one = {1.0, 1.0};
-  v2d s0 = fa->s0, s1 = fa->s1;
   for (uint32_t k = k0, t = 0; k < k1; k += 4, t += 4) {
     v4f dlj;
     memcpy(&dlj, dls + k, sizeof dlj);
@@ -165,7 +162,7 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
     const v2d a = vmax(a0, a1), mg = vmax(a, (v2d){a[1], a[0]});
     for (unsigned left = mask; left; left &= left - 1) {
       unsigned b = (unsigned)__builtin_ctz(left);
-      const probe_ctx *q = &pc[b];
+      probe_ctx *q = &pc[b];
       v2d dx0 = x0 - q->x, dx1 = x1 - q->x, dy0 = y0 - q->y, dy1 = y1 - q->y;
       v2d r0 = dx0 * dx0 + dy0 * dy0, r1 = dx1 * dx1 + dy1 * dy1;
       v2l f0 = (r0 < q->rc2) & ok0, f1 = (r1 < q->rc2) & ok1;
@@ -180,14 +177,12 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
         any |= found;
       }
       if (bits2(f0 | f1)) {
-        v2d v0 = (w0 * q->scale) * (one / lw_vsqrt2(r0) - fa->ic), v1 = (w1 * q->scale) * (one / lw_vsqrt2(r1) - fa->ic);
-        s0 += (v2d)((v2l)v0 & f0);
-        s1 += (v2d)((v2l)v1 & f1);
+        v2d v0 = (w0 * q->scale) * (one / lw_vsqrt2(r0) - sh->ic), v1 = (w1 * q->scale) * (one / lw_vsqrt2(r1) - sh->ic);
+        q->s0 += (v2d)((v2l)v0 & f0);
+        q->s1 += (v2d)((v2l)v1 & f1);
       }
     }
   }
-  fa->s0 = s0;
-  fa->s1 = s1;
   if (with_near && any) append_near(c, k0, mask, probe_id, near_bits, near);
 }
 
@@ -196,22 +191,23 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const pro
 
 /*
 ** scan four entries a vector (AVX2): each lane computed as scan computes it,
-** and the far terms of entries 0, 1 and 2, 3 added to fa's accumulators s0
+** and the far terms of entries 0, 1 and 2, 3 added to the probe's accumulators s0
 ** and s1 as there, so the same bits (vec2.h).  A maximum over lanes is
 ** exact in any order.
 */
 static inline __attribute__((always_inline, target("avx2"))) void
-scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, const probe_ctx *pc, unsigned mask,
-               const uint32_t *probe_id, far_acc *fa, lw_pair_nearlist *near, const int with_near)
+scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx *pc, unsigned mask,
+               const uint32_t *probe_id, lw_pair_nearlist *near, const int with_near)
 {
-  uint64_t near_bits[LW_PAIR_BATCH] = {0};
+  uint64_t near_bits[LW_PAIR_CHUNK]; /* those of the probes in mask only */
+  if (with_near)
+    for (unsigned left = mask; left; left &= left - 1) near_bits[__builtin_ctz(left)] = 0;
   unsigned any = 0;
   const double *xs = c->x, *ys = lw_cell_y(c);
   const float *dls = lw_cell_dl(c);
   const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
   const __m256d one = _mm256_set1_pd(1.0), ns = _mm256_set1_pd(sh->ns[0]), cut2 = _mm256_set1_pd(sh->cut2[0]);
-  const __m256d ic = _mm256_set1_pd(fa->ic[0]);
-  __m128d s0 = (__m128d)fa->s0, s1 = (__m128d)fa->s1;
+  const __m256d ic = _mm256_set1_pd(sh->ic[0]);
   for (uint32_t k = k0, t = 0; k < k1; k += 4, t += 4) {
     const __m128 dlj = _mm_loadu_ps(dls + k);
     const __m128i in_block = _mm_cmpgt_epi32(_mm_set1_epi32((int)(k1 - k)), lane); /* not past k1 */
@@ -224,7 +220,7 @@ scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh,
     const __m256d mg = _mm256_max_pd(a2, _mm256_permute_pd(a2, 0x5));
     for (unsigned left = mask; left; left &= left - 1) {
       unsigned b = (unsigned)__builtin_ctz(left);
-      const probe_ctx *q = &pc[b];
+      probe_ctx *q = &pc[b];
       const __m256d dx = _mm256_sub_pd(x, _mm256_set1_pd(q->x[0])), dy = _mm256_sub_pd(y, _mm256_set1_pd(q->y[0]));
       const __m256d r = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
       const __m256d near2 = _mm256_set1_pd(q->near2[0]);
@@ -241,29 +237,26 @@ scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh,
       if (_mm256_movemask_pd(f)) {
         const __m256d inv = _mm256_sub_pd(_mm256_div_pd(one, _mm256_sqrt_pd(r)), ic);
         const __m256d v = _mm256_and_pd(_mm256_mul_pd(_mm256_mul_pd(w, _mm256_set1_pd(q->scale[0])), inv), f);
-        s0 = _mm_add_pd(s0, _mm256_castpd256_pd128(v));
-        s1 = _mm_add_pd(s1, _mm256_extractf128_pd(v, 1));
+        q->s0 = (v2d)_mm_add_pd((__m128d)q->s0, _mm256_castpd256_pd128(v));
+        q->s1 = (v2d)_mm_add_pd((__m128d)q->s1, _mm256_extractf128_pd(v, 1));
       }
     }
   }
-  fa->s0 = (v2d)s0;
-  fa->s1 = (v2d)s1;
   if (with_near && any) append_near(c, k0, mask, probe_id, near_bits, near);
 }
 
 __attribute__((target("avx2"))) static void scan_wide_near(const lw_cell *c, uint32_t k0, uint32_t k1,
-                                                           const shared_ctx *sh, const probe_ctx *pc, unsigned mask,
-                                                           const uint32_t *probe_id, far_acc *fa,
-                                                           lw_pair_nearlist *near)
+                                                           const shared_ctx *sh, probe_ctx *pc, unsigned mask,
+                                                           const uint32_t *probe_id, lw_pair_nearlist *near)
 {
-  scan_wide_body(c, k0, k1, sh, pc, mask, probe_id, fa, near, 1);
+  scan_wide_body(c, k0, k1, sh, pc, mask, probe_id, near, 1);
 }
 
 __attribute__((target("avx2"))) static void scan_wide_far(const lw_cell *c, uint32_t k0, uint32_t k1,
-                                                          const shared_ctx *sh, const probe_ctx *pc, unsigned mask,
-                                                          const uint32_t *probe_id, far_acc *fa)
+                                                          const shared_ctx *sh, probe_ctx *pc, unsigned mask,
+                                                          const uint32_t *probe_id)
 {
-  scan_wide_body(c, k0, k1, sh, pc, mask, probe_id, fa, NULL, 0);
+  scan_wide_body(c, k0, k1, sh, pc, mask, probe_id, NULL, 0);
 }
 #endif
 
@@ -346,94 +339,135 @@ static void cell_ranges(const lw_cell *c, const lw_pair_filter *f, uint32_t r[6]
   r[2] = idx[n - 1] < f->hi ? n : first_from(idx + l, n - l, f->hi) + l;
 }
 
-/* The probes sel[0..nb-1] of P, all in cell (cx, cy): one pass over its
-** 3 x 3 block.  *visited (NULL: not counted) counts entries scanned times the probes that
-** scan them. */
-static lw_status walk_batch(const lw_cellgrid *g, const lw_pair_ctx *ctx, const shared_ctx *sh,
-                            const lw_pair_probe *P, const uint32_t *sel, int nb, int cx, int cy,
-                            const lw_pair_filter *f, int wide, far_acc *fa, lw_pair_nearlist *near,
-                            uint64_t *visited)
+/* Cells a group of probes may span (the union of their 3 x 3 blocks): a
+** proposal's probes lie within a few cells of each other. */
+#define BOX_MAX 256
+
+/* The box of cells around probe cells [x0, x1] x [y0, y1]: the grid's cells
+** within one of them. */
+typedef struct {
+  int x0, y0, w, h;
+} box;
+
+static box box_around(const lw_cellgrid *g, int x0, int x1, int y0, int y1)
 {
-  probe_ctx pc[LW_PAIR_BATCH];
+  box b;
+  b.x0 = x0 > 0 ? x0 - 1 : 0;
+  b.y0 = y0 > 0 ? y0 - 1 : 0;
+  b.w = (x1 + 1 < g->nx ? x1 + 1 : g->nx - 1) - b.x0 + 1;
+  b.h = (y1 + 1 < g->ny ? y1 + 1 : g->ny - 1) - b.y0 + 1;
+  return b;
+}
+
+/* The probes sel[0..nb-1] of P (nb <= LW_PAIR_CHUNK, cells cx[], cy[]),
+** whose cells' 3 x 3 blocks lie in box bx: one pass over the box's cells in
+** the grid's order, each cell read once for every probe whose block holds
+** it and whose gap to it is within the cutoff.  So each probe meets its
+** cells in the grid's order and their entries in theirs, whatever the
+** others.  Each probe's far sum goes to sum[sel[b] - base].  *visited (NULL:
+** not counted) counts entries scanned times the probes that scan them. */
+static lw_status walk_group(const lw_cellgrid *g, const lw_pair_ctx *ctx, const shared_ctx *sh,
+                            const lw_pair_probe *P, const uint32_t *sel, int nb, const int *cx, const int *cy,
+                            box bx, const lw_pair_filter *f, int wide, double *sum, size_t base,
+                            lw_pair_nearlist *near, uint64_t *visited)
+{
+  probe_ctx pc[LW_PAIR_CHUNK];
+  uint32_t mask[BOX_MAX];
   const double h = 1.0 / g->inv_h, skip2 = ctx->cutoff2 * GAP_MARGIN;
   const int with_near = ctx->near_scale > 0.0;
+  memset(mask, 0, (size_t)(bx.w * bx.h) * sizeof *mask);
   for (int b = 0; b < nb; b++) {
     const lw_pair_probe *p = &P[sel[b]];
     /* a weightless probe has no far pairs (its kernel is 0, even at r = 0) */
     const double rc2 = p->dl != 0.0f ? ctx->cutoff2 : -1.0, l = ctx->near_scale * (double)p->dl;
     pc[b] = (probe_ctx){{p->x, p->x}, {p->y, p->y}, {rc2, rc2}, {p->dl, p->dl, p->dl, p->dl}, {l * l, l * l},
-                        {p->scale * (double)p->dl, p->scale * (double)p->dl}, {0}, {0}};
-    axis_gaps(g->x0, h, cx, p->x, pc[b].gx);
-    axis_gaps(g->y0, h, cy, p->y, pc[b].gy);
+                        {p->scale * (double)p->dl, p->scale * (double)p->dl}, {0}, {0}, {0.0, 0.0}, {0.0, 0.0}};
+    axis_gaps(g->x0, h, cx[b], p->x, pc[b].gx);
+    axis_gaps(g->y0, h, cy[b], p->y, pc[b].gy);
+    for (int dy = -1; dy <= 1; dy++) {
+      const int y = cy[b] + dy;
+      if (y < 0 || y >= g->ny) continue;
+      for (int dx = -1; dx <= 1; dx++) {
+        const int x = cx[b] + dx;
+        if (x < 0 || x >= g->nx || pc[b].gx[dx + 1] + pc[b].gy[dy + 1] > skip2) continue;
+        mask[(y - bx.y0) * bx.w + (x - bx.x0)] |= 1u << b;
+      }
+    }
   }
-  const int x0 = cx > 0 ? cx - 1 : 0, x1 = cx + 1 < g->nx ? cx + 1 : g->nx - 1;
-  const int y0 = cy > 0 ? cy - 1 : 0, y1 = cy + 1 < g->ny ? cy + 1 : g->ny - 1;
-  for (int y = y0; y <= y1; y++) {
-    const lw_cell *row = g->cell + (size_t)y * (size_t)g->nx;
-    for (int x = x0; x <= x1; x++) {
+  for (int y = 0; y < bx.h; y++) {
+    const lw_cell *row = g->cell + (size_t)(bx.y0 + y) * (size_t)g->nx + (size_t)bx.x0;
+    for (int x = 0; x < bx.w; x++) {
+      const unsigned m = mask[y * bx.w + x];
       const lw_cell *c = row + x;
-      if (!c->n) continue;
-      unsigned mask = 0;
-      for (int b = 0; b < nb; b++)
-        if (pc[b].gx[x - cx + 1] + pc[b].gy[y - cy + 1] <= skip2) mask |= 1u << b;
-      if (!mask) continue;
+      if (!m || !c->n) continue;
       uint32_t r[6];
       cell_ranges(c, f, r);
       for (int run = 0; run < 6; run += 2) {
-        if (visited) *visited += (uint64_t)(r[run + 1] - r[run]) * (uint64_t)__builtin_popcount(mask);
+        if (visited) *visited += (uint64_t)(r[run + 1] - r[run]) * (uint64_t)__builtin_popcount(m);
         for (uint32_t k0 = r[run]; k0 < r[run + 1]; k0 += BLOCK) {
           uint32_t k1 = r[run + 1] - k0 > BLOCK ? k0 + BLOCK : r[run + 1];
           if (with_near && l_unlikely(nearlist_reserve(near, (size_t)(k1 - k0) * (size_t)nb) != LW_OK))
             return LW_ENOMEM;
 #if LW_VEC_HAVE_WIDE
           if (wide) {
-            if (with_near) scan_wide_near(c, k0, k1, sh, pc, mask, sel, fa, near);
-            else scan_wide_far(c, k0, k1, sh, pc, mask, sel, fa);
+            if (with_near) scan_wide_near(c, k0, k1, sh, pc, m, sel, near);
+            else scan_wide_far(c, k0, k1, sh, pc, m, sel);
             continue;
           }
 #endif
-          if (with_near) scan(c, k0, k1, sh, pc, mask, sel, fa, near, 1);
-          else scan(c, k0, k1, sh, pc, mask, sel, fa, NULL, 0);
+          if (with_near) scan(c, k0, k1, sh, pc, m, sel, near, 1);
+          else scan(c, k0, k1, sh, pc, m, sel, NULL, 0);
         }
       }
     }
+  }
+  for (int b = 0; b < nb; b++) {
+    const v2d t = pc[b].s0 + pc[b].s1;
+    sum[sel[b] - base] = t[0] + t[1];
   }
   return LW_OK;
 }
 
 lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pair_probe *P, size_t n,
-                       const lw_pair_filter *f, double *far, lw_pair_nearlist *near, uint64_t *visited)
+                       const lw_pair_filter *f, double *far, double *each, lw_pair_nearlist *near,
+                       uint64_t *visited)
 {
-  const shared_ctx sh = {{ctx->near_scale, ctx->near_scale}, {ctx->cutoff2, ctx->cutoff2}};
-  far_acc fa = {{0.0, 0.0}, {0.0, 0.0}, {ctx->inv_cutoff, ctx->inv_cutoff}};
+  const shared_ctx sh = {{ctx->near_scale, ctx->near_scale},
+                         {ctx->cutoff2, ctx->cutoff2},
+                         {ctx->inv_cutoff, ctx->inv_cutoff}};
   uint64_t seen = 0;
   const int wide = lw_vec_wide();
+  double total = 0.0;
   *far = 0.0;
   for (size_t c0 = 0; c0 < n; c0 += LW_PAIR_CHUNK) {
-    /* the chunk's probes in order of their cell (stable), so that each run
-    ** of one cell is one batch */
-    uint32_t cell[LW_PAIR_CHUNK], sel[LW_PAIR_CHUNK];
-    int nc = n - c0 < LW_PAIR_CHUNK ? (int)(n - c0) : LW_PAIR_CHUNK;
+    uint32_t sel[LW_PAIR_CHUNK];
+    int cx[LW_PAIR_CHUNK], cy[LW_PAIR_CHUNK];
+    double sum[LW_PAIR_CHUNK];
+    const int nc = n - c0 < LW_PAIR_CHUNK ? (int)(n - c0) : LW_PAIR_CHUNK;
     for (int i = 0; i < nc; i++) {
-      int cx, cy;
-      lw_cellgrid_locate(g, P[c0 + i].x, P[c0 + i].y, &cx, &cy);
-      cell[i] = (uint32_t)cy * (uint32_t)g->nx + (uint32_t)cx;
-      int k = i;
-      for (; k > 0 && cell[sel[k - 1] - c0] > cell[i]; k--) sel[k] = sel[k - 1];
-      sel[k] = (uint32_t)(c0 + (size_t)i);
+      lw_cellgrid_locate(g, P[c0 + i].x, P[c0 + i].y, &cx[i], &cy[i]);
+      sel[i] = (uint32_t)(c0 + (size_t)i);
     }
+    /* groups of consecutive probes whose box fits (one, for a move's) */
     for (int b = 0; b < nc;) {
-      uint32_t here = cell[sel[b] - c0];
-      int e = b + 1;
-      while (e < nc && e - b < LW_PAIR_BATCH && cell[sel[e] - c0] == here) e++;
-      int cx = (int)(here % (uint32_t)g->nx), cy = (int)(here / (uint32_t)g->nx);
-      if (walk_batch(g, ctx, &sh, P, sel + b, e - b, cx, cy, f, wide, &fa, near, visited ? &seen : NULL) != LW_OK)
+      int x0 = cx[b], x1 = cx[b], y0 = cy[b], y1 = cy[b], e = b + 1;
+      box bx = box_around(g, x0, x1, y0, y1);
+      for (; e < nc; e++) {
+        const int ax0 = cx[e] < x0 ? cx[e] : x0, ax1 = cx[e] > x1 ? cx[e] : x1;
+        const int ay0 = cy[e] < y0 ? cy[e] : y0, ay1 = cy[e] > y1 ? cy[e] : y1;
+        const box wider = box_around(g, ax0, ax1, ay0, ay1);
+        if (wider.w * wider.h > BOX_MAX) break;
+        x0 = ax0, x1 = ax1, y0 = ay0, y1 = ay1, bx = wider;
+      }
+      if (walk_group(g, ctx, &sh, P, sel + b, e - b, cx + b, cy + b, bx, f, wide, sum, c0, near,
+                     visited ? &seen : NULL) != LW_OK)
         return LW_ENOMEM;
       b = e;
     }
+    for (int i = 0; i < nc; i++) total += sum[i];
+    if (each) memcpy(each + c0, sum, (size_t)nc * sizeof *sum);
   }
-  v2d sum = fa.s0 + fa.s1;
-  *far = sum[0] + sum[1];
+  *far = total;
   if (visited) *visited += seen;
   return LW_OK;
 }

@@ -1022,6 +1022,61 @@ Test(pair, deferred_near_field_is_a_state_function_and_finishes_exactly)
   lw_scene_clear(&sc);
 }
 
+/*
+** A sweep proposes a spline's nodes in turn, and each move's old side of the
+** shared segment comes from the proposal's memo (model.h, lw_far_memo)
+** instead of a walk.  Along sweeps with random moves, half of them
+** committed, every first-stage dE, stand-in included, and every finished dE
+** equals bit for bit that of a proposal without a memo; and most moves did
+** use it.  Then the running total still matches a full recomputation.
+*/
+Test(pair, far_memo_gives_the_walks_bits)
+{
+  lw_scene sc;
+  crossing_lines(&sc, 30);
+  lw_model *m = lw_test_model_random(&sc, 30, 5, 4.0, 13);
+  lw_proposal *a = lw_proposal_new(m, NULL), *b = lw_proposal_new(m, NULL);
+  cr_assert(a && b);
+  rng_seed(31);
+  const size_t np = (size_t)sc.pair_quad.n;
+  long moves = 0, memo = 0, deferred = 0;
+  for (int sweep = 0; sweep < 4; sweep++)
+    for (uint32_t i = 0; i < m->sp->n_splines; i++)
+      for (size_t k = 0; k < m->sp->first[i + 1] - m->sp->first[i]; k++) {
+        lw_node nd = m->sp->node[m->sp->first[i] + k];
+        nd.px += urand(-0.3, 0.3);
+        nd.py += urand(-0.3, 0.3);
+        nd.vx += urand(-0.3, 0.3);
+        a->defer_near = b->defer_near = 1;
+        b->memo.spline = UINT32_MAX; /* no memo: every sample walked */
+        lw_model_propose(m, a, i, k, 1, &nd);
+        lw_model_propose(m, b, i, k, 1, &nd);
+        cr_assert(a->dE == b->dE || (isnan(a->dE) && isnan(b->dE)), "spline %u node %zu: %.17g against %.17g", i,
+                  k, a->dE, b->dE);
+        cr_assert_eq(a->near_pending, b->near_pending);
+        if (!isfinite(a->dE)) continue;
+        moves++;
+        memo += a->n_walked < 2 * a->n_seg * np;
+        deferred += a->near_pending;
+        lw_model_propose_finish(m, a);
+        lw_model_propose_finish(m, b);
+        cr_assert(a->dE == b->dE && a->dterm[LW_TERM_PAIR] == b->dterm[LW_TERM_PAIR], "finished %.17g, %.17g",
+                  a->dE, b->dE);
+        if (urand(0, 1) < 0.5) cr_assert_eq(lw_model_commit(m, a), LW_OK);
+      }
+  cr_assert_gt(moves, 400);
+  cr_assert_gt(memo, moves / 2, "the memo served %ld of %ld moves", memo, moves);
+  cr_assert_gt(deferred, moves / 10);
+  const double before = lw_model_total(m);
+  double drift;
+  cr_assert_eq(lw_model_refresh(m, &drift), LW_OK);
+  cr_assert(drift <= 1e-9, "running total %.15g, recomputed %.15g", before, lw_model_total(m));
+  lw_proposal_free(a);
+  lw_proposal_free(b);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
 Test(pair, near_field_gauss_tables_are_exact)
 {
   const lw_pairnear_consts *k = &lw_pairnear_k;

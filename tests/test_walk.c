@@ -101,7 +101,7 @@ static void check(double near_scale, int with_from, int with_two)
     near.n = 0;
     /* the narrow kernels on odd splines, the processor's choice on even ones */
     lw_vec_set_wide(spline % 2 == 0);
-    cr_assert_eq(lw_pair_walk(s.g, &s.ctx, P, n, &f, &far, &near, NULL), LW_OK);
+    cr_assert_eq(lw_pair_walk(s.g, &s.ctx, P, n, &f, &far, NULL, &near, NULL), LW_OK);
     lw_vec_set_wide(1);
     cr_assert(lw_close_rel(far, far_want, 1e-12, 1e-12), "spline %u: far %.17g, brute force %.17g", spline, far,
               far_want);
@@ -169,7 +169,7 @@ Test(walk, wide_and_narrow_scans_give_the_same_bits)
       for (int w = 0; w < 2; w++) {
         lw_vec_set_wide(w);
         near[w].n = 0;
-        cr_assert_eq(lw_pair_walk(s.g, &s.ctx, P, n, &f, &far[w], &near[w], NULL), LW_OK);
+        cr_assert_eq(lw_pair_walk(s.g, &s.ctx, P, n, &f, &far[w], NULL, &near[w], NULL), LW_OK);
       }
       lw_vec_set_wide(1);
       int same = memcmp(&far[0], &far[1], sizeof far[0]) == 0 && near[0].n == near[1].n;
@@ -208,8 +208,8 @@ Test(walk, independent_of_insertion_history)
     lw_pair_filter f = {.lo = spline * PER_SPLINE, .hi = (spline + 1) * PER_SPLINE};
     double fa, fb;
     na.n = nb.n = 0;
-    cr_assert_eq(lw_pair_walk(a.g, &a.ctx, P, n, &f, &fa, &na, NULL), LW_OK);
-    cr_assert_eq(lw_pair_walk(b.g, &b.ctx, P, n, &f, &fb, &nb, NULL), LW_OK);
+    cr_assert_eq(lw_pair_walk(a.g, &a.ctx, P, n, &f, &fa, NULL, &na, NULL), LW_OK);
+    cr_assert_eq(lw_pair_walk(b.g, &b.ctx, P, n, &f, &fb, NULL, &nb, NULL), LW_OK);
     cr_assert_eq(fa, fb, "spline %u: %.17g against %.17g", spline, fa, fb);
     cr_assert_eq(na.n, nb.n);
     for (size_t k = 0; k < na.n; k++)
@@ -256,9 +256,9 @@ Test(walk, own_spline_not_visited)
     lw_pair_probe P = {x, y, dl, 1.0};
     near.n = 0;
     f.from = 0;
-    cr_assert_eq(lw_pair_walk(g, &ctx, &P, 1, &f, &far, &near, &move), LW_OK);
+    cr_assert_eq(lw_pair_walk(g, &ctx, &P, 1, &f, &far, NULL, &near, &move), LW_OK);
     f.from = k + 1;
-    cr_assert_eq(lw_pair_walk(g, &ctx, &P, 1, &f, &far, &near, &full), LW_OK);
+    cr_assert_eq(lw_pair_walk(g, &ctx, &P, 1, &f, &far, NULL, &near, &full), LW_OK);
   }
   /* a move sees both groups of others, the full sum only those above */
   cr_assert_leq(move, (uint64_t)OWN * 2 * OTHER, "%llu pairs visited", (unsigned long long)move);
@@ -266,4 +266,63 @@ Test(walk, own_spline_not_visited)
   cr_assert_leq(full, (uint64_t)OWN * OTHER, "%llu pairs visited", (unsigned long long)full);
   lw_pair_nearlist_free(&near);
   lw_cellgrid_free(g);
+}
+
+/*
+** The contract a model's memo of the far field rests on (walk.h): a probe's
+** own far sum, and its near pairs in their order, are functions of the probe
+** and of the samples it may pair alone.  Each spline's probes walked together
+** and each probe walked alone give the same bits; so do they after the
+** spline's own samples (which the filter leaves out) moved to other cells,
+** which shifts the other samples' positions in the cells' arrays.  Run for
+** both kernel widths.
+*/
+Test(walk, each_probes_sum_is_its_own)
+{
+  static scene s;
+  rng_seed(0x5eed0777u);
+  scene_init(&s, 1.5);
+  lw_pair_nearlist all = {0}, one = {0};
+  lw_pair_probe P[2 * PER_SPLINE];
+  double each[2 * PER_SPLINE], far;
+  long compared = 0;
+  for (int wide = 0; wide < 2; wide++) {
+    lw_vec_set_wide(wide);
+    for (uint32_t spline = 0; spline < N_SAMPLES / PER_SPLINE; spline += 3) {
+      size_t n = probes_of(&s, spline, P);
+      const lw_pair_filter f = {.lo = spline * PER_SPLINE, .hi = (spline + 1) * PER_SPLINE};
+      all.n = 0;
+      cr_assert_eq(lw_pair_walk(s.g, &s.ctx, P, n, &f, &far, each, &all, NULL), LW_OK);
+      /* the spline's own samples elsewhere: other cells, other array positions */
+      for (uint32_t i = f.lo; i < f.hi; i++)
+        cr_assert_eq(lw_cellgrid_move(s.g, i, urand(0.0, PAGE), urand(0.0, PAGE), s.dl[i]), LW_OK);
+      size_t at = 0;
+      for (size_t k = 0; k < n; k++) {
+        one.n = 0;
+        cr_assert_eq(lw_pair_walk(s.g, &s.ctx, &P[k], 1, &f, &far, NULL, &one, NULL), LW_OK);
+        cr_assert(far == each[k], "spline %u probe %zu (%s): %.17g alone, %.17g with the others", spline, k,
+                  wide ? "wide" : "narrow", far, each[k]);
+        /* its near pairs, in the order they came among the others' */
+        for (size_t q = 0; q < one.n; q++) {
+          while (at < all.n && all.pair[at].probe != k) at++;
+          cr_assert(at < all.n && all.pair[at].idx == one.pair[q].idx, "spline %u probe %zu: near pair %zu", spline,
+                    k, q);
+          at++;
+        }
+        size_t mine = 0;
+        for (size_t q = 0; q < all.n; q++) mine += all.pair[q].probe == k;
+        cr_assert_eq(mine, one.n, "spline %u probe %zu: %zu near pairs among the others, %zu alone", spline, k, mine,
+                     one.n);
+        at = 0;
+        compared++;
+      }
+      for (uint32_t i = f.lo; i < f.hi; i++)
+        cr_assert_eq(lw_cellgrid_move(s.g, i, s.x[i], s.y[i], s.dl[i]), LW_OK);
+    }
+  }
+  lw_vec_set_wide(1);
+  cr_assert_gt(compared, 1000);
+  lw_pair_nearlist_free(&all);
+  lw_pair_nearlist_free(&one);
+  lw_cellgrid_free(s.g);
 }

@@ -98,6 +98,9 @@ typedef struct {
                               moves at least scene->max_segments) */
   size_t cap_seg, cap_spl;  /* room in the per-segment and per-spline caches (splices) */
   lw_slots *slots;          /* the ghosts that splices leave (slots.h); none between sweeps */
+  uint64_t serial;          /* changes with every change of the state (commits, splices,
+                            ** refreshes, compactions), unique among models: what a
+                            ** proposal's memo of the far field was taken at */
 } lw_model;
 
 /* Splines alive: those of m->sp less the ghosts. */
@@ -154,6 +157,23 @@ typedef struct {
   size_t n, cap;
 } lw_near_list;
 
+/* What the pair walk found for the segments of one spline in one state
+** (model.c, pair_walk): for segment k of the spline, where ok[k], its
+** samples' far sum and first-stage stand-in (lw_pair_walk's sums of its
+** samples, +1 each) and its near partners.  A sweep proposes the nodes of a
+** spline one after the other, and each move shares a segment with the
+** previous one: that segment's old side is taken from here.  Valid while
+** the model's serial is the one recorded (only the spline's own commits,
+** which never change its far field, move it on). */
+typedef struct {
+  const lw_model *model;
+  uint64_t serial;
+  uint32_t spline;            /* UINT32_MAX: none */
+  unsigned char *ok;          /* cap_seg each */
+  double *far, *stand;
+  lw_near_list *partners;
+} lw_far_memo;
+
 /* Scratch for one proposal: owned by one thread, sized for the model. */
 typedef struct {
   uint32_t spline;
@@ -166,7 +186,20 @@ typedef struct {
   lw_pair_sample *ps_old;     /* n_seg * quad.n pair samples before the move (pair on; the
                               ** walk's old side, and the undo of a failed commit) */
   lw_pair_probe *probe;       /* 2 n_seg quad.n: each new sample, then its old self, as probes */
-  lw_pair_nearlist near;      /* the walk's near pairs (walk.h) */
+  lw_pair_nearlist near;      /* the walk's near pairs (walk.h), by their probes' numbers */
+  lw_pair_probe *walked;      /* the probes walked: those not taken from the memo */
+  uint32_t *walked_id;        /* their numbers */
+  size_t n_walked;            /* how many (the others' sums came from the memo) */
+  double *each;               /* 2 n_seg quad.n: each probe's far sum (+1 each; walk.h) */
+  double *stand;              /* and its pairs' stand-in of the near field (near_stand_in) */
+  lw_near_list *side;         /* 2 cap_seg: the near partners of changed segment j, new (2j)
+                              ** and old (2j + 1; the memo's list holds them after the walk) */
+  double *seg_sum;            /* 4 n_seg: segment j's far sum and stand-in, new (4j, 4j + 1)
+                              ** and old (4j + 2, 4j + 3) */
+  int walk_done;              /* the walk of this move ran and its memo entries hold */
+  int any_near;               /* a changed segment has near pairs, new or old */
+  double stand_in;            /* the first stage's stand-in of the near field's change */
+  lw_far_memo memo;
   double new_spline_len;
   double *spline_seg_len;     /* the moved spline's segment lengths after the move (spline terms) */
   double dterm[LW_TERM_COUNT];

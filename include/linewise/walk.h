@@ -26,19 +26,22 @@
 ** The near scale is meant to be capped so that near pairs lie within the
 ** cutoff; the walk skips the cells beyond it and reports none beyond it.
 **
-** How it runs: the probes of one call are grouped by cell (in chunks of
-** LW_PAIR_CHUNK, at most LW_PAIR_BATCH to a group); a group shares its 3 x 3
-** block, so each cell is read once for all its probes: its runs of
-** entries the filter keeps, four entries at a time, the weights once, the
-** distances and tests per probe, in SSE2 lanes.  Where a probe has a far pair among the four, the
-** kernel runs on all four lanes (square roots and divisions two at a time)
-** and the others are masked to +0.  A little under half of the (probe,
-** group) pairs need it (44 % in the benchmark scenes) against about a
-** quarter of the lanes being far pairs, but the lanes stay in registers:
-** no copying out, no second pass.  Two accumulators of two lanes take the
-** sums in the visiting order, so the summation order is a function of the
-** positions and the probes only: the same on every thread, and the same
-** after a resume that rebuilds the grid.
+** How it runs: the probes of one call are taken LW_PAIR_CHUNK at a time (a
+** move's are one chunk), and the cells of the union of their 3 x 3 blocks
+** in the grid's order, each cell once for every probe whose block holds it
+** (a mask of probes): its runs of entries the filter keeps, four entries at
+** a time, the weights once, the distances and tests per probe, in SSE2 (or
+** AVX2) lanes.  Where a probe has a far pair among the four, the kernel
+** runs on all four lanes and the others are masked to +0.  A little under
+** half of the (probe, group) pairs need it (44 % in the benchmark scenes)
+** against about a quarter of the lanes being far pairs, but the lanes stay
+** in registers: no copying out, no second pass.  Each probe keeps its own
+** two accumulators of two lanes, which take its terms in the visiting
+** order: the cells in the grid's order, each run of a cell's entries in
+** groups of four from the run's start.  So a probe's sum is a function of
+** its position and the samples it may pair only: the same on every thread,
+** after a resume that rebuilds the grid, whatever other probes share the
+** walk and wherever the samples the filter leaves out lie.
 */
 #ifndef LINEWISE_WALK_H
 #define LINEWISE_WALK_H
@@ -50,8 +53,7 @@
 #include "linewise/grid.h"
 #include "linewise/pair.h"
 
-#define LW_PAIR_BATCH 16 /* probes of one cell walked together */
-#define LW_PAIR_CHUNK 32 /* probes sorted by cell together */
+#define LW_PAIR_CHUNK 32 /* probes walked together (at most the bits of a mask) */
 
 /* One near pair: the neighbour as the grid holds it, and the probe. */
 typedef struct {
@@ -86,13 +88,21 @@ typedef struct {
   uint32_t lo2, hi2; /* a second spline's, hi2 >= lo2 >= hi (a join's two; lo2 = hi2: none) */
 } lw_pair_filter;
 
-/* Sets *far to the far sum of the n probes P (no coefficient C) and
-** appends their near pairs to `near` (may be NULL when ctx->near_scale is
-** 0).  visited (may be NULL): adds the number of (probe, sample) pairs the
-** walk looked at, the measure of its work.  LW_ENOMEM if the near list
-** could not grow (*far is then 0 and the list holds what was found so
-** far). */
+/* Sets *far to the far sum of the n probes P (no coefficient C), the sum of
+** the probes' own far sums in their order, and appends their near pairs to
+** `near` (may be NULL when ctx->near_scale is 0).  each (may be NULL):
+** receives the probes' own far sums, each[k] that of P[k].  A probe's own
+** sum, and the order of its near pairs in `near`, are functions of the
+** probe and of the samples it may pair alone, whatever other probes share
+** the walk and wherever the filtered samples lie: the cells are taken in a
+** fixed order and each cell's runs of samples the filter keeps in groups
+** of four from the run's start (a model can keep a segment's sums and
+** reuse them, bit for bit).  visited (may be NULL): adds the number of
+** (probe, sample) pairs the walk looked at, the measure of its work.
+** LW_ENOMEM if the near list could not grow (*far is then 0 and the list
+** holds what was found so far). */
 lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pair_probe *P, size_t n,
-                       const lw_pair_filter *f, double *far, lw_pair_nearlist *near, uint64_t *visited);
+                       const lw_pair_filter *f, double *far, double *each, lw_pair_nearlist *near,
+                       uint64_t *visited);
 
 #endif
