@@ -87,7 +87,7 @@ typedef struct {
   v2d near2;      /* (near_scale dl)^2: a pair is near within the larger of its two */
   v2d scale;      /* scale dl: the factor on this probe's far pairs' dl_j (1/r - 1/rc) */
   double gx[3], gy[3]; /* squared gaps to the columns and rows of the block (axis_gaps) */
-  v2d s0, s1;     /* its far sum: entries 0, 1 and 2, 3 of each group of four */
+  v2d s0, s1;     /* its far sum: entries 0, 1 and 2, 3 of each group of four (adjacent) */
 } probe_ctx;
 
 /* What every probe of a walk shares: the near scale and the cutoff. */
@@ -237,8 +237,8 @@ scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh,
       if (_mm256_movemask_pd(f)) {
         const __m256d inv = _mm256_sub_pd(_mm256_div_pd(one, _mm256_sqrt_pd(r)), ic);
         const __m256d v = _mm256_and_pd(_mm256_mul_pd(_mm256_mul_pd(w, _mm256_set1_pd(q->scale[0])), inv), f);
-        q->s0 = (v2d)_mm_add_pd((__m128d)q->s0, _mm256_castpd256_pd128(v));
-        q->s1 = (v2d)_mm_add_pd((__m128d)q->s1, _mm256_extractf128_pd(v, 1));
+        /* s0 and s1 lie side by side: lanes 0, 1 and 2, 3 of one vector */
+        _mm256_storeu_pd((double *)&q->s0, _mm256_add_pd(_mm256_loadu_pd((const double *)&q->s0), v));
       }
     }
   }

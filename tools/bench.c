@@ -131,16 +131,23 @@ static const struct {
 static void bench_throughput(bench_ctx *b)
 {
   FILE *d = b->doc[BENCH_PERFORMANCE];
-  /* the pair rows again with the two-wide kernels, timed interleaved with the rest */
-  enum { N_RUNS = 2 * N_THROUGHPUT - 1 };
+  /* the scenes in sweeps; then the pair rows with the two-wide kernels, and
+  ** with nodes drawn at random, all timed interleaved */
+  enum { N_PAIR = N_THROUGHPUT - 1, NARROW = N_THROUGHPUT, RANDOM = N_THROUGHPUT + N_PAIR,
+         N_RUNS = N_THROUGHPUT + 2 * N_PAIR };
   bench_run r[N_RUNS];
   lw_params p;
   for (int i = 0; i < N_RUNS; i++) {
-    int k = i < N_THROUGHPUT ? i : i - N_THROUGHPUT + 1;
+    int k = i < N_THROUGHPUT ? i : (i - N_THROUGHPUT) % N_PAIR + 1;
     bench_random_params(&p, 1000, throughput[k].pair, throughput[k].spacing);
     p.pair_near = throughput[k].near_scale;
     bench_run_init(&r[i], &p, NULL, BENCH_T, NULL);
-    r[i].narrow = i >= N_THROUGHPUT;
+    lw_error err;
+    /* the splines numbered along the page, as a run numbers them */
+    if (r[i].sys->type->renumber(r[i].sys->state, &err) || lw_model_refresh(r[i].model, NULL))
+      bench_die("throughput", &err);
+    r[i].narrow = i >= NARROW && i < RANDOM;
+    r[i].sweeps = i < RANDOM;
     tune_random(&r[i]);
   }
   double ns[N_RUNS], ratio[N_RUNS];
@@ -152,11 +159,15 @@ static void bench_throughput(bench_ctx *b)
              "pair; near 1.5: a sample pair closer than 1.5 length elements makes its two segments a near\n"
              "pair, which takes the near field (pairnear.h), the product rule the others. Lines that\n"
              "cross make near pairs, and so do neighbours running alongside closely, the near field's\n"
-             "costliest case (docs/NUMERICS.md). The pair kernels run four lanes at a time where the\n"
-             "processor has AVX2 (%s here); the last column times the same scene with the two-wide\n"
-             "(SSE2) kernels, interleaved with the rest, as a ratio. Both give the same bits.\n\n"
+             "costliest case (docs/NUMERICS.md). Proposals come in sweeps, as a run makes them: the\n"
+             "nodes in order, splines numbered along the page, point and vector moves half and half\n"
+             "(docs/NUMERICS.md, \"Sweep order\"); the last column times the same scenes with the nodes\n"
+             "drawn at random instead. The pair kernels run four lanes at a time where the processor\n"
+             "has AVX2 (%s here); the column before it times the same scene with the two-wide (SSE2)\n"
+             "kernels, as a ratio. Both give the same bits. All runs interleaved.\n\n"
              "| scene | neighbours per sample | ns per proposal | proposals per second | x cost without pair | "
-             "acceptance | bytes per segment | two-wide kernels, x time |\n|---|---|---|---|---|---|---|---|\n",
+             "acceptance | bytes per segment | two-wide kernels, x time | nodes at random, proposals per second |\n"
+             "|---|---|---|---|---|---|---|---|---|\n",
           BENCH_T, lw_vec_wide() ? "it has" : "it has not");
   for (int i = 0; i < N_THROUGHPUT; i++) {
     char what[96];
@@ -167,13 +178,14 @@ static void bench_throughput(bench_ctx *b)
     else
       snprintf(what, sizeof what, "every term, pair cutoff 4 mm, lines %.1f mm apart, near field off",
                throughput[i].spacing);
-    char nb[32] = "-", two[32] = "-";
+    char nb[32] = "-", two[32] = "-", rnd[32] = "-";
     if (throughput[i].pair) {
       snprintf(nb, sizeof nb, "%.1f", mean_neighbours(r[i].model));
-      snprintf(two, sizeof two, "%.2f", ratio[i + N_THROUGHPUT - 1] / ratio[i]);
+      snprintf(two, sizeof two, "%.2f", ratio[NARROW + i - 1] / ratio[i]);
+      snprintf(rnd, sizeof rnd, "%.0f", 1e9 / ns[RANDOM + i - 1]);
     }
-    fprintf(d, "| %s | %s | %.0f | %.0f | %.1f | %.2f | %.0f | %s |\n", what, nb, ns[i], 1e9 / ns[i], ratio[i],
-            bench_run_acceptance(&r[i]), bytes_per_segment(r[i].model), two);
+    fprintf(d, "| %s | %s | %.0f | %.0f | %.1f | %.2f | %.0f | %s | %s |\n", what, nb, ns[i], 1e9 / ns[i], ratio[i],
+            bench_run_acceptance(&r[i]), bytes_per_segment(r[i].model), two, rnd);
   }
   fprintf(d, "\n");
   for (int i = 0; i < N_RUNS; i++) bench_run_free(&r[i]);

@@ -168,11 +168,16 @@ double bench_run_block(bench_run *r, double seconds, const bench_trial *trials, 
   lw_vec_set_wide(!r->narrow);
   double t0 = bench_now(), t;
   do {
-    if (trials)
+    if (trials) {
       for (int k = 0; k < 64; k++) bench_run_propose(r, &trials[(n + k) % n_trials]);
-    else
+      n += 64;
+    } else if (r->sweeps) {
+      if (lw_chain_sweep(r->chain) != LW_OK) bench_die("sweep", &(lw_error){.code = LW_ENOMEM, .msg = "sweep"});
+      n += (long)r->sys->type->sweep_size(r->sys->state);
+    } else {
       for (int k = 0; k < 64; k++) lw_chain_step(r->chain, k & 1);
-    n += 64;
+      n += 64;
+    }
     t = bench_now() - t0;
   } while (t < seconds);
   lw_vec_set_wide(1);

@@ -81,6 +81,8 @@ typedef struct {
   lw_system *sys;   /* a view of the model: the chain goes through the row */
   lw_chain *chain;
   int narrow;       /* its blocks run the two-wide kernels even where AVX2 is there (vec2.h) */
+  int sweeps;       /* its blocks run whole sweeps, as a run makes them (lw_chain_sweep), instead
+                    ** of point and vector moves of nodes drawn at random */
 } bench_run;
 
 /* Builds the scene of p, a model on sp (owned; NULL: p->splines random lines
@@ -107,9 +109,10 @@ bench_trial *bench_trials_new(const lw_splines *sp, const double step[2], int n)
 /* dE of trial t on r's model (the model is not changed). */
 double bench_run_propose(bench_run *r, const bench_trial *t);
 
-/* ns per proposal over one block of at least `seconds`: chain steps, or
-** with trials, evaluations of the trials in turn (lw_model_propose, never
-** committed: the cost of the energy terms without the Metropolis walk). */
+/* ns per proposal over one block of at least `seconds`: chain steps (or
+** sweeps, with r->sweeps), or with trials, evaluations of the trials in turn
+** (lw_model_propose, never committed: the cost of the energy terms without
+** the Metropolis walk). */
 double bench_run_block(bench_run *r, double seconds, const bench_trial *trials, int n_trials);
 
 /* Times runs[0..n-1] in b->reps interleaved blocks of b->block seconds
