@@ -838,9 +838,8 @@ static double pair_walk(const lw_model *m, lw_proposal *p)
   p->walk_done = 0;
   if (mo->model != m || mo->spline != p->spline || mo->serial != __atomic_load_n(&m->serial, __ATOMIC_RELAXED))
     memo_reset(mo, m, p->spline);
-  /* each new sample next to its old self (usually in the same cell: shorter
-  ** moves in the walk's sort by cell), the old ones of the memo's segments
-  ** left out */
+  /* each new sample next to its old self, the old ones of the memo's
+  ** segments left out */
   size_t nw = 0;
   for (size_t k = 0; k < 2 * n; k++) {
     const lw_pair_sample *ps_k = k & 1 ? &p->ps_old[k / 2] : &p->ps[k / 2];
@@ -853,12 +852,14 @@ static double pair_walk(const lw_model *m, lw_proposal *p)
   lw_pair_filter f = filter_of(&v, p->spline, 0);
   double all;
   p->near.n = 0;
-  if (lw_pair_walk(m->grid, &sc->pair, p->walked, nw, &f, &all, p->stand, &p->near, NULL) != LW_OK) {
+  if (lw_pair_walk(m->grid, &sc->pair, p->walked, nw, &f, &all, p->each, &p->near, NULL) != LW_OK) {
     memo_reset(mo, m, p->spline);
     return NAN;
   }
-  for (size_t i = nw; i-- > 0;) p->each[p->walked_id[i]] = p->stand[i]; /* walked_id[i] >= i */
-  for (size_t i = 0; i < nw; i++) p->stand[p->walked_id[i]] = 0.0;
+  /* each walked probe's sum to its number, in place: walked_id rises, and
+  ** walked_id[i] >= i */
+  for (size_t i = nw; i-- > 0;) p->each[p->walked_id[i]] = p->each[i];
+  for (size_t k = 0; k < 2 * n; k++) p->stand[k] = 0.0;
   for (size_t k = 0; k < p->near.n; k++) {
     lw_pair_near *q = &p->near.pair[k];
     q->probe = p->walked_id[q->probe];

@@ -9,12 +9,13 @@
 ** where the Hessian is not positive definite) projected into the square,
 ** each step halved until it brings the curves closer.  With d their
 ** distance, h the larger half-size of the two segments (bounding circles):
-**   apart, d / h >= 0.35: Gauss rules of the whole kernel over the whole
+**   apart, d / h >= 0.29: Gauss rules of the whole kernel over the whole
 **     square, 16 nodes each way, and 24, 32, 48, 64 as d / h falls to
-**     0.24, 0.18, 0.12, 0.09 (WHOLE_LO).  The pole of 1/r is then at least
-**     d / h half-lengths from each segment, in a Bernstein ellipse
+**     0.193, 0.144, 0.096, 0.072 (WHOLE_LO).  The pole of 1/r is then at
+**     least d / h half-lengths from each segment, in a Bernstein ellipse
 **     rho >= d / h + sqrt(1 + (d / h)^2) beside its middle: error about
-**     rho^-2m, 1e-5 at each threshold.  Most near pairs of a drawing,
+**     rho^-2m, 1e-4 at each threshold, the far field's own error at the
+**     near zone's edge (docs/NUMERICS.md).  Most near pairs of a drawing,
 **     neighbouring lines under an element apart, end here, and 64 x 64
 **     kernels cost less than the subdivision that would resolve them;
 **   otherwise (crossing, touching, running alongside closer): the
@@ -37,7 +38,7 @@
 ** chord's midpoint through the farthest of them.  A pair of pieces whose
 ** circles are more than SEP_HI times the larger radius apart takes the 6 x 6
 ** rule (1/r is analytic in a Bernstein ellipse rho >= 1 + SEP_HI +
-** sqrt((1 + SEP_HI)^2 - 1) = 3.7 about each piece: error ~ 1e-7 of the
+** sqrt((1 + SEP_HI)^2 - 1) = 3.07 about each piece: error ~ 1e-6 of the
 ** pair).  Other pairs are split, A and B in turn (a choice by size would flip
 ** between two subtrees, whose values differ by their errors), down to a
 ** leaf, where the pieces' mean chords stand in for them and are integrated
@@ -182,11 +183,14 @@ static void piece_split(const piece *p, const cubic *c, piece *lo, piece *hi)
 ** the 6 x 6 rules and 12 % of the leaves, 7 % of X) and take rules and
 ** leaves only where they are more accurate.  Narrower flatness and leaf
 ** bands steepen the blends until a central difference at 1e-6 of the
-** scale no longer follows X's derivative (tests/test_pairgrad.c). */
+** scale no longer follows X's derivative (tests/test_pairgrad.c).  The
+** limits are set, like the whole-square rules', for about 1e-4 of a pair:
+** the 6 x 6 rule from 0.7 radius apart (1e-6), flat leaves at 0.15 (of
+** second order: (f / d)^2; 0.2 doubles the worst touching pairs' error). */
 #define SEP_LO 0.6
 #define SEP_HI 0.7
-#define LEAF_RATIO 1e-2
-#define FLAT_RATIO 0.2
+#define LEAF_RATIO 5e-3
+#define FLAT_RATIO 0.15
 #define LEAF_BAND 1.5
 #define FLAT_BAND 1.5
 #define STACK_MAX 128
@@ -310,9 +314,10 @@ static const double G64_W[64] = {
 ** segments whose least distance d is at least lo (blended in up to hi) times
 ** the larger half-size h.  The pole of 1/r is then at least lo half-lengths
 ** from each segment, in a Bernstein ellipse rho = lo + sqrt(1 + lo^2) beside
-** its middle, and the rule errs by about rho^-2m: 1.6e-5 (16 nodes at 0.35),
-** 1.1e-5 (24 at 0.24, 32 at 0.18), 1.0e-5 (48 at 0.12, 64 at 0.09).  Closer
-** pairs take the subdivision. */
+** its middle, and the rule errs by about rho^-2m: 1e-4 at lo = sinh(2 ln 10
+** / m), about what the product rule errs by at the near zone's edge (the
+** thresholds for 1e-5 cost X a tenth more).  Closer pairs take the
+** subdivision. */
 #define N_WHOLE 5
 static const int WHOLE_M[N_WHOLE] = {16, 24, 32, 48, 64};
 static const double *const WHOLE_S[N_WHOLE] = {G16_S, G24_S, G32_S, G48_S, G64_S};
