@@ -79,7 +79,7 @@ static inline v2d vmax(v2d a, v2d b)
 static inline v2l lo2l(v4i m) { return (v2l)__builtin_shufflevector(m, m, 0, 0, 1, 1); }
 static inline v2l hi2l(v4i m) { return (v2l)__builtin_shufflevector(m, m, 2, 2, 3, 3); }
 
-/* A probe's constants in every lane, set up once per batch. */
+/* A probe's constants in every lane, set up once per walk, and its sums. */
 typedef struct {
   v2d x, y;
   v2d rc2;        /* far pairs need r^2 < rc2; -1 for a weightless probe */
