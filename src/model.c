@@ -796,13 +796,14 @@ static double near_stand_in(const lw_pair_ctx *ctx, const lw_pair_probe *P, cons
   return (double)P->dl * (double)q->dl * (1.0 / sqrt(r2) - ctx->inv_cutoff);
 }
 
-/* Starts p's memo afresh for spline s of m in its current state. */
-static void memo_reset(lw_far_memo *mo, const lw_model *m, uint32_t s)
+/* Starts p's memo afresh for its spline in m's current state. */
+static void memo_reset(lw_proposal *p, const lw_model *m)
 {
+  lw_far_memo *mo = &p->memo;
   mo->model = m;
-  mo->spline = s;
+  mo->spline = p->spline;
   mo->serial = __atomic_load_n(&m->serial, __ATOMIC_RELAXED);
-  memset(mo->ok, 0, m->max_segments * sizeof *mo->ok);
+  memset(mo->ok, 0, p->cap_seg * sizeof *mo->ok);
 }
 
 /*
@@ -837,7 +838,7 @@ static double pair_walk(const lw_model *m, lw_proposal *p)
   lw_far_memo *mo = &p->memo;
   p->walk_done = 0;
   if (mo->model != m || mo->spline != p->spline || mo->serial != __atomic_load_n(&m->serial, __ATOMIC_RELAXED))
-    memo_reset(mo, m, p->spline);
+    memo_reset(p, m);
   /* each new sample next to its old self, the old ones of the memo's
   ** segments left out */
   size_t nw = 0;
@@ -853,7 +854,7 @@ static double pair_walk(const lw_model *m, lw_proposal *p)
   double all;
   p->near.n = 0;
   if (lw_pair_walk(m->grid, &sc->pair, p->walked, nw, &f, &all, p->each, &p->near, NULL) != LW_OK) {
-    memo_reset(mo, m, p->spline);
+    memo_reset(p, m);
     return NAN;
   }
   /* each walked probe's sum to its number, in place: walked_id rises, and
@@ -866,7 +867,7 @@ static double pair_walk(const lw_model *m, lw_proposal *p)
     p->stand[q->probe] += near_stand_in(&sc->pair, &p->probe[q->probe], q);
   }
   if (side_partners(p, np) != LW_OK) {
-    memo_reset(mo, m, p->spline);
+    memo_reset(p, m);
     return NAN;
   }
   double pe = 0.0, stand = 0.0;
@@ -1133,7 +1134,7 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p);
 static void memo_commit(const lw_model *m, lw_proposal *p, uint64_t serial)
 {
   lw_far_memo *mo = &p->memo;
-  if (mo->model != m || mo->spline != p->spline || mo->serial != serial - 1) memo_reset(mo, m, p->spline);
+  if (mo->model != m || mo->spline != p->spline || mo->serial != serial - 1) memo_reset(p, m);
   mo->serial = serial;
   for (size_t j = 0; j < p->n_seg; j++) {
     const size_t k = p->seg0 + j;
