@@ -97,12 +97,11 @@ typedef struct {
   v2d ic;         /* 1 / rc (0 without a cutoff) */
 } shared_ctx;
 
-
 /* The near pairs a scan of entries k0 on of cell c marked (bit t of
 ** near_bits[b]: entry k0 + t with probe b), in the order of the probes and
 ** then of the entries. */
 static inline __attribute__((always_inline)) void append_near(const lw_cell *c, uint32_t k0, unsigned mask,
-                                                               const uint32_t *probe_id, const uint64_t *near_bits,
+                                                               uint32_t id0, const uint64_t *near_bits,
                                                                lw_pair_nearlist *near)
 {
   const double *xs = c->x, *ys = lw_cell_y(c);
@@ -112,7 +111,7 @@ static inline __attribute__((always_inline)) void append_near(const lw_cell *c, 
     unsigned b = (unsigned)__builtin_ctz(left);
     for (uint64_t bits = near_bits[b]; bits; bits &= bits - 1) {
       uint32_t k = k0 + (uint32_t)__builtin_ctzll(bits);
-      near->pair[near->n++] = (lw_pair_near){xs[k], ys[k], dls[k], id[k], probe_id[b]};
+      near->pair[near->n++] = (lw_pair_near){xs[k], ys[k], dls[k], id[k], id0 + b};
     }
   }
 }
@@ -131,7 +130,7 @@ static inline __attribute__((always_inline)) void append_near(const lw_cell *c, 
 */
 static inline __attribute__((always_inline)) void
 scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx *pc, unsigned mask,
-     const uint32_t *probe_id, lw_pair_nearlist *near, const int with_near)
+     uint32_t id0, lw_pair_nearlist *near, const int with_near)
 {
   uint64_t near_bits[LW_PAIR_CHUNK]; /* those of the probes in mask only */
   if (with_near)
@@ -177,13 +176,14 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx
         any |= found;
       }
       if (bits2(f0 | f1)) {
-        v2d v0 = (w0 * q->scale) * (one / lw_vsqrt2(r0) - sh->ic), v1 = (w1 * q->scale) * (one / lw_vsqrt2(r1) - sh->ic);
+        v2d v0 = (w0 * q->scale) * (one / lw_vsqrt2(r0) - sh->ic);
+        v2d v1 = (w1 * q->scale) * (one / lw_vsqrt2(r1) - sh->ic);
         q->s0 += (v2d)((v2l)v0 & f0);
         q->s1 += (v2d)((v2l)v1 & f1);
       }
     }
   }
-  if (with_near && any) append_near(c, k0, mask, probe_id, near_bits, near);
+  if (with_near && any) append_near(c, k0, mask, id0, near_bits, near);
 }
 
 #if LW_VEC_HAVE_WIDE
@@ -197,7 +197,7 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx
 */
 static inline __attribute__((always_inline, target("avx2"))) void
 scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx *pc, unsigned mask,
-               const uint32_t *probe_id, lw_pair_nearlist *near, const int with_near)
+               uint32_t id0, lw_pair_nearlist *near, const int with_near)
 {
   uint64_t near_bits[LW_PAIR_CHUNK]; /* those of the probes in mask only */
   if (with_near)
@@ -242,21 +242,21 @@ scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh,
       }
     }
   }
-  if (with_near && any) append_near(c, k0, mask, probe_id, near_bits, near);
+  if (with_near && any) append_near(c, k0, mask, id0, near_bits, near);
 }
 
 __attribute__((target("avx2"))) static void scan_wide_near(const lw_cell *c, uint32_t k0, uint32_t k1,
                                                            const shared_ctx *sh, probe_ctx *pc, unsigned mask,
-                                                           const uint32_t *probe_id, lw_pair_nearlist *near)
+                                                           uint32_t id0, lw_pair_nearlist *near)
 {
-  scan_wide_body(c, k0, k1, sh, pc, mask, probe_id, near, 1);
+  scan_wide_body(c, k0, k1, sh, pc, mask, id0, near, 1);
 }
 
 __attribute__((target("avx2"))) static void scan_wide_far(const lw_cell *c, uint32_t k0, uint32_t k1,
                                                           const shared_ctx *sh, probe_ctx *pc, unsigned mask,
-                                                          const uint32_t *probe_id)
+                                                          uint32_t id0)
 {
-  scan_wide_body(c, k0, k1, sh, pc, mask, probe_id, NULL, 0);
+  scan_wide_body(c, k0, k1, sh, pc, mask, id0, NULL, 0);
 }
 #endif
 
@@ -359,16 +359,16 @@ static box box_around(const lw_cellgrid *g, int x0, int x1, int y0, int y1)
   return b;
 }
 
-/* The probes sel[0..nb-1] of P (nb <= LW_PAIR_CHUNK, cells cx[], cy[]),
+/* Probes id0 to id0 + nb - 1 of P (nb <= LW_PAIR_CHUNK, cells cx[], cy[]),
 ** whose cells' 3 x 3 blocks lie in box bx: one pass over the box's cells in
 ** the grid's order, each cell read once for every probe whose block holds
 ** it and whose gap to it is within the cutoff.  So each probe meets its
 ** cells in the grid's order and their entries in theirs, whatever the
-** others.  Each probe's far sum goes to sum[sel[b] - base].  *visited (NULL:
+** others.  Each probe's far sum goes to sum[b].  *visited (NULL:
 ** not counted) counts entries scanned times the probes that scan them. */
 static lw_status walk_group(const lw_cellgrid *g, const lw_pair_ctx *ctx, const shared_ctx *sh,
-                            const lw_pair_probe *P, const uint32_t *sel, int nb, const int *cx, const int *cy,
-                            box bx, const lw_pair_filter *f, int wide, double *sum, size_t base,
+                            const lw_pair_probe *P, uint32_t id0, int nb, const int *cx, const int *cy,
+                            box bx, const lw_pair_filter *f, int wide, double *sum,
                             lw_pair_nearlist *near, uint64_t *visited)
 {
   probe_ctx pc[LW_PAIR_CHUNK];
@@ -377,7 +377,7 @@ static lw_status walk_group(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
   const int with_near = ctx->near_scale > 0.0;
   memset(mask, 0, (size_t)(bx.w * bx.h) * sizeof *mask);
   for (int b = 0; b < nb; b++) {
-    const lw_pair_probe *p = &P[sel[b]];
+    const lw_pair_probe *p = &P[id0 + (uint32_t)b];
     /* a weightless probe has no far pairs (its kernel is 0, even at r = 0) */
     const double rc2 = p->dl != 0.0f ? ctx->cutoff2 : -1.0, l = ctx->near_scale * (double)p->dl;
     pc[b] = (probe_ctx){{p->x, p->x}, {p->y, p->y}, {rc2, rc2}, {p->dl, p->dl, p->dl, p->dl}, {l * l, l * l},
@@ -410,20 +410,20 @@ static lw_status walk_group(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
             return LW_ENOMEM;
 #if LW_VEC_HAVE_WIDE
           if (wide) {
-            if (with_near) scan_wide_near(c, k0, k1, sh, pc, m, sel, near);
-            else scan_wide_far(c, k0, k1, sh, pc, m, sel);
+            if (with_near) scan_wide_near(c, k0, k1, sh, pc, m, id0, near);
+            else scan_wide_far(c, k0, k1, sh, pc, m, id0);
             continue;
           }
 #endif
-          if (with_near) scan(c, k0, k1, sh, pc, m, sel, near, 1);
-          else scan(c, k0, k1, sh, pc, m, sel, NULL, 0);
+          if (with_near) scan(c, k0, k1, sh, pc, m, id0, near, 1);
+          else scan(c, k0, k1, sh, pc, m, id0, NULL, 0);
         }
       }
     }
   }
   for (int b = 0; b < nb; b++) {
     const v2d t = pc[b].s0 + pc[b].s1;
-    sum[sel[b] - base] = t[0] + t[1];
+    sum[b] = t[0] + t[1];
   }
   return LW_OK;
 }
@@ -440,14 +440,10 @@ lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pa
   double total = 0.0;
   *far = 0.0;
   for (size_t c0 = 0; c0 < n; c0 += LW_PAIR_CHUNK) {
-    uint32_t sel[LW_PAIR_CHUNK];
     int cx[LW_PAIR_CHUNK], cy[LW_PAIR_CHUNK];
     double sum[LW_PAIR_CHUNK];
     const int nc = n - c0 < LW_PAIR_CHUNK ? (int)(n - c0) : LW_PAIR_CHUNK;
-    for (int i = 0; i < nc; i++) {
-      lw_cellgrid_locate(g, P[c0 + i].x, P[c0 + i].y, &cx[i], &cy[i]);
-      sel[i] = (uint32_t)(c0 + (size_t)i);
-    }
+    for (int i = 0; i < nc; i++) lw_cellgrid_locate(g, P[c0 + i].x, P[c0 + i].y, &cx[i], &cy[i]);
     /* groups of consecutive probes whose box fits (one, for a move's) */
     for (int b = 0; b < nc;) {
       int x0 = cx[b], x1 = cx[b], y0 = cy[b], y1 = cy[b], e = b + 1;
@@ -459,7 +455,7 @@ lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pa
         if (wider.w * wider.h > BOX_MAX) break;
         x0 = ax0, x1 = ax1, y0 = ay0, y1 = ay1, bx = wider;
       }
-      if (walk_group(g, ctx, &sh, P, sel + b, e - b, cx + b, cy + b, bx, f, wide, sum, c0, near,
+      if (walk_group(g, ctx, &sh, P, (uint32_t)(c0 + (size_t)b), e - b, cx + b, cy + b, bx, f, wide, sum + b, near,
                      visited ? &seen : NULL) != LW_OK)
         return LW_ENOMEM;
       b = e;
