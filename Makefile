@@ -161,7 +161,7 @@ docs: bin/linewise
 
 # The benchmark: tools/bench*.c with the shared pieces in tools/benchutil.c and
 # the two-curve reference of the tests (tests/pairref.h).
-BENCH_SRC := tools/bench.c tools/bench-accuracy.c tools/bench-order.c tools/bench-regularity.c tools/bench-siman.c tools/bench-tempering.c tools/bench-domains.c tools/bench-tone.c tools/bench-nurbs.c tools/bench-quench.c tools/bench-transdim.c tools/benchutil.c
+BENCH_SRC := tools/bench.c tools/bench-accuracy.c tools/bench-order.c tools/bench-regularity.c tools/bench-siman.c tools/bench-tempering.c tools/bench-domains.c tools/bench-tone.c tools/bench-nurbs.c tools/bench-quench.c tools/bench-transdim.c tools/bench-kink.c tools/benchutil.c
 BENCH_HDR := tools/benchutil.h tests/pairref.h tests/testutil.h $(wildcard include/linewise/*.h)
 TOOL_FLAGS = $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -Itools -Itests
 

@@ -15,7 +15,8 @@
 ** Markdown into b->doc[its document].  This file holds the sections on
 ** throughput, scaling, the cost of each term and the oriented particles; bench-accuracy.c the
 ** accuracy studies, bench-regularity.c the regularity threshold and its
-** cost, bench-siman.c the GSL baseline, bench-quench.c the quench.
+** cost, bench-siman.c the GSL baseline, bench-quench.c the quench, bench-kink.c what
+** resolving the kernel's kink at the cutoff would buy dE.
 */
 #include <gsl/gsl_math.h>
 #include <math.h>
@@ -41,6 +42,7 @@
 void bench_quadrature(bench_ctx *b);
 void bench_cutoff(bench_ctx *b);
 void bench_near(bench_ctx *b);
+void bench_kink(bench_ctx *b);
 void bench_guide(bench_ctx *b);
 void bench_baseline(bench_ctx *b);
 void bench_tempering(bench_ctx *b);
@@ -692,6 +694,7 @@ static const bench_section sections[] = {
     {"quadrature", BENCH_ACCURACY, bench_quadrature},
     {"cutoff", BENCH_ACCURACY, bench_cutoff},
     {"near", BENCH_ACCURACY, bench_near},
+    {"kink", BENCH_ACCURACY, bench_kink},
     {"tone_accuracy", BENCH_ACCURACY, bench_tone_accuracy},
     {"guide", BENCH_ACCURACY, bench_guide},
     {"quench", BENCH_ACCURACY, bench_quench},
