@@ -29,8 +29,10 @@ typedef struct {
   /* Against the reference, over the trials: the median and the rms of the
   ** relative error of dE (or of the studied term's part), and the share of
   ** Metropolis decisions that differ: with one uniform number u deciding both,
-  ** they differ when u falls between the two acceptance probabilities. */
-  double de_median, de_rms, decisions;
+  ** they differ when u falls between the two acceptance probabilities.
+  ** de_per_T: the median absolute error of dE (or of the part) over the
+  ** temperature the decisions are taken at, what a decision feels. */
+  double de_median, de_rms, de_per_T, decisions;
   double ns, ratio, spread; /* ns per proposal; time over the timing reference's, block by block */
 } variant;
 
@@ -47,9 +49,9 @@ static void run_variants(bench_ctx *b, variant *v, int n, int acc_ref, int time_
   const int nt = b->quick ? 400 : 4000;
   bench_trial *t = bench_trials_new(sp, b->ann_step, nt);
   double *dE = malloc((size_t)n * nt * sizeof *dE), *part = malloc((size_t)n * nt * sizeof *part);
-  double *relerr = malloc((size_t)nt * sizeof *relerr);
+  double *relerr = malloc((size_t)nt * sizeof *relerr), *abserr = malloc((size_t)nt * sizeof *abserr);
   bench_run *r = malloc((size_t)n * sizeof *r);
-  if (!dE || !part || !relerr || !r) bench_die("out of memory", NULL);
+  if (!dE || !part || !relerr || !abserr || !r) bench_die("out of memory", NULL);
   for (int i = 0; i < n; i++) {
     lw_error err;
     lw_splines *copy = lw_splines_clone(sp);
@@ -74,7 +76,7 @@ static void run_variants(bench_ctx *b, variant *v, int n, int acc_ref, int time_
   for (int i = 0; i < n; i++) {
     const double *x = part + (size_t)i * nt, *tot = dE + (size_t)i * nt;
     double num = 0.0, den = 0.0, acc = 0.0;
-    int m = 0;
+    int m = 0, ma = 0;
     for (int k = 0; k < nt; k++) {
       double other = term >= 0 ? tot[k] - x[k] : 0.0; /* the terms not studied */
       if (!isfinite(other)) other = tot[k];
@@ -82,11 +84,13 @@ static void run_variants(bench_ctx *b, variant *v, int n, int acc_ref, int time_
       if (isfinite(x[k]) && isfinite(ref[k])) {
         num += (x[k] - ref[k]) * (x[k] - ref[k]);
         den += ref[k] * ref[k];
+        abserr[ma++] = fabs(x[k] - ref[k]) / T;
         if (ref[k] != 0) relerr[m++] = fabs(x[k] - ref[k]) / fabs(ref[k]);
       }
     }
     v[i].de_rms = den > 0 ? sqrt(num / den) : 0.0;
     v[i].de_median = m ? bench_median(relerr, m) : 0.0;
+    v[i].de_per_T = ma ? bench_median(abserr, ma) : 0.0;
     v[i].decisions = acc / nt;
   }
   double ns[BENCH_MAX_ROWS], ratio[BENCH_MAX_ROWS], spread[BENCH_MAX_ROWS];
@@ -99,6 +103,7 @@ static void run_variants(bench_ctx *b, variant *v, int n, int acc_ref, int time_
   }
   free(r);
   free(relerr);
+  free(abserr);
   free(part);
   free(dE);
   free(t);
@@ -379,18 +384,20 @@ void bench_near(bench_ctx *b)
   fprintf(d, "### The annealed scene\n\n"
              "The pair energy and the pair part of dE at 8 nodes for each near-field radius, against\n"
              "64 nodes with near field 1.5 (so the errors include the far field's quadrature error at\n"
-             "8 nodes).\n\n"
-             "| near | pair energy | dE | dE rms | decisions | ns per proposal | x cost of 1.5 |\n"
-             "|---|---|---|---|---|---|---|\n");
+             "8 nodes). *dE / T*: the median absolute error of the pair part of dE over the temperature\n"
+             "the decisions are taken at (T = %g).\n\n"
+             "| near | pair energy | dE | dE rms | dE / T | decisions | ns per proposal | x cost of 1.5 |\n"
+             "|---|---|---|---|---|---|---|---|\n", b->ann_params.t_end);
   for (int i = 0; i < n; i++) {
     if (i == ref) {
-      fprintf(d, "| 1.5 at 64 nodes (reference) | - | - | - | - | %.0f | %.2f +- %.2f |\n", v[i].ns, v[i].ratio,
+      fprintf(d, "| 1.5 at 64 nodes (reference) | - | - | - | - | - | %.0f | %.2f +- %.2f |\n", v[i].ns, v[i].ratio,
               v[i].spread);
       continue;
     }
     double e = rel(v[i].term[LW_TERM_PAIR], v[ref].term[LW_TERM_PAIR]);
-    fprintf(d, "| %g%s | %.1e | %.1e | %.1e | %.2f %% | %.0f | %.2f +- %.2f |\n", scene_near[i],
-            scene_near[i] ? "" : " (off)", e, v[i].de_median, v[i].de_rms, 100 * v[i].decisions, v[i].ns, v[i].ratio,
+    fprintf(d, "| %g%s | %.1e | %.1e | %.1e | %.1e | %.2f %% | %.0f | %.2f +- %.2f |\n", scene_near[i],
+            scene_near[i] ? "" : " (off)", e, v[i].de_median, v[i].de_rms, v[i].de_per_T, 100 * v[i].decisions, v[i].ns,
+            v[i].ratio,
             v[i].spread);
     keep(&b->near, i, scene_near[i], e, &v[i]);
   }
@@ -406,7 +413,7 @@ void bench_near(bench_ctx *b)
              "cutoffs. An error of the near field would not depend on the cutoff; the kink of\n"
              "(1/r - 1/rc)+ at r = rc (its slope jumps by 1/rc^2, and every sample pair that a move takes\n"
              "across rc sees it) does.\n\n"
-             "| cutoff mm | pair energy | dE | dE rms | decisions |\n|---|---|---|---|---|\n");
+             "| cutoff mm | pair energy | dE | dE rms | dE / T | decisions |\n|---|---|---|---|---|---|\n");
   double de_cut[3];
   for (int c = 0; c < 3; c++) {
     variant w[2];
@@ -416,8 +423,9 @@ void bench_near(bench_ctx *b)
       w[i].p.quadrature = i ? 64 : 8;
     }
     run_variants(b, w, 2, 1, 0, LW_TERM_PAIR);
-    fprintf(d, "| %g | %.1e | %.1e | %.1e | %.2f %% |\n", cuts[c], rel(w[0].term[LW_TERM_PAIR], w[1].term[LW_TERM_PAIR]),
-            w[0].de_median, w[0].de_rms, 100 * w[0].decisions);
+    fprintf(d, "| %g | %.1e | %.1e | %.1e | %.1e | %.2f %% |\n", cuts[c],
+            rel(w[0].term[LW_TERM_PAIR], w[1].term[LW_TERM_PAIR]), w[0].de_median, w[0].de_rms, w[0].de_per_T,
+            100 * w[0].decisions);
     de_cut[c] = w[0].de_median;
   }
   fprintf(d, "\nThe median error of dE falls as rc^%.1f: the kink, not the near field, sets it\n"
