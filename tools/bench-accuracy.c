@@ -397,8 +397,7 @@ void bench_near(bench_ctx *b)
     double e = rel(v[i].term[LW_TERM_PAIR], v[ref].term[LW_TERM_PAIR]);
     fprintf(d, "| %g%s | %.1e | %.1e | %.1e | %.1e | %.2f %% | %.0f | %.2f +- %.2f |\n", scene_near[i],
             scene_near[i] ? "" : " (off)", e, v[i].de_median, v[i].de_rms, v[i].de_per_T, 100 * v[i].decisions, v[i].ns,
-            v[i].ratio,
-            v[i].spread);
+            v[i].ratio, v[i].spread);
     keep(&b->near, i, scene_near[i], e, &v[i]);
   }
   fprintf(d, "\nWithout the near field close sample pairs throw single proposals far off (dE rms) and more\n"
