@@ -186,6 +186,7 @@ void bench_kink(bench_ctx *b)
   FILE *d = b->doc[BENCH_ACCURACY];
   kink_tables k = {{0}};
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  if (!r) bench_die("out of memory", NULL);
   double *err[RULES][NN];
   for (int m = 0; m < RULES; m++)
     for (int i = 0; i < NN; i++)
@@ -193,8 +194,13 @@ void bench_kink(bench_ctx *b)
   gsl_rng_set(r, 3);
   double t0 = bench_now();
   for (int c = 0; c < configs; c++) {
-    double a[8] = {0, 0, 2, gsl_ran_flat(r, -1, 1), 4, gsl_ran_flat(r, -1, 1), 6, 0}, bb[8];
-    double dist = gsl_ran_flat(r, 0.8, 2.5), th = gsl_ran_flat(r, -0.3, 0.3), x0 = gsl_ran_flat(r, 0, 6);
+    /* one draw a statement: the order of evaluation within an initialiser is unspecified */
+    double a[8] = {0, 0, 2, 0, 4, 0, 6, 0}, bb[8];
+    a[3] = gsl_ran_flat(r, -1, 1);
+    a[5] = gsl_ran_flat(r, -1, 1);
+    double dist = gsl_ran_flat(r, 0.8, 2.5);
+    double th = gsl_ran_flat(r, -0.3, 0.3);
+    double x0 = gsl_ran_flat(r, 0, 6);
     for (int j = 0; j < 4; j++) {
       double s = -3 + 2 * j, off = (j == 1 || j == 2) ? gsl_ran_flat(r, -0.7, 0.7) : 0;
       bb[2 * j] = x0 + s * cos(th) - off * sin(th);
