@@ -51,10 +51,10 @@
 #define KINK_SCAN 600 /* the inner integrands' sign is read at this many points */
 #define KINK_MAXN 64
 #define KINK_PANELS 200 /* the reference's panels on A */
-
-enum { RULE_PRODUCT, RULE_EXACT, RULE_INTERP, RULE_SPLIT, RULES };
 #define KINK_SPLIT_SCAN 400 /* A is scanned at this many points for changes in the crossings */
 #define KINK_MAXBREAK 64
+
+enum { RULE_PRODUCT, RULE_EXACT, RULE_INTERP, RULE_SPLIT, RULES };
 
 typedef struct {
   gsl_integration_glfixed_table *tab[KINK_MAXN + 1];
