@@ -727,10 +727,16 @@ static inline const lw_node *proposed_node(const lw_node *base, const lw_proposa
 static lw_status side_partners(lw_proposal *p, uint32_t np)
 {
   for (size_t j = 0; j < 2 * p->n_seg; j++) p->side[j].n = 0;
+  uint32_t last_js = UINT32_MAX, last = 0;
   for (size_t k = 0; k < p->near.n; k++) {
     const lw_pair_near *q = &p->near.pair[k];
-    const uint32_t js = 2 * (q->probe / 2 / np) + (q->probe & 1);
-    if (set_insert(&p->side[js], q->idx / np) != LW_OK) return LW_ENOMEM;
+    const uint32_t js = 2 * (q->probe / 2 / np) + (q->probe & 1), v = q->idx / np;
+    /* a probe's near pairs come cell by cell in index order, so the same
+    ** partner repeats in runs: those need no search */
+    if (js == last_js && v == last) continue;
+    if (set_insert(&p->side[js], v) != LW_OK) return LW_ENOMEM;
+    last_js = js;
+    last = v;
   }
   return LW_OK;
 }
