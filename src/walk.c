@@ -193,8 +193,54 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx
 ** scan four entries a vector (AVX2): each lane computed as scan computes it,
 ** and the far terms of entries 0, 1 and 2, 3 added to the probe's accumulators s0
 ** and s1 as there, so the same bits (vec2.h).  A maximum over lanes is
-** exact in any order.
+** exact in any order.  wide_group is one group of four, entries k to k + 3
+** (bit t on of near_bits[b]), against every probe of the mask.
 */
+static inline __attribute__((always_inline, target("avx2"))) void
+wide_group(const lw_cell *c, uint32_t k, uint32_t k1, uint32_t t, const shared_ctx *sh, probe_ctx *pc,
+           unsigned mask, uint64_t *near_bits, unsigned *any, const int with_near)
+{
+  const double *xs = c->x, *ys = lw_cell_y(c);
+  const float *dls = lw_cell_dl(c);
+  const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
+  const __m256d one = _mm256_set1_pd(1.0), ns = _mm256_set1_pd(sh->ns[0]), cut2 = _mm256_set1_pd(sh->cut2[0]);
+  const __m256d ic = _mm256_set1_pd(sh->ic[0]);
+  const __m128 dlj = _mm_loadu_ps(dls + k);
+  const __m128i in_block = _mm_cmpgt_epi32(_mm_set1_epi32((int)(k1 - k)), lane); /* not past k1 */
+  const __m128i pos = _mm_castps_si128(_mm_cmpgt_ps(dlj, _mm_setzero_ps()));
+  const __m256d ok = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_and_si128(in_block, pos)));
+  const __m256d kept = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(in_block));
+  const __m256d x = _mm256_loadu_pd(xs + k), y = _mm256_loadu_pd(ys + k), w = _mm256_cvtps_pd(dlj);
+  const __m256d e = _mm256_mul_pd(ns, w), m = _mm256_mul_pd(e, e);
+  const __m256d a = _mm256_and_pd(m, kept), a2 = _mm256_max_pd(a, _mm256_permute4x64_pd(a, 0x4e));
+  const __m256d mg = _mm256_max_pd(a2, _mm256_permute_pd(a2, 0x5));
+  for (unsigned left = mask; left; left &= left - 1) {
+    unsigned b = (unsigned)__builtin_ctz(left);
+    probe_ctx *q = &pc[b];
+    const __m256d dx = _mm256_sub_pd(x, _mm256_set1_pd(q->x[0])), dy = _mm256_sub_pd(y, _mm256_set1_pd(q->y[0]));
+    const __m256d r = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
+    const __m256d near2 = _mm256_set1_pd(q->near2[0]);
+    __m256d f = _mm256_and_pd(_mm256_cmp_pd(r, _mm256_set1_pd(q->rc2[0]), _CMP_LT_OQ), ok);
+    const __m256d G = _mm256_max_pd(mg, near2);
+    if (with_near && _mm256_movemask_pd(_mm256_cmp_pd(r, G, _CMP_LT_OQ))) {
+      __m256d n = _mm256_or_pd(_mm256_cmp_pd(r, m, _CMP_LT_OQ), _mm256_cmp_pd(r, near2, _CMP_LT_OQ));
+      n = _mm256_and_pd(_mm256_and_pd(n, _mm256_cmp_pd(r, cut2, _CMP_LT_OQ)), kept);
+      f = _mm256_andnot_pd(n, f);
+      const unsigned found = (unsigned)_mm256_movemask_pd(n);
+      near_bits[b] |= (uint64_t)found << t;
+      *any |= found;
+    }
+    /* no test for a far pair among the lanes: whether there is one is a
+    ** coin toss in most groups, and the mispredicted branch cost more than
+    ** the kernel (5 % of a proposal); lanes masked off add +0, which leaves
+    ** the sums' bits as they are (they are never -0) */
+    const __m256d inv = _mm256_sub_pd(_mm256_div_pd(one, _mm256_sqrt_pd(r)), ic);
+    const __m256d v = _mm256_and_pd(_mm256_mul_pd(_mm256_mul_pd(w, _mm256_set1_pd(q->scale[0])), inv), f);
+    /* s0 and s1 lie side by side: lanes 0, 1 and 2, 3 of one vector */
+    _mm256_storeu_pd((double *)&q->s0, _mm256_add_pd(_mm256_loadu_pd((const double *)&q->s0), v));
+  }
+}
+
 static inline __attribute__((always_inline, target("avx2"))) void
 scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx *pc, unsigned mask,
                uint32_t id0, lw_pair_nearlist *near, const int with_near)
@@ -203,47 +249,7 @@ scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh,
   if (with_near)
     for (unsigned left = mask; left; left &= left - 1) near_bits[__builtin_ctz(left)] = 0;
   unsigned any = 0;
-  const double *xs = c->x, *ys = lw_cell_y(c);
-  const float *dls = lw_cell_dl(c);
-  const __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
-  const __m256d one = _mm256_set1_pd(1.0), ns = _mm256_set1_pd(sh->ns[0]), cut2 = _mm256_set1_pd(sh->cut2[0]);
-  const __m256d ic = _mm256_set1_pd(sh->ic[0]);
-  for (uint32_t k = k0, t = 0; k < k1; k += 4, t += 4) {
-    const __m128 dlj = _mm_loadu_ps(dls + k);
-    const __m128i in_block = _mm_cmpgt_epi32(_mm_set1_epi32((int)(k1 - k)), lane); /* not past k1 */
-    const __m128i pos = _mm_castps_si128(_mm_cmpgt_ps(dlj, _mm_setzero_ps()));
-    const __m256d ok = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_and_si128(in_block, pos)));
-    const __m256d kept = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(in_block));
-    const __m256d x = _mm256_loadu_pd(xs + k), y = _mm256_loadu_pd(ys + k), w = _mm256_cvtps_pd(dlj);
-    const __m256d e = _mm256_mul_pd(ns, w), m = _mm256_mul_pd(e, e);
-    const __m256d a = _mm256_and_pd(m, kept), a2 = _mm256_max_pd(a, _mm256_permute4x64_pd(a, 0x4e));
-    const __m256d mg = _mm256_max_pd(a2, _mm256_permute_pd(a2, 0x5));
-    for (unsigned left = mask; left; left &= left - 1) {
-      unsigned b = (unsigned)__builtin_ctz(left);
-      probe_ctx *q = &pc[b];
-      const __m256d dx = _mm256_sub_pd(x, _mm256_set1_pd(q->x[0])), dy = _mm256_sub_pd(y, _mm256_set1_pd(q->y[0]));
-      const __m256d r = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
-      const __m256d near2 = _mm256_set1_pd(q->near2[0]);
-      __m256d f = _mm256_and_pd(_mm256_cmp_pd(r, _mm256_set1_pd(q->rc2[0]), _CMP_LT_OQ), ok);
-      const __m256d G = _mm256_max_pd(mg, near2);
-      if (with_near && _mm256_movemask_pd(_mm256_cmp_pd(r, G, _CMP_LT_OQ))) {
-        __m256d n = _mm256_or_pd(_mm256_cmp_pd(r, m, _CMP_LT_OQ), _mm256_cmp_pd(r, near2, _CMP_LT_OQ));
-        n = _mm256_and_pd(_mm256_and_pd(n, _mm256_cmp_pd(r, cut2, _CMP_LT_OQ)), kept);
-        f = _mm256_andnot_pd(n, f);
-        const unsigned found = (unsigned)_mm256_movemask_pd(n);
-        near_bits[b] |= (uint64_t)found << t;
-        any |= found;
-      }
-      /* no test for a far pair among the lanes: whether there is one is a
-      ** coin toss in most groups, and the mispredicted branch cost more than
-      ** the kernel (5 % of a proposal); lanes masked off add +0, which leaves
-      ** the sums' bits as they are (they are never -0) */
-      const __m256d inv = _mm256_sub_pd(_mm256_div_pd(one, _mm256_sqrt_pd(r)), ic);
-      const __m256d v = _mm256_and_pd(_mm256_mul_pd(_mm256_mul_pd(w, _mm256_set1_pd(q->scale[0])), inv), f);
-      /* s0 and s1 lie side by side: lanes 0, 1 and 2, 3 of one vector */
-      _mm256_storeu_pd((double *)&q->s0, _mm256_add_pd(_mm256_loadu_pd((const double *)&q->s0), v));
-    }
-  }
+  for (uint32_t k = k0, t = 0; k < k1; k += 4, t += 4) wide_group(c, k, k1, t, sh, pc, mask, near_bits, &any, with_near);
   if (with_near && any) append_near(c, k0, mask, id0, near_bits, near);
 }
 
@@ -259,6 +265,80 @@ __attribute__((target("avx2"))) static void scan_wide_far(const lw_cell *c, uint
                                                           uint32_t id0)
 {
   scan_wide_body(c, k0, k1, sh, pc, mask, id0, NULL, 0);
+}
+
+/*
+** scan eight entries a vector (AVX-512), two groups of four: each lane as
+** wide_group computes it, and a probe's terms of the first group added to
+** its accumulators, then those of the second, so the same bits.  The
+** eight-wide steps read no further than the four-wide ones (the second
+** group is in the block); the last group, if alone, goes four-wide.  It
+** halves the instructions a group costs outside the divider.
+*/
+#define X8_TARGET "avx2,avx512f,avx512dq,avx512vl"
+
+static inline __attribute__((always_inline, target(X8_TARGET))) void
+scan_x8_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx *pc, unsigned mask,
+             uint32_t id0, lw_pair_nearlist *near, const int with_near)
+{
+  uint64_t near_bits[LW_PAIR_CHUNK]; /* those of the probes in mask only */
+  if (with_near)
+    for (unsigned left = mask; left; left &= left - 1) near_bits[__builtin_ctz(left)] = 0;
+  unsigned any = 0;
+  const double *xs = c->x, *ys = lw_cell_y(c);
+  const float *dls = lw_cell_dl(c);
+  const __m512i lane = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m512d one = _mm512_set1_pd(1.0), ns = _mm512_set1_pd(sh->ns[0]), cut2 = _mm512_set1_pd(sh->cut2[0]);
+  const __m512d ic = _mm512_set1_pd(sh->ic[0]);
+  uint32_t k = k0, t = 0;
+  for (; k + 4 < k1; k += 8, t += 8) {
+    const __m256 dlj = _mm256_loadu_ps(dls + k);
+    const __mmask8 kept = _mm512_cmpgt_epi64_mask(_mm512_set1_epi64((long long)(k1 - k)), lane); /* not past k1 */
+    const __mmask8 ok = kept & _mm256_cmp_ps_mask(dlj, _mm256_setzero_ps(), _CMP_GT_OQ);
+    const __m512d x = _mm512_loadu_pd(xs + k), y = _mm512_loadu_pd(ys + k), w = _mm512_cvtps_pd(dlj);
+    const __m512d e = _mm512_mul_pd(ns, w), m = _mm512_mul_pd(e, e);
+    /* each group's largest radius in its four lanes (swap halves, then pairs) */
+    const __m512d a = _mm512_maskz_mov_pd(kept, m), a2 = _mm512_max_pd(a, _mm512_permutex_pd(a, 0x4e));
+    const __m512d mg = _mm512_max_pd(a2, _mm512_permute_pd(a2, 0x55));
+    for (unsigned left = mask; left; left &= left - 1) {
+      unsigned b = (unsigned)__builtin_ctz(left);
+      probe_ctx *q = &pc[b];
+      const __m512d dx = _mm512_sub_pd(x, _mm512_set1_pd(q->x[0])), dy = _mm512_sub_pd(y, _mm512_set1_pd(q->y[0]));
+      const __m512d r = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
+      const __m512d near2 = _mm512_set1_pd(q->near2[0]);
+      __mmask8 f = _mm512_mask_cmp_pd_mask(ok, r, _mm512_set1_pd(q->rc2[0]), _CMP_LT_OQ);
+      /* a lane with r under G is in either group: testing both at once finds the same pairs */
+      if (with_near && _mm512_cmp_pd_mask(r, _mm512_max_pd(mg, near2), _CMP_LT_OQ)) {
+        __mmask8 n = _mm512_cmp_pd_mask(r, m, _CMP_LT_OQ) | _mm512_cmp_pd_mask(r, near2, _CMP_LT_OQ);
+        n &= _mm512_cmp_pd_mask(r, cut2, _CMP_LT_OQ) & kept;
+        f &= (__mmask8)~n;
+        near_bits[b] |= (uint64_t)n << t;
+        any |= n;
+      }
+      const __m512d inv = _mm512_sub_pd(_mm512_div_pd(one, _mm512_sqrt_pd(r)), ic);
+      const __m512d v = _mm512_maskz_mul_pd(f, _mm512_mul_pd(w, _mm512_set1_pd(q->scale[0])), inv);
+      __m256d acc = _mm256_loadu_pd((const double *)&q->s0);
+      acc = _mm256_add_pd(acc, _mm512_castpd512_pd256(v));
+      acc = _mm256_add_pd(acc, _mm512_extractf64x4_pd(v, 1));
+      _mm256_storeu_pd((double *)&q->s0, acc);
+    }
+  }
+  if (k < k1) wide_group(c, k, k1, t, sh, pc, mask, near_bits, &any, with_near);
+  if (with_near && any) append_near(c, k0, mask, id0, near_bits, near);
+}
+
+__attribute__((target(X8_TARGET))) static void scan_x8_near(const lw_cell *c, uint32_t k0, uint32_t k1,
+                                                            const shared_ctx *sh, probe_ctx *pc, unsigned mask,
+                                                            uint32_t id0, lw_pair_nearlist *near)
+{
+  scan_x8_body(c, k0, k1, sh, pc, mask, id0, near, 1);
+}
+
+__attribute__((target(X8_TARGET))) static void scan_x8_far(const lw_cell *c, uint32_t k0, uint32_t k1,
+                                                           const shared_ctx *sh, probe_ctx *pc, unsigned mask,
+                                                           uint32_t id0)
+{
+  scan_x8_body(c, k0, k1, sh, pc, mask, id0, NULL, 0);
 }
 #endif
 
@@ -439,7 +519,12 @@ static lw_status walk_group(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
           if (with_near && l_unlikely(nearlist_reserve(near, (size_t)(k1 - k0) * (size_t)nb) != LW_OK))
             return LW_ENOMEM;
 #if LW_VEC_HAVE_WIDE
-          if (wide) {
+          if (wide == LW_VEC_8) {
+            if (with_near) scan_x8_near(c, k0, k1, sh, pc, m, id0, near);
+            else scan_x8_far(c, k0, k1, sh, pc, m, id0);
+            continue;
+          }
+          if (wide == LW_VEC_4) {
             if (with_near) scan_wide_near(c, k0, k1, sh, pc, m, id0, near);
             else scan_wide_far(c, k0, k1, sh, pc, m, id0);
             continue;
@@ -466,7 +551,7 @@ lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pa
                          {ctx->cutoff2, ctx->cutoff2},
                          {ctx->inv_cutoff, ctx->inv_cutoff}};
   uint64_t seen = 0;
-  const int wide = lw_vec_wide();
+  const int wide = lw_vec_lanes();
   double total = 0.0;
   *far = 0.0;
   for (size_t c0 = 0; c0 < n; c0 += LW_PAIR_CHUNK) {

@@ -146,18 +146,27 @@ Test(walk, two_splines_left_out)
 }
 
 /*
-** The four-wide (AVX2) scan gives the bits of the two-wide one: the far sum
-** and the near pairs in the same order, with and without near pairs and a
-** lower bound, on every spline of the scene.  Adding its four lanes to the
-** two accumulators in another order fails this.
+** The four-wide (AVX2) and eight-wide (AVX-512) scans give the bits of the
+** two-wide one: the far sum, each probe's sum and the near pairs in the same
+** order, with and without near pairs and a lower bound, on every spline of
+** the scene.  Adding the lanes to the accumulators in another order fails
+** this, and so does an eight-wide step that finds other near pairs.
 */
-Test(walk, wide_and_narrow_scans_give_the_same_bits)
+static void set_lanes(int lanes)
+{
+  lw_vec_set_wide(lanes > LW_VEC_2);
+  lw_vec_set_x8(lanes > LW_VEC_4);
+}
+
+Test(walk, scans_of_every_width_give_the_same_bits)
 {
   if (!lw_vec_wide()) cr_skip_test("this processor has no AVX2: only the narrow scan runs here");
+  static const int widths[3] = {LW_VEC_2, LW_VEC_4, LW_VEC_8};
   static scene s;
-  lw_pair_nearlist near[2] = {{0}, {0}};
+  lw_pair_nearlist near[3] = {{0}, {0}, {0}};
   lw_pair_probe P[2 * PER_SPLINE];
-  int differ = 0;
+  double each[3][2 * PER_SPLINE];
+  int differ[3] = {0}, walks = 0;
   for (int with_near = 0; with_near < 2; with_near++) {
     rng_seed(5150 + (uint64_t)with_near);
     scene_init(&s, with_near ? 1.5 : 0.0);
@@ -165,23 +174,28 @@ Test(walk, wide_and_narrow_scans_give_the_same_bits)
       size_t n = probes_of(&s, spline, P);
       lw_pair_filter f = {.lo = spline * PER_SPLINE, .hi = (spline + 1) * PER_SPLINE,
                           .from = spline % 3 ? 0 : (uint32_t)urand(0, N_SAMPLES)};
-      double far[2];
-      for (int w = 0; w < 2; w++) {
-        lw_vec_set_wide(w);
+      double far[3];
+      for (int w = 0; w < 3; w++) {
+        set_lanes(widths[w]);
         near[w].n = 0;
-        cr_assert_eq(lw_pair_walk(s.g, &s.ctx, P, n, &f, &far[w], NULL, &near[w], NULL), LW_OK);
+        cr_assert_eq(lw_pair_walk(s.g, &s.ctx, P, n, &f, &far[w], each[w], &near[w], NULL), LW_OK);
       }
-      lw_vec_set_wide(1);
-      int same = memcmp(&far[0], &far[1], sizeof far[0]) == 0 && near[0].n == near[1].n;
-      for (size_t k = 0; same && k < near[0].n; k++)
-        same = near[0].pair[k].idx == near[1].pair[k].idx && near[0].pair[k].probe == near[1].pair[k].probe;
-      differ += !same;
+      walks++;
+      for (int w = 1; w < 3; w++) {
+        int same = memcmp(&far[0], &far[w], sizeof far[0]) == 0 && memcmp(each[0], each[w], n * sizeof each[0][0]) == 0 &&
+                   near[0].n == near[w].n;
+        for (size_t k = 0; same && k < near[0].n; k++)
+          same = near[0].pair[k].idx == near[w].pair[k].idx && near[0].pair[k].probe == near[w].pair[k].probe;
+        differ[w] += !same;
+      }
     }
     lw_cellgrid_free(s.g);
   }
-  lw_pair_nearlist_free(&near[0]);
-  lw_pair_nearlist_free(&near[1]);
-  cr_assert(differ == 0, "%d walks differ between the wide and the narrow scans", differ);
+  set_lanes(LW_VEC_8);
+  for (int w = 0; w < 3; w++) lw_pair_nearlist_free(&near[w]);
+  cr_assert(differ[1] == 0, "%d of %d walks differ between the four-wide and the narrow scans", differ[1], walks);
+  cr_assert(differ[2] == 0, "%d of %d walks differ between the eight-wide (%s here) and the narrow scans", differ[2],
+            walks, lw_vec_lanes() == LW_VEC_8 ? "AVX-512" : "four-wide: no AVX-512");
 }
 
 /* Same positions, grids filled in different orders: the same bits. */

@@ -165,12 +165,13 @@ static void bench_throughput(bench_ctx *b)
              "nodes in order, splines numbered along the page, point and vector moves half and half\n"
              "(docs/NUMERICS.md, \"Sweep order\"); the last column times the same scenes with the nodes\n"
              "drawn at random instead. The pair kernels run four lanes at a time where the processor\n"
-             "has AVX2 (%s here); the column before it times the same scene with the two-wide (SSE2)\n"
-             "kernels, as a ratio. Both give the same bits. All runs interleaved.\n\n"
+             "has AVX2 (%s here), and the walk's scan eight where it has AVX-512 (%s here); the\n"
+             "column before it times the same scene with the two-wide (SSE2) kernels, as a ratio.\n"
+             "Every width gives the same bits. All runs interleaved.\n\n"
              "| scene | neighbours per sample | ns per proposal | proposals per second | x cost without pair | "
              "acceptance | bytes per segment | two-wide kernels, x time | nodes at random, proposals per second |\n"
              "|---|---|---|---|---|---|---|---|---|\n",
-          BENCH_T, lw_vec_wide() ? "it has" : "it has not");
+          BENCH_T, lw_vec_wide() ? "it has" : "it has not", lw_vec_lanes() == LW_VEC_8 ? "it has" : "it has not");
   for (int i = 0; i < N_THROUGHPUT; i++) {
     char what[96];
     if (!throughput[i].pair) snprintf(what, sizeof what, "every term but pair");

@@ -1,7 +1,8 @@
 /*
 ** vec2.h -- two doubles in one SSE2 register (GCC vector extensions), shared
 ** by the pair kernels' inner loops (walk.c, pairnear.c), and the choice of
-** their four-wide AVX2 versions where the processor has AVX2.
+** their four-wide AVX2 versions where the processor has AVX2 (and of the
+** walk's eight-wide AVX-512 scan where it has that).
 */
 #ifndef LINEWISE_VEC2_H
 #define LINEWISE_VEC2_H
@@ -48,5 +49,19 @@ int lw_vec_wide(void);
 /* 0 keeps the narrow kernels even where AVX2 is there (tests and
 ** benchmarks compare the two); 1 restores the processor's choice. */
 void lw_vec_set_wide(int on);
+
+/*
+** The lanes the walk's scan runs at: 8 (AVX-512: F, DQ and VL) where the
+** processor has them, the wide kernels are on and lw_vec_set_x8 has not
+** turned them off; else 4 where lw_vec_wide; else 2.  The eight-lane scan
+** takes two groups of four at a time and adds them to the accumulators in
+** turn, so every width gives the same bits.
+*/
+enum { LW_VEC_2 = 2, LW_VEC_4 = 4, LW_VEC_8 = 8 };
+int lw_vec_lanes(void);
+
+/* 0 keeps the scan at four lanes even where AVX-512 is there (tests and
+** benchmarks compare); 1 restores the processor's choice. */
+void lw_vec_set_x8(int on);
 
 #endif
