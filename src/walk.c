@@ -98,22 +98,37 @@ typedef struct {
 } shared_ctx;
 
 /* The near pairs a scan of entries k0 on of cell c marked (bit t of
-** near_bits[b]: entry k0 + t with probe b), in the order of the probes and
-** then of the entries. */
-static inline __attribute__((always_inline)) void append_near(const lw_cell *c, uint32_t k0, unsigned mask,
+** near_bits[b]: entry k0 + t with probe b of `touched`), in the order of the
+** probes and then of the entries. */
+static inline __attribute__((always_inline)) void append_near(const lw_cell *c, uint32_t k0, unsigned touched,
                                                                uint32_t id0, const uint64_t *near_bits,
                                                                lw_pair_nearlist *near)
 {
   const double *xs = c->x, *ys = lw_cell_y(c);
   const uint32_t *id = lw_cell_idx(c);
   const float *dls = lw_cell_dl(c);
-  for (unsigned left = mask; left; left &= left - 1) {
+  for (unsigned left = touched; left; left &= left - 1) {
     unsigned b = (unsigned)__builtin_ctz(left);
     for (uint64_t bits = near_bits[b]; bits; bits &= bits - 1) {
       uint32_t k = k0 + (uint32_t)__builtin_ctzll(bits);
       near->pair[near->n++] = (lw_pair_near){xs[k], ys[k], dls[k], id[k], id0 + b};
     }
   }
+}
+
+/* Probe b's near pairs among entries t to t + 3 or t + 7 (bits of found):
+** its bits start at 0 the first time it has any in a scan, so a scan
+** zeroes no bits for the probes without near pairs (most of them), and
+** touched lists the probes append_near has to read. */
+static inline __attribute__((always_inline)) void note_near(uint64_t *near_bits, unsigned *touched, unsigned b,
+                                                             unsigned found, uint32_t t)
+{
+  if (!found) return;
+  if (!(*touched >> b & 1)) {
+    near_bits[b] = 0;
+    *touched |= 1u << b;
+  }
+  near_bits[b] |= (uint64_t)found << t;
 }
 
 /*
@@ -132,10 +147,8 @@ static inline __attribute__((always_inline)) void
 scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx *pc, unsigned mask,
      uint32_t id0, lw_pair_nearlist *near, const int with_near)
 {
-  uint64_t near_bits[LW_PAIR_CHUNK]; /* those of the probes in mask only */
-  if (with_near)
-    for (unsigned left = mask; left; left &= left - 1) near_bits[__builtin_ctz(left)] = 0;
-  unsigned any = 0; /* some near pair: append_near has work */
+  uint64_t near_bits[LW_PAIR_CHUNK]; /* those of the touched probes only (note_near) */
+  unsigned touched = 0;
   const double *xs = c->x, *ys = lw_cell_y(c);
   const float *dls = lw_cell_dl(c);
   const v4f zero = {0.0f, 0.0f, 0.0f, 0.0f};
@@ -171,9 +184,7 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx
         v2l n1 = ((r1 < m1) | (r1 < q->near2)) & (r1 < sh->cut2) & ~hi2l(skip);
         f0 &= ~n0;
         f1 &= ~n1;
-        const unsigned found = bits2(n0) | bits2(n1) << 2;
-        near_bits[b] |= (uint64_t)found << t;
-        any |= found;
+        note_near(near_bits, &touched, b, bits2(n0) | bits2(n1) << 2, t);
       }
       if (bits2(f0 | f1)) {
         v2d v0 = (w0 * q->scale) * (one / lw_vsqrt2(r0) - sh->ic);
@@ -183,7 +194,7 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx
       }
     }
   }
-  if (with_near && any) append_near(c, k0, mask, id0, near_bits, near);
+  if (touched) append_near(c, k0, touched, id0, near_bits, near);
 }
 
 #if LW_VEC_HAVE_WIDE
@@ -198,7 +209,7 @@ scan(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx
 */
 static inline __attribute__((always_inline, target("avx2"))) void
 wide_group(const lw_cell *c, uint32_t k, uint32_t k1, uint32_t t, const shared_ctx *sh, probe_ctx *pc,
-           unsigned mask, uint64_t *near_bits, unsigned *any, const int with_near)
+           unsigned mask, uint64_t *near_bits, unsigned *touched, const int with_near)
 {
   const double *xs = c->x, *ys = lw_cell_y(c);
   const float *dls = lw_cell_dl(c);
@@ -226,9 +237,7 @@ wide_group(const lw_cell *c, uint32_t k, uint32_t k1, uint32_t t, const shared_c
       __m256d n = _mm256_or_pd(_mm256_cmp_pd(r, m, _CMP_LT_OQ), _mm256_cmp_pd(r, near2, _CMP_LT_OQ));
       n = _mm256_and_pd(_mm256_and_pd(n, _mm256_cmp_pd(r, cut2, _CMP_LT_OQ)), kept);
       f = _mm256_andnot_pd(n, f);
-      const unsigned found = (unsigned)_mm256_movemask_pd(n);
-      near_bits[b] |= (uint64_t)found << t;
-      *any |= found;
+      note_near(near_bits, touched, b, (unsigned)_mm256_movemask_pd(n), t);
     }
     /* no test for a far pair among the lanes: whether there is one is a
     ** coin toss in most groups, and the mispredicted branch cost more than
@@ -245,12 +254,11 @@ static inline __attribute__((always_inline, target("avx2"))) void
 scan_wide_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx *pc, unsigned mask,
                uint32_t id0, lw_pair_nearlist *near, const int with_near)
 {
-  uint64_t near_bits[LW_PAIR_CHUNK]; /* those of the probes in mask only */
-  if (with_near)
-    for (unsigned left = mask; left; left &= left - 1) near_bits[__builtin_ctz(left)] = 0;
-  unsigned any = 0;
-  for (uint32_t k = k0, t = 0; k < k1; k += 4, t += 4) wide_group(c, k, k1, t, sh, pc, mask, near_bits, &any, with_near);
-  if (with_near && any) append_near(c, k0, mask, id0, near_bits, near);
+  uint64_t near_bits[LW_PAIR_CHUNK]; /* those of the touched probes only (note_near) */
+  unsigned touched = 0;
+  for (uint32_t k = k0, t = 0; k < k1; k += 4, t += 4)
+    wide_group(c, k, k1, t, sh, pc, mask, near_bits, &touched, with_near);
+  if (touched) append_near(c, k0, touched, id0, near_bits, near);
 }
 
 __attribute__((target("avx2"))) static void scan_wide_near(const lw_cell *c, uint32_t k0, uint32_t k1,
@@ -281,10 +289,8 @@ static inline __attribute__((always_inline, target(X8_TARGET))) void
 scan_x8_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx *pc, unsigned mask,
              uint32_t id0, lw_pair_nearlist *near, const int with_near)
 {
-  uint64_t near_bits[LW_PAIR_CHUNK]; /* those of the probes in mask only */
-  if (with_near)
-    for (unsigned left = mask; left; left &= left - 1) near_bits[__builtin_ctz(left)] = 0;
-  unsigned any = 0;
+  uint64_t near_bits[LW_PAIR_CHUNK]; /* those of the touched probes only (note_near) */
+  unsigned touched = 0;
   const double *xs = c->x, *ys = lw_cell_y(c);
   const float *dls = lw_cell_dl(c);
   const __m512i lane = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
@@ -312,8 +318,7 @@ scan_x8_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, p
         __mmask8 n = _mm512_cmp_pd_mask(r, m, _CMP_LT_OQ) | _mm512_cmp_pd_mask(r, near2, _CMP_LT_OQ);
         n &= _mm512_cmp_pd_mask(r, cut2, _CMP_LT_OQ) & kept;
         f &= (__mmask8)~n;
-        near_bits[b] |= (uint64_t)n << t;
-        any |= n;
+        note_near(near_bits, &touched, b, n, t);
       }
       const __m512d inv = _mm512_sub_pd(_mm512_div_pd(one, _mm512_sqrt_pd(r)), ic);
       const __m512d v = _mm512_maskz_mul_pd(f, _mm512_mul_pd(w, _mm512_set1_pd(q->scale[0])), inv);
@@ -323,8 +328,8 @@ scan_x8_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, p
       _mm256_storeu_pd((double *)&q->s0, acc);
     }
   }
-  if (k < k1) wide_group(c, k, k1, t, sh, pc, mask, near_bits, &any, with_near);
-  if (with_near && any) append_near(c, k0, mask, id0, near_bits, near);
+  if (k < k1) wide_group(c, k, k1, t, sh, pc, mask, near_bits, &touched, with_near);
+  if (touched) append_near(c, k0, touched, id0, near_bits, near);
 }
 
 __attribute__((target(X8_TARGET))) static void scan_x8_near(const lw_cell *c, uint32_t k0, uint32_t k1,
