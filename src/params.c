@@ -877,10 +877,11 @@ static lw_status landscape_picture(const lw_params *p, int *landscape, lw_error 
   lw_path_join(full, sizeof full, dir, p->image);
   lw_image_info info;
   lw_error probe;
+  /* the picture is what is wrong, so the message names its key: a preset's
+  ** orientation = auto reads the header before the scene loads the picture */
   if (lw_image_probe(full, &info, &probe)) {
-    lw_params_origin(p, lw_params_find("scene", "orientation"), where, sizeof where);
-    return lw_error_set(err, LW_EINPUT, "%s: key 'scene.orientation' = auto needs the picture's size: %s", where,
-                        probe.msg);
+    lw_params_origin(p, lw_params_find("scene", "image"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'scene.image': %s", where, probe.msg);
   }
   *landscape = info.width > info.height;
   return LW_OK;

@@ -369,9 +369,15 @@ Test(params, auto_orientation_follows_the_picture)
     cr_assert(p.width == cases[k].width && p.height == (cases[k].width == 297 ? 210 : 297), "case %zu: %g x %g", k,
               p.width, p.height);
   }
-  /* a picture that is not there: one message naming the key */
-  snprintf(text, sizeof text, "[scene]\npage = a4\norientation = auto\nimage = %s/none.png\n", dir);
-  cr_assert_eq(read_text(text, &p, &err), LW_EINPUT);
-  cr_assert(strstr(err.msg, "key 'scene.orientation' = auto needs the picture's size") && strstr(err.msg, "none.png"),
-            "%s", err.msg);
+  /* a picture that is not there, or that linewise cannot read: one message
+  ** naming the picture's key and line, whether orientation = auto is the
+  ** scene's or the photo preset's */
+  static const char *const extras[] = {"orientation = auto\n", "preset = photo\n"};
+  for (size_t k = 0; k < 2; k++) {
+    snprintf(text, sizeof text, "[scene]\npage = a4\n%simage = %s/none.png\n", extras[k], dir);
+    cr_assert_eq(read_text(text, &p, &err), LW_EINPUT);
+    cr_assert(strstr(err.msg, ":4: key 'scene.image': ") && strstr(err.msg, "none.png") &&
+                  !strstr(err.msg, "orientation"),
+              "%s", err.msg);
+  }
 }
