@@ -694,6 +694,52 @@ lw_status lw_image_blur(lw_image *img, double sigma, lw_error *err)
 
 /* ---- tone and page -------------------------------------------------- */
 
+/* Bins of the levels' histogram: 1/4096 of the tone range, finer than an
+** 8-bit picture's steps and than anything a line density can show. */
+#define LEVELS_BINS 4096
+
+lw_status lw_image_levels(lw_image *img, double clip, double *lo, double *hi, lw_error *err)
+{
+  size_t n = (size_t)img->width * (size_t)img->height;
+  size_t *hist = calloc(LEVELS_BINS, sizeof *hist);
+  if (!hist) return lw_error_set(err, LW_ENOMEM, "out of memory for the picture's levels");
+  size_t count = 0;
+  for (size_t k = 0; k < n; k++) {
+    if (img->alpha && img->alpha[k] < 0.5f) continue;
+    int b = (int)(img->tone[k] * LEVELS_BINS);
+    hist[b < 0 ? 0 : (b >= LEVELS_BINS ? LEVELS_BINS - 1 : b)]++;
+    count++;
+  }
+  double l = 0.0, h = 1.0;
+  if (count) {
+    /* the first bin from each end past `cut` pixels */
+    size_t cut = (size_t)floor(clip * (double)count), c = 0;
+    int b = 0;
+    while (b < LEVELS_BINS - 1 && (c += hist[b]) <= cut) b++;
+    l = (double)b / LEVELS_BINS;
+    c = 0;
+    b = LEVELS_BINS - 1;
+    while (b > 0 && (c += hist[b]) <= cut) b--;
+    h = (double)(b + 1) / LEVELS_BINS;
+  }
+  free(hist);
+  if (h - l < LW_IMAGE_LEVELS_MIN_SPAN) {
+    double m = 0.5 * (l + h);
+    l = m - 0.5 * LW_IMAGE_LEVELS_MIN_SPAN;
+    h = m + 0.5 * LW_IMAGE_LEVELS_MIN_SPAN;
+    if (l < 0) h -= l, l = 0;
+    if (h > 1) l -= h - 1, h = 1;
+  }
+  const double scale = 1.0 / (h - l);
+  for (size_t k = 0; k < n; k++) {
+    double t = (img->tone[k] - l) * scale;
+    img->tone[k] = (float)(t < 0 ? 0 : (t > 1 ? 1 : t));
+  }
+  *lo = l;
+  *hi = h;
+  return LW_OK;
+}
+
 void lw_image_tone_curve(lw_image *img, double gamma, double contrast, int invert)
 {
   size_t n = (size_t)img->width * (size_t)img->height;

@@ -75,6 +75,11 @@ const lw_param_def lw_param_table[] = {
       "Resample the picture to this width, the height following the aspect ratio; 0 = as loaded."),
   NUM("scene", "image_blur", LW_PT_DOUBLE, image_blur, "0", "mm", 0, 1e4, 0,
       "Standard deviation of a Gaussian blur of the tone, in millimetres on the page. 0 = none."),
+  NUM("scene", "image_levels", LW_PT_DOUBLE, image_levels, "0", "", 0, 0.25, 0,
+      "Auto levels, before the tone curve: the darkest and the lightest of this share of the "
+      "picture's pixels turn black and white, the tones between stretched linearly (at most "
+      "20 times), so that a dim or hazy picture uses the whole range. 0 = off; the photo "
+      "preset sets 0.01."),
   NUM("scene", "image_gamma", LW_PT_DOUBLE, image_gamma, "1", "", 0, 100, LW_MIN_OPEN,
       "Tone curve t <- t^gamma (after `image_invert`): above 1 darkens the mid-tones."),
   NUM("scene", "image_contrast", LW_PT_DOUBLE, image_contrast, "1", "", 0, 100, 0,
@@ -833,6 +838,7 @@ static const struct {
     {"anneal", "sweeps", "300", 0},        {"anneal", "steps", "5", 0},
     {"moves", "fixed_count", "0", 0},      {"energy", "chem_length", NULL, -2.5 / 0.35},
     {"moves", "grow", "0.05", 0},          {"moves", "shrink", "0.05", 0},
+    {"scene", "image_levels", "0.01", 0},
 };
 
 /* Sets an unset key from text; the key stays unset (line 0), so a later

@@ -88,6 +88,13 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
                                    p->height - p->margin);
   }
   if ((st = lw_image_blur(sc->image, p->image_blur / sc->image_place.pixel, err))) return st;
+  if (p->image_levels > 0) {
+    double lo, hi;
+    if ((st = lw_image_levels(sc->image, p->image_levels, &lo, &hi, err))) return st;
+    size_t used = strlen(sc->note);
+    snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_levels: tones %.3f to %.3f stretched to 0 to 1",
+             used ? "; " : "", lo, hi);
+  }
   lw_image_tone_curve(sc->image, p->image_gamma, p->image_contrast, p->image_invert);
   return LW_OK;
 }

@@ -1,6 +1,6 @@
 /*
 ** test_image.c -- pictures: decoding (gray conversion, alpha, orientation,
-** formats, bad files), resampling, blur, the tone curve, page fitting.
+** formats, bad files), resampling, blur, levels, the tone curve, page fitting.
 */
 #include <criterion/criterion.h>
 #include <math.h>
@@ -290,6 +290,74 @@ Test(image, tone_curve_invert_gamma_contrast)
     cr_assert(fabs(img->tone[k] - want) < 1e-6, "%d", k);
   }
   lw_image_free(img);
+}
+
+/* Auto levels on n tones spread evenly over [a, b]: the share `clip` at each
+** end goes to 0 and 1 and the rest is the linear map of the tones between the
+** levels found; those lie within a bin (1/4096) and a pixel's step of the
+** clip's quantiles. */
+Test(image, levels_stretch_the_tones_between_the_quantiles)
+{
+  const int n = 2000;
+  const double a = 0.3, b = 0.6, step = (b - a) / (n - 1), bin = 1.0 / 4096;
+  lw_image *img = lw_image_new(n, 1, 0, NULL);
+  for (int k = 0; k < n; k++) img->tone[(k * 7) % n] = (float)(a + step * k); /* any order */
+  float *orig = malloc(n * sizeof *orig);
+  memcpy(orig, img->tone, n * sizeof *orig);
+  double lo, hi;
+  cr_assert_eq(lw_image_levels(img, 0.01, &lo, &hi, NULL), LW_OK);
+  cr_assert(fabs(lo - (a + 0.01 * (b - a))) < bin + step, "lo %g", lo);
+  cr_assert(fabs(hi - (b - 0.01 * (b - a))) < bin + step, "hi %g", hi);
+  int black = 0, white = 0;
+  for (int k = 0; k < n; k++) {
+    double want = (orig[k] - lo) / (hi - lo);
+    want = want < 0 ? 0 : (want > 1 ? 1 : want);
+    cr_assert(fabs(img->tone[k] - want) < 1e-6, "%d: %g, want %g", k, img->tone[k], want);
+    black += img->tone[k] == 0.0f;
+    white += img->tone[k] == 1.0f;
+  }
+  cr_assert(abs(black - n / 100) <= 2 + (int)(bin / step) && abs(white - n / 100) <= 2 + (int)(bin / step),
+            "black %d, white %d", black, white);
+  /* clip 0: the darkest and lightest pixels themselves */
+  memcpy(img->tone, orig, n * sizeof *orig);
+  cr_assert_eq(lw_image_levels(img, 0, &lo, &hi, NULL), LW_OK);
+  cr_assert(fabs(lo - a) < bin && fabs(hi - b) < bin, "%g %g", lo, hi);
+  free(orig);
+  lw_image_free(img);
+}
+
+/* Transparent pixels (white after compositing) are not counted and stay
+** white; a flat picture is stretched at most 1 / LW_IMAGE_LEVELS_MIN_SPAN
+** times, about its middle, and inside [0, 1] near white. */
+Test(image, levels_skip_transparent_pixels_and_cap_the_stretch)
+{
+  const int n = 1000;
+  lw_image *img = lw_image_new(2 * n, 1, 1, NULL);
+  for (int k = 0; k < n; k++) {
+    img->tone[2 * k] = (float)(0.3 + 0.3 * k / (n - 1));
+    img->tone[2 * k + 1] = 1.0f;
+    img->alpha[2 * k + 1] = k % 2 ? 0.0f : 0.49f;
+  }
+  double lo, hi;
+  cr_assert_eq(lw_image_levels(img, 0.05, &lo, &hi, NULL), LW_OK);
+  cr_assert(fabs(lo - 0.315) < 1e-3 && fabs(hi - 0.585) < 1e-3, "%g %g", lo, hi);
+  for (int k = 0; k < n; k++) cr_assert_eq(img->tone[2 * k + 1], 1.0f);
+  lw_image_free(img);
+
+  /* noise of +-0.001 about 0.5, and about 0.99 */
+  static const double mid[2] = {0.5, 0.99};
+  for (int m = 0; m < 2; m++) {
+    img = lw_image_new(n, 1, 0, NULL);
+    for (int k = 0; k < n; k++) img->tone[k] = (float)(mid[m] + 0.001 * ((k % 3) - 1));
+    cr_assert_eq(lw_image_levels(img, 0.01, &lo, &hi, NULL), LW_OK);
+    cr_assert(fabs(hi - lo - LW_IMAGE_LEVELS_MIN_SPAN) < 1e-12 && lo >= 0 && hi <= 1, "%g %g", lo, hi);
+    if (m == 0) cr_assert(fabs(0.5 * (lo + hi) - 0.5) < 1e-3, "%g %g", lo, hi);
+    else cr_assert(hi == 1.0, "%g", hi);
+    double spread = 0;
+    for (int k = 0; k < n; k++) spread = fmax(spread, fabs(img->tone[k] - img->tone[0]));
+    cr_assert(spread <= 0.002 / LW_IMAGE_LEVELS_MIN_SPAN + 1e-5, "spread %g", spread);
+    lw_image_free(img);
+  }
 }
 
 Test(image, fit_centres_and_keeps_the_aspect_ratio)

@@ -308,6 +308,7 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
             p.tone_blur);
   cr_assert(fabs(p.field_sigma - 10 * 0.35) < 1e-12);
   cr_assert(p.tone == 40 && p.tone_ink == 0.5 && p.coverage == 0.6 && p.splines == 0 && p.sweeps == 300);
+  cr_assert(p.image_levels == 0.01, "image_levels %g", p.image_levels);
   /* the annealer chooses the count, its price per mm scaling with the pen */
   cr_assert(p.fixed_count == 0 && fabs(p.chem_length + 2.5) < 1e-12 && p.mix_grow == 0.05 && p.mix_shrink == 0.05,
             "fixed_count %d, chem_length %.17g", p.fixed_count, p.chem_length);
@@ -334,6 +335,7 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
   lw_params_defaults(&d);
   cr_assert_eq(read_text("[scene]\npage = a4\n", &p, &err), LW_OK);
   cr_assert(p.segment_length == d.segment_length && p.tone == d.tone && !strcmp(p.domains, d.domains));
+  cr_assert(p.image_levels == 0 && d.image_levels == 0);
 }
 
 /* orientation = auto turns a named page to the picture, which the photo

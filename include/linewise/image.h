@@ -89,6 +89,17 @@ lw_status lw_image_blur(lw_image *img, double sigma, lw_error *err);
 ** structure tensor with it). */
 lw_status lw_image_blur_plane(float *plane, int w, int h, double sigma, lw_error *err);
 
+/* Auto levels: stretches the tone linearly so that the darkest share `clip`
+** of the picture's pixels turn black and the lightest share `clip` white,
+** clipped to [0, 1].  Pixels less than half opaque are not counted (with
+** alpha the tone is already composited over white, and stays white).  The
+** stretch is at most 1 / LW_IMAGE_LEVELS_MIN_SPAN: a flatter picture is
+** widened about its middle tone, so that sensor noise on a blank page is
+** not blown up into structure.  *lo and *hi receive the tones that became 0
+** and 1.  LW_ENOMEM with err set. */
+#define LW_IMAGE_LEVELS_MIN_SPAN 0.05
+lw_status lw_image_levels(lw_image *img, double clip, double *lo, double *hi, lw_error *err);
+
 /* The tone curve, in this order:
 **     t <- 1 - t                         if invert
 **     t <- t^gamma                       (gamma > 1 darkens the mid-tones)
