@@ -209,6 +209,42 @@ Test(image_cli, scene_keys_that_need_a_picture_say_so)
   }
 }
 
+/* scene.image_levels acts on the loaded tone before the tone curve: a dim
+** picture (tones 0.4 to 0.6) spans [0, 1] after it, its darkest pixels turn
+** white under image_invert (levels, then invert), and the note names the
+** levels; without the key the tones stay as they were. */
+Test(image_cli, levels_stretch_a_dim_picture_before_the_tone_curve)
+{
+  const int w = 40, h = 30;
+  float *g = malloc(sizeof(float) * w * h);
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) g[j * w + i] = (float)(0.4 + 0.2 * (i + w * j) / (w * h - 1));
+  lw_test_png(lw_test_path("dim.png"), w, h, g, NULL);
+  free(g);
+  for (int levels = 0; levels < 2; levels++) {
+    char text[256];
+    snprintf(text, sizeof text, "[scene]\nwidth = 50\nheight = 40\nmargin = 5\nimage = dim.png\n%s",
+             levels ? "image_levels = 0.02\nimage_invert = 1\n" : "");
+    write_text("scene.ini", text);
+    lw_params p;
+    lw_scene sc;
+    lw_error err;
+    cr_assert_eq(lw_params_read(&p, lw_test_path("scene.ini"), &err), LW_OK, "%s", err.msg);
+    cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
+    const float *t = sc.image->tone;
+    float lo = 1, hi = 0;
+    for (int k = 0; k < w * h; k++) lo = fminf(lo, t[k]), hi = fmaxf(hi, t[k]);
+    if (levels) {
+      cr_assert(lo == 0.0f && hi == 1.0f && t[0] == 1.0f && t[w * h - 1] == 0.0f, "%g %g %g", lo, hi, t[0]);
+      cr_assert(strstr(sc.note, "scene.image_levels: tones 0.40"), "%s", sc.note);
+    } else {
+      cr_assert(fabsf(lo - 0.4f) < 3e-3f && fabsf(hi - 0.6f) < 3e-3f, "%g %g", lo, hi);
+      cr_assert_null(strstr(sc.note, "image_levels"), "%s", sc.note);
+    }
+    lw_scene_clear(&sc);
+  }
+}
+
 Test(image_cli, an_alpha_mask_is_the_boundary)
 {
   /* a picture opaque inside a disk of radius 15 px, 1 px = 1 mm */
