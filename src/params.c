@@ -10,6 +10,7 @@
 
 #include <errno.h>
 #include <ini.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -573,6 +574,57 @@ static int section_known(const char *section)
   return 0;
 }
 
+/* Edit distance (insertions, deletions, substitutions) of two names; names
+** longer than any parameter's are far from everything. */
+static int edit_distance(const char *a, const char *b)
+{
+  size_t la = strlen(a), lb = strlen(b);
+  int row[64];
+  if (la >= 64 || lb >= 64) return INT_MAX / 2;
+  for (size_t j = 0; j <= lb; j++) row[j] = (int)j;
+  for (size_t i = 1; i <= la; i++) {
+    int diag = row[0];
+    row[0] = (int)i;
+    for (size_t j = 1; j <= lb; j++) {
+      int up = row[j], best = diag + (a[i - 1] != b[j - 1]);
+      if (up + 1 < best) best = up + 1;
+      if (row[j - 1] + 1 < best) best = row[j - 1] + 1;
+      row[j] = best;
+      diag = up;
+    }
+  }
+  return row[lb];
+}
+
+/* "; did you mean 'scene.image'?" for the parameter nearest to a name that
+** is not one (a typo in the key, or a key in the wrong section), or "" when
+** none is near enough to be what was meant. */
+static void suggest_key(const char *section, const char *key, char *out, size_t n)
+{
+  const lw_param_def *hit = NULL;
+  int best = 1 + (int)strlen(key) / 4 + 1;
+  for (size_t i = 0; i < lw_param_count; i++) {
+    const lw_param_def *d = &lw_param_table[i];
+    int dist = edit_distance(key, d->key) + (strcmp(section, d->section) != 0);
+    if (dist < best) best = dist, hit = d;
+  }
+  if (hit) snprintf(out, n, "; did you mean '%s.%s'?", hit->section, hit->key);
+  else if (n) out[0] = '\0';
+}
+
+/* The same for a section: "; did you mean [scene]?" or "". */
+static void suggest_section(const char *section, char *out, size_t n)
+{
+  const char *hit = NULL;
+  int best = 3;
+  for (size_t i = 0; i < lw_param_count; i++) {
+    int dist = edit_distance(section, lw_param_table[i].section);
+    if (dist < best) best = dist, hit = lw_param_table[i].section;
+  }
+  if (hit) snprintf(out, n, "; did you mean [%s]?", hit);
+  else if (n) out[0] = '\0';
+}
+
 /* Index of word in "a|b|c", or -1. */
 static int choice_index(const char *choices, const char *word)
 {
@@ -743,14 +795,17 @@ static int on_key(void *user, const char *section, const char *key, const char *
   reader_ctx *rc = user;
   if (rc->failed) return 0;
   rc->failed = 1;
+  char hint[96];
   if (!section_known(section)) {
-    lw_error_set(rc->err, LW_EINPUT, "%s:%d: unknown section [%s]", rc->p->file, rc->line, section);
+    suggest_section(section, hint, sizeof hint);
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: unknown section [%s]%s", rc->p->file, rc->line, section, hint);
     return 0;
   }
   const lw_param_def *d = lw_params_find(section, key);
   if (!d) {
-    lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' is not a parameter (see docs/PARAMETERS.md)",
-                 rc->p->file, rc->line, section, key);
+    suggest_key(section, key, hint, sizeof hint);
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' is not a parameter%s (see docs/PARAMETERS.md)",
+                 rc->p->file, rc->line, section, key, hint);
     return 0;
   }
   int *line = &rc->p->line[d - lw_param_table];
@@ -955,9 +1010,12 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
   memcpy(key, dot + 1, lk);
   key[lk] = '\0';
   const lw_param_def *d = lw_params_find(section, key);
-  if (!d)
-    return lw_error_set(err, LW_EUSAGE, "--set %s.%s: not a parameter (see docs/PARAMETERS.md)",
-                        section, key);
+  if (!d) {
+    char hint[96];
+    suggest_key(section, key, hint, sizeof hint);
+    return lw_error_set(err, LW_EUSAGE, "--set %s.%s: not a parameter%s (see docs/PARAMETERS.md)", section, key,
+                        hint);
+  }
   char expected[256];
   if (!assign(p, d, eq + 1, expected, sizeof expected))
     return lw_error_set(err, LW_EUSAGE, "--set %s.%s: expected %s, got '%s'", section, key,

@@ -86,6 +86,24 @@ Test(params, bad_input_names_file_line_and_key)
 {
   expect_error("[scene]\nwidth = 100\nwidht = 3\n", ":3:", "scene.widht", "not a parameter");
   expect_error("[scenery]\nwidth = 100\n", ":2:", "[scenery]", "unknown section");
+  /* a typo, or a key in the wrong section: the message names the parameter
+  ** meant; a name near none names none */
+  expect_error("[scene]\nwidht = 3\n", ":2:", "scene.widht", "did you mean 'scene.width'?");
+  expect_error("[anneal]\nquadrature = 6\n", ":2:", "anneal.quadrature", "did you mean 'energy.quadrature'?");
+  expect_error("[energy]\npair_cuttoff = 2\n", ":2:", NULL, "did you mean 'energy.pair_cutoff'?");
+  expect_error("[scen]\nwidth = 100\n", ":2:", "[scen]", "unknown section [scen]; did you mean [scene]?");
+  for (int k = 0; k < 2; k++) {
+    lw_params p;
+    lw_error err;
+    cr_assert_eq(read_text(k ? "[scene]\nfoo = 1\n" : "[nothing]\nwidth = 1\n", &p, &err), LW_EINPUT);
+    cr_assert_null(strstr(err.msg, "did you mean"), "%s", err.msg);
+  }
+  lw_params q;
+  lw_error err;
+  lw_params_defaults(&q);
+  cr_assert_eq(lw_params_set(&q, "init.segmentlength=3", &err), LW_EUSAGE);
+  cr_assert(strstr(err.msg, "--set init.segmentlength: not a parameter; did you mean 'init.segment_length'?"), "%s",
+            err.msg);
   expect_error("[energy]\npair = -1\n", ":2:", "energy.pair", ">= 0");
   expect_error("[energy]\n\n\nquadrature = 65\n", ":4:", "energy.quadrature", "<= 64");
   expect_error("[energy]\nquadrature = 8.5\n", ":2:", "energy.quadrature", "whole number");
