@@ -14,6 +14,7 @@
 #include "linewise/model.h"
 #include "linewise/scene.h"
 #include "linewise/spacing.h"
+#include "linewise/vec2.h"
 #include "testutil.h"
 
 TestSuite(tone, .init = lw_image_dir_make, .fini = lw_image_dir_remove);
@@ -177,6 +178,41 @@ Test(tone, a_sample_deposits_its_ink_area)
   cr_assert(fabs(sum - want) <= 50 * px * 0.5 / LW_TONE_ONE * t->area + 1e-12 * want, "deposited %.17g, want %.17g",
             sum, want);
   free(r);
+  lw_scene_clear(&sc);
+}
+
+/* The footprints' integers are the same at every width the processor
+** offers (the eight-lane rows of AVX-512 and the scalar rows): samples all
+** over the raster and past its edges, into the whole raster and into a box
+** whose rows are not a multiple of eight, added and taken away. */
+Test(tone, footprints_are_the_same_integers_at_every_width)
+{
+  lw_params p = tone_params(30, 30, grey, 1.0, 0.9);
+  lw_scene sc;
+  lw_test_scene(&sc, &p);
+  const lw_tone *t = &sc.tone;
+  const int bx = 3, by = 5, bw = t->w - 7, bh = t->h - 9;
+  int64_t *r[2], *b[2];
+  for (int x8 = 0; x8 < 2; x8++) {
+    lw_vec_set_x8(x8);
+    r[x8] = lw_tone_raster_new(t);
+    b[x8] = calloc((size_t)bw * (size_t)bh, sizeof(int64_t));
+    cr_assert(r[x8] && b[x8]);
+    rng_seed(11);
+    for (int k = 0; k < 400; k++) {
+      double x = urand(-3, 33), y = urand(-3, 33), dl = urand(0.05, 0.8);
+      int sign = k % 3 ? 1 : -1;
+      lw_tone_splat(t, r[x8], 0, 0, t->w, t->h, x, y, dl, sign);
+      lw_tone_splat(t, b[x8], bx, by, bw, bh, x, y, dl, sign);
+    }
+  }
+  lw_vec_set_x8(1);
+  cr_assert(!memcmp(r[0], r[1], (size_t)t->w * (size_t)t->h * sizeof(int64_t)), "the rasters differ");
+  cr_assert(!memcmp(b[0], b[1], (size_t)bw * (size_t)bh * sizeof(int64_t)), "the boxes differ");
+  int64_t nonzero = 0;
+  for (size_t k = 0; k < (size_t)bw * (size_t)bh; k++) nonzero += b[0][k] != 0;
+  cr_assert(nonzero > bw * bh / 2, "the samples cover the box (%lld of %d pixels)", (long long)nonzero, bw * bh);
+  for (int x8 = 0; x8 < 2; x8++) free(r[x8]), free(b[x8]);
   lw_scene_clear(&sc);
 }
 
