@@ -602,7 +602,7 @@ static int edit_distance(const char *a, const char *b)
 static void suggest_key(const char *section, const char *key, char *out, size_t n)
 {
   const lw_param_def *hit = NULL;
-  int best = 1 + (int)strlen(key) / 4 + 1;
+  int best = 2 + (int)strlen(key) / 4; /* a suggestion is nearer than this */
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
     int dist = edit_distance(key, d->key) + (strcmp(section, d->section) != 0);
@@ -616,7 +616,7 @@ static void suggest_key(const char *section, const char *key, char *out, size_t 
 static void suggest_section(const char *section, char *out, size_t n)
 {
   const char *hit = NULL;
-  int best = 3;
+  int best = 3; /* a suggestion is nearer than this */
   for (size_t i = 0; i < lw_param_count; i++) {
     int dist = edit_distance(section, lw_param_table[i].section);
     if (dist < best) best = dist, hit = lw_param_table[i].section;

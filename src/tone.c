@@ -114,14 +114,9 @@ static int nearest(double c, double c0, double pixel, int radius, int n, int *k)
   return 1;
 }
 
-/* The normalised weights of the 2 radius + 1 pixel centres around pixel k
-** for a sample at c: the Gaussian less its value at rho = radius pixels,
-** 0 beyond.  Every centre outside the window is farther than rho from c, so
-** the footprint is continuous in c as the window moves with the sample (a
-** Gaussian cut at the window would jump by e^-4.5 of its peak there). */
 #if LW_VEC_HAVE_WIDE
 /* g[0, n) /= d, eight at a time (AVX-512). */
-__attribute__((target("avx2,avx512f,avx512dq,avx512vl"))) static void divide8(double *g, int n, double d)
+__attribute__((target(LW_VEC_X8_TARGET))) static void divide8(double *g, int n, double d)
 {
   const __m512d v = _mm512_set1_pd(d);
   for (int i = 0; i < n; i += 8) {
@@ -131,6 +126,11 @@ __attribute__((target("avx2,avx512f,avx512dq,avx512vl"))) static void divide8(do
 }
 #endif
 
+/* The normalised weights of the 2 radius + 1 pixel centres around pixel k
+** for a sample at c: the Gaussian less its value at rho = radius pixels,
+** 0 beyond.  Every centre outside the window is farther than rho from c, so
+** the footprint is continuous in c as the window moves with the sample (a
+** Gaussian cut at the window would jump by e^-4.5 of its peak there). */
 static void weights(const lw_tone *t, double c, double c0, int k, double *g, int x8)
 {
   const int R = t->radius;
@@ -196,8 +196,8 @@ static void splat_row(int64_t *row, const double *g, int n, double ay, int sign)
 ** scalar row's operations in its order, a product, the cap (min_pd(v, cap)
 ** is v < cap ? v : cap), a product and a sum without fused multiply-add,
 ** so the same integers. */
-__attribute__((target("avx2,avx512f,avx512dq,avx512vl"))) static void splat_row8(int64_t *row, const double *g,
-                                                                                  int n, double ay, int sign)
+__attribute__((target(LW_VEC_X8_TARGET))) static void splat_row8(int64_t *row, const double *g, int n, double ay,
+                                                                  int sign)
 {
   const __m512d a = _mm512_set1_pd(ay), cap = _mm512_set1_pd(LW_TONE_CAP), one = _mm512_set1_pd(LW_TONE_ONE),
                 half = _mm512_set1_pd(0.5);

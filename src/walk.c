@@ -283,9 +283,8 @@ __attribute__((target("avx2"))) static void scan_wide_far(const lw_cell *c, uint
 ** group is in the block); the last group, if alone, goes four-wide.  It
 ** halves the instructions a group costs outside the divider.
 */
-#define X8_TARGET "avx2,avx512f,avx512dq,avx512vl"
 
-static inline __attribute__((always_inline, target(X8_TARGET))) void
+static inline __attribute__((always_inline, target(LW_VEC_X8_TARGET))) void
 scan_x8_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, probe_ctx *pc, unsigned mask,
              uint32_t id0, lw_pair_nearlist *near, const int with_near)
 {
@@ -332,16 +331,16 @@ scan_x8_body(const lw_cell *c, uint32_t k0, uint32_t k1, const shared_ctx *sh, p
   if (touched) append_near(c, k0, touched, id0, near_bits, near);
 }
 
-__attribute__((target(X8_TARGET))) static void scan_x8_near(const lw_cell *c, uint32_t k0, uint32_t k1,
-                                                            const shared_ctx *sh, probe_ctx *pc, unsigned mask,
-                                                            uint32_t id0, lw_pair_nearlist *near)
+__attribute__((target(LW_VEC_X8_TARGET))) static void scan_x8_near(const lw_cell *c, uint32_t k0, uint32_t k1,
+                                                                    const shared_ctx *sh, probe_ctx *pc, unsigned mask,
+                                                                    uint32_t id0, lw_pair_nearlist *near)
 {
   scan_x8_body(c, k0, k1, sh, pc, mask, id0, near, 1);
 }
 
-__attribute__((target(X8_TARGET))) static void scan_x8_far(const lw_cell *c, uint32_t k0, uint32_t k1,
-                                                           const shared_ctx *sh, probe_ctx *pc, unsigned mask,
-                                                           uint32_t id0)
+__attribute__((target(LW_VEC_X8_TARGET))) static void scan_x8_far(const lw_cell *c, uint32_t k0, uint32_t k1,
+                                                                   const shared_ctx *sh, probe_ctx *pc, unsigned mask,
+                                                                   uint32_t id0)
 {
   scan_x8_body(c, k0, k1, sh, pc, mask, id0, NULL, 0);
 }

@@ -60,6 +60,9 @@ void lw_vec_set_wide(int on);
 enum { LW_VEC_2 = 2, LW_VEC_4 = 4, LW_VEC_8 = 8 };
 int lw_vec_lanes(void);
 
+/* The target of the functions that run where lw_vec_lanes() is LW_VEC_8. */
+#define LW_VEC_X8_TARGET "avx2,avx512f,avx512dq,avx512vl"
+
 /* 0 keeps the scan at four lanes even where AVX-512 is there (tests and
 ** benchmarks compare); 1 restores the processor's choice. */
 void lw_vec_set_x8(int on);
