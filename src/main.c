@@ -114,6 +114,25 @@ static int cmd_energy(int argc, char **argv)
   return rc;
 }
 
+/* --set section.key=value.  A file named on the command line is named from
+** the current directory, as by every other command; in a scene file it is
+** named from the file's directory (lw_params_read), so a relative path given
+** here is made absolute before the scene's directory can be joined to it. */
+static lw_status set_option(lw_params *p, const char *assignment, lw_error *err)
+{
+  const char *dot = strchr(assignment, '.'), *eq = strchr(assignment, '=');
+  char section[64], key[64], cwd[4096], abs[2 * LW_PATH_MAX];
+  if (dot && eq && dot < eq && (size_t)(dot - assignment) < sizeof section && (size_t)(eq - dot - 1) < sizeof key) {
+    snprintf(section, sizeof section, "%.*s", (int)(dot - assignment), assignment);
+    snprintf(key, sizeof key, "%.*s", (int)(eq - dot - 1), dot + 1);
+    const lw_param_def *d = lw_params_find(section, key);
+    if (d && d->unit && !strcmp(d->unit, "path") && eq[1] && eq[1] != '/' && getcwd(cwd, sizeof cwd) &&
+        snprintf(abs, sizeof abs, "%.*s%s/%s", (int)(eq + 1 - assignment), assignment, cwd, eq + 1) < (int)sizeof abs)
+      return lw_params_set(p, abs, err);
+  }
+  return lw_params_set(p, assignment, err);
+}
+
 static volatile sig_atomic_t stop_requested = 0;
 
 static void on_signal(int sig)
@@ -127,6 +146,8 @@ static void on_signal(int sig)
 typedef struct {
   int quiet, tty;
   long start_sweep, next_plain, last_plain;
+  double swept_from; /* the clock when the first sweep began: set-up (a large
+                     ** picture's decoding, the placement) is not a sweep's cost */
 } progress;
 
 /* What moves: the temperature and acceptance of the chain, or the clock
@@ -146,7 +167,7 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
   if (pg->quiet) return;
   double t = lw_anneal_seconds(a);
   long done = a->sweep - pg->start_sweep, total = a->end_sweep - pg->start_sweep;
-  double per = done > 0 ? (t - a->wall_before) / (double)done : 0.0;
+  double per = done > 0 ? (t - pg->swept_from) / (double)done : 0.0;
   double left = per * (double)(a->end_sweep - a->sweep);
   if (pg->tty) {
     static double shown = -1;
@@ -220,7 +241,7 @@ static int watched_fail(watcher *w, const lw_error *err)
 
 static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_error *err)
 {
-  progress pg = {quiet, isatty(2), a->sweep, a->sweep, -1};
+  progress pg = {quiet, isatty(2), a->sweep, a->sweep, -1, lw_anneal_seconds(a)};
   /* a signal during start-up stops before the first sweep; the processes
   ** of an MPI run stop together, at the sweep where one of them was asked */
   int stopped = (net ? net->stop_agreed : stop_requested) && !lw_anneal_done(a);
@@ -354,7 +375,7 @@ static int cmd_run(int argc, char **argv)
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
     if (!strcmp(argv[i], "--set")) {
       if (!v) { lw_error_set(&err, LW_EUSAGE, "--set: expected section.key=value"); return fail(&err); }
-      if (lw_params_set(&p, v, &err)) return fail(&err);
+      if (set_option(&p, v, &err)) return fail(&err);
       i++;
     } else if (!strcmp(argv[i], "--out")) {
       if (!v || !*v) { lw_error_set(&err, LW_EUSAGE, "--out: expected a directory, got '%s'", v ? v : ""); return fail(&err); }

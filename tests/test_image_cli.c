@@ -157,6 +157,29 @@ Test(image_cli, a_missing_picture_is_named_with_the_scene_directory_once)
   cr_assert_null(strstr(errs, "sub/sub/"), "%s", errs);
 }
 
+
+/* The README's "--set scene.image=my-photo.jpg" names a picture in the
+** current directory, as every command-line tool would; the scene file's own
+** paths stay relative to the file.  --set's was joined to the scene's
+** directory, so a picture beside the user was not found. */
+Test(image_cli, a_picture_named_with_set_is_found_from_the_current_directory)
+{
+  cr_assert_eq(mkdir(lw_test_path("sub"), 0777), 0);
+  write_picture("here.png", 50, 40);
+  write_picture("sub/there.png", 50, 40);
+  char text[1024], errs[8192];
+  snprintf(text, sizeof text, scene_fmt, "there.png");
+  write_text("sub/scene.ini", text);
+  cr_assert_eq(run("run sub/scene.ini --out a --quiet --stop-at 1", errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(run("run sub/scene.ini --set scene.image=here.png --out b --quiet --stop-at 1", errs, sizeof errs), 0,
+               "%s", errs);
+  cr_assert_eq(lw_test_sh("grep -qx 'image = %s' %s", lw_test_path("here.png"), lw_test_path("b/scene.ini")), 0);
+  /* the picture beside the scene is not what --set names */
+  cr_assert_eq(run("run sub/scene.ini --set scene.image=there.png --out c", errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "--set: key 'scene.image'") && strstr(errs, "/there.png: cannot open the image"), "%s",
+            errs);
+  cr_assert_null(strstr(errs, "/sub/there.png"), "%s", errs);
+}
 /* The plot report and both fidelity scores, per pen too, reach
 ** summary.json and stderr; crop = 0 reports no rectangle. */
 Test(image_cli, the_plot_and_fidelity_reports)
