@@ -128,15 +128,28 @@ static lw_status score(const lw_params *p, const lw_scene *sc, const lw_strokes 
   return s;
 }
 
-/* The close share of the paths as plotted, each path a stroke (spacing.h). */
-static lw_status close_share(const lw_params *p, const lw_strokes *st, lw_drawing_report *rep, lw_error *err)
+/* The close share of the paths as plotted, each path a stroke (spacing.h);
+** with layers.apart = pen, of each pen's paths among themselves. */
+static lw_status close_share(const lw_params *p, const lw_scene *sc, const lw_strokes *st, lw_drawing_report *rep,
+                             lw_error *err)
 {
-  size_t *owner = malloc((st->n_segs ? st->n_segs : 1) * sizeof *owner);
-  if (!owner) return lw_error_set(err, LW_ENOMEM, "out of memory for the close share");
-  for (size_t k = 0; k < st->n; k++)
-    for (size_t g = st->first[k]; g < st->first[k + 1]; g++) owner[g] = k;
-  lw_status s = lw_close_share(st->b, owner, st->n_segs, p->pen_width, &rep->close_share, err);
+  const size_t n = st->n_segs ? st->n_segs : 1;
+  const int by_pen = lw_layers_planes(&sc->layers) > 1;
+  size_t *owner = malloc(n * sizeof *owner), *pen = by_pen ? malloc(n * sizeof *pen) : NULL;
+  if (!owner || (by_pen && !pen)) {
+    free(owner);
+    free(pen);
+    return lw_error_set(err, LW_ENOMEM, "out of memory for the close share");
+  }
+  for (int q = 0; q < st->n_pens; q++)
+    for (size_t k = st->pen_first[q]; k < st->pen_first[q + 1]; k++)
+      for (size_t g = st->first[k]; g < st->first[k + 1]; g++) {
+        owner[g] = k;
+        if (pen) pen[g] = (size_t)q;
+      }
+  lw_status s = lw_close_share(st->b, owner, pen, st->n_segs, p->pen_width, &rep->close_share, err);
   free(owner);
+  free(pen);
   return s;
 }
 
@@ -173,7 +186,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
     dir_file(path, sizeof path, dir, "final.pdf");
     s = lw_output_pdf_strokes(st, &page, under, path, err);
   }
-  if (!s) s = close_share(p, st, rep, err);
+  if (!s) s = close_share(p, sc, st, rep, err);
   if (!s && tone) s = score(p, sc, st, tone, rep, err);
   lw_strokes_free(st);
   return s;

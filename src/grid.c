@@ -159,10 +159,19 @@ static void cell_set(const lw_cellgrid *g, lw_cell *c, uint32_t k, uint32_t i, d
   if (g->dim == 3) lw_cell_z(c)[k] = z;
 }
 
-/* Insert and move for both dimensions (z is ignored in 2-D). */
-static lw_status insert(lw_cellgrid *g, uint32_t i, double x, double y, double z, float dl)
+/* Cells of one plane of a 2-D grid. */
+static uint32_t plane_cells(const lw_cellgrid *g) { return (uint32_t)g->nx * (uint32_t)g->ny; }
+
+/* The cell of (x, y, z), in 2-D in the given plane (z is ignored there). */
+static uint32_t cell_in(const lw_cellgrid *g, int plane, double x, double y, double z)
 {
-  uint32_t to = cell_of(g, x, y, z);
+  return g->dim == 2 ? (uint32_t)plane * plane_cells(g) + cell_of(g, x, y, 0.0) : cell_of(g, x, y, z);
+}
+
+/* Insert and move for both dimensions. */
+static lw_status insert(lw_cellgrid *g, int plane, uint32_t i, double x, double y, double z, float dl)
+{
+  uint32_t to = cell_in(g, plane, x, y, z);
   lw_cell *c = &g->cell[to];
   if (cell_reserve(g, c) != LW_OK) return LW_ENOMEM;
   uint32_t k = lower_bound(c, i);
@@ -175,7 +184,9 @@ static lw_status insert(lw_cellgrid *g, uint32_t i, double x, double y, double z
 
 static lw_status move(lw_cellgrid *g, uint32_t i, double x, double y, double z, float dl)
 {
-  uint32_t from = g->home[i], to = cell_of(g, x, y, z);
+  /* in 2-D a sample stays in its plane */
+  const int plane = g->dim == 2 ? (int)(g->home[i] / plane_cells(g)) : 0;
+  uint32_t from = g->home[i], to = cell_in(g, plane, x, y, z);
   lw_cell *c = &g->cell[from];
   uint32_t k = lower_bound(c, i);
   if (from == to) {
@@ -190,12 +201,34 @@ static lw_status move(lw_cellgrid *g, uint32_t i, double x, double y, double z, 
   ** the growth threshold keeps a cell from resizing back and forth.  A
   ** failed shrink keeps the larger block, which is as good. */
   if (c->cap - c->n > c->n / 4 + 4) (void)cell_resize(g, c, fitted(c->n));
-  return insert(g, i, x, y, z, dl); /* cannot fail: room reserved */
+  return insert(g, plane, i, x, y, z, dl); /* cannot fail: room reserved */
 }
 
 lw_status lw_cellgrid_insert(lw_cellgrid *g, uint32_t i, double x, double y, float dl)
 {
-  return insert(g, i, x, y, 0.0, dl);
+  return insert(g, 0, i, x, y, 0.0, dl);
+}
+
+lw_status lw_cellgrid_insert_in(lw_cellgrid *g, int plane, uint32_t i, double x, double y, float dl)
+{
+  return insert(g, plane, i, x, y, 0.0, dl);
+}
+
+lw_status lw_cellgrid_planes(lw_cellgrid *g, int planes)
+{
+  if (planes <= 1 || g->dim != 2 || g->nz == planes) return LW_OK;
+  size_t n = (size_t)plane_cells(g) * (size_t)planes;
+  for (size_t c = 0; c < lw_cellgrid_cells(g); c++) free(g->cell[c].x);
+  lw_cell *cell = realloc(g->cell, n * sizeof *cell);
+  if (!cell) {
+    /* the old cells, emptied, are still a grid of one plane */
+    memset(g->cell, 0, lw_cellgrid_cells(g) * sizeof *g->cell);
+    return LW_ENOMEM;
+  }
+  memset(cell, 0, n * sizeof *cell);
+  g->cell = cell;
+  g->nz = planes;
+  return LW_OK;
 }
 
 lw_status lw_cellgrid_move(lw_cellgrid *g, uint32_t i, double x, double y, float dl)
@@ -205,7 +238,7 @@ lw_status lw_cellgrid_move(lw_cellgrid *g, uint32_t i, double x, double y, float
 
 lw_status lw_cellgrid_insert3(lw_cellgrid *g, uint32_t i, double x, double y, double z)
 {
-  return insert(g, i, x, y, z, 0.0f);
+  return insert(g, 0, i, x, y, z, 0.0f);
 }
 
 lw_status lw_cellgrid_move3(lw_cellgrid *g, uint32_t i, double x, double y, double z)

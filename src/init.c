@@ -172,6 +172,7 @@ typedef struct {
   long nx, ny;
   int32_t *head, *next;
   double *x, *y;
+  uint8_t *layer; /* each sample's layer, when lines keep apart within layers only; else NULL */
   size_t n, cap;
 } placed_samples;
 
@@ -181,9 +182,10 @@ static void placed_free(placed_samples *ps)
   free(ps->next);
   free(ps->x);
   free(ps->y);
+  free(ps->layer);
 }
 
-static int placed_init(placed_samples *ps, const lw_scene *sc, double d, size_t cap)
+static int placed_init(placed_samples *ps, const lw_scene *sc, double d, size_t cap, int by_layer)
 {
   *ps = (placed_samples){.d2 = d * d, .cap = cap};
   double w = sc->width + 2 * d, h = sc->height + 2 * d;
@@ -198,7 +200,8 @@ static int placed_init(placed_samples *ps, const lw_scene *sc, double d, size_t 
   ps->next = malloc((cap ? cap : 1) * sizeof *ps->next);
   ps->x = malloc((cap ? cap : 1) * sizeof *ps->x);
   ps->y = malloc((cap ? cap : 1) * sizeof *ps->y);
-  if (!ps->head || !ps->next || !ps->x || !ps->y) return 0;
+  ps->layer = by_layer ? malloc((cap ? cap : 1) * sizeof *ps->layer) : NULL;
+  if (!ps->head || !ps->next || !ps->x || !ps->y || (by_layer && !ps->layer)) return 0;
   for (long c = 0; c < ps->nx * ps->ny; c++) ps->head[c] = -1;
   return 1;
 }
@@ -212,8 +215,10 @@ static void placed_cell(const placed_samples *ps, double x, double y, long *cx, 
   *cy = fy < 0 ? 0 : (fy >= (double)ps->ny ? ps->ny - 1 : (long)fy);
 }
 
-/* How many of the spline's pair samples have a placed sample within d. */
-static size_t placed_crowding(const placed_samples *ps, const lw_scene *sc, const lw_node *nd, size_t segments)
+/* How many of the spline's pair samples have a placed sample (of its layer)
+** within d. */
+static size_t placed_crowding(const placed_samples *ps, const lw_scene *sc, const lw_node *nd, size_t segments,
+                              int layer)
 {
   size_t count = 0;
   lw_samples s;
@@ -226,7 +231,7 @@ static size_t placed_crowding(const placed_samples *ps, const lw_scene *sc, cons
         for (long x = cx > 0 ? cx - 1 : 0; x <= cx + 1 && x < ps->nx && !hit; x++)
           for (int32_t e = ps->head[y * ps->nx + x]; e >= 0 && !hit; e = ps->next[e]) {
             double dx = ps->x[e] - s.x[q], dy = ps->y[e] - s.y[q];
-            hit = dx * dx + dy * dy < ps->d2;
+            hit = dx * dx + dy * dy < ps->d2 && (!ps->layer || ps->layer[e] == layer);
           }
       count += (size_t)hit;
     }
@@ -234,7 +239,7 @@ static size_t placed_crowding(const placed_samples *ps, const lw_scene *sc, cons
   return count;
 }
 
-static void placed_add(placed_samples *ps, const lw_scene *sc, const lw_node *nd, size_t segments)
+static void placed_add(placed_samples *ps, const lw_scene *sc, const lw_node *nd, size_t segments, int layer)
 {
   lw_samples s;
   for (size_t m = 0; m < segments; m++) {
@@ -244,6 +249,7 @@ static void placed_add(placed_samples *ps, const lw_scene *sc, const lw_node *nd
       placed_cell(ps, s.x[q], s.y[q], &cx, &cy);
       ps->x[ps->n] = s.x[q];
       ps->y[ps->n] = s.y[q];
+      if (ps->layer) ps->layer[ps->n] = (uint8_t)layer;
       ps->next[ps->n] = ps->head[cy * ps->nx + cx];
       ps->head[cy * ps->nx + cx] = (int32_t)ps->n;
       ps->n++;
@@ -274,7 +280,9 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
   }
   const int spaced = sc->min_spacing > 0.0 && sc->pair_quad.n > 0;
   placed_samples placed = {0};
-  if (spaced) nomem |= !placed_init(&placed, sc, sc->min_spacing, n * segments * (size_t)sc->pair_quad.n);
+  if (spaced)
+    nomem |= !placed_init(&placed, sc, sc->min_spacing, n * segments * (size_t)sc->pair_quad.n,
+                          lw_layers_planes(&sc->layers) > 1);
   lw_node *best = spaced ? malloc((segments + 1) * sizeof *best) : NULL;
   nomem |= spaced && !best;
   if (nomem) {
@@ -323,7 +331,7 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
       }
       if (!fits(sc, nd, segments)) continue;
       if (!spaced) break;
-      size_t crowded = placed_crowding(&placed, sc, nd, segments);
+      size_t crowded = placed_crowding(&placed, sc, nd, segments, layer);
       if (crowded < least) {
         least = crowded;
         memcpy(best, nd, (segments + 1) * sizeof *best);
@@ -332,7 +340,7 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
     }
     if (spaced && least != SIZE_MAX) {
       memcpy(nd, best, (segments + 1) * sizeof *best);
-      placed_add(&placed, sc, nd, segments);
+      placed_add(&placed, sc, nd, segments, layer);
       t = 0; /* placed, if never in room */
     }
     if (t == tries) {

@@ -59,6 +59,7 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
 {
   memset(ls, 0, sizeof *ls);
   ls->source = p->ly_source;
+  ls->apart = p->ly_apart;
   static const char *const keys[] = {"source", "colors", "turn", "tone_min", "tone_max", "pen_width"};
   if (!p->ly_names[0]) {
     for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++)

@@ -68,7 +68,21 @@ typedef struct {
   const lw_splines *sp;
   uint32_t np;
   const lw_pair_ctx *ctx;
+  const lw_layers_spec *planes; /* the layers, when each is a plane of the grid; else NULL */
 } pair_view;
+
+/* The layers as planes of the pair grid (grid.h): with layers.apart = pen a
+** line pairs and keeps its spacing with its own layer's lines only. */
+static const lw_layers_spec *planes_of(const lw_scene *sc)
+{
+  return lw_layers_planes(&sc->layers) > 1 ? &sc->layers : NULL;
+}
+
+/* The grid plane of spline i's samples. */
+static int plane_of(const lw_layers_spec *planes, const lw_splines *sp, size_t i)
+{
+  return planes ? lw_splines_layer(planes, sp, i) : 0;
+}
 
 /* Samples i0 to i0 + n - 1 of the grid. */
 static void samples_at(const pair_view *v, uint32_t i0, size_t n, lw_pair_sample *out)
@@ -87,7 +101,8 @@ static void samples_at(const pair_view *v, uint32_t i0, size_t n, lw_pair_sample
 static lw_pair_filter filter_of(const pair_view *v, uint32_t spline, uint32_t from)
 {
   size_t g0 = lw_segment_index(v->sp, spline, 0), n = lw_splines_segments(v->sp, spline);
-  return (lw_pair_filter){.lo = (uint32_t)(g0 * v->np), .hi = (uint32_t)((g0 + n) * v->np), .from = from};
+  return (lw_pair_filter){.lo = (uint32_t)(g0 * v->np), .hi = (uint32_t)((g0 + n) * v->np), .from = from,
+                          .plane = plane_of(v->planes, v->sp, spline)};
 }
 
 /* The Bezier control points of global segment g. */
@@ -219,7 +234,7 @@ static lw_status pair_all(const pair_view *v, double *e, lw_near_values *out)
   const lw_cellgrid *g = v->g;
   double sum = 0.0, t;
   lw_status st = LW_OK;
-  for (size_t ci = 0; ci < (size_t)g->nx * (size_t)g->ny && st == LW_OK; ci++) {
+  for (size_t ci = 0; ci < lw_cellgrid_cells(g) && st == LW_OK; ci++) {
     const lw_cell *c = &g->cell[ci];
     if (!c->n) continue; /* an empty cell may have no block: NULL + 0 is undefined */
     const uint32_t *idx = lw_cell_idx(c);
@@ -314,10 +329,16 @@ static const lw_pair_ctx *pair_ctx(const lw_term_ctx *c) { return c->data; }
 
 static lw_cellgrid *grid_for(const lw_scene *sc, const lw_term_ctx *pair, size_t n_samples, lw_error *err)
 {
-  if (sc->transdim)
-    return lw_cellgrid_new_room(0.0, 0.0, sc->width, sc->height, pair_ctx(pair)->cutoff, n_samples,
-                                TRANSDIM_GRID_ROOM, err);
-  return lw_cellgrid_new(0.0, 0.0, sc->width, sc->height, pair_ctx(pair)->cutoff, n_samples, err);
+  lw_cellgrid *g =
+    sc->transdim ? lw_cellgrid_new_room(0.0, 0.0, sc->width, sc->height, pair_ctx(pair)->cutoff, n_samples,
+                                        TRANSDIM_GRID_ROOM, err)
+                 : lw_cellgrid_new(0.0, 0.0, sc->width, sc->height, pair_ctx(pair)->cutoff, n_samples, err);
+  if (g && planes_of(sc) && lw_cellgrid_planes(g, sc->layers.n) != LW_OK) {
+    lw_cellgrid_free(g);
+    lw_error_set(err, LW_ENOMEM, "out of memory for the pair grid's %d planes", sc->layers.n);
+    return NULL;
+  }
+  return g;
 }
 
 /* Adds the spline terms of spline i (segment lengths seg_len, length L) to term[]. */
@@ -422,12 +443,12 @@ static double total_of(const double term[LW_TERM_COUNT], size_t irregular)
   return irregular ? INFINITY : total;
 }
 
-/* Puts the np pair samples ps of segment g into the grid. */
-static lw_status store_samples(lw_cellgrid *grid, size_t g, int np, const lw_pair_sample *ps)
+/* Puts the np pair samples ps of segment g into the grid's plane `plane`. */
+static lw_status store_samples(lw_cellgrid *grid, int plane, size_t g, int np, const lw_pair_sample *ps)
 {
   for (int q = 0; q < np; q++) {
     size_t i = g * (size_t)np + (size_t)q;
-    if (lw_cellgrid_insert(grid, (uint32_t)i, ps[q].x, ps[q].y, ps[q].dl) != LW_OK) return LW_ENOMEM;
+    if (lw_cellgrid_insert_in(grid, plane, (uint32_t)i, ps[q].x, ps[q].y, ps[q].dl) != LW_OK) return LW_ENOMEM;
   }
   return LW_OK;
 }
@@ -453,7 +474,8 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
     irregular += !segment_eval(sc, ctx_of(&ts, sp, sp->seg_spline[g]), a, a + 1, &s, &seg_len[g], local,
                                pc ? pc->quad : NULL, grid ? seg_ps : NULL);
     for (int t = 0; t < sc->n_local; t++) term[sc->local[t]] += local[t];
-    if (grid && store_samples(grid, g, np, seg_ps) != LW_OK) goto nomem;
+    if (grid && store_samples(grid, plane_of(planes_of(sc), sp, sp->seg_spline[g]), g, np, seg_ps) != LW_OK)
+      goto nomem;
   }
   if (ts.n_spline)
     for (size_t i = 0; i < sp->n_splines; i++) {
@@ -463,7 +485,7 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
       spline_terms(&ts, sp, seg_len, i, L, term);
     }
   if (grid) {
-    pair_view v = {grid, sp, (uint32_t)np, pair_ctx(pc)};
+    pair_view v = {grid, sp, (uint32_t)np, pair_ctx(pc), planes_of(sc)};
     double e;
     if (pair_all(&v, &e, NULL) != LW_OK) goto nomem;
     term[ts.pair] = pc->coef * e;
@@ -604,7 +626,8 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
                                         pc ? pc->quad : NULL, m->grid ? seg_ps : NULL);
     m->n_irregular += m->seg_irregular[g];
     for (int t = 0; t < nl; t++) term[sc->local[t]] += local[t];
-    if (m->grid && store_samples(m->grid, g, np, seg_ps) != LW_OK) return LW_ENOMEM;
+    if (m->grid && store_samples(m->grid, plane_of(planes_of(sc), sp, sp->seg_spline[g]), g, np, seg_ps) != LW_OK)
+      return LW_ENOMEM;
   }
   for (size_t i = 0; i < sp->n_splines; i++) {
     size_t g0 = lw_segment_index(sp, i, 0), n = lw_splines_segments(sp, i);
@@ -614,7 +637,7 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
     spline_terms(ts, sp, m->seg_len, i, L, term);
   }
   if (m->grid) {
-    pair_view v = {m->grid, sp, (uint32_t)np, pair_ctx(pc)};
+    pair_view v = {m->grid, sp, (uint32_t)np, pair_ctx(pc), planes_of(sc)};
     double e;
     lw_near_values vals = {0};
     memset(m->near_valid, 0, sp->n_segments * sizeof *m->near_valid);
@@ -839,7 +862,7 @@ static double pair_walk(const lw_model *m, lw_proposal *p)
 {
   const lw_scene *sc = m->scene;
   const uint32_t np = (uint32_t)sc->pair_quad.n;
-  const pair_view v = {m->grid, m->sp, np, &sc->pair};
+  const pair_view v = {m->grid, m->sp, np, &sc->pair, planes_of(sc)};
   const size_t n = p->n_seg * np;
   lw_far_memo *mo = &p->memo;
   p->walk_done = 0;
@@ -916,7 +939,7 @@ static double pair_near_delta(const lw_model *m, lw_proposal *p, const lw_node *
 {
   const lw_scene *sc = m->scene;
   const uint32_t np = (uint32_t)sc->pair_quad.n;
-  const pair_view v = {m->grid, m->sp, np, &sc->pair};
+  const pair_view v = {m->grid, m->sp, np, &sc->pair, planes_of(sc)};
   p->partners.n = 0;
   p->near_vals.n = 0;
   for (size_t j = 0; j < p->n_seg; j++) {
@@ -943,8 +966,11 @@ static double pair_near_delta(const lw_model *m, lw_proposal *p, const lw_node *
 ** them: min_spacing is a fraction of the cell).  Edge cells hold the points
 ** clamped from beyond the grid on their outer sides only, so the facing
 ** sides bound them too. */
-static size_t crowding(const lw_cellgrid *g, const lw_pair_sample *ps, size_t n, const lw_pair_filter *f, double d2)
+static size_t crowding(const lw_cellgrid *grid, const lw_pair_sample *ps, size_t n, const lw_pair_filter *f,
+                       double d2)
 {
+  lw_cellgrid view;
+  const lw_cellgrid *g = lw_cellgrid_plane(grid, f->plane, &view);
   const double side = 1.0 / g->inv_h, far2 = d2 * (1.0 + 1e-8);
   size_t count = 0;
   for (size_t k = 0; k < n; k++) {
@@ -1066,7 +1092,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   p->pair_done = 0;
   if (m->grid) {
     /* the old samples, from the grid: the walk's old side and a failed commit's undo */
-    pair_view v = {m->grid, sp, (uint32_t)np, pair_ctx(pc)};
+    pair_view v = {m->grid, sp, (uint32_t)np, pair_ctx(pc), planes_of(sc)};
     size_t first = (g0 + p->seg0) * (size_t)np, n = p->n_seg * (size_t)np;
     samples_at(&v, (uint32_t)first, n, p->ps_old);
   }
@@ -1075,7 +1101,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
     const size_t n = p->n_seg * (size_t)np;
     const uint32_t lo = (uint32_t)(g0 * (size_t)np), hi = (uint32_t)((g0 + nseg) * (size_t)np);
     const double d2 = sc->min_spacing * sc->min_spacing;
-    const lw_pair_filter own = {.lo = lo, .hi = hi};
+    const lw_pair_filter own = {.lo = lo, .hi = hi, .plane = plane_of(planes_of(sc), sp, p->spline)};
     size_t now = crowding(m->grid, p->ps, n, &own, d2);
     /* the old side only when it matters: a move into free room is the rule */
     if (now > 0 && now > crowding(m->grid, p->ps_old, n, &own, d2)) {
@@ -1282,7 +1308,8 @@ static size_t splice_seg_node(const lw_proposal *p, size_t j)
 ** them: what a splice's pair sums and spacing leave out. */
 static lw_pair_filter old_filter(const pair_view *v, const lw_proposal *p)
 {
-  if (!p->n_old) return (lw_pair_filter){0};
+  /* a splice's splines are all of the proposal's layer */
+  if (!p->n_old) return (lw_pair_filter){.plane = v->planes ? p->layer : 0};
   lw_pair_filter f = filter_of(v, p->old[0], 0);
   if (p->n_old == 2) {
     lw_pair_filter g = filter_of(v, p->old[1], 0);
@@ -1361,7 +1388,7 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p)
 {
   const lw_scene *sc = m->scene;
   const uint32_t np = (uint32_t)sc->pair_quad.n;
-  const pair_view v = {m->grid, m->sp, np, &sc->pair};
+  const pair_view v = {m->grid, m->sp, np, &sc->pair, planes_of(sc)};
   const size_t nn = p->n_seg * np, no = p->n_old_seg * np;
   for (size_t k = 0; k < nn; k++) p->probe[k] = (lw_pair_probe){p->ps[k].x, p->ps[k].y, p->ps[k].dl, 1.0};
   for (size_t k = 0; k < no; k++)
@@ -1555,7 +1582,7 @@ void lw_model_propose_regroup(const lw_model *m, lw_proposal *p, const uint32_t 
   if ((forbidden || p->irregular) && !undefined) dE = INFINITY;
   else if (was_irregular && !undefined) dE = -INFINITY;
   p->pair_done = 0;
-  const pair_view v = {m->grid, sp, (uint32_t)np, pc ? pair_ctx(pc) : NULL};
+  const pair_view v = {m->grid, sp, (uint32_t)np, pc ? pair_ctx(pc) : NULL, planes_of(sc)};
   if (m->grid)
     for (size_t k = 0, o = 0; k < (size_t)n_old; k++) {
       const size_t first = lw_segment_index(sp, old[k], 0) * (size_t)np, run = p->old_seg[k] * (size_t)np;
@@ -1726,7 +1753,8 @@ static lw_status commit_splice(lw_model *m, const lw_proposal *p)
       slots_reset(m, g0, nn);
       if (slot[k] < 0) lw_cellgrid_extend(m->grid, nn * (size_t)np);
       for (size_t j = 0; j < nn && st == LW_OK; j++)
-        st = store_samples(m->grid, g0 + j, np, p->ps + ((size_t)j0 + j) * (size_t)np);
+        st = store_samples(m->grid, planes_of(m->scene) ? p->layer : 0, g0 + j, np,
+                           p->ps + ((size_t)j0 + j) * (size_t)np);
     }
   }
   if (m->grid && !p->pair_done) {

@@ -885,10 +885,9 @@ static lw_status pairs_push(uint32_t **v, size_t *n, size_t *cap, uint32_t ga, u
 ** the list of segment pairs (lower, higher), as the walk decides them
 ** (walk.h).
 */
-static lw_status far_field(const lw_cellgrid *g, const lw_splines *sp, uint32_t np, const lw_pair_ctx *ctx,
-                           sample_grad *gs, double *far, uint32_t **pairs, size_t *n_pairs)
+static lw_status far_plane(const lw_cellgrid *g, const lw_splines *sp, uint32_t np, const lw_pair_ctx *ctx,
+                           sample_grad *gs, double *far, uint32_t **pairs, size_t *n_pairs, size_t *cap)
 {
-  size_t cap = 0;
   double sum = 0.0;
   const double inv = ctx->inv_cutoff, cut2 = ctx->cutoff2, ns = ctx->near_scale;
   for (int cy = 0; cy < g->ny; cy++)
@@ -908,7 +907,7 @@ static lw_status far_field(const lw_cellgrid *g, const lw_splines *sp, uint32_t 
               double dx = P.x - Q.x, dy = P.y - Q.y, r2 = dx * dx + dy * dy;
               double l = ns * (double)(P.dl > Q.dl ? P.dl : Q.dl);
               if (r2 < l * l && r2 < cut2) {
-                if (pairs_push(pairs, n_pairs, &cap, i / np, j / np) != LW_OK) return LW_ENOMEM;
+                if (pairs_push(pairs, n_pairs, cap, i / np, j / np) != LW_OK) return LW_ENOMEM;
               } else if (r2 < cut2 && P.dl > 0.0f && Q.dl > 0.0f) {
                 sum += (double)P.dl * (double)Q.dl * (1.0 / sqrt(r2) - inv);
                 kernel_grad(&P, &Q, inv, 1.0, &gs[i], &gs[j]);
@@ -917,7 +916,21 @@ static lw_status far_field(const lw_cellgrid *g, const lw_splines *sp, uint32_t 
           }
       }
     }
-  *far = sum;
+  *far += sum;
+  return LW_OK;
+}
+
+/* The same over every plane of the grid (a layer each with apart = pen):
+** pairs across planes count nothing. */
+static lw_status far_field(const lw_cellgrid *grid, const lw_splines *sp, uint32_t np, const lw_pair_ctx *ctx,
+                           sample_grad *gs, double *far, uint32_t **pairs, size_t *n_pairs)
+{
+  size_t cap = 0;
+  lw_cellgrid view;
+  *far = 0.0;
+  for (int plane = 0; plane < grid->nz; plane++)
+    if (far_plane(lw_cellgrid_plane(grid, plane, &view), sp, np, ctx, gs, far, pairs, n_pairs, &cap) != LW_OK)
+      return LW_ENOMEM;
   return LW_OK;
 }
 
@@ -1016,7 +1029,11 @@ double lw_pair_gradient(const lw_scene *sc, const lw_splines *sp, lw_node *grad,
   lw_cellgrid *g = NULL;
   if (!smp || !tan || !gs || !gctrl) goto nomem;
   if (!(g = lw_cellgrid_new(0.0, 0.0, sc->width, sc->height, ctx->cutoff, n, err))) goto done;
+  /* a layer a plane when lines keep apart from their own pen's only (model.c) */
+  const int planes = lw_layers_planes(&sc->layers);
+  if (lw_cellgrid_planes(g, planes) != LW_OK) goto nomem;
   for (size_t s = 0; s < sp->n_segments; s++) {
+    const int plane = planes > 1 ? lw_splines_layer(&sc->layers, sp, sp->seg_spline[s]) : 0;
     const lw_node *a = &sp->node[lw_segment_node(sp, s)];
     lw_samples ss;
     lw_segment_sample(q, a, a + 1, &ss);
@@ -1026,7 +1043,7 @@ double lw_pair_gradient(const lw_scene *sc, const lw_splines *sp, lw_node *grad,
       double f = ss.speed[k] > 0.0 ? q->w[k] / ss.speed[k] : 0.0;
       tan[2 * i] = f * ss.dx[k];
       tan[2 * i + 1] = f * ss.dy[k];
-      if (lw_cellgrid_insert(g, (uint32_t)i, smp[i].x, smp[i].y, smp[i].dl) != LW_OK) goto nomem;
+      if (lw_cellgrid_insert_in(g, plane, (uint32_t)i, smp[i].x, smp[i].y, smp[i].dl) != LW_OK) goto nomem;
     }
   }
   if (far_field(g, sp, np, ctx, gs, &far, &pairs, &n_pairs) != LW_OK) goto nomem;

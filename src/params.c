@@ -401,6 +401,11 @@ const lw_param_def lw_param_table[] = {
          "`tone_max`; `cmyk` = the cyan, magenta, yellow and black separation of the colour picture "
          "(4 layers, in that order); `palette` = the least-squares separation of the colour picture "
          "into the pens of `colors` (docs/NUMERICS.md, \"Colour separation\")."),
+  CHOICE("layers", "apart", ly_apart, "all", "all|pen",
+         "Which lines the pair repulsion and energy.min_spacing keep apart: `all` = every line from "
+         "every other; `pen` = each line from its own layer's only, so pens overlap and cross as "
+         "inks do on paper and each layer may be as dense as one pen alone (what colour needs; "
+         "the photo preset sets it). Without layers, every line is of one pen."),
   STRING("layers", "colors", ly_colors, "", "",
          "Pen colour of each layer, `#rrggbb` or `#rgb`; empty = black (tone) or cyan, magenta, "
          "yellow, black (cmyk). `palette` needs them: they are the pens the picture is separated into."),
@@ -893,7 +898,7 @@ static const struct {
     {"anneal", "sweeps", "300", 0},        {"anneal", "steps", "5", 0},
     {"moves", "fixed_count", "0", 0},      {"energy", "chem_length", NULL, -2.5 / 0.35},
     {"moves", "grow", "0.05", 0},          {"moves", "shrink", "0.05", 0},
-    {"scene", "image_levels", "0.01", 0},
+    {"scene", "image_levels", "0.01", 0},  {"layers", "apart", "pen", 0},
 };
 
 /* Sets an unset key from text; the key stays unset (line 0), so a later

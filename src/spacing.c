@@ -29,7 +29,8 @@ static size_t pieces(const double b[8], double h)
   return k > LW_SPACING_POINTS_MAX ? LW_SPACING_POINTS_MAX : (size_t)k;
 }
 
-lw_status lw_close_share(const double *b, const size_t *owner, size_t n_seg, double d, double *share, lw_error *err)
+lw_status lw_close_share(const double *b, const size_t *owner, const size_t *group, size_t n_seg, double d,
+                         double *share, lw_error *err)
 {
   *share = 0.0;
   const double h = 0.5 * d;
@@ -48,9 +49,9 @@ lw_status lw_close_share(const double *b, const size_t *owner, size_t n_seg, dou
   if (n == 0) return LW_OK;
   if (n >= UINT32_MAX)
     return lw_error_set(err, LW_EINPUT, "close share: %zu points exceed the grid's limit of 2^32", n);
-  size_t *who = malloc(n * sizeof *who);
+  size_t *who = malloc(n * sizeof *who), *grp = group ? malloc(n * sizeof *grp) : NULL;
   float *w = malloc(n * sizeof *w);
-  lw_cellgrid *grid = who && w ? lw_cellgrid_new(x0, y0, x1 - x0, y1 - y0, d, n, err) : NULL;
+  lw_cellgrid *grid = who && w && (grp || !group) ? lw_cellgrid_new(x0, y0, x1 - x0, y1 - y0, d, n, err) : NULL;
   lw_status st = grid ? LW_OK : LW_ENOMEM;
   size_t i = 0;
   for (size_t g = 0; g < n_seg && st == LW_OK; g++) {
@@ -60,6 +61,7 @@ lw_status lw_close_share(const double *b, const size_t *owner, size_t n_seg, dou
       double x, y, speed;
       bezier_at(z, ((double)q + 0.5) / (double)k, &x, &y, &speed);
       who[i] = owner[g];
+      if (grp) grp[i] = group[g];
       w[i] = (float)(speed / (double)k);
       st = lw_cellgrid_insert(grid, (uint32_t)i, x, y, w[i]);
     }
@@ -80,7 +82,7 @@ lw_status lw_close_share(const double *b, const size_t *owner, size_t n_seg, dou
           const uint32_t *idx = lw_cell_idx(o);
           for (uint32_t f = 0; f < o->n; f++) {
             double dx = o->x[f] - px, dy = lw_cell_y(o)[f] - py;
-            if (who[idx[f]] != who[me] && dx * dx + dy * dy < d2) {
+            if (who[idx[f]] != who[me] && (!grp || grp[idx[f]] == grp[me]) && dx * dx + dy * dy < d2) {
               found = 1;
               break;
             }
@@ -94,6 +96,7 @@ lw_status lw_close_share(const double *b, const size_t *owner, size_t n_seg, dou
   else lw_error_set(err, LW_ENOMEM, "out of memory for the close share of %zu points", n);
   lw_cellgrid_free(grid);
   free(who);
+  free(grp);
   free(w);
   return st;
 }
@@ -110,7 +113,7 @@ lw_status lw_close_share_splines(const lw_splines *sp, double d, double *share, 
       lw_segment_bezier(a, a + 1, b + 8 * g);
       owner[g] = sp->seg_spline[g];
     }
-    s = lw_close_share(b, owner, sp->n_segments, d, share, err);
+    s = lw_close_share(b, owner, NULL, sp->n_segments, d, share, err);
   } else {
     lw_error_set(err, LW_ENOMEM, "out of memory for the close share of %zu segments", sp->n_segments);
   }

@@ -556,6 +556,8 @@ lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pa
                          {ctx->inv_cutoff, ctx->inv_cutoff}};
   uint64_t seen = 0;
   const int wide = lw_vec_lanes();
+  lw_cellgrid view;
+  g = lw_cellgrid_plane(g, f->plane, &view);
   double total = 0.0;
   *far = 0.0;
   for (size_t c0 = 0; c0 < n; c0 += LW_PAIR_CHUNK) {

@@ -25,6 +25,7 @@
 #include "linewise/model.h"
 #include "linewise/output.h"
 #include "linewise/scene.h"
+#include "linewise/spacing.h"
 #include "testutil.h"
 
 TestSuite(layers, .init = lw_image_dir_make, .fini = lw_image_dir_remove);
@@ -180,21 +181,24 @@ Test(layers, renumbering_keeps_every_splines_layer_and_the_energy)
   lw_scene_clear(&sc);
 }
 
-Test(layers, births_and_deaths_in_layers_change_the_energy_by_the_full_recomputation)
+/* With trans-dimensional moves a spline's layer is state (layers.h).  The
+** three pens of the test above, each with its own tone raster, potential
+** and turned field: a birth into each layer, a death and a grow of splines
+** of every layer, each term's difference against the recomputation (1e-9);
+** the committed half keeps the running totals and each layer's raster
+** plane what a fresh model of the state builds.  Catches a splice evaluated
+** with the scene's contexts or raster plane rather than its layer's (the
+** tone term off by a whole layer's share).  With apart = pen each layer is
+** a plane of the pair grid, and min_spacing holds within layers. */
+static void births_and_deaths(int apart)
 {
-  /* With trans-dimensional moves a spline's layer is state (layers.h).
-  ** The three pens of the test above, each with its own tone raster,
-  ** potential and turned field: a birth into each layer, a death and a
-  ** grow of splines of every layer, each term's difference against the
-  ** recomputation (1e-9); the committed half keeps the running totals and
-  ** each layer's raster plane what a fresh model of the state builds.
-  ** Catches a splice evaluated with the scene's contexts or raster plane
-  ** rather than its layer's (the tone term off by a whole layer's share). */
   lw_params p = three_pens();
   p.strain = 1;
   p.pair = 0.02;
   p.pair_cutoff = 2;
   p.fixed_count = 0;
+  p.ly_apart = apart;
+  if (apart == LW_APART_PEN) p.min_spacing = 0.15;
   lw_scene sc;
   lw_test_scene(&sc, &p);
   lw_model *m = lw_test_model_random(&sc, 45, 3, 3, 11);
@@ -269,6 +273,175 @@ Test(layers, births_and_deaths_in_layers_change_the_energy_by_the_full_recomputa
   lw_proposal_free(pr);
   lw_model_free(m);
   lw_scene_clear(&sc);
+}
+
+Test(layers, births_and_deaths_in_layers_change_the_energy_by_the_full_recomputation)
+{
+  births_and_deaths(LW_APART_ALL);
+}
+
+Test(layers, births_and_deaths_in_layers_kept_apart_by_pen_match_the_full_recomputation)
+{
+  births_and_deaths(LW_APART_PEN);
+}
+
+/* ---- layers.apart = pen ------------------------------------------------- */
+
+/* With apart = pen a line is repelled by its own layer's lines only: the
+** pair energy of a state is the sum over the layers of the pair energy of
+** that layer's splines alone, and pairs across layers count nothing. */
+Test(layers, kept_apart_by_pen_the_pair_energy_is_each_layers_own)
+{
+  lw_params p = three_pens();
+  p.pair = 0.02;
+  p.pair_cutoff = 2;
+  p.ly_apart = LW_APART_PEN;
+  lw_scene sc;
+  lw_test_scene(&sc, &p);
+  lw_model *m = lw_test_model_random(&sc, 60, 3, 3, 17);
+  double term[LW_TERM_COUNT], all[LW_TERM_COUNT], each[LW_TERM_COUNT];
+  lw_energy_compute(&sc, m->sp, term, NULL);
+  p.ly_apart = LW_APART_ALL;
+  lw_scene sa;
+  lw_test_scene(&sa, &p);
+  lw_energy_compute(&sa, m->sp, all, NULL);
+  double sum = 0.0;
+  unsigned char dead[64];
+  cr_assert(m->sp->n_splines <= sizeof dead);
+  for (int k = 0; k < 3; k++) {
+    for (size_t i = 0; i < m->sp->n_splines; i++) dead[i] = lw_splines_layer(&sc.layers, m->sp, i) != k;
+    lw_splines *one = spliced(m->sp, dead, NULL, 0, 0.0, 0);
+    lw_energy_compute(&sa, one, each, NULL);
+    cr_assert(each[LW_TERM_PAIR] > 0.0, "layer %d has no pairs of its own", k);
+    sum += each[LW_TERM_PAIR];
+    lw_splines_free(one);
+  }
+  cr_assert(fabs(term[LW_TERM_PAIR] - sum) <= 1e-12 * sum, "by pen %.17g, layers alone %.17g", term[LW_TERM_PAIR],
+            sum);
+  cr_assert(all[LW_TERM_PAIR] > 1.2 * sum, "pairs across layers add %g to %g", all[LW_TERM_PAIR] - sum, sum);
+  /* moves, their pair sums from the layer's plane, against the recomputation */
+  cr_assert(lw_test_moves_match_full(&sc, m, 200, 0.7, 5) > 80);
+  lw_model_free(m);
+  lw_scene_clear(&sa);
+  lw_scene_clear(&sc);
+}
+
+/* Straight splines: 0 of layer 0 along y = 20, 1 of layer 1 above it
+** along x = 18.5, 2 of layer 0 beside 1.  Moving spline 1's first node down
+** onto spline 0 adds close pairs: min_spacing refuses it when lines of
+** every layer keep apart, and allows it with apart = pen.  Moving spline
+** 2's onto spline 0 (its own pen) is refused either way. */
+Test(layers, kept_apart_by_pen_lines_of_other_pens_may_cross)
+{
+  for (int apart = LW_APART_ALL; apart <= LW_APART_PEN; apart++) {
+    lw_params p = three_pens();
+    snprintf(p.ly_names, sizeof p.ly_names, "a b");
+    snprintf(p.ly_colors, sizeof p.ly_colors, "#20a0c0 #c02060");
+    snprintf(p.ly_turn, sizeof p.ly_turn, "0 90");
+    snprintf(p.ly_pen_width, sizeof p.ly_pen_width, "0.3 0.3");
+    p.pair = 0.02;
+    p.pair_cutoff = 2;
+    p.min_spacing = 0.3;
+    p.ly_apart = apart;
+    lw_scene sc;
+    lw_test_scene(&sc, &p);
+    size_t segs[3] = {2, 2, 2};
+    lw_error err;
+    lw_splines *sp = lw_splines_new(3, segs, &err);
+    cr_assert_not_null(sp);
+    cr_assert_eq(lw_splines_layers_alloc(sp), LW_OK);
+    /* segments of 1.5 mm: pair samples closer than min_spacing along each line */
+    const double x0[3] = {17, 18.5, 21.5}, y0[3] = {20, 21, 21}, dx[3] = {1.5, 0, 0}, dy[3] = {0, 1.5, 1.5};
+    const int layer[3] = {0, 1, 0};
+    for (int i = 0; i < 3; i++) {
+      sp->layer[i] = (uint8_t)layer[i];
+      sp->rest_length[i] = 10;
+      for (int k = 0; k < 3; k++)
+        sp->node[sp->first[i] + (size_t)k] = (lw_node){x0[i] + k * dx[i], y0[i] + k * dy[i], dx[i] / 3, dy[i] / 3};
+    }
+    lw_model *m = lw_model_new(&sc, sp, &err);
+    cr_assert_not_null(m, "%s", err.msg);
+    lw_proposal *pr = lw_proposal_new(m, NULL);
+    lw_node to = m->sp->node[m->sp->first[1]];
+    to.py = 20.05;
+    lw_model_propose(m, pr, 1, 0, 1, &to);
+    if (apart == LW_APART_PEN)
+      cr_assert(!pr->crowded && isfinite(pr->dE), "a crossing of two pens refused (dE %g)", pr->dE);
+    else
+      cr_assert(pr->crowded && pr->dE == INFINITY, "a crossing allowed with every line apart (dE %g)", pr->dE);
+    lw_node on = m->sp->node[m->sp->first[2]];
+    on.px = 17.5;
+    on.py = 20.05;
+    lw_model_propose(m, pr, 2, 0, 1, &on);
+    cr_assert(pr->crowded && pr->dE == INFINITY, "apart %d: a line moved onto its own pen's was allowed", apart);
+    lw_proposal_free(pr);
+    lw_model_free(m);
+    lw_scene_clear(&sc);
+  }
+}
+
+/* Two layers of the picture's whole tone range on a page of side `page`,
+** kept apart by pen, with the pair term (coefficient pair, cutoff rc). */
+static lw_params two_layers_by_pen(double page, double pair, double rc)
+{
+  lw_params p = colour_params(page, (int)page, blotch_colours);
+  snprintf(p.ly_names, sizeof p.ly_names, "a b");
+  p.ly_source = LW_LSRC_TONE;
+  p.ly_apart = LW_APART_PEN;
+  p.pair = pair;
+  p.pair_cutoff = rc;
+  return p;
+}
+
+/* The placement starts lines apart from their own pen's only: with two
+** layers of one target, close sample pairs (min_spacing) within a layer are
+** none, across the layers as many as chance gives (some 36 crossings of two
+** random sets of 30 lines of 9 mm on this page; a placement that kept every
+** line apart leaves none). */
+Test(layers, kept_apart_by_pen_the_placement_spaces_each_layer_alone)
+{
+  lw_params p = two_layers_by_pen(40, 0.02, 2);
+  p.min_spacing = 0.3;
+  lw_scene sc;
+  lw_test_scene(&sc, &p);
+  lw_model *m = lw_test_model_random(&sc, 60, 3, 3, 21);
+  const lw_splines *sp = m->sp;
+  size_t same = 0, across = 0;
+  for (size_t g = 0; g < sp->n_segments; g++)
+    for (size_t h = g + 1; h < sp->n_segments; h++) {
+      const size_t i = sp->seg_spline[g], j = sp->seg_spline[h];
+      if (i == j) continue;
+      lw_samples a, b;
+      const lw_node *na = &sp->node[lw_segment_node(sp, g)], *nb = &sp->node[lw_segment_node(sp, h)];
+      lw_segment_sample(&sc.pair_quad, na, na + 1, &a);
+      lw_segment_sample(&sc.pair_quad, nb, nb + 1, &b);
+      for (int q = 0; q < a.n; q++)
+        for (int r = 0; r < b.n; r++) {
+          const double dx = a.x[q] - b.x[r], dy = a.y[q] - b.y[r];
+          if (dx * dx + dy * dy >= p.min_spacing * p.min_spacing) continue;
+          if (sp->layer[i] == sp->layer[j]) same++;
+          else across++;
+        }
+    }
+  cr_assert_eq(same, 0, "%zu close pairs within layers", same);
+  cr_assert(across >= 10, "only %zu close pairs across layers", across);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+/* The close share of pens kept apart counts a stroke's own pen only. */
+Test(layers, the_close_share_of_pens_kept_apart_counts_each_pen_alone)
+{
+  /* two strokes crossing at right angles */
+  const double b[16] = {0, 5, 3, 5, 7, 5, 10, 5, 5, 0, 5, 3, 5, 7, 5, 10};
+  const size_t owner[2] = {0, 1}, one[2] = {0, 0}, two[2] = {0, 1};
+  double all, same, apart;
+  cr_assert_eq(lw_close_share(b, owner, NULL, 2, 0.3, &all, NULL), LW_OK);
+  cr_assert_eq(lw_close_share(b, owner, one, 2, 0.3, &same, NULL), LW_OK);
+  cr_assert_eq(lw_close_share(b, owner, two, 2, 0.3, &apart, NULL), LW_OK);
+  cr_assert(all > 0.0 && all < 0.1, "%g", all);
+  cr_assert_eq(same, all);
+  cr_assert_eq(apart, 0.0);
 }
 
 static double blotches(double u, double v) { return 0.5 + 0.4 * sin(7 * u + 2 * v) * cos(5 * v - 3 * u * u); }
@@ -460,6 +633,56 @@ Test(layers, the_gradient_reads_each_layers_field_and_potential)
   free(g);
   lw_splines_free(sp);
   lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+/* The pair gradient with lines kept apart by pen pairs each sample with its
+** own layer's only, as the energy does: it is, node for node, the pair
+** gradient of each layer's splines alone (drawing the pairs across layers
+** in would add their forces). */
+Test(layers, kept_apart_by_pen_the_pair_gradient_is_each_layers_own)
+{
+  lw_params p = two_layers_by_pen(30, 0.05, 3);
+  lw_scene sc, sa;
+  lw_test_scene(&sc, &p);
+  p.ly_apart = LW_APART_ALL;
+  lw_test_scene(&sa, &p);
+  lw_model *m = lw_test_model_random(&sc, 16, 2, 4, 9);
+  const lw_splines *sp = m->sp;
+  const unsigned mask = 1u << LW_TERM_PAIR;
+  lw_node *g = calloc(sp->n_nodes, sizeof *g), *ga = calloc(sp->n_nodes, sizeof *ga);
+  cr_assert(g && ga);
+  lw_error err;
+  double term[LW_TERM_COUNT], big = 0.0, across = 0.0;
+  cr_assert(isfinite(lw_energy_gradient(&sc, sp, mask, g, term, &err)), "%s", err.msg);
+  cr_assert(isfinite(lw_energy_gradient(&sa, sp, mask, ga, term, &err)), "%s", err.msg);
+  unsigned char dead[16];
+  for (int k = 0; k < 2; k++) {
+    for (size_t i = 0; i < sp->n_splines; i++) dead[i] = sp->layer[i] != k;
+    lw_splines *one = spliced(sp, dead, NULL, 0, 0.0, 0);
+    lw_node *g1 = calloc(one->n_nodes, sizeof *g1);
+    cr_assert(isfinite(lw_energy_gradient(&sa, one, mask, g1, term, &err)), "%s", err.msg);
+    for (size_t i = 0, j = 0; i < sp->n_splines; i++) {
+      if (dead[i]) continue;
+      for (size_t q = 0; q <= lw_splines_segments(sp, i); q++)
+        for (int c = 0; c < 4; c++) {
+          const double mine = (&g[sp->first[i] + q].px)[c], alone = (&g1[one->first[j] + q].px)[c];
+          const double all = (&ga[sp->first[i] + q].px)[c];
+          cr_assert(fabs(mine - alone) <= 1e-9 * fmax(1e-3, fabs(alone)), "spline %zu node %zu: %.17g, alone %.17g", i,
+                    q, mine, alone);
+          big = fmax(big, fabs(alone));
+          across = fmax(across, fabs(all - alone));
+        }
+      j++;
+    }
+    free(g1);
+    lw_splines_free(one);
+  }
+  cr_assert(across > 1e-2 * big, "the pairs across layers add only %g to a gradient of %g", across, big);
+  free(g);
+  free(ga);
+  lw_model_free(m);
+  lw_scene_clear(&sa);
   lw_scene_clear(&sc);
 }
 
@@ -765,4 +988,31 @@ Test(layers, born_splines_keep_their_layers_through_checkpoints)
                           "%s/a/state.lw > %s/bad/state.lw && cp %s/a/scene.ini %s/bad", dir, dir, dir, dir, dir), 0);
   cr_assert_eq(run("energy bad", errs, sizeof errs), 2);
   cr_assert(strstr(errs, "spline 0 is of layer 7, but the scene has 4 layers"), "%s", errs);
+}
+
+/* The photo preset keeps lines apart by pen (layers.apart = pen, written to
+** the run's scene.ini), and a colour run of it, with its domains, is the
+** same on 1 and 2 threads and through a stop and resume.  A user's apart
+** outranks the preset's. */
+Test(layers, the_photo_preset_draws_colour_pens_kept_apart_by_pen_on_any_thread_count)
+{
+  write_colour_png(lw_test_path("colour.png"), 48, 64, blotch_colours);
+  const char *scene = "[scene]\npreset = photo\npage = a6\nimage = colour.png\n[layers]\nnames = c m y k\n"
+                      "source = cmyk\n[anneal]\nsweeps = 16\nseed = 5\n";
+  lw_test_write(lw_test_path("photo.ini"), scene, strlen(scene));
+  char errs[4096];
+  cr_assert_eq(run("run photo.ini --out p1 --threads 1 --quiet", errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(run("run photo.ini --out p2 --threads 2 --quiet --stop-at 7", errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(run("resume p2 --threads 2 --quiet", errs, sizeof errs), 0, "%s", errs);
+  char dir[512];
+  snprintf(dir, sizeof dir, "%s", lw_test_path(""));
+  cr_assert_eq(lw_test_sh("grep -qx 'apart = pen' %s/p1/scene.ini && grep -qx 'domains = [2-9]' %s/p1/scene.ini", dir,
+                          dir),
+               0, "the preset's apart or domains");
+  const char *files[] = {"state.lw", "trace.csv", "final.svg"};
+  for (int i = 0; i < 3; i++)
+    cr_assert_eq(lw_test_sh("cmp -s %s/p1/%s %s/p2/%s", dir, files[i], dir, files[i]), 0, "%s differs", files[i]);
+  cr_assert_eq(run("run photo.ini --out pa --quiet --set layers.apart=all --set anneal.sweeps=1", errs, sizeof errs),
+               0, "%s", errs);
+  cr_assert_eq(lw_test_sh("grep -qx 'apart = all' %s/pa/scene.ini", dir), 0);
 }

@@ -114,8 +114,39 @@ static inline void lw_cellgrid_locate(const lw_cellgrid *g, double x, double y, 
 ** increasing index order appends. */
 lw_status lw_cellgrid_insert(lw_cellgrid *g, uint32_t i, double x, double y, float dl);
 
-/* Moves sample i (in the grid) to (x, y) with weight dl.  LW_ENOMEM as for
-** insert. */
+/* ---- planes ---------------------------------------------------------------
+** A 2-D grid may hold several planes of the same cells (nz of them): a
+** sample is inserted into one and stays there when it moves, and a walk
+** over one plane (lw_cellgrid_plane) never meets another's samples.  Each
+** layer of lines (layers.h) is a plane when lines keep apart only from
+** their own pen's.  Cell c of plane p is cell[p nx ny + c]. */
+
+/* Gives a 2-D grid `planes` planes (emptying it).  LW_ENOMEM leaves it an
+** empty grid of one plane. */
+lw_status lw_cellgrid_planes(lw_cellgrid *g, int planes);
+
+/* Inserts sample i into plane `plane`, as lw_cellgrid_insert does into 0. */
+lw_status lw_cellgrid_insert_in(lw_cellgrid *g, int plane, uint32_t i, double x, double y, float dl);
+
+/* The plane of sample i (in the grid) of a 2-D grid. */
+static inline int lw_cellgrid_plane_of(const lw_cellgrid *g, uint32_t i)
+{
+  return (int)(g->home[i] / ((uint32_t)g->nx * (uint32_t)g->ny));
+}
+
+/* Plane p of a 2-D grid as a grid of one plane, sharing its cells: what a
+** walk over that plane reads (the view is valid while g is unchanged). */
+static inline const lw_cellgrid *lw_cellgrid_plane(const lw_cellgrid *g, int p, lw_cellgrid *view)
+{
+  if (p == 0) return g;
+  *view = *g;
+  view->cell = g->cell + (size_t)p * (size_t)g->nx * (size_t)g->ny;
+  view->nz = 1;
+  return view;
+}
+
+/* Moves sample i (in the grid) to (x, y) with weight dl, within its plane.
+** LW_ENOMEM as for insert. */
 lw_status lw_cellgrid_move(lw_cellgrid *g, uint32_t i, double x, double y, float dl);
 
 /* Position and weight of sample i (in the grid): a binary search in its cell. */

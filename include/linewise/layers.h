@@ -86,6 +86,7 @@ typedef struct {
 typedef struct {
   int n;                     /* 0 = no layers */
   int source;                /* LW_LSRC_* */
+  int apart;                 /* LW_APART_PEN: a line keeps apart from its own layer's only */
   lw_layer_spec spec[LW_LAYERS_MAX];
   double cum[LW_LAYERS_MAX + 1]; /* cumulated shares: cum[0] = 0, cum[n] = 1 */
 } lw_layers_spec;
@@ -128,6 +129,13 @@ static inline int lw_layers_of(const lw_layers_spec *ls, size_t i)
 static inline int lw_splines_layer(const lw_layers_spec *ls, const lw_splines *sp, size_t i)
 {
   return sp->layer ? sp->layer[i] : lw_layers_of(ls, i);
+}
+
+/* Planes of the pair grid (grid.h): one a layer when a line keeps apart
+** from its own layer's lines only (layers.apart = pen), else one. */
+static inline int lw_layers_planes(const lw_layers_spec *ls)
+{
+  return ls->n > 1 && ls->apart == LW_APART_PEN ? ls->n : 1;
 }
 
 /* Separates n pixels of colour (r, g, b) into the k pens of colours rgb:

@@ -61,6 +61,7 @@ enum { LW_PRESET_NONE, LW_PRESET_PHOTO };
 enum { LW_PIN_NONE, LW_PIN_ENDS, LW_PIN_FIRST, LW_PIN_LAST };
 enum { LW_INTEGRATOR_LEAPFROG, LW_INTEGRATOR_REVIEW };
 enum { LW_LSRC_TONE, LW_LSRC_CMYK, LW_LSRC_PALETTE };
+enum { LW_APART_ALL, LW_APART_PEN }; /* layers.apart */
 
 typedef struct {
   /* [scene] */
@@ -175,6 +176,7 @@ typedef struct {
   /* [layers] (layers.h) */
   char ly_names[LW_PATH_MAX]; /* layer names; empty = no layers */
   int ly_source;              /* LW_LSRC_* */
+  int ly_apart;               /* LW_APART_*: which lines keep apart */
   char ly_colors[LW_PATH_MAX]; /* a colour a layer, or empty */
   char ly_turn[LW_PATH_MAX];  /* degrees a layer, or empty */
   char ly_tone_min[LW_PATH_MAX], ly_tone_max[LW_PATH_MAX]; /* a tone a layer, or empty */

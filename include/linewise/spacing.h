@@ -26,8 +26,11 @@
 /* The n cubic Bezier segments b (8 doubles each: b0 b1 b2 b3 as x y pairs,
 ** mm), segment k part of stroke owner[k]: *share = (length with another
 ** stroke within d) / (length), 0 for a drawing without length.  d > 0, mm.
+** group (may be NULL: one group): segment k's group; only strokes of one
+** group count as close (the pens of layers.apart = pen overlap by design).
 ** LW_ENOMEM, or LW_EINPUT when the points would exceed 2^32. */
-lw_status lw_close_share(const double *b, const size_t *owner, size_t n, double d, double *share, lw_error *err);
+lw_status lw_close_share(const double *b, const size_t *owner, const size_t *group, size_t n, double d,
+                         double *share, lw_error *err);
 
 /* The same for splines, each spline a stroke (the state before the
 ** plotter post-pass). */

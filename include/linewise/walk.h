@@ -86,6 +86,7 @@ typedef struct {
   uint32_t lo, hi;  /* the probes' spline's sample indices [lo, hi): never paired */
   uint32_t from;    /* pairs only with samples of index >= from (0: all) */
   uint32_t lo2, hi2; /* a second spline's, hi2 >= lo2 >= hi (a join's two; lo2 = hi2: none) */
+  int plane;        /* the grid's plane the probes pair in (grid.h; 0 with one plane) */
 } lw_pair_filter;
 
 /* Sets *far to the far sum of the n probes P (no coefficient C), the sum of
