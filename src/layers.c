@@ -61,13 +61,15 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
   ls->source = p->ly_source;
   ls->apart = p->ly_apart;
   static const char *const keys[] = {"source", "colors", "turn", "tone_min", "tone_max", "pen_width"};
-  if (!p->ly_names[0]) {
+  /* cmyk names its own four pens */
+  const char *names = p->ly_names[0] || ls->source != LW_LSRC_CMYK ? p->ly_names : "cyan magenta yellow black";
+  if (!names[0]) {
     for (size_t k = 0; k < sizeof keys / sizeof keys[0]; k++)
       if (given(p, keys[k])) return bad(p, keys[k], err, "needs layers.names (the layers it describes)");
     return LW_OK;
   }
   int n = 0;
-  for (const char *c = p->ly_names;;) {
+  for (const char *c = names;;) {
     c += strspn(c, " \t,");
     if (!*c) break;
     size_t len = strcspn(c, " \t,");
@@ -83,7 +85,7 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
     n++;
     c += len;
   }
-  if (!n) return bad(p, "names", err, "expected at least one name, got '%s'", p->ly_names);
+  if (!n) return bad(p, "names", err, "expected at least one name, got '%s'", names);
   ls->n = n;
   if (ls->source == LW_LSRC_CMYK && n != 4)
     return bad(p, "source", err, "'cmyk' needs 4 layers (cyan magenta yellow black), layers.names has %d", n);

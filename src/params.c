@@ -399,7 +399,7 @@ const lw_param_def lw_param_table[] = {
   CHOICE("layers", "source", ly_source, "tone", "tone|cmyk|palette",
          "Each layer's target: `tone` = the picture's darkness through the layer's `tone_min` .. "
          "`tone_max`; `cmyk` = the cyan, magenta, yellow and black separation of the colour picture "
-         "(4 layers, in that order); `palette` = the least-squares separation of the colour picture "
+         "(4 layers, in that order; without layers.names they are named cyan, magenta, yellow and black); `palette` = the least-squares separation of the colour picture "
          "into the pens of `colors` (docs/NUMERICS.md, \"Colour separation\")."),
   CHOICE("layers", "apart", ly_apart, "all", "all|pen",
          "Which lines the pair repulsion and energy.min_spacing keep apart: `all` = every line from "

@@ -992,13 +992,13 @@ Test(layers, born_splines_keep_their_layers_through_checkpoints)
 
 /* The photo preset keeps lines apart by pen (layers.apart = pen, written to
 ** the run's scene.ini), and a colour run of it, with its domains, is the
-** same on 1 and 2 threads and through a stop and resume.  A user's apart
-** outranks the preset's. */
+** same on 1 and 2 threads and through a stop and resume.  source = cmyk
+** needs no names.  A user's apart outranks the preset's. */
 Test(layers, the_photo_preset_draws_colour_pens_kept_apart_by_pen_on_any_thread_count)
 {
   write_colour_png(lw_test_path("colour.png"), 48, 64, blotch_colours);
-  const char *scene = "[scene]\npreset = photo\npage = a6\nimage = colour.png\n[layers]\nnames = c m y k\n"
-                      "source = cmyk\n[anneal]\nsweeps = 16\nseed = 5\n";
+  const char *scene = "[scene]\npreset = photo\npage = a6\nimage = colour.png\n[layers]\nsource = cmyk\n"
+                      "[anneal]\nsweeps = 16\nseed = 5\n";
   lw_test_write(lw_test_path("photo.ini"), scene, strlen(scene));
   char errs[4096];
   cr_assert_eq(run("run photo.ini --out p1 --threads 1 --quiet", errs, sizeof errs), 0, "%s", errs);
@@ -1012,6 +1012,10 @@ Test(layers, the_photo_preset_draws_colour_pens_kept_apart_by_pen_on_any_thread_
   const char *files[] = {"state.lw", "trace.csv", "final.svg"};
   for (int i = 0; i < 3; i++)
     cr_assert_eq(lw_test_sh("cmp -s %s/p1/%s %s/p2/%s", dir, files[i], dir, files[i]), 0, "%s differs", files[i]);
+  /* cmyk without layers.names names its own four pens */
+  cr_assert_eq(lw_test_sh("grep -c 'inkscape:label=\"\\(cyan\\|magenta\\|yellow\\|black\\) ' %s/p1/final.svg | grep -qx 4",
+                          dir),
+               0, "the pens of cmyk are not cyan, magenta, yellow and black");
   cr_assert_eq(run("run photo.ini --out pa --quiet --set layers.apart=all --set anneal.sweeps=1", errs, sizeof errs),
                0, "%s", errs);
   cr_assert_eq(lw_test_sh("grep -qx 'apart = all' %s/pa/scene.ini", dir), 0);
