@@ -185,7 +185,7 @@ static lw_status insert(lw_cellgrid *g, int plane, uint32_t i, double x, double 
 static lw_status move(lw_cellgrid *g, uint32_t i, double x, double y, double z, float dl)
 {
   /* in 2-D a sample stays in its plane */
-  const int plane = g->dim == 2 ? (int)(g->home[i] / plane_cells(g)) : 0;
+  const int plane = g->dim == 2 && g->nz > 1 ? (int)(g->home[i] / plane_cells(g)) : 0;
   uint32_t from = g->home[i], to = cell_in(g, plane, x, y, z);
   lw_cell *c = &g->cell[from];
   uint32_t k = lower_bound(c, i);
