@@ -492,7 +492,7 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);
   double ladder[LW_TEMPERING_MAX];
   long trace_bytes = -1;
-  if ((s = lw_params_read(&a->params, scene_path, err)) || (s = setup_ladder(a, ladder, err)) ||
+  if ((s = lw_params_read_run(&a->params, scene_path, err)) || (s = setup_ladder(a, ladder, err)) ||
       (s = setup_schedule(a, err)) || (s = setup_system(a, err)))
     goto out;
   a->seed = st.seed;

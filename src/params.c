@@ -830,9 +830,10 @@ static int on_key(void *user, const char *section, const char *key, const char *
   return 1;
 }
 
-lw_status lw_params_read(lw_params *p, const char *path, lw_error *err)
+static lw_status read_file(lw_params *p, const char *path, int of_run, lw_error *err)
 {
   lw_params_defaults(p);
+  p->of_run = of_run;
   snprintf(p->file, sizeof p->file, "%s", path);
   FILE *f = fopen(path, "r");
   if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open scene file: %s", path, strerror(errno));
@@ -855,6 +856,10 @@ lw_status lw_params_read(lw_params *p, const char *path, lw_error *err)
   if (r < 0) return lw_error_set(err, LW_ENOMEM, "%s: out of memory while reading", path);
   return lw_params_resolve(p, err);
 }
+
+lw_status lw_params_read(lw_params *p, const char *path, lw_error *err) { return read_file(p, path, 0, err); }
+
+lw_status lw_params_read_run(lw_params *p, const char *path, lw_error *err) { return read_file(p, path, 1, err); }
 
 /* Named page sizes in mm, portrait, in the order of the choices of
 ** scene.page (custom first, which has none). */
@@ -912,7 +917,7 @@ static void preset_key(lw_params *p, const char *section, const char *key, const
 
 static void apply_preset(lw_params *p)
 {
-  if (p->preset != LW_PRESET_PHOTO) return;
+  if (p->preset != LW_PRESET_PHOTO || p->of_run) return;
   const double w = p->pen_width;
   char text[64];
   for (size_t k = 0; k < sizeof photo_preset / sizeof photo_preset[0]; k++) {

@@ -993,7 +993,8 @@ Test(layers, born_splines_keep_their_layers_through_checkpoints)
 /* The photo preset keeps lines apart by pen (layers.apart = pen, written to
 ** the run's scene.ini), and a colour run of it, with its domains, is the
 ** same on 1 and 2 threads and through a stop and resume.  source = cmyk
-** needs no names.  A user's apart outranks the preset's. */
+** needs no names.  A user's apart outranks the preset's, and a run's
+** scene.ini written before the key existed resumes as it ran. */
 Test(layers, the_photo_preset_draws_colour_pens_kept_apart_by_pen_on_any_thread_count)
 {
   write_colour_png(lw_test_path("colour.png"), 48, 64, blotch_colours);
@@ -1016,7 +1017,17 @@ Test(layers, the_photo_preset_draws_colour_pens_kept_apart_by_pen_on_any_thread_
   cr_assert_eq(lw_test_sh("grep -c 'inkscape:label=\"\\(cyan\\|magenta\\|yellow\\|black\\) ' %s/p1/final.svg | grep -qx 4",
                           dir),
                0, "the pens of cmyk are not cyan, magenta, yellow and black");
-  cr_assert_eq(run("run photo.ini --out pa --quiet --set layers.apart=all --set anneal.sweeps=1", errs, sizeof errs),
+  cr_assert_eq(run("run photo.ini --out pa --quiet --set layers.apart=all --set anneal.sweeps=4", errs, sizeof errs),
                0, "%s", errs);
   cr_assert_eq(lw_test_sh("grep -qx 'apart = all' %s/pa/scene.ini", dir), 0);
+  /* a run begun before layers.apart existed ran with every line apart: its
+  ** scene.ini has no apart, and it resumes as it ran, not as the preset
+  ** would set it now (the state's energy would not match) */
+  cr_assert_eq(run("run photo.ini --out old --quiet --set layers.apart=all --set anneal.sweeps=4 --stop-at 2", errs,
+                   sizeof errs),
+               0, "%s", errs);
+  cr_assert_eq(lw_test_sh("sed -i '/^apart = /d' %s/old/scene.ini", dir), 0);
+  cr_assert_eq(run("resume old --quiet", errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(run("energy old", errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(lw_test_sh("cmp -s %s/pa/state.lw %s/old/state.lw", dir, dir), 0, "the old run resumed differently");
 }

@@ -233,6 +233,7 @@ typedef struct {
   /* Where each value came from: the file and line (0 = default, -1 = --set). */
   char file[LW_PATH_MAX];
   int line[LW_PARAM_MAX];
+  int of_run;                 /* read from a run's scene.ini (lw_params_read_run) */
 } lw_params;
 
 /* Fills p with every default. */
@@ -240,6 +241,12 @@ void lw_params_defaults(lw_params *p);
 
 /* Reads an INI scene file into p (defaults first). */
 lw_status lw_params_read(lw_params *p, const char *path, lw_error *err);
+
+/* Reads a run directory's scene.ini, which holds every key the run's build
+** knew, resolved.  A key it lacks is newer than the run, which ran with its
+** default: a preset does not fill it (the photo preset's layers.apart = pen
+** or image_levels would change the energy of a run begun before them). */
+lw_status lw_params_read_run(lw_params *p, const char *path, lw_error *err);
 
 /* Settles what depends on several keys, once all are known: a named page
 ** sets width and height (an explicit width or height that disagrees is an
