@@ -715,12 +715,13 @@ lw_status lw_image_levels(lw_image *img, double clip, double *lo, double *hi, lw
     /* the first bin from each end past `cut` pixels */
     size_t cut = (size_t)floor(clip * (double)count), c = 0;
     int b = 0;
+    const double plateau = LW_IMAGE_LEVELS_PLATEAU * (double)count;
     while (b < LEVELS_BINS - 1 && (c += hist[b]) <= cut) b++;
-    l = (double)b / LEVELS_BINS;
+    if ((double)hist[b] <= plateau) l = (double)b / LEVELS_BINS;
     c = 0;
     b = LEVELS_BINS - 1;
     while (b > 0 && (c += hist[b]) <= cut) b--;
-    h = (double)(b + 1) / LEVELS_BINS;
+    if ((double)hist[b] <= plateau) h = (double)(b + 1) / LEVELS_BINS;
   }
   free(hist);
   if (h - l < LW_IMAGE_LEVELS_MIN_SPAN) {

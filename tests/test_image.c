@@ -344,20 +344,47 @@ Test(image, levels_skip_transparent_pixels_and_cap_the_stretch)
   for (int k = 0; k < n; k++) cr_assert_eq(img->tone[2 * k + 1], 1.0f);
   lw_image_free(img);
 
-  /* noise of +-0.001 about 0.5, and about 0.99 */
+  /* tones spread evenly over +-0.01 about 0.5, and about 0.99 (82 bins of
+  ** the histogram, none a plateau) */
   static const double mid[2] = {0.5, 0.99};
   for (int m = 0; m < 2; m++) {
     img = lw_image_new(n, 1, 0, NULL);
-    for (int k = 0; k < n; k++) img->tone[k] = (float)(mid[m] + 0.001 * ((k % 3) - 1));
+    for (int k = 0; k < n; k++) img->tone[k] = (float)(mid[m] + 0.01 * (2.0 * k / (n - 1) - 1.0));
     cr_assert_eq(lw_image_levels(img, 0.01, &lo, &hi, NULL), LW_OK);
     cr_assert(fabs(hi - lo - LW_IMAGE_LEVELS_MIN_SPAN) < 1e-12 && lo >= 0 && hi <= 1, "%g %g", lo, hi);
     if (m == 0) cr_assert(fabs(0.5 * (lo + hi) - 0.5) < 1e-3, "%g %g", lo, hi);
     else cr_assert(hi == 1.0, "%g", hi);
     double spread = 0;
     for (int k = 0; k < n; k++) spread = fmax(spread, fabs(img->tone[k] - img->tone[0]));
-    cr_assert(spread <= 0.002 / LW_IMAGE_LEVELS_MIN_SPAN + 1e-5, "spread %g", spread);
+    cr_assert(spread <= 0.02 / LW_IMAGE_LEVELS_MIN_SPAN + 1e-5, "spread %g", spread);
     lw_image_free(img);
   }
+}
+
+/* A graphic's flat colours: an end whose level is one tone held by more than
+** LW_IMAGE_LEVELS_PLATEAU of the pixels keeps its place.  A disc of tone 0.33
+** (40 % of the pixels, the lightest) and a bar of 0.26 (10 %) stay as they
+** are; the same disc over a ramp of darker tones keeps its light end while
+** the dark end is stretched. */
+Test(image, levels_leave_a_flat_colour_at_either_end_as_it_is)
+{
+  const int n = 1000;
+  lw_image *img = lw_image_new(n, 1, 1, NULL);
+  for (int k = 0; k < n; k++) {
+    img->tone[k] = k < 400 ? 0.33f : (k < 500 ? 0.26f : 1.0f);
+    img->alpha[k] = k < 500 ? 1.0f : 0.0f; /* transparent paper */
+  }
+  double lo, hi;
+  cr_assert_eq(lw_image_levels(img, 0.01, &lo, &hi, NULL), LW_OK);
+  cr_assert(lo == 0.0 && hi == 1.0, "levels %g to %g", lo, hi);
+  cr_assert(img->tone[0] == 0.33f && img->tone[450] == 0.26f && img->tone[600] == 1.0f);
+  for (int k = 0; k < n; k++) {
+    img->tone[k] = k < 400 ? 0.33f : (float)(0.1 + 0.2 * (k - 400) / (n - 401));
+    img->alpha[k] = 1.0f;
+  }
+  cr_assert_eq(lw_image_levels(img, 0.01, &lo, &hi, NULL), LW_OK);
+  cr_assert(hi == 1.0 && fabs(lo - 0.102) < 2e-3, "levels %g to %g", lo, hi);
+  lw_image_free(img);
 }
 
 Test(image, fit_centres_and_keeps_the_aspect_ratio)

@@ -95,9 +95,15 @@ lw_status lw_image_blur_plane(float *plane, int w, int h, double sigma, lw_error
 ** alpha the tone is already composited over white, and stays white).  The
 ** stretch is at most 1 / LW_IMAGE_LEVELS_MIN_SPAN: a flatter picture is
 ** widened about its middle tone, so that sensor noise on a blank page is
-** not blown up into structure.  *lo and *hi receive the tones that became 0
-** and 1.  LW_ENOMEM with err set. */
+** not blown up into structure.  An end whose level falls on a flat area,
+** one tone (a bin of the histogram) held by more than
+** LW_IMAGE_LEVELS_PLATEAU of the pixels, is not stretched: a graphic's
+** flat colours would turn white or black whole (a logo's red disc, its
+** lightest colour, vanished), where a photograph's ends are tails of a few
+** pixels a tone.  *lo and *hi receive the tones that became 0 and 1.
+** LW_ENOMEM with err set. */
 #define LW_IMAGE_LEVELS_MIN_SPAN 0.05
+#define LW_IMAGE_LEVELS_PLATEAU 0.05
 lw_status lw_image_levels(lw_image *img, double clip, double *lo, double *hi, lw_error *err);
 
 /* The tone curve, in this order:
