@@ -128,12 +128,6 @@ lw_status lw_cellgrid_planes(lw_cellgrid *g, int planes);
 /* Inserts sample i into plane `plane`, as lw_cellgrid_insert does into 0. */
 lw_status lw_cellgrid_insert_in(lw_cellgrid *g, int plane, uint32_t i, double x, double y, float dl);
 
-/* The plane of sample i (in the grid) of a 2-D grid. */
-static inline int lw_cellgrid_plane_of(const lw_cellgrid *g, uint32_t i)
-{
-  return (int)(g->home[i] / ((uint32_t)g->nx * (uint32_t)g->ny));
-}
-
 /* Plane p of a 2-D grid as a grid of one plane, sharing its cells: what a
 ** walk over that plane reads (the view is valid while g is unchanged). */
 static inline const lw_cellgrid *lw_cellgrid_plane(const lw_cellgrid *g, int p, lw_cellgrid *view)
