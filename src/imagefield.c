@@ -4,7 +4,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, lw_error *err)
+lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, lw_error *err)
 {
   const int w = img->width, h = img->height, W = w + 2, H = h + 2;
   /* node (i, j) is the centre of pixel (i - 1, j - 1); the outer ring is white */
@@ -14,8 +14,8 @@ lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl
   for (int j = 0; j < H; j++)
     for (int i = 0; i < W; i++) {
       int inner = i >= 1 && i <= w && j >= 1 && j <= h;
-      g->data[(size_t)j * W + (size_t)i] =
-        inner ? img->tone[(size_t)(j - 1) * (size_t)w + (size_t)(i - 1)] : 1.0;
+      double t = inner ? img->tone[(size_t)(j - 1) * (size_t)w + (size_t)(i - 1)] : 1.0;
+      g->data[(size_t)j * W + (size_t)i] = power == 1.0 ? t : pow(t, power);
     }
   return g;
 }

@@ -99,6 +99,10 @@ const lw_param_def lw_param_table[] = {
   NUM("scene", "potential_scale", LW_PT_DOUBLE, potential_scale, "0", "mm", 0, 1e7, 0,
       "h of the ramp and radial potentials; 0 = automatic (half the page extent along the ramp; "
       "half the page diagonal for radial)."),
+  NUM("scene", "potential_power", LW_PT_DOUBLE, potential_power, "1", "", 0, 100, LW_MIN_OPEN,
+      "potential = image: Phi = tone^power. Above 1 the potential is near 0 everywhere but near white, "
+      "so energy.potential > 0 costs line where the picture asks for none (stray lines in a white "
+      "background) and little in the mid-tones."),
   CHOICE("scene", "field", field, "constant", "constant|radial|vortex|waves|etf|gradient",
          "Vector field v read by the field term (unit length): constant along `field_angle`, "
          "radial from the centre, vortex around it, waves tangent to y = A sin(2 pi x / wavelength), "

@@ -131,12 +131,20 @@ Test(imagefield, potential_is_the_tone_and_white_beyond_the_picture)
   for (int k = 0; k < 35; k++) img->tone[k] = (float)urand(0, 1);
   lw_image_place pl = {3, 4, 2};
   lw_potential f = {.kind = LW_POTENTIAL_GRID};
-  f.grid = lw_imagefield_potential(img, &pl, NULL);
+  f.grid = lw_imagefield_potential(img, &pl, 1.0, NULL);
   for (int j = 0; j < 5; j++)
     for (int i = 0; i < 7; i++)
       cr_assert(fabs(lw_potential_eval(&f, 3 + 2 * (i + 0.5), 4 + 2 * (j + 0.5)) - img->tone[j * 7 + i]) < 1e-7);
   cr_assert(lw_potential_eval(&f, 0, 0) == 1.0 && lw_potential_eval(&f, 100, 10) == 1.0);
   cr_assert(lw_potential_eval(&f, 3 + 14 + 1, 9) == 1.0, "a pixel beyond the right edge is white");
+  lw_potential_clear(&f);
+  /* scene.potential_power: Phi = tone^power, white still 1 */
+  f.grid = lw_imagefield_potential(img, &pl, 3.0, NULL);
+  for (int j = 0; j < 5; j++)
+    for (int i = 0; i < 7; i++)
+      cr_assert(fabs(lw_potential_eval(&f, 3 + 2 * (i + 0.5), 4 + 2 * (j + 0.5)) - pow(img->tone[j * 7 + i], 3)) <
+                1e-7);
+  cr_assert(lw_potential_eval(&f, 0, 0) == 1.0);
   lw_potential_clear(&f);
   lw_image_free(img);
 }

@@ -39,7 +39,9 @@
 #include "linewise/field.h"
 #include "linewise/image.h"
 
-lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, lw_error *err);
+/* The potential of scene.potential = image: Phi = tone^power at the pixel
+** centres (white beyond the picture). */
+lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, lw_error *err);
 
 /* angle: the fallback direction, radians (0 = +x, pi/2 = +y, down). */
 lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, double sigma_mm, double flat,

@@ -84,6 +84,7 @@ typedef struct {
   double potential_value;     /* constant Phi */
   double potential_angle;     /* ramp direction, degrees */
   double potential_scale;     /* ramp half extent / radial radius, mm; 0 = automatic */
+  double potential_power;     /* potential = image: Phi = tone^power */
   int field;                  /* LW_FLD_* */
   double field_angle;         /* constant field direction (etf fallback), degrees */
   double field_sigma;         /* etf tensor smoothing, mm */
