@@ -405,7 +405,8 @@ const lw_param_def lw_param_table[] = {
   CHOICE("layers", "source", ly_source, "tone", "tone|cmyk|palette",
          "Each layer's target: `tone` = the picture's darkness through the layer's `tone_min` .. "
          "`tone_max`; `cmyk` = the cyan, magenta, yellow and black separation of the colour picture "
-         "(4 layers, in that order; without layers.names they are named cyan, magenta, yellow and black); `palette` = the least-squares separation of the colour picture "
+         "(4 layers, in that order; without layers.names they are named cyan, magenta, yellow and "
+         "black); `palette` = the least-squares separation of the colour picture "
          "into the pens of `colors` (docs/NUMERICS.md, \"Colour separation\")."),
   CHOICE("layers", "apart", ly_apart, "all", "all|pen",
          "Which lines the pair repulsion and energy.min_spacing keep apart: `all` = every line from "
@@ -891,6 +892,7 @@ static const double page_mm[][2] = {{0, 0}, {210, 297}, {297, 420}, {215.9, 279.
 ** picture and on four test photographs (docs/IMAGES.md, "With the photo
 ** preset" and "On photographs").
 */
+#define PHOTO_CHEM (2.5 / 0.35) /* the chemical potential's price of line, pen widths per mm */
 static const struct {
   const char *section, *key, *text; /* text, or NULL: pens * w */
   double pens;
@@ -907,7 +909,7 @@ static const struct {
     {"energy", "boundary", "0.2", 0},      {"anneal", "schedule", "geometric", 0},
     {"anneal", "t_start", "0.5", 0},       {"anneal", "t_end", "0.002", 0},
     {"anneal", "sweeps", "300", 0},        {"anneal", "steps", "5", 0},
-    {"moves", "fixed_count", "0", 0},      {"energy", "chem_length", NULL, -2.5 / 0.35},
+    {"moves", "fixed_count", "0", 0},      {"energy", "chem_length", NULL, -PHOTO_CHEM},
     {"moves", "grow", "0.05", 0},          {"moves", "shrink", "0.05", 0},
     {"scene", "image_levels", "0.01", 0},  {"layers", "apart", "pen", 0},
 };
@@ -937,9 +939,10 @@ static void apply_preset(lw_params *p)
   /* Pens of a colour separation: a line costs, where its pen's target is
   ** white, what the chemical potential pays for it (Phi = tone^8 is near 0
   ** elsewhere), so a pen leaves no stray lines in the other colours' areas
-  ** (docs/IMAGES.md, "White backgrounds"; correlation +0.01 to +0.025 on
-  ** four pictures in CMYK, while one pen on a photograph lost 0.02, so not
-  ** there).  Unset keys go back to their defaults when the source changes. */
+  ** (docs/IMAGES.md, "White backgrounds"; colour correlation +0.011 to
+  ** +0.029 on four pictures in CMYK, while one pen on a photograph lost
+  ** 0.02, so not there).  Unset keys go back to their defaults when the
+  ** source changes. */
   static const struct {
     const char *section, *key, *text;
   } colour_keys[] = {{"scene", "potential", "image"}, {"energy", "potential", NULL}, {"scene", "potential_power", "8"}};
@@ -948,7 +951,7 @@ static void apply_preset(lw_params *p)
     const char *t = colour_keys[k].text;
     if (!colour) t = lw_params_find(colour_keys[k].section, colour_keys[k].key)->def;
     else if (!t) {
-      snprintf(text, sizeof text, "%.17g", 2.5 / 0.35 * w);
+      snprintf(text, sizeof text, "%.17g", PHOTO_CHEM * w);
       t = text;
     }
     preset_key(p, colour_keys[k].section, colour_keys[k].key, t);
