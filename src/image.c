@@ -443,6 +443,15 @@ static lw_status decoded_orient(decoded *dec, int o, const char *name, lw_error 
   return LW_OK;
 }
 
+/* The format a file's first bytes name, for messages. */
+static const char *format_name(const unsigned char *d, size_t n)
+{
+  if (n >= 4 && d[0] == 0x89 && d[1] == 'P' && d[2] == 'N' && d[3] == 'G') return "PNG";
+  if (n >= 2 && d[0] == 0xFF && d[1] == 0xD8) return "JPEG";
+  if (n >= 2 && d[0] == 'B' && d[1] == 'M') return "BMP";
+  return "image";
+}
+
 static lw_status stb_decode(const unsigned char *data, size_t size, const char *name, decoded *out, lw_error *err)
 {
   if (size > INT_MAX)
@@ -457,9 +466,19 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
   lw_status st = bmp_complete(data, size, name, err);
   if (st) return st;
   int bits = stbi_is_16_bit_from_memory(data, (int)size) ? 16 : 8;
+  /* The decoder keeps its last reason until a new one is set, and some
+  ** failures set none: a JPEG cut short was reported as "Not a PNG", from
+  ** the format tests before it.  A reason the load did not change is not
+  ** given. */
+  const char *before = stbi_failure_reason();
   void *pix = bits == 16 ? (void *)stbi_load_16_from_memory(data, (int)size, &w, &h, &ch, 0)
                          : (void *)stbi_load_from_memory(data, (int)size, &w, &h, &ch, 0);
-  if (!pix) return lw_error_set(err, LW_EINPUT, "%s: cannot decode the image: %s", name, stbi_failure_reason());
+  if (!pix) {
+    const char *why = stbi_failure_reason();
+    return lw_error_set(err, LW_EINPUT, "%s: the %s is damaged or cut short: it does not decode%s%s%s", name,
+                        format_name(data, size), why && why != before ? " (" : "", why && why != before ? why : "",
+                        why && why != before ? ")" : "");
+  }
   *out = (decoded){pix, pix, 1, w, h, ch, bits};
   int o = jpeg_orientation(data, size);
   if (o != 1 && (st = decoded_orient(out, o, name, err)) != LW_OK) decoded_free(out);

@@ -455,6 +455,34 @@ static size_t exif_jpeg(unsigned char *out, int o, int big_endian, int bad_ifd)
   return n + j.n - 2;
 }
 
+/* A JPEG cut short anywhere past its header is refused as a damaged JPEG,
+** never with a reason about another format: the decoder keeps the reason
+** of its last failure, and a PNG test before the JPEG decoder left "Not a
+** PNG" (skimage's truncated.jpg) where the JPEG decoder set none.  A cut
+** that decoded would be no error (a decoder may pad the scan), so the test
+** asserts that cuts fail and that none is misreported. */
+Test(image, a_jpeg_cut_short_is_reported_as_one)
+{
+  unsigned char jpg[8300];
+  size_t n = exif_jpeg(jpg, 0, 0, 0);
+  int failed = 0, unreasoned = 0;
+  for (size_t cut = 200; cut < n; cut++) {
+    lw_error err;
+    lw_image *img = lw_image_decode(jpg, cut, "cut.jpg", 1e6, NULL, &err);
+    if (img) {
+      lw_image_free(img);
+      continue;
+    }
+    failed++;
+    cr_assert(strstr(err.msg, "cut.jpg: ") && strstr(err.msg, "JPEG") && !strstr(err.msg, "PNG") &&
+                  !strstr(err.msg, "png"),
+              "cut at %zu of %zu: %s", cut, n, err.msg);
+    unreasoned += strchr(err.msg, '(') == NULL;
+  }
+  cr_assert_gt(failed, 0, "no cut of %zu bytes failed to decode", n);
+  cr_log_info("%d of %zu cuts fail, %d without the decoder's reason", failed, n - 200, unreasoned);
+}
+
 /* Which corner of img holds the dark block: 0 top-left, 1 top-right,
 ** 2 bottom-right, 3 bottom-left; -1 unless exactly one 8 x 8 corner is dark. */
 static int dark_corner(const lw_image *img)
