@@ -43,11 +43,12 @@ const lw_param_def lw_param_table[] = {
   CHOICE("scene", "preset", preset, "none", "none|photo",
          "Settings that fill every key the scene leaves unset: `photo` draws a picture as a "
          "tone of lines, sized from output.pen_width and the page rather than in fixed "
-         "millimetres, so one scene works from A6 to A3 (docs/IMAGES.md, \"Photographs\", lists "
+         "millimetres, so one scene works from A6 to A0 (docs/IMAGES.md, \"Photographs\", lists "
          "what it sets). Keys the scene or --set gives win."),
-  CHOICE("scene", "page", page, "custom", "custom|a4|a3|letter|a5|a6",
-         "Page size: `custom` takes `width` and `height`; a4 is 210 x 297 mm, a3 297 x 420 mm, "
-         "letter 215.9 x 279.4 mm, a5 148 x 210 mm, a6 105 x 148 mm (portrait). A named page sets width and height; setting "
+  CHOICE("scene", "page", page, "custom", "custom|a4|a3|letter|a5|a6|a2|a1|a0|tabloid|legal",
+         "Page size: `custom` takes `width` and `height`; a6 is 105 x 148 mm, a5 148 x 210 mm, a4 210 x 297 mm, "
+         "a3 297 x 420 mm, a2 420 x 594 mm, a1 594 x 841 mm, a0 841 x 1189 mm, letter 215.9 x 279.4 mm, "
+         "legal 215.9 x 355.6 mm, tabloid 279.4 x 431.8 mm (portrait). A named page sets width and height; setting "
          "either as well is an error unless it agrees."),
   CHOICE("scene", "orientation", orientation, "portrait", "portrait|landscape|auto",
          "Orientation of a named page: landscape swaps its width and height; auto is landscape when the picture "
@@ -870,7 +871,10 @@ lw_status lw_params_read_run(lw_params *p, const char *path, lw_error *err) { re
 
 /* Named page sizes in mm, portrait, in the order of the choices of
 ** scene.page (custom first, which has none). */
-static const double page_mm[][2] = {{0, 0}, {210, 297}, {297, 420}, {215.9, 279.4}, {148, 210}, {105, 148}};
+static const double page_mm[][2] = {{0, 0},       {210, 297},   {297, 420},     {215.9, 279.4},
+                                    {148, 210},   {105, 148},   {420, 594},     {594, 841},
+                                    {841, 1189}, {279.4, 431.8}, {215.9, 355.6}};
+_Static_assert(sizeof page_mm / sizeof page_mm[0] == LW_PAGE_LEGAL + 1, "a size for every named page");
 
 /*
 ** scene.preset = photo: lengths in pen widths w (the line's own scale), the

@@ -188,6 +188,11 @@ Test(params, named_pages_set_the_size)
     {"[scene]\npage = letter\n", 215.9, 279.4},
     {"[scene]\npage = a5\n", 148, 210},
     {"[scene]\npage = a6\norientation = landscape\n", 148, 105},
+    {"[scene]\npage = a2\n", 420, 594},
+    {"[scene]\npage = a1\norientation = landscape\n", 841, 594},
+    {"[scene]\npage = a0\n", 841, 1189},
+    {"[scene]\npage = legal\n", 215.9, 355.6},
+    {"[scene]\npage = tabloid\norientation = landscape\n", 431.8, 279.4},
     {"[scene]\npage = a4\norientation = landscape\n", 297, 210},
     {"[scene]\npage = letter\norientation = landscape\n", 279.4, 215.9},
     /* an explicit size that agrees is fine (a resolved scene.ini has both) */

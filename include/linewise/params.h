@@ -43,7 +43,10 @@ extern const lw_param_def lw_param_table[];
 extern const size_t lw_param_count;
 
 /* Choice indices (order of the choices strings in params.c). */
-enum { LW_PAGE_CUSTOM, LW_PAGE_A4, LW_PAGE_A3, LW_PAGE_LETTER, LW_PAGE_A5, LW_PAGE_A6 };
+enum {
+  LW_PAGE_CUSTOM, LW_PAGE_A4, LW_PAGE_A3, LW_PAGE_LETTER, LW_PAGE_A5, LW_PAGE_A6,
+  LW_PAGE_A2, LW_PAGE_A1, LW_PAGE_A0, LW_PAGE_TABLOID, LW_PAGE_LEGAL
+};
 enum { LW_ORIENT_PORTRAIT, LW_ORIENT_LANDSCAPE, LW_ORIENT_AUTO };
 enum { LW_BND_RECT, LW_BND_CIRCLE, LW_BND_POLYGON, LW_BND_MASK };
 enum { LW_POT_CONSTANT, LW_POT_RAMP, LW_POT_RADIAL, LW_POT_IMAGE };
