@@ -148,79 +148,190 @@ lw_status lw_fidelity_blur(double *v, int w, int h, double sx, double sy, double
   return blur(v, w, h, sx, sy, radius(sx, truncate, w), radius(sy, truncate, h), err);
 }
 
-/* The local averages under the SSIM window of `planes` w x h images stored
-** one after the other in m, in place. */
-static lw_status window(double *m, int planes, int w, int h, lw_error *err)
+/*
+** The SSIM window, a row at a time.  Scoring a 4-megapixel picture on whole
+** planes held nine of them at once (288 MB); the window is separable and
+** 11 rows tall, so the rows it needs are kept instead: each plane's rows
+** are made (`fill`), blurred along x as they come, kept in a ring of
+** 2 ry + 1, and each output row is their weighted sum down the column.
+** The sums are those of the two-pass blur above, term for term and in the
+** same order, so the scores are its bits.
+*/
+typedef void (*window_fill)(void *ctx, int row, double **planes);
+
+typedef struct {
+  int w, h, planes, rx, ry, ring;
+  double gx[LW_FIDELITY_SSIM_RADIUS + 1], gy[LW_FIDELITY_SSIM_RADIUS + 1];
+  double *normx, *normy, *rows, *scratch, *out;
+  window_fill fill;
+  void *ctx;
+  int made; /* rows made so far */
+} window_rows;
+
+static void window_rows_free(window_rows *r)
 {
-  size_t n = (size_t)w * (size_t)h;
-  int rx = LW_FIDELITY_SSIM_RADIUS < w ? LW_FIDELITY_SSIM_RADIUS : w;
-  int ry = LW_FIDELITY_SSIM_RADIUS < h ? LW_FIDELITY_SSIM_RADIUS : h;
-  for (int q = 0; q < planes; q++) {
-    lw_status s = blur(m + (size_t)q * n, w, h, LW_FIDELITY_SSIM_SIGMA, LW_FIDELITY_SSIM_SIGMA, rx, ry, err);
-    if (s) return s;
+  free(r->normx);
+  free(r->normy);
+  free(r->rows);
+  free(r->scratch);
+  free(r->out);
+}
+
+static lw_status window_rows_init(window_rows *r, int planes, int w, int h, window_fill fill, void *ctx,
+                                  lw_error *err)
+{
+  *r = (window_rows){.w = w, .h = h, .planes = planes, .fill = fill, .ctx = ctx};
+  r->rx = LW_FIDELITY_SSIM_RADIUS < w ? LW_FIDELITY_SSIM_RADIUS : w;
+  r->ry = LW_FIDELITY_SSIM_RADIUS < h ? LW_FIDELITY_SSIM_RADIUS : h;
+  r->ring = 2 * r->ry + 1;
+  size_t W = (size_t)w, P = (size_t)planes;
+  r->normx = malloc(W * sizeof *r->normx);
+  r->normy = malloc((size_t)h * sizeof *r->normy);
+  r->rows = malloc((size_t)r->ring * P * W * sizeof *r->rows);
+  r->scratch = malloc(W * sizeof *r->scratch);
+  r->out = malloc(P * W * sizeof *r->out);
+  if (!r->normx || !r->normy || !r->rows || !r->scratch || !r->out) {
+    window_rows_free(r);
+    return lw_error_set(err, LW_ENOMEM, "fidelity: out of memory for the SSIM window over %d x %d pixels", w, h);
   }
+  kernel(LW_FIDELITY_SSIM_SIGMA, r->rx, W, r->gx, r->normx);
+  kernel(LW_FIDELITY_SSIM_SIGMA, r->ry, (size_t)h, r->gy, r->normy);
   return LW_OK;
 }
 
-/* Central differences (one-sided at the edges) of v into gx, gy. */
-static void gradient(const double *v, int w, int h, double *gx, double *gy)
+/* Row k's planes, made and blurred along x, in ring slot k mod ring. */
+static void window_make(window_rows *r, int k)
 {
-  for (int j = 0; j < h; j++)
-    for (int i = 0; i < w; i++) {
-      size_t k = (size_t)j * (size_t)w + (size_t)i;
-      int il = i > 0 ? i - 1 : i, ir = i + 1 < w ? i + 1 : i, jd = j > 0 ? j - 1 : j, ju = j + 1 < h ? j + 1 : j;
-      gx[k] = ir > il ? (v[(size_t)j * w + ir] - v[(size_t)j * w + il]) / (ir - il) : 0.0;
-      gy[k] = ju > jd ? (v[(size_t)ju * w + i] - v[(size_t)jd * w + i]) / (ju - jd) : 0.0;
-    }
+  size_t W = (size_t)r->w, P = (size_t)r->planes;
+  double *slot = r->rows + (size_t)(k % r->ring) * P * W, *planes[8];
+  for (size_t q = 0; q < P; q++) planes[q] = slot + q * W;
+  r->fill(r->ctx, k, planes);
+  for (size_t q = 0; q < P; q++) blur_axis(planes[q], W, 1, 1, W, r->gx, r->rx, r->normx, r->scratch);
 }
 
-/* The doubled-angle vector (Jxx - Jyy, 2 Jxy) of the structure tensor of v
-** under the SSIM window into u[0 .. 2n): its angle is twice the dominant
-** gradient direction, its length the anisotropy. */
-static lw_status tensor(const double *v, int w, int h, double *u, double *t, lw_error *err)
+/* The windowed planes of row j into r->out (plane q at out + q w).  Rows
+** are asked for in order 0, 1, ..., h - 1. */
+static const double *window_row(window_rows *r, int j)
 {
-  size_t n = (size_t)w * (size_t)h;
-  double *gx = u, *gy = u + n, *jxx = t, *jxy = t + n, *jyy = t + 2 * n;
-  gradient(v, w, h, gx, gy);
-  for (size_t k = 0; k < n; k++) {
-    jxx[k] = gx[k] * gx[k];
-    jxy[k] = gx[k] * gy[k];
-    jyy[k] = gy[k] * gy[k];
+  int lo = j >= r->ry ? j - r->ry : 0, hi = j + r->ry < r->h ? j + r->ry : r->h - 1;
+  for (; r->made <= hi; r->made++) window_make(r, r->made);
+  size_t W = (size_t)r->w, P = (size_t)r->planes;
+  for (size_t q = 0; q < P; q++) {
+    double *o = r->out + q * W;
+    for (size_t c = 0; c < W; c++) o[c] = 0.0;
+    for (int k = lo; k <= hi; k++) {
+      const double *in = r->rows + ((size_t)(k % r->ring) * P + q) * W;
+      double g = r->gy[k > j ? k - j : j - k];
+      for (size_t c = 0; c < W; c++) o[c] += g * in[c];
+    }
+    for (size_t c = 0; c < W; c++) o[c] /= r->normy[j];
   }
-  lw_status s = window(t, 3, w, h, err);
+  return r->out;
+}
+
+/* Central differences (one-sided at the edges) of row j of v into gx, gy. */
+static void gradient_row(const double *v, int w, int h, int j, double *gx, double *gy)
+{
+  size_t W = (size_t)w;
+  int jd = j > 0 ? j - 1 : j, ju = j + 1 < h ? j + 1 : j;
+  for (int i = 0; i < w; i++) {
+    int il = i > 0 ? i - 1 : i, ir = i + 1 < w ? i + 1 : i;
+    gx[i] = ir > il ? (v[(size_t)j * W + ir] - v[(size_t)j * W + il]) / (ir - il) : 0.0;
+    gy[i] = ju > jd ? (v[(size_t)ju * W + i] - v[(size_t)jd * W + i]) / (ju - jd) : 0.0;
+  }
+}
+
+typedef struct {
+  const double *a, *b;
+  int w, h;
+  double *gx, *gy;
+} pair_rows;
+
+/* SSIM's planes: a, b, a^2, b^2, ab. */
+static void fill_moments(void *ctx, int row, double **pl)
+{
+  const pair_rows *c = ctx;
+  const double *a = c->a + (size_t)row * (size_t)c->w, *b = c->b + (size_t)row * (size_t)c->w;
+  for (int i = 0; i < c->w; i++) {
+    pl[0][i] = a[i];
+    pl[1][i] = b[i];
+    pl[2][i] = a[i] * a[i];
+    pl[3][i] = b[i] * b[i];
+    pl[4][i] = a[i] * b[i];
+  }
+}
+
+/* The structure tensors' planes: gx^2, gx gy, gy^2 of a, then of b. */
+static void fill_tensors(void *ctx, int row, double **pl)
+{
+  const pair_rows *c = ctx;
+  for (int s = 0; s < 2; s++) {
+    gradient_row(s ? c->b : c->a, c->w, c->h, row, c->gx, c->gy);
+    double *xx = pl[3 * s], *xy = pl[3 * s + 1], *yy = pl[3 * s + 2];
+    for (int i = 0; i < c->w; i++) {
+      xx[i] = c->gx[i] * c->gx[i];
+      xy[i] = c->gx[i] * c->gy[i];
+      yy[i] = c->gy[i] * c->gy[i];
+    }
+  }
+}
+
+/* SSIM of a against b, its map averaged over every pixel. */
+static lw_status ssim(const double *a, const double *b, int w, int h, double *out, lw_error *err)
+{
+  pair_rows c = {a, b, w, h, NULL, NULL};
+  window_rows r;
+  lw_status s = window_rows_init(&r, 5, w, h, fill_moments, &c, err);
   if (s) return s;
-  for (size_t k = 0; k < n; k++) {
-    u[k] = jxx[k] - jyy[k];
-    u[n + k] = 2 * jxy[k];
+  const double C1 = 0.01 * 0.01, C2 = 0.03 * 0.03; /* L = 1 */
+  size_t W = (size_t)w;
+  double sum = 0.0;
+  for (int j = 0; j < h; j++) {
+    const double *ma = window_row(&r, j), *mb = ma + W, *aa = mb + W, *bb = aa + W, *ab = bb + W;
+    for (size_t k = 0; k < W; k++) {
+      double va = aa[k] - ma[k] * ma[k], vb = bb[k] - mb[k] * mb[k], cov = ab[k] - ma[k] * mb[k];
+      sum += (2 * ma[k] * mb[k] + C1) * (2 * cov + C2) / ((ma[k] * ma[k] + mb[k] * mb[k] + C1) * (va + vb + C2));
+    }
   }
+  *out = sum / ((double)W * (double)h);
+  window_rows_free(&r);
   return LW_OK;
 }
 
 /* Orientation agreement of a with b (the target): the mean of cos 2 dtheta
-** between their dominant gradient axes, weighted by b's anisotropy; a pixel
-** where a has no direction counts 0.  NaN where b has no structure. */
+** between their dominant gradient axes, the doubled-angle vectors
+** (Jxx - Jyy, 2 Jxy) of their structure tensors under the SSIM window,
+** weighted by b's anisotropy; a pixel where a has no direction counts 0.
+** NaN where b has no structure. */
 static lw_status orientation(const double *a, const double *b, int w, int h, double *out, lw_error *err)
 {
-  size_t n = (size_t)w * (size_t)h;
-  double *m = malloc(7 * n * sizeof *m);
-  if (!m) return lw_error_set(err, LW_ENOMEM, "fidelity: out of memory for %d x %d pixels", w, h);
-  double *ua = m, *ub = m + 2 * n, *t = m + 4 * n;
-  lw_status s;
-  if ((s = tensor(a, w, h, ua, t, err)) || (s = tensor(b, w, h, ub, t, err))) {
-    free(m);
+  size_t W = (size_t)w;
+  double *g = malloc(2 * W * sizeof *g);
+  if (!g) return lw_error_set(err, LW_ENOMEM, "fidelity: out of memory for %d x %d pixels", w, h);
+  pair_rows c = {a, b, w, h, g, g + W};
+  window_rows r;
+  lw_status s = window_rows_init(&r, 6, w, h, fill_tensors, &c, err);
+  if (s) {
+    free(g);
     return s;
   }
   /* below LW_FIDELITY_FLAT a pixel has no direction: rounding in the blur
   ** leaves gradients of ~1e-17 on a flat image */
   double num = 0.0, den = 0.0, flat = LW_FIDELITY_FLAT * LW_FIDELITY_FLAT;
-  for (size_t k = 0; k < n; k++) {
-    double la = hypot(ua[k], ua[n + k]), lb = hypot(ub[k], ub[n + k]);
-    if (lb <= flat) continue;
-    den += lb;
-    if (la > flat) num += (ua[k] * ub[k] + ua[n + k] * ub[n + k]) / la;
+  for (int j = 0; j < h; j++) {
+    const double *t = window_row(&r, j);
+    for (size_t k = 0; k < W; k++) {
+      double ua0 = t[k] - t[2 * W + k], ua1 = 2 * t[W + k];
+      double ub0 = t[3 * W + k] - t[5 * W + k], ub1 = 2 * t[4 * W + k];
+      double la = hypot(ua0, ua1), lb = hypot(ub0, ub1);
+      if (lb <= flat) continue;
+      den += lb;
+      if (la > flat) num += (ua0 * ub0 + ua1 * ub1) / la;
+    }
   }
   *out = den > 0 ? num / den : NAN;
-  free(m);
+  window_rows_free(&r);
+  free(g);
   return LW_OK;
 }
 
@@ -236,31 +347,7 @@ lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, dou
   double sum = 0.0;
   for (size_t k = 0; k < n; k++) sum += (a[k] - b[k]) * (a[k] - b[k]);
   out->mse = sum / (double)n;
-
-  /* SSIM: local means, variances and covariance under the window */
-  double *m = malloc(5 * n * sizeof *m);
-  if (!m) return lw_error_set(err, LW_ENOMEM, "fidelity: out of memory for SSIM of %d x %d pixels", w, h);
-  double *ma = m, *mb = m + n, *aa = m + 2 * n, *bb = m + 3 * n, *ab = m + 4 * n;
-  for (size_t k = 0; k < n; k++) {
-    ma[k] = a[k];
-    mb[k] = b[k];
-    aa[k] = a[k] * a[k];
-    bb[k] = b[k] * b[k];
-    ab[k] = a[k] * b[k];
-  }
-  if ((s = window(m, 5, w, h, err))) {
-    free(m);
-    return s;
-  }
-  const double C1 = 0.01 * 0.01, C2 = 0.03 * 0.03; /* L = 1 */
-  sum = 0.0;
-  for (size_t k = 0; k < n; k++) {
-    double va = aa[k] - ma[k] * ma[k], vb = bb[k] - mb[k] * mb[k], cov = ab[k] - ma[k] * mb[k];
-    sum += (2 * ma[k] * mb[k] + C1) * (2 * cov + C2) /
-           ((ma[k] * ma[k] + mb[k] * mb[k] + C1) * (va + vb + C2));
-  }
-  out->ssim = sum / (double)n;
-  free(m);
+  if ((s = ssim(a, b, w, h, &out->ssim, err))) return s;
   return orientation(a, b, w, h, &out->orientation, err);
 }
 
