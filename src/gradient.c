@@ -20,6 +20,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/tone.h"
+
 void lw_samples_grad_zero(lw_samples_grad *g, int n)
 {
   memset(g, 0, sizeof *g);
@@ -53,10 +55,10 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
 {
   double e[LW_TERM_COUNT] = {0};
   memset(grad, 0, sp->n_nodes * sizeof *grad);
-  /* the user term (an opaque function) and the tone term have none */
+  /* the user term (an opaque function) has none */
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     const lw_term_type *r = &lw_term_types[t];
-    if (sc->on[t] && selected(term_mask, t) && !r->segment_grad && !r->spline_grad && !r->pairwise) {
+    if (sc->on[t] && selected(term_mask, t) && !r->segment_grad && !r->spline_grad && !r->pairwise && !r->raster) {
       lw_error_set(err, LW_EINPUT, "the %s term has no gradient (energy.%s): the dynamics and the quench need "
                    "one; leave the term out", lw_term_names[t], lw_term_names[t]);
       return NAN;
@@ -68,6 +70,13 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
   int strain = 0; /* spline terms that are on and selected */
   for (int t = 0; t < LW_TERM_COUNT; t++)
     if (lw_term_types[t].spline_grad && sc->on[t] && selected(term_mask, t)) strain = 1;
+  /* The tone term: the raster of every sample first, whose residual each
+  ** sample's footprint reads (tone.h, lw_tone_sample_grad). */
+  int64_t *raster = NULL;
+  if (sc->on[LW_TERM_TONE] && selected(term_mask, LW_TERM_TONE)) {
+    e[LW_TERM_TONE] = lw_energy_raster(sc, sp, LW_TERM_TONE, &raster, err);
+    if (isnan(e[LW_TERM_TONE])) return NAN;
+  }
   double *seg_len = NULL, *dlen = NULL;
   if (strain) {
     size_t ns = sp->n_segments ? sp->n_segments : 1;
@@ -76,6 +85,7 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
     if (!seg_len || !dlen) {
       free(seg_len);
       free(dlen);
+      free(raster);
       lw_error_set(err, LW_ENOMEM, "out of memory for the gradient of %zu segments", sp->n_segments);
       return NAN;
     }
@@ -113,6 +123,22 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
       e[t] += lw_term_types[t].segment(&s, &c[t]);
       lw_term_types[t].segment_grad(&s, &c[t], &sg);
     }
+    if (raster) {
+      const lw_tone *tn = c[LW_TERM_TONE].data;
+      const int64_t *rp =
+        raster + (sc->layers.n ? (size_t)lw_splines_layer(&sc->layers, sp, sp->seg_spline[g]) : 0) *
+                   (size_t)tn->w * (size_t)tn->h;
+      for (int q = 0; q < s.n; q++) {
+        double ex, ey, edl;
+        lw_tone_sample_grad(tn, rp, c[LW_TERM_TONE].coef, s.x[q], s.y[q], s.dl[q], &ex, &ey, &edl);
+        sg.x[q] += ex;
+        sg.y[q] += ey;
+        if (!(s.speed[q] > 0.0)) continue; /* dl = w |r'| has no gradient at 0: a subgradient */
+        double f = edl * sc->quad.w[q] / s.speed[q];
+        sg.dx[q] += f * s.dx[q];
+        sg.dy[q] += f * s.dy[q];
+      }
+    }
     if (strain)
       for (int q = 0; q < s.n; q++) {
         if (!(s.speed[q] > 0.0)) continue; /* |r'| has no gradient at 0: a subgradient */
@@ -124,6 +150,7 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
   }
   free(seg_len);
   free(dlen);
+  free(raster);
   if (sc->on[LW_TERM_PAIR] && selected(term_mask, LW_TERM_PAIR)) {
     e[LW_TERM_PAIR] = lw_pair_gradient(sc, sp, grad, err);
     if (isnan(e[LW_TERM_PAIR])) {

@@ -508,6 +508,17 @@ fail:
   return NAN;
 }
 
+double lw_energy_raster(const lw_scene *sc, const lw_splines *sp, int t, int64_t **out, lw_error *err)
+{
+  lw_term_set ts;
+  term_set_init(&ts, sc);
+  if (!(*out = raster_new(&ts, t))) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for the %s raster", lw_term_names[t]);
+    return NAN;
+  }
+  return raster_fill(&ts, t, sp, *out);
+}
+
 /* Pair samples a segment: the pairwise term's nodes (the quadrature's when
 ** there is none, for sizes only). */
 static int pair_nodes(const lw_model *m)

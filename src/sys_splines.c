@@ -44,6 +44,7 @@ typedef struct {
   lw_drawing_report drawing;     /* of the last final drawing */
   lw_node *grad;                 /* the gradient's scratch, allocated by the first
                                     gradient() call: none on a Monte Carlo run */
+  size_t grad_cap;               /* its nodes: births and grows add nodes between calls */
 } spl_state;
 
 static void setup_free(void *setup)
@@ -922,9 +923,15 @@ static double gradient(void *state, double *g, lw_error *err)
 {
   spl_state *s = state;
   const lw_splines *sp = s->m->sp;
-  if (!s->grad && !(s->grad = malloc((sp->n_nodes ? sp->n_nodes : 1) * sizeof *s->grad))) {
-    lw_error_set(err, LW_ENOMEM, "out of memory for the gradient of %zu nodes", sp->n_nodes);
-    return NAN;
+  if (!s->grad || s->grad_cap < sp->n_nodes) {
+    size_t cap = sp->n_nodes ? sp->n_nodes : 1;
+    lw_node *g2 = realloc(s->grad, cap * sizeof *g2);
+    if (!g2) {
+      lw_error_set(err, LW_ENOMEM, "out of memory for the gradient of %zu nodes", sp->n_nodes);
+      return NAN;
+    }
+    s->grad = g2;
+    s->grad_cap = cap;
   }
   double e = lw_energy_gradient(s->m->scene, sp, LW_GRAD_ALL, s->grad, NULL, err);
   for (size_t k = 0; k < sp->n_nodes; k++) {

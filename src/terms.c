@@ -292,6 +292,6 @@ const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_USER, .segment = seg_user}, /* no gradient: the caller's function is opaque */
   {LW_TERM_PARAM, .segment = seg_param, .segment_grad = grad_param},
   {LW_TERM_LOAD, .segment = seg_load, .segment_grad = grad_load},
-  {LW_TERM_TONE, .raster = 1}, /* no gradient yet (gradient.h refuses it) */
+  {LW_TERM_TONE, .raster = 1}, /* its gradient: lw_tone_sample_grad, summed in gradient.c */
   {LW_TERM_CHEMICAL, .spline = spline_chemical, .spline_grad = grad_chemical},
 };

@@ -252,6 +252,69 @@ void lw_tone_splat(const lw_tone *t, int64_t *r, int wx, int wy, int ww, int wh,
   }
 }
 
+/* The weights of weights() (at one exp a pixel: the gradient is not the
+** chain's loop) and their derivatives with respect to the sample's
+** coordinate c: for f = exp(-d^2 inv) - floor, d the pixel centre less c,
+** df/dc = 2 d inv exp(-d^2 inv) where f > 0, and g = f / sum f. */
+static void weight_slopes(const lw_tone *t, double c, double c0, int k, double *g, double *dg)
+{
+  const int R = t->radius;
+  const double p = t->pixel, inv = t->inv, d0 = c0 + (k - R + 0.5) * p - c;
+  double sum = 0.0, dsum = 0.0;
+  for (int m = 0; m <= 2 * R; m++) {
+    double d = d0 + m * p, e = exp(-d * d * inv);
+    g[m] = e > t->floor ? e - t->floor : 0.0;
+    dg[m] = e > t->floor ? 2.0 * d * inv * e : 0.0;
+    sum += g[m];
+    dsum += dg[m];
+  }
+  if (!(sum > 0.0)) { /* all of it in the sample's own pixel, wherever it lies in it */
+    for (int m = 0; m <= 2 * R; m++) g[m] = dg[m] = 0.0;
+    g[R] = 1.0;
+    return;
+  }
+  for (int m = 0; m <= 2 * R; m++) {
+    dg[m] = (dg[m] - g[m] * dsum / sum) / sum;
+    g[m] /= sum;
+  }
+}
+
+void lw_tone_sample_grad(const lw_tone *t, const int64_t *r, double coef, double x, double y, double dl,
+                         double *ex, double *ey, double *edl)
+{
+  *ex = *ey = *edl = 0.0;
+  const int R = t->radius;
+  int ci, cj;
+  if (!(dl > 0.0) || !nearest(x, t->x0, t->pixel, R, t->w, &ci) || !nearest(y, t->y0, t->pixel, R, t->h, &cj))
+    return;
+  double gx[2 * LW_TONE_RADIUS_MAX + 1], gy[2 * LW_TONE_RADIUS_MAX + 1];
+  double dgx[2 * LW_TONE_RADIUS_MAX + 1], dgy[2 * LW_TONE_RADIUS_MAX + 1];
+  weight_slopes(t, x, t->x0, ci, gx, dgx);
+  weight_slopes(t, y, t->y0, cj, gy, dgy);
+  int i0 = ci - R > 0 ? ci - R : 0, i1 = ci + R + 1 < t->w ? ci + R + 1 : t->w;
+  int j0 = cj - R > 0 ? cj - R : 0, j1 = cj + R + 1 < t->h ? cj + R + 1 : t->h;
+  double s = 0.0, sx = 0.0, sy = 0.0;
+  for (int j = j0; j < j1; j++) {
+    const int64_t *row = r + (size_t)j * (size_t)t->w;
+    const float *dark = t->dark + (size_t)j * (size_t)t->w;
+    const double wy = gy[j - cj + R], dwy = dgy[j - cj + R];
+    double rs = 0.0, rsx = 0.0;
+    for (int i = i0; i < i1; i++) {
+      double res = (double)row[i] / LW_TONE_ONE - dark[i];
+      rs += res * gx[i - ci + R];
+      rsx += res * dgx[i - ci + R];
+    }
+    s += rs * wy;
+    sx += rsx * wy;
+    sy += rs * dwy;
+  }
+  /* dE/dB_p = 2 coef A (B_p - D_p), and the sample adds (pen dl / A) gx gy */
+  const double k = 2.0 * coef * t->pen;
+  *edl = k * s;
+  *ex = k * dl * sx;
+  *ey = k * dl * sy;
+}
+
 double lw_tone_energy(const lw_tone *t, const int64_t *r)
 {
   const size_t n = (size_t)t->w * (size_t)t->h;

@@ -115,9 +115,13 @@ static double central(const lw_scene *sc, const lw_splines *sp, int t, double *x
   return (ep - em) / (2 * h);
 }
 
-/* Term t's gradient against central differences at every coordinate;
-** returns how many coordinates disagree (and reports the first few). */
-static int check_term(const lw_scene *sc, lw_splines *sp, int t, const char *what)
+/* Term t's gradient against central differences at every coordinate, with
+** steps of h_rel times the coordinate or the mean segment, quartered up to
+** `shorter` times, and tolerance tol_rel times the larger of the gradient
+** and its rms; returns how many coordinates disagree (and reports the
+** first few). */
+static int check_term_at(const lw_scene *sc, lw_splines *sp, int t, const char *what, double h_rel, int shorter,
+                         double tol_rel)
 {
   lw_error err = {0};
   lw_node *g = calloc(sp->n_nodes, sizeof *g);
@@ -139,12 +143,12 @@ static int check_term(const lw_scene *sc, lw_splines *sp, int t, const char *wha
     double *x = &sp->node[k].px;
     const double *gk = &g[k].px;
     for (int c = 0; c < 4; c++) {
-      double x0 = x[c], h = 1e-6 * fmax(fabs(x0), l), tol = 1e-5 * fmax(fabs(gk[c]), rms);
+      double x0 = x[c], h = h_rel * fmax(fabs(x0), l), tol = tol_rel * fmax(fabs(gk[c]), rms);
       double fd = central(sc, sp, t, x, c, h);
       /* A kink of an interpolation within h of a sample: the differences
       ** at h and h/4 disagree.  Shorter steps until two agree leave the
       ** kink outside (a wrong gradient disagrees at every step). */
-      for (int r = 0; r < 6; r++) {
+      for (int r = 0; r < shorter; r++) {
         double fq = central(sc, sp, t, x, c, h / 4);
         if (fabs(fq - fd) <= 0.1 * tol) break;
         fd = fq;
@@ -162,16 +166,19 @@ static int check_term(const lw_scene *sc, lw_splines *sp, int t, const char *wha
   return bad;
 }
 
-/* Term t alone on three sets of random splines. */
-static void check_scene(const lw_scene *sc, int t, const char *what)
+/* Term t alone on three sets of random splines, steps and tolerance as
+** check_term_at. */
+static void check_scene_at(const lw_scene *sc, int t, const char *what, double h_rel, int shorter, double tol_rel)
 {
   for (uint64_t seed = 1; seed <= 3; seed++) {
     lw_splines *sp = random_splines(sc, 3, 5, 0x9e3779b9u * seed + (uint64_t)t);
-    int bad = check_term(sc, sp, t, what);
+    int bad = check_term_at(sc, sp, t, what, h_rel, shorter, tol_rel);
     cr_expect_eq(bad, 0, "%s (seed %llu): %d coordinates off", what, (unsigned long long)seed, bad);
     lw_splines_free(sp);
   }
 }
+
+static void check_scene(const lw_scene *sc, int t, const char *what) { check_scene_at(sc, t, what, 1e-6, 6, 1e-5); }
 
 Test(gradient, strain_both_modes)
 {
@@ -321,6 +328,43 @@ Test(gradient, image_scene)
   check_scene(&sc, LW_TERM_POTENTIAL, "image potential");
   check_scene(&sc, LW_TERM_FIELD, "image etf field");
   lw_scene_clear(&sc);
+}
+
+/* The tone term (tone.h): each sample's footprint moves and stretches with
+** the sample, and the gradient is that of the raster the energy reads.  At
+** blurs of 1 and 0.5 mm (1.8 and 2.2 raster pixels of 0.56 and 0.23 mm),
+** and with two pens of a palette, each with its own target and plane of
+** the raster.
+** The differences take steps of 2e-4 of a coordinate, shortened at most
+** three times, and agree within 5e-3 of the gradient's scale: the raster's
+** fixed point (2^-33 of ink a pixel and footprint) makes shorter steps
+** noise, and the footprint's cut (a kink where a pixel centre crosses rho)
+** lies within a step at some coordinates.  A footprint's slope without its
+** normalisation term, or a sample's length element left out, is off by
+** tenths at most coordinates. */
+Test(gradient, tone_term)
+{
+  const char *root = getenv("LW_ROOT");
+  const double blur[] = {1.0, 0.5};
+  for (int k = 0; k < 3; k++) {
+    lw_params p = base_params();
+    snprintf(p.image, sizeof p.image, "%s/params/picture.png", root ? root : ".");
+    p.tone = 4.0;
+    p.tone_blur = blur[k < 2 ? k : 0];
+    p.pen_width = 0.5;
+    if (k == 2) {
+      snprintf(p.ly_names, sizeof p.ly_names, "a b");
+      p.ly_source = LW_LSRC_PALETTE;
+      snprintf(p.ly_colors, sizeof p.ly_colors, "#303030 #a0a0a0");
+      snprintf(p.ly_pen_width, sizeof p.ly_pen_width, "0.3 0.6");
+    }
+    lw_scene sc;
+    scene_with(&sc, &p);
+    cr_assert(sc.on[LW_TERM_TONE] && sc.layers.n == (k == 2 ? 2 : 0));
+    check_scene_at(&sc, LW_TERM_TONE, k == 2 ? "tone, two pens" : k ? "tone, blur 0.5 mm" : "tone, blur 1 mm", 2e-4, 3,
+                   5e-3);
+    lw_scene_clear(&sc);
+  }
 }
 
 /* The sum over every term equals lw_energy_compute's total and each term's

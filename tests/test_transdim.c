@@ -17,6 +17,7 @@
 #include "linewise/domains.h"
 #include "linewise/mc.h"
 #include "linewise/sys_splines.h"
+#include "linewise/gradient.h"
 #include "linewise/transdim.h"
 #include "imageutil.h"
 #include "testutil.h"
@@ -487,6 +488,48 @@ Test(transdim, incremental_equals_full_with_births_and_deaths)
               c->stats[k].accepted, c->stats[k].proposed);
   /* the spliced caches and grid are what a model built afresh holds */
   same_as_fresh(m);
+  td_chain_free(c, setup);
+}
+
+/* The gradient's scratch follows the state: births and grows after its
+** first call (the check that a quench can run, at the start) add nodes, and
+** the quench at the end wrote past the scratch sized then (make asan
+** found it; a photograph with anneal.quench = bfgs aborted on "double free
+** or corruption").  The row's gradient is lw_energy_gradient's, bit for
+** bit, after the state has grown. */
+Test(transdim, the_gradient_follows_a_growing_state)
+{
+  lw_params p;
+  splice_scene(&p);
+  p.splines = 4;
+  p.segments = 3;
+  p.max_segments = 6;
+  p.mix_birth = p.mix_death = 0.3; /* a birth needs its reverse, a death, to be proposed */
+  p.mix_grow = p.mix_shrink = 0.2;
+  p.chem_spline = -20; /* mean count exp(10) at T = 2: the count grows */
+  void *setup;
+  lw_chain *c = td_chain(&p, 2.0, 21, &setup);
+  const lw_model *m = lw_splines_model(c->sys);
+  const lw_system_type *t = c->sys->type;
+  lw_error err = {0};
+  size_t n0 = t->n_coords(c->sys->state);
+  double *g = malloc(n0 * sizeof *g);
+  cr_assert(isfinite(t->gradient(c->sys->state, g, &err)), "%s", err.msg);
+  free(g);
+  for (int k = 0; k < 50 && t->n_coords(c->sys->state) < 2 * n0; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  size_t n1 = t->n_coords(c->sys->state);
+  cr_assert_geq(n1, 2 * n0, "the state grew from %zu to %zu coordinates only", n0, n1);
+  g = malloc(n1 * sizeof *g);
+  lw_node *ref = malloc(m->sp->n_nodes * sizeof *ref);
+  double e = t->gradient(c->sys->state, g, &err);
+  double e_ref = lw_energy_gradient(m->scene, m->sp, LW_GRAD_ALL, ref, NULL, &err);
+  cr_assert(isfinite(e) && e == e_ref, "row %.17g, lw_energy_gradient %.17g", e, e_ref);
+  for (size_t k = 0; k < m->sp->n_nodes; k++)
+    cr_assert(g[4 * k] == ref[k].px && g[4 * k + 1] == ref[k].py && g[4 * k + 2] == ref[k].vx &&
+                  g[4 * k + 3] == ref[k].vy,
+              "node %zu", k);
+  free(g);
+  free(ref);
   td_chain_free(c, setup);
 }
 

@@ -44,8 +44,9 @@ void lw_segment_grad_nodes(const lw_quad *q, const lw_samples_grad *g, lw_node *
 ** the others).  Returns the total of
 ** the selected terms; +inf (grad then undefined) if a segment is irregular
 ** or a sample is outside the boundary.  LW_ENOMEM through err.  The user
-** and tone terms have no gradient: a mask that selects one while it is on
-** is an error (LW_EINPUT, naming the term). */
+** term has no gradient: a mask that selects it while it is on is an error
+** (LW_EINPUT, naming the term).  The tone term's is that of its raster
+** built afresh from sp (tone.h, lw_tone_sample_grad). */
 #define LW_GRAD_ALL (~0u)
 double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned term_mask, lw_node *grad,
                           double term[LW_TERM_COUNT], lw_error *err);

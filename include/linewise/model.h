@@ -328,4 +328,11 @@ lw_status lw_model_check_layers(const lw_scene *sc, lw_splines *sp, const char *
 double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[LW_TERM_COUNT],
                          lw_error *err);
 
+/* The raster of raster term t (the tone term) for sp, built as
+** lw_energy_compute builds it (a plane a layer, each layer's w * h after
+** the one before), in *out (the caller frees it), and the term's energy
+** with its coefficient, bit for bit lw_energy_compute's.  NAN and
+** LW_ENOMEM through err. */
+double lw_energy_raster(const lw_scene *sc, const lw_splines *sp, int t, int64_t **out, lw_error *err);
+
 #endif

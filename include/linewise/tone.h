@@ -101,6 +101,14 @@ void lw_tone_splat(const lw_tone *t, int64_t *r, int wx, int wy, int ww, int wh,
 /* sum_p A (B_p - D_p)^2 (no coefficient) in pixel order. */
 double lw_tone_energy(const lw_tone *t, const int64_t *r);
 
+/* The partials of coef sum_p A (B_p - D_p)^2, r the raster of every
+** sample, with respect to one sample's position (x, y) and length element
+** dl, into *ex, *ey, *edl: the derivative of the footprint as the raster
+** holds it, its rounding to fixed point left out (2^-33 of full ink a
+** pixel).  0 for a sample whose footprint misses the raster. */
+void lw_tone_sample_grad(const lw_tone *t, const int64_t *r, double coef, double x, double y, double dl,
+                         double *ex, double *ey, double *edl);
+
 /* A rectangle of changes to the raster, [x0, x1) x [y0, y1). */
 typedef struct {
   int x0, y0, x1, y1;
