@@ -14,6 +14,9 @@
 /* Massless steps: the Armijo fraction and the most halvings of a step. */
 #define ARMIJO 1e-4
 #define HALVINGS_MAX 60
+/* Massless steps: the most times a trial holds the parts it would make
+** forbidden and tries again at the same length. */
+#define HOLD_ROUNDS 8
 
 static double max_abs(const double *a, size_t n)
 {
@@ -47,6 +50,7 @@ void lw_dynamics_free(lw_dynamics *d)
   free(d->pi1);
   free(d->u);
   free(d->work);
+  free(d->held);
   free(d);
 }
 
@@ -117,6 +121,11 @@ lw_dynamics *lw_dynamics_new(const lw_system_type *t, void *state, const lw_para
       lw_error_set(err, LW_ENOMEM, "out of memory for the dynamics of %zu coordinates", d->n);
       return NULL;
     }
+  if (d->rho == 0.0 && t->blocked && !(d->held = calloc(d->n + 1, 1))) {
+    lw_dynamics_free(d);
+    lw_error_set(err, LW_ENOMEM, "out of memory for the dynamics of %zu coordinates", d->n);
+    return NULL;
+  }
   /* massless: the matrix of the flow is the damping's, gamma per unit density */
   d->mass = t->mass_new(state, p, d->rho > 0.0 ? d->rho : d->gamma, err);
   if (!d->mass || lw_dynamics_sync(d, err)) {
@@ -225,8 +234,23 @@ static lw_status flow(lw_dynamics *d, lw_error *err)
   memcpy(d->pi1, d->g, n * sizeof *d->g); /* grad E at x, should every trial fail */
   double h = d->dt;
   lw_status s;
+  if (d->held) memset(d->held, 0, n);
   for (int k = 0; k <= HALVINGS_MAX; k++, h *= 0.5) {
     for (size_t i = 0; i < n; i++) d->x1[i] = d->x[i] + h * dir[i];
+    /* hold the parts this trial would take through a wall, while the
+    ** direction left still descends */
+    for (int r = 0; d->held && r < HOLD_ROUNDS; r++) {
+      if (!t->blocked(d->state, d->x1, d->held)) break;
+      double held_slope = 0.0;
+      for (size_t i = 0; i < n; i++)
+        if (!d->held[i]) held_slope += d->g[i] * dir[i];
+      if (!(held_slope < 0.0)) break;
+      slope = held_slope;
+      for (size_t i = 0; i < n; i++) {
+        if (d->held[i]) dir[i] = 0.0;
+        d->x1[i] = d->x[i] + h * dir[i];
+      }
+    }
     if ((s = evaluate(d, d->x1, err))) return s;
     if (d->energy <= e0 + ARMIJO * h * slope) {
       memcpy(d->x, d->x1, n * sizeof *d->x);

@@ -943,6 +943,34 @@ static double gradient(void *state, double *g, lw_error *err)
   return e;
 }
 
+/* The segments coordinates x would make forbidden: not finite, irregular
+** (lw_segment_allowed) or, with the boundary term on, with a sample or an
+** end outside (lw_term_boundary infinite): their two nodes' coordinates. */
+static size_t blocked(void *state, const double *x, unsigned char *held)
+{
+  const spl_state *s = state;
+  const lw_scene *sc = s->m->scene;
+  const lw_splines *sp = s->m->sp;
+  size_t parts = 0;
+  lw_samples smp;
+  for (size_t g = 0; g < sp->n_segments; g++) {
+    const size_t k = lw_segment_node(sp, g);
+    const double *c = x + 4 * k;
+    const lw_node a = {c[0], c[1], c[2], c[3]}, b = {c[4], c[5], c[6], c[7]};
+    int bad = 0;
+    for (int i = 0; i < 8; i++) bad |= !isfinite(c[i]);
+    if (!bad) {
+      lw_segment_sample(&sc->quad, &a, &b, &smp);
+      bad = !lw_segment_allowed(sc, &a, &b, smp.length) ||
+            (sc->on[LW_TERM_BOUNDARY] && !isfinite(lw_term_boundary(&smp, &sc->quad, &sc->boundary)));
+    }
+    if (!bad) continue;
+    memset(held + 4 * k, 1, 8);
+    parts++;
+  }
+  return parts;
+}
+
 static lw_status draw(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err)
 {
   spl_state *s = state;
@@ -1055,6 +1083,7 @@ static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinne
   .get_coords = get_coords, \
   .set_coords = set_coords, \
   .gradient = gradient, \
+  .blocked = blocked, \
   .mass_new = mass_new, \
   .mass_free = mass_free, \
   .mass_at = mass_at, \

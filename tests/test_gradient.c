@@ -367,6 +367,47 @@ Test(gradient, tone_term)
   }
 }
 
+/* The splines row's `blocked` (system.h): the nodes of exactly the segments
+** a point would make irregular or take outside the boundary, and nothing
+** else; what it was given stays marked. */
+Test(gradient, blocked_marks_the_segments_at_a_wall)
+{
+  lw_params p = base_params();
+  p.bending = 1;
+  p.boundary_coef = 0.5;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  lw_error err = {0};
+  lw_model *m = lw_model_new(&sc, random_splines(&sc, 3, 4, 77), &err);
+  cr_assert_not_null(m, "%s", err.msg);
+  lw_system *sys = lw_splines_view(m, &err);
+  cr_assert_not_null(sys);
+  const lw_system_type *t = sys->type;
+  size_t n = t->n_coords(sys->state);
+  double *x = malloc(n * sizeof *x);
+  unsigned char *held = calloc(n, 1);
+  t->get_coords(sys->state, x);
+  cr_assert_eq(t->blocked(sys->state, x, held), 0);
+  for (size_t i = 0; i < n; i++) cr_assert_eq(held[i], 0);
+  /* spline 1's third node outside the page: its two segments; spline 2's
+  ** first handle folded back over its segment: that segment */
+  size_t k1 = m->sp->first[1] + 2, k2 = m->sp->first[2];
+  x[4 * k1] = -50;
+  x[4 * k2 + 2] = -40 * (x[4 * k2 + 4] - x[4 * k2]);
+  x[4 * k2 + 3] = -40 * (x[4 * k2 + 5] - x[4 * k2 + 1]);
+  cr_assert_eq(t->blocked(sys->state, x, held), 3);
+  for (size_t k = 0; k < m->sp->n_nodes; k++) {
+    int want = (k + 1 >= k1 && k <= k1 + 1) || k == k2 || k == k2 + 1;
+    for (int c = 0; c < 4; c++) cr_assert_eq(held[4 * k + c], want, "node %zu coordinate %d", k, c);
+  }
+  cr_assert_neq(m->sp->node[k1].px, -50.0, "the state is left as it was");
+  free(x);
+  free(held);
+  lw_system_free(sys);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
 /* The sum over every term equals lw_energy_compute's total and each term's
 ** value, and the gradient of the sum is the sum of the gradients. */
 Test(gradient, total_matches_energy_compute)

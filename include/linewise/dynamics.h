@@ -33,7 +33,12 @@
 ** the damping matrix D = gamma M/rho, as D-NURBS fits.  Each step is an
 ** explicit Euler step dx = -h D^-1 grad E, halved until the energy falls by
 ** at least 1e-4 of what the slope promises (Armijo), so the flow never
-** leaves the allowed set and its energy never rises.
+** leaves the allowed set and its energy never rises.  Where the system says
+** which parts a trial would make forbidden (its row's `blocked`), the step
+** holds their coordinates and moves the rest at the same length, up to
+** HOLD_ROUNDS times, before it is halved: a page of thousands of segments
+** always has one at a regularity wall, which would otherwise halve every
+** step to nothing.
 **
 ** `dynamics.integrator = review` replaces the leapfrog by the implicit
 ** scheme of the D-NURBS review (dyn_review.h): backward in the stiffness, so
@@ -60,6 +65,7 @@ typedef struct {
   int iterations_max;        /* most fixed-point iterations a step needed */
   int integrator;            /* LW_INTEGRATOR_* */
   double *work;              /* the review scheme's scratch (dyn_review.h), or NULL */
+  unsigned char *held;       /* massless: the coordinates a step holds (n) */
 } lw_dynamics;
 
 /* A driver for `state` (a system of row t) with the [dynamics] parameters;

@@ -205,6 +205,14 @@ struct lw_system_type {
   void (*get_coords)(const void *state, double *x);
   lw_status (*set_coords)(void *state, const double *x, lw_error *err);
   double (*gradient)(void *state, double *g, lw_error *err);
+  /* Optional (NULL: none): sets blocked[i] = 1 for the coordinates of every
+  ** part of the state that coordinates x would make forbidden (for splines
+  ** the nodes of a segment that would be irregular or leave the boundary),
+  ** leaves the other entries as they were and the state unchanged; returns
+  ** how many parts.  A gradient driver holds those coordinates and lets
+  ** the rest move, where shortening the whole step would let one segment
+  ** at a wall stop every other (dynamics.h, quench.h). */
+  size_t (*blocked)(void *state, const double *x, unsigned char *blocked);
   /* Inertia (the dynamics driver, dynamics.h): the mass matrix M(x) of the
   ** kinetic energy T = 1/2 xdot' M(x) xdot for a density (mass per unit
   ** of the system's measure), with the coordinates the scene pins held:
