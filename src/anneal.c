@@ -9,6 +9,7 @@
 #include <gsl/gsl_math.h>
 #include <stdarg.h>
 #include <math.h>
+#include <stddef.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
@@ -709,6 +710,20 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
   return sweep_files(a, err);
 }
 
+/* One count of lw_move_stats (at byte offset `at`) per move kind, by name. */
+static void put_per_move(lw_json *j, const char *key, const lw_chain *c, const lw_system_type *t, size_t at)
+{
+  lw_json_key(j, key);
+  lw_json_begin_object(j);
+  for (int k = 0; k < c->n_moves; k++) {
+    unsigned long v;
+    memcpy(&v, (const char *)&c->stats[k] + at, sizeof v);
+    lw_json_key(j, t->move_names[k]);
+    lw_json_int(j, (long long)v);
+  }
+  lw_json_end_object(j);
+}
+
 static lw_status write_summary(lw_anneal *a, lw_error *err)
 {
   char path[LW_PATH_MAX + 32], tmp[LW_PATH_MAX + 64];
@@ -734,13 +749,8 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json_key(&j, "proposals"); lw_json_int(&j, (long long)prop);
   lw_json_key(&j, "accepted"); lw_json_int(&j, (long long)acc);
   lw_json_key(&j, "rejected_nan"); lw_json_int(&j, (long long)nan);
-  lw_json_key(&j, "rejected_irregular");
-  lw_json_begin_object(&j);
-  for (int k = 0; k < c->n_moves; k++) {
-    lw_json_key(&j, t->move_names[k]);
-    lw_json_int(&j, (long long)c->stats[k].irregular);
-  }
-  lw_json_end_object(&j);
+  put_per_move(&j, "rejected_irregular", c, t, offsetof(lw_move_stats, irregular));
+  put_per_move(&j, "rejected_crowded", c, t, offsetof(lw_move_stats, crowded));
   lw_json_key(&j, "wall_seconds"); lw_json_number(&j, wall);
   double here = now_seconds() - a->wall_start;
   lw_json_key(&j, "proposals_per_second");

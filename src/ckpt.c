@@ -305,13 +305,22 @@ lw_status lw_ckpt_numbers(lw_ckpt *c, const char *sec, const char *key, double *
 lw_status lw_ckpt_counts(lw_ckpt *c, const char *sec, const char *key, unsigned long *out, int n, int required,
                          lw_error *err)
 {
+  return lw_ckpt_counts_upto(c, sec, key, out, n, n, required, err);
+}
+
+lw_status lw_ckpt_counts_upto(lw_ckpt *c, const char *sec, const char *key, unsigned long *out, int n_min,
+                              int n_max, int required, lw_error *err)
+{
   int line;
   const char *v = lw_ckpt_text(c, sec, key, &line);
   if (!v) return required ? missing(c, sec, key, err) : LW_OK;
   double tmp[64];
   char expected[96];
-  snprintf(expected, sizeof expected, "%d whole number%s from 0 to 2^53", n, n == 1 ? "" : "s");
-  if (n > 64 || lw_number_list(v, 0, tmp, n) != n) return bad_value(c, line, sec, key, expected, v, err);
+  if (n_min == n_max)
+    snprintf(expected, sizeof expected, "%d whole number%s from 0 to 2^53", n_max, n_max == 1 ? "" : "s");
+  else snprintf(expected, sizeof expected, "%d to %d whole numbers from 0 to 2^53", n_min, n_max);
+  const int n = n_max > 64 ? -1 : lw_number_list(v, 0, tmp, n_max);
+  if (n < n_min || n > n_max) return bad_value(c, line, sec, key, expected, v, err);
   for (int i = 0; i < n; i++)
     if (!(tmp[i] >= 0 && tmp[i] <= 9007199254740992.0) || tmp[i] != floor(tmp[i]))
       return bad_value(c, line, sec, key, expected, v, err);

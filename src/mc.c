@@ -88,6 +88,9 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
   } else if (forbidden == 2) {
     c->outside++;
     accept = 0;
+  } else if (forbidden == 3) {
+    s->crowded++;
+    accept = 0;
   } else if (forbidden) {
     s->irregular++;
     accept = 0;
@@ -185,6 +188,7 @@ void lw_chain_absorb(lw_chain *c, lw_chain *from)
     a->accepted += b->accepted;
     a->nan += b->nan;
     a->irregular += b->irregular;
+    a->crowded += b->crowded;
     if (c->tuning) {
       c->win_prop[k] += b->proposed;
       c->win_acc[k] += b->accepted;

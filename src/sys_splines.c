@@ -289,6 +289,7 @@ static void spline_box(const lw_splines *sp, uint32_t i, size_t node0, size_t n,
 static double refuse(lw_proposal *p)
 {
   p->splice = 0;
+  p->crowded = 0;
   p->near_pending = 0;
   p->log_ratio = 0.0;
   return INFINITY;
@@ -368,7 +369,7 @@ static double propose_on(const lw_model *m, const lw_td *td, lw_proposal *p, int
     p->log_ratio = n_node == 1 ? lw_td_prior_change(td, src, nn, node0, &nd[0])
                                : lw_td_prior(td, nd, nn) - lw_td_prior(td, src, nn);
   }
-  *forbidden = p->irregular;
+  *forbidden = p->crowded ? 3 : p->irregular;
   return p->dE;
 }
 
@@ -635,7 +636,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
   *forbidden = 0;
   if (kind == LW_MOVE_SPLIT || kind == LW_MOVE_JOIN) {
     const double dE = kind == LW_MOVE_SPLIT ? propose_split(s, p, rng) : propose_join(s, p, rng);
-    *forbidden = p->splice && p->irregular;
+    *forbidden = !p->splice ? 0 : p->crowded ? 3 : p->irregular;
     return dE;
   }
   if (kind == LW_MOVE_BIRTH) {
@@ -682,7 +683,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
       p->log_ratio = lw[2] - lw[3] + lr;
     }
   }
-  *forbidden = p->irregular;
+  *forbidden = p->crowded ? 3 : p->irregular;
   return p->dE;
 }
 

@@ -457,7 +457,7 @@ Test(tone, the_spacing_constraint_holds_once_kept)
   ** pairs come closer than 0.3 mm within a few sweeps, with it none ever
   ** does (checked from scratch after every sweep). */
   size_t worst[2] = {0, 0};
-  unsigned long accepted = 0;
+  unsigned long accepted = 0, crowded[2] = {0, 0};
   for (int on = 0; on < 2; on++) {
     lw_params p = tone_params(30, 30, blotches, 20.0, 0.8);
     p.pair = 0.001;
@@ -477,8 +477,10 @@ Test(tone, the_spacing_constraint_holds_once_kept)
       size_t k = close_pairs(&sc, m->sp, 0.3);
       if (k > worst[on]) worst[on] = k;
     }
-    if (on)
-      for (int k = 0; k < 4; k++) accepted += c->stats[k].accepted;
+    for (int k = 0; k < 4; k++) {
+      if (on) accepted += c->stats[k].accepted;
+      crowded[on] += c->stats[k].crowded;
+    }
     model_chain_free(c);
     lw_model_free(m);
     lw_scene_clear(&sc);
@@ -487,6 +489,10 @@ Test(tone, the_spacing_constraint_holds_once_kept)
   cr_assert(worst[0] > 0, "the tone term pulls strokes together when nothing stops it");
   cr_assert_eq(worst[1], 0, "%zu pairs closer than min_spacing", worst[1]);
   cr_assert(accepted > 1000, "the chain kept moving: %lu accepted", accepted);
+  /* the refusals are counted as such (summary.json, rejected_crowded), and
+  ** only where the rule is on */
+  cr_assert_eq(crowded[0], 0, "%lu counted crowded without the rule", crowded[0]);
+  cr_assert(crowded[1] > 0, "no refusal of the rule was counted");
 }
 
 Test(tone, a_crowded_start_only_gets_less_crowded)

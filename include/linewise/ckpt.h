@@ -65,6 +65,11 @@ lw_status lw_ckpt_numbers(lw_ckpt *c, const char *section, const char *key, doub
 lw_status lw_ckpt_counts(lw_ckpt *c, const char *section, const char *key, unsigned long *out, int n,
                          int required, lw_error *err);
 
+/* n_min to n_max of them (a list that older files wrote shorter); the
+** entries past those given keep their values. */
+lw_status lw_ckpt_counts_upto(lw_ckpt *c, const char *section, const char *key, unsigned long *out, int n_min,
+                              int n_max, int required, lw_error *err);
+
 /* One whole number in [lo, hi] (|lo|, |hi| <= 2^53). */
 lw_status lw_ckpt_whole(lw_ckpt *c, const char *section, const char *key, long *out, long lo, long hi,
                         int required, lw_error *err);

@@ -27,6 +27,7 @@
 typedef struct {
   unsigned long proposed, accepted, nan; /* nan: proposals rejected for a NaN dE */
   unsigned long irregular;  /* proposals rejected for a forbidden state (model.h) */
+  unsigned long crowded;    /* ... for closing in on another stroke (energy.min_spacing) */
 } lw_move_stats;
 
 /* How often tuning looks at the acceptance of a move kind (proposals):

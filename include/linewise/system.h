@@ -87,7 +87,8 @@ struct lw_system_type {
   ** kind k past it.  propose: draws one proposal of kind k with step `step`
   ** from rng into prop (the chain's scratch) and returns dE (NaN: undefined,
   ** rejected and counted; +inf forbidden), with *forbidden = 1 when it is
-  ** refused for a forbidden state (counted apart).  The state is not
+  ** refused for a forbidden state, 3 when for coming closer to another
+  ** stroke than a hard spacing rule allows (each counted apart).  The state is not
   ** changed, but caches may be filled: one thread per state.  commit applies
   ** the last proposal (LW_ENOMEM leaves the state as it was). */
   void (*moves)(const lw_params *p, double *weight, double *step, double *target);

@@ -87,13 +87,14 @@ static int replica_here(const lw_anneal *a, int r)
 ** slots: every value arrives bit for bit (signed zeros, infinities and
 ** NaNs included), which a sum would not promise.  Layout: a status per
 ** process, the stop flag, per replica its terms and total, the coldest
-** rung's move counts. */
+** rung's move counts (lw_move_stats, field by field). */
+#define STATS_WORDS 5
 static lw_status share(lw_anneal_net *net, lw_anneal *a, int failed, lw_error *err)
 {
   mpi_net *m = (mpi_net *)net;
   const lw_system_type *t = a->sys_type;
   int n = a->n_rep, nt = t->n_terms, nm = a->chain->n_moves, per = nt + 1;
-  size_t len = (size_t)net->size + 1 + (size_t)n * (size_t)per + 4 * (size_t)nm;
+  size_t len = (size_t)net->size + 1 + (size_t)n * (size_t)per + STATS_WORDS * (size_t)nm;
   if (len > m->buf_len) {
     uint64_t *b = realloc(m->buf, len * sizeof *b);
     /* every process needs the same length: failing here alone would leave
@@ -122,8 +123,8 @@ static lw_status share(lw_anneal_net *net, lw_anneal *a, int failed, lw_error *e
   if (rung_here(a, 0))
     for (int k = 0; k < nm; k++) {
       const lw_move_stats *s = &a->chain->stats[k];
-      uint64_t v[4] = {s->proposed, s->accepted, s->nan, s->irregular};
-      memcpy(st + 4 * k, v, sizeof v);
+      uint64_t v[STATS_WORDS] = {s->proposed, s->accepted, s->nan, s->irregular, s->crowded};
+      memcpy(st + STATS_WORDS * k, v, sizeof v);
     }
   double t0 = MPI_Wtime();
   if (!m->sweeps++) m->t_first = t0;
@@ -138,10 +139,8 @@ static lw_status share(lw_anneal_net *net, lw_anneal *a, int failed, lw_error *e
   if (!rung_here(a, 0))
     for (int k = 0; k < nm; k++) {
       lw_move_stats *s = &a->chain->stats[k];
-      s->proposed = st[4 * k];
-      s->accepted = st[4 * k + 1];
-      s->nan = st[4 * k + 2];
-      s->irregular = st[4 * k + 3];
+      const uint64_t *v = st + STATS_WORDS * k;
+      *s = (lw_move_stats){v[0], v[1], v[2], v[3], v[4]};
     }
   int first = net->size;
   for (int p = net->size - 1; p >= 0; p--)
