@@ -792,6 +792,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     lw_json_key(&j, "gradient_before"); lw_json_number(&j, q->gradient_before);
     lw_json_key(&j, "gradient_after"); lw_json_number(&j, q->gradient_after);
     lw_json_key(&j, "converged"); lw_json_bool(&j, q->converged);
+    lw_json_key(&j, "ended"); lw_json_string(&j, q->ended);
     lw_json_key(&j, "iterations"); lw_json_int(&j, q->iterations);
     lw_json_key(&j, "evaluations"); lw_json_int(&j, q->evaluations);
     lw_json_key(&j, "forbidden"); lw_json_int(&j, q->forbidden);
@@ -864,9 +865,11 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
   if (!rung_here(a, 0)) return LW_OK; /* the process of the coldest replica draws it */
   if (a->params.quench == LW_QUENCH_BFGS && !a->quenched) {
     lw_phase_set("quenching to the nearest minimum");
-    s = lw_quench_run(a->sys, a->params.quench_tol, a->params.quench_iterations, &a->quench, err);
+    const lw_quench_opts o = {a->params.quench_tol, a->params.quench_iterations, a->params.quench_stall, a->stop};
+    s = lw_quench_run(a->sys, &o, &a->quench, err);
     lw_phase_set(NULL);
     if (s) return s;
+    if (a->quench.stopped) return LW_OK; /* state.lw holds the annealed state: resume quenches again */
     a->quenched = 1;
   }
   lw_phase_set("drawing the final files (ordering the paths, then each file)");

@@ -241,6 +241,7 @@ static int watched_fail(watcher *w, const lw_error *err)
 
 static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_error *err)
 {
+  a->stop = &stop_requested;
   progress pg = {quiet, isatty(2), a->sweep, a->sweep, -1, lw_anneal_seconds(a)};
   /* a signal during start-up stops before the first sweep; the processes
   ** of an MPI run stop together, at the sweep where one of them was asked */
@@ -272,14 +273,20 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_err
 #endif
   if (s) return watched_fail(w, err);
   watcher_stop(w, 0);
+  if (a->quench.stopped) {
+    if (!quiet)
+      fprintf(stderr, "linewise: stopped during the quench (nothing drawn); state saved in %s/state.lw ('linewise resume "
+              "%s' quenches again)\n", a->dir, a->dir);
+    return 0;
+  }
   if (!quiet) {
     char drawn[2048]; /* a line a pen of a layered drawing */
     if (drew) a->sys_type->describe(a->sys->state, LW_DESCRIBE_DRAWING, drawn, sizeof drawn);
     if (drew) fprintf(stderr, "%s", drawn);
     if (a->quenched)
-      fprintf(stderr, "linewise: quench: energy %.10g -> %.10g, gradient norm %.3g -> %.3g, %ld iterations, %.2f s\n",
+      fprintf(stderr, "linewise: quench: energy %.10g -> %.10g, gradient norm %.3g -> %.3g, %ld iterations (%s), %.2f s\n",
               a->quench.energy_before, a->quench.energy_after, a->quench.gradient_before, a->quench.gradient_after,
-              a->quench.iterations, a->quench.seconds);
+              a->quench.iterations, a->quench.ended, a->quench.seconds);
     fprintf(stderr, "linewise: done: %s/%s, summary.json, trace.csv, state.lw\n", a->dir, a->sys_type->files);
   }
   return 0;

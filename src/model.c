@@ -1005,6 +1005,28 @@ static size_t crowding(const lw_cellgrid *grid, const lw_pair_sample *ps, size_t
   return count;
 }
 
+int lw_model_segment_crowds(const lw_model *m, size_t g, const lw_node *a, const lw_node *b, double margin)
+{
+  const lw_scene *sc = m->scene;
+  if (!(sc->min_spacing > 0.0) || !m->grid || m->terms.pair < 0) return 0;
+  const lw_splines *sp = m->sp;
+  const int np = pair_nodes(m);
+  const uint32_t i = sp->seg_spline[g];
+  lw_samples s;
+  lw_segment_sample(m->terms.ctx[m->terms.pair].quad, a, b, &s);
+  lw_pair_sample now[LW_QUAD_MAX], before[LW_QUAD_MAX];
+  for (int q = 0; q < np; q++) now[q] = (lw_pair_sample){s.x[q], s.y[q], (float)s.dl[q]};
+  const pair_view v = {m->grid, sp, (uint32_t)np, pair_ctx(&m->terms.ctx[m->terms.pair]), planes_of(sc)};
+  samples_at(&v, (uint32_t)(g * (size_t)np), (size_t)np, before);
+  const uint32_t lo = (uint32_t)(lw_segment_index(sp, i, 0) * (size_t)np);
+  const lw_pair_filter own = {.lo = lo, .hi = lo + (uint32_t)(lw_splines_segments(sp, i) * (size_t)np),
+                              .plane = plane_of(planes_of(sc), sp, i)};
+  /* crowding looks one cell around a sample: the cells are at least the cutoff */
+  const double d = fmin(sc->min_spacing + margin, pair_ctx(&m->terms.ctx[m->terms.pair])->cutoff);
+  const size_t k = crowding(m->grid, now, (size_t)np, &own, d * d);
+  return k > 0 && k > crowding(m->grid, before, (size_t)np, &own, sc->min_spacing * sc->min_spacing);
+}
+
 /* A raster term's part of dE (no coefficient): the affected segments' old
 ** samples splatted out of and their new ones into a box of changes, and
 ** the energy difference over the box.  NAN if the box cannot grow. */

@@ -313,14 +313,19 @@ const lw_param_def lw_param_table[] = {
          "when fewer than 2 fit a side. The result depends on this key, never on the threads. docs/SCALING.md."),
   CHOICE("anneal", "quench", quench, "none", "none|bfgs",
          "After the last sweep: none, or bfgs, which takes the coldest replica to the nearest local "
-         "minimum of its energy (GSL's vector_bfgs2 on the system's gradient; docs/ACCURACY.md). "
+         "minimum of its energy (limited-memory BFGS on the system's gradient, holding the parts a "
+         "step would take through a wall; docs/ACCURACY.md). "
          "The drawings and summary.json show the quenched state; state.lw keeps the annealed one, so "
          "a resumed or longer run continues the chain. Needs a system with a gradient (splines)."),
   NUM("anneal", "quench_tol", LW_PT_DOUBLE, quench_tol, "1e-6", "energy/mm", 0, 1e300, LW_MIN_OPEN,
       "The quench stops when the gradient's Euclidean norm falls to this."),
   NUM("anneal", "quench_iterations", LW_PT_INT, quench_iterations, "2000", "", 1, 1e9, 0,
-      "The quench stops after this many minimiser iterations (or earlier when a line search "
-      "makes no progress: the minimum to rounding)."),
+      "The quench stops after this many minimiser iterations (or earlier when no step descends: "
+      "the minimum to rounding)."),
+  NUM("anneal", "quench_stall", LW_PT_DOUBLE, quench_stall, "0.05", "", 0, 1, 0,
+      "The quench stops when its last 50 iterations removed less than this share of the energy it "
+      "has removed so far (0: never). A picture's terms are bilinear in its pixels, so the gradient "
+      "norm stops falling short of quench_tol and only this or quench_iterations ends the quench."),
   NUM("tempering", "replicas", LW_PT_INT, replicas, "1", "", 1, 256, 0,
       "Replicas on the temperature ladder (parallel tempering, run by OpenMP threads). 1 = off. "
       "The coldest replica gives final.svg and state.lw."),

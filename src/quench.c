@@ -1,53 +1,55 @@
 /*
-** quench.c -- BFGS from the annealed state to the nearest local minimum
+** quench.c -- limited-memory BFGS from the annealed state to the nearest
+** local minimum, holding the parts a step would take through a wall
 ** (quench.h).
 **
-** Forbidden states.  The energy is +inf outside the allowed set (the
-** boundary, regularity).  BFGS2's line search (Fletcher's, in GSL's
-** linear_minimize.c) brackets along the search direction and then sections
-** the bracket by interpolation, clamped into its inner part; a trial value
-** above f(0) + rho alpha f'(0) ends the bracketing at once without asking
-** for the slope there.  So a forbidden point evaluated as a large finite
-** WALL is simply a much worse point: the bracket closes on it and the next
-** trial lies strictly inside, at most ~0.9 of the way to it (GSL's tau
-** bounds), so the step shortens geometrically until it is allowed again.
-** A step is accepted only with a value below f(0), never at WALL, so every
-** iterate is allowed.  GSL 2.x's sectioning happens to survive +inf too
-** (its quadratic step falls back to the bracket's inner clamp; the tests
-** give the same iterates), but a finite wall keeps every difference the
-** line search may form finite, whichever interpolation it takes; halving by
-** hand would duplicate the line search.  WALL is 1e150: far above any
-** energy a scene reaches, yet its square (the cubic interpolation's
-** discriminant) stays finite.  The slope at a forbidden point, should GSL
-** ask for it, is given as 0.
+** Why not GSL's minimisers.  The energy is +inf outside the allowed set
+** (the boundary, regularity), and an annealed state of thousands of
+** segments always has some of them at a regularity wall.  GSL's BFGS owns
+** its line search: a trial point past a wall can only be given a large
+** value, the search shrinks the step (some 150 evaluations a wall on the
+** bundled example) and a restart from the lowest point meets the wall again
+** at once, so it stopped after two iterations, having removed 1e-6 of the
+** energy in 6.7 s.  Here the step itself knows the walls, as the massless
+** flow's does (dynamics.c): the system's `blocked` names the parts a trial
+** point would make forbidden, their coordinates are held for that step and
+** the rest moves at full length while the direction still descends.  The
+** direction is L-BFGS's two-loop recursion (Nocedal and Wright, Numerical
+** Optimization, algorithm 7.4) over the last MEMORY steps; a step is taken
+** at the first length, halving from 1, that meets Armijo's condition, and a
+** step pair with s.y <= 0 (possible without the curvature condition) is
+** not kept.  A direction that does not descend, or a search that fails,
+** drops the memory and tries steepest descent; it stops when that fails too
+** (the minimum to rounding, or every part that could still move is held).
 **
-** Every evaluation moves the system's state there (set_coords refreshes its
-** caches and totals) and remembers the allowed point of lowest energy; at
-** the end the state is set to that point (finite, hence allowed), or back
-** to the start if nothing was lower.
+** Every state evaluated is allowed or is never accepted (an Armijo test on
+** +inf fails), so the state it ends in is finite, hence regular and inside.
+** Deterministic: the same state gives the same iterates whatever the
+** thread count (the gradient and the energy are serial sums in a fixed
+** order).
 */
 #include "linewise/quench.h"
 
-#include <gsl/gsl_blas.h>
-#include <gsl/gsl_errno.h>
-#include <gsl/gsl_multimin.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
-#define WALL 1e150
+#define MEMORY 5         /* step pairs kept: 2 MEMORY + 6 vectors of n doubles in all */
+#define HALVINGS_MAX 50  /* a step of 2^-50 of the first is nothing */
+#define HOLD_ROUNDS 8    /* holds a trial step may add before it is evaluated */
+#define ARMIJO 1e-4
 
 typedef struct {
   lw_system *sys;
   size_t n;
-  double *x, *g;   /* scratch: coordinates and gradient, n each */
-  double *best;    /* the allowed point of lowest energy evaluated so far (n) */
-  double best_f;
-  lw_status st;    /* the first error, LW_OK if none */
-  lw_error *err;
-  long evaluations, forbidden;
-} quench_ctx;
+  double *x, *g, *x1, *g1, *d;     /* the point, its gradient, a trial, its gradient, the direction */
+  double *s[MEMORY], *y[MEMORY];   /* step pairs, oldest at (head - used) mod MEMORY */
+  double rho[MEMORY], a[MEMORY];
+  int used, head;
+  unsigned char *held;             /* n: this step's held coordinates */
+  long evaluations, forbidden, holds;
+} lbfgs;
 
 static double seconds_now(void)
 {
@@ -56,137 +58,218 @@ static double seconds_now(void)
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* The energy at v (the gradient into grad if not NULL): WALL and a zero
-** gradient where the state is forbidden or an error occurred (kept in
-** ctx->st, so the minimiser stops making progress and the caller reports
-** it). */
-static double eval_at(const gsl_vector *v, quench_ctx *c, gsl_vector *grad)
+static double dot(const double *u, const double *v, size_t n)
 {
-  const lw_system_type *t = c->sys->type;
-  for (size_t i = 0; i < c->n; i++) c->x[i] = gsl_vector_get(v, i);
-  c->evaluations++;
-  double e = WALL;
+  double s = 0.0;
+  for (size_t i = 0; i < n; i++) s += u[i] * v[i];
+  return s;
+}
+
+/* The energy at x and its gradient into g: +inf where x is forbidden (a
+** non-finite coordinate too); NAN with err set on a failure of the
+** gradient. */
+static double evaluate(lbfgs *q, const double *x, double *g, lw_error *err)
+{
+  const lw_system_type *t = q->sys->type;
   lw_error e2 = {0};
-  if (c->st == LW_OK) {
-    if (t->set_coords(c->sys->state, c->x, &e2) != LW_OK) {
-      /* non-finite coordinates (a runaway step) are forbidden, not an error */
-      if (e2.code != LW_EINPUT) c->st = lw_error_set(c->err, e2.code, "quench: %s", e2.msg);
-    } else if (grad) {
-      e = t->gradient(c->sys->state, c->g, &e2);
-      if (isnan(e)) c->st = lw_error_set(c->err, e2.code ? e2.code : LW_EINPUT, "quench: %s", e2.msg);
-    } else {
-      e = t->total(c->sys->state);
+  q->evaluations++;
+  if (t->set_coords(q->sys->state, x, &e2) != LW_OK) {
+    if (e2.code != LW_EINPUT) {
+      lw_error_set(err, e2.code, "quench: %s", e2.msg);
+      return NAN;
+    }
+    q->forbidden++;
+    return INFINITY;
+  }
+  double e = t->gradient(q->sys->state, g, &e2);
+  if (isnan(e)) {
+    lw_error_set(err, e2.code ? e2.code : LW_EINPUT, "quench: %s", e2.msg);
+    return NAN;
+  }
+  if (!isfinite(e)) q->forbidden++;
+  return e;
+}
+
+/* d = -H g by the two-loop recursion; H0 = gamma I, gamma from the newest
+** pair, or scale0 (the first step's length over |g|) without one. */
+static void direction(lbfgs *q, double scale0)
+{
+  const size_t n = q->n;
+  double *d = q->d;
+  memcpy(d, q->g, n * sizeof *d);
+  for (int k = 0; k < q->used; k++) {
+    const int i = (q->head - 1 - k + MEMORY) % MEMORY;
+    q->a[i] = q->rho[i] * dot(q->s[i], d, n);
+    for (size_t j = 0; j < n; j++) d[j] -= q->a[i] * q->y[i][j];
+  }
+  double gamma = scale0;
+  if (q->used) {
+    const int i = (q->head - 1 + MEMORY) % MEMORY;
+    gamma = 1.0 / (q->rho[i] * dot(q->y[i], q->y[i], n));
+  }
+  for (size_t j = 0; j < n; j++) d[j] *= gamma;
+  for (int k = q->used - 1; k >= 0; k--) {
+    const int i = (q->head - 1 - k + MEMORY) % MEMORY;
+    const double b = q->rho[i] * dot(q->y[i], d, n);
+    for (size_t j = 0; j < n; j++) d[j] += (q->a[i] - b) * q->s[i][j];
+  }
+  for (size_t j = 0; j < n; j++) d[j] = -d[j];
+}
+
+/* The trial x + h d, holding (d = 0) the coordinates of the parts it would
+** make forbidden while the direction left still descends; the slope g.d
+** left, or 0 when holding took it all. */
+static double trial(lbfgs *q, double h, double slope)
+{
+  const lw_system_type *t = q->sys->type;
+  const size_t n = q->n;
+  for (size_t i = 0; i < n; i++) q->x1[i] = q->x[i] + h * q->d[i];
+  for (int r = 0; t->blocked && r < HOLD_ROUNDS; r++) {
+    const size_t parts = t->blocked(q->sys->state, q->x1, q->held);
+    if (!parts) break;
+    q->holds += (long)parts;
+    for (size_t i = 0; i < n; i++)
+      if (q->held[i]) q->d[i] = 0.0;
+    slope = dot(q->g, q->d, n);
+    if (!(slope < 0.0)) return 0.0;
+    for (size_t i = 0; i < n; i++) q->x1[i] = q->x[i] + h * q->d[i];
+  }
+  return slope;
+}
+
+/* One step from x along d: 1 if taken (x, g and *e moved on), 0 if no
+** length descended, -1 on an error. */
+static int line_search(lbfgs *q, double *e, lw_error *err)
+{
+  const size_t n = q->n;
+  double slope = dot(q->g, q->d, n);
+  if (!(slope < 0.0)) return 0;
+  memset(q->held, 0, n);
+  double h = 1.0;
+  for (int k = 0; k <= HALVINGS_MAX; k++, h *= 0.5) {
+    slope = trial(q, h, slope);
+    if (!(slope < 0.0)) return 0;
+    const double e1 = evaluate(q, q->x1, q->g1, err);
+    if (isnan(e1)) return -1;
+    if (e1 <= *e + ARMIJO * h * slope) {
+      /* the pair (s, y) before x and g move on, kept if s.y > 0 */
+      double *s = q->s[q->head], *y = q->y[q->head];
+      for (size_t i = 0; i < n; i++) {
+        s[i] = q->x1[i] - q->x[i];
+        y[i] = q->g1[i] - q->g[i];
+      }
+      const double sy = dot(s, y, n);
+      if (sy > 0.0 && isfinite(sy)) {
+        q->rho[q->head] = 1.0 / sy;
+        q->head = (q->head + 1) % MEMORY;
+        if (q->used < MEMORY) q->used++;
+      }
+      memcpy(q->x, q->x1, n * sizeof *q->x);
+      memcpy(q->g, q->g1, n * sizeof *q->g);
+      *e = e1;
+      return 1;
     }
   }
-  int ok = c->st == LW_OK && isfinite(e) && e < WALL;
-  c->forbidden += c->st == LW_OK && !ok;
-  if (grad)
-    for (size_t i = 0; i < c->n; i++) gsl_vector_set(grad, i, ok ? c->g[i] : 0.0);
-  if (ok && e < c->best_f) {
-    c->best_f = e;
-    memcpy(c->best, c->x, c->n * sizeof *c->x);
-  }
-  return ok ? e : WALL;
+  return 0;
 }
 
-static double f_cb(const gsl_vector *v, void *p) { return eval_at(v, p, NULL); }
-static void df_cb(const gsl_vector *v, void *p, gsl_vector *g) { eval_at(v, p, g); }
-static void fdf_cb(const gsl_vector *v, void *p, double *f, gsl_vector *g) { *f = eval_at(v, p, g); }
-
-static double norm2(const double *g, size_t n)
+/* One iteration: L-BFGS's direction, or steepest descent where that leads
+** nowhere (scale0 sizes a step without curvature pairs); 1 if a step was
+** taken, 0 if none descends (or an error, in *st). */
+static int step(lbfgs *q, double *e, double scale0, lw_status *st, lw_error *err)
 {
-  double s = 0.0;
-  for (size_t i = 0; i < n; i++) s += g[i] * g[i];
-  return sqrt(s);
+  direction(q, scale0);
+  int took = line_search(q, e, err);
+  if (took == 0 && q->used) {
+    q->used = 0;
+    direction(q, scale0);
+    took = line_search(q, e, err);
+  }
+  if (took < 0) *st = err->code;
+  return took > 0;
 }
 
-/* The first trial step, in the coordinates' unit: a thousandth of their
-** root mean square (for splines ~0.1 mm on a page); the line search
-** scales it from there. */
+/* The first step's length, in the coordinates' unit: a thousandth of their
+** root mean square (for splines ~0.1 mm on a page); later steps take the
+** length L-BFGS's curvature estimate gives. */
 static double first_step(const double *x, size_t n)
 {
-  double s = 0.0;
-  for (size_t i = 0; i < n; i++) s += x[i] * x[i];
+  double s = dot(x, x, n);
   s = sqrt(s / (double)(n ? n : 1));
   return s > 0.0 ? 1e-3 * s : 1e-3;
 }
 
-lw_status lw_quench_run(lw_system *sys, double tol, long max_iter, lw_quench_report *r, lw_error *err)
+static void lbfgs_free(lbfgs *q)
+{
+  free(q->x);
+  free(q->g);
+  free(q->x1);
+  free(q->g1);
+  free(q->d);
+  for (int k = 0; k < MEMORY; k++) {
+    free(q->s[k]);
+    free(q->y[k]);
+  }
+  free(q->held);
+}
+
+lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_report *r, lw_error *err)
 {
   const lw_system_type *t = sys->type;
   const double t0 = seconds_now();
   memset(r, 0, sizeof *r);
+  r->ended = "no descent";
   r->energy_before = r->energy_after = t->total(sys->state);
   if (!t->gradient || !t->n_coords || !t->get_coords || !t->set_coords)
     return lw_error_set(err, LW_EINPUT, "quench: the %s system has no gradient", t->name);
   const size_t n = t->n_coords(sys->state), nb = (n ? n : 1) * sizeof(double);
-  quench_ctx c = {.sys = sys, .n = n, .x = malloc(nb), .g = malloc(nb), .best = malloc(nb), .best_f = INFINITY,
-                  .st = LW_OK, .err = err};
-  double *start = malloc(nb);
-  gsl_vector *x0 = n ? gsl_vector_alloc(n) : NULL;
-  gsl_multimin_fdfminimizer *m = n ? gsl_multimin_fdfminimizer_alloc(gsl_multimin_fdfminimizer_vector_bfgs2, n) : NULL;
+  lbfgs q = {.sys = sys, .n = n};
+  int ok = (q.x = malloc(nb)) && (q.g = malloc(nb)) && (q.x1 = malloc(nb)) && (q.g1 = malloc(nb)) &&
+           (q.d = malloc(nb)) && (q.held = calloc(n ? n : 1, 1));
+  for (int k = 0; ok && k < MEMORY; k++) ok = (q.s[k] = malloc(nb)) && (q.y[k] = malloc(nb));
   lw_status st = LW_OK;
-  if (!c.x || !c.g || !c.best || !start || (n && (!x0 || !m))) {
+  if (!ok) {
     st = lw_error_set(err, LW_ENOMEM, "out of memory for the quench of %zu coordinates", n);
     goto out;
   }
   if (n == 0 || !isfinite(r->energy_before)) goto out; /* nothing to move, or a forbidden start */
-  t->get_coords(sys->state, start);
-  for (size_t i = 0; i < n; i++) gsl_vector_set(x0, i, start[i]);
-  gsl_error_handler_t *old = gsl_set_error_handler_off();
-  gsl_multimin_function_fdf F = {.f = f_cb, .df = df_cb, .fdf = fdf_cb, .n = n, .params = &c};
-  const double step = first_step(start, n);
-  int gs = gsl_multimin_fdfminimizer_set(m, &F, x0, step, 0.1);
-  r->gradient_before = gsl_blas_dnrm2(gsl_multimin_fdfminimizer_gradient(m));
-  double gnorm = r->gradient_before;
-  /*
-  ** A line search fails when the minimum along its direction lies on the
-  ** wall of the allowed set (a segment at the regularity limit, a sample
-  ** at the boundary): the slope there is still negative, so no step meets
-  ** the curvature condition.  It has still evaluated lower allowed points;
-  ** the minimiser restarts from the lowest (its Hessian estimate starts
-  ** afresh) and counts the restart as an iteration.  It stops when a failed
-  ** search found nothing lower (the minimum to rounding) or when the search
-  ** right after a restart fails too: steepest descent runs into the wall
-  ** at once, so the state sits on the wall, where only a method that knows
-  ** the wall's normal could slide along it (docs/ACCURACY.md).
-  */
-  int failed = 0;
-  while (gs == GSL_SUCCESS && c.st == LW_OK && !(gnorm <= tol) && r->iterations < max_iter) {
-    double f_before = gsl_multimin_fdfminimizer_minimum(m);
-    gs = gsl_multimin_fdfminimizer_iterate(m);
-    if (c.st != LW_OK) break;
-    r->iterations++;
-    /* an iteration that did not lower the energy failed too (its search
-    ** shrank to nothing against the wall) */
-    int fail = gs != GSL_SUCCESS || !(gsl_multimin_fdfminimizer_minimum(m) < f_before);
-    failed = fail ? failed + 1 : 0;
-    if (fail) {
-      if (!(c.best_f < f_before) || failed > 1) break;
-      for (size_t i = 0; i < n; i++) gsl_vector_set(x0, i, c.best[i]);
-      gs = gsl_multimin_fdfminimizer_set(m, &F, x0, step, 0.1);
-    }
-    gnorm = gsl_blas_dnrm2(gsl_multimin_fdfminimizer_gradient(m));
+  t->get_coords(sys->state, q.x);
+  double e = evaluate(&q, q.x, q.g, err);
+  if (isnan(e)) {
+    st = err->code;
+    goto out;
   }
-  gsl_set_error_handler(old);
-  st = c.st;
-  /* the lowest allowed point seen (finite, so regular and inside), or the start */
+  const double step0 = first_step(q.x, n), e_start = e;
+  double gnorm = sqrt(dot(q.g, q.g, n));
+  double back[LW_QUENCH_WINDOW]; /* the energy of the last iterations, by iteration mod the window */
+  r->gradient_before = gnorm;
+  for (;;) {
+    const long it = r->iterations;
+    if (gnorm <= o->tol) r->ended = "converged";
+    else if (it >= o->max_iter) r->ended = "iterations";
+    else if (o->stop && *o->stop) r->ended = "stopped";
+    else if (it >= LW_QUENCH_WINDOW && back[it % LW_QUENCH_WINDOW] - e < o->stall * (e_start - e)) r->ended = "stalled";
+    else {
+      back[it % LW_QUENCH_WINDOW] = e;
+      if (!step(&q, &e, gnorm > 0.0 ? step0 / gnorm : 0.0, &st, err)) break;
+      r->iterations++;
+      gnorm = sqrt(dot(q.g, q.g, n));
+      continue;
+    }
+    break;
+  }
+  r->stopped = !strcmp(r->ended, "stopped");
+  /* the state where the last accepted step left it (the start if none) */
   lw_error e2 = {0};
-  const double *end = c.best_f < r->energy_before ? c.best : start;
-  if (t->set_coords(sys->state, end, &e2) != LW_OK && !st) st = lw_error_set(err, e2.code, "quench: %s", e2.msg);
-  double g_end = t->gradient(sys->state, c.g, &e2);
-  r->gradient_after = isfinite(g_end) ? norm2(c.g, n) : NAN;
-  r->converged = r->gradient_after <= tol;
+  if (t->set_coords(sys->state, q.x, &e2) != LW_OK && !st) st = lw_error_set(err, e2.code, "quench: %s", e2.msg);
+  r->gradient_after = gnorm;
+  r->converged = gnorm <= o->tol;
   r->energy_after = t->total(sys->state);
 out:
-  r->evaluations = c.evaluations;
-  r->forbidden = c.forbidden;
+  r->evaluations = q.evaluations;
+  r->forbidden = q.forbidden;
+  r->holds = q.holds;
   r->seconds = seconds_now() - t0;
-  gsl_multimin_fdfminimizer_free(m);
-  gsl_vector_free(x0);
-  free(start);
-  free(c.x);
-  free(c.g);
-  free(c.best);
+  lbfgs_free(&q);
   return st;
 }

@@ -944,15 +944,34 @@ static double gradient(void *state, double *g, lw_error *err)
   return e;
 }
 
+/* 1 if coordinates c are those of nodes o and o + 1: a segment that does not
+** move cannot close in on anything (whatever comes to it is the mover's). */
+static int same_nodes(const lw_node *o, const double *c)
+{
+  return o[0].px == c[0] && o[0].py == c[1] && o[0].vx == c[2] && o[0].vy == c[3] && o[1].px == c[4] &&
+         o[1].py == c[5] && o[1].vx == c[6] && o[1].vy == c[7];
+}
+
 /* The segments coordinates x would make forbidden: not finite, irregular
 ** (lw_segment_allowed) or, with the boundary term on, with a sample or an
-** end outside (lw_term_boundary infinite): their two nodes' coordinates. */
+** end outside (lw_term_boundary infinite); and those that would close in on
+** another stroke against energy.min_spacing (lw_model_segment_crowds,
+** against the others where they stand with a margin of the farthest any
+** control point moves, which bounds how far a sample of theirs may come):
+** their two nodes' coordinates. */
 static size_t blocked(void *state, const double *x, unsigned char *held)
 {
   const spl_state *s = state;
   const lw_scene *sc = s->m->scene;
   const lw_splines *sp = s->m->sp;
   size_t parts = 0;
+  double reach = 0.0;
+  for (size_t k = 0; sc->min_spacing > 0.0 && k < sp->n_nodes; k++) {
+    const double *c = x + 4 * k;
+    const lw_node *o = &sp->node[k];
+    const double r = hypot(c[0] - o->px, c[1] - o->py) + hypot(c[2] - o->vx, c[3] - o->vy);
+    if (r > reach || isnan(r)) reach = isnan(r) ? INFINITY : r;
+  }
   lw_samples smp;
   for (size_t g = 0; g < sp->n_segments; g++) {
     const size_t k = lw_segment_node(sp, g);
@@ -963,7 +982,8 @@ static size_t blocked(void *state, const double *x, unsigned char *held)
     if (!bad) {
       lw_segment_sample(&sc->quad, &a, &b, &smp);
       bad = !lw_segment_allowed(sc, &a, &b, smp.length) ||
-            (sc->on[LW_TERM_BOUNDARY] && !isfinite(lw_term_boundary(&smp, &sc->quad, &sc->boundary)));
+            (sc->on[LW_TERM_BOUNDARY] && !isfinite(lw_term_boundary(&smp, &sc->quad, &sc->boundary))) ||
+            (!same_nodes(sp->node + k, c) && lw_model_segment_crowds(s->m, g, &a, &b, reach));
     }
     if (!bad) continue;
     memset(held + 4 * k, 1, 8);

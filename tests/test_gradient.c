@@ -567,7 +567,8 @@ static lw_quench_report quench_splines(const lw_scene *sc, size_t n, size_t segs
   lw_system *sys = lw_splines_view(m, &err);
   cr_assert_not_null(sys);
   lw_quench_report r;
-  cr_assert_eq(lw_quench_run(sys, 1e-6, 5000, &r, &err), LW_OK, "%s", err.msg);
+  const lw_quench_opts o = {1e-6, 5000, 0.0, NULL};
+  cr_assert_eq(lw_quench_run(sys, &o, &r, &err), LW_OK, "%s", err.msg);
   lw_system_free(sys);
   *out = m;
   return r;
@@ -629,10 +630,10 @@ Test(quench, never_leaves_the_allowed_set)
   scene_with(&sc, &p);
   lw_model *m;
   lw_quench_report r = quench_splines(&sc, 3, 4, 77, &m);
-  cr_log_info("boundary: %.10g -> %.10g, %ld iterations, %ld of %ld trials forbidden", r.energy_before, r.energy_after,
-              r.iterations, r.forbidden, r.evaluations);
+  cr_log_info("boundary: %.10g -> %.10g, %ld iterations, %ld of %ld trials forbidden, %ld parts held", r.energy_before,
+              r.energy_after, r.iterations, r.forbidden, r.evaluations, r.holds);
   cr_assert(r.energy_after < r.energy_before);
-  cr_assert(r.forbidden > 0, "the steps never met a wall: the test tests nothing");
+  cr_assert(r.holds > 0, "the steps never met a wall: the test tests nothing");
   assert_allowed(&sc, m, r.energy_after);
   lw_model_free(m);
   lw_scene_clear(&sc);
@@ -643,12 +644,46 @@ Test(quench, never_leaves_the_allowed_set)
   p.regularity = 0;
   scene_with(&sc, &p);
   r = quench_splines(&sc, 3, 4, 78, &m);
-  cr_log_info("min_speed: %.10g -> %.10g, %ld iterations, %ld of %ld trials forbidden", r.energy_before,
-              r.energy_after, r.iterations, r.forbidden, r.evaluations);
+  cr_log_info("min_speed: %.10g -> %.10g, %ld iterations, %ld of %ld trials forbidden, %ld parts held",
+              r.energy_before, r.energy_after, r.iterations, r.forbidden, r.evaluations, r.holds);
   cr_assert(r.energy_after < r.energy_before);
-  cr_assert(r.forbidden > 0, "the steps never met a wall: the test tests nothing");
+  cr_assert(r.holds > 0, "the steps never met a wall: the test tests nothing");
   assert_allowed(&sc, m, r.energy_after);
   lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+/* A stop asked for (a signal, main.c) ends the quench at the next
+** iteration: asked before it starts, it takes no step and leaves the state
+** where it was; not asked, the same quench takes its steps. */
+Test(quench, a_stop_ends_it_and_says_so)
+{
+  lw_params p = base_params();
+  p.strain = 2;
+  p.bending = 0.5;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  for (int asked = 0; asked < 2; asked++) {
+    lw_error err = {0};
+    lw_model *m = lw_model_new(&sc, random_splines(&sc, 3, 4, 2024), &err);
+    cr_assert_not_null(m, "%s", err.msg);
+    lw_system *sys = lw_splines_view(m, &err);
+    const double e0 = lw_model_total(m);
+    volatile sig_atomic_t stop = asked;
+    lw_quench_report r;
+    const lw_quench_opts o = {1e-6, 5000, 0.0, &stop};
+    cr_assert_eq(lw_quench_run(sys, &o, &r, &err), LW_OK, "%s", err.msg);
+    cr_assert_eq(r.stopped, asked);
+    if (asked) {
+      cr_assert_eq(r.iterations, 0);
+      cr_assert_eq(lw_model_total(m), e0, "a stopped quench moved the state");
+      cr_assert_eq(r.energy_after, r.energy_before);
+    } else {
+      cr_assert(r.iterations > 10 && r.energy_after < e0, "%ld iterations, %g -> %g", r.iterations, e0, r.energy_after);
+    }
+    lw_system_free(sys);
+    lw_model_free(m);
+  }
   lw_scene_clear(&sc);
 }
 
@@ -665,6 +700,22 @@ Test(quench, refused_for_a_system_without_gradient, .init = qsetup, .fini = qtea
   cr_assert_eq(lw_test_sh("grep -q \"p.ini:[0-9]*: key 'anneal.quench': the particles system has no gradient\" "
                           "%s/err.txt", qdir), 0);
   cr_assert_neq(lw_test_sh("test -e %s/run", qdir), 0, "nothing is written for a refused scene");
+}
+
+/* A signal during the quench stops it (the quench of a picture's page takes
+** minutes): the run ends at once, exit 0, with the annealed state saved
+** and nothing drawn, as a run stopped between sweeps; the phase line on
+** stderr says when the quench is under way. */
+Test(quench, a_signal_stops_a_quench_under_way, .init = qsetup, .fini = qteardown)
+{
+  int rc = lw_test_sh("%s run %s/params/example.ini --set anneal.sweeps=1 --set anneal.quench=bfgs --out %s/r "
+                      "2> %s/err.txt & p=$!; i=0; while [ $i -lt 600 ] && ! grep -q 'quenching' %s/err.txt; do "
+                      "sleep 0.1; i=$((i+1)); done; kill -INT $p; wait $p",
+                      lw_test_bin(), lw_test_root(), qdir, qdir, qdir);
+  cr_assert_eq(rc, 0);
+  cr_assert_eq(lw_test_sh("grep -q 'stopped during the quench' %s/err.txt", qdir), 0, "no stop message");
+  cr_assert_eq(lw_test_sh("test -f %s/r/state.lw && ! test -e %s/r/final.svg && ! test -e %s/r/summary.json", qdir,
+                          qdir, qdir), 0, "a stopped quench saves the state and draws nothing");
 }
 
 /* Same scene and seed: the same bytes for any thread count (tempering,

@@ -12,6 +12,8 @@
 #include "imageutil.h"
 #include "linewise/init.h"
 #include "linewise/model.h"
+#include "linewise/quench.h"
+#include "linewise/sys_splines.h"
 #include "linewise/scene.h"
 #include "linewise/spacing.h"
 #include "linewise/vec2.h"
@@ -450,6 +452,19 @@ static lw_splines *rows(int n_rows)
   return sp;
 }
 
+/* Darker blotches whose tone term pulls strokes together, with the spacing
+** rule at 0.3 mm on or off. */
+static void spacing_scene(lw_scene *sc, int on)
+{
+  lw_params p = tone_params(30, 30, blotches, 20.0, 0.8);
+  p.pair = 0.001;
+  p.pair_cutoff = 1.0;
+  p.min_spacing = on ? 0.3 : 0.0;
+  p.strain = 10;
+  p.bending = 0.3;
+  lw_test_scene(sc, &p);
+}
+
 Test(tone, the_spacing_constraint_holds_once_kept)
 {
   /* From a crowded layout that keeps 0.3 mm, the tone term of a picture
@@ -459,14 +474,8 @@ Test(tone, the_spacing_constraint_holds_once_kept)
   size_t worst[2] = {0, 0};
   unsigned long accepted = 0, crowded[2] = {0, 0};
   for (int on = 0; on < 2; on++) {
-    lw_params p = tone_params(30, 30, blotches, 20.0, 0.8);
-    p.pair = 0.001;
-    p.pair_cutoff = 1.0;
-    p.min_spacing = on ? 0.3 : 0.0;
-    p.strain = 10;
-    p.bending = 0.3;
     lw_scene sc;
-    lw_test_scene(&sc, &p);
+    spacing_scene(&sc, on);
     lw_splines *sp = rows(40);
     cr_assert_eq(close_pairs(&sc, sp, 0.3), 0, "the start keeps the spacing");
     lw_model *m = lw_model_new(&sc, sp, NULL);
@@ -493,6 +502,39 @@ Test(tone, the_spacing_constraint_holds_once_kept)
   ** only where the rule is on */
   cr_assert_eq(crowded[0], 0, "%lu counted crowded without the rule", crowded[0]);
   cr_assert(crowded[1] > 0, "no refusal of the rule was counted");
+}
+
+/* The quench (quench.h) keeps the spacing rule too: on the same crowded rows
+** and blotches, quenched without the rule it brings strokes closer than
+** 0.3 mm; with it, the segments a step would bring closer are held, and no
+** pair comes closer at the end while the energy still falls. */
+Test(tone, the_quench_keeps_the_spacing)
+{
+  size_t close[2];
+  double removed[2];
+  for (int on = 0; on < 2; on++) {
+    lw_scene sc;
+    spacing_scene(&sc, on);
+    lw_error err = {0};
+    lw_model *m = lw_model_new(&sc, rows(16), &err);
+    cr_assert_not_null(m, "%s", err.msg);
+    lw_system *sys = lw_splines_view(m, &err);
+    cr_assert_not_null(sys, "%s", err.msg);
+    const lw_quench_opts o = {1e-9, 100, 0.0, NULL};
+    lw_quench_report r;
+    cr_assert_eq(lw_quench_run(sys, &o, &r, &err), LW_OK, "%s", err.msg);
+    close[on] = close_pairs(&sc, m->sp, 0.3);
+    removed[on] = r.energy_before - r.energy_after;
+    cr_log_info("quench, spacing %s: %g removed in %ld iterations, %ld held, %zu close pairs", on ? "on" : "off",
+                removed[on], r.iterations, r.holds, close[on]);
+    lw_system_free(sys);
+    lw_model_free(m);
+    lw_scene_clear(&sc);
+  }
+  cr_assert(close[0] > 0, "the quench brings strokes together when nothing stops it: the test tests nothing");
+  cr_assert_eq(close[1], 0, "%zu pairs closer than min_spacing after the quench", close[1]);
+  cr_assert(removed[1] > 0.2 * removed[0], "held too much: %g removed, against %g without the rule", removed[1],
+            removed[0]);
 }
 
 Test(tone, a_crowded_start_only_gets_less_crowded)

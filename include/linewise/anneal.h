@@ -64,6 +64,8 @@ typedef struct lw_anneal {
   lw_move_stats trace_mark[LW_MOVES_MAX]; /* stats at the last trace row */
   int quenched;                /* 1 once lw_anneal_finish has quenched (anneal.quench) */
   lw_quench_report quench;     /* what the quench did */
+  const volatile sig_atomic_t *stop; /* not NULL: set (by a signal) stops a quench under way,
+                               ** and lw_anneal_finish then draws nothing (not owned) */
   FILE *trace;                 /* NULL on the processes other than the first (anneal_net.h) */
   lw_anneal_net *net;          /* NULL in one process; else the hooks of a spread run (not owned) */
 } lw_anneal;

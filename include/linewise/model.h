@@ -303,6 +303,14 @@ lw_status lw_model_commit(lw_model *m, lw_proposal *p);
 lw_status lw_model_commit_part(lw_model *m, lw_proposal *p);
 lw_status lw_model_merge(lw_model *m, lw_proposal *p);
 
+/* 1 if global segment g moved to nodes a and b would have more pair samples
+** closer than energy.min_spacing + margin to another stroke's, as the grid
+** holds them now, than it has closer than min_spacing: the spacing rule of a
+** proposal (p->crowded, margin 0), asked of one segment for a step that
+** moves many (the quench, system.h `blocked`), whose margin is how far the
+** others may move.  0 without the rule. */
+int lw_model_segment_crowds(const lw_model *m, size_t g, const lw_node *a, const lw_node *b, double margin);
+
 /* 1 if the segment from a to b, of quadrature length `length`, is regular
 ** for the scene: its speed never falls below scene->min_speed times its
 ** length, the mean speed, and its bending integrand is analytic inside the

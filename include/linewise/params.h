@@ -150,6 +150,7 @@ typedef struct {
   int quench;                 /* LW_QUENCH_*: after the last sweep, to the nearest local minimum */
   double quench_tol;          /* stop at this gradient norm, energy/mm */
   int quench_iterations;      /* at most this many minimiser iterations */
+  double quench_stall;        /* stop when the last 50 iterations removed less than this share */
   /* [tempering] */
   int replicas;               /* 1 = no tempering */
   double t_min, t_max;        /* geometric ladder, energy units */

@@ -1,22 +1,23 @@
 /*
-** quench.h -- the quench after annealing ([anneal] quench = bfgs): GSL's
-** BFGS minimiser (gsl_multimin_fdfminimizer_vector_bfgs2) takes a system's
-** state to the nearest local minimum of its energy, through the row's
-** coordinates and gradient (system.h), so it works for any system that has
-** a gradient and names none.
+** quench.h -- the quench after annealing ([anneal] quench = bfgs):
+** limited-memory BFGS takes a system's state to the nearest local minimum
+** of its energy, through the row's coordinates and gradient (system.h), so
+** it works for any system that has a gradient and names none.
 **
 ** The allowed set: a state the energy forbids (+inf: outside the boundary,
-** an irregular segment) is never accepted.  Its energy is handed to the
-** minimiser as a large finite wall, so the line search sees a point far
-** worse than where it came from and shortens the step (quench.c has the
-** argument); the state it ends in is the best one it accepted, which is
-** finite, hence regular and inside.
+** an irregular segment) is never accepted.  Where the row says which parts
+** a step would make forbidden (system.h, `blocked`), the step holds those
+** parts and moves the rest, so one segment at a wall does not stop the
+** others (quench.c has why GSL's minimisers could not); elsewhere the step
+** is halved until it is allowed.
 **
 ** Deterministic: the same state gives the same iterates whatever the thread
 ** count (the gradient and the energy are serial sums in a fixed order).
 */
 #ifndef LINEWISE_QUENCH_H
 #define LINEWISE_QUENCH_H
+
+#include <signal.h>
 
 #include "linewise/error.h"
 #include "linewise/system.h"
@@ -27,15 +28,29 @@ typedef struct {
   long iterations;                        /* minimiser iterations */
   long evaluations;                       /* energy evaluations (with or without gradient) */
   long forbidden;                         /* of which at forbidden points: steps shortened */
+  long holds;                             /* parts held by a step at a wall (each time) */
   double seconds;                         /* wall-clock time of the quench */
   int converged;                          /* 1: the gradient norm reached tol */
+  const char *ended;                      /* why it ended: "converged", "stalled", "iterations",
+                                          ** "no descent" (the minimum to rounding) or "stopped" */
+  int stopped;                            /* 1: *stop was set before it ended */
 } lw_quench_report;
 
-/* Quenches the state of sys in place: at most max_iter iterations, until
-** the gradient norm is <= tol or a line search makes no progress.
-** LW_EINPUT if the system has no gradient or its gradient fails (err says
-** why), LW_ENOMEM; the state is then the last accepted one (or the start),
-** never a forbidden one.  A start that is itself forbidden is left alone. */
-lw_status lw_quench_run(lw_system *sys, double tol, long max_iter, lw_quench_report *r, lw_error *err);
+/* When to stop. */
+#define LW_QUENCH_WINDOW 50 /* iterations the stall rule looks back over */
+typedef struct {
+  double tol;      /* the gradient norm to stop at */
+  long max_iter;   /* iterations at most */
+  double stall;    /* stop when the last LW_QUENCH_WINDOW iterations removed less than this
+                   ** share of the energy the quench removed so far (0: never) */
+  const volatile sig_atomic_t *stop; /* may be NULL; set (a signal): stop at the next iteration */
+} lw_quench_opts;
+
+/* Quenches the state of sys in place until one of o's rules, or no step
+** descending any more, ends it (r->ended says which).  LW_EINPUT if the
+** system has no gradient or its gradient fails (err says why), LW_ENOMEM;
+** the state is then the last accepted one (or the start), never a
+** forbidden one.  A start that is itself forbidden is left alone. */
+lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_report *r, lw_error *err);
 
 #endif
