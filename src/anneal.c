@@ -796,6 +796,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     lw_json_key(&j, "iterations"); lw_json_int(&j, q->iterations);
     lw_json_key(&j, "evaluations"); lw_json_int(&j, q->evaluations);
     lw_json_key(&j, "forbidden"); lw_json_int(&j, q->forbidden);
+    lw_json_key(&j, "holds"); lw_json_int(&j, q->holds);
     lw_json_key(&j, "seconds"); lw_json_number(&j, q->seconds);
     lw_json_end_object(&j);
   }

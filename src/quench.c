@@ -44,6 +44,7 @@ typedef struct {
   lw_system *sys;
   size_t n;
   double *x, *g, *x1, *g1, *d;     /* the point, its gradient, a trial, its gradient, the direction */
+  double *d0;                      /* the direction before a trial's holds */
   double *s[MEMORY], *y[MEMORY];   /* step pairs, oldest at (head - used) mod MEMORY */
   double rho[MEMORY], a[MEMORY];
   int used, head;
@@ -142,13 +143,17 @@ static double trial(lbfgs *q, double h, double slope)
 static int line_search(lbfgs *q, double *e, lw_error *err)
 {
   const size_t n = q->n;
-  double slope = dot(q->g, q->d, n);
-  if (!(slope < 0.0)) return 0;
-  memset(q->held, 0, n);
+  const double slope0 = dot(q->g, q->d, n);
+  if (!(slope0 < 0.0)) return 0;
+  memcpy(q->d0, q->d, n * sizeof *q->d);
   double h = 1.0;
   for (int k = 0; k <= HALVINGS_MAX; k++, h *= 0.5) {
-    slope = trial(q, h, slope);
-    if (!(slope < 0.0)) return 0;
+    /* each length holds what it would take through a wall; a shorter one
+    ** may hold less (held all, it is only shorter) */
+    memcpy(q->d, q->d0, n * sizeof *q->d);
+    memset(q->held, 0, n);
+    const double slope = trial(q, h, slope0);
+    if (!(slope < 0.0)) continue;
     const double e1 = evaluate(q, q->x1, q->g1, err);
     if (isnan(e1)) return -1;
     if (e1 <= *e + ARMIJO * h * slope) {
@@ -206,6 +211,7 @@ static void lbfgs_free(lbfgs *q)
   free(q->x1);
   free(q->g1);
   free(q->d);
+  free(q->d0);
   for (int k = 0; k < MEMORY; k++) {
     free(q->s[k]);
     free(q->y[k]);
@@ -225,7 +231,7 @@ lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_repor
   const size_t n = t->n_coords(sys->state), nb = (n ? n : 1) * sizeof(double);
   lbfgs q = {.sys = sys, .n = n};
   int ok = (q.x = malloc(nb)) && (q.g = malloc(nb)) && (q.x1 = malloc(nb)) && (q.g1 = malloc(nb)) &&
-           (q.d = malloc(nb)) && (q.held = calloc(n ? n : 1, 1));
+           (q.d = malloc(nb)) && (q.d0 = malloc(nb)) && (q.held = calloc(n ? n : 1, 1));
   for (int k = 0; ok && k < MEMORY; k++) ok = (q.s[k] = malloc(nb)) && (q.y[k] = malloc(nb));
   lw_status st = LW_OK;
   if (!ok) {

@@ -741,7 +741,9 @@ Test(quench, deterministic_and_resumable, .init = qsetup, .fini = qteardown)
                             "q.pop('seconds'); print(sorted(q.items()))\" > %s/q%c.txt", qdir, *o, qdir, *o), 0);
   cr_expect_eq(lw_test_sh("cmp -s %s/qa.txt %s/qb.txt", qdir, qdir), 0, "summary quench: threads");
   cr_expect_eq(lw_test_sh("cmp -s %s/qa.txt %s/qc.txt", qdir, qdir), 0, "summary quench: resume");
-  /* and it lowered the energy */
+  /* and it lowered the energy, and says why it ended and what it held */
   cr_assert_eq(lw_test_sh("python3 -c \"import json,sys; q=json.load(open('%s/a/summary.json'))['quench']; "
-                          "sys.exit(0 if q['energy_after'] < q['energy_before'] else 1)\"", qdir), 0);
+                          "sys.exit(0 if q['energy_after'] < q['energy_before'] and q['ended'] in "
+                          "('converged', 'stalled', 'iterations', 'no descent') and q['holds'] >= 0 else 1)\"",
+                          qdir), 0);
 }
