@@ -39,6 +39,11 @@
 #define HALVINGS_MAX 50  /* a step of 2^-50 of the first is nothing */
 #define HOLD_ROUNDS 8    /* holds a trial step may add before it is evaluated */
 #define ARMIJO 1e-4
+/* No coordinate moves more than this many first steps in one (the rms of
+** the coordinates: a page): where the energy has no floor (a weight with
+** nothing to hold it) the quench walks off instead of leaping to
+** coordinates no drawing can render. */
+#define MAX_MOVE 1000.0
 
 typedef struct {
   lw_system *sys;
@@ -138,15 +143,17 @@ static double trial(lbfgs *q, double h, double slope)
   return slope;
 }
 
-/* One step from x along d: 1 if taken (x, g and *e moved on), 0 if no
-** length descended, -1 on an error. */
-static int line_search(lbfgs *q, double *e, lw_error *err)
+/* One step from x along d, no coordinate moving more than max_move: 1 if
+** taken (x, g and *e moved on), 0 if no length descended, -1 on an error. */
+static int line_search(lbfgs *q, double *e, double max_move, lw_error *err)
 {
   const size_t n = q->n;
   const double slope0 = dot(q->g, q->d, n);
   if (!(slope0 < 0.0)) return 0;
   memcpy(q->d0, q->d, n * sizeof *q->d);
-  double h = 1.0;
+  double longest = 0.0;
+  for (size_t i = 0; i < n; i++) longest = fmax(longest, fabs(q->d[i]));
+  double h = longest > max_move ? max_move / longest : 1.0;
   for (int k = 0; k <= HALVINGS_MAX; k++, h *= 0.5) {
     /* each length holds what it would take through a wall; a shorter one
     ** may hold less (held all, it is only shorter) */
@@ -181,14 +188,14 @@ static int line_search(lbfgs *q, double *e, lw_error *err)
 /* One iteration: L-BFGS's direction, or steepest descent where that leads
 ** nowhere (scale0 sizes a step without curvature pairs); 1 if a step was
 ** taken, 0 if none descends (or an error, in *st). */
-static int step(lbfgs *q, double *e, double scale0, lw_status *st, lw_error *err)
+static int step(lbfgs *q, double *e, double scale0, double max_move, lw_status *st, lw_error *err)
 {
   direction(q, scale0);
-  int took = line_search(q, e, err);
+  int took = line_search(q, e, max_move, err);
   if (took == 0 && q->used) {
     q->used = 0;
     direction(q, scale0);
-    took = line_search(q, e, err);
+    took = line_search(q, e, max_move, err);
   }
   if (took < 0) *st = err->code;
   return took > 0;
@@ -257,7 +264,7 @@ lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_repor
     else if (it >= LW_QUENCH_WINDOW && back[it % LW_QUENCH_WINDOW] - e < o->stall * (e_start - e)) r->ended = "stalled";
     else {
       back[it % LW_QUENCH_WINDOW] = e;
-      if (!step(&q, &e, gnorm > 0.0 ? step0 / gnorm : 0.0, &st, err)) break;
+      if (!step(&q, &e, gnorm > 0.0 ? step0 / gnorm : 0.0, MAX_MOVE * step0, &st, err)) break;
       r->iterations++;
       gnorm = sqrt(dot(q.g, q.g, n));
       continue;
