@@ -792,7 +792,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     lw_json_key(&j, "gradient_before"); lw_json_number(&j, q->gradient_before);
     lw_json_key(&j, "gradient_after"); lw_json_number(&j, q->gradient_after);
     lw_json_key(&j, "converged"); lw_json_bool(&j, q->converged);
-    lw_json_key(&j, "ended"); lw_json_string(&j, q->ended);
+    lw_json_key(&j, "ended"); lw_json_string(&j, lw_quench_end_name(q->ended));
     lw_json_key(&j, "iterations"); lw_json_int(&j, q->iterations);
     lw_json_key(&j, "evaluations"); lw_json_int(&j, q->evaluations);
     lw_json_key(&j, "forbidden"); lw_json_int(&j, q->forbidden);
@@ -870,7 +870,7 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
     s = lw_quench_run(a->sys, &o, &a->quench, err);
     lw_phase_set(NULL);
     if (s) return s;
-    if (a->quench.stopped) return LW_OK; /* state.lw holds the annealed state: resume quenches again */
+    if (a->quench.ended == LW_QUENCH_STOPPED) return LW_OK; /* state.lw holds the annealed state: resume quenches again */
     a->quenched = 1;
   }
   lw_phase_set("drawing the final files (ordering the paths, then each file)");

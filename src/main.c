@@ -273,7 +273,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_err
 #endif
   if (s) return watched_fail(w, err);
   watcher_stop(w, 0);
-  if (a->quench.stopped) {
+  if (a->quench.ended == LW_QUENCH_STOPPED) {
     if (!quiet)
       fprintf(stderr, "linewise: stopped during the quench (nothing drawn); state saved in %s/state.lw ('linewise resume "
               "%s' quenches again)\n", a->dir, a->dir);
@@ -286,7 +286,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_err
     if (a->quenched)
       fprintf(stderr, "linewise: quench: energy %.10g -> %.10g, gradient norm %.3g -> %.3g, %ld iterations (%s), %.2f s\n",
               a->quench.energy_before, a->quench.energy_after, a->quench.gradient_before, a->quench.gradient_after,
-              a->quench.iterations, a->quench.ended, a->quench.seconds);
+              a->quench.iterations, lw_quench_end_name(a->quench.ended), a->quench.seconds);
     fprintf(stderr, "linewise: done: %s/%s, summary.json, trace.csv, state.lw\n", a->dir, a->sys_type->files);
   }
   return 0;

@@ -211,6 +211,25 @@ static double first_step(const double *x, size_t n)
   return s > 0.0 ? 1e-3 * s : 1e-3;
 }
 
+/* Whether o's rules end the quench before iteration `it` (at energy e,
+** gradient norm gnorm; back[] the energies before the last iterations, by
+** iteration mod the window). */
+static lw_quench_end end_now(const lw_quench_opts *o, long it, double gnorm, const double *back, double e,
+                             double e_start)
+{
+  if (gnorm <= o->tol) return LW_QUENCH_CONVERGED;
+  if (it >= o->max_iter) return LW_QUENCH_ITERATIONS;
+  if (o->stop && *o->stop) return LW_QUENCH_STOPPED;
+  if (it >= LW_QUENCH_WINDOW && back[it % LW_QUENCH_WINDOW] - e < o->stall * (e_start - e)) return LW_QUENCH_STALLED;
+  return LW_QUENCH_RUNNING;
+}
+
+const char *lw_quench_end_name(lw_quench_end e)
+{
+  static const char *const name[] = {"running", "converged", "stalled", "iterations", "stopped", "no descent"};
+  return (unsigned)e < sizeof name / sizeof name[0] ? name[e] : "?";
+}
+
 static void lbfgs_free(lbfgs *q)
 {
   free(q->x);
@@ -231,7 +250,7 @@ lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_repor
   const lw_system_type *t = sys->type;
   const double t0 = seconds_now();
   memset(r, 0, sizeof *r);
-  r->ended = "no descent";
+  r->ended = LW_QUENCH_NO_DESCENT;
   r->energy_before = r->energy_after = t->total(sys->state);
   if (!t->gradient || !t->n_coords || !t->get_coords || !t->set_coords)
     return lw_error_set(err, LW_EINPUT, "quench: the %s system has no gradient", t->name);
@@ -256,22 +275,14 @@ lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_repor
   double gnorm = sqrt(dot(q.g, q.g, n));
   double back[LW_QUENCH_WINDOW]; /* the energy of the last iterations, by iteration mod the window */
   r->gradient_before = gnorm;
-  for (;;) {
-    const long it = r->iterations;
-    if (gnorm <= o->tol) r->ended = "converged";
-    else if (it >= o->max_iter) r->ended = "iterations";
-    else if (o->stop && *o->stop) r->ended = "stopped";
-    else if (it >= LW_QUENCH_WINDOW && back[it % LW_QUENCH_WINDOW] - e < o->stall * (e_start - e)) r->ended = "stalled";
-    else {
-      back[it % LW_QUENCH_WINDOW] = e;
-      if (!step(&q, &e, gnorm > 0.0 ? step0 / gnorm : 0.0, MAX_MOVE * step0, &st, err)) break;
-      r->iterations++;
-      gnorm = sqrt(dot(q.g, q.g, n));
-      continue;
-    }
-    break;
+  lw_quench_end end;
+  while ((end = end_now(o, r->iterations, gnorm, back, e, e_start)) == LW_QUENCH_RUNNING) {
+    back[r->iterations % LW_QUENCH_WINDOW] = e;
+    if (!step(&q, &e, gnorm > 0.0 ? step0 / gnorm : 0.0, MAX_MOVE * step0, &st, err)) break;
+    r->iterations++;
+    gnorm = sqrt(dot(q.g, q.g, n));
   }
-  r->stopped = !strcmp(r->ended, "stopped");
+  if (end != LW_QUENCH_RUNNING) r->ended = end;
   /* the state where the last accepted step left it (the start if none) */
   lw_error e2 = {0};
   if (t->set_coords(sys->state, q.x, &e2) != LW_OK && !st) st = lw_error_set(err, e2.code, "quench: %s", e2.msg);

@@ -673,7 +673,7 @@ Test(quench, a_stop_ends_it_and_says_so)
     lw_quench_report r;
     const lw_quench_opts o = {1e-6, 5000, 0.0, &stop};
     cr_assert_eq(lw_quench_run(sys, &o, &r, &err), LW_OK, "%s", err.msg);
-    cr_assert_eq(r.stopped, asked);
+    cr_assert_eq(r.ended == LW_QUENCH_STOPPED, asked);
     if (asked) {
       cr_assert_eq(r.iterations, 0);
       cr_assert_eq(lw_model_total(m), e0, "a stopped quench moved the state");

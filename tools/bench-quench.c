@@ -83,7 +83,7 @@ void bench_quench(bench_ctx *b)
     fprintf(d, "| %s | %.6g | %.6g | %.4g | %.3g | %.3g -> %.3g | %ld (%s) | %ld | %ld | %.2f | %.2f | %.2f |\n",
             rows[r].name, q->energy_before, q->energy_after, q->energy_before - q->energy_after,
             0.5 * (double)res[r][0].coords * rows[r].t_end, q->gradient_before, q->gradient_after, q->iterations,
-            q->ended, q->evaluations, q->holds, mq, ma, mq / ma);
+            lw_quench_end_name(q->ended), q->evaluations, q->holds, mq, ma, mq / ma);
   }
   fprintf(d, "\n");
   fprintf(d,

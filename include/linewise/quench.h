@@ -22,6 +22,18 @@
 #include "linewise/error.h"
 #include "linewise/system.h"
 
+/* Why a quench ended (lw_quench_end_name: its word in summary.json). */
+typedef enum {
+  LW_QUENCH_RUNNING,    /* not yet */
+  LW_QUENCH_CONVERGED,  /* the gradient norm reached tol */
+  LW_QUENCH_STALLED,    /* the stall rule */
+  LW_QUENCH_ITERATIONS, /* max_iter */
+  LW_QUENCH_STOPPED,    /* *stop was set (a signal) */
+  LW_QUENCH_NO_DESCENT  /* no step descends: the minimum to rounding */
+} lw_quench_end;
+
+const char *lw_quench_end_name(lw_quench_end e);
+
 typedef struct {
   double energy_before, energy_after;     /* total energy */
   double gradient_before, gradient_after; /* Euclidean norm of the gradient, energy/mm */
@@ -31,9 +43,7 @@ typedef struct {
   long holds;                             /* parts held by a step at a wall (each time) */
   double seconds;                         /* wall-clock time of the quench */
   int converged;                          /* 1: the gradient norm reached tol */
-  const char *ended;                      /* why it ended: "converged", "stalled", "iterations",
-                                          ** "no descent" (the minimum to rounding) or "stopped" */
-  int stopped;                            /* 1: *stop was set before it ended */
+  lw_quench_end ended;                    /* why it ended */
 } lw_quench_report;
 
 /* When to stop. */
