@@ -39,6 +39,27 @@ lw_status lw_fidelity_render(const lw_splines *sp, const lw_grid2d *tone, double
   return s;
 }
 
+/*
+** Fine pixels a side for each raster pixel.  Coarse pixels miscount ink:
+** cairo keeps coverage in eight bits and rounds it at every path, so a pen
+** far narrower than a pixel inks it by a few 255ths a path, which round
+** away (an 8 x 6 picture on a page, 37 mm pixels, scored as blank paper);
+** and lines that share a pixel cannot be told apart from lines that
+** overlap.  On pixels no wider than LW_FIDELITY_PEN_PIXELS pen widths a
+** crossing covers much of a pixel and two strokes seldom share one; coarser
+** pixels are rendered that fine and averaged.  The fine surface is capped
+** at LW_FIDELITY_FINE_MAX pixels (and cairo's 32767 a side).
+*/
+static int supersampling(const lw_grid2d *t, double pen)
+{
+  double h = t->hx > t->hy ? t->hx : t->hy, want = ceil(h / (LW_FIDELITY_PEN_PIXELS * pen));
+  double n = (double)t->nx * (double)t->ny, side = t->nx > t->ny ? t->nx : t->ny;
+  double cap = floor(sqrt(LW_FIDELITY_FINE_MAX / n)), cap_side = floor(32767.0 / side);
+  if (cap_side < cap) cap = cap_side;
+  if (want > cap) want = cap;
+  return want > 1 ? (int)want : 1;
+}
+
 lw_status lw_fidelity_render_strokes(const lw_strokes *st, int pen, const lw_grid2d *tone, double pen_width_mm,
                                      double *ink, lw_error *err)
 {
@@ -46,18 +67,23 @@ lw_status lw_fidelity_render_strokes(const lw_strokes *st, int pen, const lw_gri
   if (s) return s;
   if (!positive(pen_width_mm))
     return lw_error_set(err, LW_EINPUT, "fidelity: pen width %g mm: expected a positive number", pen_width_mm);
+  const int k = supersampling(tone, pen_width_mm);
   /* A8: the alpha channel alone is the ink coverage. */
-  cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_A8, tone->nx, tone->ny);
+  cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_A8, tone->nx * k, tone->ny * k);
   cairo_t *cr = cairo_create(surf);
   if (cairo_status(cr)) {
-    s = lw_error_set(err, LW_ENOMEM, "fidelity: cannot render %d x %d pixels", tone->nx, tone->ny);
+    s = lw_error_set(err, LW_ENOMEM, "fidelity: cannot render %d x %d pixels", tone->nx * k, tone->ny * k);
     goto done;
   }
   /* user unit mm, the raster's top-left corner at the surface origin */
-  cairo_scale(cr, 1.0 / tone->hx, 1.0 / tone->hy);
+  cairo_scale(cr, k / tone->hx, k / tone->hy);
   cairo_translate(cr, -(tone->x0 - 0.5 * tone->hx), -(tone->y0 - 0.5 * tone->hy));
   cairo_set_source_rgba(cr, 0, 0, 0, 1);
   cairo_set_line_width(cr, pen_width_mm);
+  /* Paths add their coverage (capped at full ink): lines that share a pixel
+  ** without touching ink it together, where OVER would treat their coverage
+  ** as independent and count 1 - (1 - a)(1 - b) of it. */
+  cairo_set_operator(cr, CAIRO_OPERATOR_ADD);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
   cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
   lw_output_cairo_strokes(cr, st, pen);
@@ -67,10 +93,15 @@ lw_status lw_fidelity_render_strokes(const lw_strokes *st, int pen, const lw_gri
     goto done;
   }
   const unsigned char *data = cairo_image_surface_get_data(surf);
-  int stride = cairo_image_surface_get_stride(surf);
-  for (int j = 0; j < tone->ny; j++)
-    for (int i = 0; i < tone->nx; i++)
-      ink[(size_t)j * (size_t)tone->nx + (size_t)i] = data[(size_t)j * (size_t)stride + (size_t)i] / 255.0;
+  const size_t stride = (size_t)cairo_image_surface_get_stride(surf), nx = (size_t)tone->nx, K = (size_t)k;
+  const double scale = 1.0 / (255.0 * (double)k * (double)k);
+  for (size_t j = 0; j < (size_t)tone->ny; j++)
+    for (size_t i = 0; i < nx; i++) {
+      unsigned sum = 0; /* at most 255 k^2 <= 255 LW_FIDELITY_FINE_MAX */
+      for (size_t b = 0; b < K; b++)
+        for (size_t a = 0; a < K; a++) sum += data[(j * K + b) * stride + i * K + a];
+      ink[j * nx + i] = sum * scale;
+    }
 done:
   cairo_destroy(cr);
   cairo_surface_destroy(surf);

@@ -127,6 +127,39 @@ Test(fidelity, render_conserves_ink_area)
   lw_grid2d_free(tone);
 }
 
+/* On pixels far wider than the pen the ink is still the stroked area: on a
+** 4 x 3 raster of 12.5 mm pixels, lines of 0.3 mm and 30 mm long, 20 of
+** them 1.2 mm apart in the first two columns and 20 of them 0.45 mm apart
+** (gaps of half a pen) in the third.  Rendered at the raster's own pixels
+** each path's 2.4 % of a pixel rounded away in eight bits (no ink at all);
+** composited as independent coverage (OVER), lines that share a fine pixel
+** lose their common share. */
+Test(fidelity, coarse_pixels_keep_the_ink)
+{
+  const double px = 12.5, pen = 0.3;
+  const int w = 4, h = 3;
+  lw_grid2d *tone = lw_grid2d_new(w, h, 1, 0.5 * px, 0.5 * px, px, px, NULL);
+  size_t segs[40];
+  for (int k = 0; k < 40; k++) segs[k] = 2;
+  lw_splines *sp = lw_splines_new(40, segs, NULL);
+  for (int k = 0; k < 20; k++) {
+    lw_test_straight(sp, (size_t)k, 0.75 + 1.2 * k, 2.0, 0.75 + 1.2 * k, 32.0);
+    lw_test_straight(sp, (size_t)(20 + k), 27.0 + 0.45 * k, 2.0, 27.0 + 0.45 * k, 32.0);
+  }
+  double ink[12];
+  cr_assert_eq(lw_fidelity_render(sp, tone, pen, ink, NULL), LW_OK);
+  const double line = 30 * pen + M_PI * 0.25 * pen * pen; /* caps included */
+  double col[4] = {0, 0, 0, 0};
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) col[i] += ink[j * w + i] * px * px;
+  const double want[4] = {10 * line, 10 * line, 20 * line, 0};
+  for (int i = 0; i < 3; i++)
+    cr_assert(fabs(col[i] / want[i] - 1) < 0.01, "column %d: ink %.6g mm^2, expected %.6g", i, col[i], want[i]);
+  cr_assert(col[3] == 0);
+  lw_splines_free(sp);
+  lw_grid2d_free(tone);
+}
+
 /* Hatching at 2 mm with a 0.4 mm pen is a grey of darkness 0.2 once blurred
 ** by 1 mm (ripple damped by exp(-2 pi^2 / 4) < 1%): far closer to the flat
 ** 0.2 target than blank paper (MSE 0.04), and structurally alike. */

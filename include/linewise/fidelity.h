@@ -8,7 +8,10 @@
 **
 ** 1. The lines are rendered over that rectangle at the raster's resolution
 **    (cairo, antialiased, the exact Bezier curves stroked with the pen
-**    width, round caps): ink = the covered fraction of each pixel, 0..1.
+**    width, round caps): ink = the covered fraction of each pixel, summed
+**    over the paths and capped at 1.  Pixels wider than
+**    LW_FIDELITY_PEN_PIXELS pen widths are rendered as k x k finer ones and
+**    averaged (cairo's coverage is eight bits a path).
 **    The target's darkness is 1 - tone.
 ** 2. Both are blurred with the same Gaussian of standard deviation sigma
 **    (mm; sigma / hx and sigma / hy pixels per axis), truncated at 4 sigma
@@ -53,6 +56,8 @@
 #define LW_FIDELITY_SSIM_SIGMA 1.5    /* SSIM window, pixels */
 #define LW_FIDELITY_SSIM_RADIUS 5     /* SSIM window half width: 11 x 11 */
 #define LW_FIDELITY_FLAT 1e-9         /* gradient (per pixel) below which a pixel has no direction */
+#define LW_FIDELITY_PEN_PIXELS 1.0    /* coarser pixels (in pen widths) are rendered finer and averaged */
+#define LW_FIDELITY_FINE_MAX 16777216.0 /* the fine render's most pixels */
 
 typedef struct {
   double mse;       /* mean squared difference of blurred ink and darkness */
