@@ -10,13 +10,13 @@
 **                  dl = w_q |r'_q| at r'_q;
 **   near pairs     dE_AB = (1 - W) dP_AB + (X_AB - P_AB) dW + W dX_AB, with
 **                  dW that of the pair that sets the maximum;
-**   X_AB           forward mode through lw_pair_segments_exact: every
-**                  quantity it computes carries its 16 partials with
-**                  respect to the control points of A and B (a "jet"),
-**                  taken step by step through the same branches, blends,
-**                  subdivision and closest points, and the exact
+**   X_AB           reverse mode through lw_pair_segments_exact: every
+**                  quantity it computes is a value and a tape node (a
+**                  "jet"), taken step by step through the same branches,
+**                  blends, subdivision and closest points, and the exact
 **                  segment-segment integrals of its leaves by
-**                  lw_pair_segseg_grad.
+**                  lw_pair_segseg_grad; one sweep back gives the partials
+**                  by the control points of A and B.
 **
 ** The samples' weights are stored as float (pair.h); the derivative is that
 ** of the formula with the weights exact, whose float rounding is a step
@@ -35,6 +35,7 @@
 #include "linewise/grid.h"
 #include "linewise/pairnear.h"
 #include "linewise/terms.h"
+#include "linewise/vec2.h"
 
 /* ---- the segment-segment integral ----------------------------------------- */
 
@@ -137,35 +138,112 @@ double lw_pair_segseg_grad(const double a0[2], const double a1[2], const double 
   return I;
 }
 
-/* ---- jets: a value and its partials by the 16 control coordinates --------- */
+/* ---- jets: values on a tape, partials by one sweep back ---------------- */
 
-#define ND 16
-
+/*
+** A jet is a value and the tape node that made it (-1: a constant).  A node
+** keeps its parents and its partials by them; one sweep back from the
+** result gives its partials by the 16 control coordinates, which are the
+** first 16 nodes.  Carrying the 16 partials forward through every operation
+** cost 16 multiply-adds an operation, and the jets, 136 bytes each, filled
+** the pieces the subdivision copies; the sweep costs one an edge (the same
+** derivative, summed in another order).  The tape belongs to the thread's
+** pairgrad_work and is reached through a thread-local pointer, so the
+** operations keep their two-operand form.
+*/
 typedef struct {
-  double v, d[ND];
+  double v;
+  int i;
 } jet;
 
-static inline jet jc(double v)
+#define NCTRL 16 /* the control coordinates: a's 8, then b's */
+
+typedef struct {
+  int n, cap;     /* nodes, room */
+  int m, mcap;    /* edges, room */
+  int open;       /* the node jacc may still add edges to, or -1 */
+  int failed;     /* out of memory: the partials are lost */
+  int *start;     /* node k's edges are [start[k], start[k + 1]) */
+  int *par;       /* an edge's parent node */
+  double *d;      /* an edge's partial */
+  double *adj;    /* the sweep's adjoints, one a node */
+} jtape;
+
+static _Thread_local jtape *T;
+
+static int tape_grow(jtape *t, int nodes, int edges)
 {
-  jet r;
-  r.v = v;
-  memset(r.d, 0, sizeof r.d);
+  if (nodes > t->cap) {
+    int cap = t->cap ? 2 * t->cap : 4096;
+    while (cap < nodes) cap *= 2;
+    int *st = realloc(t->start, ((size_t)cap + 1) * sizeof *st);
+    if (st) t->start = st;
+    double *adj = st ? realloc(t->adj, (size_t)cap * sizeof *adj) : NULL;
+    if (adj) t->adj = adj;
+    if (!st || !adj) return -1;
+    t->cap = cap;
+  }
+  if (edges > t->mcap) {
+    int cap = t->mcap ? 2 * t->mcap : 8192;
+    while (cap < edges) cap *= 2;
+    int *par = realloc(t->par, (size_t)cap * sizeof *par);
+    if (par) t->par = par;
+    double *d = par ? realloc(t->d, (size_t)cap * sizeof *d) : NULL;
+    if (d) t->d = d;
+    if (!par || !d) return -1;
+    t->mcap = cap;
+  }
+  return 0;
+}
+
+/* The rare path of tape_node and tape_edge: room, or the tape fails. */
+static __attribute__((noinline)) int tape_room(jtape *t, int nodes, int edges)
+{
+  if (!t->failed && tape_grow(t, nodes, edges)) t->failed = 1;
+  return t->failed;
+}
+
+/* A node with no edges yet, or -1 when the tape cannot grow.  Its edges
+** end where the next node's start (tape_sweep closes the last one). */
+static inline __attribute__((always_inline)) int tape_node(void)
+{
+  jtape *t = T;
+  if (t->n + 1 >= t->cap && tape_room(t, t->n + 2, 0)) return -1;
+  t->open = -1;
+  t->start[t->n] = t->m;
+  return t->n++;
+}
+
+/* An edge of the newest node (a constant parent has none). */
+static inline __attribute__((always_inline)) void tape_edge(jtape *t, int par, double d)
+{
+  if (par < 0) return;
+  if (t->m >= t->mcap && tape_room(t, 0, t->m + 1)) return;
+  t->par[t->m] = par;
+  t->d[t->m++] = d;
+}
+
+static inline __attribute__((always_inline)) jet jmake1(double v, int a, double da)
+{
+  jet r = {v, -1};
+  if (a >= 0 && (r.i = tape_node()) >= 0) tape_edge(T, a, da);
   return r;
 }
 
-static inline jet jadd(jet a, jet b)
+static inline __attribute__((always_inline)) jet jmake2(double v, int a, double da, int b, double db)
 {
-  for (int k = 0; k < ND; k++) a.d[k] += b.d[k];
-  a.v += b.v;
-  return a;
+  jet r = {v, -1};
+  if ((a >= 0 || b >= 0) && (r.i = tape_node()) >= 0) {
+    jtape *t = T;
+    tape_edge(t, a, da);
+    tape_edge(t, b, db);
+  }
+  return r;
 }
 
-static inline jet jsub(jet a, jet b)
-{
-  for (int k = 0; k < ND; k++) a.d[k] -= b.d[k];
-  a.v -= b.v;
-  return a;
-}
+static inline jet jc(double v) { return (jet){v, -1}; }
+static inline jet jadd(jet a, jet b) { return jmake2(a.v + b.v, a.i, 1.0, b.i, 1.0); }
+static inline jet jsub(jet a, jet b) { return jmake2(a.v - b.v, a.i, 1.0, b.i, -1.0); }
 
 static inline jet jaddc(jet a, double c)
 {
@@ -173,52 +251,62 @@ static inline jet jaddc(jet a, double c)
   return a;
 }
 
-static inline jet jscale(jet a, double c)
-{
-  for (int k = 0; k < ND; k++) a.d[k] *= c;
-  a.v *= c;
-  return a;
-}
-
-static inline jet jmul(jet a, jet b)
-{
-  jet r;
-  r.v = a.v * b.v;
-  for (int k = 0; k < ND; k++) r.d[k] = a.d[k] * b.v + a.v * b.d[k];
-  return r;
-}
+static inline jet jscale(jet a, double c) { return jmake1(a.v * c, a.i, c); }
+static inline jet jmul(jet a, jet b) { return jmake2(a.v * b.v, a.i, b.v, b.i, a.v); }
 
 static inline jet jdiv(jet a, jet b)
 {
-  jet r;
-  r.v = a.v / b.v;
-  for (int k = 0; k < ND; k++) r.d[k] = (a.d[k] - r.v * b.d[k]) / b.v;
-  return r;
+  double q = a.v / b.v;
+  return jmake2(q, a.i, 1.0 / b.v, b.i, -q / b.v);
 }
 
 /* a / c for a constant c, rounded as the value is */
-static inline jet jdivc(jet a, double c)
-{
-  for (int k = 0; k < ND; k++) a.d[k] /= c;
-  a.v /= c;
-  return a;
-}
+static inline jet jdivc(jet a, double c) { return jmake1(a.v / c, a.i, 1.0 / c); }
 
 static inline jet jsqrt(jet a)
 {
-  jet r;
-  r.v = sqrt(a.v);
-  double f = r.v > 0.0 ? 0.5 / r.v : 0.0;
-  for (int k = 0; k < ND; k++) r.d[k] = f * a.d[k];
-  return r;
+  double r = sqrt(a.v);
+  return jmake1(r, a.i, r > 0.0 ? 0.5 / r : 0.0);
 }
 
 static inline jet jabs(jet a) { return a.v < 0.0 ? jscale(a, -1.0) : a; }
 
-/* acc.d += f * x.d (partials only) */
-static inline void jacc(jet *acc, double f, const jet *x)
+/* acc's partials += f times x's (partials only).  Repeated on the same acc
+** with nothing else made between, the edges gather on one node. */
+static inline __attribute__((always_inline)) void jacc(jet *acc, double f, const jet *x)
 {
-  for (int k = 0; k < ND; k++) acc->d[k] += f * x->d[k];
+  if (x->i < 0) return;
+  if (acc->i < 0 || acc->i != T->open) {
+    int k = tape_node();
+    if (k < 0) return;
+    tape_edge(T, acc->i, 1.0);
+    acc->i = k;
+    T->open = k;
+  }
+  tape_edge(T, x->i, f);
+}
+
+/* The partials of the result r by the tape's first 16 nodes: one sweep
+** back.  NAN when the tape ran out of memory. */
+static double tape_sweep(jet r, double g[NCTRL])
+{
+  jtape *t = T;
+  for (int k = 0; k < NCTRL; k++) g[k] = 0.0;
+  if (t->failed) return NAN;
+  if (r.i < 0) return r.v;
+  t->start[t->n] = t->m;
+  double *adj = t->adj;
+  memset(adj, 0, ((size_t)r.i + 1) * sizeof *adj);
+  adj[r.i] = 1.0;
+  const int *start = t->start, *par = t->par;
+  const double *d = t->d;
+  for (int k = r.i; k >= NCTRL; k--) {
+    const double a = adj[k];
+    if (a == 0.0) continue; /* unused: its partials, infinite ones too, add nothing */
+    for (int e = start[k]; e < start[k + 1]; e++) adj[par[e]] += d[e] * a;
+  }
+  for (int k = 0; k < NCTRL; k++) g[k] = adj[k];
+  return r.v;
 }
 
 static inline jet jhypot(jet x, jet y) { return jsqrt(jadd(jmul(x, x), jmul(y, y))); }
@@ -229,9 +317,7 @@ static jet jsmooth(jet x)
   if (x.v <= 0.0) return jc(0.0);
   if (x.v >= 1.0) return jc(1.0);
   double t = x.v, r = t * t * t * (10.0 + t * (6.0 * t - 15.0)), dr = 30.0 * t * t * (1.0 - t) * (1.0 - t);
-  jet o = jscale(x, dr);
-  o.v = r;
-  return o;
+  return jmake1(r, x.i, dr);
 }
 
 /* ---- the near field's double integral, in jets ------------------------- */
@@ -256,24 +342,26 @@ static void jcubic_from_bezier(const jet b[8], double ox, double oy, jcubic *c)
   c->y[3] = jadd(jsub(y3, y0), jscale(jsub(y1, y2), 3.0));
 }
 
-/* r, r', r'' at a fixed parameter t (dd may be NULL): Horner on the value
-** and on each partial, in pairnear.c's order of operations. */
+/* A value v linear in a cubic's coefficients q[from..3], by c[from..3]. */
+static jet jlin(double v, const jet q[4], int from, const double c[4])
+{
+  jet r = jc(v);
+  for (int k = from; k < 4; k++) jacc(&r, c[k], &q[k]);
+  return r;
+}
+
+/* r, r' and r'' at a fixed parameter t (dd may be NULL): values by Horner
+** in pairnear.c's order of operations, each linear in the coefficients. */
 static void jcubic_eval(const jcubic *c, double t, jet r[2], jet d[2], jet dd[2])
 {
   const jet *p[2] = {c->x, c->y};
-  const double t3 = 3.0 * t, t6 = 6.0 * t;
+  const double t3 = 3.0 * t, t6 = 6.0 * t, tt = t * t;
+  const double cr[4] = {1.0, t, tt, tt * t}, cd[4] = {0.0, 1.0, 2.0 * t, 3.0 * tt}, cdd[4] = {0.0, 0.0, 2.0, t6};
   for (int i = 0; i < 2; i++) {
     const jet *q = p[i];
-    r[i].v = q[0].v + t * (q[1].v + t * (q[2].v + t * q[3].v));
-    d[i].v = q[1].v + t * (2.0 * q[2].v + t3 * q[3].v);
-    for (int k = 0; k < ND; k++) {
-      r[i].d[k] = q[0].d[k] + t * (q[1].d[k] + t * (q[2].d[k] + t * q[3].d[k]));
-      d[i].d[k] = q[1].d[k] + t * (2.0 * q[2].d[k] + t3 * q[3].d[k]);
-    }
-    if (dd) {
-      dd[i].v = 2.0 * q[2].v + t6 * q[3].v;
-      for (int k = 0; k < ND; k++) dd[i].d[k] = 2.0 * q[2].d[k] + t6 * q[3].d[k];
-    }
+    r[i] = jlin(q[0].v + t * (q[1].v + t * (q[2].v + t * q[3].v)), q, 0, cr);
+    d[i] = jlin(q[1].v + t * (2.0 * q[2].v + t3 * q[3].v), q, 1, cd);
+    if (dd) dd[i] = jlin(2.0 * q[2].v + t6 * q[3].v, q, 2, cdd);
   }
 }
 
@@ -340,14 +428,25 @@ typedef struct {
 static void jrule_nodes(const jcubic *c, double t0, double t1, const double *s, const double *w, int m,
                         jnodes *n)
 {
-  double h = t1 - t0;
-  jet r[2], d[2];
+  const double h = t1 - t0;
+  const jet *qx = c->x, *qy = c->y;
   n->m = m;
   for (int k = 0; k < m; k++) {
-    jcubic_eval(c, t0 + h * s[k], r, d, NULL);
-    n->x[k] = r[0];
-    n->y[k] = r[1];
-    n->w[k] = jscale(jhypot(d[0], d[1]), h * w[k]);
+    const double t = t0 + h * s[k], t3 = 3.0 * t, tt = t * t;
+    const double cr[4] = {1.0, t, tt, tt * t}, cd[4] = {0.0, 1.0, 2.0 * t, 3.0 * tt};
+    n->x[k] = jlin(qx[0].v + t * (qx[1].v + t * (qx[2].v + t * qx[3].v)), qx, 0, cr);
+    n->y[k] = jlin(qy[0].v + t * (qy[1].v + t * (qy[2].v + t * qy[3].v)), qy, 0, cr);
+    /* the length weight h w_k |r'(t)|, straight from the coefficients: its
+    ** partial by r'_x is h w_k r'_x / |r'| */
+    const double dx = qx[1].v + t * (2.0 * qx[2].v + t3 * qx[3].v), dy = qy[1].v + t * (2.0 * qy[2].v + t3 * qy[3].v);
+    const double len = sqrt(dx * dx + dy * dy), hw = h * w[k], fx = len > 0.0 ? hw * dx / len : 0.0,
+                 fy = len > 0.0 ? hw * dy / len : 0.0;
+    jet wk = jc(len * hw);
+    for (int j = 1; j < 4; j++) {
+      jacc(&wk, fx * cd[j], &qx[j]);
+      jacc(&wk, fy * cd[j], &qy[j]);
+    }
+    n->w[k] = wk;
   }
 }
 
@@ -355,29 +454,48 @@ typedef enum { KERNEL_INV, KERNEL_CUT } kernel_kind;
 
 /* The product rule over two node sets for the kernels of pairnear.c (1/r;
 ** (1/r - 1/rc)+), its partials gathered per node first (reverse mode
-** inside, which costs O(m^2 + m ND)). */
+** inside, which costs O(m^2) and 6 m edges).  B's nodes go two at a time
+** (m is even: the rules have 6 nodes or a multiple of 4). */
 static jet jproduct(const jnodes *A, const jnodes *B, kernel_kind kind, double rc)
 {
-  const double inv = rc > 0.0 ? 1.0 / rc : 0.0, rc2 = rc > 0.0 ? rc * rc : INFINITY;
-  double aw[JNODES_MAX] = {0}, ax[JNODES_MAX] = {0}, ay[JNODES_MAX] = {0}, bw[JNODES_MAX] = {0}, bx[JNODES_MAX] = {0},
-         by[JNODES_MAX] = {0}, sum = 0.0;
+  typedef lw_v2d v2d;
+  const int h = B->m / 2;
+  const v2d inv = {rc > 0.0 ? 1.0 / rc : 0.0, rc > 0.0 ? 1.0 / rc : 0.0};
+  const v2d rc2 = {rc > 0.0 ? rc * rc : INFINITY, rc > 0.0 ? rc * rc : INFINITY};
+  v2d bx[JNODES_MAX / 2], by[JNODES_MAX / 2], bw[JNODES_MAX / 2];
+  v2d gbw[JNODES_MAX / 2], gbx[JNODES_MAX / 2], gby[JNODES_MAX / 2];
+  double aw[JNODES_MAX], ax[JNODES_MAX], ay[JNODES_MAX], sum = 0.0;
+  for (int j = 0; j < h; j++) {
+    bx[j] = (v2d){B->x[2 * j].v, B->x[2 * j + 1].v};
+    by[j] = (v2d){B->y[2 * j].v, B->y[2 * j + 1].v};
+    bw[j] = (v2d){B->w[2 * j].v, B->w[2 * j + 1].v};
+    gbw[j] = gbx[j] = gby[j] = (v2d){0.0, 0.0};
+  }
   for (int i = 0; i < A->m; i++) {
-    double acc = 0.0, wi = A->w[i].v;
-    for (int j = 0; j < B->m; j++) {
-      double dx = A->x[i].v - B->x[j].v, dy = A->y[i].v - B->y[j].v, r2 = dx * dx + dy * dy, r = sqrt(r2);
-      double k, kr; /* k(r) and k'(r) / r */
-      if (kind == KERNEL_INV) k = 1.0 / r, kr = -1.0 / (r2 * r);
-      else k = r2 < rc2 ? 1.0 / r - inv : 0.0, kr = r2 < rc2 ? -1.0 / (r2 * r) : 0.0;
-      double wj = B->w[j].v, f = wi * wj * kr;
-      acc += wj * k;
-      bw[j] += wi * k;
-      ax[i] += f * dx;
-      ay[i] += f * dy;
-      bx[j] -= f * dx;
-      by[j] -= f * dy;
+    const double wi = A->w[i].v;
+    const v2d x = {A->x[i].v, A->x[i].v}, y = {A->y[i].v, A->y[i].v}, vwi = {wi, wi};
+    v2d acc = {0.0, 0.0}, gx = {0.0, 0.0}, gy = {0.0, 0.0};
+    for (int j = 0; j < h; j++) {
+      const v2d dx = x - bx[j], dy = y - by[j], r2 = dx * dx + dy * dy, q = 1.0 / lw_vsqrt2(r2);
+      v2d k = q, kr = -q / r2; /* k(r) and k'(r) / r */
+      if (kind == KERNEL_CUT) {
+        const lw_v2l in = r2 < rc2;
+        if (!(in[0] | in[1])) continue;
+        k = (v2d)((lw_v2l)(q - inv) & in);
+        kr = (v2d)((lw_v2l)kr & in);
+      }
+      const v2d f = vwi * bw[j] * kr;
+      acc += bw[j] * k;
+      gbw[j] += vwi * k;
+      gx += f * dx;
+      gy += f * dy;
+      gbx[j] -= f * dx;
+      gby[j] -= f * dy;
     }
-    aw[i] = acc;
-    sum += wi * acc;
+    aw[i] = acc[0] + acc[1];
+    ax[i] = gx[0] + gx[1];
+    ay[i] = gy[0] + gy[1];
+    sum += wi * aw[i];
   }
   jet r = jc(sum);
   for (int i = 0; i < A->m; i++) {
@@ -386,9 +504,9 @@ static jet jproduct(const jnodes *A, const jnodes *B, kernel_kind kind, double r
     jacc(&r, ay[i], &A->y[i]);
   }
   for (int j = 0; j < B->m; j++) {
-    jacc(&r, bw[j], &B->w[j]);
-    jacc(&r, bx[j], &B->x[j]);
-    jacc(&r, by[j], &B->y[j]);
+    jacc(&r, gbw[j / 2][j % 2], &B->w[j]);
+    jacc(&r, gbx[j / 2][j % 2], &B->x[j]);
+    jacc(&r, gby[j / 2][j % 2], &B->y[j]);
   }
   return r;
 }
@@ -413,6 +531,7 @@ typedef struct {
   jet *share;
   int *depth;
   jnodes na, nb; /* the whole-square rules' nodes (64 jets each way) */
+  jtape tape;
 } pairgrad_work;
 
 static pairgrad_work *work_new(void)
@@ -442,6 +561,10 @@ static void work_free(pairgrad_work *w)
   free(w->sb);
   free(w->share);
   free(w->depth);
+  free(w->tape.start);
+  free(w->tape.par);
+  free(w->tape.d);
+  free(w->tape.adj);
   free(w);
 }
 
@@ -511,7 +634,16 @@ static jet point_segment(const jet *p, const jet *a, const jet *b)
   return jhypot(jsub(px, jmul(t, ux)), jsub(py, jmul(t, uy)));
 }
 
-static jet jmin(jet a, jet b) { return b.v < a.v ? b : a; }
+/* point_segment's value alone, by the same operations. */
+static double point_segment_value(const jet *p, const jet *a, const jet *b)
+{
+  double ux = b[0].v - a[0].v, uy = b[1].v - a[1].v, px = p[0].v - a[0].v, py = p[1].v - a[1].v;
+  double uu = ux * ux + uy * uy, t = uu > 0.0 ? (px * ux + py * uy) / uu : 0.0;
+  if (t < 0.0) t = 0.0;
+  else if (t > 1.0) t = 1.0;
+  double x = px - t * ux, y = py - t * uy;
+  return sqrt(x * x + y * y);
+}
 
 static jet chord_distance(const jpiece *pa, const jpiece *pb)
 {
@@ -522,8 +654,14 @@ static jet chord_distance(const jpiece *pa, const jpiece *pb)
   double t0 = vx * (pa->r0[1].v - pb->r0[1].v) - vy * (pa->r0[0].v - pb->r0[0].v);
   double t1 = vx * (pa->r1[1].v - pb->r0[1].v) - vy * (pa->r1[0].v - pb->r0[0].v);
   if (((s0 < 0.0) != (s1 < 0.0)) && ((t0 < 0.0) != (t1 < 0.0))) return jc(0.0);
-  jet d = jmin(point_segment(pa->r0, pb->r0, pb->r1), point_segment(pa->r1, pb->r0, pb->r1));
-  return jmin(d, jmin(point_segment(pb->r0, pa->r0, pa->r1), point_segment(pb->r1, pa->r0, pa->r1)));
+  /* the nearest of the four end points, chosen on the values as jmin
+  ** chooses; only it goes on the tape */
+  const jet *p[4] = {pa->r0, pa->r1, pb->r0, pb->r1}, *s[4][2] = {{pb->r0, pb->r1}, {pb->r0, pb->r1},
+                                                                 {pa->r0, pa->r1}, {pa->r0, pa->r1}};
+  double d[4];
+  for (int k = 0; k < 4; k++) d[k] = point_segment_value(p[k], s[k][0], s[k][1]);
+  int a = d[1] < d[0] ? 1 : 0, b = d[3] < d[2] ? 3 : 2, k = d[b] < d[a] ? b : a;
+  return point_segment(p[k], s[k][0], s[k][1]);
 }
 
 /* pairnear.c's subdivided, in jets: the shares carry their partials too,
@@ -684,13 +822,14 @@ static void closest(const jcubic *ca, const jcubic *cb, jet *ps, jet *pt)
 static double segments_exact_grad(const double a[8], const double b[8], double cutoff, pairgrad_work *wk,
                                   double ga[8], double gb[8])
 {
+  jtape *outer = T;
+  T = &wk->tape;
+  T->n = T->m = 0;
+  T->open = -1;
+  T->failed = 0;
   jet ja[8], jb[8];
-  for (int k = 0; k < 8; k++) {
-    ja[k] = jc(a[k]);
-    ja[k].d[k] = 1.0;
-    jb[k] = jc(b[k]);
-    jb[k].d[8 + k] = 1.0;
-  }
+  for (int k = 0; k < 8; k++) ja[k] = (jet){a[k], tape_node()}; /* nodes 0..7 */
+  for (int k = 0; k < 8; k++) jb[k] = (jet){b[k], tape_node()}; /* nodes 8..15 */
   /* the local origin is a constant: the integral does not depend on it */
   double ox = 0.25 * (a[0] + a[6] + b[0] + b[6]), oy = 0.25 * (a[1] + a[7] + b[1] + b[7]);
   jcubic ca, cb;
@@ -721,11 +860,13 @@ static double segments_exact_grad(const double a[8], const double b[8], double c
     const cut k = {cutoff > 0.0, cutoff, cutoff > 0.0 ? 1.0 / cutoff : 0.0};
     v = jadd(v, subdivided(&ca, &pa, &cb, &pb, rest, &k, wk));
   }
+  double g[NCTRL], e = tape_sweep(v, g);
   for (int k = 0; k < 8; k++) {
-    ga[k] = v.d[k];
-    gb[k] = v.d[8 + k];
+    ga[k] = g[k];
+    gb[k] = g[8 + k];
   }
-  return v.v;
+  T = outer;
+  return e;
 }
 
 double lw_pair_segments_exact_grad(const double a[8], const double b[8], double cutoff, double ga[8],
