@@ -213,8 +213,10 @@ const lw_param_def lw_param_table[] = {
       "Least distance between pair samples of different splines, a hard constraint: a move that "
       "brings more of its samples closer than this to another spline than it had is refused "
       "(+infinity), so a drawing that keeps it never loses it; the placement starts splines apart "
-      "by it where it can. Needs the pair term (it looks in its cell grid) and at most pair_cutoff. "
-      "Typically the pen width. 0 = off."),
+      "by it where it can. The quench and the massless flow keep it between the curves (they hold "
+      "a segment that a step could bring closer than this to another curve than it was; "
+      "docs/NUMERICS.md, \"Dynamics\"). Needs the pair term (it looks in its cell grid) and at most "
+      "pair_cutoff. Typically the pen width. 0 = off."),
   NUM("energy", "chem_spline", LW_PT_DOUBLE, chem_spline, "0", "energy", -1e12, 1e12, 0,
       "Chemical potential per spline: the energy a spline costs just by being there (term "
       "'chemical', with chem_length). With moves.fixed_count = 0 it sets how many lines the "

@@ -45,6 +45,9 @@ typedef struct {
   lw_node *grad;                 /* the gradient's scratch, allocated by the first
                                     gradient() call: none on a Monte Carlo run */
   size_t grad_cap;               /* its nodes: births and grows add nodes between calls */
+  double *margin;                /* blocked's reach and gap, one each a segment (none
+                                    without a gradient driver and energy.min_spacing) */
+  size_t margin_n;               /* their segments */
 } spl_state;
 
 static void setup_free(void *setup)
@@ -112,6 +115,7 @@ static void state_free(void *state)
   if (!s) return;
   if (s->owns_model) lw_model_free(s->m);
   free(s->grad);
+  free(s->margin);
   free(s);
 }
 
@@ -956,21 +960,48 @@ static int same_nodes(const lw_node *o, const double *c)
 ** (lw_segment_allowed) or, with the boundary term on, with a sample or an
 ** end outside (lw_term_boundary infinite); and those that would close in on
 ** another stroke against energy.min_spacing (lw_model_segment_crowds,
-** against the others where they stand with a margin of the farthest any
-** control point moves, which bounds how far a sample of theirs may come):
+** against the others where they stand, each with a margin of the farthest
+** its own control points move, which bounds how far its samples may come):
 ** their two nodes' coordinates. */
 static size_t blocked(void *state, const double *x, unsigned char *held)
 {
-  const spl_state *s = state;
+  spl_state *s = state;
   const lw_scene *sc = s->m->scene;
   const lw_splines *sp = s->m->sp;
   size_t parts = 0;
-  double reach = 0.0;
-  for (size_t k = 0; sc->min_spacing > 0.0 && k < sp->n_nodes; k++) {
-    const double *c = x + 4 * k;
-    const lw_node *o = &sp->node[k];
-    const double r = hypot(c[0] - o->px, c[1] - o->py) + hypot(c[2] - o->vx, c[3] - o->vy);
-    if (r > reach || isnan(r)) reach = isnan(r) ? INFINITY : r;
+  lw_step_margins mg = {0};
+  if (sc->min_spacing > 0.0) {
+    if (s->margin_n < sp->n_segments) {
+      double *r = realloc(s->margin, 2 * sp->n_segments * sizeof *r);
+      if (!r) { /* no room for the margins: every moving segment is held */
+        for (size_t g = 0; g < sp->n_segments; g++) {
+          const size_t k = lw_segment_node(sp, g);
+          if (same_nodes(sp->node + k, x + 4 * k)) continue;
+          memset(held + 4 * k, 1, 8);
+          parts++;
+        }
+        return parts;
+      }
+      s->margin = r;
+      s->margin_n = sp->n_segments;
+    }
+    double *reach = s->margin, *gap = s->margin + sp->n_segments;
+    lw_model_sample_gaps(s->m, gap);
+    for (size_t g = 0; g < sp->n_segments; g++) {
+      const size_t k = lw_segment_node(sp, g);
+      double r = 0.0;
+      for (int e = 0; e < 2; e++) {
+        const double *c = x + 4 * (k + (size_t)e);
+        const lw_node *o = &sp->node[k + (size_t)e];
+        const double d = hypot(c[0] - o->px, c[1] - o->py) + hypot(c[2] - o->vx, c[3] - o->vy);
+        if (d > r || isnan(d)) r = isnan(d) ? INFINITY : d;
+      }
+      reach[g] = r;
+      mg.reach_max = fmax(mg.reach_max, r);
+      mg.gap_max = fmax(mg.gap_max, gap[g]);
+    }
+    mg.reach = reach;
+    mg.gap = gap;
   }
   lw_samples smp;
   for (size_t g = 0; g < sp->n_segments; g++) {
@@ -983,7 +1014,7 @@ static size_t blocked(void *state, const double *x, unsigned char *held)
       lw_segment_sample(&sc->quad, &a, &b, &smp);
       bad = !lw_segment_allowed(sc, &a, &b, smp.length) ||
             (sc->on[LW_TERM_BOUNDARY] && !isfinite(lw_term_boundary(&smp, &sc->quad, &sc->boundary))) ||
-            (!same_nodes(sp->node + k, c) && lw_model_segment_crowds(s->m, g, &a, &b, reach));
+            (!same_nodes(sp->node + k, c) && lw_model_segment_crowds(s->m, g, &a, &b, &mg));
     }
     if (!bad) continue;
     memset(held + 4 * k, 1, 8);

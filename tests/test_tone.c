@@ -409,37 +409,78 @@ Test(tone, bad_keys_are_named)
   cr_assert(strstr(err.msg, "energy.tone_blur"), "%s", err.msg);
 }
 
-/* Pairs of pair samples of different splines closer than d, from scratch. */
+/* Points of the strokes, each with its spline. */
+typedef struct {
+  double *x, *y;
+  uint32_t *owner;
+  size_t n;
+} stroke_points;
+
+static stroke_points stroke_points_new(size_t n)
+{
+  stroke_points p = {malloc(n * sizeof *p.x), malloc(n * sizeof *p.y), malloc(n * sizeof *p.owner), n};
+  cr_assert(p.x && p.y && p.owner);
+  return p;
+}
+
+/* The pairs of points of different splines closer than d (brute force);
+** frees the points. */
+static size_t stroke_points_closer(stroke_points *p, double d)
+{
+  size_t count = 0;
+  for (size_t i = 0; i < p->n; i++)
+    for (size_t j = i + 1; j < p->n; j++) {
+      double dx = p->x[i] - p->x[j], dy = p->y[i] - p->y[j];
+      count += p->owner[i] != p->owner[j] && dx * dx + dy * dy < d * d;
+    }
+  free(p->x);
+  free(p->y);
+  free(p->owner);
+  return count;
+}
+
 static size_t close_pairs(const lw_scene *sc, const lw_splines *sp, double d)
 {
-  size_t n = sp->n_segments * (size_t)sc->pair_quad.n, count = 0, k = 0;
-  double *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y);
-  uint32_t *owner = malloc(n * sizeof *owner);
+  stroke_points p = stroke_points_new(sp->n_segments * (size_t)sc->pair_quad.n);
   lw_samples s;
-  for (size_t g = 0; g < sp->n_segments; g++) {
+  for (size_t g = 0, k = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
     lw_segment_sample(&sc->pair_quad, a, a + 1, &s);
     for (int q = 0; q < s.n; q++, k++) {
-      x[k] = s.x[q];
-      y[k] = s.y[q];
-      owner[k] = sp->seg_spline[g];
+      p.x[k] = s.x[q];
+      p.y[k] = s.y[q];
+      p.owner[k] = sp->seg_spline[g];
     }
   }
-  for (size_t i = 0; i < n; i++)
-    for (size_t j = i + 1; j < n; j++) {
-      double dx = x[i] - x[j], dy = y[i] - y[j];
-      count += owner[i] != owner[j] && dx * dx + dy * dy < d * d;
-    }
-  free(x);
-  free(y);
-  free(owner);
-  return count;
+  return stroke_points_closer(&p, d);
 }
 
 /* Rows of straight strokes 0.45 mm apart (3 strokes of 6 mm a row, 1.5 mm
 ** gaps): crowded, but no pair of samples of different strokes closer than
 ** 0.3 mm (at 8 pair nodes on 2 mm segments the samples along a row are at
 ** most 0.4 mm apart; across rows 0.45 mm). */
+/* The pairs of points of different splines closer than d, the curves drawn
+** at 32 points a segment (0.06 mm apart on these 2 mm segments): the
+** distance of the curves themselves, between the pair samples too. */
+static size_t close_curve_points(const lw_splines *sp, double d)
+{
+  enum { PER = 32 };
+  stroke_points p = stroke_points_new(sp->n_segments * PER);
+  for (size_t g = 0, k = 0; g < sp->n_segments; g++) {
+    double c[8];
+    const lw_node *a = &sp->node[lw_segment_node(sp, g)];
+    lw_segment_bezier(a, a + 1, c);
+    for (int q = 0; q < PER; q++, k++) {
+      double t = (q + 0.5) / PER, u = 1 - t;
+      double w[4] = {u * u * u, 3 * u * u * t, 3 * u * t * t, t * t * t};
+      p.x[k] = w[0] * c[0] + w[1] * c[2] + w[2] * c[4] + w[3] * c[6];
+      p.y[k] = w[0] * c[1] + w[1] * c[3] + w[2] * c[5] + w[3] * c[7];
+      p.owner[k] = sp->seg_spline[g];
+    }
+  }
+  return stroke_points_closer(&p, d);
+}
+
 static lw_splines *rows(int n_rows)
 {
   size_t n = 3 * (size_t)n_rows, segs[256];
@@ -510,13 +551,15 @@ Test(tone, the_spacing_constraint_holds_once_kept)
 ** pair comes closer at the end while the energy still falls. */
 Test(tone, the_quench_keeps_the_spacing)
 {
-  size_t close[2];
+  size_t close[2], curves[2];
   double removed[2];
   for (int on = 0; on < 2; on++) {
     lw_scene sc;
     spacing_scene(&sc, on);
     lw_error err = {0};
-    lw_model *m = lw_model_new(&sc, rows(16), &err);
+    lw_splines *start = rows(16);
+    cr_assert_eq(close_curve_points(start, 0.3 - 0.04), 0, "the start keeps the spacing between samples too");
+    lw_model *m = lw_model_new(&sc, start, &err);
     cr_assert_not_null(m, "%s", err.msg);
     lw_system *sys = lw_splines_view(m, &err);
     cr_assert_not_null(sys, "%s", err.msg);
@@ -524,15 +567,19 @@ Test(tone, the_quench_keeps_the_spacing)
     lw_quench_report r;
     cr_assert_eq(lw_quench_run(sys, &o, &r, &err), LW_OK, "%s", err.msg);
     close[on] = close_pairs(&sc, m->sp, 0.3);
+    curves[on] = close_curve_points(m->sp, 0.3 - 0.04);
     removed[on] = r.energy_before - r.energy_after;
-    cr_log_info("quench, spacing %s: %g removed in %ld iterations, %ld held, %zu close pairs", on ? "on" : "off",
-                removed[on], r.iterations, r.holds, close[on]);
+    cr_log_info("quench, spacing %s: %g removed in %ld iterations, %ld held, %zu close pairs, %zu close curve points",
+                on ? "on" : "off", removed[on], r.iterations, r.holds, close[on], curves[on]);
     lw_system_free(sys);
     lw_model_free(m);
     lw_scene_clear(&sc);
   }
   cr_assert(close[0] > 0, "the quench brings strokes together when nothing stops it: the test tests nothing");
   cr_assert_eq(close[1], 0, "%zu pairs closer than min_spacing after the quench", close[1]);
+  /* and the curves between the samples: 0.04 mm below min_spacing is
+  ** closer for certain (the points are at most 0.03 mm from the nearest) */
+  cr_assert_eq(curves[1], 0, "%zu points of the curves closer than min_spacing after the quench", curves[1]);
   cr_assert(removed[1] > 0.2 * removed[0], "held too much: %g removed, against %g without the rule", removed[1],
             removed[0]);
 }

@@ -303,13 +303,29 @@ lw_status lw_model_commit(lw_model *m, lw_proposal *p);
 lw_status lw_model_commit_part(lw_model *m, lw_proposal *p);
 lw_status lw_model_merge(lw_model *m, lw_proposal *p);
 
-/* 1 if global segment g moved to nodes a and b would have more pair samples
-** closer than energy.min_spacing + margin to another stroke's, as the grid
-** holds them now, than it has closer than min_spacing: the spacing rule of a
-** proposal (p->crowded, margin 0), asked of one segment for a step that
-** moves many (the quench, system.h `blocked`), whose margin is how far the
-** others may move.  0 without the rule. */
-int lw_model_segment_crowds(const lw_model *m, size_t g, const lw_node *a, const lw_node *b, double margin);
+/* How far the segments may come in a step that moves many (system.h
+** `blocked`): per segment, the farthest any of its control points moves
+** (reach) and the widest space between its pair samples where it stands
+** (gap, lw_model_sample_gaps), with the largest of each. */
+typedef struct {
+  const double *reach, *gap;
+  double reach_max, gap_max;
+} lw_step_margins;
+
+/* 1 if global segment g moved to nodes a and b in such a step could come
+** closer to another stroke than energy.min_spacing and than it is: the
+** spacing rule of a proposal (p->crowded), asked of one segment for the
+** quench and the massless flow.  Its check points (two a pair sample, evenly
+** along the curve) against the other strokes' pair samples where they
+** stand: within sqrt(min_spacing^2 + (gap / 2)^2) + reach of one (so within
+** min_spacing of its curve, wherever it moves), a point must move away from
+** it by more than its reach.  0 without the rule. */
+int lw_model_segment_crowds(const lw_model *m, size_t g, const lw_node *a, const lw_node *b,
+                            const lw_step_margins *mg);
+
+/* gap[g] for every segment: the widest space between consecutive pair
+** samples of segment g where it stands (0 without the pair term). */
+void lw_model_sample_gaps(const lw_model *m, double *gap);
 
 /* 1 if the segment from a to b, of quadrature length `length`, is regular
 ** for the scene: its speed never falls below scene->min_speed times its

@@ -208,7 +208,8 @@ struct lw_system_type {
   double (*gradient)(void *state, double *g, lw_error *err);
   /* Optional (NULL: none): sets blocked[i] = 1 for the coordinates of every
   ** part of the state that coordinates x would make forbidden (for splines
-  ** the nodes of a segment that would be irregular or leave the boundary),
+  ** the nodes of a segment that would be irregular, leave the boundary or
+  ** come closer than energy.min_spacing to another stroke, model.h),
   ** leaves the other entries as they were and the state unchanged; returns
   ** how many parts.  A gradient driver holds those coordinates and lets
   ** the rest move, where shortening the whole step would let one segment
