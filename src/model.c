@@ -1005,20 +1005,54 @@ static size_t crowding(const lw_cellgrid *grid, const lw_pair_sample *ps, size_t
   return count;
 }
 
-/* 1 if a check point moved from before[k] to now[k] comes within the
-** spacing of another stroke's sample without moving away from it by more
-** than that sample's segment may move (mg->reach): then the two may end
-** closer than they were, and closer than the spacing.  The spacing a sample
-** keeps is sqrt(min_spacing^2 + (gap / 2)^2), gap the widest space between
-** its segment's samples (mg->gap): a point that far from every sample is
-** about min_spacing from the curve between them (the chord's distance). */
-static int closes_in(const lw_cellgrid *grid, const lw_pair_sample *now, const lw_pair_sample *before, size_t n,
-                     const lw_pair_filter *f, double d2, const lw_step_margins *mg, uint32_t np, double spacing)
+#define LW_CURVE_NEWTON 4 /* Newton steps to a curve's nearest point from its sample's */
+
+/* The distance from p to segment h's curve where it stands, by Newton's
+** method on (b(t) - p) . b'(t) from the parameter t of its sample nearest
+** p, in [0, 1]. */
+static double curve_distance(const lw_splines *sp, size_t h, double t, double px, double py)
 {
+  double c[8];
+  const lw_node *a = &sp->node[lw_segment_node(sp, h)];
+  lw_segment_bezier(a, a + 1, c);
+  /* power form, as pairnear.c: b(t) = q0 + q1 t + q2 t^2 + q3 t^3 */
+  double qx[4] = {c[0] - px, 3.0 * (c[2] - c[0]), 3.0 * (c[0] - 2.0 * c[2] + c[4]), c[6] - c[0] + 3.0 * (c[2] - c[4])};
+  double qy[4] = {c[1] - py, 3.0 * (c[3] - c[1]), 3.0 * (c[1] - 2.0 * c[3] + c[5]), c[7] - c[1] + 3.0 * (c[3] - c[5])};
+  double x = 0.0, y = 0.0;
+  for (int it = 0; it < LW_CURVE_NEWTON; it++) {
+    x = qx[0] + t * (qx[1] + t * (qx[2] + t * qx[3]));
+    y = qy[0] + t * (qy[1] + t * (qy[2] + t * qy[3]));
+    const double dx = qx[1] + t * (2.0 * qx[2] + 3.0 * t * qx[3]), dy = qy[1] + t * (2.0 * qy[2] + 3.0 * t * qy[3]);
+    const double ddx = 2.0 * qx[2] + 6.0 * t * qx[3], ddy = 2.0 * qy[2] + 6.0 * t * qy[3];
+    const double f = x * dx + y * dy, fp = dx * dx + dy * dy + x * ddx + y * ddy;
+    if (!(fp > 0.0)) break;
+    t = fmin(1.0, fmax(0.0, t - f / fp));
+  }
+  x = qx[0] + t * (qx[1] + t * (qx[2] + t * qx[3]));
+  y = qy[0] + t * (qy[1] + t * (qy[2] + t * qy[3]));
+  return sqrt(x * x + y * y);
+}
+
+/* 1 if a check point moved from before[k] to now[k] comes within
+** min_spacing + r of another stroke's curve without moving away from it by
+** more than r, r how far that curve may move (mg->reach of its segment):
+** then the two may end closer than they were, and closer than the spacing.
+** The curves near a point are found by their samples: within min_spacing of
+** a curve is within min_spacing + gap / 2 of one of its samples, gap the
+** widest space between them (mg->gap). */
+static int closes_in(const lw_model *m, const lw_pair_sample *now, const lw_pair_sample *before, size_t n,
+                     const lw_pair_filter *f, double d2, const lw_step_margins *mg, uint32_t np)
+{
+  enum { NEAR = 32 }; /* the curves near one point; past that, each sample is asked */
   lw_cellgrid view;
-  const lw_cellgrid *g = lw_cellgrid_plane(grid, f->plane, &view);
-  const double side = 1.0 / g->inv_h, far2 = d2 * (1.0 + 1e-8), cut = sqrt(d2), s2 = spacing * spacing;
+  const lw_cellgrid *g = lw_cellgrid_plane(m->grid, f->plane, &view);
+  const lw_quad *quad = m->terms.ctx[m->terms.pair].quad;
+  const double side = 1.0 / g->inv_h, far2 = d2 * (1.0 + 1e-8), spacing = m->scene->min_spacing;
   for (size_t k = 0; k < n; k++) {
+    /* each nearby curve once, from its sample nearest the point */
+    uint32_t seg[NEAR];
+    double t0[NEAR], ds0[NEAR];
+    int n_near = 0;
     int cx, cy;
     lw_cellgrid_locate(g, now[k].x, now[k].y, &cx, &cy);
     const double u = now[k].x - (g->x0 + cx * side), v = now[k].y - (g->y0 + cy * side);
@@ -1032,21 +1066,37 @@ static int closes_in(const lw_cellgrid *grid, const lw_pair_sample *now, const l
         for (uint32_t e = 0; e < c->n; e++) {
           if ((idx[e] >= f->lo && idx[e] < f->hi) || (idx[e] >= f->lo2 && idx[e] < f->hi2)) continue;
           const uint32_t h = idx[e] / np;
-          const double r = mg->reach[h], d = hypot(xs[e] - now[k].x, ys[e] - now[k].y);
-          if (d >= fmin(sqrt(s2 + 0.25 * mg->gap[h] * mg->gap[h]) + r, cut)) continue;
-          if (d < hypot(xs[e] - before[k].x, ys[e] - before[k].y) + r) return 1;
+          const double dx = xs[e] - now[k].x, dy = ys[e] - now[k].y, ds = dx * dx + dy * dy;
+          const double within = spacing + 0.5 * mg->gap[h] + mg->reach[h], t = quad->s[idx[e] % np];
+          if (ds >= within * within) continue; /* ds: squared */
+          int j = 0;
+          while (j < n_near && seg[j] != h) j++;
+          if (j < n_near) {
+            if (ds < ds0[j]) ds0[j] = ds, t0[j] = t;
+          } else if (n_near < NEAR) {
+            seg[n_near] = h, t0[n_near] = t, ds0[n_near] = ds;
+            n_near++;
+          } else {
+            const double r = mg->reach[h], dc = curve_distance(m->sp, h, t, now[k].x, now[k].y);
+            if (dc < spacing + r && dc < curve_distance(m->sp, h, t, before[k].x, before[k].y) + r) return 1;
+          }
         }
       }
+    for (int j = 0; j < n_near; j++) {
+      const double r = mg->reach[seg[j]], dc = curve_distance(m->sp, seg[j], t0[j], now[k].x, now[k].y);
+      if (dc < spacing + r && dc < curve_distance(m->sp, seg[j], t0[j], before[k].x, before[k].y) + r) return 1;
+    }
   }
   return 0;
 }
 
 /* The check points of the spacing rule for a step (lw_model_segment_crowds):
-** LW_CROWD_POINTS per pair sample, evenly in the segment's parameter, so a
-** stroke cannot settle between two of them closer than the rule allows
-** (between pair samples 0.47 mm apart, parallel lines 0.35 mm apart by the
-** samples could come to 0.26 mm). */
-#define LW_CROWD_POINTS 2
+** LW_CROWD_POINTS per pair sample, evenly in the segment's parameter.  The
+** other curve is measured exactly; the moving one only at these points, so
+** between two of them it could come closer: with two a sample a quench
+** still brought sample pairs within min_spacing (tests/test_tone.c), with
+** four none. */
+#define LW_CROWD_POINTS 4
 
 static size_t check_points(const lw_node *a, const lw_node *b, int np, lw_pair_sample *out)
 {
@@ -1078,9 +1128,9 @@ int lw_model_segment_crowds(const lw_model *m, size_t g, const lw_node *a, const
   const lw_pair_filter own = {.lo = lo, .hi = lo + (uint32_t)(lw_splines_segments(sp, i) * (size_t)np),
                               .plane = plane_of(planes_of(sc), sp, i)};
   /* closes_in looks one cell around a point: the cells are at least the cutoff */
-  const double cut = pair_ctx(&m->terms.ctx[m->terms.pair])->cutoff, s = sc->min_spacing;
-  const double d = fmin(sqrt(s * s + 0.25 * mg->gap_max * mg->gap_max) + mg->reach_max, cut);
-  return closes_in(m->grid, now, before, n, &own, d * d, mg, (uint32_t)np, sc->min_spacing);
+  const double cut = pair_ctx(&m->terms.ctx[m->terms.pair])->cutoff;
+  const double d = fmin(sc->min_spacing + 0.5 * mg->gap_max + mg->reach_max, cut);
+  return closes_in(m, now, before, n, &own, d * d, mg, (uint32_t)np);
 }
 
 void lw_model_sample_gaps(const lw_model *m, double *gap)

@@ -547,8 +547,10 @@ Test(tone, the_spacing_constraint_holds_once_kept)
 
 /* The quench (quench.h) keeps the spacing rule too: on the same crowded rows
 ** and blotches, quenched without the rule it brings strokes closer than
-** 0.3 mm; with it, the segments a step would bring closer are held, and no
-** pair comes closer at the end while the energy still falls. */
+** 0.3 mm; with it, the segments a step would bring closer are held, and
+** neither a pair of samples nor the curves between them (model.h,
+** lw_model_segment_crowds) come closer at the end while the energy still
+** falls. */
 Test(tone, the_quench_keeps_the_spacing)
 {
   size_t close[2], curves[2];

@@ -315,11 +315,12 @@ typedef struct {
 /* 1 if global segment g moved to nodes a and b in such a step could come
 ** closer to another stroke than energy.min_spacing and than it is: the
 ** spacing rule of a proposal (p->crowded), asked of one segment for the
-** quench and the massless flow.  Its check points (two a pair sample, evenly
-** along the curve) against the other strokes' pair samples where they
-** stand: within sqrt(min_spacing^2 + (gap / 2)^2) + reach of one (so within
-** min_spacing of its curve, wherever it moves), a point must move away from
-** it by more than its reach.  0 without the rule. */
+** quench and the massless flow.  Its check points (four a pair sample,
+** evenly along the curve) are measured to the other strokes' curves where
+** they stand (Newton from their nearest sample; the curves within reach
+** found by their samples, within min_spacing + gap / 2 + reach): a point
+** within min_spacing + reach of a curve must move away from it by more than
+** reach.  0 without the rule. */
 int lw_model_segment_crowds(const lw_model *m, size_t g, const lw_node *a, const lw_node *b,
                             const lw_step_margins *mg);
 
