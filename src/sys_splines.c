@@ -960,8 +960,8 @@ static int same_nodes(const lw_node *o, const double *c)
 ** (lw_segment_allowed) or, with the boundary term on, with a sample or an
 ** end outside (lw_term_boundary infinite); and those that would close in on
 ** another stroke against energy.min_spacing (lw_model_segment_crowds,
-** against the others where they stand, each with a margin of the farthest
-** its own control points move, which bounds how far its samples may come):
+** against the others' curves where they stand, each with a margin of the
+** farthest its own control points move, which bounds how far it may come):
 ** their two nodes' coordinates. */
 static size_t blocked(void *state, const double *x, unsigned char *held)
 {
