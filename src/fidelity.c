@@ -43,7 +43,7 @@ lw_status lw_fidelity_render(const lw_splines *sp, const lw_grid2d *tone, double
 ** Fine pixels a side for each raster pixel.  Coarse pixels miscount ink:
 ** cairo keeps coverage in eight bits and rounds it at every path, so a pen
 ** far narrower than a pixel inks it by a few 255ths a path, which round
-** away (an 8 x 6 picture on a page, 37 mm pixels, scored as blank paper);
+** away (an 8 x 6 picture on A5, 21 mm pixels, scored as blank paper);
 ** and lines that share a pixel cannot be told apart from lines that
 ** overlap.  On pixels no wider than LW_FIDELITY_PEN_PIXELS pen widths a
 ** crossing covers much of a pixel and two strokes seldom share one; coarser
