@@ -121,6 +121,9 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
     if (isnan(d2)) {
       s->nan++;
       accept = 0;
+    } else if (d2 == INFINITY) {
+      s->crowded++; /* a constraint the row checks only here (system.h) */
+      accept = 0;
     } else if (d2 > 0.0) {
       const double x = -d2 / c->temperature; /* defer is off at T = 0 */
       accept = x > -745.0 && gsl_rng_uniform(c->rng) < exp(x);

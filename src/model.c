@@ -5,6 +5,7 @@
 #include "linewise/model.h"
 
 #include "linewise/pairnear.h"
+#include "linewise/spacing.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -1005,6 +1006,117 @@ static size_t crowding(const lw_cellgrid *grid, const lw_pair_sample *ps, size_t
   return count;
 }
 
+/*
+** The spacing rule between the curves.  crowding counts pairs of samples,
+** and two curves can meet between them: the photo preset's pair samples lie
+** up to twice min_spacing apart along a line, crossing strokes passed the
+** count, and on a photograph the lines touched over 4 % of their length.
+** So a move that passes the count is then asked how many of the other
+** strokes' segments its curves touch (come within min_spacing of:
+** lw_bezier_near2), against its old curves; a move that touches more is
+** refused.  From a state whose curves keep the spacing none ever comes
+** closer; a crowded start only sheds contacts, as it sheds sample pairs.
+*/
+enum { LW_CONTACTS_MAX = 64 };
+
+typedef struct {
+  uint32_t seg[LW_CONTACTS_MAX];
+  int n, full; /* full: more than LW_CONTACTS_MAX, the rest unrecorded */
+} contact_set;
+
+static void contact_add(contact_set *cs, uint32_t h)
+{
+  for (int k = 0; k < cs->n; k++)
+    if (cs->seg[k] == h) return;
+  if (cs->n < LW_CONTACTS_MAX) cs->seg[cs->n++] = h;
+  else cs->full = 1;
+}
+
+/* 1 if the move touches more segments than it did (a full set: may). */
+static int contacts_grew(const contact_set *now, const contact_set *before)
+{
+  return now->full || now->n > before->n;
+}
+
+typedef struct {
+  const lw_model *m;
+  const lw_cellgrid *grid; /* the plane's */
+  uint32_t np;             /* pair samples a segment */
+} contact_view;
+
+/* The box of the control points of c, widened by d: the curve's, as it
+** lies in their convex hull. */
+static void control_box(const double c[8], double d, double box[4])
+{
+  box[0] = box[2] = c[0], box[1] = box[3] = c[1];
+  for (int k = 2; k < 8; k += 2) {
+    box[0] = c[k] < box[0] ? c[k] : box[0], box[2] = c[k] > box[2] ? c[k] : box[2];
+    box[1] = c[k + 1] < box[1] ? c[k + 1] : box[1], box[3] = c[k + 1] > box[3] ? c[k + 1] : box[3];
+  }
+  box[0] -= d, box[1] -= d, box[2] += d, box[3] += d;
+}
+
+/* Adds h to cs when segment h's curve comes within min_spacing of the
+** curve c, whose control box widened by min_spacing is box. */
+static void contact_test(const contact_view *cv, const double c[8], const double box[4], uint32_t h, contact_set *cs)
+{
+  double b[8];
+  segment_bezier(cv->m->sp, h, b);
+  double bb[4];
+  control_box(b, 0.0, bb);
+  if (bb[0] > box[2] || bb[2] < box[0] || bb[1] > box[3] || bb[3] < box[1]) return;
+  const double d = cv->m->scene->min_spacing;
+  if (lw_bezier_near2(c, b, d) < d * d) contact_add(cs, h);
+}
+
+/* Adds to cs the other strokes' segments (outside f) whose curves come
+** within min_spacing of the curve of the segment with control points c and
+** pair samples ps.  A curve is found by its samples in the cells around
+** c's (the box of their cells, one wider, each cell at least the cutoff):
+** every point of a curve lies within half the widest gap between its
+** samples of one of them, so a curve within min_spacing of c has a sample
+** in those cells while min_spacing and the two half gaps add up to no more
+** than the cutoff (in the photo preset 1 + 0.95 + 0.95 pen widths against
+** 3).  Each segment met is measured once (a small table of those seen;
+** a collision only measures one twice). */
+static void segment_contacts(const contact_view *cv, const double c[8], const lw_pair_sample *ps,
+                             const lw_pair_filter *f, contact_set *cs)
+{
+  enum { SEEN = 128 };
+  const lw_cellgrid *g = cv->grid;
+  const uint32_t np = cv->np;
+  int x0 = g->nx, x1 = -1, y0 = g->ny, y1 = -1;
+  for (uint32_t k = 0; k < np; k++) {
+    int cx, cy;
+    lw_cellgrid_locate(g, ps[k].x, ps[k].y, &cx, &cy);
+    x0 = cx < x0 ? cx : x0, x1 = cx > x1 ? cx : x1, y0 = cy < y0 ? cy : y0, y1 = cy > y1 ? cy : y1;
+  }
+  x0 = x0 > 0 ? x0 - 1 : 0, y0 = y0 > 0 ? y0 - 1 : 0;
+  x1 = x1 + 1 < g->nx ? x1 + 1 : g->nx - 1, y1 = y1 + 1 < g->ny ? y1 + 1 : g->ny - 1;
+  double box[4];
+  control_box(c, cv->m->scene->min_spacing, box);
+  uint32_t seen[SEEN];
+  memset(seen, 0xff, sizeof seen);
+  for (int y = y0; y <= y1; y++)
+    for (int x = x0; x <= x1; x++) {
+      const lw_cell *cell = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
+      const uint32_t *idx = cell->n ? lw_cell_idx(cell) : NULL; /* an empty cell may have no block */
+      for (uint32_t e = 0; e < cell->n; e++) {
+        if ((idx[e] >= f->lo && idx[e] < f->hi) || (idx[e] >= f->lo2 && idx[e] < f->hi2)) continue;
+        const uint32_t h = idx[e] / np;
+        if (seen[h % SEEN] == h) continue;
+        seen[h % SEEN] = h;
+        contact_test(cv, c, box, h, cs);
+      }
+    }
+}
+
+static contact_view contact_view_of(const lw_model *m, const lw_pair_filter *f, lw_cellgrid *view)
+{
+  return (contact_view){m, lw_cellgrid_plane(m->grid, f->plane, view), (uint32_t)pair_nodes(m)};
+}
+
+
 #define LW_CURVE_NEWTON 4 /* Newton steps to a curve's nearest point from its sample's */
 
 /* The distance from p to segment h's curve where it stands, by Newton's
@@ -1254,6 +1366,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
     samples_at(&v, (uint32_t)first, n, p->ps_old);
   }
   p->crowded = 0;
+  p->curves_pending = 0;
   if (sc->min_spacing > 0.0 && !(dE == INFINITY) && !isnan(dE)) {
     const size_t n = p->n_seg * (size_t)np;
     const uint32_t lo = (uint32_t)(g0 * (size_t)np), hi = (uint32_t)((g0 + nseg) * (size_t)np);
@@ -1265,6 +1378,9 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
       p->crowded = 1;
       dE = INFINITY;
     }
+    /* the curves wait for lw_model_propose_finish: only a move the chain
+    ** would take needs them */
+    p->curves_pending = !p->crowded && !isnan(dE);
   }
   p->near_pending = 0;
   if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
@@ -1297,7 +1413,8 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   p->dE = dE;
 }
 
-double lw_model_propose_finish(const lw_model *m, lw_proposal *p)
+/* The near field a proposal left out (delayed acceptance): what it adds to dE. */
+static double finish_near(const lw_model *m, lw_proposal *p)
 {
   if (!p->near_pending) return 0.0;
   const lw_term_set *ts = &m->terms;
@@ -1314,6 +1431,7 @@ double lw_model_propose_finish(const lw_model *m, lw_proposal *p)
   p->dE = dE;
   return dE - before;
 }
+
 
 static lw_status commit_splice(lw_model *m, const lw_proposal *p);
 
@@ -1339,7 +1457,8 @@ static void memo_commit(const lw_model *m, lw_proposal *p, uint64_t serial)
 ** splice is committed whole by lw_model_commit. */
 lw_status lw_model_commit_part(lw_model *m, lw_proposal *p)
 {
-  if (p->near_pending) (void)lw_model_propose_finish(m, p);
+  p->curves_pending = 0; /* a commit takes the move as it is */
+  (void)finish_near(m, p);
   lw_splines *sp = m->sp;
   const int np = pair_nodes(m), nl = m->scene->n_local;
   const size_t g0 = lw_segment_index(sp, p->spline, 0);
@@ -1679,6 +1798,76 @@ static void splice_new_segments(const lw_model *m, lw_proposal *p, int *forbidde
   }
 }
 
+/* 1 if the moved segments' curves touch more segments of other strokes
+** than their old curves did (the rule between the curves, above). */
+static int curves_touch(const lw_model *m, const lw_proposal *p)
+{
+  const lw_splines *sp = m->sp;
+  const uint32_t np = (uint32_t)pair_nodes(m);
+  const lw_node *base = &sp->node[sp->first[p->spline]];
+  const uint32_t lo = (uint32_t)(lw_segment_index(sp, p->spline, 0) * np);
+  const lw_pair_filter own = {.lo = lo, .hi = lo + (uint32_t)(lw_splines_segments(sp, p->spline) * np),
+                              .plane = plane_of(planes_of(m->scene), sp, p->spline)};
+  lw_cellgrid view;
+  const contact_view cv = contact_view_of(m, &own, &view);
+  contact_set now = {.n = 0}, before = {.n = 0};
+  double c[8];
+  for (size_t j = 0; j < p->n_seg; j++) {
+    const size_t k = p->seg0 + j;
+    lw_segment_bezier(proposed_node(base, p, k), proposed_node(base, p, k + 1), c);
+    segment_contacts(&cv, c, p->ps + j * np, &own, &now);
+  }
+  if (!now.n && !now.full) return 0; /* the old side only when the new touches */
+  for (size_t j = 0; j < p->n_seg; j++) {
+    const size_t k = p->seg0 + j;
+    lw_segment_bezier(&base[k], &base[k + 1], c);
+    segment_contacts(&cv, c, p->ps_old + j * np, &own, &before);
+  }
+  return contacts_grew(&now, &before);
+}
+
+/* curves_touch for a splice: its new splines' curves against its old
+** ones'.  The two new splines of a split against each other are left to
+** the count of samples (crowded_pairs). */
+static int splice_curves_touch(const lw_model *m, const lw_proposal *p)
+{
+  const pair_view v = {m->grid, m->sp, (uint32_t)pair_nodes(m), NULL, planes_of(m->scene)};
+  const lw_pair_filter own = old_filter(&v, p);
+  lw_cellgrid view;
+  const contact_view cv = contact_view_of(m, &own, &view);
+  const size_t np = cv.np;
+  contact_set now = {.n = 0}, before = {.n = 0};
+  double c[8];
+  for (size_t j = 0; j < p->n_seg; j++) {
+    const size_t a = splice_seg_node(p, j);
+    lw_segment_bezier(&p->node[a], &p->node[a + 1], c);
+    segment_contacts(&cv, c, p->ps + j * np, &own, &now);
+  }
+  if (!now.n && !now.full) return 0;
+  for (int k = 0, o = 0; k < p->n_old; k++) {
+    const lw_node *nd = splice_old_nodes(m, p, k);
+    for (size_t j = 0; j < p->old_seg[k]; j++, o++) {
+      lw_segment_bezier(&nd[j], &nd[j + 1], c);
+      segment_contacts(&cv, c, p->ps_old + (size_t)o * np, &own, &before);
+    }
+  }
+  return contacts_grew(&now, &before);
+}
+
+double lw_model_propose_finish(const lw_model *m, lw_proposal *p)
+{
+  if (p->curves_pending) {
+    p->curves_pending = 0;
+    if (p->splice ? splice_curves_touch(m, p) : curves_touch(m, p)) {
+      p->crowded = 1;
+      p->near_pending = 0;
+      p->dE = INFINITY;
+      return INFINITY;
+    }
+  }
+  return finish_near(m, p);
+}
+
 void lw_model_propose_regroup(const lw_model *m, lw_proposal *p, const uint32_t *old, int n_old,
                               const lw_node *nodes, const size_t *new_node, int n_new, const double *rest,
                               int layer)
@@ -1747,20 +1936,23 @@ void lw_model_propose_regroup(const lw_model *m, lw_proposal *p, const uint32_t 
       o += run;
     }
   p->crowded = 0;
+  p->curves_pending = 0;
   if (sc->min_spacing > 0.0 && p->n_seg && !(dE == INFINITY) && !isnan(dE)) {
     const lw_pair_filter own = old_filter(&v, p);
     const double d2 = sc->min_spacing * sc->min_spacing;
     const size_t n0 = n_new == 2 ? (new_node[0] - 1) * (size_t)np : 0, o0 = n_old == 2 ? p->old_seg[0] * (size_t)np : 0;
     size_t now = crowding(m->grid, p->ps, p->n_seg * (size_t)np, &own, d2);
     if (n0) now += crowded_pairs(p->ps, n0, p->ps + n0, p->n_seg * (size_t)np - n0, d2);
+    size_t before = 0;
     if (now > 0) {
-      size_t before = crowding(m->grid, p->ps_old, p->n_old_seg * (size_t)np, &own, d2);
+      before = crowding(m->grid, p->ps_old, p->n_old_seg * (size_t)np, &own, d2);
       if (o0) before += crowded_pairs(p->ps_old, o0, p->ps_old + o0, p->n_old_seg * (size_t)np - o0, d2);
-      if (now > before) {
-        p->crowded = 1;
-        dE = INFINITY;
-      }
     }
+    if (now > 0 && now > before) {
+      p->crowded = 1;
+      dE = INFINITY;
+    }
+    p->curves_pending = !p->crowded && !isnan(dE);
   }
   if (m->grid && !(dE == INFINITY) && !isnan(dE)) {
     double pe = splice_pair_delta(m, p);

@@ -512,7 +512,7 @@ Test(tone, the_spacing_constraint_holds_once_kept)
   ** with darker blotches pulls strokes together: without the constraint
   ** pairs come closer than 0.3 mm within a few sweeps, with it none ever
   ** does (checked from scratch after every sweep). */
-  size_t worst[2] = {0, 0};
+  size_t worst[2] = {0, 0}, curves[2] = {0, 0};
   unsigned long accepted = 0, crowded[2] = {0, 0};
   for (int on = 0; on < 2; on++) {
     lw_scene sc;
@@ -526,6 +526,11 @@ Test(tone, the_spacing_constraint_holds_once_kept)
       cr_assert_eq(lw_chain_sweep(c), LW_OK);
       size_t k = close_pairs(&sc, m->sp, 0.3);
       if (k > worst[on]) worst[on] = k;
+      /* and the curves between the samples (points at most 0.03 mm from
+      ** the nearest: 0.04 mm below the spacing is closer for certain),
+      ** every fourth sweep (the count is quadratic) */
+      const size_t kc = on && s % 4 == 3 ? close_curve_points(m->sp, 0.3 - 0.04) : 0;
+      if (kc > curves[on]) curves[on] = kc;
     }
     for (int k = 0; k < 4; k++) {
       if (on) accepted += c->stats[k].accepted;
@@ -535,9 +540,11 @@ Test(tone, the_spacing_constraint_holds_once_kept)
     lw_model_free(m);
     lw_scene_clear(&sc);
   }
-  cr_log_info("spacing: up to %zu pairs closer than 0.3 mm without the constraint, %zu with it", worst[0], worst[1]);
+  cr_log_info("spacing: up to %zu pairs closer than 0.3 mm without the constraint, %zu (%zu points of the curves) with it",
+              worst[0], worst[1], curves[1]);
   cr_assert(worst[0] > 0, "the tone term pulls strokes together when nothing stops it");
   cr_assert_eq(worst[1], 0, "%zu pairs closer than min_spacing", worst[1]);
+  cr_assert_eq(curves[1], 0, "%zu points of the curves closer than min_spacing", curves[1]);
   cr_assert(accepted > 1000, "the chain kept moving: %lu accepted", accepted);
   /* the refusals are counted as such (summary.json, rejected_crowded), and
   ** only where the rule is on */
@@ -614,6 +621,75 @@ Test(tone, a_crowded_start_only_gets_less_crowded)
   model_chain_free(c);
   lw_model_free(m);
   lw_scene_clear(&sc);
+}
+
+/* Point of the cubic Bezier c at t. */
+static void bezier_point(const double c[8], double t, double *x, double *y)
+{
+  const double u = 1.0 - t, w0 = u * u * u, w1 = 3 * u * u * t, w2 = 3 * u * t * t, w3 = t * t * t;
+  *x = w0 * c[0] + w1 * c[2] + w2 * c[4] + w3 * c[6];
+  *y = w0 * c[1] + w1 * c[3] + w2 * c[5] + w3 * c[7];
+}
+
+/* lw_bezier_near2 (the spacing rule between curves) against brute force:
+** 1500 pairs of segments 2.8 mm long crossing a disc of 1.6 mm at random
+** angles, their handles off the chord by up to 0.05 to 0.3 of its length
+** (gentle to strong bends), each against its least distance on a grid of
+** N + 1 parameters a side.  The grid's points lie at most half a step
+** from any point of a curve, a step at most 3 (longest leg) / N along it,
+** which bounds the grid's error e.  Where the reference is more than e
+** from d = 0.35 the answer must agree on "within d", and every distance
+** returned is a distance between two points of the curves, so no less
+** than the grid's least less e and, the search being local from the
+** nearest points of the polygons, at most 0.02 mm above it. */
+static double longest_leg(const double c[8])
+{
+  return fmax(hypot(c[2] - c[0], c[3] - c[1]), fmax(hypot(c[4] - c[2], c[5] - c[3]), hypot(c[6] - c[4], c[7] - c[5])));
+}
+
+Test(tone, the_curves_distance_agrees_with_brute_force)
+{
+  enum { N = 300 };
+  const double d = 0.35;
+  rng_seed(17);
+  int checked = 0, off = 0;
+  static double xa[N + 1], ya[N + 1], xb[N + 1], yb[N + 1];
+  for (int n = 0; n < 1500; n++) {
+    const double bend = 0.05 + 0.25 * (n % 6) / 5.0;
+    double c[2][8];
+    for (int k = 0; k < 2; k++) {
+      const double x0 = urand(-0.8, 0.8), y0 = urand(-0.8, 0.8), th = urand(-M_PI, M_PI), L = 2.8;
+      const double dx = cos(th) * L, dy = sin(th) * L;
+      double *z = c[k];
+      z[0] = x0 - dx / 2, z[1] = y0 - dy / 2, z[6] = x0 + dx / 2, z[7] = y0 + dy / 2;
+      z[2] = z[0] + dx / 3 + urand(-bend, bend) * L, z[3] = z[1] + dy / 3 + urand(-bend, bend) * L;
+      z[4] = z[6] - dx / 3 + urand(-bend, bend) * L, z[5] = z[7] - dy / 3 + urand(-bend, bend) * L;
+    }
+    double ref = INFINITY;
+    for (int i = 0; i <= N; i++) bezier_point(c[0], (double)i / N, &xa[i], &ya[i]), bezier_point(c[1], (double)i / N, &xb[i], &yb[i]);
+    for (int i = 0; i <= N; i++)
+      for (int j = 0; j <= N; j++) ref = fmin(ref, (xa[i] - xb[j]) * (xa[i] - xb[j]) + (ya[i] - yb[j]) * (ya[i] - yb[j]));
+    ref = sqrt(ref);
+    const double e = 1.5 * (longest_leg(c[0]) + longest_leg(c[1])) / N;
+    const double got2 = lw_bezier_near2(c[0], c[1], d), got = sqrt(got2);
+    if (fabs(ref - d) > e) {
+      cr_assert_eq(got2 < d * d, ref < d, "pair %d: %g against %g", n, got, ref);
+      checked++;
+    }
+    if (got2 < INFINITY) {
+      cr_assert(got >= ref - e && got <= ref + 0.02, "pair %d: %g against %g (grid error %g)", n, got, ref, e);
+      off += got > ref + 1e-3;
+    }
+  }
+  cr_log_info("curves' distance: %d decisions checked, %d distances more than 1e-3 mm above the grid's", checked, off);
+  cr_assert(checked > 1400 && off < 15, "%d checked, %d off", checked, off);
+  /* known layouts: parallel lines 0.2 apart, crossing lines, lines 0.5 apart */
+  const double par[2][8] = {{0, 0, 1, 0, 2, 0, 3, 0}, {0.5, 0.2, 1.5, 0.2, 2.5, 0.2, 3.5, 0.2}};
+  cr_assert(fabs(lw_bezier_near2(par[0], par[1], d) - 0.04) < 1e-12, "parallel: %g", lw_bezier_near2(par[0], par[1], d));
+  const double cross[8] = {1.5, -1, 1.5, 0, 1.5, 1, 1.5, 2};
+  cr_assert(lw_bezier_near2(par[0], cross, d) < 1e-20, "crossing: %g", lw_bezier_near2(par[0], cross, d));
+  const double apart[8] = {0, 0.5, 1, 0.5, 2, 0.5, 3, 0.5};
+  cr_assert_eq(lw_bezier_near2(par[0], apart, d), INFINITY);
 }
 
 Test(tone, close_share_of_known_layouts)

@@ -18,6 +18,7 @@
 #include "linewise/mc.h"
 #include "linewise/sys_splines.h"
 #include "linewise/gradient.h"
+#include "linewise/spacing.h"
 #include "linewise/transdim.h"
 #include "imageutil.h"
 #include "testutil.h"
@@ -488,6 +489,60 @@ Test(transdim, incremental_equals_full_with_births_and_deaths)
               c->stats[k].accepted, c->stats[k].proposed);
   /* the spliced caches and grid are what a model built afresh holds */
   same_as_fresh(m);
+  td_chain_free(c, setup);
+}
+
+/* energy.min_spacing holds between the curves through births, grows and
+** joins: from a page that keeps it, a chain that fills the page with line
+** (a chemical potential that pays for length) brings no two strokes' curves
+** closer.  The pair samples here are 0.5 mm apart along a line against a
+** spacing of 0.3 mm, so strokes can cross between them: with the count of
+** sample pairs alone 26 % of the length ended closer than 0.29 mm, with the
+** curves' rule for the moves within a spline but not for the splices 19 %. */
+Test(transdim, births_and_grows_keep_the_spacing_between_curves)
+{
+  lw_params p;
+  splice_scene(&p);
+  p.width = 30;
+  p.height = 25;
+  p.margin = 1;
+  p.splines = 1; /* a page that keeps the spacing: what follows is the moves' */
+  p.segments = 2;
+  p.segment_length = 3;
+  p.max_segments = 6;
+  p.pair_quadrature = 6;
+  p.pair_cutoff = 1.2;
+  p.min_spacing = 0.3;
+  p.min_speed = 0; /* births drawn by the prior fold often: not what is tested */
+  p.regularity = 0;
+  p.bending = 0.02;
+  p.chem_spline = -20;
+  p.chem_length = -3;
+  p.mix_birth = p.mix_death = 0.2;
+  p.mix_grow = p.mix_shrink = 0.3;
+  p.mix_join = 0.1;
+  void *setup;
+  lw_chain *c = td_chain(&p, 1.0, 31, &setup);
+  const lw_model *m = lw_splines_model(c->sys);
+  /* lw_close_share counts no line farther than d: 0.29 keeps a margin
+  ** for the search of the rule (spacing.h) */
+  double share;
+  cr_assert_eq(lw_close_share_splines(m->sp, 0.29, &share, NULL), LW_OK);
+  cr_assert_eq(share, 0.0, "the placement keeps the spacing (share %g)", share);
+  const size_t before = m->sp->n_segments;
+  unsigned long props = 0;
+  for (int s = 0; props < 40000; s++) {
+    cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    props = 0;
+    for (int k = 0; k < c->n_moves; k++) props += c->stats[k].proposed;
+  }
+  cr_assert_eq(lw_close_share_splines(m->sp, 0.29, &share, NULL), LW_OK);
+  cr_log_info("spacing with births: %zu segments to %zu, close share %g", before, m->sp->n_segments, share);
+  cr_assert_eq(share, 0.0, "%g of the length closer than 0.29 mm to another stroke", share);
+  cr_assert(m->sp->n_segments > 20 * before, "the page did not fill: %zu segments from %zu", m->sp->n_segments, before);
+  for (int k = LW_MOVE_BIRTH; k < c->n_moves; k++)
+    if (k != LW_MOVE_DEATH && k != LW_MOVE_SHRINK && c->stats[k].proposed)
+      cr_assert(c->stats[k].crowded > 0, "%s: no proposal refused by the spacing", c->sys->type->move_names[k]);
   td_chain_free(c, setup);
 }
 

@@ -219,6 +219,7 @@ typedef struct {
   lw_tone_box box[LW_TERM_COUNT]; /* each raster term's changes */
   int raster_done;            /* 1 if the raster terms were evaluated */
   int crowded;                /* 1 if refused by the spacing constraint */
+  int curves_pending;         /* its rule between the curves waits for lw_model_propose_finish */
   /* Changes of the running totals committed through this scratch and not
   ** yet merged into the model (lw_model_commit_part); -0.0 when none, the
   ** identity of +, so a merged single commit adds exactly dterm. */
@@ -257,7 +258,11 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
 ** a cheap stand-in (near_pending = 1).  lw_model_propose_finish computes it
 ** and returns what it adds to dE (0 when nothing was left out), leaving
 ** dterm and dE bitwise what a proposal without deferral gives.  A commit
-** finishes a pending proposal first. */
+** finishes a pending proposal first.  With energy.min_spacing the spacing
+** rule between the curves waits here too, for every move that passed the
+** count of samples (curves_pending): +inf, crowded = 1 and dE = +inf if the
+** move's curves touch more of the other strokes' segments than they did
+** (docs/NUMERICS.md, "Spacing"); a commit takes the move without it. */
 double lw_model_propose_finish(const lw_model *m, lw_proposal *p);
 
 /*

@@ -1,7 +1,9 @@
 /*
 ** spacing.h -- how crowded a drawing is: the share of its line length that
 ** has a point of another stroke (spline) closer than a given distance,
-** reported as summary.json's close_share with the pen width as distance.
+** reported as summary.json's close_share with the pen width as distance;
+** and how near two segments' curves come (lw_bezier_near2), for the
+** spacing rule of the Monte Carlo moves (model.c).
 **
 ** Each segment is cut into k = ceil(length / (d / 2)) pieces of equal
 ** parameter (at most LW_SPACING_POINTS_MAX), each piece stands for its
@@ -35,5 +37,21 @@ lw_status lw_close_share(const double *b, const size_t *owner, const size_t *gro
 /* The same for splines, each spline a stroke (the state before the
 ** plotter post-pass). */
 lw_status lw_close_share_splines(const lw_splines *sp, double d, double *share, lw_error *err);
+
+/* The least squared distance between the curves of two cubic Bezier
+** segments a and b (8 doubles each, as above) that a local search finds
+** from the parameters (s, t) in [0, 1]: Levenberg-Marquardt on
+** a(s) - b(t), steps of at most 1/8 in either parameter, a side whose step
+** would leave [0, 1] held at its end; the least value met is returned.
+** (s, t) should lie in the valley of the nearest points. */
+double lw_bezier_distance2(const double a[8], const double b[8], double s, double t);
+
+/* Whether the curves of two cubic Bezier segments a and b come within d
+** (> 0) of each other: their least squared distance if so (to the local
+** search's accuracy), else INFINITY.  Global: the search starts from the
+** nearest points of polygons of the curves fine enough that the curves
+** lie within d / 20 of them (at most 16 pieces: sharper bends only start
+** it less well). */
+double lw_bezier_near2(const double a[8], const double b[8], double d);
 
 #endif

@@ -113,7 +113,9 @@ struct lw_system_type {
   ** propose's dE and calls finish only for a proposal that passed, deciding
   ** on what it returns a second time: the chain keeps exp(-E/T) exactly
   ** whatever the stand-in, as long as it is a function of the two states
-  ** (docs/NUMERICS.md, "Delayed acceptance"). */
+  ** (docs/NUMERICS.md, "Delayed acceptance").  finish() may also check a
+  ** constraint that only a move about to be taken needs: +inf refuses the
+  ** move, counted as crowded (lw_move_stats). */
   void (*defer)(void *prop, int on);
   double (*finish)(void *state, void *prop);
   /* Optional (NULL: a sweep is never split; domains.h, [anneal] domains):
