@@ -1009,7 +1009,7 @@ static size_t crowding(const lw_cellgrid *grid, const lw_pair_sample *ps, size_t
 /*
 ** The spacing rule between the curves.  crowding counts pairs of samples,
 ** and two curves can meet between them: the photo preset's pair samples lie
-** up to twice min_spacing apart along a line, crossing strokes passed the
+** up to 1.9 min_spacing apart along a line, crossing strokes passed the
 ** count, and on a photograph the lines touched over 4 % of their length.
 ** So a move that passes the count is then asked how many of the other
 ** strokes' segments its curves touch (come within min_spacing of:
@@ -1115,7 +1115,6 @@ static contact_view contact_view_of(const lw_model *m, const lw_pair_filter *f, 
 {
   return (contact_view){m, lw_cellgrid_plane(m->grid, f->plane, view), (uint32_t)pair_nodes(m)};
 }
-
 
 #define LW_CURVE_NEWTON 4 /* Newton steps to a curve's nearest point from its sample's */
 

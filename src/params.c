@@ -210,13 +210,14 @@ const lw_param_def lw_param_table[] = {
       "target is tone_ink * darkness. Below 1 the darks are drawn as dense lines rather than "
       "solid ink, so lines keep their own width apart (1/tone_ink pen widths at black)."),
   NUM("energy", "min_spacing", LW_PT_DOUBLE, min_spacing, "0", "mm", 0, 1e7, 0,
-      "Least distance between pair samples of different splines, a hard constraint: a move that "
-      "brings more of its samples closer than this to another spline than it had is refused "
-      "(+infinity), so a drawing that keeps it never loses it; the placement starts splines apart "
-      "by it where it can. The quench and the massless flow keep it between the curves (they hold "
-      "a segment that a step could bring closer than this to another curve than it was; "
-      "docs/NUMERICS.md, \"Dynamics\"). Needs the pair term (it looks in its cell grid) and at most "
-      "pair_cutoff. Typically the pen width. 0 = off."),
+      "Least distance between the curves of different splines, a hard constraint: a move that "
+      "brings more of its pair samples closer than this to another spline than it had, or whose "
+      "curves come this close to more segments of other splines than they did, is refused "
+      "(+infinity), so a drawing that keeps it never loses it (docs/NUMERICS.md, \"Spacing\"); "
+      "the placement starts splines apart by it where it can. The quench and the massless flow "
+      "keep it too (they hold a segment that a step could bring closer than this to another curve "
+      "than it was; docs/NUMERICS.md, \"Dynamics\"). Needs the pair term (it looks in its cell "
+      "grid) and at most pair_cutoff. Typically the pen width. 0 = off."),
   NUM("energy", "chem_spline", LW_PT_DOUBLE, chem_spline, "0", "energy", -1e12, 1e12, 0,
       "Chemical potential per spline: the energy a spline costs just by being there (term "
       "'chemical', with chem_length). With moves.fixed_count = 0 it sets how many lines the "

@@ -117,7 +117,9 @@ void bench_tone(bench_ctx *b)
           pixel, b->ann_params.quadrature, fine.reps, fine.block);
   tone_table(&fine, off, (int)(sizeof off / sizeof off[0]));
   fprintf(d, "With the scene's pair term, and the spacing constraint (energy.min_spacing), which\n"
-             "counts the neighbours closer than 0.35 mm in the pair grid's cells:\n\n");
+             "counts the neighbours closer than 0.35 mm in the pair grid's cells and asks the moves\n"
+             "the Metropolis test takes what their curves touch (docs/NUMERICS.md, \"Spacing\"; the\n"
+             "chain's second stage, so in the chain's column only):\n\n");
   tone_table(b, spaced, (int)(sizeof spaced / sizeof spaced[0]));
 }
 

@@ -119,7 +119,7 @@ typedef struct {
   double tone;                /* T, energy / mm^2; 0 = off */
   double tone_blur;           /* sigma of the tone term's blur, mm */
   double tone_ink;            /* ink fraction the darkest tone asks for */
-  double min_spacing;         /* least distance between samples of different splines, mm; 0 = none */
+  double min_spacing;         /* least distance between curves of different splines, mm; 0 = none */
   double chem_spline;         /* chemical potential: energy per spline; 0 = none */
   double chem_length;         /* chemical potential: energy per mm of line; 0 = none */
   /* [moves] */

@@ -54,7 +54,7 @@ typedef struct lw_scene {
   lw_field field;               /* valid when on[LW_TERM_FIELD] */
   lw_boundary boundary;         /* the frame (also used for placement) */
   lw_tone tone;                 /* valid when on[LW_TERM_TONE]: target and footprint */
-  double min_spacing;           /* least distance between pair samples of different
+  double min_spacing;           /* least distance between the curves of different
                                    splines, mm (a hard constraint, model.h); 0 = none */
   lw_user_term_fn user_fn;      /* valid when on[LW_TERM_USER] */
   const void *user_data;        /* passed to user_fn; not owned */
