@@ -132,7 +132,7 @@ static void power_form(const double b[8], int o, double q[4])
   q[3] = b[6 + o] - b[o] + 3.0 * (b[2 + o] - b[4 + o]);
 }
 
-#define LW_BEZIER_STEPS 16    /* Gauss-Newton steps from the samples' parameters */
+#define LW_BEZIER_STEPS 16    /* steps of the local search */
 #define LW_BEZIER_TRUST 0.125 /* the longest step in either parameter */
 #define LW_BEZIER_TRIES 12    /* dampings of one step, tenfold each */
 
@@ -270,7 +270,8 @@ static int parted_along(const double c[8], const double a[8], const double b[8],
   const double len = sqrt(tx * tx + ty * ty);
   if (!(len > 0.0)) return 0;
   const double ux = tx / len, uy = ty / len;
-  double lo[2][2] = {{INFINITY, INFINITY}, {INFINITY, INFINITY}}, hi[2][2] = {{-INFINITY, -INFINITY}, {-INFINITY, -INFINITY}};
+  double lo[2][2] = {{INFINITY, INFINITY}, {INFINITY, INFINITY}};
+  double hi[2][2] = {{-INFINITY, -INFINITY}, {-INFINITY, -INFINITY}};
   for (int k = 0; k < 8; k += 2)
     for (int w = 0; w < 2; w++) {
       const double *p = w ? b : a;

@@ -540,7 +540,8 @@ Test(tone, the_spacing_constraint_holds_once_kept)
     lw_model_free(m);
     lw_scene_clear(&sc);
   }
-  cr_log_info("spacing: up to %zu pairs closer than 0.3 mm without the constraint, %zu (%zu points of the curves) with it",
+  cr_log_info("spacing: up to %zu pairs closer than 0.3 mm without the constraint, %zu (%zu points of the "
+              "curves) with it",
               worst[0], worst[1], curves[1]);
   cr_assert(worst[0] > 0, "the tone term pulls strokes together when nothing stops it");
   cr_assert_eq(worst[1], 0, "%zu pairs closer than min_spacing", worst[1]);
@@ -666,9 +667,15 @@ Test(tone, the_curves_distance_agrees_with_brute_force)
       z[4] = z[6] - dx / 3 + urand(-bend, bend) * L, z[5] = z[7] - dy / 3 + urand(-bend, bend) * L;
     }
     double ref = INFINITY;
-    for (int i = 0; i <= N; i++) bezier_point(c[0], (double)i / N, &xa[i], &ya[i]), bezier_point(c[1], (double)i / N, &xb[i], &yb[i]);
+    for (int i = 0; i <= N; i++) {
+      bezier_point(c[0], (double)i / N, &xa[i], &ya[i]);
+      bezier_point(c[1], (double)i / N, &xb[i], &yb[i]);
+    }
     for (int i = 0; i <= N; i++)
-      for (int j = 0; j <= N; j++) ref = fmin(ref, (xa[i] - xb[j]) * (xa[i] - xb[j]) + (ya[i] - yb[j]) * (ya[i] - yb[j]));
+      for (int j = 0; j <= N; j++) {
+        const double dx = xa[i] - xb[j], dy = ya[i] - yb[j];
+        ref = fmin(ref, dx * dx + dy * dy);
+      }
     ref = sqrt(ref);
     const double e = 1.5 * (longest_leg(c[0]) + longest_leg(c[1])) / N;
     const double got2 = lw_bezier_near2(c[0], c[1], d), got = sqrt(got2);
@@ -685,7 +692,8 @@ Test(tone, the_curves_distance_agrees_with_brute_force)
   cr_assert(checked > 1400 && off < 15, "%d checked, %d off", checked, off);
   /* known layouts: parallel lines 0.2 apart, crossing lines, lines 0.5 apart */
   const double par[2][8] = {{0, 0, 1, 0, 2, 0, 3, 0}, {0.5, 0.2, 1.5, 0.2, 2.5, 0.2, 3.5, 0.2}};
-  cr_assert(fabs(lw_bezier_near2(par[0], par[1], d) - 0.04) < 1e-12, "parallel: %g", lw_bezier_near2(par[0], par[1], d));
+  const double parallel = lw_bezier_near2(par[0], par[1], d);
+  cr_assert(fabs(parallel - 0.04) < 1e-12, "parallel: %g", parallel);
   const double cross[8] = {1.5, -1, 1.5, 0, 1.5, 1, 1.5, 2};
   cr_assert(lw_bezier_near2(par[0], cross, d) < 1e-20, "crossing: %g", lw_bezier_near2(par[0], cross, d));
   const double apart[8] = {0, 0.5, 1, 0.5, 2, 0.5, 3, 0.5};
