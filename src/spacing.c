@@ -147,7 +147,11 @@ static void gap_at(const double q[4][4], double s, double t, double e[2], double
   }
 }
 
-double lw_bezier_distance2(const double a[8], const double b[8], double s, double t)
+/* The least squared distance between the curves a and b that a local
+** search finds from the parameters (s, t): Levenberg-Marquardt on
+** a(s) - b(t), steps of at most LW_BEZIER_TRUST in either parameter, a side
+** whose step would leave [0, 1] held at its end; the least value met. */
+static double bezier_distance2(const double a[8], const double b[8], double s, double t)
 {
   /* Levenberg-Marquardt on the gap e(s, t) = a(s) - b(t): undamped where
   ** the curves cross it is Newton's method for e = 0 (quadratic), elsewhere
@@ -309,5 +313,5 @@ double lw_bezier_near2(const double a[8], const double b[8], double d)
       if (dd < least) least = dd, s0 = (i + u) / na, t0 = (j + v) / nb;
     }
   if (sqrt(least) - 0.125 * (ma / ((double)na * na) + mb / ((double)nb * nb)) >= d) return INFINITY;
-  return lw_bezier_distance2(a, b, s0, t0);
+  return bezier_distance2(a, b, s0, t0);
 }

@@ -38,19 +38,13 @@ lw_status lw_close_share(const double *b, const size_t *owner, const size_t *gro
 ** plotter post-pass). */
 lw_status lw_close_share_splines(const lw_splines *sp, double d, double *share, lw_error *err);
 
-/* The least squared distance between the curves of two cubic Bezier
-** segments a and b (8 doubles each, as above) that a local search finds
-** from the parameters (s, t) in [0, 1]: Levenberg-Marquardt on
-** a(s) - b(t), steps of at most 1/8 in either parameter, a side whose step
-** would leave [0, 1] held at its end; the least value met is returned.
-** (s, t) should lie in the valley of the nearest points. */
-double lw_bezier_distance2(const double a[8], const double b[8], double s, double t);
-
 /* Whether the curves of two cubic Bezier segments a and b come within d
-** (> 0) of each other: their least squared distance if so (to the local
-** search's accuracy), else INFINITY.  Global: the search starts from the
-** nearest points of polygons of the curves fine enough that the curves
-** lie within d / 20 of them (at most 16 pieces: sharper bends only start
+** (> 0) of each other: their least squared distance if so, else INFINITY.
+** INFINITY is certain: polygons of the curves, with the bound on how far a
+** curve strays from its polygon, give a lower bound.  The distance is a
+** local search's (a distance between two points of the curves, never below
+** the least), started from the polygons' nearest points; the polygons keep
+** within d / 20 of the curves (at most 16 pieces: sharper bends only start
 ** it less well). */
 double lw_bezier_near2(const double a[8], const double b[8], double d);
 
