@@ -39,13 +39,14 @@ lw_status lw_close_share(const double *b, const size_t *owner, const size_t *gro
 lw_status lw_close_share_splines(const lw_splines *sp, double d, double *share, lw_error *err);
 
 /* Whether the curves of two cubic Bezier segments a and b come within d
-** (> 0) of each other: their least squared distance if so, else INFINITY.
-** INFINITY is certain: polygons of the curves, with the bound on how far a
-** curve strays from its polygon, give a lower bound.  The distance is a
-** local search's (a distance between two points of the curves, never below
-** the least), started from the polygons' nearest points; the polygons keep
-** within d / 20 of the curves (at most 16 pieces: sharper bends only start
-** it less well). */
+** (> 0) of each other: below d^2 (their least squared distance) if so, at
+** least d^2 if not.  INFINITY is certain: the control points' hulls, or
+** polygons of the curves with the bound on how far a curve strays from its
+** polygon, keep them d apart.  Otherwise the value is a local search's (a
+** distance between two points of the curves, never below the least),
+** started from the polygons' nearest points; the polygons keep within
+** d / 20 of the curves (at most 16 pieces: sharper bends only start it
+** less well). */
 double lw_bezier_near2(const double a[8], const double b[8], double d);
 
 #endif
