@@ -190,6 +190,35 @@ Test(fidelity, hatching_matches_its_grey)
   lw_grid2d_free(tone);
 }
 
+/* Stray ink is the ink on paper the target leaves white for some two blur
+** sigmas around: a picture black on its left half, white on its right.
+** Lines in the black and 1 mm into the white beside the edge (blurred
+** darkness 0.16 there at sigma 1 mm) are not stray; a line 10 mm into the
+** white is, whole: with three lines of one length its share is a third. */
+Test(fidelity, stray_ink_is_ink_far_inside_the_white)
+{
+  const double px = 0.2;
+  const int w = 200, h = 150; /* 40 x 30 mm */
+  lw_grid2d *tone = lw_grid2d_new(w, h, 1, 0.5 * px, 0.5 * px, px, px, NULL);
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) tone->data[j * w + i] = i < w / 2 ? 0.0 : 1.0;
+  size_t segs[3] = {1, 1, 1};
+  const double x[3] = {19.8, 21, 30};
+  lw_splines *edge = lw_splines_new(2, segs, NULL), *all = lw_splines_new(3, segs, NULL);
+  for (size_t i = 0; i < 3; i++) {
+    if (i < 2) lw_test_straight(edge, i, x[i], 5, x[i], 25);
+    lw_test_straight(all, i, x[i], 5, x[i], 25);
+  }
+  lw_fidelity f;
+  cr_assert_eq(lw_fidelity_compute(edge, tone, 0.3, 1.0, &f, NULL), LW_OK);
+  cr_assert(f.stray == 0, "edge lines: stray %g", f.stray);
+  cr_assert_eq(lw_fidelity_compute(all, tone, 0.3, 1.0, &f, NULL), LW_OK);
+  cr_assert(fabs(f.stray - 1.0 / 3) < 1e-3, "stray %g, expected 1/3", f.stray);
+  lw_splines_free(edge);
+  lw_splines_free(all);
+  lw_grid2d_free(tone);
+}
+
 Test(fidelity, bad_input)
 {
   lw_splines *sp = lw_splines_new(0, NULL, NULL);

@@ -40,6 +40,11 @@
 **    into a tone (the tone's gradient) or not (each line's own gradient is
 **    across it, along the target's), which is why it depends far less on
 **    sigma than MSE and SSIM do (docs/IMAGES.md).  NaN for a flat target.
+** 5. Stray ink: the share of the ink (unblurred, summed over pixels) that
+**    lies where the blurred darkness is under LW_FIDELITY_WHITE: paper the
+**    target leaves white for about two sigmas around, so a line along the
+**    edge of a dark area does not count and one across a white background
+**    does.  0 for a drawing without ink.
 **
 ** The drawing is scored as plotted (strokes.h: joined, cropped, dropped);
 ** a pen's score renders that pen's paths alone against the same target.
@@ -58,11 +63,13 @@
 #define LW_FIDELITY_FLAT 1e-9         /* gradient (per pixel) below which a pixel has no direction */
 #define LW_FIDELITY_PEN_PIXELS 1.0    /* coarser pixels (in pen widths) are rendered finer and averaged */
 #define LW_FIDELITY_FINE_MAX 16777216.0 /* the fine render's most pixels */
+#define LW_FIDELITY_WHITE 0.02        /* blurred darkness under which the target is white paper */
 
 typedef struct {
   double mse;       /* mean squared difference of blurred ink and darkness */
   double ssim;      /* mean structural similarity, -1..1 */
   double orientation; /* orientation agreement, -1..1 (NaN: flat target) */
+  double stray;     /* share of the ink on white paper, 0..1 */
   double sigma_mm;  /* the blur used, mm */
 } lw_fidelity;
 
@@ -82,7 +89,7 @@ lw_status lw_fidelity_render(const lw_splines *sp, const lw_grid2d *tone, double
 lw_status lw_fidelity_render_strokes(const lw_strokes *s, int pen, const lw_grid2d *tone, double pen_width_mm,
                                      double *ink, lw_error *err);
 
-/* Steps 2-4 for two w x h images a and b (changed in place: blurred),
+/* Steps 2-5 for the ink a and the darkness b, w x h (changed in place: blurred),
 ** blur sigma sx, sy in pixels (0 = none); out->sigma_mm is left alone. */
 lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, double sy, lw_fidelity *out,
                               lw_error *err);
