@@ -104,8 +104,7 @@ const lw_param_def lw_param_table[] = {
       "potential = image: Phi = tone^power. Above 1 the potential is near 0 everywhere but near white, "
       "so energy.potential > 0 costs line where the picture asks for none (stray lines in a white "
       "background) and little in the mid-tones. The photo preset sets 8, with potential = image and "
-      "energy.potential = 7.14 pen widths, for the pens of a colour separation (layers.source = cmyk "
-      "or palette; docs/IMAGES.md, \"White backgrounds\")."),
+      "energy.potential = 7.14 pen widths (docs/IMAGES.md, \"White backgrounds\")."),
   CHOICE("scene", "field", field, "constant", "constant|radial|vortex|waves|etf|gradient",
          "Vector field v read by the field term (unit length): constant along `field_angle`, "
          "radial from the centre, vortex around it, waves tangent to y = A sin(2 pi x / wavelength), "
@@ -902,7 +901,12 @@ _Static_assert(sizeof page_mm / sizeof page_mm[0] == LW_PAGE_LEGAL + 1, "a size 
 ** at w = 0.35 (-7.14 w: line length per area goes as 1 / w); at the same
 ** CPU time this beat every fixed coverage from 0.4 to 0.8 on the bundled
 ** picture and on four test photographs (docs/IMAGES.md, "With the photo
-** preset" and "On photographs").
+** preset" and "On photographs").  Where the picture is white paper a line
+** costs what that chemical potential pays for it (potential = image,
+** Phi = tone^8, near 0 but near white): without it the first thin line in
+** white costs almost nothing (the tone term is quadratic in the ink) and
+** stray lines crossed white backgrounds (docs/IMAGES.md, "White
+** backgrounds").
 */
 #define PHOTO_CHEM (2.5 / 0.35) /* the chemical potential's price of line, pen widths per mm */
 static const struct {
@@ -924,6 +928,8 @@ static const struct {
     {"moves", "fixed_count", "0", 0},      {"energy", "chem_length", NULL, -PHOTO_CHEM},
     {"moves", "grow", "0.05", 0},          {"moves", "shrink", "0.05", 0},
     {"scene", "image_levels", "0.01", 0},  {"layers", "apart", "pen", 0},
+    {"scene", "potential", "image", 0},    {"energy", "potential", NULL, PHOTO_CHEM},
+    {"scene", "potential_power", "8", 0},
 };
 
 /* Sets an unset key from text; the key stays unset (line 0), so a later
@@ -947,26 +953,6 @@ static void apply_preset(lw_params *p)
       t = text;
     }
     preset_key(p, photo_preset[k].section, photo_preset[k].key, t);
-  }
-  /* Pens of a colour separation: a line costs, where its pen's target is
-  ** white, what the chemical potential pays for it (Phi = tone^8 is near 0
-  ** elsewhere), so a pen leaves no stray lines in the other colours' areas
-  ** (docs/IMAGES.md, "White backgrounds"; colour correlation +0.011 to
-  ** +0.029 on four pictures in CMYK, while one pen on a photograph lost
-  ** 0.02, so not there).  Unset keys go back to their defaults when the
-  ** source changes. */
-  static const struct {
-    const char *section, *key, *text;
-  } colour_keys[] = {{"scene", "potential", "image"}, {"energy", "potential", NULL}, {"scene", "potential_power", "8"}};
-  const int colour = p->ly_source != LW_LSRC_TONE;
-  for (size_t k = 0; k < sizeof colour_keys / sizeof colour_keys[0]; k++) {
-    const char *t = colour_keys[k].text;
-    if (!colour) t = lw_params_find(colour_keys[k].section, colour_keys[k].key)->def;
-    else if (!t) {
-      snprintf(text, sizeof text, "%.17g", PHOTO_CHEM * w);
-      t = text;
-    }
-    preset_key(p, colour_keys[k].section, colour_keys[k].key, t);
   }
   /* domains of 90 w: more than twice a move's reach (a spline of 40 w and
   ** the cutoff), and small enough that each of the four phases has work

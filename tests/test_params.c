@@ -353,16 +353,14 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
   cr_assert_eq(lw_params_set(&p, "output.pen_width=1", &err), LW_OK);
   cr_assert_eq(lw_params_resolve(&p, &err), LW_OK);
   cr_assert_str_eq(p.domains, "off");
-  /* a colour separation's pens cost line where their targets are white;
-  ** one pen, or a source that changes back to tone, has no potential */
-  cr_assert(p.potential_coef == 0 && p.potential_power == 1);
+  /* a line costs what the chemical potential pays for it where the
+  ** picture is white, for one pen (1 mm here) and for a colour separation's */
+  cr_assert(p.potential == LW_POT_IMAGE && fabs(p.potential_coef - 2.5 / 0.35) < 1e-12 && p.potential_power == 8,
+            "potential %d, %.17g, power %g", p.potential, p.potential_coef, p.potential_power);
   cr_assert_eq(read_text("[scene]\npreset = photo\n[layers]\nsource = cmyk\n[output]\npen_width = 0.35\n", &p, &err),
                LW_OK, "%s", err.msg);
   cr_assert(p.potential == LW_POT_IMAGE && fabs(p.potential_coef - 2.5) < 1e-12 && p.potential_power == 8,
             "potential %d, %.17g, power %g", p.potential, p.potential_coef, p.potential_power);
-  cr_assert_eq(lw_params_set(&p, "layers.source=tone", &err), LW_OK);
-  cr_assert_eq(lw_params_resolve(&p, &err), LW_OK);
-  cr_assert(p.potential == LW_POT_CONSTANT && p.potential_coef == 0 && p.potential_power == 1);
   /* without the preset nothing changes */
   lw_params d;
   lw_params_defaults(&d);
