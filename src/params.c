@@ -758,13 +758,6 @@ void lw_params_defaults(lw_params *p)
   for (size_t i = 0; i < lw_param_count; i++) assign(p, &lw_param_table[i], lw_param_table[i].def, expected, sizeof expected);
 }
 
-void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size_t n)
-{
-  int line = p->line[d - lw_param_table];
-  if (line > 0) snprintf(buf, n, "%s:%d", p->file, line);
-  else if (line < 0) snprintf(buf, n, "--set");
-  else snprintf(buf, n, "default");
-}
 
 lw_status lw_params_blame(const lw_params *p, const char *section, const char *key, lw_error *err)
 {
@@ -961,6 +954,30 @@ static void apply_preset(lw_params *p)
   int n = (int)floor((fmin(p->width, p->height) - 2.0 * p->margin) / (90.0 * w));
   snprintf(text, sizeof text, "%d", n < 1 ? 1 : (n > 64 ? 64 : n));
   preset_key(p, "anneal", "domains", n < 2 ? "off" : text);
+}
+
+/* A key the photo preset filled names the preset as where it came from,
+** and the pen widths it was sized from: a message about a blur of 150 mm
+** then says why (output.pen_width = 50). */
+void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size_t n)
+{
+  int line = p->line[d - lw_param_table];
+  if (line > 0) {
+    snprintf(buf, n, "%s:%d", p->file, line);
+    return;
+  }
+  if (line < 0) {
+    snprintf(buf, n, "--set");
+    return;
+  }
+  snprintf(buf, n, "default");
+  if (p->preset != LW_PRESET_PHOTO || p->of_run) return;
+  for (size_t k = 0; k < sizeof photo_preset / sizeof photo_preset[0]; k++)
+    if (!strcmp(photo_preset[k].section, d->section) && !strcmp(photo_preset[k].key, d->key)) {
+      if (photo_preset[k].text) snprintf(buf, n, "scene.preset = photo");
+      else snprintf(buf, n, "scene.preset = photo (%g pen widths of %g mm)", photo_preset[k].pens, p->pen_width);
+      return;
+    }
 }
 
 /* orientation = auto: the picture's header says which way it lies.  A

@@ -337,6 +337,17 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
             "fixed_count %d, chem_length %.17g", p.fixed_count, p.chem_length);
   /* A4 less 10 mm margins: 190 mm / (90 x 0.35 mm) = 6 domains a side */
   cr_assert_str_eq(p.domains, "6");
+  /* a message about a key the preset filled names the preset, and the pen
+  ** widths it sized a length from; the file's own keys name their line */
+  char where[256];
+  lw_params_origin(&p, lw_params_find("energy", "tone_blur"), where, sizeof where);
+  cr_assert_str_eq(where, "scene.preset = photo (3 pen widths of 0.35 mm)");
+  lw_params_origin(&p, lw_params_find("energy", "tone"), where, sizeof where);
+  cr_assert_str_eq(where, "scene.preset = photo");
+  lw_params_origin(&p, lw_params_find("output", "pen_width"), where, sizeof where);
+  cr_assert(strstr(where, ":5"), "%s", where);
+  lw_params_origin(&p, lw_params_find("energy", "strain_mode"), where, sizeof where);
+  cr_assert_str_eq(where, "default");
   /* --set of the pen width: the preset's keys follow, a set key stays */
   cr_assert_eq(lw_params_set(&p, "output.pen_width=0.5", &err), LW_OK);
   cr_assert_eq(lw_params_set(&p, "energy.pair_cutoff=4", &err), LW_OK);

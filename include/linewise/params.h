@@ -272,7 +272,8 @@ void lw_params_write_doc(FILE *f);
 /* The definition of section.key, or NULL. */
 const lw_param_def *lw_params_find(const char *section, const char *key);
 
-/* Where a parameter was set, for messages: "scene.ini:12", "--set" or "default". */
+/* Where a parameter was set, for messages: "scene.ini:12", "--set", "scene.preset = photo"
+** (with the pen widths a length was sized from) or "default". */
 void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size_t n);
 
 /* Prefixes the message in err with where section.key was set and the key:
