@@ -16,16 +16,21 @@
 ** layers (layers.h) a spline's darkness is its layer's target's and its
 ** field its layer's.
 **
-** With energy.min_spacing d the draws also keep apart: a spline whose pair
-** samples come closer than d to those of one placed before is drawn again,
-** up to SPACING_TRIES fitting draws, and then the one with the fewest close
-** samples is kept.  The spacing constraint refuses only moves that add
-** close samples (model.c), so what the placement leaves crowded -- lines
-** crossing where the field is noisy, as on photographs -- would stay.
+** With energy.min_spacing d the draws also keep apart: a spline whose
+** curves come within d of those of one placed before (pair samples within
+** d, or else lw_bezier_near2: lines cross between samples) is drawn again,
+** up to SPACING_TRIES fitting draws.  The spacing rule refuses only moves
+** that add contacts (model.c), so what the placement leaves crowded --
+** lines crossing where the field is noisy, as on photographs -- would stay.
+** With a fixed count the draw with the fewest crowded samples is kept
+** after that; where the annealer chooses the count the draw whose longest
+** run of clear segments is longest is cut to that run (or left out if it
+** has none), and births and grows fill the room later.
 */
 #include "linewise/init.h"
 
 #include "linewise/model.h"
+#include "linewise/spacing.h"
 
 #include <gsl/gsl_math.h>
 #include <math.h>
@@ -165,8 +170,10 @@ static void trace(const lw_field *f, lw_node *nd, size_t segments, double h, dou
 ** crowded is kept, so a page fuller than random packing allows still fills. */
 #define SPACING_TRIES 64
 
-/* The pair samples of the splines placed so far in buckets of side >= d:
-** a chained hash over the page's cells (head per cell, next per sample). */
+/* The splines placed so far: their pair samples in buckets of side >= d (a
+** chained hash over the page's cells, head per cell, next per sample), and
+** their segments' curves listed in the coarser cells their control boxes
+** meet. */
 typedef struct {
   double d2, side, x0, y0;
   long nx, ny;
@@ -174,20 +181,38 @@ typedef struct {
   double *x, *y;
   uint8_t *layer; /* each sample's layer, when lines keep apart within layers only; else NULL */
   size_t n, cap;
-} placed_samples;
+  /* the placed segments' curves, in cells of side cside listing each segment
+  ** whose control box meets them */
+  double cside;
+  long cnx, cny;
+  int32_t *chead, *cnext, *centry; /* per cell, per entry; centry: the entry's segment */
+  size_t cn, ccap;
+  double *bez;         /* 8 a segment: its control points */
+  uint8_t *seg_layer;  /* each segment's layer, with layer */
+  uint32_t *seen;      /* per segment: the query that last met it */
+  uint32_t query;
+  size_t nseg, capseg;
+} placed_lines;
 
-static void placed_free(placed_samples *ps)
+static void placed_free(placed_lines *ps)
 {
   free(ps->head);
   free(ps->next);
   free(ps->x);
   free(ps->y);
   free(ps->layer);
+  free(ps->chead);
+  free(ps->cnext);
+  free(ps->centry);
+  free(ps->bez);
+  free(ps->seg_layer);
+  free(ps->seen);
 }
 
-static int placed_init(placed_samples *ps, const lw_scene *sc, double d, size_t cap, int by_layer)
+static int placed_init(placed_lines *ps, const lw_scene *sc, double d, size_t cap, double segment_length,
+                       int by_layer)
 {
-  *ps = (placed_samples){.d2 = d * d, .cap = cap};
+  *ps = (placed_lines){.d2 = d * d, .cap = cap};
   double w = sc->width + 2 * d, h = sc->height + 2 * d;
   /* cells at least d wide, and not many more than samples (a wide page) */
   ps->side = fmax(d, sqrt(w * h / (4.0 * (double)cap + 1024.0)));
@@ -203,26 +228,117 @@ static int placed_init(placed_samples *ps, const lw_scene *sc, double d, size_t 
   ps->layer = by_layer ? malloc((cap ? cap : 1) * sizeof *ps->layer) : NULL;
   if (!ps->head || !ps->next || !ps->x || !ps->y || (by_layer && !ps->layer)) return 0;
   for (long c = 0; c < ps->nx * ps->ny; c++) ps->head[c] = -1;
+  /* a segment's control box spans a few of these cells */
+  const size_t segs = cap / (size_t)sc->pair_quad.n;
+  ps->capseg = segs;
+  ps->cside = fmax(ps->side, fmax(segment_length, sqrt(w * h / ((double)segs + 256.0))));
+  ps->cnx = (long)ceil(w / ps->cside);
+  ps->cny = (long)ceil(h / ps->cside);
+  ps->ccap = 4 * (segs ? segs : 1);
+  ps->chead = malloc((size_t)(ps->cnx * ps->cny) * sizeof *ps->chead);
+  ps->cnext = malloc(ps->ccap * sizeof *ps->cnext);
+  ps->centry = malloc(ps->ccap * sizeof *ps->centry);
+  ps->bez = malloc(8 * (segs ? segs : 1) * sizeof *ps->bez);
+  ps->seg_layer = by_layer ? malloc((segs ? segs : 1) * sizeof *ps->seg_layer) : NULL;
+  ps->seen = malloc((segs ? segs : 1) * sizeof *ps->seen);
+  if (!ps->chead || !ps->cnext || !ps->centry || !ps->bez || (by_layer && !ps->seg_layer) || !ps->seen) return 0;
+  for (long c = 0; c < ps->cnx * ps->cny; c++) ps->chead[c] = -1;
+  return 1;
+}
+
+/* The cells of side cside that box {x0, y0, x1, y1} meets, clamped: c = {first
+** column, first row, last column, last row}. */
+static void curve_cells(const placed_lines *ps, const double box[4], long c[4])
+{
+  const double lo[2] = {box[0], box[1]}, hi[2] = {box[2], box[3]};
+  const long n[2] = {ps->cnx, ps->cny};
+  const double o[2] = {ps->x0, ps->y0};
+  for (int k = 0; k < 2; k++) {
+    double a = floor((lo[k] - o[k]) / ps->cside), b = floor((hi[k] - o[k]) / ps->cside);
+    c[k] = a < 0 ? 0 : (a >= (double)n[k] ? n[k] - 1 : (long)a);
+    c[k + 2] = b < 0 ? 0 : (b >= (double)n[k] ? n[k] - 1 : (long)b);
+  }
+}
+
+/* How many placed segments (of the layer) come within d of the curve b. */
+static size_t curve_contacts(placed_lines *ps, const double b[8], double d, int layer)
+{
+  double box[4];
+  lw_bezier_box(b, d, box);
+  long c[4];
+  curve_cells(ps, box, c);
+  if (++ps->query == 0) { /* wrapped: forget every earlier query */
+    memset(ps->seen, 0, ps->nseg * sizeof *ps->seen);
+    ps->query = 1;
+  }
+  const uint32_t q = ps->query;
+  size_t count = 0;
+  for (long y = c[1]; y <= c[3]; y++)
+    for (long x = c[0]; x <= c[2]; x++)
+      for (int32_t e = ps->chead[y * ps->cnx + x]; e >= 0; e = ps->cnext[e]) {
+        const int32_t g = ps->centry[e];
+        if (ps->seen[g] == q) continue;
+        ps->seen[g] = q;
+        if (ps->seg_layer && ps->seg_layer[g] != layer) continue;
+        const double *o = ps->bez + 8 * (size_t)g;
+        double ob[4];
+        lw_bezier_box(o, 0.0, ob);
+        if (lw_boxes_meet(box, ob)) count += lw_bezier_near2(b, o, d) < d * d;
+      }
+  return count;
+}
+
+/* 0 when out of memory for the cells' lists. */
+static int curve_add(placed_lines *ps, const double b[8], int layer)
+{
+  if (ps->nseg == ps->capseg) return 1;
+  const int32_t g = (int32_t)ps->nseg++;
+  memcpy(ps->bez + 8 * (size_t)g, b, 8 * sizeof *b);
+  if (ps->seg_layer) ps->seg_layer[g] = (uint8_t)layer;
+  ps->seen[g] = 0;
+  double box[4];
+  lw_bezier_box(b, 0.0, box);
+  long c[4];
+  curve_cells(ps, box, c);
+  for (long y = c[1]; y <= c[3]; y++)
+    for (long x = c[0]; x <= c[2]; x++) {
+      if (ps->cn == ps->ccap) {
+        size_t cap = 2 * ps->ccap;
+        if (cap > INT32_MAX) return 0;
+        int32_t *nx = realloc(ps->cnext, cap * sizeof *nx);
+        if (nx) ps->cnext = nx;
+        int32_t *ne = realloc(ps->centry, cap * sizeof *ne);
+        if (ne) ps->centry = ne;
+        if (!nx || !ne) return 0;
+        ps->ccap = cap;
+      }
+      ps->centry[ps->cn] = g;
+      ps->cnext[ps->cn] = ps->chead[y * ps->cnx + x];
+      ps->chead[y * ps->cnx + x] = (int32_t)ps->cn++;
+    }
   return 1;
 }
 
 /* The cell of (x, y), clamped: the boundary keeps samples on the page, and
 ** a clamped one is only compared with more samples, never fewer. */
-static void placed_cell(const placed_samples *ps, double x, double y, long *cx, long *cy)
+static void placed_cell(const placed_lines *ps, double x, double y, long *cx, long *cy)
 {
   double fx = floor((x - ps->x0) / ps->side), fy = floor((y - ps->y0) / ps->side);
   *cx = fx < 0 ? 0 : (fx >= (double)ps->nx ? ps->nx - 1 : (long)fx);
   *cy = fy < 0 ? 0 : (fy >= (double)ps->ny ? ps->ny - 1 : (long)fy);
 }
 
-/* How many of the spline's pair samples have a placed sample (of its layer)
-** within d. */
-static size_t placed_crowding(const placed_samples *ps, const lw_scene *sc, const lw_node *nd, size_t segments,
-                              int layer)
+/* How crowded each segment of the spline is, in per[m]: how many of its
+** pair samples have a placed sample (of its layer) within d, or where none
+** has, how many placed segments its curve comes within d of.  Returns the
+** sum. */
+static size_t placed_crowding(placed_lines *ps, const lw_scene *sc, const lw_node *nd, size_t segments,
+                              int layer, size_t *per)
 {
   size_t count = 0;
   lw_samples s;
   for (size_t m = 0; m < segments; m++) {
+    const size_t before = count;
     lw_segment_sample(&sc->pair_quad, &nd[m], &nd[m + 1], &s);
     for (int q = 0; q < s.n; q++) {
       long cx, cy, hit = 0;
@@ -235,14 +351,73 @@ static size_t placed_crowding(const placed_samples *ps, const lw_scene *sc, cons
           }
       count += (size_t)hit;
     }
+    if (count == before) { /* samples apart, curves perhaps not: lines crossing between samples */
+      double b[8];
+      lw_segment_bezier(&nd[m], &nd[m + 1], b);
+      count += curve_contacts(ps, b, sqrt(ps->d2), layer);
+    }
+    per[m] = count - before;
   }
   return count;
 }
 
-static void placed_add(placed_samples *ps, const lw_scene *sc, const lw_node *nd, size_t segments, int layer)
+/* The longest run of segments none of which is crowded: its length, its
+** first segment in *from. */
+static size_t clear_run(const size_t *per, size_t segments, size_t *from)
+{
+  size_t run = 0, longest = 0;
+  *from = 0;
+  for (size_t m = 0; m < segments; m++) {
+    run = per[m] ? 0 : run + 1;
+    if (run > longest) {
+      longest = run;
+      *from = m + 1 - run;
+    }
+  }
+  return longest;
+}
+
+/* The placed splines cut to their clear runs (keep[2i]: first segment,
+** keep[2i + 1]: segments; 0 drops the spline), each with the rest length of
+** what is left, in the placement's order; each keeps the layer its index gave
+** it.  NULL and err set when out of memory. */
+static lw_splines *cut_to_clear_runs(const lw_scene *sc, const lw_splines *sp, const size_t *keep,
+                                     double segment_length, lw_error *err)
+{
+  size_t n = 0, *segs = malloc((sp->n_splines ? sp->n_splines : 1) * sizeof *segs);
+  if (!segs) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for the placement");
+    return NULL;
+  }
+  for (size_t i = 0; i < sp->n_splines; i++)
+    if (keep[2 * i + 1]) segs[n++] = keep[2 * i + 1];
+  lw_splines *cut = lw_splines_new(n, segs, err);
+  free(segs);
+  if (!cut) return NULL;
+  if (sc->layers.n && lw_splines_layers_alloc(cut) != LW_OK) {
+    lw_splines_free(cut);
+    lw_error_set(err, LW_ENOMEM, "out of memory for the placement");
+    return NULL;
+  }
+  for (size_t i = 0, k = 0; i < sp->n_splines; i++) {
+    const size_t m = keep[2 * i + 1];
+    if (!m) continue;
+    memcpy(&cut->node[cut->first[k]], &sp->node[sp->first[i] + keep[2 * i]], (m + 1) * sizeof *cut->node);
+    cut->rest_length[k] = segment_length * (double)m; /* what a birth's grows would give it */
+    if (cut->layer) cut->layer[k] = (uint8_t)lw_layers_of(&sc->layers, i);
+    k++;
+  }
+  return cut;
+}
+
+/* 0 when out of memory. */
+static int placed_add(placed_lines *ps, const lw_scene *sc, const lw_node *nd, size_t segments, int layer)
 {
   lw_samples s;
   for (size_t m = 0; m < segments; m++) {
+    double b[8];
+    lw_segment_bezier(&nd[m], &nd[m + 1], b);
+    if (!curve_add(ps, b, layer)) return 0;
     lw_segment_sample(&sc->pair_quad, &nd[m], &nd[m + 1], &s);
     for (int q = 0; q < s.n && ps->n < ps->cap; q++) {
       long cx, cy;
@@ -255,6 +430,7 @@ static void placed_add(placed_samples *ps, const lw_scene *sc, const lw_node *nd
       ps->n++;
     }
   }
+  return 1;
 }
 
 lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double segment_length,
@@ -279,16 +455,25 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
     nomem |= sc->image && !cums[k];
   }
   const int spaced = sc->min_spacing > 0.0 && sc->pair_quad.n > 0;
-  placed_samples placed = {0};
+  placed_lines placed = {0};
   if (spaced)
-    nomem |= !placed_init(&placed, sc, sc->min_spacing, n * segments * (size_t)sc->pair_quad.n,
+    nomem |= !placed_init(&placed, sc, sc->min_spacing, n * segments * (size_t)sc->pair_quad.n, segment_length,
                           lw_layers_planes(&sc->layers) > 1);
+  /* where the annealer chooses the count, a spline that finds no clear room
+  ** is cut to the longest clear run of its best draw, or left out: the
+  ** spacing rule would keep every contact it starts with (model.c), and
+  ** births and grows fill what the cut leaves */
+  const int cut = spaced && sc->transdim;
   lw_node *best = spaced ? malloc((segments + 1) * sizeof *best) : NULL;
-  nomem |= spaced && !best;
+  size_t *per = spaced ? malloc(segments * sizeof *per) : NULL;
+  size_t *keep = cut ? malloc(2 * (n ? n : 1) * sizeof *keep) : NULL;
+  nomem |= (spaced && (!best || !per)) || (cut && !keep);
   if (nomem) {
     for (int k = 0; k < nl; k++) free(cums[k]);
     placed_free(&placed);
     free(best);
+    free(per);
+    free(keep);
     lw_splines_free(sp);
     lw_error_set(err, LW_ENOMEM, "out of memory for the placement");
     return NULL;
@@ -296,6 +481,7 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
   const int follow = sc->on[LW_TERM_FIELD];
   const double L = segment_length * (double)segments;
   const int tries = 10000;
+  size_t done = 0; /* splines placed */
   for (size_t i = 0; i < n; i++) {
     lw_node *nd = &sp->node[sp->first[i]];
     const int layer = sc->layers.n ? lw_layers_of(&sc->layers, i) : 0;
@@ -305,7 +491,7 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
     /* a white picture has nothing to draw toward: uniform, as without one */
     const int weighted = cum && cum[img->height] > 0;
     int t, fitting = 0;
-    size_t least = SIZE_MAX;
+    size_t least = SIZE_MAX, longest = 0, from = 0;
     for (t = 0; t < tries; t++) {
       double cx, cy;
       if (weighted) lw_init_dark_point(sc, img, cum, rng, &cx, &cy);
@@ -331,33 +517,53 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
       }
       if (!fits(sc, nd, segments)) continue;
       if (!spaced) break;
-      size_t crowded = placed_crowding(&placed, sc, nd, segments, layer);
-      if (crowded < least) {
+      size_t crowded = placed_crowding(&placed, sc, nd, segments, layer, per), at;
+      size_t run = cut ? clear_run(per, segments, &at) : 0;
+      if (run > longest || (run == longest && crowded < least)) {
         least = crowded;
+        longest = run;
+        from = cut ? at : 0;
         memcpy(best, nd, (segments + 1) * sizeof *best);
       }
       if (crowded == 0 || ++fitting == SPACING_TRIES) break;
     }
     if (spaced && least != SIZE_MAX) {
       memcpy(nd, best, (segments + 1) * sizeof *best);
-      placed_add(&placed, sc, nd, segments, layer);
+      const size_t kept = cut ? longest : segments;
+      if (cut) {
+        keep[2 * i] = from;
+        keep[2 * i + 1] = kept;
+      }
+      if (!placed_add(&placed, sc, nd + from, kept, layer)) {
+        lw_error_set(err, LW_ENOMEM, "out of memory for the placement");
+        break;
+      }
       t = 0; /* placed, if never in room */
     }
     if (t == tries) {
       lw_error_set(err, LW_EINPUT,
                    "[init]: spline %zu of length %g mm did not fit inside the boundary in %d tries "
                    "(shorten init.segment_length or init.segments)", i, L, tries);
-      lw_splines_free(sp);
-      for (int k = 0; k < nl; k++) free(cums[k]);
-      placed_free(&placed);
-      free(best);
-      return NULL;
+      break;
     }
     sp->rest_length[i] = L;
+    done++;
   }
   for (int k = 0; k < nl; k++) free(cums[k]);
   placed_free(&placed);
   free(best);
+  free(per);
+  int whole = done == n;
+  for (size_t i = 0; cut && whole && i < n; i++) whole = keep[2 * i + 1] == segments;
+  if (done < n) {
+    lw_splines_free(sp);
+    sp = NULL;
+  } else if (!whole) {
+    lw_splines *c = cut_to_clear_runs(sc, sp, keep, segment_length, err);
+    lw_splines_free(sp);
+    sp = c;
+  }
+  free(keep);
   return sp;
 }
 

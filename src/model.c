@@ -1044,18 +1044,6 @@ typedef struct {
   uint32_t np;             /* pair samples a segment */
 } contact_view;
 
-/* The box of the control points of c, widened by d: the curve's, as it
-** lies in their convex hull. */
-static void control_box(const double c[8], double d, double box[4])
-{
-  box[0] = box[2] = c[0], box[1] = box[3] = c[1];
-  for (int k = 2; k < 8; k += 2) {
-    box[0] = c[k] < box[0] ? c[k] : box[0], box[2] = c[k] > box[2] ? c[k] : box[2];
-    box[1] = c[k + 1] < box[1] ? c[k + 1] : box[1], box[3] = c[k + 1] > box[3] ? c[k + 1] : box[3];
-  }
-  box[0] -= d, box[1] -= d, box[2] += d, box[3] += d;
-}
-
 /* Adds h to cs when segment h's curve comes within min_spacing of the
 ** curve c, whose control box widened by min_spacing is box. */
 static void contact_test(const contact_view *cv, const double c[8], const double box[4], uint32_t h, contact_set *cs)
@@ -1063,8 +1051,8 @@ static void contact_test(const contact_view *cv, const double c[8], const double
   double b[8];
   segment_bezier(cv->m->sp, h, b);
   double bb[4];
-  control_box(b, 0.0, bb);
-  if (bb[0] > box[2] || bb[2] < box[0] || bb[1] > box[3] || bb[3] < box[1]) return;
+  lw_bezier_box(b, 0.0, bb);
+  if (!lw_boxes_meet(box, bb)) return;
   const double d = cv->m->scene->min_spacing;
   if (lw_bezier_near2(c, b, d) < d * d) contact_add(cs, h);
 }
@@ -1094,7 +1082,7 @@ static void segment_contacts(const contact_view *cv, const double c[8], const lw
   x0 = x0 > 0 ? x0 - 1 : 0, y0 = y0 > 0 ? y0 - 1 : 0;
   x1 = x1 + 1 < g->nx ? x1 + 1 : g->nx - 1, y1 = y1 + 1 < g->ny ? y1 + 1 : g->ny - 1;
   double box[4];
-  control_box(c, cv->m->scene->min_spacing, box);
+  lw_bezier_box(c, cv->m->scene->min_spacing, box);
   uint32_t seen[SEEN];
   memset(seen, 0xff, sizeof seen);
   for (int y = y0; y <= y1; y++)

@@ -213,7 +213,8 @@ const lw_param_def lw_param_table[] = {
       "brings more of its pair samples closer than this to another spline than it had, or whose "
       "curves come this close to more segments of other splines than they did, is refused "
       "(+infinity), so a drawing that keeps it never loses it (docs/NUMERICS.md, \"Spacing\"); "
-      "the placement starts splines apart by it where it can. The quench and the massless flow "
+      "the placement starts splines apart by it where it can (with moves.fixed_count = 0 it cuts a "
+      "spline that finds no room to its clear segments). The quench and the massless flow "
       "keep it too (they hold a segment that a step could bring closer than this to another curve "
       "than it was; docs/NUMERICS.md, \"Dynamics\"). Needs the pair term (it looks in its cell "
       "grid) and at most pair_cutoff. Typically the pen width. 0 = off."),

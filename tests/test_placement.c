@@ -12,6 +12,7 @@
 #include "imageutil.h"
 #include "linewise/fieldview.h"
 #include "linewise/init.h"
+#include "linewise/spacing.h"
 #include "testutil.h"
 
 TestSuite(placement, .init = lw_image_dir_make, .fini = lw_image_dir_remove);
@@ -235,6 +236,23 @@ static size_t close_sample_pairs(const lw_scene *sc, const lw_splines *sp, doubl
   return close;
 }
 
+/* Pairs of segments of different splines whose curves come within d, by
+** brute force. */
+static size_t close_curve_pairs(const lw_splines *sp, double d)
+{
+  size_t close = 0;
+  for (size_t i = 0; i < sp->n_splines; i++)
+    for (size_t j = i + 1; j < sp->n_splines; j++)
+      for (size_t a = 0; a < lw_splines_segments(sp, i); a++)
+        for (size_t b = 0; b < lw_splines_segments(sp, j); b++) {
+          double ba[8], bb[8];
+          lw_splines_bezier(sp, i, a, ba);
+          lw_splines_bezier(sp, j, b, bb);
+          close += lw_bezier_near2(ba, bb, d) < d * d;
+        }
+  return close;
+}
+
 /* With energy.min_spacing the placement leaves room between splines, which
 ** the spacing constraint then keeps (it refuses only moves that add close
 ** samples, so crossings placed at the start would stay).  Random straight
@@ -270,4 +288,58 @@ Test(placement, min_spacing_places_lines_apart)
   cr_assert_eq(close[1], 0, "with it %zu close pairs, without %zu", close[1], close[0]);
   lw_scene_clear(&plain);
   lw_scene_clear(&spaced);
+}
+
+/* Where the annealer chooses the count (moves.fixed_count = 0) a spline that
+** finds no clear room in its draws is cut to the longest run of its best
+** draw's segments that is clear, or left out: births and grows can add line
+** later, while the spacing rule would keep every contact placed.  At 150
+** lines of the test above only one draw in a hundred is clear, so with a
+** fixed count the fallback places crowded lines; here none is crowded, the
+** cut splines keep the rest length of what is left (n l, as a birth's grows
+** give it), and most of the line is still placed. */
+Test(placement, a_chosen_count_cuts_crowded_splines_to_their_clear_runs)
+{
+  lw_params p;
+  lw_scene fixed, chosen;
+  two_tone_scene(&p, &fixed, 0);
+  lw_scene_clear(&fixed);
+  p.pair = 0.01;
+  p.pair_cutoff = 1;
+  p.min_spacing = 0.5;
+  lw_error err;
+  cr_assert_eq(lw_scene_init(&fixed, &p, &err), LW_OK, "%s", err.msg);
+  p.fixed_count = 0;
+  cr_assert_eq(lw_scene_init(&chosen, &p, &err), LW_OK, "%s", err.msg);
+  const size_t N = 150, S = 4;
+  const double l = 5;
+  gsl_rng *r = rng(5);
+  lw_splines *sp = lw_init_random(&fixed, N, S, l, r, &err);
+  gsl_rng_free(r);
+  cr_assert_not_null(sp, "%s", err.msg);
+  const size_t crowded = close_sample_pairs(&fixed, sp, p.min_spacing);
+  cr_assert(sp->n_splines == N && sp->n_segments == N * S && crowded > 0, "fixed: %zu splines, %zu close pairs",
+            sp->n_splines, crowded);
+  lw_splines_free(sp);
+  r = rng(5);
+  sp = lw_init_random(&chosen, N, S, l, r, &err);
+  gsl_rng_free(r);
+  cr_assert_not_null(sp, "%s", err.msg);
+  /* the curves too: samples up to 0.92 mm apart (8 Gauss nodes on 5 mm)
+  ** against 0.5 let lines cross between them */
+  cr_assert_eq(close_curve_pairs(sp, p.min_spacing), 0);
+  size_t cut = 0;
+  for (size_t i = 0; i < sp->n_splines; i++) {
+    const size_t m = lw_splines_segments(sp, i);
+    cr_assert(m >= 1 && m <= S && sp->rest_length[i] == (double)m * l, "spline %zu: %zu segments, rest %.17g", i,
+              m, sp->rest_length[i]);
+    cut += m < S;
+  }
+  cr_log_info("%zu splines, %zu segments of %zu, %zu cut; %zu close pairs with a fixed count", sp->n_splines,
+              sp->n_segments, N * S, cut, crowded);
+  cr_assert(cut > 0 && sp->n_splines <= N, "%zu cut of %zu", cut, sp->n_splines);
+  cr_assert(sp->n_segments > N * S / 2, "%zu segments of %zu placed", sp->n_segments, N * S);
+  lw_splines_free(sp);
+  lw_scene_clear(&fixed);
+  lw_scene_clear(&chosen);
 }

@@ -49,4 +49,22 @@ lw_status lw_close_share_splines(const lw_splines *sp, double d, double *share, 
 ** less well). */
 double lw_bezier_near2(const double a[8], const double b[8], double d);
 
+/* The box {x0, y0, x1, y1} of the control points of c, widened by d on
+** every side: the curve's widened by d, as it lies in their convex hull. */
+static inline void lw_bezier_box(const double c[8], double d, double box[4])
+{
+  box[0] = box[2] = c[0], box[1] = box[3] = c[1];
+  for (int k = 2; k < 8; k += 2) {
+    box[0] = c[k] < box[0] ? c[k] : box[0], box[2] = c[k] > box[2] ? c[k] : box[2];
+    box[1] = c[k + 1] < box[1] ? c[k + 1] : box[1], box[3] = c[k + 1] > box[3] ? c[k + 1] : box[3];
+  }
+  box[0] -= d, box[1] -= d, box[2] += d, box[3] += d;
+}
+
+/* 1 if the boxes a and b overlap. */
+static inline int lw_boxes_meet(const double a[4], const double b[4])
+{
+  return !(b[0] > a[2] || b[2] < a[0] || b[1] > a[3] || b[3] < a[1]);
+}
+
 #endif
