@@ -970,6 +970,30 @@ static double pair_near_delta(const lw_model *m, lw_proposal *p, const lw_node *
   return pe;
 }
 
+/* The cells of the 3 x 3 around (x, y) that hold samples and whose side
+** facing (x, y) is nearer than sqrt(far2) (cells are at least the cutoff,
+** and so min_spacing, wide), into near; returns how many. */
+static inline int facing_cells(const lw_cellgrid *g, double x, double y, double far2, const lw_cell *near[9])
+{
+  const double side = 1.0 / g->inv_h;
+  int cx, cy, n = 0;
+  lw_cellgrid_locate(g, x, y, &cx, &cy);
+  const double u = x - (g->x0 + cx * side), v = y - (g->y0 + cy * side);
+  const double gx[3] = {u * u, 0.0, (side - u) * (side - u)}, gy[3] = {v * v, 0.0, (side - v) * (side - v)};
+  for (int j = cy > 0 ? cy - 1 : 0; j <= cy + 1 && j < g->ny; j++)
+    for (int i = cx > 0 ? cx - 1 : 0; i <= cx + 1 && i < g->nx; i++) {
+      const lw_cell *c = &g->cell[(size_t)j * (size_t)g->nx + (size_t)i];
+      if (c->n && gx[i - cx + 1] + gy[j - cy + 1] <= far2) near[n++] = c; /* an empty cell may have no block */
+    }
+  return n;
+}
+
+/* 1 if sample index e is one of the moving spline's own (f's ranges). */
+static inline int own_sample(const lw_pair_filter *f, uint32_t e)
+{
+  return (e >= f->lo && e < f->hi) || (e >= f->lo2 && e < f->hi2);
+}
+
 /* How many pairs of one of the n samples ps and a sample of another spline
 ** (an index outside f's ranges [lo, hi) and [lo2, hi2)) are closer than
 ** sqrt(d2): the 3 x 3 cells around each (cells are at least the cutoff >=
@@ -983,25 +1007,21 @@ static size_t crowding(const lw_cellgrid *grid, const lw_pair_sample *ps, size_t
 {
   lw_cellgrid view;
   const lw_cellgrid *g = lw_cellgrid_plane(grid, f->plane, &view);
-  const double side = 1.0 / g->inv_h, far2 = d2 * (1.0 + 1e-8);
+  const double far2 = d2 * (1.0 + 1e-8);
   size_t count = 0;
   for (size_t k = 0; k < n; k++) {
-    int cx, cy;
-    lw_cellgrid_locate(g, ps[k].x, ps[k].y, &cx, &cy);
-    const double u = ps[k].x - (g->x0 + cx * side), v = ps[k].y - (g->y0 + cy * side);
-    const double gx[3] = {u * u, 0.0, (side - u) * (side - u)}, gy[3] = {v * v, 0.0, (side - v) * (side - v)};
-    for (int y = cy > 0 ? cy - 1 : 0; y <= cy + 1 && y < g->ny; y++)
-      for (int x = cx > 0 ? cx - 1 : 0; x <= cx + 1 && x < g->nx; x++) {
-        const lw_cell *c = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
-        if (!c->n || gx[x - cx + 1] + gy[y - cy + 1] > far2) continue; /* an empty cell may have no block */
-        const double *xs = c->x, *ys = lw_cell_y(c);
-        const uint32_t *idx = lw_cell_idx(c);
-        for (uint32_t e = 0; e < c->n; e++) {
-          if ((idx[e] >= f->lo && idx[e] < f->hi) || (idx[e] >= f->lo2 && idx[e] < f->hi2)) continue; /* its own */
-          double dx = xs[e] - ps[k].x, dy = ys[e] - ps[k].y;
-          count += dx * dx + dy * dy < d2;
-        }
+    const lw_cell *near[9];
+    const int nc = facing_cells(g, ps[k].x, ps[k].y, far2, near);
+    for (int j = 0; j < nc; j++) {
+      const lw_cell *c = near[j];
+      const double *xs = c->x, *ys = lw_cell_y(c);
+      const uint32_t *idx = lw_cell_idx(c);
+      for (uint32_t e = 0; e < c->n; e++) {
+        if (own_sample(f, idx[e])) continue;
+        double dx = xs[e] - ps[k].x, dy = ys[e] - ps[k].y;
+        count += dx * dx + dy * dy < d2;
       }
+    }
   }
   return count;
 }
@@ -1090,7 +1110,7 @@ static void segment_contacts(const contact_view *cv, const double c[8], const lw
       const lw_cell *cell = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
       const uint32_t *idx = cell->n ? lw_cell_idx(cell) : NULL; /* an empty cell may have no block */
       for (uint32_t e = 0; e < cell->n; e++) {
-        if ((idx[e] >= f->lo && idx[e] < f->hi) || (idx[e] >= f->lo2 && idx[e] < f->hi2)) continue;
+        if (own_sample(f, idx[e])) continue;
         const uint32_t h = idx[e] / np;
         if (seen[h % SEEN] == h) continue;
         seen[h % SEEN] = h;
@@ -1146,41 +1166,37 @@ static int closes_in(const lw_model *m, const lw_pair_sample *now, const lw_pair
   lw_cellgrid view;
   const lw_cellgrid *g = lw_cellgrid_plane(m->grid, f->plane, &view);
   const lw_quad *quad = m->terms.ctx[m->terms.pair].quad;
-  const double side = 1.0 / g->inv_h, far2 = d2 * (1.0 + 1e-8), spacing = m->scene->min_spacing;
+  const double far2 = d2 * (1.0 + 1e-8), spacing = m->scene->min_spacing;
   for (size_t k = 0; k < n; k++) {
     /* each nearby curve once, from its sample nearest the point */
     uint32_t seg[NEAR];
     double t0[NEAR], ds0[NEAR];
     int n_near = 0;
-    int cx, cy;
-    lw_cellgrid_locate(g, now[k].x, now[k].y, &cx, &cy);
-    const double u = now[k].x - (g->x0 + cx * side), v = now[k].y - (g->y0 + cy * side);
-    const double gx[3] = {u * u, 0.0, (side - u) * (side - u)}, gy[3] = {v * v, 0.0, (side - v) * (side - v)};
-    for (int y = cy > 0 ? cy - 1 : 0; y <= cy + 1 && y < g->ny; y++)
-      for (int x = cx > 0 ? cx - 1 : 0; x <= cx + 1 && x < g->nx; x++) {
-        const lw_cell *c = &g->cell[(size_t)y * (size_t)g->nx + (size_t)x];
-        if (!c->n || gx[x - cx + 1] + gy[y - cy + 1] > far2) continue;
-        const double *xs = c->x, *ys = lw_cell_y(c);
-        const uint32_t *idx = lw_cell_idx(c);
-        for (uint32_t e = 0; e < c->n; e++) {
-          if ((idx[e] >= f->lo && idx[e] < f->hi) || (idx[e] >= f->lo2 && idx[e] < f->hi2)) continue;
-          const uint32_t h = idx[e] / np;
-          const double dx = xs[e] - now[k].x, dy = ys[e] - now[k].y, ds = dx * dx + dy * dy;
-          const double within = spacing + 0.5 * mg->gap[h] + mg->reach[h], t = quad->s[idx[e] % np];
-          if (ds >= within * within) continue; /* ds: squared */
-          int j = 0;
-          while (j < n_near && seg[j] != h) j++;
-          if (j < n_near) {
-            if (ds < ds0[j]) ds0[j] = ds, t0[j] = t;
-          } else if (n_near < NEAR) {
-            seg[n_near] = h, t0[n_near] = t, ds0[n_near] = ds;
-            n_near++;
-          } else {
-            const double r = mg->reach[h], dc = curve_distance(m->sp, h, t, now[k].x, now[k].y);
-            if (dc < spacing + r && dc < curve_distance(m->sp, h, t, before[k].x, before[k].y) + r) return 1;
-          }
+    const lw_cell *cells[9];
+    const int nc = facing_cells(g, now[k].x, now[k].y, far2, cells);
+    for (int cj = 0; cj < nc; cj++) {
+      const lw_cell *c = cells[cj];
+      const double *xs = c->x, *ys = lw_cell_y(c);
+      const uint32_t *idx = lw_cell_idx(c);
+      for (uint32_t e = 0; e < c->n; e++) {
+        if (own_sample(f, idx[e])) continue;
+        const uint32_t h = idx[e] / np;
+        const double dx = xs[e] - now[k].x, dy = ys[e] - now[k].y, ds = dx * dx + dy * dy;
+        const double within = spacing + 0.5 * mg->gap[h] + mg->reach[h], t = quad->s[idx[e] % np];
+        if (ds >= within * within) continue; /* ds: squared */
+        int j = 0;
+        while (j < n_near && seg[j] != h) j++;
+        if (j < n_near) {
+          if (ds < ds0[j]) ds0[j] = ds, t0[j] = t;
+        } else if (n_near < NEAR) {
+          seg[n_near] = h, t0[n_near] = t, ds0[n_near] = ds;
+          n_near++;
+        } else {
+          const double r = mg->reach[h], dc = curve_distance(m->sp, h, t, now[k].x, now[k].y);
+          if (dc < spacing + r && dc < curve_distance(m->sp, h, t, before[k].x, before[k].y) + r) return 1;
         }
       }
+    }
     for (int j = 0; j < n_near; j++) {
       const double r = mg->reach[seg[j]], dc = curve_distance(m->sp, seg[j], t0[j], now[k].x, now[k].y);
       if (dc < spacing + r && dc < curve_distance(m->sp, seg[j], t0[j], before[k].x, before[k].y) + r) return 1;
