@@ -305,10 +305,12 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
   if (w < 0 || (size_t)w >= n) return;
   k = (size_t)w;
   if (!d->has_fidelity) return;
-  w = snprintf(buf + k, n - k, "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f, orientation %.4f, stray ink %.4f\n",
+  w = snprintf(buf + k, n - k,
+               "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f, orientation %.4f, stray ink %.4f\n",
                d->fidelity.sigma_mm, d->fidelity.mse, d->fidelity.ssim, d->fidelity.orientation, d->fidelity.stray);
   for (int p = 0; d->n_pens > 1 && p < d->n_pens && w >= 0 && (k += (size_t)w) < n; p++)
-    w = snprintf(buf + k, n - k, "linewise: fidelity of pen %d: MSE %.6g, SSIM %.4f, orientation %.4f, stray ink %.4f\n",
-                 p + 1, d->pen_fidelity[p].mse, d->pen_fidelity[p].ssim, d->pen_fidelity[p].orientation,
+    w = snprintf(buf + k, n - k,
+                 "linewise: fidelity of pen %d: MSE %.6g, SSIM %.4f, orientation %.4f, stray ink %.4f\n", p + 1,
+                 d->pen_fidelity[p].mse, d->pen_fidelity[p].ssim, d->pen_fidelity[p].orientation,
                  d->pen_fidelity[p].stray);
 }

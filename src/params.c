@@ -759,7 +759,6 @@ void lw_params_defaults(lw_params *p)
   for (size_t i = 0; i < lw_param_count; i++) assign(p, &lw_param_table[i], lw_param_table[i].def, expected, sizeof expected);
 }
 
-
 lw_status lw_params_blame(const lw_params *p, const char *section, const char *key, lw_error *err)
 {
   char where[LW_PATH_MAX + 32], msg[LW_ERROR_MSG];

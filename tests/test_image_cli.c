@@ -451,9 +451,9 @@ Test(image_cli, photo_preset_keeps_strokes_apart_on_grainy_pictures)
 ** picture).  The preset's chemical potential pays 7.14 pen widths a mm for
 ** line anywhere, and the tone term's price of the first thin line in white
 ** is quadratic in its ink, so next to nothing: before the preset made line
-** cost as much where the picture is white, 150 sweeps on A6 left 6.3 % of
+** cost as much where the picture is white, 150 sweeps on A6 left 6.1 % of
 ** the ink as long strokes across the white (stray ink, fidelity.h), and 300
-** sweeps 12.6 %.  With it, none (the run below without it is the control:
+** sweeps 12.6 %.  With it, 3e-6 (the run below without it is the control:
 ** the same seed and sweeps, only energy.potential = 0). */
 Test(image_cli, the_photo_preset_leaves_white_paper_white)
 {
