@@ -299,9 +299,10 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
   int w = snprintf(buf, n,
                    "linewise: %zu paths (%zu strokes: %zu joins, %zu cut by the crop, %zu outside it, %zu too short); "
                    "pen-up travel %.1f mm in index order, %.1f mm as plotted\n"
-                   "linewise: plot time about %s (%.0f s: %.0f mm pen down, %zu lifts)\n",
+                   "linewise: plot time about %s (%.0f s: %.0f mm pen down, %zu lifts); close share %.4f (of the "
+                   "line within a pen width of another stroke)\n",
                    d->paths, r->lifts_before, r->joins, r->cut, r->outside, r->dropped, d->travel_before,
-                   d->travel_after, clock, d->time_s, d->pen_down_mm, r->lifts_after);
+                   d->travel_after, clock, d->time_s, d->pen_down_mm, r->lifts_after, d->close_share);
   if (w < 0 || (size_t)w >= n) return;
   k = (size_t)w;
   if (!d->has_fidelity) return;

@@ -189,16 +189,19 @@ Test(image_cli, the_plot_and_fidelity_reports)
   char errs[8192];
   cr_assert_eq(run("run scene.ini --out out --set output.pens=2", errs, sizeof errs), 0, "%s", errs);
   cr_assert(strstr(errs, "linewise: plot time about "), "%s", errs);
-  cr_assert(strstr(errs, " lifts)\n"), "%s", errs);
-  cr_assert(strstr(errs, ", orientation "), "%s", errs);
+  cr_assert(strstr(errs, " lifts); close share "), "%s", errs);
+  cr_assert(strstr(errs, ", orientation ") && strstr(errs, ", stray ink "), "%s", errs);
   const char *js = lw_test_read_text(lw_test_path("out/summary.json"));
   const char *want[] = {"\"plot\": {", "\"lifts\": {", "\"joins\": ", "\"cut\": ", "\"outside\": ",
                         "\"dropped\": ", "\"crop_mm\": [", "\"pen_down_mm\": ", "\"pen_up_mm\": ",
-                        "\"time_s\": ", "\"orientation\": ", "\"pens\": ["};
+                        "\"time_s\": ", "\"orientation\": ", "\"stray\": ", "\"pens\": ["};
   for (size_t k = 0; k < sizeof want / sizeof *want; k++) cr_assert(strstr(js, want[k]), "%s in\n%s", want[k], js);
   /* one overall score and one per pen */
   size_t n = 0;
   for (const char *c = js; (c = strstr(c, "\"orientation\": ")); c++) n++;
+  cr_assert_eq(n, 3, "%s", js);
+  n = 0;
+  for (const char *c = js; (c = strstr(c, "\"stray\": ")); c++) n++;
   cr_assert_eq(n, 3, "%s", js);
   cr_assert_eq(run("run scene.ini --out out2 --set plot.crop=0", errs, sizeof errs), 0, "%s", errs);
   js = lw_test_read_text(lw_test_path("out2/summary.json"));
