@@ -165,8 +165,9 @@ static void member(const char *json, const char *obj, const char *key, char *out
   snprintf(out, n, "%.*s", (int)(len < n ? len : n - 1), at);
 }
 
-/* Every energy and acceptance cell of row r equals run/summary.json, text
-** for text (the gatherer copies values, so the CSV is exact). */
+/* Every energy, acceptance, close share and fidelity cell of row r equals
+** run/summary.json, text for text (the gatherer copies values, so the CSV is
+** exact). */
 static void row_matches_summary(const csv *t, int r, const char *run)
 {
   char *js = slurp("%s/%s/summary.json", dir, run);
@@ -176,7 +177,9 @@ static void row_matches_summary(const csv *t, int r, const char *run)
     const char *h = t->head[c];
     if (!strncmp(h, "energy_", 7)) member(js, "energy", h + 7, want, sizeof want);
     else if (!strncmp(h, "acceptance_", 11)) member(js, "acceptance", h + 11, want, sizeof want);
-    else if (!strcmp(h, "seed") || !strcmp(h, "proposals_per_second") || !strcmp(h, "wall_seconds"))
+    else if (!strncmp(h, "fidelity_", 9)) member(js, "fidelity", h + 9, want, sizeof want);
+    else if (!strcmp(h, "seed") || !strcmp(h, "proposals_per_second") || !strcmp(h, "wall_seconds") ||
+             !strcmp(h, "close_share"))
       member(js, NULL, h, want, sizeof want);
     else continue;
     if (!strcmp(want, "null")) want[0] = '\0';
@@ -214,9 +217,10 @@ Test(tools, seed_sweep_gathers_every_summary_and_links_the_best)
   csv_read(&t, path);
   const char *want_cols[] = {"seed", "energy_total", "energy_strain", "energy_bending", "energy_pair",
                              "energy_boundary", "acceptance_point", "acceptance_rotate",
-                             "proposals_per_second", "wall_seconds", "run"};
+                             "proposals_per_second", "wall_seconds", "close_share", "run"};
   for (size_t i = 0; i < sizeof want_cols / sizeof *want_cols; i++)
     cr_assert(col(&t, want_cols[i]) >= 0, "no column %s", want_cols[i]);
+  cr_assert(col(&t, "fidelity_ssim") < 0, "fidelity columns without a picture");
   cr_assert_eq(col(&t, "seed"), 0);
   cr_assert_eq(col(&t, "energy_total"), 1, "no key columns in a seed sweep");
   cr_assert_eq(t.nrow, 4);
@@ -252,6 +256,31 @@ Test(tools, seed_sweep_gathers_every_summary_and_links_the_best)
   cr_assert(fabs(number_after(out, "mean ") - mean) <= 1e-9 * fabs(mean), "%s", out);
   cr_assert(fabs(number_after(out, "std ") - sd) <= 1e-9 * sd, "sample std %.10g: %s", sd, out);
   free(out);
+  free(t.text);
+}
+
+/* A sweep of a picture gathers the drawing's scores too: close share and
+** fidelity_mse, _ssim, _orientation and _stray, each the run's own. */
+Test(tools, a_sweep_of_a_picture_gathers_the_drawings_scores)
+{
+  cr_assert_eq(sh("%s %s/params/example.ini --seeds 1-2 -j 2 --set anneal.sweeps=2 --bin %s --out %s/p",
+                  tool("seed-sweep"), env("LW_ROOT"), env("LW_BIN"), dir),
+               0, "%s", err_txt());
+  csv t;
+  char path[128];
+  snprintf(path, sizeof path, "%s/p/sweep.csv", dir);
+  csv_read(&t, path);
+  const char *want_cols[] = {"close_share", "fidelity_mse", "fidelity_ssim", "fidelity_orientation",
+                             "fidelity_stray"};
+  for (size_t i = 0; i < sizeof want_cols / sizeof *want_cols; i++)
+    cr_assert(col(&t, want_cols[i]) >= 0, "no column %s", want_cols[i]);
+  cr_assert_eq(t.nrow, 2);
+  for (int r = 0; r < 2; r++) {
+    char run[32];
+    snprintf(run, sizeof run, "p/seed-%d", r + 1);
+    row_matches_summary(&t, r, run);
+    cr_assert(atof(cell(&t, r, "fidelity_ssim")) > 0, "seed %d: ssim %s", r + 1, cell(&t, r, "fidelity_ssim"));
+  }
   free(t.text);
 }
 
