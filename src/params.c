@@ -255,12 +255,18 @@ const lw_param_def lw_param_table[] = {
       "docs/NUMERICS.md), so the chemical potential and the other terms decide how many lines "
       "a drawing needs. Splines system only."),
   NUM("moves", "birth", LW_PT_DOUBLE, mix_birth, "0.01", "", 0, 1e6, 0,
-      "Relative frequency of births: a new spline of init.segments segments placed along the "
-      "field, starting where the picture is dark (fixed_count = 0)."),
+      "Relative frequency of births: a new spline of init.segments segments (another count "
+      "with birth_spread) placed along the field, starting where the picture is dark "
+      "(fixed_count = 0)."),
   NUM("moves", "birth_uniform", LW_PT_DOUBLE, birth_uniform, "0.1", "", 1e-3, 1, 0,
       "With a picture, the share of born splines whose first point is uniform on the page; the "
       "others start where placement starts a spline, by darkness. It keeps every point "
       "possible for a first node (fixed_count = 0; docs/NUMERICS.md)."),
+  NUM("moves", "birth_spread", LW_PT_DOUBLE, birth_spread, "0", "", 0, 1, LW_MAX_OPEN,
+      "The share of births whose segment count is drawn uniformly from 1 .. max_segments "
+      "other than init.segments. With 0 a death removes only splines of init.segments "
+      "segments (what a birth makes); above 0 it removes a spline of any count, so a short "
+      "piece can leave without growing first (fixed_count = 0; docs/NUMERICS.md)."),
   NUM("moves", "death", LW_PT_DOUBLE, mix_death, "0.01", "", 0, 1e6, 0,
       "Relative frequency of deaths: a spline chosen uniformly is removed (fixed_count = 0)."),
   NUM("moves", "grow", LW_PT_DOUBLE, mix_grow, "0.02", "", 0, 1e6, 0,
@@ -899,7 +905,10 @@ _Static_assert(sizeof page_mm / sizeof page_mm[0] == LW_PAGE_LEGAL + 1, "a size 
 ** Phi = tone^8, near 0 but near white): without it the first thin line in
 ** white costs almost nothing (the tone term is quadratic in the ink) and
 ** stray lines crossed white backgrounds (docs/IMAGES.md, "White
-** backgrounds").
+** backgrounds").  A tenth of the births draw another segment count, so
+** that a death can take a short piece too: a piece that could leave only
+** by growing first stayed where growing costs, in a colour pen's white
+** (docs/NUMERICS.md, "Trans-dimensional moves").
 */
 #define PHOTO_CHEM (2.5 / 0.35) /* the chemical potential's price of line, pen widths per mm */
 static const struct {
@@ -922,7 +931,7 @@ static const struct {
     {"moves", "grow", "0.05", 0},          {"moves", "shrink", "0.05", 0},
     {"scene", "image_levels", "0.01", 0},  {"layers", "apart", "pen", 0},
     {"scene", "potential", "image", 0},    {"energy", "potential", NULL, PHOTO_CHEM},
-    {"scene", "potential_power", "8", 0},
+    {"scene", "potential_power", "8", 0},  {"moves", "birth_spread", "0.1", 0},
 };
 
 /* Sets an unset key from text; the key stays unset (line 0), so a later

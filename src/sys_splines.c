@@ -72,7 +72,7 @@ static void *setup_new(const lw_params *p, lw_error *err)
   if (su->scene.image && !(su->tone = lw_image_tone_grid(su->scene.image, &su->scene.image_place, err)))
     goto fail;
   if (lw_td_init(&su->td, &su->scene, (size_t)p->segments, p->segment_length, su->scene.max_segments,
-                 p->birth_uniform)) {
+                 p->birth_uniform, p->birth_spread)) {
     lw_error_set(err, LW_ENOMEM, "out of memory for the birth prior's darkness table");
     goto fail;
   }
@@ -622,10 +622,11 @@ static double propose_join(spl_state *s, lw_proposal *p, gsl_rng *rng)
 /*
 ** Birth, death, grow and shrink (transdim.h; docs/NUMERICS.md has the
 ** derivation of each Hastings factor).  A birth adds a spline drawn from
-** the prior, a death removes one chosen uniformly: the state is a set, and
-** its numbering (where the model puts a new spline, slots.h) plays no part
-** in any density.  A death removes only splines a birth could have made
-** (lw_td_mortal): for the others the reverse proposal has density 0.  A
+** the prior, its segment count from lw_td_birth_size, a death removes one
+** chosen uniformly: the state is a set, and its numbering (where the model
+** puts a new spline, slots.h) plays no part in any density.  A death
+** removes only splines a birth could have made (lw_td_mortal): for the
+** others the reverse proposal has density 0.  A
 ** grow or shrink moves the rest length by l and keeps its excess over n l
 ** (lw_td_rest), so that each undoes the other for any rest length.
 */
@@ -635,7 +636,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
   const lw_td *td = &su->td;
   const lw_model *m = s->m;
   const lw_splines *sp = m->sp;
-  const size_t N = lw_model_count(m), nb = td->birth_segments;
+  const size_t N = lw_model_count(m);
   const double *lw = su->log_w;
   *forbidden = 0;
   if (kind == LW_MOVE_SPLIT || kind == LW_MOVE_JOIN) {
@@ -644,19 +645,21 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
     return dE;
   }
   if (kind == LW_MOVE_BIRTH) {
-    lw_td_birth_draw(td, rng, p->node);
+    const size_t nb = lw_td_birth_size(td, rng);
+    lw_td_birth_draw(td, rng, nb, p->node);
     /* its layer by the layers' shares, the prior's own law of a layer:
     ** the factors cancel (docs/NUMERICS.md) */
     const lw_layers_spec *ls = &m->scene->layers;
     const int layer = ls->n ? lw_layers_at(ls, gsl_rng_uniform(rng)) : 0;
     lw_model_propose_splice(m, p, 0, 0, NULL, nb + 1, (double)nb * td->length, layer);
-    p->log_ratio = lw[1] - lw[0] - log((double)(N + 1));
+    p->log_ratio = lw[1] - lw[0] - log((double)(N + 1)) - lw_td_size_log(td, nb);
   } else if (kind == LW_MOVE_DEATH) {
     if (N == 0) return refuse(p);
     uint32_t j = live_spline(m, rng);
-    if (!lw_td_mortal(td, lw_splines_segments(sp, j), sp->rest_length[j])) return refuse(p);
+    const size_t n = lw_splines_segments(sp, j);
+    if (!lw_td_mortal(td, n, sp->rest_length[j])) return refuse(p);
     lw_model_propose_splice(m, p, j, 1, NULL, 0, 0.0, 0);
-    p->log_ratio = lw[0] - lw[1] + log((double)N);
+    p->log_ratio = lw[0] - lw[1] + log((double)N) + lw_td_size_log(td, n);
   } else {
     if (N == 0) return refuse(p);
     uint32_t i = live_spline(m, rng);

@@ -15,7 +15,7 @@
 #include "linewise/init.h"
 
 lw_status lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double length, size_t max_segments,
-                     double uniform)
+                     double uniform, double spread)
 {
   td->scene = sc;
   td->cum = NULL;
@@ -36,6 +36,7 @@ lw_status lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, doubl
   td->sigma_v = length / 12.0;
   td->birth_segments = birth_segments;
   td->max_segments = max_segments;
+  td->spread = max_segments > 1 ? spread : 0.0; /* else no other count */
   return LW_OK;
 }
 
@@ -56,9 +57,23 @@ int lw_td_plain(const lw_td *td, size_t n, double rest)
   return rest == (double)n * td->length;
 }
 
+size_t lw_td_birth_size(const lw_td *td, gsl_rng *rng)
+{
+  if (td->spread <= 0.0 || gsl_rng_uniform(rng) >= td->spread) return td->birth_segments;
+  const size_t n = 1 + gsl_rng_uniform_int(rng, td->max_segments - 1);
+  return n >= td->birth_segments ? n + 1 : n;
+}
+
+double lw_td_size_log(const lw_td *td, size_t n)
+{
+  if (n == td->birth_segments) return log1p(-td->spread);
+  if (n < 1 || n > td->max_segments || td->spread <= 0.0) return -INFINITY;
+  return log(td->spread / (double)(td->max_segments - 1));
+}
+
 int lw_td_mortal(const lw_td *td, size_t n, double rest)
 {
-  return n == td->birth_segments && lw_td_plain(td, n, rest);
+  return lw_td_size_log(td, n) > -INFINITY && lw_td_plain(td, n, rest);
 }
 
 /* log pi(x, y) (transdim.h): -inf off the page. */
@@ -160,7 +175,7 @@ double lw_td_first_log(const lw_td *td, const lw_node *n0)
   return lp - log(2.0 * M_PI * s * s) - 0.5 * (v - r) * (v - r) / (s * s) + log(gsl_sf_bessel_I0_scaled(z));
 }
 
-void lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd)
+void lw_td_birth_draw(const lw_td *td, gsl_rng *rng, size_t n, lw_node *nd)
 {
   const double r = td->length / 3.0;
   double ux, uy;
@@ -182,7 +197,7 @@ void lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd)
   }
   nd[0].vx = r * ux + gsl_ran_gaussian_ziggurat(rng, td->sigma_v);
   nd[0].vy = r * uy + gsl_ran_gaussian_ziggurat(rng, td->sigma_v);
-  for (size_t k = 1; k <= td->birth_segments; k++) lw_td_next_draw(td, &nd[k - 1], 1, rng, &nd[k]);
+  for (size_t k = 1; k <= n; k++) lw_td_next_draw(td, &nd[k - 1], 1, rng, &nd[k]);
 }
 
 double lw_td_prior(const lw_td *td, const lw_node *nd, size_t n)

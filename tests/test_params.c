@@ -372,12 +372,13 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
                LW_OK, "%s", err.msg);
   cr_assert(p.potential == LW_POT_IMAGE && fabs(p.potential_coef - 2.5) < 1e-12 && p.potential_power == 8,
             "potential %d, %.17g, power %g", p.potential, p.potential_coef, p.potential_power);
+  cr_assert(p.birth_spread == 0.1, "a short piece may die: birth_spread %g", p.birth_spread);
   /* without the preset nothing changes */
   lw_params d;
   lw_params_defaults(&d);
   cr_assert_eq(read_text("[scene]\npage = a4\n", &p, &err), LW_OK);
   cr_assert(p.segment_length == d.segment_length && p.tone == d.tone && !strcmp(p.domains, d.domains));
-  cr_assert(p.image_levels == 0 && d.image_levels == 0);
+  cr_assert(p.image_levels == 0 && d.image_levels == 0 && p.birth_spread == 0 && d.birth_spread == 0);
 }
 
 /* orientation = auto turns a named page to the picture, which the photo

@@ -192,6 +192,28 @@ Test(transdim, ideal_gas_segments_are_uniform)
   td_chain_free(c, setup);
 }
 
+/* Runs chain c (burn-in, then 12000 samples 8 sweeps apart) and checks
+** that N is Poisson with mean `mean` and each spline's segment count uniform
+** over 1..4 (chi-square, p > 1e-3); leaves the segment counts in sc, ns. */
+static void poisson_and_uniform_sizes(lw_chain *c, double mean, unsigned long *sc, unsigned long *ns)
+{
+  unsigned long nc[NMAX] = {0};
+  tally(c, 500, 4, nc, sc, ns);
+  memset(nc, 0, sizeof nc);
+  memset(sc, 0, NMAX * sizeof *sc);
+  *ns = 0;
+  const long n = lw_test_long() ? 100000 : 12000;
+  tally(c, n, 8, nc, sc, ns);
+  double prob[NMAX];
+  for (int k = 0; k < NMAX; k++) prob[k] = gsl_ran_poisson_pdf((unsigned)k, mean);
+  double pv = chisq_p(nc, prob, 30, (unsigned long)n);
+  cr_assert(pv > 1e-3, "spline count vs Poisson(%g): chi-square p = %g", mean, pv);
+  double pu[NMAX] = {0};
+  for (int k = 1; k <= 4; k++) pu[k] = 0.25;
+  pv = chisq_p(sc + 1, pu + 1, 4, *ns);
+  cr_assert(pv > 1e-3, "segments vs uniform 1..4: p = %g", pv);
+}
+
 /* Everything at once: N is Poisson with mean K exp(-mu_s / T), K = 4
 ** reachable segment counts, and the segment counts stay uniform. */
 Test(transdim, ideal_gas_all_moves_together)
@@ -205,21 +227,36 @@ Test(transdim, ideal_gas_all_moves_together)
   p.mix_point = p.mix_vector = p.mix_translate = p.mix_rotate = 0.5;
   void *setup;
   lw_chain *c = td_chain(&p, T, 13, &setup);
-  unsigned long nc[NMAX] = {0}, sc[NMAX] = {0}, ns = 0;
-  tally(c, 500, 4, nc, sc, &ns);
-  memset(nc, 0, sizeof nc);
-  memset(sc, 0, sizeof sc);
-  ns = 0;
-  const long n = lw_test_long() ? 100000 : 12000;
-  tally(c, n, 8, nc, sc, &ns);
-  double prob[NMAX];
-  for (int k = 0; k < NMAX; k++) prob[k] = gsl_ran_poisson_pdf((unsigned)k, 4 * lambda);
-  double pv = chisq_p(nc, prob, 30, (unsigned long)n);
-  cr_assert(pv > 1e-3, "spline count vs Poisson(%g): chi-square p = %g", 4 * lambda, pv);
-  double pu[NMAX] = {0};
-  for (int k = 1; k <= 4; k++) pu[k] = 0.25;
-  pv = chisq_p(sc + 1, pu + 1, 4, ns);
-  cr_assert(pv > 1e-3, "segments vs uniform 1..4: p = %g", pv);
+  unsigned long sc[NMAX] = {0}, ns = 0;
+  poisson_and_uniform_sizes(c, 4 * lambda, sc, &ns);
+  td_chain_free(c, setup);
+}
+
+/* Births of several sizes (moves.birth_spread), births and deaths alone:
+** a birth draws 2 segments with probability 0.7 and 1, 3 or 4 with 0.1
+** each, and its Hastings factor and the death's carry that law, so the
+** target is the one of all four counts reachable: N is Poisson with mean
+** 4 exp(-mu_s / T), the segment counts uniform over 1..4, not the births'
+** law.  Without the law's factor in the ratios the counts would follow the
+** births' (0.7 of them 2 segments) and the mean would be exp(-mu_s / T);
+** the last chi-square shows the test tells those apart. */
+Test(transdim, ideal_gas_births_of_every_size_reach_every_count)
+{
+  lw_params p;
+  const double T = 1.1, lambda = 2.0;
+  ideal_gas(&p, -T * log(lambda));
+  p.splines = 12;
+  p.max_segments = 4;
+  p.birth_spread = 0.3;
+  p.mix_birth = p.mix_death = 1;
+  void *setup;
+  lw_chain *c = td_chain(&p, T, 17, &setup);
+  unsigned long sc[NMAX] = {0}, ns = 0;
+  poisson_and_uniform_sizes(c, 4 * lambda, sc, &ns);
+  const double births[5] = {0, 0.1, 0.7, 0.1, 0.1};
+  cr_assert(chisq_p(sc + 1, births + 1, 4, ns) < 1e-3, "the segment counts follow the births' own law");
+  for (int k = LW_MOVE_BIRTH; k <= LW_MOVE_DEATH; k++)
+    cr_assert(c->stats[k].accepted > 1000, "kind %d accepted %lu", k, c->stats[k].accepted);
   td_chain_free(c, setup);
 }
 
@@ -345,7 +382,8 @@ static void darkness_law(const char *domains, unsigned long seed)
 ** rest length (before, both reset it to n l: a grow and a shrink took a
 ** rest length of 17.3 mm to 15); births' rest lengths come back exactly;
 ** a shrink that would leave no positive rest length is refused; a death
-** only takes what a birth makes. */
+** only takes what a birth makes (of init.segments segments, or of any
+** count up to max_segments with moves.birth_spread). */
 Test(transdim, grow_and_shrink_keep_a_rest_length_reversible)
 {
   lw_params p;
@@ -353,7 +391,7 @@ Test(transdim, grow_and_shrink_keep_a_rest_length_reversible)
   lw_scene sc;
   lw_test_scene(&sc, &p);
   lw_td td;
-  cr_assert_eq(lw_td_init(&td, &sc, 2, 5.0, 8, 0.1), LW_OK);
+  cr_assert_eq(lw_td_init(&td, &sc, 2, 5.0, 8, 0.1, 0.0), LW_OK);
   cr_assert_eq(lw_td_rest(&td, 15.0, 3, 4), 20.0);
   cr_assert_eq(lw_td_rest(&td, lw_td_rest(&td, 15.0, 3, 4), 4, 3), 15.0);
   cr_assert_eq(lw_td_rest(&td, lw_td_rest(&td, 10.0, 2, 1), 1, 2), 10.0);
@@ -366,7 +404,15 @@ Test(transdim, grow_and_shrink_keep_a_rest_length_reversible)
   cr_assert(isnan(lw_td_rest(&td, 4.0, 2, 1)), "a shrink to a rest length of -1 mm");
   cr_assert(lw_td_mortal(&td, 2, 10.0));
   cr_assert(!lw_td_mortal(&td, 2, 10.5), "no birth makes a rest length of 10.5 mm for 2 segments");
-  cr_assert(!lw_td_mortal(&td, 3, 15.0));
+  cr_assert(!lw_td_mortal(&td, 3, 15.0), "births make 2 segments only");
+  /* births of every size: any count up to max_segments dies, at rest length n l still */
+  td.spread = 0.3;
+  cr_assert(lw_td_mortal(&td, 1, 5.0) && lw_td_mortal(&td, 3, 15.0) && lw_td_mortal(&td, 8, 40.0));
+  cr_assert(!lw_td_mortal(&td, 9, 45.0), "no birth is longer than max_segments");
+  cr_assert(!lw_td_mortal(&td, 3, 15.5));
+  double sum = 0.0;
+  for (size_t n = 1; n <= 8; n++) sum += exp(lw_td_size_log(&td, n));
+  cr_assert(fabs(sum - 1.0) < 1e-15 && fabs(exp(lw_td_size_log(&td, 2)) - 0.7) < 1e-15, "the births' law of sizes");
   lw_td_clear(&td);
   lw_scene_clear(&sc);
 }
@@ -1091,7 +1137,7 @@ Test(transdim, split_claims_the_frequency_of_its_join)
   lw_model *m = lw_splines_model(c->sys);
   lw_proposal *pr = c->prop;
   lw_td td;
-  cr_assert_eq(lw_td_init(&td, m->scene, (size_t)p.segments, p.segment_length, 8, 0.1), LW_OK);
+  cr_assert_eq(lw_td_init(&td, m->scene, (size_t)p.segments, p.segment_length, 8, 0.1, 0.0), LW_OK);
   const long draws = 200000;
   int seen[3] = {0};
   for (int trial = 0; trial < 40 && !(seen[0] && seen[1] && seen[2]); trial++) {

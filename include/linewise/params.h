@@ -133,6 +133,7 @@ typedef struct {
   int fixed_count;            /* 1: no trans-dimensional moves (the count stays as placed) */
   double mix_birth, mix_death, mix_grow, mix_shrink; /* relative frequencies (fixed_count = 0) */
   double birth_uniform;       /* share of births placed uniformly rather than by darkness */
+  double birth_spread;        /* share of births of a segment count other than init.segments */
   int max_segments;           /* grow never makes a spline longer than this, segments */
   double mix_split, mix_join; /* relative frequencies of split and join (fixed_count = 0) */
   double join_radius;         /* ends closer than this join, in init.segment_length */

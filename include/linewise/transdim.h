@@ -32,7 +32,8 @@
 **          field's direction at p_0 either way (probability 1/2 each), or,
 **          where there is no field, a uniform direction (v_0 then has the
 **          density of a Gaussian ring, with a Bessel I0); then node k+1
-**          from node k as for grow at the tail.
+**          from node k as for grow at the tail, for the segment count
+**          lw_td_birth_size draws.
 **   grow   at the tail (dir = +1) after node a: p ~ N(p_a + 3 v_a, s_p^2),
 **          v ~ N((l/3) u(p), s_v^2), u the field's direction at p turned
 **          to agree with v_a (the direction of v_a where the field is off
@@ -58,13 +59,16 @@ typedef struct {
   double dark_scale;      /* (1 - b) / (D a^2), 1 / mm^2 */
   double length;          /* l: mm */
   double sigma_p, sigma_v; /* mm */
-  size_t birth_segments;  /* segments of a born spline */
+  size_t birth_segments;  /* segments of most born splines */
   size_t max_segments;    /* grow stops here */
+  double spread;          /* share of births of another segment count (moves.birth_spread) */
 } lw_td;
 
-/* LW_ENOMEM if the picture's darkness table cannot be had. */
+/* LW_ENOMEM if the picture's darkness table cannot be had.  spread in
+** [0, 1): the share of births whose segment count is drawn uniformly from
+** 1 .. max_segments other than birth_segments. */
 lw_status lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double length, size_t max_segments,
-                     double uniform);
+                     double uniform, double spread);
 void lw_td_clear(lw_td *td);
 
 /* log q_{n-1} of the n >= 1 nodes nd (-inf when node 0 is off the page). */
@@ -77,8 +81,16 @@ double lw_td_first_log(const lw_td *td, const lw_node *n0);
 /* The change of log q when node k of the n nodes nd becomes *to. */
 double lw_td_prior_change(const lw_td *td, const lw_node *nd, size_t n, size_t k, const lw_node *to);
 
-/* Draws a born spline of birth_segments + 1 nodes into nd from the prior. */
-void lw_td_birth_draw(const lw_td *td, gsl_rng *rng, lw_node *nd);
+/* The segment count of a birth: birth_segments with probability
+** 1 - spread, else one of the other counts 1 .. max_segments uniformly.
+** With spread 0 it draws nothing from rng, so a chain without the spread
+** keeps its stream.  lw_td_size_log: the log of that law at n (-inf where
+** it is 0), the factor a birth's and a death's Hastings ratios carry. */
+size_t lw_td_birth_size(const lw_td *td, gsl_rng *rng);
+double lw_td_size_log(const lw_td *td, size_t n);
+
+/* Draws a born spline of n segments (n + 1 nodes) into nd from the prior. */
+void lw_td_birth_draw(const lw_td *td, gsl_rng *rng, size_t n, lw_node *nd);
 
 /* The rest length of a spline of n_old segments and rest length `rest`
 ** after a grow or shrink to n_new: n_new l plus the spline's own excess
@@ -96,8 +108,8 @@ double lw_td_rest(const lw_td *td, double rest, size_t n_old, size_t n_new);
 int lw_td_plain(const lw_td *td, size_t n, double rest);
 
 /* 1 if a death may remove a spline of n segments and rest length `rest`:
-** a birth could have made it (birth_segments segments, rest length
-** birth_segments l exactly); the reverse density is 0 for the others. */
+** a birth could have made it (a segment count births draw, rest length
+** n l exactly); the reverse density is 0 for the others. */
 int lw_td_mortal(const lw_td *td, size_t n, double rest);
 
 /* Draws the node beyond `end` (dir +1: after it, -1: before it) into out;
