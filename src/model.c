@@ -1583,6 +1583,10 @@ static size_t splice_seg_node(const lw_proposal *p, size_t j)
   return j + (p->n_new == 2 && j + 1 >= p->new_node[0]);
 }
 
+/* 1 if a splice keeps its new segment j, its old segment o (splice_kept). */
+static int kept_new(const lw_proposal *p, size_t j) { return j < 64 && p->kept_new >> j & 1; }
+static int kept_old(const lw_proposal *p, size_t o) { return o < 64 && p->kept_old >> o & 1; }
+
 /* The old splines' sample ranges, in increasing order as the walk wants
 ** them: what a splice's pair sums and spacing leave out. */
 static lw_pair_filter old_filter(const pair_view *v, const lw_proposal *p)
@@ -1658,6 +1662,22 @@ static const lw_node *splice_old_nodes(const lw_model *m, const lw_proposal *p, 
   return &m->sp->node[m->sp->first[p->old[k]]];
 }
 
+/* What a split's two pieces have with each other, less what a join's two
+** splines had: the pairs no walk of a splice sees. */
+static double splice_pair_between(const lw_model *m, const lw_proposal *p, const pair_view *v)
+{
+  const uint32_t np = v->np;
+  double pe = 0.0;
+  if (p->n_new == 2) {
+    const size_t n0 = p->new_node[0] - 1;
+    pe += pair_between(v->ctx, np, p->node, p->ps, n0, p->node + n0 + 1, p->ps + n0 * np, p->new_node[1] - 1);
+  }
+  if (p->n_old == 2)
+    pe -= pair_between(v->ctx, np, splice_old_nodes(m, p, 0), p->ps_old, p->old_seg[0], splice_old_nodes(m, p, 1),
+                       p->ps_old + p->old_seg[0] * np, p->old_seg[1]);
+  return pe;
+}
+
 /* The pair part of a splice's dE (no coefficient); NAN if out of memory.
 ** With one old spline its near field comes from the cache as for a move;
 ** with two (a join) each one's cached near field holds the other too, so
@@ -1669,14 +1689,34 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p)
   const uint32_t np = (uint32_t)sc->pair_quad.n;
   const pair_view v = {m->grid, m->sp, np, &sc->pair, planes_of(sc)};
   const size_t nn = p->n_seg * np, no = p->n_old_seg * np;
-  for (size_t k = 0; k < nn; k++) p->probe[k] = (lw_pair_probe){p->ps[k].x, p->ps[k].y, p->ps[k].dl, 1.0};
-  for (size_t k = 0; k < no; k++)
-    p->probe[nn + k] = (lw_pair_probe){p->ps_old[k].x, p->ps_old[k].y, p->ps_old[k].dl, -1.0};
   /* an inserted spline has no samples in the grid yet: nothing to leave out */
   const lw_pair_filter f = old_filter(&v, p);
   double pe;
   p->near.n = 0;
   p->partners.n = 0;
+  if (!(sc->pair.near_scale > 0.0)) {
+    /* without the near field a kept segment's pairs with other strokes are
+    ** the same before and after (the pair term leaves a spline's own
+    ** pairs out, and the splines of a splice meet in pair_between): only
+    ** the segments that change are walked, one of a grow's 2 n + 1 */
+    size_t n = 0;
+    for (size_t j = 0; j < p->n_seg; j++)
+      for (size_t q = 0; !kept_new(p, j) && q < np; q++, n++) {
+        const lw_pair_sample *x = &p->ps[j * np + q];
+        p->probe[n] = (lw_pair_probe){x->x, x->y, x->dl, 1.0};
+      }
+    for (size_t o = 0; o < p->n_old_seg; o++)
+      for (size_t q = 0; !kept_old(p, o) && q < np; q++, n++) {
+        const lw_pair_sample *x = &p->ps_old[o * np + q];
+        p->probe[n] = (lw_pair_probe){x->x, x->y, x->dl, -1.0};
+      }
+    if (lw_pair_walk(m->grid, &sc->pair, p->probe, n, &f, &pe, NULL, &p->near, NULL) != LW_OK) return NAN;
+    for (size_t j = 0; j < p->n_seg; j++) p->near_new[j] = 0.0;
+    return pe + splice_pair_between(m, p, &v);
+  }
+  for (size_t k = 0; k < nn; k++) p->probe[k] = (lw_pair_probe){p->ps[k].x, p->ps[k].y, p->ps[k].dl, 1.0};
+  for (size_t k = 0; k < no; k++)
+    p->probe[nn + k] = (lw_pair_probe){p->ps_old[k].x, p->ps_old[k].y, p->ps_old[k].dl, -1.0};
   if (lw_pair_walk(m->grid, &sc->pair, p->probe, nn + no, &f, &pe, NULL, &p->near, NULL) != LW_OK) return NAN;
   for (size_t j = 0; j < p->n_seg; j++) {
     double bez[8];
@@ -1703,39 +1743,41 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p)
       if (add_partners(p, &p->segs) != LW_OK) return NAN;
     }
   }
-  if (p->n_new == 2) {
-    const size_t n0 = p->new_node[0] - 1;
-    pe += pair_between(v.ctx, np, p->node, p->ps, n0, p->node + n0 + 1, p->ps + n0 * np, p->new_node[1] - 1);
-  }
-  if (p->n_old == 2)
-    pe -= pair_between(v.ctx, np, splice_old_nodes(m, p, 0), p->ps_old, p->old_seg[0], splice_old_nodes(m, p, 1),
-                       p->ps_old + p->old_seg[0] * np, p->old_seg[1]);
-  return pe;
+  return pe + splice_pair_between(m, p, &v);
 }
 
-/* Marks in kept_old and kept_new (bit per segment, old ones numbered through
-** the old splines in order) the segments a splice keeps as they were, the
-** same two nodes bit for bit: a grow's or a shrink's, a split's or a join's
-** pieces that keep their direction.  Nothing is marked past 64 of either. */
-static void splice_kept(const lw_model *m, const lw_proposal *p, uint64_t *kept_old, uint64_t *kept_new)
+/* Marks in p->kept_old and p->kept_new (bit per segment, old ones numbered
+** through the old splines in order) the segments a splice keeps as they
+** were, the same two nodes bit for bit: a grow's or a shrink's, a split's or
+** a join's pieces that keep their direction; kept_from pairs them.  Nothing
+** is marked past 64 of either: those are evaluated as new. */
+static void splice_kept(const lw_model *m, lw_proposal *p)
 {
   const lw_node *old[64];
   size_t n = 0;
-  *kept_old = *kept_new = 0;
+  p->kept_old = p->kept_new = 0;
   for (int k = 0; k < p->n_old; k++)
     for (size_t j = 0; j < p->old_seg[k]; j++) {
-      if (n == 64) return;
+      if (n == 64) break;
       old[n++] = &splice_old_nodes(m, p, k)[j];
     }
   for (size_t j = 0; j < p->n_seg && j < 64; j++) {
     const lw_node *q = &p->node[splice_seg_node(p, j)];
     for (size_t o = 0; o < n; o++)
-      if (!(*kept_old >> o & 1) && !memcmp(old[o], q, 2 * sizeof *q)) {
-        *kept_old |= 1ull << o;
-        *kept_new |= 1ull << j;
+      if (!(p->kept_old >> o & 1) && !memcmp(old[o], q, 2 * sizeof *q)) {
+        p->kept_old |= 1ull << o;
+        p->kept_new |= 1ull << j;
+        p->kept_from[j] = (uint8_t)o;
         break;
       }
   }
+}
+
+/* The global number of old segment o of a splice (numbered as in splice_kept). */
+static size_t splice_old_segment(const lw_model *m, const lw_proposal *p, size_t o)
+{
+  const int k = o >= p->old_seg[0];
+  return lw_segment_index(m->sp, p->old[k], 0) + (k ? o - p->old_seg[0] : o);
 }
 
 /* A raster term's part of a splice's dE (no coefficient); NAN if the box
@@ -1748,21 +1790,19 @@ static double splice_raster_delta(const lw_model *m, lw_proposal *p, int t)
 {
   const lw_term_ctx *c = &ctx_in(&m->terms, p->layer)[t];
   lw_tone_box *b = &p->box[t];
-  uint64_t kept_old, kept_new;
-  splice_kept(m, p, &kept_old, &kept_new);
   lw_tone_box_reset(b);
   for (int pass = 0; pass < 2; pass++) {
     if (pass && lw_tone_box_ready(b) != LW_OK) return NAN;
     size_t o = 0;
     for (int k = 0; k < p->n_old; k++)
       for (size_t j = 0; j < p->old_seg[k]; j++, o++) {
-        if (o < 64 && kept_old >> o & 1) continue;
+        if (kept_old(p, o)) continue;
         const lw_node *nd = &splice_old_nodes(m, p, k)[j];
         if (pass) raster_segment(c, b, nd, nd + 1, -1);
         else raster_cover(c->data, b, nd, nd + 1);
       }
     for (size_t j = 0; j < p->n_seg; j++) {
-      if (j < 64 && kept_new >> j & 1) continue;
+      if (kept_new(p, j)) continue;
       const lw_node *nd = &p->node[splice_seg_node(p, j)];
       if (pass) raster_segment(c, b, nd, nd + 1, 1);
       else raster_cover(c->data, b, nd, nd + 1);
@@ -1772,25 +1812,38 @@ static double splice_raster_delta(const lw_model *m, lw_proposal *p, int t)
 }
 
 /* The new splines' segments: their caches in p and their share of dterm;
-** sets *forbidden and *undefined as lw_model_propose does. */
+** sets *forbidden and *undefined as lw_model_propose does.  A segment the
+** splice keeps takes its old self's caches, bit for bit what evaluating it
+** gives, and adds nothing to dterm: its old self is not taken away either
+** (lw_model_propose_regroup). */
 static void splice_new_segments(const lw_model *m, lw_proposal *p, int *forbidden, int *undefined)
 {
   const lw_scene *sc = m->scene;
   const lw_term_set *ts = &m->terms;
   const lw_term_ctx *pc = ts->pair >= 0 ? &ts->ctx[ts->pair] : NULL;
   const int np = pair_nodes(m), nl = sc->n_local;
+  const pair_view v = {m->grid, m->sp, (uint32_t)np, NULL, NULL};
   lw_samples s;
   p->irregular = 0;
   for (int k = 0, j = 0, a = 0; k < p->n_new; a += (int)p->new_node[k++]) {
     double L = 0.0;
     for (size_t i = 0; i + 1 < p->new_node[k]; i++, j++) {
       double *local = p->local + (size_t)j * (size_t)nl;
-      p->seg_irregular[j] = !segment_eval(sc, ctx_in(ts, p->layer), &p->node[(size_t)a + i], &p->node[(size_t)a + i + 1], &s,
-                                          &p->len[j], local, pc ? pc->quad : NULL,
-                                          m->grid ? p->ps + (size_t)j * (size_t)np : NULL);
+      const int kept = kept_new(p, (size_t)j);
+      if (kept) {
+        const size_t g = splice_old_segment(m, p, p->kept_from[j]);
+        p->seg_irregular[j] = m->seg_irregular[g];
+        p->len[j] = m->seg_len[g];
+        memcpy(local, m->seg_local + g * (size_t)nl, (size_t)nl * sizeof *local);
+        if (m->grid) samples_at(&v, (uint32_t)(g * (size_t)np), (size_t)np, p->ps + (size_t)j * (size_t)np);
+      } else {
+        p->seg_irregular[j] = !segment_eval(sc, ctx_in(ts, p->layer), &p->node[(size_t)a + i],
+                                            &p->node[(size_t)a + i + 1], &s, &p->len[j], local, pc ? pc->quad : NULL,
+                                            m->grid ? p->ps + (size_t)j * (size_t)np : NULL);
+      }
       p->irregular |= p->seg_irregular[j];
       for (int t = 0; t < nl; t++) {
-        p->dterm[sc->local[t]] += local[t];
+        if (!kept) p->dterm[sc->local[t]] += local[t];
         if (local[t] == INFINITY) *forbidden = 1;
         else if (isnan(local[t])) *undefined = 1;
       }
@@ -1905,14 +1958,16 @@ void lw_model_propose_regroup(const lw_model *m, lw_proposal *p, const uint32_t 
   p->layer = n_old ? layer_of(ts, sp, old[0]) : layer;
   if (nodes && nodes != p->node) memcpy(p->node, nodes, p->n_node * sizeof *nodes);
   for (int t = 0; t < LW_TERM_COUNT; t++) p->dterm[t] = 0.0;
+  splice_kept(m, p);
 
   int forbidden = 0, undefined = 0, was_irregular = 0;
   splice_new_segments(m, p, &forbidden, &undefined);
-  for (int k = 0; k < n_old; k++) {
+  for (int k = 0, o = 0; k < n_old; k++) {
     const size_t g0 = lw_segment_index(sp, old[k], 0);
-    for (size_t j = 0; j < p->old_seg[k]; j++) {
+    for (size_t j = 0; j < p->old_seg[k]; j++, o++) {
       const double *ol = m->seg_local + (g0 + j) * (size_t)nl;
-      for (int t = 0; t < nl; t++) p->dterm[sc->local[t]] -= ol[t];
+      if (!kept_old(p, (size_t)o))
+        for (int t = 0; t < nl; t++) p->dterm[sc->local[t]] -= ol[t];
       was_irregular |= m->seg_irregular[g0 + j];
     }
   }
@@ -1944,11 +1999,16 @@ void lw_model_propose_regroup(const lw_model *m, lw_proposal *p, const uint32_t 
     const lw_pair_filter own = old_filter(&v, p);
     const double d2 = sc->min_spacing * sc->min_spacing;
     const size_t n0 = n_new == 2 ? (new_node[0] - 1) * (size_t)np : 0, o0 = n_old == 2 ? p->old_seg[0] * (size_t)np : 0;
-    size_t now = crowding(m->grid, p->ps, p->n_seg * (size_t)np, &own, d2);
+    /* the kept segments' pairs with other strokes count the same on both
+    ** sides: left out of both, the comparison is the same */
+    size_t now = 0;
+    for (size_t j = 0; j < p->n_seg; j++)
+      if (!kept_new(p, j)) now += crowding(m->grid, p->ps + j * (size_t)np, (size_t)np, &own, d2);
     if (n0) now += crowded_pairs(p->ps, n0, p->ps + n0, p->n_seg * (size_t)np - n0, d2);
     size_t before = 0;
     if (now > 0) {
-      before = crowding(m->grid, p->ps_old, p->n_old_seg * (size_t)np, &own, d2);
+      for (size_t o = 0; o < p->n_old_seg; o++)
+        if (!kept_old(p, o)) before += crowding(m->grid, p->ps_old + o * (size_t)np, (size_t)np, &own, d2);
       if (o0) before += crowded_pairs(p->ps_old, o0, p->ps_old + o0, p->n_old_seg * (size_t)np - o0, d2);
     }
     if (now > 0 && now > before) {

@@ -260,6 +260,37 @@ Test(transdim, ideal_gas_births_of_every_size_reach_every_count)
   td_chain_free(c, setup);
 }
 
+/* What the spread is for: a short piece can leave.  Line costs 0.5 per mm
+** and nothing pays for it; at T = 0.05 a death of a 3-segment spline gains
+** about 150 T, and so does a shrink by a segment, 50 T.  Without the spread
+** the splines that shrank before a death drew them are stuck (no birth
+** makes 1 or 2 segments, and grow is uphill by 50 T); with it every spline
+** dies. */
+static size_t left_after_a_cold_shrink(double spread)
+{
+  lw_params p;
+  ideal_gas(&p, 0.0);
+  p.splines = 40;
+  p.segments = 3;
+  p.chem_length = 0.5;
+  p.birth_spread = spread;
+  p.mix_birth = p.mix_death = 0.02;
+  p.mix_grow = p.mix_shrink = 0.1;
+  void *setup;
+  lw_chain *c = td_chain(&p, 0.05, 19, &setup);
+  for (int s = 0; s < 200; s++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  const size_t n = lw_model_count(lw_splines_model(c->sys));
+  td_chain_free(c, setup);
+  return n;
+}
+
+Test(transdim, births_of_every_size_let_short_pieces_die)
+{
+  const size_t stuck = left_after_a_cold_shrink(0.0), left = left_after_a_cold_shrink(0.1);
+  cr_assert(stuck >= 10, "without the spread the pieces that shrank first stay: %zu of 40", stuck);
+  cr_assert_eq(left, 0, "with it every line goes: %zu left", left);
+}
+
 /* The birth prior follows the picture (transdim.h): with every move kind on
 ** and a ramp picture (white at its left edge, black at its right), N is
 ** still Poisson with mean K exp(-mu_s / T), the prior being normalised, and
@@ -517,10 +548,12 @@ static int run_checking_totals(lw_chain *c, const lw_model *m, unsigned long tot
 ** a high temperature: the running terms equal a recomputation from scratch
 ** within 1e-9 after many mixed proposals, and the caches a fresh model
 ** builds. */
-Test(transdim, incremental_equals_full_with_births_and_deaths)
+static void births_and_deaths_totals(double near, double spacing)
 {
   lw_params p;
   splice_scene(&p);
+  p.pair_near = near;
+  p.min_spacing = spacing;
   p.splines = 12;
   p.segments = 3;
   p.max_segments = 6;
@@ -536,6 +569,18 @@ Test(transdim, incremental_equals_full_with_births_and_deaths)
   /* the spliced caches and grid are what a model built afresh holds */
   same_as_fresh(m);
   td_chain_free(c, setup);
+}
+
+Test(transdim, incremental_equals_full_with_births_and_deaths) { births_and_deaths_totals(1.5, 0.0); }
+
+/* Without the near field a grow or a shrink evaluates only the segment it
+** adds or takes away: the segments it keeps take their caches from the
+** model and leave the pair walk and the spacing count (model.c,
+** splice_kept).  Here with the spacing constraint on, whose count they
+** leave too. */
+Test(transdim, incremental_equals_full_with_births_and_deaths_without_the_near_field)
+{
+  births_and_deaths_totals(0.0, 0.2);
 }
 
 /* energy.min_spacing holds between the curves through births, grows and

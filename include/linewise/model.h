@@ -238,6 +238,9 @@ typedef struct {
   double new_rest[2];         /* the new splines' rest lengths, mm */
   double new_len[2];          /* and lengths, mm */
   int layer;                  /* the layer of every spline involved (layers.h; 0 without layers) */
+  uint64_t kept_old, kept_new; /* the segments it keeps bit for bit (the first 64 of each side;
+                              ** old ones numbered through the old splines in order) */
+  uint8_t kept_from[64];      /* kept new segment j: that number of its old self */
   double log_ratio;           /* the Hastings factor of a trans-dimensional kind (system.h);
                               ** 0 for the symmetric ones */
 } lw_proposal;
