@@ -48,6 +48,20 @@ typedef struct {
   double *margin;                /* blocked's reach and gap, one each a segment (none
                                     without a gradient driver and energy.min_spacing) */
   size_t margin_n;               /* their segments */
+  /* split and join: the live splines' ends by cells of the join radius, and
+  ** the splines that may split, as of the state m->serial (every commit
+  ** changes it); built again when a split or join finds it stale */
+  struct {
+    int built;
+    uint64_t serial;
+    double x0, y0, side;
+    int nx, ny;
+    uint32_t *start;             /* nx ny + 1: where each cell's entries begin */
+    uint32_t *entry;             /* spline << 1 | end (1: the tail), by cell, in slot order */
+    uint32_t *split;             /* the splines that may split, in slot order */
+    uint32_t *near;              /* scratch: the ends a scan finds */
+    size_t n_split, cap_cells, cap_entry, cap_split, cap_near;
+  } ends;
 } spl_state;
 
 static void setup_free(void *setup)
@@ -116,6 +130,10 @@ static void state_free(void *state)
   if (s->owns_model) lw_model_free(s->m);
   free(s->grad);
   free(s->margin);
+  free(s->ends.start);
+  free(s->ends.entry);
+  free(s->ends.split);
+  free(s->ends.near);
   free(s);
 }
 
@@ -441,6 +459,84 @@ static void log_add(double lw, double *mx, double *sum)
 ** the other with the layers as state. */
 static int spline_layer(const lw_splines *sp, uint32_t i) { return sp->layer ? sp->layer[i] : 0; }
 
+/* 1 if spline i may split: 3 .. max_segments segments (each piece keeps
+** one, and a join could make it) and rest length n l (lw_td_plain). */
+static int splittable(const lw_td *td, const lw_splines *sp, uint32_t i)
+{
+  const size_t n = lw_splines_segments(sp, i);
+  return n >= 3 && n <= td->max_segments && lw_td_plain(td, n, sp->rest_length[i]);
+}
+
+/* The cell of coordinate c along an axis of n cells from c0: clamped, so
+** that an end off the page (or not finite) still has one; clamping keeps
+** two coordinates within a side of each other within a cell of each other. */
+static int end_cell(double c, double c0, double side, int n)
+{
+  const double u = floor((c - c0) / side);
+  return u >= 0.0 ? (u < (double)(n - 1) ? (int)u : n - 1) : 0;
+}
+
+static int room_u32(uint32_t **a, size_t *cap, size_t n)
+{
+  if (n <= *cap) return 1;
+  uint32_t *q = realloc(*a, n * sizeof *q);
+  if (!q) return 0;
+  *a = q;
+  *cap = n;
+  return 1;
+}
+
+/* The ends table of s for the state as it is: O(N + cells), once after each
+** commit that a split or join proposal follows.  0 if out of memory. */
+static int ends_ready(spl_state *s)
+{
+  const lw_model *m = s->m;
+  const lw_splines *sp = m->sp;
+  if (s->ends.built && s->ends.serial == m->serial) return 1;
+  const lw_scene *sc = m->scene;
+  const double side = sqrt(s->setup->join_r2);
+  const int nx = (int)fmin(fmax(ceil(sc->width / side), 1.0), 1024.0);
+  const int ny = (int)fmin(fmax(ceil(sc->height / side), 1.0), 1024.0);
+  const size_t cells = (size_t)nx * (size_t)ny, n = sp->n_splines;
+  if (!room_u32(&s->ends.start, &s->ends.cap_cells, cells + 1) ||
+      !room_u32(&s->ends.entry, &s->ends.cap_entry, 2 * n + 1) || !room_u32(&s->ends.split, &s->ends.cap_split, n + 1))
+    return 0;
+  uint32_t *start = s->ends.start;
+  memset(start, 0, (cells + 1) * sizeof *start);
+  s->ends.x0 = 0.0;
+  s->ends.y0 = 0.0;
+  s->ends.side = side;
+  s->ends.nx = nx;
+  s->ends.ny = ny;
+  s->ends.n_split = 0;
+#define END_CELL(i, t)                                                                                               \
+  ((size_t)end_cell(sp->node[(t) ? sp->first[(i) + 1] - 1 : sp->first[i]].py, 0.0, side, ny) * (size_t)nx +          \
+   (size_t)end_cell(sp->node[(t) ? sp->first[(i) + 1] - 1 : sp->first[i]].px, 0.0, side, nx))
+  /* a counting sort by cell: entries in slot order within each */
+  for (uint32_t i = 0; i < n; i++) {
+    if (lw_model_ghost(m, i)) continue;
+    if (splittable(&s->setup->td, sp, i)) s->ends.split[s->ends.n_split++] = i;
+    for (int t = 0; t < 2; t++) start[END_CELL(i, t) + 1]++;
+  }
+  for (size_t c = 0; c < cells; c++) start[c + 1] += start[c];
+  for (uint32_t i = 0; i < n; i++) {
+    if (lw_model_ghost(m, i)) continue;
+    for (int t = 0; t < 2; t++) s->ends.entry[start[END_CELL(i, t)]++] = i << 1 | (uint32_t)t;
+  }
+#undef END_CELL
+  for (size_t c = cells; c > 0; c--) start[c] = start[c - 1];
+  start[0] = 0;
+  s->ends.serial = m->serial;
+  s->ends.built = 1;
+  return 1;
+}
+
+static int entry_order(const void *a, const void *b)
+{
+  const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+  return (x > y) - (x < y);
+}
+
 /* The partners of end e (node en, tail te) of a spline of layer `layer` for
 ** a join: the ends within the join radius of every live spline of that
 ** layer but `skip`, in slot order, then the ends
@@ -448,28 +544,45 @@ static int spline_layer(const lw_splines *sp, uint32_t i) { return sp->layer ? s
 ** (NULL: none; a split's other piece).  With u < 0 returns log Z, the log
 ** of the sum of their join weights (-inf if there are none); with u in
 ** [0, 1) and log_z that sum, picks the partner whose cumulative share
-** first exceeds u into *pick (its spline) and *pick_tail. */
-static double join_scan(const spl_state *s, const lw_node *en, int te, int layer, uint32_t skip, const lw_node *extra,
+** first exceeds u into *pick (its spline) and *pick_tail.  The ends come
+** from the cells of the ends table around en (ends_ready), sorted back into
+** slot order, so that the sums and the pick are those of a scan of every
+** spline in turn.  NAN if out of memory. */
+static double join_scan(spl_state *s, const lw_node *en, int te, int layer, uint32_t skip, const lw_node *extra,
                         double u, double log_z, uint32_t *pick, int *pick_tail)
 {
   const lw_model *m = s->m;
   const lw_splines *sp = m->sp;
   const spl_setup *su = s->setup;
-  double mx = -INFINITY, sum = 0.0, cum = 0.0;
-  for (uint32_t i = 0; i < sp->n_splines; i++) {
-    if (i == skip || lw_model_ghost(m, i) || spline_layer(sp, i) != layer) continue;
-    for (int t = 0; t < 2; t++) {
-      const lw_node *f = &sp->node[t ? sp->first[i + 1] - 1 : sp->first[i]];
-      if (!joinable(su, en, f)) continue;
-      const double lw = join_log(&su->td, en, te, f, t);
-      if (u < 0.0) {
-        log_add(lw, &mx, &sum);
-      } else if (lw > -INFINITY) {
-        /* the last partner with a weight, should rounding leave cum below u */
-        *pick = i;
-        *pick_tail = t;
-        if (u < (cum += exp(lw - log_z))) return log_z;
+  if (!ends_ready(s)) return NAN;
+  size_t n_near = 0;
+  const int cx = end_cell(en->px, s->ends.x0, s->ends.side, s->ends.nx);
+  const int cy = end_cell(en->py, s->ends.y0, s->ends.side, s->ends.ny);
+  for (int y = cy > 0 ? cy - 1 : 0; y <= cy + 1 && y < s->ends.ny; y++)
+    for (int x = cx > 0 ? cx - 1 : 0; x <= cx + 1 && x < s->ends.nx; x++) {
+      const size_t c = (size_t)y * (size_t)s->ends.nx + (size_t)x;
+      for (uint32_t k = s->ends.start[c]; k < s->ends.start[c + 1]; k++) {
+        const uint32_t e = s->ends.entry[k], i = e >> 1;
+        if (i == skip || spline_layer(sp, i) != layer) continue;
+        if (!joinable(su, en, &sp->node[e & 1 ? sp->first[i + 1] - 1 : sp->first[i]])) continue;
+        if (!room_u32(&s->ends.near, &s->ends.cap_near, n_near + 1 + n_near / 2)) return NAN;
+        s->ends.near[n_near++] = e;
       }
+    }
+  const uint32_t *near = s->ends.near;
+  if (n_near > 1) qsort(s->ends.near, n_near, sizeof *near, entry_order);
+  double mx = -INFINITY, sum = 0.0, cum = 0.0;
+  for (size_t k = 0; k < n_near; k++) {
+    const uint32_t i = near[k] >> 1;
+    const int t = (int)(near[k] & 1);
+    const double lw = join_log(&su->td, en, te, &sp->node[t ? sp->first[i + 1] - 1 : sp->first[i]], t);
+    if (u < 0.0) {
+      log_add(lw, &mx, &sum);
+    } else if (lw > -INFINITY) {
+      /* the last partner with a weight, should rounding leave cum below u */
+      *pick = i;
+      *pick_tail = t;
+      if (u < (cum += exp(lw - log_z))) return log_z;
     }
   }
   for (int t = 0; extra && u < 0.0 && t < 2; t++)
@@ -492,7 +605,7 @@ static double join_scan(const spl_state *s, const lw_node *en, int te, int layer
 ** and B's own slots.  `layer` is J's (and so F's and B's).  The join's
 ** factor is minus this one.
 */
-static double split_log_ratio(const spl_state *s, const lw_node *jn, size_t n, size_t c, int r, const lw_node *fp,
+static double split_log_ratio(spl_state *s, const lw_node *jn, size_t n, size_t c, int r, const lw_node *fp,
                               const lw_node *bp, size_t n_x, size_t n_split, uint32_t skip_f, uint32_t skip_b,
                               int pieces_live, int layer)
 {
@@ -503,11 +616,15 @@ static double split_log_ratio(const spl_state *s, const lw_node *jn, size_t n, s
   double mx = -INFINITY, sum = 0.0;
   if (r != 1) {
     const lw_node ends[2] = {bp[0], bp[nb]};
-    log_add(lg - join_scan(s, &fp[c], 1, layer, skip_f, pieces_live ? NULL : ends, -1.0, 0.0, NULL, NULL), &mx, &sum);
+    const double z = join_scan(s, &fp[c], 1, layer, skip_f, pieces_live ? NULL : ends, -1.0, 0.0, NULL, NULL);
+    if (isnan(z)) return NAN;
+    log_add(lg - z, &mx, &sum);
   }
   if (r != 2) {
     const lw_node ends[2] = {fp[0], fp[c]};
-    log_add(lg - join_scan(s, &bp[0], 0, layer, skip_b, pieces_live ? NULL : ends, -1.0, 0.0, NULL, NULL), &mx, &sum);
+    const double z = join_scan(s, &bp[0], 0, layer, skip_b, pieces_live ? NULL : ends, -1.0, 0.0, NULL, NULL);
+    if (isnan(z)) return NAN;
+    log_add(lg - z, &mx, &sum);
   }
   double lq = lw_td_prior(td, fp, c + 1) + lw_td_prior(td, bp, nb + 1) - lw_td_prior(td, jn, n + 1);
   /* with layers the target has the layer's share s_k per spline: one more */
@@ -518,25 +635,14 @@ static double split_log_ratio(const spl_state *s, const lw_node *jn, size_t n, s
   return lq + join - split;
 }
 
-/* 1 if spline i may split: 3 .. max_segments segments (each piece keeps
-** one, and a join could make it) and rest length n l (lw_td_plain). */
-static int splittable(const lw_td *td, const lw_splines *sp, uint32_t i)
+/* How many live splines may split (the ends table's list); with pick below
+** that count, the pick-th of them in slot order into *which.  SIZE_MAX if
+** out of memory. */
+static size_t count_splittable(spl_state *s, size_t pick, uint32_t *which)
 {
-  const size_t n = lw_splines_segments(sp, i);
-  return n >= 3 && n <= td->max_segments && lw_td_plain(td, n, sp->rest_length[i]);
-}
-
-/* How many live splines may split; with pick < that count, the pick-th of
-** them (in slot order) into *which.  O(N), as a join's partner scan. */
-static size_t count_splittable(const spl_state *s, size_t pick, uint32_t *which)
-{
-  const lw_model *m = s->m;
-  size_t count = 0;
-  for (uint32_t i = 0; i < m->sp->n_splines; i++) {
-    if (lw_model_ghost(m, i) || !splittable(&s->setup->td, m->sp, i)) continue;
-    if (count++ == pick) *which = i;
-  }
-  return count;
+  if (!ends_ready(s)) return SIZE_MAX;
+  if (pick < s->ends.n_split) *which = s->ends.split[pick];
+  return s->ends.n_split;
 }
 
 /*
@@ -554,7 +660,7 @@ static double propose_split(spl_state *s, lw_proposal *p, gsl_rng *rng)
   const lw_splines *sp = m->sp;
   uint32_t j = 0;
   const size_t n_split = count_splittable(s, SIZE_MAX, NULL);
-  if (n_split == 0) return refuse(p);
+  if (n_split == 0 || n_split == SIZE_MAX) return refuse(p); /* SIZE_MAX: out of memory */
   count_splittable(s, gsl_rng_uniform_int(rng, n_split), &j);
   const size_t n = lw_splines_segments(sp, j);
   const size_t c = 1 + gsl_rng_uniform_int(rng, n - 2);
@@ -608,6 +714,7 @@ static double propose_join(spl_state *s, lw_proposal *p, gsl_rng *rng)
   copy_nodes(p->node + c + 1, bp, n - c, te && y_turned);
   const int r = y_turned ? (te ? 2 : 1) : 0;
   /* the splines that may split after the join: F and B leave, J comes */
+  if (count_splittable(s, SIZE_MAX, NULL) == SIZE_MAX) return refuse(p);
   const size_t n_split = count_splittable(s, SIZE_MAX, NULL) - (size_t)splittable(td, sp, f) -
                          (size_t)splittable(td, sp, b) + 1;
   const double lr = -split_log_ratio(s, p->node, n, c, r, fp, bp, N, n_split, f, b, 1, layer);
