@@ -54,7 +54,7 @@ typedef struct {
   struct {
     int built;
     uint64_t serial;
-    double x0, y0, side;
+    double side;                 /* the join radius, mm */
     int nx, ny;
     uint32_t *start;             /* nx ny + 1: where each cell's entries begin */
     uint32_t *entry;             /* spline << 1 | end (1: the tail), by cell, in slot order */
@@ -467,13 +467,25 @@ static int splittable(const lw_td *td, const lw_splines *sp, uint32_t i)
   return n >= 3 && n <= td->max_segments && lw_td_plain(td, n, sp->rest_length[i]);
 }
 
-/* The cell of coordinate c along an axis of n cells from c0: clamped, so
+/* End `tail` (1: the last node) of spline i. */
+static const lw_node *spline_end(const lw_splines *sp, uint32_t i, int tail)
+{
+  return &sp->node[tail ? sp->first[i + 1] - 1 : sp->first[i]];
+}
+
+/* The cell of coordinate c along an axis of n cells from 0: clamped, so
 ** that an end off the page (or not finite) still has one; clamping keeps
 ** two coordinates within a side of each other within a cell of each other. */
-static int end_cell(double c, double c0, double side, int n)
+static int end_cell(double c, double side, int n)
 {
-  const double u = floor((c - c0) / side);
+  const double u = floor(c / side);
   return u >= 0.0 ? (u < (double)(n - 1) ? (int)u : n - 1) : 0;
+}
+
+static size_t ends_cell(const spl_state *s, const lw_node *a)
+{
+  return (size_t)end_cell(a->py, s->ends.side, s->ends.ny) * (size_t)s->ends.nx +
+         (size_t)end_cell(a->px, s->ends.side, s->ends.nx);
 }
 
 static int room_u32(uint32_t **a, size_t *cap, size_t n)
@@ -503,27 +515,21 @@ static int ends_ready(spl_state *s)
     return 0;
   uint32_t *start = s->ends.start;
   memset(start, 0, (cells + 1) * sizeof *start);
-  s->ends.x0 = 0.0;
-  s->ends.y0 = 0.0;
   s->ends.side = side;
   s->ends.nx = nx;
   s->ends.ny = ny;
   s->ends.n_split = 0;
-#define END_CELL(i, t)                                                                                               \
-  ((size_t)end_cell(sp->node[(t) ? sp->first[(i) + 1] - 1 : sp->first[i]].py, 0.0, side, ny) * (size_t)nx +          \
-   (size_t)end_cell(sp->node[(t) ? sp->first[(i) + 1] - 1 : sp->first[i]].px, 0.0, side, nx))
   /* a counting sort by cell: entries in slot order within each */
   for (uint32_t i = 0; i < n; i++) {
     if (lw_model_ghost(m, i)) continue;
     if (splittable(&s->setup->td, sp, i)) s->ends.split[s->ends.n_split++] = i;
-    for (int t = 0; t < 2; t++) start[END_CELL(i, t) + 1]++;
+    for (int t = 0; t < 2; t++) start[ends_cell(s, spline_end(sp, i, t)) + 1]++;
   }
   for (size_t c = 0; c < cells; c++) start[c + 1] += start[c];
   for (uint32_t i = 0; i < n; i++) {
     if (lw_model_ghost(m, i)) continue;
-    for (int t = 0; t < 2; t++) s->ends.entry[start[END_CELL(i, t)]++] = i << 1 | (uint32_t)t;
+    for (int t = 0; t < 2; t++) s->ends.entry[start[ends_cell(s, spline_end(sp, i, t))]++] = i << 1 | (uint32_t)t;
   }
-#undef END_CELL
   for (size_t c = cells; c > 0; c--) start[c] = start[c - 1];
   start[0] = 0;
   s->ends.serial = m->serial;
@@ -556,15 +562,14 @@ static double join_scan(spl_state *s, const lw_node *en, int te, int layer, uint
   const spl_setup *su = s->setup;
   if (!ends_ready(s)) return NAN;
   size_t n_near = 0;
-  const int cx = end_cell(en->px, s->ends.x0, s->ends.side, s->ends.nx);
-  const int cy = end_cell(en->py, s->ends.y0, s->ends.side, s->ends.ny);
+  const int cx = end_cell(en->px, s->ends.side, s->ends.nx), cy = end_cell(en->py, s->ends.side, s->ends.ny);
   for (int y = cy > 0 ? cy - 1 : 0; y <= cy + 1 && y < s->ends.ny; y++)
     for (int x = cx > 0 ? cx - 1 : 0; x <= cx + 1 && x < s->ends.nx; x++) {
       const size_t c = (size_t)y * (size_t)s->ends.nx + (size_t)x;
       for (uint32_t k = s->ends.start[c]; k < s->ends.start[c + 1]; k++) {
         const uint32_t e = s->ends.entry[k], i = e >> 1;
         if (i == skip || spline_layer(sp, i) != layer) continue;
-        if (!joinable(su, en, &sp->node[e & 1 ? sp->first[i + 1] - 1 : sp->first[i]])) continue;
+        if (!joinable(su, en, spline_end(sp, i, (int)(e & 1)))) continue;
         if (!room_u32(&s->ends.near, &s->ends.cap_near, n_near + 1 + n_near / 2)) return NAN;
         s->ends.near[n_near++] = e;
       }
@@ -575,7 +580,7 @@ static double join_scan(spl_state *s, const lw_node *en, int te, int layer, uint
   for (size_t k = 0; k < n_near; k++) {
     const uint32_t i = near[k] >> 1;
     const int t = (int)(near[k] & 1);
-    const double lw = join_log(&su->td, en, te, &sp->node[t ? sp->first[i + 1] - 1 : sp->first[i]], t);
+    const double lw = join_log(&su->td, en, te, spline_end(sp, i, t), t);
     if (u < 0.0) {
       log_add(lw, &mx, &sum);
     } else if (lw > -INFINITY) {
