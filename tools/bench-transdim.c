@@ -29,22 +29,45 @@ typedef struct {
   double propose, death, birth, compact; /* seconds, medians */
 } splice_cost;
 
+/* A model of the random scene p with trans-dimensional storage, n splines
+** placed from seed 7 (the placement's rng left in *rng), and a proposal. */
+typedef struct {
+  lw_scene sc;
+  gsl_rng *rng;
+  lw_model *m;
+  lw_proposal *pr;
+} td_bench;
+
+static void td_bench_new(td_bench *b, lw_params *p, size_t n)
+{
+  lw_error err;
+  p->fixed_count = 0;
+  if (lw_scene_init(&b->sc, p, &err)) bench_die("scene", &err);
+  b->rng = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(b->rng, 7);
+  lw_splines *sp = lw_init_random(&b->sc, n, (size_t)p->segments, p->segment_length, b->rng, &err);
+  if (!sp) bench_die("placement", &err);
+  if (!(b->m = lw_model_new(&b->sc, sp, &err))) bench_die("model", &err);
+  if (!(b->pr = lw_proposal_new(b->m, &err))) bench_die("proposal", &err);
+}
+
+static void td_bench_free(td_bench *b)
+{
+  lw_proposal_free(b->pr);
+  lw_model_free(b->m);
+  lw_scene_clear(&b->sc);
+  gsl_rng_free(b->rng);
+}
+
 static void splice_measure(size_t n, int reps, splice_cost *out)
 {
   lw_params p;
-  lw_error err;
-  lw_scene sc;
   bench_random_params(&p, n, 1, 2.8);
-  p.fixed_count = 0;
-  if (lw_scene_init(&sc, &p, &err)) bench_die("scene", &err);
-  gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
-  gsl_rng_set(rng, 7);
-  lw_splines *sp = lw_init_random(&sc, n, (size_t)p.segments, p.segment_length, rng, &err);
-  if (!sp) bench_die("placement", &err);
-  lw_model *m = lw_model_new(&sc, sp, &err);
-  if (!m) bench_die("model", &err);
-  lw_proposal *pr = lw_proposal_new(m, &err);
-  if (!pr) bench_die("proposal", &err);
+  td_bench b;
+  td_bench_new(&b, &p, n);
+  gsl_rng *rng = b.rng;
+  lw_model *m = b.m;
+  lw_proposal *pr = b.pr;
   double *t_prop = malloc((size_t)reps * sizeof *t_prop), *t_death = malloc((size_t)reps * sizeof *t_death);
   double *t_birth = malloc((size_t)reps * sizeof *t_birth), *t_comp = malloc((size_t)reps * sizeof *t_comp);
   lw_node nodes[64]; /* 4 segments: 5 nodes */
@@ -86,10 +109,7 @@ static void splice_measure(size_t n, int reps, splice_cost *out)
   free(t_death);
   free(t_birth);
   free(t_comp);
-  lw_proposal_free(pr);
-  lw_model_free(m);
-  lw_scene_clear(&sc);
-  gsl_rng_free(rng);
+  td_bench_free(&b);
 }
 
 /* The medians of proposing a grow and a shrink at the tail of a spline
@@ -100,23 +120,17 @@ static void splice_measure(size_t n, int reps, splice_cost *out)
 static void grow_measure(size_t n, double near, int reps, double out[3])
 {
   lw_params p;
-  lw_error err;
-  lw_scene sc;
   bench_random_params(&p, n, 1, 2.8);
-  p.fixed_count = 0;
   p.segments = 8;
   p.segment_length = 2.5;
   p.pair_near = near;
   p.min_spacing = 0.3;
-  if (lw_scene_init(&sc, &p, &err)) bench_die("scene", &err);
-  gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
-  gsl_rng_set(rng, 7);
-  lw_splines *sp = lw_init_random(&sc, n, (size_t)p.segments, p.segment_length, rng, &err);
-  if (!sp) bench_die("placement", &err);
-  lw_model *m = lw_model_new(&sc, sp, &err);
-  if (!m) bench_die("model", &err);
-  lw_proposal *pr = lw_proposal_new(m, &err);
-  if (!pr) bench_die("proposal", &err);
+  td_bench b;
+  td_bench_new(&b, &p, n);
+  gsl_rng *rng = b.rng;
+  lw_model *m = b.m;
+  lw_proposal *pr = b.pr;
+  const lw_scene *sc = &b.sc;
   double *t = malloc(3 * (size_t)reps * sizeof *t);
   if (!t) bench_die("grow", &(lw_error){.code = LW_ENOMEM, .msg = "times"});
   lw_node nodes[64];
@@ -132,7 +146,7 @@ static void grow_measure(size_t n, double near, int reps, double out[3])
     double t1 = cpu_now();
     lw_model_propose_splice(m, pr, j, 1, nodes, nn - 1, rest - l, 0);
     double t2 = cpu_now();
-    for (size_t k = 0; k < nn; k++) nodes[k].px = fmod(nodes[k].px + sc.width / 3.0, sc.width);
+    for (size_t k = 0; k < nn; k++) nodes[k].px = fmod(nodes[k].px + sc->width / 3.0, sc->width);
     double t3 = cpu_now();
     lw_model_propose_splice(m, pr, (uint32_t)m->sp->n_splines, 0, nodes, nn, rest, 0);
     double t4 = cpu_now();
@@ -142,10 +156,7 @@ static void grow_measure(size_t n, double near, int reps, double out[3])
   }
   for (int k = 0; k < 3; k++) out[k] = bench_median(t + (size_t)k * (size_t)reps, reps);
   free(t);
-  lw_proposal_free(pr);
-  lw_model_free(m);
-  lw_scene_clear(&sc);
-  gsl_rng_free(rng);
+  td_bench_free(&b);
 }
 
 void bench_splice(bench_ctx *b)
