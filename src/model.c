@@ -1437,6 +1437,7 @@ static double finish_near(const lw_model *m, lw_proposal *p)
 
 
 static lw_status commit_splice(lw_model *m, const lw_proposal *p);
+static void splice_kept_samples(const lw_model *m, lw_proposal *p);
 
 /* The memo after p's move, committed as serial: the moved segments hold the
 ** walk's new side; the spline's others keep theirs if no other change came
@@ -1552,7 +1553,10 @@ lw_status lw_model_merge(lw_model *m, lw_proposal *p)
 
 lw_status lw_model_commit(lw_model *m, lw_proposal *p)
 {
-  if (p->splice) return commit_splice(m, p);
+  if (p->splice) {
+    splice_kept_samples(m, p);
+    return commit_splice(m, p);
+  }
   lw_status s = lw_model_commit_part(m, p);
   return s != LW_OK ? s : lw_model_merge(m, p);
 }
@@ -1811,18 +1815,35 @@ static double splice_raster_delta(const lw_model *m, lw_proposal *p, int t)
   return lw_tone_delta(c->data, m->raster[t] + plane_in(p->layer, c->data), b);
 }
 
+/* The pair samples of the segments a splice keeps: the old ones read from
+** the grid where lw_model_propose_regroup left them out, the new ones
+** copies of their old selves.  A grow or a shrink without the near field
+** needs them only for the rule between the curves and the commit, which
+** most proposals never reach, so they are read then. */
+static void splice_kept_samples(const lw_model *m, lw_proposal *p)
+{
+  if (!p->kept_pending) return;
+  const size_t np = (size_t)pair_nodes(m);
+  const pair_view v = {m->grid, m->sp, (uint32_t)np, NULL, NULL};
+  for (size_t o = 0; p->kept_pending == 2 && o < p->n_old_seg; o++)
+    if (kept_old(p, o)) samples_at(&v, (uint32_t)(splice_old_segment(m, p, o) * np), np, p->ps_old + o * np);
+  for (size_t j = 0; j < p->n_seg; j++)
+    if (kept_new(p, j)) memcpy(p->ps + j * np, p->ps_old + p->kept_from[j] * np, np * sizeof *p->ps);
+  p->kept_pending = 0;
+}
+
 /* The new splines' segments: their caches in p and their share of dterm;
 ** sets *forbidden and *undefined as lw_model_propose does.  A segment the
 ** splice keeps takes its old self's caches, bit for bit what evaluating it
 ** gives, and adds nothing to dterm: its old self is not taken away either
-** (lw_model_propose_regroup). */
+** (lw_model_propose_regroup); its pair samples come with its old self's
+** (splice_kept_samples). */
 static void splice_new_segments(const lw_model *m, lw_proposal *p, int *forbidden, int *undefined)
 {
   const lw_scene *sc = m->scene;
   const lw_term_set *ts = &m->terms;
   const lw_term_ctx *pc = ts->pair >= 0 ? &ts->ctx[ts->pair] : NULL;
   const int np = pair_nodes(m), nl = sc->n_local;
-  const pair_view v = {m->grid, m->sp, (uint32_t)np, NULL, NULL};
   lw_samples s;
   p->irregular = 0;
   for (int k = 0, j = 0, a = 0; k < p->n_new; a += (int)p->new_node[k++]) {
@@ -1835,7 +1856,6 @@ static void splice_new_segments(const lw_model *m, lw_proposal *p, int *forbidde
         p->seg_irregular[j] = m->seg_irregular[g];
         p->len[j] = m->seg_len[g];
         memcpy(local, m->seg_local + g * (size_t)nl, (size_t)nl * sizeof *local);
-        if (m->grid) samples_at(&v, (uint32_t)(g * (size_t)np), (size_t)np, p->ps + (size_t)j * (size_t)np);
       } else {
         p->seg_irregular[j] = !segment_eval(sc, ctx_in(ts, p->layer), &p->node[(size_t)a + i],
                                             &p->node[(size_t)a + i + 1], &s, &p->len[j], local, pc ? pc->quad : NULL,
@@ -1914,6 +1934,7 @@ double lw_model_propose_finish(const lw_model *m, lw_proposal *p)
 {
   if (p->curves_pending) {
     p->curves_pending = 0;
+    if (p->splice) splice_kept_samples(m, p);
     if (p->splice ? splice_curves_touch(m, p) : curves_touch(m, p)) {
       p->crowded = 1;
       p->near_pending = 0;
@@ -1987,12 +2008,24 @@ void lw_model_propose_regroup(const lw_model *m, lw_proposal *p, const uint32_t 
   else if (was_irregular && !undefined) dE = -INFINITY;
   p->pair_done = 0;
   const pair_view v = {m->grid, sp, (uint32_t)np, pc ? pair_ctx(pc) : NULL, planes_of(sc)};
-  if (m->grid)
+  /* the kept segments' samples wait where only the changed ones are walked
+  ** and counted (splice_pair_delta): a grow or a shrink without the near field */
+  const int later = n_old == 1 && n_new == 1 && !(sc->pair.near_scale > 0.0);
+  p->kept_pending = 0;
+  if (m->grid && later) {
+    for (size_t o = 0; o < p->n_old_seg; o++)
+      if (!kept_old(p, o))
+        samples_at(&v, (uint32_t)(splice_old_segment(m, p, o) * (size_t)np), (size_t)np, p->ps_old + o * (size_t)np);
+    p->kept_pending = 2;
+  } else if (m->grid) {
     for (size_t k = 0, o = 0; k < (size_t)n_old; k++) {
       const size_t first = lw_segment_index(sp, old[k], 0) * (size_t)np, run = p->old_seg[k] * (size_t)np;
       samples_at(&v, (uint32_t)first, run, p->ps_old + o);
       o += run;
     }
+    p->kept_pending = 1;
+    splice_kept_samples(m, p);
+  }
   p->crowded = 0;
   p->curves_pending = 0;
   if (sc->min_spacing > 0.0 && p->n_seg && !(dE == INFINITY) && !isnan(dE)) {

@@ -241,6 +241,7 @@ typedef struct {
   uint64_t kept_old, kept_new; /* the segments it keeps bit for bit (the first 64 of each side;
                               ** old ones numbered through the old splines in order) */
   uint8_t kept_from[64];      /* kept new segment j: that number of its old self */
+  int kept_pending;           /* the kept segments' pair samples are still to be read */
   double log_ratio;           /* the Hastings factor of a trans-dimensional kind (system.h);
                               ** 0 for the symmetric ones */
 } lw_proposal;
