@@ -14,9 +14,6 @@
 /* Massless steps: the Armijo fraction and the most halvings of a step. */
 #define ARMIJO 1e-4
 #define HALVINGS_MAX 60
-/* Massless steps: the most times a trial holds the parts it would make
-** forbidden and tries again at the same length. */
-#define HOLD_ROUNDS 8
 
 static double max_abs(const double *a, size_t n)
 {
@@ -232,26 +229,30 @@ static lw_status flow(lw_dynamics *d, lw_error *err)
     slope += d->g[i] * dir[i];
   }
   memcpy(d->pi1, d->g, n * sizeof *d->g); /* grad E at x, should every trial fail */
+  if (d->held) memcpy(d->tx, dir, n * sizeof *dir); /* the direction before a trial's holds */
   double h = d->dt;
   lw_status s;
-  if (d->held) memset(d->held, 0, n);
+  long holds = 0;
+  int away = 0; /* the state stands at a rejected trial */
   for (int k = 0; k <= HALVINGS_MAX; k++, h *= 0.5) {
-    for (size_t i = 0; i < n; i++) d->x1[i] = d->x[i] + h * dir[i];
-    /* hold the parts this trial would take through a wall, while the
-    ** direction left still descends */
-    for (int r = 0; d->held && r < HOLD_ROUNDS; r++) {
-      if (!t->blocked(d->state, d->x1, d->held)) break;
-      double held_slope = 0.0;
-      for (size_t i = 0; i < n; i++)
-        if (!d->held[i]) held_slope += d->g[i] * dir[i];
-      if (!(held_slope < 0.0)) break;
-      slope = held_slope;
-      for (size_t i = 0; i < n; i++) {
-        if (d->held[i]) dir[i] = 0.0;
-        d->x1[i] = d->x[i] + h * dir[i];
+    /* hold the parts this trial would take through a wall (measured from
+    ** x, where the state must stand: back from a rejected trial first); a
+    ** shorter trial may hold less */
+    if (d->held) {
+      memcpy(dir, d->tx, n * sizeof *dir);
+      memset(d->held, 0, n);
+      if (away && (s = t->set_coords(d->state, d->x, err))) return s;
+      away = 0;
+      slope = lw_system_hold(t, d->state, d->x, d->pi1, dir, h, d->x1, d->held, n, &holds);
+      if (!(slope < 0.0)) {
+        d->halvings++;
+        continue;
       }
+    } else {
+      for (size_t i = 0; i < n; i++) d->x1[i] = d->x[i] + h * dir[i];
     }
     if ((s = evaluate(d, d->x1, err))) return s;
+    away = 1;
     if (d->energy <= e0 + ARMIJO * h * slope) {
       memcpy(d->x, d->x1, n * sizeof *d->x);
       d->time += h;

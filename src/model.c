@@ -1152,55 +1152,155 @@ static double curve_distance(const lw_splines *sp, size_t h, double t, double px
   return sqrt(x * x + y * y);
 }
 
+/* The curves near one check point, each once, from its sample nearest the
+** point; past NEAR of them each sample is asked at once. */
+enum { NEAR_CURVES = 32 };
+typedef struct {
+  uint32_t seg[NEAR_CURVES];
+  double t0[NEAR_CURVES], ds0[NEAR_CURVES];
+  int n;
+} near_curves;
+
+/* 1 if segment h's curve, which may move by r, is one the check point at
+** now (from before) comes within min_spacing + r of without moving away
+** from it by more than r; t: the parameter to start Newton from. */
+static int point_closes(const lw_model *m, const lw_step_margins *mg, uint32_t h, double t, const lw_pair_sample *now,
+                        const lw_pair_sample *before)
+{
+  const double r = mg->reach[h], dc = curve_distance(m->sp, h, t, now->x, now->y);
+  return dc < m->scene->min_spacing + r && dc < curve_distance(m->sp, h, t, before->x, before->y) + r;
+}
+
+/* Notes the sample of segment h at parameter t, ds (squared) from the
+** check point; 1 if it must be asked at once and closes in. */
+static int note_curve(const lw_model *m, const lw_step_margins *mg, near_curves *nc, uint32_t h, double t, double ds,
+                      const lw_pair_sample *now, const lw_pair_sample *before)
+{
+  int j = 0;
+  while (j < nc->n && nc->seg[j] != h) j++;
+  if (j < nc->n) {
+    if (ds < nc->ds0[j]) nc->ds0[j] = ds, nc->t0[j] = t;
+  } else if (nc->n < NEAR_CURVES) {
+    nc->seg[nc->n] = h, nc->t0[nc->n] = t, nc->ds0[nc->n] = ds;
+    nc->n++;
+  } else if (point_closes(m, mg, h, t, now, before)) {
+    return 1;
+  }
+  return 0;
+}
+
+static int curves_close(const lw_model *m, const lw_step_margins *mg, const near_curves *nc, const lw_pair_sample *now,
+                        const lw_pair_sample *before)
+{
+  for (int j = 0; j < nc->n; j++)
+    if (point_closes(m, mg, nc->seg[j], nc->t0[j], now, before)) return 1;
+  return 0;
+}
+
+/* A sample that may be near one of a segment's check points (closes_in):
+** within its curve's reach of the points' box. */
+typedef struct {
+  double x, y, within;
+  uint32_t idx;
+  int cx, cy; /* its cell */
+} crowd_candidate;
+
+enum { CROWD_CANDIDATES = 512 };
+
+/* The samples of other strokes within their reach (min_spacing + gap / 2 +
+** reach of their segment) of the box of the n check points, from the cells
+** any point's 3 x 3 holds, in the order each point's scan of its cells meets
+** them (rows of cells, then entries); -1 if more than CROWD_CANDIDATES.
+** Rounding is monotone, so a sample whose distance from the box is within
+** is never nearer a point than within. */
+static int crowd_candidates(const lw_model *m, const lw_cellgrid *g, const lw_pair_sample *pt, size_t n, double d,
+                            const lw_pair_filter *f, const lw_step_margins *mg, uint32_t np, crowd_candidate *out)
+{
+  const double spacing = m->scene->min_spacing;
+  double bx0 = INFINITY, bx1 = -INFINITY, by0 = INFINITY, by1 = -INFINITY;
+  for (size_t k = 0; k < n; k++)
+    bx0 = fmin(bx0, pt[k].x), bx1 = fmax(bx1, pt[k].x), by0 = fmin(by0, pt[k].y), by1 = fmax(by1, pt[k].y);
+  /* every cell a point's facing test takes meets the box widened by d */
+  int x0, x1, y0, y1;
+  lw_cellgrid_locate(g, bx0 - d, by0 - d, &x0, &y0);
+  lw_cellgrid_locate(g, bx1 + d, by1 + d, &x1, &y1);
+  int count = 0;
+  for (int cy = y0; cy <= y1; cy++)
+    for (int cx = x0; cx <= x1; cx++) {
+      const lw_cell *c = &g->cell[(size_t)cy * (size_t)g->nx + (size_t)cx];
+      if (!c->n) continue; /* an empty cell may have no block */
+      const double *xs = c->x, *ys = lw_cell_y(c);
+      const uint32_t *idx = lw_cell_idx(c);
+      for (uint32_t e = 0; e < c->n; e++) {
+        if (own_sample(f, idx[e])) continue;
+        const uint32_t h = idx[e] / np;
+        const double within = spacing + 0.5 * mg->gap[h] + mg->reach[h];
+        const double dx = fmax(0.0, fmax(bx0 - xs[e], xs[e] - bx1)), dy = fmax(0.0, fmax(by0 - ys[e], ys[e] - by1));
+        if (dx * dx + dy * dy >= within * within) continue;
+        if (count == CROWD_CANDIDATES) return -1;
+        out[count++] = (crowd_candidate){xs[e], ys[e], within, idx[e], cx, cy};
+      }
+    }
+  return count;
+}
+
 /* 1 if a check point moved from before[k] to now[k] comes within
 ** min_spacing + r of another stroke's curve without moving away from it by
 ** more than r, r how far that curve may move (mg->reach of its segment):
 ** then the two may end closer than they were, and closer than the spacing.
 ** The curves near a point are found by their samples: within min_spacing of
 ** a curve is within min_spacing + gap / 2 of one of its samples, gap the
-** widest space between them (mg->gap). */
+** widest space between them (mg->gap).  The samples near the segment are
+** gathered once (crowd_candidates) and each point asks them in the order of
+** its own scan of the cells around it, which it falls back to when they are
+** too many, so both ways decide alike.  Gathering once: the quench's cut
+** d reaches as far as its farthest-moving segment, which is most of 9 cells
+** a point, where each sample's own reach is far less. */
 static int closes_in(const lw_model *m, const lw_pair_sample *now, const lw_pair_sample *before, size_t n,
                      const lw_pair_filter *f, double d2, const lw_step_margins *mg, uint32_t np)
 {
-  enum { NEAR = 32 }; /* the curves near one point; past that, each sample is asked */
   lw_cellgrid view;
   const lw_cellgrid *g = lw_cellgrid_plane(m->grid, f->plane, &view);
   const lw_quad *quad = m->terms.ctx[m->terms.pair].quad;
   const double far2 = d2 * (1.0 + 1e-8), spacing = m->scene->min_spacing;
+  crowd_candidate cand[CROWD_CANDIDATES];
+  const int n_cand = crowd_candidates(m, g, now, n, sqrt(far2) * (1.0 + 1e-6), f, mg, np, cand);
+  const double side = 1.0 / g->inv_h;
   for (size_t k = 0; k < n; k++) {
-    /* each nearby curve once, from its sample nearest the point */
-    uint32_t seg[NEAR];
-    double t0[NEAR], ds0[NEAR];
-    int n_near = 0;
-    const lw_cell *cells[9];
-    const int nc = facing_cells(g, now[k].x, now[k].y, far2, cells);
-    for (int cj = 0; cj < nc; cj++) {
-      const lw_cell *c = cells[cj];
-      const double *xs = c->x, *ys = lw_cell_y(c);
-      const uint32_t *idx = lw_cell_idx(c);
-      for (uint32_t e = 0; e < c->n; e++) {
-        if (own_sample(f, idx[e])) continue;
-        const uint32_t h = idx[e] / np;
-        const double dx = xs[e] - now[k].x, dy = ys[e] - now[k].y, ds = dx * dx + dy * dy;
-        const double within = spacing + 0.5 * mg->gap[h] + mg->reach[h], t = quad->s[idx[e] % np];
-        if (ds >= within * within) continue; /* ds: squared */
-        int j = 0;
-        while (j < n_near && seg[j] != h) j++;
-        if (j < n_near) {
-          if (ds < ds0[j]) ds0[j] = ds, t0[j] = t;
-        } else if (n_near < NEAR) {
-          seg[n_near] = h, t0[n_near] = t, ds0[n_near] = ds;
-          n_near++;
-        } else {
-          const double r = mg->reach[h], dc = curve_distance(m->sp, h, t, now[k].x, now[k].y);
-          if (dc < spacing + r && dc < curve_distance(m->sp, h, t, before[k].x, before[k].y) + r) return 1;
+    near_curves nc;
+    nc.n = 0;
+    if (n_cand >= 0) {
+      int cx, cy;
+      lw_cellgrid_locate(g, now[k].x, now[k].y, &cx, &cy);
+      /* facing_cells' test, cell by cell */
+      const double u = now[k].x - (g->x0 + cx * side), v = now[k].y - (g->y0 + cy * side);
+      const double gx[3] = {u * u, 0.0, (side - u) * (side - u)}, gy[3] = {v * v, 0.0, (side - v) * (side - v)};
+      for (int e = 0; e < n_cand; e++) {
+        const crowd_candidate *c = &cand[e];
+        const int di = c->cx - cx + 1, dj = c->cy - cy + 1;
+        if (di < 0 || di > 2 || dj < 0 || dj > 2 || gx[di] + gy[dj] > far2) continue;
+        const double dx = c->x - now[k].x, dy = c->y - now[k].y, ds = dx * dx + dy * dy;
+        if (ds >= c->within * c->within) continue;
+        if (note_curve(m, mg, &nc, c->idx / np, quad->s[c->idx % np], ds, &now[k], &before[k])) return 1;
+      }
+    } else {
+      const lw_cell *cells[9];
+      const int ncell = facing_cells(g, now[k].x, now[k].y, far2, cells);
+      for (int cj = 0; cj < ncell; cj++) {
+        const lw_cell *c = cells[cj];
+        const double *xs = c->x, *ys = lw_cell_y(c);
+        const uint32_t *idx = lw_cell_idx(c);
+        for (uint32_t e = 0; e < c->n; e++) {
+          if (own_sample(f, idx[e])) continue;
+          const uint32_t h = idx[e] / np;
+          const double dx = xs[e] - now[k].x, dy = ys[e] - now[k].y, ds = dx * dx + dy * dy;
+          const double within = spacing + 0.5 * mg->gap[h] + mg->reach[h];
+          if (ds >= within * within) continue; /* ds: squared */
+          if (note_curve(m, mg, &nc, h, quad->s[idx[e] % np], ds, &now[k], &before[k])) return 1;
         }
       }
     }
-    for (int j = 0; j < n_near; j++) {
-      const double r = mg->reach[seg[j]], dc = curve_distance(m->sp, seg[j], t0[j], now[k].x, now[k].y);
-      if (dc < spacing + r && dc < curve_distance(m->sp, seg[j], t0[j], before[k].x, before[k].y) + r) return 1;
-    }
+    if (curves_close(m, mg, &nc, &now[k], &before[k])) return 1;
   }
   return 0;
 }

@@ -37,7 +37,6 @@
 
 #define MEMORY 5         /* step pairs kept: 2 MEMORY + 6 vectors of n doubles in all */
 #define HALVINGS_MAX 50  /* a step of 2^-50 of the first is nothing */
-#define HOLD_ROUNDS 8    /* holds a trial step may add before it is evaluated */
 #define ARMIJO 1e-4
 /* No coordinate moves more than this many first steps in one (the rms of
 ** the coordinates: a page): where the energy has no floor (a weight with
@@ -55,6 +54,7 @@ typedef struct {
   int used, head;
   unsigned char *held;             /* n: this step's held coordinates */
   long evaluations, forbidden, holds;
+  int away;                        /* the state stands at a rejected trial, not at x */
 } lbfgs;
 
 static double seconds_now(void)
@@ -122,31 +122,25 @@ static void direction(lbfgs *q, double scale0)
   for (size_t j = 0; j < n; j++) d[j] = -d[j];
 }
 
-/* The trial x + h d, holding (d = 0) the coordinates of the parts it would
-** make forbidden while the direction left still descends; the slope g.d
-** left, or 0 when holding took it all. */
-static double trial(lbfgs *q, double h, double slope)
+/* Moves the state back to x from a rejected trial, for the next trial's
+** holds (lw_system_hold measures from where the state stands: from the
+** rejected trial a part held at x moved, and was held again every round).
+** Only a system with walls needs it; the next evaluation moves it anyway. */
+static lw_status restore(lbfgs *q, lw_error *err)
 {
   const lw_system_type *t = q->sys->type;
-  const size_t n = q->n;
-  for (size_t i = 0; i < n; i++) q->x1[i] = q->x[i] + h * q->d[i];
-  for (int r = 0; t->blocked && r < HOLD_ROUNDS; r++) {
-    const size_t parts = t->blocked(q->sys->state, q->x1, q->held);
-    if (!parts) break;
-    q->holds += (long)parts;
-    for (size_t i = 0; i < n; i++)
-      if (q->held[i]) q->d[i] = 0.0;
-    slope = dot(q->g, q->d, n);
-    if (!(slope < 0.0)) return 0.0;
-    for (size_t i = 0; i < n; i++) q->x1[i] = q->x[i] + h * q->d[i];
-  }
-  return slope;
+  if (!t->blocked) return LW_OK;
+  lw_error e2 = {0};
+  if (t->set_coords(q->sys->state, q->x, &e2) != LW_OK) return lw_error_set(err, e2.code, "quench: %s", e2.msg);
+  q->away = 0;
+  return LW_OK;
 }
 
 /* One step from x along d, no coordinate moving more than max_move: 1 if
 ** taken (x, g and *e moved on), 0 if no length descended, -1 on an error. */
 static int line_search(lbfgs *q, double *e, double max_move, lw_error *err)
 {
+  const lw_system_type *t = q->sys->type;
   const size_t n = q->n;
   const double slope0 = dot(q->g, q->d, n);
   if (!(slope0 < 0.0)) return 0;
@@ -159,11 +153,14 @@ static int line_search(lbfgs *q, double *e, double max_move, lw_error *err)
     ** may hold less (held all, it is only shorter) */
     memcpy(q->d, q->d0, n * sizeof *q->d);
     memset(q->held, 0, n);
-    const double slope = trial(q, h, slope0);
+    if (q->away && restore(q, err) != LW_OK) return -1;
+    const double slope = lw_system_hold(t, q->sys->state, q->x, q->g, q->d, h, q->x1, q->held, n, &q->holds);
     if (!(slope < 0.0)) continue;
     const double e1 = evaluate(q, q->x1, q->g1, err);
     if (isnan(e1)) return -1;
+    q->away = 1;
     if (e1 <= *e + ARMIJO * h * slope) {
+      q->away = 0;
       /* the pair (s, y) before x and g move on, kept if s.y > 0 */
       double *s = q->s[q->head], *y = q->y[q->head];
       for (size_t i = 0; i < n; i++) {

@@ -69,3 +69,28 @@ void lw_system_free(lw_system *s)
   s->type->state_free(s->state);
   free(s);
 }
+
+static double dot(const double *u, const double *v, size_t n)
+{
+  double s = 0.0;
+  for (size_t i = 0; i < n; i++) s += u[i] * v[i];
+  return s;
+}
+
+double lw_system_hold(const lw_system_type *t, void *state, const double *x, const double *g, double *dir, double h,
+                      double *x1, unsigned char *held, size_t n, long *holds)
+{
+  for (size_t i = 0; i < n; i++) x1[i] = x[i] + h * dir[i];
+  double slope = dot(g, dir, n);
+  for (int r = 0; t->blocked && slope < 0.0; r++) {
+    const size_t parts = t->blocked(state, x1, held);
+    if (!parts) return slope;
+    if (r == LW_HOLD_ROUNDS) return 0.0;
+    *holds += (long)parts;
+    for (size_t i = 0; i < n; i++)
+      if (held[i]) dir[i] = 0.0;
+    slope = dot(g, dir, n);
+    for (size_t i = 0; i < n; i++) x1[i] = x[i] + h * dir[i];
+  }
+  return slope < 0.0 ? slope : 0.0;
+}

@@ -554,6 +554,7 @@ Test(gradient, splines_row_coordinates_and_gradient)
 
 /* ---- the quench (quench.h) ------------------------------------------ */
 
+#include "linewise/dynamics.h"
 #include "linewise/quench.h"
 #include "linewise/sys_splines.h"
 
@@ -651,6 +652,113 @@ Test(quench, never_leaves_the_allowed_set)
   assert_allowed(&sc, m, r.energy_after);
   lw_model_free(m);
   lw_scene_clear(&sc);
+}
+
+/* A system with walls: thin bands of each coordinate where the energy is
+** +inf, which a longer step may jump and a shorter one land in.  Its energy
+** has ripples, so that line searches reject trials.  It counts what a
+** driver should never do: evaluate a state in a band, or ask blocked about
+** a trial whose held parts are not where the state stands (blocked
+** measures a step from there, as the spacing rule does). */
+enum { WALLED_N = 8 };
+static const double walled_ripple = 0.3, walled_k = 10.0, walled_band = 20.0;
+typedef struct {
+  double cur[WALLED_N];
+  long stale, checks;
+} walled;
+
+static int walled_in_band(double x) { return sin(walled_band * x) > 0.9; }
+static double walled_energy(const double *x, double *g)
+{
+  double e = 0.0;
+  for (int i = 0; i < WALLED_N; i++) {
+    const double c = 3.0 + 0.5 * i;
+    if (walled_in_band(x[i])) return INFINITY;
+    e += 0.5 * (x[i] - c) * (x[i] - c) + walled_ripple * sin(walled_k * x[i]);
+    if (g) g[i] = (x[i] - c) + walled_ripple * walled_k * cos(walled_k * x[i]);
+  }
+  return e;
+}
+static size_t walled_n(const void *st) { return (void)st, WALLED_N; }
+static void walled_get(const void *st, double *x) { memcpy(x, ((const walled *)st)->cur, WALLED_N * sizeof *x); }
+static lw_status walled_set(void *st, const double *x, lw_error *err)
+{
+  memcpy(((walled *)st)->cur, x, WALLED_N * sizeof *x);
+  return LW_OK;
+}
+static double walled_gradient(void *st, double *g, lw_error *err) { return walled_energy(((walled *)st)->cur, g); }
+static double walled_total(const void *st) { return walled_energy(((const walled *)st)->cur, NULL); }
+static size_t walled_blocked(void *st, const double *x, unsigned char *held)
+{
+  walled *w = st;
+  size_t parts = 0;
+  for (int i = 0; i < WALLED_N; i++) {
+    w->stale += held[i] && x[i] != w->cur[i];
+    if (walled_in_band(x[i])) held[i] = 1, parts++;
+  }
+  w->checks++;
+  return parts;
+}
+static void walled_free(void *st) { (void)st; }
+/* the massless flow's damping matrix: the identity */
+static void *walled_mass_new(const void *st, const lw_params *p, double density, lw_error *err)
+{
+  return (void *)st;
+}
+static void walled_mass_free(void *mass) { (void)mass; }
+static lw_status walled_mass_at(void *mass, const double *x, lw_error *err) { return LW_OK; }
+static void walled_mass_solve(const void *mass, const double *b, double *v) { memcpy(v, b, WALLED_N * sizeof *v); }
+static int walled_mass_pinned(const void *mass, size_t i) { return 0; }
+
+static const lw_system_type walled_type = {
+  .name = "walled", .state_free = walled_free, .total = walled_total, .n_coords = walled_n,
+  .get_coords = walled_get, .set_coords = walled_set, .gradient = walled_gradient, .blocked = walled_blocked,
+  .mass_new = walled_mass_new, .mass_free = walled_mass_free, .mass_at = walled_mass_at,
+  .mass_solve = walled_mass_solve, .mass_pinned = walled_mass_pinned};
+
+/* A gradient driver measures each trial's walls from the point it stands
+** at (lw_system_hold), and evaluates no trial that passes one.  The quench
+** and the massless flow did not: after a rejected trial the state stood
+** there, and the next length's holds were measured from it (7 and 16 times
+** here).  The energy is lowered on the way. */
+Test(quench, measures_each_trial_from_where_it_stands)
+{
+  walled w = {.cur = {0}};
+  lw_error err = {0};
+  lw_system sys = {&walled_type, &w};
+  lw_quench_report r;
+  const lw_quench_opts o = {1e-8, 500, 0.0, NULL};
+  cr_assert_eq(lw_quench_run(&sys, &o, &r, &err), LW_OK, "%s", err.msg);
+  cr_log_info("walled: %.10g -> %.10g, %ld iterations, %ld evaluations, %ld holds, %ld checks, %ld stale, %ld forbidden", r.energy_before,
+              r.energy_after, r.iterations, r.evaluations, r.holds, w.checks, w.stale, r.forbidden);
+  cr_assert(r.holds > 0 && r.evaluations > r.iterations + 1, "no wall met or no trial rejected: nothing tested");
+  cr_assert_eq(w.stale, 0, "%ld trials measured from elsewhere", w.stale);
+  cr_assert_eq(r.forbidden, 0, "%ld trials evaluated past a wall", r.forbidden);
+  cr_assert(r.energy_after < r.energy_before);
+}
+
+Test(dynamics, the_massless_flow_measures_each_trial_from_where_it_stands)
+{
+  walled w = {.cur = {0}};
+  lw_error err = {0};
+  lw_params p = base_params();
+  p.dyn_rho = 0;
+  p.dyn_gamma = 1;
+  p.dyn_dt = 4;
+  lw_dynamics *d = lw_dynamics_new(&walled_type, &w, &p, &err);
+  cr_assert_not_null(d, "%s", err.msg);
+  const double e0 = d->energy;
+  for (int k = 0; k < 100; k++) {
+    const double before = d->energy;
+    cr_assert_eq(lw_dynamics_step(d, &err), LW_OK, "%s", err.msg);
+    cr_assert_leq(d->energy, before);
+  }
+  cr_log_info("walled flow: %.10g -> %.10g, %lu halvings, %ld checks, %ld stale", e0, d->energy, d->halvings,
+              w.checks, w.stale);
+  cr_assert(d->halvings > 0 && w.checks > 0, "no trial rejected or no wall: nothing tested");
+  cr_assert_eq(w.stale, 0, "%ld trials measured from elsewhere", w.stale);
+  cr_assert(d->energy < e0);
+  lw_dynamics_free(d);
 }
 
 /* A stop asked for (a signal, main.c) ends the quench at the next

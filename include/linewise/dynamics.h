@@ -35,10 +35,11 @@
 ** at least 1e-4 of what the slope promises (Armijo), so the flow never
 ** leaves the allowed set and its energy never rises.  Where the system says
 ** which parts a trial would make forbidden (its row's `blocked`), the step
-** holds their coordinates and moves the rest at the same length, up to
-** HOLD_ROUNDS times, before it is halved: a page of thousands of segments
-** always has one at a regularity wall, which would otherwise halve every
-** step to nothing.
+** holds their coordinates and moves the rest at the same length
+** (lw_system_hold: measured from where the flow stands, in up to
+** LW_HOLD_ROUNDS rounds) before it is halved: a page of thousands of
+** segments always has one at a regularity wall, which would otherwise halve
+** every step to nothing.
 **
 ** `dynamics.integrator = review` replaces the leapfrog by the implicit
 ** scheme of the D-NURBS review (dyn_review.h): backward in the stiffness, so

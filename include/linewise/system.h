@@ -263,6 +263,18 @@ const lw_system_type *lw_system_of(const lw_params *p, lw_error *err);
 lw_system *lw_system_wrap(const lw_system_type *type, void *state, lw_error *err);
 void lw_system_free(lw_system *s);
 
+/* The trial x1 = x + h dir of a gradient driver (dynamics.h, quench.h),
+** with the coordinates of every part it would make forbidden held: marked
+** in held and zeroed in dir, a round at a time, since a part held moves
+** those beside it (a held segment's nodes are its neighbours' too).  The
+** state must stand at x: `blocked` measures a step from where the state
+** is.  Returns g . dir left, < 0 when the trial may be evaluated; 0 when
+** holding took the descent, or when LW_HOLD_ROUNDS rounds still left a part
+** at a wall (a shorter step holds less).  *holds counts the parts held. */
+#define LW_HOLD_ROUNDS 8
+double lw_system_hold(const lw_system_type *t, void *state, const double *x, const double *g, double *dir, double h,
+                      double *x1, unsigned char *held, size_t n, long *holds);
+
 /* The row's calls on an instance. */
 static inline double lw_system_total(const lw_system *s) { return s->type->total(s->state); }
 
