@@ -282,6 +282,15 @@ void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep)
   }
 }
 
+/* The orientation score for the terminal: none where the picture has no
+** direction to follow (a flat tone; summary.json has null). */
+static const char *orientation_text(double o, char buf[40])
+{
+  if (isnan(o)) return "none (a flat picture)";
+  snprintf(buf, 40, "%.4f", o);
+  return buf;
+}
+
 /* h:mm:ss, or m:ss under an hour */
 static void clock_text(double s, char *buf, size_t n)
 {
@@ -306,12 +315,12 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
   if (w < 0 || (size_t)w >= n) return;
   k = (size_t)w;
   if (!d->has_fidelity) return;
-  w = snprintf(buf + k, n - k,
-               "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f, orientation %.4f, stray ink %.4f\n",
-               d->fidelity.sigma_mm, d->fidelity.mse, d->fidelity.ssim, d->fidelity.orientation, d->fidelity.stray);
+  char o[40];
+  w = snprintf(buf + k, n - k, "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f, orientation %s, stray ink %.4f\n",
+               d->fidelity.sigma_mm, d->fidelity.mse, d->fidelity.ssim, orientation_text(d->fidelity.orientation, o),
+               d->fidelity.stray);
   for (int p = 0; d->n_pens > 1 && p < d->n_pens && w >= 0 && (k += (size_t)w) < n; p++)
-    w = snprintf(buf + k, n - k,
-                 "linewise: fidelity of pen %d: MSE %.6g, SSIM %.4f, orientation %.4f, stray ink %.4f\n", p + 1,
-                 d->pen_fidelity[p].mse, d->pen_fidelity[p].ssim, d->pen_fidelity[p].orientation,
-                 d->pen_fidelity[p].stray);
+    w = snprintf(buf + k, n - k, "linewise: fidelity of pen %d: MSE %.6g, SSIM %.4f, orientation %s, stray ink %.4f\n",
+                 p + 1, d->pen_fidelity[p].mse, d->pen_fidelity[p].ssim,
+                 orientation_text(d->pen_fidelity[p].orientation, o), d->pen_fidelity[p].stray);
 }

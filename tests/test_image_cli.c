@@ -207,6 +207,15 @@ Test(image_cli, the_plot_and_fidelity_reports)
   js = lw_test_read_text(lw_test_path("out2/summary.json"));
   cr_assert(strstr(js, "\"crop_mm\": null"), "%s", js);
   cr_assert_null(strstr(js, "\"pens\""), "%s", js);
+  /* a flat picture has no direction to follow: no orientation score (it said "nan") */
+  float flat[30 * 20];
+  for (int k = 0; k < 30 * 20; k++) flat[k] = 0.5f;
+  lw_test_png(lw_test_path("flat.png"), 30, 20, flat, NULL);
+  cr_assert_eq(run("run scene.ini --out out3 --set scene.image=flat.png --set scene.image_levels=0", errs,
+                   sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, ", orientation none (a flat picture), "), "%s", errs);
+  js = lw_test_read_text(lw_test_path("out3/summary.json"));
+  cr_assert(strstr(js, "\"orientation\": null"), "%s", js);
 }
 
 Test(image_cli, scene_keys_that_need_a_picture_say_so)
