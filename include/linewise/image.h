@@ -82,7 +82,8 @@ lw_image *lw_image_resize(const lw_image *src, int w, int h, lw_error *err);
 /* Gaussian blur of the tone plane with standard deviation sigma pixels
 ** (<= 0: nothing), separable, the kernel cut at 4 sigma and normalised.  The
 ** picture is mirrored at its edges (half-sample symmetric), which makes the
-** blur conserve the mean tone exactly. */
+** blur conserve the mean tone exactly (to 1e-6 from sigma 16 on, where it is
+** summed at every sigma/8-th pixel and interpolated: image.c). */
 lw_status lw_image_blur(lw_image *img, double sigma, lw_error *err);
 
 /* The same blur on any w x h float plane (the field code smooths its
