@@ -82,15 +82,22 @@ double lw_system_hold(const lw_system_type *t, void *state, const double *x, con
 {
   for (size_t i = 0; i < n; i++) x1[i] = x[i] + h * dir[i];
   double slope = dot(g, dir, n);
+  /* the coordinates a round held back (NULL without room: every part asked) */
+  unsigned char *changed = t->blocked ? malloc(n ? n : 1) : NULL;
   for (int r = 0; t->blocked && slope < 0.0; r++) {
-    const size_t parts = t->blocked(state, x1, held);
-    if (!parts) return slope;
-    if (r == LW_HOLD_ROUNDS) return 0.0;
+    const size_t parts = t->blocked(state, x1, held, r && changed ? changed : NULL);
+    if (!parts || r == LW_HOLD_ROUNDS) {
+      free(changed);
+      return parts ? 0.0 : slope;
+    }
     *holds += (long)parts;
-    for (size_t i = 0; i < n; i++)
+    for (size_t i = 0; i < n; i++) {
+      if (changed) changed[i] = held[i] && dir[i] != 0.0;
       if (held[i]) dir[i] = 0.0;
+    }
     slope = dot(g, dir, n);
     for (size_t i = 0; i < n; i++) x1[i] = x[i] + h * dir[i];
   }
+  free(changed);
   return slope < 0.0 ? slope : 0.0;
 }

@@ -387,7 +387,7 @@ Test(gradient, blocked_marks_the_segments_at_a_wall)
   double *x = malloc(n * sizeof *x);
   unsigned char *held = calloc(n, 1);
   t->get_coords(sys->state, x);
-  cr_assert_eq(t->blocked(sys->state, x, held), 0);
+  cr_assert_eq(t->blocked(sys->state, x, held, NULL), 0);
   for (size_t i = 0; i < n; i++) cr_assert_eq(held[i], 0);
   /* spline 1's third node outside the page: its two segments; spline 2's
   ** first handle folded back over its segment: that segment */
@@ -396,7 +396,7 @@ Test(gradient, blocked_marks_the_segments_at_a_wall)
   x[4 * k1] = -50;
   x[4 * k2 + 2] = -40 * (x[4 * k2 + 4] - x[4 * k2]);
   x[4 * k2 + 3] = -40 * (x[4 * k2 + 5] - x[4 * k2 + 1]);
-  cr_assert_eq(t->blocked(sys->state, x, held), 3);
+  cr_assert_eq(t->blocked(sys->state, x, held, NULL), 3);
   for (size_t k = 0; k < m->sp->n_nodes; k++) {
     int want = (k + 1 >= k1 && k <= k1 + 1) || k == k2 || k == k2 + 1;
     for (int c = 0; c < 4; c++)
@@ -688,7 +688,7 @@ static lw_status walled_set(void *st, const double *x, lw_error *err)
 }
 static double walled_gradient(void *st, double *g, lw_error *err) { return walled_energy(((walled *)st)->cur, g); }
 static double walled_total(const void *st) { return walled_energy(((const walled *)st)->cur, NULL); }
-static size_t walled_blocked(void *st, const double *x, unsigned char *held)
+static size_t walled_blocked(void *st, const double *x, unsigned char *held, const unsigned char *changed)
 {
   walled *w = st;
   size_t parts = 0;

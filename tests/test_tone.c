@@ -594,6 +594,53 @@ Test(tone, the_quench_keeps_the_spacing)
             removed[0]);
 }
 
+/* A hold round after the first asks only the segments beside the new
+** holds (system.h, `changed`): the others were allowed and every curve now
+** moves less.  On the crowded rows (lines 0.45 apart, spacing 0.3), a step
+** down the gradient whose longest move is 6 mm holds more in later rounds
+** (the neighbours of held segments, half moved), and each round asking
+** only beside the new holds holds what asking every segment holds. */
+Test(tone, later_hold_rounds_ask_only_beside_the_new_holds)
+{
+  lw_scene sc;
+  spacing_scene(&sc, 1);
+  lw_error err = {0};
+  lw_model *m = lw_model_new(&sc, rows(16), &err);
+  cr_assert_not_null(m, "%s", err.msg);
+  lw_system *sys = lw_splines_view(m, &err);
+  cr_assert_not_null(sys, "%s", err.msg);
+  const lw_system_type *t = sys->type;
+  const size_t n = t->n_coords(sys->state);
+  double *x = malloc(n * sizeof *x), *x1 = malloc(n * sizeof *x1);
+  unsigned char *held = calloc(n, 1), *all = calloc(n, 1), *changed = calloc(n, 1);
+  t->get_coords(sys->state, x);
+  double *g = malloc(n * sizeof *g), gmax = 0;
+  cr_assert(isfinite(t->gradient(sys->state, g, &err)), "%s", err.msg);
+  for (size_t i = 0; i < n; i++) gmax = fmax(gmax, fabs(g[i]));
+  for (size_t i = 0; i < n; i++) x1[i] = x[i] - 6.0 * g[i] / gmax;
+  size_t parts = t->blocked(sys->state, x1, held, NULL), later = 0;
+  cr_assert(parts > 0, "nothing met a wall: the test tests nothing");
+  for (int r = 1; parts && r < 20; r++) {
+    for (size_t i = 0; i < n; i++) {
+      changed[i] = held[i] && x1[i] != x[i];
+      if (held[i]) x1[i] = x[i];
+    }
+    memcpy(all, held, n);
+    parts = t->blocked(sys->state, x1, held, changed);
+    size_t every = t->blocked(sys->state, x1, all, NULL);
+    cr_assert_eq(parts, every, "round %d: %zu parts asking beside the holds, %zu asking all", r, parts, every);
+    cr_assert(!memcmp(held, all, n), "round %d: other parts held", r);
+    later += parts;
+  }
+  cr_log_info("hold rounds: %zu parts after the first round", later);
+  cr_assert(later > 0, "no later round held anything: the test tests nothing");
+  cr_assert_eq(parts, 0);
+  free(x), free(x1), free(g), free(held), free(all), free(changed);
+  lw_system_free(sys);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
 Test(tone, a_crowded_start_only_gets_less_crowded)
 {
   /* A random placement breaks the spacing everywhere; no move may add a

@@ -215,8 +215,13 @@ struct lw_system_type {
   ** leaves the other entries as they were and the state unchanged; returns
   ** how many parts.  A gradient driver holds those coordinates and lets
   ** the rest move, where shortening the whole step would let one segment
-  ** at a wall stop every other (dynamics.h, quench.h). */
-  size_t (*blocked)(void *state, const double *x, unsigned char *blocked);
+  ** at a wall stop every other (dynamics.h, quench.h).  changed: NULL
+  ** (ask every part), or 1 for the coordinates x changed since the previous
+  ** call on the same state, each only by moving less (held back to where
+  ** the state stands); then only the parts with a changed coordinate are
+  ** asked, since a part that was allowed stays so when the others move
+  ** less (lw_system_hold). */
+  size_t (*blocked)(void *state, const double *x, unsigned char *blocked, const unsigned char *changed);
   /* Inertia (the dynamics driver, dynamics.h): the mass matrix M(x) of the
   ** kinetic energy T = 1/2 xdot' M(x) xdot for a density (mass per unit
   ** of the system's measure), with the coordinates the scene pins held:
@@ -270,7 +275,8 @@ void lw_system_free(lw_system *s);
 ** state must stand at x: `blocked` measures a step from where the state
 ** is.  Returns g . dir left, < 0 when the trial may be evaluated; 0 when
 ** holding took the descent, or when LW_HOLD_ROUNDS rounds still left a part
-** at a wall (a shorter step holds less).  *holds counts the parts held. */
+** at a wall (a shorter step holds less).  *holds counts the parts held.
+** Rounds after the first ask only the parts beside the new holds. */
 #define LW_HOLD_ROUNDS 8
 double lw_system_hold(const lw_system_type *t, void *state, const double *x, const double *g, double *dir, double h,
                       double *x1, unsigned char *held, size_t n, long *holds);
