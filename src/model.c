@@ -1153,7 +1153,7 @@ static double curve_distance(const lw_splines *sp, size_t h, double t, double px
 }
 
 /* The curves near one check point, each once, from its sample nearest the
-** point; past NEAR of them each sample is asked at once. */
+** point; past NEAR_CURVES of them each sample is asked at once. */
 enum { NEAR_CURVES = 32 };
 typedef struct {
   uint32_t seg[NEAR_CURVES];
