@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/image.h"
 #include "linewise/output.h"
 
 static int positive(double x) { return isfinite(x) && x > 0; }
@@ -168,15 +169,6 @@ static double blur_at(const double *v, size_t n, size_t step, long x, const doub
   return norm > 0.0 ? sum / norm : 0.0;
 }
 
-static void catmull_rom(double u, double wt[4])
-{
-  const double u2 = u * u, u3 = u2 * u;
-  wt[0] = 0.5 * (-u3 + 2.0 * u2 - u);
-  wt[1] = 0.5 * (3.0 * u3 - 5.0 * u2 + 2.0);
-  wt[2] = 0.5 * (-3.0 * u3 + 4.0 * u2 + u);
-  wt[3] = 0.5 * (u3 - u2);
-}
-
 static lw_status blur_sparse(double *v, int w, int h, double sx, double sy, int rx, int ry, int f, lw_error *err)
 {
   const size_t W = (size_t)w, H = (size_t)h, Kx = (W - 1) / (size_t)f + 4, Ky = (H - 1) / (size_t)f + 4;
@@ -193,10 +185,10 @@ static lw_status blur_sparse(double *v, int w, int h, double sx, double sy, int 
     for (size_t k = 0; k < Kx; k++) rows[y * Kx + k] = blur_at(v + y * W, W, 1, ((long)k - 1) * f, gx, rx);
   for (size_t k = 0; k < Kx; k++)
     for (size_t j = 0; j < Ky; j++) grid[j * Kx + k] = blur_at(rows + k, H, Kx, ((long)j - 1) * f, gy, ry);
-  for (size_t x = 0; x < W; x++) catmull_rom((double)(x % (size_t)f) / f, wx + 4 * x);
+  for (size_t x = 0; x < W; x++) lw_image_cubic_weights((double)(x % (size_t)f) / f, wx + 4 * x);
   for (size_t y = 0; y < H; y++) {
     double wy[4];
-    catmull_rom((double)(y % (size_t)f) / f, wy);
+    lw_image_cubic_weights((double)(y % (size_t)f) / f, wy);
     const double *g = grid + (y / (size_t)f) * Kx;
     for (size_t x = 0; x < W; x++) {
       const double *c = g + x / (size_t)f, *a = wx + 4 * x;

@@ -724,8 +724,7 @@ static void blur_line_sparse(const float *q, size_t estride, int n, const double
   }
 }
 
-/* The four Catmull-Rom weights at fraction u of a step. */
-static void cubic_weights(double u, double wt[4])
+void lw_image_cubic_weights(double u, double wt[4])
 {
   const double u2 = u * u, u3 = u2 * u;
   wt[0] = 0.5 * (-u3 + 2.0 * u2 - u);
@@ -742,7 +741,7 @@ static lw_status blur_sparse(float *plane, int w, int h, const double *kx, int t
   double *wx = malloc(4 * (size_t)w * sizeof *wx);
   int failed = !rows || !grid || !wx;
   if (!failed) {
-    for (int x = 0; x < w; x++) cubic_weights((double)(x % f) / f, wx + 4 * (size_t)x);
+    for (int x = 0; x < w; x++) lw_image_cubic_weights((double)(x % f) / f, wx + 4 * (size_t)x);
 #pragma omp parallel reduction(| : failed)
     {
       const int longest = (w > h ? w : h) + 3 * f + (tx > ty ? tx : ty);
@@ -758,7 +757,7 @@ static lw_status blur_sparse(float *plane, int w, int h, const double *kx, int t
 #pragma omp for schedule(static)
         for (int y = 0; y < h; y++) {
           double wy[4];
-          cubic_weights((double)(y % f) / f, wy);
+          lw_image_cubic_weights((double)(y % f) / f, wy);
           const float *g = grid + (size_t)(y / f) * Kx;
           float *out = plane + (size_t)y * (size_t)w;
           for (int x = 0; x < w; x++) {

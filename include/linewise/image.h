@@ -90,6 +90,11 @@ lw_status lw_image_blur(lw_image *img, double sigma, lw_error *err);
 ** structure tensor with it). */
 lw_status lw_image_blur_plane(float *plane, int w, int h, double sigma, lw_error *err);
 
+/* The four Catmull-Rom weights, for the samples at -1, 0, 1 and 2 steps,
+** of the point u of a step (0 <= u < 1) past sample 0: how the wide blurs
+** (here and in fidelity.c) fill in between the pixels they sum at. */
+void lw_image_cubic_weights(double u, double w[4]);
+
 /* Auto levels: stretches the tone linearly so that the darkest share `clip`
 ** of the picture's pixels turn black and the lightest share `clip` white,
 ** clipped to [0, 1].  Pixels less than half opaque are not counted (with
