@@ -366,6 +366,34 @@ static lw_status bmp_complete(const unsigned char *d, size_t n, const char *name
   return LW_OK;
 }
 
+/* stb_image reads missing bytes at the end of a GIF as zeros too, so a
+** cut file decodes to a picture with a black or garbled foot.  The blocks
+** are walked to the end of the first picture's data (the one decoded): the
+** screen descriptor and global colour table, then extensions (a label and
+** sub-blocks) up to the image descriptor, its local colour table, the LZW
+** code size and its data sub-blocks, each a length byte and that many
+** bytes, up to the empty one. */
+static lw_status gif_complete(const unsigned char *d, size_t n, const char *name, lw_error *err)
+{
+  if (n < 13 || memcmp(d, "GIF8", 4)) return LW_OK;
+  size_t at = 13;
+  if (d[10] & 0x80) at += 3u << ((d[10] & 7) + 1);
+  while (at < n && d[at] != 0x2C) {
+    if (d[at] != 0x21) return LW_OK; /* the trailer or a stray byte: the decoder's to refuse */
+    at += 2;
+    while (at < n && d[at]) at += (size_t)d[at] + 1;
+    at++;
+  }
+  if (at + 10 <= n) {
+    unsigned flags = d[at + 9];
+    at += 10 + ((flags & 0x80) ? 3u << ((flags & 7) + 1) : 0u) + 1;
+    while (at < n && d[at]) at += (size_t)d[at] + 1;
+    if (at < n) return LW_OK;
+  }
+  return lw_error_set(err, LW_EINPUT, "%s: truncated: the GIF's first picture runs past the end of the file (%zu bytes)",
+                      name, n);
+}
+
 static uint32_t tiff32(const unsigned char *p, int be)
 {
   return be ? (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3] : le32(p);
@@ -449,6 +477,7 @@ static const char *format_name(const unsigned char *d, size_t n)
   if (n >= 4 && d[0] == 0x89 && d[1] == 'P' && d[2] == 'N' && d[3] == 'G') return "PNG";
   if (n >= 2 && d[0] == 0xFF && d[1] == 0xD8) return "JPEG";
   if (n >= 2 && d[0] == 'B' && d[1] == 'M') return "BMP";
+  if (n >= 4 && !memcmp(d, "GIF8", 4)) return "GIF";
   return "image";
 }
 
@@ -458,12 +487,13 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
     return lw_error_set(err, LW_EINPUT, "%s: a file of %zu bytes is too large for the image decoder", name, size);
   int w, h, ch;
   if (!stbi_info_from_memory(data, (int)size, &w, &h, &ch))
-    return lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, BMP, PGM/PPM): %s", name,
+    return lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, PGM/PPM): %s", name,
                         stbi_failure_reason());
   if ((double)w * (double)h > LW_IMAGE_MAX_PIXELS)
     return lw_error_set(err, LW_EINPUT, "%s: %d x %d pixels is more than the %.0e pixels linewise decodes", name,
                         w, h, LW_IMAGE_MAX_PIXELS);
   lw_status st = bmp_complete(data, size, name, err);
+  if (!st) st = gif_complete(data, size, name, err);
   if (st) return st;
   int bits = stbi_is_16_bit_from_memory(data, (int)size) ? 16 : 8;
   /* The decoder keeps its last reason until a new one is set, and some
@@ -610,7 +640,7 @@ lw_status lw_image_probe(const char *path, lw_image_info *info, lw_error *err)
   } else {
     int iw, ih, ch;
     if (size == 0 || size > INT_MAX || !stbi_info_from_memory(data, (int)size, &iw, &ih, &ch))
-      st = lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, BMP, PGM/PPM): %s", path,
+      st = lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, PGM/PPM): %s", path,
                         size == 0 ? "empty file" : stbi_failure_reason());
     else if (jpeg_orientation(data, size) >= 5) /* stored on its side */
       *info = (lw_image_info){ih, iw, ch, 8};

@@ -67,7 +67,7 @@ const lw_param_def lw_param_table[] = {
   STRING("scene", "polygon", polygon, "", "mm",
          "Polygon boundary vertices as `x y x y ...` (at least 3 vertices; either orientation)."),
   STRING("scene", "image", image, "", "path",
-         "A picture (PNG, JPEG, BMP, PGM/PPM; gray or colour, with or without alpha) relative to "
+         "A picture (PNG, JPEG, GIF, BMP, PGM/PPM; gray or colour, with or without alpha) relative to "
          "the scene file. It is fitted into the page inset by `margin`, centred, aspect kept. "
          "Its tone feeds potential = image, field = etf and gradient, mask = alpha, and the "
          "placement of the splines (docs/IMAGES.md). Empty = none."),

@@ -1,6 +1,6 @@
 /*
 ** stb_image_impl.c -- the one translation unit that compiles stb_image
-** (libstb-dev ships it as a header only).  Only PNG, JPEG and BMP are
+** (libstb-dev ships it as a header only).  Only PNG, JPEG, GIF and BMP are
 ** built (image.c reads PGM/PPM itself), from memory only (image.c reads files itself so that it can
 ** say why a file could not be read), with the decoder's user-facing
 ** failure messages.  Warnings are the library's business: silenced here,
@@ -12,6 +12,7 @@
 #define STBI_ONLY_PNG
 #define STBI_ONLY_JPEG
 #define STBI_ONLY_BMP
+#define STBI_ONLY_GIF
 
 #if defined(__GNUC__)
 #pragma GCC diagnostic push

@@ -112,6 +112,45 @@ Test(image, pgm_and_ppm_any_maxval_and_truncation)
   cr_assert(err.code == LW_EINPUT && strstr(err.msg, "bad.pgm"), "%s", err.msg);
 }
 
+/* A GIF's first picture, with its transparency: 12 x 6, the left half
+** black, the lower right gray (127), the upper right transparent (made by
+** ImageMagick, with its application extension before the picture, which
+** the walk to the picture's end must skip).  stb_image reads a GIF cut
+** short as zeros, so every cut before the picture's last data block is
+** refused, naming the file and the GIF. */
+Test(image, a_gif_decodes_and_a_gif_cut_short_is_refused)
+{
+  static const unsigned char gif[] = {
+    0x47, 0x49, 0x46, 0x38, 0x39, 0x61, 0x0c, 0x00, 0x06, 0x00, 0xf1, 0x00, 0x00, 0x00, 0x00, 0x00, 0x7f, 0x7f, 0x7f,
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x21, 0xf9, 0x04, 0x01, 0x00, 0x00, 0x02, 0x00, 0x21, 0xff, 0x0b, 0x49, 0x6d,
+    0x61, 0x67, 0x65, 0x4d, 0x61, 0x67, 0x69, 0x63, 0x6b, 0x0e, 0x67, 0x61, 0x6d, 0x6d, 0x61, 0x3d, 0x30, 0x2e, 0x34,
+    0x35, 0x34, 0x35, 0x34, 0x35, 0x00, 0x2c, 0x00, 0x00, 0x00, 0x00, 0x0c, 0x00, 0x06, 0x00, 0x00, 0x02, 0x0f, 0x84,
+    0x2f, 0xa9, 0x87, 0x9a, 0x6c, 0xdc, 0x83, 0xa1, 0x5a, 0x08, 0xec, 0xa5, 0x3a, 0x14, 0x00, 0x3b};
+  lw_error err;
+  lw_image_info info;
+  lw_image *img = lw_image_decode(gif, sizeof gif, "t.gif", 1e6, &info, &err);
+  cr_assert_not_null(img, "%s", err.msg);
+  cr_assert(img->width == 12 && img->height == 6 && img->alpha, "%d x %d", img->width, img->height);
+  for (int y = 0; y < 6; y++)
+    for (int x = 0; x < 12; x++) {
+      size_t k = (size_t)y * 12 + (size_t)x;
+      double tone = x < 6 ? 0.0 : y >= 3 ? 127 / 255.0 : 1.0, alpha = x >= 6 && y < 3 ? 0.0 : 1.0;
+      cr_assert(fabs(img->tone[k] - tone) < 1e-6 && fabs(img->alpha[k] - alpha) < 1e-6,
+                "pixel (%d, %d): tone %g alpha %g, expected %g and %g", x, y, img->tone[k], img->alpha[k], tone, alpha);
+    }
+  lw_image_free(img);
+  /* the last data block ends at byte 90 (its empty terminator); the trailer after it is not needed */
+  for (size_t cut = 1; cut < sizeof gif - 1; cut++) {
+    cr_assert_null(lw_image_decode(gif, cut, "cut.gif", 1e6, NULL, &err), "a cut at %zu of %zu decoded", cut,
+                   sizeof gif);
+    cr_assert(err.code == LW_EINPUT && strstr(err.msg, "cut.gif: ") && (strstr(err.msg, "GIF") || cut < 6), "cut at %zu: %s",
+              cut, err.msg);
+  }
+  img = lw_image_decode(gif, sizeof gif - 1, "t.gif", 1e6, NULL, &err);
+  cr_assert_not_null(img, "without its trailer: %s", err.msg);
+  lw_image_free(img);
+}
+
 Test(image, alpha_is_kept_and_the_tone_composited_over_white)
 {
   const float g[4] = {0, 0, 0.5f, 1}, a[4] = {1, 0.5f, 0.2f, 0};
