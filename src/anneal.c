@@ -819,7 +819,8 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json_begin_object(&j);
   for (int k = 0; k < c->n_moves; k++) {
     lw_json_key(&j, t->move_names[k]);
-    lw_json_number(&j, c->step[k] / t->move_unit[k]);
+    if (c->step_max[k] > 0.0) lw_json_number(&j, c->step[k] / t->move_unit[k]);
+    else lw_json_null(&j);
   }
   lw_json_end_object(&j);
   if (a->pt) {

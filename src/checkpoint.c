@@ -252,8 +252,11 @@ static lw_status get_chain(lw_ckpt *doc, int k, const lw_system_type *t, lw_chai
     const char *name = t->move_names[m];
     unsigned long v[5] = {0, 0, 0, 0, 0};
     snprintf(key, sizeof key, "step.%s", name);
-    /* tuning keeps steps in [1e-300, step_max] (mc.c) */
-    if ((s = lw_ckpt_numbers(doc, sec, key, &c->step[m], 1, 1e-300, c->step_max[m], 0, err))) break;
+    /* tuning keeps steps in [1e-300, step_max] (mc.c); a kind without a
+    ** step has 0, or before 2026-12 whatever tuning had left in [0, 1] */
+    if (c->step_max[m] > 0.0) s = lw_ckpt_numbers(doc, sec, key, &c->step[m], 1, 1e-300, c->step_max[m], 0, err);
+    else if (!(s = lw_ckpt_numbers(doc, sec, key, &c->step[m], 1, 0.0, 1.0, 0, err))) c->step[m] = 0.0;
+    if (s) break;
     snprintf(key, sizeof key, "window.%s", name);
     if ((s = lw_ckpt_counts(doc, sec, key, v, 2, 0, err))) break;
     if (v[1] > v[0]) {

@@ -57,6 +57,10 @@ void lw_chain_free(lw_chain *c)
 static void tune_window(lw_chain *c, int kind)
 {
   if (c->win_prop[kind] < LW_TUNE_WINDOW) return;
+  if (c->step_max[kind] <= 0.0) { /* a kind without a step: only the window restarts */
+    c->win_prop[kind] = c->win_acc[kind] = 0;
+    return;
+  }
   double rate = (double)c->win_acc[kind] / (double)c->win_prop[kind];
   /* multiplicative update: a step that accepts too often grows, one that
   ** rarely accepts shrinks; the factor is bounded by e^{+-1} per window and

@@ -245,8 +245,8 @@ static void moves(const lw_params *p, double *weight, double *step, double *targ
   const int n = lw_splines_row(p)->n_moves;
   for (int k = 0; k < n; k++) {
     weight[k] = w[k];
-    /* a trans-dimensional kind has no step: tuning may change it, nothing reads it */
-    step[k] = k < LW_MOVE_KINDS ? st[k] * move_unit[k] : 1.0;
+    /* a trans-dimensional kind has no step (step_max 0) */
+    step[k] = k < LW_MOVE_KINDS ? st[k] * move_unit[k] : 0.0;
     target[k] = k < LW_MOVE_KINDS ? tg[k] : p->target_spline;
   }
 }
@@ -266,11 +266,12 @@ static size_t sweep_size(const void *state)
 static size_t sites(const void *state) { return ((const spl_state *)state)->m->sp->n_nodes; }
 
 /* Steps are capped at the page size: beyond that a Gaussian step only
-** throws nodes off the page; an angle at half a turn. */
+** throws nodes off the page; an angle at half a turn.  The
+** trans-dimensional kinds have none. */
 static double step_max(const void *state, int kind)
 {
   const lw_scene *sc = ((const spl_state *)state)->m->scene;
-  return kind == LW_MOVE_ROTATE ? M_PI : kind >= LW_MOVE_KINDS ? 1.0 : fmax(sc->width, sc->height);
+  return kind == LW_MOVE_ROTATE ? M_PI : kind >= LW_MOVE_KINDS ? 0.0 : fmax(sc->width, sc->height);
 }
 
 static void *proposal_new(const void *state, lw_error *err)

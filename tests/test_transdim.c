@@ -827,6 +827,11 @@ Test(transdim, runs_are_deterministic_and_resume_bit_exactly, .timeout = 300)
     cr_assert(a > 0 && a < 1, "%s: acceptance %g", kinds[k], a);
   }
   cr_assert_eq(lw_test_sh("head -1 %s/a/trace.csv | grep -q ',acc_birth,acc_death,acc_grow,acc_shrink'", dir), 0);
+  /* the kinds without a step say so (tuning once drove theirs to 1e-267), the tuned ones keep theirs */
+  for (int k = 0; k < 4; k++)
+    cr_assert_eq(lw_test_sh("grep -A10 '\"steps\": {' %s/a/summary.json | grep -q '\"%s\": null'", dir, kinds[k]), 0,
+                 "steps.%s is not null", kinds[k]);
+  cr_assert_gt(summary_value(dir, "steps", "point"), 0.0);
   cr_assert_neq(lw_test_sh("grep -q split %s/a/trace.csv %s/a/summary.json", dir, dir), 0,
                 "split and join off: the eight kinds' columns and keys only");
   cr_assert_neq(lw_test_sh("grep -q '\"splines\": 10,' %s/a/summary.json", dir), 0, "the count never changed");
