@@ -38,7 +38,8 @@ static const char usage[] =
   "\n"
   "commands:\n"
   "  run SCENE.ini       anneal a scene into a run directory\n"
-  "      --out DIR           run directory (default out/<scene name>)\n"
+  "      --out DIR           run directory, replaced if it holds a run (default\n"
+  "                          out/<scene name>, or the first free out/<scene name>-N)\n"
   "      --set SEC.KEY=VAL   override a scene parameter (repeatable)\n"
   "      --seed N            override anneal.seed\n"
   "      --stop-at N         stop cleanly after sweep N, as if interrupted\n"
@@ -346,6 +347,35 @@ static lw_status spread_start(lw_status s, lw_anneal *a, int fresh, lw_error *er
   return s;
 }
 
+/* Whether dir holds a run (its scene.ini or state.lw). */
+static int holds_run(const char *dir)
+{
+  char path[LW_PATH_MAX + 16];
+  snprintf(path, sizeof path, "%s/scene.ini", dir);
+  if (access(path, F_OK) == 0) return 1;
+  snprintf(path, sizeof path, "%s/state.lw", dir);
+  return access(path, F_OK) == 0;
+}
+
+/* The default run directory: out/<scene name>, or out/<scene name>-2, -3,
+** ... when that holds a run already, so that a run started without --out
+** never replaces the drawing of another (--out names a directory to
+** replace).  The processes of an MPI run look before any of them writes. */
+static void default_dir(char *dir, size_t size, const char *scene)
+{
+  const char *base = strrchr(scene, '/');
+  base = base ? base + 1 : scene;
+  const int n = (int)strcspn(base, ".");
+  snprintf(dir, size, "out/%.*s", n, base);
+  for (int k = 2; holds_run(dir) && k < 1000000; k++) snprintf(dir, size, "out/%.*s-%d", n, base, k);
+#ifdef LW_MPI
+  if (net) {
+    lw_error err;
+    lw_mpi_agree(net, LW_OK, &err);
+  }
+#endif
+}
+
 static int cmd_run(int argc, char **argv)
 {
   lw_error err;
@@ -402,11 +432,7 @@ static int cmd_run(int argc, char **argv)
   }
   char dir[LW_PATH_MAX];
   if (out) snprintf(dir, sizeof dir, "%s", out);
-  else {
-    const char *base = strrchr(scene, '/');
-    base = base ? base + 1 : scene;
-    snprintf(dir, sizeof dir, "out/%.*s", (int)strcspn(base, "."), base);
-  }
+  else default_dir(dir, sizeof dir, scene);
   static lw_anneal a;
   watcher w;
   if (net && net->rank) quiet = 1;

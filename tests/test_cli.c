@@ -313,3 +313,28 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
   cr_assert(strstr(errs, "fz/state.lw: write failed: File too large"), "%s", errs);
   cr_assert_neq(lw_test_sh("ls %s/fz/*.tmp 2>/dev/null | grep -q .", dir), 0, "a temporary file was left behind");
 }
+
+/* A run started without --out goes to out/<scene name>, and when that
+** holds a run, to the first out/<scene name>-N that does not: the first
+** drawing is not replaced.  --out names a directory to replace. */
+Test(cli, a_run_without_out_never_replaces_another)
+{
+  write_file("s.ini", scene_text);
+  const char *b = lw_test_bin();
+  for (int k = 0; k < 3; k++)
+    cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --quiet --seed %d --set anneal.sweeps=2", dir, b, k + 1), 0);
+  cr_assert_eq(lw_test_sh("cd %s/out && test -f s/final.svg && test -f s-2/final.svg && test -f s-3/final.svg && "
+                          "! test -e s-4 && grep -q 'seed = 1' s/scene.ini && grep -q 'seed = 2' s-2/scene.ini && "
+                          "grep -q 'seed = 3' s-3/scene.ini",
+                          dir),
+               0, "three runs without --out: out/s, out/s-2 and out/s-3, seeds 1, 2 and 3");
+  /* a directory without a run in it is used as it is */
+  cr_assert_eq(lw_test_sh("mkdir -p %s/out/t && cp %s/s.ini %s/t.ini && cd %s && %s run t.ini --quiet "
+                          "--set anneal.sweeps=2 && test -f out/t/final.svg && ! test -e out/t-2",
+                          dir, dir, dir, dir, b),
+               0);
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --quiet --seed 9 --set anneal.sweeps=2 --out out/s && "
+                          "grep -q 'seed = 9' out/s/scene.ini && ! test -e out/s-4",
+                          dir, b),
+               0, "--out replaces the run it names");
+}
