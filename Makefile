@@ -27,7 +27,7 @@ LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_OBJ := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%.o) $(BUILD)/tests/stb_write.o
 # The fuzz harnesses, compiled with cc into the suite, which replays the corpus.
-FUZZ_NAMES := params state resume energy
+FUZZ_NAMES := params state resume energy image
 FUZZ_REPLAY_OBJ := $(FUZZ_NAMES:%=$(BUILD)/tests/fuzz_%.o)
 TEST_JOBS ?= 2
 # study tools (shell, gnuplot), installed as linewise-<name>
@@ -102,7 +102,8 @@ FUZZ_CC   ?= clang
 FUZZ_TIME ?= 60
 FUZZ_FLAGS ?=
 FUZZ_OBJ  := $(LIB_SRC:src/%.c=build-fuzz/obj/%.o)
-FUZZ_SAN  := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
+FUZZ_SAN  := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined \
+             -DLW_IMAGE_MAX_PIXELS=4194304
 FUZZ_WARN := $(WARN) -Wno-unknown-pragmas
 
 build-fuzz/obj/%.o: src/%.c $(wildcard include/linewise/*.h) | build-fuzz/obj

@@ -394,6 +394,52 @@ static lw_status gif_complete(const unsigned char *d, size_t n, const char *name
                       name, n);
 }
 
+/* A byte of d as stb_image reads it: 0 past the end. */
+static unsigned byte_at(const unsigned char *d, size_t n, size_t at) { return at < n ? d[at] : 0u; }
+
+/* stb_image 2.27 (Debian's libstb) builds a JPEG Huffman table without
+** checking that its 16 code counts sum to at most 256, and writes past the
+** table when they do (found by tests/fuzz/fuzz_image.c).  Every table of
+** every DHT segment the decoder could reach is checked first, the markers
+** walked as it walks them: bytes that are not 0xFF skipped one by one, fill
+** bytes 0xFF before a marker, segments by their lengths, and after a scan's
+** header its entropy-coded data up to the next 0xFF that is neither a
+** stuffed zero, a fill byte nor a restart marker. */
+static lw_status jpeg_tables_sound(const unsigned char *d, size_t n, const char *name, lw_error *err)
+{
+  if (n < 2 || d[0] != 0xFF || d[1] != 0xD8) return LW_OK;
+  size_t at = 2;
+  while (at < n) {
+    if (d[at] != 0xFF) {
+      at++;
+      continue;
+    }
+    while (at < n && d[at] == 0xFF) at++;
+    if (at >= n) break;
+    const unsigned marker = d[at++];
+    if (marker == 0xD9) break;
+    if (marker == 0x00 || marker == 0x01 || (marker >= 0xD0 && marker <= 0xD8)) continue;
+    const size_t len = byte_at(d, n, at) << 8 | byte_at(d, n, at + 1);
+    if (marker == 0xC4)
+      for (size_t t = at + 2; t < at + len && t < n;) {
+        const unsigned q = d[t];
+        if (q >> 4 > 1 || (q & 15) > 3) break; /* refused by the decoder itself */
+        size_t count = 0;
+        for (size_t i = 1; i <= 16; i++) count += byte_at(d, n, t + i);
+        if (count > 256)
+          return lw_error_set(err, LW_EINPUT, "%s: the JPEG is damaged: a Huffman table of %zu codes (256 at most)",
+                              name, count);
+        t += 17 + count;
+      }
+    at += len;
+    if (marker == 0xDA)
+      while (at + 1 < n && !(d[at] == 0xFF && d[at + 1] != 0x00 && d[at + 1] != 0xFF &&
+                             !(d[at + 1] >= 0xD0 && d[at + 1] <= 0xD7)))
+        at++;
+  }
+  return LW_OK;
+}
+
 static uint32_t tiff32(const unsigned char *p, int be)
 {
   return be ? (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3] : le32(p);
@@ -481,10 +527,23 @@ static const char *format_name(const unsigned char *d, size_t n)
   return "image";
 }
 
+/* What stb_image must not be given: a BMP or GIF cut short, a JPEG whose
+** tables would make it write out of bounds.  Checked before any call into
+** it, stbi_info too (which reads a JPEG's tables). */
+static lw_status stb_input_sound(const unsigned char *data, size_t size, const char *name, lw_error *err)
+{
+  lw_status st = bmp_complete(data, size, name, err);
+  if (!st) st = gif_complete(data, size, name, err);
+  if (!st) st = jpeg_tables_sound(data, size, name, err);
+  return st;
+}
+
 static lw_status stb_decode(const unsigned char *data, size_t size, const char *name, decoded *out, lw_error *err)
 {
   if (size > INT_MAX)
     return lw_error_set(err, LW_EINPUT, "%s: a file of %zu bytes is too large for the image decoder", name, size);
+  lw_status st = stb_input_sound(data, size, name, err);
+  if (st) return st;
   int w, h, ch;
   if (!stbi_info_from_memory(data, (int)size, &w, &h, &ch))
     return lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, PGM/PPM): %s", name,
@@ -492,9 +551,6 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
   if ((double)w * (double)h > LW_IMAGE_MAX_PIXELS)
     return lw_error_set(err, LW_EINPUT, "%s: %d x %d pixels is more than the %.0e pixels linewise decodes", name,
                         w, h, LW_IMAGE_MAX_PIXELS);
-  lw_status st = bmp_complete(data, size, name, err);
-  if (!st) st = gif_complete(data, size, name, err);
-  if (st) return st;
   int bits = stbi_is_16_bit_from_memory(data, (int)size) ? 16 : 8;
   /* The decoder keeps its last reason until a new one is set, and some
   ** failures set none: a JPEG cut short was reported as "Not a PNG", from
@@ -639,7 +695,10 @@ lw_status lw_image_probe(const char *path, lw_image_info *info, lw_error *err)
       *info = (lw_image_info){(int)w, (int)h, data[1] == '6' ? 3 : 1, maxval > 255 ? 16 : 8};
   } else {
     int iw, ih, ch;
-    if (size == 0 || size > INT_MAX || !stbi_info_from_memory(data, (int)size, &iw, &ih, &ch))
+    if (size > 0 && size <= INT_MAX) st = stb_input_sound(data, size, path, err);
+    if (st)
+      ; /* refused before stb_image reads it */
+    else if (size == 0 || size > INT_MAX || !stbi_info_from_memory(data, (int)size, &iw, &ih, &ch))
       st = lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, PGM/PPM): %s", path,
                         size == 0 ? "empty file" : stbi_failure_reason());
     else if (jpeg_orientation(data, size) >= 5) /* stored on its side */

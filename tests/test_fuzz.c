@@ -15,6 +15,7 @@ int lw_fuzz_params_one(const uint8_t *data, size_t size);
 int lw_fuzz_state_one(const uint8_t *data, size_t size);
 int lw_fuzz_resume_one(const uint8_t *data, size_t size);
 int lw_fuzz_energy_one(const uint8_t *data, size_t size);
+int lw_fuzz_image_one(const uint8_t *data, size_t size);
 
 /* Feeds every file of tests/fuzz/corpus/<name> to fn; returns the count. */
 static int replay(const char *name, int (*fn)(const uint8_t *, size_t))
@@ -64,4 +65,9 @@ Test(fuzz, resume_corpus_replays_clean)
 Test(fuzz, energy_corpus_replays_clean)
 {
   cr_assert_geq(replay("energy", lw_fuzz_energy_one), 4, "the energy corpus lost its seeds");
+}
+
+Test(fuzz, image_corpus_replays_clean)
+{
+  cr_assert_geq(replay("image", lw_fuzz_image_one), 12, "the image corpus lost its seeds");
 }
