@@ -399,16 +399,28 @@ static unsigned byte_at(const unsigned char *d, size_t n, size_t at) { return at
 
 /* stb_image 2.27 (Debian's libstb) builds a JPEG Huffman table without
 ** checking that its 16 code counts sum to at most 256, and writes past the
-** table when they do (found by tests/fuzz/fuzz_image.c).  Every table of
-** every DHT segment the decoder could reach is checked first, the markers
+** table when they do; and a scan that names a Huffman or quantization
+** table no segment defined reads the decoder's uninitialised memory, so
+** that the picture, or whether it decodes at all, changes from run to run
+** (both found by tests/fuzz/fuzz_image.c).  Every table of every DHT
+** segment the decoder could reach is checked first, and every scan's
+** tables: the DC table where a scan starts the DC coefficients, the AC
+** table where it codes any AC one, the quantization table of each of its
+** components.  The markers
 ** walked as it walks them: bytes that are not 0xFF skipped one by one, fill
-** bytes 0xFF before a marker, segments by their lengths, and after a scan's
+** bytes 0xFF before a marker (the start marker too), segments by their lengths, and after a scan's
 ** header its entropy-coded data up to the next 0xFF that is neither a
 ** stuffed zero, a fill byte nor a restart marker. */
 static lw_status jpeg_tables_sound(const unsigned char *d, size_t n, const char *name, lw_error *err)
 {
-  if (n < 2 || d[0] != 0xFF || d[1] != 0xD8) return LW_OK;
-  size_t at = 2;
+  size_t at = 0;
+  while (at < n && d[at] == 0xFF) at++; /* the decoder takes fill bytes before the start marker too */
+  if (at == 0 || at >= n || d[at] != 0xD8) return LW_OK;
+  at++;
+  /* the tables defined so far: Huffman DC 0-3 and AC 4-7, quantization 0-3;
+  ** the frame's components (id and quantization table) */
+  unsigned huffman = 0, quant = 0, frame_quant[4] = {0, 0, 0, 0};
+  int frame_id[4] = {-1, -1, -1, -1};
   while (at < n) {
     if (d[at] != 0xFF) {
       at++;
@@ -429,8 +441,30 @@ static lw_status jpeg_tables_sound(const unsigned char *d, size_t n, const char 
         if (count > 256)
           return lw_error_set(err, LW_EINPUT, "%s: the JPEG is damaged: a Huffman table of %zu codes (256 at most)",
                               name, count);
+        huffman |= 1u << ((q >> 4) * 4 + (q & 15));
         t += 17 + count;
       }
+    else if (marker == 0xDB)
+      for (size_t t = at + 2; t < at + len && t < n && (d[t] & 15) <= 3; t += 1 + (d[t] >> 4 ? 128 : 64))
+        quant |= 1u << (d[t] & 15);
+    else if (marker >= 0xC0 && marker <= 0xC2)
+      for (unsigned c = 0; c < byte_at(d, n, at + 7) && c < 4; c++) {
+        frame_id[c] = (int)byte_at(d, n, at + 8 + 3 * c);
+        frame_quant[c] = byte_at(d, n, at + 10 + 3 * c) & 15;
+      }
+    else if (marker == 0xDA) {
+      const unsigned ns = byte_at(d, n, at + 2), ss = byte_at(d, n, at + 3 + 2 * ns),
+                     se = byte_at(d, n, at + 4 + 2 * ns), ah = byte_at(d, n, at + 5 + 2 * ns) >> 4;
+      for (unsigned c = 0; c < ns && c < 4; c++) {
+        const unsigned id = byte_at(d, n, at + 3 + 2 * c), q = byte_at(d, n, at + 4 + 2 * c);
+        unsigned need = (ss == 0 && ah == 0 ? 1u << (q >> 4) : 0u) | (se > 0 ? 1u << (4 + (q & 15)) : 0u);
+        for (int f = 0; f < 4; f++)
+          if (frame_id[f] == (int)id) need |= 1u << (8 + frame_quant[f]);
+        if (need & ~(huffman | quant << 8))
+          return lw_error_set(err, LW_EINPUT, "%s: the JPEG is damaged: a scan uses a %s table it never defined",
+                              name, need & ~(huffman | quant << 8) & 0xFF ? "Huffman" : "quantization");
+      }
+    }
     at += len;
     if (marker == 0xDA)
       while (at + 1 < n && !(d[at] == 0xFF && d[at + 1] != 0x00 && d[at + 1] != 0xFF &&
@@ -595,8 +629,10 @@ lw_image *lw_image_decode_channel(const unsigned char *data, size_t size, const 
     double f = sqrt(max_pixels / ((double)w * (double)h));
     w2 = (int)floor(w * f);
     h2 = (int)floor(h * f);
-    if (w2 < 1) w2 = 1;
-    if (h2 < 1) h2 = 1;
+    /* a strip thinner than the factor keeps one pixel across and gives up
+    ** its aspect along: still at most max_pixels */
+    if (w2 < 1) w2 = 1, h2 = (int)fmin(h, floor(max_pixels));
+    if (h2 < 1) h2 = 1, w2 = (int)fmin(w, floor(max_pixels));
   }
   int has_alpha = ch == 2 || ch == 4;
   lw_image *img = lw_image_new(w2, h2, has_alpha, err);
