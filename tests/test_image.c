@@ -162,7 +162,7 @@ Test(image, a_gif_decodes_and_a_gif_cut_short_is_refused)
 ** undefined AC table, one with an undefined quantization table), are
 ** refused before they reach the decoder, by the probe too, and the
 ** corpus's sound JPEGs still decode. */
-Test(image, a_jpeg_with_tables_the_decoder_mishandles_is_refused)
+Test(image, pictures_the_decoder_mishandles_are_refused)
 {
   static const char *const bad[] = {"dht-257-codes.jpg", "dht-in-info.jpg", "dht-after-fill.jpg",
                                     "undefined-huffman.jpg", "undefined-quant.jpg"};
@@ -179,6 +179,13 @@ Test(image, a_jpeg_with_tables_the_decoder_mishandles_is_refused)
     cr_assert_eq(lw_image_probe(path, &info, &err), LW_EINPUT);
     cr_assert(strstr(err.msg, codes[k]), "probe: %s", err.msg);
   }
+  /* found by the same harness: a BMP of width 0 passes stb_image's header check */
+  snprintf(path, sizeof path, "%s/tests/fuzz/corpus/image/bmp-width-0.bmp", lw_test_root());
+  cr_assert_null(lw_image_load(path, 1e6, NULL, &err));
+  cr_assert(strstr(err.msg, "bmp-width-0.bmp: the BMP is damaged: 0 x 27 pixels"), "%s", err.msg);
+  lw_image_info info;
+  cr_assert_eq(lw_image_probe(path, &info, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "0 x 27 pixels"), "probe: %s", err.msg);
   const char *sound[] = {"exif6.jpg", "prog.jpg"};
   for (int k = 0; k < 2; k++) {
     snprintf(path, sizeof path, "%s/tests/fuzz/corpus/image/%s", lw_test_root(), sound[k]);
