@@ -406,9 +406,9 @@ static unsigned byte_at(const unsigned char *d, size_t n, size_t at) { return at
 ** segment the decoder could reach is checked first, and every scan's
 ** tables: the DC table where a scan starts the DC coefficients, the AC
 ** table where it codes any AC one, the quantization table of each of its
-** components.  The markers
-** walked as it walks them: bytes that are not 0xFF skipped one by one, fill
-** bytes 0xFF before a marker (the start marker too), segments by their lengths, and after a scan's
+** components.  The markers are walked as the decoder walks them: bytes
+** that are not 0xFF skipped one by one, fill bytes 0xFF before a marker
+** (the start marker too), segments by their lengths, and after a scan's
 ** header its entropy-coded data up to the next 0xFF that is neither a
 ** stuffed zero, a fill byte nor a restart marker. */
 static lw_status jpeg_tables_sound(const unsigned char *d, size_t n, const char *name, lw_error *err)
@@ -562,8 +562,9 @@ static const char *format_name(const unsigned char *d, size_t n)
 }
 
 /* What stb_image must not be given: a BMP or GIF cut short, a JPEG whose
-** tables would make it write out of bounds.  Checked before any call into
-** it, stbi_info too (which reads a JPEG's tables). */
+** tables would make it write out of bounds or read uninitialised memory.
+** Checked before any call into it, stbi_info too (which reads a JPEG's
+** tables). */
 static lw_status stb_input_sound(const unsigned char *data, size_t size, const char *name, lw_error *err)
 {
   lw_status st = bmp_complete(data, size, name, err);

@@ -49,10 +49,10 @@ lw_image *lw_image_new(int w, int h, int with_alpha, lw_error *err);
 void lw_image_free(lw_image *img);
 
 /* Decodes a PNG, JPEG, GIF (its first picture), BMP or PGM/PPM file held
-** in memory; `name` only labels messages.  If the picture has more than max_pixels pixels it is
-** box-filtered down (same aspect ratio; a strip thinner than the reduction
-** keeps one pixel across) to at most max_pixels while it is
-** converted.  info (may be NULL) receives what the file held.  LW_EINPUT for
+** in memory; `name` only labels messages.  If the picture has more than
+** max_pixels pixels it is box-filtered down (same aspect ratio; a strip
+** thinner than the reduction keeps one pixel across) to at most max_pixels
+** while it is converted.  info (may be NULL) receives what the file held.  LW_EINPUT for
 ** anything that is not a decodable picture, naming `name` and the decoder's
 ** reason. */
 lw_image *lw_image_decode(const unsigned char *data, size_t size, const char *name,

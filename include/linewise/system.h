@@ -85,8 +85,9 @@ struct lw_system_type {
   ** targets of the n_moves kinds from the parameters.  sweep_size: proposals
   ** a sweep (0: nothing to move).  step_max: tuning never grows a step of
   ** kind k past it; 0 for a kind that has no step (a birth, say): its step
-  ** is 0, never tuned, and summary.json writes null for it.  propose: draws one proposal of kind k with step `step`
-  ** from rng into prop (the chain's scratch) and returns dE (NaN: undefined,
+  ** is 0, never tuned, and summary.json writes null for it.  propose:
+  ** draws one proposal of kind k with step `step` from rng into prop (the
+  ** chain's scratch) and returns dE (NaN: undefined,
   ** rejected and counted; +inf forbidden), with *forbidden = 1 when it is
   ** refused for a forbidden state, 3 when for coming closer to another
   ** stroke than a hard spacing rule allows (each counted apart).  The state is not
