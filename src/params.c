@@ -965,9 +965,10 @@ static void apply_preset(lw_params *p)
   preset_key(p, "anneal", "domains", n < 2 ? "off" : text);
 }
 
-/* A key the photo preset filled names the preset as where it came from,
-** and the pen widths it was sized from: a message about a blur of 150 mm
-** then says why (output.pen_width = 50). */
+/* Where a key's value came from: the file and line, --set, or the file's
+** default.  A key the photo preset filled names the preset, and the pen
+** widths it was sized from: a message about a blur of 150 mm then says why
+** (output.pen_width = 50). */
 void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size_t n)
 {
   int line = p->line[d - lw_param_table];
@@ -979,7 +980,10 @@ void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size
     snprintf(buf, n, "--set");
     return;
   }
-  snprintf(buf, n, "default");
+  /* a default still names the file: a message about it may come of another
+  ** key the file sets (tempering.t_max below its t_min) */
+  if (p->file[0]) snprintf(buf, n, "%s (default)", p->file);
+  else snprintf(buf, n, "default");
   if (p->preset != LW_PRESET_PHOTO || p->of_run) return;
   for (size_t k = 0; k < sizeof photo_preset / sizeof photo_preset[0]; k++)
     if (!strcmp(photo_preset[k].section, d->section) && !strcmp(photo_preset[k].key, d->key)) {

@@ -274,7 +274,8 @@ void lw_params_write_doc(FILE *f);
 const lw_param_def *lw_params_find(const char *section, const char *key);
 
 /* Where a parameter was set, for messages: "scene.ini:12", "--set", "scene.preset = photo"
-** (with the pen widths a length was sized from) or "default". */
+** (with the pen widths a length was sized from), "scene.ini (default)", or
+** "default" for parameters read from no file. */
 void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size_t n);
 
 /* Prefixes the message in err with where section.key was set and the key:
