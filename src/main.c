@@ -351,9 +351,9 @@ static lw_status spread_start(lw_status s, lw_anneal *a, int fresh, lw_error *er
 static int holds_run(const char *dir)
 {
   char path[LW_PATH_MAX + 16];
-  snprintf(path, sizeof path, "%s/scene.ini", dir);
+  lw_path_join(path, sizeof path, dir, "scene.ini");
   if (access(path, F_OK) == 0) return 1;
-  snprintf(path, sizeof path, "%s/state.lw", dir);
+  lw_path_join(path, sizeof path, dir, "state.lw");
   return access(path, F_OK) == 0;
 }
 
