@@ -815,6 +815,12 @@ static int on_key(void *user, const char *section, const char *key, const char *
   if (rc->failed) return 0;
   rc->failed = 1;
   char hint[96];
+  if (!section[0]) { /* a key above every [section]: name the section it belongs to */
+    suggest_key("", key, hint, sizeof hint);
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s' comes before any [section]%s", rc->p->file, rc->line, key,
+                 hint);
+    return 0;
+  }
   if (!section_known(section)) {
     suggest_section(section, hint, sizeof hint);
     lw_error_set(rc->err, LW_EINPUT, "%s:%d: unknown section [%s]%s", rc->p->file, rc->line, section, hint);

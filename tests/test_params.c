@@ -92,6 +92,7 @@ Test(params, bad_input_names_file_line_and_key)
   expect_error("[anneal]\nquadrature = 6\n", ":2:", "anneal.quadrature", "did you mean 'energy.quadrature'?");
   expect_error("[energy]\npair_cuttoff = 2\n", ":2:", NULL, "did you mean 'energy.pair_cutoff'?");
   expect_error("[scen]\nwidth = 100\n", ":2:", "[scen]", "unknown section [scen]; did you mean [scene]?");
+  expect_error("; a scene\nwidth = 100\n[scene]\n", ":2:", "'width'", "before any [section]; did you mean 'scene.width'?");
   for (int k = 0; k < 2; k++) {
     lw_params p;
     lw_error err;
