@@ -484,18 +484,23 @@ static uint32_t tiff32(const unsigned char *p, int be)
 ** be read): a camera stores the sensor's rows and says in IFD0's tag 0x0112
 ** how to turn them for display, so a phone's portrait photograph is stored
 ** on its side.  The markers before the first scan are walked to an APP1
-** segment "Exif\0\0", whose TIFF header gives the byte order and IFD0.
+** segment "Exif\0\0", whose TIFF header gives the byte order and IFD0;
+** fill bytes 0xFF may stand before any marker, as the decoder allows.
 ** Every offset is checked against the segment: a bad one means "none".
 */
 static int jpeg_orientation(const unsigned char *d, size_t n)
 {
-  if (n < 4 || d[0] != 0xFF || d[1] != 0xD8) return 1;
-  size_t at = 2;
-  while (at + 4 <= n && d[at] == 0xFF) {
-    unsigned marker = d[at + 1];
-    size_t len = (size_t)d[at + 2] << 8 | d[at + 3];
-    if (marker == 0xDA || marker == 0xD9 || len < 2 || at + 2 + len > n) break;
-    const unsigned char *seg = d + at + 4;
+  size_t at = 0;
+  while (at < n && d[at] == 0xFF) at++;
+  if (at == 0 || at >= n || d[at] != 0xD8) return 1;
+  at++;
+  while (at < n && d[at] == 0xFF) {
+    while (at < n && d[at] == 0xFF) at++;
+    if (at + 3 > n) break;
+    unsigned marker = d[at];
+    size_t len = (size_t)d[at + 1] << 8 | d[at + 2];
+    if (marker == 0xDA || marker == 0xD9 || len < 2 || at + 1 + len > n) break;
+    const unsigned char *seg = d + at + 3;
     size_t sn = len - 2;
     if (marker == 0xE1 && sn >= 14 && !memcmp(seg, "Exif\0\0", 6)) {
       const unsigned char *t = seg + 6;
@@ -514,7 +519,7 @@ static int jpeg_orientation(const unsigned char *d, size_t n)
       }
       return 1;
     }
-    at += 2 + len;
+    at += 1 + len;
   }
   return 1;
 }

@@ -597,8 +597,9 @@ static void jpeg_put(void *ctx, void *data, int size)
 /* A 32 x 16 JPEG, light with a dark 8 x 8 block in its stored top-left
 ** corner, and an APP1 "Exif" segment with orientation o (0: none) in big-
 ** or little-endian TIFF order right after SOI; bad_ifd points IFD0 past
-** the segment. */
-static size_t exif_jpeg(unsigned char *out, int o, int big_endian, int bad_ifd)
+** the segment; fill > 0 puts that many fill bytes 0xFF before SOI and
+** before the APP1 and the marker after it. */
+static size_t exif_jpeg_filled(unsigned char *out, int o, int big_endian, int bad_ifd, int fill)
 {
   unsigned char px[32 * 16];
   for (int y = 0; y < 16; y++)
@@ -616,14 +617,24 @@ static size_t exif_jpeg(unsigned char *out, int o, int big_endian, int bad_ifd)
     memcpy(t, tiff, sizeof tiff);
     if (bad_ifd) t[4] = 200;
   }
-  memcpy(out, j.b, 2);
-  size_t n = 2;
+  size_t n = (size_t)fill;
+  memset(out, 0xFF, n);
+  memcpy(out + n, j.b, 2);
+  n += 2;
   if (o) {
-    memcpy(out + n, app, sizeof app);
-    n += sizeof app;
+    memset(out + n, 0xFF, (size_t)fill);
+    memcpy(out + n + fill, app, sizeof app);
+    n += (size_t)fill + sizeof app;
   }
+  memset(out + n, 0xFF, (size_t)fill);
+  n += (size_t)fill;
   memcpy(out + n, j.b + 2, j.n - 2);
   return n + j.n - 2;
+}
+
+static size_t exif_jpeg(unsigned char *out, int o, int big_endian, int bad_ifd)
+{
+  return exif_jpeg_filled(out, o, big_endian, bad_ifd, 0);
 }
 
 /* A JPEG cut short anywhere past its header is refused as a damaged JPEG,
@@ -676,16 +687,19 @@ static int dark_corner(const lw_image *img)
 ** anticlockwise (a transpose), 6 a quarter turn clockwise, 7 mirror then a
 ** quarter turn clockwise, 8 a quarter turn anticlockwise.  Ignoring the tag
 ** (the old decoder) fails every orientation but 1; a broken IFD offset
-** means "as stored", not an error.  lw_image_probe, which sizes the page
-** of scene.orientation = auto, reports the upright size too. */
+** means "as stored", not an error.  Fill bytes before the markers, which
+** the decoder skips, hide no tag (a walk that wanted SOI at byte 0 and a
+** marker right after each segment missed it).  lw_image_probe, which
+** sizes the page of scene.orientation = auto, reports the upright size
+** too. */
 Test(image, jpeg_exif_orientation_is_turned_upright)
 {
   static const int corner[9] = {0, 0, 1, 2, 3, 0, 1, 2, 3};
-  unsigned char jpg[8300];
+  unsigned char jpg[8400];
   lw_error err;
   for (int o = 0; o <= 8; o++)
-    for (int be = 0; be < 2; be++) {
-      size_t n = exif_jpeg(jpg, o, be, 0);
+    for (int be = 0; be < 4; be++) {
+      size_t n = exif_jpeg_filled(jpg, o, be & 1, 0, be >> 1 ? 3 : 0);
       lw_image_info info;
       lw_image *img = lw_image_decode(jpg, n, "t.jpg", 1e6, &info, &err);
       cr_assert_not_null(img, "orientation %d: %s", o, err.msg);
@@ -693,8 +707,8 @@ Test(image, jpeg_exif_orientation_is_turned_upright)
       cr_assert(img->width == (turned ? 16 : 32) && img->height == (turned ? 32 : 16) &&
                     info.width == img->width && info.height == img->height,
                 "orientation %d: %d x %d", o, img->width, img->height);
-      cr_assert_eq(dark_corner(img), corner[o], "orientation %d (%s-endian): dark corner %d, expected %d", o,
-                   be ? "big" : "little", dark_corner(img), corner[o]);
+      cr_assert_eq(dark_corner(img), corner[o], "orientation %d (%s-endian%s): dark corner %d, expected %d", o,
+                   be & 1 ? "big" : "little", be >> 1 ? ", fill bytes" : "", dark_corner(img), corner[o]);
       lw_image_free(img);
     }
   for (int be = 0; be < 2; be++) {
