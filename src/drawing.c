@@ -111,16 +111,18 @@ static void options(const lw_params *p, const lw_scene *sc, lw_strokes_options *
 static lw_status score(const lw_params *p, const lw_scene *sc, const lw_strokes *st, const lw_grid2d *tone,
                        lw_drawing_report *rep, lw_error *err)
 {
-  lw_status s = lw_fidelity_compute_strokes(st, -1, tone, p->pen_width, p->fidelity_sigma, &rep->fidelity, err);
+  lw_status s =
+      lw_fidelity_compute_strokes(st, -1, tone, p->tone_ink, p->pen_width, p->fidelity_sigma, &rep->fidelity, err);
   for (int k = 0; !s && st->n_pens > 1 && k < st->n_pens; k++) {
     const lw_image *target = k < sc->layers.n ? sc->layer[k].target : NULL;
     if (!target) {
-      s = lw_fidelity_compute_strokes(st, k, tone, p->pen_width, p->fidelity_sigma, &rep->pen_fidelity[k], err);
+      s = lw_fidelity_compute_strokes(st, k, tone, p->tone_ink, p->pen_width, p->fidelity_sigma,
+                                      &rep->pen_fidelity[k], err);
       continue;
     }
     lw_grid2d *g = lw_image_tone_grid(target, &sc->image_place, err);
     if (!g) return err ? err->code : LW_ENOMEM;
-    s = lw_fidelity_compute_strokes(st, k, g, sc->layers.spec[k].pen_width, p->fidelity_sigma,
+    s = lw_fidelity_compute_strokes(st, k, g, p->tone_ink, sc->layers.spec[k].pen_width, p->fidelity_sigma,
                                     &rep->pen_fidelity[k], err);
     lw_grid2d_free(g);
   }
@@ -268,6 +270,8 @@ void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep)
     fidelity_members(j, &rep->fidelity);
     lw_json_key(j, "sigma_mm");
     lw_json_number(j, rep->fidelity.sigma_mm);
+    lw_json_key(j, "black");
+    lw_json_number(j, rep->fidelity.black);
     if (rep->n_pens > 1) {
       lw_json_key(j, "pens");
       lw_json_begin_array(j);
@@ -316,8 +320,9 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
   k = (size_t)w;
   if (!d->has_fidelity) return;
   char o[40];
-  w = snprintf(buf + k, n - k, "linewise: fidelity (blur %g mm): MSE %.6g, SSIM %.4f, orientation %s, stray ink %.4f\n",
-               d->fidelity.sigma_mm, d->fidelity.mse, d->fidelity.ssim, orientation_text(d->fidelity.orientation, o),
+  w = snprintf(buf + k, n - k,
+               "linewise: fidelity (blur %g mm, black %g): MSE %.6g, SSIM %.4f, orientation %s, stray ink %.4f\n",
+               d->fidelity.sigma_mm, d->fidelity.black, d->fidelity.mse, d->fidelity.ssim, orientation_text(d->fidelity.orientation, o),
                d->fidelity.stray);
   for (int p = 0; d->n_pens > 1 && p < d->n_pens && w >= 0 && (k += (size_t)w) < n; p++)
     w = snprintf(buf + k, n - k, "linewise: fidelity of pen %d: MSE %.6g, SSIM %.4f, orientation %s, stray ink %.4f\n",

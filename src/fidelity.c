@@ -429,8 +429,8 @@ static lw_status orientation(const double *a, const double *b, int w, int h, dou
   return LW_OK;
 }
 
-lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, double sy, lw_fidelity *out,
-                              lw_error *err)
+lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, double sy, double white,
+                              lw_fidelity *out, lw_error *err)
 {
   if (w < 1 || h < 1) return lw_error_set(err, LW_EINPUT, "fidelity: empty image %d x %d", w, h);
   lw_status s;
@@ -440,7 +440,7 @@ lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, dou
   double ink = 0.0, stray = 0.0;
   for (size_t k = 0; k < n; k++) {
     ink += a[k];
-    if (b[k] < LW_FIDELITY_WHITE) stray += a[k];
+    if (b[k] < white) stray += a[k];
   }
   out->stray = ink > 0 ? stray / ink : 0.0;
   if ((s = lw_fidelity_blur(a, w, h, sx, sy, LW_FIDELITY_TRUNCATE, err))) return s;
@@ -456,18 +456,20 @@ lw_status lw_fidelity_compute(const lw_splines *sp, const lw_grid2d *tone, doubl
 {
   lw_strokes *st = as_strokes(sp, err);
   if (!st) return err ? err->code : LW_EINPUT;
-  lw_status s = lw_fidelity_compute_strokes(st, -1, tone, pen_width_mm, sigma_mm, out, err);
+  lw_status s = lw_fidelity_compute_strokes(st, -1, tone, 1.0, pen_width_mm, sigma_mm, out, err);
   lw_strokes_free(st);
   return s;
 }
 
-lw_status lw_fidelity_compute_strokes(const lw_strokes *st, int pen, const lw_grid2d *tone, double pen_width_mm,
-                                      double sigma_mm, lw_fidelity *out, lw_error *err)
+lw_status lw_fidelity_compute_strokes(const lw_strokes *st, int pen, const lw_grid2d *tone, double black,
+                                      double pen_width_mm, double sigma_mm, lw_fidelity *out, lw_error *err)
 {
   lw_status s = check_raster(tone, err);
   if (s) return s;
   if (!positive(sigma_mm))
     return lw_error_set(err, LW_EINPUT, "fidelity: blur %g mm: expected a positive number", sigma_mm);
+  if (!positive(black) || black > 1)
+    return lw_error_set(err, LW_EINPUT, "fidelity: black ink %g: expected a number > 0 and <= 1", black);
   size_t n = (size_t)tone->nx * (size_t)tone->ny;
   double *ink = malloc(n * sizeof *ink), *dark = malloc(n * sizeof *dark);
   if (!ink || !dark) {
@@ -477,11 +479,13 @@ lw_status lw_fidelity_compute_strokes(const lw_strokes *st, int pen, const lw_gr
   }
   for (size_t k = 0; k < n; k++) {
     double t = tone->data[k];
-    dark[k] = 1.0 - (t < 0 ? 0 : t > 1 ? 1 : t);
+    dark[k] = black * (1.0 - (t < 0 ? 0 : t > 1 ? 1 : t));
   }
   if (!(s = lw_fidelity_render_strokes(st, pen, tone, pen_width_mm, ink, err)))
-    s = lw_fidelity_compare(ink, dark, tone->nx, tone->ny, sigma_mm / tone->hx, sigma_mm / tone->hy, out, err);
+    s = lw_fidelity_compare(ink, dark, tone->nx, tone->ny, sigma_mm / tone->hx, sigma_mm / tone->hy,
+                            LW_FIDELITY_WHITE * black, out, err);
   out->sigma_mm = sigma_mm;
+  out->black = black;
   free(ink);
   free(dark);
   return s;

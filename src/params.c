@@ -902,21 +902,24 @@ _Static_assert(sizeof page_mm / sizeof page_mm[0] == LW_PAGE_LEGAL + 1, "a size 
 ** field's -1 lets density follow tone (5, 10, 20, 40 raised SSIM on every
 ** picture; 80 made the lines wavy).  The annealer chooses how much line
 ** (moves.fixed_count = 0): it starts from coverage 0.6 and grows and
-** shrinks lines (weights 0.05) against a chemical potential of -2.5 per mm
-** at w = 0.35 (-7.14 w: line length per area goes as 1 / w); at the same
-** CPU time this beat every fixed coverage from 0.4 to 0.8 on the bundled
-** picture and on four test photographs (docs/IMAGES.md, "With the photo
-** preset" and "On photographs").  Where the picture is white paper a line
-** costs what that chemical potential pays for it (potential = image,
-** Phi = tone^8, near 0 but near white): without it the first thin line in
-** white costs almost nothing (the tone term is quadratic in the ink) and
-** stray lines crossed white backgrounds (docs/IMAGES.md, "White
-** backgrounds").  A tenth of the births draw another segment count, so
+** shrinks lines (weights 0.05) where the tone term pays for them; at the
+** same CPU time this beat every fixed coverage from 0.4 to 0.8 on the
+** bundled picture and on four test photographs (docs/IMAGES.md, "With the
+** photo preset" and "On photographs").  No chemical potential: one that
+** paid for line (-2.5 per mm, until 2026-12-03) darkened every light tone
+** by about a tenth of ink, flattening the picture's contrast ("What the
+** scores asked for").  Where the picture is white paper a line costs 2.5
+** per mm at w = 0.35 (potential = image, Phi = tone^8, near 0 but near
+** white; 7.14 w, since line length per area goes as 1 / w): without it the
+** first thin line in white costs almost nothing (the tone term is
+** quadratic in the ink) and the field's reward for aligned line drew stray
+** lines across white backgrounds (docs/IMAGES.md, "White backgrounds").
+** A tenth of the births draw another segment count, so
 ** that a death can take a short piece too: a piece that could leave only
 ** by growing first stayed where growing costs, in a colour pen's white
 ** (docs/NUMERICS.md, "Trans-dimensional moves").
 */
-#define PHOTO_CHEM (2.5 / 0.35) /* the chemical potential's price of line, pen widths per mm */
+#define PHOTO_WHITE (2.5 / 0.35) /* what a millimetre of line costs on white paper, per pen width */
 static const struct {
   const char *section, *key, *text; /* text, or NULL: pens * w */
   double pens;
@@ -933,11 +936,11 @@ static const struct {
     {"energy", "boundary", "0.2", 0},      {"anneal", "schedule", "geometric", 0},
     {"anneal", "t_start", "0.5", 0},       {"anneal", "t_end", "0.002", 0},
     {"anneal", "sweeps", "300", 0},        {"anneal", "steps", "5", 0},
-    {"moves", "fixed_count", "0", 0},      {"energy", "chem_length", NULL, -PHOTO_CHEM},
-    {"moves", "grow", "0.05", 0},          {"moves", "shrink", "0.05", 0},
-    {"scene", "image_levels", "0.01", 0},  {"layers", "apart", "pen", 0},
-    {"scene", "potential", "image", 0},    {"energy", "potential", NULL, PHOTO_CHEM},
-    {"scene", "potential_power", "8", 0},  {"moves", "birth_spread", "0.1", 0},
+    {"moves", "fixed_count", "0", 0},      {"moves", "grow", "0.05", 0},
+    {"moves", "shrink", "0.05", 0},        {"scene", "image_levels", "0.01", 0},
+    {"layers", "apart", "pen", 0},         {"scene", "potential", "image", 0},
+    {"energy", "potential", NULL, PHOTO_WHITE}, {"scene", "potential_power", "8", 0},
+    {"moves", "birth_spread", "0.1", 0},
 };
 
 /* Sets an unset key from text; the key stays unset (line 0), so a later

@@ -27,7 +27,7 @@ Test(fidelity, identical_images_score_perfectly)
   rng_seed(3);
   for (int k = 0; k < W * H; k++) a[k] = b[k] = urand(0, 1);
   lw_fidelity f;
-  cr_assert_eq(lw_fidelity_compare(a, b, W, H, 1.7, 2.2, &f, NULL), LW_OK);
+  cr_assert_eq(lw_fidelity_compare(a, b, W, H, 1.7, 2.2, LW_FIDELITY_WHITE, &f, NULL), LW_OK);
   cr_assert_eq(f.mse, 0.0);
   cr_assert(fabs(f.ssim - 1.0) < 1e-12, "ssim %.17g", f.ssim);
 }
@@ -43,7 +43,7 @@ Test(fidelity, ssim_falls_with_shift_and_blur)
     memcpy(a, ref, sizeof a);
     disc(b, W, H, 32 + shift, 32 + 0.5 * shift);
     lw_fidelity f;
-    cr_assert_eq(lw_fidelity_compare(a, b, W, H, 1, 1, &f, NULL), LW_OK);
+    cr_assert_eq(lw_fidelity_compare(a, b, W, H, 1, 1, LW_FIDELITY_WHITE, &f, NULL), LW_OK);
     cr_assert(f.ssim < last_ssim && f.mse > last_mse, "shift %d: ssim %g (before %g), mse %g (before %g)", shift,
               f.ssim, last_ssim, f.mse, last_mse);
     last_ssim = f.ssim;
@@ -57,7 +57,7 @@ Test(fidelity, ssim_falls_with_shift_and_blur)
     memcpy(b, ref, sizeof b);
     cr_assert_eq(lw_fidelity_blur(b, W, H, blur[k], blur[k], 4, NULL), LW_OK);
     lw_fidelity f;
-    cr_assert_eq(lw_fidelity_compare(a, b, W, H, 0, 0, &f, NULL), LW_OK);
+    cr_assert_eq(lw_fidelity_compare(a, b, W, H, 0, 0, LW_FIDELITY_WHITE, &f, NULL), LW_OK);
     cr_assert(f.ssim < last_ssim && f.mse > last_mse, "blur %g: ssim %g, mse %g", blur[k], f.ssim, f.mse);
     last_ssim = f.ssim;
     last_mse = f.mse;
@@ -236,6 +236,39 @@ Test(fidelity, hatching_matches_its_grey)
   lw_grid2d_free(tone);
 }
 
+/* The target is the ink the drawing is asked for, black * (1 - tone): the
+** hatching above (ink 0.2) drawn for tone 0.6 with black 0.5 (the photo
+** preset's tone_ink: black is lines two pen widths apart) is what was asked,
+** and against solid black (black 1, darkness 0.4) it is 0.2 short.  Paper
+** counts as white at the same share of black, so the stray ink of a drawing
+** does not change with black. */
+Test(fidelity, the_target_is_the_ink_asked_for)
+{
+  const double px = 0.2;
+  const int w = 200, h = 150; /* 40 x 30 mm */
+  lw_grid2d *tone = lw_grid2d_new(w, h, 1, 0.5 * px, 0.5 * px, px, px, NULL);
+  for (int k = 0; k < w * h; k++) tone->data[k] = 0.6;
+  size_t segs[15];
+  for (size_t i = 0; i < 15; i++) segs[i] = 1;
+  lw_splines *sp = lw_splines_new(15, segs, NULL);
+  for (size_t i = 0; i < 15; i++) lw_test_straight(sp, i, -5, 1 + 2.0 * (double)i, 45, 1 + 2.0 * (double)i);
+  lw_strokes *st = lw_strokes_from_plot(sp, NULL, NULL);
+  cr_assert_not_null(st);
+  lw_fidelity f, g;
+  cr_assert_eq(lw_fidelity_compute_strokes(st, -1, tone, 0.5, 0.4, 1.0, &f, NULL), LW_OK);
+  cr_assert(f.mse < 1e-4 && f.black == 0.5, "mse %g against half ink", f.mse);
+  cr_assert_eq(lw_fidelity_compute_strokes(st, -1, tone, 1.0, 0.4, 1.0, &g, NULL), LW_OK);
+  cr_assert(fabs(g.mse / 0.04 - 1) < 0.05, "mse %g against solid black, expected 0.04", g.mse);
+  for (int k = 0; k < w * h; k++) tone->data[k] = k % w < w / 2 ? 0.0 : 0.995;
+  cr_assert_eq(lw_fidelity_compute_strokes(st, -1, tone, 0.5, 0.4, 1.0, &f, NULL), LW_OK);
+  cr_assert_eq(lw_fidelity_compute_strokes(st, -1, tone, 1.0, 0.4, 1.0, &g, NULL), LW_OK);
+  cr_assert(f.stray > 0.3 && f.stray == g.stray, "stray %g with black 0.5, %g with black 1", f.stray, g.stray);
+  cr_assert_eq(lw_fidelity_compute_strokes(st, -1, tone, 0.0, 0.4, 1.0, &f, NULL), LW_EINPUT);
+  lw_strokes_free(st);
+  lw_splines_free(sp);
+  lw_grid2d_free(tone);
+}
+
 /* Stray ink is the ink on paper the target leaves white for some two blur
 ** sigmas around: a picture black on its left half, white on its right.
 ** Lines in the black and 1 mm into the white beside the edge (blurred
@@ -335,17 +368,17 @@ Test(fidelity, orientation_of_a_flat_target_is_undefined_and_of_no_ink_zero)
   double a[40 * 30], b[40 * 30];
   lw_fidelity f;
   for (int k = 0; k < w * h; k++) a[k] = b[k] = 0.3;
-  cr_assert_eq(lw_fidelity_compare(a, b, w, h, 1, 1, &f, NULL), LW_OK);
+  cr_assert_eq(lw_fidelity_compare(a, b, w, h, 1, 1, LW_FIDELITY_WHITE, &f, NULL), LW_OK);
   cr_assert(isnan(f.orientation));
   disc(b, w, h, 20, 15);
   for (int k = 0; k < w * h; k++) a[k] = 0.0;
-  cr_assert_eq(lw_fidelity_compare(a, b, w, h, 1, 1, &f, NULL), LW_OK);
+  cr_assert_eq(lw_fidelity_compare(a, b, w, h, 1, 1, LW_FIDELITY_WHITE, &f, NULL), LW_OK);
   cr_assert_eq(f.orientation, 0.0);
   /* the same disc, fainter: structure alike, tone not */
   disc(a, w, h, 20, 15);
   for (int k = 0; k < w * h; k++) a[k] *= 0.3;
   disc(b, w, h, 20, 15);
-  cr_assert_eq(lw_fidelity_compare(a, b, w, h, 1, 1, &f, NULL), LW_OK);
+  cr_assert_eq(lw_fidelity_compare(a, b, w, h, 1, 1, LW_FIDELITY_WHITE, &f, NULL), LW_OK);
   cr_assert(fabs(f.orientation - 1) < 1e-12, "%g", f.orientation);
 }
 
@@ -433,7 +466,7 @@ Test(fidelity, scores_row_by_row_are_those_of_whole_planes)
         b[j * w + i] = 0.5 + 0.4 * sin(0.7 * i + 0.3 * j) + urand(-0.05, 0.05);
       }
     lw_fidelity f;
-    cr_assert_eq(lw_fidelity_compare(a, b, w, h, 0.8, 1.3, &f, NULL), LW_OK);
+    cr_assert_eq(lw_fidelity_compare(a, b, w, h, 0.8, 1.3, LW_FIDELITY_WHITE, &f, NULL), LW_OK);
     /* lw_fidelity_compare blurred a and b in place: the reference starts there */
     memcpy(a0, a, n * sizeof *a);
     memcpy(b0, b, n * sizeof *b);

@@ -333,8 +333,9 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
   cr_assert(fabs(p.field_sigma - 10 * 0.35) < 1e-12);
   cr_assert(p.tone == 40 && p.tone_ink == 0.5 && p.coverage == 0.6 && p.splines == 0 && p.sweeps == 300);
   cr_assert(p.image_levels == 0.01, "image_levels %g", p.image_levels);
-  /* the annealer chooses the count, its price per mm scaling with the pen */
-  cr_assert(p.fixed_count == 0 && fabs(p.chem_length + 2.5) < 1e-12 && p.mix_grow == 0.05 && p.mix_shrink == 0.05,
+  /* the annealer chooses the count where the tone term pays for line: no
+  ** chemical potential darkens every light tone */
+  cr_assert(p.fixed_count == 0 && p.chem_length == 0 && p.mix_grow == 0.05 && p.mix_shrink == 0.05,
             "fixed_count %d, chem_length %.17g", p.fixed_count, p.chem_length);
   /* A4 less 10 mm margins: 190 mm / (90 x 0.35 mm) = 6 domains a side */
   cr_assert_str_eq(p.domains, "6");
@@ -357,7 +358,7 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
   cr_assert_eq(lw_params_resolve(&p, &err), LW_OK);
   cr_assert(fabs(p.segment_length - 4.0) < 1e-12 && p.pair_cutoff == 4.0, "%g %g", p.segment_length,
             p.pair_cutoff);
-  cr_assert(fabs(p.chem_length + 2.5 / 0.35 * 0.5) < 1e-12, "chem_length %.17g", p.chem_length);
+  cr_assert(fabs(p.potential_coef - 2.5 / 0.35 * 0.5) < 1e-12, "potential %.17g", p.potential_coef);
   cr_assert_str_eq(p.domains, "4");
   /* the file's keys win; A6 at the default pen of 0.3 mm: 85 mm / 27 mm = 3
   ** domains a side, and with a 1 mm pen fewer than 2, so not split */
@@ -367,8 +368,8 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
   cr_assert_eq(lw_params_set(&p, "output.pen_width=1", &err), LW_OK);
   cr_assert_eq(lw_params_resolve(&p, &err), LW_OK);
   cr_assert_str_eq(p.domains, "off");
-  /* a line costs what the chemical potential pays for it where the
-  ** picture is white, for one pen (1 mm here) and for a colour separation's */
+  /* a millimetre of line costs 7.14 pen widths where the picture is white,
+  ** for one pen (1 mm here) and for a colour separation's */
   cr_assert(p.potential == LW_POT_IMAGE && fabs(p.potential_coef - 2.5 / 0.35) < 1e-12 && p.potential_power == 8,
             "potential %d, %.17g, power %g", p.potential, p.potential_coef, p.potential_power);
   cr_assert_eq(read_text("[scene]\npreset = photo\n[layers]\nsource = cmyk\n[output]\npen_width = 0.35\n", &p, &err),

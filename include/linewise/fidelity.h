@@ -12,7 +12,11 @@
 **    over the paths and capped at 1.  Pixels wider than
 **    LW_FIDELITY_PEN_PIXELS pen widths are rendered as k x k finer ones and
 **    averaged (cairo's coverage is eight bits a path).
-**    The target's darkness is 1 - tone.
+**    The target is the ink the drawing is asked for: black * (1 - tone),
+**    black the ink where the picture is black (the tone term's tone_ink: a
+**    drawing whose black is lines two pen widths apart is scored against
+**    half ink there, not against solid black it was never meant to reach).
+**    "Darkness" below is this target.
 ** 2. Both are blurred with the same Gaussian of standard deviation sigma
 **    (mm; sigma / hx and sigma / hy pixels per axis), truncated at 4 sigma
 **    and renormalised by the weights that fall inside the raster, so a flat
@@ -41,7 +45,7 @@
 **    across it, along the target's), which is why it depends far less on
 **    sigma than MSE and SSIM do (docs/IMAGES.md).  NaN for a flat target.
 ** 5. Stray ink: the share of the ink (unblurred, summed over pixels) that
-**    lies where the blurred darkness is under LW_FIDELITY_WHITE: paper the
+**    lies where the blurred darkness is under LW_FIDELITY_WHITE of black: paper the
 **    target leaves white for about two sigmas around, so a line along the
 **    edge of a dark area does not count and one across a white background
 **    does.  0 for a drawing without ink.
@@ -71,17 +75,20 @@ typedef struct {
   double orientation; /* orientation agreement, -1..1 (NaN: flat target) */
   double stray;     /* share of the ink on white paper, 0..1 */
   double sigma_mm;  /* the blur used, mm */
+  double black;     /* the ink the target asks where the picture is black, 0..1 */
 } lw_fidelity;
 
-/* Steps 1-3 above for the splines against the tone raster, pen width and
-** blur sigma in mm.  LW_EINPUT for a raster that is not one value per
-** pixel or a width or sigma that is not positive, LW_ENOMEM. */
+/* Steps 1-5 above for the splines against the tone raster, black 1 (solid
+** ink where the picture is black), pen width and blur sigma in mm.
+** LW_EINPUT for a raster that is not one value per pixel or a width or
+** sigma that is not positive, LW_ENOMEM. */
 lw_status lw_fidelity_compute(const lw_splines *sp, const lw_grid2d *tone, double pen_width_mm,
                               double sigma_mm, lw_fidelity *out, lw_error *err);
 
-/* The same for the paths of pen `pen` of a drawing (0-based; -1: all). */
-lw_status lw_fidelity_compute_strokes(const lw_strokes *s, int pen, const lw_grid2d *tone, double pen_width_mm,
-                                      double sigma_mm, lw_fidelity *out, lw_error *err);
+/* The same for the paths of pen `pen` of a drawing (0-based; -1: all),
+** against black * (1 - tone), black in (0, 1]. */
+lw_status lw_fidelity_compute_strokes(const lw_strokes *s, int pen, const lw_grid2d *tone, double black,
+                                      double pen_width_mm, double sigma_mm, lw_fidelity *out, lw_error *err);
 
 /* Step 1 alone: ink[j * nx + i] for the pixels of the tone raster. */
 lw_status lw_fidelity_render(const lw_splines *sp, const lw_grid2d *tone, double pen_width_mm, double *ink,
@@ -90,9 +97,10 @@ lw_status lw_fidelity_render_strokes(const lw_strokes *s, int pen, const lw_grid
                                      double *ink, lw_error *err);
 
 /* Steps 2-5 for the ink a and the darkness b, w x h (changed in place: blurred),
-** blur sigma sx, sy in pixels (0 = none); out->sigma_mm is left alone. */
-lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, double sy, lw_fidelity *out,
-                              lw_error *err);
+** blur sigma sx, sy in pixels (0 = none), paper white where the blurred b is
+** under `white`; out->sigma_mm and out->black are left alone. */
+lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, double sy, double white,
+                              lw_fidelity *out, lw_error *err);
 
 /* Gaussian blur of the w x h image v in place, sigma sx, sy pixels (0 =
 ** none along that axis), kernel radius ceil(truncate * sigma) pixels,
