@@ -206,8 +206,9 @@ const lw_param_def lw_param_table[] = {
       "wide, fine enough for a blurred field (docs/NUMERICS.md)."),
   NUM("energy", "tone_ink", LW_PT_DOUBLE, tone_ink, "1", "", 0, 1, LW_MIN_OPEN,
       "The share of the paper that ink covers where the picture is black: the tone term's "
-      "target is tone_ink * darkness. Below 1 the darks are drawn as dense lines rather than "
-      "solid ink, so lines keep their own width apart (1/tone_ink pen widths at black)."),
+      "target, and the fidelity scores', is tone_ink * darkness. Below 1 the darks are drawn as "
+      "dense lines rather than solid ink, so lines keep their own width apart (1/tone_ink pen "
+      "widths at black)."),
   NUM("energy", "min_spacing", LW_PT_DOUBLE, min_spacing, "0", "mm", 0, 1e7, 0,
       "Least distance between the curves of different splines, a hard constraint: a move that "
       "brings more of its pair samples closer than this to another spline than it had, or whose "
@@ -380,9 +381,9 @@ const lw_param_def lw_param_table[] = {
   NUM("output", "frames_every", LW_PT_INT, frames_every, "0", "sweeps", 0, 2e9, 0,
       "Sweeps between animation frames frames/frame-SSSSSS.png (SSSSSS = the sweep). 0 = none."),
   NUM("output", "fidelity_sigma", LW_PT_DOUBLE, fidelity_sigma, "1", "mm", 0, 1e4, LW_MIN_OPEN,
-      "Gaussian blur applied to both the rendered lines and the target tone before the fidelity "
-      "score (MSE, SSIM) compares them; about half the widest line spacing that should read as a "
-      "flat tone (docs/FORMATS.md)."),
+      "Gaussian blur applied to both the rendered lines and the target (the ink asked for, "
+      "energy.tone_ink * darkness) before the fidelity score (MSE, SSIM) compares them; about "
+      "half the widest line spacing that should read as a flat tone (docs/FORMATS.md)."),
   NUM("output", "field_preview", LW_PT_INT, field_preview, "0", "", 0, 1, 0,
       "1 = write field.png at the start of a run: the tone (white without an image) under "
       "short strokes along the field (needs the field term)."),
