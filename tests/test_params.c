@@ -331,7 +331,7 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
             "segment %g, cutoff %g, spacing %g, blur %g", p.segment_length, p.pair_cutoff, p.min_spacing,
             p.tone_blur);
   cr_assert(fabs(p.field_sigma - 10 * 0.35) < 1e-12);
-  cr_assert(p.tone == 40 && p.tone_ink == 0.5 && p.coverage == 0.6 && p.splines == 0 && p.sweeps == 300);
+  cr_assert(p.tone == 80 && p.tone_ink == 0.5 && p.coverage == 0.6 && p.splines == 0 && p.sweeps == 300);
   cr_assert(p.image_levels == 0.01, "image_levels %g", p.image_levels);
   /* the annealer chooses the count where the tone term pays for line: no
   ** chemical potential darkens every light tone */
