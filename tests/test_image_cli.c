@@ -459,6 +459,64 @@ Test(image_cli, photo_preset_keeps_strokes_apart_on_grainy_pictures)
   cr_assert(close < 0.03, "close share %g", close);
 }
 
+/* Mean ink of final.png over [x0, x1] x [y0, y1] mm of an A6 page (105 mm
+** wide), as the eye sees it at a distance: 1 - the mean tone. */
+static double page_ink(const char *dir, double x0, double y0, double x1, double y1)
+{
+  char path[600];
+  snprintf(path, sizeof path, "%s/final.png", dir);
+  lw_error err;
+  lw_image *img = lw_image_load(path, 1e9, NULL, &err);
+  cr_assert_not_null(img, "%s", err.msg);
+  const double px = img->width / 105.0;
+  double sum = 0;
+  long n = 0;
+  for (int j = (int)(y0 * px); j < (int)(y1 * px); j++)
+    for (int i = (int)(x0 * px); i < (int)(x1 * px); i++, n++) sum += 1.0 - img->tone[(size_t)j * img->width + i];
+  lw_image_free(img);
+  return sum / (double)n;
+}
+
+/* The photo preset draws a tone as the ink the tone term asks for,
+** tone_ink (0.5) x darkness: four flat bands of tone 0.9, 0.7, 0.45 and 0.2
+** filling an A6 page inside its 10 mm margins (levels and tone curve off)
+** ask for ink 0.05, 0.15, 0.275 and 0.4, measured in each band's middle.
+** Within 0.04 of each (measured 2026-12-03: within 0.02 for the preset).
+** The control, the preset of before with its chemical potential of 2.5
+** a mm, drew every band about 0.05 darker (0.102, 0.204, 0.329, 0.449):
+** lights darkened, contrast flattened (docs/IMAGES.md, "What the scores
+** asked for"). */
+Test(image_cli, the_photo_preset_draws_each_tone_as_the_ink_asked_for)
+{
+  enum { W = 255, H = 384 }; /* the aspect of A6 inside its margins, 85 x 128 mm */
+  static const double tone[4] = {0.9, 0.7, 0.45, 0.2};
+  float *g = malloc(sizeof(float) * W * H);
+  cr_assert_not_null(g);
+  for (int j = 0; j < H; j++)
+    for (int i = 0; i < W; i++) g[j * W + i] = (float)tone[j / (H / 4)];
+  char pic[512];
+  snprintf(pic, sizeof pic, "%s", lw_test_path("bands.png"));
+  lw_test_png(pic, W, H, g, NULL);
+  free(g);
+  for (int k = 0; k < 2; k++) {
+    char dir[512];
+    snprintf(dir, sizeof dir, "%s", lw_test_path(k ? "bands-paid" : "bands"));
+    cr_assert_eq(lw_test_sh("%s run %s/params/photo.ini --out %s --set scene.image=%s --set scene.page=a6 "
+                            "--set scene.image_levels=0 --set scene.image_gamma=1 --set anneal.sweeps=150 "
+                            "--quiet%s",
+                            lw_test_bin(), lw_test_root(), dir, pic, k ? " --set energy.chem_length=-2.5" : ""),
+                 0);
+    double worst = 0;
+    for (int b = 0; b < 4; b++) {
+      const double asked = 0.5 * (1 - tone[b]), drawn = page_ink(dir, 20, 18 + 32 * b, 85, 34 + 32 * b);
+      cr_log_info("%s: tone %g asks ink %.3f, drawn %.3f", k ? "paid for line" : "preset", tone[b], asked, drawn);
+      if (fabs(drawn - asked) > worst) worst = fabs(drawn - asked);
+      if (!k) cr_assert(fabs(drawn - asked) < 0.04, "tone %g: ink %.3f, asked %.3f", tone[b], drawn, asked);
+    }
+    if (k) cr_assert(worst > 0.04, "the control drew every tone within %.3f of what it asks", worst);
+  }
+}
+
 /* A silhouette on white paper (a dark head and neck on a white 3:4
 ** picture).  The tone term's price of the first thin line in white is
 ** quadratic in its ink, so next to nothing, and anything that pays for line
