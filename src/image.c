@@ -312,7 +312,7 @@ static lw_status pnm_header(const unsigned char *d, size_t n, const char *name, 
                         "maxval 1 to 65535", name, w, h, maxval);
   if ((double)w * (double)h > LW_IMAGE_MAX_PIXELS)
     return lw_error_set(err, LW_EINPUT, "%s: %ld x %ld pixels is more than the %.0e pixels linewise decodes", name,
-                        w, h, LW_IMAGE_MAX_PIXELS);
+                        w, h, (double)LW_IMAGE_MAX_PIXELS);
   *w_out = w;
   *h_out = h;
   *maxval_out = maxval;
@@ -592,7 +592,7 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
     return lw_error_set(err, LW_EINPUT, "%s: the %s is damaged: %d x %d pixels", name, format_name(data, size), w, h);
   if ((double)w * (double)h > LW_IMAGE_MAX_PIXELS)
     return lw_error_set(err, LW_EINPUT, "%s: %d x %d pixels is more than the %.0e pixels linewise decodes", name,
-                        w, h, LW_IMAGE_MAX_PIXELS);
+                        w, h, (double)LW_IMAGE_MAX_PIXELS);
   int bits = stbi_is_16_bit_from_memory(data, (int)size) ? 16 : 8;
   /* The decoder keeps its last reason until a new one is set, and some
   ** failures set none: a JPEG cut short was reported as "Not a PNG", from
