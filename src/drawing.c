@@ -322,8 +322,8 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
   char o[40];
   w = snprintf(buf + k, n - k,
                "linewise: fidelity (blur %g mm, black %g): MSE %.6g, SSIM %.4f, orientation %s, stray ink %.4f\n",
-               d->fidelity.sigma_mm, d->fidelity.black, d->fidelity.mse, d->fidelity.ssim, orientation_text(d->fidelity.orientation, o),
-               d->fidelity.stray);
+               d->fidelity.sigma_mm, d->fidelity.black, d->fidelity.mse, d->fidelity.ssim,
+               orientation_text(d->fidelity.orientation, o), d->fidelity.stray);
   for (int p = 0; d->n_pens > 1 && p < d->n_pens && w >= 0 && (k += (size_t)w) < n; p++)
     w = snprintf(buf + k, n - k, "linewise: fidelity of pen %d: MSE %.6g, SSIM %.4f, orientation %s, stray ink %.4f\n",
                  p + 1, d->pen_fidelity[p].mse, d->pen_fidelity[p].ssim,
