@@ -171,6 +171,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   if (!st) return err ? err->code : LW_ENOMEM;
   rep->paths = st->n;
   rep->n_pens = st->n_pens;
+  for (int k = 0; k < st->n_pens; k++) rep->pen_paths[k] = st->pen_first[k + 1] - st->pen_first[k];
   rep->travel_before = rep->post.travel_before;
   rep->travel_after = rep->post.travel_after;
   rep->cropped = o.crop;
@@ -228,6 +229,12 @@ static void count(lw_json *j, const char *key, size_t v)
 void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep)
 {
   count(j, "paths", rep->paths);
+  if (rep->n_pens > 1) {
+    lw_json_key(j, "pen_paths");
+    lw_json_begin_array(j);
+    for (int k = 0; k < rep->n_pens; k++) lw_json_int(j, (long long)rep->pen_paths[k]);
+    lw_json_end_array(j);
+  }
   lw_json_key(j, "pen_up_travel_mm");
   lw_json_begin_object(j);
   lw_json_key(j, "before");
@@ -318,6 +325,13 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
                    d->travel_after, clock, d->time_s, d->pen_down_mm, r->lifts_after, d->close_share);
   if (w < 0 || (size_t)w >= n) return;
   k = (size_t)w;
+  /* a colour pen whose separation is empty (a warm picture's cyan) still has
+  ** its layer in final.svg: say so, so that no pen is changed for nothing */
+  for (int p = 0; d->n_pens > 1 && p < d->n_pens; p++) {
+    if (d->pen_paths[p]) continue;
+    w = snprintf(buf + k, n - k, "linewise: pen %d draws nothing (its layer in final.svg is empty)\n", p + 1);
+    if (w < 0 || (k += (size_t)w) >= n) return;
+  }
   if (!d->has_fidelity) return;
   char o[40];
   w = snprintf(buf + k, n - k,

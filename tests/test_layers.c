@@ -912,6 +912,31 @@ Test(layers, the_svg_has_one_group_a_pen_with_its_colour_and_width)
   cr_assert_eq(n, 4, "one score a layer");
 }
 
+/* A picture of cyan and yellow asks nothing of the magenta and black pens:
+** their layers stay in final.svg (pen numbers are plotting order), and the
+** run says they draw nothing, so that no pen is changed for an empty layer;
+** summary.json counts each pen's paths. */
+Test(layers, a_pen_that_draws_nothing_is_named)
+{
+  write_colour_png(lw_test_path("colour.png"), 32, 32, cyan_yellow);
+  lw_test_write(lw_test_path("scene.ini"), colour_scene, strlen(colour_scene));
+  char errs[8192];
+  cr_assert_eq(run("run scene.ini --out out", errs, sizeof errs), 0, "%s", errs);
+  for (int k = 1; k <= 4; k++) {
+    char line[64];
+    snprintf(line, sizeof line, "linewise: pen %d draws nothing", k);
+    if (k == 2 || k == 4) cr_assert_not_null(strstr(errs, line), "no note for pen %d:\n%s", k, errs);
+    else cr_assert_null(strstr(errs, line), "pen %d draws:\n%s", k, errs);
+  }
+  char path[512];
+  snprintf(path, sizeof path, "%s", lw_test_path("out/summary.json"));
+  const char *js = lw_test_read_text(path), *pp = strstr(js, "\"pen_paths\"");
+  cr_assert_not_null(pp, "summary.json counts the paths of each pen");
+  long n[4];
+  cr_assert_eq(sscanf(pp, "\"pen_paths\": [ %ld , %ld , %ld , %ld ]", &n[0], &n[1], &n[2], &n[3]), 4, "%.80s", pp);
+  cr_assert(n[0] > 0 && n[1] == 0 && n[2] > 0 && n[3] == 0, "pen paths %ld %ld %ld %ld", n[0], n[1], n[2], n[3]);
+}
+
 Test(layers, bad_layer_keys_give_one_line_with_file_line_and_key_and_exit_2)
 {
   write_colour_png(lw_test_path("colour.png"), 16, 16, blotch_colours);

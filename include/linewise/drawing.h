@@ -59,6 +59,7 @@ typedef struct {
   int has_fidelity;                   /* a target tone was given */
   lw_fidelity fidelity;               /* of all pens */
   int n_pens;
+  size_t pen_paths[LW_PLOT_PENS_MAX];         /* paths of each pen */
   lw_fidelity pen_fidelity[LW_PLOT_PENS_MAX]; /* per pen, when n_pens > 1 */
 } lw_drawing_report;
 
