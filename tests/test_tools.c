@@ -271,7 +271,7 @@ Test(tools, a_sweep_of_a_picture_gathers_the_drawings_scores)
   snprintf(path, sizeof path, "%s/p/sweep.csv", dir);
   csv_read(&t, path);
   const char *want_cols[] = {"close_share", "fidelity_mse", "fidelity_ssim", "fidelity_orientation",
-                             "fidelity_stray"};
+                             "fidelity_stray", "fidelity_black"};
   for (size_t i = 0; i < sizeof want_cols / sizeof *want_cols; i++)
     cr_assert(col(&t, want_cols[i]) >= 0, "no column %s", want_cols[i]);
   cr_assert_eq(t.nrow, 2);
@@ -280,6 +280,8 @@ Test(tools, a_sweep_of_a_picture_gathers_the_drawings_scores)
     snprintf(run, sizeof run, "p/seed-%d", r + 1);
     row_matches_summary(&t, r, run);
     cr_assert(atof(cell(&t, r, "fidelity_ssim")) > 0, "seed %d: ssim %s", r + 1, cell(&t, r, "fidelity_ssim"));
+    /* the scores' target, the photo preset's tone_ink */
+    cr_assert_str_eq(cell(&t, r, "fidelity_black"), "0.5", "seed %d", r + 1);
   }
   free(t.text);
 }
