@@ -281,7 +281,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_err
     return 0;
   }
   if (!quiet) {
-    char drawn[2048]; /* a line a pen of a layered drawing */
+    char drawn[4096]; /* up to two lines a pen of a drawing of 16 (LW_PLOT_PENS_MAX) */
     if (drew) a->sys_type->describe(a->sys->state, LW_DESCRIBE_DRAWING, drawn, sizeof drawn);
     if (drew) fprintf(stderr, "%s", drawn);
     if (a->quenched)
