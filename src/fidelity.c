@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <omp.h>
+
 #include "linewise/image.h"
 #include "linewise/output.h"
 
@@ -109,22 +111,36 @@ done:
   return s;
 }
 
-/* One axis of the blur: n values spaced `step` apart starting at v[0],
-** `count` such lines `line` apart.  g[0..r] the kernel's half, norm[i] the
-** sum of the weights that land inside for position i. */
-static void blur_axis(double *v, size_t n, size_t step, size_t count, size_t line, const double *g, int r,
-                      const double *norm, double *row)
+/* One line of the blur: n values spaced `step` apart starting at v[0].
+** g[0..r] the kernel's half, norm[i] the sum of the weights that land
+** inside for position i; row: scratch of n values. */
+static void blur_line(double *v, size_t n, size_t step, const double *g, int r, const double *norm, double *row)
 {
-  for (size_t c = 0; c < count; c++) {
-    double *base = v + c * line;
-    for (size_t i = 0; i < n; i++) row[i] = base[i * step];
-    for (size_t i = 0; i < n; i++) {
-      size_t lo = i >= (size_t)r ? i - (size_t)r : 0, hi = i + (size_t)r < n ? i + (size_t)r : n - 1;
-      double sum = 0.0;
-      for (size_t k = lo; k <= hi; k++) sum += g[k > i ? k - i : i - k] * row[k];
-      base[i * step] = sum / norm[i];
-    }
+  for (size_t i = 0; i < n; i++) row[i] = v[i * step];
+  for (size_t i = 0; i < n; i++) {
+    size_t lo = i >= (size_t)r ? i - (size_t)r : 0, hi = i + (size_t)r < n ? i + (size_t)r : n - 1;
+    double sum = 0.0;
+    for (size_t k = lo; k < i; k++) sum += g[i - k] * row[k]; /* from the lowest index up, in two runs */
+    for (size_t k = i; k <= hi; k++) sum += g[k - i] * row[k];
+    v[i * step] = sum / norm[i];
   }
+}
+
+/* `count` such lines `line` apart.  A picture's lines are independent and
+** each is summed as one thread alone would, so the threads share them out
+** and the result does not depend on how many there are (the scores of a
+** camera's picture in four pens took 10 s serially). */
+static lw_status blur_axis(double *v, size_t n, size_t step, size_t count, size_t line, const double *g, int r,
+                           const double *norm)
+{
+  const int threads = omp_get_max_threads();
+  double *rows = malloc((size_t)threads * n * sizeof *rows);
+  if (!rows) return LW_ENOMEM;
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (long c = 0; c < (long)count; c++)
+    blur_line(v + (size_t)c * line, n, step, g, r, norm, rows + (size_t)omp_get_thread_num() * n);
+  free(rows);
+  return LW_OK;
 }
 
 /* Kernel halves and edge norms for n positions, sigma s, radius r. */
@@ -181,11 +197,15 @@ static lw_status blur_sparse(double *v, int w, int h, double sx, double sy, int 
   }
   for (int k = 0; k <= rx; k++) gx[k] = exp(-0.5 * (double)k * (double)k / (sx * sx));
   for (int k = 0; k <= ry; k++) gy[k] = exp(-0.5 * (double)k * (double)k / (sy * sy));
+  /* every value below is one thread's sum: the threads only share them out */
+#pragma omp parallel for schedule(static)
   for (size_t y = 0; y < H; y++)
     for (size_t k = 0; k < Kx; k++) rows[y * Kx + k] = blur_at(v + y * W, W, 1, ((long)k - 1) * f, gx, rx);
+#pragma omp parallel for schedule(static)
   for (size_t k = 0; k < Kx; k++)
     for (size_t j = 0; j < Ky; j++) grid[j * Kx + k] = blur_at(rows + k, H, Kx, ((long)j - 1) * f, gy, ry);
   for (size_t x = 0; x < W; x++) lw_image_cubic_weights((double)(x % (size_t)f) / f, wx + 4 * x);
+#pragma omp parallel for schedule(static)
   for (size_t y = 0; y < H; y++) {
     double wy[4];
     lw_image_cubic_weights((double)(y % (size_t)f) / f, wy);
@@ -208,26 +228,19 @@ static lw_status blur(double *v, int w, int h, double sx, double sy, int rx, int
     return blur_sparse(v, w, h, sx, sy, rx, ry, (int)(fmin(sx, sy) / 8.0), err);
   size_t W = (size_t)w, H = (size_t)h, n = W > H ? W : H;
   int rmax = rx > ry ? rx : ry;
-  double *row = malloc(n * sizeof *row), *norm = malloc(n * sizeof *norm);
-  double *g = malloc(((size_t)rmax + 1) * sizeof *g);
-  if (!row || !norm || !g) {
-    free(row);
-    free(norm);
-    free(g);
-    return lw_error_set(err, LW_ENOMEM, "fidelity: out of memory blurring %d x %d pixels", w, h);
-  }
-  if (sx > 0 && rx > 0) {
+  double *norm = malloc(n * sizeof *norm), *g = malloc(((size_t)rmax + 1) * sizeof *g);
+  lw_status s = norm && g ? LW_OK : LW_ENOMEM;
+  if (!s && sx > 0 && rx > 0) {
     kernel(sx, rx, W, g, norm);
-    blur_axis(v, W, 1, H, W, g, rx, norm, row);
+    s = blur_axis(v, W, 1, H, W, g, rx, norm);
   }
-  if (sy > 0 && ry > 0) {
+  if (!s && sy > 0 && ry > 0) {
     kernel(sy, ry, H, g, norm);
-    blur_axis(v, H, W, W, 1, g, ry, norm, row);
+    s = blur_axis(v, H, W, W, 1, g, ry, norm);
   }
-  free(row);
   free(norm);
   free(g);
-  return LW_OK;
+  return s ? lw_error_set(err, s, "fidelity: out of memory blurring %d x %d pixels", w, h) : LW_OK;
 }
 
 /* Radius ceil(truncate * sigma), kept below the image size it acts on. */
@@ -249,16 +262,21 @@ lw_status lw_fidelity_blur(double *v, int w, int h, double sx, double sy, double
 ** are made (`fill`), blurred along x as they come, kept in a ring of
 ** 2 ry + 1, and each output row is their weighted sum down the column.
 ** The sums are those of the two-pass blur above, term for term and in the
-** same order, so the scores are its bits.
+** same order.  Each thread runs a ring over a band of rows (making the
+** 2 ry rows above its band again), and a row's score is summed along the
+** row alone, so every row's sum, and their total in row order, is the
+** same for any number of threads.
 */
-typedef void (*window_fill)(void *ctx, int row, double **planes);
+typedef void (*window_fill)(const void *ctx, int row, double **planes, double *scratch);
+/* Adds what row's windowed planes t (plane q at t + q w) give to sums[]. */
+typedef void (*window_score)(const double *t, size_t w, double *sums);
 
 typedef struct {
   int w, h, planes, rx, ry, ring;
   double gx[LW_FIDELITY_SSIM_RADIUS + 1], gy[LW_FIDELITY_SSIM_RADIUS + 1];
-  double *normx, *normy, *rows, *scratch, *out;
+  double *normx, *normy, *rows, *scratch, *out; /* scratch: 2 w, for fill and the blur */
   window_fill fill;
-  void *ctx;
+  const void *ctx;
   int made; /* rows made so far */
 } window_rows;
 
@@ -271,26 +289,27 @@ static void window_rows_free(window_rows *r)
   free(r->out);
 }
 
-static lw_status window_rows_init(window_rows *r, int planes, int w, int h, window_fill fill, void *ctx,
-                                  lw_error *err)
+/* A ring whose first row asked for is `first`; 0 when out of memory. */
+static int window_rows_init(window_rows *r, int planes, int w, int h, window_fill fill, const void *ctx, int first)
 {
   *r = (window_rows){.w = w, .h = h, .planes = planes, .fill = fill, .ctx = ctx};
   r->rx = LW_FIDELITY_SSIM_RADIUS < w ? LW_FIDELITY_SSIM_RADIUS : w;
   r->ry = LW_FIDELITY_SSIM_RADIUS < h ? LW_FIDELITY_SSIM_RADIUS : h;
   r->ring = 2 * r->ry + 1;
+  r->made = first >= r->ry ? first - r->ry : 0;
   size_t W = (size_t)w, P = (size_t)planes;
   r->normx = malloc(W * sizeof *r->normx);
   r->normy = malloc((size_t)h * sizeof *r->normy);
   r->rows = malloc((size_t)r->ring * P * W * sizeof *r->rows);
-  r->scratch = malloc(W * sizeof *r->scratch);
+  r->scratch = malloc(2 * W * sizeof *r->scratch);
   r->out = malloc(P * W * sizeof *r->out);
   if (!r->normx || !r->normy || !r->rows || !r->scratch || !r->out) {
     window_rows_free(r);
-    return lw_error_set(err, LW_ENOMEM, "fidelity: out of memory for the SSIM window over %d x %d pixels", w, h);
+    return 0;
   }
   kernel(LW_FIDELITY_SSIM_SIGMA, r->rx, W, r->gx, r->normx);
   kernel(LW_FIDELITY_SSIM_SIGMA, r->ry, (size_t)h, r->gy, r->normy);
-  return LW_OK;
+  return 1;
 }
 
 /* Row k's planes, made and blurred along x, in ring slot k mod ring. */
@@ -299,12 +318,12 @@ static void window_make(window_rows *r, int k)
   size_t W = (size_t)r->w, P = (size_t)r->planes;
   double *slot = r->rows + (size_t)(k % r->ring) * P * W, *planes[8];
   for (size_t q = 0; q < P; q++) planes[q] = slot + q * W;
-  r->fill(r->ctx, k, planes);
-  for (size_t q = 0; q < P; q++) blur_axis(planes[q], W, 1, 1, W, r->gx, r->rx, r->normx, r->scratch);
+  r->fill(r->ctx, k, planes, r->scratch);
+  for (size_t q = 0; q < P; q++) blur_line(planes[q], W, 1, r->gx, r->rx, r->normx, r->scratch);
 }
 
 /* The windowed planes of row j into r->out (plane q at out + q w).  Rows
-** are asked for in order 0, 1, ..., h - 1. */
+** are asked for in order from the ring's first. */
 static const double *window_row(window_rows *r, int j)
 {
   int lo = j >= r->ry ? j - r->ry : 0, hi = j + r->ry < r->h ? j + r->ry : r->h - 1;
@@ -323,6 +342,34 @@ static const double *window_row(window_rows *r, int j)
   return r->out;
 }
 
+/* The sums[0 .. n) of score over every row of the window's planes. */
+static lw_status window_sum(int planes, int w, int h, window_fill fill, const void *ctx, window_score score, int n,
+                            double *sums, lw_error *err)
+{
+  double *part = calloc((size_t)h * (size_t)n, sizeof *part);
+  if (!part) return lw_error_set(err, LW_ENOMEM, "fidelity: out of memory for %d x %d pixels", w, h);
+  const int bands = omp_get_max_threads() < h ? omp_get_max_threads() : h;
+  int failed = 0;
+#pragma omp parallel for schedule(static, 1) num_threads(bands) reduction(| : failed)
+  for (int b = 0; b < bands; b++) {
+    const int j0 = (int)((long)h * b / bands), j1 = (int)((long)h * (b + 1) / bands);
+    window_rows r;
+    if (!window_rows_init(&r, planes, w, h, fill, ctx, j0)) {
+      failed = 1;
+      continue;
+    }
+    for (int j = j0; j < j1; j++) score(window_row(&r, j), (size_t)w, part + (size_t)j * (size_t)n);
+    window_rows_free(&r);
+  }
+  for (int q = 0; q < n; q++) sums[q] = 0.0;
+  for (size_t j = 0; j < (size_t)h; j++)
+    for (int q = 0; q < n; q++) sums[q] += part[j * (size_t)n + (size_t)q];
+  free(part);
+  if (failed)
+    return lw_error_set(err, LW_ENOMEM, "fidelity: out of memory for the SSIM window over %d x %d pixels", w, h);
+  return LW_OK;
+}
+
 /* Central differences (one-sided at the edges) of row j of v into gx, gy. */
 static void gradient_row(const double *v, int w, int h, int j, double *gx, double *gy)
 {
@@ -338,11 +385,10 @@ static void gradient_row(const double *v, int w, int h, int j, double *gx, doubl
 typedef struct {
   const double *a, *b;
   int w, h;
-  double *gx, *gy;
 } pair_rows;
 
 /* SSIM's planes: a, b, a^2, b^2, ab. */
-static void fill_moments(void *ctx, int row, double **pl)
+static void fill_moments(const void *ctx, int row, double **pl, double *scratch)
 {
   const pair_rows *c = ctx;
   const double *a = c->a + (size_t)row * (size_t)c->w, *b = c->b + (size_t)row * (size_t)c->w;
@@ -356,40 +402,61 @@ static void fill_moments(void *ctx, int row, double **pl)
 }
 
 /* The structure tensors' planes: gx^2, gx gy, gy^2 of a, then of b. */
-static void fill_tensors(void *ctx, int row, double **pl)
+static void fill_tensors(const void *ctx, int row, double **pl, double *scratch)
 {
   const pair_rows *c = ctx;
+  double *gx = scratch, *gy = scratch + c->w;
   for (int s = 0; s < 2; s++) {
-    gradient_row(s ? c->b : c->a, c->w, c->h, row, c->gx, c->gy);
+    gradient_row(s ? c->b : c->a, c->w, c->h, row, gx, gy);
     double *xx = pl[3 * s], *xy = pl[3 * s + 1], *yy = pl[3 * s + 2];
     for (int i = 0; i < c->w; i++) {
-      xx[i] = c->gx[i] * c->gx[i];
-      xy[i] = c->gx[i] * c->gy[i];
-      yy[i] = c->gy[i] * c->gy[i];
+      xx[i] = gx[i] * gx[i];
+      xy[i] = gx[i] * gy[i];
+      yy[i] = gy[i] * gy[i];
     }
   }
+}
+
+/* A row's SSIM map, summed. */
+static void score_ssim(const double *ma, size_t W, double *sums)
+{
+  const double *mb = ma + W, *aa = mb + W, *bb = aa + W, *ab = bb + W;
+  const double C1 = 0.01 * 0.01, C2 = 0.03 * 0.03; /* L = 1 */
+  double sum = 0.0;
+  for (size_t k = 0; k < W; k++) {
+    double va = aa[k] - ma[k] * ma[k], vb = bb[k] - mb[k] * mb[k], cov = ab[k] - ma[k] * mb[k];
+    sum += (2 * ma[k] * mb[k] + C1) * (2 * cov + C2) / ((ma[k] * ma[k] + mb[k] * mb[k] + C1) * (va + vb + C2));
+  }
+  sums[0] = sum;
 }
 
 /* SSIM of a against b, its map averaged over every pixel. */
 static lw_status ssim(const double *a, const double *b, int w, int h, double *out, lw_error *err)
 {
-  pair_rows c = {a, b, w, h, NULL, NULL};
-  window_rows r;
-  lw_status s = window_rows_init(&r, 5, w, h, fill_moments, &c, err);
-  if (s) return s;
-  const double C1 = 0.01 * 0.01, C2 = 0.03 * 0.03; /* L = 1 */
-  size_t W = (size_t)w;
-  double sum = 0.0;
-  for (int j = 0; j < h; j++) {
-    const double *ma = window_row(&r, j), *mb = ma + W, *aa = mb + W, *bb = aa + W, *ab = bb + W;
-    for (size_t k = 0; k < W; k++) {
-      double va = aa[k] - ma[k] * ma[k], vb = bb[k] - mb[k] * mb[k], cov = ab[k] - ma[k] * mb[k];
-      sum += (2 * ma[k] * mb[k] + C1) * (2 * cov + C2) / ((ma[k] * ma[k] + mb[k] * mb[k] + C1) * (va + vb + C2));
-    }
+  pair_rows c = {a, b, w, h};
+  double sum;
+  lw_status s = window_sum(5, w, h, fill_moments, &c, score_ssim, 1, &sum, err);
+  *out = sum / ((double)w * (double)h);
+  return s;
+}
+
+/* A row's agreement and weight (orientation, below).  Below
+** LW_FIDELITY_FLAT a pixel has no direction: rounding in the blur leaves
+** gradients of ~1e-17 on a flat image. */
+static void score_orientation(const double *t, size_t W, double *sums)
+{
+  const double flat = LW_FIDELITY_FLAT * LW_FIDELITY_FLAT;
+  double num = 0.0, den = 0.0;
+  for (size_t k = 0; k < W; k++) {
+    double ua0 = t[k] - t[2 * W + k], ua1 = 2 * t[W + k];
+    double ub0 = t[3 * W + k] - t[5 * W + k], ub1 = 2 * t[4 * W + k];
+    double la = hypot(ua0, ua1), lb = hypot(ub0, ub1);
+    if (lb <= flat) continue;
+    den += lb;
+    if (la > flat) num += (ua0 * ub0 + ua1 * ub1) / la;
   }
-  *out = sum / ((double)W * (double)h);
-  window_rows_free(&r);
-  return LW_OK;
+  sums[0] = num;
+  sums[1] = den;
 }
 
 /* Orientation agreement of a with b (the target): the mean of cos 2 dtheta
@@ -399,34 +466,11 @@ static lw_status ssim(const double *a, const double *b, int w, int h, double *ou
 ** NaN where b has no structure. */
 static lw_status orientation(const double *a, const double *b, int w, int h, double *out, lw_error *err)
 {
-  size_t W = (size_t)w;
-  double *g = malloc(2 * W * sizeof *g);
-  if (!g) return lw_error_set(err, LW_ENOMEM, "fidelity: out of memory for %d x %d pixels", w, h);
-  pair_rows c = {a, b, w, h, g, g + W};
-  window_rows r;
-  lw_status s = window_rows_init(&r, 6, w, h, fill_tensors, &c, err);
-  if (s) {
-    free(g);
-    return s;
-  }
-  /* below LW_FIDELITY_FLAT a pixel has no direction: rounding in the blur
-  ** leaves gradients of ~1e-17 on a flat image */
-  double num = 0.0, den = 0.0, flat = LW_FIDELITY_FLAT * LW_FIDELITY_FLAT;
-  for (int j = 0; j < h; j++) {
-    const double *t = window_row(&r, j);
-    for (size_t k = 0; k < W; k++) {
-      double ua0 = t[k] - t[2 * W + k], ua1 = 2 * t[W + k];
-      double ub0 = t[3 * W + k] - t[5 * W + k], ub1 = 2 * t[4 * W + k];
-      double la = hypot(ua0, ua1), lb = hypot(ub0, ub1);
-      if (lb <= flat) continue;
-      den += lb;
-      if (la > flat) num += (ua0 * ub0 + ua1 * ub1) / la;
-    }
-  }
-  *out = den > 0 ? num / den : NAN;
-  window_rows_free(&r);
-  free(g);
-  return LW_OK;
+  pair_rows c = {a, b, w, h};
+  double sums[2];
+  lw_status s = window_sum(6, w, h, fill_tensors, &c, score_orientation, 2, sums, err);
+  *out = sums[1] > 0 ? sums[0] / sums[1] : NAN;
+  return s;
 }
 
 lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, double sy, double white,

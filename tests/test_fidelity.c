@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <omp.h>
+
 #include "linewise/fidelity.h"
 #include "testutil.h"
 
@@ -429,17 +431,22 @@ static void ref_scores(const double *a, const double *b, int w, int h, double *s
         m[at + k] = gx * gx, m[at + n + k] = gx * gy, m[at + 2 * n + k] = gy * gy;
       }
   for (int q = 0; q < 11; q++) ref_window(m + (size_t)q * n, w, h);
+  /* each row summed along the row, then the rows' sums in row order */
   double sum = 0.0, num = 0.0, den = 0.0, flat = LW_FIDELITY_FLAT * LW_FIDELITY_FLAT;
-  for (size_t k = 0; k < n; k++) {
-    double ma = m[k], mb = m[n + k], va = m[2 * n + k] - ma * ma, vb = m[3 * n + k] - mb * mb;
-    double cov = m[4 * n + k] - ma * mb;
-    sum += (2 * ma * mb + C1) * (2 * cov + 0.03 * 0.03) / ((ma * ma + mb * mb + C1) * (va + vb + 0.03 * 0.03));
-    double ua0 = m[5 * n + k] - m[7 * n + k], ua1 = 2 * m[6 * n + k];
-    double ub0 = m[8 * n + k] - m[10 * n + k], ub1 = 2 * m[9 * n + k];
-    double la = hypot(ua0, ua1), lb = hypot(ub0, ub1);
-    if (lb <= flat) continue;
-    den += lb;
-    if (la > flat) num += (ua0 * ub0 + ua1 * ub1) / la;
+  for (int j = 0; j < h; j++) {
+    double rsum = 0.0, rnum = 0.0, rden = 0.0;
+    for (size_t k = (size_t)j * (size_t)w; k < (size_t)(j + 1) * (size_t)w; k++) {
+      double ma = m[k], mb = m[n + k], va = m[2 * n + k] - ma * ma, vb = m[3 * n + k] - mb * mb;
+      double cov = m[4 * n + k] - ma * mb;
+      rsum += (2 * ma * mb + C1) * (2 * cov + 0.03 * 0.03) / ((ma * ma + mb * mb + C1) * (va + vb + 0.03 * 0.03));
+      double ua0 = m[5 * n + k] - m[7 * n + k], ua1 = 2 * m[6 * n + k];
+      double ub0 = m[8 * n + k] - m[10 * n + k], ub1 = 2 * m[9 * n + k];
+      double la = hypot(ua0, ua1), lb = hypot(ub0, ub1);
+      if (lb <= flat) continue;
+      rden += lb;
+      if (la > flat) rnum += (ua0 * ub0 + ua1 * ub1) / la;
+    }
+    sum += rsum, num += rnum, den += rden;
   }
   *ssim = sum / (double)n;
   *orient = den > 0 ? num / den : NAN;
@@ -447,10 +454,12 @@ static void ref_scores(const double *a, const double *b, int w, int h, double *s
 }
 
 /* The SSIM window runs a row at a time (a ring of 11 rows instead of nine
-** whole planes: 288 MB for a 4-megapixel picture before); its scores are
-** those of the whole planes to the bit, on images narrower and shorter
-** than the window too.  A ring that reused a slot too early, a column sum
-** in another order or an edge weight taken from the wrong axis fails. */
+** whole planes: 288 MB for a 4-megapixel picture before), each thread over
+** a band of rows; its scores are those of the whole planes to the bit, on
+** images narrower and shorter than the window too, and on 1, 2, 3 and 7
+** threads.  A ring that reused a slot too early or started a band without
+** the rows above it, a column sum in another order or an edge weight taken
+** from the wrong axis fails. */
 Test(fidelity, scores_row_by_row_are_those_of_whole_planes)
 {
   static const int size[][2] = {{1, 1}, {1, 9}, {9, 1}, {4, 3}, {11, 11}, {12, 30}, {37, 23}, {64, 7}};
@@ -465,16 +474,53 @@ Test(fidelity, scores_row_by_row_are_those_of_whole_planes)
         a[j * w + i] = urand(0, 1) * (i % 3 == 0);
         b[j * w + i] = 0.5 + 0.4 * sin(0.7 * i + 0.3 * j) + urand(-0.05, 0.05);
       }
-    lw_fidelity f;
-    cr_assert_eq(lw_fidelity_compare(a, b, w, h, 0.8, 1.3, LW_FIDELITY_WHITE, &f, NULL), LW_OK);
-    /* lw_fidelity_compare blurred a and b in place: the reference starts there */
     memcpy(a0, a, n * sizeof *a);
     memcpy(b0, b, n * sizeof *b);
-    double ssim, orient;
-    ref_scores(a0, b0, w, h, &ssim, &orient);
-    cr_assert(f.ssim == ssim, "%d x %d: ssim %.17g, on whole planes %.17g", w, h, f.ssim, ssim);
-    cr_assert(f.orientation == orient || (isnan(f.orientation) && isnan(orient)),
-              "%d x %d: orientation %.17g, on whole planes %.17g", w, h, f.orientation, orient);
+    static const int threads[] = {1, 2, 3, 7};
+    const int had = omp_get_max_threads();
+    for (size_t t = 0; t < sizeof threads / sizeof threads[0]; t++) {
+      omp_set_num_threads(threads[t]);
+      memcpy(a, a0, n * sizeof *a);
+      memcpy(b, b0, n * sizeof *b);
+      lw_fidelity f;
+      cr_assert_eq(lw_fidelity_compare(a, b, w, h, 0.8, 1.3, LW_FIDELITY_WHITE, &f, NULL), LW_OK);
+      /* lw_fidelity_compare blurred a and b in place: the reference starts there */
+      double ssim, orient;
+      ref_scores(a, b, w, h, &ssim, &orient);
+      cr_assert(f.ssim == ssim, "%d x %d, %d threads: ssim %.17g, on whole planes %.17g", w, h, threads[t], f.ssim,
+                ssim);
+      cr_assert(f.orientation == orient || (isnan(f.orientation) && isnan(orient)),
+                "%d x %d, %d threads: orientation %.17g, on whole planes %.17g", w, h, threads[t], f.orientation,
+                orient);
+    }
+    omp_set_num_threads(had);
     free(a), free(b), free(a0), free(b0);
   }
+}
+
+/* The blurs share a picture's lines out among the threads: the same bits
+** on 1 and 3 threads, summed directly (sigma 3) and sparsely (sigma 20,
+** where every 2nd position is summed and the rest interpolated).  A
+** scratch line shared between threads fails. */
+Test(fidelity, blurs_are_the_same_on_any_number_of_threads)
+{
+  const int w = 197, h = 131;
+  const size_t n = (size_t)w * (size_t)h;
+  double *v = malloc(n * sizeof *v), *one = malloc(n * sizeof *one), *three = malloc(n * sizeof *three);
+  rng_seed(5);
+  for (size_t k = 0; k < n; k++) v[k] = urand(0, 1);
+  const int had = omp_get_max_threads();
+  const double sigma[] = {3, 20};
+  for (int s = 0; s < 2; s++) {
+    memcpy(one, v, n * sizeof *v);
+    memcpy(three, v, n * sizeof *v);
+    omp_set_num_threads(1);
+    cr_assert_eq(lw_fidelity_blur(one, w, h, sigma[s], sigma[s], LW_FIDELITY_TRUNCATE, NULL), LW_OK);
+    omp_set_num_threads(3);
+    cr_assert_eq(lw_fidelity_blur(three, w, h, sigma[s], sigma[s], LW_FIDELITY_TRUNCATE, NULL), LW_OK);
+    cr_assert(!memcmp(one, three, n * sizeof *v), "sigma %g: 1 and 3 threads differ", sigma[s]);
+    cr_assert(memcmp(one, v, n * sizeof *v), "sigma %g: nothing was blurred", sigma[s]);
+  }
+  omp_set_num_threads(had);
+  free(v), free(one), free(three);
 }
