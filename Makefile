@@ -162,7 +162,7 @@ docs: bin/linewise
 
 # The benchmark: tools/bench*.c with the shared pieces in tools/benchutil.c and
 # the two-curve reference of the tests (tests/pairref.h).
-BENCH_SRC := tools/bench.c tools/bench-accuracy.c tools/bench-order.c tools/bench-regularity.c tools/bench-siman.c tools/bench-tempering.c tools/bench-domains.c tools/bench-tone.c tools/bench-nurbs.c tools/bench-quench.c tools/bench-transdim.c tools/bench-kink.c tools/benchutil.c
+BENCH_SRC := tools/bench.c tools/bench-accuracy.c tools/bench-order.c tools/bench-regularity.c tools/bench-siman.c tools/bench-tempering.c tools/bench-domains.c tools/bench-tone.c tools/bench-nurbs.c tools/bench-quench.c tools/bench-transdim.c tools/bench-kink.c tools/bench-photo.c tools/benchutil.c
 BENCH_HDR := tools/benchutil.h tests/pairref.h tests/testutil.h $(wildcard include/linewise/*.h)
 TOOL_FLAGS = $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -Itools -Itests
 
@@ -171,7 +171,7 @@ $(BUILD)/bench: $(BENCH_SRC) $(BENCH_HDR) $(BUILD)/liblinewise.a
 
 # Benchmarks rewrite docs/PERFORMANCE.md and docs/ACCURACY.md (machine and date
 # recorded with them) and their plots docs/*.png; BENCH_QUICK=1 for a smoke run.
-bench: $(BUILD)/bench $(MPI_BIN)
+bench: $(BUILD)/bench bin/linewise $(BUILD)/make-picture $(MPI_BIN)
 	mkdir -p $(BUILD)/bench-data
 	LW_MPI_BIN=$(MPI_BIN) $(BUILD)/bench docs $(BUILD)/bench-data
 	gnuplot -e "data='$(BUILD)/bench-data'; out='docs'" tools/bench.gp

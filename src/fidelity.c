@@ -126,6 +126,48 @@ static void blur_line(double *v, size_t n, size_t step, const double *g, int r, 
   }
 }
 
+/* The same sums for the wide blur of the scores, with the kernel folded
+** where it lies wholly inside the line: g[0] v[i] + sum over d = 1 .. r of
+** g[d] (v[i - d] + v[i + d]), d upward, eight positions a step (each its
+** own sum, in that order, whatever the step holds), so the compiler can
+** take the positions in vectors.  Half the products of blur_line, and the
+** same value at every position on any machine. */
+static void blur_line_folded(double *v, size_t n, size_t step, const double *g, int r, const double *norm,
+                             double *row)
+{
+  const size_t R = (size_t)r;
+  if (n < 2 * R + 1) {
+    blur_line(v, n, step, g, r, norm, row);
+    return;
+  }
+  for (size_t i = 0; i < n; i++) row[i] = v[i * step];
+  size_t i = 0;
+  for (; i < R; i++) { /* the window cut by the start */
+    double sum = 0.0;
+    for (size_t k = 0; k < i; k++) sum += g[i - k] * row[k];
+    for (size_t k = i; k <= i + R; k++) sum += g[k - i] * row[k];
+    v[i * step] = sum / norm[i];
+  }
+  for (; i + R + 8 <= n; i += 8) {
+    double acc[8];
+    for (int j = 0; j < 8; j++) acc[j] = g[0] * row[i + j];
+    for (size_t dd = 1; dd <= R; dd++)
+      for (int j = 0; j < 8; j++) acc[j] += g[dd] * (row[i + j - dd] + row[i + j + dd]);
+    for (int j = 0; j < 8; j++) v[(i + j) * step] = acc[j] / norm[i + j];
+  }
+  for (; i + R < n; i++) {
+    double sum = g[0] * row[i];
+    for (size_t dd = 1; dd <= R; dd++) sum += g[dd] * (row[i - dd] + row[i + dd]);
+    v[i * step] = sum / norm[i];
+  }
+  for (; i < n; i++) { /* the window cut by the end */
+    double sum = 0.0;
+    for (size_t k = i - R; k < i; k++) sum += g[i - k] * row[k];
+    for (size_t k = i; k < n; k++) sum += g[k - i] * row[k];
+    v[i * step] = sum / norm[i];
+  }
+}
+
 /* `count` such lines `line` apart.  A picture's lines are independent and
 ** each is summed as one thread alone would, so the threads share them out
 ** and the result does not depend on how many there are (the scores of a
@@ -138,7 +180,7 @@ static lw_status blur_axis(double *v, size_t n, size_t step, size_t count, size_
   if (!rows) return LW_ENOMEM;
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (long c = 0; c < (long)count; c++)
-    blur_line(v + (size_t)c * line, n, step, g, r, norm, rows + (size_t)omp_get_thread_num() * n);
+    blur_line_folded(v + (size_t)c * line, n, step, g, r, norm, rows + (size_t)omp_get_thread_num() * n);
   free(rows);
   return LW_OK;
 }
@@ -335,9 +377,13 @@ static const double *window_row(window_rows *r, int j)
     for (int k = lo; k <= hi; k++) {
       const double *in = r->rows + ((size_t)(k % r->ring) * P + q) * W;
       double g = r->gy[k > j ? k - j : j - k];
+      /* columns in vectors: each column's sum keeps its order */
+#pragma omp simd
       for (size_t c = 0; c < W; c++) o[c] += g * in[c];
     }
-    for (size_t c = 0; c < W; c++) o[c] /= r->normy[j];
+    const double nj = r->normy[j];
+#pragma omp simd
+    for (size_t c = 0; c < W; c++) o[c] /= nj;
   }
   return r->out;
 }

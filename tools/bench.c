@@ -55,6 +55,7 @@ void bench_tone(bench_ctx *b);
 void bench_tone_accuracy(bench_ctx *b);
 void bench_quench(bench_ctx *b);
 void bench_splice(bench_ctx *b);
+void bench_photo(bench_ctx *b);
 
 /* ---- throughput and scaling ---------------------------------------------- */
 
@@ -710,6 +711,7 @@ static const bench_section sections[] = {
     {"tone", BENCH_PERFORMANCE, bench_tone},
     {"nurbs", BENCH_PERFORMANCE, bench_nurbs},
     {"splice", BENCH_PERFORMANCE, bench_splice},
+    {"photo", BENCH_PERFORMANCE, bench_photo},
     {"regularity", BENCH_ACCURACY, bench_regularity},
     {"quadrature", BENCH_ACCURACY, bench_quadrature},
     {"cutoff", BENCH_ACCURACY, bench_cutoff},
