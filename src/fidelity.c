@@ -111,19 +111,46 @@ done:
   return s;
 }
 
-/* One line of the blur: n values spaced `step` apart starting at v[0].
-** g[0..r] the kernel's half, norm[i] the sum of the weights that land
-** inside for position i; row: scratch of n values. */
-static void blur_line(double *v, size_t n, size_t step, const double *g, int r, const double *norm, double *row)
+/* Positions [from, to) of one line of the blur, from the copy in row. */
+static void blur_positions(double *v, size_t n, size_t step, const double *g, int r, const double *norm,
+                           const double *row, size_t from, size_t to)
 {
-  for (size_t i = 0; i < n; i++) row[i] = v[i * step];
-  for (size_t i = 0; i < n; i++) {
+  for (size_t i = from; i < to; i++) {
     size_t lo = i >= (size_t)r ? i - (size_t)r : 0, hi = i + (size_t)r < n ? i + (size_t)r : n - 1;
     double sum = 0.0;
     for (size_t k = lo; k < i; k++) sum += g[i - k] * row[k]; /* from the lowest index up, in two runs */
     for (size_t k = i; k <= hi; k++) sum += g[k - i] * row[k];
     v[i * step] = sum / norm[i];
   }
+}
+
+/* One line of the blur: n values spaced `step` apart starting at v[0].
+** g[0..r] the kernel's half, norm[i] the sum of the weights that land
+** inside for position i; row: scratch of n values. */
+static void blur_line(double *v, size_t n, size_t step, const double *g, int r, const double *norm, double *row)
+{
+  for (size_t i = 0; i < n; i++) row[i] = v[i * step];
+  const size_t R = (size_t)r;
+  if (r <= LW_FIDELITY_SSIM_RADIUS && n >= 2 * R + 1) {
+    /* the window's lines: where the kernel lies inside, eight positions a
+    ** step, each its own sum from the lowest index up as below */
+    double gf[2 * LW_FIDELITY_SSIM_RADIUS + 1];
+    for (size_t t = 0; t <= 2 * R; t++) gf[t] = g[t > R ? t - R : R - t];
+    size_t i = R;
+    for (; i + R + 8 <= n; i += 8) {
+      double acc[8] = {0};
+      for (size_t t = 0; t <= 2 * R; t++) {
+        const double w = gf[t], *e = row + i - R + t;
+#pragma omp simd
+        for (int j = 0; j < 8; j++) acc[j] += w * e[j];
+      }
+      for (int j = 0; j < 8; j++) v[(i + j) * step] = acc[j] / norm[i + j];
+    }
+    blur_positions(v, n, step, g, r, norm, row, 0, R);
+    blur_positions(v, n, step, g, r, norm, row, i, n);
+    return;
+  }
+  blur_positions(v, n, step, g, r, norm, row, 0, n);
 }
 
 /* The same sums for the wide blur of the scores, with the kernel folded
@@ -141,13 +168,8 @@ static void blur_line_folded(double *v, size_t n, size_t step, const double *g, 
     return;
   }
   for (size_t i = 0; i < n; i++) row[i] = v[i * step];
-  size_t i = 0;
-  for (; i < R; i++) { /* the window cut by the start */
-    double sum = 0.0;
-    for (size_t k = 0; k < i; k++) sum += g[i - k] * row[k];
-    for (size_t k = i; k <= i + R; k++) sum += g[k - i] * row[k];
-    v[i * step] = sum / norm[i];
-  }
+  blur_positions(v, n, step, g, r, norm, row, 0, R); /* the window cut by the start */
+  size_t i = R;
   for (; i + R + 8 <= n; i += 8) {
     double acc[8];
     for (int j = 0; j < 8; j++) acc[j] = g[0] * row[i + j];
@@ -160,12 +182,7 @@ static void blur_line_folded(double *v, size_t n, size_t step, const double *g, 
     for (size_t dd = 1; dd <= R; dd++) sum += g[dd] * (row[i - dd] + row[i + dd]);
     v[i * step] = sum / norm[i];
   }
-  for (; i < n; i++) { /* the window cut by the end */
-    double sum = 0.0;
-    for (size_t k = i - R; k < i; k++) sum += g[i - k] * row[k];
-    for (size_t k = i; k < n; k++) sum += g[k - i] * row[k];
-    v[i * step] = sum / norm[i];
-  }
+  blur_positions(v, n, step, g, r, norm, row, i, n); /* the window cut by the end */
 }
 
 /* `count` such lines `line` apart.  A picture's lines are independent and
