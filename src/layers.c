@@ -247,6 +247,8 @@ void lw_layers_separate(const float *r, const float *g, const float *b, size_t n
   for (int i = 0; i < k; i++)
     for (int j = 0; j < k; j++)
       nm.M[i][j] = u[i][0] * u[j][0] + u[i][1] * u[j][1] + u[i][2] * u[j][2] + (i == j ? LW_LAYERS_RIDGE : 0.0);
+  /* pixels are independent: threads share them out, the same values */
+#pragma omp parallel for schedule(static)
   for (size_t p = 0; p < n; p++) {
     double d[3] = {1.0 - r[p], 1.0 - g[p], 1.0 - b[p]}, rhs[LW_LAYERS_MAX], x[LW_LAYERS_MAX];
     for (int j = 0; j < k; j++) rhs[j] = u[j][0] * d[0] + u[j][1] * d[1] + u[j][2] * d[2] - LW_LAYERS_INK;
