@@ -7,10 +7,32 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifdef _OPENMP
 #include <omp.h>
+#endif
 
 #include "linewise/image.h"
 #include "linewise/output.h"
+
+/* The threads the blurs and the window share a picture among (1 in a build
+** without OpenMP, as the fuzzing harnesses are). */
+static int threads_max(void)
+{
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+
+static int thread_id(void)
+{
+#ifdef _OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
 
 static int positive(double x) { return isfinite(x) && x > 0; }
 
@@ -192,12 +214,12 @@ static void blur_line_folded(double *v, size_t n, size_t step, const double *g, 
 static lw_status blur_axis(double *v, size_t n, size_t step, size_t count, size_t line, const double *g, int r,
                            const double *norm)
 {
-  const int threads = omp_get_max_threads();
+  const int threads = threads_max();
   double *rows = malloc((size_t)threads * n * sizeof *rows);
   if (!rows) return LW_ENOMEM;
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (long c = 0; c < (long)count; c++)
-    blur_line_folded(v + (size_t)c * line, n, step, g, r, norm, rows + (size_t)omp_get_thread_num() * n);
+    blur_line_folded(v + (size_t)c * line, n, step, g, r, norm, rows + (size_t)thread_id() * n);
   free(rows);
   return LW_OK;
 }
@@ -411,7 +433,7 @@ static lw_status window_sum(int planes, int w, int h, window_fill fill, const vo
 {
   double *part = calloc((size_t)h * (size_t)n, sizeof *part);
   if (!part) return lw_error_set(err, LW_ENOMEM, "fidelity: out of memory for %d x %d pixels", w, h);
-  const int bands = omp_get_max_threads() < h ? omp_get_max_threads() : h;
+  const int bands = threads_max() < h ? threads_max() : h;
   int failed = 0;
 #pragma omp parallel for schedule(static, 1) num_threads(bands) reduction(| : failed)
   for (int b = 0; b < bands; b++) {
