@@ -74,5 +74,8 @@ void bench_photo(bench_ctx *b)
     fprintf(d, "\n");
   }
   fprintf(d, "\nThe blurs and the scores' windows run on every core, and the scores are the same bits\n"
-             "on any number of threads (docs/IMAGES.md, \"How a drawing is scored\").\n\n");
+             "on any number of threads (docs/IMAGES.md, \"How a drawing is scored\"). Before (2026-12-03,\n"
+             "the build of that morning, 3 runs alternated with the new one): 16.7 s for the 12-megapixel\n"
+             "picture in four pens and 4.5 s in one, against 8.3 and 2.8 s, when the scores ran on one\n"
+             "core, their direct blur unfolded and the picture's blurs a pixel at a time.\n\n");
 }
