@@ -171,9 +171,10 @@ $(BUILD)/bench: $(BENCH_SRC) $(BENCH_HDR) $(BUILD)/liblinewise.a
 
 # Benchmarks rewrite docs/PERFORMANCE.md and docs/ACCURACY.md (machine and date
 # recorded with them) and their plots docs/*.png; BENCH_QUICK=1 for a smoke run.
-bench: $(BUILD)/bench bin/linewise $(BUILD)/make-picture $(MPI_BIN)
+bench: $(BUILD)/bench $(BIN)/linewise $(BUILD)/make-picture $(MPI_BIN)
 	mkdir -p $(BUILD)/bench-data
-	LW_MPI_BIN=$(MPI_BIN) $(BUILD)/bench docs $(BUILD)/bench-data
+	LW_MPI_BIN=$(MPI_BIN) LW_BIN=$(BIN)/linewise LW_MAKE_PICTURE=$(BUILD)/make-picture \
+	  $(BUILD)/bench docs $(BUILD)/bench-data
 	gnuplot -e "data='$(BUILD)/bench-data'; out='docs'" tools/bench.gp
 
 # The elastic wire of the D-NURBS review: its Figures 8 and 9 as
