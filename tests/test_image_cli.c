@@ -527,7 +527,9 @@ Test(image_cli, the_photo_preset_draws_each_tone_as_the_ink_asked_for)
 ** The preset makes line cost that much where the picture is white.  The
 ** runs: the preset; the preset with that reward for line, which the price
 ** in white must still hold off; and the same without the price, the control
-** (the same seed and sweeps), which must show stray ink. */
+** (the same seed and sweeps), which must show stray ink: 0.006 to 0.05 over
+** seeds 7 to 12 (2026-12-03), against 0 to 0.0002 with the price, so twice
+** the preset's bound tells them apart at any of those seeds. */
 Test(image_cli, the_photo_preset_leaves_white_paper_white)
 {
   enum { W = 240, H = 320 };
@@ -560,5 +562,5 @@ Test(image_cli, the_photo_preset_leaves_white_paper_white)
   cr_log_info("stray ink %g, with line paid for %g, and without the potential %g", stray[0], stray[1], stray[2]);
   cr_assert(stray[0] < 0.002, "stray ink %g", stray[0]);
   cr_assert(stray[1] < 0.002, "stray ink %g with line paid for", stray[1]);
-  cr_assert(stray[2] > 0.02, "the control: stray ink %g with line paid for and no potential", stray[2]);
+  cr_assert(stray[2] > 0.004, "the control: stray ink %g with line paid for and no potential", stray[2]);
 }
