@@ -677,18 +677,10 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
   ** chain, stream and system, so the thread count cannot change the result. */
   /* Threads go to the rungs first; a rung split into domains runs its
   ** share of the rest there (domains.h). */
-  if (m == 1) {
-    /* outside any parallel region, so that a domain sweep's teams are the
-    ** program's first level, whose threads stay; within a region of one
-    ** thread every team of theirs would start new threads */
-    a->chains[here[0]]->tuning = tuning;
-    failed = lw_chain_sweep(a->chains[here[0]]) != LW_OK;
-  } else {
-#pragma omp parallel for schedule(static, 1) reduction(| : failed) num_threads(m < omp_get_max_threads() ? m : omp_get_max_threads())
-    for (int i = 0; i < m; i++) {
-      a->chains[here[i]]->tuning = tuning;
-      if (lw_chain_sweep(a->chains[here[i]]) != LW_OK) failed = 1;
-    }
+#pragma omp parallel for schedule(static, 1) reduction(| : failed) num_threads(m < omp_get_max_threads() ? m : omp_get_max_threads()) if (m > 1)
+  for (int i = 0; i < m; i++) {
+    a->chains[here[i]]->tuning = tuning;
+    if (lw_chain_sweep(a->chains[here[i]]) != LW_OK) failed = 1;
   }
   lw_status s;
   if (a->net && (s = a->net->share(a->net, a, failed, err))) return s;

@@ -27,11 +27,6 @@ void lw_domains_free(lw_domains *d)
   free(d->active);
   free(d->seed);
   free(d->cell_cpu);
-  for (int k = 0; d->block && k < d->batch; k++) {
-    if (d->block[k].prop) d->block_free(d->block[k].prop);
-    if (d->block[k].rng) gsl_rng_free(d->block[k].rng);
-  }
-  free(d->block);
   free(d);
 }
 
@@ -147,17 +142,6 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
   d->min_parallel = LW_DOMAINS_MIN_PARALLEL;
   for (int k = 0; k < d->n; k++)
     if (!(d->cell[k] = cell_chain(c, err))) goto nomem;
-  /* the block's places: a few a thread where proposals may be evaluated
-  ** at once, else one; where every kind runs in the domains, none */
-  if (t->n_domain_moves > 0 && t->n_domain_moves < c->n_moves) {
-    d->batch = t->concurrent && t->concurrent(c->sys->state) ? LW_DOMAINS_BATCH * d->threads : 1;
-    d->block_free = t->proposal_free;
-    if (!(d->block = calloc((size_t)d->batch, sizeof *d->block))) goto nomem;
-    for (int k = 0; k < d->batch; k++)
-      if (!(d->block[k].prop = t->proposal_new(c->sys->state, err)) ||
-          !(d->block[k].rng = gsl_rng_alloc(gsl_rng_taus2)))
-        goto nomem;
-  }
   c->domains = d;
   return LW_OK;
 nomem:

@@ -78,12 +78,12 @@ static void tune(lw_chain *c, int kind, int accepted)
   tune_window(c, kind);
 }
 
-/* The Metropolis decision on proposal prop, evaluated, its commit and the
-** counts; its uniforms from rng. */
-static int decide(lw_chain *c, int kind, void *prop, gsl_rng *rng, double dE, int forbidden)
+/* The Metropolis decision on an evaluated proposal, its commit and the
+** counts. */
+static int decide(lw_chain *c, int kind, double dE, int forbidden)
 {
   int accept;
-  const double lr = c->sys->type->log_ratio ? c->sys->type->log_ratio(prop) : 0.0;
+  const double lr = c->sys->type->log_ratio ? c->sys->type->log_ratio(c->prop) : 0.0;
   lw_move_stats *s = &c->stats[kind];
   s->proposed++;
   if (isnan(dE)) {
@@ -104,7 +104,7 @@ static int decide(lw_chain *c, int kind, void *prop, gsl_rng *rng, double dE, in
     if (isnan(lr) || lr == -INFINITY || dE == INFINITY) accept = 0;
     else if (c->temperature > 0.0) {
       double x = lr - dE / c->temperature;
-      accept = x >= 0.0 || (x > -745.0 && gsl_rng_uniform(rng) < exp(x));
+      accept = x >= 0.0 || (x > -745.0 && gsl_rng_uniform(c->rng) < exp(x));
     } else {
       accept = dE < 0.0 || (dE == 0.0 && lr > 0.0);
     }
@@ -113,7 +113,7 @@ static int decide(lw_chain *c, int kind, void *prop, gsl_rng *rng, double dE, in
   } else if (c->temperature > 0.0 && dE < INFINITY) {
     double x = -dE / c->temperature;
     /* exp underflows to 0 below about -745: no need to draw then */
-    accept = x > -745.0 && gsl_rng_uniform(rng) < exp(x);
+    accept = x > -745.0 && gsl_rng_uniform(c->rng) < exp(x);
   } else {
     accept = 0;
   }
@@ -121,7 +121,7 @@ static int decide(lw_chain *c, int kind, void *prop, gsl_rng *rng, double dE, in
   if (accept && t->finish) {
     /* the second stage of delayed acceptance (system.h): the part of dE
     ** the first one saw only a stand-in for */
-    const double d2 = t->finish(c->sys->state, prop);
+    const double d2 = t->finish(c->sys->state, c->prop);
     if (isnan(d2)) {
       s->nan++;
       accept = 0;
@@ -130,11 +130,11 @@ static int decide(lw_chain *c, int kind, void *prop, gsl_rng *rng, double dE, in
       accept = 0;
     } else if (d2 > 0.0) {
       const double x = -d2 / c->temperature; /* defer is off at T = 0 */
-      accept = x > -745.0 && gsl_rng_uniform(rng) < exp(x);
+      accept = x > -745.0 && gsl_rng_uniform(c->rng) < exp(x);
     }
   }
   if (accept) {
-    if ((c->part ? t->commit_part : t->commit)(c->sys->state, prop) != LW_OK) accept = -1;
+    if ((c->part ? t->commit_part : t->commit)(c->sys->state, c->prop) != LW_OK) accept = -1;
     else s->accepted++;
   }
   if (c->tuning && accept >= 0) tune(c, kind, accept);
@@ -143,9 +143,9 @@ static int decide(lw_chain *c, int kind, void *prop, gsl_rng *rng, double dE, in
 
 /* Delayed acceptance (system.h) where there is a temperature: at T = 0 the
 ** chain decides on the sign of the whole dE. */
-static void stage(lw_chain *c, void *prop)
+static void stage(lw_chain *c)
 {
-  if (c->sys->type->defer) c->sys->type->defer(prop, c->delayed && c->temperature > 0.0);
+  if (c->sys->type->defer) c->sys->type->defer(c->prop, c->delayed && c->temperature > 0.0);
 }
 
 int lw_chain_step(lw_chain *c, int kind)
@@ -154,9 +154,9 @@ int lw_chain_step(lw_chain *c, int kind)
   void *state = c->sys->state;
   if (t->sweep_size(state) == 0) return 0;
   int forbidden = 0;
-  stage(c, c->prop);
+  stage(c);
   double dE = t->propose(state, c->prop, kind, c->step[kind], c->rng, &forbidden);
-  return decide(c, kind, c->prop, c->rng, dE, forbidden);
+  return decide(c, kind, dE, forbidden);
 }
 
 int lw_chain_step_at(lw_chain *c, int kind, size_t site)
@@ -164,9 +164,9 @@ int lw_chain_step_at(lw_chain *c, int kind, size_t site)
   const lw_system_type *t = c->sys->type;
   if (!t->propose_at) return lw_chain_step(c, kind);
   int forbidden = 0;
-  stage(c, c->prop);
+  stage(c);
   double dE = t->propose_at(c->sys->state, c->prop, kind, site, c->step[kind], c->rng, &forbidden);
-  return decide(c, kind, c->prop, c->rng, dE, forbidden);
+  return decide(c, kind, dE, forbidden);
 }
 
 /* The kind whose slice of the cumulative mix holds u in [0, 1). */
@@ -182,9 +182,9 @@ static int draw_kind(lw_chain *c) { return kind_at(c, gsl_rng_uniform(c->rng)); 
 int lw_chain_visit_in(lw_chain *c, size_t site, const double box[4])
 {
   int kind = draw_kind(c), forbidden = 0;
-  stage(c, c->prop);
+  stage(c);
   double dE = c->sys->type->propose_in(c->sys->state, c->prop, kind, site, c->step[kind], c->rng, &forbidden, box);
-  return decide(c, kind, c->prop, c->rng, dE, forbidden);
+  return decide(c, kind, dE, forbidden);
 }
 
 void lw_chain_absorb(lw_chain *c, lw_chain *from)
@@ -213,76 +213,22 @@ void lw_chain_tune(lw_chain *c)
 
 /*
 ** The kinds a domain cannot run (system.h, n_domain_moves), after a domain
-** sweep's phases: their share of the mix of sweep_size proposals, a count
-** that the state does not change (the sweep stays a fixed product of kernels
-** that each fix the target; a count that followed the state would observe
-** the chain at times that depend on it, docs/NUMERICS.md,
-** "Trans-dimensional moves with domains").
-**
-** They are the serial chain's proposals one after the other, but each draws
-** everything (its kind, its spline and nodes, its Metropolis uniforms) from
-** a stream of its own, seeded by one number of the chain's stream in order.
-** So a proposal is a function of its seed and of the state it meets, and
-** may be evaluated before the ones ahead of it are decided: a batch of up
-** to d->batch is evaluated at once where the row allows (concurrent), then
-** decided in order; at the first one accepted the rest of the batch is
-** dropped, to be evaluated again, from the same seeds, on the state the
-** commit left, as the serial chain would.  Most proposals of the block are
-** refused (births in a drawing almost all), so little is dropped, and the
-** result is the same for any batch, any thread count.
+** sweep's phases: serially, from the chain's stream, their share of the mix
+** of sweep_size proposals, a count that the state does not change (the
+** sweep stays a fixed product of kernels that each fix the target; a count
+** that followed the state would observe the chain at times that depend on
+** it, docs/NUMERICS.md, "Trans-dimensional moves with domains").
 */
 static lw_status global_moves(lw_chain *c)
 {
   const lw_system_type *t = c->sys->type;
   const int first = t->n_domain_moves;
-  void *state = c->sys->state;
-  lw_domains *d = c->domains;
-  if (first <= 0 || first >= c->n_moves || t->sweep_size(state) == 0) return LW_OK;
+  if (first <= 0 || first >= c->n_moves) return LW_OK;
   const double lo = c->cum_weight[first - 1];
-  const size_t n = (size_t)llround((1.0 - lo) * (double)t->sweep_size(state));
-  lw_block_slot *b = d->block;
-  size_t done = 0; /* proposals decided */
-  int k = 0, seeded = 0, failed = 0; /* the batch, and its places that hold their proposal's seed */
-  /* one team for the whole block, which the batches pass between them by
-  ** barriers: a team a batch costs a team's start each time (inside the
-  ** rungs' loop, new threads) */
-#pragma omp parallel num_threads(d->threads) if (d->batch > 1 && d->threads > 1)
-  while (done < n && !failed) {
-#pragma omp single
-    {
-      k = n - done < (size_t)d->batch ? (int)(n - done) : d->batch;
-      for (; seeded < k; seeded++) b[seeded].seed = gsl_rng_get(c->rng);
-    }
-/* a birth evaluates a whole spline, a death little: taken as threads come free */
-#pragma omp for schedule(dynamic, 1)
-    for (int j = 0; j < k; j++) {
-      lw_block_slot *s = &b[j];
-      gsl_rng_set(s->rng, s->seed);
-      s->kind = kind_at(c, lo + (1.0 - lo) * gsl_rng_uniform(s->rng));
-      s->step = c->step[s->kind];
-      stage(c, s->prop);
-      s->dE = t->propose(state, s->prop, s->kind, s->step, s->rng, &s->forbidden);
-    }
-#pragma omp single
-    {
-      int used = 0;
-      while (used < k) {
-        lw_block_slot *s = &b[used];
-        /* a step the decisions before it tuned: evaluated again (the
-        ** block's kinds have none today) */
-        if (s->step != c->step[s->kind]) break;
-        const int a = decide(c, s->kind, s->prop, s->rng, s->dE, s->forbidden);
-        if (a < 0) failed = 1;
-        used++;
-        if (a) break;
-      }
-      /* the seeds of the dropped proposals move to the front */
-      for (int j = used; j < seeded; j++) b[j - used].seed = b[j].seed;
-      seeded -= used;
-      done += (size_t)used;
-    }
-  }
-  return failed ? LW_ENOMEM : LW_OK;
+  const size_t n = (size_t)llround((1.0 - lo) * (double)t->sweep_size(c->sys->state));
+  for (size_t k = 0; k < n; k++)
+    if (lw_chain_step(c, kind_at(c, lo + (1.0 - lo) * gsl_rng_uniform(c->rng))) < 0) return LW_ENOMEM;
+  return LW_OK;
 }
 
 lw_status lw_chain_sweep(lw_chain *c)

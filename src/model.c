@@ -789,9 +789,6 @@ static void list_swap(lw_near_list *a, lw_near_list *b)
 static double old_near(const lw_model *m, const pair_view *v, size_t g, const lw_node *a, const lw_pair_sample *ps,
                        const lw_near_list *segs)
 {
-  /* without the near field there is nothing to cache, and a proposal that
-  ** writes nothing may be evaluated beside others (system.h, concurrent) */
-  if (!segs->n && !(m->scene->pair.near_scale > 0.0)) return 0.0;
   if (!m->near_valid[g]) {
     double bez[8], sum = 0.0;
     lw_segment_bezier(a, a + 1, bez);

@@ -1282,14 +1282,6 @@ const lw_system_type lw_system_splines = {
     .propose_at = propose_at,
 };
 
-/* A birth, death, grow or shrink reads the model only (lw_model_propose_splice),
-** but for the near field's cache of an old segment, which it fills (the
-** tdj row's split and join build the ends table too: not concurrent). */
-static int concurrent(const void *state)
-{
-  return !(((const spl_state *)state)->m->scene->pair.near_scale > 0.0);
-}
-
 /* Births, deaths, grows and shrinks draw their own spline anywhere on the
 ** page and change the storage: with domains they run after the phases
 ** (mc.h), and the domains visit the nodes, not sweep_size's fixed count.
@@ -1305,7 +1297,6 @@ const lw_system_type lw_system_splines_td = {
     SPLINES_ROW
     .n_domain_moves = LW_MOVE_KINDS,
     .sites = sites,
-    .concurrent = concurrent,
 };
 
 const lw_system_type lw_system_splines_tdj = {

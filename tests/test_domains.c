@@ -144,59 +144,6 @@ Test(domains, split_and_join_same_on_1_and_3_threads_and_resume, .timeout = 300)
   td_same_on_threads_and_resume(sj_extra);
 }
 
-/* The block after the phases (mc.c) evaluates a batch of proposals at once
-** where no proposal writes to the state (the near field off): the same chain
-** as one proposal at a time.  Fails when a batch keeps what follows an
-** accepted proposal (evaluated on the state before its commit) or draws its
-** seeds again; with the near field on, the row asks for one at a time. */
-static void run_block(const lw_params *p, const char *dir, int batch, lw_anneal *a)
-{
-  lw_error err;
-  char path[128];
-  snprintf(path, sizeof path, "%s/run%d", dir, batch);
-  cr_assert_eq(lw_anneal_start(a, p, path, &err), LW_OK, "%s", err.msg);
-  cr_assert_not_null(a->chain->domains, "domains = 3 did not split");
-  cr_assert_gt(a->chain->domains->batch, 1, "no batch without the near field");
-  if (batch) a->chain->domains->batch = batch; /* fewer places than it holds */
-  while (!lw_anneal_done(a)) cr_assert_eq(lw_anneal_sweep(a, &err), LW_OK, "%s", err.msg);
-}
-
-Test(domains, the_block_gives_the_same_chain_in_batches_as_one_at_a_time, .timeout = 300)
-{
-  char dir[64], extra[512];
-  cr_assert_eq(lw_test_dir_make(dir, "domains_batch"), 0);
-  snprintf(extra, sizeof extra, "%s[energy]\npair_near = 0\n", td_extra);
-  write_scene(dir, extra);
-  lw_params p;
-  lw_error err;
-  char path[128];
-  snprintf(path, sizeof path, "%s/s.ini", dir);
-  cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
-  p.sweeps = 12;
-  lw_anneal one, many;
-  run_block(&p, dir, 1, &one);
-  run_block(&p, dir, 0, &many);
-  const lw_model *m1 = lw_splines_model(one.sys), *m2 = lw_splines_model(many.sys);
-  /* births and deaths were accepted, so batches were cut */
-  cr_assert_gt(one.chain->stats[LW_MOVE_BIRTH].accepted + one.chain->stats[LW_MOVE_DEATH].accepted, 20);
-  for (int k = 0; k < LW_MOVE_KINDS_TD; k++)
-    cr_assert_eq(one.chain->stats[k].accepted, many.chain->stats[k].accepted, "%s accepted %lu against %lu",
-                 one.chain->sys->type->move_names[k], one.chain->stats[k].accepted, many.chain->stats[k].accepted);
-  cr_assert_eq(m1->sp->n_nodes, m2->sp->n_nodes);
-  cr_assert(!memcmp(m1->sp->node, m2->sp->node, m1->sp->n_nodes * sizeof *m1->sp->node), "the nodes differ");
-  cr_assert(lw_model_total(m1) == lw_model_total(m2), "energies %.17g and %.17g", lw_model_total(m1),
-            lw_model_total(m2));
-  lw_anneal_free(&one);
-  lw_anneal_free(&many);
-  /* the near field's caches are filled by proposals: one at a time */
-  p.pair_near = 1.5;
-  snprintf(path, sizeof path, "%s/near", dir);
-  cr_assert_eq(lw_anneal_start(&one, &p, path, &err), LW_OK, "%s", err.msg);
-  cr_assert_eq(one.chain->domains->batch, 1);
-  lw_anneal_free(&one);
-  lw_test_dir_remove(dir);
-}
-
 /* Regression for the split commits: the running totals are merged from the
 ** domains' own sums, and must still equal the energy from scratch; with
 ** trans-dimensional moves (td = 1) also after the splices between the

@@ -28,10 +28,8 @@
 **
 ** The cells run only the kinds of the row's n_domain_moves (system.h), in
 ** the proportions of their weights; kinds that draw their own object
-** anywhere (births and deaths) run after the phases as the serial chain
-** would run them, a batch of up to `batch` (the threads) evaluated at once
-** where the row allows it (system.h, concurrent; mc.c; docs/NUMERICS.md,
-** "Trans-dimensional moves with domains").
+** anywhere (births and deaths) run after the phases, serially (mc.h;
+** docs/NUMERICS.md, "Trans-dimensional moves with domains").
 */
 #ifndef LINEWISE_DOMAINS_H
 #define LINEWISE_DOMAINS_H
@@ -44,20 +42,6 @@
 
 /* Below this many sites a phase is not worth waking threads for. */
 #define LW_DOMAINS_MIN_PARALLEL 256
-
-/* Proposals of the block (mc.c) a thread evaluates at once: a team passes
-** two barriers a batch, and drops what follows an accepted proposal. */
-#define LW_DOMAINS_BATCH 4
-
-/* One place in a batch of the block of kinds the domains cannot run
-** (mc.c): a proposal's own scratch and stream, and what it gave. */
-typedef struct {
-  void *prop;
-  gsl_rng *rng;        /* gsl_rng_taus2: seeded per proposal, cheaply */
-  unsigned long seed;  /* from the chain's stream, one a proposal, in order */
-  int kind, forbidden;
-  double step, dE;     /* the step it was proposed with, and its dE */
-} lw_block_slot;
 
 typedef struct lw_domains {
   int nx, ny;           /* domains per side; the shifted lattice has (nx + 1) x (ny + 1) cells */
@@ -74,9 +58,6 @@ typedef struct lw_domains {
   int *active;          /* scratch: the cells of a phase */
   unsigned long *seed;  /* scratch: each cell's seed this sweep */
   size_t min_parallel;  /* a phase of fewer sites runs on one thread (no effect on results) */
-  lw_block_slot *block; /* batch places for the block (mc.c) */
-  int batch;
-  void (*block_free)(void *prop); /* the row's proposal_free */
   /* Profile for the benchmark (tools/bench-domains.c), off while cell_cpu
   ** is NULL: each cell's thread CPU seconds in the last sweep (0 if it had
   ** no sites), and the last sweep's own seconds outside the cells. */

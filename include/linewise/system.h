@@ -147,12 +147,6 @@ struct lw_system_type {
   ** a fixed count of proposals rather than its sites. */
   int n_domain_moves;
   size_t (*sites)(const void *state);
-  /* Optional (NULL: never): 1 when proposals of the kinds past
-  ** n_domain_moves only read the state, so that several may be evaluated at
-  ** once on it, each with its own prop and stream (mc.c, the block after a
-  ** domain sweep's phases).  For splines: unless the near field's caches,
-  ** which a proposal fills, or the ends table of split and join are on. */
-  int (*concurrent)(const void *state);
   /* Optional (NULL: every proposal is symmetric): the log of the last
   ** proposal's Hastings factor, log [q(x' -> x) / q(x -> x')] with the
   ** reference measures' change folded in; the chain then accepts with
