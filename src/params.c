@@ -268,6 +268,13 @@ const lw_param_def lw_param_table[] = {
       "other than init.segments. With 0 a death removes only splines of init.segments "
       "segments (what a birth makes); above 0 it removes a spline of any count, so a short "
       "piece can leave without growing first (fixed_count = 0; docs/NUMERICS.md)."),
+  NUM("moves", "prior_sd", LW_PT_DOUBLE, prior_sd, "0.25", "", 0, 1, LW_MIN_OPEN,
+      "The spread of the prior that births and grows draw from and every move of a spline "
+      "pays (fixed_count = 0): the standard deviation of a next node's point about 3 v beyond "
+      "the last, in init.segment_length, its vector's a third of it. At 0.25, 97 % of the "
+      "5-segment births of the photo preset break the regularity check (energy.min_speed, "
+      "energy.regularity); 0.1 lowers that to 32 to 44 %, and trades tone for alignment "
+      "(docs/NUMERICS.md, \"The prior's spread\")."),
   NUM("moves", "death", LW_PT_DOUBLE, mix_death, "0.01", "", 0, 1e6, 0,
       "Relative frequency of deaths: a spline chosen uniformly is removed (fixed_count = 0)."),
   NUM("moves", "grow", LW_PT_DOUBLE, mix_grow, "0.02", "", 0, 1e6, 0,

@@ -86,7 +86,7 @@ static void *setup_new(const lw_params *p, lw_error *err)
   if (su->scene.image && !(su->tone = lw_image_tone_grid(su->scene.image, &su->scene.image_place, err)))
     goto fail;
   if (lw_td_init(&su->td, &su->scene, (size_t)p->segments, p->segment_length, su->scene.max_segments,
-                 p->birth_uniform, p->birth_spread)) {
+                 p->birth_uniform, p->birth_spread, p->prior_sd)) {
     lw_error_set(err, LW_ENOMEM, "out of memory for the birth prior's darkness table");
     goto fail;
   }

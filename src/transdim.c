@@ -15,7 +15,7 @@
 #include "linewise/init.h"
 
 lw_status lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double length, size_t max_segments,
-                     double uniform, double spread)
+                     double uniform, double spread, double sd)
 {
   td->scene = sc;
   td->cum = NULL;
@@ -32,8 +32,8 @@ lw_status lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, doubl
     }
   }
   td->length = length;
-  td->sigma_p = length / 4.0;
-  td->sigma_v = length / 12.0;
+  td->sigma_p = sd * length;
+  td->sigma_v = sd * length / 3.0;
   td->birth_segments = birth_segments;
   td->max_segments = max_segments;
   td->spread = max_segments > 1 ? spread : 0.0; /* else no other count */

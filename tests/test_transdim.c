@@ -8,6 +8,7 @@
 */
 #include <criterion/criterion.h>
 #include <gsl/gsl_cdf.h>
+#include <gsl/gsl_math.h>
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_sf_gamma.h>
 #include <math.h>
@@ -422,7 +423,7 @@ Test(transdim, grow_and_shrink_keep_a_rest_length_reversible)
   lw_scene sc;
   lw_test_scene(&sc, &p);
   lw_td td;
-  cr_assert_eq(lw_td_init(&td, &sc, 2, 5.0, 8, 0.1, 0.0), LW_OK);
+  cr_assert_eq(lw_td_init(&td, &sc, 2, 5.0, 8, 0.1, 0.0, 0.25), LW_OK);
   cr_assert_eq(lw_td_rest(&td, 15.0, 3, 4), 20.0);
   cr_assert_eq(lw_td_rest(&td, lw_td_rest(&td, 15.0, 3, 4), 4, 3), 15.0);
   cr_assert_eq(lw_td_rest(&td, lw_td_rest(&td, 10.0, 2, 1), 1, 2), 10.0);
@@ -445,6 +446,49 @@ Test(transdim, grow_and_shrink_keep_a_rest_length_reversible)
   for (size_t n = 1; n <= 8; n++) sum += exp(lw_td_size_log(&td, n));
   cr_assert(fabs(sum - 1.0) < 1e-15 && fabs(exp(lw_td_size_log(&td, 2)) - 0.7) < 1e-15, "the births' law of sizes");
   lw_td_clear(&td);
+  lw_scene_clear(&sc);
+}
+
+/* moves.prior_sd s sets the prior's spread: a next node's point lies about
+** 3 v beyond the last with deviation s l per axis, its vector about (l/3) u
+** with s l / 3, in the draws and in the density.  The draws: |d|^2 / sigma^2
+** is chi-square with 2 degrees of freedom (mean 2, variance 4), so over N
+** draws the mean of |d|^2 / (2 sigma^2) is 1 with standard deviation
+** 1 / sqrt(N), 0.007 here; the bound is 5 of them.  The density at its mean
+** is that of two isotropic Gaussians' peaks. */
+Test(transdim, the_priors_spread_is_moves_prior_sd)
+{
+  lw_params p;
+  ideal_gas(&p, 0.0);
+  lw_scene sc;
+  lw_test_scene(&sc, &p);
+  gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+  const double l = 5.0, sds[2] = {0.25, 0.1};
+  const lw_node end = {40.0, 50.0, 1.2, 0.9};
+  enum { N = 20000 };
+  for (int k = 0; k < 2; k++) {
+    lw_td td;
+    cr_assert_eq(lw_td_init(&td, &sc, 2, l, 8, 0.1, 0.0, sds[k]), LW_OK);
+    const double sp = sds[k] * l, sv = sp / 3.0, mx = end.px + 3.0 * end.vx, my = end.py + 3.0 * end.vy;
+    /* the field is off: a vector's mean is along the last one's, l/3 long */
+    const double r = l / 3.0 / hypot(end.vx, end.vy), ux = r * end.vx, uy = r * end.vy;
+    double dp = 0.0, dv = 0.0;
+    gsl_rng_set(rng, 11);
+    for (int i = 0; i < N; i++) {
+      lw_node nd;
+      lw_td_next_draw(&td, &end, 1, rng, &nd);
+      dp += (gsl_pow_2(nd.px - mx) + gsl_pow_2(nd.py - my)) / (2.0 * sp * sp);
+      dv += (gsl_pow_2(nd.vx - ux) + gsl_pow_2(nd.vy - uy)) / (2.0 * sv * sv);
+    }
+    cr_assert(fabs(dp / N - 1.0) < 5.0 / sqrt(N), "prior_sd %g: points spread %g of s l", sds[k], sqrt(dp / N));
+    cr_assert(fabs(dv / N - 1.0) < 5.0 / sqrt(N), "prior_sd %g: vectors spread %g of s l / 3", sds[k], sqrt(dv / N));
+    const lw_node at_mean = {mx, my, ux, uy};
+    const double peak = -log(2.0 * M_PI * sp * sp) - log(2.0 * M_PI * sv * sv);
+    cr_assert(fabs(lw_td_next_log(&td, &end, 1, &at_mean) - peak) < 1e-12, "prior_sd %g: density %.17g, peak %.17g",
+              sds[k], lw_td_next_log(&td, &end, 1, &at_mean), peak);
+    lw_td_clear(&td);
+  }
+  gsl_rng_free(rng);
   lw_scene_clear(&sc);
 }
 
@@ -1187,7 +1231,7 @@ Test(transdim, split_claims_the_frequency_of_its_join)
   lw_model *m = lw_splines_model(c->sys);
   lw_proposal *pr = c->prop;
   lw_td td;
-  cr_assert_eq(lw_td_init(&td, m->scene, (size_t)p.segments, p.segment_length, 8, 0.1, 0.0), LW_OK);
+  cr_assert_eq(lw_td_init(&td, m->scene, (size_t)p.segments, p.segment_length, 8, 0.1, 0.0, p.prior_sd), LW_OK);
   const long draws = 200000;
   int seen[3] = {0};
   for (int trial = 0; trial < 40 && !(seen[0] && seen[1] && seen[2]); trial++) {

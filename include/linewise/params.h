@@ -134,6 +134,7 @@ typedef struct {
   double mix_birth, mix_death, mix_grow, mix_shrink; /* relative frequencies (fixed_count = 0) */
   double birth_uniform;       /* share of births placed uniformly rather than by darkness */
   double birth_spread;        /* share of births of a segment count other than init.segments */
+  double prior_sd;            /* the prior's next-point deviation, in init.segment_length */
   int max_segments;           /* grow never makes a spline longer than this, segments */
   double mix_split, mix_join; /* relative frequencies of split and join (fixed_count = 0) */
   double join_radius;         /* ends closer than this join, in init.segment_length */

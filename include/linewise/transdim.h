@@ -66,9 +66,10 @@ typedef struct {
 
 /* LW_ENOMEM if the picture's darkness table cannot be had.  spread in
 ** [0, 1): the share of births whose segment count is drawn uniformly from
-** 1 .. max_segments other than birth_segments. */
+** 1 .. max_segments other than birth_segments; sd > 0: sigma_p in units of
+** length (moves.prior_sd), sigma_v a third of it. */
 lw_status lw_td_init(lw_td *td, const lw_scene *sc, size_t birth_segments, double length, size_t max_segments,
-                     double uniform, double spread);
+                     double uniform, double spread, double sd);
 void lw_td_clear(lw_td *td);
 
 /* log q_{n-1} of the n >= 1 nodes nd (-inf when node 0 is off the page). */
