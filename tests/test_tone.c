@@ -50,6 +50,14 @@ static double blotches(double u, double v) { return 0.5 + 0.4 * sin(7 * u + 2 * 
 static double grey(double u, double v) { (void)u; (void)v; return 0.7; }
 static double ramp(double u, double v) { (void)v; return 1.0 - u; } /* white at the left, black at the right */
 
+/* The tone of a grey 30 mm page (blur 0.9 mm), for the footprint tests. */
+static const lw_tone *grey_tone(lw_scene *sc)
+{
+  lw_params p = tone_params(30, 30, grey, 1.0, 0.9);
+  lw_test_scene(sc, &p);
+  return &sc->tone;
+}
+
 
 /* A chain over m at temperature T with the default mix. */
 static lw_chain *chain_of(lw_model *m, double T, unsigned long seed)
@@ -161,10 +169,8 @@ Test(tone, a_sample_deposits_its_ink_area)
 {
   /* The footprint is normalised per axis: inside the raster a sample adds
   ** pen * dl to sum_p A B_p, up to the rounding of each pixel (2^-32). */
-  lw_params p = tone_params(30, 30, grey, 1.0, 0.9);
   lw_scene sc;
-  lw_test_scene(&sc, &p);
-  const lw_tone *t = &sc.tone;
+  const lw_tone *t = grey_tone(&sc);
   int64_t *r = lw_tone_raster_new(t);
   cr_assert_not_null(r);
   rng_seed(3);
@@ -189,10 +195,8 @@ Test(tone, a_sample_deposits_its_ink_area)
 ** whose rows are not a multiple of eight, added and taken away. */
 Test(tone, footprints_are_the_same_integers_at_every_width)
 {
-  lw_params p = tone_params(30, 30, grey, 1.0, 0.9);
   lw_scene sc;
-  lw_test_scene(&sc, &p);
-  const lw_tone *t = &sc.tone;
+  const lw_tone *t = grey_tone(&sc);
   const int bx = 3, by = 5, bw = t->w - 7, bh = t->h - 9;
   int64_t *r[2], *b[2];
   for (int x8 = 0; x8 < 2; x8++) {
@@ -226,10 +230,8 @@ Test(tone, footprints_are_the_same_integers_at_every_width)
 ** fails. */
 Test(tone, a_box_difference_is_the_same_at_every_width)
 {
-  lw_params p = tone_params(30, 30, grey, 1.0, 0.9);
   lw_scene sc;
-  lw_test_scene(&sc, &p);
-  const lw_tone *t = &sc.tone;
+  const lw_tone *t = grey_tone(&sc);
   int64_t *r = lw_tone_raster_new(t);
   cr_assert(r);
   rng_seed(17);
