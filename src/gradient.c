@@ -50,6 +50,34 @@ void lw_segment_grad_nodes(const lw_quad *q, const lw_samples_grad *g, lw_node *
 
 static int selected(unsigned mask, int t) { return (mask >> t) & 1u; }
 
+/* The tone term's part of one segment's gradient (the segment from a, its
+** samples s at the scene's nodes): into sg where the term samples at those
+** nodes, else at its own, taken to the nodes' gradients ga and gb here. */
+static void tone_grad(const lw_term_ctx *c, const int64_t *r, const lw_node *a, const lw_samples *s,
+                      lw_samples_grad *sg, lw_node *ga, lw_node *gb)
+{
+  lw_samples own;
+  lw_samples_grad own_g;
+  const int apart = c->quad->n != s->n;
+  if (apart) {
+    lw_segment_sample(c->quad, a, a + 1, &own);
+    lw_samples_grad_zero(&own_g, own.n);
+    s = &own;
+    sg = &own_g;
+  }
+  for (int q = 0; q < s->n; q++) {
+    double ex, ey, edl;
+    lw_tone_sample_grad(c->data, r, c->coef, s->x[q], s->y[q], s->dl[q], &ex, &ey, &edl);
+    sg->x[q] += ex;
+    sg->y[q] += ey;
+    if (!(s->speed[q] > 0.0)) continue; /* dl = w |r'| has no gradient at 0: a subgradient */
+    double f = edl * c->quad->w[q] / s->speed[q];
+    sg->dx[q] += f * s->dx[q];
+    sg->dy[q] += f * s->dy[q];
+  }
+  if (apart) lw_segment_grad_nodes(c->quad, &own_g, ga, gb);
+}
+
 double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned term_mask, lw_node *grad,
                           double term[LW_TERM_COUNT], lw_error *err)
 {
@@ -125,19 +153,9 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
     }
     if (raster) {
       const lw_tone *tn = c[LW_TERM_TONE].data;
-      const int64_t *rp =
-        raster + (sc->layers.n ? (size_t)lw_splines_layer(&sc->layers, sp, sp->seg_spline[g]) : 0) *
-                   (size_t)tn->w * (size_t)tn->h;
-      for (int q = 0; q < s.n; q++) {
-        double ex, ey, edl;
-        lw_tone_sample_grad(tn, rp, c[LW_TERM_TONE].coef, s.x[q], s.y[q], s.dl[q], &ex, &ey, &edl);
-        sg.x[q] += ex;
-        sg.y[q] += ey;
-        if (!(s.speed[q] > 0.0)) continue; /* dl = w |r'| has no gradient at 0: a subgradient */
-        double f = edl * sc->quad.w[q] / s.speed[q];
-        sg.dx[q] += f * s.dx[q];
-        sg.dy[q] += f * s.dy[q];
-      }
+      const int layer = sc->layers.n ? lw_splines_layer(&sc->layers, sp, sp->seg_spline[g]) : 0;
+      tone_grad(&c[LW_TERM_TONE], raster + (size_t)layer * (size_t)tn->w * (size_t)tn->h, a, &s, &sg, &grad[k],
+                &grad[k + 1]);
     }
     if (strain)
       for (int q = 0; q < s.n; q++) {

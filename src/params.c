@@ -19,6 +19,7 @@
 #include "linewise/image.h"
 #include "linewise/number.h"
 #include "linewise/output.h"
+#include "linewise/quad.h"
 #include "linewise/state.h"
 
 #define OFF(f) offsetof(lw_params, f)
@@ -186,11 +187,18 @@ const lw_param_def lw_param_table[] = {
       "G: parametrisation G * integral of (|r'| - l)^2 ds / l per segment (l = its length) holds "
       "the handle lengths that leave a segment's shape unchanged (docs/NUMERICS.md). 0 = off."),
   NUM("energy", "quadrature", LW_PT_INT, quadrature, "8", "nodes", 2, 64, 0,
-      "Gauss-Legendre nodes per segment for every integral but the pair term's."),
+      "Gauss-Legendre nodes per segment for every integral but the pair and tone terms' where "
+      "they have their own (`pair_quadrature`, `tone_quadrature`)."),
   NUM("energy", "pair_quadrature", LW_PT_INT, pair_quadrature, "0", "nodes", 0, 64, 0,
       "Gauss-Legendre nodes per segment for the pair term (its samples in the cell grid); "
       "0 = the same as `quadrature`. The pair sum costs about the square of this number per "
       "proposal; docs/ACCURACY.md shows what fewer nodes cost in accuracy."),
+  NUM("energy", "tone_quadrature", LW_PT_INT, tone_quadrature, "0", "nodes", 0, 64, 0,
+      "Gauss-Legendre nodes per segment for the tone term (the samples it splats); 0 = the "
+      "same as `quadrature`. Its cost per proposal grows with this number; with samples 0.7 "
+      "tone_blur apart (segment_length / nodes) an annealed photograph's tone energy was within "
+      "6e-4 of 32 nodes' (docs/ACCURACY.md). The photo preset sets the fewest that are that "
+      "close."),
   NUM("energy", "tone", LW_PT_DOUBLE, tone, "0", "energy / mm^2", 0, 1e12, 0,
       "T: tone T * sum over pixels of A (G * ink - darkness)^2: the lines, as ink of "
       "output.pen_width, blurred by a Gaussian of `tone_blur` and compared with the picture's "
@@ -975,6 +983,14 @@ static void apply_preset(lw_params *p)
     }
     preset_key(p, photo_preset[k].section, photo_preset[k].key, t);
   }
+  /* the tone's samples no closer than a line needs to read as a line,
+  ** 0.7 tone_blur apart along a segment (4 nodes): on four photographs
+  ** the anneal took 0.88 of the CPU time of 6 (the other terms' nodes) at
+  ** the same scores, and its final tone energy was within 5.5e-4 of 32
+  ** nodes' (docs/ACCURACY.md, "On the photo preset") */
+  const int nt = (int)ceil(p->segment_length / (0.7 * p->tone_blur));
+  snprintf(text, sizeof text, "%d", nt < LW_QUAD_MIN ? LW_QUAD_MIN : (nt < p->quadrature ? nt : 0));
+  preset_key(p, "energy", "tone_quadrature", text);
   /* domains of 90 w: more than twice a move's reach (a spline of 40 w and
   ** the cutoff), and small enough that each of the four phases has work
   ** for every core where the picture's ink is uneven (3 a side on A4 used

@@ -30,6 +30,19 @@ static lw_status bad_key(const lw_params *p, const char *section, const char *ke
   return lw_error_set(err, code, "%s: key '%s.%s': %s", where, section, key, what);
 }
 
+/* A term's own nodes q: n of them where the term is on and n is set (the
+** key energy.key), else the scene's. */
+static lw_status term_nodes(const lw_params *p, const lw_scene *sc, int on, const char *key, int n, lw_quad *q,
+                            lw_error *err)
+{
+  *q = sc->quad;
+  if (!on || !n || n == sc->quad.n) return LW_OK;
+  if (n < LW_QUAD_MIN)
+    return bad_key(p, "energy", key, LW_EINPUT, err, "expected 0 or %d to %d nodes, got %d", LW_QUAD_MIN, LW_QUAD_MAX,
+                   n);
+  return lw_quad_init(q, n, err);
+}
+
 /* The margin box: the page inset by `margin`, which frames the rect and
 ** circle boundaries and holds the picture. */
 static lw_status margin_ok(const lw_params *p, lw_error *err)
@@ -188,6 +201,7 @@ void lw_scene_term_ctx(const lw_scene *sc, lw_term_ctx ctx[LW_TERM_COUNT])
   ctx[LW_TERM_USER].fn = sc->user_fn;
   ctx[LW_TERM_LOAD].data = sc->load;
   ctx[LW_TERM_TONE].data = &sc->tone;
+  ctx[LW_TERM_TONE].quad = &sc->tone_quad;
   ctx[LW_TERM_CHEMICAL].data = sc->chem;
 }
 
@@ -343,16 +357,9 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   sc->regularity = p->regularity > 1.0 ? p->regularity : 0.0;
   lw_status st = lw_quad_init(&sc->quad, p->quadrature, err);
   if (st) return st;
-  sc->pair_quad = sc->quad;
-  if (sc->on[LW_TERM_PAIR] && p->pair_quadrature && p->pair_quadrature != p->quadrature) {
-    if (p->pair_quadrature < LW_QUAD_MIN) {
-      char where[LW_PATH_MAX + 32];
-      lw_params_origin(p, lw_params_find("energy", "pair_quadrature"), where, sizeof where);
-      return lw_error_set(err, LW_EINPUT, "%s: key 'energy.pair_quadrature': expected 0 or %d to %d nodes, got %d",
-                          where, LW_QUAD_MIN, LW_QUAD_MAX, p->pair_quadrature);
-    }
-    if ((st = lw_quad_init(&sc->pair_quad, p->pair_quadrature, err))) return st;
-  }
+  if ((st = term_nodes(p, sc, sc->on[LW_TERM_PAIR], "pair_quadrature", p->pair_quadrature, &sc->pair_quad, err)) ||
+      (st = term_nodes(p, sc, sc->on[LW_TERM_TONE], "tone_quadrature", p->tone_quadrature, &sc->tone_quad, err)))
+    return st;
   lw_pair_ctx_init(&sc->pair, p->pair_cutoff, p->pair_near);
 
   double cx = p->center_x >= 0 ? p->center_x : 0.5 * p->width;

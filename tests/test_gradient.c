@@ -341,17 +341,21 @@ Test(gradient, image_scene)
 ** noise, and the footprint's cut (a kink where a pixel centre crosses rho)
 ** lies within a step at some coordinates.  A footprint's slope without its
 ** normalisation term, or a sample's length element left out, is off by
-** tenths at most coordinates. */
+** tenths at most coordinates.  The fourth case samples the tone at 4
+** nodes (energy.tone_quadrature) and every other term at 8: its gradient
+** taken through the 8 nodes' basis, or with their weights, is off. */
 Test(gradient, tone_term)
 {
   const char *root = getenv("LW_ROOT");
   const double blur[] = {1.0, 0.5};
-  for (int k = 0; k < 3; k++) {
+  static const char *const what[] = {"tone, blur 1 mm", "tone, blur 0.5 mm", "tone, two pens", "tone at 4 nodes"};
+  for (int k = 0; k < 4; k++) {
     lw_params p = base_params();
     snprintf(p.image, sizeof p.image, "%s/params/picture.png", root ? root : ".");
     p.tone = 4.0;
     p.tone_blur = blur[k < 2 ? k : 0];
     p.pen_width = 0.5;
+    if (k == 3) p.tone_quadrature = 4;
     if (k == 2) {
       snprintf(p.ly_names, sizeof p.ly_names, "a b");
       p.ly_source = LW_LSRC_PALETTE;
@@ -361,8 +365,8 @@ Test(gradient, tone_term)
     lw_scene sc;
     scene_with(&sc, &p);
     cr_assert(sc.on[LW_TERM_TONE] && sc.layers.n == (k == 2 ? 2 : 0));
-    check_scene_at(&sc, LW_TERM_TONE, k == 2 ? "tone, two pens" : k ? "tone, blur 0.5 mm" : "tone, blur 1 mm", 2e-4, 3,
-                   5e-3);
+    cr_assert_eq(sc.tone_quad.n, k == 3 ? 4 : sc.quad.n);
+    check_scene_at(&sc, LW_TERM_TONE, what[k], 2e-4, 3, 5e-3);
     lw_scene_clear(&sc);
   }
 }

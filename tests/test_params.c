@@ -332,6 +332,8 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
             p.tone_blur);
   cr_assert(fabs(p.field_sigma - 10 * 0.35) < 1e-12);
   cr_assert(p.tone == 80 && p.tone_ink == 0.5 && p.coverage == 0.6 && p.splines == 0 && p.sweeps == 300);
+  /* the tone's own nodes, the fewest 0.7 tone_blur apart: 8 / (0.7 x 3) */
+  cr_assert(p.quadrature == 6 && p.tone_quadrature == 4, "nodes %d, tone's %d", p.quadrature, p.tone_quadrature);
   cr_assert(p.image_levels == 0.01, "image_levels %g", p.image_levels);
   /* the annealer chooses the count where the tone term pays for line: no
   ** chemical potential darkens every light tone */
@@ -360,6 +362,14 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
             p.pair_cutoff);
   cr_assert(fabs(p.potential_coef - 2.5 / 0.35 * 0.5) < 1e-12, "potential %.17g", p.potential_coef);
   cr_assert_str_eq(p.domains, "4");
+  /* a finer blur asks for more tone nodes, up to the other terms' (0) */
+  cr_assert_eq(p.tone_quadrature, 4);
+  cr_assert_eq(lw_params_set(&p, "energy.tone_blur=0.6", &err), LW_OK);
+  cr_assert_eq(lw_params_resolve(&p, &err), LW_OK);
+  cr_assert_eq(p.tone_quadrature, 0, "4 mm segments at 0.42 mm: 10 nodes, more than 6");
+  cr_assert_eq(lw_params_set(&p, "energy.tone_blur=1.2", &err), LW_OK);
+  cr_assert_eq(lw_params_resolve(&p, &err), LW_OK);
+  cr_assert_eq(p.tone_quadrature, 5, "4 mm segments at 0.84 mm: 5 nodes");
   /* the file's keys win; A6 at the default pen of 0.3 mm: 85 mm / 27 mm = 3
   ** domains a side, and with a 1 mm pen fewer than 2, so not split */
   cr_assert_eq(read_text("[scene]\npreset = photo\npage = a6\n[init]\ncoverage = 0.3\n", &p, &err), LW_OK);

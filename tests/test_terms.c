@@ -443,7 +443,7 @@ Test(terms, every_row_reads_its_own_context_only)
     cr_assert_eq(ctx[t].coef, sc.coef[t], "%s", lw_term_names[t]);
   }
   cr_assert(ctx[LW_TERM_PAIR].data == &sc.pair && ctx[LW_TERM_PAIR].quad == &sc.pair_quad);
-  cr_assert(ctx[LW_TERM_TONE].data == &sc.tone && ctx[LW_TERM_TONE].quad == &sc.quad);
+  cr_assert(ctx[LW_TERM_TONE].data == &sc.tone && ctx[LW_TERM_TONE].quad == &sc.tone_quad);
   lw_splines *sp = splines(1, 2);
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
   gsl_rng_set(r, 5);

@@ -135,7 +135,7 @@ void bench_tone_accuracy(bench_ctx *b)
   for (int k = 0; k < S; k++)
     for (int i = 0; i < N; i++) {
       lw_params p = tone_scene(b, 1.0, sigmas[k], 0.0);
-      p.quadrature = nodes[i];
+      p.tone_quadrature = nodes[i];
       lw_scene sc;
       if (lw_scene_init(&sc, &p, &err)) bench_die("tone accuracy", &err);
       double term[LW_TERM_COUNT];
@@ -148,8 +148,9 @@ void bench_tone_accuracy(bench_ctx *b)
   fprintf(d, "## Tone term: quadrature nodes\n\n"
              "The tone term splats each quadrature sample as a Gaussian footprint (tone.h), so its\n"
              "value depends on how finely the samples cover the line: a sample stands for dl of ink\n"
-             "at one point. The annealed accuracy scene's tone energy at each node count, against 32\n"
-             "nodes (segments of %.0f mm, blur sigma as given; the picture's pixel is 0.45 mm, the\n"
+             "at one point. The annealed accuracy scene's tone energy at each node count\n"
+             "(`energy.tone_quadrature`), against 32 nodes (segments of %.0f mm, blur sigma as given;\n"
+             "the picture's pixel is 0.45 mm, the\n"
              "raster's the same but at sigma 2 mm, where it is two of them):\n\n"
              "| nodes | sample spacing mm |",
           b->ann_params.segment_length);
@@ -164,7 +165,9 @@ void bench_tone_accuracy(bench_ctx *b)
   }
   fprintf(d, "\nThe error is small once the samples are closer than about the blur: a footprint wider\n"
              "than the gaps between samples sees a line, not a row of dots. Keep\n"
-             "segment_length / quadrature below tone_blur. Below about 1e-7 the errors stop falling:\n"
+             "segment_length / tone_quadrature below tone_blur; the tone's cost a proposal grows with\n"
+             "its nodes, and the other terms keep theirs (`quadrature`). Below about 1e-7 the errors\n"
+             "stop falling:\n"
              "the fixed-point raster rounds each footprint value to 2^-32 of full ink, some 1e-9 of\n"
              "a pixel's value summed over its footprints, 1e-8 to 1e-7 of (B - D). The annealed scene's\n"
              "close share (the share of its line length within one pen width, %.2f mm, of another\n"

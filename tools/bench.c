@@ -56,6 +56,7 @@ void bench_tone_accuracy(bench_ctx *b);
 void bench_quench(bench_ctx *b);
 void bench_splice(bench_ctx *b);
 void bench_photo(bench_ctx *b);
+void bench_photo_tone(bench_ctx *b);
 
 /* ---- throughput and scaling ---------------------------------------------- */
 
@@ -718,6 +719,7 @@ static const bench_section sections[] = {
     {"near", BENCH_ACCURACY, bench_near},
     {"kink", BENCH_ACCURACY, bench_kink},
     {"tone_accuracy", BENCH_ACCURACY, bench_tone_accuracy},
+    {"photo_tone", BENCH_ACCURACY, bench_photo_tone},
     {"guide", BENCH_ACCURACY, bench_guide},
     {"quench", BENCH_ACCURACY, bench_quench},
 };

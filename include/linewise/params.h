@@ -116,6 +116,7 @@ typedef struct {
   double parametrisation;     /* G, energy / mm; 0 = off */
   int quadrature;             /* nodes per segment */
   int pair_quadrature;        /* pair samples per segment; 0 = quadrature */
+  int tone_quadrature;        /* tone samples per segment; 0 = quadrature */
   double tone;                /* T, energy / mm^2; 0 = off */
   double tone_blur;           /* sigma of the tone term's blur, mm */
   double tone_ink;            /* ink fraction the darkest tone asks for */

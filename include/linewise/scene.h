@@ -49,6 +49,7 @@ typedef struct lw_scene {
                                    integrand must be analytic in; 0 = no check */
   lw_quad quad;
   lw_quad pair_quad;            /* nodes of the pair samples (valid when pair is on) */
+  lw_quad tone_quad;            /* nodes of the tone samples (valid when tone is on) */
   lw_pair_ctx pair;
   lw_potential potential;       /* valid when on[LW_TERM_POTENTIAL] */
   lw_field field;               /* valid when on[LW_TERM_FIELD] */
