@@ -126,18 +126,47 @@ __attribute__((target(LW_VEC_X8_TARGET))) static void divide8(double *g, int n, 
 }
 #endif
 
+/* The distance d0 from c to the first of the 2 radius + 1 pixel centres
+** around pixel k, and a0 = (2 d0 p + p^2) inv, the exponent of the ratio of
+** its Gaussian to the next's; 1 where the Gaussians can go by products
+** (weights_from), 0 where they would overflow (a blur well below a pixel). */
+static int first_centre(const lw_tone *t, double c, double c0, int k, double *d0, double *a0)
+{
+  const double p = t->pixel;
+  *d0 = c0 + (k - t->radius + 0.5) * p - c;
+  *a0 = (2.0 * *d0 * p + p * p) * t->inv;
+  return fabs(*a0) < 600.0 && *d0 * *d0 * t->inv < 600.0;
+}
+
+/* g[m] /= sum for m in [0, 2 R], where sum > 0; else all of the ink in the
+** sample's own pixel, g[R] = 1 (a blur far below a pixel).  Divisions in
+** vectors are the same correctly rounded quotients, several a step: one at a
+** time they were half of the weights' time. */
+static void normalise(double *g, int R, double sum, int x8)
+{
+  if (!(sum > 0.0)) g[R] = sum = 1.0;
+#if LW_VEC_HAVE_WIDE
+  if (x8) {
+    divide8(g, 2 * R + 1, sum);
+    return;
+  }
+#endif
+#pragma omp simd
+  for (int m = 0; m <= 2 * R; m++) g[m] /= sum;
+}
+
 /* The normalised weights of the 2 radius + 1 pixel centres around pixel k
-** for a sample at c: the Gaussian less its value at rho = radius pixels,
-** 0 beyond.  Every centre outside the window is farther than rho from c, so
-** the footprint is continuous in c as the window moves with the sample (a
-** Gaussian cut at the window would jump by e^-4.5 of its peak there). */
-static void weights(const lw_tone *t, double c, double c0, int k, double *g, int x8)
+** for a sample at c (d0, a0 and ok from first_centre): the Gaussian less its
+** value at rho = radius pixels, 0 beyond.  Every centre outside the window
+** is farther than rho from c, so the footprint is continuous in c as the
+** window moves with the sample (a Gaussian cut at the window would jump by
+** e^-4.5 of its peak there). */
+static void weights_from(const lw_tone *t, double d0, double a0, int ok, double *g, int x8)
 {
   const int R = t->radius;
   const double p = t->pixel, inv = t->inv, floor_ = t->floor;
-  const double d0 = c0 + (k - R + 0.5) * p - c, a0 = (2.0 * d0 * p + p * p) * inv;
   double sum = 0.0;
-  if (fabs(a0) < 600.0 && d0 * d0 * inv < 600.0) {
+  if (ok) {
     /* exp(-d_m^2 inv) for d_m = d0 + m p by products: the ratio of
     ** neighbours is exp(-(2 d_m p + p^2) inv), itself falling by
     ** exp(-2 p^2 inv) (t->fall) a step.  Two exps an axis instead of 2 R + 1. */
@@ -149,7 +178,7 @@ static void weights(const lw_tone *t, double c, double c0, int k, double *g, int
       e *= r;
       r *= c2;
     }
-  } else { /* a blur well below a pixel: the products would overflow */
+  } else {
     for (int m = 0; m <= 2 * R; m++) {
       double d = d0 + m * p;
       double e = exp(-d * d * inv);
@@ -157,19 +186,43 @@ static void weights(const lw_tone *t, double c, double c0, int k, double *g, int
       sum += g[m];
     }
   }
-  if (!(sum > 0.0)) { /* a blur far below a pixel: all of it in the sample's own pixel */
-    g[R] = sum = 1.0;
+  normalise(g, R, sum, x8);
+}
+
+/* weights_from on both axes where both go by products: the two chains of
+** products interleaved (each is a chain of dependent multiplications, so
+** one alone leaves the multiplier idle), each axis with the operations
+** weights_from takes in its order, so the same bits. */
+static void weights_xy(const lw_tone *t, double dx, double ax, double dy, double ay, double *gx, double *gy, int x8)
+{
+  const int R = t->radius;
+  const double inv = t->inv, floor_ = t->floor, c2 = t->fall;
+  double ex = exp(-dx * dx * inv), rx = exp(-ax), ey = exp(-dy * dy * inv), ry = exp(-ay), sx = 0.0, sy = 0.0;
+  for (int m = 0; m <= 2 * R; m++) {
+    gx[m] = ex > floor_ ? ex - floor_ : 0.0;
+    gy[m] = ey > floor_ ? ey - floor_ : 0.0;
+    sx += gx[m];
+    sy += gy[m];
+    ex *= rx;
+    ey *= ry;
+    rx *= c2;
+    ry *= c2;
   }
-  /* divisions in vectors are the same correctly rounded quotients, several a
-  ** step: one at a time they were half of this function's time */
-#if LW_VEC_HAVE_WIDE
-  if (x8) {
-    divide8(g, 2 * R + 1, sum);
+  normalise(gx, R, sx, x8);
+  normalise(gy, R, sy, x8);
+}
+
+/* The weights of a sample at (x, y) on both axes, around pixels ci and cj. */
+static void weights(const lw_tone *t, double x, double y, int ci, int cj, double *gx, double *gy, int x8)
+{
+  double dx, ax, dy, ay;
+  const int okx = first_centre(t, x, t->x0, ci, &dx, &ax), oky = first_centre(t, y, t->y0, cj, &dy, &ay);
+  if (okx && oky) {
+    weights_xy(t, dx, ax, dy, ay, gx, gy, x8);
     return;
   }
-#endif
-#pragma omp simd
-  for (int m = 0; m <= 2 * R; m++) g[m] /= sum;
+  weights_from(t, dx, ax, okx, gx, x8);
+  weights_from(t, dy, ay, oky, gy, x8);
 }
 
 /* One raster pixel's share of a footprint: rounded (half up: v >= 0) from
@@ -224,8 +277,7 @@ void lw_tone_splat(const lw_tone *t, int64_t *r, int wx, int wy, int ww, int wh,
   const int x8 = 0;
 #endif
   double gx[2 * LW_TONE_RADIUS_MAX + 1], gy[2 * LW_TONE_RADIUS_MAX + 1];
-  weights(t, x, t->x0, ci, gx, x8);
-  weights(t, y, t->y0, cj, gy, x8);
+  weights(t, x, y, ci, cj, gx, gy, x8);
   /* the window within the raster, in raster pixels */
   int i0 = ci - R, i1 = ci + R + 1, j0 = cj - R, j1 = cj + R + 1;
   if (i0 < wx) i0 = wx;
