@@ -4,19 +4,40 @@
 #include <math.h>
 #include <stdlib.h>
 
-lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, lw_error *err)
+lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, double sigma,
+                                   lw_error *err)
 {
   const int w = img->width, h = img->height, W = w + 2, H = h + 2;
   /* node (i, j) is the centre of pixel (i - 1, j - 1); the outer ring is white */
   lw_grid2d *g = lw_grid2d_new(W, H, 1, pl->x0 - 0.5 * pl->pixel, pl->y0 - 0.5 * pl->pixel, pl->pixel,
                                pl->pixel, err);
   if (!g) return NULL;
+  /* blurred, Phi goes through the blur's float plane; else straight in */
+  float *phi = NULL;
+  if (sigma > 0.0) {
+    if (!(phi = malloc((size_t)w * (size_t)h * sizeof *phi))) {
+      lw_error_set(err, LW_ENOMEM, "out of memory for a potential of %d x %d pixels", w, h);
+      lw_grid2d_free(g);
+      return NULL;
+    }
+    for (size_t k = 0; k < (size_t)w * (size_t)h; k++)
+      phi[k] = (float)(power == 1.0 ? img->tone[k] : pow(img->tone[k], power));
+    if (lw_image_blur_plane(phi, w, h, sigma, err)) {
+      free(phi);
+      lw_grid2d_free(g);
+      return NULL;
+    }
+  }
   for (int j = 0; j < H; j++)
     for (int i = 0; i < W; i++) {
-      int inner = i >= 1 && i <= w && j >= 1 && j <= h;
-      double t = inner ? img->tone[(size_t)(j - 1) * (size_t)w + (size_t)(i - 1)] : 1.0;
-      g->data[(size_t)j * W + (size_t)i] = power == 1.0 ? t : pow(t, power);
+      const int inner = i >= 1 && i <= w && j >= 1 && j <= h;
+      const size_t k = inner ? (size_t)(j - 1) * (size_t)w + (size_t)(i - 1) : 0;
+      double v = 1.0;
+      if (inner && phi) v = phi[k];
+      else if (inner) v = power == 1.0 ? img->tone[k] : pow(img->tone[k], power);
+      g->data[(size_t)j * W + (size_t)i] = v;
     }
+  free(phi);
   return g;
 }
 

@@ -106,6 +106,12 @@ const lw_param_def lw_param_table[] = {
       "so energy.potential > 0 costs line where the picture asks for none (stray lines in a white "
       "background) and little in the mid-tones. The photo preset sets 8, with potential = image and "
       "energy.potential = 7.14 pen widths (docs/IMAGES.md, \"White backgrounds\")."),
+  NUM("scene", "potential_blur", LW_PT_DOUBLE, potential_blur, "0", "mm", 0, 1e4, 0,
+      "potential = image: standard deviation of a Gaussian blur of Phi. Phi at the picture's own "
+      "pixels can change between two quadrature nodes, and an annealer then puts the nodes where "
+      "Phi is low and the line between them where it is high; blurred over about the nodes' "
+      "spacing (segment_length / quadrature) it hides far less (docs/NUMERICS.md, \"The potential "
+      "between the nodes\"). 0 = none."),
   CHOICE("scene", "field", field, "constant", "constant|radial|vortex|waves|etf|gradient",
          "Vector field v read by the field term (unit length): constant along `field_angle`, "
          "radial from the centre, vortex around it, waves tangent to y = A sin(2 pi x / wavelength), "

@@ -314,7 +314,8 @@ static lw_status build_layers(lw_scene *sc, const lw_params *p, lw_error *err)
       l->potential = sc->potential;
       l->potential.grid = NULL;
       if (sc->potential.kind == LW_POTENTIAL_GRID &&
-          !(l->potential.grid = lw_imagefield_potential(l->target, &sc->image_place, p->potential_power, err)))
+          !(l->potential.grid = lw_imagefield_potential(l->target, &sc->image_place, p->potential_power,
+                                                        p->potential_blur / sc->image_place.pixel, err)))
         return err->code;
     }
     if (sc->on[LW_TERM_TONE]) {
@@ -391,7 +392,9 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     case LW_POT_IMAGE:
       if (!sc->image) return bad_key(p, "scene", "potential", LW_EINPUT, err, "'image' needs scene.image");
       f->kind = LW_POTENTIAL_GRID;
-      if (!(f->grid = lw_imagefield_potential(sc->image, &sc->image_place, p->potential_power, err))) return err->code;
+      if (!(f->grid = lw_imagefield_potential(sc->image, &sc->image_place, p->potential_power,
+                                              p->potential_blur / sc->image_place.pixel, err)))
+        return err->code;
       break;
     }
   }

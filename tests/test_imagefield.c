@@ -131,7 +131,7 @@ Test(imagefield, potential_is_the_tone_and_white_beyond_the_picture)
   for (int k = 0; k < 35; k++) img->tone[k] = (float)urand(0, 1);
   lw_image_place pl = {3, 4, 2};
   lw_potential f = {.kind = LW_POTENTIAL_GRID};
-  f.grid = lw_imagefield_potential(img, &pl, 1.0, NULL);
+  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, NULL);
   for (int j = 0; j < 5; j++)
     for (int i = 0; i < 7; i++)
       cr_assert(fabs(lw_potential_eval(&f, 3 + 2 * (i + 0.5), 4 + 2 * (j + 0.5)) - img->tone[j * 7 + i]) < 1e-7);
@@ -139,12 +139,38 @@ Test(imagefield, potential_is_the_tone_and_white_beyond_the_picture)
   cr_assert(lw_potential_eval(&f, 3 + 14 + 1, 9) == 1.0, "a pixel beyond the right edge is white");
   lw_potential_clear(&f);
   /* scene.potential_power: Phi = tone^power, white still 1 */
-  f.grid = lw_imagefield_potential(img, &pl, 3.0, NULL);
+  f.grid = lw_imagefield_potential(img, &pl, 3.0, 0.0, NULL);
   for (int j = 0; j < 5; j++)
     for (int i = 0; i < 7; i++)
       cr_assert(fabs(lw_potential_eval(&f, 3 + 2 * (i + 0.5), 4 + 2 * (j + 0.5)) - pow(img->tone[j * 7 + i], 3)) <
                 1e-7);
   cr_assert(lw_potential_eval(&f, 0, 0) == 1.0);
+  lw_potential_clear(&f);
+  lw_image_free(img);
+}
+
+Test(imagefield, a_blurred_potential_spreads_phi_and_keeps_its_sum)
+{
+  /* scene.potential_blur: one white pixel on black, power 8, blurred by 2
+  ** pixels: Phi (not the tone, whose eighth power would all but vanish)
+  ** spreads as a Gaussian of 2 pixels, 1 / (2 pi 4) at its centre, its sum
+  ** kept and the same at equal distances; beyond the picture still white. */
+  lw_image *img = lw_image_new(21, 21, 0, NULL);
+  for (int k = 0; k < 21 * 21; k++) img->tone[k] = 0.0f;
+  img->tone[10 * 21 + 10] = 1.0f;
+  lw_image_place pl = {0, 0, 1};
+  lw_potential f = {.kind = LW_POTENTIAL_GRID};
+  f.grid = lw_imagefield_potential(img, &pl, 8.0, 2.0, NULL);
+  cr_assert_not_null(f.grid);
+  double sum = 0.0;
+  for (int j = 0; j < 21; j++)
+    for (int i = 0; i < 21; i++) sum += lw_potential_eval(&f, i + 0.5, j + 0.5);
+  const double centre = lw_potential_eval(&f, 10.5, 10.5);
+  cr_assert(fabs(sum - 1.0) < 1e-5, "sum %.9g", sum);
+  cr_assert(fabs(centre - 1.0 / (8.0 * M_PI)) < 2e-3, "centre %.9g", centre);
+  cr_assert(fabs(lw_potential_eval(&f, 12.5, 10.5) - lw_potential_eval(&f, 10.5, 8.5)) < 1e-7);
+  cr_assert(lw_potential_eval(&f, 12.5, 10.5) < centre && lw_potential_eval(&f, 12.5, 10.5) > 0.1 * centre);
+  cr_assert(lw_potential_eval(&f, -5, 3) == 1.0, "white beyond the picture");
   lw_potential_clear(&f);
   lw_image_free(img);
 }

@@ -40,8 +40,10 @@
 #include "linewise/image.h"
 
 /* The potential of scene.potential = image: Phi = tone^power at the pixel
-** centres (white beyond the picture). */
-lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, lw_error *err);
+** centres (white beyond the picture), blurred by a Gaussian of sigma pixels
+** (0: not blurred; the blur reads the picture's edge pixels beyond it). */
+lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, double sigma,
+                                   lw_error *err);
 
 /* angle: the fallback direction, radians (0 = +x, pi/2 = +y, down). */
 lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, double sigma_mm, double flat,

@@ -88,6 +88,7 @@ typedef struct {
   double potential_angle;     /* ramp direction, degrees */
   double potential_scale;     /* ramp half extent / radial radius, mm; 0 = automatic */
   double potential_power;     /* potential = image: Phi = tone^power */
+  double potential_blur;      /* potential = image: sigma of Phi's blur, mm; 0 = none */
   int field;                  /* LW_FLD_* */
   double field_angle;         /* constant field direction (etf fallback), degrees */
   double field_sigma;         /* etf tensor smoothing, mm */
