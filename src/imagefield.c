@@ -31,10 +31,14 @@ lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl
   for (int j = 0; j < H; j++)
     for (int i = 0; i < W; i++) {
       const int inner = i >= 1 && i <= w && j >= 1 && j <= h;
-      const size_t k = inner ? (size_t)(j - 1) * (size_t)w + (size_t)(i - 1) : 0;
       double v = 1.0;
-      if (inner && phi) v = phi[k];
-      else if (inner) v = power == 1.0 ? img->tone[k] : pow(img->tone[k], power);
+      if (phi) { /* the ring continues the edge, as the blur read it: no step there */
+        const int ii = i < 1 ? 0 : (i > w ? w - 1 : i - 1), jj = j < 1 ? 0 : (j > h ? h - 1 : j - 1);
+        v = phi[(size_t)jj * (size_t)w + (size_t)ii];
+      } else if (inner) {
+        const float t = img->tone[(size_t)(j - 1) * (size_t)w + (size_t)(i - 1)];
+        v = power == 1.0 ? t : pow(t, power);
+      }
       g->data[(size_t)j * W + (size_t)i] = v;
     }
   free(phi);

@@ -332,6 +332,8 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
             p.tone_blur);
   cr_assert(fabs(p.field_sigma - 10 * 0.35) < 1e-12);
   cr_assert(p.tone == 80 && p.tone_ink == 0.5 && p.coverage == 0.6 && p.splines == 0 && p.sweeps == 300);
+  /* Phi blurred over about the nodes' spacing (8 / 6 pen widths) */
+  cr_assert(fabs(p.potential_blur - 1.5 * 0.35) < 1e-12, "potential_blur %g", p.potential_blur);
   /* the tone's own nodes, the fewest 0.7 tone_blur apart: 8 / (0.7 x 3) */
   cr_assert(p.quadrature == 6 && p.tone_quadrature == 4, "nodes %d, tone's %d", p.quadrature, p.tone_quadrature);
   cr_assert(p.image_levels == 0.01, "image_levels %g", p.image_levels);

@@ -40,8 +40,10 @@
 #include "linewise/image.h"
 
 /* The potential of scene.potential = image: Phi = tone^power at the pixel
-** centres (white beyond the picture), blurred by a Gaussian of sigma pixels
-** (0: not blurred; the blur reads the picture's edge pixels beyond it). */
+** centres, white beyond the picture; or (sigma > 0) blurred by a Gaussian
+** of sigma pixels, which reads the picture's edge pixels beyond it, and
+** continued beyond it as the blur read it, so that no step at the edge
+** lies between two quadrature nodes. */
 lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, double sigma,
                                    lw_error *err);
 
