@@ -52,6 +52,8 @@ static const char usage[] =
   "      --stop-at N, --threads N, --quiet  as for run\n"
   "  energy DIR          recompute DIR/state.lw's energy from scratch with its scene;\n"
   "                      prints '<term> <value>' per enabled term, then 'total <value>'\n"
+  "      --set SEC.KEY=VAL   with a key of the scene changed (repeatable): with\n"
+  "                          energy.quadrature=32, what the run's nodes leave out\n"
   "  params              print every scene parameter as Markdown (docs/PARAMETERS.md)\n"
   "  schedules           print the temperature schedules as Markdown (docs/SCHEDULES.md)\n"
   "  help                this text\n"
@@ -85,18 +87,46 @@ static lw_status load_run_dir(const char *dir, lw_params *p, lw_state *st, char 
   return s;
 }
 
+static lw_status set_option(lw_params *p, const char *assignment, lw_error *err);
+
+/* energy DIR [--set SEC.KEY=VAL]...: the state's energy with its scene, or
+** with keys of it changed (the quadrature's nodes, to see what the run's
+** leave out: docs/NUMERICS.md, "The potential between the nodes"). */
 static int cmd_energy(int argc, char **argv)
 {
   lw_error err;
   lw_error_clear(&err);
-  if (argc != 1) {
+  const char *dir = NULL;
+  for (int i = 0; i < argc; i++) {
+    if (!strcmp(argv[i], "--set")) {
+      i++;
+      continue;
+    }
+    if (argv[i][0] == '-' || dir) {
+      lw_error_set(&err, LW_EUSAGE, "energy: expected one run directory and --set options, got '%s' "
+                   "(usage: linewise energy DIR [--set SEC.KEY=VAL]...)", argv[i]);
+      return fail(&err);
+    }
+    dir = argv[i];
+  }
+  if (!dir) {
     lw_error_set(&err, LW_EUSAGE, "energy: expected one run directory (usage: linewise energy DIR)");
     return fail(&err);
   }
   static lw_params p;
   lw_state st;
   char path[LW_PATH_MAX + 32];
-  if (load_run_dir(argv[0], &p, &st, path, sizeof path, &err)) return fail(&err);
+  if (load_run_dir(dir, &p, &st, path, sizeof path, &err)) return fail(&err);
+  int set = 0;
+  for (int i = 0; i < argc && !err.code; i++) {
+    if (strcmp(argv[i], "--set")) continue;
+    if (i + 1 >= argc) lw_error_set(&err, LW_EUSAGE, "--set: expected section.key=value");
+    else set = !set_option(&p, argv[++i], &err);
+  }
+  if (err.code || (set && lw_params_resolve(&p, &err))) {
+    lw_state_clear(&st);
+    return fail(&err);
+  }
   const lw_system_type *t = lw_system_of(&p, &err);
   void *setup = t ? t->setup_new(&p, &err) : NULL;
   int rc = 0;

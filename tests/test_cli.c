@@ -106,6 +106,50 @@ Test(cli, energy_prints_each_enabled_term_and_the_total)
   lw_state_clear(&st);
 }
 
+/* The total `linewise energy` prints for args, in *total; its exit status. */
+static int energy_total(const char *args, double *total, char *errs, size_t n)
+{
+  char out[4096];
+  const int rc = run(args, out, sizeof out, errs, n);
+  const char *t = strstr(out, "total ");
+  *total = t ? strtod(t + 6, NULL) : NAN;
+  return rc;
+}
+
+Test(cli, energy_with_a_key_changed_is_that_scenes_energy)
+{
+  /* energy DIR --set energy.quadrature=24: the state's energy with the
+  ** scene's nodes changed (what the run's nodes leave out), as computed in
+  ** process with that scene, and not the run's own; a bad key is named. */
+  write_file("scene.ini", scene_text);
+  size_t segs[2] = {3, 4};
+  lw_state st = {.scene = "scene.ini", .seed = 7, .sp = lw_splines_new(2, segs, NULL)};
+  lw_test_straight(st.sp, 0, 20, 20, 70, 30);
+  lw_test_circle(st.sp, 1, 50, 45, 12);
+  char path[128], args[256], errs[4096];
+  snprintf(path, sizeof path, "%s/state.lw", dir);
+  cr_assert_eq(lw_state_write(&st, path, NULL), LW_OK);
+  double own, fine;
+  snprintf(args, sizeof args, "energy %s", dir);
+  cr_assert_eq(energy_total(args, &own, errs, sizeof errs), 0, "%s", errs);
+  snprintf(args, sizeof args, "energy --set energy.quadrature=24 %s", dir);
+  cr_assert_eq(energy_total(args, &fine, errs, sizeof errs), 0, "%s", errs);
+  lw_params p;
+  lw_scene sc;
+  snprintf(path, sizeof path, "%s/scene.ini", dir);
+  cr_assert_eq(lw_params_read(&p, path, NULL), LW_OK);
+  p.quadrature = 24;
+  cr_assert_eq(lw_scene_init(&sc, &p, NULL), LW_OK);
+  double term[LW_TERM_COUNT];
+  const double want = lw_energy_compute(&sc, st.sp, term, NULL);
+  cr_assert(fine == want && fine != own, "24 nodes: printed %.17g, computed %.17g; 8 nodes %.17g", fine, want, own);
+  snprintf(args, sizeof args, "energy %s --set energy.quadrature=1", dir);
+  cr_assert_eq(energy_total(args, &fine, errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "energy.quadrature"), "%s", errs);
+  lw_scene_clear(&sc);
+  lw_state_clear(&st);
+}
+
 Test(cli, energy_lists_only_enabled_terms)
 {
   write_file("scene.ini", "[energy]\nbending = 1\n");
