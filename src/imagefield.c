@@ -8,7 +8,7 @@ lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl
                                    lw_error *err)
 {
   const int w = img->width, h = img->height, W = w + 2, H = h + 2;
-  /* node (i, j) is the centre of pixel (i - 1, j - 1); the outer ring is white */
+  /* node (i, j) is the centre of pixel (i - 1, j - 1); the outer ring is white, or blurred the edge */
   lw_grid2d *g = lw_grid2d_new(W, H, 1, pl->x0 - 0.5 * pl->pixel, pl->y0 - 0.5 * pl->pixel, pl->pixel,
                                pl->pixel, err);
   if (!g) return NULL;
