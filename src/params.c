@@ -78,6 +78,12 @@ const lw_param_def lw_param_table[] = {
       "Resample the picture to this width, the height following the aspect ratio; 0 = as loaded."),
   NUM("scene", "image_blur", LW_PT_DOUBLE, image_blur, "0", "mm", 0, 1e4, 0,
       "Standard deviation of a Gaussian blur of the tone, in millimetres on the page. 0 = none."),
+  NUM("scene", "image_flatten", LW_PT_DOUBLE, image_flatten, "0", "mm", 0, 1e4, 0,
+      "Flat-field correction, after the blur: the tone is divided by the paper's brightness "
+      "about each pixel, the lightest tone within this radius on the page, smoothed, so that "
+      "uneven light (a photographed page, a vignette) turns to white paper and only what is "
+      "darker than its surroundings draws. Make it wider than the widest dark mark: a dark "
+      "area wider than twice the radius turns light from its inside. 0 = off (docs/IMAGES.md)."),
   NUM("scene", "image_levels", LW_PT_DOUBLE, image_levels, "0", "", 0, 0.25, 0,
       "Auto levels, before the tone curve: the darkest and the lightest of this share of the "
       "picture's pixels turn black and white, the tones between stretched linearly (at most "

@@ -79,7 +79,7 @@ static lw_image *load_picture(lw_scene *sc, const lw_params *p, const char *key,
   return img;
 }
 
-/* The picture pipeline after loading: resize, blur, tone curve. */
+/* The picture pipeline after loading: resize, blur, flattening, levels, tone curve. */
 static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
 {
   lw_status st = margin_ok(p, err);
@@ -101,6 +101,13 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
                                    p->height - p->margin);
   }
   if ((st = lw_image_blur(sc->image, p->image_blur / sc->image_place.pixel, err))) return st;
+  if (p->image_flatten > 0) {
+    double lo, hi;
+    if ((st = lw_image_flatten(sc->image, p->image_flatten / sc->image_place.pixel, &lo, &hi, err))) return st;
+    size_t used = strlen(sc->note);
+    snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_flatten: paper tones %.3f to %.3f divided out",
+             used ? "; " : "", lo, hi);
+  }
   if (p->image_levels > 0) {
     double lo, hi;
     if ((st = lw_image_levels(sc->image, p->image_levels, &lo, &hi, err))) return st;
@@ -228,8 +235,10 @@ lw_status lw_scene_set_user_term(lw_scene *sc, double coef, lw_user_term_fn fn, 
   return LW_OK;
 }
 
-/* One colour channel of the picture, through the luma's resize and blur
-** (not its tone curve, which shapes the luma), at sc->image's size. */
+/* One colour channel of the picture, through the luma's resize, blur and
+** flattening (not its tone curve, which shapes the luma), at sc->image's size:
+** flattened on its own, each channel's paper turns white, the light's colour
+** with its unevenness. */
 static lw_image *load_channel(lw_scene *sc, const lw_params *p, lw_image_channel which, lw_error *err)
 {
   char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
@@ -242,7 +251,9 @@ static lw_image *load_channel(lw_scene *sc, const lw_params *p, lw_image_channel
     lw_image_free(img);
     if (!(img = r)) return NULL;
   }
-  if (lw_image_blur(img, p->image_blur / sc->image_place.pixel, err)) {
+  double lo, hi;
+  if (lw_image_blur(img, p->image_blur / sc->image_place.pixel, err) ||
+      (p->image_flatten > 0 && lw_image_flatten(img, p->image_flatten / sc->image_place.pixel, &lo, &hi, err))) {
     lw_image_free(img);
     return NULL;
   }

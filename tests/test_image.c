@@ -558,6 +558,63 @@ Test(image, levels_leave_a_flat_colour_at_either_end_as_it_is)
   lw_image_free(img);
 }
 
+/* Flat-field correction on a page lit unevenly: light L(x) rising from 0.4
+** to 0.9 across 240 columns (slope s = 0.5 / 239 a pixel), white paper and
+** bars 3 px wide of reflectance 0.3 every 60 px, radius r = 8 px.  Away from
+** the bars the paper estimate is L(x + r) (the window's lightest mean; the
+** blurs keep a linear ramp), so the paper comes out L(x) / L(x + r), at
+** least 1 - r s / 0.4 = 0.958.  Near a bar the blurred tone dips, by at most
+** 0.7 x 3 x phi(2) / 4 = 0.028 at the window's far end (r from the bar, the
+** pre-blur's sigma r / 2): the estimate is low by that, and the paper stays
+** within 1 - 0.042 - 0.028 = 0.93 of white and at most 1.  A bar keeps its
+** ratio to the paper, 0.3, within 0.3 x 0.042 below and 0.3 x 0.028 / 0.972
+** above: 0.015.  r = 8 px finds the paper on the picture boxed down by 2 (a
+** linear ramp stays linear through the box means and the interpolation). */
+Test(image, flatten_divides_out_uneven_light_and_keeps_a_marks_ratio)
+{
+  const int w = 240, h = 40, r = 8;
+  lw_image *img = lw_image_new(w, h, 0, NULL);
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) {
+      const int bar = i % 60 >= 28 && i % 60 < 31;
+      img->tone[j * w + i] = (float)((0.4 + 0.5 * i / (w - 1)) * (bar ? 0.3 : 1.0));
+    }
+  double lo, hi;
+  cr_assert_eq(lw_image_flatten(img, r, &lo, &hi, NULL), LW_OK);
+  cr_assert(lo >= 0.40 && lo <= 0.43 && hi >= 0.88 && hi <= 0.9001, "paper %g to %g", lo, hi);
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) {
+      const float t = img->tone[j * w + i];
+      if (i % 60 == 29)
+        cr_assert(fabsf(t - 0.3f) <= 0.015f, "bar at %d, %d: %g", i, j, t);
+      else if (i % 60 < 28 || i % 60 >= 31)
+        cr_assert(t >= 0.93f && t <= 1.0f, "paper at %d, %d: %g", i, j, t);
+    }
+  lw_image_free(img);
+}
+
+/* A dark area wider than twice the radius is paper to the correction from
+** its inside: a square of 60 px, radius 5 px, turns white at its centre and
+** keeps its tone one pixel in from its edge, where the window sees the
+** white around it.  Black, its paper is under LW_IMAGE_FLATTEN_MIN_PAPER:
+** white there too, not 0 / 0. */
+Test(image, flatten_turns_a_wide_dark_area_light_from_inside)
+{
+  const float tones[2] = {0.2f, 0.0f};
+  for (int k = 0; k < 2; k++) {
+    lw_image *img = lw_image_new(100, 100, 0, NULL);
+    for (int j = 20; j < 80; j++)
+      for (int i = 20; i < 80; i++) img->tone[j * 100 + i] = tones[k];
+    double lo, hi;
+    cr_assert_eq(lw_image_flatten(img, 5, &lo, &hi, NULL), LW_OK);
+    cr_assert(fabs(lo - tones[k]) < 1e-6 && fabs(hi - 1.0) < 1e-6, "paper %g to %g", lo, hi);
+    cr_assert(img->tone[50 * 100 + 50] > 0.999f, "centre %g", img->tone[50 * 100 + 50]);
+    cr_assert(img->tone[50 * 100 + 21] < tones[k] + 0.05f, "edge %g", img->tone[50 * 100 + 21]);
+    cr_assert(img->tone[5 * 100 + 5] > 0.999f, "paper %g", img->tone[5 * 100 + 5]);
+    lw_image_free(img);
+  }
+}
+
 Test(image, fit_centres_and_keeps_the_aspect_ratio)
 {
   lw_image_place pl = lw_image_fit(600, 800, 8, 8, 142, 192);

@@ -244,28 +244,54 @@ Test(image_cli, scene_keys_that_need_a_picture_say_so)
   }
 }
 
+/* A PICTURE_W x PICTURE_H picture of tone(i, j) at pixel (i, j). */
+#define PICTURE_W 40
+#define PICTURE_H 30
+static void write_tone_picture(const char *name, float (*tone)(int i, int j))
+{
+  float g[PICTURE_W * PICTURE_H];
+  for (int j = 0; j < PICTURE_H; j++)
+    for (int i = 0; i < PICTURE_W; i++) g[j * PICTURE_W + i] = tone(i, j);
+  lw_test_png(lw_test_path(name), PICTURE_W, PICTURE_H, g, NULL);
+}
+
+/* Tones 0.4 to 0.6 in reading order. */
+static float dim_tone(int i, int j)
+{
+  return (float)(0.4 + 0.2 * (i + PICTURE_W * j) / (PICTURE_W * PICTURE_H - 1));
+}
+
+/* Light from 0.3 to 0.9 across, and a bar of a third of it at column 25. */
+static float lit_tone(int i, int j)
+{
+  return (float)((0.3 + 0.6 * i / (PICTURE_W - 1)) * (i == 25 ? 1.0 / 3 : 1.0));
+}
+
+/* The scene of a 50 x 40 mm page with margin 5 around `picture` (a
+** PICTURE_W x PICTURE_H picture: 1 mm a pixel) and the [scene] keys `keys`,
+** built into sc. */
+static void picture_scene(const char *picture, const char *keys, lw_scene *sc)
+{
+  char text[256];
+  snprintf(text, sizeof text, "[scene]\nwidth = 50\nheight = 40\nmargin = 5\nimage = %s\n%s", picture, keys);
+  write_text("scene.ini", text);
+  lw_params p;
+  lw_error err;
+  cr_assert_eq(lw_params_read(&p, lw_test_path("scene.ini"), &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_scene_init(sc, &p, &err), LW_OK, "%s", err.msg);
+}
+
 /* scene.image_levels acts on the loaded tone before the tone curve: a dim
 ** picture (tones 0.4 to 0.6) spans [0, 1] after it, its darkest pixels turn
 ** white under image_invert (levels, then invert), and the note names the
 ** levels; without the key the tones stay as they were. */
 Test(image_cli, levels_stretch_a_dim_picture_before_the_tone_curve)
 {
-  const int w = 40, h = 30;
-  float *g = malloc(sizeof(float) * w * h);
-  for (int j = 0; j < h; j++)
-    for (int i = 0; i < w; i++) g[j * w + i] = (float)(0.4 + 0.2 * (i + w * j) / (w * h - 1));
-  lw_test_png(lw_test_path("dim.png"), w, h, g, NULL);
-  free(g);
+  const int w = PICTURE_W, h = PICTURE_H;
+  write_tone_picture("dim.png", dim_tone);
   for (int levels = 0; levels < 2; levels++) {
-    char text[256];
-    snprintf(text, sizeof text, "[scene]\nwidth = 50\nheight = 40\nmargin = 5\nimage = dim.png\n%s",
-             levels ? "image_levels = 0.02\nimage_invert = 1\n" : "");
-    write_text("scene.ini", text);
-    lw_params p;
     lw_scene sc;
-    lw_error err;
-    cr_assert_eq(lw_params_read(&p, lw_test_path("scene.ini"), &err), LW_OK, "%s", err.msg);
-    cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
+    picture_scene("dim.png", levels ? "image_levels = 0.02\nimage_invert = 1\n" : "", &sc);
     const float *t = sc.image->tone;
     float lo = 1, hi = 0;
     for (int k = 0; k < w * h; k++) lo = fminf(lo, t[k]), hi = fmaxf(hi, t[k]);
@@ -275,6 +301,32 @@ Test(image_cli, levels_stretch_a_dim_picture_before_the_tone_curve)
     } else {
       cr_assert(fabsf(lo - 0.4f) < 3e-3f && fabsf(hi - 0.6f) < 3e-3f, "%g %g", lo, hi);
       cr_assert_null(strstr(sc.note, "image_levels"), "%s", sc.note);
+    }
+    lw_scene_clear(&sc);
+  }
+}
+
+/* scene.image_flatten reaches the picture in millimetres on the page: a
+** page lit from 0.3 to 0.9 across 40 px (1 mm a pixel) with a dark bar
+** turns to paper within 0.1 of white (the rise of the light over the
+** radius, 4 mm: 0.6 x 4 / 39 / 0.3 = 0.21 at the dark end at most, 0.1
+** from the middle on) and keeps the bar at a third of it; the note gives
+** the paper's range.  Without the key the light stays. */
+Test(image_cli, flatten_takes_uneven_light_out_of_the_picture)
+{
+  const int w = PICTURE_W;
+  write_tone_picture("lit.png", lit_tone);
+  for (int flat = 0; flat < 2; flat++) {
+    lw_scene sc;
+    picture_scene("lit.png", flat ? "image_flatten = 4\n" : "", &sc);
+    const float *t = sc.image->tone;
+    const float mid = t[15 * w + 20], bar = t[15 * w + 25], right = t[15 * w + 30];
+    if (flat) {
+      cr_assert(mid > 0.9f && right > 0.9f && fabsf(bar / right - 1.0f / 3) < 0.05f, "%g %g %g", mid, bar, right);
+      cr_assert(strstr(sc.note, "scene.image_flatten: paper tones 0."), "%s", sc.note);
+    } else {
+      cr_assert(fabsf(mid - 0.61f) < 0.01f, "%g", mid);
+      cr_assert_null(strstr(sc.note, "image_flatten"), "%s", sc.note);
     }
     lw_scene_clear(&sc);
   }

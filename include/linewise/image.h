@@ -98,6 +98,24 @@ lw_status lw_image_blur_plane(float *plane, int w, int h, double sigma, lw_error
 ** (here and in fidelity.c) fill in between the pixels they sum at. */
 void lw_image_cubic_weights(double u, double w[4]);
 
+/* Flat-field correction: divides the tone by the paper's brightness about
+** each pixel, so that uneven light (a photographed page, a vignette, a
+** shadow across a sketch) turns to white paper and only what is darker than
+** its surroundings keeps its tone, as its ratio to them.  The paper is the
+** lightest tone within `radius` pixels (a square window, the picture's
+** edges repeated) of the tone blurred by radius / 2, itself blurred by
+** radius / 2: the lightest local mean, not the lightest grain.  From 8
+** pixels a radius on it is found on the picture boxed down to 4 pixels a
+** radius and interpolated back: the same cost at any radius.
+** Marks narrower than twice the radius are removed from that estimate and
+** keep their contrast; a dark area wider than that turns light from its
+** inside.  Where the paper is under LW_IMAGE_FLATTEN_MIN_PAPER (a black
+** area wider than the window) there is no contrast to keep: white.  A
+** radius under one pixel counts as one.  *lo and *hi receive the darkest
+** and lightest paper tone found.  LW_ENOMEM with err set. */
+#define LW_IMAGE_FLATTEN_MIN_PAPER (1.0 / 256.0)
+lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi, lw_error *err);
+
 /* Auto levels: stretches the tone linearly so that the darkest share `clip`
 ** of the picture's pixels turn black and the lightest share `clip` white,
 ** clipped to [0, 1].  Pixels less than half opaque are not counted (with

@@ -79,6 +79,7 @@ typedef struct {
   double image_max_pixels;    /* downsampling budget, pixels */
   int image_width;            /* resample to this width, pixels; 0 = keep */
   double image_blur;          /* Gaussian sigma, mm on the page */
+  double image_flatten;       /* radius of the paper's brightness, mm on the page; 0 = off */
   double image_gamma;         /* tone curve exponent */
   double image_contrast;      /* tone curve slope about 1/2 */
   double image_levels;        /* auto levels: share clipped at each end; 0 = off */
