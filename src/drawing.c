@@ -106,11 +106,19 @@ static void options(const lw_params *p, const lw_scene *sc, lw_strokes_options *
   }
 }
 
-/* The fidelity scores of the drawing, overall and per pen; a layer's pen
+/* The fidelity scores of the drawing, overall and per pen, against the
+** reference picture if there is one, else the target tone; a layer's pen
 ** against the layer's own target, drawn with its own width. */
 static lw_status score(const lw_params *p, const lw_scene *sc, const lw_strokes *st, const lw_grid2d *tone,
                        lw_drawing_report *rep, lw_error *err)
 {
+  lw_grid2d *ref = NULL;
+  if (sc->reference && !(ref = lw_image_tone_grid(sc->reference, &sc->reference_place, err)))
+    return err ? err->code : LW_ENOMEM;
+  if (ref) {
+    tone = ref;
+    snprintf(rep->reference, sizeof rep->reference, "%s", p->fidelity_reference);
+  }
   lw_status s =
       lw_fidelity_compute_strokes(st, -1, tone, p->tone_ink, p->pen_width, p->fidelity_sigma, &rep->fidelity, err);
   for (int k = 0; !s && st->n_pens > 1 && k < st->n_pens; k++) {
@@ -121,11 +129,15 @@ static lw_status score(const lw_params *p, const lw_scene *sc, const lw_strokes 
       continue;
     }
     lw_grid2d *g = lw_image_tone_grid(target, &sc->image_place, err);
-    if (!g) return err ? err->code : LW_ENOMEM;
+    if (!g) {
+      s = err ? err->code : LW_ENOMEM;
+      break;
+    }
     s = lw_fidelity_compute_strokes(st, k, g, p->tone_ink, sc->layers.spec[k].pen_width, p->fidelity_sigma,
                                     &rep->pen_fidelity[k], err);
     lw_grid2d_free(g);
   }
+  lw_grid2d_free(ref);
   rep->has_fidelity = !s;
   return s;
 }
@@ -190,7 +202,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
     s = lw_output_pdf_strokes(st, &page, under, path, err);
   }
   if (!s) s = close_share(p, sc, st, rep, err);
-  if (!s && tone) s = score(p, sc, st, tone, rep, err);
+  if (!s && (tone || sc->reference)) s = score(p, sc, st, tone, rep, err);
   lw_strokes_free(st);
   return s;
 }
@@ -279,6 +291,10 @@ void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep)
     lw_json_number(j, rep->fidelity.sigma_mm);
     lw_json_key(j, "black");
     lw_json_number(j, rep->fidelity.black);
+    if (rep->reference[0]) {
+      lw_json_key(j, "reference");
+      lw_json_string(j, rep->reference);
+    }
     if (rep->n_pens > 1) {
       lw_json_key(j, "pens");
       lw_json_begin_array(j);
@@ -335,8 +351,9 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
   if (!d->has_fidelity) return;
   char o[40];
   w = snprintf(buf + k, n - k,
-               "linewise: fidelity (blur %g mm, black %g): MSE %.6g, SSIM %.4f, orientation %s, stray ink %.4f\n",
-               d->fidelity.sigma_mm, d->fidelity.black, d->fidelity.mse, d->fidelity.ssim,
+               "linewise: fidelity%s%s (blur %g mm, black %g): MSE %.6g, SSIM %.4f, orientation %s, stray ink %.4f\n",
+               d->reference[0] ? " against " : "", d->reference, d->fidelity.sigma_mm, d->fidelity.black,
+               d->fidelity.mse, d->fidelity.ssim,
                orientation_text(d->fidelity.orientation, o), d->fidelity.stray);
   for (int p = 0; d->n_pens > 1 && p < d->n_pens && w >= 0 && (k += (size_t)w) < n; p++)
     w = snprintf(buf + k, n - k, "linewise: fidelity of pen %d: MSE %.6g, SSIM %.4f, orientation %s, stray ink %.4f\n",

@@ -411,6 +411,12 @@ const lw_param_def lw_param_table[] = {
       "Gaussian blur applied to both the rendered lines and the target (the ink asked for, "
       "energy.tone_ink * darkness) before the fidelity score (MSE, SSIM) compares them; about "
       "half the widest line spacing that should read as a flat tone (docs/FORMATS.md)."),
+  STRING("output", "fidelity_reference", fidelity_reference, "", "path",
+         "A picture to score the drawing against instead of the target (the picture after the "
+         "scene's pipeline), relative to the scene file: taken as it loads (gray, composited over "
+         "white; no blur, flattening, levels or tone curve) and fitted into the page inset by "
+         "scene.margin like scene.image. Scores that stay comparable while the pipeline's keys "
+         "change, or against a clean original of a photograph (docs/FORMATS.md). Empty = the target."),
   NUM("output", "field_preview", LW_PT_INT, field_preview, "0", "", 0, 1, 0,
       "1 = write field.png at the start of a run: the tone (white without an image) under "
       "short strokes along the field (needs the field term)."),

@@ -53,10 +53,11 @@ static lw_status margin_ok(const lw_params *p, lw_error *err)
   return LW_OK;
 }
 
-/* Loads the picture of key (scene.image or scene.mask_image) at path,
-** relative to the scene file, and fits it into the margin box. */
-static lw_image *load_picture(lw_scene *sc, const lw_params *p, const char *key, const char *path,
-                              lw_image_place *pl, lw_error *err)
+/* Loads the picture of section.key (scene.image, scene.mask_image,
+** output.fidelity_reference) at path, relative to the scene file, and fits
+** it into the margin box. */
+static lw_image *load_picture(lw_scene *sc, const lw_params *p, const char *section, const char *key,
+                              const char *path, lw_image_place *pl, lw_error *err)
 {
   char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
   lw_path_dir(dir, sizeof dir, p->file);
@@ -65,7 +66,7 @@ static lw_image *load_picture(lw_scene *sc, const lw_params *p, const char *key,
   lw_error e2;
   lw_image *img = lw_image_load(full, p->image_max_pixels, &info, &e2);
   if (!img) {
-    bad_key(p, "scene", key, e2.code, err, "%s", e2.msg);
+    bad_key(p, section, key, e2.code, err, "%s", e2.msg);
     return NULL;
   }
   if (img->width != info.width || img->height != info.height) {
@@ -84,7 +85,7 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
 {
   lw_status st = margin_ok(p, err);
   if (st) return st;
-  sc->image = load_picture(sc, p, "image", p->image, &sc->image_place, err);
+  sc->image = load_picture(sc, p, "scene", "image", p->image, &sc->image_place, err);
   if (!sc->image) return err->code;
   if (p->image_width > 0 && p->image_width != sc->image->width) {
     double h = (double)sc->image->height * p->image_width / sc->image->width;
@@ -136,7 +137,7 @@ static lw_status build_mask(lw_scene *sc, const lw_params *p, lw_error *err)
     if (!p->mask_image[0]) return bad_key(p, "scene", "mask", LW_EINPUT, err, "'image' needs scene.mask_image");
     lw_status st = margin_ok(p, err);
     if (st) return st;
-    img = own = load_picture(sc, p, "mask_image", p->mask_image, &pl, err);
+    img = own = load_picture(sc, p, "scene", "mask_image", p->mask_image, &pl, err);
     if (!own) return err->code;
   }
   size_t n = (size_t)img->width * (size_t)img->height;
@@ -378,6 +379,12 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   double cy = p->center_y >= 0 ? p->center_y : 0.5 * p->height;
 
   if (p->image[0] && (st = build_image(sc, p, err))) return st;
+  if (p->fidelity_reference[0]) {
+    if ((st = margin_ok(p, err))) return st;
+    sc->reference = load_picture(sc, p, "output", "fidelity_reference", p->fidelity_reference,
+                                 &sc->reference_place, err);
+    if (!sc->reference) return err->code;
+  }
 
   if (sc->on[LW_TERM_POTENTIAL]) {
     lw_potential *f = &sc->potential;
@@ -510,4 +517,6 @@ void lw_scene_clear(lw_scene *sc)
   }
   lw_image_free(sc->image);
   sc->image = NULL;
+  lw_image_free(sc->reference);
+  sc->reference = NULL;
 }

@@ -422,6 +422,36 @@ static double summary_number(const char *dir, const char *key)
   return at ? strtod(at + strlen(want), NULL) : NAN;
 }
 
+/* output.fidelity_reference scores against the picture as it loads: a run
+** whose target the levels stretch, scored against the unstretched picture,
+** gives the same numbers, to the bit, as its drawing scored on a scene whose
+** target is that picture (init.from, no sweeps), and not those of its own
+** target; the report names the reference.  A reference that is not a
+** picture is refused naming the key. */
+Test(image_cli, fidelity_against_a_reference_picture)
+{
+  write_tone_picture("dim.png", dim_tone);
+  write_scene("dim.png");
+  char errs[8192];
+  cr_assert_eq(run("run scene.ini --out a --set scene.image_levels=0.02 --set output.fidelity_reference=dim.png",
+                   errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "linewise: fidelity against "), "%s", errs);
+  cr_assert(strstr(lw_test_read_text(lw_test_path("a/summary.json")), "\"reference\": \""));
+  cr_assert_eq(run("run scene.ini --out b --set init.from=a/state.lw --set anneal.sweeps=0", errs, sizeof errs), 0,
+               "%s", errs);
+  cr_assert_eq(run("run scene.ini --out c --set scene.image_levels=0.02 --set init.from=a/state.lw "
+                   "--set anneal.sweeps=0", errs, sizeof errs), 0, "%s", errs);
+  const char *keys[2] = {"mse", "ssim"};
+  for (int k = 0; k < 2; k++) {
+    double a = summary_number(lw_test_path("a"), keys[k]), b = summary_number(lw_test_path("b"), keys[k]),
+           c = summary_number(lw_test_path("c"), keys[k]);
+    cr_assert(a == b && fabs(a - c) > 1e-3 * fabs(c), "%s: %.17g %.17g %.17g", keys[k], a, b, c);
+  }
+  cr_assert_eq(run("run scene.ini --out d --set output.fidelity_reference=scene.ini", errs, sizeof errs), 2, "%s",
+               errs);
+  cr_assert(strstr(errs, "output.fidelity_reference") && !strchr(strchr(errs, '\n') + 1, '\n'), "%s", errs);
+}
+
 /*
 ** Issue 20: one photo scene for every page.  params/photo.ini (scene.preset
 ** = photo) on A6 and A5, shortened to 40 sweeps: the preset sizes the lines

@@ -56,7 +56,8 @@ typedef struct {
   double crop_mm[4];                  /* x0 y0 x1 y1 */
   double pen_down_mm;                 /* ink length */
   double time_s;                      /* plot time estimate */
-  int has_fidelity;                   /* a target tone was given */
+  int has_fidelity;                   /* a target tone or a reference was given */
+  char reference[LW_PATH_MAX];        /* output.fidelity_reference scored against, or empty */
   lw_fidelity fidelity;               /* of all pens */
   int n_pens;
   size_t pen_paths[LW_PLOT_PENS_MAX];         /* paths of each pen */

@@ -175,6 +175,7 @@ typedef struct {
   int preview_image;          /* 1 = tone under the previews */
   int frames_every;           /* sweeps between frames; 0 = none */
   double fidelity_sigma;      /* blur before the fidelity score, mm */
+  char fidelity_reference[LW_PATH_MAX]; /* picture the score is against, or empty: the target */
   int field_preview;          /* 1 = write field.png */
   /* [plot] (strokes.h) */
   double join_distance;       /* pen widths; 0 = no joining */

@@ -67,6 +67,8 @@ typedef struct lw_scene {
   lw_term_id local[LW_TERM_COUNT]; /* ... and which */
   lw_image *image;              /* the processed picture (owned), or NULL */
   lw_image_place image_place;   /* where it lies on the page */
+  lw_image *reference;          /* output.fidelity_reference as loaded (owned), or NULL */
+  lw_image_place reference_place;
   lw_layers_spec layers;        /* [layers]; layers.n = 0: none (layers.h) */
   lw_layer layer[LW_LAYERS_MAX]; /* what each layer's terms read */
   char note[LW_ERROR_MSG];      /* something the user should know (a picture was
