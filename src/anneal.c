@@ -131,7 +131,8 @@ static lw_status setup_schedule(lw_anneal *a, lw_error *err)
 }
 
 /* Paths in the scene are relative to the scene file; the resolved scene.ini
-** lives in the run directory, so they are made absolute first. */
+** lives in the run directory, so they are made absolute first (path is a
+** key's field of LW_PATH_MAX bytes). */
 static void absolute_path(char *path, const char *scene_file)
 {
   if (!path[0] || path[0] == '/') return;
@@ -333,10 +334,11 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   a->net = net;
   a->wall_start = now_seconds();
   a->params = *p;
-  absolute_path(a->params.from, p->file);
-  absolute_path(a->params.table, p->file);
-  absolute_path(a->params.image, p->file);
-  absolute_path(a->params.mask_image, p->file);
+  for (size_t i = 0; i < lw_param_count; i++) { /* every key that names a file */
+    const lw_param_def *d = &lw_param_table[i];
+    if (d->type == LW_PT_STRING && d->unit && !strcmp(d->unit, "path") && d->size == LW_PATH_MAX)
+      absolute_path((char *)&a->params + d->offset, p->file);
+  }
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   a->seed = (unsigned long)p->seed;
   a->block = -1;

@@ -437,7 +437,8 @@ static int cmd_run(int argc, char **argv)
     lw_error_set(&err, LW_EUSAGE, "run: expected a scene file (usage: linewise run SCENE.ini [options])");
     return fail(&err);
   }
-  if (lw_params_read(&p, scene, &err)) return fail(&err);
+  /* resolved once --set has applied: lw_anneal_start */
+  if (lw_params_read_unresolved(&p, scene, &err)) return fail(&err);
   for (int i = 0; i < argc; i++) {
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
     if (!strcmp(argv[i], "--set")) {

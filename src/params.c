@@ -884,7 +884,7 @@ static int on_key(void *user, const char *section, const char *key, const char *
   return 1;
 }
 
-static lw_status read_file(lw_params *p, const char *path, int of_run, lw_error *err)
+static lw_status read_file(lw_params *p, const char *path, int of_run, int resolve, lw_error *err)
 {
   lw_params_defaults(p);
   p->of_run = of_run;
@@ -908,12 +908,17 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, lw_error 
     return lw_error_set(err, LW_EINPUT,
                         "%s:%d: syntax error: expected '[section]', 'key = value' or a comment", path, r);
   if (r < 0) return lw_error_set(err, LW_ENOMEM, "%s: out of memory while reading", path);
-  return lw_params_resolve(p, err);
+  return resolve ? lw_params_resolve(p, err) : LW_OK;
 }
 
-lw_status lw_params_read(lw_params *p, const char *path, lw_error *err) { return read_file(p, path, 0, err); }
+lw_status lw_params_read(lw_params *p, const char *path, lw_error *err) { return read_file(p, path, 0, 1, err); }
 
-lw_status lw_params_read_run(lw_params *p, const char *path, lw_error *err) { return read_file(p, path, 1, err); }
+lw_status lw_params_read_unresolved(lw_params *p, const char *path, lw_error *err)
+{
+  return read_file(p, path, 0, 0, err);
+}
+
+lw_status lw_params_read_run(lw_params *p, const char *path, lw_error *err) { return read_file(p, path, 1, 1, err); }
 
 /* Named page sizes in mm, portrait, in the order of the choices of
 ** scene.page (custom first, which has none). */

@@ -452,6 +452,28 @@ Test(image_cli, fidelity_against_a_reference_picture)
   cr_assert(strstr(errs, "output.fidelity_reference") && !strchr(strchr(errs, '\n') + 1, '\n'), "%s", errs);
 }
 
+/* --set applies on top of the scene file before anything is checked: a
+** copy of the photo scene whose picture is not there runs with --set
+** scene.image naming another (the preset's orientation = auto once read the
+** file's picture first and refused the run), and without the --set it is
+** refused with one line naming the file's line and key.  A file the scene
+** names relative to itself (output.fidelity_reference) is absolute in the
+** run's scene.ini, which lives elsewhere. */
+Test(image_cli, set_replaces_a_missing_picture_and_paths_stay_the_scenes)
+{
+  write_picture("pic.png", 60, 50);
+  cr_assert_eq(mkdir(lw_test_path("scenes"), 0755), 0);
+  write_text("scenes/s.ini", "[scene]\npreset = photo\npage = a6\nimage = gone.png\n[anneal]\nsweeps = 2\n"
+                             "[output]\nfidelity_reference = ../pic.png\n");
+  char errs[8192];
+  cr_assert_eq(run("run scenes/s.ini --out a", errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "s.ini:4: key 'scene.image': ") && !strchr(strchr(errs, '\n') + 1, '\n'), "%s", errs);
+  cr_assert_eq(run("run scenes/s.ini --out b --set scene.image=pic.png", errs, sizeof errs), 0, "%s", errs);
+  const char *ini = lw_test_read_text(lw_test_path("b/scene.ini"));
+  cr_assert(strstr(ini, "\nfidelity_reference = /"), "%s", ini);
+  cr_assert(strstr(lw_test_read_text(lw_test_path("b/summary.json")), "\"reference\": \"/"));
+}
+
 /*
 ** Issue 20: one photo scene for every page.  params/photo.ini (scene.preset
 ** = photo) on A6 and A5, shortened to 40 sweeps: the preset sizes the lines

@@ -253,6 +253,12 @@ void lw_params_defaults(lw_params *p);
 /* Reads an INI scene file into p (defaults first). */
 lw_status lw_params_read(lw_params *p, const char *path, lw_error *err);
 
+/* The same without lw_params_resolve, for a caller that changes keys (--set)
+** and then resolves: what the file says and a --set replaces is not checked
+** on its own (a picture the file names need not exist when --set names
+** another; the photo preset's orientation = auto would read its header). */
+lw_status lw_params_read_unresolved(lw_params *p, const char *path, lw_error *err);
+
 /* Reads a run directory's scene.ini, which holds every key the run's build
 ** knew, resolved.  A key it lacks is newer than the run, which ran with its
 ** default: a preset does not fill it (the photo preset's layers.apart = pen
