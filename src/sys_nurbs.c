@@ -452,6 +452,27 @@ static double propose_weight(lw_nurbs_state *s, nb_prop *q)
   return q->de[T_ELASTIC] + q->de[T_GRAVITY] + q->de[T_WEIGHTS];
 }
 
+/* (K P)_i from the band, summed afresh: a running K P, updated by each
+** move, carried the rounding of the moves so far, which a resumed run
+** (K P from scratch) did not share, and its energies came out a few ulps
+** apart.  K(i, i + d) = K[i k + d], K(i, i - d) = K[(i - d) k + d]. */
+static void band_row(const lw_dnurbs *m, const double *P, size_t i, double r[2])
+{
+  const size_t n = m->n, k = (size_t)m->k;
+  r[0] = m->K[i * k] * P[2 * i];
+  r[1] = m->K[i * k] * P[2 * i + 1];
+  for (size_t d = 1; d < k; d++) {
+    if (i + d < n) {
+      r[0] += m->K[i * k + d] * P[2 * (i + d)];
+      r[1] += m->K[i * k + d] * P[2 * (i + d) + 1];
+    }
+    if (i >= d) {
+      r[0] += m->K[(i - d) * k + d] * P[2 * (i - d)];
+      r[1] += m->K[(i - d) * k + d] * P[2 * (i - d) + 1];
+    }
+  }
+}
+
 /* point: dE of P_i + d = (K P)_i . d + 1/2 K_ii |d|^2 - f_i . d, from the band. */
 static double propose(void *state, void *prop, int kind, double step, gsl_rng *rng, int *forbidden)
 {
@@ -465,9 +486,9 @@ static double propose(void *state, void *prop, int kind, double step, gsl_rng *r
   if (kind == K_WEIGHT) return propose_weight(s, q);
   q->d[1] = step * (2.0 * gsl_rng_uniform(rng) - 1.0);
   size_t i = q->i;
-  double kii = s->mat->K[i * (size_t)s->mat->k];
-  q->de[T_ELASTIC] = s->KP[2 * i] * q->d[0] + s->KP[2 * i + 1] * q->d[1] +
-                     0.5 * kii * (q->d[0] * q->d[0] + q->d[1] * q->d[1]);
+  double kii = s->mat->K[i * (size_t)s->mat->k], kp[2];
+  band_row(s->mat, s->c->P, i, kp);
+  q->de[T_ELASTIC] = kp[0] * q->d[0] + kp[1] * q->d[1] + 0.5 * kii * (q->d[0] * q->d[0] + q->d[1] * q->d[1]);
   q->de[T_GRAVITY] = -(s->f[2 * i] * q->d[0] + s->f[2 * i + 1] * q->d[1]);
   q->de[T_WEIGHTS] = 0.0;
   return q->de[T_ELASTIC] + q->de[T_GRAVITY];
@@ -477,8 +498,7 @@ static lw_status commit(void *state, void *prop)
 {
   lw_nurbs_state *s = state;
   const nb_prop *q = prop;
-  const lw_dnurbs *m = s->mat;
-  size_t i = q->i, n = m->n, k = (size_t)m->k;
+  size_t i = q->i;
   if (q->kind == K_WEIGHT) {
     /* K and f change over 2k - 1 control points: assembled again, O(n) */
     lw_error err = {0};
@@ -492,19 +512,9 @@ static lw_status commit(void *state, void *prop)
       return LW_ENOMEM;
     }
   } else {
+    /* K P is not kept: propose sums its row, gradient the whole of it */
     s->c->P[2 * i] += q->d[0];
     s->c->P[2 * i + 1] += q->d[1];
-    /* column i of K: K(i + d, i) below, K(i, i - d) = K(i - d, i) above */
-    for (size_t d = 0; d < k; d++) {
-      if (i + d < n) {
-        s->KP[2 * (i + d)] += m->K[i * k + d] * q->d[0];
-        s->KP[2 * (i + d) + 1] += m->K[i * k + d] * q->d[1];
-      }
-      if (d > 0 && i >= d) {
-        s->KP[2 * (i - d)] += m->K[(i - d) * k + d] * q->d[0];
-        s->KP[2 * (i - d) + 1] += m->K[(i - d) * k + d] * q->d[1];
-      }
-    }
   }
   for (int t = 0; t < N_TERMS; t++) s->term[t] += q->de[t];
   return LW_OK;
@@ -621,6 +631,7 @@ static double gradient(void *state, double *g, lw_error *err)
 {
   lw_nurbs_state *s = state;
   size_t n = s->c->n, m = per_point(s->su);
+  lw_band_apply(s->mat->K, n, s->mat->k, s->c->P, s->KP);
   for (size_t i = 0; i < n; i++)
     for (size_t c = 0; c < 2; c++) g[m * i + c] = s->KP[2 * i + c] - s->f[2 * i + c];
   if (s->s) {

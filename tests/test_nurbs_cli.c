@@ -98,6 +98,13 @@ Test(nurbs_cli, a_points_file_holds_a_long_curve)
   cr_assert_eq(sh("%s run %s/long.ini --out %s/long --quiet", lw_test_bin(), dir, dir), 0);
   cr_assert_eq(sh("grep -q '\"control_points\": 60' %s/long/summary.json && grep -q '\"fixed\": 4' "
                   "%s/long/summary.json", dir, dir), 0);
+  /* the file is named from the scene's directory, the run's scene.ini lives
+  ** in the run's: it names the file absolutely, so the run resumes (it did
+  ** not: "half/long.txt: cannot read"), and to the same bytes (a running
+  ** K P, kept by the point moves, once left the energy a few ulps apart) */
+  cr_assert_eq(sh("%s run %s/long.ini --out %s/half --quiet --stop-at 10", lw_test_bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s resume %s/half --quiet", lw_test_bin(), dir), 0);
+  cr_assert_eq(sh("cmp -s %s/long/state.lw %s/half/state.lw", dir, dir), 0);
   refused("points = 0 0 1 x\\n", "bad.ini:4: key .nurbs.points.: expected numbers");
 }
 
