@@ -266,6 +266,7 @@ static lw_status rebuild(lw_nurbs_state *s, lw_error *err)
     }
   }
   lw_band_apply(s->mat->K, n, s->mat->k, s->c->P, s->KP);
+  s->kp_stale = 0;
   return LW_OK;
 }
 
@@ -515,6 +516,7 @@ static lw_status commit(void *state, void *prop)
     /* K P is not kept: propose sums its row, gradient the whole of it */
     s->c->P[2 * i] += q->d[0];
     s->c->P[2 * i + 1] += q->d[1];
+    s->kp_stale = 1;
   }
   for (int t = 0; t < N_TERMS; t++) s->term[t] += q->de[t];
   return LW_OK;
@@ -631,7 +633,8 @@ static double gradient(void *state, double *g, lw_error *err)
 {
   lw_nurbs_state *s = state;
   size_t n = s->c->n, m = per_point(s->su);
-  lw_band_apply(s->mat->K, n, s->mat->k, s->c->P, s->KP);
+  if (s->kp_stale) lw_band_apply(s->mat->K, n, s->mat->k, s->c->P, s->KP);
+  s->kp_stale = 0;
   for (size_t i = 0; i < n; i++)
     for (size_t c = 0; c < 2; c++) g[m * i + c] = s->KP[2 * i + c] - s->f[2 * i + c];
   if (s->s) {
