@@ -649,6 +649,24 @@ static lw_status dynamics_sweep(lw_anneal *a, lw_error *err)
   return sweep_files(a, err);
 }
 
+/* Whether the energy is recomputed from scratch after sweep `sweep`: every
+** `every` sweeps (the drift check, with the renumbering before it), and at
+** sweeps 1, 2, 4, 8, ... below that.  A placement can start many orders of
+** magnitude above where the first sweeps take it (particles of a points
+** file on top of a pattern's: 1e19, then -2,800 twenty sweeps on), and a
+** running total keeps the rounding of that fall: a drift of 7 % by sweep
+** 20, and a checkpoint that resume refused as damaged.  The early
+** recomputations drop it while the fall lasts, at log2(every) of them a run
+** (where the totals agree with them to LW_ANNEAL_EARLY_DRIFT, the totals
+** stay); the sweep alone decides, so a resumed run recomputes where the
+** first did. */
+#define LW_ANNEAL_EARLY_DRIFT 1e-9 /* relative drift an early recomputation corrects */
+static int refresh_due(long sweep, long every, int *renumber)
+{
+  *renumber = sweep % every == 0;
+  return *renumber || (sweep > 0 && sweep < every && (sweep & (sweep - 1)) == 0);
+}
+
 lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
 {
   if (a->dyn) return dynamics_sweep(a, err);
@@ -696,14 +714,23 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
     a->acc_sumsq += e * e;
   }
   if (a->sweep % p->trace_every == 0 || lw_anneal_done(a)) trace_row(a);
-  if (a->sweep % p->check_every == 0) {
+  int renumber;
+  if (refresh_due(a->sweep, p->check_every, &renumber)) {
     s = LW_OK;
     for (int r = 0; r < n && !s; r++) {
-      double drift;
+      double drift, run[LW_SYSTEM_TERMS_MAX];
+      void *state = a->systems[r]->state;
       if (!replica_here(a, r)) continue;
-      if (a->sys_type->renumber && (s = a->sys_type->renumber(a->systems[r]->state, err))) break;
-      if (a->sys_type->refresh(a->systems[r]->state, &drift) != LW_OK)
+      if (renumber && a->sys_type->renumber && (s = a->sys_type->renumber(state, err))) break;
+      a->sys_type->terms(state, run);
+      if (a->sys_type->refresh(state, &drift) != LW_OK) {
         s = lw_error_set(err, LW_ENOMEM, "out of memory");
+        break;
+      }
+      /* an early recomputation keeps running totals that agree with it, and
+      ** does not count in max_drift: the bits of a run without it (and of
+      ** runs begun by older releases) */
+      if (!renumber && !(drift > LW_ANNEAL_EARLY_DRIFT)) a->sys_type->set_terms(state, run);
       else if (drift > a->max_drift) a->max_drift = drift;
     }
     if (a->net) s = a->net->drift(a->net, a, s, err);
