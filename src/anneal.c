@@ -340,7 +340,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
       absolute_path((char *)&a->params + d->offset, p->file);
   }
   snprintf(a->dir, sizeof a->dir, "%s", dir);
-  a->seed = (unsigned long)p->seed;
+  a->seed = (unsigned long)a->params.seed;
   a->block = -1;
   lw_status s;
   double ladder[LW_TEMPERING_MAX];
@@ -361,7 +361,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
     }
   if ((s = build(a, all, ladder, err)) || (s = check_quench(a, err))) return s;
   a->energy_initial = lw_system_total(a->sys);
-  a->end_sweep = p->sweeps;
+  a->end_sweep = a->params.sweeps; /* resolved: the caller's p may not be (a preset's sweeps) */
   /* Everything above only read input: the directory appears once the run
   ** is known to be valid. */
   if ((s = make_dir(dir, err))) return s;

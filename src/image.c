@@ -1005,13 +1005,14 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
   const lw_image tone = {w, h, img->tone, NULL};
   const int f = radius >= 2 * FLATTEN_COARSE ? (int)(radius / FLATTEN_COARSE) : 1;
   const int cw = (w + f - 1) / f, ch = (h + f - 1) / f;
-  lw_image *coarse = f > 1 ? lw_image_resize(&tone, cw, ch, err) : lw_image_new(w, h, 0, err), *paper = NULL;
-  if (!coarse) return err ? err->code : LW_ENOMEM;
-  if (f == 1) memcpy(coarse->tone, img->tone, n * sizeof *img->tone);
-  lw_status st = paper_of(coarse->tone, cw, ch, radius * cw / w, err);
-  if (!st && f > 1 && !(paper = lw_image_resize(coarse, w, h, err))) st = err ? err->code : LW_ENOMEM;
-  if (f == 1) paper = coarse, coarse = NULL;
-  lw_image_free(coarse);
+  lw_image *paper = lw_image_resize(&tone, cw, ch, err); /* f = 1: a copy */
+  if (!paper) return err ? err->code : LW_ENOMEM;
+  lw_status st = paper_of(paper->tone, cw, ch, radius * cw / w, err);
+  if (!st && f > 1) {
+    lw_image *full = lw_image_resize(paper, w, h, err);
+    lw_image_free(paper);
+    if (!(paper = full)) return err ? err->code : LW_ENOMEM;
+  }
   if (st) {
     lw_image_free(paper);
     return st;

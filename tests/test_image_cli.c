@@ -458,19 +458,26 @@ Test(image_cli, fidelity_against_a_reference_picture)
 ** file's picture first and refused the run), and without the --set it is
 ** refused with one line naming the file's line and key.  A file the scene
 ** names relative to itself (output.fidelity_reference) is absolute in the
-** run's scene.ini, which lives elsewhere. */
+** run's scene.ini, which lives elsewhere, and the run is that of the
+** resolved scene (the preset's sweeps). */
 Test(image_cli, set_replaces_a_missing_picture_and_paths_stay_the_scenes)
 {
   write_picture("pic.png", 60, 50);
   cr_assert_eq(mkdir(lw_test_path("scenes"), 0755), 0);
-  write_text("scenes/s.ini", "[scene]\npreset = photo\npage = a6\nimage = gone.png\n[anneal]\nsweeps = 2\n"
+  write_text("scenes/s.ini", "[scene]\npreset = photo\nwidth = 30\nheight = 24\nmargin = 2\nimage = gone.png\n"
                              "[output]\nfidelity_reference = ../pic.png\n");
   char errs[8192];
   cr_assert_eq(run("run scenes/s.ini --out a", errs, sizeof errs), 2, "%s", errs);
-  cr_assert(strstr(errs, "s.ini:4: key 'scene.image': ") && !strchr(strchr(errs, '\n') + 1, '\n'), "%s", errs);
+  cr_assert(strstr(errs, "s.ini:6: key 'scene.image': ") && !strchr(strchr(errs, '\n') + 1, '\n'), "%s", errs);
   cr_assert_eq(run("run scenes/s.ini --out b --set scene.image=pic.png", errs, sizeof errs), 0, "%s", errs);
   const char *ini = lw_test_read_text(lw_test_path("b/scene.ini"));
   cr_assert(strstr(ini, "\nfidelity_reference = /"), "%s", ini);
+  /* and the run is the resolved scene's: the preset's sweeps, which the
+  ** scene does not set (the loop once took the unresolved default, 1000) */
+  const char *at = strstr(ini, "\nsweeps = ");
+  cr_assert_not_null(at);
+  const double sweeps = strtod(at + strlen("\nsweeps = "), NULL);
+  cr_assert(sweeps != 1000 && summary_number(lw_test_path("b"), "sweeps") == sweeps, "%g", sweeps);
   cr_assert(strstr(lw_test_read_text(lw_test_path("b/summary.json")), "\"reference\": \"/"));
 }
 
