@@ -256,7 +256,9 @@ lw_status lw_params_read(lw_params *p, const char *path, lw_error *err);
 /* The same without lw_params_resolve, for a caller that changes keys (--set)
 ** and then resolves: what the file says and a --set replaces is not checked
 ** on its own (a picture the file names need not exist when --set names
-** another; the photo preset's orientation = auto would read its header). */
+** another; the photo preset's orientation = auto would read its header).
+** p is not to be used before lw_params_resolve (lw_anneal_start resolves
+** its own copy). */
 lw_status lw_params_read_unresolved(lw_params *p, const char *path, lw_error *err);
 
 /* Reads a run directory's scene.ini, which holds every key the run's build
