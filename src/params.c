@@ -355,7 +355,7 @@ const lw_param_def lw_param_table[] = {
          "minimum of its energy (limited-memory BFGS on the system's gradient, holding the parts a "
          "step would take through a wall; docs/ACCURACY.md). "
          "The drawings and summary.json show the quenched state; state.lw keeps the annealed one, so "
-         "a resumed or longer run continues the chain. Needs a system with a gradient (splines)."),
+         "a resumed or longer run continues the chain. Needs a system with a gradient (splines, nurbs, particles)."),
   NUM("anneal", "quench_tol", LW_PT_DOUBLE, quench_tol, "1e-6", "energy/mm", 0, 1e300, LW_MIN_OPEN,
       "The quench stops when the gradient's Euclidean norm falls to this."),
   NUM("anneal", "quench_iterations", LW_PT_INT, quench_iterations, "2000", "", 1, 1e9, 0,

@@ -157,6 +157,25 @@ static void axis_gaps(double a, double h, int c, double p, double gap[3])
   gap[2] = above * above;
 }
 
+/* The cells a walk from x visits: x's cell c, the ranges lo..hi (its
+** neighbours within the grid) and the squared gaps to them along each axis. */
+typedef struct {
+  int c[3], lo[3], hi[3];
+  double gap[3][3];
+} around;
+
+static void cells_around(const lw_cellgrid *g, const double x[3], around *a)
+{
+  const double h = 1.0 / g->inv_h, o[3] = {g->x0, g->y0, g->z0};
+  const int n[3] = {g->nx, g->ny, g->nz};
+  lw_cellgrid_locate3(g, x[0], x[1], x[2], &a->c[0], &a->c[1], &a->c[2]);
+  for (int k = 0; k < 3; k++) {
+    axis_gaps(o[k], h, a->c[k], x[k], a->gap[k]);
+    a->lo[k] = a->c[k] > 0 ? a->c[k] - 1 : 0;
+    a->hi[k] = a->c[k] + 1 < n[k] ? a->c[k] + 1 : n[k] - 1;
+  }
+}
+
 /*
 ** The pair energies of a particle at x against its neighbours j != k with
 ** j >= from, added per term to ea (with normal na) and, when nb is not NULL,
@@ -171,24 +190,17 @@ static void walk(const lw_particles *p, uint32_t k, uint32_t from, const double 
 {
   const lw_cellgrid *g = p->grid;
   const lw_ppair_ctx *c = &p->setup->pair;
-  const double range2 = c->range2, skip2 = range2 * (1.0 + 1e-9), h = 1.0 / g->inv_h;
+  const double range2 = c->range2, skip2 = range2 * (1.0 + 1e-9);
   const double *nrm = p->nrm;
-  int cx, cy, cz;
-  lw_cellgrid_locate3(g, x[0], x[1], x[2], &cx, &cy, &cz);
-  double gx[3], gy[3], gz[3];
-  axis_gaps(g->x0, h, cx, x[0], gx);
-  axis_gaps(g->y0, h, cy, x[1], gy);
-  axis_gaps(g->z0, h, cz, x[2], gz);
-  int z0 = cz > 0 ? cz - 1 : 0, z1 = cz + 1 < g->nz ? cz + 1 : g->nz - 1;
-  int y0 = cy > 0 ? cy - 1 : 0, y1 = cy + 1 < g->ny ? cy + 1 : g->ny - 1;
-  int x0 = cx > 0 ? cx - 1 : 0, x1 = cx + 1 < g->nx ? cx + 1 : g->nx - 1;
-  for (int zz = z0; zz <= z1; zz++)
-    for (int yy = y0; yy <= y1; yy++) {
-      double gyz = gz[zz - cz + 1] + gy[yy - cy + 1];
+  around a;
+  cells_around(g, x, &a);
+  for (int zz = a.lo[2]; zz <= a.hi[2]; zz++)
+    for (int yy = a.lo[1]; yy <= a.hi[1]; yy++) {
+      double gyz = a.gap[2][zz - a.c[2] + 1] + a.gap[1][yy - a.c[1] + 1];
       if (gyz > skip2) continue;
       const lw_cell *row = g->cell + ((size_t)zz * (size_t)g->ny + (size_t)yy) * (size_t)g->nx;
-      for (int xx = x0; xx <= x1; xx++) {
-        if (gyz + gx[xx - cx + 1] > skip2) continue;
+      for (int xx = a.lo[0]; xx <= a.hi[0]; xx++) {
+        if (gyz + a.gap[0][xx - a.c[0] + 1] > skip2) continue;
         const lw_cell *cell = row + xx;
         const double *px = cell->x, *py = lw_cell_y(cell), *pz = lw_cell_z(cell);
         const uint32_t *id = lw_cell_idx(cell);
@@ -212,6 +224,140 @@ void lw_particles_energy(const lw_particles *p, double term[LW_PTERM_COUNT])
   for (size_t i = 0; i < p->n; i++) {
     if (s->pair.on) walk(p, (uint32_t)i, (uint32_t)i + 1, p->x + 3 * i, p->nrm + 3 * i, NULL, term, NULL);
     if (external(s, p->x + 3 * i, term)) term[LW_PTERM_BOUNDARY] = INFINITY;
+  }
+}
+
+/* ---- gradient ------------------------------------------------------------ */
+
+/* dE/dx (3n) into gx and dE/dn (3n, each normal a free vector) into gn, of
+** every term that is on, the pairs in the order of lw_particles_energy. */
+static void gradient_xn(const lw_particles *p, double *gx, double *gn)
+{
+  const lw_particles_setup *s = p->setup;
+  const lw_ppair_ctx *c = &s->pair;
+  memset(gx, 0, 3 * p->n * sizeof *gx);
+  memset(gn, 0, 3 * p->n * sizeof *gn);
+  for (size_t i = 0; i < p->n; i++) {
+    const double *x = p->x + 3 * i, *ni = p->nrm + 3 * i;
+    double *gxi = gx + 3 * i, *gni = gn + 3 * i;
+    if (c->on) {
+      const lw_cellgrid *g = p->grid;
+      const double skip2 = c->range2 * (1.0 + 1e-9);
+      around a;
+      cells_around(g, x, &a);
+      for (int zz = a.lo[2]; zz <= a.hi[2]; zz++)
+        for (int yy = a.lo[1]; yy <= a.hi[1]; yy++)
+          for (int xx = a.lo[0]; xx <= a.hi[0]; xx++) {
+            if (a.gap[2][zz - a.c[2] + 1] + a.gap[1][yy - a.c[1] + 1] + a.gap[0][xx - a.c[0] + 1] > skip2) continue;
+            const lw_cell *cell = g->cell + ((size_t)zz * (size_t)g->ny + (size_t)yy) * (size_t)g->nx + xx;
+            const double *px = cell->x, *py = lw_cell_y(cell), *pz = lw_cell_z(cell);
+            const uint32_t *id = lw_cell_idx(cell);
+            for (uint32_t e = 0; e < cell->n; e++) {
+              size_t j = id[e];
+              if (j <= i) continue;
+              double r[3] = {px[e] - x[0], py[e] - x[1], pz[e] - x[2]}, gr[3] = {0, 0, 0};
+              double d2 = lw_v3_dot(r, r);
+              if (d2 >= c->range2) continue;
+              lw_ppair_grad(c, r, d2, ni, p->nrm + 3 * j, gr, gni, gn + 3 * j);
+              for (int k = 0; k < 3; k++) {
+                gxi[k] -= gr[k];
+                gx[3 * j + k] += gr[k];
+              }
+            }
+          }
+    }
+    gxi[2] += s->gravity;
+    if (s->boundary == LW_PBOUNDARY_NONE || s->alpha_b == 0.0) continue;
+    /* alpha_B / d^2: the slope -2 alpha_B / d^3 along grad d */
+    if (s->boundary == LW_PBOUNDARY_PLANE) {
+      double d = x[2] - s->boundary_z;
+      gxi[2] -= 2.0 * s->alpha_b / (d * d * d);
+    } else {
+      double len = sqrt(lw_v3_dot(x, x)), d = s->boundary_radius - len;
+      double f = len > 0.0 ? 2.0 * s->alpha_b / (d * d * d * len) : 0.0;
+      for (int k = 0; k < 3; k++) gxi[k] += f * x[k];
+    }
+  }
+}
+
+size_t lw_particles_n_coords(const lw_particles *p) { return LW_PARTICLE_COORDS * p->n; }
+
+void lw_particles_get_coords(const lw_particles *p, double *c)
+{
+  for (size_t i = 0; i < p->n; i++) {
+    memcpy(c + LW_PARTICLE_COORDS * i, p->x + 3 * i, 3 * sizeof *c);
+    memcpy(c + LW_PARTICLE_COORDS * i + 3, p->q + 4 * i, 4 * sizeof *c);
+  }
+}
+
+lw_status lw_particles_set_coords(lw_particles *p, const double *c, lw_error *err)
+{
+  if (!p->qlen && !(p->qlen = malloc((p->n ? p->n : 1) * sizeof *p->qlen)))
+    return lw_error_set(err, LW_ENOMEM, "out of memory for %zu particles", p->n);
+  for (size_t i = 0; i < LW_PARTICLE_COORDS * p->n; i++)
+    if (!isfinite(c[i]))
+      return lw_error_set(err, LW_EINPUT, "particle %zu: a coordinate is not finite", i / LW_PARTICLE_COORDS);
+  for (size_t i = 0; i < p->n; i++) {
+    const double *ci = c + LW_PARTICLE_COORDS * i, *cq = ci + 3;
+    double *x = p->x + 3 * i, *q = p->q + 4 * i;
+    if (ci[0] != x[0] || ci[1] != x[1] || ci[2] != x[2]) {
+      if (lw_cellgrid_move3(p->grid, (uint32_t)i, ci[0], ci[1], ci[2]))
+        return lw_error_set(err, LW_ENOMEM, "out of memory for the particle grid");
+      memcpy(x, ci, 3 * sizeof *x);
+    }
+    double len = sqrt(cq[0] * cq[0] + cq[1] * cq[1] + cq[2] * cq[2] + cq[3] * cq[3]);
+    if (!(len > 0.0)) return lw_error_set(err, LW_EINPUT, "particle %zu: a quaternion of length 0", i);
+    /* a unit quaternion to rounding is kept as given, so that a driver's
+    ** coordinates and the state (and a checkpoint of it) agree bit for bit */
+    p->qlen[i] = fabs(len - 1.0) <= LW_PARTICLE_UNIT_TOL ? 1.0 : len;
+    if (!memcmp(q, cq, 4 * sizeof *q)) continue;
+    memcpy(q, cq, 4 * sizeof *q);
+    if (p->qlen[i] != 1.0) lw_quat_normalise(q);
+    lw_quat_normal(q, p->nrm + 3 * i);
+  }
+  lw_particles_energy(p, p->term);
+  return LW_OK;
+}
+
+double lw_particles_gradient(const lw_particles *p, double *g, lw_error *err)
+{
+  double e = lw_particles_total(p);
+  if (!isfinite(e)) return e;
+  double *gx = malloc(6 * (p->n ? p->n : 1) * sizeof *gx);
+  if (!gx) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for the gradient of %zu particles", p->n);
+    return NAN;
+  }
+  double *gn = gx + 3 * p->n;
+  gradient_xn(p, gx, gn);
+  for (size_t i = 0; i < p->n; i++) {
+    double *gi = g + LW_PARTICLE_COORDS * i, *gq = gi + 3;
+    const double *q = p->q + 4 * i, *n = gn + 3 * i;
+    for (int k = 0; k < 3; k++) gi[k] = p->pin[i] & LW_PIN_POSITION ? 0.0 : gx[3 * i + k];
+    /* through n(q) = (2 (xz + wy), 2 (yz - wx), 1 - 2 (x^2 + y^2)), then
+    ** onto the sphere's tangent, since the energy sees q / |q| */
+    gq[0] = 2.0 * (n[0] * q[2] - n[1] * q[1]);
+    gq[1] = 2.0 * (n[0] * q[3] - n[1] * q[0] - 2.0 * n[2] * q[1]);
+    gq[2] = 2.0 * (n[0] * q[0] + n[1] * q[3] - 2.0 * n[2] * q[2]);
+    gq[3] = 2.0 * (n[0] * q[1] + n[1] * q[2]);
+    double along = gq[0] * q[0] + gq[1] * q[1] + gq[2] * q[2] + gq[3] * q[3];
+    double scale = p->pin[i] & LW_PIN_ORIENTATION ? 0.0 : 1.0 / (p->qlen ? p->qlen[i] : 1.0);
+    for (int k = 0; k < 4; k++) gq[k] = (gq[k] - along * q[k]) * scale;
+  }
+  free(gx);
+  return e;
+}
+
+void lw_particles_constrain(const lw_particles *p, double *c, double *pi)
+{
+  for (size_t i = 0; i < p->n; i++) {
+    if (p->pin[i] & LW_PIN_ORIENTATION) continue;
+    double *q = c + LW_PARTICLE_COORDS * i + 3;
+    lw_quat_normalise(q);
+    if (!pi) continue;
+    double *m = pi + LW_PARTICLE_COORDS * i + 3;
+    double along = m[0] * q[0] + m[1] * q[1] + m[2] * q[2] + m[3] * q[3];
+    for (int k = 0; k < 4; k++) m[k] -= along * q[k];
   }
 }
 
@@ -254,6 +400,7 @@ void lw_particles_free(lw_particles *p)
   free(p->q);
   free(p->nrm);
   free(p->pin);
+  free(p->qlen);
   for (int m = 0; m < LW_PMOVE_KINDS; m++) free(p->movable[m]);
   lw_cellgrid_free(p->grid);
   free(p);

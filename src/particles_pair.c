@@ -27,3 +27,65 @@ lw_status lw_ppair_init(lw_ppair_ctx *c, double r0, double range, int weight, do
   c->weighted = alpha[LW_PTERM_PLANAR] != 0.0 || alpha[LW_PTERM_NORMAL] != 0.0 || alpha[LW_PTERM_CIRCULAR] != 0.0;
   return LW_OK;
 }
+
+/* The weight's gradient: dw/dr into wr, dw/dn_i into wi, dw/dn_j into wj
+** (docs/NUMERICS.md, "Forces and torques"); returns w. */
+static double weight_grad(const lw_ppair_ctx *c, const double r[3], double d2, const double ni[3],
+                          const double nj[3], double zi, double zj, double wr[3], double wi[3], double wj[3])
+{
+  for (int k = 0; k < 3; k++) wr[k] = wi[k] = wj[k] = 0.0;
+  switch (c->weight) {
+  case LW_PWEIGHT_POLY: {
+    double t = 1.0 - d2 * c->inv_range2, dw = -6.0 * t * t * c->inv_range2; /* dw/dd2 times 2 */
+    for (int k = 0; k < 3; k++) wr[k] = dw * r[k];
+    return t * t * t;
+  }
+  case LW_PWEIGHT_GAUSS: {
+    double e = exp(-d2 * c->ia), dw = -2.0 * c->ia * e * c->g_scale;
+    for (int k = 0; k < 3; k++) wr[k] = dw * r[k];
+    return (e - c->g_R) * c->g_scale;
+  }
+  default: { /* aniso: each end's g clipped at 0 has no slope where it is clipped */
+    double w = 0.0, h = 0.5 * c->g_scale;
+    const double *n[2] = {ni, nj};
+    double z[2] = {zi, zj}, *wn[2] = {wi, wj};
+    for (int e = 0; e < 2; e++) {
+      double z2 = z[e] * z[e], ge = exp(-(d2 - z2) * c->ia - z2 * c->ib);
+      if (!(ge - c->g_R > 0.0)) continue;
+      w += h * (ge - c->g_R);
+      double dz = h * ge * 2.0 * z[e] * (c->ia - c->ib), dd = -h * ge * 2.0 * c->ia;
+      for (int k = 0; k < 3; k++) {
+        wr[k] += dd * r[k] + dz * n[e][k];
+        wn[e][k] = dz * r[k];
+      }
+    }
+    return w;
+  }
+  }
+}
+
+void lw_ppair_grad(const lw_ppair_ctx *c, const double r[3], double d2, const double ni[3], const double nj[3],
+                   double gr[3], double gi[3], double gj[3])
+{
+  if (c->alpha[LW_PTERM_LJ] != 0.0) {
+    double s = c->r0 * c->r0 / d2, s6 = s * s * s;
+    double f = c->alpha[LW_PTERM_LJ] * -12.0 * s6 * (s6 - 1.0) / d2; /* 2 dphi/dd2 */
+    for (int k = 0; k < 3; k++) gr[k] += f * r[k];
+  }
+  if (!c->weighted) return;
+  double zi = lw_v3_dot(ni, r), zj = lw_v3_dot(nj, r), s = zi + zj;
+  double wr[3], wi[3], wj[3];
+  double w = weight_grad(c, r, d2, ni, nj, zi, zj, wr, wi, wj);
+  const double ap = c->alpha[LW_PTERM_PLANAR], an = c->alpha[LW_PTERM_NORMAL], ac = c->alpha[LW_PTERM_CIRCULAR];
+  double dn[3] = {ni[0] - nj[0], ni[1] - nj[1], ni[2] - nj[2]};
+  /* U = aP (zi^2 + zj^2) + aN |ni - nj|^2 + aC (zi + zj)^2, E = w U */
+  double u = ap * (zi * zi + zj * zj) + an * lw_v3_dot(dn, dn) + ac * s * s;
+  for (int k = 0; k < 3; k++) {
+    double ur = 2.0 * (ap * (zi * ni[k] + zj * nj[k]) + ac * s * (ni[k] + nj[k]));
+    double ui = 2.0 * (ap * zi * r[k] + an * dn[k] + ac * s * r[k]);
+    double uj = 2.0 * (ap * zj * r[k] - an * dn[k] + ac * s * r[k]);
+    gr[k] += u * wr[k] + w * ur;
+    gi[k] += u * wi[k] + w * ui;
+    gj[k] += u * wj[k] + w * uj;
+  }
+}

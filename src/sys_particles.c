@@ -92,6 +92,17 @@ static double energy(const void *setup, const lw_state *st, const char *path, do
   return e;
 }
 
+static size_t n_coords(const void *state) { return lw_particles_n_coords(state); }
+
+static void get_coords(const void *state, double *x) { lw_particles_get_coords(state, x); }
+
+static lw_status set_coords(void *state, const double *x, lw_error *err)
+{
+  return lw_particles_set_coords(state, x, err);
+}
+
+static double gradient(void *state, double *g, lw_error *err) { return lw_particles_gradient(state, g, err); }
+
 static lw_status save(const void *state, lw_ckpt_writer *w, const char *section, lw_error *err)
 {
   lw_particles_put(w, section, state);
@@ -176,4 +187,8 @@ const lw_system_type lw_system_particles = {
     .draw = draw,
     .summary = summary,
     .describe = describe,
+    .n_coords = n_coords,
+    .get_coords = get_coords,
+    .set_coords = set_coords,
+    .gradient = gradient,
 };

@@ -803,17 +803,6 @@ static char qdir[64];
 static void qsetup(void) { cr_assert_eq(lw_test_dir_make(qdir, "quench"), 0); }
 static void qteardown(void) { lw_test_dir_remove(qdir); }
 
-Test(quench, refused_for_a_system_without_gradient, .init = qsetup, .fini = qteardown)
-{
-  cr_assert_eq(lw_test_sh("sed 's/^sweeps = .*/sweeps = 5/' %s/params/particles-sheet.ini > %s/p.ini && "
-                          "printf 'quench = bfgs\\n' >> %s/p.ini", lw_test_root(), qdir, qdir), 0);
-  int rc = lw_test_sh("%s run %s/p.ini --out %s/run --quiet 2> %s/err.txt", lw_test_bin(), qdir, qdir, qdir);
-  cr_assert_eq(rc, 2);
-  cr_assert_eq(lw_test_sh("grep -q \"p.ini:[0-9]*: key 'anneal.quench': the particles system has no gradient\" "
-                          "%s/err.txt", qdir), 0);
-  cr_assert_neq(lw_test_sh("test -e %s/run", qdir), 0, "nothing is written for a refused scene");
-}
-
 /* A signal during the quench stops it (the quench of a picture's page takes
 ** minutes): the run ends at once, exit 0, with the annealed state saved
 ** and nothing drawn, as a run stopped between sweeps; the phase line on

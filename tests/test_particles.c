@@ -1248,3 +1248,82 @@ Test(particles, degenerate_draws_give_nan_and_a_turn_without_weights_changes_not
   lw_particles_free(p);
   lw_particles_setup_free(s);
 }
+
+/* ---- the gradient for the quench and the dynamics ------------------------ */
+
+/* The total energy at coordinates c (set_coords, then the totals). */
+static double energy_at(lw_particles *p, const double *c)
+{
+  cr_assert_eq(lw_particles_set_coords(p, c, NULL), LW_OK);
+  return lw_particles_total(p);
+}
+
+Test(particles, the_gradient_matches_central_differences_of_the_energy)
+{
+  /* Every term on, each weight, both walls with a soft term, gravity, some
+  ** quaternions off the unit sphere (the energy reads q / |q|) and some
+  ** particles pinned (their gradient is 0).  Central differences with
+  ** h = 1e-6 on energies of order 10 err by about h^2 E''' + eps E / h,
+  ** 1e-9 here: tolerance 1e-6 (1 + |g|).  A sign or a factor 2 slipped in
+  ** any term, or a missed projection, is off by 1e-2 and more. */
+  const int weights[3] = {LW_PWEIGHT_POLY, LW_PWEIGHT_GAUSS, LW_PWEIGHT_ANISO};
+  for (int v = 0; v < 6; v++) {
+    lw_params prm = scene(0.7, 1.3, 0.9, 0.6);
+    prm.pt_pattern = LW_PPATTERN_PLANE;
+    prm.pt_count = 24;
+    prm.pt_noise = 0.15;
+    prm.pt_normal_noise = 25;
+    prm.pt_weight = weights[v % 3];
+    prm.pt_sigma = 0.9;
+    prm.pt_sigma_normal = 0.6;
+    prm.pt_gravity = 0.3;
+    prm.pt_alpha_b = 0.2;
+    prm.pt_boundary = v < 3 ? LW_PBOUNDARY_PLANE : LW_PBOUNDARY_SPHERE;
+    prm.pt_boundary_z = -1.5;
+    prm.pt_boundary_radius = 5;
+    lw_particles_setup *s = setup_of(&prm);
+    lw_particles *p0 = lw_particles_new(s, 40 + (unsigned long)v, NULL);
+    cr_assert_not_null(p0);
+    unsigned char pin[24] = {0};
+    pin[3] = LW_PIN_POSITION;
+    pin[7] = LW_PIN_ORIENTATION;
+    pin[11] = LW_PIN_POSITION | LW_PIN_ORIENTATION;
+    lw_particles *p = lw_particles_new_from(s, p0->n, p0->x, p0->q, pin, NULL);
+    cr_assert_not_null(p);
+    const size_t n = lw_particles_n_coords(p);
+    cr_assert_eq(n, 7 * p->n);
+    double *c = malloc(n * sizeof *c), *g = malloc(n * sizeof *g), *cc = malloc(n * sizeof *cc);
+    lw_particles_get_coords(p, c);
+    for (size_t i = 0; i < p->n; i += 3)
+      for (int k = 3; k < 7; k++) c[7 * i + k] *= 1.3;
+    double e = energy_at(p, c);
+    cr_assert(isfinite(e) && fabs(e) > 1, "energy %g", e);
+    cr_assert_float_eq(lw_particles_gradient(p, g, NULL), e, 1e-12);
+    double worst = 0, largest = 0;
+    for (size_t k = 0; k < n; k++) {
+      const double h = 1e-6;
+      memcpy(cc, c, n * sizeof *c);
+      cc[k] = c[k] + h;
+      double ep = energy_at(p, cc);
+      cc[k] = c[k] - h;
+      double fd = (ep - energy_at(p, cc)) / (2 * h);
+      size_t i = k / 7;
+      int pinned = k % 7 < 3 ? pin[i] & LW_PIN_POSITION : pin[i] & LW_PIN_ORIENTATION;
+      if (pinned) {
+        cr_assert_eq(g[k], 0.0, "pinned coordinate %zu has gradient %g", k, g[k]);
+        continue;
+      }
+      double err = fabs(fd - g[k]) / (1 + fabs(g[k]));
+      cr_assert(err < 1e-6, "variant %d coordinate %zu: difference %.10g, gradient %.10g", v, k, fd, g[k]);
+      if (err > worst) worst = err;
+      if (fabs(g[k]) > largest) largest = fabs(g[k]);
+    }
+    cr_assert_gt(largest, 0.1, "a gradient too small to tell anything");
+    free(c);
+    free(g);
+    free(cc);
+    lw_particles_free(p);
+    lw_particles_free(p0);
+    lw_particles_setup_free(s);
+  }
+}

@@ -111,6 +111,7 @@ typedef struct {
   size_t n_sweep;               /* particles with a free degree of freedom */
   lw_cellgrid *grid;            /* positions by cell (x, y, z, index) */
   double term[LW_PTERM_COUNT];  /* running totals */
+  double *qlen;                 /* n: |q| as last given to set_coords (NULL: never; 1 for a unit one) */
 } lw_particles;
 
 /* The initial state: the point file's particles, then `count` placed by the
@@ -176,5 +177,31 @@ double lw_particles_evaluate(const lw_particles *p, lw_particles_prop *pr, uint3
 /* Applies an evaluated proposal.  LW_ENOMEM if the grid could not grow
 ** (the state is unchanged then). */
 lw_status lw_particles_commit(lw_particles *p, const lw_particles_prop *pr);
+
+/* ---- the gradient-based drivers (quench.h, dynamics.h) ----
+** The state as LW_PARTICLE_COORDS coordinates a particle: x y z, then the
+** quaternion w x y z.  The energy is read at q / |q| (a quaternion within
+** LW_PARTICLE_UNIT_TOL of unit length as it is), so its gradient along q is
+** 0 and a quench may leave the sphere; set_coords stores q / |q|.  A pinned
+** part's gradient is 0 (a driver never moves it).  With the isotropic
+** inertia of the seed, |omega| = 2 |dq/dt| on the sphere: the kinetic energy
+** is 1/2 (4 I) |dq/dt|^2, a constant mass for the quaternion's coordinates,
+** and constrain() brings a driver's coordinates back to the sphere (and its
+** momenta to its tangent) after each step (docs/NUMERICS.md). */
+#define LW_PARTICLE_COORDS 7
+#define LW_PARTICLE_UNIT_TOL 1e-12
+
+size_t lw_particles_n_coords(const lw_particles *p);
+void lw_particles_get_coords(const lw_particles *p, double *c);
+/* Moves the state to c and sums its energy afresh (+inf in the totals where
+** a particle is outside the boundary).  LW_EINPUT for a coordinate that is
+** not finite or a quaternion of length 0, LW_ENOMEM. */
+lw_status lw_particles_set_coords(lw_particles *p, const double *c, lw_error *err);
+/* The total energy and its gradient by the coordinates into g (+inf, g
+** untouched, in a forbidden state; NAN with err set when memory runs out). */
+double lw_particles_gradient(const lw_particles *p, double *g, lw_error *err);
+/* Unit quaternions in c and, when pi is not NULL, momenta on their tangent
+** (pinned orientations untouched). */
+void lw_particles_constrain(const lw_particles *p, double *c, double *pi);
 
 #endif

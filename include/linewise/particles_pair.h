@@ -119,4 +119,11 @@ static inline void lw_ppair_add(const lw_ppair_ctx *c, const double r[3], double
   }
 }
 
+/* Adds the pair energy's gradient (coefficients applied, every term that is
+** on) for r = x_j - x_i with d2 = |r|^2 < R^2: dE/dr to gr (so dE/dx_j;
+** dE/dx_i is its negative), dE/dn_i to gi and dE/dn_j to gj, the normals
+** taken as free vectors (the caller projects onto what moves them). */
+void lw_ppair_grad(const lw_ppair_ctx *c, const double r[3], double d2, const double ni[3], const double nj[3],
+                   double gr[3], double gi[3], double gj[3]);
+
 #endif
