@@ -107,6 +107,13 @@ lw_dynamics *lw_dynamics_new(const lw_system_type *t, void *state, const lw_para
   d->gamma = p->dyn_gamma;
   d->dt = p->dyn_dt;
   d->integrator = p->dyn_integrator;
+  if (d->integrator == LW_INTEGRATOR_REVIEW && t->constrain) {
+    lw_params_origin(p, lw_params_find("dynamics", "integrator"), where, sizeof where);
+    lw_error_set(err, LW_EINPUT, "%s: key 'dynamics.integrator': the review's scheme takes free coordinates; the "
+                 "%s system's are constrained: use integrator = leapfrog", where, t->name);
+    lw_dynamics_free(d);
+    return NULL;
+  }
   if (d->integrator == LW_INTEGRATOR_REVIEW && lw_dyn_review_init(d, p, err)) {
     lw_dynamics_free(d);
     return NULL;
@@ -203,6 +210,7 @@ static lw_status leapfrog(lw_dynamics *d, lw_error *err)
     if (++it == FIXED_MAX) return not_converged(d, "position step", err);
   }
   if (it > d->iterations_max) d->iterations_max = it;
+  if (t->constrain) t->constrain(d->state, x1, pih);
   if ((s = t->mass_at(d->mass, x1, err)) || (s = evaluate(d, x1, err))) return s;
   if (!isfinite(d->energy))
     return lw_error_set(err, LW_EINPUT, "the motion reached a forbidden state at t = %g s (energy %g: a segment "
@@ -251,6 +259,7 @@ static lw_status flow(lw_dynamics *d, lw_error *err)
     } else {
       for (size_t i = 0; i < n; i++) d->x1[i] = d->x[i] + h * dir[i];
     }
+    if (t->constrain) t->constrain(d->state, d->x1, NULL);
     if ((s = evaluate(d, d->x1, err))) return s;
     away = 1;
     if (d->energy <= e0 + ARMIJO * h * slope) {

@@ -545,10 +545,12 @@ const lw_param_def lw_param_table[] = {
   NUM("particles", "disc", LW_PT_DOUBLE, pt_disc, "0.5", "r0", 0, 100, LW_MIN_OPEN,
       "Radius of each particle's disc in final.png."),
   NUM("dynamics", "rho", LW_PT_DOUBLE, dyn_rho, "1", "mass/mm", 0, 1e12, 0,
-      "Line density rho of the kinetic energy (rho/2) int |dr/dt|^2 dl. 0 = massless: the "
+      "Line density rho of the kinetic energy (rho/2) int |dr/dt|^2 dl; for particles the mass of "
+      "each, with the inertia of a ball of diameter r0. 0 = massless: the "
       "motion is the gradient flow D(x) dx/dt = -grad E of the damping (needs gamma > 0)."),
   NUM("dynamics", "gamma", LW_PT_DOUBLE, dyn_gamma, "0", "force s/mm^2", 0, 1e12, 0,
-      "Rayleigh damping: a force -gamma dr/dt per mm of line. 0 = none (energy is conserved)."),
+      "Rayleigh damping: a force -gamma dr/dt per mm of line (particles: per particle, and "
+      "its rotation at the same rate). 0 = none (energy is conserved)."),
   NUM("dynamics", "dt", LW_PT_DOUBLE, dyn_dt, "0.001", "s", 0, 1e6, LW_MIN_OPEN,
       "Time step of the integrator (massless: the first step tried; halved where the energy "
       "would not fall)."),

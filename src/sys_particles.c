@@ -10,6 +10,7 @@
 #include <gsl/gsl_math.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
@@ -103,6 +104,81 @@ static lw_status set_coords(void *state, const double *x, lw_error *err)
 
 static double gradient(void *state, double *g, lw_error *err) { return lw_particles_gradient(state, g, err); }
 
+/* Inertia: a particle is a ball of mass rho and diameter r0, I = rho r0^2 / 10
+** about every axis (the seed's isotropic tensor), so T = rho/2 |dx/dt|^2 +
+** 2 I |dq/dt|^2: a constant diagonal mass, 4 I on each quaternion
+** coordinate (particles.h).  A pinned part is held. */
+typedef struct {
+  size_t n;
+  double *m;            /* n: the diagonal */
+  unsigned char *held;  /* n */
+} pt_mass;
+
+static void mass_free(void *mass)
+{
+  pt_mass *m = mass;
+  if (!m) return;
+  free(m->m);
+  free(m->held);
+  free(m);
+}
+
+static void *mass_new(const void *state, const lw_params *p, double density, lw_error *err)
+{
+  const lw_particles *s = state;
+  static const char *const loads[] = {"gravity_x", "gravity_y", "force_x", "force_y"};
+  const double load[] = {p->dyn_gravity_x, p->dyn_gravity_y, p->dyn_force_x, p->dyn_force_y};
+  for (int k = 0; k < 4; k++)
+    if (load[k] != 0.0) {
+      lw_error_set(err, LW_EINPUT, "the particle system's load is particles.gravity; expected 0");
+      lw_params_blame(p, "dynamics", loads[k], err);
+      return NULL;
+    }
+  if (p->dyn_pin != LW_PIN_NONE || p->dyn_pin_vectors) {
+    lw_error_set(err, LW_EINPUT, "particles are pinned by their point file (particles.pinned); expected none");
+    lw_params_blame(p, "dynamics", p->dyn_pin != LW_PIN_NONE ? "pin" : "pin_vectors", err);
+    return NULL;
+  }
+  pt_mass *m = calloc(1, sizeof *m);
+  size_t n = lw_particles_n_coords(s);
+  if (!m || !(m->m = malloc((n ? n : 1) * sizeof *m->m)) || !(m->held = malloc(n ? n : 1))) {
+    mass_free(m);
+    lw_error_set(err, LW_ENOMEM, "out of memory for the mass matrix of %zu particles", s->n);
+    return NULL;
+  }
+  m->n = n;
+  const double r0 = s->setup->pair.r0, inertia = 4.0 * density * r0 * r0 / 10.0;
+  for (size_t i = 0; i < n; i++) {
+    int rot = i % LW_PARTICLE_COORDS >= 3;
+    m->m[i] = rot ? inertia : density;
+    m->held[i] = (s->pin[i / LW_PARTICLE_COORDS] & (rot ? LW_PIN_ORIENTATION : LW_PIN_POSITION)) != 0;
+  }
+  return m;
+}
+
+static lw_status mass_at(void *mass, const double *x, lw_error *err) { return LW_OK; }
+
+static void mass_solve(const void *mass, const double *b, double *v)
+{
+  const pt_mass *m = mass;
+  for (size_t i = 0; i < m->n; i++) v[i] = m->held[i] ? 0.0 : b[i] / m->m[i];
+}
+
+static void mass_apply(const void *mass, const double *v, double *b)
+{
+  const pt_mass *m = mass;
+  for (size_t i = 0; i < m->n; i++) b[i] = m->m[i] * v[i];
+}
+
+static void mass_dx(const void *mass, const double *x, const double *v, double *out)
+{
+  memset(out, 0, ((const pt_mass *)mass)->n * sizeof *out);
+}
+
+static int mass_pinned(const void *mass, size_t i) { return ((const pt_mass *)mass)->held[i]; }
+
+static void constrain(const void *state, double *x, double *pi) { lw_particles_constrain(state, x, pi); }
+
 static lw_status save(const void *state, lw_ckpt_writer *w, const char *section, lw_error *err)
 {
   lw_particles_put(w, section, state);
@@ -191,4 +267,12 @@ const lw_system_type lw_system_particles = {
     .get_coords = get_coords,
     .set_coords = set_coords,
     .gradient = gradient,
+    .mass_new = mass_new,
+    .mass_free = mass_free,
+    .mass_at = mass_at,
+    .mass_solve = mass_solve,
+    .mass_apply = mass_apply,
+    .mass_dx = mass_dx,
+    .mass_pinned = mass_pinned,
+    .constrain = constrain,
 };

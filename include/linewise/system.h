@@ -238,6 +238,12 @@ struct lw_system_type {
   void (*mass_apply)(const void *mass, const double *v, double *b);
   void (*mass_dx)(const void *mass, const double *x, const double *v, double *out);
   int (*mass_pinned)(const void *mass, size_t i);
+  /* Optional (NULL: the coordinates are free): brings coordinates x that a
+  ** step left off the system's constraint back onto it, and momenta pi
+  ** (NULL: none) onto its tangent there; for particles, unit quaternions.
+  ** The dynamics calls it on every new position before the state moves
+  ** there, so the state and the driver's coordinates agree bit for bit. */
+  void (*constrain)(const void *state, double *x, double *pi);
 
   const char *files;
   lw_status (*draw)(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err);
