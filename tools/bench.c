@@ -638,9 +638,11 @@ static void bench_particles(bench_ctx *b)
              "Translations and rotations alternate; a proposal walks the cells around its particle that\n"
              "come within the range: a translation at its old and new place, a rotation once, and not at\n"
              "all without a weighted term (it cannot change a distance). The neighbours are counted after\n"
-             "the timing.\n\n"
-             "| scene | neighbours | ns per proposal | proposals per second | acceptance |\n"
-             "|---|---|---|---|---|\n",
+             "the timing. The gradient (the quench's and the dynamics' forces and torques, every pair once)\n"
+             "is timed on the same state, per particle, and against a sweep (one proposal a particle).\n\n"
+             "| scene | neighbours | ns per proposal | proposals per second | acceptance | gradient, ns per "
+             "particle | gradient / sweep |\n"
+             "|---|---|---|---|---|---|---|\n",
           count, density, T);
   for (int k = 0; k < N_PARTICLE_ROWS; k++) {
     lw_params prm;
@@ -680,8 +682,26 @@ static void bench_particles(bench_ctx *b)
       ns[rep] = 1e9 * t / (double)n;
     }
     double med = bench_median(ns, b->reps);
-    fprintf(d, "| %s | %.1f | %.0f | %.0f | %.2f |\n", row[k].what, particle_neighbours(p), med, 1e9 / med,
-            (double)accepted / (double)tried);
+    size_t nc = lw_particles_n_coords(p);
+    double *g = malloc(nc * sizeof *g), *c = malloc(nc * sizeof *c);
+    if (!g || !c) bench_die("out of memory", NULL);
+    lw_particles_get_coords(p, c);
+    if (lw_particles_set_coords(p, c, &err)) bench_die("particles", &err);
+    for (int rep = 0; rep < b->reps; rep++) {
+      double t0 = bench_now(), t;
+      unsigned long n = 0;
+      do {
+        if (!isfinite(lw_particles_gradient(p, g, &err))) bench_die("particles: gradient", &err);
+        n++;
+        t = bench_now() - t0;
+      } while (t < b->block);
+      ns[rep] = 1e9 * t / ((double)n * (double)p->n);
+    }
+    double grad = bench_median(ns, b->reps);
+    free(g);
+    free(c);
+    fprintf(d, "| %s | %.1f | %.0f | %.0f | %.2f | %.0f | %.2f |\n", row[k].what, particle_neighbours(p), med,
+            1e9 / med, (double)accepted / (double)tried, grad, grad / med);
     gsl_rng_free(r);
     lw_particles_prop_free(pr);
     lw_particles_free(p);

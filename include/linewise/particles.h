@@ -39,7 +39,9 @@
 ** state_copy / state_free, sweep_size, step_max, proposal_new / free,
 ** propose, commit, total, terms, term_on, refresh; save / load as lines of
 ** the in-memory state.lw and energy (load, then lw_particles_energy) in
-** particles_io.h; draw (final.ply, final.png) in particles_draw.h.  The move
+** particles_io.h; draw (final.ply, final.png) in particles_draw.h; the
+** gradient-based members (n_coords, get_coords, set_coords, gradient,
+** constrain) at the end of this file, the mass matrix in sys_particles.c.  The move
 ** kinds' [moves] keys are translate and rotate (step_translate, length;
 ** step_rotate, degrees).
 */
