@@ -104,6 +104,25 @@ static lw_status set_coords(void *state, const double *x, lw_error *err)
 
 static double gradient(void *state, double *g, lw_error *err) { return lw_particles_gradient(state, g, err); }
 
+/* A particle that x would take outside the boundary is held where it is, so
+** that one particle at a wall does not shorten every other's step (system.h,
+** lw_system_hold): its height at a floor (it may still slide and turn), its
+** position at a sphere's wall. */
+static size_t blocked(void *state, const double *x, unsigned char *held, const unsigned char *changed)
+{
+  const lw_particles *p = state;
+  size_t parts = 0;
+  for (size_t i = 0; i < p->n; i++) {
+    const size_t c = LW_PARTICLE_COORDS * i;
+    if (changed && !(changed[c] | changed[c + 1] | changed[c + 2])) continue;
+    if (!lw_particles_outside(p->setup, x + c)) continue;
+    if (p->setup->boundary == LW_PBOUNDARY_PLANE) held[c + 2] = 1;
+    else memset(held + c, 1, 3);
+    parts++;
+  }
+  return parts;
+}
+
 /* Inertia: a particle is a ball of mass rho and diameter r0, I = rho r0^2 / 10
 ** about every axis (the seed's isotropic tensor), so T = rho/2 |dx/dt|^2 +
 ** 2 I |dq/dt|^2: a constant diagonal mass, 4 I on each quaternion
@@ -267,6 +286,7 @@ const lw_system_type lw_system_particles = {
     .get_coords = get_coords,
     .set_coords = set_coords,
     .gradient = gradient,
+    .blocked = blocked,
     .mass_new = mass_new,
     .mass_free = mass_free,
     .mass_at = mass_at,
