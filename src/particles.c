@@ -202,6 +202,7 @@ static void walk(const lw_particles *p, uint32_t k, uint32_t from, const double 
       for (int xx = a.lo[0]; xx <= a.hi[0]; xx++) {
         if (gyz + a.gap[0][xx - a.c[0] + 1] > skip2) continue;
         const lw_cell *cell = row + xx;
+        if (!cell->n) continue; /* an empty cell has no block: no pointer into it */
         const double *px = cell->x, *py = lw_cell_y(cell), *pz = lw_cell_z(cell);
         const uint32_t *id = lw_cell_idx(cell);
         for (uint32_t e = 0; e < cell->n; e++) {
@@ -250,6 +251,7 @@ static void gradient_xn(const lw_particles *p, double *gx, double *gn)
           for (int xx = a.lo[0]; xx <= a.hi[0]; xx++) {
             if (a.gap[2][zz - a.c[2] + 1] + a.gap[1][yy - a.c[1] + 1] + a.gap[0][xx - a.c[0] + 1] > skip2) continue;
             const lw_cell *cell = g->cell + ((size_t)zz * (size_t)g->ny + (size_t)yy) * (size_t)g->nx + xx;
+            if (!cell->n) continue;
             const double *px = cell->x, *py = lw_cell_y(cell), *pz = lw_cell_z(cell);
             const uint32_t *id = lw_cell_idx(cell);
             for (uint32_t e = 0; e < cell->n; e++) {
