@@ -107,6 +107,7 @@ lw_dynamics *lw_dynamics_new(const lw_system_type *t, void *state, const lw_para
   d->gamma = p->dyn_gamma;
   d->dt = p->dyn_dt;
   d->integrator = p->dyn_integrator;
+  d->h_ref = NAN;
   if (d->integrator == LW_INTEGRATOR_REVIEW && t->constrain) {
     lw_params_origin(p, lw_params_find("dynamics", "integrator"), where, sizeof where);
     lw_error_set(err, LW_EINPUT, "%s: key 'dynamics.integrator': the review's scheme takes free coordinates; the "
@@ -213,8 +214,8 @@ static lw_status leapfrog(lw_dynamics *d, lw_error *err)
   if (t->constrain) t->constrain(d->state, x1, pih);
   if ((s = t->mass_at(d->mass, x1, err)) || (s = evaluate(d, x1, err))) return s;
   if (!isfinite(d->energy))
-    return lw_error_set(err, LW_EINPUT, "the motion reached a forbidden state at t = %g s (energy %g: a segment "
-                        "irregular or outside the boundary): lower dynamics.dt (now %g s)", d->time + h, d->energy, h);
+    return lw_error_set(err, LW_EINPUT, "the motion reached a forbidden state at t = %g s (energy %g: outside the "
+                        "boundary, or a segment irregular): lower dynamics.dt (now %g s)", d->time + h, d->energy, h);
   memcpy(d->x, x1, n * sizeof *x1);
   /* pi' = pi+ - h/2 dH/dx(x', pi+) */
   dh_dx(d, d->x, pih, d->u);
@@ -275,11 +276,30 @@ static lw_status flow(lw_dynamics *d, lw_error *err)
   return t->set_coords(d->state, d->x, err);
 }
 
+/* With inertia: E + K against its value before this driver's first step
+** (after a resume too, once the momenta are read). */
+static lw_status check_stable(lw_dynamics *d, lw_error *err)
+{
+  const double h = d->energy + lw_dynamics_kinetic(d);
+  if (isnan(d->h_ref)) {
+    d->h_ref = h;
+    d->h_scale = fabs(d->energy) + (h - d->energy);
+    if (!(d->h_scale > 0.0)) d->h_scale = 1.0;
+    return LW_OK;
+  }
+  if (h - d->h_ref <= LW_DYN_BLOWUP * d->h_scale) return LW_OK;
+  return lw_error_set(err, LW_EINPUT, "the motion is unstable at t = %g s: the energy E + K rose from %g to %g: "
+                      "lower dynamics.dt (now %g s)", d->time, d->h_ref, h, d->dt);
+}
+
 lw_status lw_dynamics_step(lw_dynamics *d, lw_error *err)
 {
-  lw_status s = d->rho == 0.0                             ? flow(d, err)
-                : d->integrator == LW_INTEGRATOR_REVIEW ? lw_dyn_review_step(d, err)
-                                                        : leapfrog(d, err);
+  lw_status s;
+  if (d->rho > 0.0 && isnan(d->h_ref) && (s = check_stable(d, err))) return s;
+  s = d->rho == 0.0                             ? flow(d, err)
+      : d->integrator == LW_INTEGRATOR_REVIEW ? lw_dyn_review_step(d, err)
+                                              : leapfrog(d, err);
+  if (!s && d->rho > 0.0) s = check_stable(d, err);
   if (!s) d->steps++;
   return s;
 }

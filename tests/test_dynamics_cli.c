@@ -238,3 +238,20 @@ Test(dynamics_cli, particles_keep_their_energy_and_resume_to_the_same_bytes)
   trace_totals("f", &a0, &a1);
   cr_assert(a0 > a1 && a1 < -302.4 && a1 > -302.5, "the flow's energy %.9g -> %.9g", a0, a1);
 }
+
+/* A step far too long for the bonds: the sheet's closest pair (0.56 r0
+** apart, its force about 5000) flings the particles off within one step of
+** 50 ms, and the leapfrog's energy grows without bound (E + K was 5e18 at the
+** first trace row, 2e19 at the end, and the run ended "done" with the
+** particles scattered).  Now the run stops at the first step where E + K has
+** risen past LW_DYN_BLOWUP times its scale, naming dt, with exit 2 and the
+** start's state.lw kept; at 2 ms the same scene runs to its end. */
+Test(dynamics_cli, an_unstable_motion_stops_and_names_the_step)
+{
+  const char *run = "%s run %s/params/particles-sheet.ini --out %s/%s --quiet --set scene.driver=dynamics "
+                    "--set dynamics.dt=%s --set anneal.sweeps=50 2>%s/err.txt";
+  cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "u", "0.05", dir), 2);
+  cr_assert_eq(sh("grep -q 'the motion is unstable at t = .*: lower dynamics.dt (now 0.05 s)' %s/err.txt", dir), 0);
+  cr_assert_eq(sh("test -s %s/u/state.lw && grep -q '^sweep = 0$' %s/u/state.lw", dir, dir), 0);
+  cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "s", "0.002", dir), 0);
+}

@@ -67,7 +67,13 @@ typedef struct {
   int integrator;            /* LW_INTEGRATOR_* */
   double *work;              /* the review scheme's scratch (dyn_review.h), or NULL */
   unsigned char *held;       /* massless: the coordinates a step holds (n) */
+  double h_ref, h_scale;     /* E + K and |E| + K before the first step here (NAN: not yet) */
 } lw_dynamics;
+
+/* With inertia, E + K may not rise by more than this many times h_scale
+** (damping only lowers it, the leapfrog's error is O(dt^2)): beyond it the
+** motion is unstable, its step too long, and it stops. */
+#define LW_DYN_BLOWUP 100.0
 
 /* A driver for `state` (a system of row t) with the [dynamics] parameters;
 ** momenta start at 0.  LW_EINPUT naming the key if the system has no
@@ -76,8 +82,8 @@ lw_dynamics *lw_dynamics_new(const lw_system_type *t, void *state, const lw_para
 void lw_dynamics_free(lw_dynamics *d);
 
 /* One time step; the system's state follows.  LW_EINPUT if the motion
-** reaches a forbidden state (lower dynamics.dt) or a fixed point does not
-** converge. */
+** reaches a forbidden state or becomes unstable (lower dynamics.dt) or a
+** fixed point does not converge. */
 lw_status lw_dynamics_step(lw_dynamics *d, lw_error *err);
 
 /* The kinetic energy 1/2 pi' M^-1 pi at the current x. */
