@@ -302,7 +302,9 @@ lw_status lw_particles_set_coords(lw_particles *p, const double *c, lw_error *er
   for (size_t i = 0; i < p->n; i++) {
     const double *ci = c + LW_PARTICLE_COORDS * i, *cq = ci + 3;
     double *x = p->x + 3 * i, *q = p->q + 4 * i;
-    if (ci[0] != x[0] || ci[1] != x[1] || ci[2] != x[2]) {
+    /* a pinned part stays as it is, to the bit (a driver's 0 * step may
+    ** turn a -0 into +0) */
+    if (!(p->pin[i] & LW_PIN_POSITION) && (ci[0] != x[0] || ci[1] != x[1] || ci[2] != x[2])) {
       if (lw_cellgrid_move3(p->grid, (uint32_t)i, ci[0], ci[1], ci[2]))
         return lw_error_set(err, LW_ENOMEM, "out of memory for the particle grid");
       memcpy(x, ci, 3 * sizeof *x);
@@ -312,7 +314,7 @@ lw_status lw_particles_set_coords(lw_particles *p, const double *c, lw_error *er
     /* a unit quaternion to rounding is kept as given, so that a driver's
     ** coordinates and the state (and a checkpoint of it) agree bit for bit */
     p->qlen[i] = fabs(len - 1.0) <= LW_PARTICLE_UNIT_TOL ? 1.0 : len;
-    if (!memcmp(q, cq, 4 * sizeof *q)) continue;
+    if ((p->pin[i] & LW_PIN_ORIENTATION) || !memcmp(q, cq, 4 * sizeof *q)) continue;
     memcpy(q, cq, 4 * sizeof *q);
     if (p->qlen[i] != 1.0) lw_quat_normalise(q);
     lw_quat_normal(q, p->nrm + 3 * i);

@@ -185,7 +185,7 @@ lw_status lw_particles_commit(lw_particles *p, const lw_particles_prop *pr);
 ** quaternion w x y z.  The energy is read at q / |q| (a quaternion within
 ** LW_PARTICLE_UNIT_TOL of unit length as it is), so its gradient along q is
 ** 0 and a quench may leave the sphere; set_coords stores q / |q|.  A pinned
-** part's gradient is 0 (a driver never moves it).  With the isotropic
+** part's gradient is 0 and set_coords leaves it as it is, to the bit.  With the isotropic
 ** inertia of the seed, |omega| = 2 |dq/dt| on the sphere: the kinetic energy
 ** is 1/2 (4 I) |dq/dt|^2, a constant mass for the quaternion's coordinates,
 ** and constrain() brings a driver's coordinates back to the sphere (and its
