@@ -95,7 +95,8 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
     /* Wider than twice the reach with room to spare, and wide against a
     ** spline, so few sit on a boundary (those are not moved that sweep);
     ** from the parameters alone, so a resumed run splits the same way. */
-    double l = fmax(2.5 * reach, 16.0 * p->segments * p->segment_length);
+    double l = fmax(2.5 * reach, t->domain_side ? t->domain_side(c->sys->state)
+                                                : 16.0 * p->segments * p->segment_length);
     nx = (int)fmin(floor(w / l), DOMAINS_MAX);
     ny = (int)fmin(floor(h / l), DOMAINS_MAX);
     if (nx < 2 || ny < 2) return LW_OK; /* nothing to gain: sweeps stay serial */

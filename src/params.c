@@ -348,7 +348,8 @@ const lw_param_def lw_param_table[] = {
          "Domain decomposition of each replica's sweeps (docs/NUMERICS.md, \"Domains\"): `off`; `N` "
          "(1 to 64), an N x N lattice of domains over the page, shifted at random each sweep, whose four "
          "sub-lattices are swept in turn, the domains of each in parallel (OpenMP); `auto`, domains "
-         "of side max(2.5 reach, 16 init.segments init.segment_length), at most 64 a side, not split "
+         "of side max(2.5 reach, 16 init.segments init.segment_length) (particles: 2.5 reach, the page "
+         "their grid's box in x and y), at most 64 a side, not split "
          "when fewer than 2 fit a side. The result depends on this key, never on the threads. docs/SCALING.md."),
   CHOICE("anneal", "quench", quench, "none", "none|bfgs",
          "After the last sweep: none, or bfgs, which takes the coldest replica to the nearest local "

@@ -601,22 +601,20 @@ double lw_particles_evaluate(const lw_particles *p, lw_particles_prop *pr, uint3
   return pr->dE = dE;
 }
 
-double lw_particles_propose(const lw_particles *p, lw_particles_prop *pr, int kind, double step, gsl_rng *rng,
-                            int *forbidden)
+/* The identity: a symmetric proposal that changes nothing. */
+static double identity(lw_particles_prop *pr)
 {
-  pr->kind = kind;
-  if (forbidden) *forbidden = 0;
-  size_t m = p->n_movable[kind];
-  if (m == 0) {
-    /* the identity: a symmetric proposal that changes nothing */
-    pr->identity = 1;
-    for (int t = 0; t < LW_PTERM_COUNT; t++) pr->dterm[t] = 0.0;
-    return pr->dE = 0.0;
-  }
-  uint32_t k = p->movable[kind][gsl_rng_uniform_int(rng, m)];
-  double x[3], q[4];
-  memcpy(x, p->x + 3 * (size_t)k, sizeof x);
-  memcpy(q, p->q + 4 * (size_t)k, sizeof q);
+  pr->identity = 1;
+  for (int t = 0; t < LW_PTERM_COUNT; t++) pr->dterm[t] = 0.0;
+  return pr->dE = 0.0;
+}
+
+/* Draws the new position x and quaternion q of a move of kind `kind` of
+** particle k. */
+static void draw_move(const lw_particles *p, uint32_t k, int kind, double step, gsl_rng *rng, double x[3], double q[4])
+{
+  memcpy(x, p->x + 3 * (size_t)k, 3 * sizeof *x);
+  memcpy(q, p->q + 4 * (size_t)k, 4 * sizeof *q);
   if (kind == LW_PMOVE_TRANSLATE) {
     for (int c = 0; c < 3; c++) x[c] += gsl_ran_gaussian_ziggurat(rng, step);
   } else {
@@ -626,12 +624,41 @@ double lw_particles_propose(const lw_particles *p, lw_particles_prop *pr, int ki
     lw_quat_mul(dq, p->q + 4 * (size_t)k, q);
     lw_quat_normalise(q);
   }
+}
+
+double lw_particles_propose(const lw_particles *p, lw_particles_prop *pr, int kind, double step, gsl_rng *rng,
+                            int *forbidden)
+{
+  pr->kind = kind;
+  if (forbidden) *forbidden = 0;
+  size_t m = p->n_movable[kind];
+  if (m == 0) return identity(pr);
+  uint32_t k = p->movable[kind][gsl_rng_uniform_int(rng, m)];
+  double x[3], q[4];
+  draw_move(p, k, kind, step, rng, x, q);
   return lw_particles_evaluate(p, pr, k, x, q, forbidden);
 }
 
-lw_status lw_particles_commit(lw_particles *p, const lw_particles_prop *pr)
+double lw_particles_propose_in(const lw_particles *p, lw_particles_prop *pr, int kind, size_t site, double step,
+                               gsl_rng *rng, int *forbidden, const double box[4])
 {
-  if (pr->identity) return LW_OK;
+  pr->kind = kind;
+  if (forbidden) *forbidden = 0;
+  if (p->pin[site] & (kind == LW_PMOVE_TRANSLATE ? LW_PIN_POSITION : LW_PIN_ORIENTATION)) return identity(pr);
+  double x[3], q[4];
+  draw_move(p, (uint32_t)site, kind, step, rng, x, q);
+  if (!(x[0] >= box[0] && x[1] >= box[1] && x[0] <= box[2] && x[1] <= box[3])) {
+    pr->identity = 1; /* never committed: refused */
+    for (int t = 0; t < LW_PTERM_COUNT; t++) pr->dterm[t] = 0.0;
+    if (forbidden) *forbidden = 2;
+    return pr->dE = INFINITY;
+  }
+  return lw_particles_evaluate(p, pr, (uint32_t)site, x, q, forbidden);
+}
+
+/* The state's part of a commit: the particle, its normal and its cell. */
+static lw_status commit_move(lw_particles *p, const lw_particles_prop *pr)
+{
   size_t k = pr->k;
   double *x = p->x + 3 * k;
   if ((x[0] != pr->x[0] || x[1] != pr->x[1] || x[2] != pr->x[2]) &&
@@ -640,6 +667,29 @@ lw_status lw_particles_commit(lw_particles *p, const lw_particles_prop *pr)
   memcpy(x, pr->x, sizeof pr->x);
   memcpy(p->q + 4 * k, pr->q, sizeof pr->q);
   memcpy(p->nrm + 3 * k, pr->n, sizeof pr->n);
+  return LW_OK;
+}
+
+lw_status lw_particles_commit_part(lw_particles *p, lw_particles_prop *pr)
+{
+  if (pr->identity) return LW_OK;
+  if (commit_move(p, pr)) return LW_ENOMEM;
+  for (int t = 0; t < LW_PTERM_COUNT; t++) pr->acc[t] += pr->dterm[t];
+  return LW_OK;
+}
+
+void lw_particles_merge(lw_particles *p, lw_particles_prop *pr)
+{
+  for (int t = 0; t < LW_PTERM_COUNT; t++) {
+    p->term[t] += pr->acc[t];
+    pr->acc[t] = 0.0;
+  }
+}
+
+lw_status lw_particles_commit(lw_particles *p, const lw_particles_prop *pr)
+{
+  if (pr->identity) return LW_OK;
+  if (commit_move(p, pr)) return LW_ENOMEM;
   for (int t = 0; t < LW_PTERM_COUNT; t++) p->term[t] += pr->dterm[t];
   return LW_OK;
 }

@@ -93,6 +93,47 @@ static double energy(const void *setup, const lw_state *st, const char *path, do
   return e;
 }
 
+/* Domains (domains.h): the page is the grid's box in x and y (particles
+** beyond it sit in its edge cells, and in the edge domains, which reach to
+** infinity); a move reads and writes within two cell sides of its box. */
+static const char *split(const void *state, double page[4], double *reach)
+{
+  const lw_particles *p = state;
+  const lw_particles_setup *s = p->setup;
+  page[0] = s->lo[0];
+  page[1] = s->lo[1];
+  page[2] = s->lo[0] + s->extent[0];
+  page[3] = s->lo[1] + s->extent[1];
+  *reach = 2.0 / p->grid->inv_h;
+  return NULL;
+}
+
+static size_t group(const void *state, size_t site, double box[4])
+{
+  const double *x = ((const lw_particles *)state)->x + 3 * site;
+  box[0] = box[2] = x[0];
+  box[1] = box[3] = x[1];
+  return 1;
+}
+
+static double propose_in(void *state, void *prop, int kind, size_t site, double step, gsl_rng *rng, int *forbidden,
+                         const double box[4])
+{
+  return lw_particles_propose_in(state, prop, kind, site, step, rng, forbidden, box);
+}
+
+static lw_status commit_part(void *state, void *prop) { return lw_particles_commit_part(state, prop); }
+
+static lw_status merge(void *state, void *prop)
+{
+  lw_particles_merge(state, prop);
+  return LW_OK;
+}
+
+static size_t sites(const void *state) { return ((const lw_particles *)state)->n; }
+
+static double domain_side(const void *state) { return 0.0; }
+
 static size_t n_coords(const void *state) { return lw_particles_n_coords(state); }
 
 static void get_coords(const void *state, double *x) { lw_particles_get_coords(state, x); }
@@ -295,4 +336,11 @@ const lw_system_type lw_system_particles = {
     .mass_dx = mass_dx,
     .mass_pinned = mass_pinned,
     .constrain = constrain,
+    .split = split,
+    .group = group,
+    .propose_in = propose_in,
+    .commit_part = commit_part,
+    .merge = merge,
+    .sites = sites,
+    .domain_side = domain_side,
 };

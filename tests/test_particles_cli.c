@@ -6,6 +6,7 @@
 ** recomputes a particle run.
 */
 #include <criterion/criterion.h>
+#include <gsl/gsl_cdf.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -337,4 +338,85 @@ Test(particles_cli, a_quench_lays_the_sheet_on_a_hard_floor)
   cr_assert(fabs(after - (-302.44545 - 63.5)) < 1e-3, "quenched to %.9g", after);
   cr_assert(evaluations < 1.5 * iterations + 50 && forbidden == 0, "%g evaluations, %g forbidden, %g iterations",
             evaluations, forbidden, iterations);
+}
+
+/* A gas of 2000 particles with no pair term, under gravity 1 in a sphere of
+** radius 5 with a soft wall (alpha_B 0.5) at T = 1: each particle samples
+** p(x) ~ exp(-(g z + alpha_B / (R - |x|)^2) / T) on its own, so one snapshot
+** after 600 sweeps is 2000 independent draws.  With domains (auto: a 3 x 3
+** lattice shifted each sweep, moves leaving their domain refused) the x and z
+** marginals must still follow p: chi-square against p integrated on a grid
+** of 160^3 cells, over the 10 bins of each axis that expect 5 or more, at a
+** false-alarm rate of 1e-3 for its degrees of freedom (measured 4.1 in z
+** with 6 degrees).  A refusal that favoured a side would pile particles up
+** in x (a rule refusing steps of more than 0.4 to the right gave 30665).
+** The run is the same for 1 and 2 threads and after a stop and resume, and
+** differs from the run without domains (the domains did split the sweeps). */
+static void marginals(const char *ply, double hist[2][10])
+{
+  FILE *f = fopen(ply, "r");
+  cr_assert_not_null(f, "%s", ply);
+  char line[256];
+  while (fgets(line, sizeof line, f) && strcmp(line, "end_header\n")) {}
+  memset(hist, 0, 2 * 10 * sizeof(double));
+  double v[3];
+  while (fgets(line, sizeof line, f) && sscanf(line, "%lf %lf %lf", &v[0], &v[1], &v[2]) == 3)
+    for (int a = 0; a < 2; a++) {
+      int b = (int)floor((v[a ? 2 : 0] + 5.0));
+      if (b >= 0 && b < 10) hist[a][b] += 1;
+    }
+  fclose(f);
+}
+
+Test(particles_cli, domains_sample_the_gas_and_keep_their_bytes)
+{
+  cr_assert_eq(lw_test_write_text(dir, "gas.ini",
+                                  "[scene]\nsystem = particles\n[particles]\ncount = 2000\npattern = cloud\nsize = 5\n"
+                                  "r0 = 0.5\nalpha_lj = 0\nalpha_p = 0\nalpha_n = 0\nalpha_c = 0\ngravity = 1\n"
+                                  "boundary = sphere\nboundary_radius = 5\nalpha_b = 0.5\npng_size = 64\n"
+                                  "[moves]\ntranslate = 1\nrotate = 0\nstep_translate = 0.5\n"
+                                  "[anneal]\nschedule = constant\nt_start = 1\nt_end = 1\nsweeps = 600\nseed = 11\n"
+                                  "domains = auto\n"),
+               0);
+  cr_assert_eq(sh("%s run %s/gas.ini --out %s/g2 --threads 2 --quiet", lw_test_bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/gas.ini --out %s/g1 --threads 1 --quiet", lw_test_bin(), dir, dir), 0);
+  cr_assert_eq(sh("cmp -s %s/g1/state.lw %s/g2/state.lw && cmp -s %s/g1/final.ply %s/g2/final.ply", dir, dir, dir,
+                  dir), 0, "the thread count changed the run");
+  cr_assert_eq(sh("%s run %s/gas.ini --out %s/gr --quiet --threads 2 --stop-at 250 && %s resume %s/gr --quiet",
+                  lw_test_bin(), dir, dir, lw_test_bin(), dir), 0);
+  cr_assert_eq(sh("cmp -s %s/g1/state.lw %s/gr/state.lw", dir, dir), 0, "a resumed run differs");
+  cr_assert_eq(sh("%s run %s/gas.ini --out %s/g0 --quiet --set anneal.domains=off", lw_test_bin(), dir, dir), 0);
+  cr_assert_neq(sh("cmp -s %s/g0/state.lw %s/g1/state.lw", dir, dir), 0, "domains = auto did not split the sweeps");
+  /* p on a grid, binned along x and z */
+  const double R = 5, ab = 0.5, g = 1, T = 1, h = 10.0 / 160;
+  double expect[2][10] = {{0}}, total = 0;
+  for (int i = 0; i < 160; i++)
+    for (int j = 0; j < 160; j++)
+      for (int k = 0; k < 160; k++) {
+        double x = -5 + (i + 0.5) * h, y = -5 + (j + 0.5) * h, z = -5 + (k + 0.5) * h, r = sqrt(x * x + y * y + z * z);
+        if (r >= R) continue;
+        double w = exp(-(g * z + ab / ((R - r) * (R - r))) / T);
+        expect[0][(int)floor(x + 5)] += w;
+        expect[1][(int)floor(z + 5)] += w;
+        total += w;
+      }
+  char path[128];
+  snprintf(path, sizeof path, "%s/g1/final.ply", dir);
+  double hist[2][10];
+  marginals(path, hist);
+  for (int a = 0; a < 2; a++) {
+    double chi = 0, n = 0;
+    int bins = 0;
+    for (int b = 0; b < 10; b++) n += hist[a][b];
+    cr_assert_eq(n, 2000, "axis %d: %g particles in the bins", a, n);
+    for (int b = 0; b < 10; b++) {
+      double e = n * expect[a][b] / total;
+      if (e < 5) continue;
+      chi += (hist[a][b] - e) * (hist[a][b] - e) / e;
+      bins++;
+    }
+    double limit = gsl_cdf_chisq_Qinv(1e-3, bins - 1);
+    cr_log_info("axis %s: chi-square %.2f over %d bins, limit %.1f", a ? "z" : "x", chi, bins, limit);
+    cr_assert_lt(chi, limit, "axis %s: chi-square %.2f over %d bins (limit %.1f)", a ? "z" : "x", chi, bins, limit);
+  }
 }

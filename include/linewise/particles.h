@@ -160,6 +160,7 @@ typedef struct {
   double x[3], q[4], n[3];      /* its new position, quaternion and normal */
   double dterm[LW_PTERM_COUNT];
   double dE;
+  double acc[LW_PTERM_COUNT];   /* domains: the changes lw_particles_commit_part kept */
 } lw_particles_prop;
 
 lw_particles_prop *lw_particles_prop_new(const lw_particles *p, lw_error *err);
@@ -179,6 +180,20 @@ double lw_particles_evaluate(const lw_particles *p, lw_particles_prop *pr, uint3
 /* Applies an evaluated proposal.  LW_ENOMEM if the grid could not grow
 ** (the state is unchanged then). */
 lw_status lw_particles_commit(lw_particles *p, const lw_particles_prop *pr);
+
+/* ---- domains (domains.h, [anneal] domains) ----
+** Sites are the particles 0 .. n-1, each its own group (a point).
+** propose_in draws a move of particle `site` (the identity where it is
+** pinned for that kind) and refuses one whose new position leaves
+** box = {x0, y0, x1, y1} (dE = +inf, *forbidden = 2); commit_part commits
+** keeping the running totals' changes in pr->acc, which merge adds to the
+** state's.  A move reads the cells within the range of its old and new
+** places and writes those it leaves and enters: within two cell sides of
+** the box, the reach split() gives. */
+double lw_particles_propose_in(const lw_particles *p, lw_particles_prop *pr, int kind, size_t site, double step,
+                               gsl_rng *rng, int *forbidden, const double box[4]);
+lw_status lw_particles_commit_part(lw_particles *p, lw_particles_prop *pr);
+void lw_particles_merge(lw_particles *p, lw_particles_prop *pr);
 
 /* ---- the gradient-based drivers (quench.h, dynamics.h) ----
 ** The state as LW_PARTICLE_COORDS coordinates a particle: x y z, then the

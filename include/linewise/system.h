@@ -147,6 +147,11 @@ struct lw_system_type {
   ** a fixed count of proposals rather than its sites. */
   int n_domain_moves;
   size_t (*sites)(const void *state);
+  /* Optional (NULL: a spline's, 16 init.segments init.segment_length):
+  ** the least side `anneal.domains = auto` gives a domain besides 2.5
+  ** reach, about a group's extent, so that few groups sit on a boundary
+  ** (a group on one is not moved that sweep); 0 for groups that are points. */
+  double (*domain_side)(const void *state);
   /* Optional (NULL: every proposal is symmetric): the log of the last
   ** proposal's Hastings factor, log [q(x' -> x) / q(x -> x')] with the
   ** reference measures' change folded in; the chain then accepts with
