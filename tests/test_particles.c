@@ -621,6 +621,21 @@ Test(particles, a_perturbed_sphere_anneals_back)
   lw_particles_setup_free(s);
 }
 
+/* The pinned rim of rim_file around 61 free particles: the inner hexagon
+** with noise 0.1 r0 and 20 degrees, bonds and stiff bending. */
+static lw_params rim_scene(void)
+{
+  char path[128];
+  rim_file(path, sizeof path);
+  lw_params prm = scene(1, 10, 10, 0);
+  strcpy(prm.pt_points, path);
+  prm.pt_pinned = 1;
+  prm.pt_count = 61;
+  prm.pt_noise = 0.1;
+  prm.pt_normal_noise = 20;
+  return prm;
+}
+
 Test(particles, pinned_particles_stay_and_free_ones_fill_between)
 {
   /* The rim of a hexagon of 91 sites pinned (from a point file, half of them
@@ -630,14 +645,7 @@ Test(particles, pinned_particles_stay_and_free_ones_fill_between)
   ** (a perfect lattice gives 1/sqrt 3 = 0.577; a missing particle about 1),
   ** all in the plane of the rim, none beyond it.  Measured over six seeds:
   ** 0.576, |z| <= 0.007 r0. */
-  char path[128];
-  rim_file(path, sizeof path);
-  lw_params prm = scene(1, 10, 10, 0);
-  strcpy(prm.pt_points, path);
-  prm.pt_pinned = 1;
-  prm.pt_count = 61;
-  prm.pt_noise = 0.1;
-  prm.pt_normal_noise = 20;
+  lw_params prm = rim_scene();
   lw_particles_setup *s = setup_of(&prm);
   cr_assert_eq(s->n_points, 30);
   lw_particles *p = lw_particles_new(s, 2, NULL);
@@ -1339,14 +1347,7 @@ Test(particles, the_gradient_matches_central_differences_of_the_energy)
 ** the motion leaves is unit to 1e-12. */
 Test(particles, the_quench_and_the_motion_keep_pinned_particles_to_the_bit)
 {
-  char path[128];
-  rim_file(path, sizeof path);
-  lw_params prm = scene(1, 10, 10, 0);
-  strcpy(prm.pt_points, path);
-  prm.pt_pinned = 1;
-  prm.pt_count = 61;
-  prm.pt_noise = 0.1;
-  prm.pt_normal_noise = 20;
+  lw_params prm = rim_scene();
   prm.dyn_rho = 1;
   prm.dyn_gamma = 2;
   prm.dyn_dt = 0.002;
