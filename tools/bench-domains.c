@@ -23,6 +23,8 @@
 #include "linewise/domains.h"
 
 #define DOMAIN_SPLINES 100000
+#define DOMAIN_PARTICLES 20000
+#define DOMAIN_PARTICLES_TEXT "20,000 particles"
 #define MAX_THREADS 5 /* 1, 2, 4, 8, 16 */
 
 typedef struct {
@@ -30,17 +32,37 @@ typedef struct {
   double setup_s;
 } dom_run;
 
-static void dom_start(dom_run *r, int pair, const char *domains, const char *dir)
+/* The scenes: the splines with local terms only, with the pair term, and
+** the oriented particles. */
+enum { DOM_LOCAL, DOM_PAIR, DOM_PARTICLES };
+
+static void dom_start(dom_run *r, int scene, const char *domains, const char *dir)
 {
   lw_params p;
   lw_error err;
-  bench_random_params(&p, DOMAIN_SPLINES, pair, 2.8);
-  p.pair_near = 0.0;
-  /* as the scaling table: point and vector moves */
-  p.mix_point = p.mix_vector = 0.5;
-  p.mix_translate = p.mix_rotate = 0.0;
+  if (scene == DOM_PARTICLES) {
+    /* a noisy plane of particles with every weighted term, as the sheet */
+    lw_params_defaults(&p);
+    strcpy(p.system, "particles");
+    p.pt_pattern = LW_PPATTERN_PLANE;
+    p.pt_count = DOMAIN_PARTICLES;
+    p.pt_noise = 0.1;
+    p.pt_normal_noise = 10;
+    p.pt_alpha_p = p.pt_alpha_n = 10;
+    p.pt_alpha_c = 0.5;
+    p.mix_translate = p.mix_rotate = 1.0;
+    p.step_translate = 0.1;
+    p.step_rotate = 5;
+    p.t_start = 0.01;
+  } else {
+    bench_random_params(&p, DOMAIN_SPLINES, scene == DOM_PAIR, 2.8);
+    p.pair_near = 0.0;
+    /* as the scaling table: point and vector moves */
+    p.mix_point = p.mix_vector = 0.5;
+    p.mix_translate = p.mix_rotate = 0.0;
+    p.t_start = 0.05;
+  }
   strcpy(p.schedule, "constant");
-  p.t_start = 0.05;
   p.tune_sweeps = 1;
   p.sweeps = 1000000;
   p.checkpoint_every = 1000000;
@@ -115,20 +137,21 @@ static double profile_speedup(const lw_domains *d, int threads)
   return span > 0.0 ? total / span : 1.0;
 }
 
-static void domains_table(bench_ctx *b, int pair, const char *dir, FILE *data)
+static void domains_table(bench_ctx *b, int scene, const char *dir, FILE *data)
 {
+  static const char *const what[] = {"splines, pair off", "splines, pair on", "particles"};
   FILE *d = b->doc[BENCH_PERFORMANCE];
   int cores = (int)sysconf(_SC_NPROCESSORS_ONLN), n_th = 0, th[MAX_THREADS];
   for (int t = 1; t <= 16 && n_th < MAX_THREADS; t *= 2)
     if (t == 1 || t <= cores) th[n_th++] = t;
   char sub[LW_PATH_MAX];
   dom_run off, split;
-  bench_note("domains: %d splines, pair %s, unsplit", DOMAIN_SPLINES, pair ? "on" : "off");
-  snprintf(sub, sizeof sub, "%s/off-%d", dir, pair);
-  dom_start(&off, pair, "off", sub);
-  bench_note("domains: %d splines, pair %s, domains = auto", DOMAIN_SPLINES, pair ? "on" : "off");
-  snprintf(sub, sizeof sub, "%s/auto-%d", dir, pair);
-  dom_start(&split, pair, "auto", sub);
+  bench_note("domains: %s, unsplit", what[scene]);
+  snprintf(sub, sizeof sub, "%s/off-%d", dir, scene);
+  dom_start(&off, scene, "off", sub);
+  bench_note("domains: %s, domains = auto", what[scene]);
+  snprintf(sub, sizeof sub, "%s/auto-%d", dir, scene);
+  dom_start(&split, scene, "auto", sub);
   lw_domains *dm = split.a.chain->domains;
   if (!dm || !(dm->cell_cpu = calloc((size_t)dm->n, sizeof *dm->cell_cpu))) {
     lw_error err = {.code = LW_EINPUT};
@@ -156,12 +179,15 @@ static void domains_table(bench_ctx *b, int pair, const char *dir, FILE *data)
     if (fscanf(la, "%lf", &load) != 1) load = -1.0;
     fclose(la);
   }
-  fprintf(d, "%s: %d x %d domains of %.0f mm (reach %.1f mm), %.1f %% of site visits skipped (splines on a "
+  static const char *const title[] = {"Local terms only (the pair term off)",
+                                       "With the pair term (cutoff 4 mm, near field off)",
+                                       "Oriented particles (" DOMAIN_PARTICLES_TEXT " on a noisy plane, every "
+                                       "weighted term, T = 0.01; lengths in r0)"};
+  fprintf(d, "%s: %d x %d domains of %.3g %s (reach %.2g %s), %.1f %% of site visits skipped (on a "
              "boundary), %.2f %% of proposals rejected for leaving their domain; set-up %.1f s; load average "
              "%.1f.\n\n",
-          pair ? "With the pair term (cutoff 4 mm, near field off)" : "Local terms only (the pair term off)",
-          dm->nx, dm->ny, dm->lx, dm->reach, 100.0 * frozen, 100.0 * outside, split.setup_s,
-          load);
+          title[scene], dm->nx, dm->ny, dm->lx, scene == DOM_PARTICLES ? "r0" : "mm", dm->reach,
+          scene == DOM_PARTICLES ? "r0" : "mm", 100.0 * frozen, 100.0 * outside, split.setup_s, load);
   fprintf(d, "| sweep | threads | ms per sweep | wall ns per proposal | speed-up over 1 thread | "
              "over the unsplit sweep | on dedicated cores, from the profile |\n|---|---|---|---|---|---|---|\n");
   double w[BENCH_MAX_REPS];
@@ -182,7 +208,7 @@ static void domains_table(bench_ctx *b, int pair, const char *dir, FILE *data)
     double s1 = bench_median(q1, reps), so = bench_median(qo, reps);
     fprintf(d, "| domains = auto | %d | %.0f | %.0f | %.2f | %.2f | %.2f |\n", th[i], msm, nsm, s1, so,
             bench_median(est[i], reps));
-    fprintf(data, "%d %d %.1f %.4f %.4f\n", pair, th[i], nsm, s1, so);
+    fprintf(data, "%d %d %.1f %.4f %.4f\n", scene, th[i], nsm, s1, so);
   }
   fprintf(d, "\n");
   fprintf(data, "\n\n");
@@ -213,8 +239,9 @@ void bench_domains(bench_ctx *b)
              "loaded thread, phase by phase); it leaves out what threads share (memory bandwidth).\n\n",
           DOMAIN_SPLINES, b->reps, b->block);
   FILE *f = bench_data(b, "domains.dat");
-  domains_table(b, 0, dir, f);
-  domains_table(b, 1, dir, f);
+  domains_table(b, DOM_LOCAL, dir, f);
+  domains_table(b, DOM_PAIR, dir, f);
+  domains_table(b, DOM_PARTICLES, dir, f);
   fclose(f);
   char cmd[96];
   snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
