@@ -5,8 +5,9 @@
 ** unsplit sweep.
 **
 ** The scaling section's 10^5-spline scene (lines 2.8 mm apart, every local
-** term, with and without the pair term) annealed at constant T by
-** lw_anneal with [anneal] domains = auto.  The thread count of a split run
+** term, with and without the pair term), then 20,000 oriented particles on a
+** noisy plane, annealed at constant T by lw_anneal with [anneal] domains =
+** auto.  The thread count of a split run
 ** changes nothing in its result, so one run is timed block by block with 1,
 ** 2, 4 ... threads in turn (interleaved, so a change in the machine's load
 ** hits them alike), and the unsplit run beside it; ratios are taken block by
