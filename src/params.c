@@ -364,8 +364,10 @@ const lw_param_def lw_param_table[] = {
       "the minimum to rounding)."),
   NUM("anneal", "quench_stall", LW_PT_DOUBLE, quench_stall, "0.05", "", 0, 1, 0,
       "The quench stops when its last 50 iterations removed less than this share of the energy it "
-      "has removed so far (0: never). A picture's terms are bilinear in its pixels, so the gradient "
-      "norm stops falling short of quench_tol and only this or quench_iterations ends the quench."),
+      "has removed so far while the gradient norm fell by less than a tenth over them (0: never). "
+      "A picture's terms are bilinear in its pixels, so the gradient norm stops falling short of "
+      "quench_tol and only this or quench_iterations ends the quench; on a smooth energy the norm "
+      "keeps falling, and the quench goes on to quench_tol."),
   NUM("tempering", "replicas", LW_PT_INT, replicas, "1", "", 1, 256, 0,
       "Replicas on the temperature ladder (parallel tempering, run by OpenMP threads). 1 = off. "
       "The coldest replica gives final.svg and state.lw."),

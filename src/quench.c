@@ -209,15 +209,20 @@ static double first_step(const double *x, size_t n)
 }
 
 /* Whether o's rules end the quench before iteration `it` (at energy e,
-** gradient norm gnorm; back[] the energies before the last iterations, by
-** iteration mod the window). */
-static lw_quench_end end_now(const lw_quench_opts *o, long it, double gnorm, const double *back, double e,
-                             double e_start)
+** gradient norm gnorm; back[] and back_g[] the energies and gradient norms
+** before the last iterations, by iteration mod the window).  The stall rule
+** waits while the gradient norm still halves over the window: on a smooth
+** energy the last digits of the minimum remove little energy but the norm
+** keeps falling, where on a picture's kinked one it stops falling. */
+static lw_quench_end end_now(const lw_quench_opts *o, long it, double gnorm, const double *back,
+                             const double *back_g, double e, double e_start)
 {
   if (gnorm <= o->tol) return LW_QUENCH_CONVERGED;
   if (it >= o->max_iter) return LW_QUENCH_ITERATIONS;
   if (o->stop && *o->stop) return LW_QUENCH_STOPPED;
-  if (it >= LW_QUENCH_WINDOW && back[it % LW_QUENCH_WINDOW] - e < o->stall * (e_start - e)) return LW_QUENCH_STALLED;
+  if (it >= LW_QUENCH_WINDOW && back[it % LW_QUENCH_WINDOW] - e < o->stall * (e_start - e) &&
+      !(gnorm < 0.9 * back_g[it % LW_QUENCH_WINDOW]))
+    return LW_QUENCH_STALLED;
   return LW_QUENCH_RUNNING;
 }
 
@@ -270,11 +275,13 @@ lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_repor
   }
   const double step0 = first_step(q.x, n), e_start = e;
   double gnorm = sqrt(dot(q.g, q.g, n));
-  double back[LW_QUENCH_WINDOW]; /* the energy of the last iterations, by iteration mod the window */
+  /* the energy and gradient norm of the last iterations, by iteration mod the window */
+  double back[LW_QUENCH_WINDOW], back_g[LW_QUENCH_WINDOW];
   r->gradient_before = gnorm;
   lw_quench_end end;
-  while ((end = end_now(o, r->iterations, gnorm, back, e, e_start)) == LW_QUENCH_RUNNING) {
+  while ((end = end_now(o, r->iterations, gnorm, back, back_g, e, e_start)) == LW_QUENCH_RUNNING) {
     back[r->iterations % LW_QUENCH_WINDOW] = e;
+    back_g[r->iterations % LW_QUENCH_WINDOW] = gnorm;
     if (!step(&q, &e, gnorm > 0.0 ? step0 / gnorm : 0.0, MAX_MOVE * step0, &st, err)) break;
     r->iterations++;
     gnorm = sqrt(dot(q.g, q.g, n));

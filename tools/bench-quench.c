@@ -96,7 +96,8 @@ void bench_quench(bench_ctx *b)
           "move. The picture's terms are bilinear in cells of about half a millimetre, with a kink on\n"
           "every cell line: the gradient norm does not fall to quench_tol there, whatever the\n"
           "minimiser, so `converged` stays false and `anneal.quench_stall` (a share of what the quench\n"
-          "has removed, over its last %d iterations) ends it. The example's annealed state is further\n"
+          "has removed, over its last %d iterations, while the gradient norm falls by less than a\n"
+          "tenth over them) ends it. The example's annealed state is further\n"
           "from its minimum than equipartition says: its last sweeps were still lowering the energy.\n"
           "On smooth scenes the quench converges to quench_tol (tests/test_gradient.c).\n\n",
           LW_QUENCH_WINDOW);
