@@ -647,9 +647,9 @@ double lw_particles_propose_in(const lw_particles *p, lw_particles_prop *pr, int
   if (p->pin[site] & (kind == LW_PMOVE_TRANSLATE ? LW_PIN_POSITION : LW_PIN_ORIENTATION)) return identity(pr);
   double x[3], q[4];
   draw_move(p, (uint32_t)site, kind, step, rng, x, q);
-  if (!(x[0] >= box[0] && x[1] >= box[1] && x[0] <= box[2] && x[1] <= box[3])) {
-    pr->identity = 1; /* never committed: refused */
-    for (int t = 0; t < LW_PTERM_COUNT; t++) pr->dterm[t] = 0.0;
+  /* a step that is not finite goes on to evaluate, which rejects it as NaN */
+  if (isfinite(x[0] + x[1]) && !(x[0] >= box[0] && x[1] >= box[1] && x[0] <= box[2] && x[1] <= box[3])) {
+    identity(pr); /* refused: never committed */
     if (forbidden) *forbidden = 2;
     return pr->dE = INFINITY;
   }

@@ -211,7 +211,7 @@ static double first_step(const double *x, size_t n)
 /* Whether o's rules end the quench before iteration `it` (at energy e,
 ** gradient norm gnorm; back[] and back_g[] the energies and gradient norms
 ** before the last iterations, by iteration mod the window).  The stall rule
-** waits while the gradient norm still halves over the window: on a smooth
+** waits while the gradient norm still falls by a tenth over the window: on a smooth
 ** energy the last digits of the minimum remove little energy but the norm
 ** keeps falling, where on a picture's kinked one it stops falling. */
 static lw_quench_end end_now(const lw_quench_opts *o, long it, double gnorm, const double *back,
@@ -221,7 +221,7 @@ static lw_quench_end end_now(const lw_quench_opts *o, long it, double gnorm, con
   if (it >= o->max_iter) return LW_QUENCH_ITERATIONS;
   if (o->stop && *o->stop) return LW_QUENCH_STOPPED;
   if (it >= LW_QUENCH_WINDOW && back[it % LW_QUENCH_WINDOW] - e < o->stall * (e_start - e) &&
-      !(gnorm < 0.9 * back_g[it % LW_QUENCH_WINDOW]))
+      !(gnorm < LW_QUENCH_STALL_GRADIENT * back_g[it % LW_QUENCH_WINDOW]))
     return LW_QUENCH_STALLED;
   return LW_QUENCH_RUNNING;
 }

@@ -285,8 +285,6 @@ Test(dynamics_cli, the_sheet_drapes_in_the_bowl)
   cr_assert_eq(n, 127);
   cr_assert(rmin > 7.3 && rmax < 8.0, "particles %g to %g from the centre", rmin, rmax);
   cr_assert_gt(along / n, 0.98, "normals along the radius: %g", along / n);
-  snprintf(path, sizeof path, "%s/drape/summary.json", dir);
-  cr_assert_eq(sh("grep -q '\"kinetic\": [0-9.e-]*' %s", path), 0);
   double first, last;
   trace_totals("drape", &first, &last);
   cr_assert_lt(last, first - 700, "E + K %g -> %g", first, last);

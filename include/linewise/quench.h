@@ -48,11 +48,14 @@ typedef struct {
 
 /* When to stop. */
 #define LW_QUENCH_WINDOW 50 /* iterations the stall rule looks back over */
+#define LW_QUENCH_STALL_GRADIENT 0.9 /* ... and waits while the gradient norm falls below this share */
 typedef struct {
   double tol;      /* the gradient norm to stop at */
   long max_iter;   /* iterations at most */
   double stall;    /* stop when the last LW_QUENCH_WINDOW iterations removed less than this
-                   ** share of the energy the quench removed so far (0: never) */
+                   ** share of the energy the quench removed so far, and the gradient norm
+                   ** did not fall below LW_QUENCH_STALL_GRADIENT of its value over them
+                   ** (0: never) */
   const volatile sig_atomic_t *stop; /* may be NULL; set (a signal): stop at the next iteration */
 } lw_quench_opts;
 
