@@ -95,6 +95,17 @@ lw_dynamics *lw_dynamics_new(const lw_system_type *t, void *state, const lw_para
                  "the damping, so gamma must be > 0", where);
     return NULL;
   }
+  const char *dashpot = p->dyn_dashpot != 0.0 ? "dashpot" : p->dyn_dashpot_angular != 0.0 ? "dashpot_angular" : NULL;
+  if (dashpot && (!t->damp_pairs || p->dyn_rho == 0.0)) {
+    lw_params_origin(p, lw_params_find("dynamics", dashpot), where, sizeof where);
+    if (!t->damp_pairs)
+      lw_error_set(err, LW_EINPUT, "%s: key 'dynamics.%s': the system '%s' has no dampers between neighbours; "
+                   "expected 0 (its damping is dynamics.gamma)", where, dashpot, t->name);
+    else
+      lw_error_set(err, LW_EINPUT, "%s: key 'dynamics.%s': a massless motion (rho = 0) is damped by gamma alone; "
+                   "expected 0", where, dashpot);
+    return NULL;
+  }
   lw_dynamics *d = calloc(1, sizeof *d);
   if (!d) {
     lw_error_set(err, LW_ENOMEM, "out of memory");
@@ -108,6 +119,7 @@ lw_dynamics *lw_dynamics_new(const lw_system_type *t, void *state, const lw_para
   d->dt = p->dyn_dt;
   d->integrator = p->dyn_integrator;
   d->h_ref = NAN;
+  d->pair_dampers = dashpot != NULL;
   if (d->integrator == LW_INTEGRATOR_REVIEW && t->constrain) {
     lw_params_origin(p, lw_params_find("dynamics", "integrator"), where, sizeof where);
     lw_error_set(err, LW_EINPUT, "%s: key 'dynamics.integrator': the review's scheme takes free coordinates; the "
@@ -171,11 +183,15 @@ static lw_status not_converged(const lw_dynamics *d, const char *what, lw_error 
                       "(now %g s)", what, d->time, d->steps, d->dt);
 }
 
-static void damp(lw_dynamics *d, double h)
+/* Half a step of the damping: gamma's uniform decay, which commutes with the
+** pair dampers, and theirs forward (first half) or back (second half). */
+static void damp(lw_dynamics *d, double h, int second)
 {
-  if (d->gamma == 0.0) return;
-  double f = exp(-d->gamma / d->rho * h);
-  for (size_t i = 0; i < d->n; i++) d->pi[i] *= f;
+  if (d->gamma != 0.0) {
+    double f = exp(-d->gamma / d->rho * h);
+    for (size_t i = 0; i < d->n; i++) d->pi[i] *= f;
+  }
+  if (d->pair_dampers) d->pairs_took += d->type->damp_pairs(d->state, d->mass, h, second, d->pi);
 }
 
 static lw_status leapfrog(lw_dynamics *d, lw_error *err)
@@ -184,7 +200,7 @@ static lw_status leapfrog(lw_dynamics *d, lw_error *err)
   size_t n = d->n;
   double h = d->dt, *pih = d->pi1, *x1 = d->x1;
   lw_status s;
-  damp(d, 0.5 * h);
+  damp(d, 0.5 * h, 0);
   /* pi+ = pi - h/2 dH/dx(x, pi+), M factored at x */
   memcpy(pih, d->pi, n * sizeof *pih);
   int it = 0;
@@ -220,7 +236,7 @@ static lw_status leapfrog(lw_dynamics *d, lw_error *err)
   /* pi' = pi+ - h/2 dH/dx(x', pi+) */
   dh_dx(d, d->x, pih, d->u);
   for (size_t i = 0; i < n; i++) d->pi[i] = t->mass_pinned(d->mass, i) ? 0.0 : pih[i] - 0.5 * h * d->u[i];
-  damp(d, 0.5 * h);
+  damp(d, 0.5 * h, 1);
   d->time += h;
   return LW_OK;
 }

@@ -554,6 +554,13 @@ const lw_param_def lw_param_table[] = {
   NUM("dynamics", "gamma", LW_PT_DOUBLE, dyn_gamma, "0", "force s/mm^2", 0, 1e12, 0,
       "Rayleigh damping: a force -gamma dr/dt per mm of line (particles: per particle, and "
       "its rotation at the same rate). 0 = none (energy is conserved)."),
+  NUM("dynamics", "dashpot", LW_PT_DOUBLE, dyn_dashpot, "0", "force s / length", 0, 1e12, 0,
+      "Particles: a dashpot between neighbours, the force -dashpot w (v_i - v_j) on i, w the pair "
+      "weight (the seed's beta_1): damps the particles' motion against each other, not a common "
+      "translation. 0 = none. Needs rho > 0. docs/NUMERICS.md, \"Dampers between neighbours\"."),
+  NUM("dynamics", "dashpot_angular", LW_PT_DOUBLE, dyn_dashpot_angular, "0", "energy s", 0, 1e12, 0,
+      "Particles: the torque -dashpot_angular w (omega_i - omega_j) on i between neighbours (the "
+      "seed's beta_3): damps their turning against each other. 0 = none. Needs rho > 0."),
   NUM("dynamics", "dt", LW_PT_DOUBLE, dyn_dt, "0.001", "s", 0, 1e6, LW_MIN_OPEN,
       "Time step of the integrator (massless: the first step tried; halved where the energy "
       "would not fall)."),

@@ -172,6 +172,8 @@ typedef struct {
   size_t n;
   double *m;            /* n: the diagonal */
   unsigned char *held;  /* n */
+  double mass, inertia; /* of a particle: rho, I */
+  double dashpot, dashpot_angular; /* the pair dampers (dynamics.dashpot*) */
 } pt_mass;
 
 static void mass_free(void *mass)
@@ -208,6 +210,10 @@ static void *mass_new(const void *state, const lw_params *p, double density, lw_
   }
   m->n = n;
   const double r0 = s->setup->pair.r0, inertia = 4.0 * density * r0 * r0 / 10.0;
+  m->mass = density;
+  m->inertia = inertia / 4.0;
+  m->dashpot = p->dyn_dashpot;
+  m->dashpot_angular = p->dyn_dashpot_angular;
   for (size_t i = 0; i < n; i++) {
     int rot = i % LW_PARTICLE_COORDS >= 3;
     m->m[i] = rot ? inertia : density;
@@ -236,6 +242,94 @@ static void mass_dx(const void *mass, const double *x, const double *v, double *
 }
 
 static int mass_pinned(const void *mass, size_t i) { return ((const pt_mass *)mass)->held[i]; }
+
+/* The pair dampers (dynamics.dashpot and dashpot_angular; NUMERICS.md,
+** "Dampers between neighbours").  Under the force -c w u on i and +c w u
+** on j, u = v_i - v_j, the pair's relative velocity obeys du/dt = -c w k u
+** with k = 1/m_i + 1/m_j (a held side adds 0), so over a time h it decays
+** exactly by exp(-c w k h): an impulse (1 - exp(-c w k h)) u / k moves from
+** i to j, keeping the pair's momentum, and the kinetic energy falls by
+** (1 - exp(-2 c w k h)) |u|^2 / 2k.  The spins likewise, with the angular
+** momentum L = I omega = (pi_q q^-1) / 2 and back pi_q = 2 L q.  Pairs are
+** taken one at a time (Shardlow's splitting of dissipative particle
+** dynamics), so no step can overshoot and none needs a solve. */
+typedef struct {
+  const lw_particles *p;
+  const pt_mass *m;
+  double *pi, h, taken;
+} damp_ctx;
+
+/* The impulse out[] that takes the relative velocity ui - uj of a pair with
+** inverse masses ki, kj (0 for a held side) through time h of its decay at
+** coefficient c and weight w, with the kinetic energy it takes added to the
+** context; 0 when both sides are held. */
+static int pair_impulse(damp_ctx *a, double c, double w, double ki, double kj, const double ui[3],
+                        const double uj[3], double out[3])
+{
+  double k = ki + kj;
+  if (!(k > 0.0)) return 0;
+  double f = -expm1(-c * w * k * a->h), u2 = 0.0;
+  for (int e = 0; e < 3; e++) {
+    double u = ui[e] - uj[e];
+    u2 += u * u;
+    out[e] = f / k * u;
+  }
+  a->taken += 0.5 * u2 / k * f * (2.0 - f);
+  return 1;
+}
+
+static void damp_pair(void *ctx, size_t i, size_t j, const double r[3], double d2)
+{
+  damp_ctx *a = ctx;
+  const lw_particles *p = a->p;
+  const pt_mass *m = a->m;
+  const double w = lw_ppair_weight(&p->setup->pair, d2, lw_v3_dot(p->nrm + 3 * i, r), lw_v3_dot(p->nrm + 3 * j, r));
+  if (!(w > 0.0)) return;
+  double *pi = a->pi + LW_PARTICLE_COORDS * i, *pj = a->pi + LW_PARTICLE_COORDS * j, d[3];
+  if (m->dashpot > 0.0) {
+    double ki = p->pin[i] & LW_PIN_POSITION ? 0.0 : 1.0 / m->mass;
+    double kj = p->pin[j] & LW_PIN_POSITION ? 0.0 : 1.0 / m->mass;
+    double vi[3] = {ki * pi[0], ki * pi[1], ki * pi[2]}, vj[3] = {kj * pj[0], kj * pj[1], kj * pj[2]};
+    if (pair_impulse(a, m->dashpot, w, ki, kj, vi, vj, d))
+      for (int e = 0; e < 3; e++) {
+        if (ki > 0.0) pi[e] -= d[e];
+        if (kj > 0.0) pj[e] += d[e];
+      }
+  }
+  if (m->dashpot_angular > 0.0) {
+    const double *qi = p->q + 4 * i, *qj = p->q + 4 * j;
+    double ki = p->pin[i] & LW_PIN_ORIENTATION ? 0.0 : 1.0 / m->inertia;
+    double kj = p->pin[j] & LW_PIN_ORIENTATION ? 0.0 : 1.0 / m->inertia;
+    /* omega = L / I = (pi_q q^-1) / 2I: the vector part (pi_q is on q's tangent) */
+    double ci[4] = {qi[0], -qi[1], -qi[2], -qi[3]}, cj[4] = {qj[0], -qj[1], -qj[2], -qj[3]}, li[4], lj[4];
+    lw_quat_mul(pi + 3, ci, li);
+    lw_quat_mul(pj + 3, cj, lj);
+    double wi[3], wj[3];
+    for (int e = 0; e < 3; e++) {
+      wi[e] = 0.5 * ki * li[e + 1];
+      wj[e] = 0.5 * kj * lj[e + 1];
+    }
+    if (pair_impulse(a, m->dashpot_angular, w, ki, kj, wi, wj, d)) {
+      /* L_i -= D, L_j += D: pi_q by 2 D q */
+      double dq[4] = {0.0, d[0], d[1], d[2]}, t[4];
+      if (ki > 0.0) {
+        lw_quat_mul(dq, qi, t);
+        for (int e = 0; e < 4; e++) pi[3 + e] -= 2.0 * t[e];
+      }
+      if (kj > 0.0) {
+        lw_quat_mul(dq, qj, t);
+        for (int e = 0; e < 4; e++) pj[3 + e] += 2.0 * t[e];
+      }
+    }
+  }
+}
+
+static double damp_pairs(const void *state, const void *mass, double h, int reverse, double *pi)
+{
+  damp_ctx a = {state, mass, pi, h, 0.0};
+  if (a.m->dashpot > 0.0 || a.m->dashpot_angular > 0.0) lw_particles_each_pair(state, reverse, damp_pair, &a);
+  return a.taken;
+}
 
 static void constrain(const void *state, double *x, double *pi) { lw_particles_constrain(state, x, pi); }
 
@@ -336,6 +430,7 @@ const lw_system_type lw_system_particles = {
     .mass_dx = mass_dx,
     .mass_pinned = mass_pinned,
     .constrain = constrain,
+    .damp_pairs = damp_pairs,
     .split = split,
     .group = group,
     .propose_in = propose_in,

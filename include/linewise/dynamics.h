@@ -27,7 +27,11 @@
 ** energy error stays O(h^2) over long times and the momentum of a
 ** translation-invariant scene is kept to rounding.  Damping is the exact
 ** flow pi <- pi exp(-gamma h / 2 rho) for half a step on either side
-** (Strang splitting: order 2, and exact for the decay alone).
+** (Strang splitting: order 2, and exact for the decay alone).  Dampers
+** between neighbours (the row's damp_pairs; particles' dynamics.dashpot)
+** take the momenta through half a step on either side too, their pairs in
+** one order before and in the opposite order after, which keeps the step
+** symmetric and so of order 2.
 **
 ** Massless (rho = 0, gamma > 0): the gradient flow D(x) dx/dt = -grad E with
 ** the damping matrix D = gamma M/rho, as D-NURBS fits.  Each step is an
@@ -68,6 +72,8 @@ typedef struct {
   double *work;              /* the review scheme's scratch (dyn_review.h), or NULL */
   unsigned char *held;       /* massless: the coordinates a step holds (n) */
   double h_ref, h_scale;     /* E + K and |E| + K before the first step here (NAN: not yet) */
+  int pair_dampers;          /* 1 if the scene names dampers between neighbours */
+  double pairs_took;         /* the kinetic energy they took since this driver began */
 } lw_dynamics;
 
 /* With inertia, E + K may not rise by more than this many times h_scale

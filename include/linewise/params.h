@@ -218,6 +218,8 @@ typedef struct {
   /* [dynamics] (driver = dynamics; dynamics.h) */
   double dyn_rho;             /* line density, mass per mm; 0 = massless (gradient flow) */
   double dyn_gamma;           /* Rayleigh damping, force per (mm/s) per mm */
+  double dyn_dashpot;         /* particles: damping of neighbours' relative velocity, force s / length */
+  double dyn_dashpot_angular; /* particles: of their relative angular velocity, energy s */
   double dyn_dt;              /* time step, s */
   double dyn_gravity_x, dyn_gravity_y; /* g, mm/s^2 (y down the page) */
   double dyn_force_x, dyn_force_y;     /* constant force per mm of line */

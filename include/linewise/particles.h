@@ -220,5 +220,12 @@ double lw_particles_gradient(const lw_particles *p, double *g, lw_error *err);
 /* Unit quaternions in c and, when pi is not NULL, momenta on their tangent
 ** (pinned orientations untouched). */
 void lw_particles_constrain(const lw_particles *p, double *c, double *pi);
+/* Calls visit(ctx, i, j, r, d2) for every pair i < j closer than the
+** range, r = x_j - x_i and d2 = |r|^2: in the order of the energy's sum,
+** or with reverse = 1 in exactly the reverse order (the dynamics' pair
+** dampers go one way for the first half of a step and back for the
+** second, which keeps the step symmetric). */
+void lw_particles_each_pair(const lw_particles *p, int reverse,
+                            void (*visit)(void *ctx, size_t i, size_t j, const double r[3], double d2), void *ctx);
 
 #endif

@@ -249,6 +249,15 @@ struct lw_system_type {
   ** The dynamics calls it on every new position before the state moves
   ** there, so the state and the driver's coordinates agree bit for bit. */
   void (*constrain)(const void *state, double *x, double *pi);
+  /* Optional (NULL: none, and a scene that sets dynamics.dashpot or
+** dashpot_angular is refused): the dampers between neighbours the scene
+** names, read by mass_new; for particles the seed's beta_1 and beta_3.
+** Takes the momenta pi (of that mass matrix, at the state's positions)
+** through time h of the dampers alone, one pair at a time and each pair
+** exactly, in the row's order of its pairs or (reverse = 1) in exactly the
+** opposite order, so that a half step each way makes a symmetric step.
+** Returns the kinetic energy taken (>= 0). */
+  double (*damp_pairs)(const void *state, const void *mass, double h, int reverse, double *pi);
 
   const char *files;
   lw_status (*draw)(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err);
