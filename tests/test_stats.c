@@ -10,7 +10,10 @@
 **   3. a free worm-like chain (bending, strain holding its length) against
 **      the 2-D Kratky-Porod results;
 **   4. delayed acceptance against plain Metropolis, and its first stage
-**      alone, which the same test must reject.
+**      alone, which the same test must reject;
+**   5. oriented particles (the particle system's row): heights under gravity
+**      over a floor, and the normals of free and of co-normal pairs, against
+**      their Boltzmann distributions, with a wrong temperature rejected.
 **
 ** Seeds are fixed, so each test is deterministic; every tolerance is derived
 ** from the variance of the estimate and stated where it is used.  `make test`
@@ -27,6 +30,8 @@
 #include "linewise/domains.h"
 #include "linewise/mc.h"
 #include "linewise/model.h"
+#include "linewise/particles.h"
+#include "linewise/sys_particles.h"
 #include "linewise/scene.h"
 #include "testutil.h"
 
@@ -279,18 +284,27 @@ static double autocorrelation_time(const double *x, size_t n_ser, size_t n)
   return tau;
 }
 
-/* Chi-square p-value of the samples against N(mu, sd^2) in nb bins of equal
-** probability (expected count n / nb each). */
-static double gaussian_chisq_p(const double *x, size_t n, double mu, double sd, int nb)
+/* Chi-square p-value of the samples against the distribution with CDF
+** cdf(x, par) in nb bins of equal probability (expected count n / nb each). */
+static double chisq_p(const double *x, size_t n, double (*cdf)(double, const double *), const double *par, int nb)
 {
   long count[64] = {0};
   for (size_t i = 0; i < n; i++) {
-    int b = (int)floor(gsl_cdf_ugaussian_P((x[i] - mu) / sd) * nb);
+    int b = (int)floor(cdf(x[i], par) * nb);
     count[b < 0 ? 0 : b >= nb ? nb - 1 : b]++;
   }
   double e = (double)n / nb, chi2 = 0.0;
   for (int b = 0; b < nb; b++) chi2 += (count[b] - e) * (count[b] - e) / e;
   return gsl_cdf_chisq_Q(chi2, nb - 1);
+}
+
+static double gaussian_cdf(double x, const double *par) { return gsl_cdf_ugaussian_P((x - par[0]) / par[1]); }
+
+/* ... against N(mu, sd^2). */
+static double gaussian_chisq_p(const double *x, size_t n, double mu, double sd, int nb)
+{
+  const double par[2] = {mu, sd};
+  return chisq_p(x, n, gaussian_cdf, par, nb);
 }
 
 /*
@@ -623,4 +637,179 @@ Test(stats, delayed_acceptance_samples_the_boltzmann_distribution, .timeout = 30
             se[1]);
   cr_assert(fabs(mean[2] - mean[1]) > 4.0 * hypot(se[2], se[1]),
             "no power: the first stage alone gives %.5f +- %.5f, plain %.5f +- %.5f", mean[2], se[2], mean[1], se[1]);
+}
+
+/* ---- 5. oriented particles ------------------------------------------------ */
+
+/*
+** The particle row through the same chain.  Two small systems with exact
+** Boltzmann distributions:
+**
+**   heights: particles with no pair term, gravity g (energy g z) above a
+**   hard floor at z0: each height above the floor is exponential with rate
+**   g / T, each normal uniform on the sphere, so n_z is uniform on [-1, 1]
+**   (Archimedes) whatever the rotate move's axis and angle law, as long as
+**   its proposal is symmetric;
+**
+**   co-normal pairs: two particles held in place at distance d, normals
+**   free, alpha_N w |n_i - n_j|^2 = 2 alpha_N w (1 - c) with c = n_i . n_j.
+**   Under uniform orientations c is uniform on [-1, 1], so its Boltzmann
+**   density is proportional to exp(kappa c), kappa = 2 alpha_N w / T.  The
+**   pairs stand 10 r0 apart, beyond each other's range.
+**
+** Steps are tuned, then frozen; records are 3 autocorrelation times apart,
+** as in section 2, and the same 1e-3 thresholds hold, with the power of each
+** test shown on a wrong distribution.
+*/
+static double exponential_cdf(double z, const double *par) { return -expm1(-par[0] * z); }
+
+static double uniform_cdf(double c, const double *par) { return 0.5 * (c + 1.0); }
+
+static double tilted_cdf(double c, const double *par) { return expm1(par[0] * (c + 1.0)) / expm1(2.0 * par[0]); }
+
+/* Tunes the chain's steps at temperature T for 200 sweeps and freezes them,
+** then samples: record(p, t, x) writes the n_ser values of record t into x
+** series-major (x[j * n + t] for a pilot of n records) or record-major.
+** Returns the samples, n_keep records of n_ser, 3 tau apart. */
+typedef void particle_record(const lw_particles *p, double *v);
+
+static double *sample_particles(lw_chain *c, const lw_particles *p, particle_record *rec, size_t n_ser, size_t n_keep,
+                                double *tau_out)
+{
+  c->tuning = 1;
+  for (int k = 0; k < 200; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  c->tuning = 0;
+  const size_t n_pilot = 2000;
+  double *x = malloc(n_ser * (n_pilot > n_keep ? n_pilot : n_keep) * sizeof *x), *v = malloc(n_ser * sizeof *v);
+  for (size_t t = 0; t < n_pilot; t++) {
+    cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    rec(p, v);
+    for (size_t j = 0; j < n_ser; j++) x[j * n_pilot + t] = v[j];
+  }
+  double tau = autocorrelation_time(x, n_ser, n_pilot);
+  cr_assert(tau > 0.5 && tau < 50, "autocorrelation time %.2f sweeps is implausible", tau);
+  long thin = (long)ceil(3.0 * tau);
+  for (size_t t = 0; t < n_keep; t++) {
+    for (long k = 0; k < thin; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    rec(p, x + t * n_ser);
+  }
+  free(v);
+  *tau_out = tau;
+  return x;
+}
+
+static lw_params particle_scene(void)
+{
+  lw_params prm;
+  lw_params_defaults(&prm);
+  strcpy(prm.system, "particles");
+  prm.pt_alpha_lj = prm.pt_alpha_p = prm.pt_alpha_n = prm.pt_alpha_c = 0;
+  return prm;
+}
+
+#define FLOOR_Z (-1.0)
+
+static void record_heights(const lw_particles *p, double *v)
+{
+  for (size_t i = 0; i < p->n; i++) v[i] = p->x[3 * i + 2] - FLOOR_Z;
+}
+
+static void record_normals(const lw_particles *p, double *v)
+{
+  for (size_t i = 0; i < p->n; i++) v[i] = p->nrm[3 * i + 2];
+}
+
+static void record_cosines(const lw_particles *p, double *v)
+{
+  for (size_t k = 0; k < p->n / 2; k++) {
+    const double *a = p->nrm + 6 * k, *b = a + 3;
+    v[k] = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  }
+}
+
+/* 100 particles, gravity 1 over a hard floor, T = 0.5: heights against the
+** exponential of rate 2 (and, for power, of rate 2 / 1.1: T 10 % high) and
+** n_z against the uniform law (power: against the tilt kappa = 0.1, a mean
+** 0.033 higher). */
+Test(stats, particle_heights_and_normals_follow_the_boltzmann_distribution)
+{
+  const int longrun = lw_test_long();
+  const double T = 0.5, g = 1.0;
+  lw_params prm = particle_scene();
+  prm.pt_count = 100;
+  prm.pt_gravity = g;
+  prm.pt_boundary = LW_PBOUNDARY_PLANE;
+  prm.pt_boundary_z = FLOOR_Z;
+  prm.pt_alpha_b = 0;
+  lw_error err;
+  lw_particles_setup *s = lw_particles_setup_new(&prm, &err);
+  cr_assert_not_null(s, "%s", err.msg);
+  lw_particles *p = lw_particles_new(s, 17, &err);
+  cr_assert_not_null(p, "%s", err.msg);
+  lw_system *sys = lw_system_wrap(&lw_system_particles, p, &err);
+  cr_assert_not_null(sys, "%s", err.msg);
+  const double w[2] = {1, 1}, st[2] = {0.3, 0.5}, tg[2] = {0.44, 0.44};
+  lw_chain *c = lw_chain_new(sys, w, st, tg, 99, &err);
+  cr_assert_not_null(c, "%s", err.msg);
+  c->temperature = T;
+  const size_t n_keep = longrun ? 4000 : 400, n = n_keep * p->n;
+  double tau_z, tau_n;
+  double *z = sample_particles(c, p, record_heights, p->n, n_keep, &tau_z);
+  double *nz = sample_particles(c, p, record_normals, p->n, n_keep, &tau_n);
+  const double rate = g / T, rate_hot = g / (1.1 * T), tilt = 0.1;
+  double pz = chisq_p(z, n, exponential_cdf, &rate, 20), pz_hot = chisq_p(z, n, exponential_cdf, &rate_hot, 20);
+  double pn = chisq_p(nz, n, uniform_cdf, NULL, 20), pn_tilt = chisq_p(nz, n, tilted_cdf, &tilt, 20);
+  cr_log_info("particles: heights tau %.2f sweeps, p %.3g (1.1 T: %.3g); n_z tau %.2f, p %.3g (tilted: %.3g); %zu "
+              "samples each", tau_z, pz, pz_hot, tau_n, pn, pn_tilt, n);
+  cr_assert(pz > 1e-3, "heights do not follow exp(-g z / T): p = %.3g", pz);
+  cr_assert(pn > 1e-3, "normals are not uniform: p = %.3g", pn);
+  cr_assert(pz_hot < 1e-3, "the test cannot tell T from 1.1 T: p = %.3g", pz_hot);
+  cr_assert(pn_tilt < 1e-3, "the test cannot see a tilt of 0.1: p = %.3g", pn_tilt);
+  free(z);
+  free(nz);
+  lw_chain_free(c);
+  lw_system_free(sys);
+  lw_particles_setup_free(s);
+}
+
+/* 40 pairs held 1 r0 apart (poly weight w = (1 - 1/1.6^2)^3), alpha_N = 1,
+** T = 0.2: kappa = 10 w = 2.26, against kappa 2.26 / 1.1 for power. */
+Test(stats, co_normal_pairs_follow_the_boltzmann_distribution)
+{
+  const int longrun = lw_test_long();
+  const double T = 0.2, d = 1.0;
+  lw_params prm = particle_scene();
+  prm.pt_alpha_n = 1;
+  lw_error err;
+  lw_particles_setup *s = lw_particles_setup_new(&prm, &err);
+  cr_assert_not_null(s, "%s", err.msg);
+  enum { PAIRS = 40 };
+  double x[6 * PAIRS] = {0}, q[8 * PAIRS] = {0};
+  unsigned char pin[2 * PAIRS];
+  for (int k = 0; k < 2 * PAIRS; k++) {
+    x[3 * k] = 10.0 * (k / 2) + d * (k % 2);
+    q[4 * k] = 1.0;
+    pin[k] = LW_PIN_POSITION;
+  }
+  lw_particles *p = lw_particles_new_from(s, 2 * PAIRS, x, q, pin, &err);
+  cr_assert_not_null(p, "%s", err.msg);
+  lw_system *sys = lw_system_wrap(&lw_system_particles, p, &err);
+  cr_assert_not_null(sys, "%s", err.msg);
+  const double w[2] = {0, 1}, st[2] = {0.1, 0.5}, tg[2] = {0.44, 0.44};
+  lw_chain *c = lw_chain_new(sys, w, st, tg, 7, &err);
+  cr_assert_not_null(c, "%s", err.msg);
+  c->temperature = T;
+  const size_t n_keep = longrun ? 10000 : 1000, n = n_keep * PAIRS;
+  double tau;
+  double *cs = sample_particles(c, p, record_cosines, PAIRS, n_keep, &tau);
+  const double wt = pow(1.0 - d * d / (1.6 * 1.6), 3.0), kappa = 2.0 * prm.pt_alpha_n * wt / T, hot = kappa / 1.1;
+  double pc = chisq_p(cs, n, tilted_cdf, &kappa, 20), pc_hot = chisq_p(cs, n, tilted_cdf, &hot, 20);
+  cr_log_info("co-normal pairs: kappa %.4f, tau %.2f sweeps, %zu samples: p %.3g (1.1 T: %.3g)", kappa, tau, n, pc,
+              pc_hot);
+  cr_assert(pc > 1e-3, "n_i . n_j does not follow exp(kappa c): p = %.3g", pc);
+  cr_assert(pc_hot < 1e-3, "the test cannot tell T from 1.1 T: p = %.3g", pc_hot);
+  free(cs);
+  lw_chain_free(c);
+  lw_system_free(sys);
+  lw_particles_setup_free(s);
 }
