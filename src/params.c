@@ -497,8 +497,10 @@ const lw_param_def lw_param_table[] = {
       "random axis)."),
   STRING("particles", "points", pt_points, "", "path",
          "Point file relative to the scene file: one particle per line as `x y z` or "
-         "`x y z nx ny nz` (the normal need not be unit); `#` starts a comment. These particles "
-         "come first; without a normal a particle starts with normal +z. Empty = none."),
+         "`x y z nx ny nz` (the normal need not be unit); `#` starts a comment. Or a PLY file "
+         "(ASCII or binary; its vertices' x y z and nx ny nz, as a scanner or a run's final.ply "
+         "writes them). These particles come first; without a normal a particle starts with "
+         "normal +z. Empty = none."),
   NUM("particles", "pinned", LW_PT_INT, pt_pinned, "0", "", 0, 1, 0,
       "1 = the particles of `points` never move: their positions, and the orientations of "
       "those given with a normal (the others still turn). Moves pick free particles only."),

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "linewise/number.h"
+#include "linewise/ply.h"
 
 /* The next line of f into *buf (newline removed), or NULL at the end. */
 static char *next_line(FILE *f, char **buf, size_t *cap, int *line)
@@ -18,19 +19,49 @@ static char *next_line(FILE *f, char **buf, size_t *cap, int *line)
   return *buf;
 }
 
-lw_status lw_particles_read_points(const char *path, size_t *n, double **x, double **normal,
-                                   unsigned char **has_normal, lw_error *err)
+/* The points read so far, grown as they come. */
+typedef struct {
+  size_t n, cap;
+  double *x, *normal;
+  unsigned char *has_normal;
+} points;
+
+/* Appends a point at v[0..2] with the normal v[3..5] (NULL: none), which
+** must have a direction (where names the line or vertex). */
+static lw_status append(points *pt, const double *v, const double *nrm, const char *path, const char *where,
+                        lw_error *err)
 {
-  *n = 0;
-  *x = *normal = NULL;
-  *has_normal = NULL;
-  FILE *f = fopen(path, "r");
-  if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open point file: %s", path, strerror(errno));
+  double len = nrm ? sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]) : 1.0;
+  if (!(len > 1e-300) || !isfinite(len))
+    return lw_error_set(err, LW_EINPUT, "%s%s: expected a normal nx ny nz with a direction, got length %g", path,
+                        where, len);
+  if (pt->n == pt->cap) {
+    size_t cap = pt->cap ? 2 * pt->cap : 64;
+    double *nx = realloc(pt->x, 3 * cap * sizeof *nx), *nn = NULL;
+    if (nx) pt->x = nx;
+    if (nx && (nn = realloc(pt->normal, 3 * cap * sizeof *nn))) pt->normal = nn;
+    unsigned char *nh = nn ? realloc(pt->has_normal, cap) : NULL;
+    if (!nh) return lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu points", path, cap);
+    pt->has_normal = nh;
+    pt->cap = cap;
+  }
+  double *xi = pt->x + 3 * pt->n, *ni = pt->normal + 3 * pt->n;
+  for (int c = 0; c < 3; c++) {
+    xi[c] = v[c];
+    ni[c] = nrm ? nrm[c] / len : (c == 2 ? 1.0 : 0.0);
+  }
+  pt->has_normal[pt->n++] = nrm != NULL;
+  return LW_OK;
+}
+
+/* The text format: "x y z" or "x y z nx ny nz" a line. */
+static lw_status read_text(FILE *f, const char *path, points *pt, lw_error *err)
+{
   lw_status s = LW_OK;
-  char *buf = NULL;
-  size_t bcap = 0, cap = 0;
+  char *buf = NULL, where[32];
+  size_t bcap = 0;
   int line = 0;
-  while (next_line(f, &buf, &bcap, &line)) {
+  while (!s && next_line(f, &buf, &bcap, &line)) {
     char *hash = strchr(buf, '#');
     if (hash) *hash = '\0';
     double v[6];
@@ -41,48 +72,62 @@ lw_status lw_particles_read_points(const char *path, size_t *n, double **x, doub
                                path, line, buf)
                 : lw_error_set(err, LW_EINPUT, "%s:%d: expected 3 numbers (x y z) or 6 (x y z nx ny nz), got %d",
                                path, line, k);
-      goto out;
+      break;
     }
-    double len = k == 6 ? sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5]) : 1.0;
-    if (!(len > 1e-300) || !isfinite(len)) {
-      s = lw_error_set(err, LW_EINPUT, "%s:%d: expected a normal nx ny nz with a direction, got length %g", path,
-                       line, len);
-      goto out;
-    }
-    if (*n == cap) {
-      cap = cap ? 2 * cap : 64;
-      double *nx = realloc(*x, 3 * cap * sizeof **x), *nn = realloc(*normal, 3 * cap * sizeof **normal);
-      if (nx) *x = nx;
-      if (nn) *normal = nn;
-      unsigned char *nh = realloc(*has_normal, cap);
-      if (nh) *has_normal = nh;
-      if (!nx || !nn || !nh) {
-        s = lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu points", path, cap);
-        goto out;
-      }
-    }
-    double *xi = *x + 3 * *n, *ni = *normal + 3 * *n;
-    for (int c = 0; c < 3; c++) {
-      xi[c] = v[c];
-      ni[c] = k == 6 ? v[3 + c] / len : (c == 2 ? 1.0 : 0.0);
-    }
-    (*has_normal)[*n] = k == 6;
-    (*n)++;
+    snprintf(where, sizeof where, ":%d", line);
+    s = append(pt, v, k == 6 ? v + 3 : NULL, path, where, err);
   }
-  if (ferror(f)) s = lw_error_set(err, LW_EIO, "%s: read error", path);
-  else if (*n == 0) s = lw_error_set(err, LW_EINPUT, "%s:%d: expected at least one point 'x y z [nx ny nz]', found none", path, line);
-out:
+  if (!s && ferror(f)) s = lw_error_set(err, LW_EIO, "%s: read error", path);
+  else if (!s && pt->n == 0)
+    s = lw_error_set(err, LW_EINPUT, "%s:%d: expected at least one point 'x y z [nx ny nz]', found none", path, line);
   free(buf);
+  return s;
+}
+
+/* A PLY file's vertices: x, y, z, and nx, ny, nz where it has all three. */
+static lw_status read_ply(FILE *f, const char *path, points *pt, lw_error *err)
+{
+  static const char *const names[6] = {"x", "y", "z", "nx", "ny", "nz"};
+  size_t n;
+  double *v;
+  unsigned found;
+  lw_status s = lw_ply_read_vertices(f, path, names, 6, &n, &v, &found, err);
+  if (s) return s;
+  for (int c = 0; c < 6 && !s; c++)
+    if (c < 3 ? !(found >> c & 1) : (found >> 3 & 7) && !(found >> c & 1))
+      s = lw_error_set(err, LW_EINPUT, "%s: expected the vertex property '%s' (x, y, z%s), found none", path, names[c],
+                       c < 3 ? "; nx, ny, nz if any" : ", and nx, ny, nz all or none");
+  char where[48];
+  for (size_t i = 0; i < n && !s; i++) {
+    snprintf(where, sizeof where, ": vertex %zu", i);
+    s = append(pt, v + 6 * i, found >> 3 & 7 ? v + 6 * i + 3 : NULL, path, where, err);
+  }
+  free(v);
+  return s;
+}
+
+lw_status lw_particles_read_points(const char *path, size_t *n, double **x, double **normal,
+                                   unsigned char **has_normal, lw_error *err)
+{
+  *n = 0;
+  *x = *normal = NULL;
+  *has_normal = NULL;
+  FILE *f = fopen(path, "r");
+  if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open point file: %s", path, strerror(errno));
+  points pt = {0};
+  lw_status s = lw_ply_detect(f) ? read_ply(f, path, &pt, err) : read_text(f, path, &pt, err);
   fclose(f);
   if (s) {
-    free(*x);
-    free(*normal);
-    free(*has_normal);
-    *x = *normal = NULL;
-    *has_normal = NULL;
-    *n = 0;
+    free(pt.x);
+    free(pt.normal);
+    free(pt.has_normal);
+    return s;
   }
-  return s;
+  *n = pt.n;
+  *x = pt.x;
+  *normal = pt.normal;
+  *has_normal = pt.has_normal;
+  return LW_OK;
 }
 
 /* ---- the checkpoint section ------------------------------------------------ */

@@ -16,6 +16,7 @@ int lw_fuzz_state_one(const uint8_t *data, size_t size);
 int lw_fuzz_resume_one(const uint8_t *data, size_t size);
 int lw_fuzz_energy_one(const uint8_t *data, size_t size);
 int lw_fuzz_image_one(const uint8_t *data, size_t size);
+int lw_fuzz_points_one(const uint8_t *data, size_t size);
 
 /* Feeds every file of tests/fuzz/corpus/<name> to fn; returns the count. */
 static int replay(const char *name, int (*fn)(const uint8_t *, size_t))
@@ -70,4 +71,9 @@ Test(fuzz, energy_corpus_replays_clean)
 Test(fuzz, image_corpus_replays_clean)
 {
   cr_assert_geq(replay("image", lw_fuzz_image_one), 12, "the image corpus lost its seeds");
+}
+
+Test(fuzz, points_corpus_replays_clean)
+{
+  cr_assert_geq(replay("points", lw_fuzz_points_one), 5, "the points corpus lost its seeds");
 }

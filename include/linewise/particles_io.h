@@ -7,8 +7,10 @@
 **     x y z            or      x y z nx ny nz
 **
 ** numbers separated by blanks; '#' starts a comment; blank lines are
-** skipped.  The normal need not be unit but must have a length (it is
-** normalised).  Errors name the file and line and say what was expected.
+** skipped.  Or a PLY file (its first line "ply"; ply.h): the vertices' x y
+** z and, where it has all three, nx ny nz.  The normal need not be unit but
+** must have a length (it is normalised).  Errors name the file and line
+** (or vertex) and say what was expected.
 **
 ** Checkpoint section (the row's save / load): the system's own section of
 ** state.lw (ckpt.h), [system particles] or [system particles K],
