@@ -112,7 +112,7 @@ lw_status lw_particles_read_points(const char *path, size_t *n, double **x, doub
   *n = 0;
   *x = *normal = NULL;
   *has_normal = NULL;
-  FILE *f = fopen(path, "r");
+  FILE *f = fopen(path, "rb");
   if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open point file: %s", path, strerror(errno));
   points pt = {0};
   lw_status s = lw_ply_detect(f) ? read_ply(f, path, &pt, err) : read_text(f, path, &pt, err);

@@ -45,7 +45,7 @@ typedef struct {
   FILE *f;
   const char *path;
   int format;
-  int line;
+  long line;
   char *buf;
   size_t cap;
   lw_error *err;
@@ -71,14 +71,14 @@ static ptype type_of(const char *s)
 int lw_ply_detect(FILE *f)
 {
   char head[5] = {0};
-  size_t got = fread(head, 1, 4, f);
+  size_t got = fread(head, 1, 5, f);
   rewind(f);
-  return got >= 4 && !memcmp(head, "ply", 3) && (head[3] == '\n' || head[3] == '\r');
+  return got >= 4 && (!memcmp(head, "ply\n", 4) || (got == 5 && !memcmp(head, "ply\r\n", 5)));
 }
 
 static lw_status bad_line(reader *r, const char *expected, const char *got)
 {
-  return lw_error_set(r->err, LW_EINPUT, "%s:%d: expected %s, got '%.60s'", r->path, r->line, expected, got);
+  return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected %s, got '%.60s'", r->path, r->line, expected, got);
 }
 
 /* The header, up to end_header: the format and the elements. */
@@ -104,7 +104,7 @@ static lw_status read_header(reader *r, const char *const *names, int n_names, e
       ** would be read for nothing (and, in the billions, for ever) */
       for (int k = 0; k < *n_el; k++)
         if (el[k].count && !el[k].n_props)
-          return lw_error_set(r->err, LW_EINPUT, "%s:%d: expected properties for the element '%s', found none",
+          return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected properties for the element '%s', found none",
                               r->path, r->line, el[k].name);
       return LW_OK;
     }
@@ -115,9 +115,9 @@ static lw_status read_header(reader *r, const char *const *names, int n_names, e
           !lw_number_parse_whole(count, 0, 1e15, &c))
         return bad_line(r, "'element NAME COUNT' (a name under 32 characters, a whole count)", name ? name : "");
       if (*n_el == ELEMS_MAX)
-        return lw_error_set(r->err, LW_EINPUT, "%s:%d: expected at most %d elements", r->path, r->line, ELEMS_MAX);
+        return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected at most %d elements", r->path, r->line, ELEMS_MAX);
       if (!strcmp(name, "vertex") && c > LW_PLY_VERTICES_MAX)
-        return lw_error_set(r->err, LW_EINPUT, "%s:%d: expected at most %d vertices, got %lld", r->path, r->line,
+        return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected at most %d vertices, got %lld", r->path, r->line,
                             LW_PLY_VERTICES_MAX, c);
       elem *e = el + (*n_el)++;
       strcpy(e->name, name);
@@ -129,7 +129,7 @@ static lw_status read_header(reader *r, const char *const *names, int n_names, e
       if (!*n_el) return bad_line(r, "an element before its properties", w);
       elem *e = el + *n_el - 1;
       if (e->n_props == PROPS_MAX)
-        return lw_error_set(r->err, LW_EINPUT, "%s:%d: expected at most %d properties an element", r->path, r->line,
+        return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected at most %d properties an element", r->path, r->line,
                             PROPS_MAX);
       prop *p = e->props + e->n_props++;
       char *t = strtok_r(NULL, " \t", &save), *name;
@@ -155,7 +155,7 @@ static lw_status read_header(reader *r, const char *const *names, int n_names, e
     }
     return bad_line(r, "a header line (comment, element, property or end_header)", w);
   }
-  return lw_error_set(r->err, LW_EINPUT, "%s:%d: expected 'end_header', found the end of the file", r->path, r->line);
+  return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected 'end_header', found the end of the file", r->path, r->line);
 }
 
 /* ---- binary -------------------------------------------------------------- */
@@ -205,8 +205,10 @@ static int binary_instance(reader *r, const elem *e, double *row)
     }
     if (!read_binary(r, p->count, &v)) return 0;
     if (v < 0 || v > LIST_MAX) return -1;
-    long skip = (long)v * type_size[p->type];
-    if (skip && fseek(r->f, skip, SEEK_CUR)) return 0;
+    /* read, not skipped by fseek, which passes the end of a file cut short
+    ** without a word */
+    for (long m = 0, items = (long)v; m < items; m++)
+      if (!read_binary(r, p->type, &v)) return 0;
   }
   return 1;
 }
@@ -219,7 +221,7 @@ static lw_status ascii_instance(reader *r, const elem *e, size_t index, double *
   char *s;
   do {
     if (!(s = next_line(r)))
-      return lw_error_set(r->err, LW_EINPUT, "%s:%d: expected %zu %s lines, the file ends after %zu", r->path, r->line,
+      return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected %zu %s lines, the file ends after %zu", r->path, r->line,
                           e->count, e->name, index);
   } while (strspn(s, " \t") == strlen(s));
   char *save, *tok = strtok_r(s, " \t", &save);
@@ -227,7 +229,7 @@ static lw_status ascii_instance(reader *r, const elem *e, size_t index, double *
     const prop *p = e->props + k;
     double v;
     if (!tok || !lw_number_parse(tok, &v))
-      return lw_error_set(r->err, LW_EINPUT, "%s:%d: expected property %d of %s %zu as a finite number, got '%.40s'",
+      return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected property %d of %s %zu as a finite number, got '%.40s'",
                           r->path, r->line, k + 1, e->name, index, tok ? tok : "");
     tok = strtok_r(NULL, " \t", &save);
     if (p->count == T_NONE) {
@@ -235,16 +237,16 @@ static lw_status ascii_instance(reader *r, const elem *e, size_t index, double *
       continue;
     }
     if (v < 0 || v > LIST_MAX || v != floor(v))
-      return lw_error_set(r->err, LW_EINPUT, "%s:%d: expected a list's length (a whole number up to %d), got %g",
+      return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected a list's length (a whole number up to %d), got %g",
                           r->path, r->line, LIST_MAX, v);
     double item;
     for (long m = 0, items = (long)v; m < items; m++, tok = strtok_r(NULL, " \t", &save))
       if (!tok || !lw_number_parse(tok, &item))
-        return lw_error_set(r->err, LW_EINPUT, "%s:%d: expected a list item as a finite number, got '%.40s'",
+        return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected a list item as a finite number, got '%.40s'",
                             r->path, r->line, tok ? tok : "");
   }
   if (tok)
-    return lw_error_set(r->err, LW_EINPUT, "%s:%d: expected %d values for %s %zu (its properties), got more: '%.40s'",
+    return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected %d values for %s %zu (its properties), got more: '%.40s'",
                         r->path, r->line, e->n_props, e->name, index, tok);
   return LW_OK;
 }
@@ -256,6 +258,7 @@ static lw_status instance(reader *r, const elem *e, size_t index, double *row)
   double scratch[PROPS_MAX];
   int got = binary_instance(r, e, row ? row : scratch);
   if (got > 0) return LW_OK;
+  if (ferror(r->f)) return lw_error_set(r->err, LW_EIO, "%s: read error in %s %zu", r->path, e->name, index);
   if (got < 0)
     return lw_error_set(r->err, LW_EINPUT, "%s: %s %zu: expected a list of at most %d items", r->path, e->name,
                         index, LIST_MAX);
@@ -304,7 +307,7 @@ lw_status lw_ply_read_vertices(FILE *f, const char *path, const char *const *nam
       double *row = *values + i * (size_t)n_names;
       memset(row, 0, (size_t)n_names * sizeof *row);
       if ((s = instance(&r, v, i, row))) break;
-      for (int c = 0; c < n_names; c++)
+      for (int c = 0; c < n_names && !s; c++)
         if (!isfinite(row[c]))
           s = lw_error_set(err, LW_EINPUT, "%s: vertex %zu: expected a finite %s, got %g", path, i, names[c], row[c]);
     }

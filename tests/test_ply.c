@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "linewise/particles_io.h"
 #include "linewise/ply.h"
@@ -181,6 +182,15 @@ Test(ply, every_refusal_names_the_file_and_where)
   /* binary: cut short inside the last vertex, and a value that is not finite */
   snprintf(path, sizeof path, "%s/cut.ply", dir);
   write_binary(path, 0, 2);
+  read_points(path, LW_EINPUT, "vertex 2: the file ends inside it (the header says 3)");
+  /* cut inside the last vertex's list (its last property): items are read,
+  ** not skipped by a seek that would pass the end without a word */
+  write_binary(path, 1, 3);
+  FILE *g = fopen(path, "rb+");
+  fseek(g, 0, SEEK_END);
+  long size = ftell(g);
+  fclose(g);
+  cr_assert_eq(truncate(path, size - 8), 0); /* the edge element and one of vertex 2's two list items */
   read_points(path, LW_EINPUT, "vertex 2: the file ends inside it (the header says 3)");
   FILE *f = fopen(path, "wb");
   fprintf(f, "ply\nformat binary_big_endian 1.0\nelement vertex 1\nproperty double x\nproperty float y\n"

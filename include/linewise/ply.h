@@ -12,8 +12,10 @@
 ** obj_info lines are ignored.  An ASCII element instance is one line.
 **
 ** Everything is checked: the header's lines (each error names the file and
-** line and says what was expected), the element counts against the file's
-** size, every value finite, a binary file not cut short (naming the vertex).
+** line and says what was expected), every value finite, a file that ends
+** before its element counts do (naming the line or the instance; the
+** vertices' memory grows as they come, so a count costs none before it is
+** found out).  Lines end in LF or CR LF.
 */
 #ifndef LINEWISE_PLY_H
 #define LINEWISE_PLY_H
@@ -35,7 +37,7 @@ int lw_ply_detect(FILE *f);
 ** as doubles into *values (n * n_names, malloc'ed, vertex-major); a
 ** property the vertices lack reads 0 and leaves bit k of *found clear.
 ** LW_EINPUT naming the file and the line or vertex for a file that is not
-** what the header says, or without vertices; LW_ENOMEM. */
+** what the header says, or without vertices; LW_EIO; LW_ENOMEM. */
 lw_status lw_ply_read_vertices(FILE *f, const char *path, const char *const *names, int n_names, size_t *n,
                                double **values, unsigned *found, lw_error *err);
 
