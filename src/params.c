@@ -484,9 +484,11 @@ const lw_param_def lw_param_table[] = {
   NUM("particles", "count", LW_PT_INT, pt_count, "100", "", 0, 1e7, 0,
       "Particles placed by `pattern` (after those of `points`, if any)."),
   CHOICE("particles", "pattern", pt_pattern, "plane", "cloud|plane|sphere",
-         "Initial placement: cloud = uniform in a cube with random orientations; plane = a "
-         "hexagonal patch in z = 0 with normals +z; sphere = a Fibonacci sphere around the "
-         "origin with outward normals. Then `noise` and `normal_noise`; drawn from anneal.seed."),
+         "Initial placement: cloud = uniform in a cube (the part inside `boundary`) with random "
+         "orientations; plane = a hexagonal patch in z = 0 with normals +z; sphere = a Fibonacci "
+         "sphere around the origin with outward normals. Then `noise` and `normal_noise`; drawn "
+         "from anneal.seed. A plane or sphere whose sites reach the boundary is refused, naming "
+         "`size` or `boundary_z`."),
   NUM("particles", "size", LW_PT_DOUBLE, pt_size, "0", "length", 0, 1e9, 0,
       "Extent of the pattern: the cube's side, the patch's or the sphere's diameter. 0 = "
       "automatic: the extent `count` particles fill at the spacing r0 (docs/NUMERICS.md)."),

@@ -139,6 +139,11 @@ static int external(const lw_particles_setup *s, const double x[3], double e[LW_
   return 0;
 }
 
+static const char *boundary_name(const lw_particles_setup *s)
+{
+  return s->boundary == LW_PBOUNDARY_PLANE ? "plane" : "sphere";
+}
+
 int lw_particles_outside(const lw_particles_setup *s, const double x[3])
 {
   double e[LW_PTERM_COUNT] = {0};
@@ -510,7 +515,7 @@ lw_particles *lw_particles_new_from(const lw_particles_setup *s, size_t n, const
     }
     if (lw_particles_outside(s, xi)) {
       lw_error_set(err, LW_EINPUT, "particle %zu at (%g, %g, %g) is outside the %s boundary", i, xi[0], xi[1],
-                   xi[2], s->boundary == LW_PBOUNDARY_PLANE ? "plane" : "sphere");
+                   xi[2], boundary_name(s));
       return NULL;
     }
   }
@@ -533,6 +538,41 @@ fail:
   return NULL;
 }
 
+static int place_outside(const void *setup, const double x[3]) { return lw_particles_outside(setup, x); }
+
+lw_status lw_particles_check_start(const lw_particles_setup *s, const char **key, lw_error *err)
+{
+  *key = "points";
+  for (size_t i = 0; i < s->n_points; i++) {
+    const double *x = s->point + 3 * i;
+    if (lw_particles_outside(s, x))
+      return lw_error_set(err, LW_EINPUT, "point %zu at (%g, %g, %g) is outside the %s boundary: expected every "
+                          "point inside it", i + 1, x[0], x[1], x[2], boundary_name(s));
+  }
+  if (!s->count || s->boundary == LW_PBOUNDARY_NONE) return LW_OK;
+  static const char *const name[] = {"cloud", "plane", "sphere"};
+  *key = s->boundary == LW_PBOUNDARY_PLANE ? "boundary_z" : "size";
+  if (s->pattern == LW_PPATTERN_CLOUD) {
+    /* its places are drawn inside the boundary: only a cube wholly beyond a
+    ** floor has none */
+    if (s->boundary == LW_PBOUNDARY_SPHERE || 0.5 * s->size > s->boundary_z) return LW_OK;
+    return lw_error_set(err, LW_EINPUT, "the cloud pattern (size %g) lies below z = %g: expected the floor below "
+                        "that, got %g", s->size, 0.5 * s->size, s->boundary_z);
+  }
+  /* the lattice's sites before their noise (they need no generator) */
+  double *x = malloc(7 * s->count * sizeof *x);
+  if (!x) return lw_error_set(err, LW_ENOMEM, "out of memory for %zu particles", s->count);
+  lw_status st = lw_particles_place(s->pattern, s->count, s->size, 0.0, 0.0, 0.0, 0, NULL, NULL, x, x + 3 * s->count,
+                                    err);
+  for (size_t i = 0; !st && i < s->count; i++)
+    if (lw_particles_outside(s, x + 3 * i))
+      st = lw_error_set(err, LW_EINPUT, "the %s pattern (size %g) puts a site at (%g, %g, %g), outside the %s "
+                        "boundary: expected the pattern inside it", name[s->pattern], s->size, x[3 * i],
+                        x[3 * i + 1], x[3 * i + 2], boundary_name(s));
+  free(x);
+  return st;
+}
+
 lw_particles *lw_particles_new(const lw_particles_setup *s, unsigned long seed, lw_error *err)
 {
   size_t n = s->n_points + s->count;
@@ -549,7 +589,7 @@ lw_particles *lw_particles_new(const lw_particles_setup *s, unsigned long seed, 
     pin[i] = s->point_pin[i];
   }
   if (lw_particles_place(s->pattern, s->count, s->size, s->noise, s->normal_noise, 0.5 * s->pair.r0, seed,
-                         x + 3 * s->n_points, q + 4 * s->n_points, err))
+                         place_outside, s, x + 3 * s->n_points, q + 4 * s->n_points, err))
     goto out;
   p = lw_particles_new_from(s, n, x, q, pin, err);
 out:

@@ -81,7 +81,8 @@ static int crowded(const lw_cellgrid *g, const double *x, const double p[3], dou
 }
 
 lw_status lw_particles_place(int pattern, size_t count, double size, double noise, double normal_noise,
-                             double min_dist, unsigned long seed, double *x, double *q, lw_error *err)
+                             double min_dist, unsigned long seed, int (*outside)(const void *, const double[3]),
+                             const void *ctx, double *x, double *q, lw_error *err)
 {
   lw_cellgrid *g = NULL;
   if (pattern == LW_PPATTERN_PLANE) {
@@ -101,11 +102,11 @@ lw_status lw_particles_place(int pattern, size_t count, double size, double nois
   for (size_t k = 0; k < count; k++) {
     double *xk = x + 3 * k, *qk = q + 4 * k;
     if (pattern == LW_PPATTERN_CLOUD) {
-      /* random sequential addition: a few tries for a place min_dist clear
-      ** of the others, then the last try stands */
+      /* random sequential addition: a few tries for a place inside the
+      ** boundary and min_dist clear of the others, then the last try stands */
       for (int tries = 0; tries < LW_PLACE_TRIES; tries++) {
         for (int c = 0; c < 3; c++) xk[c] = size * (gsl_rng_uniform(r) - 0.5);
-        if (!g || !crowded(g, x, xk, min_dist)) break;
+        if ((!outside || !outside(ctx, xk)) && (!g || !crowded(g, x, xk, min_dist))) break;
       }
       if (g && lw_cellgrid_insert3(g, (uint32_t)k, xk[0], xk[1], xk[2])) {
         gsl_rng_free(r);

@@ -32,7 +32,14 @@ static const char *note(const void *setup) { return ""; }
 /* The particles of the state [init] from names, if any, else the set-up's placement. */
 static void *state_new(const void *setup, const lw_params *p, unsigned long seed, lw_error *err)
 {
-  if (!p->from[0]) return lw_particles_new(setup, seed, err);
+  if (!p->from[0]) {
+    const char *key;
+    if (lw_particles_check_start(setup, &key, err)) {
+      if (err->code == LW_EINPUT) lw_params_blame(p, "particles", key, err);
+      return NULL;
+    }
+    return lw_particles_new(setup, seed, err);
+  }
   lw_state st;
   lw_particles *s = NULL;
   if (!lw_state_read(&st, p->from, err)) {

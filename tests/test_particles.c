@@ -928,6 +928,41 @@ Test(particles, bad_keys_name_file_line_and_key)
   cr_assert_eq(lw_params_read(&prm, path, &err), LW_OK, "%s", err.msg);
   cr_assert_null(lw_particles_setup_new(&prm, &err));
   cr_assert(strstr(err.msg, "s.ini:2: key 'particles.count': expected at least 1 particle"), "%s", err.msg);
+  /* a pattern or a point that cannot lie inside the boundary: the key to
+  ** blame and what was expected (before, a particle index and its place) */
+  static const struct {
+    const char *text, *key, *msg;
+  } outside[] = {
+      {"[particles]\npattern = sphere\nsize = 16\nboundary = sphere\nboundary_radius = 7\n", "size",
+       "the sphere pattern (size 16) puts a site at"},
+      {"[particles]\npattern = plane\nboundary = plane\nboundary_z = 0\n", "boundary_z",
+       "outside the plane boundary: expected the pattern inside it"},
+      {"[particles]\npattern = cloud\nsize = 4\nboundary = plane\nboundary_z = 2\n", "boundary_z",
+       "the cloud pattern (size 4) lies below z = 2: expected the floor below that, got 2"},
+      {"[particles]\npoints = pts.txt\ncount = 0\nboundary = sphere\nboundary_radius = 3\n", "points",
+       "point 2 at (0, 4, 0) is outside the sphere boundary"},
+  };
+  write_file("pts.txt", "0 0 0\n0 4 0\n", path, sizeof path);
+  for (size_t k = 0; k < sizeof outside / sizeof *outside; k++) {
+    write_file("s.ini", outside[k].text, path, sizeof path);
+    cr_assert_eq(lw_params_read(&prm, path, &err), LW_OK, "%s", err.msg);
+    lw_particles_setup *s = setup_of(&prm);
+    const char *key = NULL;
+    cr_assert_eq(lw_particles_check_start(s, &key, &err), LW_EINPUT, "case %zu", k);
+    cr_assert_str_eq(key, outside[k].key, "case %zu", k);
+    cr_assert(strstr(err.msg, outside[k].msg), "case %zu: %s", k, err.msg);
+    lw_particles_setup_free(s);
+  }
+  /* a cloud half below a floor draws its places above it */
+  write_file("s.ini", "[particles]\npattern = cloud\ncount = 200\nsize = 6\nnoise = 0\nboundary = plane\n"
+             "boundary_z = 1\n", path, sizeof path);
+  cr_assert_eq(lw_params_read(&prm, path, &err), LW_OK, "%s", err.msg);
+  lw_particles_setup *s = setup_of(&prm);
+  lw_particles *p = lw_particles_new(s, 4, &err);
+  cr_assert_not_null(p, "%s", err.msg);
+  for (size_t i = 0; i < p->n; i++) cr_assert_gt(p->x[3 * i + 2], 1.0, "particle %zu", i);
+  lw_particles_free(p);
+  lw_particles_setup_free(s);
   /* the command line reads the same table: exit status 2 and the message */
   const char *bin = getenv("LW_BIN");
   cr_assert_not_null(bin);
@@ -935,6 +970,11 @@ Test(particles, bad_keys_name_file_line_and_key)
   cr_assert_eq(lw_test_sh("%s run %s --out %s/o --quiet 2>%s/err.txt", bin, path, dir, dir), 2);
   cr_assert_eq(lw_test_sh("grep -q \"s.ini:3: key 'particles.pattern': expected one of cloud|plane|sphere\" %s/err.txt",
                           dir), 0);
+  write_file("s.ini", "[scene]\nsystem = particles\n[particles]\npattern = sphere\nsize = 16\nboundary = sphere\n"
+             "boundary_radius = 7\n", path, sizeof path);
+  cr_assert_eq(lw_test_sh("%s run %s --out %s/o --quiet 2>%s/err.txt", bin, path, dir, dir), 2);
+  cr_assert_eq(lw_test_sh("grep -q \"s.ini:5: key 'particles.size': the sphere pattern (size 16) puts a site\" "
+                          "%s/err.txt && test $(wc -l < %s/err.txt) = 1", dir, dir), 0);
 }
 
 /* ---- placement ---------------------------------------------------------- */

@@ -116,6 +116,14 @@ typedef struct {
   double *qlen;                 /* n: |q| as last given to set_coords (NULL: never; 1 for a unit one) */
 } lw_particles;
 
+/* LW_EINPUT, with *key the [particles] key to blame ("points", "size" or
+** "boundary_z"), when the start cannot lie inside the boundary: a point of
+** the point file outside it, a plane or sphere pattern whose sites (before
+** their noise) reach it, a cloud wholly below a floor (a cloud draws its
+** places inside).  Called before lw_particles_new, whose own refusal of a
+** particle outside names only the particle. */
+lw_status lw_particles_check_start(const lw_particles_setup *s, const char **key, lw_error *err);
+
 /* The initial state: the point file's particles, then `count` placed by the
 ** pattern from an mt19937 stream seeded with seed.  LW_EINPUT when a
 ** particle starts outside the boundary or two coincide (infinite energy). */

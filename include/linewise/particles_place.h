@@ -2,10 +2,10 @@
 ** particles_place.h -- initial placement of the oriented particles: a random
 ** cloud, a noisy plane or a noisy sphere (particles.pattern).
 **
-**   cloud   positions uniform in the cube of side `size` around the origin,
-**           no two closer than min_dist (r0/2: random sequential addition,
-**           LW_PLACE_TRIES draws for a clear place, then the last draw
-**           stands), orientations uniform over all rotations (a normalised
+**   cloud   positions uniform in the cube of side `size` around the origin
+**           and inside the boundary, no two closer than min_dist (r0/2:
+**           random sequential addition, LW_PLACE_TRIES draws for a clear
+**           place, then the last draw stands), orientations uniform over all rotations (a normalised
 **           4-D Gaussian quaternion).  Pure uniform placement puts some
 **           pairs so close that the Lennard-Jones energy reaches 1e20 and
 **           more, which no running total can later cancel to 1e-9 of
@@ -43,9 +43,12 @@ double lw_particles_plane_spacing(size_t count, double size);
 
 #define LW_PLACE_TRIES 100
 
-/* Places count particles: x (3 count) and q (4 count, unit).  LW_ENOMEM
-** if the lattice or the cloud's grid cannot be built. */
+/* Places count particles: x (3 count) and q (4 count, unit).  A cloud's
+** tries also count a place where outside(ctx, x) is not 0 as taken (a
+** boundary; outside NULL: none).  LW_ENOMEM if the lattice or the cloud's
+** grid cannot be built. */
 lw_status lw_particles_place(int pattern, size_t count, double size, double noise, double normal_noise,
-                             double min_dist, unsigned long seed, double *x, double *q, lw_error *err);
+                             double min_dist, unsigned long seed, int (*outside)(const void *, const double[3]),
+                             const void *ctx, double *x, double *q, lw_error *err);
 
 #endif
