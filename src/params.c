@@ -499,7 +499,8 @@ const lw_param_def lw_param_table[] = {
       "random axis)."),
   STRING("particles", "points", pt_points, "", "path",
          "Point file relative to the scene file: one particle per line as `x y z` or "
-         "`x y z nx ny nz` (the normal need not be unit); `#` starts a comment. Or a PLY file "
+         "`x y z nx ny nz`, blanks or commas between (the normal need not be unit); `#` starts "
+         "a comment, and so does `//` at a line's start. Or a PLY file "
          "(ASCII or binary; its vertices' x y z and nx ny nz, as a scanner or a run's final.ply "
          "writes them). These particles come first; without a normal a particle starts with "
          "normal +z. Empty = none."),

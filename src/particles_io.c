@@ -54,7 +54,8 @@ static lw_status append(points *pt, const double *v, const double *nrm, const ch
   return LW_OK;
 }
 
-/* The text format: "x y z" or "x y z nx ny nz" a line. */
+/* The text format: "x y z" or "x y z nx ny nz" a line, blanks or commas
+** between the numbers. */
 static lw_status read_text(FILE *f, const char *path, points *pt, lw_error *err)
 {
   lw_status s = LW_OK;
@@ -64,8 +65,10 @@ static lw_status read_text(FILE *f, const char *path, points *pt, lw_error *err)
   while (!s && next_line(f, &buf, &bcap, &line)) {
     char *hash = strchr(buf, '#');
     if (hash) *hash = '\0';
+    /* CloudCompare's ASCII export heads its columns with "//X,Y,Z,..." */
+    if (!strncmp(buf + strspn(buf, " \t"), "//", 2)) continue;
     double v[6];
-    int k = lw_number_list(buf, 0, v, 6);
+    int k = lw_number_list(buf, 1, v, 6);
     if (k == 0) continue;
     if (k != 3 && k != 6) {
       s = k < 0 ? lw_error_set(err, LW_EINPUT, "%s:%d: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got '%.80s'",

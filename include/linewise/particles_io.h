@@ -6,7 +6,8 @@
 **
 **     x y z            or      x y z nx ny nz
 **
-** numbers separated by blanks; '#' starts a comment; blank lines are
+** numbers separated by blanks or commas; '#' starts a comment, and a line
+** that starts with "//" is one (a CloudCompare header); blank lines are
 ** skipped.  Or a PLY file (its first line "ply"; ply.h): the vertices' x y
 ** z and, where it has all three, nx ny nz.  The normal need not be unit but
 ** must have a length (it is normalised).  Errors name the file and line
