@@ -67,6 +67,12 @@ lw_cellgrid *lw_cellgrid_new3(const double lo[3], const double size[3], double c
   return grid_new(3, lo, size, cell, n_samples, 0, err);
 }
 
+lw_cellgrid *lw_cellgrid_new3_room(const double lo[3], const double size[3], double cell, size_t n_samples,
+                                   size_t room, lw_error *err)
+{
+  return grid_new(3, lo, size, cell, n_samples, room, err);
+}
+
 void lw_cellgrid_free(lw_cellgrid *g)
 {
   if (!g) return;
@@ -310,6 +316,11 @@ lw_status lw_cellgrid_reserve(lw_cellgrid *g, size_t n)
 void lw_cellgrid_extend(lw_cellgrid *g, size_t n)
 {
   g->n_samples += n;
+}
+
+void lw_cellgrid_truncate(lw_cellgrid *g, size_t n)
+{
+  g->n_samples = n;
 }
 
 void lw_cellgrid_renumber(lw_cellgrid *g, const uint32_t *to, uint32_t per, size_t n)

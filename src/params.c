@@ -552,6 +552,17 @@ const lw_param_def lw_param_table[] = {
       "Width and height of final.png."),
   NUM("particles", "disc", LW_PT_DOUBLE, pt_disc, "0.5", "r0", 0, 100, LW_MIN_OPEN,
       "Radius of each particle's disc in final.png."),
+  NUM("particles", "birth", LW_PT_DOUBLE, pt_birth, "0", "", 0, 1e6, 0,
+      "Mix weight of births: a new free particle in the tangent plane of a random particle, "
+      "0.75 to 1.25 r0 from it, its normal near that one's (the seed's growth of a surface; "
+      "docs/NUMERICS.md, \"Births and deaths\"). 0 with death = 0: the count is fixed."),
+  NUM("particles", "death", LW_PT_DOUBLE, pt_death, "0", "", 0, 1e6, 0,
+      "Mix weight of deaths: a random free particle (pin flags 0) removed, the reverse of a birth."),
+  NUM("particles", "chem", LW_PT_DOUBLE, pt_chem, "0", "energy", -1e12, 1e12, 0,
+      "Energy of each particle, the term chem N (minus the chemical potential, against a "
+      "density of one particle per r0^3): higher makes fewer. 0 = off."),
+  NUM("particles", "max_count", LW_PT_INT, pt_max_count, "100000", "", 1, 1e7, 0,
+      "Births stop at this many particles."),
   NUM("dynamics", "rho", LW_PT_DOUBLE, dyn_rho, "1", "mass/mm", 0, 1e12, 0,
       "Line density rho of the kinetic energy (rho/2) int |dr/dt|^2 dl; for particles the mass of "
       "each, with the inertia of a ball of diameter r0. 0 = massless: the "

@@ -10,11 +10,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/particles_grow.h"
 #include "linewise/particles_io.h"
 #include "linewise/particles_place.h"
 #include "linewise/state.h"
 
-const char *const lw_particles_move_names[LW_PMOVE_KINDS] = {"translate", "rotate"};
+const char *const lw_particles_move_names[LW_PMOVE_ALL] = {"translate", "rotate", "birth", "death"};
 
 /* ---- set-up ------------------------------------------------------------- */
 
@@ -80,6 +81,25 @@ lw_particles_setup *lw_particles_setup_new(const lw_params *p, lw_error *err)
   s->size = p->pt_size > 0 ? p->pt_size : lw_particles_auto_size(p->pt_pattern, s->count, p->pt_r0);
   s->noise = p->pt_noise;
   s->normal_noise = p->pt_normal_noise * M_PI / 180.0;
+  s->chem = p->pt_chem;
+  s->birth = p->pt_birth;
+  s->death = p->pt_death;
+  s->max_count = (size_t)p->pt_max_count;
+  if ((s->birth > 0.0) != (s->death > 0.0)) {
+    const char *zero = s->birth > 0.0 ? "death" : "birth";
+    origin(p, zero, where, sizeof where);
+    lw_error_set(err, LW_EINPUT, "%s: key 'particles.%s': births and deaths are each other's reverse, so both or "
+                 "neither: expected > 0 with particles.%s = %g", where, zero, s->birth > 0.0 ? "birth" : "death",
+                 s->birth > 0.0 ? s->birth : s->death);
+    goto fail;
+  }
+  if ((s->birth > 0.0 || s->death > 0.0) && !(p->pt_range >= LW_GROW_REACH)) {
+    origin(p, "range", where, sizeof where);
+    lw_error_set(err, LW_EINPUT, "%s: key 'particles.range': births and deaths find a particle's anchors within "
+                 "%.4g r0 of it: expected range >= %.4g with particles.birth or death > 0, got %g", where,
+                 LW_GROW_REACH, LW_GROW_REACH, p->pt_range);
+    goto fail;
+  }
   if (p->pt_points[0]) {
     char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
     lw_path_dir(dir, sizeof dir, p->file);
@@ -223,6 +243,38 @@ static void walk(const lw_particles *p, uint32_t k, uint32_t from, const double 
     }
 }
 
+int lw_particles_site_energy(const lw_particles *p, uint32_t skip, const double x[3], const double n[3],
+                             double e[LW_PTERM_COUNT])
+{
+  if (external(p->setup, x, e)) return 1;
+  if (p->setup->pair.on) walk(p, skip, 0, x, n, NULL, e, NULL);
+  return 0;
+}
+
+void lw_particles_near(const lw_particles *p, uint32_t skip, const double x[3],
+                       void (*visit)(void *ctx, size_t j, const double r[3], double d2), void *ctx)
+{
+  const lw_cellgrid *g = p->grid;
+  const double range2 = p->setup->pair.range2, skip2 = range2 * (1.0 + 1e-9);
+  around a;
+  cells_around(g, x, &a);
+  for (int zz = a.lo[2]; zz <= a.hi[2]; zz++)
+    for (int yy = a.lo[1]; yy <= a.hi[1]; yy++)
+      for (int xx = a.lo[0]; xx <= a.hi[0]; xx++) {
+        if (a.gap[2][zz - a.c[2] + 1] + a.gap[1][yy - a.c[1] + 1] + a.gap[0][xx - a.c[0] + 1] > skip2) continue;
+        const lw_cell *cell = g->cell + ((size_t)zz * (size_t)g->ny + (size_t)yy) * (size_t)g->nx + xx;
+        if (!cell->n) continue;
+        const double *px = cell->x, *py = lw_cell_y(cell), *pz = lw_cell_z(cell);
+        const uint32_t *id = lw_cell_idx(cell);
+        for (uint32_t e = 0; e < cell->n; e++) {
+          if (id[e] == skip) continue;
+          double r[3] = {px[e] - x[0], py[e] - x[1], pz[e] - x[2]};
+          double d2 = lw_v3_dot(r, r);
+          if (d2 < range2) visit(ctx, id[e], r, d2);
+        }
+      }
+}
+
 void lw_particles_energy(const lw_particles *p, double term[LW_PTERM_COUNT])
 {
   for (int t = 0; t < LW_PTERM_COUNT; t++) term[t] = 0.0;
@@ -231,6 +283,7 @@ void lw_particles_energy(const lw_particles *p, double term[LW_PTERM_COUNT])
     if (s->pair.on) walk(p, (uint32_t)i, (uint32_t)i + 1, p->x + 3 * i, p->nrm + 3 * i, NULL, term, NULL);
     if (external(s, p->x + 3 * i, term)) term[LW_PTERM_BOUNDARY] = INFINITY;
   }
+  if (s->chem != 0.0) term[LW_PTERM_CHEM] = s->chem * (double)p->n;
 }
 
 /* ---- gradient ------------------------------------------------------------ */
@@ -417,6 +470,7 @@ int lw_particles_term_on(const lw_particles_setup *s, int t)
   switch (t) {
   case LW_PTERM_GRAVITY: return s->gravity != 0.0;
   case LW_PTERM_BOUNDARY: return s->boundary != LW_PBOUNDARY_NONE && s->alpha_b != 0.0;
+  case LW_PTERM_CHEM: return s->chem != 0.0;
   default: return t >= 0 && t < LW_PTERM_PAIRS && s->pair.alpha[t] != 0.0;
   }
 }
@@ -453,6 +507,7 @@ void lw_particles_free(lw_particles *p)
   free(p->pin);
   free(p->qlen);
   for (int m = 0; m < LW_PMOVE_KINDS; m++) free(p->movable[m]);
+  free(p->loose);
   lw_cellgrid_free(p->grid);
   free(p);
 }
@@ -463,13 +518,14 @@ static lw_particles *alloc_state(const lw_particles_setup *s, size_t n, lw_error
   if (!p) goto nomem;
   p->setup = s;
   p->n = n;
-  size_t m = n ? n : 1;
+  size_t m = p->cap = n ? n : 1;
   p->x = malloc(3 * m * sizeof *p->x);
   p->q = malloc(4 * m * sizeof *p->q);
   p->nrm = malloc(3 * m * sizeof *p->nrm);
   p->pin = calloc(m, 1);
   for (int k = 0; k < LW_PMOVE_KINDS; k++) p->movable[k] = malloc(m * sizeof *p->movable[k]);
-  if (!p->x || !p->q || !p->nrm || !p->pin || !p->movable[0] || !p->movable[1]) goto nomem;
+  p->loose = malloc(m * sizeof *p->loose);
+  if (!p->x || !p->q || !p->nrm || !p->pin || !p->movable[0] || !p->movable[1] || !p->loose) goto nomem;
   return p;
 nomem:
   lw_particles_free(p);
@@ -479,17 +535,27 @@ nomem:
 
 /* Normals, the free lists and the grid of a state whose x, q and pin are
 ** set. */
-static lw_status finish(lw_particles *p, lw_error *err)
+/* The free lists and n_sweep from the pin flags, in index order. */
+static void list_free(lw_particles *p)
 {
-  const lw_particles_setup *s = p->setup;
-  p->n_sweep = p->n_movable[0] = p->n_movable[1] = 0;
+  p->n_sweep = p->n_movable[0] = p->n_movable[1] = p->n_loose = 0;
   for (size_t i = 0; i < p->n; i++) {
-    lw_quat_normal(p->q + 4 * i, p->nrm + 3 * i);
     if (!(p->pin[i] & LW_PIN_POSITION)) p->movable[LW_PMOVE_TRANSLATE][p->n_movable[LW_PMOVE_TRANSLATE]++] = (uint32_t)i;
     if (!(p->pin[i] & LW_PIN_ORIENTATION)) p->movable[LW_PMOVE_ROTATE][p->n_movable[LW_PMOVE_ROTATE]++] = (uint32_t)i;
     if ((p->pin[i] & (LW_PIN_POSITION | LW_PIN_ORIENTATION)) != (LW_PIN_POSITION | LW_PIN_ORIENTATION)) p->n_sweep++;
+    if (!p->pin[i]) p->loose[p->n_loose++] = (uint32_t)i;
   }
-  p->grid = lw_cellgrid_new3(s->lo, s->extent, s->pair.range, p->n, err);
+}
+
+static lw_status finish(lw_particles *p, lw_error *err)
+{
+  const lw_particles_setup *s = p->setup;
+  for (size_t i = 0; i < p->n; i++) lw_quat_normal(p->q + 4 * i, p->nrm + 3 * i);
+  list_free(p);
+  /* with births the cells are those of max_count particles whatever the
+  ** count, so that a resumed run walks them in the same order */
+  size_t room = s->birth > 0.0 || s->death > 0.0 ? s->max_count : 0;
+  p->grid = lw_cellgrid_new3_room(s->lo, s->extent, s->pair.range, p->n, room, err);
   if (!p->grid) return LW_ENOMEM;
   for (size_t i = 0; i < p->n; i++)
     if (lw_cellgrid_insert3(p->grid, (uint32_t)i, p->x[3 * i], p->x[3 * i + 1], p->x[3 * i + 2]))
@@ -645,6 +711,7 @@ double lw_particles_evaluate(const lw_particles *p, lw_particles_prop *pr, uint3
   const lw_particles_setup *s = p->setup;
   const double *xo = p->x + 3 * (size_t)k, *no = p->nrm + 3 * (size_t)k;
   pr->identity = 0;
+  pr->log_ratio = 0.0;
   pr->k = k;
   memcpy(pr->x, x, sizeof pr->x);
   memcpy(pr->q, q, sizeof pr->q);
@@ -687,6 +754,7 @@ double lw_particles_evaluate(const lw_particles *p, lw_particles_prop *pr, uint3
 static double identity(lw_particles_prop *pr)
 {
   pr->identity = 1;
+  pr->log_ratio = 0.0;
   for (int t = 0; t < LW_PTERM_COUNT; t++) pr->dterm[t] = 0.0;
   return pr->dE = 0.0;
 }
@@ -768,10 +836,85 @@ void lw_particles_merge(lw_particles *p, lw_particles_prop *pr)
   }
 }
 
+/* Room for one more particle in every array (the state unchanged when
+** memory runs out). */
+static lw_status grow(lw_particles *p)
+{
+  if (p->n < p->cap) return LW_OK;
+  size_t c = 2 * p->cap;
+  double *x = realloc(p->x, 3 * c * sizeof *x);
+  if (x) p->x = x;
+  double *q = x ? realloc(p->q, 4 * c * sizeof *q) : NULL;
+  if (q) p->q = q;
+  double *nrm = q ? realloc(p->nrm, 3 * c * sizeof *nrm) : NULL;
+  if (nrm) p->nrm = nrm;
+  unsigned char *pin = nrm ? realloc(p->pin, c) : NULL;
+  if (pin) p->pin = pin;
+  uint32_t *lists[LW_PMOVE_KINDS + 1] = {NULL, NULL, NULL};
+  int ok = pin != NULL;
+  for (int k = 0; ok && k <= LW_PMOVE_KINDS; k++) {
+    uint32_t **l = k < LW_PMOVE_KINDS ? &p->movable[k] : &p->loose;
+    if ((lists[k] = realloc(*l, c * sizeof **l))) *l = lists[k];
+    else ok = 0;
+  }
+  double *qlen = ok && p->qlen ? realloc(p->qlen, c * sizeof *qlen) : NULL;
+  if (qlen) p->qlen = qlen;
+  if (!ok || (p->qlen && !qlen)) return LW_ENOMEM;
+  p->cap = c;
+  return LW_OK;
+}
+
+/* A free particle at the end (a birth). */
+static lw_status append(lw_particles *p, const lw_particles_prop *pr)
+{
+  size_t k = p->n;
+  if (grow(p) || lw_cellgrid_reserve(p->grid, k + 1)) return LW_ENOMEM;
+  lw_cellgrid_extend(p->grid, 1);
+  if (lw_cellgrid_insert3(p->grid, (uint32_t)k, pr->x[0], pr->x[1], pr->x[2])) {
+    lw_cellgrid_truncate(p->grid, k);
+    return LW_ENOMEM;
+  }
+  memcpy(p->x + 3 * k, pr->x, sizeof pr->x);
+  memcpy(p->q + 4 * k, pr->q, sizeof pr->q);
+  memcpy(p->nrm + 3 * k, pr->n, sizeof pr->n);
+  p->pin[k] = 0;
+  if (p->qlen) p->qlen[k] = 1.0;
+  p->movable[LW_PMOVE_TRANSLATE][p->n_movable[LW_PMOVE_TRANSLATE]++] = (uint32_t)k;
+  p->movable[LW_PMOVE_ROTATE][p->n_movable[LW_PMOVE_ROTATE]++] = (uint32_t)k;
+  p->loose[p->n_loose++] = (uint32_t)k;
+  p->n_sweep++;
+  p->n = k + 1;
+  return LW_OK;
+}
+
+/* Particle k taken out (a death): the last one takes its index, so the
+** arrays stay dense and a state is a function of its particles in order. */
+static lw_status take_out(lw_particles *p, size_t k)
+{
+  size_t last = p->n - 1;
+  if (k != last) {
+    /* k to the last one's place first: a move that fails changes nothing */
+    const double *xl = p->x + 3 * last;
+    if (lw_cellgrid_move3(p->grid, (uint32_t)k, xl[0], xl[1], xl[2])) return LW_ENOMEM;
+    memcpy(p->x + 3 * k, xl, 3 * sizeof *p->x);
+    memcpy(p->q + 4 * k, p->q + 4 * last, 4 * sizeof *p->q);
+    memcpy(p->nrm + 3 * k, p->nrm + 3 * last, 3 * sizeof *p->nrm);
+    p->pin[k] = p->pin[last];
+    if (p->qlen) p->qlen[k] = p->qlen[last];
+  }
+  lw_cellgrid_remove(p->grid, (uint32_t)last);
+  lw_cellgrid_truncate(p->grid, last);
+  p->n = last;
+  list_free(p);
+  return LW_OK;
+}
+
 lw_status lw_particles_commit(lw_particles *p, const lw_particles_prop *pr)
 {
   if (pr->identity) return LW_OK;
-  if (commit_move(p, pr)) return LW_ENOMEM;
+  lw_status s = pr->kind == LW_PMOVE_BIRTH ? append(p, pr) : pr->kind == LW_PMOVE_DEATH ? take_out(p, pr->k)
+                                                                                          : commit_move(p, pr);
+  if (s) return LW_ENOMEM;
   for (int t = 0; t < LW_PTERM_COUNT; t++) p->term[t] += pr->dterm[t];
   return LW_OK;
 }

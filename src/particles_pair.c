@@ -2,7 +2,7 @@
 #include "linewise/particles_pair.h"
 
 const char *const lw_pterm_names[LW_PTERM_COUNT] = {"lj", "coplanarity", "conormality", "cocircularity",
-                                                    "gravity", "boundary"};
+                                                    "gravity", "boundary", "chem"};
 
 lw_status lw_ppair_init(lw_ppair_ctx *c, double r0, double range, int weight, double sigma, double sigma_normal,
                         const double alpha[LW_PTERM_PAIRS], lw_error *err)

@@ -15,10 +15,12 @@
 #include <sys/stat.h>
 
 #include "linewise/particles_draw.h"
+#include "linewise/particles_grow.h"
 #include "linewise/particles_io.h"
 
-/* steps are kept in lengths and radians; [moves] step_rotate is in degrees */
-static const double move_unit[LW_PMOVE_KINDS] = {1.0, M_PI / 180.0};
+/* steps are kept in lengths and radians; [moves] step_rotate is in degrees;
+** births and deaths have none */
+static const double move_unit[LW_PMOVE_ALL] = {1.0, M_PI / 180.0, 0.0, 0.0};
 
 /* The coldest rung's section; [init] from and `linewise energy` read it. */
 #define SECTION "system particles"
@@ -56,9 +58,9 @@ static void state_free(void *state) { lw_particles_free(state); }
 
 static void moves(const lw_params *p, double *weight, double *step, double *target)
 {
-  const double w[LW_PMOVE_KINDS] = {p->mix_translate, p->mix_rotate};
-  const double st[LW_PMOVE_KINDS] = {p->step_translate, p->step_rotate};
-  for (int k = 0; k < LW_PMOVE_KINDS; k++) {
+  const double w[LW_PMOVE_ALL] = {p->mix_translate, p->mix_rotate, p->pt_birth, p->pt_death};
+  const double st[LW_PMOVE_ALL] = {p->step_translate, p->step_rotate, 0.0, 0.0};
+  for (int k = 0; k < lw_particles_row(p)->n_moves; k++) {
     weight[k] = w[k];
     step[k] = st[k] * move_unit[k];
     target[k] = p->target_spline;
@@ -67,7 +69,19 @@ static void moves(const lw_params *p, double *weight, double *step, double *targ
 
 static size_t sweep_size(const void *state) { return lw_particles_sweep_size(state); }
 
-static double step_max(const void *state, int kind) { return lw_particles_step_max(state, kind); }
+/* With births a sweep is a fixed number of proposals, the start's count, as
+** the splines' (sys_splines.c): a sweep as long as the state's count would
+** look at the chain at times that depend on its state. */
+static size_t sweep_size_grow(const void *state)
+{
+  const lw_particles_setup *s = ((const lw_particles *)state)->setup;
+  return s->n_points + s->count;
+}
+
+static double step_max(const void *state, int kind)
+{
+  return kind < LW_PMOVE_KINDS ? lw_particles_step_max(state, kind) : 0.0;
+}
 
 static void *proposal_new(const void *state, lw_error *err) { return lw_particles_prop_new(state, err); }
 
@@ -76,8 +90,11 @@ static void proposal_free(void *prop) { lw_particles_prop_free(prop); }
 static double propose(void *state, void *prop, int kind, double step, gsl_rng *rng, int *forbidden)
 {
   *forbidden = 0;
+  if (kind >= LW_PMOVE_KINDS) return lw_particles_propose_grow(state, prop, kind, rng, forbidden);
   return lw_particles_propose(state, prop, kind, step, rng, forbidden);
 }
+
+static double log_ratio(const void *prop) { return ((const lw_particles_prop *)prop)->log_ratio; }
 
 static lw_status commit(void *state, void *prop) { return lw_particles_commit(state, prop); }
 
@@ -392,57 +409,77 @@ static void describe(const void *state, int what, char *buf, size_t n)
   else if (n) buf[0] = '\0';
 }
 
+/* The rows differ only in their move kinds (sys_particles.h). */
+#define PARTICLES_ROW \
+    .move_names = lw_particles_move_names, \
+    .move_unit = move_unit, \
+    .n_terms = LW_PTERM_COUNT, \
+    .term_names = lw_pterm_names, \
+    .setup_new = setup_new, \
+    .setup_free = setup_free, \
+    .note = note, \
+    .state_new = state_new, \
+    .state_copy = state_copy, \
+    .state_free = state_free, \
+    .moves = moves, \
+    .step_max = step_max, \
+    .proposal_new = proposal_new, \
+    .proposal_free = proposal_free, \
+    .propose = propose, \
+    .commit = commit, \
+    .total = total, \
+    .terms = terms, \
+    .term_on = term_on, \
+    .refresh = refresh, \
+    .energy = energy, \
+    .save = save, \
+    .load = load, \
+    .set_terms = set_terms, \
+    .files = "final.ply, final.png", \
+    .draw = draw, \
+    .summary = summary, \
+    .describe = describe, \
+    .n_coords = n_coords, \
+    .get_coords = get_coords, \
+    .set_coords = set_coords, \
+    .gradient = gradient, \
+    .blocked = blocked, \
+    .mass_new = mass_new, \
+    .mass_free = mass_free, \
+    .mass_at = mass_at, \
+    .mass_solve = mass_solve, \
+    .mass_apply = mass_apply, \
+    .mass_dx = mass_dx, \
+    .mass_pinned = mass_pinned, \
+    .constrain = constrain, \
+    .damp_pairs = damp_pairs, \
+    .split = split, \
+    .group = group, \
+    .propose_in = propose_in, \
+    .commit_part = commit_part, \
+    .merge = merge, \
+    .sites = sites, \
+    .domain_side = domain_side,
+
 const lw_system_type lw_system_particles = {
     .name = "particles",
     .n_moves = LW_PMOVE_KINDS,
-    .move_names = lw_particles_move_names,
-    .move_unit = move_unit,
-    .n_terms = LW_PTERM_COUNT,
-    .term_names = lw_pterm_names,
-    .setup_new = setup_new,
-    .setup_free = setup_free,
-    .note = note,
-    .state_new = state_new,
-    .state_copy = state_copy,
-    .state_free = state_free,
-    .moves = moves,
     .sweep_size = sweep_size,
-    .step_max = step_max,
-    .proposal_new = proposal_new,
-    .proposal_free = proposal_free,
-    .propose = propose,
-    .commit = commit,
-    .total = total,
-    .terms = terms,
-    .term_on = term_on,
-    .refresh = refresh,
-    .energy = energy,
-    .save = save,
-    .load = load,
-    .set_terms = set_terms,
-    .files = "final.ply, final.png",
-    .draw = draw,
-    .summary = summary,
-    .describe = describe,
-    .n_coords = n_coords,
-    .get_coords = get_coords,
-    .set_coords = set_coords,
-    .gradient = gradient,
-    .blocked = blocked,
-    .mass_new = mass_new,
-    .mass_free = mass_free,
-    .mass_at = mass_at,
-    .mass_solve = mass_solve,
-    .mass_apply = mass_apply,
-    .mass_dx = mass_dx,
-    .mass_pinned = mass_pinned,
-    .constrain = constrain,
-    .damp_pairs = damp_pairs,
-    .split = split,
-    .group = group,
-    .propose_in = propose_in,
-    .commit_part = commit_part,
-    .merge = merge,
-    .sites = sites,
-    .domain_side = domain_side,
+    PARTICLES_ROW
 };
+
+/* The same system with births and deaths (particles_grow.h). */
+const lw_system_type lw_system_particles_grow = {
+    .name = "particles",
+    .n_moves = LW_PMOVE_ALL,
+    .sweep_size = sweep_size_grow,
+    .log_ratio = log_ratio,
+    .n_domain_moves = LW_PMOVE_KINDS,
+    PARTICLES_ROW
+};
+
+const lw_system_type *lw_particles_row(const lw_params *p)
+{
+  return p->pt_birth > 0.0 || p->pt_death > 0.0 ? &lw_system_particles_grow : &lw_system_particles;
+}
+

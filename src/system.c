@@ -46,6 +46,7 @@ const lw_system_type *lw_system_of(const lw_params *p, lw_error *err)
   }
   /* the same system with its trans-dimensional move kinds (sys_splines.h) */
   if (t == &lw_system_splines) t = lw_splines_row(p);
+  if (t == &lw_system_particles) t = lw_particles_row(p);
   return t;
 }
 

@@ -421,3 +421,49 @@ Test(particles_cli, domains_sample_the_gas_and_keep_their_bytes)
     cr_assert_lt(chi, limit, "axis %s: chi-square %.2f over %d bins (limit %.1f)", a ? "z" : "x", chi, bins, limit);
   }
 }
+
+/* Births and deaths (particles_grow.h) through the run loop: a sheet with a
+** cost per particle (chem) that the bonds outweigh grows and shrinks while
+** it anneals, with tempering and domains.  The count changes; the running
+** totals match the energy from scratch (max_relative_drift, and `linewise
+** energy` on the final state); stopped and resumed, and on 1 or 2 threads,
+** the same bytes; the trace and summary name the two kinds. */
+Test(particles_cli, births_and_deaths_keep_their_energy_bytes_and_resume)
+{
+  cr_assert_eq(lw_test_write_text(dir, "g.ini",
+                                  "[scene]\nsystem = particles\n[particles]\ncount = 37\npattern = plane\nnoise = 0.05\n"
+                                  "alpha_p = 5\nalpha_n = 5\nbirth = 0.2\ndeath = 0.2\nchem = 0.5\npng_size = 64\n"
+                                  "[moves]\ntranslate = 1\nrotate = 1\nstep_translate = 0.1\nstep_rotate = 5\n"
+                                  "[anneal]\nschedule = geometric\nt_start = 0.3\nt_end = 0.01\nsweeps = 200\n"
+                                  "seed = 3\ncheck_every = 10\ndomains = auto\n"
+                                  "[tempering]\nreplicas = 2\nt_min = 0.3\nt_max = 1\n"
+                                  "[output]\ncheckpoint_every = 30\n"),
+               0);
+  cr_assert_eq(sh("%s run %s/g.ini --out %s/b1 --threads 1 --quiet", lw_test_bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/g.ini --out %s/b2 --threads 2 --quiet", lw_test_bin(), dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/g.ini --out %s/br --threads 2 --quiet --stop-at 77 && %s resume %s/br --quiet",
+                  lw_test_bin(), dir, dir, lw_test_bin(), dir), 0);
+  static const char *const files[] = {"state.lw", "replica-1.lw", "trace.csv", "final.ply"};
+  for (int k = 0; k < 4; k++) {
+    cr_assert_eq(sh("cmp -s %s/b1/%s %s/b2/%s", dir, files[k], dir, files[k]), 0, "%s: 1 and 2 threads differ",
+                 files[k]);
+    cr_assert_eq(sh("cmp -s %s/b1/%s %s/br/%s", dir, files[k], dir, files[k]), 0, "%s: the resumed run differs",
+                 files[k]);
+  }
+  char path[160];
+  snprintf(path, sizeof path, "%s/b1/summary.json", dir);
+  const char *js = lw_test_read_text(path);
+  long count = strtol(strstr(js, "\"particles\": ") + 13, NULL, 10);
+  double drift = strtod(strstr(js, "\"max_relative_drift\": ") + 22, NULL);
+  double total = strtod(strstr(strstr(js, "\"energy\": {"), "\"total\": ") + 9, NULL);
+  cr_assert(count != 37 && count > 0, "the count stayed %ld", count);
+  cr_assert_lt(drift, 1e-9, "running totals drifted by %g", drift);
+  cr_assert(strstr(js, "\"birth\":") && strstr(js, "\"death\":"), "summary.json lacks the kinds");
+  cr_assert_eq(sh("head -1 %s/b1/trace.csv | grep -q ',chem,.*acc_birth,acc_death'", dir), 0);
+  cr_assert_eq(sh("%s energy %s/b1 > %s/e.txt", lw_test_bin(), dir, dir), 0);
+  snprintf(path, sizeof path, "%s/e.txt", dir);
+  const char *e = strstr(lw_test_read_text(path), "total ");
+  cr_assert_not_null(e);
+  double fresh = strtod(e + 6, NULL);
+  cr_assert_lt(fabs(fresh - total), 1e-9 * fmax(1, fabs(total)), "from scratch %.17g, running %.17g", fresh, total);
+}

@@ -813,3 +813,128 @@ Test(stats, co_normal_pairs_follow_the_boltzmann_distribution)
   lw_system_free(sys);
   lw_particles_setup_free(s);
 }
+
+/* ---- 6. births and deaths of particles ------------------------------------ */
+
+/*
+** One particle held at the origin (normal +z, pinned), a second one born and
+** killed in its tangent plane (particles_grow.h), turned by rotate moves,
+** never translated, at most two particles: the chain moves between N = 1
+** and N = 2.  With alpha_N the energy of the pair is 2 alpha_N w(r) (1 - c),
+** c = n . z, so the exact Boltzmann weights against the reference measure
+** dx / r0^3 times the rotation group's are
+**
+**     P(2) / P(1) = e^(-chem/T) int_S dx / r0^3 K(beta(r)),
+**     K(beta) = (1/2) int e^(-beta (1 - c)) dc = (1 - e^(-2 beta)) / (2 beta),
+**     beta(r) = 2 alpha_N w(r) / T,
+**
+** S the annulus 0.75 <= rho <= 1.25 r0 times the slab |h| <= 0.25 r0 that a
+** birth reaches from the held particle, and given N = 2 the cosine c has the
+** CDF int_S dx (e^(-beta (1 - c)) - e^(-2 beta)) / beta over int_S dx 2 K.
+** chem is set so that P(2) = P(1).  A Hastings factor that left out the
+** proposal's position density would move P(2) by vol(S) (1.57 r0^3), one
+** that left out its normal density would bend c toward the proposal's.
+*/
+typedef struct {
+  double alpha, T;
+} grow_case;
+
+/* int_S dx / r0^3 f(beta(r)) by the midpoint rule (the integrand is smooth
+** on S; 400 x 200 cells give 1e-6 relative). */
+static double over_spread(const grow_case *g, double (*f)(double beta, const double *par), const double *par)
+{
+  const int nr = 400, nh = 200;
+  const double a = 0.75, b = 1.25, c = 0.25;
+  double sum = 0.0;
+  for (int i = 0; i < nr; i++) {
+    double rho = a + (b - a) * (i + 0.5) / nr;
+    for (int k = 0; k < nh; k++) {
+      double h = -c + 2 * c * (k + 0.5) / nh, r2 = rho * rho + h * h, t = 1 - r2 / (1.6 * 1.6);
+      sum += 2 * M_PI * rho * f(2 * g->alpha * t * t * t / g->T, par);
+    }
+  }
+  return sum * (b - a) / nr * 2 * c / nh;
+}
+
+static double grow_k(double beta, const double *par) { return -expm1(-2 * beta) / (2 * beta); }
+
+/* the CDF's numerator at c = par[0] */
+static double grow_below(double beta, const double *par)
+{
+  return (exp(-beta * (1 - par[0])) - exp(-2 * beta)) / beta;
+}
+
+#define GROW_CDF_POINTS 401
+static double grow_cdf_table[GROW_CDF_POINTS];
+
+static double grow_cdf(double c, const double *par)
+{
+  double u = (c + 1) / 2 * (GROW_CDF_POINTS - 1);
+  if (u <= 0) return 0;
+  if (u >= GROW_CDF_POINTS - 1) return 1;
+  int i = (int)u;
+  return grow_cdf_table[i] + (u - i) * (grow_cdf_table[i + 1] - grow_cdf_table[i]);
+}
+
+Test(stats, particle_births_and_deaths_follow_the_boltzmann_distribution)
+{
+  const int longrun = lw_test_long();
+  const grow_case g = {1.0, 0.2};
+  const double K = over_spread(&g, grow_k, NULL), chem = g.T * log(K);
+  double total = over_spread(&g, grow_k, NULL) * 2;
+  for (int i = 0; i < GROW_CDF_POINTS; i++) {
+    double c = -1 + 2.0 * i / (GROW_CDF_POINTS - 1);
+    grow_cdf_table[i] = over_spread(&g, grow_below, &c) / total;
+  }
+  lw_params prm = particle_scene();
+  prm.pt_alpha_n = g.alpha;
+  prm.pt_count = 10; /* a sweep: 10 proposals */
+  prm.pt_birth = prm.pt_death = 1;
+  prm.pt_chem = chem;
+  prm.pt_max_count = 2;
+  lw_error err;
+  lw_particles_setup *s = lw_particles_setup_new(&prm, &err);
+  cr_assert_not_null(s, "%s", err.msg);
+  const double x[3] = {0, 0, 0}, q[4] = {1, 0, 0, 0};
+  const unsigned char pin[1] = {LW_PIN_POSITION | LW_PIN_ORIENTATION};
+  lw_particles *p = lw_particles_new_from(s, 1, x, q, pin, &err);
+  cr_assert_not_null(p, "%s", err.msg);
+  lw_system *sys = lw_system_wrap(&lw_system_particles_grow, p, &err);
+  cr_assert_not_null(sys, "%s", err.msg);
+  const double w[4] = {0, 1, 1, 1}, st[4] = {0.1, 0.5, 0, 0}, tg[4] = {0.44, 0.44, 0.44, 0.44};
+  lw_chain *c = lw_chain_new(sys, w, st, tg, 11, &err);
+  cr_assert_not_null(c, "%s", err.msg);
+  c->temperature = g.T;
+  c->tuning = 1;
+  for (int k = 0; k < 300; k++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  c->tuning = 0;
+  /* the occupation, a sweep apart, and the cosines of the born particle */
+  const size_t n = longrun ? 400000 : 40000;
+  double *occ = malloc(n * sizeof *occ), *cs = malloc(n * sizeof *cs);
+  size_t n_cs = 0;
+  for (size_t t = 0; t < n; t++) {
+    cr_assert_eq(lw_chain_sweep(c), LW_OK);
+    occ[t] = (double)(p->n - 1);
+    if (p->n == 2) cs[n_cs++] = p->nrm[3 + 2];
+  }
+  double tau = autocorrelation_time(occ, 1, n), f = 0;
+  for (size_t t = 0; t < n; t++) f += occ[t];
+  f /= (double)n;
+  double sd = sqrt(0.25 * 2 * tau / (double)n);
+  /* the cosines, thinned to about 3 tau of the occupation apart (a born
+  ** particle's normal also turns by rotate moves while it lives) */
+  size_t thin = (size_t)ceil(3 * tau), m = 0;
+  for (size_t i = 0; i < n_cs; i += thin) cs[m++] = cs[i];
+  double pc = chisq_p(cs, m, grow_cdf, NULL, 20);
+  cr_log_info("births and deaths: K %.5f, chem %.5f; P(2) %.4f +- %.4f (tau %.2f sweeps, %zu sweeps), want 0.5; "
+              "cosines: %zu samples, p %.3g; birth acceptance %.3f, death %.3f", K, chem, f, sd, tau, n, m, pc,
+              (double)c->stats[2].accepted / (double)c->stats[2].proposed,
+              (double)c->stats[3].accepted / (double)c->stats[3].proposed);
+  cr_assert_lt(fabs(f - 0.5), 4 * sd, "P(2) = %.4f, want 0.5 +- %.4f (4 sd)", f, 4 * sd);
+  cr_assert(pc > 1e-3, "the born particle's normals: p = %.3g", pc);
+  free(occ);
+  free(cs);
+  lw_chain_free(c);
+  lw_system_free(sys);
+  lw_particles_setup_free(s);
+}

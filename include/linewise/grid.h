@@ -92,6 +92,10 @@ void lw_cellgrid_extend(lw_cellgrid *g, size_t n);
 ** with no samples in the grid. */
 void lw_cellgrid_renumber(lw_cellgrid *g, const uint32_t *to, uint32_t per, size_t n);
 
+/* Counts only the indices below n, which must all be out of the grid (a
+** removal from the end). */
+void lw_cellgrid_truncate(lw_cellgrid *g, size_t n);
+
 /* Takes sample i (in the grid) out of it; its index stays counted. */
 void lw_cellgrid_remove(lw_cellgrid *g, uint32_t i);
 
@@ -172,6 +176,10 @@ static inline size_t lw_cellgrid_cells(const lw_cellgrid *g)
 ** (the same cap on the cell count); entries hold x, y, z and idx. */
 lw_cellgrid *lw_cellgrid_new3(const double lo[3], const double size[3], double cell, size_t n_samples,
                               lw_error *err);
+
+/* The same with cells sized for max(n_samples, room), as lw_cellgrid_new_room. */
+lw_cellgrid *lw_cellgrid_new3_room(const double lo[3], const double size[3], double cell, size_t n_samples,
+                                   size_t room, lw_error *err);
 
 /* The cell holding (x, y, z) after clamping, per axis as in 2-D. */
 static inline void lw_cellgrid_locate3(const lw_cellgrid *g, double x, double y, double z, int *cx, int *cy,

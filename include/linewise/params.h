@@ -215,6 +215,9 @@ typedef struct {
   double pt_view_elevation;   /* degrees */
   int pt_png_size;            /* preview pixels per side */
   double pt_disc;             /* preview disc radius, units of r0 */
+  double pt_birth, pt_death;  /* mix weights of births and deaths (0: the count is fixed) */
+  double pt_chem;             /* energy per particle */
+  int pt_max_count;           /* births stop at this count */
   /* [dynamics] (driver = dynamics; dynamics.h) */
   double dyn_rho;             /* line density, mass per mm; 0 = massless (gradient flow) */
   double dyn_gamma;           /* Rayleigh damping, force per (mm/s) per mm */

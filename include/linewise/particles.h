@@ -59,7 +59,11 @@
 
 typedef enum { LW_PMOVE_TRANSLATE, LW_PMOVE_ROTATE, LW_PMOVE_KINDS } lw_particles_move;
 
-extern const char *const lw_particles_move_names[LW_PMOVE_KINDS];
+/* With births and deaths (particles.birth, particles.death; particles_grow.h)
+** two more kinds follow the moves of a fixed count. */
+enum { LW_PMOVE_BIRTH = LW_PMOVE_KINDS, LW_PMOVE_DEATH, LW_PMOVE_ALL };
+
+extern const char *const lw_particles_move_names[LW_PMOVE_ALL];
 
 /* Pin flags of a particle. */
 #define LW_PIN_POSITION 1
@@ -85,6 +89,10 @@ typedef struct {
   unsigned char *point_pin;     /* n_points: pin flags */
   /* grid box */
   double lo[3], extent[3];      /* length */
+  /* births and deaths (particles_grow.h) */
+  double chem;                  /* energy per particle */
+  double birth, death;          /* mix weights; both 0: the count is fixed */
+  size_t max_count;             /* births stop there */
   /* preview */
   double view[3];               /* unit vector toward the viewer */
   int png_size;                 /* pixels */
@@ -108,8 +116,11 @@ typedef struct {
   double *q;                    /* 4n unit quaternions {w, x, y, z} */
   double *nrm;                  /* 3n normals: lw_quat_normal of q, kept in step */
   unsigned char *pin;           /* n pin flags */
+  size_t cap;                   /* room in the arrays, >= n (births grow it) */
   uint32_t *movable[LW_PMOVE_KINDS]; /* the particles free for each move kind */
   size_t n_movable[LW_PMOVE_KINDS];
+  uint32_t *loose;              /* the particles with no pin flag: those a death may take */
+  size_t n_loose;
   size_t n_sweep;               /* particles with a free degree of freedom */
   lw_cellgrid *grid;            /* positions by cell (x, y, z, index) */
   double term[LW_PTERM_COUNT];  /* running totals */
@@ -169,6 +180,7 @@ typedef struct {
   double dterm[LW_PTERM_COUNT];
   double dE;
   double acc[LW_PTERM_COUNT];   /* domains: the changes lw_particles_commit_part kept */
+  double log_ratio;             /* a birth's or death's Hastings factor (system.h); 0 for the others */
 } lw_particles_prop;
 
 lw_particles_prop *lw_particles_prop_new(const lw_particles *p, lw_error *err);
@@ -185,9 +197,21 @@ double lw_particles_propose(const lw_particles *p, lw_particles_prop *pr, int ki
 double lw_particles_evaluate(const lw_particles *p, lw_particles_prop *pr, uint32_t k, const double x[3],
                              const double q[4], int *forbidden);
 
-/* Applies an evaluated proposal.  LW_ENOMEM if the grid could not grow
-** (the state is unchanged then). */
+/* Applies an evaluated proposal (births and deaths too).  LW_ENOMEM if the
+** grid or the arrays could not grow (the state is unchanged then). */
 lw_status lw_particles_commit(lw_particles *p, const lw_particles_prop *pr);
+
+/* The energies per term of a particle at x with normal n against every
+** particle but `skip` (UINT32_MAX: none), and its own terms (gravity, wall;
+** not chem), added to e; 1 (e's boundary term not set) if x is outside the
+** boundary. */
+int lw_particles_site_energy(const lw_particles *p, uint32_t skip, const double x[3], const double n[3],
+                             double e[LW_PTERM_COUNT]);
+
+/* Calls visit(ctx, j, r, d2) for every particle j != skip closer to x than
+** the range, r = x_j - x, d2 = |r|^2, in the walk's fixed order. */
+void lw_particles_near(const lw_particles *p, uint32_t skip, const double x[3],
+                       void (*visit)(void *ctx, size_t j, const double r[3], double d2), void *ctx);
 
 /* ---- domains (domains.h, [anneal] domains) ----
 ** Sites are the particles 0 .. n-1, each its own group (a point).

@@ -46,6 +46,7 @@ typedef enum {
   LW_PTERM_CIRCULAR,
   LW_PTERM_GRAVITY,
   LW_PTERM_BOUNDARY,
+  LW_PTERM_CHEM, /* chem N: the particles' own energy (births and deaths) */
   LW_PTERM_COUNT
 } lw_pterm;
 
