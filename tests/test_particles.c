@@ -1264,8 +1264,8 @@ Test(particles, the_bundled_particle_scenes_read_build_and_anneal)
 {
   const char *root = getenv("LW_ROOT");
   cr_assert_not_null(root);
-  const char *names[] = {"particles-sheet.ini", "particles-sphere.ini"};
-  for (int k = 0; k < 2; k++) {
+  const char *names[] = {"particles-sheet.ini", "particles-sphere.ini", "particles-grow.ini"};
+  for (int k = 0; k < 3; k++) {
     char path[1024];
     snprintf(path, sizeof path, "%s/params/%s", root, names[k]);
     lw_params prm;
