@@ -251,30 +251,6 @@ int lw_particles_site_energy(const lw_particles *p, uint32_t skip, const double 
   return 0;
 }
 
-void lw_particles_near(const lw_particles *p, uint32_t skip, const double x[3],
-                       void (*visit)(void *ctx, size_t j, const double r[3], double d2), void *ctx)
-{
-  const lw_cellgrid *g = p->grid;
-  const double range2 = p->setup->pair.range2, skip2 = range2 * (1.0 + 1e-9);
-  around a;
-  cells_around(g, x, &a);
-  for (int zz = a.lo[2]; zz <= a.hi[2]; zz++)
-    for (int yy = a.lo[1]; yy <= a.hi[1]; yy++)
-      for (int xx = a.lo[0]; xx <= a.hi[0]; xx++) {
-        if (a.gap[2][zz - a.c[2] + 1] + a.gap[1][yy - a.c[1] + 1] + a.gap[0][xx - a.c[0] + 1] > skip2) continue;
-        const lw_cell *cell = g->cell + ((size_t)zz * (size_t)g->ny + (size_t)yy) * (size_t)g->nx + xx;
-        if (!cell->n) continue;
-        const double *px = cell->x, *py = lw_cell_y(cell), *pz = lw_cell_z(cell);
-        const uint32_t *id = lw_cell_idx(cell);
-        for (uint32_t e = 0; e < cell->n; e++) {
-          if (id[e] == skip) continue;
-          double r[3] = {px[e] - x[0], py[e] - x[1], pz[e] - x[2]};
-          double d2 = lw_v3_dot(r, r);
-          if (d2 < range2) visit(ctx, id[e], r, d2);
-        }
-      }
-}
-
 void lw_particles_energy(const lw_particles *p, double term[LW_PTERM_COUNT])
 {
   for (int t = 0; t < LW_PTERM_COUNT; t++) term[t] = 0.0;
@@ -288,48 +264,60 @@ void lw_particles_energy(const lw_particles *p, double term[LW_PTERM_COUNT])
 
 /* ---- gradient ------------------------------------------------------------ */
 
-/* The walk of lw_particles_energy with every loop run backwards when
-** reverse: the cells z, y, x and their entries, and the particles.  Inlined
-** where it is called, so that the gradient's copy has its visitor inlined
-** and its direction fixed (a call per pair cost it a tenth). */
+/* The particles j closer than the range to x, in the walk's order (cells z,
+** y, x, entries by index) or with reverse = 1 in exactly the opposite order:
+** visit(ctx, i, j, x_j - x, d2) for j > i (after = 1: the pairs of particle
+** i), else for j != i.  Inlined where it is called, so that the gradient's
+** copy has its visitor inlined and its direction fixed (a call per pair
+** cost it a tenth). */
 typedef void pair_visitor(void *ctx, size_t i, size_t j, const double r[3], double d2);
 
+static inline __attribute__((always_inline)) void around_point(const lw_particles *p, const double x[3], size_t i,
+                                                               int after, int reverse, pair_visitor *visit, void *ctx)
+{
+  const lw_cellgrid *g = p->grid;
+  const double range2 = p->setup->pair.range2, skip2 = range2 * (1.0 + 1e-9);
+  const int step = reverse ? -1 : 1;
+  around a;
+  cells_around(g, x, &a);
+  int first[3], last[3];
+  for (int k = 0; k < 3; k++) {
+    first[k] = reverse ? a.hi[k] : a.lo[k];
+    last[k] = (reverse ? a.lo[k] : a.hi[k]) + step;
+  }
+  for (int zz = first[2]; zz != last[2]; zz += step)
+    for (int yy = first[1]; yy != last[1]; yy += step)
+      for (int xx = first[0]; xx != last[0]; xx += step) {
+        if (a.gap[2][zz - a.c[2] + 1] + a.gap[1][yy - a.c[1] + 1] + a.gap[0][xx - a.c[0] + 1] > skip2) continue;
+        const lw_cell *cell = g->cell + ((size_t)zz * (size_t)g->ny + (size_t)yy) * (size_t)g->nx + xx;
+        if (!cell->n) continue;
+        const double *px = cell->x, *py = lw_cell_y(cell), *pz = lw_cell_z(cell);
+        const uint32_t *id = lw_cell_idx(cell);
+        for (uint32_t m = 0; m < cell->n; m++) {
+          uint32_t e = reverse ? cell->n - 1 - m : m;
+          size_t j = id[e];
+          if (after ? j <= i : j == i) continue;
+          double r[3] = {px[e] - x[0], py[e] - x[1], pz[e] - x[2]};
+          double d2 = lw_v3_dot(r, r);
+          if (d2 >= range2) continue;
+          visit(ctx, i, j, r, d2);
+        }
+      }
+}
+
+/* Every pair i < j in the order of lw_particles_energy, or its reverse. */
 static inline __attribute__((always_inline)) void each_pair(const lw_particles *p, int reverse, pair_visitor *visit,
                                                             void *ctx)
 {
-  const lw_cellgrid *g = p->grid;
-  const lw_ppair_ctx *c = &p->setup->pair;
-  const double skip2 = c->range2 * (1.0 + 1e-9);
-  const int step = reverse ? -1 : 1;
   for (size_t n = 0; n < p->n; n++) {
     size_t i = reverse ? p->n - 1 - n : n;
-    const double *x = p->x + 3 * i;
-    around a;
-    cells_around(g, x, &a);
-    int first[3], last[3];
-    for (int k = 0; k < 3; k++) {
-      first[k] = reverse ? a.hi[k] : a.lo[k];
-      last[k] = (reverse ? a.lo[k] : a.hi[k]) + step;
-    }
-    for (int zz = first[2]; zz != last[2]; zz += step)
-      for (int yy = first[1]; yy != last[1]; yy += step)
-        for (int xx = first[0]; xx != last[0]; xx += step) {
-          if (a.gap[2][zz - a.c[2] + 1] + a.gap[1][yy - a.c[1] + 1] + a.gap[0][xx - a.c[0] + 1] > skip2) continue;
-          const lw_cell *cell = g->cell + ((size_t)zz * (size_t)g->ny + (size_t)yy) * (size_t)g->nx + xx;
-          if (!cell->n) continue;
-          const double *px = cell->x, *py = lw_cell_y(cell), *pz = lw_cell_z(cell);
-          const uint32_t *id = lw_cell_idx(cell);
-          for (uint32_t m = 0; m < cell->n; m++) {
-            uint32_t e = reverse ? cell->n - 1 - m : m;
-            size_t j = id[e];
-            if (j <= i) continue;
-            double r[3] = {px[e] - x[0], py[e] - x[1], pz[e] - x[2]};
-            double d2 = lw_v3_dot(r, r);
-            if (d2 >= c->range2) continue;
-            visit(ctx, i, j, r, d2);
-          }
-        }
+    around_point(p, p->x + 3 * i, i, 1, reverse, visit, ctx);
   }
+}
+
+void lw_particles_near(const lw_particles *p, uint32_t skip, const double x[3], pair_visitor *visit, void *ctx)
+{
+  around_point(p, x, skip, 0, 0, visit, ctx);
 }
 
 /* dE/dx (3n) into gx and dE/dn (3n, each normal a free vector) into gn, of

@@ -39,7 +39,7 @@ typedef struct {
 } density_ctx;
 
 /* Anchor j's density at the new particle, r = x_j - x. */
-static void anchor(void *ctx, size_t j, const double r[3], double d2)
+static void anchor(void *ctx, size_t skip, size_t j, const double r[3], double d2)
 {
   density_ctx *a = ctx;
   const double *nj = a->p->nrm + 3 * j, r0 = a->p->setup->pair.r0;

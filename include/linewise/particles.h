@@ -208,10 +208,11 @@ lw_status lw_particles_commit(lw_particles *p, const lw_particles_prop *pr);
 int lw_particles_site_energy(const lw_particles *p, uint32_t skip, const double x[3], const double n[3],
                              double e[LW_PTERM_COUNT]);
 
-/* Calls visit(ctx, j, r, d2) for every particle j != skip closer to x than
-** the range, r = x_j - x, d2 = |r|^2, in the walk's fixed order. */
+/* Calls visit(ctx, skip, j, r, d2) for every particle j != skip closer to x
+** than the range, r = x_j - x, d2 = |r|^2, in the walk's fixed order (the
+** visitor of lw_particles_each_pair; skip UINT32_MAX: none). */
 void lw_particles_near(const lw_particles *p, uint32_t skip, const double x[3],
-                       void (*visit)(void *ctx, size_t j, const double r[3], double d2), void *ctx);
+                       void (*visit)(void *ctx, size_t i, size_t j, const double r[3], double d2), void *ctx);
 
 /* ---- domains (domains.h, [anneal] domains) ----
 ** Sites are the particles 0 .. n-1, each its own group (a point).
