@@ -211,6 +211,12 @@ static lw_status setup_system(lw_anneal *a, lw_error *err)
     return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.quench': the %s system has no gradient to quench with; "
                         "expected none", where, a->sys_type->name);
   }
+  if (a->params.observables && !a->sys_type->observe) {
+    char where[LW_PATH_MAX + 32];
+    lw_params_origin(&a->params, lw_params_find("output", "observables"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'output.observables': the %s system has no observables; "
+                        "expected 0", where, a->sys_type->name);
+  }
   a->setup = a->sys_type->setup_new(&a->params, err);
   return a->setup ? LW_OK : err->code;
 }
@@ -297,6 +303,30 @@ static void set_temperatures(lw_anneal *a)
   for (int k = 0; k < a->n_rep; k++) a->chains[k]->temperature = a->pt->ladder[k] * f;
 }
 
+/* The end of trace.csv's header and of a row: the observables of the
+** coldest rung's state where the scene asks for them (output.observables),
+** and the newline.  An undefined one (NaN) is an empty field. */
+static void trace_header_end(lw_anneal *a)
+{
+  const lw_system_type *t = a->sys_type;
+  for (int k = 0; a->params.observables && k < t->n_observables; k++)
+    fprintf(a->trace, ",obs_%s", t->observable_names[k]);
+  fprintf(a->trace, "\n");
+}
+
+static void trace_row_end(lw_anneal *a)
+{
+  const lw_system_type *t = a->sys_type;
+  if (a->params.observables) {
+    double v[LW_OBSERVABLES_MAX];
+    t->observe(a->sys->state, v);
+    for (int k = 0; k < t->n_observables; k++)
+      if (isnan(v[k])) fprintf(a->trace, ",");
+      else fprintf(a->trace, ",%.10g", v[k]);
+  }
+  fprintf(a->trace, "\n");
+}
+
 static lw_status open_trace(lw_anneal *a, int fresh, lw_error *err)
 {
   char path[LW_PATH_MAX + 32];
@@ -308,7 +338,8 @@ static lw_status open_trace(lw_anneal *a, int fresh, lw_error *err)
     fprintf(a->trace, "sweep,time");
     for (int k = 0; k < t->n_terms; k++)
       if (t->term_on(a->setup, k)) fprintf(a->trace, ",%s", t->term_names[k]);
-    fprintf(a->trace, ",potential,kinetic,total\n");
+    fprintf(a->trace, ",potential,kinetic,total");
+    trace_header_end(a);
   } else if (fresh) {
     const lw_system_type *t = a->sys_type;
     fprintf(a->trace, "sweep,temperature");
@@ -318,7 +349,7 @@ static lw_status open_trace(lw_anneal *a, int fresh, lw_error *err)
     for (int k = 0; k < t->n_moves; k++) fprintf(a->trace, ",acc_%s", t->move_names[k]);
     for (int k = 0; a->pt && k < a->n_rep; k++) fprintf(a->trace, ",replica%d_temperature,replica%d_energy", k, k);
     for (int k = 0; a->pt && k + 1 < a->n_rep; k++) fprintf(a->trace, ",swap%d", k);
-    fprintf(a->trace, "\n");
+    trace_header_end(a);
   }
   return LW_OK;
 }
@@ -541,7 +572,8 @@ static void trace_row(lw_anneal *a)
     fprintf(a->trace, "%ld,%.10g", a->sweep, a->dyn->time);
     for (int k = 0; k < t->n_terms; k++)
       if (t->term_on(a->setup, k)) fprintf(a->trace, ",%.10g", term[k]);
-    fprintf(a->trace, ",%.17g,%.17g,%.17g\n", pot, kin, pot + kin);
+    fprintf(a->trace, ",%.17g,%.17g,%.17g", pot, kin, pot + kin);
+    trace_row_end(a);
     return;
   }
   fprintf(a->trace, "%ld,%.10g", a->sweep, c->temperature);
@@ -568,7 +600,7 @@ static void trace_row(lw_anneal *a)
       a->swap_mark[2 * k + 1] = a->pt->accepted[k];
     }
   }
-  fprintf(a->trace, "\n");
+  trace_row_end(a);
 }
 
 /* ladder.ini: the tuned ladder, ready to paste into a scene or --set. */

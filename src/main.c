@@ -20,6 +20,7 @@
 #include "linewise/phase.h"
 #include "linewise/state.h"
 #include "linewise/system.h"
+#include "linewise/trace.h"
 #ifdef LW_MPI
 #include "linewise/mpi_tempering.h"
 #endif
@@ -54,6 +55,12 @@ static const char usage[] =
   "                      prints '<term> <value>' per enabled term, then 'total <value>'\n"
   "      --set SEC.KEY=VAL   with a key of the scene changed (repeatable): with\n"
   "                          energy.quadrature=32, what the run's nodes leave out\n"
+  "  stats DIR           means with error bars of DIR/trace.csv's columns (their\n"
+  "                      integrated autocorrelation times), by default over the final\n"
+  "                      temperature's sweeps after its tuning\n"
+  "      --from S, --to S    only the rows of sweeps S to S (inclusive)\n"
+  "      --csv               one CSV line a column: column,n,mean,stderr,sd,\n"
+  "                          tau_sweeps,n_eff,window_closed,drift_z\n"
   "  params              print every scene parameter as Markdown (docs/PARAMETERS.md)\n"
   "  schedules           print the temperature schedules as Markdown (docs/SCHEDULES.md)\n"
   "  help                this text\n"
@@ -526,6 +533,55 @@ static int cmd_resume(int argc, char **argv)
   return rc;
 }
 
+/* stats DIR [--from S] [--to S] [--csv]: the means with error bars of the
+** columns of DIR/trace.csv (trace.h); the run's scene.ini gives the tuning
+** sweeps that the default stretch leaves out. */
+static int cmd_stats(int argc, char **argv)
+{
+  lw_error err;
+  lw_error_clear(&err);
+  const char *dir = NULL;
+  lw_trace_select sel = {.from = -1, .to = -1};
+  for (int i = 0; i < argc; i++) {
+    const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+    if (!strcmp(argv[i], "--from") || !strcmp(argv[i], "--to")) {
+      if (!parse_count(argv[i], v, LW_STATE_SWEEP_MAX, argv[i][2] == 'f' ? &sel.from : &sel.to, &err))
+        return fail(&err);
+      i++;
+    } else if (!strcmp(argv[i], "--csv")) {
+      sel.csv = 1;
+    } else if (argv[i][0] == '-' || dir) {
+      lw_error_set(&err, LW_EUSAGE, "stats: unexpected '%s' (usage: linewise stats DIR [--from S] [--to S] [--csv])",
+                   argv[i]);
+      return fail(&err);
+    } else {
+      dir = argv[i];
+    }
+  }
+  if (!dir) {
+    lw_error_set(&err, LW_EUSAGE, "stats: expected a run directory (usage: linewise stats DIR [--from S] [--to S] "
+                 "[--csv])");
+    return fail(&err);
+  }
+  static lw_params p;
+  char path[LW_PATH_MAX + 32];
+  lw_path_join(path, sizeof path, dir, "scene.ini");
+  if (lw_params_read_run(&p, path, &err)) return fail(&err);
+  if (p.driver == LW_DRIVER_METROPOLIS) {
+    sel.tune = p.tune_sweeps;
+    sel.steps = p.steps;
+    sel.sweeps = p.sweeps;
+  }
+  lw_path_join(path, sizeof path, dir, "trace.csv");
+  lw_trace *t = lw_trace_read(path, &err);
+  if (!t || lw_trace_stats(t, path, &sel, stdout, &err)) {
+    lw_trace_free(t);
+    return fail(&err);
+  }
+  lw_trace_free(t);
+  return 0;
+}
+
 /* "linewise CMD --help" prints the usage and exits 0. */
 static int wants_help(int argc, char **argv)
 {
@@ -579,6 +635,7 @@ static int command(int argc, char **argv)
   if (!strcmp(argv[1], "energy")) return cmd_energy(argc - 2, argv + 2);
   if (!strcmp(argv[1], "run")) return cmd_run(argc - 2, argv + 2);
   if (!strcmp(argv[1], "resume")) return cmd_resume(argc - 2, argv + 2);
+  if (!strcmp(argv[1], "stats")) return cmd_stats(argc - 2, argv + 2);
   if (!strcmp(argv[1], "schedules")) {
     printf("\n| schedule | temperature of step b of B |\n|---|---|\n");
     for (const lw_schedule_type *const *t = lw_schedule_types; *t; t++)

@@ -391,6 +391,12 @@ const lw_param_def lw_param_table[] = {
       "Sweeps between checkpoints of state.lw (also written at the end and on SIGINT/SIGTERM)."),
   NUM("output", "trace_every", LW_PT_INT, trace_every, "1", "sweeps", 1, 2e9, 0,
       "Sweeps per row of trace.csv."),
+  NUM("output", "observables", LW_PT_INT, observables, "0", "", 0, 1, 0,
+      "1 adds the system's observables to every row of trace.csv (columns obs_<name>: for splines "
+      "the count and the means over the splines of length, squared end-to-end distance, squared "
+      "radius of gyration and the cosine between the end tangents; for particles the count, squared "
+      "radius of gyration, rms distance from the best plane and the order of the normals; "
+      "docs/FORMATS.md). `linewise stats DIR` gives their means with error bars."),
   NUM("output", "pen_width", LW_PT_DOUBLE, pen_width, "0.3", "mm", 0, 100, LW_MIN_OPEN,
       "Stroke width of every pen in final.svg, the previews and the fidelity render: the pen's line width."),
   NUM("output", "pens", LW_PT_INT, pens, "1", "", 1, 16, 0,

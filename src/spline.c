@@ -241,6 +241,31 @@ void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_
   out->end_y[1] = b->py;
 }
 
+void lw_spline_shape_of(const lw_splines *sp, size_t i, const lw_quad *q, lw_spline_shape *out)
+{
+  const lw_node *nd = sp->node + sp->first[i], *last = sp->node + sp->first[i + 1] - 1;
+  /* moments about the first node, where the page's offset cannot cancel */
+  const double ox = nd->px, oy = nd->py;
+  double len = 0.0, mx = 0.0, my = 0.0, m2 = 0.0;
+  lw_samples smp;
+  for (const lw_node *a = nd; a < last; a++) {
+    lw_segment_sample(q, a, a + 1, &smp);
+    for (int k = 0; k < smp.n; k++) {
+      double x = smp.x[k] - ox, y = smp.y[k] - oy;
+      mx += x * smp.dl[k];
+      my += y * smp.dl[k];
+      m2 += (x * x + y * y) * smp.dl[k];
+    }
+    len += smp.length;
+  }
+  out->length = len;
+  out->rg2 = len > 0.0 ? fmax(m2 / len - (mx * mx + my * my) / (len * len), 0.0) : 0.0;
+  double ex = last->px - ox, ey = last->py - oy;
+  out->end2 = ex * ex + ey * ey;
+  double n0 = hypot(nd->vx, nd->vy), n1 = hypot(last->vx, last->vy);
+  out->end_cos = n0 > 0.0 && n1 > 0.0 ? (nd->vx * last->vx + nd->vy * last->vy) / (n0 * n1) : 0.0;
+}
+
 int lw_splines_finite(const lw_splines *sp)
 {
   for (size_t k = 0; k < sp->n_nodes; k++) {

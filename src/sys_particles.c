@@ -7,7 +7,9 @@
 #include "linewise/sys_particles.h"
 
 #include <errno.h>
+#include <gsl/gsl_eigen.h>
 #include <gsl/gsl_math.h>
+#include <gsl/gsl_sort_double.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -402,6 +404,56 @@ static void summary(const void *state, lw_json *j)
   lw_json_int(j, (long long)pinned(p));
 }
 
+/* The eigenvalues of the symmetric 3 x 3 matrix m (destroyed), ascending;
+** NaN when GSL's workspace cannot be had. */
+static void eigenvalues3(double m[9], double ev[3])
+{
+  gsl_eigen_symm_workspace *w = gsl_eigen_symm_alloc(3);
+  if (!w) {
+    ev[0] = ev[1] = ev[2] = NAN;
+    return;
+  }
+  gsl_matrix_view mv = gsl_matrix_view_array(m, 3, 3);
+  gsl_vector_view vv = gsl_vector_view_array(ev, 3);
+  gsl_eigen_symm(&mv.matrix, &vv.vector, w);
+  gsl_eigen_symm_free(w);
+  gsl_sort(ev, 1, 3);
+}
+
+/* The observables (docs/FORMATS.md, "trace.csv"): the count; the squared
+** radius of gyration (the trace of the positions' covariance); the rms
+** distance from the best plane through them (the root of its least
+** eigenvalue); and the order of the normals, S = (3 lambda - 1) / 2 with
+** lambda the greatest eigenvalue of the mean of n n^T: 1 when every normal
+** is parallel or opposite to one axis, 0 for normals spread evenly. */
+static const char *const observable_names[] = {"count", "rg2", "plane_rms", "normal_order"};
+
+static void observe(const void *state, double *out)
+{
+  const lw_particles *p = state;
+  out[0] = (double)p->n;
+  if (!p->n) {
+    out[1] = out[2] = out[3] = NAN;
+    return;
+  }
+  double c[3] = {0.0, 0.0, 0.0}, cov[9] = {0.0}, nn[9] = {0.0}, ev[3];
+  for (size_t i = 0; i < p->n; i++)
+    for (int a = 0; a < 3; a++) c[a] += p->x[3 * i + a] / (double)p->n;
+  for (size_t i = 0; i < p->n; i++) {
+    const double *x = p->x + 3 * i, *n = p->nrm + 3 * i;
+    for (int a = 0; a < 3; a++)
+      for (int b = 0; b < 3; b++) {
+        cov[3 * a + b] += (x[a] - c[a]) * (x[b] - c[b]) / (double)p->n;
+        nn[3 * a + b] += n[a] * n[b] / (double)p->n;
+      }
+  }
+  out[1] = cov[0] + cov[4] + cov[8];
+  eigenvalues3(cov, ev);
+  out[2] = sqrt(fmax(ev[0], 0.0));
+  eigenvalues3(nn, ev);
+  out[3] = 1.5 * ev[2] - 0.5;
+}
+
 static void describe(const void *state, int what, char *buf, size_t n)
 {
   const lw_particles *p = state;
@@ -411,6 +463,9 @@ static void describe(const void *state, int what, char *buf, size_t n)
 
 /* The rows differ only in their move kinds (sys_particles.h). */
 #define PARTICLES_ROW \
+    .n_observables = (int)(sizeof observable_names / sizeof observable_names[0]), \
+    .observable_names = observable_names, \
+    .observe = observe, \
     .move_names = lw_particles_move_names, \
     .move_unit = move_unit, \
     .n_terms = LW_PTERM_COUNT, \

@@ -1167,6 +1167,27 @@ static void summary(const void *state, lw_json *j)
   lw_drawing_report_json(j, &s->drawing);
 }
 
+/* The observables: the count, and means over the splines of
+** lw_spline_shape's members (docs/FORMATS.md, "trace.csv"). */
+static const char *const observable_names[] = {"count", "length", "end2", "rg2", "end_cos"};
+
+static void observe(const void *state, double *out)
+{
+  const spl_state *s = state;
+  const lw_splines *sp = s->m->sp;
+  double sum[4] = {0.0, 0.0, 0.0, 0.0};
+  for (size_t i = 0; i < sp->n_splines; i++) {
+    lw_spline_shape sh;
+    lw_spline_shape_of(sp, i, &s->m->scene->quad, &sh);
+    sum[0] += sh.length;
+    sum[1] += sh.end2;
+    sum[2] += sh.rg2;
+    sum[3] += sh.end_cos;
+  }
+  out[0] = (double)sp->n_splines;
+  for (int k = 0; k < 4; k++) out[k + 1] = sp->n_splines ? sum[k] / (double)sp->n_splines : NAN;
+}
+
 static void describe(const void *state, int what, char *buf, size_t n)
 {
   const spl_state *s = state;
@@ -1267,6 +1288,9 @@ static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinne
   .draw = draw, \
   .summary = summary, \
   .describe = describe, \
+  .n_observables = (int)(sizeof observable_names / sizeof observable_names[0]), \
+  .observable_names = observable_names, \
+  .observe = observe, \
   .split = split, \
   .group = group, \
   .propose_in = propose_in, \

@@ -33,6 +33,7 @@
 #include "linewise/particles.h"
 #include "linewise/sys_particles.h"
 #include "linewise/scene.h"
+#include "linewise/series.h"
 #include "testutil.h"
 
 /* ---- the harmonic well (a user term) ------------------------------------ */
@@ -258,32 +259,6 @@ Test(stats, point_move_acceptance_with_domains_on_1_2_4_threads)
 
 /* ---- 2. the Boltzmann distribution (chi-square) -------------------------- */
 
-/*
-** Integrated autocorrelation time (in records) of n_ser series of length n
-** stored series-major, from the averaged autocorrelation with Sokal's
-** self-consistent window W >= 5 tau.
-*/
-static double autocorrelation_time(const double *x, size_t n_ser, size_t n)
-{
-  double c0 = 0.0, tau = 0.5;
-  double *mean = malloc(n_ser * sizeof *mean);
-  for (size_t j = 0; j < n_ser; j++) {
-    double m = 0.0;
-    for (size_t t = 0; t < n; t++) m += x[j * n + t];
-    mean[j] = m / (double)n;
-    for (size_t t = 0; t < n; t++) c0 += (x[j * n + t] - mean[j]) * (x[j * n + t] - mean[j]);
-  }
-  for (size_t k = 1; k < n / 2; k++) {
-    double ck = 0.0;
-    for (size_t j = 0; j < n_ser; j++)
-      for (size_t t = 0; t + k < n; t++) ck += (x[j * n + t] - mean[j]) * (x[j * n + t + k] - mean[j]);
-    tau += ck / c0 * (double)n / (double)(n - k);
-    if ((double)k >= 5.0 * tau) break;
-  }
-  free(mean);
-  return tau;
-}
-
 /* Chi-square p-value of the samples against the distribution with CDF
 ** cdf(x, par) in nb bins of equal probability (expected count n / nb each). */
 static double chisq_p(const double *x, size_t n, double (*cdf)(double, const double *), const double *par, int nb)
@@ -359,7 +334,7 @@ static void boltzmann_case(double period, const char *domains, int threads)
     lw_chain_sweep(c);
     for (size_t j = 0; j < n_spl; j++) x[j * n_pilot + t] = m->sp->node[m->sp->first[j]].px - period * (double)(j % WELL_ROW);
   }
-  double tau = autocorrelation_time(x, n_spl, n_pilot);
+  double tau = lw_series_tau(x, n_spl, n_pilot, NULL);
   cr_assert(tau > 0.5 && tau < 50, "autocorrelation time %.2f sweeps is implausible", tau);
   /* Records 3 tau apart: residual correlations inflate the chi-square by
   ** about 1 + 2 sum_k exp(-3k) ~ 1.1, small against the 1e-3 threshold. */
@@ -686,7 +661,7 @@ static double *sample_particles(lw_chain *c, const lw_particles *p, particle_rec
     rec(p, v);
     for (size_t j = 0; j < n_ser; j++) x[j * n_pilot + t] = v[j];
   }
-  double tau = autocorrelation_time(x, n_ser, n_pilot);
+  double tau = lw_series_tau(x, n_ser, n_pilot, NULL);
   cr_assert(tau > 0.5 && tau < 50, "autocorrelation time %.2f sweeps is implausible", tau);
   long thin = (long)ceil(3.0 * tau);
   for (size_t t = 0; t < n_keep; t++) {
@@ -917,7 +892,7 @@ Test(stats, particle_births_and_deaths_follow_the_boltzmann_distribution)
     occ[t] = (double)(p->n - 1);
     if (p->n == 2) cs[n_cs++] = p->nrm[3 + 2];
   }
-  double tau = autocorrelation_time(occ, 1, n), f = 0;
+  double tau = lw_series_tau(occ, 1, n, NULL), f = 0;
   for (size_t t = 0; t < n; t++) f += occ[t];
   f /= (double)n;
   double sd = sqrt(0.25 * 2 * tau / (double)n);

@@ -166,6 +166,7 @@ typedef struct {
   /* [output] */
   int checkpoint_every;       /* sweeps between state.lw checkpoints */
   int trace_every;            /* sweeps per trace.csv row */
+  int observables;            /* 1 = the system's observables in trace.csv */
   double pen_width;           /* stroke of every pen, mm */
   int pens;                   /* pens (Inkscape layers), 1..16 */
   char pen_colors[LW_PATH_MAX]; /* "#rrggbb ..." one per pen; empty = black */

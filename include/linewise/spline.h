@@ -136,6 +136,17 @@ typedef struct {
 
 void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_samples *out);
 
+/* What a study reads off spline i (the observables of a trace, system.h):
+** its length by the rule q, the squared distance between its ends, its
+** squared radius of gyration along the contour, 1/L integral |r - r_cm|^2 dl
+** by the same rule, and the cosine of the angle between its end tangents
+** v_0 and v_n (0 where either is zero: no direction to compare). */
+typedef struct {
+  double length, end2, rg2, end_cos;
+} lw_spline_shape;
+
+void lw_spline_shape_of(const lw_splines *sp, size_t i, const lw_quad *q, lw_spline_shape *out);
+
 /*
 ** Regularity: the hodograph r'(t) of a cubic segment is the quadratic Bezier
 ** with control points h0 = 3 v_a, h1 = 3 (b2 - b1), h2 = 3 v_b.  Where

@@ -53,10 +53,11 @@
 #include "linewise/params.h"
 #include "linewise/state.h"
 
-/* At most this many move kinds and terms a system (fixed arrays in the
+/* At most this many move kinds, terms and observables a system (fixed arrays in the
 ** chain and the run loop's trace marks). */
 #define LW_MOVES_MAX 10
 #define LW_SYSTEM_TERMS_MAX 16
+#define LW_OBSERVABLES_MAX 8
 
 typedef struct lw_system_type lw_system_type;
 
@@ -258,6 +259,15 @@ struct lw_system_type {
 ** opposite order, so that a half step each way makes a symmetric step.
 ** Returns the kinetic energy taken (>= 0). */
   double (*damp_pairs)(const void *state, const void *mass, double h, int reverse, double *pi);
+
+  /* Optional (NULL: none, and a scene that sets output.observables = 1 is
+  ** refused): what a study reads off a state besides its energy, as
+  ** trace.csv columns obs_<name> (docs/FORMATS.md): n_observables values,
+  ** at most LW_OBSERVABLES_MAX, each a function of the state alone, NaN
+  ** where it is undefined (a mean over no splines). */
+  int n_observables;
+  const char *const *observable_names;
+  void (*observe)(const void *state, double *out);
 
   const char *files;
   lw_status (*draw)(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err);

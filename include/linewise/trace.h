@@ -1,0 +1,48 @@
+/*
+** trace.h -- a run's trace.csv read back, and the means with error bars of
+** its columns over a stretch of sweeps (`linewise stats`, docs/FORMATS.md).
+*/
+#ifndef LINEWISE_TRACE_H
+#define LINEWISE_TRACE_H
+
+#include <stdio.h>
+
+#include "linewise/error.h"
+
+typedef struct {
+  size_t n_cols, n_rows;
+  char **name;   /* n_cols column names, from the header */
+  double *v;     /* n_rows x n_cols, row-major; NaN for an empty field */
+} lw_trace;
+
+/* Reads a trace.csv.  A last line without its newline (a run still writing,
+** or killed mid-row) is left out.  NULL and err set (LW_EINPUT naming the
+** file, line and column) on anything else that is not a header of names and
+** rows of numbers or empty fields under it. */
+lw_trace *lw_trace_read(const char *path, lw_error *err);
+void lw_trace_free(lw_trace *t);
+
+/* The column of that name, or -1. */
+int lw_trace_column(const lw_trace *t, const char *name);
+
+/* Which rows `linewise stats` takes, by sweep: from <= sweep <= to (from < 0:
+** the first sweep at the last row's temperature, or without a temperature
+** column, the dynamics' trace, the first row; to < 0: to the end), less
+** the rows of sweeps whose steps still adapted: the first `tune`
+** (moves.tune_sweeps) of each of the schedule's `steps` temperature steps
+** over `sweeps` (anneal.steps, anneal.sweeps; tune = 0: none). */
+typedef struct {
+  long from, to;
+  long tune, steps, sweeps;
+  int csv;       /* 1: one CSV line per column; 0: a table for people */
+} lw_trace_select;
+
+/* Prints the statistics (series.h) of every column but the sweep and
+** temperature or time (and the rungs' temperatures) over the rows chosen,
+** then a warning line per column whose halves disagree (series.h's
+** drift_z beyond 4) or whose autocorrelation window did not close.  path
+** names the file in messages.  LW_EINPUT when no row is chosen. */
+lw_status lw_trace_stats(const lw_trace *t, const char *path, const lw_trace_select *sel, FILE *out,
+                         lw_error *err);
+
+#endif
