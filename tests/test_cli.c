@@ -4,6 +4,7 @@
 ** sets it).
 */
 #include <criterion/criterion.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -381,4 +382,74 @@ Test(cli, a_run_without_out_never_replaces_another)
                           "grep -q 'seed = 9' out/s/scene.ini && ! test -e out/s-4",
                           dir, b),
                0, "--out replaces the run it names");
+}
+
+/* The mean and standard error of a column in `linewise stats --csv` output. */
+static void stats_column(const char *csv, const char *name, double *mean, double *se)
+{
+  char key[64];
+  snprintf(key, sizeof key, "\n%s,", name);
+  const char *p = strstr(csv, key);
+  cr_assert_not_null(p, "no column %s in:\n%s", name, csv);
+  long n;
+  cr_assert_eq(sscanf(p + strlen(key), "%ld,%lf,%lf", &n, mean, se), 3, "%s", p);
+}
+
+/* A study as a user runs it: params/wlc.ini samples 50 free worm-like
+** chains with output.observables, and `linewise stats` gives the means
+** with error bars, which must match the 2-D Kratky-Porod chain within the
+** discretisation's bias measured in docs/NUMERICS.md ("Worm-like chain":
+** l_p up to 6 % long, R^2 up to 0.33 l0 / l_p high) plus 4 of the stats'
+** own standard errors.  Then a run stopped half way and resumed writes
+** the same trace, observables included. */
+Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars)
+{
+  char out[8192], errs[1024], args[512];
+  const double lp = 10.0, l0 = 1.0;
+  snprintf(args, sizeof args, "run %s/params/wlc.ini --out %s/wlc --quiet", lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  snprintf(args, sizeof args, "stats %s/wlc --from 4000 --csv", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  double L, Lse, r2, r2se, c, cse;
+  stats_column(out, "obs_length", &L, &Lse);
+  stats_column(out, "obs_end2", &r2, &r2se);
+  stats_column(out, "obs_end_cos", &c, &cse);
+  double kp = 2.0 * lp * L * (1.0 - lp / L * (1.0 - exp(-L / lp)));
+  double kp6 = 2.0 * 1.06 * lp * L * (1.0 - 1.06 * lp / L * (1.0 - exp(-L / (1.06 * lp))));
+  double bias = 0.33 * l0 / lp + fabs(kp6 / kp - 1.0);
+  cr_log_info("wlc study: L %.4f, R^2 %.4f +- %.4f (Kratky-Porod %.4f, bound %.4f), end cos %.4f +- %.4f", L, r2,
+              r2se, kp, bias, c, cse);
+  cr_assert(fabs(r2 / kp - 1.0) <= bias + 4.0 * r2se / kp, "<R^2> %.4f +- %.4f against %.4f", r2, r2se, kp);
+  /* the end tangents' l_p, and its standard error by the delta method */
+  double lp_c = -L / log(c), lp_se = L * cse / (c * log(c) * log(c));
+  cr_assert(fabs(lp_c / lp - 1.0) <= 0.06 + 4.0 * lp_se / lp, "end tangents give l_p %.3f +- %.3f", lp_c, lp_se);
+  cr_assert(lp_se / lp < 0.05 && r2se / kp < 0.01, "error bars too wide to test anything");
+  /* the table for people says the same, with the stretch it took */
+  snprintf(args, sizeof args, "stats %s/wlc --from 4000", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(out, "sweeps 4000 to 24000 at temperature 1: 4001 rows, one every 5 sweeps\n"), "%s", out);
+  cr_assert(strstr(out, "\nobs_count                     50           0           0           -         -\n"), "%s",
+            out);
+  /* stopped and resumed: the same trace, byte for byte */
+  snprintf(args, sizeof args, "run %s/params/wlc.ini --out %s/half --quiet --stop-at 10000", lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  snprintf(args, sizeof args, "resume %s/half --quiet", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(lw_test_sh("cmp -s %s/wlc/trace.csv %s/half/trace.csv", dir, dir), 0, "the resumed trace differs");
+}
+
+Test(cli, observables_and_stats_refuse_what_they_cannot_do)
+{
+  char out[2048], errs[1024], args[512];
+  snprintf(args, sizeof args, "run %s/params/wire.ini --out %s/w --quiet --set output.observables=1", lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "--set: key 'output.observables': the nurbs system has no observables; "
+                         "expected 0"), "%s", errs);
+  cr_assert_eq(lw_test_sh("test -e %s/w", dir), 1, "a refused run left a directory");
+  snprintf(args, sizeof args, "stats %s/nothing", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "nothing/scene.ini") && !strchr(strchr(errs, '\n') + 1, '\n'), "%s", errs);
+  snprintf(args, sizeof args, "stats %s --from x", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "--from: expected a whole number"), "%s", errs);
 }

@@ -1,0 +1,307 @@
+/*
+** test_series.c -- error bars from a correlated series (series.h), trace.csv
+** read back (trace.h), and the observables the systems report (system.h).
+**
+** The statistical checks use AR(1) series x_t = phi x_{t-1} + e_t, whose
+** integrated autocorrelation time is known exactly: rho(t) = phi^t, so
+** tau = 1/2 + phi / (1 - phi) = (1 + phi) / (2 (1 - phi)).  Fixed seeds;
+** each tolerance is derived from the estimator's variance where it is used.
+*/
+#include <criterion/criterion.h>
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "linewise/model.h"
+#include "linewise/particles.h"
+#include "linewise/particles_geom.h"
+#include "linewise/series.h"
+#include "linewise/sys_particles.h"
+#include "linewise/sys_splines.h"
+#include "linewise/trace.h"
+#include "testutil.h"
+
+/* n values of a stationary AR(1) series of unit innovations. */
+static void ar1(gsl_rng *r, double phi, double *x, size_t n)
+{
+  double v = gsl_ran_gaussian(r, 1.0) / sqrt(1.0 - phi * phi); /* the stationary law */
+  for (size_t t = 0; t < n; t++) {
+    x[t] = v;
+    v = phi * v + gsl_ran_gaussian(r, 1.0);
+  }
+}
+
+Test(series, the_autocorrelation_time_of_an_ar1_series)
+{
+  /* Madras and Sokal: var(tau) ~ 2 (2W + 1) / n tau^2 for the window W;
+  ** with tau = 4.5, W ~ 23 and n = 10^5, sd(tau) ~ 0.14.  The window's
+  ** cut leaves phi^W / (1 - phi) ~ 0.03 out.  Allowed: 4 sd + that. */
+  const double phi = 0.8, exact = (1.0 + phi) / (2.0 * (1.0 - phi));
+  const size_t n = 100000;
+  double *x = malloc(n * sizeof *x);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 4242);
+  ar1(r, phi, x, n);
+  size_t w;
+  double tau = lw_series_tau(x, 1, n, &w);
+  double sd = exact * sqrt(2.0 * (2.0 * (double)w + 1.0) / (double)n), cut = pow(phi, (double)w) / (1.0 - phi);
+  cr_log_info("AR(1) phi %.2f: tau %.3f (exact %.3f, sd %.3f), window %zu", phi, tau, exact, sd, w);
+  cr_assert(w >= 5.0 * tau && w < n / 2, "window %zu for tau %.3f", w, tau);
+  cr_assert(fabs(tau - exact) < 4.0 * sd + cut, "tau %.4f, exact %.4f (sd %.4f)", tau, exact, sd);
+  /* the same series twice, as two of n_ser, pools to the same estimate */
+  double *xx = malloc(2 * n * sizeof *xx);
+  memcpy(xx, x, n * sizeof *x);
+  memcpy(xx + n, x, n * sizeof *x);
+  cr_assert_float_eq(lw_series_tau(xx, 2, n, NULL), tau, 1e-12);
+  free(xx);
+  free(x);
+  gsl_rng_free(r);
+}
+
+Test(series, error_bars_cover_the_true_mean_as_often_as_they_claim)
+{
+  /* 400 independent AR(1) series (phi 0.9, tau 9.5) of 4000 values, true
+  ** mean 0: |mean| <= 2 stderr should hold for 95.4 % of them, less the
+  ** small loss to tau's own noise and the finite n_eff (~210).  Binomial
+  ** sd of the fraction: sqrt(0.95 * 0.05 / 400) = 0.011, so the band
+  ** 0.905 to 0.995 is 4 sd wide each side.  An error bar that ignored the
+  ** correlation (sd / sqrt(n), 4.4 times too small) covers about 35 %. */
+  const double phi = 0.9;
+  const size_t n = 4000, runs = 400;
+  double *x = malloc(n * sizeof *x);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 777);
+  size_t covered = 0, naive = 0, drifted = 0;
+  for (size_t k = 0; k < runs; k++) {
+    ar1(r, phi, x, n);
+    lw_series_stats s;
+    lw_series_stats_of(x, n, &s);
+    covered += fabs(s.mean) <= 2.0 * s.stderr_mean;
+    naive += fabs(s.mean) <= 2.0 * s.sd / sqrt((double)n);
+    drifted += fabs(s.drift_z) > 4.0;
+  }
+  double f = (double)covered / (double)runs;
+  cr_log_info("coverage %.3f (naive %.3f), drift flagged %zu of %zu", f, (double)naive / (double)runs, drifted, runs);
+  cr_assert(f > 0.905 && f < 0.995, "2-stderr coverage %.3f", f);
+  cr_assert((double)naive / (double)runs < 0.6, "the test cannot tell an honest error bar from a naive one");
+  /* P(|z| > 4) = 6e-5 per stationary series: none expected in 400 */
+  cr_assert(drifted <= 1, "%zu stationary series flagged as drifting", drifted);
+  free(x);
+  gsl_rng_free(r);
+}
+
+Test(series, a_step_in_the_mean_is_flagged_and_a_constant_is_exact)
+{
+  const size_t n = 4000;
+  double *x = malloc(n * sizeof *x);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 99);
+  ar1(r, 0.5, x, n);
+  /* a shift of half the series' sd in the second half: with tau = 1.5 and
+  ** 2000 values a half, the halves' difference has a standard error of
+  ** sd sqrt(2 * 2 tau / 2000) ~ 0.045 sd, so z ~ 11 */
+  for (size_t t = n / 2; t < n; t++) x[t] += 0.5 * 1.1547;
+  lw_series_stats s;
+  lw_series_stats_of(x, n, &s);
+  cr_assert(s.drift_z > 4.0, "drift z %.2f", s.drift_z);
+  for (size_t t = 0; t < n; t++) x[t] = 3.25;
+  lw_series_stats_of(x, n, &s);
+  cr_assert(s.mean == 3.25 && s.sd == 0.0 && s.stderr_mean == 0.0 && s.tau == 0.5 && s.window == 1 &&
+            s.drift_z == 0.0);
+  /* a trend: its autocorrelation stays positive past half the series, so
+  ** the window never closes and the error bar is flagged as a lower bound */
+  for (size_t t = 0; t < 200; t++) x[t] = (double)t;
+  lw_series_stats_of(x, 200, &s);
+  cr_assert(s.window == 0, "a ramp closed its window at %zu (tau %.1f)", s.window, s.tau);
+  free(x);
+  gsl_rng_free(r);
+}
+
+/* ---- trace.csv read back ------------------------------------------------- */
+
+static char dir[64];
+
+static void make_dir(void) { cr_assert_eq(lw_test_dir_make(dir, "series"), 0); }
+
+static void remove_dir(void) { cr_assert_eq(lw_test_dir_remove(dir), 0); }
+
+static void write_trace(const char *name, const char *text, char *path, size_t n)
+{
+  snprintf(path, n, "%s/%s", dir, name);
+  FILE *f = fopen(path, "w");
+  cr_assert_not_null(f);
+  fputs(text, f);
+  fclose(f);
+}
+
+Test(trace, rows_and_empty_fields_read_back_and_a_partial_last_row_is_left_out, .init = make_dir, .fini = remove_dir)
+{
+  char path[128];
+  write_trace("t.csv", "sweep,temperature,total,acc_point\n1,0.5,10.25,0.5\n2,0.5,9.5,\n3,0.5,9", path, sizeof path);
+  lw_error err;
+  lw_trace *t = lw_trace_read(path, &err);
+  cr_assert_not_null(t, "%s", err.msg);
+  cr_assert(t->n_cols == 4 && t->n_rows == 2, "%zu columns, %zu rows", t->n_cols, t->n_rows);
+  cr_assert_eq(lw_trace_column(t, "acc_point"), 3);
+  cr_assert_eq(lw_trace_column(t, "nothing"), -1);
+  cr_assert(t->v[2] == 10.25 && t->v[4 + 2] == 9.5 && isnan(t->v[4 + 3]));
+  lw_trace_free(t);
+}
+
+Test(trace, a_bad_field_is_named_by_file_line_and_column, .init = make_dir, .fini = remove_dir)
+{
+  char path[128];
+  lw_error err;
+  write_trace("a.csv", "sweep,total\n1,2\n2,x3\n", path, sizeof path);
+  cr_assert_null(lw_trace_read(path, &err));
+  cr_assert(err.code == LW_EINPUT && strstr(err.msg, "a.csv:3: column 'total': 'x3' is not a number"), "%s", err.msg);
+  write_trace("b.csv", "sweep,total\n1,2,3\n", path, sizeof path);
+  cr_assert_null(lw_trace_read(path, &err));
+  cr_assert(strstr(err.msg, "b.csv:2: more fields, expected 2"), "%s", err.msg);
+  write_trace("c.csv", "sweep,,total\n", path, sizeof path);
+  cr_assert_null(lw_trace_read(path, &err));
+  cr_assert(strstr(err.msg, "c.csv:1: column 2 has no name"), "%s", err.msg);
+}
+
+/* The statistics of a trace as CSV lines, into buf. */
+static void stats_csv(const lw_trace *t, const lw_trace_select *sel, char *buf, size_t n)
+{
+  FILE *f = fmemopen(buf, n, "w");
+  lw_error err;
+  cr_assert_eq(lw_trace_stats(t, "t.csv", sel, f, &err), LW_OK, "%s", err.msg);
+  fclose(f);
+}
+
+Test(trace, the_default_stretch_is_the_final_temperature_less_its_tuning_sweeps, .init = make_dir,
+     .fini = remove_dir)
+{
+  /* 2 steps of 10 sweeps (T 1 then 0.5), 3 tuning sweeps each: the
+  ** default takes sweeps 11 to 20 less 11, 12 and 13; total there is
+  ** 14 .. 20, mean 17 */
+  char text[1024], path[128], out[2048];
+  int k = snprintf(text, sizeof text, "sweep,temperature,total\n");
+  for (int s = 1; s <= 20; s++) k += snprintf(text + k, sizeof text - (size_t)k, "%d,%g,%d\n", s, s <= 10 ? 1.0 : 0.5, s);
+  write_trace("t.csv", text, path, sizeof path);
+  lw_error err;
+  lw_trace *t = lw_trace_read(path, &err);
+  cr_assert_not_null(t, "%s", err.msg);
+  lw_trace_select sel = {.from = -1, .to = -1, .tune = 3, .steps = 2, .sweeps = 20, .csv = 1};
+  stats_csv(t, &sel, out, sizeof out);
+  cr_assert(strstr(out, "\ntotal,7,17,"), "%s", out);
+  /* --from 2 --to 8: sweeps 4 .. 8 once the first step's tuning is out */
+  sel.from = 2;
+  sel.to = 8;
+  stats_csv(t, &sel, out, sizeof out);
+  cr_assert(strstr(out, "\ntotal,5,6,"), "%s", out);
+  /* nothing left: an error naming the trace's span */
+  sel.from = 11;
+  sel.to = 13;
+  FILE *f = fmemopen(out, sizeof out, "w");
+  cr_assert_eq(lw_trace_stats(t, "t.csv", &sel, f, &err), LW_EINPUT);
+  fclose(f);
+  cr_assert(strstr(err.msg, "no row from sweep 11 to 13 with frozen steps"), "%s", err.msg);
+  lw_trace_free(t);
+}
+
+/* ---- observables --------------------------------------------------------- */
+
+Test(observables, a_line_and_a_circle_have_their_known_shapes)
+{
+  lw_quad q;
+  lw_error err;
+  cr_assert_eq(lw_quad_init(&q, 8, &err), LW_OK);
+  size_t segs[2] = {3, 4};
+  lw_splines *sp = lw_splines_new(2, segs, &err);
+  lw_test_straight(sp, 0, 10.0, 20.0, 10.0 + 30.0 * 0.6, 20.0 + 30.0 * 0.8);
+  lw_test_circle(sp, 1, 50.0, 50.0, 7.0);
+  lw_spline_shape sh;
+  lw_spline_shape_of(sp, 0, &q, &sh);
+  /* a line of length L: rg2 = L^2 / 12 */
+  cr_assert(fabs(sh.length - 30.0) < 1e-12 && fabs(sh.end2 - 900.0) < 1e-9 && fabs(sh.rg2 - 75.0) < 1e-9 &&
+            fabs(sh.end_cos - 1.0) < 1e-15, "line: %g %g %g %g", sh.length, sh.end2, sh.rg2, sh.end_cos);
+  /* the four-arc circle stays within 2.7e-4 R of the circle: rg2 = R^2
+  ** and the length 2 pi R to that order */
+  lw_spline_shape_of(sp, 1, &q, &sh);
+  cr_assert(fabs(sh.length / (2.0 * M_PI * 7.0) - 1.0) < 6e-4 && fabs(sh.rg2 / 49.0 - 1.0) < 6e-4 &&
+            sh.end2 < 1e-20 && fabs(sh.end_cos - 1.0) < 1e-15, "circle: %g %g %g %g", sh.length, sh.end2, sh.rg2,
+            sh.end_cos);
+  /* the row's observables are the means over the splines */
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = p.height = 100;
+  lw_scene sc;
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
+  lw_model *m = lw_model_new(&sc, sp, &err);
+  cr_assert_not_null(m, "%s", err.msg);
+  lw_system *sys = lw_splines_view(m, &err);
+  cr_assert_not_null(sys, "%s", err.msg);
+  const lw_system_type *t = sys->type;
+  cr_assert(t->n_observables == 5 && !strcmp(t->observable_names[2], "end2"));
+  double v[LW_OBSERVABLES_MAX], line_rg2 = 75.0;
+  t->observe(sys->state, v);
+  lw_spline_shape c;
+  lw_spline_shape_of(m->sp, 1, &sc.quad, &c);
+  cr_assert(v[0] == 2.0 && fabs(v[2] - (900.0 + c.end2) / 2.0) < 1e-9 && fabs(v[3] - (line_rg2 + c.rg2) / 2.0) < 1e-9,
+            "%g %g %g", v[0], v[2], v[3]);
+  lw_system_free(sys);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+Test(observables, particles_on_a_plane_and_on_a_sphere)
+{
+  lw_params prm;
+  lw_params_defaults(&prm);
+  strcpy(prm.system, "particles");
+  prm.pt_alpha_lj = 1.0;
+  lw_error err;
+  lw_particles_setup *s = lw_particles_setup_new(&prm, &err);
+  cr_assert_not_null(s, "%s", err.msg);
+  /* 400 particles on a 20 x 20 lattice of spacing 1.5 in z = 3, normals up:
+  ** rg2 = 2 * 1.5^2 (20^2 - 1) / 12, no distance from the plane, order 1 */
+  const size_t n = 400;
+  double *x = malloc(3 * n * sizeof *x), *q = malloc(4 * n * sizeof *q);
+  for (size_t i = 0; i < n; i++) {
+    x[3 * i] = 1.5 * (double)(i % 20);
+    x[3 * i + 1] = 1.5 * (double)(i / 20);
+    x[3 * i + 2] = 3.0;
+    q[4 * i] = 1.0;
+    q[4 * i + 1] = q[4 * i + 2] = q[4 * i + 3] = 0.0;
+  }
+  const lw_system_type *t = &lw_system_particles;
+  lw_particles *p = lw_particles_new_from(s, n, x, q, NULL, &err);
+  cr_assert_not_null(p, "%s", err.msg);
+  double v[LW_OBSERVABLES_MAX];
+  t->observe(p, v);
+  cr_assert(v[0] == 400.0 && fabs(v[1] - 2.0 * 2.25 * 399.0 / 12.0) < 1e-9 && v[2] < 1e-7 && fabs(v[3] - 1.0) < 1e-12,
+            "plane: %g %g %g %g", v[0], v[1], v[2], v[3]);
+  lw_particles_free(p);
+  /* on a sphere of radius 10 (a Fibonacci lattice), normals drawn
+  ** uniformly: rg2 = R^2, the rms distance from any plane through the
+  ** centre R / sqrt(3) to within the lattice's unevenness, and the order
+  ** near 0 (its sampling bias for 400 normals is about 0.05) */
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 5);
+  for (size_t i = 0; i < n; i++) {
+    double z = 1.0 - (2.0 * (double)i + 1.0) / (double)n, rho = sqrt(1.0 - z * z), a = 2.399963 * (double)i;
+    x[3 * i] = 10.0 * rho * cos(a);
+    x[3 * i + 1] = 10.0 * rho * sin(a);
+    x[3 * i + 2] = 10.0 * z;
+    double nrm[3];
+    gsl_ran_dir_3d(r, &nrm[0], &nrm[1], &nrm[2]);
+    lw_quat_from_normal(nrm, q + 4 * i);
+  }
+  p = lw_particles_new_from(s, n, x, q, NULL, &err);
+  cr_assert_not_null(p, "%s", err.msg);
+  t->observe(p, v);
+  cr_assert(fabs(v[1] / 100.0 - 1.0) < 1e-3 && fabs(v[2] / (10.0 / sqrt(3.0)) - 1.0) < 0.01 && fabs(v[3]) < 0.15,
+            "sphere: %g %g %g", v[1], v[2], v[3]);
+  lw_particles_free(p);
+  gsl_rng_free(r);
+  free(x);
+  free(q);
+  lw_particles_setup_free(s);
+}
