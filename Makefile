@@ -27,7 +27,7 @@ LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_OBJ := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%.o) $(BUILD)/tests/stb_write.o
 # The fuzz harnesses, compiled with cc into the suite, which replays the corpus.
-FUZZ_NAMES := params state resume energy image points
+FUZZ_NAMES := params state resume energy image points trace
 FUZZ_REPLAY_OBJ := $(FUZZ_NAMES:%=$(BUILD)/tests/fuzz_%.o)
 TEST_JOBS ?= 2
 # study tools (shell, gnuplot), installed as linewise-<name>

@@ -179,6 +179,11 @@ lw_status lw_trace_stats(const lw_trace *t, const char *path, const lw_trace_sel
   int sweep = lw_trace_column(t, "sweep");
   if (sweep < 0) return lw_error_set(err, LW_EINPUT, "%s: no 'sweep' column (expected a trace.csv)", path);
   if (!t->n_rows) return lw_error_set(err, LW_EINPUT, "%s: no rows yet", path);
+  for (size_t r = 0; r < t->n_rows; r++) {
+    double v = at(t, r, sweep);
+    if (!(v >= 0.0 && v <= 9007199254740992.0) || v != floor(v))
+      return lw_error_set(err, LW_EINPUT, "%s:%zu: column 'sweep': expected a sweep count", path, r + 2);
+  }
   long from = sel->from >= 0 ? sel->from : default_from(t, sweep);
   long to = sel->to >= 0 ? sel->to : (long)at(t, t->n_rows - 1, sweep);
   size_t r0 = 0, r1 = 0; /* the rows [r0, r1) */

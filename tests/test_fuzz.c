@@ -17,6 +17,7 @@ int lw_fuzz_resume_one(const uint8_t *data, size_t size);
 int lw_fuzz_energy_one(const uint8_t *data, size_t size);
 int lw_fuzz_image_one(const uint8_t *data, size_t size);
 int lw_fuzz_points_one(const uint8_t *data, size_t size);
+int lw_fuzz_trace_one(const uint8_t *data, size_t size);
 
 /* Feeds every file of tests/fuzz/corpus/<name> to fn; returns the count. */
 static int replay(const char *name, int (*fn)(const uint8_t *, size_t))
@@ -76,4 +77,9 @@ Test(fuzz, image_corpus_replays_clean)
 Test(fuzz, points_corpus_replays_clean)
 {
   cr_assert_geq(replay("points", lw_fuzz_points_one), 5, "the points corpus lost its seeds");
+}
+
+Test(fuzz, trace_corpus_replays_clean)
+{
+  cr_assert_geq(replay("trace", lw_fuzz_trace_one), 4, "the trace corpus lost its seeds");
 }
