@@ -211,11 +211,16 @@ static lw_status setup_system(lw_anneal *a, lw_error *err)
     return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.quench': the %s system has no gradient to quench with; "
                         "expected none", where, a->sys_type->name);
   }
-  if (a->params.observables && !a->sys_type->observe) {
+  if (a->params.observables && (!a->sys_type->observe || (a->net && a->net->size > 1))) {
+    /* over MPI the coldest rung's state may live in another process than
+    ** the one writing the trace, which holds only its energies */
     char where[LW_PATH_MAX + 32];
     lw_params_origin(&a->params, lw_params_find("output", "observables"), where, sizeof where);
-    return lw_error_set(err, LW_EINPUT, "%s: key 'output.observables': the %s system has no observables; "
-                        "expected 0", where, a->sys_type->name);
+    if (!a->sys_type->observe)
+      return lw_error_set(err, LW_EINPUT, "%s: key 'output.observables': the %s system has no observables; "
+                          "expected 0", where, a->sys_type->name);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'output.observables': linewise-mpi over %d processes does not "
+                        "write observables yet; expected 0 (or one process)", where, a->net->size);
   }
   a->setup = a->sys_type->setup_new(&a->params, err);
   return a->setup ? LW_OK : err->code;

@@ -98,6 +98,13 @@ Test(mpi, more_processes_than_replicas_is_refused_before_anything_is_written)
   /* said once, by process 0 */
   cr_assert_eq(sh("test $(grep -c 'replicas for 3 processes' %s/err.txt) -eq 1", dir), 0);
   cr_assert_neq(sh("test -e %s/x", dir), 0, "an output directory was created for bad input");
+  /* the observables are the coldest rung's state's, which process 0 may
+  ** not hold: refused over several processes, said once */
+  cr_assert_eq(sh(MPIRUN " -n 2 %s run %s/s.ini --set output.observables=1 --out %s/o --quiet 2>%s/err.txt", m, dir,
+                  dir, dir), 2);
+  cr_assert_eq(sh("test $(grep -c \"key 'output.observables': linewise-mpi over 2 processes\" %s/err.txt) -eq 1", dir),
+               0);
+  cr_assert_neq(sh("test -e %s/o", dir), 0, "an output directory was created for bad input");
 }
 
 /* Starts a long run on 2 processes in the background (mpirun's status into
