@@ -38,6 +38,9 @@ static lw_status read_header(lw_trace *t, char *line, const char *path, lw_error
     char *end = strchr(tok, ',');
     if (end) *end = '\0';
     if (!*tok) return lw_error_set(err, LW_EINPUT, "%s:1: column %zu has no name (expected a header of names)", path, k + 1);
+    for (const char *c = tok; *c; c++)
+      if ((unsigned char)*c < 0x20 || *c == 0x7f)
+        return lw_error_set(err, LW_EINPUT, "%s:1: column %zu: a control character in its name", path, k + 1);
     if (!(t->name[k] = strdup(tok))) return lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
     t->n_cols = k + 1;
     tok = end ? end + 1 : tok;
@@ -82,6 +85,10 @@ lw_trace *lw_trace_read(const char *path, lw_error *err)
     int whole = line[len - 1] == '\n';
     if (whole) line[--len] = '\0';
     if (len && line[len - 1] == '\r') line[--len] = '\0';
+    if (strlen(line) != (size_t)len) {
+      s = lw_error_set(err, LW_EINPUT, "%s:%zu: a NUL byte (expected text)", path, line_no);
+      break;
+    }
     if (line_no == 1) {
       s = read_header(t, line, path, err);
       continue;
