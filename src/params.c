@@ -394,7 +394,8 @@ const lw_param_def lw_param_table[] = {
   NUM("output", "observables", LW_PT_INT, observables, "0", "", 0, 1, 0,
       "1 adds the system's observables to every row of trace.csv (columns obs_<name>: for splines "
       "the count and the means over the splines of length, squared end-to-end distance, squared "
-      "radius of gyration and the cosine between the end tangents; for particles the count, squared "
+      "radius of gyration and the cosine between the end tangents, for a D-NURBS curve the same of "
+      "the curve; for particles the count, squared "
       "radius of gyration, rms distance from the best plane and the order of the normals; "
       "docs/FORMATS.md). `linewise stats DIR` gives their means with error bars."),
   NUM("output", "pen_width", LW_PT_DOUBLE, pen_width, "0.3", "mm", 0, 100, LW_MIN_OPEN,

@@ -10,6 +10,7 @@
 
 #include <cairo.h>
 #include <errno.h>
+#include <gsl/gsl_integration.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -914,6 +915,49 @@ static void summary(const void *state, lw_json *j)
   lw_json_number(j, s->deviation);
 }
 
+/* The observables of the one curve (docs/FORMATS.md, "trace.csv"), as the
+** splines' are of each spline: its length, the squared distance between its
+** ends, its squared radius of gyration along the arc, 1/L integral of
+** |r - r_cm|^2 dl, and the cosine between its end tangents; the integrals
+** by an 8-point Gauss rule on every knot span. */
+static const char *const observable_names[] = {"length", "end2", "rg2", "end_cos"};
+
+static void observe(const void *state, double *out)
+{
+  const lw_nurbs *c = ((const lw_nurbs_state *)state)->c;
+  const size_t k = (size_t)c->order, nq = 8;
+  gsl_integration_glfixed_table *gl = gsl_integration_glfixed_table_alloc(nq);
+  if (!gl) {
+    out[0] = out[1] = out[2] = out[3] = NAN;
+    return;
+  }
+  double p0[2], t0[2], p1[2], t1[2], pt[2], d[2];
+  lw_nurbs_eval(c, lw_nurbs_u0(c), p0, t0, NULL);
+  lw_nurbs_eval(c, lw_nurbs_u1(c), p1, t1, NULL);
+  /* moments about the first end, where the page's offset cannot cancel */
+  double len = 0.0, mx = 0.0, my = 0.0, m2 = 0.0;
+  for (size_t sp = k - 1; sp < c->n; sp++) {
+    double a = c->knot[sp], b = c->knot[sp + 1];
+    if (!(b > a)) continue; /* a repeated knot: no span */
+    for (size_t q = 0; q < nq; q++) {
+      double u, wq;
+      gsl_integration_glfixed_point(a, b, q, &u, &wq, gl);
+      lw_nurbs_eval(c, u, pt, d, NULL);
+      double dl = wq * hypot(d[0], d[1]), x = pt[0] - p0[0], y = pt[1] - p0[1];
+      len += dl;
+      mx += x * dl;
+      my += y * dl;
+      m2 += (x * x + y * y) * dl;
+    }
+  }
+  gsl_integration_glfixed_table_free(gl);
+  double ex = p1[0] - p0[0], ey = p1[1] - p0[1], n0 = hypot(t0[0], t0[1]), n1 = hypot(t1[0], t1[1]);
+  out[0] = len;
+  out[1] = ex * ex + ey * ey;
+  out[2] = len > 0.0 ? fmax(m2 / len - (mx * mx + my * my) / (len * len), 0.0) : 0.0;
+  out[3] = n0 > 0.0 && n1 > 0.0 ? (t0[0] * t1[0] + t0[1] * t1[1]) / (n0 * n1) : 0.0;
+}
+
 static void describe(const void *state, int what, char *buf, size_t n)
 {
   const lw_nurbs_state *s = state;
@@ -968,4 +1012,7 @@ const lw_system_type lw_system_nurbs = {
     .draw = draw,
     .summary = summary,
     .describe = describe,
+    .n_observables = (int)(sizeof observable_names / sizeof observable_names[0]),
+    .observable_names = observable_names,
+    .observe = observe,
 };

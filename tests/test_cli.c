@@ -438,14 +438,9 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
   cr_assert_eq(lw_test_sh("cmp -s %s/wlc/trace.csv %s/half/trace.csv", dir, dir), 0, "the resumed trace differs");
 }
 
-Test(cli, observables_and_stats_refuse_what_they_cannot_do)
+Test(cli, stats_refuses_a_missing_run_and_a_bad_option_in_one_line)
 {
   char out[2048], errs[1024], args[512];
-  snprintf(args, sizeof args, "run %s/params/wire.ini --out %s/w --quiet --set output.observables=1", lw_test_root(), dir);
-  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
-  cr_assert(strstr(errs, "--set: key 'output.observables': the nurbs system has no observables; "
-                         "expected 0"), "%s", errs);
-  cr_assert_eq(lw_test_sh("test -e %s/w", dir), 1, "a refused run left a directory");
   snprintf(args, sizeof args, "stats %s/nothing", dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
   cr_assert(strstr(errs, "nothing/scene.ini") && !strchr(strchr(errs, '\n') + 1, '\n'), "%s", errs);
