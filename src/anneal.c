@@ -25,6 +25,7 @@
 #include "linewise/output.h"
 #include "linewise/phase.h"
 #include "linewise/state.h"
+#include "linewise/trace.h"
 
 static double now_seconds(void)
 {
@@ -790,6 +791,54 @@ static void put_per_move(lw_json *j, const char *key, const lw_chain *c, const l
   lw_json_end_object(j);
 }
 
+/* summary.json's observables: each obs_ column's mean, standard error and
+** autocorrelation time over the stretch that `linewise stats` takes by
+** default (trace.h), read back from trace.csv, which the checkpoint before
+** has flushed; null where the trace has no such stretch. */
+static void put_observables(const lw_anneal *a, lw_json *j)
+{
+  char path[LW_PATH_MAX + 32], key[96];
+  dir_file(path, sizeof path, a, "trace.csv");
+  lw_error e;
+  lw_trace *t = lw_trace_read(path, &e);
+  lw_trace_select sel = {.from = -1, .to = -1};
+  lw_trace_select_of(&a->params, &sel);
+  size_t *rows = NULL, n = 0, tuned;
+  double *x = NULL;
+  lw_json_key(j, "observables");
+  if (!t || lw_trace_rows(t, path, &sel, &rows, &n, &tuned, &e) || !(x = malloc(n * sizeof *x))) {
+    lw_json_null(j);
+  } else {
+    const int sweep = lw_trace_column(t, "sweep");
+    const double every = lw_trace_every(t);
+    lw_json_begin_object(j);
+    lw_json_key(j, "from"); lw_json_int(j, (long long)t->v[rows[0] * t->n_cols + (size_t)sweep]);
+    lw_json_key(j, "to"); lw_json_int(j, (long long)t->v[rows[n - 1] * t->n_cols + (size_t)sweep]);
+    lw_json_key(j, "rows"); lw_json_int(j, (long long)n);
+    for (size_t k = 0; k < t->n_cols; k++) {
+      if (strncmp(t->name[k], "obs_", 4)) continue;
+      lw_series_stats st;
+      lw_trace_column_stats(t, rows, n, (int)k, x, &st);
+      const char *name = t->name[k] + 4;
+      lw_json_key(j, name);
+      if (st.n) lw_json_number(j, st.mean);
+      else lw_json_null(j);
+      snprintf(key, sizeof key, "%s_stderr", name);
+      lw_json_key(j, key);
+      if (st.n) lw_json_number(j, st.stderr_mean);
+      else lw_json_null(j);
+      snprintf(key, sizeof key, "%s_tau_sweeps", name);
+      lw_json_key(j, key);
+      if (st.n && st.sd > 0.0) lw_json_number(j, st.tau * every);
+      else lw_json_null(j);
+    }
+    lw_json_end_object(j);
+  }
+  free(x);
+  free(rows);
+  lw_trace_free(t);
+}
+
 static lw_status write_summary(lw_anneal *a, lw_error *err)
 {
   char path[LW_PATH_MAX + 32], tmp[LW_PATH_MAX + 64];
@@ -874,6 +923,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     else lw_json_null(&j);
   }
   lw_json_end_object(&j);
+  if (a->params.observables) put_observables(a, &j);
   lw_json_key(&j, "proposed");
   lw_json_begin_object(&j);
   for (int k = 0; k < c->n_moves; k++) {

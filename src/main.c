@@ -567,11 +567,7 @@ static int cmd_stats(int argc, char **argv)
   char path[LW_PATH_MAX + 32];
   lw_path_join(path, sizeof path, dir, "scene.ini");
   if (lw_params_read_run(&p, path, &err)) return fail(&err);
-  if (p.driver == LW_DRIVER_METROPOLIS) {
-    sel.tune = p.tune_sweeps;
-    sel.steps = p.steps;
-    sel.sweeps = p.sweeps;
-  }
+  lw_trace_select_of(&p, &sel);
   lw_path_join(path, sizeof path, dir, "trace.csv");
   lw_trace *t = lw_trace_read(path, &err);
   if (!t || lw_trace_stats(t, path, &sel, stdout, &err)) {

@@ -398,6 +398,11 @@ const lw_param_def lw_param_table[] = {
       "the curve; for particles the count, squared "
       "radius of gyration, rms distance from the best plane and the order of the normals; "
       "docs/FORMATS.md). `linewise stats DIR` gives their means with error bars."),
+  NUM("output", "stats_from", LW_PT_INT, stats_from, "0", "sweeps", 0, 2e9, 0,
+      "First sweep of the stretch of trace.csv whose statistics `linewise stats DIR` takes by default and "
+      "summary.json reports for the observables (their means, standard errors and autocorrelation times): "
+      "the end of a study's burn-in. 0 = the sweeps at the final temperature. Either way the sweeps whose "
+      "steps were still tuning are left out."),
   NUM("output", "pen_width", LW_PT_DOUBLE, pen_width, "0.3", "mm", 0, 100, LW_MIN_OPEN,
       "Stroke width of every pen in final.svg, the previews and the fidelity render: the pen's line width."),
   NUM("output", "pens", LW_PT_INT, pens, "1", "", 1, 16, 0,

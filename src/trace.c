@@ -128,6 +128,15 @@ static int is_coordinate(const char *name)
 
 static double at(const lw_trace *t, size_t row, int col) { return t->v[row * t->n_cols + (size_t)col]; }
 
+void lw_trace_select_of(const lw_params *p, lw_trace_select *sel)
+{
+  if (sel->from < 0 && p->stats_from > 0) sel->from = p->stats_from;
+  if (p->driver != LW_DRIVER_METROPOLIS) return; /* the dynamics tunes nothing */
+  sel->tune = p->tune_sweeps;
+  sel->steps = p->steps;
+  sel->sweeps = p->sweeps;
+}
+
 /* Whether the row of sweep s (counted from 1) reports a sweep whose steps
 ** still adapted: within the first `tune` sweeps of one of the schedule's
 ** temperature steps, as the run loop decides (anneal.c). */
@@ -180,9 +189,11 @@ static void warn(FILE *out, const lw_trace *t, const lw_series_stats *st, int wh
   if (any) fprintf(out, ": %s\n", text);
 }
 
-lw_status lw_trace_stats(const lw_trace *t, const char *path, const lw_trace_select *sel, FILE *out,
-                         lw_error *err)
+lw_status lw_trace_rows(const lw_trace *t, const char *path, const lw_trace_select *sel, size_t **rows, size_t *n,
+                        size_t *tuned, lw_error *err)
 {
+  *rows = NULL;
+  *n = *tuned = 0;
   int sweep = lw_trace_column(t, "sweep");
   if (sweep < 0) return lw_error_set(err, LW_EINPUT, "%s: no 'sweep' column (expected a trace.csv)", path);
   if (!t->n_rows) return lw_error_set(err, LW_EINPUT, "%s: no rows yet", path);
@@ -196,31 +207,52 @@ lw_status lw_trace_stats(const lw_trace *t, const char *path, const lw_trace_sel
   size_t r0 = 0, r1 = 0; /* the rows [r0, r1) */
   while (r0 < t->n_rows && at(t, r0, sweep) < (double)from) r0++;
   for (r1 = r0; r1 < t->n_rows && at(t, r1, sweep) <= (double)to; r1++) continue;
-  size_t *row = malloc((r1 > r0 ? r1 - r0 : 1) * sizeof *row), n = 0, tuned = 0;
-  double *x = malloc((r1 > r0 ? r1 - r0 : 1) * sizeof *x);
+  if (!(*rows = malloc((r1 > r0 ? r1 - r0 : 1) * sizeof **rows))) return lw_error_set(err, LW_ENOMEM, "out of memory");
+  for (size_t r = r0; r < r1; r++) {
+    if (tuning(sel, (long)at(t, r, sweep))) ++*tuned;
+    else (*rows)[(*n)++] = r;
+  }
+  if (!*n) {
+    free(*rows);
+    *rows = NULL;
+    return lw_error_set(err, LW_EINPUT, "%s: no row from sweep %ld to %ld%s (its rows run from sweep %.0f to %.0f)",
+                        path, from, to, *tuned ? " with frozen steps" : "", at(t, 0, sweep),
+                        at(t, t->n_rows - 1, sweep));
+  }
+  return LW_OK;
+}
+
+double lw_trace_every(const lw_trace *t)
+{
+  int sweep = lw_trace_column(t, "sweep");
+  return sweep >= 0 && t->n_rows > 1 ? at(t, 1, sweep) - at(t, 0, sweep) : 1.0;
+}
+
+void lw_trace_column_stats(const lw_trace *t, const size_t *rows, size_t n, int col, double *x, lw_series_stats *out)
+{
+  size_t m = 0;
+  for (size_t i = 0; i < n; i++)
+    if (!isnan(at(t, rows[i], col))) x[m++] = at(t, rows[i], col);
+  if (m) lw_series_stats_of(x, m, out);
+  else memset(out, 0, sizeof *out);
+}
+
+lw_status lw_trace_stats(const lw_trace *t, const char *path, const lw_trace_select *sel, FILE *out,
+                         lw_error *err)
+{
+  size_t *row, n, tuned;
+  lw_status status = lw_trace_rows(t, path, sel, &row, &n, &tuned, err);
+  if (status) return status;
+  double *x = malloc(n * sizeof *x);
   lw_series_stats *st = calloc(t->n_cols, sizeof *st);
-  if (!row || !x || !st) {
+  if (!x || !st) {
     free(row);
     free(x);
     free(st);
     return lw_error_set(err, LW_ENOMEM, "out of memory");
   }
-  for (size_t r = r0; r < r1; r++) {
-    if (tuning(sel, (long)at(t, r, sweep))) tuned++;
-    else row[n++] = r;
-  }
-  if (!n) {
-    free(row);
-    free(x);
-    free(st);
-    return lw_error_set(err, LW_EINPUT, "%s: no row from sweep %ld to %ld%s (its rows run from sweep %.0f to %.0f)",
-                        path, from, to, tuned ? " with frozen steps" : "", at(t, 0, sweep),
-                        at(t, t->n_rows - 1, sweep));
-  }
-  double first = at(t, row[0], sweep), last = at(t, row[n - 1], sweep);
-  /* the rows' spacing in sweeps (output.trace_every) from the first two */
-  double every = t->n_rows > 1 ? at(t, 1, sweep) - at(t, 0, sweep) : 1.0;
-  int temp = lw_trace_column(t, "temperature");
+  int sweep = lw_trace_column(t, "sweep"), temp = lw_trace_column(t, "temperature");
+  double first = at(t, row[0], sweep), last = at(t, row[n - 1], sweep), every = lw_trace_every(t);
   double tlo = INFINITY, thi = -INFINITY;
   for (size_t i = 0; temp >= 0 && i < n; i++) {
     tlo = fmin(tlo, at(t, row[i], temp));
@@ -239,23 +271,19 @@ lw_status lw_trace_stats(const lw_trace *t, const char *path, const lw_trace_sel
   }
   for (size_t k = 0; k < t->n_cols; k++) {
     if (is_coordinate(t->name[k])) continue;
-    size_t m = 0;
-    for (size_t i = 0; i < n; i++)
-      if (!isnan(at(t, row[i], (int)k))) x[m++] = at(t, row[i], (int)k);
     lw_series_stats *s = &st[k];
-    if (!m) {
+    lw_trace_column_stats(t, row, n, (int)k, x, s);
+    if (!s->n) {
       if (!sel->csv) fprintf(out, "%-16s %15s\n", t->name[k], "(empty)");
-      continue;
-    }
-    lw_series_stats_of(x, m, s);
-    if (sel->csv)
-      fprintf(out, "%s,%zu,%.10g,%.4g,%.4g,%.4g,%.4g,%d,%.3g\n", t->name[k], m, s->mean, s->stderr_mean, s->sd,
+    } else if (sel->csv) {
+      fprintf(out, "%s,%zu,%.10g,%.4g,%.4g,%.4g,%.4g,%d,%.3g\n", t->name[k], s->n, s->mean, s->stderr_mean, s->sd,
               s->tau * every, s->n_eff, s->window > 0, s->drift_z);
-    else if (!(s->sd > 0.0))
+    } else if (!(s->sd > 0.0)) {
       fprintf(out, "%-16s %15.9g %11.4g %11.4g %11s %9s\n", t->name[k], s->mean, 0.0, 0.0, "-", "-");
-    else
+    } else {
       fprintf(out, "%-16s %15.9g %11.4g %11.4g %11.4g %9.0f%s\n", t->name[k], s->mean, s->stderr_mean, s->sd,
               s->tau * every, s->n_eff, flagged(s) ? " *" : "");
+    }
   }
   if (!sel->csv) {
     if (temp >= 0 && tlo != thi)

@@ -397,7 +397,8 @@ static void stats_column(const char *csv, const char *name, double *mean, double
 
 /* A study as a user runs it: params/wlc.ini samples 50 free worm-like
 ** chains with output.observables, and `linewise stats` gives the means
-** with error bars, which must match the 2-D Kratky-Porod chain within the
+** with error bars (from output.stats_from, the scene's burn-in; summary.json
+** has the same), which must match the 2-D Kratky-Porod chain within the
 ** discretisation's bias measured in docs/NUMERICS.md ("Worm-like chain":
 ** l_p up to 6 % long, R^2 up to 0.33 l0 / l_p high) plus 4 of the stats'
 ** own standard errors.  Then a run stopped half way and resumed writes
@@ -408,7 +409,7 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
   const double lp = 10.0, l0 = 1.0;
   snprintf(args, sizeof args, "run %s/params/wlc.ini --out %s/wlc --quiet", lw_test_root(), dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
-  snprintf(args, sizeof args, "stats %s/wlc --from 4000 --csv", dir);
+  snprintf(args, sizeof args, "stats %s/wlc --csv", dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   double L, Lse, r2, r2se, c, cse;
   stats_column(out, "obs_length", &L, &Lse);
@@ -424,8 +425,17 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
   double lp_c = -L / log(c), lp_se = L * cse / (c * log(c) * log(c));
   cr_assert(fabs(lp_c / lp - 1.0) <= 0.06 + 4.0 * lp_se / lp, "end tangents give l_p %.3f +- %.3f", lp_c, lp_se);
   cr_assert(lp_se / lp < 0.05 && r2se / kp < 0.01, "error bars too wide to test anything");
+  /* summary.json reports the same stretch's means and error bars */
+  cr_assert_eq(lw_test_sh("grep -q '^    \"from\": 4000,$' %s/wlc/summary.json", dir), 0);
+  char *js = lw_test_slurp("%s/wlc/summary.json", dir);
+  cr_assert_not_null(js);
+  const char *at = strstr(js, "\n    \"end2\": "), *se = strstr(js, "\n    \"end2_stderr\": ");
+  cr_assert(at && se, "%s", js);
+  cr_assert(fabs(strtod(at + 13, NULL) / r2 - 1.0) < 1e-9 && fabs(strtod(se + 20, NULL) / r2se - 1.0) < 1e-3,
+            "summary.json's end2 differs from the stats' %.10g +- %.4g", r2, r2se);
+  free(js);
   /* the table for people says the same, with the stretch it took */
-  snprintf(args, sizeof args, "stats %s/wlc --from 4000", dir);
+  snprintf(args, sizeof args, "stats %s/wlc", dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   cr_assert(strstr(out, "sweeps 4000 to 24000 at temperature 1: 4001 rows, one every 5 sweeps\n"), "%s", out);
   cr_assert(strstr(out, "\nobs_count                     50           0           0           -         -\n"), "%s",

@@ -65,30 +65,8 @@ static const char *scene(void)
   return buf;
 }
 
-/* The whole file (NUL-terminated, caller frees), or NULL. */
-static char *slurp(const char *fmt, ...)
-{
-  char path[512];
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(path, sizeof path, fmt, ap);
-  va_end(ap);
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  size_t cap = 4096, n = 0;
-  char *s = malloc(cap);
-  size_t got;
-  while ((got = fread(s + n, 1, cap - n - 1, f)) > 0) {
-    n += got;
-    if (n + 1 == cap) s = realloc(s, cap *= 2);
-  }
-  fclose(f);
-  s[n] = '\0';
-  return s;
-}
-
-static char *out_txt(void) { return slurp("%s/out.txt", dir); }
-static char *err_txt(void) { return slurp("%s/err.txt", dir); }
+static char *out_txt(void) { return lw_test_slurp("%s/out.txt", dir); }
+static char *err_txt(void) { return lw_test_slurp("%s/err.txt", dir); }
 
 /* ---- sweep.csv and summary.json --------------------------------------- */
 
@@ -117,7 +95,7 @@ static int split(char *line, char **out)
 static void csv_read(csv *t, const char *path)
 {
   memset(t, 0, sizeof *t);
-  t->text = slurp("%s", path);
+  t->text = lw_test_slurp("%s", path);
   cr_assert_not_null(t->text, "%s missing", path);
   char *save, *line = strtok_r(t->text, "\n", &save);
   cr_assert_not_null(line, "%s empty", path);
@@ -165,12 +143,12 @@ static void member(const char *json, const char *obj, const char *key, char *out
   snprintf(out, n, "%.*s", (int)(len < n ? len : n - 1), at);
 }
 
-/* Every energy, acceptance, close share and fidelity cell of row r equals
+/* Every energy, acceptance, close share, fidelity and observable cell of row r equals
 ** run/summary.json, text for text (the gatherer copies values, so the CSV is
 ** exact). */
 static void row_matches_summary(const csv *t, int r, const char *run)
 {
-  char *js = slurp("%s/%s/summary.json", dir, run);
+  char *js = lw_test_slurp("%s/%s/summary.json", dir, run);
   cr_assert_not_null(js, "%s/summary.json missing", run);
   char want[64];
   for (int c = 0; c < t->ncol; c++) {
@@ -178,6 +156,7 @@ static void row_matches_summary(const csv *t, int r, const char *run)
     if (!strncmp(h, "energy_", 7)) member(js, "energy", h + 7, want, sizeof want);
     else if (!strncmp(h, "acceptance_", 11)) member(js, "acceptance", h + 11, want, sizeof want);
     else if (!strncmp(h, "fidelity_", 9)) member(js, "fidelity", h + 9, want, sizeof want);
+    else if (!strncmp(h, "obs_", 4)) member(js, "observables", h + 4, want, sizeof want);
     else if (!strcmp(h, "seed") || !strcmp(h, "proposals_per_second") || !strcmp(h, "wall_seconds") ||
              !strcmp(h, "close_share"))
       member(js, NULL, h, want, sizeof want);
@@ -190,7 +169,7 @@ static void row_matches_summary(const csv *t, int r, const char *run)
 
 static double summary_total(const char *run)
 {
-  char *js = slurp("%s/%s/summary.json", dir, run);
+  char *js = lw_test_slurp("%s/%s/summary.json", dir, run);
   cr_assert_not_null(js, "%s/summary.json missing", run);
   char v[64];
   member(js, "energy", "total", v, sizeof v);
@@ -286,6 +265,33 @@ Test(tools, a_sweep_of_a_picture_gathers_the_drawings_scores)
   free(t.text);
 }
 
+/* A sweep of a study gathers summary.json's observables: each one's mean,
+** standard error and autocorrelation time, as the run reported them. */
+Test(tools, a_sweep_of_a_study_gathers_its_observables_with_error_bars)
+{
+  cr_assert_eq(sh("%s %s/params/wlc.ini --seeds 1-2 -j 2 --set anneal.sweeps=1500 --set output.stats_from=500 "
+                  "--bin %s --out %s/o", tool("seed-sweep"), env("LW_ROOT"), env("LW_BIN"), dir),
+               0, "%s", err_txt());
+  csv t;
+  char path[128];
+  snprintf(path, sizeof path, "%s/o/sweep.csv", dir);
+  csv_read(&t, path);
+  const char *want_cols[] = {"obs_count", "obs_length", "obs_end2", "obs_end2_stderr", "obs_end2_tau_sweeps",
+                             "obs_rg2", "obs_end_cos_stderr"};
+  for (size_t i = 0; i < sizeof want_cols / sizeof *want_cols; i++)
+    cr_assert(col(&t, want_cols[i]) >= 0, "no column %s", want_cols[i]);
+  cr_assert(col(&t, "obs_from") < 0 && col(&t, "obs_rows") < 0, "the stretch is not an observable");
+  cr_assert_eq(t.nrow, 2);
+  for (int r = 0; r < 2; r++) {
+    char run[32];
+    snprintf(run, sizeof run, "o/seed-%d", r + 1);
+    row_matches_summary(&t, r, run);
+    cr_assert_str_eq(cell(&t, r, "obs_count"), "50");
+    cr_assert(atof(cell(&t, r, "obs_end2_stderr")) > 0, "seed %d: no error bar", r + 1);
+  }
+  free(t.text);
+}
+
 static void set_old_mtime(const char *path)
 {
   struct timespec ts[2] = {{946684800, 0}, {946684800, 0}}; /* 2000-01-01 */
@@ -310,7 +316,7 @@ Test(tools, rerun_skips_finished_runs_and_redoes_missing_ones)
     snprintf(path, sizeof path, "%s/s/seed-1/%s", dir, files[i]);
     set_old_mtime(path);
   }
-  char *before = slurp("%s/s/seed-1/summary.json", dir);
+  char *before = lw_test_slurp("%s/s/seed-1/summary.json", dir);
   cr_assert_eq(sh("rm -r %s/s/seed-2", dir), 0);
 
   cr_assert_eq(sh(cmd, tool("seed-sweep"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
@@ -318,7 +324,7 @@ Test(tools, rerun_skips_finished_runs_and_redoes_missing_ones)
     snprintf(path, sizeof path, "%s/s/seed-1/%s", dir, files[i]);
     cr_assert_eq(mtime(path), 946684800, "finished run rewritten: %s", files[i]);
   }
-  char *after = slurp("%s/s/seed-1/summary.json", dir);
+  char *after = lw_test_slurp("%s/s/seed-1/summary.json", dir);
   cr_assert_str_eq(after, before);
   /* the deleted run is done again, to the same result (same seed) */
   cr_assert_eq(summary_total("s/seed-2"), e2);
@@ -344,7 +350,7 @@ Test(tools, interrupted_run_is_resumed_not_restarted)
   cr_assert_neq(access(path, F_OK), 0);
   cr_assert_eq(sh("%s %s --seeds 2 " TINY " --bin %s --out %s/a", tool("seed-sweep"), scene(), env("LW_BIN"), dir), 0,
                "%s", err_txt());
-  char *out = out_txt(), *log = slurp("%s/a/seed-2/linewise.log", dir);
+  char *out = out_txt(), *log = lw_test_slurp("%s/a/seed-2/linewise.log", dir);
   cr_assert(strstr(out, "seed-2: resumed"), "%s", out);
   cr_assert(log && strstr(log, "at sweep 7 of 20"), "%s", log);
   /* and ends where an uninterrupted run ends, bit for bit */
@@ -387,7 +393,7 @@ Test(tools, param_sweep_crosses_every_value_with_every_seed)
     snprintf(sub, sizeof sub, "p/%s", run);
     row_matches_summary(&t, r, sub);
     /* the run really used the value: its resolved scene says so */
-    char *ini = slurp("%s/p/%s/scene.ini", dir, run);
+    char *ini = lw_test_slurp("%s/p/%s/scene.ini", dir, run);
     char want[64];
     snprintf(want, sizeof want, "\nt_start = %s\n", ts);
     cr_assert(ini && strstr(ini, want), "%s: scene.ini lacks '%s'", run, want + 1);

@@ -149,6 +149,29 @@ static inline int lw_test_dir_make(char dir[64], const char *tag)
   return mkdtemp(dir) ? 0 : -1;
 }
 /* Runs a shell command built like printf; its exit status, or -1. */
+/* The whole file named by the format (NUL-terminated, caller frees), or NULL. */
+static inline char *lw_test_slurp(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static inline char *lw_test_slurp(const char *fmt, ...)
+{
+  char path[512];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(path, sizeof path, fmt, ap);
+  va_end(ap);
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  size_t cap = 4096, n = 0;
+  char *s = malloc(cap);
+  size_t got;
+  while ((got = fread(s + n, 1, cap - n - 1, f)) > 0) {
+    n += got;
+    if (n + 1 == cap) s = realloc(s, cap *= 2);
+  }
+  fclose(f);
+  s[n] = '\0';
+  return s;
+}
+
 static inline int lw_test_sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 static inline int lw_test_sh(const char *fmt, ...)
 {

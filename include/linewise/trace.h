@@ -8,6 +8,8 @@
 #include <stdio.h>
 
 #include "linewise/error.h"
+#include "linewise/params.h"
+#include "linewise/series.h"
 
 typedef struct {
   size_t n_cols, n_rows;
@@ -36,6 +38,23 @@ typedef struct {
   long tune, steps, sweeps;
   int csv;       /* 1: one CSV line per column; 0: a table for people */
 } lw_trace_select;
+
+/* From a run's parameters: the tuning that the rows leave out, and from =
+** output.stats_from where it is set and sel->from is not. */
+void lw_trace_select_of(const lw_params *p, lw_trace_select *sel);
+
+/* The rows sel chooses: their indices into *rows (malloc'd: free it), their
+** count *n, and *tuned the rows left out for tuning.  LW_EINPUT naming path
+** for a trace without a sweep count column or with no row chosen. */
+lw_status lw_trace_rows(const lw_trace *t, const char *path, const lw_trace_select *sel, size_t **rows, size_t *n,
+                        size_t *tuned, lw_error *err);
+
+/* The rows' spacing in sweeps (output.trace_every), from the first two. */
+double lw_trace_every(const lw_trace *t);
+
+/* The statistics of column col over the n rows, empty fields skipped (out->n
+** = 0 when every one is empty); x is scratch for n values. */
+void lw_trace_column_stats(const lw_trace *t, const size_t *rows, size_t n, int col, double *x, lw_series_stats *out);
 
 /* Prints the statistics (series.h) of every column but the sweep and
 ** temperature or time (and the rungs' temperatures) over the rows chosen,
