@@ -63,6 +63,39 @@ Test(series, the_autocorrelation_time_of_an_ar1_series)
   gsl_rng_free(r);
 }
 
+/* A window past the directly summed lags takes every lag by FFT: the same
+** tau as summing each lag, to rounding. */
+Test(series, a_long_window_by_fft_matches_the_direct_sums)
+{
+  const double phi = 0.98; /* tau 49.5: a window of about 250 lags */
+  const size_t n = 20000;
+  double *x = malloc(2 * n * sizeof *x);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 12);
+  ar1(r, phi, x, n);
+  ar1(r, phi, x + n, n);
+  double m[2] = {0, 0}, c0 = 0, tau = 0.5;
+  for (int j = 0; j < 2; j++) {
+    for (size_t t = 0; t < n; t++) m[j] += x[j * n + t] / (double)n;
+    for (size_t t = 0; t < n; t++) c0 += (x[j * n + t] - m[j]) * (x[j * n + t] - m[j]);
+  }
+  size_t k = 1;
+  for (; k < n / 2; k++) {
+    double ck = 0;
+    for (int j = 0; j < 2; j++)
+      for (size_t t = 0; t + k < n; t++) ck += (x[j * n + t] - m[j]) * (x[j * n + t + k] - m[j]);
+    tau += ck / c0 * (double)n / (double)(n - k);
+    if ((double)k >= 5.0 * tau) break;
+  }
+  size_t w;
+  double got = lw_series_tau(x, 2, n, &w);
+  cr_log_info("pooled AR(1) phi 0.98: tau %.6f by FFT, %.6f summed, windows %zu and %zu", got, tau, w, k);
+  cr_assert(k > 64 && w == k && fabs(got / tau - 1.0) < 1e-10, "tau %.12g (window %zu) against %.12g (%zu)", got, w,
+            tau, k);
+  free(x);
+  gsl_rng_free(r);
+}
+
 Test(series, error_bars_cover_the_true_mean_as_often_as_they_claim)
 {
   /* 400 independent AR(1) series (phi 0.9, tau 9.5) of 4000 values, true
