@@ -212,16 +212,11 @@ static lw_status setup_system(lw_anneal *a, lw_error *err)
     return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.quench': the %s system has no gradient to quench with; "
                         "expected none", where, a->sys_type->name);
   }
-  if (a->params.observables && (!a->sys_type->observe || (a->net && a->net->size > 1))) {
-    /* over MPI the coldest rung's state may live in another process than
-    ** the one writing the trace, which holds only its energies */
+  if (a->params.observables && !a->sys_type->observe) {
     char where[LW_PATH_MAX + 32];
     lw_params_origin(&a->params, lw_params_find("output", "observables"), where, sizeof where);
-    if (!a->sys_type->observe)
-      return lw_error_set(err, LW_EINPUT, "%s: key 'output.observables': the %s system has no observables; "
-                          "expected 0", where, a->sys_type->name);
-    return lw_error_set(err, LW_EINPUT, "%s: key 'output.observables': linewise-mpi over %d processes does not "
-                        "write observables yet; expected 0 (or one process)", where, a->net->size);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'output.observables': the %s system has no observables; "
+                        "expected 0", where, a->sys_type->name);
   }
   a->setup = a->sys_type->setup_new(&a->params, err);
   return a->setup ? LW_OK : err->code;
@@ -320,12 +315,10 @@ static void trace_header_end(lw_anneal *a)
   fprintf(a->trace, "\n");
 }
 
-static void trace_row_end(lw_anneal *a)
+static void trace_row_end(lw_anneal *a, const double *v)
 {
   const lw_system_type *t = a->sys_type;
   if (a->params.observables) {
-    double v[LW_OBSERVABLES_MAX];
-    t->observe(a->sys->state, v);
     for (int k = 0; k < t->n_observables; k++)
       if (isnan(v[k])) fprintf(a->trace, ",");
       else fprintf(a->trace, ",%.10g", v[k]);
@@ -568,9 +561,20 @@ out:
 
 static void trace_row(lw_anneal *a)
 {
+  /* the observables come from the process that sweeps the replica at rung
+  ** 0 (every process holds every replica, but the others' are stand-ins:
+  ** anneal_net.h), so every process takes part before all but the one
+  ** writing the trace return */
+  const lw_system_type *t = a->sys_type;
+  double v[LW_OBSERVABLES_MAX];
+  if (a->params.observables) {
+    if (rung_here(a, 0)) t->observe(a->sys->state, v);
+    if (a->net)
+      a->net->broadcast(a->net, lw_anneal_net_owner(a->pt ? a->pt->at[0] : 0, a->n_rep, a->net->size), v,
+                        t->n_observables);
+  }
   if (!a->trace) return; /* another process writes it */
   lw_chain *c = a->chain;
-  const lw_system_type *t = a->sys_type;
   double term[LW_SYSTEM_TERMS_MAX];
   t->terms(a->sys->state, term);
   if (a->dyn) {
@@ -579,7 +583,7 @@ static void trace_row(lw_anneal *a)
     for (int k = 0; k < t->n_terms; k++)
       if (t->term_on(a->setup, k)) fprintf(a->trace, ",%.10g", term[k]);
     fprintf(a->trace, ",%.17g,%.17g,%.17g", pot, kin, pot + kin);
-    trace_row_end(a);
+    trace_row_end(a, v);
     return;
   }
   fprintf(a->trace, "%ld,%.10g", a->sweep, c->temperature);
@@ -606,7 +610,7 @@ static void trace_row(lw_anneal *a)
       a->swap_mark[2 * k + 1] = a->pt->accepted[k];
     }
   }
-  trace_row_end(a);
+  trace_row_end(a, v);
 }
 
 /* ladder.ini: the tuned ladder, ready to paste into a scene or --set. */

@@ -39,6 +39,9 @@ struct lw_anneal_net {
   /* After a drift check of the local replicas (s: its status): the largest
   ** drift and the status agreed. */
   lw_status (*drift)(lw_anneal_net *net, struct lw_anneal *a, lw_status s, lw_error *err);
+  /* At a trace row, collectively: the n values v of process root (the one
+  ** that sweeps the replica at rung 0: its observables), everywhere. */
+  void (*broadcast)(lw_anneal_net *net, int root, double *v, int n);
   /* The whole checkpoint, collectively (replaces lw_checkpoint_write). */
   lw_status (*checkpoint)(lw_anneal_net *net, struct lw_anneal *a, lw_error *err);
 };

@@ -191,6 +191,12 @@ static void chain_unpack(lw_chain *c, const unsigned char *b)
 ** processes A (the one now at k+1) and B, A swept rung k's chain and B
 ** rung k+1's, and each now needs the other's: one exchange of two small
 ** messages per such pair, in rung order on both sides. */
+static void broadcast(lw_anneal_net *net, int root, double *v, int n)
+{
+  (void)net;
+  MPI_Bcast(v, n, MPI_DOUBLE, root, comm);
+}
+
 static lw_status moved(lw_anneal_net *net, lw_anneal *a, const int *swapped, lw_error *err)
 {
   int n = a->n_rep;
@@ -477,6 +483,7 @@ lw_anneal_net *lw_mpi_init(int *argc, char ***argv, volatile sig_atomic_t *stop)
   m.net.moved = moved;
   m.net.drift = drift;
   m.net.checkpoint = checkpoint;
+  m.net.broadcast = broadcast;
   m.stop = stop;
   return &m.net;
 }
