@@ -529,7 +529,15 @@ Test(tools, plot_run_draws_energy_temperature_and_acceptance)
   check_png("r/plots/temperature.png");
   check_png("r/plots/acceptance.png");
   cr_assert(!exists("r/plots/replicas.png") && !exists("r/plots/swaps.png"), "no tempering, no tempering plots");
+  cr_assert(!exists("r/plots/observables.png"), "no observables traced, no plot of them");
   cr_assert_eq(sh("%s %s/nothing", tool("plot-run"), dir), 2);
+  /* observables get their own panels, drawn after the swaps' bars (whose
+  ** settings once left the observables' data unread) */
+  cr_assert_eq(sh("%s run %s " TINY " --quiet --out %s/o --set output.observables=1 --set tempering.replicas=2",
+                  env("LW_BIN"), scene(), dir), 0);
+  cr_assert_eq(sh("%s %s/o", tool("plot-run"), dir), 0, "%s", err_txt());
+  check_png("o/plots/swaps.png");
+  check_png("o/plots/observables.png");
 }
 
 static void write_text(const char *name, const char *text)
