@@ -603,6 +603,11 @@ Test(tools, plot_sweep_draws_a_png_beside_the_csv)
                            "1,0.5,2.5,0.1,a\n2,0.5,1.5,0.1,b\n1,2,3.5,0.1,c\n2,2,3.25,0.1,d\n");
   cr_assert_eq(sh("%s %s/params.csv --y wall_seconds", tool("plot-sweep"), dir), 0, "%s", err_txt());
   check_png("params-wall_seconds.png");
+  /* a column with its own error bar draws each run's */
+  write_text("obs.csv", "seed,anneal.t_start,energy_total,obs_end2,obs_end2_stderr,run\n"
+                        "1,0.5,2.5,15.1,0.04,a\n2,0.5,1.5,15.3,0.03,b\n1,1,3.5,14.5,0.06,c\n2,1,3.25,14.55,,d\n");
+  cr_assert_eq(sh("%s %s/obs.csv --y obs_end2", tool("plot-sweep"), dir), 0, "%s", err_txt());
+  check_png("obs-obs_end2.png");
   write_text("words.csv", "seed,anneal.schedule,energy_total,run\n1,linear,2.5,a\n1,geometric,1.5,b\n");
   cr_assert_eq(sh("%s %s/words.csv --out %s/w.png", tool("plot-sweep"), dir, dir), 0, "%s", err_txt());
   check_png("w.png");

@@ -58,9 +58,11 @@ void lw_trace_column_stats(const lw_trace *t, const size_t *rows, size_t n, int 
 
 /* Prints the statistics (series.h) of every column but the sweep and
 ** temperature or time (and the rungs' temperatures) over the rows chosen,
-** then a warning line per column whose halves disagree (series.h's
-** drift_z beyond 4) or whose autocorrelation window did not close.  path
-** names the file in messages.  LW_EINPUT when no row is chosen. */
+** as a table or CSV (sel->csv); the table is followed by one warning line
+** per kind of trouble, naming its columns: a window that did not close,
+** fewer than 25 independent samples, halves that disagree (series.h's
+** drift_z beyond 4), a temperature that changes.  path names the file in
+** messages.  LW_EINPUT when no row is chosen. */
 lw_status lw_trace_stats(const lw_trace *t, const char *path, const lw_trace_select *sel, FILE *out,
                          lw_error *err);
 
