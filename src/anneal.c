@@ -212,6 +212,12 @@ static lw_status setup_system(lw_anneal *a, lw_error *err)
     return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.quench': the %s system has no gradient to quench with; "
                         "expected none", where, a->sys_type->name);
   }
+  if (a->params.samples_every && !a->sys_type->write_sample) {
+    char where[LW_PATH_MAX + 32];
+    lw_params_origin(&a->params, lw_params_find("output", "samples_every"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'output.samples_every': the %s system writes no samples; "
+                        "expected 0", where, a->sys_type->name);
+  }
   if (a->params.observables && !a->sys_type->observe) {
     char where[LW_PATH_MAX + 32];
     lw_params_origin(&a->params, lw_params_find("output", "observables"), where, sizeof where);
@@ -664,13 +670,31 @@ static lw_status exchange(lw_anneal *a, lw_error *err)
   return LW_OK;
 }
 
-/* Frames and checkpoints that fall due after a sweep.  Frames are extra
-** files: they read the state and change nothing. */
+/* samples/sample-SSSSSS.csv: the coldest replica's configuration, written
+** whole under a temporary name and renamed.  A run resumed from an earlier
+** checkpoint writes the same bytes again, so no sample needs undoing. */
+static lw_status write_sample(lw_anneal *a, lw_error *err)
+{
+  char path[LW_PATH_MAX + 64], tmp[LW_PATH_MAX + 96];
+  dir_file(path, sizeof path, a, "samples");
+  if (mkdir(path, 0777) && errno != EEXIST) return lw_error_set(err, LW_EIO, "%s: %s", path, strerror(errno));
+  size_t n = strlen(path);
+  snprintf(path + n, sizeof path - n, "/sample-%06ld.csv", a->sweep);
+  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
+  if (!f) return err->code;
+  a->sys_type->write_sample(a->sys->state, f);
+  return lw_output_commit(f, tmp, path, err);
+}
+
+/* Frames, samples and checkpoints that fall due after a sweep.  Frames and
+** samples are extra files: they read the state and change nothing. */
 static lw_status sweep_files(lw_anneal *a, lw_error *err)
 {
   const lw_params *p = &a->params;
   if (p->frames_every && a->sweep % p->frames_every == 0 && rung_here(a, 0) &&
       a->sys_type->draw(a->sys->state, p, a->dir, a->sweep, err))
+    return err->code;
+  if (p->samples_every && a->sweep % p->samples_every == 0 && rung_here(a, 0) && write_sample(a, err))
     return err->code;
   if (a->sweep % p->checkpoint_every == 0) return lw_anneal_checkpoint(a, err);
   return LW_OK;

@@ -398,6 +398,11 @@ const lw_param_def lw_param_table[] = {
       "the curve; for particles the count, squared "
       "radius of gyration, rms distance from the best plane and the order of the normals; "
       "docs/FORMATS.md). `linewise stats DIR` gives their means with error bars."),
+  NUM("output", "samples_every", LW_PT_INT, samples_every, "0", "sweeps", 0, 2e9, 0,
+      "Sweeps between samples of the coldest replica's configuration, samples/sample-SSSSSS.csv: every "
+      "degree of freedom with 17 digits (splines: spline,node,px,py,vx,vy; D-NURBS: point,x,y,w; "
+      "particles: particle,x,y,z,qw,qx,qy,qz,pinned; docs/FORMATS.md), for studies of distributions "
+      "and correlations. 0 = none."),
   NUM("output", "stats_from", LW_PT_INT, stats_from, "0", "sweeps", 0, 2e9, 0,
       "First sweep of the stretch of trace.csv whose statistics `linewise stats DIR` takes by default and "
       "summary.json reports for the observables (their means, standard errors and autocorrelation times): "

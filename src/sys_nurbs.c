@@ -958,6 +958,16 @@ static void observe(const void *state, double *out)
   out[3] = n0 > 0.0 && n1 > 0.0 ? (t0[0] * t1[0] + t0[1] * t1[1]) / (n0 * n1) : 0.0;
 }
 
+/* A sample of the configuration (system.h): the control points and weights
+** (the knots are the scene's and never move). */
+static void write_sample(const void *state, FILE *f)
+{
+  const lw_nurbs *c = ((const lw_nurbs_state *)state)->c;
+  fputs("point,x,y,w\n", f);
+  for (size_t i = 0; i < c->n; i++)
+    fprintf(f, "%zu,%.17g,%.17g,%.17g\n", i, c->P[2 * i], c->P[2 * i + 1], c->w[i]);
+}
+
 static void describe(const void *state, int what, char *buf, size_t n)
 {
   const lw_nurbs_state *s = state;
@@ -1015,4 +1025,5 @@ const lw_system_type lw_system_nurbs = {
     .n_observables = (int)(sizeof observable_names / sizeof observable_names[0]),
     .observable_names = observable_names,
     .observe = observe,
+    .write_sample = write_sample,
 };

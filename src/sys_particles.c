@@ -454,6 +454,19 @@ static void observe(const void *state, double *out)
   out[3] = 1.5 * ev[2] - 0.5;
 }
 
+/* A sample of the configuration (system.h): each particle's position,
+** unit quaternion (its normal is the third column of the rotation) and pin. */
+static void write_sample(const void *state, FILE *f)
+{
+  const lw_particles *p = state;
+  fputs("particle,x,y,z,qw,qx,qy,qz,pinned\n", f);
+  for (size_t i = 0; i < p->n; i++) {
+    const double *x = p->x + 3 * i, *q = p->q + 4 * i;
+    fprintf(f, "%zu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%d\n", i, x[0], x[1], x[2], q[0], q[1], q[2], q[3],
+            p->pin[i] != 0);
+  }
+}
+
 static void describe(const void *state, int what, char *buf, size_t n)
 {
   const lw_particles *p = state;
@@ -466,6 +479,7 @@ static void describe(const void *state, int what, char *buf, size_t n)
     .n_observables = (int)(sizeof observable_names / sizeof observable_names[0]), \
     .observable_names = observable_names, \
     .observe = observe, \
+    .write_sample = write_sample, \
     .move_names = lw_particles_move_names, \
     .move_unit = move_unit, \
     .n_terms = LW_PTERM_COUNT, \

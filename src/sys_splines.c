@@ -1188,6 +1188,18 @@ static void observe(const void *state, double *out)
   for (int k = 0; k < 4; k++) out[k + 1] = sp->n_splines ? sum[k] / (double)sp->n_splines : NAN;
 }
 
+/* A sample of the configuration (system.h): every node of every spline. */
+static void write_sample(const void *state, FILE *f)
+{
+  const lw_splines *sp = ((const spl_state *)state)->m->sp;
+  fputs("spline,node,px,py,vx,vy\n", f);
+  for (size_t i = 0; i < sp->n_splines; i++)
+    for (size_t k = sp->first[i]; k < sp->first[i + 1]; k++) {
+      const lw_node *nd = &sp->node[k];
+      fprintf(f, "%zu,%zu,%.17g,%.17g,%.17g,%.17g\n", i, k - sp->first[i], nd->px, nd->py, nd->vx, nd->vy);
+    }
+}
+
 static void describe(const void *state, int what, char *buf, size_t n)
 {
   const spl_state *s = state;
@@ -1291,6 +1303,7 @@ static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinne
   .n_observables = (int)(sizeof observable_names / sizeof observable_names[0]), \
   .observable_names = observable_names, \
   .observe = observe, \
+  .write_sample = write_sample, \
   .split = split, \
   .group = group, \
   .propose_in = propose_in, \

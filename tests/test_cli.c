@@ -407,7 +407,8 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
 {
   char out[8192], errs[1024], args[512];
   const double lp = 10.0, l0 = 1.0;
-  snprintf(args, sizeof args, "run %s/params/wlc.ini --out %s/wlc --quiet", lw_test_root(), dir);
+  snprintf(args, sizeof args, "run %s/params/wlc.ini --out %s/wlc --quiet --set output.samples_every=6000",
+           lw_test_root(), dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   snprintf(args, sizeof args, "stats %s/wlc --csv", dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
@@ -441,11 +442,39 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
   cr_assert(strstr(out, "\nobs_count                     50           0           0           -         -\n"), "%s",
             out);
   /* stopped and resumed: the same trace, byte for byte */
-  snprintf(args, sizeof args, "run %s/params/wlc.ini --out %s/half --quiet --stop-at 10000", lw_test_root(), dir);
+  snprintf(args, sizeof args, "run %s/params/wlc.ini --out %s/half --quiet --stop-at 10000 "
+           "--set output.samples_every=6000", lw_test_root(), dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   snprintf(args, sizeof args, "resume %s/half --quiet", dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   cr_assert_eq(lw_test_sh("cmp -s %s/wlc/trace.csv %s/half/trace.csv", dir, dir), 0, "the resumed trace differs");
+  cr_assert_eq(lw_test_sh("diff -r %s/wlc/samples %s/half/samples", dir, dir), 0, "the resumed samples differ");
+  /* the samples: at sweeps 6000 .. 24000, each every node of the 50 chains;
+  ** the last one's mean squared end-to-end distance is the last trace
+  ** row's obs_end2 (both of the state after sweep 24000) */
+  cr_assert_eq(lw_test_sh("test \"$(ls %s/wlc/samples | tr '\\n' ' ')\" = "
+                          "'sample-006000.csv sample-012000.csv sample-018000.csv sample-024000.csv '", dir), 0);
+  char *smp = lw_test_slurp("%s/wlc/samples/sample-024000.csv", dir), *tr = lw_test_slurp("%s/wlc/trace.csv", dir);
+  cr_assert(smp && tr && !strncmp(smp, "spline,node,px,py,vx,vy\n", 24));
+  double p0[2] = {0, 0}, sum = 0;
+  int rows = 0, spl, node;
+  for (const char *l = strchr(smp, '\n') + 1; *l; l = strchr(l, '\n') + 1, rows++) {
+    double px, py;
+    cr_assert_eq(sscanf(l, "%d,%d,%lf,%lf", &spl, &node, &px, &py), 4, "%.60s", l);
+    if (node == 0) p0[0] = px, p0[1] = py;
+    if (node == 4) sum += (px - p0[0]) * (px - p0[0]) + (py - p0[1]) * (py - p0[1]);
+  }
+  cr_assert_eq(rows, 250, "50 chains of 5 nodes");
+  /* the column of obs_end2 in the header, and that field of the last row */
+  int col = 0;
+  for (const char *h = tr; h < strstr(tr, "obs_end2,"); h++) col += *h == ',';
+  const char *last = tr + strlen(tr) - 1;
+  while (last > tr && last[-1] != '\n') last--;
+  for (int k = 0; k < col; k++) last = strchr(last, ',') + 1;
+  double want = strtod(last, NULL);
+  cr_assert(fabs(sum / 50.0 / want - 1.0) < 1e-9, "sample end2 %.10g, trace %.10g", sum / 50.0, want);
+  free(smp);
+  free(tr);
 }
 
 Test(cli, stats_refuses_a_missing_run_and_a_bad_option_in_one_line)

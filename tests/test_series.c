@@ -366,3 +366,99 @@ Test(observables, a_straight_nurbs_curve_has_the_shape_of_a_line)
             fabs(v[3] - 1.0) < 1e-15, "%.12g %.12g %.12g %.12g", v[0], v[1], v[2], v[3]);
   lw_nurbs_free(c);
 }
+
+/* ---- samples ------------------------------------------------------------- */
+
+/* The text a row's write_sample gives for state (caller frees). */
+static char *sample_text(const lw_system_type *t, const void *state)
+{
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *f = open_memstream(&buf, &len);
+  cr_assert_not_null(f);
+  cr_assert_not_null(t->write_sample, "the %s row writes no samples", t->name);
+  t->write_sample(state, f);
+  fclose(f);
+  return buf;
+}
+
+Test(samples, every_system_writes_its_degrees_of_freedom_to_the_bit)
+{
+  lw_error err;
+  /* splines: a row per node, in spline and node order */
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = p.height = 100;
+  lw_scene sc;
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
+  size_t segs[2] = {1, 4};
+  lw_splines *sp = lw_splines_new(2, segs, &err);
+  lw_test_straight(sp, 0, 10.0 / 3.0, 20.0, 40.0, 20.0 + M_PI);
+  lw_test_circle(sp, 1, 50.0, 50.0, 7.0);
+  lw_model *m = lw_model_new(&sc, sp, &err);
+  cr_assert_not_null(m, "%s", err.msg);
+  lw_system *sys = lw_splines_view(m, &err);
+  char *txt = sample_text(sys->type, sys->state);
+  cr_assert(!strncmp(txt, "spline,node,px,py,vx,vy\n", 24), "%s", txt);
+  const char *l = strchr(txt, '\n') + 1;
+  for (size_t k = 0; k < m->sp->n_nodes; k++, l = strchr(l, '\n') + 1) {
+    int i, j;
+    double v[4];
+    cr_assert_eq(sscanf(l, "%d,%d,%lf,%lf,%lf,%lf", &i, &j, &v[0], &v[1], &v[2], &v[3]), 6, "%s", l);
+    const lw_node *nd = &m->sp->node[m->sp->first[i] + (size_t)j];
+    cr_assert(m->sp->first[i] + (size_t)j == k && v[0] == nd->px && v[1] == nd->py && v[2] == nd->vx && v[3] == nd->vy,
+              "node %zu: %s", k, l);
+  }
+  cr_assert_eq(*l, '\0', "rows past the nodes");
+  free(txt);
+  lw_system_free(sys);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+
+  /* D-NURBS: control points and weights */
+  const double knot[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+  double P[8] = {0, 0, 1.0 / 3.0, 1, 2, -1, 3, M_PI}, w[4] = {1, 0.7, 1.3, 1};
+  lw_nurbs *c = lw_nurbs_new(4, 4, knot, P, w, &err);
+  cr_assert_not_null(c, "%s", err.msg);
+  lw_nurbs_state ns = {.c = c};
+  txt = sample_text(&lw_system_nurbs, &ns);
+  cr_assert(!strncmp(txt, "point,x,y,w\n", 12), "%s", txt);
+  l = strchr(txt, '\n') + 1;
+  for (int i = 0; i < 4; i++, l = strchr(l, '\n') + 1) {
+    int k;
+    double v[3];
+    cr_assert_eq(sscanf(l, "%d,%lf,%lf,%lf", &k, &v[0], &v[1], &v[2]), 4, "%s", l);
+    cr_assert(k == i && v[0] == P[2 * i] && v[1] == P[2 * i + 1] && v[2] == w[i], "%s", l);
+  }
+  free(txt);
+  lw_nurbs_free(c);
+
+  /* particles: position, quaternion, pin */
+  lw_params prm;
+  lw_params_defaults(&prm);
+  strcpy(prm.system, "particles");
+  prm.pt_alpha_lj = 1.0;
+  lw_particles_setup *s = lw_particles_setup_new(&prm, &err);
+  cr_assert_not_null(s, "%s", err.msg);
+  double x[6] = {0.1, 0.2, 1.0 / 3.0, 1.5, 0.25, 0.0}, q[8], nrm[3] = {0.6, 0.0, 0.8};
+  unsigned char pin[2] = {0, 1};
+  lw_quat_from_normal(nrm, q);
+  lw_quat_from_normal(nrm + 0, q + 4);
+  lw_particles *pp = lw_particles_new_from(s, 2, x, q, pin, &err);
+  cr_assert_not_null(pp, "%s", err.msg);
+  txt = sample_text(&lw_system_particles, pp);
+  cr_assert(!strncmp(txt, "particle,x,y,z,qw,qx,qy,qz,pinned\n", 34), "%s", txt);
+  l = strchr(txt, '\n') + 1;
+  for (int i = 0; i < 2; i++, l = strchr(l, '\n') + 1) {
+    int k, pinned;
+    double v[7];
+    cr_assert_eq(sscanf(l, "%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d", &k, &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6],
+                        &pinned), 9, "%s", l);
+    cr_assert(k == i && pinned == pin[i], "%s", l);
+    for (int a = 0; a < 3; a++) cr_assert(v[a] == pp->x[3 * i + a], "%s", l);
+    for (int a = 0; a < 4; a++) cr_assert(v[3 + a] == pp->q[4 * i + a], "%s", l);
+  }
+  free(txt);
+  lw_particles_free(pp);
+  lw_particles_setup_free(s);
+}

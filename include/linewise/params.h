@@ -168,6 +168,7 @@ typedef struct {
   int trace_every;            /* sweeps per trace.csv row */
   int observables;            /* 1 = the system's observables in trace.csv */
   int stats_from;             /* first sweep of the stretch the statistics take (0: the final temperature's) */
+  int samples_every;          /* sweeps between samples/sample-SSSSSS.csv (0: none) */
   double pen_width;           /* stroke of every pen, mm */
   int pens;                   /* pens (Inkscape layers), 1..16 */
   char pen_colors[LW_PATH_MAX]; /* "#rrggbb ..." one per pen; empty = black */

@@ -47,6 +47,7 @@
 
 #include <gsl/gsl_rng.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include "linewise/error.h"
 #include "linewise/json.h"
@@ -268,6 +269,11 @@ struct lw_system_type {
   int n_observables;
   const char *const *observable_names;
   void (*observe)(const void *state, double *out);
+  /* Optional (NULL: output.samples_every is refused): the state's degrees
+  ** of freedom as CSV, a header line and a row per point (for splines
+  ** spline,node,px,py,vx,vy), every number with 17 digits, for studies that
+  ** read configurations (samples/sample-SSSSSS.csv, docs/FORMATS.md). */
+  void (*write_sample)(const void *state, FILE *f);
 
   const char *files;
   lw_status (*draw)(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err);
