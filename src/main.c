@@ -55,12 +55,14 @@ static const char usage[] =
   "                      prints '<term> <value>' per enabled term, then 'total <value>'\n"
   "      --set SEC.KEY=VAL   with a key of the scene changed (repeatable): with\n"
   "                          energy.quadrature=32, what the run's nodes leave out\n"
-  "  stats DIR           means with error bars of DIR/trace.csv's columns (their\n"
+  "  stats DIR...        means with error bars of DIR/trace.csv's columns (their\n"
   "                      integrated autocorrelation times), by default over the final\n"
-  "                      temperature's sweeps after its tuning\n"
+  "                      temperature's sweeps (or from output.stats_from), tuning left\n"
+  "                      out; with several runs (seeds) also whether they agree\n"
   "      --from S, --to S    only the rows of sweeps S to S (inclusive)\n"
   "      --csv               one CSV line a column: column,n,mean,stderr,sd,\n"
-  "                          tau_sweeps,n_eff,window_closed,drift_z\n"
+  "                          tau_sweeps,n_eff,window_closed,drift_z (several runs:\n"
+  "                          column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs)\n"
   "  params              print every scene parameter as Markdown (docs/PARAMETERS.md)\n"
   "  schedules           print the temperature schedules as Markdown (docs/SCHEDULES.md)\n"
   "  help                this text\n"
@@ -533,49 +535,58 @@ static int cmd_resume(int argc, char **argv)
   return rc;
 }
 
-/* stats DIR [--from S] [--to S] [--csv]: the means with error bars of the
-** columns of DIR/trace.csv (trace.h); the run's scene.ini gives the tuning
-** sweeps that the default stretch leaves out. */
+/* stats DIR... [--from S] [--to S] [--csv]: the means with error bars of
+** the columns of DIR/trace.csv (trace.h), and with several runs whether
+** they agree; each run's scene.ini gives its tuning sweeps and stats_from. */
 static int cmd_stats(int argc, char **argv)
 {
+  static const char use[] = "(usage: linewise stats DIR... [--from S] [--to S] [--csv])";
   lw_error err;
   lw_error_clear(&err);
-  const char *dir = NULL;
-  lw_trace_select sel = {.from = -1, .to = -1};
-  for (int i = 0; i < argc; i++) {
+  const char **dir = calloc((size_t)argc + 1, sizeof *dir);
+  int k = 0;
+  lw_trace_select base = {.from = -1, .to = -1};
+  for (int i = 0; dir && i < argc; i++) {
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
     if (!strcmp(argv[i], "--from") || !strcmp(argv[i], "--to")) {
-      if (!parse_count(argv[i], v, LW_STATE_SWEEP_MAX, argv[i][2] == 'f' ? &sel.from : &sel.to, &err))
-        return fail(&err);
+      if (!parse_count(argv[i], v, LW_STATE_SWEEP_MAX, argv[i][2] == 'f' ? &base.from : &base.to, &err)) break;
       i++;
     } else if (!strcmp(argv[i], "--csv")) {
-      sel.csv = 1;
-    } else if (argv[i][0] == '-' || dir) {
-      lw_error_set(&err, LW_EUSAGE, "stats: unexpected '%s' (usage: linewise stats DIR [--from S] [--to S] [--csv])",
-                   argv[i]);
-      return fail(&err);
+      base.csv = 1;
+    } else if (argv[i][0] == '-') {
+      lw_error_set(&err, LW_EUSAGE, "stats: unexpected '%s' %s", argv[i], use);
+      break;
     } else {
-      dir = argv[i];
+      dir[k++] = argv[i];
     }
   }
-  if (!dir) {
-    lw_error_set(&err, LW_EUSAGE, "stats: expected a run directory (usage: linewise stats DIR [--from S] [--to S] "
-                 "[--csv])");
-    return fail(&err);
-  }
+  if (!dir) lw_error_set(&err, LW_ENOMEM, "out of memory");
+  else if (!err.code && !k) lw_error_set(&err, LW_EUSAGE, "stats: expected a run directory %s", use);
+  lw_trace **t = err.code ? NULL : calloc((size_t)k, sizeof *t);
+  lw_trace_select *sel = t ? calloc((size_t)k, sizeof *sel) : NULL;
+  char **path = sel ? calloc((size_t)k, sizeof *path) : NULL;
+  if (!err.code && !path) lw_error_set(&err, LW_ENOMEM, "out of memory");
   static lw_params p;
-  char path[LW_PATH_MAX + 32];
-  lw_path_join(path, sizeof path, dir, "scene.ini");
-  if (lw_params_read_run(&p, path, &err)) return fail(&err);
-  lw_trace_select_of(&p, &sel);
-  lw_path_join(path, sizeof path, dir, "trace.csv");
-  lw_trace *t = lw_trace_read(path, &err);
-  if (!t || lw_trace_stats(t, path, &sel, stdout, &err)) {
-    lw_trace_free(t);
-    return fail(&err);
+  for (int r = 0; !err.code && r < k; r++) {
+    char where[LW_PATH_MAX + 32];
+    lw_path_join(where, sizeof where, dir[r], "scene.ini");
+    if (lw_params_read_run(&p, where, &err)) break;
+    sel[r] = base;
+    lw_trace_select_of(&p, &sel[r]);
+    lw_path_join(where, sizeof where, dir[r], "trace.csv");
+    if (!(path[r] = strdup(where))) lw_error_set(&err, LW_ENOMEM, "out of memory");
+    else t[r] = lw_trace_read(where, &err);
   }
-  lw_trace_free(t);
-  return 0;
+  if (!err.code) lw_trace_stats_runs((const lw_trace *const *)t, (const char *const *)path, sel, k, stdout, &err);
+  for (int r = 0; path && r < k; r++) {
+    lw_trace_free(t[r]);
+    free(path[r]);
+  }
+  free(path);
+  free(sel);
+  free(t);
+  free(dir);
+  return err.code ? fail(&err) : 0;
 }
 
 /* "linewise CMD --help" prints the usage and exits 0. */

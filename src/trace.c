@@ -4,6 +4,7 @@
 #include "linewise/trace.h"
 
 #include <errno.h>
+#include <gsl/gsl_cdf.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -159,10 +160,19 @@ static long default_from(const lw_trace *t, int sweep)
   return (long)at(t, r, sweep);
 }
 
-enum { WARN_OPEN, WARN_FEW, WARN_DRIFT };
+enum { WARN_OPEN, WARN_FEW, WARN_DRIFT, WARN_RUNS };
 
-/* Whether a column with spread has problem `what`. */
-static int has_problem(const lw_series_stats *s, int what)
+/* A column's statistics: per run (k of them), and with several runs what
+** they say together. */
+typedef struct {
+  lw_series_stats *run; /* k */
+  double mean, stderr_mean, sd, tau_sweeps, n_eff;
+  double r_hat;         /* Gelman and Rubin's potential scale reduction */
+  double p_runs;        /* chi-square probability of the runs' means under their error bars */
+} column_stats;
+
+/* Whether a run's column with spread has problem `what` (one run's kinds). */
+static int run_problem(const lw_series_stats *s, int what)
 {
   if (!s->n || !(s->sd > 0.0)) return 0;
   switch (what) {
@@ -175,18 +185,74 @@ static int has_problem(const lw_series_stats *s, int what)
   }
 }
 
-static int flagged(const lw_series_stats *s) { return has_problem(s, WARN_OPEN) || has_problem(s, WARN_FEW); }
+/* Whether column c has problem `what` in any of its k runs, or (WARN_RUNS)
+** across them: means further apart than their error bars allow (p < 1e-3)
+** or a potential scale reduction above 1.1. */
+static int has_problem(const column_stats *c, int k, int what)
+{
+  if (what == WARN_RUNS) return k > 1 && !isnan(c->p_runs) && (c->p_runs < 1e-3 || c->r_hat > 1.1);
+  for (int r = 0; r < k; r++)
+    if (run_problem(&c->run[r], what)) return 1;
+  return 0;
+}
+
+static int flagged(const column_stats *c, int k)
+{
+  return has_problem(c, k, WARN_OPEN) || has_problem(c, k, WARN_FEW) || has_problem(c, k, WARN_RUNS);
+}
 
 /* One line naming every column with problem `what`, or nothing. */
-static void warn(FILE *out, const lw_trace *t, const lw_series_stats *st, int what, const char *text)
+static void warn(FILE *out, const lw_trace *t, const column_stats *cs, int k, int what, const char *text)
 {
   int any = 0;
-  for (size_t k = 0; k < t->n_cols; k++) {
-    if (is_coordinate(t->name[k]) || !has_problem(&st[k], what)) continue;
-    fprintf(out, "%s%s", any ? ", " : "warning: ", t->name[k]);
+  for (size_t c = 0; c < t->n_cols; c++) {
+    if (is_coordinate(t->name[c]) || !cs[c].run[0].n || !has_problem(&cs[c], k, what)) continue;
+    fprintf(out, "%s%s", any ? ", " : "warning: ", t->name[c]);
     any = 1;
   }
   if (any) fprintf(out, ": %s\n", text);
+}
+
+/* The runs together (k > 1): the mean of their means with the error bar of
+** that mean, the within-run spread, the mean tau, the summed n_eff; the
+** chi-square of the means against their error bars (k - 1 degrees of
+** freedom); and R-hat = sqrt(var+ / W), W the mean within-run variance, B / n
+** the variance of the means, var+ = (n - 1) / n W + B / n (Gelman and Rubin
+** 1992, Stat. Sci. 7, 457), n the mean rows a run. */
+static void combine(column_stats *c, int k, const double *every)
+{
+  double m = 0.0, se2 = 0.0, w = 0.0, n = 0.0, tau = 0.0, neff = 0.0;
+  for (int r = 0; r < k; r++) {
+    const lw_series_stats *s = &c->run[r];
+    m += s->mean / k;
+    se2 += s->stderr_mean * s->stderr_mean / ((double)k * k);
+    w += s->n > 1 ? s->sd * s->sd * (double)s->n / (double)(s->n - 1) / k : 0.0;
+    n += (double)s->n / k;
+    tau += s->tau * every[r] / k;
+    neff += s->n_eff;
+  }
+  double b = 0.0, chi2 = 0.0;
+  int exact = 1; /* every run without spread: the means must agree exactly */
+  for (int r = 0; r < k; r++) {
+    const lw_series_stats *s = &c->run[r];
+    b += (s->mean - m) * (s->mean - m) / (k - 1);
+    if (s->stderr_mean > 0.0) {
+      chi2 += (s->mean - m) * (s->mean - m) / (s->stderr_mean * s->stderr_mean);
+      exact = 0;
+    }
+  }
+  c->mean = m;
+  c->stderr_mean = sqrt(se2);
+  c->sd = sqrt(w);
+  c->tau_sweeps = tau;
+  c->n_eff = neff;
+  if (exact) {
+    c->p_runs = b > 0.0 ? 0.0 : 1.0;
+    c->r_hat = b > 0.0 ? INFINITY : 1.0;
+  } else {
+    c->p_runs = gsl_cdf_chisq_Q(chi2, (double)(k - 1));
+    c->r_hat = w > 0.0 ? sqrt(((n - 1.0) / n * w + b) / w) : INFINITY;
+  }
 }
 
 lw_status lw_trace_rows(const lw_trace *t, const char *path, const lw_trace_select *sel, size_t **rows, size_t *n,
@@ -237,65 +303,151 @@ void lw_trace_column_stats(const lw_trace *t, const size_t *rows, size_t n, int 
   else memset(out, 0, sizeof *out);
 }
 
-lw_status lw_trace_stats(const lw_trace *t, const char *path, const lw_trace_select *sel, FILE *out,
-                         lw_error *err)
+/* The first line about run r's stretch. */
+static void stretch_line(FILE *out, const char *lead, const lw_trace *t, const char *path, const size_t *row, size_t n,
+                         size_t tuned)
 {
-  size_t *row, n, tuned;
-  lw_status status = lw_trace_rows(t, path, sel, &row, &n, &tuned, err);
-  if (status) return status;
-  double *x = malloc(n * sizeof *x);
-  lw_series_stats *st = calloc(t->n_cols, sizeof *st);
-  if (!x || !st) {
-    free(row);
-    free(x);
-    free(st);
-    return lw_error_set(err, LW_ENOMEM, "out of memory");
-  }
   int sweep = lw_trace_column(t, "sweep"), temp = lw_trace_column(t, "temperature");
-  double first = at(t, row[0], sweep), last = at(t, row[n - 1], sweep), every = lw_trace_every(t);
-  double tlo = INFINITY, thi = -INFINITY;
+  double every = lw_trace_every(t), tlo = INFINITY, thi = -INFINITY;
   for (size_t i = 0; temp >= 0 && i < n; i++) {
     tlo = fmin(tlo, at(t, row[i], temp));
     thi = fmax(thi, at(t, row[i], temp));
   }
-  if (!sel->csv) {
-    fprintf(out, "%s: sweeps %.0f to %.0f", path, first, last);
-    if (temp >= 0 && tlo == thi) fprintf(out, " at temperature %.6g", tlo);
-    else if (temp >= 0) fprintf(out, " at temperatures %.6g to %.6g", tlo, thi);
-    fprintf(out, ": %zu rows", n);
-    if (every != 1.0) fprintf(out, ", one every %.6g sweeps", every);
-    if (tuned) fprintf(out, " (%zu rows of tuning sweeps left out)", tuned);
-    fprintf(out, "\n%-16s %15s %11s %11s %11s %9s\n", "column", "mean", "stderr", "sd", "tau_sweeps", "n_eff");
-  } else {
-    fprintf(out, "column,n,mean,stderr,sd,tau_sweeps,n_eff,window_closed,drift_z\n");
+  fprintf(out, "%s%s: sweeps %.0f to %.0f", lead, path, at(t, row[0], sweep), at(t, row[n - 1], sweep));
+  if (temp >= 0 && tlo == thi) fprintf(out, " at temperature %.6g", tlo);
+  else if (temp >= 0) fprintf(out, " at temperatures %.6g to %.6g", tlo, thi);
+  fprintf(out, ": %zu rows", n);
+  if (every != 1.0) fprintf(out, ", one every %.6g sweeps", every);
+  if (tuned) fprintf(out, " (%zu rows of tuning sweeps left out)", tuned);
+  fputc('\n', out);
+}
+
+/* The temperatures of the rows chosen, all runs together. */
+static void temperature_range(const lw_trace *t, const size_t *row, size_t n, double *lo, double *hi)
+{
+  int temp = lw_trace_column(t, "temperature");
+  for (size_t i = 0; temp >= 0 && i < n; i++) {
+    *lo = fmin(*lo, at(t, row[i], temp));
+    *hi = fmax(*hi, at(t, row[i], temp));
   }
-  for (size_t k = 0; k < t->n_cols; k++) {
-    if (is_coordinate(t->name[k])) continue;
-    lw_series_stats *s = &st[k];
-    lw_trace_column_stats(t, row, n, (int)k, x, s);
-    if (!s->n) {
-      if (!sel->csv) fprintf(out, "%-16s %15s\n", t->name[k], "(empty)");
-    } else if (sel->csv) {
-      fprintf(out, "%s,%zu,%.10g,%.4g,%.4g,%.4g,%.4g,%d,%.3g\n", t->name[k], s->n, s->mean, s->stderr_mean, s->sd,
-              s->tau * every, s->n_eff, s->window > 0, s->drift_z);
-    } else if (!(s->sd > 0.0)) {
-      fprintf(out, "%-16s %15.9g %11.4g %11.4g %11s %9s\n", t->name[k], s->mean, 0.0, 0.0, "-", "-");
-    } else {
-      fprintf(out, "%-16s %15.9g %11.4g %11.4g %11.4g %9.0f%s\n", t->name[k], s->mean, s->stderr_mean, s->sd,
-              s->tau * every, s->n_eff, flagged(s) ? " *" : "");
+}
+
+/* Refuses a run whose columns are not the first run's. */
+static lw_status same_columns(const lw_trace *a, const char *pa, const lw_trace *b, const char *pb, lw_error *err)
+{
+  for (size_t c = 0; c < a->n_cols || c < b->n_cols; c++)
+    if (c >= a->n_cols || c >= b->n_cols || strcmp(a->name[c], b->name[c]))
+      return lw_error_set(err, LW_EINPUT, "%s: column %zu is '%s', but '%s' in %s (expected runs of one scene)", pb,
+                          c + 1, c < b->n_cols ? b->name[c] : "(none)", c < a->n_cols ? a->name[c] : "(none)", pa);
+  return LW_OK;
+}
+
+lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
+                              FILE *out, lw_error *err)
+{
+  const int csv = sel[0].csv;
+  size_t **row = calloc((size_t)k, sizeof *row), *n = calloc((size_t)k, sizeof *n), *tuned = calloc((size_t)k, sizeof *tuned);
+  double *every = calloc((size_t)k, sizeof *every), *x = NULL;
+  column_stats *cs = calloc(t[0]->n_cols, sizeof *cs);
+  lw_series_stats *runs = calloc(t[0]->n_cols * (size_t)k, sizeof *runs);
+  lw_status status = row && n && tuned && every && cs && runs ? LW_OK : lw_error_set(err, LW_ENOMEM, "out of memory");
+  size_t most = 0;
+  for (int r = 0; !status && r < k; r++) {
+    if (r && (status = same_columns(t[0], path[0], t[r], path[r], err))) break;
+    if ((status = lw_trace_rows(t[r], path[r], &sel[r], &row[r], &n[r], &tuned[r], err))) break;
+    every[r] = lw_trace_every(t[r]);
+    if (n[r] > most) most = n[r];
+  }
+  if (!status && !(x = malloc(most * sizeof *x))) status = lw_error_set(err, LW_ENOMEM, "out of memory");
+  if (status) goto done;
+  double tlo = INFINITY, thi = -INFINITY;
+  for (int r = 0; r < k; r++) temperature_range(t[r], row[r], n[r], &tlo, &thi);
+  for (size_t c = 0; c < t[0]->n_cols; c++) {
+    cs[c].run = runs + c * (size_t)k;
+    if (is_coordinate(t[0]->name[c])) continue;
+    int empty = 0;
+    for (int r = 0; r < k; r++) {
+      lw_trace_column_stats(t[r], row[r], n[r], (int)c, x, &cs[c].run[r]);
+      empty |= !cs[c].run[r].n;
+    }
+    if (empty) {
+      cs[c].run[0].n = 0; /* a column some run never filled: left out */
+    } else if (k > 1) {
+      combine(&cs[c], k, every);
+      /* an acceptance depends on each run's own tuned step: runs need not agree */
+      if (!strncmp(t[0]->name[c], "acc_", 4) || !strncmp(t[0]->name[c], "swap", 4)) cs[c].p_runs = cs[c].r_hat = NAN;
     }
   }
-  if (!sel->csv) {
-    if (temp >= 0 && tlo != thi)
-      fprintf(out, "warning: the temperature changes within these rows: the means mix ensembles\n");
-    warn(out, t, st, WARN_OPEN, "the autocorrelation did not die out within half the rows: tau is a lower bound "
-         "and the error bar too small (a longer stretch is needed)");
-    warn(out, t, st, WARN_FEW, "fewer than 25 independent samples: the error bar is rough");
-    warn(out, t, st, WARN_DRIFT, "the first and second halves differ by more than 4 standard errors: not yet "
-         "stationary (start later with --from)");
+  if (csv) {
+    fprintf(out, k > 1 ? "column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs\n"
+                       : "column,n,mean,stderr,sd,tau_sweeps,n_eff,window_closed,drift_z\n");
+  } else {
+    if (k > 1) fprintf(out, "%d runs:\n", k);
+    for (int r = 0; r < k; r++) stretch_line(out, k > 1 ? "  " : "", t[r], path[r], row[r], n[r], tuned[r]);
+    fprintf(out, "%-16s %15s %11s %11s %11s %9s", "column", "mean", "stderr", "sd", "tau_sweeps", "n_eff");
+    fprintf(out, k > 1 ? " %8s %9s\n" : "\n", "R_hat", "p_runs");
   }
+  for (size_t c = 0; c < t[0]->n_cols; c++) {
+    const char *name = t[0]->name[c];
+    const column_stats *q = &cs[c];
+    const lw_series_stats *s = &q->run[0];
+    if (is_coordinate(name)) continue;
+    if (!s->n) {
+      if (!csv) fprintf(out, "%-16s %15s\n", name, "(empty)");
+    } else if (k > 1) {
+      size_t rows = 0;
+      for (int r = 0; r < k; r++) rows += q->run[r].n;
+      char tau[32] = "-", neff[32] = "-", rh[32] = "-", pr[32] = "-";
+      if (q->sd > 0.0) {
+        snprintf(tau, sizeof tau, "%.4g", q->tau_sweeps);
+        snprintf(neff, sizeof neff, csv ? "%.4g" : "%.0f", q->n_eff);
+      }
+      if (!isnan(q->p_runs)) {
+        snprintf(rh, sizeof rh, "%.4g", q->r_hat);
+        snprintf(pr, sizeof pr, "%.3g", q->p_runs);
+      }
+      if (csv)
+        fprintf(out, "%s,%d,%zu,%.10g,%.4g,%.4g,%s,%s,%s,%s\n", name, k, rows, q->mean, q->stderr_mean, q->sd,
+                tau, neff, rh, pr);
+      else
+        fprintf(out, "%-16s %15.9g %11.4g %11.4g %11s %9s %8s %9s%s\n", name, q->mean, q->stderr_mean, q->sd, tau,
+                neff, rh, pr, flagged(q, k) ? " *" : "");
+    } else if (csv) {
+      fprintf(out, "%s,%zu,%.10g,%.4g,%.4g,%.4g,%.4g,%d,%.3g\n", name, s->n, s->mean, s->stderr_mean, s->sd,
+              s->tau * every[0], s->n_eff, s->window > 0, s->drift_z);
+    } else if (!(s->sd > 0.0)) {
+      fprintf(out, "%-16s %15.9g %11.4g %11.4g %11s %9s\n", name, s->mean, 0.0, 0.0, "-", "-");
+    } else {
+      fprintf(out, "%-16s %15.9g %11.4g %11.4g %11.4g %9.0f%s\n", name, s->mean, s->stderr_mean, s->sd,
+              s->tau * every[0], s->n_eff, flagged(q, 1) ? " *" : "");
+    }
+  }
+  if (!csv) {
+    if (tlo != thi)
+      fprintf(out, "warning: the temperature changes within %s: the means mix ensembles\n",
+              k > 1 ? "or between the runs" : "these rows");
+    warn(out, t[0], cs, k, WARN_OPEN, "the autocorrelation did not die out within half the rows: tau is a lower "
+         "bound and the error bar too small (a longer stretch is needed)");
+    warn(out, t[0], cs, k, WARN_FEW, "fewer than 25 independent samples: the error bar is rough");
+    warn(out, t[0], cs, k, WARN_DRIFT, "the first and second halves differ by more than 4 standard errors: not yet "
+         "stationary (start later with --from)");
+    warn(out, t[0], cs, k, WARN_RUNS, "the runs disagree beyond their error bars (p_runs < 0.001 or R_hat > 1.1): "
+         "not converged, or the stretches too short for their error bars");
+  }
+done:
+  for (int r = 0; row && r < k; r++) free(row[r]);
   free(row);
+  free(n);
+  free(tuned);
+  free(every);
   free(x);
-  free(st);
-  return LW_OK;
+  free(cs);
+  free(runs);
+  return status;
+}
+
+lw_status lw_trace_stats(const lw_trace *t, const char *path, const lw_trace_select *sel, FILE *out,
+                         lw_error *err)
+{
+  return lw_trace_stats_runs(&t, &path, sel, 1, out, err);
 }

@@ -449,6 +449,11 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   cr_assert_eq(lw_test_sh("cmp -s %s/wlc/trace.csv %s/half/trace.csv", dir, dir), 0, "the resumed trace differs");
   cr_assert_eq(lw_test_sh("diff -r %s/wlc/samples %s/half/samples", dir, dir), 0, "the resumed samples differ");
+  /* the two runs together: the same chain, so their means agree exactly */
+  snprintf(args, sizeof args, "stats %s/wlc %s/half --csv", dir, dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(out, "column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs\n") &&
+            strstr(out, "\nobs_end2,2,8002,") && strstr(out, ",1\nobs_rg2,"), "%s", out);
   /* the samples: at sweeps 6000 .. 24000, each every node of the 50 chains;
   ** the last one's mean squared end-to-end distance is the last trace
   ** row's obs_end2 (both of the state after sweep 24000) */

@@ -241,6 +241,86 @@ Test(trace, the_default_stretch_is_the_final_temperature_less_its_tuning_sweeps,
   lw_trace_free(t);
 }
 
+/* Writes run r's trace: 4000 rows of an AR(1) column `x` (phi 0.8) shifted
+** by `shift`, and an acceptance column with a level of the run's own. */
+static void write_run(const char *name, unsigned long seed, double shift, double acc, char *path, size_t n)
+{
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, seed);
+  const size_t rows = 4000;
+  double *x = malloc(rows * sizeof *x);
+  ar1(r, 0.8, x, rows);
+  size_t cap = 64 * rows, k = 0;
+  char *text = malloc(cap);
+  k += (size_t)snprintf(text, cap, "sweep,temperature,x,acc_point\n");
+  for (size_t t = 0; t < rows; t++)
+    k += (size_t)snprintf(text + k, cap - k, "%zu,1,%.17g,%.6f\n", t + 1, x[t] + shift, acc + 0.01 * x[t] / 3.0);
+  write_trace(name, text, path, n);
+  free(text);
+  free(x);
+  gsl_rng_free(r);
+}
+
+/* The p_runs and R-hat of a column in the several runs' CSV. */
+static void runs_agreement(const char *csv, const char *col, double *r_hat, double *p)
+{
+  char key[64];
+  snprintf(key, sizeof key, "\n%s,", col);
+  const char *l = strstr(csv, key);
+  cr_assert_not_null(l, "%s", csv);
+  for (int c = 0; c < 8; c++) l = strchr(l + 1, ',');
+  cr_assert_eq(sscanf(l + 1, "%lf,%lf", r_hat, p), 2, "%s", csv);
+}
+
+Test(trace, several_runs_agree_or_are_flagged, .init = make_dir, .fini = remove_dir)
+{
+  /* 4 runs of the same AR(1) law (tau 4.5, stderr of a run's mean about
+  ** 1.67 sqrt(9 / 4000) = 0.079): their means agree (the chi-square of 3
+  ** degrees of freedom falls under p = 0.001 once in a thousand), and R-hat
+  ** is near 1.  Shifting one run by 0.8 (10 of its error bars, half the
+  ** series' sd) must fail the chi-square; R-hat, which weighs the shift
+  ** against the spread of the values rather than of the means, stays near
+  ** 1.03 there and passes 1.1 at a shift of 3 (1.8 sd).  Each run's
+  ** acceptance level differs (its own tuned step): never tested for
+  ** agreement. */
+  char path[4][128], out[4096];
+  const char *paths[4];
+  lw_trace *t[4];
+  lw_trace_select sel[4];
+  lw_error err;
+  const double shift[3] = {0.0, 0.8, 3.0};
+  for (int shifted = 0; shifted < 3; shifted++) {
+    for (int r = 0; r < 4; r++) {
+      char name[32];
+      snprintf(name, sizeof name, "r%d-%d.csv", shifted, r);
+      write_run(name, 100 + (unsigned long)r, r == 3 ? shift[shifted] : 0.0, 0.3 + 0.05 * r, path[r], sizeof path[r]);
+      paths[r] = path[r];
+      t[r] = lw_trace_read(path[r], &err);
+      cr_assert_not_null(t[r], "%s", err.msg);
+      sel[r] = (lw_trace_select){.from = -1, .to = -1, .csv = 1};
+    }
+    FILE *f = fmemopen(out, sizeof out, "w");
+    cr_assert_eq(lw_trace_stats_runs((const lw_trace *const *)t, paths, sel, 4, f, &err), LW_OK, "%s", err.msg);
+    fclose(f);
+    double rh, p;
+    runs_agreement(out, "x", &rh, &p);
+    cr_log_info("runs, one shifted by %g: R-hat %.4f, p %.3g", shift[shifted], rh, p);
+    if (shifted) cr_assert(p < 1e-3, "a shift of %g passed the chi-square: p %g", shift[shifted], p);
+    else cr_assert(p > 1e-3 && rh < 1.02, "alike runs flagged: R-hat %g, p %g", rh, p);
+    if (shifted == 2) cr_assert(rh > 1.1, "a shift of 1.8 sd: R-hat %g", rh);
+    cr_assert(strstr(out, "\nacc_point,4,16000,") && strstr(out, ",-,-\n"), "%s", out);
+    for (int r = 0; r < 4; r++) lw_trace_free(t[r]);
+  }
+  /* a run of another scene: its columns differ */
+  write_trace("other.csv", "sweep,temperature,y,acc_point\n1,1,2,0.5\n", path[3], sizeof path[3]);
+  for (int r = 0; r < 4; r++) t[r] = lw_trace_read(path[r], &err);
+  FILE *f = fmemopen(out, sizeof out, "w");
+  cr_assert_eq(lw_trace_stats_runs((const lw_trace *const *)t, paths, sel, 4, f, &err), LW_EINPUT);
+  fclose(f);
+  cr_assert(strstr(err.msg, "other.csv: column 3 is 'y', but 'x' in "), "%s", err.msg);
+  for (int r = 0; r < 4; r++) lw_trace_free(t[r]);
+}
+
 /* ---- observables --------------------------------------------------------- */
 
 Test(observables, a_line_and_a_circle_have_their_known_shapes)

@@ -66,4 +66,14 @@ void lw_trace_column_stats(const lw_trace *t, const size_t *rows, size_t n, int 
 lw_status lw_trace_stats(const lw_trace *t, const char *path, const lw_trace_select *sel, FILE *out,
                          lw_error *err);
 
+/* The same for k >= 1 runs of one scene (independent seeds, say), each with
+** its own stretch (sel[r]; the format from sel[0].csv): per column the
+** mean of the runs' means and its error bar, and whether they agree: the
+** chi-square probability of their spread under their own error bars
+** (p_runs) and Gelman and Rubin's R-hat; a warning names the columns where
+** p_runs < 0.001 or R-hat > 1.1.  LW_EINPUT when a run's columns are not
+** the first's. */
+lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
+                              FILE *out, lw_error *err);
+
 #endif
