@@ -7,7 +7,8 @@
 **   - an accepted trace's values are finite or NaN (an empty field), and
 **     written back with 17 digits it reads back the same, bit for bit;
 **   - its statistics either print or refuse with a message naming it,
-**     with the tuning settings taken from the input's first bytes.
+**     with the tuning settings taken from the input's first bytes, and the
+**     same trace taken as two runs does the same.
 **
 ** Built with clang -fsanitize=fuzzer by `make fuzz`; `make test` compiles it
 ** with cc and replays tests/fuzz/corpus/trace through the same function.
@@ -69,6 +70,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
   if (out) {
     lw_status s = lw_trace_stats(t, path, &sel, out, &err);
     LW_FUZZ_CHECK(!s || strstr(err.msg, path) || s == LW_ENOMEM, "stats refused without the file: '%s'", err.msg);
+    /* the same trace twice, as two runs: the same refusal, or a table */
+    const lw_trace *two[2] = {t, t};
+    const char *paths[2] = {path, path};
+    const lw_trace_select sels[2] = {sel, sel};
+    lw_status s2 = lw_trace_stats_runs(two, paths, sels, 2, out, &err);
+    LW_FUZZ_CHECK(s2 == s || s2 == LW_ENOMEM || s == LW_ENOMEM, "one run gave %d, the same twice %d", (int)s, (int)s2);
     fclose(out);
   }
   lw_trace_free(t);
