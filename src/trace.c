@@ -38,7 +38,8 @@ static lw_status read_header(lw_trace *t, char *line, const char *path, lw_error
   for (size_t k = 0; k < n; k++) {
     char *end = strchr(tok, ',');
     if (end) *end = '\0';
-    if (!*tok) return lw_error_set(err, LW_EINPUT, "%s:1: column %zu has no name (expected a header of names)", path, k + 1);
+    if (!*tok)
+      return lw_error_set(err, LW_EINPUT, "%s:1: column %zu has no name (expected a header of names)", path, k + 1);
     for (const char *c = tok; *c; c++)
       if ((unsigned char)*c < 0x20 || *c == 0x7f)
         return lw_error_set(err, LW_EINPUT, "%s:1: column %zu: a control character in its name", path, k + 1);
@@ -346,7 +347,8 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
                               FILE *out, lw_error *err)
 {
   const int csv = sel[0].csv;
-  size_t **row = calloc((size_t)k, sizeof *row), *n = calloc((size_t)k, sizeof *n), *tuned = calloc((size_t)k, sizeof *tuned);
+  size_t **row = calloc((size_t)k, sizeof *row), *n = calloc((size_t)k, sizeof *n);
+  size_t *tuned = calloc((size_t)k, sizeof *tuned);
   double *every = calloc((size_t)k, sizeof *every), *x = NULL;
   column_stats *cs = calloc(t[0]->n_cols, sizeof *cs);
   lw_series_stats *runs = calloc(t[0]->n_cols * (size_t)k, sizeof *runs);
