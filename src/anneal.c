@@ -819,10 +819,12 @@ static void put_per_move(lw_json *j, const char *key, const lw_chain *c, const l
   lw_json_end_object(j);
 }
 
-/* summary.json's observables: each obs_ column's mean, standard error and
-** autocorrelation time over the stretch that `linewise stats` takes by
-** default (trace.h), read back from trace.csv, which the checkpoint before
-** has flushed; null where the trace has no such stretch. */
+/* summary.json's observables: each obs_ column's mean, standard error,
+** autocorrelation time and effective samples over the stretch that
+** `linewise stats` takes by default (trace.h), read back from trace.csv,
+** which the checkpoint before has flushed; null where the trace has no such
+** stretch.  The effective samples let a sweep's table show the error bars
+** too rough to trust (under 25, as `linewise stats` warns). */
 static void put_observables(const lw_anneal *a, lw_json *j)
 {
   char path[LW_PATH_MAX + 32], key[96];
@@ -858,6 +860,10 @@ static void put_observables(const lw_anneal *a, lw_json *j)
       snprintf(key, sizeof key, "%s_tau_sweeps", name);
       lw_json_key(j, key);
       if (st.n && st.sd > 0.0) lw_json_number(j, st.tau * every);
+      else lw_json_null(j);
+      snprintf(key, sizeof key, "%s_n_eff", name);
+      lw_json_key(j, key);
+      if (st.n && st.sd > 0.0) lw_json_number(j, st.n_eff);
       else lw_json_null(j);
     }
     lw_json_end_object(j);
