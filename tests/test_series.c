@@ -163,13 +163,11 @@ static void make_dir(void) { cr_assert_eq(lw_test_dir_make(dir, "series"), 0); }
 
 static void remove_dir(void) { cr_assert_eq(lw_test_dir_remove(dir), 0); }
 
+/* Writes the file name in the suite's directory, its path into path. */
 static void write_trace(const char *name, const char *text, char *path, size_t n)
 {
+  cr_assert_eq(lw_test_write_text(dir, name, text), 0, "%s", name);
   snprintf(path, n, "%s/%s", dir, name);
-  FILE *f = fopen(path, "w");
-  cr_assert_not_null(f);
-  fputs(text, f);
-  fclose(f);
 }
 
 Test(trace, rows_and_empty_fields_read_back_and_a_partial_last_row_is_left_out, .init = make_dir, .fini = remove_dir)
