@@ -327,7 +327,9 @@ const lw_param_def lw_param_table[] = {
   NUM("anneal", "sweeps", LW_PT_INT, sweeps, "1000", "sweeps", 0, 2e9, 0,
       "Sweeps in all; a sweep is as many proposals as the scene has nodes."),
   NUM("anneal", "steps", LW_PT_INT, steps, "20", "", 1, 1e9, 0,
-      "Temperature steps; the sweeps are shared out evenly among them."),
+      "Temperature steps; the sweeps are shared out evenly among them, and the moves' steps tune "
+      "at the start of each (moves.tune_sweeps). With schedule = constant the default is 1: one "
+      "temperature, tuned once, then frozen for the sampling."),
   NUM("anneal", "lambda", LW_PT_DOUBLE, lambda, "0.7", "", 0, 1e6, LW_MIN_OPEN,
       "Cooling rate of the adaptive schedule: T <- T exp(-lambda T / sigma_E)."),
   STRING("anneal", "table", table, "", "path",
@@ -1160,7 +1162,16 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
       *value[k] = want[k];
     }
   }
+  /* The constant schedule has one temperature, so one step: its steps tune
+  ** once, at the start, and stay frozen for the sampling (a step tunes
+  ** again: moves.tune_sweeps), unless the scene sets anneal.steps.  The
+  ** key is reset first, since an override may have changed the schedule. */
+  const lw_param_def *steps = lw_params_find("anneal", "steps");
+  const int steps_unset = !p->of_run && !p->line[steps - lw_param_table];
+  char expected[64];
+  if (steps_unset) assign(p, steps, steps->def, expected, sizeof expected);
   apply_preset(p);
+  if (steps_unset && !strcmp(p->schedule, "constant")) assign(p, steps, "1", expected, sizeof expected);
   unsigned char rgb[LW_PLOT_PENS_MAX][3];
   if (p->pen_colors[0] && lw_output_colors_parse(p->pen_colors, rgb, LW_PLOT_PENS_MAX) != p->pens) {
     lw_params_origin(p, lw_params_find("output", "pen_colors"), where, sizeof where);

@@ -442,3 +442,26 @@ Test(params, auto_orientation_follows_the_picture)
               "%s", err.msg);
   }
 }
+
+/* The constant schedule has one temperature, so one step by default (its
+** moves tune once); a scene's own anneal.steps wins, an override of the
+** schedule brings the usual default back, and the photo preset's 5 holds
+** for its own schedule only. */
+Test(params, a_constant_schedule_has_one_step_unless_the_scene_says)
+{
+  lw_params p;
+  lw_error err;
+  cr_assert_eq(read_text("[anneal]\nschedule = constant\n", &p, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(p.steps, 1);
+  cr_assert_eq(lw_params_set(&p, "anneal.schedule=geometric", &err), LW_OK);
+  cr_assert_eq(lw_params_resolve(&p, &err), LW_OK);
+  cr_assert_eq(p.steps, 20, "the default after the schedule changed: %d", p.steps);
+  cr_assert_eq(read_text("[anneal]\nschedule = constant\nsteps = 7\n", &p, &err), LW_OK);
+  cr_assert_eq(p.steps, 7);
+  cr_assert_eq(read_text("[anneal]\nschedule = linear\n", &p, &err), LW_OK);
+  cr_assert_eq(p.steps, 20);
+  cr_assert_eq(read_text("[scene]\npreset = photo\n", &p, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(p.steps, 5);
+  cr_assert_eq(read_text("[scene]\npreset = photo\n[anneal]\nschedule = constant\n", &p, &err), LW_OK);
+  cr_assert_eq(p.steps, 1);
+}
