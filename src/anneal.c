@@ -212,17 +212,14 @@ static lw_status setup_system(lw_anneal *a, lw_error *err)
     return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.quench': the %s system has no gradient to quench with; "
                         "expected none", where, a->sys_type->name);
   }
-  if (a->params.samples_every && !a->sys_type->write_sample) {
+  const char *missing = a->params.samples_every && !a->sys_type->write_sample ? "samples_every"
+                        : a->params.observables && !a->sys_type->observe       ? "observables"
+                                                                                : NULL;
+  if (missing) {
     char where[LW_PATH_MAX + 32];
-    lw_params_origin(&a->params, lw_params_find("output", "samples_every"), where, sizeof where);
-    return lw_error_set(err, LW_EINPUT, "%s: key 'output.samples_every': the %s system writes no samples; "
-                        "expected 0", where, a->sys_type->name);
-  }
-  if (a->params.observables && !a->sys_type->observe) {
-    char where[LW_PATH_MAX + 32];
-    lw_params_origin(&a->params, lw_params_find("output", "observables"), where, sizeof where);
-    return lw_error_set(err, LW_EINPUT, "%s: key 'output.observables': the %s system has no observables; "
-                        "expected 0", where, a->sys_type->name);
+    lw_params_origin(&a->params, lw_params_find("output", missing), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'output.%s': the %s system has no %s; expected 0", where, missing,
+                        a->sys_type->name, *missing == 's' ? "samples" : "observables");
   }
   a->setup = a->sys_type->setup_new(&a->params, err);
   return a->setup ? LW_OK : err->code;
@@ -849,22 +846,15 @@ static void put_observables(const lw_anneal *a, lw_json *j)
       if (strncmp(t->name[k], "obs_", 4)) continue;
       lw_series_stats st;
       lw_trace_column_stats(t, rows, n, (int)k, x, &st);
-      const char *name = t->name[k] + 4;
-      lw_json_key(j, name);
-      if (st.n) lw_json_number(j, st.mean);
-      else lw_json_null(j);
-      snprintf(key, sizeof key, "%s_stderr", name);
-      lw_json_key(j, key);
-      if (st.n) lw_json_number(j, st.stderr_mean);
-      else lw_json_null(j);
-      snprintf(key, sizeof key, "%s_tau_sweeps", name);
-      lw_json_key(j, key);
-      if (st.n && st.sd > 0.0) lw_json_number(j, st.tau * every);
-      else lw_json_null(j);
-      snprintf(key, sizeof key, "%s_n_eff", name);
-      lw_json_key(j, key);
-      if (st.n && st.sd > 0.0) lw_json_number(j, st.n_eff);
-      else lw_json_null(j);
+      const char *suffix[4] = {"", "_stderr", "_tau_sweeps", "_n_eff"};
+      const double value[4] = {st.mean, st.stderr_mean, st.tau * every, st.n_eff};
+      for (int q = 0; q < 4; q++) {
+        snprintf(key, sizeof key, "%s%s", t->name[k] + 4, suffix[q]);
+        lw_json_key(j, key);
+        /* tau and n_eff mean nothing for a column without spread */
+        if (st.n && (q < 2 || st.sd > 0.0)) lw_json_number(j, value[q]);
+        else lw_json_null(j);
+      }
     }
     lw_json_end_object(j);
   }

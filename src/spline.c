@@ -241,29 +241,27 @@ void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_
   out->end_y[1] = b->py;
 }
 
+void lw_shape_finish(const lw_arc_moments *m, double ex, double ey, const double t0[2], const double t1[2],
+                     lw_spline_shape *out)
+{
+  const double len = m->len, n0 = hypot(t0[0], t0[1]), n1 = hypot(t1[0], t1[1]);
+  out->length = len;
+  out->rg2 = len > 0.0 ? fmax(m->m2 / len - (m->mx * m->mx + m->my * m->my) / (len * len), 0.0) : 0.0;
+  out->end2 = ex * ex + ey * ey;
+  out->end_cos = n0 > 0.0 && n1 > 0.0 ? (t0[0] * t1[0] + t0[1] * t1[1]) / (n0 * n1) : 0.0;
+}
+
 void lw_spline_shape_of(const lw_splines *sp, size_t i, const lw_quad *q, lw_spline_shape *out)
 {
   const lw_node *nd = sp->node + sp->first[i], *last = sp->node + sp->first[i + 1] - 1;
-  /* moments about the first node, where the page's offset cannot cancel */
-  const double ox = nd->px, oy = nd->py;
-  double len = 0.0, mx = 0.0, my = 0.0, m2 = 0.0;
+  lw_arc_moments m = {0.0, 0.0, 0.0, 0.0};
   lw_samples smp;
   for (const lw_node *a = nd; a < last; a++) {
     lw_segment_sample(q, a, a + 1, &smp);
-    for (int k = 0; k < smp.n; k++) {
-      double x = smp.x[k] - ox, y = smp.y[k] - oy;
-      mx += x * smp.dl[k];
-      my += y * smp.dl[k];
-      m2 += (x * x + y * y) * smp.dl[k];
-    }
-    len += smp.length;
+    for (int k = 0; k < smp.n; k++) lw_arc_moments_add(&m, smp.x[k] - nd->px, smp.y[k] - nd->py, smp.dl[k]);
   }
-  out->length = len;
-  out->rg2 = len > 0.0 ? fmax(m2 / len - (mx * mx + my * my) / (len * len), 0.0) : 0.0;
-  double ex = last->px - ox, ey = last->py - oy;
-  out->end2 = ex * ex + ey * ey;
-  double n0 = hypot(nd->vx, nd->vy), n1 = hypot(last->vx, last->vy);
-  out->end_cos = n0 > 0.0 && n1 > 0.0 ? (nd->vx * last->vx + nd->vy * last->vy) / (n0 * n1) : 0.0;
+  const double t0[2] = {nd->vx, nd->vy}, t1[2] = {last->vx, last->vy};
+  lw_shape_finish(&m, last->px - nd->px, last->py - nd->py, t0, t1, out);
 }
 
 int lw_splines_finite(const lw_splines *sp)

@@ -19,6 +19,7 @@
 
 #include "linewise/number.h"
 #include "linewise/output.h"
+#include "linewise/spline.h"
 
 static const char *const move_names[2] = {"point", "weight"};
 static const double move_unit[2] = {1.0, 1.0};
@@ -934,8 +935,7 @@ static void observe(const void *state, double *out)
   double p0[2], t0[2], p1[2], t1[2], pt[2], d[2];
   lw_nurbs_eval(c, lw_nurbs_u0(c), p0, t0, NULL);
   lw_nurbs_eval(c, lw_nurbs_u1(c), p1, t1, NULL);
-  /* moments about the first end, where the page's offset cannot cancel */
-  double len = 0.0, mx = 0.0, my = 0.0, m2 = 0.0;
+  lw_arc_moments m = {0.0, 0.0, 0.0, 0.0};
   for (size_t sp = k - 1; sp < c->n; sp++) {
     double a = c->knot[sp], b = c->knot[sp + 1];
     if (!(b > a)) continue; /* a repeated knot: no span */
@@ -943,19 +943,16 @@ static void observe(const void *state, double *out)
       double u, wq;
       gsl_integration_glfixed_point(a, b, q, &u, &wq, gl);
       lw_nurbs_eval(c, u, pt, d, NULL);
-      double dl = wq * hypot(d[0], d[1]), x = pt[0] - p0[0], y = pt[1] - p0[1];
-      len += dl;
-      mx += x * dl;
-      my += y * dl;
-      m2 += (x * x + y * y) * dl;
+      lw_arc_moments_add(&m, pt[0] - p0[0], pt[1] - p0[1], wq * hypot(d[0], d[1]));
     }
   }
   gsl_integration_glfixed_table_free(gl);
-  double ex = p1[0] - p0[0], ey = p1[1] - p0[1], n0 = hypot(t0[0], t0[1]), n1 = hypot(t1[0], t1[1]);
-  out[0] = len;
-  out[1] = ex * ex + ey * ey;
-  out[2] = len > 0.0 ? fmax(m2 / len - (mx * mx + my * my) / (len * len), 0.0) : 0.0;
-  out[3] = n0 > 0.0 && n1 > 0.0 ? (t0[0] * t1[0] + t0[1] * t1[1]) / (n0 * n1) : 0.0;
+  lw_spline_shape sh;
+  lw_shape_finish(&m, p1[0] - p0[0], p1[1] - p0[1], t0, t1, &sh);
+  out[0] = sh.length;
+  out[1] = sh.end2;
+  out[2] = sh.rg2;
+  out[3] = sh.end_cos;
 }
 
 /* A sample of the configuration (system.h): the control points and weights

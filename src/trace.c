@@ -304,26 +304,7 @@ void lw_trace_column_stats(const lw_trace *t, const size_t *rows, size_t n, int 
   else memset(out, 0, sizeof *out);
 }
 
-/* The first line about run r's stretch. */
-static void stretch_line(FILE *out, const char *lead, const lw_trace *t, const char *path, const size_t *row, size_t n,
-                         size_t tuned)
-{
-  int sweep = lw_trace_column(t, "sweep"), temp = lw_trace_column(t, "temperature");
-  double every = lw_trace_every(t), tlo = INFINITY, thi = -INFINITY;
-  for (size_t i = 0; temp >= 0 && i < n; i++) {
-    tlo = fmin(tlo, at(t, row[i], temp));
-    thi = fmax(thi, at(t, row[i], temp));
-  }
-  fprintf(out, "%s%s: sweeps %.0f to %.0f", lead, path, at(t, row[0], sweep), at(t, row[n - 1], sweep));
-  if (temp >= 0 && tlo == thi) fprintf(out, " at temperature %.6g", tlo);
-  else if (temp >= 0) fprintf(out, " at temperatures %.6g to %.6g", tlo, thi);
-  fprintf(out, ": %zu rows", n);
-  if (every != 1.0) fprintf(out, ", one every %.6g sweeps", every);
-  if (tuned) fprintf(out, " (%zu rows of tuning sweeps left out)", tuned);
-  fputc('\n', out);
-}
-
-/* The temperatures of the rows chosen, all runs together. */
+/* The temperatures of the rows chosen, widened into [*lo, *hi]. */
 static void temperature_range(const lw_trace *t, const size_t *row, size_t n, double *lo, double *hi)
 {
   int temp = lw_trace_column(t, "temperature");
@@ -331,6 +312,22 @@ static void temperature_range(const lw_trace *t, const size_t *row, size_t n, do
     *lo = fmin(*lo, at(t, row[i], temp));
     *hi = fmax(*hi, at(t, row[i], temp));
   }
+}
+
+/* The line about one run's stretch of rows. */
+static void stretch_line(FILE *out, const char *lead, const lw_trace *t, const char *path, const size_t *row, size_t n,
+                         size_t tuned)
+{
+  int sweep = lw_trace_column(t, "sweep"), temp = lw_trace_column(t, "temperature");
+  double every = lw_trace_every(t), tlo = INFINITY, thi = -INFINITY;
+  temperature_range(t, row, n, &tlo, &thi);
+  fprintf(out, "%s%s: sweeps %.0f to %.0f", lead, path, at(t, row[0], sweep), at(t, row[n - 1], sweep));
+  if (temp >= 0 && tlo == thi) fprintf(out, " at temperature %.6g", tlo);
+  else if (temp >= 0) fprintf(out, " at temperatures %.6g to %.6g", tlo, thi);
+  fprintf(out, ": %zu rows", n);
+  if (every != 1.0) fprintf(out, ", one every %.6g sweeps", every);
+  if (tuned) fprintf(out, " (%zu rows of tuning sweeps left out)", tuned);
+  fputc('\n', out);
 }
 
 /* Refuses a run whose columns are not the first run's. */

@@ -364,7 +364,8 @@ Test(observables, a_line_and_a_circle_have_their_known_shapes)
   lw_scene_clear(&sc);
 }
 
-Test(observables, particles_on_a_plane_and_on_a_sphere)
+/* A particle set-up of the defaults with a Lennard-Jones term. */
+static lw_particles_setup *particle_setup(void)
 {
   lw_params prm;
   lw_params_defaults(&prm);
@@ -373,6 +374,13 @@ Test(observables, particles_on_a_plane_and_on_a_sphere)
   lw_error err;
   lw_particles_setup *s = lw_particles_setup_new(&prm, &err);
   cr_assert_not_null(s, "%s", err.msg);
+  return s;
+}
+
+Test(observables, particles_on_a_plane_and_on_a_sphere)
+{
+  lw_error err;
+  lw_particles_setup *s = particle_setup();
   /* 400 particles on a 20 x 20 lattice of spacing 1.5 in z = 3, normals up:
   ** rg2 = 2 * 1.5^2 (20^2 - 1) / 12, no distance from the plane, order 1 */
   const size_t n = 400;
@@ -512,12 +520,7 @@ Test(samples, every_system_writes_its_degrees_of_freedom_to_the_bit)
   lw_nurbs_free(c);
 
   /* particles: position, quaternion, pin */
-  lw_params prm;
-  lw_params_defaults(&prm);
-  strcpy(prm.system, "particles");
-  prm.pt_alpha_lj = 1.0;
-  lw_particles_setup *s = lw_particles_setup_new(&prm, &err);
-  cr_assert_not_null(s, "%s", err.msg);
+  lw_particles_setup *s = particle_setup();
   double x[6] = {0.1, 0.2, 1.0 / 3.0, 1.5, 0.25, 0.0}, q[8], nrm[3] = {0.6, 0.0, 0.8};
   unsigned char pin[2] = {0, 1};
   lw_quat_from_normal(nrm, q);

@@ -147,6 +147,26 @@ typedef struct {
 
 void lw_spline_shape_of(const lw_splines *sp, size_t i, const lw_quad *q, lw_spline_shape *out);
 
+/* The moments behind a shape, summed sample by sample (x, y about a fixed
+** point of the curve, where the page's offset cannot cancel; dl the
+** sample's length element), then lw_shape_finish with the far end (ex, ey)
+** relative to that point and the end tangents t0, t1 (any lengths).  For
+** curves of other systems too (the D-NURBS curve). */
+typedef struct {
+  double len, mx, my, m2;
+} lw_arc_moments;
+
+static inline void lw_arc_moments_add(lw_arc_moments *m, double x, double y, double dl)
+{
+  m->len += dl;
+  m->mx += x * dl;
+  m->my += y * dl;
+  m->m2 += (x * x + y * y) * dl;
+}
+
+void lw_shape_finish(const lw_arc_moments *m, double ex, double ey, const double t0[2], const double t1[2],
+                     lw_spline_shape *out);
+
 /*
 ** Regularity: the hodograph r'(t) of a cubic segment is the quadratic Bezier
 ** with control points h0 = 3 v_a, h1 = 3 (b2 - b1), h2 = 3 v_b.  Where
