@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/plotter.h"
 #include "linewise/spacing.h"
 
 lw_status lw_drawing_page(const lw_params *p, lw_output_page *page, lw_error *err)
@@ -200,6 +201,15 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   if (!s && p->pdf) {
     dir_file(path, sizeof path, dir, "final.pdf");
     s = lw_output_pdf_strokes(st, &page, under, path, err);
+  }
+  const lw_plotter_options po = {p->plot_tolerance, p->speed_down, p->gcode_pen_up, p->gcode_pen_down};
+  if (!s && p->hpgl) {
+    dir_file(path, sizeof path, dir, "final.hpgl");
+    s = lw_output_hpgl_strokes(st, &page, &po, path, err);
+  }
+  if (!s && p->gcode) {
+    dir_file(path, sizeof path, dir, "final.gcode");
+    s = lw_output_gcode_strokes(st, &page, &po, path, err);
   }
   if (!s) s = close_share(p, sc, st, rep, err);
   if (!s && (tone || sc->reference)) s = score(p, sc, st, tone, rep, err);

@@ -159,8 +159,8 @@ static lw_strokes *checked_strokes(const lw_splines *sp, const lw_output_page *p
   return s;
 }
 
-static lw_status check_strokes(const lw_strokes *s, const lw_output_page *page, const lw_grid2d *tone,
-                               const char *path, lw_error *err)
+lw_status lw_output_check_strokes(const lw_strokes *s, const lw_output_page *page, const lw_grid2d *tone,
+                                  const char *path, lw_error *err)
 {
   lw_status st = check_page(page, s->n_pens, tone, path, err);
   if (st) return st;
@@ -172,20 +172,19 @@ static lw_status check_strokes(const lw_strokes *s, const lw_output_page *page, 
 
 /* ---- SVG -------------------------------------------------------------- */
 
-/* A length in mm with 4 fixed decimals, trailing zeros and a bare point
-** removed, "-0" folded to "0".  Fixed decimals rather than %g: the precision
-** of a plot is absolute (mm), not relative, and %g would switch to exponents
-** that some plotter tools do not parse.  The buffer holds the widest finite
-** double (309 digits). */
-static void put_mm(FILE *f, double v)
+void lw_output_put_fixed(FILE *f, double v, int decimals)
 {
   char buf[352];
-  snprintf(buf, sizeof buf, "%.4f", v);
+  snprintf(buf, sizeof buf, "%.*f", decimals, v);
   char *end = buf + strlen(buf);
-  while (end[-1] == '0') *--end = '\0';
-  if (end[-1] == '.') *--end = '\0';
+  if (strchr(buf, '.')) {
+    while (end[-1] == '0') *--end = '\0';
+    if (end[-1] == '.') *--end = '\0';
+  }
   fputs(strcmp(buf, "-0") ? buf : "0", f);
 }
+
+static void put_mm(FILE *f, double v) { lw_output_put_fixed(f, v, LW_OUTPUT_SVG_DECIMALS); }
 
 static void put_coords(FILE *f, const double *xy, int n)
 {
@@ -197,40 +196,23 @@ static void put_coords(FILE *f, const double *xy, int n)
   }
 }
 
-/* One path's d attribute.  Reversed, segment m's control points b3 b2 b1
-** b0 are written as they are, last segment first: the same numbers, so the
-** same curve to the last printed digit. */
+/* One path's d attribute, in the direction it is drawn. */
 static void put_path_data(FILE *f, const lw_strokes *s, size_t k)
 {
-  size_t a = s->first[k], n = s->first[k + 1] - a;
-  int reversed = s->reversed[k];
-  double r[8];
+  double cp[8];
   fputs("M", f);
-  for (size_t j = 0; j < n; j++) {
-    const double *b = s->b + 8 * (reversed ? a + n - 1 - j : a + j);
-    if (reversed)
-      for (int c = 0; c < 4; c++) {
-        r[2 * c] = b[6 - 2 * c];
-        r[2 * c + 1] = b[7 - 2 * c];
-      }
-    const double *cp = reversed ? r : b;
+  for (size_t j = 0; j < s->first[k + 1] - s->first[k]; j++) {
+    lw_strokes_drawn_segment(s, k, j, cp);
     if (!j) put_coords(f, cp, 1);
     fputs(" C", f);
     put_coords(f, cp + 2, 3);
   }
 }
 
-/* The first and one-past-last path of pen k. */
-static void pen_range(const lw_strokes *s, int k, size_t *a, size_t *z)
-{
-  *a = s->pen_first[k];
-  *z = k + 1 < s->n_pens ? s->pen_first[k + 1] : s->n;
-}
-
 lw_status lw_output_svg_strokes(const lw_strokes *s, const lw_output_page *page, const char *path,
                                 lw_error *err)
 {
-  lw_status st = check_strokes(s, page, NULL, path, err);
+  lw_status st = lw_output_check_strokes(s, page, NULL, path, err);
   if (st) return st;
   char tmp[LW_OUTPUT_PATH_MAX];
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
@@ -257,7 +239,7 @@ lw_status lw_output_svg_strokes(const lw_strokes *s, const lw_output_page *page,
     put_mm(f, pen->width_mm);
     fprintf(f, " mm)\" id=\"pen%d\">\n", k + 1);
     size_t a, z;
-    pen_range(s, k, &a, &z);
+    lw_strokes_pen_range(s, k, &a, &z);
     for (size_t j = a; j < z; j++) {
       /* Style on every path rather than inherited from the group: simple
       ** plotter tools read a path's own attributes only, and a closed curve
@@ -302,7 +284,7 @@ static void trace_path(cairo_t *cr, const lw_strokes *s, size_t k)
 void lw_output_cairo_strokes(cairo_t *cr, const lw_strokes *s, int pen)
 {
   size_t a = 0, z = s->n;
-  if (pen >= 0) pen_range(s, pen, &a, &z);
+  if (pen >= 0) lw_strokes_pen_range(s, pen, &a, &z);
   for (size_t k = a; k < z; k++) {
     trace_path(cr, s, k);
     /* One stroke per path keeps cairo's path memory to one path. */
@@ -388,7 +370,7 @@ static cairo_status_t file_write(void *closure, const unsigned char *data, unsig
 lw_status lw_output_png_strokes(const lw_strokes *st, const lw_output_page *page, const lw_grid2d *tone,
                                 double px_per_mm, const char *path, lw_error *err)
 {
-  lw_status s = check_strokes(st, page, tone, path, err);
+  lw_status s = lw_output_check_strokes(st, page, tone, path, err);
   if (s) return s;
   int w, h;
   double k;
@@ -466,7 +448,7 @@ lw_status lw_output_frame(const char *dir, long sweep, const lw_splines *sp, con
 lw_status lw_output_pdf_strokes(const lw_strokes *st, const lw_output_page *page, const lw_grid2d *tone,
                                 const char *path, lw_error *err)
 {
-  lw_status s = check_strokes(st, page, tone, path, err);
+  lw_status s = lw_output_check_strokes(st, page, tone, path, err);
   if (s) return s;
   char tmp[LW_OUTPUT_PATH_MAX];
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);

@@ -19,6 +19,7 @@
 #include "linewise/image.h"
 #include "linewise/number.h"
 #include "linewise/output.h"
+#include "linewise/plotter.h"
 #include "linewise/quad.h"
 #include "linewise/state.h"
 
@@ -426,6 +427,14 @@ const lw_param_def lw_param_table[] = {
       "Pixels per millimetre of final.png and the frames (the long side is capped at 4096 px)."),
   NUM("output", "pdf", LW_PT_INT, pdf, "0", "", 0, 1, 0,
       "1 = also write final.pdf, a vector PDF of the page."),
+  NUM("output", "hpgl", LW_PT_INT, hpgl, "0", "", 0, 1, 0,
+      "1 = also write final.hpgl, the drawing in HP-GL for pen plotters that read no SVG (HP, Roland; a "
+      "pen a carousel slot): the curves as chords within plot.tolerance, in plotter units of 0.025 mm "
+      "from the page's lower-left corner (docs/FORMATS.md)."),
+  NUM("output", "gcode", LW_PT_INT, gcode, "0", "", 0, 1, 0,
+      "1 = also write final.gcode, the drawing in G-code for GRBL and other CNC-style plotters: the "
+      "curves as chords within plot.tolerance, mm from the page's lower-left corner, the pen moved by "
+      "plot.gcode_pen_up and plot.gcode_pen_down, a pause (M0) to change pens (docs/FORMATS.md)."),
   NUM("output", "preview_image", LW_PT_INT, preview_image, "0", "", 0, 1, 0,
       "1 = paint the source image's tone under the lines of final.png, final.pdf and the frames "
       "(at half strength). Needs an image."),
@@ -460,13 +469,25 @@ const lw_param_def lw_param_table[] = {
       "out: below about three widths a stroke prints as a dot and costs a whole pen lift. 0 = "
       "keep all."),
   NUM("plot", "speed_down", LW_PT_DOUBLE, speed_down, "50", "mm/s", 0, 1e5, LW_MIN_OPEN,
-      "Pen-down speed for the plot time estimate. The default is an AxiDraw's at its default "
+      "Pen-down speed for the plot time estimate, and the speed final.hpgl (VS, in cm/s) and "
+      "final.gcode (F, in mm/min) draw at. The default is an AxiDraw's at its default "
       "settings (speed_pendown 25 % of the 8.6979 in/s high-resolution limit, scaled by 1/110)."),
   NUM("plot", "speed_up", LW_PT_DOUBLE, speed_up, "150", "mm/s", 0, 1e5, LW_MIN_OPEN,
       "Pen-up (travel) speed for the plot time estimate; AxiDraw default speed_penup 75 %."),
   NUM("plot", "lift_time", LW_PT_DOUBLE, lift_time, "0.2", "s", 0, 1e3, 0,
       "Time of one pen lift and lowering for the plot time estimate; an AxiDraw's servo at its "
       "default rates (raise 75 %, lower 50 %, over 30 % of a 200 ms sweep) takes about 0.2 s."),
+  NUM("plot", "tolerance", LW_PT_DOUBLE, plot_tolerance, "0.02", "mm", 1e-3, 10, 0,
+      "Largest distance between a curve and the chords that stand for it in final.hpgl and "
+      "final.gcode (straight moves only); HP-GL's 0.025 mm grid adds up to 0.018 mm. 0.02 mm is "
+      "far below a pen's width; larger values make shorter files."),
+  STRING("plot", "gcode_pen_up", gcode_pen_up, "G0 Z5", "",
+         "The G-code line that lifts the pen in final.gcode, written as it is: `G0 Z5` for a pen on the "
+         "Z axis, `M5` or `M3 S30` for a servo on a GRBL fork. One line of printable ASCII."),
+  STRING("plot", "gcode_pen_down", gcode_pen_down, "G1 Z0 F500", "",
+         "The G-code line that lowers the pen in final.gcode, written as it is (a feed it sets is "
+         "replaced by plot.speed_down on the first drawing move); e.g. `M3 S90 G4 P0.2` for a servo "
+         "that needs 0.2 s to settle. One line of printable ASCII."),
   STRING("layers", "names", ly_names, "", "",
          "Hatching layers or colour pens: one name a layer (letters, digits, `-`, `_`, `.`; it labels "
          "the pen's SVG layer), separated by blanks (at most 16). Each "
@@ -1178,6 +1199,16 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
     return lw_error_set(err, LW_EINPUT,
                         "%s: key 'output.pen_colors': expected %d colours '#rrggbb' or '#rgb' (one per pen), got '%s'",
                         where, p->pens, p->pen_colors);
+  }
+  /* A G-code sender takes a line as a command: an empty pen line would draw
+  ** every travel, a byte past ASCII is refused by most controllers. */
+  const char *pen_key[2] = {"gcode_pen_up", "gcode_pen_down"}, *pen_line[2] = {p->gcode_pen_up, p->gcode_pen_down};
+  for (int k = 0; p->gcode && k < 2; k++) {
+    if (lw_plotter_gcode_line_ok(pen_line[k])) continue;
+    lw_params_origin(p, lw_params_find("plot", pen_key[k]), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT,
+                        "%s: key 'plot.%s' = '%s': expected a G-code line of printable ASCII (output.gcode = 1)",
+                        where, pen_key[k], pen_line[k]);
   }
   return LW_OK;
 }

@@ -153,6 +153,26 @@ lw_strokes *lw_strokes_from_plot(const lw_splines *sp, const lw_plot *plot, lw_e
 
 /* ---- Bezier pieces -------------------------------------------------------- */
 
+void lw_strokes_pen_range(const lw_strokes *s, int k, size_t *a, size_t *z)
+{
+  *a = s->pen_first[k];
+  *z = k + 1 < s->n_pens ? s->pen_first[k + 1] : s->n;
+}
+
+void lw_strokes_drawn_segment(const lw_strokes *s, size_t k, size_t j, double *out)
+{
+  size_t a = s->first[k], n = s->first[k + 1] - a;
+  if (!s->reversed[k]) {
+    memcpy(out, s->b + 8 * (a + j), 8 * sizeof *out);
+    return;
+  }
+  const double *b = s->b + 8 * (a + n - 1 - j);
+  for (int c = 0; c < 4; c++) {
+    out[2 * c] = b[6 - 2 * c];
+    out[2 * c + 1] = b[7 - 2 * c];
+  }
+}
+
 void lw_bezier_eval(const double *b, double t, double *xy)
 {
   double u = 1.0 - t;

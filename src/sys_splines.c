@@ -195,7 +195,10 @@ static void *state_new(const void *setup, const lw_params *p, unsigned long seed
       lw_params_blame(p, "init", "from", err);
       return NULL;
     }
-    if (along_curve(&su->scene, sp, err) < 0) {
+    /* Renumbered for the sweeps' sake only: a run of no sweeps (a redraw)
+    ** keeps the state's numbering, and so its drawing's path ids, pens
+    ** and order. */
+    if (p->sweeps > 0 && along_curve(&su->scene, sp, err) < 0) {
       lw_splines_free(sp);
       return NULL;
     }

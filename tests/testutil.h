@@ -148,7 +148,6 @@ static inline int lw_test_dir_make(char dir[64], const char *tag)
   snprintf(dir, 64, "/tmp/lw_%s_XXXXXX", tag);
   return mkdtemp(dir) ? 0 : -1;
 }
-/* Runs a shell command built like printf; its exit status, or -1. */
 /* The whole file named by the format (NUL-terminated, caller frees), or NULL. */
 static inline char *lw_test_slurp(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 static inline char *lw_test_slurp(const char *fmt, ...)
@@ -172,6 +171,7 @@ static inline char *lw_test_slurp(const char *fmt, ...)
   return s;
 }
 
+/* Runs a shell command built like printf; its exit status, or -1. */
 static inline int lw_test_sh(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 static inline int lw_test_sh(const char *fmt, ...)
 {

@@ -37,6 +37,7 @@
 #define LW_OUTPUT_PNG_MAX_PX 4096     /* longest side of a preview, pixels */
 #define LW_OUTPUT_PATH_MAX 4096       /* room for "<path>.tmp" in the writers here */
 #define LW_OUTPUT_UNDERLAY_ALPHA 0.5  /* strength of the source image under a preview */
+#define LW_OUTPUT_SVG_DECIMALS 4      /* decimals of final.svg's millimetres */
 
 typedef struct {
   double width_mm;                    /* stroke width, mm (> 0) */
@@ -52,6 +53,18 @@ typedef struct {
                                          others by multiplying colours (cyan over yellow
                                          is green); 0: each paints over */
 } lw_output_page;
+
+/* v with `decimals` fixed decimals, trailing zeros and a bare point removed,
+** "-0" folded to "0".  Fixed decimals rather than %g: the precision of a plot
+** is absolute (mm), not relative, and %g would switch to exponents that some
+** plotter tools do not parse.  Any finite double fits (309 digits). */
+void lw_output_put_fixed(FILE *f, double v, int decimals);
+
+/* The page (as lw_output_svg checks it), tone (may be NULL) and paths of a
+** drawing that is about to be written to path: LW_EINPUT and err naming
+** path when a size, pen or control point is not what a file can hold. */
+lw_status lw_output_check_strokes(const lw_strokes *s, const lw_output_page *page, const lw_grid2d *tone,
+                                  const char *path, lw_error *err);
 
 /* A page of the given size with one pen: 0.3 mm, black. */
 void lw_output_page_init(lw_output_page *page, double width_mm, double height_mm);

@@ -175,6 +175,7 @@ typedef struct {
   int order;                  /* lw_plot_order: none, greedy, 2opt */
   double png_scale;           /* preview pixels per mm */
   int pdf;                    /* 1 = write final.pdf */
+  int hpgl, gcode;            /* 1 = write final.hpgl, final.gcode (plotter.h) */
   int preview_image;          /* 1 = tone under the previews */
   int frames_every;           /* sweeps between frames; 0 = none */
   double fidelity_sigma;      /* blur before the fidelity score, mm */
@@ -187,6 +188,8 @@ typedef struct {
   double min_length;          /* pen widths; 0 = keep all */
   double speed_down, speed_up; /* plot time estimate, mm/s */
   double lift_time;           /* s per pen lift */
+  double plot_tolerance;      /* chords of final.hpgl and final.gcode, mm */
+  char gcode_pen_up[128], gcode_pen_down[128]; /* final.gcode's pen lines */
   /* [layers] (layers.h) */
   char ly_names[LW_PATH_MAX]; /* layer names; empty = no layers */
   int ly_source;              /* LW_LSRC_* */

@@ -127,6 +127,14 @@ double lw_strokes_total_length(const lw_strokes *s);
 /* Plot time in seconds (see above); travel is the pen-up travel in mm. */
 double lw_strokes_time(const lw_strokes *s, double travel, double speed_down, double speed_up, double lift_time);
 
+/* The paths of pen k (0-based): a .. z - 1. */
+void lw_strokes_pen_range(const lw_strokes *s, int k, size_t *a, size_t *z);
+
+/* Segment j (0-based) of path k in the order the plotter draws it, into
+** out[8]: of a reversed path, the last stored segment first with its
+** control points b3 b2 b1 b0 (the same numbers, so the same curve). */
+void lw_strokes_drawn_segment(const lw_strokes *s, size_t k, size_t j, double *out);
+
 /* The point at t in [0, 1] of the cubic b[8] into xy[2]. */
 void lw_bezier_eval(const double *b, double t, double *xy);
 

@@ -1,0 +1,220 @@
+/* plotter.c -- final.hpgl and final.gcode: the paths as chords for
+** plotters that read no SVG (plotter.h). */
+#include "linewise/plotter.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* Coordinates past this (mm) are refused before anything is written: far
+** beyond any page the scene accepts (1e7 mm), and still exact integers of
+** HP-GL units and G-code's thousandths. */
+#define LW_PLOTTER_MM_MAX 1e8
+
+/* HP-GL's VS takes 0 < v < 128 cm/s. */
+#define LW_HPGL_VS_MIN 0.01
+#define LW_HPGL_VS_MAX 127.99
+
+/* Points a PD instruction carries: long lists are legal, but short ones
+** keep within the input buffers of older plotters. */
+#define LW_HPGL_PD_POINTS 32
+
+size_t lw_plotter_chords(const double *b, double tol)
+{
+  double m = 0.0;
+  for (int k = 0; k < 2; k++) {
+    const double *c = b + 2 * k;
+    double dx = c[0] - 2.0 * c[2] + c[4], dy = c[1] - 2.0 * c[3] + c[5];
+    m = fmax(m, hypot(dx, dy));
+  }
+  double n = ceil(sqrt(6.0 * m / (8.0 * tol)));
+  if (!(n >= 1.0)) return 1; /* also NaN */
+  return n > LW_PLOTTER_CHORDS_MAX ? LW_PLOTTER_CHORDS_MAX : (size_t)n;
+}
+
+int lw_plotter_gcode_line_ok(const char *line)
+{
+  for (const char *c = line; *c; c++)
+    if (*c < 0x20 || *c >= 0x7f) return 0;
+  return line[0] != '\0';
+}
+
+/* put(ctx, x, y) for the first point of path k and the end of each chord
+** after it, page millimetres (y down). */
+static void walk_path(const lw_strokes *s, size_t k, double tol, void (*put)(void *, double, double), void *ctx)
+{
+  double b[8], xy[2];
+  for (size_t j = 0; j < s->first[k + 1] - s->first[k]; j++) {
+    lw_strokes_drawn_segment(s, k, j, b);
+    if (!j) put(ctx, b[0], b[1]);
+    size_t n = lw_plotter_chords(b, tol);
+    for (size_t i = 1; i < n; i++) {
+      lw_bezier_eval(b, (double)i / (double)n, xy);
+      put(ctx, xy[0], xy[1]);
+    }
+    put(ctx, b[6], b[7]);
+  }
+}
+
+static lw_status check(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o, int gcode,
+                       const char *path, lw_error *err)
+{
+  lw_status st = lw_output_check_strokes(s, page, NULL, path, err);
+  if (st) return st;
+  if (!(o->tolerance > 0 && isfinite(o->tolerance)))
+    return lw_error_set(err, LW_EINPUT, "%s: chord tolerance %g mm: expected a positive number", path, o->tolerance);
+  if (!(o->speed_down > 0 && isfinite(o->speed_down)))
+    return lw_error_set(err, LW_EINPUT, "%s: pen-down speed %g mm/s: expected a positive number", path,
+                        o->speed_down);
+  for (size_t k = 0; k < 8 * s->n_segs; k++)
+    if (fabs(s->b[k]) > LW_PLOTTER_MM_MAX)
+      return lw_error_set(err, LW_EINPUT, "%s: a control point of segment %zu lies %g mm from the origin: "
+                          "expected at most %g", path, k / 8, fabs(s->b[k]), LW_PLOTTER_MM_MAX);
+  if (!gcode) return LW_OK;
+  const char *line[2] = {o->pen_up, o->pen_down}, *what[2] = {"pen-up", "pen-down"};
+  for (int k = 0; k < 2; k++) {
+    if (!line[k] || !lw_plotter_gcode_line_ok(line[k]))
+      return lw_error_set(err, LW_EINPUT, "%s: the %s line '%s': expected one line of printable ASCII", path,
+                          what[k], line[k] ? line[k] : "");
+  }
+  return LW_OK;
+}
+
+/* ---- HP-GL -------------------------------------------------------------- */
+
+typedef struct {
+  FILE *f;
+  double height;     /* page, mm: y flips about it */
+  long x, y;         /* the last point, plotter units */
+  size_t points;     /* points of the path so far */
+  size_t drawn;      /* of them in PD instructions */
+} hpgl_path;
+
+static void hpgl_point(void *ctx, double x, double y)
+{
+  hpgl_path *h = ctx;
+  long px = lround(x * LW_HPGL_UNITS_PER_MM), py = lround((h->height - y) * LW_HPGL_UNITS_PER_MM);
+  if (h->points++ == 0) {
+    fprintf(h->f, "PU%ld,%ld;\n", px, py);
+  } else {
+    if (px == h->x && py == h->y) return;
+    if (h->drawn % LW_HPGL_PD_POINTS == 0) fputs(h->drawn ? ";\nPD" : "PD", h->f);
+    else fputc(',', h->f);
+    fprintf(h->f, "%ld,%ld", px, py);
+    h->drawn++;
+  }
+  h->x = px;
+  h->y = py;
+}
+
+lw_status lw_output_hpgl_strokes(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o,
+                                 const char *path, lw_error *err)
+{
+  lw_status st = check(s, page, o, 0, path, err);
+  if (st) return st;
+  char tmp[LW_OUTPUT_PATH_MAX];
+  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
+  if (!f) return err ? err->code : LW_EIO;
+  fputs("IN;\nVS", f);
+  lw_output_put_fixed(f, fmin(fmax(o->speed_down / 10.0, LW_HPGL_VS_MIN), LW_HPGL_VS_MAX), 2);
+  fputs(";\n", f);
+  for (int k = 0; k < s->n_pens; k++) {
+    fprintf(f, "SP%d;\n", k + 1);
+    size_t a, z;
+    lw_strokes_pen_range(s, k, &a, &z);
+    for (size_t j = a; j < z; j++) {
+      hpgl_path h = {.f = f, .height = page->height_mm};
+      walk_path(s, j, o->tolerance, hpgl_point, &h);
+      /* a path that rounds to one point is a dot */
+      fputs(h.drawn ? ";\n" : "PD;\n", f);
+    }
+  }
+  fputs("PU;SP0;\n", f);
+  return lw_output_commit(f, tmp, path, err);
+}
+
+/* ---- G-code ------------------------------------------------------------- */
+
+typedef struct {
+  FILE *f;
+  const lw_plotter_options *o;
+  double height;     /* page, mm */
+  long long x, y;    /* the last point, thousandths of a mm */
+  size_t points;     /* points of the path so far */
+  size_t drawn;      /* of them drawn (G1) */
+} gcode_path;
+
+static void put_xy(FILE *f, long long x, long long y)
+{
+  fputs(" X", f);
+  lw_output_put_fixed(f, (double)x / 1000.0, LW_GCODE_DECIMALS);
+  fputs(" Y", f);
+  lw_output_put_fixed(f, (double)y / 1000.0, LW_GCODE_DECIMALS);
+}
+
+static void gcode_point(void *ctx, double x, double y)
+{
+  gcode_path *g = ctx;
+  long long px = llround(x * 1000.0), py = llround((g->height - y) * 1000.0);
+  if (g->points++ == 0) {
+    fputs("G0", g->f);
+    put_xy(g->f, px, py);
+    fprintf(g->f, "\n%s\n", g->o->pen_down);
+  } else {
+    if (px == g->x && py == g->y) return;
+    fputs("G1", g->f);
+    put_xy(g->f, px, py);
+    /* the pen-down line may set a feed of its own (G1 Z0 F...) */
+    if (g->drawn++ == 0) {
+      fputs(" F", g->f);
+      lw_output_put_fixed(g->f, 60.0 * g->o->speed_down, 1);
+    }
+    fputc('\n', g->f);
+  }
+  g->x = px;
+  g->y = py;
+}
+
+/* "pen 2 (cyan, #00ffff, 0.3 mm)" */
+static void put_pen(FILE *f, const lw_output_page *page, int k)
+{
+  const lw_output_pen *pen = &page->pen[k];
+  fprintf(f, "pen %d (", k + 1);
+  if (page->pen_name[k][0]) fprintf(f, "%s, ", page->pen_name[k]);
+  fprintf(f, "#%02x%02x%02x, ", pen->rgb[0], pen->rgb[1], pen->rgb[2]);
+  lw_output_put_fixed(f, pen->width_mm, LW_OUTPUT_SVG_DECIMALS);
+  fputs(" mm)", f);
+}
+
+lw_status lw_output_gcode_strokes(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o,
+                                  const char *path, lw_error *err)
+{
+  lw_status st = check(s, page, o, 1, path, err);
+  if (st) return st;
+  char tmp[LW_OUTPUT_PATH_MAX];
+  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
+  if (!f) return err ? err->code : LW_EIO;
+  fputs("; linewise: a page of ", f);
+  lw_output_put_fixed(f, page->width_mm, LW_OUTPUT_SVG_DECIMALS);
+  fputs(" x ", f);
+  lw_output_put_fixed(f, page->height_mm, LW_OUTPUT_SVG_DECIMALS);
+  fputs(" mm, origin at its lower-left corner, y up\n; load ", f);
+  put_pen(f, page, 0);
+  fprintf(f, " before starting\nG21\nG90\n%s\n", o->pen_up);
+  for (int k = 0; k < s->n_pens; k++) {
+    if (k) {
+      fputs("; load ", f);
+      put_pen(f, page, k);
+      fputs(", then resume\nM0\n", f);
+    }
+    size_t a, z;
+    lw_strokes_pen_range(s, k, &a, &z);
+    for (size_t j = a; j < z; j++) {
+      gcode_path g = {.f = f, .o = o, .height = page->height_mm};
+      walk_path(s, j, o->tolerance, gcode_point, &g);
+      fprintf(f, "%s\n", o->pen_up);
+    }
+  }
+  fputs("G0 X0 Y0\nM2\n", f);
+  return lw_output_commit(f, tmp, path, err);
+}

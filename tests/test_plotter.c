@@ -1,0 +1,389 @@
+/*
+** test_plotter.c -- final.hpgl and final.gcode (plotter.h): the chord count
+** keeps its bound and is not wasteful, both files read back to the curves
+** they stand for (pens, order, directions, the flipped y), their commands
+** come in the order a machine needs, bad options write nothing, and the
+** command line writes the same files for the same seed.
+*/
+#include <criterion/criterion.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "linewise/plotter.h"
+#include "testutil.h"
+
+#define PAGE_W 100.0
+#define PAGE_H 80.0
+#define TOL 0.02
+#define HPGL_ROUND (0.5 * M_SQRT2 / LW_HPGL_UNITS_PER_MM) /* a rounded point moves at most this */
+#define GCODE_ROUND (0.5e-3 * M_SQRT2)
+
+/* Distance from p to the segment a-b. */
+static double to_segment(const double *p, const double *a, const double *b)
+{
+  double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
+  double t = l2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0;
+  t = t < 0 ? 0 : t > 1 ? 1 : t;
+  return hypot(p[0] - a[0] - t * dx, p[1] - a[1] - t * dy);
+}
+
+/* A random cubic in a 40 mm box, some nearly straight, some looped. */
+static void random_cubic(double *b)
+{
+  double s = urand(0, 1) < 0.3 ? 0.05 : 1.0;
+  b[0] = urand(0, 40);
+  b[1] = urand(0, 40);
+  b[6] = urand(0, 40);
+  b[7] = urand(0, 40);
+  for (int c = 2; c < 6; c++) b[c] = (c & 1 ? b[1] : b[0]) + s * urand(-20, 20) + (b[6 + (c & 1)] - b[c & 1]) * (c / 2) / 3.0;
+}
+
+Test(plotter, chords_keep_every_point_within_the_tolerance)
+{
+  rng_seed(2026);
+  const double tols[] = {1e-3, 0.02, 0.5};
+  for (int trial = 0; trial < 300; trial++) {
+    double b[8];
+    random_cubic(b);
+    double tol = tols[trial % 3];
+    size_t n = lw_plotter_chords(b, tol);
+    cr_assert(n >= 1 && n <= LW_PLOTTER_CHORDS_MAX);
+    double worst = 0;
+    for (size_t i = 0; i < n; i++) {
+      double a[2], z[2];
+      lw_bezier_eval(b, (double)i / n, a);
+      lw_bezier_eval(b, (double)(i + 1) / n, z);
+      for (int q = 1; q < 32; q++) {
+        double p[2];
+        lw_bezier_eval(b, (i + q / 32.0) / n, p);
+        worst = fmax(worst, to_segment(p, a, z));
+      }
+    }
+    cr_assert(worst <= tol * (1 + 1e-9), "trial %d: %zu chords miss by %g > %g", trial, n, worst, tol);
+  }
+}
+
+Test(plotter, chords_are_the_fewest_on_a_parabola)
+{
+  /* A cubic that is a parabola has constant B'' = 6 d, and its chords over
+  ** [t0, t0 + h] miss it by exactly h^2/8 |B''| at their middles: the count
+  ** is tight when n - 1 chords would miss by more than tol, i.e. the miss
+  ** at n exceeds tol ((n - 1)/n)^2. */
+  const double tols[] = {1e-3, 3e-3, 0.02, 0.1};
+  for (int k = 0; k < 4; k++) {
+    double q0[2] = {0, 0}, q1[2] = {15, 9}, q2[2] = {30, -2};
+    double b[8] = {q0[0], q0[1], q0[0] + 2 * (q1[0] - q0[0]) / 3, q0[1] + 2 * (q1[1] - q0[1]) / 3,
+                   q2[0] + 2 * (q1[0] - q2[0]) / 3, q2[1] + 2 * (q1[1] - q2[1]) / 3, q2[0], q2[1]};
+    size_t n = lw_plotter_chords(b, tols[k]);
+    cr_assert(n >= 2);
+    double h = 1.0 / n, d = hypot(b[0] - 2 * b[2] + b[4], b[1] - 2 * b[3] + b[5]);
+    double miss = h * h / 8 * 6 * d;
+    double p[2], a[2], z[2];
+    lw_bezier_eval(b, 0.5 * h, p);
+    lw_bezier_eval(b, 0, a);
+    lw_bezier_eval(b, h, z);
+    cr_assert(fabs(hypot(p[0] - 0.5 * (a[0] + z[0]), p[1] - 0.5 * (a[1] + z[1])) - miss) < 1e-12);
+    cr_assert(miss <= tols[k] && miss > tols[k] * pow((n - 1.0) / n, 2), "n = %zu, miss %g, tol %g", n, miss,
+              tols[k]);
+  }
+}
+
+/* The drawing the file tests read back: pen 1 a circle of four cubics
+** (forward) and an S-curve drawn backwards, pen 2 a straight line. */
+static lw_strokes *drawing(void)
+{
+  lw_strokes *s = lw_strokes_new(2, NULL);
+  const double k = 0.5522847498 * 20, cx = 50, cy = 40;
+  double circle[32] = {cx + 20, cy,     cx + 20, cy + k, cx + k,  cy + 20, cx,      cy + 20,
+                       cx,      cy + 20, cx - k, cy + 20, cx - 20, cy + k, cx - 20, cy,
+                       cx - 20, cy,     cx - 20, cy - k, cx - k,  cy - 20, cx,      cy - 20,
+                       cx,      cy - 20, cx + k, cy - 20, cx + 20, cy - k, cx + 20, cy};
+  double scurve[16] = {5, 5, 25, 5, 5, 30, 25, 30, 25, 30, 45, 30, 25, 55, 45, 75};
+  double line[8] = {90, 2, 90, 30, 91, 50, 91, 78};
+  cr_assert_eq(lw_strokes_add(s, 0, 0, 0, 0, circle, 4, NULL), LW_OK);
+  cr_assert_eq(lw_strokes_add(s, 0, 1, 0, 1, scurve, 2, NULL), LW_OK);
+  cr_assert_eq(lw_strokes_add(s, 1, 2, 0, 0, line, 1, NULL), LW_OK);
+  return s;
+}
+
+static lw_output_page page_of(void)
+{
+  lw_output_page page;
+  lw_output_page_init(&page, PAGE_W, PAGE_H);
+  page.n_pens = 2;
+  page.pen[1] = (lw_output_pen){0.5, {0, 255, 255}};
+  snprintf(page.pen_name[1], sizeof page.pen_name[1], "cyan");
+  return page;
+}
+
+/* A polyline read back from a file, page coordinates (y down). */
+typedef struct {
+  int pen;
+  size_t n;
+  double xy[2 * 8192];
+} polyline;
+
+/* Both ways: every vertex near the path's curve (rounding only), every
+** point of the curve near the polyline (tolerance plus rounding), and the
+** ends where the path is drawn from and to. */
+static void assert_matches(const lw_strokes *s, size_t k, const polyline *pl, double round)
+{
+  double b[8], start[2], end[2];
+  size_t nseg = s->first[k + 1] - s->first[k];
+  lw_strokes_drawn_segment(s, k, 0, b);
+  start[0] = b[0];
+  start[1] = b[1];
+  lw_strokes_drawn_segment(s, k, nseg - 1, b);
+  end[0] = b[6];
+  end[1] = b[7];
+  cr_assert(pl->n >= 2, "path %zu: %zu points", k, pl->n);
+  cr_assert(hypot(pl->xy[0] - start[0], pl->xy[1] - start[1]) <= round, "path %zu starts elsewhere", k);
+  cr_assert(hypot(pl->xy[2 * pl->n - 2] - end[0], pl->xy[2 * pl->n - 1] - end[1]) <= round, "path %zu ends elsewhere",
+            k);
+  enum { DENSE = 2000 };
+  static double curve[2 * 8 * (DENSE + 1)];
+  size_t nc = 0;
+  for (size_t j = 0; j < nseg; j++) {
+    lw_strokes_drawn_segment(s, k, j, b);
+    for (int q = 0; q <= DENSE; q++, nc++) lw_bezier_eval(b, (double)q / DENSE, curve + 2 * nc);
+  }
+  /* the dense samples' own chords miss the curve by under 1e-5 mm */
+  for (size_t v = 0; v < pl->n; v++) {
+    double best = INFINITY;
+    for (size_t c = 0; c + 1 < nc; c++) best = fmin(best, to_segment(pl->xy + 2 * v, curve + 2 * c, curve + 2 * c + 2));
+    cr_assert(best <= round + 1e-5, "path %zu vertex %zu lies %g from the curve", k, v, best);
+  }
+  size_t from = 0;
+  for (size_t c = 0; c < nc; c++) {
+    /* the polyline runs along the curve, so the nearest chord is at or
+    ** after the last one found */
+    double best = INFINITY;
+    size_t at = from;
+    for (size_t v = from; v + 1 < pl->n; v++) {
+      double d = to_segment(curve + 2 * c, pl->xy + 2 * v, pl->xy + 2 * v + 2);
+      if (d < best) {
+        best = d;
+        at = v;
+      }
+      if (d > 2.0 && v > at + 4) break;
+    }
+    from = at;
+    cr_assert(best <= TOL + round, "path %zu: the curve lies %g from its chords", k, best);
+  }
+}
+
+static lw_plotter_options options(void)
+{
+  return (lw_plotter_options){.tolerance = TOL, .speed_down = 50, .pen_up = "M3 S30", .pen_down = "M3 S90 G4 P0.2"};
+}
+
+/* The drawing() written by `write` to dir/name; its text (caller frees),
+** the drawing in *s. */
+static char *written(lw_status (*write)(const lw_strokes *, const lw_output_page *, const lw_plotter_options *,
+                                        const char *, lw_error *),
+                     const char *name, char dir[64], lw_strokes **s)
+{
+  char path[128];
+  cr_assert_eq(lw_test_dir_make(dir, "plotter"), 0);
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  *s = drawing();
+  lw_output_page page = page_of();
+  lw_plotter_options o = options();
+  cr_assert_eq(write(*s, &page, &o, path, NULL), LW_OK);
+  char *text = lw_test_slurp("%s", path);
+  cr_assert_not_null(text);
+  return text;
+}
+
+Test(plotter, hpgl_reads_back_to_the_curves_pen_by_pen)
+{
+  char dir[64];
+  lw_strokes *s;
+  char *text = written(lw_output_hpgl_strokes, "final.hpgl", dir, &s);
+  /* instructions are separated by ';', the newlines between them ignored */
+  static polyline pl[3];
+  int pen = 0, paths = 0, sp0 = 0;
+  size_t n_ins = 0;
+  for (char *ins = strtok(text, ";\n"); ins; ins = strtok(NULL, ";\n"), n_ins++) {
+    cr_assert(!sp0, "'%s' after SP0", ins);
+    if (n_ins == 0) cr_assert_str_eq(ins, "IN");
+    else if (n_ins == 1) cr_assert_str_eq(ins, "VS5", "50 mm/s is 5 cm/s");
+    else if (!strncmp(ins, "SP", 2)) {
+      int k = atoi(ins + 2);
+      if (k == 0) {
+        sp0 = 1;
+      } else {
+        cr_assert_eq(k, pen + 1, "pens in order");
+        pen = k;
+      }
+    } else if (!strcmp(ins, "PU")) {
+      continue;
+    } else if (!strncmp(ins, "PU", 2)) {
+      cr_assert(paths < 3 && pen >= 1);
+      polyline *p = &pl[paths++];
+      p->pen = pen;
+      long x, y;
+      cr_assert_eq(sscanf(ins + 2, "%ld,%ld", &x, &y), 2, "%s", ins);
+      p->xy[0] = x / LW_HPGL_UNITS_PER_MM;
+      p->xy[1] = PAGE_H - y / LW_HPGL_UNITS_PER_MM;
+      p->n = 1;
+    } else {
+      cr_assert(!strncmp(ins, "PD", 2) && paths > 0, "unexpected '%s'", ins);
+      polyline *p = &pl[paths - 1];
+      for (char *c = ins + 2; *c;) {
+        long x = strtol(c, &c, 10);
+        cr_assert_eq(*c, ',');
+        long y = strtol(c + 1, &c, 10);
+        if (*c == ',') c++;
+        p->xy[2 * p->n] = x / LW_HPGL_UNITS_PER_MM;
+        p->xy[2 * p->n + 1] = PAGE_H - y / LW_HPGL_UNITS_PER_MM;
+        cr_assert(p->n == 0 || p->xy[2 * p->n] != p->xy[2 * p->n - 2] || p->xy[2 * p->n + 1] != p->xy[2 * p->n - 1],
+                  "a repeated point");
+        p->n++;
+      }
+    }
+  }
+  cr_assert(sp0, "the pen is put back at the end");
+  cr_assert_eq(paths, 3);
+  cr_assert(pl[0].pen == 1 && pl[1].pen == 1 && pl[2].pen == 2);
+  for (size_t k = 0; k < 3; k++) assert_matches(s, k, &pl[k], HPGL_ROUND + 1e-12);
+  /* the S-curve is drawn from its last point */
+  cr_assert(fabs(pl[1].xy[0] - 45) < 0.02 && fabs(pl[1].xy[1] - 75) < 0.02);
+  free(text);
+  lw_strokes_free(s);
+  lw_test_sh("rm -rf %s", dir);
+}
+
+Test(plotter, gcode_reads_back_and_moves_the_pen_in_order)
+{
+  char dir[64];
+  lw_strokes *s;
+  char *text = written(lw_output_gcode_strokes, "final.gcode", dir, &s);
+  lw_plotter_options o = options();
+  static polyline pl[3];
+  int down = 0, pen = 1, paths = 0, pauses = 0, ended = 0, units = 0, absolute = 0, feed_next = 0;
+  for (char *line = strtok(text, "\n"); line; line = strtok(NULL, "\n")) {
+    cr_assert(!ended, "'%s' after M2", line);
+    if (line[0] == ';') {
+      if (strstr(line, "load pen 2 (cyan, #00ffff, 0.5 mm)")) cr_assert_eq(pauses, 0, "the note comes before M0");
+      continue;
+    }
+    if (!strcmp(line, "G21")) units = 1;
+    else if (!strcmp(line, "G90")) absolute = 1;
+    else if (!strcmp(line, o.pen_up)) down = 0;
+    else if (!strcmp(line, o.pen_down)) {
+      cr_assert(!down && paths > 0);
+      down = feed_next = 1;
+    } else if (!strcmp(line, "M0")) {
+      cr_assert(!down, "the pen is up for a change");
+      pauses++;
+      pen++;
+    } else if (!strcmp(line, "M2")) {
+      ended = 1;
+    } else {
+      double x, y;
+      cr_assert(units && absolute, "millimetres and absolute before any move");
+      int g = -1;
+      cr_assert_eq(sscanf(line, "G%d X%lf Y%lf", &g, &x, &y), 3, "'%s'", line);
+      const char *f = strstr(line, " F");
+      if (g == 0) {
+        cr_assert(!down, "a travel with the pen down: '%s'", line);
+        if (x == 0 && y == 0) continue; /* home */
+        cr_assert(paths < 3);
+        pl[paths] = (polyline){.pen = pen, .n = 0};
+        paths++;
+      } else {
+        cr_assert(g == 1 && down, "'%s'", line);
+        cr_assert_eq(f != NULL, feed_next, "the feed after each pen-down only: '%s'", line);
+        if (f) cr_assert_eq(atof(f + 2), 3000.0, "50 mm/s is 3000 mm/min");
+        feed_next = 0;
+      }
+      polyline *p = &pl[paths - 1];
+      p->xy[2 * p->n] = x;
+      p->xy[2 * p->n + 1] = PAGE_H - y;
+      p->n++;
+    }
+  }
+  cr_assert(ended && !down);
+  cr_assert_eq(pauses, 1, "one pen change");
+  cr_assert_eq(paths, 3);
+  cr_assert(pl[0].pen == 1 && pl[1].pen == 1 && pl[2].pen == 2);
+  for (size_t k = 0; k < 3; k++) assert_matches(s, k, &pl[k], GCODE_ROUND + 1e-12);
+  free(text);
+  lw_strokes_free(s);
+  lw_test_sh("rm -rf %s", dir);
+}
+
+Test(plotter, bad_options_leave_the_old_file)
+{
+  char dir[64], path[128];
+  cr_assert_eq(lw_test_dir_make(dir, "plotter"), 0);
+  snprintf(path, sizeof path, "%s/final.gcode", dir);
+  cr_assert_eq(lw_test_write_text(dir, "final.gcode", "old\n"), 0);
+  lw_strokes *s = drawing();
+  lw_output_page page = page_of();
+  lw_plotter_options bad[4] = {options(), options(), options(), options()};
+  bad[0].tolerance = 0;
+  bad[1].speed_down = NAN;
+  bad[2].pen_up = "G0 Z5\nM2";
+  bad[3].pen_down = "";
+  for (int k = 0; k < 4; k++) {
+    lw_error err = {0};
+    cr_assert_eq(lw_output_gcode_strokes(s, &page, &bad[k], path, &err), LW_EINPUT, "case %d", k);
+    cr_assert(strstr(err.msg, path), "case %d: %s", k, err.msg);
+    char *text = lw_test_slurp("%s", path);
+    cr_assert_str_eq(text, "old\n");
+    free(text);
+    cr_assert_neq(lw_test_sh("test -e %s.tmp", path), 0, "no temporary file left");
+  }
+  page.height_mm = -1;
+  cr_assert_eq(lw_output_hpgl_strokes(s, &page, &bad[3], path, NULL), LW_EINPUT);
+  lw_strokes_free(s);
+  lw_test_sh("rm -rf %s", dir);
+}
+
+Test(plotter, command_line_writes_the_same_files_for_the_same_seed)
+{
+  const char *bin = lw_test_bin(), *root = lw_test_root();
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "plotter"), 0);
+  const char *set = "--set output.hpgl=1 --set output.gcode=1 --set output.pens=2 --set anneal.sweeps=30";
+  for (int r = 0; r < 2; r++)
+    cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini %s --quiet --out %s/r%d", bin, root, set, dir, r), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set anneal.sweeps=30 --set output.pens=2 --quiet "
+                          "--out %s/plain", bin, root, dir), 0);
+  cr_assert_eq(lw_test_sh("cmp -s %s/r0/final.hpgl %s/r1/final.hpgl && cmp -s %s/r0/final.gcode %s/r1/final.gcode",
+                          dir, dir, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("cmp -s %s/r0/final.svg %s/plain/final.svg && test ! -e %s/plain/final.gcode", dir, dir,
+                          dir), 0, "the machine files change nothing else");
+  /* one pen-down a path of final.svg, one SP a pen */
+  char *svg = lw_test_slurp("%s/r0/final.svg", dir), *gcode = lw_test_slurp("%s/r0/final.gcode", dir),
+       *hpgl = lw_test_slurp("%s/r0/final.hpgl", dir);
+  size_t paths = 0, downs = 0, sp = 0, pu = 0;
+  for (const char *c = svg; (c = strstr(c, "<path")); c++) paths++;
+  for (const char *c = gcode; (c = strstr(c, "\nG1 Z0 F500\n")); c++) downs++;
+  for (const char *c = hpgl; (c = strstr(c, "SP")); c++) sp++;
+  for (const char *c = hpgl; (c = strstr(c, "PU")); c++) pu += c[2] != ';';
+  cr_assert(paths > 5);
+  cr_assert_eq(downs, paths);
+  cr_assert_eq(pu, paths);
+  cr_assert_eq(sp, 3, "SP1, SP2, SP0");
+  free(svg);
+  free(gcode);
+  free(hpgl);
+  /* redrawn from its state without sweeps, the run draws the same */
+  cr_assert_eq(lw_test_sh("%s run %s/r0/scene.ini --set init.from=%s/r0/state.lw --set anneal.sweeps=0 --quiet "
+                          "--out %s/redraw && cmp -s %s/r0/final.svg %s/redraw/final.svg && "
+                          "cmp -s %s/r0/final.hpgl %s/redraw/final.hpgl",
+                          bin, dir, dir, dir, dir, dir, dir, dir), 0);
+  /* an empty pen line is refused, naming the key */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set plot.gcode_pen_up= --quiet "
+                          "--out %s/bad 2>%s/err.txt", bin, root, dir, dir), 2);
+  char *errs = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(errs, "key 'plot.gcode_pen_up'") && strstr(errs, "expected a G-code line"), "%s", errs);
+  free(errs);
+  cr_assert_neq(lw_test_sh("test -e %s/bad", dir), 0, "nothing written");
+  lw_test_sh("rm -rf %s", dir);
+}
