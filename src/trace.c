@@ -330,6 +330,82 @@ static void stretch_line(FILE *out, const char *lead, const lw_trace *t, const c
   fputc('\n', out);
 }
 
+/* The energy columns whose fluctuations make a heat capacity, each with its
+** temperature column: with tempering every rung's energy at the rung's
+** temperature, else the total at the row's (the dynamics has neither).
+** Their count, at most max. */
+static int heat_sources(const lw_trace *t, int *energy, int *temp, int max)
+{
+  int n = 0;
+  for (; n < max; n++) {
+    char e[48], tt[48];
+    snprintf(e, sizeof e, "replica%d_energy", n);
+    snprintf(tt, sizeof tt, "replica%d_temperature", n);
+    if ((energy[n] = lw_trace_column(t, e)) < 0 || (temp[n] = lw_trace_column(t, tt)) < 0) break;
+  }
+  if (n || max < 1) return n;
+  energy[0] = lw_trace_column(t, "total");
+  temp[0] = lw_trace_column(t, "temperature");
+  return energy[0] >= 0 && temp[0] >= 0;
+}
+
+/* A copy of t with a heat capacity column after its own for each source:
+** `heat_capacity` of the total, `replicaK_heat_capacity` of rung K.  On
+** the n rows chosen its values are (E - <E>)^2 / T^2, <E> their mean, so
+** that the column's mean is C = Var(E) / T^2 (k_B = 1) and its error bar
+** comes from its own autocorrelation like any column's; elsewhere, and
+** where T changes within the rows (no ensemble to speak of), they are
+** empty. */
+static lw_trace *with_heat_capacity(const lw_trace *t, const size_t *rows, size_t n, const char *path,
+                                    lw_error *err)
+{
+  int energy[LW_TRACE_HEAT_MAX], temp[LW_TRACE_HEAT_MAX];
+  const int k = heat_sources(t, energy, temp, LW_TRACE_HEAT_MAX);
+  const size_t cols = t->n_cols + (size_t)k;
+  lw_trace *h = calloc(1, sizeof *h);
+  if (!h || !(h->name = calloc(cols, sizeof *h->name)) ||
+      !(h->v = malloc((t->n_rows ? t->n_rows : 1) * cols * sizeof *h->v))) {
+    lw_trace_free(h);
+    lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+    return NULL;
+  }
+  h->n_rows = t->n_rows;
+  for (size_t c = 0; c < cols; c++) {
+    char derived[64] = "";
+    if (c >= t->n_cols) { /* replicaK_energy -> replicaK_heat_capacity, total -> heat_capacity */
+      const char *src = t->name[energy[c - t->n_cols]];
+      int keep = strcmp(src, "total") ? (int)(strlen(src) - strlen("energy")) : 0;
+      snprintf(derived, sizeof derived, "%.*sheat_capacity", keep, src);
+    }
+    if (!(h->name[c] = strdup(c < t->n_cols ? t->name[c] : derived))) {
+      lw_trace_free(h);
+      lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+      return NULL;
+    }
+    h->n_cols = c + 1;
+  }
+  for (size_t r = 0; r < t->n_rows; r++) {
+    memcpy(h->v + r * cols, t->v + r * t->n_cols, t->n_cols * sizeof *h->v);
+    for (int j = 0; j < k; j++) h->v[r * cols + t->n_cols + (size_t)j] = NAN;
+  }
+  for (int j = 0; j < k; j++) {
+    double mean = 0.0, T = at(t, rows[0], temp[j]);
+    size_t m = 0;
+    int same = 1;
+    for (size_t i = 0; i < n; i++) {
+      double e = at(t, rows[i], energy[j]);
+      same &= at(t, rows[i], temp[j]) == T;
+      if (!isnan(e)) mean += (e - mean) / (double)++m;
+    }
+    if (!same || !(T > 0.0)) continue;
+    for (size_t i = 0; i < n; i++) {
+      double d = at(t, rows[i], energy[j]) - mean;
+      h->v[rows[i] * cols + t->n_cols + (size_t)j] = d * d / (T * T);
+    }
+  }
+  return h;
+}
+
 /* Refuses a run whose columns are not the first run's. */
 static lw_status same_columns(const lw_trace *a, const char *pa, const lw_trace *b, const char *pb, lw_error *err)
 {
@@ -347,9 +423,12 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
   size_t **row = calloc((size_t)k, sizeof *row), *n = calloc((size_t)k, sizeof *n);
   size_t *tuned = calloc((size_t)k, sizeof *tuned);
   double *every = calloc((size_t)k, sizeof *every), *x = NULL;
-  column_stats *cs = calloc(t[0]->n_cols, sizeof *cs);
-  lw_series_stats *runs = calloc(t[0]->n_cols * (size_t)k, sizeof *runs);
-  lw_status status = row && n && tuned && every && cs && runs ? LW_OK : lw_error_set(err, LW_ENOMEM, "out of memory");
+  lw_trace **heat = calloc((size_t)k, sizeof *heat); /* t with its heat capacities */
+  const size_t cols = t[0]->n_cols + LW_TRACE_HEAT_MAX;
+  column_stats *cs = calloc(cols, sizeof *cs);
+  lw_series_stats *runs = calloc(cols * (size_t)k, sizeof *runs);
+  lw_status status =
+      row && n && tuned && every && heat && cs && runs ? LW_OK : lw_error_set(err, LW_ENOMEM, "out of memory");
   size_t most = 0;
   for (int r = 0; !status && r < k; r++) {
     if (r && (status = same_columns(t[0], path[0], t[r], path[r], err))) break;
@@ -358,7 +437,10 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     if (n[r] > most) most = n[r];
   }
   if (!status && !(x = malloc(most * sizeof *x))) status = lw_error_set(err, LW_ENOMEM, "out of memory");
+  for (int r = 0; !status && r < k; r++)
+    if (!(heat[r] = with_heat_capacity(t[r], row[r], n[r], path[r], err))) status = err ? err->code : LW_ENOMEM;
   if (status) goto done;
+  t = (const lw_trace *const *)heat;
   double tlo = INFINITY, thi = -INFINITY;
   for (int r = 0; r < k; r++) temperature_range(t[r], row[r], n[r], &tlo, &thi);
   for (size_t c = 0; c < t[0]->n_cols; c++) {
@@ -377,13 +459,16 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       if (!strncmp(t[0]->name[c], "acc_", 4) || !strncmp(t[0]->name[c], "swap", 4)) cs[c].p_runs = cs[c].r_hat = NAN;
     }
   }
+  int width = 16; /* the names' column */
+  for (size_t c = 0; c < t[0]->n_cols; c++)
+    if (!is_coordinate(t[0]->name[c]) && strlen(t[0]->name[c]) > (size_t)width) width = (int)strlen(t[0]->name[c]);
   if (csv) {
     fprintf(out, k > 1 ? "column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs\n"
                        : "column,n,mean,stderr,sd,tau_sweeps,n_eff,window_closed,drift_z\n");
   } else {
     if (k > 1) fprintf(out, "%d runs:\n", k);
     for (int r = 0; r < k; r++) stretch_line(out, k > 1 ? "  " : "", t[r], path[r], row[r], n[r], tuned[r]);
-    fprintf(out, "%-16s %15s %11s %11s %11s %9s", "column", "mean", "stderr", "sd", "tau_sweeps", "n_eff");
+    fprintf(out, "%-*s %15s %11s %11s %11s %9s", width, "column", "mean", "stderr", "sd", "tau_sweeps", "n_eff");
     fprintf(out, k > 1 ? " %8s %9s\n" : "\n", "R_hat", "p_runs");
   }
   for (size_t c = 0; c < t[0]->n_cols; c++) {
@@ -392,7 +477,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     const lw_series_stats *s = &q->run[0];
     if (is_coordinate(name)) continue;
     if (!s->n) {
-      if (!csv) fprintf(out, "%-16s %15s\n", name, "(empty)");
+      if (!csv) fprintf(out, "%-*s %15s\n", width, name, "(empty)");
     } else if (k > 1) {
       size_t rows = 0;
       for (int r = 0; r < k; r++) rows += q->run[r].n;
@@ -409,15 +494,15 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
         fprintf(out, "%s,%d,%zu,%.10g,%.4g,%.4g,%s,%s,%s,%s\n", name, k, rows, q->mean, q->stderr_mean, q->sd,
                 tau, neff, rh, pr);
       else
-        fprintf(out, "%-16s %15.9g %11.4g %11.4g %11s %9s %8s %9s%s\n", name, q->mean, q->stderr_mean, q->sd, tau,
+        fprintf(out, "%-*s %15.9g %11.4g %11.4g %11s %9s %8s %9s%s\n", width, name, q->mean, q->stderr_mean, q->sd, tau,
                 neff, rh, pr, flagged(q, k) ? " *" : "");
     } else if (csv) {
       fprintf(out, "%s,%zu,%.10g,%.4g,%.4g,%.4g,%.4g,%d,%.3g\n", name, s->n, s->mean, s->stderr_mean, s->sd,
               s->tau * every[0], s->n_eff, s->window > 0, s->drift_z);
     } else if (!(s->sd > 0.0)) {
-      fprintf(out, "%-16s %15.9g %11.4g %11.4g %11s %9s\n", name, s->mean, 0.0, 0.0, "-", "-");
+      fprintf(out, "%-*s %15.9g %11.4g %11.4g %11s %9s\n", width, name, s->mean, 0.0, 0.0, "-", "-");
     } else {
-      fprintf(out, "%-16s %15.9g %11.4g %11.4g %11.4g %9.0f%s\n", name, s->mean, s->stderr_mean, s->sd,
+      fprintf(out, "%-*s %15.9g %11.4g %11.4g %11.4g %9.0f%s\n", width, name, s->mean, s->stderr_mean, s->sd,
               s->tau * every[0], s->n_eff, flagged(q, 1) ? " *" : "");
     }
   }
@@ -435,6 +520,8 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
   }
 done:
   for (int r = 0; row && r < k; r++) free(row[r]);
+  for (int r = 0; heat && r < k; r++) lw_trace_free(heat[r]);
+  free(heat);
   free(row);
   free(n);
   free(tuned);

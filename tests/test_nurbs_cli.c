@@ -4,6 +4,7 @@
 ** exact Beziers), Monte Carlo on a rational curve, and bad [nurbs] input.
 */
 #include <criterion/criterion.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -53,6 +54,36 @@ Test(nurbs_cli, monte_carlo_anneals_a_rational_curve_and_bounds_its_svg)
   /* the energy command recomputes the saved state's energy */
   cr_assert_eq(sh("%s energy %s/c > %s/e.txt", lw_test_bin(), dir, dir), 0);
   cr_assert_eq(sh("grep -q elastic %s/e.txt", dir), 0);
+}
+
+Test(nurbs_cli, monte_carlo_heat_capacity_is_half_the_free_coordinates)
+{
+  /* The wire's energy is quadratic in its control points (weights frozen,
+  ** gravity linear), so the Boltzmann distribution is Gaussian in its
+  ** 5 free points (the ends held): 10 coordinates, Var(E) = 10/2 T^2 at
+  ** every temperature, a heat capacity of 5 on each rung of a ladder.
+  ** `linewise stats` must find that within 4 of its own error bars, which
+  ** must be small enough (under 5 % of C) for the check to mean something.
+  ** Fixed seed; 38,000 sweeps a rung after a burn-in of 2000. */
+  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/pt --quiet --set scene.driver=metropolis "
+                  "--set anneal.schedule=constant --set anneal.t_start=1 --set anneal.t_end=1 "
+                  "--set anneal.sweeps=40000 --set moves.tune_sweeps=500 --set output.frames_every=0 "
+                  "--set output.stats_from=2000 --set tempering.replicas=3 --set 'tempering.ladder=1 2 4'",
+                  lw_test_bin(), lw_test_root(), dir), 0);
+  cr_assert_eq(sh("%s stats %s/pt --csv > %s/pt.csv", lw_test_bin(), dir, dir), 0);
+  char *csv = lw_test_slurp("%s/pt.csv", dir);
+  cr_assert_not_null(csv);
+  for (int k = 0; k < 3; k++) {
+    char key[64];
+    snprintf(key, sizeof key, "\nreplica%d_heat_capacity,", k);
+    const char *l = strstr(csv, key);
+    cr_assert_not_null(l, "%s", csv);
+    double n, c, se;
+    cr_assert_eq(sscanf(strchr(l + 1, ',') + 1, "%lf,%lf,%lf", &n, &c, &se), 3, "%s", l);
+    cr_log_info("rung %d: C = %.4f +- %.4f (5)", k, c, se);
+    cr_assert(se > 0 && se < 0.25 && fabs(c - 5.0) < 4 * se, "rung %d: C = %g +- %g, expected 5", k, c, se);
+  }
+  free(csv);
 }
 
 /* A scene's [nurbs] key with a bad value: exit 2, the file, line and key

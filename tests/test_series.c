@@ -319,6 +319,79 @@ Test(trace, several_runs_agree_or_are_flagged, .init = make_dir, .fini = remove_
   for (int r = 0; r < 4; r++) lw_trace_free(t[r]);
 }
 
+/* The value of column col in the CSV of `linewise stats` (field 3: the
+** mean; 4: its error bar), or NAN when the line is missing. */
+static double csv_field(const char *csv, const char *col, int field)
+{
+  char key[64];
+  snprintf(key, sizeof key, "\n%s,", col);
+  const char *l = strstr(csv, key);
+  if (!l) return NAN;
+  for (int c = 1; c < field; c++) l = strchr(l + 1, ',');
+  return atof(l + 1);
+}
+
+Test(trace, the_heat_capacity_is_the_energy_variance_over_t_squared, .init = make_dir, .fini = remove_dir)
+{
+  /* Independent Gaussian energies of sd 3 at T = 0.5: C = 9 / 0.25 = 36.
+  ** Its estimate is the mean of (E - <E>)^2 / T^2, whose sd is sqrt(2) 36
+  ** for a Gaussian, so over n = 20000 rows the error bar should be
+  ** 36 sqrt(2 / n) = 0.36 (within 10 %: tau of an independent series is
+  ** estimated near 1/2), and the estimate within 4 of them.  With
+  ** tempering each rung gets its own; where T changes within the rows
+  ** there is none. */
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 42);
+  const size_t rows = 20000;
+  size_t cap = 96 * rows, k = 0;
+  char *text = malloc(cap), path[128];
+  k += (size_t)snprintf(text, cap, "sweep,temperature,total,replica0_temperature,replica0_energy,"
+                                   "replica1_temperature,replica1_energy\n");
+  for (size_t t = 0; t < rows; t++) {
+    double e0 = 100.0 + gsl_ran_gaussian(r, 3.0), e1 = 200.0 + gsl_ran_gaussian(r, 8.0);
+    k += (size_t)snprintf(text + k, cap - k, "%zu,0.5,%.17g,0.5,%.17g,%g,%.17g\n", t + 1, e0, e0,
+                          t < rows / 2 ? 2.0 : 2.5, e1);
+  }
+  write_trace("t.csv", text, path, sizeof path);
+  lw_error err;
+  lw_trace *t = lw_trace_read(path, &err);
+  cr_assert_not_null(t, "%s", err.msg);
+  static char out[8192];
+  lw_trace_select sel = {.from = -1, .to = -1, .csv = 1};
+  stats_csv(t, &sel, out, sizeof out);
+  double c = csv_field(out, "replica0_heat_capacity", 3), se = csv_field(out, "replica0_heat_capacity", 4);
+  cr_log_info("C %.4f +- %.4f (36 +- %.4f)", c, se, 36 * sqrt(2.0 / rows));
+  cr_assert(fabs(se / (36 * sqrt(2.0 / rows)) - 1) < 0.1, "error bar %g", se);
+  cr_assert(fabs(c - 36) < 4 * se, "C %g +- %g", c, se);
+  cr_assert(isnan(csv_field(out, "heat_capacity", 3)), "with tempering the rungs' only: %s", out);
+  /* rung 1's temperature changes at the middle: the default stretch is
+  ** the coldest rung's, all rows, so rung 1 has no ensemble there (the
+  ** CSV leaves an empty column out, the table says so) */
+  cr_assert(isnan(csv_field(out, "replica1_heat_capacity", 3)), "%s", out);
+  FILE *f = fmemopen(out, sizeof out, "w");
+  sel.csv = 0;
+  cr_assert_eq(lw_trace_stats(t, "t.csv", &sel, f, &err), LW_OK);
+  fclose(f);
+  const char *line = strstr(out, "\nreplica1_heat_capacity ");
+  cr_assert(line && strstr(line, "(empty)") && strstr(line, "(empty)") < strchr(line + 1, '\n'), "%s", out);
+  /* its second half alone is at one temperature: C = 64 / 6.25 */
+  sel = (lw_trace_select){.from = (long)rows / 2 + 1, .to = -1, .csv = 1};
+  stats_csv(t, &sel, out, sizeof out);
+  c = csv_field(out, "replica1_heat_capacity", 3);
+  se = csv_field(out, "replica1_heat_capacity", 4);
+  cr_assert(fabs(c - 10.24) < 4 * se && se < 0.02 * 10.24, "C %g +- %g", c, se);
+  lw_trace_free(t);
+  /* without tempering the total's, named heat_capacity */
+  write_trace("u.csv", "sweep,temperature,total\n1,2,1\n2,2,3\n3,2,1\n4,2,3\n", path, sizeof path);
+  t = lw_trace_read(path, &err);
+  sel.from = -1;
+  stats_csv(t, &sel, out, sizeof out);
+  cr_assert(strstr(out, "\nheat_capacity,4,0.25,"), "Var 1 / T^2 4: %s", out);
+  lw_trace_free(t);
+  free(text);
+  gsl_rng_free(r);
+}
+
 /* ---- observables --------------------------------------------------------- */
 
 Test(observables, a_line_and_a_circle_have_their_known_shapes)

@@ -11,6 +11,8 @@
 #include "linewise/params.h"
 #include "linewise/series.h"
 
+#define LW_TRACE_HEAT_MAX 256 /* heat capacity columns at most: a rung each (tempering.replicas) */
+
 typedef struct {
   size_t n_cols, n_rows;
   char **name;   /* n_cols column names, from the header */
@@ -58,6 +60,8 @@ void lw_trace_column_stats(const lw_trace *t, const size_t *rows, size_t n, int 
 
 /* Prints the statistics (series.h) of every column but the sweep and
 ** temperature or time (and the rungs' temperatures) over the rows chosen,
+** then of the heat capacities Var(E) / T^2 derived from them (of the
+** total, or with tempering of each rung's energy; docs/FORMATS.md),
 ** as a table or CSV (sel->csv); the table is followed by one warning line
 ** per kind of trouble, naming its columns: a window that did not close,
 ** fewer than 25 independent samples, halves that disagree (series.h's
