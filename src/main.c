@@ -20,6 +20,7 @@
 #include "linewise/phase.h"
 #include "linewise/state.h"
 #include "linewise/system.h"
+#include "linewise/reweight.h"
 #include "linewise/trace.h"
 #ifdef LW_MPI
 #include "linewise/mpi_tempering.h"
@@ -60,6 +61,9 @@ static const char usage[] =
   "                      temperature's sweeps (or from output.stats_from), tuning left\n"
   "                      out, and the heat capacity Var(E)/T^2 (each rung's when\n"
   "                      tempering); with several runs (seeds) also whether they agree\n"
+  "      --reweight N        instead, a tempering run's mean energy and heat capacity\n"
+  "                          at N temperatures from the coldest rung's to the hottest's,\n"
+  "                          every rung's energies reweighted (multiple histograms)\n"
   "      --from S, --to S    only the rows of sweeps S to S (inclusive)\n"
   "      --csv               one CSV line a column: column,n,mean,stderr,sd,\n"
   "                          tau_sweeps,n_eff,window_closed,drift_z (several runs:\n"
@@ -536,17 +540,20 @@ static int cmd_resume(int argc, char **argv)
   return rc;
 }
 
-/* stats DIR... [--from S] [--to S] [--csv]: the means with error bars of
-** the columns of DIR/trace.csv (trace.h), and with several runs whether
-** they agree; each run's scene.ini gives its tuning sweeps and stats_from. */
+/* stats DIR... [--from S] [--to S] [--csv] [--reweight N]: the means with
+** error bars of the columns of DIR/trace.csv (trace.h), and with several
+** runs whether they agree; or the rungs' energies reweighted to N
+** temperatures (reweight.h).  Each run's scene.ini gives its tuning sweeps
+** and stats_from. */
 static int cmd_stats(int argc, char **argv)
 {
-  static const char use[] = "(usage: linewise stats DIR... [--from S] [--to S] [--csv])";
+  static const char use[] = "(usage: linewise stats DIR... [--from S] [--to S] [--csv] [--reweight N])";
   lw_error err;
   lw_error_clear(&err);
   const char **dir = calloc((size_t)argc + 1, sizeof *dir);
   int k = 0;
   lw_trace_select base = {.from = -1, .to = -1};
+  long reweight = 0;
   for (int i = 0; dir && i < argc; i++) {
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
     if (!strcmp(argv[i], "--from") || !strcmp(argv[i], "--to")) {
@@ -554,6 +561,14 @@ static int cmd_stats(int argc, char **argv)
       i++;
     } else if (!strcmp(argv[i], "--csv")) {
       base.csv = 1;
+    } else if (!strcmp(argv[i], "--reweight")) {
+      if (!parse_count(argv[i], v, LW_REWEIGHT_TEMPS_MAX, &reweight, &err)) break;
+      if (reweight < 2) {
+        lw_error_set(&err, LW_EUSAGE, "--reweight: expected a whole number from 2 to %d, got '%s'",
+                     LW_REWEIGHT_TEMPS_MAX, v);
+        break;
+      }
+      i++;
     } else if (argv[i][0] == '-') {
       lw_error_set(&err, LW_EUSAGE, "stats: unexpected '%s' %s", argv[i], use);
       break;
@@ -578,7 +593,10 @@ static int cmd_stats(int argc, char **argv)
     if (!(path[r] = strdup(where))) lw_error_set(&err, LW_ENOMEM, "out of memory");
     else t[r] = lw_trace_read(where, &err);
   }
-  if (!err.code) lw_trace_stats_runs((const lw_trace *const *)t, (const char *const *)path, sel, k, stdout, &err);
+  if (!err.code && reweight)
+    lw_trace_reweight((const lw_trace *const *)t, (const char *const *)path, sel, k, (int)reweight, stdout, &err);
+  else if (!err.code)
+    lw_trace_stats_runs((const lw_trace *const *)t, (const char *const *)path, sel, k, stdout, &err);
   for (int r = 0; path && r < k; r++) {
     lw_trace_free(t[r]);
     free(path[r]);

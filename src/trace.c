@@ -134,16 +134,19 @@ void lw_trace_select_of(const lw_params *p, lw_trace_select *sel)
 {
   if (sel->from < 0 && p->stats_from > 0) sel->from = p->stats_from;
   if (p->driver != LW_DRIVER_METROPOLIS) return; /* the dynamics tunes nothing */
+  if (p->replicas > 1 && p->tune_ladder == LW_LADDER_EQUAL) sel->ladder = p->ladder_sweeps;
   sel->tune = p->tune_sweeps;
   sel->steps = p->steps;
   sel->sweeps = p->sweeps;
 }
 
 /* Whether the row of sweep s (counted from 1) reports a sweep whose steps
-** still adapted: within the first `tune` sweeps of one of the schedule's
-** temperature steps, as the run loop decides (anneal.c). */
+** or ladder still adapted: within the first `tune` sweeps of one of the
+** schedule's temperature steps, as the run loop decides (anneal.c), or
+** within the ladder's warm-up. */
 static int tuning(const lw_trace_select *sel, long s)
 {
+  if (s <= sel->ladder) return 1;
   long long i = s - 1, S = sel->sweeps, B = sel->steps;
   if (sel->tune <= 0 || S <= 0 || B <= 0 || i < 0 || i >= S) return 0;
   long long b = i * B / S; /* its step, and the step's first sweep */
@@ -330,11 +333,7 @@ static void stretch_line(FILE *out, const char *lead, const lw_trace *t, const c
   fputc('\n', out);
 }
 
-/* The energy columns whose fluctuations make a heat capacity, each with its
-** temperature column: with tempering every rung's energy at the rung's
-** temperature, else the total at the row's (the dynamics has neither).
-** Their count, at most max. */
-static int heat_sources(const lw_trace *t, int *energy, int *temp, int max)
+int lw_trace_rungs(const lw_trace *t, int *energy, int *temp, int max)
 {
   int n = 0;
   for (; n < max; n++) {
@@ -343,6 +342,15 @@ static int heat_sources(const lw_trace *t, int *energy, int *temp, int max)
     snprintf(tt, sizeof tt, "replica%d_temperature", n);
     if ((energy[n] = lw_trace_column(t, e)) < 0 || (temp[n] = lw_trace_column(t, tt)) < 0) break;
   }
+  return n;
+}
+
+/* The energy columns whose fluctuations make a heat capacity, each with its
+** temperature column: with tempering every rung's, else the total at the
+** row's temperature (the dynamics has neither).  Their count, at most max. */
+static int heat_sources(const lw_trace *t, int *energy, int *temp, int max)
+{
+  int n = lw_trace_rungs(t, energy, temp, max);
   if (n || max < 1) return n;
   energy[0] = lw_trace_column(t, "total");
   temp[0] = lw_trace_column(t, "temperature");

@@ -84,6 +84,25 @@ Test(nurbs_cli, monte_carlo_heat_capacity_is_half_the_free_coordinates)
     cr_assert(se > 0 && se < 0.25 && fabs(c - 5.0) < 4 * se, "rung %d: C = %g +- %g, expected 5", k, c, se);
   }
   free(csv);
+  /* between the rungs, by reweighting all three: C = 5 still, and <E>
+  ** grows by 5 a unit of temperature from the coldest rung's */
+  cr_assert_eq(sh("%s stats %s/pt --reweight 5 --csv > %s/rw.csv", lw_test_bin(), dir, dir), 0);
+  csv = lw_test_slurp("%s/rw.csv", dir);
+  const char *line = strchr(csv, '\n') + 1;
+  double t0 = 0, e0 = 0, se0 = 0;
+  for (int j = 0; j < 5; j++, line = strchr(line, '\n') + 1) {
+    double T, e, se, c, sc;
+    cr_assert_eq(sscanf(line, "%lf,%lf,%lf,%lf,%lf", &T, &e, &se, &c, &sc), 5, "%s", csv);
+    if (!j) {
+      t0 = T;
+      e0 = e;
+      se0 = se;
+    }
+    cr_log_info("T %.4g: <E> - <E>(1) = %.4f (%.4f), C = %.4f +- %.4f", T, e - e0, 5 * (T - t0), c, sc);
+    cr_assert(fabs(c - 5.0) < 4 * sc && sc < 0.25, "T %g: C = %g +- %g", T, c, sc);
+    cr_assert(fabs(e - e0 - 5 * (T - t0)) < 4 * (se + se0), "T %g: <E> %g, from %g", T, e, e0);
+  }
+  free(csv);
 }
 
 /* A scene's [nurbs] key with a bad value: exit 2, the file, line and key

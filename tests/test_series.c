@@ -19,6 +19,7 @@
 #include "linewise/nurbs.h"
 #include "linewise/particles.h"
 #include "linewise/particles_geom.h"
+#include "linewise/reweight.h"
 #include "linewise/series.h"
 #include "linewise/sys_nurbs.h"
 #include "linewise/sys_particles.h"
@@ -229,6 +230,11 @@ Test(trace, the_default_stretch_is_the_final_temperature_less_its_tuning_sweeps,
   sel.to = 8;
   stats_csv(t, &sel, out, sizeof out);
   cr_assert(strstr(out, "\ntotal,5,6,"), "%s", out);
+  /* a tempering ladder's warm-up of 5 sweeps is left out too: 6 .. 8 */
+  sel.ladder = 5;
+  stats_csv(t, &sel, out, sizeof out);
+  cr_assert(strstr(out, "\ntotal,3,7,"), "%s", out);
+  sel.ladder = 0;
   /* nothing left: an error naming the trace's span */
   sel.from = 11;
   sel.to = 13;
@@ -387,6 +393,112 @@ Test(trace, the_heat_capacity_is_the_energy_variance_over_t_squared, .init = mak
   sel.from = -1;
   stats_csv(t, &sel, out, sizeof out);
   cr_assert(strstr(out, "\nheat_capacity,4,0.25,"), "Var 1 / T^2 4: %s", out);
+  lw_trace_free(t);
+  free(text);
+  gsl_rng_free(r);
+}
+
+/* ---- reweighting between rungs --------------------------------------------- */
+
+/* A harmonic system of d coordinates has a density of states ~ E^(d/2 - 1),
+** so at temperature T its energy is Gamma(d/2, T) exactly: <E> = d/2 T,
+** C = d/2 at every T, and f = -ln Z = d/2 ln beta + const.  Rung samples
+** drawn from those laws test the reweighting without a chain. */
+#define HARMONIC_D 10
+
+Test(reweight, free_energies_of_a_harmonic_system)
+{
+  /* 4000 independent samples at each of 4 rungs; the free energy
+  ** differences' own scatter is about 1 / sqrt(overlapping samples), a few
+  ** 1e-2 here, so 0.1 is about 4 of it (measured: within 0.03). */
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 7);
+  const int K = 4;
+  const size_t n = 4000;
+  double beta[4], f[4], *E = malloc(K * n * sizeof *E);
+  size_t first[5];
+  for (int k = 0; k < K; k++) {
+    beta[k] = 1.0 / pow(1.5, k);
+    first[k] = (size_t)k * n;
+    for (size_t i = 0; i < n; i++) E[k * n + i] = 1000.0 + gsl_ran_gamma(r, HARMONIC_D / 2.0, 1.0 / beta[k]);
+  }
+  first[K] = K * n;
+  int it;
+  lw_error err;
+  cr_assert_eq(lw_reweight_solve(E, first, beta, K, 0, f, &it, &err), LW_OK, "%s", err.msg);
+  for (int k = 0; k < K; k++) {
+    /* the constant offset 1000 adds 1000 beta to f */
+    double exact = HARMONIC_D / 2.0 * log(beta[k] / beta[0]) + 1000.0 * (beta[k] - beta[0]);
+    cr_log_info("f_%d = %.5f, exact %.5f (%d iterations)", k, f[k], exact, it);
+    cr_assert(fabs(f[k] - exact) < 0.1, "f_%d = %g, exact %g", k, f[k], exact);
+  }
+  /* at a rung's own temperature the reweighted mean is close to that
+  ** rung's sample mean: mostly its own samples carry the weight */
+  double e, c;
+  cr_assert_eq(lw_reweight_at(E, first, beta, f, K, beta[1], &e, &c, &err), LW_OK);
+  cr_assert(fabs(e - (1000.0 + HARMONIC_D / 2.0 / beta[1])) < 0.15, "<E> %g", e);
+  free(E);
+  gsl_rng_free(r);
+}
+
+Test(reweight, a_tempering_trace_gives_the_harmonic_curve_between_its_rungs, .init = make_dir, .fini = remove_dir)
+{
+  /* The trace of a 4-rung run (T = 1 .. 3.375) whose rows are independent
+  ** Gamma energies: at 9 temperatures from 1 to 3.375 the reweighted
+  ** <E> must be d/2 T and C d/2, each within 4 of the bootstrap's error
+  ** bars, which must be tight enough (under 4 % of C) to mean something. */
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 11);
+  const size_t rows = 3000;
+  size_t cap = 160 * rows, k = 0;
+  char *text = malloc(cap), path[128];
+  k += (size_t)snprintf(text, cap, "sweep,temperature,total");
+  for (int q = 0; q < 4; q++) k += (size_t)snprintf(text + k, cap - k, ",replica%d_temperature,replica%d_energy", q, q);
+  k += (size_t)snprintf(text + k, cap - k, ",swap0,swap1,swap2\n");
+  for (size_t t = 0; t < rows; t++) {
+    double e[4];
+    for (int q = 0; q < 4; q++) e[q] = gsl_ran_gamma(r, HARMONIC_D / 2.0, pow(1.5, q));
+    k += (size_t)snprintf(text + k, cap - k, "%zu,1,%.17g", t + 1, e[0]);
+    for (int q = 0; q < 4; q++) k += (size_t)snprintf(text + k, cap - k, ",%.17g,%.17g", pow(1.5, q), e[q]);
+    k += (size_t)snprintf(text + k, cap - k, ",0.3,0.3,0.3\n");
+  }
+  write_trace("pt.csv", text, path, sizeof path);
+  lw_error err;
+  lw_trace *t = lw_trace_read(path, &err);
+  cr_assert_not_null(t, "%s", err.msg);
+  static char out[4096];
+  FILE *f = fmemopen(out, sizeof out, "w");
+  lw_trace_select sel = {.from = -1, .to = -1, .csv = 1};
+  const char *paths[1] = {path};
+  cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, 9, f, &err), LW_OK, "%s", err.msg);
+  fclose(f);
+  cr_assert(!strncmp(out, "temperature,energy,energy_stderr,heat_capacity,heat_capacity_stderr\n", 68), "%s", out);
+  const char *line = strchr(out, '\n') + 1;
+  for (int j = 0; j < 9; j++, line = strchr(line, '\n') + 1) {
+    double T, e, se, c, sc;
+    cr_assert_eq(sscanf(line, "%lf,%lf,%lf,%lf,%lf", &T, &e, &se, &c, &sc), 5, "%s", out);
+    cr_assert(fabs(T - pow(3.375, j / 8.0)) < 1e-9 * T, "geometric temperatures: %s", out);
+    cr_assert(fabs(e - HARMONIC_D / 2.0 * T) < 4 * se && fabs(c - HARMONIC_D / 2.0) < 4 * sc,
+              "T %g: <E> %g +- %g (%g), C %g +- %g (%g)", T, e, se, HARMONIC_D / 2.0 * T, c, sc, HARMONIC_D / 2.0);
+    cr_assert(se > 0 && sc > 0 && sc < 0.04 * HARMONIC_D / 2.0, "T %g: error bars %g, %g", T, se, sc);
+  }
+  lw_trace_free(t);
+  /* a trace without rungs, and one whose rung warms within the rows */
+  write_trace("one.csv", "sweep,temperature,total\n1,1,2\n2,1,3\n", path, sizeof path);
+  t = lw_trace_read(path, &err);
+  f = fmemopen(out, sizeof out, "w");
+  cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, 9, f, &err), LW_EINPUT);
+  fclose(f);
+  cr_assert(strstr(err.msg, "one.csv: no tempering rungs"), "%s", err.msg);
+  lw_trace_free(t);
+  write_trace("warm.csv", "sweep,temperature,replica0_temperature,replica0_energy,replica1_temperature,"
+              "replica1_energy\n1,1,1,2,2,5\n2,1,1,3,2.5,6\n", path, sizeof path);
+  t = lw_trace_read(path, &err);
+  f = fmemopen(out, sizeof out, "w");
+  cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, 9, f, &err), LW_EINPUT);
+  fclose(f);
+  cr_assert(strstr(err.msg, "warm.csv: rung 1's temperature changes within the rows (2, then 2.5 at line 3)"), "%s",
+            err.msg);
   lw_trace_free(t);
   free(text);
   gsl_rng_free(r);

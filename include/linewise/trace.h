@@ -29,19 +29,27 @@ void lw_trace_free(lw_trace *t);
 /* The column of that name, or -1. */
 int lw_trace_column(const lw_trace *t, const char *name);
 
+/* The rungs of a tempering run's trace: the columns of replicaK_energy and
+** replicaK_temperature for K = 0, 1, ... into energy[] and temp[]; their
+** count (0 without tempering), at most max. */
+int lw_trace_rungs(const lw_trace *t, int *energy, int *temp, int max);
+
 /* Which rows `linewise stats` takes, by sweep: from <= sweep <= to (from < 0:
 ** the first sweep at the last row's temperature, or without a temperature
 ** column, the dynamics' trace, the first row; to < 0: to the end), less
 ** the rows of sweeps whose steps still adapted: the first `tune`
 ** (moves.tune_sweeps) of each of the schedule's `steps` temperature steps
-** over `sweeps` (anneal.steps, anneal.sweeps; tune = 0: none). */
+** over `sweeps` (anneal.steps, anneal.sweeps; tune = 0: none), and the
+** first `ladder` sweeps, a tempering ladder's warm-up (tempering.ladder_sweeps
+** under tune_ladder = equal; 0: none). */
 typedef struct {
   long from, to;
   long tune, steps, sweeps;
+  long ladder;
   int csv;       /* 1: one CSV line per column; 0: a table for people */
 } lw_trace_select;
 
-/* From a run's parameters: the tuning that the rows leave out, and from =
+/* From a run's parameters: the tuning (steps and ladder) that the rows leave out, and from =
 ** output.stats_from where it is set and sel->from is not. */
 void lw_trace_select_of(const lw_params *p, lw_trace_select *sel);
 

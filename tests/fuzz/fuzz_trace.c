@@ -6,7 +6,8 @@
 **   - a rejected file gets a message that names the file;
 **   - an accepted trace's values are finite or NaN (an empty field), and
 **     written back with 17 digits it reads back the same, bit for bit;
-**   - its statistics either print or refuse with a message naming it,
+**   - its statistics, and its rungs reweighted, either print or refuse with
+**     a message naming it,
 **     with the tuning settings taken from the input's first bytes, and the
 **     same trace taken as two runs does the same.
 **
@@ -20,6 +21,7 @@
 #include <string.h>
 
 #include "fuzz_util.h"
+#include "linewise/reweight.h"
 #include "linewise/trace.h"
 
 static int same(double a, double b) { return (isnan(a) && isnan(b)) || !memcmp(&a, &b, sizeof a); }
@@ -76,6 +78,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     const lw_trace_select sels[2] = {sel, sel};
     lw_status s2 = lw_trace_stats_runs(two, paths, sels, 2, out, &err);
     LW_FUZZ_CHECK(s2 == s || s2 == LW_ENOMEM || s == LW_ENOMEM, "one run gave %d, the same twice %d", (int)s, (int)s2);
+    /* reweighting the rungs: a table, or a refusal naming the file */
+    lw_status s3 = lw_trace_reweight((const lw_trace *const *)&t, &path, &sel, 1, 2 + (size ? data[0] % 5 : 0), out,
+                                     &err);
+    LW_FUZZ_CHECK(!s3 || strstr(err.msg, path) || s3 == LW_ENOMEM, "reweighting refused without the file: '%s'",
+                  err.msg);
     fclose(out);
   }
   lw_trace_free(t);

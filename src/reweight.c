@@ -1,0 +1,426 @@
+/* reweight.c -- multiple-histogram reweighting between tempering rungs
+** (reweight.h). */
+#include "linewise/reweight.h"
+
+#include <gsl/gsl_linalg.h>
+#include <gsl/gsl_rng.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "linewise/series.h"
+
+/* Energies are taken about their mean, so the exponents stay near the
+** spread of beta E rather than its size. */
+static double mean_of(const double *E, size_t n)
+{
+  double m = 0.0;
+  for (size_t i = 0; i < n; i++) m += (E[i] - m) / (double)(i + 1);
+  return m;
+}
+
+/* ln D_i = ln sum_m N_m exp(f_m - beta_m e_i), by the largest term. */
+static double log_denominator(double e, const double *log_n, const double *f, const double *beta, int K)
+{
+  double top = -INFINITY, s = 0.0;
+  for (int m = 0; m < K; m++) top = fmax(top, log_n[m] + f[m] - beta[m] * e);
+  for (int m = 0; m < K; m++) s += exp(log_n[m] + f[m] - beta[m] * e - top);
+  return top + log(s);
+}
+
+/* ln sum_i exp(-b e_i - ln D_i). */
+static double log_partition(const double *E, size_t n, double eref, const double *log_d, double b)
+{
+  double top = -INFINITY, s = 0.0;
+  for (size_t i = 0; i < n; i++) top = fmax(top, -b * (E[i] - eref) - log_d[i]);
+  for (size_t i = 0; i < n; i++) s += exp(-b * (E[i] - eref) - log_d[i] - top);
+  return top + log(s);
+}
+
+/* One pass over the samples at f (about eref): ln D_i into log_d, and the
+** sums of W_ik = exp(f_k - beta_k e_i) / D_i, s[k] = sum_i W_ik and ww[k K
+** + l] = sum_i W_ik W_il (w: K of scratch).  The equations hold where
+** every s_k = 1; returns the largest |s_k - 1|. */
+static double pass(const double *E, size_t n, double eref, const double *log_n, const double *f, const double *beta,
+                   int K, double *log_d, double *s, double *ww, double *w)
+{
+  memset(s, 0, (size_t)K * sizeof *s);
+  memset(ww, 0, (size_t)K * (size_t)K * sizeof *ww);
+  for (size_t i = 0; i < n; i++) {
+    double e = E[i] - eref;
+    log_d[i] = log_denominator(e, log_n, f, beta, K);
+    for (int k = 0; k < K; k++) {
+      w[k] = exp(f[k] - beta[k] * e - log_d[i]);
+      s[k] += w[k];
+    }
+    for (int k = 0; k < K; k++)
+      for (int l = 0; l <= k; l++) ww[k * K + l] += w[k] * w[l];
+  }
+  double worst = 0.0;
+  for (int k = 0; k < K; k++) worst = fmax(worst, fabs(s[k] - 1.0));
+  return worst;
+}
+
+/* The Newton step of f_1 .. f_{K-1} (f_0 held) on the convex function
+** sum_i ln D_i - sum_k N_k f_k, whose gradient is N_k (s_k - 1) and whose
+** Hessian is N_k s_k delta_kl - N_k N_l ww_kl; 0 when the Hessian is not
+** positive definite (states that share nothing). */
+static int newton_step(const double *log_n, const double *s, const double *ww, int K, double *step)
+{
+  const size_t m = (size_t)K - 1;
+  gsl_matrix *h = gsl_matrix_alloc(m, m);
+  gsl_vector *g = gsl_vector_alloc(m), *x = gsl_vector_alloc(m);
+  int ok = h && g && x;
+  for (size_t a = 0; ok && a < m; a++) {
+    double na = exp(log_n[a + 1]);
+    gsl_vector_set(g, a, -na * (s[a + 1] - 1.0));
+    for (size_t b = 0; b <= a; b++) {
+      double v = -na * exp(log_n[b + 1]) * ww[(a + 1) * (size_t)K + b + 1] + (a == b ? na * s[a + 1] : 0.0);
+      gsl_matrix_set(h, a, b, v);
+      gsl_matrix_set(h, b, a, v);
+    }
+  }
+  gsl_error_handler_t *old = gsl_set_error_handler_off();
+  ok = ok && !gsl_linalg_cholesky_decomp1(h) && !gsl_linalg_cholesky_solve(h, g, x);
+  gsl_set_error_handler(old);
+  step[0] = 0.0;
+  for (size_t a = 0; ok && a < m; a++) step[a + 1] = gsl_vector_get(x, a);
+  gsl_matrix_free(h);
+  gsl_vector_free(g);
+  gsl_vector_free(x);
+  return ok;
+}
+
+lw_status lw_reweight_solve(const double *E, const size_t *first, const double *beta, int K, int warm, double *f,
+                            int *iterations, lw_error *err)
+{
+  if (K < 1) return lw_error_set(err, LW_EINPUT, "no states to reweight");
+  const size_t n = first[K];
+  const size_t k1 = (size_t)K;
+  double *log_d = malloc((n ? n : 1) * sizeof *log_d), *log_n = malloc(k1 * sizeof *log_n),
+         *mean = malloc(k1 * sizeof *mean), *next = malloc(k1 * sizeof *next), *s_sum = malloc(k1 * sizeof *s_sum),
+         *ww = malloc(k1 * k1 * sizeof *ww), *w = malloc(k1 * sizeof *w), *step = malloc(k1 * sizeof *step),
+         *trial = malloc(k1 * sizeof *trial);
+  int *order = malloc(k1 * sizeof *order);
+  lw_status st = LW_OK;
+  if (!log_d || !log_n || !mean || !next || !s_sum || !ww || !w || !step || !trial || !order) {
+    st = lw_error_set(err, LW_ENOMEM, "out of memory reweighting %zu samples", n);
+    goto done;
+  }
+  const double eref = mean_of(E, n);
+  /* the start: the thermodynamic integral of <E> over beta, in beta's order */
+  for (int k = 0; k < K; k++) {
+    log_n[k] = log((double)(first[k + 1] - first[k]));
+    mean[k] = mean_of(E + first[k], first[k + 1] - first[k]) - eref;
+    order[k] = k;
+  }
+  for (int a = 1; a < K; a++)
+    for (int b = a; b > 0 && beta[order[b]] < beta[order[b - 1]]; b--) {
+      int tmp = order[b];
+      order[b] = order[b - 1];
+      order[b - 1] = tmp;
+    }
+  if (warm) { /* f as given, about eref */
+    for (int k = 0; k < K; k++) f[k] -= (beta[k] - beta[0]) * eref;
+  } else {
+    f[order[0]] = 0.0;
+    for (int a = 1; a < K; a++) {
+      int p = order[a - 1], q = order[a];
+      f[q] = f[p] + (beta[q] - beta[p]) * 0.5 * (mean[p] + mean[q]);
+    }
+    for (int k = K - 1; k >= 0; k--) f[k] -= f[0]; /* the constant: f_0 = 0, which Newton holds */
+  }
+  /* Newton's steps, halved until the equations are met better, else the
+  ** self-consistent step (the equations' own iteration: slow where states
+  ** overlap little, but never lost) */
+  int it = 0;
+  double worst = pass(E, n, eref, log_n, f, beta, K, log_d, s_sum, ww, w);
+  for (double change = INFINITY; change > LW_REWEIGHT_TOL && worst > LW_REWEIGHT_TOL; it++) {
+    if (it == LW_REWEIGHT_ITER) {
+      st = lw_error_set(err, LW_EINPUT, "reweighting did not settle in %d iterations (last change %.3g): the "
+                        "rungs' energies barely overlap", LW_REWEIGHT_ITER, change);
+      goto done;
+    }
+    for (int k = 0; k < K; k++) next[k] = -log_partition(E, n, eref, log_d, beta[k]);
+    for (int k = K - 1; k >= 0; k--) next[k] -= next[0];
+    int newton = K > 1 && newton_step(log_n, s_sum, ww, K, step);
+    double t = 1.0, tried = INFINITY;
+    for (; newton && t > 1e-3; t *= 0.5) {
+      for (int k = 0; k < K; k++) trial[k] = f[k] + t * step[k];
+      if ((tried = pass(E, n, eref, log_n, trial, beta, K, log_d, s_sum, ww, w)) < worst) break;
+    }
+    if (!(tried < worst)) memcpy(trial, next, (size_t)K * sizeof *trial);
+    change = 0.0;
+    for (int k = 0; k < K; k++) change = fmax(change, fabs(trial[k] - f[k]));
+    memcpy(f, trial, (size_t)K * sizeof *f);
+    worst = tried < worst ? tried : pass(E, n, eref, log_n, f, beta, K, log_d, s_sum, ww, w);
+    if (!isfinite(change) || isnan(worst)) {
+      st = lw_error_set(err, LW_EINPUT, "reweighting failed: the free energies are not finite (energies or "
+                        "temperatures beyond what the sums can hold)");
+      goto done;
+    }
+  }
+  /* back from the energies about eref: f_k shifts by beta_k eref */
+  for (int k = K - 1; k >= 0; k--) f[k] += (beta[k] - beta[0]) * eref;
+  if (iterations) *iterations = it;
+done:
+  free(log_d);
+  free(log_n);
+  free(mean);
+  free(next);
+  free(s_sum);
+  free(ww);
+  free(w);
+  free(step);
+  free(trial);
+  free(order);
+  return st;
+}
+
+lw_status lw_reweight_at(const double *E, const size_t *first, const double *beta, const double *f, int K, double b,
+                         double *mean_energy, double *heat_capacity, lw_error *err)
+{
+  const size_t n = first[K];
+  const double eref = mean_of(E, n);
+  double *log_n = malloc((size_t)K * sizeof *log_n), *fs = malloc((size_t)K * sizeof *fs);
+  if (!log_n || !fs) {
+    free(log_n);
+    free(fs);
+    return lw_error_set(err, LW_ENOMEM, "out of memory reweighting %d states", K);
+  }
+  for (int m = 0; m < K; m++) {
+    log_n[m] = log((double)(first[m + 1] - first[m]));
+    fs[m] = f[m] - (beta[m] - beta[0]) * eref;
+  }
+  /* the weights' sums in one pass, scaled by the largest weight so far */
+  double top = -INFINITY, w = 0.0, m1 = 0.0, m2 = 0.0;
+  for (size_t i = 0; i < n; i++) {
+    double e = E[i] - eref, lw = -b * e - log_denominator(e, log_n, fs, beta, K);
+    if (lw > top) {
+      double scale = exp(top - lw);
+      w *= scale;
+      m1 *= scale;
+      m2 *= scale;
+      top = lw;
+    }
+    double wi = exp(lw - top);
+    w += wi;
+    m1 += wi * e;
+    m2 += wi * e * e;
+  }
+  m1 /= w;
+  *mean_energy = eref + m1;
+  *heat_capacity = b * b * fmax(m2 / w - m1 * m1, 0.0);
+  free(log_n);
+  free(fs);
+  return LW_OK;
+}
+
+/* ---- a tempering run's trace ------------------------------------------- */
+
+/* Every (run, rung) is a state: its rows' energies thinned to one every
+** 2 tau (at least every row), so that they are about independent. */
+typedef struct {
+  int K;             /* states */
+  double *E;         /* first[K] samples */
+  size_t *first;     /* K + 1 */
+  double *beta;      /* K */
+  double *thin;      /* K: rows a sample stands for */
+  int open;          /* states whose autocorrelation window did not close */
+  double worst_swap; /* lowest neighbour exchange acceptance over the rows (NAN: none) */
+  int worst_pair;
+} rw_states;
+
+static void states_free(rw_states *s)
+{
+  free(s->E);
+  free(s->first);
+  free(s->beta);
+  free(s->thin);
+}
+
+/* The mean of column col over the rows, empty fields skipped (NAN: none). */
+static double column_mean(const lw_trace *t, const size_t *row, size_t n, int col)
+{
+  double m = 0.0;
+  size_t c = 0;
+  for (size_t i = 0; i < n; i++) {
+    double v = t->v[row[i] * t->n_cols + (size_t)col];
+    if (!isnan(v)) m += (v - m) / (double)++c;
+  }
+  return c ? m : NAN;
+}
+
+static lw_status gather(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
+                        rw_states *s, lw_error *err)
+{
+  memset(s, 0, sizeof *s);
+  s->worst_swap = NAN;
+  int energy[LW_TRACE_HEAT_MAX], temp[LW_TRACE_HEAT_MAX], rungs = 0;
+  size_t cap = 0, most = 0; /* samples at most in all, rows at most of a run */
+  lw_status st = LW_OK;
+  for (int r = 0; r < k; r++) {
+    int m = lw_trace_rungs(t[r], energy, temp, LW_TRACE_HEAT_MAX);
+    rungs += m;
+    cap += (size_t)m * t[r]->n_rows;
+    if (t[r]->n_rows > most) most = t[r]->n_rows;
+  }
+  if (rungs < 2)
+    return lw_error_set(err, LW_EINPUT, "%s: no tempering rungs (replicaK_energy columns): reweighting needs a "
+                        "run with [tempering] replicas >= 2", path[0]);
+  s->E = malloc((cap ? cap : 1) * sizeof *s->E);
+  s->first = calloc((size_t)rungs + 1, sizeof *s->first);
+  s->beta = malloc((size_t)rungs * sizeof *s->beta);
+  s->thin = malloc((size_t)rungs * sizeof *s->thin);
+  double *x = malloc((most ? most : 1) * sizeof *x);
+  if (!s->E || !s->first || !s->beta || !s->thin || !x) {
+    st = lw_error_set(err, LW_ENOMEM, "out of memory reweighting %zu rows", cap);
+    goto done;
+  }
+  for (int r = 0; r < k; r++) {
+    size_t *row = NULL, n = 0, tuned = 0;
+    if ((st = lw_trace_rows(t[r], path[r], &sel[r], &row, &n, &tuned, err))) goto done;
+    int m = lw_trace_rungs(t[r], energy, temp, LW_TRACE_HEAT_MAX);
+    for (int q = 0; q < m; q++) {
+      const double T = t[r]->v[row[0] * t[r]->n_cols + (size_t)temp[q]];
+      size_t c = 0;
+      for (size_t i = 0; i < n; i++) {
+        const double *v = t[r]->v + row[i] * t[r]->n_cols;
+        if (v[temp[q]] != T) {
+          st = lw_error_set(err, LW_EINPUT, "%s: rung %d's temperature changes within the rows (%g, then %g at "
+                            "line %zu): reweighting needs fixed rungs (start after the ladder's tuning with --from)",
+                            path[r], q, T, v[temp[q]], row[i] + 2);
+          free(row);
+          goto done;
+        }
+        if (!isnan(v[energy[q]])) x[c++] = v[energy[q]];
+      }
+      if (!(T > 0.0) || c < 2) {
+        free(row);
+        st = lw_error_set(err, LW_EINPUT, "%s: rung %d has %s", path[r], q, c < 2 ? "fewer than 2 energies in the "
+                          "rows" : "no positive temperature");
+        goto done;
+      }
+      size_t window;
+      const size_t g = (size_t)ceil(2.0 * fmax(lw_series_tau(x, 1, c, &window), 0.5));
+      s->open += !window;
+      size_t at = s->first[s->K];
+      for (size_t i = 0; i < c; i += g) s->E[at++] = x[i];
+      s->beta[s->K] = 1.0 / T;
+      s->thin[s->K] = (double)g;
+      s->first[++s->K] = at;
+    }
+    /* the exchanges between neighbours: rungs that never swap share no energies */
+    for (int q = 0;; q++) {
+      char name[32];
+      snprintf(name, sizeof name, "swap%d", q);
+      int col = lw_trace_column(t[r], name);
+      if (col < 0) break;
+      double a = column_mean(t[r], row, n, col);
+      if (!isnan(a) && !(a >= s->worst_swap)) {
+        s->worst_swap = a;
+        s->worst_pair = q;
+      }
+    }
+    free(row);
+  }
+done:
+  free(x);
+  if (st) states_free(s);
+  return st;
+}
+
+lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
+                            int n_temps, FILE *out, lw_error *err)
+{
+  if (n_temps < 2 || n_temps > LW_REWEIGHT_TEMPS_MAX)
+    return lw_error_set(err, LW_EUSAGE, "--reweight %d: expected 2 to %d temperatures", n_temps,
+                        LW_REWEIGHT_TEMPS_MAX);
+  rw_states s;
+  lw_status st = gather(t, path, sel, k, &s, err);
+  if (st) return st;
+  const int K = s.K, B = LW_REWEIGHT_BOOTSTRAP;
+  const size_t n = s.first[K];
+  double *f = malloc((size_t)K * sizeof *f), *fb = malloc((size_t)K * sizeof *fb), *Eb = malloc(n * sizeof *Eb);
+  double *est = calloc((size_t)n_temps * 2, sizeof *est), *sum = calloc((size_t)n_temps * 4, sizeof *sum);
+  gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+  if (!f || !fb || !Eb || !est || !sum || !rng) {
+    st = lw_error_set(err, LW_ENOMEM, "out of memory reweighting %zu samples", n);
+    goto done;
+  }
+  double blo = INFINITY, bhi = -INFINITY;
+  for (int q = 0; q < K; q++) {
+    blo = fmin(blo, s.beta[q]);
+    bhi = fmax(bhi, s.beta[q]);
+  }
+  const double tlo = 1.0 / bhi, thi = 1.0 / blo;
+  int iterations;
+  if ((st = lw_reweight_solve(s.E, s.first, s.beta, K, 0, f, &iterations, err))) goto done;
+  for (int j = 0; j < n_temps && !st; j++) {
+    double T = tlo * pow(thi / tlo, (double)j / (n_temps - 1));
+    st = lw_reweight_at(s.E, s.first, s.beta, f, K, 1.0 / T, &est[2 * j], &est[2 * j + 1], err);
+  }
+  /* the error bars: each state's samples drawn again with replacement, a
+  ** fixed seed so that the output is the same every time */
+  gsl_rng_set(rng, 1);
+  for (int b = 0; b < B && !st; b++) {
+    for (int q = 0; q < K; q++) {
+      size_t a = s.first[q], m = s.first[q + 1] - a;
+      for (size_t i = 0; i < m; i++) Eb[a + i] = s.E[a + gsl_rng_uniform_int(rng, m)];
+    }
+    memcpy(fb, f, (size_t)K * sizeof *fb); /* the whole data's: close to a resample's */
+    if ((st = lw_reweight_solve(Eb, s.first, s.beta, K, 1, fb, NULL, err))) break;
+    for (int j = 0; j < n_temps && !st; j++) {
+      double T = tlo * pow(thi / tlo, (double)j / (n_temps - 1)), e, c;
+      if ((st = lw_reweight_at(Eb, s.first, s.beta, fb, K, 1.0 / T, &e, &c, err))) break;
+      double d[2] = {e - est[2 * j], c - est[2 * j + 1]}; /* about the estimate: no cancellation */
+      for (int v = 0; v < 2; v++) {
+        sum[4 * j + 2 * v] += d[v];
+        sum[4 * j + 2 * v + 1] += d[v] * d[v];
+      }
+    }
+  }
+  if (st) goto done;
+  if (sel[0].csv) {
+    fputs("temperature,energy,energy_stderr,heat_capacity,heat_capacity_stderr\n", out);
+  } else {
+    double thin = 0.0;
+    for (int q = 0; q < K; q++) thin = fmax(thin, s.thin[q]);
+    fprintf(out, "reweighted over %d rung%s from T = %.6g to %.6g: %zu samples (each rung's rows thinned to one "
+            "every 2 tau, at most every %.0f), %d iterations, %d bootstrap resamples\n",
+            K, K > 1 ? "s" : "", tlo, thi, n, thin, iterations, B);
+    fprintf(out, "%15s %17s %11s %15s %11s\n", "temperature", "energy", "stderr", "heat_capacity", "stderr");
+  }
+  for (int j = 0; j < n_temps; j++) {
+    double T = tlo * pow(thi / tlo, (double)j / (n_temps - 1)), se[2];
+    for (int v = 0; v < 2; v++) {
+      double m = sum[4 * j + 2 * v] / B;
+      se[v] = sqrt(fmax(sum[4 * j + 2 * v + 1] / B - m * m, 0.0) * B / (B - 1));
+    }
+    if (sel[0].csv)
+      fprintf(out, "%.10g,%.10g,%.4g,%.10g,%.4g\n", T, est[2 * j], se[0], est[2 * j + 1], se[1]);
+    else
+      fprintf(out, "%15.6g %17.10g %11.4g %15.6g %11.4g\n", T, est[2 * j], se[0], est[2 * j + 1], se[1]);
+  }
+  if (!sel[0].csv && s.open)
+    fprintf(out, "warning: %d rung%s autocorrelation window did not close: thinned by too little, the error "
+            "bars are too small (a longer stretch is needed)\n", s.open, s.open > 1 ? "s'" : "'s");
+  if (!sel[0].csv && s.worst_swap < LW_REWEIGHT_SWAP_MIN)
+    fprintf(out, "warning: rungs %d and %d exchanged in %.3g of the tries: their energies barely overlap and the "
+            "curve between them is unreliable (more rungs there)\n", s.worst_pair, s.worst_pair + 1, s.worst_swap);
+done:
+  if (st == LW_EINPUT && err && strncmp(err->msg, path[0], strlen(path[0]))) { /* the solver's, of this trace */
+    char why[sizeof err->msg];
+    snprintf(why, sizeof why, "%s", err->msg);
+    lw_error_set(err, st, "%s: %s", path[0], why);
+  }
+  states_free(&s);
+  free(f);
+  free(fb);
+  free(Eb);
+  free(est);
+  free(sum);
+  gsl_rng_free(rng);
+  return st;
+}
