@@ -64,12 +64,9 @@ Test(nurbs_cli, monte_carlo_heat_capacity_is_half_the_free_coordinates)
   ** every temperature, a heat capacity of 5 on each rung of a ladder.
   ** `linewise stats` must find that within 4 of its own error bars, which
   ** must be small enough (under 5 % of C) for the check to mean something.
-  ** Fixed seed; 38,000 sweeps a rung after a burn-in of 2000. */
-  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/pt --quiet --set scene.driver=metropolis "
-                  "--set anneal.schedule=constant --set anneal.t_start=1 --set anneal.t_end=1 "
-                  "--set anneal.sweeps=40000 --set moves.tune_sweeps=500 --set output.frames_every=0 "
-                  "--set output.stats_from=2000 --set tempering.replicas=3 --set 'tempering.ladder=1 2 4'",
-                  lw_test_bin(), lw_test_root(), dir), 0);
+  ** params/wire-ladder.ini: fixed seed; 38,000 sweeps a rung after a burn-in
+  ** of 2000. */
+  cr_assert_eq(sh("%s run %s/params/wire-ladder.ini --out %s/pt --quiet", lw_test_bin(), lw_test_root(), dir), 0);
   cr_assert_eq(sh("%s stats %s/pt --csv > %s/pt.csv", lw_test_bin(), dir, dir), 0);
   char *csv = lw_test_slurp("%s/pt.csv", dir);
   cr_assert_not_null(csv);
