@@ -202,7 +202,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
     dir_file(path, sizeof path, dir, "final.pdf");
     s = lw_output_pdf_strokes(st, &page, under, path, err);
   }
-  const lw_plotter_options po = {p->plot_tolerance, p->speed_down, p->gcode_pen_up, p->gcode_pen_down};
+  const lw_plotter_options po = {p->plot_tolerance, p->speed_down, p->gcode_pen_up, p->gcode_pen_down, p->plot_turn};
   if (!s && p->hpgl) {
     dir_file(path, sizeof path, dir, "final.hpgl");
     s = lw_output_hpgl_strokes(st, &page, &po, path, err);

@@ -481,6 +481,11 @@ const lw_param_def lw_param_table[] = {
       "Largest distance between a curve and the chords that stand for it in final.hpgl and "
       "final.gcode (straight moves only); HP-GL's 0.025 mm grid adds up to 0.018 mm. 0.02 mm is "
       "far below a pen's width; larger values make shorter files."),
+  CHOICE("plot", "turn", plot_turn, "0", "0|90",
+         "Quarter turn of the page in final.hpgl and final.gcode: 0 puts its lower-left corner at the "
+         "machine's origin; 90 turns it counterclockwise, its top-left corner at the origin and its top "
+         "edge along the machine's y axis, so a portrait page plots on paper loaded landscape (an HP "
+         "7475A takes A4 and A3 so)."),
   STRING("plot", "gcode_pen_up", gcode_pen_up, "G0 Z5", "",
          "The G-code line that lifts the pen in final.gcode, written as it is: `G0 Z5` for a pen on the "
          "Z axis, `M5` or `M3 S30` for a servo on a GRBL fork. One line of printable ASCII."),

@@ -39,20 +39,40 @@ int lw_plotter_gcode_line_ok(const char *line)
   return line[0] != '\0';
 }
 
-/* put(ctx, x, y) for the first point of path k and the end of each chord
-** after it, page millimetres (y down). */
-static void walk_path(const lw_strokes *s, size_t k, double tol, void (*put)(void *, double, double), void *ctx)
+/* Page millimetres (y down) to the machine's (y up): the page's lower-left
+** corner at the origin, or turned a quarter turn counterclockwise, its
+** top-left corner there. */
+static void machine(const lw_output_page *page, const lw_plotter_options *o, double x, double y, double *mx,
+                    double *my)
 {
-  double b[8], xy[2];
+  if (o->turn) {
+    *mx = y;
+    *my = x;
+  } else {
+    *mx = x;
+    *my = page->height_mm - y;
+  }
+}
+
+/* put(ctx, x, y) for the first point of path k and the end of each chord
+** after it, machine millimetres. */
+static void walk_path(const lw_strokes *s, size_t k, const lw_output_page *page, const lw_plotter_options *o,
+                      void (*put)(void *, double, double), void *ctx)
+{
+  double b[8], xy[2], m[2];
   for (size_t j = 0; j < s->first[k + 1] - s->first[k]; j++) {
     lw_strokes_drawn_segment(s, k, j, b);
-    if (!j) put(ctx, b[0], b[1]);
-    size_t n = lw_plotter_chords(b, tol);
-    for (size_t i = 1; i < n; i++) {
-      lw_bezier_eval(b, (double)i / (double)n, xy);
-      put(ctx, xy[0], xy[1]);
+    if (!j) {
+      machine(page, o, b[0], b[1], &m[0], &m[1]);
+      put(ctx, m[0], m[1]);
     }
-    put(ctx, b[6], b[7]);
+    size_t n = lw_plotter_chords(b, o->tolerance);
+    for (size_t i = 1; i <= n; i++) {
+      if (i < n) lw_bezier_eval(b, (double)i / (double)n, xy);
+      else memcpy(xy, b + 6, sizeof xy);
+      machine(page, o, xy[0], xy[1], &m[0], &m[1]);
+      put(ctx, m[0], m[1]);
+    }
   }
 }
 
@@ -84,7 +104,6 @@ static lw_status check(const lw_strokes *s, const lw_output_page *page, const lw
 
 typedef struct {
   FILE *f;
-  double height;     /* page, mm: y flips about it */
   long x, y;         /* the last point, plotter units */
   size_t points;     /* points of the path so far */
   size_t drawn;      /* of them in PD instructions */
@@ -93,7 +112,7 @@ typedef struct {
 static void hpgl_point(void *ctx, double x, double y)
 {
   hpgl_path *h = ctx;
-  long px = lround(x * LW_HPGL_UNITS_PER_MM), py = lround((h->height - y) * LW_HPGL_UNITS_PER_MM);
+  long px = lround(x * LW_HPGL_UNITS_PER_MM), py = lround(y * LW_HPGL_UNITS_PER_MM);
   if (h->points++ == 0) {
     fprintf(h->f, "PU%ld,%ld;\n", px, py);
   } else {
@@ -123,8 +142,8 @@ lw_status lw_output_hpgl_strokes(const lw_strokes *s, const lw_output_page *page
     size_t a, z;
     lw_strokes_pen_range(s, k, &a, &z);
     for (size_t j = a; j < z; j++) {
-      hpgl_path h = {.f = f, .height = page->height_mm};
-      walk_path(s, j, o->tolerance, hpgl_point, &h);
+      hpgl_path h = {.f = f};
+      walk_path(s, j, page, o, hpgl_point, &h);
       /* a path that rounds to one point is a dot */
       fputs(h.drawn ? ";\n" : "PD;\n", f);
     }
@@ -138,7 +157,6 @@ lw_status lw_output_hpgl_strokes(const lw_strokes *s, const lw_output_page *page
 typedef struct {
   FILE *f;
   const lw_plotter_options *o;
-  double height;     /* page, mm */
   long long x, y;    /* the last point, thousandths of a mm */
   size_t points;     /* points of the path so far */
   size_t drawn;      /* of them drawn (G1) */
@@ -155,7 +173,7 @@ static void put_xy(FILE *f, long long x, long long y)
 static void gcode_point(void *ctx, double x, double y)
 {
   gcode_path *g = ctx;
-  long long px = llround(x * 1000.0), py = llround((g->height - y) * 1000.0);
+  long long px = llround(x * 1000.0), py = llround(y * 1000.0);
   if (g->points++ == 0) {
     fputs("G0", g->f);
     put_xy(g->f, px, py);
@@ -198,7 +216,8 @@ lw_status lw_output_gcode_strokes(const lw_strokes *s, const lw_output_page *pag
   lw_output_put_fixed(f, page->width_mm, LW_OUTPUT_SVG_DECIMALS);
   fputs(" x ", f);
   lw_output_put_fixed(f, page->height_mm, LW_OUTPUT_SVG_DECIMALS);
-  fputs(" mm, origin at its lower-left corner, y up\n; load ", f);
+  fputs(o->turn ? " mm turned a quarter turn counterclockwise, origin at its top-left corner, its top edge "
+                  "along y\n; load " : " mm, origin at its lower-left corner, y up\n; load ", f);
   put_pen(f, page, 0);
   fprintf(f, " before starting\nG21\nG90\n%s\n", o->pen_up);
   for (int k = 0; k < s->n_pens; k++) {
@@ -210,8 +229,8 @@ lw_status lw_output_gcode_strokes(const lw_strokes *s, const lw_output_page *pag
     size_t a, z;
     lw_strokes_pen_range(s, k, &a, &z);
     for (size_t j = a; j < z; j++) {
-      gcode_path g = {.f = f, .o = o, .height = page->height_mm};
-      walk_path(s, j, o->tolerance, gcode_point, &g);
+      gcode_path g = {.f = f, .o = o};
+      walk_path(s, j, page, o, gcode_point, &g);
       fprintf(f, "%s\n", o->pen_up);
     }
   }

@@ -1,7 +1,7 @@
 /*
 ** test_plotter.c -- final.hpgl and final.gcode (plotter.h): the chord count
 ** keeps its bound and is not wasteful, both files read back to the curves
-** they stand for (pens, order, directions, the flipped y), their commands
+** they stand for (pens, order, directions, the flipped y or the quarter turn), their commands
 ** come in the order a machine needs, bad options write nothing, and the
 ** command line writes the same files for the same seed.
 */
@@ -179,11 +179,11 @@ static lw_plotter_options options(void)
   return (lw_plotter_options){.tolerance = TOL, .speed_down = 50, .pen_up = "M3 S30", .pen_down = "M3 S90 G4 P0.2"};
 }
 
-/* The drawing() written by `write` to dir/name; its text (caller frees),
-** the drawing in *s. */
+/* The drawing() written by `write` to dir/name, the page turned or not; its
+** text (caller frees), the drawing in *s. */
 static char *written(lw_status (*write)(const lw_strokes *, const lw_output_page *, const lw_plotter_options *,
                                         const char *, lw_error *),
-                     const char *name, char dir[64], lw_strokes **s)
+                     const char *name, int turn, char dir[64], lw_strokes **s)
 {
   char path[128];
   cr_assert_eq(lw_test_dir_make(dir, "plotter"), 0);
@@ -191,76 +191,86 @@ static char *written(lw_status (*write)(const lw_strokes *, const lw_output_page
   *s = drawing();
   lw_output_page page = page_of();
   lw_plotter_options o = options();
+  o.turn = turn;
   cr_assert_eq(write(*s, &page, &o, path, NULL), LW_OK);
   char *text = lw_test_slurp("%s", path);
   cr_assert_not_null(text);
   return text;
 }
 
+/* A machine point (plotter units, y up) back on the page: flipped, or
+** turned back a quarter turn. */
+static void page_point(long x, long y, int turn, double *xy)
+{
+  double mx = x / LW_HPGL_UNITS_PER_MM, my = y / LW_HPGL_UNITS_PER_MM;
+  xy[0] = turn ? my : mx;
+  xy[1] = turn ? mx : PAGE_H - my;
+}
+
 Test(plotter, hpgl_reads_back_to_the_curves_pen_by_pen)
 {
-  char dir[64];
-  lw_strokes *s;
-  char *text = written(lw_output_hpgl_strokes, "final.hpgl", dir, &s);
-  /* instructions are separated by ';', the newlines between them ignored */
-  static polyline pl[3];
-  int pen = 0, paths = 0, sp0 = 0;
-  size_t n_ins = 0;
-  for (char *ins = strtok(text, ";\n"); ins; ins = strtok(NULL, ";\n"), n_ins++) {
-    cr_assert(!sp0, "'%s' after SP0", ins);
-    if (n_ins == 0) cr_assert_str_eq(ins, "IN");
-    else if (n_ins == 1) cr_assert_str_eq(ins, "VS5", "50 mm/s is 5 cm/s");
-    else if (!strncmp(ins, "SP", 2)) {
-      int k = atoi(ins + 2);
-      if (k == 0) {
-        sp0 = 1;
+  for (int turn = 0; turn < 2; turn++) {
+    char dir[64];
+    lw_strokes *s;
+    char *text = written(lw_output_hpgl_strokes, "final.hpgl", turn, dir, &s);
+    /* instructions are separated by ';', the newlines between them ignored */
+    static polyline pl[3];
+    int pen = 0, paths = 0, sp0 = 0;
+    size_t n_ins = 0;
+    for (char *ins = strtok(text, ";\n"); ins; ins = strtok(NULL, ";\n"), n_ins++) {
+      cr_assert(!sp0, "'%s' after SP0", ins);
+      if (n_ins == 0) cr_assert_str_eq(ins, "IN");
+      else if (n_ins == 1) cr_assert_str_eq(ins, "VS5", "50 mm/s is 5 cm/s");
+      else if (!strncmp(ins, "SP", 2)) {
+        int k = atoi(ins + 2);
+        if (k == 0) {
+          sp0 = 1;
+        } else {
+          cr_assert_eq(k, pen + 1, "pens in order");
+          pen = k;
+        }
+      } else if (!strcmp(ins, "PU")) {
+        continue;
+      } else if (!strncmp(ins, "PU", 2)) {
+        cr_assert(paths < 3 && pen >= 1);
+        polyline *p = &pl[paths++];
+        p->pen = pen;
+        long x, y;
+        cr_assert_eq(sscanf(ins + 2, "%ld,%ld", &x, &y), 2, "%s", ins);
+        page_point(x, y, turn, p->xy);
+        p->n = 1;
       } else {
-        cr_assert_eq(k, pen + 1, "pens in order");
-        pen = k;
-      }
-    } else if (!strcmp(ins, "PU")) {
-      continue;
-    } else if (!strncmp(ins, "PU", 2)) {
-      cr_assert(paths < 3 && pen >= 1);
-      polyline *p = &pl[paths++];
-      p->pen = pen;
-      long x, y;
-      cr_assert_eq(sscanf(ins + 2, "%ld,%ld", &x, &y), 2, "%s", ins);
-      p->xy[0] = x / LW_HPGL_UNITS_PER_MM;
-      p->xy[1] = PAGE_H - y / LW_HPGL_UNITS_PER_MM;
-      p->n = 1;
-    } else {
-      cr_assert(!strncmp(ins, "PD", 2) && paths > 0, "unexpected '%s'", ins);
-      polyline *p = &pl[paths - 1];
-      for (char *c = ins + 2; *c;) {
-        long x = strtol(c, &c, 10);
-        cr_assert_eq(*c, ',');
-        long y = strtol(c + 1, &c, 10);
-        if (*c == ',') c++;
-        p->xy[2 * p->n] = x / LW_HPGL_UNITS_PER_MM;
-        p->xy[2 * p->n + 1] = PAGE_H - y / LW_HPGL_UNITS_PER_MM;
-        cr_assert(p->n == 0 || p->xy[2 * p->n] != p->xy[2 * p->n - 2] || p->xy[2 * p->n + 1] != p->xy[2 * p->n - 1],
-                  "a repeated point");
-        p->n++;
+        cr_assert(!strncmp(ins, "PD", 2) && paths > 0, "unexpected '%s'", ins);
+        polyline *p = &pl[paths - 1];
+        for (char *c = ins + 2; *c;) {
+          long x = strtol(c, &c, 10);
+          cr_assert_eq(*c, ',');
+          long y = strtol(c + 1, &c, 10);
+          if (*c == ',') c++;
+          page_point(x, y, turn, p->xy + 2 * p->n);
+          cr_assert(p->n == 0 || p->xy[2 * p->n] != p->xy[2 * p->n - 2] || p->xy[2 * p->n + 1] != p->xy[2 * p->n - 1],
+                    "a repeated point");
+          p->n++;
+        }
       }
     }
+    cr_assert(sp0, "the pen is put back at the end");
+    cr_assert_eq(paths, 3);
+    cr_assert(pl[0].pen == 1 && pl[1].pen == 1 && pl[2].pen == 2);
+    for (size_t k = 0; k < 3; k++) assert_matches(s, k, &pl[k], HPGL_ROUND + 1e-12);
+    /* the S-curve is drawn from its last point */
+    cr_assert(fabs(pl[1].xy[0] - 45) < 0.02 && fabs(pl[1].xy[1] - 75) < 0.02);
+    free(text);
+    lw_strokes_free(s);
+    lw_test_sh("rm -rf %s", dir);
   }
-  cr_assert(sp0, "the pen is put back at the end");
-  cr_assert_eq(paths, 3);
-  cr_assert(pl[0].pen == 1 && pl[1].pen == 1 && pl[2].pen == 2);
-  for (size_t k = 0; k < 3; k++) assert_matches(s, k, &pl[k], HPGL_ROUND + 1e-12);
-  /* the S-curve is drawn from its last point */
-  cr_assert(fabs(pl[1].xy[0] - 45) < 0.02 && fabs(pl[1].xy[1] - 75) < 0.02);
-  free(text);
-  lw_strokes_free(s);
-  lw_test_sh("rm -rf %s", dir);
 }
 
 Test(plotter, gcode_reads_back_and_moves_the_pen_in_order)
 {
   char dir[64];
   lw_strokes *s;
-  char *text = written(lw_output_gcode_strokes, "final.gcode", dir, &s);
+  char *text = written(lw_output_gcode_strokes, "final.gcode", 0, dir, &s);
   lw_plotter_options o = options();
   static polyline pl[3];
   int down = 0, pen = 1, paths = 0, pauses = 0, ended = 0, units = 0, absolute = 0, feed_next = 0;

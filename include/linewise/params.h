@@ -189,6 +189,7 @@ typedef struct {
   double speed_down, speed_up; /* plot time estimate, mm/s */
   double lift_time;           /* s per pen lift */
   double plot_tolerance;      /* chords of final.hpgl and final.gcode, mm */
+  int plot_turn;              /* 1: final.hpgl and final.gcode turn the page a quarter turn */
   char gcode_pen_up[128], gcode_pen_down[128]; /* final.gcode's pen lines */
   /* [layers] (layers.h) */
   char ly_names[LW_PATH_MAX]; /* layer names; empty = no layers */

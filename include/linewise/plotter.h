@@ -19,7 +19,10 @@
 **
 ** Both files put the origin at the page's lower-left corner with y up (the
 ** machines' convention; the page's own y points down, output.h), so the
-** drawing is not mirrored.  Pens are drawn in order, pen 1 first, each
+** drawing is not mirrored; or, with `turn`, turn the page a quarter turn
+** counterclockwise, (x, y) to (y, x): the page's top-left corner at the
+** origin, its top edge along the machine's y axis, so a portrait page
+** plots on paper loaded landscape (an HP 7475A's A4 and A3).  Pens are drawn in order, pen 1 first, each
 ** path from its first point.
 **
 ** HP-GL: IN; then VS (pen-down speed in cm/s, from speed_down, limited to
@@ -49,6 +52,7 @@ typedef struct {
   double speed_down;         /* mm/s: HP-GL's VS, G-code's F of drawing moves (> 0) */
   const char *pen_up;        /* G-code: the line that lifts the pen */
   const char *pen_down;      /* G-code: the line that lowers it */
+  int turn;                  /* 1: the page turned a quarter turn counterclockwise */
 } lw_plotter_options;
 
 /* The chords that keep the cubic b[8] within tol of them (above), 1 ..
