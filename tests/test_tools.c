@@ -586,11 +586,29 @@ Test(tools, plot_run_draws_replicas_and_swaps_when_tempering)
   check_png("pt/plots/energy.png");
   check_png("pt/plots/replicas.png");
   check_png("pt/plots/swaps.png");
+  /* a hand-made trace without its scene cannot be reweighted: a note, no
+  ** heat capacity plot, and still success */
+  char *e = err_txt();
+  cr_assert(strstr(e, "plot-run: no heat capacity plot: "), "%s", e);
+  free(e);
+  cr_assert_eq(sh("test ! -e %s/pt/plots/heat_capacity.png", dir), 0);
   /* the summary alone (no replica columns in the trace) still gives both */
   write_tempering_run("ps", 0);
   cr_assert_eq(sh("%s %s/ps", tool("plot-run"), dir), 0, "%s", err_txt());
   check_png("ps/plots/replicas.png");
   check_png("ps/plots/swaps.png");
+}
+
+Test(tools, plot_run_draws_the_heat_capacity_between_the_rungs)
+{
+  cr_assert_eq(sh("%s run %s/params/wire-ladder.ini --out %s/wl --quiet", env("LW_BIN"), env("LW_ROOT"), dir), 0,
+               "%s", err_txt());
+  cr_assert_eq(sh("%s %s/wl", tool("plot-run"), dir), 0, "%s", err_txt());
+  char *out = out_txt();
+  cr_assert(strstr(out, "wl/plots/heat_capacity.png\n"), "%s", out);
+  free(out);
+  check_png("wl/plots/heat_capacity.png");
+  cr_assert_eq(sh("test ! -e %s/wl/plots/.reweight.csv.tmp", dir), 0, "no temporary file left");
 }
 
 Test(tools, plot_sweep_draws_a_png_beside_the_csv)
