@@ -816,8 +816,9 @@ static void put_per_move(lw_json *j, const char *key, const lw_chain *c, const l
   lw_json_end_object(j);
 }
 
-/* summary.json's observables: each obs_ column's mean, standard error,
-** autocorrelation time and effective samples over the stretch that
+/* summary.json's observables: each obs_ column's, and each heat capacity's
+** (trace.h), mean, standard error, autocorrelation time and effective
+** samples over the stretch that
 ** `linewise stats` takes by default (trace.h), read back from trace.csv,
 ** which the checkpoint before has flushed; null where the trace has no such
 ** stretch.  The effective samples let a sweep's table show the error bars
@@ -832,8 +833,10 @@ static void put_observables(const lw_anneal *a, lw_json *j)
   lw_trace_select_of(&a->params, &sel);
   size_t *rows = NULL, n = 0, tuned;
   double *x = NULL;
+  lw_trace *h = NULL; /* t with its heat capacities */
   lw_json_key(j, "observables");
-  if (!t || lw_trace_rows(t, path, &sel, &rows, &n, &tuned, &e) || !(x = malloc(n * sizeof *x))) {
+  if (!t || lw_trace_rows(t, path, &sel, &rows, &n, &tuned, &e) || !(x = malloc(n * sizeof *x)) ||
+      !(h = lw_trace_with_heat_capacity(t, rows, n, path, &e))) {
     lw_json_null(j);
   } else {
     const int sweep = lw_trace_column(t, "sweep");
@@ -842,14 +845,17 @@ static void put_observables(const lw_anneal *a, lw_json *j)
     lw_json_key(j, "from"); lw_json_int(j, (long long)t->v[rows[0] * t->n_cols + (size_t)sweep]);
     lw_json_key(j, "to"); lw_json_int(j, (long long)t->v[rows[n - 1] * t->n_cols + (size_t)sweep]);
     lw_json_key(j, "rows"); lw_json_int(j, (long long)n);
-    for (size_t k = 0; k < t->n_cols; k++) {
-      if (strncmp(t->name[k], "obs_", 4)) continue;
+    for (size_t k = 0; k < h->n_cols; k++) {
+      const char *name = h->name[k];
+      size_t len = strlen(name);
+      int obs = !strncmp(name, "obs_", 4), heat = len >= 13 && !strcmp(name + len - 13, "heat_capacity");
+      if (!obs && !heat) continue;
       lw_series_stats st;
-      lw_trace_column_stats(t, rows, n, (int)k, x, &st);
+      lw_trace_column_stats(h, rows, n, (int)k, x, &st);
       const char *suffix[4] = {"", "_stderr", "_tau_sweeps", "_n_eff"};
       const double value[4] = {st.mean, st.stderr_mean, st.tau * every, st.n_eff};
       for (int q = 0; q < 4; q++) {
-        snprintf(key, sizeof key, "%s%s", t->name[k] + 4, suffix[q]);
+        snprintf(key, sizeof key, "%s%s", obs ? name + 4 : name, suffix[q]);
         lw_json_key(j, key);
         /* tau and n_eff mean nothing for a column without spread */
         if (st.n && (q < 2 || st.sd > 0.0)) lw_json_number(j, value[q]);
@@ -860,6 +866,7 @@ static void put_observables(const lw_anneal *a, lw_json *j)
   }
   free(x);
   free(rows);
+  lw_trace_free(h);
   lw_trace_free(t);
 }
 

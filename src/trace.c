@@ -357,15 +357,8 @@ static int heat_sources(const lw_trace *t, int *energy, int *temp, int max)
   return energy[0] >= 0 && temp[0] >= 0;
 }
 
-/* A copy of t with a heat capacity column after its own for each source:
-** `heat_capacity` of the total, `replicaK_heat_capacity` of rung K.  On
-** the n rows chosen its values are (E - <E>)^2 / T^2, <E> their mean, so
-** that the column's mean is C = Var(E) / T^2 (k_B = 1) and its error bar
-** comes from its own autocorrelation like any column's; elsewhere, and
-** where T changes within the rows (no ensemble to speak of), they are
-** empty. */
-static lw_trace *with_heat_capacity(const lw_trace *t, const size_t *rows, size_t n, const char *path,
-                                    lw_error *err)
+lw_trace *lw_trace_with_heat_capacity(const lw_trace *t, const size_t *rows, size_t n, const char *path,
+                                      lw_error *err)
 {
   int energy[LW_TRACE_HEAT_MAX], temp[LW_TRACE_HEAT_MAX];
   const int k = heat_sources(t, energy, temp, LW_TRACE_HEAT_MAX);
@@ -446,7 +439,8 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
   }
   if (!status && !(x = malloc(most * sizeof *x))) status = lw_error_set(err, LW_ENOMEM, "out of memory");
   for (int r = 0; !status && r < k; r++)
-    if (!(heat[r] = with_heat_capacity(t[r], row[r], n[r], path[r], err))) status = err ? err->code : LW_ENOMEM;
+    if (!(heat[r] = lw_trace_with_heat_capacity(t[r], row[r], n[r], path[r], err)))
+      status = err ? err->code : LW_ENOMEM;
   if (status) goto done;
   t = (const lw_trace *const *)heat;
   double tlo = INFINITY, thi = -INFINITY;

@@ -66,7 +66,8 @@ Test(nurbs_cli, monte_carlo_heat_capacity_is_half_the_free_coordinates)
   ** must be small enough (under 5 % of C) for the check to mean something.
   ** params/wire-ladder.ini: fixed seed; 38,000 sweeps a rung after a burn-in
   ** of 2000. */
-  cr_assert_eq(sh("%s run %s/params/wire-ladder.ini --out %s/pt --quiet", lw_test_bin(), lw_test_root(), dir), 0);
+  cr_assert_eq(sh("%s run %s/params/wire-ladder.ini --out %s/pt --quiet --set output.observables=1", lw_test_bin(),
+                  lw_test_root(), dir), 0);
   cr_assert_eq(sh("%s stats %s/pt --csv > %s/pt.csv", lw_test_bin(), dir, dir), 0);
   char *csv = lw_test_slurp("%s/pt.csv", dir);
   cr_assert_not_null(csv);
@@ -79,6 +80,9 @@ Test(nurbs_cli, monte_carlo_heat_capacity_is_half_the_free_coordinates)
     cr_assert_eq(sscanf(strchr(l + 1, ',') + 1, "%lf,%lf,%lf", &n, &c, &se), 3, "%s", l);
     cr_log_info("rung %d: C = %.4f +- %.4f (5)", k, c, se);
     cr_assert(se > 0 && se < 0.25 && fabs(c - 5.0) < 4 * se, "rung %d: C = %g +- %g, expected 5", k, c, se);
+    /* summary.json's observables carry the same, for sweeps over runs */
+    cr_assert_eq(sh("awk -F': ' '/\"replica%d_heat_capacity\"/ { d = $2 - %.10g; f = d < 1e-8 && d > -1e-8 } "
+                    "END { exit !f }' %s/pt/summary.json", k, c, dir), 0, "rung %d's C in summary.json", k);
   }
   free(csv);
   /* between the rungs, by reweighting all three: C = 5 still, and <E>

@@ -59,6 +59,17 @@ void lw_trace_select_of(const lw_params *p, lw_trace_select *sel);
 lw_status lw_trace_rows(const lw_trace *t, const char *path, const lw_trace_select *sel, size_t **rows, size_t *n,
                         size_t *tuned, lw_error *err);
 
+/* A copy of t with a heat capacity column after its own for each energy
+** with a temperature: `heat_capacity` of the total at the row's
+** temperature, or with tempering `replicaK_heat_capacity` of every rung
+** (lw_trace_rungs).  On the n rows chosen its values are (E - <E>)^2 / T^2,
+** <E> their mean, so that the column's mean is C = Var(E) / T^2 (k_B = 1)
+** and its error bar comes from its own autocorrelation like any column's;
+** elsewhere, and where T changes within the rows (no ensemble to speak
+** of), they are empty.  NULL and err (LW_ENOMEM, naming path). */
+lw_trace *lw_trace_with_heat_capacity(const lw_trace *t, const size_t *rows, size_t n, const char *path,
+                                      lw_error *err);
+
 /* The rows' spacing in sweeps (output.trace_every), from the first two. */
 double lw_trace_every(const lw_trace *t);
 
