@@ -93,7 +93,7 @@ static int newton_step(const double *log_n, const double *s, const double *ww, i
 }
 
 lw_status lw_reweight_solve(const double *E, const size_t *first, const double *beta, int K, int warm, double *f,
-                            int *iterations, lw_error *err)
+                            double *log_den, int *iterations, lw_error *err)
 {
   if (K < 1) return lw_error_set(err, LW_EINPUT, "no states to reweight");
   const size_t n = first[K];
@@ -161,8 +161,10 @@ lw_status lw_reweight_solve(const double *E, const size_t *first, const double *
       goto done;
     }
   }
-  /* back from the energies about eref: f_k shifts by beta_k eref */
+  /* back from the energies about eref: f_k shifts by beta_k eref, and
+  ** ln D_i by beta_0 eref, which no normalised weight sees */
   for (int k = K - 1; k >= 0; k--) f[k] += (beta[k] - beta[0]) * eref;
+  if (log_den) memcpy(log_den, log_d, n * sizeof *log_den);
   if (iterations) *iterations = it;
 done:
   free(log_d);
@@ -178,25 +180,14 @@ done:
   return st;
 }
 
-lw_status lw_reweight_at(const double *E, const size_t *first, const double *beta, const double *f, int K, double b,
-                         double *mean_energy, double *heat_capacity, lw_error *err)
+void lw_reweight_at(const double *E, size_t n, const double *log_den, double b, double *mean_energy,
+                    double *heat_capacity)
 {
-  const size_t n = first[K];
   const double eref = mean_of(E, n);
-  double *log_n = malloc((size_t)K * sizeof *log_n), *fs = malloc((size_t)K * sizeof *fs);
-  if (!log_n || !fs) {
-    free(log_n);
-    free(fs);
-    return lw_error_set(err, LW_ENOMEM, "out of memory reweighting %d states", K);
-  }
-  for (int m = 0; m < K; m++) {
-    log_n[m] = log((double)(first[m + 1] - first[m]));
-    fs[m] = f[m] - (beta[m] - beta[0]) * eref;
-  }
   /* the weights' sums in one pass, scaled by the largest weight so far */
   double top = -INFINITY, w = 0.0, m1 = 0.0, m2 = 0.0;
   for (size_t i = 0; i < n; i++) {
-    double e = E[i] - eref, lw = -b * e - log_denominator(e, log_n, fs, beta, K);
+    double e = E[i] - eref, lw = -b * e - log_den[i];
     if (lw > top) {
       double scale = exp(top - lw);
       w *= scale;
@@ -212,9 +203,6 @@ lw_status lw_reweight_at(const double *E, const size_t *first, const double *bet
   m1 /= w;
   *mean_energy = eref + m1;
   *heat_capacity = b * b * fmax(m2 / w - m1 * m1, 0.0);
-  free(log_n);
-  free(fs);
-  return LW_OK;
 }
 
 /* ---- a tempering run's trace ------------------------------------------- */
@@ -303,7 +291,11 @@ static lw_status gather(const lw_trace *const *t, const char *const *path, const
         goto done;
       }
       size_t window;
-      const size_t g = (size_t)ceil(2.0 * fmax(lw_series_tau(x, 1, c, &window), 0.5));
+      /* one every 2 tau, and no more than LW_REWEIGHT_SAMPLES a rung: beyond
+      ** that the error bars are far below the trace's own scatter, and the
+      ** solves' cost grows with the samples */
+      size_t g = (size_t)ceil(2.0 * fmax(lw_series_tau(x, 1, c, &window), 0.5));
+      if (c > g * LW_REWEIGHT_SAMPLES) g = (c + LW_REWEIGHT_SAMPLES - 1) / LW_REWEIGHT_SAMPLES;
       s->open += !window;
       size_t at = s->first[s->K];
       for (size_t i = 0; i < c; i += g) s->E[at++] = x[i];
@@ -342,10 +334,11 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
   if (st) return st;
   const int K = s.K, B = LW_REWEIGHT_BOOTSTRAP;
   const size_t n = s.first[K];
-  double *f = malloc((size_t)K * sizeof *f), *fb = malloc((size_t)K * sizeof *fb), *Eb = malloc(n * sizeof *Eb);
+  double *f = malloc((size_t)K * sizeof *f), *fb = malloc((size_t)K * sizeof *fb), *Eb = malloc(n * sizeof *Eb),
+         *log_den = malloc(n * sizeof *log_den);
   double *est = calloc((size_t)n_temps * 2, sizeof *est), *sum = calloc((size_t)n_temps * 4, sizeof *sum);
   gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
-  if (!f || !fb || !Eb || !est || !sum || !rng) {
+  if (!f || !fb || !Eb || !log_den || !est || !sum || !rng) {
     st = lw_error_set(err, LW_ENOMEM, "out of memory reweighting %zu samples", n);
     goto done;
   }
@@ -356,10 +349,10 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
   }
   const double tlo = 1.0 / bhi, thi = 1.0 / blo;
   int iterations;
-  if ((st = lw_reweight_solve(s.E, s.first, s.beta, K, 0, f, &iterations, err))) goto done;
-  for (int j = 0; j < n_temps && !st; j++) {
+  if ((st = lw_reweight_solve(s.E, s.first, s.beta, K, 0, f, log_den, &iterations, err))) goto done;
+  for (int j = 0; j < n_temps; j++) {
     double T = tlo * pow(thi / tlo, (double)j / (n_temps - 1));
-    st = lw_reweight_at(s.E, s.first, s.beta, f, K, 1.0 / T, &est[2 * j], &est[2 * j + 1], err);
+    lw_reweight_at(s.E, n, log_den, 1.0 / T, &est[2 * j], &est[2 * j + 1]);
   }
   /* the error bars: each state's samples drawn again with replacement, a
   ** fixed seed so that the output is the same every time */
@@ -370,10 +363,10 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
       for (size_t i = 0; i < m; i++) Eb[a + i] = s.E[a + gsl_rng_uniform_int(rng, m)];
     }
     memcpy(fb, f, (size_t)K * sizeof *fb); /* the whole data's: close to a resample's */
-    if ((st = lw_reweight_solve(Eb, s.first, s.beta, K, 1, fb, NULL, err))) break;
-    for (int j = 0; j < n_temps && !st; j++) {
+    if ((st = lw_reweight_solve(Eb, s.first, s.beta, K, 1, fb, log_den, NULL, err))) break;
+    for (int j = 0; j < n_temps; j++) {
       double T = tlo * pow(thi / tlo, (double)j / (n_temps - 1)), e, c;
-      if ((st = lw_reweight_at(Eb, s.first, s.beta, fb, K, 1.0 / T, &e, &c, err))) break;
+      lw_reweight_at(Eb, n, log_den, 1.0 / T, &e, &c);
       double d[2] = {e - est[2 * j], c - est[2 * j + 1]}; /* about the estimate: no cancellation */
       for (int v = 0; v < 2; v++) {
         sum[4 * j + 2 * v] += d[v];
@@ -419,6 +412,7 @@ done:
   free(f);
   free(fb);
   free(Eb);
+  free(log_den);
   free(est);
   free(sum);
   gsl_rng_free(rng);

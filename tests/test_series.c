@@ -425,7 +425,8 @@ Test(reweight, free_energies_of_a_harmonic_system)
   first[K] = K * n;
   int it;
   lw_error err;
-  cr_assert_eq(lw_reweight_solve(E, first, beta, K, 0, f, &it, &err), LW_OK, "%s", err.msg);
+  double *log_den = malloc(K * n * sizeof *log_den);
+  cr_assert_eq(lw_reweight_solve(E, first, beta, K, 0, f, log_den, &it, &err), LW_OK, "%s", err.msg);
   for (int k = 0; k < K; k++) {
     /* the constant offset 1000 adds 1000 beta to f */
     double exact = HARMONIC_D / 2.0 * log(beta[k] / beta[0]) + 1000.0 * (beta[k] - beta[0]);
@@ -435,8 +436,9 @@ Test(reweight, free_energies_of_a_harmonic_system)
   /* at a rung's own temperature the reweighted mean is close to that
   ** rung's sample mean: mostly its own samples carry the weight */
   double e, c;
-  cr_assert_eq(lw_reweight_at(E, first, beta, f, K, beta[1], &e, &c, &err), LW_OK);
+  lw_reweight_at(E, first[K], log_den, beta[1], &e, &c);
   cr_assert(fabs(e - (1000.0 + HARMONIC_D / 2.0 / beta[1])) < 0.15, "<E> %g", e);
+  free(log_den);
   free(E);
   gsl_rng_free(r);
 }

@@ -32,6 +32,7 @@
 #define LW_REWEIGHT_TOL 1e-10       /* the f_k's last change, at most */
 #define LW_REWEIGHT_ITER 10000      /* iterations at most */
 #define LW_REWEIGHT_BOOTSTRAP 32    /* resamples for the error bars */
+#define LW_REWEIGHT_SAMPLES 20000   /* samples a rung at most, after thinning */
 #define LW_REWEIGHT_TEMPS_MAX 10000 /* temperatures a table, at most */
 #define LW_REWEIGHT_SWAP_MIN 0.05   /* neighbour exchange acceptance below which a warning says the
                                        rungs barely overlap */
@@ -40,16 +41,18 @@
 ** E[first[k] .. first[k + 1] - 1] at inverse temperatures beta[k] (every
 ** state with a sample; first[K] = N), from the thermodynamic integral, or
 ** with warm = 1 from f as given (a solution for similar samples: a
-** bootstrap resample's).  *iterations (NULL: not asked) the iterations
-** taken.  LW_EINPUT when the iteration does not settle (states that share
-** no energies), LW_ENOMEM. */
+** bootstrap resample's); log_den[N] (NULL: not asked) the samples' ln D_i
+** up to one constant, what lw_reweight_at needs.  *iterations (NULL: not
+** asked) the iterations taken.  LW_EINPUT when the iteration does not
+** settle (states that share no energies), LW_ENOMEM. */
 lw_status lw_reweight_solve(const double *E, const size_t *first, const double *beta, int K, int warm, double *f,
-                            int *iterations, lw_error *err);
+                            double *log_den, int *iterations, lw_error *err);
 
-/* The mean energy and heat capacity at inverse temperature b from the
-** solved states (f from lw_reweight_solve); LW_ENOMEM. */
-lw_status lw_reweight_at(const double *E, const size_t *first, const double *beta, const double *f, int K, double b,
-                         double *mean_energy, double *heat_capacity, lw_error *err);
+/* The mean energy and heat capacity at inverse temperature b from the n
+** samples and their ln D_i (from lw_reweight_solve): one exponential a
+** sample. */
+void lw_reweight_at(const double *E, size_t n, const double *log_den, double b, double *mean_energy,
+                    double *heat_capacity);
 
 /* `linewise stats --reweight N`: the mean energy and heat capacity, with
 ** bootstrap error bars, at n_temps temperatures spaced geometrically from
