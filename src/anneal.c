@@ -818,10 +818,9 @@ static void put_per_move(lw_json *j, const char *key, const lw_chain *c, const l
 
 /* summary.json's observables: each obs_ column's, and each heat capacity's
 ** (trace.h), mean, standard error, autocorrelation time and effective
-** samples over the stretch that
-** `linewise stats` takes by default (trace.h), read back from trace.csv,
-** which the checkpoint before has flushed; null where the trace has no such
-** stretch.  The effective samples let a sweep's table show the error bars
+** samples over the stretch that `linewise stats` takes by default (trace.h),
+** read back from trace.csv, which the checkpoint before has flushed; null
+** where the trace has no such stretch.  The effective samples let a sweep's table show the error bars
 ** too rough to trust (under 25, as `linewise stats` warns). */
 static void put_observables(const lw_anneal *a, lw_json *j)
 {

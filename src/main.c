@@ -18,9 +18,9 @@
 #include "linewise/number.h"
 #include "linewise/params.h"
 #include "linewise/phase.h"
+#include "linewise/reweight.h"
 #include "linewise/state.h"
 #include "linewise/system.h"
-#include "linewise/reweight.h"
 #include "linewise/trace.h"
 #ifdef LW_MPI
 #include "linewise/mpi_tempering.h"

@@ -151,8 +151,6 @@ lw_strokes *lw_strokes_from_plot(const lw_splines *sp, const lw_plot *plot, lw_e
   return s;
 }
 
-/* ---- Bezier pieces -------------------------------------------------------- */
-
 void lw_strokes_pen_range(const lw_strokes *s, int k, size_t *a, size_t *z)
 {
   *a = s->pen_first[k];
@@ -172,6 +170,8 @@ void lw_strokes_drawn_segment(const lw_strokes *s, size_t k, size_t j, double *o
     out[2 * c + 1] = b[7 - 2 * c];
   }
 }
+
+/* ---- Bezier pieces -------------------------------------------------------- */
 
 void lw_bezier_eval(const double *b, double t, double *xy)
 {
