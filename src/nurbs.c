@@ -128,19 +128,28 @@ double lw_nurbs_u0(const lw_nurbs *c) { return c->knot[c->order - 1]; }
 
 double lw_nurbs_u1(const lw_nurbs *c) { return c->knot[c->n]; }
 
-size_t lw_nurbs_rational(const lw_nurbs *c, double u, double *R)
+/* The k B-spline basis functions nonzero at u (clamped to the range) and
+** their first and second derivatives, into c->dB; returns the first's
+** index. */
+static size_t basis_at(const lw_nurbs *c, double u)
 {
-  const int k = c->order;
+  const size_t k = (size_t)c->order;
   double u0 = lw_nurbs_u0(c), u1 = lw_nurbs_u1(c);
   u = u < u0 ? u0 : u > u1 ? u1 : u;
   size_t first, last;
   /* the second derivative of an order-2 basis is 0; GSL wants nderiv < k there */
   size_t nd = k > 2 ? 2 : 1;
   size_t s = span_of(c, u);
-  for (size_t i = 0; i < 2 * (size_t)k; i++) gsl_vector_set(c->ws->knots, i, c->knot[s + 1 - (size_t)k + i]);
+  for (size_t i = 0; i < 2 * k; i++) gsl_vector_set(c->ws->knots, i, c->knot[s + 1 - k + i]);
   gsl_matrix_set_zero(c->dB);
   gsl_bspline_deriv_eval_nonzero(u, nd, c->dB, &first, &last, c->ws);
-  first = s + 1 - (size_t)k;
+  return s + 1 - k;
+}
+
+size_t lw_nurbs_rational(const lw_nurbs *c, double u, double *R)
+{
+  const int k = c->order;
+  size_t first = basis_at(c, u);
   double W[3] = {0.0, 0.0, 0.0};
   for (int j = 0; j < k; j++)
     for (int d = 0; d < 3; d++) W[d] += c->w[first + (size_t)j] * gsl_matrix_get(c->dB, (size_t)j, (size_t)d);
@@ -226,6 +235,125 @@ lw_status lw_nurbs_insert_knot(lw_nurbs *c, double u, lw_error *err)
   c->w = w;
   c->n = n + 1;
   return LW_OK;
+}
+
+/* The knot vector of lw_nurbs_refine into t (room for the bound below);
+** returns its length. */
+static size_t refined_knots(const lw_nurbs *c, size_t k2, size_t elevate, size_t split, double *t)
+{
+  const size_t k = (size_t)c->order, n = c->n;
+  const double u1 = lw_nurbs_u1(c);
+  size_t m = 0;
+  double a = lw_nurbs_u0(c);
+  for (size_t j = 0; j < k2; j++) t[m++] = a;
+  for (size_t i = k; i <= n;) { /* knot[i] is the next value after a */
+    double b = c->knot[i];
+    size_t mult = 1;
+    while (i + mult <= n && c->knot[i + mult] == b) mult++;
+    for (size_t q = 1; q < split; q++) t[m++] = a + (b - a) * (double)q / (double)split;
+    if (b == u1) break;
+    for (size_t j = 0; j < mult + elevate; j++) t[m++] = b;
+    a = b;
+    i += mult;
+  }
+  for (size_t j = 0; j < k2; j++) t[m++] = u1;
+  return m;
+}
+
+/* The new control points solve the interpolation of the curve's
+** homogeneous coordinates (w x, w y, w) at the new basis's Greville
+** abscissae: the curve lies in the new space, so the interpolant is the
+** curve itself, to rounding.  That collocation matrix is banded (k2 - 1 on
+** either side) and totally positive, so Gaussian elimination without
+** pivoting is stable (de Boor and Pinkus 1977).  A polynomial curve stays
+** one: its weights are kept and only its points interpolated. */
+lw_status lw_nurbs_refine(lw_nurbs *c, int elevate, int split, lw_error *err)
+{
+  if (elevate < 0 || split < 1)
+    return lw_error_set(err, LW_EINPUT, "elevate %d and split %d: expected elevate >= 0 and split >= 1", elevate,
+                        split);
+  if (!elevate && split == 1) return LW_OK;
+  const size_t k = (size_t)c->order, n = c->n, k2 = k + (size_t)elevate, hb = k2 - 1, wb = 2 * hb + 1;
+  if (k2 > LW_NURBS_ORDER_MAX)
+    return lw_error_set(err, LW_EINPUT, "order %zu raised by %d is %zu: at most %d", k, elevate, k2,
+                        LW_NURBS_ORDER_MAX);
+  const size_t cap = 2 * k2 + (n - k) * (1 + (size_t)elevate) + (n - k + 1) * ((size_t)split - 1);
+  const int poly = lw_nurbs_polynomial(c);
+  double *t = malloc(cap * sizeof *t);
+  lw_nurbs *d = NULL;
+  double *A = NULL, *h = NULL;
+  lw_status st = LW_OK;
+  if (!t) goto nomem;
+  size_t n2 = refined_knots(c, k2, (size_t)elevate, (size_t)split, t) - k2;
+  if (!(d = alloc_curve((int)k2, n2, err))) {
+    free(t);
+    return LW_ENOMEM;
+  }
+  memcpy(d->knot, t, (n2 + k2) * sizeof *t);
+  A = calloc(n2 * wb, sizeof *A);
+  h = malloc(3 * n2 * sizeof *h);
+  if (attach_basis(d, err) || !A || !h) goto nomem;
+  for (size_t i = 0; i < n2; i++) {
+    double xi = 0.0;
+    for (size_t j = 1; j < k2; j++) xi += t[i + j];
+    xi /= (double)(k2 - 1);
+    size_t f2 = basis_at(d, xi);
+    for (size_t j = 0; j < k2; j++) A[i * wb + (f2 + j + hb - i)] = gsl_matrix_get(d->dB, j, 0);
+    size_t f = basis_at(c, xi);
+    double *hi = h + 3 * i;
+    hi[0] = hi[1] = hi[2] = 0.0;
+    for (size_t j = 0; j < k; j++) {
+      double nw = gsl_matrix_get(c->dB, j, 0) * (poly ? 1.0 : c->w[f + j]);
+      hi[0] += nw * c->P[2 * (f + j)];
+      hi[1] += nw * c->P[2 * (f + j) + 1];
+      hi[2] += nw;
+    }
+  }
+  for (size_t col = 0; col < n2; col++) {
+    const double *pr = A + col * wb + hb; /* pr[j]: column col + j of row col */
+    if (!(fabs(pr[0]) > 0.0)) {
+      st = lw_error_set(err, LW_EINPUT, "the refined basis is singular at control point %zu", col);
+      goto out;
+    }
+    for (size_t r = col + 1; r < n2 && r <= col + hb; r++) {
+      double *rr = A + r * wb + hb - (r - col); /* rr[j]: column col + j of row r */
+      double f = rr[0] / pr[0];
+      for (size_t j = 0; j <= hb && col + j < n2; j++) rr[j] -= f * pr[j];
+      for (int q = 0; q < 3; q++) h[3 * r + q] -= f * h[3 * col + q];
+    }
+  }
+  for (size_t i = n2; i-- > 0;) {
+    const double *ar = A + i * wb + hb;
+    for (size_t j = 1; j <= hb && i + j < n2; j++)
+      for (int q = 0; q < 3; q++) h[3 * i + q] -= ar[j] * h[3 * (i + j) + q];
+    for (int q = 0; q < 3; q++) h[3 * i + q] /= ar[0];
+  }
+  for (size_t i = 0; i < n2; i++) {
+    double wi = poly ? c->w[0] : h[3 * i + 2];
+    d->w[i] = wi;
+    d->P[2 * i] = poly ? h[3 * i] : h[3 * i] / wi;
+    d->P[2 * i + 1] = poly ? h[3 * i + 1] : h[3 * i + 1] / wi;
+    if (!(wi > 0.0) || !isfinite(d->P[2 * i]) || !isfinite(d->P[2 * i + 1])) {
+      st = lw_error_set(err, LW_EINPUT, "the refined curve's control point %zu came out as (%g, %g) of weight %g", i,
+                        d->P[2 * i], d->P[2 * i + 1], wi);
+      goto out;
+    }
+  }
+  /* an open knot vector interpolates its ends: keep them to the bit */
+  memcpy(d->P, c->P, 2 * sizeof *d->P);
+  memcpy(d->P + 2 * (n2 - 1), c->P + 2 * (n - 1), 2 * sizeof *d->P);
+  d->w[0] = c->w[0];
+  d->w[n2 - 1] = c->w[n - 1];
+  lw_nurbs swap = *c;
+  *c = *d;
+  *d = swap;
+  goto out;
+nomem:
+  st = lw_error_set(err, LW_ENOMEM, "out of memory refining a NURBS curve");
+out:
+  lw_nurbs_free(d);
+  free(t), free(A), free(h);
+  return st;
 }
 
 /* Beziers deeper than this many bisections are kept as they are (and their

@@ -656,6 +656,15 @@ const lw_param_def lw_param_table[] = {
   STRING("nurbs", "knots", nb_knots, "", "",
          "The open knot vector: n + k nondecreasing numbers, the first k equal and the last k "
          "equal; empty = uniform inner knots on [0, 1]."),
+  NUM("nurbs", "elevate", LW_PT_INT, nb_elevate, "0", "", 0, 6, 0,
+      "Raise the degree by this much before the run (degree elevation: each knot's multiplicity "
+      "rises with it, so the curve and its continuity are unchanged; order + elevate <= 8). "
+      "docs/NURBS.md, \"Refinement\"."),
+  NUM("nurbs", "refine", LW_PT_INT, nb_refine, "1", "", 1, 1000, 0,
+      "Cut every knot span into this many equal spans before the run, after `elevate` (knot "
+      "insertion: the curve unchanged, more control points, the new knots simple). The energy "
+      "is the curve's, so a finer curve is a finer Ritz approximation of the same wire. "
+      "docs/NURBS.md, \"Refinement\"."),
   NUM("nurbs", "alpha", LW_PT_DOUBLE, nb_alpha, "1", "energy", 0, 1e12, 0,
       "Tension alpha of the energy 1/2 int alpha |c_u|^2 + beta |c_uu|^2 du (over the parameter u)."),
   NUM("nurbs", "beta", LW_PT_DOUBLE, nb_beta, "0", "energy", 0, 1e12, 0,

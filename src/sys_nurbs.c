@@ -159,6 +159,11 @@ static lw_nurbs *curve_of(const lw_params *p, lw_error *err)
     goto out;
   }
   c = lw_nurbs_new(p->nb_order, n, knot, P, nw ? w : NULL, err);
+  if (c && lw_nurbs_refine(c, p->nb_elevate, p->nb_refine, err)) {
+    lw_params_blame(p, "nurbs", p->nb_order + p->nb_elevate > LW_NURBS_ORDER_MAX ? "elevate" : "refine", err);
+    lw_nurbs_free(c);
+    c = NULL;
+  }
 out:
   free(P), free(w), free(knot);
   return c;
@@ -673,6 +678,37 @@ static void mass_free(void *mass)
   free(m);
 }
 
+/* The highest angular frequency of the frozen-weight curve, omega^2 the
+** largest eigenvalue of (K, rho M1) on the free points, by power iteration
+** from the alternating vector (the highest mode alternates). Its Rayleigh
+** quotients rise toward omega^2 from below, so a refusal on it is never
+** wrong. L is the factor of rho M1 with the held points (mass_new). */
+static double highest_omega(const lw_nurbs_setup *su, const double *M, const double *L, lw_error *err)
+{
+  const size_t n = su->mat->n;
+  const int k = su->mat->k;
+  double *v = malloc(3 * n * sizeof *v), *kv = v + n, *mv = v + 2 * n, rq = 0.0;
+  if (!v) {
+    lw_error_set(err, LW_ENOMEM, "out of memory");
+    return NAN;
+  }
+  for (size_t i = 0; i < n; i++) v[i] = su->pin[i] ? 0.0 : i % 2 ? -1.0 : 1.0;
+  for (int it = 0; it < 200; it++) {
+    lw_band_apply_dim(su->mat->K, n, k, 1, v, kv);
+    lw_band_apply_dim(M, n, k, 1, v, mv);
+    double vkv = 0.0, vmv = 0.0, norm = 0.0;
+    for (size_t i = 0; i < n; i++) vkv += v[i] * kv[i], vmv += v[i] * mv[i];
+    if (!(vmv > 0.0)) break;
+    rq = fmax(rq, vkv / vmv);
+    lw_band_solve_dim(L, su->pin, n, k, 1, kv, v);
+    for (size_t i = 0; i < n; i++) norm = fmax(norm, fabs(v[i]));
+    if (!(norm > 0.0)) break;
+    for (size_t i = 0; i < n; i++) v[i] /= norm;
+  }
+  free(v);
+  return sqrt(rq);
+}
+
 static void *mass_new(const void *state, const lw_params *p, double density, lw_error *err)
 {
   const lw_nurbs_state *s = state;
@@ -701,6 +737,22 @@ static void *mass_new(const void *state, const lw_params *p, double density, lw_
   if (lw_band_factor(m->M, su->pin, m->n, (int)m->k, m->L, err)) {
     mass_free(m);
     return NULL;
+  }
+  /* the undamped leapfrog is stable for omega_max dt < 2: refuse a step past
+  ** that before anything is written (a damped or implicit motion, or the
+  ** massless flow, is left to the run's own check of E + K) */
+  if (p->dyn_rho > 0.0 && p->dyn_gamma == 0.0 && p->dyn_integrator == LW_INTEGRATOR_LEAPFROG) {
+    double omega = highest_omega(su, m->M, m->L, err);
+    if (isnan(omega) || omega * p->dyn_dt >= 2.0) {
+      if (!isnan(omega)) {
+        lw_error_set(err, LW_EINPUT, "%g s is past the leapfrog's stability limit 2 / omega_max = %.3g s of this "
+                     "curve (omega_max = %.4g /s, %zu control points): take dt <= %.2g", p->dyn_dt, 2.0 / omega,
+                     omega, m->n, 1.8 / omega);
+        lw_params_blame(p, "dynamics", "dt", err);
+      }
+      mass_free(m);
+      return NULL;
+    }
   }
   return m;
 nomem:

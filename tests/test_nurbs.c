@@ -6,6 +6,7 @@
 #include <criterion/criterion.h>
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "linewise/nurbs.h"
 #include "testutil.h"
@@ -153,6 +154,76 @@ Test(nurbs, knot_insertion_keeps_a_rational_curve)
   }
   lw_nurbs_free(c);
   lw_nurbs_free(b);
+}
+
+/* The largest distance between two curves' points and first and second
+** derivatives over 401 parameters, relative to the curve's own size (or
+** absolute below 1). */
+static void curve_distance(const lw_nurbs *a, const lw_nurbs *b, double d[3])
+{
+  double scale[3] = {0.0, 0.0, 0.0};
+  d[0] = d[1] = d[2] = 0.0;
+  for (int q = 0; q <= 400; q++) {
+    double u = q / 400.0, p[3][2], r[3][2];
+    lw_nurbs_eval(a, u, p[0], p[1], p[2]);
+    lw_nurbs_eval(b, u, r[0], r[1], r[2]);
+    for (int j = 0; j < 3; j++) {
+      d[j] = fmax(d[j], hypot(p[j][0] - r[j][0], p[j][1] - r[j][1]));
+      scale[j] = fmax(scale[j], hypot(p[j][0], p[j][1]));
+    }
+  }
+  for (int j = 0; j < 3; j++) d[j] /= fmax(scale[j], 1.0);
+}
+
+Test(nurbs, refinement_and_elevation_keep_the_curve_and_its_continuity)
+{
+  /* random rational and polynomial curves of orders 2 to 6 on knots with
+  ** repeats, raised by 0 to 2 and split 1 to 5: the same curve (point,
+  ** first and second derivative; the derivatives of an order-2 curve jump
+  ** at its knots, which each side evaluates alike), the new counts, the
+  ** end points to the bit, polynomial curves still polynomial */
+  rng_seed(23);
+  lw_error err;
+  for (int k = 2; k <= 6; k++)
+    for (int e = 0; e <= 2; e++)
+      for (int split = 1; split <= 5; split += 2)
+        for (int rational = 0; rational <= 1; rational++) {
+          size_t n = (size_t)k + 5;
+          double t[32], P[64], w[32];
+          random_knots(n, k, t);
+          for (size_t i = 0; i < n; i++)
+            P[2 * i] = urand(-3, 3), P[2 * i + 1] = urand(-3, 3), w[i] = rational ? urand(0.3, 3) : 1.0;
+          lw_nurbs *c = lw_nurbs_new(k, n, t, P, w, &err), *b = lw_nurbs_copy(c, &err);
+          cr_assert_not_null(b);
+          cr_assert_eq(lw_nurbs_refine(b, e, split, &err), LW_OK, "%s", err.msg);
+          size_t distinct = 0; /* inner knot values */
+          for (size_t i = (size_t)k; i < n; i++) distinct += t[i] != t[i - 1];
+          cr_assert_eq(b->order, k + e);
+          cr_assert_eq(b->n, n + (size_t)e * (distinct + 1) + (distinct + 1) * (size_t)(split - 1),
+                       "k %d e %d split %d: %zu points", k, e, split, b->n);
+          double d[3];
+          curve_distance(c, b, d);
+          cr_assert(d[0] < 1e-12 && d[1] < 1e-10 && d[2] < 1e-8, "k %d e %d split %d rational %d: moved %g %g %g", k, e,
+                    split, rational, d[0], d[1], d[2]);
+          cr_assert(b->P[0] == P[0] && b->P[1] == P[1] && b->P[2 * b->n - 2] == P[2 * n - 2] &&
+                    b->P[2 * b->n - 1] == P[2 * n - 1]);
+          cr_assert_eq(lw_nurbs_polynomial(b), !rational);
+          lw_nurbs_free(c);
+          lw_nurbs_free(b);
+        }
+}
+
+Test(nurbs, refinement_refuses_an_order_past_the_largest)
+{
+  double t[] = {0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1}, P[12] = {0, 0, 1, 1, 2, 0, 3, 1, 4, 0, 5, 1};
+  lw_error err;
+  lw_nurbs *c = lw_nurbs_new(6, 6, t, P, NULL, &err);
+  cr_assert_eq(lw_nurbs_refine(c, 3, 1, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "at most 8"), "%s", err.msg);
+  cr_assert_eq(c->n, 6, "a refused refinement leaves the curve");
+  cr_assert_eq(lw_nurbs_refine(c, 2, 1, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(c->order, 8);
+  lw_nurbs_free(c);
 }
 
 Test(nurbs, a_circle_is_exact_with_the_standard_weights)

@@ -206,3 +206,46 @@ Test(nurbs_cli, free_weights_refuse_a_free_scale_and_the_review_scheme)
                   dir), 0);
   cr_assert_neq(sh("test -e %s/rv", dir), 0);
 }
+
+Test(nurbs_cli, a_refined_wire_runs_resumes_and_refuses_a_step_past_its_stability)
+{
+  /* cut into four spans a span, the wire has 19 control points and a
+  ** highest frequency of 2613 /s (the pencil's, tests/test_wire.c), so the
+  ** review's dt = 0.008 s is refused before anything is written, with the
+  ** step that is stable */
+  const char *wire = "--set nurbs.refine=4 --set dynamics.steps_per_sweep=20 --set anneal.sweeps=30";
+  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/r --quiet %s 2> %s/err.txt", lw_test_bin(), lw_test_root(), dir,
+                  wire, dir),
+               2);
+  cr_assert_eq(sh("grep -q \"wire.ini:27: key 'dynamics.dt': 0.008 s is past the leapfrog's stability limit 2 / "
+                  "omega_max = 0.000766 s .*omega_max = 2613 /s, 19 control points): take dt <= 0.00069\" %s/err.txt",
+                  dir),
+               0);
+  cr_assert_neq(sh("test -e %s/r", dir), 0);
+  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/r --quiet %s --set dynamics.dt=0.0006", lw_test_bin(),
+                  lw_test_root(), dir, wire),
+               0);
+  cr_assert_eq(sh("grep -q '\"control_points\": 19' %s/r/summary.json && grep -q '\"svg_beziers\": 16' "
+                  "%s/r/summary.json",
+                  dir, dir),
+               0, "a polynomial cubic stays one Bezier a span");
+  cr_assert_eq(sh("grep -c '^point = ' %s/r/state.lw | grep -q '^19$'", dir), 0);
+  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/h --quiet %s --set dynamics.dt=0.0006 --stop-at 11",
+                  lw_test_bin(), lw_test_root(), dir, wire),
+               0);
+  cr_assert_eq(sh("%s resume %s/h --quiet", lw_test_bin(), dir), 0);
+  cr_assert_eq(sh("cmp -s %s/r/state.lw %s/h/state.lw && cmp -s %s/r/final.svg %s/h/final.svg", dir, dir, dir, dir),
+               0);
+  /* the energy over the run: the leapfrog keeps E + K (the trace's total) */
+  cr_assert_eq(sh("awk -F, 'NR == 2 { h = $7 } NR > 2 { d = $7 - h; if (d < 0) d = -d; if (d > 1e-3 * h) bad = 1 } "
+                  "END { exit bad }' %s/r/trace.csv",
+                  dir),
+               0);
+}
+
+Test(nurbs_cli, refinement_past_the_largest_order_is_refused)
+{
+  refused("order = 6\\nelevate = 3\\npoints = 0 0 1 1 2 0 3 1 4 0 5 1\\n",
+          "bad.ini:5: key .nurbs.elevate.: order 6 raised by 3 is 9: at most 8");
+  refused("refine = 0\\npoints = 0 0 1 1 2 0 3 1\\n", "bad.ini:4: key .nurbs.refine.: expected");
+}

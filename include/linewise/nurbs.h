@@ -61,6 +61,16 @@ int lw_nurbs_polynomial(const lw_nurbs *c);
 ** is unchanged for rational curves too: one control point more. */
 lw_status lw_nurbs_insert_knot(lw_nurbs *c, double u, lw_error *err);
 
+/* The same curve in a richer space (h- and p-refinement): the degree
+** raised by elevate, each inner knot's multiplicity with it (so the
+** continuity at every knot is kept), then every knot span cut into split
+** equal spans by simple knots (the curve's smoothest there).  The control
+** points and weights are interpolated at the new Greville abscissae, so the
+** curve is unchanged to rounding; the end points are kept to the bit and a
+** polynomial curve stays one.  elevate = 0, split = 1 changes nothing;
+** LW_EINPUT when the order would pass LW_NURBS_ORDER_MAX. */
+lw_status lw_nurbs_refine(lw_nurbs *c, int elevate, int split, lw_error *err);
+
 /* The curve as cubic Beziers for SVG: each knot span by the cubic Hermite
 ** interpolant of its end points and end derivatives, bisected while it is
 ** farther than tol from the curve at 32 parameter samples (a parametric

@@ -243,6 +243,8 @@ typedef struct {
   char nb_weights[2048];      /* "w w ...", empty = all 1 */
   char nb_knots[2048];        /* n + k knots, empty = open uniform */
   char nb_file[LW_PATH_MAX];  /* "x y [w]" a line instead of points/weights, or empty */
+  int nb_elevate;             /* degree elevation before the run */
+  int nb_refine;              /* each knot span cut into this many */
   double nb_alpha, nb_beta;   /* energy coefficients */
   int nb_gauss;               /* Gauss points per knot span */
   int nb_fixed;               /* control points held at each end */
