@@ -2,8 +2,9 @@
 ** test_particles_cli.c -- the oriented-particle system through the seam, on
 ** the command line: the bundled sheet anneals and writes a valid final.ply,
 ** stop and resume give the bytes of an uninterrupted run, the outputs do
-** not depend on the thread count with tempering, and `linewise energy`
-** recomputes a particle run.
+** not depend on the thread count with tempering, `linewise energy`
+** recomputes a particle run, and the LJ13 cluster of params/lj13.ini melts
+** with the heat capacity the physics asks for.
 */
 #include <criterion/criterion.h>
 #include <gsl/gsl_cdf.h>
@@ -513,4 +514,68 @@ Test(particles_cli, the_bundled_seed_patch_grows_into_a_flat_sheet)
   gsl_vector_free(val);
   gsl_matrix_free(vec);
   gsl_matrix_free(cov);
+}
+
+/* The heat capacity of rung k from `linewise stats --csv` (mean and
+** standard error). */
+static void rung_heat_capacity(const char *csv, int k, double *c, double *se)
+{
+  char key[64];
+  snprintf(key, sizeof key, "\nreplica%d_heat_capacity,", k);
+  const char *l = strstr(csv, key);
+  cr_assert_not_null(l, "%s", csv);
+  double n;
+  cr_assert_eq(sscanf(strchr(l + 1, ',') + 1, "%lf,%lf,%lf", &n, c, se), 3, "%s", l);
+}
+
+Test(particles_cli, the_lj13_cluster_melts_with_a_heat_capacity_peak, .timeout = 240)
+{
+  /* params/lj13.ini over 60,000 sweeps (fixed seed), then quenched:
+  ** - the quench finds the icosahedron, the global minimum of LJ13
+  **   (-44.326801, Wales and Doye 1997), shifted by the cut: all 78 pairs
+  **   lie within 3 r0, each raised by -phi(3) = 2/3^6 - 1/3^12;
+  ** - at low T the energy is harmonic in the 33 vibrations (translation
+  **   and rotation cost nothing in the hard sphere), so C -> 33/2: the
+  **   weighted straight line through the rungs' C at T <= 0.08 meets T = 0
+  **   within 4 of its standard errors of 16.5 (they must be under 0.3, so
+  **   that 3N/2 - 1.5 = 18, counting the translations, fails);
+  ** - reweighted between the rungs, C(T) rises to an inner maximum, the
+  **   melting, between T = 0.23 and 0.34 (the literature's is near 0.3),
+  **   over three times its value at T = 0.1. */
+  cr_assert_eq(sh("%s run %s/params/lj13.ini --out %s/lj --quiet --set anneal.sweeps=60000 --set anneal.quench=bfgs",
+                  lw_test_bin(), lw_test_root(), dir),
+               0);
+  const double phi3 = pow(3, -12) - 2 * pow(3, -6), global = -44.326801 - 78 * phi3;
+  cr_assert_eq(sh("awk -F': ' '/\"energy_after\"/ { d = $2 - (%.9f); f = d < 1e-6 && d > -1e-6 } END { exit !f }' "
+                  "%s/lj/summary.json",
+                  global, dir),
+               0, "the quench missed %.6f", global);
+  cr_assert_eq(sh("%s stats %s/lj --csv > %s/lj.csv", lw_test_bin(), dir, dir), 0);
+  char *csv = lw_test_slurp("%s/lj.csv", dir);
+  cr_assert_not_null(csv);
+  double sw = 0, st = 0, stt = 0, sc = 0, stc = 0;
+  for (int k = 0; k < 7; k++) {
+    double T = 0.02 * pow(30, k / 15.0), c, se;
+    rung_heat_capacity(csv, k, &c, &se);
+    double w = 1 / (se * se);
+    sw += w, st += w * T, stt += w * T * T, sc += w * c, stc += w * T * c;
+  }
+  free(csv);
+  double det = sw * stt - st * st, c0 = (stt * sc - st * stc) / det, se0 = sqrt(stt / det);
+  cr_log_info("C(T -> 0) = %.3f +- %.3f (16.5)", c0, se0);
+  cr_assert(se0 < 0.3 && fabs(c0 - 16.5) < 4 * se0, "C(T -> 0) = %g +- %g, expected 16.5", c0, se0);
+  cr_assert_eq(sh("%s stats %s/lj --reweight 30 --csv > %s/rw.csv", lw_test_bin(), dir, dir), 0);
+  csv = lw_test_slurp("%s/rw.csv", dir);
+  const char *line = strchr(csv, '\n') + 1;
+  double tmax = 0, cmax = 0, c01 = 0, best = INFINITY;
+  for (int j = 0; j < 30; j++, line = strchr(line, '\n') + 1) {
+    double T, e, se, c, sc2;
+    cr_assert_eq(sscanf(line, "%lf,%lf,%lf,%lf,%lf", &T, &e, &se, &c, &sc2), 5, "%s", csv);
+    if (c > cmax) cmax = c, tmax = T;
+    if (fabs(T - 0.1) < best) best = fabs(T - 0.1), c01 = c;
+  }
+  free(csv);
+  cr_log_info("C(T) peaks at %.3f: %.1f (C(0.1) = %.1f)", tmax, cmax, c01);
+  cr_assert(tmax > 0.23 && tmax < 0.34 && cmax > 3 * c01, "C(T) peaks at T = %g: %g, against %g at 0.1", tmax, cmax,
+            c01);
 }
