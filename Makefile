@@ -31,7 +31,7 @@ FUZZ_NAMES := params state resume energy image points trace
 FUZZ_REPLAY_OBJ := $(FUZZ_NAMES:%=$(BUILD)/tests/fuzz_%.o)
 TEST_JOBS ?= 2
 # study tools (shell, gnuplot), installed as linewise-<name>
-TOOLS   := seed-sweep param-sweep plot-run plot-sweep
+TOOLS   := seed-sweep param-sweep plot-run plot-sweep thread-scaling
 # The example picture is generated (no third-party images in the repository).
 PICTURE := params/picture.png
 

@@ -730,6 +730,23 @@ static int refresh_due(long sweep, long every, int *renumber)
   return *renumber || (sweep > 0 && sweep < every && (sweep & (sweep - 1)) == 0);
 }
 
+/* The recomputation of replica r from scratch (with the renumbering of
+** its parts where due), its drift, and the running totals kept where an
+** early one agrees with them: the bits of a run without it (and of runs
+** begun by older releases); such a one does not count in max_drift. */
+static lw_status refresh_replica(lw_anneal *a, int r, int renumber, double *drift, lw_error *err)
+{
+  double run[LW_SYSTEM_TERMS_MAX];
+  void *state = a->systems[r]->state;
+  lw_status s;
+  *drift = 0.0;
+  if (renumber && a->sys_type->renumber && (s = a->sys_type->renumber(state, err))) return s;
+  a->sys_type->terms(state, run);
+  if (a->sys_type->refresh(state, drift) != LW_OK) return lw_error_set(err, LW_ENOMEM, "out of memory");
+  if (!renumber && !(*drift > LW_ANNEAL_EARLY_DRIFT)) a->sys_type->set_terms(state, run);
+  return LW_OK;
+}
+
 lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
 {
   if (a->dyn) return dynamics_sweep(a, err);
@@ -779,22 +796,31 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
   if (a->sweep % p->trace_every == 0 || lw_anneal_done(a)) trace_row(a);
   int renumber;
   if (refresh_due(a->sweep, p->check_every, &renumber)) {
-    s = LW_OK;
-    for (int r = 0; r < n && !s; r++) {
-      double drift, run[LW_SYSTEM_TERMS_MAX];
-      void *state = a->systems[r]->state;
-      if (!replica_here(a, r)) continue;
-      if (renumber && a->sys_type->renumber && (s = a->sys_type->renumber(state, err))) break;
-      a->sys_type->terms(state, run);
-      if (a->sys_type->refresh(state, &drift) != LW_OK) {
-        s = lw_error_set(err, LW_ENOMEM, "out of memory");
-        break;
+    /* each replica's recomputation is its own, like its sweep: on the
+    ** sweep's threads, then the first failure in replica order and the
+    ** largest drift, so the thread count changes nothing */
+    int rep[LW_TEMPERING_MAX], nr = 0, first_r = n;
+    double drift[LW_TEMPERING_MAX];
+    lw_status rs[LW_TEMPERING_MAX];
+    lw_error first = {0};
+    for (int r = 0; r < n; r++)
+      if (replica_here(a, r)) rep[nr++] = r;
+#pragma omp parallel for schedule(static, 1) num_threads(nr < omp_get_max_threads() ? nr : omp_get_max_threads()) if (nr > 1)
+    for (int i = 0; i < nr; i++) {
+      lw_error re = {0};
+      if ((rs[i] = refresh_replica(a, rep[i], renumber, &drift[i], &re)) != LW_OK) {
+#pragma omp critical(lw_anneal_refresh)
+        if (rep[i] < first_r) first_r = rep[i], first = re;
       }
-      /* an early recomputation keeps running totals that agree with it, and
-      ** does not count in max_drift: the bits of a run without it (and of
-      ** runs begun by older releases) */
-      if (!renumber && !(drift > LW_ANNEAL_EARLY_DRIFT)) a->sys_type->set_terms(state, run);
-      else if (drift > a->max_drift) a->max_drift = drift;
+    }
+    s = LW_OK;
+    for (int i = 0; i < nr && !s; i++) {
+      if (rs[i] != LW_OK) {
+        *err = first;
+        s = first.code;
+      } else if ((renumber || drift[i] > LW_ANNEAL_EARLY_DRIFT) && drift[i] > a->max_drift) {
+        a->max_drift = drift[i];
+      }
     }
     if (a->net) s = a->net->drift(a->net, a, s, err);
     if (s) return s;

@@ -631,3 +631,34 @@ Test(tools, plot_sweep_draws_a_png_beside_the_csv)
   check_png("w.png");
   cr_assert_eq(sh("%s %s/seeds.csv --y nothing", tool("plot-sweep"), dir), 2);
 }
+
+Test(tools, thread_scaling_times_each_count_and_checks_the_bytes)
+{
+  cr_assert_eq(sh("%s %s/params/minimal.ini --threads 1,2 --reps 2 --bin %s --set anneal.sweeps=30 "
+                  "--set tempering.replicas=2",
+                  tool("thread-scaling"), env("LW_ROOT"), env("LW_BIN")),
+               0, "%s", err_txt());
+  char *out = out_txt();
+  double s1, s2, u1, u2;
+  const char *r1 = strstr(out, "\n       1 "), *r2 = strstr(out, "\n       2 ");
+  cr_assert(r1 && r2, "%s", out);
+  cr_assert_eq(sscanf(r1, "%*d %lf %lf", &s1, &u1), 2, "%s", out);
+  cr_assert_eq(sscanf(r2, "%*d %lf %lf", &s2, &u2), 2, "%s", out);
+  cr_assert(s1 > 0 && s2 > 0 && u1 == 1.0 && fabs(u2 - s1 / s2) < 0.01 * u2 + 0.006, "%s", out);
+  cr_assert(strstr(r2, "the same bytes"), "%s", out);
+  free(out);
+  /* a binary whose state depends on its threads is caught: exit 1 */
+  write_text("fake", "#!/bin/sh\n# run SCENE --out DIR --quiet --threads T ...\n"
+                     "mkdir -p \"$4\" && echo \"threads $7\" > \"$4/state.lw\" && "
+                     "echo '{\"wall_seconds\": 0.5}' > \"$4/summary.json\"\n");
+  cr_assert_eq(sh("chmod +x %s/fake && %s %s/params/minimal.ini --threads 1,3 --reps 1 --bin %s/fake", dir,
+                  tool("thread-scaling"), env("LW_ROOT"), dir),
+               1, "%s", err_txt());
+  out = out_txt();
+  cr_assert(strstr(out, "       3        0.500      1.00  DIFFERS"), "%s", out);
+  free(out);
+  cr_assert_eq(sh("%s %s/params/minimal.ini --threads 0", tool("thread-scaling"), env("LW_ROOT")), 2);
+  char *err = err_txt();
+  cr_assert(strstr(err, "thread-scaling: --threads: expected whole numbers >= 1, got '0'"), "%s", err);
+  free(err);
+}
