@@ -530,7 +530,8 @@ static void rung_heat_capacity(const char *csv, int k, double *c, double *se)
 
 Test(particles_cli, the_lj13_cluster_melts_with_a_heat_capacity_peak, .timeout = 240)
 {
-  /* params/lj13.ini over 60,000 sweeps (fixed seed), then quenched:
+  /* params/lj13.ini over 60,000 sweeps (fixed seed, a trace row every
+  ** sweep for the error bars below), then quenched:
   ** - the quench finds the icosahedron, the global minimum of LJ13
   **   (-44.326801, Wales and Doye 1997), shifted by the cut: all 78 pairs
   **   lie within 3 r0, each raised by -phi(3) = 2/3^6 - 1/3^12;
@@ -542,7 +543,8 @@ Test(particles_cli, the_lj13_cluster_melts_with_a_heat_capacity_peak, .timeout =
   ** - reweighted between the rungs, C(T) rises to an inner maximum, the
   **   melting, between T = 0.23 and 0.34 (the literature's is near 0.3),
   **   over three times its value at T = 0.1. */
-  cr_assert_eq(sh("%s run %s/params/lj13.ini --out %s/lj --quiet --set anneal.sweeps=60000 --set anneal.quench=bfgs",
+  cr_assert_eq(sh("%s run %s/params/lj13.ini --out %s/lj --quiet --set anneal.sweeps=60000 --set anneal.quench=bfgs "
+                  "--set output.trace_every=1",
                   lw_test_bin(), lw_test_root(), dir),
                0);
   const double phi3 = pow(3, -12) - 2 * pow(3, -6), global = -44.326801 - 78 * phi3;
