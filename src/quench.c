@@ -267,6 +267,7 @@ lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_repor
     goto out;
   }
   if (n == 0 || !isfinite(r->energy_before)) goto out; /* nothing to move, or a forbidden start */
+  if (t->minimize && (st = t->minimize(sys->state, err))) goto out;
   t->get_coords(sys->state, q.x);
   double e = evaluate(&q, q.x, q.g, err);
   if (isnan(e)) {

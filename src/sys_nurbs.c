@@ -655,6 +655,10 @@ static double gradient(void *state, double *g, lw_error *err)
     for (size_t i = 0; i < n; i++) g[3 * i + 2] = gs[i] + s->su->weight_stiffness * s->s[i];
     free(gs);
   }
+  /* a held point (and its weight) is no coordinate that moves: its force is
+  ** the support's, which the quench must not follow (system.h) */
+  for (size_t i = 0; i < n; i++)
+    if (s->su->pin[i]) memset(g + m * i, 0, m * sizeof *g);
   return total(s);
 }
 
@@ -812,6 +816,37 @@ static int mass_pinned(const void *mass, size_t i)
 {
   const nb_mass *m = mass;
   return m->c ? m->pin[i] : m->su->pin[i / 2];
+}
+
+/* Frozen weights make the energy quadratic, 1/2 P'KP - f'P, so its minimum
+** with the held points where they are is one banded solve: K_ff P_f =
+** f_f - K_fh P_h (system.h). A K that is not positive definite on the free
+** points (nothing held, alpha = 0 ...) has no unique minimum: left to the
+** quench's own iterations, as free weights are. */
+static lw_status minimize(void *state, lw_error *err)
+{
+  lw_nurbs_state *s = state;
+  const lw_nurbs_setup *su = s->su;
+  if (s->s) return LW_OK;
+  const size_t n = s->c->n;
+  const int k = s->mat->k;
+  double *L = malloc(n * (size_t)k * sizeof *L), *held = malloc(2 * n * sizeof *held),
+         *r = malloc(2 * n * sizeof *r);
+  lw_error e2 = {0};
+  lw_status st = LW_OK;
+  if (!L || !held || !r) {
+    st = lw_error_set(err, LW_ENOMEM, "out of memory for the curve's minimum");
+  } else if (lw_band_factor(s->mat->K, su->pin, n, k, L, &e2) == LW_OK) {
+    for (size_t i = 0; i < 2 * n; i++) held[i] = su->pin[i / 2] ? s->c->P[i] : 0.0;
+    lw_band_apply(s->mat->K, n, k, held, r);
+    for (size_t i = 0; i < 2 * n; i++) r[i] = s->f[i] - r[i];
+    lw_band_solve(L, su->pin, n, k, r, r);
+    for (size_t i = 0; i < 2 * n; i++)
+      if (!su->pin[i / 2]) s->c->P[i] = r[i];
+    st = recompute(s, err);
+  }
+  free(L), free(held), free(r);
+  return st;
 }
 
 /* ---- drawings ------------------------------------------------------------- */
@@ -1060,6 +1095,7 @@ const lw_system_type lw_system_nurbs = {
     .get_coords = get_coords,
     .set_coords = set_coords,
     .gradient = gradient,
+    .minimize = minimize,
     .mass_new = mass_new,
     .mass_free = mass_free,
     .mass_at = mass_at,

@@ -820,14 +820,14 @@ Test(quench, a_signal_stops_a_quench_under_way, .init = qsetup, .fini = qteardow
 }
 
 /* A weight with nothing to hold it (params/wire.ini's wire under gravity,
-** whose ends only the dynamics driver pins) has an energy without a floor.
+** its ends let go: nurbs.fixed = 0) has an energy without a floor.
 ** The quench then walks off a bounded length a step and the stall rule ends
 ** it, so the run draws: an unbounded step leapt to coordinates whose
 ** drawing did not finish within the minute. */
 Test(quench, an_energy_without_a_floor_walks_off_and_still_draws, .init = qsetup, .fini = qteardown)
 {
   int rc = lw_test_sh("timeout -s KILL 60 %s run %s/params/wire.ini --set scene.driver=metropolis "
-                      "--set anneal.quench=bfgs --set anneal.sweeps=20 --out %s/w --quiet",
+                      "--set nurbs.fixed=0 --set anneal.quench=bfgs --set anneal.sweeps=20 --out %s/w --quiet",
                       lw_test_bin(), lw_test_root(), qdir);
   cr_assert_eq(rc, 0, "exit %d", rc);
   cr_assert_eq(lw_test_sh("test -s %s/w/final.svg && python3 -c \"import json,sys; "

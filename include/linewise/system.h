@@ -211,7 +211,9 @@ struct lw_system_type {
   ** vector of n_coords() generalised coordinates (for splines the nodes'
   ** px py vx vy in node order), set_coords() moves the state there and
   ** recomputes every cache and running total, gradient() returns the total
-  ** energy and dE/dx (+inf, g undefined, in a forbidden state).  NULL when a
+  ** energy and dE/dx (+inf, g undefined, in a forbidden state), 0 for the
+  ** coordinates the scene holds (pinned particles, a curve's fixed points:
+  ** Monte Carlo never moves them, and neither may the quench).  NULL when a
   ** system has no gradient; a driver that needs one refuses such a scene. */
   size_t (*n_coords)(const void *state);
   void (*get_coords)(const void *state, double *x);
@@ -231,6 +233,14 @@ struct lw_system_type {
   ** asked, since a part that was allowed stays so when the others move
   ** less (lw_system_hold). */
   size_t (*blocked)(void *state, const double *x, unsigned char *blocked, const unsigned char *changed);
+  /* Optional (NULL: none): moves the state to the minimum of its energy in
+  ** one step where the system can solve for it (a quadratic energy: one
+  ** linear solve), the held parts where they are, and does nothing where it
+  ** cannot; the quench (quench.h) calls it first and goes on from there.
+  ** Iterations alone converge slowly where the energy is stiff: L-BFGS
+  ** stalled at a gradient of 379 on a refined wire whose minimum this finds
+  ** to rounding. */
+  lw_status (*minimize)(void *state, lw_error *err);
   /* Inertia (the dynamics driver, dynamics.h): the mass matrix M(x) of the
   ** kinetic energy T = 1/2 xdot' M(x) xdot for a density (mass per unit
   ** of the system's measure), with the coordinates the scene pins held:
