@@ -202,7 +202,14 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
     dir_file(path, sizeof path, dir, "final.pdf");
     s = lw_output_pdf_strokes(st, &page, under, path, err);
   }
-  const lw_plotter_options po = {p->plot_tolerance, p->speed_down, p->gcode_pen_up, p->gcode_pen_down, p->plot_turn};
+  const lw_plotter_options po = {.tolerance = p->plot_tolerance,
+                                 .speed_down = p->speed_down,
+                                 .pen_up = p->gcode_pen_up,
+                                 .pen_down = p->gcode_pen_down,
+                                 .turn = p->plot_turn,
+                                 .bed = {p->plot_bed_w, p->plot_bed_h},
+                                 .travel_feed = p->gcode_travel == LW_GCODE_TRAVEL_FEED,
+                                 .speed_up = p->speed_up};
   if (!s && p->hpgl) {
     dir_file(path, sizeof path, dir, "final.hpgl");
     s = lw_output_hpgl_strokes(st, &page, &po, path, err);

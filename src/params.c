@@ -486,6 +486,17 @@ const lw_param_def lw_param_table[] = {
          "machine's origin; 90 turns it counterclockwise, its top-left corner at the origin and its top "
          "edge along the machine's y axis, so a portrait page plots on paper loaded landscape (an HP "
          "7475A takes A4 and A3 so)."),
+  NUM("plot", "bed_width", LW_PT_DOUBLE, plot_bed_w, "0", "mm", 0, 1e7, 0,
+      "How far the plotter reaches along its x axis from its origin (after plot.turn): with "
+      "output.hpgl or output.gcode a scene whose drawing area (the page inset by scene.margin) "
+      "reaches further is refused before the run, and the files are checked against it too "
+      "(an HP 7475A clips at its hard-clip limits, a GRBL machine stops at its soft limits). "
+      "0 = not checked."),
+  NUM("plot", "bed_height", LW_PT_DOUBLE, plot_bed_h, "0", "mm", 0, 1e7, 0,
+      "How far the plotter reaches along its y axis; as plot.bed_width. 0 = not checked."),
+  CHOICE("plot", "gcode_travel", gcode_travel, "rapid", "rapid|feed",
+         "The pen-up moves of final.gcode: `rapid` (G0, the machine's fastest) or `feed` (G1 at "
+         "plot.speed_up), for machines whose rapids shake a lifted pen or outrun its servo."),
   STRING("plot", "gcode_pen_up", gcode_pen_up, "G0 Z5", "",
          "The G-code line that lifts the pen in final.gcode, written as it is: `G0 Z5` for a pen on the "
          "Z axis, `M5` or `M3 S30` for a servo on a GRBL fork. One line of printable ASCII."),
@@ -1223,6 +1234,27 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
     return lw_error_set(err, LW_EINPUT,
                         "%s: key 'plot.%s' = '%s': expected a G-code line of printable ASCII (output.gcode = 1)",
                         where, pen_key[k], pen_line[k]);
+  }
+  /* With crop (the default) every stroke is cut inside the page inset by
+  ** the margin, so that box decides, on the machine's axes, before a long
+  ** anneal; the writers check the strokes themselves (plotter.h). */
+  const char *bed_key[2] = {"bed_width", "bed_height"}, axis[2] = {'x', 'y'};
+  const double bed[2] = {p->plot_bed_w, p->plot_bed_h};
+  const double reach[2] = {(p->plot_turn ? p->height : p->width) - p->margin,
+                           (p->plot_turn ? p->width : p->height) - p->margin};
+  /* the other turn, where it would fit */
+  const int turn_fits = !(bed[0] > 0.0 && reach[1] > bed[0]) && !(bed[1] > 0.0 && reach[0] > bed[1]);
+  for (int k = 0; (p->hpgl || p->gcode) && k < 2; k++) {
+    if (!(bed[k] > 0.0) || reach[k] <= bed[k]) continue;
+    lw_params_origin(p, lw_params_find("plot", bed_key[k]), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT,
+                        "%s: key 'plot.%s' = %g mm: the drawing area (the %g x %g mm page inset by scene.margin = "
+                        "%g%s) reaches %c = %g mm on the machine; expected a wider margin or a smaller page%s",
+                        where, bed_key[k], bed[k], p->width, p->height, p->margin,
+                        p->plot_turn ? ", turned by plot.turn" : "", axis[k], reach[k],
+                        !turn_fits      ? ""
+                        : p->plot_turn ? ", or plot.turn = 0, which fits"
+                                       : ", or plot.turn = 90, which fits");
   }
   return LW_OK;
 }

@@ -76,6 +76,20 @@ static void walk_path(const lw_strokes *s, size_t k, const lw_output_page *page,
   }
 }
 
+/* The box of every point the files would visit, on the machine's axes; a
+** point on the bed's edge within HP-GL's half grid step is on it. */
+#define BED_SLACK (0.5 / LW_HPGL_UNITS_PER_MM)
+typedef struct {
+  double lo[2], hi[2];
+} extent;
+
+static void extend(void *ctx, double x, double y)
+{
+  extent *e = ctx;
+  e->lo[0] = fmin(e->lo[0], x), e->hi[0] = fmax(e->hi[0], x);
+  e->lo[1] = fmin(e->lo[1], y), e->hi[1] = fmax(e->hi[1], y);
+}
+
 static lw_status check(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o, int gcode,
                        const char *path, lw_error *err)
 {
@@ -90,7 +104,19 @@ static lw_status check(const lw_strokes *s, const lw_output_page *page, const lw
     if (fabs(s->b[k]) > LW_PLOTTER_MM_MAX)
       return lw_error_set(err, LW_EINPUT, "%s: a control point of segment %zu lies %g mm from the origin: "
                           "expected at most %g", path, k / 8, fabs(s->b[k]), LW_PLOTTER_MM_MAX);
+  if (o->bed[0] > 0.0 || o->bed[1] > 0.0) {
+    extent e = {{INFINITY, INFINITY}, {-INFINITY, -INFINITY}};
+    for (size_t j = 0; j < s->n; j++) walk_path(s, j, page, o, extend, &e);
+    for (int k = 0; k < 2; k++) {
+      if (!(o->bed[k] > 0.0) || (e.lo[k] >= -BED_SLACK && e.hi[k] <= o->bed[k] + BED_SLACK)) continue;
+      return lw_error_set(err, LW_EINPUT, "%s: the drawing reaches %c = %.3f to %.3f mm on the machine, past its "
+                          "bed of %g mm (plot.bed_%s): expected a wider margin, crop = 1 or a turn of the page",
+                          path, "xy"[k], e.lo[k], e.hi[k], o->bed[k], k ? "height" : "width");
+    }
+  }
   if (!gcode) return LW_OK;
+  if (o->travel_feed && !(o->speed_up > 0 && isfinite(o->speed_up)))
+    return lw_error_set(err, LW_EINPUT, "%s: pen-up speed %g mm/s: expected a positive number", path, o->speed_up);
   const char *line[2] = {o->pen_up, o->pen_down}, *what[2] = {"pen-up", "pen-down"};
   for (int k = 0; k < 2; k++) {
     if (!line[k] || !lw_plotter_gcode_line_ok(line[k]))
@@ -170,14 +196,26 @@ static void put_xy(FILE *f, long long x, long long y)
   lw_output_put_fixed(f, (double)y / 1000.0, LW_GCODE_DECIMALS);
 }
 
+/* A pen-up move: a rapid, or a feed at speed_up (set again each time: a
+** drawing move between has set its own) */
+static void travel(FILE *f, const lw_plotter_options *o, long long x, long long y)
+{
+  fputs(o->travel_feed ? "G1" : "G0", f);
+  put_xy(f, x, y);
+  if (o->travel_feed) {
+    fputs(" F", f);
+    lw_output_put_fixed(f, 60.0 * o->speed_up, 1);
+  }
+  fputc('\n', f);
+}
+
 static void gcode_point(void *ctx, double x, double y)
 {
   gcode_path *g = ctx;
   long long px = llround(x * 1000.0), py = llround(y * 1000.0);
   if (g->points++ == 0) {
-    fputs("G0", g->f);
-    put_xy(g->f, px, py);
-    fprintf(g->f, "\n%s\n", g->o->pen_down);
+    travel(g->f, g->o, px, py);
+    fprintf(g->f, "%s\n", g->o->pen_down);
   } else {
     if (px == g->x && py == g->y) return;
     fputs("G1", g->f);
@@ -234,6 +272,7 @@ lw_status lw_output_gcode_strokes(const lw_strokes *s, const lw_output_page *pag
       fprintf(f, "%s\n", o->pen_up);
     }
   }
-  fputs("G0 X0 Y0\nM2\n", f);
+  travel(f, o, 0, 0);
+  fputs("M2\n", f);
   return lw_output_commit(f, tmp, path, err);
 }

@@ -397,3 +397,76 @@ Test(plotter, command_line_writes_the_same_files_for_the_same_seed)
   cr_assert_neq(lw_test_sh("test -e %s/bad", dir), 0, "nothing written");
   lw_test_sh("rm -rf %s", dir);
 }
+
+Test(plotter, a_drawing_past_the_bed_is_refused_and_travel_can_feed)
+{
+  char dir[64], path[128];
+  cr_assert_eq(lw_test_dir_make(dir, "plotter"), 0);
+  snprintf(path, sizeof path, "%s/final.gcode", dir);
+  lw_strokes *s = drawing();
+  lw_output_page page = page_of();
+  lw_plotter_options o = options();
+  /* the page itself is a bed the drawing fits; a bed 1 mm narrower than
+  ** the drawing's reach refuses both files and keeps the old one */
+  o.bed[0] = PAGE_W, o.bed[1] = PAGE_H;
+  cr_assert_eq(lw_output_gcode_strokes(s, &page, &o, path, NULL), LW_OK);
+  double reach = 0; /* the segments' ends lie on the drawing */
+  for (size_t k = 0; k < s->n_segs; k++) reach = fmax(reach, fmax(s->b[8 * k], s->b[8 * k + 6]));
+  cr_assert_eq(lw_test_write_text(dir, "final.gcode", "old\n"), 0);
+  for (int hpgl = 0; hpgl < 2; hpgl++) {
+    lw_error err = {0};
+    o.bed[0] = reach - 1;
+    lw_status st = hpgl ? lw_output_hpgl_strokes(s, &page, &o, path, &err)
+                        : lw_output_gcode_strokes(s, &page, &o, path, &err);
+    cr_assert_eq(st, LW_EINPUT);
+    cr_assert(strstr(err.msg, "the drawing reaches x = ") && strstr(err.msg, "(plot.bed_width)"), "%s", err.msg);
+    char *text = lw_test_slurp("%s", path);
+    cr_assert_str_eq(text, "old\n");
+    free(text);
+  }
+  /* travel by feed: each path's start and the way home are G1 at speed_up
+  ** (150 mm/s: F9000), each path's first drawing move sets speed_down again */
+  o.bed[0] = o.bed[1] = 0;
+  o.travel_feed = 1;
+  o.speed_up = 150;
+  cr_assert_eq(lw_output_gcode_strokes(s, &page, &o, path, NULL), LW_OK);
+  char *text = lw_test_slurp("%s", path);
+  size_t travels = 0, resets = 0, rapids = 0;
+  for (const char *l = text; *l; l = strchr(l, '\n') + 1) {
+    travels += !strncmp(l, "G1 X", 4) && strstr(l, " F9000\n") == strchr(l, '\n') - 6;
+    resets += !strncmp(l, "G1 X", 4) && strstr(l, " F3000\n") == strchr(l, '\n') - 6;
+    rapids += !strncmp(l, "G0 X", 4);
+  }
+  cr_assert_eq(travels, s->n + 1, "%s", text);
+  cr_assert_eq(resets, s->n, "%s", text);
+  cr_assert_eq(rapids, 0);
+  free(text);
+  o.speed_up = 0;
+  cr_assert_eq(lw_output_gcode_strokes(s, &page, &o, path, NULL), LW_EINPUT);
+  lw_strokes_free(s);
+  lw_test_sh("rm -rf %s", dir);
+}
+
+Test(plotter, a_page_past_the_bed_is_refused_before_the_run)
+{
+  /* params/minimal.ini: a 100 mm square page, margin 5, so the drawing
+  ** area reaches 95 mm on both axes */
+  const char *bin = lw_test_bin(), *root = lw_test_root();
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "plotter"), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set plot.bed_width=94.9 --quiet "
+                          "--out %s/r 2> %s/err.txt", bin, root, dir, dir), 2);
+  char *err = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(err, "--set: key 'plot.bed_width' = 94.9 mm: the drawing area (the 100 x 100 mm page inset by "
+                        "scene.margin = 5) reaches x = 95 mm on the machine; expected a wider margin or a smaller page\n"),
+            "%s", err);
+  free(err);
+  cr_assert_neq(lw_test_sh("test -e %s/r", dir), 0, "nothing written");
+  /* the bed's own size fits; without a machine file the bed is not asked */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.hpgl=1 --set plot.bed_height=95 --set "
+                          "anneal.sweeps=5 --quiet --out %s/r", bin, root, dir), 0);
+  cr_assert_eq(lw_test_sh("test -s %s/r/final.hpgl", dir), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set plot.bed_width=10 --set anneal.sweeps=5 --quiet "
+                          "--out %s/s", bin, root, dir), 0);
+  lw_test_sh("rm -rf %s", dir);
+}

@@ -65,6 +65,7 @@ enum { LW_PIN_NONE, LW_PIN_ENDS, LW_PIN_FIRST, LW_PIN_LAST };
 enum { LW_INTEGRATOR_LEAPFROG, LW_INTEGRATOR_REVIEW };
 enum { LW_LSRC_TONE, LW_LSRC_CMYK, LW_LSRC_PALETTE };
 enum { LW_APART_ALL, LW_APART_PEN }; /* layers.apart */
+enum { LW_GCODE_TRAVEL_RAPID, LW_GCODE_TRAVEL_FEED }; /* plot.gcode_travel */
 
 typedef struct {
   /* [scene] */
@@ -191,6 +192,8 @@ typedef struct {
   double plot_tolerance;      /* chords of final.hpgl and final.gcode, mm */
   int plot_turn;              /* 1: final.hpgl and final.gcode turn the page a quarter turn */
   char gcode_pen_up[128], gcode_pen_down[128]; /* final.gcode's pen lines */
+  double plot_bed_w, plot_bed_h; /* the machine's reach, mm (0: unchecked) */
+  int gcode_travel;           /* LW_GCODE_TRAVEL_*: final.gcode's pen-up moves */
   /* [layers] (layers.h) */
   char ly_names[LW_PATH_MAX]; /* layer names; empty = no layers */
   int ly_source;              /* LW_LSRC_* */

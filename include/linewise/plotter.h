@@ -32,7 +32,12 @@
 ** pen-down line, G1 moves with F (speed_down in mm/min) on the first, and
 ** the pen-up line; M0 (a pause to change the pen) before every pen after
 ** the first; at the end G0 X0 Y0 and M2.  The pen lines are the scene's
-** plot.gcode_pen_up and plot.gcode_pen_down, written as they are.
+** plot.gcode_pen_up and plot.gcode_pen_down, written as they are; with
+** travel_feed the moves to a path's start and home are G1 at speed_up.
+**
+** With a bed, a drawing any of whose points falls outside [0, bed[0]] x
+** [0, bed[1]] on the machine's axes is refused (LW_EINPUT, naming how far
+** it reaches), and no file is written.
 */
 #ifndef LINEWISE_PLOTTER_H
 #define LINEWISE_PLOTTER_H
@@ -53,6 +58,9 @@ typedef struct {
   const char *pen_up;        /* G-code: the line that lifts the pen */
   const char *pen_down;      /* G-code: the line that lowers it */
   int turn;                  /* 1: the page turned a quarter turn counterclockwise */
+  double bed[2];             /* mm the machine reaches along x and y from its origin (0: unchecked) */
+  int travel_feed;           /* G-code: 1 = pen-up moves by G1 at speed_up, 0 = rapids (G0) */
+  double speed_up;           /* mm/s: travel_feed's F (> 0 where it is on) */
 } lw_plotter_options;
 
 /* The chords that keep the cubic b[8] within tol of them (above), 1 ..
