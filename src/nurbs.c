@@ -277,6 +277,12 @@ lw_status lw_nurbs_refine(lw_nurbs *c, int elevate, int split, lw_error *err)
   if (k2 > LW_NURBS_ORDER_MAX)
     return lw_error_set(err, LW_EINPUT, "order %zu raised by %d is %zu: at most %d", k, elevate, k2,
                         LW_NURBS_ORDER_MAX);
+  size_t spans = 1; /* the distinct knot spans */
+  for (size_t i = k; i < n; i++) spans += c->knot[i] != c->knot[i - 1];
+  const double want = (double)n + (double)spans * ((double)elevate + (double)split - 1.0);
+  if (want > LW_NURBS_REFINED_MAX)
+    return lw_error_set(err, LW_EINPUT, "%zu control points raised by %d and split %d times would be %.0f: at most %d",
+                        n, elevate, split, want, LW_NURBS_REFINED_MAX);
   const size_t cap = 2 * k2 + (n - k) * (1 + (size_t)elevate) + (n - k + 1) * ((size_t)split - 1);
   const int poly = lw_nurbs_polynomial(c);
   double *t = malloc(cap * sizeof *t);

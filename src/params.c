@@ -673,7 +673,8 @@ const lw_param_def lw_param_table[] = {
       "docs/NURBS.md, \"Refinement\"."),
   NUM("nurbs", "refine", LW_PT_INT, nb_refine, "1", "", 1, 1000, 0,
       "Cut every knot span into this many equal spans before the run, after `elevate` (knot "
-      "insertion: the curve unchanged, more control points, the new knots simple). The energy "
+      "insertion: the curve unchanged, more control points, the new knots simple; at most "
+      "1,000,000 control points after). The energy "
       "is the curve's, so a finer curve is a finer Ritz approximation of the same wire. "
       "docs/NURBS.md, \"Refinement\"."),
   NUM("nurbs", "alpha", LW_PT_DOUBLE, nb_alpha, "1", "energy", 0, 1e12, 0,

@@ -213,7 +213,7 @@ Test(nurbs, refinement_and_elevation_keep_the_curve_and_its_continuity)
         }
 }
 
-Test(nurbs, refinement_refuses_an_order_past_the_largest)
+Test(nurbs, refinement_refuses_an_order_or_a_count_past_the_largest)
 {
   double t[] = {0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1}, P[12] = {0, 0, 1, 1, 2, 0, 3, 1, 4, 0, 5, 1};
   lw_error err;
@@ -224,6 +224,21 @@ Test(nurbs, refinement_refuses_an_order_past_the_largest)
   cr_assert_eq(lw_nurbs_refine(c, 2, 1, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(c->order, 8);
   lw_nurbs_free(c);
+  /* a polyline of 2000 points (1999 spans) split 1000 times would have
+  ** 2000 + 1999 x 999 = 1,999,001 points: refused before anything is
+  ** allocated */
+  size_t n = 2000;
+  double *tk = malloc((n + 2) * sizeof *tk), *pts = calloc(2 * n, sizeof *pts);
+  for (size_t i = 0; i < n + 2; i++) tk[i] = i == 0 ? 0.0 : i > n ? 1.0 : (double)(i - 1) / (double)(n - 1);
+  for (size_t i = 0; i < n; i++) pts[2 * i] = (double)i;
+  c = lw_nurbs_new(2, n, tk, pts, NULL, &err);
+  cr_assert_not_null(c, "%s", err.msg);
+  cr_assert_eq(lw_nurbs_refine(c, 0, 1000, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "would be 1999001: at most 1000000"), "%s", err.msg);
+  cr_assert_eq(lw_nurbs_refine(c, 0, 500, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(c->n, n + 1999 * 499);
+  lw_nurbs_free(c);
+  free(tk), free(pts);
 }
 
 Test(nurbs, a_circle_is_exact_with_the_standard_weights)

@@ -18,6 +18,9 @@
 
 /* orders 2 (polyline) to this */
 #define LW_NURBS_ORDER_MAX 8
+/* control points a refinement may make (a step of the wire costs 0.25 us
+** a point, its matrices 200 bytes a point) */
+#define LW_NURBS_REFINED_MAX 1000000
 
 typedef struct {
   int order;      /* k: degree k - 1 */
@@ -68,7 +71,8 @@ lw_status lw_nurbs_insert_knot(lw_nurbs *c, double u, lw_error *err);
 ** points and weights are interpolated at the new Greville abscissae, so the
 ** curve is unchanged to rounding; the end points are kept to the bit and a
 ** polynomial curve stays one.  elevate = 0, split = 1 changes nothing;
-** LW_EINPUT when the order would pass LW_NURBS_ORDER_MAX. */
+** LW_EINPUT when the order would pass LW_NURBS_ORDER_MAX or the points
+** LW_NURBS_REFINED_MAX. */
 lw_status lw_nurbs_refine(lw_nurbs *c, int elevate, int split, lw_error *err);
 
 /* The curve as cubic Beziers for SVG: each knot span by the cubic Hermite
