@@ -332,7 +332,14 @@ static lw_nurbs_state *state_get(const lw_nurbs_setup *su, lw_ckpt *doc, const c
     return lw_error_set(err, LW_EINPUT, "%s: section [%s]: missing (a state of another system?)", path, section), NULL;
   size_t n = su->curve->n, i = 0, j = 0, pos = 0;
   long count;
-  if (lw_ckpt_whole(doc, section, "count", &count, (long)n, (long)n, 1, err)) return NULL;
+  if (lw_ckpt_whole(doc, section, "count", &count, 1, 1L << 53, 1, err)) return NULL;
+  if (count != (long)n) {
+    int at = 0;
+    lw_ckpt_text(doc, section, "count", &at);
+    return lw_error_set(err, LW_EINPUT, "%s:%d: [%s] count: %ld control points, but the scene's curve has %zu (its "
+                        "points refined by nurbs.elevate and nurbs.refine): a state is read with the scene it was "
+                        "run with", path, at, section, count, n), NULL;
+  }
   double *P = malloc(3 * n * sizeof *P), *lw = P + 2 * n;
   if (!P) return lw_error_set(err, LW_ENOMEM, "out of memory"), NULL;
   const char *key, *val;

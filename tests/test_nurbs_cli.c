@@ -236,6 +236,11 @@ Test(nurbs_cli, a_refined_wire_runs_resumes_and_refuses_a_step_past_its_stabilit
   cr_assert_eq(sh("%s resume %s/h --quiet", lw_test_bin(), dir), 0);
   cr_assert_eq(sh("cmp -s %s/r/state.lw %s/h/state.lw && cmp -s %s/r/final.svg %s/h/final.svg", dir, dir, dir, dir),
                0);
+  /* its state read with another refinement: one message, naming why */
+  cr_assert_eq(sh("%s energy %s/r --set nurbs.refine=2 2> %s/err.txt", lw_test_bin(), dir, dir), 2);
+  cr_assert_eq(sh("grep -q \"r/state.lw:[0-9]*: \\[system nurbs\\] count: 19 control points, but the scene's curve "
+                  "has 11 (its points refined by nurbs.elevate and nurbs.refine)\" %s/err.txt", dir),
+               0);
   /* the energy over the run: the leapfrog keeps E + K (the trace's total) */
   cr_assert_eq(sh("awk -F, 'NR == 2 { h = $7 } NR > 2 { d = $7 - h; if (d < 0) d = -d; if (d > 1e-3 * h) bad = 1 } "
                   "END { exit bad }' %s/r/trace.csv",
