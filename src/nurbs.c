@@ -237,8 +237,8 @@ lw_status lw_nurbs_insert_knot(lw_nurbs *c, double u, lw_error *err)
   return LW_OK;
 }
 
-/* The knot vector of lw_nurbs_refine into t (room for the bound below);
-** returns its length. */
+/* The knot vector of lw_nurbs_refine into t (n + spans (elevate + split -
+** 1) + k2 of them); returns its length. */
 static size_t refined_knots(const lw_nurbs *c, size_t k2, size_t elevate, size_t split, double *t)
 {
   const size_t k = (size_t)c->order, n = c->n;
@@ -283,9 +283,8 @@ lw_status lw_nurbs_refine(lw_nurbs *c, int elevate, int split, lw_error *err)
   if (want > LW_NURBS_REFINED_MAX)
     return lw_error_set(err, LW_EINPUT, "%zu control points raised by %d and split %d times would be %.0f: at most %d",
                         n, elevate, split, want, LW_NURBS_REFINED_MAX);
-  const size_t cap = 2 * k2 + (n - k) * (1 + (size_t)elevate) + (n - k + 1) * ((size_t)split - 1);
   const int poly = lw_nurbs_polynomial(c);
-  double *t = malloc(cap * sizeof *t);
+  double *t = malloc(((size_t)want + k2) * sizeof *t); /* n2 + k2 knots: want is n2 */
   lw_nurbs *d = NULL;
   double *A = NULL, *h = NULL;
   lw_status st = LW_OK;
