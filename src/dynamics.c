@@ -127,10 +127,6 @@ lw_dynamics *lw_dynamics_new(const lw_system_type *t, void *state, const lw_para
     lw_dynamics_free(d);
     return NULL;
   }
-  if (d->integrator == LW_INTEGRATOR_REVIEW && lw_dyn_review_init(d, p, err)) {
-    lw_dynamics_free(d);
-    return NULL;
-  }
   double **arrays[] = {&d->x, &d->pi, &d->g, &d->v, &d->tx, &d->x1, &d->pi1, &d->u};
   for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)
     if (!(*arrays[k] = calloc(d->n + 1, sizeof(double)))) {
@@ -145,7 +141,8 @@ lw_dynamics *lw_dynamics_new(const lw_system_type *t, void *state, const lw_para
   }
   /* massless: the matrix of the flow is the damping's, gamma per unit density */
   d->mass = t->mass_new(state, p, d->rho > 0.0 ? d->rho : d->gamma, err);
-  if (!d->mass || lw_dynamics_sync(d, err)) {
+  if (!d->mass || lw_dynamics_sync(d, err) ||
+      (d->integrator == LW_INTEGRATOR_REVIEW && lw_dyn_review_init(d, p, err))) {
     lw_dynamics_free(d);
     return NULL;
   }

@@ -674,6 +674,7 @@ typedef struct {
   size_t n, k;      /* the band: rows and columns (3 n, 3 k with free weights) */
   double density;
   double *M, *L;    /* the mass matrix and its factor (held coordinates as identity) */
+  double *S;        /* frozen weights: the factor of a M + b K (mass_shift), or NULL */
   unsigned char *pin;  /* n: held coordinates (free weights; else su->pin a point) */
   lw_nurbs *c;      /* free weights: the curve at the last x */
 } nb_mass;
@@ -684,6 +685,7 @@ static void mass_free(void *mass)
   if (!m) return;
   free(m->M);
   free(m->L);
+  free(m->S);
   free(m->pin);
   lw_nurbs_free(m->c);
   free(m);
@@ -823,6 +825,31 @@ static int mass_pinned(const void *mass, size_t i)
 {
   const nb_mass *m = mass;
   return m->c ? m->pin[i] : m->su->pin[i / 2];
+}
+
+/* Frozen weights make the energy quadratic with the constant Hessian K (the
+** stiffness; gravity is linear), so a M + b K is a band like M. */
+static lw_status mass_shift(void *mass, double a, double b, int *done, lw_error *err)
+{
+  nb_mass *m = mass;
+  *done = 0;
+  if (m->c) return LW_OK;
+  double *A = malloc(m->n * m->k * sizeof *A);
+  if (!A || (!m->S && !(m->S = malloc(m->n * m->k * sizeof *m->S)))) {
+    free(A);
+    return lw_error_set(err, LW_ENOMEM, "out of memory for the review scheme's matrix");
+  }
+  for (size_t i = 0; i < m->n * m->k; i++) A[i] = a * m->M[i] + b * m->su->mat->K[i];
+  lw_status st = lw_band_factor(A, m->su->pin, m->n, (int)m->k, m->S, err);
+  free(A);
+  *done = st == LW_OK;
+  return st;
+}
+
+static void mass_shift_solve(const void *mass, const double *b, double *v)
+{
+  const nb_mass *m = mass;
+  lw_band_solve(m->S, m->su->pin, m->n, (int)m->k, b, v);
 }
 
 /* Frozen weights make the energy quadratic, 1/2 P'KP - f'P, so its minimum
@@ -1110,6 +1137,8 @@ const lw_system_type lw_system_nurbs = {
     .mass_apply = mass_apply,
     .mass_dx = mass_dx,
     .mass_pinned = mass_pinned,
+    .mass_shift = mass_shift,
+    .mass_shift_solve = mass_shift_solve,
     .files = "final.svg, final.png",
     .draw = draw,
     .summary = summary,

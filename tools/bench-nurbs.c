@@ -2,8 +2,10 @@
 ** bench-nurbs.c -- the D-NURBS wire's cost per time step against the number
 ** of control points (the review's Figure 10 measured 20 to 140), here up to
 ** 10^4: with banded matrices a leapfrog step is O(n), which the cost per
-** control point shows; the review's implicit scheme adds conjugate-gradient
-** iterations that grow with the stiffness's condition number.
+** control point shows.  The review's implicit scheme solves by conjugate
+** gradients preconditioned by the row's factor of its matrix (mass_shift):
+** O(n) too; preconditioned by M alone, as before, its iterations grow with
+** the stiffness's condition number, timed beside it over the review's range.
 */
 #include <math.h>
 #include <stdlib.h>
@@ -70,6 +72,49 @@ static double omega_max(const lw_nurbs_setup *su, double mu)
 }
 
 #define N_SIZES 10
+enum { LEAPFROG, REVIEW, REVIEW_BY_M, N_WAYS };
+
+/* Median microseconds a step of one way of stepping the wire of n points;
+** its set-up's milliseconds, omega_max and dt (the leapfrog's: it sets them
+** first) and the most CG iterations a step took (the review's). */
+static double time_steps(bench_ctx *b, size_t n, int way, double *assembly, double *om, double *dt0, int *iters)
+{
+  lw_system_type row = lw_system_nurbs;
+  if (way == REVIEW_BY_M) row.mass_shift = NULL, row.mass_shift_solve = NULL;
+  lw_params *p = malloc(sizeof *p);
+  lw_error err = {0};
+  double t0 = bench_now();
+  lw_nurbs_setup *su = p ? wire(p, n, way == LEAPFROG ? LW_INTEGRATOR_LEAPFROG : LW_INTEGRATOR_REVIEW, &err) : NULL;
+  if (!su) bench_die("nurbs set-up", &err);
+  if (way == LEAPFROG) {
+    *assembly = 1e3 * (bench_now() - t0);
+    /* the leapfrog at omega_max dt = 1 (a stable step; the cost of a step
+    ** does not depend on it), the review's scheme at its 0.008 s */
+    *om = omega_max(su, p->dyn_rho);
+    p->dyn_dt = *dt0 = fmin(0.008, 1.0 / *om);
+  }
+  void *st = row.state_new(su, p, 0, &err);
+  lw_dynamics *dy = st ? lw_dynamics_new(&row, st, p, &err) : NULL;
+  if (!dy) bench_die("nurbs dynamics", &err);
+  double per[BENCH_MAX_REPS];
+  for (int rep = 0; rep < b->reps; rep++) {
+    double t1 = bench_now(), t;
+    unsigned long steps = 0;
+    do {
+      if (lw_dynamics_step(dy, &err)) bench_die("nurbs step", &err);
+      steps++;
+      t = bench_now() - t1;
+    } while (t < b->block);
+    per[rep] = 1e6 * t / (double)steps;
+  }
+  *iters = dy->iterations_max;
+  lw_dynamics_free(dy);
+  row.state_free(st);
+  row.setup_free(su);
+  free(p);
+  return bench_median(per, b->reps);
+}
+
 void bench_nurbs(bench_ctx *b)
 {
   static const size_t sizes[N_SIZES] = {20, 40, 60, 80, 100, 120, 140, 400, 1000, 10000};
@@ -82,60 +127,31 @@ void bench_nurbs(bench_ctx *b)
              "highest frequency grows as n^2 through the beta term), the review's implicit scheme at\n"
              "the review's dt = 0.008 s. Each figure is the median of %d blocks of at least %g s of time steps through\n"
              "the system's row (`lw_dynamics_step`). Assembly is the set-up's banded K, M and b. The\n"
-             "review's scheme needs conjugate-gradient iterations (the most a step is shown), which grow with the\n"
-             "stiffness's condition number (about h^2 omega_max^2, growing as n^4), so its cost per step\n"
-             "grows far faster than n: it is timed over the review's range, 20 to 140, only.\n"
+             "review's scheme solves ((1 + h c/2) M + h^2 K) delta = r by conjugate gradients (the most\n"
+             "iterations a step took is shown), preconditioned by the banded Cholesky factor of that\n"
+             "matrix (`mass_shift`, factored once): O(n) a step, like the leapfrog. Beside it, over the\n"
+             "review's range 20 to 140, the same scheme preconditioned by M alone, as before this\n"
+             "factor: its iterations grow with the condition number (about h^2 omega_max^2, as n^4).\n"
              "\n"
-             "| control points | assembly ms | omega_max 1/s | leapfrog dt s | leapfrog us/step | ns/step per point | review us/step | CG iterations (most a step) |\n"
-             "|---|---|---|---|---|---|---|---|\n",
+             "| control points | assembly ms | omega_max 1/s | leapfrog dt s | leapfrog us/step | ns/step per point | review us/step | CG iterations | review by M alone us/step | its CG iterations |\n"
+             "|---|---|---|---|---|---|---|---|---|---|\n",
           b->reps, b->block);
-  if (dat) fprintf(dat, "# n  leapfrog_us  review_us\n");
+  if (dat) fprintf(dat, "# n  leapfrog_us  review_us  review_by_M_us\n");
   for (int k = 0; k < N_SIZES; k++) {
     size_t n = sizes[k];
     if (b->quick && n > 1000) continue;
-    double us[2], assembly = 0.0, iters = 0.0, om = 0.0, dt0 = 0.0;
-    us[1] = NAN;
-    /* the review's scheme only over the review's range: beyond, its CG takes
-    ** thousands of iterations a step */
-    for (int integ = 0; integ < (n <= 140 ? 2 : 1); integ++) {
-      lw_params *p = malloc(sizeof *p);
-      lw_error err = {0};
-      double t0 = bench_now();
-      lw_nurbs_setup *su = p ? wire(p, n, integ, &err) : NULL;
-      if (!su) bench_die("nurbs set-up", &err);
-      if (integ == 0) {
-        assembly = 1e3 * (bench_now() - t0);
-        /* the leapfrog at omega_max dt = 1 (a stable step; the cost of a
-        ** step does not depend on it), the review's scheme at its 0.008 s */
-        om = omega_max(su, p->dyn_rho);
-        p->dyn_dt = fmin(0.008, 1.0 / om);
-        dt0 = p->dyn_dt;
-      }
-      void *st = lw_system_nurbs.state_new(su, p, 0, &err);
-      lw_dynamics *dy = st ? lw_dynamics_new(&lw_system_nurbs, st, p, &err) : NULL;
-      if (!dy) bench_die("nurbs dynamics", &err);
-      double per[BENCH_MAX_REPS];
-      for (int rep = 0; rep < b->reps; rep++) {
-        double t1 = bench_now(), t;
-        unsigned long steps = 0;
-        do {
-          if (lw_dynamics_step(dy, &err)) bench_die("nurbs step", &err);
-          steps++;
-          t = bench_now() - t1;
-        } while (t < b->block);
-        per[rep] = 1e6 * t / (double)steps;
-      }
-      us[integ] = bench_median(per, b->reps);
-      if (integ == 1) iters = (double)dy->iterations_max;
-      lw_dynamics_free(dy);
-      lw_system_nurbs.state_free(st);
-      lw_system_nurbs.setup_free(su);
-      free(p);
-    }
-    fprintf(d, "| %zu | %.2f | %.3g | %.3g | %.1f | %.0f | ", n, assembly, om, dt0, us[0], 1e3 * us[0] / (double)n);
-    if (isnan(us[1])) fprintf(d, "- | - |\n");
-    else fprintf(d, "%.1f | %.0f |\n", us[1], iters);
-    if (dat) fprintf(dat, "%zu %.6g %.6g\n", n, us[0], isnan(us[1]) ? -1.0 : us[1]);
+    double us[N_WAYS], assembly = 0.0, om = 0.0, dt0 = 0.0;
+    int iters[N_WAYS];
+    /* preconditioned by M alone only over the review's range: beyond, its
+    ** CG takes thousands of iterations a step */
+    for (int way = 0; way < N_WAYS; way++)
+      us[way] = way == REVIEW_BY_M && n > 140 ? NAN : time_steps(b, n, way, &assembly, &om, &dt0, &iters[way]);
+    fprintf(d, "| %zu | %.2f | %.3g | %.3g | %.1f | %.0f | %.1f | %d | ", n, assembly, om, dt0, us[LEAPFROG],
+            1e3 * us[LEAPFROG] / (double)n, us[REVIEW], iters[REVIEW]);
+    if (isnan(us[REVIEW_BY_M])) fprintf(d, "- | - |\n");
+    else fprintf(d, "%.1f | %d |\n", us[REVIEW_BY_M], iters[REVIEW_BY_M]);
+    if (dat)
+      fprintf(dat, "%zu %.6g %.6g %.6g\n", n, us[LEAPFROG], us[REVIEW], isnan(us[REVIEW_BY_M]) ? -1.0 : us[REVIEW_BY_M]);
   }
   if (dat) fclose(dat);
   fprintf(d, "\n");

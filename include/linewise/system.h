@@ -255,6 +255,15 @@ struct lw_system_type {
   void (*mass_apply)(const void *mass, const double *v, double *b);
   void (*mass_dx)(const void *mass, const double *x, const double *v, double *out);
   int (*mass_pinned)(const void *mass, size_t i);
+  /* Optional (NULL: none): where the energy is quadratic, its Hessian K
+  ** constant, factors a M + b K with the held coordinates held and sets
+  ** *done = 1 (0, nothing factored, where the row cannot at this state);
+  ** mass_shift_solve then gives v = (a M + b K)^-1 b, 0 at held
+  ** coordinates.  The review's implicit scheme (dyn_review.h) solves with
+  ** it: one iteration a step at any dt, where conjugate gradients
+  ** preconditioned by M alone need a number growing as h omega_max. */
+  lw_status (*mass_shift)(void *mass, double a, double b, int *done, lw_error *err);
+  void (*mass_shift_solve)(const void *mass, const double *b, double *v);
   /* Optional (NULL: the coordinates are free): brings coordinates x that a
   ** step left off the system's constraint back onto it, and momenta pi
   ** (NULL: none) onto its tangent there; for particles, unit quaternions.
