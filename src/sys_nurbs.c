@@ -759,8 +759,8 @@ static void *mass_new(const void *state, const lw_params *p, double density, lw_
     if (isnan(omega) || omega * p->dyn_dt >= 2.0) {
       if (!isnan(omega)) {
         lw_error_set(err, LW_EINPUT, "%g s is past the leapfrog's stability limit 2 / omega_max = %.3g s of this "
-                     "curve (omega_max = %.4g /s, %zu control points): take dt <= %.2g", p->dyn_dt, 2.0 / omega,
-                     omega, m->n, 1.8 / omega);
+                     "curve (omega_max = %.4g /s, %zu control points): take dt <= %.2g, or integrator = review "
+                     "(stable at any dt; it damps the high modes)", p->dyn_dt, 2.0 / omega, omega, m->n, 1.8 / omega);
         lw_params_blame(p, "dynamics", "dt", err);
       }
       mass_free(m);

@@ -218,9 +218,15 @@ Test(nurbs_cli, a_refined_wire_runs_resumes_and_refuses_a_step_past_its_stabilit
                   wire, dir),
                2);
   cr_assert_eq(sh("grep -q \"wire.ini:27: key 'dynamics.dt': 0.008 s is past the leapfrog's stability limit 2 / "
-                  "omega_max = 0.000766 s .*omega_max = 2613 /s, 19 control points): take dt <= 0.00069\" %s/err.txt",
+                  "omega_max = 0.000766 s .*omega_max = 2613 /s, 19 control points): take dt <= 0.00069, or "
+                  "integrator = review\" %s/err.txt",
                   dir),
                0);
+  /* which takes the review's dt on the refined wire, in one CG iteration a step */
+  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/rv --quiet %s --set dynamics.integrator=review", lw_test_bin(),
+                  lw_test_root(), dir, wire),
+               0);
+  cr_assert_eq(sh("grep -q '\"fixed_point_iterations_max\": 1$' %s/rv/summary.json", dir), 0);
   cr_assert_neq(sh("test -e %s/r", dir), 0);
   cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/r --quiet %s --set dynamics.dt=0.0006", lw_test_bin(),
                   lw_test_root(), dir, wire),
