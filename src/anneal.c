@@ -965,6 +965,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     lw_json_key(&j, "converged"); lw_json_bool(&j, q->converged);
     lw_json_key(&j, "ended"); lw_json_string(&j, lw_quench_end_name(q->ended));
     lw_json_key(&j, "iterations"); lw_json_int(&j, q->iterations);
+    lw_json_key(&j, "rounds"); lw_json_int(&j, q->rounds);
     lw_json_key(&j, "evaluations"); lw_json_int(&j, q->evaluations);
     lw_json_key(&j, "forbidden"); lw_json_int(&j, q->forbidden);
     lw_json_key(&j, "holds"); lw_json_int(&j, q->holds);

@@ -43,6 +43,10 @@
 ** nothing to hold it) the quench walks off instead of leaping to
 ** coordinates no drawing can render. */
 #define MAX_MOVE 1000.0
+/* Rounds of the row's own minimum and L-BFGS (lw_quench_run): another
+** only while the row's step lowers the energy by more than this share. */
+#define ROUNDS_MAX 50
+#define ROUND_GAIN 1e-13
 
 typedef struct {
   lw_system *sys;
@@ -267,25 +271,42 @@ lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_repor
     goto out;
   }
   if (n == 0 || !isfinite(r->energy_before)) goto out; /* nothing to move, or a forbidden start */
-  if (t->minimize && (st = t->minimize(sys->state, err))) goto out;
-  t->get_coords(sys->state, q.x);
-  double e = evaluate(&q, q.x, q.g, err);
-  if (isnan(e)) {
-    st = err->code;
-    goto out;
-  }
-  const double step0 = first_step(q.x, n), e_start = e;
-  double gnorm = sqrt(dot(q.g, q.g, n));
   /* the energy and gradient norm of the last iterations, by iteration mod the window */
-  double back[LW_QUENCH_WINDOW], back_g[LW_QUENCH_WINDOW];
-  r->gradient_before = gnorm;
-  lw_quench_end end;
-  while ((end = end_now(o, r->iterations, gnorm, back, back_g, e, e_start)) == LW_QUENCH_RUNNING) {
-    back[r->iterations % LW_QUENCH_WINDOW] = e;
-    back_g[r->iterations % LW_QUENCH_WINDOW] = gnorm;
-    if (!step(&q, &e, gnorm > 0.0 ? step0 / gnorm : 0.0, MAX_MOVE * step0, &st, err)) break;
-    r->iterations++;
+  double back[LW_QUENCH_WINDOW], back_g[LW_QUENCH_WINDOW], e = NAN, e_start = NAN, gnorm = NAN, step0 = 0.0;
+  lw_quench_end end = LW_QUENCH_RUNNING;
+  /* Rounds: the row's own step to the minimum over what it can solve for
+  ** (the control points of a D-NURBS curve at its present weights), then
+  ** L-BFGS over everything; where that stalls and the row's step still
+  ** lowers the energy, another round.  Without `minimize`, one round. */
+  for (int round = 0; round < ROUNDS_MAX; round++) {
+    if (t->minimize && (st = t->minimize(sys->state, err))) goto out;
+    t->get_coords(sys->state, q.x);
+    const double e_was = e;
+    e = evaluate(&q, q.x, q.g, err);
+    if (isnan(e)) {
+      st = err->code;
+      goto out;
+    }
     gnorm = sqrt(dot(q.g, q.g, n));
+    if (round == 0) {
+      step0 = first_step(q.x, n);
+      e_start = e;
+      r->gradient_before = gnorm;
+    } else if (!(e < e_was - ROUND_GAIN * fabs(e_was))) {
+      break;
+    }
+    r->rounds = round + 1;
+    q.used = 0;
+    while ((end = end_now(o, r->iterations, gnorm, back, back_g, e, e_start)) == LW_QUENCH_RUNNING) {
+      back[r->iterations % LW_QUENCH_WINDOW] = e;
+      back_g[r->iterations % LW_QUENCH_WINDOW] = gnorm;
+      if (!step(&q, &e, gnorm > 0.0 ? step0 / gnorm : 0.0, MAX_MOVE * step0, &st, err)) break;
+      r->iterations++;
+      gnorm = sqrt(dot(q.g, q.g, n));
+    }
+    if (st || !t->minimize || end == LW_QUENCH_CONVERGED || end == LW_QUENCH_ITERATIONS || end == LW_QUENCH_STOPPED)
+      break;
+    if ((st = t->set_coords(sys->state, q.x, err))) goto out;
   }
   if (end != LW_QUENCH_RUNNING) r->ended = end;
   /* the state where the last accepted step left it (the start if none) */

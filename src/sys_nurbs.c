@@ -852,16 +852,18 @@ static void mass_shift_solve(const void *mass, const double *b, double *v)
   lw_band_solve(m->S, m->su->pin, m->n, (int)m->k, b, v);
 }
 
-/* Frozen weights make the energy quadratic, 1/2 P'KP - f'P, so its minimum
-** with the held points where they are is one banded solve: K_ff P_f =
-** f_f - K_fh P_h (system.h). A K that is not positive definite on the free
+/* At given weights the energy is quadratic in the control points,
+** 1/2 P'K(w)P - f(w)'P (+ the weights' own term), so its minimum over them
+** with the held points where they are is one banded solve: K_ff P_f = f_f -
+** K_fh P_h (system.h). Frozen weights: the minimum. Free weights: the
+** minimum at these weights, between which the quench's L-BFGS moves the
+** weights too (its rounds). A K that is not positive definite on the free
 ** points (nothing held, alpha = 0 ...) has no unique minimum: left to the
-** quench's own iterations, as free weights are. */
+** quench's own iterations. */
 static lw_status minimize(void *state, lw_error *err)
 {
   lw_nurbs_state *s = state;
   const lw_nurbs_setup *su = s->su;
-  if (s->s) return LW_OK;
   const size_t n = s->c->n;
   const int k = s->mat->k;
   double *L = malloc(n * (size_t)k * sizeof *L), *held = malloc(2 * n * sizeof *held),

@@ -15,6 +15,7 @@
 
 #include "linewise/dynamics.h"
 #include "linewise/mc.h"
+#include "linewise/quench.h"
 #include "linewise/sys_nurbs.h"
 #include "testutil.h"
 
@@ -29,10 +30,12 @@ typedef struct {
 } fwire;
 
 /* The review's wire (test_wire.c) with free weights starting at `weights`
-** (NULL: all 1), `gauss` points a span (the review's 10). */
-static void fwire_open(fwire *w, const char *weights, double gamma, int gauss)
+** (NULL: all 1), `gauss` points a span (the review's 10), each span cut
+** into `refine` (nurbs.refine). */
+static void fwire_open_refined(fwire *w, const char *weights, double gamma, int gauss, int refine)
 {
   lw_params_defaults(&w->p);
+  w->p.nb_refine = refine;
   strcpy(w->p.nb_points, "-5 5  -4.17 5  -2.5 5  0 5  2.5 5  4.17 5  5 5");
   strcpy(w->p.nb_knots, "0 0 0 0 0.25 0.5 0.75 1 1 1 1");
   if (weights) strcpy(w->p.nb_weights, weights);
@@ -54,6 +57,11 @@ static void fwire_open(fwire *w, const char *weights, double gamma, int gauss)
   w->st = w->sys->state;
   w->nc = lw_system_nurbs.n_coords(w->st);
   cr_assert_eq(w->nc, 3 * w->su->curve->n);
+}
+
+static void fwire_open(fwire *w, const char *weights, double gamma, int gauss)
+{
+  fwire_open_refined(w, weights, gamma, gauss, 1);
 }
 
 static void fwire_close(fwire *w)
@@ -312,5 +320,33 @@ Test(nurbs_weights, annealing_with_weight_moves_ends_where_the_gradient_vanishes
   cr_log_info("annealed with weights: max |dE/dx| %g (start %g)", g1, g0);
   cr_assert_lt(g1, 1e-4 * g0, "max |dE/dx| %g at the end, %g at the start", g1, g0);
   lw_chain_free(c);
+  fwire_close(&w);
+}
+
+Test(nurbs_weights, the_quench_of_a_refined_wire_alternates_the_points_solve_and_l_bfgs)
+{
+  /* Refined 8 times (35 points, stiffness condition 1e7), from the straight
+  ** start and weights of 1.2 and 0.8.  All weights 1 is a point of the free
+  ** space with no weights term, so the free minimum lies at or below the
+  ** frozen one, 3193.4015741514 at this refinement (tests/test_wire.c).
+  ** L-BFGS alone stalled at 3214.7 (gradient 830); each round solves for
+  ** the points at the present weights (minimize), then L-BFGS moves both. */
+  fwire w;
+  fwire_open_refined(&w, "1 1.2 1 0.8 1 1.2 1", 0, 10, 8);
+  double *x0 = malloc(w.nc * sizeof *x0), *x1 = malloc(w.nc * sizeof *x1);
+  lw_system_nurbs.get_coords(w.st, x0);
+  lw_quench_opts o = {.tol = 1e-6, .max_iter = 2000, .stall = 0.05};
+  lw_quench_report r;
+  lw_error err = {0};
+  cr_assert_eq(lw_quench_run(w.sys, &o, &r, &err), LW_OK, "%s", err.msg);
+  cr_log_info("free weights, refined: %s after %d rounds, %ld iterations, gradient %g, energy %.10f",
+              lw_quench_end_name(r.ended), r.rounds, r.iterations, r.gradient_after, r.energy_after);
+  cr_assert_geq(r.rounds, 2);
+  cr_assert_lt(r.energy_after, 3193.4015741514 + 1e-4, "energy %.10f", r.energy_after);
+  lw_system_nurbs.get_coords(w.st, x1);
+  for (size_t i = 0; i < w.nc; i++)
+    if (w.su->pin[i / 3]) cr_assert(x1[i] == x0[i], "held coordinate %zu moved", i);
+  free(x0);
+  free(x1);
   fwire_close(&w);
 }

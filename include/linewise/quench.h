@@ -11,6 +11,10 @@
 ** others (quench.c has why GSL's minimisers could not); elsewhere the step
 ** is halved until it is allowed.
 **
+** Where the row can solve for part of its minimum itself (system.h,
+** `minimize`), that solve comes first, and again after each stall while it
+** lowers the energy (rounds): the stiff part is then solved, not iterated.
+**
 ** Deterministic: the same state gives the same iterates whatever the thread
 ** count (the gradient and the energy are serial sums in a fixed order).
 */
@@ -38,6 +42,7 @@ typedef struct {
   double energy_before, energy_after;     /* total energy */
   double gradient_before, gradient_after; /* Euclidean norm of the gradient, energy/mm */
   long iterations;                        /* minimiser iterations */
+  int rounds;                             /* rounds of the row's own minimum and L-BFGS (0: none ran) */
   long evaluations;                       /* energy evaluations (with or without gradient) */
   long forbidden;                         /* of which at forbidden points: steps shortened */
   long holds;                             /* parts held by a step at a wall (each time) */

@@ -233,10 +233,12 @@ struct lw_system_type {
   ** asked, since a part that was allowed stays so when the others move
   ** less (lw_system_hold). */
   size_t (*blocked)(void *state, const double *x, unsigned char *blocked, const unsigned char *changed);
-  /* Optional (NULL: none): moves the state to the minimum of its energy in
-  ** one step where the system can solve for it (a quadratic energy: one
-  ** linear solve), the held parts where they are, and does nothing where it
-  ** cannot; the quench (quench.h) calls it first and goes on from there.
+  /* Optional (NULL: none): moves the state to the minimum of its energy
+  ** over the coordinates the system can solve for in one step (where the
+  ** energy is quadratic in them: one linear solve), the others and the held
+  ** parts where they are, and does nothing where it cannot; the quench
+  ** (quench.h) calls it first, goes on from there, and calls it again after
+  ** a stall for as long as it lowers the energy.
   ** Iterations alone converge slowly where the energy is stiff: L-BFGS
   ** stalled at a gradient of 379 on a refined wire whose minimum this finds
   ** to rounding. */
