@@ -6,7 +6,8 @@
 #include <string.h>
 
 /* Conjugate gradients stop at this relative residual, or after a number of
-** iterations proportional to the size (exact arithmetic needs n). */
+** iterations proportional to the size (exact arithmetic needs n; with the
+** row's factor as preconditioner one or two do). */
 #define CG_TOL 1e-11
 #define CG_ITER(n) (10 * (n) + 100)
 
@@ -20,21 +21,22 @@ lw_status lw_dyn_review_init(lw_dynamics *d, const lw_params *p, lw_error *err)
     return lw_error_set(err, LW_EINPUT, "%s: key 'dynamics.integrator': the review's scheme needs inertia (rho > 0)",
                         where);
   }
+  /* the scheme is derived for a constant M and a quadratic E: the row's
+  ** factor of (1 + h c / 2) M + h^2 K says it has them */
+  double h = d->dt, c = d->gamma / d->rho;
+  int factored = 0;
+  lw_status st = d->type->mass_shift ? d->type->mass_shift(d->mass, 1.0 + 0.5 * h * c, h * h, &factored, err) : LW_OK;
+  if (st) return st;
+  if (!factored) {
+    char where[LW_PATH_MAX + 32];
+    lw_params_origin(p, lw_params_find("dynamics", "integrator"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'dynamics.integrator': the review's scheme takes a constant mass "
+                        "matrix and a quadratic energy (the nurbs system with frozen weights); the %s system's are "
+                        "not: use integrator = leapfrog", where, d->type->name);
+  }
   if (!(d->work = calloc(W_COUNT * d->n + 1, sizeof *d->work)))
     return lw_error_set(err, LW_ENOMEM, "out of memory for the dynamics of %zu coordinates", d->n);
-  /* the system's own (1 + h c / 2) M + h^2 K, where its energy is quadratic,
-  ** makes the preconditioned operator the identity up to rounding */
-  double h = d->dt, c = d->gamma / d->rho;
-  if (d->type->mass_shift) return d->type->mass_shift(d->mass, 1.0 + 0.5 * h * c, h * h, &d->review_shifted, err);
   return LW_OK;
-}
-
-static void precondition(const lw_dynamics *d, const double *r, double *z)
-{
-  if (d->review_shifted)
-    d->type->mass_shift_solve(d->mass, r, z);
-  else
-    d->type->mass_solve(d->mass, r, z);
 }
 
 static double dot(const double *a, const double *b, size_t n)
@@ -87,7 +89,7 @@ lw_status lw_dyn_review_step(lw_dynamics *d, lw_error *err)
     delta[i] = 0.0;
   }
   hold(d, r);
-  precondition(d, r, z);
+  t->mass_shift_solve(d->mass, r, z);
   memcpy(s, z, n * sizeof *s);
   double rz = dot(r, z, n), r0 = sqrt(dot(r, r, n));
   int it = 0;
@@ -98,7 +100,7 @@ lw_status lw_dyn_review_step(lw_dynamics *d, lw_error *err)
     if ((st = apply_a(d, s, as, err))) return st;
     double alpha = rz / dot(s, as, n);
     for (size_t i = 0; i < n; i++) delta[i] += alpha * s[i], r[i] -= alpha * as[i];
-    precondition(d, r, z);
+    t->mass_shift_solve(d->mass, r, z);
     double rz1 = dot(r, z, n);
     for (size_t i = 0; i < n; i++) s[i] = z[i] + rz1 / rz * s[i];
     rz = rz1;

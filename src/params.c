@@ -653,7 +653,8 @@ const lw_param_def lw_param_table[] = {
   CHOICE("dynamics", "integrator", dyn_integrator, "leapfrog", "leapfrog|review",
          "`leapfrog`: the generalised leapfrog (order 2, symplectic). `review`: the implicit scheme of "
          "the D-NURBS review (its eqs. 90 and 104; backward in the stiffness, so it damps high "
-         "frequencies; needs rho > 0). docs/NUMERICS.md, \"D-NURBS\"."),
+         "frequencies; needs rho > 0, a constant mass matrix and a quadratic energy: the nurbs system "
+         "with frozen weights, at any dt in one solve a step). docs/NUMERICS.md, \"D-NURBS\"."),
   NUM("nurbs", "order", LW_PT_INT, nb_order, "4", "", 2, 8, 0,
       "Order k of the NURBS curve (degree k - 1; 4 = cubic). docs/NURBS.md."),
   STRING("nurbs", "points", nb_points, "", "length",

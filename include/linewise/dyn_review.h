@@ -15,10 +15,11 @@
 ** with pi = M (p - p-) / h the backward-difference momentum the driver
 ** keeps (so checkpoints and the kinetic energy need nothing new).  It is
 ** solved by conjugate gradients, whose products K v are differences of the
-** row's gradient (exact for a quadratic energy; a Newton step otherwise),
-** preconditioned by the row's factor of the matrix itself where it has one
-** (mass_shift: one iteration, plus one for rounding) and by M otherwise
-** (iterations growing as h omega_max).  Unconditionally stable, first order: a mode of
+** row's gradient (exact for the quadratic energy), preconditioned by the
+** row's factor of the matrix itself (mass_shift): one iteration, plus one or
+** two for rounding.  A row without that factor (a mass matrix that depends
+** on the coordinates, an energy that is not quadratic: splines, particles,
+** free weights) is refused.  Unconditionally stable, first order: a mode of
 ** frequency omega loses amplitude at the rate omega^2 h / 2 that no
 ** physics asks for.
 */
@@ -27,8 +28,9 @@
 
 #include "linewise/dynamics.h"
 
-/* Allocates the scheme's scratch and has the row factor the matrix (after
-** the mass matrix is made); LW_EINPUT naming the key if rho = 0. */
+/* Has the row factor the matrix (after the mass matrix is made) and
+** allocates the scheme's scratch; LW_EINPUT naming the key if rho = 0 or the
+** row has no such factor. */
 lw_status lw_dyn_review_init(lw_dynamics *d, const lw_params *p, lw_error *err);
 
 /* One step; LW_EINPUT if the solve does not converge or the state is forbidden. */

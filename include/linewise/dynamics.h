@@ -70,7 +70,6 @@ typedef struct {
   int iterations_max;        /* most fixed-point iterations a step needed */
   int integrator;            /* LW_INTEGRATOR_* */
   double *work;              /* the review scheme's scratch (dyn_review.h), or NULL */
-  int review_shifted;        /* 1: its solve is preconditioned by the row's mass_shift */
   unsigned char *held;       /* massless: the coordinates a step holds (n) */
   double h_ref, h_scale;     /* E + K and |E| + K before the first step here (NAN: not yet) */
   int pair_dampers;          /* 1 if the scene names dampers between neighbours */

@@ -261,9 +261,10 @@ struct lw_system_type {
   ** constant, factors a M + b K with the held coordinates held and sets
   ** *done = 1 (0, nothing factored, where the row cannot at this state);
   ** mass_shift_solve then gives v = (a M + b K)^-1 b, 0 at held
-  ** coordinates.  The review's implicit scheme (dyn_review.h) solves with
-  ** it: one iteration a step at any dt, where conjugate gradients
-  ** preconditioned by M alone need a number growing as h omega_max. */
+  ** coordinates.  The review's implicit scheme (dyn_review.h) takes only a
+  ** row that has it, and solves with it in one iteration a step at any dt
+  ** (conjugate gradients preconditioned by M alone needed a number growing
+  ** as h omega_max). */
   lw_status (*mass_shift)(void *mass, double a, double b, int *done, lw_error *err);
   void (*mass_shift_solve)(const void *mass, const double *b, double *v);
   /* Optional (NULL: the coordinates are free): brings coordinates x that a
