@@ -279,9 +279,10 @@ lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_repor
   ** L-BFGS over everything; where that stalls and the row's step still
   ** lowers the energy, another round.  Without `minimize`, one round. */
   for (int round = 0; round < ROUNDS_MAX; round++) {
+    const double e_was = e, gnorm_was = gnorm;
+    if (round > 0) memcpy(q.x1, q.x, n * sizeof *q.x); /* where L-BFGS left it */
     if (t->minimize && (st = t->minimize(sys->state, err))) goto out;
     t->get_coords(sys->state, q.x);
-    const double e_was = e;
     e = evaluate(&q, q.x, q.g, err);
     if (isnan(e)) {
       st = err->code;
@@ -293,6 +294,9 @@ lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_repor
       e_start = e;
       r->gradient_before = gnorm;
     } else if (!(e < e_was - ROUND_GAIN * fabs(e_was))) {
+      /* the solve gained nothing: the quench ends where L-BFGS did */
+      memcpy(q.x, q.x1, n * sizeof *q.x);
+      e = e_was, gnorm = gnorm_was;
       break;
     }
     r->rounds = round + 1;
