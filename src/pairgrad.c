@@ -242,8 +242,8 @@ static inline __attribute__((always_inline)) jet jmake2(double v, int a, double 
 }
 
 static inline jet jc(double v) { return (jet){v, -1}; }
-static inline jet jadd(jet a, jet b) { return jmake2(a.v + b.v, a.i, 1.0, b.i, 1.0); }
-static inline jet jsub(jet a, jet b) { return jmake2(a.v - b.v, a.i, 1.0, b.i, -1.0); }
+static inline __attribute__((always_inline)) jet jadd(jet a, jet b) { return jmake2(a.v + b.v, a.i, 1.0, b.i, 1.0); }
+static inline __attribute__((always_inline)) jet jsub(jet a, jet b) { return jmake2(a.v - b.v, a.i, 1.0, b.i, -1.0); }
 
 static inline jet jaddc(jet a, double c)
 {
@@ -251,8 +251,8 @@ static inline jet jaddc(jet a, double c)
   return a;
 }
 
-static inline jet jscale(jet a, double c) { return jmake1(a.v * c, a.i, c); }
-static inline jet jmul(jet a, jet b) { return jmake2(a.v * b.v, a.i, b.v, b.i, a.v); }
+static inline __attribute__((always_inline)) jet jscale(jet a, double c) { return jmake1(a.v * c, a.i, c); }
+static inline __attribute__((always_inline)) jet jmul(jet a, jet b) { return jmake2(a.v * b.v, a.i, b.v, b.i, a.v); }
 
 static inline jet jdiv(jet a, jet b)
 {
