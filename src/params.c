@@ -357,7 +357,8 @@ const lw_param_def lw_param_table[] = {
   CHOICE("anneal", "quench", quench, "none", "none|bfgs",
          "After the last sweep: none, or bfgs, which takes the coldest replica to the nearest local "
          "minimum of its energy (limited-memory BFGS on the system's gradient, holding the parts a "
-         "step would take through a wall; docs/ACCURACY.md). "
+         "step would take through a wall; docs/ACCURACY.md; a D-NURBS curve's control points are "
+         "solved for exactly first, and again between L-BFGS runs where its weights are free). "
          "The drawings and summary.json show the quenched state; state.lw keeps the annealed one, so "
          "a resumed or longer run continues the chain. Needs a system with a gradient (splines, nurbs, particles)."),
   NUM("anneal", "quench_tol", LW_PT_DOUBLE, quench_tol, "1e-6", "energy/mm", 0, 1e300, LW_MIN_OPEN,
