@@ -78,7 +78,7 @@ enum { LEAPFROG, REVIEW, N_WAYS };
 ** first) and the most CG iterations a step took (the review's). */
 static double time_steps(bench_ctx *b, size_t n, int way, double *assembly, double *om, double *dt0, int *iters)
 {
-  const lw_system_type row = lw_system_nurbs;
+  const lw_system_type *row = &lw_system_nurbs;
   lw_params *p = malloc(sizeof *p);
   lw_error err = {0};
   double t0 = bench_now();
@@ -91,8 +91,8 @@ static double time_steps(bench_ctx *b, size_t n, int way, double *assembly, doub
     *om = omega_max(su, p->dyn_rho);
     p->dyn_dt = *dt0 = fmin(0.008, 1.0 / *om);
   }
-  void *st = row.state_new(su, p, 0, &err);
-  lw_dynamics *dy = st ? lw_dynamics_new(&row, st, p, &err) : NULL;
+  void *st = row->state_new(su, p, 0, &err);
+  lw_dynamics *dy = st ? lw_dynamics_new(row, st, p, &err) : NULL;
   if (!dy) bench_die("nurbs dynamics", &err);
   double per[BENCH_MAX_REPS];
   for (int rep = 0; rep < b->reps; rep++) {
@@ -107,8 +107,8 @@ static double time_steps(bench_ctx *b, size_t n, int way, double *assembly, doub
   }
   *iters = dy->iterations_max;
   lw_dynamics_free(dy);
-  row.state_free(st);
-  row.setup_free(su);
+  row->state_free(st);
+  row->setup_free(su);
   free(p);
   return bench_median(per, b->reps);
 }
