@@ -5,6 +5,7 @@
 */
 #include "linewise/anneal.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <gsl/gsl_math.h>
 #include <stdarg.h>
@@ -105,6 +106,67 @@ static lw_status make_dir(const char *dir, lw_error *err)
   return LW_OK;
 }
 
+/* The files a run writes, and their temporaries.  A run into a directory
+** that held one removes the old run's first: a final.gcode or a replica
+** state of another run beside the new drawing would be taken for its own. */
+static const char *const run_files[] = {"scene.ini",  "state.lw",  "trace.csv",  "summary.json", "timing.txt",
+                                        "ladder.ini", "field.png", "final.svg",  "final.png",    "final.pdf",
+                                        "final.hpgl", "final.gcode", "final.ply"};
+
+/* Whether name is prefix + digits + suffix, or that + ".tmp" (a write cut off). */
+static int numbered(const char *name, const char *prefix, const char *suffix)
+{
+  size_t np = strlen(prefix), nd = 0;
+  if (strncmp(name, prefix, np)) return 0;
+  while (name[np + nd] >= '0' && name[np + nd] <= '9') nd++;
+  const char *rest = name + np + nd;
+  size_t ns = strlen(suffix);
+  return nd > 0 && !strncmp(rest, suffix, ns) && (!rest[ns] || !strcmp(rest + ns, ".tmp"));
+}
+
+/* Removes sub's entries prefix + digits + suffix under dir, then sub if
+** that leaves it empty. */
+static lw_status clear_numbered(const char *dir, const char *sub, const char *prefix, const char *suffix,
+                                lw_error *err)
+{
+  char path[LW_PATH_MAX + 64];
+  lw_path_join(path, sizeof path, dir, sub);
+  DIR *d = opendir(path);
+  if (!d) return LW_OK;
+  lw_status s = LW_OK;
+  for (struct dirent *e; !s && (e = readdir(d));) {
+    if (!numbered(e->d_name, prefix, suffix)) continue;
+    char file[2 * LW_PATH_MAX];
+    snprintf(file, sizeof file, "%s/%s", path, e->d_name);
+    if (unlink(file) && errno != ENOENT) s = lw_error_set(err, LW_EIO, "%s: cannot remove: %s", file, strerror(errno));
+  }
+  closedir(d);
+  if (!s && sub[0] != '.') rmdir(path); /* fails, harmlessly, if the user keeps other files there */
+  return s;
+}
+
+static lw_status clear_run(const char *dir, lw_error *err)
+{
+  char path[LW_PATH_MAX + 32];
+  lw_path_join(path, sizeof path, dir, "scene.ini");
+  int held = access(path, F_OK) == 0;
+  lw_path_join(path, sizeof path, dir, "state.lw");
+  if (!held && access(path, F_OK)) return LW_OK;
+  for (size_t i = 0; i < sizeof run_files / sizeof *run_files; i++)
+    for (int tmp = 0; tmp < 2; tmp++) {
+      char name[64];
+      snprintf(name, sizeof name, "%s%s", run_files[i], tmp ? ".tmp" : "");
+      lw_path_join(path, sizeof path, dir, name);
+      if (unlink(path) && errno != ENOENT)
+        return lw_error_set(err, LW_EIO, "%s: cannot remove the file of the run before: %s", path, strerror(errno));
+    }
+  lw_status s;
+  if ((s = clear_numbered(dir, ".", "replica-", ".lw", err)) ||
+      (s = clear_numbered(dir, "frames", "frame-", ".png", err)))
+    return s;
+  return clear_numbered(dir, "samples", "sample-", ".csv", err);
+}
+
 /* Schedule and its table (relative to the scene file). */
 static lw_status setup_schedule(lw_anneal *a, lw_error *err)
 {
@@ -188,6 +250,12 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
     lw_params_origin(p, lw_params_find("scene", "driver"), where, sizeof where);
     return lw_error_set(err, LW_EINPUT, "%s: key 'scene.driver': the dynamics moves one system; parallel tempering "
                         "(%d replicas) needs driver = metropolis", where, a->n_rep);
+  }
+  if (p->driver == LW_DRIVER_DYNAMICS && strcmp(p->domains, "off")) {
+    lw_params_origin(p, lw_params_find("anneal", "domains"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.domains': domains split the sweeps of Monte Carlo; the "
+                        "dynamics moves every node at once (driver = dynamics): expected off, got '%s'", where,
+                        p->domains);
   }
   if (a->net && a->n_rep < a->net->size) {
     lw_params_origin(p, lw_params_find("tempering", "replicas"), where, sizeof where);
@@ -398,6 +466,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   /* Everything above only read input: the directory appears once the run
   ** is known to be valid. */
   if ((s = make_dir(dir, err))) return s;
+  if (writes_files(a) && (s = clear_run(dir, err))) return s;
   if (!writes_files(a)) {
     lw_phase_set(NULL);
     return LW_OK;
@@ -428,6 +497,30 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
   return s;
 }
 
+/* The sweep of the last row within the first `bytes` bytes of the trace
+** (a run writes one every trace_every sweeps, and one where it ends), or
+** -1 if there is only the header; -2 if it cannot be read. */
+static long last_row_sweep(const char *path, long bytes)
+{
+  enum { TAIL = 1 << 16 };
+  FILE *f = fopen(path, "rb");
+  if (!f) return -2;
+  long from = bytes > TAIL ? bytes - TAIL : 0, n = bytes - from, sweep = -2;
+  char *buf = malloc((size_t)n + 1);
+  if (buf && !fseek(f, from, SEEK_SET) && fread(buf, 1, (size_t)n, f) == (size_t)n) {
+    buf[n] = '\0';
+    if (n > 0 && buf[n - 1] == '\n') buf[--n] = '\0';
+    char *line = strrchr(buf, '\n');
+    long long v;
+    if (!line && from == 0) sweep = -1; /* the header alone */
+    else if (line && (line[1 + strcspn(line + 1, ",")] = '\0', lw_number_parse_whole(line + 1, 0, LW_STATE_SWEEP_MAX, &v)))
+      sweep = (long)v;
+  }
+  free(buf);
+  fclose(f);
+  return sweep;
+}
+
 /* trace.csv back to the checkpoint: rows written after it belong to sweeps
 ** that will run again.  A format-2 checkpoint knows the length it synced;
 ** a format-1 one only its sweep, so complete rows up to it are kept. */
@@ -442,6 +535,19 @@ static lw_status truncate_trace(lw_anneal *a, long bytes, lw_error *err)
     if (!S_ISREG(sb.st_mode) || sb.st_size < bytes)
       return lw_error_set(err, LW_EINPUT, "%s: %lld bytes, but state.lw counts %ld (the trace was cut or replaced)",
                           path, (long long)sb.st_size, bytes);
+    /* the rows the state counts end at its sweep: a state whose sweep was
+    ** edited would run sweeps again and write their rows twice */
+    long last = last_row_sweep(path, bytes), every = a->params.trace_every;
+    if (last == -2)
+      return lw_error_set(err, LW_EINPUT, "%s: the last of the rows state.lw counts (%ld bytes) has no sweep", path,
+                          bytes);
+    if (last >= 0 && (last > a->sweep || a->sweep - last >= every)) {
+      char state[LW_PATH_MAX + 32];
+      dir_file(state, sizeof state, a, "state.lw");
+      return lw_error_set(err, LW_EINPUT, "%s: the rows %s counts end at sweep %ld, but it is at sweep %ld (a row "
+                          "every %ld sweeps): the state or the trace was edited, or is of another run",
+                          path, state, last, a->sweep, every);
+    }
     if (truncate(path, bytes)) return lw_error_set(err, LW_EIO, "%s: cannot truncate: %s", path, strerror(errno));
     return open_trace(a, 0, err);
   }
@@ -542,6 +648,12 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   if ((s = build(a, all, ladder, err)) || (s = check_quench(a, err))) goto out;
   if (st.version == 1 && (s = lw_checkpoint_upgrade_v1(st.doc, rep, a->n_rep, err))) goto out;
   if ((s = lw_checkpoint_restore(a, st.doc, &trace_bytes, err))) goto out;
+  if (!a->dyn && a->block != (a->sweep ? block_of(a, a->sweep - 1) : -1)) {
+    s = lw_error_set(err, LW_EINPUT, "%s: [run] sweep: %ld is in the schedule's temperature step %ld, but the "
+                     "file's block is %ld: the state was edited", path, a->sweep,
+                     a->sweep ? block_of(a, a->sweep - 1) : -1, a->block);
+    goto out;
+  }
   set_temperatures(a);
   dir_file(path, sizeof path, a, "timing.txt");
   FILE *tf = fopen(path, "r");
@@ -550,9 +662,17 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
       a->wall_before = 0;
     fclose(tf);
   }
-  a->end_sweep = more >= 0 ? a->sweep + more : (a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep);
+  if (more >= 0) a->end_sweep = a->sweep + more;
+  else if (a->end_sweep < 0) a->end_sweep = a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep;
   for (int k = 0; k < a->chain->n_moves; k++) a->proposals_before += a->chain->stats[k].proposed;
   if (writes_files(a)) s = truncate_trace(a, trace_bytes, err);
+  if (!s && writes_files(a) && !lw_anneal_done(a)) {
+    /* a finished run extended by --sweeps is no longer finished: its
+    ** summary would describe a state that is gone (studies take a
+    ** summary.json as the sign of a finished run) */
+    dir_file(path, sizeof path, a, "summary.json");
+    if (unlink(path) && errno != ENOENT) s = lw_error_set(err, LW_EIO, "%s: cannot remove: %s", path, strerror(errno));
+  }
 out:
   lw_phase_set(NULL);
   for (int k = 1; k < LW_TEMPERING_MAX; k++) lw_ckpt_free(rep[k]);

@@ -158,6 +158,9 @@ void lw_checkpoint_put_run(lw_ckpt_writer *w, const lw_anneal *a, long trace_byt
 {
   lw_state head = {.scene = "scene.ini", .seed = a->seed, .sweep = a->sweep};
   lw_state_put_header(w, &head);
+  /* where the run stops: a resume --sweeps N that is stopped or killed
+  ** goes on to it, not to the scene's anneal.sweeps */
+  lw_ckpt_put(w, "end_sweep", "%ld", a->end_sweep);
   lw_ckpt_put(w, "temperature", "%.17g", a->t_sched);
   lw_ckpt_put(w, "block", "%ld", a->block);
   lw_ckpt_put(w, "t_prev", "%.17g", a->t_prev);
@@ -449,6 +452,10 @@ lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, l
   double v[3];
   unsigned long u[3];
   long block = 0, tb = -1;
+  /* absent in files of older releases: the caller falls back on anneal.sweeps */
+  a->end_sweep = -1;
+  if ((s = lw_ckpt_whole(doc, "run", "end_sweep", &a->end_sweep, a->sweep, (long)LW_STATE_SWEEP_MAX, 0, err)))
+    return s;
 #define NUMS(key, n, lo, hi) if ((s = lw_ckpt_numbers(doc, "run", key, v, n, lo, hi, 1, err))) return s
   NUMS("temperature", 1, 0, DBL_MAX); a->t_sched = v[0];
   if ((s = lw_ckpt_whole(doc, "run", "block", &block, -1, a->params.steps - 1, 1, err))) return s;

@@ -45,8 +45,9 @@ static const char usage[] =
   "      --set SEC.KEY=VAL   override a scene parameter (repeatable)\n"
   "      --seed N            override anneal.seed\n"
   "      --stop-at N         stop cleanly after sweep N, as if interrupted\n"
-  "      --threads N         OpenMP threads for the replicas of parallel tempering\n"
-  "                          (default OMP_NUM_THREADS or all cores; results never depend on it)\n"
+  "      --threads N         OpenMP threads: the replicas of parallel tempering, then\n"
+  "                          anneal.domains (default OMP_NUM_THREADS or all cores;\n"
+  "                          results never depend on it)\n"
   "      --quiet             no progress or parameter echo on stderr\n"
   "  resume DIR          continue the run in DIR bit-exactly from DIR/state.lw\n"
   "      --sweeps N          run N more sweeps (default: to the end of the schedule;\n"
@@ -350,8 +351,8 @@ static int parse_count(const char *opt, const char *v, double max, long *out, lw
   return 1;
 }
 
-/* --threads N: OpenMP threads for the tempering replicas.  Results never
-** depend on it (each rung has its own stream; exchanges are serial). */
+/* --threads N: OpenMP threads for the tempering replicas and the domains.
+** Results never depend on it (each rung and cell has its own stream). */
 static int set_threads(const char *v, lw_error *err)
 {
   long t;

@@ -335,7 +335,7 @@ const lw_param_def lw_param_table[] = {
       "Cooling rate of the adaptive schedule: T <- T exp(-lambda T / sigma_E)."),
   STRING("anneal", "table", table, "", "path",
          "Table schedule file: lines 'step temperature' (relative to the scene file)."),
-  NUM("anneal", "seed", LW_PT_DOUBLE, seed, "1", "", 0, 4294967295.0, 0,
+  NUM("anneal", "seed", LW_PT_WHOLE, seed, "1", "", 0, 4294967295.0, 0,
       "Seed of the random number generator; the same scene and seed give the same run."),
   NUM("anneal", "check_every", LW_PT_INT, check_every, "100", "sweeps", 1, 2e9, 0,
       "Sweeps between full recomputations of the energy (the drift check); splines are "
@@ -830,14 +830,16 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
   char range[128];
   switch (d->type) {
   case LW_PT_DOUBLE:
-  case LW_PT_INT: {
+  case LW_PT_INT:
+  case LW_PT_WHOLE: {
     double v;
+    const int whole = d->type != LW_PT_DOUBLE;
     range_text(d, range, sizeof range);
     if (!lw_number_parse(text, &v)) {
-      snprintf(expected, n, "a %s %s", d->type == LW_PT_INT ? "whole number" : "number", range);
+      snprintf(expected, n, "a %s %s", whole ? "whole number" : "number", range);
       return 0;
     }
-    if (d->type == LW_PT_INT && v != floor(v)) {
+    if (whole && v != floor(v)) {
       snprintf(expected, n, "a whole number %s", range);
       return 0;
     }
@@ -989,8 +991,8 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
   snprintf(p->file, sizeof p->file, "%s", path);
   FILE *f = fopen(path, "r");
   if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open scene file: %s", path, strerror(errno));
-  /* Keys must start at column 0; a continuation line would silently glue a
-  ** typo onto the previous value. */
+  /* No continuation lines: an indented line without '=' would silently
+  ** glue a typo onto the previous value (an indented key = value is a key). */
   ini_allow_multiline = false;
   ini_stop_on_first_error = true;
   reader_ctx rc = {p, f, 0, err, 0, NULL, 0};
@@ -1123,7 +1125,8 @@ static void apply_preset(lw_params *p)
   ** 1.3 of 2 cores, 6 a side 1.8; docs/IMAGES.md) */
   int n = (int)floor((fmin(p->width, p->height) - 2.0 * p->margin) / (90.0 * w));
   snprintf(text, sizeof text, "%d", n < 1 ? 1 : (n > 64 ? 64 : n));
-  preset_key(p, "anneal", "domains", n < 2 ? "off" : text);
+  /* (the dynamics has no sweeps to split) */
+  if (p->driver != LW_DRIVER_DYNAMICS) preset_key(p, "anneal", "domains", n < 2 ? "off" : text);
 }
 
 /* Where a key's value came from: the file and line, --set, or the file's
@@ -1295,7 +1298,8 @@ static void value_text(const lw_params *p, const lw_param_def *d, char *buf, siz
 {
   const char *base = (const char *)p + d->offset;
   switch (d->type) {
-  case LW_PT_DOUBLE: snprintf(buf, n, "%.17g", *(const double *)base); break;
+  case LW_PT_DOUBLE:
+  case LW_PT_WHOLE: snprintf(buf, n, "%.17g", *(const double *)base); break;
   case LW_PT_INT: snprintf(buf, n, "%d", *(const int *)base); break;
   case LW_PT_CHOICE: choice_name(d->choices, *(const int *)base, buf, n); break;
   case LW_PT_STRING: snprintf(buf, n, "%s", base); break;
@@ -1329,8 +1333,8 @@ void lw_params_write_doc(FILE *f)
                  "|---|---|---|---|---|---|\n", d->section);
       section = d->section;
     }
-    const char *type = d->type == LW_PT_DOUBLE ? "number" : d->type == LW_PT_INT ? "integer"
-                       : d->type == LW_PT_CHOICE ? "choice" : "text";
+    static const char *const type_name[] = {"number", "integer", "integer", "choice", "text"};
+    const char *type = type_name[d->type];
     if (d->type == LW_PT_CHOICE) snprintf(range, sizeof range, "%s", d->choices);
     else if (d->type == LW_PT_STRING) snprintf(range, sizeof range, "-");
     else range_text(d, range, sizeof range);

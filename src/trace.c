@@ -509,7 +509,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     }
   }
   if (!csv) {
-    if (tlo != thi)
+    if (tlo < thi) /* equal: one temperature; inf > -inf: no temperature column (dynamics) */
       fprintf(out, "warning: the temperature changes within %s: the means mix ensembles\n",
               k > 1 ? "or between the runs" : "these rows");
     warn(out, t[0], cs, k, WARN_OPEN, "the autocorrelation did not die out within half the rows: tau is a lower "

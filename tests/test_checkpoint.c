@@ -108,6 +108,10 @@ Test(checkpoint, every_run_data_value_is_checked_on_resume)
     {"$s/$/\\nextra = 1/", "[system splines] extra: expected nothing after"},
     {"s/^sweep = 20$/sweep = 20\\nsweep = 21/", "[run] sweep: unknown or repeated key"},
     {"s/^block = 1$/block = 1\\o000/", "a NUL byte inside the line"},
+    /* the sweep against the schedule's step (6 of 10 sweeps) and the trace's rows */
+    {"s/^sweep = 20$/sweep = 2/", "[run] sweep: 2 is in the schedule"},
+    {"s/^sweep = 20$/sweep = 19/", "counts end at sweep 20, but it is at sweep 19 (a row every 1 sweeps)"},
+    {"s/^end_sweep = .*/end_sweep = 19/", "[run] end_sweep: expected a whole number from 20"},
   };
   stopped_run();
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
@@ -145,4 +149,26 @@ Test(checkpoint, rows_written_after_the_checkpoint_are_cut_back_on_resume)
                           "truncate -s 100 %s/r/trace.csv", dir, lw_test_bin(), lw_test_root(), dir, dir), 0);
   cr_assert_eq(lw_test_sh("%s resume %s/r --quiet 2>%s/err.txt", lw_test_bin(), dir, dir), 2);
   cr_assert(err_has("trace.csv: 100 bytes, but state.lw counts"));
+}
+
+/* resume --sweeps N saves its end with the state: stopped on the way, a
+** plain resume goes on to it and ends as the extension run at once; while
+** it runs the run is not finished, so summary.json is gone. */
+Test(checkpoint, an_extension_stopped_on_the_way_resumes_to_its_own_end)
+{
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("%s run %s/tests/fixtures/v1/plain.ini --out %s/a --quiet && cp -r %s/a %s/b", b,
+                          lw_test_root(), dir, dir, dir),
+               0);
+  cr_assert_eq(lw_test_sh("%s resume %s/a --sweeps 30 --quiet", b, dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/b --sweeps 30 --stop-at 75 --quiet", b, dir), 0);
+  cr_assert_eq(lw_test_sh("! test -e %s/b/summary.json && grep -qx 'end_sweep = 90' %s/b/state.lw", dir, dir), 0,
+               "the stopped extension kept a summary.json or lost its end");
+  cr_assert_eq(lw_test_sh("%s resume %s/b --quiet", b, dir), 0);
+  static const char *const files[] = {"state.lw", "trace.csv", "final.svg", "final.png"};
+  for (int k = 0; k < 4; k++)
+    cr_expect_eq(lw_test_sh("cmp -s %s/a/%s %s/b/%s", dir, files[k], dir, files[k]), 0, "%s differs", files[k]);
+  cr_assert_eq(lw_test_sh("grep -qx 'sweep = 90' %s/b/state.lw && grep -q '\"sweeps\": 90' %s/b/summary.json", dir,
+                          dir),
+               0);
 }

@@ -308,6 +308,7 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
     {"run %s/trail.ini", "trail.ini:2: key 'scene.width'"},
     {"run %s/nul.ini", "nul.ini:2: a NUL byte inside the line"},
     {"run %s/s.ini --set scene.width=0x10", "--set scene.width: expected a number"},
+    {"run %s/s.ini --set anneal.seed=1.5", "--set anneal.seed: expected a whole number >= 0"},
     {"run %s/tb.ini", "tb.ini:3: key 'anneal.table': "},
     {"run %s/fr.ini", "fr.ini:2: key 'init.from': "},
     {"run %s/pl.ini", "pl.ini:5: key 'init.segment_length': "},
@@ -382,6 +383,34 @@ Test(cli, a_run_without_out_never_replaces_another)
                           "grep -q 'seed = 9' out/s/scene.ini && ! test -e out/s-4",
                           dir, b),
                0, "--out replaces the run it names");
+}
+
+/* A run into a directory that held another leaves none of the old run's
+** files: its machine files, replica states, frames and samples would be
+** taken for the new run's.  What the user put there stays. */
+Test(cli, a_run_replacing_another_removes_the_files_it_does_not_write_again)
+{
+  write_file("s.ini", scene_text);
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --quiet --out r --set anneal.sweeps=4 --set tempering.replicas=2 "
+                          "--set tempering.t_max=2 --set output.gcode=1 --set output.hpgl=1 --set output.pdf=1 "
+                          "--set output.frames_every=2 --set output.samples_every=2 && echo mine > r/notes.txt && "
+                          "echo mine > r/frames/keep.txt && touch r/state.lw.tmp && test -f r/replica-1.lw && "
+                          "test -f r/final.gcode && test -f r/frames/frame-000002.png && "
+                          "test -f r/samples/sample-000002.csv",
+                          dir, b),
+               0);
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --quiet --out r --set anneal.sweeps=2", dir, b), 0);
+  cr_assert_eq(lw_test_sh("cd %s/r && test -f final.svg && test -f summary.json && ! test -e replica-1.lw && "
+                          "! test -e final.gcode && ! test -e final.hpgl && ! test -e final.pdf && "
+                          "! test -e ladder.ini && ! test -e samples && ! test -e state.lw.tmp && "
+                          "! test -e frames/frame-000002.png && test \"$(cat notes.txt frames/keep.txt)\" = "
+                          "\"$(printf 'mine\\nmine')\"",
+                          dir),
+               0, "the old run's files stay, or the user's went");
+  /* a refused run leaves the old one whole */
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --quiet --out r --set anneal.sweeps=-1 2>/dev/null", dir, b), 2);
+  cr_assert_eq(lw_test_sh("test -f %s/r/final.svg && test -f %s/r/summary.json", dir, dir), 0);
 }
 
 /* The mean and standard error of a column in `linewise stats --csv` output. */

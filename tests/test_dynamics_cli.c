@@ -84,6 +84,7 @@ Test(dynamics_cli, scenes_the_driver_cannot_move_are_refused_with_the_key)
     {"--set dynamics.dashpot=1", "key 'dynamics.dashpot': the system 'splines' has no dampers between neighbours"},
     {"--set dynamics.integrator=review", "key 'dynamics.integrator': the review's scheme takes a constant mass matrix "
      "and a quadratic energy (the nurbs system with frozen weights); the splines system's are not"},
+    {"--set anneal.domains=2", "key 'anneal.domains': domains split the sweeps of Monte Carlo"},
   };
   for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
     cr_assert_eq(sh("%s run %s/params/hanging.ini --out %s/x%zu --quiet %s 2>%s/err.txt", lw_test_bin(), lw_test_root(), dir, k,

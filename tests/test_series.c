@@ -200,8 +200,8 @@ Test(trace, a_bad_field_is_named_by_file_line_and_column, .init = make_dir, .fin
   cr_assert(strstr(err.msg, "c.csv:1: column 2 has no name"), "%s", err.msg);
 }
 
-/* The statistics of a trace as CSV lines, into buf. */
-static void stats_csv(const lw_trace *t, const lw_trace_select *sel, char *buf, size_t n)
+/* The statistics of a trace (CSV lines or the table, as sel says), into buf. */
+static void report_of(const lw_trace *t, const lw_trace_select *sel, char *buf, size_t n)
 {
   FILE *f = fmemopen(buf, n, "w");
   lw_error err;
@@ -223,16 +223,16 @@ Test(trace, the_default_stretch_is_the_final_temperature_less_its_tuning_sweeps,
   lw_trace *t = lw_trace_read(path, &err);
   cr_assert_not_null(t, "%s", err.msg);
   lw_trace_select sel = {.from = -1, .to = -1, .tune = 3, .steps = 2, .sweeps = 20, .csv = 1};
-  stats_csv(t, &sel, out, sizeof out);
+  report_of(t, &sel, out, sizeof out);
   cr_assert(strstr(out, "\ntotal,7,17,"), "%s", out);
   /* --from 2 --to 8: sweeps 4 .. 8 once the first step's tuning is out */
   sel.from = 2;
   sel.to = 8;
-  stats_csv(t, &sel, out, sizeof out);
+  report_of(t, &sel, out, sizeof out);
   cr_assert(strstr(out, "\ntotal,5,6,"), "%s", out);
   /* a tempering ladder's warm-up of 5 sweeps is left out too: 6 .. 8 */
   sel.ladder = 5;
-  stats_csv(t, &sel, out, sizeof out);
+  report_of(t, &sel, out, sizeof out);
   cr_assert(strstr(out, "\ntotal,3,7,"), "%s", out);
   sel.ladder = 0;
   /* nothing left: an error naming the trace's span */
@@ -243,6 +243,28 @@ Test(trace, the_default_stretch_is_the_final_temperature_less_its_tuning_sweeps,
   fclose(f);
   cr_assert(strstr(err.msg, "no row from sweep 11 to 13 with frozen steps"), "%s", err.msg);
   lw_trace_free(t);
+}
+
+Test(trace, the_temperature_warning_needs_a_temperature_that_changes, .init = make_dir, .fini = remove_dir)
+{
+  /* a dynamics trace has no temperature column: nothing to warn of; a
+  ** schedule's rows that span two temperatures are warned of */
+  char text[2048], path[128], out[4096];
+  const char *const head[] = {"sweep,time,total\n", "sweep,temperature,total\n"};
+  for (int warm = 0; warm < 2; warm++) {
+    int k = snprintf(text, sizeof text, "%s", head[warm]);
+    for (int s = 1; s <= 40; s++)
+      k += snprintf(text + k, sizeof text - (size_t)k, "%d,%g,%g\n", s, warm ? (s <= 20 ? 1.0 : 0.5) : 0.1 * s,
+                    sin(0.7 * s));
+    write_trace("t.csv", text, path, sizeof path);
+    lw_error err;
+    lw_trace *t = lw_trace_read(path, &err);
+    cr_assert_not_null(t, "%s", err.msg);
+    lw_trace_select sel = {.from = 1, .to = 40};
+    report_of(t, &sel, out, sizeof out);
+    cr_assert_eq(strstr(out, "the temperature changes") != NULL, warm, "%s", out);
+    lw_trace_free(t);
+  }
 }
 
 /* Writes run r's trace: 4000 rows of an AR(1) column `x` (phi 0.8) shifted
@@ -364,7 +386,7 @@ Test(trace, the_heat_capacity_is_the_energy_variance_over_t_squared, .init = mak
   cr_assert_not_null(t, "%s", err.msg);
   static char out[8192];
   lw_trace_select sel = {.from = -1, .to = -1, .csv = 1};
-  stats_csv(t, &sel, out, sizeof out);
+  report_of(t, &sel, out, sizeof out);
   double c = csv_field(out, "replica0_heat_capacity", 3), se = csv_field(out, "replica0_heat_capacity", 4);
   cr_log_info("C %.4f +- %.4f (36 +- %.4f)", c, se, 36 * sqrt(2.0 / rows));
   cr_assert(fabs(se / (36 * sqrt(2.0 / rows)) - 1) < 0.1, "error bar %g", se);
@@ -382,7 +404,7 @@ Test(trace, the_heat_capacity_is_the_energy_variance_over_t_squared, .init = mak
   cr_assert(line && strstr(line, "(empty)") && strstr(line, "(empty)") < strchr(line + 1, '\n'), "%s", out);
   /* its second half alone is at one temperature: C = 64 / 6.25 */
   sel = (lw_trace_select){.from = (long)rows / 2 + 1, .to = -1, .csv = 1};
-  stats_csv(t, &sel, out, sizeof out);
+  report_of(t, &sel, out, sizeof out);
   c = csv_field(out, "replica1_heat_capacity", 3);
   se = csv_field(out, "replica1_heat_capacity", 4);
   cr_assert(fabs(c - 10.24) < 4 * se && se < 0.02 * 10.24, "C %g +- %g", c, se);
@@ -391,7 +413,7 @@ Test(trace, the_heat_capacity_is_the_energy_variance_over_t_squared, .init = mak
   write_trace("u.csv", "sweep,temperature,total\n1,2,1\n2,2,3\n3,2,1\n4,2,3\n", path, sizeof path);
   t = lw_trace_read(path, &err);
   sel.from = -1;
-  stats_csv(t, &sel, out, sizeof out);
+  report_of(t, &sel, out, sizeof out);
   cr_assert(strstr(out, "\nheat_capacity,4,0.25,"), "Var 1 / T^2 4: %s", out);
   lw_trace_free(t);
   free(text);

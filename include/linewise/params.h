@@ -19,7 +19,8 @@
 #define LW_PATH_MAX 1024
 #define LW_PARAM_MAX 256 /* capacity of lw_params.line; the table is checked against it */
 
-typedef enum { LW_PT_DOUBLE, LW_PT_INT, LW_PT_CHOICE, LW_PT_STRING } lw_param_type;
+/* LW_PT_WHOLE: a whole number beyond int's range (the seed), held in a double. */
+typedef enum { LW_PT_DOUBLE, LW_PT_INT, LW_PT_WHOLE, LW_PT_CHOICE, LW_PT_STRING } lw_param_type;
 
 /* Range flags for numbers. */
 #define LW_MIN_OPEN 1 /* value > min rather than >= min */

@@ -89,6 +89,34 @@ static int replica_here(const lw_anneal *a, int r)
 ** process, the stop flag, per replica its terms and total, the coldest
 ** rung's move counts (lw_move_stats, field by field). */
 #define STATS_WORDS 5
+/* Per replica its terms and total, in the slots of the replicas this
+** process sweeps (the others stay 0 for the reduction). */
+static void pack_terms(const lw_anneal *a, uint64_t *w)
+{
+  const lw_system_type *t = a->sys_type;
+  const int nt = t->n_terms, per = nt + 1;
+  double term[LW_SYSTEM_TERMS_MAX + 1];
+  for (int r = 0; r < a->n_rep; r++)
+    if (replica_here(a, r)) {
+      t->terms(a->systems[r]->state, term);
+      term[nt] = lw_system_total(a->systems[r]);
+      memcpy(w + (size_t)r * (size_t)per, term, (size_t)per * sizeof *term);
+    }
+}
+
+/* After the reduction: every replica's total, and the stand-ins' terms. */
+static void unpack_terms(lw_anneal_net *net, lw_anneal *a, const uint64_t *w)
+{
+  const lw_system_type *t = a->sys_type;
+  const int nt = t->n_terms, per = nt + 1;
+  double term[LW_SYSTEM_TERMS_MAX + 1];
+  for (int r = 0; r < a->n_rep; r++) {
+    memcpy(term, w + (size_t)r * (size_t)per, (size_t)per * sizeof *term);
+    net->energy[r] = term[nt];
+    if (!replica_here(a, r)) t->set_terms(a->systems[r]->state, term);
+  }
+}
+
 static lw_status share(lw_anneal_net *net, lw_anneal *a, int failed, lw_error *err)
 {
   mpi_net *m = (mpi_net *)net;
@@ -113,13 +141,7 @@ static lw_status share(lw_anneal_net *net, lw_anneal *a, int failed, lw_error *e
     w[net->rank] = 1;
   }
   w[net->size] = *m->stop != 0;
-  double term[LW_SYSTEM_TERMS_MAX + 1];
-  for (int r = 0; r < n; r++)
-    if (replica_here(a, r)) {
-      t->terms(a->systems[r]->state, term);
-      term[nt] = lw_system_total(a->systems[r]);
-      memcpy(w + net->size + 1 + (size_t)r * (size_t)per, term, (size_t)per * sizeof *term);
-    }
+  pack_terms(a, w + net->size + 1);
   if (rung_here(a, 0))
     for (int k = 0; k < nm; k++) {
       const lw_move_stats *s = &a->chain->stats[k];
@@ -131,11 +153,7 @@ static lw_status share(lw_anneal_net *net, lw_anneal *a, int failed, lw_error *e
   MPI_Allreduce(MPI_IN_PLACE, w, (int)len, MPI_UINT64_T, MPI_BOR, comm);
   m->t_comm += MPI_Wtime() - t0;
   net->stop_agreed = w[net->size] != 0;
-  for (int r = 0; r < n; r++) {
-    memcpy(term, w + net->size + 1 + (size_t)r * (size_t)per, (size_t)per * sizeof *term);
-    net->energy[r] = term[nt];
-    if (!replica_here(a, r)) t->set_terms(a->systems[r]->state, term);
-  }
+  unpack_terms(net, a, w + net->size + 1);
   if (!rung_here(a, 0))
     for (int k = 0; k < nm; k++) {
       lw_move_stats *s = &a->chain->stats[k];
@@ -223,12 +241,24 @@ static lw_status moved(lw_anneal_net *net, lw_anneal *a, const int *swapped, lw_
   return LW_OK;
 }
 
+/* After a recomputation from scratch the totals differ from the running
+** ones in their last bits: the stand-ins take them too, so that what is
+** read of another process's rungs before the next sweep (the summary
+** after the last) is what the one-process run reads. */
 static lw_status drift(lw_anneal_net *net, lw_anneal *a, lw_status s, lw_error *err)
 {
+  mpi_net *m = (mpi_net *)net;
   double t0 = MPI_Wtime();
   MPI_Allreduce(MPI_IN_PLACE, &a->max_drift, 1, MPI_DOUBLE, MPI_MAX, comm);
   s = lw_mpi_agree(net, s, err);
-  ((mpi_net *)net)->t_comm += MPI_Wtime() - t0;
+  if (!s && m->buf) {
+    size_t len = (size_t)a->n_rep * (size_t)(a->sys_type->n_terms + 1);
+    memset(m->buf, 0, len * sizeof *m->buf); /* share() sized it for more */
+    pack_terms(a, m->buf);
+    MPI_Allreduce(MPI_IN_PLACE, m->buf, (int)len, MPI_UINT64_T, MPI_BOR, comm);
+    unpack_terms(net, a, m->buf);
+  }
+  m->t_comm += MPI_Wtime() - t0;
   return s;
 }
 
