@@ -511,10 +511,14 @@ static long last_row_sweep(const char *path, long bytes)
     buf[n] = '\0';
     if (n > 0 && buf[n - 1] == '\n') buf[--n] = '\0';
     char *line = strrchr(buf, '\n');
-    long long v;
-    if (!line && from == 0) sweep = -1; /* the header alone */
-    else if (line && (line[1 + strcspn(line + 1, ",")] = '\0', lw_number_parse_whole(line + 1, 0, LW_STATE_SWEEP_MAX, &v)))
-      sweep = (long)v;
+    if (!line && from == 0) {
+      sweep = -1; /* the header alone */
+    } else if (line) {
+      long long v;
+      line++;
+      line[strcspn(line, ",")] = '\0';
+      if (lw_number_parse_whole(line, 0, LW_STATE_SWEEP_MAX, &v)) sweep = (long)v;
+    }
   }
   free(buf);
   fclose(f);
