@@ -6,6 +6,7 @@
 
 #include "linewise/pairnear.h"
 #include "linewise/spacing.h"
+#include "linewise/state.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -1389,6 +1390,19 @@ static double raster_delta(const lw_model *m, lw_proposal *p, int t, const lw_no
   return lw_tone_delta(c->data, m->raster[t] + plane_in(layer, c->data), b);
 }
 
+/* Whether a proposed node lies beyond what a state file holds
+** (LW_STATE_COORD_MAX): such a state is forbidden, so that every state the
+** chain reaches can be checkpointed and resumed (a spline free of the
+** boundary would otherwise wander there by translations). */
+static int beyond_state_range(const lw_node *node, size_t n)
+{
+  for (size_t i = 0; i < n; i++)
+    if (!(fabs(node[i].px) <= LW_STATE_COORD_MAX && fabs(node[i].py) <= LW_STATE_COORD_MAX &&
+          fabs(node[i].vx) <= LW_STATE_COORD_MAX && fabs(node[i].vy) <= LW_STATE_COORD_MAX))
+      return 1;
+  return 0;
+}
+
 void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t node0,
                       size_t n_node, const lw_node *nodes)
 {
@@ -1414,7 +1428,7 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
 
   lw_samples s;
   double dlen = 0.0;
-  int forbidden = 0, undefined = 0; /* a new local energy is +inf; a new value is NaN */
+  int forbidden = beyond_state_range(p->node, n_node), undefined = 0; /* +inf new energy; a NaN value */
   int was_irregular = 0;            /* an affected segment is irregular now */
   p->irregular = 0;
   for (size_t j = 0; j < p->n_seg; j++) {
@@ -2081,7 +2095,7 @@ void lw_model_propose_regroup(const lw_model *m, lw_proposal *p, const uint32_t 
   for (int t = 0; t < LW_TERM_COUNT; t++) p->dterm[t] = 0.0;
   splice_kept(m, p);
 
-  int forbidden = 0, undefined = 0, was_irregular = 0;
+  int forbidden = beyond_state_range(p->node, p->n_node), undefined = 0, was_irregular = 0;
   splice_new_segments(m, p, &forbidden, &undefined);
   for (int k = 0, o = 0; k < n_old; k++) {
     const size_t g0 = lw_segment_index(sp, old[k], 0);

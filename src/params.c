@@ -157,8 +157,9 @@ const lw_param_def lw_param_table[] = {
       "image the darkness is 1. 0 = off."),
   NUM("init", "segments", LW_PT_INT, segments, "4", "", 1, 1e5, 0,
       "Cubic Bezier segments per spline."),
-  NUM("init", "segment_length", LW_PT_DOUBLE, segment_length, "10", "mm", 0, 1e7, LW_MIN_OPEN,
-      "Length of each segment; a spline's rest length L0 is segments * segment_length."),
+  NUM("init", "segment_length", LW_PT_DOUBLE, segment_length, "10", "mm", 1e-6, 1e7, 0,
+      "Length of each segment; a spline's rest length L0 is segments * segment_length. At least a "
+      "nanometre: the bending term's powers of shorter lengths leave the range of doubles."),
   STRING("init", "from", from, "", "path",
          "A state.lw to start from instead of random placement (relative to the scene file)."),
   NUM("energy", "strain", LW_PT_DOUBLE, strain, "0", "energy", 0, 1e12, 0,
@@ -711,7 +712,7 @@ const lw_param_def lw_param_table[] = {
       "Largest distance of final.svg's cubic Beziers from a rational curve (a polynomial one of "
       "order <= 4 is exact); the largest found is reported in summary.json."),
   NUM("nurbs", "png_scale", LW_PT_DOUBLE, nb_png_scale, "50", "pixels/length", 0, 1e6, LW_MIN_OPEN,
-      "Scale of final.png and the frames."),
+      "Scale of final.png and the frames (final.png's long side at most 4096 pixels)."),
 };
 const size_t lw_param_count = sizeof lw_param_table / sizeof lw_param_table[0];
 

@@ -104,7 +104,10 @@ lw_particles_setup *lw_particles_setup_new(const lw_params *p, lw_error *err)
     char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
     lw_path_dir(dir, sizeof dir, p->file);
     lw_path_join(full, sizeof full, dir, p->pt_points);
-    if (lw_particles_read_points(full, &s->n_points, &s->point, &s->point_normal, &s->point_pin, err)) goto fail;
+    if (lw_particles_read_points(full, &s->n_points, &s->point, &s->point_normal, &s->point_pin, err)) {
+      lw_params_blame(p, "particles", "points", err);
+      goto fail;
+    }
     /* has_normal becomes the pin flags: a given normal is pinned with its point */
     for (size_t i = 0; i < s->n_points; i++)
       s->point_pin[i] = p->pt_pinned ? (unsigned char)(LW_PIN_POSITION | (s->point_pin[i] ? LW_PIN_ORIENTATION : 0))

@@ -31,6 +31,10 @@ typedef struct {
 static lw_status append(points *pt, const double *v, const double *nrm, const char *path, const char *where,
                         lw_error *err)
 {
+  for (int c = 0; c < 3; c++)
+    if (!(fabs(v[c]) <= LW_POINTS_COORD_MAX))
+      return lw_error_set(err, LW_EINPUT, "%s%s: expected coordinates within +-%g (in r0), got (%g, %g, %g)", path,
+                          where, LW_POINTS_COORD_MAX, v[0], v[1], v[2]);
   double len = nrm ? sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]) : 1.0;
   if (!(len > 1e-300) || !isfinite(len))
     return lw_error_set(err, LW_EINPUT, "%s%s: expected a normal nx ny nz with a direction, got length %g", path,

@@ -951,11 +951,15 @@ static cairo_status_t png_write(void *closure, const unsigned char *data, unsign
 /* A PNG of the curve (black) and its control polygon (grey) in box b. */
 static lw_status write_png(const lw_nurbs_state *s, const double b[4], const char *path, lw_error *err)
 {
-  double scale = s->su->png_scale;
-  int W = (int)ceil((b[2] - b[0]) * scale), H = (int)ceil((b[3] - b[1]) * scale);
-  if (W < 1 || H < 1 || W > 20000 || H > 20000)
-    return lw_error_set(err, LW_EINPUT, "%s: a picture of %d x %d pixels: change nurbs.png_scale (now %g)", path, W, H,
-                        scale);
+  /* the curve's box at png_scale, its long side capped as the splines'
+  ** previews are: a curve that sagged far must still be drawn */
+  lw_output_page box;
+  lw_output_page_init(&box, b[2] - b[0], b[3] - b[1]);
+  double scale;
+  int W, H;
+  if (!lw_output_png_size(&box, s->su->png_scale, &W, &H, &scale))
+    return lw_error_set(err, LW_ERUN, "%s: the curve's box (%g to %g, %g to %g) cannot be drawn", path, b[0], b[2],
+                        b[1], b[3]);
   cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);
   cairo_t *cr = cairo_create(surf);
   cairo_set_source_rgb(cr, 1, 1, 1);

@@ -40,6 +40,28 @@ Test(nurbs_cli, the_wire_runs_and_resumes_to_the_same_bytes)
   cr_assert_eq(sh("grep -c '^point = ' %s/a/state.lw | grep -q '^7$'", dir), 0);
 }
 
+/* A wire that sags far under a strong load is still drawn: final.png's
+** long side is capped at 4096 pixels (before, the run failed after its
+** last sweep, and every resume failed again). */
+Test(nurbs_cli, a_wire_that_sagged_far_is_drawn_at_a_capped_size)
+{
+  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/s --quiet --set anneal.sweeps=20 --set output.frames_every=0 "
+                  "--set dynamics.gravity_y=-1e5",
+                  lw_test_bin(), lw_test_root(), dir),
+               0);
+  char path[128];
+  snprintf(path, sizeof path, "%s/s/final.png", dir);
+  FILE *f = fopen(path, "rb");
+  cr_assert_not_null(f);
+  unsigned char h[24];
+  cr_assert_eq(fread(h, 1, sizeof h, f), sizeof h);
+  fclose(f);
+  unsigned long w = (unsigned long)h[16] << 24 | h[17] << 16 | h[18] << 8 | h[19];
+  unsigned long t = (unsigned long)h[20] << 24 | h[21] << 16 | h[22] << 8 | h[23];
+  cr_assert(w >= 1 && t >= 1 && (w == 4096 || t == 4096) && w <= 4096 && t <= 4096, "%lu x %lu pixels", w, t);
+  cr_assert_eq(sh("test -s %s/s/summary.json", dir), 0);
+}
+
 Test(nurbs_cli, monte_carlo_anneals_a_rational_curve_and_bounds_its_svg)
 {
   cr_assert_eq(sh("printf '[scene]\\nsystem = nurbs\\n[nurbs]\\norder = 3\\npoints = 2 0 2 2 0 2 -2 2 -2 0\\n"

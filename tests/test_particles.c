@@ -894,6 +894,8 @@ Test(particles, point_files_are_read_and_bad_ones_name_file_line_and_what_was_ex
     {"1 2 nan\n", "bad.xyz:1: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got '1 2 nan'"},
     {"1 2 3 4 5 6 7\n", "bad.xyz:1: expected 3 numbers (x y z) or 6 (x y z nx ny nz), got 7"},
     {"1 2 3 0 0 0\n", "bad.xyz:1: expected a normal nx ny nz with a direction, got length 0"},
+    /* a preview cannot scale a page of 1e300 (before: the run failed at its end) */
+    {"0 0 0\n1e300 0 0\n", "bad.xyz:2: expected coordinates within +-1e+09 (in r0), got (1e+300, 0, 0)"},
     {"# nothing\n\n", "bad.xyz:2: expected at least one point"},
     {NULL, NULL},
   };
@@ -910,7 +912,8 @@ Test(particles, point_files_are_read_and_bad_ones_name_file_line_and_what_was_ex
   strcpy(prm.pt_points, "bad.xyz");
   cr_assert_null(lw_particles_setup_new(&prm, &err));
   cr_assert_eq(err.code, LW_EINPUT);
-  cr_assert(strstr(err.msg, "/bad.xyz:2: expected at least one point"), "%s", err.msg);
+  cr_assert(strstr(err.msg, "key 'particles.points': ") && strstr(err.msg, "/bad.xyz:2: expected at least one point"),
+            "%s", err.msg);
   strcpy(prm.pt_points, "missing.xyz");
   cr_assert_null(lw_particles_setup_new(&prm, &err));
   cr_assert(strstr(err.msg, "missing.xyz: cannot open point file"), "%s", err.msg);

@@ -33,6 +33,10 @@
 #include "linewise/ckpt.h"
 #include "linewise/particles.h"
 
+/* The largest coordinate a point file may give, in r0: the previews and
+** the cell grid need a page that doubles can scale. */
+#define LW_POINTS_COORD_MAX 1e9
+
 /* Reads a point file: *n particles, positions (3n), unit normals (3n;
 ** (0, 0, 1) where a line has none) and has_normal (n), all malloc'ed.
 ** LW_EINPUT with "path:line: ..." for a bad line or an empty file. */
