@@ -499,7 +499,8 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
 
 /* The sweep of the last row within the first `bytes` bytes of the trace
 ** (a run writes one every trace_every sweeps, and one where it ends), or
-** -1 if there is only the header; -2 if it cannot be read. */
+** -1 if there is only the header; -2 if those bytes do not end a line or
+** cannot be read. */
 static long last_row_sweep(const char *path, long bytes)
 {
   enum { TAIL = 1 << 16 };
@@ -507,9 +508,8 @@ static long last_row_sweep(const char *path, long bytes)
   if (!f) return -2;
   long from = bytes > TAIL ? bytes - TAIL : 0, n = bytes - from, sweep = -2;
   char *buf = malloc((size_t)n + 1);
-  if (buf && !fseek(f, from, SEEK_SET) && fread(buf, 1, (size_t)n, f) == (size_t)n) {
-    buf[n] = '\0';
-    if (n > 0 && buf[n - 1] == '\n') buf[--n] = '\0';
+  if (buf && n > 0 && !fseek(f, from, SEEK_SET) && fread(buf, 1, (size_t)n, f) == (size_t)n && buf[n - 1] == '\n') {
+    buf[--n] = '\0';
     char *line = strrchr(buf, '\n');
     if (!line && from == 0) {
       sweep = -1; /* the header alone */
@@ -542,16 +542,15 @@ static lw_status truncate_trace(lw_anneal *a, long bytes, lw_error *err)
     /* the rows the state counts end at its sweep: a state whose sweep was
     ** edited would run sweeps again and write their rows twice */
     long last = last_row_sweep(path, bytes), every = a->params.trace_every;
+    char state[LW_PATH_MAX + 32];
+    dir_file(state, sizeof state, a, "state.lw");
     if (last == -2)
-      return lw_error_set(err, LW_EINPUT, "%s: the last of the rows state.lw counts (%ld bytes) has no sweep", path,
-                          bytes);
-    if (last >= 0 && (last > a->sweep || a->sweep - last >= every)) {
-      char state[LW_PATH_MAX + 32];
-      dir_file(state, sizeof state, a, "state.lw");
+      return lw_error_set(err, LW_EINPUT, "%s: %s counts %ld bytes of it, which do not end a row with its sweep (the "
+                          "state or the trace was edited)", path, state, bytes);
+    if (last >= 0 && (last > a->sweep || a->sweep - last >= every))
       return lw_error_set(err, LW_EINPUT, "%s: the rows %s counts end at sweep %ld, but it is at sweep %ld (a row "
                           "every %ld sweeps): the state or the trace was edited, or is of another run",
                           path, state, last, a->sweep, every);
-    }
     if (truncate(path, bytes)) return lw_error_set(err, LW_EIO, "%s: cannot truncate: %s", path, strerror(errno));
     return open_trace(a, 0, err);
   }

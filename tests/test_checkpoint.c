@@ -112,6 +112,7 @@ Test(checkpoint, every_run_data_value_is_checked_on_resume)
     {"s/^sweep = 20$/sweep = 2/", "[run] sweep: 2 is in the schedule"},
     {"s/^sweep = 20$/sweep = 19/", "counts end at sweep 20, but it is at sweep 19 (a row every 1 sweeps)"},
     {"s/^end_sweep = .*/end_sweep = 19/", "[run] end_sweep: expected a whole number from 20"},
+    {"s/^trace_bytes = .*/trace_bytes = 10/", "counts 10 bytes of it, which do not end a row"},
   };
   stopped_run();
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
