@@ -85,12 +85,20 @@ static void dir_file(char *buf, size_t n, const char *dir, const char *name)
   snprintf(buf, n, "%s/%s", dir, name);
 }
 
-/* The post-pass options of p and sc (the crop rectangle from the picture). */
-static void options(const lw_params *p, const lw_scene *sc, lw_strokes_options *o)
+/* The post-pass options of p and sc (the crop rectangle from the picture);
+** the gaps joined and the paths dropped in widths of each pen's own. */
+static void options(const lw_params *p, const lw_scene *sc, const lw_output_page *page, lw_strokes_options *o)
 {
-  o->join_dist = p->join_distance * p->pen_width;
+  memset(o, 0, sizeof *o);
+  for (int k = 0; k < page->n_pens; k++) {
+    o->join_dist[k] = p->join_distance * page->pen[k].width_mm;
+    o->min_length[k] = p->min_length * page->pen[k].width_mm;
+  }
   o->join_angle = p->join_angle * M_PI / 180.0;
-  o->min_length = p->min_length * p->pen_width;
+  /* the pen starts where the machine's origin is: a machine file's, the
+  ** page's lower-left corner unless the page is turned; else the page's
+  ** top-left corner, where an SVG plotter (AxiDraw) starts */
+  if ((p->gcode || p->hpgl) && !p->plot_turn) o->home_y = page->height_mm;
   o->order = (lw_plot_order)p->order;
   o->crop = p->crop;
   if (sc->image) {
@@ -178,7 +186,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   lw_plot *pl = make_plot(p, sc, sp, tone, err);
   if (!pl) return err ? err->code : LW_ENOMEM;
   lw_strokes_options o;
-  options(p, sc, &o);
+  options(p, sc, &page, &o);
   lw_strokes *st = lw_strokes_prepare(sp, pl, &o, &rep->post, err);
   lw_plot_free(pl);
   if (!st) return err ? err->code : LW_ENOMEM;

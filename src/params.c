@@ -423,7 +423,8 @@ const lw_param_def lw_param_table[] = {
          "Colours of the pens as `#rrggbb` or `#rgb`, one per pen, separated by spaces; empty = all black."),
   CHOICE("output", "order", order, "2opt", "none|greedy|2opt",
          "Order of the paths of each pen in final.svg: index order, greedy nearest neighbour from "
-         "the page origin, or greedy improved by 2-opt and Or-opt moves; paths may be reversed. Reduces pen-up "
+         "home (the page's top-left corner; its lower-left with gcode or hpgl and plot.turn = 0, the "
+         "machine's origin), or greedy improved by 2-opt and Or-opt moves; paths may be reversed. Reduces pen-up "
          "travel (reported in summary.json)."),
   NUM("output", "png_scale", LW_PT_DOUBLE, png_scale, "4", "px/mm", 0, 100, LW_MIN_OPEN,
       "Pixels per millimetre of final.png and the frames (the long side is capped at 4096 px)."),
@@ -456,8 +457,8 @@ const lw_param_def lw_param_table[] = {
       "1 = write field.png at the start of a run: the tone (white without an image) under "
       "short strokes along the field (needs the field term)."),
   NUM("plot", "join_distance", LW_PT_DOUBLE, join_distance, "1", "pen widths", 0, 1000, 0,
-      "Strokes of one pen whose ends lie at most this far apart (in widths of the pen: a gap "
-      "the ink closes anyway) and align within `join_angle` become one path, bridged by a short "
+      "Strokes of one pen whose ends lie at most this far apart (in widths of the pen, with "
+      "layers each its own `layers.pen_width`: a gap the ink closes anyway) and align within `join_angle` become one path, bridged by a short "
       "curve along both tangents: one pen lift fewer. 0 = no joining."),
   NUM("plot", "join_angle", LW_PT_DOUBLE, join_angle, "30", "degrees", 0, 180, 0,
       "Largest turn at a join: between the direction out of the one stroke's end and into the "
@@ -467,7 +468,8 @@ const lw_param_def lw_param_table[] = {
       "inset by scene.margin) and keep the pieces inside, split exactly at the crossing; 0 = "
       "draw strokes as they lie, margins included."),
   NUM("plot", "min_length", LW_PT_DOUBLE, min_length, "3", "pen widths", 0, 1e6, 0,
-      "Paths shorter than this (in widths of the pen), after joining and cropping, are left "
+      "Paths shorter than this (in widths of their pen, as for `join_distance`), after joining "
+      "and cropping, are left "
       "out: below about three widths a stroke prints as a dot and costs a whole pen lift. 0 = "
       "keep all."),
   NUM("plot", "speed_down", LW_PT_DOUBLE, speed_down, "50", "mm/s", 0, 1e5, LW_MIN_OPEN,

@@ -163,10 +163,12 @@ lw_status lw_output_hpgl_strokes(const lw_strokes *s, const lw_output_page *page
   fputs("IN;\nVS", f);
   lw_output_put_fixed(f, fmin(fmax(o->speed_down / 10.0, LW_HPGL_VS_MIN), LW_HPGL_VS_MAX), 2);
   fputs(";\n", f);
-  for (int k = 0; k < s->n_pens; k++) {
-    fprintf(f, "SP%d;\n", k + 1);
+  for (int k = 0, drew = 0; k < s->n_pens; k++) {
     size_t a, z;
     lw_strokes_pen_range(s, k, &a, &z);
+    if (a == z) continue; /* a pen that draws nothing is not asked for */
+    /* pens change at the origin, where the next pen's tour starts */
+    fprintf(f, "%sSP%d;\n", drew++ ? "PU0,0;" : "", k + 1);
     for (size_t j = a; j < z; j++) {
       hpgl_path h = {.f = f};
       walk_path(s, j, page, o, hpgl_point, &h);
@@ -255,17 +257,23 @@ lw_status lw_output_gcode_strokes(const lw_strokes *s, const lw_output_page *pag
   fputs(" x ", f);
   lw_output_put_fixed(f, page->height_mm, LW_OUTPUT_SVG_DECIMALS);
   fputs(o->turn ? " mm turned a quarter turn counterclockwise, origin at its top-left corner, its top edge "
-                  "along y\n; load " : " mm, origin at its lower-left corner, y up\n; load ", f);
-  put_pen(f, page, 0);
+                  "along y\n" : " mm, origin at its lower-left corner, y up\n", f);
+  int first = 0; /* the first pen that draws: a pen that draws nothing is not asked for */
+  while (first + 1 < s->n_pens && s->pen_first[first] == s->pen_first[first + 1]) first++;
+  fputs("; load ", f);
+  put_pen(f, page, first);
   fprintf(f, " before starting\nG21\nG90\n%s\n", o->pen_up);
-  for (int k = 0; k < s->n_pens; k++) {
-    if (k) {
+  for (int k = first; k < s->n_pens; k++) {
+    size_t a, z;
+    lw_strokes_pen_range(s, k, &a, &z);
+    if (a == z) continue;
+    if (k > first) {
+      /* pens change at the origin, where the next pen's tour starts */
+      travel(f, o, 0, 0);
       fputs("; load ", f);
       put_pen(f, page, k);
       fputs(", then resume\nM0\n", f);
     }
-    size_t a, z;
-    lw_strokes_pen_range(s, k, &a, &z);
     for (size_t j = a; j < z; j++) {
       gcode_path g = {.f = f, .o = o};
       walk_path(s, j, page, o, gcode_point, &g);

@@ -424,7 +424,7 @@ done:
   return s;
 }
 
-lw_strokes *lw_strokes_join(const lw_strokes *in, double dist, double angle, lw_strokes_report *rep,
+lw_strokes *lw_strokes_join(const lw_strokes *in, const double *dist, double angle, lw_strokes_report *rep,
                             lw_error *err)
 {
   lw_strokes *out = lw_strokes_new(in->n_pens, err);
@@ -433,10 +433,10 @@ lw_strokes *lw_strokes_join(const lw_strokes *in, double dist, double angle, lw_
   double cos_max = cos(angle) - 1e-12;
   for (int k = 0; k < in->n_pens; k++) {
     size_t a = in->pen_first[k], z = k + 1 < in->n_pens ? in->pen_first[k + 1] : in->n;
-    if (!(dist > 0)) {
+    if (!(dist[k] > 0)) {
       for (size_t j = a; j < z; j++)
         if (copy_path(out, in, j, err)) return fail(out);
-    } else if (join_pen(in, k, a, z - a, dist, cos_max, rep, out, err)) {
+    } else if (join_pen(in, k, a, z - a, dist[k], cos_max, rep, out, err)) {
       return fail(out);
     }
   }
@@ -617,17 +617,18 @@ lw_strokes *lw_strokes_crop(const lw_strokes *in, double x0, double y0, double x
 
 /* ---- drop ---------------------------------------------------------------- */
 
-lw_strokes *lw_strokes_drop(const lw_strokes *in, double min_length, lw_strokes_report *rep, lw_error *err)
+lw_strokes *lw_strokes_drop(const lw_strokes *in, const double *min_length, lw_strokes_report *rep, lw_error *err)
 {
   lw_strokes *out = lw_strokes_new(in->n_pens, err);
   if (!out) return NULL;
-  for (size_t k = 0; k < in->n; k++) {
-    if (min_length > 0 && lw_strokes_length(in, k) < min_length) {
-      rep->dropped++;
-      continue;
+  for (int q = 0; q < in->n_pens; q++)
+    for (size_t k = in->pen_first[q]; k < in->pen_first[q + 1]; k++) {
+      if (min_length[q] > 0 && lw_strokes_length(in, k) < min_length[q]) {
+        rep->dropped++;
+        continue;
+      }
+      if (copy_path(out, in, k, err)) return fail(out);
     }
-    if (copy_path(out, in, k, err)) return fail(out);
-  }
   return out;
 }
 
@@ -651,16 +652,29 @@ lw_status lw_strokes_order(lw_strokes *s, lw_plot_order order, double hx, double
     goto done;
   }
   rep->travel_before = rep->travel_after = 0.0;
+  /* the exits of the last pen that drew, before and after ordering: the
+  ** pen goes home from there to be changed (an empty pen is skipped) */
+  double was[2][2];
+  int drew = 0;
   for (int k = 0; k < s->n_pens; k++) {
     size_t a = s->pen_first[k], z = k + 1 < s->n_pens ? s->pen_first[k + 1] : n;
+    if (a == z) continue;
     for (size_t j = a; j < z; j++) {
       const double *b0 = s->b + 8 * s->first[j], *b1 = s->b + 8 * (s->first[j + 1] - 1);
       path[j - a] = (lw_order_path){b0[0], b0[1], b1[6], b1[7]};
     }
     double before, after;
     if ((st = lw_plot_order_paths(path, z - a, order, hx, hy, tour, rev, &before, &after, err))) goto done;
+    if (drew) {
+      before += hypot(was[0][0] - hx, was[0][1] - hy);
+      after += hypot(was[1][0] - hx, was[1][1] - hy);
+    }
     rep->travel_before += before;
     rep->travel_after += after;
+    const lw_order_path *last = &path[z - a - 1], *end = &path[tour[z - a - 1]];
+    was[0][0] = last->x1, was[0][1] = last->y1;
+    was[1][0] = rev[z - a - 1] ? end->x0 : end->x1, was[1][1] = rev[z - a - 1] ? end->y0 : end->y1;
+    drew = 1;
     for (size_t j = 0; j < z - a; j++) {
       size_t q = a + tour[j];
       if ((st = lw_strokes_add(out, k, s->src[q], s->part[q], rev[j], s->b + 8 * s->first[q],
@@ -689,7 +703,9 @@ lw_strokes *lw_strokes_prepare(const lw_splines *sp, const lw_plot *plot, const 
   lw_strokes *s = lw_strokes_from_plot(sp, plot, err), *t;
   if (!s) return NULL;
   rep->lifts_before = s->n;
-  if (o->join_dist > 0) {
+  int join = 0, drop = 0;
+  for (int k = 0; k < s->n_pens; k++) join |= o->join_dist[k] > 0, drop |= o->min_length[k] > 0;
+  if (join) {
     t = lw_strokes_join(s, o->join_dist, o->join_angle, rep, err);
     lw_strokes_free(s);
     if (!(s = t)) return NULL;
@@ -699,12 +715,12 @@ lw_strokes *lw_strokes_prepare(const lw_splines *sp, const lw_plot *plot, const 
     lw_strokes_free(s);
     if (!(s = t)) return NULL;
   }
-  if (o->min_length > 0) {
+  if (drop) {
     t = lw_strokes_drop(s, o->min_length, rep, err);
     lw_strokes_free(s);
     if (!(s = t)) return NULL;
   }
-  if (lw_strokes_order(s, o->order, 0.0, 0.0, rep, err)) return fail(s);
+  if (lw_strokes_order(s, o->order, o->home_x, o->home_y, rep, err)) return fail(s);
   rep->lifts_after = s->n;
   return s;
 }

@@ -229,7 +229,7 @@ Test(plotter, hpgl_reads_back_to_the_curves_pen_by_pen)
           cr_assert_eq(k, pen + 1, "pens in order");
           pen = k;
         }
-      } else if (!strcmp(ins, "PU")) {
+      } else if (!strcmp(ins, "PU") || !strcmp(ins, "PU0,0")) { /* the way home to change pens */
         continue;
       } else if (!strncmp(ins, "PU", 2)) {
         cr_assert(paths < 3 && pen >= 1);
@@ -326,6 +326,44 @@ Test(plotter, gcode_reads_back_and_moves_the_pen_in_order)
   lw_test_sh("rm -rf %s", dir);
 }
 
+/* Pens that draw nothing (a grey picture's cyan, magenta and yellow) are
+** not asked for: no load, no pause, no SP; each pen that draws is changed
+** at the origin, where its tour starts. */
+Test(plotter, pens_without_paths_are_not_asked_for)
+{
+  char dir[64], path[128];
+  cr_assert_eq(lw_test_dir_make(dir, "plotter"), 0);
+  lw_strokes *s = lw_strokes_new(4, NULL);
+  double line[8] = {10, 10, 20, 10, 30, 10, 40, 10};
+  cr_assert_eq(lw_strokes_add(s, 1, 0, 0, 0, line, 1, NULL), LW_OK);
+  cr_assert_eq(lw_strokes_add(s, 3, 1, 0, 0, line, 1, NULL), LW_OK);
+  lw_output_page page;
+  lw_output_page_init(&page, PAGE_W, PAGE_H);
+  page.n_pens = 4;
+  for (int k = 1; k < 4; k++) page.pen[k] = page.pen[0];
+  lw_plotter_options o = options();
+  o.speed_up = 150;
+  snprintf(path, sizeof path, "%s/final.gcode", dir);
+  cr_assert_eq(lw_output_gcode_strokes(s, &page, &o, path, NULL), LW_OK);
+  char *text = lw_test_slurp("%s", path);
+  cr_assert(strstr(text, "; load pen 2 (") && strstr(text, "before starting\n") && strstr(text, "; load pen 4 (") &&
+                !strstr(text, "pen 1 (") && !strstr(text, "pen 3 ("),
+            "%s", text);
+  size_t pauses = 0;
+  for (const char *c = text; (c = strstr(c, "\nM0\n")); c++) pauses++;
+  cr_assert_eq(pauses, 1, "%s", text);
+  cr_assert(strstr(text, "G0 X0 Y0\n; load pen 4"), "home before the change: %s", text);
+  free(text);
+  snprintf(path, sizeof path, "%s/final.hpgl", dir);
+  cr_assert_eq(lw_output_hpgl_strokes(s, &page, &o, path, NULL), LW_OK);
+  text = lw_test_slurp("%s", path);
+  cr_assert(strstr(text, "\nSP2;\n") && strstr(text, "PU0,0;SP4;\n") && !strstr(text, "SP1") && !strstr(text, "SP3"),
+            "%s", text);
+  free(text);
+  lw_strokes_free(s);
+  lw_test_sh("rm -rf %s", dir);
+}
+
 Test(plotter, bad_options_leave_the_old_file)
 {
   char dir[64], path[128];
@@ -364,10 +402,16 @@ Test(plotter, command_line_writes_the_same_files_for_the_same_seed)
     cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini %s --quiet --out %s/r%d", bin, root, set, dir, r), 0);
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set anneal.sweeps=30 --set output.pens=2 --quiet "
                           "--out %s/plain", bin, root, dir), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini %s --set plot.turn=90 --quiet --out %s/turned", bin, root, set,
+                          dir), 0);
   cr_assert_eq(lw_test_sh("cmp -s %s/r0/final.hpgl %s/r1/final.hpgl && cmp -s %s/r0/final.gcode %s/r1/final.gcode",
                           dir, dir, dir, dir), 0);
-  cr_assert_eq(lw_test_sh("cmp -s %s/r0/final.svg %s/plain/final.svg && test ! -e %s/plain/final.gcode", dir, dir,
-                          dir), 0, "the machine files change nothing else");
+  /* the paths are ordered from the machine's origin: the page's lower-left
+  ** corner, or with the page turned its top-left one, an SVG plotter's */
+  cr_assert_eq(lw_test_sh("cmp -s %s/turned/final.svg %s/plain/final.svg && test ! -e %s/plain/final.gcode", dir, dir,
+                          dir), 0, "the machine files change nothing but where the order starts");
+  cr_assert_eq(lw_test_sh("grep -c '<path' %s/r0/final.svg > %s/n0 && grep -c '<path' %s/plain/final.svg > %s/n1 && "
+                          "cmp -s %s/n0 %s/n1", dir, dir, dir, dir, dir, dir), 0, "the same paths");
   /* one pen-down a path of final.svg, one SP a pen */
   char *svg = lw_test_slurp("%s/r0/final.svg", dir), *gcode = lw_test_slurp("%s/r0/final.gcode", dir),
        *hpgl = lw_test_slurp("%s/r0/final.hpgl", dir);
@@ -375,7 +419,7 @@ Test(plotter, command_line_writes_the_same_files_for_the_same_seed)
   for (const char *c = svg; (c = strstr(c, "<path")); c++) paths++;
   for (const char *c = gcode; (c = strstr(c, "\nG1 Z0 F500\n")); c++) downs++;
   for (const char *c = hpgl; (c = strstr(c, "SP")); c++) sp++;
-  for (const char *c = hpgl; (c = strstr(c, "PU")); c++) pu += c[2] != ';';
+  for (const char *c = hpgl; (c = strstr(c, "PU")); c++) pu += c[2] != ';' && strncmp(c, "PU0,0;SP", 8);
   cr_assert(paths > 5);
   cr_assert_eq(downs, paths);
   cr_assert_eq(pu, paths);
@@ -437,7 +481,8 @@ Test(plotter, a_drawing_past_the_bed_is_refused_and_travel_can_feed)
     resets += !strncmp(l, "G1 X", 4) && strstr(l, " F3000\n") == strchr(l, '\n') - 6;
     rapids += !strncmp(l, "G0 X", 4);
   }
-  cr_assert_eq(travels, s->n + 1, "%s", text);
+  cr_assert_eq(travels, s->n + 1 + (size_t)(s->n_pens - 1), "a travel a path, home, and home at each change: %s",
+               text);
   cr_assert_eq(resets, s->n, "%s", text);
   cr_assert_eq(rapids, 0);
   free(text);

@@ -41,7 +41,7 @@ Test(strokes, joins_close_aligned_ends_and_nothing_else)
   add_line(s, 0, 2, 10.1, 0.05, 10.1, 8); /* C starts near A's end but turns 90 degrees */
   add_line(s, 0, 3, 20.5, 0, 30, 0);    /* D starts 0.5 after B's far end: too far */
   lw_strokes_report rep = {0};
-  lw_strokes *j = lw_strokes_join(s, 0.3, 30 * M_PI / 180, &rep, NULL);
+  lw_strokes *j = lw_strokes_join(s, (const double[]){0.3}, 30 * M_PI / 180, &rep, NULL);
   cr_assert_not_null(j);
   cr_assert_eq(rep.joins, 1);
   cr_assert_eq(j->n, 3, "A+B, C, D");
@@ -61,7 +61,7 @@ Test(strokes, joins_close_aligned_ends_and_nothing_else)
   /* any turn allowed and a wider distance: the nearest ends go first, so
   ** C (0.11 from A's end) takes A's end before B (0.2), and B joins D */
   memset(&rep, 0, sizeof rep);
-  j = lw_strokes_join(s, 0.6, M_PI, &rep, NULL);
+  j = lw_strokes_join(s, (const double[]){0.6}, M_PI, &rep, NULL);
   cr_assert_eq(rep.joins, 2);
   cr_assert_eq(j->n, 2);
   cr_assert_eq(segs(j, 0), 3, "A, a bridge, C");
@@ -82,7 +82,7 @@ Test(strokes, a_ring_of_strokes_joins_into_one_open_path)
   add_line(s, 0, 2, 9.9, 10, 0.1, 10);
   add_line(s, 0, 3, 0, 9.9, 0, 0.1);
   lw_strokes_report rep = {0};
-  lw_strokes *j = lw_strokes_join(s, 0.2, M_PI, &rep, NULL);
+  lw_strokes *j = lw_strokes_join(s, (const double[]){0.2}, M_PI, &rep, NULL);
   cr_assert_eq(rep.joins, 3);
   cr_assert_eq(j->n, 1);
   cr_assert_eq(segs(j, 0), 7, "four sides and three bridges");
@@ -92,7 +92,7 @@ Test(strokes, a_ring_of_strokes_joins_into_one_open_path)
   lw_strokes_free(j);
   /* a 90 degree corner is above the default 30 degrees */
   memset(&rep, 0, sizeof rep);
-  j = lw_strokes_join(s, 0.2, 30 * M_PI / 180, &rep, NULL);
+  j = lw_strokes_join(s, (const double[]){0.2}, 30 * M_PI / 180, &rep, NULL);
   cr_assert_eq(rep.joins, 0);
   cr_assert_eq(j->n, 4);
   lw_strokes_free(j);
@@ -105,10 +105,36 @@ Test(strokes, joins_stay_within_their_pen)
   add_line(s, 0, 0, 0, 0, 10, 0);
   add_line(s, 1, 1, 10.1, 0, 20, 0);
   lw_strokes_report rep = {0};
-  lw_strokes *j = lw_strokes_join(s, 0.3, M_PI, &rep, NULL);
+  lw_strokes *j = lw_strokes_join(s, (const double[]){0.3, 0.3}, M_PI, &rep, NULL);
   cr_assert_eq(rep.joins, 0);
   cr_assert_eq(j->n, 2);
   cr_assert_eq(j->pen_first[1], 1);
+  lw_strokes_free(j);
+  lw_strokes_free(s);
+}
+
+/* Each pen joins the gaps and drops the paths its own width says: a gap of
+** 0.8 mm is closed by a pen of 1 mm and kept by one of 0.3 mm, and a path
+** of 2 mm is short for the wide pen (3 widths) only. */
+Test(strokes, each_pen_joins_and_drops_by_its_own_width)
+{
+  lw_strokes *s = lw_strokes_new(2, NULL);
+  for (int pen = 0; pen < 2; pen++) {
+    const double y = 10.0 * pen;
+    add_line(s, pen, 3 * (size_t)pen, 0, y, 10, y);
+    add_line(s, pen, 3 * (size_t)pen + 1, 10.8, y, 20.8, y);
+    add_line(s, pen, 3 * (size_t)pen + 2, 40, y, 42, y);
+  }
+  const double width[2] = {0.3, 1.0}, join[2] = {width[0], width[1]}, drop[2] = {3 * width[0], 3 * width[1]};
+  lw_strokes_report rep = {0};
+  lw_strokes *j = lw_strokes_join(s, join, M_PI, &rep, NULL);
+  cr_assert_eq(rep.joins, 1);
+  cr_assert(j->n == 5 && j->pen_first[1] == 3, "%zu paths, pen 2 from %zu", j->n, j->pen_first[1]);
+  lw_strokes *d = lw_strokes_drop(j, drop, &rep, NULL);
+  cr_assert_eq(rep.dropped, 1);
+  cr_assert(d->n == 4 && d->pen_first[1] == 3, "%zu paths, pen 2 from %zu", d->n, d->pen_first[1]);
+  cr_assert(fabs(lw_strokes_length(d, 3) - 20.8) < 1e-9, "pen 2's joined path: %g mm", lw_strokes_length(d, 3));
+  lw_strokes_free(d);
   lw_strokes_free(j);
   lw_strokes_free(s);
 }
@@ -121,7 +147,7 @@ Test(strokes, drops_paths_shorter_than_the_minimum)
   add_line(s, 0, 2, 5, 5, 8, 9);
   cr_assert(fabs(lw_strokes_length(s, 2) - 5) < 1e-12);
   lw_strokes_report rep = {0};
-  lw_strokes *d = lw_strokes_drop(s, 1.0, &rep, NULL);
+  lw_strokes *d = lw_strokes_drop(s, (const double[]){1.0}, &rep, NULL);
   cr_assert_eq(rep.dropped, 1);
   cr_assert_eq(d->n, 2);
   cr_assert_eq(d->src[0], 1);
@@ -296,8 +322,8 @@ Test(strokes, prepared_splines_stay_inside_and_keep_their_counts)
                                              len * cos(a) / (3.0 * nseg), len * sin(a) / (3.0 * nseg)};
     }
   }
-  lw_strokes_options o = {.join_dist = 0.3, .join_angle = 30 * M_PI / 180, .crop = 1, .x0 = R[0], .y0 = R[1],
-                          .x1 = R[2], .y1 = R[3], .min_length = 1.0, .order = LW_PLOT_ORDER_2OPT};
+  lw_strokes_options o = {.join_dist = {0.3}, .join_angle = 30 * M_PI / 180, .crop = 1, .x0 = R[0], .y0 = R[1],
+                          .x1 = R[2], .y1 = R[3], .min_length = {1.0}, .order = LW_PLOT_ORDER_2OPT};
   lw_strokes_report rep;
   lw_strokes *s = lw_strokes_prepare(sp, NULL, &o, &rep, NULL);
   cr_assert_not_null(s);
@@ -322,7 +348,7 @@ Test(strokes, prepared_splines_stay_inside_and_keep_their_counts)
   lw_splines_free(sp);
 }
 
-Test(strokes, plot_time_of_a_hand_made_drawing)
+Test(strokes, plot_time_and_travel_of_hand_made_drawings)
 {
   /* two strokes of 30 and 40 mm; unordered from home (0, 0):
   ** travel = |(0,0) - (10,0)| + |(40,0) - (40,10)| = 10 + 10 */
@@ -335,6 +361,15 @@ Test(strokes, plot_time_of_a_hand_made_drawing)
   cr_assert(fabs(lw_strokes_total_length(s) - 70) < 1e-12);
   double t = lw_strokes_time(s, rep.travel_after, 50, 150, 0.2);
   cr_assert(fabs(t - (70 / 50.0 + 20 / 150.0 + 2 * 0.2)) < 1e-12, "%.15g", t);
+  lw_strokes_free(s);
+  /* each pen starts at home, and goes home from the last path of a pen
+  ** that drew to be changed: 1 out, 2 back, 3 out; an empty pen adds nothing */
+  s = lw_strokes_new(3, NULL);
+  add_line(s, 0, 0, 1, 0, 2, 0);
+  add_line(s, 2, 1, 3, 0, 4, 0);
+  cr_assert_eq(lw_strokes_order(s, LW_PLOT_ORDER_NONE, 0, 0, &rep, NULL), LW_OK);
+  cr_assert(fabs(rep.travel_after - 6) < 1e-12 && fabs(rep.travel_before - 6) < 1e-12, "%g %g", rep.travel_before,
+            rep.travel_after);
   lw_strokes_free(s);
 }
 

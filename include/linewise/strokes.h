@@ -78,12 +78,13 @@ typedef struct {
 } lw_strokes_report;
 
 typedef struct {
-  double join_dist;          /* mm; 0 = no joining */
-  double join_angle;         /* radians, 0 .. pi */
-  int crop;                  /* 1 = crop to [x0, x1] x [y0, y1] */
-  double x0, y0, x1, y1;     /* the rectangle, mm */
-  double min_length;         /* mm; 0 = keep all */
+  double join_dist[LW_PLOT_PENS_MAX];  /* per pen, mm; 0 = no joining (a pen's width sets it) */
+  double join_angle;                   /* radians, 0 .. pi */
+  int crop;                            /* 1 = crop to [x0, x1] x [y0, y1] */
+  double x0, y0, x1, y1;               /* the rectangle, mm */
+  double min_length[LW_PLOT_PENS_MAX]; /* per pen, mm; 0 = keep all */
   lw_plot_order order;
+  double home_x, home_y;               /* where each pen starts (the machine's origin), mm */
 } lw_strokes_options;
 
 /* An empty drawing with n_pens pens (1 .. LW_PLOT_PENS_MAX); NULL and err on
@@ -102,18 +103,18 @@ lw_strokes *lw_strokes_from_plot(const lw_splines *sp, const lw_plot *plot, lw_e
 
 /* Steps 1-3 of the post-pass on in (unchanged), into a new drawing; the
 ** report's counts are filled (not the travels). */
-lw_strokes *lw_strokes_join(const lw_strokes *in, double dist, double angle, lw_strokes_report *rep,
+lw_strokes *lw_strokes_join(const lw_strokes *in, const double *dist, double angle, lw_strokes_report *rep,
                             lw_error *err);
 lw_strokes *lw_strokes_crop(const lw_strokes *in, double x0, double y0, double x1, double y1,
                             lw_strokes_report *rep, lw_error *err);
-lw_strokes *lw_strokes_drop(const lw_strokes *in, double min_length, lw_strokes_report *rep, lw_error *err);
+lw_strokes *lw_strokes_drop(const lw_strokes *in, const double *min_length, lw_strokes_report *rep, lw_error *err);
 
 /* Step 4 in place: orders each pen's paths from home (hx, hy) and sets
 ** their directions; rep->travel_before and travel_after are set. */
 lw_status lw_strokes_order(lw_strokes *s, lw_plot_order order, double hx, double hy, lw_strokes_report *rep,
                            lw_error *err);
 
-/* The whole post-pass on the plot's paths, home at the page origin. */
+/* The whole post-pass on the plot's paths. */
 lw_strokes *lw_strokes_prepare(const lw_splines *sp, const lw_plot *plot, const lw_strokes_options *o,
                                lw_strokes_report *rep, lw_error *err);
 
