@@ -942,6 +942,28 @@ static char *read_line(char *str, int num, void *stream)
     rc->failed = 1;
     return NULL;
   }
+  /* a section header is checked where it stands: inih would take "[scene]]"
+  ** or "[scene] x" as [scene], and an unknown section without keys unseen */
+  const char *h = rc->buf + strspn(rc->buf, " \t");
+  if (*h == '[') {
+    size_t n = strcspn(h + 1, "]\r\n");
+    const char *rest = h + 1 + n + (h[1 + n] == ']');
+    rest += strspn(rest, " \t\r\n");
+    char name[64], hint[96];
+    snprintf(name, sizeof name, "%.*s", (int)(n < sizeof name ? n : sizeof name - 1), h + 1);
+    if (h[1 + n] != ']' || (*rest && *rest != ';' && *rest != '#')) {
+      lw_error_set(rc->err, LW_EINPUT, "%s:%d: expected a section header '[name]', got '%.*s'", rc->p->file, rc->line,
+                   (int)strcspn(h, "\r\n"), h);
+      rc->failed = 1;
+      return NULL;
+    }
+    if (n >= sizeof name || !section_known(name)) {
+      suggest_section(name, hint, sizeof hint);
+      lw_error_set(rc->err, LW_EINPUT, "%s:%d: unknown section [%s]%s", rc->p->file, rc->line, name, hint);
+      rc->failed = 1;
+      return NULL;
+    }
+  }
   memcpy(str, rc->buf, (size_t)len + 1);
   return str;
 }
@@ -958,12 +980,7 @@ static int on_key(void *user, const char *section, const char *key, const char *
                  hint);
     return 0;
   }
-  if (!section_known(section)) {
-    suggest_section(section, hint, sizeof hint);
-    lw_error_set(rc->err, LW_EINPUT, "%s:%d: unknown section [%s]%s", rc->p->file, rc->line, section, hint);
-    return 0;
-  }
-  const lw_param_def *d = lw_params_find(section, key);
+  const lw_param_def *d = lw_params_find(section, key); /* the section is known: read_line checked it */
   if (!d) {
     suggest_key(section, key, hint, sizeof hint);
     lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' is not a parameter%s (see docs/PARAMETERS.md)",

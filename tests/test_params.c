@@ -85,13 +85,17 @@ static void expect_error(const char *text, const char *line, const char *key, co
 Test(params, bad_input_names_file_line_and_key)
 {
   expect_error("[scene]\nwidth = 100\nwidht = 3\n", ":3:", "scene.widht", "not a parameter");
-  expect_error("[scenery]\nwidth = 100\n", ":2:", "[scenery]", "unknown section");
+  /* a section header is judged on its own line, keys or none */
+  expect_error("[scenery]\nwidth = 100\n", ":1:", "[scenery]", "unknown section");
+  expect_error("[scene]\nwidth = 100\n[bogus]\n", ":3:", "[bogus]", "unknown section");
+  expect_error("[scene]]\nwidth = 100\n", ":1:", "'[scene]]'", "expected a section header '[name]'");
+  expect_error("[scene] junk\nwidth = 100\n", ":1:", "'[scene] junk'", "expected a section header");
   /* a typo, or a key in the wrong section: the message names the parameter
   ** meant; a name near none names none */
   expect_error("[scene]\nwidht = 3\n", ":2:", "scene.widht", "did you mean 'scene.width'?");
   expect_error("[anneal]\nquadrature = 6\n", ":2:", "anneal.quadrature", "did you mean 'energy.quadrature'?");
   expect_error("[energy]\npair_cuttoff = 2\n", ":2:", NULL, "did you mean 'energy.pair_cutoff'?");
-  expect_error("[scen]\nwidth = 100\n", ":2:", "[scen]", "unknown section [scen]; did you mean [scene]?");
+  expect_error("[scen]\nwidth = 100\n", ":1:", "[scen]", "unknown section [scen]; did you mean [scene]?");
   expect_error("; a scene\nwidth = 100\n[scene]\n", ":2:", "'width'", "before any [section]; did you mean 'scene.width'?");
   for (int k = 0; k < 2; k++) {
     lw_params p;
@@ -113,7 +117,7 @@ Test(params, bad_input_names_file_line_and_key)
   expect_error("[scene]\nboundary = hexagon\n", ":2:", "scene.boundary", "rect|circle|polygon");
   expect_error("[scene]\nwidth = 1\nwidth = 2\n", ":3:", "scene.width", "repeated");
   expect_error("[scene]\nthis line has no equals sign\n", ":2:", NULL, "syntax");
-  expect_error("[scene\nwidth = 1\n", ":1:", NULL, "syntax");
+  expect_error("[scene\nwidth = 1\n", ":1:", NULL, "expected a section header");
 }
 
 Test(params, missing_file_is_input_error)
