@@ -360,6 +360,21 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
   cr_assert_neq(lw_test_sh("ls %s/fz/*.tmp 2>/dev/null | grep -q .", dir), 0, "a temporary file was left behind");
 }
 
+/* A sweep can take minutes (here a billion time steps of the whip): the
+** first SIGINT asks for a stop after it, a second stops the process at
+** once (exit 128 + 2), and the checkpoint state.lw holds still reads.  The
+** signals come a second after the first checkpoint, in the first sweep (in
+** the start-up one alone would stop the run cleanly before it). */
+Test(cli, a_second_signal_stops_at_once_and_leaves_the_checkpoint)
+{
+  cr_assert_eq(lw_test_sh("%s run %s/params/whip.ini --out %s/w --quiet --set dynamics.steps_per_sweep=1000000000 & "
+                          "p=$!; i=0; while [ $i -lt 500 ] && ! test -f %s/w/state.lw; do sleep 0.01; i=$((i+1)); "
+                          "done; sleep 1; kill -INT $p; sleep 0.2; kill -INT $p; wait $p; test $? -eq 130",
+                          lw_test_bin(), lw_test_root(), dir, dir),
+               0);
+  cr_assert_eq(lw_test_sh("%s energy %s/w >/dev/null && ! test -e %s/w/summary.json", lw_test_bin(), dir, dir), 0);
+}
+
 /* A run started without --out goes to out/<scene name>, and when that
 ** holds a run, to the first out/<scene name>-N that does not: the first
 ** drawing is not replaced.  --out names a directory to replace. */
