@@ -82,6 +82,10 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
         return bad(p, "names", err, "expected names of letters, digits, '-', '_' and '.', got '%.*s'", (int)len, c);
     memcpy(ls->spec[n].name, c, len);
     ls->spec[n].name[len] = '\0';
+    /* a name says which pen a layer is: two alike would leave the plotter guessing */
+    for (int q = 0; q < n; q++)
+      if (!strcmp(ls->spec[q].name, ls->spec[n].name))
+        return bad(p, "names", err, "expected names that differ, got '%s' twice", ls->spec[n].name);
     n++;
     c += len;
   }

@@ -8,6 +8,7 @@
 #include <omp.h>
 #include <pthread.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -349,7 +350,12 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_err
       fprintf(stderr, "linewise: quench: energy %.10g -> %.10g, gradient norm %.3g -> %.3g, %ld iterations (%s), %.2f s\n",
               a->quench.energy_before, a->quench.energy_after, a->quench.gradient_before, a->quench.gradient_after,
               a->quench.iterations, lw_quench_end_name(a->quench.ended), a->quench.seconds);
-    fprintf(stderr, "linewise: done: %s/%s, summary.json, trace.csv, state.lw\n", a->dir, a->sys_type->files);
+    /* the plotter's files beside the system's own (the splines' drawing) */
+    const lw_params *p = &a->params;
+    const int plot = drew && !strcmp(a->sys_type->name, "splines");
+    fprintf(stderr, "linewise: done: %s/%s%s%s%s, summary.json, trace.csv, state.lw\n", a->dir, a->sys_type->files,
+            p->pdf && plot ? ", final.pdf" : "", p->hpgl && plot ? ", final.hpgl" : "",
+            p->gcode && plot ? ", final.gcode" : "");
   }
   return 0;
 }
@@ -477,7 +483,12 @@ static int cmd_run(int argc, char **argv)
       if (set_option(&p, v, &err)) return fail(&err);
       i++;
     } else if (!strcmp(argv[i], "--out")) {
-      if (!v || !*v) { lw_error_set(&err, LW_EUSAGE, "--out: expected a directory, got '%s'", v ? v : ""); return fail(&err); }
+      struct stat sb;
+      if (!v || !*v || (stat(v, &sb) == 0 && !S_ISDIR(sb.st_mode))) {
+        lw_error_set(&err, LW_EUSAGE, "--out: expected a directory, got '%s'%s", v ? v : "",
+                     v && *v ? " (a file)" : "");
+        return fail(&err);
+      }
       out = v;
       i++;
     } else if (!strcmp(argv[i], "--seed")) {

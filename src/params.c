@@ -510,7 +510,7 @@ const lw_param_def lw_param_table[] = {
          "that needs 0.2 s to settle. One line of printable ASCII."),
   STRING("layers", "names", ly_names, "", "",
          "Hatching layers or colour pens: one name a layer (letters, digits, `-`, `_`, `.`; it labels "
-         "the pen's SVG layer), separated by blanks (at most 16). Each "
+         "the pen's SVG layer, so no two alike), separated by blanks (at most 16). Each "
          "layer is a pen of its own (one SVG group) with its own target, field, width and colour; "
          "each spline belongs to one, by its index, the layers getting splines in proportion to "
          "the ink of their targets. Needs output.pens = 1 (the layers are the pens). Empty = no "

@@ -463,6 +463,9 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   if (p->field_preview && !sc->on[LW_TERM_FIELD])
     return bad_key(p, "output", "field_preview", LW_EINPUT, err,
                    "the scene has no field to preview (energy.field is 0)");
+  if (p->preview_image && !sc->image)
+    return bad_key(p, "output", "preview_image", LW_EINPUT, err, "the scene has no picture to paint under the lines "
+                   "(scene.image is empty)");
 
   lw_boundary *b = &sc->boundary;
   switch (p->boundary) {

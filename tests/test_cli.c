@@ -299,6 +299,7 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
   static const struct { const char *args, *msg; } bad[] = {
     {"run %s", "cannot read scene file: Is a directory"},
     {"run %s/s.ini --out ''", "--out: expected a directory"},
+    {"run %s/s.ini --out /dev/null", "--out: expected a directory, got '/dev/null' (a file)"},
     {"run %s/s.ini --stop-at 99999999999999999999", "--stop-at: expected a whole number"},
     {"run %s/s.ini --stop-at 0x10", "--stop-at: expected a whole number"},
     {"run %s/s.ini --seed 1e300", "--seed: expected a whole number"},

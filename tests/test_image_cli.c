@@ -230,6 +230,7 @@ Test(image_cli, scene_keys_that_need_a_picture_say_so)
     {"[scene]\nimage = p.png\nmask = alpha\n", "scene.mask"},
     {"[scene]\nmask = image\nboundary = mask\n", "scene.mask"},
     {"[output]\nfield_preview = 1\n", "output.field_preview"},
+    {"[output]\npreview_image = 1\n", "output.preview_image"},
     {"[scene]\nmask = image\nmask_image = nowhere.png\nboundary = mask\n", "scene.mask_image"},
   };
   write_picture("p.png", 20, 16); /* no alpha channel */

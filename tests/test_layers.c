@@ -953,6 +953,7 @@ Test(layers, bad_layer_keys_give_one_line_with_file_line_and_key_and_exit_2)
     {"[layers]\nnames = a b\npen_width = 0.3 -1\n", "scene.ini:10: key 'layers.pen_width': expected values"},
     {"[layers]\nnames = a b\n[output]\npens = 3\n", "scene.ini:11: key 'output.pens': layers set the pens"},
     {"[layers]\nnames = a <b>\n", "scene.ini:9: key 'layers.names': expected names of letters"},
+    {"[layers]\nnames = a b a\n", "scene.ini:9: key 'layers.names': expected names that differ, got 'a' twice"},
     {"[layers]\nnames = ,\n", "scene.ini:9: key 'layers.names': expected at least one name"},
   };
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
