@@ -37,6 +37,8 @@ lw_status lw_boundary_polygon(lw_boundary *b, size_t n, const double *x, const d
     ymax = fmax(ymax, y[i]);
   }
   double w = xmax - xmin, h = ymax - ymin;
+  if (!isfinite(a2) || !isfinite(w * w + h * h))
+    return lw_error_set(err, LW_EINPUT, "polygon of %zu vertices spans %g x %g: its area overflows", n, w, h);
   if (!(fabs(a2) > 1e-12 * (w * w + h * h)))
     return lw_error_set(err, LW_EINPUT, "polygon of %zu vertices has zero area", n);
 

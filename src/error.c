@@ -11,6 +11,10 @@ lw_status lw_error_set(lw_error *err, lw_status code, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(err->msg, sizeof err->msg, fmt, ap);
     va_end(ap);
+    /* a message quotes input, which may be binary: no control character
+    ** reaches the terminal, and the message stays one line */
+    for (char *c = err->msg; *c; c++)
+      if ((unsigned char)*c < 0x20 || *c == 0x7f) *c = '?';
     err->code = code;
   }
   return code;

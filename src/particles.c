@@ -597,6 +597,20 @@ fail:
 
 static int place_outside(const void *setup, const double x[3]) { return lw_particles_outside(setup, x); }
 
+/* A point and its place in the file, ordered by coordinates, x first. */
+typedef struct {
+  double x[3];
+  size_t i;
+} placed_point;
+
+static int by_place(const void *a, const void *b)
+{
+  const placed_point *p = a, *q = b;
+  for (int c = 0; c < 3; c++)
+    if (p->x[c] != q->x[c]) return p->x[c] < q->x[c] ? -1 : 1;
+  return (p->i > q->i) - (p->i < q->i);
+}
+
 lw_status lw_particles_check_start(const lw_particles_setup *s, const char **key, lw_error *err)
 {
   *key = "points";
@@ -606,6 +620,23 @@ lw_status lw_particles_check_start(const lw_particles_setup *s, const char **key
       return lw_error_set(err, LW_EINPUT, "point %zu at (%g, %g, %g) is outside the %s boundary: expected every "
                           "point inside it", i + 1, x[0], x[1], x[2], boundary_name(s));
   }
+  /* a point given twice (a file joined with itself) has an infinite
+  ** repulsion: name the two, which the energy cannot */
+  placed_point *pt = malloc((s->n_points ? s->n_points : 1) * sizeof *pt);
+  if (!pt) return lw_error_set(err, LW_ENOMEM, "out of memory for %zu points", s->n_points);
+  for (size_t i = 0; i < s->n_points; i++) {
+    memcpy(pt[i].x, s->point + 3 * i, sizeof pt[i].x);
+    pt[i].i = i;
+  }
+  qsort(pt, s->n_points, sizeof *pt, by_place);
+  for (size_t k = 1; k < s->n_points; k++)
+    if (pt[k - 1].x[0] == pt[k].x[0] && pt[k - 1].x[1] == pt[k].x[1] && pt[k - 1].x[2] == pt[k].x[2]) {
+      lw_status st = lw_error_set(err, LW_EINPUT, "points %zu and %zu are both at (%g, %g, %g): expected distinct "
+                                  "points", pt[k - 1].i + 1, pt[k].i + 1, pt[k].x[0], pt[k].x[1], pt[k].x[2]);
+      free(pt);
+      return st;
+    }
+  free(pt);
   if (!s->count || s->boundary == LW_PBOUNDARY_NONE) return LW_OK;
   static const char *const name[] = {"cloud", "plane", "sphere"};
   *key = s->boundary == LW_PBOUNDARY_PLANE ? "boundary_z" : "size";

@@ -154,7 +154,8 @@ static lw_status build_mask(lw_scene *sc, const lw_params *p, lw_error *err)
   free(inside);
   lw_image_free(own);
   if (!sc->boundary.sdt)
-    return bad_key(p, "scene", p->mask == LW_MASK_ALPHA ? "mask" : "mask_image", e2.code, err, "%s", e2.msg);
+    return bad_key(p, "scene", p->mask == LW_MASK_ALPHA ? "mask" : "mask_image", e2.code, err, "%s (inside: %s)",
+                   e2.msg, p->mask == LW_MASK_ALPHA ? "alpha at least 1/2" : "opaque, and tone below 1/2");
   return LW_OK;
 }
 
@@ -175,10 +176,20 @@ static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
     double *xs = malloc(n / 2 * sizeof *xs), *ys = malloc(n / 2 * sizeof *ys);
     if (!xs || !ys) st = lw_error_set(err, LW_ENOMEM, "out of memory reading the polygon");
     else {
-      for (size_t i = 0; i < n / 2; i++) { xs[i] = v[2 * i]; ys[i] = v[2 * i + 1]; }
+      double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+      for (size_t i = 0; i < n / 2; i++) {
+        xs[i] = v[2 * i];
+        ys[i] = v[2 * i + 1];
+        lo[0] = fmin(lo[0], xs[i]), hi[0] = fmax(hi[0], xs[i]);
+        lo[1] = fmin(lo[1], ys[i]), hi[1] = fmax(hi[1], ys[i]);
+      }
       lw_error e2;
-      st = lw_boundary_polygon(&sc->boundary, n / 2, xs, ys, &e2);
-      if (st != LW_OK) bad_key(p, "scene", "polygon", st, err, "%s", e2.msg);
+      /* its box must meet the page: a polygon beside it has no room on it */
+      if (!(hi[0] >= 0 && lo[0] <= p->width && hi[1] >= 0 && lo[1] <= p->height))
+        st = bad_key(p, "scene", "polygon", LW_EINPUT, err, "the polygon (x %g to %g, y %g to %g mm) lies off the "
+                     "page of %g x %g mm", lo[0], hi[0], lo[1], hi[1], p->width, p->height);
+      else if ((st = lw_boundary_polygon(&sc->boundary, n / 2, xs, ys, &e2)) != LW_OK)
+        bad_key(p, "scene", "polygon", st, err, "%s", e2.msg);
     }
     free(xs);
     free(ys);

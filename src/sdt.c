@@ -77,7 +77,7 @@ lw_grid2d *lw_sdt_grid(const unsigned char *inside, int w, int h, const lw_image
   size_t count = 0;
   for (size_t k = 0; k < (size_t)w * (size_t)h; k++) count += inside[k] != 0;
   if (!count) {
-    lw_error_set(err, LW_EINPUT, "the mask has no inside (no pixel is opaque and dark)");
+    lw_error_set(err, LW_EINPUT, "the mask has no inside pixel");
     return NULL;
   }
   /* node (i, j) of the padded grid is the centre of pixel (i - 1, j - 1) */

@@ -322,6 +322,12 @@ Test(boundary, invalid_polygons_rejected)
     cr_assert(b.kind == LW_BOUNDARY_RECT && b.x1 == 7 && b.vx == NULL, "case %zu: b untouched",
               k);
   }
+  /* a polygon too large for its area in doubles is named so, not "zero area" */
+  double hugex[3] = {0, 1e200, 0}, hugey[3] = {0, 0, 1e200};
+  lw_boundary h;
+  lw_error e;
+  cr_assert_eq(lw_boundary_polygon(&h, 3, hugex, hugey, &e), LW_EINPUT);
+  cr_assert(strstr(e.msg, "its area overflows"), "%s", e.msg);
   /* the valid triangle, and NULL err */
   lw_boundary b;
   cr_assert_eq(lw_boundary_polygon(&b, 3, x3, y3, NULL), LW_OK);

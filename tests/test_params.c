@@ -177,6 +177,12 @@ Test(params, bad_polygon_and_margin_name_the_key)
   cr_assert(strstr(err.msg, "scene.polygon") && strstr(err.msg, ":3"), "%s", err.msg);
   cr_assert_eq(read_text("[scene]\nboundary = polygon\npolygon = 0 0 10 0 20 0\n", &p, &err), LW_OK);
   cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT, "collinear polygon accepted");
+  cr_assert(strstr(err.msg, "zero area"), "%s", err.msg);
+  cr_assert_eq(read_text("[scene]\nwidth = 100\nheight = 100\nboundary = polygon\npolygon = 200 200 300 200 300 300\n",
+                         &p, &err), LW_OK);
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, ":5: key 'scene.polygon': the polygon (x 200 to 300, y 200 to 300 mm) lies off the page"),
+            "%s", err.msg);
   cr_assert_eq(read_text("[scene]\nwidth = 50\nmargin = 30\n", &p, &err), LW_OK);
   cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT);
   cr_assert(strstr(err.msg, "scene.margin") && strstr(err.msg, ":3"), "%s", err.msg);

@@ -894,6 +894,8 @@ Test(particles, point_files_are_read_and_bad_ones_name_file_line_and_what_was_ex
     {"1 2 nan\n", "bad.xyz:1: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got '1 2 nan'"},
     {"1 2 3 4 5 6 7\n", "bad.xyz:1: expected 3 numbers (x y z) or 6 (x y z nx ny nz), got 7"},
     {"1 2 3 0 0 0\n", "bad.xyz:1: expected a normal nx ny nz with a direction, got length 0"},
+    /* what the message quotes reaches a terminal: no control character */
+    {"1 2 \x1b[2J\n", "bad.xyz:1: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got '1 2 ?[2J'"},
     /* a preview cannot scale a page of 1e300 (before: the run failed at its end) */
     {"0 0 0\n1e300 0 0\n", "bad.xyz:2: expected coordinates within +-1e+09 (in r0), got (1e+300, 0, 0)"},
     {"# nothing\n\n", "bad.xyz:2: expected at least one point"},
@@ -917,6 +919,16 @@ Test(particles, point_files_are_read_and_bad_ones_name_file_line_and_what_was_ex
   strcpy(prm.pt_points, "missing.xyz");
   cr_assert_null(lw_particles_setup_new(&prm, &err));
   cr_assert(strstr(err.msg, "missing.xyz: cannot open point file"), "%s", err.msg);
+  /* a point given twice is named before its infinite repulsion is */
+  write_file("dup.xyz", "0 0 0\n1 0 0\n-0 0 0\n", path, sizeof path);
+  strcpy(prm.pt_points, "dup.xyz");
+  lw_particles_setup *su = lw_particles_setup_new(&prm, &err);
+  cr_assert_not_null(su, "%s", err.msg);
+  const char *key;
+  cr_assert_eq(lw_particles_check_start(su, &key, &err), LW_EINPUT);
+  cr_assert(!strcmp(key, "points") && strstr(err.msg, "points 1 and 3 are both at (-0, 0, 0)"), "%s: %s", key,
+            err.msg);
+  lw_particles_setup_free(su);
 }
 
 Test(particles, bad_keys_name_file_line_and_key)
