@@ -182,11 +182,11 @@ static lw_status set_option(lw_params *p, const char *assignment, lw_error *err)
 
 static volatile sig_atomic_t stop_requested = 0;
 
+static volatile sig_atomic_t on_terminal = 0; /* stderr is one: say what a signal does */
+
 /* The first signal asks for a clean stop after the sweep in progress; a
 ** second ends the process at once (a sweep can take minutes), leaving
 ** the last checkpoint, which state.lw always holds whole. */
-static volatile sig_atomic_t on_terminal = 0; /* stderr is one: say what a signal does */
-
 static void on_signal(int sig)
 {
   static const char first[] = "\nlinewise: stopping after the sweep in progress (a second Ctrl-C stops at once)\n";
@@ -645,8 +645,9 @@ static int wants_help(int argc, char **argv)
 
 /* From the first instruction: SIGINT and SIGTERM ask for a clean stop
 ** (a run started meanwhile finishes its start-up, writes its first
-** checkpoint and stops; a second signal ends it at once), and a file-size limit makes writes fail with EFBIG,
-** reported with the file, instead of killing the process. */
+** checkpoint and stops; a second signal ends it at once), and a file-size
+** limit makes writes fail with EFBIG, reported with the file, instead of
+** killing the process. */
 static void install_signals(void)
 {
   struct sigaction sa;
