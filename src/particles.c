@@ -661,8 +661,9 @@ lw_status lw_particles_check_start(const lw_particles_setup *s, const char **key
   return st;
 }
 
-lw_particles *lw_particles_new(const lw_particles_setup *s, unsigned long seed, lw_error *err)
+lw_particles *lw_particles_new(const lw_particles_setup *s, unsigned long seed, const char **key, lw_error *err)
 {
+  if (key) *key = NULL;
   size_t n = s->n_points + s->count;
   double *x = malloc(3 * n * sizeof *x), *q = malloc(4 * n * sizeof *q);
   unsigned char *pin = calloc(n, 1);
@@ -677,8 +678,10 @@ lw_particles *lw_particles_new(const lw_particles_setup *s, unsigned long seed, 
     pin[i] = s->point_pin[i];
   }
   if (lw_particles_place(s->pattern, s->count, s->size, s->noise, s->normal_noise, 0.5 * s->pair.r0, seed,
-                         place_outside, s, x + 3 * s->n_points, q + 4 * s->n_points, err))
+                         place_outside, s, x + 3 * s->n_points, q + 4 * s->n_points, err)) {
+    if (key && err && err->code == LW_EINPUT) *key = s->boundary == LW_PBOUNDARY_SPHERE ? "boundary_radius" : "boundary_z";
     goto out;
+  }
   p = lw_particles_new_from(s, n, x, q, pin, err);
 out:
   free(x);

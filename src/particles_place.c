@@ -108,6 +108,13 @@ lw_status lw_particles_place(int pattern, size_t count, double size, double nois
         for (int c = 0; c < 3; c++) xk[c] = size * (gsl_rng_uniform(r) - 0.5);
         if ((!outside || !outside(ctx, xk)) && (!g || !crowded(g, x, xk, min_dist))) break;
       }
+      if (outside && outside(ctx, xk)) { /* a crowded place stands; one outside cannot */
+        gsl_rng_free(r);
+        lw_cellgrid_free(g);
+        return lw_error_set(err, LW_EINPUT, "the cloud pattern (a cube of side %g) found no place inside the boundary "
+                            "for particle %zu in %d tries: expected a boundary that holds more of the cube", size,
+                            k + 1, LW_PLACE_TRIES);
+      }
       if (g && lw_cellgrid_insert3(g, (uint32_t)k, xk[0], xk[1], xk[2])) {
         gsl_rng_free(r);
         lw_cellgrid_free(g);

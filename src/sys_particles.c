@@ -42,7 +42,9 @@ static void *state_new(const void *setup, const lw_params *p, unsigned long seed
       if (err->code == LW_EINPUT) lw_params_blame(p, "particles", key, err);
       return NULL;
     }
-    return lw_particles_new(setup, seed, err);
+    lw_particles *pt = lw_particles_new(setup, seed, &key, err);
+    if (!pt && key) lw_params_blame(p, "particles", key, err); /* the pattern found no room */
+    return pt;
   }
   lw_state st;
   lw_particles *s = NULL;

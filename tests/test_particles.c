@@ -413,6 +413,20 @@ Test(particles, gravity_and_boundaries_match_their_closed_forms)
   cr_assert_eq(err.code, LW_EINPUT);
   cr_assert(strstr(err.msg, "outside the sphere boundary"), "%s", err.msg);
   lw_particles_setup_free(s);
+  /* a cloud whose cube the sphere barely meets finds no room: the
+  ** placement says so and names the key (before: "particle 0 ... is
+  ** outside", with no key) */
+  prm.pt_pattern = LW_PPATTERN_CLOUD;
+  prm.pt_count = 13;
+  prm.pt_size = 20;
+  prm.pt_boundary_radius = 0.01;
+  s = setup_of(&prm);
+  const char *key = "unset";
+  cr_assert_null(lw_particles_new(s, 1, &key, &err));
+  cr_assert(err.code == LW_EINPUT && key && !strcmp(key, "boundary_radius") &&
+                strstr(err.msg, "found no place inside the boundary"),
+            "%s: %s", key ? key : "(none)", err.msg);
+  lw_particles_setup_free(s);
 }
 
 Test(particles, energy_is_invariant_under_a_common_rotation_and_translation)
@@ -422,7 +436,7 @@ Test(particles, energy_is_invariant_under_a_common_rotation_and_translation)
   prm.pt_count = 300;
   prm.pt_weight = LW_PWEIGHT_ANISO;
   lw_particles_setup *s = setup_of(&prm);
-  lw_particles *p = lw_particles_new(s, 11, NULL);
+  lw_particles *p = lw_particles_new(s, 11, NULL, NULL);
   cr_assert_not_null(p);
   double before[LW_PTERM_COUNT];
   lw_particles_energy(p, before);
@@ -536,7 +550,7 @@ Test(particles, a_noisy_plane_anneals_flat_at_the_lj_spacing)
   prm.pt_noise = 0.1;
   prm.pt_normal_noise = 10;
   lw_particles_setup *s = setup_of(&prm);
-  lw_particles *p = lw_particles_new(s, 21, NULL);
+  lw_particles *p = lw_particles_new(s, 21, NULL, NULL);
   double c[3], nrm[3];
   cr_assert_gt(fit_plane(p, c, nrm), 0.05, "the start is not flat");
   anneal(p, 5, 3000, 0.01, 1e-6, 3000);
@@ -562,7 +576,7 @@ Test(particles, particles_on_a_sphere_with_radial_normals_have_no_cocircularity)
   prm.pt_noise = 0;
   prm.pt_normal_noise = 0;
   lw_particles_setup *s = setup_of(&prm);
-  lw_particles *p = lw_particles_new(s, 1, NULL);
+  lw_particles *p = lw_particles_new(s, 1, NULL, NULL);
   cr_assert_gt(p->term[LW_PTERM_PLANAR], 1.0);
   cr_assert_lt(fabs(p->term[LW_PTERM_CIRCULAR]), 1e-12, "%g", p->term[LW_PTERM_CIRCULAR]);
   /* and for points drawn at random on a sphere (not a lattice) */
@@ -604,7 +618,7 @@ Test(particles, a_perturbed_sphere_anneals_back)
   prm.pt_noise = 0;
   prm.pt_normal_noise = 0;
   lw_particles_setup *s = setup_of(&prm);
-  lw_particles *p = lw_particles_new(s, 1, NULL);
+  lw_particles *p = lw_particles_new(s, 1, NULL, NULL);
   anneal(p, 3, 0, 0, 0, 1000);
   double mean, worst, R = sphere_metrics(p, &mean, &worst);
   lw_particles *m = perturbed(p, 0.05, 5 * M_PI / 180, 9);
@@ -648,7 +662,7 @@ Test(particles, pinned_particles_stay_and_free_ones_fill_between)
   lw_params prm = rim_scene();
   lw_particles_setup *s = setup_of(&prm);
   cr_assert_eq(s->n_points, 30);
-  lw_particles *p = lw_particles_new(s, 2, NULL);
+  lw_particles *p = lw_particles_new(s, 2, NULL, NULL);
   cr_assert_not_null(p);
   cr_assert_eq(p->n_movable[LW_PMOVE_TRANSLATE], 61);
   size_t turn = 0; /* rim particles given without a normal still turn */
@@ -702,7 +716,7 @@ Test(particles, incremental_equals_full_after_a_million_proposals)
   strcpy(prm.pt_points, path);
   prm.pt_pinned = 1;
   lw_particles_setup *s = setup_of(&prm);
-  lw_particles *p = lw_particles_new(s, 8, NULL);
+  lw_particles *p = lw_particles_new(s, 8, NULL, NULL);
   cr_assert_not_null(p);
   /* the cloud starts at ~3e5 (close pairs) and ends near -500: the running
   ** totals cancel that much and still agree; measured 7e-13 */
@@ -740,7 +754,7 @@ Test(particles, a_seed_fixes_the_run_and_a_copy_runs_on_identically)
   prm.pt_pattern = LW_PPATTERN_CLOUD;
   prm.pt_count = 80;
   lw_particles_setup *s = setup_of(&prm);
-  lw_particles *a = lw_particles_new(s, 4, NULL), *b = lw_particles_new(s, 4, NULL), *c = lw_particles_new(s, 5, NULL);
+  lw_particles *a = lw_particles_new(s, 4, NULL, NULL), *b = lw_particles_new(s, 4, NULL, NULL), *c = lw_particles_new(s, 5, NULL, NULL);
   cr_assert(same_state(a, b));
   cr_assert(!same_state(a, c), "another seed places the particles elsewhere");
   anneal(a, 1, 30, 0.2, 0.2, 0);
@@ -767,7 +781,7 @@ Test(particles, the_section_round_trips_bit_for_bit_and_resumes_identically)
   strcpy(prm.pt_points, path);
   prm.pt_pinned = 1;
   lw_particles_setup *s = setup_of(&prm);
-  lw_particles *p = lw_particles_new(s, 3, NULL);
+  lw_particles *p = lw_particles_new(s, 3, NULL, NULL);
   anneal(p, 1, 20, 0.1, 0.1, 0);
   /* a whole state.lw as the run loop writes it: header, another section
   ** before and after the particles' own */
@@ -981,7 +995,7 @@ Test(particles, bad_keys_name_file_line_and_key)
              "boundary_z = 1\n", path, sizeof path);
   cr_assert_eq(lw_params_read(&prm, path, &err), LW_OK, "%s", err.msg);
   lw_particles_setup *s = setup_of(&prm);
-  lw_particles *p = lw_particles_new(s, 4, &err);
+  lw_particles *p = lw_particles_new(s, 4, NULL, &err);
   cr_assert_not_null(p, "%s", err.msg);
   for (size_t i = 0; i < p->n; i++) cr_assert_gt(p->x[3 * i + 2], 1.0, "particle %zu", i);
   lw_particles_free(p);
@@ -1011,7 +1025,7 @@ Test(particles, the_patterns_place_what_they_promise)
   /* plane: 19 sites = the centred hexagon of radius 2 at the spacing r0 */
   prm.pt_count = 19;
   lw_particles_setup *s = setup_of(&prm);
-  lw_particles *p = lw_particles_new(s, 1, NULL);
+  lw_particles *p = lw_particles_new(s, 1, NULL, NULL);
   double c[3], nrm[3];
   cr_assert_lt(fit_plane(p, c, nrm), 1e-15);
   for (size_t i = 0; i < p->n; i++) {
@@ -1026,7 +1040,7 @@ Test(particles, the_patterns_place_what_they_promise)
   prm.pt_count = 70;
   prm.pt_size = 9;
   s = setup_of(&prm);
-  p = lw_particles_new(s, 1, NULL);
+  p = lw_particles_new(s, 1, NULL, NULL);
   for (size_t i = 0; i < p->n; i++) {
     const double *x = p->x + 3 * i;
     cr_assert(fabs(sqrt(lw_v3_dot(x, x)) - 4.5) < 1e-12);
@@ -1039,7 +1053,7 @@ Test(particles, the_patterns_place_what_they_promise)
   prm.pt_count = 2000;
   prm.pt_size = 12; /* 1.2 per unit volume: dense, yet far below what r0/2 apart allows */
   s = setup_of(&prm);
-  p = lw_particles_new(s, 1, NULL);
+  p = lw_particles_new(s, 1, NULL, NULL);
   double sum[3] = {0, 0, 0}, closest = INFINITY;
   for (size_t i = 0; i < p->n; i++) {
     for (int k = 0; k < 3; k++) {
@@ -1062,7 +1076,7 @@ Test(particles, the_patterns_place_what_they_promise)
   prm.pt_size = 0;
   prm.pt_noise = 0.3;
   s = setup_of(&prm);
-  p = lw_particles_new(s, 1, NULL);
+  p = lw_particles_new(s, 1, NULL, NULL);
   double ss = 0;
   for (size_t i = 0; i < p->n; i++) ss += p->x[3 * i + 2] * p->x[3 * i + 2];
   /* the sd of z estimates 0.3 within 4 sd of the estimate, 1/sqrt(2 n) relative */
@@ -1080,7 +1094,7 @@ Test(particles, pinned_everything_gives_the_identity_move)
   prm.pt_pinned = 1;
   prm.pt_count = 0;
   lw_particles_setup *s = setup_of(&prm);
-  lw_particles *p = lw_particles_new(s, 1, NULL);
+  lw_particles *p = lw_particles_new(s, 1, NULL, NULL);
   cr_assert_eq(lw_particles_sweep_size(p), 0);
   lw_particles_prop *pr = lw_particles_prop_new(p, NULL);
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
@@ -1124,7 +1138,7 @@ Test(particles, final_ply_and_final_png)
   prm.pt_png_size = 200;
   prm.pt_view_elevation = 90; /* from +z: the sheet's normals face the viewer */
   lw_particles_setup *s = setup_of(&prm);
-  lw_particles *p = lw_particles_new(s, 3, NULL);
+  lw_particles *p = lw_particles_new(s, 3, NULL, NULL);
   lw_error err;
   cr_assert_eq(lw_particles_draw(p, dir, &err), LW_OK, "%s", err.msg);
   char path[128];
@@ -1164,7 +1178,7 @@ Test(particles, final_ply_and_final_png)
   /* from below the sheet shows its back: orange */
   prm.pt_view_elevation = -90;
   s = setup_of(&prm);
-  p = lw_particles_new(s, 3, NULL);
+  p = lw_particles_new(s, 3, NULL, NULL);
   cr_assert_eq(lw_particles_write_png(p, path, &err), LW_OK, "%s", err.msg);
   centre_colour(path, 200, &red, &blue);
   cr_assert(red > 0.5 && blue < 0.4, "the back of the sheet is orange (%g, %g)", red, blue);
@@ -1288,7 +1302,7 @@ Test(particles, the_bundled_particle_scenes_read_build_and_anneal)
     cr_assert_eq(lw_params_read(&prm, path, &err), LW_OK, "%s", err.msg);
     cr_assert_str_eq(prm.system, "particles");
     lw_particles_setup *s = setup_of(&prm);
-    lw_particles *p = lw_particles_new(s, (unsigned long)prm.seed, &err);
+    lw_particles *p = lw_particles_new(s, (unsigned long)prm.seed, NULL, &err);
     cr_assert_not_null(p, "%s: %s", names[k], err.msg);
     double e0 = lw_particles_total(p);
     anneal(p, 1, 20, prm.t_start, prm.t_start, 5);
@@ -1303,7 +1317,7 @@ Test(particles, degenerate_draws_give_nan_and_a_turn_without_weights_changes_not
   lw_params prm = scene(1, 0, 0, 0);
   prm.pt_count = 19;
   lw_particles_setup *s = setup_of(&prm);
-  lw_particles *p = lw_particles_new(s, 1, NULL);
+  lw_particles *p = lw_particles_new(s, 1, NULL, NULL);
   lw_particles_prop *pr = lw_particles_prop_new(p, NULL);
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
   int forbidden;
@@ -1356,7 +1370,7 @@ Test(particles, the_gradient_matches_central_differences_of_the_energy)
     prm.pt_boundary_z = -1.5;
     prm.pt_boundary_radius = 5;
     lw_particles_setup *s = setup_of(&prm);
-    lw_particles *p0 = lw_particles_new(s, 40 + (unsigned long)v, NULL);
+    lw_particles *p0 = lw_particles_new(s, 40 + (unsigned long)v, NULL, NULL);
     cr_assert_not_null(p0);
     unsigned char pin[24] = {0};
     pin[3] = LW_PIN_POSITION;
@@ -1417,7 +1431,7 @@ Test(particles, the_quench_and_the_motion_keep_pinned_particles_to_the_bit)
   lw_particles_setup *s = setup_of(&prm);
   for (int driver = 0; driver < 2; driver++) {
     lw_error err;
-    lw_particles *p = lw_particles_new(s, 2, &err);
+    lw_particles *p = lw_particles_new(s, 2, NULL, &err);
     cr_assert_not_null(p, "%s", err.msg);
     double x0[3 * 91], q0[4 * 91];
     memcpy(x0, p->x, sizeof x0);
@@ -1583,7 +1597,7 @@ Test(particles, the_dampers_keep_the_energy_balance_to_second_order_and_the_mome
   for (int run = 0; run < 2; run++) {
     prm.dyn_dt = run ? 0.001 : 0.002;
     lw_error err;
-    lw_particles *p = lw_particles_new(s, 3, &err);
+    lw_particles *p = lw_particles_new(s, 3, NULL, &err);
     cr_assert_not_null(p, "%s", err.msg);
     lw_dynamics *d = lw_dynamics_new(&lw_system_particles, p, &prm, &err);
     cr_assert_not_null(d, "%s", err.msg);
@@ -1662,7 +1676,7 @@ Test(particles, the_pair_dampers_half_steps_make_a_step_of_order_two)
   prm.dyn_dashpot = 4;
   lw_particles_setup *s = setup_of(&prm);
   lw_error err;
-  lw_particles *p = lw_particles_new(s, 3, &err);
+  lw_particles *p = lw_particles_new(s, 3, NULL, &err);
   cr_assert_not_null(p, "%s", err.msg);
   const lw_system_type *t = &lw_system_particles;
   void *mass = t->mass_new(p, &prm, prm.dyn_rho, &err);

@@ -719,7 +719,7 @@ Test(stats, particle_heights_and_normals_follow_the_boltzmann_distribution)
   lw_error err;
   lw_particles_setup *s = lw_particles_setup_new(&prm, &err);
   cr_assert_not_null(s, "%s", err.msg);
-  lw_particles *p = lw_particles_new(s, 17, &err);
+  lw_particles *p = lw_particles_new(s, 17, NULL, &err);
   cr_assert_not_null(p, "%s", err.msg);
   lw_system *sys = lw_system_wrap(&lw_system_particles, p, &err);
   cr_assert_not_null(sys, "%s", err.msg);

@@ -658,7 +658,7 @@ static void bench_particles(bench_ctx *b)
     prm.pt_alpha_c = row[k].alpha[3];
     lw_error err;
     lw_particles_setup *s = lw_particles_setup_new(&prm, &err);
-    lw_particles *p = s ? lw_particles_new(s, 1, &err) : NULL;
+    lw_particles *p = s ? lw_particles_new(s, 1, NULL, &err) : NULL;
     lw_particles_prop *pr = p ? lw_particles_prop_new(p, &err) : NULL;
     gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
     if (!pr || !r) bench_die("particles", &err);

@@ -137,8 +137,10 @@ lw_status lw_particles_check_start(const lw_particles_setup *s, const char **key
 
 /* The initial state: the point file's particles, then `count` placed by the
 ** pattern from an mt19937 stream seeded with seed.  LW_EINPUT when a
-** particle starts outside the boundary or two coincide (infinite energy). */
-lw_particles *lw_particles_new(const lw_particles_setup *s, unsigned long seed, lw_error *err);
+** particle starts outside the boundary or two coincide (infinite energy);
+** *key (may be NULL) names the [particles] key to blame when the pattern
+** found no room inside the boundary, else NULL. */
+lw_particles *lw_particles_new(const lw_particles_setup *s, unsigned long seed, const char **key, lw_error *err);
 
 /* A state of n particles at x (3n) with quaternions q (4n, unit within
 ** 1e-9: they are renormalised) and pin flags (NULL: none pinned).
