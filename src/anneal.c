@@ -475,7 +475,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   dir_file(path, sizeof path, a, "scene.ini");
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
   if (!f) return err->code;
-  fprintf(f, "; resolved parameters of this run (linewise)\n");
+  fprintf(f, "%s\n", LW_RUN_SCENE_HEADER);
   lw_params_write(&a->params, f);
   if ((s = lw_output_commit(f, tmp, path, err))) return s;
   if ((s = open_trace(a, 1, err))) return s;

@@ -443,6 +443,21 @@ static void default_dir(char *dir, size_t size, const char *scene)
 #endif
 }
 
+/* Whether the file's first line is text (and a newline). */
+static int first_line_is(const char *path, const char *text)
+{
+  char line[256];
+  FILE *f = fopen(path, "r");
+  if (!f) return 0;
+  int is = 0;
+  if (fgets(line, sizeof line, f)) {
+    size_t n = strcspn(line, "\r\n");
+    is = line[n] != '\0' && n == strlen(text) && !strncmp(line, text, n);
+  }
+  fclose(f);
+  return is;
+}
+
 static int cmd_run(int argc, char **argv)
 {
   lw_error err;
@@ -506,6 +521,17 @@ static int cmd_run(int argc, char **argv)
   char dir[LW_PATH_MAX];
   if (out) snprintf(dir, sizeof dir, "%s", out);
   else default_dir(dir, sizeof dir, scene);
+  /* the run writes its resolved parameters to DIR/scene.ini: over a run's
+  ** own (a run made again in place), never over a scene file a person wrote */
+  char mine[LW_PATH_MAX + 16];
+  struct stat s1, s2;
+  lw_path_join(mine, sizeof mine, dir, "scene.ini");
+  if (!stat(scene, &s1) && !stat(mine, &s2) && s1.st_dev == s2.st_dev && s1.st_ino == s2.st_ino &&
+      !first_line_is(scene, LW_RUN_SCENE_HEADER)) {
+    lw_error_set(&err, LW_EUSAGE, "--out %s: the run would write its scene.ini over the scene file %s: expected "
+                 "another directory", dir, scene);
+    return fail(&err);
+  }
   static lw_anneal a;
   watcher w;
   if (net && net->rank) quiet = 1;

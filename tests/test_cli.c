@@ -427,6 +427,16 @@ Test(cli, a_run_replacing_another_removes_the_files_it_does_not_write_again)
   /* a refused run leaves the old one whole */
   cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --quiet --out r --set anneal.sweeps=-1 2>/dev/null", dir, b), 2);
   cr_assert_eq(lw_test_sh("test -f %s/r/final.svg && test -f %s/r/summary.json", dir, dir), 0);
+  /* a run made again in place from its own scene.ini is fine; a scene file
+  ** a person wrote is never overwritten by the run's resolved one */
+  cr_assert_eq(lw_test_sh("cd %s && %s run r/scene.ini --quiet --out r --seed 5 && grep -q '^seed = 5' r/scene.ini", dir,
+                          b),
+               0);
+  cr_assert_eq(lw_test_sh("cd %s && mkdir own && cp s.ini own/scene.ini && %s run own/scene.ini --quiet --out own "
+                          "2>err.txt; test $? -eq 2 && grep -q 'over the scene file' err.txt && cmp -s s.ini "
+                          "own/scene.ini",
+                          dir, b),
+               0);
 }
 
 /* The mean and standard error of a column in `linewise stats --csv` output. */

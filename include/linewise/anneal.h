@@ -28,6 +28,9 @@
 #include "linewise/dynamics.h"
 #include "linewise/mc.h"
 #include "linewise/params.h"
+
+/* The first line of a run directory's scene.ini (its resolved parameters). */
+#define LW_RUN_SCENE_HEADER "; resolved parameters of this run (linewise)"
 #include "linewise/quench.h"
 #include "linewise/schedule.h"
 #include "linewise/system.h"
