@@ -274,6 +274,14 @@ lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_repor
   /* the energy and gradient norm of the last iterations, by iteration mod the window */
   double back[LW_QUENCH_WINDOW], back_g[LW_QUENCH_WINDOW], e = NAN, e_start = NAN, gnorm = NAN, step0 = 0.0;
   lw_quench_end end = LW_QUENCH_RUNNING;
+  if (t->minimize) { /* the row's solve moves first: the gradient before the quench is the start's */
+    t->get_coords(sys->state, q.x);
+    if (isnan(e = evaluate(&q, q.x, q.g, err))) {
+      st = err->code;
+      goto out;
+    }
+    r->gradient_before = sqrt(dot(q.g, q.g, n));
+  }
   /* Rounds: the row's own step to the minimum over what it can solve for
   ** (the control points of a D-NURBS curve at its present weights), then
   ** L-BFGS over everything; where that stalls and the row's step still
@@ -292,7 +300,7 @@ lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_repor
     if (round == 0) {
       step0 = first_step(q.x, n);
       e_start = e;
-      r->gradient_before = gnorm;
+      if (!t->minimize) r->gradient_before = gnorm;
     } else if (!(e < e_was - ROUND_GAIN * fabs(e_was))) {
       /* the solve gained nothing: the quench ends where L-BFGS did */
       memcpy(q.x, q.x1, n * sizeof *q.x);
