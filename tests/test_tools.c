@@ -489,6 +489,13 @@ Test(tools, bad_usage_exits_2_with_one_message_and_writes_nothing)
   cr_assert(strstr(errs, "sweep.conf"), "%s", errs);
   free(errs);
   cr_assert_eq(sh("%s --gather-only %s", tool("seed-sweep"), dir), 2, "not a sweep directory");
+  /* every tool: --help prints its usage (exit 0), nothing at all is bad usage (exit 2) */
+  static const char *const all[] = {"seed-sweep", "param-sweep", "plot-run", "plot-sweep", "animate.sh"};
+  for (size_t i = 0; i < sizeof all / sizeof *all; i++) {
+    cr_assert_eq(sh("%s --help > %s/help.txt && grep -q usage %s/help.txt", tool(all[i]), dir, dir), 0, "%s --help",
+                 all[i]);
+    cr_assert_eq(sh("%s", tool(all[i])), 2, "%s without arguments", all[i]);
+  }
 }
 
 /* ---- plots ------------------------------------------------------------ */

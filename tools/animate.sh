@@ -3,7 +3,12 @@
 # RUN_DIR/animation.mp4 (H.264, yuv420p: plays in browsers and players).
 # Needs ffmpeg: `make deps-animation` installs it.
 set -eu
-dir=${1:?usage: tools/animate.sh RUN_DIR [FPS]}
+usage="usage: tools/animate.sh RUN_DIR [FPS]   writes RUN_DIR/animation.mp4 from RUN_DIR/frames"
+case ${1:-} in
+-h | --help) echo "$usage"; exit 0 ;;
+"") echo "$usage" >&2; exit 2 ;;
+esac
+dir=$1
 fps=${2:-25}
 if [ ! -d "$dir/frames" ] || [ -z "$(ls "$dir/frames" 2>/dev/null | grep '^frame-.*\.png$')" ]; then
   echo "animate.sh: $dir/frames has no frames (set output.frames_every in the scene)" >&2
