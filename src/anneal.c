@@ -450,6 +450,15 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
       (s = setup_schedule(a, err)) ||
       (s = setup_system(a, err)))
     return s;
+  const lw_params *rp = &a->params;
+  if (a->n_rep > 1 && rp->tune_ladder == LW_LADDER_EQUAL && rp->ladder_sweeps >= rp->sweeps) {
+    /* (a run of an older release that did so still resumes) */
+    char where[LW_PATH_MAX + 32];
+    lw_params_origin(rp, lw_params_find("tempering", "ladder_sweeps"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder_sweeps': the ladder is tuned for the first "
+                        "ladder_sweeps sweeps, then frozen, and the swap statistics and ladder.ini come after: "
+                        "expected fewer than anneal.sweeps (%d), got %d", where, rp->sweeps, rp->ladder_sweeps);
+  }
   const lw_system_type *t = a->sys_type;
   lw_phase_set("placing the initial state and building its energy");
   void *all[LW_TEMPERING_MAX] = {t->state_new(a->setup, &a->params, lw_stream_seed(a->seed, 0), err)};

@@ -112,8 +112,8 @@ lw_status lw_dyn_review_step(lw_dynamics *d, lw_error *err)
   d->energy = t->gradient(d->state, d->g, err);
   if (err->code) return err->code;
   if (!isfinite(d->energy))
-    return lw_error_set(err, LW_EINPUT, "the motion reached a forbidden state at t = %g s: lower dynamics.dt (now %g s)",
-                        d->time + h, h);
+    return lw_error_set(err, LW_ERUN, "the motion reached a forbidden state at t = %g s: %s", d->time + h,
+                        LW_DYNAMICS_FORBIDDEN_HINT);
   t->mass_apply(d->mass, delta, d->pi);
   for (size_t i = 0; i < n; i++) d->pi[i] /= h;
   hold(d, d->pi);

@@ -227,8 +227,8 @@ static lw_status leapfrog(lw_dynamics *d, lw_error *err)
   if (t->constrain) t->constrain(d->state, x1, pih);
   if ((s = t->mass_at(d->mass, x1, err)) || (s = evaluate(d, x1, err))) return s;
   if (!isfinite(d->energy))
-    return lw_error_set(err, LW_EINPUT, "the motion reached a forbidden state at t = %g s (energy %g: outside the "
-                        "boundary, or a segment irregular): lower dynamics.dt (now %g s)", d->time + h, d->energy, h);
+    return lw_error_set(err, LW_ERUN, "the motion reached a forbidden state at t = %g s (energy %g: outside the "
+                        "boundary, or a segment irregular): %s", d->time + h, d->energy, LW_DYNAMICS_FORBIDDEN_HINT);
   memcpy(d->x, x1, n * sizeof *x1);
   /* pi' = pi+ - h/2 dH/dx(x', pi+) */
   dh_dx(d, d->x, pih, d->u);

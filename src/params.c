@@ -391,7 +391,8 @@ const lw_param_def lw_param_table[] = {
          "fixed keeps the ladder; equal moves the inner rungs toward equal swap acceptance during "
          "the first `ladder_sweeps` sweeps (then the ladder is frozen and swap statistics restart)."),
   NUM("tempering", "ladder_sweeps", LW_PT_INT, ladder_sweeps, "200", "sweeps", 0, 2e9, 0,
-      "Warm-up sweeps of ladder tuning (tune_ladder = equal)."),
+      "Warm-up sweeps of ladder tuning (tune_ladder = equal); fewer than anneal.sweeps, since the "
+      "swap statistics and ladder.ini come after it."),
   NUM("output", "checkpoint_every", LW_PT_INT, checkpoint_every, "100", "sweeps", 1, 2e9, 0,
       "Sweeps between checkpoints of state.lw (also written at the end and on SIGINT/SIGTERM)."),
   NUM("output", "trace_every", LW_PT_INT, trace_every, "1", "sweeps", 1, 2e9, 0,

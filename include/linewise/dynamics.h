@@ -81,6 +81,13 @@ typedef struct {
 ** motion is unstable, its step too long, and it stops. */
 #define LW_DYN_BLOWUP 100.0
 
+/* What a motion that reached a forbidden state (+inf energy) can do: a
+** step too long gets there where a shorter one does not; a motion that
+** gets there at the same time whatever the step goes there itself. */
+#define LW_DYNAMICS_FORBIDDEN_HINT                                                                     \
+  "a shorter dynamics.dt passes it if the step took it there; if the motion stops at the same time " \
+  "whatever the step, it goes there itself (more damping, dynamics.gamma, or stiffer terms hold it)"
+
 /* A driver for `state` (a system of row t) with the [dynamics] parameters;
 ** momenta start at 0.  LW_EINPUT naming the key if the system has no
 ** inertia or gradient, or rho = gamma = 0. */
