@@ -438,14 +438,31 @@ double lw_particles_gradient(const lw_particles *p, double *g, lw_error *err)
   return e;
 }
 
-void lw_particles_constrain(const lw_particles *p, double *c, double *pi)
+void lw_particles_constrain(const lw_particles *p, const double *from, double *c, double *pi)
 {
   for (size_t i = 0; i < p->n; i++) {
     if (p->pin[i] & LW_PIN_ORIENTATION) continue;
-    double *q = c + LW_PARTICLE_COORDS * i + 3;
-    lw_quat_normalise(q);
+    const size_t o = LW_PARTICLE_COORDS * i + 3;
+    const double *q = c ? c + o : from + o;
+    if (c && from) {
+      /* RATTLE: back along the start's q0 (the constraint's normal there),
+      ** q - s q0 with |q - s q0| = 1: the root of s^2 - 2 b s + |q|^2 - 1
+      ** nearer 0, in the form without cancellation */
+      double *u = c + o;
+      const double *q0 = from + o;
+      double b = u[0] * q0[0] + u[1] * q0[1] + u[2] * q0[2] + u[3] * q0[3];
+      double e = u[0] * u[0] + u[1] * u[1] + u[2] * u[2] + u[3] * u[3] - 1.0, disc = b * b - e;
+      if (b > 0.0 && disc >= 0.0) {
+        double sh = e / (b + sqrt(disc));
+        for (int k = 0; k < 4; k++) u[k] -= sh * q0[k];
+      } else {
+        lw_quat_normalise(u); /* a turn of a quarter or more in one step: no such root */
+      }
+    } else if (c) {
+      lw_quat_normalise(c + o);
+    }
     if (!pi) continue;
-    double *m = pi + LW_PARTICLE_COORDS * i + 3;
+    double *m = pi + o;
     double along = m[0] * q[0] + m[1] * q[1] + m[2] * q[2] + m[3] * q[3];
     for (int k = 0; k < 4; k++) m[k] -= along * q[k];
   }

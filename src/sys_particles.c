@@ -359,7 +359,10 @@ static double damp_pairs(const void *state, const void *mass, double h, int reve
   return a.taken;
 }
 
-static void constrain(const void *state, double *x, double *pi) { lw_particles_constrain(state, x, pi); }
+static void constrain(const void *state, const double *from, double *x, double *pi)
+{
+  lw_particles_constrain(state, from, x, pi);
+}
 
 static lw_status save(const void *state, lw_ckpt_writer *w, const char *section, lw_error *err)
 {

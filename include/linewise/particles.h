@@ -252,9 +252,11 @@ lw_status lw_particles_set_coords(lw_particles *p, const double *c, lw_error *er
 /* The total energy and its gradient by the coordinates into g (+inf, g
 ** untouched, in a forbidden state; NAN with err set when memory runs out). */
 double lw_particles_gradient(const lw_particles *p, double *g, lw_error *err);
-/* Unit quaternions in c and, when pi is not NULL, momenta on their tangent
-** (pinned orientations untouched). */
-void lw_particles_constrain(const lw_particles *p, double *c, double *pi);
+/* The row's constrain (system.h): unit quaternions in c (when not NULL),
+** brought back along from's (when not NULL) or by normalising; momenta pi
+** (when not NULL) onto the tangent at c, or at from where c is NULL.
+** Pinned orientations are untouched. */
+void lw_particles_constrain(const lw_particles *p, const double *from, double *c, double *pi);
 /* Calls visit(ctx, i, j, r, d2) for every pair i < j closer than the
 ** range, r = x_j - x_i and d2 = |r|^2: in the order of the energy's sum,
 ** or with reverse = 1 in exactly the reverse order (the dynamics' pair

@@ -268,11 +268,14 @@ struct lw_system_type {
   lw_status (*mass_shift)(void *mass, double a, double b, int *done, lw_error *err);
   void (*mass_shift_solve)(const void *mass, const double *b, double *v);
   /* Optional (NULL: the coordinates are free): brings coordinates x that a
-  ** step left off the system's constraint back onto it, and momenta pi
-  ** (NULL: none) onto its tangent there; for particles, unit quaternions.
-  ** The dynamics calls it on every new position before the state moves
-  ** there, so the state and the driver's coordinates agree bit for bit. */
-  void (*constrain)(const void *state, double *x, double *pi);
+  ** step left off the system's constraint back onto it (for particles,
+  ** unit quaternions): along the constraint's normal at `from`, the step's
+  ** start, where from is given (RATTLE's projection), else by the shortest
+  ** way; and momenta pi (NULL: none) onto its tangent at x (at from where x
+  ** is NULL).  The dynamics calls it on every new position before the
+  ** state moves there, so the state and the driver's coordinates agree bit
+  ** for bit. */
+  void (*constrain)(const void *state, const double *from, double *x, double *pi);
   /* Optional (NULL: none, and a scene that sets dynamics.dashpot or
 ** dashpot_angular is refused): the dampers between neighbours the scene
 ** names, read by mass_new; for particles the seed's beta_1 and beta_3.
