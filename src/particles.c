@@ -696,7 +696,8 @@ lw_particles *lw_particles_new(const lw_particles_setup *s, unsigned long seed, 
   }
   if (lw_particles_place(s->pattern, s->count, s->size, s->noise, s->normal_noise, 0.5 * s->pair.r0, seed,
                          place_outside, s, x + 3 * s->n_points, q + 4 * s->n_points, err)) {
-    if (key && err && err->code == LW_EINPUT) *key = s->boundary == LW_PBOUNDARY_SPHERE ? "boundary_radius" : "boundary_z";
+    if (key && err && err->code == LW_EINPUT)
+      *key = s->boundary == LW_PBOUNDARY_SPHERE ? "boundary_radius" : "boundary_z";
     goto out;
   }
   p = lw_particles_new_from(s, n, x, q, pin, err);
