@@ -522,14 +522,13 @@ static int cmd_run(int argc, char **argv)
   if (out) snprintf(dir, sizeof dir, "%s", out);
   else default_dir(dir, sizeof dir, scene);
   /* the run writes its resolved parameters to DIR/scene.ini: over a run's
-  ** own (a run made again in place), never over a scene file a person wrote */
+  ** (a run made again in place), never over a scene file a person wrote,
+  ** the one this run reads included */
   char mine[LW_PATH_MAX + 16];
-  struct stat s1, s2;
   lw_path_join(mine, sizeof mine, dir, "scene.ini");
-  if (!stat(scene, &s1) && !stat(mine, &s2) && s1.st_dev == s2.st_dev && s1.st_ino == s2.st_ino &&
-      !first_line_is(scene, LW_RUN_SCENE_HEADER)) {
-    lw_error_set(&err, LW_EUSAGE, "--out %s: the run would write its scene.ini over the scene file %s: expected "
-                 "another directory", dir, scene);
+  if (access(mine, F_OK) == 0 && !first_line_is(mine, LW_RUN_SCENE_HEADER)) {
+    lw_error_set(&err, LW_EUSAGE, "--out %s: %s is not a run's (a scene file?) and the run would write over it: "
+                 "expected a run directory or a new one", dir, mine);
     return fail(&err);
   }
   static lw_anneal a;

@@ -436,7 +436,7 @@ Test(cli, a_run_replacing_another_removes_the_files_it_does_not_write_again)
                           b),
                0);
   cr_assert_eq(lw_test_sh("cd %s && mkdir own && cp s.ini own/scene.ini && %s run own/scene.ini --quiet --out own "
-                          "2>err.txt; test $? -eq 2 && grep -q 'over the scene file' err.txt && cmp -s s.ini "
+                          "2>err.txt; test $? -eq 2 && grep -q 'is not a run.s (a scene file?)' err.txt && cmp -s s.ini "
                           "own/scene.ini",
                           dir, b),
                0);
