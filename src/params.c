@@ -459,7 +459,8 @@ const lw_param_def lw_param_table[] = {
       "short strokes along the field (needs the field term)."),
   NUM("plot", "join_distance", LW_PT_DOUBLE, join_distance, "1", "pen widths", 0, 1000, 0,
       "Strokes of one pen whose ends lie at most this far apart (in widths of the pen, with "
-      "layers each its own `layers.pen_width`: a gap the ink closes anyway) and align within `join_angle` become one path, bridged by a short "
+      "layers each its own `layers.pen_width`: a gap the ink closes anyway) and align within "
+      "`join_angle` become one path, bridged by a short "
       "curve along both tangents: one pen lift fewer. 0 = no joining."),
   NUM("plot", "join_angle", LW_PT_DOUBLE, join_angle, "30", "degrees", 0, 180, 0,
       "Largest turn at a join: between the direction out of the one stroke's end and into the "
@@ -1355,6 +1356,7 @@ void lw_params_write_doc(FILE *f)
       section = d->section;
     }
     static const char *const type_name[] = {"number", "integer", "integer", "choice", "text"};
+    _Static_assert(LW_PT_STRING == 4, "type_name follows lw_param_type");
     const char *type = type_name[d->type];
     if (d->type == LW_PT_CHOICE) snprintf(range, sizeof range, "%s", d->choices);
     else if (d->type == LW_PT_STRING) snprintf(range, sizeof range, "-");

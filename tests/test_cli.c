@@ -432,12 +432,12 @@ Test(cli, a_run_replacing_another_removes_the_files_it_does_not_write_again)
   cr_assert_eq(lw_test_sh("test -f %s/r/final.svg && test -f %s/r/summary.json", dir, dir), 0);
   /* a run made again in place from its own scene.ini is fine; a scene file
   ** a person wrote is never overwritten by the run's resolved one */
-  cr_assert_eq(lw_test_sh("cd %s && %s run r/scene.ini --quiet --out r --seed 5 && grep -q '^seed = 5' r/scene.ini", dir,
-                          b),
+  cr_assert_eq(lw_test_sh("cd %s && %s run r/scene.ini --quiet --out r --seed 5 && grep -q '^seed = 5' "
+                          "r/scene.ini", dir, b),
                0);
   cr_assert_eq(lw_test_sh("cd %s && mkdir own && cp s.ini own/scene.ini && %s run own/scene.ini --quiet --out own "
-                          "2>err.txt; test $? -eq 2 && grep -q 'is not a run.s (a scene file?)' err.txt && cmp -s s.ini "
-                          "own/scene.ini",
+                          "2>err.txt; test $? -eq 2 && grep -q 'is not a run.s (a scene file?)' err.txt && "
+                          "cmp -s s.ini own/scene.ini",
                           dir, b),
                0);
 }

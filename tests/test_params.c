@@ -51,7 +51,9 @@ Test(params, defaults_cover_every_key_and_read_back)
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
     const char *a = (const char *)&p + d->offset, *b = (const char *)&q + d->offset;
-    size_t n = d->type == LW_PT_DOUBLE || d->type == LW_PT_WHOLE ? sizeof(double) : d->type == LW_PT_STRING ? d->size : sizeof(int);
+    size_t n = d->type == LW_PT_DOUBLE || d->type == LW_PT_WHOLE ? sizeof(double)
+               : d->type == LW_PT_STRING                            ? d->size
+                                                                    : sizeof(int);
     cr_assert(!memcmp(a, b, n), "%s.%s differs after a round trip", d->section, d->key);
   }
 }

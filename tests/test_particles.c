@@ -754,7 +754,8 @@ Test(particles, a_seed_fixes_the_run_and_a_copy_runs_on_identically)
   prm.pt_pattern = LW_PPATTERN_CLOUD;
   prm.pt_count = 80;
   lw_particles_setup *s = setup_of(&prm);
-  lw_particles *a = lw_particles_new(s, 4, NULL, NULL), *b = lw_particles_new(s, 4, NULL, NULL), *c = lw_particles_new(s, 5, NULL, NULL);
+  lw_particles *a = lw_particles_new(s, 4, NULL, NULL), *b = lw_particles_new(s, 4, NULL, NULL),
+               *c = lw_particles_new(s, 5, NULL, NULL);
   cr_assert(same_state(a, b));
   cr_assert(!same_state(a, c), "another seed places the particles elsewhere");
   anneal(a, 1, 30, 0.2, 0.2, 0);
