@@ -239,6 +239,7 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
         return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected increasing positive "
                             "temperatures, got '%s'", where, p->ladder);
     a->n_rep = n;
+    a->params.replicas = n; /* scene.ini says how many rungs ran */
   } else if (a->n_rep > 1) {
     lw_params_origin(p, lw_params_find("tempering", "t_max"), where, sizeof where);
     if (!(p->t_max > p->t_min))
@@ -266,6 +267,78 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
   if (a->n_rep > 1 && !(p->t_start > 0.0))
     return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.t_start': parallel tempering scales the ladder by "
                         "T(step) / t_start, so t_start must be > 0", where);
+  return LW_OK;
+}
+
+/* What each driver reads of a scene besides its system's keys (system.h,
+** keys): the same run keys for both; Monte Carlo its schedule, its ladder and
+** its tuning, and no time step; the dynamics its time step and damping, and
+** no [moves] (a row's [moves] keys count only under Monte Carlo). */
+#define RUN_KEYS "scene.system", "scene.driver", "anneal.sweeps", "anneal.seed", "anneal.check_every", \
+    "anneal.quench", "anneal.quench_tol", "anneal.quench_iterations", "anneal.quench_stall", \
+    "output.checkpoint_every", "output.trace_every", "output.observables", "output.samples_every", \
+    "output.stats_from", "output.frames_every"
+static const char *const metropolis_keys[] = {RUN_KEYS, "anneal.*", "tempering.*", "moves.tune_sweeps", NULL};
+static const char *const dynamics_keys[] = {RUN_KEYS, "dynamics.dt", "dynamics.gamma", "dynamics.steps_per_sweep",
+                                            "dynamics.integrator", NULL};
+static const char *const dynamics_skips[] = {"moves.*", NULL};
+static const char *const driver_names[] = {"metropolis", "dynamics"};
+
+/* Whether a scene of system t under driver (LW_DRIVER_*) reads key d. */
+static int key_read(const lw_system_type *t, int driver, const lw_param_def *d)
+{
+  if (driver == LW_DRIVER_DYNAMICS)
+    return lw_params_named(dynamics_keys, d) || (lw_params_named(t->keys, d) && !lw_params_named(dynamics_skips, d)) ||
+           lw_params_named(t->keys_dynamics, d);
+  return lw_params_named(metropolis_keys, d) || lw_params_named(t->keys, d);
+}
+
+void lw_anneal_key_readers(const lw_param_def *d, char *buf, size_t n)
+{
+  char sys[2][128] = {"", ""};
+  int all[2] = {1, 1};
+  for (int v = 0; v < 2; v++)
+    for (int k = 0; lw_system_types[k]; k++) {
+      const lw_system_type *t = lw_system_types[k];
+      size_t m = strlen(sys[v]);
+      if (key_read(t, v, d)) snprintf(sys[v] + m, sizeof sys[v] - m, "%s%s", m ? ", " : "", t->name);
+      else all[v] = 0;
+    }
+  for (int v = 0; v < 2; v++)
+    if (all[v]) snprintf(sys[v], sizeof sys[v], "all");
+  if (!strcmp(sys[0], sys[1])) snprintf(buf, n, "%s", sys[0]);
+  else if (!sys[0][0] || !sys[1][0]) snprintf(buf, n, "%s under %s", sys[!sys[0][0]], driver_names[!sys[0][0]]);
+  else snprintf(buf, n, "%s under %s; %s under %s", sys[0], driver_names[0], sys[1], driver_names[1]);
+}
+
+/* A key the scene sets that its system reads under neither driver would
+** change nothing: refused, with the scenes that read it.  One that only the
+** other driver reads is noted (a->unread): one scene file may serve both
+** drivers of its system (--set scene.driver).  A run's own scene.ini
+** writes every key, unread ones at their defaults. */
+static lw_status check_keys_read(lw_anneal *a, lw_error *err)
+{
+  const lw_params *p = &a->params;
+  const lw_system_type *t = lw_system_of(p, err);
+  if (!t) return err->code;
+  size_t m = 0;
+  a->unread[0] = '\0';
+  for (size_t i = 0; i < lw_param_count; i++) {
+    const lw_param_def *d = &lw_param_table[i];
+    if (!lw_params_given(p, d) || key_read(t, p->driver, d)) continue;
+    char where[LW_PATH_MAX + 32], readers[300];
+    lw_params_origin(p, d, where, sizeof where);
+    if (key_read(t, !p->driver, d)) {
+      if (m < sizeof a->unread)
+        m += (size_t)snprintf(a->unread + m, sizeof a->unread - m, "%s%s.%s (%s)", m ? ", " : "", d->section,
+                              d->key, where);
+      continue;
+    }
+    lw_anneal_key_readers(d, readers, sizeof readers);
+    return lw_error_set(err, LW_EINPUT, "%s: key '%s.%s': the %s system reads it under neither driver (read by: "
+                        "%s); expected no line, or the default '%s'", where, d->section, d->key, t->name, readers,
+                        d->def);
+  }
   return LW_OK;
 }
 
@@ -447,7 +520,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   double ladder[LW_TEMPERING_MAX];
   lw_phase_set("setting up the scene");
   if ((s = lw_params_resolve(&a->params, err)) || (s = setup_ladder(a, ladder, err)) ||
-      (s = setup_schedule(a, err)) ||
+      (s = check_keys_read(a, err)) || (s = setup_schedule(a, err)) ||
       (s = setup_system(a, err)))
     return s;
   const lw_params *rp = &a->params;
@@ -472,6 +545,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   if ((s = build(a, all, ladder, err)) || (s = check_quench(a, err))) return s;
   a->energy_initial = lw_system_total(a->sys);
   a->end_sweep = a->params.sweeps; /* resolved: the caller's p may not be (a preset's sweeps) */
+  a->scene_hash = lw_params_run_hash(&a->params);
   /* Everything above only read input: the directory appears once the run
   ** is known to be valid. */
   if ((s = make_dir(dir, err))) return s;
@@ -646,7 +720,8 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);
   double ladder[LW_TEMPERING_MAX];
   long trace_bytes = -1;
-  if ((s = lw_params_read_run(&a->params, scene_path, err)) || (s = setup_ladder(a, ladder, err)) ||
+  if (!(s = lw_params_read_run(&a->params, scene_path, err))) a->scene_hash = lw_params_run_hash(&a->params);
+  if (s || (s = setup_ladder(a, ladder, err)) ||
       (s = setup_schedule(a, err)) || (s = setup_system(a, err)))
     goto out;
   a->seed = st.seed;
@@ -674,16 +749,21 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
       a->wall_before = 0;
     fclose(tf);
   }
+  if (a->end_sweep < 0) a->end_sweep = a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep;
+  const long saved_end = a->end_sweep;
   if (more >= 0) a->end_sweep = a->sweep + more;
-  else if (a->end_sweep < 0) a->end_sweep = a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep;
-  for (int k = 0; k < a->chain->n_moves; k++) a->proposals_before += a->chain->stats[k].proposed;
   if (writes_files(a)) s = truncate_trace(a, trace_bytes, err);
   if (!s && writes_files(a) && !lw_anneal_done(a)) {
+    /* a new end goes into state.lw at once, or a kill before the first
+    ** checkpoint would leave the old one; this process holds every replica
+    ** as read, so it writes them alone */
+    if (a->end_sweep != saved_end) s = lw_checkpoint_write(a, err);
     /* a finished run extended by --sweeps is no longer finished: its
     ** summary would describe a state that is gone (studies take a
     ** summary.json as the sign of a finished run) */
     dir_file(path, sizeof path, a, "summary.json");
-    if (unlink(path) && errno != ENOENT) s = lw_error_set(err, LW_EIO, "%s: cannot remove: %s", path, strerror(errno));
+    if (!s && unlink(path) && errno != ENOENT)
+      s = lw_error_set(err, LW_EIO, "%s: cannot remove: %s", path, strerror(errno));
   }
 out:
   lw_phase_set(NULL);
@@ -1055,9 +1135,8 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   put_per_move(&j, "rejected_irregular", c, t, offsetof(lw_move_stats, irregular));
   put_per_move(&j, "rejected_crowded", c, t, offsetof(lw_move_stats, crowded));
   lw_json_key(&j, "wall_seconds"); lw_json_number(&j, wall);
-  double here = now_seconds() - a->wall_start;
-  lw_json_key(&j, "proposals_per_second");
-  lw_json_number(&j, here > 0 ? (double)(prop - a->proposals_before) / here : 0.0);
+  lw_json_key(&j, "proposals_per_second"); /* of the whole run, as wall_seconds */
+  lw_json_number(&j, wall > 0 ? (double)prop / wall : 0.0);
   lw_json_key(&j, "max_relative_drift"); lw_json_number(&j, a->max_drift);
   lw_json_key(&j, "temperature_final"); lw_json_number(&j, c->temperature);
   lw_json_key(&j, "schedule"); lw_json_string(&j, a->sched_type->name);

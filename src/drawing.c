@@ -99,6 +99,7 @@ static void options(const lw_params *p, const lw_scene *sc, const lw_output_page
   ** page's lower-left corner unless the page is turned; else the page's
   ** top-left corner, where an SVG plotter (AxiDraw) starts */
   if ((p->gcode || p->hpgl) && !p->plot_turn) o->home_y = page->height_mm;
+  o->home_back = p->gcode || p->hpgl; /* both files end at home */
   o->order = (lw_plot_order)p->order;
   o->crop = p->crop;
   if (sc->image) {
@@ -366,9 +367,13 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
                    d->travel_after, clock, d->time_s, d->pen_down_mm, r->lifts_after, d->close_share);
   if (w < 0 || (size_t)w >= n) return;
   k = (size_t)w;
+  if (!d->paths) {
+    w = snprintf(buf + k, n - k, "linewise: the drawing is empty: final.svg has no path\n");
+    if (w < 0 || (k += (size_t)w) >= n) return;
+  }
   /* a colour pen whose separation is empty (a warm picture's cyan) still has
   ** its layer in final.svg: say so, so that no pen is changed for nothing */
-  for (int p = 0; d->n_pens > 1 && p < d->n_pens; p++) {
+  for (int p = 0; d->n_pens > 1 && d->paths && p < d->n_pens; p++) {
     if (d->pen_paths[p]) continue;
     w = snprintf(buf + k, n - k, "linewise: pen %d draws nothing (its layer in final.svg is empty)\n", p + 1);
     if (w < 0 || (k += (size_t)w) >= n) return;

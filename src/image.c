@@ -586,8 +586,8 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
   if (st) return st;
   int w, h, ch;
   if (!stbi_info_from_memory(data, (int)size, &w, &h, &ch))
-    return lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, PGM/PPM): %s", name,
-                        stbi_failure_reason());
+    return lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, binary PGM/PPM): %s",
+                        name, stbi_failure_reason());
   if (w < 1 || h < 1) /* stb_image passes a BMP of width 0 */
     return lw_error_set(err, LW_EINPUT, "%s: the %s is damaged: %d x %d pixels", name, format_name(data, size), w, h);
   if ((double)w * (double)h > LW_IMAGE_MAX_PIXELS)
@@ -743,8 +743,8 @@ lw_status lw_image_probe(const char *path, lw_image_info *info, lw_error *err)
     if (st)
       ; /* refused before stb_image reads it */
     else if (size == 0 || size > INT_MAX || !stbi_info_from_memory(data, (int)size, &iw, &ih, &ch))
-      st = lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, PGM/PPM): %s", path,
-                        size == 0 ? "empty file" : stbi_failure_reason());
+      st = lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, binary PGM/PPM): %s",
+                        path, size == 0 ? "empty file" : stbi_failure_reason());
     else if (iw < 1 || ih < 1)
       st = lw_error_set(err, LW_EINPUT, "%s: the %s is damaged: %d x %d pixels", path, format_name(data, size), iw, ih);
     else if (jpeg_orientation(data, size) >= 5) /* stored on its side */

@@ -45,7 +45,8 @@ static const char usage[] =
   "                          out/<scene name>, or the first free out/<scene name>-N)\n"
   "      --set SEC.KEY=VAL   override a scene parameter (repeatable)\n"
   "      --seed N            override anneal.seed\n"
-  "      --stop-at N         stop cleanly after sweep N, as if interrupted\n"
+  "      --stop-at N         stop cleanly after sweep N, as if interrupted (0: after the\n"
+  "                          set-up; resume refuses a sweep the run has passed)\n"
   "      --threads N         OpenMP threads: the replicas of parallel tempering, then\n"
   "                          anneal.domains (default OMP_NUM_THREADS or all cores;\n"
   "                          results never depend on it)\n"
@@ -302,13 +303,17 @@ static int watched_fail(watcher *w, const lw_error *err)
   return fail(err);
 }
 
-static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_error *err)
+/* quiet: nothing on stderr but errors (--quiet, or a process of an MPI run
+** other than the first); asked: --quiet itself.  The process that draws
+** tells what it drew unless --quiet, whichever it is. */
+static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher *w, lw_error *err)
 {
   a->stop = &stop_requested;
   progress pg = {quiet, isatty(2), a->sweep, a->sweep, -1, lw_anneal_seconds(a)};
   /* a signal during start-up stops before the first sweep; the processes
   ** of an MPI run stop together, at the sweep where one of them was asked */
-  int stopped = (net ? net->stop_agreed : stop_requested) && !lw_anneal_done(a);
+  int stopped = ((net ? net->stop_agreed : stop_requested) || (stop_at >= 0 && a->sweep >= stop_at)) &&
+                !lw_anneal_done(a);
   while (!stopped && !lw_anneal_done(a)) {
     if (lw_anneal_sweep(a, err)) return watched_fail(w, err);
     progress_show(&pg, a, 0);
@@ -342,17 +347,20 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, watcher *w, lw_err
               "%s' quenches again)\n", a->dir, a->dir);
     return 0;
   }
-  if (!quiet) {
+  if (drew && !asked) {
     char drawn[4096]; /* up to two lines a pen of a drawing of 16 (LW_PLOT_PENS_MAX) */
-    if (drew) a->sys_type->describe(a->sys->state, LW_DESCRIBE_DRAWING, drawn, sizeof drawn);
-    if (drew) fprintf(stderr, "%s", drawn);
+    a->sys_type->describe(a->sys->state, LW_DESCRIBE_DRAWING, drawn, sizeof drawn);
+    fprintf(stderr, "%s", drawn);
+  }
+  if (!quiet) {
     if (a->quenched)
       fprintf(stderr, "linewise: quench: energy %.10g -> %.10g, gradient norm %.3g -> %.3g, %ld iterations (%s), %.2f s\n",
               a->quench.energy_before, a->quench.energy_after, a->quench.gradient_before, a->quench.gradient_after,
               a->quench.iterations, lw_quench_end_name(a->quench.ended), a->quench.seconds);
-    /* the plotter's files beside the system's own (the splines' drawing) */
+    /* the plotter's files beside the system's own (the splines' drawing,
+    ** whichever process drew it) */
     const lw_params *p = &a->params;
-    const int plot = drew && !strcmp(a->sys_type->name, "splines");
+    const int plot = !strcmp(a->sys_type->name, "splines");
     fprintf(stderr, "linewise: done: %s/%s%s%s%s, summary.json, trace.csv, state.lw\n", a->dir, a->sys_type->files,
             p->pdf && plot ? ", final.pdf" : "", p->hpgl && plot ? ", final.hpgl" : "",
             p->gcode && plot ? ", final.gcode" : "");
@@ -409,6 +417,9 @@ static lw_status spread_start(lw_status s, lw_anneal *a, int fresh, lw_error *er
   if (!net) return s;
   if ((s = lw_mpi_agree(net, s, err))) return s;
   started = 1;
+  /* every process holds every replica as placed or read, so the totals a
+  ** run with no sweep left reads (its summary) are known before any share() */
+  for (int r = 0; r < a->n_rep; r++) net->energy[r] = lw_system_total(a->systems[r]);
   if (fresh) s = lw_anneal_checkpoint(a, err);
 #endif
   return s;
@@ -533,6 +544,7 @@ static int cmd_run(int argc, char **argv)
   }
   static lw_anneal a;
   watcher w;
+  const int asked = quiet;
   if (net && net->rank) quiet = 1;
   watcher_start(&w, quiet);
   if (spread_start(lw_anneal_start_net(&a, &p, dir, net, &err), &a, 1, &err)) {
@@ -544,11 +556,14 @@ static int cmd_run(int argc, char **argv)
     char size[128];
     a.sys_type->describe(a.sys->state, LW_DESCRIBE_SIZE, size, sizeof size);
     if (note[0]) fprintf(stderr, "linewise: note: %s\n", note);
+    if (a.unread[0])
+      fprintf(stderr, "linewise: note: under driver = %s these keys have no effect: %s\n",
+              a.params.driver == LW_DRIVER_DYNAMICS ? "dynamics" : "metropolis", a.unread);
     fprintf(stderr, "linewise: scene %s, seed %lu, %s, into %s\n", scene, a.seed, size, dir);
     fprintf(stderr, "linewise: resolved parameters:\n");
     lw_params_write(&a.params, stderr);
   }
-  int rc = anneal_loop(&a, stop_at, quiet, &w, &err);
+  int rc = anneal_loop(&a, stop_at, quiet, asked, &w, &err);
   lw_anneal_free(&a);
   return rc;
 }
@@ -581,14 +596,21 @@ static int cmd_resume(int argc, char **argv)
   }
   static lw_anneal a;
   watcher w;
+  const int asked = quiet;
   if (net && net->rank) quiet = 1;
   watcher_start(&w, quiet);
   if (spread_start(lw_anneal_resume_net(&a, dir, more, net, &err), &a, 0, &err)) {
     lw_anneal_free(&a);
     return watched_fail(&w, &err);
   }
+  if (stop_at >= 0 && stop_at < a.sweep) {
+    lw_error_set(&err, LW_EUSAGE, "--stop-at %ld: the run in %s stands at sweep %ld already; expected %ld or more",
+                 stop_at, dir, a.sweep, a.sweep);
+    lw_anneal_free(&a);
+    return watched_fail(&w, &err);
+  }
   if (!quiet) fprintf(stderr, "linewise: resuming %s at sweep %ld of %ld\n", dir, a.sweep, a.end_sweep);
-  int rc = anneal_loop(&a, stop_at, quiet, &w, &err);
+  int rc = anneal_loop(&a, stop_at, quiet, asked, &w, &err);
   lw_anneal_free(&a);
   return rc;
 }
@@ -687,8 +709,40 @@ static void install_signals(void)
 
 static int command(int argc, char **argv);
 
+#ifndef LW_MPI
+/* OpenMP threads spin at their barriers (libgomp's default), which is fast
+** while each has a core, but on a machine busy with other work a spinning
+** thread waits for one that is not running: lj13.ini with --threads 2 on 2
+** cores at a load of 6 took 6.1 s, with OMP_WAIT_POLICY=passive 0.96 s, on
+** one thread 0.84 s.  Passive waits cost small rungs on an idle machine
+** (lj13 at 16 threads of 16 idle cores: 1.19 s against 0.54 s;
+** docs/SCALING.md), so they are chosen only where the threads and the load
+** already there exceed the cores.  libgomp reads the policy when it loads,
+** before main: the process starts again with it set.  A policy the
+** environment sets is left alone (so is a single thread, which never
+** waits). */
+static void choose_wait_policy(int argc, char **argv)
+{
+  if (argc < 2 || (strcmp(argv[1], "run") && strcmp(argv[1], "resume")) || getenv("OMP_WAIT_POLICY")) return;
+  int threads = omp_get_max_threads();
+  for (int i = 2; i + 1 < argc; i++)
+    if (!strcmp(argv[i], "--threads")) threads = atoi(argv[i + 1]);
+  double load = 0.0;
+  FILE *f = fopen("/proc/loadavg", "r");
+  if (!f) return;
+  int got = fscanf(f, "%lf", &load);
+  fclose(f);
+  if (got != 1 || threads < 2 || !(load + threads > omp_get_num_procs() + 0.5)) return;
+  if (setenv("OMP_WAIT_POLICY", "passive", 1)) return;
+  execv("/proc/self/exe", argv); /* on failure the process goes on spinning */
+}
+#endif
+
 int main(int argc, char **argv)
 {
+#ifndef LW_MPI
+  choose_wait_policy(argc, argv);
+#endif
   install_signals();
 #ifdef LW_MPI
   if (!(net = lw_mpi_init(&argc, &argv, &stop_requested))) return 1;
@@ -723,7 +777,7 @@ static int command(int argc, char **argv)
     return 0;
   }
   if (!strcmp(argv[1], "params")) {
-    lw_params_write_doc(stdout);
+    lw_params_write_doc(stdout, lw_anneal_key_readers);
     return 0;
   }
   fprintf(stderr, "linewise: unknown command '%s' (try 'linewise --help')\n", argv[1]);

@@ -234,8 +234,11 @@ lw_status lw_output_svg_strokes(const lw_strokes *s, const lw_output_page *page,
     const lw_output_pen *pen = &page->pen[k];
     char color[8];
     snprintf(color, sizeof color, "#%02x%02x%02x", pen->rgb[0], pen->rgb[1], pen->rgb[2]);
-    if (page->pen_name[k][0]) fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"%s (", page->pen_name[k]);
-    else fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"pen %d (", k + 1);
+    /* the label begins with the pen's number: AxiDraw's software plots a
+    ** layer by the number its name begins with ("Plot layer 2") */
+    if (page->pen_name[k][0])
+      fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"%d %s (", k + 1, page->pen_name[k]);
+    else fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"%d pen (", k + 1);
     put_mm(f, pen->width_mm);
     fprintf(f, " mm)\" id=\"pen%d\">\n", k + 1);
     size_t a, z;

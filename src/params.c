@@ -60,7 +60,8 @@ const lw_param_def lw_param_table[] = {
   NUM("scene", "height", LW_PT_DOUBLE, height, "297", "mm", 0, 1e7, LW_MIN_OPEN,
       "Page height (set by a named `page`)."),
   CHOICE("scene", "boundary", boundary, "rect", "rect|circle|polygon|mask",
-         "Shape of the frame the lines stay inside: the page rectangle inset by `margin`, "
+         "Shape of the frame `energy.boundary` keeps the lines inside (with it 0 they may leave, and "
+         "what lies outside is cut from the drawing): the page rectangle inset by `margin`, "
          "the largest circle inside that rectangle, `polygon`, or `mask` (the inside of "
          "`mask`, by its signed distance transform; docs/IMAGES.md)."),
   NUM("scene", "margin", LW_PT_DOUBLE, margin, "10", "mm", 0, 1e7, 0,
@@ -69,7 +70,7 @@ const lw_param_def lw_param_table[] = {
   STRING("scene", "polygon", polygon, "", "mm",
          "Polygon boundary vertices as `x y x y ...` (at least 3 vertices; either orientation)."),
   STRING("scene", "image", image, "", "path",
-         "A picture (PNG, JPEG, GIF, BMP, PGM/PPM; gray or colour, with or without alpha) relative to "
+         "A picture (PNG, JPEG, GIF, BMP, binary PGM/PPM; gray or colour, with or without alpha) relative to "
          "the scene file. It is fitted into the page inset by `margin`, centred, aspect kept. "
          "Its tone feeds potential = image, field = etf and gradient, mask = alpha, and the "
          "placement of the splines (docs/IMAGES.md). Empty = none."),
@@ -645,7 +646,8 @@ const lw_param_def lw_param_table[] = {
   NUM("dynamics", "steps_per_sweep", LW_PT_INT, dyn_steps_per_sweep, "1", "", 1, 1e9, 0,
       "Time steps per sweep of the run loop (trace, frames and checkpoints count sweeps)."),
   NUM("dynamics", "gravity_x", LW_PT_DOUBLE, dyn_gravity_x, "0", "mm/s^2", -1e12, 1e12, 0,
-      "x of the gravity g acting on the line density: energy -rho int g.r dl (the load term)."),
+      "x of the gravity g acting on the line density: energy -rho int g.r dl (the load term; the "
+      "particles' gravity is particles.gravity)."),
   NUM("dynamics", "gravity_y", LW_PT_DOUBLE, dyn_gravity_y, "0", "mm/s^2", -1e12, 1e12, 0,
       "y of g (y points down the page: 9810 is the Earth's gravity on a page held upright)."),
   NUM("dynamics", "force_x", LW_PT_DOUBLE, dyn_force_x, "0", "force/mm", -1e12, 1e12, 0,
@@ -653,7 +655,8 @@ const lw_param_def lw_param_table[] = {
   NUM("dynamics", "force_y", LW_PT_DOUBLE, dyn_force_y, "0", "force/mm", -1e12, 1e12, 0,
       "y of the constant external force per mm."),
   CHOICE("dynamics", "pin", dyn_pin, "none", "none|ends|first|last",
-         "End points held fixed: of both ends of every spline, the first node, the last node."),
+         "End points held fixed: of both ends of every spline, the first node, the last node (a wire's "
+         "are nurbs.fixed, the particles' particles.pinned)."),
   NUM("dynamics", "pin_vectors", LW_PT_INT, dyn_pin_vectors, "0", "", 0, 1, 0,
       "1 = a pinned node's vector is held too (a clamped end); 0 = it turns freely."),
   CHOICE("dynamics", "integrator", dyn_integrator, "leapfrog", "leapfrog|review",
@@ -902,6 +905,37 @@ void lw_params_defaults(lw_params *p)
   memset(p, 0, sizeof *p);
   char expected[256];
   for (size_t i = 0; i < lw_param_count; i++) assign(p, &lw_param_table[i], lw_param_table[i].def, expected, sizeof expected);
+}
+
+/* Whether p holds d's default. */
+static int at_default(const lw_params *p, const lw_param_def *d)
+{
+  const char *base = (const char *)p + d->offset;
+  double v;
+  switch (d->type) {
+  case LW_PT_DOUBLE:
+  case LW_PT_WHOLE: return lw_number_parse(d->def, &v) && *(const double *)base == v;
+  case LW_PT_INT: return lw_number_parse(d->def, &v) && *(const int *)base == (int)v;
+  case LW_PT_CHOICE: return *(const int *)base == choice_index(d->choices, d->def);
+  case LW_PT_STRING: return !strcmp(base, d->def);
+  }
+  return 0;
+}
+
+int lw_params_given(const lw_params *p, const lw_param_def *d)
+{
+  return !p->of_run && p->line[d - lw_param_table] && !at_default(p, d);
+}
+
+int lw_params_named(const char *const *patterns, const lw_param_def *d)
+{
+  size_t n = strlen(d->section);
+  for (; patterns && *patterns; patterns++) {
+    const char *q = *patterns;
+    if (strncmp(q, d->section, n) || q[n] != '.') continue;
+    if (!strcmp(q + n + 1, "*") || !strcmp(q + n + 1, d->key)) return 1;
+  }
+  return 0;
 }
 
 lw_status lw_params_blame(const lw_params *p, const char *section, const char *key, lw_error *err)
@@ -1328,6 +1362,31 @@ static void value_text(const lw_params *p, const lw_param_def *d, char *buf, siz
   }
 }
 
+/* Keys that shape only the final files (and when they are written), which
+** a person may change in a run's scene.ini before it resumes. */
+static const char *const file_keys[] = {"plot.*", "output.pen_colors", "output.png_scale", "output.pdf",
+                                        "output.hpgl", "output.gcode", "output.preview_image",
+                                        "output.fidelity_sigma", "output.fidelity_reference", "output.field_preview",
+                                        "output.order", "output.checkpoint_every", "output.frames_every",
+                                        "output.samples_every", "output.stats_from", "nurbs.svg_tolerance",
+                                        "nurbs.png_scale", "particles.view_azimuth", "particles.view_elevation",
+                                        "particles.png_size", "particles.disc", NULL};
+
+unsigned long long lw_params_run_hash(const lw_params *p)
+{
+  unsigned long long h = 0xcbf29ce484222325ULL; /* FNV-1a, 64 bits */
+  char line[LW_PATH_MAX + 4200];
+  for (size_t i = 0; i < lw_param_count; i++) {
+    const lw_param_def *d = &lw_param_table[i];
+    if (at_default(p, d) || lw_params_named(file_keys, d)) continue;
+    int n = snprintf(line, sizeof line, "%s.%s=", d->section, d->key);
+    value_text(p, d, line + n, sizeof line - (size_t)n);
+    for (const char *c = line; *c; c++) h = (h ^ (unsigned char)*c) * 0x100000001b3ULL;
+    h = (h ^ '\n') * 0x100000001b3ULL;
+  }
+  return h;
+}
+
 int lw_params_write(const lw_params *p, FILE *f)
 {
   const char *section = "";
@@ -1344,15 +1403,15 @@ int lw_params_write(const lw_params *p, FILE *f)
   return ferror(f) ? -1 : 0;
 }
 
-void lw_params_write_doc(FILE *f)
+void lw_params_write_doc(FILE *f, void (*read_by)(const lw_param_def *d, char *buf, size_t n))
 {
   const char *section = "";
-  char range[128];
+  char range[128], readers[256];
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
     if (strcmp(section, d->section)) {
-      fprintf(f, "\n## [%s]\n\n| key | type | default | unit | range | meaning |\n"
-                 "|---|---|---|---|---|---|\n", d->section);
+      fprintf(f, "\n## [%s]\n\n| key | type | default | unit | range | read by | meaning |\n"
+                 "|---|---|---|---|---|---|---|\n", d->section);
       section = d->section;
     }
     static const char *const type_name[] = {"number", "integer", "integer", "choice", "text"};
@@ -1363,8 +1422,9 @@ void lw_params_write_doc(FILE *f)
     else range_text(d, range, sizeof range);
     for (char *c = range; *c; c++)
       if (*c == '|') *c = '/';
-    fprintf(f, "| `%s` | %s | `%s` | %s | %s | ", d->key, type, d->def, d->unit[0] ? d->unit : "-",
-            range);
+    read_by(d, readers, sizeof readers);
+    fprintf(f, "| `%s` | %s | `%s` | %s | %s | %s | ", d->key, type, d->def, d->unit[0] ? d->unit : "-",
+            range, readers);
     for (const char *c = d->help; *c; c++) {
       if (*c == '|') fputc('\\', f); /* a bare | would end the Markdown cell */
       fputc(*c, f);

@@ -176,7 +176,7 @@ lw_status lw_output_hpgl_strokes(const lw_strokes *s, const lw_output_page *page
       fputs(h.drawn ? ";\n" : "PD;\n", f);
     }
   }
-  fputs("PU;SP0;\n", f);
+  fputs("PU0,0;SP0;\n", f); /* home, as the G-code ends, and the pen put away */
   return lw_output_commit(f, tmp, path, err);
 }
 

@@ -113,8 +113,12 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
     double lo, hi;
     if ((st = lw_image_levels(sc->image, p->image_levels, &lo, &hi, err))) return st;
     size_t used = strlen(sc->note);
-    snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_levels: tones %.3f to %.3f stretched to 0 to 1",
-             used ? "; " : "", lo, hi);
+    if (lo > 0.0 || hi < 1.0)
+      snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_levels: tones %.3f to %.3f stretched to 0 to 1",
+               used ? "; " : "", lo, hi);
+    else /* a plateau of paper or of black at an end keeps its end */
+      snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_levels: the tones left as they are",
+               used ? "; " : "");
   }
   lw_image_tone_curve(sc->image, p->image_gamma, p->image_contrast, p->image_invert);
   return LW_OK;

@@ -634,7 +634,7 @@ lw_strokes *lw_strokes_drop(const lw_strokes *in, const double *min_length, lw_s
 
 /* ---- order --------------------------------------------------------------- */
 
-lw_status lw_strokes_order(lw_strokes *s, lw_plot_order order, double hx, double hy, lw_strokes_report *rep,
+lw_status lw_strokes_order(lw_strokes *s, lw_plot_order order, double hx, double hy, int back, lw_strokes_report *rep,
                            lw_error *err)
 {
   size_t n = s->n;
@@ -654,7 +654,7 @@ lw_status lw_strokes_order(lw_strokes *s, lw_plot_order order, double hx, double
   rep->travel_before = rep->travel_after = 0.0;
   /* the exits of the last pen that drew, before and after ordering: the
   ** pen goes home from there to be changed (an empty pen is skipped) */
-  double was[2][2];
+  double was[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
   int drew = 0;
   for (int k = 0; k < s->n_pens; k++) {
     size_t a = s->pen_first[k], z = k + 1 < s->n_pens ? s->pen_first[k + 1] : n;
@@ -681,6 +681,10 @@ lw_status lw_strokes_order(lw_strokes *s, lw_plot_order order, double hx, double
                                s->first[q + 1] - s->first[q], err)))
         goto done;
     }
+  }
+  if (drew && back) {
+    rep->travel_before += hypot(was[0][0] - hx, was[0][1] - hy);
+    rep->travel_after += hypot(was[1][0] - hx, was[1][1] - hy);
   }
   /* the ordered drawing takes the place of the old one */
   lw_strokes tmp = *s;
@@ -720,7 +724,7 @@ lw_strokes *lw_strokes_prepare(const lw_splines *sp, const lw_plot *plot, const 
     lw_strokes_free(s);
     if (!(s = t)) return NULL;
   }
-  if (lw_strokes_order(s, o->order, o->home_x, o->home_y, rep, err)) return fail(s);
+  if (lw_strokes_order(s, o->order, o->home_x, o->home_y, o->home_back, rep, err)) return fail(s);
   rep->lifts_after = s->n;
   return s;
 }

@@ -1103,8 +1103,14 @@ static void describe(const void *state, int what, char *buf, size_t n)
              s->deviation, lw_nurbs_polynomial(s->c) && s->c->order <= 4 ? " (exact)" : "");
 }
 
+/* The wire's load acts on Monte Carlo too; its ends are held by
+** nurbs.fixed, not the dynamics' pins. */
+static const char *const keys[] = {"init.from", "moves.step_point", "moves.target", "nurbs.*", "dynamics.rho",
+                                   "dynamics.gravity_x", "dynamics.gravity_y", NULL};
+
 const lw_system_type lw_system_nurbs = {
     .name = "nurbs",
+    .keys = keys,
     .n_moves = 2,
     .move_names = move_names,
     .move_unit = move_unit,

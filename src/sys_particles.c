@@ -216,19 +216,6 @@ static void mass_free(void *mass)
 static void *mass_new(const void *state, const lw_params *p, double density, lw_error *err)
 {
   const lw_particles *s = state;
-  static const char *const loads[] = {"gravity_x", "gravity_y", "force_x", "force_y"};
-  const double load[] = {p->dyn_gravity_x, p->dyn_gravity_y, p->dyn_force_x, p->dyn_force_y};
-  for (int k = 0; k < 4; k++)
-    if (load[k] != 0.0) {
-      lw_error_set(err, LW_EINPUT, "the particle system's load is particles.gravity; expected 0");
-      lw_params_blame(p, "dynamics", loads[k], err);
-      return NULL;
-    }
-  if (p->dyn_pin != LW_PIN_NONE || p->dyn_pin_vectors) {
-    lw_error_set(err, LW_EINPUT, "particles are pinned by their point file (particles.pinned); expected none");
-    lw_params_blame(p, "dynamics", p->dyn_pin != LW_PIN_NONE ? "pin" : "pin_vectors", err);
-    return NULL;
-  }
   pt_mass *m = calloc(1, sizeof *m);
   size_t n = lw_particles_n_coords(s);
   if (!m || !(m->m = malloc((n ? n : 1) * sizeof *m->m)) || !(m->held = malloc(n ? n : 1))) {
@@ -479,8 +466,16 @@ static void describe(const void *state, int what, char *buf, size_t n)
   else if (n) buf[0] = '\0';
 }
 
+/* The particles' load is particles.gravity and their pins particles.pinned,
+** not the dynamics' keys; only they have dampers between neighbours. */
+static const char *const keys[] = {"init.from", "moves.translate", "moves.rotate", "moves.step_translate",
+                                   "moves.step_rotate", "moves.target_spline", "particles.*", NULL};
+static const char *const keys_dynamics[] = {"dynamics.rho", "dynamics.dashpot", "dynamics.dashpot_angular", NULL};
+
 /* The rows differ only in their move kinds (sys_particles.h). */
 #define PARTICLES_ROW \
+    .keys = keys, \
+    .keys_dynamics = keys_dynamics, \
     .n_observables = (int)(sizeof observable_names / sizeof observable_names[0]), \
     .observable_names = observable_names, \
     .observe = observe, \

@@ -1257,8 +1257,17 @@ static void mass_dx(const void *mass, const double *x, const double *v, double *
 
 static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinned(mass, i); }
 
+/* Every key of the page, the curves and their drawing; the load acts on
+** Monte Carlo too, the pins only in the dynamics. */
+static const char *const keys[] = {"scene.*", "init.*", "energy.*", "moves.*", "output.*", "plot.*", "layers.*",
+                                   "dynamics.rho", "dynamics.gravity_x", "dynamics.gravity_y", "dynamics.force_x",
+                                   "dynamics.force_y", NULL};
+static const char *const keys_dynamics[] = {"dynamics.pin", "dynamics.pin_vectors", NULL};
+
 /* The rows differ only in their move kinds (sys_splines.h). */
 #define SPLINES_ROW \
+  .keys = keys, \
+  .keys_dynamics = keys_dynamics, \
   .n_terms = LW_TERM_COUNT, \
   .term_names = lw_term_names, \
   .setup_new = setup_new, \

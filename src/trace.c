@@ -514,7 +514,9 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
               k > 1 ? "or between the runs" : "these rows");
     warn(out, t[0], cs, k, WARN_OPEN, "the autocorrelation did not die out within half the rows: tau is a lower "
          "bound and the error bar too small (a longer stretch is needed)");
-    warn(out, t[0], cs, k, WARN_FEW, "fewer than 25 independent samples: the error bar is rough");
+    warn(out, t[0], cs, k, WARN_FEW, k > 1 ? "fewer than 25 independent samples in a run (n_eff above sums the "
+         "runs): that run's error bar, and the test of the runs against each other, are rough"
+         : "fewer than 25 independent samples: the error bar is rough");
     warn(out, t[0], cs, k, WARN_DRIFT, "the first and second halves differ by more than 4 standard errors: not yet "
          "stationary (start later with --from)");
     warn(out, t[0], cs, k, WARN_RUNS, "the runs disagree beyond their error bars (p_runs < 0.001 or R_hat > 1.1): "

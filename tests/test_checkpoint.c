@@ -173,3 +173,70 @@ Test(checkpoint, an_extension_stopped_on_the_way_resumes_to_its_own_end)
                           dir),
                0);
 }
+
+/* The new end of an extension is in state.lw before its first sweep: a
+** kill before the extension's first checkpoint still resumes to it. */
+Test(checkpoint, an_extension_killed_before_its_first_checkpoint_keeps_its_end)
+{
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("%s run %s/params/example.ini --set anneal.sweeps=2 --set init.splines=200 --out %s/a "
+                          "--quiet", b, lw_test_root(), dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/a --sweeps 1000 2>%s/err.txt & p=$!; i=0; "
+                          "until grep -q 'resuming' %s/err.txt || [ $i -gt 600 ]; do sleep 0.05; i=$((i+1)); done; "
+                          "kill -KILL $p; wait $p; test $? -eq 137",
+                          b, dir, dir, dir),
+               0);
+  cr_assert_eq(lw_test_sh("grep -qx 'end_sweep = 1002' %s/a/state.lw && grep -qx 'sweep = 2' %s/a/state.lw && "
+                          "! test -e %s/a/summary.json", dir, dir, dir),
+               0, "the extension's end was not saved before its first sweep");
+}
+
+/* scene.ini is what the run ran with: an edit of a key that steers the
+** run is refused on resume; [plot] and the final files' keys may change. */
+Test(checkpoint, a_scene_ini_edited_in_a_key_that_steers_the_run_is_refused)
+{
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set anneal.sweeps=40 --out %s/a --quiet --stop-at 20 && "
+                          "cp %s/a/scene.ini %s/scene.keep", b, lw_test_root(), dir, dir, dir), 0);
+  static const char *const steer[] = {"s/^t_end = .*/t_end = 0.5/", "s/^domains = off/domains = 2/",
+                                      "s/^trace_every = .*/trace_every = 3/", "s/^point = .*/point = 0.9/"};
+  for (int k = 0; k < 4; k++) {
+    cr_assert_eq(lw_test_sh("sed -i '%s' %s/a/scene.ini && ! cmp -s %s/a/scene.ini %s/scene.keep", steer[k], dir, dir,
+                            dir), 0, "%s", steer[k]);
+    cr_assert_eq(lw_test_sh("%s resume %s/a --quiet 2>%s/err.txt", b, dir, dir), 2, "%s", steer[k]);
+    cr_assert_eq(lw_test_sh("grep -q \"state.lw:[0-9]*: \\[run\\] scene_hash: the run's scene.ini was edited\" "
+                            "%s/err.txt && grep -qx 'sweep = 20' %s/a/state.lw", dir, dir), 0, "%s", steer[k]);
+    cr_assert_eq(lw_test_sh("cp %s/scene.keep %s/a/scene.ini", dir, dir), 0);
+  }
+  cr_assert_eq(lw_test_sh("sed -i -e 's/^min_length = .*/min_length = 0/' -e 's/^png_scale = .*/png_scale = 2/' "
+                          "%s/a/scene.ini && %s resume %s/a --quiet", dir, b, dir), 0,
+               "a key of the drawing only was refused");
+}
+
+/* --stop-at at the sweep the run stands at stops before any sweep; one it
+** has passed is refused; 0 on a new run stops after the set-up. */
+Test(checkpoint, stop_at_a_sweep_reached_runs_no_sweep)
+{
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set anneal.sweeps=40 --out %s/a --quiet --stop-at 0 && "
+                          "grep -qx 'sweep = 0' %s/a/state.lw", b, lw_test_root(), dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/a --quiet --stop-at 12 && %s resume %s/a --quiet --stop-at 12 && "
+                          "grep -qx 'sweep = 12' %s/a/state.lw", b, dir, b, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/a --stop-at 5 2>%s/err.txt", b, dir, dir), 2);
+  cr_assert_eq(lw_test_sh("grep -q 'stands at sweep 12 already; expected 12 or more' %s/err.txt && "
+                          "grep -qx 'sweep = 12' %s/a/state.lw", dir, dir), 0);
+}
+
+/* A tempering ladder given as temperatures says in scene.ini how many
+** rungs ran; a finished run resumed keeps a whole-run proposal rate. */
+Test(checkpoint, scene_ini_and_summary_tell_the_run_as_it_ran)
+{
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set anneal.sweeps=10 --set 'tempering.ladder=0.01 0.1 1' "
+                          "--out %s/a --quiet && grep -qx 'replicas = 3' %s/a/scene.ini && %s resume %s/a --quiet",
+                          b, lw_test_root(), dir, dir, b, dir), 0);
+  cr_assert_eq(lw_test_sh("awk -F: '/\"proposals\"/ { p = $2 + 0 } /\"wall_seconds\"/ { w = $2 + 0 } "
+                          "/\"proposals_per_second\"/ { r = $2 + 0 } END { exit !(r > 0 && w > 0 && "
+                          "(r * w / p - 1) ^ 2 < 1e-6) }' %s/a/summary.json", dir), 0,
+               "proposals_per_second is not proposals / wall_seconds");
+}

@@ -219,6 +219,49 @@ Test(cli, bad_input_exits_2_with_one_message)
   cr_assert(strstr(errs, "frobnicate"));
 }
 
+/* A key the scene's system reads under neither driver is refused before
+** anything is written, naming where it was set and who reads it; the
+** default, named, is not; a key only the other driver reads is noted and the
+** run goes on (one scene file may serve both drivers). */
+Test(cli, keys_the_system_never_reads_are_refused)
+{
+  char out[4096], errs[8192], args[512];
+  static const struct { const char *scene, *set, *want; } bad[] = {
+    {"particles-sheet", "energy.bending=5",
+     "--set: key 'energy.bending': the particles system reads it under neither driver (read by: splines); "
+     "expected no line, or the default '0'"},
+    {"wire", "output.pdf=1", "key 'output.pdf': the nurbs system reads it under neither driver (read by: splines)"},
+    {"wire", "dynamics.pin=ends", "key 'dynamics.pin': the nurbs system reads it under neither driver (read by: "
+     "splines under dynamics)"},
+    {"example", "particles.r0=2", "key 'particles.r0': the splines system reads it under neither driver (read by: "
+     "particles)"},
+    {"lj13", "scene.preset=photo", "key 'scene.preset': the particles system"},
+  };
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+    snprintf(args, sizeof args, "run %s/params/%s.ini --quiet --set %s --out %s/r%zu", lw_test_root(), bad[k].scene,
+             bad[k].set, dir, k);
+    cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", bad[k].set);
+    cr_assert(strstr(errs, bad[k].want), "%s: %s", bad[k].set, errs);
+    snprintf(args, sizeof args, "test ! -e %s/r%zu", dir, k);
+    cr_assert_eq(system(args), 0, "%s: a run directory was made", bad[k].set);
+  }
+  /* in the file, with its line; the default given is accepted */
+  write_file("p.ini", "[scene]\nsystem = particles\n[particles]\ncount = 3\n[energy]\nbending = 0\n"
+                      "[anneal]\nsweeps = 1\n");
+  snprintf(args, sizeof args, "run %s/p.ini --out %s/p --quiet", dir, dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  write_file("q.ini", "[scene]\nsystem = particles\n[particles]\ncount = 3\n[energy]\nbending = 1\n");
+  snprintf(args, sizeof args, "run %s/q.ini --out %s/q --quiet", dir, dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "q.ini:6: key 'energy.bending'"), "%s", errs);
+  /* the other driver's keys: a note, and the run */
+  snprintf(args, sizeof args, "run %s/params/hanging.ini --set anneal.sweeps=1 --set moves.point=3 --out %s/h",
+           lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "linewise: note: under driver = dynamics these keys have no effect: ") &&
+            strstr(errs, "moves.point (--set)"), "%s", errs);
+}
+
 Test(cli, empty_scene_has_zero_energy)
 {
   write_file("scene.ini", "[energy]\npair = 1\nboundary = 1\n");

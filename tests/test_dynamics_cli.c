@@ -81,7 +81,8 @@ Test(dynamics_cli, scenes_the_driver_cannot_move_are_refused_with_the_key)
     {"--set energy.quadrature=3", "at least 4 quadrature nodes"},
     {"--set dynamics.dt=0", "dynamics.dt"},
     {"--set dynamics.pin=both", "dynamics.pin"},
-    {"--set dynamics.dashpot=1", "key 'dynamics.dashpot': the system 'splines' has no dampers between neighbours"},
+    {"--set dynamics.dashpot=1", "key 'dynamics.dashpot': the splines system reads it under neither driver (read by: "
+     "particles under dynamics)"},
     {"--set dynamics.integrator=review", "key 'dynamics.integrator': the review's scheme takes a constant mass matrix "
      "and a quadratic energy (the nurbs system with frozen weights); the splines system's are not"},
     {"--set anneal.domains=2", "key 'anneal.domains': domains split the sweeps of Monte Carlo"},
@@ -93,11 +94,14 @@ Test(dynamics_cli, scenes_the_driver_cannot_move_are_refused_with_the_key)
     cr_assert_eq(sh("test ! -e %s/x%zu", dir, k), 0, "case %zu: a run directory was made", k);
   }
   /* what the particle system cannot take: the review's scheme (its
-  ** quaternions are constrained), the splines' load and pins */
+  ** quaternions are constrained), the splines' load and pins (its own are
+  ** particles.gravity and particles.pinned) */
   static const struct { const char *set, *want; } pbad[] = {
     {"--set dynamics.integrator=review", "key 'dynamics.integrator': the review's scheme takes free coordinates"},
-    {"--set dynamics.gravity_y=9810", "key 'dynamics.gravity_y': the particle system's load is particles.gravity"},
-    {"--set dynamics.pin=ends", "key 'dynamics.pin': particles are pinned by their point file"},
+    {"--set dynamics.gravity_y=9810", "key 'dynamics.gravity_y': the particles system reads it under neither driver "
+     "(read by: splines, nurbs)"},
+    {"--set dynamics.pin=ends", "key 'dynamics.pin': the particles system reads it under neither driver (read by: "
+     "splines under dynamics)"},
     {"--set dynamics.rho=0 --set dynamics.gamma=1 --set dynamics.dashpot_angular=1",
      "key 'dynamics.dashpot_angular': a massless motion (rho = 0) is damped by gamma alone"},
   };

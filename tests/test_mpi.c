@@ -91,6 +91,24 @@ Test(mpi, summary_json_reads_every_rung_as_the_one_process_run)
                0, "summary.json's replicas differ between one and two processes");
 }
 
+/* A run killed in its final drawings (state.lw at the last sweep, no
+** summary.json) is resumed with no sweep left: the rungs held by the other
+** process read as before any exchange of energies. */
+Test(mpi, a_resume_with_no_sweep_left_reads_every_rung)
+{
+  const char *m = mpi_bin(), *b = lw_test_bin();
+  write_scene();
+  cr_assert_eq(sh("%s run %s/s.ini --out %s/ref --quiet && rm %s/ref/summary.json && cp -r %s/ref %s/p2", b, dir, dir,
+                  dir, dir, dir), 0);
+  cr_assert_eq(sh("%s resume %s/ref --quiet", b, dir), 0);
+  cr_assert_eq(sh(MPIRUN " -n 2 %s resume %s/p2 --quiet", m, dir), 0);
+  cr_assert_eq(sh("sed -n '/\"replicas\"/,/]/p' %s/ref/summary.json > %s/r1 && "
+                  "sed -n '/\"replicas\"/,/]/p' %s/p2/summary.json > %s/r2 && grep -c energy %s/r1 | grep -qx 4 && "
+                  "cmp -s %s/r1 %s/r2",
+                  dir, dir, dir, dir, dir, dir, dir),
+               0, "summary.json's replicas differ between one and two processes");
+}
+
 Test(mpi, resume_with_other_process_counts_continues_bit_exactly)
 {
   const char *m = mpi_bin(), *b = lw_test_bin();

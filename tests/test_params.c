@@ -5,6 +5,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "linewise/anneal.h"
 #include "linewise/params.h"
 #include "linewise/scene.h"
 #include "testutil.h"
@@ -476,4 +477,60 @@ Test(params, a_constant_schedule_has_one_step_unless_the_scene_says)
   cr_assert_eq(p.steps, 5);
   cr_assert_eq(read_text("[scene]\npreset = photo\n[anneal]\nschedule = constant\n", &p, &err), LW_OK);
   cr_assert_eq(p.steps, 1);
+}
+
+/* A key counts as given when the file or --set names it with another value
+** than its default, and never in a run's own scene.ini (which names all). */
+Test(params, a_key_is_given_only_with_a_value_of_its_own)
+{
+  char path[] = "/tmp/lw_params_given_XXXXXX";
+  int fd = mkstemp(path);
+  FILE *f = fdopen(fd, "w");
+  fputs("[energy]\nbending = 0\nstrain = 2\n[output]\norder = 2opt\npen_colors =\n[scene]\nfield = vortex\n", f);
+  fclose(f);
+  lw_params p;
+  lw_error err;
+  cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_params_set(&p, "energy.tone=0.5", &err), LW_OK, "%s", err.msg);
+  cr_assert(!lw_params_given(&p, lw_params_find("energy", "bending")), "the default, named");
+  cr_assert(lw_params_given(&p, lw_params_find("energy", "strain")));
+  cr_assert(!lw_params_given(&p, lw_params_find("output", "order")), "a choice at its default");
+  cr_assert(!lw_params_given(&p, lw_params_find("output", "pen_colors")), "a text at its default");
+  cr_assert(lw_params_given(&p, lw_params_find("scene", "field")));
+  cr_assert(lw_params_given(&p, lw_params_find("energy", "tone")), "--set");
+  cr_assert(!lw_params_given(&p, lw_params_find("energy", "pair")), "not named");
+  cr_assert_eq(lw_params_read_run(&p, path, &err), LW_OK, "%s", err.msg);
+  cr_assert(!lw_params_given(&p, lw_params_find("energy", "strain")), "a run's own scene.ini");
+  unlink(path);
+  static const char *const pat[] = {"energy.strain", "plot.*", NULL};
+  cr_assert(lw_params_named(pat, lw_params_find("energy", "strain")));
+  cr_assert(!lw_params_named(pat, lw_params_find("energy", "strain_mode")), "a whole key, not a prefix");
+  cr_assert(lw_params_named(pat, lw_params_find("plot", "crop")));
+  cr_assert(!lw_params_named(NULL, lw_params_find("plot", "crop")));
+}
+
+/* Every key is read by some system under some driver (a key no row lists
+** would be refused in every scene), and the readers are what the rows say. */
+Test(params, every_key_has_a_reader)
+{
+  char buf[256];
+  for (size_t i = 0; i < lw_param_count; i++) {
+    lw_anneal_key_readers(&lw_param_table[i], buf, sizeof buf);
+    cr_assert(buf[0], "%s.%s: no system reads it", lw_param_table[i].section, lw_param_table[i].key);
+  }
+  static const struct { const char *section, *key, *want; } known[] = {
+    {"anneal", "sweeps", "all"},
+    {"energy", "bending", "splines"},
+    {"particles", "r0", "particles"},
+    {"nurbs", "alpha", "nurbs"},
+    {"dynamics", "dt", "all under dynamics"},
+    {"tempering", "replicas", "all under metropolis"},
+    {"moves", "point", "splines under metropolis"},
+    {"dynamics", "pin", "splines under dynamics"},
+    {"dynamics", "rho", "splines, nurbs under metropolis; all under dynamics"},
+  };
+  for (size_t k = 0; k < sizeof known / sizeof known[0]; k++) {
+    lw_anneal_key_readers(lw_params_find(known[k].section, known[k].key), buf, sizeof buf);
+    cr_assert_str_eq(buf, known[k].want, "%s.%s", known[k].section, known[k].key);
+  }
 }

@@ -30,7 +30,7 @@ static const char scene[] =
   "[scene]\nsystem = particles\n"
   "[particles]\ncount = 37\npattern = plane\nnoise = 0.1\nnormal_noise = 10\nalpha_p = 10\nalpha_n = 10\n"
   "alpha_c = 0.5\ngravity = 0.01\nboundary = plane\nboundary_z = -3\nalpha_b = 0.1\npng_size = 64\n"
-  "[moves]\npoint = 0\nvector = 0\ntranslate = 1\nrotate = 1\nstep_translate = 0.1\nstep_rotate = 5\n"
+  "[moves]\ntranslate = 1\nrotate = 1\nstep_translate = 0.1\nstep_rotate = 5\n"
   "[anneal]\nschedule = geometric\nt_start = 0.05\nt_end = 0.001\nsweeps = 60\nsteps = 6\nseed = 5\n"
   "check_every = 7\n"
   "[tempering]\nreplicas = 3\nt_min = 0.05\nt_max = 0.5\n"

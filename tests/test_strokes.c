@@ -356,7 +356,7 @@ Test(strokes, plot_time_and_travel_of_hand_made_drawings)
   add_line(s, 0, 0, 10, 0, 40, 0);
   add_line(s, 0, 1, 40, 10, 40, 50);
   lw_strokes_report rep = {0};
-  cr_assert_eq(lw_strokes_order(s, LW_PLOT_ORDER_NONE, 0, 0, &rep, NULL), LW_OK);
+  cr_assert_eq(lw_strokes_order(s, LW_PLOT_ORDER_NONE, 0, 0, 0, &rep, NULL), LW_OK);
   cr_assert(fabs(rep.travel_after - 20) < 1e-12);
   cr_assert(fabs(lw_strokes_total_length(s) - 70) < 1e-12);
   double t = lw_strokes_time(s, rep.travel_after, 50, 150, 0.2);
@@ -367,8 +367,12 @@ Test(strokes, plot_time_and_travel_of_hand_made_drawings)
   s = lw_strokes_new(3, NULL);
   add_line(s, 0, 0, 1, 0, 2, 0);
   add_line(s, 2, 1, 3, 0, 4, 0);
-  cr_assert_eq(lw_strokes_order(s, LW_PLOT_ORDER_NONE, 0, 0, &rep, NULL), LW_OK);
+  cr_assert_eq(lw_strokes_order(s, LW_PLOT_ORDER_NONE, 0, 0, 0, &rep, NULL), LW_OK);
   cr_assert(fabs(rep.travel_after - 6) < 1e-12 && fabs(rep.travel_before - 6) < 1e-12, "%g %g", rep.travel_before,
+            rep.travel_after);
+  /* the machine files end at home: 4 back from the last path's end */
+  cr_assert_eq(lw_strokes_order(s, LW_PLOT_ORDER_NONE, 0, 0, 1, &rep, NULL), LW_OK);
+  cr_assert(fabs(rep.travel_after - 10) < 1e-12 && fabs(rep.travel_before - 10) < 1e-12, "%g %g", rep.travel_before,
             rep.travel_after);
   lw_strokes_free(s);
 }
@@ -379,7 +383,7 @@ Test(strokes, ordering_reverses_and_reorders_within_pens)
   add_line(s, 0, 0, 100, 0, 90, 0);
   add_line(s, 0, 1, 50, 0, 1, 0);
   lw_strokes_report rep = {0};
-  cr_assert_eq(lw_strokes_order(s, LW_PLOT_ORDER_2OPT, 0, 0, &rep, NULL), LW_OK);
+  cr_assert_eq(lw_strokes_order(s, LW_PLOT_ORDER_2OPT, 0, 0, 0, &rep, NULL), LW_OK);
   /* from home: the second stroke backwards from (1, 0), then the first backwards */
   cr_assert_eq(s->src[0], 1);
   cr_assert_eq(s->reversed[0], 1);

@@ -52,9 +52,11 @@ typedef struct lw_anneal {
   const lw_schedule_type *sched_type;
   lw_schedule sched;
   char dir[LW_PATH_MAX];
+  char unread[1024];           /* keys the scene sets that only the other driver reads, where set, or "" */
   unsigned long seed;
   long sweep;                  /* sweeps done */
   long end_sweep;              /* stop after this sweep */
+  unsigned long long scene_hash; /* lw_params_run_hash of scene.ini, kept in state.lw */
   long block;                  /* current temperature step */
   double t_prev;               /* temperature of the previous step */
   lw_block_stats prev;         /* energy statistics of the previous step */
@@ -62,7 +64,6 @@ typedef struct lw_anneal {
   double max_drift;            /* largest relative drift seen at a check */
   double energy_initial;
   double wall_before;          /* seconds spent before a resume */
-  unsigned long proposals_before; /* proposals made before a resume */
   double wall_start;           /* monotonic clock at start of this process */
   lw_move_stats trace_mark[LW_MOVES_MAX]; /* stats at the last trace row */
   int quenched;                /* 1 once lw_anneal_finish has quenched (anneal.quench) */
@@ -106,6 +107,13 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err);
 lw_status lw_anneal_finish(lw_anneal *a, lw_error *err);
 
 void lw_anneal_free(lw_anneal *a);
+
+/* Which scenes read key d, for messages and docs/PARAMETERS.md: "all",
+** "splines", "all under dynamics", "splines, nurbs under metropolis; all
+** under dynamics".  A scene that gives another key a value of its own is
+** refused when it starts (system.h, keys). */
+void lw_anneal_key_readers(const lw_param_def *d, char *buf, size_t n);
+
 
 /* Current temperature, energy and overall acceptance (for progress displays). */
 double lw_anneal_temperature(const lw_anneal *a);

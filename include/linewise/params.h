@@ -295,11 +295,28 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err);
 ** the last one). */
 lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err);
 
+/* A hash of the keys that steer a run (all but [plot] and the keys that
+** only shape the final files) where they differ from their defaults, as
+** scene.ini writes them (so a key a later build adds, at its default,
+** changes nothing).  state.lw keeps it, so that a resume refuses a
+** scene.ini edited since. */
+unsigned long long lw_params_run_hash(const lw_params *p);
+
 /* Writes every parameter as an INI file that reads back to the same values. */
 int lw_params_write(const lw_params *p, FILE *f);
 
-/* Writes the Markdown table of docs/PARAMETERS.md. */
-void lw_params_write_doc(FILE *f);
+/* Whether the scene gives key d a value of its own: from its file or
+** --set, and other than the default.  Never for a run's scene.ini, which
+** writes every key. */
+int lw_params_given(const lw_params *p, const lw_param_def *d);
+
+/* Whether patterns (NULL-terminated "section.key" or "section.*"; NULL:
+** none) name key d. */
+int lw_params_named(const char *const *patterns, const lw_param_def *d);
+
+/* Writes the Markdown table of docs/PARAMETERS.md, with the scenes that read
+** each key from read_by (lw_anneal_key_readers). */
+void lw_params_write_doc(FILE *f, void (*read_by)(const lw_param_def *d, char *buf, size_t n));
 
 /* The definition of section.key, or NULL. */
 const lw_param_def *lw_params_find(const char *section, const char *key);

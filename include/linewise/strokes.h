@@ -85,6 +85,7 @@ typedef struct {
   double min_length[LW_PLOT_PENS_MAX]; /* per pen, mm; 0 = keep all */
   lw_plot_order order;
   double home_x, home_y;               /* where each pen starts (the machine's origin), mm */
+  int home_back;                       /* 1: the pen goes home after the last pen (machine files) */
 } lw_strokes_options;
 
 /* An empty drawing with n_pens pens (1 .. LW_PLOT_PENS_MAX); NULL and err on
@@ -110,8 +111,10 @@ lw_strokes *lw_strokes_crop(const lw_strokes *in, double x0, double y0, double x
 lw_strokes *lw_strokes_drop(const lw_strokes *in, const double *min_length, lw_strokes_report *rep, lw_error *err);
 
 /* Step 4 in place: orders each pen's paths from home (hx, hy) and sets
-** their directions; rep->travel_before and travel_after are set. */
-lw_status lw_strokes_order(lw_strokes *s, lw_plot_order order, double hx, double hy, lw_strokes_report *rep,
+** their directions; rep->travel_before and travel_after are set, with the
+** way home between pens, and after the last where back is 1 (the machine
+** files end at home). */
+lw_status lw_strokes_order(lw_strokes *s, lw_plot_order order, double hx, double hy, int back, lw_strokes_report *rep,
                            lw_error *err);
 
 /* The whole post-pass on the plot's paths. */
