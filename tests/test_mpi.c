@@ -109,6 +109,19 @@ Test(mpi, a_resume_with_no_sweep_left_reads_every_rung)
                0, "summary.json's replicas differ between one and two processes");
 }
 
+/* The process that drew tells what it drew, whichever it is, and the done
+** line names the plotter's files. */
+Test(mpi, the_drawing_is_described_and_every_file_named)
+{
+  const char *m = mpi_bin();
+  write_scene();
+  cr_assert_eq(sh(MPIRUN " -n 2 %s run %s/s.ini --set anneal.sweeps=50 --set output.gcode=1 --out %s/g 2>%s/err.txt",
+                  m, dir, dir, dir), 0);
+  cr_assert_eq(sh("grep -q '^linewise: [0-9]* paths (' %s/err.txt && grep -q '^linewise: plot time about' %s/err.txt && "
+                  "grep -q '^linewise: done: .*final.gcode' %s/err.txt && test -s %s/g/final.gcode",
+                  dir, dir, dir, dir), 0, "the MPI run did not describe its drawing or name final.gcode");
+}
+
 Test(mpi, resume_with_other_process_counts_continues_bit_exactly)
 {
   const char *m = mpi_bin(), *b = lw_test_bin();
