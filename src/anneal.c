@@ -225,7 +225,10 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
   const lw_params *p = &a->params;
   char where[LW_PATH_MAX + 32];
   a->n_rep = p->replicas;
-  if (p->ladder[0]) {
+  /* the dynamics moves one system: a scene's ladder is for Monte Carlo
+  ** (lw_anneal_check_keys notes it) */
+  if (p->driver == LW_DRIVER_DYNAMICS) a->n_rep = 1;
+  else if (p->ladder[0]) {
     lw_params_origin(p, lw_params_find("tempering", "ladder"), where, sizeof where);
     int n = lw_number_list(p->ladder, 1, ladder, LW_TEMPERING_MAX);
     if (n < 2 || n > LW_TEMPERING_MAX)
@@ -239,24 +242,12 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
         return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected increasing positive "
                             "temperatures, got '%s'", where, p->ladder);
     a->n_rep = n;
-    a->params.replicas = n; /* scene.ini says how many rungs ran */
   } else if (a->n_rep > 1) {
     lw_params_origin(p, lw_params_find("tempering", "t_max"), where, sizeof where);
     if (!(p->t_max > p->t_min))
       return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.t_max': expected a value above t_min = %g, got %g",
                           where, p->t_min, p->t_max);
     lw_tempering_geometric(ladder, a->n_rep, p->t_min, p->t_max);
-  }
-  if (a->n_rep > 1 && p->driver == LW_DRIVER_DYNAMICS) {
-    lw_params_origin(p, lw_params_find("scene", "driver"), where, sizeof where);
-    return lw_error_set(err, LW_EINPUT, "%s: key 'scene.driver': the dynamics moves one system; parallel tempering "
-                        "(%d replicas) needs driver = metropolis", where, a->n_rep);
-  }
-  if (p->driver == LW_DRIVER_DYNAMICS && strcmp(p->domains, "off")) {
-    lw_params_origin(p, lw_params_find("anneal", "domains"), where, sizeof where);
-    return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.domains': domains split the sweeps of Monte Carlo; the "
-                        "dynamics moves every node at once (driver = dynamics): expected off, got '%s'", where,
-                        p->domains);
   }
   if (a->net && a->n_rep < a->net->size) {
     lw_params_origin(p, lw_params_find("tempering", "replicas"), where, sizeof where);
@@ -271,26 +262,29 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
 }
 
 /* What each driver reads of a scene besides its system's keys (system.h,
-** keys): the same run keys for both; Monte Carlo its schedule, its ladder and
-** its tuning, and no time step; the dynamics its time step and damping, and
-** no [moves] (a row's [moves] keys count only under Monte Carlo). */
-#define RUN_KEYS "scene.system", "scene.driver", "anneal.sweeps", "anneal.seed", "anneal.check_every", \
+** keys): the same run keys for both; Monte Carlo its schedule, its ladder,
+** its tuning and its recomputations from scratch; the dynamics its time
+** step and damping. */
+#define RUN_KEYS "scene.system", "scene.driver", "anneal.sweeps", "anneal.seed", \
     "anneal.quench", "anneal.quench_tol", "anneal.quench_iterations", "anneal.quench_stall", \
     "output.checkpoint_every", "output.trace_every", "output.observables", "output.samples_every", \
     "output.stats_from", "output.frames_every"
-static const char *const metropolis_keys[] = {RUN_KEYS, "anneal.*", "tempering.*", "moves.tune_sweeps", NULL};
+static const char *const metropolis_keys[] = {RUN_KEYS, "anneal.schedule", "anneal.t_start", "anneal.t_end",
+                                              "anneal.steps", "anneal.lambda", "anneal.table", "anneal.check_every",
+                                              "tempering.*", "moves.tune_sweeps", NULL};
 static const char *const dynamics_keys[] = {RUN_KEYS, "dynamics.dt", "dynamics.gamma", "dynamics.steps_per_sweep",
                                             "dynamics.integrator", NULL};
-static const char *const dynamics_skips[] = {"moves.*", NULL};
 static const char *const driver_names[] = {"metropolis", "dynamics"};
 
-/* Whether a scene of system t under driver (LW_DRIVER_*) reads key d. */
+/* Whether a scene of system t under driver (LW_DRIVER_*) reads key d: a
+** key the row names for one driver is read under that driver only, though
+** its `keys` name it too (a section's wildcard). */
 static int key_read(const lw_system_type *t, int driver, const lw_param_def *d)
 {
-  if (driver == LW_DRIVER_DYNAMICS)
-    return lw_params_named(dynamics_keys, d) || (lw_params_named(t->keys, d) && !lw_params_named(dynamics_skips, d)) ||
-           lw_params_named(t->keys_dynamics, d);
-  return lw_params_named(metropolis_keys, d) || lw_params_named(t->keys, d);
+  if (lw_params_named(driver == LW_DRIVER_DYNAMICS ? dynamics_keys : metropolis_keys, d)) return 1;
+  if (lw_params_named(t->keys_dynamics, d)) return driver == LW_DRIVER_DYNAMICS;
+  if (lw_params_named(t->keys_metropolis, d)) return driver == LW_DRIVER_METROPOLIS;
+  return lw_params_named(t->keys, d);
 }
 
 void lw_anneal_key_readers(const lw_param_def *d, char *buf, size_t n)
@@ -311,27 +305,20 @@ void lw_anneal_key_readers(const lw_param_def *d, char *buf, size_t n)
   else snprintf(buf, n, "%s under %s; %s under %s", sys[0], driver_names[0], sys[1], driver_names[1]);
 }
 
-/* A key the scene sets that its system reads under neither driver would
-** change nothing: refused, with the scenes that read it.  One that only the
-** other driver reads is noted (a->unread): one scene file may serve both
-** drivers of its system (--set scene.driver).  A run's own scene.ini
-** writes every key, unread ones at their defaults. */
-static lw_status check_keys_read(lw_anneal *a, lw_error *err)
+lw_status lw_anneal_check_keys(const lw_params *p, char *unread, size_t size, lw_error *err)
 {
-  const lw_params *p = &a->params;
   const lw_system_type *t = lw_system_of(p, err);
   if (!t) return err->code;
   size_t m = 0;
-  a->unread[0] = '\0';
+  if (size) unread[0] = '\0';
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
     if (!lw_params_given(p, d) || key_read(t, p->driver, d)) continue;
     char where[LW_PATH_MAX + 32], readers[300];
     lw_params_origin(p, d, where, sizeof where);
     if (key_read(t, !p->driver, d)) {
-      if (m < sizeof a->unread)
-        m += (size_t)snprintf(a->unread + m, sizeof a->unread - m, "%s%s.%s (%s)", m ? ", " : "", d->section,
-                              d->key, where);
+      if (m < size)
+        m += (size_t)snprintf(unread + m, size - m, "%s%s.%s (%s)", m ? ", " : "", d->section, d->key, where);
       continue;
     }
     lw_anneal_key_readers(d, readers, sizeof readers);
@@ -520,7 +507,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   double ladder[LW_TEMPERING_MAX];
   lw_phase_set("setting up the scene");
   if ((s = lw_params_resolve(&a->params, err)) || (s = setup_ladder(a, ladder, err)) ||
-      (s = check_keys_read(a, err)) || (s = setup_schedule(a, err)) ||
+      (s = lw_anneal_check_keys(&a->params, a->unread, sizeof a->unread, err)) || (s = setup_schedule(a, err)) ||
       (s = setup_system(a, err)))
     return s;
   const lw_params *rp = &a->params;
@@ -571,8 +558,30 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
 
 /* ---- checkpoints (checkpoint.c) ------------------------------------- */
 
+/* Before a resumed run's first sweep or checkpoint: a new end goes into
+** state.lw at once, or a kill before the first checkpoint would leave the old
+** one (this process holds every replica as read, so it writes them alone);
+** a finished run extended by --sweeps is no longer finished, and its summary
+** would describe a state that is gone (studies take a summary.json as the
+** sign of a finished run). */
+static lw_status settle_extension(lw_anneal *a, lw_error *err)
+{
+  if (!a->extending) return LW_OK;
+  a->extending = 0;
+  if (a->new_end) {
+    lw_status s = lw_checkpoint_write(a, err);
+    if (s) return s;
+  }
+  char path[LW_PATH_MAX + 32];
+  dir_file(path, sizeof path, a, "summary.json");
+  if (unlink(path) && errno != ENOENT) return lw_error_set(err, LW_EIO, "%s: cannot remove: %s", path, strerror(errno));
+  return LW_OK;
+}
+
 lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
 {
+  lw_status se = settle_extension(a, err);
+  if (se) return se;
   const char *was = lw_phase_get(NULL);
   lw_phase_set("writing state.lw");
   lw_status s = a->net ? a->net->checkpoint(a->net, a, err) : lw_checkpoint_write(a, err);
@@ -747,24 +756,19 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   if (tf) {
     if (fscanf(tf, "wall_seconds %lf", &a->wall_before) != 1 || !(a->wall_before >= 0 && a->wall_before < 1e12))
       a->wall_before = 0;
+    /* (absent before 2026-12-04: the rate then counts this process's sweeps) */
+    if (fscanf(tf, " sweep_seconds %lf", &a->sweep_seconds) != 1 ||
+        !(a->sweep_seconds >= 0 && a->sweep_seconds < 1e12))
+      a->sweep_seconds = 0;
     fclose(tf);
   }
   if (a->end_sweep < 0) a->end_sweep = a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep;
   const long saved_end = a->end_sweep;
   if (more >= 0) a->end_sweep = a->sweep + more;
   if (writes_files(a)) s = truncate_trace(a, trace_bytes, err);
-  if (!s && writes_files(a) && !lw_anneal_done(a)) {
-    /* a new end goes into state.lw at once, or a kill before the first
-    ** checkpoint would leave the old one; this process holds every replica
-    ** as read, so it writes them alone */
-    if (a->end_sweep != saved_end) s = lw_checkpoint_write(a, err);
-    /* a finished run extended by --sweeps is no longer finished: its
-    ** summary would describe a state that is gone (studies take a
-    ** summary.json as the sign of a finished run) */
-    dir_file(path, sizeof path, a, "summary.json");
-    if (!s && unlink(path) && errno != ENOENT)
-      s = lw_error_set(err, LW_EIO, "%s: cannot remove: %s", path, strerror(errno));
-  }
+  /* nothing is written yet: the caller may still refuse to go on */
+  a->extending = !s && writes_files(a) && !lw_anneal_done(a);
+  a->new_end = a->end_sweep != saved_end;
 out:
   lw_phase_set(NULL);
   for (int k = 1; k < LW_TEMPERING_MAX; k++) lw_ckpt_free(rep[k]);
@@ -917,6 +921,9 @@ static lw_status dynamics_sweep(lw_anneal *a, lw_error *err)
   const lw_params *p = &a->params;
   for (int k = 0; k < p->dyn_steps_per_sweep; k++) {
     lw_status s = lw_dynamics_step(a->dyn, err);
+    /* the scene was read and checked: what stops the motion now is the
+    ** run's failure (exit 1), its files kept */
+    if (s == LW_EINPUT) s = err->code = LW_ERUN;
     if (s) return s;
   }
   a->sweep++;
@@ -959,7 +966,7 @@ static lw_status refresh_replica(lw_anneal *a, int r, int renumber, double *drif
   return LW_OK;
 }
 
-lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
+static lw_status sweep_once(lw_anneal *a, lw_error *err)
 {
   if (a->dyn) return dynamics_sweep(a, err);
   const lw_params *p = &a->params;
@@ -1038,6 +1045,18 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
     if (s) return s;
   }
   return sweep_files(a, err);
+}
+
+/* The sweep timed: proposals_per_second is the sweeps' rate, not the set-up's
+** or the drawings' (which at 10^5 splines took four fifths of a short run). */
+lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
+{
+  lw_status s = settle_extension(a, err);
+  if (s) return s;
+  const double t0 = now_seconds();
+  s = sweep_once(a, err);
+  a->sweep_seconds += now_seconds() - t0;
+  return s;
 }
 
 /* One count of lw_move_stats (at byte offset `at`) per move kind, by name. */
@@ -1135,8 +1154,9 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   put_per_move(&j, "rejected_irregular", c, t, offsetof(lw_move_stats, irregular));
   put_per_move(&j, "rejected_crowded", c, t, offsetof(lw_move_stats, crowded));
   lw_json_key(&j, "wall_seconds"); lw_json_number(&j, wall);
-  lw_json_key(&j, "proposals_per_second"); /* of the whole run, as wall_seconds */
-  lw_json_number(&j, wall > 0 ? (double)prop / wall : 0.0);
+  lw_json_key(&j, "sweep_seconds"); lw_json_number(&j, a->sweep_seconds);
+  lw_json_key(&j, "proposals_per_second"); /* of the sweeps of the whole run */
+  lw_json_number(&j, a->sweep_seconds > 0 ? (double)prop / a->sweep_seconds : 0.0);
   lw_json_key(&j, "max_relative_drift"); lw_json_number(&j, a->max_drift);
   lw_json_key(&j, "temperature_final"); lw_json_number(&j, c->temperature);
   lw_json_key(&j, "schedule"); lw_json_string(&j, a->sched_type->name);
@@ -1251,8 +1271,17 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
   if (!rung_here(a, 0)) return LW_OK; /* the process of the coldest replica draws it */
   if (a->params.quench == LW_QUENCH_BFGS && !a->quenched) {
     lw_phase_set("quenching to the nearest minimum");
-    const lw_quench_opts o = {a->params.quench_tol, a->params.quench_iterations, a->params.quench_stall, a->stop};
+    /* the dynamics' pins hold in its quench too */
+    unsigned char *pinned = NULL;
+    if (a->dyn) {
+      const size_t n = a->sys_type->n_coords(a->sys->state);
+      if (!(pinned = malloc(n ? n : 1))) return lw_error_set(err, LW_ENOMEM, "out of memory for the quench's pins");
+      for (size_t i = 0; i < n; i++) pinned[i] = (unsigned char)a->sys_type->mass_pinned(a->dyn->mass, i);
+    }
+    const lw_quench_opts o = {a->params.quench_tol, a->params.quench_iterations, a->params.quench_stall, a->stop,
+                              pinned};
     s = lw_quench_run(a->sys, &o, &a->quench, err);
+    free(pinned);
     lw_phase_set(NULL);
     if (s) return s;
     if (a->quench.ended == LW_QUENCH_STOPPED) return LW_OK; /* state.lw holds the annealed state: resume quenches again */

@@ -199,7 +199,7 @@ lw_status lw_checkpoint_write_timing(const lw_anneal *a, lw_error *err)
   dir_file(path, sizeof path, a, "timing.txt");
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
   if (!f) return err->code;
-  fprintf(f, "wall_seconds %.6f\n", lw_anneal_seconds(a));
+  fprintf(f, "wall_seconds %.6f\nsweep_seconds %.6f\n", lw_anneal_seconds(a), a->sweep_seconds);
   return lw_output_commit(f, tmp, path, err);
 }
 

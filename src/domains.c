@@ -117,6 +117,25 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
                      "which picks a count that fits",
                      what);
     }
+    /* A group moves in a sweep only where its box falls inside one domain
+    ** (the grid lies anew each sweep): with boxes near a domain's size most
+    ** would never move, and the run would end near where it began.  Below a
+    ** quarter a sweep, refused (the photo preset's A4 page at 8 domains moves
+    ** 48 %, and draws as well as unsplit: docs/SCALING.md). */
+    double moved = 0.0;
+    size_t groups = 0, n = t->sites ? t->sites(c->sys->state) : t->sweep_size(c->sys->state);
+    for (size_t site = 0, k; site < n; site += k ? k : 1, groups++) {
+      double box[4];
+      k = t->group(c->sys->state, site, box);
+      moved += fmax(0.0, 1.0 - (box[2] - box[0]) * nx / w) * fmax(0.0, 1.0 - (box[3] - box[1]) * ny / h);
+    }
+    if (groups && moved < 0.25 * (double)groups) {
+      char what[200];
+      snprintf(what, sizeof what, " (domains %.4g x %.4g mm: %.0f %% of the moves' groups a sweep, a spline "
+               "as wide as a domain never)", w / nx, h / ny, 100.0 * moved / (double)groups);
+      return bad_key(p, err, "'%s': domains this small leave most of the state unmoved%s; expected fewer, or auto",
+                     what);
+    }
   }
   lw_domains *d = calloc(1, sizeof *d);
   if (!d) goto nomem;

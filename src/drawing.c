@@ -163,7 +163,8 @@ static lw_status close_share(const lw_params *p, const lw_scene *sc, const lw_st
   if (!owner || (by_pen && !pen)) {
     free(owner);
     free(pen);
-    return lw_error_set(err, LW_ENOMEM, "out of memory for the close share");
+    rep->close_share = NAN;
+    return LW_OK;
   }
   for (int q = 0; q < st->n_pens; q++)
     for (size_t k = st->pen_first[q]; k < st->pen_first[q + 1]; k++)
@@ -174,6 +175,13 @@ static lw_status close_share(const lw_params *p, const lw_scene *sc, const lw_st
   lw_status s = lw_close_share(st->b, owner, pen, st->n_segs, p->pen_width, &rep->close_share, err);
   free(owner);
   free(pen);
+  /* a score of the finished drawing, which its want of memory must not
+  ** fail: summary.json's close_share is then null */
+  if (s == LW_ENOMEM) {
+    rep->close_share = NAN;
+    lw_error_clear(err);
+    s = LW_OK;
+  }
   return s;
 }
 
@@ -355,16 +363,17 @@ static void clock_text(double s, char *buf, size_t n)
 void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
 {
   const lw_strokes_report *r = &d->post;
-  char clock[32];
+  char clock[32], close[96];
   clock_text(d->time_s, clock, sizeof clock);
+  if (isnan(d->close_share)) snprintf(close, sizeof close, "not measured (out of memory)");
+  else snprintf(close, sizeof close, "%.4f (of the line within a pen width of another stroke)", d->close_share);
   size_t k = 0;
   int w = snprintf(buf, n,
                    "linewise: %zu paths (%zu strokes: %zu joins, %zu cut by the crop, %zu outside it, %zu too short); "
                    "pen-up travel %.1f mm in index order, %.1f mm as plotted\n"
-                   "linewise: plot time about %s (%.0f s: %.0f mm pen down, %zu lifts); close share %.4f (of the "
-                   "line within a pen width of another stroke)\n",
+                   "linewise: plot time about %s (%.0f s: %.0f mm pen down, %zu lifts); close share %s\n",
                    d->paths, r->lifts_before, r->joins, r->cut, r->outside, r->dropped, d->travel_before,
-                   d->travel_after, clock, d->time_s, d->pen_down_mm, r->lifts_after, d->close_share);
+                   d->travel_after, clock, d->time_s, d->pen_down_mm, r->lifts_after, close);
   if (w < 0 || (size_t)w >= n) return;
   k = (size_t)w;
   if (!d->paths) {

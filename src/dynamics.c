@@ -327,5 +327,12 @@ lw_status lw_dynamics_step(lw_dynamics *d, lw_error *err)
                                               : leapfrog(d, err);
   if (!s && d->rho > 0.0) s = check_stable(d, err);
   if (!s) d->steps++;
+  /* a state the row cannot hold (a D-NURBS weight past the doubles' range)
+  ** says what it is, not what to do: the step that took it there */
+  if (s == LW_EINPUT && !strstr(err->msg, "dynamics.dt")) {
+    char msg[LW_ERROR_MSG];
+    snprintf(msg, sizeof msg, "%s", err->msg);
+    lw_error_set(err, LW_EINPUT, "the motion at t = %g s: %s: lower dynamics.dt (now %g s)", d->time, msg, d->dt);
+  }
   return s;
 }

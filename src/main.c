@@ -140,7 +140,7 @@ static int cmd_energy(int argc, char **argv)
     if (i + 1 >= argc) lw_error_set(&err, LW_EUSAGE, "--set: expected section.key=value");
     else set = !set_option(&p, argv[++i], &err);
   }
-  if (err.code || (set && lw_params_resolve(&p, &err))) {
+  if (err.code || (set && (lw_params_resolve(&p, &err) || lw_anneal_check_keys(&p, NULL, 0, &err)))) {
     lw_state_clear(&st);
     return fail(&err);
   }

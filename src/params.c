@@ -24,6 +24,7 @@
 #include "linewise/state.h"
 
 #define OFF(f) offsetof(lw_params, f)
+#define LW_PDF_SIDE_MAX 5080.0 /* mm: 14,400 points, the PDF reference's largest page */
 #define NUM(sec, key, T, f, def, unit, lo, hi, open, help) \
   {sec, key, T, OFF(f), def, unit, lo, hi, open, NULL, help, 0}
 #define CHOICE(sec, key, f, def, choices, help) \
@@ -352,7 +353,9 @@ const lw_param_def lw_param_table[] = {
   STRING("anneal", "domains", domains, "off", "",
          "Domain decomposition of each replica's sweeps (docs/NUMERICS.md, \"Domains\"): `off`; `N` "
          "(1 to 64), an N x N lattice of domains over the page, shifted at random each sweep, whose four "
-         "sub-lattices are swept in turn, the domains of each in parallel (OpenMP); `auto`, domains "
+         "sub-lattices are swept in turn, the domains of each in parallel (OpenMP); a spline moves in a "
+         "sweep only where it falls inside one domain, and a count that would move fewer than a quarter "
+         "of them a sweep is refused; `auto`, domains "
          "of side max(2.5 reach, 16 init.segments init.segment_length) (particles: 2.5 reach, the page "
          "their grid's box in x and y), at most 64 a side, not split "
          "when fewer than 2 fit a side. The result depends on this key, never on the threads. docs/SCALING.md."),
@@ -385,7 +388,8 @@ const lw_param_def lw_param_table[] = {
       "Hottest temperature of the geometric ladder."),
   STRING("tempering", "ladder", ladder, "", "energy",
          "Explicit ladder `t0 t1 ...` (increasing; overrides t_min and t_max; its length sets the "
-         "replicas). A run with ladder tuning writes its tuned ladder to ladder.ini for reuse."),
+         "replicas, and `replicas` may stay 1, as a run's scene.ini then keeps it). A run with ladder "
+         "tuning writes its tuned ladder to ladder.ini for reuse."),
   NUM("tempering", "exchange_every", LW_PT_INT, exchange_every, "1", "sweeps", 1, 2e9, 0,
       "Sweeps between exchange steps; steps alternate between even (0-1, 2-3, ...) and odd pairs."),
   CHOICE("tempering", "tune_ladder", tune_ladder, "fixed", "fixed|equal",
@@ -431,7 +435,7 @@ const lw_param_def lw_param_table[] = {
   NUM("output", "png_scale", LW_PT_DOUBLE, png_scale, "4", "px/mm", 0, 100, LW_MIN_OPEN,
       "Pixels per millimetre of final.png and the frames (the long side is capped at 4096 px)."),
   NUM("output", "pdf", LW_PT_INT, pdf, "0", "", 0, 1, 0,
-      "1 = also write final.pdf, a vector PDF of the page."),
+      "1 = also write final.pdf, a vector PDF of the page (at most 5080 mm a side, as PDF allows)."),
   NUM("output", "hpgl", LW_PT_INT, hpgl, "0", "", 0, 1, 0,
       "1 = also write final.hpgl, the drawing in HP-GL for pen plotters that read no SVG (HP, Roland; a "
       "pen a carousel slot): the curves as chords within plot.tolerance, in plotter units of 0.025 mm "
@@ -924,7 +928,8 @@ static int at_default(const lw_params *p, const lw_param_def *d)
 
 int lw_params_given(const lw_params *p, const lw_param_def *d)
 {
-  return !p->of_run && p->line[d - lw_param_table] && !at_default(p, d);
+  const int line = p->line[d - lw_param_table];
+  return line && !(p->of_run && line > 0) && !at_default(p, d);
 }
 
 int lw_params_named(const char *const *patterns, const lw_param_def *d)
@@ -1318,6 +1323,14 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
                         : p->plot_turn ? ", or plot.turn = 0, which fits"
                                        : ", or plot.turn = 90, which fits");
   }
+  /* PDF readers take pages of at most 14,400 points a side (5080 mm), and
+  ** cairo's PDF of a page of kilometres ran out of memory or crashed */
+  if (p->pdf && (p->width > LW_PDF_SIDE_MAX || p->height > LW_PDF_SIDE_MAX)) {
+    lw_params_origin(p, lw_params_find("output", "pdf"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'output.pdf': a page of %g x %g mm; PDF pages are at most %g mm "
+                        "a side (14,400 points): expected 0, or a smaller page", where, p->width, p->height,
+                        LW_PDF_SIDE_MAX);
+  }
   return LW_OK;
 }
 
@@ -1370,7 +1383,7 @@ static const char *const file_keys[] = {"plot.*", "output.pen_colors", "output.p
                                         "output.order", "output.checkpoint_every", "output.frames_every",
                                         "output.samples_every", "output.stats_from", "nurbs.svg_tolerance",
                                         "nurbs.png_scale", "particles.view_azimuth", "particles.view_elevation",
-                                        "particles.png_size", "particles.disc", NULL};
+                                        "particles.png_size", "particles.disc", "output.pens", NULL};
 
 unsigned long long lw_params_run_hash(const lw_params *p)
 {
@@ -1378,7 +1391,7 @@ unsigned long long lw_params_run_hash(const lw_params *p)
   char line[LW_PATH_MAX + 4200];
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
-    if (at_default(p, d) || lw_params_named(file_keys, d)) continue;
+    if ((p->of_run && p->line[i] <= 0) || lw_params_named(file_keys, d)) continue;
     int n = snprintf(line, sizeof line, "%s.%s=", d->section, d->key);
     value_text(p, d, line + n, sizeof line - (size_t)n);
     for (const char *c = line; *c; c++) h = (h ^ (unsigned char)*c) * 0x100000001b3ULL;

@@ -57,6 +57,7 @@ typedef struct {
   double rho[MEMORY], a[MEMORY];
   int used, head;
   unsigned char *held;             /* n: this step's held coordinates */
+  const unsigned char *pinned;     /* NULL, or n: coordinates never moved (lw_quench_opts) */
   long evaluations, forbidden, holds;
   int away;                        /* the state stands at a rejected trial, not at x */
 } lbfgs;
@@ -92,6 +93,10 @@ static double evaluate(lbfgs *q, const double *x, double *g, lw_error *err)
     return INFINITY;
   }
   double e = t->gradient(q->sys->state, g, &e2);
+  /* a coordinate that feels no force is never moved: the steps are made of
+  ** gradients (L-BFGS's pairs keep it 0 too) */
+  for (size_t i = 0; q->pinned && i < q->n; i++)
+    if (q->pinned[i]) g[i] = 0.0;
   if (isnan(e)) {
     lw_error_set(err, e2.code ? e2.code : LW_EINPUT, "quench: %s", e2.msg);
     return NAN;
@@ -261,7 +266,7 @@ lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_repor
   if (!t->gradient || !t->n_coords || !t->get_coords || !t->set_coords)
     return lw_error_set(err, LW_EINPUT, "quench: the %s system has no gradient", t->name);
   const size_t n = t->n_coords(sys->state), nb = (n ? n : 1) * sizeof(double);
-  lbfgs q = {.sys = sys, .n = n};
+  lbfgs q = {.sys = sys, .n = n, .pinned = o->pinned};
   int ok = (q.x = malloc(nb)) && (q.g = malloc(nb)) && (q.x1 = malloc(nb)) && (q.g1 = malloc(nb)) &&
            (q.d = malloc(nb)) && (q.d0 = malloc(nb)) && (q.held = calloc(n ? n : 1, 1));
   for (int k = 0; ok && k < MEMORY; k++) ok = (q.s[k] = malloc(nb)) && (q.y[k] = malloc(nb));

@@ -1105,12 +1105,16 @@ static void describe(const void *state, int what, char *buf, size_t n)
 
 /* The wire's load acts on Monte Carlo too; its ends are held by
 ** nurbs.fixed, not the dynamics' pins. */
-static const char *const keys[] = {"init.from", "moves.step_point", "moves.target", "nurbs.*", "dynamics.rho",
-                                   "dynamics.gravity_x", "dynamics.gravity_y", NULL};
+static const char *const keys[] = {"init.from", "nurbs.*", "dynamics.rho", "dynamics.gravity_x", "dynamics.gravity_y",
+                                   NULL};
+static const char *const keys_dynamics[] = {"nurbs.weight_inertia", NULL};
+static const char *const keys_metropolis[] = {"moves.step_point", "moves.target", "nurbs.step_weight", NULL};
 
 const lw_system_type lw_system_nurbs = {
     .name = "nurbs",
     .keys = keys,
+    .keys_dynamics = keys_dynamics,
+    .keys_metropolis = keys_metropolis,
     .n_moves = 2,
     .move_names = move_names,
     .move_unit = move_unit,

@@ -467,15 +467,20 @@ static void describe(const void *state, int what, char *buf, size_t n)
 }
 
 /* The particles' load is particles.gravity and their pins particles.pinned,
-** not the dynamics' keys; only they have dampers between neighbours. */
-static const char *const keys[] = {"init.from", "moves.translate", "moves.rotate", "moves.step_translate",
-                                   "moves.step_rotate", "moves.target_spline", "particles.*", NULL};
+** not the dynamics' keys; only they have dampers between neighbours; births
+** and deaths are Monte Carlo's moves. */
+static const char *const keys[] = {"init.from", "particles.*", NULL};
 static const char *const keys_dynamics[] = {"dynamics.rho", "dynamics.dashpot", "dynamics.dashpot_angular", NULL};
+static const char *const keys_metropolis[] = {"moves.translate", "moves.rotate", "moves.step_translate",
+                                              "moves.step_rotate", "moves.target_spline", "particles.birth",
+                                              "particles.death", "particles.chem", "particles.max_count",
+                                              "anneal.domains", NULL};
 
 /* The rows differ only in their move kinds (sys_particles.h). */
 #define PARTICLES_ROW \
     .keys = keys, \
     .keys_dynamics = keys_dynamics, \
+    .keys_metropolis = keys_metropolis, \
     .n_observables = (int)(sizeof observable_names / sizeof observable_names[0]), \
     .observable_names = observable_names, \
     .observe = observe, \

@@ -1259,15 +1259,17 @@ static int mass_pinned(const void *mass, size_t i) { return lw_spline_mass_pinne
 
 /* Every key of the page, the curves and their drawing; the load acts on
 ** Monte Carlo too, the pins only in the dynamics. */
-static const char *const keys[] = {"scene.*", "init.*", "energy.*", "moves.*", "output.*", "plot.*", "layers.*",
+static const char *const keys[] = {"scene.*", "init.*", "energy.*", "output.*", "plot.*", "layers.*",
                                    "dynamics.rho", "dynamics.gravity_x", "dynamics.gravity_y", "dynamics.force_x",
                                    "dynamics.force_y", NULL};
 static const char *const keys_dynamics[] = {"dynamics.pin", "dynamics.pin_vectors", NULL};
+static const char *const keys_metropolis[] = {"moves.*", "anneal.delayed_acceptance", "anneal.domains", NULL};
 
 /* The rows differ only in their move kinds (sys_splines.h). */
 #define SPLINES_ROW \
   .keys = keys, \
   .keys_dynamics = keys_dynamics, \
+  .keys_metropolis = keys_metropolis, \
   .n_terms = LW_TERM_COUNT, \
   .term_names = lw_term_names, \
   .setup_new = setup_new, \

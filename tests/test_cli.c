@@ -254,12 +254,33 @@ Test(cli, keys_the_system_never_reads_are_refused)
   snprintf(args, sizeof args, "run %s/q.ini --out %s/q --quiet", dir, dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
   cr_assert(strstr(errs, "q.ini:6: key 'energy.bending'"), "%s", errs);
+  /* energy --set of a key the run's system never reads measures nothing */
+  snprintf(args, sizeof args, "energy %s/p --set energy.quadrature=32", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "--set: key 'energy.quadrature': the particles system reads it under neither driver"), "%s",
+            errs);
+  snprintf(args, sizeof args, "energy %s/p --set particles.r0=1.1", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   /* the other driver's keys: a note, and the run */
   snprintf(args, sizeof args, "run %s/params/hanging.ini --set anneal.sweeps=1 --set moves.point=3 --out %s/h",
            lw_test_root(), dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   cr_assert(strstr(errs, "linewise: note: under driver = dynamics these keys have no effect: ") &&
             strstr(errs, "moves.point (--set)"), "%s", errs);
+}
+
+/* A PDF page past what PDF allows (14,400 points) is refused before the run:
+** cairo's PDF of a page of kilometres ran out of memory or crashed. */
+Test(cli, a_pdf_page_past_what_pdf_allows_is_refused)
+{
+  char out[1024], errs[2048], args[512];
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --quiet --set scene.width=6000 --set output.pdf=1 --out %s/pdf",
+           lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "key 'output.pdf': a page of 6000 x 100 mm; PDF pages are at most 5080 mm"), "%s", errs);
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --quiet --set scene.width=5000 --set output.pdf=1 "
+           "--set anneal.sweeps=1 --out %s/pdf", lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
 }
 
 Test(cli, empty_scene_has_zero_energy)

@@ -237,9 +237,11 @@ Test(domains, bad_values_are_refused_naming_the_key)
   refused(dir, NULL, "3x", "expected off, auto or a count");
   /* 300 mm in 40 domains is 7.5 mm, under twice the reach of the pair grid and tone */
   refused(dir, NULL, "40", "wider than twice the reach");
+  /* domains narrower than the splines (32 mm in 33 mm): 7 % would move a sweep */
+  refused(dir, "params/minimal.ini --set init.splines=60", "3", "leave most of the state unmoved");
   /* a system whose row cannot split (the NURBS curve under Monte Carlo):
   ** refused, not run serially behind the user's back */
-  refused(dir, "params/wire.ini --set scene.driver=metropolis", "2", "cannot split its sweeps");
+  refused(dir, "params/wire.ini --set scene.driver=metropolis", "2", "the nurbs system reads it under neither driver");
   lw_test_dir_remove(dir);
 }
 

@@ -572,7 +572,7 @@ static lw_quench_report quench_splines(const lw_scene *sc, size_t n, size_t segs
   lw_system *sys = lw_splines_view(m, &err);
   cr_assert_not_null(sys);
   lw_quench_report r;
-  const lw_quench_opts o = {1e-6, 5000, 0.0, NULL};
+  const lw_quench_opts o = {1e-6, 5000, 0.0, NULL, NULL};
   cr_assert_eq(lw_quench_run(sys, &o, &r, &err), LW_OK, "%s", err.msg);
   lw_system_free(sys);
   *out = m;
@@ -731,7 +731,7 @@ Test(quench, measures_each_trial_from_where_it_stands)
   lw_error err = {0};
   lw_system sys = {&walled_type, &w};
   lw_quench_report r;
-  const lw_quench_opts o = {1e-8, 500, 0.0, NULL};
+  const lw_quench_opts o = {1e-8, 500, 0.0, NULL, NULL};
   cr_assert_eq(lw_quench_run(&sys, &o, &r, &err), LW_OK, "%s", err.msg);
   cr_log_info("walled: %.10g -> %.10g, %ld iterations, %ld evaluations, %ld holds, %ld checks, %ld stale, %ld forbidden", r.energy_before,
               r.energy_after, r.iterations, r.evaluations, r.holds, w.checks, w.stale, r.forbidden);
@@ -783,7 +783,7 @@ Test(quench, a_stop_ends_it_and_says_so)
     const double e0 = lw_model_total(m);
     volatile sig_atomic_t stop = asked;
     lw_quench_report r;
-    const lw_quench_opts o = {1e-6, 5000, 0.0, &stop};
+    const lw_quench_opts o = {1e-6, 5000, 0.0, &stop, NULL};
     cr_assert_eq(lw_quench_run(sys, &o, &r, &err), LW_OK, "%s", err.msg);
     cr_assert_eq(r.ended == LW_QUENCH_STOPPED, asked);
     if (asked) {

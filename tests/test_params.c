@@ -501,6 +501,8 @@ Test(params, a_key_is_given_only_with_a_value_of_its_own)
   cr_assert(!lw_params_given(&p, lw_params_find("energy", "pair")), "not named");
   cr_assert_eq(lw_params_read_run(&p, path, &err), LW_OK, "%s", err.msg);
   cr_assert(!lw_params_given(&p, lw_params_find("energy", "strain")), "a run's own scene.ini");
+  cr_assert_eq(lw_params_set(&p, "energy.pair=0.5", &err), LW_OK, "%s", err.msg);
+  cr_assert(lw_params_given(&p, lw_params_find("energy", "pair")), "--set on a run's scene.ini");
   unlink(path);
   static const char *const pat[] = {"energy.strain", "plot.*", NULL};
   cr_assert(lw_params_named(pat, lw_params_find("energy", "strain")));
@@ -526,6 +528,9 @@ Test(params, every_key_has_a_reader)
     {"dynamics", "dt", "all under dynamics"},
     {"tempering", "replicas", "all under metropolis"},
     {"moves", "point", "splines under metropolis"},
+    {"particles", "birth", "particles under metropolis"},
+    {"nurbs", "weight_inertia", "nurbs under dynamics"},
+    {"anneal", "delayed_acceptance", "splines under metropolis"},
     {"dynamics", "pin", "splines under dynamics"},
     {"dynamics", "rho", "splines, nurbs under metropolis; all under dynamics"},
   };

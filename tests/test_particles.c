@@ -1441,7 +1441,7 @@ Test(particles, the_quench_and_the_motion_keep_pinned_particles_to_the_bit)
     lw_system *sys = lw_system_wrap(&lw_system_particles, p, &err);
     cr_assert_not_null(sys, "%s", err.msg);
     if (driver == 0) {
-      const lw_quench_opts o = {1e-6, 3000, 0.0, NULL};
+      const lw_quench_opts o = {1e-6, 3000, 0.0, NULL, NULL};
       lw_quench_report r;
       cr_assert_eq(lw_quench_run(sys, &o, &r, &err), LW_OK, "%s", err.msg);
       cr_assert_lt(r.energy_after, e0 - 0.5 * fabs(e0), "quenched %g -> %g", e0, r.energy_after);

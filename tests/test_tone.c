@@ -671,7 +671,7 @@ Test(tone, the_quench_keeps_the_spacing)
     cr_assert_not_null(m, "%s", err.msg);
     lw_system *sys = lw_splines_view(m, &err);
     cr_assert_not_null(sys, "%s", err.msg);
-    const lw_quench_opts o = {1e-9, 100, 0.0, NULL};
+    const lw_quench_opts o = {1e-9, 100, 0.0, NULL, NULL};
     lw_quench_report r;
     cr_assert_eq(lw_quench_run(sys, &o, &r, &err), LW_OK, "%s", err.msg);
     close[on] = close_pairs(&sc, m->sp, 0.3);

@@ -56,6 +56,7 @@ typedef struct lw_anneal {
   unsigned long seed;
   long sweep;                  /* sweeps done */
   long end_sweep;              /* stop after this sweep */
+  int extending, new_end;      /* a resume to settle before its first sweep (anneal.c) */
   unsigned long long scene_hash; /* lw_params_run_hash of scene.ini, kept in state.lw */
   long block;                  /* current temperature step */
   double t_prev;               /* temperature of the previous step */
@@ -64,6 +65,7 @@ typedef struct lw_anneal {
   double max_drift;            /* largest relative drift seen at a check */
   double energy_initial;
   double wall_before;          /* seconds spent before a resume */
+  double sweep_seconds;        /* seconds in sweeps, with the processes before (timing.txt) */
   double wall_start;           /* monotonic clock at start of this process */
   lw_move_stats trace_mark[LW_MOVES_MAX]; /* stats at the last trace row */
   int quenched;                /* 1 once lw_anneal_finish has quenched (anneal.quench) */
@@ -110,9 +112,16 @@ void lw_anneal_free(lw_anneal *a);
 
 /* Which scenes read key d, for messages and docs/PARAMETERS.md: "all",
 ** "splines", "all under dynamics", "splines, nurbs under metropolis; all
-** under dynamics".  A scene that gives another key a value of its own is
-** refused when it starts (system.h, keys). */
+** under dynamics". */
 void lw_anneal_key_readers(const lw_param_def *d, char *buf, size_t n);
+
+/* LW_EINPUT, naming where it was set and who reads it, when p gives a key
+** (lw_params_given) that its system reads under neither driver: it would
+** change nothing, and a study that varied it would measure noise.  Keys
+** only the other driver reads are listed in unread (size bytes, may be 0):
+** one scene file may serve both drivers of its system.  lw_anneal_start
+** calls it. */
+lw_status lw_anneal_check_keys(const lw_params *p, char *unread, size_t size, lw_error *err);
 
 
 /* Current temperature, energy and overall acceptance (for progress displays). */

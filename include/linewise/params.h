@@ -296,9 +296,9 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err);
 lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err);
 
 /* A hash of the keys that steer a run (all but [plot] and the keys that
-** only shape the final files) where they differ from their defaults, as
-** scene.ini writes them (so a key a later build adds, at its default,
-** changes nothing).  state.lw keeps it, so that a resume refuses a
+** only shape the final files), as scene.ini writes them: all of them, or of
+** a run's own scene.ini those it holds (a later build knows more, and its
+** defaults may differ).  state.lw keeps it, so that a resume refuses a
 ** scene.ini edited since. */
 unsigned long long lw_params_run_hash(const lw_params *p);
 
@@ -306,8 +306,8 @@ unsigned long long lw_params_run_hash(const lw_params *p);
 int lw_params_write(const lw_params *p, FILE *f);
 
 /* Whether the scene gives key d a value of its own: from its file or
-** --set, and other than the default.  Never for a run's scene.ini, which
-** writes every key. */
+** --set, and other than the default.  Of a run's scene.ini, which writes
+** every key, only --set counts. */
 int lw_params_given(const lw_params *p, const lw_param_def *d);
 
 /* Whether patterns (NULL-terminated "section.key" or "section.*"; NULL:

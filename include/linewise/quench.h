@@ -62,6 +62,8 @@ typedef struct {
                    ** did not fall below LW_QUENCH_STALL_GRADIENT of its value over them
                    ** (0: never) */
   const volatile sig_atomic_t *stop; /* may be NULL; set (a signal): stop at the next iteration */
+  const unsigned char *pinned; /* NULL, or 1 at the coordinates the scene holds besides those the row
+                               ** holds itself (the dynamics' pins): never moved */
 } lw_quench_opts;
 
 /* Quenches the state of sys in place until one of o's rules, or no step

@@ -7,8 +7,8 @@
 **
 ** Each segment is cut into k = ceil(length / (d / 2)) pieces of equal
 ** parameter (at most LW_SPACING_POINTS_MAX), each piece stands for its
-** midpoint with the length |r'(t)| / k, and the points go into a cell grid
-** (grid.h) of side d.  A point counts as close when a point of another
+** midpoint with the length |r'(t)| / k, and the points are sorted into cells
+** at least d wide (no more cells than points).  A point counts as close when a point of another
 ** spline lies within d of it.  Points are at most d / 2 apart along a
 ** line, so the nearest point of a line at true distance x < d is within
 ** sqrt(x^2 + d^2 / 16) of it: only lines between 0.968 d and d apart can be

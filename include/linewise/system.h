@@ -70,15 +70,17 @@ struct lw_system_type {
   int n_terms;                        /* energy terms, <= LW_SYSTEM_TERMS_MAX ... */
   const char *const *term_names;      /* ... by name: trace columns, summary, state.lw */
 
-  /* The scene keys the row reads, "section.key" or "section.*" (NULL-
-  ** terminated): under any driver (its [moves] keys only under Monte
-  ** Carlo), and under the dynamics only.  The drivers' own keys ([anneal],
+  /* The scene keys the row reads, "section.key" or "section.*" (each list
+  ** NULL-terminated, or NULL): under either driver, and under the dynamics
+  ** or Monte Carlo only (a key named there is read under that driver only,
+  ** though `keys` names its section).  The drivers' own keys (the schedule,
   ** [tempering], a run's outputs, the time step) need no listing.  A scene
-  ** that gives a key a value of its own that neither its row nor its
-  ** driver reads is refused before the run (anneal.c): it would change
-  ** nothing, and a study that varied it would measure noise. */
+  ** that gives a key the row reads under neither driver a value of its own
+  ** is refused before the run (anneal.c): it would change nothing, and a
+  ** study that varied it would measure noise. */
   const char *const *keys;
   const char *const *keys_dynamics;
+  const char *const *keys_metropolis;
 
   /* The shared set-up of a scene (NULL and err set on bad input, naming the
   ** parameter's file and line), and a note for the user or "" (e.g. a
