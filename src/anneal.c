@@ -1287,7 +1287,7 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
     if (a->quench.ended == LW_QUENCH_STOPPED) return LW_OK; /* state.lw holds the annealed state: resume quenches again */
     a->quenched = 1;
   }
-  lw_phase_set("drawing the final files (ordering the paths, then each file)");
+  lw_phase_set("drawing the final files and scoring them");
   if (!(s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_FINAL, err))) s = write_summary(a, err);
   lw_phase_set(NULL);
   return s;

@@ -274,8 +274,8 @@ Test(cli, keys_the_system_never_reads_are_refused)
 Test(cli, a_pdf_page_past_what_pdf_allows_is_refused)
 {
   char out[1024], errs[2048], args[512];
-  snprintf(args, sizeof args, "run %s/params/minimal.ini --quiet --set scene.width=6000 --set output.pdf=1 --out %s/pdf",
-           lw_test_root(), dir);
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --quiet --set scene.width=6000 --set output.pdf=1 "
+           "--out %s/pdf", lw_test_root(), dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
   cr_assert(strstr(errs, "key 'output.pdf': a page of 6000 x 100 mm; PDF pages are at most 5080 mm"), "%s", errs);
   snprintf(args, sizeof args, "run %s/params/minimal.ini --quiet --set scene.width=5000 --set output.pdf=1 "
