@@ -873,6 +873,74 @@ Test(tone, close_share_of_known_layouts)
   lw_splines_free(sp);
 }
 
+/* The close share against every pair of its points: random curved
+** segments, strokes of three, packed tight enough that much of the line is
+** close, and one stroke far off, so that the cells grow past the pen width
+** (no more cells than points).  The points are the documented
+** ones (FORMATS.md): k = ceil(control polygon / (d / 2)) pieces of equal
+** parameter, each its midpoint with the length |r'| / k. */
+Test(tone, close_share_equals_a_search_of_every_pair)
+{
+  enum { SEGS = 300 };
+  const double d = 0.35;
+  static double b[8 * SEGS];
+  static size_t owner[SEGS], group[SEGS];
+  unsigned long r = 12345;
+  for (int g = 0; g < SEGS; g++) {
+    double x = 0, y = 0;
+    for (int k = 0; k < 8; k += 2) {
+      /* a stroke of 3 segments every 3, in one of two pens */
+      r = r * 6364136223846793005UL + 1442695040888963407UL;
+      double u = (double)(r >> 11) / 9007199254740992.0;
+      r = r * 6364136223846793005UL + 1442695040888963407UL;
+      double v = (double)(r >> 11) / 9007199254740992.0;
+      if (k == 0) x = (g % 3 && g) ? b[8 * (g - 1) + 6] : 60.0 * u, y = (g % 3 && g) ? b[8 * (g - 1) + 7] : 8.0 * v;
+      if (k == 0 && g == SEGS - 3) x = 3000.0; /* a stroke far off: the grid's box grows */
+      else x += 3.0 * (u - 0.3), y += 1.0 * (v - 0.5);
+      b[8 * g + k] = x;
+      b[8 * g + k + 1] = y;
+    }
+    owner[g] = (size_t)g / 3;
+    group[g] = ((size_t)g / 3) % 2;
+  }
+  for (int grouped = 0; grouped < 2; grouped++) {
+    double share;
+    cr_assert_eq(lw_close_share(b, owner, grouped ? group : NULL, SEGS, d, &share, NULL), LW_OK);
+    /* every point against every point */
+    static double px[SEGS * 64], py[SEGS * 64], len[SEGS * 64];
+    static size_t who[SEGS * 64], grp[SEGS * 64];
+    size_t n = 0;
+    for (int g = 0; g < SEGS; g++) {
+      const double *z = b + 8 * g;
+      double poly = hypot(z[2] - z[0], z[3] - z[1]) + hypot(z[4] - z[2], z[5] - z[3]) + hypot(z[6] - z[4], z[7] - z[5]);
+      size_t k = (size_t)ceil(poly / (0.5 * d));
+      cr_assert(k >= 1 && k <= 64);
+      for (size_t q = 0; q < k; q++, n++) {
+        double t = ((double)q + 0.5) / (double)k, u = 1.0 - t;
+        px[n] = u * u * u * z[0] + 3 * u * u * t * z[2] + 3 * u * t * t * z[4] + t * t * t * z[6];
+        py[n] = u * u * u * z[1] + 3 * u * u * t * z[3] + 3 * u * t * t * z[5] + t * t * t * z[7];
+        double dx = 3 * u * u * (z[2] - z[0]) + 6 * u * t * (z[4] - z[2]) + 3 * t * t * (z[6] - z[4]);
+        double dy = 3 * u * u * (z[3] - z[1]) + 6 * u * t * (z[5] - z[3]) + 3 * t * t * (z[7] - z[5]);
+        len[n] = (float)(hypot(dx, dy) / (double)k);
+        who[n] = owner[g];
+        grp[n] = grouped ? group[g] : 0;
+      }
+    }
+    double close = 0.0, all = 0.0;
+    for (size_t p = 0; p < n; p++) {
+      int found = 0;
+      for (size_t o = 0; o < n && !found; o++)
+        found = who[o] != who[p] && grp[o] == grp[p] && (px[o] - px[p]) * (px[o] - px[p]) +
+                (py[o] - py[p]) * (py[o] - py[p]) < d * d;
+      all += len[p];
+      if (found) close += len[p];
+    }
+    cr_assert(close > 0.1 * all && close < 0.9 * all, "a layout that tests little: %g of %g", close, all);
+    cr_assert(fabs(share - close / all) < 1e-12, "grouped %d: %.17g against every pair's %.17g", grouped, share,
+              close / all);
+  }
+}
+
 Test(tone, runs_resume_and_thread_counts_give_the_same_bytes)
 {
   /* Through the binary: a scene with the tone term and the spacing
