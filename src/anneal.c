@@ -558,13 +558,13 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
 
 /* ---- checkpoints (checkpoint.c) ------------------------------------- */
 
-/* Before a resumed run's first sweep or checkpoint: a new end goes into
-** state.lw at once, or a kill before the first checkpoint would leave the old
-** one (this process holds every replica as read, so it writes them alone);
+/* A new end goes into state.lw before the first sweep, or a kill before the
+** first checkpoint would leave the old one (this process holds every replica
+** as read, so it writes them alone);
 ** a finished run extended by --sweeps is no longer finished, and its summary
 ** would describe a state that is gone (studies take a summary.json as the
 ** sign of a finished run). */
-static lw_status settle_extension(lw_anneal *a, lw_error *err)
+lw_status lw_anneal_settle(lw_anneal *a, lw_error *err)
 {
   if (!a->extending) return LW_OK;
   a->extending = 0;
@@ -580,7 +580,7 @@ static lw_status settle_extension(lw_anneal *a, lw_error *err)
 
 lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
 {
-  lw_status se = settle_extension(a, err);
+  lw_status se = lw_anneal_settle(a, err);
   if (se) return se;
   const char *was = lw_phase_get(NULL);
   lw_phase_set("writing state.lw");
@@ -1051,7 +1051,7 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
 ** or the drawings' (which at 10^5 splines took four fifths of a short run). */
 lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
 {
-  lw_status s = settle_extension(a, err);
+  lw_status s = lw_anneal_settle(a, err);
   if (s) return s;
   const double t0 = now_seconds();
   s = sweep_once(a, err);

@@ -609,6 +609,10 @@ static int cmd_resume(int argc, char **argv)
     lw_anneal_free(&a);
     return watched_fail(&w, &err);
   }
+  if (lw_anneal_settle(&a, &err)) {
+    lw_anneal_free(&a);
+    return watched_fail(&w, &err);
+  }
   if (!quiet) fprintf(stderr, "linewise: resuming %s at sweep %ld of %ld\n", dir, a.sweep, a.end_sweep);
   int rc = anneal_loop(&a, stop_at, quiet, asked, &w, &err);
   lw_anneal_free(&a);

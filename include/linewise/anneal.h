@@ -91,6 +91,12 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
 lw_status lw_anneal_resume(lw_anneal *a, const char *dir, long more, lw_error *err);
 lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anneal_net *net, lw_error *err);
 
+/* What a resume writes once it is to go on: a new end (--sweeps) into
+** state.lw, and a finished run's summary.json removed.  Nothing before, so
+** that a caller may still refuse to go on; the first sweep or checkpoint
+** does it where the caller did not. */
+lw_status lw_anneal_settle(lw_anneal *a, lw_error *err);
+
 /* One sweep with everything that falls due after it (trace row, drift check,
 ** checkpoint). */
 lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err);
