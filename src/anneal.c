@@ -560,10 +560,9 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
 
 /* A new end goes into state.lw before the first sweep, or a kill before the
 ** first checkpoint would leave the old one (this process holds every replica
-** as read, so it writes them alone);
-** a finished run extended by --sweeps is no longer finished, and its summary
-** would describe a state that is gone (studies take a summary.json as the
-** sign of a finished run). */
+** as read, so it writes them alone); a finished run extended by --sweeps is
+** no longer finished, and its summary would describe a state that is gone
+** (studies take a summary.json as the sign of a finished run). */
 lw_status lw_anneal_settle(lw_anneal *a, lw_error *err)
 {
   if (!a->extending) return LW_OK;
