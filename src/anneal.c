@@ -167,10 +167,13 @@ static lw_status clear_run(const char *dir, lw_error *err)
   return clear_numbered(dir, "samples", "sample-", ".csv", err);
 }
 
-/* Schedule and its table (relative to the scene file). */
+/* Schedule and its table (relative to the scene file).  The dynamics has no
+** temperature: its scene's schedule keys are only noted as unread
+** (lw_anneal_check_keys), not checked. */
 static lw_status setup_schedule(lw_anneal *a, lw_error *err)
 {
   const lw_params *p = &a->params;
+  if (p->driver == LW_DRIVER_DYNAMICS) return LW_OK;
   const lw_param_def *d = lw_params_find("anneal", "schedule");
   char where[LW_PATH_MAX + 32];
   lw_params_origin(p, d, where, sizeof where);
@@ -1147,18 +1150,25 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json_key(&j, "sweeps"); lw_json_int(&j, a->sweep);
   lw_json_key(&j, "system"); lw_json_string(&j, t->name);
   t->summary(a->sys->state, &j);
-  lw_json_key(&j, "proposals"); lw_json_int(&j, (long long)prop);
-  lw_json_key(&j, "accepted"); lw_json_int(&j, (long long)acc);
-  lw_json_key(&j, "rejected_nan"); lw_json_int(&j, (long long)nan);
-  put_per_move(&j, "rejected_irregular", c, t, offsetof(lw_move_stats, irregular));
-  put_per_move(&j, "rejected_crowded", c, t, offsetof(lw_move_stats, crowded));
+  /* the dynamics proposes nothing and has no temperature: what Monte Carlo
+  ** counts would read as zeros and the unread schedule's name */
+  const int mc = !a->dyn;
+  if (mc) {
+    lw_json_key(&j, "proposals"); lw_json_int(&j, (long long)prop);
+    lw_json_key(&j, "accepted"); lw_json_int(&j, (long long)acc);
+    lw_json_key(&j, "rejected_nan"); lw_json_int(&j, (long long)nan);
+    put_per_move(&j, "rejected_irregular", c, t, offsetof(lw_move_stats, irregular));
+    put_per_move(&j, "rejected_crowded", c, t, offsetof(lw_move_stats, crowded));
+  }
   lw_json_key(&j, "wall_seconds"); lw_json_number(&j, wall);
   lw_json_key(&j, "sweep_seconds"); lw_json_number(&j, a->sweep_seconds);
-  lw_json_key(&j, "proposals_per_second"); /* of the sweeps of the whole run */
-  lw_json_number(&j, a->sweep_seconds > 0 ? (double)prop / a->sweep_seconds : 0.0);
-  lw_json_key(&j, "max_relative_drift"); lw_json_number(&j, a->max_drift);
-  lw_json_key(&j, "temperature_final"); lw_json_number(&j, c->temperature);
-  lw_json_key(&j, "schedule"); lw_json_string(&j, a->sched_type->name);
+  if (mc) {
+    lw_json_key(&j, "proposals_per_second"); /* of the sweeps of the whole run */
+    lw_json_number(&j, a->sweep_seconds > 0 ? (double)prop / a->sweep_seconds : 0.0);
+    lw_json_key(&j, "max_relative_drift"); lw_json_number(&j, a->max_drift);
+    lw_json_key(&j, "temperature_final"); lw_json_number(&j, c->temperature);
+    lw_json_key(&j, "schedule"); lw_json_string(&j, a->sched_type->name);
+  }
   lw_json_key(&j, "driver"); lw_json_string(&j, a->dyn ? "dynamics" : "metropolis");
   if (a->dyn) {
     lw_dynamics *d = a->dyn;
@@ -1202,30 +1212,34 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     lw_json_key(&j, "seconds"); lw_json_number(&j, q->seconds);
     lw_json_end_object(&j);
   }
-  lw_json_key(&j, "acceptance");
-  lw_json_begin_object(&j);
-  for (int k = 0; k < c->n_moves; k++) {
-    lw_json_key(&j, t->move_names[k]);
-    if (c->stats[k].proposed) lw_json_number(&j, (double)c->stats[k].accepted / (double)c->stats[k].proposed);
-    else lw_json_null(&j);
+  if (mc) {
+    lw_json_key(&j, "acceptance");
+    lw_json_begin_object(&j);
+    for (int k = 0; k < c->n_moves; k++) {
+      lw_json_key(&j, t->move_names[k]);
+      if (c->stats[k].proposed) lw_json_number(&j, (double)c->stats[k].accepted / (double)c->stats[k].proposed);
+      else lw_json_null(&j);
+    }
+    lw_json_end_object(&j);
   }
-  lw_json_end_object(&j);
   if (a->params.observables) put_observables(a, &j);
-  lw_json_key(&j, "proposed");
-  lw_json_begin_object(&j);
-  for (int k = 0; k < c->n_moves; k++) {
-    lw_json_key(&j, t->move_names[k]);
-    lw_json_int(&j, (long long)c->stats[k].proposed);
+  if (mc) {
+    lw_json_key(&j, "proposed");
+    lw_json_begin_object(&j);
+    for (int k = 0; k < c->n_moves; k++) {
+      lw_json_key(&j, t->move_names[k]);
+      lw_json_int(&j, (long long)c->stats[k].proposed);
+    }
+    lw_json_end_object(&j);
+    lw_json_key(&j, "steps");
+    lw_json_begin_object(&j);
+    for (int k = 0; k < c->n_moves; k++) {
+      lw_json_key(&j, t->move_names[k]);
+      if (c->step_max[k] > 0.0) lw_json_number(&j, c->step[k] / t->move_unit[k]);
+      else lw_json_null(&j);
+    }
+    lw_json_end_object(&j);
   }
-  lw_json_end_object(&j);
-  lw_json_key(&j, "steps");
-  lw_json_begin_object(&j);
-  for (int k = 0; k < c->n_moves; k++) {
-    lw_json_key(&j, t->move_names[k]);
-    if (c->step_max[k] > 0.0) lw_json_number(&j, c->step[k] / t->move_unit[k]);
-    else lw_json_null(&j);
-  }
-  lw_json_end_object(&j);
   if (a->pt) {
     const lw_tempering *pt = a->pt;
     lw_json_key(&j, "replicas");

@@ -65,10 +65,23 @@ Test(dynamics_cli, the_hanging_lines_settle_and_resume_gives_the_same_bytes)
                   dir, dir), 0);
 }
 
+/* The whip's frames; its summary has no Monte Carlo members (zeros and an
+** unread schedule's name, before), and a schedule it does not read is
+** noted, not checked (a table schedule without its table was refused). */
 Test(dynamics_cli, the_whip_writes_frames)
 {
-  cr_assert_eq(sh("%s run %s/params/whip.ini --out %s/w --quiet --set anneal.sweeps=10", lw_test_bin(), lw_test_root(), dir), 0);
+  cr_assert_eq(sh("%s run %s/params/whip.ini --out %s/w --set anneal.sweeps=10 --set anneal.schedule=table "
+                  "2>%s/err.txt", lw_test_bin(), lw_test_root(), dir, dir), 0);
   cr_assert_eq(sh("test -s %s/w/frames/frame-000010.png && test -s %s/w/final.png", dir, dir), 0);
+  cr_assert_eq(sh("grep -q 'under driver = dynamics these keys have no effect: anneal.schedule (--set)' %s/err.txt",
+                  dir), 0);
+  const char *absent[] = {"proposals", "accepted", "rejected_nan", "rejected_irregular", "rejected_crowded",
+                          "proposals_per_second", "max_relative_drift", "temperature_final", "schedule",
+                          "acceptance", "proposed", "steps"};
+  for (size_t k = 0; k < sizeof absent / sizeof absent[0]; k++)
+    cr_assert_neq(sh("grep -q '^  \"%s\": ' %s/w/summary.json", absent[k], dir), 0, "%s", absent[k]);
+  cr_assert_eq(sh("grep -q '^    \"time_steps\": ' %s/w/summary.json && grep -q '^  \"sweep_seconds\": ' "
+                  "%s/w/summary.json", dir, dir), 0);
 }
 
 Test(dynamics_cli, scenes_the_driver_cannot_move_are_refused_with_the_key)
