@@ -957,13 +957,15 @@ static int refresh_due(long sweep, long every, int *renumber)
 ** begun by older releases); such a one does not count in max_drift. */
 static lw_status refresh_replica(lw_anneal *a, int r, int renumber, double *drift, lw_error *err)
 {
-  double run[LW_SYSTEM_TERMS_MAX];
+  double run[LW_SYSTEM_TERMS_MAX], fresh[LW_SYSTEM_TERMS_MAX];
   void *state = a->systems[r]->state;
   lw_status s;
   *drift = 0.0;
   if (renumber && a->sys_type->renumber && (s = a->sys_type->renumber(state, err))) return s;
   a->sys_type->terms(state, run);
-  if (a->sys_type->refresh(state, drift) != LW_OK) return lw_error_set(err, LW_ENOMEM, "out of memory");
+  if (a->sys_type->refresh(state) != LW_OK) return lw_error_set(err, LW_ENOMEM, "out of memory");
+  a->sys_type->terms(state, fresh);
+  *drift = lw_system_drift(run, fresh, a->sys_type->n_terms);
   if (!renumber && !(*drift > LW_ANNEAL_EARLY_DRIFT)) a->sys_type->set_terms(state, run);
   return LW_OK;
 }

@@ -556,14 +556,10 @@ static int term_on(const void *setup, int t)
   return 0;
 }
 
-static lw_status refresh(void *state, double *drift)
+static lw_status refresh(void *state)
 {
-  lw_nurbs_state *s = state;
-  double old = total(s);
   lw_error err = {0};
-  if (recompute(s, &err)) return err.code;
-  if (drift) *drift = fabs(total(s) - old) / fmax(fabs(total(s)), 1.0);
-  return LW_OK;
+  return recompute(state, &err) ? err.code : LW_OK;
 }
 
 static double energy(const void *setup, const lw_state *st, const char *path, double *term, lw_error *err)

@@ -108,7 +108,7 @@ static void terms(const void *state, double *term) { lw_particles_terms(state, t
 
 static int term_on(const void *setup, int t) { return lw_particles_term_on(setup, t); }
 
-static lw_status refresh(void *state, double *drift) { return lw_particles_refresh(state, drift); }
+static lw_status refresh(void *state) { return lw_particles_refresh(state, NULL); }
 
 static double energy(const void *setup, const lw_state *st, const char *path, double *term, lw_error *err)
 {

@@ -963,7 +963,7 @@ static void terms(const void *state, double *term)
 
 static int term_on(const void *setup, int t) { return ((const spl_setup *)setup)->scene.on[t]; }
 
-static lw_status refresh(void *state, double *drift) { return lw_model_refresh(((spl_state *)state)->m, drift); }
+static lw_status refresh(void *state) { return lw_model_refresh(((spl_state *)state)->m, NULL); }
 
 static double energy(const void *setup, const lw_state *st, const char *path, double *term, lw_error *err)
 {

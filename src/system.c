@@ -1,6 +1,7 @@
 /* system.c -- the table of system types (system.h). */
 #include "linewise/system.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -69,6 +70,18 @@ void lw_system_free(lw_system *s)
   if (!s) return;
   s->type->state_free(s->state);
   free(s);
+}
+
+double lw_system_drift(const double *before, const double *after, int n)
+{
+  double was = 0.0, now = 0.0, size = 0.0;
+  for (int t = 0; t < n; t++) {
+    was += before[t];
+    now += after[t];
+    size += fabs(after[t]);
+  }
+  if (!isfinite(was) || !isfinite(now) || !isfinite(size)) return was == now ? 0.0 : INFINITY;
+  return fabs(now - was) / fmax(size, 1.0);
 }
 
 static double dot(const double *u, const double *v, size_t n)

@@ -187,12 +187,11 @@ struct lw_system_type {
   /* Energies: the running total (+inf in a forbidden state), the running
   ** value of each term (n_terms values, 0 when off), whether term t is on
   ** in the set-up, and a recomputation of every cache and total from the
-  ** state (drift: the relative change of the total, |new - old| /
-  ** max(|new|, 1)). */
+  ** state (lw_system_drift measures what it changed). */
   double (*total)(const void *state);
   void (*terms)(const void *state, double *term);
   int (*term_on)(const void *setup, int t);
-  lw_status (*refresh)(void *state, double *drift);
+  lw_status (*refresh)(void *state);
   /* The energy per term of a saved state (st, read from path) computed from
   ** scratch, and the total; err set (naming path) when the state is refused
   ** or memory runs out (`linewise energy`). */
@@ -358,5 +357,12 @@ double lw_system_hold(const lw_system_type *t, void *state, const double *x, con
 
 /* The row's calls on an instance. */
 static inline double lw_system_total(const lw_system *s) { return s->type->total(s->state); }
+
+/* How far a recomputation moved the total: |sum(after) - sum(before)| over
+** max(sum |after[t]|, 1), for n terms.  Against the terms' sizes, not the
+** total's, since the rounding of a running sum is the terms' (terms of
+** +-6e10 around a total of 3 drift 1e-5 absolute, which is 1e-16 of them);
+** infinite where a sum is not finite and the two differ. */
+double lw_system_drift(const double *before, const double *after, int n);
 
 #endif
