@@ -146,6 +146,14 @@ lw_status lw_dnurbs_energy_near(lw_nurbs *c, double alpha, double beta, const do
   return each_point(c, gauss, j, j + (size_t)c->order, add_energy, &g, err);
 }
 
+lw_status lw_dnurbs_energy(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, double term[2],
+                           lw_error *err)
+{
+  density_ctx g = {alpha, beta, {mug[0], mug[1]}, term};
+  term[0] = term[1] = 0.0;
+  return each_point(c, gauss, 0, c->n, add_energy, &g, err);
+}
+
 typedef struct {
   const double *v;
   double *out;

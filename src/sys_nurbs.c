@@ -277,18 +277,12 @@ static lw_status rebuild(lw_nurbs_state *s, lw_error *err)
   return LW_OK;
 }
 
-/* K P and the terms from scratch. */
+/* K P and the terms from scratch (lw_dnurbs_energy: not as 1/2 P'KP). */
 static lw_status recompute(lw_nurbs_state *s, lw_error *err)
 {
+  const lw_dnurbs *m = s->mat;
   lw_status st = rebuild(s, err);
-  if (st) return st;
-  double el = 0.0, g = 0.0;
-  for (size_t i = 0; i < 2 * s->c->n; i++) {
-    el += 0.5 * s->c->P[i] * s->KP[i];
-    g -= s->f[i] * s->c->P[i];
-  }
-  s->term[T_ELASTIC] = el;
-  s->term[T_GRAVITY] = g;
+  if (st || (st = lw_dnurbs_energy(s->c, m->alpha, m->beta, s->su->mug, m->gauss, s->term, err))) return st;
   s->term[T_WEIGHTS] = 0.0;
   for (size_t i = 0; s->s && i < s->c->n; i++) s->term[T_WEIGHTS] += 0.5 * s->su->weight_stiffness * s->s[i] * s->s[i];
   return LW_OK;
@@ -470,20 +464,24 @@ static double propose_weight(lw_nurbs_state *s, nb_prop *q)
 /* (K P)_i from the band, summed afresh: a running K P, updated by each
 ** move, carried the rounding of the moves so far, which a resumed run
 ** (K P from scratch) did not share, and its energies came out a few ulps
-** apart.  K(i, i + d) = K[i k + d], K(i, i - d) = K[(i - d) k + d]. */
+** apart.  K's rows sum to 0 (the basis sums to 1, so a translation costs
+** nothing), so the row is summed over P_j - P_i: over P itself, terms of
+** |K| |P| cancel to a force (at nurbs.refine = 200, K ~ 5e9 and P ~ 5, so
+** 1e-5 of rounding in a row).  K(i, i + d) = K[i k + d],
+** K(i, i - d) = K[(i - d) k + d]. */
 static void band_row(const lw_dnurbs *m, const double *P, size_t i, double r[2])
 {
   const size_t n = m->n, k = (size_t)m->k;
-  r[0] = m->K[i * k] * P[2 * i];
-  r[1] = m->K[i * k] * P[2 * i + 1];
+  const double x = P[2 * i], y = P[2 * i + 1];
+  r[0] = r[1] = 0.0;
   for (size_t d = 1; d < k; d++) {
     if (i + d < n) {
-      r[0] += m->K[i * k + d] * P[2 * (i + d)];
-      r[1] += m->K[i * k + d] * P[2 * (i + d) + 1];
+      r[0] += m->K[i * k + d] * (P[2 * (i + d)] - x);
+      r[1] += m->K[i * k + d] * (P[2 * (i + d) + 1] - y);
     }
     if (i >= d) {
-      r[0] += m->K[(i - d) * k + d] * P[2 * (i - d)];
-      r[1] += m->K[(i - d) * k + d] * P[2 * (i - d) + 1];
+      r[0] += m->K[(i - d) * k + d] * (P[2 * (i - d)] - x);
+      r[1] += m->K[(i - d) * k + d] * (P[2 * (i - d) + 1] - y);
     }
   }
 }
