@@ -254,12 +254,11 @@ static void state_free(void *state)
   lw_dnurbs_free(s->own);
   free(s->s);
   free(s->f);
-  free(s->KP);
   free(s);
 }
 
-/* K, f and K P at the present weights (with free weights, K and f from
-** scratch: they depend on every weight near a changed one). */
+/* K and f at the present weights (with free weights, from scratch: they
+** depend on every weight near a changed one). */
 static lw_status rebuild(lw_nurbs_state *s, lw_error *err)
 {
   const lw_nurbs_setup *su = s->su;
@@ -272,12 +271,10 @@ static lw_status rebuild(lw_nurbs_state *s, lw_error *err)
       s->f[2 * i + 1] = su->mug[1] * s->own->b[i];
     }
   }
-  lw_band_apply(s->mat->K, n, s->mat->k, s->c->P, s->KP);
-  s->kp_stale = 0;
   return LW_OK;
 }
 
-/* K P and the terms from scratch (lw_dnurbs_energy: not as 1/2 P'KP). */
+/* The terms from scratch (lw_dnurbs_energy: not as 1/2 P'KP). */
 static lw_status recompute(lw_nurbs_state *s, lw_error *err)
 {
   const lw_dnurbs *m = s->mat;
@@ -294,7 +291,7 @@ static lw_nurbs_state *state_at(const lw_nurbs_setup *su, const double *P, const
 {
   size_t n = su->curve->n;
   lw_nurbs_state *s = calloc(1, sizeof *s);
-  if (!s || !(s->c = lw_nurbs_copy(su->curve, err)) || !(s->KP = malloc(2 * n * sizeof *s->KP)) ||
+  if (!s || !(s->c = lw_nurbs_copy(su->curve, err)) ||
       !(s->f = malloc(2 * n * sizeof *s->f)) ||
       (su->free_weights && (!(s->s = malloc(n * sizeof *s->s)) ||
                             !(s->own = lw_dnurbs_new(s->c, su->mat->alpha, su->mat->beta, su->mat->gauss, err))))) {
@@ -525,10 +522,8 @@ static lw_status commit(void *state, void *prop)
       return LW_ENOMEM;
     }
   } else {
-    /* K P is not kept: propose sums its row, gradient the whole of it */
     s->c->P[2 * i] += q->d[0];
     s->c->P[2 * i + 1] += q->d[1];
-    s->kp_stale = 1;
   }
   for (int t = 0; t < N_TERMS; t++) s->term[t] += q->de[t];
   return LW_OK;
@@ -641,10 +636,11 @@ static double gradient(void *state, double *g, lw_error *err)
 {
   lw_nurbs_state *s = state;
   size_t n = s->c->n, m = per_point(s->su);
-  if (s->kp_stale) lw_band_apply(s->mat->K, n, s->mat->k, s->c->P, s->KP);
-  s->kp_stale = 0;
-  for (size_t i = 0; i < n; i++)
-    for (size_t c = 0; c < 2; c++) g[m * i + c] = s->KP[2 * i + c] - s->f[2 * i + c];
+  for (size_t i = 0; i < n; i++) {
+    double kp[2];
+    band_row(s->mat, s->c->P, i, kp);
+    for (size_t c = 0; c < 2; c++) g[m * i + c] = kp[c] - s->f[2 * i + c];
+  }
   if (s->s) {
     const lw_dnurbs *d = s->mat;
     double *gs = malloc(n * sizeof *gs);

@@ -50,8 +50,6 @@ typedef struct {
   lw_dnurbs *own;         /* free weights: K, M1, b at c->w (else NULL) */
   const lw_dnurbs *mat;   /* su->mat or own */
   double *f;              /* 2 n: the load mu g b_i at c->w */
-  double *KP;             /* 2 n: K P as of the last recompute or gradient ... */
-  int kp_stale;           /* ... or not: a Monte Carlo point move since (it does not keep K P) */
   double term[3];         /* elastic, gravity, weights */
   double deviation;       /* of the last final.svg */
   size_t beziers;
