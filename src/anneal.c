@@ -267,7 +267,7 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
 /* What each driver reads of a scene besides its system's keys (system.h,
 ** keys): the same run keys for both; Monte Carlo its schedule, its ladder,
 ** its tuning and its recomputations from scratch; the dynamics its time
-** step and damping. */
+** step, damping and density (rho = 0: the massless flow, dynamics.c). */
 #define RUN_KEYS "scene.system", "scene.driver", "anneal.sweeps", "anneal.seed", \
     "anneal.quench", "anneal.quench_tol", "anneal.quench_iterations", "anneal.quench_stall", \
     "output.checkpoint_every", "output.trace_every", "output.observables", "output.samples_every", \
@@ -275,7 +275,7 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
 static const char *const metropolis_keys[] = {RUN_KEYS, "anneal.schedule", "anneal.t_start", "anneal.t_end",
                                               "anneal.steps", "anneal.lambda", "anneal.table", "anneal.check_every",
                                               "tempering.*", "moves.tune_sweeps", NULL};
-static const char *const dynamics_keys[] = {RUN_KEYS, "dynamics.dt", "dynamics.gamma", "dynamics.steps_per_sweep",
+static const char *const dynamics_keys[] = {RUN_KEYS, "dynamics.rho", "dynamics.dt", "dynamics.gamma", "dynamics.steps_per_sweep",
                                             "dynamics.integrator", NULL};
 static const char *const driver_names[] = {"metropolis", "dynamics"};
 

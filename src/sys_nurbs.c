@@ -26,6 +26,7 @@ static const double move_unit[2] = {1.0, 1.0};
 enum { K_POINT, K_WEIGHT };
 static const char *const term_names[3] = {"elastic", "gravity", "weights"};
 enum { T_ELASTIC, T_GRAVITY, T_WEIGHTS, N_TERMS };
+_Static_assert(N_TERMS <= LW_SYSTEM_TERMS_MAX, "the curve's terms fit the run loop's arrays (system.h)");
 
 #define SECTION "system nurbs"
 

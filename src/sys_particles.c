@@ -104,6 +104,8 @@ static lw_status commit(void *state, void *prop) { return lw_particles_commit(st
 
 static double total(const void *state) { return lw_particles_total(state); }
 
+_Static_assert(LW_PTERM_COUNT <= LW_SYSTEM_TERMS_MAX, "the particle terms fit the run loop's arrays (system.h)");
+
 static void terms(const void *state, double *term) { lw_particles_terms(state, term); }
 
 static int term_on(const void *setup, int t) { return lw_particles_term_on(setup, t); }
@@ -470,7 +472,7 @@ static void describe(const void *state, int what, char *buf, size_t n)
 ** not the dynamics' keys; only they have dampers between neighbours; births
 ** and deaths are Monte Carlo's moves. */
 static const char *const keys[] = {"init.from", "particles.*", NULL};
-static const char *const keys_dynamics[] = {"dynamics.rho", "dynamics.dashpot", "dynamics.dashpot_angular", NULL};
+static const char *const keys_dynamics[] = {"dynamics.dashpot", "dynamics.dashpot_angular", NULL};
 static const char *const keys_metropolis[] = {"moves.translate", "moves.rotate", "moves.step_translate",
                                               "moves.step_rotate", "moves.target_spline", "particles.birth",
                                               "particles.death", "particles.chem", "particles.max_count",

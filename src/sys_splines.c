@@ -956,6 +956,8 @@ static double log_ratio(const void *prop) { return ((const lw_proposal *)prop)->
 
 static double total(const void *state) { return lw_model_total(((const spl_state *)state)->m); }
 
+_Static_assert(LW_TERM_COUNT <= LW_SYSTEM_TERMS_MAX, "the spline terms fit the run loop's arrays (system.h)");
+
 static void terms(const void *state, double *term)
 {
   memcpy(term, ((const spl_state *)state)->m->term, LW_TERM_COUNT * sizeof *term);

@@ -48,7 +48,17 @@ const lw_system_type *lw_system_of(const lw_params *p, lw_error *err)
   /* the same system with its trans-dimensional move kinds (sys_splines.h) */
   if (t == &lw_system_splines) t = lw_splines_row(p);
   if (t == &lw_system_particles) t = lw_particles_row(p);
-  return t;
+  return t && lw_system_row_fits(t, err) ? t : NULL;
+}
+
+int lw_system_row_fits(const lw_system_type *t, lw_error *err)
+{
+  if (t->n_moves <= LW_MOVES_MAX && t->n_terms <= LW_SYSTEM_TERMS_MAX && t->n_observables <= LW_OBSERVABLES_MAX)
+    return 1;
+  lw_error_set(err, LW_EINPUT, "the %s system's row has %d move kinds, %d terms and %d observables; at most %d, %d "
+               "and %d fit (include/linewise/system.h)", t->name, t->n_moves, t->n_terms, t->n_observables,
+               LW_MOVES_MAX, LW_SYSTEM_TERMS_MAX, LW_OBSERVABLES_MAX);
+  return 0;
 }
 
 lw_system *lw_system_wrap(const lw_system_type *type, void *state, lw_error *err)

@@ -8,6 +8,8 @@
 #include "linewise/anneal.h"
 #include "linewise/params.h"
 #include "linewise/scene.h"
+#include "linewise/schedule.h"
+#include "linewise/system.h"
 #include "testutil.h"
 
 /* Writes text to a fresh temporary file; returns its path (static buffer). */
@@ -538,4 +540,21 @@ Test(params, every_key_has_a_reader)
     lw_anneal_key_readers(lw_params_find(known[k].section, known[k].key), buf, sizeof buf);
     cr_assert_str_eq(buf, known[k].want, "%s.%s", known[k].section, known[k].key);
   }
+}
+
+/* The help of scene.system and anneal.schedule (linewise params,
+** docs/PARAMETERS.md) names every row and every schedule of the tables, so
+** a new one is not left out of what users read. */
+Test(params, the_help_names_every_system_and_schedule)
+{
+  const char *sys_help = lw_params_find("scene", "system")->help;
+  for (int k = 0; lw_system_types[k]; k++) {
+    char quoted[64];
+    snprintf(quoted, sizeof quoted, "`%s`", lw_system_types[k]->name);
+    cr_assert(strstr(sys_help, quoted), "scene.system's help does not name %s", quoted);
+  }
+  const char *sched_help = lw_params_find("anneal", "schedule")->help;
+  for (int k = 0; lw_schedule_types[k]; k++)
+    cr_assert(strstr(sched_help, lw_schedule_types[k]->name), "anneal.schedule's help does not name %s",
+              lw_schedule_types[k]->name);
 }

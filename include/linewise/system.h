@@ -335,8 +335,14 @@ const lw_system_type *lw_system_find(const char *name);
 const char *lw_system_names(void);
 
 /* The row the parameters name ([scene] system); NULL and LW_EINPUT naming
-** the key's file and line if there is none of that name. */
+** the key's file and line if there is none of that name, or if the row does
+** not fit (lw_system_row_fits). */
 const lw_system_type *lw_system_of(const lw_params *p, lw_error *err);
+
+/* Whether row t's move kinds, terms and observables fit the fixed arrays of
+** the chain and the run loop (LW_MOVES_MAX ...); 0 and err set if not: a
+** row past them would write over its neighbours and still exit 0. */
+int lw_system_row_fits(const lw_system_type *t, lw_error *err);
 
 /* An instance owning `state` (freed on failure too). */
 lw_system *lw_system_wrap(const lw_system_type *type, void *state, lw_error *err);
