@@ -20,6 +20,7 @@
 
 #include "linewise/checkpoint.h"
 #include "linewise/domains.h"
+#include "linewise/rundir.h"
 #include "linewise/init.h"
 #include "linewise/json.h"
 #include "linewise/number.h"
@@ -88,24 +89,6 @@ static double rung_energy(const lw_anneal *a, int k)
 
 double lw_anneal_energy(const lw_anneal *a) { return rung_energy(a, 0); }
 
-/* mkdir -p */
-static lw_status make_dir(const char *dir, lw_error *err)
-{
-  char buf[LW_PATH_MAX];
-  snprintf(buf, sizeof buf, "%s", dir);
-  for (char *c = buf + 1;; c++) {
-    if (*c == '/' || *c == '\0') {
-      char save = *c;
-      *c = '\0';
-      if (mkdir(buf, 0777) && errno != EEXIST)
-        return lw_error_set(err, LW_EIO, "%s: cannot create directory: %s", buf, strerror(errno));
-      *c = save;
-      if (!save) break;
-    }
-  }
-  return LW_OK;
-}
-
 /* The files a run writes, and their temporaries.  A run into a directory
 ** that held one removes the old run's first: a final.gcode or a replica
 ** state of another run beside the new drawing would be taken for its own. */
@@ -148,10 +131,7 @@ static lw_status clear_numbered(const char *dir, const char *sub, const char *pr
 static lw_status clear_run(const char *dir, lw_error *err)
 {
   char path[LW_PATH_MAX + 32];
-  lw_path_join(path, sizeof path, dir, "scene.ini");
-  int held = access(path, F_OK) == 0;
-  lw_path_join(path, sizeof path, dir, "state.lw");
-  if (!held && access(path, F_OK)) return LW_OK;
+  if (!lw_rundir_holds_run(dir)) return LW_OK;
   for (size_t i = 0; i < sizeof run_files / sizeof *run_files; i++)
     for (int tmp = 0; tmp < 2; tmp++) {
       char name[64];
@@ -538,7 +518,8 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   a->scene_hash = lw_params_run_hash(&a->params);
   /* Everything above only read input: the directory appears once the run
   ** is known to be valid. */
-  if ((s = make_dir(dir, err))) return s;
+  if ((s = lw_rundir_make(dir, err)) || (writes_files(a) && (s = lw_rundir_lock(dir, &a->dir_hold, err))))
+    return s;
   if (writes_files(a) && (s = clear_run(dir, err))) return s;
   if (!writes_files(a)) {
     lw_phase_set(NULL);
@@ -726,6 +707,11 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   void *all[LW_TEMPERING_MAX] = {NULL};
   lw_ckpt *rep[LW_TEMPERING_MAX] = {NULL};
   lw_phase_set("reading state.lw and rebuilding the energy");
+  /* (a directory that is not there has no state.lw to read, which says so) */
+  if (writes_files(a) && access(dir, F_OK) == 0) {
+    lw_status sl = lw_rundir_lock(dir, &a->dir_hold, err);
+    if (sl) return sl;
+  }
   lw_status s = lw_state_read(&st, path, err);
   if (s) return s;
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);
@@ -1320,5 +1306,6 @@ void lw_anneal_free(lw_anneal *a)
   if (a->setup) a->sys_type->setup_free(a->setup);
   lw_tempering_free(a->pt);
   lw_schedule_clear(&a->sched);
+  lw_rundir_unlock(a->dir_hold);
   memset(a, 0, sizeof *a);
 }

@@ -20,6 +20,7 @@
 #include "linewise/params.h"
 #include "linewise/phase.h"
 #include "linewise/reweight.h"
+#include "linewise/rundir.h"
 #include "linewise/state.h"
 #include "linewise/system.h"
 #include "linewise/trace.h"
@@ -425,33 +426,58 @@ static lw_status spread_start(lw_status s, lw_anneal *a, int fresh, lw_error *er
   return s;
 }
 
-/* Whether dir holds a run (its scene.ini or state.lw). */
-static int holds_run(const char *dir)
-{
-  char path[LW_PATH_MAX + 16];
-  lw_path_join(path, sizeof path, dir, "scene.ini");
-  if (access(path, F_OK) == 0) return 1;
-  lw_path_join(path, sizeof path, dir, "state.lw");
-  return access(path, F_OK) == 0;
-}
-
 /* The default run directory: out/<scene name>, or out/<scene name>-2, -3,
-** ... when that holds a run already, so that a run started without --out
-** never replaces the drawing of another (--out names a directory to
-** replace).  The processes of an MPI run look before any of them writes. */
-static void default_dir(char *dir, size_t size, const char *scene)
+** ... : the first that holds no run and that no other process is writing,
+** made and locked (rundir.h) before the run is set up, so that runs
+** started together without --out each get their own, and none replaces
+** the drawing of another (--out names a directory to replace).  *made: 1
+** the directory is new, 2 out/ too (taken away again if the run is
+** refused).  The processes
+** of an MPI run look before any of them writes, and the first locks the
+** directory as it starts. */
+static lw_status default_dir(char *dir, size_t size, const char *scene, int *hold, int *made, lw_error *err)
 {
   const char *base = strrchr(scene, '/');
   base = base ? base + 1 : scene;
   const int n = (int)strcspn(base, ".");
+  *hold = *made = 0;
+  const int out_existed = access("out", F_OK) == 0;
   snprintf(dir, size, "out/%.*s", n, base);
-  for (int k = 2; holds_run(dir) && k < 1000000; k++) snprintf(dir, size, "out/%.*s-%d", n, base, k);
 #ifdef LW_MPI
   if (net) {
-    lw_error err;
-    lw_mpi_agree(net, LW_OK, &err);
+    for (int k = 2; lw_rundir_holds_run(dir) && k < 1000000; k++) snprintf(dir, size, "out/%.*s-%d", n, base, k);
+    return lw_mpi_agree(net, LW_OK, err);
   }
 #endif
+  for (int k = 2; k <= 1000000; k++) {
+    const int existed = access(dir, F_OK) == 0;
+    if (!existed || !lw_rundir_holds_run(dir)) {
+      lw_status s = lw_rundir_make(dir, err);
+      if (!s) s = lw_rundir_lock(dir, hold, err);
+      if (s && s != LW_EUSAGE) return s; /* LW_EUSAGE: another run's */
+      if (!s && !lw_rundir_holds_run(dir)) {
+        *made = existed ? 0 : out_existed ? 1 : 3;
+        return LW_OK;
+      }
+      lw_rundir_unlock(*hold);
+      *hold = 0;
+    }
+    snprintf(dir, size, "out/%.*s-%d", n, base, k);
+  }
+  return lw_error_set(err, LW_EUSAGE, "out/%.*s: a million runs there already; give --out", n, base);
+}
+
+/* A directory default_dir made for a run that was then refused goes again:
+** "nothing is written" for bad input. */
+static void unmake_dir(const char *dir, int hold, int made)
+{
+  if (!made || lw_rundir_holds_run(dir)) return;
+  char path[LW_PATH_MAX + 16];
+  lw_path_join(path, sizeof path, dir, ".lock");
+  unlink(path);
+  rmdir(dir);
+  if (made & 2) rmdir("out");
+  lw_rundir_unlock(hold);
 }
 
 /* Whether the file's first line is text (and a newline). */
@@ -530,8 +556,9 @@ static int cmd_run(int argc, char **argv)
     }
   }
   char dir[LW_PATH_MAX];
+  int hold = 0, made = 0; /* the default directory's lock, held to the end */
   if (out) snprintf(dir, sizeof dir, "%s", out);
-  else default_dir(dir, sizeof dir, scene);
+  else if (default_dir(dir, sizeof dir, scene, &hold, &made, &err)) return fail(&err);
   /* the run writes its resolved parameters to DIR/scene.ini: over a run's
   ** (a run made again in place), never over a scene file a person wrote,
   ** the one this run reads included */
@@ -549,6 +576,7 @@ static int cmd_run(int argc, char **argv)
   watcher_start(&w, quiet);
   if (spread_start(lw_anneal_start_net(&a, &p, dir, net, &err), &a, 1, &err)) {
     lw_anneal_free(&a);
+    unmake_dir(dir, hold, made);
     return watched_fail(&w, &err);
   }
   if (!quiet) {

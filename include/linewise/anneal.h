@@ -52,6 +52,7 @@ typedef struct lw_anneal {
   const lw_schedule_type *sched_type;
   lw_schedule sched;
   char dir[LW_PATH_MAX];
+  int dir_hold;                 /* lw_rundir_lock's hold on dir while it writes there, 0 none */
   char unread[1024];           /* keys the scene sets that only the other driver reads, where set, or "" */
   unsigned long seed;
   long sweep;                  /* sweeps done */

@@ -1,0 +1,33 @@
+/*
+** rundir.h -- one process at a time in a run directory.
+**
+** Two runs writing one directory at once (two runs started without --out
+** that chose the same out/<name>, a sweep submitted twice, a resume while
+** the run still goes) left a summary.json over another run's scene.ini, and
+** trace files with holes.  A run, a resume and a redraw hold an exclusive
+** flock(2) on DIR/.lock while they write; the kernel drops it when the
+** process ends, however it ends, so a killed run leaves no stale lock.  On a
+** file system without locks the run goes on unguarded, as before.
+*/
+#ifndef LINEWISE_RUNDIR_H
+#define LINEWISE_RUNDIR_H
+
+#include "linewise/error.h"
+
+/* mkdir -p dir. */
+lw_status lw_rundir_make(const char *dir, lw_error *err);
+
+/* Whether dir holds a run (its scene.ini or state.lw). */
+int lw_rundir_holds_run(const char *dir);
+
+/* Takes the lock of the existing directory dir for this process: LW_OK and
+** *hold set (0 where the file system has no locks), or LW_EUSAGE naming the
+** directory when another process holds it.  A second call for a directory
+** this process holds succeeds; each needs its lw_rundir_unlock. */
+lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err);
+
+/* Gives back one lw_rundir_lock (hold 0: nothing); the last of a directory
+** releases its lock. */
+void lw_rundir_unlock(int hold);
+
+#endif

@@ -1,0 +1,99 @@
+/* rundir.c -- the lock of a run directory (rundir.h). */
+#include "linewise/rundir.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "linewise/params.h"
+
+/* The locks this process holds, by the lock file's identity: flock locks
+** of two open files conflict even within one process, so a second lock of
+** a held directory (a default directory chosen, then started) must find
+** the first.  A hold is a slot's index + 1. */
+#define HELD_MAX 64
+static struct {
+  dev_t dev;
+  ino_t ino;
+  int fd, count;
+} held[HELD_MAX];
+
+lw_status lw_rundir_make(const char *dir, lw_error *err)
+{
+  char buf[LW_PATH_MAX];
+  snprintf(buf, sizeof buf, "%s", dir);
+  for (char *c = buf + 1;; c++) {
+    if (*c == '/' || *c == '\0') {
+      char save = *c;
+      *c = '\0';
+      if (mkdir(buf, 0777) && errno != EEXIST)
+        return lw_error_set(err, LW_EIO, "%s: cannot create directory: %s", buf, strerror(errno));
+      *c = save;
+      if (!save) break;
+    }
+  }
+  return LW_OK;
+}
+
+int lw_rundir_holds_run(const char *dir)
+{
+  char path[LW_PATH_MAX + 16];
+  snprintf(path, sizeof path, "%s/scene.ini", dir);
+  if (access(path, F_OK) == 0) return 1;
+  snprintf(path, sizeof path, "%s/state.lw", dir);
+  return access(path, F_OK) == 0;
+}
+
+lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
+{
+  char path[LW_PATH_MAX + 16];
+  *hold = 0;
+  if (snprintf(path, sizeof path, "%s/.lock", dir) >= (int)sizeof path)
+    return lw_error_set(err, LW_EINPUT, "%s: the run directory's name is too long", dir);
+  int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+  struct stat st;
+  if (fd < 0 || fstat(fd, &st)) {
+    int e = errno;
+    if (fd >= 0) close(fd);
+    return lw_error_set(err, LW_EIO, "%s: cannot open the run directory's lock: %s", path, strerror(e));
+  }
+  int k, free_slot = -1;
+  for (k = 0; k < HELD_MAX; k++) {
+    if (held[k].count && held[k].dev == st.st_dev && held[k].ino == st.st_ino) {
+      close(fd);
+      held[k].count++;
+      *hold = k + 1;
+      return LW_OK;
+    }
+    if (!held[k].count && free_slot < 0) free_slot = k;
+  }
+  if (free_slot < 0) {
+    close(fd);
+    return lw_error_set(err, LW_ERUN, "%s: more than %d run directories open in one process", dir, HELD_MAX);
+  }
+  if (flock(fd, LOCK_EX | LOCK_NB)) {
+    int e = errno;
+    close(fd);
+    if (e == EWOULDBLOCK)
+      return lw_error_set(err, LW_EUSAGE, "%s: another linewise process is writing this run directory (it holds "
+                          "%s); wait for it to end, or give another --out", dir, path);
+    if (e == ENOLCK || e == EOPNOTSUPP || e == ENOSYS || e == EINVAL) return LW_OK; /* no locks here */
+    return lw_error_set(err, LW_EIO, "%s: cannot lock the run directory: %s", path, strerror(e));
+  }
+  held[free_slot].dev = st.st_dev;
+  held[free_slot].ino = st.st_ino;
+  held[free_slot].fd = fd;
+  held[free_slot].count = 1;
+  *hold = free_slot + 1;
+  return LW_OK;
+}
+
+void lw_rundir_unlock(int hold)
+{
+  if (hold < 1 || hold > HELD_MAX || !held[hold - 1].count) return;
+  if (!--held[hold - 1].count) close(held[hold - 1].fd);
+}

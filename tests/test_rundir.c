@@ -1,0 +1,91 @@
+/*
+** test_rundir.c -- one process at a time in a run directory (rundir.h):
+** runs started together without --out each get their own directory, and a
+** run, a resume or a redraw into a directory another process is writing is
+** refused before it writes anything.
+*/
+#include <criterion/criterion.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include "linewise/rundir.h"
+#include "testutil.h"
+
+static char dir[64];
+
+static void make_dir(void) { cr_assert_eq(lw_test_dir_make(dir, "rdir"), 0); }
+static void remove_dir(void) { cr_assert_eq(lw_test_dir_remove(dir), 0); }
+
+TestSuite(rundir, .init = make_dir, .fini = remove_dir);
+
+#define sh lw_test_sh
+
+/* Three runs of one scene started at once without --out: before, two of
+** them shared out/minimal (4 times in 4), and a summary.json of seed 1 sat
+** beside a scene.ini of seed 2.  Each now has its own directory, whose
+** files all are its own. */
+Test(rundir, runs_started_together_without_out_each_get_their_own_directory)
+{
+  cr_assert_eq(sh("cd %s && for s in 1 2 3; do %s run %s/params/minimal.ini --set anneal.sweeps=400 --threads 1 "
+                  "--quiet --seed $s & done; wait", dir, lw_test_bin(), lw_test_root()), 0);
+  for (int s = 1; s <= 3; s++)
+    cr_assert_eq(sh("cd %s && n=$(grep -l '\"seed\": %d,' out/*/summary.json | wc -l) && test $n = 1 && "
+                    "d=$(dirname $(grep -l '\"seed\": %d,' out/*/summary.json)) && grep -q '^seed = %d$' $d/scene.ini",
+                    dir, s, s, s), 0, "seed %d", s);
+  cr_assert_eq(sh("test $(ls -d %s/out/minimal* | wc -l) = 3", dir), 0);
+}
+
+/* While another process holds DIR/.lock, run, resume and a redraw into
+** DIR exit 2 with one line and leave the run there as it was; once it
+** lets go, they go on. */
+Test(rundir, a_directory_another_process_writes_is_refused)
+{
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/r --quiet --set anneal.sweeps=20 --stop-at 10", lw_test_bin(),
+                  lw_test_root(), dir), 0);
+  cr_assert_eq(sh("cp %s/r/state.lw %s/state.before", dir, dir), 0);
+  char path[128];
+  snprintf(path, sizeof path, "%s/r/.lock", dir);
+  int fd = open(path, O_RDWR | O_CREAT, 0666);
+  cr_assert(fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0, "the test takes the lock");
+  cr_assert_eq(sh("%s resume %s/r 2> %s/err.txt", lw_test_bin(), dir, dir), 2);
+  cr_assert_eq(sh("grep -q \"r: another linewise process is writing this run directory (it holds .*r/.lock); wait "
+                  "for it to end, or give another --out\" %s/err.txt && test $(wc -l < %s/err.txt) = 1", dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/r --set anneal.sweeps=0 2> %s/err.txt", lw_test_bin(),
+                  lw_test_root(), dir, dir), 2);
+  cr_assert_eq(sh("grep -q 'another linewise process is writing this run directory' %s/err.txt", dir), 0);
+  cr_assert_eq(sh("cmp -s %s/r/state.lw %s/state.before && test ! -e %s/r/summary.json", dir, dir, dir), 0);
+  close(fd);
+  cr_assert_eq(sh("%s resume %s/r --quiet && test -s %s/r/summary.json", lw_test_bin(), dir, dir), 0);
+}
+
+/* The lock is per process: taken twice here it is held once, and let go
+** when the last hold goes. */
+Test(rundir, a_process_may_hold_its_own_lock_twice)
+{
+  lw_error err;
+  int a = 0, b = 0;
+  cr_assert_eq(lw_rundir_lock(dir, &a, &err), LW_OK);
+  cr_assert_eq(lw_rundir_lock(dir, &b, &err), LW_OK, "%s", err.msg);
+  cr_assert(a > 0 && a == b);
+  char path[128];
+  snprintf(path, sizeof path, "%s/.lock", dir);
+  lw_rundir_unlock(a);
+  int fd = open(path, O_RDWR);
+  cr_assert(fd >= 0);
+  cr_assert_neq(flock(fd, LOCK_EX | LOCK_NB), 0, "one hold is left");
+  lw_rundir_unlock(b);
+  cr_assert_eq(flock(fd, LOCK_EX | LOCK_NB), 0, "both let go");
+  close(fd);
+}
+
+/* A run refused for bad input leaves no directory behind, out/ included,
+** when it chose out/<name> itself. */
+Test(rundir, a_refused_run_without_out_leaves_no_directory)
+{
+  cr_assert_eq(sh("cd %s && printf '[scene]\\nimage = nothere.png\\n' > bad.ini && %s run bad.ini 2> err.txt", dir,
+                  lw_test_bin()), 2);
+  cr_assert_eq(sh("cd %s && grep -q 'nothere.png' err.txt && test ! -e out", dir), 0);
+}
