@@ -179,7 +179,7 @@ static lw_status setup_schedule(lw_anneal *a, lw_error *err)
 /* Paths in the scene are relative to the scene file; the resolved scene.ini
 ** lives in the run directory, so they are made absolute first (path is a
 ** key's field of LW_PATH_MAX bytes). */
-static void absolute_path(char *path, const char *scene_file)
+static void make_absolute(char *path, const char *scene_file)
 {
   if (!path[0] || path[0] == '/') return;
   char dir[LW_PATH_MAX], joined[2 * LW_PATH_MAX + 2], real[4096];
@@ -199,6 +199,32 @@ static void absolute_path(char *path, const char *scene_file)
   } else if (strlen(joined) < LW_PATH_MAX) {
     strcpy(path, joined);
   }
+}
+
+/* Every key of a's parameters that names a file, made absolute; refused
+** where that no longer fits on a line of the run's scene.ini, which resume
+** reads (a picture named "pic.png" from a deep directory wrote a scene.ini
+** that neither resume nor energy could read). */
+static lw_status absolute_paths(lw_anneal *a, lw_error *err)
+{
+  for (size_t i = 0; i < lw_param_count; i++) {
+    const lw_param_def *d = &lw_param_table[i];
+    if (d->type != LW_PT_STRING || !d->unit || strcmp(d->unit, "path") || d->size != LW_PATH_MAX) continue;
+    char *path = (char *)&a->params + d->offset, was[LW_PATH_MAX];
+    snprintf(was, sizeof was, "%s", path);
+    make_absolute(path, a->params.file);
+    size_t len = strlen(path), cap = lw_params_text_cap(d);
+    if (len > cap || (was[0] && path[0] != '/')) {
+      char where[LW_PATH_MAX + 32];
+      lw_params_origin(&a->params, d, where, sizeof where);
+      char size[48] = "too long";
+      if (path[0] == '/') snprintf(size, sizeof size, "%zu characters", len);
+      return lw_error_set(err, LW_EINPUT, "%s: key '%s.%s': '%s' made absolute is %s, and the run's scene.ini "
+                          "(which resume reads) holds %zu on its line; move the file, or run from a shorter path",
+                          where, d->section, d->key, was, size, cap);
+    }
+  }
+  return LW_OK;
 }
 
 /* Replicas of the run (the explicit ladder's length, or [tempering]
@@ -478,15 +504,11 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   a->net = net;
   a->wall_start = now_seconds();
   a->params = *p;
-  for (size_t i = 0; i < lw_param_count; i++) { /* every key that names a file */
-    const lw_param_def *d = &lw_param_table[i];
-    if (d->type == LW_PT_STRING && d->unit && !strcmp(d->unit, "path") && d->size == LW_PATH_MAX)
-      absolute_path((char *)&a->params + d->offset, p->file);
-  }
+  lw_status s;
+  if ((s = absolute_paths(a, err))) return s;
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   a->seed = (unsigned long)a->params.seed;
   a->block = -1;
-  lw_status s;
   double ladder[LW_TEMPERING_MAX];
   lw_phase_set("setting up the scene");
   if ((s = lw_params_resolve(&a->params, err)) || (s = setup_ladder(a, ladder, err)) ||

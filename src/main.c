@@ -4,6 +4,8 @@
 ** stderr and an exit status: 2 for bad usage or input, 1 for failures while
 ** running.
 */
+#include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <omp.h>
 #include <pthread.h>
@@ -770,8 +772,30 @@ static void choose_wait_policy(int argc, char **argv)
 }
 #endif
 
+/* Descriptors 0 to 2 that the caller closed (2>&-) would be the first files
+** a run opens: trace.csv took descriptor 2, and the progress lines went into
+** it.  They are opened on /dev/null instead, stdout read-only, so that what
+** a command prints to a closed stdout fails and says so (finish_stdout)
+** rather than vanish. */
+static void open_standard_descriptors(void)
+{
+  for (int fd = 0; fd < 3; fd++)
+    if (fcntl(fd, F_GETFD) == -1 && errno == EBADF) (void)open("/dev/null", fd == 2 ? O_WRONLY : O_RDONLY);
+}
+
+/* Output that did not all reach stdout (a full disk, a closed stdout) is a
+** failure: exit 1 with one line, not 0 and an empty file. */
+static int finish_stdout(int rc)
+{
+  errno = 0;
+  if (fflush(stdout) == 0 && !ferror(stdout)) return rc;
+  fprintf(stderr, "linewise: writing to stdout failed%s%s\n", errno ? ": " : "", errno ? strerror(errno) : "");
+  return rc ? rc : 1;
+}
+
 int main(int argc, char **argv)
 {
+  open_standard_descriptors();
 #ifndef LW_MPI
   choose_wait_policy(argc, argv);
 #endif
@@ -781,10 +805,11 @@ int main(int argc, char **argv)
   /* the commands other than run and resume are one process's */
   int spread = argc >= 2 && (!strcmp(argv[1], "run") || !strcmp(argv[1], "resume"));
   int rc = spread || net->rank == 0 ? command(argc, argv) : 0;
+  rc = finish_stdout(rc);
   lw_mpi_finish();
   return rc;
 #else
-  return command(argc, argv);
+  return finish_stdout(command(argc, argv));
 #endif
 }
 

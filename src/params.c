@@ -878,8 +878,7 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     /* Each text field has its own capacity (anneal.schedule is short), and
     ** "key = value" must fit on one line of the INI reader (read_line), so
     ** that scene.ini, written back by a run, reads again. */
-    size_t len = strlen(text), cap = INI_MAX_LINE - 5 - strlen(d->key);
-    if (cap > d->size - 1) cap = d->size - 1;
+    size_t len = strlen(text), cap = lw_params_text_cap(d);
     if (len > cap) {
       snprintf(expected, n, "at most %zu characters", cap);
       return 0;
@@ -1237,6 +1236,12 @@ static lw_status landscape_picture(const lw_params *p, int *landscape, lw_error 
   }
   *landscape = info.width > info.height;
   return LW_OK;
+}
+
+size_t lw_params_text_cap(const lw_param_def *d)
+{
+  size_t cap = INI_MAX_LINE - 5 - strlen(d->key);
+  return cap > d->size - 1 ? d->size - 1 : cap;
 }
 
 lw_status lw_params_resolve(lw_params *p, lw_error *err)

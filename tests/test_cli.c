@@ -614,3 +614,25 @@ Test(cli, stats_refuses_a_missing_run_and_a_bad_option_in_one_line)
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
   cr_assert(strstr(errs, "--from: expected a whole number"), "%s", errs);
 }
+
+/* A caller that closes stderr (2>&-) gets a clean trace: before, trace.csv
+** took descriptor 2, and the parameter echo and progress lines went into
+** it (exit 0, and `stats` then failed on it).  Output that does not reach
+** stdout (a full disk, a closed stdout) exits 1 with one line: before,
+** `energy > full/file` left an empty file and exit 0. */
+Test(cli, closed_and_full_standard_streams_are_not_written_over_or_ignored)
+{
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/c --set anneal.sweeps=20 2>&-", lw_test_bin(),
+                          lw_test_root(), dir), 0);
+  cr_assert_eq(lw_test_sh("head -1 %s/c/trace.csv | grep -q '^sweep,' && awk -F, 'NR > 1 && $1 !~ /^[0-9]+$/ { bad = 1 }"
+                          " END { exit bad || NR != 21 }' %s/c/trace.csv", dir, dir), 0);
+  const char *cmd[] = {"energy %s/c > /dev/full", "params > /dev/full", "energy %s/c >&-", "schedules >&-"};
+  for (size_t k = 0; k < sizeof cmd / sizeof cmd[0]; k++) {
+    char args[256], line[512];
+    snprintf(args, sizeof args, cmd[k], dir);
+    snprintf(line, sizeof line, "%s %s 2> %s/err.txt", lw_test_bin(), args, dir);
+    cr_assert_eq(lw_test_sh("%s", line), 1, "%s", args);
+    cr_assert_eq(lw_test_sh("grep -q '^linewise: writing to stdout failed: ' %s/err.txt && test $(wc -l < %s/err.txt) "
+                            "= 1", dir, dir), 0, "%s", args);
+  }
+}

@@ -103,6 +103,18 @@ Test(image_cli, bad_pictures_exit_2_with_one_line_and_touch_nothing)
     fclose(f);
     cr_assert_str_eq(keep, "precious\n");
   }
+  /* A PNG whose header asks 20000 x 20000 RGB pixels: within linewise's 1e9
+  ** but past the decoder's 2^30 bytes; it was called "not of any known
+  ** type, or corrupt" */
+  static const unsigned char huge[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+                                       0, 0, 0x4e, 0x20, 0, 0, 0x4e, 0x20, 8, 2, 0, 0, 0, 0, 0, 0, 0};
+  lw_test_write(lw_test_path("huge.png"), huge, sizeof huge);
+  write_scene("huge.png");
+  char why[2048];
+  cr_assert_eq(run("run scene.ini --out out", why, sizeof why), 2, "%s", why);
+  cr_assert(strstr(why, "huge.png: the PNG is too large to decode: its width x height x channels is more than 2^30 "
+                        "(1.07e9 grey, 358 million RGB or 268 million RGBA pixels); scale it down first"), "%s", why);
+  cr_assert_eq(count_entries(lw_test_path("out")), 1);
   /* the same scene with the good picture runs */
   write_scene("good.png");
   char errs[8192];
@@ -111,6 +123,34 @@ Test(image_cli, bad_pictures_exit_2_with_one_line_and_touch_nothing)
   struct stat sb;
   cr_assert_eq(stat(lw_test_path("out/field.png"), &sb), 0, "field.png written");
   cr_assert_eq(stat(lw_test_path("out/final.svg"), &sb), 0);
+}
+
+/* A picture named relatively from a deep directory: made absolute, its
+** line in the run's scene.ini was past what the INI reader takes, so the
+** run went and its resume, energy and redraw all failed.  It is refused
+** before anything is written, naming the key. */
+Test(image_cli, a_path_too_long_for_the_runs_scene_file_is_refused_before_the_run)
+{
+  char deep[300], name[200];
+  memset(name, 'd', 180);
+  name[180] = '\0';
+  snprintf(deep, sizeof deep, "%s/%s", lw_test_dir, name);
+  cr_assert_eq(mkdir(deep, 0777), 0);
+  char rel[256];
+  snprintf(rel, sizeof rel, "%s/good.png", name);
+  write_picture(rel, 64, 48);
+  snprintf(rel, sizeof rel, "%s/scene.ini", name);
+  char text[1024];
+  snprintf(text, sizeof text, scene_fmt, "good.png");
+  write_text(rel, text);
+  char cmd[600], errs[2048];
+  snprintf(cmd, sizeof cmd, "run %s/scene.ini --out out", name);
+  cr_assert_eq(run(cmd, errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "scene.ini:4: key 'scene.image': 'good.png' made absolute is ") &&
+                strstr(errs, "and the run's scene.ini (which resume reads) holds 190 on its line; move the file, or "
+                             "run from a shorter path"), "%s", errs);
+  struct stat sb;
+  cr_assert_neq(stat(lw_test_path("out"), &sb), 0, "nothing written");
 }
 
 Test(image_cli, a_large_picture_is_downsampled_with_a_note)

@@ -285,6 +285,11 @@ lw_status lw_params_read_unresolved(lw_params *p, const char *path, lw_error *er
 ** or image_levels would change the energy of a run begun before them). */
 lw_status lw_params_read_run(lw_params *p, const char *path, lw_error *err);
 
+/* The most characters text key d holds: its field's, and what fits on one
+** line "key = value" of the INI reader, so that a run's scene.ini reads
+** back. */
+size_t lw_params_text_cap(const lw_param_def *d);
+
 /* Settles what depends on several keys, once all are known: a named page
 ** sets width and height (an explicit width or height that disagrees is an
 ** error naming its line), and pen_colors must hold one colour per pen.
