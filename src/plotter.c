@@ -260,9 +260,16 @@ lw_status lw_output_gcode_strokes(const lw_strokes *s, const lw_output_page *pag
                   "along y\n" : " mm, origin at its lower-left corner, y up\n", f);
   int first = 0; /* the first pen that draws: a pen that draws nothing is not asked for */
   while (first + 1 < s->n_pens && s->pen_first[first] == s->pen_first[first + 1]) first++;
-  fputs("; load ", f);
-  put_pen(f, page, first);
-  fprintf(f, " before starting\nG21\nG90\n%s\n", o->pen_up);
+  size_t a0, z0;
+  lw_strokes_pen_range(s, first, &a0, &z0);
+  if (a0 < z0) {
+    fputs("; load ", f);
+    put_pen(f, page, first);
+    fputs(" before starting\n", f);
+  } else {
+    fputs("; an empty drawing: no pen is asked for\n", f);
+  }
+  fprintf(f, "G21\nG90\n%s\n", o->pen_up);
   for (int k = first; k < s->n_pens; k++) {
     size_t a, z;
     lw_strokes_pen_range(s, k, &a, &z);

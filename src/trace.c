@@ -499,8 +499,15 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
         fprintf(out, "%-*s %15.9g %11.4g %11.4g %11s %9s %8s %9s%s\n", width, name, q->mean, q->stderr_mean, q->sd, tau,
                 neff, rh, pr, flagged(q, k) ? " *" : "");
     } else if (csv) {
-      fprintf(out, "%s,%zu,%.10g,%.4g,%.4g,%.4g,%.4g,%d,%.3g\n", name, s->n, s->mean, s->stderr_mean, s->sd,
-              s->tau * every[0], s->n_eff, s->window > 0, s->drift_z);
+      /* tau and n_eff mean nothing for a column without spread: empty, as
+      ** the table's '-' and summary.json's null */
+      char tau[32] = "", neff[32] = "";
+      if (s->sd > 0.0) {
+        snprintf(tau, sizeof tau, "%.4g", s->tau * every[0]);
+        snprintf(neff, sizeof neff, "%.4g", s->n_eff);
+      }
+      fprintf(out, "%s,%zu,%.10g,%.4g,%.4g,%s,%s,%d,%.3g\n", name, s->n, s->mean, s->stderr_mean, s->sd, tau, neff,
+              s->window > 0, s->drift_z);
     } else if (!(s->sd > 0.0)) {
       fprintf(out, "%-*s %15.9g %11.4g %11.4g %11s %9s\n", width, name, s->mean, 0.0, 0.0, "-", "-");
     } else {

@@ -538,6 +538,8 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
   stats_column(out, "obs_length", &L, &Lse);
   stats_column(out, "obs_end2", &r2, &r2se);
   stats_column(out, "obs_end_cos", &c, &cse);
+  /* a column without spread has no tau and n_eff (it had 0.5 and n) */
+  cr_assert(strstr(out, "\nobs_count,4001,50,0,0,,,"), "%s", out);
   double kp = 2.0 * lp * L * (1.0 - lp / L * (1.0 - exp(-L / lp)));
   double kp6 = 2.0 * 1.06 * lp * L * (1.0 - 1.06 * lp / L * (1.0 - exp(-L / (1.06 * lp))));
   double bias = 0.33 * l0 / lp + fabs(kp6 / kp - 1.0);

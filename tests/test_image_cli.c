@@ -179,6 +179,13 @@ Test(image_cli, a_run_with_a_relative_picture_resumes_and_recomputes_anywhere)
   snprintf(args, sizeof args, "resume %s --sweeps 2 --quiet && cd / && %s energy %s", lw_test_path("out"),
            getenv("LW_BIN"), lw_test_path("out"));
   cr_assert_eq(run(args, errs, sizeof errs), 0, "%s", errs);
+  /* a picture changed under a run is caught on resume, and the message
+  ** names it as a cause, not state.lw alone */
+  write_picture("pic.png", 40, 50);
+  snprintf(args, sizeof args, "resume %s --sweeps 2 --quiet", lw_test_path("out"));
+  cr_assert_eq(run(args, errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "state.lw: [chain] energy.") && strstr(errs, "or a file the scene reads was changed: its "
+            "picture, field or table)"), "%s", errs);
 }
 
 /* Issue 20: the run made the picture's path absolute by joining the scene's

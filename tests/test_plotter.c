@@ -361,6 +361,15 @@ Test(plotter, pens_without_paths_are_not_asked_for)
             "%s", text);
   free(text);
   lw_strokes_free(s);
+  /* an empty drawing asks for no pen at all (it asked for pen 1) */
+  s = lw_strokes_new(4, NULL);
+  snprintf(path, sizeof path, "%s/final.gcode", dir);
+  cr_assert_eq(lw_output_gcode_strokes(s, &page, &o, path, NULL), LW_OK);
+  text = lw_test_slurp("%s", path);
+  cr_assert(!strstr(text, "load") && !strstr(text, "\nM0\n") && strstr(text, "; an empty drawing: no pen is asked "
+            "for\nG21\n"), "%s", text);
+  free(text);
+  lw_strokes_free(s);
   lw_test_sh("rm -rf %s", dir);
 }
 
