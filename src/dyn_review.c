@@ -115,9 +115,12 @@ lw_status lw_dyn_review_step(lw_dynamics *d, lw_error *err)
   if ((st = t->set_coords(d->state, d->x, err))) return st;
   d->energy = t->gradient(d->state, d->g, err);
   if (err->code) return err->code;
-  if (!isfinite(d->energy))
-    return lw_error_set(err, LW_ERUN, "the motion reached a forbidden state at t = %g s: %s", d->time + h,
+  if (!isfinite(d->energy)) {
+    char what[160];
+    lw_dynamics_forbidden_what(t, d->state, what, sizeof what);
+    return lw_error_set(err, LW_ERUN, "the motion reached a forbidden state at t = %g s%s: %s", d->time + h, what,
                         LW_DYNAMICS_FORBIDDEN_HINT);
+  }
   t->mass_apply(d->mass, delta, d->pi);
   for (size_t i = 0; i < n; i++) d->pi[i] /= h;
   hold(d, d->pi);

@@ -69,14 +69,23 @@ static lw_status evaluate(lw_dynamics *d, const double *x, lw_error *err)
   return LW_OK;
 }
 
+void lw_dynamics_forbidden_what(const lw_system_type *t, const void *state, char *buf, size_t n)
+{
+  char what[128] = "";
+  t->describe(state, LW_DESCRIBE_FORBIDDEN, what, sizeof what);
+  snprintf(buf, n, what[0] ? " (%s)" : "%s", what);
+}
+
 lw_status lw_dynamics_sync(lw_dynamics *d, lw_error *err)
 {
   d->type->get_coords(d->state, d->x);
   lw_status s = evaluate(d, d->x, err);
   if (s) return s;
-  if (!isfinite(d->energy))
-    return lw_error_set(err, LW_EINPUT, "the dynamics starts in a forbidden state (a segment irregular or outside "
-                        "the boundary)");
+  if (!isfinite(d->energy)) {
+    char what[160];
+    lw_dynamics_forbidden_what(d->type, d->state, what, sizeof what);
+    return lw_error_set(err, LW_EINPUT, "the dynamics starts in a forbidden state%s", what);
+  }
   return d->type->mass_at(d->mass, d->x, err);
 }
 
@@ -239,9 +248,12 @@ static lw_status leapfrog(lw_dynamics *d, lw_error *err)
     t->constrain(d->state, x1, NULL, pih);
   }
   if ((s = t->mass_at(d->mass, x1, err)) || (s = evaluate(d, x1, err))) return s;
-  if (!isfinite(d->energy))
-    return lw_error_set(err, LW_ERUN, "the motion reached a forbidden state at t = %g s (energy %g: outside the "
-                        "boundary, or a segment irregular): %s", d->time + h, d->energy, LW_DYNAMICS_FORBIDDEN_HINT);
+  if (!isfinite(d->energy)) {
+    char what[160];
+    lw_dynamics_forbidden_what(t, d->state, what, sizeof what);
+    return lw_error_set(err, LW_ERUN, "the motion reached a forbidden state at t = %g s%s: %s", d->time + h, what,
+                        LW_DYNAMICS_FORBIDDEN_HINT);
+  }
   memcpy(d->x, x1, n * sizeof *x1);
   /* pi' = pi+ - h/2 dH/dx(x', pi+) */
   dh_dx(d, d->x, pih, d->u);

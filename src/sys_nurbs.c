@@ -1089,6 +1089,8 @@ static void describe(const void *state, int what, char *buf, size_t n)
   if (what == LW_DESCRIBE_SIZE)
     snprintf(buf, n, "a NURBS curve of order %d, %zu control points, %zu free%s", s->c->order, s->c->n, s->su->n_free,
              s->s ? ", free weights" : "");
+  else if (what == LW_DESCRIBE_FORBIDDEN)
+    snprintf(buf, n, "an energy that is not finite");
   else
     snprintf(buf, n, "linewise: final.svg: %zu cubic Beziers, at most %.3g from the curve%s\n", s->beziers,
              s->deviation, lw_nurbs_polynomial(s->c) && s->c->order <= 4 ? " (exact)" : "");

@@ -465,6 +465,7 @@ static void describe(const void *state, int what, char *buf, size_t n)
 {
   const lw_particles *p = state;
   if (what == LW_DESCRIBE_SIZE) snprintf(buf, n, "%zu particles, %zu pinned", p->n, pinned(p));
+  else if (what == LW_DESCRIBE_FORBIDDEN) snprintf(buf, n, "a particle on or past the boundary");
   else if (n) buf[0] = '\0';
 }
 

@@ -1210,11 +1210,9 @@ static void describe(const void *state, int what, char *buf, size_t n)
   const spl_state *s = state;
   const lw_splines *sp = s->m->sp;
   const lw_drawing_report *d = &s->drawing;
-  if (what == LW_DESCRIBE_SIZE) {
-    snprintf(buf, n, "%zu splines, %zu segments", sp->n_splines, sp->n_segments);
-    return;
-  }
-  lw_drawing_report_text(d, buf, n);
+  if (what == LW_DESCRIBE_SIZE) snprintf(buf, n, "%zu splines, %zu segments", sp->n_splines, sp->n_segments);
+  else if (what == LW_DESCRIBE_FORBIDDEN) snprintf(buf, n, "a segment irregular or outside the boundary");
+  else lw_drawing_report_text(d, buf, n);
 }
 
 /* ---- inertia (the dynamics driver) ------------------------------------------ */

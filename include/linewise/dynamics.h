@@ -84,6 +84,10 @@ typedef struct {
 /* What a motion that reached a forbidden state (+inf energy) can do: a
 ** step too long gets there where a shorter one does not; a motion that
 ** gets there at the same time whatever the step goes there itself. */
+/* " (what makes the row's states forbidden)", from its describe(), or ""
+** where it names nothing: for the messages of a motion that reached one. */
+void lw_dynamics_forbidden_what(const lw_system_type *t, const void *state, char *buf, size_t n);
+
 #define LW_DYNAMICS_FORBIDDEN_HINT                                                                     \
   "a shorter dynamics.dt passes it if the step took it there; if the motion stops at the same time " \
   "whatever the step, it goes there itself (more damping, dynamics.gamma, or stiffer terms hold it)"

@@ -216,8 +216,10 @@ struct lw_system_type {
   ** or the animation frame of a sweep >= 0; summary() writes the system's members of
   ** summary.json (sizes, what the final drawing reported); describe()
   ** text for the command line: the size (LW_DESCRIBE_SIZE, "20 splines, 80
-  ** segments") or what the final drawing reported (LW_DESCRIBE_DRAWING,
-  ** whole lines "linewise: ...\n", or ""); files names the drawing files. */
+  ** segments"), what the final drawing reported (LW_DESCRIBE_DRAWING,
+  ** whole lines "linewise: ...\n", or "") or what makes a state forbidden
+  ** (LW_DESCRIBE_FORBIDDEN, "a segment irregular or outside the boundary",
+  ** or "" where nothing does); files names the drawing files. */
   /* Gradient-based drivers (dynamics, quench; gradient.h): the state as a
   ** vector of n_coords() generalised coordinates (for splines the nodes'
   ** px py vx vy in node order), set_coords() moves the state there and
@@ -319,7 +321,7 @@ struct lw_system_type {
 
 #define LW_DRAW_START (-2)
 #define LW_DRAW_FINAL (-1)
-enum { LW_DESCRIBE_SIZE, LW_DESCRIBE_DRAWING };
+enum { LW_DESCRIBE_SIZE, LW_DESCRIBE_DRAWING, LW_DESCRIBE_FORBIDDEN };
 
 /* One instance: the row and a state (owned). */
 typedef struct {
