@@ -69,3 +69,9 @@ int lw_number_list(const char *s, int commas, double *out, int max)
     s += len;
   }
 }
+
+void lw_text_drop_bom(char *s)
+{
+  if ((unsigned char)s[0] == 0xEF && (unsigned char)s[1] == 0xBB && (unsigned char)s[2] == 0xBF)
+    memmove(s, s + 3, strlen(s + 3) + 1);
+}

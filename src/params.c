@@ -970,6 +970,21 @@ static char *read_line(char *str, int num, void *stream)
   ssize_t len = getline(&rc->buf, &rc->cap, rc->f);
   if (len < 0) return NULL;
   rc->line++;
+  /* a CRLF line end counts as LF: the limit is the text's (it refused a
+  ** line of 198 characters from Windows that it took from Unix) */
+  if (len >= 2 && rc->buf[len - 2] == '\r' && rc->buf[len - 1] == '\n') {
+    rc->buf[len - 2] = '\n';
+    rc->buf[--len] = '\0';
+  }
+  /* a CR inside the line: a file of CR line ends (old Mac OS) reads as
+  ** one line, a comment or too long, and the scene silently empty */
+  const char *cr = memchr(rc->buf, '\r', (size_t)len);
+  if (cr && cr + 1 < rc->buf + len && cr[1] != '\n') {
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: a CR inside the line (a file of CR line ends, as old Mac OS wrote): "
+                 "expected LF or CRLF line ends", rc->p->file, rc->line);
+    rc->failed = 1;
+    return NULL;
+  }
   if (len >= num) {
     lw_error_set(rc->err, LW_EINPUT, "%s:%d: line longer than %d characters (the limit of the INI reader)",
                  rc->p->file, rc->line, num - 2);

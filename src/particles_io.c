@@ -14,7 +14,10 @@ static char *next_line(FILE *f, char **buf, size_t *cap, int *line)
 {
   ssize_t len = getline(buf, cap, f);
   if (len < 0) return NULL;
-  (*line)++;
+  if (++*line == 1) {
+    lw_text_drop_bom(*buf);
+    len = (ssize_t)strlen(*buf);
+  }
   while (len > 0 && ((*buf)[len - 1] == '\n' || (*buf)[len - 1] == '\r')) (*buf)[--len] = '\0';
   return *buf;
 }

@@ -263,6 +263,7 @@ lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err
       break;
     }
     lineno++;
+    if (lineno == 1) lw_text_drop_bom(line);
     line[strcspn(line, "#")] = '\0';
     char shown[64], *tok[3];
     snprintf(shown, sizeof shown, "%s", line + strspn(line, " \t"));

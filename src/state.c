@@ -262,6 +262,7 @@ static char *next_line(reader *r)
       r->nul = 1;
       return NULL;
     }
+    if (r->line == 1) lw_text_drop_bom(r->buf);
     /* trailing blanks go, as format 2 trims them: a value reads the same in both */
     size_t n = strcspn(r->buf, "\r\n");
     while (n > 0 && (r->buf[n - 1] == ' ' || r->buf[n - 1] == '\t')) n--;

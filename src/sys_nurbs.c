@@ -93,7 +93,7 @@ static lw_status read_file(const lw_params *p, double **P, size_t *np, double **
   size_t cap_p = 0, cap_w = 0;
   int lineno = 0, per = 0;
   while (fgets(line, sizeof line, f)) {
-    lineno++;
+    if (++lineno == 1) lw_text_drop_bom(line);
     line[strcspn(line, "#\r\n")] = '\0';
     double v[4];
     int k = lw_number_list(line, 0, v, 4);

@@ -638,3 +638,31 @@ Test(cli, closed_and_full_standard_streams_are_not_written_over_or_ignored)
                             "= 1", dir, dir), 0, "%s", args);
   }
 }
+
+/* Text inputs saved with a UTF-8 byte-order mark (Windows editors) read as
+** without one: a schedule table, a points file, a curve's file and a state
+** file.  Before, only scene files did; the others said "expected 'block
+** temperature', got ''" with the mark invisible in the quote. */
+Test(cli, text_files_with_a_byte_order_mark_read_as_without)
+{
+  cr_assert_eq(lw_test_sh("cd %s && printf '\\357\\273\\2770 1\\n3 0.01\\n' > t.txt && printf '0 1\\n3 0.01\\n' > u.txt",
+                          dir), 0);
+  const char *run_t = "%s run %s/params/minimal.ini --out %s/%s --quiet --set anneal.schedule=table "
+                      "--set anneal.table=%s/%s --set anneal.sweeps=20";
+  cr_assert_eq(lw_test_sh(run_t, lw_test_bin(), lw_test_root(), dir, "t", dir, "t.txt"), 0);
+  cr_assert_eq(lw_test_sh(run_t, lw_test_bin(), lw_test_root(), dir, "u", dir, "u.txt"), 0);
+  cr_assert_eq(lw_test_sh("cmp -s %s/t/trace.csv %s/u/trace.csv", dir, dir), 0);
+  /* points and a curve's file */
+  cr_assert_eq(lw_test_sh("cd %s && printf '\\357\\273\\2770 0 0\\n1.1 0 0\\n0 1.1 0\\n' > p.xyz && "
+                          "printf '[scene]\\nsystem = particles\\n[particles]\\npoints = p.xyz\\n[anneal]\\nsweeps = 2\\n'"
+                          " > p.ini && %s run p.ini --out p --quiet", dir, lw_test_bin()), 0);
+  cr_assert_eq(lw_test_sh("cd %s && printf '\\357\\273\\2770 0\\n1 1\\n2 0\\n3 1\\n' > c.txt && printf '[scene]\\n"
+                          "system = nurbs\\n[nurbs]\\norder = 3\\nfile = c.txt\\nfixed = 1\\n[anneal]\\nsweeps = 2\\n' > c.ini"
+                          " && %s run c.ini --out c --quiet", dir, lw_test_bin()), 0);
+  /* a state file: the run resumes from it as from the one written */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/s --quiet --set anneal.sweeps=20 --stop-at 10 && "
+                          "cp -r %s/s %s/b && { printf '\\357\\273\\277'; cat %s/s/state.lw; } > %s/b/state.lw && "
+                          "%s resume %s/s --quiet && %s resume %s/b --quiet && cmp -s %s/s/final.svg %s/b/final.svg",
+                          lw_test_bin(), lw_test_root(), dir, dir, dir, dir, dir, lw_test_bin(), dir, lw_test_bin(),
+                          dir, dir, dir), 0);
+}

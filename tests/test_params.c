@@ -328,6 +328,15 @@ Test(params, long_lines_are_refused_with_their_own_line_number)
   cr_assert_eq(lw_params_read(&q, path, &err), LW_OK, "%s", err.msg);
   unlink(path);
   cr_assert_str_eq(q.polygon, p.polygon);
+  /* 198 characters and a CRLF line end are a line (refused as 199 before);
+  ** a file of CR line ends is named as such (it read as one long line, or,
+  ** shorter, as one comment and an empty scene) */
+  char crlf[400] = ";";
+  memset(crlf + 1, 'x', 197);
+  strcpy(crlf + 198, "\r\n[scene]\r\nwidth = 50\r\n");
+  cr_assert_eq(read_text(crlf, &p, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(p.width, 50.0);
+  expect_error("; a scene\r[scene]\rwidth = 50\r", ":1:", NULL, "a CR inside the line (a file of CR line ends");
 }
 
 /*

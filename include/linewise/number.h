@@ -25,6 +25,12 @@ int lw_number_parse(const char *s, double *out);
 ** every value is exact); "1e3" counts as 1000.  1 on success. */
 int lw_number_parse_whole(const char *s, double lo, double hi, long long *out);
 
+/* Removes a UTF-8 byte-order mark from the start of the text line s, in
+** place: editors on Windows begin a file with one, and every reader of a
+** text input drops it from its first line, as the scene reader does (it
+** showed as nothing in "got ''" messages). */
+void lw_text_drop_bom(char *s);
+
 /* Splits s at blanks (and commas when `commas`) into at most max numbers;
 ** returns how many tokens there were (more than max are counted but not
 ** stored), or -1 if a token is not a number. */
