@@ -12,6 +12,9 @@ WARN    := -std=c11 -Wall -Wextra -Wshadow -Wstrict-prototypes -Wno-unused-param
 CPPFLAGS += -Iinclude -D_POSIX_C_SOURCE=200809L $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 LDLIBS  += $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lm
 OMP     := -fopenmp
+# Each object lists the headers it includes in a .d file beside it, so a
+# header's change rebuilds only what includes it.
+DEPFLAGS := -MMD -MP
 
 DEBS    := build-essential pkg-config libgsl-dev libcairo2-dev libinih-dev libstb-dev \
            libcriterion-dev gnuplot-nox clang libclang-rt-dev
@@ -40,31 +43,32 @@ PICTURE := params/picture.png
 # first, needs it.
 all: $(BIN)/linewise $(PICTURE)
 
-$(BUILD)/obj/%.o: src/%.c $(wildcard include/linewise/*.h) | $(BUILD)/obj
-	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -c $< -o $@
+$(BUILD)/obj/%.o: src/%.c | $(BUILD)/obj
+	$(CC) $(WARN) $(CFLAGS) $(OMP) $(DEPFLAGS) $(CPPFLAGS) -c $< -o $@
 
 $(BUILD)/liblinewise.a: $(LIB_OBJ)
 	rm -f $@ && ar rcs $@ $^
 
-$(BIN)/linewise: src/main.c $(BUILD)/liblinewise.a | $(BIN)
+# (main.c alone, so any header's change compiles it again)
+$(BIN)/linewise: src/main.c $(wildcard include/linewise/*.h) $(BUILD)/liblinewise.a | $(BIN)
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) $< -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
 
 mpi: $(BIN)/linewise-mpi
 
-$(BIN)/linewise-mpi: src/main.c $(wildcard src/mpi/*.c) $(BUILD)/liblinewise.a | $(BIN)
+$(BIN)/linewise-mpi: src/main.c $(wildcard src/mpi/*.c) $(wildcard include/linewise/*.h) $(BUILD)/liblinewise.a | $(BIN)
 	$(MPICC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -DLW_MPI src/main.c $(wildcard src/mpi/*.c) -o $@ \
 	  $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
 
-$(BUILD)/tests/%.o: tests/%.c $(wildcard tests/*.h) $(wildcard include/linewise/*.h) | $(BUILD)/tests
-	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -Itests -c $< -o $@
+$(BUILD)/tests/%.o: tests/%.c | $(BUILD)/tests
+	$(CC) $(WARN) $(CFLAGS) $(OMP) $(DEPFLAGS) $(CPPFLAGS) -Itests -c $< -o $@
 
 # stb_image_write (the image tests' JPEG writer) shifts signed ints out of
 # range: built without UBSan, so that `make asan` reports only our code
 $(BUILD)/tests/stb_write.o: tests/stb_write.c | $(BUILD)/tests
 	$(CC) $(WARN) $(CFLAGS) -fno-sanitize=undefined $(CPPFLAGS) -c $< -o $@
 
-$(BUILD)/tests/fuzz_%.o: tests/fuzz/fuzz_%.c $(wildcard tests/fuzz/*.h) $(wildcard include/linewise/*.h) | $(BUILD)/tests
-	$(CC) $(WARN) $(CFLAGS) $(CPPFLAGS) -DLLVMFuzzerTestOneInput=lw_fuzz_$*_one -c $< -o $@
+$(BUILD)/tests/fuzz_%.o: tests/fuzz/fuzz_%.c | $(BUILD)/tests
+	$(CC) $(WARN) $(CFLAGS) $(DEPFLAGS) $(CPPFLAGS) -DLLVMFuzzerTestOneInput=lw_fuzz_$*_one -c $< -o $@
 
 $(BUILD)/tests/run: $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(BUILD)/liblinewise.a
 	$(CC) $(CFLAGS) $(OMP) $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS) -lcriterion
@@ -106,8 +110,8 @@ FUZZ_SAN  := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sa
              -DLW_IMAGE_MAX_PIXELS=4194304
 FUZZ_WARN := $(WARN) -Wno-unknown-pragmas
 
-build-fuzz/obj/%.o: src/%.c $(wildcard include/linewise/*.h) | build-fuzz/obj
-	$(FUZZ_CC) $(FUZZ_WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link $(CPPFLAGS) -c $< -o $@
+build-fuzz/obj/%.o: src/%.c | build-fuzz/obj
+	$(FUZZ_CC) $(FUZZ_WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link $(DEPFLAGS) $(CPPFLAGS) -c $< -o $@
 
 build-fuzz/fuzz_%: tests/fuzz/fuzz_%.c $(wildcard tests/fuzz/*.h) $(FUZZ_OBJ)
 	$(FUZZ_CC) $(FUZZ_WARN) $(FUZZ_SAN) -fsanitize=fuzzer $(CPPFLAGS) $< $(FUZZ_OBJ) -o $@ $(LDLIBS)
@@ -207,3 +211,6 @@ install: $(BIN)/linewise $(PICTURE)
 
 clean:
 	rm -rf build build-asan build-fuzz bin $(PICTURE)
+
+# the headers each object was built from (DEPFLAGS)
+-include $(wildcard $(BUILD)/obj/*.d $(BUILD)/tests/*.d build-fuzz/obj/*.d)
