@@ -729,8 +729,9 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   void *all[LW_TEMPERING_MAX] = {NULL};
   lw_ckpt *rep[LW_TEMPERING_MAX] = {NULL};
   lw_phase_set("reading state.lw and rebuilding the energy");
-  /* (a directory that is not there has no state.lw to read, which says so) */
-  if (writes_files(a) && access(dir, F_OK) == 0) {
+  /* (a directory that holds no run has no state.lw to read, which says so,
+  ** and gets no lock file) */
+  if (writes_files(a) && lw_rundir_holds_run(dir)) {
     lw_status sl = lw_rundir_lock(dir, &a->dir_hold, err);
     if (sl) return sl;
   }

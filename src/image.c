@@ -566,19 +566,22 @@ static const char *format_name(const unsigned char *d, size_t n)
   return "image";
 }
 
-/* Whether a PNG's header asks more than the decoder's 2^30 bytes of pixels
-** (width x height x channels, a palette's counted as 4), which it refuses
-** before linewise's own 1e9 pixels; the formats it tries after PNG then
-** leave "unknown type" as the reason, and a 20000 x 20000 RGB picture was
-** called corrupt. */
-static int png_too_large(const unsigned char *d, size_t n)
+/* Why the decoder refuses a PNG's header as too large, or NULL: more than
+** 2^30 bytes of pixels (width x height x channels, a palette's counted as
+** 4), or a side past 2^24 pixels, both before linewise's own 1e9 pixels;
+** the formats it tries after PNG then leave "unknown type" as the reason,
+** and a 20000 x 20000 RGB picture was called corrupt. */
+static const char *png_too_large(const unsigned char *d, size_t n)
 {
-  if (n < 26 || strcmp(format_name(d, n), "PNG") || memcmp(d + 12, "IHDR", 4)) return 0;
+  if (n < 26 || strcmp(format_name(d, n), "PNG") || memcmp(d + 12, "IHDR", 4)) return NULL;
   double w = (double)((uint32_t)d[16] << 24 | (uint32_t)d[17] << 16 | (uint32_t)d[18] << 8 | d[19]);
   double h = (double)((uint32_t)d[20] << 24 | (uint32_t)d[21] << 16 | (uint32_t)d[22] << 8 | d[23]);
   static const int channels[7] = {1, 0, 3, 4, 2, 0, 4}; /* by colour type: grey, -, RGB, palette, grey+alpha, -, RGBA */
   int ch = d[25] < 7 ? channels[d[25]] : 0;
-  return ch && w * h * ch > 1073741824.0;
+  if (w > 16777216.0 || h > 16777216.0) return "a side is more than 2^24 pixels";
+  if (ch && w * h * ch > 1073741824.0)
+    return "its width x height x channels is more than 2^30 (1.07e9 grey, 358 million RGB or 268 million RGBA pixels)";
+  return NULL;
 }
 
 /* What stb_image must not be given: a BMP or GIF cut short, a JPEG whose
@@ -601,10 +604,8 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
   if (st) return st;
   int w, h, ch;
   if (!stbi_info_from_memory(data, (int)size, &w, &h, &ch)) {
-    if (png_too_large(data, size))
-      return lw_error_set(err, LW_EINPUT, "%s: the PNG is too large to decode: its width x height x channels is more "
-                          "than 2^30 (1.07e9 grey, 358 million RGB or 268 million RGBA pixels); scale it down first",
-                          name);
+    const char *why = png_too_large(data, size);
+    if (why) return lw_error_set(err, LW_EINPUT, "%s: the PNG is too large to decode: %s; scale it down first", name, why);
     return lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, binary PGM/PPM): %s",
                         name, stbi_failure_reason());
   }

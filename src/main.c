@@ -434,50 +434,60 @@ static lw_status spread_start(lw_status s, lw_anneal *a, int fresh, lw_error *er
 ** started together without --out each get their own, and none replaces
 ** the drawing of another (--out names a directory to replace).  *made: 1
 ** the directory is new, 2 out/ too (taken away again if the run is
-** refused).  The processes
-** of an MPI run look before any of them writes, and the first locks the
-** directory as it starts. */
+** refused).  Where the directory cannot be made here (a read-only
+** checkout), the first name without a run is taken unmade, and the run says
+** why once its scene is known to be good.  Under MPI process 0 chooses and
+** holds the lock, and tells the others. */
 static lw_status default_dir(char *dir, size_t size, const char *scene, int *hold, int *made, lw_error *err)
 {
   const char *base = strrchr(scene, '/');
   base = base ? base + 1 : scene;
   const int n = (int)strcspn(base, ".");
   *hold = *made = 0;
-  const int out_existed = access("out", F_OK) == 0;
-  snprintf(dir, size, "out/%.*s", n, base);
+  lw_status s = LW_OK;
 #ifdef LW_MPI
-  if (net) {
-    for (int k = 2; lw_rundir_holds_run(dir) && k < 1000000; k++) snprintf(dir, size, "out/%.*s-%d", n, base, k);
-    return lw_mpi_agree(net, LW_OK, err);
-  }
+  if (!net || !net->rank)
 #endif
-  for (int k = 2; k <= 1000000; k++) {
-    const int existed = access(dir, F_OK) == 0;
-    if (!existed || !lw_rundir_holds_run(dir)) {
-      lw_status s = lw_rundir_make(dir, err);
-      if (!s) s = lw_rundir_lock(dir, hold, err);
-      if (s && s != LW_EUSAGE) return s; /* LW_EUSAGE: another run's */
-      if (!s && !lw_rundir_holds_run(dir)) {
-        *made = existed ? 0 : out_existed ? 1 : 3;
-        return LW_OK;
+  {
+    const int out_existed = access("out", F_OK) == 0;
+    snprintf(dir, size, "out/%.*s", n, base);
+    for (int k = 2;; k++) {
+      const int existed = access(dir, F_OK) == 0;
+      if (!existed || !lw_rundir_holds_run(dir)) {
+        lw_error e2;
+        if (lw_rundir_make(dir, &e2)) break; /* taken unmade */
+        s = lw_rundir_lock(dir, hold, err);
+        if (s && s != LW_EUSAGE) break; /* LW_EUSAGE: another run's */
+        if (!s && !lw_rundir_holds_run(dir)) {
+          *made = existed ? 0 : out_existed ? 1 : 3;
+          break;
+        }
+        s = LW_OK;
+        lw_rundir_unlock(*hold);
+        *hold = 0;
       }
-      lw_rundir_unlock(*hold);
-      *hold = 0;
+      if (k > 1000000) {
+        s = lw_error_set(err, LW_EUSAGE, "out/%.*s: a million runs there already; give --out", n, base);
+        break;
+      }
+      snprintf(dir, size, "out/%.*s-%d", n, base, k);
     }
-    snprintf(dir, size, "out/%.*s-%d", n, base, k);
   }
-  return lw_error_set(err, LW_EUSAGE, "out/%.*s: a million runs there already; give --out", n, base);
+#ifdef LW_MPI
+  if (net && !(s = lw_mpi_agree(net, s, err))) lw_mpi_share_text(net, dir, size);
+#endif
+  return s;
 }
 
-/* A directory default_dir made for a run that was then refused goes again:
-** "nothing is written" for bad input. */
+/* What default_dir made for a run that was then refused goes again, its
+** lock too: "nothing is written" for bad input. */
 static void unmake_dir(const char *dir, int hold, int made)
 {
-  if (!made || lw_rundir_holds_run(dir)) return;
+  if (!hold || lw_rundir_holds_run(dir)) return;
   char path[LW_PATH_MAX + 16];
   lw_path_join(path, sizeof path, dir, ".lock");
   unlink(path);
-  rmdir(dir);
+  if (made) rmdir(dir);
   if (made & 2) rmdir("out");
   lw_rundir_unlock(hold);
 }

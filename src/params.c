@@ -260,7 +260,8 @@ const lw_param_def lw_param_table[] = {
   NUM("moves", "rotate", LW_PT_DOUBLE, mix_rotate, "0.05", "", 0, 1e6, 0,
       "Relative frequency of whole-spline rotations about the mean of its points."),
   NUM("moves", "step_point", LW_PT_DOUBLE, step_point, "0.5", "mm", 0, 1e7, LW_MIN_OPEN,
-      "Initial standard deviation of a point move (tuned while tuning)."),
+      "Initial step of a point move (tuned while tuning): the standard deviation of a Gaussian "
+      "step for splines, the half side of a uniform square step for nurbs."),
   NUM("moves", "step_vector", LW_PT_DOUBLE, step_vector, "0.5", "mm", 0, 1e7, LW_MIN_OPEN,
       "Initial standard deviation of a vector move."),
   NUM("moves", "step_translate", LW_PT_DOUBLE, step_translate, "0.5", "mm", 0, 1e7, LW_MIN_OPEN,

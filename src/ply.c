@@ -56,7 +56,10 @@ static char *next_line(reader *r)
 {
   ssize_t len = getline(&r->buf, &r->cap, r->f);
   if (len < 0) return NULL;
-  r->line++;
+  if (++r->line == 1) {
+    lw_text_drop_bom(r->buf);
+    len = (ssize_t)strlen(r->buf);
+  }
   while (len > 0 && (r->buf[len - 1] == '\n' || r->buf[len - 1] == '\r')) r->buf[--len] = '\0';
   return r->buf;
 }
@@ -70,10 +73,11 @@ static ptype type_of(const char *s)
 
 int lw_ply_detect(FILE *f)
 {
-  char head[5] = {0};
-  size_t got = fread(head, 1, 5, f);
+  char head[8] = {0};
+  size_t got = fread(head, 1, 8, f);
   rewind(f);
-  return got >= 4 && (!memcmp(head, "ply\n", 4) || (got == 5 && !memcmp(head, "ply\r\n", 5)));
+  const size_t b = got >= 3 && !memcmp(head, "\xEF\xBB\xBF", 3) ? 3 : 0; /* a byte-order mark (number.h) */
+  return got >= b + 4 && (!memcmp(head + b, "ply\n", 4) || (got >= b + 5 && !memcmp(head + b, "ply\r\n", 5)));
 }
 
 static lw_status bad_line(reader *r, const char *expected, const char *got)

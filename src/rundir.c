@@ -54,7 +54,9 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
   *hold = 0;
   if (snprintf(path, sizeof path, "%s/.lock", dir) >= (int)sizeof path)
     return lw_error_set(err, LW_EINPUT, "%s: the run directory's name is too long", dir);
-  int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+  /* read-only: flock needs no more, and another user of a shared directory
+  ** can open a lock file the first one made */
+  int fd = open(path, O_RDONLY | O_CREAT | O_CLOEXEC, 0666);
   struct stat st;
   if (fd < 0 || fstat(fd, &st)) {
     int e = errno;
@@ -80,7 +82,7 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
     close(fd);
     if (e == EWOULDBLOCK)
       return lw_error_set(err, LW_EUSAGE, "%s: another linewise process is writing this run directory (it holds "
-                          "%s); wait for it to end, or give another --out", dir, path);
+                          "%s); wait for it to end, or write another directory", dir, path);
     if (e == ENOLCK || e == EOPNOTSUPP || e == ENOSYS || e == EINVAL) return LW_OK; /* no locks here */
     return lw_error_set(err, LW_EIO, "%s: cannot lock the run directory: %s", path, strerror(e));
   }

@@ -484,6 +484,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       size_t rows = 0;
       for (int r = 0; r < k; r++) rows += q->run[r].n;
       char tau[32] = "-", neff[32] = "-", rh[32] = "-", pr[32] = "-";
+      if (csv) tau[0] = neff[0] = rh[0] = pr[0] = '\0'; /* a value that is not there: empty, as for one run */
       if (q->sd > 0.0) {
         snprintf(tau, sizeof tau, "%.4g", q->tau_sweeps);
         snprintf(neff, sizeof neff, csv ? "%.4g" : "%.0f", q->n_eff);

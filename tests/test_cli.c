@@ -656,6 +656,9 @@ Test(cli, text_files_with_a_byte_order_mark_read_as_without)
   cr_assert_eq(lw_test_sh("cd %s && printf '\\357\\273\\2770 0 0\\n1.1 0 0\\n0 1.1 0\\n' > p.xyz && "
                           "printf '[scene]\\nsystem = particles\\n[particles]\\npoints = p.xyz\\n[anneal]\\nsweeps = 2\\n'"
                           " > p.ini && %s run p.ini --out p --quiet", dir, lw_test_bin()), 0);
+  cr_assert_eq(lw_test_sh("cd %s && printf '\\357\\273\\277ply\\nformat ascii 1.0\\nelement vertex 3\\nproperty float x\\n"
+                          "property float y\\nproperty float z\\nend_header\\n0 0 0\\n1.1 0 0\\n0 1.1 0\\n' > q.ply && "
+                          "%s run p.ini --out q --quiet --set particles.points=q.ply", dir, lw_test_bin()), 0);
   cr_assert_eq(lw_test_sh("cd %s && printf '\\357\\273\\2770 0\\n1 1\\n2 0\\n3 1\\n' > c.txt && printf '[scene]\\n"
                           "system = nurbs\\n[nurbs]\\norder = 3\\nfile = c.txt\\nfixed = 1\\n[anneal]\\nsweeps = 2\\n' > c.ini"
                           " && %s run c.ini --out c --quiet", dir, lw_test_bin()), 0);

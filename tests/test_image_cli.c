@@ -115,6 +115,13 @@ Test(image_cli, bad_pictures_exit_2_with_one_line_and_touch_nothing)
   cr_assert(strstr(why, "huge.png: the PNG is too large to decode: its width x height x channels is more than 2^30 "
                         "(1.07e9 grey, 358 million RGB or 268 million RGBA pixels); scale it down first"), "%s", why);
   cr_assert_eq(count_entries(lw_test_path("out")), 1);
+  /* and one whose side is past the decoder's 2^24 pixels */
+  static const unsigned char wide[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+                                       0x01, 0, 0, 0x01, 0, 0, 0, 1, 8, 0, 0, 0, 0, 0, 0, 0, 0};
+  lw_test_write(lw_test_path("wide.png"), wide, sizeof wide);
+  write_scene("wide.png");
+  cr_assert_eq(run("run scene.ini --out out", why, sizeof why), 2, "%s", why);
+  cr_assert(strstr(why, "wide.png: the PNG is too large to decode: a side is more than 2^24 pixels"), "%s", why);
   /* the same scene with the good picture runs */
   write_scene("good.png");
   char errs[8192];

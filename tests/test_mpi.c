@@ -6,6 +6,9 @@
 ** where the MPI build or mpirun is missing (make deps-mpi installs them).
 */
 #include <criterion/criterion.h>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
 #include <stdlib.h>
 
 #include "testutil.h"
@@ -215,4 +218,23 @@ Test(mpi, a_killed_process_ends_the_run_with_a_message_and_leaves_it_resumable, 
   cr_assert_eq(sh(MPIRUN " -n 2 %s resume %s/kill --quiet --sweeps 7", m, dir), 0);
   cr_assert_eq(sh("cd %s && %s resume kill-ref --quiet --sweeps 7 && "
                   "cmp -s kill/state.lw kill-ref/state.lw && cmp -s kill/trace.csv kill-ref/trace.csv", dir, b), 0);
+}
+
+/* An MPI run without --out takes a directory no other process is writing,
+** as a one-process run does: process 0 chooses and locks it, and tells the
+** others.  Before, every process looked only for a directory without a
+** run, chose out/s while another process was setting up there, and then
+** found it locked (exit 2).  Here the test holds out/s's lock. */
+Test(mpi, a_run_without_out_skips_a_directory_another_process_writes)
+{
+  const char *m = mpi_bin();
+  write_scene();
+  char path[128];
+  cr_assert_eq(sh("mkdir -p %s/out/s", dir), 0);
+  snprintf(path, sizeof path, "%s/out/s/.lock", dir);
+  int fd = open(path, O_RDONLY | O_CREAT, 0666);
+  cr_assert(fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0);
+  cr_assert_eq(sh("cd %s && " MPIRUN " -n 2 %s run s.ini --quiet --set anneal.sweeps=50", dir, m), 0);
+  close(fd);
+  cr_assert_eq(sh("test -s %s/out/s-2/summary.json && test ! -e %s/out/s/summary.json", dir, dir), 0);
 }

@@ -52,7 +52,7 @@ Test(rundir, a_directory_another_process_writes_is_refused)
   cr_assert(fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0, "the test takes the lock");
   cr_assert_eq(sh("%s resume %s/r 2> %s/err.txt", lw_test_bin(), dir, dir), 2);
   cr_assert_eq(sh("grep -q \"r: another linewise process is writing this run directory (it holds .*r/.lock); wait "
-                  "for it to end, or give another --out\" %s/err.txt && test $(wc -l < %s/err.txt) = 1", dir, dir), 0);
+                  "for it to end, or write another directory\" %s/err.txt && test $(wc -l < %s/err.txt) = 1", dir, dir), 0);
   cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/r --set anneal.sweeps=0 2> %s/err.txt", lw_test_bin(),
                   lw_test_root(), dir, dir), 2);
   cr_assert_eq(sh("grep -q 'another linewise process is writing this run directory' %s/err.txt", dir), 0);
@@ -88,4 +88,14 @@ Test(rundir, a_refused_run_without_out_leaves_no_directory)
   cr_assert_eq(sh("cd %s && printf '[scene]\\nimage = nothere.png\\n' > bad.ini && %s run bad.ini 2> err.txt", dir,
                   lw_test_bin()), 2);
   cr_assert_eq(sh("cd %s && grep -q 'nothere.png' err.txt && test ! -e out", dir), 0);
+}
+
+/* Resume of a directory that holds no run, or of a file, is bad input
+** (exit 2, naming state.lw) and writes nothing there, no lock file either. */
+Test(rundir, resume_of_what_holds_no_run_writes_nothing)
+{
+  cr_assert_eq(sh("mkdir %s/empty && touch %s/afile", dir, dir), 0);
+  cr_assert_eq(sh("%s resume %s/empty 2> %s/err.txt", lw_test_bin(), dir, dir), 2);
+  cr_assert_eq(sh("grep -q 'empty/state.lw' %s/err.txt && test -z \"$(ls -A %s/empty)\"", dir, dir), 0);
+  cr_assert_eq(sh("%s resume %s/afile 2> %s/err.txt", lw_test_bin(), dir, dir), 2);
 }

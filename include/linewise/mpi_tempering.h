@@ -36,6 +36,10 @@ lw_anneal_net *lw_mpi_init(int *argc, char ***argv, volatile sig_atomic_t *stop)
 ** flag (net->stop_agreed). */
 lw_status lw_mpi_agree(lw_anneal_net *net, lw_status s, lw_error *err);
 
+/* Collective: process 0's text (n bytes, NUL-terminated) into every
+** process's. */
+void lw_mpi_share_text(lw_anneal_net *net, char *text, size_t n);
+
 /* 1 if the last failure a hook or lw_mpi_agree returned was agreed (every
 ** process has it); a failure that was not must end the job (lw_mpi_abort). */
 int lw_mpi_agreed(void);

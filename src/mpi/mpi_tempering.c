@@ -72,6 +72,13 @@ lw_status lw_mpi_agree(lw_anneal_net *net, lw_status s, lw_error *err)
   return adopt(all[0], net->size, err);
 }
 
+void lw_mpi_share_text(lw_anneal_net *net, char *text, size_t n)
+{
+  (void)net;
+  MPI_Bcast(text, (int)n, MPI_CHAR, 0, comm);
+  text[n - 1] = '\0';
+}
+
 static int rung_here(const lw_anneal *a, int k)
 {
   int r = a->pt ? a->pt->at[k] : 0;
