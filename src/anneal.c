@@ -50,6 +50,29 @@ double lw_anneal_acceptance(const lw_anneal *a)
   return p ? (double)acc / (double)p : 0.0;
 }
 
+/* A wire of 5 free points with the default 10 tuning sweeps (50 proposals)
+** kept its first step and was accepted 2 % of the time against the target
+** 44 %, so its samples' autocorrelation ran to 500 sweeps, and nothing said
+** so.  Annealing schedules tune at every step, and their acceptance falls
+** with the temperature by design: only a constant one is judged. */
+void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n)
+{
+  buf[0] = '\0';
+  const lw_chain *c = a->chain;
+  if (a->dyn || !c || !a->sched_type || strcmp(a->sched_type->name, "constant")) return;
+  for (int k = 0; k < c->n_moves; k++) {
+    const lw_move_stats *st = &c->stats[k];
+    if (!(c->step_max[k] > 0.0) || st->proposed < 100) continue;
+    const double acc = (double)st->accepted / (double)st->proposed;
+    if (acc < 0.25 * c->target[k]) {
+      snprintf(buf, n, "%s moves were accepted %.1f %% of the time against the target %.0f %%: "
+               "moves.tune_sweeps = %d sweeps was too short to tune their step for this system (raise it)",
+               a->sys_type->move_names[k], 100.0 * acc, 100.0 * c->target[k], a->params.tune_sweeps);
+      return;
+    }
+  }
+}
+
 /* Temperature step of sweep s: the sweeps are shared out evenly; past the
 ** end the last step holds. */
 static long block_of(const lw_anneal *a, long s)

@@ -354,6 +354,8 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     char drawn[4096]; /* up to two lines a pen of a drawing of 16 (LW_PLOT_PENS_MAX) */
     a->sys_type->describe(a->sys->state, LW_DESCRIBE_DRAWING, drawn, sizeof drawn);
     fprintf(stderr, "%s", drawn);
+    lw_anneal_tuning_note(a, drawn, sizeof drawn);
+    if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
   }
   if (!quiet) {
     if (a->quenched)

@@ -135,6 +135,11 @@ lw_status lw_anneal_check_keys(const lw_params *p, char *unread, size_t size, lw
 double lw_anneal_temperature(const lw_anneal *a);
 double lw_anneal_energy(const lw_anneal *a);
 double lw_anneal_acceptance(const lw_anneal *a);
+
+/* A note, or "", where a constant-temperature run's tuning was too short
+** for its system: a move kind accepted under a quarter of its target over
+** the run, from the process that holds the coldest rung. */
+void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n);
 double lw_anneal_seconds(const lw_anneal *a);
 
 #endif
