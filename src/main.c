@@ -72,7 +72,7 @@ static const char usage[] =
   "                          every rung's energies reweighted (multiple histograms)\n"
   "      --from S, --to S    only the rows of sweeps S to S (inclusive)\n"
   "      --csv               one CSV line a column: column,n,mean,stderr,sd,\n"
-  "                          tau_sweeps,n_eff,window_closed,drift_z (several runs:\n"
+  "                          tau_sweeps,n_eff,window_closed,drift_z,batch_ratio (several runs:\n"
   "                          column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs)\n"
   "  params              print every scene parameter as Markdown (docs/PARAMETERS.md)\n"
   "  schedules           print the temperature schedules as Markdown (docs/SCHEDULES.md)\n"

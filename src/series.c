@@ -122,4 +122,12 @@ void lw_series_stats_of(const double *x, size_t n, lw_series_stats *out)
     if (se2 > 0.0) out->drift_z = (m[1] - m[0]) / sqrt(se2);
     else if (m[1] != m[0]) out->drift_z = m[1] > m[0] ? INFINITY : -INFINITY;
   }
+  out->batch_ratio = NAN;
+  const size_t len = n / LW_SERIES_BATCHES; /* the first B len values */
+  if (len >= 2 && out->stderr_mean > 0.0) {
+    double b[LW_SERIES_BATCHES], mb = 0.0, vb = 0.0;
+    for (int k = 0; k < LW_SERIES_BATCHES; k++) mb += (b[k] = mean_of(x + (size_t)k * len, len)) / LW_SERIES_BATCHES;
+    for (int k = 0; k < LW_SERIES_BATCHES; k++) vb += (b[k] - mb) * (b[k] - mb) / (LW_SERIES_BATCHES - 1);
+    out->batch_ratio = sqrt(vb / LW_SERIES_BATCHES) / out->stderr_mean;
+  }
 }

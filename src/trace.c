@@ -164,7 +164,7 @@ static long default_from(const lw_trace *t, int sweep)
   return (long)at(t, r, sweep);
 }
 
-enum { WARN_OPEN, WARN_FEW, WARN_DRIFT, WARN_RUNS };
+enum { WARN_OPEN, WARN_FEW, WARN_DRIFT, WARN_BATCH, WARN_RUNS };
 
 /* A column's statistics: per run (k of them), and with several runs what
 ** they say together. */
@@ -184,6 +184,8 @@ static int run_problem(const lw_series_stats *s, int what)
     return !s->window;
   case WARN_FEW:
     return s->window && s->n_eff < 25.0;
+  case WARN_BATCH:
+    return s->batch_ratio > LW_SERIES_BATCH_WARN;
   default:
     return fabs(s->drift_z) > 4.0;
   }
@@ -202,7 +204,8 @@ static int has_problem(const column_stats *c, int k, int what)
 
 static int flagged(const column_stats *c, int k)
 {
-  return has_problem(c, k, WARN_OPEN) || has_problem(c, k, WARN_FEW) || has_problem(c, k, WARN_RUNS);
+  return has_problem(c, k, WARN_OPEN) || has_problem(c, k, WARN_FEW) || has_problem(c, k, WARN_BATCH) ||
+         has_problem(c, k, WARN_RUNS);
 }
 
 /* One line naming every column with problem `what`, or nothing. */
@@ -466,7 +469,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     if (!is_coordinate(t[0]->name[c]) && strlen(t[0]->name[c]) > (size_t)width) width = (int)strlen(t[0]->name[c]);
   if (csv) {
     fprintf(out, k > 1 ? "column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs\n"
-                       : "column,n,mean,stderr,sd,tau_sweeps,n_eff,window_closed,drift_z\n");
+                       : "column,n,mean,stderr,sd,tau_sweeps,n_eff,window_closed,drift_z,batch_ratio\n");
   } else {
     if (k > 1) fprintf(out, "%d runs:\n", k);
     for (int r = 0; r < k; r++) stretch_line(out, k > 1 ? "  " : "", t[r], path[r], row[r], n[r], tuned[r]);
@@ -507,8 +510,10 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
         snprintf(tau, sizeof tau, "%.4g", s->tau * every[0]);
         snprintf(neff, sizeof neff, "%.4g", s->n_eff);
       }
-      fprintf(out, "%s,%zu,%.10g,%.4g,%.4g,%s,%s,%d,%.3g\n", name, s->n, s->mean, s->stderr_mean, s->sd, tau, neff,
-              s->window > 0, s->drift_z);
+      char batch[32] = "";
+      if (!isnan(s->batch_ratio)) snprintf(batch, sizeof batch, "%.3g", s->batch_ratio);
+      fprintf(out, "%s,%zu,%.10g,%.4g,%.4g,%s,%s,%d,%.3g,%s\n", name, s->n, s->mean, s->stderr_mean, s->sd, tau, neff,
+              s->window > 0, s->drift_z, batch);
     } else if (!(s->sd > 0.0)) {
       fprintf(out, "%-*s %15.9g %11.4g %11.4g %11s %9s\n", width, name, s->mean, 0.0, 0.0, "-", "-");
     } else {
@@ -525,6 +530,9 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     warn(out, t[0], cs, k, WARN_FEW, k > 1 ? "fewer than 25 independent samples in a run (n_eff above sums the "
          "runs): that run's error bar, and the test of the runs against each other, are rough"
          : "fewer than 25 independent samples: the error bar is rough");
+    warn(out, t[0], cs, k, WARN_BATCH, "the means of 20 batches spread more than 1.5 times the error bar allows "
+         "(by chance 1 time in 700): a slower mode the autocorrelation window missed, so the error bar is too small "
+         "(batch_ratio in --csv is the factor; run longer, or trust the larger bar)");
     warn(out, t[0], cs, k, WARN_DRIFT, "the first and second halves differ by more than 4 standard errors: not yet "
          "stationary (start later with --from)");
     warn(out, t[0], cs, k, WARN_RUNS, "the runs disagree beyond their error bars (p_runs < 0.001 or R_hat > 1.1): "

@@ -110,7 +110,8 @@ Test(series, error_bars_cover_the_true_mean_as_often_as_they_claim)
   double *x = malloc(n * sizeof *x);
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
   gsl_rng_set(r, 777);
-  size_t covered = 0, naive = 0, drifted = 0;
+  size_t covered = 0, naive = 0, drifted = 0, batched = 0;
+  double ratio_sum = 0.0;
   for (size_t k = 0; k < runs; k++) {
     ar1(r, phi, x, n);
     lw_series_stats s;
@@ -118,14 +119,49 @@ Test(series, error_bars_cover_the_true_mean_as_often_as_they_claim)
     covered += fabs(s.mean) <= 2.0 * s.stderr_mean;
     naive += fabs(s.mean) <= 2.0 * s.sd / sqrt((double)n);
     drifted += fabs(s.drift_z) > 4.0;
+    batched += s.batch_ratio > LW_SERIES_BATCH_WARN;
+    ratio_sum += s.batch_ratio;
   }
   double f = (double)covered / (double)runs;
-  cr_log_info("coverage %.3f (naive %.3f), drift flagged %zu of %zu", f, (double)naive / (double)runs, drifted, runs);
+  cr_log_info("coverage %.3f (naive %.3f), drift flagged %zu of %zu, batch ratio mean %.3f, flagged %zu",
+              f, (double)naive / (double)runs, drifted, runs, ratio_sum / runs, batched);
   cr_assert(f > 0.905 && f < 0.995, "2-stderr coverage %.3f", f);
   cr_assert((double)naive / (double)runs < 0.6, "the test cannot tell an honest error bar from a naive one");
   /* P(|z| > 4) = 6e-5 per stationary series: none expected in 400 */
   cr_assert(drifted <= 1, "%zu stationary series flagged as drifting", drifted);
+  /* the batch check: P(ratio > 1.5) = 0.0014 from the batches alone (more
+  ** with tau's own noise), so about 0.6 of 400; 5 or more would happen by
+  ** chance 4e-4 of the time (Poisson) */
+  cr_assert(batched <= 4, "%zu series with a right tau flagged by their batch means", batched);
   free(x);
+  gsl_rng_free(r);
+}
+
+/* A fast mode with a small slow one: x = a + b, a AR(1) at phi 0.5 (tau
+** 1.5), b at phi 0.999 (tau 999.5) with a twentieth of a's variance, so
+** tau = (1.5 + 0.05 x 999.5) / 1.05 = 49 in all.  rho(t) falls to the slow
+** plateau of 0.048 within a few lags, and the window closes there (W about
+** 10, tau about 2): the error bar is some 5 times too small.  The batch
+** means (20 batches of 10 slow times) see it; a single mode is not flagged. */
+Test(series, batch_means_catch_a_slow_mode_the_window_missed)
+{
+  const size_t n = 200000;
+  double *x = malloc(n * sizeof *x), *b = malloc(n * sizeof *b);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 4242);
+  ar1(r, 0.5, x, n);
+  lw_series_stats s;
+  lw_series_stats_of(x, n, &s);
+  cr_assert(s.batch_ratio > 0.6 && s.batch_ratio < LW_SERIES_BATCH_WARN, "one mode: batch ratio %g", s.batch_ratio);
+  ar1(r, 0.999, b, n);
+  const double scale = sqrt(0.05 * (1.0 / (1.0 - 0.25)) * (1.0 - 0.999 * 0.999)); /* var b = var a / 20 */
+  for (size_t t = 0; t < n; t++) x[t] += scale * b[t];
+  lw_series_stats_of(x, n, &s);
+  cr_log_info("slow mode: tau %.2f (true 49), window %zu, batch ratio %.2f", s.tau, s.window, s.batch_ratio);
+  cr_assert(s.window > 0 && s.tau < 10.0, "the window was meant to close early: tau %g", s.tau);
+  cr_assert(s.batch_ratio > 2.0, "batch ratio %g", s.batch_ratio);
+  free(x);
+  free(b);
   gsl_rng_free(r);
 }
 

@@ -36,7 +36,20 @@ typedef struct {
   double drift_z;     /* the difference of the first and second halves' means in
                          units of its standard error (both halves with the whole
                          series' tau): beyond about 4 the series is not stationary */
+  double batch_ratio; /* the standard error from the means of LW_SERIES_BATCHES
+                         batches over stderr_mean: about 1 where tau is right;
+                         above LW_SERIES_BATCH_WARN a slower mode the window missed
+                         (NAN under 2 values a batch, or without spread) */
 } lw_series_stats;
+
+/* The batch-means check: the standard error from 20 batch means is itself
+** uncertain by 1 / sqrt(2 x 19) = 16 %, so where tau is right it exceeds
+** 1.5 times the window's by chance with chi-square probability 0.0014 (19
+** degrees of freedom at 19 x 1.5^2).  A refined wire's energy read 1.5
+** times its window's error bar this way, and one seed +2.7 sigma off
+** equipartition by the window's. */
+#define LW_SERIES_BATCHES 20
+#define LW_SERIES_BATCH_WARN 1.5
 
 /* The statistics of one series of n values (n >= 1). */
 void lw_series_stats_of(const double *x, size_t n, lw_series_stats *out);
