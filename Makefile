@@ -13,8 +13,7 @@ CPPFLAGS += -Iinclude -D_POSIX_C_SOURCE=200809L $(shell pkg-config --cflags $(PK
 LDLIBS  += $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lm
 OMP     := -fopenmp
 # Each object lists the headers it includes in a .d file beside it, so a
-# header's change rebuilds only what includes it; an object without its .d
-# (built before, or the .d lost) is built again.
+# header's change rebuilds only what includes it.
 DEPFLAGS := -MMD -MP
 
 DEBS    := build-essential pkg-config libgsl-dev libcairo2-dev libinih-dev libstb-dev \
@@ -44,7 +43,7 @@ PICTURE := params/picture.png
 # first, needs it.
 all: $(BIN)/linewise $(PICTURE)
 
-$(BUILD)/obj/%.o: src/%.c $(BUILD)/obj/%.d | $(BUILD)/obj
+$(BUILD)/obj/%.o: src/%.c | $(BUILD)/obj
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(DEPFLAGS) $(CPPFLAGS) -c $< -o $@
 
 $(BUILD)/liblinewise.a: $(LIB_OBJ)
@@ -60,7 +59,7 @@ $(BIN)/linewise-mpi: src/main.c $(wildcard src/mpi/*.c) $(wildcard include/linew
 	$(MPICC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -DLW_MPI src/main.c $(wildcard src/mpi/*.c) -o $@ \
 	  $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
 
-$(BUILD)/tests/%.o: tests/%.c $(BUILD)/tests/%.d | $(BUILD)/tests
+$(BUILD)/tests/%.o: tests/%.c | $(BUILD)/tests
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(DEPFLAGS) $(CPPFLAGS) -Itests -c $< -o $@
 
 # stb_image_write (the image tests' JPEG writer) shifts signed ints out of
@@ -68,7 +67,7 @@ $(BUILD)/tests/%.o: tests/%.c $(BUILD)/tests/%.d | $(BUILD)/tests
 $(BUILD)/tests/stb_write.o: tests/stb_write.c | $(BUILD)/tests
 	$(CC) $(WARN) $(CFLAGS) -fno-sanitize=undefined $(CPPFLAGS) -c $< -o $@
 
-$(BUILD)/tests/fuzz_%.o: tests/fuzz/fuzz_%.c $(BUILD)/tests/fuzz_%.d | $(BUILD)/tests
+$(BUILD)/tests/fuzz_%.o: tests/fuzz/fuzz_%.c | $(BUILD)/tests
 	$(CC) $(WARN) $(CFLAGS) $(DEPFLAGS) $(CPPFLAGS) -DLLVMFuzzerTestOneInput=lw_fuzz_$*_one -c $< -o $@
 
 $(BUILD)/tests/run: $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(BUILD)/liblinewise.a
@@ -111,7 +110,7 @@ FUZZ_SAN  := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sa
              -DLW_IMAGE_MAX_PIXELS=4194304
 FUZZ_WARN := $(WARN) -Wno-unknown-pragmas
 
-build-fuzz/obj/%.o: src/%.c build-fuzz/obj/%.d | build-fuzz/obj
+build-fuzz/obj/%.o: src/%.c | build-fuzz/obj
 	$(FUZZ_CC) $(FUZZ_WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link $(DEPFLAGS) $(CPPFLAGS) -c $< -o $@
 
 build-fuzz/fuzz_%: tests/fuzz/fuzz_%.c $(wildcard tests/fuzz/*.h) $(FUZZ_OBJ)
@@ -213,9 +212,11 @@ install: $(BIN)/linewise $(PICTURE)
 clean:
 	rm -rf build build-asan build-fuzz bin $(PICTURE)
 
-# the headers each object was built from (DEPFLAGS); a missing .d is made
-# by nothing, which builds its object again (explicit targets: a pattern
-# would make them intermediate, and a missing intermediate rebuilds nothing)
+# the headers each object was built from (DEPFLAGS); an object without its
+# .d (built before them, or the .d lost) depends on every header, as all did
+# before.  (Not the .d itself as a prerequisite: clang writes it after the
+# object, which then always looked out of date.)
 DEP_FILES := $(LIB_OBJ:.o=.d) $(TEST_SRC:tests/%.c=$(BUILD)/tests/%.d) $(FUZZ_REPLAY_OBJ:.o=.d) $(FUZZ_OBJ:.o=.d)
-$(DEP_FILES): ;
+ALL_HEADERS := $(wildcard include/linewise/*.h tests/*.h tests/fuzz/*.h)
+$(foreach d,$(DEP_FILES),$(if $(wildcard $(d)),,$(eval $(d:.d=.o): $(ALL_HEADERS))))
 -include $(wildcard $(DEP_FILES))

@@ -28,6 +28,18 @@ lw_status lw_dyn_review_init(lw_dynamics *d, const lw_params *p, lw_error *err)
   double h = d->dt, c = d->gamma / d->rho;
   int factored = 0;
   lw_status st = d->type->mass_shift ? d->type->mass_shift(d->mass, 1.0 + 0.5 * h * c, h * h, &factored, err) : LW_OK;
+  if (st == LW_EINPUT) {
+    /* K's entries grow like the cube of the control points, M's shrink:
+    ** near 2e5 control points the sum is no longer positive definite in
+    ** double precision, and the message named no key */
+    char where[LW_PATH_MAX + 32], was[LW_ERROR_MSG];
+    snprintf(was, sizeof was, "%s", err->msg);
+    lw_params_origin(p, lw_params_find("dynamics", "integrator"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'dynamics.integrator': the review's scheme cannot factor "
+                        "(1 + h c/2) M + h^2 K: %s (the curve is refined past what double precision holds: its "
+                        "stiffness grows like the cube of the control points); refine less (nurbs.refine), or use "
+                        "integrator = leapfrog", where, was);
+  }
   if (st) return st;
   if (!factored) {
     char where[LW_PATH_MAX + 32];

@@ -485,9 +485,9 @@ static lw_status default_dir(char *dir, size_t size, const char *scene, int *hol
 ** lock too: "nothing is written" for bad input. */
 static void unmake_dir(const char *dir, int hold, int made)
 {
-  if (!hold || lw_rundir_holds_run(dir)) return;
+  if ((!hold && !made) || lw_rundir_holds_run(dir)) return;
   char path[LW_PATH_MAX + 16];
-  lw_path_join(path, sizeof path, dir, ".lock");
+  lw_path_join(path, sizeof path, dir, ".lock"); /* (made without locks, its file is there all the same) */
   unlink(path);
   if (made) rmdir(dir);
   if (made & 2) rmdir("out");

@@ -334,7 +334,7 @@ lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_repor
         !(e < e_solved - ROUND_GAIN * fabs(e_solved))) {
       memcpy(q.x, q.solved, n * sizeof *q.x);
       e = e_solved, gnorm = g_solved;
-      end = LW_QUENCH_NO_DESCENT;
+      if (end != LW_QUENCH_ITERATIONS) end = LW_QUENCH_NO_DESCENT; /* a cap that was hit is still said */
       break;
     }
     if (st || !t->minimize || end == LW_QUENCH_CONVERGED || end == LW_QUENCH_ITERATIONS || end == LW_QUENCH_STOPPED)

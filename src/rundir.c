@@ -54,9 +54,12 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
   *hold = 0;
   if (snprintf(path, sizeof path, "%s/.lock", dir) >= (int)sizeof path)
     return lw_error_set(err, LW_EINPUT, "%s: the run directory's name is too long", dir);
-  /* read-only: flock needs no more, and another user of a shared directory
-  ** can open a lock file the first one made */
-  int fd = open(path, O_RDONLY | O_CREAT | O_CLOEXEC, 0666);
+  /* for writing where it may (NFS's flock takes an exclusive lock only on a
+  ** file open for writing), else read-only (another user of a shared
+  ** directory may read the lock file the first one made, and a local flock
+  ** needs no more) */
+  int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+  if (fd < 0 && errno == EACCES) fd = open(path, O_RDONLY | O_CLOEXEC);
   struct stat st;
   if (fd < 0 || fstat(fd, &st)) {
     int e = errno;
@@ -83,7 +86,8 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
     if (e == EWOULDBLOCK)
       return lw_error_set(err, LW_EUSAGE, "%s: another linewise process is writing this run directory (it holds "
                           "%s); wait for it to end, or write another directory", dir, path);
-    if (e == ENOLCK || e == EOPNOTSUPP || e == ENOSYS || e == EINVAL) return LW_OK; /* no locks here */
+    /* no locks here (EBADF: an NFS lock on a file we could only read) */
+    if (e == ENOLCK || e == EOPNOTSUPP || e == ENOSYS || e == EINVAL || e == EBADF) return LW_OK;
     return lw_error_set(err, LW_EIO, "%s: cannot lock the run directory: %s", path, strerror(e));
   }
   held[free_slot].dev = st.st_dev;
