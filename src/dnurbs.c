@@ -146,12 +146,15 @@ lw_status lw_dnurbs_energy_near(lw_nurbs *c, double alpha, double beta, const do
   return each_point(c, gauss, j, j + (size_t)c->order, add_energy, &g, err);
 }
 
-lw_status lw_dnurbs_energy(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, double term[2],
-                           lw_error *err)
+double lw_band_energy(const double *K, size_t n, int k, const double *P)
 {
-  density_ctx g = {alpha, beta, {mug[0], mug[1]}, term};
-  term[0] = term[1] = 0.0;
-  return each_point(c, gauss, 0, c->n, add_energy, &g, err);
+  double e = 0.0;
+  for (size_t i = 0; i < n; i++)
+    for (size_t d = 1; d < (size_t)k && i + d < n; d++) {
+      const double dx = P[2 * (i + d)] - P[2 * i], dy = P[2 * (i + d) + 1] - P[2 * i + 1];
+      e -= K[i * (size_t)k + d] * (dx * dx + dy * dy);
+    }
+  return 0.5 * e;
 }
 
 typedef struct {

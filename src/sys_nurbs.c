@@ -275,12 +275,15 @@ static lw_status rebuild(lw_nurbs_state *s, lw_error *err)
   return LW_OK;
 }
 
-/* The terms from scratch (lw_dnurbs_energy: not as 1/2 P'KP). */
+/* The terms from scratch (the elastic one over differences, lw_band_energy). */
 static lw_status recompute(lw_nurbs_state *s, lw_error *err)
 {
-  const lw_dnurbs *m = s->mat;
   lw_status st = rebuild(s, err);
-  if (st || (st = lw_dnurbs_energy(s->c, m->alpha, m->beta, s->su->mug, m->gauss, s->term, err))) return st;
+  if (st) return st;
+  const size_t n = s->c->n;
+  s->term[T_ELASTIC] = lw_band_energy(s->mat->K, n, s->mat->k, s->c->P);
+  s->term[T_GRAVITY] = 0.0;
+  for (size_t i = 0; i < 2 * n; i++) s->term[T_GRAVITY] -= s->f[i] * s->c->P[i];
   s->term[T_WEIGHTS] = 0.0;
   for (size_t i = 0; s->s && i < s->c->n; i++) s->term[T_WEIGHTS] += 0.5 * s->su->weight_stiffness * s->s[i] * s->s[i];
   return LW_OK;

@@ -51,12 +51,12 @@ lw_status lw_dnurbs_grad_s(lw_nurbs *c, double alpha, double beta, const double 
 lw_status lw_dnurbs_energy_near(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, size_t j,
                                 double term[2], lw_error *err);
 
-/* The same over the whole curve: 1/2 P'KP - f'P by the rule that assembles
-** K, summed as the squares of c' and c'' rather than through K, whose band
-** grows like (k/h)^3 while the energy does not (refine 200: 1/2 P'KP was
-** off by 1.5e-3 of an energy of 1,765). */
-lw_status lw_dnurbs_energy(lw_nurbs *c, double alpha, double beta, const double mug[2], int gauss, double term[2],
-                           lw_error *err);
+/* 1/2 P'KP for the band K (n rows of k) and the 2 n coordinates P, summed
+** as -1/2 sum over i < j of K_ij |P_i - P_j|^2, equal since K's rows sum
+** to 0 (the basis sums to 1).  Over P itself the terms of K's size (5e9 at
+** nurbs.refine = 200) cancel to the energy (1,765), and 1/2 P'KP lost
+** 1.5e-3 of it; over the differences, 1e-12. */
+double lw_band_energy(const double *K, size_t n, int k, const double *P);
 
 /* The mass matrix per unit density over the free-weight coordinates
 ** x = (x_i, y_i, s_i) of each control point, s_i = log w_i: M = int J'J du
