@@ -362,13 +362,15 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
       fprintf(stderr, "linewise: quench: energy %.10g -> %.10g, gradient norm %.3g -> %.3g, %ld iterations (%s), %.2f s\n",
               a->quench.energy_before, a->quench.energy_after, a->quench.gradient_before, a->quench.gradient_after,
               a->quench.iterations, lw_quench_end_name(a->quench.ended), a->quench.seconds);
-    /* the plotter's files beside the system's own (the splines' drawing,
-    ** whichever process drew it) */
-    const lw_params *p = &a->params;
-    const int plot = !strcmp(a->sys_type->name, "splines");
-    fprintf(stderr, "linewise: done: %s/%s%s%s%s, summary.json, trace.csv, state.lw\n", a->dir, a->sys_type->files,
-            p->pdf && plot ? ", final.pdf" : "", p->hpgl && plot ? ", final.hpgl" : "",
-            p->gcode && plot ? ", final.gcode" : "");
+    /* the plotter's files beside the system's own, where the drawing wrote
+    ** them (whichever process drew it; a run removes those of the run before) */
+    static const char *const extra[] = {"final.pdf", "final.hpgl", "final.gcode"};
+    char files[64] = "", path[LW_PATH_MAX + 16];
+    for (int k = 0; k < 3; k++) {
+      lw_path_join(path, sizeof path, a->dir, extra[k]);
+      if (!access(path, F_OK)) snprintf(files + strlen(files), sizeof files - strlen(files), ", %s", extra[k]);
+    }
+    fprintf(stderr, "linewise: done: %s/%s%s, summary.json, trace.csv, state.lw\n", a->dir, a->sys_type->files, files);
   }
   return 0;
 }
