@@ -188,6 +188,21 @@ static volatile sig_atomic_t stop_requested = 0;
 
 static volatile sig_atomic_t on_terminal = 0; /* stderr is one: say what a signal does */
 
+/* What a second signal says, written before it can come: the handler may
+** only write (it named DIR, not the run's directory). */
+#define SECOND_MSG "\nlinewise: a second signal: stopped at once; 'linewise resume DIR' continues from the last " \
+                   "checkpoint\n"
+static char second_msg[LW_PATH_MAX + 128] = SECOND_MSG;
+static volatile sig_atomic_t second_len = sizeof SECOND_MSG - 1;
+
+static void name_run_dir(const char *dir)
+{
+  second_len = 0;
+  int n = snprintf(second_msg, sizeof second_msg, "\nlinewise: a second signal: stopped at once; 'linewise resume "
+                   "%s' continues from the last checkpoint\n", dir);
+  if (n > 0 && (size_t)n < sizeof second_msg) second_len = n;
+}
+
 /* The first signal asks for a clean stop after the sweep in progress; a
 ** second ends the process at once (a sweep can take minutes), leaving
 ** the last checkpoint, which state.lw always holds whole. */
@@ -199,9 +214,7 @@ static void on_signal(int sig)
     (void)w;
   }
   if (stop_requested) {
-    static const char msg[] = "\nlinewise: a second signal: stopped at once; 'linewise resume DIR' continues from "
-                              "the last checkpoint\n";
-    ssize_t w = write(2, msg, sizeof msg - 1);
+    ssize_t w = write(2, second_msg, (size_t)second_len);
     (void)w;
     _exit(128 + sig);
   }
@@ -575,6 +588,7 @@ static int cmd_run(int argc, char **argv)
   int hold = 0, made = 0; /* the default directory's lock, held to the end */
   if (out) snprintf(dir, sizeof dir, "%s", out);
   else if (default_dir(dir, sizeof dir, scene, &hold, &made, &err)) return fail(&err);
+  name_run_dir(dir);
   /* the run writes its resolved parameters to DIR/scene.ini: over a run's
   ** (a run made again in place), never over a scene file a person wrote,
   ** the one this run reads included */
@@ -638,6 +652,7 @@ static int cmd_resume(int argc, char **argv)
     lw_error_set(&err, LW_EUSAGE, "resume: expected a run directory (usage: linewise resume DIR [--sweeps N])");
     return fail(&err);
   }
+  name_run_dir(dir);
   static lw_anneal a;
   watcher w;
   const int asked = quiet;
