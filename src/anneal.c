@@ -53,8 +53,10 @@ double lw_anneal_acceptance(const lw_anneal *a)
 /* A wire of 5 free points with the default 10 tuning sweeps (50 proposals)
 ** kept its first step and was accepted 2 % of the time against the target
 ** 44 %, so its samples' autocorrelation ran to 500 sweeps, and nothing said
-** so.  Annealing schedules tune at every step, and their acceptance falls
-** with the temperature by design: only a constant one is judged. */
+** so.  Steps far too small are as bad (every move accepted, the chain
+** crawling) unless the step is at its cap, where a flat energy takes
+** everything.  Annealing schedules tune at every step, and their acceptance
+** falls with the temperature by design: only a constant one is judged. */
 void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n)
 {
   buf[0] = '\0';
@@ -64,7 +66,7 @@ void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n)
     const lw_move_stats *st = &c->stats[k];
     if (!(c->step_max[k] > 0.0) || st->proposed < 100) continue;
     const double acc = (double)st->accepted / (double)st->proposed;
-    if (acc < 0.25 * c->target[k]) {
+    if (acc < 0.25 * c->target[k] || (acc > 1.0 - 0.25 * (1.0 - c->target[k]) && c->step[k] < 0.5 * c->step_max[k])) {
       snprintf(buf, n, "%s moves were accepted %.1f %% of the time against the target %.0f %%: "
                "moves.tune_sweeps = %d sweeps was too short to tune their step for this system (raise it)",
                a->sys_type->move_names[k], 100.0 * acc, 100.0 * c->target[k], a->params.tune_sweeps);

@@ -534,7 +534,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
          "(by chance 1 time in 700): a slower mode the autocorrelation window missed, so the error bar is too small "
          "(batch_ratio in --csv is the factor; run longer, or trust the larger bar)");
     warn(out, t[0], cs, k, WARN_DRIFT, "the first and second halves differ by more than 4 standard errors: not yet "
-         "stationary (start later with --from)");
+         "stationary (start later with --from), or, where the batch means warn too, the same slow mode (run longer)");
     warn(out, t[0], cs, k, WARN_RUNS, "the runs disagree beyond their error bars (p_runs < 0.001 or R_hat > 1.1): "
          "not converged, or the stretches too short for their error bars");
   }

@@ -329,4 +329,9 @@ Test(nurbs_cli, a_constant_temperature_run_too_short_to_tune_says_so)
                   "moves.tune_sweeps = 10 sweeps was too short' %s/err.txt", dir), 0);
   cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "t2", "--set moves.tune_sweeps=200", dir), 0);
   cr_assert_neq(sh("grep -q 'too short to tune' %s/err.txt", dir), 0);
+  /* steps far too small, never tuned: every move accepted, said too */
+  cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "t3", "--set moves.tune_sweeps=0 --set moves.step_point=1e-7",
+                  dir), 0);
+  cr_assert_eq(sh("grep -q 'note: point moves were accepted 100.0 %% of the time against the target 44 %%' %s/err.txt",
+                  dir), 0);
 }
