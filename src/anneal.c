@@ -1146,13 +1146,13 @@ static void put_observables(const lw_anneal *a, lw_json *j)
       if (!obs && !heat) continue;
       lw_series_stats st;
       lw_trace_column_stats(h, rows, n, (int)k, x, &st);
-      const char *suffix[4] = {"", "_stderr", "_tau_sweeps", "_n_eff"};
-      const double value[4] = {st.mean, st.stderr_mean, st.tau * every, st.n_eff};
-      for (int q = 0; q < 4; q++) {
+      const char *suffix[5] = {"", "_stderr", "_tau_sweeps", "_n_eff", "_batch_ratio"};
+      const double value[5] = {st.mean, st.stderr_mean, st.tau * every, st.n_eff, st.batch_ratio};
+      for (int q = 0; q < 5; q++) {
         snprintf(key, sizeof key, "%s%s", obs ? name + 4 : name, suffix[q]);
         lw_json_key(j, key);
-        /* tau and n_eff mean nothing for a column without spread */
-        if (st.n && (q < 2 || st.sd > 0.0)) lw_json_number(j, value[q]);
+        /* tau, n_eff and the batches mean nothing for a column without spread */
+        if (st.n && (q < 2 || st.sd > 0.0) && !isnan(value[q])) lw_json_number(j, value[q]);
         else lw_json_null(j);
       }
     }

@@ -554,8 +554,12 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
   cr_assert_eq(lw_test_sh("grep -q '^    \"from\": 4000,$' %s/wlc/summary.json", dir), 0);
   char *js = lw_test_slurp("%s/wlc/summary.json", dir);
   cr_assert_not_null(js);
-  const char *at = strstr(js, "\n    \"end2\": "), *se = strstr(js, "\n    \"end2_stderr\": ");
-  cr_assert(at && se, "%s", js);
+  const char *at = strstr(js, "\n    \"end2\": "), *se = strstr(js, "\n    \"end2_stderr\": "),
+             *br = strstr(js, "\n    \"end2_batch_ratio\": ");
+  cr_assert(at && se && br, "%s", js);
+  /* the batch-means check, which warns beyond 1.5, passes the well-mixed study */
+  double ratio = strtod(br + 25, NULL);
+  cr_assert(ratio > 0.5 && ratio < 1.5, "end2's batch ratio %g", ratio);
   cr_assert(fabs(strtod(at + 13, NULL) / r2 - 1.0) < 1e-9 && fabs(strtod(se + 20, NULL) / r2se - 1.0) < 1e-3,
             "summary.json's end2 differs from the stats' %.10g +- %.4g", r2, r2se);
   free(js);
