@@ -62,17 +62,18 @@ void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n)
   buf[0] = '\0';
   const lw_chain *c = a->chain;
   if (a->dyn || !c || !a->sched_type || strcmp(a->sched_type->name, "constant")) return;
-  for (int k = 0; k < c->n_moves; k++) {
+  size_t m = 0;
+  for (int k = 0; k < c->n_moves && m + 1 < n; k++) {
     const lw_move_stats *st = &c->stats[k];
     if (!(c->step_max[k] > 0.0) || st->proposed < 100) continue;
     const double acc = (double)st->accepted / (double)st->proposed;
-    if (acc < 0.25 * c->target[k] || (acc > 1.0 - 0.25 * (1.0 - c->target[k]) && c->step[k] < 0.5 * c->step_max[k])) {
-      snprintf(buf, n, "%s moves were accepted %.1f %% of the time against the target %.0f %%: "
-               "moves.tune_sweeps = %d sweeps was too short to tune their step for this system (raise it)",
-               a->sys_type->move_names[k], 100.0 * acc, 100.0 * c->target[k], a->params.tune_sweeps);
-      return;
-    }
+    if (acc < 0.25 * c->target[k] || (acc > 1.0 - 0.25 * (1.0 - c->target[k]) && c->step[k] < 0.5 * c->step_max[k]))
+      m += (size_t)snprintf(buf + m, n - m, "%s%s moves were accepted %.1f %% of the time against the target %.0f %%",
+                            m ? ", " : "", a->sys_type->move_names[k], 100.0 * acc, 100.0 * c->target[k]);
   }
+  if (m && m + 1 < n)
+    snprintf(buf + m, n - m, ": moves.tune_sweeps = %d sweeps was too short to tune their step for this system "
+             "(raise it)", a->params.tune_sweeps);
 }
 
 /* Temperature step of sweep s: the sweeps are shared out evenly; past the

@@ -584,6 +584,16 @@ static const char *png_too_large(const unsigned char *d, size_t n)
   return NULL;
 }
 
+/* Why stb_image refused what it was given: too large (png_too_large), or
+** not an image it reads. */
+static lw_status not_decoded(const unsigned char *data, size_t size, const char *name, lw_error *err)
+{
+  const char *why = png_too_large(data, size);
+  if (why) return lw_error_set(err, LW_EINPUT, "%s: the PNG is too large to decode: %s; scale it down first", name, why);
+  return lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, binary PGM/PPM): %s",
+                      name, size == 0 ? "empty file" : stbi_failure_reason());
+}
+
 /* What stb_image must not be given: a BMP or GIF cut short, a JPEG whose
 ** tables would make it write out of bounds or read uninitialised memory.
 ** Checked before any call into it, stbi_info too (which reads a JPEG's
@@ -603,12 +613,7 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
   lw_status st = stb_input_sound(data, size, name, err);
   if (st) return st;
   int w, h, ch;
-  if (!stbi_info_from_memory(data, (int)size, &w, &h, &ch)) {
-    const char *why = png_too_large(data, size);
-    if (why) return lw_error_set(err, LW_EINPUT, "%s: the PNG is too large to decode: %s; scale it down first", name, why);
-    return lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, binary PGM/PPM): %s",
-                        name, stbi_failure_reason());
-  }
+  if (!stbi_info_from_memory(data, (int)size, &w, &h, &ch)) return not_decoded(data, size, name, err);
   if (w < 1 || h < 1) /* stb_image passes a BMP of width 0 */
     return lw_error_set(err, LW_EINPUT, "%s: the %s is damaged: %d x %d pixels", name, format_name(data, size), w, h);
   if ((double)w * (double)h > LW_IMAGE_MAX_PIXELS)
@@ -764,8 +769,7 @@ lw_status lw_image_probe(const char *path, lw_image_info *info, lw_error *err)
     if (st)
       ; /* refused before stb_image reads it */
     else if (size == 0 || size > INT_MAX || !stbi_info_from_memory(data, (int)size, &iw, &ih, &ch))
-      st = lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, binary PGM/PPM): %s",
-                        path, size == 0 ? "empty file" : stbi_failure_reason());
+      st = not_decoded(data, size, path, err);
     else if (iw < 1 || ih < 1)
       st = lw_error_set(err, LW_EINPUT, "%s: the %s is damaged: %d x %d pixels", path, format_name(data, size), iw, ih);
     else if (jpeg_orientation(data, size) >= 5) /* stored on its side */

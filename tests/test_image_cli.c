@@ -114,6 +114,10 @@ Test(image_cli, bad_pictures_exit_2_with_one_line_and_touch_nothing)
   cr_assert_eq(run("run scene.ini --out out", why, sizeof why), 2, "%s", why);
   cr_assert(strstr(why, "huge.png: the PNG is too large to decode: its width x height x channels is more than 2^30 "
                         "(1.07e9 grey, 358 million RGB or 268 million RGBA pixels); scale it down first"), "%s", why);
+  /* the photo preset reads the header first, to turn the page: the same message */
+  cr_assert_eq(run("run scene.ini --out out --set scene.preset=photo --set scene.page=a4", why, sizeof why), 2, "%s",
+               why);
+  cr_assert(strstr(why, "huge.png: the PNG is too large to decode: its width x height x channels"), "%s", why);
   cr_assert_eq(count_entries(lw_test_path("out")), 1);
   /* and one whose side is past the decoder's 2^24 pixels */
   static const unsigned char wide[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
