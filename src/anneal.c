@@ -20,12 +20,12 @@
 
 #include "linewise/checkpoint.h"
 #include "linewise/domains.h"
-#include "linewise/rundir.h"
 #include "linewise/init.h"
 #include "linewise/json.h"
 #include "linewise/number.h"
 #include "linewise/output.h"
 #include "linewise/phase.h"
+#include "linewise/rundir.h"
 #include "linewise/state.h"
 #include "linewise/trace.h"
 
@@ -307,8 +307,8 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
 static const char *const metropolis_keys[] = {RUN_KEYS, "anneal.schedule", "anneal.t_start", "anneal.t_end",
                                               "anneal.steps", "anneal.lambda", "anneal.table", "anneal.check_every",
                                               "tempering.*", "moves.tune_sweeps", NULL};
-static const char *const dynamics_keys[] = {RUN_KEYS, "dynamics.rho", "dynamics.dt", "dynamics.gamma", "dynamics.steps_per_sweep",
-                                            "dynamics.integrator", NULL};
+static const char *const dynamics_keys[] = {RUN_KEYS, "dynamics.rho", "dynamics.dt", "dynamics.gamma",
+                                            "dynamics.steps_per_sweep", "dynamics.integrator", NULL};
 static const char *const driver_names[] = {"metropolis", "dynamics"};
 
 /* Whether a scene of system t under driver (LW_DRIVER_*) reads key d: a

@@ -589,7 +589,8 @@ static const char *png_too_large(const unsigned char *d, size_t n)
 static lw_status not_decoded(const unsigned char *data, size_t size, const char *name, lw_error *err)
 {
   const char *why = png_too_large(data, size);
-  if (why) return lw_error_set(err, LW_EINPUT, "%s: the PNG is too large to decode: %s; scale it down first", name, why);
+  if (why)
+    return lw_error_set(err, LW_EINPUT, "%s: the PNG is too large to decode: %s; scale it down first", name, why);
   return lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, binary PGM/PPM): %s",
                       name, size == 0 ? "empty file" : stbi_failure_reason());
 }

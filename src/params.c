@@ -276,9 +276,9 @@ const lw_param_def lw_param_table[] = {
       "Sweeps at the start of each temperature step during which steps adapt; afterwards "
       "they are frozen so sampling obeys detailed balance. 0 = never tune. A small system "
       "needs more (a sweep is as many proposals as it has nodes): a constant-temperature run "
-      "whose move kinds end accepted under a quarter of their target, or with under a quarter "
-      "of its rejections (a step below half its cap), says so, naming each (of those proposed "
-      "100 times or more)."),
+      "says so, naming each move kind proposed 100 times or more whose acceptance ends under a "
+      "quarter of its target, or whose rejections end under a quarter of the target's (a step "
+      "below half its cap)."),
   NUM("moves", "fixed_count", LW_PT_INT, fixed_count, "1", "", 0, 1, 0,
       "1 keeps the number of splines and of their segments as placed; 0 adds the "
       "trans-dimensional moves birth, death, grow and shrink (reversible jump, "

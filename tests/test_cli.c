@@ -630,8 +630,9 @@ Test(cli, closed_and_full_standard_streams_are_not_written_over_or_ignored)
 {
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/c --set anneal.sweeps=20 2>&-", lw_test_bin(),
                           lw_test_root(), dir), 0);
-  cr_assert_eq(lw_test_sh("head -1 %s/c/trace.csv | grep -q '^sweep,' && awk -F, 'NR > 1 && $1 !~ /^[0-9]+$/ { bad = 1 }"
-                          " END { exit bad || NR != 21 }' %s/c/trace.csv", dir, dir), 0);
+  cr_assert_eq(lw_test_sh("head -1 %s/c/trace.csv | grep -q '^sweep,' && "
+                          "awk -F, 'NR > 1 && $1 !~ /^[0-9]+$/ { bad = 1 } END { exit bad || NR != 21 }' "
+                          "%s/c/trace.csv", dir, dir), 0);
   const char *cmd[] = {"energy %s/c > /dev/full", "params > /dev/full", "energy %s/c >&-", "schedules >&-"};
   for (size_t k = 0; k < sizeof cmd / sizeof cmd[0]; k++) {
     char args[256], line[512];
@@ -649,8 +650,8 @@ Test(cli, closed_and_full_standard_streams_are_not_written_over_or_ignored)
 ** temperature', got ''" with the mark invisible in the quote. */
 Test(cli, text_files_with_a_byte_order_mark_read_as_without)
 {
-  cr_assert_eq(lw_test_sh("cd %s && printf '\\357\\273\\2770 1\\n3 0.01\\n' > t.txt && printf '0 1\\n3 0.01\\n' > u.txt",
-                          dir), 0);
+  cr_assert_eq(lw_test_sh("cd %s && printf '\\357\\273\\2770 1\\n3 0.01\\n' > t.txt && "
+                          "printf '0 1\\n3 0.01\\n' > u.txt", dir), 0);
   const char *run_t = "%s run %s/params/minimal.ini --out %s/%s --quiet --set anneal.schedule=table "
                       "--set anneal.table=%s/%s --set anneal.sweeps=20";
   cr_assert_eq(lw_test_sh(run_t, lw_test_bin(), lw_test_root(), dir, "t", dir, "t.txt"), 0);
@@ -658,13 +659,15 @@ Test(cli, text_files_with_a_byte_order_mark_read_as_without)
   cr_assert_eq(lw_test_sh("cmp -s %s/t/trace.csv %s/u/trace.csv", dir, dir), 0);
   /* points and a curve's file */
   cr_assert_eq(lw_test_sh("cd %s && printf '\\357\\273\\2770 0 0\\n1.1 0 0\\n0 1.1 0\\n' > p.xyz && "
-                          "printf '[scene]\\nsystem = particles\\n[particles]\\npoints = p.xyz\\n[anneal]\\nsweeps = 2\\n'"
-                          " > p.ini && %s run p.ini --out p --quiet", dir, lw_test_bin()), 0);
-  cr_assert_eq(lw_test_sh("cd %s && printf '\\357\\273\\277ply\\nformat ascii 1.0\\nelement vertex 3\\nproperty float x\\n"
-                          "property float y\\nproperty float z\\nend_header\\n0 0 0\\n1.1 0 0\\n0 1.1 0\\n' > q.ply && "
+                          "printf '[scene]\\nsystem = particles\\n[particles]\\npoints = p.xyz\\n"
+                          "[anneal]\\nsweeps = 2\\n' > p.ini && %s run p.ini --out p --quiet", dir, lw_test_bin()), 0);
+  cr_assert_eq(lw_test_sh("cd %s && printf '\\357\\273\\277ply\\nformat ascii 1.0\\nelement vertex 3\\n"
+                          "property float x\\nproperty float y\\nproperty float z\\nend_header\\n"
+                          "0 0 0\\n1.1 0 0\\n0 1.1 0\\n' > q.ply && "
                           "%s run p.ini --out q --quiet --set particles.points=q.ply", dir, lw_test_bin()), 0);
   cr_assert_eq(lw_test_sh("cd %s && printf '\\357\\273\\2770 0\\n1 1\\n2 0\\n3 1\\n' > c.txt && printf '[scene]\\n"
-                          "system = nurbs\\n[nurbs]\\norder = 3\\nfile = c.txt\\nfixed = 1\\n[anneal]\\nsweeps = 2\\n' > c.ini"
+                          "system = nurbs\\n[nurbs]\\norder = 3\\nfile = c.txt\\nfixed = 1\\n"
+                          "[anneal]\\nsweeps = 2\\n' > c.ini"
                           " && %s run c.ini --out c --quiet", dir, lw_test_bin()), 0);
   /* a state file: the run resumes from it as from the one written */
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/s --quiet --set anneal.sweeps=20 --stop-at 10 && "

@@ -292,7 +292,8 @@ Test(nurbs_cli, a_finely_refined_wire_keeps_its_running_energy)
                   "%s/f/summary.json", dir), 0, "the running energy drifted");
   cr_assert_eq(sh("%s energy %s/f > %s/fe.txt", lw_test_bin(), dir, dir), 0);
   cr_assert_eq(sh("awk 'NR == FNR { if ($1 == \"total\") e = $2; next } /\"total\": / { t = $2 + 0 } "
-                  "END { d = e - t; if (d < 0) d = -d; exit !(e != 0 && d <= 1e-9 * 3235) }' %s/fe.txt %s/f/summary.json",
+                  "END { d = e - t; if (d < 0) d = -d; exit !(e != 0 && d <= 1e-9 * 3235) }' "
+                  "%s/fe.txt %s/f/summary.json",
                   dir, dir), 0, "`linewise energy` differs from the summary");
   /* Its quench: the banded solve finds the minimum to rounding (the
   ** continuous 3193.4015705858 plus order 4's 9e-12, to the energy's own
@@ -322,16 +323,17 @@ Test(nurbs_cli, refinement_past_the_largest_order_is_refused)
 ** nothing. */
 Test(nurbs_cli, a_constant_temperature_run_too_short_to_tune_says_so)
 {
-  const char *run = "%s run %s/params/wire.ini --out %s/%s --set scene.driver=metropolis --set anneal.schedule=constant "
-                    "--set anneal.t_start=1 --set anneal.sweeps=2000 --set output.frames_every=0 %s 2> %s/err.txt";
+  const char *run = "%s run %s/params/wire.ini --out %s/%s --set scene.driver=metropolis "
+                    "--set anneal.schedule=constant --set anneal.t_start=1 --set anneal.sweeps=2000 "
+                    "--set output.frames_every=0 %s 2> %s/err.txt";
   cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "t1", "", dir), 0);
   cr_assert_eq(sh("grep -q 'note: point moves were accepted [0-9.]* %% of the time against the target 44 %%: "
                   "moves.tune_sweeps = 10 sweeps was too short' %s/err.txt", dir), 0);
   cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "t2", "--set moves.tune_sweeps=200", dir), 0);
   cr_assert_neq(sh("grep -q 'too short to tune' %s/err.txt", dir), 0);
   /* steps far too small, never tuned: every move accepted, said too */
-  cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "t3", "--set moves.tune_sweeps=0 --set moves.step_point=1e-7",
-                  dir), 0);
+  cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "t3",
+                  "--set moves.tune_sweeps=0 --set moves.step_point=1e-7", dir), 0);
   cr_assert_eq(sh("grep -q 'note: point moves were accepted 100.0 %% of the time against the target 44 %%' %s/err.txt",
                   dir), 0);
 }

@@ -52,7 +52,8 @@ Test(rundir, a_directory_another_process_writes_is_refused)
   cr_assert(fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0, "the test takes the lock");
   cr_assert_eq(sh("%s resume %s/r 2> %s/err.txt", lw_test_bin(), dir, dir), 2);
   cr_assert_eq(sh("grep -q \"r: another linewise process is writing this run directory (it holds .*r/.lock); wait "
-                  "for it to end, or write another directory\" %s/err.txt && test $(wc -l < %s/err.txt) = 1", dir, dir), 0);
+                  "for it to end, or write another directory\" %s/err.txt && test $(wc -l < %s/err.txt) = 1",
+                  dir, dir), 0);
   cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/r --set anneal.sweeps=0 2> %s/err.txt", lw_test_bin(),
                   lw_test_root(), dir, dir), 2);
   cr_assert_eq(sh("grep -q 'another linewise process is writing this run directory' %s/err.txt", dir), 0);

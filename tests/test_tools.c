@@ -492,7 +492,8 @@ Test(tools, bad_usage_exits_2_with_one_message_and_writes_nothing)
   ** guard, and the corrected one takes its directory */
   cr_assert_eq(sh("%s %s --seeds 1,2 --set energy.bending=abc --bin %s --out %s/t", tool("seed-sweep"), scene(),
                   env("LW_BIN"), dir), 1);
-  cr_assert_eq(sh("%s %s --seeds 1,2 " TINY " --bin %s --out %s/t", tool("seed-sweep"), scene(), env("LW_BIN"), dir), 0);
+  cr_assert_eq(sh("%s %s --seeds 1,2 " TINY " --bin %s --out %s/t", tool("seed-sweep"), scene(), env("LW_BIN"), dir),
+               0);
   cr_assert_eq(sh("test -s %s/t/seed-1/summary.json && test -s %s/t/seed-2/summary.json", dir, dir), 0);
   cr_assert_eq(sh("%s --gather-only %s", tool("seed-sweep"), dir), 2, "not a sweep directory");
   /* every tool: --help prints its usage (exit 0), nothing at all is bad usage (exit 2) */

@@ -176,6 +176,19 @@ Test(wire, the_banded_matrices_give_the_energies_of_the_curve)
     double tol = rational ? 1e-6 : 1e-12;
     double want = integral(c, elastic_density);
     cr_assert(fabs(el - want) < tol * want, "rational %d: 1/2 P'KP = %.15g, curve %.15g", rational, el, want);
+    /* summed over differences (lw_band_energy), the same energy; and a
+    ** translation by 1e3 changes its terms only by the rounding of the
+    ** moved points (1e-13 of a difference), where 1/2 P'KP's products
+    ** grow by 1e6 and cancel to the energy */
+    double ed = lw_band_energy(m->K, w.n, m->k, c->P);
+    cr_assert(fabs(ed - want) < tol * want, "rational %d: over differences %.15g, curve %.15g", rational, ed, want);
+    double keep[2 * 64];
+    cr_assert(2 * w.n <= 2 * 64);
+    memcpy(keep, c->P, 2 * w.n * sizeof *keep);
+    for (size_t i = 0; i < 2 * w.n; i++) c->P[i] += 1e3;
+    double moved = lw_band_energy(m->K, w.n, m->k, c->P);
+    cr_assert(fabs(moved - ed) <= 1e-12 * ed, "rational %d: translated %.17g, not %.17g", rational, moved, ed);
+    memcpy(c->P, keep, 2 * w.n * sizeof *keep);
     want = integral(c, square);
     cr_assert(fabs(mass - want) < tol * want, "rational %d: P'M1P = %.15g, curve %.15g", rational, mass, want);
     want = integral(c, height);
