@@ -209,6 +209,80 @@ double lw_boundary_distance_grad(const lw_boundary *b, double x, double y, doubl
   return d;
 }
 
+double lw_boundary_mask_slope(const lw_grid2d *g)
+{
+  double slope = 1.0;
+  for (int j = 0; j + 1 < g->ny; j++)
+    for (int i = 0; i + 1 < g->nx; i++) {
+      const double *v = g->data + (size_t)j * (size_t)g->nx + (size_t)i, *w = v + g->nx;
+      const double gx = fmax(fabs(v[1] - v[0]), fabs(w[1] - w[0])) / g->hx;
+      const double gy = fmax(fabs(w[0] - v[0]), fabs(w[1] - v[1])) / g->hy;
+      slope = fmax(slope, hypot(gx, gy));
+    }
+  return slope;
+}
+
+/* A piece of the curve: its four control points. */
+typedef struct {
+  double x[4], y[4];
+} bezier_piece;
+
+/* The curve's point at t = 1/2 and the two halves (de Casteljau). */
+static void split_half(const bezier_piece *p, bezier_piece *l, bezier_piece *r)
+{
+  const double *c[2] = {p->x, p->y};
+  double *lo[2] = {l->x, l->y}, *hi[2] = {r->x, r->y};
+  for (int k = 0; k < 2; k++) {
+    const double *q = c[k];
+    const double a = 0.5 * (q[0] + q[1]), b = 0.5 * (q[1] + q[2]), e = 0.5 * (q[2] + q[3]);
+    const double ab = 0.5 * (a + b), be = 0.5 * (b + e), m = 0.5 * (ab + be);
+    lo[k][0] = q[0], lo[k][1] = a, lo[k][2] = ab, lo[k][3] = m;
+    hi[k][0] = m, hi[k][1] = be, hi[k][2] = e, hi[k][3] = q[3];
+  }
+}
+
+/* Pieces of 1e-9 mm are not split: the distance differs from their tested
+** ends by less than that.  The stack holds one piece a level and the next. */
+#define CLEAR_TOL 1e-9
+#define CLEAR_DEPTH 80
+
+int lw_boundary_curve_clear(const lw_boundary *b, const double x[4], const double y[4], double clear)
+{
+  if (b->kind == LW_BOUNDARY_NONE) return 1;
+  const double slope = b->kind == LW_BOUNDARY_MASK ? b->slope : 1.0;
+  /* d <= -clear and d < 0 at once (clear may be 0) */
+  const double limit = clear > 0.0 ? -clear : -0.0;
+#define CLEAR_OK(d) ((d) <= limit && (d) < 0.0)
+  for (int k = 0; k < 4; k++) /* fmin and fmax below would pass over a NaN */
+    if (!isfinite(x[k]) || !isfinite(y[k])) return 0;
+  if (!CLEAR_OK(lw_boundary_distance(b, x[0], y[0])) || !CLEAR_OK(lw_boundary_distance(b, x[3], y[3]))) return 0;
+  bezier_piece stack[CLEAR_DEPTH + 2];
+  int top = 0;
+  memcpy(stack[0].x, x, sizeof stack[0].x);
+  memcpy(stack[0].y, y, sizeof stack[0].y);
+  top = 1;
+  while (top > 0) {
+    const bezier_piece p = stack[--top];
+    /* the control points' box centre, and the disc about it holding them */
+    const double cx = 0.5 * (fmin(fmin(p.x[0], p.x[1]), fmin(p.x[2], p.x[3])) +
+                             fmax(fmax(p.x[0], p.x[1]), fmax(p.x[2], p.x[3])));
+    const double cy = 0.5 * (fmin(fmin(p.y[0], p.y[1]), fmin(p.y[2], p.y[3])) +
+                             fmax(fmax(p.y[0], p.y[1]), fmax(p.y[2], p.y[3])));
+    double r = 0.0;
+    for (int k = 0; k < 4; k++) r = fmax(r, hypot(p.x[k] - cx, p.y[k] - cy));
+    const double reach = lw_boundary_distance(b, cx, cy) + slope * r;
+    if (CLEAR_OK(reach)) continue;
+    bezier_piece lo, hi;
+    split_half(&p, &lo, &hi);
+    if (!CLEAR_OK(lw_boundary_distance(b, lo.x[3], lo.y[3]))) return 0;
+    if (r < CLEAR_TOL || top + 2 > CLEAR_DEPTH + 2) continue;
+    stack[top++] = hi;
+    stack[top++] = lo;
+  }
+#undef CLEAR_OK
+  return 1;
+}
+
 int lw_boundary_inside(const lw_boundary *b, double x, double y)
 {
   return lw_boundary_distance(b, x, y) < 0;

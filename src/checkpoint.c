@@ -319,8 +319,9 @@ lw_status lw_checkpoint_check_finite(const lw_scene *sc, const lw_splines *sp, c
     for (size_t m = 0; m < lw_splines_segments(sp, i); m++)
       if (!part_finite(sc, sp, i, (long)m))
         return lw_error_set(err, LW_EINPUT, "%s: spline %zu segment %zu (nodes %zu and %zu): the %s energy is not "
-                            "finite (outside the boundary, or coordinates too large)", path, i, m, m, m + 1,
-                            lw_term_names[bad]);
+                            "finite (%s)", path, i, m, m, m + 1, lw_term_names[bad],
+                            bad == LW_TERM_BOUNDARY ? "outside the frame, or closer to it than "
+                            "energy.boundary_clearance allows" : "coordinates too large");
     return lw_error_set(err, LW_EINPUT, "%s: spline %zu: the %s energy is not finite", path, i,
                         lw_term_names[bad]);
   }

@@ -71,11 +71,14 @@ static void straight(lw_node *nd, size_t segments, double segment_length, double
   }
 }
 
+/* 1 if the spline lies inside the frame: with the boundary term on, as the
+** term allows it (its clearance too), else at its samples and nodes. */
 static int fits(const lw_scene *sc, const lw_node *nd, size_t segments)
 {
   lw_samples s;
   for (size_t m = 0; m < segments; m++) {
     lw_segment_sample(&sc->quad, &nd[m], &nd[m + 1], &s);
+    if (sc->on[LW_TERM_BOUNDARY] && !isfinite(lw_term_boundary(&s, &sc->quad, &sc->boundary))) return 0;
     for (int q = 0; q < s.n; q++)
       if (!(lw_boundary_distance(&sc->boundary, s.x[q], s.y[q]) < 0)) return 0;
   }

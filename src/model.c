@@ -14,6 +14,7 @@
 
 int lw_segment_allowed(const lw_scene *sc, const lw_node *a, const lw_node *b, double length)
 {
+  if (sc->pair_gap_max > 0.0 && !lw_segment_gaps_within(&sc->pair_quad, a, b, sc->pair_gap_max)) return 0;
   if (sc->min_speed == 0.0 && sc->regularity == 0.0) return 1;
   if (!(length > 0.0)) return 0;
   return lw_segment_check(a, b, sc->min_speed * length, sc->regularity);
@@ -404,13 +405,22 @@ static void raster_segment(const lw_term_ctx *c, lw_tone_box *b, const lw_node *
 
 lw_status lw_model_check_regular(const lw_scene *sc, const lw_splines *sp, const char *path, lw_error *err)
 {
-  if (sc->min_speed == 0.0 && sc->regularity == 0.0) return LW_OK;
+  if (sc->min_speed == 0.0 && sc->regularity == 0.0 && sc->pair_gap_max == 0.0) return LW_OK;
   lw_samples s;
   for (size_t g = 0; g < sp->n_segments; g++) {
     const lw_node *a = &sp->node[lw_segment_node(sp, g)];
     lw_segment_sample(&sc->quad, a, a + 1, &s);
     if (lw_segment_allowed(sc, a, a + 1, s.length)) continue;
     size_t i = sp->seg_spline[g];
+    const int regular = (sc->min_speed == 0.0 && sc->regularity == 0.0) ||
+                        (s.length > 0.0 && lw_segment_check(a, a + 1, sc->min_speed * s.length, sc->regularity));
+    if (regular)
+      return lw_error_set(err, LW_EINPUT,
+                          "%s: spline %zu, segment %zu is too long for the pair cutoff: two of its pair "
+                          "samples lie %.3g mm apart, more than %g of energy.pair_cutoff (%g mm), so a line "
+                          "could cross it unseen; raise energy.pair_cutoff or energy.pair_quadrature",
+                          path, i, g - lw_segment_index(sp, i, 0), lw_segment_widest_gap(&sc->pair_quad, a, a + 1),
+                          LW_PAIR_GAP_SHARE, sc->pair_gap_max / LW_PAIR_GAP_SHARE);
     double ratio = s.length > 0.0 ? lw_segment_min_speed(a, a + 1) / s.length : 0.0;
     return lw_error_set(err, LW_EINPUT,
                         "%s: spline %zu, segment %zu is irregular: its speed falls to %.3g of its mean "

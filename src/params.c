@@ -189,6 +189,12 @@ const lw_param_def lw_param_table[] = {
       "0 = off (product rule only; infinite where samples coincide)."),
   NUM("energy", "boundary", LW_PT_DOUBLE, boundary_coef, "0", "energy mm", 0, 1e12, 0,
       "R: boundary R * integral of 1/d^2 dl keeps lines inside (+infinity outside). 0 = off."),
+  NUM("energy", "boundary_clearance", LW_PT_DOUBLE, boundary_clearance, "1.5", "length elements", 0, 100, 0,
+      "With the boundary term on, a segment whose curve comes closer to the frame than this many of "
+      "its own length elements (its length / nodes), anywhere between the nodes too, is forbidden "
+      "(+infinity, like leaving the frame): closer, the nodes cannot resolve 1/d^2 and an end or a "
+      "bulge at the frame would hide its energy. 1.5 keeps each segment's boundary integral at 8 "
+      "nodes within 2e-4 (docs/ACCURACY.md). 0 = the curve only has to stay inside."),
   NUM("energy", "min_speed", LW_PT_DOUBLE, min_speed, "0.4", "fraction of the mean speed", 0, 1, LW_MAX_OPEN,
       "Regularity: a segment whose speed |r'| falls anywhere below this fraction of its mean speed "
       "(its length) is forbidden (+infinity, like leaving the frame), whatever the node count: "

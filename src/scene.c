@@ -389,6 +389,7 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
       (st = term_nodes(p, sc, sc->on[LW_TERM_TONE], "tone_quadrature", p->tone_quadrature, &sc->tone_quad, err)))
     return st;
   lw_pair_ctx_init(&sc->pair, p->pair_cutoff, p->pair_near);
+  sc->pair_gap_max = sc->on[LW_TERM_PAIR] && p->pair_cutoff > 0.0 ? LW_PAIR_GAP_SHARE * p->pair_cutoff : 0.0;
 
   double cx = p->center_x >= 0 ? p->center_x : 0.5 * p->width;
   double cy = p->center_y >= 0 ? p->center_y : 0.5 * p->height;
@@ -510,6 +511,8 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   }
   if (p->boundary != LW_BND_MASK && p->mask != LW_MASK_NONE)
     return bad_key(p, "scene", "mask", LW_EINPUT, err, "a mask needs scene.boundary = mask");
+  b->slope = b->kind == LW_BOUNDARY_MASK ? lw_boundary_mask_slope(b->sdt) : 1.0;
+  b->clearance = p->boundary_clearance;
   return build_layers(sc, p, err);
 }
 

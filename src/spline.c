@@ -239,6 +239,10 @@ void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_
   out->end_y[0] = a->py;
   out->end_x[1] = b->px;
   out->end_y[1] = b->py;
+  out->hand_x[0] = a->px + a->vx;
+  out->hand_y[0] = a->py + a->vy;
+  out->hand_x[1] = b->px - b->vx;
+  out->hand_y[1] = b->py - b->vy;
 }
 
 void lw_shape_finish(const lw_arc_moments *m, double ex, double ey, const double t0[2], const double t1[2],
@@ -387,6 +391,39 @@ static double disc_radius2(double rho)
 {
   double R = 0.25 * (rho + 1.0 / rho);
   return R * R;
+}
+
+double lw_segment_widest_gap(const lw_quad *q, const lw_node *a, const lw_node *b)
+{
+  double widest = 0.0, px = 0.0, py = 0.0;
+  for (int i = 0; i < q->n; i++) {
+    const double *c = q->pos[i];
+    const double x = c[0] * a->px + c[1] * a->vx + c[2] * b->px + c[3] * b->vx;
+    const double y = c[0] * a->py + c[1] * a->vy + c[2] * b->py + c[3] * b->vy;
+    if (i > 0) {
+      const double g = hypot(x - px, y - py);
+      if (!(g <= widest)) widest = g; /* NaN wins */
+    }
+    px = x;
+    py = y;
+  }
+  return widest;
+}
+
+int lw_segment_gaps_within(const lw_quad *q, const lw_node *a, const lw_node *b, double gap_max)
+{
+  double h[6];
+  hodograph(a, b, h);
+  /* |h|^2 <= the largest of its Bernstein coefficients (speed_bound's) */
+  const double c0 = h[0] * h[0] + h[1] * h[1], c1 = h[0] * h[2] + h[1] * h[3];
+  const double c2 = ((h[0] * h[4] + h[1] * h[5]) + 2.0 * (h[2] * h[2] + h[3] * h[3])) * (1.0 / 3.0);
+  const double c3 = h[2] * h[4] + h[3] * h[5], c4 = h[4] * h[4] + h[5] * h[5];
+  const double top = fmax(fmax(fmax(c0, c1), fmax(c2, c3)), c4);
+  if (!isfinite(c0 + c1 + c2 + c3 + c4)) return 0;
+  double spacing = 0.0;
+  for (int i = 1; i < q->n; i++) spacing = fmax(spacing, q->s[i] - q->s[i - 1]);
+  if (spacing * spacing * top <= gap_max * gap_max) return 1;
+  return lw_segment_widest_gap(q, a, b) <= gap_max;
 }
 
 int lw_segment_check(const lw_node *a, const lw_node *b, double min_speed, double rho)

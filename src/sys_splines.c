@@ -154,14 +154,21 @@ static int along_curve(const lw_scene *sc, lw_splines *sp, lw_error *err)
 }
 
 /* A model on sp (owned) after checking that the splines read from path are
-** allowed for the scene. */
-static spl_state *state_from_file(const spl_setup *su, lw_splines *sp, const char *path, lw_error *err)
+** allowed for the scene and that their energy is finite (where: path and
+** the section, for that message). */
+static spl_state *state_from_file(const spl_setup *su, lw_splines *sp, const char *path, const char *where,
+                                  lw_error *err)
 {
   if (lw_model_check_regular(&su->scene, sp, path, err) || lw_model_check_layers(&su->scene, sp, path, err)) {
     lw_splines_free(sp);
     return NULL;
   }
-  return state_of(su, lw_model_new(&su->scene, sp, err), 1, err);
+  spl_state *s = state_of(su, lw_model_new(&su->scene, sp, err), 1, err);
+  if (s && lw_checkpoint_check_finite(&su->scene, s->m->sp, s->m->term, where, err)) {
+    state_free(s);
+    return NULL;
+  }
+  return s;
 }
 
 /* The coldest rung's splines, read with the header (st->sp, taken over);
@@ -202,7 +209,7 @@ static void *state_new(const void *setup, const lw_params *p, unsigned long seed
       lw_splines_free(sp);
       return NULL;
     }
-    spl_state *s = state_from_file(su, sp, p->from, err);
+    spl_state *s = state_from_file(su, sp, p->from, p->from, err);
     if (!s && err->code == LW_EINPUT) lw_params_blame(p, "init", "from", err);
     return s;
   }
@@ -998,15 +1005,9 @@ static void *load(const void *setup, lw_state *st, const char *section, const ch
   } else if (lw_state_get_splines(st->doc, section, &sp, err)) {
     return NULL;
   }
-  spl_state *s = state_from_file(su, sp, path, err);
-  if (!s) return NULL;
   char where[LW_PATH_MAX + 64];
   snprintf(where, sizeof where, "%s: [%s]", path, section);
-  if (lw_checkpoint_check_finite(&su->scene, s->m->sp, s->m->term, where, err)) {
-    state_free(s);
-    return NULL;
-  }
-  return s;
+  return state_from_file(su, sp, path, where, err);
 }
 
 static void set_terms(void *state, const double *term)

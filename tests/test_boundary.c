@@ -372,3 +372,96 @@ Test(boundary, non_finite_points_are_outside_not_nan)
   cr_assert(isinf(lw_boundary_distance(&poly_b, 1, 0.5)));
   lw_boundary_clear(&poly_b);
 }
+
+/* ---- a whole curve against the frame ---------------------------------- */
+
+/* The least of -d over the cubic with control points (x, y), sampled at
+** 20001 parameters: the curve's clearance up to the sampling (a point
+** between samples is within 1/20000 of the control polygon's length of one,
+** and d moves by at most that times the slope). */
+static double sampled_clearance(const lw_boundary *b, const double x[4], const double y[4], double *slack)
+{
+  double least = INFINITY, polygon_length = 0.0;
+  for (int k = 0; k < 3; k++) polygon_length += hypot(x[k + 1] - x[k], y[k + 1] - y[k]);
+  for (int i = 0; i <= 20000; i++) {
+    const double t = i / 20000.0, u = 1.0 - t;
+    const double b0 = u * u * u, b1 = 3 * u * u * t, b2 = 3 * u * t * t, b3 = t * t * t;
+    const double d = lw_boundary_distance(b, b0 * x[0] + b1 * x[1] + b2 * x[2] + b3 * x[3],
+                                          b0 * y[0] + b1 * y[1] + b2 * y[2] + b3 * y[3]);
+    least = fmin(least, -d);
+  }
+  *slack = (b->kind == LW_BOUNDARY_MASK ? b->slope : 1.0) * polygon_length / 20000.0 + 1e-9;
+  return least;
+}
+
+/* Random cubics about the frame of b (its box [x0, x1] x [y0, y1]), each
+** asked with a random clearance: lw_boundary_curve_clear agrees with dense
+** sampling wherever the sampled margin decides, and both answers occur. */
+static void check_curves(const lw_boundary *b, double x0, double y0, double x1, double y1, const char *what)
+{
+  int yes = 0, no = 0;
+  const double size = fmax(x1 - x0, y1 - y0);
+  for (int k = 0; k < 3000; k++) {
+    double x[4], y[4];
+    x[0] = urand(x0, x1);
+    y[0] = urand(y0, y1);
+    const double len = urand(0.02, 0.4) * size, turn = urand(0, 2 * M_PI);
+    for (int j = 1; j < 4; j++) {
+      x[j] = x[0] + len * (j / 3.0) * cos(turn) + urand(-0.3, 0.3) * len;
+      y[j] = y[0] + len * (j / 3.0) * sin(turn) + urand(-0.3, 0.3) * len;
+    }
+    const double clear = k % 3 == 0 ? 0.0 : urand(0, 0.1) * size;
+    double slack, margin = sampled_clearance(b, x, y, &slack);
+    const int got = lw_boundary_curve_clear(b, x, y, clear);
+    if (margin - clear > slack) {
+      cr_assert(got, "%s: curve %d clears %.9g by the samples, asked %.9g, refused", what, k, margin, clear);
+      yes++;
+    } else if (margin < clear) {
+      cr_assert(!got, "%s: curve %d comes to %.9g of the frame by the samples, asked %.9g, allowed", what, k,
+                margin, clear);
+      no++;
+    }
+  }
+  cr_assert(yes > 300 && no > 300, "%s: %d clear, %d not", what, yes, no);
+}
+
+Test(boundary, a_whole_curve_is_checked_against_the_frame_of_every_kind)
+{
+  rng_seed(0xb0de0010);
+  lw_boundary r = {.kind = LW_BOUNDARY_RECT, .x0 = 1, .y0 = 2, .x1 = 11, .y1 = 8};
+  check_curves(&r, 0, 1, 12, 9, "rect");
+  lw_boundary c = {.kind = LW_BOUNDARY_CIRCLE, .cx = 5, .cy = 5, .radius = 4};
+  check_curves(&c, 0, 0, 10, 10, "circle");
+  double lx[6] = {0, 10, 10, 4, 4, 0}, ly[6] = {0, 0, 3, 3, 10, 10};
+  lw_boundary l;
+  cr_assert_eq(lw_boundary_polygon(&l, 6, lx, ly, NULL), LW_OK);
+  check_curves(&l, -1, -1, 11, 11, "L-shaped polygon");
+  lw_boundary_clear(&l);
+  /* a mask: the disc's signed distance on a coarse grid, bilinear between
+  ** its nodes (its slope is 1 by construction, a little more between) */
+  lw_error err;
+  lw_grid2d *g = lw_grid2d_new(41, 41, 1, 0.0, 0.0, 0.25, 0.25, &err);
+  cr_assert(g);
+  for (int j = 0; j < 41; j++)
+    for (int i = 0; i < 41; i++) g->data[j * 41 + i] = hypot(i * 0.25 - 5, j * 0.25 - 5) - 4;
+  lw_boundary m = {.kind = LW_BOUNDARY_MASK, .sdt = g, .slope = lw_boundary_mask_slope(g)};
+  cr_assert(m.slope >= 1.0 && m.slope < 1.5, "slope %g", m.slope);
+  check_curves(&m, 0, 0, 10, 10, "mask");
+  lw_boundary_clear(&m);
+}
+
+Test(boundary, a_curve_with_a_coordinate_not_finite_is_never_clear)
+{
+  lw_boundary r = {.kind = LW_BOUNDARY_RECT, .x0 = 0, .y0 = 0, .x1 = 10, .y1 = 10};
+  double x[4] = {2, 3, 4, 5}, y[4] = {5, 5, 5, 5};
+  cr_assert(lw_boundary_curve_clear(&r, x, y, 1.0));
+  for (int k = 0; k < 4; k++) {
+    double xs[4] = {2, 3, 4, 5};
+    xs[k] = NAN;
+    cr_assert(!lw_boundary_curve_clear(&r, xs, y, 1.0), "NaN at control point %d", k);
+    xs[k] = INFINITY;
+    cr_assert(!lw_boundary_curve_clear(&r, xs, y, 0.0), "inf at control point %d", k);
+  }
+  lw_boundary none = {.kind = LW_BOUNDARY_NONE};
+  cr_assert(lw_boundary_curve_clear(&none, x, y, 1e9));
+}

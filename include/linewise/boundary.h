@@ -35,6 +35,10 @@ typedef struct {
   size_t n;               /* polygon: vertex count (>= 3) */
   double *vx, *vy;        /* polygon: vertices, owned */
   lw_grid2d *sdt;         /* mask: signed distances, mm, owned (ncomp 1) */
+  double slope;           /* mask: the steepest the bilinear distance gets
+                             (lw_boundary_mask_slope); the exact kinds' is 1 */
+  double clearance;       /* the boundary term's: how far inside a curve must
+                             stay, in its own length elements (lw_term_boundary) */
 } lw_boundary;
 
 /* Polygon from n >= 3 vertices (copied).  LW_EINPUT for fewer vertices,
@@ -51,6 +55,21 @@ double lw_boundary_distance(const lw_boundary *b, double x, double y);
 ** the mask's grid; 0 where d has no gradient (the medial axis of a rect
 ** takes one side, a circle's centre gives 0) and for LW_BOUNDARY_NONE. */
 double lw_boundary_distance_grad(const lw_boundary *b, double x, double y, double g[2]);
+
+/* 1 if every point of the cubic Bezier curve with control points (x[k],
+** y[k]) lies at least `clear` (>= 0, mm) inside: d <= -clear, and d < 0.
+** Exact up to 1e-9 mm, whatever the sampling: a piece whose control points
+** lie within a disc far enough inside (the distance changes by at most the
+** slope times the disc's radius) is inside; otherwise it is split in two at
+** its middle, whose point on the curve is tested, down to pieces of 1e-9
+** mm.  0 for non-finite input; 1 for LW_BOUNDARY_NONE. */
+int lw_boundary_curve_clear(const lw_boundary *b, const double x[4], const double y[4], double clear);
+
+/* The steepest slope of the mask's bilinear distance (>= 1 where its grid
+** is a true distance): over each cell, the largest difference along x
+** and along y over the spacing, combined.  What lw_boundary_curve_clear
+** bounds a disc with. */
+double lw_boundary_mask_slope(const lw_grid2d *sdt);
 
 /* Is (x, y) strictly inside? (d < 0) */
 int lw_boundary_inside(const lw_boundary *b, double x, double y);

@@ -32,7 +32,8 @@
 **
 ** Regularity (lw_segment_allowed): a segment whose speed falls below
 ** scene->min_speed times its length, or whose bending integrand has a
-** singularity inside the Bernstein ellipse scene->regularity (spline.h), is
+** singularity inside the Bernstein ellipse scene->regularity (spline.h), or
+** whose pair samples lie wider apart than scene->pair_gap_max, is
 ** forbidden.  The terms of a state
 ** with one stay what the quadrature gives, but its total is +infinity
 ** (lw_model_total, lw_energy_compute); a proposal that makes a segment
@@ -341,8 +342,10 @@ void lw_model_sample_gaps(const lw_model *m, double *gap);
 ** for the scene: its speed never falls below scene->min_speed times its
 ** length, the mean speed, and its bending integrand is analytic inside the
 ** Bernstein ellipse of parameter scene->regularity (spline.h; each test off
-** at 0).  A segment without length has no direction at all, so it is
-** irregular whenever a test is on. */
+** at 0), and, with the pair term's cutoff, no two consecutive pair samples
+** lie more than scene->pair_gap_max apart (lw_segment_gaps_within).  A
+** segment without length has no direction at all, so it is irregular
+** whenever a speed or rho test is on. */
 int lw_segment_allowed(const lw_scene *sc, const lw_node *a, const lw_node *b, double length);
 
 /* LW_EINPUT naming path, the spline, the segment, its speed ratio and rho,

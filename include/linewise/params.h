@@ -115,6 +115,7 @@ typedef struct {
   int field_mode;             /* LW_FIELDMODE_* */
   double pair_cutoff;         /* mm; 0 = none */
   double pair_near;           /* element lengths; 0 = off */
+  double boundary_clearance;  /* boundary: least distance from the frame, in length elements */
   double min_speed;           /* regularity: fraction of the mean speed; 0 = none */
   double regularity;          /* regularity: Bernstein ellipse parameter; <= 1 = none */
   double parametrisation;     /* G, energy / mm; 0 = off */

@@ -37,6 +37,13 @@
 #include "linewise/terms.h"
 #include "linewise/tone.h"
 
+/* With a cutoff rc, a segment whose consecutive pair samples lie more than
+** this share of rc apart is forbidden: a line crossing it between two of
+** them might then pass no sample within rc, and the pair term would not see
+** the crossing.  0.9: crossings of segments at the limit err by at most
+** 4.8e-4 at 8 nodes (docs/NUMERICS.md, "Regular segments"). */
+#define LW_PAIR_GAP_SHARE 0.9
+
 typedef struct lw_scene {
   double width, height;         /* page, mm */
   double coef[LW_TERM_COUNT];   /* S B Q P C R, the user term's, G, T; 0 = off */
@@ -47,6 +54,9 @@ typedef struct lw_scene {
                                    speed must keep; 0 = no check (spline.h) */
   double regularity;            /* regularity: the Bernstein ellipse its bending
                                    integrand must be analytic in; 0 = no check */
+  double pair_gap_max;          /* the widest space between a segment's consecutive
+                                   pair samples, mm (LW_PAIR_GAP_SHARE of the
+                                   cutoff); 0 = no check (no pair term or no cutoff) */
   lw_quad quad;
   lw_quad pair_quad;            /* nodes of the pair samples (valid when pair is on) */
   lw_quad tone_quad;            /* nodes of the tone samples (valid when tone is on) */

@@ -132,6 +132,9 @@ typedef struct {
   double length;                             /* sum of dl, mm */
   double end_x[2], end_y[2];                 /* r(0) and r(1): the nodes, which no
                                                 Gauss node reaches (boundary term) */
+  double hand_x[2], hand_y[2];               /* the inner control points p_a + v_a and
+                                                p_b - v_b: with the ends they bound the
+                                                curve (the boundary's clearance) */
 } lw_samples;
 
 void lw_segment_sample(const lw_quad *q, const lw_node *a, const lw_node *b, lw_samples *out);
@@ -201,6 +204,19 @@ double lw_segment_rho(const lw_node *a, const lw_node *b);
 ** lies in the disc |t - 1/2| <= (rho + 1/rho) / 4, where Taylor's bound at
 ** t = 1/2 keeps |h_x + i h_y| away from 0.  0 for non-finite input. */
 int lw_segment_check(const lw_node *a, const lw_node *b, double min_speed, double rho);
+
+/* 1 if no two consecutive nodes of the rule q lie more than gap_max (mm)
+** apart on the segment from a to b (chords): the pair term's guarantee
+** that a line crossing the segment passes within gap_max of one of its
+** samples (docs/NUMERICS.md, "Regular segments").  First the bound
+** (largest node spacing) x (largest speed), the speed bounded by the
+** Bernstein coefficients of |r'|^2; the chords only where that is in
+** doubt.  0 for non-finite input. */
+int lw_segment_gaps_within(const lw_quad *q, const lw_node *a, const lw_node *b, double gap_max);
+
+/* The widest space between consecutive nodes of q on the segment (chords,
+** mm): what lw_segment_gaps_within compares. */
+double lw_segment_widest_gap(const lw_quad *q, const lw_node *a, const lw_node *b);
 
 /* 1 if every coordinate is finite. */
 int lw_splines_finite(const lw_splines *sp);
