@@ -268,9 +268,12 @@ int lw_boundary_curve_clear(const lw_boundary *b, const double x[4], const doubl
                              fmax(fmax(p.x[0], p.x[1]), fmax(p.x[2], p.x[3])));
     const double cy = 0.5 * (fmin(fmin(p.y[0], p.y[1]), fmin(p.y[2], p.y[3])) +
                              fmax(fmax(p.y[0], p.y[1]), fmax(p.y[2], p.y[3])));
-    double r = 0.0;
-    for (int k = 0; k < 4; k++) r = fmax(r, hypot(p.x[k] - cx, p.y[k] - cy));
-    const double reach = lw_boundary_distance(b, cx, cy) + slope * r;
+    double r2 = 0.0;
+    for (int k = 0; k < 4; k++) {
+      const double dx = p.x[k] - cx, dy = p.y[k] - cy;
+      r2 = fmax(r2, dx * dx + dy * dy);
+    }
+    const double r = sqrt(r2), reach = lw_boundary_distance(b, cx, cy) + slope * r;
     if (CLEAR_OK(reach)) continue;
     bezier_piece lo, hi;
     split_half(&p, &lo, &hi);

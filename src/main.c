@@ -112,6 +112,18 @@ static lw_status set_option(lw_params *p, const char *assignment, lw_error *err)
 /* energy DIR [--set SEC.KEY=VAL]...: the state's energy with its scene, or
 ** with keys of it changed (the quadrature's nodes, to see what the run's
 ** leave out: docs/NUMERICS.md, "The potential between the nodes"). */
+/* A run directory's path must leave room for the names of the files in it
+** (DIR/frames/frame-000000.png and the like): paths are held in
+** LW_PATH_MAX bytes, and a longer one would be cut to another directory. */
+#define RUN_DIR_MAX (LW_PATH_MAX - 64)
+
+static lw_status dir_fits(const char *what, const char *dir, lw_error *err)
+{
+  if (strlen(dir) <= RUN_DIR_MAX) return LW_OK;
+  return lw_error_set(err, LW_EUSAGE, "%s: a path of %zu bytes, longer than the %d a run directory may have",
+                      what, strlen(dir), RUN_DIR_MAX);
+}
+
 static int cmd_energy(int argc, char **argv)
 {
   lw_error err;
@@ -133,6 +145,7 @@ static int cmd_energy(int argc, char **argv)
     lw_error_set(&err, LW_EUSAGE, "energy: expected one run directory (usage: linewise energy DIR)");
     return fail(&err);
   }
+  if (dir_fits("energy", dir, &err)) return fail(&err);
   static lw_params p;
   lw_state st;
   char path[LW_PATH_MAX + 32];
@@ -570,6 +583,7 @@ static int cmd_run(int argc, char **argv)
                      v && *v ? " (a file)" : "");
         return fail(&err);
       }
+      if (dir_fits("--out", v, &err)) return fail(&err);
       out = v;
       i++;
     } else if (!strcmp(argv[i], "--seed")) {
@@ -652,6 +666,7 @@ static int cmd_resume(int argc, char **argv)
     lw_error_set(&err, LW_EUSAGE, "resume: expected a run directory (usage: linewise resume DIR [--sweeps N])");
     return fail(&err);
   }
+  if (dir_fits("resume", dir, &err)) return fail(&err);
   name_run_dir(dir);
   static lw_anneal a;
   watcher w;

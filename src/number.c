@@ -10,6 +10,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -74,4 +75,19 @@ void lw_text_drop_bom(char *s)
 {
   if ((unsigned char)s[0] == 0xEF && (unsigned char)s[1] == 0xBB && (unsigned char)s[2] == 0xBF)
     memmove(s, s + 3, strlen(s + 3) + 1);
+}
+
+long lw_text_next_line(FILE *f, char **buf, size_t *cap, long *line)
+{
+  errno = 0;
+  ssize_t len = getline(buf, cap, f);
+  if (len < 0) return ferror(f) ? -2 : -1;
+  ++*line;
+  if (memchr(*buf, '\0', (size_t)len)) return -2;
+  if (*line == 1) {
+    lw_text_drop_bom(*buf);
+    len = (ssize_t)strlen(*buf);
+  }
+  while (len > 0 && ((*buf)[len - 1] == '\n' || (*buf)[len - 1] == '\r')) (*buf)[--len] = '\0';
+  return (long)len;
 }

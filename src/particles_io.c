@@ -9,19 +9,6 @@
 #include "linewise/number.h"
 #include "linewise/ply.h"
 
-/* The next line of f into *buf (newline removed), or NULL at the end. */
-static char *next_line(FILE *f, char **buf, size_t *cap, int *line)
-{
-  ssize_t len = getline(buf, cap, f);
-  if (len < 0) return NULL;
-  if (++*line == 1) {
-    lw_text_drop_bom(*buf);
-    len = (ssize_t)strlen(*buf);
-  }
-  while (len > 0 && ((*buf)[len - 1] == '\n' || (*buf)[len - 1] == '\r')) (*buf)[--len] = '\0';
-  return *buf;
-}
-
 /* The points read so far, grown as they come. */
 typedef struct {
   size_t n, cap;
@@ -68,8 +55,8 @@ static lw_status read_text(FILE *f, const char *path, points *pt, lw_error *err)
   lw_status s = LW_OK;
   char *buf = NULL, where[32];
   size_t bcap = 0;
-  int line = 0;
-  while (!s && next_line(f, &buf, &bcap, &line)) {
+  long line = 0, len;
+  while (!s && (len = lw_text_next_line(f, &buf, &bcap, &line)) >= 0) {
     char *hash = strchr(buf, '#');
     if (hash) *hash = '\0';
     /* CloudCompare's ASCII export heads its columns with "//X,Y,Z,..." */
@@ -78,18 +65,19 @@ static lw_status read_text(FILE *f, const char *path, points *pt, lw_error *err)
     int k = lw_number_list(buf, 1, v, 6);
     if (k == 0) continue;
     if (k != 3 && k != 6) {
-      s = k < 0 ? lw_error_set(err, LW_EINPUT, "%s:%d: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got '%.80s'",
+      s = k < 0 ? lw_error_set(err, LW_EINPUT, "%s:%ld: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got '%.80s'",
                                path, line, buf)
-                : lw_error_set(err, LW_EINPUT, "%s:%d: expected 3 numbers (x y z) or 6 (x y z nx ny nz), got %d",
+                : lw_error_set(err, LW_EINPUT, "%s:%ld: expected 3 numbers (x y z) or 6 (x y z nx ny nz), got %d",
                                path, line, k);
       break;
     }
-    snprintf(where, sizeof where, ":%d", line);
+    snprintf(where, sizeof where, ":%ld", line);
     s = append(pt, v, k == 6 ? v + 3 : NULL, path, where, err);
   }
   if (!s && ferror(f)) s = lw_error_set(err, LW_EIO, "%s: read error", path);
+  else if (!s && len == -2) s = lw_error_set(err, LW_EINPUT, "%s:%ld: a NUL byte inside the line", path, line);
   else if (!s && pt->n == 0)
-    s = lw_error_set(err, LW_EINPUT, "%s:%d: expected at least one point 'x y z [nx ny nz]', found none", path, line);
+    s = lw_error_set(err, LW_EINPUT, "%s:%ld: expected at least one point 'x y z [nx ny nz]', found none", path, line);
   free(buf);
   return s;
 }

@@ -107,6 +107,8 @@ lw_status lw_quad_init(lw_quad *q, int n, lw_error *err)
   q->e[0] = 0.0;
   for (int i = 0; i < n; i++) q->e[i + 1] = q->e[i] + q->w[i];
   q->e[n] = 1.0;
+  q->spacing = 0.0;
+  for (int i = 1; i < n; i++) q->spacing = fmax(q->spacing, q->s[i] - q->s[i - 1]);
   for (int i = 0; i < n; i++) {
     bernstein(q->s[i], q->bern3[i], q->bern2[i], q->bern1[i]);
     coefficients(q->bern3[i], q->bern2[i], q->bern1[i], q->pos[i], q->d1[i], q->d2[i]);

@@ -252,22 +252,19 @@ lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err
   long lineno = 0;
   lw_status status = LW_OK;
   for (;;) {
-    errno = 0;
-    ssize_t len = getline(&line, &cap, f);
-    if (len < 0) {
+    long len = lw_text_next_line(f, &line, &cap, &lineno);
+    if (len == -2) {
       if (errno == ENOMEM) status = lw_error_set(err, LW_ENOMEM, "%s: out of memory while reading", path);
       else if (ferror(f))
         /* a directory, say: the user named the wrong file, so it is bad input */
         status = lw_error_set(err, LW_EINPUT, "%s:%ld: cannot read schedule table: %s", path, lineno + 1,
                               strerror(errno ? errno : EIO));
-      break;
+      else status = lw_error_set(err, LW_EINPUT, "%s:%ld: a NUL byte inside the line", path, lineno);
     }
-    lineno++;
-    if (lineno == 1) lw_text_drop_bom(line);
+    if (len < 0) break;
     line[strcspn(line, "#")] = '\0';
     char shown[64], *tok[3];
     snprintf(shown, sizeof shown, "%s", line + strspn(line, " \t"));
-    shown[strcspn(shown, "\r\n")] = '\0';
     int ntok = split(line, tok);
     if (ntok == 0) continue;
     double bv, tv;

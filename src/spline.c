@@ -420,9 +420,7 @@ int lw_segment_gaps_within(const lw_quad *q, const lw_node *a, const lw_node *b,
   const double c3 = h[2] * h[4] + h[3] * h[5], c4 = h[4] * h[4] + h[5] * h[5];
   const double top = fmax(fmax(fmax(c0, c1), fmax(c2, c3)), c4);
   if (!isfinite(c0 + c1 + c2 + c3 + c4)) return 0;
-  double spacing = 0.0;
-  for (int i = 1; i < q->n; i++) spacing = fmax(spacing, q->s[i] - q->s[i - 1]);
-  if (spacing * spacing * top <= gap_max * gap_max) return 1;
+  if (q->spacing * q->spacing * top <= gap_max * gap_max) return 1;
   return lw_segment_widest_gap(q, a, b) <= gap_max;
 }
 

@@ -82,7 +82,7 @@ static int push(double **a, size_t *n, size_t *cap, double v)
 ** nurbs.file; messages name the file and line, blamed on the key. */
 static lw_status read_file(const lw_params *p, double **P, size_t *np, double **w, size_t *nw, lw_error *err)
 {
-  char dir[LW_PATH_MAX], path[2 * LW_PATH_MAX + 2], line[1024];
+  char dir[LW_PATH_MAX], path[2 * LW_PATH_MAX + 2], *line = NULL;
   lw_path_dir(dir, sizeof dir, p->file);
   lw_path_join(path, sizeof path, dir, p->nb_file);
   FILE *f = fopen(path, "r");
@@ -90,29 +90,39 @@ static lw_status read_file(const lw_params *p, double **P, size_t *np, double **
     lw_error_set(err, LW_EINPUT, "%s: cannot read: %s", path, strerror(errno));
     return lw_params_blame(p, "nurbs", "file", err);
   }
-  size_t cap_p = 0, cap_w = 0;
-  int lineno = 0, per = 0;
-  while (fgets(line, sizeof line, f)) {
-    if (++lineno == 1) lw_text_drop_bom(line);
-    line[strcspn(line, "#\r\n")] = '\0';
+  size_t cap_p = 0, cap_w = 0, cap = 0;
+  long lineno = 0, len;
+  int per = 0;
+  lw_status st = LW_OK;
+  while ((len = lw_text_next_line(f, &line, &cap, &lineno)) >= 0) {
+    line[strcspn(line, "#")] = '\0';
     double v[4];
     int k = lw_number_list(line, 0, v, 4);
     if (k == 0) continue;
     if ((k != 2 && k != 3) || (per && k != per) || (k == 3 && !(v[2] > 0.0))) {
-      lw_error_set(err, LW_EINPUT, "%s:%d: expected %s, got '%.60s'", path, lineno,
+      lw_error_set(err, LW_EINPUT, "%s:%ld: expected %s, got '%.60s'", path, lineno,
                    per == 2 ? "'x y' like the lines before" : per == 3 ? "'x y w' (w > 0) like the lines before"
                                                                       : "'x y' or 'x y w' (w > 0)", line);
-      fclose(f);
-      return lw_params_blame(p, "nurbs", "file", err);
+      st = lw_params_blame(p, "nurbs", "file", err);
+      break;
     }
     per = k;
     if (!push(P, np, &cap_p, v[0]) || !push(P, np, &cap_p, v[1]) || (k == 3 && !push(w, nw, &cap_w, v[2]))) {
-      fclose(f);
-      return lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+      st = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+      break;
     }
   }
+  if (!st && len == -2) {
+    if (errno == ENOMEM) st = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+    else {
+      lw_error_set(err, LW_EINPUT, "%s:%ld: %s", path, lineno + (ferror(f) != 0),
+                   ferror(f) ? "cannot read" : "a NUL byte inside the line");
+      st = lw_params_blame(p, "nurbs", "file", err);
+    }
+  }
+  free(line);
   fclose(f);
-  return LW_OK;
+  return st;
 }
 
 static lw_nurbs *curve_of(const lw_params *p, lw_error *err)

@@ -446,6 +446,28 @@ Test(cli, a_second_signal_stops_at_once_and_leaves_the_checkpoint)
 /* A run started without --out goes to out/<scene name>, and when that
 ** holds a run, to the first out/<scene name>-N that does not: the first
 ** drawing is not replaced.  --out names a directory to replace. */
+Test(cli, a_directory_path_too_long_to_hold_is_refused)
+{
+  /* five components of 250 bytes: the run was written into the path cut at
+  ** 1023 bytes, another directory, and said nothing */
+  write_file("s.ini", scene_text);
+  char a[251];
+  memset(a, 'a', 250);
+  a[250] = '\0';
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --quiet --set anneal.sweeps=2 --out d/%s/%s/%s/%s 2> err.txt",
+                          dir, b, a, a, a, a),
+               2);
+  cr_assert_eq(lw_test_sh("cd %s && grep -q -- '--out: a path of 1005 bytes, longer than the 960' err.txt && "
+                          "! test -e d",
+                          dir),
+               0);
+  cr_assert_eq(lw_test_sh("cd %s && %s resume d/%s/%s/%s/%s 2> err.txt; test $? = 2 && "
+                          "grep -q 'resume: a path of 1005 bytes' err.txt",
+                          dir, b, a, a, a, a),
+               0);
+}
+
 Test(cli, a_run_without_out_never_replaces_another)
 {
   write_file("s.ini", scene_text);

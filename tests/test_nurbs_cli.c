@@ -179,6 +179,15 @@ Test(nurbs_cli, a_points_file_holds_a_long_curve)
   cr_assert_eq(sh("%s resume %s/half --quiet", lw_test_bin(), dir), 0);
   cr_assert_eq(sh("cmp -s %s/long/state.lw %s/half/state.lw", dir, dir), 0);
   refused("points = 0 0 1 x\\n", "bad.ini:4: key .nurbs.points.: expected numbers");
+  /* a comment line longer than any buffer is a comment, whole (its tail
+  ** once read as a point), and a NUL byte is refused, not cut at */
+  cr_assert_eq(sh("awk 'BEGIN { printf \"# \"; for (i = 0; i < 1100; i++) printf \"x\"; print \" 7 7\"; "
+                  "for (i = 0; i < 7; i++) print i, i %% 2 }' > %s/long.txt", dir), 0);
+  cr_assert_eq(sh("%s run %s/long.ini --out %s/comment --quiet", lw_test_bin(), dir, dir), 0);
+  cr_assert_eq(sh("grep -q '\"control_points\": 7' %s/comment/summary.json", dir), 0);
+  cr_assert_eq(sh("printf '0 0\\n1 1\\0 5 5\\n2 0\\n3 1\\n4 0\\n' > %s/long.txt", dir), 0);
+  cr_assert_eq(sh("%s run %s/long.ini --out %s/nul --quiet 2> %s/err.txt", lw_test_bin(), dir, dir, dir), 2);
+  cr_assert_eq(sh("grep -q 'long.txt:2: a NUL byte inside the line' %s/err.txt", dir), 0);
 }
 
 Test(nurbs_cli, tempering_replicas_give_the_same_bytes_for_any_thread_count)

@@ -264,6 +264,22 @@ Test(schedule, table_rejects_malformed_files_with_line_numbers)
     cr_assert(s.n_table == 0 && !s.table_block && !s.table_temp, "case %zu: s unchanged", i);
     unlink(path);
   }
+  /* a NUL byte would end the line early as a string: refused, not cut */
+  {
+    char path[64];
+    temp_file(path, "0 1\n");
+    FILE *f = fopen(path, "a");
+    cr_assert(f);
+    fwrite("100 0.5\0 zzz\n", 1, 14, f);
+    fclose(f);
+    lw_schedule s = {.blocks = 10};
+    lw_error err;
+    cr_assert_eq(lw_schedule_read_table(&s, path, &err), LW_EINPUT);
+    char want[128];
+    snprintf(want, sizeof want, "%s:2: a NUL byte", path);
+    cr_assert(strstr(err.msg, want), "%s", err.msg);
+    unlink(path);
+  }
   /* a failed read leaves an existing table alone */
   char path[64];
   temp_file(path, "0 3\n10 1\n");

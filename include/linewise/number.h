@@ -14,6 +14,7 @@
 #define LINEWISE_NUMBER_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 /* The first len characters of s as a finite double; 1 on success. */
 int lw_number_parse_n(const char *s, size_t len, double *out);
@@ -30,6 +31,14 @@ int lw_number_parse_whole(const char *s, double lo, double hi, long long *out);
 ** text input drops it from its first line, as the scene reader does (it
 ** showed as nothing in "got ''" messages). */
 void lw_text_drop_bom(char *s);
+
+/* The next line of a text input f into *buf (getline's buffer, *cap its
+** size), without its line end (LF, CRLF or a lone trailing CR) and, on the
+** first line, without a byte-order mark; *line counts the lines read.
+** Returns its length, -1 at the end, -2 for a line holding a NUL byte
+** (which would end it early as a string and drop the rest unseen) or a
+** failed read (errno set; ENOMEM when out of memory). */
+long lw_text_next_line(FILE *f, char **buf, size_t *cap, long *line);
 
 /* Splits s at blanks (and commas when `commas`) into at most max numbers;
 ** returns how many tokens there were (more than max are counted but not

@@ -33,6 +33,7 @@ typedef struct {
   double s[LW_QUAD_MAX];      /* nodes on [0,1], increasing */
   double w[LW_QUAD_MAX];      /* weights on [0,1], sum 1 */
   double e[LW_QUAD_MAX + 1];  /* element bounds: e[0]=0, e[q+1]=e[q]+w[q] */
+  double spacing;             /* the widest s[q+1] - s[q] */
   double bern3[LW_QUAD_MAX][4]; /* b^3_k(s_q) = C(3,k) (1-s)^(3-k) s^k */
   double bern2[LW_QUAD_MAX][3]; /* b^2_k(s_q) */
   double bern1[LW_QUAD_MAX][2]; /* b^1_k(s_q) */
