@@ -445,6 +445,24 @@ static lw_status get_dynamics(lw_ckpt *doc, lw_dynamics *d, lw_error *err)
   return LW_OK;
 }
 
+lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, unsigned long long scene_hash, lw_error *err)
+{
+  int line = 0;
+  const char *hash = lw_ckpt_text(doc, "run", "scene_hash", &line); /* absent in older files */
+  if (!hash) return LW_OK;
+  const char *path = lw_ckpt_path(doc);
+  unsigned long long h = strtoull(hash, NULL, 16);
+  if (strlen(hash) != 16 || strspn(hash, "0123456789abcdef") != 16)
+    return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: expected 16 hexadecimal digits, got '%s'", path,
+                        line, hash);
+  if (h != scene_hash)
+    return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: the run's scene.ini was edited since it "
+                        "started, in a key that steers the run; a run resumes with the parameters it ran with "
+                        "(only [plot] and the keys of the final files may change): expected %016llx, "
+                        "scene.ini gives %016llx", path, line, h, scene_hash);
+  return LW_OK;
+}
+
 lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, lw_error *err)
 {
   const char *path = lw_ckpt_path(doc);
@@ -460,19 +478,6 @@ lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, l
   a->end_sweep = -1;
   if ((s = lw_ckpt_whole(doc, "run", "end_sweep", &a->end_sweep, a->sweep, (long)LW_STATE_SWEEP_MAX, 0, err)))
     return s;
-  int line = 0;
-  const char *hash = lw_ckpt_text(doc, "run", "scene_hash", &line); /* absent in older files */
-  if (hash) {
-    unsigned long long h = strtoull(hash, NULL, 16);
-    if (strlen(hash) != 16 || strspn(hash, "0123456789abcdef") != 16)
-      return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: expected 16 hexadecimal digits, got '%s'", path,
-                          line, hash);
-    if (h != a->scene_hash)
-      return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: the run's scene.ini was edited since it "
-                          "started, in a key that steers the run; a run resumes with the parameters it ran with "
-                          "(only [plot] and the keys of the final files may change): expected %016llx, "
-                          "scene.ini gives %016llx", path, line, h, a->scene_hash);
-  }
 #define NUMS(key, n, lo, hi) if ((s = lw_ckpt_numbers(doc, "run", key, v, n, lo, hi, 1, err))) return s
   NUMS("temperature", 1, 0, DBL_MAX); a->t_sched = v[0];
   if ((s = lw_ckpt_whole(doc, "run", "block", &block, -1, a->params.steps - 1, 1, err))) return s;

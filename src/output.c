@@ -332,8 +332,29 @@ static void paint_tone(cairo_t *cr, const lw_grid2d *tone)
   cairo_surface_destroy(img);
 }
 
-/* The whole drawing on cr, whose user unit is 1 mm. */
-static void draw(cairo_t *cr, const lw_strokes *s, const lw_output_page *page, const lw_grid2d *tone)
+/* A PDF's strokes go in batches of this many paths, one cairo_stroke each:
+** cairo's PDF surface adds every drawing operation's box to one region
+** when it finishes the page, at a cost that grows with the boxes already
+** there, so a stroke a path took minutes at 10,000 paths (the image
+** surface has no such cost, and keeps one path a stroke). */
+#define PDF_BATCH 1024
+
+/* The pen's strokes as paths of up to `batch` subpaths each.  With opaque
+** pens drawn over each other this paints what a stroke a path does; under
+** MULTIPLY a pen's own overlaps would darken once instead of twice. */
+static void stroke_batches(cairo_t *cr, const lw_strokes *s, int pen, size_t batch)
+{
+  size_t a = 0, z = s->n;
+  lw_strokes_pen_range(s, pen, &a, &z);
+  for (size_t k = a; k < z; k++) {
+    trace_path(cr, s, k);
+    if ((k - a + 1) % batch == 0 || k + 1 == z) cairo_stroke(cr);
+  }
+}
+
+/* The whole drawing on cr, whose user unit is 1 mm; strokes in batches of
+** `batch` paths where the pens are opaque (1: a stroke a path). */
+static void draw(cairo_t *cr, const lw_strokes *s, const lw_output_page *page, const lw_grid2d *tone, size_t batch)
 {
   if (tone) paint_tone(cr, tone);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
@@ -343,7 +364,8 @@ static void draw(cairo_t *cr, const lw_strokes *s, const lw_output_page *page, c
     const lw_output_pen *pen = &page->pen[k];
     cairo_set_source_rgb(cr, pen->rgb[0] / 255.0, pen->rgb[1] / 255.0, pen->rgb[2] / 255.0);
     cairo_set_line_width(cr, pen->width_mm);
-    lw_output_cairo_strokes(cr, s, k);
+    if (batch > 1 && !page->multiply) stroke_batches(cr, s, k, batch);
+    else lw_output_cairo_strokes(cr, s, k);
   }
 }
 
@@ -393,7 +415,7 @@ lw_status lw_output_png_strokes(const lw_strokes *st, const lw_output_page *page
   cairo_paint(cr);
   /* Draw in mm: the line width is then the pen width in page units. */
   cairo_scale(cr, k, k);
-  draw(cr, st, page, tone);
+  draw(cr, st, page, tone, 1);
   cairo_surface_flush(surf);
   if (cairo_status(cr)) {
     s = lw_error_set(err, LW_ERUN, "%s: drawing the preview failed: %s", path,
@@ -464,7 +486,7 @@ lw_status lw_output_pdf_strokes(const lw_strokes *st, const lw_output_page *page
   cairo_pdf_surface_set_metadata(surf, CAIRO_PDF_METADATA_CREATE_DATE, "");
   cairo_t *cr = cairo_create(surf);
   cairo_scale(cr, pt_per_mm, pt_per_mm);
-  draw(cr, st, page, tone);
+  draw(cr, st, page, tone, PDF_BATCH);
   cairo_status_t cs = cairo_status(cr);
   cairo_destroy(cr);
   /* finishing writes the document; stream errors show up only now */

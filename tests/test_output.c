@@ -764,6 +764,27 @@ Test(output, pdf_has_the_page_size_and_is_reproducible)
   cr_assert(fabs(x1 - 210 * 72 / 25.4) < 1e-3 && fabs(y1 - 297 * 72 / 25.4) < 1e-3, "MediaBox %g %g", x1, y1);
   free(pa);
   free(pb);
+  /* more paths than a batch of strokes (PDF_BATCH): the same bytes again,
+  ** and a whole file (the batches took the page from minutes at 10,000
+  ** paths to seconds: docs/PERFORMANCE.md) */
+  {
+    size_t segs[2500];
+    for (size_t k = 0; k < 2500; k++) segs[k] = 1;
+    lw_splines *many = lw_splines_new(2500, segs, NULL);
+    cr_assert_not_null(many);
+    for (size_t k = 0; k < 2500; k++)
+      lw_test_straight(many, k, 10 + (double)(k % 50) * 3.8, 10 + (double)(k / 50) * 5, 12 + (double)(k % 50) * 3.8,
+                       13 + (double)(k / 50) * 5);
+    cr_assert_eq(lw_output_pdf(many, &page, NULL, NULL, a, &err), LW_OK, "%s", err.msg);
+    cr_assert_eq(lw_output_pdf(many, &page, NULL, NULL, b, &err), LW_OK, "%s", err.msg);
+    pa = slurp(a, &la);
+    pb = slurp(b, &lb);
+    cr_assert(la == lb && !memcmp(pa, pb, la), "the same drawing gives the same bytes");
+    cr_assert(la > 1000 && !strncmp(pa, "%PDF-", 5) && find_bytes(pa + la - 8, 8, "%%EOF"), "a whole PDF file");
+    free(pa);
+    free(pb);
+    lw_splines_free(many);
+  }
   /* bad input is refused before a file exists */
   sp->node[2].px = INFINITY;
   cr_assert_eq(lw_output_pdf(sp, &page, NULL, NULL, a, &err), LW_EINPUT);

@@ -56,6 +56,7 @@ typedef struct lw_anneal {
   char unread[1024];           /* keys the scene sets that only the other driver reads, where set, or "" */
   unsigned long seed;
   long sweep;                  /* sweeps done */
+  long saved;                  /* sweep + 1 at the last checkpoint this process wrote; 0 none */
   long end_sweep;              /* stop after this sweep */
   int extending, new_end;      /* a resume to settle before its first sweep (anneal.c) */
   unsigned long long scene_hash; /* lw_params_run_hash of scene.ini, kept in state.lw */

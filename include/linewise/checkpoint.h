@@ -46,6 +46,12 @@ lw_status lw_checkpoint_write_timing(const lw_anneal *a, lw_error *err);
 ** every value checked (ranges, counts, the generator states, the running
 ** energies against a recomputation).  *trace_bytes is the length of
 ** trace.csv at the checkpoint, or -1 if the file does not say (format 1). */
+/* LW_EINPUT if state.lw's [run] scene_hash (absent in older files) is not
+** scene_hash, lw_params_run_hash of the run's scene.ini: checked before the
+** state is rebuilt, whose energies an edited coefficient would change (a
+** message blaming state.lw for what an edit of scene.ini did). */
+lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, unsigned long long scene_hash, lw_error *err);
+
 lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, lw_error *err);
 
 /* The spline system's: LW_EINPUT if an energy of a state read from path is not finite (a node
