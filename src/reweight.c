@@ -215,6 +215,8 @@ typedef struct {
   size_t *first;     /* K + 1 */
   double *beta;      /* K */
   double *thin;      /* K: rows a sample stands for */
+  int *run;          /* K: the trace each state came from */
+  size_t *rows;      /* K: the rows its samples were thinned from */
   int open;          /* states whose autocorrelation window did not close */
   double worst_swap; /* lowest neighbour exchange acceptance over the rows (NAN: none) */
   int worst_pair;
@@ -226,6 +228,8 @@ static void states_free(rw_states *s)
   free(s->first);
   free(s->beta);
   free(s->thin);
+  free(s->run);
+  free(s->rows);
 }
 
 /* The mean of column col over the rows, empty fields skipped (NAN: none). */
@@ -261,8 +265,10 @@ static lw_status gather(const lw_trace *const *t, const char *const *path, const
   s->first = calloc((size_t)rungs + 1, sizeof *s->first);
   s->beta = malloc((size_t)rungs * sizeof *s->beta);
   s->thin = malloc((size_t)rungs * sizeof *s->thin);
+  s->run = malloc((size_t)rungs * sizeof *s->run);
+  s->rows = malloc((size_t)rungs * sizeof *s->rows);
   double *x = malloc((most ? most : 1) * sizeof *x);
-  if (!s->E || !s->first || !s->beta || !s->thin || !x) {
+  if (!s->E || !s->first || !s->beta || !s->thin || !s->run || !s->rows || !x) {
     st = lw_error_set(err, LW_ENOMEM, "out of memory reweighting %zu rows", cap);
     goto done;
   }
@@ -301,6 +307,8 @@ static lw_status gather(const lw_trace *const *t, const char *const *path, const
       for (size_t i = 0; i < c; i += g) s->E[at++] = x[i];
       s->beta[s->K] = 1.0 / T;
       s->thin[s->K] = (double)g;
+      s->run[s->K] = r;
+      s->rows[s->K] = c;
       s->first[++s->K] = at;
     }
     /* the exchanges between neighbours: rungs that never swap share no energies */
@@ -321,6 +329,52 @@ done:
   free(x);
   if (st) states_free(s);
   return st;
+}
+
+/* One bootstrap resample of every state into Eb: circular blocks of rows
+** drawn once for each trace and read by all its rungs alike.  The samples
+** of one rung, thinned to one every 2 tau, still correlate (about e^-2 from
+** one to the next), and the rungs of one trace correlate with each other
+** (an exchange hands a configuration, and its energy, to the neighbour):
+** drawn sample by sample and rung by rung, the resamples lost both and the
+** error bars between the rungs came out 1.3 to 1.5 times too small
+** (docs/NUMERICS.md, "Error bars from a trace").  A block is
+** LW_REWEIGHT_BLOCK samples of the trace's most thinned rung. */
+static lw_status resample(const rw_states *s, int traces, gsl_rng *rng, double *Eb, lw_error *err)
+{
+  for (int r = 0; r < traces; r++) {
+    size_t rows = 0, span = 1;
+    for (int q = 0; q < s->K; q++)
+      if (s->run[q] == r) {
+        rows = s->rows[q] > rows ? s->rows[q] : rows;
+        span = (size_t)s->thin[q] > span ? (size_t)s->thin[q] : span;
+      }
+    if (!rows) continue;
+    span *= LW_REWEIGHT_BLOCK;
+    if (span > rows) span = rows;
+    /* enough blocks for every rung: each holds at least span / thin - 1
+    ** of a rung's samples */
+    size_t blocks = 0;
+    for (int q = 0; q < s->K; q++)
+      if (s->run[q] == r) {
+        const size_t g = (size_t)s->thin[q], per = span / g > 1 ? span / g - 1 : 1;
+        const size_t need = (s->first[q + 1] - s->first[q] + per - 1) / per;
+        if (need > blocks) blocks = need;
+      }
+    size_t *start = malloc(blocks * sizeof *start);
+    if (!start) return lw_error_set(err, LW_ENOMEM, "out of memory resampling %zu blocks", blocks);
+    for (size_t b = 0; b < blocks; b++) start[b] = gsl_rng_uniform_int(rng, rows);
+    for (int q = 0; q < s->K; q++) {
+      if (s->run[q] != r) continue;
+      const size_t a = s->first[q], m = s->first[q + 1] - a, g = (size_t)s->thin[q], n = s->rows[q];
+      size_t got = 0;
+      for (size_t b = 0; got < m; b = (b + 1) % blocks)
+        for (size_t i = start[b] % n, left = span; left > 0 && got < m; i = (i + 1) % n, left--)
+          if (i % g == 0 && i / g < m) Eb[a + got++] = s->E[a + i / g];
+    }
+    free(start);
+  }
+  return LW_OK;
 }
 
 lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
@@ -358,10 +412,7 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
   ** fixed seed so that the output is the same every time */
   gsl_rng_set(rng, 1);
   for (int b = 0; b < B && !st; b++) {
-    for (int q = 0; q < K; q++) {
-      size_t a = s.first[q], m = s.first[q + 1] - a;
-      for (size_t i = 0; i < m; i++) Eb[a + i] = s.E[a + gsl_rng_uniform_int(rng, m)];
-    }
+    if ((st = resample(&s, k, rng, Eb, err))) break;
     memcpy(fb, f, (size_t)K * sizeof *fb); /* the whole data's: close to a resample's */
     if ((st = lw_reweight_solve(Eb, s.first, s.beta, K, 1, fb, log_den, NULL, err))) break;
     for (int j = 0; j < n_temps; j++) {

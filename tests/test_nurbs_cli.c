@@ -122,7 +122,9 @@ Test(nurbs_cli, monte_carlo_heat_capacity_is_half_the_free_coordinates)
       se0 = se;
     }
     cr_log_info("T %.4g: <E> - <E>(1) = %.4f (%.4f), C = %.4f +- %.4f", T, e - e0, 5 * (T - t0), c, sc);
-    cr_assert(fabs(c - 5.0) < 4 * sc && sc < 0.25, "T %g: C = %g +- %g", T, c, sc);
+    /* (the reweighted error bars under 6 % of C: 5.1 % at T = 4 since the
+    ** bootstrap keeps the rows' correlations, 4.2 % before) */
+    cr_assert(fabs(c - 5.0) < 4 * sc && sc < 0.3, "T %g: C = %g +- %g", T, c, sc);
     cr_assert(fabs(e - e0 - 5 * (T - t0)) < 4 * (se + se0), "T %g: <E> %g, from %g", T, e, e0);
   }
   free(csv);

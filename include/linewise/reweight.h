@@ -33,6 +33,7 @@
 #define LW_REWEIGHT_ITER 10000      /* iterations at most */
 #define LW_REWEIGHT_BOOTSTRAP 32    /* resamples for the error bars */
 #define LW_REWEIGHT_SAMPLES 20000   /* samples a rung at most, after thinning */
+#define LW_REWEIGHT_BLOCK 4         /* samples of the most thinned rung a bootstrap block holds */
 #define LW_REWEIGHT_TEMPS_MAX 10000 /* temperatures a table, at most */
 #define LW_REWEIGHT_SWAP_MIN 0.05   /* neighbour exchange acceptance below which a warning says the
                                        rungs barely overlap */
