@@ -503,6 +503,21 @@ Test(reweight, free_energies_of_a_harmonic_system)
   gsl_rng_free(r);
 }
 
+/* A 4-rung ladder's trace (T = 1.5^q): the header, and row t's energies e. */
+static size_t ladder_header(char *text, size_t cap)
+{
+  size_t k = (size_t)snprintf(text, cap, "sweep,temperature,total");
+  for (int q = 0; q < 4; q++) k += (size_t)snprintf(text + k, cap - k, ",replica%d_temperature,replica%d_energy", q, q);
+  return k + (size_t)snprintf(text + k, cap - k, ",swap0,swap1,swap2\n");
+}
+
+static size_t ladder_row(char *text, size_t cap, size_t t, const double e[4])
+{
+  size_t k = (size_t)snprintf(text, cap, "%zu,1,%.17g", t + 1, e[0]);
+  for (int q = 0; q < 4; q++) k += (size_t)snprintf(text + k, cap - k, ",%.17g,%.17g", pow(1.5, q), e[q]);
+  return k + (size_t)snprintf(text + k, cap - k, ",0.3,0.3,0.3\n");
+}
+
 /* The error bars must hold what the estimates scatter by: 40 traces of a
 ** 4-rung run (T = 1 .. 3.375) whose rows are Gamma energies (the harmonic
 ** system's law, so <E> = d/2 T exactly) correlated as a tempering run's
@@ -528,9 +543,7 @@ Test(reweight, the_error_bars_hold_the_scatter_of_correlated_rungs, .init = make
   double z2 = 0.0;
   int count = 0;
   for (int trace = 0; trace < 40; trace++) {
-    size_t k = (size_t)snprintf(text, cap, "sweep,temperature,total");
-    for (int q = 0; q < 4; q++) k += (size_t)snprintf(text + k, cap - k, ",replica%d_temperature,replica%d_energy", q, q);
-    k += (size_t)snprintf(text + k, cap - k, ",swap0,swap1,swap2\n");
+    size_t k = ladder_header(text, cap);
     double a = gsl_ran_gaussian(r, 1.0), b[4];
     for (int q = 0; q < 4; q++) b[q] = gsl_ran_gaussian(r, 1.0);
     for (size_t t = 0; t < rows; t++) {
@@ -541,9 +554,7 @@ Test(reweight, the_error_bars_hold_the_scatter_of_correlated_rungs, .init = make
         const double u = gsl_cdf_ugaussian_P(sqrt(share) * a + sqrt(1 - share) * b[q]);
         e[q] = gsl_cdf_gamma_Pinv(fmin(fmax(u, 1e-15), 1 - 1e-15), HARMONIC_D / 2.0, pow(1.5, q));
       }
-      k += (size_t)snprintf(text + k, cap - k, "%zu,1,%.17g", t + 1, e[0]);
-      for (int q = 0; q < 4; q++) k += (size_t)snprintf(text + k, cap - k, ",%.17g,%.17g", pow(1.5, q), e[q]);
-      k += (size_t)snprintf(text + k, cap - k, ",0.3,0.3,0.3\n");
+      k += ladder_row(text + k, cap - k, t, e);
     }
     write_trace("pt.csv", text, path, sizeof path);
     lw_error err;
@@ -582,15 +593,11 @@ Test(reweight, a_tempering_trace_gives_the_harmonic_curve_between_its_rungs, .in
   const size_t rows = 3000;
   size_t cap = 160 * rows, k = 0;
   char *text = malloc(cap), path[128];
-  k += (size_t)snprintf(text, cap, "sweep,temperature,total");
-  for (int q = 0; q < 4; q++) k += (size_t)snprintf(text + k, cap - k, ",replica%d_temperature,replica%d_energy", q, q);
-  k += (size_t)snprintf(text + k, cap - k, ",swap0,swap1,swap2\n");
+  k += ladder_header(text, cap);
   for (size_t t = 0; t < rows; t++) {
     double e[4];
     for (int q = 0; q < 4; q++) e[q] = gsl_ran_gamma(r, HARMONIC_D / 2.0, pow(1.5, q));
-    k += (size_t)snprintf(text + k, cap - k, "%zu,1,%.17g", t + 1, e[0]);
-    for (int q = 0; q < 4; q++) k += (size_t)snprintf(text + k, cap - k, ",%.17g,%.17g", pow(1.5, q), e[q]);
-    k += (size_t)snprintf(text + k, cap - k, ",0.3,0.3,0.3\n");
+    k += ladder_row(text + k, cap - k, t, e);
   }
   write_trace("pt.csv", text, path, sizeof path);
   lw_error err;
