@@ -1319,8 +1319,11 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 {
   lw_status s;
   /* the last sweep's checkpoint, where one fell due, holds this state
-  ** already: written again, the same bytes (1.3 s at 1e5 splines) */
-  if (a->saved != a->sweep + 1 && (s = lw_anneal_checkpoint(a, err))) return s;
+  ** already: written again, the same bytes (1.3 s at 1e5 splines); its
+  ** timings were taken before that sweep's time was added */
+  if (a->saved != a->sweep + 1) s = lw_anneal_checkpoint(a, err);
+  else s = writes_files(a) ? lw_checkpoint_write_timing(a, err) : LW_OK;
+  if (s) return s;
   if (!rung_here(a, 0)) return LW_OK; /* the process of the coldest replica draws it */
   if (a->params.quench == LW_QUENCH_BFGS && !a->quenched) {
     lw_phase_set("quenching to the nearest minimum");
@@ -1341,7 +1344,9 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
     a->quenched = 1;
   }
   lw_phase_set("drawing the final files and scoring them");
+  if (a->drawing) *a->drawing = 1;
   if (!(s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_FINAL, err))) s = write_summary(a, err);
+  if (a->drawing) *a->drawing = 0;
   lw_phase_set(NULL);
   return s;
 }

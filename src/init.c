@@ -602,18 +602,20 @@ double lw_init_ink_area(const lw_scene *sc)
 
 lw_status lw_init_count(const lw_scene *sc, const lw_params *p, size_t *n, lw_error *err)
 {
-  /* With the cutoff within two length elements of the placed segments the
-  ** kink of (1/r - 1/rc)+ falls between the samples of most pairs, and the
-  ** pair energy is off by more than 1e-2 (docs/ACCURACY.md). */
-  double element = p->segment_length / sc->pair_quad.n;
-  if (sc->on[LW_TERM_PAIR] && p->pair_cutoff > 0.0 && p->pair_cutoff < 2.0 * element) {
+  /* The placed segments' pair samples within LW_PAIR_GAP_SHARE cutoffs, as
+  ** every segment's must stay (lw_segment_allowed): about two length
+  ** elements, within which the kink of (1/r - 1/rc)+ also falls between the
+  ** samples of most pairs and the pair energy is off by more than 1e-2
+  ** (docs/ACCURACY.md). */
+  const double gap = sc->pair_quad.spacing * p->segment_length;
+  if (sc->on[LW_TERM_PAIR] && p->pair_cutoff > 0.0 && gap > LW_PAIR_GAP_SHARE * p->pair_cutoff) {
     char at[LW_PATH_MAX + 32];
     lw_params_origin(p, lw_params_find("energy", "pair_cutoff"), at, sizeof at);
     return lw_error_set(err, LW_EINPUT,
-                        "%s: key 'energy.pair_cutoff': expected at least two length elements, %g mm "
-                        "(init.segment_length / nodes = %g mm), got %g mm; raise it, or the pair nodes "
-                        "(energy.pair_quadrature)",
-                        at, 2.0 * element, element, p->pair_cutoff);
+                        "%s: key 'energy.pair_cutoff': expected at least %.4g mm (about two length elements: "
+                        "the placed segments' pair samples lie up to %.4g mm apart, and a segment's must stay "
+                        "within %g cutoffs), got %g mm; raise it, or the pair nodes (energy.pair_quadrature)",
+                        at, gap / LW_PAIR_GAP_SHARE, gap, LW_PAIR_GAP_SHARE, p->pair_cutoff);
   }
   const lw_param_def *cov = lw_params_find("init", "coverage"), *spl = lw_params_find("init", "splines");
   char where[LW_PATH_MAX + 32];

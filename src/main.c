@@ -219,17 +219,19 @@ static void name_run_dir(const char *dir)
 /* The first signal asks for a clean stop after the sweep in progress; a
 ** second ends the process at once (a sweep can take minutes), leaving
 ** the last checkpoint, which state.lw always holds whole. */
-static volatile sig_atomic_t finishing = 0; /* the sweeps are done: the files are being written (not --quiet) */
+static volatile sig_atomic_t finishing = 0; /* the final files are being written (lw_anneal.drawing) */
+static volatile sig_atomic_t say_finishing = 0; /* and a signal then says so (not --quiet) */
 
 static void on_signal(int sig)
 {
   static const char first[] = "\nlinewise: stopping after the sweep in progress (a second Ctrl-C stops at once)\n";
   /* nothing would answer a signal then until the files are written, which
   ** can take minutes on a large drawing: say so, terminal or log */
-  static const char last[] = "\nlinewise: the sweeps are done; writing the final files first (a second signal stops "
-                             "at once, without them)\n";
-  if (!stop_requested && (finishing || on_terminal)) {
-    ssize_t w = finishing ? write(2, last, sizeof last - 1) : write(2, first, sizeof first - 1);
+  static const char last[] = "\nlinewise: writing the final files first (a second signal stops at once, without "
+                             "them)\n";
+  const int files = finishing && say_finishing;
+  if (!stop_requested && (files || on_terminal)) {
+    ssize_t w = files ? write(2, last, sizeof last - 1) : write(2, first, sizeof first - 1);
     (void)w;
   }
   if (stop_requested) {
@@ -366,9 +368,9 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
               a->sweep, a->dir, a->dir);
     return 0;
   }
-  finishing = !quiet;
+  say_finishing = !quiet;
+  a->drawing = &finishing;
   lw_status s = lw_anneal_finish(a, err);
-  finishing = 0;
 #ifdef LW_MPI
   /* only the process of the coldest replica drew and quenched it */
   int drew = !net || lw_anneal_net_owner(a->pt ? a->pt->at[0] : 0, a->n_rep, net->size) == net->rank;

@@ -180,7 +180,8 @@ const lw_param_def lw_param_table[] = {
       "C: pair repulsion C * double integral of dl dl / r between different splines. 0 = off."),
   NUM("energy", "pair_cutoff", LW_PT_DOUBLE, pair_cutoff, "5", "mm", 0, 1e7, 0,
       "Pair interaction range; the kernel is shifted to 1/r - 1/rc so the energy is continuous. "
-      "At least two length elements (init.segment_length / pair nodes). "
+      "At least about two length elements (init.segment_length / pair nodes): the placed segments' "
+      "widest gap between pair samples over 0.75, as every segment's gap must stay within 0.75 cutoffs. "
       "0 = no cutoff (all pairs; slow for large scenes)."),
   NUM("energy", "pair_near", LW_PT_DOUBLE, pair_near, "1.5", "element lengths", 0, 100, 0,
       "Near field: two segments with a pair of samples closer than this many length elements "
@@ -194,7 +195,9 @@ const lw_param_def lw_param_table[] = {
       "its own length elements (its length / nodes), anywhere between the nodes too, is forbidden "
       "(+infinity, like leaving the frame): closer, the nodes cannot resolve 1/d^2 and an end or a "
       "bulge at the frame would hide its energy. 1.5 keeps each segment's boundary integral at 8 "
-      "nodes within 2e-4 (docs/ACCURACY.md). 0 = the curve only has to stay inside."),
+      "nodes within 2e-4 (docs/ACCURACY.md; not across a corner's bisector, where the distance has a "
+      "kink). The photo preset sets 0.5, so that lines reach a frame or a mask's outline. "
+      "0 = the curve only has to stay inside."),
   NUM("energy", "min_speed", LW_PT_DOUBLE, min_speed, "0.4", "fraction of the mean speed", 0, 1, LW_MAX_OPEN,
       "Regularity: a segment whose speed |r'| falls anywhere below this fraction of its mean speed "
       "(its length) is forbidden (+infinity, like leaving the frame), whatever the node count: "
@@ -1165,7 +1168,8 @@ static const struct {
     {"energy", "tone_ink", "0.5", 0},      {"energy", "pair", "0.01", 0},
     {"energy", "pair_cutoff", NULL, 3},    {"energy", "pair_near", "0", 0},
     {"energy", "min_spacing", NULL, 1},    {"energy", "quadrature", "6", 0},
-    {"energy", "boundary", "0.2", 0},      {"anneal", "schedule", "geometric", 0},
+    {"energy", "boundary", "0.2", 0},      {"energy", "boundary_clearance", "0.5", 0},
+    {"anneal", "schedule", "geometric", 0},
     {"anneal", "t_start", "0.5", 0},       {"anneal", "t_end", "0.002", 0},
     {"anneal", "sweeps", "300", 0},        {"anneal", "steps", "5", 0},
     {"moves", "fixed_count", "0", 0},      {"moves", "grow", "0.05", 0},

@@ -137,6 +137,10 @@ lw_status lw_reweight_solve(const double *E, const size_t *first, const double *
   int it = 0;
   double worst = pass(E, n, eref, log_n, f, beta, K, log_d, s_sum, ww, w);
   for (double change = INFINITY; change > LW_REWEIGHT_TOL && worst > LW_REWEIGHT_TOL; it++) {
+    /* a resample's free energies need not be known to 1e-10 (their spread is
+    ** what is sought): one that creeps at that level (blocks of few rows
+    ** where the rungs barely overlap) is taken as it stands */
+    if (it == LW_REWEIGHT_ITER && warm && change <= 1e-6) break;
     if (it == LW_REWEIGHT_ITER) {
       st = lw_error_set(err, LW_EINPUT, "reweighting did not settle in %d iterations (last change %.3g): the "
                         "rungs' energies barely overlap", LW_REWEIGHT_ITER, change);
@@ -338,8 +342,7 @@ done:
 ** (an exchange hands a configuration, and its energy, to the neighbour):
 ** drawn sample by sample and rung by rung, the resamples lost both and the
 ** error bars between the rungs came out 1.3 to 1.5 times too small
-** (docs/NUMERICS.md, "Error bars from a trace").  A block is
-** LW_REWEIGHT_BLOCK samples of the trace's most thinned rung. */
+** (docs/NUMERICS.md, "Reweighting between the rungs"). */
 static lw_status resample(const rw_states *s, int traces, gsl_rng *rng, double *Eb, lw_error *err)
 {
   for (int r = 0; r < traces; r++) {
@@ -350,8 +353,14 @@ static lw_status resample(const rw_states *s, int traces, gsl_rng *rng, double *
         span = (size_t)s->thin[q] > span ? (size_t)s->thin[q] : span;
       }
     if (!rows) continue;
+    /* LW_REWEIGHT_BLOCK samples of the slowest rung, but no fewer than
+    ** LW_REWEIGHT_BLOCKS blocks in the rows (one block as long as the rows
+    ** would draw the data back every time: error bars of 0), nor less than
+    ** one sample of that rung */
+    const size_t slowest = span;
     span *= LW_REWEIGHT_BLOCK;
-    if (span > rows) span = rows;
+    if (span > rows / LW_REWEIGHT_BLOCKS) span = rows / LW_REWEIGHT_BLOCKS;
+    if (span < slowest) span = slowest < rows ? slowest : rows;
     /* enough blocks for every rung: each holds at least span / thin - 1
     ** of a rung's samples */
     size_t blocks = 0;

@@ -465,3 +465,33 @@ Test(boundary, a_curve_with_a_coordinate_not_finite_is_never_clear)
   lw_boundary none = {.kind = LW_BOUNDARY_NONE};
   cr_assert(lw_boundary_curve_clear(&none, x, y, 1e9));
 }
+
+Test(boundary, a_curve_along_the_limit_is_decided_in_bounded_work, .timeout = 20)
+{
+  /* A straight segment parallel to a side, a hair beyond the clearance: the
+  ** disc test alone split it down to pieces of that hair (143 s for one
+  ** segment 1e-8 mm beyond).  On a convex frame the control points decide
+  ** it exactly; on a frame that is not convex the work is capped and the
+  ** curve refused. */
+  lw_boundary r = {.kind = LW_BOUNDARY_RECT, .x0 = 0, .y0 = 0, .x1 = 100, .y1 = 100};
+  const double clear = 1.125;
+  for (int k = 0; k < 4; k++) {
+    const double hair = k == 3 ? -1e-12 : pow(10.0, -8 - k);
+    const double y[4] = {clear + hair, clear + hair, clear + hair, clear + hair}, x[4] = {10, 12, 14, 16};
+    cr_assert_eq(lw_boundary_curve_clear(&r, x, y, clear), hair > 0, "hair %g", hair);
+  }
+  double lx[6] = {0, 100, 100, 40, 40, 0}, ly[6] = {0, 0, 30, 30, 100, 100};
+  lw_boundary l;
+  cr_assert_eq(lw_boundary_polygon(&l, 6, lx, ly, NULL), LW_OK);
+  cr_assert(!l.convex);
+  const double x[4] = {50, 55, 60, 65}, y[4] = {clear + 1e-10, clear + 1e-10, clear + 1e-10, clear + 1e-10};
+  cr_assert(!lw_boundary_curve_clear(&l, x, y, clear), "refused: more pieces than the cap");
+  const double y2[4] = {clear + 0.01, clear + 0.01, clear + 0.01, clear + 0.01};
+  cr_assert(lw_boundary_curve_clear(&l, x, y2, clear), "0.01 mm beyond is clear within the cap");
+  double sx[4] = {0, 10, 10, 0}, sy[4] = {0, 0, 10, 10};
+  lw_boundary sq;
+  cr_assert_eq(lw_boundary_polygon(&sq, 4, sx, sy, NULL), LW_OK);
+  cr_assert(sq.convex);
+  lw_boundary_clear(&l);
+  lw_boundary_clear(&sq);
+}

@@ -575,6 +575,35 @@ Test(reweight, the_error_bars_hold_the_scatter_of_correlated_rungs, .init = make
       count++;
     }
   }
+  /* a stretch of a few blocks still resamples (one block as long as the
+  ** rows drew the data back every time: error bars of exactly 0) */
+  size_t k = ladder_header(text, cap);
+  double ar[4] = {0, 0, 0, 0};
+  for (size_t t = 0; t < 60; t++) { /* tau about 10 rows: thinned to one in 20 */
+    double e[4];
+    for (int q = 0; q < 4; q++) {
+      ar[q] = 0.9 * ar[q] + sqrt(1 - 0.81) * gsl_ran_gaussian(r, 1.0);
+      const double u = gsl_cdf_ugaussian_P(ar[q]);
+      e[q] = gsl_cdf_gamma_Pinv(fmin(fmax(u, 1e-15), 1 - 1e-15), HARMONIC_D / 2.0, pow(1.5, q));
+    }
+    k += ladder_row(text + k, cap - k, t, e);
+  }
+  write_trace("short.csv", text, path, sizeof path);
+  lw_error err;
+  lw_trace *t = lw_trace_read(path, &err);
+  cr_assert_not_null(t, "%s", err.msg);
+  FILE *f = fmemopen(out, sizeof out, "w");
+  lw_trace_select sel = {.from = -1, .to = -1, .csv = 1};
+  const char *paths[1] = {path};
+  cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, 3, f, &err), LW_OK, "%s", err.msg);
+  fclose(f);
+  lw_trace_free(t);
+  const char *line = strchr(out, '\n') + 1;
+  for (int j = 0; j < 3; j++, line = strchr(line, '\n') + 1) {
+    double T, e, se, c, sc;
+    cr_assert_eq(sscanf(line, "%lf,%lf,%lf,%lf,%lf", &T, &e, &se, &c, &sc), 5, "%s", out);
+    cr_assert(se > 1e-3 && sc > 1e-3, "60 rows: error bars %g and %g", se, sc);
+  }
   free(text);
   gsl_rng_free(r);
   z2 /= count;

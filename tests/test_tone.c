@@ -702,6 +702,10 @@ Test(tone, later_hold_rounds_ask_only_beside_the_new_holds)
 {
   lw_scene sc;
   spacing_scene(&sc, 1);
+  /* the spacing rule's rounds alone: a 6 mm step stretches segments past the
+  ** pair term's sample gaps (its cutoff is 1 mm), which held them all in the
+  ** first round */
+  sc.pair_gap_max = 0.0;
   lw_error err = {0};
   lw_model *m = lw_model_new(&sc, rows(16), &err);
   cr_assert_not_null(m, "%s", err.msg);

@@ -74,6 +74,8 @@ typedef struct lw_anneal {
   lw_quench_report quench;     /* what the quench did */
   const volatile sig_atomic_t *stop; /* not NULL: set (by a signal) stops a quench under way,
                                ** and lw_anneal_finish then draws nothing (not owned) */
+  volatile sig_atomic_t *drawing; /* not NULL: set to 1 while the final files are written
+                                      (lw_anneal_finish), for a signal handler to say so */
   FILE *trace;                 /* NULL on the processes other than the first (anneal_net.h) */
   lw_anneal_net *net;          /* NULL in one process; else the hooks of a spread run (not owned) */
 } lw_anneal;

@@ -34,6 +34,7 @@ typedef struct {
   double cx, cy, radius;  /* circle, mm; radius > 0 */
   size_t n;               /* polygon: vertex count (>= 3) */
   double *vx, *vy;        /* polygon: vertices, owned */
+  int convex;             /* polygon: convex (lw_boundary_curve_clear's fast test) */
   lw_grid2d *sdt;         /* mask: signed distances, mm, owned (ncomp 1) */
   double slope;           /* mask: the steepest the bilinear distance gets
                              (lw_boundary_mask_slope); the exact kinds' is 1 */
@@ -62,7 +63,12 @@ double lw_boundary_distance_grad(const lw_boundary *b, double x, double y, doubl
 ** lie within a disc far enough inside (the distance changes by at most the
 ** slope times the disc's radius) is inside; otherwise it is split in two at
 ** its middle, whose point on the curve is tested, down to pieces of 1e-9
-** mm.  0 for non-finite input; 1 for LW_BOUNDARY_NONE. */
+** mm; where the frame is convex (rect, circle, a convex polygon) a piece
+** whose control points are all far enough inside is clear too (the
+** distance is convex there), which decides a piece parallel to a side at
+** once.  A curve needing more than 4096 pieces (one along the limit within
+** a hair, in a frame that is not convex) is refused.  0 for non-finite
+** input; 1 for LW_BOUNDARY_NONE. */
 int lw_boundary_curve_clear(const lw_boundary *b, const double x[4], const double y[4], double clear);
 
 /* The steepest slope of the mask's bilinear distance (>= 1 where its grid

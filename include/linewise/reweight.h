@@ -34,6 +34,7 @@
 #define LW_REWEIGHT_BOOTSTRAP 32    /* resamples for the error bars */
 #define LW_REWEIGHT_SAMPLES 20000   /* samples a rung at most, after thinning */
 #define LW_REWEIGHT_BLOCK 4         /* samples of the most thinned rung a bootstrap block holds */
+#define LW_REWEIGHT_BLOCKS 16       /* bootstrap blocks a run's rows hold at least */
 #define LW_REWEIGHT_TEMPS_MAX 10000 /* temperatures a table, at most */
 #define LW_REWEIGHT_SWAP_MIN 0.05   /* neighbour exchange acceptance below which a warning says the
                                        rungs barely overlap */
@@ -45,7 +46,8 @@
 ** bootstrap resample's); log_den[N] (NULL: not asked) the samples' ln D_i
 ** up to one constant, what lw_reweight_at needs.  *iterations (NULL: not
 ** asked) the iterations taken.  LW_EINPUT when the iteration does not
-** settle (states that share no energies), LW_ENOMEM. */
+** settle (states that share no energies; a warm solve still creeping by at
+** most 1e-6 then is taken as it stands), LW_ENOMEM. */
 lw_status lw_reweight_solve(const double *E, const size_t *first, const double *beta, int K, int warm, double *f,
                             double *log_den, int *iterations, lw_error *err);
 

@@ -39,10 +39,13 @@
 
 /* With a cutoff rc, a segment whose consecutive pair samples lie more than
 ** this share of rc apart is forbidden: a line crossing it between two of
-** them might then pass no sample within rc, and the pair term would not see
-** the crossing.  0.9: crossings of segments at the limit err by at most
-** 4.8e-4 at 8 nodes (docs/NUMERICS.md, "Regular segments"). */
-#define LW_PAIR_GAP_SHARE 0.9
+** them might then pass no sample pair within rc / 2, where the near field
+** takes a crossing whole, and the product rule would hide most of it.
+** 0.75: the worst crossing of segments at the limit (a right angle, in the
+** middle of both segments' widest gaps) errs by 7.5e-4 at 8 nodes, 7e-3 at
+** 0.8 and 5.5e-2 at 0.9 (docs/NUMERICS.md, "Regular segments").  Placement
+** asks it of the placed segments (lw_init_count). */
+#define LW_PAIR_GAP_SHARE 0.75
 
 typedef struct lw_scene {
   double width, height;         /* page, mm */
