@@ -518,6 +518,29 @@ static size_t ladder_row(char *text, size_t cap, size_t t, const double e[4])
   return k + (size_t)snprintf(text + k, cap - k, ",0.3,0.3,0.3\n");
 }
 
+/* The trace text reweighted at n temperatures (the csv table): each row's
+** temperature, <E> and its error bar, and C's error bar. */
+static void reweight_text(const char *text, int n, double *T, double *e, double *se, double *sc)
+{
+  static char out[4096];
+  char path[128];
+  write_trace("rw.csv", text, path, sizeof path);
+  lw_error err;
+  lw_trace *t = lw_trace_read(path, &err);
+  cr_assert_not_null(t, "%s", err.msg);
+  FILE *f = fmemopen(out, sizeof out, "w");
+  lw_trace_select sel = {.from = -1, .to = -1, .csv = 1};
+  const char *paths[1] = {path};
+  cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, n, f, &err), LW_OK, "%s", err.msg);
+  fclose(f);
+  lw_trace_free(t);
+  const char *line = strchr(out, '\n') + 1;
+  for (int j = 0; j < n; j++, line = strchr(line, '\n') + 1) {
+    double c;
+    cr_assert_eq(sscanf(line, "%lf,%lf,%lf,%lf,%lf", &T[j], &e[j], &se[j], &c, &sc[j]), 5, "%s", out);
+  }
+}
+
 /* The error bars must hold what the estimates scatter by: 40 traces of a
 ** 4-rung run (T = 1 .. 3.375) whose rows are Gamma energies (the harmonic
 ** system's law, so <E> = d/2 T exactly) correlated as a tempering run's
@@ -538,8 +561,7 @@ Test(reweight, the_error_bars_hold_the_scatter_of_correlated_rungs, .init = make
   const size_t rows = 4000;
   const double rho = exp(-1.0 / 5.0), share = 0.6;
   size_t cap = 200 * rows;
-  char *text = malloc(cap), path[128];
-  static char out[4096];
+  char *text = malloc(cap);
   double z2 = 0.0;
   int count = 0;
   for (int trace = 0; trace < 40; trace++) {
@@ -556,21 +578,10 @@ Test(reweight, the_error_bars_hold_the_scatter_of_correlated_rungs, .init = make
       }
       k += ladder_row(text + k, cap - k, t, e);
     }
-    write_trace("pt.csv", text, path, sizeof path);
-    lw_error err;
-    lw_trace *t = lw_trace_read(path, &err);
-    cr_assert_not_null(t, "%s", err.msg);
-    FILE *f = fmemopen(out, sizeof out, "w");
-    lw_trace_select sel = {.from = -1, .to = -1, .csv = 1};
-    const char *paths[1] = {path};
-    cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, 9, f, &err), LW_OK, "%s", err.msg);
-    fclose(f);
-    lw_trace_free(t);
-    const char *line = strchr(out, '\n') + 1;
-    for (int j = 0; j < 9; j++, line = strchr(line, '\n') + 1) {
-      double T, e, se, c, sc;
-      cr_assert_eq(sscanf(line, "%lf,%lf,%lf,%lf,%lf", &T, &e, &se, &c, &sc), 5, "%s", out);
-      const double z = (e - HARMONIC_D / 2.0 * T) / se;
+    double T[9], e[9], se[9], sc[9];
+    reweight_text(text, 9, T, e, se, sc);
+    for (int j = 0; j < 9; j++) {
+      const double z = (e[j] - HARMONIC_D / 2.0 * T[j]) / se[j];
       z2 += z * z;
       count++;
     }
@@ -588,22 +599,9 @@ Test(reweight, the_error_bars_hold_the_scatter_of_correlated_rungs, .init = make
     }
     k += ladder_row(text + k, cap - k, t, e);
   }
-  write_trace("short.csv", text, path, sizeof path);
-  lw_error err;
-  lw_trace *t = lw_trace_read(path, &err);
-  cr_assert_not_null(t, "%s", err.msg);
-  FILE *f = fmemopen(out, sizeof out, "w");
-  lw_trace_select sel = {.from = -1, .to = -1, .csv = 1};
-  const char *paths[1] = {path};
-  cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, 3, f, &err), LW_OK, "%s", err.msg);
-  fclose(f);
-  lw_trace_free(t);
-  const char *line = strchr(out, '\n') + 1;
-  for (int j = 0; j < 3; j++, line = strchr(line, '\n') + 1) {
-    double T, e, se, c, sc;
-    cr_assert_eq(sscanf(line, "%lf,%lf,%lf,%lf,%lf", &T, &e, &se, &c, &sc), 5, "%s", out);
-    cr_assert(se > 1e-3 && sc > 1e-3, "60 rows: error bars %g and %g", se, sc);
-  }
+  double T[3], e[3], se[3], sc[3];
+  reweight_text(text, 3, T, e, se, sc);
+  for (int j = 0; j < 3; j++) cr_assert(se[j] > 1e-3 && sc[j] > 1e-3, "60 rows: error bars %g and %g", se[j], sc[j]);
   free(text);
   gsl_rng_free(r);
   z2 /= count;
