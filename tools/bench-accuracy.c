@@ -194,6 +194,14 @@ void bench_quadrature(bench_ctx *b)
           v[ref].total, v[ref].term[0], v[ref].term[1], v[ref].term[2], v[ref].term[3], v[ref].term[4],
           v[ref].term[5], b->ann_params.min_speed, b->ann_params.regularity, irregular, sp->n_segments,
           b->ann_params.pair_near, b->ann_params.pair_near * b->ann_params.segment_length / b->ann_params.quadrature);
+  fprintf(d, "These errors are of a state annealed at %d nodes. A state annealed at few nodes is worse,\n"
+             "since the annealer finds what its own rule misses: a scene annealed at 2 nodes (10\n"
+             "splines of 3 segments of 5 mm, potential -1 paying for length, pair and boundary on) ends\n"
+             "with its pair energy 20 %% and its bending 16 %% under their 64-node values, at 6 nodes\n"
+             "within 0.2 %% (measured 2026-12-04; before the sample-gap and clearance checks of \"Regular\n"
+             "segments\" the 2-node pair energy was 186 times too small). Below 6 nodes, anneal for\n"
+             "speed and evaluate at 8 or more (`linewise energy DIR --set energy.quadrature=...`).\n\n",
+          b->ann_params.quadrature);
   fprintf(d, "What the chain sees, and what it costs (proposals at T = %g on the annealed state):\n\n"
              "![error against ns per proposal for each node count](accuracy-quadrature.png)\n\n"
              "| nodes | dE | dE rms | decisions | ns per proposal | x cost of 8 |\n|---|---|---|---|---|---|\n",

@@ -384,6 +384,15 @@ void bench_regularity(bench_ctx *b)
     fprintf(d, "\n\n");
   } else
     fprintf(d, "\nNo pair measured keeps 8 nodes within 1e-3.\n\n");
+  fprintf(d, "The pair and boundary terms have scales of their own (the cutoff, the distance to the\n"
+             "frame), and two more exact tests keep every allowed segment short enough against them:\n"
+             "with a cutoff, no two consecutive pair samples more than %g cutoffs apart (the worst\n"
+             "crossing of straight segments at that limit errs by 7.5e-4 at 8 nodes); with the\n"
+             "boundary term, the curve at least `energy.boundary_clearance` (1.5) of its own length\n"
+             "elements from the frame (each segment's boundary integral within 2e-4 at 8 nodes, but\n"
+             "for the kink of the distance along a corner's bisector: up to 1e-2 there).\n"
+             "docs/NUMERICS.md (\"Regular segments\") has the tables behind both.\n\n",
+          LW_PAIR_GAP_SHARE);
   gsl_rng_free(r);
   gsl_integration_workspace_free(st.ws);
   gsl_set_error_handler(old);
