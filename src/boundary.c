@@ -283,10 +283,9 @@ int lw_boundary_curve_clear(const lw_boundary *b, const double x[4], const doubl
     if (!isfinite(x[k]) || !isfinite(y[k])) return 0;
   if (!CLEAR_OK(lw_boundary_distance(b, x[0], y[0])) || !CLEAR_OK(lw_boundary_distance(b, x[3], y[3]))) return 0;
   bezier_piece stack[CLEAR_DEPTH + 2];
-  int top = 0;
   memcpy(stack[0].x, x, sizeof stack[0].x);
   memcpy(stack[0].y, y, sizeof stack[0].y);
-  top = 1;
+  int top = 1;
   const int convex = frame_convex(b);
   for (int pieces = 0; top > 0; pieces++) {
     if (pieces == CLEAR_PIECES) return 0;

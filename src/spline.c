@@ -330,17 +330,27 @@ double lw_segment_min_speed(const lw_node *a, const lw_node *b)
   return sqrt(best);
 }
 
+/* |h|^2 = sum_k c_k b^4_k(t), the quartic's Bernstein coefficients; the
+** b^4_k are >= 0 and sum to 1, so min_k c_k <= |h|^2 <= max_k c_k.  1 if
+** they are finite. */
+static int speed2_bernstein(const double h[6], double c[5])
+{
+  c[0] = h[0] * h[0] + h[1] * h[1];
+  c[1] = h[0] * h[2] + h[1] * h[3];
+  c[2] = ((h[0] * h[4] + h[1] * h[5]) + 2.0 * (h[2] * h[2] + h[3] * h[3])) * (1.0 / 3.0);
+  c[3] = h[2] * h[4] + h[3] * h[5];
+  c[4] = h[4] * h[4] + h[5] * h[5];
+  return isfinite(c[0] + c[1] + c[2] + c[3] + c[4]);
+}
+
 /* 1 if |h|^2 >= need on [0, 1] by the Bernstein bound, 0 if in doubt, -1
-** for non-finite input.  |h|^2 = sum_k c_k b^4_k(t) with the coefficients
-** below; the b^4_k are >= 0 and sum to 1, so |h|^2 >= min_k c_k. */
+** for non-finite input. */
 static int speed_bound(const double h[6], double need)
 {
-  const double c0 = h[0] * h[0] + h[1] * h[1], c1 = h[0] * h[2] + h[1] * h[3];
-  const double c2 = ((h[0] * h[4] + h[1] * h[5]) + 2.0 * (h[2] * h[2] + h[3] * h[3])) * (1.0 / 3.0);
-  const double c3 = h[2] * h[4] + h[3] * h[5], c4 = h[4] * h[4] + h[5] * h[5];
-  if (!isfinite(c0 + c1 + c2 + c3 + c4)) return -1;
+  double c[5];
+  if (!speed2_bernstein(h, c)) return -1;
   /* plain comparisons: this runs for every new segment of every proposal */
-  return c0 >= need && c1 >= need && c2 >= need && c3 >= need && c4 >= need;
+  return c[0] >= need && c[1] >= need && c[2] >= need && c[3] >= need && c[4] >= need;
 }
 
 /* 1 if h_x + i h_y has no zero in the disc |t - 1/2| <= R (R2 = R^2), 0 if
@@ -412,14 +422,10 @@ double lw_segment_widest_gap(const lw_quad *q, const lw_node *a, const lw_node *
 
 int lw_segment_gaps_within(const lw_quad *q, const lw_node *a, const lw_node *b, double gap_max)
 {
-  double h[6];
+  double h[6], c[5];
   hodograph(a, b, h);
-  /* |h|^2 <= the largest of its Bernstein coefficients (speed_bound's) */
-  const double c0 = h[0] * h[0] + h[1] * h[1], c1 = h[0] * h[2] + h[1] * h[3];
-  const double c2 = ((h[0] * h[4] + h[1] * h[5]) + 2.0 * (h[2] * h[2] + h[3] * h[3])) * (1.0 / 3.0);
-  const double c3 = h[2] * h[4] + h[3] * h[5], c4 = h[4] * h[4] + h[5] * h[5];
-  const double top = fmax(fmax(fmax(c0, c1), fmax(c2, c3)), c4);
-  if (!isfinite(c0 + c1 + c2 + c3 + c4)) return 0;
+  if (!speed2_bernstein(h, c)) return 0;
+  const double top = fmax(fmax(fmax(c[0], c[1]), fmax(c[2], c[3])), c[4]); /* >= |h|^2 */
   if (q->spacing * q->spacing * top <= gap_max * gap_max) return 1;
   return lw_segment_widest_gap(q, a, b) <= gap_max;
 }
