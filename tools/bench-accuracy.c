@@ -284,7 +284,8 @@ void bench_cutoff(bench_ctx *b)
              "page edges that the shifted kernel 1/r - 1/rc leaves out. So the cutoff sets the range\n"
              "of the repulsion: a modelling choice whose cost grows with the number of neighbours, here\n"
              "as rc^%.2f (least squares from 2 mm up; the neighbours grow as rc^2, the fixed cost of a\n"
-             "proposal does not). A cutoff shorter than two length elements of the placed segments is\n"
+             "proposal does not). A cutoff shorter than about two length elements of the placed segments\n"
+             "(their widest gap between pair samples over 0.75: NUMERICS.md, \"Regular segments\") is\n"
              "refused; a cutoff within the near radius (%g elements, here about %.2f mm) caps it, and\n"
              "the energy stays continuous (NUMERICS.md).\n\n",
           v[ref].term[LW_TERM_PAIR], rc[time_ref], v[time_ref].term[LW_TERM_PAIR], b->cutoff_exponent,
