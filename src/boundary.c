@@ -272,6 +272,49 @@ static int frame_convex(const lw_boundary *b)
          (b->kind == LW_BOUNDARY_POLYGON && b->convex);
 }
 
+/* Squared distance from (px, py) to the segment (ax, ay)-(bx, by). */
+static double point_segment2(double px, double py, double ax, double ay, double bx, double by)
+{
+  const double ex = bx - ax, ey = by - ay, ee = ex * ex + ey * ey;
+  double t = ee > 0.0 ? ((px - ax) * ex + (py - ay) * ey) / ee : 0.0;
+  t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+  const double dx = px - ax - t * ex, dy = py - ay - t * ey;
+  return dx * dx + dy * dy;
+}
+
+/* The distance between two segments: 0 where they cross, else the least
+** of the four from an end to the other segment. */
+static double segment_segment(const double a[4], const double b[4])
+{
+  const double d1x = a[2] - a[0], d1y = a[3] - a[1], d2x = b[2] - b[0], d2y = b[3] - b[1];
+  const double s1 = d1x * (b[1] - a[1]) - d1y * (b[0] - a[0]), s2 = d1x * (b[3] - a[1]) - d1y * (b[2] - a[0]);
+  const double s3 = d2x * (a[1] - b[1]) - d2y * (a[0] - b[0]), s4 = d2x * (a[3] - b[1]) - d2y * (a[2] - b[0]);
+  if (((s1 < 0) != (s2 < 0)) && ((s3 < 0) != (s4 < 0))) return 0.0;
+  double m = point_segment2(a[0], a[1], b[0], b[1], b[2], b[3]);
+  m = fmin(m, point_segment2(a[2], a[3], b[0], b[1], b[2], b[3]));
+  m = fmin(m, point_segment2(b[0], b[1], a[0], a[1], a[2], a[3]));
+  m = fmin(m, point_segment2(b[2], b[3], a[0], a[1], a[2], a[3]));
+  return sqrt(m);
+}
+
+/* A polygon's piece whose start lies inside: clear if its chord keeps
+** clear + f from every edge, f how far its inner control points stand off
+** the chord (the piece lies within f of it).  Then the chord crosses no
+** edge, so it lies inside with its start, and every point of the piece
+** keeps clear.  Exact for a flat piece beside an edge, where a concave
+** frame's discs would split down to the hair it stands off the limit. */
+static int polygon_piece_clear(const lw_boundary *b, const double *x, const double *y, double clear)
+{
+  const double chord[4] = {x[0], y[0], x[3], y[3]};
+  const double f = sqrt(fmax(point_segment2(x[1], y[1], x[0], y[0], x[3], y[3]),
+                             point_segment2(x[2], y[2], x[0], y[0], x[3], y[3])));
+  for (size_t i = 0, j = b->n - 1; i < b->n; j = i++) {
+    const double edge[4] = {b->vx[j], b->vy[j], b->vx[i], b->vy[i]};
+    if (!(segment_segment(chord, edge) - f > clear)) return 0;
+  }
+  return 1;
+}
+
 int lw_boundary_curve_clear(const lw_boundary *b, const double x[4], const double y[4], double clear)
 {
   if (b->kind == LW_BOUNDARY_NONE) return 1;
@@ -303,6 +346,7 @@ int lw_boundary_curve_clear(const lw_boundary *b, const double x[4], const doubl
     }
     const double r = sqrt(r2);
     if (convex ? CLEAR_OK(far) : CLEAR_OK(lw_boundary_distance(b, cx, cy) + slope * r)) continue;
+    if (b->kind == LW_BOUNDARY_POLYGON && !convex && polygon_piece_clear(b, p.x, p.y, clear)) continue;
     bezier_piece lo, hi;
     split_half(&p, &lo, &hi);
     if (!CLEAR_OK(lw_boundary_distance(b, lo.x[3], lo.y[3]))) return 0;

@@ -471,8 +471,8 @@ Test(boundary, a_curve_along_the_limit_is_decided_in_bounded_work, .timeout = 20
   /* A straight segment parallel to a side, a hair beyond the clearance: the
   ** disc test alone split it down to pieces of that hair (143 s for one
   ** segment 1e-8 mm beyond).  On a convex frame the control points decide
-  ** it exactly; on a frame that is not convex the work is capped and the
-  ** curve refused. */
+  ** it exactly, on a polygon that is not the chord's distance to the edges;
+  ** on a mask the work is capped and the curve refused. */
   lw_boundary r = {.kind = LW_BOUNDARY_RECT, .x0 = 0, .y0 = 0, .x1 = 100, .y1 = 100};
   const double clear = 1.125;
   for (int k = 0; k < 4; k++) {
@@ -484,10 +484,27 @@ Test(boundary, a_curve_along_the_limit_is_decided_in_bounded_work, .timeout = 20
   lw_boundary l;
   cr_assert_eq(lw_boundary_polygon(&l, 6, lx, ly, NULL), LW_OK);
   cr_assert(!l.convex);
-  const double x[4] = {50, 55, 60, 65}, y[4] = {clear + 1e-10, clear + 1e-10, clear + 1e-10, clear + 1e-10};
-  cr_assert(!lw_boundary_curve_clear(&l, x, y, clear), "refused: more pieces than the cap");
-  const double y2[4] = {clear + 0.01, clear + 0.01, clear + 0.01, clear + 0.01};
-  cr_assert(lw_boundary_curve_clear(&l, x, y2, clear), "0.01 mm beyond is clear within the cap");
+  const double x[4] = {50, 55, 60, 65}, y[4] = {clear + 1e-8, clear + 1e-8, clear + 1e-8, clear + 1e-8};
+  cr_assert(lw_boundary_curve_clear(&l, x, y, clear), "a hair beyond, beside a concave polygon's edge");
+  const double y2[4] = {clear - 1e-8, clear - 1e-8, clear - 1e-8, clear - 1e-8};
+  cr_assert(!lw_boundary_curve_clear(&l, x, y2, clear), "a hair within");
+  /* and beside the concave corner's other side (x = 40, inside below),
+  ** bent away from it, its ends a hair beyond the limit */
+  const double bx[4] = {40 - clear - 1e-6, 40 - clear - 1, 40 - clear - 1, 40 - clear - 1e-6},
+               by[4] = {60, 65, 70, 75};
+  cr_assert(lw_boundary_curve_clear(&l, bx, by, clear));
+  /* a mask's discs split a curve along the limit until the cap refuses it */
+  lw_error err;
+  lw_grid2d *g = lw_grid2d_new(101, 101, 1, 0.0, 0.0, 1.0, 1.0, &err);
+  cr_assert(g);
+  for (int j = 0; j < 101; j++)
+    for (int i = 0; i < 101; i++) g->data[j * 101 + i] = -fmin(fmin(i, 100 - i), fmin(j, 100 - j));
+  lw_boundary m = {.kind = LW_BOUNDARY_MASK, .sdt = g, .slope = lw_boundary_mask_slope(g)};
+  const double my[4] = {clear + 1e-9, clear + 1e-9, clear + 1e-9, clear + 1e-9};
+  cr_assert(!lw_boundary_curve_clear(&m, x, my, clear), "refused: more pieces than the cap");
+  const double my2[4] = {clear + 0.01, clear + 0.01, clear + 0.01, clear + 0.01};
+  cr_assert(lw_boundary_curve_clear(&m, x, my2, clear), "0.01 mm beyond is clear within the cap");
+  lw_boundary_clear(&m);
   double sx[4] = {0, 10, 10, 0}, sy[4] = {0, 0, 10, 10};
   lw_boundary sq;
   cr_assert_eq(lw_boundary_polygon(&sq, 4, sx, sy, NULL), LW_OK);
