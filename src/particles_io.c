@@ -65,8 +65,9 @@ static lw_status read_text(FILE *f, const char *path, points *pt, lw_error *err)
     int k = lw_number_list(buf, 1, v, 6);
     if (k == 0) continue;
     if (k != 3 && k != 6) {
-      s = k < 0 ? lw_error_set(err, LW_EINPUT, "%s:%ld: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got '%.80s'",
-                               path, line, buf)
+      s = k < 0 ? lw_error_set(err, LW_EINPUT,
+                               "%s:%ld: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got '%.80s'", path,
+                               line, buf)
                 : lw_error_set(err, LW_EINPUT, "%s:%ld: expected 3 numbers (x y z) or 6 (x y z nx ny nz), got %d",
                                path, line, k);
       break;
