@@ -50,20 +50,17 @@ double lw_term_field(const lw_samples *s, const lw_quad *q, const lw_field *f, i
 
 double lw_term_boundary(const lw_samples *s, const lw_quad *q, const lw_boundary *b)
 {
-  /* Gauss nodes never reach the segment ends: check the nodes themselves so
-  ** no drawn end pokes out of the frame. */
-  for (int e = 0; e < 2; e++)
-    if (!(lw_boundary_distance(b, s->end_x[e], s->end_y[e]) < 0.0)) return INFINITY;
   double sum = 0.0;
   for (int i = 0; i < s->n; i++) {
     double d = lw_boundary_distance(b, s->x[i], s->y[i]);
     if (!(d < 0.0)) return INFINITY; /* on or beyond the frame, or NaN: forbidden */
     sum += s->dl[i] / (d * d);
   }
-  /* Between the nodes too, and with room: 1/d^2 is resolved by n nodes only
-  ** where the curve keeps some length elements from the frame (its pole at
-  ** d = 0 then lies outside the rule's Bernstein ellipse); a bulge or an end
-  ** closer than that would hide most of its energy (docs/NUMERICS.md). */
+  /* The whole curve, its ends (which no Gauss node reaches) and the stretches
+  ** between the nodes, with room: 1/d^2 is resolved by n nodes only where the
+  ** curve keeps some length elements from the frame (its pole at d = 0 then
+  ** lies outside the rule's Bernstein ellipse); a bulge or an end closer than
+  ** that would hide most of its energy (docs/NUMERICS.md). */
   const double x[4] = {s->end_x[0], s->hand_x[0], s->hand_x[1], s->end_x[1]};
   const double y[4] = {s->end_y[0], s->hand_y[0], s->hand_y[1], s->end_y[1]};
   if (!lw_boundary_curve_clear(b, x, y, b->clearance * s->length / s->n)) return INFINITY;
