@@ -563,7 +563,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   if ((s = build(a, all, ladder, err)) || (s = check_quench(a, err))) return s;
   a->energy_initial = lw_system_total(a->sys);
   a->end_sweep = a->params.sweeps; /* resolved: the caller's p may not be (a preset's sweeps) */
-  a->scene_hash = lw_params_run_hash(&a->params);
+  a->scene_hash = lw_params_run_hash(&a->params, &a->scene_keys);
   /* Everything above only read input: the directory appears once the run
   ** is known to be valid. */
   if ((s = lw_rundir_make(dir, err)) || (writes_files(a) && (s = lw_rundir_lock(dir, &a->dir_hold, err))))
@@ -767,8 +767,9 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);
   double ladder[LW_TEMPERING_MAX];
   long trace_bytes = -1;
-  if (!(s = lw_params_read_run(&a->params, scene_path, err))) a->scene_hash = lw_params_run_hash(&a->params);
-  if (s || (s = lw_checkpoint_scene_hash(st.doc, a->scene_hash, err)) || (s = setup_ladder(a, ladder, err)) ||
+  if ((s = lw_params_read_run(&a->params, scene_path, 0, err)) ||
+      (s = lw_checkpoint_scene_hash(st.doc, &a->params, &a->scene_keys, &a->scene_hash, err)) ||
+      (s = lw_params_resolve(&a->params, err)) || (s = setup_ladder(a, ladder, err)) ||
       (s = setup_schedule(a, err)) || (s = setup_system(a, err)))
     goto out;
   a->seed = st.seed;

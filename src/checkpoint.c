@@ -163,6 +163,11 @@ void lw_checkpoint_put_run(lw_ckpt_writer *w, const lw_anneal *a, long trace_byt
   lw_ckpt_put(w, "end_sweep", "%ld", a->end_sweep);
   /* what scene.ini held when the run started: a resume refuses another */
   lw_ckpt_put(w, "scene_hash", "%016llx", a->scene_hash);
+  /* each key's part, so that a refusal can name the keys edited */
+  char keys[4 * LW_PARAM_MAX + 1];
+  for (size_t k = 0; k < a->scene_keys.n; k++) snprintf(keys + 4 * k, 5, "%04x", a->scene_keys.hash[k]);
+  keys[4 * a->scene_keys.n] = '\0';
+  lw_ckpt_put(w, "scene_keys", "%s", keys);
   lw_ckpt_put(w, "temperature", "%.17g", a->t_sched);
   lw_ckpt_put(w, "block", "%ld", a->block);
   lw_ckpt_put(w, "t_prev", "%.17g", a->t_prev);
@@ -445,22 +450,67 @@ static lw_status get_dynamics(lw_ckpt *doc, lw_dynamics *d, lw_error *err)
   return LW_OK;
 }
 
-lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, unsigned long long scene_hash, lw_error *err)
+/* The keys whose parts differ from state.lw's scene_keys (text, 4 hex
+** digits a key), the first three as "'a.b' (line N), ..." in buf; their count, or -1 where
+** the two do not list the same keys (a key's line taken out of scene.ini). */
+static int edited_keys(const lw_params *p, const lw_run_keys *now, const char *text, char *buf, size_t n,
+                       int *unread_key)
 {
-  int line = 0;
+  if (strlen(text) != 4 * now->n || strspn(text, "0123456789abcdef") != strlen(text)) return -1;
+  int count = 0;
+  size_t used = 0;
+  buf[0] = '\0';
+  *unread_key = -1;
+  for (size_t k = 0; k < now->n; k++) {
+    char part[5] = {text[4 * k], text[4 * k + 1], text[4 * k + 2], text[4 * k + 3], '\0'};
+    if (strtoul(part, NULL, 16) == now->hash[k]) continue;
+    const lw_param_def *d = &lw_param_table[now->index[k]];
+    if (now->unread[k] && *unread_key < 0) *unread_key = (int)k;
+    /* the first three: more say that the two are not of one run */
+    if (count < 3 && used < n)
+      used += (size_t)snprintf(buf + used, n - used, "%s'%s.%s' (line %d)", count ? ", " : "", d->section, d->key,
+                               p->line[now->index[k]]);
+    count++;
+  }
+  return count;
+}
+
+lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, const lw_params *p, lw_run_keys *keys,
+                                   unsigned long long *scene_hash, lw_error *err)
+{
+  int line = 0, kline = 0;
+  *scene_hash = lw_params_run_hash(p, keys);
   const char *hash = lw_ckpt_text(doc, "run", "scene_hash", &line); /* absent in older files */
   if (!hash) return LW_OK;
-  const char *path = lw_ckpt_path(doc);
+  const char *path = lw_ckpt_path(doc), *text = lw_ckpt_text(doc, "run", "scene_keys", &kline);
   unsigned long long h = strtoull(hash, NULL, 16);
   if (strlen(hash) != 16 || strspn(hash, "0123456789abcdef") != 16)
     return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: expected 16 hexadecimal digits, got '%s'", path,
                         line, hash);
-  if (h != scene_hash)
-    return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: the run's scene.ini was edited since it "
-                        "started, in a key that steers the run; a run resumes with the parameters it ran with "
-                        "(only [plot] and the keys of the final files may change): expected %016llx, "
-                        "scene.ini gives %016llx", path, line, h, scene_hash);
-  return LW_OK;
+  /* files before 2026-12-05 hashed the files' names */
+  const unsigned long long mine = text ? *scene_hash : lw_params_run_hash(p, NULL);
+  if (h == mine) return LW_OK;
+  const char *scene = p->file;
+  char which[1024];
+  int unread = -1, count = text ? edited_keys(p, keys, text, which, sizeof which, &unread) : -1;
+  if (unread >= 0) {
+    const lw_param_def *d = &lw_param_table[keys->index[unread]];
+    return lw_error_set(err, LW_EINPUT, "%s:%d: key '%s.%s': cannot read %s: %s (a run resumes with the files "
+                        "it started with, wherever they are now)", scene, p->line[keys->index[unread]], d->section,
+                        d->key, (const char *)p + d->offset, strerror(keys->unread[unread]));
+  }
+  if (count > 3)
+    return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: %s and %s are not of one run: %d keys differ, "
+                        "%s, ...", path, line, path, scene, count, which);
+  if (count > 0)
+    return lw_error_set(err, LW_EINPUT, "%s: %s edited since the run started, or a file %s changed: "
+                        "a run resumes with the parameters and files it ran with (only [plot] and the keys of "
+                        "the final files may change; a file may move, its key naming the new place)", scene, which,
+                        count > 1 ? "they name" : "it names");
+  return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: the run's scene.ini was edited since it "
+                      "started, in a key that steers the run, or state.lw is another run's; a run resumes with "
+                      "the parameters it ran with (only [plot] and the keys of the final files may change): "
+                      "expected %016llx, scene.ini gives %016llx", path, line, h, mine);
 }
 
 lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, lw_error *err)

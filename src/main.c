@@ -103,7 +103,7 @@ static lw_status load_run_dir(const char *dir, lw_params *p, lw_state *st, char 
   lw_status s = lw_state_read(st, path, err);
   if (s) return s;
   lw_path_join(scene_path, sizeof scene_path, dir, st->scene);
-  if ((s = lw_params_read_run(p, scene_path, err))) lw_state_clear(st);
+  if ((s = lw_params_read_run(p, scene_path, 1, err))) lw_state_clear(st);
   return s;
 }
 
@@ -532,21 +532,6 @@ static void unmake_dir(const char *dir, int hold, int made)
   lw_rundir_unlock(hold);
 }
 
-/* Whether the file's first line is text (and a newline). */
-static int first_line_is(const char *path, const char *text)
-{
-  char line[256];
-  FILE *f = fopen(path, "r");
-  if (!f) return 0;
-  int is = 0;
-  if (fgets(line, sizeof line, f)) {
-    size_t n = strcspn(line, "\r\n");
-    is = line[n] != '\0' && n == strlen(text) && !strncmp(line, text, n);
-  }
-  fclose(f);
-  return is;
-}
-
 static int cmd_run(int argc, char **argv)
 {
   lw_error err;
@@ -616,13 +601,13 @@ static int cmd_run(int argc, char **argv)
   /* the run writes its resolved parameters to DIR/scene.ini: over a run's
   ** (a run made again in place), never over a scene file a person wrote,
   ** the one this run reads included */
-  char mine[LW_PATH_MAX + 16];
-  lw_path_join(mine, sizeof mine, dir, "scene.ini");
-  if (access(mine, F_OK) == 0 && !first_line_is(mine, LW_RUN_SCENE_HEADER)) {
-    lw_error_set(&err, LW_EUSAGE, "--out %s: %s is not a run's (a scene file?) and the run would write over it: "
-                 "expected a run directory or a new one", dir, mine);
-    return fail(&err);
-  }
+  static const char *const mine[] = {"scene.ini", "state.lw"}, *const what[] = {"a scene file?", "not a state"};
+  for (int k = 0; k < 2; k++)
+    if (lw_rundir_foreign(dir, mine[k])) {
+      lw_error_set(&err, LW_EUSAGE, "--out %s: %s/%s is not a run's (%s) and the run would write over it: "
+                   "expected a run directory or a new one", dir, dir, mine[k], what[k]);
+      return fail(&err);
+    }
   static lw_anneal a;
   watcher w;
   const int asked = quiet;
@@ -748,7 +733,7 @@ static int cmd_stats(int argc, char **argv)
   for (int r = 0; !err.code && r < k; r++) {
     char where[LW_PATH_MAX + 32];
     lw_path_join(where, sizeof where, dir[r], "scene.ini");
-    if (lw_params_read_run(&p, where, &err)) break;
+    if (lw_params_read_run(&p, where, 1, &err)) break;
     sel[r] = base;
     lw_trace_select_of(&p, &sel[r]);
     lw_path_join(where, sizeof where, dir[r], "trace.csv");

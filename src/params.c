@@ -187,7 +187,10 @@ const lw_param_def lw_param_table[] = {
       "Near field: two segments with a pair of samples closer than this many length elements "
       "(the larger of the two; at most the cutoff) take the double integral over the exact curves, "
       "blended smoothly into the product rule (finite where curves touch or cross). "
-      "0 = off (product rule only; infinite where samples coincide)."),
+      "0 = off (product rule only; infinite where samples coincide). Otherwise at least sqrt 2 times "
+      "the pair rule's widest node spacing over its largest weight (1.43 at 8 nodes, 1.47 at 4, "
+      "1.63 at 2), where a crossing between samples is taken whole; less is refused "
+      "(docs/ACCURACY.md, \"Near field\")."),
   NUM("energy", "boundary", LW_PT_DOUBLE, boundary_coef, "0", "energy mm", 0, 1e12, 0,
       "R: boundary R * integral of 1/d^2 dl keeps lines inside (+infinity outside). 0 = off."),
   NUM("energy", "boundary_clearance", LW_PT_DOUBLE, boundary_clearance, "1.5", "length elements", 0, 100, 0,
@@ -215,12 +218,12 @@ const lw_param_def lw_param_table[] = {
       "Gauss-Legendre nodes per segment for every integral but the pair and tone terms' where "
       "they have their own (`pair_quadrature`, `tone_quadrature`)."),
   NUM("energy", "pair_quadrature", LW_PT_INT, pair_quadrature, "0", "nodes", 0, 64, 0,
-      "Gauss-Legendre nodes per segment for the pair term (its samples in the cell grid); "
-      "0 = the same as `quadrature`. The pair sum costs about the square of this number per "
+      "Gauss-Legendre nodes per segment for the pair term (its samples in the cell grid): 0 = the "
+      "same as `quadrature`, else 2 to 64. The pair sum costs about the square of this number per "
       "proposal; docs/ACCURACY.md shows what fewer nodes cost in accuracy."),
   NUM("energy", "tone_quadrature", LW_PT_INT, tone_quadrature, "0", "nodes", 0, 64, 0,
-      "Gauss-Legendre nodes per segment for the tone term (the samples it splats); 0 = the "
-      "same as `quadrature`. Its cost per proposal grows with this number; with samples 0.7 "
+      "Gauss-Legendre nodes per segment for the tone term (the samples it splats): 0 = the "
+      "same as `quadrature`, else 2 to 64. Its cost per proposal grows with this number; with samples 0.7 "
       "tone_blur apart (segment_length / nodes) an annealed photograph's tone energy was within "
       "6e-4 of 32 nodes' (docs/ACCURACY.md). The photo preset sets the fewest that are that "
       "close."),
@@ -1107,7 +1110,10 @@ lw_status lw_params_read_unresolved(lw_params *p, const char *path, lw_error *er
   return read_file(p, path, 0, 0, err);
 }
 
-lw_status lw_params_read_run(lw_params *p, const char *path, lw_error *err) { return read_file(p, path, 1, 1, err); }
+lw_status lw_params_read_run(lw_params *p, const char *path, int resolve, lw_error *err)
+{
+  return read_file(p, path, 1, resolve, err);
+}
 
 /* Named page sizes in mm, portrait, in the order of the choices of
 ** scene.page (custom first, which has none). */
@@ -1420,17 +1426,57 @@ static const char *const file_keys[] = {"plot.*", "output.pen_colors", "output.p
                                         "nurbs.png_scale", "particles.view_azimuth", "particles.view_elevation",
                                         "particles.png_size", "particles.disc", "output.pens", NULL};
 
-unsigned long long lw_params_run_hash(const lw_params *p)
+/* FNV-1a, 64 bits, of n bytes on from h. */
+static unsigned long long fnv(unsigned long long h, const void *bytes, size_t n)
 {
-  unsigned long long h = 0xcbf29ce484222325ULL; /* FNV-1a, 64 bits */
+  const unsigned char *c = bytes;
+  for (size_t i = 0; i < n; i++) h = (h ^ c[i]) * 0x100000001b3ULL;
+  return h;
+}
+
+#define FNV_START 0xcbf29ce484222325ULL
+
+/* The hash of a file's bytes as text ("file " and 16 hex digits), or of
+** what stopped its reading ("unread", errno in *unread). */
+static void file_text(const char *path, char *buf, size_t n, int *unread)
+{
+  FILE *f = fopen(path, "rb");
+  unsigned long long h = FNV_START;
+  unsigned char block[65536];
+  size_t got;
+  *unread = 0;
+  if (f) {
+    while ((got = fread(block, 1, sizeof block, f)) > 0) h = fnv(h, block, got);
+    if (ferror(f)) *unread = errno ? errno : EIO;
+    fclose(f);
+  } else {
+    *unread = errno;
+  }
+  if (*unread) snprintf(buf, n, "unread");
+  else snprintf(buf, n, "file %016llx", h);
+}
+
+unsigned long long lw_params_run_hash(const lw_params *p, lw_run_keys *keys)
+{
+  unsigned long long h = FNV_START;
   char line[LW_PATH_MAX + 4200];
+  if (keys) keys->n = 0;
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
     if ((p->of_run && p->line[i] <= 0) || lw_params_named(file_keys, d)) continue;
-    int n = snprintf(line, sizeof line, "%s.%s=", d->section, d->key);
-    value_text(p, d, line + n, sizeof line - (size_t)n);
-    for (const char *c = line; *c; c++) h = (h ^ (unsigned char)*c) * 0x100000001b3ULL;
-    h = (h ^ '\n') * 0x100000001b3ULL;
+    const int is_path = d->type == LW_PT_STRING && !strcmp(d->unit, "path");
+    if (keys && is_path && !strcmp(d->section, "init") && !strcmp(d->key, "from")) continue;
+    int n = snprintf(line, sizeof line, "%s.%s=", d->section, d->key), unread = 0;
+    const char *path = (const char *)p + d->offset;
+    if (keys && is_path && path[0]) file_text(path, line + n, sizeof line - (size_t)n, &unread);
+    else value_text(p, d, line + n, sizeof line - (size_t)n);
+    size_t len = strlen(line);
+    h = fnv(fnv(h, line, len), "\n", 1);
+    if (keys) {
+      keys->index[keys->n] = (unsigned short)i;
+      keys->hash[keys->n] = (unsigned short)(fnv(FNV_START, line, len) & 0xffff);
+      keys->unread[keys->n++] = unread;
+    }
   }
   return h;
 }

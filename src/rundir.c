@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "linewise/params.h"
+#include "linewise/state.h"
 
 /* The locks this process holds, by the lock file's identity: flock locks
 ** of two open files conflict even within one process, so a second lock of
@@ -39,13 +40,35 @@ lw_status lw_rundir_make(const char *dir, lw_error *err)
   return LW_OK;
 }
 
+/* Whether the first line of dir/name begins with head (and, whole, is it). */
+static int first_line_is(const char *dir, const char *name, const char *head, int whole)
+{
+  char path[LW_PATH_MAX + 16], line[256];
+  lw_path_join(path, sizeof path, dir, name);
+  FILE *f = fopen(path, "r");
+  if (!f) return 0;
+  int is = 0;
+  if (fgets(line, sizeof line, f)) {
+    size_t n = strcspn(line, "\r\n"), h = strlen(head);
+    is = n >= h && !strncmp(line, head, h) && (!whole || (n == h && line[n] != '\0'));
+  }
+  fclose(f);
+  return is;
+}
+
 int lw_rundir_holds_run(const char *dir)
 {
+  return first_line_is(dir, "scene.ini", LW_RUN_SCENE_HEADER, 1) ||
+         first_line_is(dir, "state.lw", LW_STATE_MAGIC, 0);
+}
+
+int lw_rundir_foreign(const char *dir, const char *name)
+{
   char path[LW_PATH_MAX + 16];
-  snprintf(path, sizeof path, "%s/scene.ini", dir);
-  if (access(path, F_OK) == 0) return 1;
-  snprintf(path, sizeof path, "%s/state.lw", dir);
-  return access(path, F_OK) == 0;
+  lw_path_join(path, sizeof path, dir, name);
+  if (access(path, F_OK)) return 0;
+  return !strcmp(name, "state.lw") ? !first_line_is(dir, name, LW_STATE_MAGIC, 0)
+                                   : !first_line_is(dir, name, LW_RUN_SCENE_HEADER, 1);
 }
 
 lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)

@@ -43,6 +43,13 @@ static lw_status term_nodes(const lw_params *p, const lw_scene *sc, int on, cons
   return lw_quad_init(q, n, err);
 }
 
+double lw_pair_near_least(const lw_quad *q)
+{
+  double w = 0.0;
+  for (int i = 0; i < q->n; i++) w = fmax(w, q->w[i]);
+  return M_SQRT2 * q->spacing / w;
+}
+
 /* The margin box: the page inset by `margin`, which frames the rect and
 ** circle boundaries and holds the picture. */
 static lw_status margin_ok(const lw_params *p, lw_error *err)
@@ -388,6 +395,11 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   if ((st = term_nodes(p, sc, sc->on[LW_TERM_PAIR], "pair_quadrature", p->pair_quadrature, &sc->pair_quad, err)) ||
       (st = term_nodes(p, sc, sc->on[LW_TERM_TONE], "tone_quadrature", p->tone_quadrature, &sc->tone_quad, err)))
     return st;
+  if (sc->on[LW_TERM_PAIR] && p->pair_near > 0.0 && p->pair_near < lw_pair_near_least(&sc->pair_quad))
+    return bad_key(p, "energy", "pair_near", LW_EINPUT, err, "expected 0 (off) or at least %.3f at %d pair nodes "
+                   "(energy.pair_quadrature; closer, a line crossing another between their samples is taken only in part: "
+                   "docs/ACCURACY.md, \"Near field\"), got %g", lw_pair_near_least(&sc->pair_quad) + 5e-4,
+                   sc->pair_quad.n, p->pair_near);
   lw_pair_ctx_init(&sc->pair, p->pair_cutoff, p->pair_near);
   sc->pair_gap_max = sc->on[LW_TERM_PAIR] && p->pair_cutoff > 0.0 ? LW_PAIR_GAP_SHARE * p->pair_cutoff : 0.0;
 

@@ -366,7 +366,8 @@ lw_status lw_state_read(lw_state *st, const char *path, lw_error *err)
   long long version = 0;
   if (!c && ferror(r.f)) /* a directory opens but does not read */
     s = lw_error_set(err, LW_EINPUT, "%s: cannot read state file: %s", path, strerror(errno ? errno : EIO));
-  else if (!c || strncmp(c, "linewise-state ", 15) || !lw_number_parse_whole(c + 15, 0, 1e9, &version))
+  else if (!c || strncmp(c, LW_STATE_MAGIC, strlen(LW_STATE_MAGIC)) ||
+           !lw_number_parse_whole(c + strlen(LW_STATE_MAGIC), 0, 1e9, &version))
     s = bad(&r, err, "header", "'linewise-state <version>'", c);
   else if (version != 1 && version != LW_STATE_VERSION)
     s = lw_error_set(err, LW_EINPUT, "%s:%d: header: version %lld is not supported (expected 1 or %d)", path, r.line,

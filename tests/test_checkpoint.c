@@ -36,10 +36,11 @@ static void resume_fixture_matches_fresh_run(const char *name, const char *const
   cr_assert_eq(lw_test_sh("printf '26,0.1\n22' >> %s/old/trace.csv", dir), 0);
   cr_assert_eq(lw_test_sh("%s resume %s/old --quiet", lw_test_bin(), dir), 0, "the old run directory does not resume");
   cr_assert_eq(lw_test_sh("%s run %s/old/scene.ini --out %s/fresh --quiet", lw_test_bin(), dir, dir), 0);
-  /* but for scene_hash: the old scene.ini lacks the keys added since, which
-  ** a resume leaves out of the hash and a fresh run of it writes in */
+  /* but for scene_hash and scene_keys: the old scene.ini lacks the keys
+  ** added since, which a resume leaves out of the hash and a fresh run of it
+  ** writes in */
   for (const char *const *f = files; *f; f++)
-    cr_expect_eq(lw_test_sh("grep -v '^scene_hash = ' %s/old/%s > %s/f1; grep -v '^scene_hash = ' %s/fresh/%s > %s/f2; "
+    cr_expect_eq(lw_test_sh("grep -v '^scene_[hk]' %s/old/%s > %s/f1; grep -v '^scene_[hk]' %s/fresh/%s > %s/f2; "
                             "cmp -s %s/f1 %s/f2", dir, *f, dir, dir, *f, dir, dir, dir),
                  0, "%s: %s differs from an uninterrupted run", name, *f);
   /* and the resumed state reads back through `linewise energy` */
@@ -208,17 +209,56 @@ Test(checkpoint, a_scene_ini_edited_in_a_key_that_steers_the_run_is_refused)
   static const char *const steer[] = {"s/^t_end = .*/t_end = 0.5/", "s/^domains = off/domains = 2/",
                                       "s/^trace_every = .*/trace_every = 3/", "s/^point = .*/point = 0.9/",
                                       "s/^bending = .*/bending = 1.5/"};
+  static const char *const key[] = {"anneal.t_end", "anneal.domains", "output.trace_every", "moves.point",
+                                    "energy.bending"};
   for (int k = 0; k < 5; k++) {
     cr_assert_eq(lw_test_sh("sed -i '%s' %s/a/scene.ini && ! cmp -s %s/a/scene.ini %s/scene.keep", steer[k], dir, dir,
                             dir), 0, "%s", steer[k]);
     cr_assert_eq(lw_test_sh("%s resume %s/a --quiet 2>%s/err.txt", b, dir, dir), 2, "%s", steer[k]);
-    cr_assert_eq(lw_test_sh("grep -q \"state.lw:[0-9]*: \\[run\\] scene_hash: the run's scene.ini was edited\" "
-                            "%s/err.txt && grep -qx 'sweep = 20' %s/a/state.lw", dir, dir), 0, "%s", steer[k]);
+    /* the message names the key and its line */
+    cr_assert_eq(lw_test_sh("grep -q \"a/scene.ini: '%s' (line [0-9]*) edited since the run started\" "
+                            "%s/err.txt && grep -qx 'sweep = 20' %s/a/state.lw", key[k], dir, dir), 0, "%s", steer[k]);
     cr_assert_eq(lw_test_sh("cp %s/scene.keep %s/a/scene.ini", dir, dir), 0);
   }
+  /* another run's state.lw: not blamed on an edit */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set anneal.sweeps=40 --set energy.strain=3 --set "
+                          "energy.bending=2 --set anneal.t_start=2 --set anneal.seed=5 --out %s/other --quiet "
+                          "--stop-at 1 && cp %s/a/state.lw %s/state.keep && cp %s/other/state.lw %s/a/", b,
+                          lw_test_root(), dir, dir, dir, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/a --quiet 2>%s/err.txt", b, dir, dir), 2);
+  cr_assert_eq(lw_test_sh("grep -q 'state.lw and .*scene.ini are not of one run: [4-9] keys differ' %s/err.txt", dir), 0);
+  cr_assert_eq(lw_test_sh("cp %s/state.keep %s/a/state.lw", dir, dir), 0);
   cr_assert_eq(lw_test_sh("sed -i -e 's/^min_length = .*/min_length = 0/' -e 's/^png_scale = .*/png_scale = 2/' "
                           "%s/a/scene.ini && %s resume %s/a --quiet", dir, b, dir), 0,
                "a key of the drawing only was refused");
+}
+
+/* The files a run reads count by their bytes, not their names: a run whose
+** table moved resumes once scene.ini names the new place (to the result of
+** a run left alone); one whose table was edited is refused, naming the key,
+** and so is one whose table is gone. */
+Test(checkpoint, a_run_resumes_with_its_files_wherever_they_are_and_not_with_others)
+{
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("mkdir %s/t1 && printf '0 1\\n10 0.2\\n39 0.01\\n' > %s/t1/table.txt", dir, dir), 0);
+  const char *set = "--set anneal.sweeps=40 --set anneal.schedule=table --set output.trace_every=1";
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini %s --set anneal.table=%s/t1/table.txt --out %s/whole "
+                          "--quiet && %s run %s/params/minimal.ini %s --set anneal.table=%s/t1/table.txt --out %s/a "
+                          "--quiet --stop-at 20", b, lw_test_root(), set, dir, dir, b, lw_test_root(), set, dir, dir),
+               0);
+  cr_assert_eq(lw_test_sh("cp -r %s/a %s/keep && mv %s/t1 %s/t2", dir, dir, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/a --quiet 2>%s/err.txt", b, dir, dir), 2);
+  cr_assert_eq(lw_test_sh("grep -q \"a/scene.ini:[0-9]*: key 'anneal.table': cannot read .*t1/table.txt: No such "
+                          "file\" %s/err.txt", dir), 0);
+  cr_assert_eq(lw_test_sh("sed -i 's#/t1/table.txt#/t2/table.txt#' %s/a/scene.ini && %s resume %s/a --quiet && "
+                          "cmp %s/a/final.svg %s/whole/final.svg && cmp %s/a/trace.csv %s/whole/trace.csv", dir, b, dir,
+                          dir, dir, dir, dir), 0, "the moved table's run did not resume as if left alone");
+  cr_assert_eq(lw_test_sh("sed -i 's#/t1/table.txt#/t2/table.txt#' %s/keep/scene.ini && "
+                          "printf '0 5\\n39 3\\n' > %s/t2/table.txt", dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/keep --quiet 2>%s/err.txt", b, dir, dir), 2);
+  cr_assert_eq(lw_test_sh("grep -q \"keep/scene.ini: 'anneal.table' (line [0-9]*) edited since the run started, or "
+                          "a file it names changed\" %s/err.txt && grep -qx 'sweep = 20' %s/keep/state.lw", dir, dir),
+               0);
 }
 
 /* --stop-at at the sweep the run stands at stops before any sweep; one it

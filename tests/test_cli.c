@@ -526,6 +526,15 @@ Test(cli, a_run_replacing_another_removes_the_files_it_does_not_write_again)
                           "cmp -s s.ini own/scene.ini",
                           dir, b),
                0);
+  /* nor does a stray state.lw make a person's directory a run's, whose
+  ** run files (their final.gcode, frames) the run would clear */
+  cr_assert_eq(lw_test_sh("cd %s && mkdir -p mine/frames && echo st > mine/state.lw && echo g > mine/final.gcode && "
+                          "echo f > mine/frames/frame-000001.png && %s run s.ini --quiet --out mine 2>err.txt; "
+                          "test $? -eq 2 && grep -q 'mine/state.lw is not a run.s (not a state)' err.txt && "
+                          "test \"$(cat mine/state.lw mine/final.gcode mine/frames/frame-000001.png)\" = "
+                          "\"$(printf 'st\\ng\\nf')\"",
+                          dir, b),
+               0, "a stray state.lw let the run clear the directory");
 }
 
 /* The mean and standard error of a column in `linewise stats --csv` output. */

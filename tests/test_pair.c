@@ -401,6 +401,53 @@ Test(pair, segseg_never_nan_on_degenerate_grids)
   }
 }
 
+/* energy.pair_near below lw_pair_near_least is refused: there a right-angle
+** crossing in the middle of both lines' widest gaps (the middle of two
+** one-segment lines at 8 nodes) is taken only in part.  At the least radius
+** it is taken whole (5e-4, the near field's own error); a little below, not
+** (2.5e-3 at 1.3, 8.6e-2 at 1, set through the context as scenes refuse it). */
+Test(pair, a_near_field_too_small_for_a_crossing_between_samples_is_refused)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = p.height = 20;
+  p.margin = 0;
+  p.strain = p.bending = p.potential_coef = p.field_coef = p.boundary_coef = 0;
+  p.pair = 1;
+  p.pair_cutoff = 5;
+  lw_quad q;
+  lw_error err;
+  cr_assert_eq(lw_quad_init(&q, 8, &err), LW_OK);
+  const double least = lw_pair_near_least(&q);
+  cr_assert(least > 1.43 && least < 1.431, "%.6f", least);
+  lw_scene sc;
+  p.pair_near = 1.43;
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "key 'energy.pair_near': expected 0 (off) or at least 1.431 at 8 pair nodes"), "%s",
+            err.msg);
+  p.pair_quadrature = 2;
+  p.pair_near = 1.5;
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT, "1.5 at 2 nodes (least 1.63)");
+  p.pair_quadrature = 0;
+  p.pair_near = 0;
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "off: %s", err.msg);
+  lw_scene_clear(&sc);
+
+  lw_splines *sp = two_splines(1, 1);
+  const double a0[2] = {4, 10}, a1[2] = {16, 10}, b0[2] = {10, 4}, b1[2] = {10, 16};
+  straight(sp, 0, a0, a1);
+  straight(sp, 1, b0, b1);
+  const double ref = lw_pairref_energy_cut(sp, 5), whole = pair_energy(sp, 8, 5, least);
+  cr_assert(fabs(whole / ref - 1) < 1e-3, "at the least radius %.3e", fabs(whole / ref - 1));
+  p.pair_near = 1.5;
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
+  lw_pair_ctx_init(&sc.pair, 5, 0.9 * least);
+  double term[LW_TERM_COUNT], part = lw_energy_compute(&sc, sp, term, &err);
+  cr_assert(fabs(part / ref - 1) > 2e-3, "at 0.9 of it %.3e: the least radius is not the least", fabs(part / ref - 1));
+  lw_scene_clear(&sc);
+  lw_splines_free(sp);
+}
+
 /* ---- the kernel: straight splines ----------------------------------------- */
 
 /*

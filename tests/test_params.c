@@ -510,7 +510,7 @@ Test(params, a_key_is_given_only_with_a_value_of_its_own)
   cr_assert(lw_params_given(&p, lw_params_find("scene", "field")));
   cr_assert(lw_params_given(&p, lw_params_find("energy", "tone")), "--set");
   cr_assert(!lw_params_given(&p, lw_params_find("energy", "pair")), "not named");
-  cr_assert_eq(lw_params_read_run(&p, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_params_read_run(&p, path, 1, &err), LW_OK, "%s", err.msg);
   cr_assert(!lw_params_given(&p, lw_params_find("energy", "strain")), "a run's own scene.ini");
   cr_assert_eq(lw_params_set(&p, "energy.pair=0.5", &err), LW_OK, "%s", err.msg);
   cr_assert(lw_params_given(&p, lw_params_find("energy", "pair")), "--set on a run's scene.ini");

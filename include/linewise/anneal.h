@@ -28,9 +28,6 @@
 #include "linewise/dynamics.h"
 #include "linewise/mc.h"
 #include "linewise/params.h"
-
-/* The first line of a run directory's scene.ini (its resolved parameters). */
-#define LW_RUN_SCENE_HEADER "; resolved parameters of this run (linewise)"
 #include "linewise/quench.h"
 #include "linewise/schedule.h"
 #include "linewise/system.h"
@@ -60,6 +57,7 @@ typedef struct lw_anneal {
   long end_sweep;              /* stop after this sweep */
   int extending, new_end;      /* a resume to settle before its first sweep (anneal.c) */
   unsigned long long scene_hash; /* lw_params_run_hash of scene.ini, kept in state.lw */
+  lw_run_keys scene_keys;        /* and its keys' parts */
   long block;                  /* current temperature step */
   double t_prev;               /* temperature of the previous step */
   lw_block_stats prev;         /* energy statistics of the previous step */

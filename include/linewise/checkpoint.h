@@ -46,11 +46,14 @@ lw_status lw_checkpoint_write_timing(const lw_anneal *a, lw_error *err);
 ** every value checked (ranges, counts, the generator states, the running
 ** energies against a recomputation).  *trace_bytes is the length of
 ** trace.csv at the checkpoint, or -1 if the file does not say (format 1). */
-/* LW_EINPUT if state.lw's [run] scene_hash (absent in older files) is not
-** scene_hash, lw_params_run_hash of the run's scene.ini: checked before the
-** state is rebuilt, whose energies an edited coefficient would change (a
-** message blaming state.lw for what an edit of scene.ini did). */
-lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, unsigned long long scene_hash, lw_error *err);
+/* *scene_hash and keys: lw_params_run_hash of p, the run's scene.ini (to
+** be kept in state.lw from now on); LW_EINPUT if state.lw's [run]
+** scene_hash (absent in older files) is another, naming the keys that
+** differ where state.lw lists its keys' parts (scene_keys).  Checked before
+** the state is rebuilt, whose energies an edited coefficient would change
+** (a message blaming state.lw for what an edit of scene.ini did). */
+lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, const lw_params *p, lw_run_keys *keys,
+                                   unsigned long long *scene_hash, lw_error *err);
 
 lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, lw_error *err);
 

@@ -283,8 +283,10 @@ lw_status lw_params_read_unresolved(lw_params *p, const char *path, lw_error *er
 /* Reads a run directory's scene.ini, which holds every key the run's build
 ** knew, resolved.  A key it lacks is newer than the run, which ran with its
 ** default: a preset does not fill it (the photo preset's layers.apart = pen
-** or image_levels would change the energy of a run begun before them). */
-lw_status lw_params_read_run(lw_params *p, const char *path, lw_error *err);
+** or image_levels would change the energy of a run begun before them).
+** resolve 0: not resolved yet (a resume checks the run's hash first, and a
+** picture replaced by one of another shape would fail the page's size). */
+lw_status lw_params_read_run(lw_params *p, const char *path, int resolve, lw_error *err);
 
 /* The most characters text key d holds: its field's, and what fits on one
 ** line "key = value" of the INI reader, so that a run's scene.ini reads
@@ -301,12 +303,26 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err);
 ** the last one). */
 lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err);
 
+/* What lw_params_run_hash saw of each key it hashed: the key's index in
+** lw_param_table, 16 bits of the key's own hash, and the errno that stopped
+** the reading of the file the key names (0 where read, or not a file). */
+typedef struct lw_run_keys {
+  size_t n;
+  unsigned short index[LW_PARAM_MAX], hash[LW_PARAM_MAX];
+  int unread[LW_PARAM_MAX];
+} lw_run_keys;
+
 /* A hash of the keys that steer a run (all but [plot] and the keys that
 ** only shape the final files), as scene.ini writes them: all of them, or of
 ** a run's own scene.ini those it holds (a later build knows more, and its
 ** defaults may differ).  state.lw keeps it, so that a resume refuses a
-** scene.ini edited since. */
-unsigned long long lw_params_run_hash(const lw_params *p);
+** scene.ini edited since.  With keys (the form since 2026-12-05, which
+** state.lw marks by its scene_keys), a key that names a file counts by the
+** file's bytes, not its name: a run whose picture moves resumes once the
+** key names the new place, and one whose table was edited does not;
+** init.from (read only when the run starts) does not count.  keys NULL:
+** the form before, by the names, for older files. */
+unsigned long long lw_params_run_hash(const lw_params *p, lw_run_keys *keys);
 
 /* Writes every parameter as an INI file that reads back to the same values. */
 int lw_params_write(const lw_params *p, FILE *f);

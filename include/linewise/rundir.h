@@ -17,8 +17,18 @@
 /* mkdir -p dir. */
 lw_status lw_rundir_make(const char *dir, lw_error *err);
 
-/* Whether dir holds a run (its scene.ini or state.lw). */
+/* The first line of a run directory's scene.ini (its resolved parameters). */
+#define LW_RUN_SCENE_HEADER "; resolved parameters of this run (linewise)"
+
+/* Whether dir holds a run: a scene.ini a run wrote (its first line
+** LW_RUN_SCENE_HEADER) or a state.lw (its first line a state's header).
+** Only then may a run clear the directory's run files: a file of either
+** name that a person put there keeps the directory theirs. */
 int lw_rundir_holds_run(const char *dir);
+
+/* Whether dir/name exists and is not a run's (a scene file a person wrote,
+** any state.lw without a state's header): a run refuses to write there. */
+int lw_rundir_foreign(const char *dir, const char *name);
 
 /* Takes the lock of the existing directory dir for this process: LW_OK and
 ** *hold set (0 where the file system has no locks), or LW_EUSAGE naming the

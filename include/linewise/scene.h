@@ -47,6 +47,16 @@
 ** asks it of the placed segments (lw_init_count). */
 #define LW_PAIR_GAP_SHARE 0.75
 
+/* The least energy.pair_near (other than 0, off) for the pair rule q: the
+** near field takes a crossing whole where a sample pair lies within half
+** its radius, near times the larger element length.  A right angle in the
+** middle of both lines' widest gaps (spacing s of the rule, of elements
+** up to w long) has its nearest pair s / sqrt 2 from it, so near must be
+** at least sqrt(2) s / w: 1.43 at 8 nodes, 1.63 at 2.  Below, crossings
+** between samples are taken in part: 3e-3 hidden at 1.3, 14 % at 1, 38 %
+** at 0.5 (8 nodes; docs/ACCURACY.md, "Near field"). */
+double lw_pair_near_least(const lw_quad *q);
+
 typedef struct lw_scene {
   double width, height;         /* page, mm */
   double coef[LW_TERM_COUNT];   /* S B Q P C R, the user term's, G, T; 0 = off */

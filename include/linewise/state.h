@@ -22,6 +22,7 @@
 #include "linewise/spline.h"
 
 #define LW_STATE_VERSION 2
+#define LW_STATE_MAGIC "linewise-state " /* and the version */
 #define LW_STATE_HEADER "linewise-state 2"
 
 /* Node coordinates (mm) beyond this are refused: the largest page is 1e7
