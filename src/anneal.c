@@ -197,9 +197,17 @@ static lw_status setup_schedule(lw_anneal *a, lw_error *err)
     if (lw_schedule_read_table(&a->sched, p->table, err)) return lw_params_blame(p, "anneal", "table", err);
   }
   lw_error e2;
-  if (lw_schedule_check(a->sched_type, &a->sched, &e2))
-    return lw_error_set(err, LW_EINPUT, "%s: anneal.schedule = %s: %s", where, p->schedule, e2.msg);
-  return LW_OK;
+  if (!lw_schedule_check(a->sched_type, &a->sched, &e2)) return LW_OK;
+  /* the message names the parameter it found wrong: blame its key (the
+  ** order takes t_end where a cooling schedule's t_end exceeds t_start) */
+  static const char *const named[][2] = {{"t_end", "t_end"}, {"t_start", "t_start"}, {"lambda", "lambda"},
+                                         {"blocks", "steps"}};
+  for (size_t k = 0; k < sizeof named / sizeof named[0]; k++)
+    if (strstr(e2.msg, named[k][0])) {
+      lw_error_set(err, LW_EINPUT, "%s", e2.msg);
+      return lw_params_blame(p, "anneal", named[k][1], err);
+    }
+  return lw_error_set(err, LW_EINPUT, "%s: anneal.schedule = %s: %s", where, p->schedule, e2.msg);
 }
 
 /* Paths in the scene are relative to the scene file; the resolved scene.ini
@@ -362,6 +370,58 @@ lw_status lw_anneal_check_keys(const lw_params *p, char *unread, size_t size, lw
                         d->def);
   }
   return LW_OK;
+}
+
+/* Keys the scene sets that its other settings leave idle (a table under a
+** schedule that reads none, a polygon under another frame), in idle with
+** why: noted, so that a mistake there shows before the setting that reads
+** them is chosen (a missing table file went unseen). */
+static void idle_keys(const lw_anneal *a, char *idle, size_t size)
+{
+  const lw_params *p = &a->params;
+  const unsigned needs = a->sched_type ? a->sched_type->needs : ~0u; /* (dynamics: noted as unread) */
+  static const char *const table[] = {"anneal.table", NULL}, *const lambda[] = {"anneal.lambda", NULL},
+                           *const polygon[] = {"scene.polygon", NULL}, *const mask[] = {"scene.mask_image", NULL},
+                           *const coverage[] = {"init.coverage", NULL},
+                           *const orientation[] = {"scene.orientation", NULL},
+                           *const picture[] = {"scene.image_width", "scene.image_blur", "scene.image_flatten",
+                                               "scene.image_levels", "scene.image_gamma", "scene.image_contrast",
+                                               "scene.image_invert", NULL},
+                           *const ladder[] = {"tempering.t_min", "tempering.t_max", "tempering.exchange_every",
+                                              "tempering.tune_ladder", "tempering.ladder_sweeps", NULL},
+                           *const jumps[] = {"moves.birth", "moves.birth_uniform", "moves.birth_spread",
+                                             "moves.prior_sd", "moves.death", "moves.grow", "moves.shrink",
+                                             "moves.max_segments", "moves.split", "moves.join",
+                                             "moves.join_radius", NULL};
+  const struct {
+    const char *const *keys;
+    int idle;
+    const char *why;
+  } rule[] = {
+      {table, !(needs & LW_SCHEDULE_USES_TABLE), "anneal.schedule reads no table"},
+      {lambda, !(needs & LW_SCHEDULE_USES_LAMBDA), "anneal.schedule is not adaptive"},
+      {polygon, p->boundary != LW_BND_POLYGON, "scene.boundary is not polygon"},
+      {mask, p->mask != LW_MASK_IMAGE, "scene.mask is not image"},
+      {coverage, p->splines != 0, "init.splines is not 0"},
+      {orientation, p->page == LW_PAGE_CUSTOM, "no scene.page names a size"},
+      {picture, !p->image[0], "no scene.image"},
+      {ladder, a->n_rep == 1, "one replica"},
+      {jumps, p->fixed_count, "moves.fixed_count = 1"},
+  };
+  size_t m = 0;
+  if (size) idle[0] = '\0';
+  for (size_t r = 0; r < sizeof rule / sizeof rule[0]; r++) {
+    if (!rule[r].idle) continue;
+    for (size_t i = 0; i < lw_param_count; i++) {
+      const lw_param_def *d = &lw_param_table[i];
+      if (!lw_params_named(rule[r].keys, d) || !lw_params_given(p, d)) continue;
+      char where[LW_PATH_MAX + 32];
+      lw_params_origin(p, d, where, sizeof where);
+      if (m < size)
+        m += (size_t)snprintf(idle + m, size - m, "%s%s.%s (%s: %s)", m ? ", " : "", d->section, d->key, where,
+                              rule[r].why);
+    }
+  }
 }
 
 /* The system's row and its set-up of the scene; a quench needs a row with
@@ -541,6 +601,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
       (s = lw_anneal_check_keys(&a->params, a->unread, sizeof a->unread, err)) || (s = setup_schedule(a, err)) ||
       (s = setup_system(a, err)))
     return s;
+  idle_keys(a, a->idle, sizeof a->idle);
   const lw_params *rp = &a->params;
   if (a->n_rep > 1 && rp->tune_ladder == LW_LADDER_EQUAL && rp->ladder_sweeps >= rp->sweeps) {
     /* (a run of an older release that did so still resumes) */
@@ -1347,7 +1408,7 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
   lw_phase_set("drawing the final files and scoring them");
   if (a->drawing) *a->drawing = 1;
   if (!(s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_FINAL, err))) s = write_summary(a, err);
-  if (a->drawing) *a->drawing = 0;
+  if (a->drawing) *a->drawing = s ? 0 : 2;
   lw_phase_set(NULL);
   return s;
 }

@@ -219,7 +219,8 @@ static void name_run_dir(const char *dir)
 /* The first signal asks for a clean stop after the sweep in progress; a
 ** second ends the process at once (a sweep can take minutes), leaving
 ** the last checkpoint, which state.lw always holds whole. */
-static volatile sig_atomic_t finishing = 0; /* the final files are being written (lw_anneal.drawing) */
+static volatile sig_atomic_t finishing = 0; /* 1 the final files are being written, 2 they are
+                                                 (lw_anneal.drawing) */
 static volatile sig_atomic_t say_finishing = 0; /* and a signal then says so (not --quiet) */
 
 static void on_signal(int sig)
@@ -229,7 +230,8 @@ static void on_signal(int sig)
   ** can take minutes on a large drawing: say so, terminal or log */
   static const char last[] = "\nlinewise: writing the final files first (a second signal stops at once, without "
                              "them)\n";
-  const int files = finishing && say_finishing;
+  const int files = finishing == 1 && say_finishing;
+  if (finishing == 2) return; /* the run is whole, summary.json too: it ends as it would have */
   if (!stop_requested && (files || on_terminal)) {
     ssize_t w = files ? write(2, last, sizeof last - 1) : write(2, first, sizeof first - 1);
     (void)w;
@@ -626,6 +628,7 @@ static int cmd_run(int argc, char **argv)
     if (a.unread[0])
       fprintf(stderr, "linewise: note: under driver = %s these keys have no effect: %s\n",
               a.params.driver == LW_DRIVER_DYNAMICS ? "dynamics" : "metropolis", a.unread);
+    if (a.idle[0]) fprintf(stderr, "linewise: note: these keys have no effect here: %s\n", a.idle);
     fprintf(stderr, "linewise: scene %s, seed %lu, %s, into %s\n", scene, a.seed, size, dir);
     fprintf(stderr, "linewise: resolved parameters:\n");
     lw_params_write(&a.params, stderr);
@@ -763,12 +766,12 @@ static int wants_help(int argc, char **argv)
   return 0;
 }
 
-/* From the first instruction: SIGINT and SIGTERM ask for a clean stop
+/* From the first instruction: SIGINT, SIGTERM and SIGHUP ask for a clean stop
 ** (a run started meanwhile finishes its start-up, writes its first
 ** checkpoint and stops; a second signal ends it at once), and a file-size
 ** limit makes writes fail with EFBIG, reported with the file, instead of
 ** killing the process. */
-static void install_signals(void)
+static void install_signals(int pipe_proof)
 {
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);
@@ -777,7 +780,14 @@ static void install_signals(void)
   on_terminal = isatty(2);
   sigaction(SIGINT, &sa, NULL);
   sigaction(SIGTERM, &sa, NULL);
+  /* a terminal or ssh session that goes away stops a run as cleanly */
+  sigaction(SIGHUP, &sa, NULL);
   signal(SIGXFSZ, SIG_IGN);
+  /* run and resume write their results to files: a reader of their
+  ** progress that goes away (`| head`, a closed log pipe) must not kill
+  ** them (writes to stderr then fail, unheard); the other commands print
+  ** their results, and stop when nobody reads them */
+  if (pipe_proof) signal(SIGPIPE, SIG_IGN);
 }
 
 static int command(int argc, char **argv);
@@ -838,7 +848,7 @@ int main(int argc, char **argv)
 #ifndef LW_MPI
   choose_wait_policy(argc, argv);
 #endif
-  install_signals();
+  install_signals(argc >= 2 && (!strcmp(argv[1], "run") || !strcmp(argv[1], "resume")));
 #ifdef LW_MPI
   if (!(net = lw_mpi_init(&argc, &argv, &stop_requested))) return 1;
   /* the commands other than run and resume are one process's */

@@ -342,9 +342,11 @@ const lw_param_def lw_param_table[] = {
          "Temperature schedule: constant, linear, geometric, logarithmic, adaptive or table "
          "(formulas in docs/SCHEDULES.md)."),
   NUM("anneal", "t_start", LW_PT_DOUBLE, t_start, "1", "energy", 0, 1e300, 0,
-      "Temperature of the first step."),
+      "Temperature of the first step (above 0 for the geometric, logarithmic and adaptive "
+      "schedules, which take ratios or logarithms)."),
   NUM("anneal", "t_end", LW_PT_DOUBLE, t_end, "0.01", "energy", 0, 1e300, 0,
-      "Temperature of the last step (the floor of the adaptive schedule)."),
+      "Temperature of the last step (the floor of the adaptive schedule; above 0 where "
+      "`t_start` must be)."),
   NUM("anneal", "sweeps", LW_PT_INT, sweeps, "1000", "sweeps", 0, 2e9, 0,
       "Sweeps in all; a sweep is as many proposals as the scene has nodes."),
   NUM("anneal", "steps", LW_PT_INT, steps, "20", "", 1, 1e9, 0,
@@ -1309,7 +1311,7 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
         char page_name[16];
         choice_name(dp->choices, p->page, page_name, sizeof page_name);
         return lw_error_set(err, LW_EINPUT,
-                            "%s: key 'scene.%s' = %g mm conflicts with scene.page = %s (%g x %g mm, set at %s): "
+                            "%s: key 'scene.%s' = %.12g mm conflicts with scene.page = %s (%g x %g mm, set at %s): "
                             "expected %g or no %s",
                             where, names[k], *value[k], page_name, w, h, where_page, want[k], names[k]);
       }

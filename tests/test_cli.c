@@ -267,6 +267,19 @@ Test(cli, keys_the_system_never_reads_are_refused)
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   cr_assert(strstr(errs, "linewise: note: under driver = dynamics these keys have no effect: ") &&
             strstr(errs, "moves.point (--set)"), "%s", errs);
+  /* keys the scene's other settings leave idle: a note with why (a table
+  ** file that does not exist went unseen until its schedule was chosen) */
+  write_file("i.ini", "[init]\nsplines = 3\n[anneal]\nsweeps = 1\ntable = missing.txt\n[scene]\n"
+                      "polygon = 1 2 three\nimage_invert = 1\n[moves]\nbirth = 2\n");
+  snprintf(args, sizeof args, "run %s/i.ini --out %s/i --set tempering.t_min=0.5 --set init.coverage=0.2", dir, dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "linewise: note: these keys have no effect here: anneal.table (") &&
+            strstr(errs, "i.ini:5: anneal.schedule reads no table)") &&
+            strstr(errs, "scene.polygon (") && strstr(errs, "i.ini:7: scene.boundary is not polygon)") &&
+            strstr(errs, "scene.image_invert (") && strstr(errs, "i.ini:8: no scene.image)") &&
+            strstr(errs, "init.coverage (--set: init.splines is not 0)") &&
+            strstr(errs, "tempering.t_min (--set: one replica)") &&
+            strstr(errs, "moves.birth (") && strstr(errs, "i.ini:10: moves.fixed_count = 1)"), "%s", errs);
 }
 
 /* A PDF page past what PDF allows (14,400 points) is refused before the run:
@@ -353,6 +366,7 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
   write_file("fr.ini", "[init]\nfrom = fr.lw\n");
   write_file("fr.lw", "linewise-state 2\n[run]\nscene = s.ini\nseed = 1\nsweep = 0\n[system splines]\nsplines = 1x\n");
   write_file("pl.ini", "[scene]\nwidth = 100\nheight = 80\n[init]\nsegment_length = 500\n");
+  write_file("te.ini", "[anneal]\nschedule = geometric\nt_end = 0\n");
   {
     char path[128];
     snprintf(path, sizeof path, "%s/nul.ini", dir);
@@ -380,6 +394,8 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
     {"run %s/tb.ini", "tb.ini:3: key 'anneal.table': "},
     {"run %s/fr.ini", "fr.ini:2: key 'init.from': "},
     {"run %s/pl.ini", "pl.ini:5: key 'init.segment_length': "},
+    {"run %s/te.ini", "te.ini:3: key 'anneal.t_end': schedule geometric: t_end must be a finite number > 0"},
+    {"run %s/s.ini --set anneal.t_start=-0", "--set: key 'anneal.t_start': schedule geometric: t_start must be"},
     {"energy %s", "state.lw: cannot read state file: Is a directory"},
   };
   char sub[128];
@@ -441,6 +457,24 @@ Test(cli, a_second_signal_stops_at_once_and_leaves_the_checkpoint)
                           lw_test_bin(), lw_test_root(), dir, dir),
                0);
   cr_assert_eq(lw_test_sh("%s energy %s/w >/dev/null && ! test -e %s/w/summary.json", lw_test_bin(), dir, dir), 0);
+}
+
+/* A hang-up (a terminal or ssh session gone) stops a run as cleanly as
+** SIGTERM, and a reader of its progress that goes away (a log pipe closed,
+** `| head`) does not end it: both killed the run, losing the sweeps since
+** the last checkpoint. */
+Test(cli, a_hang_up_stops_cleanly_and_a_closed_progress_pipe_is_harmless)
+{
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/h --quiet --set anneal.sweeps=1000000 & "
+                          "p=$!; i=0; while [ $i -lt 500 ] && ! test -f %s/h/state.lw; do sleep 0.01; i=$((i+1)); "
+                          "done; sleep 0.3; kill -HUP $p; wait $p", b, lw_test_root(), dir, dir),
+               0, "a hang-up did not stop the run cleanly");
+  cr_assert_eq(lw_test_sh("grep -q '^sweep = [1-9]' %s/h/state.lw && ! test -e %s/h/summary.json", dir, dir), 0);
+  cr_assert_eq(lw_test_sh("{ %s run %s/params/minimal.ini --out %s/p --set anneal.sweeps=300 2>&1; echo $? > %s/rc; } "
+                          "| head -c 1 >/dev/null; test \"$(cat %s/rc)\" = 0 && test -f %s/p/summary.json", b,
+                          lw_test_root(), dir, dir, dir, dir),
+               0, "the run ended with its progress pipe");
 }
 
 /* A run started without --out goes to out/<scene name>, and when that
