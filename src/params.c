@@ -8,6 +8,7 @@
 */
 #include "linewise/params.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <ini.h>
 #include <limits.h>
@@ -488,7 +489,10 @@ const lw_param_def lw_param_table[] = {
       "curve along both tangents: one pen lift fewer. 0 = no joining."),
   NUM("plot", "join_angle", LW_PT_DOUBLE, join_angle, "30", "degrees", 0, 180, 0,
       "Largest turn at a join: between the direction out of the one stroke's end and into the "
-      "other's. 30 degrees reads as one bending line; 180 joins any two ends that are close."),
+      "other's. 30 degrees reads as one bending line; 180 joins any two ends that are close. "
+      "Below 180 the gap must also lead on from both ends (it may run back by at most a tenth "
+      "of `join_distance`): strokes side by side, one starting behind where the other ends, "
+      "are not bridged by a hook back over the ink."),
   NUM("plot", "crop", LW_PT_INT, crop, "1", "", 0, 1, 0,
       "1 = cut every path at the edge of the picture's rectangle (without a picture: the page "
       "inset by scene.margin) and keep the pieces inside, split exactly at the crossing; 0 = "
@@ -536,7 +540,7 @@ const lw_param_def lw_param_table[] = {
          "that needs 0.2 s to settle. One line of printable ASCII."),
   STRING("layers", "names", ly_names, "", "",
          "Hatching layers or colour pens: one name a layer (letters, digits, `-`, `_`, `.`; it labels "
-         "the pen's SVG layer, so no two alike), separated by blanks (at most 16). Each "
+         "the pen's SVG layer, so no two alike), separated by blanks or commas (at most 16). Each "
          "layer is a pen of its own (one SVG group) with its own target, field, width and colour; "
          "each spline belongs to one, by its index, the layers getting splines in proportion to "
          "the ink of their targets. Needs output.pens = 1 (the layers are the pens). Empty = no "
@@ -1392,6 +1396,10 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
   memcpy(key, dot + 1, lk);
   key[lk] = '\0';
   const lw_param_def *d = lw_params_find(section, key);
+  if (!d && (isblank((unsigned char)section[0]) || isblank((unsigned char)key[0]) ||
+             (lk && isblank((unsigned char)key[lk - 1]))))
+    return lw_error_set(err, LW_EUSAGE, "--set '%s': blanks around the name; expected section.key=value "
+                        "without them", assignment);
   if (!d) {
     char hint[96];
     suggest_key(section, key, hint, sizeof hint);

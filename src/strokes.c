@@ -359,10 +359,17 @@ static lw_status join_pen(const lw_strokes *in, int pen, size_t base, size_t n, 
     for (size_t j = i + 1; j < ne && sx[j].x - sx[i].x <= dist; j++) {
       size_t a = sx[i].e, b = sx[j].e;
       if (a / 2 == b / 2) continue;
-      double d = hypot(pt[2 * a] - pt[2 * b], pt[2 * a + 1] - pt[2 * b + 1]);
+      const double gx = pt[2 * b] - pt[2 * a], gy = pt[2 * b + 1] - pt[2 * a + 1], d = hypot(gx, gy);
       /* out of one end, into the other: the turn is between dir[a] and -dir[b] */
       double c = -(dir[2 * a] * dir[2 * b] + dir[2 * a + 1] * dir[2 * b + 1]);
       if (d > dist || c < cos_max) continue;
+      /* and the gap leads on from each end: two strokes side by side, the
+      ** one starting behind where the other ends, align but would be bridged
+      ** by a hook back over the ink (a tenth of the distance is let through:
+      ** ends that overlap by a hair) */
+      if (cos_max > -1.0 && (gx * dir[2 * a] + gy * dir[2 * a + 1] < -0.1 * dist ||
+                             -(gx * dir[2 * b] + gy * dir[2 * b + 1]) < -0.1 * dist))
+        continue;
       if (n_cand == cap) {
         cap = cap ? 2 * cap : 64;
         join_cand *nc = realloc(cand, cap * sizeof *nc);

@@ -394,6 +394,7 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
     {"run %s/tb.ini", "tb.ini:3: key 'anneal.table': "},
     {"run %s/fr.ini", "fr.ini:2: key 'init.from': "},
     {"run %s/pl.ini", "pl.ini:5: key 'init.segment_length': "},
+    {"run %s/s.ini --set 'anneal.sweeps =5'", "--set 'anneal.sweeps =5': blanks around the name"},
     {"run %s/te.ini", "te.ini:3: key 'anneal.t_end': schedule geometric: t_end must be a finite number > 0"},
     {"run %s/s.ini --set anneal.t_start=-0", "--set: key 'anneal.t_start': schedule geometric: t_start must be"},
     {"energy %s", "state.lw: cannot read state file: Is a directory"},

@@ -70,6 +70,25 @@ Test(strokes, joins_close_aligned_ends_and_nothing_else)
   cr_assert_eq(segs(j, 1), 3, "B backwards, a bridge, D");
   lw_strokes_free(j);
   lw_strokes_free(s);
+
+  /* strokes side by side, the second starting 0.2 behind where the first
+  ** ends: they align, but the bridge would hook back over the ink */
+  s = lw_strokes_new(1, NULL);
+  add_line(s, 0, 0, 0, 0, 10, 0);
+  add_line(s, 0, 1, 9.8, 0.1, 20, 0.1);
+  memset(&rep, 0, sizeof rep);
+  j = lw_strokes_join(s, (const double[]){0.3}, 30 * M_PI / 180, &rep, NULL);
+  cr_assert_eq(rep.joins, 0, "a bridge back over the ink");
+  lw_strokes_free(j);
+  /* 0.02 behind (a tenth of the distance): joined */
+  s->b[8 * 1] = 9.98;
+  s->b[8 * 1 + 2] = 9.98 + (20 - 9.98) / 3;
+  s->b[8 * 1 + 4] = 9.98 + 2 * (20 - 9.98) / 3;
+  memset(&rep, 0, sizeof rep);
+  j = lw_strokes_join(s, (const double[]){0.3}, 30 * M_PI / 180, &rep, NULL);
+  cr_assert_eq(rep.joins, 1, "ends that overlap by a hair");
+  lw_strokes_free(j);
+  lw_strokes_free(s);
 }
 
 Test(strokes, a_ring_of_strokes_joins_into_one_open_path)
