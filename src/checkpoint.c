@@ -480,9 +480,11 @@ lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, const lw_params *p, lw_run_keys
 {
   int line = 0, kline = 0;
   *scene_hash = lw_params_run_hash(p, keys);
-  const char *hash = lw_ckpt_text(doc, "run", "scene_hash", &line); /* absent in older files */
+  /* both absent in older files; scene_keys read either way, or it stays unread */
+  const char *hash = lw_ckpt_text(doc, "run", "scene_hash", &line);
+  const char *text = lw_ckpt_text(doc, "run", "scene_keys", &kline);
   if (!hash) return LW_OK;
-  const char *path = lw_ckpt_path(doc), *text = lw_ckpt_text(doc, "run", "scene_keys", &kline);
+  const char *path = lw_ckpt_path(doc);
   unsigned long long h = strtoull(hash, NULL, 16);
   if (strlen(hash) != 16 || strspn(hash, "0123456789abcdef") != 16)
     return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: expected 16 hexadecimal digits, got '%s'", path,

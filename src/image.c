@@ -1108,12 +1108,21 @@ lw_status lw_image_levels(lw_image *img, double clip, double *lo, double *hi, lw
 void lw_image_tone_curve(lw_image *img, double gamma, double contrast, int invert)
 {
   size_t n = (size_t)img->width * (size_t)img->height;
+  const int identity = !invert && gamma == 1.0 && contrast == 1.0;
   for (size_t k = 0; k < n; k++) {
-    double t = img->tone[k];
+    /* The curve is the picture's, not the paper's that a transparent pixel
+    ** shows (composited over white as it loaded): inverted, that paper had
+    ** asked for full ink.  So a pixel short of opaque is taken apart into
+    ** its picture and its paper, and only the picture goes through. */
+    const double a = img->alpha && !identity ? img->alpha[k] : 1.0;
+    if (!(a > 0.0)) continue; /* paper alone: white, as loaded */
+    double t = a < 1.0 ? (img->tone[k] - (1.0 - a)) / a : img->tone[k];
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
     if (invert) t = 1.0 - t;
     if (gamma != 1.0) t = pow(t > 0 ? t : 0, gamma);
     t = 0.5 + contrast * (t - 0.5);
-    img->tone[k] = (float)(t < 0 ? 0 : (t > 1 ? 1 : t));
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    img->tone[k] = (float)(a < 1.0 ? a * t + (1.0 - a) : t);
   }
 }
 

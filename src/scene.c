@@ -60,6 +60,16 @@ static lw_status margin_ok(const lw_params *p, lw_error *err)
   return LW_OK;
 }
 
+/* Whether a w x h picture keeps the shape of the W x H one it was made
+** from to within a quarter: a strip that downsampling or image_width keeps
+** one pixel across does not (a 20000 x 20 panorama at 1 x 1 filled a square
+** page).  A short side of 4 pixels or more always does. */
+static int keeps_aspect(int w, int h, int W, int H)
+{
+  const double r = ((double)w * H) / ((double)h * W);
+  return r <= 1.25 && r >= 1.0 / 1.25;
+}
+
 /* Loads the picture of section.key (scene.image, scene.mask_image,
 ** output.fidelity_reference) at path, relative to the scene file, and fits
 ** it into the margin box. */
@@ -74,6 +84,15 @@ static lw_image *load_picture(lw_scene *sc, const lw_params *p, const char *sect
   lw_image *img = lw_image_load(full, p->image_max_pixels, &info, &e2);
   if (!img) {
     bad_key(p, section, key, e2.code, err, "%s", e2.msg);
+    return NULL;
+  }
+  if (!keeps_aspect(img->width, img->height, info.width, info.height)) {
+    const int side = info.width < info.height ? info.width : info.height;
+    bad_key(p, "scene", "image_max_pixels", LW_EINPUT, err, "%s: a %d x %d picture within %.0f pixels is %d x %d, "
+            "its shape lost (its short side a pixel or two): expected at least %.0f pixels", full, info.width,
+            info.height, p->image_max_pixels, img->width, img->height,
+            ceil((double)info.width * info.height * 16.0 / ((double)side * side)));
+    lw_image_free(img);
     return NULL;
   }
   if (img->width != info.width || img->height != info.height) {
@@ -97,6 +116,11 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
   if (p->image_width > 0 && p->image_width != sc->image->width) {
     double h = (double)sc->image->height * p->image_width / sc->image->width;
     int hh = h < 1 ? 1 : (int)lround(h);
+    if (!keeps_aspect(p->image_width, hh, sc->image->width, sc->image->height))
+      return bad_key(p, "scene", "image_width", LW_EINPUT, err, "%d pixels wide, the %d x %d picture is %d x %d, "
+                     "its shape lost (its short side a pixel or two): expected at least %.0f", p->image_width,
+                     sc->image->width, sc->image->height, p->image_width, hh,
+                     ceil(4.0 * fmax(1.0, (double)sc->image->width / sc->image->height)));
     if ((double)p->image_width * hh > p->image_max_pixels)
       return bad_key(p, "scene", "image_width", LW_EINPUT, err,
                      "%d x %d pixels is more than scene.image_max_pixels (%.0f)", p->image_width, hh,
@@ -397,7 +421,8 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     return st;
   if (sc->on[LW_TERM_PAIR] && p->pair_near > 0.0 && p->pair_near < lw_pair_near_least(&sc->pair_quad))
     return bad_key(p, "energy", "pair_near", LW_EINPUT, err, "expected 0 (off) or at least %.3f at %d pair nodes "
-                   "(energy.pair_quadrature; closer, a line crossing another between their samples is taken only in part: "
+                   "(energy.pair_quadrature; closer, a line crossing another between their samples is taken "
+                   "only in part: "
                    "docs/ACCURACY.md, \"Near field\"), got %g", lw_pair_near_least(&sc->pair_quad) + 5e-4,
                    sc->pair_quad.n, p->pair_near);
   lw_pair_ctx_init(&sc->pair, p->pair_cutoff, p->pair_near);

@@ -226,7 +226,8 @@ Test(checkpoint, a_scene_ini_edited_in_a_key_that_steers_the_run_is_refused)
                           "--stop-at 1 && cp %s/a/state.lw %s/state.keep && cp %s/other/state.lw %s/a/", b,
                           lw_test_root(), dir, dir, dir, dir, dir), 0);
   cr_assert_eq(lw_test_sh("%s resume %s/a --quiet 2>%s/err.txt", b, dir, dir), 2);
-  cr_assert_eq(lw_test_sh("grep -q 'state.lw and .*scene.ini are not of one run: [4-9] keys differ' %s/err.txt", dir), 0);
+  cr_assert_eq(lw_test_sh("grep -q 'state.lw and .*scene.ini are not of one run: [4-9] keys differ' %s/err.txt",
+                          dir), 0);
   cr_assert_eq(lw_test_sh("cp %s/state.keep %s/a/state.lw", dir, dir), 0);
   cr_assert_eq(lw_test_sh("sed -i -e 's/^min_length = .*/min_length = 0/' -e 's/^png_scale = .*/png_scale = 2/' "
                           "%s/a/scene.ini && %s resume %s/a --quiet", dir, b, dir), 0,

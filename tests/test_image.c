@@ -439,6 +439,27 @@ Test(image, blurred_impulse_has_the_variance_sigma_squared)
   lw_image_free(img);
 }
 
+/* The curve takes the picture under a pixel's transparency, not the white
+** paper it shows: a transparent background inverted had asked for full ink
+** (a white logo on transparency, inverted, was hatched all over). */
+Test(image, tone_curve_leaves_transparency_white)
+{
+  lw_image *img = lw_image_new(3, 1, 1, NULL);
+  /* picture tones 0.2 under alpha 1, 0.5, 0 (composited over white) */
+  const float a[3] = {1, 0.5f, 0}, t[3] = {0.2f, 0.2f, 0.2f};
+  for (int k = 0; k < 3; k++) {
+    img->alpha[k] = a[k];
+    img->tone[k] = a[k] * t[k] + 1 - a[k];
+  }
+  lw_image_tone_curve(img, 2.0, 1.5, 1);
+  for (int k = 0; k < 3; k++) {
+    double c = 0.5 + 1.5 * (pow(1 - t[k], 2.0) - 0.5), want = a[k] * fmin(1, fmax(0, c)) + 1 - a[k];
+    cr_assert(fabs(img->tone[k] - want) < 1e-6, "alpha %g: %g, want %g", a[k], img->tone[k], want);
+  }
+  cr_assert_eq(img->tone[2], 1.0f, "transparent stays paper");
+  lw_image_free(img);
+}
+
 Test(image, tone_curve_invert_gamma_contrast)
 {
   lw_image *img = lw_image_new(5, 1, 0, NULL);

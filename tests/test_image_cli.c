@@ -190,13 +190,38 @@ Test(image_cli, a_run_with_a_relative_picture_resumes_and_recomputes_anywhere)
   snprintf(args, sizeof args, "resume %s --sweeps 2 --quiet && cd / && %s energy %s", lw_test_path("out"),
            getenv("LW_BIN"), lw_test_path("out"));
   cr_assert_eq(run(args, errs, sizeof errs), 0, "%s", errs);
-  /* a picture changed under a run is caught on resume, and the message
-  ** names it as a cause, not state.lw alone */
+  /* a picture changed under a run is caught on resume, by its bytes, and
+  ** the message names its key, not state.lw */
   write_picture("pic.png", 40, 50);
   snprintf(args, sizeof args, "resume %s --sweeps 2 --quiet", lw_test_path("out"));
   cr_assert_eq(run(args, errs, sizeof errs), 2, "%s", errs);
-  cr_assert(strstr(errs, "state.lw: [chain] energy.") && strstr(errs, "or a file the scene reads was changed: its "
-            "picture, field or table)"), "%s", errs);
+  cr_assert(strstr(errs, "out/scene.ini: 'scene.image' (line ") &&
+            strstr(errs, ") edited since the run started, or a file it names changed"), "%s", errs);
+}
+
+/* A budget or width that leaves a picture's short side a pixel or two loses
+** its shape (a 20000 x 20 panorama at 1 x 1 filled a square page): refused,
+** naming the key and what would keep it. */
+Test(image_cli, a_picture_whose_shape_would_be_lost_is_refused)
+{
+  write_picture("strip.png", 400, 4);
+  write_picture("small.png", 60, 40);
+  write_scene("strip.png");
+  char errs[8192];
+  cr_assert_eq(run("run scene.ini --out s --quiet --set scene.image_max_pixels=40", errs, sizeof errs), 2, "%s",
+               errs);
+  cr_assert(strstr(errs, "--set: key 'scene.image_max_pixels': ") && strstr(errs, "a 400 x 4 picture within 40 "
+            "pixels is 40 x 1, its shape lost (its short side a pixel or two): expected at least 1600 pixels"), "%s",
+            errs);
+  /* a short side of one pixel that keeps the shape is fine */
+  cr_assert_eq(run("run scene.ini --out s --quiet --set scene.image_max_pixels=100", errs, sizeof errs), 0, "%s",
+               errs);
+  cr_assert_eq(run("run scene.ini --out s --quiet --set scene.image_max_pixels=1600", errs, sizeof errs), 0, "%s",
+               errs);
+  write_scene("small.png");
+  cr_assert_eq(run("run scene.ini --out w --quiet --set scene.image_width=2", errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "key 'scene.image_width': 2 pixels wide, the 60 x 40 picture is 2 x 1, its shape lost"),
+            "%s", errs);
 }
 
 /* Issue 20: the run made the picture's path absolute by joining the scene's

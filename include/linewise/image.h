@@ -137,6 +137,8 @@ lw_status lw_image_levels(lw_image *img, double clip, double *lo, double *hi, lw
 **     t <- 1 - t                         if invert
 **     t <- t^gamma                       (gamma > 1 darkens the mid-tones)
 **     t <- clamp(1/2 + contrast (t - 1/2), 0, 1)
+** applied to the picture under a pixel's transparency (alpha), not to the
+** white paper it lets through: transparent stays white, inverted too.
 */
 void lw_image_tone_curve(lw_image *img, double gamma, double contrast, int invert);
 
