@@ -9,11 +9,6 @@
 
 #include "linewise/output.h"
 
-static cairo_status_t write_stream(void *closure, const unsigned char *data, unsigned int length)
-{
-  return fwrite(data, 1, length, closure) == length ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
-}
-
 /* The tone under the strokes, one value per preview pixel. */
 static void paint_tone(cairo_surface_t *s, const lw_scene *sc, double scale)
 {
@@ -72,17 +67,7 @@ lw_status lw_fieldview_png(const lw_scene *sc, double px_per_mm, const char *pat
     }
   cairo_destroy(cr);
 
-  char tmp[LW_OUTPUT_PATH_MAX + 8];
-  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
-  if (!f) {
-    cairo_surface_destroy(s);
-    return err->code;
-  }
-  cairo_status_t cs = cairo_surface_write_to_png_stream(s, write_stream, f);
+  lw_status st = lw_output_png_surface(s, path, err);
   cairo_surface_destroy(s);
-  if (cs != CAIRO_STATUS_SUCCESS) {
-    lw_output_abort(f, tmp);
-    return lw_error_set(err, LW_EIO, "%s: cannot write the preview: %s", path, cairo_status_to_string(cs));
-  }
-  return lw_output_commit(f, tmp, path, err);
+  return st;
 }

@@ -387,9 +387,39 @@ int lw_output_png_size(const lw_output_page *page, double px_per_mm, int *width_
   return 1;
 }
 
+/* cairo's stream to a file, keeping why a write failed: cairo reports
+** only "error while writing to output stream", and a full disk must be
+** named (FORMATS.md). */
+typedef struct {
+  FILE *f;
+  int error;
+} file_sink;
+
 static cairo_status_t file_write(void *closure, const unsigned char *data, unsigned int length)
 {
-  return fwrite(data, 1, length, closure) == length ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
+  file_sink *k = closure;
+  if (fwrite(data, 1, length, k->f) == length) return CAIRO_STATUS_SUCCESS;
+  if (!k->error) k->error = errno ? errno : EIO;
+  return CAIRO_STATUS_WRITE_ERROR;
+}
+
+lw_status lw_output_png_surface(cairo_surface_t *surf, const char *path, lw_error *err)
+{
+  /* To a stream on our temporary file rather than
+  ** cairo_surface_write_to_png(tmp): the commit then fsyncs it like every
+  ** other output. */
+  char tmp[LW_OUTPUT_PATH_MAX];
+  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
+  if (!f) return err ? err->code : LW_EIO;
+  file_sink k = {f, 0};
+  errno = 0;
+  cairo_status_t cs = cairo_surface_write_to_png_stream(surf, file_write, &k);
+  if (cs) {
+    lw_output_abort(f, tmp);
+    return lw_error_set(err, LW_EIO, "%s: writing the PNG failed: %s", path,
+                        k.error ? strerror(k.error) : cairo_status_to_string(cs));
+  }
+  return lw_output_commit(f, tmp, path, err);
 }
 
 lw_status lw_output_png_strokes(const lw_strokes *st, const lw_output_page *page, const lw_grid2d *tone,
@@ -423,22 +453,7 @@ lw_status lw_output_png_strokes(const lw_strokes *st, const lw_output_page *page
     goto done;
   }
 
-  /* To a stream on our temporary file rather than
-  ** cairo_surface_write_to_png(tmp): the commit then fsyncs it like every
-  ** other output. */
-  char tmp[LW_OUTPUT_PATH_MAX];
-  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
-  if (!f) {
-    s = err ? err->code : LW_EIO;
-    goto done;
-  }
-  cairo_status_t cs = cairo_surface_write_to_png_stream(surf, file_write, f);
-  if (cs) {
-    lw_output_abort(f, tmp);
-    s = lw_error_set(err, LW_EIO, "%s: writing the PNG failed: %s", path, cairo_status_to_string(cs));
-    goto done;
-  }
-  s = lw_output_commit(f, tmp, path, err);
+  s = lw_output_png_surface(surf, path, err);
 done:
   cairo_destroy(cr);
   cairo_surface_destroy(surf);
@@ -479,7 +494,9 @@ lw_status lw_output_pdf_strokes(const lw_strokes *st, const lw_output_page *page
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
   if (!f) return err ? err->code : LW_EIO;
   const double pt_per_mm = 72.0 / 25.4;
-  cairo_surface_t *surf = cairo_pdf_surface_create_for_stream(file_write, f, page->width_mm * pt_per_mm,
+  file_sink k = {f, 0};
+  errno = 0;
+  cairo_surface_t *surf = cairo_pdf_surface_create_for_stream(file_write, &k, page->width_mm * pt_per_mm,
                                                               page->height_mm * pt_per_mm);
   /* An empty date leaves /CreationDate out: otherwise every run would
   ** differ from the last. */
@@ -496,7 +513,7 @@ lw_status lw_output_pdf_strokes(const lw_strokes *st, const lw_output_page *page
   if (cs) {
     lw_output_abort(f, tmp);
     return lw_error_set(err, cs == CAIRO_STATUS_WRITE_ERROR ? LW_EIO : LW_ERUN, "%s: writing the PDF failed: %s",
-                        path, cairo_status_to_string(cs));
+                        path, k.error ? strerror(k.error) : cairo_status_to_string(cs));
   }
   return lw_output_commit(f, tmp, path, err);
 }

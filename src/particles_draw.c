@@ -52,11 +52,6 @@ static int depth_cmp(const void *pa, const void *pb)
   return (a->i > b->i) - (a->i < b->i);
 }
 
-static cairo_status_t file_write(void *closure, const unsigned char *data, unsigned int length)
-{
-  return fwrite(data, 1, length, closure) == length ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
-}
-
 /* Paints the particles onto cr, a size x size picture. */
 static void paint(cairo_t *cr, const lw_particles *p, const depth_key *order, int size)
 {
@@ -123,19 +118,7 @@ lw_status lw_particles_write_png(const lw_particles *p, const char *path, lw_err
     st = lw_error_set(err, LW_ERUN, "%s: drawing the preview failed: %s", path, cairo_status_to_string(cairo_status(cr)));
     goto done;
   }
-  char tmp[LW_OUTPUT_PATH_MAX];
-  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
-  if (!f) {
-    st = err ? err->code : LW_EIO;
-    goto done;
-  }
-  cairo_status_t cs = cairo_surface_write_to_png_stream(surf, file_write, f);
-  if (cs) {
-    lw_output_abort(f, tmp);
-    st = lw_error_set(err, LW_EIO, "%s: writing the PNG failed: %s", path, cairo_status_to_string(cs));
-    goto done;
-  }
-  st = lw_output_commit(f, tmp, path, err);
+  st = lw_output_png_surface(surf, path, err);
 done:
   cairo_destroy(cr);
   cairo_surface_destroy(surf);

@@ -947,11 +947,6 @@ static lw_status write_svg(lw_nurbs_state *s, const char *path, lw_error *err)
   return lw_output_commit(f, tmp, path, err);
 }
 
-static cairo_status_t png_write(void *closure, const unsigned char *data, unsigned int len)
-{
-  return fwrite(data, 1, len, closure) == len ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
-}
-
 /* A PNG of the curve (black) and its control polygon (grey) in box b. */
 static lw_status write_png(const lw_nurbs_state *s, const double b[4], const char *path, lw_error *err)
 {
@@ -985,19 +980,9 @@ static lw_status write_png(const lw_nurbs_state *s, const double b[4], const cha
   lw_nurbs_beziers(s->c, s->su->tolerance, cairo_bezier, &k);
   cairo_stroke(cr);
   cairo_surface_flush(surf);
-  lw_status st = LW_OK;
-  char tmp[LW_OUTPUT_PATH_MAX];
-  FILE *f = NULL;
-  if (cairo_status(cr)) {
-    st = lw_error_set(err, LW_ERUN, "%s: drawing failed: %s", path, cairo_status_to_string(cairo_status(cr)));
-  } else if (!(f = lw_output_open_tmp(path, tmp, sizeof tmp, err))) {
-    st = err->code;
-  } else if (cairo_surface_write_to_png_stream(surf, png_write, f)) {
-    lw_output_abort(f, tmp);
-    st = lw_error_set(err, LW_EIO, "%s: writing the PNG failed", path);
-  } else {
-    st = lw_output_commit(f, tmp, path, err);
-  }
+  lw_status st = cairo_status(cr) ? lw_error_set(err, LW_ERUN, "%s: drawing failed: %s", path,
+                                                 cairo_status_to_string(cairo_status(cr)))
+                                  : lw_output_png_surface(surf, path, err);
   cairo_destroy(cr);
   cairo_surface_destroy(surf);
   return st;

@@ -443,6 +443,11 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
   fclose(f);
   cr_assert(strstr(errs, "fz/state.lw: write failed: File too large"), "%s", errs);
   cr_assert_neq(lw_test_sh("ls %s/fz/*.tmp 2>/dev/null | grep -q .", dir), 0, "a temporary file was left behind");
+  /* a PNG cut short says why too (cairo's own message named no reason) */
+  cr_assert_eq(lw_test_sh("sh -c 'ulimit -f 60; %s run %s/params/minimal.ini --out %s/fp --quiet --set "
+                          "output.png_scale=20 --set anneal.sweeps=5' 2>%s/err.txt; test $? -eq 1 && grep -q "
+                          "'fp/final.png: writing the PNG failed: File too large' %s/err.txt", lw_test_bin(),
+                          lw_test_root(), dir, dir, dir), 0);
 }
 
 /* A sweep can take minutes (here a billion time steps of the whip): the

@@ -170,7 +170,13 @@ void bench_quadrature(bench_ctx *b)
              "| nodes | total | strain | bending | potential | field | pair | boundary |\n"
              "|---|---|---|---|---|---|---|---|\n",
           nodes[ref]);
+  int forbidden = 0;
   for (int i = 0; i < ref; i++) {
+    if (!isfinite(v[i].total)) {
+      fprintf(d, "| %d | forbidden | - | - | - | - | - | - |\n", nodes[i]);
+      forbidden++;
+      continue;
+    }
     double et = fabs(v[i].total - v[ref].total) / v[ref].magnitude;
     fprintf(d, "| %d | %.1e |", nodes[i], et);
     for (int k = 0; k <= LW_TERM_BOUNDARY; k++) /* the six terms a scene can name */
@@ -189,6 +195,11 @@ void bench_quadrature(bench_ctx *b)
     irregular += !lw_segment_allowed(&sc, a, a + 1, smp.length);
   }
   lw_scene_clear(&sc);
+  if (forbidden)
+    fprintf(d, "\n*Forbidden*: at so few nodes the annealed state's pair samples lie more than %g cutoffs\n"
+               "apart on some segments, which a scene refuses (NUMERICS.md, \"Regular segments\"): its\n"
+               "energy there is +infinity, and a scene at those nodes needs a longer cutoff.\n",
+            LW_PAIR_GAP_SHARE);
   fprintf(d, "\nThe reference energies: total %.6g; strain %.4g, bending %.4g, potential %.4g, field %.4g,\n"
              "pair %.4g, boundary %.4g. The annealer ran with the regularity checks (energy.min_speed %g,\n"
              "energy.regularity %g: above); %zu of the %zu segments it left fail them, none is folded,\n"
@@ -216,6 +227,8 @@ void bench_quadrature(bench_ctx *b)
   for (int i = 0; i < n; i++) {
     if (i == ref)
       fprintf(d, "| %d (reference) | - | - | - | %.0f | %.2f +- %.2f |\n", nodes[i], v[i].ns, v[i].ratio, v[i].spread);
+    else if (!isfinite(v[i].total))
+      fprintf(d, "| %d | forbidden | - | - | - | - |\n", nodes[i]);
     else {
       fprintf(d, "| %d | %.1e | %.1e | %.2f %% | %.0f | %.2f +- %.2f |\n", nodes[i], v[i].de_median, v[i].de_rms,
               100 * v[i].decisions, v[i].ns, v[i].ratio, v[i].spread);
@@ -255,11 +268,17 @@ void bench_cutoff(bench_ctx *b)
              "|---|---|---|---|---|---|---|---|\n",
           b->ann_params.quadrature, b->ann_params.pair_near, s);
   FILE *f = bench_data(b, "cutoff.dat");
+  int forbidden = 0;
   fprintf(f, "# cutoff_mm cutoff_in_spacings ns ratio err_pair de_median de_rms decisions\n");
   for (int i = 0; i < n; i++) {
     double e = rel(v[i].term[LW_TERM_PAIR], v[ref].term[LW_TERM_PAIR]);
     if (i == ref) {
       fprintf(d, "| none (reference) | - | - | - | - | - | %.0f | %.2f +- %.2f |\n", v[i].ns, v[i].ratio, v[i].spread);
+      continue;
+    }
+    if (!isfinite(v[i].total)) {
+      fprintf(d, "| %g | %.1f | forbidden | - | - | - | - | - |\n", rc[i], rc[i] / s);
+      forbidden++;
       continue;
     }
     fprintf(d, "| %g | %.1f | %.2f | %.2f | %.2f | %.1f %% | %.0f | %.2f +- %.2f |\n", rc[i], rc[i] / s, e,
@@ -282,6 +301,10 @@ void bench_cutoff(bench_ctx *b)
       m++;
     }
   b->cutoff_exponent = m > 1 ? (m * sxy - sx * sy) / (m * sxx - sx * sx) : NAN;
+  if (forbidden)
+    fprintf(d, "\n*Forbidden*: the annealed state's pair samples lie more than %g of so short a cutoff\n"
+               "apart on some segments, which a scene refuses (NUMERICS.md, \"Regular segments\").\n",
+            LW_PAIR_GAP_SHARE);
   fprintf(d, "\nThe cutoff does not approximate the uncut 1/r sum at any affordable range, and is not\n"
              "meant to: in 2-D that sum grows with the page (lines of density rho around a sample add\n"
              "about 2 pi C rho R over a radius R; here the uncut pair energy is %.0f, cut at %g mm %.1f),\n"

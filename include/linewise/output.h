@@ -119,6 +119,11 @@ lw_status lw_output_pdf(const lw_splines *sp, const lw_output_page *page, const 
 lw_status lw_output_frame(const char *dir, long sweep, const lw_splines *sp, const lw_output_page *page,
                           const lw_plot *plot, const lw_grid2d *tone, double px_per_mm, lw_error *err);
 
+/* Writes surf as a PNG to path through a temporary file and
+** lw_output_commit; a failed write names the file and the reason (errno,
+** which cairo's own message leaves out). */
+lw_status lw_output_png_surface(cairo_surface_t *surf, const char *path, lw_error *err);
+
 /* The same three drawings of paths (strokes.h) as they are: their pens,
 ** order and directions; the calls above turn the splines and plot into
 ** paths and call these. */
