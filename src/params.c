@@ -15,6 +15,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/types.h>
 
 #include "linewise/image.h"
@@ -1447,14 +1448,20 @@ static unsigned long long fnv(unsigned long long h, const void *bytes, size_t n)
 #define FNV_START 0xcbf29ce484222325ULL
 
 /* The hash of a file's bytes as text ("file " and 16 hex digits), or of
-** what stopped its reading ("unread", errno in *unread). */
+** what stopped its reading ("unread", errno in *unread); a path that is no
+** regular file (a pipe would be read dry, or block) by its name. */
 static void file_text(const char *path, char *buf, size_t n, int *unread)
 {
+  struct stat st;
+  *unread = 0;
+  if (!stat(path, &st) && !S_ISREG(st.st_mode)) {
+    snprintf(buf, n, "%s", path);
+    return;
+  }
   FILE *f = fopen(path, "rb");
   unsigned long long h = FNV_START;
   unsigned char block[65536];
   size_t got;
-  *unread = 0;
   if (f) {
     while ((got = fread(block, 1, sizeof block, f)) > 0) h = fnv(h, block, got);
     if (ferror(f)) *unread = errno ? errno : EIO;
