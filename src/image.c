@@ -410,7 +410,9 @@ static unsigned byte_at(const unsigned char *d, size_t n, size_t at) { return at
 ** that are not 0xFF skipped one by one, fill bytes 0xFF before a marker
 ** (the start marker too), segments by their lengths, and after a scan's
 ** header its entropy-coded data up to the next 0xFF that is neither a
-** stuffed zero, a fill byte nor a restart marker. */
+** stuffed zero, a fill byte nor a restart marker.  A frame the decoder does
+** not read (12 bits, lossless, arithmetic-coded) is named here, where its
+** own message would say "not an image". */
 static lw_status jpeg_tables_sound(const unsigned char *d, size_t n, const char *name, lw_error *err)
 {
   size_t at = 0;
@@ -447,6 +449,14 @@ static lw_status jpeg_tables_sound(const unsigned char *d, size_t n, const char 
     else if (marker == 0xDB)
       for (size_t t = at + 2; t < at + len && t < n && (d[t] & 15) <= 3; t += 1 + (d[t] >> 4 ? 128 : 64))
         quant |= 1u << (d[t] & 15);
+    else if (marker >= 0xC3 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC)
+      /* the decoder's message would call it no image at all */
+      return lw_error_set(err, LW_EINPUT, "%s: %s JPEG, which the decoder does not read: expected a baseline or "
+                          "progressive one (save it again as such)", name,
+                          marker >= 0xC9 ? "an arithmetic-coded" : marker == 0xC3 ? "a lossless" : "a hierarchical");
+    else if (marker >= 0xC0 && marker <= 0xC2 && byte_at(d, n, at + 2) != 8)
+      return lw_error_set(err, LW_EINPUT, "%s: a %u-bit JPEG, which the decoder does not read: expected 8 bits (save "
+                          "it again as such)", name, byte_at(d, n, at + 2));
     else if (marker >= 0xC0 && marker <= 0xC2)
       for (unsigned c = 0; c < byte_at(d, n, at + 7) && c < 4; c++) {
         frame_id[c] = (int)byte_at(d, n, at + 8 + 3 * c);

@@ -195,6 +195,40 @@ Test(image, pictures_the_decoder_mishandles_are_refused)
   }
 }
 
+/* JPEG frames the decoder does not read (12 bits, arithmetic-coded,
+** lossless) are named as such: its own message said "not an image". */
+Test(image, jpeg_kinds_the_decoder_does_not_read_are_named)
+{
+  char path[1024], dir[64];
+  snprintf(path, sizeof path, "%s/tests/fuzz/corpus/image/exif6.jpg", lw_test_root());
+  FILE *f = fopen(path, "rb");
+  cr_assert_not_null(f);
+  unsigned char d[65536];
+  size_t n = fread(d, 1, sizeof d, f);
+  fclose(f);
+  size_t sof = 0;
+  while (sof + 4 < n && !(d[sof] == 0xFF && d[sof + 1] == 0xC0)) sof++;
+  cr_assert(sof + 4 < n, "a baseline frame");
+  cr_assert_eq(lw_test_dir_make(dir, "jpeg"), 0);
+  static const struct { size_t at; unsigned char byte; const char *msg; } kind[] = {
+      {1, 0xC9, "an arithmetic-coded JPEG, which the decoder does not read"},
+      {1, 0xC3, "a lossless JPEG, which the decoder does not read"},
+      {4, 12, "a 12-bit JPEG, which the decoder does not read: expected 8 bits"}};
+  for (int k = 0; k < 3; k++) {
+    unsigned char was = d[sof + kind[k].at];
+    d[sof + kind[k].at] = kind[k].byte;
+    snprintf(path, sizeof path, "%s/k%d.jpg", dir, k);
+    f = fopen(path, "wb");
+    fwrite(d, 1, n, f);
+    fclose(f);
+    d[sof + kind[k].at] = was;
+    lw_error err;
+    cr_assert_null(lw_image_load(path, 1e6, NULL, &err));
+    cr_assert(err.code == LW_EINPUT && strstr(err.msg, kind[k].msg), "%s", err.msg);
+  }
+  lw_test_dir_remove(dir);
+}
+
 /* Boxed down to at most max_pixels, whatever the shape: a strip thinner
 ** than the reduction keeps one pixel across and at most max_pixels along
 ** (the image fuzzer's JPEG of 23561 x 5 came to 549 x 1 for 64 pixels). */
