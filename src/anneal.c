@@ -422,6 +422,7 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
                               rule[r].why);
     }
   }
+  if (m >= size && size > 4) strcpy(idle + size - 4, "..."); /* cut: said so */
 }
 
 /* The system's row and its set-up of the scene; a quench needs a row with
@@ -828,7 +829,9 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);
   double ladder[LW_TEMPERING_MAX];
   long trace_bytes = -1;
-  if ((s = lw_params_read_run(&a->params, scene_path, 0, err)) ||
+  /* a path edited into scene.ini is relative to it, as in any scene file:
+  ** made absolute before the files' bytes are checked and read */
+  if ((s = lw_params_read_run(&a->params, scene_path, 0, err)) || (s = absolute_paths(a, err)) ||
       (s = lw_checkpoint_scene_hash(st.doc, &a->params, &a->scene_keys, &a->scene_hash, err)) ||
       (s = lw_params_resolve(&a->params, err)) || (s = setup_ladder(a, ladder, err)) ||
       (s = setup_schedule(a, err)) || (s = setup_system(a, err)))

@@ -451,25 +451,29 @@ static lw_status get_dynamics(lw_ckpt *doc, lw_dynamics *d, lw_error *err)
 }
 
 /* The keys whose parts differ from state.lw's scene_keys (text, 4 hex
-** digits a key), the first three as "'a.b' (line N), ..." in buf; their count, or -1 where
-** the two do not list the same keys (a key's line taken out of scene.ini). */
+** digits a key): the first eight as "'a.b' (line N), ..." in buf, *path
+** set where one of them names a file; their count, or -1 where the two do
+** not list as many keys. */
 static int edited_keys(const lw_params *p, const lw_run_keys *now, const char *text, char *buf, size_t n,
-                       int *unread_key)
+                       int *path, int *unread_key)
 {
   if (strlen(text) != 4 * now->n || strspn(text, "0123456789abcdef") != strlen(text)) return -1;
   int count = 0;
   size_t used = 0;
   buf[0] = '\0';
+  *path = 0;
   *unread_key = -1;
   for (size_t k = 0; k < now->n; k++) {
     char part[5] = {text[4 * k], text[4 * k + 1], text[4 * k + 2], text[4 * k + 3], '\0'};
     if (strtoul(part, NULL, 16) == now->hash[k]) continue;
     const lw_param_def *d = &lw_param_table[now->index[k]];
     if (now->unread[k] && *unread_key < 0) *unread_key = (int)k;
-    /* the first three: more say that the two are not of one run */
-    if (count < 3 && used < n)
+    if (d->type == LW_PT_STRING && !strcmp(d->unit, "path")) *path = 1;
+    if (count < 8 && used < n)
       used += (size_t)snprintf(buf + used, n - used, "%s'%s.%s' (line %d)", count ? ", " : "", d->section, d->key,
                                p->line[now->index[k]]);
+    else if (count == 8 && used < n)
+      used += (size_t)snprintf(buf + used, n - used, ", ...");
     count++;
   }
   return count;
@@ -484,7 +488,7 @@ lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, const lw_params *p, lw_run_keys
   const char *hash = lw_ckpt_text(doc, "run", "scene_hash", &line);
   const char *text = lw_ckpt_text(doc, "run", "scene_keys", &kline);
   if (!hash) return LW_OK;
-  const char *path = lw_ckpt_path(doc);
+  const char *path = lw_ckpt_path(doc), *scene = p->file;
   unsigned long long h = strtoull(hash, NULL, 16);
   if (strlen(hash) != 16 || strspn(hash, "0123456789abcdef") != 16)
     return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: expected 16 hexadecimal digits, got '%s'", path,
@@ -492,27 +496,33 @@ lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, const lw_params *p, lw_run_keys
   /* files before 2026-12-05 hashed the files' names */
   const unsigned long long mine = text ? *scene_hash : lw_params_run_hash(p, NULL);
   if (h == mine) return LW_OK;
-  const char *scene = p->file;
+  static const char resumes[] = "a run resumes with the parameters and files it ran with (only [plot] and the "
+                                "keys of the final files may change; a file may move, its key naming the new place)";
   char which[1024];
-  int unread = -1, count = text ? edited_keys(p, keys, text, which, sizeof which, &unread) : -1;
+  int in_path = 0, unread = -1, count = text ? edited_keys(p, keys, text, which, sizeof which, &in_path, &unread) : -1;
   if (unread >= 0) {
     const lw_param_def *d = &lw_param_table[keys->index[unread]];
-    return lw_error_set(err, LW_EINPUT, "%s:%d: key '%s.%s': cannot read %s: %s (a run resumes with the files "
-                        "it started with, wherever they are now)", scene, p->line[keys->index[unread]], d->section,
-                        d->key, (const char *)p + d->offset, strerror(keys->unread[unread]));
+    return lw_error_set(err, LW_EINPUT, "%s:%d: key '%s.%s': cannot read %s: %s (%s)", scene,
+                        p->line[keys->index[unread]], d->section, d->key, (const char *)p + d->offset,
+                        strerror(keys->unread[unread]), resumes);
   }
-  if (count > 3)
-    return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: %s and %s are not of one run: %d keys differ, "
-                        "%s, ...", path, line, path, scene, count, which);
+  if (count > 8)
+    return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: %s and %s seem to be of different runs: %d keys "
+                        "differ (%s)", path, line, path, scene, count, which);
   if (count > 0)
-    return lw_error_set(err, LW_EINPUT, "%s: %s edited since the run started, or a file %s changed: "
-                        "a run resumes with the parameters and files it ran with (only [plot] and the keys of "
-                        "the final files may change; a file may move, its key naming the new place)", scene, which,
-                        count > 1 ? "they name" : "it names");
-  return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: the run's scene.ini was edited since it "
-                      "started, in a key that steers the run, or state.lw is another run's; a run resumes with "
-                      "the parameters it ran with (only [plot] and the keys of the final files may change): "
-                      "expected %016llx, scene.ini gives %016llx", path, line, h, mine);
+    return lw_error_set(err, LW_EINPUT, "%s: %s edited since the run started%s: %s", scene, which,
+                        !in_path ? "" : count > 1 ? ", or a file they name changed" : ", or the file it names changed",
+                        resumes);
+  if (text && strlen(text) % 4 == 0 && strlen(text) / 4 != keys->n) {
+    const size_t was = strlen(text) / 4;
+    const size_t off = was > keys->n ? was - keys->n : keys->n - was;
+    return lw_error_set(err, LW_EINPUT, "%s: %zu key%s %s than when the run started (a key's line %s?): %s", scene,
+                        off, off > 1 ? "s" : "", was > keys->n ? "fewer" : "more",
+                        was > keys->n ? "taken out" : "added", resumes);
+  }
+  return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash %016llx, of scene.ini now %016llx: scene.ini was "
+                      "edited in a key that steers the run, or state.lw is another run's; %s", path, line, h, mine,
+                      resumes);
 }
 
 lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, lw_error *err)

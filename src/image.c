@@ -1115,7 +1115,7 @@ lw_status lw_image_levels(lw_image *img, double clip, double *lo, double *hi, lw
   return LW_OK;
 }
 
-void lw_image_tone_curve(lw_image *img, double gamma, double contrast, int invert)
+void lw_image_tone_curve(lw_image *img, const float *alpha, double gamma, double contrast, int invert)
 {
   size_t n = (size_t)img->width * (size_t)img->height;
   const int identity = !invert && gamma == 1.0 && contrast == 1.0;
@@ -1124,7 +1124,7 @@ void lw_image_tone_curve(lw_image *img, double gamma, double contrast, int inver
     ** shows (composited over white as it loaded): inverted, that paper had
     ** asked for full ink.  So a pixel short of opaque is taken apart into
     ** its picture and its paper, and only the picture goes through. */
-    const double a = img->alpha && !identity ? img->alpha[k] : 1.0;
+    const double a = alpha && !identity ? alpha[k] : 1.0;
     if (!(a > 0.0)) continue; /* paper alone: white, as loaded */
     double t = a < 1.0 ? (img->tone[k] - (1.0 - a)) / a : img->tone[k];
     t = t < 0 ? 0 : (t > 1 ? 1 : t);

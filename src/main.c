@@ -471,8 +471,9 @@ static lw_status spread_start(lw_status s, lw_anneal *a, int fresh, lw_error *er
 }
 
 /* The default run directory: out/<scene name>, or out/<scene name>-2, -3,
-** ... : the first that holds no run and that no other process is writing,
-** made and locked (rundir.h) before the run is set up, so that runs
+** ... : the first that holds no run (nor a person's scene.ini or state.lw)
+** and that no other process is writing, made and locked (rundir.h) before
+** the run is set up, so that runs
 ** started together without --out each get their own, and none replaces
 ** the drawing of another (--out names a directory to replace).  *made: 1
 ** the directory is new, 2 out/ too (taken away again if the run is
@@ -480,6 +481,13 @@ static lw_status spread_start(lw_status s, lw_anneal *a, int fresh, lw_error *er
 ** checkout), the first name without a run is taken unmade, and the run says
 ** why once its scene is known to be good.  Under MPI process 0 chooses and
 ** holds the lock, and tells the others. */
+/* Whether dir holds a run, or a scene.ini or state.lw of a person's, which
+** a run would refuse to write over. */
+static int taken(const char *dir)
+{
+  return lw_rundir_holds_run(dir) || lw_rundir_foreign(dir, "scene.ini") || lw_rundir_foreign(dir, "state.lw");
+}
+
 static lw_status default_dir(char *dir, size_t size, const char *scene, int *hold, int *made, lw_error *err)
 {
   const char *base = strrchr(scene, '/');
@@ -495,12 +503,12 @@ static lw_status default_dir(char *dir, size_t size, const char *scene, int *hol
     snprintf(dir, size, "out/%.*s", n, base);
     for (int k = 2;; k++) {
       const int existed = access(dir, F_OK) == 0;
-      if (!existed || !lw_rundir_holds_run(dir)) {
+      if (!existed || !taken(dir)) {
         lw_error e2;
         if (lw_rundir_make(dir, &e2)) break; /* taken unmade */
         s = lw_rundir_lock(dir, hold, err);
         if (s && s != LW_EUSAGE) break; /* LW_EUSAGE: another run's */
-        if (!s && !lw_rundir_holds_run(dir)) {
+        if (!s && !taken(dir)) {
           *made = existed ? 0 : out_existed ? 1 : 3;
           break;
         }
@@ -780,8 +788,10 @@ static void install_signals(int pipe_proof)
   on_terminal = isatty(2);
   sigaction(SIGINT, &sa, NULL);
   sigaction(SIGTERM, &sa, NULL);
-  /* a terminal or ssh session that goes away stops a run as cleanly */
-  sigaction(SIGHUP, &sa, NULL);
+  /* a terminal or ssh session that goes away stops a run as cleanly, but
+  ** for a run told to outlive it (nohup, trap '' HUP: ignored already) */
+  struct sigaction was;
+  if (!sigaction(SIGHUP, NULL, &was) && was.sa_handler != SIG_IGN) sigaction(SIGHUP, &sa, NULL);
   signal(SIGXFSZ, SIG_IGN);
   /* run and resume write their results to files: a reader of their
   ** progress that goes away (`| head`, a closed log pipe) must not kill

@@ -23,6 +23,7 @@
 #include "linewise/output.h"
 #include "linewise/plotter.h"
 #include "linewise/quad.h"
+#include "linewise/schedule.h"
 #include "linewise/state.h"
 
 #define OFF(f) offsetof(lw_params, f)
@@ -190,9 +191,9 @@ const lw_param_def lw_param_table[] = {
       "(the larger of the two; at most the cutoff) take the double integral over the exact curves, "
       "blended smoothly into the product rule (finite where curves touch or cross). "
       "0 = off (product rule only; infinite where samples coincide). Otherwise at least sqrt 2 times "
-      "the pair rule's widest node spacing over its largest weight (1.43 at 8 nodes, 1.47 at 4, "
-      "1.63 at 2), where a crossing between samples is taken whole; less is refused "
-      "(docs/ACCURACY.md, \"Near field\")."),
+      "the pair rule's widest node spacing over its largest weight (1.431 at 8 nodes, 1.475 at 4, "
+      "1.633 at 2, rounded up), where a crossing between samples is taken whole; less is refused "
+      "(docs/ACCURACY.md, \"Near field\"), but in a run begun before 2026-12-05."),
   NUM("energy", "boundary", LW_PT_DOUBLE, boundary_coef, "0", "energy mm", 0, 1e12, 0,
       "R: boundary R * integral of 1/d^2 dl keeps lines inside (+infinity outside). 0 = off."),
   NUM("energy", "boundary_clearance", LW_PT_DOUBLE, boundary_clearance, "1.5", "length elements", 0, 100, 0,
@@ -1473,6 +1474,20 @@ static void file_text(const char *path, char *buf, size_t n, int *unread)
   else snprintf(buf, n, "file %016llx", h);
 }
 
+/* Whether the file path key d names is never read by the run as it goes
+** on: init.from (read at the start only), a table under a schedule that
+** reads none, a mask picture without mask = image.  Such a file may move or
+** change. */
+static int path_idle(const lw_params *p, const lw_param_def *d)
+{
+  if (!strcmp(d->section, "init") && !strcmp(d->key, "from")) return 1;
+  if (!strcmp(d->section, "anneal") && !strcmp(d->key, "table")) {
+    const lw_schedule_type *t = p->driver == LW_DRIVER_DYNAMICS ? NULL : lw_schedule_find(p->schedule);
+    return !t || !(t->needs & LW_SCHEDULE_USES_TABLE);
+  }
+  return !strcmp(d->section, "scene") && !strcmp(d->key, "mask_image") && p->mask != LW_MASK_IMAGE;
+}
+
 unsigned long long lw_params_run_hash(const lw_params *p, lw_run_keys *keys)
 {
   unsigned long long h = FNV_START;
@@ -1482,7 +1497,7 @@ unsigned long long lw_params_run_hash(const lw_params *p, lw_run_keys *keys)
     const lw_param_def *d = &lw_param_table[i];
     if ((p->of_run && p->line[i] <= 0) || lw_params_named(file_keys, d)) continue;
     const int is_path = d->type == LW_PT_STRING && !strcmp(d->unit, "path");
-    if (keys && is_path && !strcmp(d->section, "init") && !strcmp(d->key, "from")) continue;
+    if (keys && is_path && path_idle(p, d)) continue;
     int n = snprintf(line, sizeof line, "%s.%s=", d->section, d->key), unread = 0;
     const char *path = (const char *)p + d->offset;
     if (keys && is_path && path[0]) file_text(path, line + n, sizeof line - (size_t)n, &unread);

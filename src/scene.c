@@ -60,15 +60,11 @@ static lw_status margin_ok(const lw_params *p, lw_error *err)
   return LW_OK;
 }
 
-/* Whether a w x h picture keeps the shape of the W x H one it was made
-** from to within a quarter: a strip that downsampling or image_width keeps
-** one pixel across does not (a 20000 x 20 panorama at 1 x 1 filled a square
-** page).  A short side of 4 pixels or more always does. */
-static int keeps_aspect(int w, int h, int W, int H)
-{
-  const double r = ((double)w * H) / ((double)h * W);
-  return r <= 1.25 && r >= 1.0 / 1.25;
-}
+/* The fewest pixels a scaled W x H picture's short side may keep: 4, or
+** the picture's own where it has fewer.  Scaled to fewer, a picture loses
+** its shape to the rounding (a 20000 x 20 panorama at 1 x 1 filled a square
+** page): a budget or width that asks for that is refused. */
+static double least_side(int W, int H) { return fmin(4.0, fmin(W, H)); }
 
 /* Loads the picture of section.key (scene.image, scene.mask_image,
 ** output.fidelity_reference) at path, relative to the scene file, and fits
@@ -86,12 +82,13 @@ static lw_image *load_picture(lw_scene *sc, const lw_params *p, const char *sect
     bad_key(p, section, key, e2.code, err, "%s", e2.msg);
     return NULL;
   }
-  if (!keeps_aspect(img->width, img->height, info.width, info.height)) {
-    const int side = info.width < info.height ? info.width : info.height;
-    bad_key(p, "scene", "image_max_pixels", LW_EINPUT, err, "%s: a %d x %d picture within %.0f pixels is %d x %d, "
-            "its shape lost (its short side a pixel or two): expected at least %.0f pixels", full, info.width,
-            info.height, p->image_max_pixels, img->width, img->height,
-            ceil((double)info.width * info.height * 16.0 / ((double)side * side)));
+  const double all = (double)info.width * info.height, side = fmin(info.width, info.height);
+  if (all > p->image_max_pixels && side * sqrt(p->image_max_pixels / all) < least_side(info.width, info.height)) {
+    const double m = least_side(info.width, info.height);
+    bad_key(p, "scene", "image_max_pixels", LW_EINPUT, err, "%s: a %d x %d picture within %.0f pixels keeps %.2f "
+            "pixels across, too few to keep its shape: expected at least %.0f pixels (%.0f across)", full, info.width,
+            info.height, p->image_max_pixels, side * sqrt(p->image_max_pixels / all), ceil(all * m * m / (side * side)),
+            m);
     lw_image_free(img);
     return NULL;
   }
@@ -116,11 +113,12 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
   if (p->image_width > 0 && p->image_width != sc->image->width) {
     double h = (double)sc->image->height * p->image_width / sc->image->width;
     int hh = h < 1 ? 1 : (int)lround(h);
-    if (!keeps_aspect(p->image_width, hh, sc->image->width, sc->image->height))
-      return bad_key(p, "scene", "image_width", LW_EINPUT, err, "%d pixels wide, the %d x %d picture is %d x %d, "
-                     "its shape lost (its short side a pixel or two): expected at least %.0f", p->image_width,
-                     sc->image->width, sc->image->height, p->image_width, hh,
-                     ceil(4.0 * fmax(1.0, (double)sc->image->width / sc->image->height)));
+    const int W = sc->image->width, H = sc->image->height;
+    const double m = least_side(W, H);
+    if (fmin(p->image_width, h) < m)
+      return bad_key(p, "scene", "image_width", LW_EINPUT, err, "%d pixels wide, the %d x %d picture keeps %.2f "
+                     "pixels across, too few to keep its shape: expected at least %.0f", p->image_width, W, H,
+                     fmin(p->image_width, h), ceil(H < W ? m * W / H : m));
     if ((double)p->image_width * hh > p->image_max_pixels)
       return bad_key(p, "scene", "image_width", LW_EINPUT, err,
                      "%d x %d pixels is more than scene.image_max_pixels (%.0f)", p->image_width, hh,
@@ -151,7 +149,26 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
       snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_levels: the tones left as they are",
                used ? "; " : "");
   }
-  lw_image_tone_curve(sc->image, p->image_gamma, p->image_contrast, p->image_invert);
+  /* The tone curve takes the picture under its transparency (image.h).  A
+  ** blur spreads the picture's edge onto its transparent side, so the curve
+  ** takes the alpha blurred alike: with the sharp one, the spread edge was
+  ** left out of the curve (an inverted picture got a ring of ink). */
+  const int curve = p->image_invert || p->image_gamma != 1.0 || p->image_contrast != 1.0;
+  const size_t npx = (size_t)sc->image->width * (size_t)sc->image->height;
+  float *cover = NULL;
+  if (sc->image->alpha && curve && p->image_blur > 0) {
+    if (!(cover = malloc(npx * sizeof *cover)))
+      return lw_error_set(err, LW_ENOMEM, "out of memory for the picture's transparency");
+    memcpy(cover, sc->image->alpha, npx * sizeof *cover);
+    if ((st = lw_image_blur_plane(cover, sc->image->width, sc->image->height,
+                                  p->image_blur / sc->image_place.pixel, err))) {
+      free(cover);
+      return st;
+    }
+  }
+  lw_image_tone_curve(sc->image, cover ? cover : sc->image->alpha, p->image_gamma, p->image_contrast,
+                      p->image_invert);
+  free(cover);
   return LW_OK;
 }
 
@@ -419,12 +436,19 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   if ((st = term_nodes(p, sc, sc->on[LW_TERM_PAIR], "pair_quadrature", p->pair_quadrature, &sc->pair_quad, err)) ||
       (st = term_nodes(p, sc, sc->on[LW_TERM_TONE], "tone_quadrature", p->tone_quadrature, &sc->tone_quad, err)))
     return st;
-  if (sc->on[LW_TERM_PAIR] && p->pair_near > 0.0 && p->pair_near < lw_pair_near_least(&sc->pair_quad))
-    return bad_key(p, "energy", "pair_near", LW_EINPUT, err, "expected 0 (off) or at least %.3f at %d pair nodes "
-                   "(energy.pair_quadrature; closer, a line crossing another between their samples is taken "
-                   "only in part: "
-                   "docs/ACCURACY.md, \"Near field\"), got %g", lw_pair_near_least(&sc->pair_quad) + 5e-4,
-                   sc->pair_quad.n, p->pair_near);
+  /* (a run begun before the rule, whose scene.ini holds a smaller one,
+  ** still resumes and measures as it ran) */
+  const double least = ceil(1e3 * lw_pair_near_least(&sc->pair_quad)) / 1e3;
+  if (sc->on[LW_TERM_PAIR] && p->pair_near > 0.0 && p->pair_near < least && !p->of_run) {
+    /* blame what the user set: the radius, or the nodes under the default one */
+    const lw_param_def *d = lw_params_find("energy", "pair_near");
+    const char *nodes = p->pair_quadrature > 0 ? "pair_quadrature" : "quadrature";
+    const char *key = !p->line[d - lw_param_table] ? nodes : "pair_near";
+    return bad_key(p, "energy", key, LW_EINPUT, err, "energy.pair_near = %g is less than %.3f, the least at %d pair "
+                   "nodes (energy.%s): expected pair_near 0 (off) or at least that (closer, a line "
+                   "crossing another between their samples is taken only in part: docs/ACCURACY.md, \"Near "
+                   "field\")", p->pair_near, least, sc->pair_quad.n, nodes);
+  }
   lw_pair_ctx_init(&sc->pair, p->pair_cutoff, p->pair_near);
   sc->pair_gap_max = sc->on[LW_TERM_PAIR] && p->pair_cutoff > 0.0 ? LW_PAIR_GAP_SHARE * p->pair_cutoff : 0.0;
 

@@ -485,7 +485,7 @@ Test(image, tone_curve_leaves_transparency_white)
     img->alpha[k] = a[k];
     img->tone[k] = a[k] * t[k] + 1 - a[k];
   }
-  lw_image_tone_curve(img, 2.0, 1.5, 1);
+  lw_image_tone_curve(img, img->alpha, 2.0, 1.5, 1);
   for (int k = 0; k < 3; k++) {
     double c = 0.5 + 1.5 * (pow(1 - t[k], 2.0) - 0.5), want = a[k] * fmin(1, fmax(0, c)) + 1 - a[k];
     cr_assert(fabs(img->tone[k] - want) < 1e-6, "alpha %g: %g, want %g", a[k], img->tone[k], want);
@@ -499,18 +499,18 @@ Test(image, tone_curve_invert_gamma_contrast)
   lw_image *img = lw_image_new(5, 1, 0, NULL);
   const float t[5] = {0, 0.25f, 0.5f, 0.8f, 1};
   memcpy(img->tone, t, sizeof t);
-  lw_image_tone_curve(img, 2.0, 1.0, 0);
+  lw_image_tone_curve(img, NULL, 2.0, 1.0, 0);
   for (int k = 0; k < 5; k++) cr_assert(fabs(img->tone[k] - t[k] * t[k]) < 1e-6);
   memcpy(img->tone, t, sizeof t);
-  lw_image_tone_curve(img, 1.0, 1.0, 1);
+  lw_image_tone_curve(img, NULL, 1.0, 1.0, 1);
   for (int k = 0; k < 5; k++) cr_assert(fabs(img->tone[k] - (1 - t[k])) < 1e-6);
   memcpy(img->tone, t, sizeof t);
-  lw_image_tone_curve(img, 1.0, 3.0, 0);
+  lw_image_tone_curve(img, NULL, 1.0, 3.0, 0);
   const float c3[5] = {0, 0, 0.5f, 1, 1}; /* 0.5 + 3 (t - 0.5), clipped */
   for (int k = 0; k < 5; k++) cr_assert(fabs(img->tone[k] - c3[k]) < 1e-6, "%d: %g", k, img->tone[k]);
   /* the order: invert, then gamma, then contrast */
   memcpy(img->tone, t, sizeof t);
-  lw_image_tone_curve(img, 0.5, 0.5, 1);
+  lw_image_tone_curve(img, NULL, 0.5, 0.5, 1);
   for (int k = 0; k < 5; k++) {
     double want = 0.5 + 0.5 * (sqrt(1 - t[k]) - 0.5);
     cr_assert(fabs(img->tone[k] - want) < 1e-6, "%d", k);

@@ -417,8 +417,8 @@ void bench_near(bench_ctx *b)
              "segments crossing there at 8 nodes (cutoff 5 mm) err by 38 %% at near 0.5, 14 %% at 1,\n"
              "9.2e-3 at 1.25, 3.4e-3 at 1.3, 8.7e-4 at 1.35 and 6.5e-4 (the near field's own, at\n"
              "another place) from 1.4 on. So `energy.pair_near` must be 0 (off) or at least sqrt 2\n"
-             "times the rule's widest spacing over its largest weight: 1.43 at 8 nodes, 1.47 at 4,\n"
-             "1.63 at 2 (lw_pair_near_least); less is refused.\n\n");
+             "times the rule's widest spacing over its largest weight: 1.431 at 8 nodes, 1.475 at 4,\n"
+             "1.633 at 2, rounded up (lw_pair_near_least); less is refused.\n\n");
 
   /* the annealed scene: near radii at 8 nodes against 64 nodes with near 1.5 */
   static const double scene_near[] = {0, 1.5, 2, 3};

@@ -51,7 +51,7 @@ typedef struct lw_anneal {
   char dir[LW_PATH_MAX];
   int dir_hold;                 /* lw_rundir_lock's hold on dir while it writes there, 0 none */
   char unread[1024];           /* keys the scene sets that only the other driver reads, where set, or "" */
-  char idle[1024];             /* keys the scene sets that its other settings leave idle, where and why */
+  char idle[4096];             /* keys the scene sets that its other settings leave idle, where and why */
   unsigned long seed;
   long sweep;                  /* sweeps done */
   long saved;                  /* sweep + 1 at the last checkpoint this process wrote; 0 none */

@@ -137,10 +137,10 @@ lw_status lw_image_levels(lw_image *img, double clip, double *lo, double *hi, lw
 **     t <- 1 - t                         if invert
 **     t <- t^gamma                       (gamma > 1 darkens the mid-tones)
 **     t <- clamp(1/2 + contrast (t - 1/2), 0, 1)
-** applied to the picture under a pixel's transparency (alpha), not to the
-** white paper it lets through: transparent stays white, inverted too.
-*/
-void lw_image_tone_curve(lw_image *img, double gamma, double contrast, int invert);
+** applied to the picture under a pixel's transparency alpha (NULL: opaque),
+** not to the white paper it lets through: transparent stays white, inverted
+** too.  alpha is the picture's, blurred as its tone was. */
+void lw_image_tone_curve(lw_image *img, const float *alpha, double gamma, double contrast, int invert);
 
 /* Where the picture lies on the page: pixel (i, j) covers the square of side
 ** `pixel` mm whose top-left corner is (x0 + i pixel, y0 + j pixel). */

@@ -319,8 +319,9 @@ typedef struct lw_run_keys {
 ** scene.ini edited since.  With keys (the form since 2026-12-05, which
 ** state.lw marks by its scene_keys), a key that names a file counts by the
 ** file's bytes, not its name: a run whose picture moves resumes once the
-** key names the new place, and one whose table was edited does not;
-** init.from (read only when the run starts) does not count.  keys NULL:
+** key names the new place, and one whose table was edited does not; a
+** file the run never reads as it goes on (init.from, read at the start; a
+** table or mask picture its settings leave idle) does not count.  keys NULL:
 ** the form before, by the names, for older files. */
 unsigned long long lw_params_run_hash(const lw_params *p, lw_run_keys *keys);
 

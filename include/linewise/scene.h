@@ -52,9 +52,10 @@
 ** its radius, near times the larger element length.  A right angle in the
 ** middle of both lines' widest gaps (spacing s of the rule, of elements
 ** up to w long) has its nearest pair s / sqrt 2 from it, so near must be
-** at least sqrt(2) s / w: 1.43 at 8 nodes, 1.63 at 2.  Below, crossings
-** between samples are taken in part: 3e-3 hidden at 1.3, 14 % at 1, 38 %
-** at 0.5 (8 nodes; docs/ACCURACY.md, "Near field"). */
+** at least sqrt(2) s / w: 1.431 at 8 nodes, 1.633 at 2 (rounded up, as the
+** scene refuses less).  Below, crossings between samples are taken in
+** part: 3e-3 hidden at 1.3, 14 % at 1, 38 % at 0.5 (8 nodes;
+** docs/ACCURACY.md, "Near field"). */
 double lw_pair_near_least(const lw_quad *q);
 
 typedef struct lw_scene {
