@@ -66,6 +66,10 @@ static void run_variants(bench_ctx *b, variant *v, int n, int acc_ref, int time_
       v[i].total += v[i].term[k];
       v[i].magnitude += fabs(v[i].term[k]);
     }
+    /* a state these settings forbid (a segment too long for the cutoff at
+    ** these nodes: NUMERICS.md, "Regular segments") is marked so, as the
+    ** scene would refuse it */
+    if (lw_model_check_regular(&r[i].scene, r[i].model->sp, "bench", &err)) v[i].total = INFINITY;
     for (int k = 0; k < nt; k++) {
       size_t at = (size_t)i * nt + (size_t)k;
       dE[at] = bench_run_propose(&r[i], &t[k]);
@@ -175,6 +179,8 @@ void bench_quadrature(bench_ctx *b)
     if (!isfinite(v[i].total)) {
       fprintf(d, "| %d | forbidden | - | - | - | - | - | - |\n", nodes[i]);
       forbidden++;
+      keep(&b->quadrature, i, nodes[i], INFINITY, &v[i]);
+      b->quadrature.decisions[i] = 1.0; /* never the guide's choice */
       continue;
     }
     double et = fabs(v[i].total - v[ref].total) / v[ref].magnitude;
@@ -279,6 +285,8 @@ void bench_cutoff(bench_ctx *b)
     if (!isfinite(v[i].total)) {
       fprintf(d, "| %g | %.1f | forbidden | - | - | - | - | - |\n", rc[i], rc[i] / s);
       forbidden++;
+      keep(&b->cutoff, i, rc[i], INFINITY, &v[i]);
+      b->cutoff.decisions[i] = 1.0;
       continue;
     }
     fprintf(d, "| %g | %.1f | %.2f | %.2f | %.2f | %.1f %% | %.0f | %.2f +- %.2f |\n", rc[i], rc[i] / s, e,
@@ -599,7 +607,7 @@ void bench_guide(bench_ctx *b)
     fprintf(d, "| %s | %g | %g | %.1f | %.1f | %.0f | %.0f | %s |\n", plots[k].name, plots[k].pen, plots[k].s, seg,
             rc_s * plots[k].s, splines, n_nodes, t);
   }
-  if (iq > 0)
+  if (iq > 0 && isfinite(q->err[iq - 1]))
     fprintf(d, "\nFor a quick draft, %d nodes take %.2f x the time of %d, at the accuracy in the tables above.\n",
             (int)q->value[iq - 1], q->ratio[iq - 1] / q->ratio[iq], nodes);
   /* single moves: the kink at rc keeps dE first order in the element (NUMERICS.md,
