@@ -564,7 +564,8 @@ static lw_status open_trace(lw_anneal *a, int fresh, lw_error *err)
     fprintf(a->trace, "sweep,time");
     for (int k = 0; k < t->n_terms; k++)
       if (t->term_on(a->setup, k)) fprintf(a->trace, ",%s", t->term_names[k]);
-    fprintf(a->trace, ",potential,kinetic,total");
+    /* U as potential_energy: "potential" is a term of the splines' */
+    fprintf(a->trace, ",potential_energy,kinetic,total");
     trace_header_end(a);
   } else if (fresh) {
     const lw_system_type *t = a->sys_type;
