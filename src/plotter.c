@@ -110,8 +110,8 @@ static lw_status check(const lw_strokes *s, const lw_output_page *page, const lw
     for (int k = 0; k < 2; k++) {
       if (!(o->bed[k] > 0.0) || (e.lo[k] >= -BED_SLACK && e.hi[k] <= o->bed[k] + BED_SLACK)) continue;
       return lw_error_set(err, LW_EINPUT, "%s: the drawing reaches %c = %.3f to %.3f mm on the machine, past its "
-                          "bed of %g mm (plot.bed_%s): expected plot.crop = 1 (which cuts the strokes to the page inside "
-                          "its margin), a wider margin or a turn of the page",
+                          "bed of %g mm (plot.bed_%s): expected plot.crop = 1 (which cuts the strokes to the page "
+                          "inside its margin), a wider margin or a turn of the page",
                           path, "xy"[k], e.lo[k], e.hi[k], o->bed[k], k ? "height" : "width");
     }
   }

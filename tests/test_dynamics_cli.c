@@ -364,8 +364,8 @@ Test(dynamics_cli, the_sheet_drapes_in_the_bowl)
 ** printed two rows of one name.  Every column's name is its own. */
 Test(dynamics_cli, the_trace_names_every_column_once)
 {
-  cr_assert_eq(sh("%s run %s/params/example.ini --set scene.driver=dynamics --set dynamics.rho=0 --set dynamics.gamma=1 "
-                  "--set dynamics.dt=0.01 --set dynamics.steps_per_sweep=2 --set anneal.sweeps=1 --out %s/p --quiet "
+  cr_assert_eq(sh("%s run %s/params/example.ini --set scene.driver=dynamics --set dynamics.rho=0 "
+                  "--set dynamics.gamma=1 --set dynamics.dt=0.01 --set dynamics.steps_per_sweep=2 --set anneal.sweeps=1 --out %s/p --quiet "
                   "--threads 1", lw_test_bin(), lw_test_root(), dir), 0);
   cr_assert_eq(sh("head -1 %s/p/trace.csv | grep -q ',potential,.*,potential_energy,kinetic,total$' && "
                   "test -z \"$(head -1 %s/p/trace.csv | tr , '\\n' | sort | uniq -d)\"", dir, dir), 0);

@@ -29,7 +29,8 @@ Test(nurbs_cli, the_wire_runs_and_resumes_to_the_same_bytes)
   const char *same[] = {"state.lw", "trace.csv", "final.svg", "final.png"};
   for (int k = 0; k < 4; k++)
     cr_assert_eq(sh("cmp -s %s/a/%s %s/b/%s", dir, same[k], dir, same[k]), 0, "%s differs after a resume", same[k]);
-  cr_assert_eq(sh("head -1 %s/a/trace.csv | grep -q '^sweep,time,elastic,gravity,potential_energy,kinetic,total$'", dir), 0);
+  cr_assert_eq(sh("head -1 %s/a/trace.csv | grep -q '^sweep,time,elastic,gravity,potential_energy,kinetic,total$'",
+                  dir), 0);
   /* undamped: the total energy is kept (leapfrog: bounded error) */
   cr_assert_eq(sh("awk -F, 'NR == 2 { h = $7 } NR > 2 { d = $7 - h; if (d < 0) d = -d; if (d > 1e-3 * h) bad = 1 } "
                   "END { exit bad }' %s/a/trace.csv", dir), 0);
