@@ -1270,7 +1270,9 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     lw_json_key(&j, "proposals_per_second"); /* of the sweeps of the whole run */
     lw_json_number(&j, a->sweep_seconds > 0 ? (double)prop / a->sweep_seconds : 0.0);
     lw_json_key(&j, "max_relative_drift"); lw_json_number(&j, a->max_drift);
-    lw_json_key(&j, "temperature_final"); lw_json_number(&j, c->temperature);
+    lw_json_key(&j, "temperature_final"); /* none where no sweep ran (a redraw) */
+    if (a->sweep > 0) lw_json_number(&j, c->temperature);
+    else lw_json_null(&j);
     lw_json_key(&j, "schedule"); lw_json_string(&j, a->sched_type->name);
   }
   lw_json_key(&j, "driver"); lw_json_string(&j, a->dyn ? "dynamics" : "metropolis");

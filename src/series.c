@@ -100,13 +100,20 @@ double lw_series_tau(const double *x, size_t n_ser, size_t n, size_t *window)
 void lw_series_stats_of(const double *x, size_t n, lw_series_stats *out)
 {
   out->n = n;
-  out->mean = n ? mean_of(x, n) : NAN;
+  /* rows of one value have no spread, exactly: their mean is that value (a
+  ** sum of 600 copies of 0.2074103559 is not, by 1e-16, whose spread gave
+  ** a tau of 1248 and a warning) */
+  size_t same = 1;
+  while (same < n && x[same] == x[0]) same++;
+  out->mean = !n ? NAN : same == n ? x[0] : mean_of(x, n);
   double v = 0.0;
   for (size_t t = 0; t < n; t++) v += (x[t] - out->mean) * (x[t] - out->mean);
-  out->sd = n ? sqrt(v / (double)n) : NAN;
+  /* one row has a mean and no spread to speak of: its error bar is unknown,
+  ** not 0 */
+  out->sd = n > 1 ? sqrt(v / (double)n) : NAN;
   out->tau = fmax(lw_series_tau(x, 1, n, &out->window), 0.5);
   out->n_eff = (double)n / (2.0 * out->tau);
-  out->stderr_mean = n ? out->sd * sqrt(2.0 * out->tau / (double)n) : NAN;
+  out->stderr_mean = n > 1 ? out->sd * sqrt(2.0 * out->tau / (double)n) : NAN;
   out->drift_z = 0.0;
   size_t h = n / 2;
   if (h >= 2) {

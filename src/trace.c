@@ -178,6 +178,7 @@ typedef struct {
 /* Whether a run's column with spread has problem `what` (one run's kinds). */
 static int run_problem(const lw_series_stats *s, int what)
 {
+  if (what == WARN_FEW && s->n == 1) return 1; /* one row: no error bar at all */
   if (!s->n || !(s->sd > 0.0)) return 0;
   switch (what) {
   case WARN_OPEN:
@@ -253,6 +254,13 @@ static void combine(column_stats *c, int k, const double *every)
   c->sd = sqrt(w);
   c->tau_sweeps = tau;
   c->n_eff = neff;
+  int single = 0; /* a run of one row has no error bar: the runs' means are the samples */
+  for (int r = 0; r < k; r++) single |= c->run[r].n < 2;
+  if (single) {
+    c->stderr_mean = sqrt(b / k);
+    c->sd = c->p_runs = c->r_hat = NAN;
+    return;
+  }
   if (exact) {
     c->p_runs = b > 0.0 ? 0.0 : 1.0;
     c->r_hat = b > 0.0 ? INFINITY : 1.0;
@@ -401,7 +409,8 @@ lw_trace *lw_trace_with_heat_capacity(const lw_trace *t, const size_t *rows, siz
       same &= at(t, rows[i], temp[j]) == T;
       if (!isnan(e)) mean += (e - mean) / (double)++m;
     }
-    if (!same || !(T > 0.0)) continue;
+    /* (one energy has no variance: left empty, not 0) */
+    if (!same || !(T > 0.0) || m < 2) continue;
     for (size_t i = 0; i < n; i++) {
       double d = at(t, rows[i], energy[j]) - mean;
       h->v[rows[i] * cols + t->n_cols + (size_t)j] = d * d / (T * T);
@@ -482,7 +491,10 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     const lw_series_stats *s = &q->run[0];
     if (is_coordinate(name)) continue;
     if (!s->n) {
+      /* (in the CSV too, so that scripts see the table's columns) */
       if (!csv) fprintf(out, "%-*s %15s\n", width, name, "(empty)");
+      else if (k > 1) fprintf(out, "%s,%d,0,,,,,,,\n", name, k);
+      else fprintf(out, "%s,0,,,,,,,,\n", name);
     } else if (k > 1) {
       size_t rows = 0;
       for (int r = 0; r < k; r++) rows += q->run[r].n;
@@ -496,11 +508,14 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
         snprintf(rh, sizeof rh, "%.4g", q->r_hat);
         snprintf(pr, sizeof pr, "%.3g", q->p_runs);
       }
+      char sd[32] = "-";
+      if (csv) sd[0] = '\0';
+      if (!isnan(q->sd)) snprintf(sd, sizeof sd, "%.4g", q->sd);
       if (csv)
-        fprintf(out, "%s,%d,%zu,%.10g,%.4g,%.4g,%s,%s,%s,%s\n", name, k, rows, q->mean, q->stderr_mean, q->sd,
-                tau, neff, rh, pr);
+        fprintf(out, "%s,%d,%zu,%.10g,%.4g,%s,%s,%s,%s,%s\n", name, k, rows, q->mean, q->stderr_mean, sd, tau, neff,
+                rh, pr);
       else
-        fprintf(out, "%-*s %15.9g %11.4g %11.4g %11s %9s %8s %9s%s\n", width, name, q->mean, q->stderr_mean, q->sd, tau,
+        fprintf(out, "%-*s %15.9g %11.4g %11s %11s %9s %8s %9s%s\n", width, name, q->mean, q->stderr_mean, sd, tau,
                 neff, rh, pr, flagged(q, k) ? " *" : "");
     } else if (csv) {
       /* tau and n_eff mean nothing for a column without spread: empty, as
@@ -512,8 +527,15 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       }
       char batch[32] = "";
       if (!isnan(s->batch_ratio)) snprintf(batch, sizeof batch, "%.4g", s->batch_ratio); /* 1.501 warns, 1.5 not */
-      fprintf(out, "%s,%zu,%.10g,%.4g,%.4g,%s,%s,%d,%.3g,%s\n", name, s->n, s->mean, s->stderr_mean, s->sd, tau, neff,
-              s->window > 0, s->drift_z, batch);
+      char se[32] = "", sd[32] = ""; /* one row: none */
+      if (s->n > 1) {
+        snprintf(se, sizeof se, "%.4g", s->stderr_mean);
+        snprintf(sd, sizeof sd, "%.4g", s->sd);
+      }
+      fprintf(out, "%s,%zu,%.10g,%s,%s,%s,%s,%d,%.3g,%s\n", name, s->n, s->mean, se, sd, tau, neff, s->window > 0,
+              s->drift_z, batch);
+    } else if (s->n == 1) {
+      fprintf(out, "%-*s %15.9g %11s %11s %11s %9s *\n", width, name, s->mean, "-", "-", "-", "-");
     } else if (!(s->sd > 0.0)) {
       fprintf(out, "%-*s %15.9g %11.4g %11.4g %11s %9s\n", width, name, s->mean, 0.0, 0.0, "-", "-");
     } else {

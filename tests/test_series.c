@@ -892,3 +892,19 @@ Test(samples, every_system_writes_its_degrees_of_freedom_to_the_bit)
   lw_particles_free(pp);
   lw_particles_setup_free(s);
 }
+
+/* Rows of one value: no spread, exactly, and the mean is that value (600
+** copies of 0.2074103559 summed to 1e-16 off it, whose "spread" gave a tau
+** of 1248 and a warning); one row: a mean, and no error bar (unknown, not 0). */
+Test(series, one_value_has_no_spread_and_one_row_no_error_bar)
+{
+  double x[600];
+  for (int i = 0; i < 600; i++) x[i] = 0.2074103559;
+  lw_series_stats s;
+  lw_series_stats_of(x, 600, &s);
+  cr_assert(s.mean == 0.2074103559 && s.sd == 0.0 && s.stderr_mean == 0.0, "mean %.17g sd %g se %g", s.mean, s.sd,
+            s.stderr_mean);
+  lw_series_stats_of(x, 1, &s);
+  cr_assert(s.n == 1 && s.mean == 0.2074103559 && isnan(s.sd) && isnan(s.stderr_mean), "sd %g se %g", s.sd,
+            s.stderr_mean);
+}
