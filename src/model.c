@@ -423,11 +423,11 @@ lw_status lw_model_check_regular(const lw_scene *sc, const lw_splines *sp, const
                           LW_PAIR_GAP_SHARE, sc->pair_gap_max / LW_PAIR_GAP_SHARE);
     double ratio = s.length > 0.0 ? lw_segment_min_speed(a, a + 1) / s.length : 0.0;
     return lw_error_set(err, LW_EINPUT,
-                        "%s: spline %zu, segment %zu is irregular: its speed falls to %.3g of its mean "
-                        "(energy.min_speed = %g) and its bending integrand is analytic within rho = %.3g "
-                        "(energy.regularity = %g), a fold the quadrature cannot see; lower these keys to "
-                        "accept it", path, i, g - lw_segment_index(sp, i, 0), ratio, sc->min_speed,
-                        lw_segment_rho(a, a + 1), sc->regularity);
+                        "%s: spline %zu, segment %zu is irregular: its speed falls to %.6g of its mean "
+                        "(energy.min_speed = %g; the mean as %d nodes measure the length) and its bending "
+                        "integrand is analytic within rho = %.6g (energy.regularity = %g), a fold the quadrature "
+                        "cannot see; lower these keys to accept it", path, i, g - lw_segment_index(sp, i, 0), ratio,
+                        sc->min_speed, sc->quad.n, lw_segment_rho(a, a + 1), sc->regularity);
   }
   return LW_OK;
 }
