@@ -421,13 +421,22 @@ lw_status lw_model_check_regular(const lw_scene *sc, const lw_splines *sp, const
                           "could cross it unseen; raise energy.pair_cutoff or energy.pair_quadrature",
                           path, i, g - lw_segment_index(sp, i, 0), lw_segment_widest_gap(&sc->pair_quad, a, a + 1),
                           LW_PAIR_GAP_SHARE, sc->pair_gap_max / LW_PAIR_GAP_SHARE);
-    double ratio = s.length > 0.0 ? lw_segment_min_speed(a, a + 1) / s.length : 0.0;
+    /* name the test that failed (both where the finer test is the one) */
+    const double ratio = s.length > 0.0 ? lw_segment_min_speed(a, a + 1) / s.length : 0.0;
+    const double rho = lw_segment_rho(a, a + 1);
+    const int slow = sc->min_speed > 0.0 && ratio < sc->min_speed, fold = sc->regularity > 0.0 && rho < sc->regularity;
+    char speed[160] = "", bend[128] = "";
+    if (slow || !fold)
+      snprintf(speed, sizeof speed, "its speed falls to %.6g of its mean (energy.min_speed = %g; the mean as %d nodes "
+               "measure the length)", ratio, sc->min_speed, sc->quad.n);
+    if (fold || !slow)
+      snprintf(bend, sizeof bend, "its bending integrand is analytic only within rho = %.6g (energy.regularity = %g)",
+               rho, sc->regularity);
     return lw_error_set(err, LW_EINPUT,
-                        "%s: spline %zu, segment %zu is irregular: its speed falls to %.6g of its mean "
-                        "(energy.min_speed = %g; the mean as %d nodes measure the length) and its bending "
-                        "integrand is analytic within rho = %.6g (energy.regularity = %g), a fold the quadrature "
-                        "cannot see; lower these keys to accept it", path, i, g - lw_segment_index(sp, i, 0), ratio,
-                        sc->min_speed, sc->quad.n, lw_segment_rho(a, a + 1), sc->regularity);
+                        "%s: spline %zu, segment %zu is irregular: %s%s%s, a fold the quadrature cannot see; lower "
+                        "%s to accept it", path, i, g - lw_segment_index(sp, i, 0), speed,
+                        speed[0] && bend[0] ? " and " : "", bend,
+                        slow && !fold ? "energy.min_speed" : fold && !slow ? "energy.regularity" : "these keys");
   }
   return LW_OK;
 }

@@ -585,22 +585,25 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
 ** the photo preset, it hid at most 3e-4. */
 static void note_blur_gaps(lw_scene *sc, const lw_params *p)
 {
-  if (sc->pair_gap_max > 0.0) return;
+  if (sc->pair_gap_max > 0.0 || !sc->image) return;
+  /* the detail's scale: the term's blur and the picture's own, or without
+  ** either its pixels */
+  const double ib = p->image_blur, px = sc->image_place.pixel;
+  const double pb = hypot(p->potential_blur, ib), tb = hypot(p->tone_blur, ib);
   const struct {
     int on;
-    double gap, blur;
+    double gap, scale;
     const char *key;
-  } g[2] = {{sc->on[LW_TERM_POTENTIAL] && p->potential == LW_POT_IMAGE && p->potential_blur > 0.0,
-             p->segment_length * sc->quad.spacing, p->potential_blur, "scene.potential_blur"},
-            {sc->on[LW_TERM_TONE] && p->tone_blur > 0.0, p->segment_length * sc->tone_quad.spacing, p->tone_blur,
-             "energy.tone_blur"}};
+  } g[2] = {{sc->on[LW_TERM_POTENTIAL] && p->potential == LW_POT_IMAGE, p->segment_length * sc->quad.spacing,
+             pb > 0.0 ? pb : px, "scene.potential_blur"},
+            {sc->on[LW_TERM_TONE], p->segment_length * sc->tone_quad.spacing, tb > 0.0 ? tb : px, "energy.tone_blur"}};
   for (int k = 0; k < 2; k++) {
-    if (!g[k].on || !(g[k].gap > g[k].blur)) continue;
+    if (!g[k].on || !(g[k].gap > g[k].scale)) continue;
     size_t used = strlen(sc->note);
     snprintf(sc->note + used, sizeof sc->note - used, "%sthe placed segments' samples lie up to %.3g mm apart, more "
-             "than %s (%g mm): annealed segments can stretch over the picture's detail between them, hidden from "
-             "the quadrature (docs/NUMERICS.md); more nodes or a wider blur close it", used ? "; " : "", g[k].gap,
-             g[k].key, g[k].blur);
+             "than the picture's detail under %s (%.3g mm, with scene.image_blur and the pixels): annealed segments "
+             "can stretch over it, hidden from the quadrature (docs/NUMERICS.md); more nodes, a wider blur or a pair "
+             "cutoff close it", used ? "; " : "", g[k].gap, g[k].key, g[k].scale);
   }
 }
 

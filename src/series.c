@@ -111,7 +111,12 @@ void lw_series_stats_of(const double *x, size_t n, lw_series_stats *out)
   /* one row has a mean and no spread to speak of: its error bar is unknown,
   ** not 0 */
   out->sd = n > 1 ? sqrt(v / (double)n) : NAN;
-  out->tau = fmax(lw_series_tau(x, 1, n, &out->window), 0.5);
+  if (n && same == n) { /* nothing to correlate: exact (its own mean of the rows would not be) */
+    out->tau = 0.5;
+    out->window = 1;
+  } else {
+    out->tau = fmax(lw_series_tau(x, 1, n, &out->window), 0.5);
+  }
   out->n_eff = (double)n / (2.0 * out->tau);
   out->stderr_mean = n > 1 ? out->sd * sqrt(2.0 * out->tau / (double)n) : NAN;
   out->drift_z = 0.0;

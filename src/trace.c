@@ -164,7 +164,7 @@ static long default_from(const lw_trace *t, int sweep)
   return (long)at(t, r, sweep);
 }
 
-enum { WARN_OPEN, WARN_FEW, WARN_DRIFT, WARN_BATCH, WARN_RUNS };
+enum { WARN_OPEN, WARN_FEW, WARN_ONE, WARN_DRIFT, WARN_BATCH, WARN_RUNS };
 
 /* A column's statistics: per run (k of them), and with several runs what
 ** they say together. */
@@ -178,7 +178,7 @@ typedef struct {
 /* Whether a run's column with spread has problem `what` (one run's kinds). */
 static int run_problem(const lw_series_stats *s, int what)
 {
-  if (what == WARN_FEW && s->n == 1) return 1; /* one row: no error bar at all */
+  if (what == WARN_ONE || s->n == 1) return what == WARN_ONE && s->n == 1; /* no error bar at all */
   if (!s->n || !(s->sd > 0.0)) return 0;
   switch (what) {
   case WARN_OPEN:
@@ -205,8 +205,8 @@ static int has_problem(const column_stats *c, int k, int what)
 
 static int flagged(const column_stats *c, int k)
 {
-  return has_problem(c, k, WARN_OPEN) || has_problem(c, k, WARN_FEW) || has_problem(c, k, WARN_BATCH) ||
-         has_problem(c, k, WARN_RUNS);
+  return has_problem(c, k, WARN_OPEN) || has_problem(c, k, WARN_FEW) || has_problem(c, k, WARN_ONE) ||
+         has_problem(c, k, WARN_BATCH) || has_problem(c, k, WARN_RUNS);
 }
 
 /* One line naming every column with problem `what`, or nothing. */
@@ -549,6 +549,9 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
               k > 1 ? "or between the runs" : "these rows");
     warn(out, t[0], cs, k, WARN_OPEN, "the autocorrelation did not die out within half the rows: tau is a lower "
          "bound and the error bar too small (a longer stretch is needed)");
+    warn(out, t[0], cs, k, WARN_ONE, k > 1 ? "a run of one row, which has no error bar of its own: the error bar "
+         "above is the spread of the runs' means over sqrt(runs), and the runs are not compared (R_hat and p_runs "
+         "empty)" : "one row: a mean and no error bar (a longer stretch is needed)");
     warn(out, t[0], cs, k, WARN_FEW, k > 1 ? "fewer than 25 independent samples in a run (n_eff above sums the "
          "runs): that run's error bar, and the test of the runs against each other, are rough"
          : "fewer than 25 independent samples: the error bar is rough");

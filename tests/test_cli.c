@@ -747,3 +747,23 @@ Test(cli, text_files_with_a_byte_order_mark_read_as_without)
                           lw_test_bin(), lw_test_root(), dir, dir, dir, dir, dir, lw_test_bin(), dir, lw_test_bin(),
                           dir, dir, dir), 0);
 }
+
+/* An irregular segment's message names the test that failed and the key to
+** lower: both were named, and both values called reasons, when one test was
+** off or passed. */
+Test(cli, an_irregular_segment_is_refused_naming_the_test_that_failed)
+{
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set anneal.sweeps=30 --out %s/m --quiet --threads 1", b,
+                          lw_test_root(), dir), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/m/scene.ini --set init.from=%s/m/state.lw --set anneal.sweeps=0 --set "
+                          "energy.min_speed=0.95 --out %s/s --quiet 2>%s/err.txt; test $? -eq 2 && grep -q "
+                          "'its speed falls to 0.[0-9]* of its mean (energy.min_speed = 0.95; the mean as 8 nodes "
+                          "measure the length), a fold the quadrature cannot see; lower energy.min_speed to accept it' "
+                          "%s/err.txt", b, dir, dir, dir, dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/m/scene.ini --set init.from=%s/m/state.lw --set anneal.sweeps=0 --set "
+                          "energy.min_speed=0 --set energy.regularity=3 --out %s/r --quiet 2>%s/err.txt; test $? -eq 2 "
+                          "&& grep -q 'is irregular: its bending integrand is analytic only within rho = [0-9.]* "
+                          "(energy.regularity = 3), a fold the quadrature cannot see; lower energy.regularity' %s/err.txt",
+                          b, dir, dir, dir, dir, dir), 0);
+}

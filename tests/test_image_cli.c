@@ -269,8 +269,11 @@ Test(image_cli, samples_wider_apart_than_the_blur_get_a_note)
                       "[energy]\nstrain = 1\nbending = 1\npotential = 10\n[anneal]\nsweeps = 1\n");
   char errs[8192];
   cr_assert_eq(run("run b.ini --out b --stop-at 0", errs, sizeof errs), 0, "%s", errs);
-  cr_assert(strstr(errs, "the placed segments' samples lie up to 1.47 mm apart, more than scene.potential_blur "
-                         "(0.5 mm)"), "%s", errs);
+  cr_assert(strstr(errs, "the placed segments' samples lie up to 1.47 mm apart, more than the picture's detail "
+                         "under scene.potential_blur (0.5 mm,"), "%s", errs);
+  /* a picture blurred as wide as the gap: none */
+  cr_assert_eq(run("run b.ini --out b --stop-at 0 --set scene.image_blur=3", errs, sizeof errs), 0, "%s", errs);
+  cr_assert_null(strstr(errs, "samples lie up to"), "%s", errs);
   cr_assert_eq(run("run b.ini --out b --stop-at 0 --set energy.pair=0.01 --set energy.pair_cutoff=3", errs,
                    sizeof errs), 0, "%s", errs);
   cr_assert_null(strstr(errs, "samples lie up to"), "%s", errs);

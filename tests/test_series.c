@@ -903,9 +903,30 @@ Test(series, one_value_has_no_spread_and_one_row_no_error_bar)
   for (int i = 0; i < 600; i++) x[i] = 0.2074103559;
   lw_series_stats s;
   lw_series_stats_of(x, 600, &s);
-  cr_assert(s.mean == 0.2074103559 && s.sd == 0.0 && s.stderr_mean == 0.0, "mean %.17g sd %g se %g", s.mean, s.sd,
-            s.stderr_mean);
+  cr_assert(s.mean == 0.2074103559 && s.sd == 0.0 && s.stderr_mean == 0.0 && s.tau == 0.5 && s.window == 1,
+            "mean %.17g sd %g se %g tau %g window %zu", s.mean, s.sd, s.stderr_mean, s.tau, (size_t)s.window);
   lw_series_stats_of(x, 1, &s);
   cr_assert(s.n == 1 && s.mean == 0.2074103559 && isnan(s.sd) && isnan(s.stderr_mean), "sd %g se %g", s.sd,
             s.stderr_mean);
+}
+
+/* A stretch of one row: a mean, no error bar (it gave stderr 0 and looked
+** exact), a warning that says so, and in the CSV empty fields; a column the
+** table shows empty is a CSV line too. */
+Test(trace, one_row_gives_a_mean_and_no_error_bar, .init = make_dir, .fini = remove_dir)
+{
+  char path[128];
+  write_trace("t.csv", "sweep,temperature,total,acc_point\n5,0.5,3.25,\n", path, sizeof path);
+  lw_error err;
+  lw_trace *t = lw_trace_read(path, &err);
+  cr_assert_not_null(t, "%s", err.msg);
+  static char out[4096];
+  lw_trace_select sel = {.from = -1, .to = -1, .csv = 0};
+  report_of(t, &sel, out, sizeof out);
+  cr_assert(strstr(out, "warning: total: one row: a mean and no error bar"), "%s", out);
+  cr_assert(strstr(out, "3.25           -           -"), "%s", out);
+  sel.csv = 1;
+  report_of(t, &sel, out, sizeof out);
+  cr_assert(strstr(out, "\ntotal,1,3.25,,,,,") && strstr(out, "\nacc_point,0,,,,,,,,\n"), "%s", out);
+  lw_trace_free(t);
 }
