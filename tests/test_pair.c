@@ -109,19 +109,25 @@ static void straight(lw_splines *sp, size_t i, const double p[2], const double q
   lw_test_straight(sp, i, p[0], p[1], q[0], q[1]);
 }
 
+/* A 20 mm page with the pair term alone (C = 1). */
+static void pair_alone(lw_params *p, int nq, double cutoff, double near)
+{
+  lw_params_defaults(p);
+  p->width = p->height = 20;
+  p->margin = 0;
+  p->strain = p->bending = p->potential_coef = p->field_coef = p->boundary_coef = 0;
+  p->pair = 1;
+  p->pair_cutoff = cutoff;
+  p->pair_near = near;
+  p->quadrature = nq;
+}
+
 /* The pair energy (no coefficient) between splines 0 and 1 as the model
 ** computes it: a scene with the pair term alone (C = 1). */
 static double pair_energy(const lw_splines *sp, int nq, double cutoff, double near)
 {
   lw_params p;
-  lw_params_defaults(&p);
-  p.width = p.height = 20;
-  p.margin = 0;
-  p.strain = p.bending = p.potential_coef = p.field_coef = p.boundary_coef = 0;
-  p.pair = 1;
-  p.pair_cutoff = cutoff;
-  p.pair_near = near;
-  p.quadrature = nq;
+  pair_alone(&p, nq, cutoff, near);
   lw_scene sc;
   lw_error err;
   cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
@@ -409,12 +415,7 @@ Test(pair, segseg_never_nan_on_degenerate_grids)
 Test(pair, a_near_field_too_small_for_a_crossing_between_samples_is_refused)
 {
   lw_params p;
-  lw_params_defaults(&p);
-  p.width = p.height = 20;
-  p.margin = 0;
-  p.strain = p.bending = p.potential_coef = p.field_coef = p.boundary_coef = 0;
-  p.pair = 1;
-  p.pair_cutoff = 5;
+  pair_alone(&p, 8, 5, 1.5);
   lw_quad q;
   lw_error err;
   cr_assert_eq(lw_quad_init(&q, 8, &err), LW_OK);
