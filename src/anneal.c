@@ -398,10 +398,11 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
     int idle;
     const char *why;
   } rule[] = {
-      {table, !(needs & LW_SCHEDULE_USES_TABLE), "anneal.schedule reads no table"},
+      {table, a->sched_type && lw_params_file_idle(p, lw_params_find("anneal", "table")),
+       "anneal.schedule reads no table"},
       {lambda, !(needs & LW_SCHEDULE_USES_LAMBDA), "anneal.schedule is not adaptive"},
       {polygon, p->boundary != LW_BND_POLYGON, "scene.boundary is not polygon"},
-      {mask, p->mask != LW_MASK_IMAGE, "scene.mask is not image"},
+      {mask, lw_params_file_idle(p, lw_params_find("scene", "mask_image")), "scene.mask is not image"},
       {coverage, p->splines != 0, "init.splines is not 0"},
       {orientation, p->page == LW_PAGE_CUSTOM, "no scene.page names a size"},
       {picture, !p->image[0], "no scene.image"},

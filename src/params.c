@@ -1474,11 +1474,7 @@ static void file_text(const char *path, char *buf, size_t n, int *unread)
   else snprintf(buf, n, "file %016llx", h);
 }
 
-/* Whether the file path key d names is never read by the run as it goes
-** on: init.from (read at the start only), a table under a schedule that
-** reads none, a mask picture without mask = image.  Such a file may move or
-** change. */
-static int path_idle(const lw_params *p, const lw_param_def *d)
+int lw_params_file_idle(const lw_params *p, const lw_param_def *d)
 {
   if (!strcmp(d->section, "init") && !strcmp(d->key, "from")) return 1;
   if (!strcmp(d->section, "anneal") && !strcmp(d->key, "table")) {
@@ -1497,7 +1493,7 @@ unsigned long long lw_params_run_hash(const lw_params *p, lw_run_keys *keys)
     const lw_param_def *d = &lw_param_table[i];
     if ((p->of_run && p->line[i] <= 0) || lw_params_named(file_keys, d)) continue;
     const int is_path = d->type == LW_PT_STRING && !strcmp(d->unit, "path");
-    if (keys && is_path && path_idle(p, d)) continue;
+    if (keys && is_path && lw_params_file_idle(p, d)) continue;
     int n = snprintf(line, sizeof line, "%s.%s=", d->section, d->key), unread = 0;
     const char *path = (const char *)p + d->offset;
     if (keys && is_path && path[0]) file_text(path, line + n, sizeof line - (size_t)n, &unread);

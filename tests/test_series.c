@@ -208,13 +208,20 @@ static void write_trace(const char *name, const char *text, char *path, size_t n
   snprintf(path, n, "%s/%s", dir, name);
 }
 
-Test(trace, rows_and_empty_fields_read_back_and_a_partial_last_row_is_left_out, .init = make_dir, .fini = remove_dir)
+/* text written as the suite's t.csv and read back (it must read). */
+static lw_trace *trace_of(const char *text)
 {
   char path[128];
-  write_trace("t.csv", "sweep,temperature,total,acc_point\n1,0.5,10.25,0.5\n2,0.5,9.5,\n3,0.5,9", path, sizeof path);
+  write_trace("t.csv", text, path, sizeof path);
   lw_error err;
   lw_trace *t = lw_trace_read(path, &err);
   cr_assert_not_null(t, "%s", err.msg);
+  return t;
+}
+
+Test(trace, rows_and_empty_fields_read_back_and_a_partial_last_row_is_left_out, .init = make_dir, .fini = remove_dir)
+{
+  lw_trace *t = trace_of("sweep,temperature,total,acc_point\n1,0.5,10.25,0.5\n2,0.5,9.5,\n3,0.5,9");
   cr_assert(t->n_cols == 4 && t->n_rows == 2, "%zu columns, %zu rows", t->n_cols, t->n_rows);
   cr_assert_eq(lw_trace_column(t, "acc_point"), 3);
   cr_assert_eq(lw_trace_column(t, "nothing"), -1);
@@ -915,11 +922,7 @@ Test(series, one_value_has_no_spread_and_one_row_no_error_bar)
 ** table shows empty is a CSV line too. */
 Test(trace, one_row_gives_a_mean_and_no_error_bar, .init = make_dir, .fini = remove_dir)
 {
-  char path[128];
-  write_trace("t.csv", "sweep,temperature,total,acc_point\n5,0.5,3.25,\n", path, sizeof path);
-  lw_error err;
-  lw_trace *t = lw_trace_read(path, &err);
-  cr_assert_not_null(t, "%s", err.msg);
+  lw_trace *t = trace_of("sweep,temperature,total,acc_point\n5,0.5,3.25,\n");
   static char out[4096];
   lw_trace_select sel = {.from = -1, .to = -1, .csv = 0};
   report_of(t, &sel, out, sizeof out);
