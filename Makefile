@@ -1,5 +1,6 @@
 # linewise -- elastic Bezier curves annealed into line art.
-# Targets: all (bin/linewise), deps, deps-mpi, mpi (bin/linewise-mpi), test, test-long, asan, fuzz, fuzz-build, run, bench, wire-figures, install, clean.
+# Targets: all (bin/linewise), deps, deps-mpi, mpi (bin/linewise-mpi), test, test-long, asan, fuzz, fuzz-build, run, bench, wire-figures,
+# install, uninstall, clean.
 
 CC      ?= cc
 PREFIX  ?= /usr/local
@@ -38,7 +39,8 @@ TOOLS   := seed-sweep param-sweep plot-run plot-sweep thread-scaling
 # The example picture is generated (no third-party images in the repository).
 PICTURE := params/picture.png
 
-.PHONY: all deps deps-mpi mpi deps-animation test test-long asan fuzz fuzz-build run bench install clean docs wire-figures
+.PHONY: all deps deps-mpi mpi deps-animation test test-long asan fuzz fuzz-build run bench install uninstall clean docs \
+        wire-figures
 # The example picture too: params/example.ini, the scene a new user tries
 # first, needs it.
 all: $(BIN)/linewise $(PICTURE)
@@ -199,15 +201,24 @@ wire-figures: $(BUILD)/wire-midpoint
 	$(BUILD)/wire-midpoint params/wire.ini 20 nurbs.beta=50 dynamics.dt=0.004 > $(WIRE_DATA)/beta50.dat
 	gnuplot -e "data='$(WIRE_DATA)'; out='docs'" tools/wire-figures.gp
 
-install: $(BIN)/linewise $(PICTURE)
-	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/linewise/params
-	install -m 755 bin/linewise $(DESTDIR)$(PREFIX)/bin/linewise
-	install -m 644 params/*.ini $(PICTURE) $(DESTDIR)$(PREFIX)/share/linewise/params/
+# The scenes with what they read (pictures, the states of init.from), the
+# tools, the man page, README and docs/; linewise-mpi where mpicc is (built
+# here, never an older one left in bin/).
+INSTALLED := bin/linewise bin/linewise-mpi $(TOOLS:%=bin/linewise-%) bin/linewise-animate \
+             share/linewise share/doc/linewise share/man/man1/linewise.1
+install: $(BIN)/linewise $(PICTURE) $(MPI_BIN)
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/linewise/params $(DESTDIR)$(PREFIX)/share/doc/linewise
+	install -m 755 $(BIN)/linewise $(MPI_BIN) $(DESTDIR)$(PREFIX)/bin/
+	install -m 644 params/*.ini params/*.lw $(PICTURE) $(DESTDIR)$(PREFIX)/share/linewise/params/
 	install -d $(DESTDIR)$(PREFIX)/share/man/man1
 	install -m 644 docs/linewise.1 $(DESTDIR)$(PREFIX)/share/man/man1/linewise.1
 	for t in $(TOOLS); do install -m 755 tools/$$t $(DESTDIR)$(PREFIX)/bin/linewise-$$t; done
+	install -m 755 tools/animate.sh $(DESTDIR)$(PREFIX)/bin/linewise-animate
 	install -m 644 tools/slurm-sweep.sbatch tools/slurm-tempering.sbatch $(DESTDIR)$(PREFIX)/share/linewise/
-	if [ -x $(BIN)/linewise-mpi ]; then install -m 755 $(BIN)/linewise-mpi $(DESTDIR)$(PREFIX)/bin/linewise-mpi; fi
+	install -m 644 README.md docs/*.md docs/*.png $(DESTDIR)$(PREFIX)/share/doc/linewise/
+
+uninstall:
+	rm -rf $(INSTALLED:%=$(DESTDIR)$(PREFIX)/%)
 
 clean:
 	rm -rf build build-asan build-fuzz bin $(PICTURE)

@@ -28,6 +28,7 @@
 #include "linewise/rundir.h"
 #include "linewise/state.h"
 #include "linewise/trace.h"
+#include "linewise/version.h"
 
 static double now_seconds(void)
 {
@@ -248,14 +249,23 @@ static lw_status absolute_paths(lw_anneal *a, lw_error *err)
     snprintf(was, sizeof was, "%s", path);
     make_absolute(path, a->params.file);
     size_t len = strlen(path), cap = lw_params_text_cap(d);
+    char where[LW_PATH_MAX + 32];
     if (len > cap || (was[0] && path[0] != '/')) {
-      char where[LW_PATH_MAX + 32];
       lw_params_origin(&a->params, d, where, sizeof where);
       char size[48] = "too long";
-      if (path[0] == '/') snprintf(size, sizeof size, "%zu characters", len);
+      if (path[0] == '/') snprintf(size, sizeof size, "%zu bytes", len);
       return lw_error_set(err, LW_EINPUT, "%s: key '%s.%s': '%s' made absolute is %s, and the run's scene.ini "
                           "(which resume reads) holds %zu on its line; move the file, or run from a shorter path",
                           where, d->section, d->key, was, size, cap);
+    }
+    /* a folder named "Fotos ;alt" is a comment from its ';' on, once the
+    ** name is written into scene.ini: resume would look for "Fotos" */
+    if (!lw_params_text_reads_back(path)) {
+      lw_params_origin(&a->params, d, where, sizeof where);
+      return lw_error_set(err, LW_EINPUT, "%s: key '%s.%s': '%s' made absolute is '%s', which the run's "
+                          "scene.ini (which resume reads) cannot hold: ';' after a blank begins a comment there, "
+                          "and blanks at either end are dropped; rename the file or its folder",
+                          where, d->section, d->key, was, path);
     }
   }
   return LW_OK;
@@ -291,6 +301,12 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
       return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.t_max': expected a value above t_min = %g, got %g",
                           where, p->t_min, p->t_max);
     lw_tempering_geometric(ladder, a->n_rep, p->t_min, p->t_max);
+  }
+  if (a->net && a->n_rep < a->net->size && p->driver == LW_DRIVER_DYNAMICS) {
+    /* its replicas key is idle (one system): not the key to change */
+    lw_params_origin(p, lw_params_find("scene", "driver"), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'scene.driver': dynamics moves one system, which one process "
+                        "holds; expected one process (mpirun -n 1, or linewise) for %d", where, a->net->size);
   }
   if (a->net && a->n_rep < a->net->size) {
     lw_params_origin(p, lw_params_find("tempering", "replicas"), where, sizeof where);
@@ -392,7 +408,13 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
                            *const jumps[] = {"moves.birth", "moves.birth_uniform", "moves.birth_spread",
                                              "moves.prior_sd", "moves.death", "moves.grow", "moves.shrink",
                                              "moves.max_segments", "moves.split", "moves.join",
-                                             "moves.join_radius", NULL};
+                                             "moves.join_radius", "energy.chem_spline", NULL},
+                           *const weights[] = {"nurbs.weight_inertia", "nurbs.weight_stiffness", "nurbs.step_weight",
+                                               NULL},
+                           *const births[] = {"particles.max_count", "particles.chem", NULL},
+                           *const sigma[] = {"particles.sigma", NULL},
+                           *const sigma_normal[] = {"particles.sigma_normal", NULL},
+                           *const gravity[] = {"dynamics.gravity_x", "dynamics.gravity_y", NULL};
   const struct {
     const char *const *keys;
     int idle;
@@ -408,6 +430,11 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
       {picture, !p->image[0], "no scene.image"},
       {ladder, a->n_rep == 1, "one replica"},
       {jumps, p->fixed_count, "moves.fixed_count = 1"},
+      {weights, !p->nb_free_weights, "nurbs.free_weights = 0"},
+      {births, p->pt_birth == 0.0 && p->pt_death == 0.0, "no particles.birth or death"},
+      {sigma, p->pt_weight == LW_PWEIGHT_POLY, "particles.weight = poly"},
+      {sigma_normal, p->pt_weight != LW_PWEIGHT_ANISO, "particles.weight is not aniso"},
+      {gravity, p->dyn_rho == 0.0, "dynamics.rho = 0: no mass to weigh"},
   };
   size_t m = 0;
   if (size) idle[0] = '\0';
@@ -630,6 +657,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   a->scene_hash = lw_params_run_hash(&a->params, &a->scene_keys);
   /* Everything above only read input: the directory appears once the run
   ** is known to be valid. */
+  lw_phase_writing();
   if ((s = lw_rundir_make(dir, err)) || (writes_files(a) && (s = lw_rundir_lock(dir, &a->dir_hold, err))))
     return s;
   if (writes_files(a) && (s = clear_run(dir, err))) return s;
@@ -870,8 +898,11 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   if (a->end_sweep < 0) a->end_sweep = a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep;
   const long saved_end = a->end_sweep;
   if (more >= 0) a->end_sweep = a->sweep + more;
+  /* (every process of an MPI run: one that writes nothing must still stop
+  ** with the others, not at once) */
+  lw_phase_writing();
   if (writes_files(a)) s = truncate_trace(a, trace_bytes, err);
-  /* nothing is written yet: the caller may still refuse to go on */
+  /* nothing else is written yet: the caller may still refuse to go on */
   a->extending = !s && writes_files(a) && !lw_anneal_done(a);
   a->new_end = a->end_sweep != saved_end;
 out:
@@ -1251,6 +1282,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json j;
   lw_json_init(&j, f);
   lw_json_begin_object(&j);
+  lw_json_key(&j, "version"); lw_json_string(&j, LW_VERSION); /* the release that wrote it */
   lw_json_key(&j, "seed"); lw_json_int(&j, (long long)a->seed);
   lw_json_key(&j, "sweeps"); lw_json_int(&j, a->sweep);
   lw_json_key(&j, "system"); lw_json_string(&j, t->name);
@@ -1264,6 +1296,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     lw_json_key(&j, "rejected_nan"); lw_json_int(&j, (long long)nan);
     put_per_move(&j, "rejected_irregular", c, t, offsetof(lw_move_stats, irregular));
     put_per_move(&j, "rejected_crowded", c, t, offsetof(lw_move_stats, crowded));
+    put_per_move(&j, "rejected_outside", c, t, offsetof(lw_move_stats, outside));
   }
   lw_json_key(&j, "wall_seconds"); lw_json_number(&j, wall);
   lw_json_key(&j, "sweep_seconds"); lw_json_number(&j, a->sweep_seconds);

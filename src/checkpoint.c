@@ -73,7 +73,9 @@ void lw_checkpoint_put_chain(lw_ckpt_writer *w, const lw_anneal *a, int k, int *
     snprintf(key, sizeof key, "window.%s", name);
     lw_ckpt_put_counts(w, key, (unsigned long[]){c->win_prop[m], c->win_acc[m]}, 2);
     snprintf(key, sizeof key, "moves.%s", name);
-    lw_ckpt_put_counts(w, key, (unsigned long[]){st->proposed, st->accepted, st->nan, st->irregular, st->crowded}, 5);
+    lw_ckpt_put_counts(w, key,
+                       (unsigned long[]){st->proposed, st->accepted, st->nan, st->irregular, st->crowded, st->outside},
+                       6);
   }
   t->terms(c->sys->state, term);
   for (int q = 0; q < t->n_terms; q++) {
@@ -260,7 +262,7 @@ static lw_status get_chain(lw_ckpt *doc, int k, const lw_system_type *t, lw_chai
   lw_status s = get_rng(doc, sec, c->rng, err);
   for (int m = 0; m < c->n_moves && !s; m++) {
     const char *name = t->move_names[m];
-    unsigned long v[5] = {0, 0, 0, 0, 0};
+    unsigned long v[6] = {0, 0, 0, 0, 0, 0};
     snprintf(key, sizeof key, "step.%s", name);
     /* tuning keeps steps in [1e-300, step_max] (mc.c); a kind without a
     ** step has 0, or before 2026-12 whatever tuning had left in [0, 1] */
@@ -276,16 +278,22 @@ static lw_status get_chain(lw_ckpt *doc, int k, const lw_system_type *t, lw_chai
     c->win_prop[m] = v[0];
     c->win_acc[m] = v[1];
     snprintf(key, sizeof key, "moves.%s", name);
-    v[0] = v[1] = v[2] = v[3] = v[4] = 0;
-    /* the crowded count is new: older files have four */
-    if ((s = lw_ckpt_counts_upto(doc, sec, key, v, 4, 5, 0, err))) break;
-    if (v[1] > v[0] || v[2] > v[0] - v[1] || v[3] > v[0] - v[1] - v[2] || v[4] > v[0] - v[1] - v[2] - v[3]) {
-      s = lw_error_set(err, LW_EINPUT, "%s: [%s] %s: expected 'proposed accepted nan irregular crowded' with "
-                       "accepted + nan + irregular + crowded <= proposed, got %lu %lu %lu %lu %lu", path, sec, key,
-                       v[0], v[1], v[2], v[3], v[4]);
+    memset(v, 0, sizeof v);
+    /* the crowded and outside counts are new: older files have four or five */
+    if ((s = lw_ckpt_counts_upto(doc, sec, key, v, 4, 6, 0, err))) break;
+    unsigned long left = v[0];
+    int fits = 1;
+    for (int q = 1; q < 6 && fits; q++) {
+      fits = v[q] <= left;
+      left -= fits ? v[q] : 0;
+    }
+    if (!fits) {
+      s = lw_error_set(err, LW_EINPUT, "%s: [%s] %s: expected 'proposed accepted nan irregular crowded outside' "
+                       "with accepted + nan + irregular + crowded + outside <= proposed, got %lu %lu %lu %lu %lu %lu",
+                       path, sec, key, v[0], v[1], v[2], v[3], v[4], v[5]);
       break;
     }
-    c->stats[m] = (lw_move_stats){v[0], v[1], v[2], v[3], v[4]};
+    c->stats[m] = (lw_move_stats){v[0], v[1], v[2], v[3], v[4], v[5]};
   }
   return s;
 }

@@ -43,7 +43,6 @@ static lw_chain *cell_chain(const lw_chain *c, lw_error *err)
   dc->rng = NULL;
   dc->part = 1;
   dc->tuning = 0;
-  dc->outside = 0;
   memset(dc->stats, 0, sizeof dc->stats);
   memset(dc->win_prop, 0, sizeof dc->win_prop);
   memset(dc->win_acc, 0, sizeof dc->win_acc);
@@ -110,8 +109,10 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
       if (nx < 2) return LW_OK;
     }
     if (!(w / nx > 2.0 * reach) || !(h / ny > 2.0 * reach)) {
+      /* in the system's lengths: mm for curves, the scene's unit for particles */
       char what[160];
-      snprintf(what, sizeof what, " (domains %.4g x %.4g mm against a reach of %.4g mm)", w / nx, h / ny, reach);
+      snprintf(what, sizeof what, " (domains %.4g x %.4g against a reach of %.4g, in the scene's lengths)", w / nx,
+               h / ny, reach);
       return bad_key(p, err,
                      "'%s': domains must be wider than twice the reach of a move%s; expected fewer, or auto, "
                      "which picks a count that fits",

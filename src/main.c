@@ -26,6 +26,7 @@
 #include "linewise/state.h"
 #include "linewise/system.h"
 #include "linewise/trace.h"
+#include "linewise/version.h"
 #ifdef LW_MPI
 #include "linewise/mpi_tempering.h"
 #endif
@@ -76,6 +77,7 @@ static const char usage[] =
   "                          column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs)\n"
   "  params              print every scene parameter as Markdown (docs/PARAMETERS.md)\n"
   "  schedules           print the temperature schedules as Markdown (docs/SCHEDULES.md)\n"
+  "  version             the release (also --version)\n"
   "  help                this text\n"
   "\n"
   "exit status: 0 done, 1 failed while running, 2 bad usage or bad input\n";
@@ -216,6 +218,28 @@ static void name_run_dir(const char *dir)
   if (n > 0 && (size_t)n < sizeof second_msg) second_len = n;
 }
 
+/* A run that has written nothing (lw_phase_unwritten: its set-up, which can
+** take minutes) ends at the first signal: there is nothing to save.  The
+** default directory made for it, empty but for its lock, goes too. */
+static char made_lock[LW_PATH_MAX + 16], made_dir[LW_PATH_MAX];
+static volatile sig_atomic_t made_what = 0; /* 1 made_dir was made for the run, 3 "out" too */
+
+static void stop_unwritten(int sig)
+{
+  static const char msg[] = "\nlinewise: stopped during the set-up, before anything was written\n";
+  ssize_t w = write(2, msg, sizeof msg - 1);
+  (void)w;
+  if (made_what) {
+    unlink(made_lock);
+    rmdir(made_dir);
+    if (made_what & 2) rmdir("out");
+  }
+  _exit(128 + sig);
+}
+
+/* A second signal before the run's first checkpoint leaves nothing to resume. */
+static volatile sig_atomic_t checkpointed = 0;
+
 /* The first signal asks for a clean stop after the sweep in progress; a
 ** second ends the process at once (a sweep can take minutes), leaving
 ** the last checkpoint, which state.lw always holds whole. */
@@ -232,12 +256,15 @@ static void on_signal(int sig)
                              "them)\n";
   const int files = finishing == 1 && say_finishing;
   if (finishing == 2) return; /* the run is whole, summary.json too: it ends as it would have */
+  if (!stop_requested && lw_phase_unwritten()) stop_unwritten(sig);
   if (!stop_requested && (files || on_terminal)) {
     ssize_t w = files ? write(2, last, sizeof last - 1) : write(2, first, sizeof first - 1);
     (void)w;
   }
   if (stop_requested) {
-    ssize_t w = write(2, second_msg, (size_t)second_len);
+    static const char none[] = "\nlinewise: a second signal: stopped at once, before the run's first checkpoint "
+                               "(nothing to resume: run it again)\n";
+    ssize_t w = checkpointed ? write(2, second_msg, (size_t)second_len) : write(2, none, sizeof none - 1);
     (void)w;
     _exit(128 + sig);
   }
@@ -608,6 +635,11 @@ static int cmd_run(int argc, char **argv)
   if (out) snprintf(dir, sizeof dir, "%s", out);
   else if (default_dir(dir, sizeof dir, scene, &hold, &made, &err)) return fail(&err);
   name_run_dir(dir);
+  if (made) {
+    snprintf(made_dir, sizeof made_dir, "%s", dir);
+    lw_path_join(made_lock, sizeof made_lock, dir, ".lock");
+    made_what = made;
+  }
   /* the run writes its resolved parameters to DIR/scene.ini: over a run's
   ** (a run made again in place), never over a scene file a person wrote,
   ** the one this run reads included */
@@ -623,11 +655,14 @@ static int cmd_run(int argc, char **argv)
   const int asked = quiet;
   if (net && net->rank) quiet = 1;
   watcher_start(&w, quiet);
+  lw_phase_hold();
   if (spread_start(lw_anneal_start_net(&a, &p, dir, net, &err), &a, 1, &err)) {
     lw_anneal_free(&a);
     unmake_dir(dir, hold, made);
     return watched_fail(&w, &err);
   }
+  made_what = 0;
+  checkpointed = 1;
   if (!quiet) {
     const char *note = a.sys_type->note(a.setup);
     char size[128];
@@ -679,6 +714,8 @@ static int cmd_resume(int argc, char **argv)
   const int asked = quiet;
   if (net && net->rank) quiet = 1;
   watcher_start(&w, quiet);
+  checkpointed = 1; /* state.lw holds the last one */
+  lw_phase_hold();
   if (spread_start(lw_anneal_resume_net(&a, dir, more, net, &err), &a, 0, &err)) {
     lw_anneal_free(&a);
     return watched_fail(&w, &err);
@@ -886,6 +923,18 @@ static int command(int argc, char **argv)
   if (!strcmp(argv[1], "run")) return cmd_run(argc - 2, argv + 2);
   if (!strcmp(argv[1], "resume")) return cmd_resume(argc - 2, argv + 2);
   if (!strcmp(argv[1], "stats")) return cmd_stats(argc - 2, argv + 2);
+  const char *cmd = argv[1];
+  const int listing = !strcmp(cmd, "schedules") || !strcmp(cmd, "params");
+  if (listing || !strcmp(cmd, "version") || !strcmp(cmd, "--version") || !strcmp(cmd, "-V")) {
+    if (argc > 2) {
+      fprintf(stderr, "linewise %s: unexpected '%s' (it takes no arguments)\n", cmd, argv[2]);
+      return 2;
+    }
+    if (!listing) {
+      printf("linewise %s\n", LW_VERSION);
+      return 0;
+    }
+  }
   if (!strcmp(argv[1], "schedules")) {
     printf("\n| schedule | temperature of step b of B |\n|---|---|\n");
     for (const lw_schedule_type *const *t = lw_schedule_types; *t; t++)

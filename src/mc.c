@@ -90,7 +90,7 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
     s->nan++;
     accept = 0;
   } else if (forbidden == 2) {
-    c->outside++;
+    s->outside++;
     accept = 0;
   } else if (forbidden == 3) {
     s->crowded++;
@@ -196,14 +196,13 @@ void lw_chain_absorb(lw_chain *c, lw_chain *from)
     a->nan += b->nan;
     a->irregular += b->irregular;
     a->crowded += b->crowded;
+    a->outside += b->outside;
     if (c->tuning) {
-      c->win_prop[k] += b->proposed;
+      c->win_prop[k] += b->proposed - b->outside;
       c->win_acc[k] += b->accepted;
     }
     *b = (lw_move_stats){0};
   }
-  c->outside += from->outside;
-  from->outside = 0;
 }
 
 void lw_chain_tune(lw_chain *c)

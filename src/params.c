@@ -905,18 +905,10 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     ** that scene.ini, written back by a run, reads again. */
     size_t len = strlen(text), cap = lw_params_text_cap(d);
     if (len > cap) {
-      snprintf(expected, n, "at most %zu characters", cap);
+      snprintf(expected, n, "at most %zu bytes", cap);
       return 0;
     }
-    /* A run writes its parameters back as INI (scene.ini, which resume
-    ** reads), where a ';' at the start of a value or after a blank begins a
-    ** comment and blanks at either end are trimmed: text like that would
-    ** come back different, so it is refused here. */
-    int ok = !len || (text[0] != ';' && text[0] != ' ' && text[0] != '\t' && text[len - 1] != ' ' &&
-                      text[len - 1] != '\t');
-    for (const char *c = text; ok && *c; c++)
-      ok = ((unsigned char)*c >= 0x20 || *c == '\t') && !((*c == ' ' || *c == '\t') && c[1] == ';');
-    if (!ok) {
+    if (!lw_params_text_reads_back(text)) {
       snprintf(expected, n, "text without control characters, blanks at either end, or ';' at the "
                             "start or after a blank");
       return 0;
@@ -1018,7 +1010,8 @@ static char *read_line(char *str, int num, void *stream)
   }
   /* inih would end the value at a NUL byte and drop the rest unseen */
   if (memchr(rc->buf, '\0', (size_t)len)) {
-    lw_error_set(rc->err, LW_EINPUT, "%s:%d: a NUL byte inside the line", rc->p->file, rc->line);
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: a NUL byte inside the line (UTF-16 text, as some editors save "
+                 "'Unicode', has one in every other byte): expected UTF-8 or ASCII text", rc->p->file, rc->line);
     rc->failed = 1;
     return NULL;
   }
@@ -1280,6 +1273,20 @@ static lw_status landscape_picture(const lw_params *p, int *landscape, lw_error 
   }
   *landscape = info.width > info.height;
   return LW_OK;
+}
+
+/* A run writes its parameters back as INI (scene.ini, which resume reads),
+** where a ';' at the start of a value or after a blank begins a comment and
+** blanks at either end are trimmed: text like that would come back
+** different. */
+int lw_params_text_reads_back(const char *text)
+{
+  size_t len = strlen(text);
+  int ok = !len || (text[0] != ';' && text[0] != ' ' && text[0] != '\t' && text[len - 1] != ' ' &&
+                    text[len - 1] != '\t');
+  for (const char *c = text; ok && *c; c++)
+    ok = ((unsigned char)*c >= 0x20 || *c == '\t') && !((*c == ' ' || *c == '\t') && c[1] == ';');
+  return ok;
 }
 
 size_t lw_params_text_cap(const lw_param_def *d)

@@ -25,6 +25,14 @@ void lw_phase_set(const char *what)
   atomic_store(&phase_what, what);
 }
 
+static volatile atomic_int unwritten;
+
+void lw_phase_hold(void) { atomic_store(&unwritten, 1); }
+
+void lw_phase_writing(void) { atomic_store(&unwritten, 0); }
+
+int lw_phase_unwritten(void) { return atomic_load(&unwritten); }
+
 const char *lw_phase_get(double *seconds)
 {
   const char *what = atomic_load(&phase_what);

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/fidelity.h"
 #include "linewise/imagefield.h"
 #include "linewise/number.h"
 #include "linewise/sdt.h"
@@ -103,6 +104,17 @@ static lw_image *load_picture(lw_scene *sc, const lw_params *p, const char *sect
   return img;
 }
 
+/* A picture the drawing's score (fidelity.h) cannot render is refused
+** before the run, not after it (a 100000 x 1 strip annealed, then failed). */
+static lw_status scored_side_ok(const lw_params *p, const char *section, const char *key, const lw_image *img,
+                                lw_error *err)
+{
+  if (img->width <= LW_FIDELITY_SIDE_MAX && img->height <= LW_FIDELITY_SIDE_MAX) return LW_OK;
+  return bad_key(p, section, key, LW_EINPUT, err, "%d x %d pixels: the drawing is scored on the picture's pixels, "
+                 "and cairo renders at most %d a side; expected a picture cropped or scaled to fit (or "
+                 "scene.image_width)", img->width, img->height, LW_FIDELITY_SIDE_MAX);
+}
+
 /* The picture pipeline after loading: resize, blur, flattening, levels, tone curve. */
 static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
 {
@@ -130,6 +142,7 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
     sc->image_place = lw_image_fit(r->width, r->height, p->margin, p->margin, p->width - p->margin,
                                    p->height - p->margin);
   }
+  if ((st = scored_side_ok(p, "scene", p->image_width > 0 ? "image_width" : "image", sc->image, err))) return st;
   if ((st = lw_image_blur(sc->image, p->image_blur / sc->image_place.pixel, err))) return st;
   if (p->image_flatten > 0) {
     double lo, hi;
@@ -461,6 +474,7 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     sc->reference = load_picture(sc, p, "output", "fidelity_reference", p->fidelity_reference,
                                  &sc->reference_place, err);
     if (!sc->reference) return err->code;
+    if ((st = scored_side_ok(p, "output", "fidelity_reference", sc->reference, err))) return st;
   }
 
   if (sc->on[LW_TERM_POTENTIAL]) {
@@ -529,9 +543,15 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
                              : lw_error_set(err, st, "%s", e2.msg);
   }
   if (p->min_spacing > 0.0) {
-    if (!sc->on[LW_TERM_PAIR])
+    if (!sc->on[LW_TERM_PAIR]) {
+      /* energy --set energy.pair=0 on a run with the rule: the --set is what
+      ** to change, not the run's scene.ini */
+      char where[LW_PATH_MAX + 32];
+      lw_params_origin(p, lw_params_find("energy", "pair"), where, sizeof where);
       return bad_key(p, "energy", "min_spacing", LW_EINPUT, err,
-                     "the spacing constraint looks in the pair term's cell grid: it needs energy.pair");
+                     "the spacing constraint looks in the pair term's cell grid: it needs energy.pair, which is 0 "
+                     "(%s); set energy.min_spacing = 0 too to go without both", where);
+    }
     if (p->pair_cutoff > 0.0 && p->min_spacing > p->pair_cutoff)
       return bad_key(p, "energy", "min_spacing", LW_EINPUT, err, "expected at most energy.pair_cutoff (%g mm), got %g",
                      p->pair_cutoff, p->min_spacing);

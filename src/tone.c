@@ -27,10 +27,14 @@ lw_status lw_tone_init(lw_tone *t, const lw_image *img, const lw_image_place *pl
   memset(t, 0, sizeof *t);
   /* the target is blurred at the picture's pixels, with a ring of white
   ** paper 3 sigma wide, before it is read at the raster's */
-  if (!(ceil(3.0 * sigma / pl->pixel) <= LW_TONE_BLUR_MAX))
-    return lw_error_set(err, LW_EINPUT, "tone: a blur of %g mm is %.0f pixels of %g mm, more than the %d the "
-                        "target allows; lower the picture's resolution (scene.image_max_pixels) or the blur",
-                        sigma, ceil(3.0 * sigma / pl->pixel), pl->pixel, LW_TONE_BLUR_MAX);
+  if (!(ceil(3.0 * sigma / pl->pixel) <= LW_TONE_BLUR_MAX)) {
+    /* the largest blur allowed, cut (not rounded) to 4 digits so that it is */
+    double most = LW_TONE_BLUR_MAX * pl->pixel / 3.0, scale = pow(10.0, 3.0 - floor(log10(most)));
+    return lw_error_set(err, LW_EINPUT, "tone: a blur of %g mm reaches %.0f pixels of %g mm (3 sigma), more than "
+                        "the %d the target allows; expected a blur of at most %g mm, or fewer pixels across the "
+                        "picture (scene.image_width or scene.image_max_pixels)",
+                        sigma, ceil(3.0 * sigma / pl->pixel), pl->pixel, LW_TONE_BLUR_MAX, floor(most * scale) / scale);
+  }
   const int k = tone_block(sigma, pl->pixel);
   const double px = k * pl->pixel, r = ceil(3.0 * sigma / px);
   /* px > sigma / (2 LW_TONE_SIGMA_PIXELS), so r < 6 LW_TONE_SIGMA_PIXELS = 9:

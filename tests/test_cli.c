@@ -13,6 +13,7 @@
 
 #include "linewise/model.h"
 #include "linewise/state.h"
+#include "linewise/version.h"
 #include "testutil.h"
 
 static char dir[64];
@@ -217,6 +218,32 @@ Test(cli, bad_input_exits_2_with_one_message)
   cr_assert_eq(run("energy", out, sizeof out, errs, sizeof errs), 2);
   cr_assert_eq(run("frobnicate", out, sizeof out, errs, sizeof errs), 2);
   cr_assert(strstr(errs, "frobnicate"));
+  /* the commands without arguments refuse one, as every other command does */
+  static const char *const bare[] = {"params x", "schedules x", "--version x"};
+  for (size_t k = 0; k < sizeof bare / sizeof bare[0]; k++) {
+    cr_assert_eq(run(bare[k], out, sizeof out, errs, sizeof errs), 2, "%s", bare[k]);
+    cr_assert(strstr(errs, "unexpected 'x' (it takes no arguments)"), "%s: %s", bare[k], errs);
+  }
+}
+
+/* The release, as --version, version and -V give it, is the man page's and
+** summary.json's. */
+Test(cli, the_version_is_the_man_pages_and_the_summarys)
+{
+  char out[256], errs[256], want[64];
+  snprintf(want, sizeof want, "linewise %s\n", LW_VERSION);
+  static const char *const ask[] = {"--version", "version", "-V"};
+  for (size_t k = 0; k < sizeof ask / sizeof ask[0]; k++) {
+    cr_assert_eq(run(ask[k], out, sizeof out, errs, sizeof errs), 0, "%s", ask[k]);
+    cr_assert_str_eq(out, want, "%s", ask[k]);
+  }
+  cr_assert_eq(lw_test_sh("grep -q '^.TH LINEWISE 1 \"[0-9]*\" \"linewise %s\"' %s/docs/linewise.1", LW_VERSION,
+                          lw_test_root()),
+               0, "docs/linewise.1 names another release than %s", LW_VERSION);
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set anneal.sweeps=2 --out %s/v --quiet && "
+                          "grep -q '^  \"version\": \"%s\",$' %s/v/summary.json",
+                          lw_test_bin(), lw_test_root(), dir, LW_VERSION, dir),
+               0);
 }
 
 /* A key the scene's system reads under neither driver is refused before
@@ -280,6 +307,23 @@ Test(cli, keys_the_system_never_reads_are_refused)
             strstr(errs, "init.coverage (--set: init.splines is not 0)") &&
             strstr(errs, "tempering.t_min (--set: one replica)") &&
             strstr(errs, "moves.birth (") && strstr(errs, "i.ini:10: moves.fixed_count = 1)"), "%s", errs);
+  /* the other systems' keys that their settings leave idle: the weights'
+  ** with frozen weights, gravity without mass, the births' without births,
+  ** a weighting's width under another weighting */
+  static const struct { const char *scene, *set, *want; } idle[] = {
+    {"wire", "--set nurbs.weight_inertia=5", "nurbs.weight_inertia (--set: nurbs.free_weights = 0)"},
+    {"wire", "--set dynamics.rho=0 --set dynamics.gamma=5", "dynamics.gravity_y (wire.ini:29: dynamics.rho = 0: "
+     "no mass to weigh)"},
+    {"particles-sheet", "--set particles.max_count=50 --set particles.sigma=0.3",
+     "particles.max_count (--set: no particles.birth or death), particles.sigma (--set: particles.weight = poly)"},
+  };
+  for (size_t k = 0; k < sizeof idle / sizeof idle[0]; k++) {
+    snprintf(args, sizeof args, "run %s/params/%s.ini --out %s/n%zu --set anneal.sweeps=1 %s", lw_test_root(),
+             idle[k].scene, dir, k, idle[k].set);
+    cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+    cr_assert(strstr(errs, "linewise: note: these keys have no effect here: ") && strstr(errs, idle[k].want),
+              "%s: %s", idle[k].set, errs);
+  }
 }
 
 /* A PDF page past what PDF allows (14,400 points) is refused before the run:
@@ -448,6 +492,25 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
                           "output.png_scale=20 --set anneal.sweeps=5' 2>%s/err.txt; test $? -eq 1 && grep -q "
                           "'fp/final.png: writing the PNG failed: File too large' %s/err.txt", lw_test_bin(),
                           lw_test_root(), dir, dir, dir), 0);
+}
+
+/* A set-up that has written nothing yet (50,000 splines placed: seconds, a
+** million: minutes) ends at the first signal, leaving nothing: the signal
+** once waited for the whole set-up, and a second one then spoke of a
+** checkpoint that was never written.  The default directory made for the
+** run goes too. */
+Test(cli, a_signal_before_anything_is_written_ends_the_set_up_at_once)
+{
+  cr_assert_eq(lw_test_sh("cd %s && { %s run %s/params/minimal.ini --threads 1 --set init.splines=50000 "
+                          "--set scene.width=1060 --set scene.height=1060 2>err.txt & p=$!; i=0; "
+                          "while [ $i -lt 3000 ] && ! grep -q 'placing the initial state' err.txt; do sleep 0.01; "
+                          "i=$((i+1)); done; kill -INT $p; wait $p; test $? -eq 130; }",
+                          dir, lw_test_bin(), lw_test_root()),
+               0);
+  char *e = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(e, "linewise: stopped during the set-up, before anything was written\n"), "%s", e);
+  free(e);
+  cr_assert_neq(lw_test_sh("test -e %s/out", dir), 0, "the default directory was left");
 }
 
 /* A sweep can take minutes (here a billion time steps of the whip): the

@@ -270,3 +270,47 @@ Test(domains, auto_splits_large_pages_only)
   lw_anneal_free(&a);
   lw_test_dir_remove(dir);
 }
+
+/* A proposal refused for leaving its domain saw no Metropolis test: it is
+** counted as such (summary.json's rejected_outside), and tuning leaves it
+** out.  With no energy every test accepts, so the steps grow to their caps
+** as they do unsplit (counted as rejections, a 160 mm page at 4 domains
+** held the point step at 15 mm). */
+Test(domains, refusals_at_a_domain_border_are_counted_apart_and_not_tuned_on)
+{
+  char dir[64], path[128];
+  cr_assert_eq(lw_test_dir_make(dir, "domains_outside"), 0);
+  cr_assert_eq(lw_test_write_text(dir, "s.ini",
+                                  "[scene]\nwidth = 160\nheight = 160\nmargin = 5\n"
+                                  "[init]\nsplines = 200\nsegments = 3\nsegment_length = 4\n"
+                                  "[energy]\nstrain = 0\nbending = 0\nboundary = 0\nmin_speed = 0\nregularity = 0\n"
+                                  "[anneal]\nschedule = constant\nt_start = 1\nsweeps = 40\nseed = 7\ndomains = 4\n"
+                                  "[moves]\ntune_sweeps = 20\n"),
+               0);
+  lw_params p;
+  lw_error err;
+  snprintf(path, sizeof path, "%s/s.ini", dir);
+  cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
+  lw_anneal a;
+  snprintf(path, sizeof path, "%s/run", dir);
+  cr_assert_eq(lw_anneal_start(&a, &p, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_not_null(a.chain->domains);
+  while (!lw_anneal_done(&a)) cr_assert_eq(lw_anneal_sweep(&a, &err), LW_OK, "%s", err.msg);
+  const lw_chain *c = a.chain;
+  unsigned long outside = 0;
+  for (int k = 0; k < c->n_moves; k++) {
+    const lw_move_stats *s = &c->stats[k];
+    cr_assert_eq(s->accepted + s->outside, s->proposed, "%s: %lu accepted, %lu outside, %lu proposed",
+                 c->sys->type->move_names[k], s->accepted, s->outside, s->proposed);
+    outside += s->outside;
+  }
+  cr_assert_gt(outside, 1000, "only %lu proposals left their domain", outside);
+  cr_assert_eq(c->step[LW_MOVE_POINT], c->step_max[LW_MOVE_POINT], "point step %g, cap %g", c->step[LW_MOVE_POINT],
+               c->step_max[LW_MOVE_POINT]);
+  /* and summary.json says so */
+  const unsigned long point = c->stats[LW_MOVE_POINT].outside;
+  cr_assert_eq(lw_anneal_finish(&a, &err), LW_OK, "%s", err.msg);
+  lw_anneal_free(&a);
+  cr_assert_eq(sh("grep -A1 '\"rejected_outside\"' %s/run/summary.json | grep -q '\"point\": %lu,'", dir, point), 0);
+  lw_test_dir_remove(dir);
+}

@@ -76,6 +76,7 @@ Test(dynamics_cli, the_whip_writes_frames)
   cr_assert_eq(sh("grep -q 'under driver = dynamics these keys have no effect: anneal.schedule (--set)' %s/err.txt",
                   dir), 0);
   const char *absent[] = {"proposals", "accepted", "rejected_nan", "rejected_irregular", "rejected_crowded",
+                          "rejected_outside",
                           "proposals_per_second", "max_relative_drift", "temperature_final", "schedule",
                           "acceptance", "proposed", "steps"};
   for (size_t k = 0; k < sizeof absent / sizeof absent[0]; k++)

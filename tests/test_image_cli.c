@@ -164,6 +164,44 @@ Test(image_cli, a_path_too_long_for_the_runs_scene_file_is_refused_before_the_ru
   cr_assert_neq(stat(lw_test_path("out"), &sb), 0, "nothing written");
 }
 
+/* A folder "Fotos ;alt": written into the run's scene.ini, the path is a
+** comment from its ';' on, and resume looked for "Fotos" (the run itself
+** went fine).  Refused before the run, naming the key and the path. */
+Test(image_cli, a_path_the_runs_scene_file_would_cut_at_a_semicolon_is_refused_before_the_run)
+{
+  cr_assert_eq(mkdir(lw_test_path("Fotos ;alt"), 0777), 0);
+  write_picture("Fotos ;alt/good.png", 64, 48);
+  char text[1024];
+  snprintf(text, sizeof text, scene_fmt, "good.png");
+  write_text("Fotos ;alt/scene.ini", text);
+  char errs[2048];
+  cr_assert_eq(run("run 'Fotos ;alt/scene.ini' --out out", errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "scene.ini:4: key 'scene.image': 'good.png' made absolute is '/") &&
+                strstr(errs, "Fotos ;alt/good.png', which the run's scene.ini (which resume reads) cannot hold: "
+                             "';' after a blank begins a comment there"), "%s", errs);
+  struct stat sb;
+  cr_assert_neq(stat(lw_test_path("out"), &sb), 0, "nothing written");
+}
+
+/* The drawing's score renders the picture's pixels, and cairo draws at most
+** 32767 a side: a longer strip once annealed to the end and then failed,
+** its summary unwritten.  Refused before the run; image_width scales it. */
+Test(image_cli, a_picture_too_long_to_score_is_refused_before_the_run)
+{
+  /* (a PGM: the tests' PNG writer is cairo, with the same limit) */
+  static char strip[16 + 80000];
+  int n = snprintf(strip, sizeof strip, "P5\n40000 2\n255\n");
+  for (int i = 0; i < 80000; i++) strip[n + i] = (char)(i % 251);
+  lw_test_write(lw_test_path("strip.pgm"), strip, (size_t)n + 80000);
+  write_scene("strip.pgm");
+  char errs[2048];
+  cr_assert_eq(run("run scene.ini --out out --set scene.image_max_pixels=1e6", errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "scene.ini:4: key 'scene.image': 40000 x 2 pixels: the drawing is scored on the picture's "
+                         "pixels, and cairo renders at most 32767 a side"), "%s", errs);
+  struct stat sb;
+  cr_assert_neq(stat(lw_test_path("out"), &sb), 0, "nothing written");
+}
+
 Test(image_cli, a_large_picture_is_downsampled_with_a_note)
 {
   write_picture("big.png", 120, 100);

@@ -148,6 +148,14 @@ Test(mpi, more_processes_than_replicas_is_refused_before_anything_is_written)
   /* said once, by process 0 */
   cr_assert_eq(sh("test $(grep -c 'replicas for 3 processes' %s/err.txt) -eq 1", dir), 0);
   cr_assert_neq(sh("test -e %s/x", dir), 0, "an output directory was created for bad input");
+  /* the dynamics moves one system: the driver is what to change, not the
+  ** replicas it leaves idle (the message asked for more of them) */
+  cr_assert_eq(sh(MPIRUN " -n 2 %s run %s/params/wire.ini --set tempering.replicas=2 --out %s/x --quiet 2>%s/err.txt",
+                  m, lw_test_root(), dir, dir),
+               2);
+  cr_assert_eq(sh("grep -q \"key 'scene.driver': dynamics moves one system, which one process holds; expected one "
+                  "process (mpirun -n 1, or linewise) for 2\" %s/err.txt", dir),
+               0);
 }
 
 /* The observables in the trace are the coldest rung's, whichever process

@@ -283,7 +283,7 @@ Test(params, text_longer_than_its_field_is_refused)
   lw_error err;
   char text[300];
   snprintf(text, sizeof text, "[anneal]\nschedule = %0100d\nt_start = 2\n", 0);
-  expect_error(text, ":2:", "anneal.schedule", "at most 63 characters");
+  expect_error(text, ":2:", "anneal.schedule", "at most 63 bytes");
   lw_params_defaults(&p);
   memset(text, 'g', 64);
   strcpy(text + 64, "");

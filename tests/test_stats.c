@@ -208,11 +208,12 @@ static void acceptance_case(int d, double ratio, unsigned long seed, long N, dou
   double sum = 0.0, sum2 = 0.0;
   long per = N / B, acc_all = 0, prop_all = 0;
   for (int b = 0; b < B; b++) {
-    unsigned long acc0 = c->stats[LW_MOVE_POINT].accepted, prop0 = c->stats[LW_MOVE_POINT].proposed - c->outside;
+    const lw_move_stats *st = &c->stats[LW_MOVE_POINT];
+    unsigned long acc0 = st->accepted, prop0 = st->proposed - st->outside;
     long prop = 0;
     while (prop < per) {
       cr_assert_eq(lw_chain_sweep(c), LW_OK);
-      prop = (long)(c->stats[LW_MOVE_POINT].proposed - c->outside - prop0);
+      prop = (long)(st->proposed - st->outside - prop0);
     }
     long acc = (long)(c->stats[LW_MOVE_POINT].accepted - acc0);
     double rb = (double)acc / (double)prop;
@@ -225,7 +226,7 @@ static void acceptance_case(int d, double ratio, unsigned long seed, long N, dou
   double var_b = (sum2 - sum * sum / B) / (B - 1);
   double se = fmax(sqrt(var_b / B), sqrt(a * (1.0 - a) / (double)prop_all));
   cr_log_info("acceptance d=%d s/sigma=%.1f domains %s threads %d: %.5f exact %.5f se %.1e (outside %lu)", d, ratio,
-              domains ? domains : "off", threads, rate, a, se, c->outside);
+              domains ? domains : "off", threads, rate, a, se, c->stats[LW_MOVE_POINT].outside);
   /* 5 standard errors: a false failure has probability ~ 6e-7 */
   cr_assert(fabs(rate - a) <= 5.0 * se,
             "d=%d s/sigma=%.2f domains %s threads %d: acceptance %.5f, exact %.5f, standard error %.2g", d, ratio,

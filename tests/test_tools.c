@@ -535,6 +535,30 @@ static int exists(const char *name)
   return access(path, F_OK) == 0;
 }
 
+/* Names a shell script mishandles: xargs -I{} once put each task number into
+** a "{}" of the arguments too (the runs went to "runs 1/", "runs 2/"); awk
+** read a relative operand "v=2/..." as an assignment (an empty sweep.csv,
+** plot-run waiting on stdin); gnuplot took a file "<cmd" as a pipe. */
+Test(tools, sweeps_and_plots_take_any_directory_name)
+{
+  cr_assert_eq(sh("cd %s && %s %s --seeds 1-2 -j 2 " TINY " --bin %s --out 'v=2 {}' </dev/null", dir,
+                  tool("seed-sweep"), scene(), env("LW_BIN")),
+               0, "%s", err_txt());
+  char *out = out_txt();
+  cr_assert(strstr(out, "2 finished runs gathered into v=2 {}/sweep.csv"), "%s", out);
+  free(out);
+  cr_assert_eq(sh("test $(wc -l < '%s/v=2 {}/sweep.csv') -eq 3 && test ! -e '%s/v=2 1'", dir, dir), 0,
+               "the runs went elsewhere, or sweep.csv lacks them");
+  cr_assert_eq(sh("cd %s && mv 'v=2 {}/seed-1' '<touch made;x' && %s '<touch made;x' </dev/null", dir,
+                  tool("plot-run")),
+               0, "%s", err_txt());
+  check_png("<touch made;x/plots/energy.png");
+  cr_assert(!exists("made"), "plot-run ran a directory's name as a command");
+  cr_assert_eq(sh("cd '%s/v=2 {}' && %s sweep.csv --out 'v=3.png' </dev/null", dir, tool("plot-sweep")), 0, "%s",
+               err_txt());
+  check_png("v=2 {}/v=3.png");
+}
+
 Test(tools, plot_run_draws_energy_temperature_and_acceptance)
 {
   cr_assert_eq(sh("%s run %s " TINY " --quiet --out %s/r", env("LW_BIN"), scene(), dir), 0);
@@ -679,4 +703,29 @@ Test(tools, thread_scaling_times_each_count_and_checks_the_bytes)
   char *err = err_txt();
   cr_assert(strstr(err, "thread-scaling: --threads: expected whole numbers >= 1, got '0'"), "%s", err);
   free(err);
+}
+
+/* ---- make install ------------------------------------------------------ */
+
+/* An installed copy runs on its own: every scene with what it reads (the
+** states of init.from once stayed behind), from another directory; the
+** tools say the names they are installed under; uninstall takes it all. */
+Test(tools, install_runs_every_scene_away_from_the_checkout_and_uninstall_removes_it, .timeout = 120)
+{
+  cr_assert_eq(sh("make -s -C %s install DESTDIR=%s/root PREFIX=/usr", env("LW_ROOT"), dir), 0, "%s", err_txt());
+  cr_assert_eq(sh("cd %s && for s in root/usr/share/linewise/params/*.ini; do "
+                  "  root/usr/bin/linewise run $s --stop-at 0 --quiet --threads 1 --out \"o-${s##*/}\" || "
+                  "  { echo \"$s\" >&2; exit 1; }; done",
+                  dir),
+               0, "%s", err_txt());
+  cr_assert_eq(sh("{ %s/root/usr/bin/linewise-seed-sweep --help && %s/root/usr/bin/linewise-plot-run --help; }", dir, dir),
+               0);
+  char *out = out_txt();
+  cr_assert(strstr(out, "usage: linewise-seed-sweep SCENE.ini") && strstr(out, "usage: linewise-plot-run RUN_DIR"),
+            "%s", out);
+  free(out);
+  cr_assert_eq(sh("test -s %s/root/usr/share/doc/linewise/PARAMETERS.md", dir), 0);
+  cr_assert_eq(sh("make -s -C %s uninstall DESTDIR=%s/root PREFIX=/usr && test -z \"$(find %s/root -type f)\"",
+                  env("LW_ROOT"), dir, dir),
+               0, "%s", err_txt());
 }

@@ -76,10 +76,12 @@ static void dom_start(dom_run *r, int scene, const char *domains, const char *di
   if (lw_anneal_sweep(&r->a, &err)) bench_die("domains", &err);
 }
 
-static unsigned long proposed(const lw_chain *c)
+/* The proposals of c's move kinds, or (outside) those refused for leaving
+** their domain. */
+static unsigned long proposed(const lw_chain *c, int outside)
 {
   unsigned long n = 0;
-  for (int k = 0; k < c->n_moves; k++) n += c->stats[k].proposed;
+  for (int k = 0; k < c->n_moves; k++) n += outside ? c->stats[k].outside : c->stats[k].proposed;
   return n;
 }
 
@@ -89,7 +91,7 @@ static double dom_block(dom_run *r, int threads, double seconds, double *ms_swee
 {
   lw_error err;
   if (r->a.chain->domains) r->a.chain->domains->threads = threads;
-  unsigned long p0 = proposed(r->a.chain);
+  unsigned long p0 = proposed(r->a.chain, 0);
   long sweeps = 0;
   double t0 = bench_now(), t;
   do {
@@ -97,7 +99,7 @@ static double dom_block(dom_run *r, int threads, double seconds, double *ms_swee
     sweeps++;
   } while ((t = bench_now() - t0) < seconds);
   *ms_sweep = 1e3 * t / (double)sweeps;
-  return 1e9 * t / (double)(proposed(r->a.chain) - p0);
+  return 1e9 * t / (double)(proposed(r->a.chain, 0) - p0);
 }
 
 /* The speed-up the last sweep allows on `threads` dedicated cores, from
@@ -173,7 +175,7 @@ static void domains_table(bench_ctx *b, int scene, const char *dir, FILE *data)
   }
   double frozen = dm->visits ? (double)dm->frozen / (double)dm->visits : 0.0;
   const lw_chain *c = split.a.chain;
-  double outside = (double)c->outside / (double)proposed(c);
+  double outside = (double)proposed(c, 1) / (double)proposed(c, 0);
   double load = -1.0;
   FILE *la = fopen("/proc/loadavg", "r");
   if (la) {

@@ -67,6 +67,7 @@
 #define LW_FIDELITY_FLAT 1e-9         /* gradient (per pixel) below which a pixel has no direction */
 #define LW_FIDELITY_PEN_PIXELS 1.0    /* coarser pixels (in pen widths) are rendered finer and averaged */
 #define LW_FIDELITY_FINE_MAX 16777216.0 /* the fine render's most pixels */
+#define LW_FIDELITY_SIDE_MAX 32767    /* the most pixels a side cairo renders: a longer picture cannot be scored */
 #define LW_FIDELITY_WHITE 0.02        /* blurred darkness under which the target is white paper */
 
 typedef struct {

@@ -28,6 +28,8 @@ typedef struct {
   unsigned long proposed, accepted, nan; /* nan: proposals rejected for a NaN dE */
   unsigned long irregular;  /* proposals rejected for a forbidden state (model.h) */
   unsigned long crowded;    /* ... for closing in on another stroke (energy.min_spacing) */
+  unsigned long outside;    /* ... for leaving its domain (anneal.domains): no Metropolis
+                            ** test saw them, so tuning leaves them out */
 } lw_move_stats;
 
 /* How often tuning looks at the acceptance of a move kind (proposals):
@@ -53,7 +55,6 @@ typedef struct {
   int part;                      /* 1 for a domain's chain: commits through commit_part */
   int delayed;                   /* 1 (the default): delayed acceptance where the row offers it
                                  ** (system.h, defer and finish) and T > 0 */
-  unsigned long outside;         /* proposals rejected for leaving their domain (not saved) */
 } lw_chain;
 
 /* A chain on sys with the mix, steps and targets of its n_moves kinds (mix

@@ -288,10 +288,14 @@ lw_status lw_params_read_unresolved(lw_params *p, const char *path, lw_error *er
 ** picture replaced by one of another shape would fail the page's size). */
 lw_status lw_params_read_run(lw_params *p, const char *path, int resolve, lw_error *err);
 
-/* The most characters text key d holds: its field's, and what fits on one
-** line "key = value" of the INI reader, so that a run's scene.ini reads
-** back. */
+/* The most bytes text key d holds: its field's, and what fits on one line
+** "key = value" of the INI reader, so that a run's scene.ini reads back. */
 size_t lw_params_text_cap(const lw_param_def *d);
+
+/* Whether text, written as a value into a run's scene.ini, reads back the
+** same: no control characters, no blanks at either end, no ';' at the start
+** or after a blank (which begins a comment). */
+int lw_params_text_reads_back(const char *text);
 
 /* Settles what depends on several keys, once all are known: a named page
 ** sets width and height (an explicit width or height that disagrees is an

@@ -22,6 +22,16 @@ void lw_phase_set(const char *what);
 /* The current phase (NULL: none) and, in *seconds, how long it has lasted. */
 const char *lw_phase_get(double *seconds);
 
+/* Whether the run has written nothing yet, so that a signal may end it at
+** once, even in a set-up of minutes, and lose nothing (main.c): the command
+** line sets it (lw_phase_hold) before it starts or resumes a run, and the
+** run clears it (lw_phase_writing) before its first write, the run
+** directory or a resumed trace cut back.  Lock-free: a signal handler reads
+** lw_phase_unwritten. */
+void lw_phase_hold(void);
+void lw_phase_writing(void);
+int lw_phase_unwritten(void);
+
 /* What a watcher prints, decided from what it reads at each tick, so that
 ** the rule can be tested with a made-up clock.  A phase is named once it has
 ** lasted over LW_PHASE_QUIET seconds: on a terminal (tty) in place, its

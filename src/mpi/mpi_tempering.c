@@ -95,7 +95,7 @@ static int replica_here(const lw_anneal *a, int r)
 ** NaNs included), which a sum would not promise.  Layout: a status per
 ** process, the stop flag, per replica its terms and total, the coldest
 ** rung's move counts (lw_move_stats, field by field). */
-#define STATS_WORDS 5
+#define STATS_WORDS 6
 /* Per replica its terms and total, in the slots of the replicas this
 ** process sweeps (the others stay 0 for the reduction). */
 static void pack_terms(const lw_anneal *a, uint64_t *w)
@@ -152,7 +152,8 @@ static lw_status share(lw_anneal_net *net, lw_anneal *a, int failed, lw_error *e
   if (rung_here(a, 0))
     for (int k = 0; k < nm; k++) {
       const lw_move_stats *s = &a->chain->stats[k];
-      uint64_t v[STATS_WORDS] = {s->proposed, s->accepted, s->nan, s->irregular, s->crowded};
+      uint64_t v[STATS_WORDS] = {s->proposed, s->accepted, s->nan, s->irregular, s->crowded,
+                                  s->outside};
       memcpy(st + STATS_WORDS * k, v, sizeof v);
     }
   double t0 = MPI_Wtime();
@@ -165,7 +166,7 @@ static lw_status share(lw_anneal_net *net, lw_anneal *a, int failed, lw_error *e
     for (int k = 0; k < nm; k++) {
       lw_move_stats *s = &a->chain->stats[k];
       const uint64_t *v = st + STATS_WORDS * k;
-      *s = (lw_move_stats){v[0], v[1], v[2], v[3], v[4]};
+      *s = (lw_move_stats){v[0], v[1], v[2], v[3], v[4], v[5]};
     }
   int first = net->size;
   for (int p = net->size - 1; p >= 0; p--)
