@@ -312,8 +312,7 @@ Test(cli, keys_the_system_never_reads_are_refused)
   ** a weighting's width under another weighting */
   static const struct { const char *scene, *set, *want; } idle[] = {
     {"wire", "--set nurbs.weight_inertia=5", "nurbs.weight_inertia (--set: nurbs.free_weights = 0)"},
-    {"wire", "--set dynamics.rho=0 --set dynamics.gamma=5", "dynamics.gravity_y (wire.ini:29: dynamics.rho = 0: "
-     "no mass to weigh)"},
+    {"wire", "--set dynamics.rho=0 --set dynamics.gamma=5", "params/wire.ini:29: dynamics.rho = 0: no mass to weigh)"},
     {"particles-sheet", "--set particles.max_count=50 --set particles.sigma=0.3",
      "particles.max_count (--set: no particles.birth or death), particles.sigma (--set: particles.weight = poly)"},
   };
