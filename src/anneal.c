@@ -408,10 +408,10 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
                            *const jumps[] = {"moves.birth", "moves.birth_uniform", "moves.birth_spread",
                                              "moves.prior_sd", "moves.death", "moves.grow", "moves.shrink",
                                              "moves.max_segments", "moves.split", "moves.join",
-                                             "moves.join_radius", "energy.chem_spline", NULL},
+                                             "moves.join_radius", NULL},
                            *const weights[] = {"nurbs.weight_inertia", "nurbs.weight_stiffness", "nurbs.step_weight",
                                                NULL},
-                           *const births[] = {"particles.max_count", "particles.chem", NULL},
+                           *const births[] = {"particles.max_count", NULL},
                            *const sigma[] = {"particles.sigma", NULL},
                            *const sigma_normal[] = {"particles.sigma_normal", NULL},
                            *const gravity[] = {"dynamics.gravity_x", "dynamics.gravity_y", NULL};
@@ -649,6 +649,13 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   for (int r = 1; r < a->n_rep; r++)
     if (!(all[r] = t->state_copy(all[0], err))) {
       for (int q = 0; q < r; q++) t->state_free(all[q]);
+      /* the replicas are what is too many, more than the scene */
+      if (err->code == LW_ENOMEM) {
+        char msg[LW_ERROR_MSG];
+        snprintf(msg, sizeof msg, "%s", err->msg);
+        lw_error_set(err, LW_ENOMEM, "%s, at replica %d of %d (tempering.replicas: each holds the whole scene)",
+                     msg, r + 1, a->n_rep);
+      }
       return err->code;
     }
   if ((s = build(a, all, ladder, err)) || (s = check_quench(a, err))) return s;

@@ -130,10 +130,12 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
       k = t->group(c->sys->state, site, box);
       moved += fmax(0.0, 1.0 - (box[2] - box[0]) * nx / w) * fmax(0.0, 1.0 - (box[3] - box[1]) * ny / h);
     }
-    if (groups && moved < 0.25 * (double)groups) {
+    /* judged on the state a run begins with: a resumed one was accepted then,
+    ** and its splines may have grown since (a run refused at its resume) */
+    if (groups && moved < 0.25 * (double)groups && !p->of_run) {
       char what[200];
-      snprintf(what, sizeof what, " (domains %.4g x %.4g mm: %.0f %% of the moves' groups a sweep, a spline "
-               "as wide as a domain never)", w / nx, h / ny, 100.0 * moved / (double)groups);
+      snprintf(what, sizeof what, " (domains %.4g x %.4g in the scene's lengths: %.0f %% of the moves' groups a "
+               "sweep, a spline as wide as a domain never)", w / nx, h / ny, 100.0 * moved / (double)groups);
       return bad_key(p, err, "'%s': domains this small leave most of the state unmoved%s; expected fewer, or auto",
                      what);
     }

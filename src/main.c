@@ -571,6 +571,7 @@ static void unmake_dir(const char *dir, int hold, int made)
 
 static int cmd_run(int argc, char **argv)
 {
+  lw_phase_hold(); /* nothing written yet: a signal ends the set-up at once */
   lw_error err;
   lw_error_clear(&err);
   const char *scene = NULL, *out = NULL;
@@ -655,7 +656,6 @@ static int cmd_run(int argc, char **argv)
   const int asked = quiet;
   if (net && net->rank) quiet = 1;
   watcher_start(&w, quiet);
-  lw_phase_hold();
   if (spread_start(lw_anneal_start_net(&a, &p, dir, net, &err), &a, 1, &err)) {
     lw_anneal_free(&a);
     unmake_dir(dir, hold, made);
@@ -683,6 +683,7 @@ static int cmd_run(int argc, char **argv)
 
 static int cmd_resume(int argc, char **argv)
 {
+  lw_phase_hold(); /* nothing written yet: a signal ends the set-up at once */
   lw_error err;
   lw_error_clear(&err);
   const char *dir = NULL;
@@ -715,7 +716,6 @@ static int cmd_resume(int argc, char **argv)
   if (net && net->rank) quiet = 1;
   watcher_start(&w, quiet);
   checkpointed = 1; /* state.lw holds the last one */
-  lw_phase_hold();
   if (spread_start(lw_anneal_resume_net(&a, dir, more, net, &err), &a, 0, &err)) {
     lw_anneal_free(&a);
     return watched_fail(&w, &err);

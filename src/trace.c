@@ -100,7 +100,11 @@ lw_trace *lw_trace_read(const char *path, lw_error *err)
       size_t nc = rows_cap ? 2 * rows_cap : 256;
       double *nv = realloc(t->v, nc * t->n_cols * sizeof *nv);
       if (!nv) {
-        s = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+        /* every row is held (the selection needs the sweeps of all): say how
+        ** much that is, so that a trace of 20 million rows is understood */
+        s = lw_error_set(err, LW_ENOMEM, "%s: out of memory holding %zu rows of %zu columns (%.0f MB; stats "
+                         "holds the whole trace, whatever --from and --to take)", path, nc, t->n_cols,
+                         (double)nc * (double)t->n_cols * sizeof *nv / 1e6);
         break;
       }
       t->v = nv;

@@ -218,7 +218,7 @@ Test(cli, bad_input_exits_2_with_one_message)
   cr_assert_eq(run("energy", out, sizeof out, errs, sizeof errs), 2);
   cr_assert_eq(run("frobnicate", out, sizeof out, errs, sizeof errs), 2);
   cr_assert(strstr(errs, "frobnicate"));
-  /* the commands without arguments refuse one, as every other command does */
+  /* the listings and the version refuse an argument (help takes any: a command it is asked about) */
   static const char *const bare[] = {"params x", "schedules x", "--version x"};
   for (size_t k = 0; k < sizeof bare / sizeof bare[0]; k++) {
     cr_assert_eq(run(bare[k], out, sizeof out, errs, sizeof errs), 2, "%s", bare[k]);
