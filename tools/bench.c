@@ -213,10 +213,11 @@ static void bench_throughput(bench_ctx *b)
              "Those rows' chains decide in two stages (`anneal.delayed_acceptance`): the acceptance is\n"
              "that of both; their extra bytes a segment are mostly the pair slots. That is the model\n"
              "between sweeps: a recomputation from scratch (the set-up, and every `anneal.check_every`\n"
-             "sweeps) holds the near field's sorted list of sample pairs on top while it runs (measured\n"
-             "2026-12-05 at 100,000 splines of the Scaling scene: a peak of 581 bytes a segment with the\n"
-             "near field at 1.5, 375 with it off; on params/minimal.ini's denser random start, 1.4 mm\n"
-             "of line a mm^2, 1,400 against 326). Where a proposal's\n"
+             "sweeps) holds the near field's sorted list of (sample, segment) pairs on top while it runs\n"
+             "(measured 2026-12-05 at 100,000 splines of the Scaling scene: a peak of 514 bytes a\n"
+             "segment with the near field at 1.5, 375 with it off; on params/minimal.ini's denser random\n"
+             "start, 1.4 mm of line a mm^2, 865 at 50,000 splines against 361. Before the list held each\n"
+             "sample's near segments once, 581 and 1,465). Where a proposal's\n"
              "time goes, and what was measured and kept or not on the way to this speed: docs/NUMERICS.md,\n"
              "\"Pair term: near field\", from \"Where the time goes\" on.\n\n",
           1e9 / ns[0], 1e9 / ns[0] / target[0], 1e9 / ns[0] / target[1], ratio[row[0]], ratio[row[1]]);
