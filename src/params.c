@@ -967,6 +967,29 @@ lw_status lw_params_blame(const lw_params *p, const char *section, const char *k
   return lw_error_set(err, err->code, "%s: key '%s.%s': %s", where, section, key, msg);
 }
 
+/* A character in a refused value that prints like a blank or like nothing
+** (a no-break space that a word processor put after "50" showed as "got
+** '50 '", and ordinary trailing blanks are accepted), named for the message:
+** " (byte K is a no-break space, U+00A0: ...)", or "" if there is none. */
+static const char *unseen_char(const char *value, char *buf, size_t n)
+{
+  static const struct { const char *utf8, *name; unsigned code; } unseen[] = {
+    {"\xc2\xa0", "a no-break space", 0xa0},         {"\xe2\x80\xaf", "a narrow no-break space", 0x202f},
+    {"\xe2\x80\x89", "a thin space", 0x2009},       {"\xe3\x80\x80", "an ideographic space", 0x3000},
+    {"\xe2\x80\x8b", "a zero-width space", 0x200b}, {"\xef\xbb\xbf", "a byte-order mark", 0xfeff},
+    {"\xe2\x81\xa0", "a word joiner", 0x2060},
+  };
+  buf[0] = '\0';
+  for (const char *c = value; *c; c++)
+    for (size_t k = 0; k < sizeof unseen / sizeof unseen[0]; k++)
+      if (!strncmp(c, unseen[k].utf8, strlen(unseen[k].utf8))) {
+        snprintf(buf, n, " (byte %zu is %s, U+%04X: delete it or type a plain space)", (size_t)(c - value) + 1,
+                 unseen[k].name, unseen[k].code);
+        return buf;
+      }
+  return buf;
+}
+
 typedef struct {
   lw_params *p;
   FILE *f;
@@ -1066,10 +1089,10 @@ static int on_key(void *user, const char *section, const char *key, const char *
                  rc->p->file, rc->line, section, key, *line);
     return 0;
   }
-  char expected[256];
+  char expected[256], unseen[96];
   if (!assign(rc->p, d, value, expected, sizeof expected)) {
-    lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s': expected %s, got '%s'",
-                 rc->p->file, rc->line, section, key, expected, value);
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s': expected %s, got '%s'%s",
+                 rc->p->file, rc->line, section, key, expected, value, unseen_char(value, unseen, sizeof unseen));
     return 0;
   }
   *line = rc->line;
@@ -1415,10 +1438,10 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
     return lw_error_set(err, LW_EUSAGE, "--set %s.%s: not a parameter%s (see docs/PARAMETERS.md)", section, key,
                         hint);
   }
-  char expected[256];
+  char expected[256], unseen[96];
   if (!assign(p, d, eq + 1, expected, sizeof expected))
-    return lw_error_set(err, LW_EUSAGE, "--set %s.%s: expected %s, got '%s'", section, key,
-                        expected, eq + 1);
+    return lw_error_set(err, LW_EUSAGE, "--set %s.%s: expected %s, got '%s'%s", section, key,
+                        expected, eq + 1, unseen_char(eq + 1, unseen, sizeof unseen));
   p->line[d - lw_param_table] = -1;
   return LW_OK;
 }

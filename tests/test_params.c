@@ -123,6 +123,11 @@ Test(params, bad_input_names_file_line_and_key)
   expect_error("[scene]\nwidth = 1\nwidth = 2\n", ":3:", "scene.width", "repeated");
   expect_error("[scene]\nthis line has no equals sign\n", ":2:", NULL, "syntax");
   expect_error("[scene\nwidth = 1\n", ":1:", NULL, "expected a section header");
+  /* a character that prints like a blank, or like nothing, is named */
+  expect_error("[scene]\nwidth = 50\xc2\xa0\n", ":2:", "scene.width",
+               "got '50\xc2\xa0' (byte 3 is a no-break space, U+00A0: delete it or type a plain space)");
+  cr_assert_eq(lw_params_set(&q, "energy.pair=\xef\xbb\xbf" "1", &err), LW_EUSAGE);
+  cr_assert(strstr(err.msg, "(byte 1 is a byte-order mark, U+FEFF"), "%s", err.msg);
 }
 
 Test(params, missing_file_is_input_error)
