@@ -111,9 +111,17 @@ static lw_status load_run_dir(const char *dir, lw_params *p, lw_state *st, char 
 
 static lw_status set_option(lw_params *p, const char *assignment, lw_error *err);
 
-/* energy DIR [--set SEC.KEY=VAL]...: the state's energy with its scene, or
-** with keys of it changed (the quadrature's nodes, to see what the run's
-** leave out: docs/NUMERICS.md, "The potential between the nodes"). */
+/* For an argument refused as an option: a file or directory of that name
+** is what was meant, and "./" says so (options are read before names). */
+static const char *dash_hint(const char *arg)
+{
+  static char buf[LW_PATH_MAX + 64];
+  buf[0] = '\0';
+  if (arg[0] == '-' && access(arg, F_OK) == 0)
+    snprintf(buf, sizeof buf, " ('%s' is a file here: write './%s')", arg, arg);
+  return buf;
+}
+
 /* A run directory's path must leave room for the names of the files in it
 ** (DIR/frames/frame-000000.png and the like): paths are held in
 ** LW_PATH_MAX bytes, and a longer one would be cut to another directory. */
@@ -126,6 +134,9 @@ static lw_status dir_fits(const char *what, const char *dir, lw_error *err)
                       what, strlen(dir), RUN_DIR_MAX);
 }
 
+/* energy DIR [--set SEC.KEY=VAL]...: the state's energy with its scene, or
+** with keys of it changed (the quadrature's nodes, to see what the run's
+** leave out: docs/NUMERICS.md, "The potential between the nodes"). */
 static int cmd_energy(int argc, char **argv)
 {
   lw_error err;
@@ -138,7 +149,7 @@ static int cmd_energy(int argc, char **argv)
     }
     if (argv[i][0] == '-' || dir) {
       lw_error_set(&err, LW_EUSAGE, "energy: expected one run directory and --set options, got '%s' "
-                   "(usage: linewise energy DIR [--set SEC.KEY=VAL]...)", argv[i]);
+                   "(usage: linewise energy DIR [--set SEC.KEY=VAL]...)%s", argv[i], dash_hint(argv[i]));
       return fail(&err);
     }
     dir = argv[i];
@@ -586,7 +597,8 @@ static int cmd_run(int argc, char **argv)
       continue;
     }
     if (argv[i][0] == '-' && strcmp(argv[i], "--quiet")) {
-      lw_error_set(&err, LW_EUSAGE, "run: unknown option '%s' (try 'linewise --help')", argv[i]);
+      lw_error_set(&err, LW_EUSAGE, "run: unknown option '%s' (try 'linewise --help')%s", argv[i],
+                   dash_hint(argv[i]));
       return fail(&err);
     }
     if (argv[i][0] != '-') {
@@ -698,7 +710,8 @@ static int cmd_resume(int argc, char **argv)
       if (used < 0) return fail(&err);
       if (used == 2) i++;
     } else if (argv[i][0] == '-' || dir) {
-      lw_error_set(&err, LW_EUSAGE, "resume: unexpected '%s' (usage: linewise resume DIR [--sweeps N])", argv[i]);
+      lw_error_set(&err, LW_EUSAGE, "resume: unexpected '%s' (usage: linewise resume DIR [--sweeps N])%s", argv[i],
+                   dash_hint(argv[i]));
       return fail(&err);
     } else {
       dir = argv[i];
@@ -765,7 +778,7 @@ static int cmd_stats(int argc, char **argv)
       }
       i++;
     } else if (argv[i][0] == '-') {
-      lw_error_set(&err, LW_EUSAGE, "stats: unexpected '%s' %s", argv[i], use);
+      lw_error_set(&err, LW_EUSAGE, "stats: unexpected '%s' %s%s", argv[i], use, dash_hint(argv[i]));
       break;
     } else {
       dir[k++] = argv[i];

@@ -224,6 +224,10 @@ Test(cli, bad_input_exits_2_with_one_message)
     cr_assert_eq(run(bare[k], out, sizeof out, errs, sizeof errs), 2, "%s", bare[k]);
     cr_assert(strstr(errs, "unexpected 'x' (it takes no arguments)"), "%s: %s", bare[k], errs);
   }
+  /* a run directory named like an option: the message says how to name it */
+  cr_assert_eq(lw_test_sh("cd %s && mkdir -p ./-r && { %s resume -r 2>err.txt; test $? -eq 2; } && "
+                          "grep -q \"('-r' is a file here: write './-r')\" err.txt", dir, lw_test_bin()),
+               0);
 }
 
 /* The release, as --version, version and -V give it, is the man page's and
