@@ -583,7 +583,8 @@ const lw_param_def lw_param_table[] = {
          "`size` or `boundary_z`."),
   NUM("particles", "size", LW_PT_DOUBLE, pt_size, "0", "length", 0, 1e9, 0,
       "Extent of the pattern: the cube's side, the patch's or the sphere's diameter. 0 = "
-      "automatic: the extent `count` particles fill at the spacing r0 (docs/NUMERICS.md)."),
+      "automatic: the extent `count` particles fill at the spacing r0 (docs/NUMERICS.md). Below half "
+      "that (closer than r0/2 on average) it is refused."),
   NUM("particles", "noise", LW_PT_DOUBLE, pt_noise, "0.05", "length", 0, 1e9, 0,
       "Standard deviation of the Gaussian noise added to each coordinate of a placed particle."),
   NUM("particles", "normal_noise", LW_PT_DOUBLE, pt_normal_noise, "5", "degrees", 0, 180, 0,

@@ -1013,6 +1013,21 @@ Test(particles, bad_keys_name_file_line_and_key)
   cr_assert_eq(lw_test_sh("%s run %s --out %s/o --quiet 2>%s/err.txt", bin, path, dir, dir), 2);
   cr_assert_eq(lw_test_sh("grep -q \"s.ini:5: key 'particles.size': the sphere pattern (size 16) puts a site\" "
                           "%s/err.txt && test $(wc -l < %s/err.txt) = 1", dir, dir), 0);
+  /* a size that packs them closer than r0/2 (10^7 in a unit cube once set
+  ** up for days, every particle within range of every other): refused, and
+  ** the least size it names is taken */
+  write_file("s.ini", "[scene]\nsystem = particles\n[particles]\npattern = cloud\ncount = 10000000\nsize = 1\n",
+             path, sizeof path);
+  cr_assert_eq(lw_test_sh("%s run %s --out %s/o --quiet 2>%s/err.txt", bin, path, dir, dir), 2);
+  cr_assert_eq(lw_test_sh("grep -q \"s.ini:6: key 'particles.size': 10000000 particles in a pattern of size 1 lie "
+                          "closer than r0/2 on average (the automatic size for them is 191.938); expected at least "
+                          "95.97, or 0 (automatic)\" %s/err.txt", dir), 0);
+  lw_params_defaults(&prm);
+  strcpy(prm.system, "particles");
+  prm.pt_pattern = LW_PPATTERN_CLOUD;
+  prm.pt_count = 10000000;
+  prm.pt_size = 95.97;
+  lw_particles_setup_free(setup_of(&prm));
 }
 
 /* ---- placement ---------------------------------------------------------- */
