@@ -861,6 +861,10 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
     lw_status sl = lw_rundir_lock(dir, &a->dir_hold, err);
     if (sl) return sl;
   }
+  /* a run stopped before its first checkpoint left its scene.ini alone */
+  if (lw_rundir_holds_run(dir) && access(path, F_OK) != 0 && errno == ENOENT)
+    return lw_error_set(err, LW_EINPUT, "%s: no state.lw: the run there stopped before its first checkpoint, so "
+                        "there is nothing to resume; run it again (linewise run SCENE --out %s)", dir, dir);
   lw_status s = lw_state_read(&st, path, err);
   if (s) return s;
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);

@@ -77,7 +77,7 @@ static const char usage[] =
   "                          column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs)\n"
   "  params              print every scene parameter as Markdown (docs/PARAMETERS.md)\n"
   "  schedules           print the temperature schedules as Markdown (docs/SCHEDULES.md)\n"
-  "  version             the release (also --version)\n"
+  "  version             the release (also --version, -V)\n"
   "  help                this text\n"
   "\n"
   "exit status: 0 done, 1 failed while running, 2 bad usage or bad input\n";
@@ -519,11 +519,16 @@ static lw_status spread_start(lw_status s, lw_anneal *a, int fresh, lw_error *er
 ** checkout), the first name without a run is taken unmade, and the run says
 ** why once its scene is known to be good.  Under MPI process 0 chooses and
 ** holds the lock, and tells the others. */
-/* Whether dir holds a run, or a scene.ini or state.lw of a person's, which
-** a run would refuse to write over. */
+/* Whether dir holds a run with a checkpoint, or a scene.ini or state.lw of
+** a person's, which a run would refuse to write over.  A run stopped before
+** its first checkpoint has nothing to resume: its directory is taken again
+** (unless the lock says it is still setting up). */
 static int taken(const char *dir)
 {
-  return lw_rundir_holds_run(dir) || lw_rundir_foreign(dir, "scene.ini") || lw_rundir_foreign(dir, "state.lw");
+  char state[LW_PATH_MAX + 16];
+  lw_path_join(state, sizeof state, dir, "state.lw");
+  return (lw_rundir_holds_run(dir) && access(state, F_OK) == 0) || lw_rundir_foreign(dir, "scene.ini") ||
+         lw_rundir_foreign(dir, "state.lw");
 }
 
 static lw_status default_dir(char *dir, size_t size, const char *scene, int *hold, int *made, lw_error *err)
@@ -582,7 +587,6 @@ static void unmake_dir(const char *dir, int hold, int made)
 
 static int cmd_run(int argc, char **argv)
 {
-  lw_phase_hold(); /* nothing written yet: a signal ends the set-up at once */
   lw_error err;
   lw_error_clear(&err);
   const char *scene = NULL, *out = NULL;
@@ -695,7 +699,6 @@ static int cmd_run(int argc, char **argv)
 
 static int cmd_resume(int argc, char **argv)
 {
-  lw_phase_hold(); /* nothing written yet: a signal ends the set-up at once */
   lw_error err;
   lw_error_clear(&err);
   const char *dir = NULL;
@@ -908,7 +911,11 @@ int main(int argc, char **argv)
 #ifndef LW_MPI
   choose_wait_policy(argc, argv);
 #endif
-  install_signals(argc >= 2 && (!strcmp(argv[1], "run") || !strcmp(argv[1], "resume")));
+  const int runs = argc >= 2 && (!strcmp(argv[1], "run") || !strcmp(argv[1], "resume"));
+  /* nothing written yet: from the handlers' first moment, a signal ends the
+  ** set-up at once (one caught before this ran the whole set-up) */
+  if (runs) lw_phase_hold();
+  install_signals(runs);
 #ifdef LW_MPI
   if (!(net = lw_mpi_init(&argc, &argv, &stop_requested))) return 1;
   /* the commands other than run and resume are one process's */

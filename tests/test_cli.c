@@ -514,6 +514,18 @@ Test(cli, a_signal_before_anything_is_written_ends_the_set_up_at_once)
   cr_assert(strstr(e, "linewise: stopped during the set-up, before anything was written\n"), "%s", e);
   free(e);
   cr_assert_neq(lw_test_sh("test -e %s/out", dir), 0, "the default directory was left");
+  /* what a second signal leaves before the first checkpoint (a run's
+  ** scene.ini, a cut state.lw.tmp, no state.lw): resume says why it cannot,
+  ** and the next run into the default directory takes it again, not
+  ** out/minimal-2 beside it for good */
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --quiet --stop-at 0 && rm out/minimal/state.lw && "
+                          "echo cut > out/minimal/state.lw.tmp && { %s resume out/minimal 2>err.txt; test $? -eq 2; } && "
+                          "grep -q 'out/minimal: no state.lw: the run there stopped before its first checkpoint' "
+                          "err.txt && %s run %s/params/minimal.ini --quiet --set anneal.sweeps=2 && "
+                          "test -s out/minimal/summary.json && ! test -e out/minimal/state.lw.tmp && ! test -e "
+                          "out/minimal-2", dir, lw_test_bin(), lw_test_root(), lw_test_bin(), lw_test_bin(),
+                          lw_test_root()),
+               0);
 }
 
 /* A sweep can take minutes (here a billion time steps of the whip): the
