@@ -388,6 +388,31 @@ lw_status lw_anneal_check_keys(const lw_params *p, char *unread, size_t size, lw
   return LW_OK;
 }
 
+/* Settings under which the schedule never reaches its end, in buf (empty if
+** none), for a note: more steps than sweeps skip some and end short of
+** t_end; one step stays at t_start; table rows past the last step (steps
+** count from 0) are never read.  Each was silent, and a methods paper
+** would have described another schedule. */
+static void schedule_note(const lw_anneal *a, char *buf, size_t n)
+{
+  const lw_params *p = &a->params;
+  const lw_schedule *s = &a->sched;
+  buf[0] = '\0';
+  if (!a->sched_type || p->driver == LW_DRIVER_DYNAMICS || p->sweeps <= 0) return;
+  const unsigned needs = a->sched_type->needs;
+  const long last = block_of(a, p->sweeps - 1);
+  if (s->n_table && s->table_block[s->n_table - 1] > (double)(s->blocks - 1))
+    snprintf(buf, n, "anneal.table has rows past step %ld, the last of anneal.steps = %ld (steps count from 0): "
+             "they are never reached, and the run ends at the table's temperature of step %ld",
+             s->blocks - 1, s->blocks, s->blocks - 1);
+  else if (last < s->blocks - 1 && (needs & LW_SCHEDULE_USES_END))
+    snprintf(buf, n, "anneal.steps = %ld is more than the %ld sweeps: some steps are skipped, and the run ends at "
+             "step %ld of %ld, short of t_end", s->blocks, (long)p->sweeps, last + 1, s->blocks);
+  else if (s->blocks == 1 && (needs & LW_SCHEDULE_USES_END) && s->t_end != s->t_start)
+    snprintf(buf, n, "anneal.steps = 1: the run stays at t_start = %g (t_end = %g is the temperature of the last "
+             "of two or more steps)", s->t_start, s->t_end);
+}
+
 /* Keys the scene sets that its other settings leave idle (a table under a
 ** schedule that reads none, a polygon under another frame), in idle with
 ** why: noted, so that a mistake there shows before the setting that reads
@@ -632,6 +657,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
       (s = setup_system(a, err)))
     return s;
   idle_keys(a, a->idle, sizeof a->idle);
+  schedule_note(a, a->schedule_note, sizeof a->schedule_note);
   const lw_params *rp = &a->params;
   if (a->n_rep > 1 && rp->tune_ladder == LW_LADDER_EQUAL && rp->ladder_sweeps >= rp->sweeps) {
     /* (a run of an older release that did so still resumes) */
@@ -908,7 +934,12 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   }
   if (a->end_sweep < 0) a->end_sweep = a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep;
   const long saved_end = a->end_sweep;
-  if (more >= 0) a->end_sweep = a->sweep + more;
+  /* N more sweeps that stay short of the end stop there, unfinished, so that
+  ** a plain resume goes on to the end (they once made sweep + N the end, and
+  ** the run "finished" half cooled); N that reach it or past extend the run */
+  a->pause_at = -1;
+  if (more >= 0 && a->sweep + more < saved_end) a->pause_at = a->sweep + more;
+  else if (more >= 0) a->end_sweep = a->sweep + more;
   /* (every process of an MPI run: one that writes nothing must still stop
   ** with the others, not at once) */
   lw_phase_writing();
@@ -1128,7 +1159,12 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
       a->prev = (lw_block_stats){mean, var > 0 ? sqrt(var) : 0.0, (long)cnt};
       a->t_prev = a->t_sched;
     }
-    a->t_sched = a->sched_type->temperature(&a->sched, b, a->t_prev, a->block >= 0 ? &a->prev : NULL);
+    /* the statistics are the coldest rung's, at ladder[0] t / t_start: Huang's
+    ** T / sd for it is this on the schedule's own scale (the schedule's
+    ** temperature with the cold rung's sd cooled 5 to 10 times too fast) */
+    lw_block_stats prev = a->prev;
+    if (a->pt && a->pt->ladder[0] > 0.0) prev.sd *= a->params.t_start / a->pt->ladder[0];
+    a->t_sched = a->sched_type->temperature(&a->sched, b, a->t_prev, a->block >= 0 ? &prev : NULL);
     set_temperatures(a);
     a->block = b;
     a->acc_n = a->acc_sum = a->acc_sumsq = 0.0;

@@ -57,7 +57,8 @@ static const char usage[] =
   "      --quiet             no progress or parameter echo on stderr\n"
   "  resume DIR          continue the run in DIR bit-exactly from DIR/state.lw\n"
   "      --sweeps N          run N more sweeps (default: to the end of the schedule;\n"
-  "                          past the end the last temperature holds)\n"
+  "                          short of it they stop as --stop-at does; past the end\n"
+  "                          the last temperature holds)\n"
   "      --stop-at N, --threads N, --quiet  as for run\n"
   "  energy DIR          recompute DIR/state.lw's energy from scratch with its scene;\n"
   "                      prints '<term> <value>' per enabled term, then 'total <value>'\n"
@@ -688,6 +689,7 @@ static int cmd_run(int argc, char **argv)
       fprintf(stderr, "linewise: note: under driver = %s these keys have no effect: %s\n",
               a.params.driver == LW_DRIVER_DYNAMICS ? "dynamics" : "metropolis", a.unread);
     if (a.idle[0]) fprintf(stderr, "linewise: note: these keys have no effect here: %s\n", a.idle);
+    if (a.schedule_note[0]) fprintf(stderr, "linewise: note: %s\n", a.schedule_note);
     fprintf(stderr, "linewise: scene %s, seed %lu, %s, into %s\n", scene, a.seed, size, dir);
     fprintf(stderr, "linewise: resolved parameters:\n");
     lw_params_write(&a.params, stderr);
@@ -746,6 +748,7 @@ static int cmd_resume(int argc, char **argv)
     lw_anneal_free(&a);
     return watched_fail(&w, &err);
   }
+  if (a.pause_at >= 0 && (stop_at < 0 || a.pause_at < stop_at)) stop_at = a.pause_at;
   if (!quiet) fprintf(stderr, "linewise: resuming %s at sweep %ld of %ld\n", dir, a.sweep, a.end_sweep);
   int rc = anneal_loop(&a, stop_at, quiet, asked, &w, &err);
   lw_anneal_free(&a);

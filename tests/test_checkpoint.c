@@ -181,6 +181,28 @@ Test(checkpoint, an_extension_stopped_on_the_way_resumes_to_its_own_end)
                0);
 }
 
+/* resume --sweeps N on a run short of its end, N within it: the sweeps run
+** and stop there, unfinished, as --stop-at; a plain resume then goes on to
+** the schedule's end, as the run that never stopped (sweep 50 + 20 once
+** became the end: a summary of a run half cooled, t_end never reached). */
+Test(checkpoint, more_sweeps_short_of_the_end_stop_there_and_leave_the_end)
+{
+  const char *b = lw_test_bin();
+  const char *set = "--set anneal.sweeps=103 --set anneal.steps=7 --quiet --threads 1";
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini %s --out %s/a --stop-at 50 && "
+                          "%s run %s/params/minimal.ini %s --out %s/b", b, lw_test_root(), set, dir, b,
+                          lw_test_root(), set, dir),
+               0);
+  cr_assert_eq(lw_test_sh("%s resume %s/a --sweeps 20 --quiet", b, dir), 0);
+  cr_assert_eq(lw_test_sh("! test -e %s/a/summary.json && grep -qx 'sweep = 70' %s/a/state.lw && "
+                          "grep -qx 'end_sweep = 103' %s/a/state.lw", dir, dir, dir),
+               0, "the sweeps short of the end ended the run there");
+  cr_assert_eq(lw_test_sh("%s resume %s/a --quiet", b, dir), 0);
+  static const char *const files[] = {"state.lw", "trace.csv", "final.svg"};
+  for (int k = 0; k < 3; k++)
+    cr_expect_eq(lw_test_sh("cmp -s %s/a/%s %s/b/%s", dir, files[k], dir, files[k]), 0, "%s differs", files[k]);
+}
+
 /* The new end of an extension is in state.lw before its first sweep: a
 ** kill before the extension's first checkpoint still resumes to it. */
 Test(checkpoint, an_extension_killed_before_its_first_checkpoint_keeps_its_end)

@@ -327,6 +327,24 @@ Test(cli, keys_the_system_never_reads_are_refused)
     cr_assert(strstr(errs, "linewise: note: these keys have no effect here: ") && strstr(errs, idle[k].want),
               "%s: %s", idle[k].set, errs);
   }
+  /* a schedule that never reaches its end says so (each was silent) */
+  write_file("t.txt", "1 1\n5 0.01\n");
+  static const struct { const char *set, *want; } end[] = {
+    {"--set anneal.sweeps=10 --set anneal.steps=15", "linewise: note: anneal.steps = 15 is more than the 10 sweeps: "
+     "some steps are skipped, and the run ends at step 14 of 15, short of t_end\n"},
+    {"--set anneal.sweeps=6 --set anneal.steps=1 --set anneal.t_end=0.5", "linewise: note: anneal.steps = 1: the run "
+     "stays at t_start = 1 (t_end = 0.5 is the temperature of the last of two or more steps)\n"},
+    {"--set anneal.sweeps=10 --set anneal.steps=5 --set anneal.schedule=table --set anneal.table=t.txt",
+     "linewise: note: anneal.table has rows past step 4, the last of anneal.steps = 5 (steps count from 0)"},
+  };
+  for (size_t k = 0; k < sizeof end / sizeof end[0]; k++) {
+    snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/e%zu %s", lw_test_root(), dir, k, end[k].set);
+    /* (from dir: --set takes the table relative to the current directory) */
+    cr_assert_eq(lw_test_sh("cd %s && %s %s 2>err.txt >/dev/null", dir, lw_test_bin(), args), 0, "%s", end[k].set);
+    char *e = lw_test_slurp("%s/err.txt", dir);
+    cr_assert(strstr(e, end[k].want), "%s: %s", end[k].set, e);
+    free(e);
+  }
 }
 
 /* A PDF page past what PDF allows (14,400 points) is refused before the run:

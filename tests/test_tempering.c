@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/anneal.h"
 #include "linewise/tempering.h"
 #include "testutil.h"
 
@@ -266,6 +267,40 @@ static void write_scene(void)
   FILE *f = fopen(path, "w");
   fputs(scene, f);
   fclose(f);
+}
+
+/* The adaptive schedule under tempering: its energy statistics are the
+** coldest rung's, so Huang's rule T_b = T_{b-1} exp(-lambda T_{b-1} / sd)
+** holds for that rung's own temperatures (it once took the schedule's
+** temperature, t_start / t_min = 10 times the rung's, and cooled the first
+** step to 0.18 where the rule gives 0.84). */
+Test(ptrun, the_adaptive_schedule_cools_the_coldest_rung_by_its_own_rule)
+{
+  char path[128];
+  snprintf(path, sizeof path, "%s/a.ini", dir);
+  FILE *f = fopen(path, "w");
+  fputs("[scene]\nwidth = 100\nheight = 100\nmargin = 5\n[init]\nsplines = 20\nsegments = 4\n"
+        "segment_length = 8\n[energy]\nstrain = 10\nbending = 1\npair = 0.02\npair_cutoff = 6\nboundary = 0.5\n"
+        "[anneal]\nschedule = adaptive\nt_start = 1\nt_end = 0.001\nsweeps = 120\nsteps = 4\nseed = 3\n"
+        "[tempering]\nreplicas = 2\nt_min = 0.1\nt_max = 1\n",
+        f);
+  fclose(f);
+  lw_params p;
+  lw_error err;
+  cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
+  lw_anneal a;
+  snprintf(path, sizeof path, "%s/a", dir);
+  cr_assert_eq(lw_anneal_start(&a, &p, path, &err), LW_OK, "%s", err.msg);
+  double before = -1.0;
+  while (a.block < 1) {
+    before = a.chains[0]->temperature;
+    cr_assert_eq(lw_anneal_sweep(&a, &err), LW_OK, "%s", err.msg);
+  }
+  const double after = a.chains[0]->temperature, want = before * exp(-p.lambda * before / a.prev.sd);
+  cr_assert(a.prev.samples > 10 && fabs(after / want - 1.0) < 1e-12, "coldest rung %g -> %g, the rule gives %g",
+            before, after, want);
+  cr_assert(fabs(before - 0.1) < 1e-15, "the coldest rung began at %g, not t_min", before);
+  lw_anneal_free(&a);
 }
 
 Test(ptrun, outputs_do_not_depend_on_the_thread_count)

@@ -52,10 +52,12 @@ typedef struct lw_anneal {
   int dir_hold;                 /* lw_rundir_lock's hold on dir while it writes there, 0 none */
   char unread[1024];           /* keys the scene sets that only the other driver reads, where set, or "" */
   char idle[4096];             /* keys the scene sets that its other settings leave idle, where and why */
+  char schedule_note[512];     /* a schedule whose steps never reach its end (lw_anneal_start), or "" */
   unsigned long seed;
   long sweep;                  /* sweeps done */
   long saved;                  /* sweep + 1 at the last checkpoint this process wrote; 0 none */
   long end_sweep;              /* stop after this sweep */
+  long pause_at;               /* resume --sweeps N short of end_sweep: stop there as --stop-at does (-1: none) */
   int extending, new_end;      /* a resume to settle before its first sweep (anneal.c) */
   unsigned long long scene_hash; /* lw_params_run_hash of scene.ini, kept in state.lw */
   lw_run_keys scene_keys;        /* and its keys' parts */
