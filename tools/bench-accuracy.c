@@ -131,10 +131,10 @@ static void scene_note(bench_ctx *b, FILE *d)
   const lw_params *p = &b->ann_params;
   const lw_splines *sp = bench_annealed(b);
   fprintf(d, "## The scene\n\n"
-             "params/study.ini (%zu splines of %d segments of %g mm on %g x %g mm, a waves field,\n"
-             "pair C = %g with cutoff %g mm, quadrature %d, near field %g) with a radial potential\n"
-             "(Q = %g) added so that every term is on, annealed by the annealer itself for %d sweeps\n"
-             "from T = %g to %g (%.0f s; the run is in build/bench-data/anneal): the curves are bent,\n"
+             "params/study.ini (%zu splines of %d segments of %g mm on %g x %g mm, the picture's edge\n"
+             "tangent flow as field, pair C = %g with cutoff %g mm, quadrature %d, near field %g) with\n"
+             "a radial potential (Q = %g) in place of the picture's, annealed by the annealer itself\n"
+             "for %d sweeps from T = %g to %g (%.0f s; the run is in build/bench-data/anneal): the curves are bent,\n"
              "dense in the middle and %.2f mm apart on average (area / length). Each study changes one\n"
              "setting and evaluates the same splines. Besides energies it replays %d proposals (point\n"
              "and vector moves with the annealer's final steps, %.3f and %.3f mm) on every variant:\n"
