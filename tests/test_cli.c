@@ -537,7 +537,8 @@ Test(cli, a_signal_before_anything_is_written_ends_the_set_up_at_once)
   ** and the next run into the default directory takes it again, not
   ** out/minimal-2 beside it for good */
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --quiet --stop-at 0 && rm out/minimal/state.lw && "
-                          "echo cut > out/minimal/state.lw.tmp && { %s resume out/minimal 2>err.txt; test $? -eq 2; } && "
+                          "echo cut > out/minimal/state.lw.tmp && "
+                          "{ %s resume out/minimal 2>err.txt; test $? -eq 2; } && "
                           "grep -q 'out/minimal: no state.lw: the run there stopped before its first checkpoint' "
                           "err.txt && %s run %s/params/minimal.ini --quiet --set anneal.sweeps=2 && "
                           "test -s out/minimal/summary.json && ! test -e out/minimal/state.lw.tmp && ! test -e "

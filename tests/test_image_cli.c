@@ -63,6 +63,17 @@ static void write_scene(const char *image)
   write_text("scene.ini", text);
 }
 
+/* Runs args, which must be refused (exit 2) with a message holding `a` and
+** `b` and nothing written (no out/). */
+static void refused_before_the_run(const char *args, const char *a, const char *b)
+{
+  char errs[2048];
+  cr_assert_eq(run(args, errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, a) && strstr(errs, b), "%s", errs);
+  struct stat sb;
+  cr_assert_neq(stat(lw_test_path("out"), &sb), 0, "nothing written");
+}
+
 /* A picture with some structure: a dark disk on a light ramp. */
 static void write_picture(const char *name, int w, int h)
 {
@@ -154,14 +165,11 @@ Test(image_cli, a_path_too_long_for_the_runs_scene_file_is_refused_before_the_ru
   char text[1024];
   snprintf(text, sizeof text, scene_fmt, "good.png");
   write_text(rel, text);
-  char cmd[600], errs[2048];
+  char cmd[600];
   snprintf(cmd, sizeof cmd, "run %s/scene.ini --out out", name);
-  cr_assert_eq(run(cmd, errs, sizeof errs), 2, "%s", errs);
-  cr_assert(strstr(errs, "scene.ini:4: key 'scene.image': 'good.png' made absolute is ") &&
-                strstr(errs, "and the run's scene.ini (which resume reads) holds 190 on its line; move the file, or "
-                             "run from a shorter path"), "%s", errs);
-  struct stat sb;
-  cr_assert_neq(stat(lw_test_path("out"), &sb), 0, "nothing written");
+  refused_before_the_run(cmd, "scene.ini:4: key 'scene.image': 'good.png' made absolute is ",
+                         "and the run's scene.ini (which resume reads) holds 190 on its line; move the file, or "
+                         "run from a shorter path");
 }
 
 /* A folder "Fotos ;alt": written into the run's scene.ini, the path is a
@@ -174,13 +182,10 @@ Test(image_cli, a_path_the_runs_scene_file_would_cut_at_a_semicolon_is_refused_b
   char text[1024];
   snprintf(text, sizeof text, scene_fmt, "good.png");
   write_text("Fotos ;alt/scene.ini", text);
-  char errs[2048];
-  cr_assert_eq(run("run 'Fotos ;alt/scene.ini' --out out", errs, sizeof errs), 2, "%s", errs);
-  cr_assert(strstr(errs, "scene.ini:4: key 'scene.image': 'good.png' made absolute is '/") &&
-                strstr(errs, "Fotos ;alt/good.png', which the run's scene.ini (which resume reads) cannot hold: "
-                             "';' after a blank begins a comment there"), "%s", errs);
-  struct stat sb;
-  cr_assert_neq(stat(lw_test_path("out"), &sb), 0, "nothing written");
+  refused_before_the_run("run 'Fotos ;alt/scene.ini' --out out",
+                         "scene.ini:4: key 'scene.image': 'good.png' made absolute is '/",
+                         "Fotos ;alt/good.png', which the run's scene.ini (which resume reads) cannot hold: "
+                         "';' after a blank begins a comment there");
 }
 
 /* The drawing's score renders the picture's pixels, and cairo draws at most
@@ -194,12 +199,9 @@ Test(image_cli, a_picture_too_long_to_score_is_refused_before_the_run)
   for (int i = 0; i < 80000; i++) strip[n + i] = (char)(i % 251);
   lw_test_write(lw_test_path("strip.pgm"), strip, (size_t)n + 80000);
   write_scene("strip.pgm");
-  char errs[2048];
-  cr_assert_eq(run("run scene.ini --out out --set scene.image_max_pixels=1e6", errs, sizeof errs), 2, "%s", errs);
-  cr_assert(strstr(errs, "scene.ini:4: key 'scene.image': 40000 x 2 pixels: the drawing is scored on the picture's "
-                         "pixels, and cairo renders at most 32767 a side"), "%s", errs);
-  struct stat sb;
-  cr_assert_neq(stat(lw_test_path("out"), &sb), 0, "nothing written");
+  refused_before_the_run("run scene.ini --out out --set scene.image_max_pixels=1e6",
+                         "scene.ini:4: key 'scene.image': 40000 x 2 pixels: the drawing is scored on the "
+                         "picture's pixels", "and cairo renders at most 32767 a side");
 }
 
 Test(image_cli, a_large_picture_is_downsampled_with_a_note)

@@ -718,8 +718,8 @@ Test(tools, install_runs_every_scene_away_from_the_checkout_and_uninstall_remove
                   "  { echo \"$s\" >&2; exit 1; }; done",
                   dir),
                0, "%s", err_txt());
-  cr_assert_eq(sh("{ %s/root/usr/bin/linewise-seed-sweep --help && %s/root/usr/bin/linewise-plot-run --help; }", dir, dir),
-               0);
+  cr_assert_eq(
+      sh("{ %s/root/usr/bin/linewise-seed-sweep --help && %s/root/usr/bin/linewise-plot-run --help; }", dir, dir), 0);
   char *out = out_txt();
   cr_assert(strstr(out, "usage: linewise-seed-sweep SCENE.ini") && strstr(out, "usage: linewise-plot-run RUN_DIR"),
             "%s", out);
