@@ -400,17 +400,20 @@ static void schedule_note(const lw_anneal *a, char *buf, size_t n)
   buf[0] = '\0';
   if (!a->sched_type || p->driver == LW_DRIVER_DYNAMICS || p->sweeps <= 0) return;
   const unsigned needs = a->sched_type->needs;
+  const int table = s->n_table > 0, ends = (needs & LW_SCHEDULE_USES_END) || table;
   const long last = block_of(a, p->sweeps - 1);
-  if (s->n_table && s->table_block[s->n_table - 1] > (double)(s->blocks - 1))
-    snprintf(buf, n, "anneal.table has rows past step %ld, the last of anneal.steps = %ld (steps count from 0): "
-             "they are never reached, and the run ends at the table's temperature of step %ld",
-             s->blocks - 1, s->blocks, s->blocks - 1);
-  else if (last < s->blocks - 1 && (needs & LW_SCHEDULE_USES_END))
-    snprintf(buf, n, "anneal.steps = %ld is more than the %ld sweeps: some steps are skipped, and the run ends at "
-             "step %ld of %ld, short of t_end", s->blocks, (long)p->sweeps, last + 1, s->blocks);
-  else if (s->blocks == 1 && (needs & LW_SCHEDULE_USES_END) && s->t_end != s->t_start)
-    snprintf(buf, n, "anneal.steps = 1: the run stays at t_start = %g (t_end = %g is the temperature of the last "
-             "of two or more steps)", s->t_start, s->t_end);
+  size_t m = 0;
+  /* steps counted from 0, as state.lw's block and the table's rows */
+  if (last < s->blocks - 1 && ends)
+    m += (size_t)snprintf(buf, n, "anneal.steps = %ld is more than the %ld sweeps: some steps are skipped, and "
+                          "the run ends at step %ld (steps count from 0 to %ld), short of %s", s->blocks,
+                          (long)p->sweeps, last, s->blocks - 1, table ? "the table's last step" : "t_end");
+  if (table && s->table_block[s->n_table - 1] > (double)(s->blocks - 1) && m < n)
+    m += (size_t)snprintf(buf + m, n - m, "%sanneal.table has rows past step %ld, the last of anneal.steps = %ld "
+                          "(steps count from 0): they are never reached", m ? "; " : "", s->blocks - 1, s->blocks);
+  if (s->blocks == 1 && (needs & LW_SCHEDULE_USES_END) && s->t_end != s->t_start && m < n)
+    snprintf(buf + m, n - m, "anneal.steps = 1: the run stays at t_start = %g (t_end = %g is the temperature of "
+             "the last of two or more steps)", s->t_start, s->t_end);
 }
 
 /* Keys the scene sets that its other settings leave idle (a table under a
@@ -888,7 +891,7 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
     if (sl) return sl;
   }
   /* a run stopped before its first checkpoint left its scene.ini alone */
-  if (lw_rundir_holds_run(dir) && access(path, F_OK) != 0 && errno == ENOENT)
+  if (lw_rundir_unstarted(dir))
     return lw_error_set(err, LW_EINPUT, "%s: no state.lw: the run there stopped before its first checkpoint, so "
                         "there is nothing to resume; run it again (linewise run SCENE --out %s)", dir, dir);
   lw_status s = lw_state_read(&st, path, err);

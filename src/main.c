@@ -119,7 +119,7 @@ static const char *dash_hint(const char *arg)
   static char buf[LW_PATH_MAX + 64];
   buf[0] = '\0';
   if (arg[0] == '-' && access(arg, F_OK) == 0)
-    snprintf(buf, sizeof buf, " ('%s' is a file here: write './%s')", arg, arg);
+    snprintf(buf, sizeof buf, " ('%s' is a file or directory here: write './%s')", arg, arg);
   return buf;
 }
 
@@ -526,9 +526,7 @@ static lw_status spread_start(lw_status s, lw_anneal *a, int fresh, lw_error *er
 ** (unless the lock says it is still setting up). */
 static int taken(const char *dir)
 {
-  char state[LW_PATH_MAX + 16];
-  lw_path_join(state, sizeof state, dir, "state.lw");
-  return (lw_rundir_holds_run(dir) && access(state, F_OK) == 0) || lw_rundir_foreign(dir, "scene.ini") ||
+  return (lw_rundir_holds_run(dir) && !lw_rundir_unstarted(dir)) || lw_rundir_foreign(dir, "scene.ini") ||
          lw_rundir_foreign(dir, "state.lw");
 }
 

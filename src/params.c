@@ -584,7 +584,7 @@ const lw_param_def lw_param_table[] = {
   NUM("particles", "size", LW_PT_DOUBLE, pt_size, "0", "length", 0, 1e9, 0,
       "Extent of the pattern: the cube's side, the patch's or the sphere's diameter. 0 = "
       "automatic: the extent `count` particles fill at the spacing r0 (docs/NUMERICS.md). Below half "
-      "that (closer than r0/2 on average) it is refused."),
+      "that (closer than r0/2 on average) a new run is refused; a run begun before 2026-12-05 resumes."),
   NUM("particles", "noise", LW_PT_DOUBLE, pt_noise, "0.05", "length", 0, 1e9, 0,
       "Standard deviation of the Gaussian noise added to each coordinate of a placed particle."),
   NUM("particles", "normal_noise", LW_PT_DOUBLE, pt_normal_noise, "5", "degrees", 0, 180, 0,
@@ -978,7 +978,8 @@ static const char *unseen_char(const char *value, char *buf, size_t n)
     {"\xc2\xa0", "a no-break space", 0xa0},         {"\xe2\x80\xaf", "a narrow no-break space", 0x202f},
     {"\xe2\x80\x89", "a thin space", 0x2009},       {"\xe3\x80\x80", "an ideographic space", 0x3000},
     {"\xe2\x80\x8b", "a zero-width space", 0x200b}, {"\xef\xbb\xbf", "a byte-order mark", 0xfeff},
-    {"\xe2\x81\xa0", "a word joiner", 0x2060},
+    {"\xe2\x81\xa0", "a word joiner", 0x2060},    {"\xe2\x80\x82", "an en space", 0x2002},
+    {"\xe2\x80\x83", "an em space", 0x2003},       {"\xe2\x80\x87", "a figure space", 0x2007},
   };
   buf[0] = '\0';
   for (const char *c = value; *c; c++)

@@ -81,9 +81,10 @@ lw_particles_setup *lw_particles_setup_new(const lw_params *p, lw_error *err)
   s->size = p->pt_size > 0 ? p->pt_size : lw_particles_auto_size(p->pt_pattern, s->count, p->pt_r0);
   /* a size that packs the particles closer than r0/2 on average: an energy
   ** beyond any use (20,000 in a cube of side r0 started at 8.5e32) and, with
-  ** every particle within range of every other, a set-up of days for 10^7 */
+  ** every particle within range of every other, a set-up of days for 10^7.
+  ** Only a new run places them: a run begun before the rule resumes. */
   const double packed = 0.5 * lw_particles_auto_size(p->pt_pattern, s->count, p->pt_r0);
-  if (s->count && p->pt_size > 0 && p->pt_size < packed) {
+  if (s->count && p->pt_size > 0 && p->pt_size < packed && !p->of_run) {
     const double scale = pow(10.0, 3.0 - floor(log10(packed))); /* 4 digits, rounded up: accepted as printed */
     origin(p, "size", where, sizeof where);
     lw_error_set(err, LW_EINPUT, "%s: key 'particles.size': %zu particles in a pattern of size %g lie closer than "

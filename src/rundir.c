@@ -74,6 +74,18 @@ int lw_rundir_foreign(const char *dir, const char *name)
                                    : !first_line_is(dir, name, LW_RUN_SCENE_HEADER, 1);
 }
 
+int lw_rundir_unstarted(const char *dir)
+{
+  static const char *const later[] = {"state.lw", "summary.json", "final.svg", "final.png", "final.ply"};
+  if (!lw_rundir_holds_run(dir)) return 0;
+  for (size_t k = 0; k < sizeof later / sizeof later[0]; k++) {
+    char path[LW_PATH_MAX + 16];
+    lw_path_join(path, sizeof path, dir, later[k]);
+    if (access(path, F_OK) == 0) return 0;
+  }
+  return 1;
+}
+
 lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
 {
   char path[LW_PATH_MAX + 16];

@@ -226,7 +226,7 @@ Test(cli, bad_input_exits_2_with_one_message)
   }
   /* a run directory named like an option: the message says how to name it */
   cr_assert_eq(lw_test_sh("cd %s && mkdir -p ./-r && { %s resume -r 2>err.txt; test $? -eq 2; } && "
-                          "grep -q \"('-r' is a file here: write './-r')\" err.txt", dir, lw_test_bin()),
+                          "grep -q \"('-r' is a file or directory here: write './-r')\" err.txt", dir, lw_test_bin()),
                0);
 }
 
@@ -331,11 +331,15 @@ Test(cli, keys_the_system_never_reads_are_refused)
   write_file("t.txt", "1 1\n5 0.01\n");
   static const struct { const char *set, *want; } end[] = {
     {"--set anneal.sweeps=10 --set anneal.steps=15", "linewise: note: anneal.steps = 15 is more than the 10 sweeps: "
-     "some steps are skipped, and the run ends at step 14 of 15, short of t_end\n"},
+     "some steps are skipped, and the run ends at step 13 (steps count from 0 to 14), short of t_end\n"},
     {"--set anneal.sweeps=6 --set anneal.steps=1 --set anneal.t_end=0.5", "linewise: note: anneal.steps = 1: the run "
      "stays at t_start = 1 (t_end = 0.5 is the temperature of the last of two or more steps)\n"},
     {"--set anneal.sweeps=10 --set anneal.steps=5 --set anneal.schedule=table --set anneal.table=t.txt",
-     "linewise: note: anneal.table has rows past step 4, the last of anneal.steps = 5 (steps count from 0)"},
+     "linewise: note: anneal.table has rows past step 4, the last of anneal.steps = 5 (steps count from 0): they "
+     "are never reached\n"},
+    {"--set anneal.sweeps=10 --set anneal.steps=20 --set anneal.schedule=table --set anneal.table=t.txt",
+     "linewise: note: anneal.steps = 20 is more than the 10 sweeps: some steps are skipped, and the run ends at step "
+     "18 (steps count from 0 to 19), short of the table's last step\n"},
   };
   for (size_t k = 0; k < sizeof end / sizeof end[0]; k++) {
     snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/e%zu %s", lw_test_root(), dir, k, end[k].set);
@@ -544,6 +548,11 @@ Test(cli, a_signal_before_anything_is_written_ends_the_set_up_at_once)
                           "test -s out/minimal/summary.json && ! test -e out/minimal/state.lw.tmp && ! test -e "
                           "out/minimal-2", dir, lw_test_bin(), lw_test_root(), lw_test_bin(), lw_test_bin(),
                           lw_test_root()),
+               0);
+  /* but a finished run whose state.lw was deleted keeps its drawing */
+  cr_assert_eq(lw_test_sh("cd %s && rm out/minimal/state.lw && %s run %s/params/minimal.ini --quiet "
+                          "--set anneal.sweeps=2 && test -s out/minimal-2/summary.json && test -s out/minimal/final.svg",
+                          dir, lw_test_bin(), lw_test_root()),
                0);
 }
 

@@ -1028,6 +1028,11 @@ Test(particles, bad_keys_name_file_line_and_key)
   prm.pt_count = 10000000;
   prm.pt_size = 95.97;
   lw_particles_setup_free(setup_of(&prm));
+  /* a run's own parameters (resume, energy) are not judged again: a run
+  ** begun before the rule goes on */
+  prm.pt_size = 1;
+  prm.of_run = 1;
+  lw_particles_setup_free(setup_of(&prm));
 }
 
 /* ---- placement ---------------------------------------------------------- */

@@ -30,6 +30,12 @@ int lw_rundir_holds_run(const char *dir);
 ** any state.lw without a state's header): a run refuses to write there. */
 int lw_rundir_foreign(const char *dir, const char *name);
 
+/* Whether dir holds a run that stopped before its first checkpoint: a run's
+** scene.ini, but no state.lw and nothing a finished run leaves (summary.json,
+** the final drawings).  It has nothing to resume, and a new run may take
+** the directory; a finished run whose state.lw was deleted is not one. */
+int lw_rundir_unstarted(const char *dir);
+
 /* Takes the lock of the existing directory dir for this process: LW_OK and
 ** *hold set (0 where the file system has no locks), or LW_EUSAGE naming the
 ** directory when another process holds it.  A second call for a directory
