@@ -185,9 +185,10 @@ static lw_status setup_schedule(lw_anneal *a, lw_error *err)
   char where[LW_PATH_MAX + 32];
   lw_params_origin(p, d, where, sizeof where);
   a->sched_type = lw_schedule_find(p->schedule);
+  char unseen[96];
   if (!a->sched_type)
-    return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.schedule': expected one of %s, got '%s'", where,
-                        lw_schedule_names(), p->schedule);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.schedule': expected one of %s, got '%s'%s", where,
+                        lw_schedule_names(), p->schedule, lw_params_unseen_char(p->schedule, unseen, sizeof unseen));
   a->sched.t_start = p->t_start;
   a->sched.t_end = p->t_end;
   a->sched.blocks = p->steps;

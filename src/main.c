@@ -788,6 +788,9 @@ static int cmd_stats(int argc, char **argv)
       dir[k++] = argv[i];
     }
   }
+  /* --to alone takes the rows from the trace's start, not from the default
+  ** stretch's (it said "no row from sweep 1000 to 300") */
+  if (base.to >= 0 && base.from < 0) base.from = 0;
   if (!dir) lw_error_set(&err, LW_ENOMEM, "out of memory");
   else if (!err.code && !k) lw_error_set(&err, LW_EUSAGE, "stats: expected a run directory %s", use);
   lw_trace **t = err.code ? NULL : calloc((size_t)k, sizeof *t);

@@ -960,19 +960,11 @@ int lw_params_named(const char *const *patterns, const lw_param_def *d)
   return 0;
 }
 
-lw_status lw_params_blame(const lw_params *p, const char *section, const char *key, lw_error *err)
-{
-  char where[LW_PATH_MAX + 32], msg[LW_ERROR_MSG];
-  lw_params_origin(p, lw_params_find(section, key), where, sizeof where);
-  snprintf(msg, sizeof msg, "%s", err->msg);
-  return lw_error_set(err, err->code, "%s: key '%s.%s': %s", where, section, key, msg);
-}
+static void value_text(const lw_params *p, const lw_param_def *d, char *buf, size_t n);
 
-/* A character in a refused value that prints like a blank or like nothing
-** (a no-break space that a word processor put after "50" showed as "got
-** '50 '", and ordinary trailing blanks are accepted), named for the message:
-** " (byte K is a no-break space, U+00A0: ...)", or "" if there is none. */
-static const char *unseen_char(const char *value, char *buf, size_t n)
+/* A no-break space that a word processor put after "50" showed as "got
+** '50 '", and ordinary trailing blanks are accepted, so the message names it. */
+const char *lw_params_unseen_char(const char *value, char *buf, size_t n)
 {
   static const struct { const char *utf8, *name; unsigned code; } unseen[] = {
     {"\xc2\xa0", "a no-break space", 0xa0},         {"\xe2\x80\xaf", "a narrow no-break space", 0x202f},
@@ -990,6 +982,20 @@ static const char *unseen_char(const char *value, char *buf, size_t n)
         return buf;
       }
   return buf;
+}
+
+lw_status lw_params_blame(const lw_params *p, const char *section, const char *key, lw_error *err)
+{
+  char where[LW_PATH_MAX + 32], msg[LW_ERROR_MSG];
+  lw_params_origin(p, lw_params_find(section, key), where, sizeof where);
+  snprintf(msg, sizeof msg, "%s", err->msg);
+  /* a schedule's name or a file's path with a no-break space is refused
+  ** after the reading, by the module the value names */
+  char value[LW_PATH_MAX + 32] = "", unseen[96];
+  const lw_param_def *d = lw_params_find(section, key);
+  if (d) value_text(p, d, value, sizeof value);
+  lw_params_unseen_char(value, unseen, sizeof unseen);
+  return lw_error_set(err, err->code, "%s: key '%s.%s': %s%s", where, section, key, msg, strstr(msg, "U+") ? "" : unseen);
 }
 
 typedef struct {
@@ -1094,7 +1100,7 @@ static int on_key(void *user, const char *section, const char *key, const char *
   char expected[256], unseen[96];
   if (!assign(rc->p, d, value, expected, sizeof expected)) {
     lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s': expected %s, got '%s'%s",
-                 rc->p->file, rc->line, section, key, expected, value, unseen_char(value, unseen, sizeof unseen));
+                 rc->p->file, rc->line, section, key, expected, value, lw_params_unseen_char(value, unseen, sizeof unseen));
     return 0;
   }
   *line = rc->line;
@@ -1285,7 +1291,7 @@ static lw_status landscape_picture(const lw_params *p, int *landscape, lw_error 
 {
   *landscape = 0;
   if (!p->image[0]) return LW_OK;
-  char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2], where[LW_PATH_MAX + 32];
+  char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
   lw_path_dir(dir, sizeof dir, p->file);
   lw_path_join(full, sizeof full, dir, p->image);
   lw_image_info info;
@@ -1293,8 +1299,8 @@ static lw_status landscape_picture(const lw_params *p, int *landscape, lw_error 
   /* the picture is what is wrong, so the message names its key: a preset's
   ** orientation = auto reads the header before the scene loads the picture */
   if (lw_image_probe(full, &info, &probe)) {
-    lw_params_origin(p, lw_params_find("scene", "image"), where, sizeof where);
-    return lw_error_set(err, LW_EINPUT, "%s: key 'scene.image': %s", where, probe.msg);
+    *err = probe;
+    return lw_params_blame(p, "scene", "image", err);
   }
   *landscape = info.width > info.height;
   return LW_OK;
@@ -1443,7 +1449,7 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
   char expected[256], unseen[96];
   if (!assign(p, d, eq + 1, expected, sizeof expected))
     return lw_error_set(err, LW_EUSAGE, "--set %s.%s: expected %s, got '%s'%s", section, key,
-                        expected, eq + 1, unseen_char(eq + 1, unseen, sizeof unseen));
+                        expected, eq + 1, lw_params_unseen_char(eq + 1, unseen, sizeof unseen));
   p->line[d - lw_param_table] = -1;
   return LW_OK;
 }

@@ -22,13 +22,13 @@ static lw_status bad_key(const lw_params *p, const char *section, const char *ke
 static lw_status bad_key(const lw_params *p, const char *section, const char *key, lw_status code,
                          lw_error *err, const char *fmt, ...)
 {
-  char where[LW_PATH_MAX + 32], what[LW_ERROR_MSG];
-  lw_params_origin(p, lw_params_find(section, key), where, sizeof where);
+  if (!err) return code;
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(what, sizeof what, fmt, ap);
+  vsnprintf(err->msg, sizeof err->msg, fmt, ap);
   va_end(ap);
-  return lw_error_set(err, code, "%s: key '%s.%s': %s", where, section, key, what);
+  err->code = code;
+  return lw_params_blame(p, section, key, err);
 }
 
 /* A term's own nodes q: n of them where the term is on and n is set (the

@@ -119,7 +119,7 @@ void lw_series_stats_of(const double *x, size_t n, lw_series_stats *out)
   }
   out->n_eff = (double)n / (2.0 * out->tau);
   out->stderr_mean = n > 1 ? out->sd * sqrt(2.0 * out->tau / (double)n) : NAN;
-  out->drift_z = 0.0;
+  out->drift_z = NAN; /* halves of one row have no spread to compare */
   size_t h = n / 2;
   if (h >= 2) {
     double se2 = 0.0, m[2];
@@ -131,6 +131,7 @@ void lw_series_stats_of(const double *x, size_t n, lw_series_stats *out)
       for (size_t t = 0; t < len; t++) vk += (s[t] - m[k]) * (s[t] - m[k]);
       se2 += vk / (double)len * 2.0 * out->tau / (double)len;
     }
+    out->drift_z = 0.0;
     if (se2 > 0.0) out->drift_z = (m[1] - m[0]) / sqrt(se2);
     else if (m[1] != m[0]) out->drift_z = m[1] > m[0] ? INFINITY : -INFINITY;
   }

@@ -40,10 +40,10 @@ const lw_system_type *lw_system_of(const lw_params *p, lw_error *err)
 {
   const lw_system_type *t = lw_system_find(p->system);
   if (!t) {
-    char where[LW_PATH_MAX + 32];
+    char where[LW_PATH_MAX + 32], unseen[96];
     lw_params_origin(p, lw_params_find("scene", "system"), where, sizeof where);
-    lw_error_set(err, LW_EINPUT, "%s: key 'scene.system': expected one of %s, got '%s'", where, lw_system_names(),
-                 p->system);
+    lw_error_set(err, LW_EINPUT, "%s: key 'scene.system': expected one of %s, got '%s'%s", where, lw_system_names(),
+                 p->system, lw_params_unseen_char(p->system, unseen, sizeof unseen));
   }
   /* the same system with its trans-dimensional move kinds (sys_splines.h) */
   if (t == &lw_system_splines) t = lw_splines_row(p);

@@ -230,6 +230,25 @@ Test(cli, bad_input_exits_2_with_one_message)
                0);
 }
 
+/* A no-break space after a value that the reader takes as text (a schedule's
+** or a system's name, a file's path) is named as the reader's refusals name
+** it: it showed as "got 'geometric '" or "pic.png : cannot open". */
+Test(cli, an_unseen_character_is_named_in_the_values_refused_after_reading)
+{
+  static const char *const line[][2] = {{"[anneal]\nschedule = geometric\xc2\xa0\n", "anneal.schedule"},
+                                        {"[scene]\nsystem = splines\xc2\xa0\n", "scene.system"},
+                                        {"[scene]\nimage = none.png\xc2\xa0\n", "scene.image"}};
+  char out[1024], errs[1024], args[256];
+  for (size_t k = 0; k < sizeof line / sizeof line[0]; k++) {
+    write_file("nbsp.ini", line[k][0]);
+    snprintf(args, sizeof args, "run %s/nbsp.ini --out %s/nbsp --quiet", dir, dir);
+    cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", line[k][1]);
+    cr_assert(strstr(errs, line[k][1]) && strstr(errs, "is a no-break space, U+00A0: delete it or type a plain space"),
+              "%s", errs);
+    cr_assert_eq(strchr(errs, '\n'), errs + strlen(errs) - 1, "one line: %s", errs);
+  }
+}
+
 /* The release, as --version, version and -V give it, is the man page's and
 ** summary.json's. */
 Test(cli, the_version_is_the_man_pages_and_the_summarys)
@@ -746,6 +765,10 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
   cr_assert(strstr(out, "sweeps 4000 to 24000 at temperature 1: 4001 rows, one every 5 sweeps\n"), "%s", out);
   cr_assert(strstr(out, "\nobs_count                     50           0           0           -         -\n"), "%s",
             out);
+  /* --to alone takes the rows from the trace's start (the first 200 sweeps tune) */
+  snprintf(args, sizeof args, "stats %s/wlc --to 1000", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(out, "sweeps 205 to 1000 at temperature 1: 160 rows, one every 5 sweeps"), "%s", out);
   /* stopped and resumed: the same trace, byte for byte */
   snprintf(args, sizeof args, "run %s/params/wlc.ini --out %s/half --quiet --stop-at 10000 "
            "--set output.samples_every=6000", lw_test_root(), dir);

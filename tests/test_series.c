@@ -311,20 +311,21 @@ Test(trace, the_temperature_warning_needs_a_temperature_that_changes, .init = ma
   }
 }
 
-/* Writes run r's trace: 4000 rows of an AR(1) column `x` (phi 0.8) shifted
-** by `shift`, and an acceptance column with a level of the run's own. */
-static void write_run(const char *name, unsigned long seed, double shift, double acc, char *path, size_t n)
+/* Writes run r's trace: `rows` rows of an AR(1) column `x` (phi 0.8) times
+** `scale`, shifted by `shift`, and an acceptance column with a level of the
+** run's own. */
+static void write_run(const char *name, unsigned long seed, size_t rows, double scale, double shift, double acc,
+                      char *path, size_t n)
 {
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
   gsl_rng_set(r, seed);
-  const size_t rows = 4000;
   double *x = malloc(rows * sizeof *x);
   ar1(r, 0.8, x, rows);
   size_t cap = 64 * rows, k = 0;
   char *text = malloc(cap);
   k += (size_t)snprintf(text, cap, "sweep,temperature,x,acc_point\n");
   for (size_t t = 0; t < rows; t++)
-    k += (size_t)snprintf(text + k, cap - k, "%zu,1,%.17g,%.6f\n", t + 1, x[t] + shift, acc + 0.01 * x[t] / 3.0);
+    k += (size_t)snprintf(text + k, cap - k, "%zu,1,%.17g,%.6f\n", t + 1, scale * x[t] + shift, acc + 0.01 * x[t] / 3.0);
   write_trace(name, text, path, n);
   free(text);
   free(x);
@@ -363,7 +364,8 @@ Test(trace, several_runs_agree_or_are_flagged, .init = make_dir, .fini = remove_
     for (int r = 0; r < 4; r++) {
       char name[32];
       snprintf(name, sizeof name, "r%d-%d.csv", shifted, r);
-      write_run(name, 100 + (unsigned long)r, r == 3 ? shift[shifted] : 0.0, 0.3 + 0.05 * r, path[r], sizeof path[r]);
+      write_run(name, 100 + (unsigned long)r, 4000, 1.0, r == 3 ? shift[shifted] : 0.0, 0.3 + 0.05 * r, path[r],
+                sizeof path[r]);
       paths[r] = path[r];
       t[r] = lw_trace_read(path[r], &err);
       cr_assert_not_null(t[r], "%s", err.msg);
@@ -390,6 +392,42 @@ Test(trace, several_runs_agree_or_are_flagged, .init = make_dir, .fini = remove_
   fclose(f);
   cr_assert(strstr(err.msg, "other.csv: column 3 is 'y', but 'x' in "), "%s", err.msg);
   for (int r = 0; r < 4; r++) lw_trace_free(t[r]);
+}
+
+/* Runs of one law whose error bars differ (one run's values a tenth the
+** others'): p_runs must be uniform, as for equal error bars.  Of 60 sets
+** of 4 agreeing runs, p_runs < 0.05 is binomial (60, 0.05): mean 3, sd
+** 1.69; 10 or more has probability 1.6e-3.  Taken about the plain average
+** of the means the chi-square made 63 % of such sets fail at 0.05. */
+Test(trace, runs_with_unequal_error_bars_are_compared_about_their_weighted_mean, .init = make_dir, .fini = remove_dir)
+{
+  char path[4][128], out[4096];
+  const char *paths[4];
+  lw_trace *t[4];
+  lw_trace_select sel[4];
+  lw_error err;
+  int low = 0;
+  for (int set = 0; set < 60; set++) {
+    for (int r = 0; r < 4; r++) {
+      char name[32];
+      snprintf(name, sizeof name, "u%d.csv", r);
+      write_run(name, 1000 + 4 * (unsigned long)set + (unsigned long)r, 1000, r ? 1.0 : 0.1, 0.0, 0.3, path[r],
+                sizeof path[r]);
+      paths[r] = path[r];
+      t[r] = lw_trace_read(path[r], &err);
+      cr_assert_not_null(t[r], "%s", err.msg);
+      sel[r] = (lw_trace_select){.from = -1, .to = -1, .csv = 1};
+    }
+    FILE *f = fmemopen(out, sizeof out, "w");
+    cr_assert_eq(lw_trace_stats_runs((const lw_trace *const *)t, paths, sel, 4, f, &err), LW_OK, "%s", err.msg);
+    fclose(f);
+    double rh, p;
+    runs_agreement(out, "x", &rh, &p);
+    low += p < 0.05;
+    for (int r = 0; r < 4; r++) lw_trace_free(t[r]);
+  }
+  cr_log_info("unequal error bars: %d of 60 sets at p_runs < 0.05", low);
+  cr_assert(low < 10, "%d of 60 sets of agreeing runs at p_runs < 0.05 (expected 3 +- 1.7)", low);
 }
 
 /* The value of column col in the CSV of `linewise stats` (field 3: the
@@ -930,6 +968,15 @@ Test(trace, one_row_gives_a_mean_and_no_error_bar, .init = make_dir, .fini = rem
   cr_assert(strstr(out, "3.25           -           -"), "%s", out);
   sel.csv = 1;
   report_of(t, &sel, out, sizeof out);
-  cr_assert(strstr(out, "\ntotal,1,3.25,,,,,") && strstr(out, "\nacc_point,0,,,,,,,,\n"), "%s", out);
+  cr_assert(strstr(out, "\ntotal,1,3.25,,,,,,,\n") && strstr(out, "\nacc_point,0,,,,,,,,\n"), "%s", out);
+  lw_trace_free(t);
+  /* two rows: their halves have no spread to compare (drift_z was 0), and
+  ** their two squares about the mean are equal (the heat capacity had an
+  ** error bar of 0): both empty */
+  t = trace_of("sweep,temperature,total\n5,0.5,3\n10,0.5,4\n");
+  report_of(t, &sel, out, sizeof out);
+  const char *total = strstr(out, "\ntotal,2,3.5,");
+  cr_assert(total && !strncmp(strchr(total + 1, '\n') - 2, ",,", 2), "%s", out);
+  cr_assert(strstr(out, "\nheat_capacity,0,,,,,,,,\n"), "%s", out);
   lw_trace_free(t);
 }
