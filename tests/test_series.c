@@ -343,6 +343,33 @@ static void runs_agreement(const char *csv, const char *col, double *r_hat, doub
   cr_assert_eq(sscanf(l + 1, "%lf,%lf", r_hat, p), 2, "%s", csv);
 }
 
+/* Four runs (run r of seed seed0 + r, `rows` rows, x scaled by scale[r] and
+** shifted by shift[r], acceptance 0.3 + 0.05 r) compared: the CSV in out,
+** and column x's R-hat and p_runs. */
+static void four_runs(const char *tag, unsigned long seed0, size_t rows, const double *scale, const double *shift,
+                      char *out, size_t n, double *rh, double *p)
+{
+  char path[4][128];
+  const char *paths[4];
+  lw_trace *t[4];
+  lw_trace_select sel[4];
+  lw_error err;
+  for (int r = 0; r < 4; r++) {
+    char name[32];
+    snprintf(name, sizeof name, "%s-%d.csv", tag, r);
+    write_run(name, seed0 + (unsigned long)r, rows, scale[r], shift[r], 0.3 + 0.05 * r, path[r], sizeof path[r]);
+    paths[r] = path[r];
+    t[r] = lw_trace_read(path[r], &err);
+    cr_assert_not_null(t[r], "%s", err.msg);
+    sel[r] = (lw_trace_select){.from = -1, .to = -1, .csv = 1};
+  }
+  FILE *f = fmemopen(out, n, "w");
+  cr_assert_eq(lw_trace_stats_runs((const lw_trace *const *)t, paths, sel, 4, f, &err), LW_OK, "%s", err.msg);
+  fclose(f);
+  runs_agreement(out, "x", rh, p);
+  for (int r = 0; r < 4; r++) lw_trace_free(t[r]);
+}
+
 Test(trace, several_runs_agree_or_are_flagged, .init = make_dir, .fini = remove_dir)
 {
   /* 4 runs of the same AR(1) law (tau 4.5, stderr of a run's mean about
@@ -354,37 +381,32 @@ Test(trace, several_runs_agree_or_are_flagged, .init = make_dir, .fini = remove_
   ** 1.03 there and passes 1.1 at a shift of 3 (1.8 sd).  Each run's
   ** acceptance level differs (its own tuned step): never tested for
   ** agreement. */
-  char path[4][128], out[4096];
-  const char *paths[4];
-  lw_trace *t[4];
-  lw_trace_select sel[4];
-  lw_error err;
-  const double shift[3] = {0.0, 0.8, 3.0};
+  char out[4096];
+  const double shift[3] = {0.0, 0.8, 3.0}, ones[4] = {1, 1, 1, 1};
   for (int shifted = 0; shifted < 3; shifted++) {
-    for (int r = 0; r < 4; r++) {
-      char name[32];
-      snprintf(name, sizeof name, "r%d-%d.csv", shifted, r);
-      write_run(name, 100 + (unsigned long)r, 4000, 1.0, r == 3 ? shift[shifted] : 0.0, 0.3 + 0.05 * r, path[r],
-                sizeof path[r]);
-      paths[r] = path[r];
-      t[r] = lw_trace_read(path[r], &err);
-      cr_assert_not_null(t[r], "%s", err.msg);
-      sel[r] = (lw_trace_select){.from = -1, .to = -1, .csv = 1};
-    }
-    FILE *f = fmemopen(out, sizeof out, "w");
-    cr_assert_eq(lw_trace_stats_runs((const lw_trace *const *)t, paths, sel, 4, f, &err), LW_OK, "%s", err.msg);
-    fclose(f);
+    const double by[4] = {0, 0, 0, shift[shifted]};
+    char tag[8];
+    snprintf(tag, sizeof tag, "r%d", shifted);
     double rh, p;
-    runs_agreement(out, "x", &rh, &p);
+    four_runs(tag, 100, 4000, ones, by, out, sizeof out, &rh, &p);
     cr_log_info("runs, one shifted by %g: R-hat %.4f, p %.3g", shift[shifted], rh, p);
     if (shifted) cr_assert(p < 1e-3, "a shift of %g passed the chi-square: p %g", shift[shifted], p);
     else cr_assert(p > 1e-3 && rh < 1.02, "alike runs flagged: R-hat %g, p %g", rh, p);
     if (shifted == 2) cr_assert(rh > 1.1, "a shift of 1.8 sd: R-hat %g", rh);
     /* an acceptance has no test of the runs: empty fields, as every missing value */
     cr_assert(strstr(out, "\nacc_point,4,16000,") && strstr(out, ",,\n"), "%s", out);
-    for (int r = 0; r < 4; r++) lw_trace_free(t[r]);
   }
   /* a run of another scene: its columns differ */
+  char path[4][128];
+  const char *paths[4];
+  lw_trace *t[4];
+  lw_trace_select sel[4];
+  lw_error err;
+  for (int r = 0; r < 4; r++) {
+    snprintf(path[r], sizeof path[r], "%s/r2-%d.csv", dir, r);
+    paths[r] = path[r];
+    sel[r] = (lw_trace_select){.from = -1, .to = -1, .csv = 1};
+  }
   write_trace("other.csv", "sweep,temperature,y,acc_point\n1,1,2,0.5\n", path[3], sizeof path[3]);
   for (int r = 0; r < 4; r++) t[r] = lw_trace_read(path[r], &err);
   FILE *f = fmemopen(out, sizeof out, "w");
@@ -401,30 +423,13 @@ Test(trace, several_runs_agree_or_are_flagged, .init = make_dir, .fini = remove_
 ** of the means the chi-square made 63 % of such sets fail at 0.05. */
 Test(trace, runs_with_unequal_error_bars_are_compared_about_their_weighted_mean, .init = make_dir, .fini = remove_dir)
 {
-  char path[4][128], out[4096];
-  const char *paths[4];
-  lw_trace *t[4];
-  lw_trace_select sel[4];
-  lw_error err;
+  char out[4096];
+  const double scale[4] = {0.1, 1, 1, 1}, none[4] = {0, 0, 0, 0};
   int low = 0;
   for (int set = 0; set < 60; set++) {
-    for (int r = 0; r < 4; r++) {
-      char name[32];
-      snprintf(name, sizeof name, "u%d.csv", r);
-      write_run(name, 1000 + 4 * (unsigned long)set + (unsigned long)r, 1000, r ? 1.0 : 0.1, 0.0, 0.3, path[r],
-                sizeof path[r]);
-      paths[r] = path[r];
-      t[r] = lw_trace_read(path[r], &err);
-      cr_assert_not_null(t[r], "%s", err.msg);
-      sel[r] = (lw_trace_select){.from = -1, .to = -1, .csv = 1};
-    }
-    FILE *f = fmemopen(out, sizeof out, "w");
-    cr_assert_eq(lw_trace_stats_runs((const lw_trace *const *)t, paths, sel, 4, f, &err), LW_OK, "%s", err.msg);
-    fclose(f);
     double rh, p;
-    runs_agreement(out, "x", &rh, &p);
+    four_runs("u", 1000 + 4 * (unsigned long)set, 1000, scale, none, out, sizeof out, &rh, &p);
     low += p < 0.05;
-    for (int r = 0; r < 4; r++) lw_trace_free(t[r]);
   }
   cr_log_info("unequal error bars: %d of 60 sets at p_runs < 0.05", low);
   cr_assert(low < 10, "%d of 60 sets of agreeing runs at p_runs < 0.05 (expected 3 +- 1.7)", low);
