@@ -924,6 +924,23 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
                      a->sweep ? block_of(a, a->sweep - 1) : -1, a->block);
     goto out;
   }
+  /* the schedule's temperature follows from the step and the parameters
+  ** (the adaptive one's from measurements the file holds as well, but its
+  ** rule under tempering changed on 2026-12-04: not checked); an edited one
+  ** ran the rest of its step at that temperature */
+  if (!a->dyn && a->block >= 0 && a->sched_type != &lw_schedule_adaptive) {
+    double t = a->sched_type->temperature(&a->sched, a->block, a->t_prev, &a->prev);
+    if (t != a->t_sched) {
+      s = lw_error_set(err, LW_EINPUT, "%s: [run] temperature: %.17g, but the %s schedule's step %ld is at %.17g: "
+                       "the state was edited", path, a->t_sched, a->sched_type->name, a->block, t);
+      goto out;
+    }
+  }
+  if (a->seed != (unsigned long)a->params.seed) {
+    s = lw_error_set(err, LW_EINPUT, "%s: [run] seed: %lu, but the run's scene.ini has anneal.seed = %.0f: the state "
+                     "was edited", path, a->seed, a->params.seed);
+    goto out;
+  }
   set_temperatures(a);
   dir_file(path, sizeof path, a, "timing.txt");
   FILE *tf = fopen(path, "r");

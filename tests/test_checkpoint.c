@@ -120,6 +120,10 @@ Test(checkpoint, every_run_data_value_is_checked_on_resume)
     {"s/^sweep = 20$/sweep = 19/", "counts end at sweep 20, but it is at sweep 19 (a row every 1 sweeps)"},
     {"s/^end_sweep = .*/end_sweep = 19/", "[run] end_sweep: expected a whole number from 20"},
     {"s/^trace_bytes = .*/trace_bytes = 10/", "counts 10 bytes of it, which do not end a row"},
+    /* a temperature or a seed of another run: each read, neither checked
+    ** (the rest of the step ran at T = 5; summary.json named the new seed) */
+    {"s/^temperature = .*/temperature = 5/", "[run] temperature: 5, but the geometric schedule"},
+    {"s/^seed = .*/seed = 2/", "[run] seed: 2, but the run"},
   };
   stopped_run();
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
