@@ -628,7 +628,7 @@ static int cmd_run(int argc, char **argv)
       struct stat sb;
       if (!v || !*v || (stat(v, &sb) == 0 && !S_ISDIR(sb.st_mode))) {
         lw_error_set(&err, LW_EUSAGE, "--out: expected a directory, got '%s'%s", v ? v : "",
-                     v && *v ? " (a file)" : "");
+                     !v || !*v ? "" : S_ISREG(sb.st_mode) ? " (a file)" : " (not a directory)");
         return fail(&err);
       }
       if (dir_fits("--out", v, &err)) return fail(&err);

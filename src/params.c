@@ -1112,6 +1112,10 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
 {
   lw_params_defaults(p);
   p->of_run = of_run;
+  /* a path cut to fit would name another file in every message */
+  if (strlen(path) >= sizeof p->file)
+    return lw_error_set(err, LW_EINPUT, "%.80s...: the scene file's path is %zu bytes; expected at most %zu",
+                        path, strlen(path), sizeof p->file - 1);
   snprintf(p->file, sizeof p->file, "%s", path);
   FILE *f = fopen(path, "r");
   if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open scene file: %s", path, strerror(errno));

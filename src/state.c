@@ -186,6 +186,8 @@ lw_status lw_state_get_splines(lw_ckpt *c, const char *section, lw_splines **out
     return BAD("'splines = <count>' first", key ? key : "end of section");
   long long ns;
   if (!lw_number_parse_whole(val, 0, 1e8, &ns)) return BAD("a whole number from 0 to 100000000", val);
+  const int count_line = line;
+  char got[96]; /* the line read, key and value: a count that disagrees with the lines showed only a value */
   collect col;
   if (!collect_init(&col, (size_t)ns)) {
     collect_free(&col);
@@ -195,8 +197,14 @@ lw_status lw_state_get_splines(lw_ckpt *c, const char *section, lw_splines **out
   for (size_t i = 0; i < (size_t)ns && !s; i++) {
     key = NULL;
     int more = lw_ckpt_next(c, section, &pos, &key, &val, &line);
-    if (!more || strcmp(key, "spline") || !spline_header(val, &col.segs[i], &col.rest[i], &col.layer[i])) {
-      s = BAD("'spline = <segments >= 1> <rest length > 0> [<layer 0 to 255>]'", more ? val : "end of section");
+    if (!more) {
+      s = lw_error_set(err, LW_EINPUT, "%s:%d: [%s] splines: %lld, but the section ends after %zu of them", path,
+                       count_line, section, ns, i);
+      break;
+    }
+    if (strcmp(key, "spline") || !spline_header(val, &col.segs[i], &col.rest[i], &col.layer[i])) {
+      snprintf(got, sizeof got, "%s = %s", key, val);
+      s = BAD("'spline = <segments >= 1> <rest length > 0> [<layer 0 to 255>]'", got);
       break;
     }
     if (i > 0 && (col.layer[i] < 0) != (col.layer[0] < 0)) {
@@ -206,9 +214,12 @@ lw_status lw_state_get_splines(lw_ckpt *c, const char *section, lw_splines **out
     for (size_t k = 0; k <= col.segs[i] && !s; k++) {
       lw_node nd;
       more = lw_ckpt_next(c, section, &pos, &key, &val, &line);
+      if (more) snprintf(got, sizeof got, "%s = %s", key, val);
       if (!more || strcmp(key, "node") || !node_values(val, &nd))
-        s = lw_error_set(err, LW_EINPUT, "%s:%d: [%s] spline %zu node %zu: expected 'node = ' and %s, got '%.60s'",
-                         path, line, section, i, k, node_expected, more ? val : "end of section");
+        s = lw_error_set(err, LW_EINPUT,
+                         "%s:%d: [%s] spline %zu node %zu: expected 'node = ' and %s, got '%.60s' (its %zu segments "
+                         "have %zu nodes)", path, line, section, i, k, node_expected, more ? got : "end of section",
+                         col.segs[i], col.segs[i] + 1);
       else if (!collect_node(&col, nd))
         s = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
     }

@@ -124,6 +124,9 @@ Test(checkpoint, every_run_data_value_is_checked_on_resume)
     ** (the rest of the step ran at T = 5; summary.json named the new seed) */
     {"s/^temperature = .*/temperature = 5/", "[run] temperature: 5, but the geometric schedule"},
     {"s/^seed = .*/seed = 2/", "[run] seed: 2, but the run"},
+    /* a count the lines do not hold, and a node line missing, said so */
+    {"s/^splines = \\([0-9]*\\)$/splines = 1\\1/", "but the section ends after"},
+    {"0,/^node = /{//d}", "segments have"},
   };
   stopped_run();
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {

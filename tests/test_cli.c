@@ -455,6 +455,7 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
   write_file("fr.lw", "linewise-state 2\n[run]\nscene = s.ini\nseed = 1\nsweep = 0\n[system splines]\nsplines = 1x\n");
   write_file("pl.ini", "[scene]\nwidth = 100\nheight = 80\n[init]\nsegment_length = 500\n");
   write_file("te.ini", "[anneal]\nschedule = geometric\nt_end = 0\n");
+  write_file("odd.ini", "[scene]\nboundary = polygon\npolygon = 10 10 90 10 90 90 10\n");
   {
     char path[128];
     snprintf(path, sizeof path, "%s/nul.ini", dir);
@@ -465,7 +466,10 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
   static const struct { const char *args, *msg; } bad[] = {
     {"run %s", "cannot read scene file: Is a directory"},
     {"run %s/s.ini --out ''", "--out: expected a directory"},
-    {"run %s/s.ini --out /dev/null", "--out: expected a directory, got '/dev/null' (a file)"},
+    {"run %s/s.ini --out /dev/null", "--out: expected a directory, got '/dev/null' (not a directory)"},
+    {"run %s/s.ini --out /etc/passwd", "--out: expected a directory, got '/etc/passwd' (a file)"},
+    {"run %s/odd.ini", "odd.ini:3: key 'scene.polygon': expected at least 3 vertices as 'x y' pairs, got 7 numbers "
+     "(an odd count: one x or y is missing)"},
     {"run %s/s.ini --stop-at 99999999999999999999", "--stop-at: expected a whole number"},
     {"run %s/s.ini --stop-at 0x10", "--stop-at: expected a whole number"},
     {"run %s/s.ini --seed 1e300", "--seed: expected a whole number"},

@@ -18,7 +18,9 @@ typedef enum {
   LW_ERUN       /* a failure while running (exit 1) */
 } lw_status;
 
-#define LW_ERROR_MSG 1024
+/* room for two paths of LW_PATH_MAX and the words about them: at 1024 a
+** message about a long path was cut before it said what was wrong */
+#define LW_ERROR_MSG 4096
 
 typedef struct {
   lw_status code;
