@@ -72,8 +72,11 @@ static lw_plot *make_plot(const lw_params *p, const lw_scene *sc, const lw_splin
       lw_error_set(err, LW_ENOMEM, "out of memory ranking %zu splines", sp->n_splines);
       return NULL;
     }
-    if (sc->on[LW_TERM_POTENTIAL]) lw_plot_mean_along(sp, &sc->quad, potential_at, &sc->potential, key);
-    else lw_plot_mean_along(sp, &sc->quad, tone_at, tone, key);
+    /* the picture's tone where there is one: the photo preset's potential is
+    ** tone^8, about 0 wherever the tone is under 0.5, so its ranking put half
+    ** the strokes of a black area in the lightest pen */
+    if (tone) lw_plot_mean_along(sp, &sc->quad, tone_at, tone, key);
+    else lw_plot_mean_along(sp, &sc->quad, potential_at, &sc->potential, key);
   }
   lw_plot *pl = lw_plot_new(sp, p->pens, key, LW_PLOT_ORDER_NONE, 0.0, 0.0, err);
   free(key);

@@ -444,9 +444,9 @@ const lw_param_def lw_param_table[] = {
   NUM("output", "pen_width", LW_PT_DOUBLE, pen_width, "0.3", "mm", 0, 100, LW_MIN_OPEN,
       "Stroke width of every pen in final.svg, the previews and the fidelity render: the pen's line width."),
   NUM("output", "pens", LW_PT_INT, pens, "1", "", 1, 16, 0,
-      "Pens, each an Inkscape layer of final.svg. With a potential the splines are ranked by "
-      "their mean potential and cut into equal runs, darkest (lowest) to pen 1; otherwise "
-      "spline i goes to pen (i mod pens) + 1."),
+      "Pens, each an Inkscape layer of final.svg. With a target tone (else a potential) the "
+      "splines are ranked by their mean tone (potential) and cut into equal runs, darkest "
+      "(lowest) to pen 1; otherwise spline i goes to pen (i mod pens) + 1."),
   STRING("output", "pen_colors", pen_colors, "", "",
          "Colours of the pens as `#rrggbb` or `#rgb`, one per pen, separated by spaces; empty = all black."),
   CHOICE("output", "order", order, "2opt", "none|greedy|2opt",

@@ -855,3 +855,38 @@ Test(image_cli, the_photo_preset_leaves_white_paper_white)
   cr_assert(stray[1] < 0.002, "stray ink %g with line paid for", stray[1]);
   cr_assert(stray[2] > 0.004, "the control: stray ink %g with line paid for and no potential", stray[2]);
 }
+
+/* Pens rank the strokes by the picture's tone: the photo preset's potential
+** (tone^8), averaged along a stroke, is the bright samples' (a black area's
+** strokes that touch a white edge ranked lighter than a mid-grey's, and went
+** to the lightest pen).  Left half black with a white line every 5 pixels
+** (mean tone 0.2, mean tone^8 0.2), right half a grey of 0.55 (0.55 and
+** 0.008): pen 1 (the darkest) must hold the left half's strokes. */
+Test(image_cli, pens_are_ranked_by_the_pictures_tone)
+{
+  const int w = 80, h = 60;
+  float *g = malloc(sizeof(float) * w * h);
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) g[j * w + i] = i < w / 2 ? (i % 5 == 4 ? 1.0f : 0.0f) : 0.55f;
+  lw_test_png(lw_test_path("halves.png"), w, h, g, NULL);
+  free(g);
+  write_text("scene.ini", "[scene]\npreset = photo\npage = a6\nimage = halves.png\n[anneal]\nsweeps = 20\n"
+                          "[output]\npens = 2\n");
+  char errs[8192];
+  cr_assert_eq(run("run scene.ini --out out --quiet --threads 2", errs, sizeof errs), 0, "%s", errs);
+  /* each pen's layer: its paths, and those that start in the right half */
+  const char *svg = lw_test_read_text(lw_test_path("out/final.svg"));
+  double mid = 0;
+  int n[2] = {0, 0}, right[2] = {0, 0}, pen = -1;
+  cr_assert(sscanf(strstr(svg, "width=\""), "width=\"%lfmm", &mid) == 1, "%.300s", svg);
+  mid /= 2;
+  for (const char *c = svg; (c = strpbrk(c, "<")); c++) {
+    if (!strncmp(c, "<g ", 3) && strstr(c, "inkscape:groupmode=\"layer\"") < strchr(c, '>')) pen++;
+    double x;
+    const char *d = !strncmp(c, "<path ", 6) ? strstr(c, " d=\"M") : NULL;
+    if (d && pen >= 0 && pen < 2 && sscanf(d, " d=\"M%lf", &x) == 1) n[pen]++, right[pen] += x > mid;
+  }
+  cr_assert(n[0] > 5 && n[1] > 5, "paths a pen: %d %d", n[0], n[1]);
+  cr_log_info("pen 1: %d of %d paths in the grey half; pen 2: %d of %d", right[0], n[0], right[1], n[1]);
+  cr_assert(right[0] < n[0] / 10, "pen 1 (the darkest) has %d of its %d paths in the grey half", right[0], n[0]);
+}
