@@ -753,6 +753,19 @@ static int cmd_resume(int argc, char **argv)
   return rc;
 }
 
+/* Whether the directory named by path (trailing slashes aside) is a link. */
+static int is_link(const char *path)
+{
+  char bare[LW_PATH_MAX];
+  size_t n = strlen(path);
+  while (n > 1 && path[n - 1] == '/') n--;
+  if (n >= sizeof bare) return 0;
+  memcpy(bare, path, n);
+  bare[n] = '\0';
+  struct stat sb;
+  return !lstat(bare, &sb) && S_ISLNK(sb.st_mode);
+}
+
 /* stats DIR... [--from S] [--to S] [--csv] [--reweight N]: the means with
 ** error bars of the columns of DIR/trace.csv (trace.h), and with several
 ** runs whether they agree; or the rungs' energies reweighted to N
@@ -793,6 +806,27 @@ static int cmd_stats(int argc, char **argv)
   if (base.to >= 0 && base.from < 0) base.from = 0;
   if (!dir) lw_error_set(&err, LW_ENOMEM, "out of memory");
   else if (!err.code && !k) lw_error_set(&err, LW_EUSAGE, "stats: expected a run directory %s", use);
+  /* a run named twice (a sweep's `best` link beside its seed-N, as a glob
+  ** of the sweep's directory gives) would count as two agreeing runs: it is
+  ** counted once, by the name that is not a link */
+  for (int r = 1; !err.code && r < k; r++) {
+    char a[LW_PATH_MAX + 32], b[LW_PATH_MAX + 32];
+    struct stat sa, sb;
+    lw_path_join(a, sizeof a, dir[r], "trace.csv");
+    for (int q = 0; q < r; q++) {
+      lw_path_join(b, sizeof b, dir[q], "trace.csv");
+      if (stat(a, &sa) || stat(b, &sb) || sa.st_dev != sb.st_dev || sa.st_ino != sb.st_ino) continue;
+      if (is_link(dir[q]) && !is_link(dir[r])) {
+        const char *keep = dir[r];
+        dir[r] = dir[q];
+        dir[q] = keep;
+      }
+      fprintf(stderr, "linewise: note: %s is the run in %s again: counted once\n", dir[r], dir[q]);
+      memmove(dir + r, dir + r + 1, (size_t)(k - r - 1) * sizeof *dir);
+      k--, r--;
+      break;
+    }
+  }
   lw_trace **t = err.code ? NULL : calloc((size_t)k, sizeof *t);
   lw_trace_select *sel = t ? calloc((size_t)k, sizeof *sel) : NULL;
   char **path = sel ? calloc((size_t)k, sizeof *path) : NULL;

@@ -786,6 +786,11 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   cr_assert(strstr(out, "column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs\n") &&
             strstr(out, "\nobs_end2,2,8002,") && strstr(out, ",1\nobs_rg2,"), "%s", out);
+  /* a run named twice, once through a link (a sweep's `best`): counted once */
+  cr_assert_eq(lw_test_sh("ln -s wlc %s/best", dir), 0);
+  snprintf(args, sizeof args, "stats %s/best %s/wlc --csv", dir, dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "/best is the run in ") && strstr(out, "column,n,mean,stderr,"), "%s%s", errs, out);
   /* the samples: at sweeps 6000 .. 24000, each every node of the 50 chains;
   ** the last one's mean squared end-to-end distance is the last trace
   ** row's obs_end2 (both of the state after sweep 24000) */

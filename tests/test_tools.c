@@ -430,6 +430,54 @@ Test(tools, failed_runs_are_reported_and_the_others_finish)
   free(t.text);
 }
 
+/* A run stopped by a signal to it alone (here: --stop-at, which ends a run as
+** a signal does, exit 0 without summary.json) is reported and the others go
+** on (it returned xargs' 255, which started no further run); an idle key's
+** note, in every run's log, is shown once; words sort the rows with the
+** seeds of a point together; the same --set options in another order are
+** the same sweep. */
+Test(tools, a_run_stopped_alone_leaves_the_others_and_notes_reach_the_sweep)
+{
+  char fake[128];
+  snprintf(fake, sizeof fake, "%s/fake-linewise", dir);
+  FILE *f = fopen(fake, "w");
+  cr_assert_not_null(f);
+  fprintf(f, "#!/bin/sh\ncase \"$*\" in *schedule=linear*'exchange_every=5 --seed 1 '*) exec %s \"$@\" --stop-at 3 ;; esac\nexec %s \"$@\"\n",
+          env("LW_BIN"), env("LW_BIN"));
+  fclose(f);
+  cr_assert_eq(chmod(fake, 0755), 0);
+  const char *args = "%s %s --vary anneal.schedule=linear,geometric --vary tempering.exchange_every=5,10 --seeds 1-2 "
+                     "-j 1 --set anneal.sweeps=20 --set init.splines=5 --bin %s --out %s/n";
+  cr_assert_eq(sh(args, tool("param-sweep"), scene(), fake, dir), 1, "%s", err_txt());
+  char *errs = err_txt(), *out = out_txt();
+  cr_assert(strstr(errs, "anneal.schedule=linear__tempering.exchange_every=5__seed-1: stopped by a signal to it alone"),
+            "%s", errs);
+  const char *note = strstr(errs, "note: these keys have no effect here: tempering.exchange_every");
+  cr_assert(note && !strstr(note + 1, "note: these keys"), "one note: %s", errs);
+  cr_assert(strstr(out, "7 finished runs gathered"), "%s", out);
+  csv t;
+  char path[128];
+  snprintf(path, sizeof path, "%s/n/sweep.csv", dir);
+  csv_read(&t, path);
+  cr_assert_eq(t.nrow, 7);
+  static const char *const order[7][2] = {{"1", "geometric"}, {"2", "geometric"}, {"1", "geometric"},
+                                          {"2", "geometric"}, {"2", "linear"},    {"1", "linear"},
+                                          {"2", "linear"}};
+  for (int r = 0; r < 7; r++)
+    cr_assert(!strcmp(cell(&t, r, "seed"), order[r][0]) && !strcmp(cell(&t, r, "anneal.schedule"), order[r][1]),
+              "row %d: seed %s, %s", r, cell(&t, r, "seed"), cell(&t, r, "anneal.schedule"));
+  free(t.text);
+  free(errs);
+  free(out);
+  /* the --set options swapped: the same sweep, whose stopped run resumes */
+  cr_assert_eq(sh("%s %s --vary anneal.schedule=linear,geometric --vary tempering.exchange_every=5,10 --seeds 1-2 "
+                  "-j 1 --set init.splines=5 --set anneal.sweeps=20 --bin %s --out %s/n",
+                  tool("param-sweep"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
+  out = out_txt();
+  cr_assert(strstr(out, "seed-1: resumed") && strstr(out, "8 finished runs gathered"), "%s", out);
+  free(out);
+}
+
 Test(tools, job_array_tasks_then_gather_only)
 {
   /* what Slurm does: one task per array index, then a gathering job */
