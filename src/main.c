@@ -39,6 +39,10 @@ static lw_anneal_net *net;
 ** input and fails the same way. */
 static int started;
 #endif
+/* a signal that ends the set-up says nothing: in a process of an MPI run but
+** the first (mpirun ends the others when one fails: process 0 speaks), and
+** once the failure is said (mpirun's signal came while it ended) */
+static volatile sig_atomic_t signal_quiet = 0;
 
 static const char usage[] =
   "usage: linewise <command> [options]\n"
@@ -92,6 +96,7 @@ static int fail(const lw_error *err)
     lw_mpi_abort(lw_error_exit_status(err->code));
   }
 #endif
+  signal_quiet = 1;
   if (net && net->rank) return lw_error_exit_status(err->code); /* process 0 says it */
   fprintf(stderr, "linewise: %s\n", err->msg);
   return lw_error_exit_status(err->code);
@@ -239,8 +244,10 @@ static volatile sig_atomic_t made_what = 0; /* 1 made_dir was made for the run, 
 static void stop_unwritten(int sig)
 {
   static const char msg[] = "\nlinewise: stopped during the set-up, before anything was written\n";
-  ssize_t w = write(2, msg, sizeof msg - 1);
-  (void)w;
+  if (!signal_quiet) {
+    ssize_t w = write(2, msg, sizeof msg - 1);
+    (void)w;
+  }
   if (made_what) {
     unlink(made_lock);
     rmdir(made_dir);
@@ -732,13 +739,13 @@ static int cmd_resume(int argc, char **argv)
   if (net && net->rank) quiet = 1;
   watcher_start(&w, quiet);
   checkpointed = 1; /* state.lw holds the last one */
-  if (spread_start(lw_anneal_resume_net(&a, dir, more, net, &err), &a, 0, &err)) {
-    lw_anneal_free(&a);
-    return watched_fail(&w, &err);
-  }
-  if (stop_at >= 0 && stop_at < a.sweep) {
-    lw_error_set(&err, LW_EUSAGE, "--stop-at %ld: the run in %s stands at sweep %ld already; expected %ld or more",
-                 stop_at, dir, a.sweep, a.sweep);
+  lw_status s = lw_anneal_resume_net(&a, dir, more, net, &err);
+  /* judged before the processes of an MPI run agree, so that it is said
+  ** once (each said it, and MPI_Abort's banner followed) */
+  if (!s && stop_at >= 0 && stop_at < a.sweep)
+    s = lw_error_set(&err, LW_EUSAGE, "--stop-at %ld: the run in %s stands at sweep %ld already; expected %ld or more",
+                     stop_at, dir, a.sweep, a.sweep);
+  if (spread_start(s, &a, 0, &err)) {
     lw_anneal_free(&a);
     return watched_fail(&w, &err);
   }
@@ -956,6 +963,7 @@ int main(int argc, char **argv)
   install_signals(runs);
 #ifdef LW_MPI
   if (!(net = lw_mpi_init(&argc, &argv, &stop_requested))) return 1;
+  signal_quiet = net->rank != 0;
   /* the commands other than run and resume are one process's */
   int spread = argc >= 2 && (!strcmp(argv[1], "run") || !strcmp(argv[1], "resume"));
   int rc = spread || net->rank == 0 ? command(argc, argv) : 0;
