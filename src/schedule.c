@@ -8,6 +8,7 @@
 #include "linewise/schedule.h"
 
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -58,7 +59,13 @@ static double geometric_temperature(const lw_schedule *s, long b, double t_prev,
   double f = block_fraction(s, b);
   if (f == 0.0) return s->t_start;
   if (f == 1.0) return s->t_end;
-  return clamp_between(s->t_start * pow(s->t_end / s->t_start, f), s->t_start, s->t_end);
+  double r = s->t_end / s->t_start;
+  /* 1e-200 / 1e200 is 0 in a double, and the run quenched from the second
+  ** step on: such ratios go through their logarithm (others keep pow, and
+  ** the temperatures of runs already made) */
+  if (!(r >= DBL_MIN && r <= DBL_MAX))
+    return clamp_between(exp(log(s->t_start) + f * (log(s->t_end) - log(s->t_start))), s->t_start, s->t_end);
+  return clamp_between(s->t_start * pow(r, f), s->t_start, s->t_end);
 }
 
 /* The classical T = T0 / (1 + c ln(1 + b)) cools too slowly to reach any
@@ -68,7 +75,12 @@ static double logarithmic_temperature(const lw_schedule *s, long b, double t_pre
 {
   if (s->blocks <= 1 || b <= 0) return s->t_start;
   if (b >= s->blocks - 1) return s->t_end;
-  double c = (s->t_start / s->t_end - 1.0) / log((double)s->blocks);
+  double ratio = s->t_start / s->t_end;
+  /* a ratio past a double's range made c infinite and T 0 (then t_end):
+  ** there 1 + c ln(1+b) is c ln(1+b), and T = t_end ln B / ln(1+b) */
+  if (!(ratio <= DBL_MAX))
+    return clamp_between(s->t_end * log((double)s->blocks) / log1p((double)b), s->t_start, s->t_end);
+  double c = (ratio - 1.0) / log((double)s->blocks);
   return clamp_between(s->t_start / (1.0 + c * log1p((double)b)), s->t_start, s->t_end);
 }
 
@@ -86,6 +98,8 @@ static double adaptive_temperature(const lw_schedule *s, long b, double t_prev, 
   double t;
   if (prev && prev->samples >= 2 && isfinite(prev->sd) && prev->sd > 0)
     t = t_prev * exp(-s->lambda * t_prev / prev->sd);
+  else if (s->blocks > 1 && !(s->t_end / s->t_start >= DBL_MIN)) /* as geometric's */
+    t = t_prev * exp((log(s->t_end) - log(s->t_start)) / (double)(s->blocks - 1));
   else
     t = t_prev * (s->blocks > 1 ? pow(s->t_end / s->t_start, 1.0 / (double)(s->blocks - 1)) : 1.0);
   if (!(t >= s->t_end)) return s->t_end; /* also NaN */

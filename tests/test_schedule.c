@@ -71,6 +71,26 @@ Test(schedule, analytic_endpoints_monotone_and_formula)
   gsl_rng_free(rng);
 }
 
+/* Ends whose ratio leaves a double's range (1e-200 / 1e200 is 0): geometric
+** and the adaptive schedule's fallback step by the ratio's logarithm, and
+** logarithmic by its limit t_end ln B / ln(1 + b); they quenched to t_end
+** from the second step on. */
+Test(schedule, ends_whose_ratio_leaves_a_double_still_cool_step_by_step)
+{
+  lw_schedule s = {.t_start = 1e200, .t_end = 1e-200, .blocks = 10, .lambda = 0.7};
+  double T[10];
+  lw_schedule_run(&lw_schedule_geometric, &s, T);
+  for (int b = 0; b < 10; b++) {
+    double want = pow(10.0, 200.0 - 400.0 * b / 9.0);
+    cr_assert(fabs(T[b] / want - 1) < 1e-12, "geometric T_%d = %g, expected %g", b, T[b], want);
+  }
+  lw_schedule_run(&lw_schedule_logarithmic, &s, T);
+  cr_assert(fabs(T[1] / (1e-200 * log(10.0) / log(2.0)) - 1) < 1e-12, "logarithmic T_1 = %g", T[1]);
+  cr_assert(T[1] > T[2] && T[8] > T[9] && T[9] == 1e-200);
+  double t1 = lw_schedule_adaptive.temperature(&s, 1, s.t_start, NULL);
+  cr_assert(fabs(t1 / pow(10.0, 200.0 - 400.0 / 9.0) - 1) < 1e-12, "adaptive's fallback step: %g", t1);
+}
+
 Test(schedule, analytic_single_block_heating_and_zero)
 {
   const lw_schedule_type *types[] = {&lw_schedule_constant, &lw_schedule_linear, &lw_schedule_geometric,
