@@ -1247,9 +1247,12 @@ static void apply_preset(lw_params *p)
   ** 0.7 tone_blur apart along a segment (4 nodes): on four photographs
   ** the anneal took 0.88 of the CPU time of 6 (the other terms' nodes) at
   ** the same scores, and its final tone energy was within 5.5e-4 of 32
-  ** nodes' (docs/ACCURACY.md, "On the photo preset") */
-  const int nt = (int)ceil(p->segment_length / (0.7 * p->tone_blur));
-  snprintf(text, sizeof text, "%d", nt < LW_QUAD_MIN ? LW_QUAD_MIN : (nt < p->quadrature ? nt : 0));
+  ** nodes' (docs/ACCURACY.md, "On the photo preset"); more than the other
+  ** terms' where the blur is narrower (0 there left 6 nodes for a blur of
+  ** 0.2 mm, whose tone energy then read 6 % high) */
+  const double need = ceil(p->segment_length / (0.7 * p->tone_blur));
+  const int nt = need < LW_QUAD_MIN ? LW_QUAD_MIN : need > LW_QUAD_MAX ? LW_QUAD_MAX : (int)need;
+  snprintf(text, sizeof text, "%d", nt == p->quadrature ? 0 : nt);
   preset_key(p, "energy", "tone_quadrature", text);
   /* domains of 90 w: more than twice a move's reach (a spline of 40 w and
   ** the cutoff), and small enough that each of the four phases has work
