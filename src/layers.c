@@ -102,7 +102,7 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
   if ((st = per_layer(p, "turn", p->ly_turn, n, -360, 360, turn, err)) ||
       (st = per_layer(p, "tone_min", p->ly_tone_min, n, 0, 1, lo, err)) ||
       (st = per_layer(p, "tone_max", p->ly_tone_max, n, 0, 1, hi, err)) ||
-      (st = per_layer(p, "pen_width", p->ly_pen_width, n, 1e-6, 1e3, width, err)))
+      (st = per_layer(p, "pen_width", p->ly_pen_width, n, 1e-3, 100, width, err)))
     return st;
   for (int k = 0; k < n; k++)
     if (!(lo[k] < hi[k]))

@@ -59,10 +59,10 @@ const lw_param_def lw_param_table[] = {
   CHOICE("scene", "orientation", orientation, "portrait", "portrait|landscape|auto",
          "Orientation of a named page: landscape swaps its width and height; auto is landscape when the picture "
          "(`image`) is wider than tall, else portrait. The photo preset sets auto."),
-  NUM("scene", "width", LW_PT_DOUBLE, width, "210", "mm", 0, 1e7, LW_MIN_OPEN,
-      "Page width (set by a named `page`)."),
-  NUM("scene", "height", LW_PT_DOUBLE, height, "297", "mm", 0, 1e7, LW_MIN_OPEN,
-      "Page height (set by a named `page`)."),
+  NUM("scene", "width", LW_PT_DOUBLE, width, "210", "mm", 1, 1e7, 0,
+      "Page width (set by a named `page`); from 1 mm, as final.svg writes millimetres to 4 decimals."),
+  NUM("scene", "height", LW_PT_DOUBLE, height, "297", "mm", 1, 1e7, 0,
+      "Page height (set by a named `page`); from 1 mm, as the width."),
   CHOICE("scene", "boundary", boundary, "rect", "rect|circle|polygon|mask",
          "Shape of the frame `energy.boundary` keeps the lines inside (with it 0 they may leave, and "
          "what lies outside is cut from the drawing): the page rectangle inset by `margin`, "
@@ -441,8 +441,9 @@ const lw_param_def lw_param_table[] = {
       "summary.json reports for the observables (their means, standard errors and autocorrelation times): "
       "the end of a study's burn-in. 0 = the sweeps at the final temperature. Either way the sweeps whose "
       "steps were still tuning are left out."),
-  NUM("output", "pen_width", LW_PT_DOUBLE, pen_width, "0.3", "mm", 0, 100, LW_MIN_OPEN,
-      "Stroke width of every pen in final.svg, the previews and the fidelity render: the pen's line width."),
+  NUM("output", "pen_width", LW_PT_DOUBLE, pen_width, "0.3", "mm", 0.001, 100, 0,
+      "Stroke width of every pen in final.svg, the previews and the fidelity render: the pen's line width "
+      "(from 0.001 mm: final.svg writes it to 4 decimals)."),
   NUM("output", "pens", LW_PT_INT, pens, "1", "", 1, 16, 0,
       "Pens, each an Inkscape layer of final.svg. With a target tone (else a potential) the "
       "splines are ranked by their mean tone (potential) and cut into equal runs, darkest "
