@@ -455,7 +455,10 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
       {polygon, p->boundary != LW_BND_POLYGON, "scene.boundary is not polygon"},
       {mask, lw_params_file_idle(p, lw_params_find("scene", "mask_image")), "scene.mask is not image"},
       {coverage, p->splines != 0, "init.splines is not 0"},
-      {orientation, p->page == LW_PAGE_CUSTOM, "no scene.page names a size"},
+      /* (the photo preset's own auto, which a run's scene.ini holds: a redraw
+      ** from it noted a key its user never set) */
+      {orientation, p->page == LW_PAGE_CUSTOM && !(p->preset == LW_PRESET_PHOTO && p->orientation == LW_ORIENT_AUTO),
+       "no scene.page names a size"},
       {picture, !p->image[0], "no scene.image"},
       {ladder, a->n_rep == 1, "one replica"},
       {jumps, p->fixed_count, "moves.fixed_count = 1"},

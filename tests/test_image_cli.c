@@ -890,3 +890,18 @@ Test(image_cli, pens_are_ranked_by_the_pictures_tone)
   cr_log_info("pen 1: %d of %d paths in the grey half; pen 2: %d of %d", right[0], n[0], right[1], n[1]);
   cr_assert(right[0] < n[0] / 10, "pen 1 (the darkest) has %d of its %d paths in the grey half", right[0], n[0]);
 }
+
+/* The redraw README shows (a finished run's scene.ini, its state, no sweep)
+** has no note about a key its user never set: the photo preset's own
+** orientation = auto, written into that scene.ini on a page of its own size. */
+Test(image_cli, a_redraw_from_a_runs_scene_notes_no_key_its_user_never_set)
+{
+  write_picture("pic.png", 60, 50);
+  write_text("scene.ini", "[scene]\npreset = photo\nwidth = 90\nheight = 80\nimage = pic.png\n[anneal]\nsweeps = 2\n");
+  char errs[8192];
+  cr_assert_eq(run("run scene.ini --out out --threads 1", errs, sizeof errs), 0, "%s", errs);
+  cr_assert_null(strstr(errs, "no effect"), "%s", errs);
+  cr_assert_eq(run("run out/scene.ini --set init.from=out/state.lw --set anneal.sweeps=0 --out again --threads 1", errs,
+                   sizeof errs), 0, "%s", errs);
+  cr_assert_null(strstr(errs, "no effect"), "%s", errs);
+}
