@@ -1364,8 +1364,9 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
         choice_name(dp->choices, p->page, page_name, sizeof page_name);
         return lw_error_set(err, LW_EINPUT,
                             "%s: key 'scene.%s' = %.12g mm conflicts with scene.page = %s (%g x %g mm, set at %s): "
-                            "expected %g or no %s",
-                            where, names[k], *value[k], page_name, w, h, where_page, want[k], names[k]);
+                            "expected %g or no %s (over a size in the scene file, give --set scene.width=%g "
+                            "--set scene.height=%g too)",
+                            where, names[k], *value[k], page_name, w, h, where_page, want[k], names[k], w, h);
       }
       *value[k] = want[k];
     }
