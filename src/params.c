@@ -1281,8 +1281,9 @@ void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size
     return;
   }
   /* a default still names the file: a message about it may come of another
-  ** key the file sets (tempering.t_max below its t_min) */
-  if (p->file[0]) snprintf(buf, n, "%s (default)", p->file);
+  ** key the file sets (tempering.t_max below its t_min); "not set" and the
+  ** value, since the file has no line of it to find */
+  if (p->file[0]) snprintf(buf, n, "%s (not set: the default, %s)", p->file, d->def[0] ? d->def : "empty");
   else snprintf(buf, n, "default");
   if (p->preset != LW_PRESET_PHOTO || p->of_run) return;
   for (size_t k = 0; k < sizeof photo_preset / sizeof photo_preset[0]; k++)

@@ -382,8 +382,8 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
   lw_params_origin(&p, lw_params_find("output", "pen_width"), where, sizeof where);
   cr_assert(strstr(where, ":5"), "%s", where);
   lw_params_origin(&p, lw_params_find("energy", "strain_mode"), where, sizeof where);
-  char expect[sizeof p.file + 16];
-  snprintf(expect, sizeof expect, "%s (default)", p.file);
+  char expect[sizeof p.file + 48];
+  snprintf(expect, sizeof expect, "%s (not set: the default, spline)", p.file);
   cr_assert_str_eq(where, expect, "a default names the scene file");
   /* --set of the pen width: the preset's keys follow, a set key stays */
   cr_assert_eq(lw_params_set(&p, "output.pen_width=0.5", &err), LW_OK);
