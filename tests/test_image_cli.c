@@ -299,8 +299,9 @@ Test(image_cli, a_blurred_transparent_edge_goes_through_the_tone_curve)
 
 /* Samples further apart than the potential's blur, with no pair cutoff to
 ** hold the stretch: the annealer hid 7e-2 of the potential between them
-** (docs/NUMERICS.md).  The run says so; with a cutoff (the pair gap check
-** holds the stretch) it does not. */
+** (docs/NUMERICS.md).  The run says so, naming the keys; with a cutoff (the
+** pair gap check holds the stretch) only past 1.4 times the blur, where the
+** placed samples alone step over the detail. */
 Test(image_cli, samples_wider_apart_than_the_blur_get_a_note)
 {
   write_picture("pic.png", 64, 48);
@@ -310,13 +311,18 @@ Test(image_cli, samples_wider_apart_than_the_blur_get_a_note)
   char errs[8192];
   cr_assert_eq(run("run b.ini --out b --stop-at 0", errs, sizeof errs), 0, "%s", errs);
   cr_assert(strstr(errs, "the placed segments' samples lie up to 1.47 mm apart, more than the picture's detail "
-                         "under scene.potential_blur (0.5 mm,"), "%s", errs);
+                         "under scene.potential_blur (0.5 mm,") &&
+            strstr(errs, "(energy.quadrature) or a wider blur close it, and energy.pair > 0 with a pair_cutoff"),
+            "%s", errs);
   /* a picture blurred as wide as the gap: none */
   cr_assert_eq(run("run b.ini --out b --stop-at 0 --set scene.image_blur=3", errs, sizeof errs), 0, "%s", errs);
   cr_assert_null(strstr(errs, "samples lie up to"), "%s", errs);
   cr_assert_eq(run("run b.ini --out b --stop-at 0 --set energy.pair=0.01 --set energy.pair_cutoff=3", errs,
                    sizeof errs), 0, "%s", errs);
-  cr_assert_null(strstr(errs, "samples lie up to"), "%s", errs);
+  cr_assert(strstr(errs, "the samples step over it") && !strstr(errs, "holds the stretch"), "%s", errs);
+  cr_assert_eq(run("run b.ini --out b --stop-at 0 --set energy.pair=0.01 --set energy.pair_cutoff=3 "
+                   "--set scene.potential_blur=1.2", errs, sizeof errs), 0, "%s", errs);
+  cr_assert_null(strstr(errs, "samples lie up to"), "1.22 times the blur, held: %s", errs);
 }
 
 /* Issue 20: the run made the picture's path absolute by joining the scene's
