@@ -204,7 +204,20 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   if (!st) return err ? err->code : LW_ENOMEM;
   rep->paths = st->n;
   rep->n_pens = st->n_pens;
-  for (int k = 0; k < st->n_pens; k++) rep->pen_paths[k] = st->pen_first[k + 1] - st->pen_first[k];
+  for (int k = 0; k < st->n_pens; k++) {
+    rep->pen_paths[k] = st->pen_first[k + 1] - st->pen_first[k];
+    snprintf(rep->pen_name[k], sizeof rep->pen_name[k], "%s", page.pen_name[k]);
+  }
+  /* an empty drawing said only that: what removed its lines, and the keys */
+  if (!st->n && rep->post.lifts_before)
+    snprintf(rep->empty_why, sizeof rep->empty_why, "every stroke was cut by the crop or too short for "
+             "plot.min_length (%g pen widths)", p->min_length);
+  else if (!st->n && sc->on[LW_TERM_POTENTIAL] && sc->image)
+    snprintf(rep->empty_why, sizeof rep->empty_why, "the anneal removed every line: the price of line "
+             "(energy.potential) is more than the picture's tone pays for it (a pale picture); a lower "
+             "energy.potential keeps lines");
+  else if (!st->n)
+    snprintf(rep->empty_why, sizeof rep->empty_why, "no spline is left (init.splines, or the anneal's deaths)");
   rep->travel_before = rep->post.travel_before;
   rep->travel_after = rep->post.travel_after;
   rep->cropped = o.crop;
@@ -380,14 +393,16 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
   if (w < 0 || (size_t)w >= n) return;
   k = (size_t)w;
   if (!d->paths) {
-    w = snprintf(buf + k, n - k, "linewise: the drawing is empty: final.svg has no path\n");
+    w = snprintf(buf + k, n - k, "linewise: the drawing is empty: final.svg has no path%s%s\n",
+                 d->empty_why[0] ? ": " : "", d->empty_why);
     if (w < 0 || (k += (size_t)w) >= n) return;
   }
   /* a colour pen whose separation is empty (a warm picture's cyan) still has
   ** its layer in final.svg: say so, so that no pen is changed for nothing */
   for (int p = 0; d->n_pens > 1 && d->paths && p < d->n_pens; p++) {
     if (d->pen_paths[p]) continue;
-    w = snprintf(buf + k, n - k, "linewise: pen %d draws nothing (its layer in final.svg is empty)\n", p + 1);
+    w = snprintf(buf + k, n - k, "linewise: pen %d%s%s draws nothing (its layer in final.svg is empty)\n", p + 1,
+                 d->pen_name[p][0] ? " " : "", d->pen_name[p]);
     if (w < 0 || (k += (size_t)w) >= n) return;
   }
   if (!d->has_fidelity) return;
@@ -398,7 +413,7 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
                d->fidelity.mse, d->fidelity.ssim,
                orientation_text(d->fidelity.orientation, o), d->fidelity.stray);
   for (int p = 0; d->n_pens > 1 && p < d->n_pens && w >= 0 && (k += (size_t)w) < n; p++)
-    w = snprintf(buf + k, n - k, "linewise: fidelity of pen %d: MSE %.6g, SSIM %.4f, orientation %s, stray ink %.4f\n",
-                 p + 1, d->pen_fidelity[p].mse, d->pen_fidelity[p].ssim,
+    w = snprintf(buf + k, n - k, "linewise: fidelity of pen %d%s%s: MSE %.6g, SSIM %.4f, orientation %s, stray ink "
+                 "%.4f\n", p + 1, d->pen_name[p][0] ? " " : "", d->pen_name[p], d->pen_fidelity[p].mse, d->pen_fidelity[p].ssim,
                  orientation_text(d->pen_fidelity[p].orientation, o), d->pen_fidelity[p].stray);
 }

@@ -907,3 +907,15 @@ Test(cli, an_irregular_segment_is_refused_naming_the_test_that_failed)
                           "(energy.regularity = 3), a fold the quadrature cannot see; lower energy.regularity' %s/err.txt",
                           b, dir, dir, dir, dir, dir), 0);
 }
+
+/* An empty drawing says what removed its lines (it said only "final.svg has
+** no path"): here every stroke is under plot.min_length's 3 pen widths. */
+Test(cli, an_empty_drawing_says_what_removed_its_lines)
+{
+  char out[1024], errs[16384], args[512];
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --set output.pen_width=100 --set anneal.sweeps=5 --out %s/e",
+           lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "the drawing is empty: final.svg has no path: every stroke was cut by the crop or too short "
+                         "for plot.min_length (3 pen widths)"), "%s", errs);
+}

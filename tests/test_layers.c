@@ -914,17 +914,18 @@ Test(layers, the_svg_has_one_group_a_pen_with_its_colour_and_width)
 
 /* A picture of cyan and yellow asks nothing of the magenta and black pens:
 ** their layers stay in final.svg (pen numbers are plotting order), and the
-** run says they draw nothing, so that no pen is changed for an empty layer;
-** summary.json counts each pen's paths. */
+** run says they draw nothing, by number and name, so that no pen is changed
+** for an empty layer; summary.json counts each pen's paths. */
 Test(layers, a_pen_that_draws_nothing_is_named)
 {
   write_colour_png(lw_test_path("colour.png"), 32, 32, cyan_yellow);
   lw_test_write(lw_test_path("scene.ini"), colour_scene, strlen(colour_scene));
   char errs[8192];
   cr_assert_eq(run("run scene.ini --out out", errs, sizeof errs), 0, "%s", errs);
+  static const char *const name[] = {"c", "m", "y", "k"};
   for (int k = 1; k <= 4; k++) {
     char line[64];
-    snprintf(line, sizeof line, "linewise: pen %d draws nothing", k);
+    snprintf(line, sizeof line, "linewise: pen %d %s draws nothing", k, name[k - 1]);
     if (k == 2 || k == 4) cr_assert_not_null(strstr(errs, line), "no note for pen %d:\n%s", k, errs);
     else cr_assert_null(strstr(errs, line), "pen %d draws:\n%s", k, errs);
   }
