@@ -31,11 +31,14 @@ lw_status lw_rundir_make(const char *dir, lw_error *err)
     if (*c == '/' || *c == '\0') {
       char save = *c;
       *c = '\0';
-      /* a file where a directory should be is the user's mistake (exit 2,
-      ** as --out naming a file); a disk that refuses is the machine's */
-      if (mkdir(buf, 0777) && errno != EEXIST)
-        return lw_error_set(err, errno == ENOTDIR ? LW_EUSAGE : LW_EIO, "%s: cannot create directory: %s", buf,
+      /* a place no directory can be made (a file in the way, /proc, no
+      ** permission, a read-only mount) is the user's choice (exit 2, as
+      ** --out naming a file); a disk that is full or fails is the machine's */
+      if (mkdir(buf, 0777) && errno != EEXIST) {
+        const int machine = errno == ENOSPC || errno == EIO || errno == EDQUOT || errno == ENOMEM;
+        return lw_error_set(err, machine ? LW_EIO : LW_EUSAGE, "%s: cannot create directory: %s", buf,
                             strerror(errno));
+      }
       *c = save;
       if (!save) break;
     }
