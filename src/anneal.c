@@ -435,6 +435,7 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
                            *const ladder[] = {"tempering.t_min", "tempering.t_max", "tempering.exchange_every",
                                               "tempering.tune_ladder", "tempering.ladder_sweeps", NULL},
                            *const ends[] = {"tempering.t_min", "tempering.t_max", NULL},
+                           *const seed[] = {"anneal.seed", NULL},
                            *const jumps[] = {"moves.birth", "moves.birth_uniform", "moves.birth_spread",
                                              "moves.prior_sd", "moves.death", "moves.grow", "moves.shrink",
                                              "moves.max_segments", "moves.split", "moves.join",
@@ -463,6 +464,8 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
       {picture, !p->image[0], "no scene.image"},
       {ladder, a->n_rep == 1, "one replica"},
       {ends, a->n_rep > 1 && p->ladder[0], "tempering.ladder names the temperatures"},
+      /* (a seed sweep of the whip gave identical "independent" runs) */
+      {seed, p->driver == LW_DRIVER_DYNAMICS && p->from[0], "the dynamics from init.from draws no random number"},
       {jumps, p->fixed_count, "moves.fixed_count = 1"},
       {weights, !p->nb_free_weights, "nurbs.free_weights = 0"},
       {births, p->pt_birth == 0.0 && p->pt_death == 0.0, "no particles.birth or death"},

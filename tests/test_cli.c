@@ -340,6 +340,7 @@ Test(cli, keys_the_system_never_reads_are_refused)
      "particles.max_count (--set: no particles.birth or death), particles.sigma (--set: particles.weight = poly)"},
     {"minimal", "--set 'tempering.ladder=0.01 0.1 1' --set tempering.t_max=5",
      "tempering.t_max (--set: tempering.ladder names the temperatures)"},
+    {"whip", "--seed 2", "anneal.seed (--set: the dynamics from init.from draws no random number)"},
   };
   for (size_t k = 0; k < sizeof idle / sizeof idle[0]; k++) {
     snprintf(args, sizeof args, "run %s/params/%s.ini --out %s/n%zu --set anneal.sweeps=1 %s", lw_test_root(),
