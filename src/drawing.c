@@ -88,6 +88,27 @@ static void dir_file(char *buf, size_t n, const char *dir, const char *name)
   snprintf(buf, n, "%s/%s", dir, name);
 }
 
+/* Paths of st that reach past the page [0, w] x [0, h], each segment taken
+** at 9 points: with plot.crop = 0 they were kept without a word, and a
+** plotter travelled off the paper. */
+static size_t paths_off_page(const lw_strokes *st, double w, double h)
+{
+  size_t off = 0;
+  for (size_t k = 0; k < st->n; k++) {
+    int out = 0;
+    for (size_t s = st->first[k]; s < st->first[k + 1] && !out; s++) {
+      const double *b = st->b + 8 * s;
+      for (int i = 0; i <= 8 && !out; i++) {
+        double t = i / 8.0, u = 1.0 - t, c0 = u * u * u, c1 = 3 * u * u * t, c2 = 3 * u * t * t, c3 = t * t * t;
+        double x = c0 * b[0] + c1 * b[2] + c2 * b[4] + c3 * b[6], y = c0 * b[1] + c1 * b[3] + c2 * b[5] + c3 * b[7];
+        out = x < 0.0 || x > w || y < 0.0 || y > h;
+      }
+    }
+    off += (size_t)out;
+  }
+  return off;
+}
+
 /* The post-pass options of p and sc (the crop rectangle from the picture);
 ** the gaps joined and the paths dropped in widths of each pen's own. */
 static void options(const lw_params *p, const lw_scene *sc, const lw_output_page *page, lw_strokes_options *o)
@@ -221,6 +242,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   rep->travel_before = rep->post.travel_before;
   rep->travel_after = rep->post.travel_after;
   rep->cropped = o.crop;
+  if (!o.crop) rep->off_page = paths_off_page(st, page.width_mm, page.height_mm);
   memcpy(rep->crop_mm, (double[4]){o.x0, o.y0, o.x1, o.y1}, sizeof rep->crop_mm);
   rep->pen_down_mm = lw_strokes_total_length(st);
   rep->time_s = lw_strokes_time(st, rep->travel_after, p->speed_down, p->speed_up, p->lift_time);
@@ -392,6 +414,11 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
                    d->travel_after, clock, d->time_s, d->pen_down_mm, r->lifts_after, close);
   if (w < 0 || (size_t)w >= n) return;
   k = (size_t)w;
+  if (d->off_page) {
+    w = snprintf(buf + k, n - k, "linewise: %zu paths reach past the page's edge (plot.crop = 0 keeps them whole): a "
+                 "plotter would draw off the paper\n", d->off_page);
+    if (w < 0 || (k += (size_t)w) >= n) return;
+  }
   if (!d->paths) {
     w = snprintf(buf + k, n - k, "linewise: the drawing is empty: final.svg has no path%s%s\n",
                  d->empty_why[0] ? ": " : "", d->empty_why);

@@ -499,7 +499,7 @@ const lw_param_def lw_param_table[] = {
   NUM("plot", "crop", LW_PT_INT, crop, "1", "", 0, 1, 0,
       "1 = cut every path at the edge of the picture's rectangle (without a picture: the page "
       "inset by scene.margin) and keep the pieces inside, split exactly at the crossing; 0 = "
-      "draw strokes as they lie, margins included."),
+      "draw strokes as they lie, margins included (the run counts those that reach past the page's edge)."),
   NUM("plot", "min_length", LW_PT_DOUBLE, min_length, "3", "pen widths", 0, 1e6, 0,
       "Paths shorter than this (in widths of their pen, as for `join_distance`), after joining "
       "and cropping, are left "

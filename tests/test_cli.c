@@ -920,3 +920,33 @@ Test(cli, an_empty_drawing_says_what_removed_its_lines)
   cr_assert(strstr(errs, "the drawing is empty: final.svg has no path: every stroke was cut by the crop or too short "
                          "for plot.min_length (3 pen widths)"), "%s", errs);
 }
+
+/* With plot.crop = 0 a path past the page's edge is kept whole, and said
+** (a plotter travelled off the paper without a word): as many as the crop
+** cuts or leaves out of the same state on a page half as wide. */
+Test(cli, paths_past_the_page_kept_by_crop_0_are_said)
+{
+  char out[1024], errs[16384], args[1024];
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --set anneal.sweeps=20 --out %s/f --quiet", lw_test_root(),
+           dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  size_t past = 0, cut = 0, outside = 0;
+  for (int crop = 0; crop < 2; crop++) {
+    snprintf(args, sizeof args, "run %s/params/minimal.ini --set init.from=%s/f/state.lw --set anneal.sweeps=0 "
+             "--set scene.width=50 --set energy.boundary=0 --set plot.crop=%d --out %s/h%d", lw_test_root(), dir,
+             crop, dir, crop);
+    cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+    const char *c = crop ? strstr(errs, " cut by the crop, ") : strstr(errs, " paths reach past the page's edge");
+    if (!crop) {
+      cr_assert(c, "%s", errs);
+      while (c > errs && c[-1] >= '0' && c[-1] <= '9') c--;
+      past = strtoul(c, NULL, 10);
+    } else {
+      cr_assert(c && !strstr(errs, "reach past the page"), "%s", errs);
+      while (c > errs && c[-1] >= '0' && c[-1] <= '9') c--;
+      cr_assert_eq(sscanf(c, "%zu cut by the crop, %zu outside it", &cut, &outside), 2, "%s", errs);
+    }
+  }
+  cr_assert(past > 0 && past == cut + outside, "%zu past the edge uncropped; %zu cut and %zu outside cropped", past,
+            cut, outside);
+}

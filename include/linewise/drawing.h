@@ -53,6 +53,7 @@ typedef struct {
   lw_strokes_report post;             /* what the post-pass did */
   double close_share;                 /* share of the length within a pen width of another path */
   int cropped;                        /* crop_mm holds the rectangle */
+  size_t off_page;                    /* uncropped: paths that reach past the page's edge */
   double crop_mm[4];                  /* x0 y0 x1 y1 */
   double pen_down_mm;                 /* ink length */
   double time_s;                      /* plot time estimate */
