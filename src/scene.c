@@ -623,7 +623,10 @@ static void note_blur_gaps(lw_scene *sc, const lw_params *p)
             {sc->on[LW_TERM_TONE], p->segment_length * sc->tone_quad.spacing, tb > 0.0 ? tb : px, "energy.tone_blur",
              "energy.tone_quadrature"}};
   for (int k = 0; k < 2; k++) {
-    if (!g[k].on || !(g[k].gap > (held ? 1.4 : 1.0) * g[k].scale)) continue;
+    /* (held, a picture's bare pixels are a texture the samples may step
+    ** over: every sharp picture would get the note) */
+    const int blurred = k ? tb > 0.0 : pb > 0.0;
+    if (!g[k].on || (held && !blurred) || !(g[k].gap > (held ? 1.4 : 1.0) * g[k].scale)) continue;
     size_t used = strlen(sc->note);
     snprintf(sc->note + used, sizeof sc->note - used, "%sthe placed segments' samples lie up to %.3g mm apart, more "
              "than the picture's detail under %s (%.3g mm, with scene.image_blur and the pixels): %s, hidden from "
