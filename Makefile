@@ -22,8 +22,9 @@ DEBS    := build-essential pkg-config libgsl-dev libcairo2-dev libinih-dev libst
 
 LIB_SRC := $(filter-out src/main.c,$(wildcard src/*.c))
 # The MPI build (make mpi): main.c with -DLW_MPI and src/mpi/, through
-# mpicc; the plain build never needs MPI.  make test builds and runs it too
-# where mpicc is installed (make deps-mpi), and skips its tests otherwise.
+# mpicc; the plain build never needs MPI.  make, make test and make install
+# build it too where mpicc is installed (make deps-mpi): a plain make left an
+# older linewise-mpi beside a new linewise, resolving scenes another way.
 MPICC   ?= mpicc
 MPI_DEBS := libopenmpi-dev openmpi-bin
 MPI_BIN := $(if $(shell command -v $(MPICC) 2>/dev/null),$(BIN)/linewise-mpi)
@@ -43,7 +44,7 @@ PICTURE := params/picture.png
         wire-figures
 # The example picture too: params/example.ini, the scene a new user tries
 # first, needs it.
-all: $(BIN)/linewise $(PICTURE)
+all: $(BIN)/linewise $(PICTURE) $(MPI_BIN)
 
 $(BUILD)/obj/%.o: src/%.c | $(BUILD)/obj
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(DEPFLAGS) $(CPPFLAGS) -c $< -o $@

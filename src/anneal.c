@@ -940,7 +940,9 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
     double t = a->sched_type->temperature(&a->sched, a->block, a->t_prev, &a->prev);
     if (t != a->t_sched) {
       s = lw_error_set(err, LW_EINPUT, "%s: [run] temperature: %.17g, but the %s schedule's step %ld is at %.17g: "
-                       "the state was edited", path, a->t_sched, a->sched_type->name, a->block, t);
+                       "the state was edited, or written by a release whose schedule differs (t_end / t_start "
+                       "beyond a double's range before 2026-12-05): run it again", path, a->t_sched,
+                       a->sched_type->name, a->block, t);
       goto out;
     }
   }

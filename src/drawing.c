@@ -233,12 +233,16 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   if (!st->n && rep->post.lifts_before)
     snprintf(rep->empty_why, sizeof rep->empty_why, "every stroke was cut by the crop or too short for "
              "plot.min_length (%g pen widths)", p->min_length);
-  else if (!st->n && sc->on[LW_TERM_POTENTIAL] && sc->image)
-    snprintf(rep->empty_why, sizeof rep->empty_why, "the anneal removed every line: the price of line "
-             "(energy.potential) is more than the picture's tone pays for it (a pale picture); a lower "
-             "energy.potential keeps lines");
+  else if (!st->n && !p->fixed_count && sc->on[LW_TERM_POTENTIAL] && sc->image)
+    snprintf(rep->empty_why, sizeof rep->empty_why, "no spline is left: none was placed (init.splines, "
+             "init.coverage), or the anneal removed every one, the price of line (energy.potential) being more than "
+             "the picture's tone pays for it (a pale picture: a lower energy.potential keeps lines)");
+  else if (!st->n && p->fixed_count)
+    snprintf(rep->empty_why, sizeof rep->empty_why, "no spline was placed (init.splines, or init.coverage on a "
+             "picture without dark to cover)");
   else if (!st->n)
-    snprintf(rep->empty_why, sizeof rep->empty_why, "no spline is left (init.splines, or the anneal's deaths)");
+    snprintf(rep->empty_why, sizeof rep->empty_why, "no spline is left: none was placed (init.splines, "
+             "init.coverage), or the anneal's deaths removed every one");
   rep->travel_before = rep->post.travel_before;
   rep->travel_after = rep->post.travel_after;
   rep->cropped = o.crop;

@@ -646,6 +646,7 @@ static int cmd_run(int argc, char **argv)
       char buf[64];
       snprintf(buf, sizeof buf, "anneal.seed=%ld", seed);
       if (lw_params_set(&p, buf, &err)) return fail(&err);
+      p.line[lw_params_find("anneal", "seed") - lw_param_table] = LW_PARAMS_SEED_OPTION; /* named as given */
       i++;
     } else {
       int used = shared_option(argv, argc, i, &stop_at, &quiet, &err);
@@ -811,6 +812,9 @@ static int cmd_stats(int argc, char **argv)
   /* --to alone takes the rows from the trace's start, not from the default
   ** stretch's (it said "no row from sweep 1000 to 300") */
   if (base.to >= 0 && base.from < 0) base.from = 0;
+  if (!err.code && base.to >= 0 && base.from > base.to)
+    lw_error_set(&err, LW_EUSAGE, "stats: --from %ld is after --to %ld: expected --from no later than --to",
+                 base.from, base.to);
   if (!dir) lw_error_set(&err, LW_ENOMEM, "out of memory");
   else if (!err.code && !k) lw_error_set(&err, LW_EUSAGE, "stats: expected a run directory %s", use);
   /* a run named twice (a sweep's `best` link beside its seed-N, as a glob

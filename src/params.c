@@ -1277,7 +1277,7 @@ void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size
     return;
   }
   if (line < 0) {
-    snprintf(buf, n, "--set");
+    snprintf(buf, n, line == LW_PARAMS_SEED_OPTION ? "--seed" : "--set");
     return;
   }
   /* a default still names the file: a message about it may come of another

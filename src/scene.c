@@ -618,21 +618,24 @@ static void note_blur_gaps(lw_scene *sc, const lw_params *p)
     int on;
     double gap, scale;
     const char *key, *nodes;
+    int most; /* at LW_QUAD_MAX nodes: only a wider blur closes it */
   } g[2] = {{sc->on[LW_TERM_POTENTIAL] && p->potential == LW_POT_IMAGE, p->segment_length * sc->quad.spacing,
-             pb > 0.0 ? pb : px, "scene.potential_blur", "energy.quadrature"},
+             pb > 0.0 ? pb : px, "scene.potential_blur", "energy.quadrature", sc->quad.n >= LW_QUAD_MAX},
             {sc->on[LW_TERM_TONE], p->segment_length * sc->tone_quad.spacing, tb > 0.0 ? tb : px, "energy.tone_blur",
-             "energy.tone_quadrature"}};
+             "energy.tone_quadrature", sc->tone_quad.n >= LW_QUAD_MAX}};
   for (int k = 0; k < 2; k++) {
     /* (held, a picture's bare pixels are a texture the samples may step
     ** over: every sharp picture would get the note) */
     const int blurred = k ? tb > 0.0 : pb > 0.0;
     if (!g[k].on || (held && !blurred) || !(g[k].gap > (held ? 1.4 : 1.0) * g[k].scale)) continue;
     size_t used = strlen(sc->note);
+    char more[96] = "";
+    if (!g[k].most) snprintf(more, sizeof more, "more nodes (%s) or ", g[k].nodes);
     snprintf(sc->note + used, sizeof sc->note - used, "%sthe placed segments' samples lie up to %.3g mm apart, more "
              "than the picture's detail under %s (%.3g mm, with scene.image_blur and the pixels): %s, hidden from "
-             "the quadrature (docs/NUMERICS.md); more nodes (%s) or a wider blur close it%s",
+             "the quadrature (docs/NUMERICS.md); %sa wider blur closes it%s",
              used ? "; " : "", g[k].gap, g[k].key, g[k].scale,
-             held ? "the samples step over it" : "annealed segments can stretch over it", g[k].nodes,
+             held ? "the samples step over it" : "annealed segments can stretch over it", more,
              held ? "" : ", and energy.pair > 0 with a pair_cutoff holds the stretch");
   }
 }

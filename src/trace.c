@@ -318,9 +318,9 @@ lw_status lw_trace_rows(const lw_trace *t, const char *path, const lw_trace_sele
     *rows = NULL;
     if (*tuned) /* a run shortened for a try: every row there tunes, and nothing said what to change */
       return lw_error_set(err, LW_EINPUT, "%s: no row from sweep %ld to %ld with frozen steps: its %zu rows there "
-                          "all tune (the first %ld sweeps of each temperature step, moves.tune_sweeps%s); more "
-                          "anneal.sweeps or fewer moves.tune_sweeps leave rows to average", path, from, to, *tuned,
-                          sel->tune, sel->ladder ? ", and tempering.ladder_sweeps" : "");
+                          "all tune (the first %ld sweeps of each temperature step, moves.tune_sweeps%s)%s", path,
+                          from, to, *tuned, sel->tune, sel->ladder ? ", and tempering.ladder_sweeps" : "",
+                          sel->to >= 0 ? "" : "; more anneal.sweeps or fewer moves.tune_sweeps leave rows to average");
     return lw_error_set(err, LW_EINPUT, "%s: no row from sweep %ld to %ld (its rows run from sweep %.0f to %.0f)",
                         path, from, to, at(t, 0, sweep), at(t, t->n_rows - 1, sweep));
   }

@@ -340,7 +340,7 @@ Test(cli, keys_the_system_never_reads_are_refused)
      "particles.max_count (--set: no particles.birth or death), particles.sigma (--set: particles.weight = poly)"},
     {"minimal", "--set 'tempering.ladder=0.01 0.1 1' --set tempering.t_max=5",
      "tempering.t_max (--set: tempering.ladder names the temperatures)"},
-    {"whip", "--seed 2", "anneal.seed (--set: the dynamics from init.from draws no random number)"},
+    {"whip", "--seed 2", "anneal.seed (--seed: the dynamics from init.from draws no random number)"},
   };
   for (size_t k = 0; k < sizeof idle / sizeof idle[0]; k++) {
     snprintf(args, sizeof args, "run %s/params/%s.ini --out %s/n%zu --set anneal.sweeps=1 %s", lw_test_root(),
@@ -919,6 +919,15 @@ Test(cli, an_empty_drawing_says_what_removed_its_lines)
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   cr_assert(strstr(errs, "the drawing is empty: final.svg has no path: every stroke was cut by the crop or too short "
                          "for plot.min_length (3 pen widths)"), "%s", errs);
+  /* a white picture's coverage places nothing, and without deaths the
+  ** anneal removed nothing: it blamed the price of line */
+  write_file("white.pgm", "P5\n4 4\n255\n\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff");
+  write_file("white.ini", "[scene]\nwidth = 60\nheight = 60\nimage = white.pgm\npotential = image\n[init]\nsplines = 0\n"
+                          "coverage = 0.45\n[energy]\npotential = 0.001\n[anneal]\nsweeps = 2\n");
+  snprintf(args, sizeof args, "run %s/white.ini --out %s/w", dir, dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "the drawing is empty: final.svg has no path: no spline was placed (init.splines, or "
+                         "init.coverage on a picture without dark to cover)"), "%s", errs);
 }
 
 /* With plot.crop = 0 a path past the page's edge is kept whole, and said

@@ -312,7 +312,7 @@ Test(image_cli, samples_wider_apart_than_the_blur_get_a_note)
   cr_assert_eq(run("run b.ini --out b --stop-at 0", errs, sizeof errs), 0, "%s", errs);
   cr_assert(strstr(errs, "the placed segments' samples lie up to 1.47 mm apart, more than the picture's detail "
                          "under scene.potential_blur (0.5 mm,") &&
-            strstr(errs, "(energy.quadrature) or a wider blur close it, and energy.pair > 0 with a pair_cutoff"),
+            strstr(errs, "(energy.quadrature) or a wider blur closes it, and energy.pair > 0 with a pair_cutoff"),
             "%s", errs);
   /* a picture blurred as wide as the gap: none */
   cr_assert_eq(run("run b.ini --out b --stop-at 0 --set scene.image_blur=3", errs, sizeof errs), 0, "%s", errs);

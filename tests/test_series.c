@@ -286,7 +286,17 @@ Test(trace, the_default_stretch_is_the_final_temperature_less_its_tuning_sweeps,
   cr_assert_eq(lw_trace_stats(t, "t.csv", &sel, f, &err), LW_EINPUT);
   fclose(f);
   cr_assert(strstr(err.msg, "no row from sweep 11 to 13 with frozen steps: its 3 rows there all tune") &&
-            strstr(err.msg, "more anneal.sweeps or fewer moves.tune_sweeps"), "%s", err.msg);
+            !strstr(err.msg, "more anneal.sweeps"), "rows the user chose need no longer run: %s", err.msg);
+  lw_trace_free(t);
+  /* the default stretch of a run shortened too far (2 sweeps, 3 tune): a
+  ** longer run mends it */
+  t = trace_of("sweep,temperature,total\n1,1,1\n2,1,2\n");
+  sel = (lw_trace_select){.from = -1, .to = -1, .tune = 3, .steps = 1, .sweeps = 2, .csv = 1};
+  f = fmemopen(out, sizeof out, "w");
+  cr_assert_eq(lw_trace_stats(t, "t.csv", &sel, f, &err), LW_EINPUT);
+  fclose(f);
+  cr_assert(strstr(err.msg, "all tune") && strstr(err.msg, "more anneal.sweeps or fewer moves.tune_sweeps"), "%s",
+            err.msg);
   lw_trace_free(t);
 }
 

@@ -260,7 +260,8 @@ typedef struct {
   double nb_svg_tolerance;    /* rational curves in final.svg, length */
   double nb_png_scale;        /* pixels per length */
 
-  /* Where each value came from: the file and line (0 = default, -1 = --set). */
+  /* Where each value came from: the file and line (0 = default, -1 = --set,
+  ** LW_PARAMS_SEED_OPTION = the run's --seed). */
   char file[LW_PATH_MAX];
   int line[LW_PARAM_MAX];
   int of_run;                 /* read from a run's scene.ini (lw_params_read_run) */
@@ -310,6 +311,8 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err);
 /* What lw_params_run_hash saw of each key it hashed: the key's index in
 ** lw_param_table, 16 bits of the key's own hash, and the errno that stopped
 ** the reading of the file the key names (0 where read, or not a file). */
+#define LW_PARAMS_SEED_OPTION (-2)
+
 typedef struct lw_run_keys {
   size_t n;
   unsigned short index[LW_PARAM_MAX], hash[LW_PARAM_MAX];

@@ -37,7 +37,7 @@ typedef struct {
                          units of its standard error (both halves with the whole
                          series' tau): beyond about 4 the series is not stationary,
                          or (with batch_ratio past its warning) has a slow mode;
-                         NAN under 4 values */
+                         NAN under 20 values */
   double batch_ratio; /* the standard error from the means of LW_SERIES_BATCHES
                          batches over stderr_mean: about 1 where tau is right;
                          above LW_SERIES_BATCH_WARN a slower mode the window missed
