@@ -436,6 +436,7 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
                                               "tempering.tune_ladder", "tempering.ladder_sweeps", NULL},
                            *const ends[] = {"tempering.t_min", "tempering.t_max", NULL},
                            *const seed[] = {"anneal.seed", NULL},
+                           *const inline_points[] = {"nurbs.points", "nurbs.weights", NULL},
                            *const jumps[] = {"moves.birth", "moves.birth_uniform", "moves.birth_spread",
                                              "moves.prior_sd", "moves.death", "moves.grow", "moves.shrink",
                                              "moves.max_segments", "moves.split", "moves.join",
@@ -466,6 +467,7 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
       {ends, a->n_rep > 1 && p->ladder[0], "tempering.ladder names the temperatures"},
       /* (a seed sweep of the whip gave identical "independent" runs) */
       {seed, p->driver == LW_DRIVER_DYNAMICS && p->from[0], "the dynamics from init.from draws no random number"},
+      {inline_points, p->nb_file[0] != '\0', "nurbs.file gives the points and weights"},
       {jumps, p->fixed_count, "moves.fixed_count = 1"},
       {weights, !p->nb_free_weights, "nurbs.free_weights = 0"},
       {births, p->pt_birth == 0.0 && p->pt_death == 0.0, "no particles.birth or death"},
@@ -1133,6 +1135,14 @@ static lw_status dynamics_sweep(lw_anneal *a, lw_error *err)
     /* the scene was read and checked: what stops the motion now is the
     ** run's failure (exit 1), its files kept */
     if (s == LW_EINPUT) s = err->code = LW_ERUN;
+    /* "lower dynamics.dt" sent the user the wrong way here: no dt helps
+    ** weights without a mass of their own (docs/NUMERICS.md, "Free weights") */
+    if (s && !strcmp(p->system, "nurbs") && p->nb_free_weights && p->nb_weight_inertia == 0.0) {
+      char msg[LW_ERROR_MSG];
+      snprintf(msg, sizeof msg, "%s", err->msg);
+      lw_error_set(err, s, "%s; but nurbs.weight_inertia = 0 leaves the free weights without a mass of their own, "
+                   "and no dt takes a step so: give it > 0 (default 0.1; docs/NURBS.md)", msg);
+    }
     if (s) return s;
   }
   a->sweep++;

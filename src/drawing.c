@@ -445,6 +445,7 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
                orientation_text(d->fidelity.orientation, o), d->fidelity.stray);
   for (int p = 0; d->n_pens > 1 && p < d->n_pens && w >= 0 && (k += (size_t)w) < n; p++)
     w = snprintf(buf + k, n - k, "linewise: fidelity of pen %d%s%s: MSE %.6g, SSIM %.4f, orientation %s, stray ink "
-                 "%.4f\n", p + 1, d->pen_name[p][0] ? " " : "", d->pen_name[p], d->pen_fidelity[p].mse, d->pen_fidelity[p].ssim,
+                 "%.4f\n", p + 1, d->pen_name[p][0] ? " " : "", d->pen_name[p], d->pen_fidelity[p].mse,
+                 d->pen_fidelity[p].ssim,
                  orientation_text(d->pen_fidelity[p].orientation, o), d->pen_fidelity[p].stray);
 }

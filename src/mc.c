@@ -82,6 +82,10 @@ static void tune(lw_chain *c, int kind, int accepted)
 ** counts. */
 static int decide(lw_chain *c, int kind, double dE, int forbidden)
 {
+  /* no part free to make the move: it counted as proposed and accepted, and
+  ** a death among pinned particles read an acceptance of 1 (and fed the
+  ** step tuning) */
+  if (forbidden == LW_PROPOSE_NOTHING) return 0;
   int accept;
   const double lr = c->sys->type->log_ratio ? c->sys->type->log_ratio(c->prop) : 0.0;
   lw_move_stats *s = &c->stats[kind];

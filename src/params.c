@@ -996,7 +996,8 @@ lw_status lw_params_blame(const lw_params *p, const char *section, const char *k
   const lw_param_def *d = lw_params_find(section, key);
   if (d) value_text(p, d, value, sizeof value);
   lw_params_unseen_char(value, unseen, sizeof unseen);
-  return lw_error_set(err, err->code, "%s: key '%s.%s': %s%s", where, section, key, msg, strstr(msg, "U+") ? "" : unseen);
+  return lw_error_set(err, err->code, "%s: key '%s.%s': %s%s", where, section, key, msg,
+                      strstr(msg, "U+") ? "" : unseen);
 }
 
 typedef struct {
@@ -1101,7 +1102,8 @@ static int on_key(void *user, const char *section, const char *key, const char *
   char expected[256], unseen[96];
   if (!assign(rc->p, d, value, expected, sizeof expected)) {
     lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s': expected %s, got '%s'%s",
-                 rc->p->file, rc->line, section, key, expected, value, lw_params_unseen_char(value, unseen, sizeof unseen));
+                 rc->p->file, rc->line, section, key, expected, value,
+                 lw_params_unseen_char(value, unseen, sizeof unseen));
     return 0;
   }
   *line = rc->line;

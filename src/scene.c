@@ -235,8 +235,9 @@ static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
   lw_number_list(p->polygon, 1, v, count);
   lw_status st = LW_OK;
   if (n % 2 || n < 6) {
-    st = bad_key(p, "scene", "polygon", LW_EINPUT, err, "expected at least 3 vertices as 'x y' pairs, got %zu numbers%s",
-                 n, n % 2 && n > 6 ? " (an odd count: one x or y is missing)" : "");
+    st = bad_key(p, "scene", "polygon", LW_EINPUT, err,
+                 "expected at least 3 vertices as 'x y' pairs, got %zu numbers%s", n,
+                 n % 2 && n > 6 ? " (an odd count: one x or y is missing)" : "");
   } else {
     double *xs = malloc(n / 2 * sizeof *xs), *ys = malloc(n / 2 * sizeof *ys);
     if (!xs || !ys) st = lw_error_set(err, LW_ENOMEM, "out of memory reading the polygon");

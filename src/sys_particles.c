@@ -91,11 +91,20 @@ static void *proposal_new(const void *state, lw_error *err) { return lw_particle
 
 static void proposal_free(void *prop) { lw_particles_prop_free(prop); }
 
+/* An identity that is not a refusal is a move no particle is free to make
+** (all pinned for it; a death with none loose): no proposal (system.h). */
+static double none_free(const void *prop, double dE, int *forbidden)
+{
+  if (!*forbidden && ((const lw_particles_prop *)prop)->identity) *forbidden = LW_PROPOSE_NOTHING;
+  return dE;
+}
+
 static double propose(void *state, void *prop, int kind, double step, gsl_rng *rng, int *forbidden)
 {
   *forbidden = 0;
-  if (kind >= LW_PMOVE_KINDS) return lw_particles_propose_grow(state, prop, kind, rng, forbidden);
-  return lw_particles_propose(state, prop, kind, step, rng, forbidden);
+  const double dE = kind >= LW_PMOVE_KINDS ? lw_particles_propose_grow(state, prop, kind, rng, forbidden)
+                                           : lw_particles_propose(state, prop, kind, step, rng, forbidden);
+  return none_free(prop, dE, forbidden);
 }
 
 static double log_ratio(const void *prop) { return ((const lw_particles_prop *)prop)->log_ratio; }
@@ -149,7 +158,8 @@ static size_t group(const void *state, size_t site, double box[4])
 static double propose_in(void *state, void *prop, int kind, size_t site, double step, gsl_rng *rng, int *forbidden,
                          const double box[4])
 {
-  return lw_particles_propose_in(state, prop, kind, site, step, rng, forbidden, box);
+  *forbidden = 0;
+  return none_free(prop, lw_particles_propose_in(state, prop, kind, site, step, rng, forbidden, box), forbidden);
 }
 
 static lw_status commit_part(void *state, void *prop) { return lw_particles_commit_part(state, prop); }

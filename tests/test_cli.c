@@ -922,8 +922,8 @@ Test(cli, an_empty_drawing_says_what_removed_its_lines)
   /* a white picture's coverage places nothing, and without deaths the
   ** anneal removed nothing: it blamed the price of line */
   write_file("white.pgm", "P5\n4 4\n255\n\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff");
-  write_file("white.ini", "[scene]\nwidth = 60\nheight = 60\nimage = white.pgm\npotential = image\n[init]\nsplines = 0\n"
-                          "coverage = 0.45\n[energy]\npotential = 0.001\n[anneal]\nsweeps = 2\n");
+  write_file("white.ini", "[scene]\nwidth = 60\nheight = 60\nimage = white.pgm\npotential = image\n"
+                          "[init]\nsplines = 0\ncoverage = 0.45\n[energy]\npotential = 0.001\n[anneal]\nsweeps = 2\n");
   snprintf(args, sizeof args, "run %s/white.ini --out %s/w", dir, dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   cr_assert(strstr(errs, "the drawing is empty: final.svg has no path: no spline was placed (init.splines, or "

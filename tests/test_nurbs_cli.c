@@ -181,6 +181,11 @@ Test(nurbs_cli, a_points_file_holds_a_long_curve)
   cr_assert_eq(sh("%s run %s/long.ini --out %s/half --quiet --stop-at 10", lw_test_bin(), dir, dir), 0);
   cr_assert_eq(sh("%s resume %s/half --quiet", lw_test_bin(), dir), 0);
   cr_assert_eq(sh("cmp -s %s/long/state.lw %s/half/state.lw", dir, dir), 0);
+  /* the file gives the points and weights: those keys beside it are noted
+  ** (a sweep over nurbs.weights ran the same curve each time, silently) */
+  cr_assert_eq(sh("%s run %s/long.ini --out %s/w --stop-at 0 --set 'nurbs.weights=1 2' 2>&1 | grep -q "
+                  "'no effect here: nurbs.weights (--set: nurbs.file gives the points and weights)'",
+                  lw_test_bin(), dir, dir), 0);
   refused("points = 0 0 1 x\\n", "bad.ini:4: key .nurbs.points.: expected numbers");
   /* a comment line longer than any buffer is a comment, whole (its tail
   ** once read as a point), and a NUL byte is refused, not cut at */

@@ -581,3 +581,29 @@ Test(particles_cli, the_lj13_cluster_melts_with_a_heat_capacity_peak, .timeout =
   cr_assert(tmax > 0.23 && tmax < 0.34 && cmax > 3 * c01, "C(T) peaks at T = %g: %g, against %g at 0.1", tmax, cmax,
             c01);
 }
+
+/* A move no particle is free to make is no proposal: one pinned particle and
+** births and deaths of a second (the two-state chain of "Births and deaths",
+** chem making P(2) = 1/2): a death with only the pinned one was counted as
+** proposed and accepted, reading 0.66 against 0.333 (the real deaths over
+** 400,000 sweeps), and so were its rotations.  About 6,600 real deaths in
+** 20,000 sweeps: the rate's standard error is about 0.006, so 0.05 is eight
+** of them. */
+Test(particles_cli, a_move_no_particle_is_free_to_make_is_not_counted)
+{
+  cr_assert_eq(lw_test_write_text(dir, "one.txt", "0 0 0 0 0 1\n"), 0);
+  cr_assert_eq(lw_test_write_text(dir, "db.ini",
+                                  "[scene]\nsystem = particles\n[particles]\ncount = 0\npoints = one.txt\npinned = 1\n"
+                                  "range = 1.6\nalpha_lj = 0\nalpha_p = 0\nalpha_n = 1\nbirth = 1\ndeath = 1\n"
+                                  "chem = -0.15655378626807898\nmax_count = 2\n[moves]\ntranslate = 0\nrotate = 1\n"
+                                  "step_rotate = 30\n[anneal]\nschedule = constant\nt_start = 0.2\nsweeps = 20000\n"
+                                  "seed = 5\n"),
+               0);
+  cr_assert_eq(sh("%s run %s/db.ini --out %s/db --quiet --threads 1", lw_test_bin(), dir, dir), 0);
+  char *js = lw_test_slurp("%s/db/summary.json", dir);
+  const char *acc = js ? strstr(js, "\"acceptance\": {") : NULL;
+  double death = NAN;
+  cr_assert(acc && sscanf(strstr(acc, "\"death\": ") + 9, "%lf", &death) == 1, "%s", js);
+  cr_assert(fabs(death - 1.0 / 3.0) < 0.05, "death acceptance %.4f, expected 1/3", death);
+  free(js);
+}

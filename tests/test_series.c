@@ -336,7 +336,8 @@ static void write_run(const char *name, unsigned long seed, size_t rows, double 
   char *text = malloc(cap);
   k += (size_t)snprintf(text, cap, "sweep,temperature,x,acc_point\n");
   for (size_t t = 0; t < rows; t++)
-    k += (size_t)snprintf(text + k, cap - k, "%zu,1,%.17g,%.6f\n", t + 1, scale * x[t] + shift, acc + 0.01 * x[t] / 3.0);
+    k += (size_t)snprintf(text + k, cap - k, "%zu,1,%.17g,%.6f\n", t + 1, scale * x[t] + shift,
+                          acc + 0.01 * x[t] / 3.0);
   write_trace(name, text, path, n);
   free(text);
   free(x);

@@ -442,7 +442,9 @@ Test(tools, a_run_stopped_alone_leaves_the_others_and_notes_reach_the_sweep)
   snprintf(fake, sizeof fake, "%s/fake-linewise", dir);
   FILE *f = fopen(fake, "w");
   cr_assert_not_null(f);
-  fprintf(f, "#!/bin/sh\ncase \"$*\" in *schedule=linear*'exchange_every=5 --seed 1 '*) exec %s \"$@\" --stop-at 3 ;; esac\nexec %s \"$@\"\n",
+  fprintf(f,
+          "#!/bin/sh\ncase \"$*\" in *schedule=linear*'exchange_every=5 --seed 1 '*) exec %s \"$@\" --stop-at 3 ;; "
+          "esac\nexec %s \"$@\"\n",
           env("LW_BIN"), env("LW_BIN"));
   fclose(f);
   cr_assert_eq(chmod(fake, 0755), 0);

@@ -62,6 +62,9 @@
 
 typedef struct lw_system_type lw_system_type;
 
+/* *forbidden of a proposal that is none (lw_system_type.propose). */
+#define LW_PROPOSE_NOTHING 4
+
 struct lw_system_type {
   const char *name;                   /* [scene] system = name */
   int n_moves;                        /* move kinds, <= LW_MOVES_MAX ... */
@@ -104,7 +107,9 @@ struct lw_system_type {
   ** chain's scratch) and returns dE (NaN: undefined,
   ** rejected and counted; +inf forbidden), with *forbidden = 1 when it is
   ** refused for a forbidden state, 3 when for coming closer to another
-  ** stroke than a hard spacing rule allows (each counted apart).  The state is not
+  ** stroke than a hard spacing rule allows (each counted apart), and
+  ** LW_PROPOSE_NOTHING (dE 0) when no part is free to make a move of kind k
+  ** (every particle pinned for it): no proposal, counted nowhere.  The state is not
   ** changed, but caches may be filled: one thread per state.  commit applies
   ** the last proposal (LW_ENOMEM leaves the state as it was). */
   void (*moves)(const lw_params *p, double *weight, double *step, double *target);
