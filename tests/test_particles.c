@@ -913,6 +913,9 @@ Test(particles, point_files_are_read_and_bad_ones_name_file_line_and_what_was_ex
     {"1 2 \x1b[2J\n", "bad.xyz:1: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got '1 2 ?[2J'"},
     /* a preview cannot scale a page of 1e300 (before: the run failed at its end) */
     {"0 0 0\n1e300 0 0\n", "bad.xyz:2: expected coordinates within +-1e+09 (in r0), got (1e+300, 0, 0)"},
+    /* a spreadsheet's blank cell: the values after it were read one place on */
+    {"1,,2,3\n", "bad.xyz:1: expected a number in every field, got an empty one in '1,,2,3'"},
+    {",1,2,3\n", "bad.xyz:1: expected a number in every field"},
     {"# nothing\n\n", "bad.xyz:2: expected at least one point"},
     {NULL, NULL},
   };
