@@ -48,7 +48,7 @@ double lw_anneal_acceptance(const lw_anneal *a)
     p += a->chain->stats[k].proposed;
     acc += a->chain->stats[k].accepted;
   }
-  return p ? (double)acc / (double)p : 0.0;
+  return p ? (double)acc / (double)p : NAN; /* (every particle pinned: no proposal) */
 }
 
 /* A wire of 5 free points with the default 10 tuning sweeps (50 proposals)
@@ -943,7 +943,7 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
     if (t != a->t_sched) {
       s = lw_error_set(err, LW_EINPUT, "%s: [run] temperature: %.17g, but the %s schedule's step %ld is at %.17g: "
                        "the state was edited, or written by a release whose schedule differs (t_end / t_start "
-                       "beyond a double's range before 2026-12-05): run it again", path, a->t_sched,
+                       "under 2.2e-308 or over 1.8e308 before 2026-12-05): run it again", path, a->t_sched,
                        a->sched_type->name, a->block, t);
       goto out;
     }
@@ -1137,7 +1137,7 @@ static lw_status dynamics_sweep(lw_anneal *a, lw_error *err)
     if (s == LW_EINPUT) s = err->code = LW_ERUN;
     /* "lower dynamics.dt" sent the user the wrong way here: no dt helps
     ** weights without a mass of their own (docs/NUMERICS.md, "Free weights") */
-    if (s && !strcmp(p->system, "nurbs") && p->nb_free_weights && p->nb_weight_inertia == 0.0) {
+    if (s && !strcmp(p->system, "nurbs") && p->nb_free_weights && p->nb_weight_inertia == 0.0 && p->dyn_rho > 0.0) {
       char msg[LW_ERROR_MSG];
       snprintf(msg, sizeof msg, "%s", err->msg);
       lw_error_set(err, s, "%s; but nurbs.weight_inertia = 0 leaves the free weights without a mass of their own, "

@@ -61,6 +61,21 @@ static lw_chain *cell_chain(const lw_chain *c, lw_error *err)
   return dc;
 }
 
+/* The share of the moves' groups (0 .. 1) whose boxes fall inside one
+** domain of nx x ny over w x h: a group moves in a sweep only then. */
+static double moved_share(const lw_chain *c, double w, double h, int nx, int ny)
+{
+  const lw_system_type *t = c->sys->type;
+  double moved = 0.0;
+  size_t groups = 0, n = t->sites ? t->sites(c->sys->state) : t->sweep_size(c->sys->state);
+  for (size_t site = 0, k; site < n; site += k ? k : 1, groups++) {
+    double box[4];
+    k = t->group(c->sys->state, site, box);
+    moved += fmax(0.0, 1.0 - (box[2] - box[0]) * nx / w) * fmax(0.0, 1.0 - (box[3] - box[1]) * ny / h);
+  }
+  return groups ? moved / (double)groups : 1.0;
+}
+
 static lw_status bad_key(const lw_params *p, lw_error *err, const char *fmt, const char *what)
 {
   lw_error_set(err, LW_EINPUT, fmt, p->domains, what);
@@ -104,7 +119,8 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
     /* a count the photo preset chose from the page alone (the key unset:
     ** line 0) gives way to the reach as auto does: a picture of a few
     ** pixels has tone footprints centimetres wide */
-    if (!p->line[lw_params_find("anneal", "domains") - lw_param_table]) {
+    const int chosen = !p->line[lw_params_find("anneal", "domains") - lw_param_table];
+    if (chosen) {
       while (nx > 1 && !(w / nx > 2.0 * reach && h / ny > 2.0 * reach)) nx = ny = nx - 1;
       if (nx < 2) return LW_OK;
     }
@@ -123,19 +139,20 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
     ** would never move, and the run would end near where it began.  Below a
     ** quarter a sweep, refused (the photo preset's A4 page at 8 domains moves
     ** 48 %, and draws as well as unsplit: docs/SCALING.md). */
-    double moved = 0.0;
-    size_t groups = 0, n = t->sites ? t->sites(c->sys->state) : t->sweep_size(c->sys->state);
-    for (size_t site = 0, k; site < n; site += k ? k : 1, groups++) {
-      double box[4];
-      k = t->group(c->sys->state, site, box);
-      moved += fmax(0.0, 1.0 - (box[2] - box[0]) * nx / w) * fmax(0.0, 1.0 - (box[3] - box[1]) * ny / h);
-    }
     /* judged on the state a run begins with: a resumed one was accepted then,
-    ** and its splines may have grown since (a run refused at its resume) */
-    if (groups && moved < 0.25 * (double)groups && !p->of_run) {
+    ** and its splines may have grown since (a run refused at its resume);
+    ** the preset's count gives way here too (its A4 page of 40 mm strokes
+    ** was refused, blaming a key the user never set) */
+    double share = p->of_run ? 1.0 : moved_share(c, w, h, nx, ny);
+    while (chosen && nx > 1 && share < 0.25) {
+      nx = ny = nx - 1;
+      share = moved_share(c, w, h, nx, ny);
+    }
+    if (chosen && nx < 2) return LW_OK;
+    if (share < 0.25) {
       char what[200];
       snprintf(what, sizeof what, " (domains %.4g x %.4g in the scene's lengths: %.0f %% of the moves' groups a "
-               "sweep, a spline as wide as a domain never)", w / nx, h / ny, 100.0 * moved / (double)groups);
+               "sweep, a spline as wide as a domain never)", w / nx, h / ny, 100.0 * share);
       return bad_key(p, err, "'%s': domains this small leave most of the state unmoved%s; expected fewer, or auto",
                      what);
     }

@@ -1294,6 +1294,10 @@ void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size
       else snprintf(buf, n, "scene.preset = photo (%g pen widths of %g mm)", photo_preset[k].pens, p->pen_width);
       return;
     }
+  /* the two the preset works out from the page and the blur (apply_preset) */
+  if ((!strcmp(d->section, "anneal") && !strcmp(d->key, "domains")) ||
+      (!strcmp(d->section, "energy") && !strcmp(d->key, "tone_quadrature")))
+    snprintf(buf, n, "scene.preset = photo");
 }
 
 /* orientation = auto: the picture's header says which way it lies.  A

@@ -53,10 +53,11 @@ static lw_status append(points *pt, const double *v, const double *nrm, const ch
 ** blank cell shifting the values after it). */
 static int empty_field(const char *s)
 {
-  int comma = 1; /* the line's start counts as one */
+  int comma = 1, empty = 0; /* the line's start counts as a comma */
   for (; *s; s++) {
     if (*s == ' ' || *s == '\t' || *s == '\r' || *s == '\n') continue;
-    if (*s == ',' && comma) return 1;
+    if (*s != ',' && empty) return 1; /* trailing empty fields ("x,y,z,,,": blank normals) are none */
+    empty |= *s == ',' && comma;
     comma = *s == ',';
   }
   return 0;

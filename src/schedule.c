@@ -61,9 +61,10 @@ static double geometric_temperature(const lw_schedule *s, long b, double t_prev,
   if (f == 1.0) return s->t_end;
   double r = s->t_end / s->t_start;
   /* 1e-200 / 1e200 is 0 in a double, and the run quenched from the second
-  ** step on: such ratios go through their logarithm (others, tiny ones too,
-  ** keep pow, and the temperatures of runs already made) */
-  if (r == 0.0 || !isfinite(r))
+  ** step on; a subnormal ratio has a few bits (1e300 to 7e-24 stepped 16 %
+  ** off): such ratios go through their logarithm (the others keep pow, and
+  ** the temperatures of runs already made) */
+  if (!(r >= DBL_MIN && r <= DBL_MAX))
     return clamp_between(exp(log(s->t_start) + f * (log(s->t_end) - log(s->t_start))), s->t_start, s->t_end);
   return clamp_between(s->t_start * pow(r, f), s->t_start, s->t_end);
 }
@@ -98,7 +99,7 @@ static double adaptive_temperature(const lw_schedule *s, long b, double t_prev, 
   double t;
   if (prev && prev->samples >= 2 && isfinite(prev->sd) && prev->sd > 0)
     t = t_prev * exp(-s->lambda * t_prev / prev->sd);
-  else if (s->blocks > 1 && (s->t_end / s->t_start == 0.0 || !isfinite(s->t_end / s->t_start))) /* as geometric's */
+  else if (s->blocks > 1 && !(s->t_end / s->t_start >= DBL_MIN && s->t_end / s->t_start <= DBL_MAX)) /* as geometric */
     t = t_prev * exp((log(s->t_end) - log(s->t_start)) / (double)(s->blocks - 1));
   else
     t = t_prev * (s->blocks > 1 ? pow(s->t_end / s->t_start, 1.0 / (double)(s->blocks - 1)) : 1.0);

@@ -959,3 +959,22 @@ Test(cli, paths_past_the_page_kept_by_crop_0_are_said)
   cr_assert(past > 0 && past == cut + outside, "%zu past the edge uncropped; %zu cut and %zu outside cropped", past,
             cut, outside);
 }
+
+/* The photo preset's domain count, worked out from the page alone, gives way
+** to the share of strokes a sweep can move as it does to the reach: strokes
+** of 40 mm on the example's page were refused, blaming anneal.domains, which
+** the user never set ("not set: the default, off" beside the preset's 4). */
+Test(cli, the_presets_domains_give_way_to_long_strokes)
+{
+  char out[1024], errs[16384], args[1024];
+  snprintf(args, sizeof args, "run %s/params/example.ini --out %s/d --threads 1 --stop-at 0 --set init.splines=5 "
+           "--set init.segment_length=40 --set energy.pair=0 --set energy.min_spacing=0", lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  /* set by the user, the same count is refused, naming where it was set */
+  snprintf(args, sizeof args, "run %s/params/example.ini --out %s/e --threads 1 --stop-at 0 --set init.splines=5 "
+           "--set init.segment_length=40 --set energy.pair=0 --set energy.min_spacing=0 --set anneal.domains=4",
+           lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "--set: key 'anneal.domains': '4': domains this small leave most of the state unmoved"),
+            "%s", errs);
+}

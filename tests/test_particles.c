@@ -892,11 +892,13 @@ Test(particles, point_files_are_read_and_bad_ones_name_file_line_and_what_was_ex
   free(x);
   free(nrm);
   free(has);
-  /* commas, and CloudCompare's "//X,Y,Z" header */
-  write_file("cc.txt", "//X,Y,Z,Nx,Ny,Nz\n1.5,2,3,0,0,1\n 4, 5, 6, 0, 3, 4\n", path, sizeof path);
+  /* commas, CloudCompare's "//X,Y,Z" header, and a spreadsheet's empty
+  ** normal columns at the end of a row (none before a number) */
+  write_file("cc.txt", "//X,Y,Z,Nx,Ny,Nz\n1.5,2,3,0,0,1\n 4, 5, 6, 0, 3, 4\n7,8,9,,,\n", path, sizeof path);
   cr_assert_eq(lw_particles_read_points(path, &n, &x, &nrm, &has, &err), LW_OK, "%s", err.msg);
-  cr_assert_eq(n, 2);
+  cr_assert_eq(n, 3);
   cr_assert(x[0] == 1.5 && x[5] == 6 && nrm[2] == 1 && nrm[4] == 0.6 && nrm[5] == 0.8 && has[0] && has[1]);
+  cr_assert(x[6] == 7 && x[8] == 9 && !has[2]);
   free(x);
   free(nrm);
   free(has);

@@ -89,6 +89,10 @@ Test(schedule, ends_whose_ratio_leaves_a_double_still_cool_step_by_step)
   cr_assert(T[1] > T[2] && T[8] > T[9] && T[9] == 1e-200);
   double t1 = lw_schedule_adaptive.temperature(&s, 1, s.t_start, NULL);
   cr_assert(fabs(t1 / pow(10.0, 200.0 - 400.0 / 9.0) - 1) < 1e-12, "adaptive's fallback step: %g", t1);
+  /* a subnormal ratio has a few bits: pow of it stepped 16 % off */
+  lw_schedule q = {.t_start = 1e300, .t_end = 7e-24, .blocks = 3};
+  lw_schedule_run(&lw_schedule_geometric, &q, T);
+  cr_assert(fabs(T[1] / sqrt(1e300 * 7e-24) - 1) < 1e-12, "geometric mean %g, got %g", sqrt(1e300 * 7e-24), T[1]);
 }
 
 Test(schedule, analytic_single_block_heating_and_zero)

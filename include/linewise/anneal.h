@@ -135,7 +135,8 @@ void lw_anneal_key_readers(const lw_param_def *d, char *buf, size_t n);
 lw_status lw_anneal_check_keys(const lw_params *p, char *unread, size_t size, lw_error *err);
 
 
-/* Current temperature, energy and overall acceptance (for progress displays). */
+/* Current temperature, energy and overall acceptance (for progress displays;
+** NAN before any proposal). */
 double lw_anneal_temperature(const lw_anneal *a);
 double lw_anneal_energy(const lw_anneal *a);
 double lw_anneal_acceptance(const lw_anneal *a);

@@ -21,8 +21,9 @@
 ** (the opposite step, the same axis with the opposite angle) has the same
 ** density, so Metropolis needs no Hastings factor.  A move picks its particle
 ** uniformly among those free for its kind (pinned ones never move); when
-** none is free the proposal is the identity (dE = 0).  A sweep is one
-** proposal per particle that has at least one free degree of freedom.
+** none is free there is no proposal, counted nowhere (it counted as an
+** accepted identity).  A sweep is one draw per particle that has at least
+** one free degree of freedom.
 **
 ** dE of a move comes from the moved particle's neighbours only: a 3-D cell
 ** grid (grid.h) of cubes of side >= R over a box fixed by the set-up (the
