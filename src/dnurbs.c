@@ -260,8 +260,9 @@ lw_status lw_band_factor(const double *A, const unsigned char *pin, size_t n, in
   gsl_error_handler_t *old = gsl_set_error_handler_off();
   int bad = gsl_linalg_cholesky_band_decomp(&v.matrix);
   gsl_set_error_handler(old);
-  if (bad) return lw_error_set(err, LW_EINPUT, "a D-NURBS matrix of order %zu (its free coordinates) is not positive definite",
-                               n);
+  if (bad)
+    return lw_error_set(err, LW_EINPUT, "a D-NURBS matrix of order %zu (its free coordinates) is not positive definite",
+                        n);
   return LW_OK;
 }
 
