@@ -80,8 +80,8 @@ static const char usage[] =
   "      --csv               one CSV line a column: column,n,mean,stderr,sd,\n"
   "                          tau_sweeps,n_eff,window_closed,drift_z,batch_ratio (several runs:\n"
   "                          column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs)\n"
-  "  params              print every scene parameter as Markdown (docs/PARAMETERS.md)\n"
-  "  schedules           print the temperature schedules as Markdown (docs/SCHEDULES.md)\n"
+  "  params              every scene parameter as Markdown (the table of docs/PARAMETERS.md)\n"
+  "  schedules           the schedules' formulas as Markdown (the table of docs/SCHEDULES.md)\n"
   "  version             the release (also --version, -V)\n"
   "  help                this text\n"
   "\n"
@@ -707,6 +707,8 @@ static int cmd_run(int argc, char **argv)
   return rc;
 }
 
+#define RESUME_USAGE "(usage: linewise resume DIR [--sweeps N] [--stop-at N] [--threads N] [--quiet])"
+
 static int cmd_resume(int argc, char **argv)
 {
   lw_error err;
@@ -723,15 +725,14 @@ static int cmd_resume(int argc, char **argv)
       if (used < 0) return fail(&err);
       if (used == 2) i++;
     } else if (argv[i][0] == '-' || dir) {
-      lw_error_set(&err, LW_EUSAGE, "resume: unexpected '%s' (usage: linewise resume DIR [--sweeps N])%s", argv[i],
-                   dash_hint(argv[i]));
+      lw_error_set(&err, LW_EUSAGE, "resume: unexpected '%s' %s%s", argv[i], RESUME_USAGE, dash_hint(argv[i]));
       return fail(&err);
     } else {
       dir = argv[i];
     }
   }
   if (!dir) {
-    lw_error_set(&err, LW_EUSAGE, "resume: expected a run directory (usage: linewise resume DIR [--sweeps N])");
+    lw_error_set(&err, LW_EUSAGE, "resume: expected a run directory %s", RESUME_USAGE);
     return fail(&err);
   }
   if (dir_fits("resume", dir, &err)) return fail(&err);
