@@ -345,23 +345,32 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
 ** silent.  It only reads the phase and writes stderr. */
 typedef struct {
   pthread_t thread;
+  pthread_mutex_t lock; /* one tick at a time: the thread's or watcher_settle's */
+  lw_phase_watch pw;
   int running, tty;
   atomic_int stop;
 } watcher;
 
+static void watcher_tick(watcher *w)
+{
+  char line[512];
+  double t;
+  pthread_mutex_lock(&w->lock);
+  const char *what = lw_phase_get(&t);
+  fputs(lw_phase_watch_tick(&w->pw, what, t, line, sizeof line), stderr);
+  pthread_mutex_unlock(&w->lock);
+}
+
 static void *watch(void *arg)
 {
   watcher *w = arg;
-  lw_phase_watch pw = {.tty = w->tty};
   char line[512];
   const struct timespec tick = {0, 100000000};
   while (!atomic_load(&w->stop)) {
     nanosleep(&tick, NULL);
-    double t;
-    const char *what = lw_phase_get(&t);
-    fputs(lw_phase_watch_tick(&pw, what, t, line, sizeof line), stderr);
+    watcher_tick(w);
   }
-  fputs(lw_phase_watch_end(&pw, atomic_load(&w->stop) > 1, line, sizeof line), stderr);
+  fputs(lw_phase_watch_end(&w->pw, atomic_load(&w->stop) > 1, line, sizeof line), stderr);
   return NULL;
 }
 
@@ -369,8 +378,19 @@ static void watcher_start(watcher *w, int quiet)
 {
   w->running = 0;
   w->tty = isatty(2);
+  w->pw = (lw_phase_watch){.tty = w->tty};
   atomic_init(&w->stop, 0);
-  if (!quiet) w->running = pthread_create(&w->thread, NULL, watch, w) == 0;
+  if (!quiet && !pthread_mutex_init(&w->lock, NULL)) {
+    w->running = pthread_create(&w->thread, NULL, watch, w) == 0;
+    if (!w->running) pthread_mutex_destroy(&w->lock);
+  }
+}
+
+/* The set-up's last phase has its line ("done in") before the run's header,
+** which the thread's next tick would have printed after it. */
+static void watcher_settle(watcher *w)
+{
+  if (w->running) watcher_tick(w);
 }
 
 /* failed: the phase shown last ended in an error (reported next). */
@@ -379,6 +399,7 @@ static void watcher_stop(watcher *w, int failed)
   if (!w->running) return;
   atomic_store(&w->stop, failed ? 2 : 1);
   pthread_join(w->thread, NULL);
+  pthread_mutex_destroy(&w->lock);
   w->running = 0;
 }
 
@@ -688,6 +709,7 @@ static int cmd_run(int argc, char **argv)
   }
   made_what = 0;
   checkpointed = 1;
+  watcher_settle(&w);
   if (!quiet) {
     const char *note = a.sys_type->note(a.setup);
     char size[128];
@@ -758,6 +780,7 @@ static int cmd_resume(int argc, char **argv)
     return watched_fail(&w, &err);
   }
   if (a.pause_at >= 0 && (stop_at < 0 || a.pause_at < stop_at)) stop_at = a.pause_at;
+  watcher_settle(&w);
   if (!quiet) fprintf(stderr, "linewise: resuming %s at sweep %ld of %ld\n", dir, a.sweep, a.end_sweep);
   int rc = anneal_loop(&a, stop_at, quiet, asked, &w, &err);
   lw_anneal_free(&a);

@@ -545,6 +545,26 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
                           lw_test_root(), dir, dir, dir), 0);
 }
 
+/* A set-up of seconds (60,000 splines placed, or read back) has its "done
+** in" line before the run's header: the watcher thread printed it at its
+** next tick, after the header and the parameters. */
+Test(cli, the_set_up_ends_its_line_before_the_run_header)
+{
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --threads 1 --set init.splines=60000 "
+                          "--set scene.width=5000 --set scene.height=5000 --stop-at 0 --out big 2>err.txt && "
+                          "%s resume big --threads 1 --stop-at 0 2>>err.txt", dir, lw_test_bin(),
+                          lw_test_root(), lw_test_bin()),
+               0);
+  char *e = lw_test_slurp("%s/err.txt", dir);
+  const char *placed = strstr(e, "linewise: placing the initial state and building its energy: done in ");
+  const char *header = strstr(e, "linewise: scene ");
+  const char *read = strstr(e, "linewise: reading state.lw and rebuilding the energy: done in ");
+  const char *resuming = strstr(e, "linewise: resuming big at sweep 0");
+  cr_assert(placed && header && read && resuming, "%s", e);
+  cr_assert(placed < header && header < read && read < resuming, "%s", e);
+  free(e);
+}
+
 /* A set-up that has written nothing yet (50,000 splines placed: seconds, a
 ** million: minutes) ends at the first signal, leaving nothing: the signal
 ** once waited for the whole set-up, and a second one then spoke of a
