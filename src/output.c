@@ -275,11 +275,12 @@ lw_status lw_output_svg(const lw_splines *sp, const lw_output_page *page, const 
 
 /* Path k of s as a cairo path, forward: a stroke is the same shape either
 ** way. */
-static void trace_path(cairo_t *cr, const lw_strokes *s, size_t k)
+void lw_output_cairo_path(cairo_t *cr, const lw_strokes *s, size_t k)
 {
-  for (size_t m = s->first[k]; m < s->first[k + 1]; m++) {
-    const double *b = s->b + 8 * m;
-    if (m == s->first[k]) cairo_move_to(cr, b[0], b[1]);
+  double b[8];
+  for (size_t j = 0; j < s->first[k + 1] - s->first[k]; j++) {
+    lw_strokes_drawn_segment(s, k, j, b);
+    if (!j) cairo_move_to(cr, b[0], b[1]);
     cairo_curve_to(cr, b[2], b[3], b[4], b[5], b[6], b[7]);
   }
 }
@@ -289,7 +290,7 @@ void lw_output_cairo_strokes(cairo_t *cr, const lw_strokes *s, int pen)
   size_t a = 0, z = s->n;
   if (pen >= 0) lw_strokes_pen_range(s, pen, &a, &z);
   for (size_t k = a; k < z; k++) {
-    trace_path(cr, s, k);
+    lw_output_cairo_path(cr, s, k);
     /* One stroke per path keeps cairo's path memory to one path. */
     cairo_stroke(cr);
   }
@@ -347,7 +348,7 @@ static void stroke_batches(cairo_t *cr, const lw_strokes *s, int pen, size_t bat
   size_t a = 0, z = s->n;
   lw_strokes_pen_range(s, pen, &a, &z);
   for (size_t k = a; k < z; k++) {
-    trace_path(cr, s, k);
+    lw_output_cairo_path(cr, s, k);
     if ((k - a + 1) % batch == 0 || k + 1 == z) cairo_stroke(cr);
   }
 }

@@ -12,6 +12,7 @@
 
 #include "linewise/json.h"
 #include "linewise/output.h"
+#include "linewise/strokes.h"
 #include "testutil.h"
 
 /* SVG numbers have 4 decimals: within 5e-5 mm, plus slack for the double
@@ -726,6 +727,44 @@ Test(output, png_pen_colours_and_tone_underneath)
   lw_grid2d_free(tone);
   lw_splines_free(sp);
   remove_dir(dir);
+}
+
+/* cairo (final.pdf, the PNG, the fidelity raster) draws a path the way the
+** plotter does: a reversed one from its end, its segments' control points
+** backwards.  final.pdf once kept the order but not the directions, and a
+** plot from it travelled up to 4 times as far as final.svg's. */
+Test(output, cairo_paths_follow_the_plotters_direction)
+{
+  lw_error err;
+  lw_strokes *st = lw_strokes_new(1, &err);
+  cr_assert_not_null(st);
+  const double b[16] = {0, 0, 1, 2, 3, 2, 4, 0, 4, 0, 5, -2, 7, -2, 8, 0};
+  cr_assert_eq(lw_strokes_add(st, 0, 0, 0, 1, b, 2, &err), LW_OK);
+  cr_assert_eq(lw_strokes_add(st, 0, 1, 0, 0, b, 2, &err), LW_OK);
+  cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_A8, 4, 4);
+  cairo_t *cr = cairo_create(surf);
+  for (size_t k = 0; k < 2; k++) {
+    lw_output_cairo_path(cr, st, k);
+    cairo_path_t *path = cairo_copy_path(cr);
+    cr_assert_eq(path->status, CAIRO_STATUS_SUCCESS);
+    /* move_to (2 slots) and two curve_to (4 slots each) */
+    cr_assert_eq(path->num_data, 10);
+    const cairo_path_data_t *d = path->data;
+    cr_assert_eq(d[0].header.type, CAIRO_PATH_MOVE_TO);
+    cr_assert_eq(d[2].header.type, CAIRO_PATH_CURVE_TO);
+    /* the points in drawing order: b's 8 points forwards, or backwards */
+    const int at[7] = {1, 3, 4, 5, 7, 8, 9};
+    for (int i = 0; i < 7; i++) {
+      int src = k ? i + (i > 3) : 7 - i - (i > 3);
+      cr_assert_float_eq(d[at[i]].point.x, b[2 * src], 1e-12, "path %zu point %d", k, i);
+      cr_assert_float_eq(d[at[i]].point.y, b[2 * src + 1], 1e-12, "path %zu point %d", k, i);
+    }
+    cairo_path_destroy(path);
+    cairo_new_path(cr);
+  }
+  cairo_destroy(cr);
+  cairo_surface_destroy(surf);
+  lw_strokes_free(st);
 }
 
 /* needle in the n bytes at hay, which may hold NULs (memmem is not C11). */

@@ -134,6 +134,10 @@ lw_status lw_output_png_strokes(const lw_strokes *s, const lw_output_page *page,
 lw_status lw_output_pdf_strokes(const lw_strokes *s, const lw_output_page *page, const lw_grid2d *tone,
                                 const char *path, lw_error *err);
 
+/* Appends path k to cr's path as the plotter draws it (a reversed path from
+** its end: the PDF's subpaths in final.svg's order and directions). */
+void lw_output_cairo_path(cairo_t *cr, const lw_strokes *s, size_t k);
+
 /* Strokes every path of pen `pen` (0-based; -1: every pen) with the current
 ** source, line width and transformation of cr (for renderers elsewhere). */
 void lw_output_cairo_strokes(cairo_t *cr, const lw_strokes *s, int pen);
