@@ -446,7 +446,10 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
                            *const births[] = {"particles.max_count", NULL},
                            *const sigma[] = {"particles.sigma", NULL},
                            *const sigma_normal[] = {"particles.sigma_normal", NULL},
-                           *const gravity[] = {"dynamics.gravity_x", "dynamics.gravity_y", NULL};
+                           *const gravity[] = {"dynamics.gravity_x", "dynamics.gravity_y", NULL},
+                           *const machine[] = {"plot.tolerance", "plot.turn", "plot.bed_width", "plot.bed_height",
+                                               NULL},
+                           *const gcode[] = {"plot.gcode_travel", "plot.gcode_pen_up", "plot.gcode_pen_down", NULL};
   const struct {
     const char *const *keys;
     int idle;
@@ -474,6 +477,9 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
       {sigma, p->pt_weight == LW_PWEIGHT_POLY, "particles.weight = poly"},
       {sigma_normal, p->pt_weight != LW_PWEIGHT_ANISO, "particles.weight is not aniso"},
       {gravity, p->dyn_rho == 0.0, "dynamics.rho = 0: no mass to weigh"},
+      /* (a bed too small for the page passed unchecked, without a word) */
+      {machine, !p->hpgl && !p->gcode, "neither output.hpgl nor output.gcode"},
+      {gcode, !p->gcode, "output.gcode = 0"},
   };
   size_t m = 0;
   if (size) idle[0] = '\0';
