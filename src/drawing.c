@@ -250,8 +250,33 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   memcpy(rep->crop_mm, (double[4]){o.x0, o.y0, o.x1, o.y1}, sizeof rep->crop_mm);
   rep->pen_down_mm = lw_strokes_total_length(st);
   rep->time_s = lw_strokes_time(st, rep->travel_after, p->speed_down, p->speed_up, p->lift_time);
-  const lw_grid2d *under = p->preview_image ? tone : NULL;
+  const lw_plotter_options po = {.tolerance = p->plot_tolerance,
+                                 .speed_down = p->speed_down,
+                                 .pen_up = p->gcode_pen_up,
+                                 .pen_down = p->gcode_pen_down,
+                                 .turn = p->plot_turn,
+                                 .bed = {p->plot_bed_w, p->plot_bed_h},
+                                 .travel_feed = p->gcode_travel == LW_GCODE_TRAVEL_FEED,
+                                 .speed_up = p->speed_up};
   char path[LW_OUTPUT_PATH_MAX];
+  /* a machine file the drawing cannot make (off the bed, without the crop)
+  ** is known before any file is written: none is, and the annealed state
+  ** stays for a redraw with other plot keys */
+  for (int g = 0; g < 2 && !s; g++) {
+    if (!(g ? p->gcode : p->hpgl)) continue;
+    dir_file(path, sizeof path, dir, g ? "final.gcode" : "final.hpgl");
+    if ((s = lw_plotter_check(st, &page, &po, g, path, err)) && err) {
+      size_t n = strlen(err->msg);
+      snprintf(err->msg + n, sizeof err->msg - n, "; no drawing was written, and the annealed state is in "
+               "%s/state.lw: redraw it with other plot keys (docs/FORMATS.md, \"Redrawing a finished run\")", dir);
+    }
+  }
+  if (s) {
+    lw_strokes_free(st);
+    if (err) err->code = LW_ERUN; /* the run itself went well: not a bad input's exit status */
+    return LW_ERUN;
+  }
+  const lw_grid2d *under = p->preview_image ? tone : NULL;
   dir_file(path, sizeof path, dir, "final.svg");
   if (!(s = lw_output_svg_strokes(st, &page, path, err))) {
     dir_file(path, sizeof path, dir, "final.png");
@@ -261,14 +286,6 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
     dir_file(path, sizeof path, dir, "final.pdf");
     s = lw_output_pdf_strokes(st, &page, under, path, err);
   }
-  const lw_plotter_options po = {.tolerance = p->plot_tolerance,
-                                 .speed_down = p->speed_down,
-                                 .pen_up = p->gcode_pen_up,
-                                 .pen_down = p->gcode_pen_down,
-                                 .turn = p->plot_turn,
-                                 .bed = {p->plot_bed_w, p->plot_bed_h},
-                                 .travel_feed = p->gcode_travel == LW_GCODE_TRAVEL_FEED,
-                                 .speed_up = p->speed_up};
   if (!s && p->hpgl) {
     dir_file(path, sizeof path, dir, "final.hpgl");
     s = lw_output_hpgl_strokes(st, &page, &po, path, err);

@@ -90,8 +90,26 @@ static void extend(void *ctx, double x, double y)
   e->lo[1] = fmin(e->lo[1], y), e->hi[1] = fmax(e->hi[1], y);
 }
 
-static lw_status check(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o, int gcode,
-                       const char *path, lw_error *err)
+/* The box of the drawing on the machine's axes under turn `turn`. */
+static extent reach(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o, int turn)
+{
+  lw_plotter_options t = *o;
+  t.turn = turn;
+  extent e = {{INFINITY, INFINITY}, {-INFINITY, -INFINITY}};
+  for (size_t j = 0; j < s->n; j++) walk_path(s, j, page, &t, extend, &e);
+  return e;
+}
+
+/* The axis (0, 1) along which e leaves the bed, or -1. */
+static int off_bed(const extent *e, const double bed[2])
+{
+  for (int k = 0; k < 2; k++)
+    if (bed[k] > 0.0 && !(e->lo[k] >= -BED_SLACK && e->hi[k] <= bed[k] + BED_SLACK)) return k;
+  return -1;
+}
+
+lw_status lw_plotter_check(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o, int gcode,
+                           const char *path, lw_error *err)
 {
   lw_status st = lw_output_check_strokes(s, page, NULL, path, err);
   if (st) return st;
@@ -105,14 +123,17 @@ static lw_status check(const lw_strokes *s, const lw_output_page *page, const lw
       return lw_error_set(err, LW_EINPUT, "%s: a control point of segment %zu lies %g mm from the origin: "
                           "expected at most %g", path, k / 8, fabs(s->b[k]), LW_PLOTTER_MM_MAX);
   if (o->bed[0] > 0.0 || o->bed[1] > 0.0) {
-    extent e = {{INFINITY, INFINITY}, {-INFINITY, -INFINITY}};
-    for (size_t j = 0; j < s->n; j++) walk_path(s, j, page, o, extend, &e);
-    for (int k = 0; k < 2; k++) {
-      if (!(o->bed[k] > 0.0) || (e.lo[k] >= -BED_SLACK && e.hi[k] <= o->bed[k] + BED_SLACK)) continue;
+    extent e = reach(s, page, o, o->turn);
+    int k = off_bed(&e, o->bed);
+    if (k >= 0) {
+      /* the other turn only where the drawing would fit the bed with it */
+      extent t = reach(s, page, o, !o->turn);
+      char turn[64] = "";
+      if (off_bed(&t, o->bed) < 0) snprintf(turn, sizeof turn, " or the other turn (plot.turn = %d)", o->turn ? 0 : 90);
       return lw_error_set(err, LW_EINPUT, "%s: the drawing reaches %c = %.3f to %.3f mm on the machine, past its "
                           "bed of %g mm (plot.bed_%s): expected plot.crop = 1 (which cuts the strokes to the page "
-                          "inside its margin), a wider margin or a turn of the page",
-                          path, "xy"[k], e.lo[k], e.hi[k], o->bed[k], k ? "height" : "width");
+                          "inside its margin)%s%s", path, "xy"[k], e.lo[k], e.hi[k], o->bed[k],
+                          k ? "height" : "width", turn[0] ? ", a wider margin" : " or a wider margin", turn);
     }
   }
   if (!gcode) return LW_OK;
@@ -156,7 +177,7 @@ static void hpgl_point(void *ctx, double x, double y)
 lw_status lw_output_hpgl_strokes(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o,
                                  const char *path, lw_error *err)
 {
-  lw_status st = check(s, page, o, 0, path, err);
+  lw_status st = lw_plotter_check(s, page, o, 0, path, err);
   if (st) return st;
   char tmp[LW_OUTPUT_PATH_MAX];
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
@@ -248,7 +269,7 @@ static void put_pen(FILE *f, const lw_output_page *page, int k)
 lw_status lw_output_gcode_strokes(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o,
                                   const char *path, lw_error *err)
 {
-  lw_status st = check(s, page, o, 1, path, err);
+  lw_status st = lw_plotter_check(s, page, o, 1, path, err);
   if (st) return st;
   char tmp[LW_OUTPUT_PATH_MAX];
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);

@@ -477,6 +477,18 @@ Test(plotter, a_drawing_past_the_bed_is_refused_and_travel_can_feed)
     cr_assert_str_eq(text, "old\n");
     free(text);
   }
+  /* the other turn is offered only where the drawing fits the bed with it:
+  ** turned, it reaches 78 mm along x and 91 mm along y */
+  for (int k = 0; k < 2; k++) {
+    lw_error err = {0};
+    o.bed[0] = 90, o.bed[1] = k ? 90 : 100;
+    cr_assert_eq(lw_plotter_check(s, &page, &o, 1, path, &err), LW_EINPUT);
+    cr_assert(strstr(err.msg, "the drawing reaches x = 5.000 to 91.000 mm"), "%s", err.msg);
+    cr_assert_eq(!strstr(err.msg, "or the other turn (plot.turn = 90)"), k, "%s", err.msg);
+  }
+  o.turn = 1, o.bed[0] = 90, o.bed[1] = 100;
+  cr_assert_eq(lw_plotter_check(s, &page, &o, 1, path, NULL), LW_OK);
+  o.turn = 0;
   /* travel by feed: each path's start and the way home are G1 at speed_up
   ** (150 mm/s: F9000), each path's first drawing move sets speed_down again */
   o.bed[0] = o.bed[1] = 0;
@@ -522,5 +534,17 @@ Test(plotter, a_page_past_the_bed_is_refused_before_the_run)
   cr_assert_eq(lw_test_sh("test -s %s/r/final.hpgl", dir), 0);
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set plot.bed_width=10 --set anneal.sweeps=5 --quiet "
                           "--out %s/s", bin, root, dir), 0);
+  /* a drawing that leaves the bed only after the anneal (no crop, no
+  ** boundary term, hot) is refused before any drawing file is written, with
+  ** exit 1 (the run went well), the state kept for a redraw */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set plot.bed_width=100 --set "
+                          "plot.crop=0 --set energy.boundary=0 --set scene.margin=0 --set anneal.t_start=5 --set "
+                          "anneal.t_end=1 --set anneal.sweeps=100 --quiet --out %s/t 2> %s/err.txt", bin, root, dir,
+                          dir), 1);
+  err = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(err, "t/final.gcode: the drawing reaches x = ") &&
+            strstr(err, "no drawing was written, and the annealed state is in "), "%s", err);
+  free(err);
+  cr_assert_eq(lw_test_sh("cd %s/t && test -s state.lw && ! ls final.* 2>/dev/null", dir), 0);
   lw_test_sh("rm -rf %s", dir);
 }

@@ -71,6 +71,12 @@ size_t lw_plotter_chords(const double *b, double tol);
 ** ASCII only. */
 int lw_plotter_gcode_line_ok(const char *line);
 
+/* What writing final.hpgl (gcode 0) or final.gcode (1) of the paths s
+** would refuse, without writing: the drawing checks it before any of its
+** files, so that a refused one leaves none of them behind. */
+lw_status lw_plotter_check(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o, int gcode,
+                           const char *path, lw_error *err);
+
 /* final.hpgl and final.gcode of the paths s on page: written atomically
 ** (output.h); LW_EINPUT for a bad page, path or option, LW_EIO when the
 ** file cannot be written. */
