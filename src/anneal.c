@@ -237,6 +237,23 @@ static void make_absolute(char *path, const char *scene_file)
   }
 }
 
+/* A start (init.from) from a file of the directory the run writes into:
+** the run would replace that run's record (a redraw into its own directory
+** kept one row of trace.csv). */
+static lw_status from_elsewhere(const lw_anneal *a, const char *dir, lw_error *err)
+{
+  const char *from = a->params.from;
+  char fdir[LW_PATH_MAX], rf[4096], rd[4096];
+  if (!from[0]) return LW_OK;
+  lw_path_dir(fdir, sizeof fdir, from);
+  if (!realpath(fdir, rf) || !realpath(dir, rd) || strcmp(rf, rd)) return LW_OK;
+  lw_error_set(err, LW_EINPUT, "'%s' lies in %s, the directory this run writes, and the run would replace the "
+               "files of the run there (its trace.csv, summary.json and drawings); expected another --out (a "
+               "redraw: docs/FORMATS.md, \"Redrawing a finished run\"), or 'linewise resume %s' to go on with it",
+               from, dir, dir);
+  return lw_params_blame(&a->params, "init", "from", err);
+}
+
 /* Every key of a's parameters that names a file, made absolute; refused
 ** where that no longer fits on a line of the run's scene.ini, which resume
 ** reads (a picture named "pic.png" from a deep directory wrote a scene.ini
@@ -666,7 +683,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   a->wall_start = now_seconds();
   a->params = *p;
   lw_status s;
-  if ((s = absolute_paths(a, err))) return s;
+  if ((s = absolute_paths(a, err)) || (s = from_elsewhere(a, dir, err))) return s;
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   a->seed = (unsigned long)a->params.seed;
   a->block = -1;

@@ -914,6 +914,23 @@ Test(cli, text_files_with_a_byte_order_mark_read_as_without)
                           dir, dir, dir), 0);
 }
 
+/* A redraw into the run's own directory is refused before it writes: it
+** replaced the run's trace.csv (one row left) and summary.json. */
+Test(cli, a_start_from_a_state_in_the_directory_it_writes_is_refused)
+{
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set anneal.sweeps=5 --out %s/m --quiet --threads 1", b,
+                          lw_test_root(), dir), 0);
+  cr_assert_eq(lw_test_sh("cd %s && sha256sum m/* > sums && %s run m/scene.ini --set init.from=m/state.lw --set "
+                          "anneal.sweeps=0 --out m/ --quiet 2>err.txt; test $? -eq 2 && grep -q \"^linewise: --set: "
+                          "key 'init.from': '%s/m/state.lw' lies in m/, the directory this run writes, and the run "
+                          "would replace the files of the run there\" err.txt && sha256sum -c --quiet sums", dir, b,
+                          dir), 0);
+  /* into another directory it is the documented redraw */
+  cr_assert_eq(lw_test_sh("cd %s && %s run m/scene.ini --set init.from=m/state.lw --set anneal.sweeps=0 --out r "
+                          "--quiet && cmp m/final.svg r/final.svg", dir, b), 0);
+}
+
 /* An irregular segment's message names the test that failed and the key to
 ** lower: both were named, and both values called reasons, when one test was
 ** off or passed. */
