@@ -466,7 +466,14 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
                            *const gravity[] = {"dynamics.gravity_x", "dynamics.gravity_y", NULL},
                            *const machine[] = {"plot.tolerance", "plot.turn", "plot.bed_width", "plot.bed_height",
                                                NULL},
-                           *const gcode[] = {"plot.gcode_travel", "plot.gcode_pen_up", "plot.gcode_pen_down", NULL};
+                           *const gcode[] = {"plot.gcode_travel", "plot.gcode_pen_up", "plot.gcode_pen_down", NULL},
+                           *const quench[] = {"anneal.quench_tol", "anneal.quench_iterations", "anneal.quench_stall",
+                                              NULL},
+                           *const pair[] = {"energy.pair_cutoff", "energy.pair_near", "energy.pair_quadrature", NULL},
+                           *const tuning[] = {"tempering.ladder_sweeps", NULL},
+                           *const plane[] = {"particles.boundary_z", NULL},
+                           *const sphere[] = {"particles.boundary_radius", NULL},
+                           *const wall[] = {"particles.alpha_b", NULL}, *const pinned[] = {"particles.pinned", NULL};
   const struct {
     const char *const *keys;
     int idle;
@@ -497,6 +504,13 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
       /* (a bed too small for the page passed unchecked, without a word) */
       {machine, !p->hpgl && !p->gcode, "neither output.hpgl nor output.gcode"},
       {gcode, !p->gcode, "output.gcode = 0"},
+      {quench, p->quench == LW_QUENCH_NONE, "anneal.quench = none"},
+      {pair, p->pair == 0.0, "energy.pair = 0"},
+      {tuning, a->n_rep > 1 && p->tune_ladder == LW_LADDER_FIXED, "tempering.tune_ladder = fixed"},
+      {plane, p->pt_boundary != LW_PBOUNDARY_PLANE, "particles.boundary is not plane"},
+      {sphere, p->pt_boundary != LW_PBOUNDARY_SPHERE, "particles.boundary is not sphere"},
+      {wall, p->pt_boundary == LW_PBOUNDARY_NONE, "particles.boundary = none"},
+      {pinned, !p->pt_points[0], "no particles.points"},
   };
   size_t m = 0;
   if (size) idle[0] = '\0';

@@ -346,6 +346,15 @@ Test(cli, keys_the_system_never_reads_are_refused)
      "plot.bed_width (--set: neither output.hpgl nor output.gcode), plot.gcode_pen_up (--set: output.gcode = 0)"},
     {"minimal", "--set output.hpgl=1 --set plot.bed_width=500 --set plot.gcode_travel=feed",
      "no effect here: plot.gcode_travel (--set: output.gcode = 0)\n"},
+    /* the quench's, the pair term's, the ladder tuning's and the walls' */
+    {"minimal", "--set anneal.quench_tol=1e-3", "anneal.quench_tol (--set: anneal.quench = none)"},
+    {"minimal", "--set energy.pair=0 --set energy.pair_near=3",
+     "/params/minimal.ini:17: energy.pair = 0), energy.pair_near (--set: energy.pair = 0)"},
+    {"minimal", "--set tempering.replicas=2 --set tempering.ladder_sweeps=5",
+     "tempering.ladder_sweeps (--set: tempering.tune_ladder = fixed)"},
+    {"particles-sheet", "--set particles.boundary_radius=3 --set particles.alpha_b=1 --set particles.pinned=1",
+     "particles.boundary_radius (--set: particles.boundary is not sphere), particles.alpha_b (--set: "
+     "particles.boundary = none), particles.pinned (--set: no particles.points)"},
   };
   for (size_t k = 0; k < sizeof idle / sizeof idle[0]; k++) {
     snprintf(args, sizeof args, "run %s/params/%s.ini --out %s/n%zu --set anneal.sweeps=1 %s", lw_test_root(),
