@@ -451,13 +451,15 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
       (st = term_nodes(p, sc, sc->on[LW_TERM_TONE], "tone_quadrature", p->tone_quadrature, &sc->tone_quad, err)))
     return st;
   /* (a run begun before the rule, whose scene.ini holds a smaller one,
-  ** still resumes and measures as it ran) */
+  ** still resumes and measures as it ran; unless --set changes the radius
+  ** or the nodes: `energy --set` measured a radius a run refuses) */
   const double least = ceil(1e3 * lw_pair_near_least(&sc->pair_quad)) / 1e3;
-  if (sc->on[LW_TERM_PAIR] && p->pair_near > 0.0 && p->pair_near < least && !p->of_run) {
+  const lw_param_def *d = lw_params_find("energy", "pair_near");
+  const char *nodes = p->pair_quadrature > 0 ? "pair_quadrature" : "quadrature";
+  const int near_set = lw_params_given(p, d), nodes_set = lw_params_given(p, lw_params_find("energy", nodes));
+  if (sc->on[LW_TERM_PAIR] && p->pair_near > 0.0 && p->pair_near < least && (!p->of_run || near_set || nodes_set)) {
     /* blame what the user set: the radius, or the nodes under the default one */
-    const lw_param_def *d = lw_params_find("energy", "pair_near");
-    const char *nodes = p->pair_quadrature > 0 ? "pair_quadrature" : "quadrature";
-    const char *key = !p->line[d - lw_param_table] ? nodes : "pair_near";
+    const char *key = near_set || (!p->of_run && p->line[d - lw_param_table]) ? "pair_near" : nodes;
     return bad_key(p, "energy", key, LW_EINPUT, err, "energy.pair_near = %g is less than %.3f, the least at %d pair "
                    "nodes (energy.%s): expected pair_near 0 (off) or at least that (closer, a line "
                    "crossing another between their samples is taken only in part: docs/ACCURACY.md, \"Near "

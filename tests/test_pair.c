@@ -433,6 +433,14 @@ Test(pair, a_near_field_too_small_for_a_crossing_between_samples_is_refused)
   p.of_run = 1;
   cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
   lw_scene_clear(&sc);
+  /* but not one `energy DIR --set` gives it (energy measured what run refuses) */
+  int *line = &p.line[lw_params_find("energy", "pair_near") - lw_param_table];
+  const int was = *line;
+  *line = -1;
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "--set: key 'energy.pair_near': energy.pair_near = 1.2 is less than 1.431"), "%s",
+            err.msg);
+  *line = was;
   p.of_run = 0;
   p.pair_quadrature = 2;
   p.pair_near = 1.5;
