@@ -1389,7 +1389,8 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
   apply_preset(p);
   if (steps_unset && !strcmp(p->schedule, "constant")) assign(p, steps, "1", expected, sizeof expected);
   unsigned char rgb[LW_PLOT_PENS_MAX][3];
-  if (p->pen_colors[0] && lw_output_colors_parse(p->pen_colors, rgb, LW_PLOT_PENS_MAX) != p->pens) {
+  /* (with layers the pens are theirs, which the scene says first) */
+  if (p->pen_colors[0] && !p->ly_names[0] && lw_output_colors_parse(p->pen_colors, rgb, LW_PLOT_PENS_MAX) != p->pens) {
     lw_params_origin(p, lw_params_find("output", "pen_colors"), where, sizeof where);
     return lw_error_set(err, LW_EINPUT,
                         "%s: key 'output.pen_colors': expected %d colours '#rrggbb' or '#rgb' (one per pen), got '%s'",
