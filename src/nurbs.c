@@ -16,10 +16,10 @@ lw_status lw_nurbs_check_knots(int order, size_t n, const double *knot, size_t n
     return lw_error_set(err, LW_EINPUT, "%zu knots: %zu control points of order %d need n + k = %zu", n_knots, n,
                         order, n + k);
   for (size_t i = 0; i < n_knots; i++)
-    if (!isfinite(knot[i])) return lw_error_set(err, LW_EINPUT, "knot %zu is not a finite number", i);
+    if (!isfinite(knot[i])) return lw_error_set(err, LW_EINPUT, "knot %zu (counting from 0) is not a finite number", i);
   for (size_t i = 0; i + 1 < n_knots; i++)
     if (knot[i + 1] < knot[i])
-      return lw_error_set(err, LW_EINPUT, "knot %zu (%g) is less than knot %zu (%g): knots must not decrease", i + 1,
+      return lw_error_set(err, LW_EINPUT, "knot %zu (%g) is less than knot %zu (%g): knots must not decrease (they count from 0)", i + 1,
                           knot[i + 1], i, knot[i]);
   for (size_t i = 1; i < k; i++)
     if (knot[i] != knot[0] || knot[n + i] != knot[n])
@@ -103,9 +103,9 @@ lw_nurbs *lw_nurbs_new(int order, size_t n, const double *knot, const double *P,
   if (lw_nurbs_check_knots(order, n, knot, n + (size_t)(order > 0 ? order : 0), err)) return NULL;
   for (size_t i = 0; i < n; i++) {
     if (w && !(w[i] > 0.0 && isfinite(w[i])))
-      return lw_error_set(err, LW_EINPUT, "weight %zu is %g: weights must be > 0", i, w[i]), NULL;
+      return lw_error_set(err, LW_EINPUT, "weight %zu is %g: weights must be > 0 (they count from 0)", i, w[i]), NULL;
     if (!isfinite(P[2 * i]) || !isfinite(P[2 * i + 1]))
-      return lw_error_set(err, LW_EINPUT, "control point %zu is not finite", i), NULL;
+      return lw_error_set(err, LW_EINPUT, "control point %zu (counting from 0) is not finite", i), NULL;
   }
   lw_nurbs *c = alloc_curve(order, n, err);
   if (!c) return NULL;

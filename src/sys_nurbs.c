@@ -149,7 +149,7 @@ static lw_nurbs *curve_of(const lw_params *p, lw_error *err)
   }
   for (size_t i = 0; i < nw; i++)
     if (!(w[i] > 0.0)) {
-      lw_error_set(err, LW_EINPUT, "weight %zu is %g: weights must be > 0", i, w[i]);
+      lw_error_set(err, LW_EINPUT, "weight %zu is %g: weights must be > 0 (they count from 0)", i, w[i]);
       lw_params_blame(p, "nurbs", "weights", err);
       goto out;
     }
