@@ -81,7 +81,8 @@ const lw_param_def lw_param_table[] = {
   NUM("scene", "image_max_pixels", LW_PT_DOUBLE, image_max_pixels, "4e6", "pixels", 1, 1e9, 0,
       "Pictures with more pixels are box-filtered down to this many while they load (a note says so)."),
   NUM("scene", "image_width", LW_PT_INT, image_width, "0", "pixels", 0, 1e5, 0,
-      "Resample the picture to this width, the height following the aspect ratio; 0 = as loaded."),
+      "Resample the picture to this width, the height following the aspect ratio; 0 = as loaded. "
+      "The resampled picture must still fit scene.image_max_pixels."),
   NUM("scene", "image_blur", LW_PT_DOUBLE, image_blur, "0", "mm", 0, 1e4, 0,
       "Standard deviation of a Gaussian blur of the tone, in millimetres on the page. 0 = none."),
   NUM("scene", "image_flatten", LW_PT_DOUBLE, image_flatten, "0", "mm", 0, 1e4, 0,
@@ -149,7 +150,7 @@ const lw_param_def lw_param_table[] = {
   CHOICE("scene", "mask", mask, "none", "none|alpha|image",
          "Where the inside of boundary = mask comes from: the alpha channel of `image` "
          "(opaque is inside), or the picture `mask_image` (opaque and dark is inside). "
-         "Threshold 1/2; fitted into the page like `image`."),
+         "Threshold 1/2; fitted into the page like `image`. Refused under another boundary."),
   STRING("scene", "mask_image", mask_image, "", "path",
          "The picture of mask = image, relative to the scene file."),
   NUM("init", "splines", LW_PT_INT, splines, "100", "", 0, 1e8, 0,
@@ -554,7 +555,7 @@ const lw_param_def lw_param_table[] = {
          "`tone_max`; `cmyk` = the cyan, magenta, yellow and black separation of the colour picture "
          "(4 layers, in that order; without layers.names they are named cyan, magenta, yellow and "
          "black); `palette` = the least-squares separation of the colour picture "
-         "into the pens of `colors` (docs/NUMERICS.md, \"Colour separation\")."),
+         "into the pens of `colors`, one a layer of `names` (docs/NUMERICS.md, \"Colour separation\")."),
   CHOICE("layers", "apart", ly_apart, "all", "all|pen",
          "Which lines the pair repulsion and energy.min_spacing keep apart: `all` = every line from "
          "every other; `pen` = each line from its own layer's only, so pens overlap and cross as "
