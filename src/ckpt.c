@@ -35,6 +35,7 @@ struct lw_ckpt {
   size_t len, cap;
   size_t header;      /* offset, or (size_t)-1 */
   int header_line;
+  int cut_line;       /* the last line, where the file ends inside it (no newline); 0: none */
   entry *e;
   size_t n, ecap;
   section *s;
@@ -235,6 +236,10 @@ lw_status lw_ckpt_read(lw_ckpt **out, const char *path, lw_error *err)
   if (!s && !c->text && !(c->text = malloc(1))) s = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
   if (!s) {
     c->text[c->len] = '\0';
+    if (c->len && c->text[c->len - 1] != '\n') {
+      c->cut_line = 1;
+      for (size_t k = 0; k < c->len; k++) c->cut_line += c->text[k] == '\n';
+    }
     s = parse(c, err);
     c->len++; /* what store() appends goes after the final NUL */
   }
@@ -273,10 +278,19 @@ const char *lw_ckpt_text(lw_ckpt *c, const char *sec, const char *key, int *line
   return c->text + e->value;
 }
 
+lw_status lw_ckpt_missing(const lw_ckpt *c, const char *what, const char *guess, lw_error *err)
+{
+  if (c->cut_line)
+    return lw_error_set(err, LW_EINPUT, "%s: %s: missing, and the file ends inside its line %d: cut short (a "
+                        "partial copy, a full disk?)", c->path, what, c->cut_line);
+  return lw_error_set(err, LW_EINPUT, "%s: %s: missing (%s)", c->path, what, guess);
+}
+
 static lw_status missing(const lw_ckpt *c, const char *sec, const char *key, lw_error *err)
 {
-  return lw_error_set(err, LW_EINPUT, "%s: [%s] %s: missing (not a checkpoint of a run, or a damaged one)",
-                      c->path, sec, key);
+  char what[160];
+  snprintf(what, sizeof what, "[%s] %s", sec, key);
+  return lw_ckpt_missing(c, what, "not a checkpoint of a run, or a damaged one", err);
 }
 
 static lw_status bad_value(const lw_ckpt *c, int line, const char *sec, const char *key, const char *expected,

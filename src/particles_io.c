@@ -8,6 +8,7 @@
 
 #include "linewise/number.h"
 #include "linewise/ply.h"
+#include "linewise/state.h"
 
 /* The points read so far, grown as they come. */
 typedef struct {
@@ -166,7 +167,7 @@ lw_particles *lw_particles_get(const lw_particles_setup *s, lw_ckpt *c, const ch
 {
   const char *path = lw_ckpt_path(c);
   if (!lw_ckpt_has(c, section)) {
-    lw_error_set(err, LW_EINPUT, "%s: section [%s]: missing (a state of another system?)", path, section);
+    lw_state_missing_section(c, section, err);
     return NULL;
   }
   long count;

@@ -177,7 +177,7 @@ lw_status lw_state_get_splines(lw_ckpt *c, const char *section, lw_splines **out
   const char *path = lw_ckpt_path(c), *key, *val;
   int line = 0;
   size_t pos = 0;
-  if (!lw_ckpt_has(c, section)) return lw_error_set(err, LW_EINPUT, "%s: section [%s]: missing", path, section);
+  if (!lw_ckpt_has(c, section)) return lw_state_missing_section(c, section, err);
 #define BAD(what, got)                                                                                     \
   lw_error_set(err, LW_EINPUT, "%s:%d: [%s] %s: expected %s, got '%.60s'", path, line, section, key ? key : "", \
                what, got)
@@ -231,12 +231,19 @@ lw_status lw_state_get_splines(lw_ckpt *c, const char *section, lw_splines **out
   return s;
 }
 
+lw_status lw_state_missing_section(const lw_ckpt *c, const char *section, lw_error *err)
+{
+  char what[128];
+  snprintf(what, sizeof what, "section [%s]", section);
+  return lw_ckpt_missing(c, what, "a state of another system?", err);
+}
+
 static lw_status read_v2(lw_state *st, lw_ckpt *c, lw_error *err)
 {
   const char *path = lw_ckpt_path(c);
   int line = 0;
   const char *scene = lw_ckpt_text(c, "run", "scene", &line);
-  if (!scene) return lw_error_set(err, LW_EINPUT, "%s: [run] scene: missing", path);
+  if (!scene) return lw_ckpt_missing(c, "[run] scene", "not a state of a run", err);
   if (!*scene || strlen(scene) >= sizeof st->scene)
     return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene: expected a file name, got '%.60s'", path, line, scene);
   strcpy(st->scene, scene);

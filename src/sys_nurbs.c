@@ -334,7 +334,7 @@ static lw_nurbs_state *state_get(const lw_nurbs_setup *su, lw_ckpt *doc, const c
 {
   const char *path = lw_ckpt_path(doc);
   if (!lw_ckpt_has(doc, section))
-    return lw_error_set(err, LW_EINPUT, "%s: section [%s]: missing (a state of another system?)", path, section), NULL;
+    return lw_state_missing_section(doc, section, err), NULL;
   size_t n = su->curve->n, i = 0, j = 0, pos = 0;
   long count;
   if (lw_ckpt_whole(doc, section, "count", &count, 1, 1L << 53, 1, err)) return NULL;

@@ -173,16 +173,17 @@ static spl_state *state_from_file(const spl_setup *su, lw_splines *sp, const cha
 
 /* The coldest rung's splines, read with the header (st->sp, taken over);
 ** a state without them (of another system) is refused naming the section. */
-static void no_splines(const char *path, lw_error *err)
+static void no_splines(const lw_state *st, const char *path, lw_error *err)
 {
-  lw_error_set(err, LW_EINPUT, "%s: section [system splines]: missing (a state of another system?)", path);
+  if (st->doc) lw_state_missing_section(st->doc, "system splines", err);
+  else lw_error_set(err, LW_EINPUT, "%s: section [system splines]: missing (a state of another system?)", path);
 }
 
 static lw_splines *take_splines(lw_state *st, const char *path, lw_error *err)
 {
   lw_splines *sp = st->sp;
   st->sp = NULL;
-  if (!sp) no_splines(path, err);
+  if (!sp) no_splines(st, path, err);
   return sp;
 }
 
@@ -978,7 +979,7 @@ static double energy(const void *setup, const lw_state *st, const char *path, do
 {
   const lw_scene *sc = &((const spl_setup *)setup)->scene;
   if (!st->sp) {
-    no_splines(path, err);
+    no_splines(st, path, err);
     return NAN;
   }
   if (lw_model_check_regular(sc, st->sp, path, err) || lw_model_check_layers(sc, st->sp, path, err)) return NAN;

@@ -56,6 +56,10 @@ void lw_state_put_header(lw_ckpt_writer *w, const lw_state *st);
 void lw_state_put_splines(lw_ckpt_writer *w, const char *section, const lw_splines *sp);
 lw_status lw_state_get_splines(lw_ckpt *c, const char *section, lw_splines **out, lw_error *err);
 
+/* "path: section [section]: missing" for a state without a system's section:
+** a state of another system, or one cut short (lw_ckpt_missing). */
+lw_status lw_state_missing_section(const lw_ckpt *c, const char *section, lw_error *err);
+
 /* dir + "/" + name into buf (name unchanged if absolute). */
 void lw_path_join(char *buf, size_t n, const char *dir, const char *name);
 
