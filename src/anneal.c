@@ -1565,7 +1565,8 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
                               pinned};
     s = lw_quench_run(a->sys, &o, &a->quench, err);
     free(pinned);
-    lw_phase_set(NULL);
+    /* (a stopped quench stays the phase, which the watcher ends as stopped) */
+    if (s || a->quench.ended != LW_QUENCH_STOPPED) lw_phase_set(NULL);
     if (s) return s;
     if (a->quench.ended == LW_QUENCH_STOPPED) return LW_OK; /* state.lw holds the annealed state: resume quenches again */
     a->quenched = 1;

@@ -370,7 +370,7 @@ static void *watch(void *arg)
     nanosleep(&tick, NULL);
     watcher_tick(w);
   }
-  fputs(lw_phase_watch_end(&w->pw, atomic_load(&w->stop) > 1, line, sizeof line), stderr);
+  fputs(lw_phase_watch_end(&w->pw, atomic_load(&w->stop) - 1, line, sizeof line), stderr);
   return NULL;
 }
 
@@ -393,11 +393,11 @@ static void watcher_settle(watcher *w)
   if (w->running) watcher_tick(w);
 }
 
-/* failed: the phase shown last ended in an error (reported next). */
-static void watcher_stop(watcher *w, int failed)
+/* how (LW_PHASE_*): how the phase shown last ended (an error is reported next). */
+static void watcher_stop(watcher *w, int how)
 {
   if (!w->running) return;
-  atomic_store(&w->stop, failed ? 2 : 1);
+  atomic_store(&w->stop, how + 1);
   pthread_join(w->thread, NULL);
   pthread_mutex_destroy(&w->lock);
   w->running = 0;
@@ -407,7 +407,7 @@ static void watcher_stop(watcher *w, int failed)
 ** the final files (or a checkpoint for a clean stop). */
 static int watched_fail(watcher *w, const lw_error *err)
 {
-  watcher_stop(w, 1);
+  watcher_stop(w, LW_PHASE_FAILED);
   return fail(err);
 }
 
@@ -433,7 +433,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
 #endif
   if (stopped) {
     if (lw_anneal_checkpoint(a, err)) return watched_fail(w, err);
-    watcher_stop(w, 0);
+    watcher_stop(w, LW_PHASE_DONE);
     if (!quiet)
       fprintf(stderr, "linewise: stopped after sweep %ld; state saved in %s/state.lw ('linewise resume %s' continues)\n",
               a->sweep, a->dir, a->dir);
@@ -450,7 +450,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   int drew = 1;
 #endif
   if (s) return watched_fail(w, err);
-  watcher_stop(w, 0);
+  watcher_stop(w, a->quench.ended == LW_QUENCH_STOPPED ? LW_PHASE_STOPPED : LW_PHASE_DONE);
   if (a->quench.ended == LW_QUENCH_STOPPED) {
     if (!quiet)
       fprintf(stderr, "linewise: stopped during the quench (nothing drawn); state saved in %s/state.lw ('linewise resume "

@@ -62,12 +62,13 @@ const char *lw_phase_watch_tick(lw_phase_watch *w, const char *what, double seco
   return buf;
 }
 
-const char *lw_phase_watch_end(lw_phase_watch *w, int failed, char *buf, size_t n)
+const char *lw_phase_watch_end(lw_phase_watch *w, int how, char *buf, size_t n)
 {
+  static const char *const ended[] = {"done in", "failed after", "stopped after"};
   buf[0] = '\0';
   if (w->shown)
     snprintf(buf, n, "%slinewise: %s: %s %.1f s\n", w->tty ? "\r\033[K" : "", w->shown,
-             failed ? "failed after" : "done in", w->last);
+             ended[how >= LW_PHASE_DONE && how <= LW_PHASE_STOPPED ? how : LW_PHASE_FAILED], w->last);
   w->shown = NULL;
   return buf;
 }

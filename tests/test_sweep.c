@@ -220,8 +220,13 @@ Test(phase, the_watcher_names_phases_over_a_second_and_their_time)
   for (size_t k = 0; k < sizeof steps / sizeof *steps; k++)
     cr_assert_str_eq(lw_phase_watch_tick(&log, steps[k].what, steps[k].t, buf, sizeof buf), steps[k].want,
                      "log, step %zu", k);
-  cr_assert_str_eq(lw_phase_watch_end(&log, 1, buf, sizeof buf), "linewise: writing state.lw: failed after 1.5 s\n");
-  cr_assert_str_eq(lw_phase_watch_end(&log, 0, buf, sizeof buf), "");
+  cr_assert_str_eq(lw_phase_watch_end(&log, LW_PHASE_FAILED, buf, sizeof buf),
+                   "linewise: writing state.lw: failed after 1.5 s\n");
+  cr_assert_str_eq(lw_phase_watch_end(&log, LW_PHASE_DONE, buf, sizeof buf), "");
+  /* a quench a signal stopped said "done in" */
+  cr_assert_str_eq(lw_phase_watch_tick(&log, a, 2.5, buf, sizeof buf), "linewise: placing...\n");
+  cr_assert_str_eq(lw_phase_watch_end(&log, LW_PHASE_STOPPED, buf, sizeof buf),
+                   "linewise: placing: stopped after 2.5 s\n");
 
   lw_phase_watch tty = {.tty = 1};
   cr_assert_str_eq(lw_phase_watch_tick(&tty, b, 0.9, buf, sizeof buf), "");
@@ -233,5 +238,5 @@ Test(phase, the_watcher_names_phases_over_a_second_and_their_time)
                    "\r\033[Klinewise: drawing the final files: done in 2.1 s\n\r\033[Klinewise: writing state.lw... 1 s");
   cr_assert_str_eq(lw_phase_watch_tick(&tty, NULL, 0.0, buf, sizeof buf),
                    "\r\033[Klinewise: writing state.lw: done in 1.3 s\n");
-  cr_assert_str_eq(lw_phase_watch_end(&tty, 0, buf, sizeof buf), "");
+  cr_assert_str_eq(lw_phase_watch_end(&tty, LW_PHASE_DONE, buf, sizeof buf), "");
 }

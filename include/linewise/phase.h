@@ -50,8 +50,12 @@ typedef struct {
 ** the text to print into buf[n] ("" for nothing) and returns buf. */
 const char *lw_phase_watch_tick(lw_phase_watch *w, const char *what, double seconds, char *buf, size_t n);
 
-/* The watcher stops: the end of a phase still shown, "failed after" if the
-** run ended in an error, into buf[n] ("" for nothing); returns buf. */
-const char *lw_phase_watch_end(lw_phase_watch *w, int failed, char *buf, size_t n);
+/* How the phase still shown when the watcher stops ended. */
+enum { LW_PHASE_DONE, LW_PHASE_FAILED, LW_PHASE_STOPPED };
+
+/* The watcher stops: the end of a phase still shown ("done in", "failed
+** after" if the run ended in an error, "stopped after" by a signal: how =
+** LW_PHASE_*), into buf[n] ("" for nothing); returns buf. */
+const char *lw_phase_watch_end(lw_phase_watch *w, int how, char *buf, size_t n);
 
 #endif
