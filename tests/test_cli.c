@@ -341,6 +341,7 @@ Test(cli, keys_the_system_never_reads_are_refused)
     {"minimal", "--set 'tempering.ladder=0.01 0.1 1' --set tempering.t_max=5",
      "tempering.t_max (--set: tempering.ladder names the temperatures)"},
     {"whip", "--seed 2", "anneal.seed (--seed: the dynamics from init.from draws no random number)"},
+    {"wire", "--seed 2", "anneal.seed (--seed: the D-NURBS dynamics draws no random number)"},
     /* a plotter's bed, which only machine files are checked against */
     {"minimal", "--set plot.bed_width=50 --set plot.gcode_pen_up=M5",
      "plot.bed_width (--set: neither output.hpgl nor output.gcode), plot.gcode_pen_up (--set: output.gcode = 0)"},
