@@ -562,7 +562,8 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
 
 /* A set-up of seconds (60,000 splines placed, or read back) has its "done
 ** in" line before the run's header: the watcher thread printed it at its
-** next tick, after the header and the parameters. */
+** next tick, after the header and the parameters.  The progress line at
+** sweep 0 has no temperature yet. */
 Test(cli, the_set_up_ends_its_line_before_the_run_header)
 {
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --threads 1 --set init.splines=60000 "
@@ -577,6 +578,8 @@ Test(cli, the_set_up_ends_its_line_before_the_run_header)
   const char *resuming = strstr(e, "linewise: resuming big at sweep 0");
   cr_assert(placed && header && read && resuming, "%s", e);
   cr_assert(placed < header && header < read && read < resuming, "%s", e);
+  /* no temperature before the first sweep (it read T 0) */
+  cr_assert(strstr(e, "\nsweep 0/300 T -  E "), "%s", e);
   free(e);
 }
 
