@@ -99,6 +99,14 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
   ** file open for writing), else read-only (another user of a shared
   ** directory may read the lock file the first one made, and a local flock
   ** needs no more) */
+  /* a directory this process may never write is the wrong one (exit 2, as
+  ** for one that cannot be made), not a failure while running: a queue's
+  ** script that retries on 1 retried it for ever */
+  if (access(dir, W_OK) && (errno == EACCES || errno == EROFS || errno == EPERM)) {
+    int e = errno;
+    return lw_error_set(err, LW_EINPUT, "%s: cannot write into the run directory: %s; expected one this user can "
+                        "write", dir, strerror(e));
+  }
   int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
   if (fd < 0 && errno == EACCES) fd = open(path, O_RDONLY | O_CLOEXEC);
   struct stat st;

@@ -944,6 +944,30 @@ Test(cli, a_start_from_a_state_in_the_directory_it_writes_is_refused)
                           "--quiet && cmp m/final.svg r/final.svg", dir, b), 0);
 }
 
+/* A run directory on a read-only file system is the wrong directory (exit
+** 2), like one that cannot be made, not a failure while running (exit 1,
+** which a queue's script retries); nothing in it changes. */
+Test(cli, a_run_directory_that_cannot_be_written_is_refused_with_exit_2)
+{
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=5 --out src/m --quiet", dir, b,
+                          lw_test_root()), 0);
+  if (lw_test_sh("cd %s && mkdir ro && mount --bind src ro 2>/dev/null && mount -o remount,bind,ro ro 2>/dev/null",
+                 dir))
+    cr_skip_test("cannot mount a read-only directory here (needs root and mount)");
+  int rc_run = lw_test_sh("cd %s && sha256sum src/m/* > sums && %s run %s/params/minimal.ini --out ro/m --quiet "
+                          "2>err.txt", dir, b, lw_test_root());
+  int rc_resume = lw_test_sh("cd %s && %s resume ro/m 2>>err.txt", dir, b);
+  lw_test_sh("cd %s && umount ro", dir);
+  cr_expect_eq(rc_run, 2);
+  cr_expect_eq(rc_resume, 2);
+  char *e = lw_test_slurp("%s/err.txt", dir);
+  cr_expect(strstr(e, "linewise: ro/m: cannot write into the run directory: Read-only file system; expected one "
+                      "this user can write\n"), "%s", e);
+  free(e);
+  cr_assert_eq(lw_test_sh("cd %s && sha256sum -c --quiet sums", dir), 0);
+}
+
 /* An irregular segment's message names the test that failed and the key to
 ** lower: both were named, and both values called reasons, when one test was
 ** off or passed. */
