@@ -218,7 +218,8 @@ static lw_status set_option(lw_params *p, const char *assignment, lw_error *err)
 
 static volatile sig_atomic_t stop_requested = 0;
 
-static volatile sig_atomic_t on_terminal = 0; /* stderr is one: say what a signal does */
+static volatile sig_atomic_t on_terminal = 0; /* stderr is one: say what a signal does, after a new line that
+                                                 ** ends the line a phase or the bar holds */
 
 /* What a second signal says, written before it can come: the handler may
 ** only write (it named DIR, not the run's directory). */
@@ -245,7 +246,7 @@ static void stop_unwritten(int sig)
 {
   static const char msg[] = "\nlinewise: stopped during the set-up, before anything was written\n";
   if (!signal_quiet) {
-    ssize_t w = write(2, msg, sizeof msg - 1);
+    ssize_t w = write(2, msg + !on_terminal, sizeof msg - 1 - !on_terminal);
     (void)w;
   }
   if (made_what) {
@@ -277,13 +278,15 @@ static void on_signal(int sig)
   if (finishing == 2) return; /* the run is whole, summary.json too: it ends as it would have */
   if (!stop_requested && lw_phase_unwritten()) stop_unwritten(sig);
   if (!stop_requested && (files || on_terminal)) {
-    ssize_t w = files ? write(2, last, sizeof last - 1) : write(2, first, sizeof first - 1);
+    ssize_t w = files ? write(2, last + !on_terminal, sizeof last - 1 - !on_terminal)
+                      : write(2, first + !on_terminal, sizeof first - 1 - !on_terminal);
     (void)w;
   }
   if (stop_requested) {
     static const char none[] = "\nlinewise: a second signal: stopped at once, before the run's first checkpoint "
                                "(nothing to resume: run it again)\n";
-    ssize_t w = checkpointed ? write(2, second_msg, (size_t)second_len) : write(2, none, sizeof none - 1);
+    ssize_t w = checkpointed ? write(2, second_msg + !on_terminal, (size_t)second_len - !on_terminal)
+                             : write(2, none + !on_terminal, sizeof none - 1 - !on_terminal);
     (void)w;
     _exit(128 + sig);
   }

@@ -597,7 +597,9 @@ Test(cli, a_signal_before_anything_is_written_ends_the_set_up_at_once)
                           dir, lw_test_bin(), lw_test_root()),
                0);
   char *e = lw_test_slurp("%s/err.txt", dir);
-  cr_assert(strstr(e, "linewise: stopped during the set-up, before anything was written\n"), "%s", e);
+  /* its one line, without the new line that ends a terminal's phase line (a log had an empty one) */
+  cr_assert(!strcmp(e, "linewise: stopped during the set-up, before anything was written\n") ||
+                strstr(e, "...\nlinewise: stopped during the set-up, before anything was written\n"), "%s", e);
   free(e);
   cr_assert_neq(lw_test_sh("test -e %s/out", dir), 0, "the default directory was left");
   /* what a second signal leaves before the first checkpoint (a run's
