@@ -558,6 +558,9 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
                           "output.png_scale=20 --set anneal.sweeps=5' 2>%s/err.txt; test $? -eq 1 && grep -q "
                           "'fp/final.png: writing the PNG failed: File too large' %s/err.txt", lw_test_bin(),
                           lw_test_root(), dir, dir, dir), 0);
+  /* and that the last checkpoint is whole, and how to go on */
+  cr_assert_eq(lw_test_sh("grep -q 'File too large; %s/fp/state.lw holds the checkpoint of sweep 5: ' %s/err.txt", dir,
+                          dir), 0);
 }
 
 /* A set-up of seconds (60,000 splines placed, or read back) has its "done
