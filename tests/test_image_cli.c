@@ -491,6 +491,35 @@ Test(image_cli, levels_stretch_a_dim_picture_before_the_tone_curve)
   }
 }
 
+/* Dark in its left three fifths (0.1), light right. */
+static float dark_tone(int i, int j)
+{
+  (void)j;
+  return i < 3 * PICTURE_W / 5 ? 0.1f : 0.9f;
+}
+
+/* A picture 80 % dark or darker over more than half of it gets a note
+** before the run (the rocket at night drew an even hatch, with the best
+** scores of eleven photographs); lightened by its tone curve, or without a
+** term that draws its tone, not. */
+Test(image_cli, a_picture_dark_nearly_all_over_gets_a_note)
+{
+  write_tone_picture("dark.png", dark_tone);
+  static const struct { const char *keys; int noted; } cases[] = {
+    {"[energy]\ntone = 1\n", 1},
+    {"image_gamma = 0.25\n[energy]\ntone = 1\n", 0},
+    {"potential = image\n[energy]\npotential = 1\n", 1},
+    {"", 0},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    lw_scene sc;
+    picture_scene("dark.png", cases[k].keys, &sc);
+    const char *at = strstr(sc.note, "scene.image: 60 % of the picture is 80 % dark or darker after its tone curve");
+    cr_assert_eq(at != NULL, cases[k].noted, "%s: %s", cases[k].keys, sc.note);
+    lw_scene_clear(&sc);
+  }
+}
+
 /* scene.image_flatten reaches the picture in millimetres on the page: a
 ** page lit from 0.3 to 0.9 across 40 px (1 mm a pixel) with a dark bar
 ** turns to paper within 0.1 of white (the rise of the light over the
