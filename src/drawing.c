@@ -209,6 +209,18 @@ static lw_status close_share(const lw_params *p, const lw_scene *sc, const lw_st
   return s;
 }
 
+void lw_drawing_note(const lw_params *p, char *note, size_t n)
+{
+  const double vs = p->speed_down / 10.0;
+  if (!p->hpgl || (vs >= LW_HPGL_VS_MIN && vs <= LW_HPGL_VS_MAX)) return;
+  size_t used = strlen(note);
+  if (used < n)
+    snprintf(note + used, n - used, "%splot.speed_down = %g mm/s is past what HP-GL's VS takes (%g to %g mm/s): "
+             "final.hpgl asks %g, and the plot time, reckoned at %g, does not hold for the machine", used ? "; " : "",
+             p->speed_down, 10.0 * LW_HPGL_VS_MIN, 10.0 * LW_HPGL_VS_MAX, 10.0 * fmin(fmax(vs, LW_HPGL_VS_MIN),
+             LW_HPGL_VS_MAX), p->speed_down);
+}
+
 lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_splines *sp, const lw_grid2d *tone,
                            const char *dir, lw_drawing_report *rep, lw_error *err)
 {

@@ -11,9 +11,6 @@
 ** HP-GL units and G-code's thousandths. */
 #define LW_PLOTTER_MM_MAX 1e8
 
-/* HP-GL's VS takes 0 < v < 128 cm/s. */
-#define LW_HPGL_VS_MIN 0.01
-#define LW_HPGL_VS_MAX 127.99
 
 /* Points a PD instruction carries: long lists are legal, but short ones
 ** keep within the input buffers of older plotters. */

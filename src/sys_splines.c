@@ -82,6 +82,7 @@ static void *setup_new(const lw_params *p, lw_error *err)
     return NULL;
   }
   if (lw_scene_init(&su->scene, p, err)) goto fail;
+  lw_drawing_note(p, su->scene.note, sizeof su->scene.note);
   /* the target of the fidelity score and the previews' underlay */
   if (su->scene.image && !(su->tone = lw_image_tone_grid(su->scene.image, &su->scene.image_place, err)))
     goto fail;

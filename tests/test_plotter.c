@@ -534,6 +534,11 @@ Test(plotter, a_page_past_the_bed_is_refused_before_the_run)
   cr_assert_eq(lw_test_sh("test -s %s/r/final.hpgl", dir), 0);
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set plot.bed_width=10 --set anneal.sweeps=5 --quiet "
                           "--out %s/s", bin, root, dir), 0);
+  /* a pen speed HP-GL cannot ask is said before the run (VS was limited without a word) */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.hpgl=1 --set plot.speed_down=2000 --stop-at 0 "
+                          "--out %s/v 2>&1 | grep -q 'note: plot.speed_down = 2000 mm/s is past what HP-GL.s VS takes "
+                          "(0.1 to 1279.9 mm/s): final.hpgl asks 1279.9, and the plot time, reckoned at 2000, does "
+                          "not hold'", bin, root, dir), 0);
   /* a drawing that leaves the bed only after the anneal (no crop, no
   ** boundary term, hot) is refused before any drawing file is written, with
   ** exit 1 (the run went well), the state kept for a redraw */

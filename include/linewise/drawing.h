@@ -71,6 +71,11 @@ typedef struct {
 ** name the parameter's origin. */
 lw_status lw_drawing_page(const lw_params *p, lw_output_page *page, lw_error *err);
 
+/* Appends to note[n] ("; " between notes) what the drawing keys of p will
+** not do as set: a pen speed past what HP-GL's VS takes, which final.hpgl
+** limits, so that the plot time no longer holds for the machine. */
+void lw_drawing_note(const lw_params *p, char *note, size_t n);
+
 /* Writes final.svg, final.png and (if asked) final.pdf into dir and fills
 ** rep.  tone: the target tone raster (fidelity.h) or NULL. */
 lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_splines *sp, const lw_grid2d *tone,

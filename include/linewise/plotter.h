@@ -51,6 +51,8 @@
 #define LW_HPGL_UNITS_PER_MM 40.0   /* HP-GL plotter units: 0.025 mm */
 #define LW_GCODE_DECIMALS 3         /* G-code coordinates: 0.001 mm */
 #define LW_PLOTTER_CHORDS_MAX 65536 /* chords of one segment at most */
+#define LW_HPGL_VS_MIN 0.01        /* HP-GL's VS, cm/s: 0 < v < 128 */
+#define LW_HPGL_VS_MAX 127.99
 
 typedef struct {
   double tolerance;          /* mm: every point of a curve within this of its chords (> 0) */
