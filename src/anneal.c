@@ -237,20 +237,32 @@ static void make_absolute(char *path, const char *scene_file)
   }
 }
 
-/* A start (init.from) from a file of the directory the run writes into:
-** the run would replace that run's record (a redraw into its own directory
-** kept one row of trace.csv). */
+/* A start (init.from) from a state the run would write over, or beside a
+** run it would replace: its own directory's state.lw (by any name: a link
+** to it too) or replica files, or a file there while a run is there (a
+** redraw into its own directory kept one row of the run's trace.csv). */
 static lw_status from_elsewhere(const lw_anneal *a, const char *dir, lw_error *err)
 {
   const char *from = a->params.from;
-  char fdir[LW_PATH_MAX], rf[4096], rd[4096];
-  if (!from[0]) return LW_OK;
-  lw_path_dir(fdir, sizeof fdir, from);
-  if (!realpath(fdir, rf) || !realpath(dir, rd) || strcmp(rf, rd)) return LW_OK;
-  lw_error_set(err, LW_EINPUT, "'%s' lies in %s, the directory this run writes, and the run would replace the "
-               "files of the run there (its trace.csv, summary.json and drawings); expected another --out (a "
-               "redraw: docs/FORMATS.md, \"Redrawing a finished run\"), or 'linewise resume %s' to go on with it",
-               from, dir, dir);
+  char real[4096], fdir[4096], rd[4096], state[LW_PATH_MAX + 16];
+  struct stat sf, ss;
+  if (!from[0] || !realpath(from, real) || !realpath(dir, rd) || stat(real, &sf)) return LW_OK;
+  lw_path_dir(fdir, sizeof fdir, real);
+  lw_path_join(state, sizeof state, dir, "state.lw");
+  const int run_there = !stat(state, &ss);
+  const int same_file = run_there && ss.st_dev == sf.st_dev && ss.st_ino == sf.st_ino;
+  const char *base = real + strlen(fdir) + (real[strlen(fdir)] == '/');
+  const int written = same_file || !strncmp(base, "replica-", 8) || !strcmp(base, "state.lw");
+  if (!same_file && !(!strcmp(fdir, rd) && (run_there || written))) return LW_OK;
+  char scene[LW_PATH_MAX + 16], resume[LW_PATH_MAX + 64] = "";
+  lw_path_join(scene, sizeof scene, dir, "scene.ini");
+  if (run_there && !access(scene, F_OK))
+    snprintf(resume, sizeof resume, ", or 'linewise resume %s' to go on with it", dir);
+  static const char files[] = "the files of the run there (its trace.csv, summary.json and drawings)";
+  lw_error_set(err, LW_EINPUT, "'%s' is %s in %s, the directory this run writes, which would replace %s%s; expected "
+               "another --out (a redraw: docs/FORMATS.md, \"Redrawing a finished run\")%s", from,
+               same_file ? "the state" : "a file", dir, written ? "it" : files,
+               written && run_there ? " and the files of the run there" : "", resume);
   return lw_params_blame(&a->params, "init", "from", err);
 }
 

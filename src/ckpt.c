@@ -35,7 +35,7 @@ struct lw_ckpt {
   size_t len, cap;
   size_t header;      /* offset, or (size_t)-1 */
   int header_line;
-  int cut_line;       /* the last line, where the file ends inside it (no newline); 0: none */
+  int lines;          /* the file's lines */
   entry *e;
   size_t n, ecap;
   section *s;
@@ -236,11 +236,14 @@ lw_status lw_ckpt_read(lw_ckpt **out, const char *path, lw_error *err)
   if (!s && !c->text && !(c->text = malloc(1))) s = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
   if (!s) {
     c->text[c->len] = '\0';
-    if (c->len && c->text[c->len - 1] != '\n') {
-      c->cut_line = 1;
-      for (size_t k = 0; k < c->len; k++) c->cut_line += c->text[k] == '\n';
-    }
-    s = parse(c, err);
+    for (size_t k = 0; k < c->len; k++) c->lines += c->text[k] == '\n';
+    /* every state this program writes ends its last line: one that does not
+    ** was cut short inside it (a number cut there still read as a number) */
+    if (c->len && c->text[c->len - 1] != '\n')
+      s = lw_error_set(err, LW_EINPUT, "%s:%d: the file ends inside this line: cut short (a partial copy, a full "
+                       "disk?); a state written by hand needs a newline after its last line", path, c->lines + 1);
+    else
+      s = parse(c, err);
     c->len++; /* what store() appends goes after the final NUL */
   }
   if (s) lw_ckpt_free(c);
@@ -280,10 +283,8 @@ const char *lw_ckpt_text(lw_ckpt *c, const char *sec, const char *key, int *line
 
 lw_status lw_ckpt_missing(const lw_ckpt *c, const char *what, const char *guess, lw_error *err)
 {
-  if (c->cut_line)
-    return lw_error_set(err, LW_EINPUT, "%s: %s: missing, and the file ends inside its line %d: cut short (a "
-                        "partial copy, a full disk?)", c->path, what, c->cut_line);
-  return lw_error_set(err, LW_EINPUT, "%s: %s: missing (%s)", c->path, what, guess);
+  return lw_error_set(err, LW_EINPUT, "%s: %s: missing (%s, or a file cut short: it ends at its line %d)", c->path,
+                      what, guess, c->lines);
 }
 
 static lw_status missing(const lw_ckpt *c, const char *sec, const char *key, lw_error *err)

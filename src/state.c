@@ -235,7 +235,7 @@ lw_status lw_state_missing_section(const lw_ckpt *c, const char *section, lw_err
 {
   char what[128];
   snprintf(what, sizeof what, "section [%s]", section);
-  return lw_ckpt_missing(c, what, "a state of another system?", err);
+  return lw_ckpt_missing(c, what, "a state of another system", err);
 }
 
 static lw_status read_v2(lw_state *st, lw_ckpt *c, lw_error *err)

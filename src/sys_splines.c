@@ -177,7 +177,7 @@ static spl_state *state_from_file(const spl_setup *su, lw_splines *sp, const cha
 static void no_splines(const lw_state *st, const char *path, lw_error *err)
 {
   if (st->doc) lw_state_missing_section(st->doc, "system splines", err);
-  else lw_error_set(err, LW_EINPUT, "%s: section [system splines]: missing (a state of another system?)", path);
+  else lw_error_set(err, LW_EINPUT, "%s: section [system splines]: missing (a state of another system)", path);
 }
 
 static lw_splines *take_splines(lw_state *st, const char *path, lw_error *err)

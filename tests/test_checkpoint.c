@@ -139,24 +139,29 @@ Test(checkpoint, every_run_data_value_is_checked_on_resume)
   cr_assert_eq(resume_edited("s/^sweep = 20$/sweep = 20/"), 0);
 }
 
-/* A state.lw cut short (a partial copy) is said to be: cut inside [run] or
-** [chain] it was blamed on "a state of another system?", naming no line.
-** Cut at a line's end it still names what is missing. */
+/* A state.lw cut short (a partial copy) is said to be.  Cut inside [run] or
+** [chain] it was blamed on "a state of another system?", naming no line;
+** cut inside its last number it resumed with that number shortened.  Every
+** state ends its last line, so one that does not is refused at once; one cut
+** at a line's end names what is missing and where the file ends. */
 Test(checkpoint, a_state_cut_short_is_said_to_be)
 {
   stopped_run();
-  static const long at[] = {300, 5000, 11200}; /* in [run], in [chain] rng, after it */
+  /* in [run], in [chain]'s rng, after it (of 13850 bytes), and 4 bytes into the last number */
+  static const long at[] = {300, 5000, 11200, -5};
   for (size_t i = 0; i < sizeof at / sizeof at[0]; i++) {
-    lw_test_sh("rm -rf %s/x && cp -r %s/r %s/x && truncate -s %ld %s/x/state.lw", dir, dir, dir, at[i], dir);
+    lw_test_sh("rm -rf %s/x && cp -r %s/r %s/x && truncate -s %s%ld %s/x/state.lw", dir, dir, dir,
+               at[i] < 0 ? "-" : "", at[i] < 0 ? -at[i] : at[i], dir);
     cr_assert_eq(lw_test_sh("test \"$(tail -c 1 %s/x/state.lw)\" != ''", dir), 0, "cut inside a line");
-    cr_expect_eq(lw_test_sh("%s resume %s/x --quiet 2>%s/err.txt", lw_test_bin(), dir, dir), 2);
-    cr_expect(err_has("missing, and the file ends inside its line ") && err_has("cut short (a partial copy"),
-              "cut at %ld", at[i]);
+    cr_expect_eq(lw_test_sh("%s resume %s/x --quiet 2>%s/err.txt", lw_test_bin(), dir, dir), 2, "cut at %ld", at[i]);
+    cr_expect(err_has(": the file ends inside this line: cut short (a partial copy, a full disk?)"), "cut at %ld",
+              at[i]);
   }
   lw_test_sh("rm -rf %s/x && cp -r %s/r %s/x && sed -i '/^\\[system splines\\]$/,$d' %s/x/state.lw", dir, dir, dir,
              dir);
   cr_expect_eq(lw_test_sh("%s resume %s/x --quiet 2>%s/err.txt", lw_test_bin(), dir, dir), 2);
-  cr_expect(err_has("x/state.lw: section [system splines]: missing (a state of another system?)"));
+  cr_expect(err_has("x/state.lw: section [system splines]: missing (a state of another system, or a file cut short: "
+                    "it ends at its line 48)"));
 }
 
 Test(checkpoint, a_state_with_an_infinite_energy_is_refused_with_the_spline_and_segment)

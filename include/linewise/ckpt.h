@@ -52,8 +52,8 @@ lw_status lw_ckpt_add(lw_ckpt *c, const char *section, const char *key, const ch
 /* 1 if the section exists (and marks it read). */
 int lw_ckpt_has(lw_ckpt *c, const char *section);
 
-/* "path: what: missing" and why: a file that ends inside its last line was
-** cut short (a torn copy), which the message says instead of `guess`. */
+/* "path: what: missing" and why: `guess`, or a file cut short at the end of
+** a line (lw_ckpt_read refuses one cut inside a line), naming its last. */
 lw_status lw_ckpt_missing(const lw_ckpt *c, const char *what, const char *guess, lw_error *err);
 
 /* The text of a key (marked read), or NULL if missing; *line (if not NULL)
