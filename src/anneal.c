@@ -725,7 +725,8 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   idle_keys(a, a->idle, sizeof a->idle);
   schedule_note(a, a->schedule_note, sizeof a->schedule_note);
   const lw_params *rp = &a->params;
-  if (a->n_rep > 1 && rp->tune_ladder == LW_LADDER_EQUAL && rp->ladder_sweeps >= rp->sweeps) {
+  /* (a redraw, no sweeps, tunes nothing: FORMATS' recipe was refused) */
+  if (a->n_rep > 1 && rp->tune_ladder == LW_LADDER_EQUAL && rp->sweeps > 0 && rp->ladder_sweeps >= rp->sweeps) {
     /* (a run of an older release that did so still resumes) */
     char where[LW_PATH_MAX + 32];
     lw_params_origin(rp, lw_params_find("tempering", "ladder_sweeps"), where, sizeof where);

@@ -954,6 +954,17 @@ Test(cli, a_start_from_a_state_in_the_directory_it_writes_is_refused)
                           "--quiet && cmp m/final.svg r/final.svg", dir, b), 0);
 }
 
+/* FORMATS' redraw (no sweeps) of a tempering run that tuned its ladder: it
+** was refused, as if it had to tune within its 0 sweeps. */
+Test(cli, a_tempering_run_with_a_tuned_ladder_redraws)
+{
+  const char *b = lw_test_bin();
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set tempering.replicas=3 --set tempering.t_max=5 "
+                          "--set tempering.tune_ladder=equal --set tempering.ladder_sweeps=10 --set anneal.sweeps=20 "
+                          "--out t --quiet && %s run t/scene.ini --set init.from=t/state.lw --set anneal.sweeps=0 "
+                          "--out r --quiet && cmp t/final.svg r/final.svg", dir, b, lw_test_root(), b), 0);
+}
+
 /* A run directory on a read-only file system is the wrong directory (exit
 ** 2), like one that cannot be made, not a failure while running (exit 1,
 ** which a queue's script retries); nothing in it changes. */
