@@ -498,19 +498,31 @@ static float dark_tone(int i, int j)
   return i < 3 * PICTURE_W / 5 ? 0.1f : 0.9f;
 }
 
-/* A picture 80 % dark or darker over more than half of it gets a note
-** before the run (the rocket at night drew an even hatch, with the best
-** scores of eleven photographs); lightened by its tone curve, or without a
-** term that draws its tone, not. */
+/* Inside a mask (tone below 1/2): the light right two fifths. */
+static float light_part(int i, int j)
+{
+  (void)j;
+  return i < 3 * PICTURE_W / 5 ? 1.0f : 0.0f;
+}
+
+/* A picture dark nearly all over gets a note before the run (the rocket at
+** night drew an even hatch, with the best scores of eleven photographs);
+** lightened by its tone curve, without a term that draws its tone, with its
+** dark outside a mask, or separated into colours (which the tone curve does
+** not reach), not. */
 Test(image_cli, a_picture_dark_nearly_all_over_gets_a_note)
 {
   write_tone_picture("dark.png", dark_tone);
+  write_tone_picture("inside.png", light_part);
   static const struct { const char *keys; int noted; } cases[] = {
     {"[energy]\ntone = 1\n", 1},
     {"image_gamma = 0.25\n[energy]\ntone = 1\n", 0},
     {"potential = image\n[energy]\npotential = 1\n", 1},
     {"", 0},
+    {"boundary = mask\nmask = image\nmask_image = inside.png\n[energy]\ntone = 1\n", 0},
+    {"[layers]\nsource = cmyk\n[energy]\ntone = 1\n", 0},
   };
+
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
     lw_scene sc;
     picture_scene("dark.png", cases[k].keys, &sc);
