@@ -507,7 +507,7 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
       /* (a seed sweep of the whip gave identical "independent" runs) */
       {seed, p->driver == LW_DRIVER_DYNAMICS && p->from[0], "the dynamics from init.from draws no random number"},
       /* (a seed sweep of the wire: identical runs, which stats took for agreeing seeds) */
-      {seed, p->driver == LW_DRIVER_DYNAMICS && !strcmp(p->system, "nurbs"),
+      {seed, p->driver == LW_DRIVER_DYNAMICS && !strcmp(p->system, "nurbs") && !p->from[0],
        "the D-NURBS dynamics draws no random number"},
       {inline_points, p->nb_file[0] != '\0', "nurbs.file gives the points and weights"},
       {jumps, p->fixed_count, "moves.fixed_count = 1"},

@@ -416,14 +416,16 @@ static int watched_fail(watcher *w, const lw_error *err)
   return fail(err);
 }
 
-/* A run that failed to write (a full disk) after its first checkpoint says
-** that state.lw still holds it, and how to go on. */
-static int loop_fail(const lw_anneal *a, watcher *w, lw_error *err)
+/* A run that failed to write (a full disk) says that state.lw still holds
+** its last checkpoint, and how to go on: the last this process wrote, or
+** the one the loop began from (the set-up's, or the one a resume read). */
+static int loop_fail(const lw_anneal *a, long began, watcher *w, lw_error *err)
 {
-  if (err->code == LW_EIO && a->saved > 0) {
+  if (err->code == LW_EIO) {
     size_t n = strlen(err->msg);
     snprintf(err->msg + n, sizeof err->msg - n, "; %s/state.lw holds the checkpoint of sweep %ld: 'linewise "
-             "resume %s' continues from it once the disk takes the files", a->dir, a->saved - 1, a->dir);
+             "resume %s' continues from it once the disk takes the files", a->dir, a->saved > 0 ? a->saved - 1 : began,
+             a->dir);
   }
   return watched_fail(w, err);
 }
@@ -440,7 +442,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   int stopped = ((net ? net->stop_agreed : stop_requested) || (stop_at >= 0 && a->sweep >= stop_at)) &&
                 !lw_anneal_done(a);
   while (!stopped && !lw_anneal_done(a)) {
-    if (lw_anneal_sweep(a, err)) return loop_fail(a, w, err);
+    if (lw_anneal_sweep(a, err)) return loop_fail(a, pg.start_sweep, w, err);
     progress_show(&pg, a, 0);
     stopped = (net ? net->stop_agreed : stop_requested) || (stop_at >= 0 && a->sweep >= stop_at);
   }
@@ -449,7 +451,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   lw_mpi_report(net, a, quiet);
 #endif
   if (stopped) {
-    if (lw_anneal_checkpoint(a, err)) return loop_fail(a, w, err);
+    if (lw_anneal_checkpoint(a, err)) return loop_fail(a, pg.start_sweep, w, err);
     watcher_stop(w, LW_PHASE_DONE);
     if (!quiet)
       fprintf(stderr, "linewise: stopped after sweep %ld; state saved in %s/state.lw ('linewise resume %s' continues)\n",
@@ -466,7 +468,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
 #else
   int drew = 1;
 #endif
-  if (s) return loop_fail(a, w, err);
+  if (s) return loop_fail(a, pg.start_sweep, w, err);
   watcher_stop(w, a->quench.ended == LW_QUENCH_STOPPED ? LW_PHASE_STOPPED : LW_PHASE_DONE);
   if (a->quench.ended == LW_QUENCH_STOPPED) {
     if (!quiet)
@@ -714,6 +716,11 @@ static int cmd_run(int argc, char **argv)
                    "expected a run directory or a new one", dir, dir, mine[k], what[k]);
       return fail(&err);
     }
+  /* before a set-up of minutes, not after it */
+  if (lw_rundir_writable(dir, &err)) {
+    unmake_dir(dir, hold, made);
+    return fail(&err);
+  }
   static lw_anneal a;
   watcher w;
   const int asked = quiet;

@@ -89,6 +89,25 @@ int lw_rundir_unstarted(const char *dir)
   return 1;
 }
 
+/* A directory this process may never write, or a run there whose files it
+** may not (another user's, in a shared directory), is the wrong one (exit 2,
+** as for one that cannot be made), not a failure while running: a queue's
+** script that retries on 1 retried it for ever. */
+lw_status lw_rundir_writable(const char *dir, lw_error *err)
+{
+  static const char *const files[] = {"", "state.lw", "trace.csv", "scene.ini", "summary.json"};
+  char path[LW_PATH_MAX + 16];
+  for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
+    if (snprintf(path, sizeof path, "%s%s%s", dir, k ? "/" : "", files[k]) >= (int)sizeof path) continue;
+    if ((k && access(path, F_OK)) || !access(path, W_OK)) continue;
+    if (errno != EACCES && errno != EROFS && errno != EPERM) continue;
+    int e = errno;
+    return lw_error_set(err, LW_EINPUT, "%s: cannot write %s: %s; expected a run directory this user can write",
+                        k ? path : dir, k ? "over the run's file" : "into the run directory", strerror(e));
+  }
+  return LW_OK;
+}
+
 lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
 {
   char path[LW_PATH_MAX + 16];
@@ -99,14 +118,8 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
   ** file open for writing), else read-only (another user of a shared
   ** directory may read the lock file the first one made, and a local flock
   ** needs no more) */
-  /* a directory this process may never write is the wrong one (exit 2, as
-  ** for one that cannot be made), not a failure while running: a queue's
-  ** script that retries on 1 retried it for ever */
-  if (access(dir, W_OK) && (errno == EACCES || errno == EROFS || errno == EPERM)) {
-    int e = errno;
-    return lw_error_set(err, LW_EINPUT, "%s: cannot write into the run directory: %s; expected one this user can "
-                        "write", dir, strerror(e));
-  }
+  lw_status s = lw_rundir_writable(dir, err);
+  if (s) return s;
   int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
   if (fd < 0 && errno == EACCES) fd = open(path, O_RDONLY | O_CLOEXEC);
   struct stat st;

@@ -36,6 +36,11 @@ int lw_rundir_foreign(const char *dir, const char *name);
 ** the directory; a finished run whose state.lw was deleted is not one. */
 int lw_rundir_unstarted(const char *dir);
 
+/* LW_EINPUT with a message where this process may not write into dir or
+** over a run's files there (read-only, another user's); LW_OK otherwise,
+** also where dir is not there yet. */
+lw_status lw_rundir_writable(const char *dir, lw_error *err);
+
 /* Takes the lock of the existing directory dir for this process: LW_OK and
 ** *hold set (0 where the file system has no locks), or LW_EUSAGE naming the
 ** directory when another process holds it.  A second call for a directory
