@@ -332,14 +332,18 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
     int width = 24, fill = total > 0 ? (int)(width * done / total) : width;
     char state[160];
     progress_state(a, 4, state, sizeof state);
-    fprintf(stderr, "\r[%.*s%*s] sweep %ld/%ld  %s  left %.0fs ", fill, "########################", width - fill, "",
-            a->sweep, a->end_sweep, state, left);
+    char rest[32] = "-"; /* unknown before a sweep has taken its time */
+    if (done > 0 || a->sweep >= a->end_sweep) snprintf(rest, sizeof rest, "%.0fs", left);
+    fprintf(stderr, "\r[%.*s%*s] sweep %ld/%ld  %s  left %s ", fill, "########################", width - fill, "",
+            a->sweep, a->end_sweep, state, rest);
     if (final) fputc('\n', stderr);
   } else if ((final && a->sweep != pg->last_plain) || a->sweep >= pg->next_plain) {
     pg->last_plain = a->sweep;
     char state[160];
     progress_state(a, 6, state, sizeof state);
-    fprintf(stderr, "sweep %ld/%ld %s elapsed %.1fs left %.1fs\n", a->sweep, a->end_sweep, state, t, left);
+    char rest[32] = "-";
+    if (done > 0 || a->sweep >= a->end_sweep) snprintf(rest, sizeof rest, "%.1fs", left);
+    fprintf(stderr, "sweep %ld/%ld %s elapsed %.1fs left %s\n", a->sweep, a->end_sweep, state, t, rest);
     while (pg->next_plain <= a->sweep) pg->next_plain += total / 10 > 0 ? total / 10 : 1;
   }
 }

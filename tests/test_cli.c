@@ -568,14 +568,15 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
                           lw_test_bin(), dir, dir, dir, dir), 0);
 }
 
-/* A set-up of seconds (60,000 splines placed, or read back) has its "done
-** in" line before the run's header: the watcher thread printed it at its
-** next tick, after the header and the parameters.  The progress line at
-** sweep 0 has no temperature yet. */
+/* A set-up of seconds (100,000 splines placed, or read back: each 4 s here,
+** and a phase under 1 s prints nothing) has its "done in" line before the
+** run's header: the watcher thread printed it at its next tick, after the
+** header and the parameters.  The progress line at sweep 0 has no
+** temperature or time left yet. */
 Test(cli, the_set_up_ends_its_line_before_the_run_header)
 {
-  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --threads 1 --set init.splines=60000 "
-                          "--set scene.width=5000 --set scene.height=5000 --stop-at 0 --out big 2>err.txt && "
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --threads 1 --set init.splines=100000 "
+                          "--set scene.width=6500 --set scene.height=6500 --stop-at 0 --out big 2>err.txt && "
                           "%s resume big --threads 1 --stop-at 0 2>>err.txt", dir, lw_test_bin(),
                           lw_test_root(), lw_test_bin()),
                0);
@@ -586,8 +587,8 @@ Test(cli, the_set_up_ends_its_line_before_the_run_header)
   const char *resuming = strstr(e, "linewise: resuming big at sweep 0");
   cr_assert(placed && header && read && resuming, "%s", e);
   cr_assert(placed < header && header < read && read < resuming, "%s", e);
-  /* no temperature before the first sweep (it read T 0) */
-  cr_assert(strstr(e, "\nsweep 0/300 T -  E "), "%s", e);
+  /* no temperature before the first sweep (it read T 0), nor a time left (0.0s) */
+  cr_assert(strstr(e, "\nsweep 0/300 T -  E ") && strstr(e, " acc - elapsed ") && strstr(e, "s left -\n"), "%s", e);
   free(e);
 }
 
