@@ -273,8 +273,7 @@ lw_status lw_output_svg(const lw_splines *sp, const lw_output_page *page, const 
 
 /* ---- cairo drawings ----------------------------------------------------- */
 
-/* Path k of s as a cairo path, forward: a stroke is the same shape either
-** way. */
+/* (output.h) */
 void lw_output_cairo_path(cairo_t *cr, const lw_strokes *s, size_t k)
 {
   double b[8];

@@ -115,7 +115,6 @@ static lw_status scored_side_ok(const lw_params *p, const char *section, const c
                  "scene.image_width)", img->width, img->height, LW_FIDELITY_SIDE_MAX);
 }
 
-/* The picture pipeline after loading: resize, blur, flattening, levels, tone curve. */
 /* A picture dark nearly all over asks for the densest lines nearly
 ** everywhere: an even hatch, with only its lights as gaps (skimage's rocket
 ** at night, 60 % of it 80 % dark; the Hubble deep field, 95 %), which the
@@ -152,6 +151,7 @@ static void dark_note(lw_scene *sc, const lw_params *p)
            100.0 * (1.0 - DARK_TONE));
 }
 
+/* The picture pipeline after loading: resize, blur, flattening, levels, tone curve. */
 static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
 {
   lw_status st = margin_ok(p, err);
