@@ -273,7 +273,7 @@ lw_status lw_output_svg(const lw_splines *sp, const lw_output_page *page, const 
 
 /* ---- cairo drawings ----------------------------------------------------- */
 
-/* (output.h) */
+/* Each segment as the plotter draws it (strokes.h), so final.pdf travels as final.svg does. */
 void lw_output_cairo_path(cairo_t *cr, const lw_strokes *s, size_t k)
 {
   double b[8];
