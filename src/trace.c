@@ -454,6 +454,22 @@ static lw_status same_columns(const lw_trace *a, const char *pa, const lw_trace 
   return LW_OK;
 }
 
+/* Whether every run's rows are the first run's, value for value: runs whose
+** seeds changed nothing (a scene that draws no random number), which the
+** comparison took for k agreeing runs (R_hat 0.99, p_runs 1). */
+static int identical_runs(const lw_trace *const *t, size_t *const *row, const size_t *n, int k)
+{
+  for (int r = 1; r < k; r++) {
+    if (n[r] != n[0]) return 0;
+    for (size_t i = 0; i < n[0]; i++)
+      for (size_t c = 0; c < t[0]->n_cols; c++) {
+        const double a = at(t[0], row[0][i], (int)c), b = at(t[r], row[r][i], (int)c);
+        if (a != b && !(isnan(a) && isnan(b))) return 0;
+      }
+  }
+  return 1;
+}
+
 lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
                               FILE *out, lw_error *err)
 {
@@ -589,6 +605,10 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
          "stationary (start later with --from), or, where the batch means warn too, the same slow mode (run longer)");
     warn(out, t[0], cs, k, WARN_RUNS, "the runs disagree beyond their error bars (p_runs < 0.001 or R_hat > 1.1): "
          "not converged, or the stretches too short for their error bars");
+    if (k > 1 && identical_runs(t, row, n, k))
+      fprintf(out, "warning: the %d runs are the same, row for row: their seeds changed nothing (a scene that draws "
+              "no random number, as the dynamics from init.from or the D-NURBS dynamics), so they are one run, and "
+              "R_hat and p_runs say nothing\n", k);
   }
 done:
   for (int r = 0; row && r < k; r++) free(row[r]);

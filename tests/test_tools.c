@@ -248,6 +248,15 @@ Test(tools, identical_runs_have_a_standard_deviation_of_zero)
   char *out = out_txt();
   cr_assert(strstr(out, "energy_total over 3 runs: best ") && strstr(out, ", std 0\n"), "%s", out);
   free(out);
+  /* and stats says they are one run (it read R_hat 0.99 and p_runs 1, agreeing seeds) */
+  cr_assert_eq(sh("%s stats %s/w/seed-1 %s/w/seed-2 %s/w/seed-3", env("LW_BIN"), dir, dir, dir), 0, "%s", err_txt());
+  out = out_txt();
+  cr_assert(strstr(out, "warning: the 3 runs are the same, row for row: their seeds changed nothing"), "%s", out);
+  free(out);
+  cr_assert_eq(sh("%s stats %s/w/seed-1 %s/w/seed-2 --csv", env("LW_BIN"), dir, dir), 0, "%s", err_txt());
+  out = out_txt();
+  cr_assert_null(strstr(out, "warning"), "the CSV stays a table: %s", out);
+  free(out);
 }
 
 /* A sweep of a picture gathers the drawing's scores too: close share and
