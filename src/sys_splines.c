@@ -74,6 +74,25 @@ static void setup_free(void *setup)
   free(su);
 }
 
+/* A rigid move (translate, rotate) takes every segment of its spline along,
+** so on long splines it costs the rest of the sweep many times over: a
+** sweep grows as the square of the segments (one spline of 8000 segments,
+** 25 s a sweep with the default weights, 0.2 s without).  Said before the
+** run where the rigid moves cost 20 times the point and vector moves. */
+static void long_splines_note(const lw_params *p, char *note, size_t n)
+{
+  const double rigid = p->mix_translate + p->mix_rotate, all = rigid + p->mix_point + p->mix_vector;
+  if (p->driver != LW_DRIVER_METROPOLIS || p->from[0] || !(rigid > 0.0) || rigid >= all) return;
+  const double times = rigid / (all - rigid) * p->segments;
+  if (times < 20.0) return;
+  size_t used = strlen(note);
+  if (used < n)
+    snprintf(note + used, n - used, "%sinit.segments = %d: the rigid moves (moves.translate and rotate) each take "
+             "every segment of their spline along, so they cost about %.0f times what the point and vector moves "
+             "do, and a sweep grows as the square of the segments; lower moves.translate and moves.rotate for long "
+             "splines (docs/PERFORMANCE.md, \"Scaling\")", used ? "; " : "", p->segments, times);
+}
+
 static void *setup_new(const lw_params *p, lw_error *err)
 {
   spl_setup *su = calloc(1, sizeof *su);
@@ -83,6 +102,7 @@ static void *setup_new(const lw_params *p, lw_error *err)
   }
   if (lw_scene_init(&su->scene, p, err)) goto fail;
   lw_drawing_note(p, su->scene.note, sizeof su->scene.note);
+  long_splines_note(p, su->scene.note, sizeof su->scene.note);
   /* the target of the fidelity score and the previews' underlay */
   if (su->scene.image && !(su->tone = lw_image_tone_grid(su->scene.image, &su->scene.image_place, err)))
     goto fail;

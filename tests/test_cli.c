@@ -960,6 +960,28 @@ Test(cli, a_start_from_a_state_in_the_directory_it_writes_is_refused)
                           "--quiet && cmp m/final.svg r/final.svg", dir, b), 0);
 }
 
+/* Long splines under the default rigid moves get a note before the run: a
+** sweep of one spline of 16,000 segments passed 2 minutes without a word.
+** Without the rigid moves, or on short splines, none. */
+Test(cli, long_splines_under_rigid_moves_get_a_note)
+{
+  static const struct { const char *set; int noted; } cases[] = {
+    {"--set init.segments=400", 1},
+    {"--set init.segments=400 --set moves.translate=0 --set moves.rotate=0", 0},
+    {"--set init.segments=100", 0},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    char out[256], errs[16384], args[512];
+    snprintf(args, sizeof args, "run %s/params/minimal.ini --set init.splines=2 --set init.segment_length=2 --set "
+             "scene.width=1000 --set scene.height=1000 --stop-at 0 --out %s/l%zu %s", lw_test_root(), dir, k,
+             cases[k].set);
+    cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+    cr_assert_eq(strstr(errs, "linewise: note: init.segments = 400: the rigid moves (moves.translate and rotate) each "
+                              "take every segment of their spline along, so they cost about 44 times") != NULL,
+                 cases[k].noted, "%s: %s", cases[k].set, errs);
+  }
+}
+
 /* FORMATS' redraw (no sweeps) of a tempering run that tuned its ladder: it
 ** was refused, as if it had to tune within its 0 sweeps. */
 Test(cli, a_tempering_run_with_a_tuned_ladder_redraws)
