@@ -10,6 +10,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "linewise/checkpoint.h"
 #include "linewise/drawing.h"
@@ -93,6 +94,27 @@ static void long_splines_note(const lw_params *p, char *note, size_t n)
              "splines (docs/PERFORMANCE.md, \"Scaling\")", used ? "; " : "", p->segments, times);
 }
 
+/* The least a segment's model takes (docs/PERFORMANCE.md: 474 to 865 bytes). */
+#define SEGMENT_BYTES_LEAST 400.0
+
+/* A start whose model alone would not fit this machine's memory is refused
+** before its placement: 1e8 splines filled 3 GB in 15 s with no word, on
+** their way to 200 GB, and a coverage's count was shown only once placed. */
+static lw_status fits_memory(lw_scene *sc, const lw_params *p, lw_error *err)
+{
+  size_t n = (size_t)p->splines;
+  lw_error e2; /* a count the placement refuses is refused there, with its own message */
+  if (!n && lw_init_count(sc, p, &n, &e2)) return LW_OK;
+  const double bytes = SEGMENT_BYTES_LEAST * (double)n * p->segments;
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || page <= 0 || bytes <= (double)pages * (double)page) return LW_OK;
+  lw_error_set(err, LW_EINPUT, "%zu splines of %d segments%s take at least %.3g GB (%.0f bytes a segment), more "
+               "than this machine's %.3g GB of memory: expected fewer splines or segments", n, p->segments,
+               p->splines ? "" : " (from init.coverage)", bytes / 1e9, SEGMENT_BYTES_LEAST,
+               (double)pages * (double)page / 1e9);
+  return lw_params_blame(p, "init", p->splines ? "splines" : "coverage", err);
+}
+
 static void *setup_new(const lw_params *p, lw_error *err)
 {
   spl_setup *su = calloc(1, sizeof *su);
@@ -103,6 +125,7 @@ static void *setup_new(const lw_params *p, lw_error *err)
   if (lw_scene_init(&su->scene, p, err)) goto fail;
   lw_drawing_note(p, su->scene.note, sizeof su->scene.note);
   long_splines_note(p, su->scene.note, sizeof su->scene.note);
+  if (!p->from[0] && fits_memory(&su->scene, p, err)) goto fail;
   /* the target of the fidelity score and the previews' underlay */
   if (su->scene.image && !(su->tone = lw_image_tone_grid(su->scene.image, &su->scene.image_place, err)))
     goto fail;

@@ -982,6 +982,21 @@ Test(cli, long_splines_under_rigid_moves_get_a_note)
   }
 }
 
+/* A start whose model cannot fit the machine's memory is refused before its
+** placement: 1e8 splines filled 3 GB in 15 s without a word (on their way to
+** 200 GB).  16 segments of each: at least 640 GB, more than any machine this
+** runs on. */
+Test(cli, a_start_past_the_machines_memory_is_refused_before_placing)
+{
+  char out[256], errs[4096], args[512];
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --set init.splines=100000000 --set init.segments=16 "
+           "--stop-at 0 --out %s/h", lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "linewise: --set: key 'init.splines': 100000000 splines of 16 segments take at least 640 GB "
+                         "(400 bytes a segment), more than this machine's "), "%s", errs);
+  cr_assert_null(strstr(errs, "placing"), "%s", errs);
+}
+
 /* FORMATS' redraw (no sweeps) of a tempering run that tuned its ladder: it
 ** was refused, as if it had to tune within its 0 sweeps. */
 Test(cli, a_tempering_run_with_a_tuned_ladder_redraws)
