@@ -285,7 +285,8 @@ static void on_signal(int sig)
   if (stop_requested) {
     static const char none[] = "\nlinewise: a second signal: stopped at once, before the run's first checkpoint "
                                "(nothing to resume: run it again)\n";
-    ssize_t w = checkpointed ? write(2, second_msg + !on_terminal, (size_t)second_len - !on_terminal)
+    const size_t skip = second_len > 0 && !on_terminal; /* (0: the name did not fit, and nothing is said) */
+    ssize_t w = checkpointed ? write(2, second_msg + skip, (size_t)second_len - skip)
                              : write(2, none + !on_terminal, sizeof none - 1 - !on_terminal);
     (void)w;
     _exit(128 + sig);

@@ -19,8 +19,8 @@ lw_status lw_nurbs_check_knots(int order, size_t n, const double *knot, size_t n
     if (!isfinite(knot[i])) return lw_error_set(err, LW_EINPUT, "knot %zu (counting from 0) is not a finite number", i);
   for (size_t i = 0; i + 1 < n_knots; i++)
     if (knot[i + 1] < knot[i])
-      return lw_error_set(err, LW_EINPUT, "knot %zu (%g) is less than knot %zu (%g): knots must not decrease (they count from 0)", i + 1,
-                          knot[i + 1], i, knot[i]);
+      return lw_error_set(err, LW_EINPUT, "knot %zu (%g) is less than knot %zu (%g): knots must not decrease (they "
+                          "count from 0)", i + 1, knot[i + 1], i, knot[i]);
   for (size_t i = 1; i < k; i++)
     if (knot[i] != knot[0] || knot[n + i] != knot[n])
       return lw_error_set(err, LW_EINPUT, "not an open knot vector: the first %d and the last %d knots must be equal",

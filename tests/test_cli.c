@@ -563,9 +563,9 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
                           dir), 0);
   /* a resume's too: the checkpoint it read, where it has written none yet */
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/rf --quiet --stop-at 50 && sh -c 'ulimit -f 30; %s "
-                          "resume %s/rf --quiet' 2>%s/err.txt; test $? -eq 1 && grep -q 'File too large; %s/rf/state.lw "
-                          "holds the checkpoint of sweep 50: ' %s/err.txt", lw_test_bin(), lw_test_root(), dir,
-                          lw_test_bin(), dir, dir, dir, dir), 0);
+                          "resume %s/rf --quiet' 2>%s/err.txt; test $? -eq 1 && grep -q 'File too large; "
+                          "%s/rf/state.lw holds the checkpoint of sweep 50: ' %s/err.txt", lw_test_bin(),
+                          lw_test_root(), dir, lw_test_bin(), dir, dir, dir, dir), 0);
 }
 
 /* A set-up of seconds (100,000 splines placed, or read back: each 4 s here,
