@@ -14,6 +14,7 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -546,6 +547,51 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
 
 /* The system's row and its set-up of the scene; a quench needs a row with
 ** a gradient. */
+/* The memory this process may use: the machine's, or less where its address
+** space (ulimit -v) or its cgroup (a batch job's memory.max) is limited; in
+** *by what limits it. */
+static double memory_limit(const char **by)
+{
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  double limit = pages > 0 && page > 0 ? (double)pages * (double)page : INFINITY;
+  *by = "this machine's memory";
+  struct rlimit rl;
+  if (!getrlimit(RLIMIT_AS, &rl) && rl.rlim_cur != RLIM_INFINITY && (double)rl.rlim_cur < limit) {
+    limit = (double)rl.rlim_cur;
+    *by = "this process's address space (ulimit -v)";
+  }
+  FILE *f = fopen("/sys/fs/cgroup/memory.max", "r");
+  double cg;
+  if (f && fscanf(f, "%lf", &cg) == 1 && cg > 0 && cg < limit) {
+    limit = cg;
+    *by = "this cgroup's memory.max";
+  }
+  if (f) fclose(f);
+  return limit;
+}
+
+/* A start whose replicas here would not fit the memory this process may use
+** is refused before its placement, naming the key that sets its size. */
+static lw_status fits_memory(const lw_anneal *a, lw_error *err)
+{
+  const lw_system_type *t = a->sys_type;
+  char what[160] = "";
+  const char *key = NULL, *by;
+  const double one = t->start_bytes ? t->start_bytes(a->setup, &a->params, what, sizeof what, &key) : 0.0;
+  int here = 0;
+  for (int r = 0; r < a->n_rep; r++) here += rung_here(a, r);
+  const double limit = memory_limit(&by), bytes = one * here;
+  if (!(bytes > limit) || !key) return LW_OK;
+  char reps[48] = "";
+  if (here > 1) snprintf(reps, sizeof reps, " in %d replicas", here);
+  lw_error_set(err, LW_EINPUT, "%s take at least %.3g GB%s, more than the %.3g GB of %s: expected fewer splines or "
+               "segments", what, bytes / 1e9, reps, limit / 1e9, by);
+  const char *dot = strchr(key, '.');
+  char section[32];
+  snprintf(section, sizeof section, "%.*s", dot ? (int)(dot - key) : 0, key);
+  return lw_params_blame(&a->params, section, dot ? dot + 1 : key, err);
+}
+
 static lw_status setup_system(lw_anneal *a, lw_error *err)
 {
   if (!(a->sys_type = lw_system_of(&a->params, err))) return err->code;
@@ -565,7 +611,7 @@ static lw_status setup_system(lw_anneal *a, lw_error *err)
                         a->sys_type->name, *missing == 's' ? "samples" : "observables");
   }
   a->setup = a->sys_type->setup_new(&a->params, err);
-  return a->setup ? LW_OK : err->code;
+  return a->setup ? fits_memory(a, err) : err->code;
 }
 
 /* A scene that asks for a quench must have a gradient of every term it

@@ -97,22 +97,19 @@ static void long_splines_note(const lw_params *p, char *note, size_t n)
 /* The least a segment's model takes (docs/PERFORMANCE.md: 474 to 865 bytes). */
 #define SEGMENT_BYTES_LEAST 400.0
 
-/* A start whose model alone would not fit this machine's memory is refused
-** before its placement: 1e8 splines filled 3 GB in 15 s with no word, on
-** their way to 200 GB, and a coverage's count was shown only once placed. */
-static lw_status fits_memory(lw_scene *sc, const lw_params *p, lw_error *err)
+/* (system.h) The placed splines' model: 1e8 splines filled 3 GB in 15 s
+** without a word, on their way to 160 GB, and a coverage's count was shown
+** only once placed. */
+static double start_bytes(const void *setup, const lw_params *p, char *what, size_t n, const char **key)
 {
-  size_t n = (size_t)p->splines;
+  const spl_setup *su = setup;
+  size_t count = (size_t)p->splines;
   lw_error e2; /* a count the placement refuses is refused there, with its own message */
-  if (!n && lw_init_count(sc, p, &n, &e2)) return LW_OK;
-  const double bytes = SEGMENT_BYTES_LEAST * (double)n * p->segments;
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-  if (pages <= 0 || page <= 0 || bytes <= (double)pages * (double)page) return LW_OK;
-  lw_error_set(err, LW_EINPUT, "%zu splines of %d segments%s take at least %.3g GB (%.0f bytes a segment), more "
-               "than this machine's %.3g GB of memory: expected fewer splines or segments", n, p->segments,
-               p->splines ? "" : " (from init.coverage)", bytes / 1e9, SEGMENT_BYTES_LEAST,
-               (double)pages * (double)page / 1e9);
-  return lw_params_blame(p, "init", p->splines ? "splines" : "coverage", err);
+  if (p->from[0] || (!count && lw_init_count(&su->scene, p, &count, &e2))) return 0.0;
+  snprintf(what, n, "%zu splines of %d segments%s (%.0f bytes a segment at least)", count, p->segments,
+           p->splines ? "" : " (from init.coverage)", SEGMENT_BYTES_LEAST);
+  *key = p->splines ? "init.splines" : "init.coverage";
+  return SEGMENT_BYTES_LEAST * (double)count * p->segments;
 }
 
 static void *setup_new(const lw_params *p, lw_error *err)
@@ -125,7 +122,6 @@ static void *setup_new(const lw_params *p, lw_error *err)
   if (lw_scene_init(&su->scene, p, err)) goto fail;
   lw_drawing_note(p, su->scene.note, sizeof su->scene.note);
   long_splines_note(p, su->scene.note, sizeof su->scene.note);
-  if (!p->from[0] && fits_memory(&su->scene, p, err)) goto fail;
   /* the target of the fidelity score and the previews' underlay */
   if (su->scene.image && !(su->tone = lw_image_tone_grid(su->scene.image, &su->scene.image_place, err)))
     goto fail;
@@ -1321,6 +1317,7 @@ static const char *const keys_metropolis[] = {"moves.*", "anneal.delayed_accepta
   .setup_new = setup_new, \
   .setup_free = setup_free, \
   .note = note, \
+  .start_bytes = start_bytes, \
   .state_new = state_new, \
   .state_copy = state_copy, \
   .state_free = state_free, \

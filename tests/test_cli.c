@@ -982,19 +982,24 @@ Test(cli, long_splines_under_rigid_moves_get_a_note)
   }
 }
 
-/* A start whose model cannot fit the machine's memory is refused before its
-** placement: 1e8 splines filled 3 GB in 15 s without a word (on their way to
-** 200 GB).  16 segments of each: at least 640 GB, more than any machine this
-** runs on. */
+/* A start whose model cannot fit the memory the process may use is refused
+** before its placement: 1e8 splines filled 3 GB in 15 s without a word (on
+** their way to 160 GB).  16 segments of each: at least 640 GB, more than any
+** machine this runs on. */
 Test(cli, a_start_past_the_machines_memory_is_refused_before_placing)
 {
   char out[256], errs[4096], args[512];
   snprintf(args, sizeof args, "run %s/params/minimal.ini --set init.splines=100000000 --set init.segments=16 "
            "--stop-at 0 --out %s/h", lw_test_root(), dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
-  cr_assert(strstr(errs, "linewise: --set: key 'init.splines': 100000000 splines of 16 segments take at least 640 GB "
-                         "(400 bytes a segment), more than this machine's "), "%s", errs);
+  cr_assert(strstr(errs, "linewise: --set: key 'init.splines': 100000000 splines of 16 segments (400 bytes a segment "
+                         "at least) take at least 640 GB, more than the "), "%s", errs);
   cr_assert_null(strstr(errs, "placing"), "%s", errs);
+  /* a replica a copy, and the address space a batch job allows: 300,000 splines fit 1 GB, four replicas do not */
+  cr_assert_eq(lw_test_sh("sh -c 'ulimit -v 1000000; %s run %s/params/minimal.ini --set init.splines=300000 --set "
+                          "tempering.replicas=4 --stop-at 0 --threads 1 --out %s/h' 2>%s/err.txt; test $? -eq 2 && "
+                          "grep -q 'take at least 1.92 GB in 4 replicas, more than the 1.02 GB of this process.s "
+                          "address space (ulimit -v)' %s/err.txt", lw_test_bin(), lw_test_root(), dir, dir, dir), 0);
 }
 
 /* FORMATS' redraw (no sweeps) of a tempering run that tuned its ladder: it

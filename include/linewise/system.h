@@ -91,6 +91,12 @@ struct lw_system_type {
   void *(*setup_new)(const lw_params *p, lw_error *err);
   void (*setup_free)(void *setup);
   const char *(*note)(const void *setup);
+  /* Optional (NULL: no estimate): the least memory, in bytes, one replica's
+  ** start will take, with in *what its size ("100 splines of 4 segments")
+  ** and in *key the key that sets it ("section.key"), so that a start past the machine's
+  ** memory is refused before its placement (anneal.c); 0 where unknown (a
+  ** state read from a file). */
+  double (*start_bytes)(const void *setup, const lw_params *p, char *what, size_t n, const char **key);
 
   /* The initial state of a run: placed from `seed` (a stream of its own) or
   ** read from the file the parameters name; copies for the replicas. */
