@@ -238,10 +238,11 @@ static void make_absolute(char *path, const char *scene_file)
   }
 }
 
-/* A start (init.from) from a state the run would write over, or beside a
-** run it would replace: its own directory's state.lw (by any name: a link
-** to it too) or replica files, or a file there while a run is there (a
-** redraw into its own directory kept one row of the run's trace.csv). */
+/* A start (init.from) from a state the run would write over: its own
+** directory's state.lw (by any name: a link to it too) or a replica file
+** there (a redraw into its own directory kept one row of the run's
+** trace.csv).  A start file of the user's beside a run is read before the run
+** replaces the run's files, as a run without one would. */
 static lw_status from_elsewhere(const lw_anneal *a, const char *dir, lw_error *err)
 {
   const char *from = a->params.from;
@@ -253,17 +254,16 @@ static lw_status from_elsewhere(const lw_anneal *a, const char *dir, lw_error *e
   const int run_there = !stat(state, &ss);
   const int same_file = run_there && ss.st_dev == sf.st_dev && ss.st_ino == sf.st_ino;
   const char *base = real + strlen(fdir) + (real[strlen(fdir)] == '/');
-  const int written = same_file || !strncmp(base, "replica-", 8) || !strcmp(base, "state.lw");
-  if (!same_file && !(!strcmp(fdir, rd) && (run_there || written))) return LW_OK;
+  if (!same_file && !(!strcmp(fdir, rd) && (!strncmp(base, "replica-", 8) || !strcmp(base, "state.lw"))))
+    return LW_OK;
   char scene[LW_PATH_MAX + 16], resume[LW_PATH_MAX + 64] = "";
   lw_path_join(scene, sizeof scene, dir, "scene.ini");
   if (run_there && !access(scene, F_OK))
     snprintf(resume, sizeof resume, ", or 'linewise resume %s' to go on with it", dir);
-  static const char files[] = "the files of the run there (its trace.csv, summary.json and drawings)";
-  lw_error_set(err, LW_EINPUT, "'%s' is %s in %s, the directory this run writes, which would replace %s%s; expected "
+  lw_error_set(err, LW_EINPUT, "'%s' is %s in %s, the directory this run writes, which would replace it%s; expected "
                "another --out (a redraw: docs/FORMATS.md, \"Redrawing a finished run\")%s", from,
-               same_file ? "the state" : "a file", dir, written ? "it" : files,
-               written && run_there ? " and the files of the run there" : "", resume);
+               same_file ? "the state" : "a state", dir,
+               run_there ? " and the files of the run there (its trace.csv, summary.json and drawings)" : "", resume);
   return lw_params_blame(&a->params, "init", "from", err);
 }
 

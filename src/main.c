@@ -429,7 +429,7 @@ static int loop_fail(const lw_anneal *a, long began, watcher *w, lw_error *err)
   if (err->code == LW_EIO) {
     size_t n = strlen(err->msg);
     snprintf(err->msg + n, sizeof err->msg - n, "; %s/state.lw holds the checkpoint of sweep %ld: 'linewise "
-             "resume %s' continues from it once the disk takes the files", a->dir, a->saved > 0 ? a->saved - 1 : began,
+             "resume %s' continues from it once the files can be written", a->dir, a->saved > 0 ? a->saved - 1 : began,
              a->dir);
   }
   return watched_fail(w, err);

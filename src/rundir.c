@@ -89,23 +89,44 @@ int lw_rundir_unstarted(const char *dir)
   return 1;
 }
 
+/* Whether this process may write path (a file written in place, or a
+** directory it writes files into): 0, or the errno that says why not. */
+static int denied(const char *path, int dir)
+{
+  if (access(path, F_OK) || !access(path, W_OK | (dir ? X_OK : 0))) return 0;
+  return errno == EACCES || errno == EROFS || errno == EPERM ? errno : 0;
+}
+
 /* A directory this process may never write, or a run there whose files it
 ** may not (another user's, in a shared directory), is the wrong one (exit 2,
 ** as for one that cannot be made), not a failure while running: a queue's
-** script that retries on 1 retried it for ever. */
+** script that retries on 1 retried it for ever.  The run writes trace.csv
+** in place and the lock, and the rest by rename, which needs only the
+** directory, unless it is sticky (/tmp-like) and the file another user's. */
 lw_status lw_rundir_writable(const char *dir, lw_error *err)
 {
-  static const char *const files[] = {"", "state.lw", "trace.csv", "scene.ini", "summary.json"};
+  static const char *const inside[] = {"", "frames", "samples"}, *const renamed[] = {"state.lw", "scene.ini",
+                                                                                      "summary.json"};
+  const mode_t sticky = 01000; /* S_ISVTX, which POSIX leaves to XSI */
   char path[LW_PATH_MAX + 16];
-  for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
-    if (snprintf(path, sizeof path, "%s%s%s", dir, k ? "/" : "", files[k]) >= (int)sizeof path) continue;
-    if ((k && access(path, F_OK)) || !access(path, W_OK)) continue;
-    if (errno != EACCES && errno != EROFS && errno != EPERM) continue;
-    int e = errno;
-    return lw_error_set(err, LW_EINPUT, "%s: cannot write %s: %s; expected a run directory this user can write",
-                        k ? path : dir, k ? "over the run's file" : "into the run directory", strerror(e));
-  }
-  return LW_OK;
+  const char *what = NULL;
+  int e = 0;
+  for (size_t k = 0; k < 3 && !e; k++)
+    if (snprintf(path, sizeof path, "%s%s%s", dir, k ? "/" : "", inside[k]) < (int)sizeof path && (e = denied(path, 1)))
+      what = k ? "cannot write into it" : "cannot write into the run directory";
+  if (!e && snprintf(path, sizeof path, "%s/trace.csv", dir) < (int)sizeof path && (e = denied(path, 0)))
+    what = "cannot write over the run's trace";
+  if (!e && snprintf(path, sizeof path, "%s/.lock", dir) < (int)sizeof path && !access(path, F_OK) &&
+      access(path, R_OK) && errno == EACCES)
+    e = EACCES, what = "cannot read the run directory's lock";
+  struct stat sd, sf;
+  const uid_t me = geteuid();
+  for (size_t k = 0; k < 3 && !e && me && !stat(dir, &sd) && (sd.st_mode & sticky) && sd.st_uid != me; k++)
+    if (snprintf(path, sizeof path, "%s/%s", dir, renamed[k]) < (int)sizeof path && !stat(path, &sf) && sf.st_uid != me)
+      e = EPERM, what = "cannot replace another user's file in a sticky directory";
+  if (!e) return LW_OK;
+  return lw_error_set(err, LW_EINPUT, "%s: %s: %s; expected a run directory this user can write", path, what,
+                      strerror(e));
 }
 
 lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)

@@ -948,13 +948,14 @@ Test(cli, a_start_from_a_state_in_the_directory_it_writes_is_refused)
   cr_assert_eq(lw_test_sh("cd %s && sha256sum m/* > sums && %s run m/scene.ini --set init.from=m/state.lw --set "
                           "anneal.sweeps=0 --out m/ --quiet 2>err.txt; test $? -eq 2 && grep -q \"^linewise: --set: "
                           "key 'init.from': '%s/m/state.lw' is the state in m/, the directory this run writes, which "
-                          "would replace it and the files of the run there;\" err.txt && sha256sum -c --quiet sums",
-                          dir, b, dir), 0);
-  /* by a link to it too; but a start file in a directory without a run is the user's own */
+                          "would replace it and the files of the run there (its trace.csv\" err.txt && "
+                          "sha256sum -c --quiet sums", dir, b, dir), 0);
+  /* by a link to it too; but a start file of the user's, beside a run or not, is read before the run writes */
   cr_assert_eq(lw_test_sh("cd %s && ln -s m/state.lw link.lw && %s run m/scene.ini --set init.from=link.lw --set "
                           "anneal.sweeps=0 --out m --quiet 2>err.txt; test $? -eq 2 && sha256sum -c --quiet sums && "
                           "mkdir f && cp m/state.lw f/start.lw && %s run m/scene.ini --set init.from=f/start.lw --set "
-                          "anneal.sweeps=0 --out f --quiet", dir, b, b), 0);
+                          "anneal.sweeps=0 --out f --quiet && %s run m/scene.ini --set init.from=f/start.lw --set "
+                          "anneal.sweeps=0 --out f --quiet && cmp m/state.lw f/start.lw", dir, b, b, b), 0);
   /* into another directory it is the documented redraw */
   cr_assert_eq(lw_test_sh("cd %s && %s run m/scene.ini --set init.from=m/state.lw --set anneal.sweeps=0 --out r "
                           "--quiet && cmp m/final.svg r/final.svg", dir, b), 0);
