@@ -146,9 +146,10 @@ static void dark_note(lw_scene *sc, const lw_params *p)
   size_t used = strlen(sc->note);
   snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image: %.0f %% of the picture is %.0f %% dark or darker "
            "after its tone curve, so the lines there can only hatch evenly at their densest and little of the picture "
-           "shows; scene.image_gamma below 1 lightens its mid-tones, scene.image_invert = 1 draws its light parts "
-           "(docs/IMAGES.md, \"What the preset does not draw\")", used ? "; " : "", 100.0 * (double)dark / (double)seen,
-           100.0 * (1.0 - DARK_TONE));
+           "shows; scene.image_gamma below 1 lightens its mid-tones, %s (docs/IMAGES.md, \"What the preset does not "
+           "draw\")", used ? "; " : "", 100.0 * (double)dark / (double)seen, 100.0 * (1.0 - DARK_TONE),
+           p->image_invert ? "scene.image_invert = 0 draws its dark parts (the inversion made it dark)"
+                           : "scene.image_invert = 1 draws its light parts");
 }
 
 /* The picture pipeline after loading: resize, blur, flattening, levels, tone curve. */

@@ -76,22 +76,22 @@ static void setup_free(void *setup)
 }
 
 /* A rigid move (translate, rotate) takes every segment of its spline along,
-** so on long splines it costs the rest of the sweep many times over: a
-** sweep grows as the square of the segments (one spline of 8000 segments,
-** 25 s a sweep with the default weights, 0.2 s without).  Said before the
-** run where the rigid moves cost 20 times the point and vector moves. */
+** where a point move takes two, so on long splines the rigid moves cost the
+** rest of the sweep many times over, and a sweep grows as the square of the
+** segments (one spline of 8000 segments: 25 s a sweep with the default
+** weights, 0.2 s without).  Said before the run where the rigid moves' share
+** of the proposals times the segments is 18 or more (20 times the point and
+** vector moves at the default weights; every move, where they are all). */
 static void long_splines_note(const lw_params *p, char *note, size_t n)
 {
   const double rigid = p->mix_translate + p->mix_rotate, all = rigid + p->mix_point + p->mix_vector;
-  if (p->driver != LW_DRIVER_METROPOLIS || p->from[0] || !(rigid > 0.0) || rigid >= all) return;
-  const double times = rigid / (all - rigid) * p->segments;
-  if (times < 20.0) return;
+  if (p->driver != LW_DRIVER_METROPOLIS || p->from[0] || !(rigid > 0.0) || rigid / all * p->segments < 18.0) return;
   size_t used = strlen(note);
   if (used < n)
-    snprintf(note + used, n - used, "%sinit.segments = %d: the rigid moves (moves.translate and rotate) each take "
-             "every segment of their spline along, so they cost about %.0f times what the point and vector moves "
-             "do, and a sweep grows as the square of the segments; lower moves.translate and moves.rotate for long "
-             "splines (docs/PERFORMANCE.md, \"Scaling\")", used ? "; " : "", p->segments, times);
+    snprintf(note + used, n - used, "%sinit.segments = %d: the rigid moves (moves.translate and rotate), %.0f %% of "
+             "the proposals, each take all %d segments of their spline along where a point move takes two, so a sweep "
+             "grows as the square of the segments; give moves.translate and moves.rotate a small share for long "
+             "splines (docs/PERFORMANCE.md, \"Scaling\")", used ? "; " : "", p->segments, 100.0 * rigid / all, p->segments);
 }
 
 /* The least a segment's model takes (docs/PERFORMANCE.md: 474 to 865 bytes). */

@@ -454,9 +454,10 @@ static lw_status same_columns(const lw_trace *a, const char *pa, const lw_trace 
   return LW_OK;
 }
 
-/* Whether every run's rows are the first run's, value for value: runs whose
-** seeds changed nothing (a scene that draws no random number), which the
-** comparison took for k agreeing runs (R_hat 0.99, p_runs 1). */
+/* Whether every run's rows are the first run's, value for value: one seed
+** run twice, or seeds that changed nothing (a scene that draws no random
+** number), which the comparison took for k agreeing runs (R_hat 0.99,
+** p_runs 1). */
 static int identical_runs(const lw_trace *const *t, size_t *const *row, const size_t *n, int k)
 {
   for (int r = 1; r < k; r++) {
@@ -606,9 +607,9 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     warn(out, t[0], cs, k, WARN_RUNS, "the runs disagree beyond their error bars (p_runs < 0.001 or R_hat > 1.1): "
          "not converged, or the stretches too short for their error bars");
     if (k > 1 && identical_runs(t, row, n, k))
-      fprintf(out, "warning: the %d runs are the same, row for row: their seeds changed nothing (a scene that draws "
-              "no random number, as the dynamics from init.from or the D-NURBS dynamics), so they are one run, and "
-              "R_hat and p_runs say nothing\n", k);
+      fprintf(out, "warning: the %d runs are the same, row for row: one seed run twice, or seeds that change "
+              "nothing (a scene that draws no random number, as the dynamics from init.from or the D-NURBS dynamics), "
+              "so they are one run, and R_hat and p_runs say nothing\n", k);
   }
 done:
   for (int r = 0; row && r < k; r++) free(row[r]);

@@ -968,6 +968,7 @@ Test(cli, long_splines_under_rigid_moves_get_a_note)
 {
   static const struct { const char *set; int noted; } cases[] = {
     {"--set init.segments=400", 1},
+    {"--set init.segments=400 --set moves.point=0 --set moves.vector=0", 1}, /* every move rigid */
     {"--set init.segments=400 --set moves.translate=0 --set moves.rotate=0", 0},
     {"--set init.segments=100", 0},
   };
@@ -977,8 +978,9 @@ Test(cli, long_splines_under_rigid_moves_get_a_note)
              "scene.width=1000 --set scene.height=1000 --stop-at 0 --out %s/l%zu %s", lw_test_root(), dir, k,
              cases[k].set);
     cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
-    cr_assert_eq(strstr(errs, "linewise: note: init.segments = 400: the rigid moves (moves.translate and rotate) each "
-                              "take every segment of their spline along, so they cost about 44 times") != NULL,
+    cr_assert_eq(strstr(errs, "linewise: note: init.segments = 400: the rigid moves (moves.translate and rotate), ") &&
+                     strstr(errs, " of the proposals, each take all 400 segments of their spline along where a point "
+                                  "move takes two, so a sweep grows as the square of the segments"),
                  cases[k].noted, "%s: %s", cases[k].set, errs);
   }
 }
