@@ -260,6 +260,29 @@ Test(tools, identical_runs_have_a_standard_deviation_of_zero)
   free(out);
 }
 
+/* Ctrl-C to the whole sweep (its process group; INT at its default, as in a
+** terminal): the runs in progress stop at the end of their sweep with their
+** state saved, no further run starts, and the script returns only then.  It
+** returned at once, xargs dead, while its runs still wrote (a rerun met their
+** locks); run in the background of a script, INT is ignored on entry, which
+** env --default-signal undoes here. */
+Test(tools, ctrl_c_stops_the_sweep_after_its_runs_have_saved)
+{
+  cr_assert_eq(sh("(setsid env --default-signal=INT %s %s %s --seeds 1-3 -j 2 --threads 1 --set anneal.sweeps=1000000 "
+                  "--bin %s --out %s/i >%s/i.out 2>%s/i.err & echo $! >%s/i.pid); i=0; while [ $i -lt 1000 ] && ! { "
+                  "test -s %s/i/seed-1/state.lw && test -s %s/i/seed-2/state.lw; }; do sleep 0.02; i=$((i+1)); done; "
+                  "p=$(cat %s/i.pid); kill -INT -$p; i=0; while kill -0 $p 2>/dev/null && [ $i -lt 1500 ]; do "
+                  "sleep 0.02; i=$((i+1)); done; kill -KILL -$p 2>/dev/null; test $i -lt 1500 && "
+                  "flock -n %s/i/seed-1/.lock true && flock -n %s/i/seed-2/.lock true && ! test -e %s/i/seed-3",
+                  "bash", tool("seed-sweep"), scene(), env("LW_BIN"), dir, dir, dir, dir, dir, dir, dir, dir, dir, dir),
+               0, "%s", err_txt());
+  char *e = lw_test_slurp("%s/i.err", dir);
+  cr_assert(strstr(e, "seed-sweep: interrupted: the runs in progress stopped with their state saved; rerun the sweep "
+                      "to resume\n") && strstr(e, "[1/3] seed-1: interrupted, state saved"), "%s", e);
+  free(e);
+  cr_assert_eq(lw_test_sh("grep -q '^sweep = [1-9]' %s/i/seed-1/state.lw", dir), 0);
+}
+
 /* A sweep of a picture gathers the drawing's scores too: close share and
 ** fidelity_mse, _ssim, _orientation and _stray, each the run's own. */
 Test(tools, a_sweep_of_a_picture_gathers_the_drawings_scores)
