@@ -161,7 +161,8 @@ static int cmd_energy(int argc, char **argv)
     dir = argv[i];
   }
   if (!dir) {
-    lw_error_set(&err, LW_EUSAGE, "energy: expected one run directory (usage: linewise energy DIR [--set SEC.KEY=VAL]...)");
+    lw_error_set(&err, LW_EUSAGE, "energy: expected one run directory (usage: linewise energy DIR "
+                 "[--set SEC.KEY=VAL]...)");
     return fail(&err);
   }
   if (dir_fits("energy", dir, &err)) return fail(&err);
