@@ -454,7 +454,8 @@ static lw_status get_dynamics(lw_ckpt *doc, lw_dynamics *d, lw_error *err)
     i += (size_t)want;
   }
   if (i != d->n)
-    return lw_error_set(err, LW_EINPUT, "%s: [dynamics] momentum: %zu of the system's %zu coordinates", path, i, d->n);
+    return lw_error_set(err, LW_EINPUT, "%s: [dynamics] momentum: %zu of the system's %zu coordinates%s", path, i,
+                        d->n, lw_ckpt_cut_hint(doc, "dynamics"));
   return LW_OK;
 }
 

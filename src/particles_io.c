@@ -210,7 +210,8 @@ lw_particles *lw_particles_get(const lw_particles_setup *s, lw_ckpt *c, const ch
     pin[i++] = (unsigned char)v[7];
   }
   if (i < n) {
-    lw_error_set(err, LW_EINPUT, "%s: [%s]: count = %zu, but %zu particle lines", path, section, n, i);
+    lw_error_set(err, LW_EINPUT, "%s: [%s]: count = %zu, but %zu particle lines%s", path, section, n, i,
+                 lw_ckpt_cut_hint(c, section));
     goto out;
   }
   lw_error e;

@@ -198,8 +198,8 @@ lw_status lw_state_get_splines(lw_ckpt *c, const char *section, lw_splines **out
     key = NULL;
     int more = lw_ckpt_next(c, section, &pos, &key, &val, &line);
     if (!more) {
-      s = lw_error_set(err, LW_EINPUT, "%s:%d: [%s] splines: %lld, but the section ends after %zu of them", path,
-                       count_line, section, ns, i);
+      s = lw_error_set(err, LW_EINPUT, "%s:%d: [%s] splines: %lld, but the section ends after %zu of them%s",
+                       path, count_line, section, ns, i, lw_ckpt_cut_hint(c, section));
       break;
     }
     if (strcmp(key, "spline") || !spline_header(val, &col.segs[i], &col.rest[i], &col.layer[i])) {
@@ -214,12 +214,13 @@ lw_status lw_state_get_splines(lw_ckpt *c, const char *section, lw_splines **out
     for (size_t k = 0; k <= col.segs[i] && !s; k++) {
       lw_node nd;
       more = lw_ckpt_next(c, section, &pos, &key, &val, &line);
-      if (more) snprintf(got, sizeof got, "%s = %s", key, val);
+      if (more) snprintf(got, sizeof got, "'%.24s = %.60s'", key, val);
+      else snprintf(got, sizeof got, "the end of the section");
       if (!more || strcmp(key, "node") || !node_values(val, &nd))
         s = lw_error_set(err, LW_EINPUT,
-                         "%s:%d: [%s] spline %zu node %zu: expected 'node = ' and %s, got '%.60s' (its %zu segments "
-                         "have %zu nodes)", path, line, section, i, k, node_expected, more ? got : "end of section",
-                         col.segs[i], col.segs[i] + 1);
+                         "%s:%d: [%s] spline %zu node %zu: expected 'node = ' and %s, got %s%s (its %zu segments have "
+                         "%zu nodes)", path, line, section, i, k, node_expected, got,
+                         more ? "" : lw_ckpt_cut_hint(c, section), col.segs[i], col.segs[i] + 1);
       else if (!collect_node(&col, nd))
         s = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
     }

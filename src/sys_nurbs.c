@@ -385,8 +385,8 @@ static lw_nurbs_state *state_get(const lw_nurbs_setup *su, lw_ckpt *doc, const c
     i++;
   }
   if (i < n || (j && j < n)) {
-    lw_error_set(err, LW_EINPUT, "%s: [%s]: count = %zu, but %zu %s lines", path, section, n, i < n ? i : j,
-                 i < n ? "point" : "log_weight");
+    lw_error_set(err, LW_EINPUT, "%s: [%s]: count = %zu, but %zu %s lines%s", path, section, n, i < n ? i : j,
+                 i < n ? "point" : "log_weight", lw_ckpt_cut_hint(doc, section));
     goto out;
   }
   /* a state of a frozen-weight run starts free weights at the scene's */

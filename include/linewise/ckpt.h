@@ -56,6 +56,10 @@ int lw_ckpt_has(lw_ckpt *c, const char *section);
 ** a line (lw_ckpt_read refuses one cut inside a line), naming its last. */
 lw_status lw_ckpt_missing(const lw_ckpt *c, const char *what, const char *guess, lw_error *err);
 
+/* For a message on bulk data that stops short: the words that say the file
+** ends there too (section is its last, read from a file), else "". */
+const char *lw_ckpt_cut_hint(const lw_ckpt *c, const char *section);
+
 /* The text of a key (marked read), or NULL if missing; *line (if not NULL)
 ** is its line, 0 when built in memory. */
 const char *lw_ckpt_text(lw_ckpt *c, const char *section, const char *key, int *line);
