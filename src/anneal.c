@@ -316,8 +316,8 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
     lw_params_origin(p, lw_params_find("tempering", "ladder"), where, sizeof where);
     int n = lw_number_list(p->ladder, 1, ladder, LW_TEMPERING_MAX);
     if (n < 2 || n > LW_TEMPERING_MAX)
-      return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%s'",
-                          where, LW_TEMPERING_MAX, p->ladder);
+      return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%s'%s",
+                          where, LW_TEMPERING_MAX, p->ladder, lw_number_list_hint(n));
     if (p->replicas != 1 && p->replicas != n)
       return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': %d temperatures for %d replicas", where, n,
                           p->replicas);

@@ -42,7 +42,8 @@ static lw_status per_layer(const lw_params *p, const char *key, const char *text
   if (!text[0]) return LW_OK;
   double got[LW_LAYERS_MAX];
   int count = lw_number_list(text, 1, got, LW_LAYERS_MAX);
-  if (count < 0) return bad(p, key, err, "expected %d numbers (one a layer), got '%s'", n, text);
+  if (count < 0)
+    return bad(p, key, err, "expected %d numbers (one a layer), got '%s'%s", n, text, lw_number_list_hint(count));
   if (count != n)
     return bad(p, key, err, "expected %d numbers (one a layer of layers.names), got %d", n, count);
   for (int k = 0; k < n; k++) {

@@ -58,10 +58,18 @@ int lw_number_parse_whole(const char *s, double lo, double hi, long long *out)
 int lw_number_list(const char *s, int commas, double *out, int max)
 {
   const char *sep = commas ? " \t," : " \t";
-  int n = 0;
+  /* the kind of each separator (1: holds a comma) by its place's parity */
+  int kind[2] = {-1, -1}, same = 1, alternate = 1, n = 0;
   for (;;) {
-    s += strspn(s, sep);
-    if (!*s) return n;
+    size_t gap = strspn(s, sep);
+    if (n > 0 && gap && s[gap]) {
+      int k = memchr(s, ',', gap) != NULL, *seen = &kind[(n - 1) % 2], *other = &kind[n % 2];
+      if (*seen >= 0 && *seen != k) alternate = 0;
+      if ((*seen >= 0 && *seen != k) || (*other >= 0 && *other != k)) same = 0;
+      *seen = k;
+    }
+    s += gap;
+    if (!*s) break;
     size_t len = strcspn(s, sep);
     double v;
     if (!lw_number_parse_n(s, len, &v)) return -1;
@@ -69,6 +77,13 @@ int lw_number_list(const char *s, int commas, double *out, int max)
     n++;
     s += len;
   }
+  return same || (commas == 2 && alternate) ? n : -2;
+}
+
+const char *lw_number_list_hint(int count)
+{
+  return count == -2 ? " (commas and blanks mixed between its numbers: a decimal comma? numbers take a point, 0.5 "
+                       "not 0,5)" : "";
 }
 
 void lw_text_drop_bom(char *s)

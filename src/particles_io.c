@@ -87,8 +87,8 @@ static lw_status read_text(FILE *f, const char *path, points *pt, lw_error *err)
     }
     if (k != 3 && k != 6) {
       s = k < 0 ? lw_error_set(err, LW_EINPUT,
-                               "%s:%ld: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got '%.80s'", path,
-                               line, buf)
+                               "%s:%ld: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got '%.80s'%s", path,
+                               line, buf, lw_number_list_hint(k))
                 : lw_error_set(err, LW_EINPUT, "%s:%ld: expected 3 numbers (x y z) or 6 (x y z nx ny nz), got %d",
                                path, line, k);
       break;

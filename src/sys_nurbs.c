@@ -48,9 +48,11 @@ static void setup_free(void *setup)
 /* The numbers in the text of [nurbs] key (malloc'ed; *n how many), blaming the key. */
 static double *numbers(const lw_params *p, const char *key, const char *text, size_t *n, lw_error *err)
 {
-  int count = lw_number_list(text, 1, NULL, 0);
+  const int pairs = !strcmp(key, "points") ? 2 : 1;
+  int count = lw_number_list(text, pairs, NULL, 0);
   if (count < 0) {
-    lw_error_set(err, LW_EINPUT, "expected numbers separated by blanks or commas, got '%.60s'", text);
+    lw_error_set(err, LW_EINPUT, "expected numbers separated by blanks or commas, got '%.60s'%s", text,
+                 lw_number_list_hint(count));
     lw_params_blame(p, "nurbs", key, err);
     return NULL;
   }
@@ -59,7 +61,7 @@ static double *numbers(const lw_params *p, const char *key, const char *text, si
     lw_error_set(err, LW_ENOMEM, "out of memory for %d numbers", count);
     return NULL;
   }
-  lw_number_list(text, 1, v, count);
+  lw_number_list(text, pairs, v, count);
   *n = (size_t)count;
   return v;
 }

@@ -196,7 +196,17 @@ Test(state, strict_numbers)
   cr_assert(lw_number_parse_whole("1e3", 0, 1e15, &n) && n == 1000);
   cr_assert(!lw_number_parse_whole("1.5", 0, 1e15, &n) && !lw_number_parse_whole("1e16", 0, 1e15, &n));
   double list[4];
-  cr_assert_eq(lw_number_list("1, 2\t3 ,4", 1, list, 4), 4);
+  cr_assert_eq(lw_number_list("1, 2, 3 ,4", 1, list, 4), 4);
+  cr_assert_eq(lw_number_list(" 1\t2 3 4 ", 1, list, 4), 4);
   cr_assert_eq(lw_number_list("1 2 3 4 5", 0, list, 2), 5, "tokens past max are counted");
   cr_assert_eq(lw_number_list("1 2x", 0, list, 4), -1);
+  /* separators mixed: decimal commas ("0,5 0,7": 2 numbers, not 4) are
+  ** refused; pairs of coordinates may alternate them (SVG's "x,y x,y") */
+  cr_assert_eq(lw_number_list("0,5 0,7", 1, list, 4), -2);
+  cr_assert_eq(lw_number_list("10,5 20,5 90 10 50 90", 2, list, 4), -2);
+  cr_assert_eq(lw_number_list("10,20 30,40", 2, list, 4), 4);
+  cr_assert_eq(lw_number_list("1, 2\t3 ,4", 2, list, 4), 4);
+  cr_assert_eq(lw_number_list("1 2,3", 2, list, 4), 3);
+  cr_assert_eq(lw_number_list("1 2,3 4", 1, list, 4), -2);
+  cr_assert(strstr(lw_number_list_hint(-2), "0.5 not 0,5") && !*lw_number_list_hint(-1));
 }

@@ -42,7 +42,15 @@ long lw_text_next_line(FILE *f, char **buf, size_t *cap, long *line);
 
 /* Splits s at blanks (and commas when `commas`) into at most max numbers;
 ** returns how many tokens there were (more than max are counted but not
-** stored), or -1 if a token is not a number. */
+** stored), -1 if a token is not a number, or -2 where commas and blanks
+** are mixed between them: "10,5 20,5 90 10" is a list with decimal commas
+** more likely than 6 numbers.  With commas 1 every separator holds a comma
+** or none does; with 2 (lists of x y pairs) they may also alternate, as in
+** "10,20 30,40" or "10 20, 30 40". */
 int lw_number_list(const char *s, int commas, double *out, int max);
+
+/* What to add to a message on a list refused with count (-2: mixed
+** separators), else "". */
+const char *lw_number_list_hint(int count);
 
 #endif
