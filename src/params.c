@@ -545,7 +545,7 @@ const lw_param_def lw_param_table[] = {
          "replaced by plot.speed_down on the first drawing move); e.g. `M3 S90 G4 P0.2` for a servo "
          "that needs 0.2 s to settle. One line of printable ASCII."),
   STRING("layers", "names", ly_names, "", "",
-         "Hatching layers or colour pens: one name a layer (letters, digits, `-`, `_`, `.`; it labels "
+         "Hatching layers or colour pens: one name a layer (ASCII letters, digits, `-`, `_`, `.`; it labels "
          "the pen's SVG layer, so no two alike), separated by blanks or commas (at most 16). Each "
          "layer is a pen of its own (one SVG group) with its own target, field, width and colour; "
          "each spline belongs to one, by its index, the layers getting splines in proportion to "
@@ -1039,8 +1039,8 @@ static char *read_line(char *str, int num, void *stream)
     return NULL;
   }
   if (len >= num) {
-    lw_error_set(rc->err, LW_EINPUT, "%s:%d: line longer than %d characters (the limit of the INI reader)",
-                 rc->p->file, rc->line, num - 2);
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: line longer than %d bytes (the limit of the INI reader; a letter "
+                 "outside ASCII takes two or more)", rc->p->file, rc->line, num - 2);
     rc->failed = 1;
     return NULL;
   }

@@ -315,7 +315,7 @@ Test(params, long_lines_are_refused_with_their_own_line_number)
   char text[1200] = "[scene]\nboundary = polygon\npolygon =";
   for (int i = 0; i < 60; i++) snprintf(text + strlen(text), 20, " %d %d", 10 + i % 50, 10 + (i * 7) % 40);
   strcat(text, "\nwidth = 100\n");
-  expect_error(text, ":3:", NULL, "line longer than 198 characters");
+  expect_error(text, ":3:", NULL, "line longer than 198 bytes");
   /* the longest value accepted is written on a line that reads back */
   lw_params p, q;
   lw_error err;
