@@ -90,10 +90,34 @@ void lw_json_end_object(lw_json *j) { end(j, '{'); }
 void lw_json_begin_array(lw_json *j) { begin(j, '['); }
 void lw_json_end_array(lw_json *j) { end(j, '['); }
 
+/* The length of the well-formed UTF-8 sequence at c (1 to 4), 0 if there is
+** none (a stray continuation byte, one cut short, an overlong form, a
+** surrogate, past U+10FFFF). */
+static int utf8_length(const unsigned char *c)
+{
+  if (*c < 0x80) return 1;
+  int n = *c >= 0xC2 && *c <= 0xDF ? 2 : *c >= 0xE0 && *c <= 0xEF ? 3 : *c >= 0xF0 && *c <= 0xF4 ? 4 : 0;
+  for (int k = 1; k < n; k++)
+    if ((c[k] & 0xC0) != 0x80) return 0;
+  if ((*c == 0xE0 && c[1] < 0xA0) || (*c == 0xED && c[1] > 0x9F) || (*c == 0xF0 && c[1] < 0x90) ||
+      (*c == 0xF4 && c[1] > 0x8F))
+    return 0;
+  return n;
+}
+
 static void put_string(FILE *f, const char *s)
 {
   fputc('"', f);
   for (const unsigned char *c = (const unsigned char *)s; *c; c++) {
+    int n = utf8_length(c);
+    if (n != 1) {
+      /* JSON is UTF-8: a byte of a file name that is not (Latin-1, say) as
+      ** Python's surrogateescape reads it, so os.fsencode gives the name back */
+      if (n) fwrite(c, 1, (size_t)n, f);
+      else fprintf(f, "\\udc%02x", *c);
+      c += n ? n - 1 : 0;
+      continue;
+    }
     switch (*c) {
     case '"': fputs("\\\"", f); break;
     case '\\': fputs("\\\\", f); break;
