@@ -43,6 +43,13 @@ lw_status lw_rundir_make(const char *dir, lw_error *err)
       if (!save) break;
     }
   }
+  /* mkdir says EEXIST for a symbolic link whose target is missing or loops */
+  struct stat st;
+  if (stat(dir, &st)) {
+    const int e = errno, link = !lstat(dir, &st) && S_ISLNK(st.st_mode);
+    return lw_error_set(err, LW_EUSAGE, "%s: cannot create directory: %s%s", dir, strerror(e),
+                        link && e == ENOENT ? " (a symbolic link to a place that does not exist)" : "");
+  }
   return LW_OK;
 }
 

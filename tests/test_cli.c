@@ -486,6 +486,9 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
     {"run %s/s.ini --out ''", "--out: expected a directory"},
     {"run %s/s.ini --out /dev/null", "--out: expected a directory, got '/dev/null' (not a directory)"},
     {"run %s/s.ini --out /etc/passwd", "--out: expected a directory, got '/etc/passwd' (a file)"},
+    /* mkdir's EEXIST on a link to nowhere read as success: exit 1 at the lock */
+    {"run %1$s/s.ini --out %1$s/dangling", "/dangling: cannot create directory: No such file or directory (a "
+     "symbolic link to a place that does not exist)"},
     {"run %s/odd.ini", "odd.ini:3: key 'scene.polygon': expected at least 3 vertices as 'x y' pairs, got 7 numbers "
      "(an odd count: one x or y is missing)"},
     {"run %s/s.ini --stop-at 99999999999999999999", "--stop-at: expected a whole number"},
@@ -511,7 +514,7 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
   };
   char sub[128];
   snprintf(sub, sizeof sub, "%s/sd/state.lw", dir);
-  cr_assert_eq(lw_test_sh("mkdir -p %s", sub), 0);
+  cr_assert_eq(lw_test_sh("mkdir -p %s && ln -s %s/nowhere/x %s/dangling", sub, dir, dir), 0);
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     /* energy and resume get the directory whose state.lw is a directory */
     char where[128];
