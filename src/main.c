@@ -136,8 +136,8 @@ static const char *dash_hint(const char *arg)
 static lw_status dir_fits(const char *what, const char *dir, lw_error *err)
 {
   if (strlen(dir) <= RUN_DIR_MAX) return LW_OK;
-  return lw_error_set(err, LW_EUSAGE, "%s: a path of %zu bytes, longer than the %d a run directory may have",
-                      what, strlen(dir), RUN_DIR_MAX);
+  return lw_error_set(err, LW_EUSAGE, "%s: a path of %zu bytes, longer than the %d a run directory may have (a "
+                      "relative path is shorter)", what, strlen(dir), RUN_DIR_MAX);
 }
 
 /* energy DIR [--set SEC.KEY=VAL]...: the state's energy with its scene, or
@@ -681,6 +681,12 @@ static int cmd_run(int argc, char **argv)
       i++;
     } else if (!strcmp(argv[i], "--out")) {
       struct stat sb;
+      if (v && !strncmp(v, "--", 2)) {
+        /* `--out $DIR --quiet` with DIR empty wrote the run into ./--quiet */
+        lw_error_set(&err, LW_EUSAGE, "--out: expected a directory, got the option '%s' (was the directory left "
+                     "out? one of that name is ./%s)", v, v);
+        return fail(&err);
+      }
       if (!v || !*v || (stat(v, &sb) == 0 && !S_ISDIR(sb.st_mode))) {
         lw_error_set(&err, LW_EUSAGE, "--out: expected a directory, got '%s'%s", v ? v : "",
                      !v || !*v ? "" : S_ISREG(sb.st_mode) ? " (a file)" : " (not a directory)");
@@ -860,6 +866,8 @@ static int cmd_stats(int argc, char **argv)
       i++;
     } else if (argv[i][0] == '-') {
       lw_error_set(&err, LW_EUSAGE, "stats: unexpected '%s' %s%s", argv[i], use, dash_hint(argv[i]));
+      break;
+    } else if (dir_fits("stats", argv[i], &err)) {
       break;
     } else {
       dir[k++] = argv[i];

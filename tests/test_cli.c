@@ -486,6 +486,8 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
     {"run %s/s.ini --out ''", "--out: expected a directory"},
     {"run %s/s.ini --out /dev/null", "--out: expected a directory, got '/dev/null' (not a directory)"},
     {"run %s/s.ini --out /etc/passwd", "--out: expected a directory, got '/etc/passwd' (a file)"},
+    {"run %s/s.ini --out --quiet", "--out: expected a directory, got the option '--quiet' (was the directory left "
+     "out? one of that name is ./--quiet)"},
     /* mkdir's EEXIST on a link to nowhere read as success: exit 1 at the lock */
     {"run %1$s/s.ini --out %1$s/dangling", "/dangling: cannot create directory: No such file or directory (a "
      "symbolic link to a place that does not exist)"},
