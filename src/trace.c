@@ -587,10 +587,17 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
               s->tau * every[0], s->n_eff, flagged(q, 1) ? " *" : "");
     }
   }
+  /* these two have no column in --csv: a script reads them on stderr */
+  FILE *apart = csv ? stderr : out;
+  const char *from = csv ? "linewise: " : "";
+  if (tlo < thi) /* equal: one temperature; inf > -inf: no temperature column (dynamics) */
+    fprintf(apart, "%swarning: the temperature changes within %s: the means mix ensembles\n", from,
+            k > 1 ? "or between the runs" : "these rows");
+  if (k > 1 && identical_runs(t, row, n, k))
+    fprintf(apart, "%swarning: the %d runs are the same, row for row: one seed run twice, or seeds that change "
+            "nothing (a scene that draws no random number, as the dynamics from init.from or the D-NURBS dynamics), "
+            "so they are one run, and R_hat and p_runs say nothing\n", from, k);
   if (!csv) {
-    if (tlo < thi) /* equal: one temperature; inf > -inf: no temperature column (dynamics) */
-      fprintf(out, "warning: the temperature changes within %s: the means mix ensembles\n",
-              k > 1 ? "or between the runs" : "these rows");
     warn(out, t[0], cs, k, WARN_OPEN, "the autocorrelation did not die out within half the rows: tau is a lower "
          "bound and the error bar too small (a longer stretch is needed)");
     warn(out, t[0], cs, k, WARN_ONE, k > 1 ? "a run of one row, which has no error bar of its own: the error bar "
@@ -606,10 +613,6 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
          "stationary (start later with --from), or, where the batch means warn too, the same slow mode (run longer)");
     warn(out, t[0], cs, k, WARN_RUNS, "the runs disagree beyond their error bars (p_runs < 0.001 or R_hat > 1.1): "
          "not converged, or the stretches too short for their error bars");
-    if (k > 1 && identical_runs(t, row, n, k))
-      fprintf(out, "warning: the %d runs are the same, row for row: one seed run twice, or seeds that change "
-              "nothing (a scene that draws no random number, as the dynamics from init.from or the D-NURBS dynamics), "
-              "so they are one run, and R_hat and p_runs say nothing\n", k);
   }
 done:
   for (int r = 0; row && r < k; r++) free(row[r]);

@@ -258,6 +258,10 @@ Test(tools, identical_runs_have_a_standard_deviation_of_zero)
   out = out_txt();
   cr_assert_null(strstr(out, "warning"), "the CSV stays a table: %s", out);
   free(out);
+  /* with no column saying so, the warning goes to stderr (the CSV said R_hat 0.97 alone) */
+  out = err_txt();
+  cr_assert(strstr(out, "linewise: warning: the 2 runs are the same, row for row"), "%s", out);
+  free(out);
 }
 
 /* Ctrl-C to the whole sweep (its process group; INT at its default, as in a
