@@ -489,17 +489,48 @@ static uint32_t tiff32(const unsigned char *p, int be)
   return be ? (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3] : le32(p);
 }
 
-/*
-** The EXIF orientation of a JPEG (1 to 8; 1 when there is none or it cannot
-** be read): a camera stores the sensor's rows and says in IFD0's tag 0x0112
-** how to turn them for display, so a phone's portrait photograph is stored
-** on its side.  The markers before the first scan are walked to an APP1
-** segment "Exif\0\0", whose TIFF header gives the byte order and IFD0;
-** fill bytes 0xFF may stand before any marker, as the decoder allows.
-** Every offset is checked against the segment: a bad one means "none".
-*/
-static int jpeg_orientation(const unsigned char *d, size_t n)
+/* The orientation (1 to 8) in an EXIF block t of tn bytes (a TIFF header,
+** then IFD0 with tag 0x0112); 1 when there is none or it cannot be read.
+** Every offset is checked against the block: a bad one means "none". */
+static int tiff_orientation(const unsigned char *t, size_t tn)
 {
+  if (tn < 8) return 1;
+  int be = t[0] == 'M' && t[1] == 'M';
+  if (!be && !(t[0] == 'I' && t[1] == 'I')) return 1;
+  uint32_t ifd = tiff32(t + 4, be);
+  if (ifd > tn || tn - ifd < 2) return 1;
+  unsigned count = be ? (unsigned)t[ifd] << 8 | t[ifd + 1] : (unsigned)t[ifd] | (unsigned)t[ifd + 1] << 8;
+  for (unsigned e = 0; e < count && (size_t)ifd + 2 + 12 * ((size_t)e + 1) <= tn; e++) {
+    const unsigned char *q = t + ifd + 2 + 12 * e;
+    unsigned tag = be ? (unsigned)q[0] << 8 | q[1] : (unsigned)q[0] | (unsigned)q[1] << 8;
+    if (tag != 0x0112) continue;
+    unsigned v = be ? (unsigned)q[8] << 8 | q[9] : (unsigned)q[8] | (unsigned)q[9] << 8;
+    return v >= 1 && v <= 8 ? (int)v : 1;
+  }
+  return 1;
+}
+
+/*
+** The EXIF orientation of a JPEG or PNG (1 to 8; 1 when there is none or it
+** cannot be read): a camera stores the sensor's rows and says how to turn
+** them for display, so a phone's portrait photograph is stored on its side.
+** A JPEG's markers before the first scan are walked to an APP1 segment
+** "Exif\0\0" (fill bytes 0xFF may stand before any marker, as the decoder
+** allows); a PNG's chunks to its eXIf chunk (a phone's screenshot, a
+** converted photograph), before the image data or after it.
+*/
+static int exif_orientation(const unsigned char *d, size_t n)
+{
+  if (n >= 8 && !memcmp(d, "\x89PNG\r\n\x1a\n", 8)) {
+    for (size_t at = 8; at + 12 <= n;) {
+      size_t len = (size_t)d[at] << 24 | (size_t)d[at + 1] << 16 | (size_t)d[at + 2] << 8 | d[at + 3];
+      if (len > n - at - 12) break;
+      if (!memcmp(d + at + 4, "eXIf", 4)) return tiff_orientation(d + at + 8, len);
+      if (!memcmp(d + at + 4, "IEND", 4)) break;
+      at += 12 + len;
+    }
+    return 1;
+  }
   size_t at = 0;
   while (at < n && d[at] == 0xFF) at++;
   if (at == 0 || at >= n || d[at] != 0xD8) return 1;
@@ -512,23 +543,7 @@ static int jpeg_orientation(const unsigned char *d, size_t n)
     if (marker == 0xDA || marker == 0xD9 || len < 2 || at + 1 + len > n) break;
     const unsigned char *seg = d + at + 3;
     size_t sn = len - 2;
-    if (marker == 0xE1 && sn >= 14 && !memcmp(seg, "Exif\0\0", 6)) {
-      const unsigned char *t = seg + 6;
-      size_t tn = sn - 6;
-      int be = t[0] == 'M' && t[1] == 'M';
-      if (!be && !(t[0] == 'I' && t[1] == 'I')) return 1;
-      uint32_t ifd = tiff32(t + 4, be);
-      if (ifd > tn || tn - ifd < 2) return 1;
-      unsigned count = be ? (unsigned)t[ifd] << 8 | t[ifd + 1] : (unsigned)t[ifd] | (unsigned)t[ifd + 1] << 8;
-      for (unsigned e = 0; e < count && (size_t)ifd + 2 + 12 * ((size_t)e + 1) <= tn; e++) {
-        const unsigned char *q = t + ifd + 2 + 12 * e;
-        unsigned tag = be ? (unsigned)q[0] << 8 | q[1] : (unsigned)q[0] | (unsigned)q[1] << 8;
-        if (tag != 0x0112) continue;
-        unsigned v = be ? (unsigned)q[8] << 8 | q[9] : (unsigned)q[8] | (unsigned)q[9] << 8;
-        return v >= 1 && v <= 8 ? (int)v : 1;
-      }
-      return 1;
-    }
+    if (marker == 0xE1 && sn >= 14 && !memcmp(seg, "Exif\0\0", 6)) return tiff_orientation(seg + 6, sn - 6);
     at += 1 + len;
   }
   return 1;
@@ -576,31 +591,65 @@ static const char *format_name(const unsigned char *d, size_t n)
   return "image";
 }
 
-/* Why the decoder refuses a PNG's header as too large, or NULL: more than
-** 2^30 bytes of pixels (width x height x channels, a palette's counted as
-** 4), or a side past 2^24 pixels, both before linewise's own 1e9 pixels;
-** the formats it tries after PNG then leave "unknown type" as the reason,
-** and a 20000 x 20000 RGB picture was called corrupt. */
-static const char *png_too_large(const unsigned char *d, size_t n)
+/* A picture format linewise does not read, from its first bytes, with its
+** article ("a WebP"), or NULL: an iPhone's HEIC, a WebP from the web, a scanner's TIFF
+** were "not of any known type, or corrupt", which sent people looking for
+** a broken file. */
+static const char *foreign_format(const unsigned char *d, size_t n)
 {
-  if (n < 26 || strcmp(format_name(d, n), "PNG") || memcmp(d + 12, "IHDR", 4)) return NULL;
-  double w = (double)((uint32_t)d[16] << 24 | (uint32_t)d[17] << 16 | (uint32_t)d[18] << 8 | d[19]);
-  double h = (double)((uint32_t)d[20] << 24 | (uint32_t)d[21] << 16 | (uint32_t)d[22] << 8 | d[23]);
-  static const int channels[7] = {1, 0, 3, 4, 2, 0, 4}; /* by colour type: grey, -, RGB, palette, grey+alpha, -, RGBA */
-  int ch = d[25] < 7 ? channels[d[25]] : 0;
+  if (n >= 12 && !memcmp(d, "RIFF", 4) && !memcmp(d + 8, "WEBP", 4)) return "a WebP";
+  if (n >= 4 && (!memcmp(d, "II*\0", 4) || !memcmp(d, "MM\0*", 4))) return "a TIFF";
+  if (n >= 12 && !memcmp(d + 4, "ftyp", 4)) {
+    if (!memcmp(d + 8, "avif", 4) || !memcmp(d + 8, "avis", 4)) return "an AVIF";
+    if (!memcmp(d + 8, "hei", 3) || !memcmp(d + 8, "hev", 3) || !memcmp(d + 8, "mif1", 4) || !memcmp(d + 8, "msf1", 4))
+      return "a HEIC";
+    if (!memcmp(d + 8, "jp2 ", 4)) return "a JPEG 2000";
+  }
+  if (n >= 12 && !memcmp(d, "\0\0\0\x0cjP  ", 8)) return "a JPEG 2000";
+  if (n >= 2 && d[0] == 0xFF && d[1] == 0x0A) return "a JPEG XL";
+  if (n >= 4 && !memcmp(d, "8BPS", 4)) return "a Photoshop";
+  if (n >= 5 && !memcmp(d, "%PDF-", 5)) return "a PDF";
+  if (n >= 5 && (!memcmp(d, "<svg", 4) || !memcmp(d, "<?xml", 5))) return "an SVG";
+  return NULL;
+}
+
+/* Why the decoder refuses a picture as too large, or NULL: more than 2^30
+** bytes of pixels (width x height x channels, a palette's counted as 4),
+** or a side past 2^24 pixels, both before linewise's own 1e9 pixels.  A
+** PNG's header is read here, as the formats the decoder tries after PNG
+** leave "unknown type" as the reason (a 20000 x 20000 RGB picture was
+** called corrupt); other formats give w, h and ch from stbi_info, and are
+** held to the same bound (a JPEG past it was "damaged or cut short", one
+** under it decoded with 1.8 GB). */
+static const char *too_large(const unsigned char *d, size_t n, double w, double h, int ch)
+{
+  if (n >= 26 && !strcmp(format_name(d, n), "PNG") && !memcmp(d + 12, "IHDR", 4)) {
+    w = (double)((uint32_t)d[16] << 24 | (uint32_t)d[17] << 16 | (uint32_t)d[18] << 8 | d[19]);
+    h = (double)((uint32_t)d[20] << 24 | (uint32_t)d[21] << 16 | (uint32_t)d[22] << 8 | d[23]);
+    static const int channels[7] = {1, 0, 3, 4, 2, 0, 4}; /* by colour type: grey, -, RGB, palette, grey+alpha, -, RGBA */
+    ch = d[25] < 7 ? channels[d[25]] : 0;
+  }
   if (w > 16777216.0 || h > 16777216.0) return "a side is more than 2^24 pixels";
   if (ch && w * h * ch > 1073741824.0)
     return "its width x height x channels is more than 2^30 (1.07e9 grey, 358 million RGB or 268 million RGBA pixels)";
   return NULL;
 }
 
-/* Why stb_image refused what it was given: too large (png_too_large), or
-** not an image it reads. */
+static lw_status too_large_error(const unsigned char *d, size_t n, const char *name, const char *why, lw_error *err)
+{
+  return lw_error_set(err, LW_EINPUT, "%s: the %s is too large to decode: %s; scale it down first", name,
+                      format_name(d, n), why);
+}
+
+/* Why stb_image refused what it was given: too large, a format it does not
+** read, or not an image. */
 static lw_status not_decoded(const unsigned char *data, size_t size, const char *name, lw_error *err)
 {
-  const char *why = png_too_large(data, size);
-  if (why)
-    return lw_error_set(err, LW_EINPUT, "%s: the PNG is too large to decode: %s; scale it down first", name, why);
+  const char *why = too_large(data, size, 0, 0, 0), *foreign = foreign_format(data, size);
+  if (why) return too_large_error(data, size, name, why, err);
+  if (foreign)
+    return lw_error_set(err, LW_EINPUT, "%s: %s file, which linewise does not read (PNG, JPEG, GIF, BMP, binary "
+                        "PGM/PPM): convert it to PNG or JPEG first", name, foreign);
   return lw_error_set(err, LW_EINPUT, "%s: not an image linewise reads (PNG, JPEG, GIF, BMP, binary PGM/PPM): %s",
                       name, size == 0 ? "empty file" : stbi_failure_reason());
 }
@@ -627,6 +676,8 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
   if (!stbi_info_from_memory(data, (int)size, &w, &h, &ch)) return not_decoded(data, size, name, err);
   if (w < 1 || h < 1) /* stb_image passes a BMP of width 0 */
     return lw_error_set(err, LW_EINPUT, "%s: the %s is damaged: %d x %d pixels", name, format_name(data, size), w, h);
+  const char *big = too_large(data, size, w, h, ch);
+  if (big) return too_large_error(data, size, name, big, err);
   if ((double)w * (double)h > LW_IMAGE_MAX_PIXELS)
     return lw_error_set(err, LW_EINPUT, "%s: %d x %d pixels is more than the %.0e pixels linewise decodes", name,
                         w, h, (double)LW_IMAGE_MAX_PIXELS);
@@ -645,7 +696,7 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
                         why && why != before ? ")" : "");
   }
   *out = (decoded){pix, pix, 1, w, h, ch, bits};
-  int o = jpeg_orientation(data, size);
+  int o = exif_orientation(data, size);
   if (o != 1 && (st = decoded_orient(out, o, name, err)) != LW_OK) decoded_free(out);
   return st;
 }
@@ -783,8 +834,8 @@ lw_status lw_image_probe(const char *path, lw_image_info *info, lw_error *err)
       st = not_decoded(data, size, path, err);
     else if (iw < 1 || ih < 1)
       st = lw_error_set(err, LW_EINPUT, "%s: the %s is damaged: %d x %d pixels", path, format_name(data, size), iw, ih);
-    else if (jpeg_orientation(data, size) >= 5) /* stored on its side */
-      *info = (lw_image_info){ih, iw, ch, 8};
+    else if (exif_orientation(data, size) >= 5) /* stored on its side */
+      *info = (lw_image_info){ih, iw, ch, stbi_is_16_bit_from_memory(data, (int)size) ? 16 : 8};
     else
       *info = (lw_image_info){iw, ih, ch, stbi_is_16_bit_from_memory(data, (int)size) ? 16 : 8};
   }

@@ -840,3 +840,85 @@ Test(image, jpeg_exif_orientation_is_turned_upright)
   cr_assert_eq(lw_image_probe(path, &info, &err), LW_OK, "%s", err.msg);
   cr_assert(info.width == 16 && info.height == 32, "probe: %d x %d", info.width, info.height);
 }
+
+/* The 32 x 16 picture of exif_jpeg as a PNG, with an eXIf chunk of
+** orientation o (0: none) after its header. */
+static size_t exif_png(unsigned char *out, int o)
+{
+  unsigned char px[32 * 16];
+  for (int y = 0; y < 16; y++)
+    for (int x = 0; x < 32; x++) px[y * 32 + x] = x < 8 && y < 8 ? 20 : 230;
+  jpeg_buf j = {.n = 0};
+  cr_assert(stbi_write_png_to_func(jpeg_put, &j, 32, 16, 1, px, 32));
+  static const unsigned char chunk[34] = {0, 0, 0, 22, 'e', 'X', 'I', 'f', 'M', 'M', 0, 42, 0, 0, 0, 8, 0, 1,
+                                          0x01, 0x12, 0, 3, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0};
+  size_t head = 8 + 25, n = 0; /* the signature and IHDR */
+  memcpy(out, j.b, head);
+  n = head;
+  if (o) {
+    memcpy(out + n, chunk, sizeof chunk); /* the decoder reads no CRC of an ancillary chunk: 0 */
+    out[n + 27] = (unsigned char)o;
+    n += sizeof chunk;
+  }
+  memcpy(out + n, j.b + head, j.n - head);
+  return n + j.n - head;
+}
+
+/* A PNG's eXIf chunk turns it as a JPEG's EXIF does (a phone's portrait
+** PNG was drawn on its side); the probe of orientation = auto agrees. */
+Test(image, png_exif_orientation_is_turned_upright)
+{
+  static const int corner[9] = {0, 0, 1, 2, 3, 0, 1, 2, 3};
+  unsigned char png[8400];
+  lw_error err;
+  for (int o = 0; o <= 8; o++) {
+    size_t n = exif_png(png, o);
+    lw_image_info info;
+    lw_image *img = lw_image_decode(png, n, "t.png", 1e6, &info, &err);
+    cr_assert_not_null(img, "orientation %d: %s", o, err.msg);
+    cr_assert(img->width == (o >= 5 ? 16 : 32) && dark_corner(img) == corner[o], "orientation %d: %d x %d, corner %d",
+              o, img->width, img->height, dark_corner(img));
+    lw_image_free(img);
+  }
+  const char *path = lw_test_path("side.png");
+  FILE *f = fopen(path, "wb");
+  cr_assert_not_null(f);
+  size_t n = exif_png(png, 8);
+  cr_assert_eq(fwrite(png, 1, n, f), n);
+  fclose(f);
+  lw_image_info info;
+  cr_assert_eq(lw_image_probe(path, &info, &err), LW_OK, "%s", err.msg);
+  cr_assert(info.width == 16 && info.height == 32, "probe: %d x %d", info.width, info.height);
+}
+
+/* Formats linewise does not read are named, with the way round: an
+** iPhone's HEIC, a WebP, a TIFF were "not of any known type, or corrupt".
+** A JPEG past the decoder's 2^30 bytes of pixels (its header says 20000 x
+** 20000 RGB) is refused as too large before decoding, as a PNG is: it
+** decoded with 1.8 GB, and at 30000 x 30000 was "damaged or cut short". */
+Test(image, foreign_formats_are_named_and_a_huge_jpeg_is_too_large)
+{
+  static const struct { const char *head; size_t n; const char *name; } f[] = {
+    {"\0\0\0\x18" "ftypheic\0\0\0\0mif1heic", 24, "a HEIC file"},
+    {"RIFF\x10\0\0\0WEBPVP8 ", 16, "a WebP file"},
+    {"II*\0\x08\0\0\0\0\0\0\0", 12, "a TIFF file"},
+    {"\0\0\0\x1c" "ftypavif\0\0\0\0avifmif1", 24, "an AVIF file"},
+  };
+  lw_error err;
+  for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
+    unsigned char buf[64] = {0};
+    memcpy(buf, f[i].head, f[i].n);
+    cr_assert_null(lw_image_decode(buf, sizeof buf, "x", 1e6, NULL, &err));
+    cr_assert(strstr(err.msg, f[i].name) && strstr(err.msg, "convert it to PNG or JPEG first"), "%s", err.msg);
+  }
+  unsigned char jpg[8400];
+  size_t n = exif_jpeg(jpg, 0, 0, 0);
+  size_t at = 2;
+  while (at + 4 < n && !(jpg[at] == 0xFF && jpg[at + 1] == 0xC0)) at += 2 + ((size_t)jpg[at + 2] << 8 | jpg[at + 3]);
+  cr_assert(at + 9 < n, "no SOF0");
+  jpg[at + 5] = 20000 >> 8, jpg[at + 6] = 20000 & 255, jpg[at + 7] = 20000 >> 8, jpg[at + 8] = 20000 & 255;
+  jpg[at + 9] = 3; /* 3 components: RGB */
+  cr_assert_null(lw_image_decode(jpg, n, "big.jpg", 1e6, NULL, &err));
+  cr_assert(strstr(err.msg, "big.jpg: the JPEG is too large to decode: its width x height x channels is more than "
+                   "2^30"), "%s", err.msg);
+}

@@ -15,7 +15,18 @@ if [ ! -d "$dir/frames" ] || [ -z "$(ls "$dir/frames" 2>/dev/null | grep '^frame
   exit 2
 fi
 command -v ffmpeg >/dev/null 2>&1 || { echo "${0##*/}: ffmpeg not found (make deps-animation)" >&2; exit 2; }
-# the frames are numbered by sweep, not consecutively: a glob, in order
-ffmpeg -loglevel error -y -framerate "$fps" -pattern_type glob -i "$dir/frames/frame-*.png" \
-  -vf "pad=ceil(iw/2)*2:ceil(ih/2)*2:color=white" -c:v libx264 -pix_fmt yuv420p "$dir/animation.mp4"
+# The frames are numbered by sweep, not consecutively.  ffmpeg's glob would
+# read RUN_DIR itself as a pattern ("run[1]" took run1's frames), so they
+# are linked as 1, 2, 3, ... in a directory of our own, in sweep order.
+abs=$(cd "$dir" && pwd -P)
+tmp=$(mktemp -d) || exit 1
+trap 'rm -rf "$tmp"' EXIT
+n=0
+for f in $(ls "$abs/frames" | grep '^frame-[0-9]*\.png$' | sort -t- -k2n); do
+  n=$((n + 1))
+  ln -s "$abs/frames/$f" "$tmp/$(printf %08d "$n").png"
+done
+# file: keeps a directory such as "a:b" or "-x" from reading as a protocol or an option
+(cd "$tmp" && ffmpeg -loglevel error -y -framerate "$fps" -i %08d.png \
+  -vf "pad=ceil(iw/2)*2:ceil(ih/2)*2:color=white" -c:v libx264 -pix_fmt yuv420p "file:$abs/animation.mp4")
 echo "$dir/animation.mp4"
