@@ -532,6 +532,32 @@ Test(image_cli, a_picture_dark_nearly_all_over_gets_a_note)
   }
 }
 
+/* A panorama keeps its shape inside the frame: 400 x 3 pixels in a 40 x 30
+** mm frame lies as a strip 40 x 0.3 mm, where no curve of 10 mm segments
+** fits, and is said before the run (one drew nothing, blamed on a pale
+** picture); the frame's own shape, or a picture only for its field, not. */
+Test(image_cli, a_picture_placed_as_a_thin_strip_gets_a_note)
+{
+  float g[400 * 3];
+  for (int k = 0; k < 400 * 3; k++) g[k] = 0.5f;
+  lw_test_png(lw_test_path("strip.png"), 400, 3, g, NULL);
+  write_tone_picture("frame.png", dark_tone);
+  static const struct { const char *picture, *keys; int noted; } cases[] = {
+    {"strip.png", "[energy]\ntone = 1\n", 1},
+    {"strip.png", "[init]\nsegment_length = 0.1\n[energy]\ntone = 1\n", 0},
+    {"strip.png", "", 0},
+    {"frame.png", "[energy]\ntone = 1\n", 0},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    lw_scene sc;
+    picture_scene(cases[k].picture, cases[k].keys, &sc);
+    const char *at = strstr(sc.note, "scene.image: the 400 x 3 picture keeps its shape, so it lies on the page as 40 "
+                            "x 0.3 mm, narrower than two segments");
+    cr_assert_eq(at != NULL, cases[k].noted, "%s %s: %s", cases[k].picture, cases[k].keys, sc.note);
+    lw_scene_clear(&sc);
+  }
+}
+
 /* scene.image_flatten reaches the picture in millimetres on the page: a
 ** page lit from 0.3 to 0.9 across 40 px (1 mm a pixel) with a dark bar
 ** turns to paper within 0.1 of white (the rise of the light over the
