@@ -17,8 +17,9 @@ OMP     := -fopenmp
 # header's change rebuilds only what includes it.
 DEPFLAGS := -MMD -MP
 
+# locales: the locale test builds a decimal-comma locale with localedef
 DEBS    := build-essential pkg-config libgsl-dev libcairo2-dev libinih-dev libstb-dev \
-           libcriterion-dev gnuplot-nox clang libclang-rt-dev
+           libcriterion-dev gnuplot-nox clang libclang-rt-dev locales
 
 LIB_SRC := $(filter-out src/main.c,$(wildcard src/*.c))
 # The MPI build (make mpi): main.c with -DLW_MPI and src/mpi/, through

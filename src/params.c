@@ -1118,6 +1118,7 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
 {
   lw_params_defaults(p);
   p->of_run = of_run;
+  if (lw_number_locale_ok(err)) return err->code;
   /* a path cut to fit would name another file in every message */
   if (strlen(path) >= sizeof p->file)
     return lw_error_set(err, LW_EINPUT, "%.80s...: the scene file's path is %zu bytes; expected at most %zu",

@@ -1,5 +1,6 @@
 /* test_params.c -- the parameter table, INI reading, overrides and errors. */
 #include <criterion/criterion.h>
+#include <locale.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,6 +11,7 @@
 #include "linewise/scene.h"
 #include "linewise/schedule.h"
 #include "linewise/system.h"
+#include "linewise/trace.h"
 #include "testutil.h"
 
 /* Writes text to a fresh temporary file; returns its path (static buffer). */
@@ -572,4 +574,32 @@ Test(params, the_help_names_every_system_and_schedule)
   for (int k = 0; lw_schedule_types[k]; k++)
     cr_assert(strstr(sched_help, lw_schedule_types[k]->name), "anneal.schedule's help does not name %s",
               lw_schedule_types[k]->name);
+}
+
+/* A program calling into the library after setlocale(LC_ALL, "") (a GUI
+** toolkit does) under a decimal-comma locale refused "0.02" in a correct
+** scene, collapsed the built-in defaults and would have written "0,5":
+** reading a scene or a trace is refused there, naming LC_NUMERIC and the
+** way round.  The locale is built for the test (localedef, the locales
+** package of make deps), as a CI machine has none but C. */
+Test(params, a_decimal_comma_locale_is_refused_with_the_way_round)
+{
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "locale"), 0);
+  cr_assert_eq(lw_test_sh("localedef -i de_DE -f UTF-8 %s/de_DE.UTF-8 2>/dev/null; test -d %s/de_DE.UTF-8", dir,
+                          dir), 0, "localedef (make deps installs locales)");
+  setenv("LOCPATH", dir, 1);
+  cr_assert_not_null(setlocale(LC_NUMERIC, "de_DE.UTF-8"));
+  lw_params p;
+  lw_error err;
+  cr_assert_eq(read_text("[energy]\npair = 0.02\n", &p, &err), LW_EUSAGE);
+  cr_assert(strstr(err.msg, "the locale's numbers (LC_NUMERIC 'de_DE.UTF-8') take ',' as the decimal point") &&
+                strstr(err.msg, "setlocale(LC_NUMERIC, \"C\")"), "%s", err.msg);
+  cr_assert_null(lw_trace_read("/nonexistent/trace.csv", &err));
+  cr_assert(strstr(err.msg, "LC_NUMERIC"), "%s", err.msg);
+  /* and in the C locale the same scene reads */
+  setlocale(LC_NUMERIC, "C");
+  cr_assert_eq(read_text("[energy]\npair = 0.02\n", &p, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(p.pair, 0.02);
+  lw_test_dir_remove(dir);
 }

@@ -16,6 +16,15 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include "linewise/error.h"
+
+/* LW_EUSAGE unless the C library's numbers use '.' as the decimal point:
+** every file linewise reads or writes does, and printf and strtod follow
+** LC_NUMERIC, so a program that calls setlocale(LC_ALL, "") (a GUI
+** toolkit does) would refuse "0.5" and write "0,5".  Checked where a scene,
+** a run or a trace is read. */
+lw_status lw_number_locale_ok(lw_error *err);
+
 /* The first len characters of s as a finite double; 1 on success. */
 int lw_number_parse_n(const char *s, size_t len, double *out);
 
