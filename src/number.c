@@ -3,8 +3,8 @@
 **
 ** The syntax is checked by hand before strtod sees the text: strtod alone
 ** takes hex, "inf", "nan", leading blanks and stops silently at trailing
-** garbage, and under a C locale other than "C" it could read ',' as the
-** decimal point.  Within the checked syntax strtod does the rounding.
+** garbage.  Within the checked syntax strtod does the rounding; it follows
+** LC_NUMERIC, which lw_number_locale_ok holds to a '.' point.
 */
 #include "linewise/number.h"
 
