@@ -775,8 +775,9 @@ static int section_known(const char *section)
   return 0;
 }
 
-/* Edit distance (insertions, deletions, substitutions) of two names; names
-** longer than any parameter's are far from everything. */
+/* Edit distance (insertions, deletions, substitutions) of two names, case
+** aside (WIDTH had no suggestion, Width had); names longer than any
+** parameter's are far from everything. */
 static int edit_distance(const char *a, const char *b)
 {
   size_t la = strlen(a), lb = strlen(b);
@@ -787,7 +788,7 @@ static int edit_distance(const char *a, const char *b)
     int diag = row[0];
     row[0] = (int)i;
     for (size_t j = 1; j <= lb; j++) {
-      int up = row[j], best = diag + (a[i - 1] != b[j - 1]);
+      int up = row[j], best = diag + (tolower((unsigned char)a[i - 1]) != tolower((unsigned char)b[j - 1]));
       if (up + 1 < best) best = up + 1;
       if (row[j - 1] + 1 < best) best = row[j - 1] + 1;
       row[j] = best;

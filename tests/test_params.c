@@ -102,6 +102,7 @@ Test(params, bad_input_names_file_line_and_key)
   expect_error("[scene]\nwidht = 3\n", ":2:", "scene.widht", "did you mean 'scene.width'?");
   expect_error("[anneal]\nquadrature = 6\n", ":2:", "anneal.quadrature", "did you mean 'energy.quadrature'?");
   expect_error("[energy]\npair_cuttoff = 2\n", ":2:", NULL, "did you mean 'energy.pair_cutoff'?");
+  expect_error("[scene]\nWIDTH = 3\n", ":2:", "scene.WIDTH", "did you mean 'scene.width'?"); /* case aside */
   expect_error("[scen]\nwidth = 100\n", ":1:", "[scen]", "unknown section [scen]; did you mean [scene]?");
   expect_error("; a scene\nwidth = 100\n[scene]\n", ":2:", "'width'", "before any [section]; did you mean 'scene.width'?");
   for (int k = 0; k < 2; k++) {
