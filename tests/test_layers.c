@@ -956,7 +956,7 @@ Test(layers, bad_layer_keys_give_one_line_with_file_line_and_key_and_exit_2)
     /* (a count of colours for the one pen was asked first, and then refused) */
     {"[layers]\nnames = a b\n[output]\npen_colors = #f00 #0f0\n",
      "scene.ini:11: key 'output.pen_colors': layers set the pens' colours: use layers.colors"},
-    {"[layers]\nnames = a <b>\n", "scene.ini:9: key 'layers.names': expected names of letters"},
+    {"[layers]\nnames = a <b>\n", "scene.ini:9: key 'layers.names': expected names of ASCII letters"},
     {"[layers]\nnames = a b a\n", "scene.ini:9: key 'layers.names': expected names that differ, got 'a' twice"},
     {"[layers]\nnames = ,\n", "scene.ini:9: key 'layers.names': expected at least one name"},
   };
