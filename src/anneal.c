@@ -1179,8 +1179,7 @@ static lw_status exchange(lw_anneal *a, lw_error *err)
   lw_status s;
   if (a->net && (s = a->net->moved(a->net, a, swapped, err))) return s;
   if (p->tune_ladder == LW_LADDER_EQUAL && a->sweep <= p->ladder_sweeps) {
-    /* every pair has had ~20 attempts by then */
-    if (pt->steps % 40 == 0) {
+    if (pt->steps % LW_TEMPERING_TUNE_EVERY == 0) {
       lw_tempering_tune(pt);
       set_temperatures(a);
     }

@@ -65,6 +65,10 @@ int lw_tempering_exchange(lw_tempering *pt, const double *energy, const double *
 ** detailed balance. */
 void lw_tempering_tune(lw_tempering *pt);
 
+/* Exchange steps between two calls of lw_tempering_tune (about 20 attempts
+** a pair, even and odd pairs alternating); its gain counts updates by it. */
+#define LW_TEMPERING_TUNE_EVERY 40
+
 /* Clears the swap statistics and round trips (after the warm-up). */
 void lw_tempering_reset_stats(lw_tempering *pt);
 
