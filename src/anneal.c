@@ -64,18 +64,33 @@ void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n)
   buf[0] = '\0';
   const lw_chain *c = a->chain;
   if (a->dyn || !c || !a->sched_type || strcmp(a->sched_type->name, "constant")) return;
-  size_t m = 0;
+  /* A move never refused either has a step far too small or does not
+  ** change the energy (translations of a lone spline with no term that sees
+  ** where it lies, whose tuning grew the step to 135 mm and asked for more
+  ** tuning): said apart, with both ways out. */
+  size_t m = 0, flat = 0;
+  char same[256] = "";
   for (int k = 0; k < c->n_moves && m + 1 < n; k++) {
     const lw_move_stats *st = &c->stats[k];
     if (!(c->step_max[k] > 0.0) || st->proposed < 100) continue;
     const double acc = (double)st->accepted / (double)st->proposed;
-    if (acc < 0.25 * c->target[k] || (acc > 1.0 - 0.25 * (1.0 - c->target[k]) && c->step[k] < 0.5 * c->step_max[k]))
+    if (st->accepted == st->proposed) {
+      if (flat + 1 < sizeof same)
+        flat += (size_t)snprintf(same + flat, sizeof same - flat, "%s%s", flat ? ", " : "", a->sys_type->move_names[k]);
+    } else if (acc < 0.25 * c->target[k] ||
+               (acc > 1.0 - 0.25 * (1.0 - c->target[k]) && c->step[k] < 0.5 * c->step_max[k])) {
       m += (size_t)snprintf(buf + m, n - m, "%s%s moves were accepted %.1f %% of the time against the target %.0f %%",
                             m ? ", " : "", a->sys_type->move_names[k], 100.0 * acc, 100.0 * c->target[k]);
+    }
   }
   if (m && m + 1 < n)
-    snprintf(buf + m, n - m, ": moves.tune_sweeps = %d sweeps was too short to tune their step for this system "
-             "(raise it)", a->params.tune_sweeps);
+    m += (size_t)snprintf(buf + m, n - m, ": moves.tune_sweeps = %d sweeps was too short to tune their step for this "
+                          "system (raise it)", a->params.tune_sweeps);
+  if (flat && m + 1 < n)
+    snprintf(buf + m, n - m, "%s%s moves were accepted every time: their step is far too small for this system "
+             "(moves.tune_sweeps = %d sweeps did not grow it enough), or the energy does not change under them (no "
+             "term sees them: a weight of 0 for them in [moves] leaves them out)", m ? "; " : "", same,
+             a->params.tune_sweeps);
 }
 
 /* Temperature step of sweep s: the sweeps are shared out evenly; past the

@@ -348,9 +348,18 @@ Test(nurbs_cli, a_constant_temperature_run_too_short_to_tune_says_so)
                   "moves.tune_sweeps = 10 sweeps was too short' %s/err.txt", dir), 0);
   cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "t2", "--set moves.tune_sweeps=200", dir), 0);
   cr_assert_neq(sh("grep -q 'too short to tune' %s/err.txt", dir), 0);
-  /* steps far too small, never tuned: every move accepted, said too */
+  /* steps far too small, never tuned: every move accepted, said too, as is
+  ** the other cause of it */
   cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "t3",
                   "--set moves.tune_sweeps=0 --set moves.step_point=1e-7", dir), 0);
-  cr_assert_eq(sh("grep -q 'note: point moves were accepted 100.0 %% of the time against the target 44 %%' %s/err.txt",
-                  dir), 0);
+  cr_assert_eq(sh("grep -q 'note: point moves were accepted every time: their step is far too small for this system "
+                  "(moves.tune_sweeps = 0 sweeps did not grow it enough)' %s/err.txt", dir), 0);
+  /* a move the energy does not see (a lone spline's translations and
+  ** rotations without a frame): said as such, not "raise tune_sweeps" */
+  cr_assert_eq(sh("printf '[scene]\\nwidth = 1000\\nheight = 1000\\n[init]\\nsplines = 1\\nsegments = 1\\n"
+                  "segment_length = 10\\n[energy]\\nstrain = 100\\nbending = 100\\n[moves]\\ntune_sweeps = 500\\n"
+                  "[anneal]\\nschedule = constant\\nt_start = 0.01\\nsweeps = 2000\\n' > %s/lone.ini && "
+                  "%s run %s/lone.ini --out %s/t4 2> %s/err.txt", dir, lw_test_bin(), dir, dir, dir), 0);
+  cr_assert_eq(sh("grep -q 'note: translate, rotate moves were accepted every time: .*, or the energy does not "
+                  "change under them' %s/err.txt && ! grep -q 'too short to tune' %s/err.txt", dir, dir), 0);
 }
