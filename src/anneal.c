@@ -329,7 +329,7 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
   if (p->driver == LW_DRIVER_DYNAMICS) a->n_rep = 1;
   else if (p->ladder[0]) {
     lw_params_origin(p, lw_params_find("tempering", "ladder"), where, sizeof where);
-    int n = lw_number_list(p->ladder, 1, ladder, LW_TEMPERING_MAX);
+    int n = lw_number_list(p->ladder, p->of_run ? 1 : 2, ladder, LW_TEMPERING_MAX);
     if (n < 2 || n > LW_TEMPERING_MAX)
       return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%s'%s",
                           where, LW_TEMPERING_MAX, p->ladder, lw_number_list_hint(n));

@@ -41,7 +41,7 @@ static lw_status per_layer(const lw_params *p, const char *key, const char *text
 {
   if (!text[0]) return LW_OK;
   double got[LW_LAYERS_MAX];
-  int count = lw_number_list(text, 1, got, LW_LAYERS_MAX);
+  int count = lw_number_list(text, p->of_run ? 1 : 2, got, LW_LAYERS_MAX);
   if (count < 0)
     return bad(p, key, err, "expected %d numbers (one a layer), got '%s'%s", n, text, lw_number_list_hint(count));
   if (count != n)

@@ -68,15 +68,14 @@ int lw_number_parse_whole(const char *s, double lo, double hi, long long *out)
 int lw_number_list(const char *s, int commas, double *out, int max)
 {
   const char *sep = commas ? " \t," : " \t";
-  /* the kind of each separator (1: holds a comma) by its place's parity */
-  int kind[2] = {-1, -1}, same = 1, alternate = 1, n = 0;
+  /* a comma with no blank beside it between two numbers ("0,5"), and a
+  ** separator of blanks alone, both in one list */
+  int tight = 0, blank = 0, n = 0;
   for (;;) {
     size_t gap = strspn(s, sep);
     if (n > 0 && gap && s[gap]) {
-      int k = memchr(s, ',', gap) != NULL, *seen = &kind[(n - 1) % 2], *other = &kind[n % 2];
-      if (*seen >= 0 && *seen != k) alternate = 0;
-      if ((*seen >= 0 && *seen != k) || (*other >= 0 && *other != k)) same = 0;
-      *seen = k;
+      if (!memchr(s, ',', gap)) blank = 1;
+      else if (gap == 1) tight = 1;
     }
     s += gap;
     if (!*s) break;
@@ -87,13 +86,13 @@ int lw_number_list(const char *s, int commas, double *out, int max)
     n++;
     s += len;
   }
-  return same || (commas == 2 && alternate) ? n : -2;
+  return commas == 2 && tight && blank ? -2 : n;
 }
 
 const char *lw_number_list_hint(int count)
 {
-  return count == -2 ? " (commas and blanks mixed between its numbers: a decimal comma? numbers take a point, 0.5 "
-                       "not 0,5)" : "";
+  return count == -2 ? " (a comma between digits, and blanks between numbers: decimal commas? numbers take a point, "
+                       "0.5 not 0,5; a list takes blanks, commas or ', ' between its numbers)" : "";
 }
 
 void lw_text_drop_bom(char *s)

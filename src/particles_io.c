@@ -78,7 +78,7 @@ static lw_status read_text(FILE *f, const char *path, points *pt, lw_error *err)
     /* CloudCompare's ASCII export heads its columns with "//X,Y,Z,..." */
     if (!strncmp(buf + strspn(buf, " \t"), "//", 2)) continue;
     double v[6];
-    int k = lw_number_list(buf, 1, v, 6);
+    int k = lw_number_list(buf, 2, v, 6);
     if (k == 0) continue;
     if (empty_field(buf)) {
       s = lw_error_set(err, LW_EINPUT, "%s:%ld: expected a number in every field, got an empty one in '%.80s'", path,

@@ -281,14 +281,14 @@ static lw_status build_mask(lw_scene *sc, const lw_params *p, lw_error *err)
 
 static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
 {
-  int count = lw_number_list(p->polygon, 2, NULL, 0);
+  int count = lw_number_list(p->polygon, p->of_run ? 1 : 2, NULL, 0);
   if (count < 0)
     return bad_key(p, "scene", "polygon", LW_EINPUT, err, "expected numbers 'x y x y ...', got '%s'%s", p->polygon,
                    lw_number_list_hint(count));
   size_t n = (size_t)count;
   double *v = malloc((n ? n : 1) * sizeof *v);
   if (!v) return lw_error_set(err, LW_ENOMEM, "out of memory reading the polygon");
-  lw_number_list(p->polygon, 2, v, count);
+  lw_number_list(p->polygon, 1, v, count);
   lw_status st = LW_OK;
   if (n % 2 || n < 6) {
     st = bad_key(p, "scene", "polygon", LW_EINPUT, err,

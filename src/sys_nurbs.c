@@ -48,8 +48,7 @@ static void setup_free(void *setup)
 /* The numbers in the text of [nurbs] key (malloc'ed; *n how many), blaming the key. */
 static double *numbers(const lw_params *p, const char *key, const char *text, size_t *n, lw_error *err)
 {
-  const int pairs = !strcmp(key, "points") ? 2 : 1;
-  int count = lw_number_list(text, pairs, NULL, 0);
+  int count = lw_number_list(text, p->of_run ? 1 : 2, NULL, 0);
   if (count < 0) {
     lw_error_set(err, LW_EINPUT, "expected numbers separated by blanks or commas, got '%.60s'%s", text,
                  lw_number_list_hint(count));
@@ -61,7 +60,7 @@ static double *numbers(const lw_params *p, const char *key, const char *text, si
     lw_error_set(err, LW_ENOMEM, "out of memory for %d numbers", count);
     return NULL;
   }
-  lw_number_list(text, pairs, v, count);
+  lw_number_list(text, 1, v, count);
   *n = (size_t)count;
   return v;
 }

@@ -200,13 +200,16 @@ Test(state, strict_numbers)
   cr_assert_eq(lw_number_list(" 1\t2 3 4 ", 1, list, 4), 4);
   cr_assert_eq(lw_number_list("1 2 3 4 5", 0, list, 2), 5, "tokens past max are counted");
   cr_assert_eq(lw_number_list("1 2x", 0, list, 4), -1);
-  /* separators mixed: decimal commas ("0,5 0,7": 2 numbers, not 4) are
-  ** refused; pairs of coordinates may alternate them (SVG's "x,y x,y") */
-  cr_assert_eq(lw_number_list("0,5 0,7", 1, list, 4), -2);
+  /* a comma alone between digits beside blanks alone: decimal commas
+  ** ("0,5 0,7": 2 numbers, not 4), the SVG style too; ", " and "," read, as
+  ** every mix does for a run's own scene.ini (1) */
+  cr_assert_eq(lw_number_list("0,5 0,7", 2, list, 4), -2);
+  cr_assert_eq(lw_number_list("10,2 10,4 90,6 10,8", 2, list, 4), -2);
   cr_assert_eq(lw_number_list("10,5 20,5 90 10 50 90", 2, list, 4), -2);
-  cr_assert_eq(lw_number_list("10,20 30,40", 2, list, 4), 4);
-  cr_assert_eq(lw_number_list("1, 2\t3 ,4", 2, list, 4), 4);
-  cr_assert_eq(lw_number_list("1 2,3", 2, list, 4), 3);
-  cr_assert_eq(lw_number_list("1 2,3 4", 1, list, 4), -2);
+  cr_assert_eq(lw_number_list("0,5 0,7", 1, list, 4), 4);
+  cr_assert_eq(lw_number_list("1,2,3,4", 2, list, 4), 4);
+  cr_assert_eq(lw_number_list("0 0 0 0, 0.25, 0.5, 0.75, 1 1 1 1", 2, list, 4), 11);
+  cr_assert_eq(lw_number_list("1, 2 4", 2, list, 4), 3);
+  cr_assert_eq(lw_number_list("1 ,2\t3", 2, list, 4), 3);
   cr_assert(strstr(lw_number_list_hint(-2), "0.5 not 0,5") && !*lw_number_list_hint(-1));
 }

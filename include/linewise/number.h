@@ -49,13 +49,14 @@ void lw_text_drop_bom(char *s);
 ** failed read (errno set; ENOMEM when out of memory). */
 long lw_text_next_line(FILE *f, char **buf, size_t *cap, long *line);
 
-/* Splits s at blanks (and commas when `commas`) into at most max numbers;
-** returns how many tokens there were (more than max are counted but not
-** stored), -1 if a token is not a number, or -2 where commas and blanks
-** are mixed between them: "10,5 20,5 90 10" is a list with decimal commas
-** more likely than 6 numbers.  With commas 1 every separator holds a comma
-** or none does; with 2 (lists of x y pairs) they may also alternate, as in
-** "10,20 30,40" or "10 20, 30 40". */
+/* Splits s at blanks (commas too when `commas` is 1 or 2) into at most max
+** numbers; returns how many tokens there were (more than max are counted
+** but not stored), or -1 if a token is not a number.  With commas 2, -2
+** where a comma stands alone between two numbers ("0,5") in a list that
+** also has blanks alone between two: "0,5 0,7" is two numbers with decimal
+** commas more likely than four (and so is the SVG style "10,20 30,40", which
+** "10 20 30 40" says plainly); "1, 2, 3", "1,2,3" and "0 0, 0.5, 1 1" read.
+** A run's own scene.ini takes 1, as older releases wrote any mix. */
 int lw_number_list(const char *s, int commas, double *out, int max);
 
 /* What to add to a message on a list refused with count (-2: mixed
