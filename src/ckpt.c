@@ -290,7 +290,9 @@ lw_status lw_ckpt_missing(const lw_ckpt *c, const char *what, const char *guess,
 const char *lw_ckpt_cut_hint(const lw_ckpt *c, const char *sec)
 {
   const section *s = find_section(c, sec);
-  return s && s->line && s == &c->s[c->ns - 1] ? ", where the file ends: cut short (a partial copy, a full disk?)" : "";
+  return s && s->line && s == &c->s[c->ns - 1]
+             ? ", where the file ends (cut short by a partial copy or a full disk, or edited?)"
+             : "";
 }
 
 static lw_status missing(const lw_ckpt *c, const char *sec, const char *key, lw_error *err)
