@@ -598,18 +598,32 @@ static const char *format_name(const unsigned char *d, size_t n)
 static const char *foreign_format(const unsigned char *d, size_t n)
 {
   if (n >= 12 && !memcmp(d, "RIFF", 4) && !memcmp(d + 8, "WEBP", 4)) return "a WebP";
-  if (n >= 4 && (!memcmp(d, "II*\0", 4) || !memcmp(d, "MM\0*", 4))) return "a TIFF";
+  if (n >= 4 && (!memcmp(d, "II*\0", 4) || !memcmp(d, "MM\0*", 4) || !memcmp(d, "II+\0", 4) || !memcmp(d, "MM\0+", 4)))
+    return "a TIFF";
   if (n >= 12 && !memcmp(d + 4, "ftyp", 4)) {
-    if (!memcmp(d + 8, "avif", 4) || !memcmp(d + 8, "avis", 4)) return "an AVIF";
-    if (!memcmp(d + 8, "hei", 3) || !memcmp(d + 8, "hev", 3) || !memcmp(d + 8, "mif1", 4) || !memcmp(d + 8, "msf1", 4))
-      return "a HEIC";
-    if (!memcmp(d + 8, "jp2 ", 4)) return "a JPEG 2000";
+    /* the major brand, then the compatible ones (an AVIF may say mif1 first) */
+    size_t box = (size_t)d[0] << 24 | (size_t)d[1] << 16 | (size_t)d[2] << 8 | d[3];
+    if (box < 16 || box > n) box = 12;
+    int heic = 0;
+    for (size_t at = 8; at + 4 <= box; at += at == 8 ? 8 : 4) {
+      if (!memcmp(d + at, "avif", 4) || !memcmp(d + at, "avis", 4)) return "an AVIF";
+      if (!memcmp(d + at, "jp2 ", 4)) return "a JPEG 2000";
+      if (!memcmp(d + at, "jxl ", 4)) return "a JPEG XL";
+      heic |= !memcmp(d + at, "hei", 3) || !memcmp(d + at, "hev", 3) || !memcmp(d + at, "mif1", 4) ||
+              !memcmp(d + at, "msf1", 4);
+    }
+    if (heic) return "a HEIC";
   }
   if (n >= 12 && !memcmp(d, "\0\0\0\x0cjP  ", 8)) return "a JPEG 2000";
+  if (n >= 4 && !memcmp(d, "\xff\x4f\xff\x51", 4)) return "a JPEG 2000";
+  if (n >= 12 && !memcmp(d, "\0\0\0\x0cJXL \r\n\x87\n", 12)) return "a JPEG XL";
   if (n >= 2 && d[0] == 0xFF && d[1] == 0x0A) return "a JPEG XL";
   if (n >= 4 && !memcmp(d, "8BPS", 4)) return "a Photoshop";
   if (n >= 5 && !memcmp(d, "%PDF-", 5)) return "a PDF";
-  if (n >= 5 && (!memcmp(d, "<svg", 4) || !memcmp(d, "<?xml", 5))) return "an SVG";
+  size_t at = n >= 3 && !memcmp(d, "\xef\xbb\xbf", 3) ? 3 : 0; /* a BOM, then blanks */
+  while (at < n && at < 256 && (d[at] == ' ' || d[at] == '\t' || d[at] == '\r' || d[at] == '\n')) at++;
+  if (n - at >= 5 && (!memcmp(d + at, "<svg", 4) || !memcmp(d + at, "<?xml", 5) || !memcmp(d + at, "<!DOC", 5)))
+    return "an SVG";
   return NULL;
 }
 

@@ -111,10 +111,11 @@ static void put_string(FILE *f, const char *s)
   for (const unsigned char *c = (const unsigned char *)s; *c; c++) {
     int n = utf8_length(c);
     if (n != 1) {
-      /* JSON is UTF-8: a byte of a file name that is not (Latin-1, say) as
-      ** Python's surrogateescape reads it, so os.fsencode gives the name back */
+      /* JSON is UTF-8: a byte of a file name that is not (Latin-1, say) is
+      ** U+FFFD, which every reader takes (Python's surrogate escape \udcXX
+      ** would give the name back, but strict readers refuse a lone surrogate) */
       if (n) fwrite(c, 1, (size_t)n, f);
-      else fprintf(f, "\\udc%02x", *c);
+      else fputs("\\ufffd", f);
       c += n ? n - 1 : 0;
       continue;
     }

@@ -842,8 +842,9 @@ Test(image, jpeg_exif_orientation_is_turned_upright)
 }
 
 /* The 32 x 16 picture of exif_jpeg as a PNG, with an eXIf chunk of
-** orientation o (0: none) after its header. */
-static size_t exif_png(unsigned char *out, int o)
+** orientation o (0: none) after its header, or with `late` after its
+** image data. */
+static size_t exif_png(unsigned char *out, int o, int late)
 {
   unsigned char px[32 * 16];
   for (int y = 0; y < 16; y++)
@@ -852,7 +853,7 @@ static size_t exif_png(unsigned char *out, int o)
   cr_assert(stbi_write_png_to_func(jpeg_put, &j, 32, 16, 1, px, 32));
   static const unsigned char chunk[34] = {0, 0, 0, 22, 'e', 'X', 'I', 'f', 'M', 'M', 0, 42, 0, 0, 0, 8, 0, 1,
                                           0x01, 0x12, 0, 3, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0};
-  size_t head = 8 + 25, n = 0; /* the signature and IHDR */
+  size_t head = late ? j.n - 12 : 8 + 25, n = 0; /* before IEND, or after the signature and IHDR */
   memcpy(out, j.b, head);
   n = head;
   if (o) {
@@ -865,25 +866,27 @@ static size_t exif_png(unsigned char *out, int o)
 }
 
 /* A PNG's eXIf chunk turns it as a JPEG's EXIF does (a phone's portrait
-** PNG was drawn on its side); the probe of orientation = auto agrees. */
+** PNG was drawn on its side), found after the image data too (before IEND,
+** where older writers put it); the probe of orientation = auto agrees. */
 Test(image, png_exif_orientation_is_turned_upright)
 {
   static const int corner[9] = {0, 0, 1, 2, 3, 0, 1, 2, 3};
   unsigned char png[8400];
   lw_error err;
-  for (int o = 0; o <= 8; o++) {
-    size_t n = exif_png(png, o);
+  for (int o = 0; o <= 17; o++) {
+    size_t n = exif_png(png, o % 9, o > 8);
     lw_image_info info;
     lw_image *img = lw_image_decode(png, n, "t.png", 1e6, &info, &err);
     cr_assert_not_null(img, "orientation %d: %s", o, err.msg);
-    cr_assert(img->width == (o >= 5 ? 16 : 32) && dark_corner(img) == corner[o], "orientation %d: %d x %d, corner %d",
-              o, img->width, img->height, dark_corner(img));
+    cr_assert(img->width == (o % 9 >= 5 ? 16 : 32) && dark_corner(img) == corner[o % 9],
+              "orientation %d%s: %d x %d, corner %d", o % 9, o > 8 ? " (after the data)" : "", img->width,
+              img->height, dark_corner(img));
     lw_image_free(img);
   }
   const char *path = lw_test_path("side.png");
   FILE *f = fopen(path, "wb");
   cr_assert_not_null(f);
-  size_t n = exif_png(png, 8);
+  size_t n = exif_png(png, 8, 0);
   cr_assert_eq(fwrite(png, 1, n, f), n);
   fclose(f);
   lw_image_info info;
@@ -903,6 +906,11 @@ Test(image, foreign_formats_are_named_and_a_huge_jpeg_is_too_large)
     {"RIFF\x10\0\0\0WEBPVP8 ", 16, "a WebP file"},
     {"II*\0\x08\0\0\0\0\0\0\0", 12, "a TIFF file"},
     {"\0\0\0\x1c" "ftypavif\0\0\0\0avifmif1", 24, "an AVIF file"},
+    /* an AVIF whose major brand is mif1 names avif among the compatible ones */
+    {"\0\0\0\x18" "ftypmif1\0\0\0\0mif1avif", 24, "an AVIF file"},
+    {"\0\0\0\x0cJXL \r\n\x87\n", 12, "a JPEG XL file"},
+    {"II+\0\x08\0\0\0", 8, "a TIFF file"},
+    {"\xef\xbb\xbf\n  <svg xmlns=", 16, "an SVG file"},
   };
   lw_error err;
   for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
