@@ -10,7 +10,7 @@ case ${1:-} in
 esac
 dir=$1
 fps=${2:-25}
-if [ ! -d "$dir/frames" ] || [ -z "$(ls "$dir/frames" 2>/dev/null | grep '^frame-.*\.png$')" ]; then
+if [ ! -d "$dir/frames" ] || [ -z "$(ls -- "$dir/frames" 2>/dev/null | grep '^frame-[0-9]*\.png$')" ]; then
   echo "${0##*/}: $dir/frames has no frames (set output.frames_every in the scene)" >&2
   exit 2
 fi
@@ -18,15 +18,19 @@ command -v ffmpeg >/dev/null 2>&1 || { echo "${0##*/}: ffmpeg not found (make de
 # The frames are numbered by sweep, not consecutively.  ffmpeg's glob would
 # read RUN_DIR itself as a pattern ("run[1]" took run1's frames), so they
 # are linked as 1, 2, 3, ... in a directory of our own, in sweep order.
-abs=$(cd "$dir" && pwd -P)
+abs=$(cd -- "$dir" && pwd -P)
 tmp=$(mktemp -d) || exit 1
+# dash runs no EXIT trap when a signal ends it: the signals exit through it
 trap 'rm -rf "$tmp"' EXIT
+trap 'exit 130' INT
+trap 'exit 143' TERM HUP
 n=0
-for f in $(ls "$abs/frames" | grep '^frame-[0-9]*\.png$' | sort -t- -k2n); do
+for f in $(ls -- "$abs/frames" | grep '^frame-[0-9]*\.png$' | sort -t- -k2n); do
   n=$((n + 1))
   ln -s "$abs/frames/$f" "$tmp/$(printf %08d "$n").png"
 done
-# file: keeps a directory such as "a:b" or "-x" from reading as a protocol or an option
+# file: keeps a directory such as "a:b" from reading as a protocol, and
+# ffmpeg takes it as an option only if it begins with '-' (abs never does)
 (cd "$tmp" && ffmpeg -loglevel error -y -framerate "$fps" -i %08d.png \
   -vf "pad=ceil(iw/2)*2:ceil(ih/2)*2:color=white" -c:v libx264 -pix_fmt yuv420p "file:$abs/animation.mp4")
 echo "$dir/animation.mp4"
