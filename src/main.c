@@ -919,8 +919,21 @@ static int cmd_stats(int argc, char **argv)
   }
   if (!err.code && reweight)
     lw_trace_reweight((const lw_trace *const *)t, (const char *const *)path, sel, k, (int)reweight, stdout, &err);
-  else if (!err.code)
+  else if (!err.code) {
+    /* with --csv the warnings no column carries go to stderr, a line each */
+    char *warned = NULL;
+    size_t warned_len = 0;
+    FILE *w = base.csv ? open_memstream(&warned, &warned_len) : NULL;
+    for (int r = 0; r < k; r++) sel[r].csv_warnings = w;
     lw_trace_stats_runs((const lw_trace *const *)t, (const char *const *)path, sel, k, stdout, &err);
+    if (w) fclose(w);
+    for (char *line = warned; line && *line;) {
+      size_t len = strcspn(line, "\n");
+      fprintf(stderr, "linewise: %.*s\n", (int)len, line);
+      line += len + (line[len] == '\n');
+    }
+    free(warned);
+  }
   for (int r = 0; path && r < k; r++) {
     lw_trace_free(t[r]);
     free(path[r]);

@@ -9,7 +9,7 @@
 #include "linewise/number.h"
 
 #include <errno.h>
-#include <locale.h>
+#include <langinfo.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,11 +19,12 @@ static int is_digit(char c) { return c >= '0' && c <= '9'; }
 
 lw_status lw_number_locale_ok(lw_error *err)
 {
-  const char *point = localeconv()->decimal_point;
+  /* nl_langinfo is thread-safe where localeconv and setlocale's name are not */
+  const char *point = nl_langinfo(RADIXCHAR);
   if (point && !strcmp(point, ".")) return LW_OK;
-  return lw_error_set(err, LW_EUSAGE, "the locale's numbers (LC_NUMERIC '%s') take '%s' as the decimal point, and "
-                      "linewise reads and writes numbers with '.': a program calling into it sets LC_NUMERIC to \"C\" "
-                      "first (setlocale(LC_NUMERIC, \"C\"))", setlocale(LC_NUMERIC, NULL), point ? point : "");
+  return lw_error_set(err, LW_EUSAGE, "the locale's numbers (LC_NUMERIC) take '%s' as the decimal point, and linewise "
+                      "reads and writes numbers with '.': a program calling into it sets LC_NUMERIC to \"C\" first "
+                      "(setlocale(LC_NUMERIC, \"C\"))", point ? point : "");
 }
 
 int lw_number_parse_n(const char *s, size_t len, double *out)

@@ -588,16 +588,15 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
               s->tau * every[0], s->n_eff, flagged(q, 1) ? " *" : "");
     }
   }
-  /* these two have no column in --csv: a script reads them on stderr */
-  FILE *apart = csv ? stderr : out;
-  const char *from = csv ? "linewise: " : "";
-  if (tlo < thi) /* equal: one temperature; inf > -inf: no temperature column (dynamics) */
-    fprintf(apart, "%swarning: the temperature changes within %s: the means mix ensembles\n", from,
+  /* these two have no column in --csv: there they go apart (stderr) */
+  FILE *apart = csv ? sel[0].csv_warnings : out;
+  if (apart && tlo < thi) /* equal: one temperature; inf > -inf: no temperature column (dynamics) */
+    fprintf(apart, "warning: the temperature changes within %s: the means mix ensembles\n",
             k > 1 ? "or between the runs" : "these rows");
-  if (k > 1 && identical_runs(t, row, n, k))
-    fprintf(apart, "%swarning: the %d runs are the same, row for row: one seed run twice, or seeds that change "
+  if (apart && k > 1 && identical_runs(t, row, n, k))
+    fprintf(apart, "warning: the %d runs are the same, row for row: one seed run twice, or seeds that change "
             "nothing (a scene that draws no random number, as the dynamics from init.from or the D-NURBS dynamics), "
-            "so they are one run, and R_hat and p_runs say nothing\n", from, k);
+            "so they are one run, and R_hat and p_runs say nothing\n", k);
   if (!csv) {
     warn(out, t[0], cs, k, WARN_OPEN, "the autocorrelation did not die out within half the rows: tau is a lower "
          "bound and the error bar too small (a longer stretch is needed)");

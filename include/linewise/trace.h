@@ -47,6 +47,7 @@ typedef struct {
   long tune, steps, sweeps;
   long ladder;
   int csv;       /* 1: one CSV line per column; 0: a table for people */
+  FILE *csv_warnings; /* with csv: where the warnings no column carries go (NULL: nowhere) */
 } lw_trace_select;
 
 /* From a run's parameters: the tuning (steps and ladder) that the rows leave out, and from =
