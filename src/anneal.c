@@ -93,6 +93,16 @@ void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n)
              a->params.tune_sweeps);
 }
 
+void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n)
+{
+  const double wall = now_seconds() - a->wall_start;
+  buf[0] = '\0';
+  if (a->ckpt_seconds > 1.0 && a->ckpt_seconds > wall / 3.0)
+    snprintf(buf, n, "writing state.lw every %d sweeps (output.checkpoint_every) took %.0f %% of this run's %.1f s: "
+             "a larger value costs less, and a killed run then loses more sweeps", a->params.checkpoint_every,
+             100.0 * a->ckpt_seconds / wall, wall);
+}
+
 /* Temperature step of sweep s: the sweeps are shared out evenly; past the
 ** end the last step holds. */
 static long block_of(const lw_anneal *a, long s)
@@ -868,7 +878,9 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
   if (se) return se;
   const char *was = lw_phase_get(NULL);
   lw_phase_set("writing state.lw");
+  const double t0 = now_seconds();
   lw_status s = a->net ? a->net->checkpoint(a->net, a, err) : lw_checkpoint_write(a, err);
+  a->ckpt_seconds += now_seconds() - t0;
   lw_phase_set(was);
   if (!s) a->saved = a->sweep + 1;
   return s;

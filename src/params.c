@@ -424,7 +424,9 @@ const lw_param_def lw_param_table[] = {
       "Warm-up sweeps of ladder tuning (tune_ladder = equal); fewer than anneal.sweeps, since the "
       "swap statistics and ladder.ini come after it."),
   NUM("output", "checkpoint_every", LW_PT_INT, checkpoint_every, "100", "sweeps", 1, 2e9, 0,
-      "Sweeps between checkpoints of state.lw (also written at the end and on SIGINT/SIGTERM)."),
+      "Sweeps between checkpoints of state.lw (also written at the end and on SIGINT/SIGTERM). Each is "
+      "written whole and synced to disk: for a small system (sweeps of microseconds) that is most of the "
+      "time, and the run says so at its end; thousands of sweeps between them suit a study."),
   NUM("output", "trace_every", LW_PT_INT, trace_every, "1", "sweeps", 1, 2e9, 0,
       "Sweeps per row of trace.csv."),
   NUM("output", "observables", LW_PT_INT, observables, "0", "", 0, 1, 0,

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "linewise/anneal.h"
 #include "linewise/init.h"
@@ -350,4 +351,29 @@ Test(run, pens_become_layers)
   cr_assert_eq(sh("%s run %s --out %s/q --quiet --set output.pens=3 2>%s/err.txt", b, path, dir, dir), 2);
   cr_assert_eq(sh("grep -q 's.ini:31: key .output.pen_colors.: expected 3 colours' %s/err.txt", dir), 0);
   cr_assert_neq(sh("test -e %s/q", dir), 0);
+}
+
+/* Checkpoints that take over a third of the run (and a second) are said at
+** the end: a small system's study fsync'd state.lw every 100 sweeps and
+** took 8 s instead of 1, without a word.  The note reads this process's
+** clock (CLOCK_MONOTONIC, as anneal.c's) and the time its checkpoints took. */
+Test(anneal, checkpoints_that_take_most_of_a_run_are_said)
+{
+  static lw_anneal a;
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  a.wall_start = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec - 10.0;
+  a.params.checkpoint_every = 100;
+  char note[256];
+  a.ckpt_seconds = 5.0;
+  lw_anneal_checkpoint_note(&a, note, sizeof note);
+  cr_assert(strstr(note, "writing state.lw every 100 sweeps (output.checkpoint_every) took 50 % of this run's 10.0 s"),
+            "%s", note);
+  a.ckpt_seconds = 3.0; /* under a third */
+  lw_anneal_checkpoint_note(&a, note, sizeof note);
+  cr_assert_str_eq(note, "");
+  a.wall_start += 9.5; /* a run of half a second: 0.4 s of checkpoints is no matter */
+  a.ckpt_seconds = 0.4;
+  lw_anneal_checkpoint_note(&a, note, sizeof note);
+  cr_assert_str_eq(note, "");
 }

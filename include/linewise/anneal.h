@@ -70,6 +70,7 @@ typedef struct lw_anneal {
   double wall_before;          /* seconds spent before a resume */
   double sweep_seconds;        /* seconds in sweeps, with the processes before (timing.txt) */
   double wall_start;           /* monotonic clock at start of this process */
+  double ckpt_seconds;         /* of it, writing checkpoints (lw_anneal_checkpoint_note) */
   lw_move_stats trace_mark[LW_MOVES_MAX]; /* stats at the last trace row */
   int quenched;                /* 1 once lw_anneal_finish has quenched (anneal.quench) */
   lw_quench_report quench;     /* what the quench did */
@@ -145,6 +146,11 @@ double lw_anneal_acceptance(const lw_anneal *a);
 ** for its system: a move kind accepted under a quarter of its target over
 ** the run, from the process that holds the coldest rung. */
 void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n);
+
+/* A note (else "") when this process spent over a third of its time, and
+** over a second, writing checkpoints: fsync'd state of a small system
+** every output.checkpoint_every sweeps made a 1-second study take 8. */
+void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n);
 double lw_anneal_seconds(const lw_anneal *a);
 
 #endif
