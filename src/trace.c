@@ -232,7 +232,7 @@ static void warn(FILE *out, const lw_trace *t, const column_stats *cs, int k, in
 ** average, k - 1 degrees of freedom); and R-hat = sqrt(var+ / W), W the mean within-run variance, B / n
 ** the variance of the means, var+ = (n - 1) / n W + B / n (Gelman and Rubin
 ** 1992, Stat. Sci. 7, 457), n the mean rows a run. */
-static void combine(column_stats *c, int k, const double *every)
+static void combine(column_stats *c, int k, const double *gap)
 {
   double m = 0.0, se2 = 0.0, w = 0.0, n = 0.0, tau = 0.0, neff = 0.0;
   for (int r = 0; r < k; r++) {
@@ -241,7 +241,7 @@ static void combine(column_stats *c, int k, const double *every)
     se2 += s->stderr_mean * s->stderr_mean / ((double)k * k);
     w += s->n > 1 ? s->sd * s->sd * (double)s->n / (double)(s->n - 1) / k : 0.0;
     n += (double)s->n / k;
-    tau += s->tau * every[r] / k;
+    tau += s->tau * gap[r] / k;
     neff += s->n_eff;
   }
   /* The chi-square is taken about the means' weighted average, each weighed
@@ -478,13 +478,13 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
   const int csv = sel[0].csv;
   size_t **row = calloc((size_t)k, sizeof *row), *n = calloc((size_t)k, sizeof *n);
   size_t *tuned = calloc((size_t)k, sizeof *tuned);
-  double *every = calloc((size_t)k, sizeof *every), *x = NULL;
+  double *every = calloc((size_t)k, sizeof *every), *gap = calloc((size_t)k, sizeof *gap), *x = NULL;
   lw_trace **heat = calloc((size_t)k, sizeof *heat); /* t with its heat capacities */
   const size_t cols = t[0]->n_cols + LW_TRACE_HEAT_MAX;
   column_stats *cs = calloc(cols, sizeof *cs);
   lw_series_stats *runs = calloc(cols * (size_t)k, sizeof *runs);
   lw_status status =
-      row && n && tuned && every && heat && cs && runs ? LW_OK : lw_error_set(err, LW_ENOMEM, "out of memory");
+      row && n && tuned && every && gap && heat && cs && runs ? LW_OK : lw_error_set(err, LW_ENOMEM, "out of memory");
   size_t most = 0;
   for (int r = 0; !status && r < k; r++) {
     if (r && (status = same_columns(t[0], path[0], t[r], path[r], err))) break;
@@ -507,11 +507,16 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     for (int r = 0; r < k; r++) {
       lw_trace_column_stats(t[r], row[r], n[r], (int)c, x, &cs[c].run[r]);
       empty |= !cs[c].run[r].n;
+      /* sweeps between the column's values: a swapK column is filled on
+      ** every other row (even and odd pairs take turns), so its tau in
+      ** rows is in twice the rows' sweeps (it read 1.1 sweeps for 2.2) */
+      gap[r] = cs[c].run[r].n ? every[r] * (double)n[r] / (double)cs[c].run[r].n : every[r];
     }
+    cs[c].tau_sweeps = cs[c].run[0].tau * gap[0];
     if (empty) {
       cs[c].run[0].n = 0; /* a column some run never filled: left out */
     } else if (k > 1) {
-      combine(&cs[c], k, every);
+      combine(&cs[c], k, gap);
       /* an acceptance depends on each run's own tuned step: runs need not agree */
       if (!strncmp(t[0]->name[c], "acc_", 4) || !strncmp(t[0]->name[c], "swap", 4)) cs[c].p_runs = cs[c].r_hat = NAN;
     }
@@ -565,7 +570,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       ** the table's '-' and summary.json's null */
       char tau[32] = "", neff[32] = "";
       if (s->sd > 0.0) {
-        snprintf(tau, sizeof tau, "%.4g", s->tau * every[0]);
+        snprintf(tau, sizeof tau, "%.4g", q->tau_sweeps);
         snprintf(neff, sizeof neff, "%.4g", s->n_eff);
       }
       char batch[32] = "", closed[8] = "", drift[32] = "";
@@ -585,7 +590,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       fprintf(out, "%-*s %15.9g %11.4g %11.4g %11s %9s\n", width, name, s->mean, 0.0, 0.0, "-", "-");
     } else {
       fprintf(out, "%-*s %15.9g %11.4g %11.4g %11.4g %9.0f%s\n", width, name, s->mean, s->stderr_mean, s->sd,
-              s->tau * every[0], s->n_eff, flagged(q, 1) ? " *" : "");
+              q->tau_sweeps, s->n_eff, flagged(q, 1) ? " *" : "");
     }
   }
   /* these two have no column in --csv: there they go apart (stderr) */
@@ -622,6 +627,7 @@ done:
   free(n);
   free(tuned);
   free(every);
+  free(gap);
   free(x);
   free(cs);
   free(runs);

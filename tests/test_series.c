@@ -253,6 +253,47 @@ static void report_of(const lw_trace *t, const lw_trace_select *sel, char *buf, 
   fclose(f);
 }
 
+/* tau_sweeps of the column `name` in CSV lines out. */
+static double csv_tau(const char *out, const char *name)
+{
+  char key[32];
+  snprintf(key, sizeof key, "\n%s,", name);
+  const char *at = strstr(out, key);
+  cr_assert_not_null(at, "%s", out);
+  for (int comma = 0; comma < 5; comma++) at = strchr(at + 1, ',');
+  return atof(at + 1);
+}
+
+/* A column filled on every other row (swapK: even and odd pairs take
+** turns) has its values two sweeps apart: its tau in sweeps is twice its
+** tau in values (it read 1.1 sweeps for 2.2).  The same 400 values of an
+** AR(1) series, once a row and once every other row. */
+Test(trace, tau_of_a_column_filled_every_other_row_counts_its_sweeps, .init = make_dir, .fini = remove_dir)
+{
+  static char a[40000], b[40000];
+  char out[2048];
+  int ka = snprintf(a, sizeof a, "sweep,swap0\n"), kb = snprintf(b, sizeof b, "sweep,swap0\n");
+  double x = 0.0;
+  unsigned long u = 12345;
+  for (int i = 1; i <= 400; i++) {
+    u = u * 6364136223846793005UL + 1442695040888963407UL;
+    x = 0.8 * x + ((double)(u >> 11) / 9007199254740992.0 - 0.5);
+    ka += snprintf(a + ka, sizeof a - (size_t)ka, "%d,%.17g\n", i, x);
+    kb += snprintf(b + kb, sizeof b - (size_t)kb, "%d,\n%d,%.17g\n", 2 * i - 1, 2 * i, x);
+  }
+  lw_trace_select sel = {.from = 0, .to = -1, .csv = 1};
+  lw_trace *t = trace_of(a);
+  report_of(t, &sel, out, sizeof out);
+  const double once = csv_tau(out, "swap0");
+  lw_trace_free(t);
+  t = trace_of(b);
+  report_of(t, &sel, out, sizeof out);
+  const double every_other = csv_tau(out, "swap0");
+  lw_trace_free(t);
+  cr_assert(once > 2.0 && fabs(every_other / once - 2.0) < 1e-3, "tau %g sweeps a row, %g every other row", once,
+            every_other);
+}
+
 Test(trace, the_default_stretch_is_the_final_temperature_less_its_tuning_sweeps, .init = make_dir,
      .fini = remove_dir)
 {
