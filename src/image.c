@@ -627,25 +627,28 @@ static const char *foreign_format(const unsigned char *d, size_t n)
   return NULL;
 }
 
-/* Why the decoder refuses a picture as too large, or NULL: more than 2^30
-** bytes of pixels (width x height x channels, a palette's counted as 4),
-** or a side past 2^24 pixels, both before linewise's own 1e9 pixels.  A
-** PNG's header is read here, as the formats the decoder tries after PNG
-** leave "unknown type" as the reason (a 20000 x 20000 RGB picture was
-** called corrupt); other formats give w, h and ch from stbi_info, and are
-** held to the same bound (a JPEG past it was "damaged or cut short", one
-** under it decoded with 1.8 GB). */
+/* Why the decoder refuses a picture as too large, or NULL: a side past
+** 2^24 pixels, or more bytes of pixels (width x height x channels, a
+** palette's counted as 4) than it allocates: 2^30 for a PNG, INT_MAX for
+** the others (a 24000 x 15000 RGB JPEG decodes); both before linewise's
+** own 1e9 pixels.  A PNG's header is read here, as the formats the decoder
+** tries after PNG leave "unknown type" as the reason (a 20000 x 20000 RGB
+** PNG was called corrupt); the others give w, h and ch from stbi_info (a
+** 30000 x 30000 JPEG was "damaged or cut short"). */
 static const char *too_large(const unsigned char *d, size_t n, double w, double h, int ch)
 {
-  if (n >= 26 && !strcmp(format_name(d, n), "PNG") && !memcmp(d + 12, "IHDR", 4)) {
+  const int png = n >= 26 && !strcmp(format_name(d, n), "PNG") && !memcmp(d + 12, "IHDR", 4);
+  if (png) {
     w = (double)((uint32_t)d[16] << 24 | (uint32_t)d[17] << 16 | (uint32_t)d[18] << 8 | d[19]);
     h = (double)((uint32_t)d[20] << 24 | (uint32_t)d[21] << 16 | (uint32_t)d[22] << 8 | d[23]);
     static const int channels[7] = {1, 0, 3, 4, 2, 0, 4}; /* by colour type: grey, -, RGB, palette, grey+alpha, -, RGBA */
     ch = d[25] < 7 ? channels[d[25]] : 0;
   }
   if (w > 16777216.0 || h > 16777216.0) return "a side is more than 2^24 pixels";
-  if (ch && w * h * ch > 1073741824.0)
+  if (png && ch && w * h * ch > 1073741824.0)
     return "its width x height x channels is more than 2^30 (1.07e9 grey, 358 million RGB or 268 million RGBA pixels)";
+  if (!png && ch && w * h * ch > (double)INT_MAX)
+    return "its width x height x channels is more than 2^31 (2.1e9 grey, 716 million RGB or 537 million RGBA pixels)";
   return NULL;
 }
 

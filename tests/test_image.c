@@ -896,9 +896,9 @@ Test(image, png_exif_orientation_is_turned_upright)
 
 /* Formats linewise does not read are named, with the way round: an
 ** iPhone's HEIC, a WebP, a TIFF were "not of any known type, or corrupt".
-** A JPEG past the decoder's 2^30 bytes of pixels (its header says 20000 x
-** 20000 RGB) is refused as too large before decoding, as a PNG is: it
-** decoded with 1.8 GB, and at 30000 x 30000 was "damaged or cut short". */
+** A JPEG past the decoder's INT_MAX bytes of pixels (its header says 30000
+** x 30000 RGB) is refused as too large before decoding, as a PNG past 2^30
+** is: it was "damaged or cut short". */
 Test(image, foreign_formats_are_named_and_a_huge_jpeg_is_too_large)
 {
   static const struct { const char *head; size_t n; const char *name; } f[] = {
@@ -924,9 +924,9 @@ Test(image, foreign_formats_are_named_and_a_huge_jpeg_is_too_large)
   size_t at = 2;
   while (at + 4 < n && !(jpg[at] == 0xFF && jpg[at + 1] == 0xC0)) at += 2 + ((size_t)jpg[at + 2] << 8 | jpg[at + 3]);
   cr_assert(at + 9 < n, "no SOF0");
-  jpg[at + 5] = 20000 >> 8, jpg[at + 6] = 20000 & 255, jpg[at + 7] = 20000 >> 8, jpg[at + 8] = 20000 & 255;
+  jpg[at + 5] = 30000 >> 8, jpg[at + 6] = 30000 & 255, jpg[at + 7] = 30000 >> 8, jpg[at + 8] = 30000 & 255;
   jpg[at + 9] = 3; /* 3 components: RGB */
   cr_assert_null(lw_image_decode(jpg, n, "big.jpg", 1e6, NULL, &err));
   cr_assert(strstr(err.msg, "big.jpg: the JPEG is too large to decode: its width x height x channels is more than "
-                   "2^30"), "%s", err.msg);
+                   "2^31"), "%s", err.msg);
 }
