@@ -166,7 +166,7 @@ static void thin_note(lw_scene *sc, const lw_params *p)
   size_t used = strlen(sc->note);
   snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image: the %d x %d picture keeps its shape, so it lies on "
            "the page as %.3g x %.3g mm, narrower than two segments (init.segment_length %g mm): few lines or none fit "
-           "there; a page of its shape (scene.width, scene.height) or a crop of it gives it room",
+           "there; a crop of the picture to a less narrow shape gives it room, and so do shorter segments",
            used ? "; " : "", sc->image->width, sc->image->height, w, h, p->segment_length);
 }
 

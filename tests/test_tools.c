@@ -291,25 +291,30 @@ Test(tools, ctrl_c_stops_the_sweep_after_its_runs_have_saved)
 ** the sweep returns after the last has saved.  xargs returned as soon as
 ** the first task said "stopped" (255) and printed "aborting"; the sweep then
 ** removed its stop file, so the slower run was reported as "stopped by a
-** signal to it alone", after the sweep's last line. */
-Test(tools, ctrl_c_waits_for_the_slowest_run)
+** signal to it alone", after the sweep's last line.  A hang-up (SIGHUP to
+** the group) stops the runs as Ctrl-C does: they kept it ignored from the
+** sweep and ran to their end, the sweep waiting. */
+Test(tools, ctrl_c_or_a_hang_up_waits_for_the_slowest_run)
 {
-  cr_assert_eq(sh("(setsid env --default-signal=INT %s %s %s --vary init.splines=2,600 --seeds 1 -j 2 --threads 1 "
-                  "--set anneal.sweeps=1000000 --set scene.width=300 --bin %s --out %s/w >%s/w.out 2>%s/w.err & "
-                  "echo $! >%s/w.pid); a=%s/w/init.splines=2__seed-1; b=%s/w/init.splines=600__seed-1; i=0; "
-                  "while [ $i -lt 1500 ] && ! { test -s $a/state.lw && test -s $b/state.lw; }; do sleep 0.02; "
-                  "i=$((i+1)); done; p=$(cat %s/w.pid); kill -INT -$p; i=0; while kill -0 $p 2>/dev/null && "
-                  "[ $i -lt 1500 ]; do sleep 0.02; i=$((i+1)); done; kill -KILL -$p 2>/dev/null; test $i -lt 1500 && "
-                  "flock -n $a/.lock true && flock -n $b/.lock true",
-                  "bash", tool("param-sweep"), scene(), env("LW_BIN"), dir, dir, dir, dir, dir, dir, dir),
-               0, "%s", err_txt());
-  char *e = lw_test_slurp("%s/w.err", dir);
-  const char *last = strstr(e, "param-sweep: interrupted: the runs in progress stopped with their state saved");
-  cr_assert(last && !strstr(last, "\n["), "%s", e);
-  cr_assert(strstr(e, "[1/2] init.splines=2__seed-1: interrupted, state saved") &&
-            strstr(e, "[2/2] init.splines=600__seed-1: interrupted, state saved"), "%s", e);
-  cr_assert(!strstr(e, "aborting") && !strstr(e, "alone"), "%s", e);
-  free(e);
+  static const char *const sig[] = {"INT", "HUP"};
+  for (int k = 0; k < 2; k++) {
+    cr_assert_eq(sh("rm -rf %s/w && (setsid env --default-signal=INT %s %s %s --vary init.splines=2,600 --seeds 1 -j 2 "
+                    "--threads 1 --set anneal.sweeps=1000000 --set scene.width=300 --bin %s --out %s/w >%s/w.out "
+                    "2>%s/w.err & echo $! >%s/w.pid); a=%s/w/init.splines=2__seed-1; b=%s/w/init.splines=600__seed-1; "
+                    "i=0; while [ $i -lt 1500 ] && ! { test -s $a/state.lw && test -s $b/state.lw; }; do sleep 0.02; "
+                    "i=$((i+1)); done; p=$(cat %s/w.pid); kill -%s -$p; i=0; while kill -0 $p 2>/dev/null && "
+                    "[ $i -lt 1500 ]; do sleep 0.02; i=$((i+1)); done; kill -KILL -$p 2>/dev/null; test $i -lt 1500 && "
+                    "flock -n $a/.lock true && flock -n $b/.lock true",
+                    dir, "bash", tool("param-sweep"), scene(), env("LW_BIN"), dir, dir, dir, dir, dir, dir, dir, sig[k]),
+                 0, "SIG%s: %s", sig[k], err_txt());
+    char *e = lw_test_slurp("%s/w.err", dir);
+    const char *last = strstr(e, "param-sweep: interrupted: the runs in progress stopped with their state saved");
+    cr_assert(last && !strstr(last, "\n["), "SIG%s: %s", sig[k], e);
+    cr_assert(strstr(e, "[1/2] init.splines=2__seed-1: interrupted, state saved") &&
+                  strstr(e, "[2/2] init.splines=600__seed-1: interrupted, state saved"), "SIG%s: %s", sig[k], e);
+    cr_assert(!strstr(e, "aborting") && !strstr(e, "alone") && !strstr(e, "Hangup"), "SIG%s: %s", sig[k], e);
+    free(e);
+  }
 }
 
 /* A sweep of a picture gathers the drawing's scores too: close share and

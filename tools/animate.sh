@@ -10,6 +10,8 @@ case ${1:-} in
 esac
 dir=$1
 fps=${2:-25}
+# a directory named "-x" must not read as an option of ls or cd
+case $dir in -*) dir=./$dir ;; esac
 if [ ! -d "$dir/frames" ] || [ -z "$(ls -- "$dir/frames" 2>/dev/null | grep '^frame-[0-9]*\.png$')" ]; then
   echo "${0##*/}: $dir/frames has no frames (set output.frames_every in the scene)" >&2
   exit 2
@@ -18,7 +20,7 @@ command -v ffmpeg >/dev/null 2>&1 || { echo "${0##*/}: ffmpeg not found (make de
 # The frames are numbered by sweep, not consecutively.  ffmpeg's glob would
 # read RUN_DIR itself as a pattern ("run[1]" took run1's frames), so they
 # are linked as 1, 2, 3, ... in a directory of our own, in sweep order.
-abs=$(cd -- "$dir" && pwd -P)
+abs=$(CDPATH= cd -P -- "$dir" >/dev/null && pwd -P) # CDPATH would make cd print the directory
 tmp=$(mktemp -d) || exit 1
 # dash runs no EXIT trap when a signal ends it: the signals exit through it
 trap 'rm -rf "$tmp"' EXIT
