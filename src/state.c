@@ -182,8 +182,10 @@ lw_status lw_state_get_splines(lw_ckpt *c, const char *section, lw_splines **out
   lw_error_set(err, LW_EINPUT, "%s:%d: [%s] %s: expected %s, got '%.60s'", path, line, section, key ? key : "", \
                what, got)
   key = NULL;
-  if (!lw_ckpt_next(c, section, &pos, &key, &val, &line) || strcmp(key, "splines"))
-    return BAD("'splines = <count>' first", key ? key : "end of section");
+  if (!lw_ckpt_next(c, section, &pos, &key, &val, &line))
+    return lw_error_set(err, LW_EINPUT, "%s: [%s]: expected 'splines = <count>' first, got the end of the section%s",
+                        path, section, lw_ckpt_cut_hint(c, section));
+  if (strcmp(key, "splines")) return BAD("'splines = <count>' first", key);
   long long ns;
   if (!lw_number_parse_whole(val, 0, 1e8, &ns)) return BAD("a whole number from 0 to 100000000", val);
   const int count_line = line;

@@ -165,7 +165,13 @@ Test(checkpoint, a_state_cut_short_is_said_to_be)
   /* cut after a whole node line: the spline short of its last node */
   lw_test_sh("rm -rf %s/x && cp -r %s/r %s/x && sed -i '$d' %s/x/state.lw", dir, dir, dir, dir);
   cr_expect_eq(lw_test_sh("%s resume %s/x --quiet 2>%s/err.txt", lw_test_bin(), dir, dir), 2);
-  cr_expect(err_has("got the end of the section, where the file ends (cut short by a partial copy or a full disk, or edited?) (its"));
+  cr_expect(err_has("got the end of the section, where the file ends (cut short by a partial copy or a full disk, or "
+                    "edited?) (its"));
+  /* cut right after the section's name (it said line 0 and an empty key) */
+  lw_test_sh("rm -rf %s/x && cp -r %s/r %s/x && sed -i '/^\\[system splines\\]$/q' %s/x/state.lw", dir, dir, dir, dir);
+  cr_expect_eq(lw_test_sh("%s resume %s/x --quiet 2>%s/err.txt", lw_test_bin(), dir, dir), 2);
+  cr_expect(err_has("x/state.lw: [system splines]: expected ") &&
+            err_has(" first, got the end of the section, where the file ends"));
 }
 
 Test(checkpoint, a_state_with_an_infinite_energy_is_refused_with_the_spline_and_segment)
