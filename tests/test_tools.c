@@ -593,6 +593,7 @@ Test(tools, bad_usage_exits_2_with_one_message_and_writes_nothing)
     {"--seeds 1,x", "'x'"},
     {"", "--seeds"},
     {"--seeds 1,1", "twice"},
+    {"--seeds 1 --seeds 1-2", "seed 1 is listed twice: in '1' and in '1-2'"}, /* two runs shared a directory */
     {"--seeds 1 --vary anneal.seed=1,2", "--seeds"},
     {"--seeds 1 --vary scene.width=a/b", "scene.width"},
     {"--seeds 1 --vary width=3", "section.key"},
