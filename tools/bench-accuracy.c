@@ -268,9 +268,10 @@ void bench_cutoff(bench_ctx *b)
   const double s = b->ann_spacing;
   fprintf(d, "## Pair cutoff\n\n"
              "Against no cutoff (every pair of samples on the page), quadrature %d, near field %g;\n"
-             "dE and decisions are of the pair term's part of dE. Lines are %.2f mm apart on average.\n\n"
+             "dE and decisions are of the pair term's part of dE; *pair energy left out* is 1 - E(rc) / E(none).\n"
+             "Lines are %.2f mm apart on average.\n\n"
              "![error against ns per proposal for each cutoff](accuracy-cutoff.png)\n\n"
-             "| cutoff mm | in line spacings | pair energy | dE | dE rms | decisions | ns per proposal | x cost of 4 mm |\n"
+             "| cutoff mm | in line spacings | pair energy left out | dE | dE rms | decisions | ns per proposal | x cost of 4 mm |\n"
              "|---|---|---|---|---|---|---|---|\n",
           b->ann_params.quadrature, b->ann_params.pair_near, s);
   FILE *f = bench_data(b, "cutoff.dat");
@@ -395,7 +396,10 @@ void bench_near(bench_ctx *b)
              "product rule (pairnear.h, NUMERICS.md).\n\n"
              "### Two curves\n\n"
              "Relative error of the pair energy of two curves (arcs of radius 3 and 2 of 4 segments\n"
-             "each, units arbitrary) against a brute-force reference: nested adaptive Gauss-Kronrod\n"
+             "each, touching at a node of both; 5 segments each for the contact mid-segment; the arc of\n"
+             "radius 2 moved to cross; parallel: concentric arcs of radii 3 and 3.02; units arbitrary;\n"
+             "other curves than NUMERICS.md's cases of the same names) against a brute-force\n"
+             "reference: nested adaptive Gauss-Kronrod\n"
              "over the exact Bezier curves (GSL qagp, relative tolerance 1e-11; tests/pairref.h), for\n"
              "near-field radii 0 (off), 1 (refused: below), 1.5 (default) and 3 element lengths.\n\n"
              "| curves | nodes | near 0 (off) | near 1 | near 1.5 | near 3 |\n|---|---|---|---|---|---|\n");
