@@ -93,6 +93,28 @@ void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n)
              a->params.tune_sweeps);
 }
 
+void lw_anneal_ladder_note(const lw_anneal *a, char *buf, size_t n)
+{
+  buf[0] = '\0';
+  const lw_tempering *pt = a->pt;
+  if (!pt || a->params.tune_ladder != LW_LADDER_EQUAL || a->params.ladder_sweeps <= 0) return;
+  double sum = 0.0, sq = 0.0, lo = 2.0, hi = -1.0;
+  int at_lo = 0, at_hi = 0;
+  for (int k = 0; k + 1 < pt->n; k++) {
+    if (pt->tried[k] < 1000) return; /* too few to tell: +-0.015 a pair */
+    const double r = lw_tempering_acceptance(pt, k);
+    sum += r;
+    sq += r * r;
+    if (r < lo) lo = r, at_lo = k;
+    if (r > hi) hi = r, at_hi = k;
+  }
+  const double m = sum / (pt->n - 1), rms = sqrt(fmax(0.0, sq / (pt->n - 1) - m * m));
+  if (rms > 0.06)
+    snprintf(buf, n, "the swap rates since the ladder froze run from %.2f (rungs %d and %d) to %.2f (%d and %d), %.3f "
+             "rms about their mean: tempering.ladder_sweeps = %d was too short to equalise them (raise it)", lo, at_lo,
+             at_lo + 1, hi, at_hi, at_hi + 1, rms, a->params.ladder_sweeps);
+}
+
 void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n)
 {
   const double wall = now_seconds() - a->wall_start;
@@ -468,8 +490,21 @@ static void schedule_note(const lw_anneal *a, char *buf, size_t n)
     m += (size_t)snprintf(buf + m, n - m, "%sanneal.table has rows past step %ld, the last of anneal.steps = %ld "
                           "(steps count from 0): they are never reached", m ? "; " : "", s->blocks - 1, s->blocks);
   if (s->blocks == 1 && (needs & LW_SCHEDULE_USES_END) && s->t_end != s->t_start && m < n)
-    snprintf(buf + m, n - m, "anneal.steps = 1: the run stays at t_start = %g (t_end = %g is the temperature of "
-             "the last of two or more steps)", s->t_start, s->t_end);
+    m += (size_t)snprintf(buf + m, n - m, "%sanneal.steps = 1: the run stays at t_start = %g (t_end = %g is the "
+                          "temperature of the last of two or more steps)", m ? "; " : "", s->t_start, s->t_end);
+  /* a ladder tuned over no sweeps, or while the steps still tune (LJ13's
+  ** default 200 of its 2000: swap rates less even than the geometric
+  ** start's, two round trips in 40000 sweeps), was silent */
+  if (a->n_rep > 1 && p->tune_ladder == LW_LADDER_EQUAL && m < n) {
+    if (p->ladder_sweeps == 0)
+      snprintf(buf + m, n - m, "%stempering.tune_ladder = equal with ladder_sweeps = 0 tunes nothing: the ladder "
+               "stays as given", m ? "; " : "");
+    else if (p->ladder_sweeps <= p->tune_sweeps)
+      snprintf(buf + m, n - m, "%stempering.ladder_sweeps = %d ends within moves.tune_sweeps = %d: the ladder is "
+               "tuned on rungs whose steps still tune, far from settled, and may come out less even than where it "
+               "started (a few times tune_sweeps tunes it on settled rungs)", m ? "; " : "", p->ladder_sweeps,
+               p->tune_sweeps);
+  }
 }
 
 /* Keys the scene sets that its other settings leave idle (a table under a
@@ -1176,10 +1211,23 @@ static lw_status write_ladder(const lw_anneal *a, lw_error *err)
   dir_file(path, sizeof path, a, "ladder.ini");
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
   if (!f) return err->code;
-  fprintf(f, "; ladder tuned toward equal swap acceptance over %d sweeps\n[tempering]\nladder =",
-          a->params.ladder_sweeps);
-  for (int k = 0; k < a->n_rep; k++) fprintf(f, " %.17g", a->pt->ladder[k]);
-  fprintf(f, "\n");
+  /* "ready to reuse": as many digits as let the value fit on a scene line
+  ** (16 rungs at 17 digits were 301 bytes, which --set and the INI reader
+  ** refused); 4 digits move a rung by at most 5e-4 of itself */
+  const size_t cap = lw_params_text_cap(lw_params_find("tempering", "ladder"));
+  static const int digits[] = {17, 10, 8, 6, 5, 4};
+  char value[LW_TEMPERING_MAX * 26];
+  size_t used = 0;
+  for (size_t d = 0; d < sizeof digits / sizeof *digits && (d == 0 || used > cap); d++) {
+    used = 0;
+    for (int k = 0; k < a->n_rep; k++)
+      used += (size_t)snprintf(value + used, sizeof value - used, "%s%.*g", k ? " " : "", digits[d], a->pt->ladder[k]);
+  }
+  fprintf(f, "; ladder tuned toward equal swap acceptance over %d sweeps\n", a->params.ladder_sweeps);
+  if (used > cap)
+    fprintf(f, "; %d rungs need %zu bytes, more than the %zu a scene's line holds: --set and a scene file refuse "
+            "it, and tune_ladder = equal gives it again\n", a->n_rep, used, cap);
+  fprintf(f, "[tempering]\nladder = %s\n", value);
   return lw_output_commit(f, tmp, path, err);
 }
 
@@ -1207,7 +1255,9 @@ static lw_status exchange(lw_anneal *a, lw_error *err)
   if (a->net && (s = a->net->moved(a->net, a, swapped, err))) return s;
   if (p->tune_ladder == LW_LADDER_EQUAL && a->sweep <= p->ladder_sweeps) {
     if (pt->steps % LW_TEMPERING_TUNE_EVERY == 0) {
-      lw_tempering_tune(pt);
+      /* (counted from the start: from the end of the moves' step tuning
+      ** instead, LJ13's ladders came out no more even and the wire's less) */
+      lw_tempering_tune(pt, lw_tempering_tune_gain((long)(pt->steps / LW_TEMPERING_TUNE_EVERY)));
       set_temperatures(a);
     }
     if (a->sweep + p->exchange_every > p->ladder_sweeps) {

@@ -488,6 +488,8 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     fprintf(stderr, "%s", drawn);
     lw_anneal_tuning_note(a, drawn, sizeof drawn);
     if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
+    lw_anneal_ladder_note(a, drawn, sizeof drawn);
+    if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
     lw_anneal_checkpoint_note(a, drawn, sizeof drawn);
     if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
   }

@@ -107,7 +107,9 @@ int lw_tempering_exchange(lw_tempering *pt, const double *energy, const double *
   return swaps;
 }
 
-void lw_tempering_tune(lw_tempering *pt)
+double lw_tempering_tune_gain(long updates) { return updates > 4 ? 4.0 / (double)updates : 1.0; }
+
+void lw_tempering_tune(lw_tempering *pt, double gain)
 {
   int n = pt->n;
   double mean = 0.0;
@@ -116,20 +118,8 @@ void lw_tempering_tune(lw_tempering *pt)
     mean += (double)pt->win_accepted[k] / (double)pt->win_tried[k];
   }
   mean /= (double)(n - 1);
-  /* Gaps in log T, scaled by exp(gain (acceptance - mean)): a pair that
-  ** swaps too easily is pulled apart, one that rarely swaps is pushed
-  ** together.  The factor is bounded (e^-1 .. e), so a pair that never swaps
-  ** cannot collapse the ladder in one update; renormalising keeps both ends.
-  ** A window's acceptance (about 20 attempts a pair) is noisy by +-0.1: at a
-  ** fixed gain the ladder wandered with it and froze wherever it was (a
-  ** harmonic wire whose geometric ladder is the equal one ended at swap
-  ** rates 0.19 to 0.43).  The gain falls as 4 / (update number) after the
-  ** first four (Robbins and Monro), so the ladder settles on the mean of the
-  ** windows, its spread shrinking like 1 / sqrt(updates); 4 did better
-  ** than 2 or 10 from an equal ladder and from an uneven one (measured
-  ** 2026-12-05, wire-ladder, 4 rungs: rms 0.013 off equal at 10000 tuning
-  ** sweeps, 0.03 at 1000). */
-  const double updates = (double)(pt->steps / LW_TEMPERING_TUNE_EVERY), gain = updates > 4.0 ? 4.0 / updates : 1.0;
+  /* The factor is bounded (e^-1 .. e), so a pair that never swaps cannot
+  ** collapse the ladder in one update; renormalising keeps both ends. */
   double gap[LW_TEMPERING_MAX], total = 0.0, span = log(pt->ladder[n - 1] / pt->ladder[0]);
   for (int k = 0; k + 1 < n; k++) {
     double a = (double)pt->win_accepted[k] / (double)pt->win_tried[k];

@@ -147,6 +147,11 @@ double lw_anneal_acceptance(const lw_anneal *a);
 ** the run, from the process that holds the coldest rung. */
 void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n);
 
+/* A note (else "") when, after tune_ladder = equal, the swap rates since
+** the ladder froze (each pair tried 1000 times or more) spread more than
+** 0.06 rms about their mean: a ladder_sweeps too short to equalise them. */
+void lw_anneal_ladder_note(const lw_anneal *a, char *buf, size_t n);
+
 /* A note (else "") when this process spent over a third of its time, and
 ** over a second, writing checkpoints: fsync'd state of a small system
 ** every output.checkpoint_every sweeps made a 1-second study take 8. */
