@@ -500,6 +500,17 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
   t = (const lw_trace *const *)heat;
   double tlo = INFINITY, thi = -INFINITY;
   for (int r = 0; r < k; r++) temperature_range(t[r], row[r], n[r], &tlo, &thi);
+  /* rungs at other temperatures in other runs (each tuned its own ladder,
+  ** tune_ladder = equal): their replicaK columns are other ensembles, and
+  ** every inner rung was called "not converged" */
+  int ladders_differ = 0;
+  for (size_t c = 0; c < t[0]->n_cols; c++) {
+    const char *name = t[0]->name[c];
+    if (strncmp(name, "replica", 7) || !strstr(name, "_temperature")) continue;
+    const double first = n[0] ? at(t[0], row[0][n[0] - 1], (int)c) : 0.0;
+    for (int r = 1; r < k; r++)
+      if (n[r] && fabs(at(t[r], row[r][n[r] - 1], (int)c) - first) > 1e-9 * fabs(first)) ladders_differ = 1;
+  }
   for (size_t c = 0; c < t[0]->n_cols; c++) {
     cs[c].run = runs + c * (size_t)k;
     if (is_coordinate(t[0]->name[c])) continue;
@@ -517,8 +528,11 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       cs[c].run[0].n = 0; /* a column some run never filled: left out */
     } else if (k > 1) {
       combine(&cs[c], k, gap);
-      /* an acceptance depends on each run's own tuned step: runs need not agree */
-      if (!strncmp(t[0]->name[c], "acc_", 4) || !strncmp(t[0]->name[c], "swap", 4)) cs[c].p_runs = cs[c].r_hat = NAN;
+      /* an acceptance depends on each run's own tuned step: runs need not
+      ** agree; nor need a rung's columns where the rungs' temperatures differ */
+      if (!strncmp(t[0]->name[c], "acc_", 4) || !strncmp(t[0]->name[c], "swap", 4) ||
+          (ladders_differ && !strncmp(t[0]->name[c], "replica", 7)))
+        cs[c].p_runs = cs[c].r_hat = NAN;
     }
   }
   int width = 16; /* the names' column */
@@ -598,6 +612,10 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
   if (apart && tlo < thi) /* equal: one temperature; inf > -inf: no temperature column (dynamics) */
     fprintf(apart, "warning: the temperature changes within %s: the means mix ensembles\n",
             k > 1 ? "or between the runs" : "these rows");
+  if (apart && ladders_differ)
+    fprintf(apart, "warning: the runs' rungs stand at other temperatures (their ladders were tuned each its own): "
+            "the replicaK columns mix ensembles and are not compared (R_hat and p_runs empty); compare them run by "
+            "run, or with --reweight\n");
   if (apart && k > 1 && identical_runs(t, row, n, k))
     fprintf(apart, "warning: the %d runs are the same, row for row: one seed run twice, or seeds that change "
             "nothing (a scene that draws no random number, as the dynamics from init.from or the D-NURBS dynamics), "

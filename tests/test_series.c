@@ -1033,3 +1033,35 @@ Test(trace, one_row_gives_a_mean_and_no_error_bar, .init = make_dir, .fini = rem
   cr_assert(strstr(out, "\nheat_capacity,0,,,,,,,,\n"), "%s", out);
   lw_trace_free(t);
 }
+
+/* Runs whose ladders were tuned each its own have rungs at other
+** temperatures: their replicaK columns are other ensembles, said once and
+** not compared (every inner rung was "not converged"); runs on one ladder
+** are compared as before. */
+Test(trace, runs_with_rungs_at_other_temperatures_are_not_compared_rung_by_rung, .init = make_dir,
+     .fini = remove_dir)
+{
+  static char text[2][8192];
+  for (int r = 0; r < 2; r++) {
+    int m = snprintf(text[r], sizeof text[r], "sweep,temperature,total,replica1_temperature,replica1_energy\n");
+    for (int s = 1; s <= 100; s++)
+      m += snprintf(text[r] + m, sizeof text[r] - (size_t)m, "%d,1,%g,%g,%g\n", s, 10.0 + (s * 7 % 5),
+                    r ? 2.5 : 2.0, (r ? 30.0 : 20.0) + (s * 3 % 7));
+  }
+  for (int same = 0; same < 2; same++) {
+    if (same) memcpy(text[1], text[0], sizeof text[0]);
+    lw_trace *t[2] = {trace_of(text[0]), trace_of(text[1])};
+    const char *path[2] = {"a.csv", "b.csv"};
+    lw_trace_select sel[2] = {{.from = 0, .to = -1}, {.from = 0, .to = -1}};
+    char out[8192];
+    FILE *f = fmemopen(out, sizeof out, "w");
+    lw_error err;
+    cr_assert_eq(lw_trace_stats_runs((const lw_trace *const *)t, path, sel, 2, f, &err), LW_OK, "%s", err.msg);
+    fclose(f);
+    cr_assert_eq(strstr(out, "warning: the runs' rungs stand at other temperatures") != NULL, !same, "%s", out);
+    cr_assert_eq(strstr(out, "replica1_energy: the runs disagree") == NULL && !strstr(out, ", replica1_energy"), 1,
+                 "%s", out);
+    lw_trace_free(t[0]);
+    lw_trace_free(t[1]);
+  }
+}
