@@ -67,14 +67,15 @@ void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n)
   /* A move never refused either has a step far too small or does not
   ** change the energy (translations of a lone spline with no term that sees
   ** where it lies, whose tuning grew the step to 135 mm and asked for more
-  ** tuning): said apart, with both ways out. */
+  ** tuning): said apart, with both ways out.  A step at half its cap or more
+  ** is neither (a temperature that takes everything), and is not said. */
   size_t m = 0, flat = 0;
   char same[256] = "";
   for (int k = 0; k < c->n_moves && m + 1 < n; k++) {
     const lw_move_stats *st = &c->stats[k];
     if (!(c->step_max[k] > 0.0) || st->proposed < 100) continue;
     const double acc = (double)st->accepted / (double)st->proposed;
-    if (st->accepted == st->proposed) {
+    if (st->accepted == st->proposed && c->step[k] < 0.5 * c->step_max[k]) {
       if (flat + 1 < sizeof same)
         flat += (size_t)snprintf(same + flat, sizeof same - flat, "%s%s", flat ? ", " : "", a->sys_type->move_names[k]);
     } else if (acc < 0.25 * c->target[k] ||
@@ -120,9 +121,10 @@ void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n)
   const double wall = now_seconds() - a->wall_start;
   buf[0] = '\0';
   if (a->ckpt_seconds > 1.0 && a->ckpt_seconds > wall / 3.0)
-    snprintf(buf, n, "writing state.lw every %d sweeps (output.checkpoint_every) took %.0f %% of this run's %.1f s: "
-             "a larger value costs less, and a killed run then loses more sweeps", a->params.checkpoint_every,
-             100.0 * a->ckpt_seconds / wall, wall);
+    /* (no figures of this run: a sweep shows each distinct note once) */
+    snprintf(buf, n, "writing state.lw every %d sweeps (output.checkpoint_every) took %s of this run's time: a "
+             "larger value costs less, and a killed run then loses more sweeps", a->params.checkpoint_every,
+             a->ckpt_seconds > wall / 2.0 ? "most" : "over a third");
 }
 
 /* Temperature step of sweep s: the sweeps are shared out evenly; past the

@@ -525,7 +525,9 @@ static int exif_orientation(const unsigned char *d, size_t n)
     for (size_t at = 8; at + 12 <= n;) {
       size_t len = (size_t)d[at] << 24 | (size_t)d[at + 1] << 16 | (size_t)d[at + 2] << 8 | d[at + 3];
       if (len > n - at - 12) break;
-      if (!memcmp(d + at + 4, "eXIf", 4)) return tiff_orientation(d + at + 8, len);
+      if (!memcmp(d + at + 4, "eXIf", 4)) /* (some writers keep JPEG's "Exif\0\0" before it) */
+        return len >= 6 && !memcmp(d + at + 8, "Exif\0\0", 6) ? tiff_orientation(d + at + 14, len - 6)
+                                                                : tiff_orientation(d + at + 8, len);
       if (!memcmp(d + at + 4, "IEND", 4)) break;
       at += 12 + len;
     }
@@ -603,7 +605,8 @@ static const char *foreign_format(const unsigned char *d, size_t n)
   if (n >= 12 && !memcmp(d + 4, "ftyp", 4)) {
     /* the major brand, then the compatible ones (an AVIF may say mif1 first) */
     size_t box = (size_t)d[0] << 24 | (size_t)d[1] << 16 | (size_t)d[2] << 8 | d[3];
-    if (box < 16 || box > n) box = 12;
+    if (box < 16) box = 12;
+    if (box > n) box = n;
     int heic = 0;
     for (size_t at = 8; at + 4 <= box; at += at == 8 ? 8 : 4) {
       if (!memcmp(d + at, "avif", 4) || !memcmp(d + at, "avis", 4)) return "an AVIF";
@@ -622,7 +625,8 @@ static const char *foreign_format(const unsigned char *d, size_t n)
   if (n >= 5 && !memcmp(d, "%PDF-", 5)) return "a PDF";
   size_t at = n >= 3 && !memcmp(d, "\xef\xbb\xbf", 3) ? 3 : 0; /* a BOM, then blanks */
   while (at < n && at < 256 && (d[at] == ' ' || d[at] == '\t' || d[at] == '\r' || d[at] == '\n')) at++;
-  if (n - at >= 5 && (!memcmp(d + at, "<svg", 4) || !memcmp(d + at, "<?xml", 5) || !memcmp(d + at, "<!DOC", 5)))
+  if (n - at >= 5 && (!memcmp(d + at, "<svg", 4) || !memcmp(d + at, "<?xml", 5) || !memcmp(d + at, "<!DOC", 5) ||
+                      !memcmp(d + at, "<!--", 4)))
     return "an SVG";
   return NULL;
 }
@@ -650,6 +654,28 @@ static const char *too_large(const unsigned char *d, size_t n, double w, double 
   if (!png && ch && w * h * ch > (double)INT_MAX)
     return "its width x height x channels is more than 2^31 (2.1e9 grey, 716 million RGB or 537 million RGBA pixels)";
   return NULL;
+}
+
+/* The components of a JPEG's frame (its SOF segment), 0 if none is found:
+** stbi_info says 3 for a CMYK JPEG, which the decoder holds to its limit
+** with 4 (one between 537 and 716 million pixels was "damaged"). */
+static int jpeg_components(const unsigned char *d, size_t n)
+{
+  size_t at = 0;
+  while (at < n && d[at] == 0xFF) at++;
+  if (at == 0 || at >= n || d[at] != 0xD8) return 0;
+  at++;
+  while (at < n && d[at] == 0xFF) {
+    while (at < n && d[at] == 0xFF) at++;
+    if (at + 3 > n) break;
+    unsigned marker = d[at];
+    size_t len = (size_t)d[at + 1] << 8 | d[at + 2];
+    if (marker == 0xDA || marker == 0xD9 || len < 2 || at + 1 + len > n) break;
+    if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC)
+      return len >= 8 ? d[at + 8] : 0;
+    at += 1 + len;
+  }
+  return 0;
 }
 
 static lw_status too_large_error(const unsigned char *d, size_t n, const char *name, const char *why, lw_error *err)
@@ -693,7 +719,8 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
   if (!stbi_info_from_memory(data, (int)size, &w, &h, &ch)) return not_decoded(data, size, name, err);
   if (w < 1 || h < 1) /* stb_image passes a BMP of width 0 */
     return lw_error_set(err, LW_EINPUT, "%s: the %s is damaged: %d x %d pixels", name, format_name(data, size), w, h);
-  const char *big = too_large(data, size, w, h, ch);
+  const int comps = !strcmp(format_name(data, size), "JPEG") ? jpeg_components(data, size) : 0;
+  const char *big = too_large(data, size, w, h, comps > ch ? comps : ch);
   if (big) return too_large_error(data, size, name, big, err);
   if ((double)w * (double)h > LW_IMAGE_MAX_PIXELS)
     return lw_error_set(err, LW_EINPUT, "%s: %d x %d pixels is more than the %.0e pixels linewise decodes", name,

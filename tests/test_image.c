@@ -842,8 +842,9 @@ Test(image, jpeg_exif_orientation_is_turned_upright)
 }
 
 /* The 32 x 16 picture of exif_jpeg as a PNG, with an eXIf chunk of
-** orientation o (0: none) after its header, or with `late` after its
-** image data. */
+** orientation o (0: none) after its header, or with `late` 1 after its
+** image data; `late` 2: after its header, the TIFF block behind JPEG's
+** "Exif\0\0" as some writers keep it. */
 static size_t exif_png(unsigned char *out, int o, int late)
 {
   unsigned char px[32 * 16];
@@ -853,10 +854,17 @@ static size_t exif_png(unsigned char *out, int o, int late)
   cr_assert(stbi_write_png_to_func(jpeg_put, &j, 32, 16, 1, px, 32));
   static const unsigned char chunk[34] = {0, 0, 0, 22, 'e', 'X', 'I', 'f', 'M', 'M', 0, 42, 0, 0, 0, 8, 0, 1,
                                           0x01, 0x12, 0, 3, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0};
-  size_t head = late ? j.n - 12 : 8 + 25, n = 0; /* before IEND, or after the signature and IHDR */
+  size_t head = late == 1 ? j.n - 12 : 8 + 25, n = 0; /* before IEND, or after the signature and IHDR */
   memcpy(out, j.b, head);
   n = head;
-  if (o) {
+  if (o && late == 2) {
+    memcpy(out + n, chunk, 8);
+    out[n + 3] = 28;
+    memcpy(out + n + 8, "Exif\0\0", 6);
+    memcpy(out + n + 14, chunk + 8, sizeof chunk - 8);
+    out[n + 33] = (unsigned char)o;
+    n += sizeof chunk + 6;
+  } else if (o) {
     memcpy(out + n, chunk, sizeof chunk); /* the decoder reads no CRC of an ancillary chunk: 0 */
     out[n + 27] = (unsigned char)o;
     n += sizeof chunk;
@@ -873,14 +881,14 @@ Test(image, png_exif_orientation_is_turned_upright)
   static const int corner[9] = {0, 0, 1, 2, 3, 0, 1, 2, 3};
   unsigned char png[8400];
   lw_error err;
-  for (int o = 0; o <= 17; o++) {
-    size_t n = exif_png(png, o % 9, o > 8);
+  for (int o = 0; o <= 26; o++) {
+    size_t n = exif_png(png, o % 9, o / 9);
     lw_image_info info;
     lw_image *img = lw_image_decode(png, n, "t.png", 1e6, &info, &err);
     cr_assert_not_null(img, "orientation %d: %s", o, err.msg);
     cr_assert(img->width == (o % 9 >= 5 ? 16 : 32) && dark_corner(img) == corner[o % 9],
-              "orientation %d%s: %d x %d, corner %d", o % 9, o > 8 ? " (after the data)" : "", img->width,
-              img->height, dark_corner(img));
+              "orientation %d%s: %d x %d, corner %d", o % 9,
+              o > 17 ? " (Exif prefix)" : o > 8 ? " (after the data)" : "", img->width, img->height, dark_corner(img));
     lw_image_free(img);
   }
   const char *path = lw_test_path("side.png");
@@ -928,5 +936,19 @@ Test(image, foreign_formats_are_named_and_a_huge_jpeg_is_too_large)
   jpg[at + 9] = 3; /* 3 components: RGB */
   cr_assert_null(lw_image_decode(jpg, n, "big.jpg", 1e6, NULL, &err));
   cr_assert(strstr(err.msg, "big.jpg: the JPEG is too large to decode: its width x height x channels is more than "
+                   "2^31"), "%s", err.msg);
+  /* a CMYK JPEG of 24000 x 24000: 4 components, which stbi_info counts as 3
+  ** (1.7e9 bytes, under the limit) and the decoder as 4 (2.3e9: "damaged") */
+  unsigned char cmyk[128] = {0xFF, 0xD8, 0xFF, 0xEE, 0, 14, 'A', 'd', 'o', 'b', 'e', 0, 100, 0, 0, 0, 0, 0,
+                             0xFF, 0xDB, 0, 67, 0};
+  size_t m = 18 + 69;
+  memset(cmyk + 23, 1, 64);
+  const unsigned char sof[] = {0xFF, 0xC0, 0, 20, 8, 24000 >> 8, 24000 & 255, 24000 >> 8, 24000 & 255, 4,
+                               1, 0x11, 0, 2, 0x11, 0, 3, 0x11, 0, 4, 0x11, 0};
+  memcpy(cmyk + m, sof, sizeof sof);
+  m += sizeof sof;
+  cmyk[m++] = 0xFF, cmyk[m++] = 0xD9;
+  cr_assert_null(lw_image_decode(cmyk, m, "cmyk.jpg", 1e6, NULL, &err));
+  cr_assert(strstr(err.msg, "cmyk.jpg: the JPEG is too large to decode: its width x height x channels is more than "
                    "2^31"), "%s", err.msg);
 }

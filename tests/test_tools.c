@@ -281,8 +281,8 @@ Test(tools, ctrl_c_stops_the_sweep_after_its_runs_have_saved)
                   "bash", tool("seed-sweep"), scene(), env("LW_BIN"), dir, dir, dir, dir, dir, dir, dir, dir, dir, dir),
                0, "%s", err_txt());
   char *e = lw_test_slurp("%s/i.err", dir);
-  cr_assert(strstr(e, "seed-sweep: interrupted: the runs in progress stopped with their state saved; rerun the sweep "
-                      "to resume\n") && strstr(e, "[1/3] seed-1: interrupted, state saved"), "%s", e);
+  cr_assert(strstr(e, "seed-sweep: interrupted: no further run started, and the runs in progress stopped (each said "
+                      "how); rerun the sweep to go on") && strstr(e, "[1/3] seed-1: interrupted, state saved"), "%s", e);
   free(e);
   cr_assert_eq(lw_test_sh("grep -q '^sweep = [1-9]' %s/i/seed-1/state.lw", dir), 0);
 }
@@ -308,7 +308,7 @@ Test(tools, ctrl_c_or_a_hang_up_waits_for_the_slowest_run)
                     dir, "bash", tool("param-sweep"), scene(), env("LW_BIN"), dir, dir, dir, dir, dir, dir, dir, sig[k]),
                  0, "SIG%s: %s", sig[k], err_txt());
     char *e = lw_test_slurp("%s/w.err", dir);
-    const char *last = strstr(e, "param-sweep: interrupted: the runs in progress stopped with their state saved");
+    const char *last = strstr(e, "param-sweep: interrupted: no further run started, and the runs in progress stopped");
     cr_assert(last && !strstr(last, "\n["), "SIG%s: %s", sig[k], e);
     cr_assert(strstr(e, "[1/2] init.splines=2__seed-1: interrupted, state saved") &&
                   strstr(e, "[2/2] init.splines=600__seed-1: interrupted, state saved"), "SIG%s: %s", sig[k], e);

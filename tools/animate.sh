@@ -21,18 +21,20 @@ command -v ffmpeg >/dev/null 2>&1 || { echo "${0##*/}: ffmpeg not found (make de
 # read RUN_DIR itself as a pattern ("run[1]" took run1's frames), so they
 # are linked as 1, 2, 3, ... in a directory of our own, in sweep order.
 abs=$(CDPATH= cd -P -- "$dir" >/dev/null && pwd -P) # CDPATH would make cd print the directory
-tmp=$(mktemp -d) || exit 1
+tmp=$(mktemp -d "$abs/.animate.XXXXXX") || exit 1 # beside the video: its rename is whole
 # dash runs no EXIT trap when a signal ends it: the signals exit through it
 trap 'rm -rf "$tmp"' EXIT
+trap 'exit 129' HUP
 trap 'exit 130' INT
-trap 'exit 143' TERM HUP
+trap 'exit 143' TERM
 n=0
 for f in $(ls -- "$abs/frames" | grep '^frame-[0-9]*\.png$' | sort -t- -k2n); do
   n=$((n + 1))
   ln -s "$abs/frames/$f" "$tmp/$(printf %08d "$n").png"
 done
-# file: keeps a directory such as "a:b" from reading as a protocol, and
-# ffmpeg takes it as an option only if it begins with '-' (abs never does)
+# written beside the links and moved into place whole: a signal left a
+# 48-byte animation.mp4 that no player opens
 (cd "$tmp" && ffmpeg -loglevel error -y -framerate "$fps" -i %08d.png \
-  -vf "pad=ceil(iw/2)*2:ceil(ih/2)*2:color=white" -c:v libx264 -pix_fmt yuv420p "file:$abs/animation.mp4")
+  -vf "pad=ceil(iw/2)*2:ceil(ih/2)*2:color=white" -c:v libx264 -pix_fmt yuv420p animation.mp4)
+mv -f "$tmp/animation.mp4" "$abs/animation.mp4"
 echo "$dir/animation.mp4"
