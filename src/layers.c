@@ -80,7 +80,8 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
     /* the name labels the pen's SVG layer: nothing XML would read as markup */
     for (size_t q = 0; q < len; q++)
       if (!isalnum((unsigned char)c[q]) && !strchr("-_.", c[q]))
-        return bad(p, "names", err, "expected names of ASCII letters, digits, '-', '_' and '.', got '%.*s'", (int)len, c);
+        return bad(p, "names", err, "expected names of ASCII letters, digits, '-', '_' and '.', got '%.*s'", (int)len,
+                   c);
     memcpy(ls->spec[n].name, c, len);
     ls->spec[n].name[len] = '\0';
     /* a name says which pen a layer is: two alike would leave the plotter guessing */

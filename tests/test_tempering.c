@@ -422,11 +422,12 @@ Test(ptrun, an_equal_ladder_that_did_not_settle_is_said)
 ** the most digits that fit a scene's line. */
 Test(ptrun, a_tuned_ladder_of_16_rungs_reads_back_through_set)
 {
-  cr_assert_eq(sh("%s run %s/params/lj13.ini --threads 1 --quiet --set anneal.sweeps=300 --set tempering.tune_ladder=equal "
-                  "--set tempering.ladder_sweeps=200 --out %s/lj 2> %s/err.txt", lw_test_bin(), lw_test_root(), dir, dir),
+  cr_assert_eq(sh("%s run %s/params/lj13.ini --threads 1 --quiet --set anneal.sweeps=300 "
+                  "--set tempering.tune_ladder=equal --set tempering.ladder_sweeps=200 --out %s/lj 2> %s/err.txt",
+                  lw_test_bin(), lw_test_root(), dir, dir),
                0);
   cr_assert_eq(sh("L=$(sed -n 's/^ladder = //p' %s/lj/ladder.ini) && test $(echo $L | wc -w) -eq 16 && "
-                  "%s run %s/params/lj13.ini --threads 1 --quiet --stop-at 0 --set \"tempering.ladder=$L\" --out %s/lj2 "
-                  "2> %s/err.txt && grep -q \"^ladder = $L\\$\" %s/lj2/scene.ini", dir, lw_test_bin(), lw_test_root(),
-                  dir, dir, dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+                  "%s run %s/params/lj13.ini --threads 1 --quiet --stop-at 0 --set \"tempering.ladder=$L\" "
+                  "--out %s/lj2 2> %s/err.txt && grep -q \"^ladder = $L\\$\" %s/lj2/scene.ini", dir, lw_test_bin(),
+                  lw_test_root(), dir, dir, dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
