@@ -489,6 +489,29 @@ static uint32_t tiff32(const unsigned char *p, int be)
   return be ? (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3] : le32(p);
 }
 
+/* The segments of a JPEG before its first scan, one a call: *at starts at
+** 0; returns 1 with the marker and its payload (seg, len), 0 at the scan,
+** the end or anything malformed.  Fill bytes 0xFF may stand before any
+** marker, as the decoder allows; every length is checked against the file. */
+static int jpeg_segment(const unsigned char *d, size_t n, size_t *at, unsigned *marker, const unsigned char **seg,
+                        size_t *len)
+{
+  size_t i = *at;
+  if (i == 0) {
+    while (i < n && d[i] == 0xFF) i++;
+    if (i == 0 || i >= n || d[i] != 0xD8) return 0;
+    i++;
+  }
+  if (i >= n || d[i] != 0xFF) return 0;
+  while (i < n && d[i] == 0xFF) i++;
+  if (i + 3 > n) return 0;
+  const unsigned m = d[i];
+  const size_t l = (size_t)d[i + 1] << 8 | d[i + 2];
+  if (m == 0xDA || m == 0xD9 || l < 2 || i + 1 + l > n) return 0;
+  *marker = m, *seg = d + i + 3, *len = l - 2, *at = i + 1 + l;
+  return 1;
+}
+
 /* The orientation (1 to 8) in an EXIF block t of tn bytes (a TIFF header,
 ** then IFD0 with tag 0x0112); 1 when there is none or it cannot be read.
 ** Every offset is checked against the block: a bad one means "none". */
@@ -533,21 +556,11 @@ static int exif_orientation(const unsigned char *d, size_t n)
     }
     return 1;
   }
-  size_t at = 0;
-  while (at < n && d[at] == 0xFF) at++;
-  if (at == 0 || at >= n || d[at] != 0xD8) return 1;
-  at++;
-  while (at < n && d[at] == 0xFF) {
-    while (at < n && d[at] == 0xFF) at++;
-    if (at + 3 > n) break;
-    unsigned marker = d[at];
-    size_t len = (size_t)d[at + 1] << 8 | d[at + 2];
-    if (marker == 0xDA || marker == 0xD9 || len < 2 || at + 1 + len > n) break;
-    const unsigned char *seg = d + at + 3;
-    size_t sn = len - 2;
+  size_t at = 0, sn;
+  unsigned marker;
+  const unsigned char *seg;
+  while (jpeg_segment(d, n, &at, &marker, &seg, &sn))
     if (marker == 0xE1 && sn >= 14 && !memcmp(seg, "Exif\0\0", 6)) return tiff_orientation(seg + 6, sn - 6);
-    at += 1 + len;
-  }
   return 1;
 }
 
@@ -661,20 +674,11 @@ static const char *too_large(const unsigned char *d, size_t n, double w, double 
 ** with 4 (one between 537 and 716 million pixels was "damaged"). */
 static int jpeg_components(const unsigned char *d, size_t n)
 {
-  size_t at = 0;
-  while (at < n && d[at] == 0xFF) at++;
-  if (at == 0 || at >= n || d[at] != 0xD8) return 0;
-  at++;
-  while (at < n && d[at] == 0xFF) {
-    while (at < n && d[at] == 0xFF) at++;
-    if (at + 3 > n) break;
-    unsigned marker = d[at];
-    size_t len = (size_t)d[at + 1] << 8 | d[at + 2];
-    if (marker == 0xDA || marker == 0xD9 || len < 2 || at + 1 + len > n) break;
-    if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC)
-      return len >= 8 ? d[at + 8] : 0;
-    at += 1 + len;
-  }
+  size_t at = 0, sn;
+  unsigned m;
+  const unsigned char *seg;
+  while (jpeg_segment(d, n, &at, &m, &seg, &sn))
+    if (m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC) return sn >= 6 ? seg[5] : 0;
   return 0;
 }
 
