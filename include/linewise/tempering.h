@@ -65,8 +65,8 @@ int lw_tempering_exchange(lw_tempering *pt, const double *energy, const double *
 ** warm-up phase: a ladder that moves breaks detailed balance. */
 void lw_tempering_tune(lw_tempering *pt, double gain);
 
-/* The gain of update number `updates` (counted from 1 once the rungs have
-** settled; 0 before): 1 for the first four, then 4 / updates.  A window's
+/* The gain of update number `updates` (counted from the start of the
+** tuning): 1 for the first four, then 4 / updates.  A window's
 ** acceptance (about 20 attempts a pair) is noisy by +-0.1: at a fixed gain
 ** the ladder wandered with it and froze wherever it was (a harmonic wire
 ** whose geometric ladder is the equal one ended at swap rates 0.19 to
