@@ -1327,22 +1327,44 @@ static lw_status dynamics_sweep(lw_anneal *a, lw_error *err)
   return sweep_files(a, err);
 }
 
-/* Whether the energy is recomputed from scratch after sweep `sweep`: every
-** `every` sweeps (the drift check, with the renumbering before it), and at
-** sweeps 1, 2, 4, 8, ... below that.  A placement can start many orders of
-** magnitude above where the first sweeps take it (particles of a points
-** file on top of a pattern's: 1e19, then -2,800 twenty sweeps on), and a
-** running total keeps the rounding of that fall: a drift of 7 % by sweep
-** 20, and a checkpoint that resume refused as damaged.  The early
-** recomputations drop it while the fall lasts, at log2(every) of them a run
-** (where the totals agree with them to LW_ANNEAL_EARLY_DRIFT, the totals
-** stay); the sweep alone decides, so a resumed run recomputes where the
-** first did. */
-#define LW_ANNEAL_EARLY_DRIFT 1e-9 /* relative drift an early recomputation corrects */
-static int refresh_due(long sweep, long every, int *renumber)
+/* The sum of the magnitudes of replica r's running terms (at least 1, the
+** scale of lw_system_drift); on every process, whose stand-ins hold the
+** terms of the replicas swept elsewhere (anneal_net.h). */
+static double replica_size(const lw_anneal *a, int r)
 {
-  *renumber = sweep % every == 0;
-  return *renumber || (sweep > 0 && sweep < every && (sweep & (sweep - 1)) == 0);
+  double v[LW_SYSTEM_TERMS_MAX], size = 0.0;
+  a->sys_type->terms(a->systems[r]->state, v);
+  for (int t = 0; t < a->sys_type->n_terms; t++) size += fabs(v[t]);
+  return fmax(size, 1.0);
+}
+
+/* Whether the energy is recomputed from scratch after this sweep: every
+** `every` sweeps (the drift check, with the renumbering before it), and
+** wherever a replica's terms have fallen to under 1 / LW_ANNEAL_FALL of
+** their largest size since its last recomputation.  A running total keeps
+** the rounding of where it has been: particles of a points file on top of
+** a pattern's start near 1e19 and are at -2,800 twenty sweeps on, with an
+** error of all of it, which the trace and summary showed and which made
+** resume refuse a checkpoint as damaged.  Where the totals agree with the
+** recomputation to LW_ANNEAL_EARLY_DRIFT they stay (the bits of every
+** ordinary run).  A resumed process starts its peaks at the state it read,
+** not at the larger ones before: it may skip a recomputation that the run
+** which never stopped makes, but that one finds the totals' rounding under
+** LW_ANNEAL_FALL^2 times eps of the size, so keeps them, and the bytes are
+** the same.  Sizes are of terms every process holds (stand-ins included),
+** so every process decides alike. */
+#define LW_ANNEAL_EARLY_DRIFT 1e-9 /* relative drift an early recomputation corrects */
+#define LW_ANNEAL_FALL 8.0
+static int refresh_due(lw_anneal *a, int *renumber)
+{
+  int fell = 0;
+  for (int r = 0; r < a->n_rep; r++) {
+    const double size = replica_size(a, r);
+    if (size > a->size_peak[r]) a->size_peak[r] = size;
+    if (size * LW_ANNEAL_FALL < a->size_peak[r]) fell = 1;
+  }
+  *renumber = a->sweep % a->params.check_every == 0;
+  return *renumber || fell;
 }
 
 /* The recomputation of replica r from scratch (with the renumbering of
@@ -1392,6 +1414,8 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
     }
   }
   int tuning = a->sweep - block_start(a, b) < p->tune_sweeps && a->sweep < p->sweeps;
+  if (a->size_peak[0] == 0.0)
+    for (int r = 0; r < n; r++) a->size_peak[r] = replica_size(a, r);
   int failed = 0, here[LW_TEMPERING_MAX], m = 0;
   for (int k = 0; k < n; k++)
     if (rung_here(a, k)) here[m++] = k; /* all of them in one process */
@@ -1415,9 +1439,8 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
     a->acc_sum += e;
     a->acc_sumsq += e * e;
   }
-  if (a->sweep % p->trace_every == 0 || lw_anneal_done(a)) trace_row(a);
   int renumber;
-  if (refresh_due(a->sweep, p->check_every, &renumber)) {
+  if (refresh_due(a, &renumber)) {
     /* each replica's recomputation is its own, like its sweep: on the
     ** sweep's threads, then the first failure in replica order and the
     ** largest drift, so the thread count changes nothing */
@@ -1446,7 +1469,10 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
     }
     if (a->net) s = a->net->drift(a->net, a, s, err);
     if (s) return s;
+    for (int r = 0; r < n; r++) a->size_peak[r] = replica_size(a, r);
   }
+  /* after the recomputation: a row shows the totals a checkpoint here keeps */
+  if (a->sweep % p->trace_every == 0 || lw_anneal_done(a)) trace_row(a);
   return sweep_files(a, err);
 }
 

@@ -368,8 +368,9 @@ const lw_param_def lw_param_table[] = {
   NUM("anneal", "check_every", LW_PT_INT, check_every, "100", "sweeps", 1, 2e9, 0,
       "Sweeps between full recomputations of the energy (the drift check); splines are "
       "renumbered along a Hilbert curve of the page just before each, for locality in memory. "
-      "The energy is also recomputed at sweeps 1, 2, 4, ... below it, which replaces running "
-      "totals that drifted by more than 1e-9 (a start far above the minimum: docs/NUMERICS.md)."),
+      "The energy is also recomputed after any sweep that leaves it under 1/8 of its size since "
+      "the last time, which replaces running totals that drifted by more than 1e-9 (a start far "
+      "above the minimum: docs/NUMERICS.md)."),
   NUM("anneal", "delayed_acceptance", LW_PT_INT, delayed_acceptance, "1", "", 0, 1, 0,
       "1: a proposal is first tested on a cheap stand-in for the pair term's near field, and the "
       "near field is computed only for proposals that pass (delayed acceptance; the chain samples "

@@ -216,17 +216,37 @@ Test(particles_cli, a_run_starts_from_the_particles_of_another_runs_state)
   cr_assert_eq(sh("grep -q 'spl.lw: section \\[system particles\\]: missing' %s/err.txt", dir), 0);
 }
 
+/* The total of trace.csv's last row in run directory d and the one
+** `linewise energy` recomputes from its state.lw. */
+static void trace_and_state_totals(const char *d, double *traced, double *fresh)
+{
+  char path[256];
+  cr_assert_eq(sh("awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == \"total\") c = i } END { print $c }' "
+                  "%s/trace.csv > %s/t.txt && %s energy %s | awk '$1 == \"total\" { print $2 }' >> %s/t.txt",
+                  d, dir, lw_test_bin(), d, dir), 0);
+  snprintf(path, sizeof path, "%s/t.txt", dir);
+  FILE *f = fopen(path, "r");
+  cr_assert_not_null(f);
+  cr_assert_eq(fscanf(f, "%lf %lf", traced, fresh), 2);
+  fclose(f);
+}
+
 /* Particles of a points file on top of the pattern's start at about 1e19
 ** and fall to about -2,800 within twenty sweeps.  The running total kept
 ** that fall's rounding (a drift of 0.073 with check_every = 5), and resume
 ** refused the checkpoint of sweep 10 as damaged (its total -2768, the
-** state's fresh energy 38).  With the energy recomputed at sweeps 1, 2, 4
-** and 8 the drift stays under 1e-6 (4.2e-7, measured at sweep 1: the
-** start's own rounding), and a run stopped at sweep 10 resumes to the bytes
-** of one that was not.  The points file is named relative to the scene. */
+** state's fresh energy 38).  Recomputed at sweeps 1, 2, 4 and 8 it was
+** still off in between: trace rows 4e-7 off at sweep 1 (written before the
+** recomputation) and 1e-8 at 5; and two points 1e-9 apart, at 8e17 and at
+** 2,892 three sweeps on, left a finished run whose summary said lj = 0 and
+** whose state resume --sweeps refused.  Now the energy is recomputed
+** wherever it has fallen 8 times since the last time, before the row: every
+** row (at check_every = 5) is within 1e-9 of its state, and a run stopped
+** at any of the first sweeps resumes to the bytes of one that was not.  The
+** points file is named relative to the scene. */
 Test(particles_cli, a_start_far_above_the_minimum_keeps_its_energy_and_resumes)
 {
-  char pts[25 * 16] = "", path[256];
+  char pts[25 * 16] = "", path[256], d[200];
   for (int i = 0; i < 5; i++)
     for (int j = 0; j < 5; j++) snprintf(pts + strlen(pts), sizeof pts - strlen(pts), "%g %g 0\n", 1.1 * i, 1.1 * j);
   cr_assert_eq(lw_test_write_text(dir, "pts.txt", pts), 0);
@@ -236,10 +256,29 @@ Test(particles_cli, a_start_far_above_the_minimum_keeps_its_energy_and_resumes)
   snprintf(path, sizeof path, "%s/p/summary.json", dir);
   double start = json_number(path, "energy_initial"), drift = json_number(path, "max_relative_drift");
   cr_assert(start > 1e15 && drift < 1e-6, "start %g, drift %g", start, drift);
-  cr_assert_eq(sh("%s run %s/pts.ini --out %s/q --quiet --stop-at 10", lw_test_bin(), dir, dir), 0);
-  cr_assert_eq(sh("%s resume %s/q --quiet", lw_test_bin(), dir), 0);
-  cr_assert_eq(sh("cmp -s %s/p/state.lw %s/q/state.lw && cmp -s %s/p/trace.csv %s/q/trace.csv", dir, dir, dir, dir),
-               0);
+  static const int stops[] = {1, 3, 5, 6, 7, 10};
+  for (size_t k = 0; k < sizeof stops / sizeof *stops; k++) {
+    snprintf(d, sizeof d, "%s/q%d", dir, stops[k]);
+    cr_assert_eq(sh("%s run %s/pts.ini --out %s --quiet --stop-at %d", lw_test_bin(), dir, d, stops[k]), 0);
+    double traced, fresh;
+    trace_and_state_totals(d, &traced, &fresh);
+    cr_assert(lw_close_rel(traced, fresh, 1e-9, 1.0), "sweep %d: the row says %.17g, the state %.17g", stops[k],
+              traced, fresh);
+    cr_assert_eq(sh("%s resume %s --quiet", lw_test_bin(), d), 0);
+    cr_assert_eq(sh("cmp -s %s/p/state.lw %s/state.lw && cmp -s %s/p/trace.csv %s/trace.csv", dir, d, dir, d), 0,
+                 "stopped at sweep %d", stops[k]);
+  }
+  cr_assert_eq(lw_test_write_text(dir, "near.txt", "0 0 0\n1e-9 0 0\n3 0 0\n"), 0);
+  cr_assert_eq(lw_test_write_text(dir, "near.ini", "[scene]\nsystem = particles\n[particles]\npoints = near.txt\n"
+                                                   "count = 0\nnoise = 0\nnormal_noise = 0\nrange = 1.6\n"
+                                                   "[anneal]\nschedule = geometric\nt_start = 0.001\n"
+                                                   "t_end = 1e-5\nsweeps = 3\n"), 0);
+  snprintf(d, sizeof d, "%s/n", dir);
+  cr_assert_eq(sh("%s run %s/near.ini --out %s --quiet", lw_test_bin(), dir, d), 0);
+  double traced, fresh;
+  trace_and_state_totals(d, &traced, &fresh);
+  cr_assert(lw_close_rel(traced, fresh, 1e-9, 1.0), "the row says %.17g, the state %.17g", traced, fresh);
+  cr_assert_eq(sh("%s resume %s --sweeps 5 --quiet", lw_test_bin(), d), 0);
 }
 
 /* The rms distance of final.ply's particles to their least-squares plane

@@ -66,6 +66,9 @@ typedef struct lw_anneal {
   lw_block_stats prev;         /* energy statistics of the previous step */
   double acc_n, acc_sum, acc_sumsq; /* this step's energy samples (after tuning) */
   double max_drift;            /* largest relative drift seen at a check */
+  double size_peak[LW_TEMPERING_MAX]; /* by replica: the largest sum of the terms' magnitudes
+                               ** at a sweep's end since its last recomputation (0: not yet
+                               ** taken; the first sweep of a process takes it) */
   double energy_initial;
   double wall_before;          /* seconds spent before a resume */
   double sweep_seconds;        /* seconds in sweeps, with the processes before (timing.txt) */
