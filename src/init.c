@@ -565,6 +565,17 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
     lw_splines *c = cut_to_clear_runs(sc, sp, keep, segment_length, err);
     lw_splines_free(sp);
     sp = c;
+  } else if (sc->layers.n) {
+    /* each keeps the layer it was placed in: the renumbering along the
+    ** page (sys_splines.c) reorders them, and a layer taken from the new
+    ** index put most lines into another pen's ink, across their own pen's */
+    if (lw_splines_layers_alloc(sp) != LW_OK) {
+      lw_splines_free(sp);
+      sp = NULL;
+      lw_error_set(err, LW_ENOMEM, "out of memory for the placement");
+    } else {
+      for (size_t i = 0; i < n; i++) sp->layer[i] = (uint8_t)lw_layers_of(&sc->layers, i);
+    }
   }
   free(keep);
   return sp;

@@ -26,6 +26,7 @@
 #include "linewise/output.h"
 #include "linewise/scene.h"
 #include "linewise/spacing.h"
+#include "linewise/state.h"
 #include "testutil.h"
 
 TestSuite(layers, .init = lw_image_dir_make, .fini = lw_image_dir_remove);
@@ -1065,4 +1066,64 @@ Test(layers, the_photo_preset_draws_colour_pens_kept_apart_by_pen_on_any_thread_
   cr_assert_eq(lw_test_sh("grep -v '^scene_[hk]' %s/pa/state.lw > %s/a1; grep -v '^scene_[hk]' %s/old/state.lw > "
                           "%s/a2; cmp -s %s/a1 %s/a2", dir, dir, dir, dir, dir, dir),
                0, "the old run resumed differently");
+}
+
+/* The point of a spline's segment g at parameter s (cubic Bezier of the
+** nodes' points and vectors, r'(node) = 3 v). */
+static void segment_point(const lw_node *a, double s, double *x, double *y)
+{
+  const lw_node *b = a + 1;
+  const double u = 1.0 - s, w0 = u * u * u, w1 = 3 * u * u * s, w2 = 3 * u * s * s, w3 = s * s * s;
+  *x = w0 * a->px + w1 * (a->px + a->vx) + w2 * (b->px - b->vx) + w3 * b->px;
+  *y = w0 * a->py + w1 * (a->py + a->vy) + w2 * (b->py - b->vy) + w3 * b->py;
+}
+
+/* A colour run kept apart by pen starts with every pen's lines apart from
+** that pen's others, as the placement spaced them.  The placement gave
+** each spline its layer by its index, and the renumbering of the splines
+** along the page (sys_splines.c) came after it: where no spline was cut
+** (which stored the layers) the model took the layer from the new index,
+** so the pens were shuffled, lines lay across their own pen's (412 pairs
+** closer than the spacing on a coffee cup at A6), and every pen sat on
+** the picture's mean colour. */
+Test(layers, a_colour_run_kept_apart_by_pen_starts_with_each_pens_lines_apart)
+{
+  write_colour_png(lw_test_path("colour.png"), 48, 64, blotch_colours);
+  const char *scene = "[scene]\npreset = photo\npage = a6\nimage = colour.png\n[layers]\nsource = cmyk\n"
+                      "[anneal]\nseed = 3\n";
+  lw_test_write(lw_test_path("photo.ini"), scene, strlen(scene));
+  char errs[4096];
+  cr_assert_eq(run("run photo.ini --out s --threads 1 --quiet --stop-at 0", errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(lw_test_sh("grep -qx 'apart = pen' %s/scene.ini", lw_test_path("s")), 0);
+  lw_state st = {0};
+  lw_error err = {0};
+  cr_assert_eq(lw_state_read(&st, lw_test_path("s/state.lw"), &err), LW_OK, "%s", err.msg);
+  const lw_splines *sp = st.sp;
+  cr_assert(sp && sp->layer && sp->n_splines > 50, "splines %zu", sp ? sp->n_splines : 0);
+  /* 16 points a segment (segments of a few mm: under 0.5 mm apart), the
+  ** spacing less a margin for the points between them */
+  enum { K = 16 };
+  const double d = 0.25;
+  double *x = malloc(sp->n_segments * K * sizeof *x), *y = malloc(sp->n_segments * K * sizeof *y);
+  cr_assert(x && y);
+  for (size_t g = 0; g < sp->n_segments; g++)
+    for (int k = 0; k < K; k++)
+      segment_point(&sp->node[lw_segment_node(sp, g)], (k + 0.5) / K, &x[g * K + k], &y[g * K + k]);
+  size_t same = 0, across = 0;
+  for (size_t g = 0; g < sp->n_segments; g++)
+    for (size_t h = g + 1; h < sp->n_segments; h++) {
+      const size_t i = sp->seg_spline[g], j = sp->seg_spline[h];
+      if (i == j) continue;
+      for (int q = 0; q < K * K; q++) {
+        const double dx = x[g * K + q / K] - x[h * K + q % K], dy = y[g * K + q / K] - y[h * K + q % K];
+        if (dx * dx + dy * dy >= d * d) continue;
+        if (sp->layer[i] == sp->layer[j]) same++;
+        else across++;
+      }
+    }
+  free(x);
+  free(y);
+  cr_assert_eq(same, 0, "%zu close point pairs within pens (%zu across)", same, across);
+  cr_assert_gt(across, 0, "no pens overlap: the test does not tell");
+  lw_state_clear(&st);
 }
