@@ -949,8 +949,18 @@ static double near_correction_grad(const double a[8], const lw_pair_sample *sa, 
       }
     }
   if (W == 0.0) return 0.0;
-  double gxa[8], gxb[8];
+  double gxa[8], gxb[8], dwa[8], dwb[8];
   double X = segments_exact_grad(a, b, ctx->cutoff, wk, gxa, gxb);
+  const double ow = lw_pair_order_weight(a, b, dwa, dwb);
+  if (ow != 1.0) { /* both orders in the band (pairnear.h) */
+    double hb[8], ha[8];
+    const double Y = segments_exact_grad(b, a, ctx->cutoff, wk, hb, ha);
+    for (int k = 0; k < 8; k++) {
+      gxa[k] = ow * gxa[k] + (1.0 - ow) * ha[k] + dwa[k] * (X - Y);
+      gxb[k] = ow * gxb[k] + (1.0 - ow) * hb[k] + dwb[k] * (X - Y);
+    }
+    X = ow * X + (1.0 - ow) * Y;
+  }
   double e = W * X;
   if (W < 1.0) e += (1.0 - W) * (near + far);
   e -= far;

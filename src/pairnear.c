@@ -917,6 +917,37 @@ int lw_pair_bezier_before(const double a[8], const double b[8])
   return 1;
 }
 
+double lw_pair_order_weight(const double a[8], const double b[8], double dwa[8], double dwb[8])
+{
+  if (dwa) memset(dwa, 0, 8 * sizeof *dwa);
+  if (dwb) memset(dwb, 0, 8 * sizeof *dwb);
+  const double ax = a[6] - a[0], ay = a[7] - a[1], bx = b[6] - b[0], by = b[7] - b[1];
+  const double band = LW_PAIR_ORDER_BAND * (fabs(ax) + fabs(ay) + fabs(bx) + fabs(by));
+  const double gap = b[0] - a[0]; /* >= 0 in this order */
+  if (!(gap < band)) return 1.0;
+  const double x = gap / band, w = 0.5 + 0.5 * x * x * x * (10.0 + x * (6.0 * x - 15.0));
+  if (dwa && dwb) {
+    /* dw/dx = 15 x^2 (1 - x)^2; x = gap / band */
+    const double dwdx = 15.0 * x * x * (1.0 - x) * (1.0 - x), dgap = dwdx / band, dband = -dwdx * x / band;
+    const double s = LW_PAIR_ORDER_BAND * dband;
+    dwb[0] += dgap;
+    dwa[0] -= dgap;
+    dwa[6] += s * (ax > 0) - s * (ax < 0), dwa[0] -= s * (ax > 0) - s * (ax < 0);
+    dwa[7] += s * (ay > 0) - s * (ay < 0), dwa[1] -= s * (ay > 0) - s * (ay < 0);
+    dwb[6] += s * (bx > 0) - s * (bx < 0), dwb[0] -= s * (bx > 0) - s * (bx < 0);
+    dwb[7] += s * (by > 0) - s * (by < 0), dwb[1] -= s * (by > 0) - s * (by < 0);
+  }
+  return w;
+}
+
+/* X_AB of a pair in lw_pair_bezier_before's order, both orders blended in
+** the band (pairnear.h). */
+static double ordered_exact(const double a[8], const double b[8], double cutoff)
+{
+  const double w = lw_pair_order_weight(a, b, NULL, NULL), x = lw_pair_segments_exact(a, b, cutoff);
+  return w == 1.0 ? x : w * x + (1.0 - w) * lw_pair_segments_exact(b, a, cutoff);
+}
+
 /* What lw_pair_near_correction sums over the sample pairs: the largest
 ** near weight, and the product rule's terms of the near and the far pairs. */
 typedef struct {
@@ -1020,8 +1051,8 @@ double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, cons
 #endif
     for (int i = 0; i < n; i++) near_row(&sa[i], sb, 0, n, ctx, &ns);
   const double W = ns.W, far = ns.far, near = ns.near;
-  if (W == 0.0) return 0.0;
-  double e = W * lw_pair_segments_exact(a, b, ctx->cutoff);
+  if (W == 0.0) return near;
+  double e = W * ordered_exact(a, b, ctx->cutoff);
   if (W < 1.0) e += (1.0 - W) * (near + far);
   return e - far;
 }

@@ -660,6 +660,45 @@ Test(pair, energy_is_continuous_through_every_zone)
 }
 
 /*
+** Continuity where a near pair's order flips.  lw_pair_segments_exact is not
+** symmetric (it splits A and B in turn), and the near field took a pair in
+** the order of its control points: where the first points' x passed each
+** other the energy jumped by X(a, b) - X(b, a), 1e-4 of a drawing's energy
+** in undamped dynamics (the total energy stepped by that, whatever dt).
+** Two crossing segments, B's first point moved along x through A's and
+** through the edges of the band where both orders are blended
+** (LW_PAIR_ORDER_BAND); steps of 2e-11 change a continuous energy by about
+** 1e-11 of it.  The two orders do differ here (else the test tells nothing).
+** Bound 1e-9 E.
+*/
+Test(pair, energy_is_continuous_where_a_near_pairs_order_flips)
+{
+  const double h = 1e-11;
+  const double ya = 0.0, yb = 2.0, L1 = 5.0 + 1.0 + 5.0 + 3.0; /* the chords' L1 lengths */
+  const double at[] = {0.0, LW_PAIR_ORDER_BAND * L1, -LW_PAIR_ORDER_BAND * L1};
+  const double A0[8] = {0, ya, 1.7, ya + 0.4, 3.3, ya + 0.6, 5, ya + 1}, B0[8] = {0, yb, 1.7, yb - 1, 3.3, yb - 2, 5, yb - 3};
+  double B1[8];
+  memcpy(B1, B0, sizeof B1);
+  const double xab = lw_pair_segments_exact(A0, B1, 0.0), xba = lw_pair_segments_exact(B1, A0, 0.0);
+  cr_assert(fabs(xab - xba) > 1e-9 * xab, "the two orders agree: %.17g", xab);
+  for (size_t k = 0; k < sizeof at / sizeof at[0]; k++) {
+    double e[2];
+    for (int i = 0; i < 2; i++) {
+      lw_splines *sp = two_splines(1, 1);
+      const double dx = at[k] + (2 * i - 1) * h;
+      sp->node[0] = (lw_node){A0[0], A0[1], A0[2] - A0[0], A0[3] - A0[1]};
+      sp->node[1] = (lw_node){A0[6], A0[7], A0[6] - A0[4], A0[7] - A0[5]};
+      sp->node[2] = (lw_node){B0[0] + dx, B0[1], B0[2] - B0[0], B0[3] - B0[1]};
+      sp->node[3] = (lw_node){B0[6], B0[7], B0[6] - B0[4], B0[7] - B0[5]};
+      e[i] = pair_energy(sp, 8, 0.0, NEAR_DEFAULT);
+      lw_splines_free(sp);
+    }
+    cr_assert(isfinite(e[0]) && fabs(e[1] - e[0]) <= 1e-9 * fabs(e[0]), "B's first x at %g: E %.15g to %.15g (%.1e)",
+              at[k], e[0], e[1], fabs(e[1] / e[0] - 1));
+  }
+}
+
+/*
 ** The whole-square rules (pairnear.c): 16 to 64 nodes each way, the next one
 ** blended in as the distance d falls through [lo, hi] times the half size h,
 ** the subdivision below the last.  Two parallel straight segments of 5 mm d

@@ -259,7 +259,8 @@ static double near_weight(double u)
 ** them as float (pair.h), whose rounding steps (6e-8 relative) would swamp a
 ** central difference of step 1e-6.  Far pairs dl_i dl_j k(r); a segment
 ** pair with a sample pair within the near radius takes
-** W X + (1 - W)(near + far) instead (pairnear.h).
+** W X + (1 - W)(near + far) instead, X of both orders blended in the band
+** (pairnear.h).
 */
 static double pair_energy_double(const lw_splines *sp, double C, double rc, double near, int nq)
 {
@@ -299,7 +300,13 @@ static double pair_energy_double(const lw_splines *sp, double C, double rc, doub
       const lw_node *na = &sp->node[lw_segment_node(sp, ga)], *nb = &sp->node[lw_segment_node(sp, gb)];
       lw_segment_bezier(na, na + 1, a);
       lw_segment_bezier(nb, nb + 1, b);
-      double X = lw_pair_bezier_before(a, b) ? lw_pair_segments_exact(a, b, rc) : lw_pair_segments_exact(b, a, rc);
+      if (!lw_pair_bezier_before(a, b))
+        for (int k = 0; k < 8; k++) {
+          const double t = a[k];
+          a[k] = b[k], b[k] = t;
+        }
+      const double ow = lw_pair_order_weight(a, b, NULL, NULL);
+      const double X = ow * lw_pair_segments_exact(a, b, rc) + (1.0 - ow) * lw_pair_segments_exact(b, a, rc);
       e += W * X + (1.0 - W) * (nsum + fsum);
     }
   free(S);
@@ -410,6 +417,33 @@ Test(pairgrad, near_field_gradient_matches_differences)
       free(g);
       free(gp);
     }
+    lw_splines_free(sp);
+  }
+}
+
+/* Two crossing segments whose first points' x lie within the band where the
+** near field blends both orders of the pair (pairnear.h): the weight's own
+** derivative, times X(a, b) - X(b, a), is part of the gradient there. */
+Test(pairgrad, gradient_matches_differences_where_both_orders_are_blended)
+{
+  const double A0[8] = {0, 0, 1.7, 0.4, 3.3, 0.6, 5, 1}, B0[8] = {0, 2, 1.7, 1, 3.3, 0, 5, -1};
+  const double at[] = {0.05, -0.12, 0.2};
+  for (size_t k = 0; k < sizeof at / sizeof at[0]; k++) {
+    size_t segs[2] = {1, 1};
+    lw_splines *sp = lw_splines_new(2, segs, NULL);
+    cr_assert_not_null(sp);
+    sp->node[0] = (lw_node){A0[0], A0[1], A0[2] - A0[0], A0[3] - A0[1]};
+    sp->node[1] = (lw_node){A0[6], A0[7], A0[6] - A0[4], A0[7] - A0[5]};
+    sp->node[2] = (lw_node){B0[0] + at[k], B0[1], B0[2] - B0[0], B0[3] - B0[1]};
+    sp->node[3] = (lw_node){B0[6], B0[7], B0[6] - B0[4], B0[7] - B0[5]};
+    double a[8], b[8];
+    lw_segment_bezier(&sp->node[0], &sp->node[1], a);
+    lw_segment_bezier(&sp->node[2], &sp->node[3], b);
+    const int ab = lw_pair_bezier_before(a, b);
+    const double w = ab ? lw_pair_order_weight(a, b, NULL, NULL) : lw_pair_order_weight(b, a, NULL, NULL);
+    cr_assert(w > 0.5 && w < 1.0, "B at %g: weight %g, not inside the band", at[k], w);
+    check_gradient("crossing, both orders blended", sp, 0.7, 0.0, 1.5, 8, NULL);
+    check_gradient("crossing, both orders blended, cutoff 3", sp, 0.7, 3.0, 1.5, 8, NULL);
     lw_splines_free(sp);
   }
 }

@@ -40,6 +40,22 @@
 ** (pairnear.c, docs/NUMERICS.md, docs/ACCURACY.md). */
 double lw_pair_segments_exact(const double a[8], const double b[8], double cutoff);
 
+/* lw_pair_segments_exact is not symmetric: it splits A and B in turn, and
+** X(a, b) and X(b, a) differ by its error (up to about 1e-3 of it where the
+** curves cross or touch).  The near field takes a pair in one order
+** (lw_pair_bezier_before), which flips where the first control points'
+** x pass each other: a jump of that error (1e-4 of the energy in undamped
+** dynamics).  So within a band of LW_PAIR_ORDER_BAND times the sum of the
+** chords' L1 lengths of that crossing, both orders are taken, blended by a
+** C2 weight in the gap that is 1/2 where they meet (both orders give the
+** same bits there) and 1 at the band's edge. */
+#define LW_PAIR_ORDER_BAND 0.02
+
+/* The weight of X(a, b) against X(b, a) for a pair in lw_pair_bezier_before's
+** order, and its derivatives by a's and b's control points (NULL: not
+** wanted); 1 outside the band. */
+double lw_pair_order_weight(const double a[8], const double b[8], double dwa[8], double dwb[8]);
+
 /* E_AB minus the product-rule terms of the sample pairs of A x B that are
 ** not near (those the neighbour walk adds): what the model adds for a near
 ** pair.  sa and sb: the n pair samples of each segment, as stored. */
