@@ -367,3 +367,24 @@ Test(checkpoint, a_resumed_run_keeps_its_whole_proposal_rate)
                           "(r * w / p - 1) ^ 2 < 1e-6) }' %s/a/summary.json", dir), 0,
                "proposals_per_second is not proposals / sweep_seconds");
 }
+
+/* A step the scene sets above the row's cap (tuning never grows one past
+** it) stays as set where nothing tunes it: moves.tune_sweeps = 0, or a
+** step the dynamics never uses.  The checkpoint kept it and resume
+** refused it ("expected 1 number from 1e-300 to 100"), so such a run could
+** never go on; now it resumes to the bytes of one that did not stop. */
+Test(checkpoint, a_step_above_the_cap_that_nothing_tuned_resumes)
+{
+  const char *b = lw_test_bin(), *r = lw_test_root();
+  static const char *const runs[][2] = {
+      {"minimal.ini", "--set anneal.sweeps=20 --set moves.tune_sweeps=0 --set moves.step_point=1000"},
+      {"wire.ini", "--set anneal.sweeps=20 --set nurbs.step_weight=5 --set output.frames_every=0"}};
+  for (int k = 0; k < 2; k++) {
+    cr_assert_eq(lw_test_sh("%s run %s/params/%s %s --out %s/u%d --quiet", b, r, runs[k][0], runs[k][1], dir, k), 0);
+    cr_assert_eq(lw_test_sh("%s run %s/params/%s %s --out %s/s%d --quiet --stop-at 7", b, r, runs[k][0], runs[k][1],
+                            dir, k), 0);
+    cr_assert_eq(lw_test_sh("%s resume %s/s%d --quiet 2>%s/err.txt", b, dir, k, dir), 0, "%s", runs[k][0]);
+    cr_assert_eq(lw_test_sh("cmp -s %s/u%d/state.lw %s/s%d/state.lw && cmp -s %s/u%d/trace.csv %s/s%d/trace.csv", dir,
+                            k, dir, k, dir, k, dir, k), 0, "%s resumed differently", runs[k][0]);
+  }
+}
