@@ -127,6 +127,16 @@ void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n)
              a->ckpt_seconds > wall / 2.0 ? "most" : "over a third");
 }
 
+void lw_anneal_drift_note(const lw_anneal *a, char *buf, size_t n)
+{
+  buf[0] = '\0';
+  if (a->row_drift > LW_ANNEAL_DRIFT_NOTE)
+    snprintf(buf, n, "the running energy was %.2g off its recomputation from scratch (of the largest energy since "
+             "the one before; rounding leaves about 1e-14): the moves' energy differences do not add up to the "
+             "energy, and the run sampled another energy than the one it reports (a fault of the %s system's "
+             "row; please report it)", a->row_drift, a->params.system);
+}
+
 /* Temperature step of sweep s: the sweeps are shared out evenly; past the
 ** end the last step holds. */
 static long block_of(const lw_anneal *a, long s)
@@ -1463,8 +1473,13 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
       if (rs[i] != LW_OK) {
         *err = first;
         s = first.code;
-      } else if ((renumber || drift[i] > LW_ANNEAL_EARLY_DRIFT) && drift[i] > a->max_drift) {
-        a->max_drift = drift[i];
+      } else {
+        if ((renumber || drift[i] > LW_ANNEAL_EARLY_DRIFT) && drift[i] > a->max_drift) a->max_drift = drift[i];
+        /* over the largest size since the last recomputation, the scale of
+        ** the totals' rounding: a fall's own stays near eps, and a row whose
+        ** commits do not add up its moves' dE stands out */
+        const double d = drift[i] * replica_size(a, rep[i]) / fmax(a->size_peak[rep[i]], 1.0);
+        if (d > a->row_drift) a->row_drift = d;
       }
     }
     if (a->net) s = a->net->drift(a->net, a, s, err);

@@ -492,6 +492,8 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
     lw_anneal_checkpoint_note(a, drawn, sizeof drawn);
     if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
+    lw_anneal_drift_note(a, drawn, sizeof drawn);
+    if (drawn[0]) fprintf(stderr, "linewise: warning: %s\n", drawn);
   }
   if (!quiet) {
     if (a->quenched)

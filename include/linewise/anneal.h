@@ -66,6 +66,8 @@ typedef struct lw_anneal {
   lw_block_stats prev;         /* energy statistics of the previous step */
   double acc_n, acc_sum, acc_sumsq; /* this step's energy samples (after tuning) */
   double max_drift;            /* largest relative drift seen at a check */
+  double row_drift;            /* the same over the largest size since the check before, by
+                               ** this process (lw_anneal_drift_note; not kept in state.lw) */
   double size_peak[LW_TEMPERING_MAX]; /* by replica: the largest sum of the terms' magnitudes
                                ** at a sweep's end since its last recomputation (0: not yet
                                ** taken; the first sweep of a process takes it) */
@@ -159,6 +161,12 @@ void lw_anneal_ladder_note(const lw_anneal *a, char *buf, size_t n);
 ** over a second, writing checkpoints: fsync'd state of a small system
 ** every output.checkpoint_every sweeps made a 1-second study take 8. */
 void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n);
+/* A note (else "") when a recomputation from scratch moved the running
+** energy by more than LW_ANNEAL_DRIFT_NOTE of its size (row_drift): a
+** system row whose commits do not add up its moves' dE (system.h); the
+** shipped rows drift by about 1e-14. */
+#define LW_ANNEAL_DRIFT_NOTE 1e-6
+void lw_anneal_drift_note(const lw_anneal *a, char *buf, size_t n);
 double lw_anneal_seconds(const lw_anneal *a);
 
 #endif
