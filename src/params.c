@@ -579,7 +579,9 @@ const lw_param_def lw_param_table[] = {
          "source = tone: tone at and above which a layer's target is no ink (above tone_min); "
          "one a layer, empty = 1 each. The target falls linearly in between."),
   STRING("layers", "pen_width", ly_pen_width, "", "mm",
-         "Pen width of each layer (its SVG stroke and its tone footprint); empty = output.pen_width each."),
+         "Pen width of each layer (its SVG stroke and its tone footprint); empty = output.pen_width each. "
+         "The spacing (energy.min_spacing) and the close share stay of output.pen_width: a wider layer's "
+         "strokes may run into each other's ink."),
   NUM("particles", "count", LW_PT_INT, pt_count, "100", "", 0, 1e7, 0,
       "Particles placed by `pattern` (after those of `points`, if any)."),
   CHOICE("particles", "pattern", pt_pattern, "plane", "cloud|plane|sphere",
