@@ -53,12 +53,29 @@ const lw_system_type *lw_system_of(const lw_params *p, lw_error *err)
 
 int lw_system_row_fits(const lw_system_type *t, lw_error *err)
 {
-  if (t->n_moves <= LW_MOVES_MAX && t->n_terms <= LW_SYSTEM_TERMS_MAX && t->n_observables <= LW_OBSERVABLES_MAX)
-    return 1;
-  lw_error_set(err, LW_EINPUT, "the %s system's row has %d move kinds, %d terms and %d observables; at most %d, %d "
-               "and %d fit (include/linewise/system.h)", t->name, t->n_moves, t->n_terms, t->n_observables,
-               LW_MOVES_MAX, LW_SYSTEM_TERMS_MAX, LW_OBSERVABLES_MAX);
-  return 0;
+  if (!(t->n_moves <= LW_MOVES_MAX && t->n_terms <= LW_SYSTEM_TERMS_MAX && t->n_observables <= LW_OBSERVABLES_MAX)) {
+    lw_error_set(err, LW_EINPUT, "the %s system's row has %d move kinds, %d terms and %d observables; at most %d, %d "
+                 "and %d fit (include/linewise/system.h)", t->name, t->n_moves, t->n_terms, t->n_observables,
+                 LW_MOVES_MAX, LW_SYSTEM_TERMS_MAX, LW_OBSERVABLES_MAX);
+    return 0;
+  }
+  /* the drivers' own columns of trace.csv and members of summary.json's
+  ** energy: a term of one of these names made a second "total" there */
+  static const char *const taken[] = {"sweep", "time", "temperature", "total", "kinetic", "potential_energy"};
+  for (int k = 0; k < t->n_terms; k++) {
+    for (size_t j = 0; j < sizeof taken / sizeof *taken; j++)
+      if (!strcmp(t->term_names[k], taken[j])) {
+        lw_error_set(err, LW_EINPUT, "the %s system's term '%s' has the name of a column the drivers write "
+                     "(include/linewise/system.h)", t->name, t->term_names[k]);
+        return 0;
+      }
+    for (int j = 0; j < k; j++)
+      if (!strcmp(t->term_names[k], t->term_names[j])) {
+        lw_error_set(err, LW_EINPUT, "the %s system has two terms named '%s'", t->name, t->term_names[k]);
+        return 0;
+      }
+  }
+  return 1;
 }
 
 lw_system *lw_system_wrap(const lw_system_type *type, void *state, lw_error *err)

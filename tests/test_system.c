@@ -365,6 +365,17 @@ Test(system, the_table_starts_with_splines_and_finds_rows_by_name)
   cr_assert_not(lw_system_row_fits(&big, &err));
   cr_assert(strstr(err.msg, "the gauss system's row has 2 move kinds, 2 terms and 9 observables; at most"), "%s",
             err.msg);
+  /* a term named as a driver's column (trace.csv got two "total"), or two
+  ** terms of one name */
+  static const char *const total[] = {"total", "y"}, *const twice[] = {"x", "x"};
+  lw_system_type named = gauss_type;
+  named.term_names = total;
+  cr_assert_not(lw_system_row_fits(&named, &err));
+  cr_assert(strstr(err.msg, "the gauss system's term 'total' has the name of a column the drivers write"), "%s",
+            err.msg);
+  named.term_names = twice;
+  cr_assert_not(lw_system_row_fits(&named, &err));
+  cr_assert(strstr(err.msg, "two terms named 'x'"), "%s", err.msg);
 }
 
 Test(system, an_unknown_system_exits_2_naming_file_line_and_key)
