@@ -386,9 +386,8 @@ Test(anneal, checkpoints_that_take_most_of_a_run_are_said)
 ** nothing, so a new system row with a running sum of 1.01 dE ran to its
 ** end with a 1.5e-2 drift and exit 0.  Here the running terms are put 1 %
 ** off by hand, as such a row leaves them; the recomputation at the next
-** check finds it (6.2e-4 of the terms' magnitudes, which partly cancel).  A run that only fell far (a fall's rounding, rescaled
-** to the largest energy since the check before) and an ordinary run say
-** nothing. */
+** check finds it (6.2e-4 of the terms' magnitudes, which partly cancel).
+** An ordinary run says nothing. */
 Test(run, a_running_energy_that_does_not_add_up_is_said)
 {
   char path[128];

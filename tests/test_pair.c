@@ -676,7 +676,8 @@ Test(pair, energy_is_continuous_where_a_near_pairs_order_flips)
   const double h = 1e-11;
   const double ya = 0.0, yb = 2.0, L1 = 5.0 + 1.0 + 5.0 + 3.0; /* the chords' L1 lengths */
   const double at[] = {0.0, LW_PAIR_ORDER_BAND * L1, -LW_PAIR_ORDER_BAND * L1};
-  const double A0[8] = {0, ya, 1.7, ya + 0.4, 3.3, ya + 0.6, 5, ya + 1}, B0[8] = {0, yb, 1.7, yb - 1, 3.3, yb - 2, 5, yb - 3};
+  const double A0[8] = {0, ya, 1.7, ya + 0.4, 3.3, ya + 0.6, 5, ya + 1};
+  const double B0[8] = {0, yb, 1.7, yb - 1, 3.3, yb - 2, 5, yb - 3};
   double B1[8];
   memcpy(B1, B0, sizeof B1);
   const double xab = lw_pair_segments_exact(A0, B1, 0.0), xba = lw_pair_segments_exact(B1, A0, 0.0);
