@@ -1349,7 +1349,7 @@ static double replica_size(const lw_anneal *a, int r)
 }
 
 /* Whether the energy is recomputed from scratch after this sweep: every
-** `every` sweeps (the drift check, with the renumbering before it), and
+** check_every sweeps (the drift check, with the renumbering before it), and
 ** wherever a replica's terms have fallen to under 1 / LW_ANNEAL_FALL of
 ** their largest size since its last recomputation.  A running total keeps
 ** the rounding of where it has been: particles of a points file on top of

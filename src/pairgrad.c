@@ -948,10 +948,11 @@ static double near_correction_grad(const double a[8], const lw_pair_sample *sa, 
         far += k;
       }
     }
-  if (W == 0.0) return 0.0;
-  double gxa[8], gxb[8], dwa[8], dwb[8];
-  double X = segments_exact_grad(a, b, ctx->cutoff, wk, gxa, gxb);
-  const double ow = lw_pair_order_weight(a, b, dwa, dwb);
+  /* W = 0 with near pairs: each at the near radius itself (u rounded to
+  ** 1), whose terms are the product rule's, as lw_pair_near_correction */
+  double gxa[8] = {0}, gxb[8] = {0}, dwa[8], dwb[8], X = 0.0;
+  if (W > 0.0) X = segments_exact_grad(a, b, ctx->cutoff, wk, gxa, gxb);
+  const double ow = W > 0.0 ? lw_pair_order_weight(a, b, dwa, dwb) : 1.0;
   if (ow != 1.0) { /* both orders in the band (pairnear.h) */
     double hb[8], ha[8];
     const double Y = segments_exact_grad(b, a, ctx->cutoff, wk, hb, ha);
@@ -963,7 +964,7 @@ static double near_correction_grad(const double a[8], const lw_pair_sample *sa, 
   }
   double e = W * X;
   if (W < 1.0) e += (1.0 - W) * (near + far);
-  e -= far;
+  e = W > 0.0 ? e - far : near;
   /* e = W X + (1 - W)(near + far) - far: the near terms weigh 1 - W, the
   ** far ones -W, and W moves with its pair where it is below 1 */
   for (int i = 0; i < n; i++)
@@ -973,7 +974,7 @@ static double near_correction_grad(const double a[8], const lw_pair_sample *sa, 
       double rho2 = lw_pair_near_radius2(ctx, sa[i].dl, sb[j].dl);
       kernel_grad(&sa[i], &sb[j], inv, r2 < rho2 ? 1.0 - W : -W, &gsa[i], &gsb[j]);
     }
-  if (W < 1.0) {
+  if (W < 1.0 && W > 0.0) {
     const lw_pair_sample *p = &sa[wi], *q = &sb[wj];
     double dx = p->x - q->x, dy = p->y - q->y, r = sqrt(dx * dx + dy * dy), du;
     double rho = sqrt(lw_pair_near_radius2(ctx, p->dl, q->dl)), u = r / rho;

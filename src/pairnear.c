@@ -1051,6 +1051,8 @@ double lw_pair_near_correction(const double a[8], const lw_pair_sample *sa, cons
 #endif
     for (int i = 0; i < n; i++) near_row(&sa[i], sb, 0, n, ctx, &ns);
   const double W = ns.W, far = ns.far, near = ns.near;
+  /* near pairs with W = 0 lie at the near radius itself (u rounds to 1):
+  ** their product-rule terms, which the walk left out (0 dropped them) */
   if (W == 0.0) return near;
   double e = W * ordered_exact(a, b, ctx->cutoff);
   if (W < 1.0) e += (1.0 - W) * (near + far);

@@ -1026,12 +1026,20 @@ Test(layers, born_splines_keep_their_layers_through_checkpoints)
 ** same on 1 and 2 threads and through a stop and resume.  source = cmyk
 ** needs no names.  A user's apart outranks the preset's, and a run's
 ** scene.ini written before the key existed resumes as it ran. */
-Test(layers, the_photo_preset_draws_colour_pens_kept_apart_by_pen_on_any_thread_count)
+/* photo.ini: the photo preset on A6 over a blotchy colour picture, in
+** CMYK, with the given [anneal] lines. */
+static void write_colour_photo_scene(const char *anneal)
 {
   write_colour_png(lw_test_path("colour.png"), 48, 64, blotch_colours);
-  const char *scene = "[scene]\npreset = photo\npage = a6\nimage = colour.png\n[layers]\nsource = cmyk\n"
-                      "[anneal]\nsweeps = 16\nseed = 5\n";
+  char scene[512];
+  snprintf(scene, sizeof scene,
+           "[scene]\npreset = photo\npage = a6\nimage = colour.png\n[layers]\nsource = cmyk\n[anneal]\n%s", anneal);
   lw_test_write(lw_test_path("photo.ini"), scene, strlen(scene));
+}
+
+Test(layers, the_photo_preset_draws_colour_pens_kept_apart_by_pen_on_any_thread_count)
+{
+  write_colour_photo_scene("sweeps = 16\nseed = 5\n");
   char errs[4096];
   cr_assert_eq(run("run photo.ini --out p1 --threads 1 --quiet", errs, sizeof errs), 0, "%s", errs);
   cr_assert_eq(run("run photo.ini --out p2 --threads 2 --quiet --stop-at 7", errs, sizeof errs), 0, "%s", errs);
@@ -1088,10 +1096,7 @@ static void segment_point(const lw_node *a, double s, double *x, double *y)
 ** the picture's mean colour. */
 Test(layers, a_colour_run_kept_apart_by_pen_starts_with_each_pens_lines_apart)
 {
-  write_colour_png(lw_test_path("colour.png"), 48, 64, blotch_colours);
-  const char *scene = "[scene]\npreset = photo\npage = a6\nimage = colour.png\n[layers]\nsource = cmyk\n"
-                      "[anneal]\nseed = 3\n";
-  lw_test_write(lw_test_path("photo.ini"), scene, strlen(scene));
+  write_colour_photo_scene("seed = 3\n");
   char errs[4096];
   cr_assert_eq(run("run photo.ini --out s --threads 1 --quiet --stop-at 0", errs, sizeof errs), 0, "%s", errs);
   cr_assert_eq(lw_test_sh("grep -qx 'apart = pen' %s/scene.ini", lw_test_path("s")), 0);

@@ -292,8 +292,8 @@ static double pair_energy_double(const lw_splines *sp, double C, double rc, doub
             fsum += k;
           }
         }
-      if (W == 0.0) {
-        e += fsum;
+      if (W == 0.0) { /* near pairs only at the radius itself: the product rule */
+        e += nsum + fsum;
         continue;
       }
       double a[8], b[8];
