@@ -152,6 +152,32 @@ static long block_start(const lw_anneal *a, long b)
   return (long)((b * S + B - 1) / B);
 }
 
+/* The energies a resumed step has gathered (the adaptive schedule's next
+** temperature is made of them): no more than the sweeps of the step so far,
+** and a variance that is not negative (one fell back on the geometric ratio
+** without a word). */
+static lw_status check_block_energy(const lw_anneal *a, const char *path, lw_error *err)
+{
+  const double done = a->block >= 0 ? (double)(a->sweep - block_start(a, a->block)) : 0.0;
+  const double n = a->acc_n, spread = n * a->acc_sumsq - a->acc_sum * a->acc_sum;
+  if (n <= done && !(spread < -1e-9 * n * a->acc_sumsq)) return LW_OK;
+  return lw_error_set(err, LW_EINPUT, "%s: [run] block_energy: %.17g samples with sum %.17g and sum of squares %.17g, "
+                      "but the step has had %.0f sweeps and a variance is not negative: the state was edited", path,
+                      n, a->acc_sum, a->acc_sumsq, done);
+}
+
+/* The schedule's temperature of step b after step b - 1 at a->t_prev,
+** measured in a->prev or (measured = 0: a step without sweeps, or b = 0) not
+** at all.  The statistics are the coldest rung's, at ladder[0] t / t_start:
+** Huang's T / sd for it is this on the schedule's own scale (the schedule's
+** temperature with the cold rung's sd cooled 5 to 10 times too fast). */
+static double step_temperature(const lw_anneal *a, long b, int measured)
+{
+  lw_block_stats prev = a->prev;
+  if (a->pt && a->pt->ladder[0] > 0.0) prev.sd *= a->params.t_start / a->pt->ladder[0];
+  return a->sched_type->temperature(&a->sched, b, a->t_prev, measured ? &prev : NULL);
+}
+
 static void dir_file(char *buf, size_t n, const lw_anneal *a, const char *name)
 {
   lw_path_join(buf, n, a->dir, name);
@@ -529,7 +555,6 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
   const unsigned needs = a->sched_type ? a->sched_type->needs : ~0u; /* (dynamics: noted as unread) */
   static const char *const table[] = {"anneal.table", NULL}, *const lambda[] = {"anneal.lambda", NULL},
                            *const polygon[] = {"scene.polygon", NULL}, *const mask[] = {"scene.mask_image", NULL},
-                           *const coverage[] = {"init.coverage", NULL},
                            *const orientation[] = {"scene.orientation", NULL},
                            *const picture[] = {"scene.image_width", "scene.image_blur", "scene.image_flatten",
                                                "scene.image_levels", "scene.image_gamma", "scene.image_contrast",
@@ -538,16 +563,6 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
                                               "tempering.tune_ladder", "tempering.ladder_sweeps", NULL},
                            *const ends[] = {"tempering.t_min", "tempering.t_max", NULL},
                            *const seed[] = {"anneal.seed", NULL},
-                           *const inline_points[] = {"nurbs.points", "nurbs.weights", NULL},
-                           *const jumps[] = {"moves.birth", "moves.birth_uniform", "moves.birth_spread",
-                                             "moves.prior_sd", "moves.death", "moves.grow", "moves.shrink",
-                                             "moves.max_segments", "moves.split", "moves.join",
-                                             "moves.join_radius", NULL},
-                           *const weights[] = {"nurbs.weight_inertia", "nurbs.weight_stiffness", "nurbs.step_weight",
-                                               NULL},
-                           *const births[] = {"particles.max_count", NULL},
-                           *const sigma[] = {"particles.sigma", NULL},
-                           *const sigma_normal[] = {"particles.sigma_normal", NULL},
                            *const gravity[] = {"dynamics.gravity_x", "dynamics.gravity_y", NULL},
                            *const machine[] = {"plot.tolerance", "plot.turn", "plot.bed_width", "plot.bed_height",
                                                NULL},
@@ -556,20 +571,17 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
                                               NULL},
                            *const pair[] = {"energy.pair_cutoff", "energy.pair_near", "energy.pair_quadrature", NULL},
                            *const tuning[] = {"tempering.ladder_sweeps", NULL},
-                           *const plane[] = {"particles.boundary_z", NULL},
-                           *const sphere[] = {"particles.boundary_radius", NULL},
-                           *const wall[] = {"particles.alpha_b", NULL}, *const pinned[] = {"particles.pinned", NULL};
-  const struct {
-    const char *const *keys;
-    int idle;
-    const char *why;
-  } rule[] = {
+                           *const t_start[] = {"anneal.t_start", NULL}, *const t_end[] = {"anneal.t_end", NULL};
+  lw_idle_rule rule[24 + LW_IDLE_RULES_MAX] = {
       {table, a->sched_type && lw_params_file_idle(p, lw_params_find("anneal", "table")),
        "anneal.schedule reads no table"},
       {lambda, !(needs & LW_SCHEDULE_USES_LAMBDA), "anneal.schedule is not adaptive"},
+      /* (a constant schedule's t_end, a table's: a study that varied it measured noise) */
+      {t_end, !(needs & LW_SCHEDULE_USES_END), "anneal.schedule reads no t_end"},
+      /* (tempering scales its ladder by T / t_start, whatever the schedule) */
+      {t_start, !(needs & LW_SCHEDULE_USES_START) && a->n_rep == 1, "anneal.schedule reads no t_start"},
       {polygon, p->boundary != LW_BND_POLYGON, "scene.boundary is not polygon"},
       {mask, lw_params_file_idle(p, lw_params_find("scene", "mask_image")), "scene.mask is not image"},
-      {coverage, p->splines != 0, "init.splines is not 0"},
       /* (the photo preset's own auto, which a run's scene.ini holds: a redraw
       ** from it noted a key its user never set) */
       {orientation, p->page == LW_PAGE_CUSTOM && !(p->preset == LW_PRESET_PHOTO && p->orientation == LW_ORIENT_AUTO),
@@ -579,15 +591,6 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
       {ends, a->n_rep > 1 && p->ladder[0], "tempering.ladder names the temperatures"},
       /* (a seed sweep of the whip gave identical "independent" runs) */
       {seed, p->driver == LW_DRIVER_DYNAMICS && p->from[0], "the dynamics from init.from draws no random number"},
-      /* (a seed sweep of the wire: identical runs, which stats took for agreeing seeds) */
-      {seed, p->driver == LW_DRIVER_DYNAMICS && !strcmp(p->system, "nurbs") && !p->from[0],
-       "the D-NURBS dynamics draws no random number"},
-      {inline_points, p->nb_file[0] != '\0', "nurbs.file gives the points and weights"},
-      {jumps, p->fixed_count, "moves.fixed_count = 1"},
-      {weights, !p->nb_free_weights, "nurbs.free_weights = 0"},
-      {births, p->pt_birth == 0.0 && p->pt_death == 0.0, "no particles.birth or death"},
-      {sigma, p->pt_weight == LW_PWEIGHT_POLY, "particles.weight = poly"},
-      {sigma_normal, p->pt_weight != LW_PWEIGHT_ANISO, "particles.weight is not aniso"},
       {gravity, p->dyn_rho == 0.0, "dynamics.rho = 0: no mass to weigh"},
       /* (a bed too small for the page passed unchecked, without a word) */
       {machine, !p->hpgl && !p->gcode, "neither output.hpgl nor output.gcode"},
@@ -595,14 +598,13 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
       {quench, p->quench == LW_QUENCH_NONE, "anneal.quench = none"},
       {pair, p->pair == 0.0, "energy.pair = 0"},
       {tuning, a->n_rep > 1 && p->tune_ladder == LW_LADDER_FIXED, "tempering.tune_ladder = fixed"},
-      {plane, p->pt_boundary != LW_PBOUNDARY_PLANE, "particles.boundary is not plane"},
-      {sphere, p->pt_boundary != LW_PBOUNDARY_SPHERE, "particles.boundary is not sphere"},
-      {wall, p->pt_boundary == LW_PBOUNDARY_NONE, "particles.boundary = none"},
-      {pinned, !p->pt_points[0], "no particles.points"},
   };
-  size_t m = 0;
+  size_t n = 0, m = 0;
+  while (rule[n].keys) n++;
+  /* and the system's own (its particles' boundary, its nurbs' weights) */
+  if (a->sys_type && a->sys_type->idle) n += (size_t)a->sys_type->idle(p, rule + n);
   if (size) idle[0] = '\0';
-  for (size_t r = 0; r < sizeof rule / sizeof rule[0]; r++) {
+  for (size_t r = 0; r < n; r++) {
     if (!rule[r].idle) continue;
     for (size_t i = 0; i < lw_param_count; i++) {
       const lw_param_def *d = &lw_param_table[i];
@@ -656,8 +658,8 @@ static lw_status fits_memory(const lw_anneal *a, lw_error *err)
   if (!(bytes > limit) || !key) return LW_OK;
   char reps[48] = "";
   if (here > 1) snprintf(reps, sizeof reps, " in %d replicas", here);
-  lw_error_set(err, LW_EINPUT, "%s take at least %.3g GB%s, more than the %.3g GB of %s: expected fewer splines or "
-               "segments", what, bytes / 1e9, reps, limit / 1e9, by);
+  lw_error_set(err, LW_EINPUT, "%s take at least %.3g GB%s, more than the %.3g GB of %s: expected a smaller %s",
+               what, bytes / 1e9, reps, limit / 1e9, by, key);
   const char *dot = strchr(key, '.');
   char section[32];
   snprintf(section, sizeof section, "%.*s", dot ? (int)(dot - key) : 0, key);
@@ -1107,16 +1109,28 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
                      a->sweep ? block_of(a, a->sweep - 1) : -1, a->block);
     goto out;
   }
-  /* the schedule's temperature follows from the step and the parameters
-  ** (the adaptive one's from measurements the file holds as well, but its
-  ** rule under tempering changed on 2026-12-04: not checked); an edited one
-  ** ran the rest of its step at that temperature */
-  if (!a->dyn && a->block >= 0 && a->sched_type != &lw_schedule_adaptive) {
-    double t = a->sched_type->temperature(&a->sched, a->block, a->t_prev, &a->prev);
+  if (!a->dyn && (s = check_block_energy(a, path, err))) goto out;
+  /* the schedule's temperature follows from the step and the parameters,
+  ** the adaptive one's from the measurements the file holds as well (but its
+  ** rule under tempering changed on 2026-12-04: there only its range is
+  ** checked); an edited one ran the rest of its step at that temperature,
+  ** and an adaptive one at any, 0 or 1e300 */
+  const int adaptive = a->sched_type == &lw_schedule_adaptive;
+  if (!a->dyn && a->block >= 0 && adaptive && a->n_rep > 1 &&
+      !(a->t_sched >= a->params.t_end && a->t_sched <= a->params.t_start)) {
+    s = lw_error_set(err, LW_EINPUT, "%s: [run] temperature: %.17g, outside the adaptive schedule's range [%g, %g]: "
+                     "the state was edited", path, a->t_sched, a->params.t_end, a->params.t_start);
+    goto out;
+  }
+  if (!a->dyn && a->block >= 0 && !(adaptive && a->n_rep > 1)) {
+    /* (measured where the step before had sweeps) */
+    const long b = a->block;
+    const double t = step_temperature(a, b, b > 0 && block_start(a, b - 1) < block_start(a, b));
     if (t != a->t_sched) {
       s = lw_error_set(err, LW_EINPUT, "%s: [run] temperature: %.17g, but the %s schedule's step %ld is at %.17g: "
                        "the state was edited, or written by a release whose schedule differs (t_end / t_start "
-                       "under 2.2e-308 or over 1.8e308 before 2026-12-05): run it again", path, a->t_sched,
+                       "under 2.2e-308 or over 1.8e308, or adaptive with more steps than sweeps, before "
+                       "2026-12-05): run it again", path, a->t_sched,
                        a->sched_type->name, a->block, t);
       goto out;
     }
@@ -1322,13 +1336,12 @@ static lw_status dynamics_sweep(lw_anneal *a, lw_error *err)
     /* the scene was read and checked: what stops the motion now is the
     ** run's failure (exit 1), its files kept */
     if (s == LW_EINPUT) s = err->code = LW_ERUN;
-    /* "lower dynamics.dt" sent the user the wrong way here: no dt helps
-    ** weights without a mass of their own (docs/NUMERICS.md, "Free weights") */
-    if (s && !strcmp(p->system, "nurbs") && p->nb_free_weights && p->nb_weight_inertia == 0.0 && p->dyn_rho > 0.0) {
+    /* where no dt helps, the row says what does (system.h) */
+    const char *advice = s && a->sys_type->motion_advice ? a->sys_type->motion_advice(p) : NULL;
+    if (advice) {
       char msg[LW_ERROR_MSG];
       snprintf(msg, sizeof msg, "%s", err->msg);
-      lw_error_set(err, s, "%s; but nurbs.weight_inertia = 0 leaves the free weights without a mass of their own, "
-                   "and no dt takes a step so: give it > 0 (default 0.1; docs/NURBS.md)", msg);
+      lw_error_set(err, s, "%s; %s", msg, advice);
     }
     if (s) return s;
   }
@@ -1409,12 +1422,13 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
       a->prev = (lw_block_stats){mean, var > 0 ? sqrt(var) : 0.0, (long)cnt};
       a->t_prev = a->t_sched;
     }
-    /* the statistics are the coldest rung's, at ladder[0] t / t_start: Huang's
-    ** T / sd for it is this on the schedule's own scale (the schedule's
-    ** temperature with the cold rung's sd cooled 5 to 10 times too fast) */
-    lw_block_stats prev = a->prev;
-    if (a->pt && a->pt->ladder[0] > 0.0) prev.sd *= a->params.t_start / a->pt->ladder[0];
-    a->t_sched = a->sched_type->temperature(&a->sched, b, a->t_prev, a->block >= 0 ? &prev : NULL);
+    /* steps without a sweep (more steps than sweeps) each take their turn,
+    ** unmeasured: the adaptive rule cooled one ratio per sweep, not per step,
+    ** and ended 12 times above where the step it reached stands */
+    for (long k = a->block + 1; k <= b; k++) {
+      if (k > a->block + 1) a->t_prev = a->t_sched;
+      a->t_sched = step_temperature(a, k, a->block >= 0 && k == a->block + 1);
+    }
     set_temperatures(a);
     a->block = b;
     a->acc_n = a->acc_sum = a->acc_sumsq = 0.0;

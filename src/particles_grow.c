@@ -71,6 +71,9 @@ static double birth(const lw_particles *p, lw_particles_prop *pr, gsl_rng *rng, 
 {
   const lw_particles_setup *s = p->setup;
   if (p->n >= s->max_count) return nothing(pr, INFINITY, forbidden, 1);
+  /* none to be born beside (the last one's death is refused by its
+  ** reverse, so only a test's walk gets here): no proposal */
+  if (p->n == 0) return nothing(pr, 0.0, forbidden, 0);
   size_t j = gsl_rng_uniform_int(rng, p->n);
   const double *xj = p->x + 3 * j, *nj = p->nrm + 3 * j, r0 = s->pair.r0;
   double t1[3], t2[3];

@@ -1102,7 +1102,34 @@ static const char *const keys[] = {"init.from", "nurbs.*", "dynamics.rho", "dyna
 static const char *const keys_dynamics[] = {"nurbs.weight_inertia", NULL};
 static const char *const keys_metropolis[] = {"moves.step_point", "moves.target", "nurbs.step_weight", NULL};
 
+/* Keys the scene's other settings leave idle (system.h). */
+static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
+{
+  static const char *const seed[] = {"anneal.seed", NULL},
+                           *const inline_points[] = {"nurbs.points", "nurbs.weights", NULL},
+                           *const weights[] = {"nurbs.weight_inertia", "nurbs.weight_stiffness", "nurbs.step_weight",
+                                               NULL};
+  /* (a seed sweep of the wire: identical runs, which stats took for agreeing seeds) */
+  rule[0] = (lw_idle_rule){seed, p->driver == LW_DRIVER_DYNAMICS && !p->from[0],
+                           "the D-NURBS dynamics draws no random number"};
+  rule[1] = (lw_idle_rule){inline_points, p->nb_file[0] != '\0', "nurbs.file gives the points and weights"};
+  rule[2] = (lw_idle_rule){weights, !p->nb_free_weights, "nurbs.free_weights = 0"};
+  return 3;
+}
+
+/* "lower dynamics.dt" sent the user the wrong way here: no dt helps weights
+** without a mass of their own (docs/NUMERICS.md, "Free weights"). */
+static const char *motion_advice(const lw_params *p)
+{
+  if (p->nb_free_weights && p->nb_weight_inertia == 0.0 && p->dyn_rho > 0.0)
+    return "but nurbs.weight_inertia = 0 leaves the free weights without a mass of their own, and no dt takes a "
+           "step so: give it > 0 (default 0.1; docs/NURBS.md)";
+  return NULL;
+}
+
 const lw_system_type lw_system_nurbs = {
+    .idle = idle,
+    .motion_advice = motion_advice,
     .name = "nurbs",
     .keys = keys,
     .keys_dynamics = keys_dynamics,

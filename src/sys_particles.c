@@ -490,6 +490,25 @@ static const char *const keys_metropolis[] = {"moves.translate", "moves.rotate",
                                               "anneal.domains", NULL};
 
 /* The rows differ only in their move kinds (sys_particles.h). */
+/* Keys the scene's other settings leave idle (system.h). */
+static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
+{
+  static const char *const births[] = {"particles.max_count", NULL}, *const sigma[] = {"particles.sigma", NULL},
+                           *const sigma_normal[] = {"particles.sigma_normal", NULL},
+                           *const plane[] = {"particles.boundary_z", NULL},
+                           *const sphere[] = {"particles.boundary_radius", NULL},
+                           *const wall[] = {"particles.alpha_b", NULL}, *const pinned[] = {"particles.pinned", NULL};
+  int n = 0;
+  rule[n++] = (lw_idle_rule){births, p->pt_birth == 0.0 && p->pt_death == 0.0, "no particles.birth or death"};
+  rule[n++] = (lw_idle_rule){sigma, p->pt_weight == LW_PWEIGHT_POLY, "particles.weight = poly"};
+  rule[n++] = (lw_idle_rule){sigma_normal, p->pt_weight != LW_PWEIGHT_ANISO, "particles.weight is not aniso"};
+  rule[n++] = (lw_idle_rule){plane, p->pt_boundary != LW_PBOUNDARY_PLANE, "particles.boundary is not plane"};
+  rule[n++] = (lw_idle_rule){sphere, p->pt_boundary != LW_PBOUNDARY_SPHERE, "particles.boundary is not sphere"};
+  rule[n++] = (lw_idle_rule){wall, p->pt_boundary == LW_PBOUNDARY_NONE, "particles.boundary = none"};
+  rule[n++] = (lw_idle_rule){pinned, !p->pt_points[0], "no particles.points"};
+  return n;
+}
+
 #define PARTICLES_ROW \
     .keys = keys, \
     .keys_dynamics = keys_dynamics, \
@@ -522,6 +541,8 @@ static const char *const keys_metropolis[] = {"moves.translate", "moves.rotate",
     .save = save, \
     .load = load, \
     .set_terms = set_terms, \
+    .variant = lw_particles_row, \
+    .idle = idle, \
     .files = "final.ply, final.png", \
     .draw = draw, \
     .summary = summary, \

@@ -45,10 +45,70 @@ const lw_system_type *lw_system_of(const lw_params *p, lw_error *err)
     lw_error_set(err, LW_EINPUT, "%s: key 'scene.system': expected one of %s, got '%s'%s", where, lw_system_names(),
                  p->system, lw_params_unseen_char(p->system, unseen, sizeof unseen));
   }
-  /* the same system with its trans-dimensional move kinds (sys_splines.h) */
-  if (t == &lw_system_splines) t = lw_splines_row(p);
-  if (t == &lw_system_particles) t = lw_particles_row(p);
+  if (t && t->variant) t = t->variant(p);
   return t && lw_system_row_fits(t, err) ? t : NULL;
+}
+
+/* The first member a row lacks that the drivers call without asking, or
+** that an optional member it has needs beside it (a row with split() and no
+** merge() crashed mid-sweep); NULL when none.  A row without energy()
+** crashed `linewise energy` rather than being refused. */
+static const char *row_missing(const lw_system_type *t)
+{
+#define LW_NEED(m) \
+  if (!t->m) return #m
+#define LW_NEED_WITH(have, m) \
+  if (t->have && !t->m) return #m " beside " #have
+  if (t->n_moves > 0 && !(t->move_names && t->move_unit)) return "move_names and move_unit";
+  LW_NEED(term_names);
+  LW_NEED(setup_new);
+  LW_NEED(setup_free);
+  LW_NEED(note);
+  LW_NEED(state_new);
+  LW_NEED(state_copy);
+  LW_NEED(state_free);
+  LW_NEED(moves);
+  LW_NEED(sweep_size);
+  LW_NEED(step_max);
+  LW_NEED(proposal_new);
+  LW_NEED(proposal_free);
+  LW_NEED(propose);
+  LW_NEED(commit);
+  LW_NEED(total);
+  LW_NEED(terms);
+  LW_NEED(term_on);
+  LW_NEED(refresh);
+  LW_NEED(energy);
+  LW_NEED(save);
+  LW_NEED(load);
+  LW_NEED(set_terms);
+  LW_NEED(files);
+  LW_NEED(draw);
+  LW_NEED(summary);
+  LW_NEED(describe);
+  LW_NEED_WITH(defer, finish);
+  LW_NEED_WITH(finish, defer);
+  LW_NEED_WITH(split, group);
+  LW_NEED_WITH(split, propose_in);
+  LW_NEED_WITH(split, commit_part);
+  LW_NEED_WITH(split, merge);
+  LW_NEED_WITH(gradient, n_coords);
+  LW_NEED_WITH(gradient, get_coords);
+  LW_NEED_WITH(gradient, set_coords);
+  LW_NEED_WITH(mass_new, gradient);
+  LW_NEED_WITH(mass_new, mass_free);
+  LW_NEED_WITH(mass_new, mass_at);
+  LW_NEED_WITH(mass_new, mass_solve);
+  LW_NEED_WITH(mass_new, mass_apply);
+  LW_NEED_WITH(mass_new, mass_dx);
+  LW_NEED_WITH(mass_new, mass_pinned);
+  LW_NEED_WITH(mass_shift, mass_shift_solve);
+  LW_NEED_WITH(mass_shift, mass_new);
+  LW_NEED_WITH(damp_pairs, mass_new);
+  if (t->n_observables > 0 && !(t->observable_names && t->observe)) return "observable_names and observe";
+#undef LW_NEED
+#undef LW_NEED_WITH
+  return NULL;
 }
 
 int lw_system_row_fits(const lw_system_type *t, lw_error *err)
@@ -57,6 +117,12 @@ int lw_system_row_fits(const lw_system_type *t, lw_error *err)
     lw_error_set(err, LW_EINPUT, "the %s system's row has %d move kinds, %d terms and %d observables; at most %d, %d "
                  "and %d fit (include/linewise/system.h)", t->name, t->n_moves, t->n_terms, t->n_observables,
                  LW_MOVES_MAX, LW_SYSTEM_TERMS_MAX, LW_OBSERVABLES_MAX);
+    return 0;
+  }
+  const char *missing = row_missing(t);
+  if (missing) {
+    lw_error_set(err, LW_EINPUT, "the %s system's row has no %s (include/linewise/system.h says what it must hold)",
+                 t->name, missing);
     return 0;
   }
   /* the drivers' own columns of trace.csv and members of summary.json's

@@ -419,3 +419,23 @@ Test(run, a_running_energy_that_does_not_add_up_is_said)
     lw_anneal_free(&a);
   }
 }
+
+/* With more steps than sweeps some steps have no sweep; each still takes its
+** turn of the adaptive rule, unmeasured (the geometric ratio): the rule
+** cooled one ratio per sweep instead, and ended 12 times above the step it
+** reached.  Every row's temperature is the geometric schedule's, to the
+** rounding of a product of up to 25 ratios against a power (1e-12). */
+Test(run, an_adaptive_schedule_takes_every_step_it_skips)
+{
+  const char *b = getenv("LW_BIN");
+  char path[128];
+  write_scene("", path, sizeof path);
+  static const char *const sched[] = {"adaptive", "geometric"};
+  for (int k = 0; k < 2; k++)
+    cr_assert_eq(sh("%s run %s --out %s/%s --quiet --set anneal.schedule=%s --set anneal.sweeps=10 --set "
+                    "anneal.steps=25 --set output.trace_every=1 && cut -d, -f2 %s/%s/trace.csv > %s/%s.txt", b, path,
+                    dir, sched[k], sched[k], dir, sched[k], dir, sched[k]), 0);
+  cr_assert_eq(sh("cd %s && paste adaptive.txt geometric.txt | awk 'NR > 1 { n++; r = $1 / $2 - 1; if (r > 1e-12 || "
+                  "r < -1e-12) bad++ } END { exit !(n == 10 && bad == 0) }'", dir), 0,
+               "%s", lw_test_slurp("%s/adaptive.txt", dir));
+}

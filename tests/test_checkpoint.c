@@ -139,6 +139,37 @@ Test(checkpoint, every_run_data_value_is_checked_on_resume)
   cr_assert_eq(resume_edited("s/^sweep = 20$/sweep = 20/"), 0);
 }
 
+/* The adaptive schedule's temperature follows from the previous step's and
+** the energies the file holds: an edited one (5, 0, 1e300) ran the rest of
+** the run there, and energies with a negative variance, or more samples
+** than the step has had sweeps, made the next temperature without a word.
+** Under tempering (whose rule changed on 2026-12-04) its range is checked. */
+Test(checkpoint, an_adaptive_schedules_state_is_checked_on_resume)
+{
+  cr_assert_eq(lw_test_sh("%s run %s/tests/fixtures/v1/plain.ini --out %s/r --stop-at 25 --quiet --set "
+                          "anneal.schedule=adaptive", lw_test_bin(), lw_test_root(), dir), 0);
+  static const struct { const char *sed, *msg; } bad[] = {
+    {"s/^temperature = .*/temperature = 5/", "[run] temperature: 5, but the adaptive schedule"},
+    {"s/^temperature = .*/temperature = 0/", "[run] temperature: 0, but the adaptive schedule"},
+    {"s/^temperature = .*/temperature = 1e300/", "[run] temperature: 1.0000000000000001e+300, but the adaptive"},
+    {"s/^block_energy = .*/block_energy = 5 1000 2372/", "[run] block_energy: 5 samples with sum 1000 and sum of "
+     "squares 2372, but the step has had 5 sweeps and a variance is not negative"},
+    {"s/^block_energy = .*/block_energy = 6 10 20/", "but the step has had 5 sweeps"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    int rc = resume_edited(bad[i].sed);
+    cr_expect_eq(rc, 2, "edit '%s': exit %d", bad[i].sed, rc);
+    cr_expect(err_has(bad[i].msg), "edit '%s': message lacks '%s'", bad[i].sed, bad[i].msg);
+  }
+  cr_assert_eq(resume_edited("s/^sweep = 25$/sweep = 25/"), 0);
+  cr_assert_eq(lw_test_sh("rm -rf %s/r && %s run %s/tests/fixtures/v1/plain.ini --out %s/r --stop-at 25 --quiet --set "
+                          "anneal.schedule=adaptive --set tempering.replicas=2", dir, lw_test_bin(), lw_test_root(),
+                          dir), 0);
+  cr_expect_eq(resume_edited("s/^temperature = .*/temperature = 5/"), 2);
+  cr_expect(err_has("[run] temperature: 5, outside the adaptive schedule") && err_has("range [0.01, 1]: the state was edited"));
+  cr_assert_eq(resume_edited("s/^sweep = 25$/sweep = 25/"), 0);
+}
+
 /* A state.lw cut short (a partial copy) is said to be.  Cut inside [run] or
 ** [chain] it was blamed on "a state of another system?", naming no line;
 ** cut inside its last number it resumed with that number shortened.  Every

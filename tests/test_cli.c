@@ -353,6 +353,9 @@ Test(cli, keys_the_system_never_reads_are_refused)
      "/params/minimal.ini:17: energy.pair = 0), energy.pair_near (--set: energy.pair = 0)"},
     {"minimal", "--set tempering.replicas=2 --set tempering.ladder_sweeps=5",
      "tempering.ladder_sweeps (--set: tempering.tune_ladder = fixed)"},
+    /* a schedule's ends it does not read (t_start counts under tempering) */
+    {"minimal", "--set anneal.schedule=constant --set anneal.t_end=0.5",
+     "anneal.t_end (--set: anneal.schedule reads no t_end)"},
     {"particles-sheet", "--set particles.boundary_radius=3 --set particles.alpha_b=1 --set particles.pinned=1",
      "particles.boundary_radius (--set: particles.boundary is not sphere), particles.alpha_b (--set: "
      "particles.boundary = none), particles.pinned (--set: no particles.points)"},
@@ -364,8 +367,13 @@ Test(cli, keys_the_system_never_reads_are_refused)
     cr_assert(strstr(errs, "linewise: note: these keys have no effect here: ") && strstr(errs, idle[k].want),
               "%s: %s", idle[k].set, errs);
   }
-  /* a schedule that never reaches its end says so (each was silent) */
+  /* a table's t_start, with one replica (minimal.ini's t_end is the default: not noted) */
   write_file("t.txt", "1 1\n5 0.01\n");
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out tt --set anneal.sweeps=1 --set "
+                          "anneal.schedule=table --set anneal.table=t.txt --set anneal.t_start=3 2>err.txt && grep -qF "
+                          "'anneal.t_start (--set: anneal.schedule reads no t_start)' err.txt", dir,
+                          lw_test_bin(), lw_test_root()), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+  /* a schedule that never reaches its end says so (each was silent) */
   static const struct { const char *set, *want; } end[] = {
     {"--set anneal.sweeps=10 --set anneal.steps=15", "linewise: note: anneal.steps = 15 is more than the 10 sweeps: "
      "some steps are skipped, and the run ends at step 13 (steps count from 0 to 14), short of t_end\n"},

@@ -179,6 +179,8 @@ static void gs_describe(const void *state, int what, char *buf, size_t n)
   snprintf(buf, n, what == LW_DESCRIBE_SIZE ? "%d variables" : "", NV);
 }
 
+static void gs_defer(void *prop, int on) {}
+
 static const char *const gs_move_names[] = {"one", "all"};
 static const double gs_move_unit[] = {1.0, 1.0};
 static const char *const gs_term_names[] = {"even", "odd"};
@@ -376,6 +378,16 @@ Test(system, the_table_starts_with_splines_and_finds_rows_by_name)
   named.term_names = twice;
   cr_assert_not(lw_system_row_fits(&named, &err));
   cr_assert(strstr(err.msg, "two terms named 'x'"), "%s", err.msg);
+  /* a member the drivers call without asking (a row without energy crashed
+  ** `linewise energy`), or an optional one without its partners */
+  lw_system_type lacking = gauss_type;
+  lacking.energy = NULL;
+  cr_assert_not(lw_system_row_fits(&lacking, &err));
+  cr_assert(strstr(err.msg, "the gauss system's row has no energy (include/linewise/system.h"), "%s", err.msg);
+  lacking = gauss_type;
+  lacking.defer = gs_defer;
+  cr_assert_not(lw_system_row_fits(&lacking, &err));
+  cr_assert(strstr(err.msg, "has no finish beside defer"), "%s", err.msg);
 }
 
 Test(system, an_unknown_system_exits_2_naming_file_line_and_key)

@@ -62,6 +62,17 @@
 
 typedef struct lw_system_type lw_system_type;
 
+/* Keys (NULL-terminated, "section.key" or "section.*") that a scene's other
+** settings leave idle where `idle` is set, and why ("moves.fixed_count =
+** 1"): a scene that gives one a value is noted before its run, so that a
+** mistake there shows before the setting that reads it is chosen. */
+typedef struct {
+  const char *const *keys;
+  int idle;
+  const char *why;
+} lw_idle_rule;
+#define LW_IDLE_RULES_MAX 16
+
 /* *forbidden of a proposal that is none (lw_system_type.propose). */
 #define LW_PROPOSE_NOTHING 4
 
@@ -84,6 +95,15 @@ struct lw_system_type {
   const char *const *keys;
   const char *const *keys_dynamics;
   const char *const *keys_metropolis;
+
+  /* Optional (NULL: the row itself): the row the scene's settings choose
+  ** among the system's variants (for splines and particles, those with
+  ** trans-dimensional move kinds), all of one name. */
+  const lw_system_type *(*variant)(const lw_params *p);
+  /* Optional (NULL: none): the row's own rules for keys its other settings
+  ** leave idle (a boundary's size under another boundary), noted before a
+  ** run beside the drivers' rules (anneal.c); returns how many it wrote. */
+  int (*idle)(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX]);
 
   /* The shared set-up of a scene (NULL and err set on bad input, naming the
   ** parameter's file and line), and a note for the user or "" (e.g. a
@@ -300,6 +320,10 @@ struct lw_system_type {
   ** state moves there, so the state and the driver's coordinates agree bit
   ** for bit. */
   void (*constrain)(const void *state, const double *from, double *x, double *pi);
+  /* Optional (NULL: none): what a motion that failed (dynamics.h) needs
+  ** besides the shorter dynamics.dt its message asks for, or NULL; for
+  ** D-NURBS, free weights without a mass of their own, which no dt helps. */
+  const char *(*motion_advice)(const lw_params *p);
   /* Optional (NULL: none, and a scene that sets dynamics.dashpot or
 ** dashpot_angular is refused): the dampers between neighbours the scene
 ** names, read by mass_new; for particles the seed's beta_1 and beta_3.
