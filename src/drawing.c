@@ -245,6 +245,11 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   if (!st->n && rep->post.lifts_before)
     snprintf(rep->empty_why, sizeof rep->empty_why, "every stroke was cut by the crop or too short for "
              "plot.min_length (%g pen widths)", p->min_length);
+  /* (a high chem_spline that killed every line was blamed on the potential) */
+  else if (!st->n && !p->fixed_count && (p->chem_spline > 0.0 || p->chem_length > 0.0))
+    snprintf(rep->empty_why, sizeof rep->empty_why, "no spline is left: none was placed (init.splines, "
+             "init.coverage), or the anneal removed every one, a line's own price (energy.chem_spline %g, "
+             "chem_length %g) being more than what it lowers: lower them", p->chem_spline, p->chem_length);
   else if (!st->n && !p->fixed_count && sc->on[LW_TERM_POTENTIAL] && sc->image)
     snprintf(rep->empty_why, sizeof rep->empty_why, "no spline is left: none was placed (init.splines, "
              "init.coverage), or the anneal removed every one, the price of line (energy.potential) being more than "

@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "linewise/anneal.h"
+#include "linewise/checkpoint.h"
 #include "linewise/number.h"
 #include "linewise/params.h"
 #include "linewise/phase.h"
@@ -170,6 +171,18 @@ static int cmd_energy(int argc, char **argv)
   lw_state st;
   char path[LW_PATH_MAX + 32];
   if (load_run_dir(dir, &p, &st, path, sizeof path, &err)) return fail(&err);
+  /* the energy is of the scene as DIR/scene.ini reads now: an edit since the
+  ** run started (which resume refuses) gave another energy without a word */
+  static lw_run_keys keys;
+  unsigned long long hash;
+  lw_error edited;
+  lw_error_clear(&edited);
+  if (st.doc && lw_checkpoint_scene_hash(st.doc, &p, &keys, &hash, &edited)) {
+    char *why = strstr(edited.msg, ": a run resumes with");
+    if (why) *why = '\0';
+    fprintf(stderr, "linewise: note: the energy is of the scene as it reads now, not as the run started: %s\n",
+            edited.msg);
+  }
   int set = 0;
   for (int i = 0; i < argc && !err.code; i++) {
     if (strcmp(argv[i], "--set")) continue;

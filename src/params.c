@@ -318,7 +318,7 @@ const lw_param_def lw_param_table[] = {
   NUM("moves", "prior_sd", LW_PT_DOUBLE, prior_sd, "0.25", "", 0, 1, LW_MIN_OPEN,
       "The spread of the prior that births and grows draw from and every move of a spline "
       "pays (fixed_count = 0): the standard deviation of a next node's point about 3 v beyond "
-      "the last, in init.segment_length, its vector's a third of it. At 0.25, 97 % of the "
+      "the last, in init.segment_length, its vector's a third of it. At 0.25, 97 to 99.7 % of the "
       "5-segment births of the photo preset break the regularity check (energy.min_speed, "
       "energy.regularity); 0.1 lowers that to 32 to 44 %, and trades tone for alignment "
       "(docs/NUMERICS.md, \"The prior's spread\")."),
@@ -332,7 +332,7 @@ const lw_param_def lw_param_table[] = {
       "(fixed_count = 0)."),
   NUM("moves", "max_segments", LW_PT_INT, max_segments, "16", "", 1, 1e5, 0,
       "Grow never makes a spline longer than this many segments (fixed_count = 0); shrink never "
-      "below one."),
+      "below one. At least init.segments; the default gives way to a larger init.segments."),
   NUM("moves", "split", LW_PT_DOUBLE, mix_split, "0", "", 0, 1e6, 0,
       "Relative frequency of splits: an inner segment of a spline of 3 or more segments removed, "
       "leaving two splines with the nodes as they were (fixed_count = 0; 0 = none)."),

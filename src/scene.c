@@ -491,6 +491,11 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   sc->chem[1] = p->chem_length;
   coef[LW_TERM_CHEMICAL] = sc->chem[0] != 0.0 || sc->chem[1] != 0.0;
   sc->transdim = !p->fixed_count;
+  /* a cap below the placed splines' count was raised to it without a word,
+  ** and lines grew past the cap the scene set; the default gives way */
+  if (sc->transdim && p->max_segments < p->segments && lw_params_given(p, lw_params_find("moves", "max_segments")))
+    return bad_key(p, "moves", "max_segments", LW_EINPUT, err, "expected at least init.segments = %d, the count "
+                   "the placed splines start with, got %d", p->segments, p->max_segments);
   sc->max_segments = (size_t)(p->max_segments > p->segments ? p->max_segments : p->segments);
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     sc->coef[t] = coef[t];

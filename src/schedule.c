@@ -151,7 +151,7 @@ const lw_schedule_type lw_schedule_adaptive = {
   adaptive_temperature};
 
 const lw_schedule_type lw_schedule_table = {
-  "table", "T_b piecewise linear in b through the file's (block, temperature) rows, held outside them",
+  "table", "T_b piecewise linear in b through the file's (step, temperature) rows, held outside them",
   LW_SCHEDULE_USES_TABLE, table_temperature};
 
 const lw_schedule_type *const lw_schedule_types[] = {

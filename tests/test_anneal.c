@@ -439,3 +439,40 @@ Test(run, an_adaptive_schedule_takes_every_step_it_skips)
                   "r < -1e-12) bad++ } END { exit !(n == 10 && bad == 0) }'", dir), 0,
                "%s", lw_test_slurp("%s/adaptive.txt", dir));
 }
+
+/* Once every line has died, a death, grow or shrink (or any move) has no
+** line to act on: no proposal, counted nowhere.  Each was counted a
+** rejection, so a page whose lines all died read acc_death 0.000000 in
+** every later row and a death acceptance of 0.32 where 428 of 440 were
+** taken.  The rows with no line left have every acceptance empty. */
+Test(run, a_move_with_no_line_left_is_no_proposal)
+{
+  const char *b = getenv("LW_BIN");
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/die --threads 1 --set moves.fixed_count=0 --set "
+                  "energy.chem_spline=1000 --set moves.birth_spread=0.5 --set anneal.sweeps=100 --set "
+                  "output.observables=1 2>%s/die.txt", b, lw_test_root(), dir, dir), 0);
+  /* and the empty drawing names the price that emptied it (it blamed energy.potential) */
+  cr_assert_eq(sh("grep -qF 'the anneal removed every one, a line' %s/die.txt && grep -qF 'own price "
+                  "(energy.chem_spline 1000, chem_length 0)' %s/die.txt", dir, dir), 0);
+  /* columns 9 to 16 are acc_point .. acc_shrink, 17 obs_count (the row of
+  ** the sweep where the last one died has its earlier moves); a birth may
+  ** still be tried (it is refused, counted) */
+  cr_assert_eq(sh("awk -F, 'NR == 1 { ok = $13 == \"acc_birth\" && $17 == \"obs_count\" } NR > 2 && $17 == 0 && "
+                  "last == 0 { n++; for (k = 9; k <= 16; k++) if (k != 13 && $k != \"\") bad++ } { last = $17 } "
+                  "END { exit !(ok && n >= 20 && !bad) }' "
+                  "%s/die/trace.csv", dir), 0, "%s", lw_test_slurp("%s/die/trace.csv", dir));
+}
+
+/* A cap on the segments below the count the placed splines start with was
+** raised to it without a word, and lines grew past the cap the scene set;
+** the default (16) gives way to a larger init.segments. */
+Test(run, a_segment_cap_below_the_placed_count_is_refused)
+{
+  const char *b = getenv("LW_BIN");
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/cap --quiet --set moves.fixed_count=0 --set "
+                  "moves.max_segments=3 2>%s/cap.txt; test $? -eq 2 && grep -qF \"key 'moves.max_segments': expected "
+                  "at least init.segments = 4, the count the placed splines start with, got 3\" %s/cap.txt && ! test "
+                  "-e %s/cap", b, lw_test_root(), dir, dir, dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/cap --quiet --set moves.fixed_count=0 --set init.segments=20 "
+                  "--set init.segment_length=1.5 --set anneal.sweeps=2", b, lw_test_root(), dir), 0);
+}

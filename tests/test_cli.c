@@ -152,6 +152,20 @@ Test(cli, energy_with_a_key_changed_is_that_scenes_energy)
   lw_state_clear(&st);
 }
 
+/* A run's scene.ini edited since the run started (which resume refuses)
+** gave `energy DIR` another energy without a word: it is noted, naming the
+** key and line, and the energy printed is the edited scene's. */
+Test(cli, energy_of_a_run_whose_scene_was_edited_says_so)
+{
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out e --quiet --set anneal.sweeps=3 && %s energy e "
+                          "2>err1.txt >e1.txt && sed -i 's/^strain = 10$/strain = 11/' e/scene.ini && %s energy e "
+                          "2>err2.txt >e2.txt", dir, lw_test_bin(), lw_test_root(), lw_test_bin(), lw_test_bin()), 0);
+  cr_assert_eq(lw_test_sh("cd %s && ! test -s err1.txt && ! cmp -s e1.txt e2.txt && grep -qF 'linewise: note: the "
+                          "energy is of the scene as it reads now, not as the run started: e/scene.ini: ' err2.txt && "
+                          "grep -qF energy.strain err2.txt && grep -qF '(line 47) edited since the run started' "
+                          "err2.txt", dir), 0, "%s", lw_test_slurp("%s/err2.txt", dir));
+}
+
 Test(cli, energy_lists_only_enabled_terms)
 {
   write_file("scene.ini", "[energy]\nbending = 1\n");
