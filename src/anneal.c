@@ -404,8 +404,9 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
       return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%s'%s",
                           where, LW_TEMPERING_MAX, p->ladder, lw_number_list_hint(n));
     if (p->replicas != 1 && p->replicas != n)
-      return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': %d temperatures for %d replicas", where, n,
-                          p->replicas);
+      return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': %d temperatures for %d replicas: the ladder "
+                          "sets the count, so expected tempering.replicas = %d or 1 (its default)", where, n,
+                          p->replicas, n);
     for (int k = 0; k < n; k++)
       if (!(ladder[k] > 0.0) || !isfinite(ladder[k]) || (k > 0 && !(ladder[k] > ladder[k - 1])))
         return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected increasing positive "

@@ -473,8 +473,9 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     if (lw_anneal_checkpoint(a, err)) return loop_fail(a, pg.start_sweep, w, err);
     watcher_stop(w, LW_PHASE_DONE);
     if (!quiet)
-      fprintf(stderr, "linewise: stopped after sweep %ld; state saved in %s/state.lw ('linewise resume %s' continues)\n",
-              a->sweep, a->dir, a->dir);
+      fprintf(stderr, "linewise: stopped after sweep %ld; state saved in %s/state.lw ('linewise resume %s' "
+              "continues%s)\n", a->sweep, a->dir, a->dir,
+              net && net->size > 1 ? ", on one process or again over MPI with 'mpirun -n P linewise-mpi resume'" : "");
     return 0;
   }
   say_finishing = !quiet;
@@ -758,6 +759,12 @@ static int cmd_run(int argc, char **argv)
   if (net && net->rank) quiet = 1;
   watcher_start(&w, quiet);
   if (spread_start(lw_anneal_start_net(&a, &p, dir, net, &err), &a, 1, &err)) {
+    /* (a failed first write said only that, leaving a directory without a
+    ** state.lw: what to do next, as loop_fail says later) */
+    const size_t n = strlen(err.msg);
+    if (err.code == LW_EIO)
+      snprintf(err.msg + n, sizeof err.msg - n, "; the run wrote no checkpoint: run it again once the files can be "
+               "written");
     lw_anneal_free(&a);
     unmake_dir(dir, hold, made);
     return watched_fail(&w, &err);

@@ -1,6 +1,7 @@
 /* nurbs.c -- NURBS curves: the basis from GSL, the rational part (nurbs.h). */
 #include "linewise/nurbs.h"
 
+#include <float.h>
 #include <gsl/gsl_errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -425,6 +426,11 @@ double lw_nurbs_beziers(const lw_nurbs *c, double tol, void (*emit)(const double
 {
   lw_nurbs *rev = reversed(c);
   if (!rev) return NAN;
+  /* no closer than the evaluation's rounding: a tolerance under it split
+  ** every span 2^24 times (a run drew for ever) */
+  double scale = 0.0;
+  for (size_t i = 0; i < 2 * c->n; i++) scale = fmax(scale, fabs(c->P[i]));
+  tol = fmax(tol, 1024.0 * DBL_EPSILON * scale);
   double worst = 0.0;
   for (size_t s = (size_t)c->order - 1; s < c->n; s++)
     if (c->knot[s + 1] > c->knot[s])

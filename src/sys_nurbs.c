@@ -151,7 +151,23 @@ static lw_nurbs *curve_of(const lw_params *p, lw_error *err)
   for (size_t i = 0; i < nw; i++)
     if (!(w[i] > 0.0)) {
       lw_error_set(err, LW_EINPUT, "weight %zu is %g: weights must be > 0 (they count from 0)", i, w[i]);
-      lw_params_blame(p, "nurbs", "weights", err);
+      lw_params_blame(p, "nurbs", p->nb_file[0] ? "file" : "weights", err);
+      goto out;
+    } else if (!(w[i] >= LW_NURBS_WEIGHT_MIN && w[i] <= 1.0 / LW_NURBS_WEIGHT_MIN)) {
+      /* (1e200 ended in "a D-NURBS matrix ... is not positive definite", 1e-50
+      ** in an unstable motion: products of weights leave the doubles) */
+      lw_error_set(err, LW_EINPUT, "weight %zu is %g: expected weights from %g to %g (they count from 0)", i, w[i],
+                   LW_NURBS_WEIGHT_MIN, 1.0 / LW_NURBS_WEIGHT_MIN);
+      lw_params_blame(p, "nurbs", p->nb_file[0] ? "file" : "weights", err);
+      goto out;
+    }
+  /* (a point at 1e100 drew for ever: final.svg's pieces could not get within
+  ** svg_tolerance of a curve whose rounding alone is larger) */
+  for (size_t i = 0; i < np; i++)
+    if (!(fabs(P[i]) <= LW_STATE_COORD_MAX)) {
+      lw_error_set(err, LW_EINPUT, "control point %zu has %c = %g: expected coordinates within +-%g (they count "
+                   "from 0)", i / 2, i % 2 ? 'y' : 'x', P[i], LW_STATE_COORD_MAX);
+      lw_params_blame(p, "nurbs", p->nb_file[0] ? "file" : "points", err);
       goto out;
     }
   if (!(knot = numbers(p, "knots", p->nb_knots, &nk, err))) goto out;
@@ -219,6 +235,17 @@ lw_nurbs_setup *lw_nurbs_setup_new(const lw_params *p, lw_nurbs *curve, lw_error
   su->weight_stiffness = p->nb_weight_stiffness;
   su->mug[0] = p->dyn_rho * p->dyn_gravity_x;
   su->mug[1] = p->dyn_rho * p->dyn_gravity_y;
+  /* fewer Gauss points than control points leave the mass matrix singular:
+  ** nurbs.gauss = 1 ran into a stability limit of 1e-9 s, blaming dt */
+  size_t spans = 0;
+  for (size_t s = (size_t)curve->order - 1; s < n; s++) spans += curve->knot[s + 1] > curve->knot[s];
+  if ((size_t)p->nb_gauss * spans < n) {
+    lw_error_set(err, LW_EINPUT, "expected at least %zu points a knot span: %zu spans of %zu control points, and "
+                 "fewer Gauss points than control points leave the mass matrix singular (as many as the order, %d, "
+                 "make the matrices exact)", (n + spans - 1) / spans, spans, n, curve->order);
+    lw_params_blame(p, "nurbs", "gauss", err);
+    goto fail;
+  }
   if (!(su->mat = lw_dnurbs_new(su->curve, p->nb_alpha, p->nb_beta, p->nb_gauss, err))) goto fail;
   su->pin = calloc(n, 1);
   su->f = calloc(2 * n, sizeof *su->f);

@@ -580,6 +580,12 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
   fclose(f);
   cr_assert(strstr(errs, "fz/state.lw: write failed: File too large"), "%s", errs);
   cr_assert_neq(lw_test_sh("ls %s/fz/*.tmp 2>/dev/null | grep -q .", dir), 0, "a temporary file was left behind");
+  /* a first checkpoint that fails leaves nothing to resume: said so (it was
+  ** the bare write failure) */
+  cr_assert_eq(lw_test_sh("sh -c 'ulimit -f 8; %s run %s/params/minimal.ini --out %s/f0 --quiet' 2>%s/err.txt; test "
+                          "$? -eq 1 && grep -q 'f0/state.lw: write failed: File too large; the run wrote no checkpoint: "
+                          "run it again once the files can be written' %s/err.txt", lw_test_bin(), lw_test_root(), dir,
+                          dir, dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* a PNG cut short says why too (cairo's own message named no reason) */
   cr_assert_eq(lw_test_sh("sh -c 'ulimit -f 60; %s run %s/params/minimal.ini --out %s/fp --quiet --set "
                           "output.png_scale=20 --set anneal.sweeps=5' 2>%s/err.txt; test $? -eq 1 && grep -q "

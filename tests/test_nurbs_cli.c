@@ -158,6 +158,18 @@ Test(nurbs_cli, bad_knots_and_weights_exit_2_naming_file_line_and_key)
   snprintf(body, sizeof body, "%sweights = 1 1 1\\n", pts);
   refused(body, "bad.ini:5: key .nurbs.weights.: expected one weight per control point (7), got 3");
   refused("points = 0 0 1 1 2\\n", "bad.ini:4: key .nurbs.points.: expected x y pairs");
+  /* values past what the matrices and the drawing can hold: a weight of
+  ** 1e200 was "a D-NURBS matrix ... is not positive definite" with no key,
+  ** 1e-150 an unstable motion, and a point at 1e100 drew for ever */
+  snprintf(body, sizeof body, "%sweights = 1 1 1 1e200 1 1 1\\n", pts);
+  refused(body, "bad.ini:5: key .nurbs.weights.: weight 3 is 1e+200: expected weights from 1e-100 to 1e+100");
+  snprintf(body, sizeof body, "%sweights = 1 1 1e-150 1 1 1 1\\n", pts);
+  refused(body, "bad.ini:5: key .nurbs.weights.: weight 2 is 1e-150");
+  refused("points = 0 0 1 1 2 0 1e100 1 4 0 5 1 6 0\\n",
+          "bad.ini:4: key .nurbs.points.: control point 3 has x = 1e+100: expected coordinates within +-1e+09");
+  /* one Gauss point a span: a singular mass matrix, blamed on dt */
+  snprintf(body, sizeof body, "%sgauss = 1\\n", pts);
+  refused(body, "bad.ini:5: key .nurbs.gauss.: expected at least 2 points a knot span: 4 spans of 7 control points");
   /* the points file: its own line named, behind the key's */
   cr_assert_eq(sh("printf '# wire\\n0 0 1\\n1 1 1\\n2 0\\n' > %s/p.txt", dir), 0);
   refused("file = p.txt\\n", "bad.ini:4: key .nurbs.file.: .*p.txt:4: expected .x y w. (w > 0) like the lines before");
@@ -362,4 +374,18 @@ Test(nurbs_cli, a_constant_temperature_run_too_short_to_tune_says_so)
                   "%s run %s/lone.ini --out %s/t4 2> %s/err.txt", dir, lw_test_bin(), dir, dir, dir), 0);
   cr_assert_eq(sh("grep -q 'note: translate, rotate moves were accepted every time: .*, or the energy does not "
                   "change under them' %s/err.txt && ! grep -q 'too short to tune' %s/err.txt", dir, dir), 0);
+}
+
+/* final.svg's pieces get no closer to the curve than its evaluation's
+** rounding: a tolerance under it split every span 2^24 times, and a run
+** with points near 1e6 and svg_tolerance 1e-12 drew for ever.  It ends,
+** within a few seconds, and reports the deviation it reached. */
+Test(nurbs_cli, a_tolerance_under_the_rounding_still_draws)
+{
+  cr_assert_eq(sh("printf '[scene]\\nsystem = nurbs\\n[nurbs]\\npoints = 1e6 1e6 1000001 1000002 1000002 1e6 "
+                  "1000003 1000001\\nweights = 1 2 0.5 1\\nsvg_tolerance = 1e-12\\n[anneal]\\nsweeps = 2\\n' > %s/t.ini",
+                  dir), 0);
+  cr_assert_eq(sh("timeout 60 %s run %s/t.ini --out %s/t --quiet 2> %s/err.txt", lw_test_bin(), dir, dir, dir), 0,
+               "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh("grep -q '<path' %s/t/final.svg", dir), 0);
 }

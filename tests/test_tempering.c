@@ -381,6 +381,11 @@ Test(ptrun, bad_ladders_are_refused_with_the_line)
   cr_assert_eq(sh("grep -q 'bad.ini:2: key .tempering.ladder.: expected increasing' %s/err.txt", dir), 0);
   cr_assert_eq(sh("%s run %s/s.ini --set tempering.t_max=0.1 --out %s/x --quiet 2>%s/err.txt", b, dir, dir, dir), 2);
   cr_assert_eq(sh("grep -q 'tempering.t_max' %s/err.txt", dir), 0);
+  /* a ladder against a replicas key: which one to change */
+  cr_assert_eq(sh("printf '[tempering]\nreplicas = 3\nladder = 1 2 3 4\n' > %s/bad.ini", dir), 0);
+  cr_assert_eq(sh("%s run %s/bad.ini --out %s/x --quiet 2>%s/err.txt", b, dir, dir, dir), 2);
+  cr_assert_eq(sh("grep -q 'bad.ini:3: key .tempering.ladder.: 4 temperatures for 3 replicas: the ladder sets the "
+                  "count, so expected tempering.replicas = 4 or 1 (its default)' %s/err.txt", dir), 0);
   cr_assert_neq(sh("test -e %s/x", dir), 0, "an output directory was created for bad input");
 }
 
