@@ -38,6 +38,14 @@
 #define MEMORY 5         /* step pairs kept: 2 MEMORY + 6 vectors of n doubles in all */
 #define HALVINGS_MAX 50  /* a step of 2^-50 of the first is nothing */
 #define ARMIJO 1e-4
+/* Near a minimum the decrease Armijo asks for, about |g|^2 / curvature, sinks
+** under the energy's rounding and its test decides on noise: the hanging
+** chain stalled at a gradient of 5e-6 (quench_tol 1e-6).  There a step is
+** also taken where the energy rose by no more than ROUNDING of itself and
+** the slope says the step went toward the minimum (level()). */
+#define ROUNDING 1e-12
+#define WOLFE_DELTA 0.1
+#define WOLFE_SIGMA 0.9
 /* No coordinate moves more than this many first steps in one (the rms of
 ** the coordinates: a page): where the energy has no floor (a weight with
 ** nothing to hold it) the quench walks off instead of leaping to
@@ -149,6 +157,17 @@ static lw_status restore(lbfgs *q, lw_error *err)
   return LW_OK;
 }
 
+/* Whether the trial's slope along the step (g1 . d, d the step as held)
+** lies in [SIGMA, 2 DELTA - 1] times the start's, slope: the slope part of
+** Hager and Zhang's approximate Wolfe conditions (SIAM J. Optim. 16, 2005),
+** which decide on derivatives where the energy's decrease has sunk under
+** its rounding. */
+static int level(const lbfgs *q, double slope)
+{
+  const double s1 = dot(q->g1, q->d, q->n);
+  return s1 >= WOLFE_SIGMA * slope && s1 <= (2.0 * WOLFE_DELTA - 1.0) * slope;
+}
+
 /* One step from x along d, no coordinate moving more than max_move: 1 if
 ** taken (x, g and *e moved on), 0 if no length descended, -1 on an error. */
 static int line_search(lbfgs *q, double *e, double max_move, lw_error *err)
@@ -172,7 +191,7 @@ static int line_search(lbfgs *q, double *e, double max_move, lw_error *err)
     const double e1 = evaluate(q, q->x1, q->g1, err);
     if (isnan(e1)) return -1;
     q->away = 1;
-    if (e1 <= *e + ARMIJO * h * slope) {
+    if (e1 <= *e + ARMIJO * h * slope || (e1 <= *e + ROUNDING * fabs(*e) && level(q, slope))) {
       q->away = 0;
       /* the pair (s, y) before x and g move on, kept if s.y > 0 */
       double *s = q->s[q->head], *y = q->y[q->head];

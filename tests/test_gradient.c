@@ -835,6 +835,21 @@ Test(quench, an_energy_without_a_floor_walks_off_and_still_draws, .init = qsetup
                           "sys.exit(0 if q['energy_after'] < q['energy_before'] - 1e5 else 1)\"", qdir, qdir), 0);
 }
 
+/* On a smooth energy the quench goes on to quench_tol: the hanging chain's
+** from its placement (E about -8800) stalled at a gradient of 5.2e-6, where
+** the decrease Armijo's test asks for sank under the energy's rounding.
+** The approximate Wolfe conditions take the steps from there on their
+** slope; the energy ends no higher than the stalled run's to 1e-12. */
+Test(quench, a_smooth_energy_converges_past_the_energys_rounding, .init = qsetup, .fini = qteardown)
+{
+  cr_assert_eq(lw_test_sh("%s run %s/params/hanging.ini --set anneal.sweeps=0 --set anneal.quench=bfgs --out %s/h "
+                          "--quiet", lw_test_bin(), lw_test_root(), qdir), 0);
+  cr_assert_eq(lw_test_sh("python3 -c \"import json,sys; q=json.load(open('%s/h/summary.json'))['quench']; "
+                          "sys.exit(0 if q['converged'] and q['ended'] == 'converged' and q['gradient_after'] <= 1e-6 "
+                          "and q['energy_after'] <= -8834.1234356430268 * (1 - 1e-12) else 1)\"", qdir), 0, "%s",
+               lw_test_slurp("%s/h/summary.json", qdir));
+}
+
 /* Same scene and seed: the same bytes for any thread count (tempering,
 ** two replicas: the coldest is quenched), and a run stopped and resumed
 ** quenches to the bytes of an uninterrupted one. */
