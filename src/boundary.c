@@ -14,6 +14,48 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The sign of the turn a -> b -> c. */
+static int turn(double ax, double ay, double bx, double by, double cx, double cy)
+{
+  const double t = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+  return (t > 0) - (t < 0);
+}
+
+/* Whether c lies in the box of a and b (c on their line). */
+static int within(double ax, double ay, double bx, double by, double cx, double cy)
+{
+  return cx >= fmin(ax, bx) && cx <= fmax(ax, bx) && cy >= fmin(ay, by) && cy <= fmax(ay, by);
+}
+
+/* Whether segments p1 p2 and p3 p4 meet (touching counts). */
+static int segments_meet(const double *x, const double *y, size_t i1, size_t i2, size_t i3, size_t i4)
+{
+  const int d1 = turn(x[i3], y[i3], x[i4], y[i4], x[i1], y[i1]), d2 = turn(x[i3], y[i3], x[i4], y[i4], x[i2], y[i2]),
+            d3 = turn(x[i1], y[i1], x[i2], y[i2], x[i3], y[i3]), d4 = turn(x[i1], y[i1], x[i2], y[i2], x[i4], y[i4]);
+  if (d1 * d2 < 0 && d3 * d4 < 0) return 1;
+  return (!d1 && within(x[i3], y[i3], x[i4], y[i4], x[i1], y[i1])) ||
+         (!d2 && within(x[i3], y[i3], x[i4], y[i4], x[i2], y[i2])) ||
+         (!d3 && within(x[i1], y[i1], x[i2], y[i2], x[i3], y[i3])) ||
+         (!d4 && within(x[i1], y[i1], x[i2], y[i2], x[i4], y[i4]));
+}
+
+/* The first pair of edges that are not neighbours and meet, in *a < *b;
+** 0 where none does.  Quadratic in n, which a scene line bounds (a few
+** hundred vertices). */
+static int crossing(size_t n, const double *x, const double *y, size_t *a, size_t *b)
+{
+  for (size_t i = 0; i < n; i++)
+    for (size_t j = i + 2; j < n; j++) {
+      if (i == 0 && j == n - 1) continue; /* neighbours across the closing edge */
+      if (segments_meet(x, y, i, i + 1, j, (j + 1) % n)) {
+        *a = i;
+        *b = j;
+        return 1;
+      }
+    }
+  return 0;
+}
+
 lw_status lw_boundary_polygon(lw_boundary *b, size_t n, const double *x, const double *y,
                               lw_error *err)
 {
@@ -23,6 +65,16 @@ lw_status lw_boundary_polygon(lw_boundary *b, size_t n, const double *x, const d
     if (!isfinite(x[i]) || !isfinite(y[i]))
       return lw_error_set(err, LW_EINPUT, "polygon vertex %zu (%g, %g) is not finite", i,
                           x[i], y[i]);
+
+  /* a polygon that crosses itself: a bowtie was "zero area" (its halves
+  ** cancel), and a pentagram was taken by the even-odd rule, its centre
+  ** outside, where an SVG's default fill has it inside */
+  size_t ea, eb;
+  if (crossing(n, x, y, &ea, &eb))
+    return lw_error_set(err, LW_EINPUT, "polygon crosses itself: edge %zu (vertices %zu to %zu) meets edge %zu "
+                        "(vertices %zu to %zu): expected a simple polygon, its edges meeting only at their shared "
+                        "vertices (they count from 0; draw a star by its outline)", ea, ea, (ea + 1) % n, eb, eb,
+                        (eb + 1) % n);
 
   /* Shoelace area about the first vertex (less cancellation for a polygon far
   ** from the origin).  "Zero" is relative to the bounding box, so collinear

@@ -65,14 +65,16 @@ const lw_param_def lw_param_table[] = {
       "Page height (set by a named `page`); from 1 mm, as the width."),
   CHOICE("scene", "boundary", boundary, "rect", "rect|circle|polygon|mask",
          "Shape of the frame `energy.boundary` keeps the lines inside (with it 0 they may leave, and "
-         "what lies outside is cut from the drawing): the page rectangle inset by `margin`, "
+         "what lies outside the page rectangle inset by `margin` is cut from the drawing; a circle, "
+         "polygon or mask does not cut): the page rectangle inset by `margin`, "
          "the largest circle inside that rectangle, `polygon`, or `mask` (the inside of "
          "`mask`, by its signed distance transform; docs/IMAGES.md)."),
   NUM("scene", "margin", LW_PT_DOUBLE, margin, "10", "mm", 0, 1e7, 0,
       "Inset of the rect and circle boundaries from the page edge; the picture of `image` "
       "(and `mask_image`) is fitted into the page inset by it."),
   STRING("scene", "polygon", polygon, "", "mm",
-         "Polygon boundary vertices as `x y x y ...` (at least 3 vertices; either orientation)."),
+         "Polygon boundary vertices as `x y x y ...` (at least 3 vertices; either orientation; a simple "
+         "polygon, its edges meeting only at their shared vertices: a star is given by its outline)."),
   STRING("scene", "image", image, "", "path",
          "A picture (PNG, JPEG, GIF, BMP, binary PGM/PPM; gray or colour, with or without alpha) relative to "
          "the scene file. It is fitted into the page inset by `margin`, centred, aspect kept. "
@@ -146,7 +148,8 @@ const lw_param_def lw_param_table[] = {
   NUM("scene", "field_amplitude", LW_PT_DOUBLE, field_amplitude, "10", "mm", -1e7, 1e7, 0,
       "Amplitude A of the waves field."),
   NUM("scene", "center_x", LW_PT_DOUBLE, center_x, "-1", "mm", -1, 1e7, 0,
-      "Centre of the radial and vortex presets and of the ramp; -1 = page centre."),
+      "Centre of the radial and vortex presets and of the ramp; -1 = page centre (other values below 0 are "
+      "refused)."),
   NUM("scene", "center_y", LW_PT_DOUBLE, center_y, "-1", "mm", -1, 1e7, 0,
       "See center_x."),
   CHOICE("scene", "mask", mask, "none", "none|alpha|image",

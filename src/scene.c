@@ -529,6 +529,13 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   lw_pair_ctx_init(&sc->pair, p->pair_cutoff, p->pair_near);
   sc->pair_gap_max = sc->on[LW_TERM_PAIR] && p->pair_cutoff > 0.0 ? LW_PAIR_GAP_SHARE * p->pair_cutoff : 0.0;
 
+  /* -1 is the page centre; a value between it and 0 meant it too, silently */
+  static const char *const centre_key[2] = {"center_x", "center_y"};
+  const double centre[2] = {p->center_x, p->center_y};
+  for (int k = 0; k < 2; k++)
+    if (centre[k] < 0.0 && centre[k] != -1.0)
+      return bad_key(p, "scene", centre_key[k], LW_EINPUT, err, "expected -1 (the page centre) or a coordinate >= 0, "
+                     "got %g", centre[k]);
   double cx = p->center_x >= 0 ? p->center_x : 0.5 * p->width;
   double cy = p->center_y >= 0 ? p->center_y : 0.5 * p->height;
 

@@ -1323,9 +1323,42 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
                                              "moves.prior_sd", "moves.death", "moves.grow", "moves.shrink",
                                              "moves.max_segments", "moves.split", "moves.join",
                                              "moves.join_radius", NULL};
-  rule[0] = (lw_idle_rule){coverage, p->splines != 0, "init.splines is not 0"};
-  rule[1] = (lw_idle_rule){jumps, p->fixed_count, "moves.fixed_count = 1"};
-  return 2;
+  /* the field and the potential are built only for their terms, and each
+  ** kind reads its own keys (an artist's vortex without energy.field drew
+  ** random strokes without a word) */
+  static const char *const field[] = {"scene.field", "scene.field_angle", "scene.field_sigma", "scene.field_flat",
+                                      "scene.field_wavelength", "scene.field_amplitude", "energy.field_mode",
+                                      "layers.turn", NULL},
+                           *const potential[] = {"scene.potential", "scene.potential_value", "scene.potential_angle",
+                                                 "scene.potential_scale", "scene.potential_power",
+                                                 "scene.potential_blur", NULL},
+                           *const angle[] = {"scene.field_angle", NULL}, *const sigma[] = {"scene.field_sigma", NULL},
+                           *const flat[] = {"scene.field_flat", NULL},
+                           *const waves[] = {"scene.field_wavelength", "scene.field_amplitude", NULL},
+                           *const value[] = {"scene.potential_value", NULL},
+                           *const ramp[] = {"scene.potential_angle", NULL},
+                           *const scale[] = {"scene.potential_scale", NULL},
+                           *const picture[] = {"scene.potential_power", "scene.potential_blur", NULL},
+                           *const centre[] = {"scene.center_x", "scene.center_y", NULL};
+  const int fo = p->field_coef != 0.0, po = p->potential_coef != 0.0, f = p->field, q = p->potential;
+  const int grid = f == LW_FLD_ETF || f == LW_FLD_GRADIENT;
+  int n = 0;
+  rule[n++] = (lw_idle_rule){coverage, p->splines != 0, "init.splines is not 0"};
+  rule[n++] = (lw_idle_rule){jumps, p->fixed_count, "moves.fixed_count = 1"};
+  rule[n++] = (lw_idle_rule){field, !fo, "energy.field = 0"};
+  rule[n++] = (lw_idle_rule){potential, !po, "energy.potential = 0"};
+  rule[n++] = (lw_idle_rule){angle, fo && f != LW_FLD_CONSTANT && f != LW_FLD_ETF, "scene.field is not constant or etf"};
+  rule[n++] = (lw_idle_rule){sigma, fo && f != LW_FLD_ETF, "scene.field is not etf"};
+  rule[n++] = (lw_idle_rule){flat, fo && !grid, "scene.field is not etf or gradient"};
+  rule[n++] = (lw_idle_rule){waves, fo && f != LW_FLD_WAVES, "scene.field is not waves"};
+  rule[n++] = (lw_idle_rule){value, po && q != LW_POT_CONSTANT, "scene.potential is not constant"};
+  rule[n++] = (lw_idle_rule){ramp, po && q != LW_POT_RAMP, "scene.potential is not ramp"};
+  rule[n++] = (lw_idle_rule){scale, po && q != LW_POT_RAMP && q != LW_POT_RADIAL, "scene.potential is not ramp or radial"};
+  rule[n++] = (lw_idle_rule){picture, po && q != LW_POT_IMAGE, "scene.potential is not image"};
+  rule[n++] = (lw_idle_rule){centre, !(fo && (f == LW_FLD_RADIAL || f == LW_FLD_VORTEX)) &&
+                                         !(po && (q == LW_POT_RAMP || q == LW_POT_RADIAL)),
+                             "no radial or vortex field, no ramp or radial potential"};
+  return n;
 }
 
 #define SPLINES_ROW \

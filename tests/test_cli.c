@@ -166,6 +166,17 @@ Test(cli, energy_of_a_run_whose_scene_was_edited_says_so)
                           "err2.txt", dir), 0, "%s", lw_test_slurp("%s/err2.txt", dir));
 }
 
+/* A centre between -1 (the page centre) and 0 meant the page centre too,
+** without a word; it is refused, naming the key. */
+Test(cli, a_centre_below_0_other_than_minus_1_is_refused)
+{
+  char args[512], out[256], errs[1024];
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/c --set scene.center_y=-0.5", lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "key 'scene.center_y': expected -1 (the page centre) or a coordinate >= 0, got -0.5"), "%s",
+            errs);
+}
+
 Test(cli, energy_lists_only_enabled_terms)
 {
   write_file("scene.ini", "[energy]\nbending = 1\n");
@@ -367,6 +378,14 @@ Test(cli, keys_the_system_never_reads_are_refused)
      "/params/minimal.ini:17: energy.pair = 0), energy.pair_near (--set: energy.pair = 0)"},
     {"minimal", "--set tempering.replicas=2 --set tempering.ladder_sweeps=5",
      "tempering.ladder_sweeps (--set: tempering.tune_ladder = fixed)"},
+    /* a field or a potential without its term, and each kind's keys under another */
+    {"minimal", "--set scene.field=vortex", "scene.field (--set: energy.field = 0)"},
+    {"minimal", "--set energy.field=1 --set scene.field=vortex --set scene.field_wavelength=33",
+     "scene.field_wavelength (--set: scene.field is not waves)"},
+    {"minimal", "--set energy.potential=1 --set scene.potential=radial --set scene.potential_angle=45",
+     "scene.potential_angle (--set: scene.potential is not ramp)"},
+    {"minimal", "--set scene.center_y=30",
+     "scene.center_y (--set: no radial or vortex field, no ramp or radial potential)"},
     /* a schedule's ends it does not read (t_start counts under tempering) */
     {"minimal", "--set anneal.schedule=constant --set anneal.t_end=0.5",
      "anneal.t_end (--set: anneal.schedule reads no t_end)"},
