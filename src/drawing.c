@@ -245,15 +245,23 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   if (!st->n && rep->post.lifts_before)
     snprintf(rep->empty_why, sizeof rep->empty_why, "every stroke was cut by the crop or too short for "
              "plot.min_length (%g pen widths)", p->min_length);
-  /* (a high chem_spline that killed every line was blamed on the potential) */
-  else if (!st->n && !p->fixed_count && (p->chem_spline > 0.0 || p->chem_length > 0.0))
+  /* the prices of line that could have emptied it, each named (a high
+  ** chem_spline was blamed on the potential, and the potential on a tiny
+  ** chem_spline) */
+  else if (!st->n && !p->fixed_count && ((sc->on[LW_TERM_POTENTIAL] && sc->image) || p->chem_spline > 0.0 ||
+                                         p->chem_length > 0.0)) {
+    char price[160] = "";
+    size_t k = 0;
+    if (sc->on[LW_TERM_POTENTIAL] && sc->image)
+      k += (size_t)snprintf(price + k, sizeof price - k, "energy.potential %g", p->potential_coef);
+    if (p->chem_spline > 0.0 && k < sizeof price)
+      k += (size_t)snprintf(price + k, sizeof price - k, "%senergy.chem_spline %g", k ? ", " : "", p->chem_spline);
+    if (p->chem_length > 0.0 && k < sizeof price)
+      snprintf(price + k, sizeof price - k, "%senergy.chem_length %g", k ? ", " : "", p->chem_length);
     snprintf(rep->empty_why, sizeof rep->empty_why, "no spline is left: none was placed (init.splines, "
-             "init.coverage), or the anneal removed every one, a line's own price (energy.chem_spline %g, "
-             "chem_length %g) being more than what it lowers: lower them", p->chem_spline, p->chem_length);
-  else if (!st->n && !p->fixed_count && sc->on[LW_TERM_POTENTIAL] && sc->image)
-    snprintf(rep->empty_why, sizeof rep->empty_why, "no spline is left: none was placed (init.splines, "
-             "init.coverage), or the anneal removed every one, the price of line (energy.potential) being more than "
-             "the picture's tone pays for it (a pale picture: a lower energy.potential keeps lines)");
+             "init.coverage), or the anneal removed every one, the price of line (%s) being more than what the "
+             "lines lower (a pale picture, or a price too high: lower it)", price);
+  }
   else if (!st->n && p->fixed_count)
     snprintf(rep->empty_why, sizeof rep->empty_why, "no spline was placed (init.splines, or init.coverage on a "
              "picture without dark to cover)");

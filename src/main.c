@@ -177,11 +177,10 @@ static int cmd_energy(int argc, char **argv)
   unsigned long long hash;
   lw_error edited;
   lw_error_clear(&edited);
-  if (st.doc && lw_checkpoint_scene_hash(st.doc, &p, &keys, &hash, &edited)) {
+  if (st.doc && lw_checkpoint_scene_hash(st.doc, &p, &keys, &hash, &edited) && strstr(edited.msg, "edited since")) {
     char *why = strstr(edited.msg, ": a run resumes with");
     if (why) *why = '\0';
-    fprintf(stderr, "linewise: note: the energy is of the scene as it reads now, not as the run started: %s\n",
-            edited.msg);
+    fprintf(stderr, "linewise: note: %s; the energy below is of the scene as it reads now\n", edited.msg);
   }
   int set = 0;
   for (int i = 0; i < argc && !err.code; i++) {
@@ -472,10 +471,12 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   if (stopped) {
     if (lw_anneal_checkpoint(a, err)) return loop_fail(a, pg.start_sweep, w, err);
     watcher_stop(w, LW_PHASE_DONE);
+    char mpi[LW_PATH_MAX + 96] = "";
+    if (net && net->size > 1)
+      snprintf(mpi, sizeof mpi, ", on one process, or over MPI as 'mpirun -n P linewise-mpi resume %s'", a->dir);
     if (!quiet)
       fprintf(stderr, "linewise: stopped after sweep %ld; state saved in %s/state.lw ('linewise resume %s' "
-              "continues%s)\n", a->sweep, a->dir, a->dir,
-              net && net->size > 1 ? ", on one process or again over MPI with 'mpirun -n P linewise-mpi resume'" : "");
+              "continues%s)\n", a->sweep, a->dir, a->dir, mpi);
     return 0;
   }
   say_finishing = !quiet;
@@ -762,7 +763,7 @@ static int cmd_run(int argc, char **argv)
     /* (a failed first write said only that, leaving a directory without a
     ** state.lw: what to do next, as loop_fail says later) */
     const size_t n = strlen(err.msg);
-    if (err.code == LW_EIO)
+    if (err.code == LW_EIO && strstr(err.msg, ": write failed"))
       snprintf(err.msg + n, sizeof err.msg - n, "; the run wrote no checkpoint: run it again once the files can be "
                "written");
     lw_anneal_free(&a);

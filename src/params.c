@@ -709,13 +709,15 @@ const lw_param_def lw_param_table[] = {
   NUM("nurbs", "order", LW_PT_INT, nb_order, "4", "", 2, 8, 0,
       "Order k of the NURBS curve (degree k - 1; 4 = cubic). docs/NURBS.md."),
   STRING("nurbs", "points", nb_points, "", "length",
-         "The control points as numbers `x y x y ...` (y up; at least `order` points)."),
+         "The control points as numbers `x y x y ...` (y up; at least `order` points; coordinates within "
+         "+-1e9)."),
   STRING("nurbs", "file", nb_file, "", "path",
          "A file of control points, one `x y` or `x y w` a line (`#` starts a comment), relative "
          "to the scene file; used instead of `points` and `weights` (a scene line holds about a "
          "dozen points: the INI reader stops at 198 characters)."),
   STRING("nurbs", "weights", nb_weights, "", "",
-         "One weight > 0 per control point; empty = all 1 (a polynomial spline)."),
+         "One weight > 0 per control point, the largest at most 1e6 times the smallest (past that the "
+         "matrices and final.svg's fit lose their digits); empty = all 1 (a polynomial spline)."),
   STRING("nurbs", "knots", nb_knots, "", "",
          "The open knot vector: n + k nondecreasing numbers, the first k equal and the last k "
          "equal; empty = uniform inner knots on [0, 1]."),
@@ -734,7 +736,9 @@ const lw_param_def lw_param_table[] = {
   NUM("nurbs", "beta", LW_PT_DOUBLE, nb_beta, "0", "energy", 0, 1e12, 0,
       "Rigidity beta of that energy."),
   NUM("nurbs", "gauss", LW_PT_INT, nb_gauss, "10", "", 1, 64, 0,
-      "Gauss-Legendre points per knot span for the matrices M, D and K."),
+      "Gauss-Legendre points per knot span for the matrices M, D and K: at least as many in all as "
+      "control points (fewer leave motions that the energy does not see); `order` points make the "
+      "matrices of a polynomial curve exact."),
   NUM("nurbs", "fixed", LW_PT_INT, nb_fixed, "0", "", 0, 1e9, 0,
       "Control points held at each end (1 = the ends of the curve; 2 = its end tangents too). "
       "Monte Carlo and the dynamics move only the others. Gravity is the [dynamics] "

@@ -312,6 +312,16 @@ static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
                      "page of %g x %g mm", lo[0], hi[0], lo[1], hi[1], p->width, p->height);
       else if ((st = lw_boundary_polygon(&sc->boundary, n / 2, xs, ys, &e2)) != LW_OK)
         bad_key(p, "scene", "polygon", st, err, "%s", e2.msg);
+      /* (a polygon in the margin was annealed, then drawn empty or cut,
+      ** said only at the end) */
+      else if (p->crop && !p->image[0] &&
+               (lo[0] < p->margin || hi[0] > p->width - p->margin || lo[1] < p->margin ||
+                hi[1] > p->height - p->margin)) {
+        const size_t used = strlen(sc->note);
+        snprintf(sc->note + used, sizeof sc->note - used, "%sscene.polygon (x %g to %g, y %g to %g mm) reaches past "
+                 "the page inset by scene.margin (%g mm), where plot.crop cuts the drawing", used ? "; " : "", lo[0],
+                 hi[0], lo[1], hi[1], p->margin);
+      }
     }
     free(xs);
     free(ys);
@@ -492,8 +502,10 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   coef[LW_TERM_CHEMICAL] = sc->chem[0] != 0.0 || sc->chem[1] != 0.0;
   sc->transdim = !p->fixed_count;
   /* a cap below the placed splines' count was raised to it without a word,
-  ** and lines grew past the cap the scene set; the default gives way */
-  if (sc->transdim && p->max_segments < p->segments && lw_params_given(p, lw_params_find("moves", "max_segments")))
+  ** and lines grew past the cap the scene set (16 too, the default's value);
+  ** the default gives way, and so does a cap where nothing is placed */
+  const int cap_line = p->line[lw_params_find("moves", "max_segments") - lw_param_table];
+  if (sc->transdim && p->max_segments < p->segments && cap_line && !(p->of_run && cap_line > 0) && !p->from[0])
     return bad_key(p, "moves", "max_segments", LW_EINPUT, err, "expected at least init.segments = %d, the count "
                    "the placed splines start with, got %d", p->segments, p->max_segments);
   sc->max_segments = (size_t)(p->max_segments > p->segments ? p->max_segments : p->segments);

@@ -147,7 +147,7 @@ const lw_schedule_type lw_schedule_adaptive = {
   "T_b = T_{b-1} exp(-lambda T_{b-1} / sd_{b-1}) within [t_end, t_start] (Huang et al. 1986); "
   "ratio (t_end/t_start)^(1/(B-1)) where sd is 0 or unknown",
   LW_SCHEDULE_USES_START | LW_SCHEDULE_USES_END | LW_SCHEDULE_POSITIVE | LW_SCHEDULE_COOLING |
-      LW_SCHEDULE_USES_LAMBDA,
+      LW_SCHEDULE_USES_LAMBDA | LW_SCHEDULE_RECURSIVE,
   adaptive_temperature};
 
 const lw_schedule_type lw_schedule_table = {

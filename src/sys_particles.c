@@ -489,7 +489,6 @@ static const char *const keys_metropolis[] = {"moves.translate", "moves.rotate",
                                               "particles.death", "particles.chem", "particles.max_count",
                                               "anneal.domains", NULL};
 
-/* The rows differ only in their move kinds (sys_particles.h). */
 /* Keys the scene's other settings leave idle (system.h). */
 static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
 {
@@ -509,6 +508,7 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
   return n;
 }
 
+/* The rows differ only in their move kinds (sys_particles.h). */
 #define PARTICLES_ROW \
     .keys = keys, \
     .keys_dynamics = keys_dynamics, \

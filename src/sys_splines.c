@@ -369,8 +369,8 @@ static double refuse(lw_proposal *p)
   return INFINITY;
 }
 
-/* No line to move, kill, grow or shrink: no proposal (system.h), counted
-** nowhere; a page whose lines had all died counted every such move as a
+/* No line to move, kill, grow, shrink or split (none to join with, for a
+** join): no proposal (system.h), counted nowhere; a page whose lines had all died counted every such move as a
 ** rejection, and a death's acceptance read 0.32 where 428 of 440 were taken. */
 static double nothing(lw_proposal *p, int *forbidden)
 {
@@ -814,6 +814,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
   const double *lw = su->log_w;
   *forbidden = 0;
   if (kind == LW_MOVE_SPLIT || kind == LW_MOVE_JOIN) {
+    if (N < (kind == LW_MOVE_JOIN ? 2u : 1u)) return nothing(p, forbidden);
     const double dE = kind == LW_MOVE_SPLIT ? propose_split(s, p, rng) : propose_join(s, p, rng);
     *forbidden = !p->splice ? 0 : p->crowded ? 3 : p->irregular;
     return dE;
@@ -1314,7 +1315,6 @@ static const char *const keys[] = {"scene.*", "init.*", "energy.*", "output.*", 
 static const char *const keys_dynamics[] = {"dynamics.pin", "dynamics.pin_vectors", NULL};
 static const char *const keys_metropolis[] = {"moves.*", "anneal.delayed_acceptance", "anneal.domains", NULL};
 
-/* The rows differ only in their move kinds (sys_splines.h). */
 /* Keys the scene's other settings leave idle (system.h). */
 static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
 {
@@ -1347,13 +1347,15 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
   rule[n++] = (lw_idle_rule){jumps, p->fixed_count, "moves.fixed_count = 1"};
   rule[n++] = (lw_idle_rule){field, !fo, "energy.field = 0"};
   rule[n++] = (lw_idle_rule){potential, !po, "energy.potential = 0"};
-  rule[n++] = (lw_idle_rule){angle, fo && f != LW_FLD_CONSTANT && f != LW_FLD_ETF, "scene.field is not constant or etf"};
+  rule[n++] = (lw_idle_rule){angle, fo && f != LW_FLD_CONSTANT && f != LW_FLD_ETF,
+                             "scene.field is not constant or etf"};
   rule[n++] = (lw_idle_rule){sigma, fo && f != LW_FLD_ETF, "scene.field is not etf"};
   rule[n++] = (lw_idle_rule){flat, fo && !grid, "scene.field is not etf or gradient"};
   rule[n++] = (lw_idle_rule){waves, fo && f != LW_FLD_WAVES, "scene.field is not waves"};
   rule[n++] = (lw_idle_rule){value, po && q != LW_POT_CONSTANT, "scene.potential is not constant"};
   rule[n++] = (lw_idle_rule){ramp, po && q != LW_POT_RAMP, "scene.potential is not ramp"};
-  rule[n++] = (lw_idle_rule){scale, po && q != LW_POT_RAMP && q != LW_POT_RADIAL, "scene.potential is not ramp or radial"};
+  rule[n++] = (lw_idle_rule){scale, po && q != LW_POT_RAMP && q != LW_POT_RADIAL,
+                             "scene.potential is not ramp or radial"};
   rule[n++] = (lw_idle_rule){picture, po && q != LW_POT_IMAGE, "scene.potential is not image"};
   rule[n++] = (lw_idle_rule){centre, !(fo && (f == LW_FLD_RADIAL || f == LW_FLD_VORTEX)) &&
                                          !(po && (q == LW_POT_RAMP || q == LW_POT_RADIAL)),
@@ -1361,6 +1363,7 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
   return n;
 }
 
+/* The rows differ only in their move kinds (sys_splines.h). */
 #define SPLINES_ROW \
   .keys = keys, \
   .keys_dynamics = keys_dynamics, \

@@ -448,24 +448,30 @@ Test(run, an_adaptive_schedule_takes_every_step_it_skips)
 Test(run, a_move_with_no_line_left_is_no_proposal)
 {
   const char *b = getenv("LW_BIN");
-  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/die --threads 1 --set moves.fixed_count=0 --set "
-                  "energy.chem_spline=1000 --set moves.birth_spread=0.5 --set anneal.sweeps=100 --set "
-                  "output.observables=1 2>%s/die.txt", b, lw_test_root(), dir, dir), 0);
-  /* and the empty drawing names the price that emptied it (it blamed energy.potential) */
-  cr_assert_eq(sh("grep -qF 'the anneal removed every one, a line' %s/die.txt && grep -qF 'own price "
-                  "(energy.chem_spline 1000, chem_length 0)' %s/die.txt", dir, dir), 0);
-  /* columns 9 to 16 are acc_point .. acc_shrink, 17 obs_count (the row of
-  ** the sweep where the last one died has its earlier moves); a birth may
-  ** still be tried (it is refused, counted) */
-  cr_assert_eq(sh("awk -F, 'NR == 1 { ok = $13 == \"acc_birth\" && $17 == \"obs_count\" } NR > 2 && $17 == 0 && "
-                  "last == 0 { n++; for (k = 9; k <= 16; k++) if (k != 13 && $k != \"\") bad++ } { last = $17 } "
-                  "END { exit !(ok && n >= 20 && !bad) }' "
-                  "%s/die/trace.csv", dir), 0, "%s", lw_test_slurp("%s/die/trace.csv", dir));
+  /* with split and join too (a join needs two lines) */
+  for (int splice = 0; splice < 2; splice++) {
+    cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/die%d --threads 1 --set moves.fixed_count=0 --set "
+                    "energy.chem_spline=1000 --set moves.birth_spread=0.5 --set anneal.sweeps=100 --set "
+                    "output.observables=1 %s 2>%s/die.txt", b, lw_test_root(), dir, splice,
+                    splice ? "--set moves.split=0.2 --set moves.join=0.2" : "", dir), 0);
+    /* and the empty drawing names the price that emptied it (it blamed energy.potential) */
+    cr_assert_eq(sh("grep -qF 'the anneal removed every one, the price of line (energy.chem_spline 1000) being "
+                    "more than' %s/die.txt", dir), 0, "%s", lw_test_slurp("%s/die.txt", dir));
+    /* every acc_ column but a birth's (it is refused, counted) empty in the
+    ** rows after the one of the sweep where the last line died (which has
+    ** its earlier moves) */
+    cr_assert_eq(sh("awk -F, 'NR == 1 { for (k = 1; k <= NF; k++) { if ($k == \"obs_count\") c = k; if ($k ~ /^acc_/ "
+                    "&& $k != \"acc_birth\") acc[++na] = k } } NR > 2 && $c == 0 && last == 0 { n++; for (j = 1; j <= "
+                    "na; j++) if ($acc[j] != \"\") bad++ } NR > 1 { last = $c } END { exit !(c && na >= %d && n >= 20 "
+                    "&& !bad) }' %s/die%d/trace.csv", splice ? 9 : 7, dir, splice), 0, "%s",
+                 lw_test_slurp("%s/die%d/trace.csv", dir, splice));
+  }
 }
 
 /* A cap on the segments below the count the placed splines start with was
-** raised to it without a word, and lines grew past the cap the scene set;
-** the default (16) gives way to a larger init.segments. */
+** raised to it without a word, and lines grew past the cap the scene set
+** (16 too, the default's value); the default gives way to a larger
+** init.segments, and so does a cap where init.from places nothing. */
 Test(run, a_segment_cap_below_the_placed_count_is_refused)
 {
   const char *b = getenv("LW_BIN");
@@ -475,4 +481,10 @@ Test(run, a_segment_cap_below_the_placed_count_is_refused)
                   "-e %s/cap", b, lw_test_root(), dir, dir, dir, dir), 0);
   cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/cap --quiet --set moves.fixed_count=0 --set init.segments=20 "
                   "--set init.segment_length=1.5 --set anneal.sweeps=2", b, lw_test_root(), dir), 0);
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/cap16 --quiet --set moves.fixed_count=0 --set "
+                  "init.segments=20 --set init.segment_length=1.5 --set moves.max_segments=16 2>%s/cap.txt; "
+                  "test $? -eq 2 && grep -qF 'got 16' %s/cap.txt", b, lw_test_root(), dir, dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/from --quiet --set moves.fixed_count=0 --set "
+                  "moves.max_segments=3 --set init.from=%s/cap/state.lw --set anneal.sweeps=0", b, lw_test_root(), dir,
+                  dir), 0);
 }

@@ -146,15 +146,22 @@ Test(checkpoint, every_run_data_value_is_checked_on_resume)
 ** Under tempering (whose rule changed on 2026-12-04) its range is checked. */
 Test(checkpoint, an_adaptive_schedules_state_is_checked_on_resume)
 {
+  /* (2 tuning sweeps a step of 10: the temperature is made of step 1's 8
+  ** energies, and step 2 has 3 of its own) */
   cr_assert_eq(lw_test_sh("%s run %s/tests/fixtures/v1/plain.ini --out %s/r --stop-at 25 --quiet --set "
-                          "anneal.schedule=adaptive", lw_test_bin(), lw_test_root(), dir), 0);
+                          "anneal.schedule=adaptive --set moves.tune_sweeps=2", lw_test_bin(),
+                          lw_test_root(), dir), 0);
+  cr_assert_eq(lw_test_sh("grep -q '^prev_stats = .* 8$' %s/r/state.lw && grep -q '^block_energy = 3 ' %s/r/state.lw",
+                          dir, dir), 0);
   static const struct { const char *sed, *msg; } bad[] = {
     {"s/^temperature = .*/temperature = 5/", "[run] temperature: 5, but the adaptive schedule"},
     {"s/^temperature = .*/temperature = 0/", "[run] temperature: 0, but the adaptive schedule"},
     {"s/^temperature = .*/temperature = 1e300/", "[run] temperature: 1.0000000000000001e+300, but the adaptive"},
-    {"s/^block_energy = .*/block_energy = 5 1000 2372/", "[run] block_energy: 5 samples with sum 1000 and sum of "
-     "squares 2372, but the step has had 5 sweeps and a variance is not negative"},
-    {"s/^block_energy = .*/block_energy = 6 10 20/", "but the step has had 5 sweeps"},
+    {"s/^block_energy = .*/block_energy = 3 1000 2372/", "[run] block_energy: 3 samples with sum 1000 and sum of "
+     "squares 2372 make a negative variance: the state was edited"},
+    {"s/^block_energy = .*/block_energy = 6 1 1/", "[run] block_energy: 6 samples, but the step has had 5 sweeps"},
+    /* the measured rule, from the previous step's energies */
+    {"s/^prev_stats = \\([^ ]*\\) [^ ]* 8$/prev_stats = \\1 0.5 8/", "[run] temperature: 0.05857352894254898"},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     int rc = resume_edited(bad[i].sed);
@@ -166,7 +173,8 @@ Test(checkpoint, an_adaptive_schedules_state_is_checked_on_resume)
                           "anneal.schedule=adaptive --set tempering.replicas=2", dir, lw_test_bin(), lw_test_root(),
                           dir), 0);
   cr_expect_eq(resume_edited("s/^temperature = .*/temperature = 5/"), 2);
-  cr_expect(err_has("[run] temperature: 5, outside the adaptive schedule") && err_has("range [0.01, 1]: the state was edited"));
+  cr_expect(err_has("[run] temperature: 5, outside the adaptive schedule") &&
+            err_has("range [0.01, 1]: the state was edited"));
   cr_assert_eq(resume_edited("s/^sweep = 25$/sweep = 25/"), 0);
 }
 

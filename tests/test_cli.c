@@ -160,10 +160,14 @@ Test(cli, energy_of_a_run_whose_scene_was_edited_says_so)
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out e --quiet --set anneal.sweeps=3 && %s energy e "
                           "2>err1.txt >e1.txt && sed -i 's/^strain = 10$/strain = 11/' e/scene.ini && %s energy e "
                           "2>err2.txt >e2.txt", dir, lw_test_bin(), lw_test_root(), lw_test_bin(), lw_test_bin()), 0);
-  cr_assert_eq(lw_test_sh("cd %s && ! test -s err1.txt && ! cmp -s e1.txt e2.txt && grep -qF 'linewise: note: the "
-                          "energy is of the scene as it reads now, not as the run started: e/scene.ini: ' err2.txt && "
-                          "grep -qF energy.strain err2.txt && grep -qF '(line 47) edited since the run started' "
-                          "err2.txt", dir), 0, "%s", lw_test_slurp("%s/err2.txt", dir));
+  cr_assert_eq(lw_test_sh("cd %s && ! test -s err1.txt && ! cmp -s e1.txt e2.txt && grep -qF 'linewise: note: "
+                          "e/scene.ini: ' err2.txt && grep -qF energy.strain err2.txt && grep -qF '(line 47) edited "
+                          "since the run started; the energy below is of the scene as it reads now' err2.txt", dir),
+               0, "%s", lw_test_slurp("%s/err2.txt", dir));
+  /* a damaged hash is resume's to refuse, not an edit */
+  cr_assert_eq(lw_test_sh("cd %s && cp -r e d && sed -i 's/^scene_hash = .*/scene_hash = zzzz/' d/state.lw && %s "
+                          "energy d 2>err3.txt >/dev/null && ! test -s err3.txt", dir, lw_test_bin()), 0, "%s",
+               lw_test_slurp("%s/err3.txt", dir));
 }
 
 /* A centre between -1 (the page centre) and 0 meant the page centre too,
@@ -175,6 +179,23 @@ Test(cli, a_centre_below_0_other_than_minus_1_is_refused)
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
   cr_assert(strstr(errs, "key 'scene.center_y': expected -1 (the page centre) or a coordinate >= 0, got -0.5"), "%s",
             errs);
+}
+
+/* A polygon that reaches into the margin, where the crop cuts the drawing,
+** was annealed and then drawn cut or empty, said only at the end: a note
+** says so before the run; one inside the margin gets none. */
+Test(cli, a_polygon_in_the_margin_is_noted_before_the_run)
+{
+  char args[512], out[256], errs[8192];
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/p --stop-at 0 --set scene.boundary=polygon --set "
+           "'scene.polygon=2 2 60 2 60 50 2 50'", lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "linewise: note: scene.polygon (x 2 to 60, y 2 to 50 mm) reaches past the page inset by "
+                         "scene.margin (5 mm), where plot.crop cuts the drawing"), "%s", errs);
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/q --stop-at 0 --set scene.boundary=polygon --set "
+           "'scene.polygon=10 10 60 10 60 50 10 50'", lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert_null(strstr(errs, "scene.polygon ("), "%s", errs);
 }
 
 Test(cli, energy_lists_only_enabled_terms)
@@ -602,9 +623,9 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
   /* a first checkpoint that fails leaves nothing to resume: said so (it was
   ** the bare write failure) */
   cr_assert_eq(lw_test_sh("sh -c 'ulimit -f 8; %s run %s/params/minimal.ini --out %s/f0 --quiet' 2>%s/err.txt; test "
-                          "$? -eq 1 && grep -q 'f0/state.lw: write failed: File too large; the run wrote no checkpoint: "
-                          "run it again once the files can be written' %s/err.txt", lw_test_bin(), lw_test_root(), dir,
-                          dir, dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+                          "$? -eq 1 && grep -q 'f0/state.lw: write failed: File too large; the run wrote no "
+                          "checkpoint: run it again once the files can be written' %s/err.txt", lw_test_bin(),
+                          lw_test_root(), dir, dir, dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* a PNG cut short says why too (cairo's own message named no reason) */
   cr_assert_eq(lw_test_sh("sh -c 'ulimit -f 60; %s run %s/params/minimal.ini --out %s/fp --quiet --set "
                           "output.png_scale=20 --set anneal.sweeps=5' 2>%s/err.txt; test $? -eq 1 && grep -q "

@@ -63,7 +63,7 @@ typedef struct {
   int n_pens;
   size_t pen_paths[LW_PLOT_PENS_MAX];         /* paths of each pen */
   char pen_name[LW_PLOT_PENS_MAX][64];        /* its layer's name, or empty (the messages say "pen k") */
-  char empty_why[256];                        /* with no path: what removed the lines, or empty */
+  char empty_why[400];                        /* with no path: what removed the lines, or empty */
   lw_fidelity pen_fidelity[LW_PLOT_PENS_MAX]; /* per pen, when n_pens > 1 */
 } lw_drawing_report;
 

@@ -18,9 +18,10 @@
 
 /* orders 2 (polyline) to this */
 #define LW_NURBS_ORDER_MAX 8
-/* Weights from this to its inverse: the matrices hold products of up to
-** four of them, which must stay within the doubles' range. */
-#define LW_NURBS_WEIGHT_MIN 1e-100
+/* The largest weight at most this many times the smallest: past it the
+** matrices and final.svg's fit lose their digits (1e8 drew 0.29 from a
+** curve of size 1; 1e6 keeps 1e-4). */
+#define LW_NURBS_WEIGHT_SPREAD 1e6
 /* control points a refinement may make (a step of the wire costs 0.25 us
 ** a point, its matrices 200 bytes a point) */
 #define LW_NURBS_REFINED_MAX 1000000

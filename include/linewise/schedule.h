@@ -60,7 +60,8 @@ enum {
   LW_SCHEDULE_POSITIVE = 1 << 2,    /* t_start and t_end > 0 (ratios, logarithms) */
   LW_SCHEDULE_COOLING = 1 << 3,     /* t_end <= t_start */
   LW_SCHEDULE_USES_LAMBDA = 1 << 4, /* lambda: finite, > 0 */
-  LW_SCHEDULE_USES_TABLE = 1 << 5   /* a table read with lw_schedule_read_table */
+  LW_SCHEDULE_USES_TABLE = 1 << 5,  /* a table read with lw_schedule_read_table */
+  LW_SCHEDULE_RECURSIVE = 1 << 6    /* T_b from T_{b-1}: every step takes its turn, one without sweeps too */
 };
 
 typedef struct {
