@@ -159,11 +159,20 @@ static long block_start(const lw_anneal *a, long b)
 ** without a word). */
 static lw_status check_block_energy(const lw_anneal *a, const char *path, lw_error *err)
 {
-  const double done = a->block >= 0 ? (double)(a->sweep - block_start(a, a->block)) : 0.0;
+  /* the step's sweeps since its tuning (sweep_once: a sweep tunes within
+  ** the step's first tune_sweeps, before anneal.sweeps) */
+  const long start = a->block >= 0 ? block_start(a, a->block) : a->sweep;
+  long until = a->sweep;
+  if (start + a->params.tune_sweeps < until) until = start + a->params.tune_sweeps;
+  if (a->params.sweeps < until) until = a->params.sweeps;
+  const double done = (double)(a->sweep - start - (until > start ? until - start : 0));
   const double n = a->acc_n, spread = n * a->acc_sumsq - a->acc_sum * a->acc_sum;
   if (n > done)
-    return lw_error_set(err, LW_EINPUT, "%s: [run] block_energy: %.17g samples, but the step has had %.0f sweeps: the "
-                        "state was edited", path, n, done);
+    return lw_error_set(err, LW_EINPUT, "%s: [run] block_energy: %.17g samples, but the step has had %.0f sweeps since "
+                        "its step tuning: the state was edited", path, n, done);
+  if (n == 0.0 && (a->acc_sum != 0.0 || a->acc_sumsq != 0.0))
+    return lw_error_set(err, LW_EINPUT, "%s: [run] block_energy: no samples, but sums %.17g and %.17g: the state was "
+                        "edited", path, a->acc_sum, a->acc_sumsq);
   /* the sums' rounding grows with n (a nearly constant energy summed 4e7
   ** times left n sum-of-squares - sum^2 at -2e-9 of it): 4 n eps of slack */
   if (spread < -fmax(1e-9, 4.0 * n * DBL_EPSILON) * n * a->acc_sumsq)
@@ -585,7 +594,8 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
       {lambda, !(needs & LW_SCHEDULE_USES_LAMBDA), "anneal.schedule is not adaptive"},
       /* (a constant schedule's t_end, a table's: a study that varied it measured noise) */
       {t_end, !(needs & LW_SCHEDULE_USES_END), "anneal.schedule reads no t_end"},
-      /* (tempering scales its ladder by T / t_start, whatever the schedule) */
+      /* (tempering scales its ladder by T / t_start, which a constant
+      ** schedule keeps at 1) */
       {t_start, !(needs & LW_SCHEDULE_USES_START) && a->n_rep == 1, "anneal.schedule reads no t_start"},
       {t_start, a->n_rep > 1 && a->sched_type == &lw_schedule_constant,
        "a constant schedule keeps the rungs at the ladder"},

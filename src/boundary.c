@@ -39,21 +39,27 @@ static int segments_meet(const double *x, const double *y, size_t i1, size_t i2,
          (!d4 && within(x[i1], y[i1], x[i2], y[i2], x[i4], y[i4]));
 }
 
-/* The first pair of edges that are not neighbours and meet, in *a < *b;
-** 0 where none does.  Quadratic in n, which a scene line bounds (a few
-** hundred vertices). */
-static int crossing(size_t n, const double *x, const double *y, size_t *a, size_t *b)
+int lw_boundary_crossing(size_t n, const double *x, const double *y, size_t *a, size_t *b)
 {
+  /* the vertices that differ from the one before (a repeated vertex, or the
+  ** first repeated to close the path, makes an edge of no length) */
+  size_t *v = malloc((n ? n : 1) * sizeof *v), m = 0;
+  if (!v) return 0;
   for (size_t i = 0; i < n; i++)
-    for (size_t j = i + 2; j < n; j++) {
-      if (i == 0 && j == n - 1) continue; /* neighbours across the closing edge */
-      if (segments_meet(x, y, i, i + 1, j, (j + 1) % n)) {
-        *a = i;
-        *b = j;
-        return 1;
+    if (!m || x[i] != x[v[m - 1]] || y[i] != y[v[m - 1]]) v[m++] = i;
+  while (m > 1 && x[v[m - 1]] == x[v[0]] && y[v[m - 1]] == y[v[0]]) m--;
+  int found = 0;
+  for (size_t i = 0; i < m && !found; i++)
+    for (size_t j = i + 2; j < m && !found; j++) {
+      if (i == 0 && j == m - 1) continue; /* neighbours across the closing edge */
+      if (segments_meet(x, y, v[i], v[i + 1], v[j], v[(j + 1) % m])) {
+        *a = v[i];
+        *b = v[j];
+        found = 1;
       }
     }
-  return 0;
+  free(v);
+  return found;
 }
 
 lw_status lw_boundary_polygon(lw_boundary *b, size_t n, const double *x, const double *y,
@@ -65,16 +71,6 @@ lw_status lw_boundary_polygon(lw_boundary *b, size_t n, const double *x, const d
     if (!isfinite(x[i]) || !isfinite(y[i]))
       return lw_error_set(err, LW_EINPUT, "polygon vertex %zu (%g, %g) is not finite", i,
                           x[i], y[i]);
-
-  /* a polygon that crosses itself: a bowtie was "zero area" (its halves
-  ** cancel), and a pentagram was taken by the even-odd rule, its centre
-  ** outside, where an SVG's default fill has it inside */
-  size_t ea, eb;
-  if (crossing(n, x, y, &ea, &eb))
-    return lw_error_set(err, LW_EINPUT, "polygon crosses itself: edge %zu (vertices %zu to %zu) meets edge %zu "
-                        "(vertices %zu to %zu): expected a simple polygon, its edges meeting only at their shared "
-                        "vertices (they count from 0; draw a star by its outline)", ea, ea, (ea + 1) % n, eb, eb,
-                        (eb + 1) % n);
 
   /* Shoelace area about the first vertex (less cancellation for a polygon far
   ** from the origin).  "Zero" is relative to the bounding box, so collinear

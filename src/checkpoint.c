@@ -371,7 +371,9 @@ static lw_status get_energy(lw_ckpt *doc, int k, const lw_system_type *t, lw_sys
     if ((s = lw_ckpt_numbers(doc, sec, key, &v, 1, -DBL_MAX, DBL_MAX, 0, err))) return s;
     if (!(fabs(v - fresh[q]) <= 1e-6 * scale))
       return lw_error_set(err, LW_EINPUT, "%s: [%s] %s: %.17g, but the state is at %.17g (the file was changed "
-                          "or damaged, or a file the scene reads was changed: its picture, field or table)",
+                          "or damaged, a file the scene reads was changed: its picture, field or table, or the run "
+                          "was begun by a release whose energy differs: docs/FORMATS.md, \"Runs of older "
+                          "releases\")",
                           lw_ckpt_path(doc), sec, key, v, fresh[q]);
     run[q] = v;
   }

@@ -248,11 +248,10 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   /* the prices of line that could have emptied it, each named (a high
   ** chem_spline was blamed on the potential, and the potential on a tiny
   ** chem_spline) */
-  else if (!st->n && !p->fixed_count && ((sc->on[LW_TERM_POTENTIAL] && sc->image) || p->chem_spline > 0.0 ||
-                                         p->chem_length > 0.0)) {
+  else if (!st->n && !p->fixed_count && (sc->on[LW_TERM_POTENTIAL] || p->chem_spline > 0.0 || p->chem_length > 0.0)) {
     char price[160] = "";
     size_t k = 0;
-    if (sc->on[LW_TERM_POTENTIAL] && sc->image)
+    if (sc->on[LW_TERM_POTENTIAL])
       k += (size_t)snprintf(price + k, sizeof price - k, "energy.potential %g", p->potential_coef);
     if (p->chem_spline > 0.0 && k < sizeof price)
       k += (size_t)snprintf(price + k, sizeof price - k, "%senergy.chem_spline %g", k ? ", " : "", p->chem_spline);
@@ -260,7 +259,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
       snprintf(price + k, sizeof price - k, "%senergy.chem_length %g", k ? ", " : "", p->chem_length);
     snprintf(rep->empty_why, sizeof rep->empty_why, "no spline is left: none was placed (init.splines, "
              "init.coverage), or the anneal removed every one, the price of line (%s) being more than what the "
-             "lines lower (a pale picture, or a price too high: lower it)", price);
+             "lines lower%s: lower it", price, sc->image ? " (a pale picture, or a price too high)" : "");
   }
   else if (!st->n && p->fixed_count)
     snprintf(rep->empty_why, sizeof rep->empty_why, "no spline was placed (init.splines, or init.coverage on a "

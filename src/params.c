@@ -716,7 +716,7 @@ const lw_param_def lw_param_table[] = {
          "to the scene file; used instead of `points` and `weights` (a scene line holds about a "
          "dozen points: the INI reader stops at 198 characters)."),
   STRING("nurbs", "weights", nb_weights, "", "",
-         "One weight > 0 per control point, the largest at most 1e6 times the smallest (past that the "
+         "One weight > 0 per control point, the largest at most 1e4 times the smallest (past that the "
          "matrices and final.svg's fit lose their digits); empty = all 1 (a polynomial spline)."),
   STRING("nurbs", "knots", nb_knots, "", "",
          "The open knot vector: n + k nondecreasing numbers, the first k equal and the last k "
@@ -1405,6 +1405,14 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
   if (steps_unset) assign(p, steps, steps->def, expected, sizeof expected);
   apply_preset(p);
   if (steps_unset && !strcmp(p->schedule, "constant")) assign(p, steps, "1", expected, sizeof expected);
+  /* The segment cap's default gives way to a longer placement, and
+  ** scene.ini says the cap in force: it said 16 under init.segments = 20,
+  ** which a run of that scene.ini then refused as a cap set too low. */
+  const lw_param_def *cap = lw_params_find("moves", "max_segments");
+  if (!p->of_run && !p->line[cap - lw_param_table]) {
+    assign(p, cap, cap->def, expected, sizeof expected);
+    if (p->segments > p->max_segments) p->max_segments = p->segments;
+  }
   unsigned char rgb[LW_PLOT_PENS_MAX][3];
   /* (with layers the pens are theirs, which the scene says first) */
   if (p->pen_colors[0] && !p->ly_names[0] && lw_output_colors_parse(p->pen_colors, rgb, LW_PLOT_PENS_MAX) != p->pens) {

@@ -306,10 +306,19 @@ static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
         lo[1] = fmin(lo[1], ys[i]), hi[1] = fmax(hi[1], ys[i]);
       }
       lw_error e2;
+      size_t ea, eb;
       /* its box must meet the page: a polygon beside it has no room on it */
       if (!(hi[0] >= 0 && lo[0] <= p->width && hi[1] >= 0 && lo[1] <= p->height))
         st = bad_key(p, "scene", "polygon", LW_EINPUT, err, "the polygon (x %g to %g, y %g to %g mm) lies off the "
                      "page of %g x %g mm", lo[0], hi[0], lo[1], hi[1], p->width, p->height);
+      /* a polygon that crosses itself: a bowtie was "zero area" (its halves
+      ** cancel), and a pentagram was taken by the even-odd rule, its centre
+      ** outside, where an SVG's default fill has it inside (a run begun
+      ** before 2026-12-05 keeps its shape) */
+      else if (!p->of_run && lw_boundary_crossing(n / 2, xs, ys, &ea, &eb))
+        st = bad_key(p, "scene", "polygon", LW_EINPUT, err, "the polygon crosses itself: its edge from vertex %zu "
+                     "meets the one from vertex %zu: expected a simple polygon, its edges meeting only at their "
+                     "shared vertices (they count from 0; a star is given by its outline)", ea, eb);
       else if ((st = lw_boundary_polygon(&sc->boundary, n / 2, xs, ys, &e2)) != LW_OK)
         bad_key(p, "scene", "polygon", st, err, "%s", e2.msg);
       /* (a polygon in the margin was annealed, then drawn empty or cut,
@@ -503,9 +512,9 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   sc->transdim = !p->fixed_count;
   /* a cap below the placed splines' count was raised to it without a word,
   ** and lines grew past the cap the scene set (16 too, the default's value);
-  ** the default gives way, and so does a cap where nothing is placed */
-  const int cap_line = p->line[lw_params_find("moves", "max_segments") - lw_param_table];
-  if (sc->transdim && p->max_segments < p->segments && cap_line && !(p->of_run && cap_line > 0) && !p->from[0])
+  ** the default gives way (lw_params_resolve), and so does a cap where
+  ** nothing is placed, and one of a run begun before 2026-12-05 */
+  if (sc->transdim && p->max_segments < p->segments && !p->of_run && !p->from[0])
     return bad_key(p, "moves", "max_segments", LW_EINPUT, err, "expected at least init.segments = %d, the count "
                    "the placed splines start with, got %d", p->segments, p->max_segments);
   sc->max_segments = (size_t)(p->max_segments > p->segments ? p->max_segments : p->segments);
@@ -541,10 +550,11 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   lw_pair_ctx_init(&sc->pair, p->pair_cutoff, p->pair_near);
   sc->pair_gap_max = sc->on[LW_TERM_PAIR] && p->pair_cutoff > 0.0 ? LW_PAIR_GAP_SHARE * p->pair_cutoff : 0.0;
 
-  /* -1 is the page centre; a value between it and 0 meant it too, silently */
+  /* -1 is the page centre; a value between it and 0 meant it too, silently
+  ** (and still does in a run begun before 2026-12-05) */
   static const char *const centre_key[2] = {"center_x", "center_y"};
   const double centre[2] = {p->center_x, p->center_y};
-  for (int k = 0; k < 2; k++)
+  for (int k = 0; k < 2 && !p->of_run; k++)
     if (centre[k] < 0.0 && centre[k] != -1.0)
       return bad_key(p, "scene", centre_key[k], LW_EINPUT, err, "expected -1 (the page centre) or a coordinate >= 0, "
                      "got %g", centre[k]);

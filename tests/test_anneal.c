@@ -481,6 +481,10 @@ Test(run, a_segment_cap_below_the_placed_count_is_refused)
                   "-e %s/cap", b, lw_test_root(), dir, dir, dir, dir), 0);
   cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/cap --quiet --set moves.fixed_count=0 --set init.segments=20 "
                   "--set init.segment_length=1.5 --set anneal.sweeps=2", b, lw_test_root(), dir), 0);
+  /* its scene.ini says the cap in force (it said 16, which a run of that
+  ** file then refused) */
+  cr_assert_eq(sh("grep -q '^max_segments = 20$' %s/cap/scene.ini && %s run %s/cap/scene.ini --out %s/cap2 --quiet",
+                  dir, b, dir, dir), 0);
   cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/cap16 --quiet --set moves.fixed_count=0 --set "
                   "init.segments=20 --set init.segment_length=1.5 --set moves.max_segments=16 2>%s/cap.txt; "
                   "test $? -eq 2 && grep -qF 'got 16' %s/cap.txt", b, lw_test_root(), dir, dir, dir), 0);

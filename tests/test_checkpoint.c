@@ -159,7 +159,9 @@ Test(checkpoint, an_adaptive_schedules_state_is_checked_on_resume)
     {"s/^temperature = .*/temperature = 1e300/", "[run] temperature: 1.0000000000000001e+300, but the adaptive"},
     {"s/^block_energy = .*/block_energy = 3 1000 2372/", "[run] block_energy: 3 samples with sum 1000 and sum of "
      "squares 2372 make a negative variance: the state was edited"},
-    {"s/^block_energy = .*/block_energy = 6 1 1/", "[run] block_energy: 6 samples, but the step has had 5 sweeps"},
+    {"s/^block_energy = .*/block_energy = 4 1 1/", "[run] block_energy: 4 samples, but the step has had 3 sweeps since "
+     "its step tuning"},
+    {"s/^block_energy = .*/block_energy = 0 5 30/", "[run] block_energy: no samples, but sums 5 and 30"},
     /* the measured rule, from the previous step's energies */
     {"s/^prev_stats = \\([^ ]*\\) [^ ]* 8$/prev_stats = \\1 0.5 8/", "[run] temperature: 0.05857352894254898"},
   };

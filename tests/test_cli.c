@@ -164,6 +164,11 @@ Test(cli, energy_of_a_run_whose_scene_was_edited_says_so)
                           "e/scene.ini: ' err2.txt && grep -qF energy.strain err2.txt && grep -qF '(line 47) edited "
                           "since the run started; the energy below is of the scene as it reads now' err2.txt", dir),
                0, "%s", lw_test_slurp("%s/err2.txt", dir));
+  /* values refused since 2026-12-05 stay a run's own (its scene.ini as
+  ** resume and energy read it): a centre between -1 and 0 */
+  cr_assert_eq(lw_test_sh("cd %s && sed -i 's/^center_y = .*/center_y = -0.5/' e/scene.ini && %s energy e "
+                          ">/dev/null 2>err4.txt && grep -qF center_y err4.txt", dir, lw_test_bin()), 0, "%s",
+               lw_test_slurp("%s/err4.txt", dir));
   /* a damaged hash is resume's to refuse, not an edit */
   cr_assert_eq(lw_test_sh("cd %s && cp -r e d && sed -i 's/^scene_hash = .*/scene_hash = zzzz/' d/state.lw && %s "
                           "energy d 2>err3.txt >/dev/null && ! test -s err3.txt", dir, lw_test_bin()), 0, "%s",
@@ -183,7 +188,8 @@ Test(cli, a_centre_below_0_other_than_minus_1_is_refused)
 
 /* A polygon that reaches into the margin, where the crop cuts the drawing,
 ** was annealed and then drawn cut or empty, said only at the end: a note
-** says so before the run; one inside the margin gets none. */
+** says so before the run; one inside the margin gets none.  And one that
+** crosses itself is refused. */
 Test(cli, a_polygon_in_the_margin_is_noted_before_the_run)
 {
   char args[512], out[256], errs[8192];
@@ -192,10 +198,17 @@ Test(cli, a_polygon_in_the_margin_is_noted_before_the_run)
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   cr_assert(strstr(errs, "linewise: note: scene.polygon (x 2 to 60, y 2 to 50 mm) reaches past the page inset by "
                          "scene.margin (5 mm), where plot.crop cuts the drawing"), "%s", errs);
+  /* (closed by repeating its first vertex: no crossing) */
   snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/q --stop-at 0 --set scene.boundary=polygon --set "
-           "'scene.polygon=10 10 60 10 60 50 10 50'", lw_test_root(), dir);
+           "'scene.polygon=10 10 60 10 60 50 10 50 10 10'", lw_test_root(), dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   cr_assert_null(strstr(errs, "scene.polygon ("), "%s", errs);
+  /* one that crosses itself is refused, naming its edges */
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/r --stop-at 0 --set scene.boundary=polygon --set "
+           "'scene.polygon=20 20 80 90 80 20 20 90'", lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "key 'scene.polygon': the polygon crosses itself: its edge from vertex 0 meets the one from "
+                         "vertex 2: expected a simple polygon"), "%s", errs);
 }
 
 Test(cli, energy_lists_only_enabled_terms)

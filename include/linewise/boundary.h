@@ -44,6 +44,13 @@ typedef struct {
 
 /* Polygon from n >= 3 vertices (copied).  LW_EINPUT for fewer vertices,
 ** non-finite coordinates or zero area. */
+/* Whether the closed polygon of n vertices crosses or touches itself: 1
+** with the first pair of edges that meet, starting at vertices *a < *b
+** (edges from a vertex to the next one that differs: a repeated vertex, or
+** the first repeated last to close the path, is no edge); 0 where it is
+** simple (or memory ran out). */
+int lw_boundary_crossing(size_t n, const double *x, const double *y, size_t *a, size_t *b);
+
 lw_status lw_boundary_polygon(lw_boundary *b, size_t n, const double *x, const double *y,
                               lw_error *err);
 void lw_boundary_clear(lw_boundary *b);

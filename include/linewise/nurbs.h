@@ -20,8 +20,9 @@
 #define LW_NURBS_ORDER_MAX 8
 /* The largest weight at most this many times the smallest: past it the
 ** matrices and final.svg's fit lose their digits (1e8 drew 0.29 from a
-** curve of size 1; 1e6 keeps 1e-4). */
-#define LW_NURBS_WEIGHT_SPREAD 1e6
+** curve of size 1, 1e6 at an end 1.15e-4 against svg_tolerance's 1e-4; 1e5
+** keeps 1e-4 on the wire, 1e4 leaves room). */
+#define LW_NURBS_WEIGHT_SPREAD 1e4
 /* control points a refinement may make (a step of the wire costs 0.25 us
 ** a point, its matrices 200 bytes a point) */
 #define LW_NURBS_REFINED_MAX 1000000
