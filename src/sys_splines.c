@@ -370,8 +370,9 @@ static double refuse(lw_proposal *p)
 }
 
 /* No line to move, kill, grow, shrink or split (none to join with, for a
-** join): no proposal (system.h), counted nowhere; a page whose lines had all died counted every such move as a
-** rejection, and a death's acceptance read 0.32 where 428 of 440 were taken. */
+** join): no proposal (system.h), counted nowhere.  A page whose lines had
+** all died counted every such move as a rejection, and a death's acceptance
+** read 0.32 where 428 of 440 were taken. */
 static double nothing(lw_proposal *p, int *forbidden)
 {
   refuse(p);

@@ -50,8 +50,8 @@ const lw_system_type *lw_system_of(const lw_params *p, lw_error *err)
 }
 
 /* The first member a row lacks that the drivers call without asking, or
-** that an optional member it has needs beside it (a row with split() and no
-** merge() crashed mid-sweep); NULL when none.  A row without energy()
+** that an optional member it has needs beside it (the domains call merge()
+** after every split() sweep); NULL when none.  A row without energy()
 ** crashed `linewise energy` rather than being refused. */
 static const char *row_missing(const lw_system_type *t)
 {
