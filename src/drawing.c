@@ -248,10 +248,10 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   /* the prices of line that could have emptied it, each named (a high
   ** chem_spline was blamed on the potential, and the potential on a tiny
   ** chem_spline) */
-  else if (!st->n && !p->fixed_count && (sc->on[LW_TERM_POTENTIAL] || p->chem_spline > 0.0 || p->chem_length > 0.0)) {
+  else if (!st->n && !p->fixed_count && (p->potential_coef > 0.0 || p->chem_spline > 0.0 || p->chem_length > 0.0)) {
     char price[160] = "";
     size_t k = 0;
-    if (sc->on[LW_TERM_POTENTIAL])
+    if (p->potential_coef > 0.0)
       k += (size_t)snprintf(price + k, sizeof price - k, "energy.potential %g", p->potential_coef);
     if (p->chem_spline > 0.0 && k < sizeof price)
       k += (size_t)snprintf(price + k, sizeof price - k, "%senergy.chem_spline %g", k ? ", " : "", p->chem_spline);

@@ -68,7 +68,8 @@ static const char usage[] =
   "  energy DIR          recompute DIR/state.lw's energy from scratch with its scene;\n"
   "                      prints '<term> <value>' per enabled term, then 'total <value>'\n"
   "      --set SEC.KEY=VAL   with a key of the scene changed (repeatable): with\n"
-  "                          energy.quadrature=32, what the run's nodes leave out\n"
+  "                          energy.quadrature=32 (and tone_quadrature, pair_quadrature\n"
+  "                          where the scene sets them), what the run's nodes leave out\n"
   "  stats DIR...        means with error bars of DIR/trace.csv's columns (their\n"
   "                      integrated autocorrelation times), by default over the final\n"
   "                      temperature's sweeps (or from output.stats_from), tuning left\n"
@@ -676,8 +677,9 @@ static int cmd_run(int argc, char **argv)
       continue;
     }
     if (argv[i][0] == '-' && strcmp(argv[i], "--quiet")) {
-      lw_error_set(&err, LW_EUSAGE, "run: unknown option '%s' (try 'linewise --help')%s", argv[i],
-                   dash_hint(argv[i]));
+      lw_error_set(&err, LW_EUSAGE, "run: unknown option '%s' (try 'linewise --help')%s%s", argv[i],
+                   dash_hint(argv[i]), !strcmp(argv[i], "--sweeps") ? " (a run's length is --set anneal.sweeps=N; "
+                   "--sweeps extends a finished run under resume)" : "");
       return fail(&err);
     }
     if (argv[i][0] != '-') {

@@ -335,7 +335,8 @@ const lw_param_def lw_param_table[] = {
       "(fixed_count = 0)."),
   NUM("moves", "max_segments", LW_PT_INT, max_segments, "16", "", 1, 1e5, 0,
       "Grow never makes a spline longer than this many segments (fixed_count = 0); shrink never "
-      "below one. At least init.segments; the default gives way to a larger init.segments."),
+      "below one. At least init.segments (the count placed and born splines start with); the default "
+      "value, 16, gives way to a larger init.segments."),
   NUM("moves", "split", LW_PT_DOUBLE, mix_split, "0", "", 0, 1e6, 0,
       "Relative frequency of splits: an inner segment of a spline of 3 or more segments removed, "
       "leaving two splines with the nodes as they were (fixed_count = 0; 0 = none)."),
@@ -691,7 +692,8 @@ const lw_param_def lw_param_table[] = {
       "x of the gravity g acting on the line density: energy -rho int g.r dl (the load term; the "
       "particles' gravity is particles.gravity)."),
   NUM("dynamics", "gravity_y", LW_PT_DOUBLE, dyn_gravity_y, "0", "mm/s^2", -1e12, 1e12, 0,
-      "y of g (y points down the page: 9810 is the Earth's gravity on a page held upright)."),
+      "y of g (for splines y points down the page: 9810 is the Earth's gravity on a page held upright; "
+      "a D-NURBS curve's y points up, as nurbs.points: there -9810, in its own length unit)."),
   NUM("dynamics", "force_x", LW_PT_DOUBLE, dyn_force_x, "0", "force/mm", -1e12, 1e12, 0,
       "x of a constant external force f per mm of line: energy -int f.r dl (the load term)."),
   NUM("dynamics", "force_y", LW_PT_DOUBLE, dyn_force_y, "0", "force/mm", -1e12, 1e12, 0,
@@ -960,6 +962,12 @@ static int at_default(const lw_params *p, const lw_param_def *d)
   return 0;
 }
 
+int lw_params_kept(const lw_params *p, const char *section, const char *key)
+{
+  const lw_param_def *d = lw_params_find(section, key);
+  return d && p->of_run && p->line[d - lw_param_table] > 0;
+}
+
 int lw_params_given(const lw_params *p, const lw_param_def *d)
 {
   const int line = p->line[d - lw_param_table];
@@ -1105,7 +1113,8 @@ static int on_key(void *user, const char *section, const char *key, const char *
   const lw_param_def *d = lw_params_find(section, key); /* the section is known: read_line checked it */
   if (!d) {
     suggest_key(section, key, hint, sizeof hint);
-    lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' is not a parameter%s (see docs/PARAMETERS.md)",
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' is not a parameter%s (see `linewise params` or "
+                 "docs/PARAMETERS.md)",
                  rc->p->file, rc->line, section, key, hint);
     return 0;
   }
@@ -1405,14 +1414,6 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
   if (steps_unset) assign(p, steps, steps->def, expected, sizeof expected);
   apply_preset(p);
   if (steps_unset && !strcmp(p->schedule, "constant")) assign(p, steps, "1", expected, sizeof expected);
-  /* The segment cap's default gives way to a longer placement, and
-  ** scene.ini says the cap in force: it said 16 under init.segments = 20,
-  ** which a run of that scene.ini then refused as a cap set too low. */
-  const lw_param_def *cap = lw_params_find("moves", "max_segments");
-  if (!p->of_run && !p->line[cap - lw_param_table]) {
-    assign(p, cap, cap->def, expected, sizeof expected);
-    if (p->segments > p->max_segments) p->max_segments = p->segments;
-  }
   unsigned char rgb[LW_PLOT_PENS_MAX][3];
   /* (with layers the pens are theirs, which the scene says first) */
   if (p->pen_colors[0] && !p->ly_names[0] && lw_output_colors_parse(p->pen_colors, rgb, LW_PLOT_PENS_MAX) != p->pens) {
@@ -1485,7 +1486,8 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
   if (!d) {
     char hint[96];
     suggest_key(section, key, hint, sizeof hint);
-    return lw_error_set(err, LW_EUSAGE, "--set %s.%s: not a parameter%s (see docs/PARAMETERS.md)", section, key,
+    return lw_error_set(err, LW_EUSAGE, "--set %s.%s: not a parameter%s (see `linewise params` or docs/PARAMETERS.md)",
+                        section, key,
                         hint);
   }
   char expected[256], unseen[96];

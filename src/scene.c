@@ -315,7 +315,7 @@ static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
       ** cancel), and a pentagram was taken by the even-odd rule, its centre
       ** outside, where an SVG's default fill has it inside (a run begun
       ** before 2026-12-05 keeps its shape) */
-      else if (!p->of_run && lw_boundary_crossing(n / 2, xs, ys, &ea, &eb))
+      else if (!lw_params_kept(p, "scene", "polygon") && lw_boundary_crossing(n / 2, xs, ys, &ea, &eb))
         st = bad_key(p, "scene", "polygon", LW_EINPUT, err, "the polygon crosses itself: its edge from vertex %zu "
                      "meets the one from vertex %zu: expected a simple polygon, its edges meeting only at their "
                      "shared vertices (they count from 0; a star is given by its outline)", ea, eb);
@@ -511,12 +511,14 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   coef[LW_TERM_CHEMICAL] = sc->chem[0] != 0.0 || sc->chem[1] != 0.0;
   sc->transdim = !p->fixed_count;
   /* a cap below the placed splines' count was raised to it without a word,
-  ** and lines grew past the cap the scene set (16 too, the default's value);
-  ** the default gives way (lw_params_resolve), and so does a cap where
-  ** nothing is placed, and one of a run begun before 2026-12-05 */
-  if (sc->transdim && p->max_segments < p->segments && !p->of_run && !p->from[0])
+  ** and lines grew past the cap the scene set (births start at init.segments
+  ** under init.from too); the default's value gives way (a run's scene.ini
+  ** writes it), and a run begun before 2026-12-05 keeps its cap */
+  const lw_param_def *cap = lw_params_find("moves", "max_segments");
+  if (sc->transdim && p->max_segments < p->segments && strtod(cap->def, NULL) != p->max_segments &&
+      !lw_params_kept(p, "moves", "max_segments"))
     return bad_key(p, "moves", "max_segments", LW_EINPUT, err, "expected at least init.segments = %d, the count "
-                   "the placed splines start with, got %d", p->segments, p->max_segments);
+                   "placed and born splines start with, got %d", p->segments, p->max_segments);
   sc->max_segments = (size_t)(p->max_segments > p->segments ? p->max_segments : p->segments);
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     sc->coef[t] = coef[t];
@@ -554,8 +556,8 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   ** (and still does in a run begun before 2026-12-05) */
   static const char *const centre_key[2] = {"center_x", "center_y"};
   const double centre[2] = {p->center_x, p->center_y};
-  for (int k = 0; k < 2 && !p->of_run; k++)
-    if (centre[k] < 0.0 && centre[k] != -1.0)
+  for (int k = 0; k < 2; k++)
+    if (centre[k] < 0.0 && centre[k] != -1.0 && !lw_params_kept(p, "scene", centre_key[k]))
       return bad_key(p, "scene", centre_key[k], LW_EINPUT, err, "expected -1 (the page centre) or a coordinate >= 0, "
                      "got %g", centre[k]);
   double cx = p->center_x >= 0 ? p->center_x : 0.5 * p->width;

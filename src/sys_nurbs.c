@@ -148,6 +148,9 @@ static lw_nurbs *curve_of(const lw_params *p, lw_error *err)
     lw_params_blame(p, "nurbs", "weights", err);
     goto out;
   }
+  /* the checks of 2026-12-05 leave a run's own values as they were */
+  const int file = p->nb_file[0] != '\0', kept_w = lw_params_kept(p, "nurbs", file ? "file" : "weights"),
+            kept_p = lw_params_kept(p, "nurbs", file ? "file" : "points");
   size_t lo = 0, hi = 0;
   for (size_t i = 0; i < nw; i++) {
     if (!(w[i] > 0.0)) {
@@ -160,9 +163,8 @@ static lw_nurbs *curve_of(const lw_params *p, lw_error *err)
   }
   /* (1e200 ended in "a D-NURBS matrix ... is not positive definite", 1e-50
   ** in an unstable motion at any dt, 1e8 in a final.svg 0.29 from a curve
-  ** of size 1: the matrices and the fit lose their digits; the checks of
-  ** 2026-12-05 leave a run begun before them as it was) */
-  if (nw && !p->of_run && !(w[hi] <= LW_NURBS_WEIGHT_SPREAD * w[lo])) {
+  ** of size 1: the matrices and the fit lose their digits) */
+  if (nw && !kept_w && !(w[hi] <= LW_NURBS_WEIGHT_SPREAD * w[lo])) {
     lw_error_set(err, LW_EINPUT, "weights %zu (%.10g) and %zu (%.10g) are %.10g apart: expected at most a factor of "
                  "%g between the largest and the smallest (they count from 0)", hi, w[hi], lo, w[lo], w[hi] / w[lo],
                  LW_NURBS_WEIGHT_SPREAD);
@@ -171,7 +173,7 @@ static lw_nurbs *curve_of(const lw_params *p, lw_error *err)
   }
   /* (a point at 1e100 drew for ever: final.svg's pieces could not get within
   ** svg_tolerance of a curve whose rounding alone is larger) */
-  for (size_t i = 0; i < np && !p->of_run; i++)
+  for (size_t i = 0; i < np && !kept_p; i++)
     if (!(fabs(P[i]) <= LW_STATE_COORD_MAX)) {
       lw_error_set(err, LW_EINPUT, "control point %zu has %c = %.10g: expected coordinates within +-%g (they count "
                    "from 0)", i / 2, i % 2 ? 'y' : 'x', P[i], LW_STATE_COORD_MAX);
@@ -248,7 +250,7 @@ lw_nurbs_setup *lw_nurbs_setup_new(const lw_params *p, lw_nurbs *curve, lw_error
   ** under Monte Carlo the energy would not see every motion */
   size_t spans = 0;
   for (size_t s = (size_t)curve->order - 1; s < n; s++) spans += curve->knot[s + 1] > curve->knot[s];
-  if ((size_t)p->nb_gauss * spans < n && !p->of_run) {
+  if ((size_t)p->nb_gauss * spans < n && !lw_params_kept(p, "nurbs", "gauss")) {
     lw_error_set(err, LW_EINPUT, "expected at least %zu points a knot span: %zu spans of %zu control points, and "
                  "with fewer Gauss points than control points the quadrature of the energy (and of the mass, under "
                  "the dynamics) misses some motions, which then cost nothing (as many as the order, %d, make "

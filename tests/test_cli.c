@@ -169,6 +169,10 @@ Test(cli, energy_of_a_run_whose_scene_was_edited_says_so)
   cr_assert_eq(lw_test_sh("cd %s && sed -i 's/^center_y = .*/center_y = -0.5/' e/scene.ini && %s energy e "
                           ">/dev/null 2>err4.txt && grep -qF center_y err4.txt", dir, lw_test_bin()), 0, "%s",
                lw_test_slurp("%s/err4.txt", dir));
+  /* but a value given now with --set is checked as a new scene's */
+  cr_assert_eq(lw_test_sh("cd %s && %s energy e --set scene.center_x=-0.5 >/dev/null 2>err5.txt; test $? -eq 2 && "
+                          "grep -qF 'expected -1 (the page centre)' err5.txt", dir, lw_test_bin()), 0, "%s",
+               lw_test_slurp("%s/err5.txt", dir));
   /* a damaged hash is resume's to refuse, not an edit */
   cr_assert_eq(lw_test_sh("cd %s && cp -r e d && sed -i 's/^scene_hash = .*/scene_hash = zzzz/' d/state.lw && %s "
                           "energy d 2>err3.txt >/dev/null && ! test -s err3.txt", dir, lw_test_bin()), 0, "%s",

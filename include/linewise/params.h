@@ -347,6 +347,11 @@ int lw_params_write(const lw_params *p, FILE *f);
 ** every key, only --set counts. */
 int lw_params_given(const lw_params *p, const lw_param_def *d);
 
+/* Whether section.key holds a run's own value: read from a run's scene.ini
+** by resume or energy, not set over it with --set.  A check a later release
+** adds leaves such a value as the run began with it. */
+int lw_params_kept(const lw_params *p, const char *section, const char *key);
+
 /* Whether patterns (NULL-terminated "section.key" or "section.*"; NULL:
 ** none) name key d. */
 int lw_params_named(const char *const *patterns, const lw_param_def *d);
