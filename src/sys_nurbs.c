@@ -155,7 +155,7 @@ static lw_nurbs *curve_of(const lw_params *p, lw_error *err)
   for (size_t i = 0; i < nw; i++) {
     if (!(w[i] > 0.0)) {
       lw_error_set(err, LW_EINPUT, "weight %zu is %g: weights must be > 0 (they count from 0)", i, w[i]);
-      lw_params_blame(p, "nurbs", p->nb_file[0] ? "file" : "weights", err);
+      lw_params_blame(p, "nurbs", file ? "file" : "weights", err);
       goto out;
     }
     lo = w[i] < w[lo] ? i : lo;
@@ -168,7 +168,7 @@ static lw_nurbs *curve_of(const lw_params *p, lw_error *err)
     lw_error_set(err, LW_EINPUT, "weights %zu (%.10g) and %zu (%.10g) are %.10g apart: expected at most a factor of "
                  "%g between the largest and the smallest (they count from 0)", hi, w[hi], lo, w[lo], w[hi] / w[lo],
                  LW_NURBS_WEIGHT_SPREAD);
-    lw_params_blame(p, "nurbs", p->nb_file[0] ? "file" : "weights", err);
+    lw_params_blame(p, "nurbs", file ? "file" : "weights", err);
     goto out;
   }
   /* (a point at 1e100 drew for ever: final.svg's pieces could not get within
@@ -177,7 +177,7 @@ static lw_nurbs *curve_of(const lw_params *p, lw_error *err)
     if (!(fabs(P[i]) <= LW_STATE_COORD_MAX)) {
       lw_error_set(err, LW_EINPUT, "control point %zu has %c = %.10g: expected coordinates within +-%g (they count "
                    "from 0)", i / 2, i % 2 ? 'y' : 'x', P[i], LW_STATE_COORD_MAX);
-      lw_params_blame(p, "nurbs", p->nb_file[0] ? "file" : "points", err);
+      lw_params_blame(p, "nurbs", file ? "file" : "points", err);
       goto out;
     }
   if (!(knot = numbers(p, "knots", p->nb_knots, &nk, err))) goto out;
