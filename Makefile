@@ -6,7 +6,7 @@ CC      ?= cc
 PREFIX  ?= /usr/local
 BUILD   ?= build
 BIN     ?= bin
-PKGS    := gsl cairo inih
+PKGS    := gsl cairo inih zlib
 OPT     ?= -O2
 CFLAGS  ?= $(OPT) -g
 WARN    := -std=c11 -Wall -Wextra -Wshadow -Wstrict-prototypes -Wno-unused-parameter
@@ -18,7 +18,7 @@ OMP     := -fopenmp
 DEPFLAGS := -MMD -MP
 
 # locales: the locale test builds a decimal-comma locale with localedef
-DEBS    := build-essential pkg-config libgsl-dev libcairo2-dev libinih-dev libstb-dev \
+DEBS    := build-essential pkg-config libgsl-dev libcairo2-dev libinih-dev libstb-dev zlib1g-dev \
            libcriterion-dev gnuplot-nox clang libclang-rt-dev locales
 
 LIB_SRC := $(filter-out src/main.c,$(wildcard src/*.c))
@@ -111,7 +111,7 @@ FUZZ_TIME ?= 60
 FUZZ_FLAGS ?=
 FUZZ_OBJ  := $(LIB_SRC:src/%.c=build-fuzz/obj/%.o)
 FUZZ_SAN  := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined \
-             -DLW_IMAGE_MAX_PIXELS=4194304
+             -DLW_IMAGE_MAX_PIXELS=4194304 -DFUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
 FUZZ_WARN := $(WARN) -Wno-unknown-pragmas
 
 build-fuzz/obj/%.o: src/%.c | build-fuzz/obj

@@ -496,6 +496,14 @@ void lw_anneal_key_readers(const lw_param_def *d, char *buf, size_t n)
   else snprintf(buf, n, "%s under %s; %s under %s", sys[0], driver_names[0], sys[1], driver_names[1]);
 }
 
+const char *lw_anneal_key_values(const lw_param_def *d)
+{
+  if (!strcmp(d->section, "scene") && !strcmp(d->key, "system")) return lw_system_names();
+  if (!strcmp(d->section, "anneal") && !strcmp(d->key, "schedule")) return lw_schedule_names();
+  if (!strcmp(d->section, "anneal") && !strcmp(d->key, "domains")) return "off|1 to 64|auto";
+  return NULL;
+}
+
 lw_status lw_anneal_check_keys(const lw_params *p, char *unread, size_t size, lw_error *err)
 {
   const lw_system_type *t = lw_system_of(p, err);

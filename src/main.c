@@ -1118,7 +1118,7 @@ static int command(int argc, char **argv)
     return 0;
   }
   if (!strcmp(argv[1], "params")) {
-    lw_params_write_doc(stdout, lw_anneal_key_readers);
+    lw_params_write_doc(stdout, lw_anneal_key_readers, lw_anneal_key_values);
     return 0;
   }
   fprintf(stderr, "linewise: unknown command '%s' (try 'linewise --help')\n", argv[1]);

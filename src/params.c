@@ -1607,7 +1607,8 @@ int lw_params_write(const lw_params *p, FILE *f)
   return ferror(f) ? -1 : 0;
 }
 
-void lw_params_write_doc(FILE *f, void (*read_by)(const lw_param_def *d, char *buf, size_t n))
+void lw_params_write_doc(FILE *f, void (*read_by)(const lw_param_def *d, char *buf, size_t n),
+                         const char *(*values)(const lw_param_def *d))
 {
   const char *section = "";
   char range[128], readers[256];
@@ -1620,15 +1621,20 @@ void lw_params_write_doc(FILE *f, void (*read_by)(const lw_param_def *d, char *b
     }
     static const char *const type_name[] = {"number", "integer", "integer", "choice", "text"};
     _Static_assert(LW_PT_STRING == 4, "type_name follows lw_param_type");
-    const char *type = type_name[d->type];
+    const char *type = type_name[d->type], *words = d->type == LW_PT_STRING ? values(d) : NULL;
     if (d->type == LW_PT_CHOICE) snprintf(range, sizeof range, "%s", d->choices);
+    else if (words) snprintf(range, sizeof range, "%s", words);
     else if (d->type == LW_PT_STRING) snprintf(range, sizeof range, "-");
     else range_text(d, range, sizeof range);
-    for (char *c = range; *c; c++)
-      if (*c == '|') *c = '/';
+    char *to = range; /* '|' and ", " between words become '/' */
+    for (const char *c = range; *c; c++) {
+      if (*c == '|' || (*c == ',' && c[1] == ' ' && c++)) *to++ = '/';
+      else *to++ = *c;
+    }
+    *to = '\0';
     read_by(d, readers, sizeof readers);
-    fprintf(f, "| `%s` | %s | `%s` | %s | %s | %s | ", d->key, type, d->def, d->unit[0] ? d->unit : "-",
-            range, readers);
+    fprintf(f, "| `%s` | %s | `%s` | %s | %s | %s | ", d->key, words ? "choice" : type, d->def,
+            d->unit[0] ? d->unit : "-", range, readers);
     for (const char *c = d->help; *c; c++) {
       if (*c == '|') fputc('\\', f); /* a bare | would end the Markdown cell */
       fputc(*c, f);

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <zlib.h>
 
 #include "imageutil.h"
 #include "linewise/image.h"
@@ -841,6 +842,14 @@ Test(image, jpeg_exif_orientation_is_turned_upright)
   cr_assert(info.width == 16 && info.height == 32, "probe: %d x %d", info.width, info.height);
 }
 
+/* Writes the CRC of the PNG chunk at c (its length, type and data). */
+static void png_crc_set(unsigned char *c)
+{
+  const size_t len = (size_t)c[0] << 24 | (size_t)c[1] << 16 | (size_t)c[2] << 8 | c[3];
+  const unsigned long crc = crc32(crc32(0L, Z_NULL, 0), c + 4, (uInt)len + 4);
+  for (int k = 0; k < 4; k++) c[8 + len + (size_t)k] = (unsigned char)(crc >> (24 - 8 * k));
+}
+
 /* The 32 x 16 picture of exif_jpeg as a PNG, with an eXIf chunk of
 ** orientation o (0: none) after its header, or with `late` 1 after its
 ** image data; `late` 2: after its header, the TIFF block behind JPEG's
@@ -863,10 +872,12 @@ static size_t exif_png(unsigned char *out, int o, int late)
     memcpy(out + n + 8, "Exif\0\0", 6);
     memcpy(out + n + 14, chunk + 8, sizeof chunk - 8);
     out[n + 33] = (unsigned char)o;
+    png_crc_set(out + n);
     n += sizeof chunk + 6;
   } else if (o) {
-    memcpy(out + n, chunk, sizeof chunk); /* the decoder reads no CRC of an ancillary chunk: 0 */
+    memcpy(out + n, chunk, sizeof chunk);
     out[n + 27] = (unsigned char)o;
+    png_crc_set(out + n);
     n += sizeof chunk;
   }
   memcpy(out + n, j.b + head, j.n - head);
@@ -900,6 +911,90 @@ Test(image, png_exif_orientation_is_turned_upright)
   lw_image_info info;
   cr_assert_eq(lw_image_probe(path, &info, &err), LW_OK, "%s", err.msg);
   cr_assert(info.width == 16 && info.height == 32, "probe: %d x %d", info.width, info.height);
+}
+
+/* Writes into a growing buffer (a picture past jpeg_buf's 8 KB). */
+typedef struct {
+  unsigned char *b;
+  size_t n;
+} grow_buf;
+
+static void grow_put(void *ctx, void *data, int size)
+{
+  grow_buf *g = ctx;
+  unsigned char *b = realloc(g->b, g->n + (size_t)size);
+  cr_assert_not_null(b);
+  memcpy(b + g->n, data, (size_t)size);
+  g->b = b, g->n += (size_t)size;
+}
+
+/* The decoder checks no PNG CRC, and a bit flipped in the compressed
+** pixels mostly decoded to other pixels: each chunk's CRC is checked, every
+** bit of the data and of the header is caught, and a file without its IEND
+** is cut short; a PNG of width 0 is damaged. */
+Test(image, a_png_with_a_flipped_bit_or_no_end_is_refused)
+{
+  unsigned char px[64 * 64];
+  for (int k = 0; k < 64 * 64; k++) px[k] = (unsigned char)(k * 37 % 251);
+  grow_buf g = {NULL, 0};
+  cr_assert(stbi_write_png_to_func(grow_put, &g, 64, 64, 1, px, 64));
+  lw_error err;
+  lw_image *img = lw_image_decode(g.b, g.n, "ok.png", 1e6, NULL, &err);
+  cr_assert_not_null(img, "%s", err.msg);
+  lw_image_free(img);
+  const size_t idat = 8 + 25; /* signature, IHDR; stb writes one IDAT */
+  cr_assert(!memcmp(g.b + idat + 4, "IDAT", 4));
+  for (size_t at = 8; at < g.n - 12; at += 7) {
+    const unsigned char bit = (unsigned char)(1u << (at % 8));
+    g.b[at] ^= bit;
+    img = lw_image_decode(g.b, g.n, "f.png", 1e6, NULL, &err);
+    g.b[at] ^= bit;
+    cr_assert_null(img, "a bit flipped at byte %zu of %zu decoded", at, g.n);
+    cr_assert(strstr(err.msg, "f.png: the PNG is damaged"), "byte %zu: %s", at, err.msg);
+  }
+  g.b[idat + 20] ^= 4;
+  cr_assert_null(lw_image_decode(g.b, g.n, "f.png", 1e6, NULL, &err));
+  cr_assert(strstr(err.msg, "f.png: the PNG is damaged: its chunk 'IDAT' at byte 33 fails its CRC check"), "%s",
+            err.msg);
+  g.b[idat + 20] ^= 4;
+  cr_assert_null(lw_image_decode(g.b, g.n - 12, "cut.png", 1e6, NULL, &err));
+  cr_assert(strstr(err.msg, "cut.png: the PNG is damaged or cut short: it ends at byte"), "%s", err.msg);
+  cr_assert(strstr(err.msg, "without its IEND chunk"), "%s", err.msg);
+  memset(g.b + 16, 0, 4);
+  png_crc_set(g.b + 8);
+  cr_assert_null(lw_image_decode(g.b, g.n, "w0.png", 1e6, NULL, &err));
+  cr_assert(strstr(err.msg, "w0.png: the PNG is damaged: 0 x 64 pixels"), "%s", err.msg);
+  free(g.b);
+}
+
+/* A JPEG's header claiming 30000 x 30000 grey pixels on 3.7 KB of data
+** took 35 s and 1.8 GB, the missing data read as zeros (a black page):
+** every block is coded in at least a bit, so fewer bytes than blocks / 8
+** is cut short.  A uniform grey JPEG at the lowest quality decodes (a DC
+** and an end-of-block code a block: 6 bits with the standard tables stb
+** writes; PIL's optimised tables took 2, twice the bound). */
+Test(image, a_jpeg_header_larger_than_its_data_is_refused)
+{
+  const int side = 1024;
+  unsigned char *px = malloc((size_t)side * side);
+  cr_assert_not_null(px);
+  memset(px, 128, (size_t)side * side);
+  grow_buf g = {NULL, 0};
+  cr_assert(stbi_write_jpg_to_func(grow_put, &g, side, side, 1, px, 1));
+  free(px);
+  lw_error err;
+  lw_image *img = lw_image_decode(g.b, g.n, "grey.jpg", 1e7, NULL, &err);
+  cr_assert_not_null(img, "%s", err.msg);
+  lw_image_free(img);
+  size_t at = 2;
+  while (at + 9 < g.n && !(g.b[at] == 0xFF && g.b[at + 1] == 0xC0)) at += 2 + ((size_t)g.b[at + 2] << 8 | g.b[at + 3]);
+  cr_assert(at + 9 < g.n, "no SOF0");
+  /* 12000 rows: stb writes Y sampled 2 x 2 and Cb, Cr at half, so 1 + 1/4 + 1/4 of 128 x 1500 blocks */
+  g.b[at + 5] = 12000 >> 8, g.b[at + 6] = 12000 & 255;
+  cr_assert_null(lw_image_decode(g.b, g.n, "tall.jpg", 1e7, NULL, &err));
+  cr_assert(strstr(err.msg, "tall.jpg: the JPEG is damaged or cut short: its 1024 x 12000 pixels take at least "
+                   "36000 bytes of data, the file has "), "%s", err.msg);
+  free(g.b);
 }
 
 /* Formats linewise does not read are named, with the way round: an

@@ -577,6 +577,27 @@ Test(params, the_help_names_every_system_and_schedule)
               lw_schedule_types[k]->name);
 }
 
+/* The table of docs/PARAMETERS.md lists scene.system, anneal.schedule and
+** anneal.domains as choices with their words (they were "text" with range
+** "-", though anything but the tables' names is refused). */
+Test(params, the_doc_lists_the_words_of_table_keys_as_choices)
+{
+  char *text = NULL;
+  size_t n = 0;
+  FILE *f = open_memstream(&text, &n);
+  cr_assert_not_null(f);
+  lw_params_write_doc(f, lw_anneal_key_readers, lw_anneal_key_values);
+  cr_assert_eq(fclose(f), 0);
+  char words[128], want[256];
+  snprintf(words, sizeof words, "%s", lw_schedule_names());
+  for (char *c = words; (c = strchr(c, '|'));) *c = '/';
+  snprintf(want, sizeof want, "| `schedule` | choice | `geometric` | - | %s |", words);
+  cr_assert(strstr(text, want), "no row %s", want);
+  cr_assert(strstr(text, "| `system` | choice | `splines` | - | splines/particles/nurbs |"));
+  cr_assert(strstr(text, "| `domains` | choice | `off` | - | off/1 to 64/auto |"));
+  free(text);
+}
+
 /* A program calling into the library after setlocale(LC_ALL, "") (a GUI
 ** toolkit does) under a decimal-comma locale refused "0.02" in a correct
 ** scene, collapsed the built-in defaults and would have written "0,5":

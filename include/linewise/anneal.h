@@ -132,6 +132,10 @@ void lw_anneal_free(lw_anneal *a);
 ** under dynamics". */
 void lw_anneal_key_readers(const lw_param_def *d, char *buf, size_t n);
 
+/* The words text key d takes where they are a fixed list, '|'-separated (the
+** systems' and schedules' names from their tables; domains' forms), or NULL. */
+const char *lw_anneal_key_values(const lw_param_def *d);
+
 /* LW_EINPUT, naming where it was set and who reads it, when p gives a key
 ** (lw_params_given) that its system reads under neither driver: it would
 ** change nothing, and a study that varied it would measure noise.  Keys
