@@ -339,7 +339,12 @@ static lw_status pnm_decode(const unsigned char *d, size_t n, const char *name, 
   const unsigned char *r = d + at;
   for (size_t k = 0; k < samples; k++) {
     long x = wide ? (long)r[2 * k] << 8 | r[2 * k + 1] : (long)r[k];
-    if (x > maxval) x = maxval;
+    if (x > maxval) { /* Netpbm forbids it; clamped, a damaged file drew as white */
+      free(v);
+      return lw_error_set(err, LW_EINPUT, "%s: the %s is damaged: the sample at row %zu, column %zu is %ld, above "
+                          "its maxval %ld", name, ch == 3 ? "PPM" : "PGM", k / ((size_t)w * (size_t)ch) + 1,
+                          k / (size_t)ch % (size_t)w + 1, x, maxval);
+    }
     v[k] = (uint16_t)((x * 65535 + maxval / 2) / maxval);
   }
   *out = (decoded){v, v, 0, (int)w, (int)h, ch, 16};

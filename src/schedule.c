@@ -278,25 +278,31 @@ lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err
     }
     if (len < 0) break;
     line[strcspn(line, "#")] = '\0';
+    const char *cr = strchr(line, '\r');
+    if (cr && cr[strspn(cr, "\r\n")]) { /* CR line ends read as one line of many rows */
+      status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected LF or CRLF line ends, got a CR inside the line (a "
+                            "file of CR line ends, as old Mac OS wrote)", path, lineno);
+      break;
+    }
     char shown[64], *tok[3];
     snprintf(shown, sizeof shown, "%s", line + strspn(line, " \t"));
     int ntok = split(line, tok);
     if (ntok == 0) continue;
     double bv, tv;
     if (ntok != 2) {
-      status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected 'block temperature', got '%s'", path, lineno, shown);
+      status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected 'step temperature', got '%s'", path, lineno, shown);
       break;
     }
     /* Whole numbers only, up to 2^53 where doubles still count every block. */
     if (!parse_number(tok[0], &bv) || bv < 0 || bv != floor(bv) || bv > 9007199254740992.0) {
-      status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected a block number (a whole number >= 0), got '%.40s'",
+      status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected a step number (a whole number >= 0), got '%.40s'",
                             path, lineno, tok[0]);
       break;
     }
     bv += 0.0; /* -0 -> +0 */
     if (n && bv <= blk[n - 1]) {
       status = lw_error_set(err, LW_EINPUT,
-                            "%s:%ld: expected a block number greater than the previous row's %.0f, got %.0f", path,
+                            "%s:%ld: expected a step number greater than the previous row's %.0f, got %.0f", path,
                             lineno, blk[n - 1], bv);
       break;
     }
@@ -324,7 +330,7 @@ lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err
   free(line);
   fclose(f);
   if (!status && !n)
-    status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected at least one 'block temperature' row, got end of file",
+    status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected at least one 'step temperature' row, got end of file",
                           path, lineno > 0 ? lineno : 1);
   if (status) {
     free(blk);

@@ -104,6 +104,11 @@ Test(image, pgm_and_ppm_any_maxval_and_truncation)
   cr_assert_not_null(img, "%s", err.msg);
   cr_assert(fabs(img->tone[0] - 0.2126) < 1e-6 && fabs(img->tone[1] - 1 / 3.0) < 1e-5);
   lw_image_free(img);
+  /* a sample above maxval is damage (it was clamped: drawn white) */
+  const unsigned char over[] = "P6 2 1 15\n\x0f\x00\x00\x05\x10\x05";
+  cr_assert_null(lw_image_decode(over, sizeof over - 1, "o.ppm", 1e6, NULL, &err));
+  cr_assert(strstr(err.msg, "o.ppm: the PPM is damaged: the sample at row 1, column 2 is 16, above its maxval 15"),
+            "%s", err.msg);
   /* a raster shorter than the header promises */
   const unsigned char cut[] = "P5 4 4 255\nabcdefghij";
   cr_assert_null(lw_image_decode(cut, sizeof cut - 1, "cut.pgm", 1e6, NULL, &err));

@@ -212,7 +212,7 @@ Test(schedule, adaptive_clamped_and_never_nan)
 Test(schedule, table_interpolates_and_holds)
 {
   char path[64];
-  temp_file(path, "# block temperature\n"
+  temp_file(path, "# step temperature\n"
                   "\n"
                   "  5 10\n"
                   "15\t5   # halfway\r\n"
@@ -256,16 +256,17 @@ Test(schedule, table_rejects_malformed_files_with_line_numbers)
     int line;
     const char *what;
   } cases[] = {
-    {"0 1\nfoo\n", 2, "'block temperature'"},
-    {"0 1\n1\n", 2, "'block temperature'"},
-    {"0 1\n\n1 2 3\n", 3, "'block temperature'"},
+    {"0 1\nfoo\n", 2, "'step temperature'"},
+    {"0 1\n1\n", 2, "'step temperature'"},
+    {"0 1\n\n1 2 3\n", 3, "'step temperature'"},
+    {"0 1\r1 0.5\r", 1, "got a CR inside the line"},
     {"0 1x\n", 1, "temperature"},
-    {"x1 1\n", 1, "block number"},
+    {"x1 1\n", 1, "step number"},
     {"0 1\n# again\n0 2\n", 3, "greater than"},
     {"0 1\n5 1\n3 1\n", 3, "greater than"},
-    {"-1 1\n", 1, "block number"},
-    {"1.5 1\n", 1, "block number"},
-    {"1e300 1\n", 1, "block number"},
+    {"-1 1\n", 1, "step number"},
+    {"1.5 1\n", 1, "step number"},
+    {"1e300 1\n", 1, "step number"},
     {"0 -1\n", 1, "temperature"},
     {"0 -1e-300\n", 1, "temperature"},
     {"0 nan\n", 1, "temperature"},
