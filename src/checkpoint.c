@@ -512,7 +512,10 @@ lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, const lw_params *p, lw_run_keys
   const unsigned long long mine = text ? *scene_hash : lw_params_run_hash(p, NULL);
   if (h == mine) return LW_OK;
   static const char resumes[] = "a run resumes with the parameters and files it ran with (only [plot] and the "
-                                "keys of the final files may change; a file may move, its key naming the new place)";
+                                "keys of the final files may change, docs/FORMATS.md, scene_hash; a file may move, "
+                                "its key naming the new place): undo the edit; 'resume --sweeps N' runs more "
+                                "sweeps, and a redraw draws the state with other keys (docs/FORMATS.md, \"Redrawing "
+                                "a finished run\")";
   char which[1024];
   int in_path = 0, unread = -1, count = text ? edited_keys(p, keys, text, which, sizeof which, &in_path, &unread) : -1;
   if (unread >= 0) {

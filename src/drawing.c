@@ -1,6 +1,7 @@
 /* drawing.c -- a run's drawing files from its parameters (drawing.h). */
 #include "linewise/drawing.h"
 
+#include <errno.h>
 #include <gsl/gsl_math.h>
 #include <math.h>
 #include <stdio.h>
@@ -317,6 +318,17 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   if (!s && p->gcode) {
     dir_file(path, sizeof path, dir, "final.gcode");
     s = lw_output_gcode_strokes(st, &page, &po, path, err);
+  }
+  /* a format turned off since the run's last end (scene.ini edited, then
+  ** resumed) leaves no file of the old drawing beside the new: a plotter
+  ** was sent a final.gcode that final.svg no longer showed */
+  static const char *const optional[] = {"final.pdf", "final.hpgl", "final.gcode"};
+  const int wrote[] = {p->pdf, p->hpgl, p->gcode};
+  for (int k = 0; k < 3 && !s; k++) {
+    dir_file(path, sizeof path, dir, optional[k]);
+    if (!wrote[k] && remove(path) && errno != ENOENT)
+      s = lw_error_set(err, LW_EIO, "%s: cannot remove the file of an earlier end (output.%s is now 0): %s", path,
+                       optional[k] + 6, strerror(errno));
   }
   if (!s) s = close_share(p, sc, st, rep, err);
   if (!s && (tone || sc->reference)) s = score(p, sc, st, tone, rep, err);

@@ -305,7 +305,7 @@ static void on_signal(int sig)
     (void)w;
     _exit(128 + sig);
   }
-  stop_requested = 1;
+  stop_requested = sig;
 }
 
 /* Progress on stderr: a bar redrawn in place on a terminal, one plain line
@@ -475,7 +475,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     char mpi[LW_PATH_MAX + 96] = "";
     if (net && net->size > 1)
       snprintf(mpi, sizeof mpi, ", on one process, or over MPI as 'mpirun -n P linewise-mpi resume %s'", a->dir);
-    if (!quiet)
+    if (!quiet || (asked && (!net || !net->rank))) /* a log of --quiet runs must tell a stopped one too */
       fprintf(stderr, "linewise: stopped after sweep %ld; state saved in %s/state.lw ('linewise resume %s' "
               "continues%s)\n", a->sweep, a->dir, a->dir, mpi);
     return 0;
@@ -493,7 +493,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   if (s) return loop_fail(a, pg.start_sweep, w, err);
   watcher_stop(w, a->quench.ended == LW_QUENCH_STOPPED ? LW_PHASE_STOPPED : LW_PHASE_DONE);
   if (a->quench.ended == LW_QUENCH_STOPPED) {
-    if (!quiet)
+    if (!quiet || (asked && (!net || !net->rank)))
       fprintf(stderr, "linewise: stopped during the quench (nothing drawn); state saved in %s/state.lw ('linewise resume "
               "%s' quenches again)\n", a->dir, a->dir);
     return 0;
@@ -1081,7 +1081,16 @@ int main(int argc, char **argv)
   lw_mpi_finish();
   return rc;
 #else
-  return finish_stdout(command(argc, argv));
+  int rc = finish_stdout(command(argc, argv));
+  /* A Ctrl-C stop, its state saved, ends by the signal itself: a shell runs
+  ** a loop on after a child that exits 0 (or 130) on SIGINT, so every run
+  ** of an artist's series loop was stopped in turn.  SIGTERM and SIGHUP
+  ** (a batch system's, a lost session's) still end with 0. */
+  if (rc == 0 && stop_requested == SIGINT) {
+    signal(SIGINT, SIG_DFL);
+    raise(SIGINT);
+  }
+  return rc;
 #endif
 }
 

@@ -754,6 +754,50 @@ Test(cli, a_hang_up_stops_cleanly_and_a_closed_progress_pipe_is_harmless)
                0, "the run ended with its progress pipe");
 }
 
+/* Ctrl-C to a shell loop of runs (its process group, INT at its default as
+** in a terminal) stops the loop: the run saves its state, says so under
+** --quiet too (a log showed nothing), then ends by SIGINT, so that bash
+** goes no further.  It exited 0, and the loop drew every other picture,
+** one Ctrl-C each.  SIGTERM (a batch system's) still exits 0. */
+Test(cli, ctrl_c_stops_a_shell_loop_of_runs_with_the_state_saved)
+{
+  cr_assert_eq(lw_test_sh("printf 'for i in 1 2; do %s run %s/params/minimal.ini --out %s/l$i --quiet --threads 1 "
+                          "--set anneal.sweeps=1000000; echo \"run $i: $?\"; done; echo finished\n' > %s/loop.sh && "
+                          "(setsid env --default-signal=INT bash %s/loop.sh >%s/loop.log 2>&1 & echo $! >%s/loop.pid); "
+                          "i=0; while [ $i -lt 500 ] && ! test -f %s/l1/state.lw; do sleep 0.01; i=$((i+1)); done; "
+                          "sleep 0.3; kill -INT -$(cat %s/loop.pid); i=0; while kill -0 $(cat %s/loop.pid) 2>/dev/null "
+                          "&& [ $i -lt 1500 ]; do sleep 0.02; i=$((i+1)); done; test $i -lt 1500; r=$?; "
+                          "kill -KILL -$(cat %s/loop.pid) 2>/dev/null; exit $r",
+                          lw_test_bin(), lw_test_root(), dir, dir, dir, dir, dir, dir, dir, dir, dir),
+               0);
+  char *log = lw_test_slurp("%s/loop.log", dir);
+  cr_assert(strstr(log, "linewise: stopped after sweep ") && !strstr(log, "run 1") && !strstr(log, "finished"),
+            "%s", log);
+  free(log);
+  cr_assert_eq(lw_test_sh("grep -q '^sweep = [1-9]' %s/l1/state.lw && ! test -e %s/l2", dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/t --quiet --set anneal.sweeps=1000000 2>%s/t.err & "
+                          "p=$!; i=0; while [ $i -lt 500 ] && ! test -f %s/t/state.lw; do sleep 0.01; i=$((i+1)); "
+                          "done; sleep 0.3; kill -TERM $p; wait $p && grep -q 'stopped after sweep' %s/t.err",
+                          lw_test_bin(), lw_test_root(), dir, dir, dir, dir),
+               0);
+}
+
+/* A finished run resumed after output.gcode and output.pdf were turned off
+** in its scene.ini (a redraw) leaves no final.gcode or final.pdf of the old
+** drawing: they stayed, and a plotter could be sent a G-code file that
+** final.svg no longer showed; the done line named them as written. */
+Test(cli, a_format_turned_off_leaves_no_file_of_the_old_drawing)
+{
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/g --quiet --set anneal.sweeps=5 --set output.gcode=1 "
+                          "--set output.pdf=1 && test -s %s/g/final.gcode && test -s %s/g/final.pdf && sed -i "
+                          "'s/^gcode = 1/gcode = 0/; s/^pdf = 1/pdf = 0/' %s/g/scene.ini && %s resume %s/g 2>%s/err.txt",
+                          lw_test_bin(), lw_test_root(), dir, dir, dir, dir, lw_test_bin(), dir, dir),
+               0);
+  cr_assert_eq(lw_test_sh("test -s %s/g/final.svg && ! test -e %s/g/final.gcode && ! test -e %s/g/final.pdf && "
+                          "grep -q 'done: .*final.png, summary' %s/err.txt", dir, dir, dir, dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+}
+
 /* A run started without --out goes to out/<scene name>, and when that
 ** holds a run, to the first out/<scene name>-N that does not: the first
 ** drawing is not replaced.  --out names a directory to replace. */
