@@ -440,11 +440,12 @@ static int watched_fail(watcher *w, const lw_error *err)
 ** the one the loop began from (the set-up's, or the one a resume read). */
 static int loop_fail(const lw_anneal *a, long began, watcher *w, lw_error *err)
 {
-  if (err->code == LW_EIO) {
+  /* memory too: the drawing's joins can run out after hours of sweeps */
+  if (err->code == LW_EIO || err->code == LW_ENOMEM) {
     size_t n = strlen(err->msg);
     snprintf(err->msg + n, sizeof err->msg - n, "; %s/state.lw holds the checkpoint of sweep %ld: 'linewise "
-             "resume %s' continues from it once the files can be written", a->dir, a->saved > 0 ? a->saved - 1 : began,
-             a->dir);
+             "resume %s' continues from it once %s", a->dir, a->saved > 0 ? a->saved - 1 : began, a->dir,
+             err->code == LW_EIO ? "the files can be written" : "there is more memory");
   }
   return watched_fail(w, err);
 }

@@ -228,8 +228,10 @@ const lw_param_def lw_param_table[] = {
       "they have their own (`pair_quadrature`, `tone_quadrature`)."),
   NUM("energy", "pair_quadrature", LW_PT_INT, pair_quadrature, "0", "nodes", 0, 64, 0,
       "Gauss-Legendre nodes per segment for the pair term (its samples in the cell grid): 0 = the "
-      "same as `quadrature`, else 2 to 64. The pair sum costs about the square of this number per "
-      "proposal; docs/ACCURACY.md shows what fewer nodes cost in accuracy."),
+      "same as `quadrature`, else 2 to 64. Each of a segment's samples meets those of its neighbours, "
+      "so the pair sum's cost per proposal grows up to the square of this number (measured: twice "
+      "per doubling from 4 to 16 nodes, 3 times from 16 to 32); docs/ACCURACY.md shows what fewer "
+      "nodes cost in accuracy."),
   NUM("energy", "tone_quadrature", LW_PT_INT, tone_quadrature, "0", "nodes", 0, 64, 0,
       "Gauss-Legendre nodes per segment for the tone term (the samples it splats): 0 = the "
       "same as `quadrature`, else 2 to 64. Its cost per proposal grows with this number; with samples 0.7 "
