@@ -185,6 +185,24 @@ double lw_potential_eval(const lw_potential *f, double x, double y)
   return 0.0;
 }
 
+/* The core's factor g(r) on a radial or vortex field, and dg/dr in *dg.
+** The unit field's direction turns through pi around its centre within
+** any distance d of it: on a segment passing at d, the term's integrand
+** changes on the scale d, which no fixed rule resolves as d -> 0 (8 nodes
+** took a 10 mm segment 0.2 mm from a vortex's centre 48 % off, and 8
+** nodes on one through a signed radial centre 81 %).  Inside the core the
+** field's length falls to 0 as u^3, so the integrand changes on the scale
+** of the core, whatever d; smootherstep keeps v and its Jacobian
+** continuous at r = a, so neither the energy nor the gradient jumps. */
+static double core_factor(const lw_field *f, double r, double *dg)
+{
+  if (dg) *dg = 0.0;
+  if (!(f->core > 0.0) || r >= f->core) return 1.0;
+  const double u = r / f->core;
+  if (dg) *dg = 30.0 * u * u * (1.0 - u) * (1.0 - u) / f->core;
+  return u * u * u * (10.0 + u * (6.0 * u - 15.0));
+}
+
 static void eval_raw(const lw_field *f, double x, double y, double *vx, double *vy)
 {
   switch (f->kind) {
@@ -201,7 +219,7 @@ static void eval_raw(const lw_field *f, double x, double y, double *vx, double *
       *vx = *vy = 0.0;
       return;
     }
-    double inv = 1.0 / sqrt(r2);
+    double inv = core_factor(f, sqrt(r2), NULL) / sqrt(r2);
     if (f->kind == LW_FIELD_RADIAL) {
       *vx = dx * inv;
       *vy = dy * inv;
@@ -328,6 +346,7 @@ static void jacobian_raw(const lw_field *f, double x, double y, double v[2], dou
     if (!(r > 0.0)) return;
     double nx = dx / r, ny = dy / r;
     double a = (1.0 - nx * nx) / r, b = -nx * ny / r, c = (1.0 - ny * ny) / r;
+    double m[2] = {nx, ny};
     if (f->kind == LW_FIELD_RADIAL) {
       J[0][0] = a;
       J[0][1] = J[1][0] = b;
@@ -337,6 +356,13 @@ static void jacobian_raw(const lw_field *f, double x, double y, double v[2], dou
       J[0][1] = -c;
       J[1][0] = a;
       J[1][1] = b;
+      m[0] = -ny, m[1] = nx;
+    }
+    /* in the core v = g(r) m: dv = g dm + m (g'(r) n)^T */
+    double dg, g = core_factor(f, r, &dg);
+    for (int i = 0; i < 2; i++) {
+      J[i][0] = g * J[i][0] + dg * m[i] * nx;
+      J[i][1] = g * J[i][1] + dg * m[i] * ny;
     }
     return;
   }

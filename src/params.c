@@ -147,6 +147,11 @@ const lw_param_def lw_param_table[] = {
       "Wavelength of the waves field."),
   NUM("scene", "field_amplitude", LW_PT_DOUBLE, field_amplitude, "10", "mm", -1e7, 1e7, 0,
       "Amplitude A of the waves field."),
+  NUM("scene", "field_core", LW_PT_DOUBLE, field_core, "-1", "mm", -1, 1e7, 0,
+      "radial and vortex: radius of the core about the centre inside which the field's length falls "
+      "smoothly to 0 (6u^5 - 15u^4 + 10u^3 of u = r / core), so that the quadrature resolves a segment "
+      "passing the centre; -1 = init.segment_length; 0 = none, a unit field up to its centre, where "
+      "8 nodes erred by up to 80 % of a segment's term (docs/NUMERICS.md, \"The field's centre\")."),
   NUM("scene", "center_x", LW_PT_DOUBLE, center_x, "-1", "mm", -1, 1e7, 0,
       "Centre of the radial and vortex presets and of the ramp; -1 = page centre (other values below 0 are "
       "refused)."),

@@ -560,6 +560,9 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     if (centre[k] < 0.0 && centre[k] != -1.0 && !lw_params_kept(p, "scene", centre_key[k]))
       return bad_key(p, "scene", centre_key[k], LW_EINPUT, err, "expected -1 (the page centre) or a coordinate >= 0, "
                      "got %g", centre[k]);
+  if (p->field_core < 0.0 && p->field_core != -1.0)
+    return bad_key(p, "scene", "field_core", LW_EINPUT, err, "expected -1 (init.segment_length) or a radius >= 0, "
+                   "got %g", p->field_core);
   double cx = p->center_x >= 0 ? p->center_x : 0.5 * p->width;
   double cy = p->center_y >= 0 ? p->center_y : 0.5 * p->height;
 
@@ -606,6 +609,9 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     lw_field *f = &sc->field;
     f->cx = cx;
     f->cy = cy;
+    /* a run begun before 2026-12-05 has no line for it: no core, as it ran */
+    const int before = p->of_run && !p->line[lw_params_find("scene", "field_core") - lw_param_table];
+    f->core = before ? 0.0 : p->field_core < 0.0 ? p->segment_length : p->field_core;
     f->ux = cos(p->field_angle * DEG);
     f->uy = sin(p->field_angle * DEG);
     f->wavelength = p->field_wavelength;

@@ -1328,7 +1328,7 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
   ** kind reads its own keys (an artist's vortex without energy.field drew
   ** random strokes without a word) */
   static const char *const field[] = {"scene.field", "scene.field_angle", "scene.field_sigma", "scene.field_flat",
-                                      "scene.field_wavelength", "scene.field_amplitude", "energy.field_mode",
+                                      "scene.field_wavelength", "scene.field_amplitude", "scene.field_core", "energy.field_mode",
                                       "layers.turn", NULL},
                            *const potential[] = {"scene.potential", "scene.potential_value", "scene.potential_angle",
                                                  "scene.potential_scale", "scene.potential_power",
@@ -1340,7 +1340,8 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
                            *const ramp[] = {"scene.potential_angle", NULL},
                            *const scale[] = {"scene.potential_scale", NULL},
                            *const picture[] = {"scene.potential_power", "scene.potential_blur", NULL},
-                           *const centre[] = {"scene.center_x", "scene.center_y", NULL};
+                           *const centre[] = {"scene.center_x", "scene.center_y", NULL},
+                           *const core[] = {"scene.field_core", NULL};
   const int fo = p->field_coef != 0.0, po = p->potential_coef != 0.0, f = p->field, q = p->potential;
   const int grid = f == LW_FLD_ETF || f == LW_FLD_GRADIENT;
   int n = 0;
@@ -1361,6 +1362,8 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
   rule[n++] = (lw_idle_rule){centre, !(fo && (f == LW_FLD_RADIAL || f == LW_FLD_VORTEX)) &&
                                          !(po && (q == LW_POT_RAMP || q == LW_POT_RADIAL)),
                              "no radial or vortex field, no ramp or radial potential"};
+  rule[n++] = (lw_idle_rule){core, fo && f != LW_FLD_RADIAL && f != LW_FLD_VORTEX, "scene.field is not radial or "
+                             "vortex"};
   return n;
 }
 

@@ -323,6 +323,49 @@ Test(field, constant_radial_vortex_match_formulas)
   }
 }
 
+/* Within the core a of a radial or vortex field its length is
+** g(u) = 6u^5 - 15u^4 + 10u^3 of u = r / a, its direction the unit field's;
+** from a out it is the unit field.  g and g' meet 1 and 0 at a, so the
+** field and its Jacobian are continuous there; the Jacobian is that of
+** exactly this field (central differences, inside and outside the core). */
+Test(field, a_core_takes_the_field_smoothly_to_zero_at_its_centre)
+{
+  rng_seed(0x5eed000b);
+  const double a = 7.0;
+  for (int kind = 0; kind < 2; kind++) {
+    const lw_field f = {.kind = kind ? LW_FIELD_VORTEX : LW_FIELD_RADIAL, .cx = 30, .cy = 40, .core = a};
+    const lw_field unit = {.kind = f.kind, .cx = 30, .cy = 40};
+    for (int k = 0; k < 400; k++) {
+      const double r = urand(0.01, 2.0 * a), t = urand(-M_PI, M_PI), x = 30 + r * cos(t), y = 40 + r * sin(t);
+      double vx, vy, ux, uy;
+      lw_field_eval(&f, x, y, &vx, &vy);
+      lw_field_eval(&unit, x, y, &ux, &uy);
+      const double u = fmin(r / a, 1.0), g = u * u * u * (10 - 15 * u + 6 * u * u);
+      cr_assert(fabs(vx - g * ux) < 1e-14 && fabs(vy - g * uy) < 1e-14, "r %g: (%g, %g), want %g (%g, %g)", r, vx,
+                vy, g, ux, uy);
+      double v[2], J[2][2];
+      lw_field_jacobian(&f, x, y, v, J);
+      const double h = 1e-6;
+      for (int j = 0; j < 2; j++) {
+        double p[2], m[2];
+        lw_field_eval(&f, x + (j == 0) * h, y + (j == 1) * h, &p[0], &p[1]);
+        lw_field_eval(&f, x - (j == 0) * h, y - (j == 1) * h, &m[0], &m[1]);
+        for (int i = 0; i < 2; i++)
+          cr_assert(fabs(J[i][j] - (p[i] - m[i]) / (2 * h)) < 1e-6 * (1 + 1 / r), "kind %d r %g: J[%d][%d] %.10g, "
+                    "differences %.10g", kind, r, i, j, J[i][j], (p[i] - m[i]) / (2 * h));
+      }
+    }
+    /* across r = a: no step in the field nor in its Jacobian */
+    double in[2], out[2], Jin[2][2], Jout[2][2];
+    lw_field_jacobian(&f, 30 + a * (1 - 1e-9), 40, in, Jin);
+    lw_field_jacobian(&f, 30 + a * (1 + 1e-9), 40, out, Jout);
+    for (int i = 0; i < 2; i++) {
+      cr_assert(fabs(in[i] - out[i]) < 1e-12);
+      for (int j = 0; j < 2; j++) cr_assert(fabs(Jin[i][j] - Jout[i][j]) < 1e-8, "J[%d][%d] steps at the core", i, j);
+    }
+  }
+}
+
 Test(field, waves_are_tangent_to_sine_curves)
 {
   rng_seed(0x5eed000b);

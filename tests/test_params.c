@@ -531,6 +531,40 @@ Test(params, a_key_is_given_only_with_a_value_of_its_own)
   cr_assert(!lw_params_named(NULL, lw_params_find("plot", "crop")));
 }
 
+/* scene.field_core: -1 is init.segment_length, and a run's scene.ini
+** written before the key existed (no line for it) keeps the unit field it
+** ran with, so that its energies, and its resume, are what they were; a
+** value below 0 but -1 is refused. */
+Test(params, a_field_core_of_a_run_begun_before_it_is_none)
+{
+  char path[] = "/tmp/lw_params_core_XXXXXX";
+  int fd = mkstemp(path);
+  FILE *f = fdopen(fd, "w");
+  fputs("[scene]\nfield = vortex\n[energy]\nfield = -1\n[init]\nsegment_length = 6\n", f);
+  fclose(f);
+  lw_params p;
+  lw_scene sc;
+  lw_error err;
+  const double want[3] = {6.0, 0.0, 2.5}; /* a new scene; a run's without the line; a run's with one */
+  for (int k = 0; k < 3; k++) {
+    cr_assert_eq(k ? lw_params_read_run(&p, path, 1, &err) : lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
+    cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
+    cr_assert_eq(sc.field.core, want[k], "case %d: core %g", k, sc.field.core);
+    lw_scene_clear(&sc);
+    if (k == 1) {
+      f = fopen(path, "a");
+      fputs("[scene]\nfield_core = 2.5\n", f);
+      fclose(f);
+    }
+  }
+  cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_params_set(&p, "scene.field_core=-0.5", &err), LW_OK, "%s", err.msg);
+  cr_assert_neq(lw_scene_init(&sc, &p, &err), LW_OK);
+  cr_assert(strstr(err.msg, "scene.field_core") && strstr(err.msg, "expected -1 (init.segment_length) or a radius >= 0"),
+            "%s", err.msg);
+  unlink(path);
+}
+
 /* Every key is read by some system under some driver (a key no row lists
 ** would be refused in every scene), and the readers are what the rows say. */
 Test(params, every_key_has_a_reader)

@@ -12,9 +12,11 @@
 **                       (h defaults to half the page extent along u: Phi in [0,1])
 **   potential radial    Phi = |r - c| / scale
 **   field constant      v = (cos a, sin a)
-**   field radial        v = (r - c) / |r - c|            (0 at c)
-**   field vortex        v = (-(y - cy), x - cx) / |r - c| (0 at c; counter-clockwise
+**   field radial        v = g (r - c) / |r - c|            (0 at c)
+**   field vortex        v = g (-(y - cy), x - cx) / |r - c| (0 at c; counter-clockwise
 **                       on a y-up page)
+**                       g = 1, or within the core radius a: g = 6u^5 - 15u^4 + 10u^3,
+**                       u = |r - c| / a (C2 at a; v ~ r^3 near c, smooth there)
 **   field waves         v = (1, k A cos(k x)) / |(1, k A cos(k x))|, k = 2 pi / wavelength:
 **                       the tangents of the curves y = A sin(k x) + const
 **   field grid_axial    a grid of directions without sign (imagefield.h's edge tangent
@@ -84,6 +86,7 @@ typedef struct {
   lw_field_kind kind;
   double ux, uy;       /* constant: unit direction */
   double cx, cy;       /* radial, vortex: centre, mm */
+  double core;         /* radial, vortex: core radius a, mm (0: none) */
   double wavelength;   /* waves: mm (> 0) */
   double amplitude;    /* waves: mm */
   lw_grid2d *grid;     /* grid, grid_axial: owned, ncomp = 2 */

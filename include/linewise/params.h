@@ -98,6 +98,7 @@ typedef struct {
   double field_flat;          /* etf/gradient flatness threshold, tone per mm */
   double field_wavelength;    /* waves, mm */
   double field_amplitude;     /* waves, mm */
+  double field_core;          /* radial, vortex: core radius, mm; -1 = init.segment_length */
   double center_x, center_y;  /* centre of radial/vortex presets, mm; -1 = page centre */
   int mask;                   /* LW_MASK_* */
   char mask_image[LW_PATH_MAX]; /* picture of mask = image */
