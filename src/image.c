@@ -793,7 +793,8 @@ static lw_status stb_input_sound(const unsigned char *data, size_t size, const c
 {
   lw_status st = bmp_complete(data, size, name, err);
   if (!st) st = gif_complete(data, size, name, err);
-  if (!st) st = png_chunks_sound(data, size, name, err);
+  /* (a PNG too large to decode is said to be, from its header, damaged or not) */
+  if (!st && !too_large(data, size, 0, 0, 0)) st = png_chunks_sound(data, size, name, err);
   if (!st) st = jpeg_tables_sound(data, size, name, err);
   return st;
 }
