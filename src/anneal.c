@@ -1108,6 +1108,13 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   if (lw_rundir_unstarted(dir))
     return lw_error_set(err, LW_EINPUT, "%s: no state.lw: the run there stopped before its first checkpoint, so "
                         "there is nothing to resume; run it again (linewise run SCENE --out %s)", dir, dir);
+  /* (a run that failed before writing anything, on a full disk, left only
+  ** its lock: "cannot open state file" named no way on) */
+  struct stat sb;
+  if (!lw_rundir_holds_run(dir) && stat(path, &sb) && errno == ENOENT && !stat(dir, &sb) && S_ISDIR(sb.st_mode))
+    return lw_error_set(err, LW_EINPUT, "%s: holds no run (no state.lw, no scene.ini of a run): resume takes a "
+                        "directory that 'linewise run --out' wrote; a run that failed before writing them has "
+                        "nothing to resume: run it again", dir);
   lw_status s = lw_state_read(&st, path, err);
   if (s) return s;
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);

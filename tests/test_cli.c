@@ -721,6 +721,17 @@ Test(cli, a_signal_before_anything_is_written_ends_the_set_up_at_once)
                0);
 }
 
+/* A directory no run wrote (a run that failed at once on a full disk left
+** only its lock) is said to hold no run, with the way on: it was the bare
+** "state.lw: cannot open state file". */
+Test(cli, resume_of_a_directory_without_a_run_says_so)
+{
+  cr_assert_eq(lw_test_sh("mkdir -p %s/none && : > %s/none/.lock && { %s resume %s/none 2>%s/err.txt; test $? -eq 2; "
+                          "} && grep -q 'none: holds no run (no state.lw, no scene.ini of a run): resume takes a "
+                          "directory that .linewise run --out. wrote' %s/err.txt", dir, dir, lw_test_bin(), dir, dir,
+                          dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+}
+
 /* A sweep can take minutes (here a billion time steps of the whip): the
 ** first SIGINT asks for a stop after it, a second stops the process at
 ** once (exit 128 + 2), and the checkpoint state.lw holds still reads.  The

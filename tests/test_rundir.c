@@ -92,11 +92,11 @@ Test(rundir, a_refused_run_without_out_leaves_no_directory)
 }
 
 /* Resume of a directory that holds no run, or of a file, is bad input
-** (exit 2, naming state.lw) and writes nothing there, no lock file either. */
+** (exit 2, saying so) and writes nothing there, no lock file either. */
 Test(rundir, resume_of_what_holds_no_run_writes_nothing)
 {
   cr_assert_eq(sh("mkdir %s/empty && touch %s/afile", dir, dir), 0);
   cr_assert_eq(sh("%s resume %s/empty 2> %s/err.txt", lw_test_bin(), dir, dir), 2);
-  cr_assert_eq(sh("grep -q 'empty/state.lw' %s/err.txt && test -z \"$(ls -A %s/empty)\"", dir, dir), 0);
+  cr_assert_eq(sh("grep -q 'empty: holds no run' %s/err.txt && test -z \"$(ls -A %s/empty)\"", dir, dir), 0);
   cr_assert_eq(sh("%s resume %s/afile 2> %s/err.txt", lw_test_bin(), dir, dir), 2);
 }

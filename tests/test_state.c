@@ -79,7 +79,12 @@ Test(state, malformed_files_name_line_and_key)
 {
   const char *head = "linewise-state 1\nscene s.ini\nseed 1\nsweep 0\n";
   char buf[512];
-  expect_bad("", ":0:", "header");
+  /* an empty file says so (it was "bad.lw:0: header ... got 'end of file'"),
+  ** and a picture given as a state is named, not printed raw */
+  expect_bad("", "bad.lw: empty file (0 bytes), not a state", "'linewise-state <version>'");
+  expect_bad("\x89PNG\r\n\x1a\n\n", ":1:", "got binary bytes (a PNG picture, not a state)");
+  expect_bad("\xff\xd8\xff\xe0junk\n", ":1:", "got binary bytes (not a state, which is text)");
+  expect_bad("l\xc3\xa4uft 1\n", ":1:", "got 'l\xc3\xa4uft 1'");
   expect_bad("linewise-state 9\n", ":1:", "version");
   expect_bad("linewise-state 1\nscene\n", ":2:", "scene");
   expect_bad("linewise-state 1\nscene s.ini\nseed -4\n", ":3:", "seed");
