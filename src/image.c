@@ -744,8 +744,9 @@ static lw_status jpeg_data_enough(const unsigned char *d, size_t n, const char *
   const unsigned char *seg;
   while (jpeg_segment(d, n, &at, &m, &seg, &sn)) {
     if (m < 0xC0 || m > 0xCF || m == 0xC4 || m == 0xC8 || m == 0xCC) continue;
+    if (sn < 6) return LW_OK; /* the decoder's to refuse */
     const double h = seg[1] << 8 | seg[2], w = seg[3] << 8 | seg[4];
-    const unsigned nc = sn >= 6 ? seg[5] : 0;
+    const unsigned nc = seg[5];
     if (sn < 6 + 3 * (size_t)nc || h == 0) return LW_OK; /* the decoder's to refuse; h = 0: rows told later (DNL) */
     unsigned hmax = 1, vmax = 1;
     for (unsigned c = 0; c < nc; c++) {

@@ -87,7 +87,8 @@ static const char usage[] =
   "  version             the release (also --version, -V)\n"
   "  help                this text\n"
   "\n"
-  "exit status: 0 done, 1 failed while running, 2 bad usage or bad input\n";
+  "exit status: 0 done, 1 failed while running, 2 bad usage or bad input; a run stopped by Ctrl-C ends\n"
+  "by SIGINT once its state is saved (130 in a shell)\n";
 
 static int fail(const lw_error *err)
 {
@@ -236,19 +237,27 @@ static volatile sig_atomic_t on_terminal = 0; /* stderr is one: say what a signa
                                                  ** ends the line a phase or the bar holds */
 
 /* What a second signal says, written before it can come: the handler may
-** only write (it named DIR, not the run's directory). */
+** only write (it named DIR, not the run's directory).  Written again at
+** each checkpoint, with its sweep (how much the stop loses), into the
+** buffer the handler is not reading: which one it reads flips after. */
 #define SECOND_MSG "\nlinewise: a second signal: stopped at once; 'linewise resume DIR' continues from the last " \
                    "checkpoint\n"
-static char second_msg[LW_PATH_MAX + 128] = SECOND_MSG;
-static volatile sig_atomic_t second_len = sizeof SECOND_MSG - 1;
+static char second_msg[2][LW_PATH_MAX + 160] = {SECOND_MSG, SECOND_MSG};
+static volatile sig_atomic_t second_len[2] = {sizeof SECOND_MSG - 1, sizeof SECOND_MSG - 1}, second_at = 0;
 
-static void name_run_dir(const char *dir)
+static void name_checkpoint(const char *dir, long sweep)
 {
-  second_len = 0;
-  int n = snprintf(second_msg, sizeof second_msg, "\nlinewise: a second signal: stopped at once; 'linewise resume "
-                   "%s' continues from the last checkpoint\n", dir);
-  if (n > 0 && (size_t)n < sizeof second_msg) second_len = n;
+  const int b = !second_at;
+  second_len[b] = 0;
+  char when[48] = "the last checkpoint";
+  if (sweep >= 0) snprintf(when, sizeof when, "the checkpoint of sweep %ld", sweep);
+  int n = snprintf(second_msg[b], sizeof second_msg[b], "\nlinewise: a second signal: stopped at once; 'linewise "
+                   "resume %s' continues from %s\n", dir, when);
+  if (n > 0 && (size_t)n < sizeof second_msg[b]) second_len[b] = n;
+  second_at = b;
 }
+
+static void name_run_dir(const char *dir) { name_checkpoint(dir, -1); }
 
 /* A run that has written nothing (lw_phase_unwritten: its set-up, which can
 ** take minutes) ends at the first signal: there is nothing to save.  The
@@ -299,8 +308,9 @@ static void on_signal(int sig)
   if (stop_requested) {
     static const char none[] = "\nlinewise: a second signal: stopped at once, before the run's first checkpoint "
                                "(nothing to resume: run it again)\n";
-    const size_t skip = second_len > 0 && !on_terminal; /* (0: the name did not fit, and nothing is said) */
-    ssize_t w = checkpointed ? write(2, second_msg + skip, (size_t)second_len - skip)
+    const int b = second_at;
+    const size_t skip = second_len[b] > 0 && !on_terminal; /* (0: the name did not fit, and nothing is said) */
+    ssize_t w = checkpointed ? write(2, second_msg[b] + skip, (size_t)second_len[b] - skip)
                              : write(2, none + !on_terminal, sizeof none - 1 - !on_terminal);
     (void)w;
     _exit(128 + sig);
@@ -461,8 +471,10 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   ** of an MPI run stop together, at the sweep where one of them was asked */
   int stopped = ((net ? net->stop_agreed : stop_requested) || (stop_at >= 0 && a->sweep >= stop_at)) &&
                 !lw_anneal_done(a);
+  long named = a->saved;
   while (!stopped && !lw_anneal_done(a)) {
     if (lw_anneal_sweep(a, err)) return loop_fail(a, pg.start_sweep, w, err);
+    if (a->saved != named && a->saved > 0) name_checkpoint(a->dir, (named = a->saved) - 1);
     progress_show(&pg, a, 0);
     stopped = (net ? net->stop_agreed : stop_requested) || (stop_at >= 0 && a->sweep >= stop_at);
   }
@@ -470,13 +482,17 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
 #ifdef LW_MPI
   lw_mpi_report(net, a, quiet);
 #endif
+  /* the checkpoint of the end (lw_anneal_finish's first step) is written
+  ** here, so that a second signal while the files are drawn names it */
+  if (a->saved != a->sweep + 1 && lw_anneal_checkpoint(a, err)) return loop_fail(a, pg.start_sweep, w, err);
+  if (a->saved == a->sweep + 1) name_checkpoint(a->dir, a->sweep);
   if (stopped) {
-    if (lw_anneal_checkpoint(a, err)) return loop_fail(a, pg.start_sweep, w, err);
     watcher_stop(w, LW_PHASE_DONE);
     char mpi[LW_PATH_MAX + 96] = "";
     if (net && net->size > 1)
       snprintf(mpi, sizeof mpi, ", on one process, or over MPI as 'mpirun -n P linewise-mpi resume %s'", a->dir);
-    if (!quiet || (asked && (!net || !net->rank))) /* a log of --quiet runs must tell a stopped one too */
+    /* a log of --quiet runs must tell one a signal stopped too */
+    if (!quiet || (asked && stop_requested && (!net || !net->rank)))
       fprintf(stderr, "linewise: stopped after sweep %ld; state saved in %s/state.lw ('linewise resume %s' "
               "continues%s)\n", a->sweep, a->dir, a->dir, mpi);
     return 0;
@@ -494,7 +510,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   if (s) return loop_fail(a, pg.start_sweep, w, err);
   watcher_stop(w, a->quench.ended == LW_QUENCH_STOPPED ? LW_PHASE_STOPPED : LW_PHASE_DONE);
   if (a->quench.ended == LW_QUENCH_STOPPED) {
-    if (!quiet || (asked && (!net || !net->rank)))
+    if (!quiet || (asked && stop_requested && (!net || !net->rank)))
       fprintf(stderr, "linewise: stopped during the quench (nothing drawn); state saved in %s/state.lw ('linewise resume "
               "%s' quenches again)\n", a->dir, a->dir);
     return 0;
@@ -1086,8 +1102,9 @@ int main(int argc, char **argv)
   /* A Ctrl-C stop, its state saved, ends by the signal itself: a shell runs
   ** a loop on after a child that exits 0 (or 130) on SIGINT, so every run
   ** of an artist's series loop was stopped in turn.  SIGTERM and SIGHUP
-  ** (a batch system's, a lost session's) still end with 0. */
-  if (rc == 0 && stop_requested == SIGINT) {
+  ** (a batch system's, a lost session's) still end with 0, and so does a
+  ** run that a Ctrl-C during its final files let finish (summary.json). */
+  if (rc == 0 && stop_requested == SIGINT && finishing != 2) {
     signal(SIGINT, SIG_DFL);
     raise(SIGINT);
   }

@@ -277,13 +277,13 @@ lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err
       else status = lw_error_set(err, LW_EINPUT, "%s:%ld: a NUL byte inside the line", path, lineno);
     }
     if (len < 0) break;
-    line[strcspn(line, "#")] = '\0';
-    const char *cr = strchr(line, '\r');
+    const char *cr = strchr(line, '\r'); /* before the comment is cut: "0 10 # hot\r150 1" hid its rows */
     if (cr && cr[strspn(cr, "\r\n")]) { /* CR line ends read as one line of many rows */
       status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected LF or CRLF line ends, got a CR inside the line (a "
                             "file of CR line ends, as old Mac OS wrote)", path, lineno);
       break;
     }
+    line[strcspn(line, "#")] = '\0';
     char shown[64], *tok[3];
     snprintf(shown, sizeof shown, "%s", line + strspn(line, " \t"));
     int ntok = split(line, tok);

@@ -161,8 +161,9 @@ Test(cli, energy_of_a_run_whose_scene_was_edited_says_so)
                           "2>err1.txt >e1.txt && sed -i 's/^strain = 10$/strain = 11/' e/scene.ini && %s energy e "
                           "2>err2.txt >e2.txt", dir, lw_test_bin(), lw_test_root(), lw_test_bin(), lw_test_bin()), 0);
   cr_assert_eq(lw_test_sh("cd %s && ! test -s err1.txt && ! cmp -s e1.txt e2.txt && grep -qF 'linewise: note: "
-                          "e/scene.ini: ' err2.txt && grep -qF energy.strain err2.txt && grep -q '(line [0-9]*) edited "
-                          "since the run started; the energy below is of the scene as it reads now' err2.txt", dir),
+                          "e/scene.ini: ' err2.txt && grep -qF energy.strain err2.txt && grep -qF \"(line $(grep -n '^strain = ' "
+                          "e/scene.ini | cut -d: -f1)) edited since the run started; the energy below is of the scene "
+                          "as it reads now\" err2.txt", dir),
                0, "%s", lw_test_slurp("%s/err2.txt", dir));
   /* values refused since 2026-12-05 stay a run's own (its scene.ini as
   ** resume and energy read it): a centre between -1 and 0 */
@@ -745,6 +746,15 @@ Test(cli, a_second_signal_stops_at_once_and_leaves_the_checkpoint)
                           lw_test_bin(), lw_test_root(), dir, dir),
                0);
   cr_assert_eq(lw_test_sh("%s energy %s/w >/dev/null && ! test -e %s/w/summary.json", lw_test_bin(), dir, dir), 0);
+  /* past the first checkpoint it names the one state.lw holds (how much
+  ** the stop loses): sweeps of 0.1 s or more, a checkpoint after each */
+  cr_assert_eq(lw_test_sh("%s run %s/params/whip.ini --out %s/c --quiet --set dynamics.steps_per_sweep=200000 --set "
+                          "output.checkpoint_every=1 --set anneal.sweeps=1000 2>%s/c.err & p=$!; i=0; while [ $i -lt "
+                          "1000 ] && ! grep -q '^sweep = [3-9]' %s/c/state.lw 2>/dev/null; do sleep 0.02; "
+                          "i=$((i+1)); done; kill -INT $p; sleep 0.02; kill -INT $p; wait $p; test $? -eq 130 && "
+                          "grep -q \"continues from the checkpoint of sweep $(sed -n 's/^sweep = //p' %s/c/state.lw)$\" "
+                          "%s/c.err", lw_test_bin(), lw_test_root(), dir, dir, dir, dir, dir),
+               0, "%s", lw_test_slurp("%s/c.err", dir));
 }
 
 /* A hang-up (a terminal or ssh session gone) stops a run as cleanly as

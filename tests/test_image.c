@@ -934,8 +934,9 @@ static void grow_put(void *ctx, void *data, int size)
 }
 
 /* The decoder checks no PNG CRC, and a bit flipped in the compressed
-** pixels mostly decoded to other pixels: each chunk's CRC is checked, every
-** bit of the data and of the header is caught, and a file without its IEND
+** pixels mostly decoded to other pixels: each chunk's CRC is checked, a bit
+** flipped in every seventh byte of the header and data is caught (each byte
+** in a different bit), and a file without its IEND
 ** is cut short; a PNG of width 0 is damaged. */
 Test(image, a_png_with_a_flipped_bit_or_no_end_is_refused)
 {

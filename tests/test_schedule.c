@@ -260,6 +260,8 @@ Test(schedule, table_rejects_malformed_files_with_line_numbers)
     {"0 1\n1\n", 2, "'step temperature'"},
     {"0 1\n\n1 2 3\n", 3, "'step temperature'"},
     {"0 1\r1 0.5\r", 1, "got a CR inside the line"},
+    {"0 10 # hot\r150 1\r", 1, "got a CR inside the line"},
+    {"# step temperature\r0 10\r", 1, "got a CR inside the line"},
     {"0 1x\n", 1, "temperature"},
     {"x1 1\n", 1, "step number"},
     {"0 1\n# again\n0 2\n", 3, "greater than"},

@@ -132,7 +132,7 @@ void lw_anneal_free(lw_anneal *a);
 ** under dynamics". */
 void lw_anneal_key_readers(const lw_param_def *d, char *buf, size_t n);
 
-/* The words text key d takes where they are a fixed list, '|'-separated (the
+/* The words text key d takes where they are a fixed list, '|'- or ", "-separated (the
 ** systems' and schedules' names from their tables; domains' forms), or NULL. */
 const char *lw_anneal_key_values(const lw_param_def *d);
 

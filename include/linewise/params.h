@@ -359,7 +359,8 @@ int lw_params_named(const char *const *patterns, const lw_param_def *d);
 
 /* Writes the Markdown table of docs/PARAMETERS.md, with the scenes that read
 ** each key from read_by (lw_anneal_key_readers), and the words a text key
-** takes from values ('|'-separated, or NULL: any text; lw_anneal_key_values). */
+** takes from values ('|'- or ", "-separated, or NULL: any text;
+** lw_anneal_key_values). */
 void lw_params_write_doc(FILE *f, void (*read_by)(const lw_param_def *d, char *buf, size_t n),
                          const char *(*values)(const lw_param_def *d));
 
