@@ -733,6 +733,23 @@ Test(image_cli, set_replaces_a_missing_picture_and_paths_stay_the_scenes)
   cr_assert(strstr(lw_test_read_text(lw_test_path("b/summary.json")), "\"reference\": \"/"));
 }
 
+/* Under orientation = auto the page turns with the picture: a width and
+** height that disagree are refused with the way round that holds for every
+** picture (no size, or a fixed orientation), not the size this picture
+** turned the page to, which the next picture of a series loop refused. */
+Test(image_cli, a_size_against_a_page_turned_by_the_picture_names_the_orientation)
+{
+  write_picture("wide.png", 60, 40);
+  write_text("s.ini", "[scene]\npreset = photo\npage = a6\nwidth = 105\nheight = 148\nimage = wide.png\n");
+  char errs[4096];
+  cr_assert_eq(run("run s.ini --out a", errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "s.ini:4: key 'scene.width' = 105 mm conflicts with scene.page = a6 (148 x 105 mm, set at "
+                         "s.ini:3, turned to the picture by scene.orientation = auto): expected no width (the page "
+                         "sets it), or scene.orientation = portrait or landscape"), "%s", errs);
+  cr_assert_eq(run("run s.ini --out b --set scene.orientation=portrait --set anneal.sweeps=1", errs, sizeof errs), 0,
+               "%s", errs);
+}
+
 /*
 ** Issue 20: one photo scene for every page.  params/photo.ini (scene.preset
 ** = photo) on A6 and A5, shortened to 40 sweeps: the preset sizes the lines
