@@ -1800,7 +1800,9 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
     /* (a stopped quench stays the phase, which the watcher ends as stopped) */
     if (s || a->quench.ended != LW_QUENCH_STOPPED) lw_phase_set(NULL);
     if (s) return s;
-    if (a->quench.ended == LW_QUENCH_STOPPED) return LW_OK; /* state.lw holds the annealed state: resume quenches again */
+    /* state.lw holds the annealed state: resume quenches again; the time
+    ** spent is kept (a stopped 2-minute quench vanished from the totals) */
+    if (a->quench.ended == LW_QUENCH_STOPPED) return writes_files(a) ? lw_checkpoint_write_timing(a, err) : LW_OK;
     a->quenched = 1;
   }
   lw_phase_set("drawing the final files and scoring them");

@@ -53,7 +53,7 @@ static lw_chain *cell_chain(const lw_chain *c, lw_error *err)
     for (int k = 0; k < c->n_moves; k++)
       dc->cum_weight[k] = k < nd - 1 ? c->cum_weight[k] / c->cum_weight[nd - 1] : 1.0;
   dc->prop = c->sys->type->proposal_new(c->sys->state, err);
-  dc->rng = gsl_rng_alloc(gsl_rng_mt19937);
+  dc->rng = lw_rng_new();
   if (!dc->prop || !dc->rng) {
     lw_chain_free(dc);
     return NULL;

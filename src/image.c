@@ -365,6 +365,11 @@ static lw_status bmp_complete(const unsigned char *d, size_t n, const char *name
   uint32_t offset = le32(d + 10), compression = n >= 34 ? le32(d + 30) : 0;
   int32_t w = (int32_t)le32(d + 18), h = (int32_t)le32(d + 22);
   unsigned bpp = (unsigned)d[28] | (unsigned)d[29] << 8;
+  /* the decoder reads no run-length BMP (ImageMagick writes grey ones so),
+  ** and its "not of any known type" hid why */
+  if (compression == 1 || compression == 2)
+    return lw_error_set(err, LW_EINPUT, "%s: a run-length (RLE%d) BMP, which the decoder does not read: save it "
+                        "uncompressed or as PNG", name, compression == 1 ? 8 : 4);
   if (compression != 0 && compression != 3) return LW_OK;
   double row = 4.0 * floor(((double)bpp * fabs((double)w) + 31) / 32), need = offset + row * fabs((double)h);
   if ((double)n < need)
@@ -380,9 +385,14 @@ static uint32_t be32(const unsigned char *p)
 /* stb_image checks no PNG's CRCs, and a bit flipped inside the compressed
 ** pixels mostly still decodes, to other pixels (9 of 12 random flips drew,
 ** one with tones off by 89/255).  Every chunk carries a CRC-32 of its type
-** and data (zlib's, the PNG one), so each is checked up to IEND, and a file
-** that ends before IEND is cut short.  A fuzzing build skips the CRCs: a
-** fuzzer's mutations would stop here and never reach the decoder. */
+** and data (zlib's, the PNG one): those of the chunks that make the picture
+** are checked -- the critical ones (IHDR, PLTE, IDAT, IEND: an upper-case
+** first letter), tRNS (its transparency) and eXIf (its turn) -- and a file
+** that ends before IEND is cut short.  A damaged text or colour-profile
+** chunk, which nothing here reads, is let pass, as libpng does with a
+** warning: a run begun on such a picture resumes.  A fuzzing build skips
+** the CRCs: a fuzzer's mutations would stop here and never reach the
+** decoder. */
 static lw_status png_chunks_sound(const unsigned char *d, size_t n, const char *name, lw_error *err)
 {
   if (n < 8 || memcmp(d, "\x89PNG\r\n\x1a\n", 8)) return LW_OK;
@@ -398,7 +408,8 @@ static lw_status png_chunks_sound(const unsigned char *d, size_t n, const char *
       return lw_error_set(err, LW_EINPUT, "%s: the PNG is damaged or cut short: its chunk '%s' at byte %zu holds %u "
                           "bytes, the file has %zu after its header", name, type, at, (unsigned)len, n - at - 12);
 #ifndef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
-    if (crc32(crc32(0L, Z_NULL, 0), d + at + 4, (uInt)len + 4) != be32(d + at + 8 + len))
+    const int drawn = !(d[at + 4] & 0x20) || !memcmp(d + at + 4, "tRNS", 4) || !memcmp(d + at + 4, "eXIf", 4);
+    if (drawn && crc32(crc32(0L, Z_NULL, 0), d + at + 4, (uInt)len + 4) != be32(d + at + 8 + len))
       return lw_error_set(err, LW_EINPUT, "%s: the PNG is damaged: its chunk '%s' at byte %zu fails its CRC check",
                           name, type, at);
 #endif
@@ -741,9 +752,15 @@ static lw_status jpeg_data_enough(const unsigned char *d, size_t n, const char *
 {
   size_t at = 0, sn;
   unsigned m;
-  const unsigned char *seg;
-  while (jpeg_segment(d, n, &at, &m, &seg, &sn)) {
-    if (m < 0xC0 || m > 0xCF || m == 0xC4 || m == 0xC8 || m == 0xCC) continue;
+  const unsigned char *seg, *sof = NULL;
+  size_t sof_n = 0;
+  while (jpeg_segment(d, n, &at, &m, &seg, &sn))
+    if (!sof && m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC) sof = seg, sof_n = sn;
+  /* the bytes from the first scan on: an ICC profile or an EXIF thumbnail
+  ** before it (64 KB and more on a phone's photo) hid a cut scan */
+  const size_t data = n - at;
+  if (sof) {
+    seg = sof, sn = sof_n;
     if (sn < 6) return LW_OK; /* the decoder's to refuse */
     const double h = seg[1] << 8 | seg[2], w = seg[3] << 8 | seg[4];
     const unsigned nc = seg[5];
@@ -759,10 +776,10 @@ static lw_status jpeg_data_enough(const unsigned char *d, size_t n, const char *
       unsigned hv = seg[7 + 3 * c];
       blocks += ceil(ceil(w * (hv >> 4) / hmax) / 8) * ceil(ceil(h * (hv & 15) / vmax) / 8);
     }
-    if ((double)n < blocks / 8)
+    if ((double)data < blocks / 8)
       return lw_error_set(err, LW_EINPUT, "%s: the JPEG is damaged or cut short: its %.0f x %.0f pixels take at "
-                          "least %.0f bytes of data, the file has %zu", name, w, h, ceil(blocks / 8), n);
-    return LW_OK;
+                          "least %.0f bytes of coded data, the file has %zu from its first scan on", name, w, h,
+                          ceil(blocks / 8), data);
   }
   return LW_OK;
 }
@@ -779,6 +796,16 @@ static lw_status not_decoded(const unsigned char *data, size_t size, const char 
 {
   const char *why = too_large(data, size, 0, 0, 0), *foreign = foreign_format(data, size);
   if (why) return too_large_error(data, size, name, why, err);
+  size_t at = 0, sn;
+  unsigned m;
+  const unsigned char *seg;
+  while (!strcmp(format_name(data, size), "JPEG") && jpeg_segment(data, size, &at, &m, &seg, &sn))
+    if (m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC && sn >= 5) {
+      const unsigned h = (unsigned)seg[1] << 8 | seg[2], w = (unsigned)seg[3] << 8 | seg[4];
+      if (w && h) break;
+      return lw_error_set(err, LW_EINPUT, "%s: the JPEG's frame says %u x %u pixels: damaged, or rows told after "
+                          "the data (a DNL marker), which the decoder does not read", name, w, h);
+    }
   if (foreign)
     return lw_error_set(err, LW_EINPUT, "%s: %s file, which linewise does not read (PNG, JPEG, GIF, BMP, binary "
                         "PGM/PPM): convert it to PNG or JPEG first", name, foreign);

@@ -179,7 +179,8 @@ static int cmd_energy(int argc, char **argv)
   unsigned long long hash;
   lw_error edited;
   lw_error_clear(&edited);
-  if (st.doc && lw_checkpoint_scene_hash(st.doc, &p, &keys, &hash, &edited) && strstr(edited.msg, "edited since")) {
+  if (st.doc && lw_checkpoint_scene_hash(st.doc, &p, &keys, &hash, &edited) &&
+      (strstr(edited.msg, "edited since") || strstr(edited.msg, "than when the run started"))) {
     char *why = strstr(edited.msg, ": a run resumes with");
     if (why) *why = '\0';
     fprintf(stderr, "linewise: note: %s; the energy below is of the scene as it reads now\n", edited.msg);

@@ -25,7 +25,7 @@ lw_chain *lw_chain_new(lw_system *sys, const double *weight, const double *step,
   c->n_moves = t->n_moves;
   c->delayed = 1;
   c->prop = t->proposal_new(sys->state, err);
-  c->rng = gsl_rng_alloc(gsl_rng_mt19937);
+  c->rng = lw_rng_new();
   if (!c->prop || !c->rng) goto nomem;
   gsl_rng_set(c->rng, seed);
   double acc = 0.0;
@@ -256,6 +256,14 @@ lw_status lw_chain_sweep(lw_chain *c)
     }
   }
   return t->sweep_end ? t->sweep_end(c->sys->state) : LW_OK;
+}
+
+gsl_rng *lw_rng_new(void)
+{
+  gsl_error_handler_t *old = gsl_set_error_handler_off();
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_set_error_handler(old);
+  return r;
 }
 
 char *lw_rng_save(const gsl_rng *r)

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 
 #include "linewise/grid.h"
+#include "linewise/mc.h"
 #include "linewise/params.h"
 #include "linewise/particles_geom.h"
 
@@ -92,7 +93,7 @@ lw_status lw_particles_place(int pattern, size_t count, double size, double nois
     const double lo[3] = {-0.5 * size, -0.5 * size, -0.5 * size}, ext[3] = {size, size, size};
     if (!(g = lw_cellgrid_new3(lo, ext, min_dist, count, err))) return LW_ENOMEM;
   }
-  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng *r = lw_rng_new();
   if (!r) {
     lw_cellgrid_free(g);
     return lw_error_set(err, LW_ENOMEM, "out of memory for the placement's generator");

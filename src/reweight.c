@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/mc.h"
 #include "linewise/series.h"
 
 /* Energies are taken about their mean, so the exponents stay near the
@@ -400,7 +401,7 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
   double *f = malloc((size_t)K * sizeof *f), *fb = malloc((size_t)K * sizeof *fb), *Eb = malloc(n * sizeof *Eb),
          *log_den = malloc(n * sizeof *log_den);
   double *est = calloc((size_t)n_temps * 2, sizeof *est), *sum = calloc((size_t)n_temps * 4, sizeof *sum);
-  gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng *rng = lw_rng_new();
   if (!f || !fb || !Eb || !log_den || !est || !sum || !rng) {
     st = lw_error_set(err, LW_ENOMEM, "out of memory reweighting %zu samples", n);
     goto done;

@@ -256,7 +256,7 @@ static void *state_new(const void *setup, const lw_params *p, unsigned long seed
   }
   size_t n;
   if (lw_init_count(&su->scene, p, &n, err)) return NULL;
-  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng *r = lw_rng_new();
   if (!r) {
     lw_error_set(err, LW_ENOMEM, "out of memory");
     return NULL;

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/mc.h"
+
 lw_tempering *lw_tempering_new(int n, const double *ladder, unsigned long seed, lw_error *err)
 {
   if (n < 2 || n > LW_TEMPERING_MAX) {
@@ -27,7 +29,7 @@ lw_tempering *lw_tempering_new(int n, const double *ladder, unsigned long seed, 
   pt->accepted = calloc((size_t)n, sizeof *pt->accepted);
   pt->win_tried = calloc((size_t)n, sizeof *pt->win_tried);
   pt->win_accepted = calloc((size_t)n, sizeof *pt->win_accepted);
-  pt->rng = gsl_rng_alloc(gsl_rng_mt19937);
+  pt->rng = lw_rng_new();
   if (!pt->ladder || !pt->at || !pt->label || !pt->tried || !pt->accepted || !pt->win_tried ||
       !pt->win_accepted || !pt->rng)
     goto nomem;

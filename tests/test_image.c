@@ -934,7 +934,7 @@ static void grow_put(void *ctx, void *data, int size)
 }
 
 /* The decoder checks no PNG CRC, and a bit flipped in the compressed
-** pixels mostly decoded to other pixels: each chunk's CRC is checked, a bit
+** pixels mostly decoded to other pixels: each drawn chunk's CRC is checked, a bit
 ** flipped in every seventh byte of the header and data is caught (each byte
 ** in a different bit), and a file without its IEND
 ** is cut short; a PNG of width 0 is damaged. */
@@ -966,11 +966,48 @@ Test(image, a_png_with_a_flipped_bit_or_no_end_is_refused)
   cr_assert_null(lw_image_decode(g.b, g.n - 12, "cut.png", 1e6, NULL, &err));
   cr_assert(strstr(err.msg, "cut.png: the PNG is damaged or cut short: it ends at byte"), "%s", err.msg);
   cr_assert(strstr(err.msg, "without its IEND chunk"), "%s", err.msg);
+  /* a damaged text chunk, which nothing reads, passes (a run begun on such
+  ** a picture resumes); a damaged tRNS, which changes what is drawn, not */
+  unsigned char *t = malloc(g.n + 32);
+  cr_assert_not_null(t);
+  static const unsigned char text[] = {0, 0, 0, 5, 't', 'E', 'X', 't', 'a', 0, 'b', 'c', 'd', 0, 0, 0, 0};
+  memcpy(t, g.b, idat);
+  memcpy(t + idat, text, sizeof text);
+  memcpy(t + idat + sizeof text, g.b + idat, g.n - idat);
+  img = lw_image_decode(t, g.n + sizeof text, "text.png", 1e6, NULL, &err);
+  cr_assert_not_null(img, "%s", err.msg);
+  lw_image_free(img);
+  memcpy(t + idat + 4, "tRNS", 4);
+  cr_assert_null(lw_image_decode(t, g.n + sizeof text, "trns.png", 1e6, NULL, &err));
+  cr_assert(strstr(err.msg, "trns.png: the PNG is damaged: its chunk 'tRNS' at byte 33 fails its CRC check"), "%s",
+            err.msg);
+  free(t);
   memset(g.b + 16, 0, 4);
   png_crc_set(g.b + 8);
   cr_assert_null(lw_image_decode(g.b, g.n, "w0.png", 1e6, NULL, &err));
   cr_assert(strstr(err.msg, "w0.png: the PNG is damaged: 0 x 64 pixels"), "%s", err.msg);
   free(g.b);
+}
+
+/* A run-length BMP (ImageMagick writes grey BMPs so) and a JPEG whose
+** frame has a side of 0 were "not of any known type, or corrupt": each is
+** named, with the way round. */
+Test(image, an_rle_bmp_and_a_jpeg_of_side_0_are_named)
+{
+  unsigned char bmp[128] = {'B', 'M'};
+  bmp[10] = 54, bmp[14] = 40, bmp[18] = 4, bmp[22] = 4, bmp[26] = 1, bmp[28] = 8, bmp[30] = 1; /* BI_RLE8 */
+  lw_error err;
+  cr_assert_null(lw_image_decode(bmp, sizeof bmp, "r.bmp", 1e6, NULL, &err));
+  cr_assert(strstr(err.msg, "r.bmp: a run-length (RLE8) BMP, which the decoder does not read: save it uncompressed "
+                            "or as PNG"), "%s", err.msg);
+  unsigned char jpg[8400];
+  size_t n = exif_jpeg(jpg, 0, 0, 0), at = 2;
+  while (at + 9 < n && !(jpg[at] == 0xFF && jpg[at + 1] == 0xC0)) at += 2 + ((size_t)jpg[at + 2] << 8 | jpg[at + 3]);
+  cr_assert(at + 9 < n, "no SOF0");
+  jpg[at + 5] = jpg[at + 6] = 0; /* no rows */
+  cr_assert_null(lw_image_decode(jpg, n, "h0.jpg", 1e6, NULL, &err));
+  cr_assert(strstr(err.msg, "h0.jpg: the JPEG's frame says 32 x 0 pixels: damaged, or rows told after the data"),
+            "%s", err.msg);
 }
 
 /* A JPEG's header claiming 30000 x 30000 grey pixels on 3.7 KB of data
@@ -999,7 +1036,20 @@ Test(image, a_jpeg_header_larger_than_its_data_is_refused)
   g.b[at + 5] = 12000 >> 8, g.b[at + 6] = 12000 & 255;
   cr_assert_null(lw_image_decode(g.b, g.n, "tall.jpg", 1e7, NULL, &err));
   cr_assert(strstr(err.msg, "tall.jpg: the JPEG is damaged or cut short: its 1024 x 12000 pixels take at least "
-                   "36000 bytes of data, the file has "), "%s", err.msg);
+                   "36000 bytes of coded data, the file has "), "%s", err.msg);
+  /* the bound is on the bytes from the first scan: a 60 KB colour profile
+  ** (APP2) before it does not count (it hid a cut scan) */
+  const size_t app = 60000;
+  unsigned char *big = malloc(g.n + app);
+  cr_assert_not_null(big);
+  memcpy(big, g.b, 2);
+  big[2] = 0xFF, big[3] = 0xE2, big[4] = (unsigned char)((app - 2) >> 8), big[5] = (unsigned char)((app - 2) & 255);
+  memset(big + 6, 'p', app - 4);
+  memcpy(big + 2 + app, g.b + 2, g.n - 2);
+  cr_assert_null(lw_image_decode(big, g.n + app, "icc.jpg", 1e7, NULL, &err));
+  cr_assert(strstr(err.msg, "icc.jpg: the JPEG is damaged or cut short: its 1024 x 12000 pixels take at least "
+                   "36000 bytes of coded data, the file has "), "%s", err.msg);
+  free(big);
   free(g.b);
 }
 

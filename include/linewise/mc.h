@@ -97,6 +97,11 @@ void lw_chain_tune(lw_chain *c);
 ** LW_ENOMEM if a commit could not grow the system's caches. */
 lw_status lw_chain_sweep(lw_chain *c);
 
+/* An MT19937 generator, or NULL when memory runs out: gsl_rng_alloc's
+** default error handler aborts the process there (a set-up under a memory
+** limit ended in "Default GSL error handler invoked" and a core dump). */
+gsl_rng *lw_rng_new(void);
+
 /* A generator's state as hex text (malloc'ed) and back, for checkpoints;
 ** load returns 0 if the text does not fit the generator. */
 char *lw_rng_save(const gsl_rng *r);
