@@ -812,8 +812,8 @@ Test(quench, a_signal_stops_a_quench_under_way, .init = qsetup, .fini = qteardow
 {
   /* the quench's second before the signal counts in timing.txt (a stopped
   ** quench's time was lost: the file held the last checkpoint's) */
-  int rc = lw_test_sh("t0=$(date +%%s.%%N); %s run %s/params/example.ini --set anneal.sweeps=1 --set anneal.quench=bfgs "
-                      "--out %s/r 2> %s/err.txt & p=$!; i=0; while [ $i -lt 600 ] && "
+  int rc = lw_test_sh("t0=$(date +%%s.%%N); %s run %s/params/example.ini --set anneal.sweeps=1 --set "
+                      "anneal.quench=bfgs --out %s/r 2> %s/err.txt & p=$!; i=0; while [ $i -lt 600 ] && "
                       "! grep -q 'quenching' %s/err.txt 2>/dev/null; do sleep 0.1; i=$((i+1)); done; sleep 1; "
                       "t1=$(date +%%s.%%N); kill -INT $p; wait $p; test $? -eq 130 && awk -v t=\"$t0\" -v u=\"$t1\" "
                       "'/^wall_seconds/ { ok = $2 >= u - t - 0.3 } END { exit !ok }' %s/r/timing.txt",
