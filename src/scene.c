@@ -157,17 +157,18 @@ static void dark_note(lw_scene *sc, const lw_params *p)
 ** mm, drew no line, and was blamed on a pale picture; 4000 x 30 drew 7
 ** strokes in a row and scored SSIM 0.79.  Said before the run where the
 ** placed picture is narrower than two segments (about the least room a
-** curve needs to bend in). */
-static void thin_note(lw_scene *sc, const lw_params *p)
+** curve needs to bend in).  A mask picture's strip is the most room its
+** inside has (its empty drawing was blamed on the price of line). */
+static void thin_note(lw_scene *sc, const lw_params *p, const char *key, const lw_image *img,
+                      const lw_image_place *pl)
 {
-  if (!sc->on[LW_TERM_TONE] && !(sc->on[LW_TERM_POTENTIAL] && p->potential == LW_POT_IMAGE)) return;
-  const double w = sc->image->width * sc->image_place.pixel, h = sc->image->height * sc->image_place.pixel;
+  const double w = img->width * pl->pixel, h = img->height * pl->pixel;
   if (fmin(w, h) >= 2.0 * p->segment_length) return;
   size_t used = strlen(sc->note);
-  snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image: the %d x %d picture keeps its shape, so it lies on "
+  snprintf(sc->note + used, sizeof sc->note - used, "%sscene.%s: the %d x %d picture keeps its shape, so it lies on "
            "the page as %.3g x %.3g mm, narrower than two segments (init.segment_length %g mm): few lines or none fit "
            "there; a crop of the picture to a less narrow shape gives it room, and so do shorter segments",
-           used ? "; " : "", sc->image->width, sc->image->height, w, h, p->segment_length);
+           used ? "; " : "", key, img->width, img->height, w, h, p->segment_length);
 }
 
 /* The picture pipeline after loading: resize, blur, flattening, levels, tone curve. */
@@ -259,6 +260,7 @@ static lw_status build_mask(lw_scene *sc, const lw_params *p, lw_error *err)
     if (st) return st;
     img = own = load_picture(sc, p, "scene", "mask_image", p->mask_image, &pl, err);
     if (!own) return err->code;
+    thin_note(sc, p, "mask_image", img, &pl);
   }
   size_t n = (size_t)img->width * (size_t)img->height;
   unsigned char *inside = malloc(n);
@@ -695,7 +697,9 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     return bad_key(p, "scene", "mask", LW_EINPUT, err, "a mask needs scene.boundary = mask");
   b->slope = b->kind == LW_BOUNDARY_MASK ? lw_boundary_mask_slope(b->sdt) : 1.0;
   b->clearance = p->boundary_clearance;
-  if (sc->image) dark_note(sc, p), thin_note(sc, p);
+  if (sc->image) dark_note(sc, p);
+  if (sc->image && (sc->on[LW_TERM_TONE] || (sc->on[LW_TERM_POTENTIAL] && p->potential == LW_POT_IMAGE)))
+    thin_note(sc, p, "image", sc->image, &sc->image_place);
   return build_layers(sc, p, err);
 }
 

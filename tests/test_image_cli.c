@@ -556,6 +556,15 @@ Test(image_cli, a_picture_placed_as_a_thin_strip_gets_a_note)
     cr_assert_eq(at != NULL, cases[k].noted, "%s %s: %s", cases[k].picture, cases[k].keys, sc.note);
     lw_scene_clear(&sc);
   }
+  /* a mask picture's strip is all the room its inside has (its empty
+  ** drawing was blamed on the price of line) */
+  for (int k = 0; k < 400 * 3; k++) g[k] = 0.2f;
+  lw_test_png(lw_test_path("dark-strip.png"), 400, 3, g, NULL);
+  lw_scene sc;
+  picture_scene("frame.png", "[scene]\nboundary = mask\nmask = image\nmask_image = dark-strip.png\n", &sc);
+  cr_assert(strstr(sc.note, "scene.mask_image: the 400 x 3 picture keeps its shape, so it lies on the page as 40 x "
+                            "0.3 mm, narrower than two segments"), "%s", sc.note);
+  lw_scene_clear(&sc);
 }
 
 /* scene.image_flatten reaches the picture in millimetres on the page: a
