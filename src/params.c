@@ -23,6 +23,7 @@
 #include "linewise/output.h"
 #include "linewise/plotter.h"
 #include "linewise/quad.h"
+#include "linewise/rundir.h"
 #include "linewise/schedule.h"
 #include "linewise/state.h"
 
@@ -131,7 +132,9 @@ const lw_param_def lw_param_table[] = {
       "between the nodes\"). The photo preset sets 1.5 pen widths. 0 = none."),
   CHOICE("scene", "field", field, "constant", "constant|radial|vortex|waves|etf|gradient",
          "Vector field v read by the field term (unit length): constant along `field_angle`, "
-         "radial from the centre, vortex around it, waves tangent to y = A sin(2 pi x / wavelength), "
+         "radial from the centre, vortex around it (v = (-(y - cy), x - cx) / r: clockwise as seen on "
+         "the page, whose y points down; both fall to 0 within `field_core` of the centre), waves "
+         "tangent to y = A sin(2 pi x / wavelength) (x from the page's left edge), "
          "etf (the picture's edge tangent flow: along edges and isophotes; needs field_mode = axial) "
          "or gradient (the picture's tone gradient, toward lighter tone). "
          "Built only when [energy] field is non-zero."),
@@ -178,7 +181,7 @@ const lw_param_def lw_param_table[] = {
       "nanometre: the bending term's powers of shorter lengths leave the range of doubles."),
   STRING("init", "from", from, "", "path",
          "A state.lw to start from instead of random placement (relative to the scene file)."),
-  NUM("energy", "strain", LW_PT_DOUBLE, strain, "0", "energy", 0, 1e12, 0,
+  NUM("energy", "strain", LW_PT_DOUBLE, strain, "0", "energy / mm", 0, 1e12, 0,
       "S: strain S (L - L0)^2 / L0^2 * L keeps each spline's length near L0. 0 = off."),
   CHOICE("energy", "strain_mode", strain_mode, "spline", "spline|segment",
          "Strain per spline (L = whole length) or per segment (each segment against L0/n)."),
@@ -244,9 +247,10 @@ const lw_param_def lw_param_table[] = {
       "6e-4 of 32 nodes' (docs/ACCURACY.md). The photo preset sets the fewest that are that "
       "close."),
   NUM("energy", "tone", LW_PT_DOUBLE, tone, "0", "energy / mm^2", 0, 1e12, 0,
-      "T: tone T * sum over pixels of A (G * ink - darkness)^2: the lines, as ink of "
-      "output.pen_width, blurred by a Gaussian of `tone_blur` and compared with the picture's "
-      "darkness (1 - tone) pixel by pixel (A = pixel area; the pixels are the picture's, or "
+      "T: tone T * sum over pixels of A (G * ink - tone_ink * G * darkness)^2: the lines, as ink "
+      "of output.pen_width, blurred by a Gaussian G of `tone_blur` and compared pixel by pixel "
+      "with the picture's darkness (1 - tone) blurred the same way (A = pixel area; the pixels "
+      "are the picture's, or "
       "blocks of them up to tone_blur / 1.5 wide). Unlike the potential it saturates: "
       "lines stop gathering once a place is as dark as the picture. Needs scene.image "
       "(docs/NUMERICS.md). 0 = off."),
@@ -696,8 +700,9 @@ const lw_param_def lw_param_table[] = {
   NUM("dynamics", "steps_per_sweep", LW_PT_INT, dyn_steps_per_sweep, "1", "", 1, 1e9, 0,
       "Time steps per sweep of the run loop (trace, frames and checkpoints count sweeps)."),
   NUM("dynamics", "gravity_x", LW_PT_DOUBLE, dyn_gravity_x, "0", "mm/s^2", -1e12, 1e12, 0,
-      "x of the gravity g acting on the line density: energy -rho int g.r dl (the load term; the "
-      "particles' gravity is particles.gravity)."),
+      "x of the gravity g acting on the line density: energy -rho int g.r dl along a spline (the "
+      "load term), -int mu g.c du over a D-NURBS curve's parameter (docs/NUMERICS.md, \"D-NURBS\"); "
+      "the particles' gravity is particles.gravity."),
   NUM("dynamics", "gravity_y", LW_PT_DOUBLE, dyn_gravity_y, "0", "mm/s^2", -1e12, 1e12, 0,
       "y of g (for splines y points down the page: 9810 is the Earth's gravity on a page held upright; "
       "a D-NURBS curve's y points up, as nurbs.points: there -9810, in its own length unit)."),
@@ -1072,6 +1077,8 @@ static char *read_line(char *str, int num, void *stream)
     rc->failed = 1;
     return NULL;
   }
+  if (rc->line == 1 && !strncmp(rc->buf, LW_RUN_SCENE_HEADER, strlen(LW_RUN_SCENE_HEADER)))
+    rc->p->run_written = rc->p->of_run;
   /* inih would end the value at a NUL byte and drop the rest unseen */
   if (memchr(rc->buf, '\0', (size_t)len)) {
     lw_error_set(rc->err, LW_EINPUT, "%s:%d: a NUL byte inside the line (UTF-16 text, as some editors save "
@@ -1147,6 +1154,7 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
 {
   lw_params_defaults(p);
   p->of_run = of_run;
+  p->run_written = 0;
   if (lw_number_locale_ok(err)) return err->code;
   /* a path cut to fit would name another file in every message */
   if (strlen(path) >= sizeof p->file)

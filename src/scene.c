@@ -611,8 +611,9 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     lw_field *f = &sc->field;
     f->cx = cx;
     f->cy = cy;
-    /* a run begun before 2026-12-05 has no line for it: no core, as it ran */
-    const int before = p->of_run && !p->line[lw_params_find("scene", "field_core") - lw_param_table];
+    /* a run begun before 2026-12-05 has no line for it: no core, as it ran
+    ** (a scene.ini written by hand beside a state takes the default) */
+    const int before = p->run_written && !p->line[lw_params_find("scene", "field_core") - lw_param_table];
     f->core = before ? 0.0 : p->field_core < 0.0 ? p->segment_length : p->field_core;
     f->ux = cos(p->field_angle * DEG);
     f->uy = sin(p->field_angle * DEG);

@@ -266,6 +266,8 @@ typedef struct {
   char file[LW_PATH_MAX];
   int line[LW_PARAM_MAX];
   int of_run;                 /* read from a run's scene.ini (lw_params_read_run) */
+  int run_written;            /* and that file's first line is a run's header (LW_RUN_SCENE_HEADER):
+                              ** linewise wrote it, not a hand beside a hand-made state */
 } lw_params;
 
 /* Fills p with every default. */
