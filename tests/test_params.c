@@ -8,6 +8,7 @@
 
 #include "linewise/anneal.h"
 #include "linewise/params.h"
+#include "linewise/rundir.h"
 #include "linewise/scene.h"
 #include "linewise/schedule.h"
 #include "linewise/system.h"
@@ -532,30 +533,36 @@ Test(params, a_key_is_given_only_with_a_value_of_its_own)
 }
 
 /* scene.field_core: -1 is init.segment_length, and a run's scene.ini
-** written before the key existed (no line for it) keeps the unit field it
-** ran with, so that its energies, and its resume, are what they were; a
-** value below 0 but -1 is refused. */
+** written before the key existed (its header, no line for the key) keeps
+** the unit field it ran with, so that its energies, and its resume, are
+** what they were; a scene.ini written by hand beside a state (no header)
+** takes the default; a value below 0 but -1 is refused. */
 Test(params, a_field_core_of_a_run_begun_before_it_is_none)
 {
   char path[] = "/tmp/lw_params_core_XXXXXX";
   int fd = mkstemp(path);
-  FILE *f = fdopen(fd, "w");
-  fputs("[scene]\nfield = vortex\n[energy]\nfield = -1\n[init]\nsegment_length = 6\n", f);
-  fclose(f);
+  cr_assert_geq(fd, 0);
+  close(fd);
+  static const char body[] = "[scene]\nfield = vortex\n[energy]\nfield = -1\n[init]\nsegment_length = 6\n";
+  static const struct { int header, run; const char *more; double core; } cases[] = {
+    {0, 0, "", 6.0},                            /* a new scene */
+    {1, 1, "", 0.0},                            /* a run's of before the key */
+    {0, 1, "", 6.0},                            /* a hand-made one beside a state */
+    {1, 1, "[scene]\nfield_core = 2.5\n", 2.5}, /* a run's with the line */
+  };
   lw_params p;
   lw_scene sc;
   lw_error err;
-  const double want[3] = {6.0, 0.0, 2.5}; /* a new scene; a run's without the line; a run's with one */
-  for (int k = 0; k < 3; k++) {
-    cr_assert_eq(k ? lw_params_read_run(&p, path, 1, &err) : lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    FILE *f = fopen(path, "w");
+    cr_assert_not_null(f);
+    fprintf(f, "%s%s%s", cases[k].header ? LW_RUN_SCENE_HEADER "\n" : "", body, cases[k].more);
+    fclose(f);
+    cr_assert_eq(cases[k].run ? lw_params_read_run(&p, path, 1, &err) : lw_params_read(&p, path, &err), LW_OK,
+                 "%s", err.msg);
     cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
-    cr_assert_eq(sc.field.core, want[k], "case %d: core %g", k, sc.field.core);
+    cr_assert_eq(sc.field.core, cases[k].core, "case %zu: core %g", k, sc.field.core);
     lw_scene_clear(&sc);
-    if (k == 1) {
-      f = fopen(path, "a");
-      fputs("[scene]\nfield_core = 2.5\n", f);
-      fclose(f);
-    }
   }
   cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(lw_params_set(&p, "scene.field_core=-0.5", &err), LW_OK, "%s", err.msg);
