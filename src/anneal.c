@@ -217,12 +217,13 @@ static double rung_energy(const lw_anneal *a, int k)
 
 double lw_anneal_energy(const lw_anneal *a) { return rung_energy(a, 0); }
 
-/* The files a run writes, and their temporaries.  A run into a directory
-** that held one removes the old run's first: a final.gcode or a replica
-** state of another run beside the new drawing would be taken for its own. */
-static const char *const run_files[] = {"scene.ini",  "state.lw",  "trace.csv",  "summary.json", "timing.txt",
-                                        "ladder.ini", "field.png", "final.svg",  "final.png",    "final.pdf",
-                                        "final.hpgl", "final.gcode", "final.ply"};
+/* The files a run writes, and their temporaries, and the film
+** tools/animate.sh makes of its frames.  A run into a directory that held
+** one removes the old run's first: a final.gcode, a replica state or a
+** film of another run beside the new drawing would be taken for its own. */
+static const char *const run_files[] = {"scene.ini",   "state.lw",  "trace.csv", "summary.json", "timing.txt",
+                                        "ladder.ini",  "field.png", "final.svg", "final.png",    "final.pdf",
+                                        "final.hpgl",  "final.gcode", "final.ply", "animation.mp4"};
 
 /* Whether name is prefix + digits + suffix, or that + ".tmp" (a write cut off). */
 static int numbered(const char *name, const char *prefix, const char *suffix)

@@ -52,18 +52,37 @@ static int depth_cmp(const void *pa, const void *pb)
   return (a->i > b->i) - (a->i < b->i);
 }
 
-/* Paints the particles onto cr, a size x size picture. */
-static void paint(cairo_t *cr, const lw_particles *p, const depth_key *order, int size)
+/* The frames' view, the same for every frame of a run (and of its
+** resumes): the set-up's grid box, what the pattern, the points and a
+** sphere boundary reach at the start (docs/NURBS.md's frames are fixed
+** likewise), with a floor below.  Fitted to each state, a film showed
+** neither the drape's fall into its bowl nor a sheet's growth in its
+** sphere; particles that leave the box leave the picture. */
+static void frame_box(const lw_particles_setup *s, double lo[3], double hi[3])
+{
+  for (int k = 0; k < 3; k++) lo[k] = s->lo[k], hi[k] = s->lo[k] + s->extent[k];
+  if (s->boundary == LW_PBOUNDARY_PLANE) lo[2] = fmin(lo[2], s->boundary_z);
+}
+
+/* Paints the particles onto cr, a size x size picture: fitted to them, or
+** in the frames' fixed view (frame_box). */
+static void paint(cairo_t *cr, const lw_particles *p, const depth_key *order, int size, int fixed)
 {
   const lw_particles_setup *s = p->setup;
   double e1[3], e2[3], light[3];
   screen_axes(s->view, e1, e2);
   for (int k = 0; k < 3; k++) light[k] = s->view[k] + 0.5 * e2[k] + 0.3 * e1[k];
   normalise(light);
-  /* fit the projected particles (and their discs) into the picture */
-  double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-  for (size_t i = 0; i < p->n; i++) {
-    double u = lw_v3_dot(p->x + 3 * i, e1), w = lw_v3_dot(p->x + 3 * i, e2);
+  /* fit the projected particles (and their discs), or the box's corners, into the picture */
+  double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY}, blo[3], bhi[3];
+  if (fixed) frame_box(s, blo, bhi);
+  const size_t points = fixed ? 8 : p->n;
+  for (size_t i = 0; i < points; i++) {
+    double corner[3];
+    if (fixed)
+      for (int k = 0; k < 3; k++) corner[k] = (i >> k) & 1 ? bhi[k] : blo[k];
+    const double *x = fixed ? corner : p->x + 3 * i;
+    double u = lw_v3_dot(x, e1), w = lw_v3_dot(x, e2);
     lo[0] = fmin(lo[0], u);
     hi[0] = fmax(hi[0], u);
     lo[1] = fmin(lo[1], w);
@@ -97,7 +116,7 @@ static void paint(cairo_t *cr, const lw_particles *p, const depth_key *order, in
   }
 }
 
-lw_status lw_particles_write_png(const lw_particles *p, const char *path, lw_error *err)
+lw_status lw_particles_write_png(const lw_particles *p, const char *path, int frame, lw_error *err)
 {
   const lw_particles_setup *s = p->setup;
   int size = s->png_size;
@@ -112,7 +131,7 @@ lw_status lw_particles_write_png(const lw_particles *p, const char *path, lw_err
     st = lw_error_set(err, LW_ENOMEM, "%s: cannot create a %d x %d picture", path, size, size);
     goto done;
   }
-  paint(cr, p, order, size);
+  paint(cr, p, order, size, frame);
   cairo_surface_flush(surf);
   if (cairo_status(cr)) {
     st = lw_error_set(err, LW_ERUN, "%s: drawing the preview failed: %s", path, cairo_status_to_string(cairo_status(cr)));
@@ -134,5 +153,5 @@ lw_status lw_particles_draw(const lw_particles *p, const char *dir, lw_error *er
   lw_status s = lw_particles_write_ply(p, path, err);
   if (s) return s;
   snprintf(path, sizeof path, "%s/final.png", dir);
-  return lw_particles_write_png(p, path, err);
+  return lw_particles_write_png(p, path, 0, err);
 }

@@ -389,7 +389,7 @@ static lw_status draw(void *state, const lw_params *p, const char *dir, long swe
     return lw_error_set(err, LW_EIO, "%s: path too long for the frames", dir);
   if (mkdir(path, 0777) && errno != EEXIST) return lw_error_set(err, LW_EIO, "%s: %s", path, strerror(errno));
   snprintf(path + n, sizeof path - (size_t)n, "/frame-%06ld.png", sweep);
-  return lw_particles_write_png(state, path, err);
+  return lw_particles_write_png(state, path, 1, err);
 }
 
 static size_t pinned(const lw_particles *p)

@@ -872,8 +872,9 @@ Test(cli, a_run_without_out_never_replaces_another)
 }
 
 /* A run into a directory that held another leaves none of the old run's
-** files: its machine files, replica states, frames and samples would be
-** taken for the new run's.  What the user put there stays. */
+** files: its machine files, replica states, frames, samples and the film
+** tools/animate.sh made would be taken for the new run's.  What the user
+** put there stays. */
 Test(cli, a_run_replacing_another_removes_the_files_it_does_not_write_again)
 {
   write_file("s.ini", scene_text);
@@ -881,7 +882,8 @@ Test(cli, a_run_replacing_another_removes_the_files_it_does_not_write_again)
   cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --quiet --out r --set anneal.sweeps=4 --set tempering.replicas=2 "
                           "--set tempering.t_max=2 --set output.gcode=1 --set output.hpgl=1 --set output.pdf=1 "
                           "--set output.frames_every=2 --set output.samples_every=2 && echo mine > r/notes.txt && "
-                          "echo mine > r/frames/keep.txt && touch r/state.lw.tmp && test -f r/replica-1.lw && "
+                          "echo mine > r/frames/keep.txt && touch r/state.lw.tmp r/animation.mp4 && "
+                          "test -f r/replica-1.lw && "
                           "test -f r/final.gcode && test -f r/frames/frame-000002.png && "
                           "test -f r/samples/sample-000002.csv",
                           dir, b),
@@ -890,7 +892,8 @@ Test(cli, a_run_replacing_another_removes_the_files_it_does_not_write_again)
   cr_assert_eq(lw_test_sh("cd %s/r && test -f final.svg && test -f summary.json && ! test -e replica-1.lw && "
                           "! test -e final.gcode && ! test -e final.hpgl && ! test -e final.pdf && "
                           "! test -e ladder.ini && ! test -e samples && ! test -e state.lw.tmp && "
-                          "! test -e frames/frame-000002.png && test \"$(cat notes.txt frames/keep.txt)\" = "
+                          "! test -e frames/frame-000002.png && ! test -e animation.mp4 && "
+                          "test \"$(cat notes.txt frames/keep.txt)\" = "
                           "\"$(printf 'mine\\nmine')\"",
                           dir),
                0, "the old run's files stay, or the user's went");

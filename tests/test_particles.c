@@ -1205,9 +1205,22 @@ Test(particles, final_ply_and_final_png)
   prm.pt_view_elevation = -90;
   s = setup_of(&prm);
   p = lw_particles_new(s, 3, NULL, NULL);
-  cr_assert_eq(lw_particles_write_png(p, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_particles_write_png(p, path, 0, &err), LW_OK, "%s", err.msg);
   centre_colour(path, 200, &red, &blue);
   cr_assert(red > 0.5 && blue < 0.4, "the back of the sheet is orange (%g, %g)", red, blue);
+  /* frames keep one view for the run (the set-up's box): the sheet moved
+  ** aside moves in a frame, while final.png fits it again (a film of the
+  ** drape showed no fall) */
+  char moved[160], still[160];
+  snprintf(moved, sizeof moved, "%s/moved.png", dir);
+  snprintf(still, sizeof still, "%s/still.png", dir);
+  cr_assert_eq(lw_particles_write_png(p, still, 1, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_particles_write_png(p, path, 0, &err), LW_OK, "%s", err.msg);
+  for (size_t i = 0; i < p->n; i++) p->x[3 * i] += 0.5 * s->size; /* (across the view from below) */
+  cr_assert_eq(lw_particles_write_png(p, moved, 1, &err), LW_OK, "%s", err.msg);
+  cr_assert_neq(lw_test_sh("cmp -s %s %s", moved, still), 0, "a frame followed the particles");
+  cr_assert_eq(lw_particles_write_png(p, moved, 0, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_test_sh("cmp -s %s %s", moved, path), 0, "final.png is fitted to the particles");
   /* a directory that does not exist: an error, not a crash */
   cr_assert_eq(lw_particles_draw(p, "/nonexistent/dir", &err), LW_EIO);
   lw_particles_free(p);

@@ -15,7 +15,9 @@
 ** ties by index), shaded 0.35 + 0.65 |n.L| for a light L above and to the
 ** right of the viewer; discs seen from the front (n.v >= 0) are blue, from
 ** the back orange, pinned ones outlined in dark red.  The picture is
-** png_size pixels square, the projected particles fitted with a margin.
+** png_size pixels square, the projected particles fitted with a margin; a
+** frame (frame = 1) in a view fixed for the run instead: the set-up's grid
+** box (the start's pattern and points, a sphere boundary) and a floor.
 **
 ** Both files are written to "<path>.tmp" and renamed (output.h), so a reader
 ** never sees half a file.
@@ -26,7 +28,7 @@
 #include "linewise/particles.h"
 
 lw_status lw_particles_write_ply(const lw_particles *p, const char *path, lw_error *err);
-lw_status lw_particles_write_png(const lw_particles *p, const char *path, lw_error *err);
+lw_status lw_particles_write_png(const lw_particles *p, const char *path, int frame, lw_error *err);
 
 /* dir/final.ply and dir/final.png. */
 lw_status lw_particles_draw(const lw_particles *p, const char *dir, lw_error *err);
