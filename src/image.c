@@ -385,14 +385,23 @@ static uint32_t be32(const unsigned char *p)
 /* stb_image checks no PNG's CRCs, and a bit flipped inside the compressed
 ** pixels mostly still decodes, to other pixels (9 of 12 random flips drew,
 ** one with tones off by 89/255).  Every chunk carries a CRC-32 of its type
-** and data (zlib's, the PNG one): those of the chunks that make the picture
-** are checked -- the critical ones (IHDR, PLTE, IDAT, IEND: an upper-case
-** first letter), tRNS (its transparency) and eXIf (its turn) -- and a file
-** that ends before IEND is cut short.  A damaged text or colour-profile
-** chunk, which nothing here reads, is let pass, as libpng does with a
-** warning: a run begun on such a picture resumes.  A fuzzing build skips
-** the CRCs: a fuzzer's mutations would stop here and never reach the
-** decoder. */
+** and data (zlib's, the PNG one), and every one is checked, but for the
+** chunks known to change nothing drawn (text, colour profile and gamma,
+** which nothing here reads; APNG's later frames), which pass damaged as
+** libpng lets them: a run begun on such a picture resumes.  Judged by a
+** list of harmless names, not by the type's ancillary bit, which a flipped
+** bit can set (a tRNS read as "tRnS" dropped the transparency unseen).  A
+** file that ends before IEND is cut short.  A fuzzing build skips the
+** CRCs: a fuzzer's mutations would stop here and never reach the decoder. */
+static int png_chunk_harmless(const unsigned char *type)
+{
+  static const char names[][5] = {"tEXt", "zTXt", "iTXt", "iCCP", "gAMA", "cHRM", "sRGB", "sBIT", "bKGD", "hIST",
+                                  "pHYs", "sPLT", "tIME", "acTL", "fcTL", "fdAT", "oFFs", "pCAL", "sCAL", "sTER"};
+  for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
+    if (!memcmp(type, names[k], 4)) return 1;
+  return 0;
+}
+
 static lw_status png_chunks_sound(const unsigned char *d, size_t n, const char *name, lw_error *err)
 {
   if (n < 8 || memcmp(d, "\x89PNG\r\n\x1a\n", 8)) return LW_OK;
@@ -408,8 +417,7 @@ static lw_status png_chunks_sound(const unsigned char *d, size_t n, const char *
       return lw_error_set(err, LW_EINPUT, "%s: the PNG is damaged or cut short: its chunk '%s' at byte %zu holds %u "
                           "bytes, the file has %zu after its header", name, type, at, (unsigned)len, n - at - 12);
 #ifndef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
-    const int drawn = !(d[at + 4] & 0x20) || !memcmp(d + at + 4, "tRNS", 4) || !memcmp(d + at + 4, "eXIf", 4);
-    if (drawn && crc32(crc32(0L, Z_NULL, 0), d + at + 4, (uInt)len + 4) != be32(d + at + 8 + len))
+    if (!png_chunk_harmless(d + at + 4) && crc32(crc32(0L, Z_NULL, 0), d + at + 4, (uInt)len + 4) != be32(d + at + 8 + len))
       return lw_error_set(err, LW_EINPUT, "%s: the PNG is damaged: its chunk '%s' at byte %zu fails its CRC check",
                           name, type, at);
 #endif
@@ -803,8 +811,8 @@ static lw_status not_decoded(const unsigned char *data, size_t size, const char 
     if (m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC && sn >= 5) {
       const unsigned h = (unsigned)seg[1] << 8 | seg[2], w = (unsigned)seg[3] << 8 | seg[4];
       if (w && h) break;
-      return lw_error_set(err, LW_EINPUT, "%s: the JPEG's frame says %u x %u pixels: damaged, or rows told after "
-                          "the data (a DNL marker), which the decoder does not read", name, w, h);
+      return lw_error_set(err, LW_EINPUT, "%s: the JPEG's frame says %u x %u pixels: damaged%s", name, w, h,
+                          w ? ", or rows told after the data (a DNL marker), which the decoder does not read" : "");
     }
   if (foreign)
     return lw_error_set(err, LW_EINPUT, "%s: %s file, which linewise does not read (PNG, JPEG, GIF, BMP, binary "
@@ -854,6 +862,9 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
                          : (void *)stbi_load_from_memory(data, (int)size, &w, &h, &ch, 0);
   if (!pix) {
     const char *why = stbi_failure_reason();
+    if (why && why != before && (!strcmp(why, "outofmem") || !strcmp(why, "Out of memory")))
+      return lw_error_set(err, LW_ENOMEM, "%s: out of memory decoding the %s (%d x %d pixels)", name,
+                          format_name(data, size), w, h);
     return lw_error_set(err, LW_EINPUT, "%s: the %s is damaged or cut short: it does not decode%s%s%s", name,
                         format_name(data, size), why && why != before ? " (" : "", why && why != before ? why : "",
                         why && why != before ? ")" : "");

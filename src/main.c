@@ -492,8 +492,9 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     char mpi[LW_PATH_MAX + 96] = "";
     if (net && net->size > 1)
       snprintf(mpi, sizeof mpi, ", on one process, or over MPI as 'mpirun -n P linewise-mpi resume %s'", a->dir);
-    /* a log of --quiet runs must tell one a signal stopped too */
-    if (!quiet || (asked && stop_requested && (!net || !net->rank)))
+    /* a log of --quiet runs must tell one a signal stopped too (under MPI
+    ** the first process says it, whichever process the signal reached) */
+    if (!quiet || (asked && (net ? net->stop_agreed && !net->rank : stop_requested)))
       fprintf(stderr, "linewise: stopped after sweep %ld; state saved in %s/state.lw ('linewise resume %s' "
               "continues%s)\n", a->sweep, a->dir, a->dir, mpi);
     return 0;
@@ -511,7 +512,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   if (s) return loop_fail(a, pg.start_sweep, w, err);
   watcher_stop(w, a->quench.ended == LW_QUENCH_STOPPED ? LW_PHASE_STOPPED : LW_PHASE_DONE);
   if (a->quench.ended == LW_QUENCH_STOPPED) {
-    if (!quiet || (asked && stop_requested && (!net || !net->rank)))
+    if (!quiet || (asked && (net ? !net->rank : 1)))
       fprintf(stderr, "linewise: stopped during the quench (nothing drawn); state saved in %s/state.lw ('linewise resume "
               "%s' quenches again)\n", a->dir, a->dir);
     return 0;

@@ -1410,14 +1410,19 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
         lw_params_origin(p, dp, where_page, sizeof where_page);
         char page_name[16];
         choice_name(dp->choices, p->page, page_name, sizeof page_name);
-        /* under orientation = auto the size turns with each picture: a
-        ** fixed size to give would fail the next (a series loop) */
-        if (p->orientation == LW_ORIENT_AUTO)
+        /* under orientation = auto the size turns with each picture: the
+        ** size this one turned it to would fail the next (a series loop),
+        ** so where the given size is the page's other turn, that is named */
+        const lw_param_def *dw = lw_params_find("scene", "width"), *dh = lw_params_find("scene", "height");
+        const int gw = p->line[dw - lw_param_table] != 0, gh = p->line[dh - lw_param_table] != 0;
+        const int other = (!gw || p->width == h) && (!gh || p->height == w);
+        if (p->orientation == LW_ORIENT_AUTO && p->image[0] && other)
           return lw_error_set(err, LW_EINPUT,
                               "%s: key 'scene.%s' = %.12g mm conflicts with scene.page = %s (%g x %g mm, set at %s, "
                               "turned to the picture by scene.orientation = auto): expected no %s (the page sets "
-                              "it), or scene.orientation = portrait or landscape to fix the page's turn",
-                              where, names[k], *value[k], page_name, w, h, where_page, names[k]);
+                              "it, turned to each picture), or scene.orientation = %s to keep the page so",
+                              where, names[k], *value[k], page_name, w, h, where_page, names[k],
+                              landscape ? "portrait" : "landscape");
         return lw_error_set(err, LW_EINPUT,
                             "%s: key 'scene.%s' = %.12g mm conflicts with scene.page = %s (%g x %g mm, set at %s): "
                             "expected %g or no %s (over a size in the scene file, give --set scene.width=%g "

@@ -91,7 +91,8 @@ int lw_rundir_unstarted(const char *dir)
   for (size_t k = 0; k < sizeof later / sizeof later[0]; k++) {
     char path[LW_PATH_MAX + 16];
     lw_path_join(path, sizeof path, dir, later[k]);
-    if (access(path, F_OK) == 0) return 0;
+    struct stat sb; /* a link to nowhere is there too (a state.lw gone: not a run that never wrote one) */
+    if (lstat(path, &sb) == 0) return 0;
   }
   return 1;
 }

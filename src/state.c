@@ -295,13 +295,20 @@ static char *next_line(reader *r)
   return NULL;
 }
 
-/* Whether a line reads as text: no control byte but tab, and valid UTF-8
-** where a byte is not ASCII (a picture's bytes were printed raw). */
+/* Whether a line holds a control byte but tab and CR. */
+static int has_control(const char *c)
+{
+  for (const unsigned char *u = (const unsigned char *)c; *u; u++)
+    if ((*u < 0x20 && *u != '\t' && *u != '\r') || *u == 0x7F) return 1;
+  return 0;
+}
+
+/* Whether a line reads as text: no control byte, and valid UTF-8 where a
+** byte is not ASCII (a picture's bytes were printed raw). */
 static int text_like(const char *c)
 {
+  if (has_control(c)) return 0;
   for (const unsigned char *u = (const unsigned char *)c; *u; u++) {
-    if (*u < 0x20 && *u != '\t' && *u != '\r') return 0;
-    if (*u == 0x7F) return 0;
     if (*u < 0x80) continue;
     int more = *u >= 0xF0 && *u < 0xF5 ? 3 : *u >= 0xE0 && *u < 0xF0 ? 2 : *u >= 0xC2 && *u < 0xE0 ? 1 : -1;
     if (more < 0) return 0;
@@ -406,9 +413,11 @@ lw_status lw_state_read(lw_state *st, const char *path, lw_error *err)
   else if (!c && !r.nul && r.line == 0) /* (line 0 of an empty file meant nothing to its reader) */
     s = lw_error_set(err, LW_EINPUT, "%s: empty file (0 bytes), not a state: expected 'linewise-state <version>'",
                      path);
-  else if (c && strncmp(c, LW_STATE_MAGIC, strlen(LW_STATE_MAGIC)) && !text_like(c))
-    s = lw_error_set(err, LW_EINPUT, "%s:1: header: expected 'linewise-state <version>', got binary bytes (%s)",
-                     path, !strncmp(c, "\x89PNG", 4) ? "a PNG picture, not a state" : "not a state, which is text");
+  else if ((c && strncmp(c, LW_STATE_MAGIC, strlen(LW_STATE_MAGIC)) && !text_like(c)) || (!c && r.nul))
+    s = lw_error_set(err, LW_EINPUT, "%s:1: header: expected 'linewise-state <version>', got %s", path,
+                     c && !strncmp(c, "\x89PNG", 4) ? "binary bytes (a PNG picture, not a state)"
+                     : r.nul || has_control(c)     ? "binary bytes (not a state, which is text)"
+                                                   : "bytes that are not UTF-8 text (a state is text)");
   else if (!c || strncmp(c, LW_STATE_MAGIC, strlen(LW_STATE_MAGIC)) ||
            !lw_number_parse_whole(c + strlen(LW_STATE_MAGIC), 0, 1e9, &version))
     s = bad(&r, err, "header", "'linewise-state <version>'", c);

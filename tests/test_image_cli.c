@@ -743,9 +743,9 @@ Test(image_cli, set_replaces_a_missing_picture_and_paths_stay_the_scenes)
 }
 
 /* Under orientation = auto the page turns with the picture: a width and
-** height that disagree are refused with the way round that holds for every
-** picture (no size, or a fixed orientation), not the size this picture
-** turned the page to, which the next picture of a series loop refused. */
+** height of the page's other turn are refused with the way round that
+** holds for every picture (no size, or that orientation), not the size this
+** picture turned the page to, which the next picture of a series refused. */
 Test(image_cli, a_size_against_a_page_turned_by_the_picture_names_the_orientation)
 {
   write_picture("wide.png", 60, 40);
@@ -754,7 +754,11 @@ Test(image_cli, a_size_against_a_page_turned_by_the_picture_names_the_orientatio
   cr_assert_eq(run("run s.ini --out a", errs, sizeof errs), 2, "%s", errs);
   cr_assert(strstr(errs, "s.ini:4: key 'scene.width' = 105 mm conflicts with scene.page = a6 (148 x 105 mm, set at "
                          "s.ini:3, turned to the picture by scene.orientation = auto): expected no width (the page "
-                         "sets it), or scene.orientation = portrait or landscape"), "%s", errs);
+                         "sets it, turned to each picture), or scene.orientation = portrait to keep the page so"),
+            "%s", errs);
+  /* a size of neither turn gets the plain message, with the size to give */
+  cr_assert_eq(run("run s.ini --out c --set scene.width=100", errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "expected 148 or no width") && !strstr(errs, "orientation ="), "%s", errs);
   cr_assert_eq(run("run s.ini --out b --set scene.orientation=portrait --set anneal.sweeps=1", errs, sizeof errs), 0,
                "%s", errs);
 }

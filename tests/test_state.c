@@ -83,7 +83,20 @@ Test(state, malformed_files_name_line_and_key)
   ** and a picture given as a state is named, not printed raw */
   expect_bad("", "bad.lw: empty file (0 bytes), not a state", "'linewise-state <version>'");
   expect_bad("\x89PNG\r\n\x1a\n\n", ":1:", "got binary bytes (a PNG picture, not a state)");
-  expect_bad("\xff\xd8\xff\xe0junk\n", ":1:", "got binary bytes (not a state, which is text)");
+  expect_bad("\xff\xd8\xff\xe0\x01\x10JFIF\n", ":1:", "got binary bytes (not a state, which is text)");
+  expect_bad("l\xe4uft 1\n", ":1:", "got bytes that are not UTF-8 text (a state is text)");
+  { /* a real JPEG's first line holds a NUL (its APP0 length): binary too */
+    char path[128];
+    snprintf(path, sizeof path, "%s/bad.lw", dir);
+    FILE *f = fopen(path, "wb");
+    fwrite("\xff\xd8\xff\xe0\0\x10JFIF\n", 1, 11, f);
+    fclose(f);
+    lw_state st;
+    lw_error err;
+    cr_assert_eq(lw_state_read(&st, path, &err), LW_EINPUT);
+    cr_assert(strstr(err.msg, "bad.lw:1: header: expected 'linewise-state <version>', got binary bytes"), "%s",
+              err.msg);
+  }
   expect_bad("l\xc3\xa4uft 1\n", ":1:", "got 'l\xc3\xa4uft 1'");
   expect_bad("linewise-state 9\n", ":1:", "version");
   expect_bad("linewise-state 1\nscene\n", ":2:", "scene");
