@@ -494,6 +494,32 @@ static int edited_keys(const lw_params *p, const lw_run_keys *now, const char *t
   return count;
 }
 
+/* The key whose line was taken out, where the stored hashes (text, one
+** more than now's) match now's but for one left out: it lies between the
+** two keys now holds around the gap, among those without a line.  Their
+** names into buf ("" if the hashes do not line up so). */
+static void removed_key(const lw_params *p, const lw_run_keys *now, const char *text, char *buf, size_t n)
+{
+  buf[0] = '\0';
+  size_t j = 0, was = strlen(text) / 4;
+  if (was != now->n + 1 || strspn(text, "0123456789abcdef") != strlen(text)) return;
+  unsigned long stored[LW_PARAM_MAX + 1];
+  for (size_t k = 0; k < was && k <= LW_PARAM_MAX; k++) {
+    char part[5] = {text[4 * k], text[4 * k + 1], text[4 * k + 2], text[4 * k + 3], '\0'};
+    stored[k] = strtoul(part, NULL, 16);
+  }
+  if (was > LW_PARAM_MAX + 1) return;
+  while (j < now->n && stored[j] == now->hash[j]) j++;
+  for (size_t k = j; k < now->n; k++)
+    if (stored[k + 1] != now->hash[k]) return;
+  size_t used = 0;
+  const size_t lo = j ? now->index[j - 1] + 1u : 0, hi = j < now->n ? now->index[j] : lw_param_count;
+  for (size_t i = lo; i < hi && used < n; i++)
+    if (p->line[i] <= 0)
+      used += (size_t)snprintf(buf + used, n - used, "%s'%s.%s'", used ? " or " : "", lw_param_table[i].section,
+                               lw_param_table[i].key);
+}
+
 lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, const lw_params *p, lw_run_keys *keys,
                                    unsigned long long *scene_hash, lw_error *err)
 {
@@ -534,6 +560,11 @@ lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, const lw_params *p, lw_run_keys
   if (text && strlen(text) % 4 == 0 && strlen(text) / 4 != keys->n) {
     const size_t was = strlen(text) / 4;
     const size_t off = was > keys->n ? was - keys->n : keys->n - was;
+    char gone[256];
+    removed_key(p, keys, text, gone, sizeof gone);
+    if (gone[0])
+      return lw_error_set(err, LW_EINPUT, "%s: 1 key fewer than when the run started: the line of %s taken out: %s",
+                          scene, gone, resumes);
     return lw_error_set(err, LW_EINPUT, "%s: %zu key%s %s than when the run started (a key's line %s?): %s", scene,
                         off, off > 1 ? "s" : "", was > keys->n ? "fewer" : "more",
                         was > keys->n ? "taken out" : "added", resumes);
