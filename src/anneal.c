@@ -924,6 +924,10 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   if ((s = open_trace(a, 1, err))) return s;
   lw_phase_set("drawing the start files");
   if ((s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_START, err))) return s;
+  /* the film's first frame is the start (whip's began at sweep 5, already
+  ** swinging) */
+  if (a->params.frames_every && rung_here(a, 0) && (s = a->sys_type->draw(a->sys->state, &a->params, a->dir, 0, err)))
+    return s;
   s = net ? LW_OK : lw_anneal_checkpoint(a, err);
   lw_phase_set(NULL);
   return s;

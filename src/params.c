@@ -492,7 +492,8 @@ const lw_param_def lw_param_table[] = {
       "1 = paint the source image's tone under the lines of final.png, final.pdf and the frames "
       "(at half strength). Needs an image."),
   NUM("output", "frames_every", LW_PT_INT, frames_every, "0", "sweeps", 0, 2e9, 0,
-      "Sweeps between animation frames frames/frame-SSSSSS.png (SSSSSS = the sweep). 0 = none."),
+      "Sweeps between animation frames frames/frame-SSSSSS.png (SSSSSS = the sweep; the first, 000000, "
+      "is the start). 0 = none."),
   NUM("output", "fidelity_sigma", LW_PT_DOUBLE, fidelity_sigma, "1", "mm", 0, 1e4, LW_MIN_OPEN,
       "Gaussian blur applied to both the rendered lines and the target (the ink asked for, "
       "energy.tone_ink * darkness) before the fidelity score (MSE, SSIM) compares them; about "
