@@ -633,6 +633,13 @@ Test(tools, bad_usage_exits_2_with_one_message_and_writes_nothing)
                  all[i]);
     cr_assert_eq(sh("%s", tool(all[i])), 2, "%s without arguments", all[i]);
   }
+  /* a frame rate that is no number above 0 is the script's usage error,
+  ** before ffmpeg (which said "Unable to parse option value") */
+  cr_assert_eq(sh("mkdir -p %s/an/frames && : > %s/an/frames/frame-000000.png", dir, dir), 0);
+  static const char *const fps[] = {"0", "abc", "-1", "1.2.3", "0.0"};
+  for (size_t i = 0; i < sizeof fps / sizeof *fps; i++)
+    cr_assert_eq(sh("%s %s/an '%s' 2> %s/an.err; test $? -eq 2 && grep -q \"FPS: expected a number above 0, got "
+                    "'%s'\" %s/an.err", tool("animate.sh"), dir, fps[i], dir, fps[i], dir), 0, "FPS %s", fps[i]);
 }
 
 /* ---- plots ------------------------------------------------------------ */

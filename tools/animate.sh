@@ -10,6 +10,12 @@ case ${1:-} in
 esac
 dir=$1
 fps=${2:-25}
+# a frame rate ffmpeg cannot parse reached it, and only its own message said so
+if ! printf '%s\n' "$fps" | grep -Eq '^([0-9]+\.?[0-9]*|\.[0-9]+)$' || ! awk -v f="$fps" 'BEGIN { exit !(f > 0) }'; then
+  echo "${0##*/}: FPS: expected a number above 0, got '$fps'" >&2
+  echo "$usage" >&2
+  exit 2
+fi
 # a directory named "-x" must not read as an option of ls or cd
 case $dir in -*) dir=./$dir ;; esac
 if [ ! -d "$dir/frames" ] || [ -z "$(ls -- "$dir/frames" 2>/dev/null | grep '^frame-[0-9]*\.png$')" ]; then
