@@ -212,14 +212,17 @@ static lw_status close_share(const lw_params *p, const lw_scene *sc, const lw_st
 
 void lw_drawing_note(const lw_params *p, char *note, size_t n)
 {
-  const double vs = p->speed_down / 10.0;
-  if (!p->hpgl || (vs >= LW_HPGL_VS_MIN && vs <= LW_HPGL_VS_MAX)) return;
+  const double vs = p->speed_down / 10.0, asked = round(100.0 * fmin(fmax(vs, LW_HPGL_VS_MIN), LW_HPGL_VS_MAX)) / 100.0;
+  /* VS has two decimals (0.1 mm/s): at a few mm/s its rounding is a few per
+  ** cent (1.234 mm/s was written 1.2: 2.8 % slower than the plot time) */
+  if (!p->hpgl || fabs(asked - vs) <= 0.01 * vs) return;
   size_t used = strlen(note);
+  const int past = vs < LW_HPGL_VS_MIN || vs > LW_HPGL_VS_MAX;
   if (used < n)
-    snprintf(note + used, n - used, "%splot.speed_down = %g mm/s is past what HP-GL's VS takes (%g to %g mm/s): "
-             "final.hpgl asks %g, and the plot time, reckoned at %g, does not hold for the machine", used ? "; " : "",
-             p->speed_down, 10.0 * LW_HPGL_VS_MIN, 10.0 * LW_HPGL_VS_MAX, 10.0 * fmin(fmax(vs, LW_HPGL_VS_MIN),
-             LW_HPGL_VS_MAX), p->speed_down);
+    snprintf(note + used, n - used, "%splot.speed_down = %g mm/s is %s (%g to %g mm/s, in steps of 0.1): final.hpgl "
+             "asks %g, and the plot time, reckoned at %g, does not hold for the machine", used ? "; " : "",
+             p->speed_down, past ? "past what HP-GL's VS takes" : "more than 1 % from what HP-GL's VS writes",
+             10.0 * LW_HPGL_VS_MIN, 10.0 * LW_HPGL_VS_MAX, 10.0 * asked, p->speed_down);
 }
 
 lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_splines *sp, const lw_grid2d *tone,
