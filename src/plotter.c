@@ -127,10 +127,14 @@ lw_status lw_plotter_check(const lw_strokes *s, const lw_output_page *page, cons
       extent t = reach(s, page, o, !o->turn);
       char turn[64] = "";
       if (off_bed(&t, o->bed) < 0) snprintf(turn, sizeof turn, " or the other turn (plot.turn = %d)", o->turn ? 0 : 90);
-      return lw_error_set(err, LW_EINPUT, "%s: the drawing reaches %c = %.3f to %.3f mm on the machine, past its "
-                          "bed of %g mm (plot.bed_%s): expected plot.crop = 1 (which cuts the strokes to the page "
-                          "inside its margin)%s%s", path, "xy"[k], e.lo[k], e.hi[k], o->bed[k],
-                          k ? "height" : "width", turn[0] ? ", a wider margin" : " or a wider margin", turn);
+      /* below 0 is past the machine's origin, not its bed's far side (a
+      ** stroke at x = -3 was blamed on the bed's width) */
+      char past[96];
+      if (e.lo[k] < -BED_SLACK) snprintf(past, sizeof past, "past its origin (%c below 0)", "xy"[k]);
+      else snprintf(past, sizeof past, "past its bed of %g mm (plot.bed_%s)", o->bed[k], k ? "height" : "width");
+      return lw_error_set(err, LW_EINPUT, "%s: the drawing reaches %c = %.3f to %.3f mm on the machine, %s: expected "
+                          "plot.crop = 1 (which cuts the strokes to the page inside its margin)%s%s", path, "xy"[k],
+                          e.lo[k], e.hi[k], past, turn[0] ? ", a wider margin" : " or a wider margin", turn);
     }
   }
   if (!gcode) return LW_OK;

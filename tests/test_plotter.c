@@ -489,6 +489,19 @@ Test(plotter, a_drawing_past_the_bed_is_refused_and_travel_can_feed)
   o.turn = 1, o.bed[0] = 90, o.bed[1] = 100;
   cr_assert_eq(lw_plotter_check(s, &page, &o, 1, path, NULL), LW_OK);
   o.turn = 0;
+  /* a drawing left of the machine's origin is past the origin, not the
+  ** bed's width, which it fits (it was blamed on plot.bed_width) */
+  for (size_t k = 0; k < s->n_segs; k++)
+    for (int c = 0; c < 8; c += 2) s->b[8 * k + (size_t)c] -= 8.0;
+  {
+    lw_error err = {0};
+    o.bed[0] = 200, o.bed[1] = 200;
+    cr_assert_eq(lw_plotter_check(s, &page, &o, 1, path, &err), LW_EINPUT);
+    cr_assert(strstr(err.msg, "the drawing reaches x = -3.000 to 83.000 mm on the machine, past its origin (x below "
+                              "0): expected plot.crop = 1"), "%s", err.msg);
+  }
+  for (size_t k = 0; k < s->n_segs; k++)
+    for (int c = 0; c < 8; c += 2) s->b[8 * k + (size_t)c] += 8.0;
   /* travel by feed: each path's start and the way home are G1 at speed_up
   ** (150 mm/s: F9000), each path's first drawing move sets speed_down again */
   o.bed[0] = o.bed[1] = 0;
