@@ -325,6 +325,11 @@ Test(run, frames_and_pdf_change_nothing_else)
   cr_assert_eq(sh("cmp -s %s/c/final.pdf %s/d/final.pdf && head -c 5 %s/c/final.pdf | grep -q '%%PDF-'", dir, dir, dir),
                0);
   cr_assert_neq(sh("test -e %s/a/final.pdf", dir), 0, "no PDF unless asked");
+  /* timing.txt counts the drawing too: written after summary.json, never
+  ** less (it held the last checkpoint's, before the drawing) */
+  cr_assert_eq(sh("awk -F': ' '/\"wall_seconds\"/ { s = $2 + 0 } END { print s }' %s/c/summary.json > %s/sw && "
+                  "awk -v s=\"$(cat %s/sw)\" '/^wall_seconds/ { ok = $2 >= s - 1e-6 } END { exit !ok }' "
+                  "%s/c/timing.txt", dir, dir, dir, dir), 0);
   /* the summary reports the pen-up travel, ordered no longer than before */
   snprintf(path, sizeof path, "%s/c/summary.json", dir);
   FILE *f = fopen(path, "r");

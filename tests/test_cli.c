@@ -406,6 +406,8 @@ Test(cli, keys_the_system_never_reads_are_refused)
   ** a weighting's width under another weighting */
   static const struct { const char *scene, *set, *want; } idle[] = {
     {"wire", "--set nurbs.weight_inertia=5", "nurbs.weight_inertia (--set: nurbs.free_weights = 0)"},
+    {"minimal", "--set energy.field=1 --set scene.field_core=3",
+     "scene.field_core (--set: scene.field is not radial or vortex)"},
     {"wire", "--set dynamics.rho=0 --set dynamics.gamma=5", "params/wire.ini:29: dynamics.rho = 0: no mass to weigh)"},
     {"particles-sheet", "--set particles.max_count=50 --set particles.sigma=0.3",
      "particles.max_count (--set: no particles.birth or death), particles.sigma (--set: particles.weight = poly)"},
@@ -731,9 +733,15 @@ Test(cli, a_signal_before_anything_is_written_ends_the_set_up_at_once)
 
 /* A directory no run wrote (a run that failed at once on a full disk left
 ** only its lock) is said to hold no run, with the way on: it was the bare
-** "state.lw: cannot open state file". */
+** "state.lw: cannot open state file".  A run whose state.lw is a link to
+** nowhere had one: not "stopped before its first checkpoint". */
 Test(cli, resume_of_a_directory_without_a_run_says_so)
 {
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/dl --quiet --set anneal.sweeps=2 && cd %s/dl && "
+                          "rm state.lw summary.json final.svg final.png && ln -s /nonexistent/state.lw state.lw && "
+                          "{ %s resume . 2>../dl.err; test $? -eq 2; } && grep -q 'state.lw: cannot open state file' "
+                          "../dl.err && ! grep -q 'first checkpoint' ../dl.err", lw_test_bin(), lw_test_root(), dir,
+                          dir, lw_test_bin()), 0, "%s", lw_test_slurp("%s/dl.err", dir));
   cr_assert_eq(lw_test_sh("mkdir -p %s/none && : > %s/none/.lock && { %s resume %s/none 2>%s/err.txt; test $? -eq 2; "
                           "} && grep -q 'none: holds no run (no state.lw, no scene.ini of a run): resume takes a "
                           "directory that .linewise run --out. wrote' %s/err.txt", dir, dir, lw_test_bin(), dir, dir,
@@ -817,12 +825,14 @@ Test(cli, ctrl_c_stops_a_shell_loop_of_runs_with_the_state_saved)
 Test(cli, a_format_turned_off_leaves_no_file_of_the_old_drawing)
 {
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/g --quiet --set anneal.sweeps=5 --set output.gcode=1 "
-                          "--set output.pdf=1 && test -s %s/g/final.gcode && test -s %s/g/final.pdf && sed -i "
-                          "'s/^gcode = 1/gcode = 0/; s/^pdf = 1/pdf = 0/' %s/g/scene.ini && %s resume %s/g 2>%s/err.txt",
-                          lw_test_bin(), lw_test_root(), dir, dir, dir, dir, lw_test_bin(), dir, dir),
+                          "--set output.pdf=1 --set output.hpgl=1 && test -s %s/g/final.gcode && test -s %s/g/final.pdf "
+                          "&& test -s %s/g/final.hpgl && sed -i 's/^gcode = 1/gcode = 0/; s/^pdf = 1/pdf = 0/; "
+                          "s/^hpgl = 1/hpgl = 0/' %s/g/scene.ini && %s resume %s/g 2>%s/err.txt",
+                          lw_test_bin(), lw_test_root(), dir, dir, dir, dir, dir, lw_test_bin(), dir, dir),
                0);
   cr_assert_eq(lw_test_sh("test -s %s/g/final.svg && ! test -e %s/g/final.gcode && ! test -e %s/g/final.pdf && "
-                          "grep -q 'done: .*final.png, summary' %s/err.txt", dir, dir, dir, dir),
+                          "! test -e %s/g/final.hpgl && grep -q 'done: .*final.png, summary' %s/err.txt", dir, dir, dir,
+                          dir, dir),
                0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 

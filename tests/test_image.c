@@ -987,10 +987,17 @@ Test(image, a_png_with_a_flipped_bit_or_no_end_is_refused)
   cr_assert_null(lw_image_decode(t, g.n + sizeof text, "trns.png", 1e6, NULL, &err));
   cr_assert(strstr(err.msg, "its chunk 'tRnS' at byte 33 fails its CRC check"), "%s", err.msg);
   free(t);
+  unsigned char ihdr[8];
+  memcpy(ihdr, g.b + 16, 8);
   memset(g.b + 16, 0, 4);
   png_crc_set(g.b + 8);
   cr_assert_null(lw_image_decode(g.b, g.n, "w0.png", 1e6, NULL, &err));
   cr_assert(strstr(err.msg, "w0.png: the PNG is damaged: 0 x 64 pixels"), "%s", err.msg);
+  memcpy(g.b + 16, ihdr, 8);
+  memset(g.b + 20, 0, 4);
+  png_crc_set(g.b + 8);
+  cr_assert_null(lw_image_decode(g.b, g.n, "h0.png", 1e6, NULL, &err));
+  cr_assert(strstr(err.msg, "h0.png: the PNG is damaged: 64 x 0 pixels"), "%s", err.msg);
   free(g.b);
 }
 
@@ -1005,6 +1012,9 @@ Test(image, an_rle_bmp_and_a_jpeg_of_side_0_are_named)
   cr_assert_null(lw_image_decode(bmp, sizeof bmp, "r.bmp", 1e6, NULL, &err));
   cr_assert(strstr(err.msg, "r.bmp: a run-length (RLE8) BMP, which the decoder does not read: save it uncompressed "
                             "or as PNG"), "%s", err.msg);
+  bmp[28] = 4, bmp[30] = 2; /* BI_RLE4 */
+  cr_assert_null(lw_image_decode(bmp, sizeof bmp, "r.bmp", 1e6, NULL, &err));
+  cr_assert(strstr(err.msg, "r.bmp: a run-length (RLE4) BMP"), "%s", err.msg);
   unsigned char jpg[8400];
   size_t n = exif_jpeg(jpg, 0, 0, 0), at = 2;
   while (at + 9 < n && !(jpg[at] == 0xFF && jpg[at + 1] == 0xC0)) at += 2 + ((size_t)jpg[at + 2] << 8 | jpg[at + 3]);

@@ -549,6 +549,7 @@ Test(params, a_field_core_of_a_run_begun_before_it_is_none)
     {1, 1, "", 0.0},                            /* a run's of before the key */
     {0, 1, "", 6.0},                            /* a hand-made one beside a state */
     {1, 1, "[scene]\nfield_core = 2.5\n", 2.5}, /* a run's with the line */
+    {0, 0, "[scene]\nfield_core = 0\n", 0.0},   /* none asked */
   };
   lw_params p;
   lw_scene sc;

@@ -85,6 +85,8 @@ Test(state, malformed_files_name_line_and_key)
   expect_bad("\x89PNG\r\n\x1a\n\n", ":1:", "got binary bytes (a PNG picture, not a state)");
   expect_bad("\xff\xd8\xff\xe0\x01\x10JFIF\n", ":1:", "got binary bytes (not a state, which is text)");
   expect_bad("l\xe4uft 1\n", ":1:", "got bytes that are not UTF-8 text (a state is text)");
+  expect_bad("l\xc0\xa4uft 1\n", ":1:", "not UTF-8 text"); /* an overlong lead byte */
+  expect_bad("\x7f" "ELF\n", ":1:", "got binary bytes");
   { /* a real JPEG's first line holds a NUL (its APP0 length): binary too */
     char path[128];
     snprintf(path, sizeof path, "%s/bad.lw", dir);
