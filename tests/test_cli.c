@@ -825,8 +825,8 @@ Test(cli, ctrl_c_stops_a_shell_loop_of_runs_with_the_state_saved)
 Test(cli, a_format_turned_off_leaves_no_file_of_the_old_drawing)
 {
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/g --quiet --set anneal.sweeps=5 --set output.gcode=1 "
-                          "--set output.pdf=1 --set output.hpgl=1 && test -s %s/g/final.gcode && test -s %s/g/final.pdf "
-                          "&& test -s %s/g/final.hpgl && sed -i 's/^gcode = 1/gcode = 0/; s/^pdf = 1/pdf = 0/; "
+                          "--set output.pdf=1 --set output.hpgl=1 && test -s %s/g/final.gcode && test -s "
+                          "%s/g/final.pdf && test -s %s/g/final.hpgl && sed -i 's/^gcode = 1/gcode = 0/; s/^pdf = 1/pdf = 0/; "
                           "s/^hpgl = 1/hpgl = 0/' %s/g/scene.ini && %s resume %s/g 2>%s/err.txt",
                           lw_test_bin(), lw_test_root(), dir, dir, dir, dir, dir, lw_test_bin(), dir, dir),
                0);
