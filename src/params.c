@@ -611,7 +611,8 @@ const lw_param_def lw_param_table[] = {
       "automatic: the extent `count` particles fill at the spacing r0 (docs/NUMERICS.md). Below half "
       "that (closer than r0/2 on average) a new run is refused; a run begun before 2026-12-05 resumes."),
   NUM("particles", "noise", LW_PT_DOUBLE, pt_noise, "0.05", "length", 0, 1e9, 0,
-      "Standard deviation of the Gaussian noise added to each coordinate of a placed particle."),
+      "Standard deviation of the Gaussian noise added to each coordinate of a placed particle (not "
+      "where it would push the particle past `boundary`: that one keeps its place)."),
   NUM("particles", "normal_noise", LW_PT_DOUBLE, pt_normal_noise, "5", "degrees", 0, 180, 0,
       "Standard deviation of the tilt of each placed orientation (a rotation about a uniform "
       "random axis)."),

@@ -5,6 +5,7 @@
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 #include <math.h>
+#include <string.h>
 #include <stdlib.h>
 
 #include "linewise/grid.h"
@@ -133,8 +134,15 @@ lw_status lw_particles_place(int pattern, size_t count, double size, double nois
       for (int c = 0; c < 3; c++) xk[c] = 0.5 * size * n[c];
       lw_quat_from_normal(n, qk);
     }
-    if (noise > 0)
-      for (int c = 0; c < 3; c++) xk[c] += gsl_ran_gaussian_ziggurat(r, noise);
+    if (noise > 0) {
+      /* a site the noise would push past the boundary keeps its place (a
+      ** cloud that fills its sphere could not start: "particle 70 is
+      ** outside"); the noise is drawn either way, so the stream, and every
+      ** placement it did not refuse, stay as they were */
+      double moved[3];
+      for (int c = 0; c < 3; c++) moved[c] = xk[c] + gsl_ran_gaussian_ziggurat(r, noise);
+      if (!outside || !outside(ctx, moved)) memcpy(xk, moved, sizeof moved);
+    }
     if (normal_noise > 0) {
       double axis[3], dq[4], t[4];
       gsl_ran_dir_3d(r, &axis[0], &axis[1], &axis[2]);

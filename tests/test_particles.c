@@ -1109,6 +1109,22 @@ Test(particles, the_patterns_place_what_they_promise)
   cr_assert_lt(fabs(sqrt(ss / 2000) / 0.3 - 1), 4 / sqrt(2 * 2000.0));
   lw_particles_free(p);
   lw_particles_setup_free(s);
+  /* a cloud that fills its sphere: the noise pushes none past the wall
+  ** (such a scene could not start: "particle 70 is outside"), and those it
+  ** would push keep their place */
+  prm.pt_pattern = LW_PPATTERN_CLOUD;
+  prm.pt_count = 300;
+  prm.pt_size = 20;
+  prm.pt_noise = 0.5;
+  prm.pt_boundary = LW_PBOUNDARY_SPHERE;
+  prm.pt_boundary_radius = 9;
+  s = setup_of(&prm);
+  lw_error err;
+  p = lw_particles_new(s, 1, NULL, &err);
+  cr_assert_not_null(p, "%s", err.msg);
+  for (size_t i = 0; i < p->n; i++) cr_assert(!lw_particles_outside(s, p->x + 3 * i), "particle %zu outside", i);
+  lw_particles_free(p);
+  lw_particles_setup_free(s);
 }
 
 Test(particles, pinned_everything_gives_the_identity_move)

@@ -17,7 +17,8 @@
 **           z = 1 - (2k + 1)/count, turned by the golden angle k pi (3 - sqrt 5)
 **           about z), normals outward.
 **
-** Then every coordinate gets Gaussian noise of standard deviation `noise`,
+** Then every coordinate gets Gaussian noise of standard deviation `noise`
+** (but for a site it would push outside the boundary, which keeps its place),
 ** and every orientation a tilt about a uniformly random axis by an angle of
 ** standard deviation `normal_noise`.  The automatic size (size = 0) fills
 ** the pattern at the spacing r0: a hexagonal sheet holds one particle per
