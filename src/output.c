@@ -378,6 +378,9 @@ int lw_output_png_size(const lw_output_page *page, double px_per_mm, int *width_
   double longest = page->width_mm > page->height_mm ? page->width_mm : page->height_mm;
   double k = px_per_mm;
   if (longest * k > LW_OUTPUT_PNG_MAX_PX) k = LW_OUTPUT_PNG_MAX_PX / longest;
+  /* and a pixel at least: a scale of 1e-200 made cairo's matrix singular,
+  ** and the run failed after its anneal, without final.png or summary.json */
+  if (longest * k < 1.0) k = 1.0 / longest;
   /* ceil so the whole page is shown; the 1e-6 keeps a product such as
   ** 1000 * 4.096 = 4096.0000000000005 from growing a pixel. */
   double w = ceil(page->width_mm * k - 1e-6), h = ceil(page->height_mm * k - 1e-6);

@@ -477,7 +477,8 @@ const lw_param_def lw_param_table[] = {
          "machine's origin), or greedy improved by 2-opt and Or-opt moves; paths may be reversed. Reduces pen-up "
          "travel (reported in summary.json)."),
   NUM("output", "png_scale", LW_PT_DOUBLE, png_scale, "4", "px/mm", 0, 100, LW_MIN_OPEN,
-      "Pixels per millimetre of final.png and the frames (the long side is capped at 4096 px)."),
+      "Pixels per millimetre of final.png and the frames (the long side is capped at 4096 px, and is "
+      "at least 1 px)."),
   NUM("output", "pdf", LW_PT_INT, pdf, "0", "", 0, 1, 0,
       "1 = also write final.pdf, a vector PDF of the page (at most 5080 mm a side, as PDF allows)."),
   NUM("output", "hpgl", LW_PT_INT, hpgl, "0", "", 0, 1, 0,

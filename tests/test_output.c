@@ -281,6 +281,10 @@ Test(output, png_size_is_capped)
   cr_assert(w == 420 && h == 594 && k == 2.0);
   cr_assert(!lw_output_png_size(&page, 0.0, &w, &h, &k));
   cr_assert(!lw_output_png_size(&page, NAN, &w, &h, &k));
+  /* and a pixel at least on the longest side (1e-200 px/mm made cairo's
+  ** matrix singular after the anneal) */
+  cr_assert(lw_output_png_size(&page, 1e-200, &w, &h, &k));
+  cr_assert(w == 1 && h == 1 && k == 1.0 / 297, "%d x %d at %g", w, h, k);
 
   /* and the file really has the capped size */
   char dir[64], path[128];
