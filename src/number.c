@@ -50,8 +50,10 @@ int lw_number_parse_n(const char *s, size_t len, double *out)
   errno = 0;
   char *end;
   double v = strtod(buf, &end);
-  /* ERANGE also flags underflow, which is fine: only overflow is refused */
-  if (*end || !isfinite(v) || (errno == ERANGE && fabs(v) > 1.0)) return 0;
+  /* ERANGE also flags underflow, which is fine down to the subnormals (a
+  ** file's %.17g of one reads back); a number that is not 0 and reads as 0
+  ** is refused, as overflow is: "1e-400" made moves.fixed_count 0 */
+  if (*end || !isfinite(v) || (errno == ERANGE && (fabs(v) > 1.0 || v == 0.0))) return 0;
   *out = v;
   return 1;
 }
