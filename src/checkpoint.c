@@ -502,13 +502,12 @@ static void removed_key(const lw_params *p, const lw_run_keys *now, const char *
 {
   buf[0] = '\0';
   size_t j = 0, was = strlen(text) / 4;
-  if (was != now->n + 1 || strspn(text, "0123456789abcdef") != strlen(text)) return;
+  if (was != now->n + 1 || was > LW_PARAM_MAX + 1 || strspn(text, "0123456789abcdef") != strlen(text)) return;
   unsigned long stored[LW_PARAM_MAX + 1];
-  for (size_t k = 0; k < was && k <= LW_PARAM_MAX; k++) {
+  for (size_t k = 0; k < was; k++) {
     char part[5] = {text[4 * k], text[4 * k + 1], text[4 * k + 2], text[4 * k + 3], '\0'};
     stored[k] = strtoul(part, NULL, 16);
   }
-  if (was > LW_PARAM_MAX + 1) return;
   while (j < now->n && stored[j] == now->hash[j]) j++;
   for (size_t k = j; k < now->n; k++)
     if (stored[k + 1] != now->hash[k]) return;

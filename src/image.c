@@ -417,7 +417,8 @@ static lw_status png_chunks_sound(const unsigned char *d, size_t n, const char *
       return lw_error_set(err, LW_EINPUT, "%s: the PNG is damaged or cut short: its chunk '%s' at byte %zu holds %u "
                           "bytes, the file has %zu after its header", name, type, at, (unsigned)len, n - at - 12);
 #ifndef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
-    if (!png_chunk_harmless(d + at + 4) && crc32(crc32(0L, Z_NULL, 0), d + at + 4, (uInt)len + 4) != be32(d + at + 8 + len))
+    const uLong crc = crc32(crc32(0L, Z_NULL, 0), d + at + 4, (uInt)len + 4);
+    if (!png_chunk_harmless(d + at + 4) && crc != be32(d + at + 8 + len))
       return lw_error_set(err, LW_EINPUT, "%s: the PNG is damaged: its chunk '%s' at byte %zu fails its CRC check",
                           name, type, at);
 #endif
@@ -551,7 +552,7 @@ static lw_status jpeg_tables_sound(const unsigned char *d, size_t n, const char 
 
 static uint32_t tiff32(const unsigned char *p, int be)
 {
-  return be ? (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3] : le32(p);
+  return be ? be32(p) : le32(p);
 }
 
 /* The segments of a JPEG before its first scan, one a call: *at starts at
@@ -734,17 +735,32 @@ static const char *too_large(const unsigned char *d, size_t n, double w, double 
   return NULL;
 }
 
-/* The components of a JPEG's frame (its SOF segment), 0 if none is found:
-** stbi_info says 3 for a CMYK JPEG, which the decoder holds to its limit
-** with 4 (one between 537 and 716 million pixels was "damaged"). */
+/* A JPEG's frame: its first SOF segment (seg, its payload of sn bytes:
+** precision, rows, columns, components, then 3 bytes a component), or 0 if
+** none; *scan (if asked) where the segments before the first scan end. */
+static int jpeg_frame(const unsigned char *d, size_t n, const unsigned char **seg, size_t *sn, size_t *scan)
+{
+  size_t at = 0, len;
+  unsigned m;
+  const unsigned char *s;
+  int found = 0;
+  while (jpeg_segment(d, n, &at, &m, &s, &len))
+    if (!found && m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC) {
+      *seg = s, *sn = len, found = 1;
+      if (!scan) return 1;
+    }
+  if (scan) *scan = at;
+  return found;
+}
+
+/* The components of a JPEG's frame, 0 if none is found: stbi_info says 3
+** for a CMYK JPEG, which the decoder holds to its limit with 4 (one between
+** 537 and 716 million pixels was "damaged"). */
 static int jpeg_components(const unsigned char *d, size_t n)
 {
-  size_t at = 0, sn;
-  unsigned m;
   const unsigned char *seg;
-  while (jpeg_segment(d, n, &at, &m, &seg, &sn))
-    if (m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC) return sn >= 6 ? seg[5] : 0;
-  return 0;
+  size_t sn;
+  return jpeg_frame(d, n, &seg, &sn, NULL) && sn >= 6 ? seg[5] : 0;
 }
 
 /* The decoder reads a JPEG's missing data as zeros, so a header claiming
@@ -758,37 +774,30 @@ static int jpeg_components(const unsigned char *d, size_t n)
 ** ceil(w Hi / Hmax) x ceil(h Vi / Vmax) pixels. */
 static lw_status jpeg_data_enough(const unsigned char *d, size_t n, const char *name, lw_error *err)
 {
-  size_t at = 0, sn;
-  unsigned m;
-  const unsigned char *seg, *sof = NULL;
-  size_t sof_n = 0;
-  while (jpeg_segment(d, n, &at, &m, &seg, &sn))
-    if (!sof && m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC) sof = seg, sof_n = sn;
+  size_t sn, scan;
+  const unsigned char *seg;
+  if (!jpeg_frame(d, n, &seg, &sn, &scan) || sn < 6) return LW_OK; /* the decoder's to refuse */
+  const double h = seg[1] << 8 | seg[2], w = seg[3] << 8 | seg[4];
+  const unsigned nc = seg[5];
+  if (sn < 6 + 3 * (size_t)nc || h == 0) return LW_OK; /* the decoder's to refuse; h = 0: rows told later (DNL) */
+  unsigned hmax = 1, vmax = 1;
+  for (unsigned c = 0; c < nc; c++) {
+    unsigned hv = seg[7 + 3 * c];
+    if ((hv >> 4) > hmax) hmax = hv >> 4;
+    if ((hv & 15) > vmax) vmax = hv & 15;
+  }
+  double blocks = 0;
+  for (unsigned c = 0; c < nc; c++) {
+    unsigned hv = seg[7 + 3 * c];
+    blocks += ceil(ceil(w * (hv >> 4) / hmax) / 8) * ceil(ceil(h * (hv & 15) / vmax) / 8);
+  }
   /* the bytes from the first scan on: an ICC profile or an EXIF thumbnail
   ** before it (64 KB and more on a phone's photo) hid a cut scan */
-  const size_t data = n - at;
-  if (sof) {
-    seg = sof, sn = sof_n;
-    if (sn < 6) return LW_OK; /* the decoder's to refuse */
-    const double h = seg[1] << 8 | seg[2], w = seg[3] << 8 | seg[4];
-    const unsigned nc = seg[5];
-    if (sn < 6 + 3 * (size_t)nc || h == 0) return LW_OK; /* the decoder's to refuse; h = 0: rows told later (DNL) */
-    unsigned hmax = 1, vmax = 1;
-    for (unsigned c = 0; c < nc; c++) {
-      unsigned hv = seg[7 + 3 * c];
-      if ((hv >> 4) > hmax) hmax = hv >> 4;
-      if ((hv & 15) > vmax) vmax = hv & 15;
-    }
-    double blocks = 0;
-    for (unsigned c = 0; c < nc; c++) {
-      unsigned hv = seg[7 + 3 * c];
-      blocks += ceil(ceil(w * (hv >> 4) / hmax) / 8) * ceil(ceil(h * (hv & 15) / vmax) / 8);
-    }
-    if ((double)data < blocks / 8)
-      return lw_error_set(err, LW_EINPUT, "%s: the JPEG is damaged or cut short: its %.0f x %.0f pixels take at "
-                          "least %.0f bytes of coded data, the file has %zu from its first scan on", name, w, h,
-                          ceil(blocks / 8), data);
-  }
+  const size_t data = n - scan;
+  if ((double)data < blocks / 8)
+    return lw_error_set(err, LW_EINPUT, "%s: the JPEG is damaged or cut short: its %.0f x %.0f pixels take at least "
+                        "%.0f bytes of coded data, the file has %zu from its first scan on", name, w, h,
+                        ceil(blocks / 8), data);
   return LW_OK;
 }
 
@@ -804,16 +813,14 @@ static lw_status not_decoded(const unsigned char *data, size_t size, const char 
 {
   const char *why = too_large(data, size, 0, 0, 0), *foreign = foreign_format(data, size);
   if (why) return too_large_error(data, size, name, why, err);
-  size_t at = 0, sn;
-  unsigned m;
   const unsigned char *seg;
-  while (!strcmp(format_name(data, size), "JPEG") && jpeg_segment(data, size, &at, &m, &seg, &sn))
-    if (m >= 0xC0 && m <= 0xCF && m != 0xC4 && m != 0xC8 && m != 0xCC && sn >= 5) {
-      const unsigned h = (unsigned)seg[1] << 8 | seg[2], w = (unsigned)seg[3] << 8 | seg[4];
-      if (w && h) break;
+  size_t sn;
+  if (!strcmp(format_name(data, size), "JPEG") && jpeg_frame(data, size, &seg, &sn, NULL) && sn >= 5) {
+    const unsigned h = (unsigned)seg[1] << 8 | seg[2], w = (unsigned)seg[3] << 8 | seg[4];
+    if (!w || !h)
       return lw_error_set(err, LW_EINPUT, "%s: the JPEG's frame says %u x %u pixels: damaged%s", name, w, h,
                           w ? ", or rows told after the data (a DNL marker), which the decoder does not read" : "");
-    }
+  }
   if (foreign)
     return lw_error_set(err, LW_EINPUT, "%s: %s file, which linewise does not read (PNG, JPEG, GIF, BMP, binary "
                         "PGM/PPM): convert it to PNG or JPEG first", name, foreign);

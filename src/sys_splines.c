@@ -1328,7 +1328,8 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
   ** kind reads its own keys (an artist's vortex without energy.field drew
   ** random strokes without a word) */
   static const char *const field[] = {"scene.field", "scene.field_angle", "scene.field_sigma", "scene.field_flat",
-                                      "scene.field_wavelength", "scene.field_amplitude", "scene.field_core", "energy.field_mode",
+                                      "scene.field_wavelength", "scene.field_amplitude", "scene.field_core",
+                                      "energy.field_mode",
                                       "layers.turn", NULL},
                            *const potential[] = {"scene.potential", "scene.potential_value", "scene.potential_angle",
                                                  "scene.potential_scale", "scene.potential_power",

@@ -281,8 +281,9 @@ Test(nurbs_cli, a_refined_wire_runs_resumes_and_refuses_a_step_past_its_stabilit
   ** the bundled Figure 8b damping at the unrefined wire's own dt runs */
   for (int k = 0; k < 2; k++)
     cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/d --quiet %s --set dynamics.gamma=%s 2> %s/err.txt; test $? "
-                    "-eq 2 && grep -q 'past the leapfrog.s stability limit' %s/err.txt && ! test -e %s/d", lw_test_bin(),
-                    lw_test_root(), dir, wire, k ? "1e6" : "0.1", dir, dir, dir), 0, "%s", k ? "1e6" : "0.1");
+                    "-eq 2 && grep -q 'past the leapfrog.s stability limit' %s/err.txt && ! test -e %s/d",
+                    lw_test_bin(), lw_test_root(), dir, wire, k ? "1e6" : "0.1", dir, dir, dir),
+                 0, "%s", k ? "1e6" : "0.1");
   cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/d --quiet --set dynamics.gamma=5 --set anneal.sweeps=2",
                   lw_test_bin(), lw_test_root(), dir), 0);
   /* which takes the review's dt on the refined wire, in one CG iteration a step */

@@ -568,8 +568,8 @@ Test(params, a_field_core_of_a_run_begun_before_it_is_none)
   cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(lw_params_set(&p, "scene.field_core=-0.5", &err), LW_OK, "%s", err.msg);
   cr_assert_neq(lw_scene_init(&sc, &p, &err), LW_OK);
-  cr_assert(strstr(err.msg, "scene.field_core") && strstr(err.msg, "expected -1 (init.segment_length) or a radius >= 0"),
-            "%s", err.msg);
+  cr_assert(strstr(err.msg, "scene.field_core") &&
+                strstr(err.msg, "expected -1 (init.segment_length) or a radius >= 0"), "%s", err.msg);
   unlink(path);
 }
 

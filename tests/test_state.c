@@ -207,7 +207,8 @@ Test(state, strict_numbers)
 {
   /* a number not 0 that reads as 0 (underflow past the subnormals) is
   ** refused, as overflow is: "1e-400" made moves.fixed_count 0 */
-  static const char *good[] = {"0", "-0", "+12", "1.5", ".5", "5.", "1e3", "1E-3", "-2.5e+10", "4.9406564584124654e-324",
+  static const char *good[] = {"0",  "-0",       "+12",      "1.5",    ".5",
+                               "5.", "1e3",      "1E-3",     "-2.5e+10", "4.9406564584124654e-324",
                                "0e-400", "1e-320"};
   static const char *bad[] = {"", " 1", "1 ", "0x10", "inf", "nan", "1e", "e3", ".", "-", "1.2.3", "100mm", "1e999",
                               "1,5", "--1", "1e-400", "-2e-999"};
