@@ -135,6 +135,24 @@ static int is_coordinate(const char *name)
 
 static double at(const lw_trace *t, size_t row, int col) { return t->v[row * t->n_cols + (size_t)col]; }
 
+/* 1 if name is a column of rung K ("replicaK_...") and rung K's temperature
+** at the end of the rows differs between the k runs. */
+static int rung_moves(const lw_trace *const *t, size_t *const *row, const size_t *n, int k, const char *name)
+{
+  const char *end = strchr(name, '_');
+  char col[64];
+  if (strncmp(name, "replica", 7) || !end || (size_t)(end - name) + sizeof "_temperature" > sizeof col) return 0;
+  snprintf(col, sizeof col, "%.*s_temperature", (int)(end - name), name);
+  int c = lw_trace_column(t[0], col);
+  if (c < 0 || !n[0]) return 0;
+  const double first = at(t[0], row[0][n[0] - 1], c);
+  for (int r = 1; r < k; r++) {
+    int cr = lw_trace_column(t[r], col);
+    if (cr >= 0 && n[r] && fabs(at(t[r], row[r][n[r] - 1], cr) - first) > 1e-9 * fabs(first)) return 1;
+  }
+  return 0;
+}
+
 void lw_trace_select_of(const lw_params *p, lw_trace_select *sel)
 {
   if (sel->from < 0 && p->stats_from > 0) sel->from = p->stats_from;
@@ -502,15 +520,10 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
   for (int r = 0; r < k; r++) temperature_range(t[r], row[r], n[r], &tlo, &thi);
   /* rungs at other temperatures in other runs (each tuned its own ladder,
   ** tune_ladder = equal): their replicaK columns are other ensembles, and
-  ** every inner rung was called "not converged" */
+  ** every inner rung was called "not converged"; the ladder's two ends stay
+  ** where they were and are compared */
   int ladders_differ = 0;
-  for (size_t c = 0; c < t[0]->n_cols; c++) {
-    const char *name = t[0]->name[c];
-    if (strncmp(name, "replica", 7) || !strstr(name, "_temperature")) continue;
-    const double first = n[0] ? at(t[0], row[0][n[0] - 1], (int)c) : 0.0;
-    for (int r = 1; r < k; r++)
-      if (n[r] && fabs(at(t[r], row[r][n[r] - 1], (int)c) - first) > 1e-9 * fabs(first)) ladders_differ = 1;
-  }
+  for (size_t c = 0; c < t[0]->n_cols; c++) ladders_differ |= rung_moves(t, row, n, k, t[0]->name[c]);
   for (size_t c = 0; c < t[0]->n_cols; c++) {
     cs[c].run = runs + c * (size_t)k;
     if (is_coordinate(t[0]->name[c])) continue;
@@ -531,7 +544,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       /* an acceptance depends on each run's own tuned step: runs need not
       ** agree; nor need a rung's columns where the rungs' temperatures differ */
       if (!strncmp(t[0]->name[c], "acc_", 4) || !strncmp(t[0]->name[c], "swap", 4) ||
-          (ladders_differ && !strncmp(t[0]->name[c], "replica", 7)))
+          rung_moves(t, row, n, k, t[0]->name[c]))
         cs[c].p_runs = cs[c].r_hat = NAN;
     }
   }
@@ -614,8 +627,8 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
             k > 1 ? "or between the runs" : "these rows");
   if (apart && ladders_differ)
     fprintf(apart, "warning: the runs' rungs stand at other temperatures (their ladders were tuned each its own): "
-            "the replicaK columns mix ensembles and are not compared (R_hat and p_runs empty); compare them run by "
-            "run, or with --reweight\n");
+            "the replicaK columns of those rungs mix ensembles and are not compared (R_hat and p_runs empty); "
+            "compare them run by run, or with --reweight\n");
   if (apart && k > 1 && identical_runs(t, row, n, k))
     fprintf(apart, "warning: the %d runs are the same, row for row: one seed run twice, or seeds that change "
             "nothing (a scene that draws no random number, as the dynamics from init.from or the D-NURBS dynamics), "

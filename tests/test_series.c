@@ -7,6 +7,7 @@
 ** tau = 1/2 + phi / (1 - phi) = (1 + phi) / (2 (1 - phi)).  Fixed seeds;
 ** each tolerance is derived from the estimator's variance where it is used.
 */
+#include <ctype.h>
 #include <criterion/criterion.h>
 #include <gsl/gsl_cdf.h>
 #include <gsl/gsl_randist.h>
@@ -1037,16 +1038,18 @@ Test(trace, one_row_gives_a_mean_and_no_error_bar, .init = make_dir, .fini = rem
 /* Runs whose ladders were tuned each its own have rungs at other
 ** temperatures: their replicaK columns are other ensembles, said once and
 ** not compared (every inner rung was "not converged"); runs on one ladder
-** are compared as before. */
+** are compared as before, and so is a rung that stands at one temperature
+** in every run (a tuned ladder's ends: rung 0 here). */
 Test(trace, runs_with_rungs_at_other_temperatures_are_not_compared_rung_by_rung, .init = make_dir,
      .fini = remove_dir)
 {
   static char text[2][8192];
   for (int r = 0; r < 2; r++) {
-    int m = snprintf(text[r], sizeof text[r], "sweep,temperature,total,replica1_temperature,replica1_energy\n");
+    int m = snprintf(text[r], sizeof text[r], "sweep,temperature,total,replica0_temperature,replica0_energy,"
+                     "replica1_temperature,replica1_energy\n");
     for (int s = 1; s <= 100; s++)
-      m += snprintf(text[r] + m, sizeof text[r] - (size_t)m, "%d,1,%g,%g,%g\n", s, 10.0 + (s * 7 % 5),
-                    r ? 2.5 : 2.0, (r ? 30.0 : 20.0) + (s * 3 % 7));
+      m += snprintf(text[r] + m, sizeof text[r] - (size_t)m, "%d,1,%g,1,%g,%g,%g\n", s, 10.0 + (s * 7 % 5),
+                    10.0 + (s * 7 % 5) + 0.1 * r, r ? 2.5 : 2.0, (r ? 30.0 : 20.0) + (s * 3 % 7));
   }
   for (int same = 0; same < 2; same++) {
     if (same) memcpy(text[1], text[0], sizeof text[0]);
@@ -1059,6 +1062,12 @@ Test(trace, runs_with_rungs_at_other_temperatures_are_not_compared_rung_by_rung,
     cr_assert_eq(lw_trace_stats_runs((const lw_trace *const *)t, path, sel, 2, f, &err), LW_OK, "%s", err.msg);
     fclose(f);
     cr_assert_eq(strstr(out, "warning: the runs' rungs stand at other temperatures") != NULL, !same, "%s", out);
+    char line[256] = "";
+    const char *l0 = strstr(out, "\nreplica0_energy ");
+    cr_assert(l0 && sscanf(l0 + 1, "%255[^\n*]", line) == 1, "%s", out);
+    size_t len = strlen(line);
+    while (len && line[len - 1] == ' ') line[--len] = '\0';
+    cr_assert(len && isdigit((unsigned char)line[len - 1]), "rung 0 was not compared: '%s'", line);
     cr_assert_eq(strstr(out, "replica1_energy: the runs disagree") == NULL && !strstr(out, ", replica1_energy"), 1,
                  "%s", out);
     lw_trace_free(t[0]);
