@@ -51,6 +51,23 @@ void lw_checkpoint_system_section(char *buf, size_t n, const lw_system_type *t, 
   else snprintf(buf, n, "system %s %d", t->name, k);
 }
 
+/* "run", "tempering", "dynamics", "chain" or "chain K", "system NAME" or
+** "system NAME K", K a rung from 1: the sections a state is written with. */
+int lw_checkpoint_section_known(const char *name)
+{
+  static const char *const plain[] = {"run", "tempering", "dynamics"};
+  for (size_t i = 0; i < sizeof plain / sizeof plain[0]; i++)
+    if (!strcmp(name, plain[i])) return 1;
+  const char *rest = NULL;
+  if (!strncmp(name, "chain", 5)) rest = name + 5;
+  else if (!strncmp(name, "system ", 7) && name[7] && name[7] != ' ') rest = name + 7 + strcspn(name + 7, " ");
+  if (!rest) return 0;
+  if (!*rest) return 1;
+  char *end;
+  long k = rest[0] == ' ' && rest[1] >= '1' && rest[1] <= '9' ? strtol(rest + 1, &end, 10) : 0;
+  return k >= 1 && k < LW_TEMPERING_MAX && !*end;
+}
+
 /* ---- writing ---------------------------------------------------------------- */
 
 void lw_checkpoint_put_chain(lw_ckpt_writer *w, const lw_anneal *a, int k, int *bad)
@@ -247,6 +264,7 @@ static lw_status get_rng(lw_ckpt *doc, const char *sec, gsl_rng *r, lw_error *er
 {
   int line = 0;
   const char *hex = lw_ckpt_text(doc, sec, "rng", &line);
+  if (!hex && !lw_ckpt_has(doc, sec)) return lw_ckpt_no_section(doc, sec, err);
   if (!hex) return lw_error_set(err, LW_EINPUT, "%s: [%s] rng: missing", lw_ckpt_path(doc), sec);
   if (!lw_rng_load(r, hex))
     return lw_error_set(err, LW_EINPUT, "%s:%d: [%s] rng: expected the state of a %s generator in hex (%zu digits)",
@@ -263,6 +281,23 @@ static lw_status get_chain(lw_ckpt *doc, int k, const lw_system_type *t, lw_chai
   for (int m = 0; m < c->n_moves && !s; m++) {
     const char *name = t->move_names[m];
     unsigned long v[6] = {0, 0, 0, 0, 0, 0};
+    /* a kind a newer release added has none of its three lines (counts at
+    ** 0, the scene's step); one line without the others was taken out, and
+    ** reading on would restart that step silently */
+    static const char *const part[3] = {"step", "window", "moves"};
+    int has[3], there = 0;
+    for (int q = 0; q < 3; q++) {
+      snprintf(key, sizeof key, "%s.%s", part[q], name);
+      there += has[q] = lw_ckpt_text(doc, sec, key, NULL) != NULL;
+    }
+    if (there == 1 || there == 2) {
+      int gone = !has[0] ? 0 : !has[1] ? 1 : 2, kept = has[0] ? 0 : has[1] ? 1 : 2;
+      char what[160];
+      snprintf(what, sizeof what, "[%s] %s.%s", sec, part[gone], name);
+      snprintf(key, sizeof key, "a damaged or edited file: %s.%s is there", part[kept], name);
+      s = lw_ckpt_missing(doc, what, key, err);
+      break;
+    }
     snprintf(key, sizeof key, "step.%s", name);
     /* tuning keeps steps in [1e-300, step_max] (mc.c), but a step never
     ** tuned (moves.tune_sweeps = 0, the dynamics, a stop before the first

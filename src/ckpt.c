@@ -288,6 +288,19 @@ lw_status lw_ckpt_missing(const lw_ckpt *c, const char *what, const char *guess,
                       what, guess, c->lines);
 }
 
+lw_status lw_ckpt_no_section(const lw_ckpt *c, const char *sec, lw_error *err)
+{
+  char list[1024] = "";
+  size_t at = 0;
+  for (size_t i = 0; i < c->ns && at < sizeof list; i++) {
+    int m = snprintf(list + at, sizeof list - at, "%s[%s] at line %d", i ? ", " : "", c->text + c->s[i].name,
+                     c->s[i].line);
+    if (m > 0) at += (size_t)m;
+  }
+  return lw_error_set(err, LW_EINPUT, "%s: section [%s] missing (the file has %s; a damaged or edited file, or one "
+                      "cut short: it ends at its line %d)", c->path, sec, c->ns ? list : "none", c->lines);
+}
+
 const char *lw_ckpt_cut_hint(const lw_ckpt *c, const char *sec)
 {
   const section *s = find_section(c, sec);
@@ -377,6 +390,15 @@ int lw_ckpt_next(lw_ckpt *c, const char *sec, size_t *pos, const char **key, con
   *value = c->text + e->value;
   if (line) *line = e->line;
   return 1;
+}
+
+lw_status lw_ckpt_known_sections(const lw_ckpt *c, int (*known)(const char *name), lw_error *err)
+{
+  for (size_t i = 0; i < c->ns; i++)
+    if (!known(c->text + c->s[i].name))
+      return lw_error_set(err, LW_EINPUT, "%s:%d: section [%s] is unknown to this linewise (written by a newer "
+                          "version?)", c->path, c->s[i].line, c->text + c->s[i].name);
+  return LW_OK;
 }
 
 lw_status lw_ckpt_unread(const lw_ckpt *c, lw_error *err)

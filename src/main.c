@@ -173,6 +173,12 @@ static int cmd_energy(int argc, char **argv)
   lw_state st;
   char path[LW_PATH_MAX + 32];
   if (load_run_dir(dir, &p, &st, path, sizeof path, &err)) return fail(&err);
+  /* the run's sections are read by resume, not here; an unknown one is
+  ** refused all the same, as every reader of a state does */
+  if (st.doc && lw_ckpt_known_sections(st.doc, lw_checkpoint_section_known, &err)) {
+    lw_state_clear(&st);
+    return fail(&err);
+  }
   /* the energy is of the scene as DIR/scene.ini reads now: an edit since the
   ** run started (which resume refuses) gave another energy without a word */
   static lw_run_keys keys;

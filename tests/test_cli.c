@@ -547,6 +547,14 @@ Test(cli, a_state_without_a_later_term_resumes_and_unknown_keys_are_refused)
   snprintf(args, sizeof args, "resume %s/new --quiet", dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
   cr_assert(strstr(errs, "new/state.lw:") && strstr(errs, "[chain] energy.torsion: unknown"), "%s", errs);
+  /* energy reads no [chain]; a section nothing writes is refused there too
+  ** (it printed the energy and exited 0), a rung's sections are not */
+  cr_assert_eq(lw_test_sh("printf '[chain 2]\\nx = 1\\n' >> %s/old/state.lw", dir), 0);
+  snprintf(args, sizeof args, "energy %s/old", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(lw_test_sh("printf '[extra]\\nx = 1\\n' >> %s/old/state.lw", dir), 0);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "old/state.lw:") && strstr(errs, ": section [extra] is unknown"), "%s", errs);
 }
 
 /* Bad input of every kind exits 2 with one message naming the file, line

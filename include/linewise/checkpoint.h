@@ -24,6 +24,10 @@
 ** for the coldest rung, "system <name> K" for rung K. */
 void lw_checkpoint_system_section(char *buf, size_t n, const lw_system_type *t, int k);
 
+/* 1 if name is a section a state is written with ([run], [chain 3], [system
+** splines 2], ...), for lw_ckpt_known_sections. */
+int lw_checkpoint_section_known(const char *name);
+
 /* Writes the checkpoint of a (trace.csv synced, state.lw, replica-K.lw). */
 lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err);
 
