@@ -240,44 +240,93 @@ static int numbered(const char *name, const char *prefix, const char *suffix)
   return nd > 0 && !strncmp(rest, suffix, ns) && (!rest[ns] || !strcmp(rest + ns, ".tmp"));
 }
 
-/* Removes sub's entries prefix + digits + suffix under dir, then sub if
-** that leaves it empty. */
-static lw_status clear_numbered(const char *dir, const char *sub, const char *prefix, const char *suffix,
-                                lw_error *err)
+/* A run made again in place replaces the run before, but only once its own
+** first checkpoint is written: until then the run before waits in
+** DIR/.replaced (renamed, which takes no room on a full disk) and comes back
+** if the set-up fails, so a disk that fills at the start loses neither. */
+#define STASH ".replaced"
+
+/* Moves (or, with to NULL, removes) from's entries prefix + digits + suffix
+** under sub, then removes from/sub if that leaves it empty. */
+static lw_status move_numbered(const char *from, const char *to, const char *sub, const char *prefix,
+                               const char *suffix, lw_error *err)
 {
-  char path[LW_PATH_MAX + 64];
-  lw_path_join(path, sizeof path, dir, sub);
+  char path[LW_PATH_MAX + 64], dest[LW_PATH_MAX + 64];
+  lw_path_join(path, sizeof path, from, sub);
   DIR *d = opendir(path);
   if (!d) return LW_OK;
+  if (to) {
+    lw_path_join(dest, sizeof dest, to, sub);
+    if (sub[0] != '.' && mkdir(dest, 0777) && errno != EEXIST) {
+      closedir(d);
+      return lw_error_set(err, LW_EIO, "%s: cannot make: %s", dest, strerror(errno));
+    }
+  }
   lw_status s = LW_OK;
   for (struct dirent *e; !s && (e = readdir(d));) {
     if (!numbered(e->d_name, prefix, suffix)) continue;
-    char file[2 * LW_PATH_MAX];
+    char file[2 * LW_PATH_MAX], there[2 * LW_PATH_MAX];
     snprintf(file, sizeof file, "%s/%s", path, e->d_name);
-    if (unlink(file) && errno != ENOENT) s = lw_error_set(err, LW_EIO, "%s: cannot remove: %s", file, strerror(errno));
+    if (to) snprintf(there, sizeof there, "%s/%s", dest, e->d_name);
+    if (to ? rename(file, there) : unlink(file) && errno != ENOENT)
+      s = lw_error_set(err, LW_EIO, "%s: cannot %s: %s", file, to ? "move" : "remove", strerror(errno));
   }
   closedir(d);
   if (!s && sub[0] != '.') rmdir(path); /* fails, harmlessly, if the user keeps other files there */
   return s;
 }
 
-static lw_status clear_run(const char *dir, lw_error *err)
+/* Moves (to NULL: removes) the files of a run from one directory to another. */
+static lw_status move_run(const char *from, const char *to, lw_error *err)
 {
-  char path[LW_PATH_MAX + 32];
-  if (!lw_rundir_holds_run(dir)) return LW_OK;
   for (size_t i = 0; i < sizeof run_files / sizeof *run_files; i++)
     for (int tmp = 0; tmp < 2; tmp++) {
-      char name[64];
+      char name[64], path[LW_PATH_MAX + 32], there[LW_PATH_MAX + 64];
       snprintf(name, sizeof name, "%s%s", run_files[i], tmp ? ".tmp" : "");
-      lw_path_join(path, sizeof path, dir, name);
-      if (unlink(path) && errno != ENOENT)
-        return lw_error_set(err, LW_EIO, "%s: cannot remove the file of the run before: %s", path, strerror(errno));
+      lw_path_join(path, sizeof path, from, name);
+      if (to && !tmp) lw_path_join(there, sizeof there, to, name);
+      if ((to && !tmp ? rename(path, there) : unlink(path)) && errno != ENOENT)
+        return lw_error_set(err, LW_EIO, "%s: cannot %s the file of the run before: %s", path,
+                            to && !tmp ? "move" : "remove", strerror(errno));
     }
   lw_status s;
-  if ((s = clear_numbered(dir, ".", "replica-", ".lw", err)) ||
-      (s = clear_numbered(dir, "frames", "frame-", ".png", err)))
+  if ((s = move_numbered(from, to, ".", "replica-", ".lw", err)) ||
+      (s = move_numbered(from, to, "frames", "frame-", ".png", err)))
     return s;
-  return clear_numbered(dir, "samples", "sample-", ".csv", err);
+  return move_numbered(from, to, "samples", "sample-", ".csv", err);
+}
+
+static void stash_path(char *buf, size_t n, const char *dir) { lw_path_join(buf, n, dir, STASH); }
+
+/* The run before, gone for good (the new run has its checkpoint), or a
+** stash a killed set-up left. */
+static void drop_stash(const char *dir)
+{
+  char st[LW_PATH_MAX + 16];
+  stash_path(st, sizeof st, dir);
+  if (access(st, F_OK)) return;
+  move_run(st, NULL, NULL);
+  rmdir(st);
+}
+
+static lw_status stash_run(const char *dir, lw_error *err)
+{
+  char st[LW_PATH_MAX + 16];
+  if (!lw_rundir_holds_run(dir)) return LW_OK;
+  drop_stash(dir);
+  stash_path(st, sizeof st, dir);
+  if (mkdir(st, 0777)) return lw_error_set(err, LW_EIO, "%s: cannot make: %s", st, strerror(errno));
+  return move_run(dir, st, err);
+}
+
+/* A failed set-up: its files go, the run before comes back (1 if there was
+** one and it all came back). */
+static int restore_stash(const char *dir)
+{
+  char st[LW_PATH_MAX + 16];
+  stash_path(st, sizeof st, dir);
+  if (access(st, F_OK)) return 0;
+  return !move_run(dir, NULL, NULL) && !move_run(st, dir, NULL) && !rmdir(st);
 }
 
 /* Schedule and its table (relative to the scene file).  The dynamics has no
@@ -858,6 +907,8 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
   return lw_anneal_start_net(a, p, dir, NULL, err);
 }
 
+static lw_status write_start(lw_anneal *a, lw_anneal_net *net, lw_error *err);
+
 lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir, lw_anneal_net *net, lw_error *err)
 {
   memset(a, 0, sizeof *a);
@@ -913,11 +964,23 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   lw_phase_writing();
   if ((s = lw_rundir_make(dir, err)) || (writes_files(a) && (s = lw_rundir_lock(dir, &a->dir_hold, err))))
     return s;
-  if (writes_files(a) && (s = clear_run(dir, err))) return s;
   if (!writes_files(a)) {
     lw_phase_set(NULL);
     return LW_OK;
   }
+  if ((s = stash_run(dir, err)) || (s = write_start(a, net, err))) {
+    a->put_back = restore_stash(dir);
+    return s;
+  }
+  drop_stash(dir);
+  return LW_OK;
+}
+
+/* The new run's first files, up to its first checkpoint (net: the first is
+** the network's, after this). */
+static lw_status write_start(lw_anneal *a, lw_anneal_net *net, lw_error *err)
+{
+  lw_status s;
   char path[LW_PATH_MAX + 32], tmp[LW_PATH_MAX + 64];
   dir_file(path, sizeof path, a, "scene.ini");
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);

@@ -791,8 +791,8 @@ static int cmd_run(int argc, char **argv)
     ** state.lw: what to do next, as loop_fail says later) */
     const size_t n = strlen(err.msg);
     if (err.code == LW_EIO && strstr(err.msg, ": write failed"))
-      snprintf(err.msg + n, sizeof err.msg - n, "; the run wrote no checkpoint: run it again once the files can be "
-               "written");
+      snprintf(err.msg + n, sizeof err.msg - n, "; the run wrote no checkpoint%s: run it again once the files can "
+               "be written", a.put_back ? ", and the run that was in the directory is back as it was" : "");
     lw_anneal_free(&a);
     unmake_dir(dir, hold, made);
     return watched_fail(&w, &err);

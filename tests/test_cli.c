@@ -662,6 +662,20 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
                           "$? -eq 1 && grep -q 'f0/state.lw: write failed: File too large; the run wrote no "
                           "checkpoint: run it again once the files can be written' %s/err.txt", lw_test_bin(),
                           lw_test_root(), dir, dir, dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+  /* made again over a finished run (with frames), the run before stays until
+  ** the new one's first checkpoint: a failed one puts it back, byte for
+  ** byte (it was removed first, and both were lost); a run that goes on
+  ** replaces it and leaves no .replaced */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/old --quiet --set output.frames_every=100 && cp -rp "
+                          "%s/old %s/keep && sh -c 'ulimit -f 8; %s run %s/params/minimal.ini --out %s/old --quiet "
+                          "--seed 5' 2>%s/err.txt; test $? -eq 1 && grep -q 'old/state.lw: write failed: File too "
+                          "large; the run wrote no checkpoint, and the run that was in the directory is back as it "
+                          "was' %s/err.txt && rm %s/old/.lock %s/keep/.lock && diff -r %s/old %s/keep",
+                          lw_test_bin(), lw_test_root(), dir, dir, dir, lw_test_bin(), lw_test_root(), dir, dir, dir,
+                          dir, dir, dir, dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/old --quiet --seed 5 --stop-at 0 && ! test -e "
+                          "%s/old/.replaced && ! test -e %s/old/frames && ! test -e %s/old/final.svg", lw_test_bin(),
+                          lw_test_root(), dir, dir, dir, dir), 0);
   /* a PNG cut short says why too (cairo's own message named no reason) */
   cr_assert_eq(lw_test_sh("sh -c 'ulimit -f 60; %s run %s/params/minimal.ini --out %s/fp --quiet --set "
                           "output.png_scale=20 --set anneal.sweeps=5' 2>%s/err.txt; test $? -eq 1 && grep -q "

@@ -59,6 +59,7 @@ typedef struct lw_anneal {
   long end_sweep;              /* stop after this sweep */
   long pause_at;               /* resume --sweeps N short of end_sweep: stop there as --stop-at does (-1: none) */
   int extending, new_end;      /* a resume to settle before its first sweep (anneal.c) */
+  int put_back;                /* a set-up that failed put the run it was to replace back */
   unsigned long long scene_hash; /* lw_params_run_hash of scene.ini, kept in state.lw */
   lw_run_keys scene_keys;        /* and its keys' parts */
   long block;                  /* current temperature step */
