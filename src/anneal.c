@@ -319,14 +319,16 @@ static lw_status stash_run(const char *dir, lw_error *err)
   return move_run(dir, st, err);
 }
 
-/* A failed set-up: its files go, the run before comes back (1 if there was
-** one and it all came back). */
+/* A failed set-up: its files go (a directory of a scene.ini without a state
+** resumed nothing), the run before comes back (1 if there was one and it all
+** came back). */
 static int restore_stash(const char *dir)
 {
   char st[LW_PATH_MAX + 16];
   stash_path(st, sizeof st, dir);
+  int gone = !move_run(dir, NULL, NULL);
   if (access(st, F_OK)) return 0;
-  return !move_run(dir, NULL, NULL) && !move_run(st, dir, NULL) && !rmdir(st);
+  return gone && !move_run(st, dir, NULL) && !rmdir(st);
 }
 
 /* Schedule and its table (relative to the scene file).  The dynamics has no

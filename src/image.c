@@ -252,10 +252,12 @@ static void decoded_row(const void *pix, int bits, int w, int ch, int j, lw_imag
       size_t at = base + (size_t)i * (size_t)ch + (size_t)k;
       c[k] = scale * (bits == 16 ? (float)((const uint16_t *)pix)[at] : (float)((const unsigned char *)pix)[at]);
     }
-    float g = ch < 3 ? c[0] : which == LW_IMAGE_LUMA ? 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]
-                                                     : c[which - LW_IMAGE_RED];
+    float g = ch < 3                                             ? c[0]
+              : which == LW_IMAGE_LUMA || which == LW_IMAGE_MASK ? 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]
+                                                                 : c[which - LW_IMAGE_RED];
     float a = ch == 2 ? c[1] : ch == 4 ? c[3] : 1.0f;
     tone[i] = a * g + (1.0f - a);
+    if (which == LW_IMAGE_MASK) tone[i] = tone[i] < 0.5f ? 0.0f : 1.0f;
     if (ch == 2 || ch == 4) alpha[i] = a;
   }
 }

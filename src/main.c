@@ -790,7 +790,7 @@ static int cmd_run(int argc, char **argv)
     /* (a failed first write said only that, leaving a directory without a
     ** state.lw: what to do next, as loop_fail says later) */
     const size_t n = strlen(err.msg);
-    if (err.code == LW_EIO && strstr(err.msg, ": write failed"))
+    if (err.code == LW_EIO && !lw_phase_unwritten())
       snprintf(err.msg + n, sizeof err.msg - n, "; the run wrote no checkpoint%s: run it again once the files can "
                "be written", a.put_back ? ", and the run that was in the directory is back as it was" : "");
     lw_anneal_free(&a);

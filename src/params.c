@@ -75,7 +75,9 @@ const lw_param_def lw_param_table[] = {
       "(and `mask_image`) is fitted into the page inset by it."),
   STRING("scene", "polygon", polygon, "", "mm",
          "Polygon boundary vertices as `x y x y ...` (at least 3 vertices; either orientation; a simple "
-         "polygon, its edges meeting only at their shared vertices: a star is given by its outline)."),
+         "polygon, its edges meeting only at their shared vertices: a star is given by its outline). The "
+         "value fits on one scene line, so it holds about 20 to 30 vertices; a detailed outline (a coast, "
+         "lettering) is a picture: `boundary = mask`."),
   STRING("scene", "image", image, "", "path",
          "A picture (PNG, JPEG, GIF, BMP, binary PGM/PPM; gray or colour, with or without alpha) relative to "
          "the scene file. It is fitted into the page inset by `margin`, centred, aspect kept. "
@@ -940,7 +942,8 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     ** that scene.ini, written back by a run, reads again. */
     size_t len = strlen(text), cap = lw_params_text_cap(d);
     if (len > cap) {
-      snprintf(expected, n, "at most %zu bytes", cap);
+      snprintf(expected, n, "at most %zu bytes (a scene line's%s)", cap,
+               !strcmp(d->key, "polygon") ? "; a detailed outline is a picture: boundary = mask" : "");
       return 0;
     }
     if (!lw_params_text_reads_back(text)) {

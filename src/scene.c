@@ -69,16 +69,16 @@ static double least_side(int W, int H) { return fmin(4.0, fmin(W, H)); }
 
 /* Loads the picture of section.key (scene.image, scene.mask_image,
 ** output.fidelity_reference) at path, relative to the scene file, and fits
-** it into the margin box. */
+** it into the margin box; which: its luma, or a mask's inside (image.h). */
 static lw_image *load_picture(lw_scene *sc, const lw_params *p, const char *section, const char *key,
-                              const char *path, lw_image_place *pl, lw_error *err)
+                              const char *path, lw_image_channel which, lw_image_place *pl, lw_error *err)
 {
   char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
   lw_path_dir(dir, sizeof dir, p->file);
   lw_path_join(full, sizeof full, dir, path);
   lw_image_info info;
   lw_error e2;
-  lw_image *img = lw_image_load(full, p->image_max_pixels, &info, &e2);
+  lw_image *img = lw_image_load_channel(full, p->image_max_pixels, which, &info, &e2);
   if (!img) {
     bad_key(p, section, key, e2.code, err, "%s", e2.msg);
     return NULL;
@@ -132,17 +132,21 @@ static void dark_note(lw_scene *sc, const lw_params *p)
   const lw_image *im = sc->image;
   const lw_image_place *pl = &sc->image_place;
   const int step = (int)ceil(sqrt((double)im->width * im->height / 250000.0));
-  size_t dark = 0, seen = 0;
+  /* dark inside the frame, and in the picture as a whole: lettering masked
+  ** by its own glyphs is all dark inside and wants just that */
+  size_t dark = 0, seen = 0, dark_all = 0, seen_all = 0;
   for (int j = 0; j < im->height; j += step)
     for (int i = 0; i < im->width; i += step) {
       const size_t k = (size_t)j * (size_t)im->width + (size_t)i;
-      if ((im->alpha && im->alpha[k] < 0.5f) ||
-          !lw_boundary_inside(&sc->boundary, pl->x0 + (i + 0.5) * pl->pixel, pl->y0 + (j + 0.5) * pl->pixel))
+      if (im->alpha && im->alpha[k] < 0.5f) continue;
+      seen_all++;
+      dark_all += im->tone[k] <= DARK_TONE;
+      if (!lw_boundary_inside(&sc->boundary, pl->x0 + (i + 0.5) * pl->pixel, pl->y0 + (j + 0.5) * pl->pixel))
         continue;
       seen++;
       dark += im->tone[k] <= DARK_TONE;
     }
-  if (!seen || (double)dark <= DARK_SHARE * (double)seen) return;
+  if (!seen || (double)dark <= DARK_SHARE * (double)seen || (double)dark_all <= DARK_SHARE * (double)seen_all) return;
   size_t used = strlen(sc->note);
   snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image: %.0f %% of the picture is %.0f %% dark or darker "
            "after its tone curve, so the lines there can only hatch evenly at their densest and little of the picture "
@@ -176,7 +180,7 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
 {
   lw_status st = margin_ok(p, err);
   if (st) return st;
-  sc->image = load_picture(sc, p, "scene", "image", p->image, &sc->image_place, err);
+  sc->image = load_picture(sc, p, "scene", "image", p->image, LW_IMAGE_LUMA, &sc->image_place, err);
   if (!sc->image) return err->code;
   if (p->image_width > 0 && p->image_width != sc->image->width) {
     double h = (double)sc->image->height * p->image_width / sc->image->width;
@@ -258,7 +262,7 @@ static lw_status build_mask(lw_scene *sc, const lw_params *p, lw_error *err)
     if (!p->mask_image[0]) return bad_key(p, "scene", "mask", LW_EINPUT, err, "'image' needs scene.mask_image");
     lw_status st = margin_ok(p, err);
     if (st) return st;
-    img = own = load_picture(sc, p, "scene", "mask_image", p->mask_image, &pl, err);
+    img = own = load_picture(sc, p, "scene", "mask_image", p->mask_image, LW_IMAGE_MASK, &pl, err);
     if (!own) return err->code;
     thin_note(sc, p, "mask_image", img, &pl);
   }
@@ -269,7 +273,7 @@ static lw_status build_mask(lw_scene *sc, const lw_params *p, lw_error *err)
     return lw_error_set(err, LW_ENOMEM, "out of memory for the mask");
   }
   for (size_t k = 0; k < n; k++)
-    inside[k] = p->mask == LW_MASK_ALPHA ? img->alpha[k] >= 0.5f : img->tone[k] < 0.5f;
+    inside[k] = p->mask == LW_MASK_ALPHA ? img->alpha[k] >= 0.5f : img->tone[k] <= 0.0f;
   lw_error e2;
   sc->boundary.kind = LW_BOUNDARY_MASK;
   sc->boundary.sdt = lw_sdt_grid(inside, img->width, img->height, &pl, &e2);
@@ -325,13 +329,22 @@ static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
         bad_key(p, "scene", "polygon", st, err, "%s", e2.msg);
       /* (a polygon in the margin was annealed, then drawn empty or cut,
       ** said only at the end) */
-      else if (p->crop && !p->image[0] &&
-               (lo[0] < p->margin || hi[0] > p->width - p->margin || lo[1] < p->margin ||
-                hi[1] > p->height - p->margin)) {
+      else if (p->crop) {
+        /* plot.crop's rectangle: the picture's where there is one (placed
+        ** above), else the page inset by the margin */
+        const lw_image_place *pl = &sc->image_place;
+        const double c0[2] = {sc->image ? pl->x0 : p->margin, sc->image ? pl->y0 : p->margin};
+        const double c1[2] = {sc->image ? pl->x0 + sc->image->width * pl->pixel : p->width - p->margin,
+                              sc->image ? pl->y0 + sc->image->height * pl->pixel : p->height - p->margin};
+        char box[160];
+        if (sc->image)
+          snprintf(box, sizeof box, "the picture's rectangle (x %g to %g, y %g to %g mm)", c0[0], c1[0], c0[1], c1[1]);
+        else
+          snprintf(box, sizeof box, "the page inset by scene.margin (%g mm)", p->margin);
         const size_t used = strlen(sc->note);
-        snprintf(sc->note + used, sizeof sc->note - used, "%sscene.polygon (x %g to %g, y %g to %g mm) reaches past "
-                 "the page inset by scene.margin (%g mm), where plot.crop cuts the drawing", used ? "; " : "", lo[0],
-                 hi[0], lo[1], hi[1], p->margin);
+        if (lo[0] < c0[0] || hi[0] > c1[0] || lo[1] < c0[1] || hi[1] > c1[1])
+          snprintf(sc->note + used, sizeof sc->note - used, "%sscene.polygon (x %g to %g, y %g to %g mm) reaches past "
+                   "%s, where plot.crop cuts the drawing", used ? "; " : "", lo[0], hi[0], lo[1], hi[1], box);
       }
     }
     free(xs);
@@ -571,7 +584,7 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   if (p->image[0] && (st = build_image(sc, p, err))) return st;
   if (p->fidelity_reference[0]) {
     if ((st = margin_ok(p, err))) return st;
-    sc->reference = load_picture(sc, p, "output", "fidelity_reference", p->fidelity_reference,
+    sc->reference = load_picture(sc, p, "output", "fidelity_reference", p->fidelity_reference, LW_IMAGE_LUMA,
                                  &sc->reference_place, err);
     if (!sc->reference) return err->code;
     if ((st = scored_side_ok(p, "output", "fidelity_reference", sc->reference, err))) return st;
@@ -687,6 +700,9 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     }
     break;
   case LW_BND_POLYGON:
+    /* the margin frames no polygon, but without a picture it sets plot.crop's
+    ** rectangle: an empty one failed the drawing after every sweep had run */
+    if (p->crop && !p->image[0] && (st = margin_ok(p, err))) return st;
     st = build_polygon(sc, p, err);
     if (st) return st;
     break;

@@ -84,7 +84,8 @@ lw_status lw_strokes_add(lw_strokes *s, int pen, size_t src, unsigned part, int 
   if (pen < last_pen(s) || pen >= s->n_pens || nseg == 0)
     return lw_error_set(err, LW_EINPUT, "a path of pen %d with %zu segments after pen %d of %d", pen + 1, nseg,
                         last_pen(s) + 1, s->n_pens);
-  if (!grow(s, nseg)) return lw_error_set(err, LW_ENOMEM, "out of memory for %zu paths", s->n + 1);
+  if (!grow(s, nseg))
+    return lw_error_set(err, LW_ENOMEM, "out of memory while gathering the drawing's paths (at path %zu)", s->n + 1);
   memcpy(s->b + 8 * s->n_segs, b, 8 * nseg * sizeof *b);
   s->n_segs += nseg;
   s->reversed[s->n] = (unsigned char)(reversed != 0);

@@ -611,6 +611,9 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
     {"run %s/te.ini", "te.ini:3: key 'anneal.t_end': schedule geometric: t_end must be a finite number > 0"},
     {"run %s/s.ini --set anneal.t_start=-0", "--set: key 'anneal.t_start': schedule geometric: t_start must be"},
     {"energy %s", "state.lw: cannot read state file: Is a directory"},
+    /* the margin sets a polygon's crop (no picture): it annealed, then failed */
+    {"run %s/s.ini --set scene.boundary=polygon --set 'scene.polygon=10 10 90 10 50 70' --set scene.margin=40",
+     "--set: key 'scene.margin': expected less than half the page (100 x 80 mm), got 40"},
   };
   char sub[128];
   snprintf(sub, sizeof sub, "%s/sd/state.lw", dir);

@@ -498,6 +498,13 @@ static float dark_tone(int i, int j)
   return i < 3 * PICTURE_W / 5 ? 0.1f : 0.9f;
 }
 
+/* Dark in its left fifth: lettering, masked by itself. */
+static float glyph_tone(int i, int j)
+{
+  (void)j;
+  return i < PICTURE_W / 5 ? 0.1f : 0.9f;
+}
+
 /* Inside a mask (tone below 1/2): the light right two fifths. */
 static float light_part(int i, int j)
 {
@@ -530,6 +537,13 @@ Test(image_cli, a_picture_dark_nearly_all_over_gets_a_note)
     cr_assert_eq(at != NULL, cases[k].noted, "%s: %s", cases[k].keys, sc.note);
     lw_scene_clear(&sc);
   }
+  /* all dark inside its own glyphs, a fifth dark as a whole: the dark is the
+  ** shape, and the note's advice (invert) would leave nothing to draw */
+  write_tone_picture("glyphs.png", glyph_tone);
+  lw_scene sc;
+  picture_scene("glyphs.png", "boundary = mask\nmask = image\nmask_image = glyphs.png\n[energy]\ntone = 1\n", &sc);
+  cr_assert_null(strstr(sc.note, "dark or darker"), "%s", sc.note);
+  lw_scene_clear(&sc);
 }
 
 /* A panorama keeps its shape inside the frame: 400 x 3 pixels in a 40 x 30
@@ -624,6 +638,59 @@ Test(image_cli, an_alpha_mask_is_the_boundary)
   lw_splines_free(sp);
   gsl_rng_free(r);
   lw_scene_clear(&sc);
+}
+
+/* With a picture plot.crop cuts at the picture's rectangle, not at the
+** margin: a polygon past it was cut without a word (the note looked at the
+** margin, and only without a picture). */
+Test(image_cli, a_polygon_past_the_pictures_rectangle_is_said)
+{
+  write_tone_picture("dark.png", dark_tone);
+  static const struct { const char *keys; int noted; } cases[] = {
+    {"boundary = polygon\npolygon = 0 0 50 0 50 40 0 40\n", 1},
+    {"boundary = polygon\npolygon = 20 15 30 15 25 25\n", 0},
+    {"boundary = polygon\npolygon = 0 0 50 0 50 40 0 40\n[plot]\ncrop = 0\n", 0},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    lw_scene sc;
+    picture_scene("dark.png", cases[k].keys, &sc);
+    cr_assert_eq(strstr(sc.note, "scene.polygon (x 0 to 50, y 0 to 40 mm) reaches past the picture's rectangle (x ")
+                     != NULL, cases[k].noted, "%s: %s", cases[k].keys, sc.note);
+    lw_scene_clear(&sc);
+  }
+}
+
+/* A mask downsampled keeps its gaps: land 250 px wide on a 50 mm square
+** with a river one pixel (0.2 mm) wide at x = 25.2 mm, taken to 160 x 160
+** pixels; averaged, the river came out a grey darker than 1/2 (inside), and
+** lines crossed it.  Inside now only where all a pixel covers is. */
+Test(image_cli, a_downsampled_mask_keeps_a_gap_one_pixel_wide)
+{
+  enum { W = 250 };
+  static float g[W * W];
+  for (int j = 0; j < W; j++)
+    for (int i = 0; i < W; i++) g[j * W + i] = i == 126 ? 1.0f : 0.0f;
+  lw_test_png(lw_test_path("river.png"), W, W, g, NULL);
+  lw_params p;
+  lw_scene sc;
+  lw_error err;
+  for (int small = 0; small < 2; small++) {
+    write_text("scene.ini", small ? "[scene]\nwidth = 50\nheight = 50\nmargin = 0\nboundary = mask\nmask = image\n"
+                                     "mask_image = river.png\nimage_max_pixels = 25600\n"
+                                   : "[scene]\nwidth = 50\nheight = 50\nmargin = 0\nboundary = mask\nmask = image\n"
+                                     "mask_image = river.png\n");
+    cr_assert_eq(lw_params_read(&p, lw_test_path("scene.ini"), &err), LW_OK, "%s", err.msg);
+    cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
+    cr_assert_eq(strstr(sc.note, "downsampled to 160 x 160") != NULL, small, "%s", sc.note);
+    /* every point along the river at x = 25.3 mm is outside, and the
+    ** land a pixel of the small mask away on either side inside */
+    for (double y = 1; y < 49; y += 0.5) {
+      cr_assert(!lw_boundary_inside(&sc.boundary, 25.3, y), "small %d: the river is inside at y = %g", small, y);
+      cr_assert(lw_boundary_inside(&sc.boundary, 24.4, y) && lw_boundary_inside(&sc.boundary, 26.0, y),
+                "small %d: the banks at y = %g", small, y);
+    }
+    lw_scene_clear(&sc);
+  }
 }
 
 Test(image_cli, every_bundled_scene_builds)

@@ -60,8 +60,12 @@ lw_image *lw_image_decode(const unsigned char *data, size_t size, const char *na
 
 /* What becomes the tone plane: the luma above, or one colour channel as
 ** stored (a gray picture gives its gray for each), for colour separation
-** (layers.h).  Everything else -- alpha, downsampling -- is the same. */
-typedef enum { LW_IMAGE_LUMA, LW_IMAGE_RED, LW_IMAGE_GREEN, LW_IMAGE_BLUE } lw_image_channel;
+** (layers.h).  Everything else -- alpha, downsampling -- is the same.
+** LW_IMAGE_MASK is a mask's inside: 0 where the luma composited over white is
+** below 1/2, else 1, before downsampling, so that a pixel of a downsampled
+** mask is 0 only where all it covers is inside (a thin gap outside, a river
+** one source pixel wide, averaged away under 1/2 and lines crossed it). */
+typedef enum { LW_IMAGE_LUMA, LW_IMAGE_RED, LW_IMAGE_GREEN, LW_IMAGE_BLUE, LW_IMAGE_MASK } lw_image_channel;
 lw_image *lw_image_decode_channel(const unsigned char *data, size_t size, const char *name, double max_pixels,
                                   lw_image_channel which, lw_image_info *info, lw_error *err);
 
