@@ -9,9 +9,13 @@ BIN     ?= bin
 PKGS    := gsl cairo inih zlib
 OPT     ?= -O2
 CFLAGS  ?= $(OPT) -g
-WARN    := -std=c11 -Wall -Wextra -Wshadow -Wstrict-prototypes -Wno-unused-parameter
-CPPFLAGS += -Iinclude -D_POSIX_C_SOURCE=200809L $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
-LDLIBS  += $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lm
+# -ffp-contract=off: no fused multiply-add, which clang makes by default where the
+# target has it, and which changes results (docs/NUMERICS.md, "Determinism and drift").
+WARN    := -std=c11 -ffp-contract=off -Wall -Wextra -Wshadow -Wstrict-prototypes -Wno-unused-parameter
+# What the build needs, apart from CPPFLAGS and LDLIBS, which a packager may set on the
+# command line (make CPPFLAGS="$(dpkg-buildflags --get CPPFLAGS)") and so replace.
+LW_CPPFLAGS := -Iinclude -D_POSIX_C_SOURCE=200809L $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+LW_LDLIBS := $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lm
 OMP     := -fopenmp
 # Each object lists the headers it includes in a .d file beside it, so a
 # header's change rebuilds only what includes it.
@@ -48,34 +52,34 @@ PICTURE := params/picture.png
 all: $(BIN)/linewise $(PICTURE) $(MPI_BIN)
 
 $(BUILD)/obj/%.o: src/%.c | $(BUILD)/obj
-	$(CC) $(WARN) $(CFLAGS) $(OMP) $(DEPFLAGS) $(CPPFLAGS) -c $< -o $@
+	$(CC) $(WARN) $(CFLAGS) $(OMP) $(DEPFLAGS) $(LW_CPPFLAGS) $(CPPFLAGS) -c $< -o $@
 
 $(BUILD)/liblinewise.a: $(LIB_OBJ)
 	rm -f $@ && ar rcs $@ $^
 
 # (main.c alone, so any header's change compiles it again)
 $(BIN)/linewise: src/main.c $(wildcard include/linewise/*.h) $(BUILD)/liblinewise.a | $(BIN)
-	$(CC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) $< -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
+	$(CC) $(WARN) $(CFLAGS) $(OMP) $(LW_CPPFLAGS) $(CPPFLAGS) $< -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS) $(LW_LDLIBS)
 
 mpi: $(BIN)/linewise-mpi
 
 $(BIN)/linewise-mpi: src/main.c $(wildcard src/mpi/*.c) $(wildcard include/linewise/*.h) $(BUILD)/liblinewise.a | $(BIN)
-	$(MPICC) $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -DLW_MPI src/main.c $(wildcard src/mpi/*.c) -o $@ \
-	  $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
+	$(MPICC) $(WARN) $(CFLAGS) $(OMP) $(LW_CPPFLAGS) $(CPPFLAGS) -DLW_MPI src/main.c $(wildcard src/mpi/*.c) -o $@ \
+	  $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS) $(LW_LDLIBS)
 
 $(BUILD)/tests/%.o: tests/%.c | $(BUILD)/tests
-	$(CC) $(WARN) $(CFLAGS) $(OMP) $(DEPFLAGS) $(CPPFLAGS) -Itests -c $< -o $@
+	$(CC) $(WARN) $(CFLAGS) $(OMP) $(DEPFLAGS) $(LW_CPPFLAGS) $(CPPFLAGS) -Itests -c $< -o $@
 
 # stb_image_write (the image tests' JPEG writer) shifts signed ints out of
 # range: built without UBSan, so that `make asan` reports only our code
 $(BUILD)/tests/stb_write.o: tests/stb_write.c | $(BUILD)/tests
-	$(CC) $(WARN) $(CFLAGS) -fno-sanitize=undefined $(CPPFLAGS) -c $< -o $@
+	$(CC) $(WARN) $(CFLAGS) -fno-sanitize=undefined $(LW_CPPFLAGS) $(CPPFLAGS) -c $< -o $@
 
 $(BUILD)/tests/fuzz_%.o: tests/fuzz/fuzz_%.c | $(BUILD)/tests
-	$(CC) $(WARN) $(CFLAGS) $(DEPFLAGS) $(CPPFLAGS) -DLLVMFuzzerTestOneInput=lw_fuzz_$*_one -c $< -o $@
+	$(CC) $(WARN) $(CFLAGS) $(DEPFLAGS) $(LW_CPPFLAGS) $(CPPFLAGS) -DLLVMFuzzerTestOneInput=lw_fuzz_$*_one -c $< -o $@
 
 $(BUILD)/tests/run: $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) $(BUILD)/liblinewise.a
-	$(CC) $(CFLAGS) $(OMP) $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS) -lcriterion
+	$(CC) $(CFLAGS) $(OMP) $(TEST_OBJ) $(FUZZ_REPLAY_OBJ) -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS) $(LW_LDLIBS) -lcriterion
 
 $(BUILD)/obj $(BUILD)/tests $(BIN):
 	mkdir -p $@
@@ -115,10 +119,10 @@ FUZZ_SAN  := -g -O1 -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sa
 FUZZ_WARN := $(WARN) -Wno-unknown-pragmas
 
 build-fuzz/obj/%.o: src/%.c | build-fuzz/obj
-	$(FUZZ_CC) $(FUZZ_WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link $(DEPFLAGS) $(CPPFLAGS) -c $< -o $@
+	$(FUZZ_CC) $(FUZZ_WARN) $(FUZZ_SAN) -fsanitize=fuzzer-no-link $(DEPFLAGS) $(LW_CPPFLAGS) $(CPPFLAGS) -c $< -o $@
 
 build-fuzz/fuzz_%: tests/fuzz/fuzz_%.c $(wildcard tests/fuzz/*.h) $(FUZZ_OBJ)
-	$(FUZZ_CC) $(FUZZ_WARN) $(FUZZ_SAN) -fsanitize=fuzzer $(CPPFLAGS) $< $(FUZZ_OBJ) -o $@ $(LDLIBS)
+	$(FUZZ_CC) $(FUZZ_WARN) $(FUZZ_SAN) -fsanitize=fuzzer $(LW_CPPFLAGS) $(CPPFLAGS) $< $(FUZZ_OBJ) -o $@ $(LDLIBS) $(LW_LDLIBS)
 
 # kept between runs (make would delete them as intermediates)
 .SECONDARY: $(FUZZ_OBJ)
@@ -156,7 +160,7 @@ run: bin/linewise $(PICTURE)
 	bin/linewise run params/example.ini --out out/example
 
 $(BUILD)/make-picture: tools/make-picture.c | $(BUILD)/obj
-	$(CC) $(WARN) $(CFLAGS) $(CPPFLAGS) $< -o $@ $(LDFLAGS) $(LDLIBS)
+	$(CC) $(WARN) $(CFLAGS) $(LW_CPPFLAGS) $(CPPFLAGS) $< -o $@ $(LDFLAGS) $(LDLIBS) $(LW_LDLIBS)
 
 $(PICTURE): $(BUILD)/make-picture
 	$(BUILD)/make-picture $@
@@ -172,10 +176,10 @@ docs: bin/linewise
 # the two-curve reference of the tests (tests/pairref.h).
 BENCH_SRC := tools/bench.c tools/bench-accuracy.c tools/bench-order.c tools/bench-regularity.c tools/bench-siman.c tools/bench-tempering.c tools/bench-domains.c tools/bench-tone.c tools/bench-nurbs.c tools/bench-quench.c tools/bench-transdim.c tools/bench-kink.c tools/bench-photo.c tools/benchutil.c
 BENCH_HDR := tools/benchutil.h tests/pairref.h tests/testutil.h $(wildcard include/linewise/*.h)
-TOOL_FLAGS = $(WARN) $(CFLAGS) $(OMP) $(CPPFLAGS) -Itools -Itests
+TOOL_FLAGS = $(WARN) $(CFLAGS) $(OMP) $(LW_CPPFLAGS) $(CPPFLAGS) -Itools -Itests
 
 $(BUILD)/bench: $(BENCH_SRC) $(BENCH_HDR) $(BUILD)/liblinewise.a
-	$(CC) $(TOOL_FLAGS) -DBENCH_CFLAGS='"$(CFLAGS)"' $(BENCH_SRC) -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
+	$(CC) $(TOOL_FLAGS) -DBENCH_CFLAGS='"$(CFLAGS)"' $(BENCH_SRC) -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS) $(LW_LDLIBS)
 
 # Benchmarks rewrite docs/PERFORMANCE.md and docs/ACCURACY.md (machine and date
 # recorded with them) and their plots docs/*.png; BENCH_QUICK=1 for a smoke run.
@@ -189,7 +193,7 @@ bench: $(BUILD)/bench $(BIN)/linewise $(BUILD)/make-picture $(MPI_BIN)
 # docs/nurbs-figure8.png and docs/nurbs-figure9.png (docs/NURBS.md).
 WIRE_DATA := $(BUILD)/wire-data
 $(BUILD)/wire-midpoint: tools/wire-midpoint.c $(BUILD)/liblinewise.a
-	$(CC) $(TOOL_FLAGS) $< -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS)
+	$(CC) $(TOOL_FLAGS) $< -o $@ $(BUILD)/liblinewise.a $(LDFLAGS) $(LDLIBS) $(LW_LDLIBS)
 
 wire-figures: $(BUILD)/wire-midpoint
 	mkdir -p $(WIRE_DATA)

@@ -82,6 +82,7 @@ static lw_status apply_a(lw_dynamics *d, const double *v, double *out, lw_error 
   for (size_t i = 0; i < n; i++) xs[i] = d->x[i] + s * v[i];
   lw_status st = t->set_coords(d->state, xs, err);
   if (st) return st;
+  lw_error_clear(err); /* a row's gradient sets it only where it fails */
   t->gradient(d->state, gs, err);
   if (err->code) return err->code;
   for (size_t i = 0; i < n; i++) out[i] += h * h * (gs[i] - d->g[i]) / s;
@@ -125,6 +126,7 @@ lw_status lw_dyn_review_step(lw_dynamics *d, lw_error *err)
   /* p+ = p + delta, pi+ = M delta / h */
   for (size_t i = 0; i < n; i++) d->x[i] += delta[i];
   if ((st = t->set_coords(d->state, d->x, err))) return st;
+  lw_error_clear(err);
   d->energy = t->gradient(d->state, d->g, err);
   if (err->code) return err->code;
   if (!isfinite(d->energy)) {

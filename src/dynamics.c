@@ -59,6 +59,7 @@ static lw_status evaluate(lw_dynamics *d, const double *x, lw_error *err)
 {
   lw_status s = d->type->set_coords(d->state, x, err);
   if (s) return s;
+  lw_error_clear(err); /* a row's gradient sets it only where it fails */
   d->energy = d->type->gradient(d->state, d->g, err);
   if (isnan(d->energy)) return err->code ? err->code : lw_error_set(err, LW_EINPUT, "the energy is not a number");
   if (isfinite(d->energy))

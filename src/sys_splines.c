@@ -1032,6 +1032,7 @@ static double energy(const void *setup, const lw_state *st, const char *path, do
     return NAN;
   }
   if (lw_model_check_regular(sc, st->sp, path, err) || lw_model_check_layers(sc, st->sp, path, err)) return NAN;
+  lw_error_clear(err); /* lw_energy_compute sets it only where it fails */
   double total = lw_energy_compute(sc, st->sp, term, err);
   if (err->code || lw_checkpoint_check_finite(sc, st->sp, term, path, err)) return NAN;
   return total;
