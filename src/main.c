@@ -27,6 +27,7 @@
 #include "linewise/state.h"
 #include "linewise/system.h"
 #include "linewise/trace.h"
+#include "linewise/vec2.h"
 #include "linewise/version.h"
 #ifdef LW_MPI
 #include "linewise/mpi_tempering.h"
@@ -1085,9 +1086,26 @@ static int finish_stdout(int rc)
   return rc ? rc : 1;
 }
 
+/* LW_LANES=2 or 4 narrows the SIMD kernels below what the processor has (a
+** porter's check of the same-bits promise on one machine); 0 if unset. */
+static int narrow_lanes(void)
+{
+  const char *v = getenv("LW_LANES");
+  if (!v || !*v) return 0;
+  if (strcmp(v, "2") && strcmp(v, "4") && strcmp(v, "8")) {
+    fprintf(stderr, "linewise: environment LW_LANES: expected 2, 4 or 8 (the widest the processor has), got '%s'\n",
+            v);
+    return -1;
+  }
+  if (v[0] == '2') lw_vec_set_wide(0);
+  if (v[0] != '8') lw_vec_set_x8(0);
+  return 0;
+}
+
 int main(int argc, char **argv)
 {
   open_standard_descriptors();
+  if (narrow_lanes()) return 2;
 #ifndef LW_MPI
   choose_wait_policy(argc, argv);
 #endif
@@ -1143,6 +1161,9 @@ static int command(int argc, char **argv)
     }
     if (!listing) {
       printf("linewise %s\n", LW_VERSION);
+      /* what a porter checks the same-bits promise against (LW_LANES) */
+      printf("pair kernels %d lanes, cell scan %d lanes (LW_LANES=2 or 4 narrows them; every width gives the same "
+             "bits)\n", lw_vec_wide() ? 4 : 2, lw_vec_lanes());
       return 0;
     }
   }

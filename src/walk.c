@@ -76,8 +76,13 @@ static inline v2d vmax(v2d a, v2d b)
 }
 
 /* A 32-bit lane mask widened to 64-bit lanes: lanes 0, 1 (lo) or 2, 3 (hi). */
+#if defined(__clang__) || __GNUC__ >= 12
 static inline v2l lo2l(v4i m) { return (v2l)__builtin_shufflevector(m, m, 0, 0, 1, 1); }
 static inline v2l hi2l(v4i m) { return (v2l)__builtin_shufflevector(m, m, 2, 2, 3, 3); }
+#else /* GCC before 12 has only its own shuffle, the same lanes */
+static inline v2l lo2l(v4i m) { return (v2l)__builtin_shuffle(m, (v4i){0, 0, 1, 1}); }
+static inline v2l hi2l(v4i m) { return (v2l)__builtin_shuffle(m, (v4i){2, 2, 3, 3}); }
+#endif
 
 /* A probe's constants in every lane, set up once per walk, and its sums. */
 typedef struct {
