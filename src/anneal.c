@@ -246,8 +246,21 @@ static int numbered(const char *name, const char *prefix, const char *suffix)
 ** if the set-up fails, so a disk that fills at the start loses neither. */
 #define STASH ".replaced"
 
+/* The plots tools/plot-run draws of a run (DIR/plots/NAME.png). */
+static int run_plot(const char *name)
+{
+  static const char *const plot[] = {"energy", "temperature", "acceptance", "replicas", "swaps", "heat_capacity",
+                                     "observables"};
+  for (size_t k = 0; k < sizeof plot / sizeof plot[0]; k++) {
+    size_t n = strlen(plot[k]);
+    if (!strncmp(name, plot[k], n) && !strcmp(name + n, ".png")) return 1;
+  }
+  return 0;
+}
+
 /* Moves (or, with to NULL, removes) from's entries prefix + digits + suffix
-** under sub, then removes from/sub if that leaves it empty. */
+** under sub (prefix NULL: the run's plots), then removes from/sub if that
+** leaves it empty. */
 static lw_status move_numbered(const char *from, const char *to, const char *sub, const char *prefix,
                                const char *suffix, lw_error *err)
 {
@@ -264,7 +277,7 @@ static lw_status move_numbered(const char *from, const char *to, const char *sub
   }
   lw_status s = LW_OK;
   for (struct dirent *e; !s && (e = readdir(d));) {
-    if (!numbered(e->d_name, prefix, suffix)) continue;
+    if (prefix ? !numbered(e->d_name, prefix, suffix) : !run_plot(e->d_name)) continue;
     char file[2 * LW_PATH_MAX], there[2 * LW_PATH_MAX];
     snprintf(file, sizeof file, "%s/%s", path, e->d_name);
     if (to) snprintf(there, sizeof there, "%s/%s", dest, e->d_name);
@@ -291,7 +304,8 @@ static lw_status move_run(const char *from, const char *to, lw_error *err)
     }
   lw_status s;
   if ((s = move_numbered(from, to, ".", "replica-", ".lw", err)) ||
-      (s = move_numbered(from, to, "frames", "frame-", ".png", err)))
+      (s = move_numbered(from, to, "frames", "frame-", ".png", err)) ||
+      (s = move_numbered(from, to, "plots", NULL, NULL, err)))
     return s;
   return move_numbered(from, to, "samples", "sample-", ".csv", err);
 }

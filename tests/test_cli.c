@@ -933,8 +933,9 @@ Test(cli, a_run_without_out_never_replaces_another)
 }
 
 /* A run into a directory that held another leaves none of the old run's
-** files: its machine files, replica states, frames, samples and the film
-** tools/animate.sh made would be taken for the new run's.  What the user
+** files: its machine files, replica states, frames, samples, the film
+** tools/animate.sh made and the plots of tools/plot-run would be taken for
+** the new run's.  What the user
 ** put there stays. */
 Test(cli, a_run_replacing_another_removes_the_files_it_does_not_write_again)
 {
@@ -944,6 +945,7 @@ Test(cli, a_run_replacing_another_removes_the_files_it_does_not_write_again)
                           "--set tempering.t_max=2 --set output.gcode=1 --set output.hpgl=1 --set output.pdf=1 "
                           "--set output.frames_every=2 --set output.samples_every=2 && echo mine > r/notes.txt && "
                           "echo mine > r/frames/keep.txt && touch r/state.lw.tmp r/animation.mp4 && "
+                          "mkdir r/plots && touch r/plots/swaps.png r/plots/mine.png && "
                           "test -f r/replica-1.lw && "
                           "test -f r/final.gcode && test -f r/frames/frame-000002.png && "
                           "test -f r/samples/sample-000002.csv",
@@ -954,6 +956,7 @@ Test(cli, a_run_replacing_another_removes_the_files_it_does_not_write_again)
                           "! test -e final.gcode && ! test -e final.hpgl && ! test -e final.pdf && "
                           "! test -e ladder.ini && ! test -e samples && ! test -e state.lw.tmp && "
                           "! test -e frames/frame-000002.png && ! test -e animation.mp4 && "
+                          "! test -e plots/swaps.png && test -e plots/mine.png && "
                           "test \"$(cat notes.txt frames/keep.txt)\" = "
                           "\"$(printf 'mine\\nmine')\"",
                           dir),

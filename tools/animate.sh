@@ -8,6 +8,11 @@ case ${1:-} in
 -h | --help) echo "$usage"; exit 0 ;;
 "") echo "$usage" >&2; exit 2 ;;
 esac
+if [ $# -gt 2 ]; then
+  echo "${0##*/}: expected a run directory and an optional FPS, got $# arguments" >&2
+  echo "$usage" >&2
+  exit 2
+fi
 dir=$1
 fps=${2:-25}
 # a frame rate ffmpeg cannot parse reached it, and only its own message said so
@@ -18,6 +23,10 @@ if ! printf '%s\n' "$fps" | grep -Eq '^([0-9]+\.?[0-9]*|\.[0-9]+)$' || ! awk -v 
 fi
 # a directory named "-x" must not read as an option of ls or cd
 case $dir in -*) dir=./$dir ;; esac
+if [ ! -d "$dir" ]; then
+  echo "${0##*/}: $dir: no such directory (expected a run directory)" >&2
+  exit 2
+fi
 if [ ! -d "$dir/frames" ] || [ -z "$(ls -- "$dir/frames" 2>/dev/null | grep '^frame-[0-9]*\.png$')" ]; then
   echo "${0##*/}: $dir/frames has no frames (set output.frames_every in the scene)" >&2
   exit 2
