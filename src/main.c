@@ -627,10 +627,25 @@ static lw_status spread_start(lw_status s, lw_anneal *a, int fresh, lw_error *er
 ** a person's, which a run would refuse to write over.  A run stopped before
 ** its first checkpoint has nothing to resume: its directory is taken again
 ** (unless the lock says it is still setting up). */
+/* A drawing or trace of a name a run writes, in a directory that holds no
+** run: a person's, or what is left of a run whose scene.ini and state.lw
+** were taken away; either way not to be written over unasked (its path). */
+static const char *stray_output(const char *dir)
+{
+  static const char *const outputs[] = {"final.svg", "final.png", "trace.csv", "summary.json"};
+  static char path[LW_PATH_MAX + 32];
+  if (lw_rundir_holds_run(dir)) return NULL;
+  for (size_t k = 0; k < sizeof outputs / sizeof outputs[0]; k++) {
+    lw_path_join(path, sizeof path, dir, outputs[k]);
+    if (!access(path, F_OK)) return path;
+  }
+  return NULL;
+}
+
 static int taken(const char *dir)
 {
   return (lw_rundir_holds_run(dir) && !lw_rundir_unstarted(dir)) || lw_rundir_foreign(dir, "scene.ini") ||
-         lw_rundir_foreign(dir, "state.lw");
+         lw_rundir_foreign(dir, "state.lw") || stray_output(dir);
 }
 
 static lw_status default_dir(char *dir, size_t size, const char *scene, int *hold, int *made, lw_error *err)
@@ -699,6 +714,14 @@ static int cmd_run(int argc, char **argv)
   for (int i = 0; i < argc; i++) {
     if (!strcmp(argv[i], "--set") || !strcmp(argv[i], "--out") || !strcmp(argv[i], "--seed") ||
         !strcmp(argv[i], "--stop-at") || !strcmp(argv[i], "--threads")) {
+      /* an option where the value should be is the value left out (taken as
+      ** the value, its own value was blamed as a second scene file) */
+      if (i + 1 < argc && !strncmp(argv[i + 1], "--", 2)) {
+        lw_error_set(&err, LW_EUSAGE, "%s: expected a value, got the option '%s' (was the value left out?%s%s)",
+                     argv[i], argv[i + 1], strcmp(argv[i], "--out") ? "" : " a directory of that name is ./",
+                     strcmp(argv[i], "--out") ? "" : argv[i + 1]);
+        return fail(&err);
+      }
       i++;
       continue;
     }
@@ -729,13 +752,7 @@ static int cmd_run(int argc, char **argv)
       if (set_option(&p, v, &err)) return fail(&err);
       i++;
     } else if (!strcmp(argv[i], "--out")) {
-      struct stat sb;
-      if (v && !strncmp(v, "--", 2)) {
-        /* `--out $DIR --quiet` with DIR empty wrote the run into ./--quiet */
-        lw_error_set(&err, LW_EUSAGE, "--out: expected a directory, got the option '%s' (was the directory left "
-                     "out? one of that name is ./%s)", v, v);
-        return fail(&err);
-      }
+      struct stat sb; /* (an option as v was refused above: `--out $DIR --quiet`, DIR empty, wrote ./--quiet) */
       if (!v || !*v || (stat(v, &sb) == 0 && !S_ISDIR(sb.st_mode))) {
         lw_error_set(&err, LW_EUSAGE, "--out: expected a directory, got '%s'%s", v ? v : "",
                      !v || !*v ? "" : S_ISREG(sb.st_mode) ? " (a file)" : " (not a directory)");
@@ -777,6 +794,13 @@ static int cmd_run(int argc, char **argv)
                    "expected a run directory or a new one", dir, dir, mine[k], what[k]);
       return fail(&err);
     }
+  const char *stray = stray_output(dir);
+  if (stray) {
+    lw_error_set(&err, LW_EUSAGE, "--out %s: %s is there, but no run's scene.ini or state.lw beside it, and the "
+                 "run would write over it: expected a run directory or a new one (remove the file to reuse the "
+                 "directory)", dir, stray);
+    return fail(&err);
+  }
   /* before a set-up of minutes, not after it */
   if (lw_rundir_writable(dir, &err)) {
     unmake_dir(dir, hold, made);

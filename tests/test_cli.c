@@ -606,8 +606,11 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
     {"run %s/s.ini --out ''", "--out: expected a directory"},
     {"run %s/s.ini --out /dev/null", "--out: expected a directory, got '/dev/null' (not a directory)"},
     {"run %s/s.ini --out /etc/passwd", "--out: expected a directory, got '/etc/passwd' (a file)"},
-    {"run %s/s.ini --out --quiet", "--out: expected a directory, got the option '--quiet' (was the directory left "
-     "out? one of that name is ./--quiet)"},
+    {"run %s/s.ini --out --quiet", "--out: expected a value, got the option '--quiet' (was the value left out? a "
+     "directory of that name is ./--quiet)"},
+    /* the option's own value was blamed as a second scene file */
+    {"run %s/s.ini --out --threads 1", "--out: expected a value, got the option '--threads' (was the value left"},
+    {"run %s/s.ini --seed --out x", "--seed: expected a value, got the option '--out'"},
     /* mkdir's EEXIST on a link to nowhere read as success: exit 1 at the lock */
     {"run %1$s/s.ini --out %1$s/dangling", "/dangling: cannot create directory: No such file or directory (a "
      "symbolic link to a place that does not exist)"},
@@ -961,6 +964,11 @@ Test(cli, a_run_replacing_another_removes_the_files_it_does_not_write_again)
                           "\"$(printf 'mine\\nmine')\"",
                           dir),
                0, "the old run's files stay, or the user's went");
+  /* a drawing of a run's name where no run is (a person's, or a run's whose
+  ** scene.ini and state.lw were taken away) is not written over */
+  cr_assert_eq(lw_test_sh("cd %s && mkdir stray && echo mine > stray/final.svg && %s run s.ini --quiet --out stray "
+                          "2>err.txt; test $? -eq 2 && grep -q 'stray/final.svg is there, but no run' err.txt && "
+                          "test \"$(cat stray/final.svg)\" = mine", dir, b), 0);
   /* a refused run leaves the old one whole */
   cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --quiet --out r --set anneal.sweeps=-1 2>/dev/null", dir, b), 2);
   cr_assert_eq(lw_test_sh("test -f %s/r/final.svg && test -f %s/r/summary.json", dir, dir), 0);
