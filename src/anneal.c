@@ -28,6 +28,7 @@
 #include "linewise/output.h"
 #include "linewise/phase.h"
 #include "linewise/rundir.h"
+#include "linewise/runfiles.h"
 #include "linewise/state.h"
 #include "linewise/trace.h"
 #include "linewise/version.h"
@@ -220,130 +221,6 @@ static double rung_energy(const lw_anneal *a, int k)
 }
 
 double lw_anneal_energy(const lw_anneal *a) { return rung_energy(a, 0); }
-
-/* The files a run writes, and their temporaries, and the film
-** tools/animate.sh makes of its frames.  A run into a directory that held
-** one removes the old run's first: a final.gcode, a replica state or a
-** film of another run beside the new drawing would be taken for its own. */
-static const char *const run_files[] = {"scene.ini",   "state.lw",  "trace.csv", "summary.json", "timing.txt",
-                                        "ladder.ini",  "field.png", "final.svg", "final.png",    "final.pdf",
-                                        "final.hpgl",  "final.gcode", "final.ply", "animation.mp4"};
-
-/* Whether name is prefix + digits + suffix, or that + ".tmp" (a write cut off). */
-static int numbered(const char *name, const char *prefix, const char *suffix)
-{
-  size_t np = strlen(prefix), nd = 0;
-  if (strncmp(name, prefix, np)) return 0;
-  while (name[np + nd] >= '0' && name[np + nd] <= '9') nd++;
-  const char *rest = name + np + nd;
-  size_t ns = strlen(suffix);
-  return nd > 0 && !strncmp(rest, suffix, ns) && (!rest[ns] || !strcmp(rest + ns, ".tmp"));
-}
-
-/* A run made again in place replaces the run before, but only once its own
-** first checkpoint is written: until then the run before waits in
-** DIR/.replaced (renamed, which takes no room on a full disk) and comes back
-** if the set-up fails, so a disk that fills at the start loses neither. */
-#define STASH ".replaced"
-
-/* The plots tools/plot-run draws of a run (DIR/plots/NAME.png). */
-static int run_plot(const char *name)
-{
-  static const char *const plot[] = {"energy", "temperature", "acceptance", "replicas", "swaps", "heat_capacity",
-                                     "observables"};
-  for (size_t k = 0; k < sizeof plot / sizeof plot[0]; k++) {
-    size_t n = strlen(plot[k]);
-    if (!strncmp(name, plot[k], n) && !strcmp(name + n, ".png")) return 1;
-  }
-  return 0;
-}
-
-/* Moves (or, with to NULL, removes) from's entries prefix + digits + suffix
-** under sub (prefix NULL: the run's plots), then removes from/sub if that
-** leaves it empty. */
-static lw_status move_numbered(const char *from, const char *to, const char *sub, const char *prefix,
-                               const char *suffix, lw_error *err)
-{
-  char path[LW_PATH_MAX + 64], dest[LW_PATH_MAX + 64];
-  lw_path_join(path, sizeof path, from, sub);
-  DIR *d = opendir(path);
-  if (!d) return LW_OK;
-  if (to) {
-    lw_path_join(dest, sizeof dest, to, sub);
-    if (sub[0] != '.' && mkdir(dest, 0777) && errno != EEXIST) {
-      closedir(d);
-      return lw_error_set(err, LW_EIO, "%s: cannot make: %s", dest, strerror(errno));
-    }
-  }
-  lw_status s = LW_OK;
-  for (struct dirent *e; !s && (e = readdir(d));) {
-    if (prefix ? !numbered(e->d_name, prefix, suffix) : !run_plot(e->d_name)) continue;
-    char file[2 * LW_PATH_MAX], there[2 * LW_PATH_MAX];
-    snprintf(file, sizeof file, "%s/%s", path, e->d_name);
-    if (to) snprintf(there, sizeof there, "%s/%s", dest, e->d_name);
-    if (to ? rename(file, there) : unlink(file) && errno != ENOENT)
-      s = lw_error_set(err, LW_EIO, "%s: cannot %s: %s", file, to ? "move" : "remove", strerror(errno));
-  }
-  closedir(d);
-  if (!s && sub[0] != '.') rmdir(path); /* fails, harmlessly, if the user keeps other files there */
-  return s;
-}
-
-/* Moves (to NULL: removes) the files of a run from one directory to another. */
-static lw_status move_run(const char *from, const char *to, lw_error *err)
-{
-  for (size_t i = 0; i < sizeof run_files / sizeof *run_files; i++)
-    for (int tmp = 0; tmp < 2; tmp++) {
-      char name[64], path[LW_PATH_MAX + 32], there[LW_PATH_MAX + 64];
-      snprintf(name, sizeof name, "%s%s", run_files[i], tmp ? ".tmp" : "");
-      lw_path_join(path, sizeof path, from, name);
-      if (to && !tmp) lw_path_join(there, sizeof there, to, name);
-      if ((to && !tmp ? rename(path, there) : unlink(path)) && errno != ENOENT)
-        return lw_error_set(err, LW_EIO, "%s: cannot %s the file of the run before: %s", path,
-                            to && !tmp ? "move" : "remove", strerror(errno));
-    }
-  lw_status s;
-  if ((s = move_numbered(from, to, ".", "replica-", ".lw", err)) ||
-      (s = move_numbered(from, to, "frames", "frame-", ".png", err)) ||
-      (s = move_numbered(from, to, "plots", NULL, NULL, err)))
-    return s;
-  return move_numbered(from, to, "samples", "sample-", ".csv", err);
-}
-
-static void stash_path(char *buf, size_t n, const char *dir) { lw_path_join(buf, n, dir, STASH); }
-
-/* The run before, gone for good (the new run has its checkpoint), or a
-** stash a killed set-up left. */
-static void drop_stash(const char *dir)
-{
-  char st[LW_PATH_MAX + 16];
-  stash_path(st, sizeof st, dir);
-  if (access(st, F_OK)) return;
-  move_run(st, NULL, NULL);
-  rmdir(st);
-}
-
-static lw_status stash_run(const char *dir, lw_error *err)
-{
-  char st[LW_PATH_MAX + 16];
-  if (!lw_rundir_holds_run(dir)) return LW_OK;
-  drop_stash(dir);
-  stash_path(st, sizeof st, dir);
-  if (mkdir(st, 0777)) return lw_error_set(err, LW_EIO, "%s: cannot make: %s", st, strerror(errno));
-  return move_run(dir, st, err);
-}
-
-/* A failed set-up: its files go (a directory of a scene.ini without a state
-** resumed nothing), the run before comes back (1 if there was one and it all
-** came back). */
-static int restore_stash(const char *dir)
-{
-  char st[LW_PATH_MAX + 16];
-  stash_path(st, sizeof st, dir);
-  int gone = !move_run(dir, NULL, NULL);
-  if (access(st, F_OK)) return 0;
-  return gone && !move_run(st, dir, NULL) && !rmdir(st);
-}
 
 /* Schedule and its table (relative to the scene file).  The dynamics has no
 ** temperature: its scene's schedule keys are only noted as unread
@@ -984,12 +861,35 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
     lw_phase_set(NULL);
     return LW_OK;
   }
-  if ((s = stash_run(dir, err)) || (s = write_start(a, net, err))) {
-    a->put_back = restore_stash(dir);
-    return s;
+  /* the run before (a final.gcode, a replica state or a film of it beside
+  ** the new drawing would be taken for the new run's) waits until the new
+  ** run's first checkpoint (lw_anneal_checkpoint drops it), or comes back
+  ** if the set-up fails (runfiles.h) */
+  int back;
+  if ((s = lw_runfiles_check_free(dir, err)) || (s = lw_runfiles_recover(dir, &back, err))) return s;
+  if (lw_rundir_holds_run(dir)) {
+    if ((s = lw_runfiles_stash(dir, err))) return s;
+    a->stashed = 1;
+    lw_phase_stash(1);
   }
-  drop_stash(dir);
-  return LW_OK;
+  a->fresh = 1;
+  if ((s = write_start(a, net, err))) lw_anneal_undo_start(a);
+  return s;
+}
+
+int lw_anneal_undo_start(lw_anneal *a)
+{
+  if (!a->fresh) return a->put_back;
+  a->fresh = 0;
+  if (a->stashed) {
+    lw_error e;
+    a->put_back = !lw_runfiles_unstash(a->dir, &e);
+    a->stashed = 0;
+    lw_phase_stash(a->put_back ? 0 : 1);
+  } else {
+    lw_runfiles_remove(a->dir); /* no run was there: every run file is the set-up's */
+  }
+  return a->put_back;
 }
 
 /* The new run's first files, up to its first checkpoint (net: the first is
@@ -1048,6 +948,12 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
   a->ckpt_seconds += now_seconds() - t0;
   lw_phase_set(was);
   if (!s) a->saved = a->sweep + 1;
+  if (!s && a->fresh) { /* the first: the run before, set aside, can go */
+    a->fresh = 0;
+    if (a->stashed) lw_runfiles_drop(a->dir);
+    a->stashed = 0;
+    lw_phase_stash(0);
+  }
   return s;
 }
 
@@ -1188,9 +1094,12 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   lw_phase_set("reading state.lw and rebuilding the energy");
   /* (a directory that holds no run has no state.lw to read, which says so,
   ** and gets no lock file) */
-  if (writes_files(a) && lw_rundir_holds_run(dir)) {
+  if (writes_files(a) && (lw_rundir_holds_run(dir) || lw_runfiles_stashed(dir))) {
+    int back;
     lw_status sl = lw_rundir_lock(dir, &a->dir_hold, err);
-    if (sl) return sl;
+    /* a run made again there was stopped in its set-up: the run before
+    ** comes back, to be resumed (or its new run's first checkpoint stands) */
+    if (sl || (sl = lw_runfiles_recover(dir, &back, err))) return sl;
   }
   /* a run stopped before its first checkpoint left its scene.ini alone */
   if (lw_rundir_unstarted(dir))

@@ -24,6 +24,7 @@
 #include "linewise/phase.h"
 #include "linewise/reweight.h"
 #include "linewise/rundir.h"
+#include "linewise/runfiles.h"
 #include "linewise/state.h"
 #include "linewise/system.h"
 #include "linewise/trace.h"
@@ -316,10 +317,14 @@ static void on_signal(int sig)
   if (stop_requested) {
     static const char none[] = "\nlinewise: a second signal: stopped at once, before the run's first checkpoint "
                                "(nothing to resume: run it again)\n";
+    static const char kept[] = "\nlinewise: a second signal: stopped at once, before the run's first checkpoint; "
+                               "the run that was in the directory waits in " LW_RUNFILES_STASH " and comes back "
+                               "when linewise next runs or resumes there\n";
     const int b = second_at;
     const size_t skip = second_len[b] > 0 && !on_terminal; /* (0: the name did not fit, and nothing is said) */
-    ssize_t w = checkpointed ? write(2, second_msg[b] + skip, (size_t)second_len[b] - skip)
-                             : write(2, none + !on_terminal, sizeof none - 1 - !on_terminal);
+    ssize_t w = checkpointed         ? write(2, second_msg[b] + skip, (size_t)second_len[b] - skip)
+                : lw_phase_stashed() ? write(2, kept + !on_terminal, sizeof kept - 1 - !on_terminal)
+                                     : write(2, none + !on_terminal, sizeof none - 1 - !on_terminal);
     (void)w;
     _exit(128 + sig);
   }
@@ -627,25 +632,11 @@ static lw_status spread_start(lw_status s, lw_anneal *a, int fresh, lw_error *er
 ** a person's, which a run would refuse to write over.  A run stopped before
 ** its first checkpoint has nothing to resume: its directory is taken again
 ** (unless the lock says it is still setting up). */
-/* A drawing or trace of a name a run writes, in a directory that holds no
-** run: a person's, or what is left of a run whose scene.ini and state.lw
-** were taken away; either way not to be written over unasked (its path). */
-static const char *stray_output(const char *dir)
-{
-  static const char *const outputs[] = {"final.svg", "final.png", "trace.csv", "summary.json"};
-  static char path[LW_PATH_MAX + 32];
-  if (lw_rundir_holds_run(dir)) return NULL;
-  for (size_t k = 0; k < sizeof outputs / sizeof outputs[0]; k++) {
-    lw_path_join(path, sizeof path, dir, outputs[k]);
-    if (!access(path, F_OK)) return path;
-  }
-  return NULL;
-}
-
+/* (a stash is a run that a killed set-up set aside: runfiles.h) */
 static int taken(const char *dir)
 {
   return (lw_rundir_holds_run(dir) && !lw_rundir_unstarted(dir)) || lw_rundir_foreign(dir, "scene.ini") ||
-         lw_rundir_foreign(dir, "state.lw") || stray_output(dir);
+         lw_rundir_foreign(dir, "state.lw") || lw_runfiles_check_free(dir, NULL) || lw_runfiles_stashed(dir);
 }
 
 static lw_status default_dir(char *dir, size_t size, const char *scene, int *hold, int *made, lw_error *err)
@@ -794,13 +785,7 @@ static int cmd_run(int argc, char **argv)
                    "expected a run directory or a new one", dir, dir, mine[k], what[k]);
       return fail(&err);
     }
-  const char *stray = stray_output(dir);
-  if (stray) {
-    lw_error_set(&err, LW_EUSAGE, "--out %s: %s is there, but no run's scene.ini or state.lw beside it, and the "
-                 "run would write over it: expected a run directory or a new one (remove the file to reuse the "
-                 "directory)", dir, stray);
-    return fail(&err);
-  }
+  if (lw_runfiles_check_free(dir, &err) || lw_runfiles_check_stash(dir, &err)) return fail(&err);
   /* before a set-up of minutes, not after it */
   if (lw_rundir_writable(dir, &err)) {
     unmake_dir(dir, hold, made);
@@ -814,10 +799,13 @@ static int cmd_run(int argc, char **argv)
   if (spread_start(lw_anneal_start_net(&a, &p, dir, net, &err), &a, 1, &err)) {
     /* (a failed first write said only that, leaving a directory without a
     ** state.lw: what to do next, as loop_fail says later) */
+    const int back = lw_anneal_undo_start(&a); /* (MPI: the network's checkpoint failed) */
     const size_t n = strlen(err.msg);
     if (err.code == LW_EIO && !lw_phase_unwritten())
       snprintf(err.msg + n, sizeof err.msg - n, "; the run wrote no checkpoint%s: run it again once the files can "
-               "be written", a.put_back ? ", and the run that was in the directory is back as it was" : "");
+               "be written", back ? ", and the run that was in the directory is back as it was"
+                         : lw_runfiles_stashed(dir) ? ", and the run that was in the directory waits in "
+                         LW_RUNFILES_STASH " (linewise puts it back when it next runs or resumes there)" : "");
     lw_anneal_free(&a);
     unmake_dir(dir, hold, made);
     return watched_fail(&w, &err);

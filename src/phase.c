@@ -33,6 +33,12 @@ void lw_phase_writing(void) { atomic_store(&unwritten, 0); }
 
 int lw_phase_unwritten(void) { return atomic_load(&unwritten); }
 
+static volatile atomic_int stash_waits;
+
+void lw_phase_stash(int on) { atomic_store(&stash_waits, on); }
+
+int lw_phase_stashed(void) { return atomic_load(&stash_waits); }
+
 const char *lw_phase_get(double *seconds)
 {
   const char *what = atomic_load(&phase_what);

@@ -113,13 +113,14 @@ static int denied(const char *path, int dir)
 ** directory, unless it is sticky (/tmp-like) and the file another user's. */
 lw_status lw_rundir_writable(const char *dir, lw_error *err)
 {
-  static const char *const inside[] = {"", "frames", "samples"}, *const renamed[] = {"state.lw", "scene.ini",
-                                                                                      "summary.json"};
+  /* (plots: a new run moves tools/plot-run's plots aside with the rest) */
+  static const char *const inside[] = {"", "frames", "samples", "plots"},
+                    *const renamed[] = {"state.lw", "scene.ini", "summary.json"};
   const mode_t sticky = 01000; /* S_ISVTX, which POSIX leaves to XSI */
   char path[LW_PATH_MAX + 16];
   const char *what = NULL;
   int e = 0;
-  for (size_t k = 0; k < 3 && !e; k++)
+  for (size_t k = 0; k < sizeof inside / sizeof inside[0] && !e; k++)
     if (snprintf(path, sizeof path, "%s%s%s", dir, k ? "/" : "", inside[k]) < (int)sizeof path && (e = denied(path, 1)))
       what = k ? "cannot write into it" : "cannot write into the run directory";
   if (!e && snprintf(path, sizeof path, "%s/trace.csv", dir) < (int)sizeof path && (e = denied(path, 0)))

@@ -158,6 +158,22 @@ Test(mpi, more_processes_than_replicas_is_refused_before_anything_is_written)
                0);
 }
 
+/* A run made again over a finished one keeps the run before until the
+** network's first checkpoint: the MPI build dropped it when its set-up had
+** written the start, before that checkpoint, and a full disk then lost both
+** (the plain build put it back). */
+Test(mpi, a_failed_first_checkpoint_puts_the_run_before_back)
+{
+  const char *m = mpi_bin();
+  write_scene();
+  cr_assert_eq(sh(MPIRUN " -n 2 %s run %s/s.ini --set anneal.sweeps=50 --out %s/r --quiet && cp -rp %s/r %s/keep", m,
+                  dir, dir, dir, dir), 0);
+  cr_assert_eq(sh(MPIRUN " -n 2 sh -c 'ulimit -f 8; exec %s run %s/s.ini --set anneal.sweeps=50 --seed 5 --out %s/r "
+                  "--quiet' 2>%s/err.txt; grep -q 'the run that was in the directory is back as it was' %s/err.txt",
+                  m, dir, dir, dir, dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh("rm -f %s/r/.lock %s/keep/.lock && diff -r %s/r %s/keep", dir, dir, dir, dir), 0);
+}
+
 /* The observables in the trace are the coldest rung's, whichever process
 ** sweeps its replica: the same bytes as one process, and summary.json's
 ** statistics of them the same text. */

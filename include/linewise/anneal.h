@@ -59,6 +59,8 @@ typedef struct lw_anneal {
   long end_sweep;              /* stop after this sweep */
   long pause_at;               /* resume --sweeps N short of end_sweep: stop there as --stop-at does (-1: none) */
   int extending, new_end;      /* a resume to settle before its first sweep (anneal.c) */
+  int fresh;                   /* the set-up has written files and no checkpoint yet */
+  int stashed;                 /* the run it replaces is set aside until then (runfiles.h) */
   int put_back;                /* a set-up that failed put the run it was to replace back */
   unsigned long long scene_hash; /* lw_params_run_hash of scene.ini, kept in state.lw */
   lw_run_keys scene_keys;        /* and its keys' parts */
@@ -114,6 +116,11 @@ lw_status lw_anneal_settle(lw_anneal *a, lw_error *err);
 lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err);
 
 static inline int lw_anneal_done(const lw_anneal *a) { return a->sweep >= a->end_sweep; }
+
+/* After a start that failed, here or later (the network's first checkpoint):
+** the set-up's files go and the run it was to replace comes back; 1 if that
+** run all came back.  Nothing once the first checkpoint is written. */
+int lw_anneal_undo_start(lw_anneal *a);
 
 /* Writes state.lw now (a clean stop). */
 lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err);

@@ -32,6 +32,11 @@ void lw_phase_hold(void);
 void lw_phase_writing(void);
 int lw_phase_unwritten(void);
 
+/* Whether the run before waits in DIR/.replaced (runfiles.h) until the new
+** run's first checkpoint, for a signal handler's message: lock-free too. */
+void lw_phase_stash(int on);
+int lw_phase_stashed(void);
+
 /* What a watcher prints, decided from what it reads at each tick, so that
 ** the rule can be tested with a made-up clock.  A phase is named once it has
 ** lasted over LW_PHASE_QUIET seconds: on a terminal (tty) in place, its

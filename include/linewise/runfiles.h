@@ -1,0 +1,67 @@
+/*
+** runfiles.h -- the files a run writes into its directory, and the run
+** before set aside while a new one starts there.
+**
+** A run's files: scene.ini, state.lw, trace.csv, summary.json, timing.txt,
+** ladder.ini, field.png, the final drawings (svg, png, pdf, hpgl, gcode,
+** ply), animation.mp4, replica-K.lw, frames/frame-N.png,
+** samples/sample-N.csv and the plots of tools/plot-run (plots/NAME.png).
+** Other files in the directory or its subdirectories are the user's.
+**
+** A run made again in a directory that holds a run replaces it, but only
+** once its own first checkpoint is written: until then the run before waits
+** in DIR/.replaced, moved there by renames (which take no room on a full
+** disk), and it comes back if the set-up fails.  A process killed in
+** between leaves the stash; the next run or resume there settles it under
+** the directory's lock (lw_runfiles_recover).  A marker inside says what
+** the stash holds: .moving while the run before is being moved (some of its
+** files may still be in DIR), .moved once all are (every run file in DIR is
+** the new run's).  A DIR/.replaced without a marker is not linewise's, and
+** is never written into or read from.
+*/
+#ifndef LINEWISE_RUNFILES_H
+#define LINEWISE_RUNFILES_H
+
+#include <stddef.h>
+
+#include "linewise/error.h"
+
+#define LW_RUNFILES_STASH ".replaced"
+
+/* 1 and the path of dir's first run file into path, or 0 where it has none. */
+int lw_runfiles_find(const char *dir, char *path, size_t n);
+
+/* LW_EUSAGE naming the file where dir holds run files but no run (no run's
+** scene.ini or state.lw, no stash): a person's, or what is left of a run
+** whose scene.ini and state.lw were taken away; not to be written over. */
+lw_status lw_runfiles_check_free(const char *dir, lw_error *err);
+
+/* LW_EUSAGE where dir/.replaced is there and is not linewise's stash (a
+** link, a file, a folder of the user's), which a run there would refuse. */
+lw_status lw_runfiles_check_stash(const char *dir, lw_error *err);
+
+/* Whether dir/.replaced is there, whatever it is. */
+int lw_runfiles_stashed(const char *dir);
+
+/* Sets the run in dir aside into dir/.replaced.  On failure what was moved
+** comes back (err says whether all did). */
+lw_status lw_runfiles_stash(const char *dir, lw_error *err);
+
+/* The run before back from dir/.replaced over the files of the run that was
+** to replace it (whose files without a counterpart go).  On failure what
+** is left stays in the stash, and err names it. */
+lw_status lw_runfiles_unstash(const char *dir, lw_error *err);
+
+/* Removes the stash: the new run has its first checkpoint. */
+void lw_runfiles_drop(const char *dir);
+
+/* Removes dir's run files: a set-up that failed where no run was before. */
+void lw_runfiles_remove(const char *dir);
+
+/* Settles a stash a killed process left, under dir's lock: dropped where
+** the new run had written its state.lw, else put back (*back 1).  LW_EUSAGE
+** where dir/.replaced is not linewise's stash (a link, a file, a folder of
+** the user's): nothing is touched. */
+lw_status lw_runfiles_recover(const char *dir, int *back, lw_error *err);
+
+#endif

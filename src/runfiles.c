@@ -1,0 +1,296 @@
+/* runfiles.c -- a run's files in its directory, and the stash (runfiles.h). */
+#include "linewise/runfiles.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "linewise/params.h"
+#include "linewise/rundir.h"
+
+static const char *const top_files[] = {"scene.ini", "state.lw",  "trace.csv",   "summary.json", "timing.txt",
+                                        "ladder.ini", "field.png", "final.svg",   "final.png",    "final.pdf",
+                                        "final.hpgl", "final.gcode", "final.ply", "animation.mp4"};
+
+/* The subdirectories that hold run files, and which of their entries are. */
+static const struct {
+  const char *sub, *prefix, *suffix; /* prefix NULL: the plots' names */
+} groups[] = {{".", "replica-", ".lw"}, {"frames", "frame-", ".png"}, {"samples", "sample-", ".csv"},
+              {"plots", NULL, ".png"}};
+
+static const char *const plots[] = {"energy", "temperature", "acceptance", "replicas", "swaps", "heat_capacity",
+                                    "observables"};
+
+/* Whether name is prefix + digits + suffix (or that + ".tmp": a write cut
+** off), or with prefix NULL one of the plots + suffix. */
+static int in_group(const char *name, const char *prefix, const char *suffix)
+{
+  if (!prefix) {
+    for (size_t k = 0; k < sizeof plots / sizeof plots[0]; k++) {
+      size_t n = strlen(plots[k]);
+      if (!strncmp(name, plots[k], n) && !strcmp(name + n, suffix)) return 1;
+    }
+    return 0;
+  }
+  size_t np = strlen(prefix), nd = 0;
+  if (strncmp(name, prefix, np)) return 0;
+  while (name[np + nd] >= '0' && name[np + nd] <= '9') nd++;
+  const char *rest = name + np + nd;
+  size_t ns = strlen(suffix);
+  return nd > 0 && !strncmp(rest, suffix, ns) && (!rest[ns] || !strcmp(rest + ns, ".tmp"));
+}
+
+typedef int each_fn(const char *rel, void *ctx);
+
+/* Calls fn with the path relative to root of each run file there ("x.tmp"
+** of a top file too), until one returns nonzero, which it returns. */
+static int each_file(const char *root, each_fn *fn, void *ctx)
+{
+  char rel[LW_PATH_MAX], path[2 * LW_PATH_MAX];
+  struct stat sb;
+  for (size_t i = 0; i < sizeof top_files / sizeof top_files[0]; i++)
+    for (int tmp = 0; tmp < 2; tmp++) {
+      snprintf(rel, sizeof rel, "%s%s", top_files[i], tmp ? ".tmp" : "");
+      snprintf(path, sizeof path, "%s/%s", root, rel);
+      int r;
+      if (!lstat(path, &sb) && (r = fn(rel, ctx))) return r;
+    }
+  for (size_t g = 0; g < sizeof groups / sizeof groups[0]; g++) {
+    snprintf(path, sizeof path, "%s/%s", root, groups[g].sub);
+    DIR *d = opendir(path);
+    if (!d) continue;
+    int r = 0;
+    for (struct dirent *e; !r && (e = readdir(d));) {
+      if (!in_group(e->d_name, groups[g].prefix, groups[g].suffix)) continue;
+      if (groups[g].sub[0] == '.') snprintf(rel, sizeof rel, "%s", e->d_name);
+      else snprintf(rel, sizeof rel, "%s/%s", groups[g].sub, e->d_name);
+      r = fn(rel, ctx);
+    }
+    closedir(d);
+    if (r) return r;
+  }
+  return 0;
+}
+
+/* The subdirectories of root that hold run files, removed where empty (the
+** user's own files in them keep them). */
+static void prune(const char *root)
+{
+  char path[2 * LW_PATH_MAX];
+  for (size_t g = 1; g < sizeof groups / sizeof groups[0]; g++) {
+    snprintf(path, sizeof path, "%s/%s", root, groups[g].sub);
+    rmdir(path);
+  }
+}
+
+static int first_file(const char *rel, void *ctx)
+{
+  snprintf(ctx, LW_PATH_MAX, "%s", rel);
+  return 1;
+}
+
+int lw_runfiles_find(const char *dir, char *path, size_t n)
+{
+  char rel[LW_PATH_MAX];
+  if (!each_file(dir, first_file, rel)) return 0;
+  snprintf(path, n, "%s/%s", dir, rel);
+  return 1;
+}
+
+lw_status lw_runfiles_check_free(const char *dir, lw_error *err)
+{
+  char path[2 * LW_PATH_MAX];
+  if (lw_runfiles_stashed(dir) || lw_rundir_holds_run(dir) || !lw_runfiles_find(dir, path, sizeof path))
+    return LW_OK;
+  return lw_error_set(err, LW_EUSAGE, "%s is there, but no run's scene.ini or state.lw beside it, and the run "
+                      "would write over it: expected a run directory or a new one (remove the file to reuse the "
+                      "directory)", path);
+}
+
+/* ---- the stash ---------------------------------------------------------- */
+
+static void stash_path(char *buf, size_t n, const char *dir, const char *rel)
+{
+  snprintf(buf, n, "%s/" LW_RUNFILES_STASH "%s%s", dir, rel ? "/" : "", rel ? rel : "");
+}
+
+int lw_runfiles_stashed(const char *dir)
+{
+  char st[LW_PATH_MAX + 16];
+  struct stat sb;
+  stash_path(st, sizeof st, dir, NULL);
+  return lstat(st, &sb) == 0;
+}
+
+/* Whether the stash is linewise's (a directory, not a link, with a marker)
+** and which marker it has: 1 .moving, 2 .moved, 0 not a stash. */
+static int stash_marker(const char *dir)
+{
+  char path[LW_PATH_MAX + 32];
+  struct stat sb;
+  stash_path(path, sizeof path, dir, NULL);
+  if (lstat(path, &sb) || !S_ISDIR(sb.st_mode)) return 0;
+  stash_path(path, sizeof path, dir, ".moved");
+  if (!lstat(path, &sb) && S_ISREG(sb.st_mode)) return 2;
+  stash_path(path, sizeof path, dir, ".moving");
+  return !lstat(path, &sb) && S_ISREG(sb.st_mode) ? 1 : 0;
+}
+
+typedef struct {
+  const char *from, *to; /* directories: a run file of from goes to the same place under to */
+  int err;               /* errno of the rename that failed */
+  char rel[LW_PATH_MAX];  /* and its file */
+} mover;
+
+static int move_one(const char *rel, void *ctx)
+{
+  mover *m = ctx;
+  char a[2 * LW_PATH_MAX + 32], b[2 * LW_PATH_MAX + 32];
+  snprintf(a, sizeof a, "%s/%s", m->from, rel);
+  snprintf(b, sizeof b, "%s/%s", m->to, rel);
+  const char *slash = strchr(rel, '/');
+  if (slash) { /* frames/, samples/, plots/ under to */
+    char sub[2 * LW_PATH_MAX + 32];
+    snprintf(sub, sizeof sub, "%s/%.*s", m->to, (int)(slash - rel), rel);
+    if (mkdir(sub, 0777) && errno != EEXIST) {
+      m->err = errno;
+      snprintf(m->rel, sizeof m->rel, "%.*s", (int)(slash - rel), rel);
+      return 1;
+    }
+  }
+  if (rename(a, b)) {
+    m->err = errno;
+    snprintf(m->rel, sizeof m->rel, "%s", rel);
+    return 1;
+  }
+  return 0;
+}
+
+/* A file of the new run in dir without a counterpart in the stash. */
+static int remove_new(const char *rel, void *ctx)
+{
+  const char *dir = ctx;
+  char in_stash[2 * LW_PATH_MAX + 32], path[2 * LW_PATH_MAX + 32];
+  struct stat sb;
+  stash_path(in_stash, sizeof in_stash, dir, rel);
+  if (!lstat(in_stash, &sb)) return 0; /* the rename back replaces it */
+  snprintf(path, sizeof path, "%s/%s", dir, rel);
+  unlink(path);
+  return 0;
+}
+
+static int remove_one(const char *rel, void *ctx)
+{
+  char path[2 * LW_PATH_MAX + 32];
+  snprintf(path, sizeof path, "%s/%s", (const char *)ctx, rel);
+  unlink(path);
+  return 0;
+}
+
+/* The stash's markers and subdirectories, then the stash itself, where
+** that leaves them empty. */
+static void remove_stash_dir(const char *dir)
+{
+  char st[LW_PATH_MAX + 32], path[LW_PATH_MAX + 32];
+  stash_path(st, sizeof st, dir, NULL);
+  prune(st);
+  stash_path(path, sizeof path, dir, ".moving");
+  unlink(path);
+  stash_path(path, sizeof path, dir, ".moved");
+  unlink(path);
+  rmdir(st);
+}
+
+lw_status lw_runfiles_unstash(const char *dir, lw_error *err)
+{
+  const int marker = stash_marker(dir);
+  if (!marker) return LW_OK;
+  char st[LW_PATH_MAX + 16];
+  stash_path(st, sizeof st, dir, NULL);
+  /* all of the run before is in the stash: the run files in dir are the new
+  ** run's; while it was moving, those in dir are the run before's */
+  if (marker == 2) each_file(dir, remove_new, (void *)dir);
+  mover m = {st, dir, 0, ""};
+  if (each_file(st, move_one, &m))
+    return lw_error_set(err, LW_EIO, "%s/%s: cannot put it back: %s; the rest of the run that was there before "
+                        "is in %s", dir, m.rel, strerror(m.err), st);
+  remove_stash_dir(dir);
+  prune(dir);
+  return LW_OK;
+}
+
+lw_status lw_runfiles_stash(const char *dir, lw_error *err)
+{
+  char st[LW_PATH_MAX + 16], marker[LW_PATH_MAX + 32], moved[LW_PATH_MAX + 32];
+  stash_path(st, sizeof st, dir, NULL);
+  stash_path(marker, sizeof marker, dir, ".moving");
+  stash_path(moved, sizeof moved, dir, ".moved");
+  if (mkdir(st, 0777))
+    return lw_error_set(err, LW_EIO, "%s: cannot make it to set the run there aside: %s; that run is as it was", st,
+                        strerror(errno));
+  int fd = open(marker, O_WRONLY | O_CREAT | O_EXCL, 0666);
+  if (fd < 0 || close(fd)) {
+    const int e = errno;
+    unlink(marker);
+    rmdir(st);
+    return lw_error_set(err, LW_EIO, "%s: cannot write: %s; the run there is as it was", marker, strerror(e));
+  }
+  mover m = {dir, st, 0, ""};
+  if (each_file(dir, move_one, &m) || rename(marker, moved)) {
+    const int e = m.err ? m.err : errno;
+    char what[LW_PATH_MAX + 32];
+    snprintf(what, sizeof what, "%s/%s", dir, m.err ? m.rel : LW_RUNFILES_STASH "/.moving");
+    lw_error back;
+    if (lw_runfiles_unstash(dir, &back))
+      return lw_error_set(err, LW_EIO, "%s: cannot set it aside: %s; %s", what, strerror(e), back.msg);
+    return lw_error_set(err, LW_EIO, "%s: cannot set it aside: %s; the run there is as it was", what, strerror(e));
+  }
+  prune(dir);
+  return LW_OK;
+}
+
+void lw_runfiles_drop(const char *dir)
+{
+  char st[LW_PATH_MAX + 16];
+  if (!stash_marker(dir)) return;
+  stash_path(st, sizeof st, dir, NULL);
+  each_file(st, remove_one, st);
+  remove_stash_dir(dir);
+}
+
+void lw_runfiles_remove(const char *dir)
+{
+  each_file(dir, remove_one, (void *)dir);
+  prune(dir);
+}
+
+lw_status lw_runfiles_check_stash(const char *dir, lw_error *err)
+{
+  char st[LW_PATH_MAX + 16];
+  stash_path(st, sizeof st, dir, NULL);
+  if (!lw_runfiles_stashed(dir) || stash_marker(dir)) return LW_OK;
+  return lw_error_set(err, LW_EUSAGE, "%s: not linewise's (a run sets the run before aside there while it starts, "
+                      "with a marker file in it): expected no such file or folder; remove or rename it", st);
+}
+
+lw_status lw_runfiles_recover(const char *dir, int *back, lw_error *err)
+{
+  *back = 0;
+  lw_status s = lw_runfiles_check_stash(dir, err);
+  if (s || !lw_runfiles_stashed(dir)) return s;
+  const int marker = stash_marker(dir);
+  char state[LW_PATH_MAX + 16];
+  struct stat sb;
+  snprintf(state, sizeof state, "%s/state.lw", dir);
+  if (marker == 2 && !lstat(state, &sb)) { /* the new run had its checkpoint */
+    lw_runfiles_drop(dir);
+    return LW_OK;
+  }
+  s = lw_runfiles_unstash(dir, err);
+  *back = !s;
+  return s;
+}
