@@ -101,22 +101,24 @@ void lw_anneal_ladder_note(const lw_anneal *a, char *buf, size_t n)
   buf[0] = '\0';
   const lw_tempering *pt = a->pt;
   if (!pt || a->params.tune_ladder != LW_LADDER_EQUAL || a->params.ladder_sweeps <= 0) return;
-  double sum = 0.0, sq = 0.0, noise = 0.0, lo = 2.0, hi = -1.0;
+  double sum = 0.0, sq = 0.0, inv_tries = 0.0, lo = 2.0, hi = -1.0;
   int at_lo = 0, at_hi = 0;
   for (int k = 0; k + 1 < pt->n; k++) {
     if (pt->tried[k] < 1) return;
     const double r = lw_tempering_acceptance(pt, k);
     sum += r;
     sq += r * r;
-    noise += r * (1.0 - r) / (double)pt->tried[k];
+    inv_tries += 1.0 / (double)pt->tried[k];
     if (r < lo) lo = r, at_lo = k;
     if (r > hi) hi = r, at_hi = k;
   }
   const double m = sum / (pt->n - 1), rms = sqrt(fmax(0.0, sq / (pt->n - 1) - m * m));
-  /* Equal true rates measured over few tries spread by chance (binomially:
-  ** sd sqrt(r (1 - r) / tries) a pair): only a spread past three of those
-  ** says the ladder is uneven.  Past 1000 tries a pair the 0.06 decides. */
-  if (rms > 0.06 && rms > 3.0 * sqrt(noise / (pt->n - 1)))
+  /* Equal rates m measured over few tries spread by chance (binomially: sd
+  ** sqrt(m (1 - m) / tries) a pair, with the rates pooled, since one pair's
+  ** own over one or two tries is 0 or 1 and its r (1 - r) 0): only a spread
+  ** past three of those says the ladder is uneven.  Past 1000 tries a pair
+  ** the 0.06 decides. */
+  if (rms > 0.06 && rms > 3.0 * sqrt(m * (1.0 - m) * inv_tries / (pt->n - 1)))
     snprintf(buf, n, "the swap rates since the ladder froze run from %.2f (rungs %d and %d) to %.2f (%d and %d), %.3f "
              "rms about their mean: tempering.ladder_sweeps = %d was too short to equalise them (raise it)", lo, at_lo,
              at_lo + 1, hi, at_hi, at_hi + 1, rms, a->params.ladder_sweeps);

@@ -51,21 +51,43 @@ void lw_checkpoint_system_section(char *buf, size_t n, const lw_system_type *t, 
   else snprintf(buf, n, "system %s %d", t->name, k);
 }
 
-/* "run", "tempering", "dynamics", "chain" or "chain K", "system NAME" or
-** "system NAME K", K a rung from 1: the sections a state is written with. */
-int lw_checkpoint_section_known(const char *name)
+/* The rung of a section "BASE" (0) or "BASE K" (K from 1), else -1. */
+static long rung_of(const char *name, const char *base)
 {
+  size_t n = strlen(base);
+  if (strncmp(name, base, n)) return -1;
+  if (!name[n]) return 0;
+  char *end;
+  long k = name[n] == ' ' && name[n + 1] >= '1' && name[n + 1] <= '9' ? strtol(name + n + 1, &end, 10) : -1;
+  return k >= 1 && k < LW_TEMPERING_MAX && !*end ? k : -1;
+}
+
+static int chain_section(const char *name) { return rung_of(name, "chain") >= 0; }
+
+typedef struct {
+  char system[80]; /* "system NAME" of the scene's system */
+  long rungs;      /* the [chain] sections the file has */
+} known_ctx;
+
+/* "run", "tempering", "dynamics", "chain" or "chain K", "system NAME" or
+** "system NAME K", NAME the scene's system and K below the chains' count. */
+static int section_known(const char *name, const void *ctx)
+{
+  const known_ctx *k = ctx;
   static const char *const plain[] = {"run", "tempering", "dynamics"};
   for (size_t i = 0; i < sizeof plain / sizeof plain[0]; i++)
     if (!strcmp(name, plain[i])) return 1;
-  const char *rest = NULL;
-  if (!strncmp(name, "chain", 5)) rest = name + 5;
-  else if (!strncmp(name, "system ", 7) && name[7] && name[7] != ' ') rest = name + 7 + strcspn(name + 7, " ");
-  if (!rest) return 0;
-  if (!*rest) return 1;
-  char *end;
-  long k = rest[0] == ' ' && rest[1] >= '1' && rest[1] <= '9' ? strtol(rest + 1, &end, 10) : 0;
-  return k >= 1 && k < LW_TEMPERING_MAX && !*end;
+  long r = rung_of(name, "chain");
+  if (r < 0) r = rung_of(name, k->system);
+  return r >= 0 && r < (k->rungs > 0 ? k->rungs : 1);
+}
+
+lw_status lw_checkpoint_sections_known(const lw_ckpt *doc, const char *system, lw_error *err)
+{
+  known_ctx k;
+  snprintf(k.system, sizeof k.system, "system %s", system);
+  k.rungs = (long)lw_ckpt_count_sections(doc, chain_section);
+  return lw_ckpt_known_sections(doc, section_known, &k, err);
 }
 
 /* ---- writing ---------------------------------------------------------------- */

@@ -290,13 +290,24 @@ lw_status lw_ckpt_missing(const lw_ckpt *c, const char *what, const char *guess,
 
 lw_status lw_ckpt_no_section(const lw_ckpt *c, const char *sec, lw_error *err)
 {
+  /* the sections not read yet first (a renamed one is among them), as many
+  ** as fit, and "..." for the rest */
   char list[1024] = "";
-  size_t at = 0;
-  for (size_t i = 0; i < c->ns && at < sizeof list; i++) {
-    int m = snprintf(list + at, sizeof list - at, "%s[%s] at line %d", i ? ", " : "", c->text + c->s[i].name,
-                     c->s[i].line);
-    if (m > 0) at += (size_t)m;
-  }
+  size_t at = 0, shown = 0;
+  for (int pass = 0; pass < 2; pass++)
+    for (size_t i = 0; i < c->ns; i++) {
+      if (c->s[i].read != pass) continue;
+      char one[192];
+      int m = snprintf(one, sizeof one, "%s[%s] at line %d", shown ? ", " : "", c->text + c->s[i].name, c->s[i].line);
+      if (m < 0 || at + (size_t)m + 8 >= sizeof list) {
+        snprintf(list + at, sizeof list - at, ", ...");
+        goto done;
+      }
+      memcpy(list + at, one, (size_t)m + 1);
+      at += (size_t)m;
+      shown++;
+    }
+done:
   return lw_error_set(err, LW_EINPUT, "%s: section [%s] missing (the file has %s; a damaged or edited file, or one "
                       "cut short: it ends at its line %d)", c->path, sec, c->ns ? list : "none", c->lines);
 }
@@ -392,13 +403,21 @@ int lw_ckpt_next(lw_ckpt *c, const char *sec, size_t *pos, const char **key, con
   return 1;
 }
 
-lw_status lw_ckpt_known_sections(const lw_ckpt *c, int (*known)(const char *name), lw_error *err)
+lw_status lw_ckpt_known_sections(const lw_ckpt *c, int (*known)(const char *name, const void *ctx), const void *ctx,
+                                 lw_error *err)
 {
   for (size_t i = 0; i < c->ns; i++)
-    if (!known(c->text + c->s[i].name))
+    if (!known(c->text + c->s[i].name, ctx))
       return lw_error_set(err, LW_EINPUT, "%s:%d: section [%s] is unknown to this linewise (written by a newer "
                           "version?)", c->path, c->s[i].line, c->text + c->s[i].name);
   return LW_OK;
+}
+
+size_t lw_ckpt_count_sections(const lw_ckpt *c, int (*match)(const char *name))
+{
+  size_t n = 0;
+  for (size_t i = 0; i < c->ns; i++) n += match(c->text + c->s[i].name) != 0;
+  return n;
 }
 
 lw_status lw_ckpt_unread(const lw_ckpt *c, lw_error *err)

@@ -177,7 +177,7 @@ static int cmd_energy(int argc, char **argv)
   if (load_run_dir(dir, &p, &st, path, sizeof path, &err)) return fail(&err);
   /* the run's sections are read by resume, not here; an unknown one is
   ** refused all the same, as every reader of a state does */
-  if (st.doc && lw_ckpt_known_sections(st.doc, lw_checkpoint_section_known, &err)) {
+  if (st.doc && lw_checkpoint_sections_known(st.doc, p.system, &err)) {
     lw_state_clear(&st);
     return fail(&err);
   }

@@ -153,6 +153,22 @@ static int rung_moves(const lw_trace *const *t, size_t *const *row, const size_t
   return 0;
 }
 
+/* Whether a column mixes ensembles between the runs: a rung's whose rung
+** moves, or a swap rate of a pair of which either rung does. */
+static int column_mixed(const lw_trace *const *t, size_t *const *row, const size_t *n, int k, const char *name)
+{
+  char rung[32];
+  int pair;
+  if (sscanf(name, "swap%d", &pair) == 1 && pair >= 0 && pair < 100000) {
+    for (int q = pair; q <= pair + 1; q++) {
+      snprintf(rung, sizeof rung, "replica%d_", q);
+      if (rung_moves(t, row, n, k, rung)) return 1;
+    }
+    return 0;
+  }
+  return rung_moves(t, row, n, k, name);
+}
+
 void lw_trace_select_of(const lw_params *p, lw_trace_select *sel)
 {
   if (sel->from < 0 && p->stats_from > 0) sel->from = p->stats_from;
@@ -194,6 +210,7 @@ enum { WARN_OPEN, WARN_FEW, WARN_ONE, WARN_DRIFT, WARN_BATCH, WARN_RUNS };
 typedef struct {
   lw_series_stats *run; /* k */
   double mean, stderr_mean, sd, tau_sweeps, n_eff;
+  int mixed;            /* a rung's column whose rung stands at other temperatures in other runs */
   double r_hat;         /* Gelman and Rubin's potential scale reduction */
   double p_runs;        /* chi-square probability of the runs' means under their error bars */
 } column_stats;
@@ -543,8 +560,8 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       combine(&cs[c], k, gap);
       /* an acceptance depends on each run's own tuned step: runs need not
       ** agree; nor need a rung's columns where the rungs' temperatures differ */
-      if (!strncmp(t[0]->name[c], "acc_", 4) || !strncmp(t[0]->name[c], "swap", 4) ||
-          rung_moves(t, row, n, k, t[0]->name[c]))
+      cs[c].mixed = column_mixed(t, row, n, k, t[0]->name[c]);
+      if (!strncmp(t[0]->name[c], "acc_", 4) || !strncmp(t[0]->name[c], "swap", 4) || cs[c].mixed)
         cs[c].p_runs = cs[c].r_hat = NAN;
     }
   }
@@ -586,12 +603,18 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       char sd[32] = "-";
       if (csv) sd[0] = '\0';
       if (!isnan(q->sd)) snprintf(sd, sizeof sd, "%.4g", q->sd);
+      /* a mean over other temperatures in other runs is no one ensemble's */
+      char mean[32] = "-", se[32] = "-";
+      if (csv) mean[0] = se[0] = '\0';
+      if (!q->mixed) {
+        snprintf(mean, sizeof mean, csv ? "%.10g" : "%.9g", q->mean);
+        snprintf(se, sizeof se, "%.4g", q->stderr_mean);
+      }
       if (csv)
-        fprintf(out, "%s,%d,%zu,%.10g,%.4g,%s,%s,%s,%s,%s\n", name, k, rows, q->mean, q->stderr_mean, sd, tau, neff,
-                rh, pr);
+        fprintf(out, "%s,%d,%zu,%s,%s,%s,%s,%s,%s,%s\n", name, k, rows, mean, se, sd, tau, neff, rh, pr);
       else
-        fprintf(out, "%-*s %15.9g %11.4g %11s %11s %9s %8s %9s%s\n", width, name, q->mean, q->stderr_mean, sd, tau,
-                neff, rh, pr, flagged(q, k) ? " *" : "");
+        fprintf(out, "%-*s %15s %11s %11s %11s %9s %8s %9s%s\n", width, name, mean, se, sd, tau, neff, rh, pr,
+                flagged(q, k) ? " *" : "");
     } else if (csv) {
       /* tau and n_eff mean nothing for a column without spread: empty, as
       ** the table's '-' and summary.json's null */
@@ -626,9 +649,9 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     fprintf(apart, "warning: the temperature changes within %s: the means mix ensembles\n",
             k > 1 ? "or between the runs" : "these rows");
   if (apart && ladders_differ)
-    fprintf(apart, "warning: the runs' rungs stand at other temperatures (their ladders were tuned each its own): "
-            "the replicaK columns of those rungs mix ensembles and are not compared (R_hat and p_runs empty); "
-            "compare them run by run, or with --reweight\n");
+    fprintf(apart, "warning: the runs' rungs stand at other temperatures (other ladders, or each tuned its own): "
+            "the columns of those rungs and their swaps mix ensembles, and their mean, stderr, R_hat and p_runs are "
+            "left empty; compare them run by run, or with --reweight\n");
   if (apart && k > 1 && identical_runs(t, row, n, k))
     fprintf(apart, "warning: the %d runs are the same, row for row: one seed run twice, or seeds that change "
             "nothing (a scene that draws no random number, as the dynamics from init.from or the D-NURBS dynamics), "

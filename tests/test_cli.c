@@ -570,13 +570,20 @@ Test(cli, a_state_without_a_later_term_resumes_and_unknown_keys_are_refused)
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
   cr_assert(strstr(errs, "new/state.lw:") && strstr(errs, "[chain] energy.torsion: unknown"), "%s", errs);
   /* energy reads no [chain]; a section nothing writes is refused there too
-  ** (it printed the energy and exited 0), a rung's sections are not */
-  cr_assert_eq(lw_test_sh("printf '[chain 2]\\nx = 1\\n' >> %s/old/state.lw", dir), 0);
+  ** (it printed the energy and exited 0), a rung's sections are not (the
+  ** file's chains count the rungs: [chain 1] beside [chain]) */
+  cr_assert_eq(lw_test_sh("printf '[chain 1]\\nx = 1\\n' >> %s/old/state.lw", dir), 0);
   snprintf(args, sizeof args, "energy %s/old", dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
-  cr_assert_eq(lw_test_sh("printf '[extra]\\nx = 1\\n' >> %s/old/state.lw", dir), 0);
-  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
-  cr_assert(strstr(errs, "old/state.lw:") && strstr(errs, ": section [extra] is unknown"), "%s", errs);
+  static const char *const extra[] = {"extra", "system bogus", "chain 7", "system splines 3"};
+  for (size_t k = 0; k < sizeof extra / sizeof extra[0]; k++) {
+    cr_assert_eq(lw_test_sh("cp %s/old/state.lw %s/x.lw && printf '[%s]\\nx = 1\\n' >> %s/old/state.lw", dir, dir,
+                            extra[k], dir), 0);
+    cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "[%s]", extra[k]);
+    cr_assert(strstr(errs, "old/state.lw:") && strstr(errs, ": section [") && strstr(errs, extra[k]) &&
+              strstr(errs, "] is unknown"), "%s", errs);
+    cr_assert_eq(lw_test_sh("mv %s/x.lw %s/old/state.lw", dir, dir), 0);
+  }
 }
 
 /* Bad input of every kind exits 2 with one message naming the file, line

@@ -24,9 +24,11 @@
 ** for the coldest rung, "system <name> K" for rung K. */
 void lw_checkpoint_system_section(char *buf, size_t n, const lw_system_type *t, int k);
 
-/* 1 if name is a section a state is written with ([run], [chain 3], [system
-** splines 2], ...), for lw_ckpt_known_sections. */
-int lw_checkpoint_section_known(const char *name);
+/* LW_EINPUT naming the first section of doc that a state of the scene's
+** system is not written with: [run], [tempering], [dynamics], [chain K] and
+** [system NAME K] (K below the file's count of chains), for a reader of the
+** curves alone (linewise energy), which refuses what it does not read. */
+lw_status lw_checkpoint_sections_known(const lw_ckpt *doc, const char *system, lw_error *err);
 
 /* Writes the checkpoint of a (trace.csv synced, state.lw, replica-K.lw). */
 lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err);

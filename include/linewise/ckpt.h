@@ -55,8 +55,8 @@ int lw_ckpt_has(lw_ckpt *c, const char *section);
 /* "path: what: missing" and why: `guess`, or a file cut short at the end of
 ** a line (lw_ckpt_read refuses one cut inside a line), naming its last. */
 lw_status lw_ckpt_missing(const lw_ckpt *c, const char *what, const char *guess, lw_error *err);
-/* "section [sec] missing", naming the sections the file has and their lines
-** (a renamed one stands out). */
+/* "section [sec] missing", naming the sections the file has and their lines,
+** those not read yet first (a renamed one stands out). */
 lw_status lw_ckpt_no_section(const lw_ckpt *c, const char *sec, lw_error *err);
 
 /* For a message on bulk data that stops short: the words that say the file
@@ -89,9 +89,13 @@ lw_status lw_ckpt_whole(lw_ckpt *c, const char *section, const char *key, long *
 ** returns 1 and the next entry (marked read), 0 at the end of the section. */
 int lw_ckpt_next(lw_ckpt *c, const char *section, size_t *pos, const char **key, const char **value, int *line);
 
-/* Refuses the first section whose name known() does not take (a reader
-** that leaves parts of the file unread still drops nothing unknown). */
-lw_status lw_ckpt_known_sections(const lw_ckpt *c, int (*known)(const char *name), lw_error *err);
+/* Refuses the first section whose name known(name, ctx) does not take (a
+** reader that leaves parts of the file unread still drops nothing unknown). */
+lw_status lw_ckpt_known_sections(const lw_ckpt *c, int (*known)(const char *name, const void *ctx), const void *ctx,
+                                 lw_error *err);
+
+/* How many sections' names match() takes. */
+size_t lw_ckpt_count_sections(const lw_ckpt *c, int (*match)(const char *name));
 
 /* LW_EINPUT naming the first section or key nothing asked for (written by
 ** a newer linewise), else LW_OK. */
