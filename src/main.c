@@ -175,12 +175,6 @@ static int cmd_energy(int argc, char **argv)
   lw_state st;
   char path[LW_PATH_MAX + 32];
   if (load_run_dir(dir, &p, &st, path, sizeof path, &err)) return fail(&err);
-  /* the run's sections are read by resume, not here; an unknown one is
-  ** refused all the same, as every reader of a state does */
-  if (st.doc && lw_checkpoint_sections_known(st.doc, p.system, &err)) {
-    lw_state_clear(&st);
-    return fail(&err);
-  }
   /* the energy is of the scene as DIR/scene.ini reads now: an edit since the
   ** run started (which resume refuses) gave another energy without a word */
   static lw_run_keys keys;
@@ -210,6 +204,10 @@ static int cmd_energy(int argc, char **argv)
   /* the row refuses a state it cannot place and names a term that is not
   ** finite (for splines: the spline and segment) */
   double total = setup ? t->energy(setup, &st, path, term, &err) : NAN;
+  /* the run's sections are read by resume, not here; an unknown one is
+  ** refused all the same, as every reader of a state does (after the row,
+  ** whose message names a state of another system better) */
+  if (!err.code && st.doc) lw_checkpoint_sections_known(st.doc, p.system, &err);
   if (err.code) rc = fail(&err);
   else {
     for (int k = 0; k < t->n_terms; k++)
