@@ -1,8 +1,10 @@
 /* error.c -- status codes and messages (see error.h). */
 #include "linewise/error.h"
 
+#include <gsl/gsl_errno.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 
 lw_status lw_error_set(lw_error *err, lw_status code, const char *fmt, ...)
 {
@@ -36,4 +38,12 @@ int lw_error_exit_status(lw_status code)
   case LW_EUSAGE: return 2;
   default: return 1;
   }
+}
+
+void lw_gsl_handler(const char *reason, const char *file, int line, int gsl_errno)
+{
+  if (gsl_errno == GSL_ENOMEM) return;
+  fprintf(stderr, "linewise: internal error: GSL: %s (%s:%d, %s); please report it\n", reason, file, line,
+          gsl_strerror(gsl_errno));
+  abort();
 }

@@ -5,6 +5,7 @@
 ** running.
 */
 #include <errno.h>
+#include <gsl/gsl_errno.h>
 #include <fcntl.h>
 #include <math.h>
 #include <omp.h>
@@ -1115,6 +1116,7 @@ static int narrow_lanes(void)
 int main(int argc, char **argv)
 {
   open_standard_descriptors();
+  gsl_set_error_handler(lw_gsl_handler);
   if (narrow_lanes()) return 2;
 #ifndef LW_MPI
   choose_wait_policy(argc, argv);

@@ -40,4 +40,11 @@ void lw_error_clear(lw_error *err);
 /* The process exit status for a code: 0, 1 or 2. */
 int lw_error_exit_status(lw_status code);
 
+/* A GSL error handler for a program that uses the library (gsl_set_error_handler):
+** an allocation GSL cannot make (GSL_ENOMEM) returns, so that its caller sees
+** NULL and says "out of memory" (GSL's own handler aborted the process, which
+** a run out of memory should not); any other GSL error is a fault of this
+** library, and ends the process with one line saying so. */
+void lw_gsl_handler(const char *reason, const char *file, int line, int gsl_errno);
+
 #endif
