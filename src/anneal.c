@@ -303,6 +303,16 @@ static lw_status from_elsewhere(const lw_anneal *a, const char *dir, lw_error *e
   const int run_there = !stat(state, &ss);
   const int same_file = run_there && ss.st_dev == sf.st_dev && ss.st_ino == sf.st_ino;
   const char *base = real + strlen(fdir) + (real[strlen(fdir)] == '/');
+  /* (the run before, set aside in DIR/.replaced while a run replaces it,
+  ** comes back over whatever a start from it would write) */
+  char stash[4096 + 16];
+  snprintf(stash, sizeof stash, "%s/%s", rd, LW_RUNFILES_STASH);
+  if (!strncmp(fdir, stash, strlen(stash)) && (!fdir[strlen(stash)] || fdir[strlen(stash)] == '/')) {
+    lw_error_set(err, LW_EINPUT, "'%s' is in %s, where the run in %s waits while a run replaces it: expected a "
+                 "state elsewhere (a run or resume there puts that run back first; copy the state out to redraw "
+                 "from it)", from, stash, dir);
+    return lw_params_blame(&a->params, "init", "from", err);
+  }
   if (!same_file && !(!strcmp(fdir, rd) && (!strncmp(base, "replica-", 8) || !strcmp(base, "state.lw"))))
     return LW_OK;
   char scene[LW_PATH_MAX + 16], resume[LW_PATH_MAX + 64] = "";
@@ -952,7 +962,7 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
   if (!s) a->saved = a->sweep + 1;
   if (!s && a->fresh) { /* the first: the run before, set aside, can go */
     a->fresh = 0;
-    if (a->stashed) lw_runfiles_drop(a->dir);
+    if (a->stashed) lw_runfiles_drop(a->dir, NULL); /* (one that fails stays, and the next run or resume says so) */
     a->stashed = 0;
     lw_phase_stash(0);
   }
@@ -1096,13 +1106,21 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   lw_phase_set("reading state.lw and rebuilding the energy");
   /* (a directory that holds no run has no state.lw to read, which says so,
   ** and gets no lock file) */
+  lw_status sl = LW_OK;
   if (writes_files(a) && (lw_rundir_holds_run(dir) || lw_runfiles_stashed(dir))) {
     int back;
-    lw_status sl = lw_rundir_lock(dir, &a->dir_hold, err);
+    sl = lw_rundir_lock(dir, &a->dir_hold, err);
     /* a run made again there was stopped in its set-up: the run before
     ** comes back, to be resumed (or its new run's first checkpoint stands) */
-    if (sl || (sl = lw_runfiles_recover(dir, &back, err))) return sl;
+    if (!sl) sl = lw_runfiles_recover(dir, &back, err);
   }
+  if (net) { /* the other processes read the directory once process 0 has settled it */
+    double failed = sl != LW_OK;
+    net->broadcast(net, 0, &failed, 1);
+    if (failed && !sl)
+      sl = lw_error_set(err, LW_EIO, "%s: process 0 could not take the run directory (it says why)", dir);
+  }
+  if (sl) return sl;
   /* a run stopped before its first checkpoint left its scene.ini alone */
   if (lw_rundir_unstarted(dir))
     return lw_error_set(err, LW_EINPUT, "%s: no state.lw: the run there stopped before its first checkpoint, so "

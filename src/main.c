@@ -175,7 +175,14 @@ static int cmd_energy(int argc, char **argv)
   static lw_params p;
   lw_state st;
   char path[LW_PATH_MAX + 32];
-  if (load_run_dir(dir, &p, &st, path, sizeof path, &err)) return fail(&err);
+  if (load_run_dir(dir, &p, &st, path, sizeof path, &err)) {
+    /* (the run may wait in DIR/.replaced, set aside by a run killed as it started) */
+    const size_t n = strlen(err.msg);
+    if (lw_runfiles_stashed(dir))
+      snprintf(err.msg + n, sizeof err.msg - n, "; a run there waits in %s/" LW_RUNFILES_STASH ", set aside by a run "
+               "stopped as it started: 'linewise resume %s' puts it back", dir, dir);
+    return fail(&err);
+  }
   /* the energy is of the scene as DIR/scene.ini reads now: an edit since the
   ** run started (which resume refuses) gave another energy without a word */
   static lw_run_keys keys;

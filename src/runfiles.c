@@ -126,18 +126,29 @@ int lw_runfiles_stashed(const char *dir)
   return lstat(st, &sb) == 0;
 }
 
-/* Whether the stash is linewise's (a directory, not a link, with a marker)
-** and which marker it has: 1 .moving, 2 .moved, 0 not a stash. */
+/* What the stash is (its marker): 1 .moving (the run before being moved in),
+** 2 .moved (all of it in), 3 .restoring (being moved back), 4 an empty
+** directory (a process killed before its marker, or after removing it),
+** 0 not linewise's (not a directory, a link, no marker). */
+enum { NOT_OURS, MOVING, MOVED, RESTORING, EMPTY };
+
 static int stash_marker(const char *dir)
 {
+  static const char *const marker[] = {".moving", ".moved", ".restoring"};
   char path[LW_PATH_MAX + 32];
   struct stat sb;
   stash_path(path, sizeof path, dir, NULL);
-  if (lstat(path, &sb) || !S_ISDIR(sb.st_mode)) return 0;
-  stash_path(path, sizeof path, dir, ".moved");
-  if (!lstat(path, &sb) && S_ISREG(sb.st_mode)) return 2;
-  stash_path(path, sizeof path, dir, ".moving");
-  return !lstat(path, &sb) && S_ISREG(sb.st_mode) ? 1 : 0;
+  if (lstat(path, &sb) || !S_ISDIR(sb.st_mode)) return NOT_OURS;
+  for (int k = 0; k < 3; k++) {
+    stash_path(path, sizeof path, dir, marker[k]);
+    if (!lstat(path, &sb) && S_ISREG(sb.st_mode)) return MOVING + k;
+  }
+  stash_path(path, sizeof path, dir, NULL);
+  DIR *d = opendir(path);
+  int entries = 0;
+  for (struct dirent *e; d && (e = readdir(d));) entries += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
+  if (d) closedir(d);
+  return d && !entries ? EMPTY : NOT_OURS;
 }
 
 typedef struct {
@@ -191,29 +202,44 @@ static int remove_one(const char *rel, void *ctx)
   return 0;
 }
 
-/* The stash's markers and subdirectories, then the stash itself, where
-** that leaves them empty. */
+/* The stash's subdirectories and marker, then the stash itself, where that
+** leaves them empty: the marker last, so that a kill before leaves a stash
+** that says what it is, and one after an empty directory (EMPTY). */
 static void remove_stash_dir(const char *dir)
 {
+  static const char *const marker[] = {".moving", ".moved", ".restoring"};
   char st[LW_PATH_MAX + 32], path[LW_PATH_MAX + 32];
   stash_path(st, sizeof st, dir, NULL);
   prune(st);
-  stash_path(path, sizeof path, dir, ".moving");
-  unlink(path);
-  stash_path(path, sizeof path, dir, ".moved");
-  unlink(path);
+  for (int k = 0; k < 3; k++) {
+    stash_path(path, sizeof path, dir, marker[k]);
+    unlink(path);
+  }
   rmdir(st);
 }
 
 lw_status lw_runfiles_unstash(const char *dir, lw_error *err)
 {
-  const int marker = stash_marker(dir);
-  if (!marker) return LW_OK;
-  char st[LW_PATH_MAX + 16];
+  int marker = stash_marker(dir);
+  char st[LW_PATH_MAX + 16], moved[LW_PATH_MAX + 32], restoring[LW_PATH_MAX + 32];
   stash_path(st, sizeof st, dir, NULL);
-  /* all of the run before is in the stash: the run files in dir are the new
-  ** run's; while it was moving, those in dir are the run before's */
-  if (marker == 2) each_file(dir, remove_new, (void *)dir);
+  if (marker == EMPTY) rmdir(st);
+  if (marker == NOT_OURS || marker == EMPTY) return LW_OK;
+  if (marker == MOVED) {
+    /* all of the run before is in the stash: the run files in dir are the
+    ** new run's, and those without a counterpart go; then the marker says
+    ** that what comes back into dir is the run before's (a kill while
+    ** moving back left it .moved, and the next recover took the run before's
+    ** state.lw, back already, for the new run's and dropped the rest) */
+    each_file(dir, remove_new, (void *)dir);
+    stash_path(moved, sizeof moved, dir, ".moved");
+    stash_path(restoring, sizeof restoring, dir, ".restoring");
+    if (rename(moved, restoring))
+      return lw_error_set(err, LW_EIO, "%s: cannot rename: %s; the run that was there before is in %s", moved,
+                          strerror(errno), st);
+  }
+  /* .moving or .restoring: every run file in the stash goes back, over a
+  ** counterpart in dir (the new run's) */
   mover m = {st, dir, 0, ""};
   if (each_file(st, move_one, &m))
     return lw_error_set(err, LW_EIO, "%s/%s: cannot put it back: %s; the rest of the run that was there before "
@@ -253,13 +279,24 @@ lw_status lw_runfiles_stash(const char *dir, lw_error *err)
   return LW_OK;
 }
 
-void lw_runfiles_drop(const char *dir)
+static int remove_stashed(const char *rel, void *ctx)
+{
+  char path[2 * LW_PATH_MAX + 32];
+  stash_path(path, sizeof path, ctx, rel);
+  return unlink(path) && errno != ENOENT;
+}
+
+lw_status lw_runfiles_drop(const char *dir, lw_error *err)
 {
   char st[LW_PATH_MAX + 16];
-  if (!stash_marker(dir)) return;
+  const int marker = stash_marker(dir);
   stash_path(st, sizeof st, dir, NULL);
-  each_file(st, remove_one, st);
+  if (marker == NOT_OURS) return LW_OK;
+  if (marker != EMPTY && each_file(st, remove_stashed, (void *)dir))
+    return lw_error_set(err, LW_EIO, "%s: cannot remove the run set aside there (the run that replaced it has its "
+                        "checkpoint): %s; remove the folder by hand", st, strerror(errno));
   remove_stash_dir(dir);
+  return LW_OK;
 }
 
 void lw_runfiles_remove(const char *dir)
@@ -272,7 +309,7 @@ lw_status lw_runfiles_check_stash(const char *dir, lw_error *err)
 {
   char st[LW_PATH_MAX + 16];
   stash_path(st, sizeof st, dir, NULL);
-  if (!lw_runfiles_stashed(dir) || stash_marker(dir)) return LW_OK;
+  if (!lw_runfiles_stashed(dir) || stash_marker(dir) != NOT_OURS) return LW_OK;
   return lw_error_set(err, LW_EUSAGE, "%s: not linewise's (a run sets the run before aside there while it starts, "
                       "with a marker file in it): expected no such file or folder; remove or rename it", st);
 }
@@ -286,10 +323,8 @@ lw_status lw_runfiles_recover(const char *dir, int *back, lw_error *err)
   char state[LW_PATH_MAX + 16];
   struct stat sb;
   snprintf(state, sizeof state, "%s/state.lw", dir);
-  if (marker == 2 && !lstat(state, &sb)) { /* the new run had its checkpoint */
-    lw_runfiles_drop(dir);
-    return LW_OK;
-  }
+  if (marker == EMPTY) return lw_runfiles_drop(dir, err);
+  if (marker == MOVED && !lstat(state, &sb)) return lw_runfiles_drop(dir, err); /* the new run had its checkpoint */
   s = lw_runfiles_unstash(dir, err);
   *back = !s;
   return s;

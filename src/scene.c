@@ -322,9 +322,9 @@ static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
       ** outside, where an SVG's default fill has it inside (a run begun
       ** before 2026-12-05 keeps its shape) */
       else if (!lw_params_kept(p, "scene", "polygon") && lw_boundary_crossing(n / 2, xs, ys, &ea, &eb))
-        st = bad_key(p, "scene", "polygon", LW_EINPUT, err, "the polygon crosses or touches itself: its edge from vertex %zu "
-                     "meets the one from vertex %zu: expected a simple polygon, its edges meeting only at their "
-                     "shared vertices (they count from 0; a star is given by its outline)", ea, eb);
+        st = bad_key(p, "scene", "polygon", LW_EINPUT, err, "the polygon crosses or touches itself: its edge from "
+                     "vertex %zu meets the one from vertex %zu: expected a simple polygon, its edges meeting only at "
+                     "their shared vertices (they count from 0; a star is given by its outline)", ea, eb);
       else if ((st = lw_boundary_polygon(&sc->boundary, n / 2, xs, ys, &e2)) != LW_OK)
         bad_key(p, "scene", "polygon", st, err, "%s", e2.msg);
       /* (a polygon in the margin was annealed, then drawn empty or cut,

@@ -220,8 +220,8 @@ Test(cli, a_polygon_in_the_margin_is_noted_before_the_run)
   snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/r --stop-at 0 --set scene.boundary=polygon --set "
            "'scene.polygon=20 20 80 90 80 20 20 90'", lw_test_root(), dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
-  cr_assert(strstr(errs, "key 'scene.polygon': the polygon crosses or touches itself: its edge from vertex 0 meets the one from "
-                         "vertex 2: expected a simple polygon"), "%s", errs);
+  cr_assert(strstr(errs, "key 'scene.polygon': the polygon crosses or touches itself: its edge from vertex 0 meets "
+                         "the one from vertex 2: expected a simple polygon"), "%s", errs);
 }
 
 Test(cli, energy_lists_only_enabled_terms)

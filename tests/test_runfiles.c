@@ -61,7 +61,7 @@ Test(runfiles, a_run_set_aside_comes_back_over_the_new_runs_files)
   old_run_is_back("put back");
   /* set aside again, and the new run had its checkpoint: the stash goes */
   cr_assert_eq(lw_runfiles_stash(r, &err), LW_OK, "%s", err.msg);
-  lw_runfiles_drop(r);
+  cr_assert_eq(lw_runfiles_drop(r, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(sh("cd %s/r && ! test -e .replaced && grep -qx mine notes.txt && ! test -e state.lw", dir), 0);
 }
 
@@ -89,6 +89,21 @@ Test(runfiles, a_stash_a_killed_process_left_is_settled)
   cr_assert_eq(back, 1);
   old_run_is_back("killed in the set-up");
   cr_assert_neq(sh("test -e %s/r/state.lw.tmp", dir), 0);
+  /* killed while putting it back: state.lw back already, scene.ini still the
+  ** new run's in dir and the old in the stash (marked .moved, the next
+  ** recover took the old state.lw for the new run's and dropped the rest) */
+  cr_assert_eq(lw_runfiles_stash(r, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(sh("cd %s/r && echo new > scene.ini && mv .replaced/.moved .replaced/.restoring && mv .replaced/state.lw "
+                  "state.lw", dir), 0);
+  cr_assert_eq(lw_runfiles_recover(r, &back, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(back, 1);
+  old_run_is_back("killed while putting it back");
+  /* killed with the stash made and no marker yet, or its marker gone and
+  ** the folder not: an empty .replaced is removed (it was refused as not
+  ** linewise's, and the directory blocked) */
+  cr_assert_eq(sh("mkdir %s/r/.replaced", dir), 0);
+  cr_assert_eq(lw_runfiles_recover(r, &back, &err), LW_OK, "%s", err.msg);
+  old_run_is_back("an empty stash");
   /* killed between the first checkpoint and dropping the stash */
   cr_assert_eq(lw_runfiles_stash(r, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(sh("cd %s/r && echo new > scene.ini && echo new > state.lw", dir), 0);
@@ -103,8 +118,9 @@ Test(runfiles, a_stash_a_killed_process_left_is_settled)
 ** followed, and the run it led to was deleted. */
 Test(runfiles, a_replaced_that_is_not_linewises_is_refused_and_left_alone)
 {
-  static const char *const make[] = {"mkdir .replaced && echo mine > .replaced/mine.txt && echo old > .replaced/state.lw",
-                                     "ln -s ../other .replaced", "echo mine > .replaced"};
+  static const char *const make[] = {
+    "mkdir .replaced && echo mine > .replaced/mine.txt && echo old > .replaced/state.lw", "ln -s ../other .replaced",
+    "echo mine > .replaced"};
   char r[96];
   snprintf(r, sizeof r, "%s/r", dir);
   for (size_t k = 0; k < sizeof make / sizeof make[0]; k++) {

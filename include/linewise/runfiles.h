@@ -16,8 +16,12 @@
 ** the directory's lock (lw_runfiles_recover).  A marker inside says what
 ** the stash holds: .moving while the run before is being moved (some of its
 ** files may still be in DIR), .moved once all are (every run file in DIR is
-** the new run's).  A DIR/.replaced without a marker is not linewise's, and
-** is never written into or read from.
+** the new run's), .restoring while it moves back (a run file in DIR with a
+** counterpart in the stash is the new run's, one without the run before's).
+** The marker goes last, so a kill leaves a stash that says what it is, or an
+** empty DIR/.replaced, which is removed.  A DIR/.replaced that is not empty
+** and has no marker is not linewise's, and is never written into or read
+** from.
 */
 #ifndef LINEWISE_RUNFILES_H
 #define LINEWISE_RUNFILES_H
@@ -52,8 +56,9 @@ lw_status lw_runfiles_stash(const char *dir, lw_error *err);
 ** is left stays in the stash, and err names it. */
 lw_status lw_runfiles_unstash(const char *dir, lw_error *err);
 
-/* Removes the stash: the new run has its first checkpoint. */
-void lw_runfiles_drop(const char *dir);
+/* Removes the stash: the new run has its first checkpoint.  LW_EIO where a
+** file of it cannot be removed (the stash stays, saying what it holds). */
+lw_status lw_runfiles_drop(const char *dir, lw_error *err);
 
 /* Removes dir's run files: a set-up that failed where no run was before. */
 void lw_runfiles_remove(const char *dir);
