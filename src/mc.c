@@ -86,6 +86,7 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
   ** a death among pinned particles read an acceptance of 1 (and fed the
   ** step tuning) */
   if (forbidden == LW_PROPOSE_NOTHING) return 0;
+  if (forbidden == LW_PROPOSE_NOMEM) return -1; /* (as a commit that ran out of memory) */
   int accept;
   const double lr = c->sys->type->log_ratio ? c->sys->type->log_ratio(c->prop) : 0.0;
   lw_move_stats *s = &c->stats[kind];
@@ -126,6 +127,7 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
     /* the second stage of delayed acceptance (system.h): the part of dE
     ** the first one saw only a stand-in for */
     const double d2 = t->finish(c->sys->state, c->prop);
+    if (d2 == LW_FINISH_NOMEM) return -1;
     if (isnan(d2)) {
       s->nan++;
       accept = 0;

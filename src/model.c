@@ -43,6 +43,14 @@ static int segment_eval(const lw_scene *sc, const lw_term_ctx *ctx, const lw_nod
   return regular;
 }
 
+/* What a proposal returns where an allocation failed: NAN, marked as want of
+** memory, not an undefined energy (the row stops the run: system.h). */
+static double no_memory(lw_proposal *p)
+{
+  p->nomem = 1;
+  return NAN;
+}
+
 /* Appends a segment number to a list.  LW_ENOMEM if it cannot grow. */
 static lw_status list_push(lw_near_list *l, uint32_t v)
 {
@@ -921,7 +929,7 @@ static double pair_walk(const lw_model *m, lw_proposal *p)
   p->near.n = 0;
   if (lw_pair_walk(m->grid, &sc->pair, p->walked, nw, &f, &all, p->each, &p->near, NULL) != LW_OK) {
     memo_reset(p, m);
-    return NAN;
+    return no_memory(p);
   }
   /* each walked probe's sum to its number, in place: walked_id rises, and
   ** walked_id[i] >= i */
@@ -934,7 +942,7 @@ static double pair_walk(const lw_model *m, lw_proposal *p)
   }
   if (side_partners(p, np) != LW_OK) {
     memo_reset(p, m);
-    return NAN;
+    return no_memory(p);
   }
   double pe = 0.0, stand = 0.0;
   p->any_near = p->near.n > 0;
@@ -986,11 +994,11 @@ static double pair_near_delta(const lw_model *m, lw_proposal *p, const lw_node *
     lw_segment_bezier(proposed_node(base, p, p->seg0 + j), proposed_node(base, p, p->seg0 + j + 1), bez);
     p->near_new[j] = near_part(&v, bez, p->ps + j * np, now, (uint32_t)g, &p->near_vals);
     pe += p->near_new[j];
-    if (add_partners(p, now) != LW_OK) return NAN;
+    if (add_partners(p, now) != LW_OK) return no_memory(p);
     /* the old side's partners: the memo's (pair_walk filled it) */
     const lw_near_list *old = &p->memo.partners[p->seg0 + j];
     pe -= old_near(m, &v, g, &base[p->seg0 + j], p->ps_old + j * np, old);
-    if (add_partners(p, old) != LW_OK) return NAN;
+    if (add_partners(p, old) != LW_OK) return no_memory(p);
   }
   return pe;
 }
@@ -1405,7 +1413,7 @@ static double raster_delta(const lw_model *m, lw_proposal *p, int t, const lw_no
     raster_cover(c->data, b, &base[k], &base[k + 1]);
     raster_cover(c->data, b, proposed_node(base, p, k), proposed_node(base, p, k + 1));
   }
-  if (lw_tone_box_ready(b) != LW_OK) return NAN;
+  if (lw_tone_box_ready(b) != LW_OK) return no_memory(p);
   for (size_t j = 0; j < p->n_seg; j++) {
     const size_t k = p->seg0 + j;
     raster_segment(c, b, &base[k], &base[k + 1], -1);
@@ -1852,29 +1860,29 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p)
         const lw_pair_sample *x = &p->ps_old[o * np + q];
         p->probe[n] = (lw_pair_probe){x->x, x->y, x->dl, -1.0};
       }
-    if (lw_pair_walk(m->grid, &sc->pair, p->probe, n, &f, &pe, NULL, &p->near, NULL) != LW_OK) return NAN;
+    if (lw_pair_walk(m->grid, &sc->pair, p->probe, n, &f, &pe, NULL, &p->near, NULL) != LW_OK) return no_memory(p);
     for (size_t j = 0; j < p->n_seg; j++) p->near_new[j] = 0.0;
     return pe + splice_pair_between(m, p, &v);
   }
   for (size_t k = 0; k < nn; k++) p->probe[k] = (lw_pair_probe){p->ps[k].x, p->ps[k].y, p->ps[k].dl, 1.0};
   for (size_t k = 0; k < no; k++)
     p->probe[nn + k] = (lw_pair_probe){p->ps_old[k].x, p->ps_old[k].y, p->ps_old[k].dl, -1.0};
-  if (lw_pair_walk(m->grid, &sc->pair, p->probe, nn + no, &f, &pe, NULL, &p->near, NULL) != LW_OK) return NAN;
+  if (lw_pair_walk(m->grid, &sc->pair, p->probe, nn + no, &f, &pe, NULL, &p->near, NULL) != LW_OK) return no_memory(p);
   for (size_t j = 0; j < p->n_seg; j++) {
     double bez[8];
     const size_t a = splice_seg_node(p, j);
-    if (near_of_probes(p, np, j * np, &p->segs) != LW_OK) return NAN;
+    if (near_of_probes(p, np, j * np, &p->segs) != LW_OK) return no_memory(p);
     lw_segment_bezier(&p->node[a], &p->node[a + 1], bez);
     p->near_new[j] = near_part(&v, bez, p->ps + j * np, &p->segs, 0, NULL);
     pe += p->near_new[j];
-    if (add_partners(p, &p->segs) != LW_OK) return NAN;
+    if (add_partners(p, &p->segs) != LW_OK) return no_memory(p);
   }
   for (int k = 0, o = 0; k < p->n_old; k++) {
     const size_t g0 = lw_segment_index(m->sp, p->old[k], 0);
     const lw_node *nd = splice_old_nodes(m, p, k);
     for (size_t j = 0; j < p->old_seg[k]; j++, o++) {
       const lw_pair_sample *ps = p->ps_old + (size_t)o * np;
-      if (near_of_probes(p, np, nn + (size_t)o * np, &p->segs) != LW_OK) return NAN;
+      if (near_of_probes(p, np, nn + (size_t)o * np, &p->segs) != LW_OK) return no_memory(p);
       if (p->n_old == 1) {
         pe -= old_near(m, &v, g0 + j, &nd[j], ps, &p->segs);
       } else {
@@ -1882,7 +1890,7 @@ static double splice_pair_delta(const lw_model *m, lw_proposal *p)
         lw_segment_bezier(&nd[j], &nd[j + 1], bez);
         pe -= near_part(&v, bez, ps, &p->segs, 0, NULL);
       }
-      if (add_partners(p, &p->segs) != LW_OK) return NAN;
+      if (add_partners(p, &p->segs) != LW_OK) return no_memory(p);
     }
   }
   return pe + splice_pair_between(m, p, &v);
@@ -1934,7 +1942,7 @@ static double splice_raster_delta(const lw_model *m, lw_proposal *p, int t)
   lw_tone_box *b = &p->box[t];
   lw_tone_box_reset(b);
   for (int pass = 0; pass < 2; pass++) {
-    if (pass && lw_tone_box_ready(b) != LW_OK) return NAN;
+    if (pass && lw_tone_box_ready(b) != LW_OK) return no_memory(p);
     size_t o = 0;
     for (int k = 0; k < p->n_old; k++)
       for (size_t j = 0; j < p->old_seg[k]; j++, o++) {

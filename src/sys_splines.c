@@ -877,7 +877,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
 ** sweep's earlier splices left the splines, so which node a step updates
 ** would depend on what the chain did before it in the sweep, and the
 ** stationary law is lost (docs/NUMERICS.md, "Split and join": measured). */
-static double propose(void *state, void *prop, int kind, double st, gsl_rng *rng, int *forbidden)
+static double propose_once(void *state, void *prop, int kind, double st, gsl_rng *rng, int *forbidden)
 {
   spl_state *s = state;
   const lw_model *m = s->m;
@@ -902,7 +902,7 @@ static double propose(void *state, void *prop, int kind, double st, gsl_rng *rng
 ** and vector moves.  Trans-dimensional kinds draw their own spline, and
 ** the count of sites may change within a sweep: a site past the end wraps
 ** around (each proposal is still a Metropolis update of one node). */
-static double propose_at(void *state, void *prop, int kind, size_t k, double st, gsl_rng *rng, int *forbidden)
+static double propose_at_once(void *state, void *prop, int kind, size_t k, double st, gsl_rng *rng, int *forbidden)
 {
   spl_state *s = state;
   const lw_model *m = s->m;
@@ -975,12 +975,41 @@ static size_t group(const void *state, size_t site, double box[4])
   return sp->first[i + 1] - site;
 }
 
-static double propose_in(void *state, void *prop, int kind, size_t k, double st, gsl_rng *rng, int *forbidden,
+static double propose_in_once(void *state, void *prop, int kind, size_t k, double st, gsl_rng *rng, int *forbidden,
                          const double box[4])
 {
   const spl_state *s = state;
   lw_proposal *p = prop;
   return propose_on(s->m, td_of(s), p, kind, k, spline_near(s->m->sp, p->spline, k), st, rng, forbidden, box);
+}
+
+/* The entry points: a proposal the model could not evaluate for want of
+** memory says so (LW_PROPOSE_NOMEM), and the run stops with out of memory
+** (its NaN was counted as an undefined energy and rejected: a run under
+** memory pressure went another way without a word). */
+static double checked(void *prop, double dE, int *forbidden)
+{
+  if (((lw_proposal *)prop)->nomem) *forbidden = LW_PROPOSE_NOMEM;
+  return dE;
+}
+
+static double propose(void *state, void *prop, int kind, double st, gsl_rng *rng, int *forbidden)
+{
+  ((lw_proposal *)prop)->nomem = 0;
+  return checked(prop, propose_once(state, prop, kind, st, rng, forbidden), forbidden);
+}
+
+static double propose_at(void *state, void *prop, int kind, size_t k, double st, gsl_rng *rng, int *forbidden)
+{
+  ((lw_proposal *)prop)->nomem = 0;
+  return checked(prop, propose_at_once(state, prop, kind, k, st, rng, forbidden), forbidden);
+}
+
+static double propose_in(void *state, void *prop, int kind, size_t k, double st, gsl_rng *rng, int *forbidden,
+                         const double box[4])
+{
+  ((lw_proposal *)prop)->nomem = 0;
+  return checked(prop, propose_in_once(state, prop, kind, k, st, rng, forbidden, box), forbidden);
 }
 
 static lw_status commit_part(void *state, void *prop)
@@ -1004,7 +1033,8 @@ static void defer(void *prop, int on) { ((lw_proposal *)prop)->defer_near = on; 
 
 static double finish(void *state, void *prop)
 {
-  return lw_model_propose_finish(((spl_state *)state)->m, prop);
+  const double d = lw_model_propose_finish(((spl_state *)state)->m, prop);
+  return ((lw_proposal *)prop)->nomem ? LW_FINISH_NOMEM : d;
 }
 
 static lw_status sweep_end(void *state) { return lw_model_compact(((spl_state *)state)->m); }

@@ -86,10 +86,17 @@ static double gs_step_max(const void *state, int kind) { return 10.0; }
 static void *gs_proposal_new(const void *state, lw_error *err) { return malloc(sizeof(gs_prop)); }
 static void gs_proposal_free(void *prop) { free(prop); }
 
+/* The proposal that runs out of memory (counting from 1; 0: none). */
+static long gs_nomem_at, gs_proposed;
+
 static double gs_propose(void *state, void *prop, int kind, double step, gsl_rng *rng, int *forbidden)
 {
   const gs_state *s = state;
   gs_prop *p = prop;
+  if (++gs_proposed == gs_nomem_at) {
+    *forbidden = LW_PROPOSE_NOMEM;
+    return NAN;
+  }
   p->n = 0;
   p->dterm[0] = p->dterm[1] = 0.0;
   if (kind == 0) {
@@ -265,6 +272,28 @@ Test(system, the_chain_samples_a_test_row_exactly)
   gs_terms(c->sys->state, fresh);
   double drift = lw_system_drift(run, fresh, 2);
   cr_assert(drift < 1e-9, "running energy drifted by %g", drift);
+  gauss_chain_free(c);
+}
+
+/* A proposal a row could not evaluate for want of memory stops the chain
+** (LW_ENOMEM), where its NaN was counted as an undefined energy and the run
+** went on another way: the spline row's walk under memory pressure. */
+Test(system, a_proposal_out_of_memory_stops_the_chain)
+{
+  lw_chain *c = gauss_chain(0.7, 7);
+  gs_proposed = 0;
+  gs_nomem_at = 3 * NV + 2;
+  cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  cr_assert_eq(lw_chain_sweep(c), LW_OK);
+  cr_assert_eq(lw_chain_sweep(c), LW_ENOMEM);
+  long proposed = 0;
+  for (int k = 0; k < 2; k++) {
+    cr_assert_eq(c->stats[k].nan, 0, "counted as an undefined energy");
+    proposed += (long)c->stats[k].proposed;
+  }
+  cr_assert_eq(proposed, 3 * NV + 1, "the failed proposal counted");
+  gs_nomem_at = 0;
   gauss_chain_free(c);
 }
 

@@ -198,6 +198,7 @@ typedef struct {
   double *seg_sum;            /* 4 n_seg: segment j's far sum and stand-in, new (4j, 4j + 1)
                               ** and old (4j + 2, 4j + 3) */
   int walk_done;              /* the walk of this move ran and its memo entries hold */
+  int nomem;                  /* an allocation failed: its dE is NAN for want of memory */
   int any_near;               /* a changed segment has near pairs, new or old */
   double stand_in;            /* the first stage's stand-in of the near field's change */
   lw_far_memo memo;

@@ -46,6 +46,7 @@
 #define LINEWISE_SYSTEM_H
 
 #include <gsl/gsl_rng.h>
+#include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 
@@ -75,6 +76,11 @@ typedef struct {
 
 /* *forbidden of a proposal that is none (lw_system_type.propose). */
 #define LW_PROPOSE_NOTHING 4
+/* *forbidden of a proposal that could not be evaluated for want of memory:
+** the chain stops (lw_chain_step < 0) rather than count it as rejected. */
+#define LW_PROPOSE_NOMEM 5
+/* What lw_system_type.finish returns where it ran out of memory. */
+#define LW_FINISH_NOMEM (-INFINITY)
 
 struct lw_system_type {
   const char *name;                   /* [scene] system = name */
@@ -162,7 +168,8 @@ struct lw_system_type {
   ** whatever the stand-in, as long as it is a function of the two states
   ** (docs/NUMERICS.md, "Delayed acceptance").  finish() may also check a
   ** constraint that only a move about to be taken needs: +inf refuses the
-  ** move, counted as crowded (lw_move_stats). */
+  ** move, counted as crowded (lw_move_stats).  LW_FINISH_NOMEM (-inf, which
+  ** no energy difference is) where it ran out of memory: the chain stops. */
   void (*defer)(void *prop, int on);
   double (*finish)(void *state, void *prop);
   /* Optional (NULL: a sweep is never split; domains.h, [anneal] domains):
