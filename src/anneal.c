@@ -821,6 +821,9 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   a->wall_start = now_seconds();
   a->params = *p;
   lw_status s;
+  /* every file is written with '.': a program that set a decimal-comma
+  ** locale after reading the scene wrote 'pair = 0,02' and JSON that is not */
+  if ((s = lw_number_locale_ok(err))) return s;
   if ((s = absolute_paths(a, err)) || (s = from_elsewhere(a, dir, err))) return s;
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   a->seed = (unsigned long)a->params.seed;
@@ -951,7 +954,8 @@ lw_status lw_anneal_settle(lw_anneal *a, lw_error *err)
 
 lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
 {
-  lw_status se = lw_anneal_settle(a, err);
+  lw_status se = lw_number_locale_ok(err); /* (the locale changed since the start) */
+  if (se || (se = lw_anneal_settle(a, err))) return se;
   if (se) return se;
   const char *was = lw_phase_get(NULL);
   lw_phase_set("writing state.lw");
@@ -1793,7 +1797,8 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
 
 lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 {
-  lw_status s;
+  lw_status s = lw_number_locale_ok(err);
+  if (s) return s;
   /* the last sweep's checkpoint, where one fell due, holds this state
   ** already: written again, the same bytes (1.3 s at 1e5 splines); its
   ** timings were taken before that sweep's time was added */

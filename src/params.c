@@ -1059,8 +1059,17 @@ static char *read_line(char *str, int num, void *stream)
 {
   reader_ctx *rc = stream;
   if (rc->failed) return NULL;
+  errno = 0;
   ssize_t len = getline(&rc->buf, &rc->cap, rc->f);
-  if (len < 0) return NULL;
+  if (len < 0) {
+    /* glibc sets no stream error where getline cannot grow its buffer: the
+    ** rest of the file read as its end, and the scene as defaults */
+    if (errno == ENOMEM) {
+      lw_error_set(rc->err, LW_ENOMEM, "%s:%d: out of memory reading the line", rc->p->file, rc->line + 1);
+      rc->failed = 1;
+    }
+    return NULL;
+  }
   rc->line++;
   /* a CRLF line end counts as LF: the limit is the text's (it refused a
   ** line of 198 characters from Windows that it took from Unix) */

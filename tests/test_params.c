@@ -665,5 +665,16 @@ Test(params, a_decimal_comma_locale_is_refused_with_the_way_round)
   setlocale(LC_NUMERIC, "C");
   cr_assert_eq(read_text("[energy]\npair = 0.02\n", &p, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(p.pair, 0.02);
+  /* a scene read, then the locale set: a run there would write "0,02" into
+  ** scene.ini and JSON that is not; it is refused before it writes */
+  cr_assert_not_null(setlocale(LC_NUMERIC, "de_DE.UTF-8"));
+  static lw_anneal a;
+  char out[96];
+  snprintf(out, sizeof out, "%s/run", dir);
+  cr_assert_eq(lw_anneal_start(&a, &p, out, &err), LW_EUSAGE);
+  cr_assert(strstr(err.msg, "LC_NUMERIC"), "%s", err.msg);
+  cr_assert_neq(access(out, F_OK), 0, "the run wrote a directory");
+  lw_anneal_free(&a);
+  setlocale(LC_NUMERIC, "C");
   lw_test_dir_remove(dir);
 }

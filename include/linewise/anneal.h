@@ -92,7 +92,12 @@ typedef struct lw_anneal {
 
 /* A new run of the scene file (with overrides already applied to p) into
 ** dir; seed overrides p->seed when >= 0.  Creates dir (bad input is reported
-** before anything is written). */
+** before anything is written).  The directory's lock keeps other processes
+** out, not this one: a program must not run two anneals into one directory
+** at once (the second would replace the first's files).  LC_NUMERIC must
+** read '.' (lw_number_locale_ok), here and at every checkpoint and the
+** finish.  On failure dir and its .lock may stay: a caller that made dir
+** removes it (the command line does). */
 lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_error *err);
 
 /* The same for one process of a run spread by net (anneal_net.h; NULL:
@@ -130,7 +135,8 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err);
 ** the quenched state.  state.lw keeps the annealed state: the quench is a
 ** function of it, so a resumed run quenches to the same bytes, and a run
 ** resumed for more sweeps continues the chain as an uninterrupted longer
-** run would. */
+** run would.  After it only lw_anneal_free: the quench left the coldest
+** replica quenched, and a checkpoint then would save that state. */
 lw_status lw_anneal_finish(lw_anneal *a, lw_error *err);
 
 void lw_anneal_free(lw_anneal *a);
