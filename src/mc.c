@@ -126,8 +126,9 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
   if (accept && t->finish) {
     /* the second stage of delayed acceptance (system.h): the part of dE
     ** the first one saw only a stand-in for */
-    const double d2 = t->finish(c->sys->state, c->prop);
-    if (d2 == LW_FINISH_NOMEM) return -1;
+    int nomem = 0;
+    const double d2 = t->finish(c->sys->state, c->prop, &nomem);
+    if (nomem) return -1;
     if (isnan(d2)) {
       s->nan++;
       accept = 0;

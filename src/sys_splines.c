@@ -1031,10 +1031,11 @@ static lw_status commit(void *state, void *prop) { return lw_model_commit(((spl_
 
 static void defer(void *prop, int on) { ((lw_proposal *)prop)->defer_near = on; }
 
-static double finish(void *state, void *prop)
+static double finish(void *state, void *prop, int *nomem)
 {
   const double d = lw_model_propose_finish(((spl_state *)state)->m, prop);
-  return ((lw_proposal *)prop)->nomem ? LW_FINISH_NOMEM : d;
+  *nomem = ((lw_proposal *)prop)->nomem;
+  return d;
 }
 
 static lw_status sweep_end(void *state) { return lw_model_compact(((spl_state *)state)->m); }

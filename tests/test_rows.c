@@ -161,7 +161,9 @@ static void walk(row_run *r, long commits, gsl_rng *rng)
     if (forbidden || !isfinite(dE) || !(lr > -INFINITY)) continue;
     if (dE > 0.0 && gsl_rng_uniform(rng) < 0.5) continue;
     if (t->finish) {
-      const double d2 = t->finish(r->state, r->prop);
+      int nomem = 0;
+      const double d2 = t->finish(r->state, r->prop, &nomem);
+      cr_assert_eq(nomem, 0, "%s: finish() ran out of memory", r->what);
       if (!isfinite(d2)) continue;
       cr_assert(defer || d2 == 0.0, "%s: finish() returned %g with nothing deferred", r->what, d2);
       dE += d2;

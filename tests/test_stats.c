@@ -533,10 +533,11 @@ Test(stats, free_chain_matches_the_worm_like_chain)
 /* The first stage alone: what a chain samples if the second stage never
 ** refused (the commit still finishes the proposal, so the totals stay
 ** exact): the distribution of the stand-in, which the test must tell apart. */
-static double stand_in_only(void *state, void *prop)
+static double stand_in_only(void *state, void *prop, int *nomem)
 {
   (void)state;
   (void)prop;
+  (void)nomem;
   return 0.0;
 }
 

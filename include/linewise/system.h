@@ -46,7 +46,6 @@
 #define LINEWISE_SYSTEM_H
 
 #include <gsl/gsl_rng.h>
-#include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 
@@ -79,8 +78,6 @@ typedef struct {
 /* *forbidden of a proposal that could not be evaluated for want of memory:
 ** the chain stops (lw_chain_step < 0) rather than count it as rejected. */
 #define LW_PROPOSE_NOMEM 5
-/* What lw_system_type.finish returns where it ran out of memory. */
-#define LW_FINISH_NOMEM (-INFINITY)
 
 struct lw_system_type {
   const char *name;                   /* [scene] system = name */
@@ -168,10 +165,10 @@ struct lw_system_type {
   ** whatever the stand-in, as long as it is a function of the two states
   ** (docs/NUMERICS.md, "Delayed acceptance").  finish() may also check a
   ** constraint that only a move about to be taken needs: +inf refuses the
-  ** move, counted as crowded (lw_move_stats).  LW_FINISH_NOMEM (-inf, which
-  ** no energy difference is) where it ran out of memory: the chain stops. */
+  ** move, counted as crowded (lw_move_stats).  *nomem = 1 where it ran out
+  ** of memory: the chain stops (-inf is a move out of a forbidden state). */
   void (*defer)(void *prop, int on);
-  double (*finish)(void *state, void *prop);
+  double (*finish)(void *state, void *prop, int *nomem);
   /* Optional (NULL: a sweep is never split; domains.h, [anneal] domains):
   ** domain decomposition within a replica.  split() gives the page
   ** (x0, y0, x1, y1) and the reach of a move, the distance beyond the
