@@ -791,7 +791,9 @@ static int cmd_run(int argc, char **argv)
                    "expected a run directory or a new one", dir, dir, mine[k], what[k]);
       return fail(&err);
     }
-  if (lw_runfiles_check_free(dir, &err) || lw_runfiles_check_stash(dir, &err)) return fail(&err);
+  /* (one process of an MPI run could see process 0's first files there and
+  ** leave the others waiting: there process 0 checks under its lock) */
+  if (!net && (lw_runfiles_check_free(dir, &err) || lw_runfiles_check_stash(dir, &err))) return fail(&err);
   /* before a set-up of minutes, not after it */
   if (lw_rundir_writable(dir, &err)) {
     unmake_dir(dir, hold, made);
