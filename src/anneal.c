@@ -824,6 +824,11 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   /* every file is written with '.': a program that set a decimal-comma
   ** locale after reading the scene wrote 'pair = 0,02' and JSON that is not */
   if ((s = lw_number_locale_ok(err))) return s;
+  /* (a->dir cut short would name another directory than dir: the stash
+  ** checked in one and the files removed in the other) */
+  if (strlen(dir) >= sizeof a->dir - 64)
+    return lw_error_set(err, LW_EUSAGE, "%.80s...: a run directory's path of %zu bytes, expected fewer than %zu", dir,
+                        strlen(dir), sizeof a->dir - 64);
   if ((s = absolute_paths(a, err)) || (s = from_elsewhere(a, dir, err))) return s;
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   a->seed = (unsigned long)a->params.seed;
@@ -881,7 +886,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   ** run's first checkpoint (lw_anneal_checkpoint drops it), or comes back
   ** if the set-up fails (runfiles.h) */
   int back;
-  if ((s = lw_runfiles_check_free(dir, err)) || (s = lw_runfiles_recover(dir, &back, err))) return s;
+  if ((s = lw_runfiles_recover(dir, &back, err)) || (s = lw_runfiles_check_free(dir, err))) return s;
   if (lw_rundir_holds_run(dir)) {
     if ((s = lw_runfiles_stash(dir, err))) return s;
     a->stashed = 1;
@@ -966,7 +971,8 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
   if (!s) a->saved = a->sweep + 1;
   if (!s && a->fresh) { /* the first: the run before, set aside, can go */
     a->fresh = 0;
-    if (a->stashed) lw_runfiles_drop(a->dir, NULL); /* (one that fails stays, and the next run or resume says so) */
+    lw_error e;
+    if (a->stashed && lw_runfiles_drop(a->dir, &e)) snprintf(a->stash_left, sizeof a->stash_left, "%s", e.msg);
     a->stashed = 0;
     lw_phase_stash(0);
   }
@@ -1101,6 +1107,9 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   memset(a, 0, sizeof *a);
   a->net = net;
   a->wall_start = now_seconds();
+  if (strlen(dir) >= sizeof a->dir - 64)
+    return lw_error_set(err, LW_EUSAGE, "%.80s...: a run directory's path of %zu bytes, expected fewer than %zu", dir,
+                        strlen(dir), sizeof a->dir - 64);
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   char path[LW_PATH_MAX + 32], scene_path[2 * LW_PATH_MAX + 2];
   dir_file(path, sizeof path, a, "state.lw");

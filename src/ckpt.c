@@ -298,7 +298,8 @@ lw_status lw_ckpt_no_section(const lw_ckpt *c, const char *sec, lw_error *err)
     for (size_t i = 0; i < c->ns; i++) {
       if (c->s[i].read != pass) continue;
       char one[192];
-      int m = snprintf(one, sizeof one, "%s[%s] at line %d", shown ? ", " : "", c->text + c->s[i].name, c->s[i].line);
+      int m = snprintf(one, sizeof one, "%s[%.150s] at line %d", shown ? ", " : "", c->text + c->s[i].name,
+                       c->s[i].line); /* (a name of any length: at most 150 bytes of it, so one holds m) */
       if (m < 0 || at + (size_t)m + 8 >= sizeof list) {
         snprintf(list + at, sizeof list - at, ", ...");
         goto done;

@@ -547,6 +547,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
     lw_anneal_drift_note(a, drawn, sizeof drawn);
     if (drawn[0]) fprintf(stderr, "linewise: warning: %s\n", drawn);
+    if (a->stash_left[0]) fprintf(stderr, "linewise: warning: %s\n", a->stash_left);
   }
   if (!quiet) {
     if (a->quenched)

@@ -101,11 +101,16 @@ int lw_runfiles_find(const char *dir, char *path, size_t n)
   return 1;
 }
 
+/* What a stash is: stash_marker below. */
+enum { NOT_OURS, MOVING, MOVED, RESTORING, EMPTY };
+static int stash_marker(const char *dir);
+
 lw_status lw_runfiles_check_free(const char *dir, lw_error *err)
 {
   char path[2 * LW_PATH_MAX];
-  if (lw_runfiles_stashed(dir) || lw_rundir_holds_run(dir) || !lw_runfiles_find(dir, path, sizeof path))
-    return LW_OK;
+  /* (an empty stash, which recovery removes, holds no run) */
+  const int stash = lw_runfiles_stashed(dir) && stash_marker(dir) != EMPTY;
+  if (stash || lw_rundir_holds_run(dir) || !lw_runfiles_find(dir, path, sizeof path)) return LW_OK;
   return lw_error_set(err, LW_EUSAGE, "%s is there, but no run's scene.ini or state.lw beside it, and the run "
                       "would write over it: expected a run directory or a new one (remove the file to reuse the "
                       "directory)", path);
@@ -130,8 +135,6 @@ int lw_runfiles_stashed(const char *dir)
 ** 2 .moved (all of it in), 3 .restoring (being moved back), 4 an empty
 ** directory (a process killed before its marker, or after removing it),
 ** 0 not linewise's (not a directory, a link, no marker). */
-enum { NOT_OURS, MOVING, MOVED, RESTORING, EMPTY };
-
 static int stash_marker(const char *dir)
 {
   static const char *const marker[] = {".moving", ".moved", ".restoring"};

@@ -464,6 +464,7 @@ typedef struct {
   size_t i;
   double d[2];  /* point: the step in x y; weight: d[0] the step in s */
   double de[N_TERMS];
+  int nomem;           /* a weight move's Gauss table could not be had */
 } nb_prop;
 
 static void moves(const lw_params *p, double *weight, double *step, double *target)
@@ -504,6 +505,7 @@ static double propose_weight(lw_nurbs_state *s, nb_prop *q)
   s->c->w[q->i] = exp(s->s[q->i] + q->d[0]);
   lw_dnurbs_energy_near(s->c, m->alpha, m->beta, su->mug, m->gauss, q->i, e1, &err);
   s->c->w[q->i] = w;
+  q->nomem = err.code == LW_ENOMEM;
   if (err.code) return NAN;
   double s0 = s->s[q->i], s1 = s0 + q->d[0];
   q->de[T_ELASTIC] = e1[0] - e0[0];
@@ -547,7 +549,11 @@ static double propose(void *state, void *prop, int kind, double step, gsl_rng *r
   q->kind = kind;
   q->i = su->free_idx[gsl_rng_uniform_int(rng, su->n_free)];
   q->d[0] = step * (2.0 * gsl_rng_uniform(rng) - 1.0);
-  if (kind == K_WEIGHT) return propose_weight(s, q);
+  if (kind == K_WEIGHT) {
+    const double dE = propose_weight(s, q);
+    if (q->nomem) *forbidden = LW_PROPOSE_NOMEM; /* (not a rejected move: the run stops) */
+    return dE;
+  }
   q->d[1] = step * (2.0 * gsl_rng_uniform(rng) - 1.0);
   size_t i = q->i;
   double kii = s->mat->K[i * (size_t)s->mat->k], kp[2];

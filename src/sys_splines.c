@@ -369,6 +369,16 @@ static double refuse(lw_proposal *p)
   return INFINITY;
 }
 
+/* A split or join whose scan could not grow its buffers: no move, and the
+** run stops for want of memory (propose's wrapper) rather than go on
+** another way. */
+static double out_of_memory(lw_proposal *p)
+{
+  refuse(p);
+  p->nomem = 1;
+  return NAN;
+}
+
 /* No line to move, kill, grow, shrink or split (none to join with, for a
 ** join): no proposal (system.h), counted nowhere.  A page whose lines had
 ** all died counted every such move as a rejection, and a death's acceptance
@@ -728,7 +738,8 @@ static double propose_split(spl_state *s, lw_proposal *p, gsl_rng *rng)
   const lw_splines *sp = m->sp;
   uint32_t j = 0;
   const size_t n_split = count_splittable(s, SIZE_MAX, NULL);
-  if (n_split == 0 || n_split == SIZE_MAX) return refuse(p); /* SIZE_MAX: out of memory */
+  if (n_split == SIZE_MAX) return out_of_memory(p);
+  if (n_split == 0) return refuse(p);
   count_splittable(s, gsl_rng_uniform_int(rng, n_split), &j);
   const size_t n = lw_splines_segments(sp, j);
   const size_t c = 1 + gsl_rng_uniform_int(rng, n - 2);
@@ -739,6 +750,7 @@ static double propose_split(spl_state *s, lw_proposal *p, gsl_rng *rng)
   copy_nodes(fp, src, c + 1, r == 1);
   copy_nodes(bp, src + c + 1, n - c, r == 2);
   const double lr = split_log_ratio(s, src, n, c, r, fp, bp, lw_model_count(m) + 1, n_split, j, j, 0, spline_layer(sp, j));
+  if (isnan(lr)) return out_of_memory(p); /* (its scans' NaN) */
   const size_t nodes[2] = {c + 1, n - c};
   const double rest[2] = {(double)c * td->length, (double)(n - 1 - c) * td->length};
   lw_model_propose_regroup(m, p, &j, 1, NULL, nodes, 2, rest, 0);
@@ -766,6 +778,7 @@ static double propose_join(spl_state *s, lw_proposal *p, gsl_rng *rng)
   const lw_node *xn = &sp->node[sp->first[x]], *en = &xn[te ? nx : 0];
   const int layer = spline_layer(sp, x);
   const double log_z = join_scan(s, en, te, layer, x, NULL, -1.0, 0.0, NULL, NULL);
+  if (isnan(log_z)) return out_of_memory(p); /* (join_scan's NaN: its buffers could not grow) */
   if (!(log_z > -INFINITY)) return refuse(p);
   uint32_t y = x;
   int tf = 0;
@@ -782,10 +795,11 @@ static double propose_join(spl_state *s, lw_proposal *p, gsl_rng *rng)
   copy_nodes(p->node + c + 1, bp, n - c, te && y_turned);
   const int r = y_turned ? (te ? 2 : 1) : 0;
   /* the splines that may split after the join: F and B leave, J comes */
-  if (count_splittable(s, SIZE_MAX, NULL) == SIZE_MAX) return refuse(p);
+  if (count_splittable(s, SIZE_MAX, NULL) == SIZE_MAX) return out_of_memory(p);
   const size_t n_split = count_splittable(s, SIZE_MAX, NULL) - (size_t)splittable(td, sp, f) -
                          (size_t)splittable(td, sp, b) + 1;
   const double lr = -split_log_ratio(s, p->node, n, c, r, fp, bp, N, n_split, f, b, 1, layer);
+  if (isnan(lr)) return out_of_memory(p);
   const uint32_t old[2] = {x, y};
   const size_t nodes = n + 1;
   const double rest = (double)n * td->length;

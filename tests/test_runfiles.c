@@ -153,6 +153,14 @@ Test(runfiles, run_files_where_no_run_is_are_not_written_over)
     cr_assert(strstr(err.msg, names[k]) && strstr(err.msg, "is there, but no run's scene.ini or state.lw"), "%s",
               err.msg);
   }
+  /* an empty .replaced holds no run (recovery removes it): it let a run
+  ** write over the files beside it */
+  cr_assert_eq(sh("cd %s && rm -rf u && mkdir -p u/.replaced && echo mine > u/final.svg", dir), 0);
+  {
+    char u[96];
+    snprintf(u, sizeof u, "%s/u", dir);
+    cr_assert_eq(lw_runfiles_check_free(u, NULL), LW_EUSAGE);
+  }
   /* the user's own names are not a run's */
   cr_assert_eq(sh("cd %s && rm -rf u && mkdir -p u/plots && echo mine > u/plots/other.png && echo mine > u/a.svg",
                   dir), 0);

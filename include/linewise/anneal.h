@@ -62,6 +62,7 @@ typedef struct lw_anneal {
   int fresh;                   /* the set-up has written files and no checkpoint yet */
   int stashed;                 /* the run it replaces is set aside until then (runfiles.h) */
   int put_back;                /* a set-up that failed put the run it was to replace back */
+  char stash_left[LW_ERROR_MSG]; /* why the run replaced stayed in DIR/.replaced ("": it went) */
   unsigned long long scene_hash; /* lw_params_run_hash of scene.ini, kept in state.lw */
   lw_run_keys scene_keys;        /* and its keys' parts */
   long block;                  /* current temperature step */
