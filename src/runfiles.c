@@ -87,8 +87,12 @@ static void prune(const char *root)
   }
 }
 
+/* (a write's temporary, x.tmp, is what a run killed as it wrote x leaves:
+** debris of linewise's, not a file of anyone's) */
 static int first_file(const char *rel, void *ctx)
 {
+  const size_t n = strlen(rel);
+  if (n > 4 && !strcmp(rel + n - 4, ".tmp")) return 0;
   snprintf(ctx, LW_PATH_MAX, "%s", rel);
   return 1;
 }

@@ -161,6 +161,14 @@ Test(runfiles, run_files_where_no_run_is_are_not_written_over)
     snprintf(u, sizeof u, "%s/u", dir);
     cr_assert_eq(lw_runfiles_check_free(u, NULL), LW_EUSAGE);
   }
+  /* a write's temporary alone is what a run killed as it wrote its first
+  ** file leaves (the kill test's rerun was refused) */
+  cr_assert_eq(sh("cd %s && rm -rf u && mkdir -p u && echo x > u/scene.ini.tmp", dir), 0);
+  {
+    char u[96];
+    snprintf(u, sizeof u, "%s/u", dir);
+    cr_assert_eq(lw_runfiles_check_free(u, NULL), LW_OK);
+  }
   /* the user's own names are not a run's */
   cr_assert_eq(sh("cd %s && rm -rf u && mkdir -p u/plots && echo mine > u/plots/other.png && echo mine > u/a.svg",
                   dir), 0);

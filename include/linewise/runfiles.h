@@ -32,7 +32,8 @@
 
 #define LW_RUNFILES_STASH ".replaced"
 
-/* 1 and the path of dir's first run file into path, or 0 where it has none. */
+/* 1 and the path of dir's first run file into path, or 0 where it has none
+** (a write's x.tmp does not count: it is what a kill leaves). */
 int lw_runfiles_find(const char *dir, char *path, size_t n);
 
 /* LW_EUSAGE naming the file where dir holds run files but no run (no run's
