@@ -97,7 +97,8 @@ static int first_file(const char *rel, void *ctx)
   return 1;
 }
 
-int lw_runfiles_find(const char *dir, char *path, size_t n)
+/* 1 and the path of dir's first run file into path, or 0 where it has none. */
+static int find_run_file(const char *dir, char *path, size_t n)
 {
   char rel[LW_PATH_MAX];
   if (!each_file(dir, first_file, rel)) return 0;
@@ -114,7 +115,7 @@ lw_status lw_runfiles_check_free(const char *dir, lw_error *err)
   char path[2 * LW_PATH_MAX];
   /* (an empty stash, which recovery removes, holds no run) */
   const int stash = lw_runfiles_stashed(dir) && stash_marker(dir) != EMPTY;
-  if (stash || lw_rundir_holds_run(dir) || !lw_runfiles_find(dir, path, sizeof path)) return LW_OK;
+  if (stash || lw_rundir_holds_run(dir) || !find_run_file(dir, path, sizeof path)) return LW_OK;
   return lw_error_set(err, LW_EUSAGE, "%s is there, but no run's scene.ini or state.lw beside it, and the run "
                       "would write over it: expected a run directory or a new one (remove the file to reuse the "
                       "directory)", path);

@@ -93,8 +93,8 @@ Test(runfiles, a_stash_a_killed_process_left_is_settled)
   ** new run's in dir and the old in the stash (marked .moved, the next
   ** recover took the old state.lw for the new run's and dropped the rest) */
   cr_assert_eq(lw_runfiles_stash(r, &err), LW_OK, "%s", err.msg);
-  cr_assert_eq(sh("cd %s/r && echo new > scene.ini && mv .replaced/.moved .replaced/.restoring && mv .replaced/state.lw "
-                  "state.lw", dir), 0);
+  cr_assert_eq(sh("cd %s/r && echo new > scene.ini && mv .replaced/.moved .replaced/.restoring && "
+                  "mv .replaced/state.lw state.lw", dir), 0);
   cr_assert_eq(lw_runfiles_recover(r, &back, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(back, 1);
   old_run_is_back("killed while putting it back");

@@ -32,13 +32,10 @@
 
 #define LW_RUNFILES_STASH ".replaced"
 
-/* 1 and the path of dir's first run file into path, or 0 where it has none
-** (a write's x.tmp does not count: it is what a kill leaves). */
-int lw_runfiles_find(const char *dir, char *path, size_t n);
-
 /* LW_EUSAGE naming the file where dir holds run files but no run (no run's
 ** scene.ini or state.lw, no stash): a person's, or what is left of a run
-** whose scene.ini and state.lw were taken away; not to be written over. */
+** whose scene.ini and state.lw were taken away; not to be written over (a
+** write's x.tmp alone does not count: it is what a kill leaves). */
 lw_status lw_runfiles_check_free(const char *dir, lw_error *err);
 
 /* LW_EUSAGE where dir/.replaced is there and is not linewise's stash (a
