@@ -26,8 +26,6 @@
 #ifndef LINEWISE_RUNFILES_H
 #define LINEWISE_RUNFILES_H
 
-#include <stddef.h>
-
 #include "linewise/error.h"
 
 #define LW_RUNFILES_STASH ".replaced"
