@@ -822,12 +822,14 @@ Test(cli, a_second_signal_stops_at_once_and_leaves_the_checkpoint)
   /* past the first checkpoint it names the one state.lw holds (how much
   ** the stop loses): sweeps of seconds, a checkpoint after each (at 600000
   ** steps a sweep a loaded machine ended one between the two signals; the
-  ** wait for sweep 2 allows the sanitizers' 10 times slower sweeps) */
+  ** wait for sweep 2 allows the sanitizers' 10 times slower sweeps; the
+  ** signals come 0.3 s into the next sweep: at its checkpoint the first
+  ** signal ended the run before the second came) */
   cr_assert_eq(lw_test_sh("%s run %s/params/whip.ini --out %s/c --quiet --set dynamics.steps_per_sweep=1200000 --set "
                           "output.checkpoint_every=1 --set anneal.sweeps=1000 2>%s/c.err & p=$!; i=0; while [ $i -lt "
                           "9000 ] && ! grep -q '^sweep = [2-9]' %s/c/state.lw 2>/dev/null; do sleep 0.02; "
-                          "i=$((i+1)); done; kill -INT $p; sleep 0.02; kill -INT $p; wait $p; test $? -eq 130 && "
-                          "grep -q \"continues from the checkpoint of sweep "
+                          "i=$((i+1)); done; sleep 0.3; kill -INT $p; sleep 0.02; kill -INT $p; wait $p; test $? -eq "
+                          "130 && grep -q \"continues from the checkpoint of sweep "
                           "$(sed -n 's/^sweep = //p' %s/c/state.lw)$\" %s/c.err",
                           lw_test_bin(), lw_test_root(), dir, dir, dir, dir, dir),
                0, "%s", lw_test_slurp("%s/c.err", dir));
