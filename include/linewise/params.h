@@ -308,7 +308,9 @@ int lw_params_text_reads_back(const char *text);
 lw_status lw_params_resolve(lw_params *p, lw_error *err);
 
 /* Applies one "section.key=value" override (call lw_params_resolve after
-** the last one). */
+** the last one).  A relative path a key names is then found from the scene
+** file's directory, as in the file; the command line's --set makes it
+** absolute from the current directory first.  Messages say "--set". */
 lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err);
 
 /* What lw_params_run_hash saw of each key it hashed: the key's index in
