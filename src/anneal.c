@@ -5,7 +5,6 @@
 */
 #include "linewise/anneal.h"
 
-#include <dirent.h>
 #include <errno.h>
 #include <float.h>
 #include <gsl/gsl_math.h>
@@ -814,6 +813,16 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
 
 static lw_status write_start(lw_anneal *a, lw_anneal_net *net, lw_error *err);
 
+/* a->dir cut short would name another directory than dir: the stash checked
+** in one and the files removed in the other (the command line's limit is
+** lower: main.c's RUN_DIR_MAX) */
+static lw_status dir_fits(const lw_anneal *a, const char *dir, lw_error *err)
+{
+  if (strlen(dir) < sizeof a->dir - 64) return LW_OK;
+  return lw_error_set(err, LW_EUSAGE, "%.80s...: a run directory's path of %zu bytes, expected fewer than %zu", dir,
+                      strlen(dir), sizeof a->dir - 64);
+}
+
 lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir, lw_anneal_net *net, lw_error *err)
 {
   memset(a, 0, sizeof *a);
@@ -824,11 +833,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   /* every file is written with '.': a program that set a decimal-comma
   ** locale after reading the scene wrote 'pair = 0,02' and JSON that is not */
   if ((s = lw_number_locale_ok(err))) return s;
-  /* (a->dir cut short would name another directory than dir: the stash
-  ** checked in one and the files removed in the other) */
-  if (strlen(dir) >= sizeof a->dir - 64)
-    return lw_error_set(err, LW_EUSAGE, "%.80s...: a run directory's path of %zu bytes, expected fewer than %zu", dir,
-                        strlen(dir), sizeof a->dir - 64);
+  if ((s = dir_fits(a, dir, err))) return s;
   if ((s = absolute_paths(a, err)) || (s = from_elsewhere(a, dir, err))) return s;
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   a->seed = (unsigned long)a->params.seed;
@@ -961,7 +966,6 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
 {
   lw_status se = lw_number_locale_ok(err); /* (the locale changed since the start) */
   if (se || (se = lw_anneal_settle(a, err))) return se;
-  if (se) return se;
   const char *was = lw_phase_get(NULL);
   lw_phase_set("writing state.lw");
   const double t0 = now_seconds();
@@ -1107,9 +1111,8 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   memset(a, 0, sizeof *a);
   a->net = net;
   a->wall_start = now_seconds();
-  if (strlen(dir) >= sizeof a->dir - 64)
-    return lw_error_set(err, LW_EUSAGE, "%.80s...: a run directory's path of %zu bytes, expected fewer than %zu", dir,
-                        strlen(dir), sizeof a->dir - 64);
+  lw_status sd = dir_fits(a, dir, err);
+  if (sd) return sd;
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   char path[LW_PATH_MAX + 32], scene_path[2 * LW_PATH_MAX + 2];
   dir_file(path, sizeof path, a, "state.lw");

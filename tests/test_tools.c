@@ -276,8 +276,8 @@ Test(tools, ctrl_c_stops_the_sweep_after_its_runs_have_saved)
   cr_assert_eq(sh("(setsid env --default-signal=INT %s %s %s --seeds 1-3 -j 2 --threads 1 --set anneal.sweeps=1000000 "
                   "--bin %s --out %s/i >%s/i.out 2>%s/i.err & echo $! >%s/i.pid); i=0; while [ $i -lt 1000 ] && ! { "
                   "test -s %s/i/seed-1/state.lw && test -s %s/i/seed-2/state.lw; }; do sleep 0.02; i=$((i+1)); done; "
-                  "sleep 0.3; p=$(cat %s/i.pid); kill -INT -$p; i=0; while kill -0 $p 2>/dev/null && [ $i -lt 1500 ]; do "
-                  "sleep 0.02; i=$((i+1)); done; kill -KILL -$p 2>/dev/null; test $i -lt 1500 && "
+                  "sleep 0.3; p=$(cat %s/i.pid); kill -INT -$p; i=0; while kill -0 $p 2>/dev/null && "
+                  "[ $i -lt 1500 ]; do sleep 0.02; i=$((i+1)); done; kill -KILL -$p 2>/dev/null; test $i -lt 1500 && "
                   "flock -n %s/i/seed-1/.lock true && flock -n %s/i/seed-2/.lock true && ! test -e %s/i/seed-3",
                   "bash", tool("seed-sweep"), scene(), env("LW_BIN"), dir, dir, dir, dir, dir, dir, dir, dir, dir, dir),
                0, "%s", err_txt());
