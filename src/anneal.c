@@ -917,12 +917,25 @@ int lw_anneal_undo_start(lw_anneal *a)
   return a->put_back;
 }
 
+/* A stop asked while the run before waits aside: the new run, no sweep
+** done yet, gives way to it (a Ctrl-C just after starting a run into a
+** directory by mistake would else cost the run that was there).  One
+** process only: a spread run's processes stop together, at a sweep. */
+static int gives_way(lw_anneal *a, const lw_anneal_net *net, lw_error *err)
+{
+  if (net || !a->stashed || !lw_phase_stopping()) return 0;
+  a->gave_way = 1;
+  lw_error_set(err, LW_ERUN, "%s: stopped during the set-up", a->dir);
+  return 1;
+}
+
 /* The new run's first files, up to its first checkpoint (net: the first is
 ** the network's, after this). */
 static lw_status write_start(lw_anneal *a, lw_anneal_net *net, lw_error *err)
 {
   lw_status s;
   char path[LW_PATH_MAX + 32], tmp[LW_PATH_MAX + 64];
+  if (gives_way(a, net, err)) return err->code;
   dir_file(path, sizeof path, a, "scene.ini");
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
   if (!f) return err->code;
@@ -936,7 +949,7 @@ static lw_status write_start(lw_anneal *a, lw_anneal_net *net, lw_error *err)
   ** swinging) */
   if (a->params.frames_every && rung_here(a, 0) && (s = a->sys_type->draw(a->sys->state, &a->params, a->dir, 0, err)))
     return s;
-  s = net ? LW_OK : lw_anneal_checkpoint(a, err);
+  s = net ? LW_OK : gives_way(a, net, err) ? err->code : lw_anneal_checkpoint(a, err);
   lw_phase_set(NULL);
   return s;
 }

@@ -312,12 +312,15 @@ static void on_signal(int sig)
   ** can take minutes on a large drawing: say so, terminal or log */
   static const char last[] = "\nlinewise: writing the final files first (a second signal stops at once, without "
                              "them)\n";
+  static const char back[] = "\nlinewise: stopping; the run that was in the directory comes back (a second Ctrl-C "
+                             "stops at once)\n";
   const int files = finishing == 1 && say_finishing;
   if (finishing == 2) return; /* the run is whole, summary.json too: it ends as it would have */
   if (!stop_requested && lw_phase_unwritten()) stop_unwritten(sig);
   if (!stop_requested && (files || on_terminal)) {
-    ssize_t w = files ? write(2, last + !on_terminal, sizeof last - 1 - !on_terminal)
-                      : write(2, first + !on_terminal, sizeof first - 1 - !on_terminal);
+    ssize_t w = files                ? write(2, last + !on_terminal, sizeof last - 1 - !on_terminal)
+                : lw_phase_stashed() ? write(2, back + !on_terminal, sizeof back - 1 - !on_terminal)
+                                     : write(2, first + !on_terminal, sizeof first - 1 - !on_terminal);
     (void)w;
   }
   if (stop_requested) {
@@ -335,6 +338,7 @@ static void on_signal(int sig)
     _exit(128 + sig);
   }
   stop_requested = sig;
+  lw_phase_stop();
 }
 
 /* Progress on stderr: a bar redrawn in place on a terminal, one plain line
@@ -809,6 +813,17 @@ static int cmd_run(int argc, char **argv)
     /* (a failed first write said only that, leaving a directory without a
     ** state.lw: what to do next, as loop_fail says later) */
     const int back = lw_anneal_undo_start(&a); /* (MPI: the network's checkpoint failed) */
+    if (a.gave_way) { /* (one process: a log of --quiet runs is told too) */
+      watcher_stop(&w, LW_PHASE_STOPPED);
+      lw_anneal_free(&a);
+      if (!back) {
+        lw_error_set(&err, LW_ERUN, "%s: stopped during the set-up, and the run that was there waits in %s/"
+                     LW_RUNFILES_STASH " (linewise puts it back when it next runs or resumes there)", dir, dir);
+        return fail(&err);
+      }
+      fprintf(stderr, "linewise: stopped during the set-up; the run that was in %s is back as it was\n", dir);
+      return 0;
+    }
     const size_t n = strlen(err.msg);
     if (err.code == LW_EIO && !lw_phase_unwritten())
       snprintf(err.msg + n, sizeof err.msg - n, "; the run wrote no checkpoint%s: run it again once the files can "

@@ -39,6 +39,12 @@ void lw_phase_stash(int on) { atomic_store(&stash_waits, on); }
 
 int lw_phase_stashed(void) { return atomic_load(&stash_waits); }
 
+static volatile atomic_int stop_asked;
+
+void lw_phase_stop(void) { atomic_store(&stop_asked, 1); }
+
+int lw_phase_stopping(void) { return atomic_load(&stop_asked); }
+
 const char *lw_phase_get(double *seconds)
 {
   const char *what = atomic_load(&phase_what);

@@ -12,6 +12,7 @@
 #include "linewise/anneal.h"
 #include "linewise/init.h"
 #include "linewise/mc.h"
+#include "linewise/phase.h"
 #include "testutil.h"
 
 static lw_params every_term(void)
@@ -299,6 +300,36 @@ Test(run, bad_input_writes_nothing)
   cr_assert_eq(sh("grep -q 'energy.pair' %s/err.txt", dir), 0);
   cr_assert_eq(sh("%s resume %s/nothing-here 2>%s/err.txt", b, dir, dir), 2);
   cr_assert_eq(sh("grep -q 'state.lw' %s/err.txt", dir), 0);
+}
+
+/* A stop asked while a new run sets up, the run it replaces set aside: the
+** new run, no sweep done, gives way and the run before is back byte for
+** byte.  Asked once the first checkpoint is written, the new run stays. */
+Test(run, a_stop_during_the_set_up_puts_the_run_before_back)
+{
+  const char *b = getenv("LW_BIN");
+  char path[128], out[128];
+  write_scene("", path, sizeof path);
+  cr_assert_eq(sh("%s run %s --out %s/r --quiet --set anneal.sweeps=10 && cp -a %s/r %s/before", b, path, dir, dir,
+                  dir), 0);
+  lw_params p;
+  lw_error err;
+  cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
+  p.seed = 43;
+  snprintf(out, sizeof out, "%s/r", dir);
+  lw_anneal a;
+  lw_phase_stop();
+  cr_assert_eq(lw_anneal_start(&a, &p, out, &err), LW_ERUN, "the set-up went on: %s", err.msg);
+  cr_assert(a.gave_way && strstr(err.msg, "stopped during the set-up"), "%s", err.msg);
+  cr_assert_eq(lw_anneal_undo_start(&a), 1, "the run before did not all come back");
+  lw_anneal_free(&a);
+  cr_assert_eq(sh("rm -f %s/r/.lock %s/before/.lock && diff -r %s/r %s/before", dir, dir, dir, dir), 0);
+  /* no run there to give way to: the stop leaves the new run whole */
+  snprintf(out, sizeof out, "%s/fresh", dir);
+  cr_assert_eq(lw_anneal_start(&a, &p, out, &err), LW_OK, "%s", err.msg);
+  cr_assert(!a.gave_way);
+  lw_anneal_free(&a);
+  cr_assert_eq(sh("test -s %s/fresh/state.lw", dir), 0);
 }
 
 /* Frames are extra files: a run that writes them (and a PDF) leaves the

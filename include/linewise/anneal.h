@@ -62,6 +62,7 @@ typedef struct lw_anneal {
   int fresh;                   /* the set-up has written files and no checkpoint yet */
   int stashed;                 /* the run it replaces is set aside until then (runfiles.h) */
   int put_back;                /* a set-up that failed put the run it was to replace back */
+  int gave_way;                /* the set-up failed as a stop was asked (lw_phase_stopping) */
   char stash_left[LW_ERROR_MSG]; /* why the run replaced stayed in DIR/.replaced ("": it went) */
   unsigned long long scene_hash; /* lw_params_run_hash of scene.ini, kept in state.lw */
   lw_run_keys scene_keys;        /* and its keys' parts */
@@ -98,7 +99,9 @@ typedef struct lw_anneal {
 ** at once (the second would replace the first's files).  LC_NUMERIC must
 ** read '.' (lw_number_locale_ok), here and at every checkpoint and the
 ** finish.  On failure dir and its .lock may stay: a caller that made dir
-** removes it (the command line does). */
+** removes it (the command line does).  A stop asked (lw_phase_stop) while
+** the run before waits aside ends the set-up with LW_ERUN and gave_way set:
+** the caller's lw_anneal_undo_start puts that run back. */
 lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_error *err);
 
 /* The same for one process of a run spread by net (anneal_net.h; NULL:

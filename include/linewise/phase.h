@@ -37,6 +37,13 @@ int lw_phase_unwritten(void);
 void lw_phase_stash(int on);
 int lw_phase_stashed(void);
 
+/* Whether a signal has asked the run to stop (the command line's handler
+** calls lw_phase_stop).  A new run asked during its set-up, while the run
+** before waits aside, puts that run back rather than take its place with
+** a run of no sweeps (lw_anneal_start, anneal.h).  Lock-free. */
+void lw_phase_stop(void);
+int lw_phase_stopping(void);
+
 /* What a watcher prints, decided from what it reads at each tick, so that
 ** the rule can be tested with a made-up clock.  A phase is named once it has
 ** lasted over LW_PHASE_QUIET seconds: on a terminal (tty) in place, its
