@@ -89,6 +89,7 @@ static const char usage[] =
   "  schedules           the schedules' formulas as Markdown (the table of docs/SCHEDULES.md)\n"
   "  version             the release (also --version, -V)\n"
   "  help                this text\n"
+  "  --                  ends the options: a path after it may begin with '-'\n"
   "\n"
   "exit status: 0 done, 1 failed while running, 2 bad usage or bad input; a run stopped by Ctrl-C ends\n"
   "by SIGINT once its state is saved (130 in a shell)\n";
@@ -130,7 +131,7 @@ static const char *dash_hint(const char *arg)
   static char buf[LW_PATH_MAX + 64];
   buf[0] = '\0';
   if (arg[0] == '-' && access(arg, F_OK) == 0)
-    snprintf(buf, sizeof buf, " ('%s' is a file or directory here: write './%s')", arg, arg);
+    snprintf(buf, sizeof buf, " ('%s' is a file or directory here: write './%s', or '--' before it)", arg, arg);
   return buf;
 }
 
@@ -1037,6 +1038,36 @@ static int cmd_stats(int argc, char **argv)
 }
 
 /* "linewise CMD --help" prints the usage and exits 0. */
+/* "--" ends the options (POSIX utility guideline 10): an argument after it
+** that begins with '-' is a path (a scene file or run directory named "-x"),
+** handed on as "./-x", which names the same file and matches no option.
+** Returns 0, or 1 out of memory (the copies live as long as the process). */
+static int end_of_options(int *argc, char **argv)
+{
+  static const char *const valued[] = {"--set", "--out", "--seed", "--stop-at", "--threads", "--sweeps",
+                                       "--from", "--to", "--reweight"};
+  for (int i = 2; i < *argc; i++) {
+    if (strcmp(argv[i], "--")) {
+      for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
+        if (!strcmp(argv[i], valued[k])) {
+          i++; /* its value, whatever it reads */
+          break;
+        }
+      continue;
+    }
+    memmove(argv + i, argv + i + 1, (size_t)(*argc - i) * sizeof *argv); /* argv[argc], NULL, too */
+    --*argc;
+    for (int k = i; k < *argc; k++) {
+      if (argv[k][0] != '-') continue;
+      char *dotted = malloc(strlen(argv[k]) + 3);
+      if (!dotted) return 1;
+      argv[k] = strcat(strcpy(dotted, "./"), argv[k]);
+    }
+    return 0;
+  }
+  return 0;
+}
+
 static int wants_help(int argc, char **argv)
 {
   for (int i = 2; i < argc; i++)
@@ -1143,6 +1174,10 @@ int main(int argc, char **argv)
   open_standard_descriptors();
   gsl_set_error_handler(lw_gsl_handler);
   if (narrow_lanes()) return 2;
+  if (end_of_options(&argc, argv)) {
+    fprintf(stderr, "linewise: out of memory\n");
+    return 1;
+  }
 #ifndef LW_MPI
   choose_wait_policy(argc, argv);
 #endif
