@@ -421,6 +421,33 @@ Test(tools, rerun_skips_finished_runs_and_redoes_missing_ones)
   free(t.text);
 }
 
+/* A standard output that goes away or fills ends neither the runs nor the
+** sweep before them: a reader that closed took the tasks' SIGPIPE, and
+** xargs, its task killed, returned at once with runs still writing and
+** seed-3 never started.  A full stdout is said, with exit 1; a TMPDIR that
+** is not there stops nothing (the sweep's files are its own). */
+Test(tools, a_sweep_whose_output_goes_away_runs_to_its_end)
+{
+  cr_assert_eq(sh("{ (%s %s --seeds 1-3 -j 1 " TINY " --bin %s --out %s/p; echo $? >%s/p.rc) | head -c 1; }",
+                  tool("seed-sweep"), scene(), env("LW_BIN"), dir, dir), 0, "%s", err_txt());
+  cr_assert_eq(sh("{ TMPDIR=%s/none %s %s --seeds 1-3 -j 1 " TINY " --bin %s --out %s/f >/dev/full; }", dir,
+                  tool("seed-sweep"), scene(), env("LW_BIN"), dir), 1, "%s", err_txt());
+  char *err = err_txt();
+  cr_assert(strstr(err, "seed-sweep: the standard output could not be written (closed, full, or its reader gone); "
+                        "the runs went on to their end, and ") && !strstr(err, "xargs") && !strstr(err, "error"),
+            "%s", err);
+  free(err);
+  for (int k = 0; k < 2; k++) {
+    const char *sweep = k ? "f" : "p";
+    cr_assert_eq(sh("for s in 1 2 3; do test -s %s/%s/seed-$s/summary.json || exit 1; done && test \"$(wc -l <%s/%s/"
+                    "sweep.csv)\" -eq 4 && ! ls -a %s/%s | grep -q notes", dir, sweep, dir, sweep, dir, sweep), 0,
+                 "sweep %s", sweep);
+  }
+  char *rc = lw_test_slurp("%s/p.rc", dir);
+  cr_assert(rc && (!strcmp(rc, "0\n") || !strcmp(rc, "1\n")), "%s", rc ? rc : "(no status)");
+  free(rc);
+}
+
 Test(tools, interrupted_run_is_resumed_not_restarted)
 {
   /* run seed-2 stopped at sweep 7 as a signal would, then the sweep */

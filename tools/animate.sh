@@ -3,6 +3,10 @@
 # RUN_DIR/animation.mp4 (H.264, yuv420p: plays in browsers and players).
 # Needs ffmpeg: `make deps-animation` installs it.
 set -eu
+# a closed standard stream would fail the checks below (awk cannot close
+# it) or be the first file opened: /dev/null stands in
+(exec 9>&1) 2>/dev/null || exec >/dev/null
+(exec 9>&2) || exec 2>/dev/null
 usage="usage: ${0##*/} RUN_DIR [FPS]   writes RUN_DIR/animation.mp4 from RUN_DIR/frames"
 case ${1:-} in
 -h | --help) echo "$usage"; exit 0 ;;
