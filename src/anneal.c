@@ -1450,12 +1450,11 @@ static double replica_size(const lw_anneal *a, int r)
 ** error of all of it, which the trace and summary showed and which made
 ** resume refuse a checkpoint as damaged.  Where the totals agree with the
 ** recomputation to LW_ANNEAL_EARLY_DRIFT they stay (the bits of every
-** ordinary run).  A resumed process starts its peaks at the state it read,
-** not at the larger ones before: it may skip a recomputation that the run
-** which never stopped makes, but that one finds the totals' rounding under
-** LW_ANNEAL_FALL^2 times eps of the size, so keeps them, and the bytes are
-** the same.  Sizes are of terms every process holds (stand-ins included),
-** so every process decides alike. */
+** ordinary run).  The peaks are kept in state.lw: a resumed process that
+** began them at the state it read skipped recomputations the run which
+** never stopped made, and where those replaced the totals (a strain of
+** 1e12, its drift 5e-9) the two went apart.  Sizes are of terms every
+** process holds (stand-ins included), so every process decides alike. */
 #define LW_ANNEAL_EARLY_DRIFT 1e-9 /* relative drift an early recomputation corrects */
 #define LW_ANNEAL_FALL 8.0
 static int refresh_due(lw_anneal *a, int *renumber)

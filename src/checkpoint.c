@@ -3,7 +3,7 @@
 **
 **   [run]           scene, seed, sweep (state.h); the schedule's inputs
 **                   (temperature, block, t_prev, prev_stats, block_energy),
-**                   energy_initial, max_drift, trace_bytes and
+**                   energy_initial, max_drift, size_peak, trace_bytes and
 **                   trace_mark.<move kind>
 **   [chain], [chain K]   rung 0's and rung K's chain: rng, step.<move>,
 **                   window.<move>, moves.<move>, and energy.<term> (the
@@ -216,6 +216,9 @@ void lw_checkpoint_put_run(lw_ckpt_writer *w, const lw_anneal *a, long trace_byt
   lw_ckpt_put(w, "block_energy", "%.17g %.17g %.17g", a->acc_n, a->acc_sum, a->acc_sumsq);
   lw_ckpt_put(w, "energy_initial", "%.17g", a->energy_initial);
   lw_ckpt_put(w, "max_drift", "%.17g", a->max_drift);
+  /* when the energy is next recomputed hangs on them (anneal.c,
+  ** refresh_due): a resume that began them afresh took other decisions */
+  lw_ckpt_put_numbers(w, "size_peak", a->size_peak, a->n_rep);
   lw_ckpt_put(w, "trace_bytes", "%ld", trace_bytes);
   const lw_system_type *t = a->sys_type;
   for (int m = 0; m < a->chain->n_moves; m++) {
@@ -663,6 +666,8 @@ lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, l
   NUMS("energy_initial", 1, -DBL_MAX, DBL_MAX); a->energy_initial = v[0];
   NUMS("max_drift", 1, 0, DBL_MAX); a->max_drift = v[0];
 #undef NUMS
+  /* (files before 2026-12-05 lack it: the first sweep takes the sizes read) */
+  if ((s = lw_ckpt_numbers(doc, "run", "size_peak", a->size_peak, a->n_rep, 0, DBL_MAX, 0, err))) return s;
   if ((s = lw_ckpt_whole(doc, "run", "trace_bytes", &tb, 0, (long)COUNT_MAX, 0, err))) return s;
   *trace_bytes = tb;
   for (int m = 0; m < a->chain->n_moves; m++) {

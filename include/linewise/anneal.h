@@ -75,7 +75,7 @@ typedef struct lw_anneal {
                                ** this process (lw_anneal_drift_note; not kept in state.lw) */
   double size_peak[LW_TEMPERING_MAX]; /* by replica: the largest sum of the terms' magnitudes
                                ** at a sweep's end since its last recomputation (0: not yet
-                               ** taken; the first sweep of a process takes it) */
+                               ** taken, the first sweep takes it; kept in state.lw) */
   double energy_initial;
   double wall_before;          /* seconds spent before a resume */
   double sweep_seconds;        /* seconds in sweeps, with the processes before (timing.txt) */
