@@ -874,6 +874,13 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
       return err->code;
     }
   if ((s = build(a, all, ladder, err)) || (s = check_quench(a, err))) return s;
+  /* where the photo preset's count of domains gave way to a move's reach (a
+  ** picture of a few pixels: domains.c), scene.ini, which a resume reads as
+  ** given, holds the count the run took (it held the page's, refused there) */
+  if (strcmp(a->params.domains, "auto") && strcmp(a->params.domains, "off")) {
+    if (a->chain->domains) snprintf(a->params.domains, sizeof a->params.domains, "%d", a->chain->domains->nx);
+    else snprintf(a->params.domains, sizeof a->params.domains, "off");
+  }
   a->energy_initial = lw_system_total(a->sys);
   a->end_sweep = a->params.sweeps; /* resolved: the caller's p may not be (a preset's sweeps) */
   a->scene_hash = lw_params_run_hash(&a->params, &a->scene_keys);
