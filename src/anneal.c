@@ -882,6 +882,18 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
     else snprintf(a->params.domains, sizeof a->params.domains, "off");
   }
   a->energy_initial = lw_system_total(a->sys);
+  /* the systems refuse the states they know to be bad; an energy that is
+  ** still not finite (a knot span of 1e-300, a blur of 1e-200 mm) would have
+  ** the chain reject every proposal as NaN and the run end "done" */
+  if (!isfinite(a->energy_initial)) {
+    double v[LW_SYSTEM_TERMS_MAX];
+    t->terms(a->sys->state, v);
+    int q = 0;
+    while (q < t->n_terms - 1 && isfinite(v[q])) q++;
+    return lw_error_set(err, LW_EINPUT, "the %s energy of the initial state is %g: expected a finite energy (a "
+                        "length, weight or width of the scene at the edge of what a double holds?)",
+                        t->term_names[q], v[q]);
+  }
   a->end_sweep = a->params.sweeps; /* resolved: the caller's p may not be (a preset's sweeps) */
   a->scene_hash = lw_params_run_hash(&a->params, &a->scene_keys);
   /* Everything above only read input: the directory appears once the run

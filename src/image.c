@@ -1197,7 +1197,10 @@ static lw_status blur_sparse(float *plane, int w, int h, const double *kx, int t
 
 lw_status lw_image_blur_plane(float *plane, int w, int h, double sigma, lw_error *err)
 {
-  if (!(sigma > 0)) return LW_OK;
+  /* below a tenth of a pixel the side taps are exp(-50) of the centre's or
+  ** less, so the blur is the picture itself to a float's rounding (and under
+  ** 1e-154 sigma^2 underflows: the kernel was 0 / 0) */
+  if (!(sigma >= 0.1)) return LW_OK;
   if (!isfinite(sigma)) return lw_error_set(err, LW_EINPUT, "blur of sigma %g pixels", sigma);
   int tx, ox, ty, oy;
   double *kx = blur_kernel(sigma, w, &tx, &ox), *ky = blur_kernel(sigma, h, &ty, &oy);

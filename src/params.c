@@ -91,7 +91,8 @@ const lw_param_def lw_param_table[] = {
       "Resample the picture to this width, the height following the aspect ratio; 0 = as loaded. "
       "The resampled picture must still fit scene.image_max_pixels."),
   NUM("scene", "image_blur", LW_PT_DOUBLE, image_blur, "0", "mm", 0, 1e4, 0,
-      "Standard deviation of a Gaussian blur of the tone, in millimetres on the page. 0 = none."),
+      "Standard deviation of a Gaussian blur of the tone, in millimetres on the page. 0 = none (as is "
+      "any under a tenth of the picture's pixel)."),
   NUM("scene", "image_flatten", LW_PT_DOUBLE, image_flatten, "0", "mm", 0, 1e4, 0,
       "Flat-field correction, after the blur: the tone is divided by the paper's brightness "
       "about each pixel, the lightest tone within this radius on the page, smoothed, so that "
@@ -256,7 +257,7 @@ const lw_param_def lw_param_table[] = {
       "blocks of them up to tone_blur / 1.5 wide). Unlike the potential it saturates: "
       "lines stop gathering once a place is as dark as the picture. Needs scene.image "
       "(docs/NUMERICS.md). 0 = off."),
-  NUM("energy", "tone_blur", LW_PT_DOUBLE, tone_blur, "1", "mm", 0, 1e4, LW_MIN_OPEN,
+  NUM("energy", "tone_blur", LW_PT_DOUBLE, tone_blur, "1", "mm", 1e-6, 1e4, 0,
       "Standard deviation of the tone term's blur: the scale at which ink is averaged into tone. "
       "Keep it above the distance between quadrature samples (segment_length / quadrature) so "
       "a line reads as a line, not a row of dots. Its cost does not grow with the picture's "
@@ -497,7 +498,7 @@ const lw_param_def lw_param_table[] = {
   NUM("output", "frames_every", LW_PT_INT, frames_every, "0", "sweeps", 0, 2e9, 0,
       "Sweeps between animation frames frames/frame-SSSSSS.png (SSSSSS = the sweep; the first, 000000, "
       "is the start). 0 = none."),
-  NUM("output", "fidelity_sigma", LW_PT_DOUBLE, fidelity_sigma, "1", "mm", 0, 1e4, LW_MIN_OPEN,
+  NUM("output", "fidelity_sigma", LW_PT_DOUBLE, fidelity_sigma, "1", "mm", 1e-6, 1e4, 0,
       "Gaussian blur applied to both the rendered lines and the target (the ink asked for, "
       "energy.tone_ink * darkness) before the fidelity score (MSE, SSIM) compares them; about "
       "half the widest line spacing that should read as a flat tone (docs/FORMATS.md)."),
@@ -629,7 +630,7 @@ const lw_param_def lw_param_table[] = {
   NUM("particles", "pinned", LW_PT_INT, pt_pinned, "0", "", 0, 1, 0,
       "1 = the particles of `points` never move: their positions, and the orientations of "
       "those given with a normal (the others still turn). Moves pick free particles only."),
-  NUM("particles", "r0", LW_PT_DOUBLE, pt_r0, "1", "length", 0, 1e9, LW_MIN_OPEN,
+  NUM("particles", "r0", LW_PT_DOUBLE, pt_r0, "1", "length", 1e-6, 1e9, 0,
       "r0: the spacing where the Lennard-Jones potential is lowest."),
   NUM("particles", "range", LW_PT_DOUBLE, pt_range, "1.6", "r0", 1, 100, LW_MIN_OPEN,
       "Interaction range R in units of r0: pairs farther apart do not interact; the weighting "

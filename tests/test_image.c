@@ -368,6 +368,23 @@ Test(image, blur_keeps_the_mean_exactly_even_when_wider_than_the_picture)
   }
 }
 
+/* A blur far under a pixel is the picture itself, to the last bit, down to
+** widths whose square underflows (1e-170 pixels made every pixel NaN); at
+** a tenth of a pixel, where it starts, its side taps are exp(-50). */
+Test(image, a_blur_far_under_a_pixel_is_the_picture_itself)
+{
+  rng_seed(13);
+  const double sigmas[] = {1e-170, 1e-10, 0.099, 0.1};
+  for (int k = 0; k < 4; k++) {
+    lw_image *img = random_image(9, 7), *orig = random_image(9, 7);
+    memcpy(orig->tone, img->tone, 9 * 7 * sizeof *img->tone);
+    cr_assert_eq(lw_image_blur(img, sigmas[k], NULL), LW_OK);
+    cr_assert_eq(memcmp(orig->tone, img->tone, 9 * 7 * sizeof *img->tone), 0, "sigma %g", sigmas[k]);
+    lw_image_free(img);
+    lw_image_free(orig);
+  }
+}
+
 Test(image, blur_is_the_same_for_any_thread_count)
 {
   rng_seed(13);

@@ -283,6 +283,16 @@ Test(nurbs, bad_knots_and_weights_are_refused_with_the_reason)
   double five[11] = {0, 0, 0, 0, 0, 0.5, 0.75, 1, 1, 1, 1};
   cr_assert_eq(lw_nurbs_check_knots(4, 7, five, 11, &err), LW_EINPUT);
   cr_assert(strstr(err.msg, "repeated more than k = 4 times"), "%s", err.msg);
+  /* a span of 1e-300 of the range made the energy NaN; knots of 1e300 the
+  ** gravity's */
+  double thin[11] = {0, 0, 0, 0, 1e-300, 0.5, 0.75, 1, 1, 1, 1};
+  cr_assert_eq(lw_nurbs_check_knots(4, 7, thin, 11, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "the knot span [0, 1e-300] is 1e-300 of the parameter range: expected "
+                            "none shorter than 1e-09 of it"), "%s", err.msg);
+  double wide[11] = {-1e300, -1e300, -1e300, -1e300, 0, 0.5, 0.75, 1, 1, 1, 1};
+  cr_assert_eq(lw_nurbs_check_knots(4, 7, wide, 11, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "knot 0 (counting from 0) is -1e+300: expected a number from -1e+09 to 1e+09"), "%s",
+            err.msg);
   cr_assert_eq(lw_nurbs_check_knots(4, 7, good, 11, &err), LW_OK);
   cr_assert_null(lw_nurbs_new(4, 7, good, P, w, &err));
   cr_assert(strstr(err.msg, "weight 3 is 0"), "%s", err.msg);
