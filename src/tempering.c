@@ -60,9 +60,15 @@ void lw_tempering_free(lw_tempering *pt)
 
 void lw_tempering_geometric(double *ladder, int n, double t_min, double t_max)
 {
-  for (int k = 0; k < n; k++)
-    ladder[k] = n > 1 ? t_min * pow(t_max / t_min, (double)k / (double)(n - 1)) : t_min;
-  if (n > 1) ladder[n - 1] = t_max; /* exactly, whatever pow rounds to */
+  /* (a ratio past the doubles, 1e300 / 1e-10, in logarithms: its pow made
+  ** every rung inf) */
+  const double ratio = t_max / t_min, span = log(t_max) - log(t_min);
+  for (int k = 0; k < n; k++) {
+    const double f = n > 1 ? (double)k / (double)(n - 1) : 0.0;
+    ladder[k] = isfinite(ratio) ? t_min * pow(ratio, f) : exp(log(t_min) + f * span);
+  }
+  ladder[0] = t_min; /* the ends exactly, whatever pow or exp rounds to */
+  if (n > 1) ladder[n - 1] = t_max;
 }
 
 /* log of the acceptance ratio of swapping rungs k and k+1.  A rung at T = 0

@@ -192,6 +192,27 @@ Test(tempering, round_trips_count_cold_hot_cold_journeys)
   lw_tempering_free(pt);
 }
 
+/* A geometric ladder over every pair of ends the keys accept (1e-300 to
+** 1e300): t_max / t_min past the doubles made every rung but the last inf,
+** and the ladder was refused.  Its rungs are t_min r^(k / (n - 1)). */
+Test(tempering, a_geometric_ladder_spans_any_ends_the_keys_accept)
+{
+  const double ends[][2] = {{1e-300, 1e300}, {1e-10, 1e300}, {0.01, 1.0}};
+  double ladder[5];
+  for (int c = 0; c < 3; c++) {
+    lw_tempering_geometric(ladder, 5, ends[c][0], ends[c][1]);
+    cr_assert(ladder[0] == ends[c][0] && ladder[4] == ends[c][1], "case %d: the ends are not exact", c);
+    const double step = (log(ends[c][1]) - log(ends[c][0])) / 4.0;
+    for (int k = 1; k < 4; k++)
+      cr_assert(isfinite(ladder[k]) && fabs(log(ladder[k]) - log(ends[c][0]) - k * step) < 1e-12 * (1.0 + k * step),
+                "case %d rung %d: %g", c, k, ladder[k]);
+    lw_error err;
+    lw_tempering *pt = lw_tempering_new(5, ladder, 1, &err);
+    cr_assert_not_null(pt, "%s", err.msg);
+    lw_tempering_free(pt);
+  }
+}
+
 Test(tempering, zero_and_equal_temperatures_are_handled)
 {
   const double ladder[2] = {1.0, 2.0}, zero[2] = {0.0, 0.0}, cold0[2] = {0.0, 1.0};
