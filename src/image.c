@@ -950,12 +950,18 @@ lw_image *lw_image_load(const char *path, double max_pixels, lw_image_info *info
 ** cannot be an image linewise reads. */
 static unsigned char *read_picture_file(const char *path, size_t *size_out, lw_error *err)
 {
+  /* looked at before it is opened too: opening a FIFO waits for a writer,
+  ** and the set-up hung there */
+  struct stat sb;
+  if (!stat(path, &sb) && !S_ISREG(sb.st_mode)) {
+    lw_error_set(err, LW_EINPUT, "%s: not a regular file, so not an image", path);
+    return NULL;
+  }
   FILE *f = fopen(path, "rb");
   if (!f) {
     lw_error_set(err, LW_EINPUT, "%s: cannot open the image: %s", path, strerror(errno));
     return NULL;
   }
-  struct stat sb;
   if (fstat(fileno(f), &sb) || !S_ISREG(sb.st_mode)) {
     lw_error_set(err, LW_EINPUT, "%s: not a regular file, so not an image", path);
     fclose(f);

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <zlib.h>
 
 #include "imageutil.h"
@@ -274,7 +275,9 @@ Test(image, alpha_is_kept_and_the_tone_composited_over_white)
   lw_image_free(img);
 }
 
-Test(image, bad_files_are_input_errors_naming_the_file)
+/* (a FIFO among them: opening one waits for a writer, and the test would
+** hang there without the timeout) */
+Test(image, bad_files_are_input_errors_naming_the_file, .timeout = 60)
 {
   float g[64 * 64];
   for (int k = 0; k < 64 * 64; k++) g[k] = (float)urand(0, 1); /* incompressible: a long IDAT */
@@ -289,8 +292,9 @@ Test(image, bad_files_are_input_errors_naming_the_file)
   static unsigned char rgb[3 * 20 * 10], bmp[1024];
   size_t nb = bmp_bytes(bmp, 20, 10, rgb);
   lw_test_write(lw_test_path("cut.bmp"), bmp, nb - 7);
-  const char *names[] = {"cut.png", "empty.png", "text.png", "missing.png", ".", "cut.bmp"};
-  for (int k = 0; k < 6; k++) {
+  cr_assert_eq(mkfifo(lw_test_path("fifo.png"), 0600), 0);
+  const char *names[] = {"cut.png", "empty.png", "text.png", "missing.png", ".", "cut.bmp", "fifo.png"};
+  for (int k = 0; k < 7; k++) {
     lw_error err;
     lw_error_clear(&err);
     char path[128];
