@@ -605,9 +605,11 @@ lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, const lw_params *p, lw_run_keys
   int in_path = 0, unread = -1, count = text ? edited_keys(p, keys, text, which, sizeof which, &in_path, &unread) : -1;
   if (unread >= 0) {
     const lw_param_def *d = &lw_param_table[keys->index[unread]];
-    return lw_error_set(err, LW_EINPUT, "%s:%d: key '%s.%s': cannot read %s: %s (%s)", scene,
+    /* (nothing was edited: the file moved, or went, as a checkout does) */
+    return lw_error_set(err, LW_EINPUT, "%s:%d: key '%s.%s': cannot read %s: %s (a run resumes with the files it "
+                        "ran with: put the file back, or set this key in %s to the place it moved to)", scene,
                         p->line[keys->index[unread]], d->section, d->key, (const char *)p + d->offset,
-                        strerror(keys->unread[unread]), resumes);
+                        strerror(keys->unread[unread]), scene);
   }
   if (count > 8)
     return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: %s and %s seem to be of different runs: %d keys "
