@@ -147,6 +147,15 @@ static lw_status dir_fits(const char *what, const char *dir, lw_error *err)
                       "relative path is shorter)", what, strlen(dir), RUN_DIR_MAX);
 }
 
+/* A directory's path without trailing slashes ("run/" named its files
+** "run//final.svg" in every message); "/" stays. */
+static char *trim_slashes(char *path)
+{
+  size_t n = strlen(path);
+  while (n > 1 && path[n - 1] == '/') path[--n] = '\0';
+  return path;
+}
+
 /* energy DIR [--set SEC.KEY=VAL]...: the state's energy with its scene, or
 ** with keys of it changed (the quadrature's nodes, to see what the run's
 ** leave out: docs/NUMERICS.md, "The potential between the nodes"). */
@@ -165,7 +174,7 @@ static int cmd_energy(int argc, char **argv)
                    "(usage: linewise energy DIR [--set SEC.KEY=VAL]...)%s", argv[i], dash_hint(argv[i]));
       return fail(&err);
     }
-    dir = argv[i];
+    dir = trim_slashes(argv[i]);
   }
   if (!dir) {
     lw_error_set(&err, LW_EUSAGE, "energy: expected one run directory (usage: linewise energy DIR "
@@ -762,7 +771,7 @@ static int cmd_run(int argc, char **argv)
         return fail(&err);
       }
       if (dir_fits("--out", v, &err)) return fail(&err);
-      out = v;
+      out = trim_slashes(argv[i + 1]);
       i++;
     } else if (!strcmp(argv[i], "--seed")) {
       if (!parse_count("--seed", v, 4294967295.0, &seed, &err)) return fail(&err);
@@ -878,7 +887,7 @@ static int cmd_resume(int argc, char **argv)
       lw_error_set(&err, LW_EUSAGE, "resume: unexpected '%s' %s%s", argv[i], RESUME_USAGE, dash_hint(argv[i]));
       return fail(&err);
     } else {
-      dir = argv[i];
+      dir = trim_slashes(argv[i]);
     }
   }
   if (!dir) {
@@ -962,7 +971,7 @@ static int cmd_stats(int argc, char **argv)
     } else if (dir_fits("stats", argv[i], &err)) {
       break;
     } else {
-      dir[k++] = argv[i];
+      dir[k++] = trim_slashes(argv[i]);
     }
   }
   /* --to alone takes the rows from the trace's start, not from the default

@@ -297,15 +297,18 @@ Test(cli, bad_input_exits_2_with_one_message)
     cr_assert(strstr(errs, "unexpected 'x' (it takes no arguments)"), "%s: %s", bare[k], errs);
   }
   /* a run directory named like an option: the message says how to name it,
-  ** and "--" ends the options (an option's value "--" is no end) */
+  ** and "--" ends the options (an option's value "--" is no end); a
+  ** directory's trailing slashes go (its files were "./-r////final.svg") */
   cr_assert_eq(lw_test_sh("cd %s && mkdir -p ./-r && { %s resume -r 2>err.txt; test $? -eq 2; } && "
                           "grep -q \"('-r' is a file or directory here: write './-r', or '--' before it)\" err.txt",
                           dir, lw_test_bin()), 0);
   cr_assert_eq(lw_test_sh("cd %s && cp %s/params/minimal.ini ./-s.ini && %s run --out -r --quiet --set "
                           "anneal.sweeps=30 --set moves.tune_sweeps=0 -- -s.ini && test -s ./-r/summary.json && "
                           "%s energy -- -r | grep -q '^total ' && %s stats -- -r >/dev/null && "
-                          "{ %s resume --stop-at -- -r 2>err.txt; test $? -eq 2; } && grep -q 'stop-at' err.txt",
-                          dir, lw_test_root(), lw_test_bin(), lw_test_bin(), lw_test_bin(), lw_test_bin()), 0,
+                          "{ %s resume --stop-at -- -r 2>err.txt; test $? -eq 2; } && grep -q 'stop-at' err.txt && "
+                          "%s resume ./-r/// 2>err.txt && grep -q 'done: ./-r/final.svg' err.txt",
+                          dir, lw_test_root(), lw_test_bin(), lw_test_bin(), lw_test_bin(), lw_test_bin(),
+                          lw_test_bin()), 0,
                "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
