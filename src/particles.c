@@ -613,10 +613,17 @@ lw_particles *lw_particles_new_from(const lw_particles_setup *s, size_t n, const
   if (pin) memcpy(p->pin, pin, n);
   if (finish(p, err)) goto fail;
   lw_particles_energy(p, p->term);
+  /* what makes each term infinite: the pair terms' particles on top of one
+  ** another, the wall's one on it (alpha_b / d^2), the others sizes near
+  ** what a double holds */
+  static const char *const why[LW_PTERM_COUNT] = {
+    [LW_PTERM_GRAVITY] = "a weight or height near what a double holds (particles.gravity)",
+    [LW_PTERM_BOUNDARY] = "a particle (nearly) on the boundary (particles.boundary, particles.alpha_b)",
+    [LW_PTERM_CHEM] = "a chemical potential near what a double holds (particles.chem)"};
   for (int t = 0; t < LW_PTERM_COUNT; t++)
     if (!isfinite(p->term[t])) {
-      lw_error_set(err, LW_EINPUT, "the %s energy of the particles is not finite: two of them (nearly) coincide",
-                   lw_pterm_names[t]);
+      lw_error_set(err, LW_EINPUT, "the %s energy of the particles is not finite: %s", lw_pterm_names[t],
+                   why[t] ? why[t] : "two of them (nearly) coincide, or particles.r0 is near what a double holds");
       goto fail;
     }
   return p;

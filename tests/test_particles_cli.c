@@ -279,6 +279,15 @@ Test(particles_cli, a_start_far_above_the_minimum_keeps_its_energy_and_resumes)
   trace_and_state_totals(d, &traced, &fresh);
   cr_assert(lw_close_rel(traced, fresh, 1e-9, 1.0), "the row says %.17g, the state %.17g", traced, fresh);
   cr_assert_eq(sh("%s resume %s --sweeps 5 --quiet", lw_test_bin(), d), 0);
+  /* a wall's energy that is not finite names the wall, not particles that
+  ** coincide (these are 1 apart, 1e-300 above the floor) */
+  cr_assert_eq(lw_test_write_text(dir, "wall.txt", "0 0 1e-300\n1 0 1e-300\n"), 0);
+  cr_assert_eq(lw_test_write_text(dir, "wall.ini", "[scene]\nsystem = particles\n[particles]\npoints = wall.txt\n"
+                                                   "count = 0\nboundary = plane\nboundary_z = 0\nalpha_b = 1\n"), 0);
+  cr_assert_eq(sh("%s run %s/wall.ini --out %s/w --quiet 2>%s/err.txt", lw_test_bin(), dir, dir, dir), 2);
+  cr_assert_eq(sh("grep -qx 'linewise: the boundary energy of the particles is not finite: a particle (nearly) on the "
+                  "boundary (particles.boundary, particles.alpha_b)' %s/err.txt", dir), 0, "%s",
+               lw_test_slurp("%s/err.txt", dir));
 }
 
 /* The rms distance of final.ply's particles to their least-squares plane
