@@ -402,8 +402,8 @@ lw_status lw_checkpoint_check_finite(const lw_scene *sc, const lw_splines *sp, c
     return lw_error_set(err, LW_EINPUT, "%s: spline %zu: the %s energy is not finite", path, i,
                         lw_term_names[bad]);
   }
-  return lw_error_set(err, LW_EINPUT, "%s: the %s energy of this state is not finite (curves that coincide?)", path,
-                      lw_term_names[bad]);
+  return lw_error_set(err, LW_EINPUT, "%s: the %s energy of this state is not finite (curves that coincide, or cross "
+                      "with energy.pair_near = 0?)", path, lw_term_names[bad]);
 }
 
 /* The running totals carry the rounding of the moves so far; restoring them

@@ -670,8 +670,8 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
                      "(%s); set energy.min_spacing = 0 too to go without both", where);
     }
     if (p->pair_cutoff > 0.0 && p->min_spacing > p->pair_cutoff)
-      return bad_key(p, "energy", "min_spacing", LW_EINPUT, err, "expected at most energy.pair_cutoff (%g mm), got %g",
-                     p->pair_cutoff, p->min_spacing);
+      return bad_key(p, "energy", "min_spacing", LW_EINPUT, err,
+                     "expected at most energy.pair_cutoff (%.10g mm), got %.10g", p->pair_cutoff, p->min_spacing);
     sc->min_spacing = p->min_spacing;
   }
   if (p->field_preview && !sc->on[LW_TERM_FIELD])
