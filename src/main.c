@@ -326,6 +326,9 @@ static void on_signal(int sig)
                              "stops at once)\n";
   const int files = finishing == 1 && say_finishing;
   if (finishing == 2) return; /* the run is whole, summary.json too: it ends as it would have */
+  /* past the soft CPU limit the kernel sends it again every CPU second: not
+  ** a second signal, which would stop at once */
+  if (sig == SIGXCPU && stop_requested) return;
   if (!stop_requested && lw_phase_unwritten()) stop_unwritten(sig);
   if (!stop_requested && (files || on_terminal)) {
     ssize_t w = files                ? write(2, last + !on_terminal, sizeof last - 1 - !on_terminal)
@@ -1102,6 +1105,9 @@ static void install_signals(int pipe_proof)
   ** for a run told to outlive it (nohup, trap '' HUP: ignored already) */
   struct sigaction was;
   if (!sigaction(SIGHUP, NULL, &was) && was.sa_handler != SIG_IGN) sigaction(SIGHUP, &sa, NULL);
+  /* a CPU-time limit's soft end (ulimit -t; a batch system's warning before
+  ** its hard end kills) ended the run unsaved */
+  if (!sigaction(SIGXCPU, NULL, &was) && was.sa_handler != SIG_IGN) sigaction(SIGXCPU, &sa, NULL);
   signal(SIGXFSZ, SIG_IGN);
   /* run and resume write their results to files: a reader of their
   ** progress that goes away (`| head`, a closed log pipe) must not kill

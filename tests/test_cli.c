@@ -849,7 +849,7 @@ Test(cli, a_second_signal_stops_at_once_and_leaves_the_checkpoint)
 ** SIGTERM, and a reader of its progress that goes away (a log pipe closed,
 ** `| head`) does not end it: both killed the run, losing the sweeps since
 ** the last checkpoint. */
-Test(cli, a_hang_up_stops_cleanly_and_a_closed_progress_pipe_is_harmless)
+Test(cli, a_hang_up_or_a_cpu_limit_stops_cleanly_and_a_closed_progress_pipe_is_harmless)
 {
   const char *b = lw_test_bin();
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/h --quiet --set anneal.sweeps=1000000 & "
@@ -861,6 +861,13 @@ Test(cli, a_hang_up_stops_cleanly_and_a_closed_progress_pipe_is_harmless)
                           "| head -c 1 >/dev/null; test \"$(cat %s/rc)\" = 0 && test -f %s/p/summary.json", b,
                           lw_test_root(), dir, dir, dir, dir),
                0, "the run ended with its progress pipe");
+  /* a CPU-time limit's soft end stops as cleanly (it ended the run unsaved,
+  ** exit 152), though the kernel sends it again every CPU second after */
+  cr_assert_eq(lw_test_sh("(ulimit -H -t 60; ulimit -S -t 1; exec %s run %s/params/minimal.ini --out %s/x --quiet "
+                          "--set anneal.sweeps=1000000 --set output.checkpoint_every=1000000) 2>%s/err.txt", b,
+                          lw_test_root(), dir, dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(lw_test_sh("grep -q '^sweep = [1-9]' %s/x/state.lw && ! test -e %s/x/summary.json && grep -q "
+                          "'stopped after sweep [1-9][0-9]*; state saved' %s/err.txt", dir, dir, dir), 0);
 }
 
 /* Ctrl-C to a shell loop of runs (its process group, INT at its default as
