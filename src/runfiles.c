@@ -87,23 +87,26 @@ static void prune(const char *root)
   }
 }
 
-/* (a write's temporary, x.tmp, is what a run killed as it wrote x leaves:
-** debris of linewise's, not a file of anyone's) */
-static int first_file(const char *rel, void *ctx)
+/* The run files of a directory that holds no run, for the refusal to name
+** them all at once (it named one, and the user removed them one run at a
+** time): the first few in full, then a count.  A write's temporary, x.tmp,
+** is what a run killed as it wrote x leaves: debris of linewise's, not a
+** file of anyone's. */
+enum { NAMED_MAX = 6 };
+typedef struct {
+  const char *dir;
+  int n;
+  char names[NAMED_MAX][2 * LW_PATH_MAX];
+} found_files;
+
+static int add_found(const char *rel, void *ctx)
 {
+  found_files *f = ctx;
   const size_t n = strlen(rel);
   if (n > 4 && !strcmp(rel + n - 4, ".tmp")) return 0;
-  snprintf(ctx, LW_PATH_MAX, "%s", rel);
-  return 1;
-}
-
-/* 1 and the path of dir's first run file into path, or 0 where it has none. */
-static int find_run_file(const char *dir, char *path, size_t n)
-{
-  char rel[LW_PATH_MAX];
-  if (!each_file(dir, first_file, rel)) return 0;
-  snprintf(path, n, "%s/%s", dir, rel);
-  return 1;
+  if (f->n < NAMED_MAX) snprintf(f->names[f->n], sizeof f->names[f->n], "%s/%s", f->dir, rel);
+  f->n++;
+  return 0;
 }
 
 /* What a stash is: stash_marker below. */
@@ -112,13 +115,24 @@ static int stash_marker(const char *dir);
 
 lw_status lw_runfiles_check_free(const char *dir, lw_error *err)
 {
-  char path[2 * LW_PATH_MAX];
   /* (an empty stash, which recovery removes, holds no run) */
   const int stash = lw_runfiles_stashed(dir) && stash_marker(dir) != EMPTY;
-  if (stash || lw_rundir_holds_run(dir) || !find_run_file(dir, path, sizeof path)) return LW_OK;
-  return lw_error_set(err, LW_EUSAGE, "%s is there, but no run's scene.ini or state.lw beside it, and the run "
-                      "would write over it: expected a run directory or a new one (remove the file to reuse the "
-                      "directory)", path);
+  if (stash || lw_rundir_holds_run(dir)) return LW_OK;
+  found_files f = {.dir = dir};
+  each_file(dir, add_found, &f);
+  if (!f.n) return LW_OK;
+  char list[NAMED_MAX * (2 * LW_PATH_MAX + 8)];
+  size_t used = 0;
+  const int named = f.n < NAMED_MAX ? f.n : NAMED_MAX;
+  for (int k = 0; k < named && used < sizeof list; k++)
+    used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", !k ? "" : k + 1 < named || f.n > named ?
+                             ", " : " and ", f.names[k]);
+  if (f.n > named && used < sizeof list) snprintf(list + used, sizeof list - used, " and %d more", f.n - named);
+  const int one = f.n == 1;
+  return lw_error_set(err, LW_EUSAGE, "%s %s there, but no run's scene.ini or state.lw beside %s, and the run "
+                      "would write over %s: expected a run directory or a new one (remove %s to reuse the "
+                      "directory)", list, one ? "is" : "are", one ? "it" : "them", one ? "it" : "them",
+                      one ? "the file" : "them");
 }
 
 /* ---- the stash ---------------------------------------------------------- */

@@ -153,26 +153,30 @@ Test(runfiles, run_files_where_no_run_is_are_not_written_over)
     cr_assert(strstr(err.msg, names[k]) && strstr(err.msg, "is there, but no run's scene.ini or state.lw"), "%s",
               err.msg);
   }
+  /* several are named at once (one at a time, a user removed them a run
+  ** each), the first six, then a count */
+  cr_assert_eq(sh("cd %s && rm -rf u && mkdir -p u/frames && for f in final.gcode animation.mp4 replica-1.lw; do "
+                  "echo mine > u/$f; done", dir), 0);
+  char u[96];
+  snprintf(u, sizeof u, "%s/u", dir);
+  lw_error err;
+  cr_assert_eq(lw_runfiles_check_free(u, &err), LW_EUSAGE);
+  cr_assert(strstr(err.msg, "u/final.gcode, ") && strstr(err.msg, "u/animation.mp4") && strstr(err.msg, " and ") &&
+            strstr(err.msg, "u/replica-1.lw") && strstr(err.msg, " are there, but no run's scene.ini or state.lw "
+                                                                  "beside them"), "%s", err.msg);
+  cr_assert_eq(sh("cd %s && for k in 1 2 3 4 5; do echo mine > u/frames/frame-00000$k.png; done", dir), 0);
+  cr_assert_eq(lw_runfiles_check_free(u, &err), LW_EUSAGE);
+  cr_assert(strstr(err.msg, " and 2 more are there"), "%s", err.msg);
   /* an empty .replaced holds no run (recovery removes it): it let a run
   ** write over the files beside it */
   cr_assert_eq(sh("cd %s && rm -rf u && mkdir -p u/.replaced && echo mine > u/final.svg", dir), 0);
-  {
-    char u[96];
-    snprintf(u, sizeof u, "%s/u", dir);
-    cr_assert_eq(lw_runfiles_check_free(u, NULL), LW_EUSAGE);
-  }
+  cr_assert_eq(lw_runfiles_check_free(u, NULL), LW_EUSAGE);
   /* a write's temporary alone is what a run killed as it wrote its first
   ** file leaves (the kill test's rerun was refused) */
   cr_assert_eq(sh("cd %s && rm -rf u && mkdir -p u && echo x > u/scene.ini.tmp", dir), 0);
-  {
-    char u[96];
-    snprintf(u, sizeof u, "%s/u", dir);
-    cr_assert_eq(lw_runfiles_check_free(u, NULL), LW_OK);
-  }
+  cr_assert_eq(lw_runfiles_check_free(u, NULL), LW_OK);
   /* the user's own names are not a run's */
   cr_assert_eq(sh("cd %s && rm -rf u && mkdir -p u/plots && echo mine > u/plots/other.png && echo mine > u/a.svg",
                   dir), 0);
-  char u[96];
-  snprintf(u, sizeof u, "%s/u", dir);
   cr_assert_eq(lw_runfiles_check_free(u, NULL), LW_OK);
 }
