@@ -306,8 +306,9 @@ lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err
                             lineno, blk[n - 1], bv);
       break;
     }
-    if (!parse_number(tok[1], &tv) || tv < 0) {
-      status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected a temperature (a finite number >= 0), got '%.40s'",
+    /* (the bounds of anneal.t_start and t_end: a row of 1e308 passed them) */
+    if (!parse_number(tok[1], &tv) || tv < 0 || tv > 1e300) {
+      status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected a temperature from 0 to 1e300, got '%.40s'",
                             path, lineno, tok[1]);
       break;
     }

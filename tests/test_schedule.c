@@ -274,6 +274,7 @@ Test(schedule, table_rejects_malformed_files_with_line_numbers)
     {"0 nan\n", 1, "temperature"},
     {"0 inf\n", 1, "temperature"},
     {"0 1e999\n", 1, "temperature"},
+    {"0 1e301\n", 1, "a temperature from 0 to 1e300"}, /* t_start's bound too */
     {"", 1, "at least one"},
     {"# nothing\n\n   \n", 3, "at least one"},
   };
