@@ -149,7 +149,7 @@ const lw_param_def lw_param_table[] = {
   NUM("scene", "field_flat", LW_PT_DOUBLE, field_flat, "0.01", "tone/mm", 0, 1e6, 0,
       "Tone gradient below which the picture counts as flat: etf turns toward `field_angle` there, "
       "gradient fades to 0."),
-  NUM("scene", "field_wavelength", LW_PT_DOUBLE, field_wavelength, "50", "mm", 0, 1e7, LW_MIN_OPEN,
+  NUM("scene", "field_wavelength", LW_PT_DOUBLE, field_wavelength, "50", "mm", 1e-3, 1e7, 0,
       "Wavelength of the waves field."),
   NUM("scene", "field_amplitude", LW_PT_DOUBLE, field_amplitude, "10", "mm", -1e7, 1e7, 0,
       "Amplitude A of the waves field."),
