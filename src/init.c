@@ -544,9 +544,13 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
       t = 0; /* placed, if never in room */
     }
     if (t == tries) {
+      char clear[96] = "";
+      if (sc->boundary.clearance > 0.0)
+        snprintf(clear, sizeof clear, ", or lower energy.boundary_clearance (%g mm from every edge)",
+                 sc->boundary.clearance);
       lw_error_set(err, LW_EINPUT,
                    "[init]: spline %zu of length %g mm did not fit inside the boundary in %d tries "
-                   "(shorten init.segment_length or init.segments)", i, L, tries);
+                   "(shorten init.segment_length or init.segments%s)", i, L, tries, clear);
       break;
     }
     sp->rest_length[i] = L;
