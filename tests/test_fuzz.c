@@ -11,6 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "testutil.h"
+
 int lw_fuzz_params_one(const uint8_t *data, size_t size);
 int lw_fuzz_state_one(const uint8_t *data, size_t size);
 int lw_fuzz_resume_one(const uint8_t *data, size_t size);
@@ -18,6 +20,21 @@ int lw_fuzz_energy_one(const uint8_t *data, size_t size);
 int lw_fuzz_image_one(const uint8_t *data, size_t size);
 int lw_fuzz_points_one(const uint8_t *data, size_t size);
 int lw_fuzz_trace_one(const uint8_t *data, size_t size);
+
+/* The harnesses' scratch files go to TMPDIR (fuzz_util.h): a directory of
+** the suite's, removed after, so that a replay leaves none in /tmp (each
+** process left five files and a run directory). */
+static char scratch[64];
+
+static void make_dir(void)
+{
+  cr_assert_eq(lw_test_dir_make(scratch, "fuzz"), 0);
+  cr_assert_eq(setenv("TMPDIR", scratch, 1), 0);
+}
+
+static void remove_dir(void) { cr_assert_eq(lw_test_dir_remove(scratch), 0); }
+
+TestSuite(fuzz, .init = make_dir, .fini = remove_dir);
 
 /* Feeds every file of tests/fuzz/corpus/<name> to fn; returns the count. */
 static int replay(const char *name, int (*fn)(const uint8_t *, size_t))

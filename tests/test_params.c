@@ -475,6 +475,7 @@ Test(params, auto_orientation_follows_the_picture)
                   !strstr(err.msg, "orientation"),
               "%s", err.msg);
   }
+  cr_assert_eq(lw_test_dir_remove(dir), 0);
 }
 
 /* The constant schedule has one temperature, so one step by default (its
