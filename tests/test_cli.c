@@ -1216,7 +1216,7 @@ Test(cli, a_start_from_a_state_in_the_directory_it_writes_is_refused)
                           lw_test_root(), dir), 0);
   cr_assert_eq(lw_test_sh("cd %s && sha256sum m/* > sums && %s run m/scene.ini --set init.from=m/state.lw --set "
                           "anneal.sweeps=0 --out m/ --quiet 2>err.txt; test $? -eq 2 && grep -q \"^linewise: --set: "
-                          "key 'init.from': '%s/m/state.lw' is the state in m/, the directory this run writes, which "
+                          "key 'init.from': '%s/m/state.lw' is the state in m, the directory this run writes, which "
                           "would replace it and the files of the run there (its trace.csv\" err.txt && "
                           "sha256sum -c --quiet sums", dir, b, dir), 0);
   /* by a link to it too; but a start file of the user's, beside a run or not, is read before the run writes */
