@@ -612,24 +612,31 @@ static double da_mean(int mode, long sweeps, unsigned long seed, double *acc)
 ** is an honest standard error whatever the autocorrelation).  Tolerance:
 ** 4 combined standard errors.  Power: the first stage alone (a chain that
 ** skipped the second) samples the stand-in's distribution, which lets lines
-** come closer; the same test must tell it apart from plain Metropolis.
+** come closer; the same test must tell it apart from plain Metropolis, by 3
+** combined standard errors.  Its chains are erratic (one that jams triples
+** the standard error of 12), so it runs three times as many: with 12, over
+** 20 seeds it stood 1.9 to 11.3 standard errors off, and 4 were asked; with
+** 36, over 13 seeds 5.9 to 12.8 (measured 2026-12-05).
 */
 Test(stats, delayed_acceptance_samples_the_boltzmann_distribution, .timeout = 300)
 {
-  enum { CHAINS = 12 };
+  enum { CHAINS = 12, STAGE_CHAINS = 3 * CHAINS };
   const long sweeps = lw_test_long() ? 8000 : 1000;
   double mean[3], se[3];
   for (int mode = 0; mode < 3; mode++) {
-    double v[CHAINS], acc;
-    for (int k = 0; k < CHAINS; k++) v[k] = da_mean(mode, sweeps, 100 + (unsigned long)k, &acc);
-    mean_se(v, CHAINS, &mean[mode], &se[mode]);
+    double v[STAGE_CHAINS], acc;
+    const int n = mode == 2 ? STAGE_CHAINS : CHAINS;
+    for (int k = 0; k < n; k++) v[k] = da_mean(mode, sweeps, 100 + (unsigned long)k, &acc);
+    mean_se(v, (size_t)n, &mean[mode], &se[mode]);
     cr_log_info("delayed acceptance, mode %d: <E_pair> %.5f +- %.5f, acceptance %.3f", mode, mean[mode], se[mode],
                 acc);
   }
   const double tol = 4.0 * hypot(se[0], se[1]);
   cr_assert(fabs(mean[0] - mean[1]) <= tol, "delayed %.5f +- %.5f, plain %.5f +- %.5f", mean[0], se[0], mean[1],
             se[1]);
-  cr_assert(fabs(mean[2] - mean[1]) > 4.0 * hypot(se[2], se[1]),
+  cr_log_info("delayed acceptance: the first stage alone is %.2f standard errors off",
+              fabs(mean[2] - mean[1]) / hypot(se[2], se[1]));
+  cr_assert(fabs(mean[2] - mean[1]) > 3.0 * hypot(se[2], se[1]),
             "no power: the first stage alone gives %.5f +- %.5f, plain %.5f +- %.5f", mean[2], se[2], mean[1], se[1]);
 }
 
