@@ -912,9 +912,15 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   int back;
   if ((s = lw_runfiles_recover(dir, &back, err)) || (s = lw_runfiles_check_free(dir, err))) return s;
   if (lw_rundir_holds_run(dir)) {
-    if ((s = lw_runfiles_stash(dir, err))) return s;
-    a->stashed = 1;
+    /* said before the first file moves: a second signal while they do
+    ** leaves the run half in .replaced, which the next run or resume puts
+    ** back (it said "nothing to resume: run it again") */
     lw_phase_stash(1);
+    if ((s = lw_runfiles_stash(dir, err))) {
+      lw_phase_stash(0); /* (all of it put back) */
+      return s;
+    }
+    a->stashed = 1;
   }
   a->fresh = 1;
   if ((s = write_start(a, net, err))) lw_anneal_undo_start(a);
@@ -938,8 +944,10 @@ int lw_anneal_undo_start(lw_anneal *a)
 
 /* A stop asked while the run before waits aside: the new run, no sweep
 ** done yet, gives way to it (a Ctrl-C just after starting a run into a
-** directory by mistake would else cost the run that was there).  One
-** process only: a spread run's processes stop together, at a sweep. */
+** directory by mistake would else cost the run that was there).  Asked at
+** the first checkpoint, once it is written, so that a stop while it is
+** written counts too (a second on a huge scene).  One process only: a
+** spread run's processes stop together, at a sweep. */
 static int gives_way(lw_anneal *a, const lw_anneal_net *net, lw_error *err)
 {
   if (net || !a->stashed || !lw_phase_stopping()) return 0;
@@ -954,7 +962,6 @@ static lw_status write_start(lw_anneal *a, lw_anneal_net *net, lw_error *err)
 {
   lw_status s;
   char path[LW_PATH_MAX + 32], tmp[LW_PATH_MAX + 64];
-  if (gives_way(a, net, err)) return err->code;
   dir_file(path, sizeof path, a, "scene.ini");
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
   if (!f) return err->code;
@@ -968,7 +975,7 @@ static lw_status write_start(lw_anneal *a, lw_anneal_net *net, lw_error *err)
   ** swinging) */
   if (a->params.frames_every && rung_here(a, 0) && (s = a->sys_type->draw(a->sys->state, &a->params, a->dir, 0, err)))
     return s;
-  s = net ? LW_OK : gives_way(a, net, err) ? err->code : lw_anneal_checkpoint(a, err);
+  s = net ? LW_OK : lw_anneal_checkpoint(a, err);
   lw_phase_set(NULL);
   return s;
 }
@@ -1006,6 +1013,9 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
   lw_phase_set(was);
   if (!s) a->saved = a->sweep + 1;
   if (!s && a->fresh) { /* the first: the run before, set aside, can go */
+    /* unless a stop was asked while it was written (a second on a huge
+    ** scene): the new run still gives way, its state.lw with it */
+    if (gives_way(a, a->net, err)) return err->code;
     a->fresh = 0;
     lw_error e;
     if (a->stashed && lw_runfiles_drop(a->dir, &e)) snprintf(a->stash_left, sizeof a->stash_left, "%s", e.msg);

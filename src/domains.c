@@ -118,8 +118,12 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
     nx = ny = (int)side;
     /* a count the photo preset chose from the page alone (the key unset:
     ** line 0) gives way to the reach as auto does: a picture of a few
-    ** pixels has tone footprints centimetres wide */
-    const int chosen = !p->line[lw_params_find("anneal", "domains") - lw_param_table];
+    ** pixels has tone footprints centimetres wide.  A run of the preset
+    ** resumed does too: runs before 2026-12-05 wrote the page's count into
+    ** scene.ini, not the one they took (later ones write the one taken,
+    ** which fits) */
+    const int chosen = !p->line[lw_params_find("anneal", "domains") - lw_param_table] ||
+                       (p->of_run && p->preset == LW_PRESET_PHOTO);
     if (chosen) {
       while (nx > 1 && !(w / nx > 2.0 * reach && h / ny > 2.0 * reach)) nx = ny = nx - 1;
       if (nx < 2) return LW_OK;

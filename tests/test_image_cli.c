@@ -880,9 +880,18 @@ Test(image_cli, the_photo_preset_takes_a_picture_of_a_few_pixels)
            "--stop-at 1", lw_test_root(), pic);
   cr_assert_eq(run(args, errs, sizeof errs), 0, "%s", errs);
   cr_assert_eq(lw_test_sh("grep -qx 'domains = off' %s/scene.ini", lw_test_path("tiny1")), 0);
+  /* a run of a release before that (the page's 6 in scene.ini, no
+  ** scene_hash in state.lw) resumes too, taking the count it ran with */
+  cr_assert_eq(lw_test_sh("cp -r %s %s && sed -i 's/^domains = off$/domains = 6/' %s/scene.ini && sed -i "
+                          "'/^scene_hash = /d; /^scene_keys = /d' %s/state.lw", lw_test_path("tiny1"),
+                          lw_test_path("old1"), lw_test_path("old1"), lw_test_path("old1")), 0);
   snprintf(args, sizeof args, "resume %s --quiet", lw_test_path("tiny1"));
   cr_assert_eq(run(args, errs, sizeof errs), 0, "%s", errs);
   cr_assert_eq(lw_test_sh("cmp %s/state.lw %s/state.lw", lw_test_path("tiny"), lw_test_path("tiny1")), 0);
+  snprintf(args, sizeof args, "resume %s --quiet", lw_test_path("old1"));
+  cr_assert_eq(run(args, errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(lw_test_sh("cmp %s/final.svg %s/final.svg && cmp %s/trace.csv %s/trace.csv", lw_test_path("tiny"),
+                          lw_test_path("old1"), lw_test_path("tiny"), lw_test_path("old1")), 0);
   snprintf(args, sizeof args, "run %s/params/photo.ini --out tiny6 --set scene.image=%s --set anneal.domains=6 --quiet",
            lw_test_root(), pic);
   cr_assert_eq(run(args, errs, sizeof errs), 2);
