@@ -530,8 +530,9 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     /* a log of --quiet runs must tell one a signal stopped too (under MPI
     ** the first process says it, whichever process the signal reached) */
     if (!quiet || (asked && (net ? net->stop_agreed && !net->rank : stop_requested)))
-      fprintf(stderr, "linewise: stopped after sweep %ld; state saved in %s/state.lw ('linewise resume %s' "
-              "continues%s)\n", a->sweep, a->dir, a->dir, mpi);
+      fprintf(stderr, "linewise: stopped after sweep %ld%s; state saved in %s/state.lw ('linewise resume %s' "
+              "continues%s)\n", a->sweep, stop_requested == SIGXCPU ? " (the soft CPU-time limit)" : "", a->dir,
+              a->dir, mpi);
     return 0;
   }
   say_finishing = !quiet;
