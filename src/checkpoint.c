@@ -35,6 +35,8 @@
 #include "linewise/state.h"
 #include "linewise/sys_splines.h"
 
+_Static_assert(2 * LW_TEMPERING_MAX <= LW_CKPT_LIST_MAX, "at_label holds two counts a replica");
+
 #define COUNT_MAX 9007199254740992.0 /* 2^53 */
 
 static void rung_section(char *buf, size_t n, const char *base, int k)

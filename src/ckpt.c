@@ -341,10 +341,11 @@ lw_status lw_ckpt_numbers(lw_ckpt *c, const char *sec, const char *key, double *
   int line;
   const char *v = lw_ckpt_text(c, sec, key, &line);
   if (!v) return required ? missing(c, sec, key, err) : LW_OK;
-  double tmp[64];
+  double tmp[LW_CKPT_LIST_MAX];
   char expected[160];
   snprintf(expected, sizeof expected, "%d number%s from %.17g to %.17g", n, n == 1 ? "" : "s", lo, hi);
-  if (n > 64 || lw_number_list(v, 0, tmp, n) != n) return bad_value(c, line, sec, key, expected, v, err);
+  if (n > LW_CKPT_LIST_MAX || lw_number_list(v, 0, tmp, n) != n)
+    return bad_value(c, line, sec, key, expected, v, err);
   for (int i = 0; i < n; i++)
     if (!(tmp[i] >= lo && tmp[i] <= hi)) return bad_value(c, line, sec, key, expected, v, err);
   memcpy(out, tmp, (size_t)n * sizeof *out);
@@ -363,12 +364,12 @@ lw_status lw_ckpt_counts_upto(lw_ckpt *c, const char *sec, const char *key, unsi
   int line;
   const char *v = lw_ckpt_text(c, sec, key, &line);
   if (!v) return required ? missing(c, sec, key, err) : LW_OK;
-  double tmp[64];
+  double tmp[LW_CKPT_LIST_MAX];
   char expected[96];
   if (n_min == n_max)
     snprintf(expected, sizeof expected, "%d whole number%s from 0 to 2^53", n_max, n_max == 1 ? "" : "s");
   else snprintf(expected, sizeof expected, "%d to %d whole numbers from 0 to 2^53", n_min, n_max);
-  const int n = n_max > 64 ? -1 : lw_number_list(v, 0, tmp, n_max);
+  const int n = n_max > LW_CKPT_LIST_MAX ? -1 : lw_number_list(v, 0, tmp, n_max);
   if (n < n_min || n > n_max) return bad_value(c, line, sec, key, expected, v, err);
   for (int i = 0; i < n; i++)
     if (!(tmp[i] >= 0 && tmp[i] <= 9007199254740992.0) || tmp[i] != floor(tmp[i]))

@@ -280,6 +280,20 @@ Test(run, resume_keeps_the_recomputations_of_a_drifting_run)
                0);
 }
 
+/* A tempering run of many replicas resumes as it ran: its state.lw's lists
+** (at_label, two counts a replica; ladder; size_peak) were read into 64
+** places, and from 33 replicas on a run could not resume. */
+Test(run, a_run_of_many_replicas_resumes_bit_exactly)
+{
+  const char *b = getenv("LW_BIN");
+  const char *set = "--quiet --threads 1 --set tempering.replicas=65 --set init.splines=2 --set anneal.sweeps=20";
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/a %s", b, getenv("LW_ROOT"), dir, set), 0);
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/b %s --stop-at 5 && %s resume %s/b --quiet --threads 1", b,
+                  getenv("LW_ROOT"), dir, set, b, dir), 0);
+  cr_assert_eq(sh("cmp -s %s/a/state.lw %s/b/state.lw && cmp -s %s/a/trace.csv %s/b/trace.csv", dir, dir, dir, dir),
+               0);
+}
+
 /* anneal.delayed_acceptance changes a run only where the pair term has a
 ** near field: without one the chains are the same bit for bit; with one
 ** the two-stage test takes other decisions (both sample the same

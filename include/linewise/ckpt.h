@@ -67,8 +67,13 @@ const char *lw_ckpt_cut_hint(const lw_ckpt *c, const char *section);
 ** is its line, 0 when built in memory. */
 const char *lw_ckpt_text(lw_ckpt *c, const char *section, const char *key, int *line);
 
-/* Exactly n finite numbers in [lo, hi].  A missing key is an error when
-** required, otherwise out keeps its values. */
+/* The longest list of numbers a key may hold: a tempering run's at_label,
+** two a replica (its lists were read into 64 places, and a run of 33
+** replicas or more could not resume). */
+#define LW_CKPT_LIST_MAX 512
+
+/* Exactly n (<= LW_CKPT_LIST_MAX) finite numbers in [lo, hi].  A missing key
+** is an error when required, otherwise out keeps its values. */
 lw_status lw_ckpt_numbers(lw_ckpt *c, const char *section, const char *key, double *out, int n, double lo,
                           double hi, int required, lw_error *err);
 
