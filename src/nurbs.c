@@ -16,11 +16,8 @@ lw_status lw_nurbs_check_knots(int order, size_t n, const double *knot, size_t n
   if (n_knots != n + k)
     return lw_error_set(err, LW_EINPUT, "%zu knots: %zu control points of order %d need n + k = %zu", n_knots, n,
                         order, n + k);
-  /* as the control points: beyond, the basis's differences overflow */
   for (size_t i = 0; i < n_knots; i++)
-    if (!(fabs(knot[i]) <= LW_NURBS_KNOT_MAX))
-      return lw_error_set(err, LW_EINPUT, "knot %zu (counting from 0) is %g: expected a number from -%g to %g", i,
-                          knot[i], LW_NURBS_KNOT_MAX, LW_NURBS_KNOT_MAX);
+    if (!isfinite(knot[i])) return lw_error_set(err, LW_EINPUT, "knot %zu (counting from 0) is not a finite number", i);
   for (size_t i = 0; i + 1 < n_knots; i++)
     if (knot[i + 1] < knot[i])
       return lw_error_set(err, LW_EINPUT, "knot %zu (%g) is less than knot %zu (%g): knots must not decrease (they "
@@ -33,6 +30,23 @@ lw_status lw_nurbs_check_knots(int order, size_t n, const double *knot, size_t n
   if (n > k && (knot[k] == knot[k - 1] || knot[n - 1] == knot[n]))
     return lw_error_set(err, LW_EINPUT, "not an open knot vector: an end value is repeated more than k = %d times",
                         order);
+  for (size_t i = k, run = 1; i < n; i++) {
+    run = knot[i] == knot[i - 1] ? run + 1 : 1;
+    if (run > k - 1)
+      return lw_error_set(err, LW_EINPUT, "knot %g is repeated %zu times inside: at most k - 1 = %d (the curve "
+                          "would break)", knot[i], run, order - 1);
+  }
+  return LW_OK;
+}
+
+lw_status lw_nurbs_check_knot_scale(int order, size_t n, const double *knot, lw_error *err)
+{
+  const size_t k = (size_t)order;
+  /* as the control points: beyond, the basis's differences overflow */
+  for (size_t i = 0; i < n + k; i++)
+    if (!(fabs(knot[i]) <= LW_NURBS_KNOT_MAX))
+      return lw_error_set(err, LW_EINPUT, "knot %zu (counting from 0) is %g: expected a number from -%g to %g", i,
+                          knot[i], LW_NURBS_KNOT_MAX, LW_NURBS_KNOT_MAX);
   /* the basis divides by the spans, its derivatives by their powers: a span
   ** of 1e-100 of the range made the energy inf, one of 1e-150 NaN, and the
   ** whole run rejected every proposal */
@@ -42,12 +56,6 @@ lw_status lw_nurbs_check_knots(int order, size_t n, const double *knot, size_t n
       return lw_error_set(err, LW_EINPUT, "the knot span [%.17g, %.17g] is %g of the parameter range: expected none "
                           "shorter than %g of it (or a repeated knot)", knot[i - 1], knot[i],
                           (knot[i] - knot[i - 1]) / (knot[n] - knot[k - 1]), LW_NURBS_SPAN_MIN);
-  for (size_t i = k, run = 1; i < n; i++) {
-    run = knot[i] == knot[i - 1] ? run + 1 : 1;
-    if (run > k - 1)
-      return lw_error_set(err, LW_EINPUT, "knot %g is repeated %zu times inside: at most k - 1 = %d (the curve "
-                          "would break)", knot[i], run, order - 1);
-  }
   return LW_OK;
 }
 

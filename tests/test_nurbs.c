@@ -286,11 +286,11 @@ Test(nurbs, bad_knots_and_weights_are_refused_with_the_reason)
   /* a span of 1e-300 of the range made the energy NaN; knots of 1e300 the
   ** gravity's */
   double thin[11] = {0, 0, 0, 0, 1e-300, 0.5, 0.75, 1, 1, 1, 1};
-  cr_assert_eq(lw_nurbs_check_knots(4, 7, thin, 11, &err), LW_EINPUT);
+  cr_assert_eq(lw_nurbs_check_knot_scale(4, 7, thin, &err), LW_EINPUT);
   cr_assert(strstr(err.msg, "the knot span [0, 1e-300] is 1e-300 of the parameter range: expected "
                             "none shorter than 1e-09 of it"), "%s", err.msg);
   double wide[11] = {-1e300, -1e300, -1e300, -1e300, 0, 0.5, 0.75, 1, 1, 1, 1};
-  cr_assert_eq(lw_nurbs_check_knots(4, 7, wide, 11, &err), LW_EINPUT);
+  cr_assert_eq(lw_nurbs_check_knot_scale(4, 7, wide, &err), LW_EINPUT);
   cr_assert(strstr(err.msg, "knot 0 (counting from 0) is -1e+300: expected a number from -1e+09 to 1e+09"), "%s",
             err.msg);
   cr_assert_eq(lw_nurbs_check_knots(4, 7, good, 11, &err), LW_OK);
@@ -304,5 +304,16 @@ Test(nurbs, bad_knots_and_weights_are_refused_with_the_reason)
   cr_assert_eq(lw_nurbs_insert_knot(c, 0.5, &err), LW_OK);
   cr_assert_eq(lw_nurbs_insert_knot(c, 0.5, &err), LW_OK);
   cr_assert_eq(lw_nurbs_insert_knot(c, 0.5, &err), LW_EINPUT, "a fourth 0.5 would break a cubic");
+  lw_nurbs_free(c);
+  /* the scale limits are the scene's: a span of 1e-8 refined 100 times is
+  ** a curve (its copy was refused as "out of memory") */
+  double fine[11] = {0, 0, 0, 0, 0.5, 0.50000001, 0.75, 1, 1, 1, 1};
+  cr_assert_eq(lw_nurbs_check_knot_scale(4, 7, fine, &err), LW_OK, "%s", err.msg);
+  c = lw_nurbs_new(4, 7, fine, P, NULL, &err);
+  cr_assert_not_null(c, "%s", err.msg);
+  cr_assert_eq(lw_nurbs_refine(c, 0, 100, &err), LW_OK, "%s", err.msg);
+  lw_nurbs *copy = lw_nurbs_copy(c, &err);
+  cr_assert_not_null(copy, "%s", err.msg);
+  lw_nurbs_free(copy);
   lw_nurbs_free(c);
 }

@@ -23,10 +23,11 @@
 ** curve of size 1, 1e6 at an end 1.15e-4 against svg_tolerance's 1e-4; 1e5
 ** keeps 1e-4 on the wire, 1e4 leaves room). */
 #define LW_NURBS_WEIGHT_SPREAD 1e4
-/* Knots lie in [-LW_NURBS_KNOT_MAX, LW_NURBS_KNOT_MAX] (as the control
-** points do), and a span that is not empty takes at least LW_NURBS_SPAN_MIN
-** of the parameter range (a refinement's, 1e-6 at most, are far above it):
-** the basis divides by the spans, and its derivatives by their powers. */
+/* A scene's knots lie in [-LW_NURBS_KNOT_MAX, LW_NURBS_KNOT_MAX] (as the
+** control points do), and a span of them that is not empty takes at least
+** LW_NURBS_SPAN_MIN of the parameter range: the basis divides by the spans,
+** and its derivatives by their powers (refinement cuts them up to 1000
+** times more, far above where that overflows). */
 #define LW_NURBS_KNOT_MAX 1e9
 #define LW_NURBS_SPAN_MIN 1e-9
 /* control points a refinement may make (a step of the wire costs 0.25 us
@@ -45,9 +46,13 @@ typedef struct {
 
 /* Checks a knot vector for n control points of order k: n + k knots,
 ** nondecreasing, k equal values at either end and none inside repeated more
-** than k - 1 times (the curve stays continuous), in range and none too short.  LW_EINPUT with a message
+** than k - 1 times (the curve stays continuous).  LW_EINPUT with a message
 ** saying what is wrong (the caller names the file, line and key). */
 lw_status lw_nurbs_check_knots(int order, size_t n, const double *knot, size_t n_knots, lw_error *err);
+
+/* The same for a scene's knots (a checked vector of n + k), before any
+** refinement: within LW_NURBS_KNOT_MAX, no span under LW_NURBS_SPAN_MIN. */
+lw_status lw_nurbs_check_knot_scale(int order, size_t n, const double *knot, lw_error *err);
 
 /* A curve of n control points (copied; weights NULL = all 1), checked as
 ** above and for weights > 0. */
