@@ -227,7 +227,7 @@ uninstall:
 	rm -rf $(INSTALLED:%=$(DESTDIR)$(PREFIX)/%)
 
 clean:
-	rm -rf build build-asan build-fuzz bin $(BUILD) $(BIN) $(PICTURE)
+	rm -rf build build-asan build-fuzz bin $(PICTURE)
 
 # the headers each object was built from (DEPFLAGS); an object without its
 # .d (built before them, or the .d lost) depends on every header, as all did
