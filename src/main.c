@@ -330,10 +330,15 @@ static void on_signal(int sig)
   ** a second signal, which would stop at once */
   if (sig == SIGXCPU && stop_requested) return;
   if (!stop_requested && lw_phase_unwritten()) stop_unwritten(sig);
+#ifdef LW_MPI
+  const int gives_way = 0; /* (a spread run's processes stop together, at a sweep) */
+#else
+  const int gives_way = lw_phase_stashed();
+#endif
   if (!stop_requested && (files || on_terminal)) {
-    ssize_t w = files                ? write(2, last + !on_terminal, sizeof last - 1 - !on_terminal)
-                : lw_phase_stashed() ? write(2, back + !on_terminal, sizeof back - 1 - !on_terminal)
-                                     : write(2, first + !on_terminal, sizeof first - 1 - !on_terminal);
+    ssize_t w = files       ? write(2, last + !on_terminal, sizeof last - 1 - !on_terminal)
+                : gives_way ? write(2, back + !on_terminal, sizeof back - 1 - !on_terminal)
+                            : write(2, first + !on_terminal, sizeof first - 1 - !on_terminal);
     (void)w;
   }
   if (stop_requested) {
@@ -769,13 +774,14 @@ static int cmd_run(int argc, char **argv)
       i++;
     } else if (!strcmp(argv[i], "--out")) {
       struct stat sb; /* (an option as v was refused above: `--out $DIR --quiet`, DIR empty, wrote ./--quiet) */
+      if (v) v = trim_slashes(argv[i + 1]); /* (before stat: "file/" is no file but ENOTDIR) */
       if (!v || !*v || (stat(v, &sb) == 0 && !S_ISDIR(sb.st_mode))) {
         lw_error_set(&err, LW_EUSAGE, "--out: expected a directory, got '%s'%s", v ? v : "",
                      !v || !*v ? "" : S_ISREG(sb.st_mode) ? " (a file)" : " (not a directory)");
         return fail(&err);
       }
       if (dir_fits("--out", v, &err)) return fail(&err);
-      out = trim_slashes(argv[i + 1]);
+      out = v;
       i++;
     } else if (!strcmp(argv[i], "--seed")) {
       if (!parse_count("--seed", v, 4294967295.0, &seed, &err)) return fail(&err);

@@ -94,9 +94,8 @@ static void prune(const char *root)
 ** file of anyone's. */
 enum { NAMED_MAX = 6 };
 typedef struct {
-  const char *dir;
   int n;
-  char names[NAMED_MAX][2 * LW_PATH_MAX];
+  char names[NAMED_MAX][LW_PATH_MAX];
 } found_files;
 
 static int add_found(const char *rel, void *ctx)
@@ -104,7 +103,7 @@ static int add_found(const char *rel, void *ctx)
   found_files *f = ctx;
   const size_t n = strlen(rel);
   if (n > 4 && !strcmp(rel + n - 4, ".tmp")) return 0;
-  if (f->n < NAMED_MAX) snprintf(f->names[f->n], sizeof f->names[f->n], "%s/%s", f->dir, rel);
+  if (f->n < NAMED_MAX) snprintf(f->names[f->n], sizeof f->names[f->n], "%s", rel);
   f->n++;
   return 0;
 }
@@ -118,21 +117,25 @@ lw_status lw_runfiles_check_free(const char *dir, lw_error *err)
   /* (an empty stash, which recovery removes, holds no run) */
   const int stash = lw_runfiles_stashed(dir) && stash_marker(dir) != EMPTY;
   if (stash || lw_rundir_holds_run(dir)) return LW_OK;
-  found_files f = {.dir = dir};
+  found_files f = {0};
   each_file(dir, add_found, &f);
   if (!f.n) return LW_OK;
-  char list[NAMED_MAX * (2 * LW_PATH_MAX + 8)];
+  if (f.n == 1)
+    return lw_error_set(err, LW_EUSAGE, "%s/%s is there, but no run's scene.ini or state.lw beside it, and the run "
+                        "would write over it: expected a run directory or a new one (remove the file to reuse the "
+                        "directory)", dir, f.names[0]);
+  /* named within the directory, which is named once: six long paths did
+  ** not fit the message, and cut off why */
+  char list[1024];
   size_t used = 0;
   const int named = f.n < NAMED_MAX ? f.n : NAMED_MAX;
   for (int k = 0; k < named && used < sizeof list; k++)
     used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", !k ? "" : k + 1 < named || f.n > named ?
                              ", " : " and ", f.names[k]);
   if (f.n > named && used < sizeof list) snprintf(list + used, sizeof list - used, " and %d more", f.n - named);
-  const int one = f.n == 1;
-  return lw_error_set(err, LW_EUSAGE, "%s %s there, but no run's scene.ini or state.lw beside %s, and the run "
-                      "would write over %s: expected a run directory or a new one (remove %s to reuse the "
-                      "directory)", list, one ? "is" : "are", one ? "it" : "them", one ? "it" : "them",
-                      one ? "the file" : "them");
+  return lw_error_set(err, LW_EUSAGE, "%s holds run files (%s), but no run's scene.ini or state.lw beside them, and "
+                      "the run would write over them: expected a run directory or a new one (remove them to reuse "
+                      "the directory)", dir, list);
 }
 
 /* ---- the stash ---------------------------------------------------------- */

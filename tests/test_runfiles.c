@@ -161,12 +161,12 @@ Test(runfiles, run_files_where_no_run_is_are_not_written_over)
   snprintf(u, sizeof u, "%s/u", dir);
   lw_error err;
   cr_assert_eq(lw_runfiles_check_free(u, &err), LW_EUSAGE);
-  cr_assert(strstr(err.msg, "u/final.gcode, ") && strstr(err.msg, "u/animation.mp4") && strstr(err.msg, " and ") &&
-            strstr(err.msg, "u/replica-1.lw") && strstr(err.msg, " are there, but no run's scene.ini or state.lw "
-                                                                  "beside them"), "%s", err.msg);
+  cr_assert(strstr(err.msg, "u holds run files (") && strstr(err.msg, "final.gcode") &&
+            strstr(err.msg, "animation.mp4") && strstr(err.msg, " and ") && strstr(err.msg, "replica-1.lw") &&
+            strstr(err.msg, "), but no run's scene.ini or state.lw beside them"), "%s", err.msg);
   cr_assert_eq(sh("cd %s && for k in 1 2 3 4 5; do echo mine > u/frames/frame-00000$k.png; done", dir), 0);
   cr_assert_eq(lw_runfiles_check_free(u, &err), LW_EUSAGE);
-  cr_assert(strstr(err.msg, " and 2 more are there"), "%s", err.msg);
+  cr_assert(strstr(err.msg, " and 2 more), but no run's"), "%s", err.msg);
   /* an empty .replaced holds no run (recovery removes it): it let a run
   ** write over the files beside it */
   cr_assert_eq(sh("cd %s && rm -rf u && mkdir -p u/.replaced && echo mine > u/final.svg", dir), 0);
