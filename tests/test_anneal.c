@@ -264,20 +264,27 @@ Test(run, resume_continues_bit_exactly)
   cr_assert(isfinite(total) && fabs(total - stotal) <= 1e-9 * fabs(total), "energy %.17g vs summary %.17g", total, stotal);
 }
 
+/* minimal.ini with `set` run whole into dir/a, and stopped after sweep
+** `stop` and resumed into dir/b: whether their state.lw and trace.csv are
+** the same bytes. */
+static int resumes_as_it_ran(const char *set, int stop)
+{
+  const char *b = getenv("LW_BIN"), *root = getenv("LW_ROOT");
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/a %s", b, root, dir, set), 0);
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/b %s --stop-at %d && %s resume %s/b --quiet --threads 1", b,
+                  root, dir, set, stop, b, dir), 0);
+  return !sh("cmp -s %s/a/state.lw %s/b/state.lw && cmp -s %s/a/trace.csv %s/b/trace.csv", dir, dir, dir, dir);
+}
+
 /* Where a strain of 1e12 makes the running totals drift past what an early
 ** recomputation keeps (5e-9), when those come hangs on the largest sizes
 ** since the last: a resume that began them afresh skipped one the run which
 ** never stopped made, and its state, trace and max_drift went apart. */
 Test(run, resume_keeps_the_recomputations_of_a_drifting_run)
 {
-  const char *b = getenv("LW_BIN");
-  const char *set = "--quiet --set anneal.sweeps=300 --set energy.strain=1e12 --set anneal.check_every=1000";
-  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/a %s", b, getenv("LW_ROOT"), dir, set), 0);
-  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/b %s --stop-at 137 && %s resume %s/b --quiet", b,
-                  getenv("LW_ROOT"), dir, set, b, dir), 0);
+  cr_assert(resumes_as_it_ran("--quiet --threads 1 --set anneal.sweeps=300 --set energy.strain=1e12 "
+                              "--set anneal.check_every=1000", 137));
   cr_assert_eq(sh("grep -q '^max_drift = [1-9]' %s/a/state.lw", dir), 0, "no drift to keep: the case is gone");
-  cr_assert_eq(sh("cmp -s %s/a/state.lw %s/b/state.lw && cmp -s %s/a/trace.csv %s/b/trace.csv", dir, dir, dir, dir),
-               0);
 }
 
 /* A tempering run of many replicas resumes as it ran: its state.lw's lists
@@ -285,13 +292,8 @@ Test(run, resume_keeps_the_recomputations_of_a_drifting_run)
 ** places, and from 33 replicas on a run could not resume. */
 Test(run, a_run_of_many_replicas_resumes_bit_exactly)
 {
-  const char *b = getenv("LW_BIN");
-  const char *set = "--quiet --threads 1 --set tempering.replicas=65 --set init.splines=2 --set anneal.sweeps=20";
-  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/a %s", b, getenv("LW_ROOT"), dir, set), 0);
-  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/b %s --stop-at 5 && %s resume %s/b --quiet --threads 1", b,
-                  getenv("LW_ROOT"), dir, set, b, dir), 0);
-  cr_assert_eq(sh("cmp -s %s/a/state.lw %s/b/state.lw && cmp -s %s/a/trace.csv %s/b/trace.csv", dir, dir, dir, dir),
-               0);
+  cr_assert(resumes_as_it_ran("--quiet --threads 1 --set tempering.replicas=65 --set init.splines=2 "
+                              "--set anneal.sweeps=20", 5));
 }
 
 /* anneal.delayed_acceptance changes a run only where the pair term has a

@@ -873,8 +873,8 @@ Test(cli, a_hang_up_or_a_cpu_limit_stops_cleanly_and_a_closed_progress_pipe_is_h
                           "--set anneal.sweeps=1000000 --set output.checkpoint_every=1000000) 2>%s/err.txt", b,
                           lw_test_root(), dir, dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
   cr_assert_eq(lw_test_sh("grep -q '^sweep = [1-9]' %s/x/state.lw && ! test -e %s/x/summary.json && grep -q "
-                          "'stopped after sweep [1-9][0-9]* (the soft CPU-time limit); state saved' %s/err.txt", dir, dir, dir),
-               0);
+                          "'stopped after sweep [1-9][0-9]* (the soft CPU-time limit); state saved' %s/err.txt", dir,
+                          dir, dir), 0);
 }
 
 /* Ctrl-C to a shell loop of runs (its process group, INT at its default as
