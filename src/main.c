@@ -1056,7 +1056,6 @@ static int cmd_stats(int argc, char **argv)
   return err.code ? fail(&err) : 0;
 }
 
-/* "linewise CMD --help" prints the usage and exits 0. */
 /* "--" ends the options (POSIX utility guideline 10): an argument after it
 ** that begins with '-' is a path (a scene file or run directory named "-x"),
 ** handed on as "./-x", which names the same file and matches no option.
@@ -1087,6 +1086,7 @@ static int end_of_options(int *argc, char **argv)
   return 0;
 }
 
+/* "linewise CMD --help" prints the usage and exits 0. */
 static int wants_help(int argc, char **argv)
 {
   for (int i = 2; i < argc; i++)

@@ -40,7 +40,8 @@ int lw_phase_stashed(void);
 /* Whether a signal has asked the run to stop (the command line's handler
 ** calls lw_phase_stop).  A new run asked during its set-up, while the run
 ** before waits aside, puts that run back rather than take its place with
-** a run of no sweeps (lw_anneal_start, anneal.h).  Lock-free. */
+** a run of no sweeps (lw_anneal_start, anneal.h).  Asked once, it stays so
+** for the process (the command line runs one run).  Lock-free. */
 void lw_phase_stop(void);
 int lw_phase_stopping(void);
 
