@@ -942,20 +942,6 @@ int lw_anneal_undo_start(lw_anneal *a)
   return a->put_back;
 }
 
-/* A stop asked while the run before waits aside: the new run, no sweep
-** done yet, gives way to it (a Ctrl-C just after starting a run into a
-** directory by mistake would else cost the run that was there).  Asked at
-** the first checkpoint, once it is written, so that a stop while it is
-** written counts too (a second on a huge scene).  One process only: a
-** spread run's processes stop together, at a sweep. */
-static int gives_way(lw_anneal *a, const lw_anneal_net *net, lw_error *err)
-{
-  if (net || !a->stashed || !lw_phase_stopping()) return 0;
-  a->gave_way = 1;
-  lw_error_set(err, LW_ERUN, "%s: stopped during the set-up", a->dir);
-  return 1;
-}
-
 /* The new run's first files, up to its first checkpoint (net: the first is
 ** the network's, after this). */
 static lw_status write_start(lw_anneal *a, lw_anneal_net *net, lw_error *err)
@@ -1013,9 +999,6 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
   lw_phase_set(was);
   if (!s) a->saved = a->sweep + 1;
   if (!s && a->fresh) { /* the first: the run before, set aside, can go */
-    /* unless a stop was asked while it was written (a second on a huge
-    ** scene): the new run still gives way, its state.lw with it */
-    if (gives_way(a, a->net, err)) return err->code;
     a->fresh = 0;
     lw_error e;
     if (a->stashed && lw_runfiles_drop(a->dir, &e)) snprintf(a->stash_left, sizeof a->stash_left, "%s", e.msg);

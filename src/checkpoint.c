@@ -32,6 +32,7 @@
 #include "linewise/model.h"
 #include "linewise/number.h"
 #include "linewise/output.h"
+#include "linewise/phase.h"
 #include "linewise/state.h"
 #include "linewise/sys_splines.h"
 
@@ -254,6 +255,29 @@ lw_status lw_checkpoint_write_timing(const lw_anneal *a, lw_error *err)
   return lw_output_commit(f, tmp, path, err);
 }
 
+/* The first checkpoint of a run that replaces another, set aside in
+** DIR/.replaced until state.lw is committed: a stop asked by then makes the
+** new run, no sweep done, give way (a Ctrl-C just after starting a run into
+** a directory by mistake would else cost the run that was there), and the
+** caller puts that run back (lw_anneal_undo_start).  Asked just before the
+** commit, once the rest is written, and after marking it (lw_phase_stash
+** 2), while the signal handler sets the stop before it reads the mark: one
+** of them sees the other, so the handler never says the run before comes
+** back when it goes (asked after the commit, a second signal there left the
+** new state.lw beside the stash, and the next resume dropped the run the
+** message said would come back).  One process only: a spread run's processes
+** stop together, at a sweep. */
+static int gives_way(lw_anneal *a, lw_error *err)
+{
+  if (!a->fresh || !a->stashed || a->net) return 0;
+  lw_phase_stash(2);
+  if (!lw_phase_stopping()) return 0;
+  lw_phase_stash(1);
+  a->gave_way = 1;
+  lw_error_set(err, LW_ERUN, "%s: stopped during the set-up", a->dir);
+  return 1;
+}
+
 lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err)
 {
   char path[LW_PATH_MAX + 32];
@@ -277,6 +301,10 @@ lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err)
   if (bad) {
     lw_ckpt_abort(&w);
     return lw_error_set(err, LW_ENOMEM, "out of memory writing a checkpoint");
+  }
+  if (gives_way(a, err)) {
+    lw_ckpt_abort(&w);
+    return err->code;
   }
   if ((s = lw_ckpt_commit(&w, err))) return s;
   for (int k = 1; k < a->n_rep && !s; k++) s = lw_checkpoint_write_replica(a, k, err);

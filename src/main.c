@@ -329,34 +329,44 @@ static void on_signal(int sig)
   /* past the soft CPU limit the kernel sends it again every CPU second: not
   ** a second signal, which would stop at once */
   if (sig == SIGXCPU && stop_requested) return;
-  if (!stop_requested && lw_phase_unwritten()) stop_unwritten(sig);
+  const int second = stop_requested != 0;
+  if (!second && lw_phase_unwritten()) stop_unwritten(sig);
+  /* the stop is set before the stash's mark is read: the first checkpoint
+  ** marks itself before it reads the stop (checkpoint.c, gives_way), so
+  ** one sees the other, and "comes back" is said only where it does */
+  if (!second) {
+    stop_requested = sig;
+    lw_phase_stop();
+  }
 #ifdef LW_MPI
   const int gives_way = 0; /* (a spread run's processes stop together, at a sweep) */
 #else
-  const int gives_way = lw_phase_stashed();
+  const int gives_way = lw_phase_stashed() == 1;
 #endif
-  if (!stop_requested && (files || on_terminal)) {
+  if (!second && (files || on_terminal)) {
     ssize_t w = files       ? write(2, last + !on_terminal, sizeof last - 1 - !on_terminal)
                 : gives_way ? write(2, back + !on_terminal, sizeof back - 1 - !on_terminal)
                             : write(2, first + !on_terminal, sizeof first - 1 - !on_terminal);
     (void)w;
   }
-  if (stop_requested) {
+  if (second) {
     static const char none[] = "\nlinewise: a second signal: stopped at once, before the run's first checkpoint "
                                "(nothing to resume: run it again)\n";
     static const char kept[] = "\nlinewise: a second signal: stopped at once, before the run's first checkpoint; "
                                "the run that was in the directory waits in " LW_RUNFILES_STASH " and comes back "
                                "when linewise next runs or resumes there\n";
-    const int b = second_at;
+    static const char part[] = "\nlinewise: a second signal: stopped at once as the run's first checkpoint was "
+                               "written; linewise's next run or resume there goes on from it, or, where it was not "
+                               "written, puts the run that was in the directory back\n";
+    const int b = second_at, stash = lw_phase_stashed();
     const size_t skip = second_len[b] > 0 && !on_terminal; /* (0: the name did not fit, and nothing is said) */
-    ssize_t w = checkpointed         ? write(2, second_msg[b] + skip, (size_t)second_len[b] - skip)
-                : lw_phase_stashed() ? write(2, kept + !on_terminal, sizeof kept - 1 - !on_terminal)
-                                     : write(2, none + !on_terminal, sizeof none - 1 - !on_terminal);
+    ssize_t w = checkpointed  ? write(2, second_msg[b] + skip, (size_t)second_len[b] - skip)
+                : stash == 1  ? write(2, kept + !on_terminal, sizeof kept - 1 - !on_terminal)
+                : stash == 2  ? write(2, part + !on_terminal, sizeof part - 1 - !on_terminal)
+                              : write(2, none + !on_terminal, sizeof none - 1 - !on_terminal);
     (void)w;
     _exit(128 + sig);
   }
-  stop_requested = sig;
-  lw_phase_stop();
 }
 
 /* Progress on stderr: a bar redrawn in place on a terminal, one plain line

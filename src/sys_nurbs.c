@@ -192,7 +192,8 @@ static lw_nurbs *curve_of(const lw_params *p, lw_error *err)
       knot[i] = i < k ? 0.0 : i >= n ? 1.0 : (double)(i - k + 1) / (double)(n - k + 1);
     nk = n + k;
   }
-  if (lw_nurbs_check_knots(p->nb_order, n, knot, nk, err) || lw_nurbs_check_knot_scale(p->nb_order, n, knot, err)) {
+  if (lw_nurbs_check_knots(p->nb_order, n, knot, nk, err) ||
+      (!lw_params_kept(p, "nurbs", "knots") && lw_nurbs_check_knot_scale(p->nb_order, n, knot, err))) {
     lw_params_blame(p, "nurbs", "knots", err);
     goto out;
   }

@@ -33,7 +33,9 @@ void lw_phase_writing(void);
 int lw_phase_unwritten(void);
 
 /* Whether the run before waits in DIR/.replaced (runfiles.h) until the new
-** run's first checkpoint, for a signal handler's message: lock-free too. */
+** run's first checkpoint, for a signal handler's message: 0 no, 1 it does
+** (a stop puts it back), 2 that checkpoint is being committed (the run
+** before goes).  Lock-free too. */
 void lw_phase_stash(int on);
 int lw_phase_stashed(void);
 
