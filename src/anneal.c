@@ -127,11 +127,15 @@ void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n)
 {
   const double wall = now_seconds() - a->wall_start;
   buf[0] = '\0';
-  if (a->ckpt_seconds > 1.0 && a->ckpt_seconds > wall / 3.0)
-    /* (no figures of this run: a sweep shows each distinct note once) */
+  if (!(a->ckpt_seconds > 1.0 && a->ckpt_seconds > wall / 3.0)) return;
+  /* (no figures of this run: a sweep shows each distinct note once) */
+  const char *share = a->ckpt_seconds > wall / 2.0 ? "most" : "over a third";
+  if (a->params.checkpoint_every < a->end_sweep)
     snprintf(buf, n, "writing state.lw every %d sweeps (output.checkpoint_every) took %s of this run's time: a "
-             "larger value costs less, and a killed run then loses more sweeps", a->params.checkpoint_every,
-             a->ckpt_seconds > wall / 2.0 ? "most" : "over a third");
+             "larger value costs less, and a killed run then loses more sweeps", a->params.checkpoint_every, share);
+  else /* (no checkpoint between the first and the last: the key would change nothing) */
+    snprintf(buf, n, "writing state.lw at the start and the end took %s of this run's time%s", share,
+             a->n_rep > 1 ? " (it and a replica-K.lw for each rung, each synced to disk)" : "");
 }
 
 void lw_anneal_drift_note(const lw_anneal *a, char *buf, size_t n)
@@ -1344,7 +1348,7 @@ static lw_status write_ladder(const lw_anneal *a, lw_error *err)
   fprintf(f, "; ladder tuned toward equal swap acceptance over %d sweeps\n", a->params.ladder_sweeps);
   if (used > cap)
     fprintf(f, "; %d rungs need %zu bytes, more than the %zu a scene's line holds: --set and a scene file refuse "
-            "it, and tune_ladder = equal gives it again\n", a->n_rep, used, cap);
+            "it; the same scene and seed with tune_ladder = equal tune it again\n", a->n_rep, used, cap);
   fprintf(f, "[tempering]\nladder = %s\n", value);
   return lw_output_commit(f, tmp, path, err);
 }
