@@ -1333,23 +1333,22 @@ static lw_status write_ladder(const lw_anneal *a, lw_error *err)
   dir_file(path, sizeof path, a, "ladder.ini");
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
   if (!f) return err->code;
-  /* "ready to reuse": as many digits as let the value fit on a scene line
-  ** (16 rungs at 17 digits were 301 bytes, which --set and the INI reader
-  ** refused); 4 digits move a rung by at most 5e-4 of itself */
-  const size_t cap = lw_params_text_cap(lw_params_find("tempering", "ladder"));
-  static const int digits[] = {17, 10, 8, 6, 5, 4};
+  /* "ready to reuse": the fewest digits that read back the same double, so
+  ** a run on it starts where this one froze (the field holds 256 rungs at
+  ** 17 digits), over indented lines as scene.ini writes it */
+  const lw_param_def *d = lw_params_find("tempering", "ladder");
   char value[LW_TEMPERING_MAX * 26];
   size_t used = 0;
-  for (size_t d = 0; d < sizeof digits / sizeof *digits && (d == 0 || used > cap); d++) {
-    used = 0;
-    for (int k = 0; k < a->n_rep; k++)
-      used += (size_t)snprintf(value + used, sizeof value - used, "%s%.*g", k ? " " : "", digits[d], a->pt->ladder[k]);
+  for (int k = 0; k < a->n_rep; k++) {
+    int n = 0;
+    for (int digits = 15; digits <= 17; digits++) {
+      n = snprintf(value + used, sizeof value - used, "%s%.*g", k ? " " : "", digits, a->pt->ladder[k]);
+      if (strtod(value + used, NULL) == a->pt->ladder[k]) break;
+    }
+    used += (size_t)n;
   }
-  fprintf(f, "; ladder tuned toward equal swap acceptance over %d sweeps\n", a->params.ladder_sweeps);
-  if (used > cap)
-    fprintf(f, "; %d rungs need %zu bytes, more than the %zu a scene's line holds: --set and a scene file refuse "
-            "it; the same scene and seed with tune_ladder = equal tune it again\n", a->n_rep, used, cap);
-  fprintf(f, "[tempering]\nladder = %s\n", value);
+  fprintf(f, "; ladder tuned toward equal swap acceptance over %d sweeps\n[tempering]\n", a->params.ladder_sweeps);
+  lw_params_write_list(f, d, value);
   return lw_output_commit(f, tmp, path, err);
 }
 

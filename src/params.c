@@ -30,11 +30,13 @@
 #define OFF(f) offsetof(lw_params, f)
 #define LW_PDF_SIDE_MAX 5080.0 /* mm: 14,400 points, the PDF reference's largest page */
 #define NUM(sec, key, T, f, def, unit, lo, hi, open, help) \
-  {sec, key, T, OFF(f), def, unit, lo, hi, open, NULL, help, 0}
+  {sec, key, T, OFF(f), def, unit, lo, hi, open, NULL, help, 0, 0}
 #define CHOICE(sec, key, f, def, choices, help) \
-  {sec, key, LW_PT_CHOICE, OFF(f), def, "", 0, 0, 0, choices, help, 0}
+  {sec, key, LW_PT_CHOICE, OFF(f), def, "", 0, 0, 0, choices, help, 0, 0}
 #define STRING(sec, key, f, def, unit, help) \
-  {sec, key, LW_PT_STRING, OFF(f), def, unit, 0, 0, 0, NULL, help, sizeof ((lw_params *)0)->f}
+  {sec, key, LW_PT_STRING, OFF(f), def, unit, 0, 0, 0, NULL, help, sizeof ((lw_params *)0)->f, 0}
+#define LIST(sec, key, f, def, unit, help) \
+  {sec, key, LW_PT_STRING, OFF(f), def, unit, 0, 0, 0, NULL, help, sizeof ((lw_params *)0)->f, 1}
 
 const lw_param_def lw_param_table[] = {
   STRING("scene", "system", system, "splines", "",
@@ -73,11 +75,11 @@ const lw_param_def lw_param_table[] = {
   NUM("scene", "margin", LW_PT_DOUBLE, margin, "10", "mm", 0, 1e7, 0,
       "Inset of the rect and circle boundaries from the page edge; the picture of `image` "
       "(and `mask_image`) is fitted into the page inset by it."),
-  STRING("scene", "polygon", polygon, "", "mm",
-         "Polygon boundary vertices as `x y x y ...` (at least 3 vertices; either orientation; a simple "
-         "polygon, its edges meeting only at their shared vertices: a star is given by its outline). The "
-         "value fits on one scene line, so it holds about 20 to 30 vertices; a detailed outline (a coast, "
-         "lettering) is a picture: `boundary = mask`."),
+  LIST("scene", "polygon", polygon, "", "mm",
+       "Polygon boundary vertices as `x y x y ...` (at least 3 vertices; either orientation; a simple "
+       "polygon, its edges meeting only at their shared vertices: a star is given by its outline). A "
+       "long list goes on over indented lines (README, \"Scene files\"), up to 8191 bytes, some 600 "
+       "vertices; a detailed outline (a coast, lettering) is a picture: `boundary = mask`."),
   STRING("scene", "image", image, "", "path",
          "A picture (PNG, JPEG, GIF, BMP, binary PGM/PPM; gray or colour, with or without alpha) relative to "
          "the scene file. It is fitted into the page inset by `margin`, centred, aspect kept. "
@@ -430,10 +432,10 @@ const lw_param_def lw_param_table[] = {
       "constant schedule samples at the ladder itself."),
   NUM("tempering", "t_max", LW_PT_DOUBLE, t_max, "1", "energy", 0, 1e300, LW_MIN_OPEN,
       "Hottest temperature of the geometric ladder."),
-  STRING("tempering", "ladder", ladder, "", "energy",
-         "Explicit ladder `t0 t1 ...` (increasing; overrides t_min and t_max; its length sets the "
-         "replicas, and `replicas` may stay 1, as a run's scene.ini then keeps it). A run with ladder "
-         "tuning writes its tuned ladder to ladder.ini for reuse."),
+  LIST("tempering", "ladder", ladder, "", "energy",
+       "Explicit ladder `t0 t1 ...` (increasing; overrides t_min and t_max; its length sets the "
+       "replicas, and `replicas` may stay 1, as a run's scene.ini then keeps it; a long ladder goes on "
+       "over indented lines). A run with ladder tuning writes its tuned ladder to ladder.ini for reuse."),
   NUM("tempering", "exchange_every", LW_PT_INT, exchange_every, "1", "sweeps", 1, 2e9, 0,
       "Sweeps between exchange steps; steps alternate between even (0-1, 2-3, ...) and odd pairs."),
   CHOICE("tempering", "tune_ladder", tune_ladder, "fixed", "fixed|equal",
@@ -728,19 +730,19 @@ const lw_param_def lw_param_table[] = {
          "with frozen weights, at any dt in one solve a step). docs/NUMERICS.md, \"D-NURBS\"."),
   NUM("nurbs", "order", LW_PT_INT, nb_order, "4", "", 2, 8, 0,
       "Order k of the NURBS curve (degree k - 1; 4 = cubic). docs/NURBS.md."),
-  STRING("nurbs", "points", nb_points, "", "length",
-         "The control points as numbers `x y x y ...` (y up; at least `order` points; coordinates within "
-         "+-1e9)."),
+  LIST("nurbs", "points", nb_points, "", "length",
+       "The control points as numbers `x y x y ...` (y up; at least `order` points; coordinates within "
+       "+-1e9; a long list goes on over indented lines)."),
   STRING("nurbs", "file", nb_file, "", "path",
          "A file of control points, one `x y` or `x y w` a line (`#` starts a comment), relative "
-         "to the scene file; used instead of `points` and `weights` (a scene line holds about a "
-         "dozen points: the INI reader stops at 198 characters)."),
-  STRING("nurbs", "weights", nb_weights, "", "",
-         "One weight > 0 per control point, the largest at most 1e4 times the smallest (past that the "
-         "matrices and final.svg's fit lose their digits); empty = all 1 (a polynomial spline)."),
-  STRING("nurbs", "knots", nb_knots, "", "",
-         "The open knot vector: n + k nondecreasing numbers, the first k equal and the last k "
-         "equal; empty = uniform inner knots on [0, 1]."),
+         "to the scene file; used instead of `points` and `weights` (which hold some 300 points "
+         "over indented lines: a file suits a curve made by another program)."),
+  LIST("nurbs", "weights", nb_weights, "", "",
+       "One weight > 0 per control point, the largest at most 1e4 times the smallest (past that the "
+       "matrices and final.svg's fit lose their digits); empty = all 1 (a polynomial spline)."),
+  LIST("nurbs", "knots", nb_knots, "", "",
+       "The open knot vector: n + k nondecreasing numbers, the first k equal and the last k "
+       "equal; empty = uniform inner knots on [0, 1]."),
   NUM("nurbs", "elevate", LW_PT_INT, nb_elevate, "0", "", 0, 6, 0,
       "Raise the degree by this much before the run (degree elevation: each knot's multiplicity "
       "rises with it, so the curve and its continuity are unchanged; order + elevate <= 8). "
@@ -898,6 +900,53 @@ static void range_text(const lw_param_def *d, char *buf, size_t n)
            (d->open & LW_MAX_OPEN) ? "<" : "<=", d->max);
 }
 
+/* What fits on one line "key = value" of the INI reader. */
+static size_t line_cap(const lw_param_def *d)
+{
+  return INI_MAX_LINE - 5 - strlen(d->key);
+}
+
+size_t lw_params_text_cap(const lw_param_def *d)
+{
+  size_t cap = d->list ? d->size - 1 : line_cap(d);
+  return cap > d->size - 1 ? d->size - 1 : cap;
+}
+
+/* The bytes of list text s that go on its next line: up to a lone blank
+** (one that the reader's joining gives back) at most soft bytes on, or the
+** first one past that within hard; 0 where none is. */
+static size_t list_chunk(const char *s, size_t soft, size_t hard)
+{
+  size_t len = strlen(s), best = 0;
+  if (len <= soft) return len;
+  for (size_t k = 1; k + 1 < len && k <= hard; k++) {
+    int lone = s[k] == ' ' && s[k - 1] != ' ' && s[k - 1] != '\t' && s[k + 1] != ' ' && s[k + 1] != '\t';
+    if (!lone) continue;
+    if (k > soft && best) break;
+    best = k;
+    if (k > soft) break;
+  }
+  return best ? best : len <= hard ? len : 0;
+}
+
+#define LIST_LINE 96 /* a wrapped list's lines, to read in an editor */
+
+int lw_params_write_list(FILE *f, const lw_param_def *d, const char *value)
+{
+  size_t hard = line_cap(d), len = strlen(value);
+  if (len <= hard) {
+    if (f) fprintf(f, "%s = %s\n", d->key, value);
+    return 1;
+  }
+  for (int first = 1; *value; first = 0) {
+    size_t n = list_chunk(value, LIST_LINE, hard);
+    if (!n) return 0;
+    if (f) fprintf(f, "%s%s%.*s\n", first ? d->key : "    ", first ? " = " : "", (int)n, value);
+    value += n + (value[n] == ' ');
+  }
+  return 1;
+}
+
 /* Parses text into the field of d; on failure writes what was expected. */
 static int assign(lw_params *p, const lw_param_def *d, const char *text, char *expected, size_t n)
 {
@@ -939,17 +988,23 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
   }
   case LW_PT_STRING: {
     /* Each text field has its own capacity (anneal.schedule is short), and
-    ** "key = value" must fit on one line of the INI reader (read_line), so
-    ** that scene.ini, written back by a run, reads again. */
+    ** "key = value" must fit on one line of the INI reader (read_line), or
+    ** a list on indented lines, so that scene.ini, written back by a run,
+    ** reads again. */
     size_t len = strlen(text), cap = lw_params_text_cap(d);
     if (len > cap) {
-      snprintf(expected, n, "at most %zu bytes (a scene line's%s)", cap,
+      snprintf(expected, n, "at most %zu bytes (%s%s)", cap, d->list ? "the list's field" : "a scene line's",
                !strcmp(d->key, "polygon") ? "; a detailed outline is a picture: boundary = mask" : "");
       return 0;
     }
     if (!lw_params_text_reads_back(text)) {
       snprintf(expected, n, "text without control characters, blanks at either end, or ';' at the "
                             "start or after a blank");
+      return 0;
+    }
+    if (d->list && !lw_params_write_list(NULL, d, text)) {
+      snprintf(expected, n, "a list that breaks over lines of %zu bytes at single blanks between its entries",
+               line_cap(d));
       return 0;
     }
     strcpy(base, text);
@@ -1035,7 +1090,7 @@ lw_status lw_params_blame(const lw_params *p, const char *section, const char *k
   snprintf(msg, sizeof msg, "%s", err->msg);
   /* a schedule's name or a file's path with a no-break space is refused
   ** after the reading, by the module the value names */
-  char value[LW_PATH_MAX + 32] = "", unseen[96];
+  char value[LW_PARAM_TEXT_MAX] = "", unseen[96];
   const lw_param_def *d = lw_params_find(section, key);
   if (d) value_text(p, d, value, sizeof value);
   lw_params_unseen_char(value, unseen, sizeof unseen);
@@ -1051,7 +1106,41 @@ typedef struct {
   int failed;
   char *buf;     /* getline's buffer */
   size_t cap;
+  const lw_param_def *list; /* the list key of the line before, which an indented line goes on */
 } reader_ctx;
+
+/* An indented line without '=' or ':' after a list's line goes on with the list,
+** joined by one blank (inih's own continuation would glue a typo's line
+** onto any key above, and take an indented key = value as text). */
+static int continue_list(reader_ctx *rc)
+{
+  const lw_param_def *d = rc->list;
+  const char *h = rc->buf + strspn(rc->buf, " \t");
+  rc->list = NULL;
+  if (!d || h == rc->buf || strchr("\n;#[", *h) || strpbrk(h, "=:")) return 0;
+  size_t n = strcspn(h, "\n");
+  for (const char *c = h; c < h + n; c++) /* an inline comment, as inih ends a value */
+    if (*c == ';' && (c[-1] == ' ' || c[-1] == '\t')) n = (size_t)(c - h);
+  while (n && (h[n - 1] == ' ' || h[n - 1] == '\t')) n--;
+  char *value = (char *)rc->p + d->offset;
+  size_t len = strlen(value);
+  if (len + 1 + n > lw_params_text_cap(d)) {
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' goes on past %zu bytes: expected a shorter list",
+                 rc->p->file, rc->line, d->section, d->key, lw_params_text_cap(d));
+    rc->failed = 1;
+    return 1;
+  }
+  snprintf(value + len, d->size - len, "%s%.*s", len ? " " : "", (int)n, h);
+  if (!lw_params_write_list(NULL, d, value)) {
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' goes on with a part of over %zu bytes without a single "
+                 "blank: expected entries with single blanks between them", rc->p->file, rc->line, d->section,
+                 d->key, line_cap(d));
+    rc->failed = 1;
+    return 1;
+  }
+  rc->list = d;
+  return 1;
+}
 
 /* inih holds num - 1 bytes of a line (INI_MAX_LINE - 1 with the newline)
 ** and would read the rest of a longer line as a line of its own, so a long
@@ -1101,6 +1190,11 @@ static char *read_line(char *str, int num, void *stream)
                  "'Unicode', has one in every other byte): expected UTF-8 or ASCII text", rc->p->file, rc->line);
     rc->failed = 1;
     return NULL;
+  }
+  if (continue_list(rc)) {
+    if (rc->failed) return NULL;
+    memcpy(str, "\n", 2);
+    return str;
   }
   /* a section header is checked where it stands: inih would take "[scene]]"
   ** or "[scene] x" as [scene], and an unknown section without keys unseen */
@@ -1163,6 +1257,7 @@ static int on_key(void *user, const char *section, const char *key, const char *
   }
   *line = rc->line;
   rc->failed = 0;
+  rc->list = d->list ? d : NULL;
   return 1;
 }
 
@@ -1179,11 +1274,12 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
   snprintf(p->file, sizeof p->file, "%s", path);
   FILE *f = fopen(path, "r");
   if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open scene file: %s", path, strerror(errno));
-  /* No continuation lines: an indented line without '=' would silently
-  ** glue a typo onto the previous value (an indented key = value is a key). */
+  /* inih's continuation lines off: an indented line without '=' would
+  ** glue a typo onto any value above (an indented key = value is a key);
+  ** only a list goes on (continue_list). */
   ini_allow_multiline = false;
   ini_stop_on_first_error = true;
-  reader_ctx rc = {p, f, 0, err, 0, NULL, 0};
+  reader_ctx rc = {p, f, 0, err, 0, NULL, 0, NULL};
   errno = 0;
   int r = ini_parse_stream(read_line, &rc, on_key, &rc);
   int read_error = ferror(f) ? (errno ? errno : EIO) : 0;
@@ -1390,12 +1486,6 @@ int lw_params_text_reads_back(const char *text)
   for (const char *c = text; ok && *c; c++)
     ok = ((unsigned char)*c >= 0x20 || *c == '\t') && !((*c == ' ' || *c == '\t') && c[1] == ';');
   return ok;
-}
-
-size_t lw_params_text_cap(const lw_param_def *d)
-{
-  size_t cap = INI_MAX_LINE - 5 - strlen(d->key);
-  return cap > d->size - 1 ? d->size - 1 : cap;
 }
 
 lw_status lw_params_resolve(lw_params *p, lw_error *err)
@@ -1613,7 +1703,7 @@ int lw_params_file_idle(const lw_params *p, const lw_param_def *d)
 unsigned long long lw_params_run_hash(const lw_params *p, lw_run_keys *keys)
 {
   unsigned long long h = FNV_START;
-  char line[LW_PATH_MAX + 4200];
+  char line[LW_PARAM_TEXT_MAX + 4200];
   if (keys) keys->n = 0;
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
@@ -1638,7 +1728,7 @@ unsigned long long lw_params_run_hash(const lw_params *p, lw_run_keys *keys)
 int lw_params_write(const lw_params *p, FILE *f)
 {
   const char *section = "";
-  char buf[LW_PATH_MAX + 32];
+  char buf[LW_PARAM_TEXT_MAX];
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
     if (strcmp(section, d->section)) {
@@ -1646,7 +1736,8 @@ int lw_params_write(const lw_params *p, FILE *f)
       section = d->section;
     }
     value_text(p, d, buf, sizeof buf);
-    fprintf(f, "%s = %s\n", d->key, buf);
+    if (d->list) lw_params_write_list(f, d, buf);
+    else fprintf(f, "%s = %s\n", d->key, buf);
   }
   return ferror(f) ? -1 : 0;
 }

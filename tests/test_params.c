@@ -320,7 +320,8 @@ Test(params, long_lines_are_refused_with_their_own_line_number)
   for (int i = 0; i < 60; i++) snprintf(text + strlen(text), 20, " %d %d", 10 + i % 50, 10 + (i * 7) % 40);
   strcat(text, "\nwidth = 100\n");
   expect_error(text, ":3:", NULL, "line longer than 198 bytes");
-  /* the longest value accepted is written on a line that reads back */
+  /* the longest value accepted without a blank is written on a line that
+  ** reads back (a list breaks only at its blanks) */
   lw_params p, q;
   lw_error err;
   lw_params_defaults(&p);
@@ -346,6 +347,53 @@ Test(params, long_lines_are_refused_with_their_own_line_number)
   cr_assert_eq(read_text(crlf, &p, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(p.width, 50.0);
   expect_error("; a scene\r[scene]\rwidth = 50\r", ":1:", NULL, "a CR inside the line (a file of CR line ends");
+}
+
+/* A list (a polygon, a ladder, a NURBS curve's numbers) goes on over
+** indented lines: a tempering ladder of more than about 26 rungs could not
+** be given at all (one line holds 198 bytes), though 256 replicas are
+** allowed, and ladder.ini of a tuned 64-rung ladder could not be used. */
+Test(params, a_list_goes_on_over_indented_lines_and_reads_back)
+{
+  lw_params p, q;
+  lw_error err;
+  lw_error_clear(&err);
+  cr_assert_eq(read_text("[scene]\nboundary = polygon\npolygon = 10 10 90 10   ; the base\n"
+                         "    90 60\n\t  50 80  ; the top\n  10 60\nwidth = 100\n  height = 100\n", &p, &err),
+               LW_OK, "%s", err.msg);
+  cr_assert_str_eq(p.polygon, "10 10 90 10 90 60 50 80 10 60");
+  cr_assert_eq(p.height, 100.0, "an indented key = value is a key");
+  cr_assert_eq(p.line[lw_params_find("scene", "polygon") - lw_param_table], 3, "the list's line is its key's");
+  /* only a list goes on, and only on the lines right after it */
+  expect_error("[scene]\nwidth = 100\n  120\n", ":3:", NULL, "syntax error");
+  expect_error("[scene]\npolygon = 10 10 90 10\n\n  90 60\n", ":4:", NULL, "syntax error");
+  expect_error("[scene]\npolygon = 10 10 90 10\n; a comment\n  90 60\n", ":4:", NULL, "syntax error");
+  /* past the field, or a part too long to write back on a line */
+  char text[9000] = "[nurbs]\nknots = 0";
+  for (int i = 0; i < 400; i++) strcat(text, "\n  0.25 0.25 0.5");
+  expect_error(text, ":", "nurbs.knots", "goes on past 2047 bytes");
+  char word[200];
+  memset(word, '1', 190);
+  word[190] = '\0';
+  snprintf(text, sizeof text, "[scene]\npolygon = 1 2\n %s\n", word);
+  expect_error(text, ":3:", "scene.polygon", "without a single blank");
+  /* 256 rungs at 17 digits: --set takes them, scene.ini writes them over
+  ** lines, and they read back byte for byte */
+  lw_params_defaults(&p);
+  char set[7000] = "tempering.ladder=";
+  for (int k = 0; k < 256; k++)
+    snprintf(set + strlen(set), sizeof set - strlen(set), "%s%.17g", k ? " " : "", 0.01 * (1 + k / 3.0));
+  cr_assert_eq(lw_params_set(&p, set, &err), LW_OK, "%s", err.msg);
+  char path[] = "/tmp/lw_params_list_XXXXXX";
+  FILE *f = fdopen(mkstemp(path), "w");
+  cr_assert_eq(lw_params_write(&p, f), 0);
+  fclose(f);
+  cr_assert_eq(lw_params_read(&q, path, &err), LW_OK, "%s", err.msg);
+  cr_assert_str_eq(q.ladder, p.ladder);
+  char cmd[200];
+  snprintf(cmd, sizeof cmd, "awk 'length > 110 || /^ladder =/ { n++ } END { exit n != 1 }' %s", path);
+  cr_assert_eq(system(cmd), 0, "a long list is written on lines of about 100 bytes");
+  unlink(path);
 }
 
 /*

@@ -440,16 +440,24 @@ Test(ptrun, an_equal_ladder_that_did_not_settle_is_said)
 }
 
 /* ladder.ini is ready to reuse as README says: LJ13's 16 rungs at 17 digits
-** were 301 bytes, which --set and a scene file refused; the value now takes
-** the most digits that fit a scene's line. */
-Test(ptrun, a_tuned_ladder_of_16_rungs_reads_back_through_set)
+** were 301 bytes, which --set and a scene file refused (the value then took
+** the most digits that fit a scene's line, and past 26 rungs none did).  A
+** list now goes on over indented lines: pasted into the scene or given to
+** --set, every digit comes back. */
+Test(ptrun, a_tuned_ladder_of_16_rungs_reads_back_pasted_and_through_set)
 {
   cr_assert_eq(sh("%s run %s/params/lj13.ini --threads 1 --quiet --set anneal.sweeps=300 "
                   "--set tempering.tune_ladder=equal --set tempering.ladder_sweeps=200 --out %s/lj 2> %s/err.txt",
                   lw_test_bin(), lw_test_root(), dir, dir),
                0);
-  cr_assert_eq(sh("L=$(sed -n 's/^ladder = //p' %s/lj/ladder.ini) && test $(echo $L | wc -w) -eq 16 && "
-                  "%s run %s/params/lj13.ini --threads 1 --quiet --stop-at 0 --set \"tempering.ladder=$L\" "
-                  "--out %s/lj2 2> %s/err.txt && grep -q \"^ladder = $L\\$\" %s/lj2/scene.ini", dir, lw_test_bin(),
-                  lw_test_root(), dir, dir, dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh("sed -n '/^ladder = /,$p' %s/lj/ladder.ini > %s/lad && test $(wc -l < %s/lad) -gt 1 && "
+                  "test $(cat %s/lad | wc -w) -eq 18", dir, dir, dir, dir), 0, "16 rungs over several lines");
+  cr_assert_eq(sh("cat %s/params/lj13.ini %s/lj/ladder.ini > %s/pasted.ini && %s run %s/pasted.ini --threads 1 "
+                  "--quiet --stop-at 0 --out %s/lj2 2> %s/err.txt && sed -n '/^ladder = /,/^[a-z]/p' %s/lj2/scene.ini "
+                  "| sed '$d' | cmp -s - %s/lad", lw_test_root(), dir, dir, lw_test_bin(), dir, dir, dir, dir, dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh("L=$(sed 's/^ladder = //' %s/lad | tr -s ' \n' '  ') && %s run %s/params/lj13.ini --threads 1 "
+                  "--quiet --stop-at 0 --set \"tempering.ladder=${L%% }\" --out %s/lj3 2> %s/err.txt && "
+                  "cmp -s %s/lj2/scene.ini %s/lj3/scene.ini", dir, lw_test_bin(), lw_test_root(), dir, dir, dir, dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
 }

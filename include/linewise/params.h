@@ -18,6 +18,9 @@
 
 #define LW_PATH_MAX 1024
 #define LW_PARAM_MAX 256 /* capacity of lw_params.line; the table is checked against it */
+/* The largest text field (scene.polygon); buffers that hold any value are
+** sized by it. */
+#define LW_PARAM_TEXT_MAX 8192
 
 /* LW_PT_WHOLE: a whole number beyond int's range (the seed), held in a double. */
 typedef enum { LW_PT_DOUBLE, LW_PT_INT, LW_PT_WHOLE, LW_PT_CHOICE, LW_PT_STRING } lw_param_type;
@@ -38,6 +41,7 @@ typedef struct {
   const char *choices;  /* choice: "a|b|c"; stored as the index */
   const char *help;
   size_t size;          /* text: capacity of the field in lw_params, bytes */
+  int list;             /* text: a list of numbers, which may go on over indented lines */
 } lw_param_def;
 
 extern const lw_param_def lw_param_table[];
@@ -76,7 +80,7 @@ typedef struct {
   double width, height;       /* page, mm */
   int boundary;               /* LW_BND_* */
   double margin;              /* rect and circle inset from the page edge, mm */
-  char polygon[LW_PATH_MAX];  /* "x y x y ..." mm, for boundary = polygon */
+  char polygon[LW_PARAM_TEXT_MAX]; /* "x y x y ..." mm, for boundary = polygon */
   char image[LW_PATH_MAX];    /* picture, relative to the scene file, or empty */
   double image_max_pixels;    /* downsampling budget, pixels */
   int image_width;            /* resample to this width, pixels; 0 = keep */
@@ -163,7 +167,7 @@ typedef struct {
   /* [tempering] */
   int replicas;               /* 1 = no tempering */
   double t_min, t_max;        /* geometric ladder, energy units */
-  char ladder[LW_PATH_MAX];   /* explicit ladder "t0 t1 ...", overrides t_min/t_max */
+  char ladder[6144];          /* explicit ladder "t0 t1 ...", overrides t_min/t_max: 256 rungs at 17 digits */
   int exchange_every;         /* sweeps between exchange steps */
   int tune_ladder;            /* LW_LADDER_* */
   int ladder_sweeps;          /* warm-up sweeps of ladder tuning */
@@ -292,9 +296,16 @@ lw_status lw_params_read_unresolved(lw_params *p, const char *path, lw_error *er
 ** picture replaced by one of another shape would fail the page's size). */
 lw_status lw_params_read_run(lw_params *p, const char *path, int resolve, lw_error *err);
 
-/* The most bytes text key d holds: its field's, and what fits on one line
-** "key = value" of the INI reader, so that a run's scene.ini reads back. */
+/* The most bytes text key d holds: its field's, and for a key that is not a
+** list what fits on one line "key = value" of the INI reader, so that a
+** run's scene.ini reads back (a list goes on over indented lines). */
 size_t lw_params_text_cap(const lw_param_def *d);
+
+/* Writes "key = value" for list key d as scene.ini holds it, over indented
+** lines where it does not fit on one (f NULL: only checks); 0 where the
+** text cannot be broken so (a part of more than a line without a single
+** blank), which the reader refuses to take. */
+int lw_params_write_list(FILE *f, const lw_param_def *d, const char *value);
 
 /* Whether text, written as a value into a run's scene.ini, reads back the
 ** same: no control characters, no blanks at either end, no ';' at the start
