@@ -1664,7 +1664,8 @@ static void put_observables(const lw_anneal *a, lw_json *j)
       lw_series_stats st;
       lw_trace_column_stats(h, rows, n, (int)k, x, &st);
       const char *suffix[5] = {"", "_stderr", "_tau_sweeps", "_n_eff", "_batch_ratio"};
-      const double value[5] = {st.mean, st.stderr_mean, st.tau * every, st.n_eff, st.batch_ratio};
+      const double value[5] = {st.mean, st.stderr_mean, st.tau * lw_trace_column_gap(every, n, &st), st.n_eff,
+                               st.batch_ratio};
       for (int q = 0; q < 5; q++) {
         snprintf(key, sizeof key, "%s%s", obs ? name + 4 : name, suffix[q]);
         lw_json_key(j, key);

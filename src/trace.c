@@ -369,6 +369,14 @@ double lw_trace_every(const lw_trace *t)
   return sweep >= 0 && t->n_rows > 1 ? at(t, 1, sweep) - at(t, 0, sweep) : 1.0;
 }
 
+/* A swapK column is filled on every other row (even and odd pairs take
+** turns), so its tau in values is in twice the rows' sweeps (it read 1.1
+** sweeps for 2.2). */
+double lw_trace_column_gap(double every, size_t n, const lw_series_stats *st)
+{
+  return st->n ? every * (double)n / (double)st->n : every;
+}
+
 void lw_trace_column_stats(const lw_trace *t, const size_t *rows, size_t n, int col, double *x, lw_series_stats *out)
 {
   size_t m = 0;
@@ -548,10 +556,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     for (int r = 0; r < k; r++) {
       lw_trace_column_stats(t[r], row[r], n[r], (int)c, x, &cs[c].run[r]);
       empty |= !cs[c].run[r].n;
-      /* sweeps between the column's values: a swapK column is filled on
-      ** every other row (even and odd pairs take turns), so its tau in
-      ** rows is in twice the rows' sweeps (it read 1.1 sweeps for 2.2) */
-      gap[r] = cs[c].run[r].n ? every[r] * (double)n[r] / (double)cs[c].run[r].n : every[r];
+      gap[r] = lw_trace_column_gap(every[r], n[r], &cs[c].run[r]);
     }
     cs[c].tau_sweeps = cs[c].run[0].tau * gap[0];
     if (empty) {

@@ -1141,6 +1141,44 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
   free(tr);
 }
 
+/* summary.json's tau of an observable is `linewise stats`'s: a spline's
+** observables are empty on the rows where births and deaths left none (297
+** rows of 2900 here), and summary.json counted their tau in rows, not in the
+** sweeps between their values (8.3 sweeps for stats' 81). */
+Test(cli, summary_and_stats_agree_on_tau_where_a_column_has_gaps)
+{
+  char out[8192], errs[4096], args[1024];
+  cr_assert_eq(lw_test_sh("printf '[scene]\\nwidth = 100\\nheight = 100\\n[init]\\nsplines = 2\\nsegments = 2\\n"
+                          "segment_length = 8\\n[energy]\\nboundary = 0.5\\nchem_spline = 1\\n[moves]\\n"
+                          "fixed_count = 0\\nbirth = 1\\ndeath = 1\\n[anneal]\\nschedule = constant\\nsweeps = 3000\\n"
+                          "seed = 3\\n[output]\\nobservables = 1\\ntrace_every = 1\\n' > %s/gaps.ini", dir), 0);
+  snprintf(args, sizeof args, "run %s/gaps.ini --out %s/gaps --quiet --threads 1", dir, dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  snprintf(args, sizeof args, "stats %s/gaps --csv", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  char *sum = lw_test_slurp("%s/gaps/summary.json", dir);
+  cr_assert_not_null(sum);
+  const char *names[] = {"length", "count"};
+  for (int k = 0; k < 2; k++) {
+    char key[64];
+    snprintf(key, sizeof key, "\nobs_%s,", names[k]);
+    const char *row = strstr(out, key);
+    cr_assert_not_null(row, "%s", out);
+    int filled = atoi(row + strlen(key));
+    for (int comma = 0; comma < 5; comma++) row = strchr(row + 1, ',');
+    double stats_tau = atof(row + 1);
+    snprintf(key, sizeof key, "\"%s_tau_sweeps\": ", names[k]);
+    const char *at = strstr(sum, key);
+    cr_assert_not_null(at, "%s", sum);
+    double summary_tau = atof(at + strlen(key));
+    /* stats --csv prints 4 digits */
+    cr_assert(fabs(summary_tau / stats_tau - 1.0) < 1e-3, "%s: tau %g in summary.json, %g in stats", names[k],
+              summary_tau, stats_tau);
+    if (k == 0) cr_assert(filled > 50 && filled < 2000, "the length column has gaps: %d of 2900 rows", filled);
+  }
+  free(sum);
+}
+
 Test(cli, stats_refuses_a_missing_run_and_a_bad_option_in_one_line)
 {
   char out[2048], errs[1024], args[512];

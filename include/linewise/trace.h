@@ -78,6 +78,12 @@ double lw_trace_every(const lw_trace *t);
 ** = 0 when every one is empty); x is scratch for n values. */
 void lw_trace_column_stats(const lw_trace *t, const size_t *rows, size_t n, int col, double *x, lw_series_stats *out);
 
+/* Sweeps between a column's values, its statistics st taken over n rows
+** every sweeps apart: a column filled on only some rows (swapK on every
+** other one, a spline's observable while none lives) has its tau counted in
+** its own values.  summary.json and `linewise stats` both take tau so. */
+double lw_trace_column_gap(double every, size_t n, const lw_series_stats *st);
+
 /* Prints the statistics (series.h) of every column but the sweep and
 ** temperature or time (and the rungs' temperatures) over the rows chosen,
 ** then of the heat capacities Var(E) / T^2 derived from them (of the
