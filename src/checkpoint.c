@@ -307,6 +307,7 @@ lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err)
     return err->code;
   }
   if ((s = lw_ckpt_commit(&w, err))) return s;
+  lw_phase_committed(a->sweep);
   for (int k = 1; k < a->n_rep && !s; k++) s = lw_checkpoint_write_replica(a, k, err);
   /* Wall time differs from run to run, so it lives beside the state, which
   ** must be byte-identical for the same sweeps. */

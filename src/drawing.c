@@ -10,8 +10,11 @@
 
 #include "linewise/plotter.h"
 #include "linewise/spacing.h"
+#include "linewise/state.h"
 
-lw_status lw_drawing_page(const lw_params *p, lw_output_page *page, lw_error *err)
+/* The page and pens of p: size from [scene], pens from [output].  Errors
+** name the parameter's origin. */
+static lw_status drawing_page(const lw_params *p, lw_output_page *page, lw_error *err)
 {
   lw_output_page_init(page, p->width, p->height);
   page->n_pens = p->pens;
@@ -82,11 +85,6 @@ static lw_plot *make_plot(const lw_params *p, const lw_scene *sc, const lw_splin
   lw_plot *pl = lw_plot_new(sp, p->pens, key, LW_PLOT_ORDER_NONE, 0.0, 0.0, err);
   free(key);
   return pl;
-}
-
-static void dir_file(char *buf, size_t n, const char *dir, const char *name)
-{
-  snprintf(buf, n, "%s/%s", dir, name);
 }
 
 /* Paths of st that reach past the page [0, w] x [0, h], each segment taken
@@ -230,7 +228,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
 {
   memset(rep, 0, sizeof *rep);
   lw_output_page page;
-  lw_status s = lw_drawing_page(p, &page, err);
+  lw_status s = drawing_page(p, &page, err);
   if (s) return s;
   lw_plot *pl = make_plot(p, sc, sp, tone, err);
   if (!pl) return err ? err->code : LW_ENOMEM;
@@ -292,7 +290,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   ** stays for a redraw with other plot keys */
   for (int g = 0; g < 2 && !s; g++) {
     if (!(g ? p->gcode : p->hpgl)) continue;
-    dir_file(path, sizeof path, dir, g ? "final.gcode" : "final.hpgl");
+    lw_path_join(path, sizeof path, dir, g ? "final.gcode" : "final.hpgl");
     if ((s = lw_plotter_check(st, &page, &po, g, path, err)) && err) {
       size_t n = strlen(err->msg);
       snprintf(err->msg + n, sizeof err->msg - n, "; no drawing was written, and the annealed state is in "
@@ -305,21 +303,21 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
     return LW_ERUN;
   }
   const lw_grid2d *under = p->preview_image ? tone : NULL;
-  dir_file(path, sizeof path, dir, "final.svg");
+  lw_path_join(path, sizeof path, dir, "final.svg");
   if (!(s = lw_output_svg_strokes(st, &page, path, err))) {
-    dir_file(path, sizeof path, dir, "final.png");
+    lw_path_join(path, sizeof path, dir, "final.png");
     s = lw_output_png_strokes(st, &page, under, p->png_scale, path, err);
   }
   if (!s && p->pdf) {
-    dir_file(path, sizeof path, dir, "final.pdf");
+    lw_path_join(path, sizeof path, dir, "final.pdf");
     s = lw_output_pdf_strokes(st, &page, under, path, err);
   }
   if (!s && p->hpgl) {
-    dir_file(path, sizeof path, dir, "final.hpgl");
+    lw_path_join(path, sizeof path, dir, "final.hpgl");
     s = lw_output_hpgl_strokes(st, &page, &po, path, err);
   }
   if (!s && p->gcode) {
-    dir_file(path, sizeof path, dir, "final.gcode");
+    lw_path_join(path, sizeof path, dir, "final.gcode");
     s = lw_output_gcode_strokes(st, &page, &po, path, err);
   }
   /* a format turned off since the run's last end (scene.ini edited, then
@@ -328,7 +326,7 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
   static const char *const optional[] = {"final.pdf", "final.hpgl", "final.gcode"};
   const int wrote[] = {p->pdf, p->hpgl, p->gcode};
   for (int k = 0; k < 3 && !s; k++) {
-    dir_file(path, sizeof path, dir, optional[k]);
+    lw_path_join(path, sizeof path, dir, optional[k]);
     if (!wrote[k] && remove(path) && errno != ENOENT)
       s = lw_error_set(err, LW_EIO, "%s: cannot remove the file of an earlier end (output.%s is now 0): %s", path,
                        optional[k] + 6, strerror(errno));
@@ -343,7 +341,7 @@ lw_status lw_drawing_frame(const lw_params *p, const lw_scene *sc, const lw_spli
                            const char *dir, long sweep, lw_error *err)
 {
   lw_output_page page;
-  lw_status s = lw_drawing_page(p, &page, err);
+  lw_status s = drawing_page(p, &page, err);
   if (s) return s;
   lw_plot *pl = make_plot(p, sc, sp, tone, err);
   if (!pl) return err ? err->code : LW_ENOMEM;

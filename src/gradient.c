@@ -22,7 +22,8 @@
 
 #include "linewise/tone.h"
 
-void lw_samples_grad_zero(lw_samples_grad *g, int n)
+/* Sets every partial of g to 0 for n nodes. */
+static void samples_grad_zero(lw_samples_grad *g, int n)
 {
   memset(g, 0, sizeof *g);
   g->n = n;
@@ -61,7 +62,7 @@ static void tone_grad(const lw_term_ctx *c, const int64_t *r, const lw_node *a, 
   const int apart = c->quad->n != s->n;
   if (apart) {
     lw_segment_sample(c->quad, a, a + 1, &own);
-    lw_samples_grad_zero(&own_g, own.n);
+    samples_grad_zero(&own_g, own.n);
     s = &own;
     sg = &own_g;
   }
@@ -143,7 +144,7 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
     const lw_node *a = &sp->node[k];
     lw_segment_sample(&sc->quad, a, a + 1, &s);
     irregular += !lw_segment_allowed(sc, a, a + 1, s.length);
-    lw_samples_grad_zero(&sg, s.n);
+    samples_grad_zero(&sg, s.n);
     const lw_term_ctx *c = sc->layers.n ? layer_ctx[lw_splines_layer(&sc->layers, sp, sp->seg_spline[g])] : ctx;
     for (int j = 0; j < sc->n_local; j++) {
       const int t = sc->local[j];

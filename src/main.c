@@ -262,33 +262,73 @@ static volatile sig_atomic_t on_terminal = 0; /* stderr is one: say what a signa
                                                  ** ends the line a phase or the bar holds */
 
 /* What a second signal says, written before it can come: the handler may
-** only write (it named DIR, not the run's directory).  Written again at
-** each checkpoint, with its sweep (how much the stop loses), into the
-** buffer the handler is not reading: which one it reads flips after. */
-#define SECOND_MSG "\nlinewise: a second signal: stopped at once; 'linewise resume DIR' continues from the last " \
-                   "checkpoint\n"
-static char second_msg[2][LW_PATH_MAX + 160] = {SECOND_MSG, SECOND_MSG};
-static volatile sig_atomic_t second_len[2] = {sizeof SECOND_MSG - 1, sizeof SECOND_MSG - 1}, second_at = 0;
+** only write.  The run's directory is named once, before a checkpoint is
+** (checkpointed); the sweep of the last one committed (phase.h) the handler
+** writes itself. */
+static char second_msg[LW_PATH_MAX + 160];
+static size_t second_len;
 
-static void name_checkpoint(const char *dir, long sweep)
+static void name_run_dir(const char *dir)
 {
-  const int b = !second_at;
-  second_len[b] = 0;
-  char when[48] = "the last checkpoint";
-  if (sweep >= 0) snprintf(when, sizeof when, "the checkpoint of sweep %ld", sweep);
-  int n = snprintf(second_msg[b], sizeof second_msg[b], "\nlinewise: a second signal: stopped at once; 'linewise "
-                   "resume %s' continues from %s\n", dir, when);
-  if (n > 0 && (size_t)n < sizeof second_msg[b]) second_len[b] = n;
-  second_at = b;
+  int n = snprintf(second_msg, sizeof second_msg, "\nlinewise: a second signal: stopped at once; 'linewise resume "
+                   "%s' continues from ", dir);
+  second_len = n > 0 && (size_t)n < sizeof second_msg ? (size_t)n : 0; /* (0: it did not fit: nothing is said) */
 }
 
-static void name_run_dir(const char *dir) { name_checkpoint(dir, -1); }
+/* Appends n bytes of text to buf at *at, room allowing (in a handler). */
+static void put_text(char *buf, size_t room, size_t *at, const char *text, size_t n)
+{
+  for (size_t i = 0; i < n && *at < room; i++) buf[(*at)++] = text[i];
+}
+
+/* The second signal's line for a run with a checkpoint (in a handler:
+** no stdio). */
+static void say_second(void)
+{
+  static const char of[] = "the checkpoint of sweep ", last[] = "the last checkpoint";
+  char line[sizeof second_msg + 64], digits[24];
+  size_t at = 0, n = 0;
+  if (!second_len) return;
+  const size_t skip = !on_terminal;
+  put_text(line, sizeof line, &at, second_msg + skip, second_len - skip);
+  long sweep = lw_phase_last_commit();
+  if (sweep >= 0) {
+    put_text(line, sizeof line, &at, of, sizeof of - 1);
+    do digits[n++] = (char)('0' + sweep % 10); while ((sweep /= 10) > 0);
+    while (n) put_text(line, sizeof line, &at, &digits[--n], 1);
+  } else {
+    put_text(line, sizeof line, &at, last, sizeof last - 1);
+  }
+  put_text(line, sizeof line, &at, "\n", 1);
+  ssize_t w = write(2, line, at);
+  (void)w;
+}
 
 /* A run that has written nothing (lw_phase_unwritten: its set-up, which can
 ** take minutes) ends at the first signal: there is nothing to save.  The
 ** default directory made for it, empty but for its lock, goes too. */
 static char made_lock[LW_PATH_MAX + 16], made_dir[LW_PATH_MAX];
 static volatile sig_atomic_t made_what = 0; /* 1 made_dir was made for the run, 3 "out" too */
+
+/* Ends the process from a handler: on SIGINT by the signal itself, as a run
+** stopped cleanly does (a shell goes on with a loop after a child that
+** exits, even with 130, and stops it only after one SIGINT killed), else
+** with 128 + the signal, as a shell shows it, and no core file (SIGXCPU's
+** default makes one).  Under MPI mpirun reports an exit, not a signal. */
+static void exit_by(int sig)
+{
+#ifndef LW_MPI
+  if (sig == SIGINT) {
+    sigset_t only;
+    sigemptyset(&only);
+    sigaddset(&only, SIGINT);
+    signal(SIGINT, SIG_DFL);
+    pthread_sigmask(SIG_UNBLOCK, &only, NULL); /* (a handler runs with its signal blocked) */
+    raise(SIGINT);
+  }
+#endif
+  _exit(128 + sig);
+}
 
 static void stop_unwritten(int sig)
 {
@@ -302,7 +342,7 @@ static void stop_unwritten(int sig)
     rmdir(made_dir);
     if (made_what & 2) rmdir("out");
   }
-  _exit(128 + sig);
+  exit_by(sig);
 }
 
 /* A second signal before the run's first checkpoint leaves nothing to resume. */
@@ -358,14 +398,16 @@ static void on_signal(int sig)
     static const char part[] = "\nlinewise: a second signal: stopped at once as the run's first checkpoint was "
                                "written; linewise's next run or resume there goes on from it, or, where it was not "
                                "written, puts the run that was in the directory back\n";
-    const int b = second_at, stash = lw_phase_stashed();
-    const size_t skip = second_len[b] > 0 && !on_terminal; /* (0: the name did not fit, and nothing is said) */
-    ssize_t w = checkpointed  ? write(2, second_msg[b] + skip, (size_t)second_len[b] - skip)
-                : stash == 1  ? write(2, kept + !on_terminal, sizeof kept - 1 - !on_terminal)
-                : stash == 2  ? write(2, part + !on_terminal, sizeof part - 1 - !on_terminal)
-                              : write(2, none + !on_terminal, sizeof none - 1 - !on_terminal);
-    (void)w;
-    _exit(128 + sig);
+    const int stash = lw_phase_stashed();
+    if (checkpointed) {
+      say_second();
+    } else {
+      ssize_t w = stash == 1 ? write(2, kept + !on_terminal, sizeof kept - 1 - !on_terminal)
+                  : stash == 2 ? write(2, part + !on_terminal, sizeof part - 1 - !on_terminal)
+                               : write(2, none + !on_terminal, sizeof none - 1 - !on_terminal);
+      (void)w;
+    }
+    exit_by(sig);
   }
 }
 
@@ -522,10 +564,8 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   ** of an MPI run stop together, at the sweep where one of them was asked */
   int stopped = ((net ? net->stop_agreed : stop_requested) || (stop_at >= 0 && a->sweep >= stop_at)) &&
                 !lw_anneal_done(a);
-  long named = a->saved;
   while (!stopped && !lw_anneal_done(a)) {
     if (lw_anneal_sweep(a, err)) return loop_fail(a, pg.start_sweep, w, err);
-    if (a->saved != named && a->saved > 0) name_checkpoint(a->dir, (named = a->saved) - 1);
     progress_show(&pg, a, 0);
     stopped = (net ? net->stop_agreed : stop_requested) || (stop_at >= 0 && a->sweep >= stop_at);
   }
@@ -536,7 +576,6 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   /* the checkpoint of the end (lw_anneal_finish's first step) is written
   ** here, so that a second signal while the files are drawn names it */
   if (a->saved != a->sweep + 1 && lw_anneal_checkpoint(a, err)) return loop_fail(a, pg.start_sweep, w, err);
-  if (a->saved == a->sweep + 1) name_checkpoint(a->dir, a->sweep);
   if (stopped) {
     watcher_stop(w, LW_PHASE_DONE);
     char mpi[LW_PATH_MAX + 96] = "";
@@ -923,6 +962,7 @@ static int cmd_resume(int argc, char **argv)
   watcher_start(&w, quiet);
   checkpointed = 1; /* state.lw holds the last one */
   lw_status s = lw_anneal_resume_net(&a, dir, more, net, &err);
+  if (!s) lw_phase_committed(a.sweep);
   /* judged before the processes of an MPI run agree, so that it is said
   ** once (each said it, and MPI_Abort's banner followed) */
   if (!s && stop_at >= 0 && stop_at < a.sweep)

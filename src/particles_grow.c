@@ -48,7 +48,10 @@ static void anchor(void *ctx, size_t skip, size_t j, const double r[3], double d
   a->sum += vmf(lw_v3_dot(a->n, nj)) / spread_volume();
 }
 
-double lw_particles_birth_density(const lw_particles *p, uint32_t skip, const double x[3], const double n[3])
+/* g: the density of a birth proposing a particle at x with normal n from
+** the state's anchors other than `skip` (UINT32_MAX: none), per r0^-3 and
+** per unit of the rotation group's normalised measure. */
+static double birth_density(const lw_particles *p, uint32_t skip, const double x[3], const double n[3])
 {
   size_t anchors = p->n - (skip < p->n ? 1 : 0);
   if (!anchors) return 0.0;
@@ -102,7 +105,7 @@ static double birth(const lw_particles *p, lw_particles_prop *pr, gsl_rng *rng, 
   e[LW_PTERM_CHEM] = s->chem;
   double dE = 0.0;
   for (int t = 0; t < LW_PTERM_COUNT; t++) dE += pr->dterm[t] = e[t];
-  double g = lw_particles_birth_density(p, UINT32_MAX, pr->x, pr->n) * r0 * r0 * r0;
+  double g = birth_density(p, UINT32_MAX, pr->x, pr->n) * r0 * r0 * r0;
   pr->log_ratio = log(s->death) - log((double)(p->n_loose + 1)) - log(s->birth) - log(g);
   return pr->dE = dE;
 }
@@ -120,7 +123,7 @@ static double death(const lw_particles *p, lw_particles_prop *pr, gsl_rng *rng, 
   e[LW_PTERM_CHEM] = s->chem;
   double dE = 0.0;
   for (int t = 0; t < LW_PTERM_COUNT; t++) dE += pr->dterm[t] = -e[t];
-  double g = lw_particles_birth_density(p, k, x, n) * r0 * r0 * r0;
+  double g = birth_density(p, k, x, n) * r0 * r0 * r0;
   pr->log_ratio = log(s->birth) + log(g) - log(s->death) + log((double)p->n_loose);
   return pr->dE = dE;
 }

@@ -23,7 +23,9 @@ double lw_particles_auto_size(int pattern, size_t count, double r0)
   }
 }
 
-double lw_particles_plane_spacing(size_t count, double size)
+/* The lattice spacing of the plane pattern for `count` particles in a disc
+** of diameter size. */
+static double plane_spacing(size_t count, double size)
 {
   return size * sqrt(M_PI / (2.0 * sqrt(3.0) * (double)(count ? count : 1)));
 }
@@ -88,7 +90,7 @@ lw_status lw_particles_place(int pattern, size_t count, double size, double nois
 {
   lw_cellgrid *g = NULL;
   if (pattern == LW_PPATTERN_PLANE) {
-    lw_status s = plane_sites(count, lw_particles_plane_spacing(count, size), x, err);
+    lw_status s = plane_sites(count, plane_spacing(count, size), x, err);
     if (s) return s;
   } else if (pattern == LW_PPATTERN_CLOUD && min_dist > 0) {
     const double lo[3] = {-0.5 * size, -0.5 * size, -0.5 * size}, ext[3] = {size, size, size};

@@ -45,6 +45,12 @@ void lw_phase_stop(void) { atomic_store(&stop_asked, 1); }
 
 int lw_phase_stopping(void) { return atomic_load(&stop_asked); }
 
+static volatile atomic_long committed = -1;
+
+void lw_phase_committed(long sweep) { atomic_store(&committed, sweep); }
+
+long lw_phase_last_commit(void) { return atomic_load(&committed); }
+
 const char *lw_phase_get(double *seconds)
 {
   const char *what = atomic_load(&phase_what);

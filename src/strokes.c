@@ -205,7 +205,8 @@ static void split(const double *b, double t, double *l, double *r)
   if (r) memcpy(r, out_r, sizeof out_r);
 }
 
-void lw_bezier_sub(const double *b, double t0, double t1, double *out)
+/* The sub-curve of b[8] between parameters t0 < t1 into out[8]. */
+static void bezier_sub(const double *b, double t0, double t1, double *out)
 {
   double left[8];
   if (t1 < 1.0) split(b, t1, left, NULL);
@@ -584,7 +585,7 @@ static lw_status crop_path(const lw_strokes *in, size_t k, const rect *r, double
         nb = 0;
       }
       if (run[2 * j] == 0.0 && run[2 * j + 1] == 1.0) memcpy(buf + 8 * nb, b, 8 * sizeof *buf);
-      else lw_bezier_sub(b, run[2 * j], run[2 * j + 1], buf + 8 * nb);
+      else bezier_sub(b, run[2 * j], run[2 * j + 1], buf + 8 * nb);
       nb++;
       cont = run[2 * j + 1] == 1.0;
     }

@@ -364,6 +364,30 @@ Test(run, a_stop_during_the_set_up_puts_the_run_before_back)
   cr_assert_eq(sh("test -s %s/fresh/state.lw", dir), 0);
 }
 
+/* A second signal ends the process at once and names the checkpoint a
+** resume takes up: the one whose state.lw is committed, marked as its
+** rename ends.  It was named after the replicas' files and timing.txt were
+** written too, and a signal among those named the checkpoint before (the
+** replica here fails to write, with state.lw of sweep 3 on disk). */
+Test(run, a_checkpoint_is_marked_committed_as_state_lw_is)
+{
+  char path[128], out[128];
+  write_scene("[tempering]\nreplicas = 2\n", path, sizeof path);
+  lw_params p;
+  lw_error err;
+  cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
+  snprintf(out, sizeof out, "%s/c", dir);
+  lw_anneal a;
+  cr_assert_eq(lw_anneal_start(&a, &p, out, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_phase_last_commit(), 0);
+  for (int k = 0; k < 3; k++) cr_assert_eq(lw_anneal_sweep(&a, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(sh("mkdir %s/c/replica-1.lw.tmp", dir), 0);
+  cr_assert_neq(lw_anneal_checkpoint(&a, &err), LW_OK, "the replica's file was written");
+  cr_assert_eq(lw_phase_last_commit(), a.sweep);
+  cr_assert_eq(sh("grep -q '^sweep = %ld$' %s/c/state.lw", a.sweep, dir), 0);
+  lw_anneal_free(&a);
+}
+
 /* Frames are extra files: a run that writes them (and a PDF) leaves the
 ** same state, trace and drawings as one that does not, and a stopped and
 ** resumed run writes the same frames.  The first is the start (a film of

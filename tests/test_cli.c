@@ -785,6 +785,21 @@ Test(cli, a_signal_before_anything_is_written_ends_the_set_up_at_once)
                 strstr(e, "...\nlinewise: stopped during the set-up, before anything was written\n"), "%s", e);
   free(e);
   cr_assert_neq(lw_test_sh("test -e %s/out", dir), 0, "the default directory was left");
+  /* and it ends by SIGINT, as a stop after a sweep does, so that Ctrl-C in
+  ** a set-up stops a shell loop of runs (it exited 130, and the loop went on) */
+  cr_assert_eq(lw_test_sh("cd %s && printf 'for i in 1 2; do %s run %s/params/minimal.ini --threads 1 --set "
+                          "init.splines=50000 --set scene.width=1060 --set scene.height=1060 --out l$i; "
+                          "echo \"run $i: $?\"; done; echo finished\n' > loop.sh && "
+                          "(setsid env --default-signal=INT bash loop.sh >loop.log 2>&1 & echo $! >loop.pid); i=0; "
+                          "while [ $i -lt 3000 ] && ! grep -q 'placing the initial state' loop.log; do sleep 0.01; "
+                          "i=$((i+1)); done; kill -INT -$(cat loop.pid); i=0; while kill -0 $(cat loop.pid) "
+                          "2>/dev/null && [ $i -lt 1500 ]; do sleep 0.02; i=$((i+1)); done; test $i -lt 1500; r=$?; "
+                          "kill -KILL -$(cat loop.pid) 2>/dev/null; exit $r", dir, lw_test_bin(), lw_test_root()),
+               0);
+  e = lw_test_slurp("%s/loop.log", dir);
+  cr_assert(strstr(e, "stopped during the set-up, before anything was written") && !strstr(e, "run 1") &&
+            !strstr(e, "finished"), "%s", e);
+  free(e);
   /* what a second signal leaves before the first checkpoint (a run's
   ** scene.ini, a cut state.lw.tmp, no state.lw): resume says why it cannot,
   ** and the next run into the default directory takes it again, not

@@ -67,9 +67,6 @@ typedef struct {
   lw_fidelity pen_fidelity[LW_PLOT_PENS_MAX]; /* per pen, when n_pens > 1 */
 } lw_drawing_report;
 
-/* The page and pens of p: size from [scene], pens from [output].  Errors
-** name the parameter's origin. */
-lw_status lw_drawing_page(const lw_params *p, lw_output_page *page, lw_error *err);
 
 /* Appends to note[n] ("; " between notes) what the drawing keys of p will
 ** not do as set: a pen speed past what HP-GL's VS takes, which final.hpgl

@@ -30,8 +30,6 @@
 /* lw_samples_grad, dE/d(sample values) of one segment, is declared in
 ** terms.h beside the term rows that fill it. */
 
-/* Sets every partial of g to 0 for n nodes. */
-void lw_samples_grad_zero(lw_samples_grad *g, int n);
 
 /* Adds the gradient g of one segment, taken through the basis of q, to the
 ** gradients of its first node (ga) and its last node (gb). */

@@ -51,9 +51,5 @@
 double lw_particles_propose_grow(const lw_particles *p, lw_particles_prop *pr, int kind, gsl_rng *rng,
                                  int *forbidden);
 
-/* g: the density of a birth proposing a particle at x with normal n from
-** the state's anchors other than `skip` (UINT32_MAX: none), per r0^-3 and
-** per unit of the rotation group's normalised measure. */
-double lw_particles_birth_density(const lw_particles *p, uint32_t skip, const double x[3], const double n[3]);
 
 #endif

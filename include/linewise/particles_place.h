@@ -38,9 +38,6 @@
 /* The automatic extent of `count` particles of the pattern at spacing r0. */
 double lw_particles_auto_size(int pattern, size_t count, double r0);
 
-/* The lattice spacing of the plane pattern for `count` particles in a disc
-** of diameter size. */
-double lw_particles_plane_spacing(size_t count, double size);
 
 #define LW_PLACE_TRIES 100
 

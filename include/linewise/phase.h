@@ -47,6 +47,13 @@ int lw_phase_stashed(void);
 void lw_phase_stop(void);
 int lw_phase_stopping(void);
 
+/* The sweep of the last state.lw this process committed (-1: none yet),
+** set as its rename ends, so that a second signal, which ends the process
+** at once, names the checkpoint a resume takes up (it named the one before
+** while the replicas' files of the new one were written).  Lock-free. */
+void lw_phase_committed(long sweep);
+long lw_phase_last_commit(void);
+
 /* What a watcher prints, decided from what it reads at each tick, so that
 ** the rule can be tested with a made-up clock.  A phase is named once it has
 ** lasted over LW_PHASE_QUIET seconds: on a terminal (tty) in place, its

@@ -142,7 +142,4 @@ void lw_strokes_drawn_segment(const lw_strokes *s, size_t k, size_t j, double *o
 /* The point at t in [0, 1] of the cubic b[8] into xy[2]. */
 void lw_bezier_eval(const double *b, double t, double *xy);
 
-/* The sub-curve of b[8] between parameters t0 < t1 into out[8]. */
-void lw_bezier_sub(const double *b, double t0, double t1, double *out);
-
 #endif
