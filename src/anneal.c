@@ -6,6 +6,7 @@
 #include "linewise/anneal.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <float.h>
 #include <gsl/gsl_math.h>
 #include <stdarg.h>
@@ -786,8 +787,15 @@ static lw_status open_trace(lw_anneal *a, int fresh, lw_error *err)
 {
   char path[LW_PATH_MAX + 32];
   dir_file(path, sizeof path, a, "trace.csv");
-  a->trace = fopen(path, fresh ? "w" : "a");
-  if (!a->trace) return lw_error_set(err, LW_EIO, "%s: cannot write: %s", path, strerror(errno));
+  /* written in place (a resume appends), so never through a link */
+  int fd = open(path, O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC | (fresh ? O_TRUNC : O_APPEND), 0666);
+  /* (at the end, so that ftell counts the bytes before it, as fopen's "a" does) */
+  if (fd < 0 || lseek(fd, 0, SEEK_END) < 0 || !(a->trace = fdopen(fd, fresh ? "w" : "a"))) {
+    const int e = errno;
+    if (fd >= 0) close(fd);
+    return lw_error_set(err, LW_EIO, "%s: cannot write: %s%s", path, strerror(e),
+                        e == ELOOP ? " (a symbolic link: a run writes into its own directory only)" : "");
+  }
   if (fresh && a->dyn) {
     const lw_system_type *t = a->sys_type;
     fprintf(a->trace, "sweep,time");
@@ -1396,8 +1404,7 @@ static lw_status exchange(lw_anneal *a, lw_error *err)
 static lw_status write_sample(lw_anneal *a, lw_error *err)
 {
   char path[LW_PATH_MAX + 64], tmp[LW_PATH_MAX + 96];
-  dir_file(path, sizeof path, a, "samples");
-  if (mkdir(path, 0777) && errno != EEXIST) return lw_error_set(err, LW_EIO, "%s: %s", path, strerror(errno));
+  if (lw_output_subdir(a->dir, "samples", path, sizeof path, err)) return err->code;
   size_t n = strlen(path);
   snprintf(path + n, sizeof path - n, "/sample-%06ld.csv", a->sweep);
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);

@@ -193,6 +193,12 @@ lw_status lw_checkpoint_sync_trace(lw_anneal *a, long *bytes, lw_error *err)
   *bytes = 0;
   if (!a->trace) return LW_OK;
   dir_file(path, sizeof path, a, "trace.csv");
+  /* a row cut by a disk full for a moment leaves the flag and a later
+  ** flush that succeeds: the state must not count the rows so damaged (a
+  ** resume cuts the trace back to the checkpoint before) */
+  if (ferror(a->trace))
+    return lw_error_set(err, LW_EIO, "%s: write failed: a row since the last checkpoint was not written whole (a full "
+                        "disk?)", path);
   if (fflush(a->trace) || fsync(fileno(a->trace)) || (*bytes = ftell(a->trace)) < 0)
     return lw_error_set(err, LW_EIO, "%s: write failed: %s", path, strerror(errno));
   return LW_OK;

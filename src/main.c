@@ -619,7 +619,6 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
     lw_anneal_drift_note(a, drawn, sizeof drawn);
     if (drawn[0]) fprintf(stderr, "linewise: warning: %s\n", drawn);
-    if (a->stash_left[0]) fprintf(stderr, "linewise: warning: %s\n", a->stash_left);
   }
   if (!quiet) {
     if (a->quenched)
@@ -906,6 +905,10 @@ static int cmd_run(int argc, char **argv)
   made_what = 0;
   checkpointed = 1;
   watcher_settle(&w);
+  /* the first checkpoint dropped the run set aside, or could not: said
+  ** under --quiet too (what is left takes disk space, and the next run or
+  ** resume there tries again) */
+  if (a.stash_left[0]) fprintf(stderr, "linewise: warning: %s\n", a.stash_left);
   if (!quiet) {
     const char *note = a.sys_type->note(a.setup);
     char size[128];

@@ -5,6 +5,7 @@
 #include <cairo-pdf.h>
 #include <cairo.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdint.h>
@@ -62,9 +63,36 @@ FILE *lw_output_open_tmp(const char *path, char *tmp, size_t n, lw_error *err)
     lw_error_set(err, LW_EIO, "%s: path too long for its temporary file", path);
     return NULL;
   }
-  FILE *f = fopen(tmp, "w");
-  if (!f) lw_error_set(err, LW_EIO, "%s: cannot write %s: %s", path, tmp, strerror(errno));
+  /* a stale one (a kill as it was written) or a link goes, not what it
+  ** names; O_EXCL then refuses one put back in between */
+  if (unlink(tmp) && errno != ENOENT) {
+    lw_error_set(err, LW_EIO, "%s: cannot remove %s: %s", path, tmp, strerror(errno));
+    return NULL;
+  }
+  int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+  FILE *f = fd < 0 ? NULL : fdopen(fd, "w");
+  if (!f) {
+    lw_error_set(err, LW_EIO, "%s: cannot write %s: %s", path, tmp, strerror(errno));
+    if (fd >= 0) {
+      close(fd);
+      unlink(tmp);
+    }
+  }
   return f;
+}
+
+lw_status lw_output_subdir(const char *dir, const char *sub, char *path, size_t n, lw_error *err)
+{
+  int len = snprintf(path, n, "%s/%s", dir, sub);
+  if (len < 0 || (size_t)len >= n - 32) return lw_error_set(err, LW_EIO, "%s: path too long for the %s", dir, sub);
+  struct stat sb;
+  if (mkdir(path, 0777) && errno != EEXIST)
+    return lw_error_set(err, LW_EIO, "%s: cannot create directory: %s", path, strerror(errno));
+  if (lstat(path, &sb)) return lw_error_set(err, LW_EIO, "%s: %s", path, strerror(errno));
+  if (!S_ISDIR(sb.st_mode))
+    return lw_error_set(err, LW_EIO, "%s: %s, not a folder: a run writes its %s only into its own directory; remove "
+                        "it", path, S_ISLNK(sb.st_mode) ? "a symbolic link" : "a file", sub);
+  return LW_OK;
 }
 
 lw_status lw_output_commit(FILE *f, const char *tmp, const char *path, lw_error *err)
@@ -477,12 +505,9 @@ lw_status lw_output_frame(const char *dir, long sweep, const lw_splines *sp, con
                           const lw_plot *plot, const lw_grid2d *tone, double px_per_mm, lw_error *err)
 {
   char path[LW_OUTPUT_PATH_MAX];
-  int n = snprintf(path, sizeof path, "%s/frames", dir);
-  if (n < 0 || (size_t)n >= sizeof path - 32)
-    return lw_error_set(err, LW_EIO, "%s: path too long for the frames", dir);
-  if (mkdir(path, 0777) && errno != EEXIST)
-    return lw_error_set(err, LW_EIO, "%s: cannot create directory: %s", path, strerror(errno));
-  snprintf(path + n, sizeof path - (size_t)n, "/frame-%06ld.png", sweep);
+  if (lw_output_subdir(dir, "frames", path, sizeof path, err)) return err->code;
+  size_t n = strlen(path);
+  snprintf(path + n, sizeof path - n, "/frame-%06ld.png", sweep);
   return lw_output_png(sp, page, plot, tone, px_per_mm, path, err);
 }
 

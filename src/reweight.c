@@ -320,7 +320,12 @@ static lw_status gather(const lw_trace *const *t, const char *const *path, const
       /* one every 2 tau, and no more than LW_REWEIGHT_SAMPLES a rung: beyond
       ** that the error bars are far below the trace's own scatter, and the
       ** solves' cost grows with the samples */
-      size_t g = (size_t)ceil(2.0 * fmax(lw_series_tau(x, 1, c, &window), 0.5));
+      const double tau = lw_series_tau(x, 1, c, &window);
+      if (isnan(tau)) {
+        st = lw_error_set(err, LW_ENOMEM, "%s: out of memory for the autocorrelation of rung %d", path[r], q);
+        goto done;
+      }
+      size_t g = (size_t)ceil(2.0 * fmax(tau, 0.5));
       if (c > g * LW_REWEIGHT_SAMPLES) g = (c + LW_REWEIGHT_SAMPLES - 1) / LW_REWEIGHT_SAMPLES;
       s->open += !window;
       size_t at = s->first[s->K];

@@ -150,13 +150,15 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
   ** needs no more) */
   lw_status s = lw_rundir_writable(dir, err);
   if (s) return s;
-  int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
-  if (fd < 0 && errno == EACCES) fd = open(path, O_RDONLY | O_CLOEXEC);
+  /* never through a link: one planted there made a root's run create any file */
+  int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0666);
+  if (fd < 0 && errno == EACCES) fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
   struct stat st;
   if (fd < 0 || fstat(fd, &st)) {
     int e = errno;
     if (fd >= 0) close(fd);
-    return lw_error_set(err, LW_EIO, "%s: cannot open the run directory's lock: %s", path, strerror(e));
+    return lw_error_set(err, LW_EIO, "%s: cannot open the run directory's lock: %s%s", path, strerror(e),
+                        e == ELOOP ? " (a symbolic link, which linewise does not follow: remove it)" : "");
   }
   int k, free_slot = -1;
   for (k = 0; k < HELD_MAX; k++) {

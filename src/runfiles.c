@@ -61,8 +61,13 @@ static int each_file(const char *root, each_fn *fn, void *ctx)
     }
   for (size_t g = 0; g < sizeof groups / sizeof groups[0]; g++) {
     snprintf(path, sizeof path, "%s/%s", root, groups[g].sub);
+    /* a link is not the run's folder: its files are another directory's
+    ** (moved aside and deleted, they were lost) */
+    if (groups[g].sub[0] != '.' && (lstat(path, &sb) || !S_ISDIR(sb.st_mode))) continue;
     DIR *d = opendir(path);
-    if (!d) continue;
+    /* (a folder that cannot be read, out of file handles say, would leave
+    ** another run's frames in this one, or the run set aside half removed) */
+    if (!d) return -1;
     int r = 0;
     for (struct dirent *e; !r && (e = readdir(d));) {
       if (!in_group(e->d_name, groups[g].prefix, groups[g].suffix)) continue;
@@ -266,9 +271,13 @@ lw_status lw_runfiles_unstash(const char *dir, lw_error *err)
   /* .moving or .restoring: every run file in the stash goes back, over a
   ** counterpart in dir (the new run's) */
   mover m = {st, dir, 0, ""};
-  if (each_file(st, move_one, &m))
+  if (each_file(st, move_one, &m)) {
+    if (!m.err) /* (a folder of the stash that would not open) */
+      return lw_error_set(err, LW_EIO, "%s: cannot read its folders: %s; the run that was there before is in it",
+                          st, strerror(errno));
     return lw_error_set(err, LW_EIO, "%s/%s: cannot put it back: %s; the rest of the run that was there before "
                         "is in %s", dir, m.rel, strerror(m.err), st);
+  }
   remove_stash_dir(dir);
   prune(dir);
   return LW_OK;
@@ -291,10 +300,12 @@ lw_status lw_runfiles_stash(const char *dir, lw_error *err)
     return lw_error_set(err, LW_EIO, "%s: cannot write: %s; the run there is as it was", marker, strerror(e));
   }
   mover m = {dir, st, 0, ""};
-  if (each_file(dir, move_one, &m) || rename(marker, moved)) {
+  const int unread = each_file(dir, move_one, &m) && !m.err; /* (a folder of it would not open) */
+  if (m.err || unread || rename(marker, moved)) {
     const int e = m.err ? m.err : errno;
     char what[LW_PATH_MAX + 32];
-    snprintf(what, sizeof what, "%s/%s", dir, m.err ? m.rel : LW_RUNFILES_STASH "/.moving");
+    snprintf(what, sizeof what, "%s%s%s", dir, m.err ? "/" : unread ? "" : "/" LW_RUNFILES_STASH "/.moving",
+             m.err ? m.rel : "");
     lw_error back;
     if (lw_runfiles_unstash(dir, &back))
       return lw_error_set(err, LW_EIO, "%s: cannot set it aside: %s; %s", what, strerror(e), back.msg);
@@ -319,7 +330,7 @@ lw_status lw_runfiles_drop(const char *dir, lw_error *err)
   if (marker == NOT_OURS) return LW_OK;
   if (marker != EMPTY && each_file(st, remove_stashed, (void *)dir))
     return lw_error_set(err, LW_EIO, "%s: cannot remove the run set aside there (the run that replaced it has its "
-                        "checkpoint): %s; remove the folder by hand", st, strerror(errno));
+                        "checkpoint): %s; linewise's next run or resume there removes it", st, strerror(errno));
   remove_stash_dir(dir);
   return LW_OK;
 }

@@ -115,7 +115,10 @@ void lw_series_stats_of(const double *x, size_t n, lw_series_stats *out)
     out->tau = 0.5;
     out->window = 1;
   } else {
-    out->tau = fmax(lw_series_tau(x, 1, n, &out->window), 0.5);
+    /* NAN (out of memory) stays: fmax would take it for 0.5, and the error
+    ** bars would shrink without a word */
+    const double tau = lw_series_tau(x, 1, n, &out->window);
+    out->tau = isnan(tau) ? NAN : fmax(tau, 0.5);
   }
   out->n_eff = (double)n / (2.0 * out->tau);
   out->stderr_mean = n > 1 ? out->sd * sqrt(2.0 * out->tau / (double)n) : NAN;

@@ -1062,10 +1062,9 @@ static lw_status draw(void *state, const lw_params *p, const char *dir, long swe
     lw_path_join(path, sizeof path, dir, "final.png");
     return write_png(s, b, path, err);
   }
-  int n = snprintf(path, sizeof path, "%s/frames", dir);
-  if (n < 0 || (size_t)n >= sizeof path - 32) return lw_error_set(err, LW_EIO, "%s: path too long for the frames", dir);
-  if (mkdir(path, 0777) && errno != EEXIST) return lw_error_set(err, LW_EIO, "%s: %s", path, strerror(errno));
-  snprintf(path + n, sizeof path - (size_t)n, "/frame-%06ld.png", sweep);
+  if (lw_output_subdir(dir, "frames", path, sizeof path, err)) return err->code;
+  size_t n = strlen(path);
+  snprintf(path + n, sizeof path - n, "/frame-%06ld.png", sweep);
   return write_png(s, s->su->view, path, err);
 }
 

@@ -16,6 +16,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "linewise/output.h"
 #include "linewise/particles_draw.h"
 #include "linewise/particles_grow.h"
 #include "linewise/particles_io.h"
@@ -384,11 +385,9 @@ static lw_status draw(void *state, const lw_params *p, const char *dir, long swe
   if (sweep == LW_DRAW_START) return LW_OK;
   if (sweep == LW_DRAW_FINAL) return lw_particles_draw(state, dir, err);
   char path[LW_PATH_MAX + 64];
-  int n = snprintf(path, sizeof path, "%s/frames", dir);
-  if (n < 0 || (size_t)n >= sizeof path - 32)
-    return lw_error_set(err, LW_EIO, "%s: path too long for the frames", dir);
-  if (mkdir(path, 0777) && errno != EEXIST) return lw_error_set(err, LW_EIO, "%s: %s", path, strerror(errno));
-  snprintf(path + n, sizeof path - (size_t)n, "/frame-%06ld.png", sweep);
+  if (lw_output_subdir(dir, "frames", path, sizeof path, err)) return err->code;
+  size_t n = strlen(path);
+  snprintf(path + n, sizeof path - n, "/frame-%06ld.png", sweep);
   return lw_particles_write_png(state, path, 1, err);
 }
 

@@ -555,6 +555,11 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     int empty = 0;
     for (int r = 0; r < k; r++) {
       lw_trace_column_stats(t[r], row[r], n[r], (int)c, x, &cs[c].run[r]);
+      if (cs[c].run[r].n > 1 && isnan(cs[c].run[r].tau)) {
+        status = lw_error_set(err, LW_ENOMEM, "%s: out of memory for the autocorrelation of %s", path[r],
+                              t[0]->name[c]);
+        goto done;
+      }
       empty |= !cs[c].run[r].n;
       gap[r] = lw_trace_column_gap(every[r], n[r], &cs[c].run[r]);
     }

@@ -3,11 +3,13 @@
 ** shared/DESIGN.md section 3, tuning, NaN handling, bit-exact resume.
 */
 #include <criterion/criterion.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "linewise/anneal.h"
 #include "linewise/init.h"
@@ -385,6 +387,33 @@ Test(run, a_checkpoint_is_marked_committed_as_state_lw_is)
   cr_assert_neq(lw_anneal_checkpoint(&a, &err), LW_OK, "the replica's file was written");
   cr_assert_eq(lw_phase_last_commit(), a.sweep);
   cr_assert_eq(sh("grep -q '^sweep = %ld$' %s/c/state.lw", a.sweep, dir), 0);
+  lw_anneal_free(&a);
+}
+
+/* A disk full for a moment cut a trace row, whose stream kept the error
+** while a later flush succeeded: the checkpoint counted the damaged rows,
+** and the run ended 0 with a trace.csv that stats refused.  The checkpoint
+** now fails, and a resume goes on from the one before. */
+Test(run, a_trace_row_lost_to_a_full_disk_fails_the_checkpoint)
+{
+  char path[128], out[128];
+  write_scene("", path, sizeof path);
+  lw_params p;
+  lw_error err;
+  cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
+  snprintf(out, sizeof out, "%s/t", dir);
+  lw_anneal a;
+  cr_assert_eq(lw_anneal_start(&a, &p, out, &err), LW_OK, "%s", err.msg);
+  int fd = fileno(a.trace), keep = dup(fd), full = open("/dev/full", O_WRONLY);
+  cr_assert(keep >= 0 && full >= 0);
+  cr_assert_eq(dup2(full, fd), fd);
+  for (int k = 0; k < 200; k++) fprintf(a.trace, "%d,a row that the full disk takes no byte of\n", k);
+  fflush(a.trace);
+  cr_assert_eq(dup2(keep, fd), fd);
+  close(full);
+  close(keep);
+  cr_assert_eq(lw_anneal_checkpoint(&a, &err), LW_EIO, "the checkpoint counted a damaged trace");
+  cr_assert(strstr(err.msg, "trace.csv: write failed"), "%s", err.msg);
   lw_anneal_free(&a);
 }
 

@@ -1194,6 +1194,38 @@ Test(cli, summary_and_stats_agree_on_tau_where_a_column_has_gaps)
   free(sum);
 }
 
+/* Links planted in a run directory (by another user of a shared one) are
+** not followed: a run wrote its temporaries through them (as root: into
+** any file), created the file a .lock link named, and moved aside and then
+** deleted the frames of another folder that frames/ linked to. */
+Test(cli, links_planted_in_a_run_directory_are_not_followed)
+{
+  cr_assert_eq(lw_test_sh("cd %s && mkdir -p out/m vd && echo secret > victim && touch vd/frame-000000.png && "
+                          "ln -s %s/victim out/m/state.lw.tmp && ln -s %s/victim out/m/timing.txt.tmp", dir, dir, dir),
+               0);
+  char args[1024], out[4096], errs[4096];
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/out/m --quiet --set anneal.sweeps=5", lw_test_root(),
+           dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert_eq(lw_test_sh("cd %s && grep -qx secret victim && test -f out/m/state.lw && ! test -L out/m/state.lw && "
+                          "! test -e out/m/state.lw.tmp", dir), 0, "a temporary was written through a link");
+  /* a lock that is a link: refused, the file it names not made */
+  cr_assert_eq(lw_test_sh("cd %s && mkdir out/k && ln -s %s/made out/k/.lock", dir, dir), 0);
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/out/k --quiet", lw_test_root(), dir);
+  cr_assert_neq(run(args, out, sizeof out, errs, sizeof errs), 0);
+  cr_assert(strstr(errs, ".lock: cannot open the run directory's lock") && strstr(errs, "symbolic link"), "%s", errs);
+  cr_assert_neq(lw_test_sh("test -e %s/made", dir), 0, "the lock's link made its file");
+  /* frames/ a link to another folder: its files stay, and the run is refused */
+  cr_assert_eq(lw_test_sh("cd %s && ln -s %s/vd out/m/frames", dir, dir), 0);
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/out/m --quiet --set anneal.sweeps=5 "
+           "--set output.frames_every=5", lw_test_root(), dir);
+  cr_assert_neq(run(args, out, sizeof out, errs, sizeof errs), 0);
+  cr_assert(strstr(errs, "frames: a symbolic link, not a folder"), "%s", errs);
+  cr_assert_eq(lw_test_sh("test -f %s/vd/frame-000000.png && test \"$(ls %s/vd)\" = frame-000000.png", dir, dir), 0,
+               "the linked folder's frames were moved or written");
+  cr_assert_eq(lw_test_sh("test -s %s/out/m/state.lw", dir), 0, "the run that was there is gone");
+}
+
 Test(cli, stats_refuses_a_missing_run_and_a_bad_option_in_one_line)
 {
   char out[2048], errs[1024], args[512];

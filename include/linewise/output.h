@@ -147,10 +147,16 @@ void lw_output_cairo_strokes(cairo_t *cr, const lw_strokes *s, int pen);
 int lw_output_png_size(const lw_output_page *page, double px_per_mm, int *width_px,
                        int *height_px, double *scale);
 
-/* Opens "<path>.tmp" for writing ("w"), its name stored in tmp[n].  NULL and
-** err (LW_EIO, naming path) if the name does not fit or the file cannot be
-** created, e.g. because path's directory does not exist. */
+/* Opens "<path>.tmp" for writing, its name stored in tmp[n]: a new file, in
+** place of whatever was there, never through a link (one planted in a run
+** directory had a run write, as root, into any file).  NULL and err (LW_EIO,
+** naming path) if the name does not fit or the file cannot be created, e.g.
+** because path's directory does not exist. */
 FILE *lw_output_open_tmp(const char *path, char *tmp, size_t n, lw_error *err);
+
+/* DIR/sub (frames, samples), made where it is not, into path[n]: a link or a
+** file there is refused (a run's files go into its own directory only). */
+lw_status lw_output_subdir(const char *dir, const char *sub, char *path, size_t n, lw_error *err);
 
 /* Finishes a file from lw_output_open_tmp: flush, fsync, close, then rename
 ** tmp over path.  Any write error seen on f (ferror) also fails it.  On
