@@ -371,16 +371,23 @@ Test(run, a_stop_during_the_set_up_puts_the_run_before_back)
 ** rename ends.  It was named after the replicas' files and timing.txt were
 ** written too, and a signal among those named the checkpoint before (the
 ** replica here fails to write, with state.lw of sweep 3 on disk). */
-Test(run, a_checkpoint_is_marked_committed_as_state_lw_is)
+/* Starts the scene above with extra into dir/name. */
+static void start_run(const char *extra, const char *name, lw_anneal *a)
 {
   char path[128], out[128];
-  write_scene("[tempering]\nreplicas = 2\n", path, sizeof path);
-  lw_params p;
+  write_scene(extra, path, sizeof path);
+  static lw_params p;
   lw_error err;
   cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
-  snprintf(out, sizeof out, "%s/c", dir);
+  snprintf(out, sizeof out, "%s/%s", dir, name);
+  cr_assert_eq(lw_anneal_start(a, &p, out, &err), LW_OK, "%s", err.msg);
+}
+
+Test(run, a_checkpoint_is_marked_committed_as_state_lw_is)
+{
   lw_anneal a;
-  cr_assert_eq(lw_anneal_start(&a, &p, out, &err), LW_OK, "%s", err.msg);
+  lw_error err;
+  start_run("[tempering]\nreplicas = 2\n", "c", &a);
   cr_assert_eq(lw_phase_last_commit(), 0);
   for (int k = 0; k < 3; k++) cr_assert_eq(lw_anneal_sweep(&a, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(sh("mkdir %s/c/replica-1.lw.tmp", dir), 0);
@@ -396,14 +403,9 @@ Test(run, a_checkpoint_is_marked_committed_as_state_lw_is)
 ** now fails, and a resume goes on from the one before. */
 Test(run, a_trace_row_lost_to_a_full_disk_fails_the_checkpoint)
 {
-  char path[128], out[128];
-  write_scene("", path, sizeof path);
-  lw_params p;
-  lw_error err;
-  cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
-  snprintf(out, sizeof out, "%s/t", dir);
   lw_anneal a;
-  cr_assert_eq(lw_anneal_start(&a, &p, out, &err), LW_OK, "%s", err.msg);
+  lw_error err;
+  start_run("", "t", &a);
   int fd = fileno(a.trace), keep = dup(fd), full = open("/dev/full", O_WRONLY);
   cr_assert(keep >= 0 && full >= 0);
   cr_assert_eq(dup2(full, fd), fd);
