@@ -1087,7 +1087,7 @@ static lw_status truncate_trace(lw_anneal *a, long bytes, lw_error *err)
   char *line = NULL;
   size_t cap = 0;
   ssize_t len;
-  for (int first = 1; (len = getline(&line, &cap, in)) > 0; first = 0) {
+  for (int first = 1; (len = lw_text_getline(&line, &cap, in)) > 0; first = 0) {
     /* a torn last row has no newline; its sweep may read as a smaller one */
     long long sweep;
     size_t nf = strcspn(line, ",");

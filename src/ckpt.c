@@ -206,6 +206,7 @@ lw_status lw_ckpt_read(lw_ckpt **out, const char *path, lw_error *err)
 {
   *out = NULL;
   if (lw_number_locale_ok(err)) return err->code; /* (resume and energy read it first) */
+  if (lw_text_not_fifo(path, err)) return err->code;
   lw_ckpt *c = lw_ckpt_new(path);
   if (!c) return lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
   FILE *f = fopen(path, "rb");
@@ -230,6 +231,9 @@ lw_status lw_ckpt_read(lw_ckpt **out, const char *path, lw_error *err)
     }
     memcpy(c->text + c->len, chunk, got);
     c->len += got;
+    /* text: a NUL ends the reading at once (/dev/zero, a sparse file of
+    ** gigabytes, were read whole first); the check below names its line */
+    if (memchr(chunk, '\0', got)) break;
   }
   /* a directory opens but does not read: the user named the wrong thing */
   if (!s && ferror(f)) s = lw_error_set(err, LW_EINPUT, "%s: cannot read: %s", path, strerror(errno ? errno : EIO));

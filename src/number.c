@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 static int is_digit(char c) { return c >= '0' && c <= '9'; }
 
@@ -104,10 +105,44 @@ void lw_text_drop_bom(char *s)
     memmove(s, s + 3, strlen(s + 3) + 1);
 }
 
+ssize_t lw_text_getline(char **buf, size_t *cap, FILE *f)
+{
+  size_t len = 0;
+  int c;
+  flockfile(f);
+  while (len < LW_TEXT_LINE_MAX && (c = getc_unlocked(f)) != EOF) {
+    if (len + 2 > *cap) {
+      size_t grown = *cap < 128 ? 128 : 2 * *cap;
+      char *b = realloc(*buf, grown);
+      if (!b) {
+        funlockfile(f);
+        errno = ENOMEM;
+        return -1;
+      }
+      *buf = b;
+      *cap = grown;
+    }
+    (*buf)[len++] = (char)c;
+    if (c == '\n' || c == '\0') break;
+  }
+  funlockfile(f);
+  if (!len) return -1;
+  (*buf)[len] = '\0';
+  return (ssize_t)len;
+}
+
+lw_status lw_text_not_fifo(const char *path, lw_error *err)
+{
+  struct stat sb;
+  if (stat(path, &sb) || (!S_ISFIFO(sb.st_mode) && !S_ISSOCK(sb.st_mode))) return LW_OK;
+  return lw_error_set(err, LW_EINPUT, "%s: a %s, not a file: expected a file, which linewise reads whole", path,
+                      S_ISFIFO(sb.st_mode) ? "FIFO (named pipe)" : "socket");
+}
+
 long lw_text_next_line(FILE *f, char **buf, size_t *cap, long *line)
 {
   errno = 0;
-  ssize_t len = getline(buf, cap, f);
+  ssize_t len = lw_text_getline(buf, cap, f);
   if (len < 0) return ferror(f) ? -2 : -1;
   ++*line;
   if (memchr(*buf, '\0', (size_t)len)) return -2;

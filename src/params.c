@@ -1150,7 +1150,7 @@ static char *read_line(char *str, int num, void *stream)
   reader_ctx *rc = stream;
   if (rc->failed) return NULL;
   errno = 0;
-  ssize_t len = getline(&rc->buf, &rc->cap, rc->f);
+  ssize_t len = lw_text_getline(&rc->buf, &rc->cap, rc->f);
   if (len < 0) {
     /* glibc sets no stream error where getline cannot grow its buffer: the
     ** rest of the file read as its end, and the scene as defaults */
@@ -1272,6 +1272,7 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
     return lw_error_set(err, LW_EINPUT, "%.80s...: the scene file's path is %zu bytes; expected at most %zu",
                         path, strlen(path), sizeof p->file - 1);
   snprintf(p->file, sizeof p->file, "%s", path);
+  if (lw_text_not_fifo(path, err)) return err->code;
   FILE *f = fopen(path, "r");
   if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open scene file: %s", path, strerror(errno));
   /* inih's continuation lines off: an indented line without '=' would

@@ -54,7 +54,7 @@ typedef struct {
 /* The next line into r->buf without its line end, or NULL at the end. */
 static char *next_line(reader *r)
 {
-  ssize_t len = getline(&r->buf, &r->cap, r->f);
+  ssize_t len = lw_text_getline(&r->buf, &r->cap, r->f);
   if (len < 0) return NULL;
   if (++r->line == 1) {
     lw_text_drop_bom(r->buf);

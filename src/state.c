@@ -277,7 +277,7 @@ typedef struct {
 static char *next_line(reader *r)
 {
   ssize_t len;
-  while ((len = getline(&r->buf, &r->cap, r->f)) >= 0) {
+  while ((len = lw_text_getline(&r->buf, &r->cap, r->f)) >= 0) {
     r->line++;
     if (memchr(r->buf, '\0', (size_t)len)) {
       r->nul = 1;
@@ -402,6 +402,7 @@ static lw_status read_v1(lw_state *st, reader *r, lw_error *err)
 lw_status lw_state_read(lw_state *st, const char *path, lw_error *err)
 {
   memset(st, 0, sizeof *st);
+  if (lw_text_not_fifo(path, err)) return err->code;
   reader r = {fopen(path, "r"), path, 0, NULL, 0, 0};
   if (!r.f) return lw_error_set(err, LW_EINPUT, "%s: cannot open state file: %s", path, strerror(errno));
   lw_status s = LW_OK;

@@ -72,7 +72,7 @@ static lw_status read_row(const lw_trace *t, const char *line, size_t line_no, d
 
 lw_trace *lw_trace_read(const char *path, lw_error *err)
 {
-  if (lw_number_locale_ok(err)) return NULL;
+  if (lw_number_locale_ok(err) || lw_text_not_fifo(path, err)) return NULL;
   FILE *f = fopen(path, "r");
   if (!f) {
     lw_error_set(err, errno == ENOENT ? LW_EINPUT : LW_EIO, "%s: cannot read: %s", path, strerror(errno));
@@ -83,7 +83,7 @@ lw_trace *lw_trace_read(const char *path, lw_error *err)
   size_t cap = 0, rows_cap = 0, line_no = 0;
   ssize_t len;
   lw_status s = t ? LW_OK : lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
-  while (!s && (len = getline(&line, &cap, f)) > 0) {
+  while (!s && (len = lw_text_getline(&line, &cap, f)) > 0) {
     line_no++;
     int whole = line[len - 1] == '\n';
     if (whole) line[--len] = '\0';

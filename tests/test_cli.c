@@ -1226,6 +1226,35 @@ Test(cli, links_planted_in_a_run_directory_are_not_followed)
   cr_assert_eq(lw_test_sh("test -s %s/out/m/state.lw", dir), 0, "the run that was there is gone");
 }
 
+/* A file a key names that never ends: a FIFO waited for a writer for ever
+** (the picture alone was refused), and /dev/zero or a sparse file of
+** gigabytes was read as one line until the memory was gone.  Each is
+** refused at once, naming the key. */
+Test(cli, a_fifo_or_an_endless_file_named_by_a_key_is_refused_at_once)
+{
+  cr_assert_eq(lw_test_sh("mkfifo %s/fifo", dir), 0);
+  const char *sets[][2] = {
+    {"init.from=%s/fifo", "key 'init.from': %s/fifo: a FIFO (named pipe), not a file"},
+    {"anneal.schedule=table --set anneal.table=%s/fifo", "key 'anneal.table': %s/fifo: a FIFO (named pipe)"},
+    {"init.from=/dev/zero%.0s", "key 'init.from': /dev/zero:1: header: expected 'linewise-state <version>', got "
+                               "binary bytes%.0s"},
+    {"anneal.schedule=table --set anneal.table=/dev/zero%.0s", "key 'anneal.table': /dev/zero:1: a NUL byte%.0s"},
+  };
+  for (size_t k = 0; k < sizeof sets / sizeof sets[0]; k++) {
+    char set[256], want[256], args[1024];
+    snprintf(set, sizeof set, sets[k][0], dir);
+    snprintf(want, sizeof want, sets[k][1], dir);
+    snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/o --quiet --set %s", lw_test_root(), dir, set);
+    cr_assert_eq(lw_test_sh("timeout 60 %s %s > /dev/null 2> %s/err.txt; test $? -eq 2", lw_test_bin(),
+                            args, dir), 0, "%s", set);
+    char *e = lw_test_slurp("%s/err.txt", dir);
+    cr_assert(e && strstr(e, want), "%s: %s", set, e);
+    free(e);
+  }
+  cr_assert_eq(lw_test_sh("timeout 60 %s run %s/fifo 2>&1 | grep -q 'fifo: a FIFO (named pipe), not a file'",
+                          lw_test_bin(), dir), 0);
+}
+
 Test(cli, stats_refuses_a_missing_run_and_a_bad_option_in_one_line)
 {
   char out[2048], errs[1024], args[512];

@@ -15,6 +15,7 @@
 
 #include <stddef.h>
 #include <stdio.h>
+#include <sys/types.h>
 
 #include "linewise/error.h"
 
@@ -48,6 +49,19 @@ void lw_text_drop_bom(char *s);
 ** (which would end it early as a string and drop the rest unseen) or a
 ** failed read (errno set; ENOMEM when out of memory). */
 long lw_text_next_line(FILE *f, char **buf, size_t *cap, long *line);
+
+/* getline(3) for the readers of text files, which a NUL byte ends, with it
+** (each reader refuses a line that holds one), and which gives at most
+** LW_TEXT_LINE_MAX bytes of a longer line (what follows comes as the next
+** line, which a reader finds malformed): /dev/zero or a sparse file of
+** gigabytes, named as a state, a table or points, grew one line until the
+** machine's memory was gone. */
+#define LW_TEXT_LINE_MAX (64L << 20)
+ssize_t lw_text_getline(char **buf, size_t *cap, FILE *f);
+
+/* LW_EINPUT with err where path names a FIFO or a socket, which a reader
+** would wait on for ever (opening a FIFO waits for a writer); else LW_OK. */
+lw_status lw_text_not_fifo(const char *path, lw_error *err);
 
 /* Splits s at blanks (commas too when `commas` is 1 or 2) into at most max
 ** numbers; returns how many tokens there were (more than max are counted
