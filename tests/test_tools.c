@@ -814,6 +814,45 @@ Test(tools, plot_run_draws_the_heat_capacity_between_the_rungs)
   cr_assert_eq(sh("test ! -e %s/wl/plots/.reweight.csv.tmp", dir), 0, "no temporary file left");
 }
 
+/* What the plots read goes into gnuplot's commands, and another user may
+** hand one a run or a sweep: summary.json's "from" went into a command as
+** text (system(...) ran), a line break in a name began a command of its own,
+** a seed of "EOD" ended sweep.csv's datablock and the next row ran, and
+** a planted link at a plot's temporary name was written through. */
+Test(tools, plots_run_nothing_a_run_or_sweep_file_says)
+{
+  cr_assert_eq(sh("%s run %s " TINY " --quiet --out %s/r --set output.observables=1", env("LW_BIN"), scene(), dir), 0);
+  cr_assert_eq(sh("cd %s && sed -i 's/^  \"observables\": null,/  \"observables\": {\\n    \"from\": 0,0;x=system(\"id>made1\");#,\\n    \"to\": 10\\n  },/' r/summary.json && "
+                  "grep -q made1 r/summary.json && mkdir r/plots && echo keep > victim && "
+                  "ln -s %s/victim r/plots/.energy.png.tmp && %s r </dev/null", dir, dir, tool("plot-run")),
+               0, "%s", err_txt());
+  check_png("r/plots/energy.png");
+  cr_assert(!exists("made1"), "summary.json's text ran as a gnuplot command");
+  cr_assert_eq(sh("grep -qx keep %s/victim", dir), 0, "a plot was written through a planted link");
+  cr_assert_eq(sh("cd %s && cp -r r \"$(printf 'r\\n!touch made2\\nx')\" && %s \"$(printf 'r\\n!touch made2\\nx')\" "
+                  "</dev/null", dir, tool("plot-run")), 2);
+  cr_assert(!exists("made2"), "a line break in the name began a gnuplot command");
+  write_text("eod.csv", "seed,energy_total,run\nEOD,2.5,a\nsystem('touch made3'),1.5,b\n");
+  cr_assert_eq(sh("cd %s && %s eod.csv </dev/null", dir, tool("plot-sweep")), 0, "%s", err_txt());
+  cr_assert(!exists("made3"), "a sweep.csv field ended the datablock and ran");
+}
+
+/* A run's log planted as a link (another user's, in a shared sweep folder)
+** had the sweep append the run's output to the file it named. */
+Test(tools, a_sweep_writes_no_log_through_a_link)
+{
+  cr_assert_eq(sh("mkdir -p %s/s/seed-1 && echo keep > %s/victim && ln -s %s/victim %s/s/seed-1/linewise.log", dir, dir,
+                  dir, dir), 0);
+  cr_assert_neq(sh("%s %s --seeds 1-2 " TINY " --bin %s --out %s/s", tool("seed-sweep"), scene(), env("LW_BIN"), dir),
+                0);
+  char *e = err_txt();
+  cr_assert(strstr(e, "seed-1/linewise.log: a symbolic link"), "%s", e);
+  free(e);
+  cr_assert_eq(sh("grep -qx keep %s/victim && test $(wc -l < %s/victim) -eq 1", dir, dir), 0,
+               "the log was written through the link");
+  cr_assert_eq(sh("test -s %s/s/seed-2/summary.json", dir), 0, "the other run did not finish");
+}
+
 Test(tools, plot_sweep_draws_a_png_beside_the_csv)
 {
   write_text("seeds.csv", "seed,energy_total,energy_bending,proposals_per_second,wall_seconds,run\n"
