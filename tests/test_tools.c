@@ -822,7 +822,8 @@ Test(tools, plot_run_draws_the_heat_capacity_between_the_rungs)
 Test(tools, plots_run_nothing_a_run_or_sweep_file_says)
 {
   cr_assert_eq(sh("%s run %s " TINY " --quiet --out %s/r --set output.observables=1", env("LW_BIN"), scene(), dir), 0);
-  cr_assert_eq(sh("cd %s && sed -i 's/^  \"observables\": null,/  \"observables\": {\\n    \"from\": 0,0;x=system(\"id>made1\");#,\\n    \"to\": 10\\n  },/' r/summary.json && "
+  cr_assert_eq(sh("cd %s && sed -i 's/^  \"observables\": null,/  \"observables\": {\\n    \"from\": "
+                  "0,0;x=system(\"id>made1\");#,\\n    \"to\": 10\\n  },/' r/summary.json && "
                   "grep -q made1 r/summary.json && mkdir r/plots && echo keep > victim && "
                   "ln -s %s/victim r/plots/.energy.png.tmp && %s r </dev/null", dir, dir, tool("plot-run")),
                0, "%s", err_txt());
