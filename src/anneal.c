@@ -1022,16 +1022,25 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
 
 /* The sweep of the last row within the first `bytes` bytes of the trace
 ** (a run writes one every trace_every sweeps, and one where it ends), or
-** -1 if there is only the header; -2 if those bytes do not end a line or
-** cannot be read. */
+** -1 if there is only the header; -2 if those bytes do not end a line; -3
+** (errno set) if they cannot be read (out of memory or file handles: not
+** the files' fault, which the message for -2 blames). */
 static long last_row_sweep(const char *path, long bytes)
 {
   enum { TAIL = 1 << 16 };
   FILE *f = fopen(path, "rb");
-  if (!f) return -2;
+  if (!f) return -3;
   long from = bytes > TAIL ? bytes - TAIL : 0, n = bytes - from, sweep = -2;
   char *buf = malloc((size_t)n + 1);
-  if (buf && n > 0 && !fseek(f, from, SEEK_SET) && fread(buf, 1, (size_t)n, f) == (size_t)n && buf[n - 1] == '\n') {
+  int whole = buf && n > 0 && !fseek(f, from, SEEK_SET) && fread(buf, 1, (size_t)n, f) == (size_t)n;
+  if (n > 0 && !whole) {
+    const int e = buf ? (errno ? errno : EIO) : ENOMEM;
+    free(buf);
+    fclose(f);
+    errno = e;
+    return -3;
+  }
+  if (whole && buf[n - 1] == '\n') {
     buf[--n] = '\0';
     char *line = strrchr(buf, '\n');
     if (!line && from == 0) {
@@ -1067,6 +1076,9 @@ static lw_status truncate_trace(lw_anneal *a, long bytes, lw_error *err)
     long last = last_row_sweep(path, bytes), every = a->params.trace_every;
     char state[LW_PATH_MAX + 32];
     dir_file(state, sizeof state, a, "state.lw");
+    if (last == -3)
+      return lw_error_set(err, LW_EIO, "%s: cannot read it to check the rows %s counts: %s", path, state,
+                          strerror(errno));
     if (last == -2)
       return lw_error_set(err, LW_EINPUT, "%s: %s counts %ld bytes of it, which do not end a row with its sweep (the "
                           "state or the trace was edited)", path, state, bytes);

@@ -53,17 +53,20 @@ lw_status lw_rundir_make(const char *dir, lw_error *err)
   return LW_OK;
 }
 
-/* Whether the first line of dir/name begins with head (and, whole, is it). */
+/* Whether the first line of dir/name begins with head (and, whole, is it):
+** 1 or 0, or -1 (errno set) where it is there but cannot be read. */
 static int first_line_is(const char *dir, const char *name, const char *head, int whole)
 {
   char path[LW_PATH_MAX + 16], line[256];
   lw_path_join(path, sizeof path, dir, name);
   FILE *f = fopen(path, "r");
-  if (!f) return 0;
+  if (!f) return errno == ENOENT || errno == ENOTDIR || errno == ELOOP ? 0 : -1;
   int is = 0;
   if (fgets(line, sizeof line, f)) {
     size_t n = strcspn(line, "\r\n"), h = strlen(head);
     is = n >= h && !strncmp(line, head, h) && (!whole || (n == h && line[n] != '\0'));
+  } else if (ferror(f)) {
+    is = errno == EISDIR ? 0 : -1;
   }
   fclose(f);
   return is;
@@ -71,8 +74,8 @@ static int first_line_is(const char *dir, const char *name, const char *head, in
 
 int lw_rundir_holds_run(const char *dir)
 {
-  return first_line_is(dir, "scene.ini", LW_RUN_SCENE_HEADER, 1) ||
-         first_line_is(dir, "state.lw", LW_STATE_MAGIC, 0);
+  return first_line_is(dir, "scene.ini", LW_RUN_SCENE_HEADER, 1) == 1 ||
+         first_line_is(dir, "state.lw", LW_STATE_MAGIC, 0) == 1;
 }
 
 int lw_rundir_foreign(const char *dir, const char *name)
@@ -80,8 +83,9 @@ int lw_rundir_foreign(const char *dir, const char *name)
   char path[LW_PATH_MAX + 16];
   lw_path_join(path, sizeof path, dir, name);
   if (access(path, F_OK)) return 0;
-  return !strcmp(name, "state.lw") ? !first_line_is(dir, name, LW_STATE_MAGIC, 0)
-                                   : !first_line_is(dir, name, LW_RUN_SCENE_HEADER, 1);
+  const int is = !strcmp(name, "state.lw") ? first_line_is(dir, name, LW_STATE_MAGIC, 0)
+                                           : first_line_is(dir, name, LW_RUN_SCENE_HEADER, 1);
+  return is < 0 ? -1 : !is;
 }
 
 int lw_rundir_unstarted(const char *dir)

@@ -270,6 +270,7 @@ typedef struct {
   char *buf;    /* getline's buffer: run data lines (the RNG state) are long */
   size_t cap;
   int nul;      /* the last line held a NUL byte */
+  int oom;      /* a line could not be held: out of memory, not the end */
 } reader;
 
 /* Next line that is not blank or a comment, without its newline; NULL at
@@ -277,6 +278,7 @@ typedef struct {
 static char *next_line(reader *r)
 {
   ssize_t len;
+  errno = 0;
   while ((len = lw_text_getline(&r->buf, &r->cap, r->f)) >= 0) {
     r->line++;
     if (memchr(r->buf, '\0', (size_t)len)) {
@@ -292,6 +294,7 @@ static char *next_line(reader *r)
     while (*c == ' ' || *c == '\t') c++;
     if (*c && *c != '#') return c;
   }
+  r->oom = errno == ENOMEM;
   return NULL;
 }
 
@@ -320,6 +323,7 @@ static int text_like(const char *c)
 
 static lw_status bad(reader *r, lw_error *err, const char *key, const char *expected, const char *got)
 {
+  if (r->oom) return lw_error_set(err, LW_ENOMEM, "%s:%d: out of memory reading the next line", r->path, r->line);
   return lw_error_set(err, LW_EINPUT, "%s:%d: %s: expected %s, got '%.60s'", r->path, r->line, key, expected,
                       r->nul ? "a NUL byte" : got ? got : "end of file");
 }
@@ -403,13 +407,15 @@ lw_status lw_state_read(lw_state *st, const char *path, lw_error *err)
 {
   memset(st, 0, sizeof *st);
   if (lw_text_not_fifo(path, err)) return err->code;
-  reader r = {fopen(path, "r"), path, 0, NULL, 0, 0};
+  reader r = {fopen(path, "r"), path, 0, NULL, 0, 0, 0};
   if (!r.f) return lw_error_set(err, LW_EINPUT, "%s: cannot open state file: %s", path, strerror(errno));
   lw_status s = LW_OK;
   errno = 0;
   char *c = next_line(&r);
   long long version = 0;
-  if (!c && ferror(r.f)) /* a directory opens but does not read */
+  if (!c && r.oom)
+    s = lw_error_set(err, LW_ENOMEM, "%s: out of memory reading its first line", path);
+  else if (!c && ferror(r.f)) /* a directory opens but does not read */
     s = lw_error_set(err, LW_EINPUT, "%s: cannot read state file: %s", path, strerror(errno ? errno : EIO));
   else if (!c && !r.nul && r.line == 0) /* (line 0 of an empty file meant nothing to its reader) */
     s = lw_error_set(err, LW_EINPUT, "%s: empty file (0 bytes), not a state: expected 'linewise-state <version>'",

@@ -27,7 +27,9 @@ lw_status lw_rundir_make(const char *dir, lw_error *err);
 int lw_rundir_holds_run(const char *dir);
 
 /* Whether dir/name exists and is not a run's (a scene file a person wrote,
-** any state.lw without a state's header): a run refuses to write there. */
+** any state.lw without a state's header): a run refuses to write there.
+** -1 (errno set) where it is there but cannot be read (out of file
+** handles, say): not a verdict on the file. */
 int lw_rundir_foreign(const char *dir, const char *name);
 
 /* Whether dir holds a run that stopped before its first checkpoint: a run's
