@@ -1849,7 +1849,10 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_status s = lw_json_finish(&j, err);
   if (s) {
     lw_output_abort(f, tmp);
-    return s;
+    /* (the writer does not know the file's name, which the message needs) */
+    char msg[LW_ERROR_MSG];
+    snprintf(msg, sizeof msg, "%s", err->msg);
+    return lw_error_set(err, s, "%s: %s", path, msg);
   }
   return lw_output_commit(f, tmp, path, err);
 }
