@@ -186,18 +186,6 @@ int lw_particles_outside(const lw_particles_setup *s, const double x[3])
   return external(s, x, e);
 }
 
-/* Squared distances along one axis from p, in cell c of the axis that starts
-** at a with cells of side h, to the cells c - 1 and c + 1 (0 to its own).
-** They bound the distance to every particle in those cells, clamped ones
-** included: clamping only moves particles outward. */
-static void axis_gaps(double a, double h, int c, double p, double gap[3])
-{
-  double below = p - (a + c * h), above = a + (c + 1) * h - p;
-  gap[0] = below * below;
-  gap[1] = 0.0;
-  gap[2] = above * above;
-}
-
 /* The cells a walk from x visits: x's cell c, the ranges lo..hi (its
 ** neighbours within the grid) and the squared gaps to them along each axis. */
 typedef struct {
@@ -211,7 +199,7 @@ static void cells_around(const lw_cellgrid *g, const double x[3], around *a)
   const int n[3] = {g->nx, g->ny, g->nz};
   lw_cellgrid_locate3(g, x[0], x[1], x[2], &a->c[0], &a->c[1], &a->c[2]);
   for (int k = 0; k < 3; k++) {
-    axis_gaps(o[k], h, a->c[k], x[k], a->gap[k]);
+    lw_cellgrid_axis_gaps(o[k], h, a->c[k], x[k], a->gap[k]);
     a->lo[k] = a->c[k] > 0 ? a->c[k] - 1 : 0;
     a->hi[k] = a->c[k] + 1 < n[k] ? a->c[k] + 1 : n[k] - 1;
   }
@@ -231,7 +219,7 @@ static void walk(const lw_particles *p, uint32_t k, uint32_t from, const double 
 {
   const lw_cellgrid *g = p->grid;
   const lw_ppair_ctx *c = &p->setup->pair;
-  const double range2 = c->range2, skip2 = range2 * (1.0 + 1e-9);
+  const double range2 = c->range2, skip2 = range2 * LW_CELLGRID_GAP_MARGIN;
   const double *nrm = p->nrm;
   around a;
   cells_around(g, x, &a);
@@ -292,7 +280,7 @@ static inline __attribute__((always_inline)) void around_point(const lw_particle
                                                                int after, int reverse, pair_visitor *visit, void *ctx)
 {
   const lw_cellgrid *g = p->grid;
-  const double range2 = p->setup->pair.range2, skip2 = range2 * (1.0 + 1e-9);
+  const double range2 = p->setup->pair.range2, skip2 = range2 * LW_CELLGRID_GAP_MARGIN;
   const int step = reverse ? -1 : 1;
   around a;
   cells_around(g, x, &a);

@@ -91,7 +91,7 @@ typedef struct {
   v4f dl;
   v2d near2;      /* (near_scale dl)^2: a pair is near within the larger of its two */
   v2d scale;      /* scale dl: the factor on this probe's far pairs' dl_j (1/r - 1/rc) */
-  double gx[3], gy[3]; /* squared gaps to the columns and rows of the block (axis_gaps) */
+  double gx[3], gy[3]; /* squared gaps to the columns and rows of the block (lw_cellgrid_axis_gaps) */
   v2d s0, s1;     /* its far sum: entries 0, 1 and 2, 3 of each group of four (adjacent) */
 } probe_ctx;
 
@@ -370,23 +370,6 @@ static lw_status nearlist_reserve(lw_pair_nearlist *l, size_t more)
   return LW_OK;
 }
 
-/* Squared gaps along one axis between p, in cell c of the axis starting at
-** a with cells of side h, and the cells c - 1, c, c + 1: gap[0], 0, gap[2].
-** Only the sides facing p count, and those are true bounds even for edge
-** cells, which hold the points clamped from beyond the grid on their outer
-** sides. */
-static void axis_gaps(double a, double h, int c, double p, double gap[3])
-{
-  double below = p - (a + c * h), above = a + (c + 1) * h - p;
-  gap[0] = below * below;
-  gap[1] = 0.0;
-  gap[2] = above * above;
-}
-
-/* Cells are skipped when their gap exceeds the cutoff by this factor: a
-** point sits in its cell up to the rounding of (x - x0) / h. */
-#define GAP_MARGIN (1.0 + 1e-9)
-
 /* Position of the first entry of index >= i in the cell's sorted indices. */
 static uint32_t first_from(const uint32_t *idx, uint32_t n, uint32_t i)
 {
@@ -483,7 +466,7 @@ static lw_status walk_group(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
 {
   probe_ctx pc[LW_PAIR_CHUNK];
   uint32_t mask[BOX_MAX];
-  const double h = 1.0 / g->inv_h, skip2 = ctx->cutoff2 * GAP_MARGIN;
+  const double h = 1.0 / g->inv_h, skip2 = ctx->cutoff2 * LW_CELLGRID_GAP_MARGIN;
   const int with_near = ctx->near_scale > 0.0;
   if (nb > 1) prefetch_box(g, bx); /* a lone probe (the full sum's walks) sets up too fast to gain */
   memset(mask, 0, (size_t)(bx.w * bx.h) * sizeof *mask);
@@ -492,7 +475,7 @@ static lw_status walk_group(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
     /* a weightless probe has no far pairs (its kernel is 0, even at r = 0) */
     const double rc2 = p->dl != 0.0f ? ctx->cutoff2 : -1.0, l = ctx->near_scale * (double)p->dl;
     /* field by field: a compound literal is zeroed whole first (a string
-    ** store a probe, 1 % of a proposal); axis_gaps sets gx and gy */
+    ** store a probe, 1 % of a proposal); lw_cellgrid_axis_gaps sets gx and gy */
     probe_ctx *q = &pc[b];
     q->x = (v2d){p->x, p->x};
     q->y = (v2d){p->y, p->y};
@@ -501,8 +484,8 @@ static lw_status walk_group(const lw_cellgrid *g, const lw_pair_ctx *ctx, const 
     q->near2 = (v2d){l * l, l * l};
     q->scale = (v2d){p->scale * (double)p->dl, p->scale * (double)p->dl};
     q->s0 = q->s1 = (v2d){0.0, 0.0};
-    axis_gaps(g->x0, h, cx[b], p->x, pc[b].gx);
-    axis_gaps(g->y0, h, cy[b], p->y, pc[b].gy);
+    lw_cellgrid_axis_gaps(g->x0, h, cx[b], p->x, pc[b].gx);
+    lw_cellgrid_axis_gaps(g->y0, h, cy[b], p->y, pc[b].gy);
     for (int dy = -1; dy <= 1; dy++) {
       const int y = cy[b] + dy;
       if (y < 0 || y >= g->ny) continue;

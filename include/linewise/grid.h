@@ -190,6 +190,24 @@ static inline void lw_cellgrid_locate3(const lw_cellgrid *g, double x, double y,
   *cz = fz >= 1.0 ? (fz < (double)g->nz ? (int)fz : g->nz - 1) : 0;
 }
 
+/* Squared gaps along one axis between p, in cell c of the axis starting at
+** a with cells of side h, and the cells c - 1, c, c + 1: gap[0], 0, gap[2].
+** Only the sides facing p count, and those are true bounds even for edge
+** cells, which hold the points clamped from beyond the grid on their outer
+** sides.  (The walks of the splines and of the particles share it, and the
+** margin below, so that neither skips a cell the other would visit.) */
+static inline void lw_cellgrid_axis_gaps(double a, double h, int c, double p, double gap[3])
+{
+  double below = p - (a + c * h), above = a + (c + 1) * h - p;
+  gap[0] = below * below;
+  gap[1] = 0.0;
+  gap[2] = above * above;
+}
+
+/* Cells are skipped when their gap exceeds the cutoff by this factor: a
+** point sits in its cell up to the rounding of (x - x0) / h. */
+#define LW_CELLGRID_GAP_MARGIN (1.0 + 1e-9)
+
 /* Insert and move as in 2-D, for a 3-D grid. */
 lw_status lw_cellgrid_insert3(lw_cellgrid *g, uint32_t i, double x, double y, double z);
 lw_status lw_cellgrid_move3(lw_cellgrid *g, uint32_t i, double x, double y, double z);
