@@ -1066,6 +1066,10 @@ static lw_status truncate_trace(lw_anneal *a, long bytes, lw_error *err)
   dir_file(path, sizeof path, a, "trace.csv");
   if (bytes >= 0) {
     struct stat sb;
+    /* a link is refused before the trace is cut: truncate cut the file it named */
+    if (!lstat(path, &sb) && S_ISLNK(sb.st_mode))
+      return lw_error_set(err, LW_EINPUT, "%s: a symbolic link: a run writes into its own directory only (put the "
+                          "trace itself there)", path);
     if (stat(path, &sb))
       return lw_error_set(err, LW_EINPUT, "%s: %s, but state.lw counts %ld bytes of it", path, strerror(errno), bytes);
     if (!S_ISREG(sb.st_mode) || sb.st_size < bytes)
@@ -1114,6 +1118,10 @@ static lw_status truncate_trace(lw_anneal *a, long bytes, lw_error *err)
   }
   free(line);
   fclose(in);
+  if (len == -2) { /* (not the end of the trace, which the rows after would lose) */
+    lw_output_abort(out, tmp);
+    return lw_error_set(err, LW_ENOMEM, "%s: out of memory reading it", path);
+  }
   lw_status s = lw_output_commit(out, tmp, path, err);
   return s ? s : open_trace(a, 0, err);
 }
@@ -1258,7 +1266,8 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   }
   set_temperatures(a);
   dir_file(path, sizeof path, a, "timing.txt");
-  FILE *tf = fopen(path, "r");
+  lw_error fifo; /* (a FIFO there is no timing: opening it would wait for ever) */
+  FILE *tf = lw_text_not_fifo(path, &fifo) ? NULL : fopen(path, "r");
   if (tf) {
     if (fscanf(tf, "wall_seconds %lf", &a->wall_before) != 1 || !(a->wall_before >= 0 && a->wall_before < 1e12))
       a->wall_before = 0;

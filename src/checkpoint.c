@@ -198,7 +198,7 @@ lw_status lw_checkpoint_sync_trace(lw_anneal *a, long *bytes, lw_error *err)
   ** resume cuts the trace back to the checkpoint before) */
   if (ferror(a->trace))
     return lw_error_set(err, LW_EIO, "%s: write failed: a row since the last checkpoint was not written whole (a full "
-                        "disk?)", path);
+                        "disk, a file-size limit?)", path);
   if (fflush(a->trace) || fsync(fileno(a->trace)) || (*bytes = ftell(a->trace)) < 0)
     return lw_error_set(err, LW_EIO, "%s: write failed: %s", path, strerror(errno));
   return LW_OK;
@@ -312,7 +312,11 @@ lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err)
     lw_ckpt_abort(&w);
     return err->code;
   }
-  if ((s = lw_ckpt_commit(&w, err))) return s;
+  lw_phase_committing(a->sweep);
+  if ((s = lw_ckpt_commit(&w, err))) {
+    lw_phase_committing(-1);
+    return s;
+  }
   lw_phase_committed(a->sweep);
   for (int k = 1; k < a->n_rep && !s; k++) s = lw_checkpoint_write_replica(a, k, err);
   /* Wall time differs from run to run, so it lives beside the state, which

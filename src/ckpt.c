@@ -216,7 +216,7 @@ lw_status lw_ckpt_read(lw_ckpt **out, const char *path, lw_error *err)
   }
   lw_status s = LW_OK;
   char chunk[65536];
-  size_t got;
+  size_t got, line_from = 0; /* where the line being read began */
   while ((got = fread(chunk, 1, sizeof chunk, f)) > 0) {
     if (c->len + got + 1 > c->cap) {
       size_t cap = c->cap ? 2 * c->cap : 65536;
@@ -230,10 +230,22 @@ lw_status lw_ckpt_read(lw_ckpt **out, const char *path, lw_error *err)
       c->cap = cap;
     }
     memcpy(c->text + c->len, chunk, got);
+    for (size_t k = got; k > 0; k--)
+      if (chunk[k - 1] == '\n') {
+        line_from = c->len + k;
+        break;
+      }
     c->len += got;
     /* text: a NUL ends the reading at once (/dev/zero, a sparse file of
     ** gigabytes, were read whole first); the check below names its line */
     if (memchr(chunk, '\0', got)) break;
+    if (c->len - line_from > (size_t)LW_TEXT_LINE_MAX) { /* (a text file of gigabytes named as a state) */
+      size_t lines = 1;
+      for (size_t k = 0; k < line_from; k++) lines += c->text[k] == '\n';
+      s = lw_error_set(err, LW_EINPUT, "%s:%zu: a line longer than %ld MiB: not a state", path, lines,
+                       LW_TEXT_LINE_MAX >> 20);
+      break;
+    }
   }
   /* a directory opens but does not read: the user named the wrong thing */
   if (!s && ferror(f)) s = lw_error_set(err, LW_EINPUT, "%s: cannot read: %s", path, strerror(errno ? errno : EIO));

@@ -281,23 +281,37 @@ static void put_text(char *buf, size_t room, size_t *at, const char *text, size_
   for (size_t i = 0; i < n && *at < room; i++) buf[(*at)++] = text[i];
 }
 
+/* Appends the digits of v >= 0 (in a handler: no stdio). */
+static void put_number(char *buf, size_t room, size_t *at, long v)
+{
+  char digits[24];
+  size_t n = 0;
+  do digits[n++] = (char)('0' + v % 10); while ((v /= 10) > 0);
+  while (n) put_text(buf, room, at, &digits[--n], 1);
+}
+
 /* The second signal's line for a run with a checkpoint (in a handler:
 ** no stdio). */
 static void say_second(void)
 {
-  static const char of[] = "the checkpoint of sweep ", last[] = "the last checkpoint";
-  char line[sizeof second_msg + 64], digits[24];
-  size_t at = 0, n = 0;
+  static const char of[] = "the checkpoint of sweep ", last[] = "the last checkpoint",
+                    or[] = " (or of sweep ", came[] = ", whose write the signal came during)";
+  char line[sizeof second_msg + 160];
+  size_t at = 0;
   if (!second_len) return;
   const size_t skip = !on_terminal;
   put_text(line, sizeof line, &at, second_msg + skip, second_len - skip);
-  long sweep = lw_phase_last_commit();
+  long pending, sweep = lw_phase_last_commit(&pending);
   if (sweep >= 0) {
     put_text(line, sizeof line, &at, of, sizeof of - 1);
-    do digits[n++] = (char)('0' + sweep % 10); while ((sweep /= 10) > 0);
-    while (n) put_text(line, sizeof line, &at, &digits[--n], 1);
+    put_number(line, sizeof line, &at, sweep);
   } else {
     put_text(line, sizeof line, &at, last, sizeof last - 1);
+  }
+  if (pending >= 0) { /* the rename was under way: either is on disk */
+    put_text(line, sizeof line, &at, or, sizeof or - 1);
+    put_number(line, sizeof line, &at, pending);
+    put_text(line, sizeof line, &at, came, sizeof came - 1);
   }
   put_text(line, sizeof line, &at, "\n", 1);
   ssize_t w = write(2, line, at);

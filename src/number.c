@@ -117,7 +117,7 @@ ssize_t lw_text_getline(char **buf, size_t *cap, FILE *f)
       if (!b) {
         funlockfile(f);
         errno = ENOMEM;
-        return -1;
+        return -2;
       }
       *buf = b;
       *cap = grown;
@@ -143,7 +143,7 @@ long lw_text_next_line(FILE *f, char **buf, size_t *cap, long *line)
 {
   errno = 0;
   ssize_t len = lw_text_getline(buf, cap, f);
-  if (len < 0) return ferror(f) ? -2 : -1;
+  if (len < 0) return len == -2 || ferror(f) ? -2 : -1;
   ++*line;
   if (memchr(*buf, '\0', (size_t)len)) return -2;
   if (*line == 1) {

@@ -78,7 +78,7 @@ const lw_param_def lw_param_table[] = {
   LIST("scene", "polygon", polygon, "", "mm",
        "Polygon boundary vertices as `x y x y ...` (at least 3 vertices; either orientation; a simple "
        "polygon, its edges meeting only at their shared vertices: a star is given by its outline). A "
-       "long list goes on over indented lines (README, \"Scene files\"), up to 8191 bytes, some 600 "
+       "long list goes on over indented lines (docs/FORMATS.md, \"Scene files\"), up to 8191 bytes, some 600 "
        "vertices; a detailed outline (a coast, lettering) is a picture: `boundary = mask`."),
   STRING("scene", "image", image, "", "path",
          "A picture (PNG, JPEG, GIF, BMP, binary PGM/PPM; gray or colour, with or without alpha) relative to "
@@ -1002,9 +1002,18 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
                             "start or after a blank");
       return 0;
     }
+    /* a list longer than a line is written over lines at single blanks, so
+    ** its runs of blanks and tabs become one blank (a shorter one stays as
+    ** given: a run's scene.ini of an earlier release reads the same) */
+    char list[LW_PARAM_TEXT_MAX], *to = list;
+    if (d->list && len > line_cap(d)) {
+      for (const char *c = text; *c; c++)
+        if ((*c != ' ' && *c != '\t') || (to > list && to[-1] != ' ')) *to++ = *c == '\t' ? ' ' : *c;
+      *to = '\0';
+      text = list;
+    }
     if (d->list && !lw_params_write_list(NULL, d, text)) {
-      snprintf(expected, n, "a list that breaks over lines of %zu bytes at single blanks between its entries",
-               line_cap(d));
+      snprintf(expected, n, "entries of at most %zu bytes each", line_cap(d));
       return 0;
     }
     strcpy(base, text);
@@ -1117,11 +1126,15 @@ static int continue_list(reader_ctx *rc)
   const lw_param_def *d = rc->list;
   const char *h = rc->buf + strspn(rc->buf, " \t");
   rc->list = NULL;
-  if (!d || h == rc->buf || strchr("\n;#[", *h) || strpbrk(h, "=:")) return 0;
+  if (!d || h == rc->buf || strchr("\n;#[", *h)) return 0;
   size_t n = strcspn(h, "\n");
   for (const char *c = h; c < h + n; c++) /* an inline comment, as inih ends a value */
-    if (*c == ';' && (c[-1] == ' ' || c[-1] == '\t')) n = (size_t)(c - h);
+    if (*c == ';' && (c[-1] == ' ' || c[-1] == '\t')) {
+      n = (size_t)(c - h);
+      break;
+    }
   while (n && (h[n - 1] == ' ' || h[n - 1] == '\t')) n--;
+  if (memchr(h, '=', n) || memchr(h, ':', n)) return 0; /* (a key, whatever its comment holds) */
   char *value = (char *)rc->p + d->offset;
   size_t len = strlen(value);
   if (len + 1 + n > lw_params_text_cap(d)) {

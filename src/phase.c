@@ -45,11 +45,21 @@ void lw_phase_stop(void) { atomic_store(&stop_asked, 1); }
 
 int lw_phase_stopping(void) { return atomic_load(&stop_asked); }
 
-static volatile atomic_long committed = -1;
+static volatile atomic_long committed = -1, committing = -1;
 
-void lw_phase_committed(long sweep) { atomic_store(&committed, sweep); }
+void lw_phase_committing(long sweep) { atomic_store(&committing, sweep); }
 
-long lw_phase_last_commit(void) { return atomic_load(&committed); }
+void lw_phase_committed(long sweep)
+{
+  atomic_store(&committed, sweep);
+  atomic_store(&committing, -1);
+}
+
+long lw_phase_last_commit(long *pending)
+{
+  if (pending) *pending = atomic_load(&committing);
+  return atomic_load(&committed);
+}
 
 const char *lw_phase_get(double *seconds)
 {

@@ -55,6 +55,7 @@ typedef struct {
 static char *next_line(reader *r)
 {
   ssize_t len = lw_text_getline(&r->buf, &r->cap, r->f);
+  if (len == -2) lw_error_set(r->err, LW_ENOMEM, "%s:%ld: out of memory reading the line", r->path, r->line + 1);
   if (len < 0) return NULL;
   if (++r->line == 1) {
     lw_text_drop_bom(r->buf);

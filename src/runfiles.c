@@ -122,6 +122,13 @@ lw_status lw_runfiles_check_free(const char *dir, lw_error *err)
   /* (an empty stash, which recovery removes, holds no run) */
   const int stash = lw_runfiles_stashed(dir) && stash_marker(dir) != EMPTY;
   if (stash || lw_rundir_holds_run(dir)) return LW_OK;
+  /* a run's file that cannot be read (out of file handles) says nothing of
+  ** whose the directory is: "remove them" told a user to delete a run */
+  static const char *const own[] = {"scene.ini", "state.lw"};
+  for (int k = 0; k < 2; k++)
+    if (lw_rundir_foreign(dir, own[k]) < 0)
+      return lw_error_set(err, LW_EIO, "%s/%s: cannot read it to see whose the directory is: %s; nothing was written",
+                          dir, own[k], strerror(errno));
   found_files f = {0};
   each_file(dir, add_found, &f);
   if (!f.n) return LW_OK;

@@ -66,7 +66,9 @@ double lw_series_tau(const double *x, size_t n_ser, size_t n, size_t *window)
     for (size_t t = 0; t < n; t++) c0 += (s[t] - mean[j]) * (s[t] - mean[j]);
   }
   double tau = 0.5;
-  if (c0 > 0.0) {
+  /* (values so large that their squares overflow: no tau to take, and NAN
+  ** is kept for out of memory) */
+  if (c0 > 0.0 && isfinite(c0)) {
     for (size_t k = 1; k < n / 2; k++) {
       double ck = 0.0;
       if (k <= DIRECT_LAGS) {

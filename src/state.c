@@ -278,7 +278,6 @@ typedef struct {
 static char *next_line(reader *r)
 {
   ssize_t len;
-  errno = 0;
   while ((len = lw_text_getline(&r->buf, &r->cap, r->f)) >= 0) {
     r->line++;
     if (memchr(r->buf, '\0', (size_t)len)) {
@@ -294,7 +293,7 @@ static char *next_line(reader *r)
     while (*c == ' ' || *c == '\t') c++;
     if (*c && *c != '#') return c;
   }
-  r->oom = errno == ENOMEM;
+  r->oom = len == -2;
   return NULL;
 }
 

@@ -81,7 +81,7 @@ lw_trace *lw_trace_read(const char *path, lw_error *err)
   lw_trace *t = calloc(1, sizeof *t);
   char *line = NULL;
   size_t cap = 0, rows_cap = 0, line_no = 0;
-  ssize_t len;
+  ssize_t len = 0;
   lw_status s = t ? LW_OK : lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
   while (!s && (len = lw_text_getline(&line, &cap, f)) > 0) {
     line_no++;
@@ -114,6 +114,7 @@ lw_trace *lw_trace_read(const char *path, lw_error *err)
     s = read_row(t, line, line_no, t->v + t->n_rows * t->n_cols, path, err);
     if (!s) t->n_rows++;
   }
+  if (!s && len == -2) s = lw_error_set(err, LW_ENOMEM, "%s:%zu: out of memory reading the line", path, line_no + 1);
   if (!s && ferror(f)) s = lw_error_set(err, LW_EIO, "%s: read error", path);
   if (!s && line_no == 0) s = lw_error_set(err, LW_EINPUT, "%s: empty (expected a header line and rows)", path);
   free(line);

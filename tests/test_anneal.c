@@ -388,11 +388,14 @@ Test(run, a_checkpoint_is_marked_committed_as_state_lw_is)
   lw_anneal a;
   lw_error err;
   start_run("[tempering]\nreplicas = 2\n", "c", &a);
-  cr_assert_eq(lw_phase_last_commit(), 0);
+  long pending;
+  cr_assert_eq(lw_phase_last_commit(&pending), 0);
+  cr_assert_eq(pending, -1);
   for (int k = 0; k < 3; k++) cr_assert_eq(lw_anneal_sweep(&a, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(sh("mkdir %s/c/replica-1.lw.tmp", dir), 0);
   cr_assert_neq(lw_anneal_checkpoint(&a, &err), LW_OK, "the replica's file was written");
-  cr_assert_eq(lw_phase_last_commit(), a.sweep);
+  cr_assert_eq(lw_phase_last_commit(&pending), a.sweep);
+  cr_assert_eq(pending, -1, "the commit is marked as under way after it ended");
   cr_assert_eq(sh("grep -q '^sweep = %ld$' %s/c/state.lw", a.sweep, dir), 0);
   lw_anneal_free(&a);
 }

@@ -1224,6 +1224,17 @@ Test(cli, links_planted_in_a_run_directory_are_not_followed)
   cr_assert_eq(lw_test_sh("test -f %s/vd/frame-000000.png && test \"$(ls %s/vd)\" = frame-000000.png", dir, dir), 0,
                "the linked folder's frames were moved or written");
   cr_assert_eq(lw_test_sh("test -s %s/out/m/state.lw", dir), 0, "the run that was there is gone");
+  /* a resume whose trace.csv is a link: refused before the trace is cut
+  ** back (truncate cut the file the link named) */
+  cr_assert_eq(lw_test_sh("cd %s && rm out/m/frames && %s run %s/params/minimal.ini --out out/m --quiet --set "
+                          "anneal.sweeps=30 --set output.checkpoint_every=10 --stop-at 15 && "
+                          "cp out/m/trace.csv precious && echo 'a line past the checkpoint' >> precious && "
+                          "cp precious kept && rm out/m/trace.csv && "
+                          "ln -s %s/precious out/m/trace.csv", dir, lw_test_bin(), lw_test_root(), dir), 0);
+  snprintf(args, sizeof args, "resume %s/out/m --quiet", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "trace.csv: a symbolic link"), "%s", errs);
+  cr_assert_eq(lw_test_sh("cmp -s %s/precious %s/kept", dir, dir), 0, "the file the trace's link named was cut");
 }
 
 /* A file a key names that never ends: a FIFO waited for a writer for ever
@@ -1253,6 +1264,13 @@ Test(cli, a_fifo_or_an_endless_file_named_by_a_key_is_refused_at_once)
   }
   cr_assert_eq(lw_test_sh("timeout 60 %s run %s/fifo 2>&1 | grep -q 'fifo: a FIFO (named pipe), not a file'",
                           lw_test_bin(), dir), 0);
+  /* a FIFO in a run directory, where a run's own file stands: refused, not waited on */
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out r --quiet --stop-at 0 && rm r/scene.ini && "
+                          "mkfifo r/scene.ini && rm -f r/timing.txt && mkfifo r/timing.txt", dir, lw_test_bin(),
+                          lw_test_root()), 0);
+  cr_assert_eq(lw_test_sh("cd %s && timeout 60 %s run %s/params/minimal.ini --out r --quiet 2>err.txt; "
+                          "test $? -eq 2 && grep -q 'r/scene.ini is not a run' err.txt", dir, lw_test_bin(),
+                          lw_test_root()), 0);
 }
 
 Test(cli, stats_refuses_a_missing_run_and_a_bad_option_in_one_line)

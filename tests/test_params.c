@@ -359,7 +359,7 @@ Test(params, a_list_goes_on_over_indented_lines_and_reads_back)
   lw_error err;
   lw_error_clear(&err);
   cr_assert_eq(read_text("[scene]\nboundary = polygon\npolygon = 10 10 90 10   ; the base\n"
-                         "    90 60\n\t  50 80  ; the top\n  10 60\nwidth = 100\n  height = 100\n", &p, &err),
+                         "    90 60\n\t  50 80  ; the top: y=80\n  10 60\nwidth = 100\n  height = 100\n", &p, &err),
                LW_OK, "%s", err.msg);
   cr_assert_str_eq(p.polygon, "10 10 90 10 90 60 50 80 10 60");
   cr_assert_eq(p.height, 100.0, "an indented key = value is a key");
@@ -370,8 +370,8 @@ Test(params, a_list_goes_on_over_indented_lines_and_reads_back)
   expect_error("[scene]\npolygon = 10 10 90 10\n; a comment\n  90 60\n", ":4:", NULL, "syntax error");
   /* past the field, or a part too long to write back on a line */
   char text[9000] = "[nurbs]\nknots = 0";
-  for (int i = 0; i < 400; i++) strcat(text, "\n  0.25 0.25 0.5");
-  expect_error(text, ":", "nurbs.knots", "goes on past 2047 bytes");
+  for (int i = 0; i < 560; i++) strcat(text, "\n  0.25 0.25 0.5");
+  expect_error(text, ":", "nurbs.knots", "goes on past 4095 bytes");
   char word[200];
   memset(word, '1', 190);
   word[190] = '\0';
@@ -384,6 +384,15 @@ Test(params, a_list_goes_on_over_indented_lines_and_reads_back)
   for (int k = 0; k < 256; k++)
     snprintf(set + strlen(set), sizeof set - strlen(set), "%s%.17g", k ? " " : "", 0.01 * (1 + k / 3.0));
   cr_assert_eq(lw_params_set(&p, set, &err), LW_OK, "%s", err.msg);
+  /* on the command line, where a list has no lines, its tabs and runs of
+  ** blanks become one blank where it is written over lines */
+  lw_params q2;
+  lw_params_defaults(&q2);
+  char tabs[7000] = "tempering.ladder=", *v = tabs + strlen(tabs);
+  for (char *c = strchr(set, '=') + 1; *c; c++) *v++ = *c == ' ' ? '\t' : *c;
+  *v = '\0';
+  cr_assert_eq(lw_params_set(&q2, tabs, &err), LW_OK, "%s", err.msg);
+  cr_assert_str_eq(q2.ladder, p.ladder);
   char path[] = "/tmp/lw_params_list_XXXXXX";
   FILE *f = fdopen(mkstemp(path), "w");
   cr_assert_eq(lw_params_write(&p, f), 0);

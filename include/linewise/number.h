@@ -55,7 +55,9 @@ long lw_text_next_line(FILE *f, char **buf, size_t *cap, long *line);
 ** LW_TEXT_LINE_MAX bytes of a longer line (what follows comes as the next
 ** line, which a reader finds malformed): /dev/zero or a sparse file of
 ** gigabytes, named as a state, a table or points, grew one line until the
-** machine's memory was gone. */
+** machine's memory was gone.  -1 at the end (or a read error: ferror), -2
+** out of memory (errno ENOMEM), which a reader must not take for the end
+** (stats took the rows before as the whole trace). */
 #define LW_TEXT_LINE_MAX (64L << 20)
 ssize_t lw_text_getline(char **buf, size_t *cap, FILE *f);
 

@@ -250,8 +250,8 @@ typedef struct {
   /* [nurbs] (system = nurbs; sys_nurbs.h) */
   int nb_order;               /* k */
   char nb_points[4096];       /* "x y x y ..." */
-  char nb_weights[2048];      /* "w w ...", empty = all 1 */
-  char nb_knots[2048];        /* n + k knots, empty = open uniform */
+  char nb_weights[4096];      /* "w w ...", empty = all 1 */
+  char nb_knots[4096];        /* n + k knots, empty = open uniform */
   char nb_file[LW_PATH_MAX];  /* "x y [w]" a line instead of points/weights, or empty */
   int nb_elevate;             /* degree elevation before the run */
   int nb_refine;              /* each knot span cut into this many */

@@ -50,9 +50,12 @@ int lw_phase_stopping(void);
 /* The sweep of the last state.lw this process committed (-1: none yet),
 ** set as its rename ends, so that a second signal, which ends the process
 ** at once, names the checkpoint a resume takes up (it named the one before
-** while the replicas' files of the new one were written).  Lock-free. */
+** while the replicas' files of the new one were written).  Around the
+** rename itself (lw_phase_committing) either may be on disk: *pending (not
+** NULL) is then that sweep, else -1.  Lock-free. */
+void lw_phase_committing(long sweep);
 void lw_phase_committed(long sweep);
-long lw_phase_last_commit(void);
+long lw_phase_last_commit(long *pending);
 
 /* What a watcher prints, decided from what it reads at each tick, so that
 ** the rule can be tested with a made-up clock.  A phase is named once it has
