@@ -413,7 +413,9 @@ static void on_signal(int sig)
                                "written; linewise's next run or resume there goes on from it, or, where it was not "
                                "written, puts the run that was in the directory back\n";
     const int stash = lw_phase_stashed();
-    if (checkpointed) {
+    /* (a first checkpoint committed within the set-up counts: "nothing to
+    ** resume" was said beside a state.lw that resumed) */
+    if (checkpointed || lw_phase_last_commit(NULL) >= 0) {
       say_second();
     } else {
       ssize_t w = stash == 1 ? write(2, kept + !on_terminal, sizeof kept - 1 - !on_terminal)

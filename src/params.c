@@ -992,32 +992,38 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     ** a list on indented lines, so that scene.ini, written back by a run,
     ** reads again. */
     size_t len = strlen(text), cap = lw_params_text_cap(d);
-    if (len > cap) {
+    /* a list longer than a line is written over lines at single blanks, so
+    ** its runs of blanks and tabs become one blank, before its length is
+    ** judged (a shorter one stays as given: a run's scene.ini of an earlier
+    ** release reads the same) */
+    char *merged = NULL;
+    if (d->list && len > line_cap(d)) {
+      if (!(merged = malloc(len + 1))) {
+        snprintf(expected, n, "a list that fits in memory");
+        return 0;
+      }
+      char *to = merged;
+      for (const char *c = text; *c; c++)
+        if ((*c != ' ' && *c != '\t') || (to > merged && to[-1] != ' ')) *to++ = *c == '\t' ? ' ' : *c;
+      *to = '\0';
+      text = merged;
+      len = (size_t)(to - merged);
+    }
+    int ok = 0;
+    if (len > cap)
       snprintf(expected, n, "at most %zu bytes (%s%s)", cap, d->list ? "the list's field" : "a scene line's",
                !strcmp(d->key, "polygon") ? "; a detailed outline is a picture: boundary = mask" : "");
-      return 0;
-    }
-    if (!lw_params_text_reads_back(text)) {
+    else if (!lw_params_text_reads_back(text))
       snprintf(expected, n, "text without control characters, blanks at either end, or ';' at the "
                             "start or after a blank");
-      return 0;
-    }
-    /* a list longer than a line is written over lines at single blanks, so
-    ** its runs of blanks and tabs become one blank (a shorter one stays as
-    ** given: a run's scene.ini of an earlier release reads the same) */
-    char list[LW_PARAM_TEXT_MAX], *to = list;
-    if (d->list && len > line_cap(d)) {
-      for (const char *c = text; *c; c++)
-        if ((*c != ' ' && *c != '\t') || (to > list && to[-1] != ' ')) *to++ = *c == '\t' ? ' ' : *c;
-      *to = '\0';
-      text = list;
-    }
-    if (d->list && !lw_params_write_list(NULL, d, text)) {
+    else if (d->list && !lw_params_write_list(NULL, d, text))
       snprintf(expected, n, "entries of at most %zu bytes each", line_cap(d));
-      return 0;
+    else {
+      strcpy(base, text);
+      ok = 1;
     }
-    strcpy(base, text);
-    return 1;
+    free(merged);
+    return ok;
   }
   }
   return 0;

@@ -49,13 +49,14 @@ typedef struct {
   char *buf;
   size_t cap;
   lw_error *err;
+  int oom; /* a line could not be held: not the end of the file, which the messages would say */
 } reader;
 
 /* The next line into r->buf without its line end, or NULL at the end. */
 static char *next_line(reader *r)
 {
   ssize_t len = lw_text_getline(&r->buf, &r->cap, r->f);
-  if (len == -2) lw_error_set(r->err, LW_ENOMEM, "%s:%ld: out of memory reading the line", r->path, r->line + 1);
+  r->oom = len == -2;
   if (len < 0) return NULL;
   if (++r->line == 1) {
     lw_text_drop_bom(r->buf);
@@ -81,8 +82,16 @@ int lw_ply_detect(FILE *f)
   return got >= b + 4 && (!memcmp(head + b, "ply\n", 4) || (got >= b + 5 && !memcmp(head + b, "ply\r\n", 5)));
 }
 
+/* Out of memory where a line could not be held, else LW_OK. */
+static lw_status oom(const reader *r)
+{
+  return r->oom ? lw_error_set(r->err, LW_ENOMEM, "%s:%ld: out of memory reading the line", r->path, r->line + 1)
+                : LW_OK;
+}
+
 static lw_status bad_line(reader *r, const char *expected, const char *got)
 {
+  if (r->oom) return oom(r);
   return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected %s, got '%.60s'", r->path, r->line, expected, got);
 }
 
@@ -160,6 +169,7 @@ static lw_status read_header(reader *r, const char *const *names, int n_names, e
     }
     return bad_line(r, "a header line (comment, element, property or end_header)", w);
   }
+  if (r->oom) return oom(r);
   return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected 'end_header', found the end of the file", r->path, r->line);
 }
 
@@ -225,7 +235,8 @@ static lw_status ascii_instance(reader *r, const elem *e, size_t index, double *
 {
   char *s;
   do {
-    if (!(s = next_line(r)))
+    if (!(s = next_line(r)) && r->oom) return oom(r);
+    if (!s)
       return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected %zu %s lines, the file ends after %zu", r->path, r->line,
                           e->count, e->name, index);
   } while (strspn(s, " \t") == strlen(s));
@@ -277,7 +288,7 @@ lw_status lw_ply_read_vertices(FILE *f, const char *path, const char *const *nam
   *n = 0;
   *values = NULL;
   *found = 0;
-  reader r = {f, path, ASCII, 0, NULL, 0, err};
+  reader r = {f, path, ASCII, 0, NULL, 0, err, 0};
   elem el[ELEMS_MAX];
   int n_el = 0;
   lw_status s = read_header(&r, names, n_names, el, &n_el);

@@ -96,6 +96,11 @@ lw_trace *lw_trace_read(const char *path, lw_error *err)
       s = read_header(t, line, path, err);
       continue;
     }
+    if (!whole && !feof(f)) { /* (cut by the reader, not the end: the rows after were dropped unsaid) */
+      s = lw_error_set(err, LW_EINPUT, "%s:%zu: a line longer than %ld MiB (expected a row of numbers)", path,
+                       line_no, LW_TEXT_LINE_MAX >> 20);
+      break;
+    }
     if (!whole) break; /* a row still being written */
     if (t->n_rows == rows_cap) {
       size_t nc = rows_cap ? 2 * rows_cap : 256;

@@ -111,6 +111,10 @@ Test(nurbs_cli, monte_carlo_heat_capacity_is_half_the_free_coordinates)
   /* between the rungs, by reweighting all three: C = 5 still, and <E>
   ** grows by 5 a unit of temperature from the coldest rung's */
   cr_assert_eq(sh("%s stats %s/pt --reweight 5 --csv > %s/rw.csv", lw_test_bin(), dir, dir), 0);
+  /* the bootstrap's resamples are solved on the threads: the same bytes on one and on three */
+  cr_assert_eq(sh("OMP_NUM_THREADS=1 %s stats %s/pt --reweight 5 --csv > %s/rw1.csv && OMP_NUM_THREADS=3 %s stats "
+                  "%s/pt --reweight 5 --csv > %s/rw3.csv && cmp -s %s/rw.csv %s/rw1.csv && cmp -s %s/rw.csv %s/rw3.csv",
+                  lw_test_bin(), dir, dir, lw_test_bin(), dir, dir, dir, dir, dir, dir), 0);
   csv = lw_test_slurp("%s/rw.csv", dir);
   const char *line = strchr(csv, '\n') + 1;
   double t0 = 0, e0 = 0, se0 = 0;

@@ -22,6 +22,7 @@
 #include "linewise/particles.h"
 #include "linewise/particles_geom.h"
 #include "linewise/reweight.h"
+#include "linewise/number.h"
 #include "linewise/series.h"
 #include "linewise/sys_nurbs.h"
 #include "linewise/sys_particles.h"
@@ -243,6 +244,25 @@ Test(trace, a_bad_field_is_named_by_file_line_and_column, .init = make_dir, .fin
   write_trace("c.csv", "sweep,,total\n", path, sizeof path);
   cr_assert_null(lw_trace_read(path, &err));
   cr_assert(strstr(err.msg, "c.csv:1: column 2 has no name"), "%s", err.msg);
+}
+
+/* A line past the readers' 64 MiB is refused where it stands: cut there and
+** taken for a row still being written, it ended the trace, and stats
+** reported on the rows before it alone, exit 0. */
+Test(trace, a_line_past_the_readers_limit_is_refused_not_taken_for_the_end, .init = make_dir, .fini = remove_dir)
+{
+  const size_t big = (size_t)LW_TEXT_LINE_MAX + 10;
+  char *text = malloc(big + 64);
+  cr_assert_not_null(text);
+  int k = snprintf(text, 64, "sweep,total\n1,2\n");
+  memset(text + k, '1', big);
+  strcpy(text + k + big, "\n3,4\n");
+  char path[128];
+  write_trace("long.csv", text, path, sizeof path);
+  free(text);
+  lw_error err;
+  cr_assert_null(lw_trace_read(path, &err));
+  cr_assert(strstr(err.msg, "long.csv:3: a line longer than 64 MiB"), "%s", err.msg);
 }
 
 /* The statistics of a trace (CSV lines or the table, as sel says), into buf. */
