@@ -908,6 +908,15 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   }
   a->end_sweep = a->params.sweeps; /* resolved: the caller's p may not be (a preset's sweeps) */
   a->scene_hash = lw_params_run_hash(&a->params, &a->scene_keys);
+  /* a file the run read but could not fingerprint (out of file handles, a
+  ** read error) would be hashed as unread, and every resume refuse the run
+  ** as edited */
+  for (size_t k = 0; k < a->scene_keys.n; k++)
+    if (a->scene_keys.unread[k]) {
+      const lw_param_def *d = &lw_param_table[a->scene_keys.index[k]];
+      return lw_error_set(err, LW_EIO, "%s.%s: cannot read the file it names again to fingerprint it: %s",
+                          d->section, d->key, strerror(a->scene_keys.unread[k]));
+    }
   /* Everything above only read input: the directory appears once the run
   ** is known to be valid. */
   lw_phase_writing();

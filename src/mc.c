@@ -286,10 +286,10 @@ char *lw_rng_save(const gsl_rng *r)
 ** others unmasked. */
 int lw_rng_load(gsl_rng *r, const char *hex)
 {
+  /* (on the stack: a failed malloc read as a damaged state; mt19937 holds 5000 bytes) */
+  unsigned char copy[8192], *b = gsl_rng_state(r);
   size_t n = gsl_rng_size(r);
-  if (strspn(hex, "0123456789abcdef") != 2 * n || hex[2 * n]) return 0;
-  unsigned char *b = gsl_rng_state(r), *copy = malloc(n);
-  if (!copy) return 0;
+  if (n > sizeof copy || strspn(hex, "0123456789abcdef") != 2 * n || hex[2 * n]) return 0;
   for (size_t i = 0; i < n; i++) {
     unsigned hi = (unsigned)(hex[2 * i] <= '9' ? hex[2 * i] - '0' : hex[2 * i] - 'a' + 10);
     unsigned lo = (unsigned)(hex[2 * i + 1] <= '9' ? hex[2 * i + 1] - '0' : hex[2 * i + 1] - 'a' + 10);
@@ -309,6 +309,5 @@ int lw_rng_load(gsl_rng *r, const char *hex)
     }
   }
   if (ok) memcpy(b, copy, n);
-  free(copy);
   return ok;
 }

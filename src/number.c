@@ -126,7 +126,9 @@ ssize_t lw_text_getline(char **buf, size_t *cap, FILE *f)
     if (c == '\n' || c == '\0') break;
   }
   funlockfile(f);
-  if (!len) return -1;
+  /* (a read error wins over the part of a line before it, which a reader
+  ** would parse as a whole one and blame the file for) */
+  if (!len || ferror(f)) return -1;
   (*buf)[len] = '\0';
   return (ssize_t)len;
 }

@@ -82,16 +82,19 @@ int lw_ply_detect(FILE *f)
   return got >= b + 4 && (!memcmp(head + b, "ply\n", 4) || (got >= b + 5 && !memcmp(head + b, "ply\r\n", 5)));
 }
 
-/* Out of memory where a line could not be held, else LW_OK. */
-static lw_status oom(const reader *r)
+/* Why the next line did not come where it was not the file's end: out of
+** memory, or a read error (the messages of a malformed or short file would
+** blame it); else LW_OK. */
+static lw_status not_read(const reader *r)
 {
-  return r->oom ? lw_error_set(r->err, LW_ENOMEM, "%s:%ld: out of memory reading the line", r->path, r->line + 1)
-                : LW_OK;
+  if (r->oom) return lw_error_set(r->err, LW_ENOMEM, "%s:%ld: out of memory reading the line", r->path, r->line + 1);
+  if (ferror(r->f)) return lw_error_set(r->err, LW_EIO, "%s:%ld: read error", r->path, r->line + 1);
+  return LW_OK;
 }
 
 static lw_status bad_line(reader *r, const char *expected, const char *got)
 {
-  if (r->oom) return oom(r);
+  if (r->oom || ferror(r->f)) return not_read(r);
   return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected %s, got '%.60s'", r->path, r->line, expected, got);
 }
 
@@ -169,7 +172,7 @@ static lw_status read_header(reader *r, const char *const *names, int n_names, e
     }
     return bad_line(r, "a header line (comment, element, property or end_header)", w);
   }
-  if (r->oom) return oom(r);
+  if (r->oom || ferror(r->f)) return not_read(r);
   return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected 'end_header', found the end of the file", r->path, r->line);
 }
 
@@ -235,7 +238,7 @@ static lw_status ascii_instance(reader *r, const elem *e, size_t index, double *
 {
   char *s;
   do {
-    if (!(s = next_line(r)) && r->oom) return oom(r);
+    if (!(s = next_line(r)) && (r->oom || ferror(r->f))) return not_read(r);
     if (!s)
       return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected %zu %s lines, the file ends after %zu", r->path, r->line,
                           e->count, e->name, index);

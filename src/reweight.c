@@ -5,6 +5,7 @@
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_rng.h>
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -113,9 +114,13 @@ static int newton_step(const double *log_n, const double *s, const double *ww, i
       gsl_matrix_set(h, b, a, v);
     }
   }
-  gsl_error_handler_t *old = gsl_set_error_handler_off();
+  /* GSL's handler is the process's: on the threads of the bootstrap it is
+  ** off for the whole region (one thread restoring it while another's
+  ** Cholesky failed would have ended the process) */
+  const int threads = omp_in_parallel();
+  gsl_error_handler_t *old = threads ? NULL : gsl_set_error_handler_off();
   ok = ok && !gsl_linalg_cholesky_decomp1(h) && !gsl_linalg_cholesky_solve(h, g, x);
-  gsl_set_error_handler(old);
+  if (!threads) gsl_set_error_handler(old);
   step[0] = 0.0;
   for (size_t a = 0; ok && a < m; a++) step[a + 1] = gsl_vector_get(x, a);
   gsl_matrix_free(h);
@@ -440,6 +445,7 @@ static lw_status bootstrap(const rw_states *s, int traces, gsl_rng *rng, const d
     if (!(at[b] = gsl_rng_clone(rng))) st = lw_error_set(err, LW_ENOMEM, "out of memory resampling");
     else st = resample(s, traces, rng, scratch, err); /* (to the next resample's draws) */
   free(scratch);
+  gsl_error_handler_t *handler = gsl_set_error_handler_off(); /* (newton_step's, for the region) */
 #pragma omp parallel if (!st)
   {
     double *eb = malloc(n * sizeof *eb), *fb = malloc((size_t)K * sizeof *fb), *log_den = malloc(n * sizeof *log_den);
@@ -463,6 +469,7 @@ static lw_status bootstrap(const rw_states *s, int traces, gsl_rng *rng, const d
     free(fb);
     free(log_den);
   }
+  gsl_set_error_handler(handler);
   for (int b = 0; b < B && !st; b++) {
     if ((st = sts[b])) {
       if (err) *err = errs[b];

@@ -1038,12 +1038,14 @@ static lw_status write_png(const lw_nurbs_state *s, const double b[4], const cha
   cairo_set_source_rgb(cr, 0, 0, 0);
   cairo_set_line_width(cr, 2.0 / scale);
   bz_sink k = {NULL, cr, 0};
-  lw_nurbs_beziers(s->c, s->su->tolerance, cairo_bezier, &k);
+  /* (NAN: out of memory, the curve not drawn, which final.png without it would hide) */
+  const int drawn = !isnan(lw_nurbs_beziers(s->c, s->su->tolerance, cairo_bezier, &k));
   cairo_stroke(cr);
   cairo_surface_flush(surf);
-  lw_status st = cairo_status(cr) ? lw_error_set(err, LW_ERUN, "%s: drawing failed: %s", path,
-                                                 cairo_status_to_string(cairo_status(cr)))
-                                  : lw_output_png_surface(surf, path, err);
+  lw_status st = !drawn           ? lw_error_set(err, LW_ENOMEM, "%s: out of memory drawing the curve", path)
+                 : cairo_status(cr) ? lw_error_set(err, LW_ERUN, "%s: drawing failed: %s", path,
+                                                   cairo_status_to_string(cairo_status(cr)))
+                                    : lw_output_png_surface(surf, path, err);
   cairo_destroy(cr);
   cairo_surface_destroy(surf);
   return st;
