@@ -173,7 +173,11 @@ lw_status lw_reweight_solve(const double *E, const size_t *first, const double *
   ** overlap little, but never lost) */
   int it = 0;
   double worst = pass(E, n, eref, log_n, f, beta, K, log_d, s_sum, ww, w, near);
-  for (double change = INFINITY; change > LW_REWEIGHT_TOL && worst > LW_REWEIGHT_TOL; it++) {
+  /* settled where the free energies stand still, or where the equations
+  ** hold and they barely move: equations met while the f move by whole
+  ** units are rungs that barely constrain each other (a table of such f
+  ** read C = 768734 +- 5.1e5), not a solution */
+  for (double change = INFINITY; change > LW_REWEIGHT_TOL && (worst > LW_REWEIGHT_TOL || change > 1e-6); it++) {
     /* a resample's free energies need not be known to 1e-10 (their spread is
     ** what is sought): one that creeps at that level (blocks of few rows
     ** where the rungs barely overlap) is taken as it stands */
