@@ -49,7 +49,7 @@ static double log_partition(const double *E, size_t n, double eref, const double
 ** + l] = sum_i W_ik W_il (w: K of scratch).  The equations hold where
 ** every s_k = 1; returns the largest |s_k - 1|. */
 static double pass(const double *E, size_t n, double eref, const double *log_n, const double *f, const double *beta,
-                   int K, double *log_d, double *s, double *ww, double *w, int *near)
+                   int K, double *log_d, double *s, double *ww, double *w)
 {
   memset(s, 0, (size_t)K * sizeof *s);
   memset(ww, 0, (size_t)K * (size_t)K * sizeof *ww);
@@ -139,9 +139,9 @@ lw_status lw_reweight_solve(const double *E, const size_t *first, const double *
          *mean = malloc(k1 * sizeof *mean), *next = malloc(k1 * sizeof *next), *s_sum = malloc(k1 * sizeof *s_sum),
          *ww = malloc(k1 * k1 * sizeof *ww), *w = malloc(k1 * sizeof *w), *step = malloc(k1 * sizeof *step),
          *trial = malloc(k1 * sizeof *trial);
-  int *order = malloc(k1 * sizeof *order), *near = malloc(k1 * sizeof *near);
+  int *order = malloc(k1 * sizeof *order);
   lw_status st = LW_OK;
-  if (!log_d || !log_n || !mean || !next || !s_sum || !ww || !w || !step || !trial || !order || !near) {
+  if (!log_d || !log_n || !mean || !next || !s_sum || !ww || !w || !step || !trial || !order) {
     st = lw_error_set(err, LW_ENOMEM, "out of memory reweighting %zu samples", n);
     goto done;
   }
@@ -172,7 +172,7 @@ lw_status lw_reweight_solve(const double *E, const size_t *first, const double *
   ** self-consistent step (the equations' own iteration: slow where states
   ** overlap little, but never lost) */
   int it = 0;
-  double worst = pass(E, n, eref, log_n, f, beta, K, log_d, s_sum, ww, w, near);
+  double worst = pass(E, n, eref, log_n, f, beta, K, log_d, s_sum, ww, w);
   /* settled where the free energies stand still, or where the equations
   ** hold and they barely move: equations met while the f move by whole
   ** units are rungs that barely constrain each other (a table of such f
@@ -193,13 +193,13 @@ lw_status lw_reweight_solve(const double *E, const size_t *first, const double *
     double t = 1.0, tried = INFINITY;
     for (; newton && t > 1e-3; t *= 0.5) {
       for (int k = 0; k < K; k++) trial[k] = f[k] + t * step[k];
-      if ((tried = pass(E, n, eref, log_n, trial, beta, K, log_d, s_sum, ww, w, near)) < worst) break;
+      if ((tried = pass(E, n, eref, log_n, trial, beta, K, log_d, s_sum, ww, w)) < worst) break;
     }
     if (!(tried < worst)) memcpy(trial, next, (size_t)K * sizeof *trial);
     change = 0.0;
     for (int k = 0; k < K; k++) change = fmax(change, fabs(trial[k] - f[k]));
     memcpy(f, trial, (size_t)K * sizeof *f);
-    worst = tried < worst ? tried : pass(E, n, eref, log_n, f, beta, K, log_d, s_sum, ww, w, near);
+    worst = tried < worst ? tried : pass(E, n, eref, log_n, f, beta, K, log_d, s_sum, ww, w);
     if (!isfinite(change) || isnan(worst)) {
       st = lw_error_set(err, LW_EINPUT, "reweighting failed: the free energies are not finite (energies or "
                         "temperatures beyond what the sums can hold)");
@@ -222,7 +222,6 @@ done:
   free(step);
   free(trial);
   free(order);
-  free(near);
   return st;
 }
 
