@@ -284,6 +284,15 @@ static int gives_way(lw_anneal *a, lw_error *err)
   return 1;
 }
 
+lw_status lw_checkpoint_commit(lw_ckpt_writer *w, const lw_anneal *a, lw_error *err)
+{
+  lw_phase_committing(a->sweep);
+  lw_status s = lw_ckpt_commit(w, err);
+  if (s) lw_phase_committing(-1);
+  else lw_phase_committed(a->sweep);
+  return s;
+}
+
 lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err)
 {
   char path[LW_PATH_MAX + 32];
@@ -312,12 +321,7 @@ lw_status lw_checkpoint_write(lw_anneal *a, lw_error *err)
     lw_ckpt_abort(&w);
     return err->code;
   }
-  lw_phase_committing(a->sweep);
-  if ((s = lw_ckpt_commit(&w, err))) {
-    lw_phase_committing(-1);
-    return s;
-  }
-  lw_phase_committed(a->sweep);
+  if ((s = lw_checkpoint_commit(&w, a, err))) return s;
   for (int k = 1; k < a->n_rep && !s; k++) s = lw_checkpoint_write_replica(a, k, err);
   /* Wall time differs from run to run, so it lives beside the state, which
   ** must be byte-identical for the same sweeps. */

@@ -874,19 +874,12 @@ static int cmd_run(int argc, char **argv)
   ** (a run made again in place), never over a scene file a person wrote,
   ** the one this run reads included */
   static const char *const mine[] = {"scene.ini", "state.lw"}, *const what[] = {"a scene file?", "not a state"};
-  for (int k = 0; k < 2; k++) {
-    const int foreign = lw_rundir_foreign(dir, mine[k]);
-    if (foreign < 0) {
-      lw_error_set(&err, LW_EIO, "--out %s: cannot read %s/%s to see whose it is: %s; nothing was written", dir,
-                   dir, mine[k], strerror(errno));
-      return fail(&err);
-    }
-    if (foreign) {
+  for (int k = 0; k < 2; k++) /* (one that cannot be read: lw_runfiles_check_free says so) */
+    if (lw_rundir_foreign(dir, mine[k]) > 0) {
       lw_error_set(&err, LW_EUSAGE, "--out %s: %s/%s is not a run's (%s) and the run would write over it: "
                    "expected a run directory or a new one", dir, dir, mine[k], what[k]);
       return fail(&err);
     }
-  }
   /* (one process of an MPI run could see process 0's first files there and
   ** leave the others waiting: there process 0 checks under its lock) */
   if (!net && (lw_runfiles_check_free(dir, &err) || lw_runfiles_check_stash(dir, &err))) return fail(&err);

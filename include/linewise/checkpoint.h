@@ -44,6 +44,9 @@ void lw_checkpoint_put_run(lw_ckpt_writer *w, const lw_anneal *a, long trace_byt
 void lw_checkpoint_put_chain(lw_ckpt_writer *w, const lw_anneal *a, int k, int *bad);
 void lw_checkpoint_put_ensemble(lw_ckpt_writer *w, const lw_anneal *a, int *bad);
 lw_status lw_checkpoint_put_system(lw_ckpt_writer *w, const lw_anneal *a, int k, lw_error *err);
+/* Commits state.lw (lw_ckpt_commit), marked for a second signal's message
+** as under way and then done (phase.h). */
+lw_status lw_checkpoint_commit(lw_ckpt_writer *w, const lw_anneal *a, lw_error *err);
 lw_status lw_checkpoint_write_replica(const lw_anneal *a, int k, lw_error *err);
 /* timing.txt: the wall time so far (not part of the state: it differs run to run). */
 lw_status lw_checkpoint_write_timing(const lw_anneal *a, lw_error *err);

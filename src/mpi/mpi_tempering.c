@@ -10,7 +10,6 @@
 
 #include "linewise/anneal.h"
 #include "linewise/checkpoint.h"
-#include "linewise/phase.h"
 #include "linewise/state.h"
 
 typedef struct {
@@ -421,11 +420,8 @@ static lw_status assemble(lw_anneal *a, const char *all, size_t total, long trac
     if (bad) {
       lw_ckpt_abort(&w);
       s = lw_error_set(err, LW_ENOMEM, "out of memory writing a checkpoint");
-    } else { /* (marked for a second signal's message, as lw_checkpoint_write does) */
-      lw_phase_committing(a->sweep);
-      s = lw_ckpt_commit(&w, err);
-      if (s) lw_phase_committing(-1);
-      else lw_phase_committed(a->sweep);
+    } else {
+      s = lw_checkpoint_commit(&w, a, err);
     }
   }
   free(chain);
