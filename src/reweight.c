@@ -5,7 +5,9 @@
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_rng.h>
 #include <math.h>
+#ifdef _OPENMP
 #include <omp.h>
+#endif
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -117,7 +119,11 @@ static int newton_step(const double *log_n, const double *s, const double *ww, i
   /* GSL's handler is the process's: on the threads of the bootstrap it is
   ** off for the whole region (one thread restoring it while another's
   ** Cholesky failed would have ended the process) */
+#ifdef _OPENMP
   const int threads = omp_in_parallel();
+#else
+  const int threads = 0;
+#endif
   gsl_error_handler_t *old = threads ? NULL : gsl_set_error_handler_off();
   ok = ok && !gsl_linalg_cholesky_decomp1(h) && !gsl_linalg_cholesky_solve(h, g, x);
   if (!threads) gsl_set_error_handler(old);
