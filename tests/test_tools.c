@@ -812,6 +812,23 @@ Test(tools, plot_run_draws_the_heat_capacity_between_the_rungs)
   free(out);
   check_png("wl/plots/heat_capacity.png");
   cr_assert_eq(sh("test ! -e %s/wl/plots/.reweight.csv.tmp", dir), 0, "no temporary file left");
+  /* rungs 100 apart share no energies: the curve has gaps between them,
+  ** drawn as gaps (not lines joining the rungs), and a note says so */
+  size_t cap = 1 << 19, n = 0; /* past the scene's stats_from */
+  char *trace = malloc(cap);
+  n += (size_t)snprintf(trace, cap, "sweep,temperature,total,replica0_temperature,replica0_energy,"
+                                    "replica1_temperature,replica1_energy\n");
+  for (int t = 1; t <= 6000; t++)
+    n += (size_t)snprintf(trace + n, cap - n, "%d,1,%.6f,1,%.6f,2,%.6f\n", t, 100 + sin(1.7 * t), 100 + sin(1.7 * t),
+                          200 + cos(2.3 * t));
+  cr_assert_eq(sh("mkdir %s/wg && cp %s/wl/scene.ini %s/wg/", dir, dir, dir), 0);
+  write_text("wg/trace.csv", trace);
+  free(trace);
+  cr_assert_eq(sh("%s %s/wg", tool("plot-run"), dir), 0, "%s", err_txt());
+  char *e = err_txt();
+  cr_assert(strstr(e, "plot-run: the heat capacity plot has gaps where rungs share almost no energies"), "%s", e);
+  free(e);
+  check_png("wg/plots/heat_capacity.png");
 }
 
 /* What the plots read goes into gnuplot's commands, and another user may

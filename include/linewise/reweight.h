@@ -36,6 +36,8 @@
 #define LW_REWEIGHT_BLOCK 4         /* samples of the most thinned rung a bootstrap block holds */
 #define LW_REWEIGHT_BLOCKS 16       /* bootstrap blocks a run's rows hold at least */
 #define LW_REWEIGHT_TEMPS_MAX 10000 /* temperatures a table, at most */
+#define LW_REWEIGHT_OVERLAP_MIN 0.03 /* lw_reweight_overlap of neighbouring temperatures below which nothing
+                                       between them is estimated */
 #define LW_REWEIGHT_SWAP_MIN 0.05   /* neighbour exchange acceptance below which a warning says the
                                        rungs barely overlap */
 
@@ -57,14 +59,24 @@ lw_status lw_reweight_solve(const double *E, const size_t *first, const double *
 void lw_reweight_at(const double *E, size_t n, const double *log_den, double b, double *mean_energy,
                     double *heat_capacity);
 
+/* How much the ensembles at inverse temperatures b1 and b2 overlap, from
+** the n samples and their ln D_i: the integral of p1 p2 / (p1 + p2) over
+** the energies, p the two laws, as sum_i w1_i w2_i / (w1_i + w2_i) of the
+** normalised weights: 1/2 for one law, 0 for laws that share no energies,
+** whatever either's sample count (0.22 for two normal laws 2 sd apart,
+** 0.034 for 4). */
+double lw_reweight_overlap(const double *E, size_t n, const double *log_den, double b1, double b2);
+
 /* `linewise stats --reweight N`: the mean energy and heat capacity, with
 ** bootstrap error bars, at n_temps temperatures spaced geometrically from
 ** the coldest rung's to the hottest's, from every rung of the k runs at
 ** once (each run's stretch of rows by sel[r]; the format by sel[0].csv).
 ** Every (run, rung) is a state of its own, so runs whose ladders differ
-** pool too.  A table with its warnings (a rung whose autocorrelation
-** window did not close; neighbours that exchanged in under 5 % of their
-** tries) or CSV lines.  LW_EINPUT naming the file for a trace without
+** pool too.  Where two neighbouring temperatures overlap by under
+** LW_REWEIGHT_OVERLAP_MIN (lw_reweight_overlap) the rows between them are
+** left empty and each side is reweighted alone.  A table with its warnings
+** (such a gap; a rung whose autocorrelation window did not close;
+** neighbours that exchanged in under 5 % of their tries) or CSV lines.  LW_EINPUT naming the file for a trace without
 ** two rungs or with a rung whose temperature changes within the rows;
 ** LW_EUSAGE for n_temps outside 2 .. LW_REWEIGHT_TEMPS_MAX. */
 lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
