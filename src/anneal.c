@@ -1841,7 +1841,9 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     lw_json_begin_array(&j);
     for (int k = 0; k < a->n_rep; k++) {
       lw_json_begin_object(&j);
-      lw_json_key(&j, "temperature"); lw_json_number(&j, a->chains[k]->temperature);
+      lw_json_key(&j, "temperature"); /* none where no sweep ran, as temperature_final */
+      if (a->sweep > 0) lw_json_number(&j, a->chains[k]->temperature);
+      else lw_json_null(&j);
       lw_json_key(&j, "energy"); lw_json_number(&j, rung_energy(a, k));
       lw_json_end_object(&j);
     }

@@ -187,7 +187,7 @@ const lw_param_def lw_param_table[] = {
   STRING("init", "from", from, "", "path",
          "A state.lw to start from instead of random placement (relative to the scene file)."),
   NUM("energy", "strain", LW_PT_DOUBLE, strain, "0", "energy / mm", 0, 1e12, 0,
-      "S: strain S (L - L0)^2 / L0^2 * L keeps each spline's length near L0. 0 = off."),
+      "S: strain S L (L - L0)^2 / L0^2 keeps each spline's length near L0. 0 = off."),
   CHOICE("energy", "strain_mode", strain_mode, "spline", "spline|segment",
          "Strain per spline (L = whole length) or per segment (each segment against L0/n)."),
   NUM("energy", "bending", LW_PT_DOUBLE, bending, "0", "energy mm", 0, 1e12, 0,

@@ -15,8 +15,8 @@ lw_status lw_particles_write_ply(const lw_particles *p, const char *path, lw_err
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
   if (!f) return err ? err->code : LW_EIO;
   fprintf(f, "ply\nformat ascii 1.0\ncomment linewise oriented particles; the normal is each particle's local z axis\n"
-             "element vertex %zu\nproperty float x\nproperty float y\nproperty float z\n"
-             "property float nx\nproperty float ny\nproperty float nz\nend_header\n",
+             "element vertex %zu\nproperty double x\nproperty double y\nproperty double z\n"
+             "property double nx\nproperty double ny\nproperty double nz\nend_header\n",
           p->n);
   for (size_t i = 0; i < p->n; i++) {
     const double *x = p->x + 3 * i, *n = p->nrm + 3 * i;

@@ -1188,9 +1188,9 @@ Test(particles, final_ply_and_final_png)
   FILE *f = fopen(path, "r");
   cr_assert_not_null(f);
   char line[256];
-  const char *head[] = {"ply\n", "format ascii 1.0\n", NULL, "element vertex 37\n", "property float x\n",
-                        "property float y\n", "property float z\n", "property float nx\n", "property float ny\n",
-                        "property float nz\n", "end_header\n"};
+  const char *head[] = {"ply\n", "format ascii 1.0\n", NULL, "element vertex 37\n", "property double x\n",
+                        "property double y\n", "property double z\n", "property double nx\n",
+                        "property double ny\n", "property double nz\n", "end_header\n"};
   for (int k = 0; k < 11; k++) {
     cr_assert_not_null(fgets(line, sizeof line, f));
     if (head[k]) cr_assert_str_eq(line, head[k]);

@@ -461,3 +461,17 @@ Test(ptrun, a_tuned_ladder_of_16_rungs_reads_back_pasted_and_through_set)
                   "cmp -s %s/lj2/scene.ini %s/lj3/scene.ini", dir, lw_test_bin(), lw_test_root(), dir, dir, dir, dir),
                0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
+
+/* A tempering run of no sweep has no temperatures yet: its rungs said 0
+** in summary.json (beside the ladder), where temperature_final was null. */
+Test(ptrun, a_run_of_no_sweep_gives_its_rungs_no_temperature)
+{
+  const char *run = "%s run %s/params/wire-ladder.ini --threads 1 --quiet --set anneal.sweeps=%d --out %s/z%d";
+  for (int sweeps = 0; sweeps <= 1; sweeps++) {
+    cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), sweeps, dir, sweeps), 0);
+    int nulls = sh("test $(grep -c '^      \"temperature\": null,$' %s/z%d/summary.json) -eq 3 && "
+                   "grep -q '^  \"temperature_final\": null,$' %s/z%d/summary.json", dir, sweeps, dir, sweeps);
+    int ones = sh("grep -q '^      \"temperature\": 1,$' %s/z%d/summary.json", dir, sweeps);
+    cr_assert(sweeps ? nulls != 0 && ones == 0 : nulls == 0 && ones != 0, "%d sweeps", sweeps);
+  }
+}
