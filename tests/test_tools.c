@@ -188,8 +188,8 @@ static double number_after(const char *text, const char *label)
 
 Test(tools, seed_sweep_gathers_every_summary_and_links_the_best)
 {
-  cr_assert_eq(sh("%s %s --seeds 1-4 -j 2 " TINY " --bin %s --out %s/s", tool("seed-sweep"), scene(), env("LW_BIN"), dir),
-               0, "%s", err_txt());
+  cr_assert_eq(sh("umask 027 && %s %s --seeds 1-4 -j 2 " TINY " --bin %s --out %s/s", tool("seed-sweep"), scene(),
+                  env("LW_BIN"), dir), 0, "%s", err_txt());
   csv t;
   char path[128];
   snprintf(path, sizeof path, "%s/s/sweep.csv", dir);
@@ -236,6 +236,10 @@ Test(tools, seed_sweep_gathers_every_summary_and_links_the_best)
   cr_assert(fabs(number_after(out, "std ") - sd) <= 1e-9 * sd, "sample std %.10g: %s", sd, out);
   free(out);
   free(t.text);
+  /* written aside under mktemp's names (0600), then given what the umask
+  ** gives a new file, and nothing left beside them */
+  cr_assert_eq(sh("cd %s/s && test $(stat -c %%a sweep.csv) = 640 && test $(stat -c %%a sweep.conf) = 640 && "
+                  "test -z \"$(ls -A | grep '^\\.')\"", dir), 0);
 }
 
 /* Runs that agree to the last bit have no spread: the sums of e and e^2
