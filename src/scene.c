@@ -764,12 +764,29 @@ static void note_blur_gaps(lw_scene *sc, const lw_params *p)
   }
 }
 
+/* The pair term's product rule alone, with nothing to keep strokes apart:
+** where they touch or cross it misses energy, and the chain finds such
+** states (a photograph annealed so read its pair energy 11.6 % low). */
+static void note_pair_unguarded(lw_scene *sc, const lw_params *p)
+{
+  if (!sc->on[LW_TERM_PAIR] || p->pair_near > 0.0 || p->min_spacing > 0.0) return;
+  size_t used = strlen(sc->note);
+  snprintf(sc->note + used, sizeof sc->note - used, "%senergy.pair_near = 0 and energy.min_spacing = 0: strokes may "
+           "touch and cross, where the pair term's product rule alone reads their energy low, and the annealing "
+           "seeks that out (up to 40 %% where two curves cross, docs/ACCURACY.md); a near field (energy.pair_near = "
+           "1.5) or a spacing keeps the energy whole", used ? "; " : "");
+}
+
 lw_status lw_scene_init(lw_scene *sc, const lw_params *p, lw_error *err)
 {
   memset(sc, 0, sizeof *sc);
   lw_status st = scene_build(sc, p, err);
-  if (st) lw_scene_clear(sc);
-  else note_blur_gaps(sc, p);
+  if (st) {
+    lw_scene_clear(sc);
+  } else {
+    note_blur_gaps(sc, p);
+    note_pair_unguarded(sc, p);
+  }
   return st;
 }
 
