@@ -1073,12 +1073,14 @@ static lw_status truncate_trace(lw_anneal *a, long bytes, lw_error *err)
 {
   char path[LW_PATH_MAX + 32], tmp[LW_PATH_MAX + 64];
   dir_file(path, sizeof path, a, "trace.csv");
+  struct stat sb;
+  /* a link is refused before the trace is cut (truncate cut the file it
+  ** named) or read, in either format (a format-1 state's resume wrote
+  ** through it, exit 1 where this says 2) */
+  if (!lstat(path, &sb) && S_ISLNK(sb.st_mode))
+    return lw_error_set(err, LW_EINPUT, "%s: a symbolic link: a run writes into its own directory only (put the "
+                        "trace itself there)", path);
   if (bytes >= 0) {
-    struct stat sb;
-    /* a link is refused before the trace is cut: truncate cut the file it named */
-    if (!lstat(path, &sb) && S_ISLNK(sb.st_mode))
-      return lw_error_set(err, LW_EINPUT, "%s: a symbolic link: a run writes into its own directory only (put the "
-                          "trace itself there)", path);
     if (stat(path, &sb))
       return lw_error_set(err, LW_EINPUT, "%s: %s, but state.lw counts %ld bytes of it", path, strerror(errno), bytes);
     if (!S_ISREG(sb.st_mode) || sb.st_size < bytes)

@@ -255,8 +255,10 @@ lw_status lw_ckpt_read(lw_ckpt **out, const char *path, lw_error *err)
     c->text[c->len] = '\0';
     for (size_t k = 0; k < c->len; k++) c->lines += c->text[k] == '\n';
     /* every state this program writes ends its last line: one that does not
-    ** was cut short inside it (a number cut there still read as a number) */
-    if (c->len && c->text[c->len - 1] != '\n')
+    ** was cut short inside it (a number cut there still read as a number);
+    ** but a NUL, where the reading stopped, is named by parse (a state padded
+    ** with gigabytes of NULs was called cut short) */
+    if (c->len && c->text[c->len - 1] != '\n' && !memchr(c->text, '\0', c->len))
       s = lw_error_set(err, LW_EINPUT, "%s:%d: the file ends inside this line: cut short (a partial copy, a full "
                        "disk?); a state written by hand needs a newline after its last line", path, c->lines + 1);
     else

@@ -119,6 +119,17 @@ static int stash_marker(const char *dir);
 
 lw_status lw_runfiles_check_free(const char *dir, lw_error *err)
 {
+  /* a frames/, samples/ or plots/ that is a link (planted in a shared
+  ** directory) is refused whether or not this run writes there: one that
+  ** writes none ran, and left the link in its directory */
+  for (size_t k = 1; k < sizeof groups / sizeof groups[0]; k++) {
+    char path[LW_PATH_MAX + 16];
+    struct stat sb;
+    snprintf(path, sizeof path, "%s/%s", dir, groups[k].sub);
+    if (!lstat(path, &sb) && S_ISLNK(sb.st_mode))
+      return lw_error_set(err, LW_EINPUT, "%s: a symbolic link, not a folder: a run writes its %s only into its own "
+                          "directory; remove it (nothing was written)", path, groups[k].sub);
+  }
   /* (an empty stash, which recovery removes, holds no run) */
   const int stash = lw_runfiles_stashed(dir) && stash_marker(dir) != EMPTY;
   if (stash || lw_rundir_holds_run(dir)) return LW_OK;

@@ -1224,6 +1224,13 @@ Test(cli, links_planted_in_a_run_directory_are_not_followed)
   cr_assert_eq(lw_test_sh("test -f %s/vd/frame-000000.png && test \"$(ls %s/vd)\" = frame-000000.png", dir, dir), 0,
                "the linked folder's frames were moved or written");
   cr_assert_eq(lw_test_sh("test -s %s/out/m/state.lw", dir), 0, "the run that was there is gone");
+  /* refused too by a run that writes no frames (it ran, and its first
+  ** checkpoint would have dropped the run before with the link beside it) */
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/out/m --quiet --set anneal.sweeps=5", lw_test_root(),
+           dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "frames: a symbolic link, not a folder"), "%s", errs);
+  cr_assert_eq(lw_test_sh("test \"$(ls %s/vd)\" = frame-000000.png", dir), 0, "the linked folder's frames went");
   /* a resume whose trace.csv is a link: refused before the trace is cut
   ** back (truncate cut the file the link named) */
   cr_assert_eq(lw_test_sh("cd %s && rm out/m/frames && %s run %s/params/minimal.ini --out out/m --quiet --set "
@@ -1235,6 +1242,14 @@ Test(cli, links_planted_in_a_run_directory_are_not_followed)
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
   cr_assert(strstr(errs, "trace.csv: a symbolic link"), "%s", errs);
   cr_assert_eq(lw_test_sh("cmp -s %s/precious %s/kept", dir, dir), 0, "the file the trace's link named was cut");
+  /* a format-1 state (which counts no trace bytes) with a dangling link:
+  ** refused alike, the file it names not made (it was written, exit 1) */
+  cr_assert_eq(lw_test_sh("cd %s && cp -r %s/tests/fixtures/v1/plain v1 && rm v1/trace.csv && "
+                          "ln -s %s/planted v1/trace.csv", dir, lw_test_root(), dir), 0);
+  snprintf(args, sizeof args, "resume %s/v1 --quiet --threads 1", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
+  cr_assert(strstr(errs, "trace.csv: a symbolic link"), "%s", errs);
+  cr_assert_neq(lw_test_sh("test -e %s/planted", dir), 0, "the trace's link made its file");
 }
 
 /* A file a key names that never ends: a FIFO waited for a writer for ever

@@ -237,3 +237,36 @@ Test(state, strict_numbers)
   cr_assert_eq(lw_number_list("1 ,2\t3", 2, list, 4), 3);
   cr_assert(strstr(lw_number_list_hint(-2), "0.5 not 0,5") && !*lw_number_list_hint(-1));
 }
+
+/* Text stops at its first NUL: a line reader returns what came before it,
+** and a state padded with NULs (a sparse file: 96 MiB of them, more than a
+** line may hold) is refused at once naming the NUL, not read to 64 MiB and
+** called a long line, nor called cut short (it ends in NULs, not a line). */
+Test(state, text_stops_at_its_first_nul, .init = make_dir)
+{
+  char path[128];
+  snprintf(path, sizeof path, "%s/nul.txt", dir);
+  FILE *f = fopen(path, "wb");
+  fwrite("ab\0cd\nef\n", 1, 9, f);
+  fclose(f);
+  f = fopen(path, "rb");
+  char *buf = NULL;
+  size_t cap = 0;
+  cr_assert_eq(lw_text_getline(&buf, &cap, f), 3, "the line up to its NUL, and the NUL");
+  cr_assert_str_eq(buf, "ab");
+  free(buf);
+  fclose(f);
+  snprintf(path, sizeof path, "%s/state.lw", dir);
+  f = fopen(path, "wb");
+  fputs("linewise-state 2\n", f);
+  fclose(f);
+  cr_assert_eq(truncate(path, 96L << 20), 0);
+  lw_state st;
+  lw_error err;
+  cr_assert_eq(lw_state_read(&st, path, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "state.lw:2: a NUL byte inside the line"), "%s", err.msg);
+  unlink(path);
+  snprintf(path, sizeof path, "%s/nul.txt", dir);
+  unlink(path);
+  rmdir(dir);
+}

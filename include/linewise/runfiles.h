@@ -33,7 +33,8 @@
 /* LW_EUSAGE naming the file where dir holds run files but no run (no run's
 ** scene.ini or state.lw, no stash): a person's, or what is left of a run
 ** whose scene.ini and state.lw were taken away; not to be written over (a
-** write's x.tmp alone does not count: it is what a kill leaves). */
+** write's x.tmp alone does not count: it is what a kill leaves).  LW_EINPUT
+** where dir's frames, samples or plots is a symbolic link. */
 lw_status lw_runfiles_check_free(const char *dir, lw_error *err);
 
 /* LW_EUSAGE where dir/.replaced is there and is not linewise's stash (a
