@@ -368,6 +368,26 @@ Test(params, a_list_goes_on_over_indented_lines_and_reads_back)
   expect_error("[scene]\nwidth = 100\n  120\n", ":3:", NULL, "syntax error");
   expect_error("[scene]\npolygon = 10 10 90 10\n\n  90 60\n", ":4:", NULL, "syntax error");
   expect_error("[scene]\npolygon = 10 10 90 10\n; a comment\n  90 60\n", ":4:", NULL, "syntax error");
+  expect_error("[scene]\npolygon = 10 10 90 10\n90 60\n", ":3:", NULL, "syntax error"); /* not indented */
+  /* an indented key after a list is a key, not more of the list */
+  cr_assert_eq(read_text("[scene]\nboundary = polygon\npolygon = 10 10 90 10 50 80\n  height = 120\n", &p, &err),
+               LW_OK, "%s", err.msg);
+  cr_assert(!strcmp(p.polygon, "10 10 90 10 50 80") && p.height == 120.0, "'%s', %g", p.polygon, p.height);
+  /* the field's last byte: a list of 4095 bytes over lines reads back
+  ** whole, one of 4096 is refused (not cut by a byte) */
+  for (int extra = 0; extra <= 1; extra++) {
+    char big[6000] = "[nurbs]\nknots = 0";
+    for (int i = 0; i < 2047; i++) strcat(big, i % 40 ? " 1" : "\n  1");
+    if (extra) strcat(big, "1");
+    strcat(big, "\n");
+    if (extra) {
+      expect_error(big, ":", "nurbs.knots", "goes on past 4095 bytes");
+      continue;
+    }
+    cr_assert_eq(read_text(big, &p, &err), LW_OK, "%s", err.msg);
+    cr_assert_eq(strlen(p.nb_knots), 4095);
+    cr_assert(!strcmp(p.nb_knots + 4090, "1 1 1"), "%s", p.nb_knots + 4090);
+  }
   /* past the field, or a part too long to write back on a line */
   char text[9000] = "[nurbs]\nknots = 0";
   for (int i = 0; i < 560; i++) strcat(text, "\n  0.25 0.25 0.5");

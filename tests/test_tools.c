@@ -857,6 +857,15 @@ Test(tools, plots_run_nothing_a_run_or_sweep_file_says)
   write_text("eod.csv", "seed,energy_total,run\nEOD,2.5,a\nsystem('touch made3'),1.5,b\n");
   cr_assert_eq(sh("cd %s && %s eod.csv </dev/null", dir, tool("plot-sweep")), 0, "%s", err_txt());
   cr_assert(!exists("made3"), "a sweep.csv field ended the datablock and ran");
+  /* the replicas' temperatures go into a datablock too: an EOD there ends
+  ** it, and the line after runs as a command, but for the numbers-only
+  ** filter, which nothing tested */
+  write_tempering_run("pi", 0);
+  cr_assert_eq(sh("cd %s && sed -i '0,/\"temperature\": 0.1,/s//\"temperature\": EOD,/; "
+                  "s/\"temperature\": 0.5,/\"temperature\": !touch made4,/' pi/summary.json && "
+                  "grep -q EOD pi/summary.json && grep -q made4 pi/summary.json && %s pi </dev/null", dir,
+                  tool("plot-run")), 0, "%s", err_txt());
+  cr_assert(!exists("made4"), "summary.json's replica values ended the datablock and ran");
 }
 
 /* A run's log planted as a link (another user's, in a shared sweep folder)
