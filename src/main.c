@@ -80,7 +80,8 @@ static const char usage[] =
   "                      tempering); with several runs (seeds) also whether they agree\n"
   "      --reweight N        instead, a tempering run's mean energy and heat capacity\n"
   "                          at N temperatures from the coldest rung's to the hottest's,\n"
-  "                          every rung's energies reweighted (multiple histograms)\n"
+  "                          every rung's energies reweighted (multiple histograms);\n"
+  "                          empty between rungs that share almost no energies\n"
   "      --from S, --to S    only the rows of sweeps S to S (inclusive)\n"
   "      --csv               one CSV line a column: column,n,mean,stderr,sd,\n"
   "                          tau_sweeps,n_eff,window_closed,drift_z,batch_ratio (several runs:\n"
@@ -1097,15 +1098,16 @@ static int cmd_stats(int argc, char **argv)
     if (!(path[r] = strdup(where))) lw_error_set(&err, LW_ENOMEM, "out of memory");
     else t[r] = lw_trace_read(where, &err);
   }
-  if (!err.code && reweight)
-    lw_trace_reweight((const lw_trace *const *)t, (const char *const *)path, sel, k, (int)reweight, stdout, &err);
-  else if (!err.code) {
+  if (!err.code) {
     /* with --csv the warnings no column carries go to stderr, a line each */
     char *warned = NULL;
     size_t warned_len = 0;
     FILE *w = base.csv ? open_memstream(&warned, &warned_len) : NULL;
     for (int r = 0; r < k; r++) sel[r].csv_warnings = w;
-    lw_trace_stats_runs((const lw_trace *const *)t, (const char *const *)path, sel, k, stdout, &err);
+    if (reweight)
+      lw_trace_reweight((const lw_trace *const *)t, (const char *const *)path, sel, k, (int)reweight, stdout, &err);
+    else
+      lw_trace_stats_runs((const lw_trace *const *)t, (const char *const *)path, sel, k, stdout, &err);
     if (w) fclose(w);
     for (char *line = warned; line && *line;) {
       size_t len = strcspn(line, "\n");

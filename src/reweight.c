@@ -379,6 +379,7 @@ static lw_status gather(const lw_trace *const *t, const char *const *path, const
       ** solves' cost grows with the samples */
       const double tau = lw_series_tau(x, 1, c, &window);
       if (isnan(tau)) {
+        free(row);
         st = lw_error_set(err, LW_ENOMEM, "%s: out of memory for the autocorrelation of rung %d", path[r], q);
         goto done;
       }
@@ -483,6 +484,8 @@ typedef struct {
   int n_gaps, iterations;
   double lowest; /* overlap of neighbouring temperatures (NAN: one) */
   gsl_rng *rng;
+  int inconsistent; /* rungs whose own mean the reweighting does not give (check_rungs) */
+  double worst_z, worst_t, worst_own, worst_se, worst_rw;
 } rw_table;
 
 static double table_temperature(const rw_table *tab, int j)
@@ -583,7 +586,8 @@ static int gaps_of(const rw_states *s, const double *log_den, const double *b, i
   return n;
 }
 
-/* The states of s at betas lo .. hi into c (its own arrays). */
+/* The states of s at betas lo .. hi into c (its own arrays, which the
+** caller frees with states_free, whatever this returns). */
 static lw_status states_between(const rw_states *s, double lo, double hi, rw_states *c, lw_error *err)
 {
   memset(c, 0, sizeof *c);
@@ -594,10 +598,8 @@ static lw_status states_between(const rw_states *s, double lo, double hi, rw_sta
   c->thin = malloc(K * sizeof *c->thin);
   c->run = malloc(K * sizeof *c->run);
   c->rows = malloc(K * sizeof *c->rows);
-  if (!c->E || !c->first || !c->beta || !c->thin || !c->run || !c->rows) {
-    states_free(c);
+  if (!c->E || !c->first || !c->beta || !c->thin || !c->run || !c->rows) /* (the caller frees c) */
     return lw_error_set(err, LW_ENOMEM, "out of memory reweighting %zu samples", s->first[K]);
-  }
   for (int q = 0; q < s->K; q++) {
     if (s->beta[q] < lo || s->beta[q] > hi) continue;
     const size_t a = s->first[q], m = s->first[q + 1] - a, at = c->first[c->K];
@@ -609,6 +611,36 @@ static lw_status states_between(const rw_states *s, double lo, double hi, rw_sta
     c->first[++c->K] = at + m;
   }
   return LW_OK;
+}
+
+/* Whether the states sample one system: each rung's own mean energy
+** against the reweighted one at its temperature, which for rungs of one
+** system's laws differ by about the rung's own error bar (its samples carry
+** most of the weight there).  Rungs that do not (one stuck in a basin, or
+** not yet in equilibrium) can overlap well in the solved laws, which mix
+** them: a rung of 100 +- 0.1 beside one of 110 +- 10 read 98.65 at its own
+** temperature, and C 15.6 for 0.01, with an overlap of 0.23.  The worst
+** such rung, past LW_REWEIGHT_CONSISTENT of its error bars, goes to tab. */
+static void check_rungs(const rw_states *s, const double *log_den, rw_table *tab)
+{
+  const size_t n = s->first[s->K];
+  for (int q = 0; q < s->K; q++) {
+    const size_t a = s->first[q], m = s->first[q + 1] - a;
+    if (m < 2) continue;
+    double mean = mean_of(s->E + a, m), ss = 0.0, e, c;
+    for (size_t i = 0; i < m; i++) ss += (s->E[a + i] - mean) * (s->E[a + i] - mean);
+    const double se = sqrt(ss / (double)(m - 1) / (double)m);
+    lw_reweight_at(s->E, n, log_den, s->beta[q], &e, &c);
+    const double z = fabs(e - mean) / se;
+    if (se > 0.0 && z > LW_REWEIGHT_CONSISTENT && !(z <= tab->worst_z)) {
+      tab->worst_z = z;
+      tab->worst_t = 1.0 / s->beta[q];
+      tab->worst_own = mean;
+      tab->worst_se = se;
+      tab->worst_rw = e;
+    }
+    tab->inconsistent += z > LW_REWEIGHT_CONSISTENT && se > 0.0;
+  }
 }
 
 /* The table's rows at s's temperatures, from s's samples alone.  Where
@@ -629,7 +661,6 @@ static lw_status reweight_part(const rw_states *s, rw_table *tab, lw_error *err)
     goto done;
   }
   if ((st = lw_reweight_solve(s->E, s->first, s->beta, K, 0, f, log_den, &it, err))) goto done;
-  tab->iterations += it;
   m = distinct_betas(s, b);
   const int gaps = gaps_of(s, log_den, b, m, gap, &tab->lowest);
   if (gaps) {
@@ -642,6 +673,8 @@ static lw_status reweight_part(const rw_states *s, rw_table *tab, lw_error *err)
     }
     goto done;
   }
+  tab->iterations += it; /* (of the solves whose estimates stand) */
+  check_rungs(s, log_den, tab);
   /* the rows within the part's temperatures (at its ends, to rounding) */
   int j0 = tab->n_temps, j1 = -1;
   for (int j = 0; j < tab->n_temps; j++) {
@@ -684,7 +717,7 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
   lw_status st = gather(t, path, sel, k, &s, err);
   if (st) return st;
   const int K = s.K, B = LW_REWEIGHT_BOOTSTRAP;
-  rw_table tab = {.n_temps = n_temps, .traces = k, .lowest = NAN};
+  rw_table tab = {.n_temps = n_temps, .traces = k, .lowest = NAN, .worst_z = NAN};
   tab.est = calloc((size_t)n_temps * 2, sizeof *tab.est);
   tab.sum = calloc((size_t)n_temps * 4, sizeof *tab.sum);
   tab.gap = malloc((size_t)K * sizeof *tab.gap);
@@ -714,10 +747,12 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
   } else {
     double thin = 0.0;
     for (int q = 0; q < K; q++) thin = fmax(thin, s.thin[q]);
+    char overlap[64] = ""; /* (none with one temperature) */
+    if (!isnan(tab.lowest)) snprintf(overlap, sizeof overlap, ", neighbouring temperatures' overlap at least %.2g",
+                                     tab.lowest);
     fprintf(out, "reweighted over %d rung%s from T = %.6g to %.6g: %zu samples (each rung's rows thinned to one "
-            "every 2 tau, at most every %.0f), %d iterations, %d bootstrap resamples, neighbouring temperatures' "
-            "overlap at least %.2g\n", K, K > 1 ? "s" : "", tab.tlo, tab.thi, s.first[K], thin, tab.iterations, B,
-            tab.lowest);
+            "every 2 tau, at most every %.0f), %d iterations, %d bootstrap resamples%s\n", K, K > 1 ? "s" : "",
+            tab.tlo, tab.thi, s.first[K], thin, tab.iterations, B, overlap);
     fprintf(out, "%15s %17s %11s %15s %11s\n", "temperature", "energy", "stderr", "heat_capacity", "stderr");
   }
   for (int j = 0; j < n_temps; j++) {
@@ -734,15 +769,23 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
     else
       fprintf(out, "%15.6g %17.10g %11.4g %15.6g %11.4g\n", T, est[0], se[0], est[1], se[1]);
   }
-  for (int g = 0; !sel[0].csv && g < tab.n_gaps; g++)
-    fprintf(out, "warning: no estimate between T = %.6g and %.6g: the rungs there share almost no energies (overlap "
-            "%.2g, under %g), and each side is reweighted alone (more rungs between them)\n", 1.0 / tab.gap[g].b_hi,
-            1.0 / tab.gap[g].b_lo, tab.gap[g].overlap, LW_REWEIGHT_OVERLAP_MIN);
-  if (!sel[0].csv && s.open)
-    fprintf(out, "warning: %d rung%s autocorrelation window did not close: thinned by too little, the error "
+  /* below the table, or with --csv where the caller says (stderr) */
+  FILE *apart = sel[0].csv ? sel[0].csv_warnings : out;
+  for (int g = 0; apart && g < tab.n_gaps; g++)
+    fprintf(apart, "warning: no estimate between T = %.6g and %.6g: the rungs there share almost no energies "
+            "(overlap %.2g, under %g), and each side is reweighted alone (more rungs between them)\n",
+            1.0 / tab.gap[g].b_hi, 1.0 / tab.gap[g].b_lo, tab.gap[g].overlap, LW_REWEIGHT_OVERLAP_MIN);
+  if (apart && tab.inconsistent)
+    fprintf(apart, "warning: %d rung%s own mean energy is not what the reweighting gives at %s temperature (the "
+            "worst: T = %.6g, %.10g +- %.2g, reweighted %.10g): the rungs do not sample one system's laws (one not "
+            "in equilibrium, or stuck in a basin; start later with --from, or run longer), and the table mixes "
+            "them\n", tab.inconsistent, tab.inconsistent > 1 ? "s'" : "'s", tab.inconsistent > 1 ? "their" : "its",
+            tab.worst_t, tab.worst_own, tab.worst_se, tab.worst_rw);
+  if (apart && s.open)
+    fprintf(apart, "warning: %d rung%s autocorrelation window did not close: thinned by too little, the error "
             "bars are too small (a longer stretch is needed)\n", s.open, s.open > 1 ? "s'" : "'s");
-  if (!sel[0].csv && s.worst_swap < LW_REWEIGHT_SWAP_MIN)
-    fprintf(out, "warning: rungs %d and %d exchanged in %.3g of the tries: their energies barely overlap and the "
+  if (apart && s.worst_swap < LW_REWEIGHT_SWAP_MIN)
+    fprintf(apart, "warning: rungs %d and %d exchanged in %.3g of the tries: their energies barely overlap and the "
             "curve between them is unreliable (more rungs there)\n", s.worst_pair, s.worst_pair + 1, s.worst_swap);
 done:
   if (st == LW_EINPUT && err && strncmp(err->msg, path[0], strlen(path[0]))) { /* the solver's, of this trace */

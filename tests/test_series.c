@@ -871,6 +871,55 @@ Test(reweight, rungs_that_share_no_energies_give_no_estimate_between_them, .init
   gsl_rng_free(r);
 }
 
+/* Rungs that do not sample one system's laws (one stuck in a basin: 100
+** +- 0.1 at T = 1 beside 110 +- 10 at T = 2) overlap well in the solved
+** laws, which mix them, and the table read 98.65 at T = 1 with no warning;
+** now a rung's own mean against the reweighted one at its temperature says
+** so.  Rungs of one system's laws (Gamma energies of the harmonic system)
+** differ by about their error bars, and get no such warning; nor has a
+** table of one temperature an overlap to state. */
+Test(reweight, rungs_that_do_not_sample_one_system_are_said, .init = make_dir, .fini = remove_dir)
+{
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 17);
+  const size_t rows = 3000;
+  size_t cap = 200 * rows;
+  char *text = malloc(cap), path[128];
+  static char out[8192];
+  const char *paths[1] = {path};
+  lw_error err;
+  for (int c = 0; c < 3; c++) {
+    size_t k = (size_t)snprintf(text, cap, "sweep,temperature,total,replica0_temperature,replica0_energy,"
+                                           "replica1_temperature,replica1_energy\n");
+    for (size_t t = 0; t < rows; t++) {
+      double e0, e1, T1 = c == 2 ? 1.0 : 2.0;
+      if (c == 0) { /* stuck */
+        e0 = 100.0 + gsl_ran_gaussian(r, 0.1);
+        e1 = 110.0 + gsl_ran_gaussian(r, 10.0);
+      } else {
+        e0 = gsl_ran_gamma(r, HARMONIC_D / 2.0, 1.0);
+        e1 = gsl_ran_gamma(r, HARMONIC_D / 2.0, T1);
+      }
+      k += (size_t)snprintf(text + k, cap - k, "%zu,1,%.17g,1,%.17g,%g,%.17g\n", t + 1, e0, e0, T1, e1);
+    }
+    write_trace("one.csv", text, path, sizeof path);
+    lw_trace *t = lw_trace_read(path, &err);
+    cr_assert_not_null(t, "%s", err.msg);
+    FILE *f = fmemopen(out, sizeof out, "w");
+    lw_trace_select sel = {.from = -1, .to = -1};
+    cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, 5, f, &err), LW_OK, "%s", err.msg);
+    fclose(f);
+    lw_trace_free(t);
+    const int said = strstr(out, "warning: 1 rung's own mean energy is not what the reweighting gives at its "
+                                 "temperature (the worst: T = 1, ") != NULL;
+    cr_assert_eq(said, c == 0, "case %d: %s", c, out);
+    cr_assert_eq(strstr(out, "overlap at least ") != NULL, c != 2, "case %d: %s", c, out);
+    cr_assert(!strstr(out, "nan"), "case %d: %s", c, out);
+  }
+  free(text);
+  gsl_rng_free(r);
+}
+
 /* ---- observables --------------------------------------------------------- */
 
 Test(observables, a_line_and_a_circle_have_their_known_shapes)

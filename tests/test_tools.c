@@ -240,6 +240,10 @@ Test(tools, seed_sweep_gathers_every_summary_and_links_the_best)
   ** gives a new file, and nothing left beside them */
   cr_assert_eq(sh("cd %s/s && test $(stat -c %%a sweep.csv) = 640 && test $(stat -c %%a sweep.conf) = 640 && "
                   "test -z \"$(ls -A | grep '^\\.')\"", dir), 0);
+  /* a directory whose name ends in a line break (dirname drops it: the
+  ** temporaries were sought in another directory, and the sweep failed) */
+  cr_assert_eq(sh("cd %s && %s %s --seeds 1 " TINY " --bin %s --out 'n\n' && test -s 'n\n/sweep.csv' && "
+                  "test -L 'n\n/best'", dir, tool("seed-sweep"), scene(), env("LW_BIN")), 0, "%s", err_txt());
 }
 
 /* Runs that agree to the last bit have no spread: the sums of e and e^2

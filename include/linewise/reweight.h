@@ -38,6 +38,9 @@
 #define LW_REWEIGHT_TEMPS_MAX 10000 /* temperatures a table, at most */
 #define LW_REWEIGHT_OVERLAP_MIN 0.03 /* lw_reweight_overlap of neighbouring temperatures below which nothing
                                        between them is estimated */
+#define LW_REWEIGHT_CONSISTENT 5.0 /* error bars by which a rung's own mean energy may differ from the
+                                       reweighted one at its temperature before a warning says the rungs do
+                                       not sample one system */
 #define LW_REWEIGHT_SWAP_MIN 0.05   /* neighbour exchange acceptance below which a warning says the
                                        rungs barely overlap */
 
