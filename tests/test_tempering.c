@@ -452,6 +452,12 @@ Test(ptrun, a_tuned_ladder_of_16_rungs_reads_back_pasted_and_through_set)
                0);
   cr_assert_eq(sh("sed -n '/^ladder = /,$p' %s/lj/ladder.ini > %s/lad && test $(wc -l < %s/lad) -gt 1 && "
                   "test $(cat %s/lad | wc -w) -eq 18", dir, dir, dir, dir), 0, "16 rungs over several lines");
+  /* each rung with the fewest digits that read back the same double as
+  ** state.lw's 17 (a writer of 16 at most passed every test) */
+  cr_assert_eq(sh("awk 'FNR == NR { for (i = 1; i <= NF; i++) if ($i != \"ladder\" && $i != \"=\") a[++n] = $i; next }"
+                  " /^\\[tempering\\]/ { t = 1 } t && $1 == \"ladder\" { for (i = 3; i <= NF; i++) b[++m] = $i; t = 0 }"
+                  " END { if (n != 16 || m != 16) exit 1; for (i = 1; i <= n; i++) if (a[i] + 0 != b[i] + 0) exit 1 }'"
+                  " %s/lad %s/lj/state.lw", dir, dir), 0, "ladder.ini's rungs are not state.lw's");
   cr_assert_eq(sh("cat %s/params/lj13.ini %s/lj/ladder.ini > %s/pasted.ini && %s run %s/pasted.ini --threads 1 "
                   "--quiet --stop-at 0 --out %s/lj2 2> %s/err.txt && sed -n '/^ladder = /,/^[a-z]/p' %s/lj2/scene.ini "
                   "| sed '$d' | cmp -s - %s/lad", lw_test_root(), dir, dir, lw_test_bin(), dir, dir, dir, dir, dir),
