@@ -864,6 +864,16 @@ Test(cli, a_second_signal_stops_at_once_and_leaves_the_checkpoint)
                           "$(sed -n 's/^sweep = //p' %s/c/state.lw)$\" %s/c.err",
                           lw_test_bin(), lw_test_root(), dir, dir, dir, dir, dir),
                0, "%s", lw_test_slurp("%s/c.err", dir));
+  /* a resume stopped before its first checkpoint names the one it resumed
+  ** from (nothing tested it: without the mark it said "the last checkpoint") */
+  cr_assert_eq(lw_test_sh("%s run %s/params/whip.ini --out %s/r --quiet --set dynamics.steps_per_sweep=1200000 --set "
+                          "output.checkpoint_every=1000 --set anneal.sweeps=1000 --stop-at 1", lw_test_bin(),
+                          lw_test_root(), dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/r --threads 1 2>%s/r.err & p=$!; i=0; while [ $i -lt 9000 ] && ! grep -q "
+                          "resuming %s/r.err 2>/dev/null; do sleep 0.02; i=$((i+1)); done; sleep 0.3; kill -INT $p; "
+                          "sleep 0.02; kill -INT $p; wait $p; test $? -eq 130 && grep -q 'continues from the "
+                          "checkpoint of sweep 1$' %s/r.err", lw_test_bin(), dir, dir, dir, dir),
+               0, "%s", lw_test_slurp("%s/r.err", dir));
 }
 
 /* A hang-up (a terminal or ssh session gone) stops a run as cleanly as
