@@ -295,8 +295,10 @@ typedef struct {
   int *run;          /* K: the trace each state came from */
   size_t *rows;      /* K: the rows its samples were thinned from */
   int open;          /* states whose autocorrelation window did not close */
-  double worst_swap; /* lowest neighbour exchange acceptance over the rows (NAN: none) */
-  int worst_pair;
+  int n_swaps;        /* neighbour pairs with an exchange column: */
+  double *swap;       /* their acceptance over the rows (NAN: none), */
+  double *swap_b;     /* 2 each: their rungs' inverse temperatures, */
+  int *swap_pair;     /* the pair's number in its run */
 } rw_states;
 
 static void states_free(rw_states *s)
@@ -307,6 +309,9 @@ static void states_free(rw_states *s)
   free(s->thin);
   free(s->run);
   free(s->rows);
+  free(s->swap);
+  free(s->swap_b);
+  free(s->swap_pair);
 }
 
 /* The mean of column col over the rows, empty fields skipped (NAN: none). */
@@ -325,7 +330,6 @@ static lw_status gather(const lw_trace *const *t, const char *const *path, const
                         rw_states *s, lw_error *err)
 {
   memset(s, 0, sizeof *s);
-  s->worst_swap = NAN;
   int energy[LW_TRACE_HEAT_MAX], temp[LW_TRACE_HEAT_MAX], rungs = 0;
   size_t cap = 0, most = 0; /* samples at most in all, rows at most of a run */
   lw_status st = LW_OK;
@@ -344,8 +348,12 @@ static lw_status gather(const lw_trace *const *t, const char *const *path, const
   s->thin = malloc((size_t)rungs * sizeof *s->thin);
   s->run = malloc((size_t)rungs * sizeof *s->run);
   s->rows = malloc((size_t)rungs * sizeof *s->rows);
+  s->swap = malloc((size_t)rungs * sizeof *s->swap);
+  s->swap_b = malloc(2 * (size_t)rungs * sizeof *s->swap_b);
+  s->swap_pair = malloc((size_t)rungs * sizeof *s->swap_pair);
   double *x = malloc((most ? most : 1) * sizeof *x);
-  if (!s->E || !s->first || !s->beta || !s->thin || !s->run || !s->rows || !x) {
+  if (!s->E || !s->first || !s->beta || !s->thin || !s->run || !s->rows || !s->swap || !s->swap_b || !s->swap_pair ||
+      !x) {
     st = lw_error_set(err, LW_ENOMEM, "out of memory reweighting %zu rows", cap);
     goto done;
   }
@@ -394,17 +402,18 @@ static lw_status gather(const lw_trace *const *t, const char *const *path, const
       s->rows[s->K] = c;
       s->first[++s->K] = at;
     }
-    /* the exchanges between neighbours: rungs that never swap share no energies */
-    for (int q = 0;; q++) {
+    /* the exchanges between neighbours: rungs that never swap share no
+    ** energies (kept with the pair's temperatures: a pair across a gap is
+    ** said by the gap) */
+    for (int q = 0; q + 1 < m; q++) {
       char name[32];
       snprintf(name, sizeof name, "swap%d", q);
       int col = lw_trace_column(t[r], name);
       if (col < 0) break;
-      double a = column_mean(t[r], row, n, col);
-      if (!isnan(a) && !(a >= s->worst_swap)) {
-        s->worst_swap = a;
-        s->worst_pair = q;
-      }
+      s->swap[s->n_swaps] = column_mean(t[r], row, n, col);
+      s->swap_b[2 * s->n_swaps] = s->beta[s->K - m + q];
+      s->swap_b[2 * s->n_swaps + 1] = s->beta[s->K - m + q + 1];
+      s->swap_pair[s->n_swaps++] = q;
     }
     free(row);
   }
@@ -484,6 +493,7 @@ typedef struct {
   int n_gaps, iterations;
   double lowest; /* overlap of neighbouring temperatures (NAN: one) */
   gsl_rng *rng;
+  const double *betas; /* the whole's distinct inverse temperatures, ascending */
   int inconsistent; /* rungs whose own mean the reweighting does not give (check_rungs) */
   double worst_z, worst_t, worst_own, worst_se, worst_rw;
 } rw_table;
@@ -586,6 +596,36 @@ static int gaps_of(const rw_states *s, const double *log_den, const double *b, i
   return n;
 }
 
+static lw_status states_between(const rw_states *s, double lo, double hi, rw_states *c, lw_error *err);
+
+/* The gaps between the m distinct betas b of s, each neighbouring two
+** solved alone, into gap; returns their count, -1 out of memory (with
+** err).  Two that do not settle either are a gap of overlap 0. */
+static int gaps_by_pairs(const rw_states *s, const double *b, int m, rw_gap *gap, double *lowest, lw_error *err)
+{
+  int n = 0;
+  for (int q = 1; q < m; q++) {
+    rw_states c;
+    double o = 0.0, *f = NULL, *log_den = NULL;
+    lw_error pair_err;
+    lw_status st = states_between(s, b[q - 1], b[q], &c, err);
+    if (!st) {
+      f = malloc((size_t)c.K * sizeof *f);
+      log_den = malloc((c.first[c.K] ? c.first[c.K] : 1) * sizeof *log_den);
+      if (!f || !log_den) st = lw_error_set(err, LW_ENOMEM, "out of memory reweighting %d rungs", c.K);
+    }
+    if (!st && !lw_reweight_solve(c.E, c.first, c.beta, c.K, 0, f, log_den, NULL, &pair_err))
+      o = lw_reweight_overlap(c.E, c.first[c.K], log_den, b[q - 1], b[q]);
+    states_free(&c);
+    free(f);
+    free(log_den);
+    if (st) return -1;
+    if (!(o >= *lowest)) *lowest = o;
+    if (!(o >= LW_REWEIGHT_OVERLAP_MIN)) gap[n++] = (rw_gap){b[q - 1], b[q], o};
+  }
+  return n;
+}
+
 /* The states of s at betas lo .. hi into c (its own arrays, which the
 ** caller frees with states_free, whatever this returns). */
 static lw_status states_between(const rw_states *s, double lo, double hi, rw_states *c, lw_error *err)
@@ -655,14 +695,29 @@ static lw_status reweight_part(const rw_states *s, rw_table *tab, lw_error *err)
   double *f = malloc((size_t)K * sizeof *f), *log_den = malloc(n * sizeof *log_den), *b = malloc(K * sizeof *b);
   rw_gap *gap = tab->gap + tab->n_gaps;
   lw_status st = LW_OK;
-  int it, m;
+  int it = 0, m, gaps;
   if (!f || !log_den || !b) {
     st = lw_error_set(err, LW_ENOMEM, "out of memory reweighting %zu samples", n);
     goto done;
   }
-  if ((st = lw_reweight_solve(s->E, s->first, s->beta, K, 0, f, log_den, &it, err))) goto done;
   m = distinct_betas(s, b);
-  const int gaps = gaps_of(s, log_den, b, m, gap, &tab->lowest);
+  lw_error whole;
+  st = lw_reweight_solve(s->E, s->first, s->beta, K, 0, f, log_den, &it, &whole);
+  if (st == LW_EINPUT && m > 1) {
+    /* rungs that share nothing can keep the whole from settling (a ladder of
+    ** four such rungs crept at 2e-10 for 10000 iterations): the neighbours
+    ** are then measured two at a time, and a gap splits the part as ever */
+    gaps = gaps_by_pairs(s, b, m, gap, &tab->lowest, err);
+    if (gaps < 0) st = LW_ENOMEM;
+    else if (gaps) st = LW_OK;
+    else if (err) *err = whole;
+    if (gaps <= 0) goto done;
+  } else if (st) {
+    if (err) *err = whole;
+    goto done;
+  } else {
+    gaps = gaps_of(s, log_den, b, m, gap, &tab->lowest);
+  }
   if (gaps) {
     tab->n_gaps += gaps;
     for (int g = 0; g <= gaps && !st; g++) {
@@ -685,6 +740,18 @@ static lw_status reweight_part(const rw_states *s, rw_table *tab, lw_error *err)
       lw_reweight_at(s->E, n, log_den, x, &tab->est[2 * j], &tab->est[2 * j + 1]);
     }
   }
+  /* the error bars: each state's samples drawn again with replacement, a
+  ** fixed seed so that the output is the same every time: each part's own,
+  ** where it begins in the whole's ladder (1 for the whole; drawn in turn
+  ** from one, a part's error bars moved with the temperatures asked for,
+  ** where a part before it had none and drew nothing: 1.26 or 0.84).  The
+  ** generator's state at each resample is taken in turn (the draws of one
+  ** after another), then the resamples are solved on the threads, each into
+  ** its own slot, and summed in their order: the same bytes on any number
+  ** of threads, and a 128-rung reweighting's 32 solves no longer one by one */
+  int first = 0;
+  while (tab->betas[first] != b[0]) first++;
+  gsl_rng_set(tab->rng, 1 + (unsigned long)first);
   if (j0 <= j1) st = bootstrap(s, tab, f, j0, j1, err);
 done:
   free(f);
@@ -722,7 +789,10 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
   tab.sum = calloc((size_t)n_temps * 4, sizeof *tab.sum);
   tab.gap = malloc((size_t)K * sizeof *tab.gap);
   tab.rng = lw_rng_new();
-  if (!tab.est || !tab.sum || !tab.gap || !tab.rng) {
+  double *betas = malloc((size_t)K * sizeof *betas);
+  if (betas) distinct_betas(&s, betas);
+  tab.betas = betas;
+  if (!tab.est || !tab.sum || !tab.gap || !tab.rng || !betas) {
     st = lw_error_set(err, LW_ENOMEM, "out of memory reweighting %d rungs", K);
     goto done;
   }
@@ -733,13 +803,6 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
   }
   tab.tlo = 1.0 / bhi;
   tab.thi = 1.0 / blo;
-  /* the error bars: each state's samples drawn again with replacement, a
-  ** fixed seed so that the output is the same every time.  The generator's
-  ** state at each resample is taken in turn (the draws of one after
-  ** another), then the resamples are solved on the threads, each into its
-  ** own slot, and summed in their order: the same bytes on any number of
-  ** threads, and a 128-rung reweighting's 32 solves no longer one by one */
-  gsl_rng_set(tab.rng, 1);
   if ((st = reweight_part(&s, &tab, err))) goto done;
   qsort(tab.gap, (size_t)tab.n_gaps, sizeof *tab.gap, gap_order); /* the coldest first */
   if (sel[0].csv) {
@@ -748,7 +811,7 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
     double thin = 0.0;
     for (int q = 0; q < K; q++) thin = fmax(thin, s.thin[q]);
     char overlap[64] = ""; /* (none with one temperature) */
-    if (!isnan(tab.lowest)) snprintf(overlap, sizeof overlap, ", neighbouring temperatures' overlap at least %.2g",
+    if (!isnan(tab.lowest)) snprintf(overlap, sizeof overlap, ", neighbouring temperatures' overlap at least %.3g",
                                      tab.lowest);
     fprintf(out, "reweighted over %d rung%s from T = %.6g to %.6g: %zu samples (each rung's rows thinned to one "
             "every 2 tau, at most every %.0f), %d iterations, %d bootstrap resamples%s\n", K, K > 1 ? "s" : "",
@@ -773,7 +836,7 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
   FILE *apart = sel[0].csv ? sel[0].csv_warnings : out;
   for (int g = 0; apart && g < tab.n_gaps; g++)
     fprintf(apart, "warning: no estimate between T = %.6g and %.6g: the rungs there share almost no energies "
-            "(overlap %.2g, under %g), and each side is reweighted alone (more rungs between them)\n",
+            "(overlap %.3g, under %g), and each side is reweighted alone (more rungs between them)\n",
             1.0 / tab.gap[g].b_hi, 1.0 / tab.gap[g].b_lo, tab.gap[g].overlap, LW_REWEIGHT_OVERLAP_MIN);
   if (apart && tab.inconsistent)
     fprintf(apart, "warning: %d rung%s own mean energy is not what the reweighting gives at %s temperature (the "
@@ -784,9 +847,20 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
   if (apart && s.open)
     fprintf(apart, "warning: %d rung%s autocorrelation window did not close: thinned by too little, the error "
             "bars are too small (a longer stretch is needed)\n", s.open, s.open > 1 ? "s'" : "'s");
-  if (apart && s.worst_swap < LW_REWEIGHT_SWAP_MIN)
+  /* the pair that exchanged least, of those whose curve is printed (one
+  ** across a gap named a curve of "-" rows, and hid the weak pairs) */
+  int worst = -1;
+  for (int i = 0; i < s.n_swaps; i++) {
+    const double lo = fmin(s.swap_b[2 * i], s.swap_b[2 * i + 1]), hi = fmax(s.swap_b[2 * i], s.swap_b[2 * i + 1]);
+    int across = 0;
+    for (int g = 0; g < tab.n_gaps; g++)
+      across |= tab.gap[g].b_lo >= lo * (1 - 1e-9) && tab.gap[g].b_hi <= hi * (1 + 1e-9);
+    if (!across && !isnan(s.swap[i]) && (worst < 0 || s.swap[i] < s.swap[worst])) worst = i;
+  }
+  if (apart && worst >= 0 && s.swap[worst] < LW_REWEIGHT_SWAP_MIN)
     fprintf(apart, "warning: rungs %d and %d exchanged in %.3g of the tries: their energies barely overlap and the "
-            "curve between them is unreliable (more rungs there)\n", s.worst_pair, s.worst_pair + 1, s.worst_swap);
+            "curve between them is unreliable (more rungs there)\n", s.swap_pair[worst], s.swap_pair[worst] + 1,
+            s.swap[worst]);
 done:
   if (st == LW_EINPUT && err && strncmp(err->msg, path[0], strlen(path[0]))) { /* the solver's, of this trace */
     char why[sizeof err->msg];
@@ -797,6 +871,7 @@ done:
   free(tab.est);
   free(tab.sum);
   free(tab.gap);
+  free(betas);
   gsl_rng_free(tab.rng);
   return st;
 }
