@@ -662,6 +662,21 @@ static void reweight_text(const char *text, int n, double *T, double *e, double 
   }
 }
 
+/* The reweighting of the trace at path at n temperatures (the table, or
+** CSV lines), into out. */
+static void table_of(const char *path, int n, int csv, char *out, size_t cap)
+{
+  lw_error err;
+  lw_trace *t = lw_trace_read(path, &err);
+  cr_assert_not_null(t, "%s", err.msg);
+  const char *paths[1] = {path};
+  FILE *f = fmemopen(out, cap, "w");
+  lw_trace_select sel = {.from = -1, .to = -1, .csv = csv};
+  cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, n, f, &err), LW_OK, "%s", err.msg);
+  fclose(f);
+  lw_trace_free(t);
+}
+
 /* The error bars must hold what the estimates scatter by: 40 traces of a
 ** 4-rung run (T = 1 .. 3.375) whose rows are Gamma energies (the harmonic
 ** system's law, so <E> = d/2 T exactly) correlated as a tempering run's
@@ -843,31 +858,21 @@ Test(reweight, rungs_that_share_no_energies_give_no_estimate_between_them, .init
     k += (size_t)snprintf(text + k, cap - k, "%zu,1,%.17g,1,%.17g,2,%.17g,2.5,%.17g\n", t + 1, e[0], e[0], e[1], e[2]);
   }
   write_trace("apart.csv", text, path, sizeof path);
-  lw_error err;
-  lw_trace *t = lw_trace_read(path, &err);
-  cr_assert_not_null(t, "%s", err.msg);
   static char out[4096];
-  const char *paths[1] = {path};
-  for (int csv = 1; csv >= 0; csv--) {
-    FILE *f = fmemopen(out, sizeof out, "w");
-    lw_trace_select sel = {.from = -1, .to = -1, .csv = csv};
-    cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, 5, f, &err), LW_OK, "%s", err.msg);
-    fclose(f);
-    if (!csv) break;
-    /* T = 1, 1.26, 1.58, 1.99, 2.5: rungs at the first and last only */
-    const char *line = strchr(out, '\n') + 1;
-    for (int j = 0; j < 5; j++, line = strchr(line, '\n') + 1) {
-      double T, e, se, c, sc;
-      int fields = sscanf(line, "%lf,%lf,%lf,%lf,%lf", &T, &e, &se, &c, &sc);
-      cr_assert_eq(fields, j == 0 || j == 4 ? 5 : 1, "row %d: %s", j, out);
-      if (fields == 5) cr_assert(fabs(c * T * T - 1) < 0.2, "a rung's own C: %s", out);
-      if (fields == 1) cr_assert(!strncmp(strchr(line, ','), ",,,,\n", 5), "row %d: %s", j, out);
-    }
+  table_of(path, 5, 1, out, sizeof out);
+  /* T = 1, 1.26, 1.58, 1.99, 2.5: rungs at the first and last only */
+  const char *line = strchr(out, '\n') + 1;
+  for (int j = 0; j < 5; j++, line = strchr(line, '\n') + 1) {
+    double T, e, se, c, sc;
+    int fields = sscanf(line, "%lf,%lf,%lf,%lf,%lf", &T, &e, &se, &c, &sc);
+    cr_assert_eq(fields, j == 0 || j == 4 ? 5 : 1, "row %d: %s", j, out);
+    if (fields == 5) cr_assert(fabs(c * T * T - 1) < 0.2, "a rung's own C: %s", out);
+    if (fields == 1) cr_assert(!strncmp(strchr(line, ','), ",,,,\n", 5), "row %d: %s", j, out);
   }
+  table_of(path, 5, 0, out, sizeof out);
   cr_assert(strstr(out, "warning: no estimate between T = 1 and 2: the rungs there share almost no energies")
             && strstr(out, "warning: no estimate between T = 2 and 2.5:") && strstr(out, "overlap at least "), "%s",
             out);
-  lw_trace_free(t);
   free(text);
   gsl_rng_free(r);
 }
@@ -887,8 +892,6 @@ Test(reweight, rungs_that_do_not_sample_one_system_are_said, .init = make_dir, .
   size_t cap = 200 * rows;
   char *text = malloc(cap), path[128];
   static char out[8192];
-  const char *paths[1] = {path};
-  lw_error err;
   for (int c = 0; c < 3; c++) {
     size_t k = (size_t)snprintf(text, cap, "sweep,temperature,total,replica0_temperature,replica0_energy,"
                                            "replica1_temperature,replica1_energy\n");
@@ -904,13 +907,7 @@ Test(reweight, rungs_that_do_not_sample_one_system_are_said, .init = make_dir, .
       k += (size_t)snprintf(text + k, cap - k, "%zu,1,%.17g,1,%.17g,%g,%.17g\n", t + 1, e0, e0, T1, e1);
     }
     write_trace("one.csv", text, path, sizeof path);
-    lw_trace *t = lw_trace_read(path, &err);
-    cr_assert_not_null(t, "%s", err.msg);
-    FILE *f = fmemopen(out, sizeof out, "w");
-    lw_trace_select sel = {.from = -1, .to = -1};
-    cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, 5, f, &err), LW_OK, "%s", err.msg);
-    fclose(f);
-    lw_trace_free(t);
+    table_of(path, 5, 0, out, sizeof out);
     const int said = strstr(out, "warning: 1 rung's own mean energy is not what the reweighting gives at its "
                                  "temperature (the worst: T = 1, ") != NULL;
     cr_assert_eq(said, c == 0, "case %d: %s", c, out);
@@ -934,20 +931,12 @@ Test(reweight, a_fixed_trace_gives_the_table_it_gave)
   snprintf(path, sizeof path, "%s/tests/fixtures/reweight/trace.csv", lw_test_root());
   snprintf(want_path, sizeof want_path, "%s/tests/fixtures/reweight/expected.csv", lw_test_root());
   char *want = lw_test_slurp("%s", want_path);
-  lw_error err;
-  lw_trace *t = lw_trace_read(path, &err);
-  cr_assert_not_null(t, "%s", err.msg);
-  const char *paths[1] = {path};
   static char out[4096];
   for (int threads = 1; threads <= 3; threads += 2) {
     omp_set_num_threads(threads);
-    FILE *f = fmemopen(out, sizeof out, "w");
-    lw_trace_select sel = {.from = -1, .to = -1, .csv = 1};
-    cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, 9, f, &err), LW_OK, "%s", err.msg);
-    fclose(f);
+    table_of(path, 9, 1, out, sizeof out);
     cr_assert_str_eq(out, want, "%d threads", threads);
   }
-  lw_trace_free(t);
   free(want);
 }
 
@@ -962,16 +951,8 @@ Test(reweight, rungs_all_apart_that_do_not_settle_together_are_split)
 {
   char path[512];
   snprintf(path, sizeof path, "%s/tests/fixtures/reweight/apart.csv", lw_test_root());
-  lw_error err;
-  lw_trace *t = lw_trace_read(path, &err);
-  cr_assert_not_null(t, "%s", err.msg);
-  const char *paths[1] = {path};
-  static char out[4096];
-  FILE *f = fmemopen(out, sizeof out, "w");
-  lw_trace_select sel = {.from = -1, .to = -1};
-  cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, 4, f, &err), LW_OK, "%s", err.msg);
-  fclose(f);
-  lw_trace_free(t);
+  static char out[4096], three[4096];
+  table_of(path, 4, 0, out, sizeof out);
   const char *line = strchr(strchr(out, '\n') + 1, '\n') + 1;
   for (int j = 0; j < 4; j++, line = strchr(line, '\n') + 1) {
     double T, e, se, c, sc;
@@ -984,12 +965,7 @@ Test(reweight, rungs_all_apart_that_do_not_settle_together_are_split)
   /* a rung's row whatever else is asked: at 3 temperatures the rungs at 4
   ** and 2 have none, and drew no resamples from the generator the rung at 1,
   ** solved after them, then used (its error bars moved by up to 1.5 times) */
-  static char three[4096];
-  t = lw_trace_read(path, &err);
-  f = fmemopen(three, sizeof three, "w");
-  cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, 3, f, &err), LW_OK, "%s", err.msg);
-  fclose(f);
-  lw_trace_free(t);
+  table_of(path, 3, 0, three, sizeof three);
   const char *one4 = strstr(out, "\n              1 "), *one3 = strstr(three, "\n              1 ");
   cr_assert(one4 && one3 && !strncmp(one4, one3, (size_t)(strchr(one4 + 1, '\n') - one4)), "%s\n%s", out, three);
 }
