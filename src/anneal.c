@@ -1076,10 +1076,14 @@ static lw_status truncate_trace(lw_anneal *a, long bytes, lw_error *err)
   struct stat sb;
   /* a link is refused before the trace is cut (truncate cut the file it
   ** named) or read, in either format (a format-1 state's resume wrote
-  ** through it, exit 1 where this says 2) */
+  ** through it, exit 1 where this says 2); and so is what is not a file (a
+  ** FIFO there held a format-1 resume in fopen for ever, deaf to SIGTERM) */
   if (!lstat(path, &sb) && S_ISLNK(sb.st_mode))
     return lw_error_set(err, LW_EINPUT, "%s: a symbolic link: a run writes into its own directory only (put the "
                         "trace itself there)", path);
+  if (!lstat(path, &sb) && !S_ISREG(sb.st_mode))
+    return lw_error_set(err, LW_EINPUT, "%s: not a regular file (a FIFO, a device or a folder): the run's trace is "
+                        "a file of its own", path);
   if (bytes >= 0) {
     if (stat(path, &sb))
       return lw_error_set(err, LW_EINPUT, "%s: %s, but state.lw counts %ld bytes of it", path, strerror(errno), bytes);

@@ -89,8 +89,8 @@ lw_status lw_output_subdir(const char *dir, const char *sub, char *path, size_t 
   if (mkdir(path, 0777) && errno != EEXIST)
     return lw_error_set(err, LW_EIO, "%s: cannot create directory: %s", path, strerror(errno));
   if (lstat(path, &sb)) return lw_error_set(err, LW_EIO, "%s: %s", path, strerror(errno));
-  if (!S_ISDIR(sb.st_mode))
-    return lw_error_set(err, LW_EIO, "%s: %s, not a folder: a run writes its %s only into its own directory; remove "
+  if (!S_ISDIR(sb.st_mode)) /* (bad input, as a run's start says it: exit 2) */
+    return lw_error_set(err, LW_EINPUT, "%s: %s, not a folder: a run writes its %s only into its own directory; remove "
                         "it", path, S_ISLNK(sb.st_mode) ? "a symbolic link" : "a file", sub);
   return LW_OK;
 }

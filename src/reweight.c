@@ -298,7 +298,8 @@ typedef struct {
   int n_swaps;        /* neighbour pairs with an exchange column: */
   double *swap;       /* their acceptance over the rows (NAN: none), */
   double *swap_b;     /* 2 each: their rungs' inverse temperatures, */
-  int *swap_pair;     /* the pair's number in its run */
+  int *swap_pair;     /* the pair's number in its run, */
+  int *swap_run;      /* and the run */
 } rw_states;
 
 static void states_free(rw_states *s)
@@ -312,6 +313,7 @@ static void states_free(rw_states *s)
   free(s->swap);
   free(s->swap_b);
   free(s->swap_pair);
+  free(s->swap_run);
 }
 
 /* The mean of column col over the rows, empty fields skipped (NAN: none). */
@@ -351,9 +353,10 @@ static lw_status gather(const lw_trace *const *t, const char *const *path, const
   s->swap = malloc((size_t)rungs * sizeof *s->swap);
   s->swap_b = malloc(2 * (size_t)rungs * sizeof *s->swap_b);
   s->swap_pair = malloc((size_t)rungs * sizeof *s->swap_pair);
+  s->swap_run = malloc((size_t)rungs * sizeof *s->swap_run);
   double *x = malloc((most ? most : 1) * sizeof *x);
   if (!s->E || !s->first || !s->beta || !s->thin || !s->run || !s->rows || !s->swap || !s->swap_b || !s->swap_pair ||
-      !x) {
+      !s->swap_run || !x) {
     st = lw_error_set(err, LW_ENOMEM, "out of memory reweighting %zu rows", cap);
     goto done;
   }
@@ -413,6 +416,7 @@ static lw_status gather(const lw_trace *const *t, const char *const *path, const
       s->swap[s->n_swaps] = column_mean(t[r], row, n, col);
       s->swap_b[2 * s->n_swaps] = s->beta[s->K - m + q];
       s->swap_b[2 * s->n_swaps + 1] = s->beta[s->K - m + q + 1];
+      s->swap_run[s->n_swaps] = r;
       s->swap_pair[s->n_swaps++] = q;
     }
     free(row);
@@ -664,22 +668,28 @@ static lw_status states_between(const rw_states *s, double lo, double hi, rw_sta
 static void check_rungs(const rw_states *s, const double *log_den, rw_table *tab)
 {
   const size_t n = s->first[s->K];
-  for (int q = 0; q < s->K; q++) {
+  for (int q = 0; q < s->K && s->K > 1; q++) {
     const size_t a = s->first[q], m = s->first[q + 1] - a;
-    if (m < 2) continue;
+    /* an error bar from a few samples is itself far off (at 3 a rung, 14
+    ** in 30 healthy traces warned): judged from LW_REWEIGHT_CONSISTENT_MIN */
+    if (m < LW_REWEIGHT_CONSISTENT_MIN) continue;
     double mean = mean_of(s->E + a, m), ss = 0.0, e, c;
     for (size_t i = 0; i < m; i++) ss += (s->E[a + i] - mean) * (s->E[a + i] - mean);
     const double se = sqrt(ss / (double)(m - 1) / (double)m);
     lw_reweight_at(s->E, n, log_den, s->beta[q], &e, &c);
-    const double z = fabs(e - mean) / se;
-    if (se > 0.0 && z > LW_REWEIGHT_CONSISTENT && !(z <= tab->worst_z)) {
+    /* a rung whose energy never changes (stuck) has no error bar: any
+    ** difference past rounding is one (it was passed over, and a stuck rung
+    ** read 53.77 for its 50) */
+    const double d = fabs(e - mean), z = se > 0.0 ? d / se : d > 1e-9 * fabs(mean) ? INFINITY : 0.0;
+    if (!(z > LW_REWEIGHT_CONSISTENT)) continue;
+    tab->inconsistent++;
+    if (!(z <= tab->worst_z)) {
       tab->worst_z = z;
       tab->worst_t = 1.0 / s->beta[q];
       tab->worst_own = mean;
       tab->worst_se = se;
       tab->worst_rw = e;
     }
-    tab->inconsistent += z > LW_REWEIGHT_CONSISTENT && se > 0.0;
   }
 }
 
@@ -858,9 +868,9 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
     if (!across && !isnan(s.swap[i]) && (worst < 0 || s.swap[i] < s.swap[worst])) worst = i;
   }
   if (apart && worst >= 0 && s.swap[worst] < LW_REWEIGHT_SWAP_MIN)
-    fprintf(apart, "warning: rungs %d and %d exchanged in %.3g of the tries: their energies barely overlap and the "
-            "curve between them is unreliable (more rungs there)\n", s.swap_pair[worst], s.swap_pair[worst] + 1,
-            s.swap[worst]);
+    fprintf(apart, "warning: rungs %d and %d%s%s exchanged in %.3g of the tries: their energies barely overlap and "
+            "the curve between them is unreliable (more rungs there)\n", s.swap_pair[worst], s.swap_pair[worst] + 1,
+            k > 1 ? " of " : "", k > 1 ? path[s.swap_run[worst]] : "", s.swap[worst]);
 done:
   if (st == LW_EINPUT && err && strncmp(err->msg, path[0], strlen(path[0]))) { /* the solver's, of this trace */
     char why[sizeof err->msg];

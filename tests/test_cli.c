@@ -1260,6 +1260,11 @@ Test(cli, links_planted_in_a_run_directory_are_not_followed)
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
   cr_assert(strstr(errs, "trace.csv: a symbolic link"), "%s", errs);
   cr_assert_neq(lw_test_sh("test -e %s/planted", dir), 0, "the trace's link made its file");
+  /* a FIFO there held that resume in fopen for ever, deaf to SIGTERM */
+  cr_assert_eq(lw_test_sh("cd %s && rm v1/trace.csv && mkfifo v1/trace.csv", dir), 0);
+  cr_assert_eq(lw_test_sh("timeout -s KILL 30 %s resume %s/v1 --quiet --threads 1 2>%s/fifo.err; test $? -eq 2 && "
+                          "grep -q 'trace.csv: not a regular file' %s/fifo.err", lw_test_bin(), dir, dir, dir), 0,
+               "%s", lw_test_slurp("%s/fifo.err", dir));
 }
 
 /* A file a key names that never ends: a FIFO waited for a writer for ever

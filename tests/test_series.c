@@ -883,7 +883,10 @@ Test(reweight, rungs_that_share_no_energies_give_no_estimate_between_them, .init
 ** now a rung's own mean against the reweighted one at its temperature says
 ** so.  Rungs of one system's laws (Gamma energies of the harmonic system)
 ** differ by about their error bars, and get no such warning; nor has a
-** table of one temperature an overlap to state. */
+** table of one temperature an overlap to state.  A rung stuck at one
+** energy has no error bar, and was passed over (it read 53.77 for its 50);
+** a rung of under 20 samples is not judged (its error bar from 3 warned in
+** 14 of 30 healthy traces). */
 Test(reweight, rungs_that_do_not_sample_one_system_are_said, .init = make_dir, .fini = remove_dir)
 {
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
@@ -892,13 +895,16 @@ Test(reweight, rungs_that_do_not_sample_one_system_are_said, .init = make_dir, .
   size_t cap = 200 * rows;
   char *text = malloc(cap), path[128];
   static char out[8192];
-  for (int c = 0; c < 3; c++) {
+  for (int c = 0; c < 5; c++) {
     size_t k = (size_t)snprintf(text, cap, "sweep,temperature,total,replica0_temperature,replica0_energy,"
                                            "replica1_temperature,replica1_energy\n");
-    for (size_t t = 0; t < rows; t++) {
+    for (size_t t = 0; t < (c == 4 ? 10 : rows); t++) {
       double e0, e1, T1 = c == 2 ? 1.0 : 2.0;
-      if (c == 0) { /* stuck */
+      if (c == 0 || c == 4) { /* stuck in a basin; with 10 rows, not judged */
         e0 = 100.0 + gsl_ran_gaussian(r, 0.1);
+        e1 = 110.0 + gsl_ran_gaussian(r, 10.0);
+      } else if (c == 3) { /* stuck at one energy */
+        e0 = 100.0;
         e1 = 110.0 + gsl_ran_gaussian(r, 10.0);
       } else {
         e0 = gsl_ran_gamma(r, HARMONIC_D / 2.0, 1.0);
@@ -908,9 +914,9 @@ Test(reweight, rungs_that_do_not_sample_one_system_are_said, .init = make_dir, .
     }
     write_trace("one.csv", text, path, sizeof path);
     table_of(path, 5, 0, out, sizeof out);
-    const int said = strstr(out, "warning: 1 rung's own mean energy is not what the reweighting gives at its "
-                                 "temperature (the worst: T = 1, ") != NULL;
-    cr_assert_eq(said, c == 0, "case %d: %s", c, out);
+    const int said = strstr(out, " own mean energy is not what the reweighting gives at ") &&
+                     strstr(out, "(the worst: T = 1, ");
+    cr_assert_eq(said, c == 0 || c == 3, "case %d: %s", c, out);
     cr_assert_eq(strstr(out, "overlap at least ") != NULL, c != 2, "case %d: %s", c, out);
     cr_assert(!strstr(out, "nan"), "case %d: %s", c, out);
   }

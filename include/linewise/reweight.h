@@ -41,6 +41,8 @@
 #define LW_REWEIGHT_CONSISTENT 5.0 /* error bars by which a rung's own mean energy may differ from the
                                        reweighted one at its temperature before a warning says the rungs do
                                        not sample one system */
+#define LW_REWEIGHT_CONSISTENT_MIN 20 /* samples a rung needs for that comparison (an error bar of fewer is
+                                         itself too uncertain) */
 #define LW_REWEIGHT_SWAP_MIN 0.05   /* neighbour exchange acceptance below which a warning says the
                                        rungs barely overlap */
 
