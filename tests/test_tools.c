@@ -244,6 +244,10 @@ Test(tools, seed_sweep_gathers_every_summary_and_links_the_best)
   ** temporaries were sought in another directory, and the sweep failed) */
   cr_assert_eq(sh("cd %s && %s %s --seeds 1 " TINY " --bin %s --out 'n\n' && test -s 'n\n/sweep.csv' && "
                   "test -L 'n\n/best'", dir, tool("seed-sweep"), scene(), env("LW_BIN")), 0, "%s", err_txt());
+  /* and one named with a leading '-' (mkdir and mv took it for options) */
+  cr_assert_eq(sh("cd %s && %s %s --seeds 1 " TINY " --bin %s --out -d && test -s ./-d/sweep.csv && "
+                  "test -L ./-d/best && test -z \"$(ls -A ./-d | grep '^\\.')\"", dir, tool("seed-sweep"), scene(),
+                  env("LW_BIN")), 0, "%s", err_txt());
 }
 
 /* Runs that agree to the last bit have no spread: the sums of e and e^2
