@@ -8,6 +8,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -1294,6 +1296,14 @@ Test(cli, a_fifo_or_an_endless_file_named_by_a_key_is_refused_at_once)
   }
   cr_assert_eq(lw_test_sh("timeout 60 %s run %s/fifo 2>&1 | grep -q 'fifo: a FIFO (named pipe), not a file'",
                           lw_test_bin(), dir), 0);
+  /* a socket too (the check went untested) */
+  struct sockaddr_un sa = {.sun_family = AF_UNIX};
+  snprintf(sa.sun_path, sizeof sa.sun_path, "%s/sock", dir);
+  int fd = socket(AF_UNIX, SOCK_STREAM, 0);
+  cr_assert(fd >= 0 && !bind(fd, (struct sockaddr *)&sa, sizeof sa));
+  cr_assert_eq(lw_test_sh("timeout 60 %s run %s/params/minimal.ini --out %s/o --quiet --set init.from=%s/sock 2>&1 | "
+                          "grep -q 'sock: a socket, not a file'", lw_test_bin(), lw_test_root(), dir, dir), 0);
+  close(fd);
   /* a FIFO in a run directory, where a run's own file stands: refused, not waited on */
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out r --quiet --stop-at 0 && rm r/scene.ini && "
                           "mkfifo r/scene.ini && rm -f r/timing.txt && mkfifo r/timing.txt", dir, lw_test_bin(),
