@@ -397,6 +397,14 @@ Test(run, a_checkpoint_is_marked_committed_as_state_lw_is)
   cr_assert_eq(lw_phase_last_commit(&pending), a.sweep);
   cr_assert_eq(pending, -1, "the commit is marked as under way after it ended");
   cr_assert_eq(sh("grep -q '^sweep = %ld$' %s/c/state.lw", a.sweep, dir), 0);
+  /* a commit that fails (state.lw a folder, so the rename cannot replace
+  ** it) leaves the mark at the last one made, not at this sweep */
+  const long committed = a.sweep;
+  cr_assert_eq(sh("rmdir %s/c/replica-1.lw.tmp && rm %s/c/state.lw && mkdir -p %s/c/state.lw/x", dir, dir, dir), 0);
+  cr_assert_eq(lw_anneal_sweep(&a, &err), LW_OK, "%s", err.msg);
+  cr_assert_neq(lw_anneal_checkpoint(&a, &err), LW_OK, "state.lw was replaced");
+  cr_assert_eq(lw_phase_last_commit(&pending), committed, "a failed commit was marked");
+  cr_assert_eq(pending, -1);
   lw_anneal_free(&a);
 }
 
