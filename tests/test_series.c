@@ -639,29 +639,6 @@ static size_t ladder_row(char *text, size_t cap, size_t t, const double e[4])
   return k + (size_t)snprintf(text + k, cap - k, ",0.3,0.3,0.3\n");
 }
 
-/* The trace text reweighted at n temperatures (the csv table): each row's
-** temperature, <E> and its error bar, and C's error bar. */
-static void reweight_text(const char *text, int n, double *T, double *e, double *se, double *sc)
-{
-  static char out[4096];
-  char path[128];
-  write_trace("rw.csv", text, path, sizeof path);
-  lw_error err;
-  lw_trace *t = lw_trace_read(path, &err);
-  cr_assert_not_null(t, "%s", err.msg);
-  FILE *f = fmemopen(out, sizeof out, "w");
-  lw_trace_select sel = {.from = -1, .to = -1, .csv = 1};
-  const char *paths[1] = {path};
-  cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, n, f, &err), LW_OK, "%s", err.msg);
-  fclose(f);
-  lw_trace_free(t);
-  const char *line = strchr(out, '\n') + 1;
-  for (int j = 0; j < n; j++, line = strchr(line, '\n') + 1) {
-    double c;
-    cr_assert_eq(sscanf(line, "%lf,%lf,%lf,%lf,%lf", &T[j], &e[j], &se[j], &c, &sc[j]), 5, "%s", out);
-  }
-}
-
 /* The reweighting of the trace at path at n temperatures (the table, or
 ** CSV lines), into out. */
 static void table_of(const char *path, int n, int csv, char *out, size_t cap)
@@ -675,6 +652,21 @@ static void table_of(const char *path, int n, int csv, char *out, size_t cap)
   cr_assert_eq(lw_trace_reweight((const lw_trace *const *)&t, paths, &sel, 1, n, f, &err), LW_OK, "%s", err.msg);
   fclose(f);
   lw_trace_free(t);
+}
+
+/* The trace text reweighted at n temperatures (the csv table): each row's
+** temperature, <E> and its error bar, and C's error bar. */
+static void reweight_text(const char *text, int n, double *T, double *e, double *se, double *sc)
+{
+  static char out[4096];
+  char path[128];
+  write_trace("rw.csv", text, path, sizeof path);
+  table_of(path, n, 1, out, sizeof out);
+  const char *line = strchr(out, '\n') + 1;
+  for (int j = 0; j < n; j++, line = strchr(line, '\n') + 1) {
+    double c;
+    cr_assert_eq(sscanf(line, "%lf,%lf,%lf,%lf,%lf", &T[j], &e[j], &se[j], &c, &sc[j]), 5, "%s", out);
+  }
 }
 
 /* The error bars must hold what the estimates scatter by: 40 traces of a
