@@ -22,7 +22,7 @@ static char dir[64];
 
 static void make_dir(void)
 {
-  strcpy(dir, "/tmp/lw_cli_XXXXXX");
+  lw_test_tmp_name(dir, "cli");
   cr_assert_not_null(mkdtemp(dir));
 }
 

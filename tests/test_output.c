@@ -21,7 +21,7 @@
 
 static void make_dir(char *dir)
 {
-  strcpy(dir, "/tmp/lw_output_XXXXXX");
+  lw_test_tmp_name(dir, "output");
   cr_assert_not_null(mkdtemp(dir));
 }
 
@@ -65,7 +65,7 @@ static int count_tmp(const char *dir)
   return n;
 }
 
-/* Removes the files of dir, then dir (tests leave /tmp clean). */
+/* Removes the files of dir, then dir (tests leave no files behind). */
 static void remove_dir(const char *dir)
 {
   DIR *d = opendir(dir);

@@ -19,7 +19,7 @@
 static const char *ini(const char *text)
 {
   static char path[64];
-  strcpy(path, "/tmp/lw_params_XXXXXX");
+  lw_test_tmp_name(path, "params");
   int fd = mkstemp(path);
   cr_assert(fd >= 0);
   FILE *f = fdopen(fd, "w");
@@ -43,7 +43,8 @@ Test(params, defaults_cover_every_key_and_read_back)
   cr_assert_eq(p.quadrature, 8);
   cr_assert_eq(p.width, 210);
   /* write every value and read it back */
-  char path[] = "/tmp/lw_params_rt_XXXXXX";
+  char path[64];
+  lw_test_tmp_name(path, "params_rt");
   int fd = mkstemp(path);
   FILE *f = fdopen(fd, "w");
   p.pair = 0.125;
@@ -273,7 +274,8 @@ Test(params, text_that_ini_cannot_hold_is_refused)
   }
   /* what INI does hold is still fine, and survives a write/read cycle */
   cr_assert_eq(lw_params_set(&p, "anneal.table=dir with spaces/a;b #c.txt", &err), LW_OK, "%s", err.msg);
-  char path[] = "/tmp/lw_params_txt_XXXXXX";
+  char path[64];
+  lw_test_tmp_name(path, "params_txt");
   FILE *f = fdopen(mkstemp(path), "w");
   cr_assert_eq(lw_params_write(&p, f), 0);
   fclose(f);
@@ -331,7 +333,8 @@ Test(params, long_lines_are_refused_with_their_own_line_number)
   cr_assert_eq(lw_params_set(&p, set, &err), LW_EUSAGE, "accepted %zu characters", cap + 1);
   set[strlen(set) - 1] = '\0';
   cr_assert_eq(lw_params_set(&p, set, &err), LW_OK, "%s", err.msg);
-  char path[] = "/tmp/lw_params_long_XXXXXX";
+  char path[64];
+  lw_test_tmp_name(path, "params_long");
   FILE *f = fdopen(mkstemp(path), "w");
   cr_assert_eq(lw_params_write(&p, f), 0);
   fclose(f);
@@ -413,7 +416,8 @@ Test(params, a_list_goes_on_over_indented_lines_and_reads_back)
   *v = '\0';
   cr_assert_eq(lw_params_set(&q2, tabs, &err), LW_OK, "%s", err.msg);
   cr_assert_str_eq(q2.ladder, p.ladder);
-  char path[] = "/tmp/lw_params_list_XXXXXX";
+  char path[64];
+  lw_test_tmp_name(path, "params_list");
   FILE *f = fdopen(mkstemp(path), "w");
   cr_assert_eq(lw_params_write(&p, f), 0);
   fclose(f);
@@ -592,7 +596,8 @@ Test(params, a_constant_schedule_has_one_step_unless_the_scene_says)
 ** than its default, and never in a run's own scene.ini (which names all). */
 Test(params, a_key_is_given_only_with_a_value_of_its_own)
 {
-  char path[] = "/tmp/lw_params_given_XXXXXX";
+  char path[64];
+  lw_test_tmp_name(path, "params_given");
   int fd = mkstemp(path);
   FILE *f = fdopen(fd, "w");
   fputs("[energy]\nbending = 0\nstrain = 2\n[output]\norder = 2opt\npen_colors =\n[scene]\nfield = vortex\n", f);
@@ -627,7 +632,8 @@ Test(params, a_key_is_given_only_with_a_value_of_its_own)
 ** takes the default; a value below 0 but -1 is refused. */
 Test(params, a_field_core_of_a_run_begun_before_it_is_none)
 {
-  char path[] = "/tmp/lw_params_core_XXXXXX";
+  char path[64];
+  lw_test_tmp_name(path, "params_core");
   int fd = mkstemp(path);
   cr_assert_geq(fd, 0);
   close(fd);

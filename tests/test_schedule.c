@@ -22,10 +22,10 @@ static double expected(const lw_schedule_type *t, const lw_schedule *s, long b)
   return ts; /* constant */
 }
 
-/* A file in /tmp holding text; the caller unlinks path. */
+/* A temporary file holding text; the caller unlinks path. */
 static void temp_file(char path[64], const char *text)
 {
-  snprintf(path, 64, "/tmp/lw_schedule_XXXXXX");
+  lw_test_tmp_name(path, "schedule");
   int fd = mkstemp(path);
   cr_assert(fd >= 0, "mkstemp");
   size_t n = strlen(text);

@@ -10,12 +10,13 @@
 
 #include "linewise/number.h"
 #include "linewise/state.h"
+#include "testutil.h"
 
 static char dir[64];
 
 static void make_dir(void)
 {
-  strcpy(dir, "/tmp/lw_state_XXXXXX");
+  lw_test_tmp_name(dir, "state");
   cr_assert_not_null(mkdtemp(dir));
 }
 
@@ -242,7 +243,7 @@ Test(state, strict_numbers)
 ** and a state padded with NULs (a sparse file: 96 MiB of them, more than a
 ** line may hold) is refused at once naming the NUL, not read to 64 MiB and
 ** called a long line, nor called cut short (it ends in NULs, not a line). */
-Test(state, text_stops_at_its_first_nul, .init = make_dir)
+Test(state, text_stops_at_its_first_nul)
 {
   char path[128];
   snprintf(path, sizeof path, "%s/nul.txt", dir);

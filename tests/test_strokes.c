@@ -419,7 +419,8 @@ Test(strokes, bad_plot_keys_exit_2_naming_file_line_and_key)
 {
   const char *b = getenv("LW_BIN");
   cr_assert_not_null(b, "LW_BIN must name bin/linewise (make test sets it)");
-  char dir[] = "/tmp/lw_strokes_XXXXXX";
+  char dir[64];
+  lw_test_tmp_name(dir, "strokes");
   cr_assert_not_null(mkdtemp(dir));
   struct {
     const char *line, *key;

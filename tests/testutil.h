@@ -3,6 +3,7 @@
 #define LINEWISE_TESTUTIL_H
 
 #include <criterion/criterion.h>
+#include <ctype.h>
 #include <gsl/gsl_math.h>
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
@@ -141,12 +142,31 @@ static inline void lw_test_circle(lw_splines *sp, size_t i, double cx, double cy
   sp->rest_length[i] = 2.0 * M_PI * R;
 }
 
-/* A fresh directory /tmp/lw_<tag>_XXXXXX for a suite's files, into dir
+/* Where the suites keep their files: $TMPDIR when it is a plain absolute path
+** of at most 32 characters, else /tmp.  The suites paste these paths into
+** shell commands unquoted and keep them in 64-byte buffers, so a TMPDIR with
+** spaces, quotes or a long name is passed over rather than half-honoured. */
+static inline const char *lw_test_tmp(void)
+{
+  const char *t = getenv("TMPDIR");
+  if (!t || t[0] != '/' || strlen(t) > 32) return "/tmp";
+  for (const char *c = t; *c; c++)
+    if (!isalnum((unsigned char)*c) && !strchr("_./+-", *c)) return "/tmp";
+  return t;
+}
+
+/* The mkstemp/mkdtemp template <tmp>/lw_<tag>_XXXXXX, into path (64 chars). */
+static inline char *lw_test_tmp_name(char path[64], const char *tag)
+{
+  snprintf(path, 64, "%s/lw_%s_XXXXXX", lw_test_tmp(), tag);
+  return path;
+}
+
+/* A fresh directory <tmp>/lw_<tag>_XXXXXX for a suite's files, into dir
 ** (64 chars); 0 on success.  lw_test_dir_remove deletes it and its files. */
 static inline int lw_test_dir_make(char dir[64], const char *tag)
 {
-  snprintf(dir, 64, "/tmp/lw_%s_XXXXXX", tag);
-  return mkdtemp(dir) ? 0 : -1;
+  return mkdtemp(lw_test_tmp_name(dir, tag)) ? 0 : -1;
 }
 /* The whole file named by the format (NUL-terminated, caller frees), or NULL. */
 static inline char *lw_test_slurp(const char *fmt, ...) __attribute__((format(printf, 1, 2)));

@@ -222,12 +222,8 @@ static void domains_table(bench_ctx *b, int scene, const char *dir, FILE *data)
 void bench_domains(bench_ctx *b)
 {
   FILE *d = b->doc[BENCH_PERFORMANCE];
-  char dir[] = "/tmp/lw_bench_domains_XXXXXX";
-  if (!mkdtemp(dir)) {
-    lw_error err = {.code = LW_EIO};
-    snprintf(err.msg, sizeof err.msg, "cannot make a scratch directory");
-    bench_die("domains", &err);
-  }
+  char dir[128];
+  bench_scratch_dir(dir, sizeof dir, "domains");
   fprintf(d, "## Domains: one replica on every core\n\n"
              "The scaling section's scene at %d splines, annealed at constant T = 0.05 by lw_anneal with\n"
              "`[anneal] domains = auto` (docs/NUMERICS.md, \"Domains\"): each sweep shifts the lattice of\n"
@@ -246,7 +242,5 @@ void bench_domains(bench_ctx *b)
   domains_table(b, DOM_PAIR, dir, f);
   domains_table(b, DOM_PARTICLES, dir, f);
   fclose(f);
-  char cmd[96];
-  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-  if (system(cmd) != 0) bench_note("domains: could not remove %s", dir);
+  bench_scratch_remove(dir);
 }

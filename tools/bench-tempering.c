@@ -182,12 +182,8 @@ void bench_tempering(bench_ctx *b)
 {
   FILE *d = b->doc[BENCH_PERFORMANCE];
   int reps = b->reps, cores = omp_get_num_procs();
-  char dir[] = "/tmp/lw_bench_pt_XXXXXX";
-  if (!mkdtemp(dir)) {
-    lw_error err = {.code = LW_EIO};
-    snprintf(err.msg, sizeof err.msg, "cannot make a scratch directory");
-    bench_die("tempering", &err);
-  }
+  char dir[128];
+  bench_scratch_dir(dir, sizeof dir, "pt");
   fprintf(d, "## Parallel tempering\n\n"
              "150 splines of 4 segments, every term but potential and field, pair cutoff 4 mm,\n"
              "constant temperature, geometric ladder 0.05 to 1, an exchange step every sweep (the\n"
@@ -209,7 +205,5 @@ void bench_tempering(bench_ctx *b)
   fprintf(d, "\n");
   bench_mpi(b, d, dir, cores);
   omp_set_num_threads(cores);
-  char cmd[64];
-  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-  if (system(cmd) != 0) bench_note("tempering: could not remove %s", dir);
+  bench_scratch_remove(dir);
 }

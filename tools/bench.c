@@ -377,12 +377,8 @@ static void bench_scaling(bench_ctx *b)
 {
   FILE *d = b->doc[BENCH_PERFORMANCE];
   const int n = b->quick ? 2 : N_SCALE;
-  char dir[] = "/tmp/lw_bench_scale_XXXXXX";
-  if (!mkdtemp(dir)) {
-    lw_error err = {.code = LW_EIO};
-    snprintf(err.msg, sizeof err.msg, "cannot make a scratch directory");
-    bench_die("scaling", &err);
-  }
+  char dir[128];
+  bench_scratch_dir(dir, sizeof dir, "scale");
   fprintf(d, "## Scaling\n\n"
              "The throughput scene (lines 2.8 mm apart, every local term; with and without the pair\n"
              "term, near field off) at constant density from 10^3 to 10^%d splines, annealed as a run\n"
@@ -409,9 +405,7 @@ static void bench_scaling(bench_ctx *b)
   scaling_table(b, 0, n, dir, f);
   scaling_table(b, 1, n, dir, f);
   fclose(f);
-  char cmd[64];
-  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-  if (system(cmd) != 0) bench_note("scaling: could not remove %s", dir);
+  bench_scratch_remove(dir);
 }
 
 /* ---- start-up of one long spline --------------------------------------- */

@@ -1,5 +1,8 @@
 /* benchutil.c -- shared pieces of the benchmark (benchutil.h). */
+#define _XOPEN_SOURCE 700 /* nftw */
 #include "benchutil.h"
+#include <ctype.h>
+#include <ftw.h>
 #include <gsl/gsl_randist.h>
 #include <math.h>
 #include <stdarg.h>
@@ -34,6 +37,30 @@ void bench_die(const char *what, const lw_error *err)
 {
   fprintf(stderr, "bench: %s%s%s\n", what, err ? ": " : "", err ? err->msg : "");
   exit(1);
+}
+
+void bench_scratch_dir(char *dir, size_t n, const char *tag)
+{
+  /* the scratch paths go into shell commands unquoted (mpirun), so only a
+  ** plain TMPDIR is taken */
+  const char *t = getenv("TMPDIR");
+  int plain = t && t[0] == '/' && strlen(t) <= 64;
+  for (const char *c = t; plain && *c; c++) plain = isalnum((unsigned char)*c) || strchr("_./+-", *c);
+  if ((size_t)snprintf(dir, n, "%s/lw_bench_%s_XXXXXX", plain ? t : "/tmp", tag) >= n || !mkdtemp(dir)) {
+    fprintf(stderr, "bench: %s: cannot make a scratch directory for the %s runs\n", dir, tag);
+    exit(1);
+  }
+}
+
+static int remove_entry(const char *path, const struct stat *st, int type, struct FTW *ftw)
+{
+  (void)st, (void)type, (void)ftw;
+  return remove(path);
+}
+
+void bench_scratch_remove(const char *dir)
+{
+  if (nftw(dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS) != 0) bench_note("could not remove %s", dir);
 }
 
 FILE *bench_data(const bench_ctx *b, const char *name)

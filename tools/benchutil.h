@@ -65,6 +65,12 @@ void bench_die(const char *what, const lw_error *err);
 /* Opens datadir/name for writing (exits on failure). */
 FILE *bench_data(const bench_ctx *b, const char *name);
 
+/* A fresh scratch directory $TMPDIR/lw_bench_<tag>_XXXXXX into dir[n] (/tmp
+** when TMPDIR is unset, long, or holds characters a shell would read);
+** exits on failure.  bench_scratch_remove deletes it and all in it. */
+void bench_scratch_dir(char *dir, size_t n, const char *tag);
+void bench_scratch_remove(const char *dir);
+
 /* A progress line on stderr. */
 void bench_note(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 
