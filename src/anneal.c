@@ -365,6 +365,72 @@ static lw_status absolute_paths(lw_anneal *a, lw_error *err)
   return LW_OK;
 }
 
+/* The explicit ladder text into ladder[]: its count, or 0 with a message
+** naming where the text was written. */
+static int parse_ladder(const lw_params *p, const char *text, const char *where, double *ladder, lw_error *err)
+{
+  int n = lw_number_list(text, p->of_run ? 1 : 2, ladder, LW_TEMPERING_MAX);
+  if (n < 2 || n > LW_TEMPERING_MAX)
+    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%s'%s",
+                        where, LW_TEMPERING_MAX, text, lw_number_list_hint(n)), 0;
+  if (p->replicas != 1 && p->replicas != n)
+    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': %d temperatures for %d replicas: the ladder "
+                        "sets the count, so expected tempering.replicas = %d or 1 (its default)", where, n,
+                        p->replicas, n), 0;
+  for (int k = 0; k < n; k++)
+    if (!(ladder[k] > 0.0) || !isfinite(ladder[k]) || (k > 0 && !(ladder[k] > ladder[k - 1])))
+      return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected increasing positive "
+                          "temperatures, got '%s'", where, text), 0;
+  return n;
+}
+
+/* tempering.ladder_file into tempering.ladder, checked where the file says
+** it.  The run's scene.ini holds the ladder in its place, with no file: a
+** resume reads none (it may have been tuned again since), and a redraw
+** from that scene.ini is not given the ladder twice. */
+static lw_status read_ladder_file(lw_anneal *a, lw_error *err)
+{
+  lw_params *p = &a->params;
+  if (!p->ladder_file[0] || p->driver == LW_DRIVER_DYNAMICS) return LW_OK;
+  const lw_param_def *dl = lw_params_find("tempering", "ladder");
+  char where[LW_PATH_MAX + 32], other[LW_PATH_MAX + 32];
+  if (lw_params_given(p, dl)) {
+    lw_params_origin(p, lw_params_find("tempering", "ladder_file"), where, sizeof where);
+    lw_params_origin(p, dl, other, sizeof other);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder_file': tempering.ladder is given too (%s); "
+                        "expected one of them", where, other);
+  }
+  struct stat st;
+  const int unread = stat(p->ladder_file, &st) ? errno : 0;
+  if (unread || !S_ISREG(st.st_mode)) { /* (the reader's own message would call it a scene file) */
+    lw_error_set(err, LW_EINPUT, "cannot read '%s': %s", p->ladder_file,
+                 unread ? strerror(unread) : "not a regular file");
+    return lw_params_blame(p, "tempering", "ladder_file", err);
+  }
+  lw_params *f = malloc(sizeof *f);
+  if (!f) return lw_error_set(err, LW_ENOMEM, "out of memory reading %s", p->ladder_file);
+  lw_status s = lw_params_read_unresolved(f, p->ladder_file, err);
+  const int at = f->line[dl - lw_param_table];
+  for (size_t i = 0; !s && i < lw_param_count; i++)
+    if (f->line[i] > 0 && &lw_param_table[i] != dl)
+      s = lw_error_set(err, LW_EINPUT, "%s:%d: key '%s.%s': a ladder file holds only tempering.ladder (it is "
+                       "tempering.ladder_file of %s)", f->file, f->line[i], lw_param_table[i].section,
+                       lw_param_table[i].key, p->file);
+  if (!s && at <= 0)
+    s = lw_error_set(err, LW_EINPUT, "%s: no tempering.ladder in it: expected a [tempering] section with "
+                     "ladder = t0 t1 ..., as a run's ladder.ini (it is tempering.ladder_file of %s)", f->file,
+                     p->file);
+  double ladder[LW_TEMPERING_MAX];
+  snprintf(where, sizeof where, "%s:%d", f->file, at);
+  if (!s && !parse_ladder(p, f->ladder, where, ladder, err)) s = err->code;
+  if (!s) {
+    snprintf(p->ladder, sizeof p->ladder, "%s", f->ladder);
+    p->ladder_file[0] = '\0';
+  }
+  free(f);
+  return s;
+}
+
 /* Replicas of the run (the explicit ladder's length, or [tempering]
 ** replicas) and the base ladder; messages name the key's line. */
 static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
@@ -377,18 +443,8 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
   if (p->driver == LW_DRIVER_DYNAMICS) a->n_rep = 1;
   else if (p->ladder[0]) {
     lw_params_origin(p, lw_params_find("tempering", "ladder"), where, sizeof where);
-    int n = lw_number_list(p->ladder, p->of_run ? 1 : 2, ladder, LW_TEMPERING_MAX);
-    if (n < 2 || n > LW_TEMPERING_MAX)
-      return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%s'%s",
-                          where, LW_TEMPERING_MAX, p->ladder, lw_number_list_hint(n));
-    if (p->replicas != 1 && p->replicas != n)
-      return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': %d temperatures for %d replicas: the ladder "
-                          "sets the count, so expected tempering.replicas = %d or 1 (its default)", where, n,
-                          p->replicas, n);
-    for (int k = 0; k < n; k++)
-      if (!(ladder[k] > 0.0) || !isfinite(ladder[k]) || (k > 0 && !(ladder[k] > ladder[k - 1])))
-        return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected increasing positive "
-                            "temperatures, got '%s'", where, p->ladder);
+    int n = parse_ladder(p, p->ladder, where, ladder, err);
+    if (!n) return err->code;
     a->n_rep = n;
   } else if (a->n_rep > 1) {
     lw_params_origin(p, lw_params_find("tempering", "t_max"), where, sizeof where);
@@ -846,7 +902,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   ** locale after reading the scene wrote 'pair = 0,02' and JSON that is not */
   if ((s = lw_number_locale_ok(err))) return s;
   if ((s = dir_fits(a, dir, err))) return s;
-  if ((s = absolute_paths(a, err)) || (s = from_elsewhere(a, dir, err))) return s;
+  if ((s = absolute_paths(a, err)) || (s = from_elsewhere(a, dir, err)) || (s = read_ladder_file(a, err))) return s;
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   a->seed = (unsigned long)a->params.seed;
   a->block = -1;

@@ -436,6 +436,10 @@ const lw_param_def lw_param_table[] = {
        "Explicit ladder `t0 t1 ...` (increasing; overrides t_min and t_max; its length sets the "
        "replicas, and `replicas` may stay 1, as a run's scene.ini then keeps it; a long ladder goes on "
        "over indented lines). A run with ladder tuning writes its tuned ladder to ladder.ini for reuse."),
+  STRING("tempering", "ladder_file", ladder_file, "", "path",
+         "A file of the ladder instead of `ladder`, relative to the scene file: a `[tempering]` section "
+         "with `ladder = ...` and nothing else, as a run's ladder.ini is. Read when a run starts; the "
+         "run's scene.ini holds the ladder in the file's place, so a resume needs no file."),
   NUM("tempering", "exchange_every", LW_PT_INT, exchange_every, "1", "sweeps", 1, 2e9, 0,
       "Sweeps between exchange steps; steps alternate between even (0-1, 2-3, ...) and odd pairs."),
   CHOICE("tempering", "tune_ladder", tune_ladder, "fixed", "fixed|equal",

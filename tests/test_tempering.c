@@ -468,6 +468,64 @@ Test(ptrun, a_tuned_ladder_of_16_rungs_reads_back_pasted_and_through_set)
                0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
+/* tempering.ladder_file reads a run's ladder.ini, found from the scene
+** file's directory: the run is the one --set tempering.ladder gives, byte
+** for byte, scene.ini too, which holds the ladder in the file's place, so a
+** resume reads no ladder file (the one it began with is gone here) and a
+** redraw from scene.ini runs.  A file that is not a
+** ladder, or a ladder given twice, is refused naming the file and line at
+** fault, before anything is written. */
+Test(ptrun, a_ladder_file_runs_as_its_ladder_given_by_set)
+{
+  write_scene();
+  const char *bin = lw_test_bin();
+  cr_assert_eq(sh("%s run %s/s.ini --threads 1 --quiet --out %s/t", bin, dir, dir), 0);
+  cr_assert_eq(sh("mkdir %s/sub && cp %s/t/ladder.ini %s/lad.ini && (cat %s/s.ini; printf '[tempering]\n"
+                  "ladder_file = ../lad.ini\n') | sed '/^tune_ladder/d' > %s/sub/f.ini",
+                  dir, dir, dir, dir, dir),
+               0);
+  const char *fixed = "--threads 1 --quiet --set tempering.tune_ladder=fixed --set anneal.sweeps=40";
+  cr_assert_eq(sh("L=$(sed -n '/^ladder = /,$p' %s/lad.ini | sed 's/^ladder = //' | tr -s ' \n' '  ') && "
+                  "%s run %s/s.ini %s --set \"tempering.ladder=${L%% }\" --out %s/set 2> %s/err.txt",
+                  dir, bin, dir, fixed, dir, dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh("%s run %s/sub/f.ini %s --out %s/file 2> %s/err.txt", bin, dir, fixed, dir, dir), 0, "%s",
+               lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh("cd %s && cmp set/trace.csv file/trace.csv && cmp set/state.lw file/state.lw && "
+                  "cmp set/scene.ini file/scene.ini", dir),
+               0, "the ladder file's run is not the --set ladder's");
+  /* resumed without its ladder file */
+  cr_assert_eq(sh("cd %s && %s run sub/f.ini %s --stop-at 20 --out r && mv lad.ini gone.ini && "
+                  "%s resume r --threads 1 --quiet 2> err.txt && cmp r/trace.csv file/trace.csv && "
+                  "cmp r/state.lw file/state.lw && mv gone.ini lad.ini", dir, bin, fixed, bin),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh("cd %s && %s run file/scene.ini --set init.from=file/state.lw --set anneal.sweeps=0 --quiet "
+                  "--out redraw 2> err.txt && cmp redraw/final.svg file/final.svg", dir, bin),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  const struct {
+    const char *file, *set, *says;
+  } bad[] = {
+    {"[tempering]\nladder = 1 2 4\n[anneal]\nsweeps = 5\n", "",
+     "lad.ini:4: key 'anneal.sweeps': a ladder file holds only tempering.ladder"},
+    {"; nothing\n", "", "lad.ini: no tempering.ladder in it"},
+    {"[tempering]\nladder = 1 4 2 3\n", "", "lad.ini:2: key 'tempering.ladder': expected increasing positive"},
+    {"[tempering]\nladder = 1 2\n", "", "lad.ini:2: key 'tempering.ladder': 2 temperatures for 4 replicas"},
+    {"[tempering]\nladder = 1 2 3 4\n", "--set 'tempering.ladder=1 2 3 5'",
+     "f.ini:32: key 'tempering.ladder_file': tempering.ladder is given too (--set); expected one of them"},
+    {NULL, "", "f.ini:32: key 'tempering.ladder_file': cannot read '"},
+  };
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+    if (bad[k].file) cr_assert_eq(sh("printf '%s' > %s/lad.ini", bad[k].file, dir), 0);
+    else cr_assert_eq(sh("rm %s/lad.ini", dir), 0);
+    cr_assert_eq(sh("%s run %s/sub/f.ini %s %s --out %s/no 2> %s/err.txt", bin, dir, fixed, bad[k].set, dir, dir), 2,
+                 "case %zu", k);
+    char *msg = lw_test_slurp("%s/err.txt", dir);
+    cr_assert(strstr(msg, bad[k].says) && !strchr(strchr(msg, '\n') + 1, '\n'), "case %zu: %s", k, msg);
+    free(msg);
+    cr_assert_neq(sh("test -e %s/no", dir), 0, "case %zu wrote its run directory", k);
+  }
+}
+
 /* A tempering run of no sweep has no temperatures yet: its rungs said 0
 ** in summary.json (beside the ladder), where temperature_final was null. */
 Test(ptrun, a_run_of_no_sweep_gives_its_rungs_no_temperature)

@@ -168,6 +168,7 @@ typedef struct {
   int replicas;               /* 1 = no tempering */
   double t_min, t_max;        /* geometric ladder, energy units */
   char ladder[6144];          /* explicit ladder "t0 t1 ...", overrides t_min/t_max: 256 rungs at 17 digits */
+  char ladder_file[LW_PATH_MAX]; /* a file of the ladder (ladder.ini's form), read into ladder at a run's start */
   int exchange_every;         /* sweeps between exchange steps */
   int tune_ladder;            /* LW_LADDER_* */
   int ladder_sweeps;          /* warm-up sweeps of ladder tuning */
