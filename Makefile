@@ -210,10 +210,21 @@ wire-figures: $(BUILD)/wire-midpoint
 # The scenes with what they read (pictures, the states of init.from), the
 # tools, the man page, README and docs/; linewise-mpi where mpicc is (built
 # here, never an older one left in bin/).
+# The library, its headers and linewise.pc too, for a program that embeds it
+# (C or C++: `pkg-config --cflags --libs linewise`).
 INSTALLED := bin/linewise bin/linewise-mpi $(TOOLS:%=bin/linewise-%) bin/linewise-animate \
-             share/linewise share/doc/linewise share/man/man1/linewise.1
-install: $(BIN)/linewise $(PICTURE) $(MPI_BIN)
+             share/linewise share/doc/linewise share/man/man1/linewise.1 \
+             lib/liblinewise.a lib/pkgconfig/linewise.pc include/linewise
+LW_VERSION := $(shell sed -n 's/^\#define LW_VERSION "\(.*\)"/\1/p' include/linewise/version.h)
+install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/linewise/params $(DESTDIR)$(PREFIX)/share/doc/linewise
+	install -d $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/include/linewise
+	install -m 644 $(BUILD)/liblinewise.a $(DESTDIR)$(PREFIX)/lib/
+	install -m 644 include/linewise/*.h $(DESTDIR)$(PREFIX)/include/linewise/
+	printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
+	  'Name: linewise' 'Description: elastic Bezier curves annealed into line art (the library of linewise)' \
+	  'Version: $(LW_VERSION)' 'Requires: $(PKGS)' 'Libs: -L$${libdir} -llinewise -fopenmp -lm' \
+	  'Cflags: -I$${includedir}' > $(DESTDIR)$(PREFIX)/lib/pkgconfig/linewise.pc
 	install -m 755 $(BIN)/linewise $(MPI_BIN) $(DESTDIR)$(PREFIX)/bin/
 	install -m 644 params/*.ini params/*.lw $(PICTURE) $(DESTDIR)$(PREFIX)/share/linewise/params/
 	install -d $(DESTDIR)$(PREFIX)/share/man/man1

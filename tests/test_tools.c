@@ -950,6 +950,29 @@ Test(tools, thread_scaling_times_each_count_and_checks_the_bytes)
 
 /* ---- make install ------------------------------------------------------ */
 
+/* A program embeds the installed library, in C++ too: tests/embed.cpp,
+** built with nothing but what linewise.pc names, makes the run `linewise
+** run` makes, to the byte but for summary.json's clock. */
+Test(tools, an_installed_library_embeds_in_cxx_through_its_pkg_config, .timeout = 120)
+{
+  if (sh("{ command -v c++ && command -v pkg-config; }")) cr_skip_test("no c++ or pkg-config here");
+  cr_assert_eq(sh("make -s -C %s install DESTDIR=%s/lib PREFIX=/usr", env("LW_ROOT"), dir), 0, "%s", err_txt());
+  cr_assert_eq(sh("cd %s && flags=$(PKG_CONFIG_PATH=lib/usr/lib/pkgconfig pkg-config "
+                  "--define-variable=prefix=$PWD/lib/usr --cflags --libs linewise) && "
+                  "c++ -Wall -Werror -o embed %s/tests/embed.cpp $flags",
+                  dir, env("LW_ROOT")),
+               0, "%s", err_txt());
+  cr_assert_eq(sh("cd %s && { ./embed %s e && %s run %s --quiet --out c; }", dir, scene(), env("LW_BIN"), scene()),
+               0, "%s", err_txt());
+  cr_assert_eq(sh("cd %s && for f in state.lw trace.csv final.svg scene.ini; do cmp e/$f c/$f || exit 1; done && "
+                  "grep -v _second e/summary.json > e.json && grep -v _second c/summary.json > c.json && "
+                  "cmp e.json c.json && test $(grep -c _second c/summary.json) -eq 3", dir),
+               0, "%s", out_txt());
+  cr_assert_eq(sh("make -s -C %s uninstall DESTDIR=%s/lib PREFIX=/usr && test -z \"$(find %s/lib -type f)\"",
+                  env("LW_ROOT"), dir, dir),
+               0, "%s", err_txt());
+}
+
 /* An installed copy runs on its own: every scene with what it reads (the
 ** states of init.from once stayed behind), from another directory; the
 ** tools say the names they are installed under; uninstall takes it all. */

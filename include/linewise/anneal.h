@@ -33,6 +33,10 @@
 #include "linewise/system.h"
 #include "linewise/tempering.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct lw_anneal {
   lw_params params;
   const lw_system_type *sys_type; /* [scene] system */
@@ -190,5 +194,9 @@ void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n);
 #define LW_ANNEAL_DRIFT_NOTE 1e-6
 void lw_anneal_drift_note(const lw_anneal *a, char *buf, size_t n);
 double lw_anneal_seconds(const lw_anneal *a);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

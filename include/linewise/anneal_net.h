@@ -22,6 +22,10 @@
 #include "linewise/error.h"
 #include "linewise/tempering.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 struct lw_anneal;
 
 typedef struct lw_anneal_net lw_anneal_net;
@@ -48,5 +52,9 @@ struct lw_anneal_net {
 
 /* The process that sweeps replica r of n on p processes (n >= p). */
 static inline int lw_anneal_net_owner(int r, int n, int p) { return (int)((long long)r * p / n); }
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -20,6 +20,10 @@
 #include "linewise/error.h"
 #include "linewise/field.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef enum {
   LW_BOUNDARY_NONE,
   LW_BOUNDARY_RECT,
@@ -86,5 +90,9 @@ double lw_boundary_mask_slope(const lw_grid2d *sdt);
 
 /* Is (x, y) strictly inside? (d < 0) */
 int lw_boundary_inside(const lw_boundary *b, double x, double y);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -20,6 +20,10 @@
 #include "linewise/ckpt.h"
 #include "linewise/model.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* The name of the system's section of rung k in state.lw: "system <name>"
 ** for the coldest rung, "system <name> K" for rung K. */
 void lw_checkpoint_system_section(char *buf, size_t n, const lw_system_type *t, int k);
@@ -77,5 +81,9 @@ lw_status lw_checkpoint_check_finite(const lw_scene *sc, const lw_splines *sp, c
 ** sections of its replica files (rungs 1..n-1, NULL without tempering) as
 ** the keys of format 2, so one reader serves both. */
 lw_status lw_checkpoint_upgrade_v1(lw_ckpt *doc, lw_ckpt *const *replicas, int n_rep, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -27,6 +27,10 @@
 #include "linewise/error.h"
 #include "linewise/params.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* ---- reading ------------------------------------------------------------ */
 
 typedef struct lw_ckpt lw_ckpt;
@@ -130,5 +134,9 @@ void lw_ckpt_put_counts(lw_ckpt_writer *w, const char *key, const unsigned long 
 lw_status lw_ckpt_commit(lw_ckpt_writer *w, lw_error *err);
 /* Drops the temporary file (after a failure elsewhere). */
 void lw_ckpt_abort(lw_ckpt_writer *w);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

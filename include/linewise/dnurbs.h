@@ -21,6 +21,10 @@
 
 #include "linewise/nurbs.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct {
   size_t n;     /* control points */
   int k;        /* order: the band has k columns */
@@ -80,5 +84,9 @@ lw_status lw_band_factor(const double *A, const unsigned char *pin, size_t n, in
 ** lw_band_factor; r and x may be the same array). */
 void lw_band_solve(const double *L, const unsigned char *pin, size_t n, int k, const double *r, double *x);
 void lw_band_solve_dim(const double *L, const unsigned char *pin, size_t n, int k, int dim, const double *r, double *x);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -40,6 +40,10 @@
 #include "linewise/mc.h"
 #include "linewise/params.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Below this many sites a phase is not worth waking threads for. */
 #define LW_DOMAINS_MIN_PARALLEL 256
 
@@ -79,5 +83,9 @@ void lw_domains_free(lw_domains *d);
 
 /* One sweep of chain c (mc.h's lw_chain_sweep calls it). */
 lw_status lw_domains_sweep(lw_domains *d, lw_chain *c);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -47,6 +47,10 @@
 #include "linewise/scene.h"
 #include "linewise/strokes.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct {
   size_t paths;                       /* paths drawn */
   double travel_before, travel_after; /* pen-up travel, mm (plot.h) */
@@ -88,5 +92,9 @@ void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep);
 /* The report's lines for the command line ("linewise: ...\n" each) into
 ** buf[n]. */
 void lw_drawing_report_text(const lw_drawing_report *rep, char *buf, size_t n);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -28,6 +28,10 @@
 
 #include "linewise/dynamics.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Has the row factor the matrix (after the mass matrix is made) and
 ** allocates the scheme's scratch; LW_EINPUT naming the key if rho = 0 or the
 ** row has no such factor. */
@@ -35,5 +39,9 @@ lw_status lw_dyn_review_init(lw_dynamics *d, const lw_params *p, lw_error *err);
 
 /* One step; LW_EINPUT if the solve does not converge or the state is forbidden. */
 lw_status lw_dyn_review_step(lw_dynamics *d, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -55,6 +55,10 @@
 #include "linewise/params.h"
 #include "linewise/system.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct {
   const lw_system_type *type;
   void *state;               /* the system's state (not owned) */
@@ -112,5 +116,9 @@ void lw_dynamics_set_velocity(lw_dynamics *d, const double *xdot);
 /* Recomputes x, E and its gradient, and the mass matrix from the system's
 ** state (after a resume or an outside change of the state). */
 lw_status lw_dynamics_sync(lw_dynamics *d, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

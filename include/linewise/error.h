@@ -9,6 +9,10 @@
 #ifndef LINEWISE_ERROR_H
 #define LINEWISE_ERROR_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef enum {
   LW_OK = 0,
   LW_EINPUT,    /* bad input: a file, a key, a value (exit 2) */
@@ -46,5 +50,9 @@ int lw_error_exit_status(lw_status code);
 ** a run out of memory should not); any other GSL error is a fault of this
 ** library, and ends the process with one line saying so. */
 void lw_gsl_handler(const char *reason, const char *file, int line, int gsl_errno);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

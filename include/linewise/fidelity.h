@@ -61,6 +61,10 @@
 #include "linewise/spline.h"
 #include "linewise/strokes.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_FIDELITY_TRUNCATE 4.0      /* blur kernel radius, in sigmas */
 #define LW_FIDELITY_SSIM_SIGMA 1.5    /* SSIM window, pixels */
 #define LW_FIDELITY_SSIM_RADIUS 5     /* SSIM window half width: 11 x 11 */
@@ -107,5 +111,9 @@ lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, dou
 ** none along that axis), kernel radius ceil(truncate * sigma) pixels,
 ** renormalised at the edges.  LW_ENOMEM if the scratch row cannot be had. */
 lw_status lw_fidelity_blur(double *v, int w, int h, double sx, double sy, double truncate, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

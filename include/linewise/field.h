@@ -38,6 +38,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Samples on a regular grid: node (i, j) sits at (x0 + i hx, y0 + j hy) and
 ** holds ncomp values at data[(j * nx + i) * ncomp + c]. */
 typedef struct {
@@ -113,5 +117,9 @@ void lw_field_jacobian(const lw_field *f, double x, double y, double v[2], doubl
 ** caller's. */
 void lw_potential_clear(lw_potential *f);
 void lw_field_clear(lw_field *f);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -12,11 +12,19 @@
 #include "linewise/error.h"
 #include "linewise/scene.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_FIELDVIEW_MAX_PX 2048  /* longest side, pixels */
 
 /* Writes the preview of sc's field (which must be built: the field term on)
 ** to path atomically, at px_per_mm (lowered so the longer side is at most
 ** LW_FIELDVIEW_MAX_PX). */
 lw_status lw_fieldview_png(const lw_scene *sc, double px_per_mm, const char *path, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

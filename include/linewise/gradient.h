@@ -27,6 +27,10 @@
 #include "linewise/scene.h"
 #include "linewise/spline.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* lw_samples_grad, dE/d(sample values) of one segment, is declared in
 ** terms.h beside the term rows that fill it. */
 
@@ -53,5 +57,9 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
 ** (coefficient applied, near field included) to grad and returns that
 ** energy as lw_energy_compute gives it (0 when the term is off). */
 double lw_pair_gradient(const lw_scene *sc, const lw_splines *sp, lw_node *grad, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

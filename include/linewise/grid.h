@@ -38,6 +38,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* One block of cap entries: x[cap], y[cap], then idx[cap], dl[cap], in 3-D
 ** z[cap], and 3 floats of padding, so that reading any array in groups of
 ** four from entry 0 stays within the block (walk.c masks the entries past
@@ -211,5 +215,9 @@ static inline void lw_cellgrid_axis_gaps(double a, double h, int c, double p, do
 /* Insert and move as in 2-D, for a 3-D grid. */
 lw_status lw_cellgrid_insert3(lw_cellgrid *g, uint32_t i, double x, double y, double z);
 lw_status lw_cellgrid_move3(lw_cellgrid *g, uint32_t i, double x, double y, double z);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

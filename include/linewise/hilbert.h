@@ -17,6 +17,10 @@
 #include "linewise/error.h"
 #include "linewise/spline.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Cells per side of the grid the page is quantised to: 2^LW_HILBERT_ORDER. */
 #define LW_HILBERT_ORDER 16
 
@@ -33,5 +37,9 @@ uint64_t lw_hilbert_index(uint32_t x, uint32_t y, int order);
 ** the identity, 0 if it is, -1 (and err) when out of memory. */
 int lw_hilbert_order(const lw_splines *sp, double x0, double y0, double w, double h, size_t *order,
                      lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

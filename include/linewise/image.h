@@ -25,6 +25,10 @@
 #include "linewise/error.h"
 #include "linewise/field.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #ifndef LW_IMAGE_MAX_PIXELS /* the fuzz build lowers it to its memory limit */
 #define LW_IMAGE_MAX_PIXELS 1e9 /* refused before decoding */
 #endif
@@ -164,5 +168,9 @@ double lw_image_tone_at(const lw_image *img, const lw_image_place *pl, double x,
 /* The tone as a raster on the page (fidelity.h): one node per pixel centre,
 ** spacing pl->pixel.  NULL and err set when out of memory. */
 lw_grid2d *lw_image_tone_grid(const lw_image *img, const lw_image_place *pl, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

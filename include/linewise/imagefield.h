@@ -39,6 +39,10 @@
 #include "linewise/field.h"
 #include "linewise/image.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* The potential of scene.potential = image: Phi = tone^power at the pixel
 ** centres, white beyond the picture; or (sigma > 0) blurred by a Gaussian
 ** of sigma pixels, which reads the picture's edge pixels beyond it, and
@@ -52,5 +56,9 @@ lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, doub
                              double angle, lw_error *err);
 
 lw_grid2d *lw_imagefield_gradient(const lw_image *img, const lw_image_place *pl, double flat, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

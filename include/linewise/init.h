@@ -13,6 +13,10 @@
 #include "linewise/scene.h"
 #include "linewise/spline.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* n splines of `segments` segments of `segment_length` mm, kept only if
 ** their nodes and quadrature samples lie inside the boundary; the rest
 ** length is segments * segment_length.  The centre of each is uniform over
@@ -57,5 +61,9 @@ lw_status lw_init_count(const lw_scene *sc, const lw_params *p, size_t *n, lw_er
 ** both), so replicas and the placement get independent, reproducible
 ** streams whatever the thread schedule. */
 unsigned long lw_stream_seed(unsigned long seed, unsigned long stream);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

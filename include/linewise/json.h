@@ -41,6 +41,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_JSON_MAX_DEPTH 32
 
 typedef struct {
@@ -73,5 +77,9 @@ void lw_json_null(lw_json *j);
 ** complete (a container still open), LW_EIO if the stream has an error;
 ** the file itself is not closed. */
 lw_status lw_json_finish(lw_json *j, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -70,6 +70,10 @@
 #include "linewise/spline.h"
 #include "linewise/tone.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_LAYERS_MAX LW_PLOT_PENS_MAX
 #define LW_LAYERS_RIDGE 1e-6   /* lambda of the separation */
 #define LW_LAYERS_INK 1e-5     /* mu of the separation */
@@ -144,5 +148,9 @@ static inline int lw_layers_planes(const lw_layers_spec *ls)
 ** definite. */
 void lw_layers_separate(const float *r, const float *g, const float *b, size_t n, int k,
                         const unsigned char (*rgb)[3], float *a);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -24,6 +24,10 @@
 
 #include "linewise/system.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct {
   unsigned long proposed, accepted, nan; /* nan: proposals rejected for a NaN dE */
   unsigned long irregular;  /* proposals rejected for a forbidden state (model.h) */
@@ -106,5 +110,9 @@ gsl_rng *lw_rng_new(void);
 ** load returns 0 if the text does not fit the generator. */
 char *lw_rng_save(const gsl_rng *r);
 int lw_rng_load(gsl_rng *r, const char *hex);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

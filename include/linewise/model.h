@@ -51,6 +51,10 @@
 #include "linewise/tone.h"
 #include "linewise/walk.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* The pair samples live in the grid only (grid.h: x, y and dl in the
 ** structure-of-arrays form the walk reads); the spline and node of sample i
 ** follow from i (quad.n samples per segment, the segments of a spline
@@ -372,5 +376,9 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
 ** with its coefficient, bit for bit lw_energy_compute's.  NAN and
 ** LW_ENOMEM through err. */
 double lw_energy_raster(const lw_scene *sc, const lw_splines *sp, int t, int64_t **out, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -26,6 +26,10 @@
 
 #include "linewise/anneal_net.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* MPI_Init_thread and the hooks of this process; stop is the flag the
 ** signal handler sets (agreed between the processes after every sweep).
 ** NULL if MPI could not start (the message printed). */
@@ -59,5 +63,9 @@ void lw_mpi_abort(int code);
 
 /* MPI_Finalize. */
 void lw_mpi_finish(void);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -19,6 +19,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* LW_EUSAGE unless the C library's numbers use '.' as the decimal point:
 ** every file linewise reads or writes does, and printf and strtod follow
 ** LC_NUMERIC, so a program that calls setlocale(LC_ALL, "") (a GUI
@@ -78,5 +82,9 @@ int lw_number_list(const char *s, int commas, double *out, int max);
 /* What to add to a message on a list refused with count (-2: mixed
 ** separators), else "". */
 const char *lw_number_list_hint(int count);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -16,6 +16,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* orders 2 (polyline) to this */
 #define LW_NURBS_ORDER_MAX 8
 /* The largest weight at most this many times the smallest: past it the
@@ -101,5 +105,9 @@ lw_status lw_nurbs_refine(lw_nurbs *c, int elevate, int split, lw_error *err);
 ** in curve order; returns the largest distance found (NaN: out of
 ** memory). */
 double lw_nurbs_beziers(const lw_nurbs *c, double tol, void (*emit)(const double B[8], void *ctx), void *ctx);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

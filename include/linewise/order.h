@@ -49,6 +49,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_ORDER_NEIGHBOURS 10 /* candidate end points per end point in 2-opt */
 #define LW_ORDER_WORK 10000    /* 2-opt work cap per path (checks + rewritten entries) */
 #define LW_ORDER_OR_MAX 3      /* longest stretch an Or-opt move carries, paths */
@@ -76,5 +80,9 @@ lw_status lw_order_greedy(const lw_order_path *path, size_t n, double hx, double
 ** cannot be allocated. */
 lw_status lw_order_2opt(const lw_order_path *path, size_t n, double hx, double hy,
                         size_t *order, unsigned char *reversed, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -33,6 +33,10 @@
 #include "linewise/spline.h"
 #include "linewise/strokes.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_OUTPUT_PEN_DEFAULT 0.3     /* mm */
 #define LW_OUTPUT_PNG_MAX_PX 4096     /* longest side of a preview, pixels */
 #define LW_OUTPUT_PATH_MAX 4096       /* room for "<path>.tmp" in the writers here */
@@ -166,5 +170,9 @@ lw_status lw_output_commit(FILE *f, const char *tmp, const char *path, lw_error 
 
 /* Gives up a file from lw_output_open_tmp: closes f and removes tmp. */
 void lw_output_abort(FILE *f, const char *tmp);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -31,6 +31,10 @@
 
 #include "linewise/quad.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* One sample as the pair term sees it (the cell grid holds the same values
 ** in structure-of-arrays form, grid.h).  Positions stay double (a page of
 ** 1e6 mm must still resolve 1e-6 mm); the weight is float, relative 6e-8,
@@ -74,5 +78,9 @@ double lw_pair_segseg(const double a0[2], const double a1[2],
 ** cancellation; +inf on the segment.  What lw_pair_segseg integrates far
 ** segments with, and its derivative's tangential part (pairgrad.c). */
 double lw_pair_seg_potential(double L, double x, double y);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -14,6 +14,10 @@
 #ifndef LINEWISE_PAIRGRAD_H
 #define LINEWISE_PAIRGRAD_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* lw_pair_segseg(a0, a1, b0, b1), and in g its derivatives with respect to
 ** a0x a0y a1x a1y b0x b0y b1x b1y.  The integral is not differentiable where
 ** an end point lies on the other segment (the derivative grows like log of
@@ -27,5 +31,9 @@ double lw_pair_segseg_grad(const double a0[2], const double a1[2], const double 
 ** undefined) if its workspace cannot be allocated. */
 double lw_pair_segments_exact_grad(const double a[8], const double b[8], double cutoff, double ga[8],
                                    double gb[8]);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -30,6 +30,10 @@
 
 #include "linewise/pair.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* The double integral of |a'| |b'| (1/r - 1/rc)+ over two cubic Bezier
 ** segments a and b (control points x0 y0 x1 y1 x2 y2 x3 y3, mm), or of
 ** |a'| |b'| / r without a cutoff (cutoff <= 0).  Finite where the segments
@@ -87,5 +91,9 @@ extern const lw_pairnear_consts lw_pairnear_k;
 ** the order lw_pair_near_correction takes a pair in, so that its value is
 ** bitwise symmetric. */
 int lw_pair_bezier_before(const double a[8], const double b[8]);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

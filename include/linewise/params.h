@@ -16,6 +16,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_PATH_MAX 1024
 #define LW_PARAM_MAX 256 /* capacity of lw_params.line; the table is checked against it */
 /* The largest text field (scene.polygon); buffers that hold any value are
@@ -397,5 +401,9 @@ lw_status lw_params_blame(const lw_params *p, const char *section, const char *k
 ** a message that shows the value: " (byte K is a no-break space, U+00A0:
 ** delete it or type a plain space)", or "" if there is none.  buf holds it. */
 const char *lw_params_unseen_char(const char *value, char *buf, size_t n);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -58,6 +58,10 @@
 #include "linewise/params.h"
 #include "linewise/particles_pair.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef enum { LW_PMOVE_TRANSLATE, LW_PMOVE_ROTATE, LW_PMOVE_KINDS } lw_particles_move;
 
 /* With births and deaths (particles.birth, particles.death; particles_grow.h)
@@ -265,5 +269,9 @@ void lw_particles_constrain(const lw_particles *p, const double *from, double *c
 ** second, which keeps the step symmetric). */
 void lw_particles_each_pair(const lw_particles *p, int reverse,
                             void (*visit)(void *ctx, size_t i, size_t j, const double r[3], double d2), void *ctx);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -27,10 +27,18 @@
 
 #include "linewise/particles.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 lw_status lw_particles_write_ply(const lw_particles *p, const char *path, lw_error *err);
 lw_status lw_particles_write_png(const lw_particles *p, const char *path, int frame, lw_error *err);
 
 /* dir/final.ply and dir/final.png. */
 lw_status lw_particles_draw(const lw_particles *p, const char *dir, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

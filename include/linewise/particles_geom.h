@@ -18,6 +18,10 @@
 
 #include <math.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 static inline double lw_v3_dot(const double a[3], const double b[3])
 {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -95,5 +99,9 @@ static inline void lw_quat_rotate(const double q[4], const double v[3], double o
   lw_v3_cross(u, t, s);
   for (int k = 0; k < 3; k++) out[k] = v[k] + q[0] * t[k] + s[k];
 }
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

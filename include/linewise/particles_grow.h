@@ -34,6 +34,10 @@
 
 #include "linewise/particles.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_GROW_INNER 0.75
 #define LW_GROW_OUTER 1.25
 #define LW_GROW_SLAB 0.25
@@ -51,5 +55,8 @@
 double lw_particles_propose_grow(const lw_particles *p, lw_particles_prop *pr, int kind, gsl_rng *rng,
                                  int *forbidden);
 
+#ifdef __cplusplus
+}
+#endif
 
 #endif

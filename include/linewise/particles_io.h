@@ -33,6 +33,10 @@
 #include "linewise/ckpt.h"
 #include "linewise/particles.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* The largest coordinate a point file may give, in r0: the previews and
 ** the cell grid need a page that doubles can scale. */
 #define LW_POINTS_COORD_MAX 1e9
@@ -49,5 +53,9 @@ void lw_particles_put(lw_ckpt_writer *w, const char *section, const lw_particles
 /* Reads the section `section` of c (as read from its file); NULL and err
 ** set when it is missing or refused. */
 lw_particles *lw_particles_get(const lw_particles_setup *s, lw_ckpt *c, const char *section, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

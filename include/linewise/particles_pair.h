@@ -37,6 +37,10 @@
 #include "linewise/params.h"
 #include "linewise/particles_geom.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* The energy terms of the particle system, in the order of their totals
 ** (the pair terms first). */
 typedef enum {
@@ -126,5 +130,9 @@ static inline void lw_ppair_add(const lw_ppair_ctx *c, const double r[3], double
 ** taken as free vectors (the caller projects onto what moves them). */
 void lw_ppair_grad(const lw_ppair_ctx *c, const double r[3], double d2, const double ni[3], const double nj[3],
                    double gr[3], double gi[3], double gj[3]);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -35,6 +35,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* The automatic extent of `count` particles of the pattern at spacing r0. */
 double lw_particles_auto_size(int pattern, size_t count, double r0);
 
@@ -48,5 +52,9 @@ double lw_particles_auto_size(int pattern, size_t count, double r0);
 lw_status lw_particles_place(int pattern, size_t count, double size, double noise, double normal_noise,
                              double min_dist, unsigned long seed, int (*outside)(const void *, const double[3]),
                              const void *ctx, double *x, double *q, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

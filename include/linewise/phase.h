@@ -16,6 +16,10 @@
 
 #include <stddef.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Names the phase starting now (a static string), or ends it (NULL). */
 void lw_phase_set(const char *what);
 
@@ -82,5 +86,9 @@ enum { LW_PHASE_DONE, LW_PHASE_FAILED, LW_PHASE_STOPPED };
 ** after" if the run ended in an error, "stopped after" by a signal: how =
 ** LW_PHASE_*), into buf[n] ("" for nothing); returns buf. */
 const char *lw_phase_watch_end(lw_phase_watch *w, int how, char *buf, size_t n);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -31,6 +31,10 @@
 #include "linewise/order.h"
 #include "linewise/spline.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_PLOT_PENS_MAX 16
 
 /* Values of [output] order, in the order of its choices. */
@@ -69,5 +73,9 @@ lw_status lw_plot_order_paths(const lw_order_path *path, size_t n, lw_plot_order
 ** for a spline of zero length.  f is called as f(ctx, x, y) with mm. */
 void lw_plot_mean_along(const lw_splines *sp, const lw_quad *q, double (*f)(const void *ctx, double x, double y),
                         const void *ctx, double *key);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

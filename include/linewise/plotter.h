@@ -48,6 +48,10 @@
 #include "linewise/output.h"
 #include "linewise/strokes.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_HPGL_UNITS_PER_MM 40.0   /* HP-GL plotter units: 0.025 mm */
 #define LW_GCODE_DECIMALS 3         /* G-code coordinates: 0.001 mm */
 #define LW_PLOTTER_CHORDS_MAX 65536 /* chords of one segment at most */
@@ -86,5 +90,9 @@ lw_status lw_output_hpgl_strokes(const lw_strokes *s, const lw_output_page *page
                                  const char *path, lw_error *err);
 lw_status lw_output_gcode_strokes(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o,
                                   const char *path, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

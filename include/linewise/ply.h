@@ -25,6 +25,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* At most this many vertices (particles.count's bound). */
 #define LW_PLY_VERTICES_MAX 10000000
 
@@ -40,5 +44,9 @@ int lw_ply_detect(FILE *f);
 ** what the header says, or without vertices; LW_EIO; LW_ENOMEM. */
 lw_status lw_ply_read_vertices(FILE *f, const char *path, const char *const *names, int n_names, size_t *n,
                                double **values, unsigned *found, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

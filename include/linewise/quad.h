@@ -25,6 +25,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_QUAD_MIN 2
 #define LW_QUAD_MAX 64
 
@@ -47,5 +51,9 @@ lw_status lw_quad_init(lw_quad *q, int n, lw_error *err);
 
 /* Basis coefficients of r, r', r'' at any parameter s (not only nodes). */
 void lw_quad_basis(double s, double pos[4], double d1[4], double d2[4]);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -26,6 +26,10 @@
 #include "linewise/error.h"
 #include "linewise/system.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Why a quench ended (lw_quench_end_name: its word in summary.json). */
 typedef enum {
   LW_QUENCH_RUNNING,    /* not yet */
@@ -72,5 +76,9 @@ typedef struct {
 ** the state is then the last accepted one (or the start), never a
 ** forbidden one.  A start that is itself forbidden is left alone. */
 lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_report *r, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -29,6 +29,10 @@
 #include "linewise/error.h"
 #include "linewise/trace.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_REWEIGHT_TOL 1e-10       /* the f_k's last change, at most */
 #define LW_REWEIGHT_ITER 10000      /* iterations at most */
 #define LW_REWEIGHT_BOOTSTRAP 32    /* resamples for the error bars */
@@ -86,5 +90,9 @@ double lw_reweight_overlap(const double *E, size_t n, const double *log_den, dou
 ** LW_EUSAGE for n_temps outside 2 .. LW_REWEIGHT_TEMPS_MAX. */
 lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
                             int n_temps, FILE *out, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

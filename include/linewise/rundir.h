@@ -14,6 +14,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* mkdir -p dir. */
 lw_status lw_rundir_make(const char *dir, lw_error *err);
 
@@ -52,5 +56,9 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err);
 /* Gives back one lw_rundir_lock (hold 0: nothing); the last of a directory
 ** releases its lock. */
 void lw_rundir_unlock(int hold);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -28,6 +28,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_RUNFILES_STASH ".replaced"
 
 /* LW_EUSAGE naming the file where dir holds run files but no run (no run's
@@ -65,5 +69,9 @@ void lw_runfiles_remove(const char *dir);
 ** where dir/.replaced is not linewise's stash (a link, a file, a folder of
 ** the user's): nothing is touched. */
 lw_status lw_runfiles_recover(const char *dir, int *back, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

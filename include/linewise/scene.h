@@ -37,6 +37,10 @@
 #include "linewise/terms.h"
 #include "linewise/tone.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* With a cutoff rc, a segment whose consecutive pair samples lie more than
 ** this share of rc apart is forbidden: a line crossing it between two of
 ** them might then pass no sample pair within rc / 2, where the near field
@@ -119,5 +123,9 @@ void lw_scene_layer_ctx(const lw_scene *sc, int k, lw_term_ctx ctx[LW_TERM_COUNT
 ** LW_EINPUT if coef is not finite or fn is NULL while coef != 0. */
 lw_status lw_scene_set_user_term(lw_scene *sc, double coef, lw_user_term_fn fn, const void *data,
                                  lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

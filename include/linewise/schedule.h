@@ -34,6 +34,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* The parameters of every schedule; each type reads the ones its `needs`
 ** flags name.  Copying the struct copies the table pointers, not the rows:
 ** exactly one copy may be passed to lw_schedule_clear. */
@@ -106,5 +110,9 @@ void lw_schedule_clear(lw_schedule *s);
 ** previous one, with no block statistics (prev = NULL): the schedule as
 ** planned, for previews, docs and tests. */
 void lw_schedule_run(const lw_schedule_type *t, const lw_schedule *s, double *out);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -24,6 +24,10 @@
 #include "linewise/field.h"
 #include "linewise/image.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* out[j * w + i] = squared distance (pixels^2) from pixel (i, j) to the
 ** nearest pixel with feature != 0; HUGE_VAL everywhere if there is none. */
 lw_status lw_sdt_squared(const unsigned char *feature, int w, int h, double *out, lw_error *err);
@@ -32,5 +36,9 @@ lw_status lw_sdt_squared(const unsigned char *feature, int w, int h, double *out
 ** row-major, non-zero = inside) placed on the page by pl.  LW_EINPUT if no
 ** pixel is inside. */
 lw_grid2d *lw_sdt_grid(const unsigned char *inside, int w, int h, const lw_image_place *pl, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

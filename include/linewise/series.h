@@ -15,6 +15,10 @@
 
 #include <stddef.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* The integrated autocorrelation time, in steps of the series, of n_ser
 ** series of length n stored one after another (x[j n + t]), from their
 ** pooled autocorrelation (each about its own mean).  *window (NULL: not
@@ -55,5 +59,9 @@ typedef struct {
 
 /* The statistics of one series of n values (n >= 1). */
 void lw_series_stats_of(const double *x, size_t n, lw_series_stats *out);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

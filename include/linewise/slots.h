@@ -24,6 +24,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct {
   uint32_t *slot;
   size_t n, cap;
@@ -63,5 +67,9 @@ void lw_slots_take(lw_slots *s, size_t n_seg);
 
 /* Forgets every ghost (after the compaction that removed them). */
 void lw_slots_clear(lw_slots *s, size_t n_slots);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

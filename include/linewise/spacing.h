@@ -23,6 +23,10 @@
 #include "linewise/error.h"
 #include "linewise/spline.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_SPACING_POINTS_MAX 4096 /* points per segment */
 
 /* The n cubic Bezier segments b (8 doubles each: b0 b1 b2 b3 as x y pairs,
@@ -66,5 +70,9 @@ static inline int lw_boxes_meet(const double a[4], const double b[4])
 {
   return !(b[0] > a[2] || b[2] < a[0] || b[1] > a[3] || b[3] < a[1]);
 }
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -19,6 +19,10 @@
 #include "linewise/error.h"
 #include "linewise/quad.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct {
   double px, py; /* point p_k, mm */
   double vx, vy; /* vector v_k, mm (r'(node) = 3 v_k) */
@@ -220,5 +224,9 @@ double lw_segment_widest_gap(const lw_quad *q, const lw_node *a, const lw_node *
 
 /* 1 if every coordinate is finite. */
 int lw_splines_finite(const lw_splines *sp);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -32,6 +32,10 @@
 #include "linewise/quad.h"
 #include "linewise/spline.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct lw_spline_mass lw_spline_mass;
 
 /* The mass matrix of the splines of sp (their layout only; it must outlive
@@ -59,5 +63,9 @@ void lw_spline_mass_dx(const lw_spline_mass *m, const double *x, const double *v
 
 /* 1 where coordinate i is held. */
 int lw_spline_mass_pinned(const lw_spline_mass *m, size_t i);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -21,6 +21,10 @@
 #include "linewise/params.h"
 #include "linewise/spline.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_STATE_VERSION 2
 #define LW_STATE_MAGIC "linewise-state " /* and the version */
 #define LW_STATE_HEADER "linewise-state 2"
@@ -65,5 +69,9 @@ void lw_path_join(char *buf, size_t n, const char *dir, const char *name);
 
 /* The directory part of path ("." if none) into buf. */
 void lw_path_dir(char *buf, size_t n, const char *path);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -52,6 +52,10 @@
 #include "linewise/plot.h"
 #include "linewise/spline.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct {
   size_t n;                  /* paths */
   size_t n_segs;             /* segments in all */
@@ -141,5 +145,9 @@ void lw_strokes_drawn_segment(const lw_strokes *s, size_t k, size_t j, double *o
 
 /* The point at t in [0, 1] of the cubic b[8] into xy[2]. */
 void lw_bezier_eval(const double *b, double t, double *xy);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -24,6 +24,10 @@
 #include "linewise/dnurbs.h"
 #include "linewise/system.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 extern const lw_system_type lw_system_nurbs;
 
 /* The set-up's parts the tests and the benchmark read. */
@@ -59,5 +63,9 @@ typedef struct {
 ** passes through) with the other [nurbs] and [dynamics] keys of p: what the
 ** row's setup_new does after reading the curve's keys. */
 lw_nurbs_setup *lw_nurbs_setup_new(const lw_params *p, lw_nurbs *curve, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -15,6 +15,10 @@
 #include "linewise/particles.h"
 #include "linewise/system.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 extern const lw_system_type lw_system_particles;
 /* The same with births and deaths as move kinds 2 and 3 (particles.birth,
 ** particles.death), a sweep a fixed number of proposals; kinds 0 and 1 run
@@ -23,5 +27,9 @@ extern const lw_system_type lw_system_particles_grow;
 
 /* The row a scene's parameters call for. */
 const lw_system_type *lw_particles_row(const lw_params *p);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

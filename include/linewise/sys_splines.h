@@ -24,6 +24,10 @@
 #include "linewise/model.h"
 #include "linewise/system.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef enum { LW_MOVE_POINT, LW_MOVE_VECTOR, LW_MOVE_TRANSLATE, LW_MOVE_ROTATE, LW_MOVE_KINDS } lw_move_kind;
 
 /* The trans-dimensional kinds (transdim.h), after the four: a scene with
@@ -54,5 +58,9 @@ lw_system *lw_splines_view(lw_model *m, lw_error *err);
 
 /* The model of a spline instance. */
 lw_model *lw_splines_model(const lw_system *s);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -54,6 +54,10 @@
 #include "linewise/params.h"
 #include "linewise/state.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* At most this many move kinds, terms and observables a system (fixed arrays in the
 ** chain and the run loop's trace marks). */
 #define LW_MOVES_MAX 10
@@ -411,5 +415,9 @@ static inline double lw_system_total(const lw_system *s) { return s->type->total
 ** +-6e10 around a total of 3 drift 1e-5 absolute, which is 1e-16 of them);
 ** infinite where a sum is not finite and the two differ. */
 double lw_system_drift(const double *before, const double *after, int n);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -28,6 +28,10 @@
 
 #include "linewise/error.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_TEMPERING_MAX 256
 
 typedef struct {
@@ -88,5 +92,9 @@ static inline double lw_tempering_acceptance(const lw_tempering *pt, int k)
 {
   return pt->tried[k] ? (double)pt->accepted[k] / (double)pt->tried[k] : 0.0;
 }
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

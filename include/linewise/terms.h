@@ -83,6 +83,10 @@
 #include "linewise/quad.h"
 #include "linewise/spline.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef enum {
   LW_TERM_STRAIN,
   LW_TERM_BENDING,
@@ -151,5 +155,9 @@ double lw_term_field(const lw_samples *s, const lw_quad *q, const lw_field *f, i
 double lw_term_boundary(const lw_samples *s, const lw_quad *q, const lw_boundary *b);
 double lw_term_parametrisation(const lw_samples *s, const lw_quad *q);
 double lw_term_load(const lw_samples *s, const double b[2]);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -59,6 +59,10 @@
 #include "linewise/error.h"
 #include "linewise/image.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_TONE_ONE 4294967296.0 /* 2^32 raster units per unit of ink fraction */
 #define LW_TONE_CAP 65536.0      /* largest footprint value, ink fractions */
 #define LW_TONE_RADIUS_MAX 16    /* footprint half-width limit, raster pixels (9 reached) */
@@ -132,5 +136,9 @@ void lw_tone_box_splat(const lw_tone *t, lw_tone_box *b, double x, double y, dou
 double lw_tone_delta(const lw_tone *t, const int64_t *r, const lw_tone_box *b);
 /* r += the box's changes. */
 void lw_tone_apply(const lw_tone *t, int64_t *r, const lw_tone_box *b);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

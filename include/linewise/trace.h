@@ -11,6 +11,10 @@
 #include "linewise/params.h"
 #include "linewise/series.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_TRACE_HEAT_MAX 256 /* heat capacity columns at most: a rung each (tempering.replicas) */
 
 typedef struct {
@@ -105,5 +109,9 @@ lw_status lw_trace_stats(const lw_trace *t, const char *path, const lw_trace_sel
 ** the first's. */
 lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
                               FILE *out, lw_error *err);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

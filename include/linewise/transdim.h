@@ -51,6 +51,10 @@
 #include "linewise/scene.h"
 #include "linewise/spline.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct {
   const lw_scene *scene;
   double *cum;            /* the picture's cumulated row darkness (lw_init_darkness; owned),
@@ -117,5 +121,9 @@ int lw_td_mortal(const lw_td *td, size_t n, double rest);
 ** returns log g.  lw_td_next_log: log g of a given node. */
 double lw_td_next_draw(const lw_td *td, const lw_node *end, int dir, gsl_rng *rng, lw_node *out);
 double lw_td_next_log(const lw_td *td, const lw_node *end, int dir, const lw_node *nd);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

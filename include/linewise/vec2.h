@@ -13,6 +13,10 @@
 #include <emmintrin.h>
 #endif
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef double lw_v2d __attribute__((vector_size(16)));
 /* What a comparison of two lw_v2d gives: all ones where true, 0 where false. */
 typedef long long lw_v2l __attribute__((vector_size(16)));
@@ -66,5 +70,9 @@ int lw_vec_lanes(void);
 /* 0 keeps the scan at four lanes even where AVX-512 is there (tests and
 ** benchmarks compare); 1 restores the processor's choice. */
 void lw_vec_set_x8(int on);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

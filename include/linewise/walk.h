@@ -53,6 +53,10 @@
 #include "linewise/grid.h"
 #include "linewise/pair.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define LW_PAIR_CHUNK 32 /* probes walked together (at most the bits of a mask) */
 
 /* One near pair: the neighbour as the grid holds it, and the probe. */
@@ -105,5 +109,9 @@ typedef struct {
 lw_status lw_pair_walk(const lw_cellgrid *g, const lw_pair_ctx *ctx, const lw_pair_probe *P, size_t n,
                        const lw_pair_filter *f, double *far, double *each, lw_pair_nearlist *near,
                        uint64_t *visited);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif
