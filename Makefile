@@ -214,6 +214,7 @@ wire-figures: $(BUILD)/wire-midpoint
 # (C or C++: `pkg-config --cflags --libs linewise`).
 INSTALLED := bin/linewise bin/linewise-mpi $(TOOLS:%=bin/linewise-%) bin/linewise-animate \
              share/linewise share/doc/linewise share/man/man1/linewise.1 \
+             $(TOOLS:%=share/man/man1/linewise-%.1) share/man/man1/linewise-animate.1 \
              lib/liblinewise.a lib/pkgconfig/linewise.pc include/linewise
 LW_VERSION := $(shell sed -n 's/^\#define LW_VERSION "\(.*\)"/\1/p' include/linewise/version.h)
 install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
@@ -231,6 +232,14 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	install -m 644 docs/linewise.1 $(DESTDIR)$(PREFIX)/share/man/man1/linewise.1
 	for t in $(TOOLS); do install -m 755 tools/$$t $(DESTDIR)$(PREFIX)/bin/linewise-$$t; done
 	install -m 755 tools/animate.sh $(DESTDIR)$(PREFIX)/bin/linewise-animate
+	# each tool's man page: its line of tools/whatis, then its --help as it is
+	for t in $(TOOLS) animate; do \
+	  what=$$(sed -n "s/^$$t: //p" tools/whatis); test -n "$$what" || { echo "tools/whatis: no line for $$t" >&2; exit 1; }; \
+	  { printf '.TH LINEWISE-%s 1 "" "linewise $(LW_VERSION)"\n.SH NAME\nlinewise-%s \\- %s\n.SH SYNOPSIS\n.nf\n' \
+	      "$$(echo $$t | tr a-z A-Z)" "$$t" "$$what"; \
+	    $(DESTDIR)$(PREFIX)/bin/linewise-$$t --help | sed 's/\\/\\e/g; s/^[.'"'"']/\\\&&/'; \
+	    printf '.fi\n.SH SEE ALSO\n.BR linewise (1),\nREADME.md in PREFIX/share/doc/linewise.\n'; \
+	  } > $(DESTDIR)$(PREFIX)/share/man/man1/linewise-$$t.1 || exit 1; done
 	install -m 644 tools/slurm-sweep.sbatch tools/slurm-tempering.sbatch $(DESTDIR)$(PREFIX)/share/linewise/
 	install -m 644 README.md docs/*.md docs/*.png $(DESTDIR)$(PREFIX)/share/doc/linewise/
 
