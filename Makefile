@@ -234,7 +234,8 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	install -m 755 tools/animate.sh $(DESTDIR)$(PREFIX)/bin/linewise-animate
 	# each tool's man page: its line of tools/whatis, then its --help as it is
 	for t in $(TOOLS) animate; do \
-	  what=$$(sed -n "s/^$$t: //p" tools/whatis); test -n "$$what" || { echo "tools/whatis: no line for $$t" >&2; exit 1; }; \
+	  what=$$(sed -n "s/^$$t: //p" tools/whatis); \
+	  test -n "$$what" || { echo "tools/whatis: no line for $$t" >&2; exit 1; }; \
 	  { printf '.TH LINEWISE-%s 1 "" "linewise $(LW_VERSION)"\n.SH NAME\nlinewise-%s \\- %s\n.SH SYNOPSIS\n.nf\n' \
 	      "$$(echo $$t | tr a-z A-Z)" "$$t" "$$what"; \
 	    $(DESTDIR)$(PREFIX)/bin/linewise-$$t --help | sed 's/\\/\\e/g; s/^[.'"'"']/\\\&&/'; \

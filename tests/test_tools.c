@@ -994,7 +994,8 @@ Test(tools, install_runs_every_scene_away_from_the_checkout_and_uninstall_remove
   /* a man page for each tool: its NAME, and its --help under the name it is installed by */
   cr_assert_eq(sh("cd %s/root/usr && for t in seed-sweep param-sweep plot-run plot-sweep thread-scaling animate; do "
                   "  m=share/man/man1/linewise-$t.1; grep -q \"^linewise-$t .- [a-z]\" $m && "
-                  "  grep -q \"^usage: linewise-$t \" $m && { ! command -v groff || test -z \"$(groff -man -ww -z $m 2>&1)\"; } "
+                  "  grep -q \"^usage: linewise-$t \" $m && "
+                  "  { ! command -v groff || test -z \"$(groff -man -ww -z $m 2>&1)\"; } "
                   "  || { echo $t >&2; exit 1; }; done", dir),
                0, "%s", err_txt());
   cr_assert_eq(sh("make -s -C %s uninstall DESTDIR=%s/root PREFIX=/usr && test -z \"$(find %s/root -type f)\"",
