@@ -371,11 +371,13 @@ static lw_status get_chain(lw_ckpt *doc, int k, const lw_system_type *t, lw_chai
     snprintf(key, sizeof key, "step.%s", name);
     /* tuning keeps steps in [1e-300, step_max] (mc.c), but a step never
     ** tuned (moves.tune_sweeps = 0, the dynamics, a stop before the first
-    ** tuning) is still the scene's, which may be larger: c's own, as the
-    ** scene set it; a kind without a step has 0, or before 2026-12
-    ** whatever tuning had left in [0, 1] */
+    ** tuning) is still the scene's, which may be larger, or smaller (a
+    ** scene's step of 1e-310 wrote a state its resume called damaged): c's
+    ** own, as the scene set it; a kind without a step has 0, or before
+    ** 2026-12 whatever tuning had left in [0, 1] */
     if (c->step_max[m] > 0.0)
-      s = lw_ckpt_numbers(doc, sec, key, &c->step[m], 1, 1e-300, fmax(c->step_max[m], c->step[m]), 0, err);
+      s = lw_ckpt_numbers(doc, sec, key, &c->step[m], 1, fmin(1e-300, c->step[m]), fmax(c->step_max[m], c->step[m]),
+                          0, err);
     else if (!(s = lw_ckpt_numbers(doc, sec, key, &c->step[m], 1, 0.0, 1.0, 0, err))) c->step[m] = 0.0;
     if (s) break;
     snprintf(key, sizeof key, "window.%s", name);

@@ -26,7 +26,7 @@ static lw_cellgrid *grid_new(int dim, const double lo[3], const double size[3], 
   double side = cell > 0 ? cell : fmax(fmax(w, h), d) + 1.0;
   /* No more cells than samples (times a small factor): a tiny cutoff on a huge
   ** page would otherwise allocate mostly empty cells. */
-  double max_cells = 4.0 * (double)(room > n_samples ? room : n_samples) + 16.0;
+  double max_cells = 4.0 * (double)(room ? room : n_samples) + 16.0;
   while ((ceil(w / side) + 1) * (ceil(h / side) + 1) * (dim == 3 ? ceil(d / side) + 1 : 1) > max_cells)
     side *= 1.5;
   g->inv_h = 1.0 / side;

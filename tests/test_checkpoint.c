@@ -435,14 +435,18 @@ Test(checkpoint, a_resumed_run_keeps_its_whole_proposal_rate)
 ** it) stays as set where nothing tunes it: moves.tune_sweeps = 0, or a
 ** step the dynamics never uses.  The checkpoint kept it and resume
 ** refused it ("expected 1 number from 1e-300 to 100"), so such a run could
-** never go on; now it resumes to the bytes of one that did not stop. */
-Test(checkpoint, a_step_above_the_cap_that_nothing_tuned_resumes)
+** never go on; now it resumes to the bytes of one that did not stop.  So
+** does a step below the 1e-300 that tuning keeps to, which the scene
+** allows (any step above 0; 1e-300 degrees is 1.7e-302 radians). */
+Test(checkpoint, a_step_outside_the_tuned_range_that_nothing_tuned_resumes)
 {
   const char *b = lw_test_bin(), *r = lw_test_root();
   static const char *const runs[][2] = {
       {"minimal.ini", "--set anneal.sweeps=20 --set moves.tune_sweeps=0 --set moves.step_point=1000"},
-      {"wire.ini", "--set anneal.sweeps=20 --set nurbs.step_weight=5 --set output.frames_every=0"}};
-  for (int k = 0; k < 2; k++) {
+      {"wire.ini", "--set anneal.sweeps=20 --set nurbs.step_weight=5 --set output.frames_every=0"},
+      {"minimal.ini", "--set anneal.sweeps=20 --set moves.tune_sweeps=0 --set moves.step_vector=1e-320"},
+      {"particles-sheet.ini", "--set anneal.sweeps=20 --set moves.tune_sweeps=0 --set moves.step_rotate=1e-300"}};
+  for (int k = 0; k < 4; k++) {
     cr_assert_eq(lw_test_sh("%s run %s/params/%s %s --out %s/u%d --quiet", b, r, runs[k][0], runs[k][1], dir, k), 0);
     cr_assert_eq(lw_test_sh("%s run %s/params/%s %s --out %s/s%d --quiet --stop-at 7", b, r, runs[k][0], runs[k][1],
                             dir, k), 0);

@@ -77,11 +77,13 @@ lw_cellgrid *lw_cellgrid_new(double x0, double y0, double w, double h, double ce
                              size_t n_samples, lw_error *err);
 void lw_cellgrid_free(lw_cellgrid *g);
 
-/* The same with cells sized as if for max(n_samples, room) samples: a grid
-** whose sample count changes (trans-dimensional moves) keeps the cells of
-** a fixed room, so that its geometry, and with it the order of every sum
-** over cells, depends on the scene alone and a resumed run adds in the
-** same order as one that never stopped. */
+/* The same with cells sized as if for `room` samples, however many it
+** holds: a grid whose sample count changes (trans-dimensional moves, births
+** and deaths) keeps the cells of a fixed room, so that its geometry, and
+** with it the order of every sum over cells, depends on the scene alone and
+** a resumed run adds in the same order as one that never stopped (sized for
+** the larger of the two, a start above the room had other cells than its
+** resume).  room 0: as lw_cellgrid_new. */
 lw_cellgrid *lw_cellgrid_new_room(double x0, double y0, double w, double h, double cell,
                                   size_t n_samples, size_t room, lw_error *err);
 
@@ -181,7 +183,7 @@ static inline size_t lw_cellgrid_cells(const lw_cellgrid *g)
 lw_cellgrid *lw_cellgrid_new3(const double lo[3], const double size[3], double cell, size_t n_samples,
                               lw_error *err);
 
-/* The same with cells sized for max(n_samples, room), as lw_cellgrid_new_room. */
+/* The same with cells sized for room samples, as lw_cellgrid_new_room. */
 lw_cellgrid *lw_cellgrid_new3_room(const double lo[3], const double size[3], double cell, size_t n_samples,
                                    size_t room, lw_error *err);
 
