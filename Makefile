@@ -211,7 +211,10 @@ wire-figures: $(BUILD)/wire-midpoint
 # tools, the man page, README and docs/; linewise-mpi where mpicc is (built
 # here, never an older one left in bin/).
 # The library, its headers and linewise.pc too, for a program that embeds it
-# (C or C++: `pkg-config --cflags --libs linewise`).
+# (C or C++: `pkg-config --cflags --libs linewise`).  linewise.pc finds the
+# prefix from where it lies, so a copy installed under DESTDIR, or moved, is
+# found with PKG_CONFIG_PATH alone (--define-variable=prefix= would move
+# cairo's and GSL's paths with it).
 INSTALLED := bin/linewise bin/linewise-mpi $(TOOLS:%=bin/linewise-%) bin/linewise-animate \
              share/linewise share/doc/linewise share/man/man1/linewise.1 \
              $(TOOLS:%=share/man/man1/linewise-%.1) share/man/man1/linewise-animate.1 \
@@ -222,7 +225,7 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	install -d $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/include/linewise
 	install -m 644 $(BUILD)/liblinewise.a $(DESTDIR)$(PREFIX)/lib/
 	install -m 644 include/linewise/*.h $(DESTDIR)$(PREFIX)/include/linewise/
-	printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
+	printf '%s\n' 'prefix=$${pcfiledir}/../..' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
 	  'Name: linewise' 'Description: elastic Bezier curves annealed into line art (the library of linewise)' \
 	  'Version: $(LW_VERSION)' 'Requires: $(PKGS)' 'Libs: -L$${libdir} -llinewise -fopenmp -lm' \
 	  'Cflags: -I$${includedir}' > $(DESTDIR)$(PREFIX)/lib/pkgconfig/linewise.pc

@@ -20,8 +20,9 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include <stb/stb_image.h>
 #include <zlib.h>
+
+#include "stb_image_impl.h"
 
 static float *plane_alloc(int w, int h)
 {

@@ -952,16 +952,28 @@ Test(tools, thread_scaling_times_each_count_and_checks_the_bytes)
 
 /* A program embeds the installed library, in C++ too: tests/embed.cpp,
 ** built with nothing but what linewise.pc names, makes the run `linewise
-** run` makes, to the byte but for summary.json's clock. */
+** run` makes, to the byte but for summary.json's clock.  Every header
+** compiles in C++ with those flags (cairo's too: moved with the prefix, they
+** were lost), and the library defines no global name but lw_ ones (its
+** stb_image was global, and a program with its own either failed to link
+** or had linewise read pictures through it, upside down). */
 Test(tools, an_installed_library_embeds_in_cxx_through_its_pkg_config, .timeout = 120)
 {
   if (sh("{ command -v c++ && command -v pkg-config; }")) cr_skip_test("no c++ or pkg-config here");
   cr_assert_eq(sh("make -s -C %s install DESTDIR=%s/lib PREFIX=/usr", env("LW_ROOT"), dir), 0, "%s", err_txt());
-  cr_assert_eq(sh("cd %s && flags=$(PKG_CONFIG_PATH=lib/usr/lib/pkgconfig pkg-config "
-                  "--define-variable=prefix=$PWD/lib/usr --cflags --libs linewise) && "
-                  "c++ -Wall -Werror -o embed %s/tests/embed.cpp $flags",
+  cr_assert_eq(sh("cd %s && flags=$(PKG_CONFIG_PATH=lib/usr/lib/pkgconfig pkg-config --cflags --libs linewise) && "
+                  "c++ -Wall -Werror -o embed %s/tests/embed.cpp $flags && "
+                  "for h in lib/usr/include/linewise/*.h; do echo \"#include \\\"linewise/${h##*/}\\\"\"; "
+                  "done > all.cpp && "
+                  "c++ -Wall -Wextra -Werror -fsyntax-only all.cpp $flags",
                   dir, env("LW_ROOT")),
                0, "%s", err_txt());
+  cr_assert_eq(sh("nm -g --defined-only %s/lib/usr/lib/liblinewise.a | "
+                  "awk 'NF == 3 && $3 !~ /^(lw_|.gomp_critical_user_lw_)/'", dir),
+               0);
+  char *names = out_txt();
+  cr_assert_eq(names[0], '\0', "global names outside lw_: %s", names);
+  free(names);
   cr_assert_eq(sh("cd %s && { ./embed %s e && %s run %s --quiet --out c; }", dir, scene(), env("LW_BIN"), scene()),
                0, "%s", err_txt());
   cr_assert_eq(sh("cd %s && for f in state.lw trace.csv final.svg scene.ini; do cmp e/$f c/$f || exit 1; done && "
