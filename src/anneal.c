@@ -895,6 +895,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
 {
   memset(a, 0, sizeof *a);
   a->net = net;
+  a->pause_at = -1;
   a->wall_start = now_seconds();
   a->params = *p;
   lw_status s;
@@ -1705,8 +1706,10 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
 ** or the drawings' (which at 10^5 splines took four fifths of a short run). */
 lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
 {
-  lw_status s = lw_anneal_settle(a, err);
-  if (s) return s;
+  /* (the locale changed since the start: checked at a checkpoint only, a
+  ** program's trace.csv took decimal commas for a hundred rows first) */
+  lw_status s = lw_number_locale_ok(err);
+  if (s || (s = lw_anneal_settle(a, err))) return s;
   const double t0 = now_seconds();
   s = sweep_once(a, err);
   a->sweep_seconds += now_seconds() - t0;

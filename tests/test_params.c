@@ -769,6 +769,21 @@ Test(params, a_decimal_comma_locale_is_refused_with_the_way_round)
   cr_assert(strstr(err.msg, "LC_NUMERIC"), "%s", err.msg);
   cr_assert_neq(access(out, F_OK), 0, "the run wrote a directory");
   lw_anneal_free(&a);
+  /* the locale set between sweeps: the next sweep is refused before its
+  ** trace row (checked at checkpoints only, rows of decimal commas went
+  ** into trace.csv until the next one) */
   setlocale(LC_NUMERIC, "C");
+  cr_assert_eq(read_text("[init]\nsplines = 2\n[anneal]\nsweeps = 10\n[output]\ntrace_every = 1\n", &p, &err), LW_OK,
+               "%s", err.msg);
+  cr_assert_eq(lw_anneal_start(&a, &p, out, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(lw_anneal_sweep(&a, &err), LW_OK, "%s", err.msg);
+  cr_assert_not_null(setlocale(LC_NUMERIC, "de_DE.UTF-8"));
+  cr_assert_eq(lw_anneal_sweep(&a, &err), LW_EUSAGE);
+  cr_assert(strstr(err.msg, "LC_NUMERIC"), "%s", err.msg);
+  setlocale(LC_NUMERIC, "C");
+  lw_anneal_free(&a);
+  cr_assert_eq(lw_test_sh("test $(awk -F, 'NR == 1 { n = NF } NF != n' %s/trace.csv | wc -l) -eq 0 && "
+                          "test $(wc -l < %s/trace.csv) -eq 2", out, out),
+               0, "trace.csv took a row in the comma locale");
   lw_test_dir_remove(dir);
 }

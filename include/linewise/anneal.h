@@ -96,12 +96,15 @@ typedef struct lw_anneal {
   lw_anneal_net *net;          /* NULL in one process; else the hooks of a spread run (not owned) */
 } lw_anneal;
 
-/* A new run of the scene file (with overrides already applied to p) into
-** dir; seed overrides p->seed when >= 0.  Creates dir (bad input is reported
-** before anything is written).  The directory's lock keeps other processes
-** out, not this one: a program must not run two anneals into one directory
-** at once (the second would replace the first's files).  LC_NUMERIC must
-** read '.' (lw_number_locale_ok), here and at every checkpoint and the
+/* A new run of the scene file (with overrides already applied to p; a
+** seed of its own by lw_params_set(p, "anneal.seed=N")) into dir.  Creates
+** dir (bad input is reported before anything is written).  The directory's
+** lock keeps other processes out, not this one: a program must not run two
+** anneals into one directory at once (the second would replace the first's
+** files); runs into other directories may go on in threads of their own.
+** The threads a run uses are OpenMP's (omp_set_num_threads, OMP_NUM_THREADS),
+** and its results do not depend on their count.  LC_NUMERIC must read '.'
+** (lw_number_locale_ok), here and at every trace row, checkpoint and the
 ** finish.  On failure dir and its .lock may stay: a caller that made dir
 ** removes it (the command line does).  A stop asked (lw_phase_stop) while
 ** the run before waits aside ends the set-up with LW_ERUN and gave_way set:
@@ -129,6 +132,15 @@ lw_status lw_anneal_settle(lw_anneal *a, lw_error *err);
 lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err);
 
 static inline int lw_anneal_done(const lw_anneal *a) { return a->sweep >= a->end_sweep; }
+
+/* Whether a resume for `more` sweeps short of the end has made them: the
+** caller stops there as at --stop-at, with lw_anneal_checkpoint and no
+** lw_anneal_finish (a later resume goes on to the end).  The loop of a run
+** or resume is therefore
+**     while (!lw_anneal_done(a) && !lw_anneal_paused(a)) lw_anneal_sweep(a, err);
+**     then lw_anneal_finish(a, err) if lw_anneal_done(a), else lw_anneal_checkpoint(a, err)
+** (tests/embed.cpp). */
+static inline int lw_anneal_paused(const lw_anneal *a) { return a->pause_at >= 0 && a->sweep >= a->pause_at; }
 
 /* After a start that failed, here or later (the network's first checkpoint):
 ** the set-up's files go and the run it was to replace comes back; 1 if that
