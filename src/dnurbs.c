@@ -257,9 +257,9 @@ lw_status lw_band_factor(const double *A, const unsigned char *pin, size_t n, in
     L[j * kk] = 1.0;
   }
   gsl_matrix_view v = gsl_matrix_view_array(L, n, kk);
-  gsl_error_handler_t *old = gsl_set_error_handler_off();
+  lw_gsl_off();
   int bad = gsl_linalg_cholesky_band_decomp(&v.matrix);
-  gsl_set_error_handler(old);
+  lw_gsl_on();
   if (bad)
     return lw_error_set(err, LW_EINPUT, "a D-NURBS matrix of order %zu (its free coordinates) is not positive definite",
                         n);

@@ -2,6 +2,7 @@
 #include "linewise/error.h"
 
 #include <gsl/gsl_errno.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -46,4 +47,22 @@ void lw_gsl_handler(const char *reason, const char *file, int line, int gsl_errn
   fprintf(stderr, "linewise: internal error: GSL: %s (%s:%d, %s); please report it\n", reason, file, line,
           gsl_strerror(gsl_errno));
   abort();
+}
+
+static pthread_mutex_t gsl_lock = PTHREAD_MUTEX_INITIALIZER;
+static int gsl_off_depth;
+static gsl_error_handler_t *gsl_saved;
+
+void lw_gsl_off(void)
+{
+  pthread_mutex_lock(&gsl_lock);
+  if (gsl_off_depth++ == 0) gsl_saved = gsl_set_error_handler_off();
+  pthread_mutex_unlock(&gsl_lock);
+}
+
+void lw_gsl_on(void)
+{
+  pthread_mutex_lock(&gsl_lock);
+  if (--gsl_off_depth == 0) gsl_set_error_handler(gsl_saved);
+  pthread_mutex_unlock(&gsl_lock);
 }

@@ -263,9 +263,9 @@ lw_status lw_chain_sweep(lw_chain *c)
 
 gsl_rng *lw_rng_new(void)
 {
-  gsl_error_handler_t *old = gsl_set_error_handler_off();
+  lw_gsl_off();
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-  gsl_set_error_handler(old);
+  lw_gsl_on();
   return r;
 }
 

@@ -43,6 +43,8 @@ static volatile atomic_int stop_asked;
 
 void lw_phase_stop(void) { atomic_store(&stop_asked, 1); }
 
+void lw_phase_stop_clear(void) { atomic_store(&stop_asked, 0); }
+
 int lw_phase_stopping(void) { return atomic_load(&stop_asked); }
 
 static volatile atomic_long committed = -1, committing = -1;

@@ -5,9 +5,6 @@
 #include <gsl/gsl_linalg.h>
 #include <gsl/gsl_rng.h>
 #include <math.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -116,17 +113,9 @@ static int newton_step(const double *log_n, const double *s, const double *ww, i
       gsl_matrix_set(h, b, a, v);
     }
   }
-  /* GSL's handler is the process's: on the threads of the bootstrap it is
-  ** off for the whole region (one thread restoring it while another's
-  ** Cholesky failed would have ended the process) */
-#ifdef _OPENMP
-  const int threads = omp_in_parallel();
-#else
-  const int threads = 0;
-#endif
-  gsl_error_handler_t *old = threads ? NULL : gsl_set_error_handler_off();
+  lw_gsl_off(); /* (on the bootstrap's threads too: error.h) */
   ok = ok && !gsl_linalg_cholesky_decomp1(h) && !gsl_linalg_cholesky_solve(h, g, x);
-  if (!threads) gsl_set_error_handler(old);
+  lw_gsl_on();
   step[0] = 0.0;
   for (size_t a = 0; ok && a < m; a++) step[a + 1] = gsl_vector_get(x, a);
   gsl_matrix_free(h);
@@ -526,7 +515,6 @@ static lw_status bootstrap(const rw_states *s, rw_table *tab, const double *f, i
     if (!(at[b] = gsl_rng_clone(rng))) st = lw_error_set(err, LW_ENOMEM, "out of memory resampling");
     else st = resample(s, traces, rng, scratch, err); /* (to the next resample's draws) */
   free(scratch);
-  gsl_error_handler_t *handler = gsl_set_error_handler_off(); /* (newton_step's, for the region) */
 #pragma omp parallel if (!st)
   {
     double *eb = malloc(n * sizeof *eb), *fb = malloc((size_t)K * sizeof *fb), *log_den = malloc(n * sizeof *log_den);
@@ -549,7 +537,6 @@ static lw_status bootstrap(const rw_states *s, rw_table *tab, const double *f, i
     free(fb);
     free(log_den);
   }
-  gsl_set_error_handler(handler);
   for (int b = 0; b < B && !st; b++) {
     if ((st = sts[b])) {
       if (err) *err = errs[b];

@@ -107,9 +107,9 @@ lw_status lw_spline_mass_at(lw_spline_mass *m, const double *x, lw_error *err)
     double *L = m->chol + 2 * first * BAND;
     memcpy(L, B, dim * BAND * sizeof *L);
     gsl_matrix_view v = gsl_matrix_view_array(L, dim, BAND);
-    gsl_error_handler_t *old = gsl_set_error_handler_off();
+    lw_gsl_off();
     int bad = gsl_linalg_cholesky_band_decomp(&v.matrix);
-    gsl_set_error_handler(old);
+    lw_gsl_on();
     if (bad)
       return lw_error_set(err, LW_EINPUT, "spline %zu: the mass matrix is not positive definite (a segment's speed "
                           "vanishes at a quadrature node)", i);

@@ -364,6 +364,14 @@ Test(run, a_stop_during_the_set_up_puts_the_run_before_back)
   cr_assert(!a.gave_way);
   lw_anneal_free(&a);
   cr_assert_eq(sh("test -s %s/fresh/state.lw", dir), 0);
+  /* a program that runs again after the stop clears it: the run then takes
+  ** the place of the one before */
+  lw_phase_stop_clear();
+  snprintf(out, sizeof out, "%s/r", dir);
+  cr_assert_eq(lw_anneal_start(&a, &p, out, &err), LW_OK, "%s", err.msg);
+  cr_assert(!a.gave_way);
+  lw_anneal_free(&a);
+  cr_assert_eq(sh("grep -qx 'seed = 43' %s/r/state.lw", dir), 0, "the run before is still there");
 }
 
 /* A second signal ends the process at once and names the checkpoint a

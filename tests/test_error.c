@@ -9,6 +9,7 @@
 #include <signal.h>
 
 #include "linewise/error.h"
+#include "linewise/mc.h"
 
 /* An allocation GSL cannot make returns to its caller (GSL's own handler
 ** aborted the run, which then left no message and no exit status 1). */
@@ -28,4 +29,38 @@ Test(error, any_other_gsl_error_ends_the_process, .signal = SIGABRT, .init = cr_
   gsl_vector *v = gsl_vector_alloc(2);
   gsl_vector_get(v, 5); /* index out of range: GSL_EINVAL */
   gsl_vector_free(v);
+}
+
+static int program_handler_calls;
+static void program_handler(const char *reason, const char *file, int line, int gsl_errno)
+{
+  (void)reason, (void)file, (void)line, (void)gsl_errno;
+  program_handler_calls++;
+}
+
+/* The library turns GSL's handler off around the calls whose failure it
+** handles (lw_gsl_off), on many threads at once: the program's handler is
+** back after them however they interleave.  Each call saving and restoring
+** it alone, two threads left it off for good (3 times in 3 tries). */
+Test(error, the_programs_gsl_handler_survives_the_librarys_threads)
+{
+  gsl_error_handler_t *old = gsl_set_error_handler(program_handler);
+#pragma omp parallel for num_threads(8) schedule(static, 1)
+  for (int i = 0; i < 20000; i++) {
+    gsl_rng *r = lw_rng_new(); /* off and on again, as every chain's set-up */
+    gsl_rng_free(r);
+  }
+  cr_assert_eq(gsl_set_error_handler(old), program_handler, "the program's handler is gone");
+  /* nested, it stays off until the last, then the program's is back */
+  gsl_set_error_handler(program_handler);
+  program_handler_calls = 0;
+  lw_gsl_off();
+  lw_gsl_off();
+  lw_gsl_on();
+  gsl_error("within", __FILE__, __LINE__, GSL_EDOM);
+  lw_gsl_on();
+  cr_assert_eq(program_handler_calls, 0, "the handler ran while off");
+  gsl_error("after", __FILE__, __LINE__, GSL_EDOM);
+  cr_assert_eq(program_handler_calls, 1);
+  gsl_set_error_handler(old);
 }

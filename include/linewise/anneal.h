@@ -103,7 +103,9 @@ typedef struct lw_anneal {
 ** anneals into one directory at once (the second would replace the first's
 ** files); runs into other directories may go on in threads of their own.
 ** The threads a run uses are OpenMP's (omp_set_num_threads, OMP_NUM_THREADS),
-** and its results do not depend on their count.  LC_NUMERIC must read '.'
+** and its results do not depend on their count (a run of several rungs split
+** into domains, on more threads than rungs, nests its parallel regions: it
+** raises omp_get_max_active_levels to 2 and leaves it so).  LC_NUMERIC must read '.'
 ** (lw_number_locale_ok), here and at every trace row, checkpoint and the
 ** finish.  On failure dir and its .lock may stay: a caller that made dir
 ** removes it (the command line does).  A stop asked (lw_phase_stop) while

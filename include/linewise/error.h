@@ -51,6 +51,16 @@ int lw_error_exit_status(lw_status code);
 ** library, and ends the process with one line saying so. */
 void lw_gsl_handler(const char *reason, const char *file, int line, int gsl_errno);
 
+/* GSL's error handler off around a call whose failure the caller handles
+** (a Cholesky factor of a matrix that may not be positive definite), then
+** back.  The handler is one for the process, so the calls are counted under
+** a lock: the first to turn it off keeps the program's, and the last to
+** finish puts it back, however the threads of one run, or a program's runs
+** in threads of its own, interleave (each saving and restoring it alone,
+** two threads left it off for good).  Meanwhile it is off for every thread. */
+void lw_gsl_off(void);
+void lw_gsl_on(void);
+
 #ifdef __cplusplus
 }
 #endif

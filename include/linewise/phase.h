@@ -44,11 +44,14 @@ void lw_phase_stash(int on);
 int lw_phase_stashed(void);
 
 /* Whether a signal has asked the run to stop (the command line's handler
-** calls lw_phase_stop).  A new run asked during its set-up, while the run
-** before waits aside, puts that run back rather than take its place with
-** a run of no sweeps (lw_anneal_start, anneal.h).  Asked once, it stays so
-** for the process (the command line runs one run).  Lock-free. */
+** calls lw_phase_stop; a program's Cancel may too).  A new run asked during
+** its set-up, while the run before waits aside, puts that run back rather
+** than take its place with a run of no sweeps (lw_anneal_start, anneal.h).
+** Asked once, it stays so until lw_phase_stop_clear: a program that runs
+** again after a stop clears it first (its every later start into a run's
+** directory gave way).  Lock-free. */
 void lw_phase_stop(void);
+void lw_phase_stop_clear(void);
 int lw_phase_stopping(void);
 
 /* The sweep of the last state.lw this process committed (-1: none yet),
