@@ -764,6 +764,25 @@ static unsigned long rung_stream(const lw_anneal *a, int k)
   return lw_stream_seed(a->seed, k == 0 ? 1 : 2 + (unsigned long)k);
 }
 
+/* Every move weight of the system 0: refused naming its move keys, the one
+** the user set to 0 blamed (the chain's own check named no file or key). */
+static lw_status no_move(const lw_anneal *a, lw_error *err)
+{
+  const lw_params *p = &a->params;
+  const lw_system_type *t = a->sys_type;
+  const lw_param_def *blame = NULL;
+  char names[256] = "";
+  size_t m = 0;
+  for (int k = 0; k < t->n_moves; k++) {
+    const lw_param_def *d = lw_params_find("moves", t->move_names[k]);
+    if (!d) continue;
+    m += (size_t)snprintf(names + m, m < sizeof names ? sizeof names - m : 0, "%smoves.%s", m ? ", " : "", d->key);
+    if (!blame || (lw_params_given(p, d) && !lw_params_given(p, blame))) blame = d;
+  }
+  lw_error_set(err, LW_EINPUT, "every move weight is 0 (%s): expected at least one above 0", names);
+  return blame ? lw_params_blame(p, "moves", blame->key, err) : err->code;
+}
+
 /* Systems for the n_rep states[] (ownership passes, also on failure),
 ** chains for the rungs, the exchange machinery on the base ladder. */
 static lw_status build(lw_anneal *a, void **states, const double *ladder, lw_error *err)
@@ -787,8 +806,10 @@ static lw_status build(lw_anneal *a, void **states, const double *ladder, lw_err
     }
   }
   if (s) return s;
-  double weight[LW_MOVES_MAX], step[LW_MOVES_MAX], target[LW_MOVES_MAX];
+  double weight[LW_MOVES_MAX], step[LW_MOVES_MAX], target[LW_MOVES_MAX], sum = 0.0;
   t->moves(p, weight, step, target);
+  for (int k = 0; k < t->n_moves; k++) sum += weight[k];
+  if (!(sum > 0.0)) return no_move(a, err);
   for (int k = 0; k < n; k++) {
     a->chains[k] = lw_chain_new(a->systems[k], weight, step, target, rung_stream(a, k), err);
     if (!a->chains[k]) return err->code;

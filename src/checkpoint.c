@@ -488,6 +488,15 @@ static lw_status get_energy(lw_ckpt *doc, int k, const lw_system_type *t, lw_sys
   return LW_OK;
 }
 
+/* The line of a [tempering] key read already, for a message about its
+** value ("file:line: [tempering] key: ..."). */
+static int tempering_line(lw_ckpt *doc, const char *key)
+{
+  int line = 0;
+  lw_ckpt_text(doc, "tempering", key, &line);
+  return line;
+}
+
 static lw_status get_tempering(lw_ckpt *doc, lw_anneal *a, lw_error *err)
 {
   lw_tempering *pt = a->pt;
@@ -500,14 +509,15 @@ static lw_status get_tempering(lw_ckpt *doc, lw_anneal *a, lw_error *err)
     return s;
   for (int k = 1; k < n; k++)
     if (!(pt->ladder[k] > pt->ladder[k - 1]))
-      return lw_error_set(err, LW_EINPUT, "%s: [tempering] ladder: expected increasing temperatures", path);
+      return lw_error_set(err, LW_EINPUT, "%s:%d: [tempering] ladder: expected increasing temperatures", path,
+                          tempering_line(doc, "ladder"));
   if ((s = lw_ckpt_counts(doc, "tempering", "at_label", v, 2 * n, 1, err))) return s;
   int seen[LW_TEMPERING_MAX] = {0};
   for (int k = 0; k < n; k++) {
     unsigned long r = v[2 * k];
     if (r >= (unsigned long)n || seen[r] || v[2 * k + 1] > 2)
-      return lw_error_set(err, LW_EINPUT, "%s: [tempering] at_label: expected a permutation of the replicas, each "
-                          "with a direction 0, 1 or 2", path);
+      return lw_error_set(err, LW_EINPUT, "%s:%d: [tempering] at_label: expected a permutation of the replicas, "
+                          "each with a direction 0, 1 or 2", path, tempering_line(doc, "at_label"));
     seen[r] = 1;
     pt->at[k] = (int)r;
     pt->label[k] = (int)v[2 * k + 1] - 1;
@@ -517,7 +527,8 @@ static lw_status get_tempering(lw_ckpt *doc, lw_anneal *a, lw_error *err)
     if ((s = lw_ckpt_counts(doc, "tempering", pairs[q], v, 2 * (n - 1), 1, err))) return s;
     for (int k = 0; k + 1 < n; k++)
       if (v[2 * k + 1] > v[2 * k])
-        return lw_error_set(err, LW_EINPUT, "%s: [tempering] %s: more accepted than tried at pair %d", path, pairs[q], k);
+        return lw_error_set(err, LW_EINPUT, "%s:%d: [tempering] %s: more accepted than tried at pair %d", path,
+                            tempering_line(doc, pairs[q]), pairs[q], k);
     for (int k = 0; k + 1 < n; k++) {
       unsigned long *tried = q == 0 ? pt->tried : q == 1 ? pt->win_tried : NULL;
       unsigned long *acc = q == 0 ? pt->accepted : q == 1 ? pt->win_accepted : NULL;
@@ -531,8 +542,12 @@ static lw_status get_tempering(lw_ckpt *doc, lw_anneal *a, lw_error *err)
     }
   }
   for (int k = 0; k + 1 < n; k++)
-    if (a->swap_mark[2 * k] > pt->tried[k] || pt->win_tried[k] > pt->tried[k])
-      return lw_error_set(err, LW_EINPUT, "%s: [tempering]: window or trace mark beyond the swaps at pair %d", path, k);
+    if (a->swap_mark[2 * k] > pt->tried[k] || pt->win_tried[k] > pt->tried[k]) {
+      const char *key = pt->win_tried[k] > pt->tried[k] ? "window" : "trace_mark";
+      return lw_error_set(err, LW_EINPUT, "%s:%d: [tempering] %s: %lu tried at pair %d, beyond the %lu of swaps", path,
+                          tempering_line(doc, key), key, pt->win_tried[k] > pt->tried[k] ? pt->win_tried[k]
+                          : a->swap_mark[2 * k], k, pt->tried[k]);
+    }
   if ((s = lw_ckpt_counts(doc, "tempering", "round_trips", &pt->round_trips, 1, 1, err)) ||
       (s = lw_ckpt_counts(doc, "tempering", "steps", &pt->steps, 1, 1, err)))
     return s;

@@ -157,6 +157,17 @@ static char *trim_slashes(char *path)
   return path;
 }
 
+/* A message about a run directory that could not be read says so where the
+** run waits in DIR/.replaced, set aside by a run killed as it started (its
+** files there are not the run's). */
+static void stash_note(lw_error *err, const char *dir)
+{
+  const size_t n = strlen(err->msg);
+  if (lw_runfiles_stashed(dir))
+    snprintf(err->msg + n, sizeof err->msg - n, "; a run there waits in %s/" LW_RUNFILES_STASH ", set aside by a run "
+             "stopped as it started: 'linewise resume %s' puts it back", dir, dir);
+}
+
 /* energy DIR [--set SEC.KEY=VAL]...: the state's energy with its scene, or
 ** with keys of it changed (the quadrature's nodes, to see what the run's
 ** leave out: docs/NUMERICS.md, "The potential between the nodes"). */
@@ -187,11 +198,7 @@ static int cmd_energy(int argc, char **argv)
   lw_state st;
   char path[LW_PATH_MAX + 32];
   if (load_run_dir(dir, &p, &st, path, sizeof path, &err)) {
-    /* (the run may wait in DIR/.replaced, set aside by a run killed as it started) */
-    const size_t n = strlen(err.msg);
-    if (lw_runfiles_stashed(dir))
-      snprintf(err.msg + n, sizeof err.msg - n, "; a run there waits in %s/" LW_RUNFILES_STASH ", set aside by a run "
-               "stopped as it started: 'linewise resume %s' puts it back", dir, dir);
+    stash_note(&err, dir);
     return fail(&err);
   }
   /* the energy is of the scene as DIR/scene.ini reads now: an edit since the
@@ -1116,6 +1123,13 @@ static int cmd_stats(int argc, char **argv)
     }
     free(warned);
   }
+  /* (a run the message names may wait aside: "no rows yet" of the run that
+  ** was killed replacing it said nothing of it) */
+  for (int r = 0; err.code && dir && r < k; r++)
+    if (strstr(err.msg, dir[r]) && lw_runfiles_stashed(dir[r])) {
+      stash_note(&err, dir[r]);
+      break;
+    }
   for (int r = 0; path && r < k; r++) {
     lw_trace_free(t[r]);
     free(path[r]);

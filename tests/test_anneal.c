@@ -334,6 +334,14 @@ Test(run, bad_input_writes_nothing)
   cr_assert_eq(sh("grep -q 'energy.pair' %s/err.txt", dir), 0);
   cr_assert_eq(sh("%s resume %s/nothing-here 2>%s/err.txt", b, dir, dir), 2);
   cr_assert_eq(sh("grep -q 'state.lw' %s/err.txt", dir), 0);
+  /* every move weight 0: the key set to 0 is named, and the system's other
+  ** move keys (the chain's own check named neither file nor key) */
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/out --quiet --set moves.point=0 --set moves.vector=0 "
+                  "--set moves.translate=0 --set moves.rotate=0 2>%s/err.txt", b, getenv("LW_ROOT"), dir, dir), 2);
+  cr_assert_eq(sh("grep -qx \"linewise: --set: key 'moves.point': every move weight is 0 (moves.point, moves.vector, "
+                  "moves.translate, moves.rotate): expected at least one above 0\" %s/err.txt", dir), 0, "%s",
+               lw_test_slurp("%s/err.txt", dir));
+  cr_assert_neq(sh("test -e %s/out", dir), 0, "an output directory was created for bad input");
 }
 
 /* A stop asked while a new run sets up, the run it replaces set aside: the

@@ -151,6 +151,31 @@ Test(checkpoint, every_run_data_value_is_checked_on_resume)
   cr_assert_eq(resume_edited("s/^sweep = 20$/sweep = 20/"), 0);
 }
 
+/* The [tempering] section's values are checked naming the line and the key
+** (four of its refusals named no line, and one no key). */
+Test(checkpoint, a_tempering_sections_values_are_refused_naming_line_and_key)
+{
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/r --threads 1 --quiet --stop-at 10 --set "
+                          "anneal.sweeps=20 --set tempering.replicas=3 --set tempering.t_min=0.01 --set "
+                          "tempering.t_max=1 --set anneal.schedule=constant --set anneal.t_start=1",
+                          lw_test_bin(), lw_test_root(), dir),
+               0);
+  static const struct { const char *sed, *key, *msg; } bad[] = {
+    {"s/^ladder = .*/ladder = 0.01 0.001 1/", "ladder", "expected increasing temperatures"},
+    {"s/^at_label = .*/at_label = 0 2 0 1 2 1/", "at_label", "expected a permutation of the replicas"},
+    {"s/^swaps = .*/swaps = 5 6 5 0/", "swaps", "more accepted than tried at pair 0"},
+    {"s/^window = .*/window = 9 0 5 0/", "window", "9 tried at pair 0, beyond the 5 of swaps"},
+    {"s/^trace_mark = .*/trace_mark = 9 0 5 0/", "trace_mark", "9 tried at pair 0, beyond the 5 of swaps"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    cr_assert_eq(lw_test_sh("grep -q '^%s = ' %s/r/state.lw", bad[i].key, dir), 0);
+    cr_expect_eq(resume_edited(bad[i].sed), 2, "edit '%s'", bad[i].sed);
+    cr_expect_eq(lw_test_sh("grep -q \"x/state.lw:$(grep -n '^%s = ' %s/r/state.lw | cut -d: -f1): \\[tempering\\] "
+                            "%s: %s\" %s/err.txt", bad[i].key, dir, bad[i].key, bad[i].msg, dir),
+                 0, "edit '%s': %s", bad[i].sed, lw_test_slurp("%s/err.txt", dir));
+  }
+}
+
 /* The adaptive schedule's temperature follows from the previous step's and
 ** the energies the file holds: an edited one (5, 0, 1e300) ran the rest of
 ** the run there, and energies with a negative variance, or more samples

@@ -977,6 +977,15 @@ Test(layers, bad_layer_keys_give_one_line_with_file_line_and_key_and_exit_2)
     snprintf(dir, sizeof dir, "%s/bad%zu/final.svg", lw_test_dir, k);
     cr_assert_neq(stat(dir, &sb), 0, "case %zu wrote nothing", k);
   }
+  /* the bound given last is blamed: a tone_min raised by --set over the
+  ** file's tone_max (the file's line was named) */
+  static const char tones[] = "[scene]\nwidth = 30\nheight = 30\nimage = colour.png\n[init]\nsplines = 5\n"
+                              "[layers]\nnames = a b\ntone_max = 1 0.5\n";
+  lw_test_write(lw_test_path("bad.ini"), tones, strlen(tones));
+  char errs[4096];
+  cr_assert_eq(run("run bad.ini --out badset --set 'layers.tone_min=0 0.6'", errs, sizeof errs), 2, "%s", errs);
+  cr_assert_not_null(strstr(errs, "--set: key 'layers.tone_min': expected layers.tone_min < layers.tone_max"), "%s",
+                     errs);
 }
 
 /* A CMYK scene whose splines are born and die in their layers: the layer

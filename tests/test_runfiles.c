@@ -180,3 +180,29 @@ Test(runfiles, run_files_where_no_run_is_are_not_written_over)
                   dir), 0);
   cr_assert_eq(lw_runfiles_check_free(u, NULL), LW_OK);
 }
+
+/* A run that waits in DIR/.replaced, set aside by a run killed as it
+** started (its scene.ini and a trace of no row in DIR): `stats` and `energy`
+** say where it waits and how it comes back (stats said only "no rows
+** yet"), and the resume they name puts it back, whose rows stats reads. */
+Test(runfiles, stats_and_energy_name_the_run_waiting_aside)
+{
+  const char *b = lw_test_bin();
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/r --threads 1 --quiet", b, lw_test_root(), dir), 0);
+  lw_error err;
+  char r[96];
+  snprintf(r, sizeof r, "%s/r", dir);
+  cr_assert_eq(lw_runfiles_stash(r, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(sh("cd %s/r && cp .replaced/scene.ini . && head -1 .replaced/trace.csv > trace.csv", dir), 0);
+  const char *cmd[] = {"stats", "energy"}, *says[] = {"r/trace.csv: no rows yet; a run there waits in ",
+                                                      "r/state.lw: cannot open state file"};
+  for (int k = 0; k < 2; k++) {
+    cr_assert_eq(sh("%s %s %s/r > %s/out.txt 2> %s/err.txt", b, cmd[k], dir, dir, dir), 2, "%s", cmd[k]);
+    char *msg = lw_test_slurp("%s/err.txt", dir);
+    cr_assert(strstr(msg, says[k]) && strstr(msg, "r/.replaced, set aside by a run stopped as it started: "
+                                                  "'linewise resume "), "%s: %s", cmd[k], msg);
+    free(msg);
+  }
+  cr_assert_eq(sh("%s resume %s/r --quiet && %s stats %s/r > %s/out.txt", b, dir, b, dir, dir), 0);
+  cr_assert_eq(sh("grep -q '^total  ' %s/out.txt && ! test -e %s/r/.replaced", dir, dir), 0);
+}
