@@ -1324,6 +1324,86 @@ Test(cli, stats_refuses_a_missing_run_and_a_bad_option_in_one_line)
   cr_assert(strstr(errs, "--from: expected a whole number"), "%s", errs);
 }
 
+/* Settings the docs say are refused, refused before anything is written,
+** in one line naming the key at fault and where it was set. */
+Test(cli, settings_the_docs_refuse_name_their_key_and_write_nothing)
+{
+  static const struct {
+    const char *scene, *set, *says;
+  } bad[] = {
+      {"wire.ini", "--set nurbs.fixed=4", "--set: key 'nurbs.fixed': expected at most half of the 7 control points"},
+      {"particles-sheet.ini", "--set particles.birth=1",
+       "particles-sheet.ini (not set: the default, 0): key 'particles.death': births and deaths are each other's "
+       "reverse, so both or neither"},
+      {"minimal.ini", "--set tempering.ladder=1", "--set: key 'tempering.ladder': expected 2 to 256 temperatures"},
+      {"minimal.ini", "--set tempering.replicas=2 --set anneal.t_start=0",
+       "--set: key 'anneal.t_start': parallel tempering scales the ladder by T(step) / t_start"},
+      {"minimal.ini", "--set anneal.schedule=table", "--set: key 'anneal.schedule': 'table' needs anneal.table"},
+      {"minimal.ini", "--set energy.pair_cutoff=1", "--set: key 'energy.pair_cutoff': expected at least 1.957 mm"},
+      {"example.ini", "--set scene.image_width=5000 --set scene.image_max_pixels=1e6",
+       "--set: key 'scene.image_width': 5000 x 6667 pixels is more than scene.image_max_pixels (1000000)"},
+      {"hatch.ini", "--set layers.names=aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa",
+       "--set: key 'layers.names': expected names of at most 63 characters"},
+  };
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+    cr_expect_eq(lw_test_sh("cd %s && %s run %s/params/%s %s --out o%zu --quiet > out.txt 2> err.txt", dir,
+                            lw_test_bin(), lw_test_root(), bad[k].scene, bad[k].set, k),
+                 2, "%s %s", bad[k].scene, bad[k].set);
+    char *msg = lw_test_slurp("%s/err.txt", dir);
+    cr_expect(msg && strstr(msg, bad[k].says) && !strchr(strchr(msg, '\n') + 1, '\n'), "%s %s: %s", bad[k].scene,
+              bad[k].set, msg);
+    free(msg);
+    cr_expect_eq(lw_test_sh("test ! -e %s/o%zu", dir, k), 0, "%s %s wrote its directory", bad[k].scene, bad[k].set);
+  }
+}
+
+/* Every way of calling a command wrongly exits 2 with one line naming what
+** was expected, and writes nothing: no out/ where a run without --out would
+** write, and the run the calls name unchanged. */
+Test(cli, usage_errors_exit_2_in_one_line_and_write_nothing)
+{
+  cr_assert_eq(lw_test_sh("cd %s && mkdir u && cd u && %s run %s/params/minimal.ini --out r --quiet "
+                          "--set anneal.sweeps=30 && cp r/state.lw ../before.lw", dir, lw_test_bin(), lw_test_root()),
+               0);
+  static const struct {
+    const char *args, *says;
+  } bad[] = {
+      {"run", "run: expected a scene file (usage: linewise run SCENE.ini"},
+      {"run M M", "run: one scene file expected, got "},
+      {"run M --bogus", "run: unknown option '--bogus' (try 'linewise --help')"},
+      {"run M --sweeps 5", "(a run's length is --set anneal.sweeps=N; --sweeps extends a finished run under resume"},
+      {"run M --threads 0", "--threads: expected a whole number from 1 to 4096, got '0'"},
+      {"run M --seed -1", "--seed: expected a whole number from 0 to 4294967295, got '-1'"},
+      {"run M --stop-at x", "--stop-at: expected a whole number from 0 to"},
+      {"resume", "resume: expected a run directory (usage: linewise resume DIR"},
+      {"resume r r", "resume: unexpected 'r' (usage: linewise resume DIR"},
+      {"resume r --sweeps -3", "--sweeps: expected a whole number from 0 to"},
+      {"energy", "energy: expected one run directory (usage: linewise energy DIR"},
+      {"energy r r", "energy: expected one run directory and --set options, got 'r'"},
+      {"stats", "stats: expected a run directory (usage: linewise stats DIR..."},
+      {"stats r --from 10 --to 5", "stats: --from 10 is after --to 5: expected --from no later than --to"},
+      {"stats r --reweight 1", "--reweight: expected a whole number from 2 to 10000, got '1'"},
+      {"stats r --zap", "stats: unexpected '--zap' (usage: linewise stats DIR..."},
+      {"frobnicate", "unknown command 'frobnicate' (try 'linewise --help')"},
+  };
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+    char args[256] = "";
+    for (const char *c = bad[k].args; *c; c++) { /* M: the bundled minimal scene */
+      size_t n = strlen(args);
+      if (*c == 'M' && (c[1] == ' ' || !c[1]) && (c == bad[k].args || c[-1] == ' '))
+        snprintf(args + n, sizeof args - n, "%s/params/minimal.ini", lw_test_root());
+      else snprintf(args + n, sizeof args - n, "%c", *c);
+    }
+    cr_expect_eq(lw_test_sh("cd %s/u && %s %s > out.txt 2> err.txt", dir, lw_test_bin(), args), 2, "%s", args);
+    char *msg = lw_test_slurp("%s/u/err.txt", dir);
+    cr_expect(msg && !strncmp(msg, "linewise: ", 10) && strstr(msg, bad[k].says) && strchr(msg, '\n') &&
+                  !strchr(strchr(msg, '\n') + 1, '\n'), "%s: %s", args, msg);
+    free(msg);
+    cr_expect_eq(lw_test_sh("cd %s/u && ! test -e out && test ! -s out.txt && cmp -s r/state.lw ../before.lw", dir), 0,
+                 "%s wrote something", args);
+  }
+}
+
 /* A caller that closes stderr (2>&-) gets a clean trace: before, trace.csv
 ** took descriptor 2, and the parameter echo and progress lines went into
 ** it (exit 0, and `stats` then failed on it).  Output that does not reach

@@ -325,6 +325,22 @@ Test(dynamics_cli, an_unstable_motion_stops_and_names_the_step)
   cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "s", "0.002", dir), 0);
 }
 
+/* The hanging lines on a step of 50 ms: a segment goes irregular or out
+** of the frame within three steps.  The run stops there, a failure of the
+** run (exit 1) whose message names the time and both ways out (a shorter
+** step, more damping), with the last checkpoint kept to resume from. */
+Test(dynamics_cli, a_motion_into_a_forbidden_state_stops_naming_the_ways_out)
+{
+  cr_assert_eq(sh("%s run %s/params/hanging.ini --out %s/f --quiet --set dynamics.dt=0.05 --set anneal.sweeps=30 "
+                  "2>%s/err.txt", lw_test_bin(), lw_test_root(), dir, dir),
+               1);
+  cr_assert_eq(sh("grep -q '^linewise: the motion reached a forbidden state at t = [0-9.]* s (a segment irregular or "
+                  "outside the boundary): a shorter dynamics.dt passes it.*dynamics.gamma' %s/err.txt && "
+                  "test $(wc -l < %s/err.txt) -eq 1", dir, dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh("test -s %s/f/state.lw && %s energy %s/f > /dev/null", dir, lw_test_bin(), dir), 0);
+}
+
 /* The bundled drape (params/particles-drape.ini): the sheet falls 30 s into
 ** a bowl of radius 8 r0 and comes to rest on its soft wall, a curved sheet.
 ** Measured: every particle 7.50 to 7.65 r0 from the centre, normals along
