@@ -155,8 +155,8 @@ Test(checkpoint, every_run_data_value_is_checked_on_resume)
 ** bytes) and by stats, each in one line naming the file. */
 Test(checkpoint, a_run_whose_trace_is_gone_is_refused_naming_it)
 {
-  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out a --quiet --set anneal.sweeps=40 --stop-at 20 && "
-                          "rm a/trace.csv", dir, lw_test_bin(), lw_test_root()), 0);
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out a --quiet --set anneal.sweeps=40 "
+                          "--stop-at 20 && rm a/trace.csv", dir, lw_test_bin(), lw_test_root()), 0);
   cr_assert_eq(lw_test_sh("cd %s && %s resume a --quiet 2> err.txt", dir, lw_test_bin()), 2);
   cr_assert(err_has("a/trace.csv: No such file or directory, but state.lw counts "), "%s",
             lw_test_slurp("%s/err.txt", dir));
