@@ -184,7 +184,8 @@ Test(runfiles, run_files_where_no_run_is_are_not_written_over)
 /* A run that waits in DIR/.replaced, set aside by a run killed as it
 ** started (its scene.ini and a trace of no row in DIR): `stats` and `energy`
 ** say where it waits and how it comes back (stats said only "no rows
-** yet"), and the resume they name puts it back, whose rows stats reads. */
+** yet"), a start from its state is refused, and the resume they name puts
+** it back, whose rows stats reads. */
 Test(runfiles, stats_and_energy_name_the_run_waiting_aside)
 {
   const char *b = lw_test_bin();
@@ -203,6 +204,12 @@ Test(runfiles, stats_and_energy_name_the_run_waiting_aside)
                                                   "'linewise resume "), "%s: %s", cmd[k], msg);
     free(msg);
   }
+  /* a start from the state waiting there is refused, and the stash kept */
+  cr_assert_eq(sh("cd %s && %s run %s/params/minimal.ini --out r --quiet --set init.from=r/.replaced/state.lw "
+                  "2> err.txt", dir, b, lw_test_root()), 2);
+  cr_assert_eq(sh("cd %s && grep -q \"r/.replaced/state.lw' is in .*/r/.replaced, where the run in r waits while a run "
+                  "replaces it\" err.txt && test -s r/.replaced/state.lw", dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
   cr_assert_eq(sh("%s resume %s/r --quiet && %s stats %s/r > %s/out.txt", b, dir, b, dir, dir), 0);
   cr_assert_eq(sh("grep -q '^total  ' %s/out.txt && ! test -e %s/r/.replaced", dir, dir), 0);
 }
