@@ -1611,6 +1611,14 @@ Test(cli, an_empty_drawing_says_what_removed_its_lines)
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   cr_assert(strstr(errs, "the drawing is empty: final.svg has no path: no spline was placed (init.splines, or "
                          "init.coverage on a picture without dark to cover)"), "%s", errs);
+  /* deaths under a price of line above what the lines lower: the price is
+  ** named, the only one set */
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --set moves.fixed_count=0 --set moves.birth=0.3 --set "
+           "moves.death=0.3 --set energy.chem_spline=100 --set anneal.sweeps=100 --out %s/d", lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "the drawing is empty: final.svg has no path: no spline is left: none was placed "
+                         "(init.splines, init.coverage), or the anneal removed every one, the price of line "
+                         "(energy.chem_spline 100) being more than what the lines lower: lower it"), "%s", errs);
 }
 
 /* With plot.crop = 0 a path past the page's edge is kept whole, and said
