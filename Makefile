@@ -220,35 +220,38 @@ INSTALLED := bin/linewise bin/linewise-mpi $(TOOLS:%=bin/linewise-%) bin/linewis
              $(TOOLS:%=share/man/man1/linewise-%.1) share/man/man1/linewise-animate.1 \
              lib/liblinewise.a lib/pkgconfig/linewise.pc include/linewise
 LW_VERSION := $(shell sed -n 's/^\#define LW_VERSION "\(.*\)"/\1/p' include/linewise/version.h)
+# The install's root, quoted for the shell: a DESTDIR or PREFIX with a blank
+# stays one path (unquoted, uninstall removed the directory before the blank).
+D = "$(DESTDIR)$(PREFIX)"
 install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
-	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/linewise/params $(DESTDIR)$(PREFIX)/share/doc/linewise
-	install -d $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/include/linewise
-	install -m 644 $(BUILD)/liblinewise.a $(DESTDIR)$(PREFIX)/lib/
-	install -m 644 include/linewise/*.h $(DESTDIR)$(PREFIX)/include/linewise/
+	install -d $(D)/bin $(D)/share/linewise/params $(D)/share/doc/linewise
+	install -d $(D)/lib/pkgconfig $(D)/include/linewise $(D)/share/man/man1
+	install -m 644 $(BUILD)/liblinewise.a $(D)/lib/
+	install -m 644 include/linewise/*.h $(D)/include/linewise/
 	printf '%s\n' 'prefix=$${pcfiledir}/../..' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
 	  'Name: linewise' 'Description: elastic Bezier curves annealed into line art (the library of linewise)' \
 	  'Version: $(LW_VERSION)' 'Requires: $(PKGS)' 'Libs: -L$${libdir} -llinewise -fopenmp -lm' \
-	  'Cflags: -I$${includedir}' > $(DESTDIR)$(PREFIX)/lib/pkgconfig/linewise.pc
-	install -m 755 $(BIN)/linewise $(MPI_BIN) $(DESTDIR)$(PREFIX)/bin/
-	install -m 644 params/*.ini params/*.lw $(PICTURE) $(DESTDIR)$(PREFIX)/share/linewise/params/
-	install -d $(DESTDIR)$(PREFIX)/share/man/man1
-	install -m 644 docs/linewise.1 $(DESTDIR)$(PREFIX)/share/man/man1/linewise.1
-	for t in $(TOOLS); do install -m 755 tools/$$t $(DESTDIR)$(PREFIX)/bin/linewise-$$t; done
-	install -m 755 tools/animate.sh $(DESTDIR)$(PREFIX)/bin/linewise-animate
+	  'Cflags: -I$${includedir}' > $(D)/lib/pkgconfig/linewise.pc
+	install -m 755 $(BIN)/linewise $(MPI_BIN) $(D)/bin/
+	install -m 644 params/*.ini params/*.lw $(PICTURE) $(D)/share/linewise/params/
+	install -m 644 docs/linewise.1 $(D)/share/man/man1/linewise.1
+	for t in $(TOOLS); do install -m 755 tools/$$t $(D)/bin/linewise-$$t || exit 1; done
+	install -m 755 tools/animate.sh $(D)/bin/linewise-animate
 	# each tool's man page: its line of tools/whatis, then its --help as it is
 	for t in $(TOOLS) animate; do \
 	  what=$$(sed -n "s/^$$t: //p" tools/whatis); \
 	  test -n "$$what" || { echo "tools/whatis: no line for $$t" >&2; exit 1; }; \
+	  help=$$($(D)/bin/linewise-$$t --help) || { echo "linewise-$$t --help failed" >&2; exit 1; }; \
 	  { printf '.TH LINEWISE-%s 1 "" "linewise $(LW_VERSION)"\n.SH NAME\nlinewise-%s \\- %s\n.SH SYNOPSIS\n.nf\n' \
 	      "$$(echo $$t | tr a-z A-Z)" "$$t" "$$what"; \
-	    $(DESTDIR)$(PREFIX)/bin/linewise-$$t --help | sed 's/\\/\\e/g; s/^[.'"'"']/\\\&&/'; \
-	    printf '.fi\n.SH SEE ALSO\n.BR linewise (1),\nREADME.md in PREFIX/share/doc/linewise.\n'; \
-	  } > $(DESTDIR)$(PREFIX)/share/man/man1/linewise-$$t.1 || exit 1; done
-	install -m 644 tools/slurm-sweep.sbatch tools/slurm-tempering.sbatch $(DESTDIR)$(PREFIX)/share/linewise/
-	install -m 644 README.md docs/*.md docs/*.png $(DESTDIR)$(PREFIX)/share/doc/linewise/
+	    printf '%s\n' "$$help" | sed 's/\\/\\e/g; s/^[.'"'"']/\\\&&/'; \
+	    printf '.fi\n.SH SEE ALSO\n.BR linewise (1),\nREADME.md in %s/share/doc/linewise.\n' "$(PREFIX)"; \
+	  } > $(D)/share/man/man1/linewise-$$t.1 || exit 1; done
+	install -m 644 tools/slurm-sweep.sbatch tools/slurm-tempering.sbatch $(D)/share/linewise/
+	install -m 644 README.md docs/*.md docs/*.png $(D)/share/doc/linewise/
 
 uninstall:
-	rm -rf $(INSTALLED:%=$(DESTDIR)$(PREFIX)/%)
+	for f in $(INSTALLED); do rm -rf $(D)/$$f || exit 1; done
 
 clean:
 	rm -rf build build-asan build-fuzz bin $(PICTURE)

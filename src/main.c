@@ -1095,9 +1095,11 @@ static int cmd_stats(int argc, char **argv)
   char **path = sel ? calloc((size_t)k, sizeof *path) : NULL;
   if (!err.code && !path) lw_error_set(&err, LW_ENOMEM, "out of memory");
   static lw_params p;
+  int failed = -1; /* the run an error is of */
   for (int r = 0; !err.code && r < k; r++) {
     char where[LW_PATH_MAX + 32];
     lw_path_join(where, sizeof where, dir[r], "scene.ini");
+    failed = r;
     if (lw_params_read_run(&p, where, 1, &err)) break;
     sel[r] = base;
     lw_trace_select_of(&p, &sel[r]);
@@ -1105,6 +1107,7 @@ static int cmd_stats(int argc, char **argv)
     if (!(path[r] = strdup(where))) lw_error_set(&err, LW_ENOMEM, "out of memory");
     else t[r] = lw_trace_read(where, &err);
   }
+  if (!err.code) failed = -1;
   if (!err.code) {
     /* with --csv the warnings no column carries go to stderr, a line each */
     char *warned = NULL;
@@ -1123,13 +1126,12 @@ static int cmd_stats(int argc, char **argv)
     }
     free(warned);
   }
-  /* (a run the message names may wait aside: "no rows yet" of the run that
-  ** was killed replacing it said nothing of it) */
-  for (int r = 0; err.code && dir && r < k; r++)
-    if (strstr(err.msg, dir[r]) && lw_runfiles_stashed(dir[r])) {
-      stash_note(&err, dir[r]);
-      break;
-    }
+  /* (the run the error is of may wait aside: "no rows yet" of the run that
+  ** was killed replacing it said nothing of it); a statistics' error begins
+  ** with the trace's path */
+  for (int r = 0; err.code && failed < 0 && path && r < k; r++)
+    if (path[r] && !strncmp(err.msg, path[r], strlen(path[r]))) failed = r;
+  if (err.code && failed >= 0) stash_note(&err, dir[failed]);
   for (int r = 0; path && r < k; r++) {
     lw_trace_free(t[r]);
     free(path[r]);

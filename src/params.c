@@ -691,7 +691,8 @@ const lw_param_def lw_param_table[] = {
       "Energy of each particle, the term chem N (minus the chemical potential, against a "
       "density of one particle per r0^3): higher makes fewer. 0 = off."),
   NUM("particles", "max_count", LW_PT_INT, pt_max_count, "100000", "", 1, 1e7, 0,
-      "Births stop at this many particles."),
+      "Births stop at this many particles. With births or deaths the cell grid is sized for this many "
+      "whatever the count (so that a resumed run adds in the same order): a start far above it runs slower."),
   NUM("dynamics", "rho", LW_PT_DOUBLE, dyn_rho, "1", "mass/mm", 0, 1e12, 0,
       "Line density rho of the kinetic energy (rho/2) int |dr/dt|^2 dl; for particles the mass of "
       "each, with the inertia of a ball of diameter r0. 0 = massless: the "
@@ -1721,6 +1722,9 @@ static void file_text(const char *path, char *buf, size_t n, int *unread)
 int lw_params_file_idle(const lw_params *p, const lw_param_def *d)
 {
   if (!strcmp(d->section, "init") && !strcmp(d->key, "from")) return 1;
+  /* read into tempering.ladder as a run starts (which scene.ini keeps), and
+  ** the dynamics reads no ladder */
+  if (!strcmp(d->section, "tempering") && !strcmp(d->key, "ladder_file")) return 1;
   if (!strcmp(d->section, "anneal") && !strcmp(d->key, "table")) {
     const lw_schedule_type *t = p->driver == LW_DRIVER_DYNAMICS ? NULL : lw_schedule_find(p->schedule);
     return !t || !(t->needs & LW_SCHEDULE_USES_TABLE);

@@ -32,13 +32,6 @@
 #endif
 #include <stb/stb_image.h>
 #if defined(__GNUC__)
-/* (2.27 declares this one and defines it nowhere: static, that is a
-** warning at the end of image.c, past the pop; never called) */
-static void stbi_set_unpremultiply_on_load_thread(int flag_true_if_should_unpremultiply) __attribute__((unused));
-static void stbi_set_unpremultiply_on_load_thread(int flag_true_if_should_unpremultiply)
-{
-  (void)flag_true_if_should_unpremultiply;
-}
 #pragma GCC diagnostic pop
 #endif
 

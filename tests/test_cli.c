@@ -1350,8 +1350,8 @@ Test(cli, settings_the_docs_refuse_name_their_key_and_write_nothing)
                             lw_test_bin(), lw_test_root(), bad[k].scene, bad[k].set, k),
                  2, "%s %s", bad[k].scene, bad[k].set);
     char *msg = lw_test_slurp("%s/err.txt", dir);
-    cr_expect(msg && strstr(msg, bad[k].says) && !strchr(strchr(msg, '\n') + 1, '\n'), "%s %s: %s", bad[k].scene,
-              bad[k].set, msg);
+    cr_expect(msg && strstr(msg, bad[k].says) && strchr(msg, '\n') && !strchr(strchr(msg, '\n') + 1, '\n'), "%s %s: %s",
+              bad[k].scene, bad[k].set, msg);
     free(msg);
     cr_expect_eq(lw_test_sh("test ! -e %s/o%zu", dir, k), 0, "%s %s wrote its directory", bad[k].scene, bad[k].set);
   }

@@ -204,6 +204,13 @@ Test(runfiles, stats_and_energy_name_the_run_waiting_aside)
                                                   "'linewise resume "), "%s: %s", cmd[k], msg);
     free(msg);
   }
+  /* the note is of the run the error is of: not of r beside a run b whose
+  ** trace is gone (any directory whose name the message held took it) */
+  cr_assert_eq(sh("cd %s && %s run %s/params/minimal.ini --out b --quiet && rm b/trace.csv && "
+                  "{ %s stats b r 2> err.txt; test $? -eq 2; } && "
+                  "grep -q '^linewise: b/trace.csv: cannot read' err.txt && ! grep -q 'waits in' err.txt",
+                  dir, b, lw_test_root(), b),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* a start from the state waiting there is refused, and the stash kept */
   cr_assert_eq(sh("cd %s && %s run %s/params/minimal.ini --out r --quiet --set init.from=r/.replaced/state.lw "
                   "2> err.txt", dir, b, lw_test_root()), 2);

@@ -474,7 +474,8 @@ Test(ptrun, a_tuned_ladder_of_16_rungs_reads_back_pasted_and_through_set)
 ** resume reads no ladder file (the one it began with is gone here) and a
 ** redraw from scene.ini runs.  A file that is not a
 ** ladder, or a ladder given twice, is refused naming the file and line at
-** fault, before anything is written. */
+** fault, before anything is written.  Under the dynamics, which reads no
+** ladder, the key is noted and no file is needed, to run or to resume. */
 Test(ptrun, a_ladder_file_runs_as_its_ladder_given_by_set)
 {
   write_scene();
@@ -520,10 +521,21 @@ Test(ptrun, a_ladder_file_runs_as_its_ladder_given_by_set)
     cr_assert_eq(sh("%s run %s/sub/f.ini %s %s --out %s/no 2> %s/err.txt", bin, dir, fixed, bad[k].set, dir, dir), 2,
                  "case %zu", k);
     char *msg = lw_test_slurp("%s/err.txt", dir);
-    cr_assert(strstr(msg, bad[k].says) && !strchr(strchr(msg, '\n') + 1, '\n'), "case %zu: %s", k, msg);
+    cr_assert(msg && strstr(msg, bad[k].says) && strchr(msg, '\n') && !strchr(strchr(msg, '\n') + 1, '\n'),
+              "case %zu: %s", k, msg);
     free(msg);
     cr_assert_neq(sh("test -e %s/no", dir), 0, "case %zu wrote its run directory", k);
   }
+  /* the dynamics reads no ladder: a ladder file there, missing or not, is
+  ** noted and the run goes on, and its resume needs no file */
+  cr_assert_eq(sh("cd %s && %s run %s/params/hanging.ini --out dn --set anneal.sweeps=4 "
+                  "--set tempering.ladder_file=nope.ini 2> err.txt && "
+                  "grep -q 'no effect: tempering.ladder_file' err.txt", dir, bin, lw_test_root()),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh("cd %s && printf '[tempering]\\nladder = 1 2\\n' > l2.ini && %s run %s/params/hanging.ini --out dy "
+                  "--quiet --set anneal.sweeps=4 --set tempering.ladder_file=l2.ini 2> err.txt && rm l2.ini && "
+                  "%s resume dy --quiet --sweeps 2 2> err.txt", dir, bin, lw_test_root(), bin),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
 /* A tempering run of no sweep has no temperatures yet: its rungs said 0

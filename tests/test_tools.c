@@ -998,27 +998,32 @@ Test(tools, an_installed_library_embeds_in_cxx_through_its_pkg_config, .timeout 
 ** tools say the names they are installed under; uninstall takes it all. */
 Test(tools, install_runs_every_scene_away_from_the_checkout_and_uninstall_removes_it, .timeout = 120)
 {
-  cr_assert_eq(sh("make -s -C %s install DESTDIR=%s/root PREFIX=/usr", env("LW_ROOT"), dir), 0, "%s", err_txt());
-  cr_assert_eq(sh("cd %s && for s in root/usr/share/linewise/params/*.ini; do "
-                  "  root/usr/bin/linewise run $s --stop-at 0 --quiet --threads 1 --out \"o-${s##*/}\" || "
+  /* into a DESTDIR with a blank, beside a directory named as its part
+  ** before the blank (uninstall removed that one) */
+  cr_assert_eq(sh("cd %s && mkdir ro && echo mine > ro/keep && make -s -C %s install DESTDIR=\"$PWD/ro ot\" "
+                  "PREFIX=/usr", dir, env("LW_ROOT")),
+               0, "%s", err_txt());
+  cr_assert_eq(sh("cd %s && for s in 'ro ot'/usr/share/linewise/params/*.ini; do "
+                  "  'ro ot'/usr/bin/linewise run \"$s\" --stop-at 0 --quiet --threads 1 --out \"o-${s##*/}\" || "
                   "  { echo \"$s\" >&2; exit 1; }; done",
                   dir),
                0, "%s", err_txt());
-  cr_assert_eq(
-      sh("{ %s/root/usr/bin/linewise-seed-sweep --help && %s/root/usr/bin/linewise-plot-run --help; }", dir, dir), 0);
+  cr_assert_eq(sh("cd %s && { 'ro ot'/usr/bin/linewise-seed-sweep --help && "
+                  "'ro ot'/usr/bin/linewise-plot-run --help; }", dir),
+               0);
   char *out = out_txt();
   cr_assert(strstr(out, "usage: linewise-seed-sweep SCENE.ini") && strstr(out, "usage: linewise-plot-run RUN_DIR"),
             "%s", out);
   free(out);
-  cr_assert_eq(sh("test -s %s/root/usr/share/doc/linewise/PARAMETERS.md", dir), 0);
+  cr_assert_eq(sh("test -s '%s/ro ot/usr/share/doc/linewise/PARAMETERS.md'", dir), 0);
   /* a man page for each tool: its NAME, and its --help under the name it is installed by */
-  cr_assert_eq(sh("cd %s/root/usr && for t in seed-sweep param-sweep plot-run plot-sweep thread-scaling animate; do "
+  cr_assert_eq(sh("cd '%s/ro ot/usr' && for t in seed-sweep param-sweep plot-run plot-sweep thread-scaling animate; do "
                   "  m=share/man/man1/linewise-$t.1; grep -q \"^linewise-$t .- [a-z]\" $m && "
-                  "  grep -q \"^usage: linewise-$t \" $m && "
+                  "  grep -q \"^usage: linewise-$t \" $m && grep -qx 'README.md in /usr/share/doc/linewise.' $m && "
                   "  { ! command -v groff || test -z \"$(groff -man -ww -z $m 2>&1)\"; } "
                   "  || { echo $t >&2; exit 1; }; done", dir),
                0, "%s", err_txt());
-  cr_assert_eq(sh("make -s -C %s uninstall DESTDIR=%s/root PREFIX=/usr && test -z \"$(find %s/root -type f)\"",
-                  env("LW_ROOT"), dir, dir),
+  cr_assert_eq(sh("cd %s && make -s -C %s uninstall DESTDIR=\"$PWD/ro ot\" PREFIX=/usr && "
+                  "test -z \"$(find 'ro ot' -type f)\" && grep -qx mine ro/keep", dir, env("LW_ROOT")),
                0, "%s", err_txt());
 }

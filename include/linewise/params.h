@@ -354,8 +354,9 @@ typedef struct lw_run_keys {
 unsigned long long lw_params_run_hash(const lw_params *p, lw_run_keys *keys);
 
 /* Whether the file key d names is never read by the run as it goes on:
-** init.from (read at the start only), a table under a schedule that reads
-** none, a mask picture without mask = image.  Such a file may move or
+** init.from and tempering.ladder_file (read at the start only), a table
+** under a schedule that reads none, a mask picture without mask = image.
+** Such a file may move or
 ** change (lw_params_run_hash), and a run notes a table or mask picture so
 ** given as having no effect. */
 int lw_params_file_idle(const lw_params *p, const lw_param_def *d);
