@@ -370,17 +370,19 @@ static lw_status absolute_paths(lw_anneal *a, lw_error *err)
 static int parse_ladder(const lw_params *p, const char *text, const char *where, double *ladder, lw_error *err)
 {
   int n = lw_number_list(text, p->of_run ? 1 : 2, ladder, LW_TEMPERING_MAX);
+  const int long_text = strlen(text) > 120; /* (257 rungs echoed 4.7 KB on one line) */
   if (n < 2 || n > LW_TEMPERING_MAX)
-    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%s'%s",
-                        where, LW_TEMPERING_MAX, text, lw_number_list_hint(n)), 0;
+    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%.120s%s'%s",
+                        where, LW_TEMPERING_MAX, text, long_text ? "..." : "", lw_number_list_hint(n)), 0;
   if (p->replicas != 1 && p->replicas != n)
     return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': %d temperatures for %d replicas: the ladder "
                         "sets the count, so expected tempering.replicas = %d or 1 (its default)", where, n,
                         p->replicas, n), 0;
+  /* (up to 1e300, as t_min and t_max) */
   for (int k = 0; k < n; k++)
-    if (!(ladder[k] > 0.0) || !isfinite(ladder[k]) || (k > 0 && !(ladder[k] > ladder[k - 1])))
+    if (!(ladder[k] > 0.0) || !(ladder[k] <= 1e300) || (k > 0 && !(ladder[k] > ladder[k - 1])))
       return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected increasing positive "
-                          "temperatures, got '%s'", where, text), 0;
+                          "temperatures up to 1e300, got '%.120s%s'", where, text, long_text ? "..." : ""), 0;
   return n;
 }
 

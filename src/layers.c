@@ -106,11 +106,14 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
       (st = per_layer(p, "tone_max", p->ly_tone_max, n, 0, 1, hi, err)) ||
       (st = per_layer(p, "pen_width", p->ly_pen_width, n, 1e-3, 100, width, err)))
     return st;
-  /* the bound given last is blamed: one of --set over the scene file's (a
-  ** tone_min raised by --set was blamed on the file's tone_max) */
-  const int min_set = p->line[lw_params_find("layers", "tone_min") - lw_param_table] < 0,
-            max_set = p->line[lw_params_find("layers", "tone_max") - lw_param_table] < 0;
-  const char *last = given(p, "tone_max") && !(min_set && !max_set) ? "tone_max" : "tone_min";
+  /* the bound given last is blamed: one of --set over the scene file's, a
+  ** later line over an earlier (a tone_min raised by --set was blamed on the
+  ** file's tone_max); of two --set, whose order is not kept, tone_max */
+  const int at_min = p->line[lw_params_find("layers", "tone_min") - lw_param_table],
+            at_max = p->line[lw_params_find("layers", "tone_max") - lw_param_table];
+  const int min_last = given(p, "tone_min") && (!given(p, "tone_max") || (at_min < 0 && at_max > 0) ||
+                                                 (at_min > 0 && at_max > 0 && at_min > at_max));
+  const char *last = min_last ? "tone_min" : "tone_max";
   for (int k = 0; k < n; k++)
     if (!(lo[k] < hi[k]))
       return bad(p, last, err, "expected layers.tone_min < layers.tone_max, got %g and %g for layer %d", lo[k], hi[k],

@@ -951,6 +951,9 @@ Test(layers, bad_layer_keys_give_one_line_with_file_line_and_key_and_exit_2)
     {"[layers]\nnames = a\nsource = palette\n", "scene.ini:10: key 'layers.source': 'palette' needs layers.colors"},
     {"[layers]\nnames = a b\ntone_min = 0 0.6\ntone_max = 1 0.5\n",
      "scene.ini:11: key 'layers.tone_max': expected layers.tone_min < layers.tone_max"},
+    /* (the bound on the later line is blamed) */
+    {"[layers]\nnames = a b\ntone_max = 1 0.5\ntone_min = 0 0.6\n",
+     "scene.ini:11: key 'layers.tone_min': expected layers.tone_min < layers.tone_max"},
     {"[layers]\nturn = 0 90\n", "scene.ini:9: key 'layers.turn': needs layers.names"},
     {"[layers]\nnames = a b\npen_width = 0.3 -1\n", "scene.ini:10: key 'layers.pen_width': expected values"},
     {"[layers]\nnames = a b\n[output]\npens = 3\n", "scene.ini:11: key 'output.pens': layers set the pens"},

@@ -510,6 +510,8 @@ Test(ptrun, a_ladder_file_runs_as_its_ladder_given_by_set)
      "lad.ini:4: key 'anneal.sweeps': a ladder file holds only tempering.ladder"},
     {"; nothing\n", "", "lad.ini: no tempering.ladder in it"},
     {"[tempering]\nladder = 1 4 2 3\n", "", "lad.ini:2: key 'tempering.ladder': expected increasing positive"},
+    {"[tempering]\nladder = 1 2 3 1e301\n", "", "lad.ini:2: key 'tempering.ladder': expected increasing positive "
+     "temperatures up to 1e300"},
     {"[tempering]\nladder = 1 2\n", "", "lad.ini:2: key 'tempering.ladder': 2 temperatures for 4 replicas"},
     {"[tempering]\nladder = 1 2 3 4\n", "--set 'tempering.ladder=1 2 3 5'",
      "f.ini:32: key 'tempering.ladder_file': tempering.ladder is given too (--set); expected one of them"},
