@@ -1146,6 +1146,16 @@ static int continue_list(reader_ctx *rc)
     }
   while (n && (h[n - 1] == ' ' || h[n - 1] == '\t')) n--;
   if (memchr(h, '=', n) || memchr(h, ':', n)) return 0; /* (a key, whatever its comment holds) */
+  /* (as the key's own line: a control character there was taken, and the
+  ** run's scene.ini, which holds it, could not be read back) */
+  for (const char *c = h; c < h + n; c++)
+    if ((unsigned char)*c < 0x20 && *c != '\t') {
+      lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' goes on with a control character (byte %zu of the line): "
+                   "expected text without control characters", rc->p->file, rc->line, d->section, d->key,
+                   (size_t)(c - rc->buf) + 1);
+      rc->failed = 1;
+      return 1;
+    }
   char *value = (char *)rc->p + d->offset;
   size_t len = strlen(value);
   if (len + 1 + n > lw_params_text_cap(d)) {
