@@ -778,7 +778,7 @@ static lw_status no_move(const lw_anneal *a, lw_error *err)
   for (int k = 0; k < t->n_moves; k++) {
     const lw_param_def *d = lw_params_find("moves", t->move_names[k]);
     if (!d) continue;
-    m += (size_t)snprintf(names + m, m < sizeof names ? sizeof names - m : 0, "%smoves.%s", m ? ", " : "", d->key);
+    if (m < sizeof names) m += (size_t)snprintf(names + m, sizeof names - m, "%smoves.%s", m ? ", " : "", d->key);
     if (!blame || (lw_params_given(p, d) && !lw_params_given(p, blame))) blame = d;
   }
   lw_error_set(err, LW_EINPUT, "every move weight is 0 (%s): expected at least one above 0", names);
