@@ -922,6 +922,7 @@ static int cmd_run(int argc, char **argv)
                "be written", back ? ", and the run that was in the directory is back as it was"
                          : lw_runfiles_stashed(dir) ? ", and the run that was in the directory waits in "
                          LW_RUNFILES_STASH " (linewise puts it back when it next runs or resumes there)" : "");
+    else stash_note(&err, dir); /* (bad input into a directory where an earlier run waits aside) */
     lw_anneal_free(&a);
     unmake_dir(dir, hold, made);
     return watched_fail(&w, &err);

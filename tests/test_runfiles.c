@@ -182,10 +182,10 @@ Test(runfiles, run_files_where_no_run_is_are_not_written_over)
 }
 
 /* A run that waits in DIR/.replaced, set aside by a run killed as it
-** started (its scene.ini and a trace of no row in DIR): `stats` and `energy`
-** say where it waits and how it comes back (stats said only "no rows
-** yet"), a start from its state is refused, and the resume they name puts
-** it back, whose rows stats reads. */
+** started (its scene.ini and a trace of no row in DIR): `stats`, `energy`
+** and a run refused for bad input there say where it waits and how it
+** comes back (stats said only "no rows yet"), a start from its state is
+** refused, and the resume they name puts it back, whose rows stats reads. */
 Test(runfiles, stats_and_energy_name_the_run_waiting_aside)
 {
   const char *b = lw_test_bin();
@@ -210,6 +210,12 @@ Test(runfiles, stats_and_energy_name_the_run_waiting_aside)
                   "{ %s stats b r 2> err.txt; test $? -eq 2; } && "
                   "grep -q '^linewise: b/trace.csv: cannot read' err.txt && ! grep -q 'waits in' err.txt",
                   dir, b, lw_test_root(), b),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  /* a run refused for bad input there says so too, and leaves it waiting */
+  cr_assert_eq(sh("cd %s && { %s run %s/params/minimal.ini --out r --quiet --set tempering.ladder_file=nope.ini "
+                  "2> err.txt; test $? -eq 2; } && "
+                  "grep -q \"tempering.ladder_file.*; a run there waits in r/.replaced\" err.txt && "
+                  "test -s r/.replaced/state.lw", dir, b, lw_test_root()),
                0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* a start from the state waiting there is refused, and the stash kept */
   cr_assert_eq(sh("cd %s && %s run %s/params/minimal.ini --out r --quiet --set init.from=r/.replaced/state.lw "
