@@ -221,8 +221,10 @@ INSTALLED := bin/linewise bin/linewise-mpi $(TOOLS:%=bin/linewise-%) bin/linewis
              lib/liblinewise.a lib/pkgconfig/linewise.pc include/linewise
 LW_VERSION := $(shell sed -n 's/^\#define LW_VERSION "\(.*\)"/\1/p' include/linewise/version.h)
 # The install's root, quoted for the shell: a DESTDIR or PREFIX with a blank
-# stays one path (unquoted, uninstall removed the directory before the blank).
-D = "$(DESTDIR)$(PREFIX)"
+# stays one path (unquoted, uninstall removed the directory before the blank),
+# and one with $, ` or " is taken as it is (single quotes, a ' in it escaped).
+shell_quote = '$(subst ','\'',$(1))'
+D = $(call shell_quote,$(DESTDIR)$(PREFIX))
 install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	install -d $(D)/bin $(D)/share/linewise/params $(D)/share/doc/linewise
 	install -d $(D)/lib/pkgconfig $(D)/include/linewise $(D)/share/man/man1
@@ -245,7 +247,8 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	  { printf '.TH LINEWISE-%s 1 "" "linewise $(LW_VERSION)"\n.SH NAME\nlinewise-%s \\- %s\n.SH SYNOPSIS\n.nf\n' \
 	      "$$(echo $$t | tr a-z A-Z)" "$$t" "$$what"; \
 	    printf '%s\n' "$$help" | sed 's/\\/\\e/g; s/^[.'"'"']/\\\&&/'; \
-	    printf '.fi\n.SH SEE ALSO\n.BR linewise (1),\nREADME.md in %s/share/doc/linewise.\n' "$(PREFIX)"; \
+	    printf '.fi\n.SH SEE ALSO\n.BR linewise (1),\nREADME.md in %s/share/doc/linewise.\n' \
+	      "$$(printf '%s' $(call shell_quote,$(PREFIX)) | sed 's/\\/\\e/g')"; \
 	  } > $(D)/share/man/man1/linewise-$$t.1 || exit 1; done
 	install -m 644 tools/slurm-sweep.sbatch tools/slurm-tempering.sbatch $(D)/share/linewise/
 	install -m 644 README.md docs/*.md docs/*.png $(D)/share/doc/linewise/

@@ -505,7 +505,9 @@ static lw_status get_tempering(lw_ckpt *doc, lw_anneal *a, lw_error *err)
   unsigned long v[2 * LW_TEMPERING_MAX];
   lw_status s;
   if ((s = get_rng(doc, "tempering", pt->rng, err)) ||
-      (s = lw_ckpt_numbers(doc, "tempering", "ladder", pt->ladder, n, DBL_MIN, 1e300, 1, err)))
+      /* (any positive rung the scene may set: one of 1e-310 ran, and its
+      ** resume was refused) */
+      (s = lw_ckpt_numbers(doc, "tempering", "ladder", pt->ladder, n, DBL_TRUE_MIN, 1e300, 1, err)))
     return s;
   for (int k = 1; k < n; k++)
     if (!(pt->ladder[k] > pt->ladder[k - 1]))

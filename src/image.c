@@ -1419,8 +1419,10 @@ lw_grid2d *lw_image_tone_grid(const lw_image *img, const lw_image_place *pl, lw_
 
 /* stb_image 2.27 declares stbi_set_unpremultiply_on_load_thread and defines
 ** it nowhere (2.28 does, so no stub can stand in for it); static, GCC warns
-** of it as the file ends, which is where it reads this.  A function of this
-** file left unused is still warned of: GCC judges those where they stand. */
+** of it as the file ends, which is where it reads this.  So GCC says nothing
+** of a static function of this file declared and never defined; one defined
+** and left unused above is still warned of (GCC judges those where they
+** stand), and clang, which takes this pragma too, still warns of both. */
 #if defined(__GNUC__)
 #pragma GCC diagnostic ignored "-Wunused-function"
 #endif

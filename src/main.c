@@ -1131,7 +1131,7 @@ static int cmd_stats(int argc, char **argv)
   ** was killed replacing it said nothing of it); a statistics' error begins
   ** with the trace's path */
   for (int r = 0; err.code && failed < 0 && path && r < k; r++)
-    if (path[r] && !strncmp(err.msg, path[r], strlen(path[r]))) failed = r;
+    if (path[r] && !strncmp(err.msg, path[r], strlen(path[r])) && err.msg[strlen(path[r])] == ':') failed = r;
   if (err.code && failed >= 0) stash_note(&err, dir[failed]);
   for (int r = 0; path && r < k; r++) {
     lw_trace_free(t[r]);

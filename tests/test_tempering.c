@@ -528,6 +528,12 @@ Test(ptrun, a_ladder_file_runs_as_its_ladder_given_by_set)
     free(msg);
     cr_assert_neq(sh("test -e %s/no", dir), 0, "case %zu wrote its run directory", k);
   }
+  /* a rung below the smallest normal double (any above 0 is allowed) runs,
+  ** and resumes (its state was refused as damaged) */
+  cr_assert_eq(sh("cd %s && %s run %s/params/minimal.ini --out tiny --quiet --set anneal.sweeps=20 --stop-at 10 "
+                  "--set 'tempering.ladder=1e-310 1' && %s resume tiny --quiet 2> err.txt", dir, bin, lw_test_root(),
+                  bin),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* the dynamics reads no ladder: a ladder file there, missing or not, is
   ** noted and the run goes on, and its resume needs no file */
   cr_assert_eq(sh("cd %s && %s run %s/params/hanging.ini --out dn --set anneal.sweeps=4 "
