@@ -435,7 +435,8 @@ const lw_param_def lw_param_table[] = {
   LIST("tempering", "ladder", ladder, "", "energy",
        "Explicit ladder `t0 t1 ...` (increasing, each above 0 and at most 1e300; overrides t_min and "
        "t_max; its length sets the replicas, and `replicas` may stay 1, as a run's scene.ini then keeps "
-       "it; a long ladder goes on over indented lines). A run with ladder tuning writes its tuned ladder to ladder.ini for reuse."),
+       "it; a long ladder goes on over indented lines). A run with ladder tuning writes its tuned ladder "
+       "to ladder.ini for reuse."),
   STRING("tempering", "ladder_file", ladder_file, "", "path",
          "A file of the ladder instead of `ladder`, relative to the scene file: a `[tempering]` section "
          "with `ladder = ...` and nothing else, as a run's ladder.ini is. Read when a run starts; the "

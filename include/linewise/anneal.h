@@ -105,9 +105,9 @@ typedef struct lw_anneal {
 ** The threads a run uses are OpenMP's (omp_set_num_threads, OMP_NUM_THREADS),
 ** and its results do not depend on their count (a run of several rungs split
 ** into domains, on more threads than rungs, nests its parallel regions: it
-** raises omp_get_max_active_levels to 2 and leaves it so).  LC_NUMERIC must read '.'
-** (lw_number_locale_ok), here and at every trace row, checkpoint and the
-** finish.  On failure dir and its .lock may stay: a caller that made dir
+** raises omp_get_max_active_levels to 2 and leaves it so).  LC_NUMERIC must
+** read '.' (lw_number_locale_ok), here and at every sweep, checkpoint and
+** the finish.  On failure dir and its .lock may stay: a caller that made dir
 ** removes it (the command line does).  A stop asked (lw_phase_stop) while
 ** the run before waits aside ends the set-up with LW_ERUN and gave_way set:
 ** the caller's lw_anneal_undo_start puts that run back. */
