@@ -1404,6 +1404,36 @@ Test(cli, usage_errors_exit_2_in_one_line_and_write_nothing)
   }
 }
 
+/* A stack too small for a run (OpenMP's threads of OMP_STACKSIZE, the main
+** thread of ulimit -s) is refused in one line before anything is written;
+** before, the photo preset died of a segmentation fault mid-run at 16K.  A
+** stack of the needed 256 KiB, in any of OpenMP's spellings, runs. */
+Test(cli, a_stack_too_small_is_refused_before_the_run)
+{
+  static const struct {
+    const char *env, *says;
+  } small[] = {
+      {"OMP_STACKSIZE=16K", "environment OMP_STACKSIZE: '16K' gives each thread 16 KiB of stack: expected at least 256"},
+      {"OMP_STACKSIZE=' 200 k '", "OMP_STACKSIZE: ' 200 k ' gives each thread 200 KiB"},
+      {"GOMP_STACKSIZE=100", "environment GOMP_STACKSIZE: '100' gives each thread 100 KiB"},
+      {"ulimit -s 100;", "the stack limit (ulimit -s) is 100 KiB: expected at least 256 KiB"},
+  };
+  for (size_t k = 0; k < sizeof small / sizeof small[0]; k++) {
+    cr_expect_eq(lw_test_sh("cd %s && %s %s run %s/params/minimal.ini --out s%zu --quiet 2> err.txt", dir, small[k].env,
+                            lw_test_bin(), lw_test_root(), k), 2, "%s", small[k].env);
+    char *msg = lw_test_slurp("%s/err.txt", dir);
+    cr_expect(msg && !strncmp(msg, "linewise: ", 10) && strstr(msg, small[k].says) && strchr(msg, '\n') &&
+                  !strchr(strchr(msg, '\n') + 1, '\n'), "%s: %s", small[k].env, msg);
+    free(msg);
+    cr_expect_eq(lw_test_sh("test ! -e %s/s%zu", dir, k), 0, "%s wrote its directory", small[k].env);
+  }
+  const char *enough[] = {"OMP_STACKSIZE=256", "OMP_STACKSIZE=1m", "OMP_STACKSIZE=262144B", "ulimit -s 256;"};
+  for (size_t k = 0; k < sizeof enough / sizeof enough[0]; k++)
+    cr_expect_eq(lw_test_sh("cd %s && %s %s run %s/params/minimal.ini --out e%zu --quiet --set anneal.sweeps=2 && "
+                            "test -s e%zu/summary.json", dir, enough[k], lw_test_bin(), lw_test_root(), k, k),
+                 0, "%s", enough[k]);
+}
+
 /* A caller that closes stderr (2>&-) gets a clean trace: before, trace.csv
 ** took descriptor 2, and the parameter echo and progress lines went into
 ** it (exit 0, and `stats` then failed on it).  Output that does not reach
