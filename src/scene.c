@@ -508,6 +508,142 @@ static lw_status build_layers(lw_scene *sc, const lw_params *p, lw_error *err)
   return LW_OK;
 }
 
+/* The potential the scene names, about the page point (cx, cy). */
+static lw_status build_potential(lw_scene *sc, const lw_params *p, double cx, double cy, lw_error *err)
+{
+  lw_potential *f = &sc->potential;
+  f->cx = cx;
+  f->cy = cy;
+  switch (p->potential) {
+  case LW_POT_CONSTANT:
+    f->kind = LW_POTENTIAL_CONSTANT;
+    f->value = p->potential_value;
+    break;
+  case LW_POT_RAMP:
+    f->kind = LW_POTENTIAL_RAMP;
+    f->ux = cos(p->potential_angle * DEG);
+    f->uy = sin(p->potential_angle * DEG);
+    /* half the page's extent along u, so Phi runs 0..1 corner to corner */
+    f->scale = p->potential_scale > 0 ? p->potential_scale
+               : 0.5 * (fabs(f->ux) * p->width + fabs(f->uy) * p->height);
+    break;
+  case LW_POT_RADIAL:
+    f->kind = LW_POTENTIAL_RADIAL;
+    f->scale = p->potential_scale > 0 ? p->potential_scale : 0.5 * hypot(p->width, p->height);
+    break;
+  case LW_POT_IMAGE:
+    if (!sc->image) return bad_key(p, "scene", "potential", LW_EINPUT, err, "'image' needs scene.image");
+    f->kind = LW_POTENTIAL_GRID;
+    if (!(f->grid = lw_imagefield_potential(sc->image, &sc->image_place, p->potential_power,
+                                            p->potential_blur / sc->image_place.pixel, err)))
+      return err->code;
+    break;
+  }
+  return LW_OK;
+}
+
+/* The field the scene names, about the page point (cx, cy). */
+static lw_status build_field(lw_scene *sc, const lw_params *p, double cx, double cy, lw_error *err)
+{
+  lw_field *f = &sc->field;
+  f->cx = cx;
+  f->cy = cy;
+  /* a run begun before 2026-12-05 has no line for it: no core, as it ran
+  ** (a scene.ini written by hand beside a state takes the default) */
+  const int before = p->run_written && !p->line[lw_params_find("scene", "field_core") - lw_param_table];
+  f->core = before ? 0.0 : p->field_core < 0.0 ? p->segment_length : p->field_core;
+  f->ux = cos(p->field_angle * DEG);
+  f->uy = sin(p->field_angle * DEG);
+  f->wavelength = p->field_wavelength;
+  f->amplitude = p->field_amplitude;
+  static const lw_field_kind kinds[] = {
+    [LW_FLD_CONSTANT] = LW_FIELD_CONSTANT, [LW_FLD_RADIAL] = LW_FIELD_RADIAL,
+    [LW_FLD_VORTEX] = LW_FIELD_VORTEX, [LW_FLD_WAVES] = LW_FIELD_WAVES,
+    [LW_FLD_ETF] = LW_FIELD_GRID_AXIAL, [LW_FLD_GRADIENT] = LW_FIELD_GRID,
+  };
+  f->kind = kinds[p->field];
+  if (p->field == LW_FLD_ETF || p->field == LW_FLD_GRADIENT) {
+    const char *name = p->field == LW_FLD_ETF ? "etf" : "gradient";
+    if (!sc->image) return bad_key(p, "scene", "field", LW_EINPUT, err, "'%s' needs scene.image", name);
+    /* the flow has no sign: r'.v would reward either direction at random */
+    if (p->field == LW_FLD_ETF && !sc->field_axial)
+      return bad_key(p, "scene", "field", LW_EINPUT, err,
+                     "'etf' is a direction without sign: it needs energy.field_mode = axial");
+    f->grid = p->field == LW_FLD_ETF
+              ? lw_imagefield_etf(sc->image, &sc->image_place, p->field_sigma, p->field_flat,
+                                  p->field_angle * DEG, err)
+              : lw_imagefield_gradient(sc->image, &sc->image_place, p->field_flat, err);
+    if (!f->grid) return err->code;
+  }
+  return LW_OK;
+}
+
+static lw_status build_boundary(lw_scene *sc, const lw_params *p, lw_error *err)
+{
+  lw_status st;
+  lw_boundary *b = &sc->boundary;
+  switch (p->boundary) {
+  case LW_BND_RECT:
+  case LW_BND_CIRCLE:
+    if ((st = margin_ok(p, err))) return st;
+    if (p->boundary == LW_BND_RECT) {
+      b->kind = LW_BOUNDARY_RECT;
+      b->x0 = p->margin;
+      b->y0 = p->margin;
+      b->x1 = p->width - p->margin;
+      b->y1 = p->height - p->margin;
+    } else {
+      b->kind = LW_BOUNDARY_CIRCLE;
+      b->cx = 0.5 * p->width;
+      b->cy = 0.5 * p->height;
+      b->radius = 0.5 * fmin(p->width, p->height) - p->margin;
+    }
+    break;
+  case LW_BND_POLYGON:
+    /* the margin frames no polygon, but without a picture it sets plot.crop's
+    ** rectangle: an empty one failed the drawing after every sweep had run */
+    if (p->crop && !p->image[0] && (st = margin_ok(p, err))) return st;
+    st = build_polygon(sc, p, err);
+    if (st) return st;
+    break;
+  case LW_BND_MASK:
+    if ((st = build_mask(sc, p, err))) return st;
+    break;
+  }
+  if (p->boundary != LW_BND_MASK && p->mask != LW_MASK_NONE)
+    return bad_key(p, "scene", "mask", LW_EINPUT, err, "a mask needs scene.boundary = mask");
+  b->slope = b->kind == LW_BOUNDARY_MASK ? lw_boundary_mask_slope(b->sdt) : 1.0;
+  b->clearance = p->boundary_clearance;
+  return LW_OK;
+}
+
+/* The pair and tone terms' node rules, and the pair kernel's radii. */
+static lw_status build_pair(lw_scene *sc, const lw_params *p, lw_error *err)
+{
+  lw_status st;
+  if ((st = term_nodes(p, sc, sc->on[LW_TERM_PAIR], "pair_quadrature", p->pair_quadrature, &sc->pair_quad, err)) ||
+      (st = term_nodes(p, sc, sc->on[LW_TERM_TONE], "tone_quadrature", p->tone_quadrature, &sc->tone_quad, err)))
+    return st;
+  /* (a run begun before the rule, whose scene.ini holds a smaller one,
+  ** still resumes and measures as it ran; unless --set changes the radius
+  ** or the nodes: `energy --set` measured a radius a run refuses) */
+  const double least = ceil(1e3 * lw_pair_near_least(&sc->pair_quad)) / 1e3;
+  const lw_param_def *d = lw_params_find("energy", "pair_near");
+  const char *nodes = p->pair_quadrature > 0 ? "pair_quadrature" : "quadrature";
+  const int near_set = lw_params_given(p, d), nodes_set = lw_params_given(p, lw_params_find("energy", nodes));
+  if (sc->on[LW_TERM_PAIR] && p->pair_near > 0.0 && p->pair_near < least && (!p->of_run || near_set || nodes_set)) {
+    /* blame what the user set: the radius, or the nodes under the default one */
+    const char *key = near_set || (!p->of_run && p->line[d - lw_param_table]) ? "pair_near" : nodes;
+    return bad_key(p, "energy", key, LW_EINPUT, err, "energy.pair_near = %g is less than %.3f, the least at %d pair "
+                   "nodes (energy.%s): expected pair_near 0 (off) or at least that (closer, a line "
+                   "crossing another between their samples is taken only in part: docs/ACCURACY.md, \"Near "
+                   "field\")", p->pair_near, least, sc->pair_quad.n, nodes);
+  }
+  lw_pair_ctx_init(&sc->pair, p->pair_cutoff, p->pair_near);
+  sc->pair_gap_max = sc->on[LW_TERM_PAIR] && p->pair_cutoff > 0.0 ? LW_PAIR_GAP_SHARE * p->pair_cutoff : 0.0;
+  return LW_OK;
+}
+
 static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
 {
   sc->width = p->width;
@@ -546,27 +682,7 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   sc->regularity = p->regularity > 1.0 ? p->regularity : 0.0;
   lw_status st = lw_quad_init(&sc->quad, p->quadrature, err);
   if (st) return st;
-  if ((st = term_nodes(p, sc, sc->on[LW_TERM_PAIR], "pair_quadrature", p->pair_quadrature, &sc->pair_quad, err)) ||
-      (st = term_nodes(p, sc, sc->on[LW_TERM_TONE], "tone_quadrature", p->tone_quadrature, &sc->tone_quad, err)))
-    return st;
-  /* (a run begun before the rule, whose scene.ini holds a smaller one,
-  ** still resumes and measures as it ran; unless --set changes the radius
-  ** or the nodes: `energy --set` measured a radius a run refuses) */
-  const double least = ceil(1e3 * lw_pair_near_least(&sc->pair_quad)) / 1e3;
-  const lw_param_def *d = lw_params_find("energy", "pair_near");
-  const char *nodes = p->pair_quadrature > 0 ? "pair_quadrature" : "quadrature";
-  const int near_set = lw_params_given(p, d), nodes_set = lw_params_given(p, lw_params_find("energy", nodes));
-  if (sc->on[LW_TERM_PAIR] && p->pair_near > 0.0 && p->pair_near < least && (!p->of_run || near_set || nodes_set)) {
-    /* blame what the user set: the radius, or the nodes under the default one */
-    const char *key = near_set || (!p->of_run && p->line[d - lw_param_table]) ? "pair_near" : nodes;
-    return bad_key(p, "energy", key, LW_EINPUT, err, "energy.pair_near = %g is less than %.3f, the least at %d pair "
-                   "nodes (energy.%s): expected pair_near 0 (off) or at least that (closer, a line "
-                   "crossing another between their samples is taken only in part: docs/ACCURACY.md, \"Near "
-                   "field\")", p->pair_near, least, sc->pair_quad.n, nodes);
-  }
-  lw_pair_ctx_init(&sc->pair, p->pair_cutoff, p->pair_near);
-  sc->pair_gap_max = sc->on[LW_TERM_PAIR] && p->pair_cutoff > 0.0 ? LW_PAIR_GAP_SHARE * p->pair_cutoff : 0.0;
-
+  if ((st = build_pair(sc, p, err))) return st;
   /* -1 is the page centre; a value between it and 0 meant it too, silently
   ** (and still does in a run begun before 2026-12-05) */
   static const char *const centre_key[2] = {"center_x", "center_y"};
@@ -590,68 +706,8 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     if ((st = scored_side_ok(p, "output", "fidelity_reference", sc->reference, err))) return st;
   }
 
-  if (sc->on[LW_TERM_POTENTIAL]) {
-    lw_potential *f = &sc->potential;
-    f->cx = cx;
-    f->cy = cy;
-    switch (p->potential) {
-    case LW_POT_CONSTANT:
-      f->kind = LW_POTENTIAL_CONSTANT;
-      f->value = p->potential_value;
-      break;
-    case LW_POT_RAMP:
-      f->kind = LW_POTENTIAL_RAMP;
-      f->ux = cos(p->potential_angle * DEG);
-      f->uy = sin(p->potential_angle * DEG);
-      /* half the page's extent along u, so Phi runs 0..1 corner to corner */
-      f->scale = p->potential_scale > 0 ? p->potential_scale
-                 : 0.5 * (fabs(f->ux) * p->width + fabs(f->uy) * p->height);
-      break;
-    case LW_POT_RADIAL:
-      f->kind = LW_POTENTIAL_RADIAL;
-      f->scale = p->potential_scale > 0 ? p->potential_scale : 0.5 * hypot(p->width, p->height);
-      break;
-    case LW_POT_IMAGE:
-      if (!sc->image) return bad_key(p, "scene", "potential", LW_EINPUT, err, "'image' needs scene.image");
-      f->kind = LW_POTENTIAL_GRID;
-      if (!(f->grid = lw_imagefield_potential(sc->image, &sc->image_place, p->potential_power,
-                                              p->potential_blur / sc->image_place.pixel, err)))
-        return err->code;
-      break;
-    }
-  }
-  if (sc->on[LW_TERM_FIELD]) {
-    lw_field *f = &sc->field;
-    f->cx = cx;
-    f->cy = cy;
-    /* a run begun before 2026-12-05 has no line for it: no core, as it ran
-    ** (a scene.ini written by hand beside a state takes the default) */
-    const int before = p->run_written && !p->line[lw_params_find("scene", "field_core") - lw_param_table];
-    f->core = before ? 0.0 : p->field_core < 0.0 ? p->segment_length : p->field_core;
-    f->ux = cos(p->field_angle * DEG);
-    f->uy = sin(p->field_angle * DEG);
-    f->wavelength = p->field_wavelength;
-    f->amplitude = p->field_amplitude;
-    static const lw_field_kind kinds[] = {
-      [LW_FLD_CONSTANT] = LW_FIELD_CONSTANT, [LW_FLD_RADIAL] = LW_FIELD_RADIAL,
-      [LW_FLD_VORTEX] = LW_FIELD_VORTEX, [LW_FLD_WAVES] = LW_FIELD_WAVES,
-      [LW_FLD_ETF] = LW_FIELD_GRID_AXIAL, [LW_FLD_GRADIENT] = LW_FIELD_GRID,
-    };
-    f->kind = kinds[p->field];
-    if (p->field == LW_FLD_ETF || p->field == LW_FLD_GRADIENT) {
-      const char *name = p->field == LW_FLD_ETF ? "etf" : "gradient";
-      if (!sc->image) return bad_key(p, "scene", "field", LW_EINPUT, err, "'%s' needs scene.image", name);
-      /* the flow has no sign: r'.v would reward either direction at random */
-      if (p->field == LW_FLD_ETF && !sc->field_axial)
-        return bad_key(p, "scene", "field", LW_EINPUT, err,
-                       "'etf' is a direction without sign: it needs energy.field_mode = axial");
-      f->grid = p->field == LW_FLD_ETF
-                ? lw_imagefield_etf(sc->image, &sc->image_place, p->field_sigma, p->field_flat,
-                                    p->field_angle * DEG, err)
-                : lw_imagefield_gradient(sc->image, &sc->image_place, p->field_flat, err);
-      if (!f->grid) return err->code;
-    }
-  }
+  if (sc->on[LW_TERM_POTENTIAL] && (st = build_potential(sc, p, cx, cy, err))) return st;
+  if (sc->on[LW_TERM_FIELD] && (st = build_field(sc, p, cx, cy, err))) return st;
   if (sc->on[LW_TERM_TONE]) {
     if (!sc->image) return bad_key(p, "energy", "tone", LW_EINPUT, err, "the tone term needs scene.image");
     lw_error e2;
@@ -681,39 +737,7 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
     return bad_key(p, "output", "preview_image", LW_EINPUT, err, "the scene has no picture to paint under the lines "
                    "(scene.image is empty)");
 
-  lw_boundary *b = &sc->boundary;
-  switch (p->boundary) {
-  case LW_BND_RECT:
-  case LW_BND_CIRCLE:
-    if ((st = margin_ok(p, err))) return st;
-    if (p->boundary == LW_BND_RECT) {
-      b->kind = LW_BOUNDARY_RECT;
-      b->x0 = p->margin;
-      b->y0 = p->margin;
-      b->x1 = p->width - p->margin;
-      b->y1 = p->height - p->margin;
-    } else {
-      b->kind = LW_BOUNDARY_CIRCLE;
-      b->cx = 0.5 * p->width;
-      b->cy = 0.5 * p->height;
-      b->radius = 0.5 * fmin(p->width, p->height) - p->margin;
-    }
-    break;
-  case LW_BND_POLYGON:
-    /* the margin frames no polygon, but without a picture it sets plot.crop's
-    ** rectangle: an empty one failed the drawing after every sweep had run */
-    if (p->crop && !p->image[0] && (st = margin_ok(p, err))) return st;
-    st = build_polygon(sc, p, err);
-    if (st) return st;
-    break;
-  case LW_BND_MASK:
-    if ((st = build_mask(sc, p, err))) return st;
-    break;
-  }
-  if (p->boundary != LW_BND_MASK && p->mask != LW_MASK_NONE)
-    return bad_key(p, "scene", "mask", LW_EINPUT, err, "a mask needs scene.boundary = mask");
-  b->slope = b->kind == LW_BOUNDARY_MASK ? lw_boundary_mask_slope(b->sdt) : 1.0;
-  b->clearance = p->boundary_clearance;
+  if ((st = build_boundary(sc, p, err))) return st;
   if (sc->image) dark_note(sc, p);
   if (sc->image && (sc->on[LW_TERM_TONE] || (sc->on[LW_TERM_POTENTIAL] && p->potential == LW_POT_IMAGE)))
     thin_note(sc, p, "image", sc->image, &sc->image_place);
