@@ -140,13 +140,13 @@ lw_dynamics *lw_dynamics_new(const lw_system_type *t, void *state, const lw_para
   double **arrays[] = {&d->x, &d->pi, &d->g, &d->v, &d->tx, &d->x1, &d->pi1, &d->u};
   for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++)
     if (!(*arrays[k] = calloc(d->n + 1, sizeof(double)))) {
-      lw_dynamics_free(d);
       lw_error_set(err, LW_ENOMEM, "out of memory for the dynamics of %zu coordinates", d->n);
+      lw_dynamics_free(d);
       return NULL;
     }
   if (d->rho == 0.0 && t->blocked && !(d->held = calloc(d->n + 1, 1))) {
-    lw_dynamics_free(d);
     lw_error_set(err, LW_ENOMEM, "out of memory for the dynamics of %zu coordinates", d->n);
+    lw_dynamics_free(d);
     return NULL;
   }
   /* massless: the matrix of the flow is the damping's, gamma per unit density */

@@ -305,7 +305,7 @@ static void put_number(char *buf, size_t room, size_t *at, long v)
 static void say_second(void)
 {
   static const char of[] = "the checkpoint of sweep ", last[] = "the last checkpoint",
-                    or[] = " (or of sweep ", came[] = ", whose write the signal came during)";
+                    either[] = " (or of sweep ", came[] = ", whose write the signal came during)";
   char line[sizeof second_msg + 160];
   size_t at = 0;
   if (!second_len) return;
@@ -319,7 +319,7 @@ static void say_second(void)
     put_text(line, sizeof line, &at, last, sizeof last - 1);
   }
   if (pending >= 0) { /* the rename was under way: either is on disk */
-    put_text(line, sizeof line, &at, or, sizeof or - 1);
+    put_text(line, sizeof line, &at, either, sizeof either - 1);
     put_number(line, sizeof line, &at, pending);
     put_text(line, sizeof line, &at, came, sizeof came - 1);
   }
