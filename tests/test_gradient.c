@@ -840,6 +840,22 @@ Test(quench, an_energy_without_a_floor_walks_off_and_still_draws, .init = qsetup
                           "sys.exit(0 if q['energy_after'] < q['energy_before'] - 1e5 else 1)\"", qdir, qdir), 0);
 }
 
+/* The quench's line on stderr says what summary.json records: the energies
+** to 10 digits, the gradient norms to 3, the iterations and how it ended. */
+Test(quench, the_report_line_says_what_the_summary_records, .init = qsetup, .fini = qteardown)
+{
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set anneal.quench=bfgs --set anneal.sweeps=20 --out %s/r "
+                          "2> %s/r.err", lw_test_bin(), lw_test_root(), qdir, qdir), 0);
+  cr_assert_eq(lw_test_sh("python3 -c \"import json,re,sys; q=json.load(open('%s/r/summary.json'))['quench']; "
+                          "m=re.search(r'quench: energy (\\S+) -> (\\S+), gradient norm (\\S+) -> (\\S+), "
+                          "(\\d+) iterations \\((\\w+)\\), ', open('%s/r.err').read()); "
+                          "ok=lambda s, v, d: float(s) == float('%%.*g' %% (d, v)); "
+                          "sys.exit(0 if m and ok(m[1], q['energy_before'], 10) and ok(m[2], q['energy_after'], 10) "
+                          "and ok(m[3], q['gradient_before'], 3) and ok(m[4], q['gradient_after'], 3) "
+                          "and int(m[5]) == q['iterations'] and m[6] == q['ended'] else 1)\"", qdir, qdir),
+               0, "%s", lw_test_slurp("%s/r.err", qdir));
+}
+
 /* On a smooth energy the quench goes on to quench_tol: the hanging chain's
 ** from its placement (E about -8800) stalled at a gradient of 5.2e-6, where
 ** the decrease Armijo's test asks for sank under the energy's rounding.
