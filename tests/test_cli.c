@@ -1434,6 +1434,24 @@ Test(cli, a_stack_too_small_is_refused_before_the_run)
                  0, "%s", enough[k]);
 }
 
+/* On a terminal the progress is one bar redrawn in place (carriage returns,
+** no plain "elapsed" lines), full at the last sweep and ended by a new
+** line; --quiet draws none.  script(1) gives the run its terminal. */
+Test(cli, a_terminal_gets_one_bar_redrawn_in_place)
+{
+  for (int quiet = 0; quiet < 2; quiet++) {
+    cr_assert_eq(lw_test_sh("cd %s && script -qec '%s run %s/params/minimal.ini --out t%d --set anneal.sweeps=30%s' "
+                            "/dev/null > tty%d.txt", dir, lw_test_bin(), lw_test_root(), quiet,
+                            quiet ? " --quiet" : "", quiet), 0);
+    char *out = lw_test_slurp("%s/tty%d.txt", dir, quiet);
+    cr_assert_not_null(out);
+    const char *full = strstr(out, "\r[########################] sweep 30/30  T 0.01  E ");
+    cr_expect(quiet ? !strstr(out, "sweep 30/30") : full && strstr(full, "left 0s \r\n") != NULL, "%s", out);
+    cr_expect(!strstr(out, "elapsed"), "%s", out);
+    free(out);
+  }
+}
+
 /* A caller that closes stderr (2>&-) gets a clean trace: before, trace.csv
 ** took descriptor 2, and the parameter echo and progress lines went into
 ** it (exit 0, and `stats` then failed on it).  Output that does not reach
