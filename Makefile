@@ -21,9 +21,10 @@ OMP     := -fopenmp
 # header's change rebuilds only what includes it.
 DEPFLAGS := -MMD -MP
 
-# locales: the locale test builds a decimal-comma locale with localedef
+# locales: the locale test builds a decimal-comma locale with localedef;
+# strace: the signal tests send a signal as a chosen file opens (inject=)
 DEBS    := build-essential pkg-config libgsl-dev libcairo2-dev libinih-dev libstb-dev zlib1g-dev \
-           libcriterion-dev gnuplot-nox clang libclang-rt-dev locales
+           libcriterion-dev gnuplot-nox clang libclang-rt-dev locales strace
 
 LIB_SRC := $(filter-out src/main.c,$(wildcard src/*.c))
 # The MPI build (make mpi): main.c with -DLW_MPI and src/mpi/, through

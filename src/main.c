@@ -916,7 +916,11 @@ static int cmd_run(int argc, char **argv)
         return fail(&err);
       }
       fprintf(stderr, "linewise: stopped during the set-up; the run that was in %s is back as it was\n", dir);
-      return 0;
+      /* nothing of this run is kept, as when a signal ends a set-up that
+      ** wrote nothing: 128 + the signal (SIGINT by itself, in main).  It
+      ** exited 0 beside the earlier run's summary.json, which a script took
+      ** for this run's result */
+      return stop_requested && stop_requested != SIGINT ? 128 + stop_requested : 0;
     }
     const size_t n = strlen(err.msg);
     if (err.code == LW_EIO && !lw_phase_unwritten())

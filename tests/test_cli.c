@@ -1434,6 +1434,30 @@ Test(cli, a_stack_too_small_is_refused_before_the_run)
                  0, "%s", enough[k]);
 }
 
+/* A signal while a run replaces an earlier one, before its first checkpoint
+** is committed, puts the earlier run back and ends as a set-up stopped
+** before anything was written does: 128 + the signal (by SIGINT itself).
+** It exited 0 on SIGTERM and SIGHUP, and a script took the earlier run's
+** summary.json for the new run's.  strace(1) sends the signal as the first
+** checkpoint opens its file, inside that window. */
+Test(cli, a_signal_that_gives_the_directory_back_does_not_exit_0)
+{
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out r --quiet --set anneal.sweeps=10 && "
+                          "cp -a r before && rm -f before/.lock", dir, lw_test_bin(), lw_test_root()), 0);
+  static const struct {
+    const char *sig;
+    int rc;
+  } stop[] = {{"TERM", 143}, {"HUP", 129}, {"INT", 130}};
+  for (size_t k = 0; k < sizeof stop / sizeof stop[0]; k++) {
+    cr_expect_eq(lw_test_sh("cd %s && strace -o /dev/null -P r/state.lw.tmp -e trace=openat -e inject=openat:signal=%s "
+                            "%s run %s/params/minimal.ini --seed 2 --out r --quiet --set anneal.sweeps=10 2> err.txt",
+                            dir, stop[k].sig, lw_test_bin(), lw_test_root()), stop[k].rc, "SIG%s", stop[k].sig);
+    cr_expect_eq(lw_test_sh("cd %s && grep -qx 'linewise: stopped during the set-up; the run that was in r is back as "
+                            "it was' err.txt && rm -f r/.lock && diff -r r before", dir), 0, "SIG%s: %s", stop[k].sig,
+                 lw_test_slurp("%s/err.txt", dir));
+  }
+}
+
 /* On a terminal the progress is one bar redrawn in place (carriage returns,
 ** no plain "elapsed" lines), full at the last sweep and ended by a new
 ** line; --quiet draws none.  script(1) gives the run its terminal. */
