@@ -905,12 +905,12 @@ lw_status lw_anneal_start(lw_anneal *a, const lw_params *p, const char *dir, lw_
 static lw_status write_start(lw_anneal *a, lw_anneal_net *net, lw_error *err);
 
 /* a->dir cut short would name another directory than dir: the stash checked
-** in one and the files removed in the other (the command line's limit is
-** lower: main.c's RUN_DIR_MAX) */
+** in one and the files removed in the other.  The limit is the command
+** line's (main.c's RUN_DIR_MAX), with 64 bytes left for the names inside. */
 static lw_status dir_fits(const lw_anneal *a, const char *dir, lw_error *err)
 {
-  if (strlen(dir) < sizeof a->dir - 64) return LW_OK;
-  return lw_error_set(err, LW_EUSAGE, "%.80s...: a run directory's path of %zu bytes, expected fewer than %zu", dir,
+  if (strlen(dir) <= sizeof a->dir - 64) return LW_OK;
+  return lw_error_set(err, LW_EUSAGE, "%.80s...: a run directory's path of %zu bytes, expected at most %zu", dir,
                       strlen(dir), sizeof a->dir - 64);
 }
 

@@ -950,9 +950,9 @@ Test(cli, a_format_turned_off_leaves_no_file_of_the_old_drawing)
                0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
-/* A run started without --out goes to out/<scene name>, and when that
-** holds a run, to the first out/<scene name>-N that does not: the first
-** drawing is not replaced.  --out names a directory to replace. */
+/* A run directory's path as given takes at most 960 bytes: one of exactly
+** 960 runs and resumes (it was refused by the set-up's own check, which
+** wanted fewer), 961 is refused with the limit. */
 Test(cli, a_directory_path_too_long_to_hold_is_refused)
 {
   /* five components of 250 bytes: the run was written into the path cut at
@@ -973,8 +973,23 @@ Test(cli, a_directory_path_too_long_to_hold_is_refused)
                           "grep -q 'resume: a path of 1005 bytes' err.txt",
                           dir, b, a, a, a, a),
                0);
+  /* d/ and three components of 250 and their slashes: 755 bytes; a last
+  ** one of 205 makes 960 */
+  char last[207];
+  memset(last, 'e', 206);
+  last[206] = '\0';
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --quiet --set anneal.sweeps=2 --out d/%s/%s/%s/%s 2> err.txt; "
+                          "test $? = 2 && grep -q -- '--out: a path of 961 bytes, longer than the 960' err.txt",
+                          dir, b, a, a, a, last), 0);
+  last[205] = '\0';
+  cr_assert_eq(lw_test_sh("cd %s && P=d/%s/%s/%s/%s && %s run s.ini --quiet --set anneal.sweeps=2 --out $P 2> err.txt "
+                          "&& %s resume $P --sweeps 2 --quiet 2>> err.txt && grep -q '^sweep = 4$' $P/state.lw",
+                          dir, a, a, a, last, b, b), 0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
+/* A run started without --out goes to out/<scene name>, and when that
+** holds a run, to the first out/<scene name>-N that does not: the first
+** drawing is not replaced.  --out names a directory to replace. */
 Test(cli, a_run_without_out_never_replaces_another)
 {
   write_file("s.ini", scene_text);
