@@ -477,7 +477,7 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
 ** keys): the same run keys for both; Monte Carlo its schedule, its ladder,
 ** its tuning and its recomputations from scratch; the dynamics its time
 ** step, damping and density (rho = 0: the massless flow, dynamics.c). */
-#define RUN_KEYS "scene.system", "scene.driver", "anneal.sweeps", "anneal.seed", \
+#define RUN_KEYS "scene.system", "scene.driver", "anneal.sweeps", "anneal.seed", "anneal.seed_version", \
     "anneal.quench", "anneal.quench_tol", "anneal.quench_iterations", "anneal.quench_stall", \
     "output.checkpoint_every", "output.trace_every", "output.observables", "output.samples_every", \
     "output.stats_from", "output.frames_every"
@@ -607,7 +607,7 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
                            *const ladder[] = {"tempering.t_min", "tempering.t_max", "tempering.exchange_every",
                                               "tempering.tune_ladder", "tempering.ladder_sweeps", NULL},
                            *const ends[] = {"tempering.t_min", "tempering.t_max", NULL},
-                           *const seed[] = {"anneal.seed", NULL},
+                           *const seed[] = {"anneal.seed", "anneal.seed_version", NULL},
                            *const gravity[] = {"dynamics.gravity_x", "dynamics.gravity_y", NULL},
                            *const machine[] = {"plot.tolerance", "plot.turn", "plot.bed_width", "plot.bed_height",
                                                NULL},
@@ -763,7 +763,7 @@ static lw_status check_quench(const lw_anneal *a, lw_error *err)
 ** does), the master exchange stream is 2, rung k >= 1 is stream 2 + k. */
 static unsigned long rung_stream(const lw_anneal *a, int k)
 {
-  return lw_stream_seed(a->seed, k == 0 ? 1 : 2 + (unsigned long)k);
+  return lw_stream_seed(a->seed, k == 0 ? 1 : 2 + (unsigned long)k, a->params.seed_version);
 }
 
 /* Every move weight of the system 0: refused naming its move keys, the one
@@ -821,7 +821,7 @@ static lw_status build(lw_anneal *a, void **states, const double *ladder, lw_err
   a->chain = a->chains[0];
   a->sys = a->systems[0];
   if (n > 1) {
-    a->pt = lw_tempering_new(n, ladder, lw_stream_seed(a->seed, 2), err);
+    a->pt = lw_tempering_new(n, ladder, lw_stream_seed(a->seed, 2, a->params.seed_version), err);
     if (!a->pt) return err->code;
   }
   if (p->driver == LW_DRIVER_DYNAMICS && !(a->dyn = lw_dynamics_new(t, a->sys->state, p, err))) return err->code;
@@ -950,7 +950,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   }
   const lw_system_type *t = a->sys_type;
   lw_phase_set("placing the initial state and building its energy");
-  void *all[LW_TEMPERING_MAX] = {t->state_new(a->setup, &a->params, lw_stream_seed(a->seed, 0), err)};
+  void *all[LW_TEMPERING_MAX] = {t->state_new(a->setup, &a->params, lw_stream_seed(a->seed, 0, a->params.seed_version), err)};
   if (!all[0]) return err->code;
   /* every replica starts from the same state; their streams part them */
   for (int r = 1; r < a->n_rep; r++)
@@ -1708,11 +1708,13 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
         *err = first;
         s = first.code;
       } else {
-        if ((renumber || drift[i] > LW_ANNEAL_EARLY_DRIFT) && drift[i] > a->max_drift) a->max_drift = drift[i];
         /* over the largest size since the last recomputation, the scale of
-        ** the totals' rounding: a fall's own stays near eps, and a row whose
-        ** commits do not add up its moves' dE stands out */
+        ** the totals' rounding: a fall's own stays near eps (a start at 1e17
+        ** that fell to -2800 within a sweep read 3.5e-4 in max_drift over the
+        ** size after it), and a row whose commits do not add up its moves' dE
+        ** stands out */
         const double d = drift[i] * replica_size(a, rep[i]) / fmax(a->size_peak[rep[i]], 1.0);
+        if ((renumber || drift[i] > LW_ANNEAL_EARLY_DRIFT) && d > a->max_drift) a->max_drift = d;
         if (d > a->row_drift) a->row_drift = d;
       }
     }

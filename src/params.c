@@ -385,6 +385,12 @@ const lw_param_def lw_param_table[] = {
          "Table schedule file: lines 'step temperature' (relative to the scene file)."),
   NUM("anneal", "seed", LW_PT_WHOLE, seed, "1", "", 0, 4294967295.0, 0,
       "Seed of the random number generator; the same scene and seed give the same run."),
+  NUM("anneal", "seed_version", LW_PT_INT, seed_version, "2", "", 1, 2, 0,
+      "How the seed makes the seeds of the run's random streams. 2: distinct seeds never "
+      "share a stream's numbers (docs/NUMERICS.md, \"Random numbers\"). 1: the way of runs "
+      "begun before 2026-12-06, under which two seeds could draw the same numbers (89483 "
+      "and 106945 gave the same run); a scene.ini that such a run wrote, lacking this key, "
+      "takes 1, so that running it again gives that run."),
   NUM("anneal", "check_every", LW_PT_INT, check_every, "100", "sweeps", 1, 2e9, 0,
       "Sweeps between full recomputations of the energy (the drift check); splines are "
       "renumbered along a Hilbert curve of the page just before each, for locality in memory. "
@@ -1218,7 +1224,10 @@ static char *read_line(char *str, int num, void *stream)
     return NULL;
   }
   if (rc->line == 1 && !strncmp(rc->buf, LW_RUN_SCENE_HEADER, strlen(LW_RUN_SCENE_HEADER)))
+  {
     rc->p->run_written = rc->p->of_run;
+    rc->p->run_header = 1;
+  }
   /* inih would end the value at a NUL byte and drop the rest unseen */
   if (memchr(rc->buf, '\0', (size_t)len)) {
     lw_error_set(rc->err, LW_EINPUT, "%s:%d: a NUL byte inside the line (UTF-16 text, as some editors save "
@@ -1301,6 +1310,7 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
   lw_params_defaults(p);
   p->of_run = of_run;
   p->run_written = 0;
+  p->run_header = 0;
   if (lw_number_locale_ok(err)) return err->code;
   /* a path cut to fit would name another file in every message */
   if (strlen(path) >= sizeof p->file)
@@ -1531,6 +1541,9 @@ int lw_params_text_reads_back(const char *text)
 lw_status lw_params_resolve(lw_params *p, lw_error *err)
 {
   char where[LW_PATH_MAX + 32], where_page[LW_PATH_MAX + 32];
+  /* a scene.ini that a run wrote before the key was one runs again as that
+  ** run did (the hash of a resume's leaves the missing key out) */
+  if (p->run_header && !p->line[lw_params_find("anneal", "seed_version") - lw_param_table]) p->seed_version = 1;
   /* before the page is sized, which the orientation decides */
   if (p->preset == LW_PRESET_PHOTO) preset_key(p, "scene", "orientation", "auto");
   if (p->page != LW_PAGE_CUSTOM) {

@@ -1170,7 +1170,7 @@ static const char *const keys_metropolis[] = {"moves.step_point", "moves.target"
 /* Keys the scene's other settings leave idle (system.h). */
 static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
 {
-  static const char *const seed[] = {"anneal.seed", NULL},
+  static const char *const seed[] = {"anneal.seed", "anneal.seed_version", NULL},
                            *const inline_points[] = {"nurbs.points", "nurbs.weights", NULL},
                            *const weights[] = {"nurbs.weight_inertia", "nurbs.weight_stiffness", "nurbs.step_weight",
                                                NULL};

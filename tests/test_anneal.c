@@ -15,6 +15,7 @@
 #include "linewise/init.h"
 #include "linewise/mc.h"
 #include "linewise/phase.h"
+#include "linewise/rundir.h"
 #include "testutil.h"
 
 static lw_params every_term(void)
@@ -545,8 +546,8 @@ Test(anneal, checkpoints_that_take_most_of_a_run_are_said)
 ** nothing, so a new system row with a running sum of 1.01 dE ran to its
 ** end with a 1.5e-2 drift and exit 0.  Here the running terms are put 1 %
 ** off by hand, as such a row leaves them; the recomputation at the next
-** check finds it (6.2e-4 of the terms' magnitudes, which partly cancel).
-** An ordinary run says nothing. */
+** check finds it (7.4e-4 of the terms' magnitudes, which partly cancel;
+** within 1e-4 to 1e-2 for any seed).  An ordinary run says nothing. */
 Test(run, a_running_energy_that_does_not_add_up_is_said)
 {
   char path[128];
@@ -571,8 +572,10 @@ Test(run, a_running_energy_that_does_not_add_up_is_said)
       cr_assert_eq(lw_anneal_sweep(&a, &err), LW_OK, "%s", err.msg);
     }
     lw_anneal_drift_note(&a, note, sizeof note);
+    const char *was = strstr(note, "the running energy was ");
+    const double by = was ? strtod(was + strlen("the running energy was "), NULL) : 0.0;
     if (off)
-      cr_assert(strstr(note, "the running energy was 0.0006") && strstr(note, "splines system"), "%s", note);
+      cr_assert(by > 1e-4 && by < 1e-2 && strstr(note, "splines system"), "%s", note);
     else
       cr_assert_str_eq(note, "", "an ordinary run: %s", note);
     lw_anneal_free(&a);
@@ -647,4 +650,57 @@ Test(run, a_segment_cap_below_the_placed_count_is_refused)
   cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/from --quiet --set moves.fixed_count=0 --set "
                   "moves.max_segments=3 --set init.from=%s/cap/state.lw --set anneal.sweeps=0 2>%s/cap.txt; "
                   "test $? -eq 2 && grep -qF 'got 3' %s/cap.txt", b, lw_test_root(), dir, dir, dir, dir), 0);
+}
+
+static int compare_ulong(const void *a, const void *b)
+{
+  const unsigned long x = *(const unsigned long *)a, y = *(const unsigned long *)b;
+  return (x > y) - (x < y);
+}
+
+/* Distinct seeds draw distinct numbers: every stream of a run (placement,
+** chain, exchanges, 255 more rungs) of every seed in a window of 3000 gets
+** its own generator seed, at both ends of the seed's range (GSL seeds 0 as
+** 4357, so they count as one).  Under the seeding of runs begun before
+** 2026-12-06, seeds 89483 and 106945 drew the same chain; it is kept for
+** them (version 1), and a scene.ini such a run wrote, without the key,
+** takes it. */
+Test(run, distinct_seeds_never_share_a_streams_numbers)
+{
+  enum { SEEDS = 3000, STREAMS = 2 + LW_TEMPERING_MAX };
+  unsigned long *g = malloc(sizeof *g * SEEDS * STREAMS);
+  cr_assert_not_null(g);
+  static const unsigned long from[] = {0, 4294967295ul - SEEDS + 1, 2000000000ul};
+  for (size_t w = 0; w < sizeof from / sizeof *from; w++) {
+    size_t n = 0;
+    for (unsigned long s = from[w]; s < from[w] + SEEDS; s++)
+      for (unsigned long k = 0; k < STREAMS; k++) {
+        const unsigned long v = lw_stream_seed(s, k, 2);
+        g[n++] = v ? v : 4357;
+      }
+    qsort(g, n, sizeof *g, compare_ulong);
+    size_t same = 0;
+    for (size_t i = 1; i < n; i++) same += g[i] == g[i - 1];
+    cr_expect_eq(same, 0, "seeds from %lu: %zu generator seeds shared", from[w], same);
+  }
+  free(g);
+  cr_expect_eq(lw_stream_seed(89483, 1, 1), lw_stream_seed(106945, 1, 1), "version 1 is not the old seeding");
+  cr_expect_neq(lw_stream_seed(89483, 1, 2), lw_stream_seed(106945, 1, 2));
+  static const struct {
+    const char *text;
+    int version;
+  } file[] = {
+      {LW_RUN_SCENE_HEADER "\n[anneal]\nseed = 5\n", 1},
+      {LW_RUN_SCENE_HEADER "\n[anneal]\nseed = 5\nseed_version = 2\n", 2},
+      {"[anneal]\nseed = 5\n", 2},
+  };
+  for (size_t k = 0; k < sizeof file / sizeof *file; k++) {
+    char path[128];
+    cr_assert_eq(lw_test_write_text(dir, "v.ini", file[k].text), 0);
+    snprintf(path, sizeof path, "%s/v.ini", dir);
+    lw_params p;
+    lw_error err;
+    cr_assert_eq(lw_params_read(&p, path, &err), LW_OK, "%s", err.msg);
+    cr_expect_eq(p.seed_version, file[k].version, "%s", file[k].text);
+  }
 }

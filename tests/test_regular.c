@@ -284,7 +284,7 @@ Test(regular, placement_never_creates_an_irregular_segment)
     size_t n;
     cr_assert_eq(lw_init_count(&sc, &p, &n, &err), LW_OK, "%s", err.msg);
     gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
-    gsl_rng_set(r, lw_stream_seed((unsigned long)p.seed, 0));
+    gsl_rng_set(r, lw_stream_seed((unsigned long)p.seed, 0, p.seed_version));
     lw_splines *sp = lw_init_random(&sc, n, (size_t)p.segments, p.segment_length, r, &err);
     cr_assert_not_null(sp, "%s: %s", scenes[k], err.msg);
     check_all_regular(&sc, sp, scenes[k]);

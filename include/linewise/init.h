@@ -57,10 +57,13 @@ double lw_init_ink_area(const lw_scene *sc);
 ** elements of the placed segments (segment_length / pair nodes). */
 lw_status lw_init_count(const lw_scene *sc, const lw_params *p, size_t *n, lw_error *err);
 
-/* A seed for stream `stream` of a run seeded with `seed` (SplitMix64 of
-** both), so replicas and the placement get independent, reproducible
-** streams whatever the thread schedule. */
-unsigned long lw_stream_seed(unsigned long seed, unsigned long stream);
+/* The 32-bit generator seed of stream `stream` of a run seeded with `seed`,
+** so replicas and the placement get independent, reproducible streams
+** whatever the thread schedule: distinct for distinct seeds of one stream,
+** and for any two pairs whose seeds are closer than 8,243,553 (streams up
+** to 257), but for one pair per stream that GSL seeds alike (0 is its
+** 4357).  version: anneal.seed_version (1, runs begun before 2026-12-06). */
+unsigned long lw_stream_seed(unsigned long seed, unsigned long stream, int version);
 
 #ifdef __cplusplus
 }

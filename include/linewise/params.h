@@ -161,6 +161,7 @@ typedef struct {
   double lambda;              /* adaptive cooling rate */
   char table[LW_PATH_MAX];    /* table schedule file */
   double seed;                /* RNG seed (a whole number, stored as double for the table) */
+  int seed_version;           /* how the seed makes the streams' seeds (lw_stream_seed) */
   int check_every;            /* sweeps between drift checks */
   int delayed_acceptance;     /* 1: two-stage Metropolis where the row offers it (mc.h) */
   char domains[64];           /* off, auto or domains per side (domains.h) */
@@ -277,6 +278,7 @@ typedef struct {
   int of_run;                 /* read from a run's scene.ini (lw_params_read_run) */
   int run_written;            /* and that file's first line is a run's header (LW_RUN_SCENE_HEADER):
                               ** linewise wrote it, not a hand beside a hand-made state */
+  int run_header;             /* the scene file's first line is that header, whatever reads it */
 } lw_params;
 
 /* Fills p with every default. */
