@@ -129,8 +129,7 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
   }
   for (size_t i = 0; strain && i < sp->n_splines; i++) {
     size_t g0 = lw_segment_index(sp, i, 0), ns = lw_splines_segments(sp, i);
-    double L = 0.0;
-    for (size_t m = 0; m < ns; m++) L += seg_len[g0 + m];
+    const double L = lw_term_spline_length(seg_len + g0, ns, NULL);
     for (int t = 0; t < LW_TERM_COUNT; t++) {
       const lw_term_type *ty = &lw_term_types[t];
       if (!ty->spline_grad || !sc->on[t] || !selected(term_mask, t)) continue;

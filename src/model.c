@@ -513,10 +513,8 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
   }
   if (ts.n_spline)
     for (size_t i = 0; i < sp->n_splines; i++) {
-      double L = 0.0;
       size_t g0 = lw_segment_index(sp, i, 0), ns = lw_splines_segments(sp, i);
-      for (size_t m = 0; m < ns; m++) L += seg_len[g0 + m];
-      spline_terms(&ts, sp, seg_len, i, L, term);
+      spline_terms(&ts, sp, seg_len, i, lw_term_spline_length(seg_len + g0, ns, NULL), term);
     }
   if (grid) {
     pair_view v = {grid, sp, (uint32_t)np, pair_ctx(pc), planes_of(sc)};
@@ -608,6 +606,9 @@ lw_model *lw_model_new(const lw_scene *sc, lw_splines *sp, lw_error *err)
   for (size_t i = 0; i < sp->n_splines; i++)
     if (lw_splines_segments(sp, i) > m->max_segments) m->max_segments = lw_splines_segments(sp, i);
   if (sc->transdim && sc->max_segments > m->max_segments) m->max_segments = sc->max_segments;
+  /* (births and deaths move the segments: there the lengths are summed afresh) */
+  if (!sc->transdim && m->max_segments > LW_TERM_LEN_BLOCK && !(m->seg_block = malloc(ns * sizeof *m->seg_block)))
+    goto nomem;
   m->cap_seg = ns;
   m->cap_spl = sp->n_splines ? sp->n_splines : 1;
   /* with layers a layer is state, since births and deaths, and the drift
@@ -631,8 +632,9 @@ void lw_model_free(lw_model *m)
   if (!m) return;
   lw_splines_free(m->sp);
   free(m->seg_len);
-  free(m->seg_local);
+  free(m->seg_block);
   free(m->spline_len);
+  free(m->seg_local);
   free(m->seg_irregular);
   free(m->near_cache);
   free(m->near_valid);
@@ -676,8 +678,9 @@ lw_status lw_model_refresh(lw_model *m, double *drift)
   }
   for (size_t i = 0; i < sp->n_splines; i++) {
     size_t g0 = lw_segment_index(sp, i, 0), n = lw_splines_segments(sp, i);
-    double L = 0.0;
-    for (size_t k = 0; k < n; k++) L += m->seg_len[g0 + k];
+    for (size_t b0 = 0; m->seg_block && b0 < n; b0 += LW_TERM_LEN_BLOCK)
+      m->seg_block[g0 + b0] = lw_term_block_sum(m->seg_len + g0, n, b0);
+    const double L = lw_term_spline_length(m->seg_len + g0, n, m->seg_block ? m->seg_block + g0 : NULL);
     m->spline_len[i] = L;
     spline_terms(ts, sp, m->seg_len, i, L, term);
   }
@@ -738,12 +741,11 @@ lw_proposal *lw_proposal_new(const lw_model *m, lw_error *err)
     p->side = calloc(2 * cap, sizeof *p->side);
     p->near_new = malloc(cap * sizeof *p->near_new);
     p->seg_irregular = malloc(cap * sizeof *p->seg_irregular);
-    p->spline_seg_len = malloc(cap * sizeof *p->spline_seg_len);
     for (int t = 0; t < LW_TERM_COUNT; t++) p->sum_term[t] = -0.0;
   }
   if (!p || !p->node || !p->len || !p->local || !p->ps || !p->ps_old || !p->probe || !p->walked ||
       !p->walked_id || !p->each || !p->stand || !p->seg_sum || !p->memo.ok || !p->memo.far || !p->memo.stand ||
-      !p->memo.partners || !p->side || !p->near_new || !p->seg_irregular || !p->spline_seg_len) {
+      !p->memo.partners || !p->side || !p->near_new || !p->seg_irregular) {
     lw_proposal_free(p);
     lw_error_set(err, LW_ENOMEM, "out of memory for a proposal");
     return NULL;
@@ -778,7 +780,6 @@ void lw_proposal_free(lw_proposal *p)
   free(p->near_new);
   free(p->near_vals.v);
   free(p->seg_irregular);
-  free(p->spline_seg_len);
   for (int t = 0; t < LW_TERM_COUNT; t++) lw_tone_box_free(&p->box[t]);
   free(p);
 }
@@ -1482,18 +1483,13 @@ void lw_model_propose(const lw_model *m, lw_proposal *p, uint32_t spline, size_t
   }
   p->new_spline_len = m->spline_len[spline] + dlen;
 
-  if (ts->n_spline) {
-    /* the spline's segment lengths after the move, against the cached ones */
-    const double *old_len = m->seg_len + g0, L0 = sp->rest_length[spline];
-    memcpy(p->spline_seg_len, old_len, nseg * sizeof *old_len);
-    memcpy(p->spline_seg_len + p->seg0, p->len, p->n_seg * sizeof *p->len);
-    for (int k = 0; k < ts->n_spline; k++) {
-      const int t = ts->spline[k];
-      const lw_term_ctx *c = &ts->ctx[t];
-      double (*fn)(const double *, size_t, double, double, const lw_term_ctx *) = lw_term_types[t].spline;
-      p->dterm[t] = c->coef * (fn(p->spline_seg_len, nseg, p->new_spline_len, L0, c) -
-                               fn(old_len, nseg, m->spline_len[spline], L0, c));
-    }
+  for (int k = 0; k < ts->n_spline; k++) {
+    /* the moved segments' lengths after the move, against the cached ones */
+    const int t = ts->spline[k];
+    const lw_term_ctx *c = &ts->ctx[t];
+    p->dterm[t] = c->coef * lw_term_types[t].spline_change(m->seg_len + g0 + p->seg0, p->len, p->n_seg, nseg,
+                                                           m->spline_len[spline], p->new_spline_len,
+                                                           sp->rest_length[spline], c);
   }
 
   double dE = 0.0;
@@ -1660,13 +1656,11 @@ lw_status lw_model_commit_part(lw_model *m, lw_proposal *p)
     p->sum_irregular += (long)p->seg_irregular[j] - (long)m->seg_irregular[g];
     m->seg_irregular[g] = p->seg_irregular[j];
   }
-  /* Summed afresh in a fixed order rather than updated by += dlen, so the
-  ** cached length is a function of the state alone and a resumed run sees
-  ** the same value as one that never stopped. */
-  size_t n = lw_splines_segments(sp, p->spline);
-  double L = 0.0;
-  for (size_t k = 0; k < n; k++) L += m->seg_len[g0 + k];
-  m->spline_len[p->spline] = L;
+  /* summed afresh rather than updated by += dlen (spline_length) */
+  const size_t n = lw_splines_segments(sp, p->spline);
+  for (size_t b = p->seg0 / LW_TERM_LEN_BLOCK; m->seg_block && b * LW_TERM_LEN_BLOCK < p->seg0 + p->n_seg; b++)
+    m->seg_block[g0 + b * LW_TERM_LEN_BLOCK] = lw_term_block_sum(m->seg_len + g0, n, b * LW_TERM_LEN_BLOCK);
+  m->spline_len[p->spline] = lw_term_spline_length(m->seg_len + g0, n, m->seg_block ? m->seg_block + g0 : NULL);
   for (int k = 0; p->raster_done && k < m->terms.n_raster; k++) {
     const int t = m->terms.raster[k];
     const int layer = layer_of(&m->terms, sp, p->spline);
@@ -1993,7 +1987,7 @@ static void splice_new_segments(const lw_model *m, lw_proposal *p, int *forbidde
   lw_samples s;
   p->irregular = 0;
   for (int k = 0, j = 0, a = 0; k < p->n_new; a += (int)p->new_node[k++]) {
-    double L = 0.0;
+    const int j0 = j;
     for (size_t i = 0; i + 1 < p->new_node[k]; i++, j++) {
       double *local = p->local + (size_t)j * (size_t)nl;
       const int kept = kept_new(p, (size_t)j);
@@ -2014,9 +2008,8 @@ static void splice_new_segments(const lw_model *m, lw_proposal *p, int *forbidde
         else if (isnan(local[t])) *undefined = 1;
       }
       if (isnan(p->len[j])) *undefined = 1;
-      L += p->len[j];
     }
-    p->new_len[k] = L;
+    p->new_len[k] = lw_term_spline_length(p->len + j0, (size_t)(j - j0), NULL);
   }
 }
 

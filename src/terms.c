@@ -132,6 +132,29 @@ static double spline_strain(const double *seg_len, size_t n_seg, double length, 
   return e;
 }
 
+double lw_term_block_sum(const double *seg, size_t n, size_t b0)
+{
+  double s = 0.0;
+  for (size_t k = b0; k < n && k < b0 + LW_TERM_LEN_BLOCK; k++) s += seg[k];
+  return s;
+}
+
+double lw_term_spline_length(const double *seg, size_t n, const double *blk)
+{
+  double L = 0.0;
+  for (size_t b0 = 0; b0 < n; b0 += LW_TERM_LEN_BLOCK) L += blk ? blk[b0] : lw_term_block_sum(seg, n, b0);
+  return L;
+}
+
+static double change_strain(const double *old_seg, const double *new_seg, size_t n_changed, size_t n_seg,
+                            double old_len, double new_len, double rest_length, const lw_term_ctx *c)
+{
+  if (!c->mode) return lw_term_strain(new_len, rest_length) - lw_term_strain(old_len, rest_length);
+  double l0 = rest_length / (double)n_seg, d = 0.0;
+  for (size_t m = 0; m < n_changed; m++) d += lw_term_strain(new_seg[m], l0) - lw_term_strain(old_seg[m], l0);
+  return d;
+}
+
 /*
 ** Gradients (terms.h): each adds coef * dE/d(sample) to g.  The energies
 ** above are sums over the nodes of w_q f(r_q, r'_q, r''_q), so each node's
@@ -274,6 +297,13 @@ static double spline_chemical(const double *seg_len, size_t n_seg, double length
   return mu[0] + mu[1] * length;
 }
 
+static double change_chemical(const double *old_seg, const double *new_seg, size_t n_changed, size_t n_seg,
+                              double old_len, double new_len, double rest_length, const lw_term_ctx *c)
+{
+  (void)old_seg, (void)new_seg, (void)n_changed;
+  return spline_chemical(NULL, n_seg, new_len, rest_length, c) - spline_chemical(NULL, n_seg, old_len, rest_length, c);
+}
+
 static void grad_chemical(const double *seg_len, size_t n_seg, double length, double rest_length,
                           const lw_term_ctx *c, double *dlen)
 {
@@ -287,7 +317,7 @@ const char *const lw_term_names[LW_TERM_COUNT] = {"strain", "bending", "potentia
                                                   "load", "tone", "chemical"};
 
 const lw_term_type lw_term_types[LW_TERM_COUNT] = {
-  {LW_TERM_STRAIN, .spline = spline_strain, .spline_grad = grad_strain},
+  {LW_TERM_STRAIN, .spline = spline_strain, .spline_change = change_strain, .spline_grad = grad_strain},
   {LW_TERM_BENDING, .segment = seg_bending, .segment_grad = grad_bending},
   {LW_TERM_POTENTIAL, .segment = seg_potential, .segment_grad = grad_potential},
   {LW_TERM_FIELD, .segment = seg_field, .segment_grad = grad_field},
@@ -297,5 +327,5 @@ const lw_term_type lw_term_types[LW_TERM_COUNT] = {
   {LW_TERM_PARAM, .segment = seg_param, .segment_grad = grad_param},
   {LW_TERM_LOAD, .segment = seg_load, .segment_grad = grad_load},
   {LW_TERM_TONE, .raster = 1}, /* its gradient: lw_tone_sample_grad, summed in gradient.c */
-  {LW_TERM_CHEMICAL, .spline = spline_chemical, .spline_grad = grad_chemical},
+  {LW_TERM_CHEMICAL, .spline = spline_chemical, .spline_change = change_chemical, .spline_grad = grad_chemical},
 };

@@ -555,3 +555,46 @@ Test(terms, every_row_reads_its_own_context_only)
   lw_splines_free(sp);
   lw_scene_clear(&sc);
 }
+
+/* A spline past a block of LW_TERM_LEN_BLOCK segments keeps its blocks'
+** sums, so that a commit costs a block and the blocks, not the whole
+** spline: its length stays a function of the lengths alone, bit for bit
+** what a model built afresh on the moved splines holds (a resumed run's),
+** and the strain (both modes) and chemical terms' local changes match a
+** recomputation from scratch.  Three turns of a spiral of 300 segments
+** (three blocks) beside a short spline. */
+Test(terms, a_long_splines_length_is_a_function_of_its_segments)
+{
+  lw_params p = all_terms();
+  p.pair = 0.0;
+  p.chem_length = 0.3;
+  p.chem_spline = 1.0;
+  lw_scene sc;
+  for (int mode = 0; mode < 2; mode++) {
+    p.strain_mode = mode ? LW_STRAIN_SEGMENT : LW_STRAIN_SPLINE;
+    scene_with(&sc, &p);
+    size_t segs[2] = {300, 4};
+    lw_splines *sp = lw_splines_new(2, segs, NULL);
+    cr_assert_not_null(sp);
+    for (size_t k = 0; k <= 300; k++) {
+      const double t = 0.0628 * (double)k, r = 10.0 + 2.0 * t, dt = 0.0628 / 3.0;
+      sp->node[k] = (lw_node){50 + r * cos(t), 50 + r * sin(t), (2.0 * cos(t) - r * sin(t)) * dt,
+                              (2.0 * sin(t) + r * cos(t)) * dt};
+    }
+    for (size_t k = 0; k <= 4; k++) sp->node[sp->first[1] + k] = (lw_node){5.0 + 4.0 * (double)k, 5.0, 1.3, 0.0};
+    sp->rest_length[0] = 800.0;
+    sp->rest_length[1] = 14.0;
+    lw_model *m = lw_model_new(&sc, sp, NULL);
+    cr_assert_not_null(m);
+    cr_assert_not_null(m->seg_block, "a spline of 300 segments keeps its blocks' sums");
+    cr_assert_gt(lw_test_moves_match_full(&sc, m, 600, 0.05, 17 + (unsigned long)mode), 300);
+    lw_model *fresh = lw_model_new(&sc, lw_splines_clone(m->sp), NULL);
+    cr_assert_not_null(fresh);
+    for (size_t i = 0; i < 2; i++)
+      cr_expect(m->spline_len[i] == fresh->spline_len[i], "mode %d spline %zu: kept %.17g, afresh %.17g", mode, i,
+                m->spline_len[i], fresh->spline_len[i]);
+    lw_model_free(fresh);
+    lw_model_free(m);
+    lw_scene_clear(&sc);
+  }
+}

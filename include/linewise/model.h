@@ -81,7 +81,9 @@ typedef struct {
   lw_splines *sp;           /* owned */
   double *seg_len;          /* n_segments, mm */
   double *seg_local;        /* n_segments * scene->n_local: cached local energies */
-  double *spline_len;       /* n_splines, mm: sum of seg_len in segment order */
+  double *spline_len;       /* n_splines, mm: sum of seg_len by blocks (model.c, spline_length) */
+  double *seg_block;        /* at a block's first segment, its sum (a long spline's length in
+                              ** O(block + blocks) a commit); NULL: summed afresh */
   unsigned char *seg_irregular; /* n_segments: 1 where a segment is irregular */
   size_t n_irregular;       /* how many; the total is +inf while > 0 */
   double term[LW_TERM_COUNT]; /* running totals (0 for terms that are off) */
@@ -207,7 +209,6 @@ typedef struct {
   double stand_in;            /* the first stage's stand-in of the near field's change */
   lw_far_memo memo;
   double new_spline_len;
-  double *spline_seg_len;     /* the moved spline's segment lengths after the move (spline terms) */
   double dterm[LW_TERM_COUNT];
   unsigned char *seg_irregular; /* n_seg: 1 where a new segment is irregular */
   int irregular;              /* 1 if any is: the proposal is forbidden for that */
