@@ -1055,7 +1055,7 @@ static int cmd_stats(int argc, char **argv)
     } else if (!strcmp(argv[i], "--reweight")) {
       if (!parse_count(argv[i], v, LW_REWEIGHT_TEMPS_MAX, &reweight, &err) || reweight < 2) {
         lw_error_set(&err, LW_EUSAGE, "--reweight: expected a whole number from 2 to %d, got '%s'",
-                     LW_REWEIGHT_TEMPS_MAX, v);
+                     LW_REWEIGHT_TEMPS_MAX, v ? v : "");
         break;
       }
       i++;

@@ -1398,6 +1398,7 @@ Test(cli, usage_errors_exit_2_in_one_line_and_write_nothing)
       {"stats", "stats: expected a run directory (usage: linewise stats DIR..."},
       {"stats r --from 10 --to 5", "stats: --from 10 is after --to 5: expected --from no later than --to"},
       {"stats r --reweight 1", "--reweight: expected a whole number from 2 to 10000, got '1'"},
+      {"stats r --reweight", "--reweight: expected a whole number from 2 to 10000, got ''"}, /* (was '(null)') */
       {"stats r --zap", "stats: unexpected '--zap' (usage: linewise stats DIR..."},
       {"frobnicate", "unknown command 'frobnicate' (try 'linewise --help')"},
   };

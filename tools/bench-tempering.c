@@ -162,8 +162,7 @@ static void bench_mpi(bench_ctx *b, FILE *d, const char *dir, int cores)
       int threads = cores / P > 0 ? cores / P : 1, ok = 1;
       bench_note("tempering: MPI, %d replicas on %d processes", rs[i], P);
       for (int r = 0; r < reps && ok; r++) {
-        ok = mpi_run(bin, dir, rs[i], P, threads, sweeps, run[r]);
-        t[r] = run[r][0];
+        if ((ok = mpi_run(bin, dir, rs[i], P, threads, sweeps, run[r]))) t[r] = run[r][0];
       }
       if (!ok) {
         fprintf(d, "| %d | %d | %d | failed (%s/mpi.log) | | | | | |\n", rs[i], P, threads, dir);

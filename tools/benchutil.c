@@ -33,7 +33,7 @@ double bench_median(double *v, int n)
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-void bench_die(const char *what, const lw_error *err)
+_Noreturn void bench_die(const char *what, const lw_error *err)
 {
   fprintf(stderr, "bench: %s%s%s\n", what, err ? ": " : "", err ? err->msg : "");
   exit(1);

@@ -60,7 +60,7 @@ double bench_now(void);
 double bench_median(double *v, int n);
 
 /* Prints what failed and exits 1 (the benchmark is a tool, not the library). */
-void bench_die(const char *what, const lw_error *err);
+_Noreturn void bench_die(const char *what, const lw_error *err);
 
 /* Opens datadir/name for writing (exits on failure). */
 FILE *bench_data(const bench_ctx *b, const char *name);
