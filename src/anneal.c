@@ -319,10 +319,11 @@ static lw_status from_elsewhere(const lw_anneal *a, const char *dir, lw_error *e
   }
   if (!same_file && !(!strcmp(fdir, rd) && (!strncmp(base, "replica-", 8) || !strcmp(base, "state.lw"))))
     return LW_OK;
-  char scene[LW_PATH_MAX + 16], resume[LW_PATH_MAX + 64] = "";
+  char scene[LW_PATH_MAX + 16], resume[LW_RUNDIR_WORD_MAX + 64] = "", word[LW_RUNDIR_WORD_MAX];
   lw_path_join(scene, sizeof scene, dir, "scene.ini");
   if (run_there && !access(scene, F_OK))
-    snprintf(resume, sizeof resume, ", or 'linewise resume %s' to go on with it", dir);
+    snprintf(resume, sizeof resume, ", or 'linewise resume %s' to go on with it",
+             lw_rundir_shell_word(dir, word, sizeof word));
   lw_error_set(err, LW_EINPUT, "'%s' is %s in %s, the directory this run writes, which would replace it%s; expected "
                "another --out (a redraw: docs/FORMATS.md, \"Redrawing a finished run\")%s", from,
                same_file ? "the state" : "a state", dir,

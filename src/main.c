@@ -165,9 +165,11 @@ static char *trim_slashes(char *path)
 static void stash_note(lw_error *err, const char *dir)
 {
   const size_t n = strlen(err->msg);
+  char word[LW_RUNDIR_WORD_MAX];
   if (lw_runfiles_stashed(dir))
     snprintf(err->msg + n, sizeof err->msg - n, "; a run there waits in %s/" LW_RUNFILES_STASH ", set aside by a run "
-             "stopped as it started: 'linewise resume %s' puts it back", dir, dir);
+             "stopped as it started: 'linewise resume %s' puts it back", dir,
+             lw_rundir_shell_word(dir, word, sizeof word));
 }
 
 /* energy DIR [--set SEC.KEY=VAL]...: the state's energy with its scene, or
@@ -275,13 +277,14 @@ static volatile sig_atomic_t on_terminal = 0; /* stderr is one: say what a signa
 ** only write.  The run's directory is named once, before a checkpoint is
 ** (checkpointed); the sweep of the last one committed (phase.h) the handler
 ** writes itself. */
-static char second_msg[LW_PATH_MAX + 160];
+static char second_msg[LW_RUNDIR_WORD_MAX + 160];
 static size_t second_len;
 
 static void name_run_dir(const char *dir)
 {
+  char word[LW_RUNDIR_WORD_MAX];
   int n = snprintf(second_msg, sizeof second_msg, "\nlinewise: a second signal: stopped at once; 'linewise resume "
-                   "%s' continues from ", dir);
+                   "%s' continues from ", lw_rundir_shell_word(dir, word, sizeof word));
   second_len = n > 0 && (size_t)n < sizeof second_msg ? (size_t)n : 0; /* (0: it did not fit: nothing is said) */
 }
 
@@ -572,8 +575,10 @@ static int loop_fail(const lw_anneal *a, long began, watcher *w, lw_error *err)
   /* memory too: the drawing's joins can run out after hours of sweeps */
   if (err->code == LW_EIO || err->code == LW_ENOMEM) {
     size_t n = strlen(err->msg);
+    char word[LW_RUNDIR_WORD_MAX];
     snprintf(err->msg + n, sizeof err->msg - n, "; %s/state.lw holds the checkpoint of sweep %ld: 'linewise "
-             "resume %s' continues from it once %s", a->dir, a->saved > 0 ? a->saved - 1 : began, a->dir,
+             "resume %s' continues from it once %s", a->dir, a->saved > 0 ? a->saved - 1 : began,
+             lw_rundir_shell_word(a->dir, word, sizeof word),
              err->code == LW_EIO ? "the files can be written" : "there is more memory");
   }
   return watched_fail(w, err);
@@ -604,15 +609,16 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   if (a->saved != a->sweep + 1 && lw_anneal_checkpoint(a, err)) return loop_fail(a, pg.start_sweep, w, err);
   if (stopped) {
     watcher_stop(w, LW_PHASE_DONE);
-    char mpi[LW_PATH_MAX + 96] = "";
+    char mpi[LW_RUNDIR_WORD_MAX + 96] = "", word[LW_RUNDIR_WORD_MAX];
+    lw_rundir_shell_word(a->dir, word, sizeof word);
     if (net && net->size > 1)
-      snprintf(mpi, sizeof mpi, ", on one process, or over MPI as 'mpirun -n P linewise-mpi resume %s'", a->dir);
+      snprintf(mpi, sizeof mpi, ", on one process, or over MPI as 'mpirun -n P linewise-mpi resume %s'", word);
     /* a log of --quiet runs must tell one a signal stopped too (under MPI
     ** the first process says it, whichever process the signal reached) */
     if (!quiet || (asked && (net ? net->stop_agreed && !net->rank : stop_requested)))
       fprintf(stderr, "linewise: stopped after sweep %ld%s; state saved in %s/state.lw ('linewise resume %s' "
               "continues%s)\n", a->sweep, stop_requested == SIGXCPU ? " (the soft CPU-time limit)" : "", a->dir,
-              a->dir, mpi);
+              word, mpi);
     return 0;
   }
   say_finishing = !quiet;
@@ -628,9 +634,10 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   if (s) return loop_fail(a, pg.start_sweep, w, err);
   watcher_stop(w, a->quench.ended == LW_QUENCH_STOPPED ? LW_PHASE_STOPPED : LW_PHASE_DONE);
   if (a->quench.ended == LW_QUENCH_STOPPED) {
+    char word[LW_RUNDIR_WORD_MAX];
     if (!quiet || (asked && (net ? !net->rank : 1)))
       fprintf(stderr, "linewise: stopped during the quench (nothing drawn); state saved in %s/state.lw ('linewise resume "
-              "%s' quenches again)\n", a->dir, a->dir);
+              "%s' quenches again)\n", a->dir, lw_rundir_shell_word(a->dir, word, sizeof word));
     return 0;
   }
   if (drew && !asked) {

@@ -1,6 +1,7 @@
 /* rundir.c -- the lock of a run directory (rundir.h). */
 #include "linewise/rundir.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -202,4 +203,20 @@ void lw_rundir_unlock(int hold)
 {
   if (hold < 1 || hold > HELD_MAX || !held[hold - 1].count) return;
   if (!--held[hold - 1].count) close(held[hold - 1].fd);
+}
+
+const char *lw_rundir_shell_word(const char *dir, char *buf, size_t n)
+{
+  int plain = dir[0] != '\0';
+  for (const char *c = dir; *c && plain; c++) plain = isalnum((unsigned char)*c) || strchr("_./:@%+,=-", *c);
+  size_t at = 0;
+  const char *lead = dir[0] == '-' ? "./" : "";
+  at += (size_t)snprintf(buf, n, "%s%s", plain ? "" : "\"", lead);
+  for (const char *c = dir; *c && at + 3 < n; c++) {
+    if (!plain && strchr("\\\"$`", *c)) buf[at++] = '\\';
+    buf[at++] = *c;
+  }
+  if (!plain && at + 1 < n) buf[at++] = '"';
+  buf[at < n ? at : n - 1] = '\0';
+  return buf;
 }

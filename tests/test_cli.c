@@ -1474,6 +1474,26 @@ Test(cli, a_signal_that_gives_the_directory_back_does_not_exit_0)
   }
 }
 
+/* The command a stopped run names to go on with it pastes into a shell as
+** it is, whatever the directory's name: 'linewise resume with space' ran
+** `resume with space`, and 'linewise resume -dash' took it for an option. */
+Test(cli, the_resume_command_a_stop_names_pastes_into_a_shell)
+{
+  static const char *const name[] = {"plain", "with space", "-dash", "q\"u$o`te\\s"};
+  for (size_t k = 0; k < sizeof name / sizeof *name; k++) {
+    char q[64] = "'"; /* the name in single quotes for the test's own shell */
+    for (const char *c = name[k]; *c; c++) snprintf(q + strlen(q), sizeof q - strlen(q), "%c", *c);
+    strcat(q, "'");
+    cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out %s --stop-at 3 --set anneal.sweeps=6 "
+                            "2> err.txt", dir, lw_test_bin(), lw_test_root(), q), 0, "%s", name[k]);
+    /* the command between "('" and "' continues", with the binary's path for linewise */
+    cr_assert_eq(lw_test_sh("cd %s && sed -n \"s/^linewise: stopped after sweep 3; "
+                            ".*('linewise \\(.*\\)' continues)$/\\1/p\" err.txt > cmd.txt && test -s cmd.txt && "
+                            "sh -c \"%s $(cat cmd.txt) --quiet\" && test -s ./%s/summary.json", dir, lw_test_bin(), q), 0, "%s: %s", name[k],
+                 lw_test_slurp("%s/err.txt", dir));
+  }
+}
+
 /* On a terminal the progress is one bar redrawn in place (carriage returns,
 ** no plain "elapsed" lines), full at the last sweep and ended by a new
 ** line; --quiet draws none.  script(1) gives the run its terminal. */

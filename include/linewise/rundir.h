@@ -12,6 +12,8 @@
 #ifndef LINEWISE_RUNDIR_H
 #define LINEWISE_RUNDIR_H
 
+#include <stddef.h>
+
 #include "linewise/error.h"
 
 #ifdef __cplusplus
@@ -56,6 +58,15 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err);
 /* Gives back one lw_rundir_lock (hold 0: nothing); the last of a directory
 ** releases its lock. */
 void lw_rundir_unlock(int hold);
+
+/* dir as one word of a shell command that a message tells the user to
+** paste ('linewise resume DIR'): as it is where it has only letters,
+** digits and _ . / : @ % + , = -, else in double quotes with \ " $ `
+** escaped; ./ before a relative path that begins with '-' (an option to
+** the command otherwise).  In buf of n bytes (2 * LW_PATH_MAX + 8 holds
+** any); returns buf. */
+#define LW_RUNDIR_WORD_MAX (2 * LW_PATH_MAX + 8)
+const char *lw_rundir_shell_word(const char *dir, char *buf, size_t n);
 
 #ifdef __cplusplus
 }
