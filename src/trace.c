@@ -209,7 +209,7 @@ static long default_from(const lw_trace *t, int sweep)
   return (long)at(t, r, sweep);
 }
 
-enum { WARN_OPEN, WARN_FEW, WARN_ONE, WARN_DRIFT, WARN_BATCH, WARN_RUNS };
+enum { WARN_OPEN, WARN_FEW, WARN_ONE, WARN_DRIFT, WARN_BATCH, WARN_RUNS, WARN_COARSE };
 
 /* A column's statistics: per run (k of them), and with several runs what
 ** they say together. */
@@ -217,6 +217,9 @@ typedef struct {
   lw_series_stats *run; /* k */
   double mean, stderr_mean, sd, tau_sweeps, n_eff;
   int mixed;            /* a rung's column whose rung stands at other temperatures in other runs */
+  int coarse;           /* a run's values about uncorrelated at their spacing of more than a sweep: tau at
+                        ** its floor of half a value, tau_sweeps a bound (wire-ladder at trace_every 1000
+                        ** read 500 sweeps against the 17 of every row) */
   double r_hat;         /* Gelman and Rubin's potential scale reduction */
   double p_runs;        /* chi-square probability of the runs' means under their error bars */
 } column_stats;
@@ -244,6 +247,7 @@ static int run_problem(const lw_series_stats *s, int what)
 static int has_problem(const column_stats *c, int k, int what)
 {
   if (what == WARN_RUNS) return k > 1 && !isnan(c->p_runs) && (c->p_runs < 1e-3 || c->r_hat > 1.1);
+  if (what == WARN_COARSE) return c->coarse;
   for (int r = 0; r < k; r++)
     if (run_problem(&c->run[r], what)) return 1;
   return 0;
@@ -568,6 +572,8 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       }
       empty |= !cs[c].run[r].n;
       gap[r] = lw_trace_column_gap(every[r], n[r], &cs[c].run[r]);
+      const lw_series_stats *s = &cs[c].run[r];
+      cs[c].coarse |= s->n > 1 && s->sd > 0.0 && s->tau < 0.75 && gap[r] > 1.0;
     }
     cs[c].tau_sweeps = cs[c].run[0].tau * gap[0];
     if (empty) {
@@ -688,6 +694,9 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
          "stationary (start later with --from), or, where the batch means warn too, the same slow mode (run longer)");
     warn(out, t[0], cs, k, WARN_RUNS, "the runs disagree beyond their error bars (p_runs < 0.001 or R_hat > 1.1): "
          "not converged, or the stretches too short for their error bars");
+    warn(out, t[0], cs, k, WARN_COARSE, "the values are about uncorrelated at their spacing, so tau_sweeps is at "
+         "most half of it, not a measurement (the error bar holds; rows more often, output.trace_every, measure "
+         "it)");
   }
 done:
   for (int r = 0; row && r < k; r++) free(row[r]);

@@ -316,6 +316,39 @@ Test(trace, tau_of_a_column_filled_every_other_row_counts_its_sweeps, .init = ma
             every_other);
 }
 
+/* Values about uncorrelated at a spacing of more than a sweep leave tau at
+** its floor of half a value, and tau_sweeps says only that it is at most
+** half the spacing (wire-ladder with a row every 1000 sweeps read 500
+** sweeps against the 17 its every row measures): said, naming the column.
+** The same AR(1) series (tau 4.5 values) every sweep is a measurement and
+** is not; every 20th of it, at its own 20 sweeps apart, is; and
+** uncorrelated values at every sweep measure their tau of half a sweep. */
+Test(trace, a_tau_at_the_rows_spacing_is_said_to_be_a_bound, .init = make_dir, .fini = remove_dir)
+{
+  static char text[3][200000];
+  char out[4096];
+  double x = 0.0;
+  unsigned long u = 777;
+  int k[3];
+  for (int j = 0; j < 3; j++) k[j] = snprintf(text[j], sizeof text[j], "sweep,x\n");
+  for (int i = 1; i <= 4000; i++) {
+    u = u * 6364136223846793005UL + 1442695040888963407UL;
+    const double e = (double)(u >> 11) / 9007199254740992.0 - 0.5;
+    x = 0.8 * x + e;
+    k[0] += snprintf(text[0] + k[0], sizeof text[0] - (size_t)k[0], "%d,%.17g\n", i, x);
+    if (i % 20 == 0) k[1] += snprintf(text[1] + k[1], sizeof text[1] - (size_t)k[1], "%d,%.17g\n", i, x);
+    if (i <= 400) k[2] += snprintf(text[2] + k[2], sizeof text[2] - (size_t)k[2], "%d,%.17g\n", i, e);
+  }
+  lw_trace_select sel = {.from = 0, .to = -1};
+  for (int j = 0; j < 3; j++) {
+    lw_trace *t = trace_of(text[j]);
+    report_of(t, &sel, out, sizeof out);
+    lw_trace_free(t);
+    const int said = strstr(out, "warning: x: the values are about uncorrelated at their spacing") != NULL;
+    cr_expect_eq(said, j == 1, "case %d: %s", j, out);
+  }
+}
+
 Test(trace, the_default_stretch_is_the_final_temperature_less_its_tuning_sweeps, .init = make_dir,
      .fini = remove_dir)
 {
