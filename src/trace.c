@@ -512,6 +512,25 @@ static lw_status same_columns(const lw_trace *a, const char *pa, const lw_trace 
 ** run twice, or seeds that changed nothing (a scene that draws no random
 ** number), which the comparison took for k agreeing runs (R_hat 0.99,
 ** p_runs 1). */
+/* How many of the k runs accepted no move over the rows: every acc_
+** column they filled is 0 throughout (a chain that stood still gave each
+** column a mean and an error bar of 0, and no word). */
+static int frozen_runs(const lw_trace *t, const column_stats *cs, int k)
+{
+  int frozen = 0;
+  for (int r = 0; r < k; r++) {
+    int acc = 0, moved = 0;
+    for (size_t c = 0; c < t->n_cols; c++) {
+      const lw_series_stats *s = &cs[c].run[r];
+      if (strncmp(t->name[c], "acc_", 4) || !s->n) continue;
+      acc = 1;
+      moved |= s->mean != 0.0 || s->sd > 0.0;
+    }
+    frozen += acc && !moved;
+  }
+  return frozen;
+}
+
 static int identical_runs(const lw_trace *const *t, size_t *const *row, const size_t *n, int k)
 {
   for (int r = 1; r < k; r++) {
@@ -674,6 +693,12 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     fprintf(apart, "warning: the runs' rungs stand at other temperatures (other ladders, or each tuned its own): "
             "the columns of those rungs and their swaps mix ensembles, and their mean, stderr, R_hat and p_runs are "
             "left empty; compare them run by run, or with --reweight\n");
+  const int frozen = frozen_runs(t[0], cs, k);
+  if (apart && frozen)
+    fprintf(apart, "warning: %s accepted no move in these rows (every acc_ column 0): %s chain stood still, so "
+            "its columns' means are one state's and their error bars 0 say nothing of the distribution (a step "
+            "too large, or a temperature too low, for the moves)\n", k > 1 ? (frozen > 1 ? "runs" : "a run") : "the run",
+            frozen > 1 ? "their" : "its");
   if (apart && k > 1 && identical_runs(t, row, n, k))
     fprintf(apart, "warning: the %d runs are the same, row for row: one seed run twice, or seeds that change "
             "nothing (a scene that draws no random number, as the dynamics from init.from or the D-NURBS dynamics), "

@@ -349,6 +349,25 @@ Test(trace, a_tau_at_the_rows_spacing_is_said_to_be_a_bound, .init = make_dir, .
   }
 }
 
+/* A run that accepted no move (every acc_ column 0: a step far too large)
+** is said to have stood still: its columns' zero error bars were shown
+** without a word.  One accepted move in the rows is enough to say nothing. */
+Test(trace, a_chain_that_accepted_nothing_is_said_to_have_stood_still, .init = make_dir, .fini = remove_dir)
+{
+  char text[4096], out[4096];
+  for (int moved = 0; moved < 2; moved++) {
+    int k = snprintf(text, sizeof text, "sweep,temperature,total,acc_point,acc_vector\n");
+    for (int i = 1; i <= 50; i++)
+      k += snprintf(text + k, sizeof text - (size_t)k, "%d,1,3.25,%s,0\n", i, moved && i == 30 ? "0.01" : "0");
+    lw_trace *t = trace_of(text);
+    lw_trace_select sel = {.from = 0, .to = -1};
+    report_of(t, &sel, out, sizeof out);
+    lw_trace_free(t);
+    cr_expect_eq(strstr(out, "warning: the run accepted no move in these rows (every acc_ column 0)") != NULL, !moved,
+                 "%s", out);
+  }
+}
+
 Test(trace, the_default_stretch_is_the_final_temperature_less_its_tuning_sweeps, .init = make_dir,
      .fini = remove_dir)
 {
