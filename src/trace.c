@@ -697,8 +697,8 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
   if (apart && frozen)
     fprintf(apart, "warning: %s accepted no move in these rows (every acc_ column 0): %s chain stood still, so "
             "its columns' means are one state's and their error bars 0 say nothing of the distribution (a step "
-            "too large, or a temperature too low, for the moves)\n", k > 1 ? (frozen > 1 ? "runs" : "a run") : "the run",
-            frozen > 1 ? "their" : "its");
+            "too large, or a temperature too low, for the moves)\n",
+            k > 1 ? (frozen > 1 ? "runs" : "a run") : "the run", frozen > 1 ? "their" : "its");
   if (apart && k > 1 && identical_runs(t, row, n, k))
     fprintf(apart, "warning: the %d runs are the same, row for row: one seed run twice, or seeds that change "
             "nothing (a scene that draws no random number, as the dynamics from init.from or the D-NURBS dynamics), "
