@@ -1009,12 +1009,17 @@ static int cmd_resume(int argc, char **argv)
   if (!s && stop_at >= 0 && stop_at < a.sweep)
     s = lw_error_set(&err, LW_EUSAGE, "--stop-at %ld: the run in %s stands at sweep %ld already; expected %ld or more",
                      stop_at, dir, a.sweep, a.sweep);
-  if (spread_start(s, &a, 0, &err)) {
+  if (spread_start(s, &a, 0, &err) || lw_anneal_settle(&a, &err)) {
     lw_anneal_free(&a);
-    return watched_fail(&w, &err);
-  }
-  if (lw_anneal_settle(&a, &err)) {
-    lw_anneal_free(&a);
+    /* a full disk as an extension starts said only "write failed" */
+    if (err.code == LW_EIO) {
+      char word[LW_RUNDIR_WORD_MAX], sweeps[32] = "";
+      if (more >= 0) snprintf(sweeps, sizeof sweeps, " --sweeps %ld", more);
+      const size_t n = strlen(err.msg);
+      snprintf(err.msg + n, sizeof err.msg - n, "; the run in %s is as its last checkpoint left it: 'linewise resume "
+               "%s%s' goes on once the files can be written", dir, lw_rundir_shell_word(dir, word, sizeof word),
+               sweeps);
+    }
     return watched_fail(&w, &err);
   }
   if (a.pause_at >= 0 && (stop_at < 0 || a.pause_at < stop_at)) stop_at = a.pause_at;

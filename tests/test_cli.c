@@ -1494,6 +1494,25 @@ Test(cli, the_resume_command_a_stop_names_pastes_into_a_shell)
   }
 }
 
+/* An extension (resume --sweeps) that a full disk stops as it starts says
+** what is left and how to go on, as a failure mid-run does: it said only
+** "write failed".  strace(1) fails the new state's writes with ENOSPC; the
+** run is as it was, and the command it names then extends it. */
+Test(cli, an_extension_a_full_disk_stops_says_how_to_go_on)
+{
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out m --quiet --set anneal.sweeps=50 && "
+                          "cp m/state.lw before.lw", dir, lw_test_bin(), lw_test_root()), 0);
+  cr_assert_eq(lw_test_sh("cd %s && strace -o /dev/null -P \"$PWD/m/state.lw.tmp\" -e trace=write "
+                          "-e inject=write:error=ENOSPC %s resume m --sweeps 30 --quiet 2> err.txt", dir,
+                          lw_test_bin()), 1);
+  cr_assert_eq(lw_test_sh("cd %s && grep -qx \"linewise: m/state.lw: write failed: No space left on device; the run in "
+                          "m is as its last checkpoint left it: 'linewise resume m --sweeps 30' goes on once the "
+                          "files can be written\" err.txt && cmp -s m/state.lw before.lw", dir), 0, "%s",
+               lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(lw_test_sh("cd %s && %s resume m --sweeps 30 --quiet && grep -qx 'sweep = 80' m/state.lw", dir,
+                          lw_test_bin()), 0);
+}
+
 /* On a terminal the progress is one bar redrawn in place (carriage returns,
 ** no plain "elapsed" lines), full at the last sweep and ended by a new
 ** line; --quiet draws none.  script(1) gives the run its terminal. */
