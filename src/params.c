@@ -407,7 +407,8 @@ const lw_param_def lw_param_table[] = {
          "(1 to 64), an N x N lattice of domains over the page, shifted at random each sweep, whose four "
          "sub-lattices are swept in turn, the domains of each in parallel (OpenMP); a spline moves in a "
          "sweep only where it falls inside one domain, and a count that would move fewer than a quarter "
-         "of them a sweep is refused; `auto`, domains "
+         "of them a sweep is refused, as is one whose domains are not wider than twice the reach of a "
+         "move; `auto`, domains "
          "of side max(2.5 reach, 16 init.segments init.segment_length) (particles: 2.5 reach, the page "
          "their grid's box in x and y), at most 64 a side, not split "
          "when fewer than 2 fit a side. The result depends on this key, never on the threads. docs/SCALING.md."),

@@ -84,7 +84,9 @@ static void setup_free(void *setup)
 static void long_splines_note(const lw_params *p, char *note, size_t n)
 {
   const double rigid = p->mix_translate + p->mix_rotate, all = rigid + p->mix_point + p->mix_vector;
-  if (p->driver != LW_DRIVER_METROPOLIS || p->from[0] || !(rigid > 0.0) || rigid / all * p->segments < 18.0) return;
+  if (p->driver != LW_DRIVER_METROPOLIS || p->from[0] || p->sweeps <= 0 || !(rigid > 0.0) ||
+      rigid / all * p->segments < 18.0)
+    return;
   size_t used = strlen(note);
   if (used < n)
     snprintf(note + used, n - used, "%sinit.segments = %d: the rigid moves (moves.translate and rotate), %.0f %% of "
