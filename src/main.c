@@ -4,7 +4,8 @@
 ** stderr and an exit status: 2 for bad usage or input, 1 for failures while
 ** running.
 */
-#include <ctype.h>
+/* pthread_getattr_np: a thread's stack (thread_stack_too_small) */
+#define _GNU_SOURCE
 #include <errno.h>
 #include <gsl/gsl_errno.h>
 #include <fcntl.h>
@@ -947,6 +948,13 @@ static int cmd_run(int argc, char **argv)
   ** under --quiet too (what is left takes disk space, and the next run or
   ** resume there tries again) */
   if (a.stash_left[0]) fprintf(stderr, "linewise: warning: %s\n", a.stash_left);
+  /* under --quiet too: a seed sweep over an old run's scene.ini brought back
+  ** the seeds that draw the same numbers without a word */
+  if (a.params.run_header && !a.params.line[lw_params_find("anneal", "seed_version") - lw_param_table] &&
+      (!net || !net->rank))
+    fprintf(stderr, "linewise: note: anneal.seed_version = 1: %s is a run's scene.ini from before 2026-12-06, so this "
+            "run seeds as that one did, where two seeds could draw the same numbers; --set anneal.seed_version=2 for "
+            "a new study (docs/NUMERICS.md, \"Random numbers\")\n", scene);
   if (!quiet) {
     const char *note = a.sys_type->note(a.setup);
     char size[128];
@@ -1013,12 +1021,13 @@ static int cmd_resume(int argc, char **argv)
     lw_anneal_free(&a);
     /* a full disk as an extension starts said only "write failed" */
     if (err.code == LW_EIO) {
-      char word[LW_RUNDIR_WORD_MAX], sweeps[32] = "";
+      char word[LW_RUNDIR_WORD_MAX], sweeps[64] = "";
       if (more >= 0) snprintf(sweeps, sizeof sweeps, " --sweeps %ld", more);
+      if (stop_at >= 0) snprintf(sweeps + strlen(sweeps), sizeof sweeps - strlen(sweeps), " --stop-at %ld", stop_at);
       const size_t n = strlen(err.msg);
       snprintf(err.msg + n, sizeof err.msg - n, "; the run in %s is as its last checkpoint left it: 'linewise resume "
-               "%s%s' goes on once the files can be written", dir, lw_rundir_shell_word(dir, word, sizeof word),
-               sweeps);
+               "%s%s' goes on once its files can be read and written", dir,
+               lw_rundir_shell_word(dir, word, sizeof word), sweeps);
     }
     return watched_fail(&w, &err);
   }
@@ -1231,6 +1240,15 @@ static void install_signals(int pipe_proof)
 
 static int command(int argc, char **argv);
 
+/* The threads a run or resume asks for: --threads, else OpenMP's. */
+static int threads_asked(int argc, char **argv)
+{
+  int threads = omp_get_max_threads();
+  for (int i = 2; i + 1 < argc; i++)
+    if (!strcmp(argv[i], "--threads")) threads = atoi(argv[i + 1]);
+  return threads;
+}
+
 #ifndef LW_MPI
 /* OpenMP threads spin at their barriers (libgomp's default), which is fast
 ** while each has a core, but on a machine busy with other work a spinning
@@ -1246,9 +1264,7 @@ static int command(int argc, char **argv);
 static void choose_wait_policy(int argc, char **argv)
 {
   if (argc < 2 || (strcmp(argv[1], "run") && strcmp(argv[1], "resume")) || getenv("OMP_WAIT_POLICY")) return;
-  int threads = omp_get_max_threads();
-  for (int i = 2; i + 1 < argc; i++)
-    if (!strcmp(argv[i], "--threads")) threads = atoi(argv[i + 1]);
+  const int threads = threads_asked(argc, argv);
   double load = 0.0;
   FILE *f = fopen("/proc/loadavg", "r");
   if (!f) return;
@@ -1304,54 +1320,54 @@ static int narrow_lanes(void)
 ** fault somewhere in the run. */
 #define STACK_NEEDED_KIB 256
 
-/* OMP_STACKSIZE (or libgomp's GOMP_STACKSIZE) in KiB as OpenMP reads it: a
-** positive count with an optional unit B, K, M or G (K when none), blanks
-** about either; -1 where unset or malformed (libgomp then keeps its default
-** and says so itself). */
-static double omp_stack_kib(const char **name)
-{
-  const char *v = getenv(*name = "OMP_STACKSIZE");
-  if (!v) v = getenv(*name = "GOMP_STACKSIZE");
-  if (!v) return -1.0;
-  char *end;
-  while (*v == ' ' || *v == '\t') v++;
-  if (!isdigit((unsigned char)*v)) return -1.0;
-  errno = 0;
-  double kib = (double)strtoull(v, &end, 10);
-  if (errno) return -1.0;
-  while (*end == ' ' || *end == '\t') end++;
-  const char unit = (char)toupper((unsigned char)*end);
-  if (unit == 'B') kib /= 1024.0;
-  if (unit == 'M') kib *= 1024.0;
-  if (unit == 'G') kib *= 1024.0 * 1024.0;
-  if (unit == 'B' || unit == 'K' || unit == 'M' || unit == 'G') end++;
-  while (*end == ' ' || *end == '\t') end++;
-  return *end || kib <= 0.0 ? -1.0 : kib;
-}
-
-static int stack_too_small(void)
+/* The main thread's stack: ulimit -s. */
+static int main_stack_too_small(void)
 {
   struct rlimit rl;
-  if (!getrlimit(RLIMIT_STACK, &rl) && rl.rlim_cur != RLIM_INFINITY && rl.rlim_cur < STACK_NEEDED_KIB * 1024) {
-    fprintf(stderr, "linewise: the stack limit (ulimit -s) is %llu KiB: expected at least %d KiB (8192 is usual)\n",
-            (unsigned long long)(rl.rlim_cur / 1024), STACK_NEEDED_KIB);
-    return 1;
+  if (getrlimit(RLIMIT_STACK, &rl) || rl.rlim_cur == RLIM_INFINITY || rl.rlim_cur >= STACK_NEEDED_KIB * 1024) return 0;
+  fprintf(stderr, "linewise: the stack limit (ulimit -s) is %llu KiB: expected at least %d KiB (8192 is usual)\n",
+          (unsigned long long)(rl.rlim_cur / 1024), STACK_NEEDED_KIB);
+  return 1;
+}
+
+/* OpenMP's threads' stack, measured on one of them: libgomp sizes it from
+** OMP_STACKSIZE, or GOMP_STACKSIZE where that is unset, empty or not a size
+** it reads, or else ulimit -s, each with its own rules for blanks, signs and
+** sizes it ignores; reading the variables here let "+16K", "16K\r" and a
+** GOMP_STACKSIZE behind a bad OMP_STACKSIZE through to the crash.  Only a
+** run of more than one thread has such threads. */
+static int thread_stack_too_small(int argc, char **argv)
+{
+  if (argc < 2 || (strcmp(argv[1], "run") && strcmp(argv[1], "resume")) || threads_asked(argc, argv) < 2) return 0;
+  size_t size = 0;
+#if defined(__GLIBC__)
+#pragma omp parallel num_threads(2)
+  if (omp_get_thread_num() == 1) {
+    pthread_attr_t at;
+    if (!pthread_getattr_np(pthread_self(), &at)) {
+      if (pthread_attr_getstacksize(&at, &size)) size = 0;
+      pthread_attr_destroy(&at);
+    }
   }
-  const char *name;
-  const double kib = omp_stack_kib(&name);
-  if (kib >= 0.0 && kib < STACK_NEEDED_KIB) {
-    fprintf(stderr, "linewise: environment %s: '%s' gives each thread %.4g KiB of stack: expected at least %d KiB "
-            "(unset it, or set 1M)\n", name, getenv(name), kib, STACK_NEEDED_KIB);
-    return 1;
-  }
-  return 0;
+#endif
+  if (!size || size >= STACK_NEEDED_KIB * 1024) return 0;
+  char set[2 * LW_PARAM_TEXT_MAX] = "";
+  static const char *const name[] = {"OMP_STACKSIZE", "GOMP_STACKSIZE"};
+  for (int k = 0; k < 2; k++)
+    if (getenv(name[k]))
+      snprintf(set + strlen(set), sizeof set - strlen(set), "%s%s='%.60s'", set[0] ? ", " : "", name[k],
+               getenv(name[k]));
+  fprintf(stderr, "linewise: OpenMP's threads get %zu KiB of stack (%s%s): expected at least %d KiB (%s)\n",
+          size / 1024, set[0] ? "environment " : "ulimit -s", set, STACK_NEEDED_KIB,
+          set[0] ? "unset it, or set OMP_STACKSIZE=1M" : "raise it");
+  return 1;
 }
 
 int main(int argc, char **argv)
 {
   open_standard_descriptors();
   gsl_set_error_handler(lw_gsl_handler);
-  if (narrow_lanes() || stack_too_small()) return 2;
+  if (narrow_lanes() || main_stack_too_small()) return 2;
   if (end_of_options(&argc, argv)) {
     fprintf(stderr, "linewise: out of memory\n");
     return 1;
@@ -1359,6 +1375,7 @@ int main(int argc, char **argv)
 #ifndef LW_MPI
   choose_wait_policy(argc, argv);
 #endif
+  if (thread_stack_too_small(argc, argv)) return 2;
   const int runs = argc >= 2 && (!strcmp(argv[1], "run") || !strcmp(argv[1], "resume"));
   /* nothing written yet: from the handlers' first moment, a signal ends the
   ** set-up at once (one caught before this ran the whole set-up) */
@@ -1378,8 +1395,10 @@ int main(int argc, char **argv)
   /* A Ctrl-C stop, its state saved, ends by the signal itself: a shell runs
   ** a loop on after a child that exits 0 (or 130) on SIGINT, so every run
   ** of an artist's series loop was stopped in turn.  SIGTERM and SIGHUP
-  ** (a batch system's, a lost session's) still end with 0, and so does a
-  ** run that a Ctrl-C during its final files let finish (summary.json). */
+  ** (a batch system's, a lost session's) still end with 0 where the state
+  ** is saved (128 + the signal where the run gave its directory back to the
+  ** one it replaces: cmd_run), and so does a run that a Ctrl-C during its
+  ** final files let finish (summary.json). */
   if (rc == 0 && stop_requested == SIGINT && finishing != 2) {
     signal(SIGINT, SIG_DFL);
     raise(SIGINT);

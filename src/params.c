@@ -389,8 +389,9 @@ const lw_param_def lw_param_table[] = {
       "How the seed makes the seeds of the run's random streams. 2: distinct seeds never "
       "share a stream's numbers (docs/NUMERICS.md, \"Random numbers\"). 1: the way of runs "
       "begun before 2026-12-06, under which two seeds could draw the same numbers (89483 "
-      "and 106945 gave the same run); a scene.ini that such a run wrote, lacking this key, "
-      "takes 1, so that running it again gives that run."),
+      "and 106945 drew the same chain, and without tempering ran the same run); a scene.ini "
+      "that such a run wrote, lacking this key, takes 1, so that running it again draws that "
+      "run's random numbers (and says so)."),
   NUM("anneal", "check_every", LW_PT_INT, check_every, "100", "sweeps", 1, 2e9, 0,
       "Sweeps between full recomputations of the energy (the drift check); splines are "
       "renumbered along a Hilbert curve of the page just before each, for locality in memory. "

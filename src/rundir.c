@@ -209,14 +209,20 @@ const char *lw_rundir_shell_word(const char *dir, char *buf, size_t n)
 {
   int plain = dir[0] != '\0';
   for (const char *c = dir; *c && plain; c++) plain = isalnum((unsigned char)*c) || strchr("_./:@%+,=-", *c);
-  size_t at = 0;
-  const char *lead = dir[0] == '-' ? "./" : "";
-  at += (size_t)snprintf(buf, n, "%s%s", plain ? "" : "\"", lead);
-  for (const char *c = dir; *c && at + 3 < n; c++) {
-    if (!plain && strchr("\\\"$`", *c)) buf[at++] = '\\';
+  /* an interactive bash expands ! inside double quotes: single ones then,
+  ** each ' of the name as '\'' */
+  const char quote = plain ? '\0' : strchr(dir, '!') ? '\'' : '"';
+  size_t at = (size_t)snprintf(buf, n, "%.1s%s", &quote, dir[0] == '-' ? "./" : "");
+  for (const char *c = dir; *c && at + 5 < n; c++) {
+    if (quote == '\'' && *c == '\'') {
+      memcpy(buf + at, "'\\''", 4);
+      at += 4;
+      continue;
+    }
+    if (quote == '"' && strchr("\\\"$`", *c)) buf[at++] = '\\';
     buf[at++] = *c;
   }
-  if (!plain && at + 1 < n) buf[at++] = '"';
+  if (quote && at + 1 < n) buf[at++] = quote;
   buf[at < n ? at : n - 1] = '\0';
   return buf;
 }

@@ -35,9 +35,13 @@ static size_t cell_of(double x, double y, double x0, double y0, double c, size_t
   return (cy < ny ? cy : ny - 1) * nx + (cx < nx ? cx : nx - 1);
 }
 
-/* The points in flat arrays sorted by cell (a counting sort), 36 bytes a
+/* The points in flat arrays sorted by cell (a counting sort), 40 bytes a
 ** point: a drawing of 10^5 splines has 1.4e7 of them, and the
-** score comes after the run, which it must not fail for want of memory. */
+** score comes after the run, which it must not fail for want of memory.
+** Within a cell a run of one stroke's points is stepped over at once (skip):
+** a stroke that winds over itself (a vortex, a spiral) filled its cells
+** with its own points, which every point scanned and none counted, and one
+** spline of 100,000 segments spent 60 % of its output there. */
 lw_status lw_close_share(const double *b, const size_t *owner, const size_t *group, size_t n_seg, double d,
                          double *share, lw_error *err)
 {
@@ -69,8 +73,9 @@ lw_status lw_close_share(const double *b, const size_t *owner, const size_t *gro
   float *len = malloc(n * sizeof *len);
   uint32_t *who = malloc(n * sizeof *who), *grp = group ? malloc(n * sizeof *grp) : NULL;
   uint32_t *order = malloc(n * sizeof *order), *start = calloc(cells + 1, sizeof *start);
+  uint32_t *skip = malloc(n * sizeof *skip);
   lw_status st = LW_OK;
-  if (!px || !py || !len || !who || (group && !grp) || !order || !start) {
+  if (!px || !py || !len || !who || (group && !grp) || !order || !start || !skip) {
     st = lw_error_set(err, LW_ENOMEM, "out of memory for the close share of %zu points", n);
     goto done;
   }
@@ -93,6 +98,10 @@ lw_status lw_close_share(const double *b, const size_t *owner, const size_t *gro
   for (size_t p = 0; p < n; p++) order[start[cell_of(px[p], py[p], x0, y0, c, nx, ny)]++] = (uint32_t)p;
   for (size_t q = cells; q > 0; q--) start[q] = start[q - 1]; /* the fill advanced each start to the next */
   start[0] = 0;
+  /* skip[e]: the first entry after e in its cell of another stroke's point */
+  for (size_t q = 0; q < cells; q++)
+    for (uint32_t e = start[q + 1]; e-- > start[q];)
+      skip[e] = e + 1 < start[q + 1] && who[order[e + 1]] == who[order[e]] ? skip[e + 1] : e + 1;
   double close = 0.0, all = 0.0;
   const double d2 = d * d;
   for (size_t p = 0; p < n; p++) {
@@ -100,13 +109,18 @@ lw_status lw_close_share(const double *b, const size_t *owner, const size_t *gro
     int found = 0;
     for (size_t y = cy > 0 ? cy - 1 : 0; !found && y <= cy + 1 && y < ny; y++)
       for (size_t x = cx > 0 ? cx - 1 : 0; !found && x <= cx + 1 && x < nx; x++)
-        for (uint32_t e = start[y * nx + x]; e < start[y * nx + x + 1]; e++) {
+        for (uint32_t e = start[y * nx + x]; e < start[y * nx + x + 1];) {
           const uint32_t o = order[e];
+          if (who[o] == who[p]) {
+            e = skip[e];
+            continue;
+          }
           const double dx = px[o] - px[p], dy = py[o] - py[p];
-          if (who[o] != who[p] && (!grp || grp[o] == grp[p]) && dx * dx + dy * dy < d2) {
+          if ((!grp || grp[o] == grp[p]) && dx * dx + dy * dy < d2) {
             found = 1;
             break;
           }
+          e++;
         }
     all += len[p];
     if (found) close += len[p];
@@ -120,6 +134,7 @@ done:
   free(grp);
   free(order);
   free(start);
+  free(skip);
   return st;
 }
 

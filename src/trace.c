@@ -508,13 +508,11 @@ static lw_status same_columns(const lw_trace *a, const char *pa, const lw_trace 
   return LW_OK;
 }
 
-/* Whether every run's rows are the first run's, value for value: one seed
-** run twice, or seeds that changed nothing (a scene that draws no random
-** number), which the comparison took for k agreeing runs (R_hat 0.99,
-** p_runs 1). */
-/* How many of the k runs accepted no move over the rows: every acc_
-** column they filled is 0 throughout (a chain that stood still gave each
-** column a mean and an error bar of 0, and no word). */
+/* How many of the k runs stood still over the rows: every acc_ column
+** they filled is 0 throughout, and the total has no spread (a chain that
+** accepted nothing gave each column a mean and an error bar of 0, and no
+** word; under tempering the exchanges still move the coldest rung's state,
+** whose own moves the acc_ columns count). */
 static int frozen_runs(const lw_trace *t, const column_stats *cs, int k)
 {
   int frozen = 0;
@@ -522,15 +520,23 @@ static int frozen_runs(const lw_trace *t, const column_stats *cs, int k)
     int acc = 0, moved = 0;
     for (size_t c = 0; c < t->n_cols; c++) {
       const lw_series_stats *s = &cs[c].run[r];
-      if (strncmp(t->name[c], "acc_", 4) || !s->n) continue;
-      acc = 1;
-      moved |= s->mean != 0.0 || s->sd > 0.0;
+      if (!s->n) continue;
+      if (!strncmp(t->name[c], "acc_", 4)) {
+        acc = 1;
+        moved |= s->mean != 0.0 || s->sd > 0.0;
+      } else if (!strcmp(t->name[c], "total")) {
+        moved |= s->sd > 0.0;
+      }
     }
     frozen += acc && !moved;
   }
   return frozen;
 }
 
+/* Whether every run's rows are the first run's, value for value: one seed
+** run twice, or seeds that changed nothing (a scene that draws no random
+** number), which the comparison took for k agreeing runs (R_hat 0.99,
+** p_runs 1). */
 static int identical_runs(const lw_trace *const *t, size_t *const *row, const size_t *n, int k)
 {
   for (int r = 1; r < k; r++) {
@@ -592,7 +598,8 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       empty |= !cs[c].run[r].n;
       gap[r] = lw_trace_column_gap(every[r], n[r], &cs[c].run[r]);
       const lw_series_stats *s = &cs[c].run[r];
-      cs[c].coarse |= s->n > 1 && s->sd > 0.0 && s->tau < 0.75 && gap[r] > 1.0;
+      /* (not a relaxation's: the drift test speaks for it) */
+      cs[c].coarse |= s->n > 1 && s->sd > 0.0 && s->tau < 0.75 && gap[r] > 1.0 && !(fabs(s->drift_z) > 4.0);
     }
     cs[c].tau_sweeps = cs[c].run[0].tau * gap[0];
     if (empty) {

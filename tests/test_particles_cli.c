@@ -346,10 +346,10 @@ Test(particles_cli, a_quench_takes_the_noisy_sheet_flat_at_once)
 {
   /* The bundled sheet (127 particles, noise 0.1 r0 and 10 degrees) after one
   ** sweep, quenched by L-BFGS on the particles' gradient until its norm is
-  ** 1e-6: measured 305 iterations, 0.04 s, rms distance to the plane 4e-8 r0
+  ** 1e-6: measured 305 iterations, 0.02 s, rms distance to the plane 4e-8 r0
   ** and normals within 1.6e-3 degrees (seeds 2, 4, 5 and 6: 1e-7 r0 and 0.8e-3
   ** to 1.8e-3 degrees), where the 6000 sweeps of the example's anneal leave
-  ** 9.3e-3 r0 and 0.39 degrees.  Bounds 1e-6 r0 and 1e-2 degrees:
+  ** 9.7e-3 r0 and 0.40 degrees.  Bounds 1e-6 r0 and 1e-2 degrees:
   ** a gradient off by a term or a sign stalls far above them.  With the default
   ** stall rule: it waits while the gradient norm falls (before, it stopped
   ** at 59 iterations and 6e-3 r0). */

@@ -351,14 +351,17 @@ Test(trace, a_tau_at_the_rows_spacing_is_said_to_be_a_bound, .init = make_dir, .
 
 /* A run that accepted no move (every acc_ column 0: a step far too large)
 ** is said to have stood still: its columns' zero error bars were shown
-** without a word.  One accepted move in the rows is enough to say nothing. */
+** without a word.  One accepted move in the rows is enough to say nothing,
+** and so is a total that moves without one (a tempering run's coldest rung,
+** moved by its exchanges alone). */
 Test(trace, a_chain_that_accepted_nothing_is_said_to_have_stood_still, .init = make_dir, .fini = remove_dir)
 {
   char text[4096], out[4096];
-  for (int moved = 0; moved < 2; moved++) {
+  for (int moved = 0; moved < 3; moved++) {
     int k = snprintf(text, sizeof text, "sweep,temperature,total,acc_point,acc_vector\n");
     for (int i = 1; i <= 50; i++)
-      k += snprintf(text + k, sizeof text - (size_t)k, "%d,1,3.25,%s,0\n", i, moved && i == 30 ? "0.01" : "0");
+      k += snprintf(text + k, sizeof text - (size_t)k, "%d,1,%g,%s,0\n", i, moved == 2 ? 3.25 + i % 3 : 3.25,
+                    moved == 1 && i == 30 ? "0.01" : "0");
     lw_trace *t = trace_of(text);
     lw_trace_select sel = {.from = 0, .to = -1};
     report_of(t, &sel, out, sizeof out);

@@ -15,6 +15,7 @@
 #include <stddef.h>
 
 #include "linewise/error.h"
+#include "linewise/params.h" /* LW_PATH_MAX */
 
 #ifdef __cplusplus
 extern "C" {
@@ -62,10 +63,11 @@ void lw_rundir_unlock(int hold);
 /* dir as one word of a shell command that a message tells the user to
 ** paste ('linewise resume DIR'): as it is where it has only letters,
 ** digits and _ . / : @ % + , = -, else in double quotes with \ " $ `
-** escaped; ./ before a relative path that begins with '-' (an option to
-** the command otherwise).  In buf of n bytes (2 * LW_PATH_MAX + 8 holds
-** any); returns buf. */
-#define LW_RUNDIR_WORD_MAX (2 * LW_PATH_MAX + 8)
+** escaped, or where it has a ! (which an interactive bash expands there)
+** in single quotes with each ' as '\''; ./ before a relative path that
+** begins with '-' (an option to the command otherwise).  In buf of n bytes
+** (LW_RUNDIR_WORD_MAX holds any); returns buf. */
+#define LW_RUNDIR_WORD_MAX (4 * LW_PATH_MAX + 8)
 const char *lw_rundir_shell_word(const char *dir, char *buf, size_t n);
 
 #ifdef __cplusplus
