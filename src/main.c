@@ -1351,7 +1351,7 @@ static int thread_stack_too_small(int argc, char **argv)
   }
 #endif
   if (!size || size >= STACK_NEEDED_KIB * 1024) return 0;
-  char set[2 * LW_PARAM_TEXT_MAX] = "";
+  char set[160] = "";
   static const char *const name[] = {"OMP_STACKSIZE", "GOMP_STACKSIZE"};
   for (int k = 0; k < 2; k++)
     if (getenv(name[k]))
