@@ -760,11 +760,18 @@ static lw_status check_quench(const lw_anneal *a, lw_error *err)
                       "expected none", where, e2.msg);
 }
 
+/* The generator seed of the run's stream k (docs/NUMERICS.md, "Random
+** numbers"). */
+static unsigned long stream_seed(const lw_anneal *a, unsigned long k)
+{
+  return lw_stream_seed(a->seed, k, a->params.seed_version);
+}
+
 /* Chain of rung k: rung 0 draws from stream 1 (as a run without tempering
 ** does), the master exchange stream is 2, rung k >= 1 is stream 2 + k. */
 static unsigned long rung_stream(const lw_anneal *a, int k)
 {
-  return lw_stream_seed(a->seed, k == 0 ? 1 : 2 + (unsigned long)k, a->params.seed_version);
+  return stream_seed(a, k == 0 ? 1 : 2 + (unsigned long)k);
 }
 
 /* Every move weight of the system 0: refused naming its move keys, the one
@@ -822,7 +829,7 @@ static lw_status build(lw_anneal *a, void **states, const double *ladder, lw_err
   a->chain = a->chains[0];
   a->sys = a->systems[0];
   if (n > 1) {
-    a->pt = lw_tempering_new(n, ladder, lw_stream_seed(a->seed, 2, a->params.seed_version), err);
+    a->pt = lw_tempering_new(n, ladder, stream_seed(a, 2), err);
     if (!a->pt) return err->code;
   }
   if (p->driver == LW_DRIVER_DYNAMICS && !(a->dyn = lw_dynamics_new(t, a->sys->state, p, err))) return err->code;
@@ -951,7 +958,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   }
   const lw_system_type *t = a->sys_type;
   lw_phase_set("placing the initial state and building its energy");
-  void *all[LW_TEMPERING_MAX] = {t->state_new(a->setup, &a->params, lw_stream_seed(a->seed, 0, a->params.seed_version), err)};
+  void *all[LW_TEMPERING_MAX] = {t->state_new(a->setup, &a->params, stream_seed(a, 0), err)};
   if (!all[0]) return err->code;
   /* every replica starts from the same state; their streams part them */
   for (int r = 1; r < a->n_rep; r++)

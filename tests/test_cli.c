@@ -1500,7 +1500,8 @@ Test(cli, the_resume_command_a_stop_names_pastes_into_a_shell)
     /* the command between "('" and "' continues", with the binary's path for linewise */
     cr_assert_eq(lw_test_sh("cd %s && sed -n \"s/^linewise: stopped after sweep 3; "
                             ".*('linewise \\(.*\\)' continues)$/\\1/p\" err.txt > cmd.txt && test -s cmd.txt && "
-                            "sh -c \"%s $(cat cmd.txt) --quiet\" && test -s ./%s/summary.json", dir, lw_test_bin(), q), 0, "%s: %s", name[k],
+                            "sh -c \"%s $(cat cmd.txt) --quiet\" && test -s ./%s/summary.json", dir, lw_test_bin(), q),
+                 0, "%s: %s", name[k],
                  lw_test_slurp("%s/err.txt", dir));
   }
 }
