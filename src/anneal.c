@@ -1798,15 +1798,17 @@ static void put_observables(const lw_anneal *a, lw_json *j)
       if (!obs && !heat) continue;
       lw_series_stats st;
       lw_trace_column_stats(h, rows, n, (int)k, x, &st);
-      const char *suffix[5] = {"", "_stderr", "_tau_sweeps", "_n_eff", "_batch_ratio"};
-      const double value[5] = {st.mean, st.stderr_mean, st.tau * lw_trace_column_gap(every, n, &st), st.n_eff,
-                               st.batch_ratio};
-      for (int q = 0; q < 5; q++) {
+      const char *suffix[7] = {"", "_stderr", "_tau_sweeps", "_n_eff", "_window_closed", "_drift_z", "_batch_ratio"};
+      const double value[7] = {st.mean, st.stderr_mean, st.tau * lw_trace_column_gap(every, n, &st), st.n_eff,
+                               st.window > 0, st.drift_z, st.batch_ratio};
+      for (int q = 0; q < 7; q++) {
         snprintf(key, sizeof key, "%s%s", obs ? name + 4 : name, suffix[q]);
         lw_json_key(j, key);
-        /* tau, n_eff and the batches mean nothing for a column without spread */
-        if (st.n && (q < 2 || st.sd > 0.0) && !isnan(value[q])) lw_json_number(j, value[q]);
-        else lw_json_null(j);
+        /* tau, n_eff, the window, the halves and the batches mean nothing
+        ** for a column without spread */
+        if (!st.n || (q >= 2 && !(st.sd > 0.0)) || isnan(value[q])) lw_json_null(j);
+        else if (q == 4) lw_json_bool(j, st.window > 0);
+        else lw_json_number(j, value[q]);
       }
     }
     lw_json_end_object(j);

@@ -1126,6 +1126,19 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
   cr_assert(ratio > 0.5 && ratio < 1.5, "end2's batch ratio %g", ratio);
   cr_assert(fabs(strtod(at + 13, NULL) / r2 - 1.0) < 1e-9 && fabs(strtod(se + 20, NULL) / r2se - 1.0) < 1e-3,
             "summary.json's end2 differs from the stats' %.10g +- %.4g", r2, r2se);
+  /* and the window and halves' checks of the stats' --csv row: closed, and
+  ** the drift in standard errors to the --csv's three digits; a column
+  ** without spread has neither */
+  const char *wc = strstr(js, "\n    \"end2_window_closed\": "), *dz = strstr(js, "\n    \"end2_drift_z\": "),
+             *row = strstr(out, "\nobs_end2,");
+  cr_assert(wc && dz && row, "%s", js);
+  cr_assert(!strncmp(wc + 27, "true,", 5), "%.40s", wc);
+  const char *fld = row;
+  for (int k = 0; k < 8; k++) fld = strchr(fld + 1, ',');
+  double z = strtod(dz + 21, NULL);
+  cr_assert(!strncmp(fld - 2, ",1,", 3) && fabs(strtod(fld + 1, NULL) - z) <= 5e-3 * fabs(z) + 1e-12, "%s: %g", row,
+            z);
+  cr_assert(strstr(js, "\n    \"count_window_closed\": null,\n    \"count_drift_z\": null,"), "%s", js);
   free(js);
   /* the table for people says the same, with the stretch it took */
   snprintf(args, sizeof args, "stats %s/wlc", dir);

@@ -70,7 +70,7 @@ static char *err_txt(void) { return lw_test_slurp("%s/err.txt", dir); }
 
 /* ---- sweep.csv and summary.json --------------------------------------- */
 
-#define MAXC 48
+#define MAXC 96
 #define MAXR 32
 typedef struct {
   int ncol, nrow;
@@ -369,7 +369,8 @@ Test(tools, a_sweep_of_a_study_gathers_its_observables_with_error_bars)
   snprintf(path, sizeof path, "%s/o/sweep.csv", dir);
   csv_read(&t, path);
   const char *want_cols[] = {"obs_count", "obs_length", "obs_end2", "obs_end2_stderr", "obs_end2_tau_sweeps",
-                             "obs_end2_n_eff", "obs_rg2", "obs_end_cos_stderr"};
+                             "obs_end2_n_eff", "obs_end2_window_closed", "obs_end2_drift_z", "obs_rg2",
+                             "obs_end_cos_stderr"};
   for (size_t i = 0; i < sizeof want_cols / sizeof *want_cols; i++)
     cr_assert(col(&t, want_cols[i]) >= 0, "no column %s", want_cols[i]);
   cr_assert(col(&t, "obs_from") < 0 && col(&t, "obs_rows") < 0, "the stretch is not an observable");
