@@ -96,8 +96,10 @@ static void long_splines_note(const lw_params *p, char *note, size_t n)
              p->segments);
 }
 
-/* The least a segment's model takes (docs/PERFORMANCE.md: 474 to 865 bytes). */
-#define SEGMENT_BYTES_LEAST 400.0
+/* Under the least a segment's model was measured to take at its peak
+** (docs/PERFORMANCE.md: 361 to 865 bytes), so that what would fit is never
+** refused. */
+#define SEGMENT_BYTES_LEAST 360.0
 
 /* (system.h) The placed splines' model: 1e8 splines filled 3 GB in 15 s
 ** without a word, on their way to 160 GB, and a coverage's count was shown

@@ -1669,13 +1669,13 @@ Test(cli, a_start_past_the_machines_memory_is_refused_before_placing)
   snprintf(args, sizeof args, "run %s/params/minimal.ini --set init.splines=100000000 --set init.segments=16 "
            "--stop-at 0 --out %s/h", lw_test_root(), dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
-  cr_assert(strstr(errs, "linewise: --set: key 'init.splines': 100000000 splines of 16 segments (400 bytes a segment "
-                         "at least) take at least 640 GB, more than the "), "%s", errs);
+  cr_assert(strstr(errs, "linewise: --set: key 'init.splines': 100000000 splines of 16 segments (360 bytes a segment "
+                         "at least) take at least 576 GB, more than the "), "%s", errs);
   cr_assert_null(strstr(errs, "placing"), "%s", errs);
   /* a replica a copy: splines that take half the memory fit once, not four times */
   const double memory = (double)sysconf(_SC_PHYS_PAGES) * (double)sysconf(_SC_PAGE_SIZE);
   snprintf(args, sizeof args, "run %s/params/minimal.ini --set init.splines=%.0f --set init.segments=16 --set "
-           "tempering.replicas=4 --stop-at 0 --threads 1 --out %s/h", lw_test_root(), floor(memory / 2 / (400.0 * 16)),
+           "tempering.replicas=4 --stop-at 0 --threads 1 --out %s/h", lw_test_root(), floor(memory / 2 / (360.0 * 16)),
            dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", errs);
   cr_assert(strstr(errs, " in 4 replicas, more than the ") && strstr(errs, " of this machine's memory"), "%s", errs);
@@ -1683,7 +1683,7 @@ Test(cli, a_start_past_the_machines_memory_is_refused_before_placing)
   if (strstr(lw_test_bin(), "asan")) return;
   cr_assert_eq(lw_test_sh("sh -c 'ulimit -v 1000000; %s run %s/params/minimal.ini --set init.splines=1000000 "
                           "--stop-at 0 --threads 1 --out %s/h' 2>%s/err.txt; test $? -eq 2 && grep -q 'take at least "
-                          "1.6 GB, more than the 1.02 GB of this process.s address space (ulimit -v)' %s/err.txt",
+                          "1.44 GB, more than the 1.02 GB of this process.s address space (ulimit -v)' %s/err.txt",
                           lw_test_bin(), lw_test_root(), dir, dir, dir), 0);
 }
 
