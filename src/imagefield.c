@@ -4,25 +4,41 @@
 #include <math.h>
 #include <stdlib.h>
 
+/* The white paper a blurred potential is padded with, in pixels: as far as
+** the blur's Gaussian reaches (4 sigma), at most this; a blur of over 64
+** pixels continues the value it gives that far out, short of white by the
+** darkness its Gaussian carries past 256 pixels (docs/NUMERICS.md, "The
+** potential between the nodes"). */
+#define POTENTIAL_PAD_MAX 256
+
 lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, double sigma,
                                    lw_error *err)
 {
-  const int w = img->width, h = img->height, W = w + 2, H = h + 2;
-  /* node (i, j) is the centre of pixel (i - 1, j - 1); the outer ring is white, or blurred the edge */
-  lw_grid2d *g = lw_grid2d_new(W, H, 1, pl->x0 - 0.5 * pl->pixel, pl->y0 - 0.5 * pl->pixel, pl->pixel,
+  const int w = img->width, h = img->height;
+  /* blurred, the picture is blurred on its paper: white as far as the blur
+  ** reaches, so Phi rises to 1 beyond the picture without a step */
+  const int m = sigma > 0.0 ? (int)fmin(ceil(4.0 * sigma) + 1.0, POTENTIAL_PAD_MAX) : 0;
+  const int pw = w + 2 * m, ph = h + 2 * m, W = pw + 2, H = ph + 2;
+  /* node (i, j) is the centre of pixel (i - 1 - m, j - 1 - m); the outer ring
+  ** is white, or blurred continues the padded plane */
+  lw_grid2d *g = lw_grid2d_new(W, H, 1, pl->x0 - (m + 0.5) * pl->pixel, pl->y0 - (m + 0.5) * pl->pixel, pl->pixel,
                                pl->pixel, err);
   if (!g) return NULL;
   /* blurred, Phi goes through the blur's float plane; else straight in */
   float *phi = NULL;
   if (sigma > 0.0) {
-    if (!(phi = malloc((size_t)w * (size_t)h * sizeof *phi))) {
-      lw_error_set(err, LW_ENOMEM, "out of memory for a potential of %d x %d pixels", w, h);
+    if (!(phi = malloc((size_t)pw * (size_t)ph * sizeof *phi))) {
+      lw_error_set(err, LW_ENOMEM, "out of memory for a potential of %d x %d pixels", pw, ph);
       lw_grid2d_free(g);
       return NULL;
     }
-    for (size_t k = 0; k < (size_t)w * (size_t)h; k++)
-      phi[k] = (float)(power == 1.0 ? img->tone[k] : pow(img->tone[k], power));
-    if (lw_image_blur_plane(phi, w, h, sigma, err)) {
+    for (int j = 0; j < ph; j++)
+      for (int i = 0; i < pw; i++) {
+        const int x = i - m, y = j - m;
+        const float t = x >= 0 && x < w && y >= 0 && y < h ? img->tone[(size_t)y * (size_t)w + (size_t)x] : 1.0f;
+        phi[(size_t)j * (size_t)pw + (size_t)i] = (float)(power == 1.0 ? t : pow(t, power));
+      }
+    if (lw_image_blur_plane(phi, pw, ph, sigma, err)) {
       free(phi);
       lw_grid2d_free(g);
       return NULL;
@@ -32,9 +48,9 @@ lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl
     for (int i = 0; i < W; i++) {
       const int inner = i >= 1 && i <= w && j >= 1 && j <= h;
       double v = 1.0;
-      if (phi) { /* the ring continues the edge, as the blur read it: no step there */
-        const int ii = i < 1 ? 0 : (i > w ? w - 1 : i - 1), jj = j < 1 ? 0 : (j > h ? h - 1 : j - 1);
-        v = phi[(size_t)jj * (size_t)w + (size_t)ii];
+      if (phi) {
+        const int ii = i < 1 ? 0 : (i > pw ? pw - 1 : i - 1), jj = j < 1 ? 0 : (j > ph ? ph - 1 : j - 1);
+        v = phi[(size_t)jj * (size_t)pw + (size_t)ii];
       } else if (inner) {
         const float t = img->tone[(size_t)(j - 1) * (size_t)w + (size_t)(i - 1)];
         v = power == 1.0 ? t : pow(t, power);

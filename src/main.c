@@ -13,6 +13,7 @@
 #include <omp.h>
 #include <pthread.h>
 #include <signal.h>
+#include <sys/ioctl.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <stdatomic.h>
@@ -482,8 +483,21 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
     progress_state(a, 4, state, sizeof state);
     char rest[32] = "-"; /* unknown before a sweep has taken its time */
     if (done > 0 || a->sweep >= a->end_sweep) snprintf(rest, sizeof rest, "%.0fs", left);
-    fprintf(stderr, "\r[%.*s%*s] sweep %ld/%ld  %s  left %s ", fill, "########################", width - fill, "",
-            a->sweep, a->end_sweep, state, rest);
+    char line[320];
+    int bar = snprintf(line, sizeof line, "[%.*s%*s] ", fill, "########################", width - fill, "");
+    int len = bar + snprintf(line + bar, sizeof line - (size_t)bar, "sweep %ld/%ld  %s  left %s ", a->sweep,
+                             a->end_sweep, state, rest);
+    /* a line longer than the terminal wraps, and each redraw then starts a
+    ** new one: the bar goes first, then the end of the line */
+    struct winsize ws;
+    int cols = ioctl(2, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 ? ws.ws_col : 80;
+    const char *shown_from = line;
+    if (len > cols - 1) shown_from += bar, len -= bar;
+    if (len > cols - 1) len = cols - 1 > 0 ? cols - 1 : 0;
+    /* spaces over what a longer line before left */
+    static int shown_len;
+    fprintf(stderr, "\r%.*s%*s", len, shown_from, shown_len > len ? shown_len - len : 0, "");
+    shown_len = len;
     if (final) fputc('\n', stderr);
   } else if ((final && a->sweep != pg->last_plain) || a->sweep >= pg->next_plain) {
     pg->last_plain = a->sweep;

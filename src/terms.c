@@ -5,6 +5,7 @@
 */
 #include "linewise/terms.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -20,8 +21,11 @@ double lw_term_bending(const lw_samples *s, const lw_quad *q)
   for (int i = 0; i < s->n; i++) {
     double sp2 = s->speed[i] * s->speed[i];
     if (sp2 == 0.0) continue; /* r' = 0: numerator is 0 too; a point does not bend */
-    double cross = s->dx[i] * s->ddy[i] - s->ddx[i] * s->dy[i];
-    sum += q->w[i] * cross * cross / (sp2 * sp2 * s->speed[i]);
+    double cross = s->dx[i] * s->ddy[i] - s->ddx[i] * s->dy[i], den = sp2 * sp2 * s->speed[i];
+    /* |r'|^5 underflows on a segment of 1e-65 mm, where cross / |r'|^2 does
+    ** not: the straight one's bending was 0 / 0 */
+    if (den >= DBL_MIN) sum += q->w[i] * cross * cross / den;
+    else if (cross != 0.0) sum += q->w[i] * (cross / sp2) * (cross / sp2) / s->speed[i];
   }
   return sum;
 }
@@ -172,6 +176,7 @@ static void grad_bending(const lw_samples *s, const lw_term_ctx *ctx, lw_samples
     double sp2 = s->speed[i] * s->speed[i];
     if (sp2 == 0.0) continue;
     double c = s->dx[i] * s->ddy[i] - s->ddx[i] * s->dy[i];
+    if (c == 0.0) continue; /* straight: no gradient, also where s^-5 overflows (0 inf) */
     double inv5 = 1.0 / (sp2 * sp2 * s->speed[i]);
     double a = ctx->coef * q->w[i] * 2.0 * c * inv5;            /* dE/dc */
     double b = -ctx->coef * q->w[i] * 5.0 * c * c * inv5 / sp2; /* dE/dr' = b r' through s^-5 */

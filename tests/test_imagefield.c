@@ -153,9 +153,12 @@ Test(imagefield, a_blurred_potential_spreads_phi_and_keeps_its_sum)
 {
   /* scene.potential_blur: one white pixel on black, power 8, blurred by 2
   ** pixels: Phi (not the tone, whose eighth power would all but vanish)
-  ** spreads as a Gaussian of 2 pixels, 1 / (2 pi 4) at its centre, its sum
-  ** kept and the same at equal distances; beyond the picture it continues
-  ** the edge (black here), where unblurred it is white. */
+  ** spreads as a Gaussian of 2 pixels, 1 / (2 pi 4) at its centre, the same
+  ** at equal distances.  The picture is blurred on its white paper: the
+  ** darkness 1 - Phi summed over it and the paper around keeps its 440
+  ** pixels, Phi rises across the edge without a step (the blurred step's
+  ** values either side of it sum to 1) and is white from 4 sigma on.  It
+  ** continued the black edge, and lines beyond a dark edge cost nothing. */
   lw_image *img = lw_image_new(21, 21, 0, NULL);
   for (int k = 0; k < 21 * 21; k++) img->tone[k] = 0.0f;
   img->tone[10 * 21 + 10] = 1.0f;
@@ -163,16 +166,21 @@ Test(imagefield, a_blurred_potential_spreads_phi_and_keeps_its_sum)
   lw_potential f = {.kind = LW_POTENTIAL_GRID};
   f.grid = lw_imagefield_potential(img, &pl, 8.0, 2.0, NULL);
   cr_assert_not_null(f.grid);
-  double sum = 0.0;
-  for (int j = 0; j < 21; j++)
-    for (int i = 0; i < 21; i++) sum += lw_potential_eval(&f, i + 0.5, j + 0.5);
+  double dark = 0.0;
+  for (int j = -12; j < 33; j++)
+    for (int i = -12; i < 33; i++) dark += 1.0 - lw_potential_eval(&f, i + 0.5, j + 0.5);
   const double centre = lw_potential_eval(&f, 10.5, 10.5);
-  cr_assert(fabs(sum - 1.0) < 1e-5, "sum %.9g", sum);
+  cr_assert(fabs(dark - 440.0) < 1e-3, "darkness %.9g", dark);
   cr_assert(fabs(centre - 1.0 / (8.0 * M_PI)) < 2e-3, "centre %.9g", centre);
   cr_assert(fabs(lw_potential_eval(&f, 12.5, 10.5) - lw_potential_eval(&f, 10.5, 8.5)) < 1e-7);
   cr_assert(lw_potential_eval(&f, 12.5, 10.5) < centre && lw_potential_eval(&f, 12.5, 10.5) > 0.1 * centre);
-  cr_assert(lw_potential_eval(&f, -5, 3) < 1e-6 && lw_potential_eval(&f, -0.5, 10.5) == lw_potential_eval(&f, 0.5, 10.5),
-            "beyond the picture: %g", lw_potential_eval(&f, -5, 3));
+  cr_assert(fabs(lw_potential_eval(&f, 0.5, 10.5) + lw_potential_eval(&f, -0.5, 10.5) - 1.0) < 1e-5 &&
+            lw_potential_eval(&f, 0.5, 10.5) < 0.5, "across the edge: %g and %g", lw_potential_eval(&f, 0.5, 10.5),
+            lw_potential_eval(&f, -0.5, 10.5));
+  for (double x = 0.5; x > -7.0; x -= 1.0)
+    cr_assert(lw_potential_eval(&f, x - 1.0, 10.5) > lw_potential_eval(&f, x, 10.5), "rises beyond x = %g", x);
+  cr_assert(fabs(lw_potential_eval(&f, -8.5, 10.5) - 1.0) < 1e-6 && fabs(lw_potential_eval(&f, -50, 3) - 1.0) < 1e-6 &&
+            fabs(lw_potential_eval(&f, 40, 60) - 1.0) < 1e-6, "beyond the picture: %g", lw_potential_eval(&f, -50, 3));
   lw_potential_clear(&f);
   lw_image_free(img);
 }

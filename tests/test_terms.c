@@ -67,6 +67,38 @@ static void wiggly(lw_splines *sp, size_t i, gsl_rng *r, double x0, double y0)
   sp->rest_length[i] = 6.0 * n;
 }
 
+/* A segment of 1e-65 mm: |r'|^5 underflows to 0 (and cross^2 with it on a
+** straight one, which gave 0 / 0 = NaN and a refusal naming coordinates
+** too large).  Bending goes as 1 / scale: a bent segment scaled down keeps
+** bending x scale, a straight one bends 0. */
+Test(terms, a_tiny_segment_bends_as_its_scale_says)
+{
+  lw_quad q;
+  lw_quad_init(&q, 8, NULL);
+  lw_splines *sp = splines(1, 1);
+  lw_test_straight(sp, 0, 0.3, 0.1, 10.3, 4.1);
+  sp->node[1].vx += 1.5; /* bent */
+  sp->node[0].vy -= 2.0;
+  lw_samples s;
+  samples_of(&q, sp, 0, &s);
+  const double b1 = lw_term_bending(&s, &q);
+  cr_assert(b1 > 0.0 && isfinite(b1));
+  for (double k = 1e-60; k > 1e-70; k *= 0.1) {
+    lw_splines *t = splines(1, 1);
+    for (int n = 0; n < 2; n++) {
+      t->node[n] = sp->node[n];
+      t->node[n].px *= k, t->node[n].py *= k, t->node[n].vx *= k, t->node[n].vy *= k;
+    }
+    samples_of(&q, t, 0, &s);
+    cr_assert(fabs(lw_term_bending(&s, &q) * k / b1 - 1.0) < 1e-9, "scale %g: %g", k, lw_term_bending(&s, &q) * k);
+    lw_test_straight(t, 0, 0.3 * k, 0.1 * k, 10.3 * k, 0.1 * k); /* level: its cross is 0 exactly */
+    samples_of(&q, t, 0, &s);
+    cr_assert(lw_term_bending(&s, &q) == 0.0, "scale %g: straight bends %g", k, lw_term_bending(&s, &q));
+    lw_splines_free(t);
+  }
+  lw_splines_free(sp);
+}
+
 Test(terms, straight_length_exact_and_bending_zero)
 {
   lw_quad q;

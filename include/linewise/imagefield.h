@@ -6,7 +6,8 @@
 ** Potential: Phi = tone at the pixel centres (0 black .. 1 white, so dark
 ** is low and attracts lines when Q > 0), with one ring of white (1) around
 ** the picture: outside it the paper is white and lookups, which clamp to
-** the grid's edge, read 1.
+** the grid's edge, read 1 (blurred, the paper around the picture is white
+** as the blur reaches it).
 **
 ** Gradient g = grad tone by the Sobel operator (3 x 3, the picture's edge
 ** pixels repeated beyond it), pointing toward lighter tone.
@@ -44,10 +45,10 @@ extern "C" {
 #endif
 
 /* The potential of scene.potential = image: Phi = tone^power at the pixel
-** centres, white beyond the picture; or (sigma > 0) blurred by a Gaussian
-** of sigma pixels, which reads the picture's edge pixels beyond it, and
-** continued beyond it as the blur read it, so that no step at the edge
-** lies between two quadrature nodes. */
+** centres, white beyond the picture; or (sigma > 0) the picture on white
+** paper blurred by a Gaussian of sigma pixels, the grid reaching as far as
+** the blur does (4 sigma, at most 256 pixels), so that Phi rises to white
+** beyond the picture without a step between two quadrature nodes. */
 lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, double sigma,
                                    lw_error *err);
 
