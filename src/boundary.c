@@ -398,7 +398,8 @@ int lw_boundary_curve_clear(const lw_boundary *b, const double x[4], const doubl
     bezier_piece lo, hi;
     split_half(&p, &lo, &hi);
     if (!CLEAR_OK(lw_boundary_distance(b, lo.x[3], lo.y[3]))) return 0;
-    if (r < CLEAR_TOL || top + 2 > CLEAR_DEPTH + 2) continue;
+    if (r < CLEAR_TOL) continue;
+    if (top + 2 > CLEAR_DEPTH + 2) return 0; /* deeper than a curve within 1e15 mm needs: refused, never passed */
     stack[top++] = hi;
     stack[top++] = lo;
   }
