@@ -22,6 +22,7 @@
 
 #include "linewise/checkpoint.h"
 #include "linewise/domains.h"
+#include "linewise/driver.h"
 #include "linewise/init.h"
 #include "linewise/json.h"
 #include "linewise/number.h"
@@ -234,7 +235,7 @@ double lw_anneal_energy(const lw_anneal *a) { return rung_energy(a, 0); }
 static lw_status setup_schedule(lw_anneal *a, lw_error *err)
 {
   const lw_params *p = &a->params;
-  if (p->driver == LW_DRIVER_DYNAMICS) return LW_OK;
+  if (lw_driver_is_motion(p)) return LW_OK;
   const lw_param_def *d = lw_params_find("anneal", "schedule");
   char where[LW_PATH_MAX + 32];
   lw_params_origin(p, d, where, sizeof where);
@@ -394,7 +395,7 @@ static int parse_ladder(const lw_params *p, const char *text, const char *where,
 static lw_status read_ladder_file(lw_anneal *a, lw_error *err)
 {
   lw_params *p = &a->params;
-  if (!p->ladder_file[0] || p->driver == LW_DRIVER_DYNAMICS) return LW_OK;
+  if (!p->ladder_file[0] || lw_driver_is_motion(p)) return LW_OK;
   const lw_param_def *dl = lw_params_find("tempering", "ladder");
   char where[LW_PATH_MAX + 32], other[LW_PATH_MAX + 32];
   if (lw_params_given(p, dl)) {
@@ -443,7 +444,7 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
   a->n_rep = p->replicas;
   /* the dynamics moves one system: a scene's ladder is for Monte Carlo
   ** (lw_anneal_check_keys notes it) */
-  if (p->driver == LW_DRIVER_DYNAMICS) a->n_rep = 1;
+  if (lw_driver_is_motion(p)) a->n_rep = 1;
   else if (p->ladder[0]) {
     lw_params_origin(p, lw_params_find("tempering", "ladder"), where, sizeof where);
     int n = parse_ladder(p, p->ladder, where, ladder, err);
@@ -456,7 +457,7 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
                           where, p->t_min, p->t_max);
     lw_tempering_geometric(ladder, a->n_rep, p->t_min, p->t_max);
   }
-  if (a->net && a->n_rep < a->net->size && p->driver == LW_DRIVER_DYNAMICS) {
+  if (a->net && a->n_rep < a->net->size && lw_driver_is_motion(p)) {
     /* its replicas key is idle (one system): not the key to change */
     lw_params_origin(p, lw_params_find("scene", "driver"), where, sizeof where);
     return lw_error_set(err, LW_EINPUT, "%s: key 'scene.driver': dynamics moves one system, which one process "
@@ -474,53 +475,49 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
   return LW_OK;
 }
 
-/* What each driver reads of a scene besides its system's keys (system.h,
-** keys): the same run keys for both; Monte Carlo its schedule, its ladder,
-** its tuning and its recomputations from scratch; the dynamics its time
-** step, damping and density (rho = 0: the massless flow, dynamics.c). */
-#define RUN_KEYS "scene.system", "scene.driver", "anneal.sweeps", "anneal.seed", "anneal.seed_version", \
-    "anneal.quench", "anneal.quench_tol", "anneal.quench_iterations", "anneal.quench_stall", \
-    "output.checkpoint_every", "output.trace_every", "output.observables", "output.samples_every", \
-    "output.stats_from", "output.frames_every"
-static const char *const metropolis_keys[] = {RUN_KEYS, "anneal.schedule", "anneal.t_start", "anneal.t_end",
-                                              "anneal.steps", "anneal.lambda", "anneal.table", "anneal.check_every",
-                                              "tempering.*", "moves.tune_sweeps", NULL};
-static const char *const dynamics_keys[] = {RUN_KEYS, "dynamics.rho", "dynamics.dt", "dynamics.gamma",
-                                            "dynamics.steps_per_sweep", "dynamics.integrator", NULL};
-static const char *const driver_names[] = {"metropolis", "dynamics"};
-
-/* Whether a scene of system t under driver (LW_DRIVER_*) reads key d: a
-** key the row names for one driver is read under that driver only, though
-** its `keys` name it too (a section's wildcard). */
-static int key_read(const lw_system_type *t, int driver, const lw_param_def *d)
+/* Whether a scene of system t under driver v reads key d: a key the row
+** names for one kind of driver is read under that kind only, though its
+** `keys` name it too (a section's wildcard). */
+static int key_read(const lw_system_type *t, const lw_driver_type *v, const lw_param_def *d)
 {
-  if (lw_params_named(driver == LW_DRIVER_DYNAMICS ? dynamics_keys : metropolis_keys, d)) return 1;
-  if (lw_params_named(t->keys_dynamics, d)) return driver == LW_DRIVER_DYNAMICS;
-  if (lw_params_named(t->keys_metropolis, d)) return driver == LW_DRIVER_METROPOLIS;
+  if (lw_params_named(v->keys, d)) return 1;
+  if (lw_params_named(t->keys_dynamics, d)) return v->kind == LW_DRIVE_MOTION;
+  if (lw_params_named(t->keys_metropolis, d)) return v->kind == LW_DRIVE_CHAIN;
   return lw_params_named(t->keys, d);
 }
 
 void lw_anneal_key_readers(const lw_param_def *d, char *buf, size_t n)
 {
-  char sys[2][128] = {"", ""};
-  int all[2] = {1, 1};
-  for (int v = 0; v < 2; v++)
+  enum { DRIVERS_MAX = 8 };
+  char sys[DRIVERS_MAX][128];
+  int v = 0, same = 1;
+  for (; lw_driver_types[v] && v < DRIVERS_MAX; v++) {
+    int all = 1;
+    sys[v][0] = '\0';
     for (int k = 0; lw_system_types[k]; k++) {
       const lw_system_type *t = lw_system_types[k];
       size_t m = strlen(sys[v]);
-      if (key_read(t, v, d)) snprintf(sys[v] + m, sizeof sys[v] - m, "%s%s", m ? ", " : "", t->name);
-      else all[v] = 0;
+      if (key_read(t, lw_driver_types[v], d)) snprintf(sys[v] + m, sizeof sys[v] - m, "%s%s", m ? ", " : "", t->name);
+      else all = 0;
     }
-  for (int v = 0; v < 2; v++)
-    if (all[v]) snprintf(sys[v], sizeof sys[v], "all");
-  if (!strcmp(sys[0], sys[1])) snprintf(buf, n, "%s", sys[0]);
-  else if (!sys[0][0] || !sys[1][0]) snprintf(buf, n, "%s under %s", sys[!sys[0][0]], driver_names[!sys[0][0]]);
-  else snprintf(buf, n, "%s under %s; %s under %s", sys[0], driver_names[0], sys[1], driver_names[1]);
+    if (all) snprintf(sys[v], sizeof sys[v], "all");
+    same &= !strcmp(sys[v], sys[0]);
+  }
+  if (same) {
+    snprintf(buf, n, "%s", sys[0]);
+    return;
+  }
+  size_t m = 0;
+  if (n) buf[0] = '\0';
+  for (int k = 0; k < v && m < n; k++)
+    if (sys[k][0])
+      m += (size_t)snprintf(buf + m, n - m, "%s%s under %s", m ? "; " : "", sys[k], lw_driver_types[k]->name);
 }
 
 const char *lw_anneal_key_values(const lw_param_def *d)
 {
   if (!strcmp(d->section, "scene") && !strcmp(d->key, "system")) return lw_system_names();
+  if (!strcmp(d->section, "scene") && !strcmp(d->key, "driver")) return lw_driver_names();
   if (!strcmp(d->section, "anneal") && !strcmp(d->key, "schedule")) return lw_schedule_names();
   if (!strcmp(d->section, "anneal") && !strcmp(d->key, "domains")) return "off|1 to 64|auto";
   return NULL;
@@ -529,21 +526,24 @@ const char *lw_anneal_key_values(const lw_param_def *d)
 lw_status lw_anneal_check_keys(const lw_params *p, char *unread, size_t size, lw_error *err)
 {
   const lw_system_type *t = lw_system_of(p, err);
-  if (!t) return err->code;
+  const lw_driver_type *v = t ? lw_driver_of(p, err) : NULL;
+  if (!v) return err->code;
   size_t m = 0;
   if (size) unread[0] = '\0';
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
-    if (!lw_params_given(p, d) || key_read(t, p->driver, d)) continue;
+    if (!lw_params_given(p, d) || key_read(t, v, d)) continue;
     char where[LW_PATH_MAX + 32], readers[300];
     lw_params_origin(p, d, where, sizeof where);
-    if (key_read(t, !p->driver, d)) {
+    int elsewhere = 0; /* read under another driver */
+    for (int k = 0; lw_driver_types[k]; k++) elsewhere |= key_read(t, lw_driver_types[k], d);
+    if (elsewhere) {
       if (m < size)
         m += (size_t)snprintf(unread + m, size - m, "%s%s.%s (%s)", m ? ", " : "", d->section, d->key, where);
       continue;
     }
     lw_anneal_key_readers(d, readers, sizeof readers);
-    return lw_error_set(err, LW_EINPUT, "%s: key '%s.%s': the %s system reads it under neither driver (read by: "
+    return lw_error_set(err, LW_EINPUT, "%s: key '%s.%s': the %s system reads it under no driver (read by: "
                         "%s); expected no line, or the default '%s'", where, d->section, d->key, t->name, readers,
                         d->def);
   }
@@ -560,7 +560,7 @@ static void schedule_note(const lw_anneal *a, char *buf, size_t n)
   const lw_params *p = &a->params;
   const lw_schedule *s = &a->sched;
   buf[0] = '\0';
-  if (!a->sched_type || p->driver == LW_DRIVER_DYNAMICS || p->sweeps <= 0) return;
+  if (!a->sched_type || lw_driver_is_motion(p) || p->sweeps <= 0) return;
   const unsigned needs = a->sched_type->needs;
   const int table = s->n_table > 0, ends = (needs & LW_SCHEDULE_USES_END) || table;
   const long last = block_of(a, p->sweeps - 1);
@@ -639,7 +639,7 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
       {ladder, a->n_rep == 1, "one replica"},
       {ends, a->n_rep > 1 && p->ladder[0], "tempering.ladder names the temperatures"},
       /* (a seed sweep of the whip gave identical "independent" runs) */
-      {seed, p->driver == LW_DRIVER_DYNAMICS && p->from[0], "the dynamics from init.from draws no random number"},
+      {seed, lw_driver_is_motion(p) && p->from[0], "the dynamics from init.from draws no random number"},
       {gravity, p->dyn_rho == 0.0, "dynamics.rho = 0: no mass to weigh"},
       /* (a bed too small for the page passed unchecked, without a word) */
       {machine, !p->hpgl && !p->gcode, "neither output.hpgl nor output.gcode"},
@@ -824,7 +824,8 @@ static lw_status build(lw_anneal *a, void **states, const double *ladder, lw_err
     a->chains[k] = lw_chain_new(a->systems[k], weight, step, target, rung_stream(a, k), err);
     if (!a->chains[k]) return err->code;
     a->chains[k]->delayed = p->delayed_acceptance; /* before the domains copy the chain */
-    if (p->driver != LW_DRIVER_DYNAMICS && lw_domains_attach(a->chains[k], p, n, err)) return err->code;
+    a->chains[k]->accept = lw_driver_find(p->driver)->accept;
+    if (!lw_driver_is_motion(p) && lw_domains_attach(a->chains[k], p, n, err)) return err->code;
   }
   a->chain = a->chains[0];
   a->sys = a->systems[0];
@@ -832,7 +833,7 @@ static lw_status build(lw_anneal *a, void **states, const double *ladder, lw_err
     a->pt = lw_tempering_new(n, ladder, stream_seed(a, 2), err);
     if (!a->pt) return err->code;
   }
-  if (p->driver == LW_DRIVER_DYNAMICS && !(a->dyn = lw_dynamics_new(t, a->sys->state, p, err))) return err->code;
+  if (lw_driver_is_motion(p) && !(a->dyn = lw_dynamics_new(t, a->sys->state, p, err))) return err->code;
   return LW_OK;
 }
 
@@ -1864,7 +1865,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
     else lw_json_null(&j);
     lw_json_key(&j, "schedule"); lw_json_string(&j, a->sched_type->name);
   }
-  lw_json_key(&j, "driver"); lw_json_string(&j, a->dyn ? "dynamics" : "metropolis");
+  lw_json_key(&j, "driver"); lw_json_string(&j, a->params.driver);
   if (a->dyn) {
     lw_dynamics *d = a->dyn;
     lw_json_key(&j, "dynamics");

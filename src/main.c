@@ -976,7 +976,7 @@ static int cmd_run(int argc, char **argv)
     if (note[0]) fprintf(stderr, "linewise: note: %s\n", note);
     if (a.unread[0])
       fprintf(stderr, "linewise: note: under driver = %s these keys have no effect: %s\n",
-              a.params.driver == LW_DRIVER_DYNAMICS ? "dynamics" : "metropolis", a.unread);
+              a.params.driver, a.unread);
     if (a.idle[0]) fprintf(stderr, "linewise: note: these keys have no effect here: %s\n", a.idle);
     if (a.schedule_note[0]) fprintf(stderr, "linewise: note: %s\n", a.schedule_note);
     fprintf(stderr, "linewise: scene %s, seed %lu, %s, into %s\n", scene, a.seed, size, dir);

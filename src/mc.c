@@ -103,6 +103,11 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
   } else if (forbidden) {
     s->irregular++;
     accept = 0;
+  } else if (c->accept) {
+    /* the driver's own rule (driver.h): one draw a decision at T > 0 */
+    if (isnan(lr) || lr == -INFINITY || dE == INFINITY) accept = 0;
+    else if (c->temperature > 0.0) accept = gsl_rng_uniform(c->rng) < c->accept(lr - dE / c->temperature);
+    else accept = dE < 0.0 || (dE == 0.0 && lr >= 0.0);
   } else if (lr != 0.0) {
     /* Metropolis-Hastings in logs, so that no ratio of densities over- or
     ** underflows: accept if log u < lr - dE / T (docs/NUMERICS.md) */
@@ -152,7 +157,8 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
 ** chain decides on the sign of the whole dE. */
 static void stage(lw_chain *c)
 {
-  if (c->sys->type->defer) c->sys->type->defer(c->prop, c->delayed && c->temperature > 0.0);
+  /* (the second stage is Metropolis's: not under another rule) */
+  if (c->sys->type->defer) c->sys->type->defer(c->prop, c->delayed && !c->accept && c->temperature > 0.0);
 }
 
 int lw_chain_step(lw_chain *c, int kind)

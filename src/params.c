@@ -18,6 +18,7 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 
+#include "linewise/driver.h"
 #include "linewise/image.h"
 #include "linewise/number.h"
 #include "linewise/output.h"
@@ -44,7 +45,7 @@ const lw_param_def lw_param_table[] = {
          "(oriented particles in 3-D, set up by the [particles] section; README, "
          "\"Oriented particles\") or `nurbs` (one D-NURBS curve, the [nurbs] section; "
          "docs/NURBS.md). docs/SYSTEMS.md."),
-  CHOICE("scene", "driver", driver, "metropolis", "metropolis|dynamics",
+  STRING("scene", "driver", driver, "metropolis", "",
          "What moves the system: `metropolis` anneals it by Monte Carlo (the [anneal] schedule, "
          "[tempering] with replicas); `dynamics` integrates its Lagrangian equations of motion "
          "(the [dynamics] section; docs/NUMERICS.md, \"Dynamics\"): a sweep is then "
@@ -1469,7 +1470,7 @@ static void apply_preset(lw_params *p)
   int n = (int)floor((fmin(p->width, p->height) - 2.0 * p->margin) / (90.0 * w));
   snprintf(text, sizeof text, "%d", n < 1 ? 1 : (n > 64 ? 64 : n));
   /* (the dynamics has no sweeps to split) */
-  if (p->driver != LW_DRIVER_DYNAMICS) preset_key(p, "anneal", "domains", n < 2 ? "off" : text);
+  if (!lw_driver_is_motion(p)) preset_key(p, "anneal", "domains", n < 2 ? "off" : text);
 }
 
 /* Where a key's value came from: the file and line, --set, or the file's
@@ -1546,6 +1547,8 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
   /* a scene.ini that a run wrote before the key was one runs again as that
   ** run did (the hash of a resume's leaves the missing key out) */
   if (p->run_header && !p->line[lw_params_find("anneal", "seed_version") - lw_param_table]) p->seed_version = 1;
+  /* the driver decides the presets' keys below */
+  if (!lw_driver_of(p, err)) return err->code;
   /* before the page is sized, which the orientation decides */
   if (p->preset == LW_PRESET_PHOTO) preset_key(p, "scene", "orientation", "auto");
   if (p->page != LW_PAGE_CUSTOM) {
@@ -1752,7 +1755,7 @@ int lw_params_file_idle(const lw_params *p, const lw_param_def *d)
   ** the dynamics reads no ladder */
   if (!strcmp(d->section, "tempering") && !strcmp(d->key, "ladder_file")) return 1;
   if (!strcmp(d->section, "anneal") && !strcmp(d->key, "table")) {
-    const lw_schedule_type *t = p->driver == LW_DRIVER_DYNAMICS ? NULL : lw_schedule_find(p->schedule);
+    const lw_schedule_type *t = lw_driver_is_motion(p) ? NULL : lw_schedule_find(p->schedule);
     return !t || !(t->needs & LW_SCHEDULE_USES_TABLE);
   }
   return !strcmp(d->section, "scene") && !strcmp(d->key, "mask_image") && p->mask != LW_MASK_IMAGE;

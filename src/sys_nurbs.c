@@ -17,6 +17,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "linewise/driver.h"
 #include "linewise/number.h"
 #include "linewise/output.h"
 #include "linewise/spline.h"
@@ -1175,7 +1176,7 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
                            *const weights[] = {"nurbs.weight_inertia", "nurbs.weight_stiffness", "nurbs.step_weight",
                                                NULL};
   /* (a seed sweep of the wire: identical runs, which stats took for agreeing seeds) */
-  rule[0] = (lw_idle_rule){seed, p->driver == LW_DRIVER_DYNAMICS && !p->from[0],
+  rule[0] = (lw_idle_rule){seed, lw_driver_is_motion(p) && !p->from[0],
                            "the D-NURBS dynamics draws no random number"};
   rule[1] = (lw_idle_rule){inline_points, p->nb_file[0] != '\0', "nurbs.file gives the points and weights"};
   rule[2] = (lw_idle_rule){weights, !p->nb_free_weights, "nurbs.free_weights = 0"};

@@ -13,6 +13,7 @@
 
 #include "linewise/checkpoint.h"
 #include "linewise/drawing.h"
+#include "linewise/driver.h"
 #include "linewise/fieldview.h"
 #include "linewise/gradient.h"
 #include "linewise/hilbert.h"
@@ -84,7 +85,7 @@ static void setup_free(void *setup)
 static void long_splines_note(const lw_params *p, char *note, size_t n)
 {
   const double rigid = p->mix_translate + p->mix_rotate, all = rigid + p->mix_point + p->mix_vector;
-  if (p->driver != LW_DRIVER_METROPOLIS || p->from[0] || p->sweeps <= 0 || !(rigid > 0.0) ||
+  if (lw_driver_is_motion(p) || p->from[0] || p->sweeps <= 0 || !(rigid > 0.0) ||
       rigid / all * p->segments < 18.0)
     return;
   size_t used = strlen(note);

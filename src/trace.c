@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/driver.h"
 #include "linewise/number.h"
 #include "linewise/series.h"
 
@@ -178,7 +179,7 @@ static int column_mixed(const lw_trace *const *t, size_t *const *row, const size
 void lw_trace_select_of(const lw_params *p, lw_trace_select *sel)
 {
   if (sel->from < 0 && p->stats_from > 0) sel->from = p->stats_from;
-  if (p->driver != LW_DRIVER_METROPOLIS) return; /* the dynamics tunes nothing */
+  if (lw_driver_is_motion(p)) return; /* the dynamics tunes nothing */
   if (p->replicas > 1 && p->tune_ladder == LW_LADDER_EQUAL) sel->ladder = p->ladder_sweeps;
   sel->tune = p->tune_sweeps;
   sel->steps = p->steps;

@@ -381,7 +381,7 @@ Test(cli, every_simd_width_writes_the_same_files)
                  0, "%s", lanes[k]);
 }
 
-/* A key the scene's system reads under neither driver is refused before
+/* A key the scene's system reads under no driver is refused before
 ** anything is written, naming where it was set and who reads it; the
 ** default, named, is not; a key only the other driver reads is noted and the
 ** run goes on (one scene file may serve both drivers). */
@@ -390,12 +390,12 @@ Test(cli, keys_the_system_never_reads_are_refused)
   char out[4096], errs[8192], args[512];
   static const struct { const char *scene, *set, *want; } bad[] = {
     {"particles-sheet", "energy.bending=5",
-     "--set: key 'energy.bending': the particles system reads it under neither driver (read by: splines); "
+     "--set: key 'energy.bending': the particles system reads it under no driver (read by: splines); "
      "expected no line, or the default '0'"},
-    {"wire", "output.pdf=1", "key 'output.pdf': the nurbs system reads it under neither driver (read by: splines)"},
-    {"wire", "dynamics.pin=ends", "key 'dynamics.pin': the nurbs system reads it under neither driver (read by: "
+    {"wire", "output.pdf=1", "key 'output.pdf': the nurbs system reads it under no driver (read by: splines)"},
+    {"wire", "dynamics.pin=ends", "key 'dynamics.pin': the nurbs system reads it under no driver (read by: "
      "splines under dynamics)"},
-    {"example", "particles.r0=2", "key 'particles.r0': the splines system reads it under neither driver (read by: "
+    {"example", "particles.r0=2", "key 'particles.r0': the splines system reads it under no driver (read by: "
      "particles)"},
     {"lj13", "scene.preset=photo", "key 'scene.preset': the particles system"},
   };
@@ -419,7 +419,7 @@ Test(cli, keys_the_system_never_reads_are_refused)
   /* energy --set of a key the run's system never reads measures nothing */
   snprintf(args, sizeof args, "energy %s/p --set energy.quadrature=32", dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
-  cr_assert(strstr(errs, "--set: key 'energy.quadrature': the particles system reads it under neither driver"), "%s",
+  cr_assert(strstr(errs, "--set: key 'energy.quadrature': the particles system reads it under no driver"), "%s",
             errs);
   snprintf(args, sizeof args, "energy %s/p --set particles.r0=1.1", dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);

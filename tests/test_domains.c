@@ -241,7 +241,7 @@ Test(domains, bad_values_are_refused_naming_the_key)
   refused(dir, "params/minimal.ini --set init.splines=60", "3", "leave most of the state unmoved");
   /* a system whose row cannot split (the NURBS curve under Monte Carlo):
   ** refused, not run serially behind the user's back */
-  refused(dir, "params/wire.ini --set scene.driver=metropolis", "2", "the nurbs system reads it under neither driver");
+  refused(dir, "params/wire.ini --set scene.driver=metropolis", "2", "the nurbs system reads it under no driver");
   lw_test_dir_remove(dir);
 }
 

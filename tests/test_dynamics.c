@@ -186,7 +186,7 @@ static void rig_open(rig *r, int n_seg, double strain, double bending, double po
   r->p.strain = strain;
   r->p.bending = bending;
   r->p.potential_coef = potential;
-  r->p.driver = LW_DRIVER_DYNAMICS;
+  snprintf(r->p.driver, sizeof r->p.driver, "dynamics");
   /* The handle lengths are free of every other term: without this one the
   ** tangential modes gather energy until a segment nearly stops, where the
   ** quadrature loses the bending (the regularity walls then refuse it). */

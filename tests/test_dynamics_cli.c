@@ -94,7 +94,7 @@ Test(dynamics_cli, scenes_the_driver_cannot_move_are_refused_with_the_key)
     {"--set energy.quadrature=3", "at least 4 quadrature nodes"},
     {"--set dynamics.dt=0", "dynamics.dt"},
     {"--set dynamics.pin=both", "dynamics.pin"},
-    {"--set dynamics.dashpot=1", "key 'dynamics.dashpot': the splines system reads it under neither driver (read by: "
+    {"--set dynamics.dashpot=1", "key 'dynamics.dashpot': the splines system reads it under no driver (read by: "
      "particles under dynamics)"},
     {"--set dynamics.integrator=review", "key 'dynamics.integrator': the review's scheme takes a constant mass matrix "
      "and a quadratic energy (the nurbs system with frozen weights); the splines system's are not"},
@@ -116,9 +116,9 @@ Test(dynamics_cli, scenes_the_driver_cannot_move_are_refused_with_the_key)
   ** particles.gravity and particles.pinned) */
   static const struct { const char *set, *want; } pbad[] = {
     {"--set dynamics.integrator=review", "key 'dynamics.integrator': the review's scheme takes free coordinates"},
-    {"--set dynamics.gravity_y=9810", "key 'dynamics.gravity_y': the particles system reads it under neither driver "
+    {"--set dynamics.gravity_y=9810", "key 'dynamics.gravity_y': the particles system reads it under no driver "
      "(read by: splines, nurbs)"},
-    {"--set dynamics.pin=ends", "key 'dynamics.pin': the particles system reads it under neither driver (read by: "
+    {"--set dynamics.pin=ends", "key 'dynamics.pin': the particles system reads it under no driver (read by: "
      "splines under dynamics)"},
     {"--set dynamics.rho=0 --set dynamics.gamma=1 --set dynamics.dashpot_angular=1",
      "key 'dynamics.dashpot_angular': a massless motion (rho = 0) is damped by gamma alone"},

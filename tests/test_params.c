@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "linewise/anneal.h"
+#include "linewise/driver.h"
 #include "linewise/params.h"
 #include "linewise/rundir.h"
 #include "linewise/scene.h"
@@ -696,16 +697,22 @@ Test(params, every_key_has_a_reader)
   }
 }
 
-/* The help of scene.system and anneal.schedule (linewise params,
-** docs/PARAMETERS.md) names every row and every schedule of the tables, so
-** a new one is not left out of what users read. */
-Test(params, the_help_names_every_system_and_schedule)
+/* The help of scene.system, scene.driver and anneal.schedule (linewise
+** params, docs/PARAMETERS.md) names every row of the tables, so a new one
+** is not left out of what users read. */
+Test(params, the_help_names_every_system_driver_and_schedule)
 {
   const char *sys_help = lw_params_find("scene", "system")->help;
   for (int k = 0; lw_system_types[k]; k++) {
     char quoted[64];
     snprintf(quoted, sizeof quoted, "`%s`", lw_system_types[k]->name);
     cr_assert(strstr(sys_help, quoted), "scene.system's help does not name %s", quoted);
+  }
+  const char *driver_help = lw_params_find("scene", "driver")->help;
+  for (int k = 0; lw_driver_types[k]; k++) {
+    char quoted[64];
+    snprintf(quoted, sizeof quoted, "`%s`", lw_driver_types[k]->name);
+    cr_assert(strstr(driver_help, quoted), "scene.driver's help does not name %s", quoted);
   }
   const char *sched_help = lw_params_find("anneal", "schedule")->help;
   for (int k = 0; lw_schedule_types[k]; k++)
@@ -726,9 +733,9 @@ Test(params, the_doc_lists_the_words_of_table_keys_as_choices)
   cr_assert_eq(fclose(f), 0);
   char words[128], want[256];
   /* the words from the tables themselves: a new row is listed, not a test to edit */
-  const char *tables[2][2] = {{"schedule", "geometric"}, {"system", "splines"}};
-  for (int k = 0; k < 2; k++) {
-    const char *from = k ? lw_system_names() : lw_schedule_names();
+  const char *tables[3][2] = {{"schedule", "geometric"}, {"system", "splines"}, {"driver", "metropolis"}};
+  for (int k = 0; k < 3; k++) {
+    const char *from = k == 2 ? lw_driver_names() : k ? lw_system_names() : lw_schedule_names();
     char *to = words; /* '|' and ", " become '/', as in the doc */
     for (; *from && to < words + sizeof words - 1; from++)
       if (*from == '|' || (*from == ',' && from[1] == ' ' && from++)) *to++ = '/';
@@ -737,7 +744,7 @@ Test(params, the_doc_lists_the_words_of_table_keys_as_choices)
     snprintf(want, sizeof want, "| `%s` | choice | `%s` | - | %s |", tables[k][0], tables[k][1], words);
     cr_assert(strstr(text, want), "no row %s", want);
   }
-  cr_assert(strstr(words, "splines/") && strstr(words, "/nurbs"), "%s", words);
+  cr_assert(strstr(words, "metropolis/dynamics"), "%s", words);
   cr_assert(strstr(text, "| `domains` | choice | `off` | - | off/1 to 64/auto |"));
   free(text);
 }

@@ -244,15 +244,14 @@ static void check_gaussian(const char *what, batch_mean *m1, batch_mean *m2, dou
   }
 }
 
-Test(system, the_chain_samples_a_test_row_exactly)
+/* The chain c at temperature T after 2000 sweeps of burn-in: each x_i /
+** sigma_i and its square in BATCHES batches of 20000 sweeps. */
+static void sample_gaussian(lw_chain *c, double T, batch_mean *m1, batch_mean *m2)
 {
-  const double T = 0.7;
-  lw_chain *c = gauss_chain(T, 2024);
   for (int s = 0; s < 2000; s++) cr_assert_eq(lw_chain_sweep(c), LW_OK);
   const long per = 20000;
-  batch_mean m1[NV], m2[NV];
-  memset(m1, 0, sizeof m1);
-  memset(m2, 0, sizeof m2);
+  memset(m1, 0, NV * sizeof *m1);
+  memset(m2, 0, NV * sizeof *m2);
   for (int i = 0; i < NV; i++) m1[i].per = m2[i].per = per;
   const gs_state *st = c->sys->state;
   for (long s = 0; s < BATCHES * per; s++) {
@@ -263,6 +262,14 @@ Test(system, the_chain_samples_a_test_row_exactly)
       bm_add(&m2[i], z * z);
     }
   }
+}
+
+Test(system, the_chain_samples_a_test_row_exactly)
+{
+  const double T = 0.7;
+  lw_chain *c = gauss_chain(T, 2024);
+  batch_mean m1[NV], m2[NV];
+  sample_gaussian(c, T, m1, m2);
   check_gaussian("chain", m1, m2, T);
   /* both move kinds ran under their names, and the running terms are exact */
   for (int k = 0; k < 2; k++) cr_assert(c->stats[k].accepted > 0 && c->stats[k].accepted < c->stats[k].proposed);
@@ -273,6 +280,32 @@ Test(system, the_chain_samples_a_test_row_exactly)
   double drift = lw_system_drift(run, fresh, 2);
   cr_assert(drift < 1e-9, "running energy drifted by %g", drift);
   gauss_chain_free(c);
+}
+
+/* Barker's rule, e^x / (1 + e^x): detailed balance, as Metropolis's, since
+** its ratio at x and -x is e^x; overflow-free at both ends. */
+static double barker(double x) { return x >= 0.0 ? 1.0 / (1.0 + exp(-x)) : exp(x) / (1.0 + exp(x)); }
+
+/* A chain driver with its own acceptance rule (driver.h, `accept`) samples
+** the test row exactly too: the same batch means as Metropolis (5 standard
+** errors of 50 batches), fewer moves taken (Barker accepts at most as
+** often: e^x / (1 + e^x) <= min(1, e^x)). */
+Test(system, a_chain_under_another_acceptance_rule_samples_a_test_row_exactly)
+{
+  const double T = 0.7;
+  lw_chain *c = gauss_chain(T, 77), *m = gauss_chain(T, 77);
+  c->accept = barker;
+  batch_mean m1[NV], m2[NV];
+  sample_gaussian(c, T, m1, m2);
+  check_gaussian("Barker's chain", m1, m2, T);
+  sample_gaussian(m, T, m1, m2);
+  for (int k = 0; k < 2; k++) {
+    const double rate = (double)c->stats[k].accepted / (double)c->stats[k].proposed,
+                 rate_m = (double)m->stats[k].accepted / (double)m->stats[k].proposed;
+    cr_assert(rate > 0.05 && rate < rate_m, "move %d: Barker took %g of its proposals, Metropolis %g", k, rate, rate_m);
+  }
+  gauss_chain_free(c);
+  gauss_chain_free(m);
 }
 
 /* A proposal a row could not evaluate for want of memory stops the chain

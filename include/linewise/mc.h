@@ -59,6 +59,7 @@ typedef struct {
   int part;                      /* 1 for a domain's chain: commits through commit_part */
   int delayed;                   /* 1 (the default): delayed acceptance where the row offers it
                                  ** (system.h, defer and finish) and T > 0 */
+  double (*accept)(double x);    /* the driver's acceptance rule (driver.h); NULL: Metropolis */
 } lw_chain;
 
 /* A chain on sys with the mix, steps and targets of its n_moves kinds (mix

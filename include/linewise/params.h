@@ -68,7 +68,6 @@ enum { LW_QUENCH_NONE, LW_QUENCH_BFGS };
 enum { LW_PPATTERN_CLOUD, LW_PPATTERN_PLANE, LW_PPATTERN_SPHERE };
 enum { LW_PWEIGHT_POLY, LW_PWEIGHT_GAUSS, LW_PWEIGHT_ANISO };
 enum { LW_PBOUNDARY_NONE, LW_PBOUNDARY_PLANE, LW_PBOUNDARY_SPHERE };
-enum { LW_DRIVER_METROPOLIS, LW_DRIVER_DYNAMICS };
 enum { LW_PRESET_NONE, LW_PRESET_PHOTO };
 enum { LW_PIN_NONE, LW_PIN_ENDS, LW_PIN_FIRST, LW_PIN_LAST };
 enum { LW_INTEGRATOR_LEAPFROG, LW_INTEGRATOR_REVIEW };
@@ -110,7 +109,7 @@ typedef struct {
   double center_x, center_y;  /* centre of radial/vortex presets, mm; -1 = page centre */
   int mask;                   /* LW_MASK_* */
   char mask_image[LW_PATH_MAX]; /* picture of mask = image */
-  int driver;                 /* LW_DRIVER_* */
+  char driver[64];            /* a name from the driver table (driver.h) */
   int preset;                 /* LW_PRESET_*: fills the keys a scene leaves unset */
   /* [init] */
   int splines;                /* number of splines; 0 with coverage > 0: from the coverage */
