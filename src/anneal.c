@@ -481,6 +481,7 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
 static int key_read(const lw_system_type *t, const lw_driver_type *v, const lw_param_def *d)
 {
   if (lw_params_named(v->keys, d)) return 1;
+  if (lw_params_named(v->ignores, d)) return 0;
   if (lw_params_named(t->keys_dynamics, d)) return v->kind == LW_DRIVE_MOTION;
   if (lw_params_named(t->keys_metropolis, d)) return v->kind == LW_DRIVE_CHAIN;
   return lw_params_named(t->keys, d);
@@ -507,11 +508,17 @@ void lw_anneal_key_readers(const lw_param_def *d, char *buf, size_t n)
     snprintf(buf, n, "%s", sys[0]);
     return;
   }
+  /* the drivers that read it from the same systems together: "S under a, b; T under c" */
   size_t m = 0;
   if (n) buf[0] = '\0';
-  for (int k = 0; k < v && m < n; k++)
-    if (sys[k][0])
-      m += (size_t)snprintf(buf + m, n - m, "%s%s under %s", m ? "; " : "", sys[k], lw_driver_types[k]->name);
+  for (int k = 0; k < v && m < n; k++) {
+    int first = 1;
+    for (int j = 0; j < k; j++) first &= strcmp(sys[j], sys[k]) != 0;
+    if (!sys[k][0] || !first) continue;
+    m += (size_t)snprintf(buf + m, n - m, "%s%s under %s", m ? "; " : "", sys[k], lw_driver_types[k]->name);
+    for (int j = k + 1; j < v && m < n; j++)
+      if (!strcmp(sys[j], sys[k])) m += (size_t)snprintf(buf + m, n - m, ", %s", lw_driver_types[j]->name);
+  }
 }
 
 const char *lw_anneal_key_values(const lw_param_def *d)

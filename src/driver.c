@@ -20,10 +20,10 @@ const char *const lw_driver_chain_keys[] = {RUN_KEYS, "anneal.schedule", "anneal
 const char *const lw_driver_motion_keys[] = {RUN_KEYS, "dynamics.rho", "dynamics.dt", "dynamics.gamma",
                                              "dynamics.steps_per_sweep", "dynamics.integrator", NULL};
 
-const lw_driver_type lw_driver_metropolis = {"metropolis", LW_DRIVE_CHAIN, lw_driver_chain_keys, NULL};
-const lw_driver_type lw_driver_dynamics = {"dynamics", LW_DRIVE_MOTION, lw_driver_motion_keys, NULL};
+const lw_driver_type lw_driver_metropolis = {"metropolis", LW_DRIVE_CHAIN, lw_driver_chain_keys, NULL, NULL};
+const lw_driver_type lw_driver_dynamics = {"dynamics", LW_DRIVE_MOTION, lw_driver_motion_keys, NULL, NULL};
 
-const lw_driver_type *const lw_driver_types[] = {&lw_driver_metropolis, &lw_driver_dynamics, NULL};
+const lw_driver_type *const lw_driver_types[] = {&lw_driver_metropolis, &lw_driver_dynamics, &lw_driver_barker, NULL};
 
 const lw_driver_type *lw_driver_find(const char *name)
 {

@@ -47,8 +47,10 @@ const lw_param_def lw_param_table[] = {
          "docs/NURBS.md). docs/SYSTEMS.md."),
   STRING("scene", "driver", driver, "metropolis", "",
          "What moves the system: `metropolis` anneals it by Monte Carlo (the [anneal] schedule, "
-         "[tempering] with replicas); `dynamics` integrates its Lagrangian equations of motion "
-         "(the [dynamics] section; docs/NUMERICS.md, \"Dynamics\"): a sweep is then "
+         "[tempering] with replicas); `barker` is the same chain deciding by Barker's rule, "
+         "e^x / (1 + e^x) with x = -dE / T, instead of min(1, e^x), to compare acceptance rules "
+         "(docs/NUMERICS.md, \"Acceptance rules\"); `dynamics` integrates its Lagrangian equations of "
+         "motion (the [dynamics] section; docs/NUMERICS.md, \"Dynamics\"): a sweep is then "
          "`dynamics.steps_per_sweep` time steps and `anneal.sweeps` counts them."),
   CHOICE("scene", "preset", preset, "none", "none|photo",
          "Settings that fill every key the scene leaves unset: `photo` draws a picture as a "

@@ -1081,6 +1081,52 @@ static void stats_column(const char *csv, const char *name, double *mean, double
   cr_assert_eq(sscanf(p + strlen(key), "%ld,%lf,%lf", &n, mean, se), 3, "%s", p);
 }
 
+/* scene.driver = barker: the Monte Carlo chain deciding by Barker's rule
+** (driver.h).  It reads the chain's keys without a note, names itself in
+** summary.json, takes fewer of its proposals than Metropolis at the same
+** steps and seed (its probability is at most Metropolis's), leaves the same
+** tuning sweeps out of `stats`, and a run stopped and resumed writes the
+** same files as one that never stopped. */
+Test(cli, the_barker_driver_runs_the_chain_by_its_own_rule)
+{
+  const char *b = lw_test_bin(), *root = lw_test_root();
+  const char *common = "--set anneal.sweeps=60 --set anneal.steps=2 --quiet";
+  for (int fixed = 0; fixed < 2; fixed++)
+    for (int k = 0; k < 2; k++)
+      cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini %s %s%s --out %s%d", dir, b, root, common,
+                              k ? "--set scene.driver=barker" : "", fixed ? " --set moves.tune_sweeps=0" : "",
+                              k ? "b" : "m", fixed),
+                   0);
+  cr_assert_eq(lw_test_sh("cd %s && grep -q '\"driver\": \"barker\"' b0/summary.json && "
+                          "grep -q '\"driver\": \"metropolis\"' m0/summary.json", dir), 0);
+  /* a chain's key, read without a note */
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set scene.driver=barker --set moves.point=0.4 "
+                          "--set anneal.sweeps=2 --out p > err.txt 2>&1 && ! grep -q 'no effect' err.txt", dir, b,
+                          root), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+  /* at fixed steps the share of moves taken */
+  double rate[2];
+  for (int k = 0; k < 2; k++) {
+    char *js = lw_test_slurp("%s/%s1/summary.json", dir, k ? "b" : "m");
+    cr_assert_not_null(js);
+    const char *acc = strstr(js, "\n  \"accepted\": "), *prop = strstr(js, "\n  \"proposals\": ");
+    cr_assert(acc && prop, "%s", js);
+    rate[k] = strtod(acc + 15, NULL) / strtod(prop + 16, NULL);
+    free(js);
+  }
+  cr_assert(rate[1] < rate[0] && rate[1] > 0.0, "Barker took %g of its proposals, Metropolis %g", rate[1], rate[0]);
+  /* the statistics leave out the same tuning rows */
+  cr_assert_eq(lw_test_sh("cd %s && %s stats m0 --csv | sed -n 2p | cut -d, -f2 > nm && %s stats b0 --csv | sed -n 2p "
+                          "| cut -d, -f2 > nb && cmp -s nm nb && test $(cat nb) -lt 60", dir, b, b), 0);
+  /* its second stage would be Metropolis's: delayed acceptance is a key it does not read */
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set scene.driver=barker --set anneal.sweeps=2 "
+                          "--set anneal.delayed_acceptance=0 --out d 2>&1 | grep -q 'under driver = barker these keys "
+                          "have no effect: anneal.delayed_acceptance (--set)'", dir, b, root), 0);
+  /* stopped and resumed: the same chain */
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini %s --set scene.driver=barker --stop-at 25 --out r "
+                          "2>/dev/null && %s resume r --quiet && cmp -s r/state.lw b0/state.lw && "
+                          "cmp -s r/trace.csv b0/trace.csv", dir, b, root, common, b), 0);
+}
+
 /* A study as a user runs it: params/wlc.ini samples 50 free worm-like
 ** chains with output.observables, and `linewise stats` gives the means
 ** with error bars (from output.stats_from, the scene's burn-in; summary.json

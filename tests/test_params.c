@@ -683,13 +683,13 @@ Test(params, every_key_has_a_reader)
     {"particles", "r0", "particles"},
     {"nurbs", "alpha", "nurbs"},
     {"dynamics", "dt", "all under dynamics"},
-    {"tempering", "replicas", "all under metropolis"},
-    {"moves", "point", "splines under metropolis"},
-    {"particles", "birth", "particles under metropolis"},
+    {"tempering", "replicas", "all under metropolis, barker"},
+    {"moves", "point", "splines under metropolis, barker"},
+    {"particles", "birth", "particles under metropolis, barker"},
     {"nurbs", "weight_inertia", "nurbs under dynamics"},
     {"anneal", "delayed_acceptance", "splines under metropolis"},
     {"dynamics", "pin", "splines under dynamics"},
-    {"dynamics", "rho", "splines, nurbs under metropolis; all under dynamics"},
+    {"dynamics", "rho", "splines, nurbs under metropolis, barker; all under dynamics"},
   };
   for (size_t k = 0; k < sizeof known / sizeof known[0]; k++) {
     lw_anneal_key_readers(lw_params_find(known[k].section, known[k].key), buf, sizeof buf);

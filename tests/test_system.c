@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/driver.h"
 #include "linewise/mc.h"
 #include "linewise/sys_particles.h"
 #include "linewise/sys_splines.h"
@@ -282,19 +283,20 @@ Test(system, the_chain_samples_a_test_row_exactly)
   gauss_chain_free(c);
 }
 
-/* Barker's rule, e^x / (1 + e^x): detailed balance, as Metropolis's, since
-** its ratio at x and -x is e^x; overflow-free at both ends. */
-static double barker(double x) { return x >= 0.0 ? 1.0 / (1.0 + exp(-x)) : exp(x) / (1.0 + exp(x)); }
-
-/* A chain driver with its own acceptance rule (driver.h, `accept`) samples
-** the test row exactly too: the same batch means as Metropolis (5 standard
-** errors of 50 batches), fewer moves taken (Barker accepts at most as
-** often: e^x / (1 + e^x) <= min(1, e^x)). */
+/* A chain driver with its own acceptance rule (driver.h, `accept`; the
+** barker row's, e^x / (1 + e^x), whose ratio at x and -x is e^x) samples the
+** test row exactly too: the same batch means as Metropolis (5 standard
+** errors of 50 batches), fewer moves taken (e^x / (1 + e^x) <= min(1, e^x)).
+** The rule's ends: 1 at +infinity, 0 at -infinity, 1/2 at 0, no overflow. */
 Test(system, a_chain_under_another_acceptance_rule_samples_a_test_row_exactly)
 {
   const double T = 0.7;
   lw_chain *c = gauss_chain(T, 77), *m = gauss_chain(T, 77);
-  c->accept = barker;
+  c->accept = lw_driver_barker.accept;
+  cr_assert(c->accept(INFINITY) == 1.0 && c->accept(-INFINITY) == 0.0 && c->accept(0.0) == 0.5 &&
+            c->accept(800.0) == 1.0 && c->accept(-800.0) == 0.0);
+  cr_assert(fabs(c->accept(1.5) - exp(1.5) / (1.0 + exp(1.5))) < 1e-15 &&
+            fabs(c->accept(-2.0) - 1.0 / (1.0 + exp(2.0))) < 1e-15);
   batch_mean m1[NV], m2[NV];
   sample_gaussian(c, T, m1, m2);
   check_gaussian("Barker's chain", m1, m2, T);

@@ -13,7 +13,8 @@
 ** the row's keys_dynamics and [dynamics].
 **
 ** Adding a chain driver with another acceptance rule: a file with its row
-** (the name, LW_DRIVE_CHAIN, lw_driver_chain_keys, its `accept`) and one
+** (the name, LW_DRIVE_CHAIN, lw_driver_chain_keys, the keys it ignores,
+** its `accept`) and one
 ** entry in lw_driver_types[] (driver.c); mention it in the help of
 ** `[scene] driver` (src/params.c; `make docs`).  Everything else (the key
 ** checks and notes, docs/PARAMETERS.md's "read by", the chain, tempering,
@@ -36,6 +37,8 @@ typedef struct lw_driver_type {
   int kind;                /* LW_DRIVE_* */
   const char *const *keys; /* the scene keys it reads besides its system's (`section.key`, `section.*`),
                            ** the run's own among them, NULL-terminated */
+  const char *const *ignores; /* keys a system offers drivers of its kind that this one does not
+                              ** read (NULL: none) */
   /* a chain's acceptance rule: the probability of taking a move whose log
   ** ratio is x = log q - dE / T (q the system's Hastings factor, 1 for a
   ** symmetric move), x from -infinity to +infinity; the chain draws one uniform number for
@@ -49,7 +52,7 @@ typedef struct lw_driver_type {
 extern const char *const lw_driver_chain_keys[];
 extern const char *const lw_driver_motion_keys[];
 
-extern const lw_driver_type lw_driver_metropolis, lw_driver_dynamics;
+extern const lw_driver_type lw_driver_metropolis, lw_driver_dynamics, lw_driver_barker;
 
 /* The table, NULL-terminated; its first row is the default. */
 extern const lw_driver_type *const lw_driver_types[];
