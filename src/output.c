@@ -95,6 +95,23 @@ lw_status lw_output_subdir(const char *dir, const char *sub, char *path, size_t 
   return LW_OK;
 }
 
+/* A rename outlasts a power cut only once its directory is on disk too; a
+** directory that cannot be synced (a file system without it) leaves the old
+** file or the new one, each whole, so nothing is reported. */
+static void sync_directory_of(const char *path)
+{
+  char dir[4096];
+  const char *slash = strrchr(path, '/');
+  if (!slash) snprintf(dir, sizeof dir, ".");
+  else if (slash == path) snprintf(dir, sizeof dir, "/");
+  else if ((size_t)(slash - path) < sizeof dir) snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+  else return;
+  int fd = open(dir, O_RDONLY | O_DIRECTORY);
+  if (fd < 0) return;
+  (void)fsync(fd);
+  close(fd);
+}
+
 lw_status lw_output_commit(FILE *f, const char *tmp, const char *path, lw_error *err)
 {
   /* ferror first: a failed fprintf long ago leaves the stream flagged even
@@ -117,6 +134,7 @@ lw_status lw_output_commit(FILE *f, const char *tmp, const char *path, lw_error 
     remove(tmp);
     return lw_error_set(err, LW_EIO, "%s: cannot replace: %s", path, strerror(e));
   }
+  sync_directory_of(path);
   return LW_OK;
 }
 

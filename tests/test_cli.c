@@ -1584,6 +1584,21 @@ Test(cli, an_extension_a_full_disk_stops_says_how_to_go_on)
                           lw_test_bin()), 0);
 }
 
+/* A file a run replaces (state.lw, the drawings, summary.json) is on disk
+** before the rename that replaces the last one, and the rename is on disk
+** after it: strace sees fsync of the temporary file, the rename, then fsync
+** of the directory.  Without the first, a power cut could leave an empty
+** state.lw, the run's only checkpoint (a helper's mutant dropped the fsync
+** and every test passed); without the second, the old one. */
+Test(cli, every_file_a_run_replaces_is_synced_before_and_its_rename_after)
+{
+  cr_assert_eq(lw_test_sh("cd %s && strace -f -y -e trace=fsync,rename,renameat,renameat2 -o st.txt %s run "
+                          "%s/params/minimal.ini --set anneal.sweeps=5 --out s --quiet && "
+                          "awk -f %s/tests/fsync-order.awk st.txt > order.txt", dir, lw_test_bin(), lw_test_root(),
+                          lw_test_root()),
+               0, "%s", lw_test_slurp("%s/order.txt", dir));
+}
+
 /* On a terminal the progress is one bar redrawn in place (carriage returns,
 ** no plain "elapsed" lines), full at the last sweep and ended by a new
 ** line; --quiet draws none.  script(1) gives the run its terminal. */

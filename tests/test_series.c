@@ -12,6 +12,7 @@
 #include <gsl/gsl_cdf.h>
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
+#include <gsl/gsl_statistics_double.h>
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -115,7 +116,7 @@ Test(series, error_bars_cover_the_true_mean_as_often_as_they_claim)
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
   gsl_rng_set(r, 777);
   size_t covered = 0, naive = 0, drifted = 0, batched = 0;
-  double ratio_sum = 0.0;
+  double ratio_sum = 0.0, z2_sum = 0.0;
   for (size_t k = 0; k < runs; k++) {
     ar1(r, phi, x, n);
     lw_series_stats s;
@@ -125,18 +126,57 @@ Test(series, error_bars_cover_the_true_mean_as_often_as_they_claim)
     drifted += fabs(s.drift_z) > 4.0;
     batched += s.batch_ratio > LW_SERIES_BATCH_WARN;
     ratio_sum += s.batch_ratio;
+    z2_sum += s.drift_z * s.drift_z;
   }
   double f = (double)covered / (double)runs;
-  cr_log_info("coverage %.3f (naive %.3f), drift flagged %zu of %zu, batch ratio mean %.3f, flagged %zu",
-              f, (double)naive / (double)runs, drifted, runs, ratio_sum / runs, batched);
+  cr_log_info("coverage %.3f (naive %.3f), drift flagged %zu of %zu, mean z^2 %.3f, batch ratio mean %.4f, "
+              "flagged %zu", f, (double)naive / (double)runs, drifted, runs, z2_sum / runs, ratio_sum / runs, batched);
   cr_assert(f > 0.905 && f < 0.995, "2-stderr coverage %.3f", f);
   cr_assert((double)naive / (double)runs < 0.6, "the test cannot tell an honest error bar from a naive one");
   /* P(|z| > 4) = 6e-5 per stationary series: none expected in 400 */
   cr_assert(drifted <= 1, "%zu stationary series flagged as drifting", drifted);
+  /* and z in standard errors is about N(0, 1): z^2 averages 1, sd sqrt(2 /
+  ** 400) = 0.071 over the series, so 0.7 to 1.3 is over 4 sd each side (a
+  ** standard error without its 2 tau read 2) */
+  cr_assert(z2_sum / runs > 0.7 && z2_sum / runs < 1.3, "mean z^2 %.3f over stationary series", z2_sum / runs);
   /* the batch check: P(ratio > 1.5) = 0.0014 from the batches alone (more
   ** with tau's own noise), so about 0.6 of 400; 5 or more would happen by
   ** chance 4e-4 of the time (Poisson) */
   cr_assert(batched <= 4, "%zu series with a right tau flagged by their batch means", batched);
+  free(x);
+  gsl_rng_free(r);
+}
+
+/* The halves' and the batches' checks are what series.h defines, recomputed
+** here: z = (m2 - m1) / sqrt(sum over halves of var_h 2 tau / len_h), var_h
+** the half's 1/len moment and tau the whole series'; the batch ratio the
+** standard error of the mean of 20 batch means (their spread with 19
+** degrees of freedom, over 20) over stderr_mean. */
+Test(series, the_halves_and_batches_checks_are_their_definitions)
+{
+  const size_t n = 1003; /* halves of 501 and 502; batches of 50, the last 3 values in none */
+  double *x = malloc(n * sizeof *x);
+  gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+  gsl_rng_set(r, 31);
+  ar1(r, 0.7, x, n);
+  for (size_t t = n / 2; t < n; t++) x[t] += 0.3; /* a drift to measure */
+  lw_series_stats s;
+  lw_series_stats_of(x, n, &s);
+  double se2 = 0.0, m[2];
+  const size_t len[2] = {n / 2, n - n / 2};
+  for (int k = 0; k < 2; k++) {
+    const double *h = x + (k ? len[0] : 0);
+    m[k] = gsl_stats_mean(h, 1, len[k]);
+    const double var = gsl_stats_variance_m(h, 1, len[k], m[k]) * (double)(len[k] - 1) / (double)len[k];
+    se2 += var * 2.0 * s.tau / (double)len[k];
+  }
+  const double z = (m[1] - m[0]) / sqrt(se2);
+  cr_assert(fabs(s.drift_z / z - 1.0) < 1e-12, "drift_z %.15g, by its definition %.15g", s.drift_z, z);
+  double b[LW_SERIES_BATCHES];
+  for (int k = 0; k < LW_SERIES_BATCHES; k++) b[k] = gsl_stats_mean(x + (size_t)k * 50, 1, 50);
+  const double se_b = gsl_stats_sd(b, 1, LW_SERIES_BATCHES) / sqrt((double)LW_SERIES_BATCHES);
+  cr_assert(fabs(s.batch_ratio / (se_b / s.stderr_mean) - 1.0) < 1e-12, "batch ratio %.15g, by its definition %.15g",
+            s.batch_ratio, se_b / s.stderr_mean);
   free(x);
   gsl_rng_free(r);
 }

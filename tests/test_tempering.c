@@ -192,6 +192,30 @@ Test(tempering, round_trips_count_cold_hot_cold_journeys)
   lw_tempering_free(pt);
 }
 
+/* Three rungs, every swap taken (energies falling up the ladder), pairs 0-1
+** on even steps and 1-2 on odd: each replica zigzags end to end in three
+** steps.  Replica 0 starts cold going up; it is at the hot end after step
+** 2 and cold again after 5: a trip.  Replica 1 reaches the hot end at 3 and
+** the cold end at 7, replica 2 (which starts at the hot end, so starts
+** nothing) the cold end at 3, then hot at 6 and cold at 9; replica 0 again
+** at 11.  Twelve steps: 4 round trips.  A replica first seen at the hot
+** end was labelled as coming down, and replica 2's arrival at step 3 made
+** a fifth; two rungs cannot show it. */
+Test(tempering, round_trips_on_three_rungs_count_whole_journeys_only)
+{
+  const double ladder[3] = {1.0, 2.0, 4.0}, e[3] = {5.0, 3.0, 1.0};
+  lw_error err;
+  lw_tempering *pt = lw_tempering_new(3, ladder, 1, &err);
+  cr_assert_not_null(pt, "%s", err.msg);
+  const unsigned long want[12] = {0, 0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4};
+  for (int s = 0; s < 12; s++) {
+    lw_tempering_exchange(pt, e, ladder, NULL);
+    cr_assert_eq(pt->round_trips, want[s], "after step %d: %lu round trips", s + 1, pt->round_trips);
+  }
+  cr_assert(pt->at[0] == 0 && pt->at[1] == 1 && pt->at[2] == 2, "the zigzag's period is 6 steps");
+  lw_tempering_free(pt);
+}
+
 /* A geometric ladder over every pair of ends the keys accept (1e-300 to
 ** 1e300): t_max / t_min past the doubles made every rung but the last inf,
 ** and the ladder was refused.  Its rungs are t_min r^(k / (n - 1)). */

@@ -99,6 +99,30 @@ Test(terms, a_tiny_segment_bends_as_its_scale_says)
   lw_splines_free(sp);
 }
 
+/* The field term's two modes on a straight segment across a constant field
+** at angle a: r'.v is constant along it, so the signed integral is L cos a
+** and the axial one L |cos a| exactly (the axial one once read the signed,
+** and only the gradient's test, by differences of that same energy, saw it). */
+Test(terms, the_field_term_is_the_signed_or_absolute_alignment)
+{
+  lw_quad q;
+  lw_quad_init(&q, 8, NULL);
+  lw_splines *sp = splines(1, 1);
+  lw_test_straight(sp, 0, 1.0, 2.0, 9.0, 8.0); /* L = 10 along (0.8, 0.6) */
+  lw_samples s;
+  samples_of(&q, sp, 0, &s);
+  const double angles[3] = {0.3, 2.2, M_PI / 2 + 0.9};
+  for (int k = 0; k < 3; k++) {
+    lw_field f = {.kind = LW_FIELD_CONSTANT, .ux = cos(angles[k]), .uy = sin(angles[k])};
+    const double c = 0.8 * f.ux + 0.6 * f.uy;
+    cr_assert(fabs(lw_term_field(&s, &q, &f, 0) - 10.0 * c) < 1e-12, "signed at %g: %.15g", angles[k],
+              lw_term_field(&s, &q, &f, 0));
+    cr_assert(fabs(lw_term_field(&s, &q, &f, 1) - 10.0 * fabs(c)) < 1e-12, "axial at %g: %.15g", angles[k],
+              lw_term_field(&s, &q, &f, 1));
+  }
+  lw_splines_free(sp);
+}
+
 Test(terms, straight_length_exact_and_bending_zero)
 {
   lw_quad q;
