@@ -74,6 +74,7 @@ void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n)
   ** is neither (a temperature that takes everything), and is not said. */
   size_t m = 0, flat = 0;
   char same[256] = "";
+  const double ceiling = lw_chain_ceiling(c); /* the smallest steps' acceptance (1 but for another rule) */
   for (int k = 0; k < c->n_moves && m + 1 < n; k++) {
     const lw_move_stats *st = &c->stats[k];
     if (!(c->step_max[k] > 0.0) || st->proposed < 100) continue;
@@ -82,7 +83,7 @@ void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n)
       if (flat + 1 < sizeof same)
         flat += (size_t)snprintf(same + flat, sizeof same - flat, "%s%s", flat ? ", " : "", a->sys_type->move_names[k]);
     } else if (acc < 0.25 * c->target[k] ||
-               (acc > 1.0 - 0.25 * (1.0 - c->target[k]) && c->step[k] < 0.5 * c->step_max[k])) {
+               (acc > ceiling - 0.25 * (ceiling - c->target[k]) && c->step[k] < 0.5 * c->step_max[k])) {
       m += (size_t)snprintf(buf + m, n - m, "%s%s moves were accepted %.1f %% of the time against the target %.0f %%",
                             m ? ", " : "", a->sys_type->move_names[k], 100.0 * acc, 100.0 * c->target[k]);
     }
@@ -831,7 +832,7 @@ static lw_status build(lw_anneal *a, void **states, const double *ladder, lw_err
     a->chains[k] = lw_chain_new(a->systems[k], weight, step, target, rung_stream(a, k), err);
     if (!a->chains[k]) return err->code;
     a->chains[k]->delayed = p->delayed_acceptance; /* before the domains copy the chain */
-    a->chains[k]->accept = lw_driver_find(p->driver)->accept;
+    lw_chain_set_rule(a->chains[k], lw_driver_find(p->driver)->accept);
     if (!lw_driver_is_motion(p) && lw_domains_attach(a->chains[k], p, n, err)) return err->code;
   }
   a->chain = a->chains[0];

@@ -54,6 +54,15 @@ void lw_chain_free(lw_chain *c)
 }
 
 /* A step update once the window of a kind is full. */
+void lw_chain_set_rule(lw_chain *c, double (*accept)(double x))
+{
+  const double from = lw_chain_ceiling(c);
+  c->accept = accept;
+  for (int k = 0; k < c->n_moves; k++) c->target[k] *= lw_chain_ceiling(c) / from;
+}
+
+double lw_chain_ceiling(const lw_chain *c) { return c->accept ? c->accept(0.0) : 1.0; }
+
 static void tune_window(lw_chain *c, int kind)
 {
   if (c->win_prop[kind] < LW_TUNE_WINDOW) return;

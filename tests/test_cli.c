@@ -1117,6 +1117,12 @@ Test(cli, the_barker_driver_runs_the_chain_by_its_own_rule)
   /* the statistics leave out the same tuning rows */
   cr_assert_eq(lw_test_sh("cd %s && %s stats m0 --csv | sed -n 2p | cut -d, -f2 > nm && %s stats b0 --csv | sed -n 2p "
                           "| cut -d, -f2 > nb && cmp -s nm nb && test $(cat nb) -lt 60", dir, b, b), 0);
+  /* the targets are of the smallest steps' acceptance, which is 1/2 under
+  ** Barker: a target of 0.8 tunes to 0.4 (its steps shrank to 4e-6 in 60
+  ** sweeps, on their way to 1e-45, and the chain froze) */
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini %s --set scene.driver=barker --set moves.target=0.8 "
+                          "--out t && awk '/\"steps\"/ { s = 1; next } s && /\"point\"/ { exit !($2 > 0.05) }' "
+                          "t/summary.json", dir, b, root, common), 0, "%s", lw_test_slurp("%s/t/summary.json", dir));
   /* its second stage would be Metropolis's: delayed acceptance is a key it does not read */
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set scene.driver=barker --set anneal.sweeps=2 "
                           "--set anneal.delayed_acceptance=0 --out d 2>&1 | grep -q 'under driver = barker these keys "

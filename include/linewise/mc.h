@@ -68,6 +68,16 @@ lw_chain *lw_chain_new(lw_system *sys, const double *weight, const double *step,
                        unsigned long seed, lw_error *err);
 void lw_chain_free(lw_chain *c);
 
+/* The driver's acceptance rule (driver.h; NULL: Metropolis).  A rule that
+** takes a vanishing step with probability a(0) < 1 (Barker's: 1/2) tunes
+** its steps to that share of each target: the targets are relative to the
+** smallest steps' acceptance (a target above a(0) shrank the steps to
+** 1e-45 and froze the chain).  Before the chain is copied. */
+void lw_chain_set_rule(lw_chain *c, double (*accept)(double x));
+
+/* The acceptance of the smallest steps under the chain's rule: 1, or a(0). */
+double lw_chain_ceiling(const lw_chain *c);
+
 /* One proposal of the given kind; returns 1 if accepted, 0 if rejected, -1
 ** if the commit ran out of memory. */
 int lw_chain_step(lw_chain *c, int kind);
