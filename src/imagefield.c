@@ -6,18 +6,19 @@
 
 /* The white paper a blurred potential is padded with, in pixels: as far as
 ** the blur's Gaussian reaches (4 sigma), at most this; a blur of over 64
-** pixels continues the value it gives that far out, short of white by the
-** darkness its Gaussian carries past 256 pixels (docs/NUMERICS.md, "The
-** potential between the nodes"). */
+** pixels, which the plane's mirrored edge reflects, leaves the paper there
+** and beyond short of white by up to twice the darkness its Gaussian carries
+** past 256 pixels (docs/NUMERICS.md, "The potential between the nodes"). */
 #define POTENTIAL_PAD_MAX 256
 
 lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, double sigma,
-                                   lw_error *err)
+                                   int paper, lw_error *err)
 {
   const int w = img->width, h = img->height;
   /* blurred, the picture is blurred on its paper: white as far as the blur
-  ** reaches, so Phi rises to 1 beyond the picture without a step */
-  const int m = sigma > 0.0 ? (int)fmin(ceil(4.0 * sigma) + 1.0, POTENTIAL_PAD_MAX) : 0;
+  ** reaches, so Phi rises to 1 beyond the picture without a step; without
+  ** the paper the blur repeats the edge pixels and the ring continues them */
+  const int m = sigma > 0.0 && paper ? (int)fmin(ceil(4.0 * sigma) + 1.0, POTENTIAL_PAD_MAX) : 0;
   const int pw = w + 2 * m, ph = h + 2 * m, W = pw + 2, H = ph + 2;
   /* node (i, j) is the centre of pixel (i - 1 - m, j - 1 - m); the outer ring
   ** is white, or blurred continues the padded plane */

@@ -138,6 +138,11 @@ const lw_param_def lw_param_table[] = {
       "Phi is low and the line between them where it is high; blurred over about the nodes' "
       "spacing (segment_length / quadrature) it hides far less (docs/NUMERICS.md, \"The potential "
       "between the nodes\"). The photo preset sets 1.5 pen widths. 0 = none."),
+  NUM("scene", "potential_paper", LW_PT_INT, potential_paper, "1", "", 0, 1, 0,
+      "potential = image with potential_blur: 1 = the picture is blurred on white paper, so Phi rises to "
+      "1 beyond its edge (no line lies off the picture for free); 0 = the blur continues the picture's "
+      "edge pixels beyond it, as runs before 2026-12-06 did (a run of theirs, whose scene.ini has no "
+      "line for this key, resumes so; docs/NUMERICS.md, \"The potential between the nodes\")."),
   CHOICE("scene", "field", field, "constant", "constant|radial|vortex|waves|etf|gradient",
          "Vector field v read by the field term (unit length): constant along `field_angle`, "
          "radial from the centre, vortex around it (v = (-(y - cy), x - cx) / r: clockwise as seen on "

@@ -462,6 +462,16 @@ static lw_status layer_targets(lw_scene *sc, const lw_params *p, lw_error *err)
   return st;
 }
 
+/* Whether a blurred picture's potential reads white paper beyond it: a run
+** begun before 2026-12-06 has no line for the key and resumes with the edge
+** continued, as it ran (a scene.ini written by hand beside a state takes the
+** default). */
+static int potential_paper(const lw_params *p)
+{
+  const int before = p->run_written && !p->line[lw_params_find("scene", "potential_paper") - lw_param_table];
+  return p->potential_paper && !before;
+}
+
 /* The layers' targets, fields, potentials and tone rasters (layers.h). */
 static lw_status build_layers(lw_scene *sc, const lw_params *p, lw_error *err)
 {
@@ -494,7 +504,8 @@ static lw_status build_layers(lw_scene *sc, const lw_params *p, lw_error *err)
       l->potential.grid = NULL;
       if (sc->potential.kind == LW_POTENTIAL_GRID &&
           !(l->potential.grid = lw_imagefield_potential(l->target, &sc->image_place, p->potential_power,
-                                                        p->potential_blur / sc->image_place.pixel, err)))
+                                                        p->potential_blur / sc->image_place.pixel,
+                                                        potential_paper(p), err)))
         return err->code;
     }
     if (sc->on[LW_TERM_TONE]) {
@@ -535,7 +546,7 @@ static lw_status build_potential(lw_scene *sc, const lw_params *p, double cx, do
     if (!sc->image) return bad_key(p, "scene", "potential", LW_EINPUT, err, "'image' needs scene.image");
     f->kind = LW_POTENTIAL_GRID;
     if (!(f->grid = lw_imagefield_potential(sc->image, &sc->image_place, p->potential_power,
-                                            p->potential_blur / sc->image_place.pixel, err)))
+                                            p->potential_blur / sc->image_place.pixel, potential_paper(p), err)))
       return err->code;
     break;
   }

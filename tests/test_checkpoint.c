@@ -495,3 +495,30 @@ Test(checkpoint, a_step_outside_the_tuned_range_that_nothing_tuned_resumes)
                             k, dir, k, dir, k, dir, k), 0, "%s resumed differently", runs[k][0]);
   }
 }
+
+/* tests/fixtures/v2/paper: a run of paper.ini written by the release before
+** the blurred potential read white paper beyond the picture (2026-12-06),
+** stopped at sweep 12 of 30, and paper-whole that release's uninterrupted
+** run.  Its scene.ini has no scene.potential_paper line: resumed, it keeps
+** the potential it ran with (the picture's dark bottom edge continued below
+** it) and ends on that release's files to the bit; it was refused, the
+** running potential term not the state's. */
+Test(checkpoint, a_run_from_before_the_white_paper_resumes_to_its_own_end)
+{
+  cr_assert_eq(lw_test_sh("cp -r %s/tests/fixtures/v2 %s/v2 && cd %s/v2 && "
+                          "sed -i \"s|^image = .*|image = $PWD/paper.png|\" paper/scene.ini && "
+                          "! grep -q '^potential_paper' paper/scene.ini", lw_test_root(), dir, dir), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/v2/paper --quiet 2> %s/err.txt", lw_test_bin(), dir, dir), 0, "%s",
+               lw_test_slurp("%s/err.txt", dir));
+  for (int f = 0; f < 2; f++)
+    cr_expect_eq(lw_test_sh("cmp -s %s/v2/paper/%s %s/v2/paper-whole/%s", dir, f ? "trace.csv" : "state.lw", dir,
+                            f ? "trace.csv" : "state.lw"), 0, "%s differs from the old release's run",
+                 f ? "trace.csv" : "state.lw");
+  /* a new run of the same scene reads the paper: another potential */
+  cr_assert_eq(lw_test_sh("cd %s/v2 && %s run paper.ini --set init.from=paper/state.lw --set anneal.sweeps=0 --out "
+                          "fresh --quiet && %s energy paper | grep '^potential ' > a.txt && "
+                          "grep -q '\"potential\": ' fresh/summary.json && "
+                          "! grep -q \"\\\"potential\\\": $(cut -d' ' -f2 a.txt)\" fresh/summary.json", dir,
+                          lw_test_bin(), lw_test_bin()), 0);
+}
+

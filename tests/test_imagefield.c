@@ -131,7 +131,7 @@ Test(imagefield, potential_is_the_tone_and_white_beyond_the_picture)
   for (int k = 0; k < 35; k++) img->tone[k] = (float)urand(0, 1);
   lw_image_place pl = {3, 4, 2};
   lw_potential f = {.kind = LW_POTENTIAL_GRID};
-  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, NULL);
+  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, 1, NULL);
   for (int j = 0; j < 5; j++)
     for (int i = 0; i < 7; i++)
       cr_assert(fabs(lw_potential_eval(&f, 3 + 2 * (i + 0.5), 4 + 2 * (j + 0.5)) - img->tone[j * 7 + i]) < 1e-7);
@@ -139,7 +139,7 @@ Test(imagefield, potential_is_the_tone_and_white_beyond_the_picture)
   cr_assert(lw_potential_eval(&f, 3 + 14 + 1, 9) == 1.0, "a pixel beyond the right edge is white");
   lw_potential_clear(&f);
   /* scene.potential_power: Phi = tone^power, white still 1 */
-  f.grid = lw_imagefield_potential(img, &pl, 3.0, 0.0, NULL);
+  f.grid = lw_imagefield_potential(img, &pl, 3.0, 0.0, 1, NULL);
   for (int j = 0; j < 5; j++)
     for (int i = 0; i < 7; i++)
       cr_assert(fabs(lw_potential_eval(&f, 3 + 2 * (i + 0.5), 4 + 2 * (j + 0.5)) - pow(img->tone[j * 7 + i], 3)) <
@@ -164,7 +164,7 @@ Test(imagefield, a_blurred_potential_spreads_phi_and_keeps_its_sum)
   img->tone[10 * 21 + 10] = 1.0f;
   lw_image_place pl = {0, 0, 1};
   lw_potential f = {.kind = LW_POTENTIAL_GRID};
-  f.grid = lw_imagefield_potential(img, &pl, 8.0, 2.0, NULL);
+  f.grid = lw_imagefield_potential(img, &pl, 8.0, 2.0, 1, NULL);
   cr_assert_not_null(f.grid);
   double dark = 0.0;
   for (int j = -12; j < 33; j++)
@@ -181,6 +181,14 @@ Test(imagefield, a_blurred_potential_spreads_phi_and_keeps_its_sum)
     cr_assert(lw_potential_eval(&f, x - 1.0, 10.5) > lw_potential_eval(&f, x, 10.5), "rises beyond x = %g", x);
   cr_assert(fabs(lw_potential_eval(&f, -8.5, 10.5) - 1.0) < 1e-6 && fabs(lw_potential_eval(&f, -50, 3) - 1.0) < 1e-6 &&
             fabs(lw_potential_eval(&f, 40, 60) - 1.0) < 1e-6, "beyond the picture: %g", lw_potential_eval(&f, -50, 3));
+  lw_potential_clear(&f);
+  /* without the paper (scene.potential_paper = 0, runs before 2026-12-06)
+  ** the blur repeats the edge and Phi continues it: black beyond */
+  f.grid = lw_imagefield_potential(img, &pl, 8.0, 2.0, 0, NULL);
+  cr_assert_not_null(f.grid);
+  cr_assert(lw_potential_eval(&f, -50, 3) < 1e-6 && lw_potential_eval(&f, -0.5, 10.5) == lw_potential_eval(&f, 0.5, 10.5),
+            "the edge continued: %g", lw_potential_eval(&f, -50, 3));
+  cr_assert(fabs(lw_potential_eval(&f, 10.5, 10.5) - centre) < 1e-6, "the same blur inside");
   lw_potential_clear(&f);
   lw_image_free(img);
 }

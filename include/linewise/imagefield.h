@@ -48,9 +48,12 @@ extern "C" {
 ** centres, white beyond the picture; or (sigma > 0) the picture on white
 ** paper blurred by a Gaussian of sigma pixels, the grid reaching as far as
 ** the blur does (4 sigma, at most 256 pixels), so that Phi rises to white
-** beyond the picture without a step between two quadrature nodes. */
+** beyond the picture without a step between two quadrature nodes.  With
+** paper 0 the blur repeats the picture's edge pixels and Phi continues the
+** edge beyond it (as before 2026-12-06: a line beyond a dark edge costs
+** nothing there). */
 lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, double sigma,
-                                   lw_error *err);
+                                   int paper, lw_error *err);
 
 /* angle: the fallback direction, radians (0 = +x, pi/2 = +y, down). */
 lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, double sigma_mm, double flat,

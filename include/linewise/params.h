@@ -99,6 +99,7 @@ typedef struct {
   double potential_scale;     /* ramp half extent / radial radius, mm; 0 = automatic */
   double potential_power;     /* potential = image: Phi = tone^power */
   double potential_blur;      /* potential = image: sigma of Phi's blur, mm; 0 = none */
+  int potential_paper;        /* 1: the blur reads white paper beyond the picture; 0: its edge continued */
   int field;                  /* LW_FLD_* */
   double field_angle;         /* constant field direction (etf fallback), degrees */
   double field_sigma;         /* etf tensor smoothing, mm */
