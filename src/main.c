@@ -478,25 +478,31 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
     static double shown = -1;
     if (!final && t - shown < 0.2) return;
     shown = t;
-    int width = 24, fill = total > 0 ? (int)(width * done / total) : width;
     char state[160];
     progress_state(a, 4, state, sizeof state);
     char rest[32] = "-"; /* unknown before a sweep has taken its time */
     if (done > 0 || a->sweep >= a->end_sweep) snprintf(rest, sizeof rest, "%.0fs", left);
-    char line[320];
-    int bar = snprintf(line, sizeof line, "[%.*s%*s] ", fill, "########################", width - fill, "");
-    int len = bar + snprintf(line + bar, sizeof line - (size_t)bar, "sweep %ld/%ld  %s  left %s ", a->sweep,
-                             a->end_sweep, state, rest);
+    char text[224];
+    int len = snprintf(text, sizeof text, "sweep %ld/%ld  %s  left %s ", a->sweep, a->end_sweep, state, rest);
     /* a line longer than the terminal wraps, and each redraw then starts a
-    ** new one: the bar goes first, then the end of the line */
+    ** new one: the bar narrows (to 8 marks) to fit, else goes, then the end
+    ** of the line */
     struct winsize ws;
-    int cols = ioctl(2, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 ? ws.ws_col : 80;
-    const char *shown_from = line;
-    if (len > cols - 1) shown_from += bar, len -= bar;
+    const int cols = ioctl(2, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0 ? ws.ws_col : 80;
+    int width = cols - 1 - len - 3;
+    width = width > 24 ? 24 : (width < 8 ? 0 : width);
+    char line[256];
+    int bar = 0;
+    if (width) {
+      const int fill = total > 0 ? (int)(width * done / total) : width;
+      bar = snprintf(line, sizeof line, "[%.*s%*s] ", fill, "########################", width - fill, "");
+    }
+    snprintf(line + bar, sizeof line - (size_t)bar, "%s", text);
+    len += bar;
     if (len > cols - 1) len = cols - 1 > 0 ? cols - 1 : 0;
     /* spaces over what a longer line before left */
     static int shown_len;
-    fprintf(stderr, "\r%.*s%*s", len, shown_from, shown_len > len ? shown_len - len : 0, "");
+    fprintf(stderr, "\r%.*s%*s", len, line, shown_len > len ? shown_len - len : 0, "");
     shown_len = len;
     if (final) fputc('\n', stderr);
   } else if ((final && a->sweep != pg->last_plain) || a->sweep >= pg->next_plain) {

@@ -177,9 +177,17 @@ static void grad_bending(const lw_samples *s, const lw_term_ctx *ctx, lw_samples
     if (sp2 == 0.0) continue;
     double c = s->dx[i] * s->ddy[i] - s->ddx[i] * s->dy[i];
     if (c == 0.0) continue; /* straight: no gradient, also where s^-5 overflows (0 inf) */
-    double inv5 = 1.0 / (sp2 * sp2 * s->speed[i]);
-    double a = ctx->coef * q->w[i] * 2.0 * c * inv5;            /* dE/dc */
-    double b = -ctx->coef * q->w[i] * 5.0 * c * c * inv5 / sp2; /* dE/dr' = b r' through s^-5 */
+    const double den = sp2 * sp2 * s->speed[i];
+    double a, b;
+    if (den >= DBL_MIN) {
+      const double inv5 = 1.0 / den;
+      a = ctx->coef * q->w[i] * 2.0 * c * inv5;            /* dE/dc */
+      b = -ctx->coef * q->w[i] * 5.0 * c * c * inv5 / sp2; /* dE/dr' = b r' through s^-5 */
+    } else { /* as the energy: k = c / s^2 keeps its scale where s^5 underflows */
+      const double k = c / sp2, s3 = sp2 * s->speed[i];
+      a = ctx->coef * q->w[i] * 2.0 * k / s3;
+      b = -ctx->coef * q->w[i] * 5.0 * k * k / s3;
+    }
     g->dx[i] += a * s->ddy[i] + b * s->dx[i];
     g->dy[i] += -a * s->ddx[i] + b * s->dy[i];
     g->ddx[i] += -a * s->dy[i];

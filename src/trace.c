@@ -328,9 +328,10 @@ static void combine(column_stats *c, int k, const double *gap)
     c->sd = c->p_runs = c->r_hat = NAN;
     return;
   }
-  if (exact) {
-    c->p_runs = b > 0.0 ? 0.0 : 1.0;
-    c->r_hat = b > 0.0 ? INFINITY : 1.0;
+  if (exact) { /* compared with each other: their mean's rounding (50 / 6 six times) is no spread */
+    c->p_runs = apart ? 0.0 : 1.0;
+    c->r_hat = apart ? INFINITY : 1.0;
+    if (!apart) c->mean = m_exact;
   } else {
     c->p_runs = apart ? 0.0 : gsl_cdf_chisq_Q(chi2, (double)(n_exact ? k - n_exact : k - 1));
     c->r_hat = w > 0.0 ? sqrt(((n - 1.0) / n * w + b) / w) : INFINITY;

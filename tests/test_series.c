@@ -579,6 +579,35 @@ Test(trace, several_runs_agree_or_are_flagged, .init = make_dir, .fini = remove_
   cr_assert(strstr(err.msg, "o-3.csv: column 3 is 'y', but 'x' in "), "%s", err.msg);
 }
 
+/* Runs whose column holds one value throughout, the same in each: they
+** agree exactly (R-hat 1, p_runs 1, the mean that value).  Six runs of 50
+** summed 50 / 6 six times to 50.00000000000001, which every run's 50 then
+** differed from: "the runs disagree beyond their error bars". */
+Test(trace, runs_of_one_constant_value_agree_exactly, .init = make_dir, .fini = remove_dir)
+{
+  char path[6][128], out[4096];
+  const char *paths[6];
+  lw_trace *t[6];
+  lw_trace_select sel[6];
+  lw_error err;
+  for (int r = 0; r < 6; r++) {
+    char name[32];
+    snprintf(name, sizeof name, "c-%d.csv", r);
+    write_trace(name, "sweep,temperature,c\n1,1,50\n2,1,50\n3,1,50\n4,1,50\n", path[r], sizeof path[r]);
+    paths[r] = path[r];
+    t[r] = lw_trace_read(path[r], &err);
+    cr_assert_not_null(t[r], "%s", err.msg);
+    sel[r] = (lw_trace_select){.from = -1, .to = -1, .csv = 1};
+  }
+  FILE *f = fmemopen(out, sizeof out, "w");
+  cr_assert_eq(lw_trace_stats_runs((const lw_trace *const *)t, paths, sel, 6, f, &err), LW_OK, "%s", err.msg);
+  fclose(f);
+  double rh, p;
+  runs_agreement(out, "c", &rh, &p);
+  cr_assert(rh == 1.0 && p == 1.0 && strstr(out, "\nc,6,24,50,"), "%s", out);
+  for (int r = 0; r < 6; r++) lw_trace_free(t[r]);
+}
+
 /* Runs of one law whose error bars differ (one run's values a tenth the
 ** others'): p_runs must be uniform, as for equal error bars.  Of 60 sets
 ** of 4 agreeing runs, p_runs < 0.05 is binomial (60, 0.05): mean 3, sd

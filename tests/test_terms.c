@@ -83,6 +83,10 @@ Test(terms, a_tiny_segment_bends_as_its_scale_says)
   samples_of(&q, sp, 0, &s);
   const double b1 = lw_term_bending(&s, &q);
   cr_assert(b1 > 0.0 && isfinite(b1));
+  /* its gradient in r' and r'' goes as 1 / scale^2 (it was inf - inf) */
+  const lw_term_ctx ctx = {.coef = 1.0, .quad = &q};
+  lw_samples_grad g1 = {.n = s.n}, gk;
+  lw_term_types[LW_TERM_BENDING].segment_grad(&s, &ctx, &g1);
   for (double k = 1e-60; k > 1e-70; k *= 0.1) {
     lw_splines *t = splines(1, 1);
     for (int n = 0; n < 2; n++) {
@@ -91,6 +95,15 @@ Test(terms, a_tiny_segment_bends_as_its_scale_says)
     }
     samples_of(&q, t, 0, &s);
     cr_assert(fabs(lw_term_bending(&s, &q) * k / b1 - 1.0) < 1e-9, "scale %g: %g", k, lw_term_bending(&s, &q) * k);
+    memset(&gk, 0, sizeof gk);
+    gk.n = s.n;
+    lw_term_types[LW_TERM_BENDING].segment_grad(&s, &ctx, &gk);
+    for (int i = 0; i < s.n; i++) {
+      const double want[4] = {g1.dx[i], g1.dy[i], g1.ddx[i], g1.ddy[i]}, got[4] = {gk.dx[i], gk.dy[i], gk.ddx[i], gk.ddy[i]};
+      for (int c = 0; c < 4; c++)
+        cr_assert(fabs(got[c] * k * k - want[c]) <= 1e-9 * fabs(want[c]) + 1e-12 * b1, "scale %g node %d: %g against %g",
+                  k, i, got[c] * k * k, want[c]);
+    }
     lw_test_straight(t, 0, 0.3 * k, 0.1 * k, 10.3 * k, 0.1 * k); /* level: its cross is 0 exactly */
     samples_of(&q, t, 0, &s);
     cr_assert(lw_term_bending(&s, &q) == 0.0, "scale %g: straight bends %g", k, lw_term_bending(&s, &q));
