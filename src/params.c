@@ -48,7 +48,8 @@ const lw_param_def lw_param_table[] = {
   STRING("scene", "driver", driver, "metropolis", "",
          "What moves the system: `metropolis` anneals it by Monte Carlo (the [anneal] schedule, "
          "[tempering] with replicas); `barker` is the same chain deciding by Barker's rule, "
-         "e^x / (1 + e^x) with x = -dE / T, instead of min(1, e^x), to compare acceptance rules "
+         "e^x / (1 + e^x) with x = log q - dE / T (q a move's Hastings factor), instead of min(1, e^x), "
+         "to compare acceptance rules "
          "(docs/NUMERICS.md, \"Acceptance rules\"); `dynamics` integrates its Lagrangian equations of "
          "motion (the [dynamics] section; docs/NUMERICS.md, \"Dynamics\"): a sweep is then "
          "`dynamics.steps_per_sweep` time steps and `anneal.sweeps` counts them."),
@@ -314,9 +315,12 @@ const lw_param_def lw_param_table[] = {
   NUM("moves", "step_rotate", LW_PT_DOUBLE, step_rotate, "2", "degrees", 0, 180, LW_MIN_OPEN,
       "Initial standard deviation of a rotation."),
   NUM("moves", "target", LW_PT_DOUBLE, target, "0.44", "", 0, 1, LW_MIN_OPEN | LW_MAX_OPEN,
-      "Acceptance rate the point and vector steps tune toward."),
+      "Acceptance rate the point and vector steps tune toward, as a share of the smallest steps' "
+      "acceptance: 1 under metropolis, 1/2 under barker (which so tunes to half of it; docs/NUMERICS.md, "
+      "\"Acceptance rules\")."),
   NUM("moves", "target_spline", LW_PT_DOUBLE, target_spline, "0.3", "", 0, 1, LW_MIN_OPEN | LW_MAX_OPEN,
-      "Acceptance rate the translation and rotation steps tune toward."),
+      "Acceptance rate the translation and rotation steps tune toward (a share of 1/2 under barker, "
+      "as moves.target)."),
   NUM("moves", "tune_sweeps", LW_PT_INT, tune_sweeps, "10", "sweeps", 0, 1e9, 0,
       "Sweeps at the start of each temperature step during which steps adapt; afterwards "
       "they are frozen so sampling obeys detailed balance. 0 = never tune. A small system "

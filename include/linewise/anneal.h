@@ -54,7 +54,7 @@ typedef struct lw_anneal {
   lw_schedule sched;
   char dir[LW_PATH_MAX];
   int dir_hold;                 /* lw_rundir_lock's hold on dir while it writes there, 0 none */
-  char unread[1024];           /* keys the scene sets that only the other driver reads, where set, or "" */
+  char unread[1024];           /* keys the scene sets that only other drivers read, where set, or "" */
   char idle[4096];             /* keys the scene sets that its other settings leave idle, where and why */
   char schedule_note[512];     /* a schedule whose steps never reach its end (lw_anneal_start), or "" */
   unsigned long seed;
@@ -169,14 +169,14 @@ void lw_anneal_free(lw_anneal *a);
 void lw_anneal_key_readers(const lw_param_def *d, char *buf, size_t n);
 
 /* The words text key d takes where they are a fixed list, '|'- or ", "-separated (the
-** systems' and schedules' names from their tables; domains' forms), or NULL. */
+** systems', drivers' and schedules' names from their tables; domains' forms), or NULL. */
 const char *lw_anneal_key_values(const lw_param_def *d);
 
 /* LW_EINPUT, naming where it was set and who reads it, when p gives a key
-** (lw_params_given) that its system reads under neither driver: it would
-** change nothing, and a study that varied it would measure noise.  Keys
-** only the other driver reads are listed in unread (size bytes, may be 0):
-** one scene file may serve both drivers of its system.  lw_anneal_start
+** (lw_params_given) that its system reads under no driver (driver.h): it
+** would change nothing, and a study that varied it would measure noise.
+** Keys only other drivers read are listed in unread (size bytes, may be 0):
+** one scene file may serve every driver of its system.  lw_anneal_start
 ** calls it. */
 lw_status lw_anneal_check_keys(const lw_params *p, char *unread, size_t size, lw_error *err);
 

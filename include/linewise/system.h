@@ -92,11 +92,11 @@ struct lw_system_type {
   const char *const *term_names;      /* ... by name: trace columns, summary, state.lw */
 
   /* The scene keys the row reads, "section.key" or "section.*" (each list
-  ** NULL-terminated, or NULL): under either driver, and under the dynamics
-  ** or Monte Carlo only (a key named there is read under that driver only,
-  ** though `keys` names its section).  The drivers' own keys (the schedule,
+  ** NULL-terminated, or NULL): under every driver, and under the dynamics
+  ** or the Monte Carlo chains only (a key named there is read under drivers
+  ** of that kind only, driver.h, though `keys` names its section).  The drivers' own keys (the schedule,
   ** [tempering], a run's outputs, the time step) need no listing.  A scene
-  ** that gives a key the row reads under neither driver a value of its own
+  ** that gives a key the row reads under no driver a value of its own
   ** is refused before the run (anneal.c): it would change nothing, and a
   ** study that varied it would measure noise. */
   const char *const *keys;
