@@ -488,37 +488,48 @@ static int key_read(const lw_system_type *t, const lw_driver_type *v, const lw_p
   return lw_params_named(t->keys, d);
 }
 
+/* The systems that read key d under driver v: "all", "splines, nurbs", or "". */
+static void systems_reading(const lw_param_def *d, const lw_driver_type *v, char *sys, size_t n)
+{
+  int all = 1;
+  size_t m = 0;
+  sys[0] = '\0';
+  for (int k = 0; lw_system_types[k]; k++) {
+    if (!key_read(lw_system_types[k], v, d)) all = 0;
+    else if (m < n) m += (size_t)snprintf(sys + m, n - m, "%s%s", m ? ", " : "", lw_system_types[k]->name);
+  }
+  if (all) snprintf(sys, n, "all");
+}
+
 void lw_anneal_key_readers(const lw_param_def *d, char *buf, size_t n)
 {
-  enum { DRIVERS_MAX = 8 };
-  char sys[DRIVERS_MAX][128];
-  int v = 0, same = 1;
-  for (; lw_driver_types[v] && v < DRIVERS_MAX; v++) {
-    int all = 1;
-    sys[v][0] = '\0';
-    for (int k = 0; lw_system_types[k]; k++) {
-      const lw_system_type *t = lw_system_types[k];
-      size_t m = strlen(sys[v]);
-      if (key_read(t, lw_driver_types[v], d)) snprintf(sys[v] + m, sizeof sys[v] - m, "%s%s", m ? ", " : "", t->name);
-      else all = 0;
-    }
-    if (all) snprintf(sys[v], sizeof sys[v], "all");
-    same &= !strcmp(sys[v], sys[0]);
+  char first[128], sys[128], other[128];
+  systems_reading(d, lw_driver_types[0], first, sizeof first);
+  int same = 1;
+  for (int v = 1; lw_driver_types[v]; v++) {
+    systems_reading(d, lw_driver_types[v], sys, sizeof sys);
+    same &= !strcmp(sys, first);
   }
   if (same) {
-    snprintf(buf, n, "%s", sys[0]);
+    snprintf(buf, n, "%s", first);
     return;
   }
   /* the drivers that read it from the same systems together: "S under a, b; T under c" */
   size_t m = 0;
   if (n) buf[0] = '\0';
-  for (int k = 0; k < v && m < n; k++) {
-    int first = 1;
-    for (int j = 0; j < k; j++) first &= strcmp(sys[j], sys[k]) != 0;
-    if (!sys[k][0] || !first) continue;
-    m += (size_t)snprintf(buf + m, n - m, "%s%s under %s", m ? "; " : "", sys[k], lw_driver_types[k]->name);
-    for (int j = k + 1; j < v && m < n; j++)
-      if (!strcmp(sys[j], sys[k])) m += (size_t)snprintf(buf + m, n - m, ", %s", lw_driver_types[j]->name);
+  for (int v = 0; lw_driver_types[v] && m < n; v++) {
+    systems_reading(d, lw_driver_types[v], sys, sizeof sys);
+    int seen = !sys[0];
+    for (int u = 0; u < v && !seen; u++) {
+      systems_reading(d, lw_driver_types[u], other, sizeof other);
+      seen = !strcmp(other, sys);
+    }
+    if (seen) continue;
+    m += (size_t)snprintf(buf + m, n - m, "%s%s under %s", m ? "; " : "", sys, lw_driver_types[v]->name);
+    for (int u = v + 1; lw_driver_types[u] && m < n; u++) {
+      systems_reading(d, lw_driver_types[u], other, sizeof other);
+      if (!strcmp(other, sys)) m += (size_t)snprintf(buf + m, n - m, ", %s", lw_driver_types[u]->name);
+    }
   }
 }
 
