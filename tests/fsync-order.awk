@@ -13,7 +13,10 @@ END {
     for (j = i - 1; j > 0 && before == ""; j--) if (pid[j] == pid[i]) before = line[j]
     for (j = i + 1; j <= NR && after == ""; j++) if (pid[j] == pid[i]) after = line[j]
     if (index(before, "fsync(") == 0 || index(before, tmp ">)") == 0) { bad++; print "not synced before: " line[i] }
-    if (index(after, "fsync(") == 0 || index(after, "/" dir ">)") == 0) { bad++; print "directory not synced after: " line[i] }
+    if (index(after, "fsync(") == 0 || index(after, "/" dir ">)") == 0) {
+      bad++
+      print "directory not synced after: " line[i]
+    }
   }
   print n " renames"
   exit !(n >= 5 && bad == 0)

@@ -1637,7 +1637,8 @@ Test(cli, a_narrow_terminal_gets_its_bar_cut_to_its_width)
   const int cols[2] = {40, 72};
   for (int c = 0; c < 2; c++) {
     cr_assert_eq(lw_test_sh("cd %s && script -qec 'stty cols %d; %s run %s/params/minimal.ini --out n%d "
-                            "--set anneal.sweeps=30' /dev/null > tty.txt", dir, cols[c], lw_test_bin(), lw_test_root(), c),
+                            "--set anneal.sweeps=30' /dev/null > tty.txt", dir, cols[c], lw_test_bin(), lw_test_root(),
+                            c),
                  0);
     char *out = lw_test_slurp("%s/tty.txt", dir);
     cr_assert_not_null(out);

@@ -186,7 +186,8 @@ Test(imagefield, a_blurred_potential_spreads_phi_and_keeps_its_sum)
   ** the blur repeats the edge and Phi continues it: black beyond */
   f.grid = lw_imagefield_potential(img, &pl, 8.0, 2.0, 0, NULL);
   cr_assert_not_null(f.grid);
-  cr_assert(lw_potential_eval(&f, -50, 3) < 1e-6 && lw_potential_eval(&f, -0.5, 10.5) == lw_potential_eval(&f, 0.5, 10.5),
+  cr_assert(lw_potential_eval(&f, -50, 3) < 1e-6 &&
+                lw_potential_eval(&f, -0.5, 10.5) == lw_potential_eval(&f, 0.5, 10.5),
             "the edge continued: %g", lw_potential_eval(&f, -50, 3));
   cr_assert(fabs(lw_potential_eval(&f, 10.5, 10.5) - centre) < 1e-6, "the same blur inside");
   lw_potential_clear(&f);

@@ -99,10 +99,11 @@ Test(terms, a_tiny_segment_bends_as_its_scale_says)
     gk.n = s.n;
     lw_term_types[LW_TERM_BENDING].segment_grad(&s, &ctx, &gk);
     for (int i = 0; i < s.n; i++) {
-      const double want[4] = {g1.dx[i], g1.dy[i], g1.ddx[i], g1.ddy[i]}, got[4] = {gk.dx[i], gk.dy[i], gk.ddx[i], gk.ddy[i]};
+      const double want[4] = {g1.dx[i], g1.dy[i], g1.ddx[i], g1.ddy[i]},
+                   got[4] = {gk.dx[i], gk.dy[i], gk.ddx[i], gk.ddy[i]};
       for (int c = 0; c < 4; c++)
-        cr_assert(fabs(got[c] * k * k - want[c]) <= 1e-9 * fabs(want[c]) + 1e-12 * b1, "scale %g node %d: %g against %g",
-                  k, i, got[c] * k * k, want[c]);
+        cr_assert(fabs(got[c] * k * k - want[c]) <= 1e-9 * fabs(want[c]) + 1e-12 * b1,
+                  "scale %g node %d: %g against %g", k, i, got[c] * k * k, want[c]);
     }
     lw_test_straight(t, 0, 0.3 * k, 0.1 * k, 10.3 * k, 0.1 * k); /* level: its cross is 0 exactly */
     samples_of(&q, t, 0, &s);
