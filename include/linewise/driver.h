@@ -13,12 +13,12 @@
 ** the row's keys_dynamics and [dynamics].
 **
 ** Adding a chain driver with another acceptance rule: a file with its row
-** (the name, LW_DRIVE_CHAIN, lw_driver_chain_keys, the keys it ignores,
-** its `accept`) and one
-** entry in lw_driver_types[] (driver.c); mention it in the help of
-** `[scene] driver` (src/params.c; `make docs`).  Everything else (the key
-** checks and notes, docs/PARAMETERS.md's "read by", the chain, tempering,
-** summary.json's `driver`, the statistics' tuning stretch) reads the row.
+** (the name, LW_DRIVE_CHAIN, lw_driver_chain_keys, the keys it ignores, its
+** `accept`; driver_barker.c) and one entry in lw_driver_types[] (driver.c);
+** mention it in the help of `[scene] driver` (src/params.c; `make docs`).
+** Everything else (the key checks and notes, docs/PARAMETERS.md's "read
+** by", the chain and its step tuning, tempering, summary.json's `driver`,
+** the statistics' tuning stretch) reads the row.
 */
 #ifndef LINEWISE_DRIVER_H
 #define LINEWISE_DRIVER_H
@@ -41,10 +41,12 @@ typedef struct lw_driver_type {
                               ** read (NULL: none) */
   /* a chain's acceptance rule: the probability of taking a move whose log
   ** ratio is x = log q - dE / T (q the system's Hastings factor, 1 for a
-  ** symmetric move), x from -infinity to +infinity; the chain draws one uniform number for
-  ** each decision at T > 0 and runs without delayed acceptance, whose second
-  ** stage is Metropolis's.  NULL: Metropolis, min(1, e^x), drawing nothing
-  ** where x >= 0 (and delayed acceptance where the scene asks) */
+  ** symmetric move), x from -infinity to +infinity; the chain draws one
+  ** uniform number for each decision at T > 0, runs without delayed
+  ** acceptance, whose second stage is Metropolis's, and tunes its steps to
+  ** each target as a share of accept(0) (mc.h).  NULL: Metropolis, min(1,
+  ** e^x), drawing nothing where x >= 0 (and delayed acceptance where the
+  ** scene asks) */
   double (*accept)(double x);
 } lw_driver_type;
 
