@@ -1121,6 +1121,19 @@ const char *lw_params_unseen_char(const char *value, char *buf, size_t n)
                  unseen[k].name, unseen[k].code);
         return buf;
       }
+  /* a control character or a byte that is no UTF-8 (0xFF, a Latin-1 letter)
+  ** shows as nothing or as garbage in the message: its number, then */
+  for (size_t i = 0; value[i];) {
+    const unsigned char b = (unsigned char)value[i];
+    size_t len = b < 0x80 ? 1 : (b & 0xe0) == 0xc0 ? 2 : (b & 0xf0) == 0xe0 ? 3 : (b & 0xf8) == 0xf0 ? 4 : 0;
+    int bad = !len || (b < 0x20 && b != '\t') || b == 0x7f;
+    for (size_t k = 1; k < len && !bad; k++) bad = ((unsigned char)value[i + k] & 0xc0) != 0x80;
+    if (bad) {
+      snprintf(buf, n, " (byte %zu is 0x%02X, not a character of text: delete it)", i + 1, b);
+      return buf;
+    }
+    i += len;
+  }
   return buf;
 }
 

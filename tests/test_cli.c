@@ -327,6 +327,7 @@ Test(cli, an_unseen_character_is_named_in_the_values_refused_after_reading)
 {
   static const char *const line[][2] = {{"[anneal]\nschedule = geometric\xc2\xa0\n", "anneal.schedule"},
                                         {"[scene]\nsystem = splines\xc2\xa0\n", "scene.system"},
+                                        {"[scene]\ndriver = barker\xc2\xa0\n", "scene.driver"},
                                         {"[scene]\nimage = none.png\xc2\xa0\n", "scene.image"}};
   char out[1024], errs[1024], args[256];
   for (size_t k = 0; k < sizeof line / sizeof line[0]; k++) {

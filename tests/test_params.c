@@ -134,6 +134,15 @@ Test(params, bad_input_names_file_line_and_key)
                "got '50\xc2\xa0' (byte 3 is a no-break space, U+00A0: delete it or type a plain space)");
   cr_assert_eq(lw_params_set(&q, "energy.pair=\xef\xbb\xbf" "1", &err), LW_EUSAGE);
   cr_assert(strstr(err.msg, "(byte 1 is a byte-order mark, U+FEFF"), "%s", err.msg);
+  /* and a byte that is no text (no UTF-8, or a control character) by its number; a letter of UTF-8 is text */
+  const char *stray[3][2] = {{"bark\xff" "er", "(byte 5 is 0xFF, not a character of text: delete it)"},
+                             {"me\x01tropolis", "(byte 3 is 0x01, not a character of text"},
+                             {"m\xc3\xa9tropolis", NULL}};
+  for (int k = 0; k < 3; k++) {
+    char buf[96];
+    lw_params_unseen_char(stray[k][0], buf, sizeof buf);
+    cr_assert(stray[k][1] ? strstr(buf, stray[k][1]) != NULL : !buf[0], "%s: '%s'", stray[k][0], buf);
+  }
 }
 
 Test(params, missing_file_is_input_error)
