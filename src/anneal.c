@@ -88,6 +88,9 @@ void lw_anneal_tuning_note(const lw_anneal *a, char *buf, size_t n)
                             m ? ", " : "", a->sys_type->move_names[k], 100.0 * acc, 100.0 * c->target[k]);
     }
   }
+  if (m && m + 1 < n && ceiling < 1.0)
+    m += (size_t)snprintf(buf + m, n - m, " (under driver = %s a target is its share of %.0f %%, the acceptance of "
+                          "the smallest steps)", a->params.driver, 100.0 * ceiling);
   if (m && m + 1 < n)
     m += (size_t)snprintf(buf + m, n - m, ": moves.tune_sweeps = %d sweeps was too short to tune their step for this "
                           "system (raise it)", a->params.tune_sweeps);

@@ -53,7 +53,6 @@ void lw_chain_free(lw_chain *c)
   free(c);
 }
 
-/* A step update once the window of a kind is full. */
 void lw_chain_set_rule(lw_chain *c, double (*accept)(double x))
 {
   const double from = lw_chain_ceiling(c);
@@ -63,6 +62,7 @@ void lw_chain_set_rule(lw_chain *c, double (*accept)(double x))
 
 double lw_chain_ceiling(const lw_chain *c) { return c->accept ? c->accept(0.0) : 1.0; }
 
+/* A step update once the window of a kind is full. */
 static void tune_window(lw_chain *c, int kind)
 {
   if (c->win_prop[kind] < LW_TUNE_WINDOW) return;

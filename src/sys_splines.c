@@ -1393,6 +1393,7 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
                            *const scale[] = {"scene.potential_scale", NULL},
                            *const picture[] = {"scene.potential_power", "scene.potential_blur",
                                                "scene.potential_paper", NULL},
+                           *const paper[] = {"scene.potential_paper", NULL},
                            *const centre[] = {"scene.center_x", "scene.center_y", NULL},
                            *const core[] = {"scene.field_core", NULL};
   const int fo = p->field_coef != 0.0, po = p->potential_coef != 0.0, f = p->field, q = p->potential;
@@ -1412,6 +1413,8 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
   rule[n++] = (lw_idle_rule){scale, po && q != LW_POT_RAMP && q != LW_POT_RADIAL,
                              "scene.potential is not ramp or radial"};
   rule[n++] = (lw_idle_rule){picture, po && q != LW_POT_IMAGE, "scene.potential is not image"};
+  rule[n++] = (lw_idle_rule){paper, po && q == LW_POT_IMAGE && !(p->potential_blur > 0.0),
+                             "scene.potential_blur is 0"};
   rule[n++] = (lw_idle_rule){centre, !(fo && (f == LW_FLD_RADIAL || f == LW_FLD_VORTEX)) &&
                                          !(po && (q == LW_POT_RAMP || q == LW_POT_RADIAL)),
                              "no radial or vortex field, no ramp or radial potential"};

@@ -178,16 +178,22 @@ static void grad_bending(const lw_samples *s, const lw_term_ctx *ctx, lw_samples
     double c = s->dx[i] * s->ddy[i] - s->ddx[i] * s->dy[i];
     if (c == 0.0) continue; /* straight: no gradient, also where s^-5 overflows (0 inf) */
     const double den = sp2 * sp2 * s->speed[i];
-    double a, b;
-    if (den >= DBL_MIN) {
-      const double inv5 = 1.0 / den;
-      a = ctx->coef * q->w[i] * 2.0 * c * inv5;            /* dE/dc */
-      b = -ctx->coef * q->w[i] * 5.0 * c * c * inv5 / sp2; /* dE/dr' = b r' through s^-5 */
-    } else { /* as the energy: k = c / s^2 keeps its scale where s^5 underflows */
-      const double k = c / sp2, s3 = sp2 * s->speed[i];
-      a = ctx->coef * q->w[i] * 2.0 * k / s3;
-      b = -ctx->coef * q->w[i] * 5.0 * k * k / s3;
+    if (!(den >= DBL_MIN)) {
+      /* as the energy, through k = c / s^2, where s^5 underflows; dE/dc and
+      ** dE/dr' (about 1 / s^3) overflow where s is under 1e-103, their
+      ** products with r' and r'' (about 1 / s^2) do not: those, from the
+      ** components over s */
+      const double k = c / sp2, w = ctx->coef * q->w[i] / sp2, sp = s->speed[i];
+      const double ux = s->dx[i] / sp, uy = s->dy[i] / sp, vx = s->ddx[i] / sp, vy = s->ddy[i] / sp;
+      g->dx[i] += w * (2.0 * k * vy - 5.0 * k * k * ux);
+      g->dy[i] += w * (-2.0 * k * vx - 5.0 * k * k * uy);
+      g->ddx[i] += -w * 2.0 * k * uy;
+      g->ddy[i] += w * 2.0 * k * ux;
+      continue;
     }
+    const double inv5 = 1.0 / den;
+    const double a = ctx->coef * q->w[i] * 2.0 * c * inv5;            /* dE/dc */
+    const double b = -ctx->coef * q->w[i] * 5.0 * c * c * inv5 / sp2; /* dE/dr' = b r' through s^-5 */
     g->dx[i] += a * s->ddy[i] + b * s->dx[i];
     g->dy[i] += -a * s->ddx[i] + b * s->dy[i];
     g->ddx[i] += -a * s->dy[i];

@@ -450,6 +450,7 @@ Test(cli, keys_the_system_never_reads_are_refused)
     {"wire", "--set nurbs.weight_inertia=5", "nurbs.weight_inertia (--set: nurbs.free_weights = 0)"},
     {"minimal", "--set energy.field=1 --set scene.field_core=3",
      "scene.field_core (--set: scene.field is not radial or vortex)"},
+    {"study", "--set scene.potential_paper=0", "scene.potential_paper (--set: scene.potential_blur is 0)"},
     {"wire", "--set dynamics.rho=0 --set dynamics.gamma=5", "params/wire.ini:29: dynamics.rho = 0: no mass to weigh)"},
     {"particles-sheet", "--set particles.max_count=50 --set particles.sigma=0.3",
      "particles.max_count (--set: no particles.birth or death), particles.sigma (--set: particles.weight = poly)"},
@@ -1124,6 +1125,13 @@ Test(cli, the_barker_driver_runs_the_chain_by_its_own_rule)
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini %s --set scene.driver=barker --set moves.target=0.8 "
                           "--out t && awk '/\"steps\"/ { s = 1; next } s && /\"point\"/ { exit !($2 > 0.05) }' "
                           "t/summary.json", dir, b, root, common), 0, "%s", lw_test_slurp("%s/t/summary.json", dir));
+  /* steps far too small show as the smallest steps' acceptance, 1/2, not 1:
+  ** the tuning note judges against that (it waited for 80 %) */
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/wlc.ini --set scene.driver=barker --set moves.tune_sweeps=0 "
+                          "--set moves.step_point=1e-9 --set moves.step_vector=1e-9 --set anneal.sweeps=300 --out f "
+                          "2> note.txt && grep -q 'point moves were accepted 5[0-9.]* %% of the time against the "
+                          "target 22 %%.* (under driver = barker a target is its share of 50 %%, the acceptance of "
+                          "the smallest steps)' note.txt", dir, b, root), 0, "%s", lw_test_slurp("%s/note.txt", dir));
   /* its second stage would be Metropolis's: delayed acceptance is a key it does not read */
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set scene.driver=barker --set anneal.sweeps=2 "
                           "--set anneal.delayed_acceptance=0 --out d 2>&1 | grep -q 'under driver = barker these keys "

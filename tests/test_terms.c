@@ -70,7 +70,8 @@ static void wiggly(lw_splines *sp, size_t i, gsl_rng *r, double x0, double y0)
 /* A segment of 1e-65 mm: |r'|^5 underflows to 0 (and cross^2 with it on a
 ** straight one, which gave 0 / 0 = NaN and a refusal naming coordinates
 ** too large).  Bending goes as 1 / scale: a bent segment scaled down keeps
-** bending x scale, a straight one bends 0. */
+** bending x scale, a straight one bends 0; its gradient in r' and r'' goes
+** as 1 / scale^2, to 1e-150 (it was inf - inf from 1e-62, then from 1e-103). */
 Test(terms, a_tiny_segment_bends_as_its_scale_says)
 {
   lw_quad q;
@@ -87,7 +88,7 @@ Test(terms, a_tiny_segment_bends_as_its_scale_says)
   const lw_term_ctx ctx = {.coef = 1.0, .quad = &q};
   lw_samples_grad g1 = {.n = s.n}, gk;
   lw_term_types[LW_TERM_BENDING].segment_grad(&s, &ctx, &g1);
-  for (double k = 1e-60; k > 1e-70; k *= 0.1) {
+  for (double k = 1e-60; k > 1e-151; k *= 1e-10) { /* s^5 underflows from 1e-62 on, s^3 from 1e-103 */
     lw_splines *t = splines(1, 1);
     for (int n = 0; n < 2; n++) {
       t->node[n] = sp->node[n];

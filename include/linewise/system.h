@@ -75,7 +75,7 @@ typedef struct {
   int idle;
   const char *why;
 } lw_idle_rule;
-#define LW_IDLE_RULES_MAX 16
+#define LW_IDLE_RULES_MAX 24
 
 /* *forbidden of a proposal that is none (lw_system_type.propose). */
 #define LW_PROPOSE_NOTHING 4
