@@ -1143,12 +1143,18 @@ static int cmd_stats(int argc, char **argv)
   char **path = sel ? calloc((size_t)k, sizeof *path) : NULL;
   if (!err.code && !path) lw_error_set(&err, LW_ENOMEM, "out of memory");
   static lw_params p;
-  int failed = -1; /* the run an error is of */
+  int failed = -1, other_driver = -1; /* the run an error is of; the first run of another driver than run 0's */
+  char driver0[sizeof p.driver] = "", driver1[sizeof p.driver] = "";
   for (int r = 0; !err.code && r < k; r++) {
     char where[LW_PATH_MAX + 32];
     lw_path_join(where, sizeof where, dir[r], "scene.ini");
     failed = r;
     if (lw_params_read_run(&p, where, 1, &err)) break;
+    if (!r) snprintf(driver0, sizeof driver0, "%s", p.driver);
+    else if (other_driver < 0 && strcmp(p.driver, driver0)) {
+      other_driver = r;
+      snprintf(driver1, sizeof driver1, "%s", p.driver);
+    }
     sel[r] = base;
     lw_trace_select_of(&p, &sel[r]);
     lw_path_join(where, sizeof where, dir[r], "trace.csv");
@@ -1173,6 +1179,11 @@ static int cmd_stats(int argc, char **argv)
       line += len + (line[len] == '\n');
     }
     free(warned);
+    /* pooled, their means sample one distribution; the rest is of each chain */
+    if (!err.code && other_driver >= 0)
+      fprintf(stderr, "linewise: note: the runs ran under different drivers (%s: %s, %s: %s): their means sample one "
+              "distribution, their acceptances, steps and autocorrelation times are each of its own chain\n", dir[0],
+              driver0, dir[other_driver], driver1);
   }
   /* (the run the error is of may wait aside: "no rows yet" of the run that
   ** was killed replacing it said nothing of it); a statistics' error begins

@@ -1116,6 +1116,10 @@ Test(cli, the_barker_driver_runs_the_chain_by_its_own_rule)
     free(js);
   }
   cr_assert(rate[1] < rate[0] && rate[1] > 0.0, "Barker took %g of its proposals, Metropolis %g", rate[1], rate[0]);
+  /* pooled with Metropolis's run, a note says what the pooling means */
+  cr_assert_eq(lw_test_sh("cd %s && %s stats m0 b0 2> pooled.txt > /dev/null && grep -q 'note: the runs ran under "
+                          "different drivers (m0: metropolis, b0: barker): their means sample one distribution' "
+                          "pooled.txt", dir, b), 0, "%s", lw_test_slurp("%s/pooled.txt", dir));
   /* the statistics leave out the same tuning rows */
   cr_assert_eq(lw_test_sh("cd %s && %s stats m0 --csv | sed -n 2p | cut -d, -f2 > nm && %s stats b0 --csv | sed -n 2p "
                           "| cut -d, -f2 > nb && cmp -s nm nb && test $(cat nb) -lt 60", dir, b, b), 0);
