@@ -95,9 +95,17 @@ lw_status lw_output_subdir(const char *dir, const char *sub, char *path, size_t 
   return LW_OK;
 }
 
-/* A rename outlasts a power cut only once its directory is on disk too; a
-** directory that cannot be synced (a file system without it) leaves the old
-** file or the new one, each whole, so nothing is reported. */
+/* A directory that cannot be synced (a file system without it) leaves the
+** old file or the new one, each whole, so nothing is reported. */
+void lw_output_sync_dir(const char *dir)
+{
+  int fd = open(dir, O_RDONLY | O_DIRECTORY);
+  if (fd < 0) return;
+  (void)fsync(fd);
+  close(fd);
+}
+
+/* A rename outlasts a power cut only once its directory is on disk too. */
 static void sync_directory_of(const char *path)
 {
   char dir[4096];
@@ -106,10 +114,7 @@ static void sync_directory_of(const char *path)
   else if (slash == path) snprintf(dir, sizeof dir, "/");
   else if ((size_t)(slash - path) < sizeof dir) snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
   else return;
-  int fd = open(dir, O_RDONLY | O_DIRECTORY);
-  if (fd < 0) return;
-  (void)fsync(fd);
-  close(fd);
+  lw_output_sync_dir(dir);
 }
 
 lw_status lw_output_commit(FILE *f, const char *tmp, const char *path, lw_error *err)
@@ -286,7 +291,10 @@ lw_status lw_output_svg_strokes(const lw_strokes *s, const lw_output_page *page,
       fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"%d %s (", k + 1, page->pen_name[k]);
     else fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"%d pen (", k + 1);
     put_mm(f, pen->width_mm);
-    fprintf(f, " mm)\" id=\"pen%d\">\n", k + 1);
+    /* layers multiply as inks on paper, as the previews draw them (a browser
+    ** or Inkscape showed the top pen opaque where two cross); plotter tools
+    ** read no group style */
+    fprintf(f, " mm)\" id=\"pen%d\"%s>\n", k + 1, page->multiply ? " style=\"mix-blend-mode:multiply\"" : "");
     size_t a, z;
     lw_strokes_pen_range(s, k, &a, &z);
     for (size_t j = a; j < z; j++) {

@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "linewise/output.h"
 #include "linewise/params.h"
 #include "linewise/rundir.h"
 
@@ -89,6 +90,21 @@ static void prune(const char *root)
   for (size_t g = 1; g < sizeof groups / sizeof groups[0]; g++) {
     snprintf(path, sizeof path, "%s/%s", root, groups[g].sub);
     rmdir(path);
+  }
+}
+
+/* fsync of root and of its folders of run files.  A stash's marker changes
+** only after this on both sides: on disk it never says more than the moves
+** before it did (a .moved whose moves a power cut undid would have the
+** recovery take the run before's state.lw, still in DIR, for the new run's
+** and drop the rest of that run). */
+static void sync_run_dirs(const char *root)
+{
+  char path[2 * LW_PATH_MAX];
+  struct stat sb;
+  for (size_t g = 0; g < sizeof groups / sizeof groups[0]; g++) {
+    snprintf(path, sizeof path, "%s/%s", root, groups[g].sub);
+    if (!lstat(path, &sb) && S_ISDIR(sb.st_mode)) lw_output_sync_dir(path);
   }
 }
 
@@ -280,11 +296,13 @@ lw_status lw_runfiles_unstash(const char *dir, lw_error *err)
     ** moving back left it .moved, and the next recover took the run before's
     ** state.lw, back already, for the new run's and dropped the rest) */
     each_file(dir, remove_new, (void *)dir);
+    sync_run_dirs(dir);
     stash_path(moved, sizeof moved, dir, ".moved");
     stash_path(restoring, sizeof restoring, dir, ".restoring");
     if (rename(moved, restoring))
       return lw_error_set(err, LW_EIO, "%s: cannot rename: %s; the run that was there before is in %s", moved,
                           strerror(errno), st);
+    lw_output_sync_dir(st);
   }
   /* .moving or .restoring: every run file in the stash goes back, over a
   ** counterpart in dir (the new run's) */
@@ -296,6 +314,8 @@ lw_status lw_runfiles_unstash(const char *dir, lw_error *err)
     return lw_error_set(err, LW_EIO, "%s/%s: cannot put it back: %s; the rest of the run that was there before "
                         "is in %s", dir, m.rel, strerror(m.err), st);
   }
+  sync_run_dirs(dir);
+  sync_run_dirs(st);
   remove_stash_dir(dir);
   prune(dir);
   return LW_OK;
@@ -317,8 +337,16 @@ lw_status lw_runfiles_stash(const char *dir, lw_error *err)
     rmdir(st);
     return lw_error_set(err, LW_EIO, "%s: cannot write: %s; the run there is as it was", marker, strerror(e));
   }
+  /* (the stash and its marker on disk before any move into it: a stash
+  ** without a marker is not linewise's, and what it held would be lost) */
+  lw_output_sync_dir(st);
+  lw_output_sync_dir(dir);
   mover m = {dir, st, 0, ""};
   const int unread = each_file(dir, move_one, &m) && !m.err; /* (a folder of it would not open) */
+  if (!m.err && !unread) {
+    sync_run_dirs(dir);
+    sync_run_dirs(st);
+  }
   if (m.err || unread || rename(marker, moved)) {
     const int e = m.err ? m.err : errno;
     char what[LW_PATH_MAX + 32];
@@ -329,6 +357,7 @@ lw_status lw_runfiles_stash(const char *dir, lw_error *err)
       return lw_error_set(err, LW_EIO, "%s: cannot set it aside: %s; %s", what, strerror(e), back.msg);
     return lw_error_set(err, LW_EIO, "%s: cannot set it aside: %s; the run there is as it was", what, strerror(e));
   }
+  lw_output_sync_dir(st);
   prune(dir);
   return LW_OK;
 }

@@ -1620,6 +1620,24 @@ Test(cli, every_file_a_run_replaces_is_synced_before_and_its_rename_after)
                0, "%s", lw_test_slurp("%s/order.txt", dir));
 }
 
+/* A run that replaces one sets the run before aside by renames into
+** DIR/.replaced, whose marker then says .moved: from then on a recovery takes
+** DIR's state.lw for the new run's.  The marker's rename on disk before the
+** moves it speaks of would, after a power cut, have the run before's
+** state.lw taken for the new run's and the rest of that run dropped: strace
+** sees the directory and the stash synced between the last move and the
+** marker's rename, and the stash after it. */
+Test(cli, a_run_set_aside_is_synced_before_its_marker_says_so)
+{
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=5 --out r --quiet && "
+                          "ASAN_OPTIONS=detect_leaks=0 strace -f -y -e trace=fsync,rename,renameat,renameat2 -o st.txt "
+                          "%s run %s/params/minimal.ini --set anneal.sweeps=7 --out r --quiet && "
+                          "grep -qx 'sweep = 7' r/state.lw && test ! -e r/.replaced && "
+                          "awk -f %s/tests/stash-order.awk st.txt > order.txt",
+                          dir, lw_test_bin(), lw_test_root(), lw_test_bin(), lw_test_root(), lw_test_root()),
+               0, "%s", lw_test_slurp("%s/order.txt", dir));
+}
+
 /* On a terminal the progress is one bar redrawn in place (carriage returns,
 ** no plain "elapsed" lines), full at the last sweep and ended by a new
 ** line; --quiet draws none.  script(1) gives the run its terminal. */

@@ -888,11 +888,12 @@ Test(layers, the_svg_has_one_group_a_pen_with_its_colour_and_width)
   for (const char *c = svg; (c = strstr(c, "<g ")); c++) groups++;
   cr_assert_eq(groups, 4, "one group a pen");
   for (int k = 0; k < 4; k++) {
-    char id[32], head[64], stroke[64];
+    char id[32], head[128], stroke[64];
     snprintf(id, sizeof id, "id=\"pen%d\"", k + 1);
     const char *g = strstr(svg, id), *next = k < 3 ? strstr(svg, (snprintf(head, sizeof head, "id=\"pen%d\"", k + 2), head)) : svg + strlen(svg);
     cr_assert_not_null(g, "%s", id);
-    snprintf(head, sizeof head, "inkscape:label=\"%d %c (%s mm)\" id=\"pen%d\"", k + 1, "cmyk"[k], width[k], k + 1);
+    snprintf(head, sizeof head, "inkscape:label=\"%d %c (%s mm)\" id=\"pen%d\" style=\"mix-blend-mode:multiply\">",
+             k + 1, "cmyk"[k], width[k], k + 1);
     cr_assert_not_null(strstr(svg, head), "%s", head);
     /* every path of the group in the pen's colour and width */
     snprintf(stroke, sizeof stroke, "stroke=\"%s\" stroke-width=\"%s\"", colour[k], width[k]);

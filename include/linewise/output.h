@@ -168,6 +168,10 @@ lw_status lw_output_subdir(const char *dir, const char *sub, char *path, size_t 
 ** in every case. */
 lw_status lw_output_commit(FILE *f, const char *tmp, const char *path, lw_error *err);
 
+/* fsync of the directory dir, so that the renames and removals in it so far
+** outlast a power cut; quiet where the file system cannot. */
+void lw_output_sync_dir(const char *dir);
+
 /* Gives up a file from lw_output_open_tmp: closes f and removes tmp. */
 void lw_output_abort(FILE *f, const char *tmp);
 
