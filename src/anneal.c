@@ -377,18 +377,28 @@ static int parse_ladder(const lw_params *p, const char *text, const char *where,
 {
   int n = lw_number_list(text, p->of_run ? 1 : 2, ladder, LW_TEMPERING_MAX);
   const int long_text = strlen(text) > 120; /* (257 rungs echoed 4.7 KB on one line) */
+  if (n == -1) { /* the word that is no number ("1 2x 4" was said not to be 2 to 256 temperatures) */
+    const char *w = text;
+    size_t len = 0;
+    double v;
+    while (*(w += len + strspn(w + len, " \t,")) && lw_number_parse_n(w, len = strcspn(w, " \t,"), &v)) {}
+    len = strcspn(w, " \t,");
+    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': '%.*s' is not a temperature; expected finite "
+                        "numbers such as 0.5 or 2e-3", where, len > 60 ? 60 : (int)len, w), 0;
+  }
   if (n < 2 || n > LW_TEMPERING_MAX)
     return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%.120s%s'%s",
                         where, LW_TEMPERING_MAX, text, long_text ? "..." : "", lw_number_list_hint(n)), 0;
-  if (p->replicas != 1 && p->replicas != n)
-    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': %d temperatures for %d replicas: the ladder "
-                        "sets the count, so expected tempering.replicas = %d or 1 (its default)", where, n,
-                        p->replicas, n), 0;
-  /* (up to 1e300, as t_min and t_max) */
+  /* (up to 1e300, as t_min and t_max); before the count against replicas,
+  ** which sent "1 2 2 4" to replicas = 4 first and then refused it anyway */
   for (int k = 0; k < n; k++)
     if (!(ladder[k] > 0.0) || !(ladder[k] <= 1e300) || (k > 0 && !(ladder[k] > ladder[k - 1])))
       return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected increasing positive "
                           "temperatures up to 1e300, got '%.120s%s'", where, text, long_text ? "..." : ""), 0;
+  if (p->replicas != 1 && p->replicas != n)
+    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': %d temperatures for %d replicas: the ladder "
+                        "sets the count, so expected tempering.replicas = %d or 1 (its default)", where, n,
+                        p->replicas, n), 0;
   return n;
 }
 
@@ -468,9 +478,14 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
                         "holds; expected one process (mpirun -n 1, or linewise) for %d", where, a->net->size);
   }
   if (a->net && a->n_rep < a->net->size) {
-    lw_params_origin(p, lw_params_find("tempering", "replicas"), where, sizeof where);
-    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.replicas': %d replicas for %d processes; expected at "
-                        "least one replica per process", where, a->n_rep, a->net->size);
+    /* the key that set the count: the ladder's length, where one is given
+    ** (replicas "not set: the default, 1" was blamed for a ladder of 3) */
+    const char *key = lw_params_given(p, lw_params_find("tempering", "ladder")) ? "ladder"
+                      : lw_params_given(p, lw_params_find("tempering", "ladder_file")) ? "ladder_file" : "replicas";
+    lw_params_origin(p, lw_params_find("tempering", key), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.%s': %d replicas for %d processes; expected at least one "
+                        "replica per process%s", where, key, a->n_rep, a->net->size,
+                        key[0] == 'l' ? " (the ladder's temperatures set the count)" : "");
   }
   lw_params_origin(p, lw_params_find("anneal", "t_start"), where, sizeof where);
   if (a->n_rep > 1 && !(p->t_start > 0.0))
@@ -1061,17 +1076,32 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
 
 int lw_anneal_undo_start(lw_anneal *a)
 {
-  if (!a->fresh) return a->put_back;
+  if (!a->fresh && !a->stashed) return a->put_back;
+  const int fresh = a->fresh;
   a->fresh = 0;
   if (a->stashed) {
     lw_error e;
     a->put_back = !lw_runfiles_unstash(a->dir, &e);
     a->stashed = 0;
-    lw_phase_stash(a->put_back ? 0 : 1);
+    if (fresh) lw_phase_stash(a->put_back ? 0 : 1);
   } else {
     lw_runfiles_remove(a->dir); /* no run was there: every run file is the set-up's */
   }
   return a->put_back;
+}
+
+/* The run set aside goes once this one has done a sweep or ended: a run
+** that failed before (a dynamics whose first step cannot converge, at
+** sweep 0 after its first checkpoint) took the finished drawing with it and
+** left a state that fails again on resume.  A kill in between leaves the
+** new run's checkpoint, which the next run or resume there keeps
+** (lw_runfiles_recover), as a stop does here. */
+static void drop_stash(lw_anneal *a)
+{
+  lw_error e;
+  if (!a->stashed || a->fresh) return;
+  if (lw_runfiles_drop(a->dir, &e)) snprintf(a->stash_left, sizeof a->stash_left, "%s", e.msg);
+  a->stashed = 0;
 }
 
 /* The new run's first files, up to its first checkpoint (net: the first is
@@ -1130,14 +1160,15 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
   a->ckpt_seconds += now_seconds() - t0;
   lw_phase_set(was);
   if (!s) a->saved = a->sweep + 1;
-  if (!s && a->fresh) { /* the first: the run before, set aside, can go */
-    a->fresh = 0;
-    lw_error e;
-    if (a->stashed && lw_runfiles_drop(a->dir, &e)) snprintf(a->stash_left, sizeof a->stash_left, "%s", e.msg);
-    a->stashed = 0;
-    lw_phase_stash(0);
-  }
-  return s;
+  if (s) return s;
+  const int first = a->fresh;
+  a->fresh = 0;
+  if (first) lw_phase_stash(0); /* (a stop no longer makes the new run give way) */
+  /* the run set aside goes with the first sweep (drop_stash); a spread
+  ** run's with the first checkpoint, its processes failing together only
+  ** at a sweep */
+  if (!first || a->net) drop_stash(a);
+  return LW_OK;
 }
 
 /* The sweep of the last row within the first `bytes` bytes of the trace
@@ -1769,6 +1800,7 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
   const double t0 = now_seconds();
   s = sweep_once(a, err);
   a->sweep_seconds += now_seconds() - t0;
+  if (!s) drop_stash(a);
   return s;
 }
 
@@ -2051,6 +2083,7 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
   }
   if (a->drawing) *a->drawing = s ? 0 : 2;
   lw_phase_set(NULL);
+  if (!s) drop_stash(a);
   return s;
 }
 

@@ -591,8 +591,29 @@ static int watched_fail(watcher *w, const lw_error *err)
 /* A run that failed to write (a full disk) says that state.lw still holds
 ** its last checkpoint, and how to go on: the last this process wrote, or
 ** the one the loop began from (the set-up's, or the one a resume read). */
-static int loop_fail(const lw_anneal *a, long began, watcher *w, lw_error *err)
+/* The run set aside could not all be removed once this one replaced it:
+** said under --quiet too (what is left takes disk space, and the next run or
+** resume there tries again). */
+static void say_stash_left(lw_anneal *a)
 {
+  if (a->stash_left[0]) fprintf(stderr, "linewise: warning: %s\n", a->stash_left);
+  a->stash_left[0] = 0;
+}
+
+static int loop_fail(lw_anneal *a, long began, watcher *w, lw_error *err)
+{
+  /* a run that failed before its first sweep was done gives the directory
+  ** back to the run it was to replace (anneal.c, drop_stash) */
+  if (a->stashed) {
+    const size_t n = strlen(err->msg);
+    char word[LW_RUNDIR_WORD_MAX];
+    lw_rundir_shell_word(a->dir, word, sizeof word);
+    if (lw_anneal_undo_start(a)) snprintf(err->msg + n, sizeof err->msg - n, "; the run that was in %s is back "
+                                          "as it was", word);
+    else snprintf(err->msg + n, sizeof err->msg - n, "; the run that was in %s did not all come back: what is "
+                  "left of it is in %s/" LW_RUNFILES_STASH, word, word);
+    return watched_fail(w, err);
+  }
   /* memory too: the drawing's joins can run out after hours of sweeps */
   if (err->code == LW_EIO || err->code == LW_ENOMEM) {
     size_t n = strlen(err->msg);
@@ -618,6 +639,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
                 !lw_anneal_done(a);
   while (!stopped && !lw_anneal_done(a)) {
     if (lw_anneal_sweep(a, err)) return loop_fail(a, pg.start_sweep, w, err);
+    say_stash_left(a);
     progress_show(&pg, a, 0);
     stopped = (net ? net->stop_agreed : stop_requested) || (stop_at >= 0 && a->sweep >= stop_at);
   }
@@ -627,7 +649,9 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
 #endif
   /* the checkpoint of the end (lw_anneal_finish's first step) is written
   ** here, so that a second signal while the files are drawn names it */
-  if (a->saved != a->sweep + 1 && lw_anneal_checkpoint(a, err)) return loop_fail(a, pg.start_sweep, w, err);
+  if ((a->saved != a->sweep + 1 || a->stashed) && lw_anneal_checkpoint(a, err))
+    return loop_fail(a, pg.start_sweep, w, err);
+  say_stash_left(a);
   if (stopped) {
     watcher_stop(w, LW_PHASE_DONE);
     char mpi[LW_RUNDIR_WORD_MAX + 96] = "", word[LW_RUNDIR_WORD_MAX];
@@ -653,6 +677,7 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   int drew = 1;
 #endif
   if (s) return loop_fail(a, pg.start_sweep, w, err);
+  say_stash_left(a);
   watcher_stop(w, a->quench.ended == LW_QUENCH_STOPPED ? LW_PHASE_STOPPED : LW_PHASE_DONE);
   if (a->quench.ended == LW_QUENCH_STOPPED) {
     char word[LW_RUNDIR_WORD_MAX];
@@ -964,10 +989,7 @@ static int cmd_run(int argc, char **argv)
   made_what = 0;
   checkpointed = 1;
   watcher_settle(&w);
-  /* the first checkpoint dropped the run set aside, or could not: said
-  ** under --quiet too (what is left takes disk space, and the next run or
-  ** resume there tries again) */
-  if (a.stash_left[0]) fprintf(stderr, "linewise: warning: %s\n", a.stash_left);
+  say_stash_left(&a); /* (an MPI run's first checkpoint drops the run set aside) */
   /* under --quiet too: a seed sweep over an old run's scene.ini brought back
   ** the seeds that draw the same numbers without a word */
   if (a.params.run_header && !a.params.line[lw_params_find("anneal", "seed_version") - lw_param_table] &&

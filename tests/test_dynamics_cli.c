@@ -85,6 +85,26 @@ Test(dynamics_cli, the_whip_writes_frames)
                   "%s/w/summary.json", dir, dir), 0);
 }
 
+/* A run that cannot take its first step (a time step the integrator cannot
+** converge at) fails after its first checkpoint, at sweep 0: into a
+** directory that held a finished drawing it took that drawing with it and
+** left a state that failed again on resume.  The run before waits aside
+** until the new run's first sweep, and comes back byte for byte. */
+Test(dynamics_cli, a_run_that_fails_at_its_first_step_gives_the_run_it_replaced_back)
+{
+  cr_assert_eq(sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=20 --out r --quiet && cp -rp r kept",
+                  dir, lw_test_bin(), lw_test_root()), 0);
+  cr_assert_eq(sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=20 --set scene.driver=dynamics "
+                  "--set dynamics.dt=1e6 --out r --quiet 2> err.txt", dir, lw_test_bin(), lw_test_root()), 1);
+  cr_assert_eq(sh("cd %s && grep -q '^linewise: the dynamics.*; the run that was in r is back as it was$' err.txt && "
+                  "test $(wc -l < err.txt) = 1 && diff -r -x .lock kept r && test ! -e r/.replaced", dir), 0, "%s",
+               lw_test_slurp("%s/err.txt", dir));
+  /* the same run with a step it can take replaces it, the run set aside gone */
+  cr_assert_eq(sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=2 --set scene.driver=dynamics "
+                  "--set dynamics.dt=1e-4 --out r --quiet && grep -q '^driver = dynamics' r/scene.ini && "
+                  "test -e r/summary.json && test ! -e r/.replaced", dir, lw_test_bin(), lw_test_root()), 0);
+}
+
 Test(dynamics_cli, scenes_the_driver_cannot_move_are_refused_with_the_key)
 {
   struct {

@@ -148,6 +148,13 @@ Test(mpi, more_processes_than_replicas_is_refused_before_anything_is_written)
   /* said once, by process 0 */
   cr_assert_eq(sh("test $(grep -c 'replicas for 3 processes' %s/err.txt) -eq 1", dir), 0);
   cr_assert_neq(sh("test -e %s/x", dir), 0, "an output directory was created for bad input");
+  /* a ladder sets the count: its key is named, not replicas "not set: the
+  ** default, 1" */
+  cr_assert_eq(sh(MPIRUN " -n 3 %s run %s/s.ini --set tempering.replicas=1 --set 'tempering.ladder=1 2' --out %s/x --quiet 2>%s/err.txt", m,
+                  dir, dir, dir), 2);
+  cr_assert_eq(sh("grep -q \"^linewise: --set: key 'tempering.ladder': 2 replicas for 3 processes; expected at least "
+                  "one replica per process (the ladder's temperatures set the count)$\" %s/err.txt", dir), 0, "%s",
+               lw_test_slurp("%s/err.txt", dir));
   /* the dynamics moves one system: the driver is what to change, not the
   ** replicas it leaves idle (the message asked for more of them) */
   cr_assert_eq(sh(MPIRUN " -n 2 %s run %s/params/wire.ini --set tempering.replicas=2 --out %s/x --quiet 2>%s/err.txt",

@@ -537,6 +537,12 @@ Test(ptrun, a_ladder_file_runs_as_its_ladder_given_by_set)
     {"[tempering]\nladder = 1 2 3 1e301\n", "", "lad.ini:2: key 'tempering.ladder': expected increasing positive "
      "temperatures up to 1e300"},
     {"[tempering]\nladder = 1 2\n", "", "lad.ini:2: key 'tempering.ladder': 2 temperatures for 4 replicas"},
+    /* the word that is no number is named (said: not 2 to 256 temperatures) */
+    {"[tempering]\nladder = 1 2x 4\n", "", "lad.ini:2: key 'tempering.ladder': '2x' is not a temperature; expected "
+     "finite numbers"},
+    {"[tempering]\nladder = 1, 2, nan, 4\n", "", "lad.ini:2: key 'tempering.ladder': 'nan' is not a temperature"},
+    /* values before the count: "1 2 2" was sent to replicas = 3 first */
+    {"[tempering]\nladder = 1 2 2\n", "", "lad.ini:2: key 'tempering.ladder': expected increasing positive"},
     {"[tempering]\nladder = 1 2 3 4\n", "--set 'tempering.ladder=1 2 3 5'",
      "f.ini:32: key 'tempering.ladder_file': tempering.ladder is given too (--set); expected one of them"},
     {NULL, "", "f.ini:32: key 'tempering.ladder_file': cannot read '"},

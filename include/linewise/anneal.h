@@ -64,7 +64,7 @@ typedef struct lw_anneal {
   long pause_at;               /* resume --sweeps N short of end_sweep: stop there as --stop-at does (-1: none) */
   int extending, new_end;      /* a resume to settle before its first sweep (anneal.c) */
   int fresh;                   /* the set-up has written files and no checkpoint yet */
-  int stashed;                 /* the run it replaces is set aside until then (runfiles.h) */
+  int stashed;                 /* the run it replaces is set aside until its first sweep (runfiles.h) */
   int put_back;                /* a set-up that failed put the run it was to replace back */
   int gave_way;                /* the set-up failed as a stop was asked (lw_phase_stopping) */
   char stash_left[LW_ERROR_MSG]; /* why the run replaced stayed in DIR/.replaced ("": it went) */
@@ -144,9 +144,13 @@ static inline int lw_anneal_done(const lw_anneal *a) { return a->sweep >= a->end
 ** (tests/embed.cpp). */
 static inline int lw_anneal_paused(const lw_anneal *a) { return a->pause_at >= 0 && a->sweep >= a->pause_at; }
 
-/* After a start that failed, here or later (the network's first checkpoint):
-** the set-up's files go and the run it was to replace comes back; 1 if that
-** run all came back.  Nothing once the first checkpoint is written. */
+/* After a start that failed, here or later (the network's first checkpoint),
+** or a run that failed before its first sweep was done (lw_anneal_sweep)
+** or its end (lw_anneal_finish): the set-up's files go and the run it was
+** to replace comes back; 1 if that run all came back.  Nothing once the first
+** checkpoint is written where no run was set aside, nor once the run set
+** aside has gone (the first sweep, a later checkpoint, the end; under MPI
+** the first checkpoint). */
 int lw_anneal_undo_start(lw_anneal *a);
 
 /* Writes state.lw now (a clean stop). */
