@@ -122,7 +122,7 @@ lw_status lw_domains_attach(lw_chain *c, const lw_params *p, int replicas, lw_er
     ** resumed does too: runs before 2026-12-05 wrote the page's count into
     ** scene.ini, not the one they took (later ones write the one taken,
     ** which fits) */
-    const int chosen = !p->line[lw_params_find("anneal", "domains") - lw_param_table] ||
+    const int chosen = !lw_params_line(p, "anneal", "domains") ||
                        (p->of_run && p->preset == LW_PRESET_PHOTO);
     if (chosen) {
       while (nx > 1 && !(w / nx > 2.0 * reach && h / ny > 2.0 * reach)) nx = ny = nx - 1;

@@ -109,8 +109,8 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
   /* the bound given last is blamed: one of --set over the scene file's, a
   ** later line over an earlier (a tone_min raised by --set was blamed on the
   ** file's tone_max); of two --set, whose order is not kept, tone_max */
-  const int at_min = p->line[lw_params_find("layers", "tone_min") - lw_param_table],
-            at_max = p->line[lw_params_find("layers", "tone_max") - lw_param_table];
+  const int at_min = lw_params_line(p, "layers", "tone_min"),
+            at_max = lw_params_line(p, "layers", "tone_max");
   const int min_last = given(p, "tone_min") && (!given(p, "tone_max") || (at_min < 0 && at_max > 0) ||
                                                  (at_min > 0 && at_max > 0 && at_min > at_max));
   const char *last = min_last ? "tone_min" : "tone_max";

@@ -717,6 +717,17 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   return 0;
 }
 
+/* Whether arg is an option of some command that takes the next argument
+** as its value: what "--" and the threads asked skip over. */
+static int takes_value(const char *arg)
+{
+  static const char *const valued[] = {"--set",   "--out",  "--seed", "--stop-at", "--threads",
+                                       "--sweeps", "--from", "--to",   "--reweight"};
+  for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
+    if (!strcmp(arg, valued[k])) return 1;
+  return 0;
+}
+
 /* A count on the command line from 0 to max, read by the parser of scene
 ** keys; sweep counts stop at 1e15, so sweep + count cannot overflow. */
 static int parse_count(const char *opt, const char *v, double max, long *out, lw_error *err)
@@ -860,6 +871,8 @@ static int cmd_run(int argc, char **argv)
   static lw_params p;
   /* the scene file first, so --set applies on top of it whatever the order */
   for (int i = 0; i < argc; i++) {
+    /* run's own options with a value (takes_value has every command's: here
+    ** another's, --sweeps say, is refused below as run's unknown option) */
     if (!strcmp(argv[i], "--set") || !strcmp(argv[i], "--out") || !strcmp(argv[i], "--seed") ||
         !strcmp(argv[i], "--stop-at") || !strcmp(argv[i], "--threads")) {
       /* an option where the value should be is the value left out (taken as
@@ -992,7 +1005,7 @@ static int cmd_run(int argc, char **argv)
   say_stash_left(&a); /* (an MPI run's first checkpoint drops the run set aside) */
   /* under --quiet too: a seed sweep over an old run's scene.ini brought back
   ** the seeds that draw the same numbers without a word */
-  if (a.params.run_header && !a.params.line[lw_params_find("anneal", "seed_version") - lw_param_table] &&
+  if (a.params.run_header && !lw_params_line(&a.params, "anneal", "seed_version") &&
       (!net || !net->rank))
     fprintf(stderr, "linewise: note: anneal.seed_version = 1: %s is a run's scene.ini from before 2026-12-06, so this "
             "run seeds as that one did, where two seeds could draw the same numbers; --set anneal.seed_version=2 for "
@@ -1183,8 +1196,8 @@ static int cmd_stats(int argc, char **argv)
     if (!(path[r] = strdup(where))) lw_error_set(&err, LW_ENOMEM, "out of memory");
     else t[r] = lw_trace_read(where, &err);
   }
-  if (!err.code) failed = -1;
   if (!err.code) {
+    failed = -1;
     /* with --csv the warnings no column carries go to stderr, a line each */
     char *warned = NULL;
     size_t warned_len = 0;
@@ -1230,15 +1243,9 @@ static int cmd_stats(int argc, char **argv)
 ** Returns 0, or 1 out of memory (the copies live as long as the process). */
 static int end_of_options(int *argc, char **argv)
 {
-  static const char *const valued[] = {"--set", "--out", "--seed", "--stop-at", "--threads", "--sweeps",
-                                       "--from", "--to", "--reweight"};
   for (int i = 2; i < *argc; i++) {
     if (strcmp(argv[i], "--")) {
-      for (size_t k = 0; k < sizeof valued / sizeof *valued; k++)
-        if (!strcmp(argv[i], valued[k])) {
-          i++; /* its value, whatever it reads */
-          break;
-        }
+      i += takes_value(argv[i]); /* its value, whatever it reads */
       continue;
     }
     memmove(argv + i, argv + i + 1, (size_t)(*argc - i) * sizeof *argv); /* argv[argc], NULL, too */
@@ -1297,8 +1304,9 @@ static int command(int argc, char **argv);
 static int threads_asked(int argc, char **argv)
 {
   int threads = omp_get_max_threads();
-  for (int i = 2; i + 1 < argc; i++)
-    if (!strcmp(argv[i], "--threads")) threads = atoi(argv[i + 1]);
+  long long n;
+  for (int i = 2; i + 1 < argc && strcmp(argv[i], "--"); i += 1 + takes_value(argv[i]))
+    if (!strcmp(argv[i], "--threads") && lw_number_parse_whole(argv[i + 1], 1, 4096, &n)) threads = (int)n;
   return threads;
 }
 

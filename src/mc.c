@@ -87,13 +87,19 @@ static void tune(lw_chain *c, int kind, int accepted)
   tune_window(c, kind);
 }
 
+/* Whether a uniform u drawn from rng is below e^x (x < 0): Metropolis's
+** draw.  Below -745, where e^x is at most the least subnormal, the move is
+** lost without a draw (the stream stays where it was), in all three places
+** alike. */
+static int below_exp(gsl_rng *rng, double x) { return x > -745.0 && gsl_rng_uniform(rng) < exp(x); }
+
 /* The Metropolis decision on an evaluated proposal, its commit and the
 ** counts. */
 static int decide(lw_chain *c, int kind, double dE, int forbidden)
 {
-  /* no part free to make the move: it counted as proposed and accepted, and
-  ** a death among pinned particles read an acceptance of 1 (and fed the
-  ** step tuning) */
+  /* no part free to make the move: no proposal (once counted as proposed
+  ** and accepted, a death among pinned particles read an acceptance of 1
+  ** and fed the step tuning) */
   if (forbidden == LW_PROPOSE_NOTHING) return 0;
   if (forbidden == LW_PROPOSE_NOMEM) return -1; /* (as a commit that ran out of memory) */
   int accept;
@@ -103,10 +109,10 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
   if (isnan(dE)) {
     s->nan++;
     accept = 0;
-  } else if (forbidden == 2) {
+  } else if (forbidden == LW_PROPOSE_OUTSIDE) {
     s->outside++;
     accept = 0;
-  } else if (forbidden == 3) {
+  } else if (forbidden == LW_PROPOSE_CROWDED) {
     s->crowded++;
     accept = 0;
   } else if (forbidden) {
@@ -123,16 +129,14 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
     if (isnan(lr) || lr == -INFINITY || dE == INFINITY) accept = 0;
     else if (c->temperature > 0.0) {
       double x = lr - dE / c->temperature;
-      accept = x >= 0.0 || (x > -745.0 && gsl_rng_uniform(c->rng) < exp(x));
+      accept = x >= 0.0 || below_exp(c->rng, x);
     } else {
       accept = dE < 0.0 || (dE == 0.0 && lr > 0.0);
     }
   } else if (dE <= 0.0) {
     accept = 1;
   } else if (c->temperature > 0.0 && dE < INFINITY) {
-    double x = -dE / c->temperature;
-    /* exp underflows to 0 below about -745: no need to draw then */
-    accept = x > -745.0 && gsl_rng_uniform(c->rng) < exp(x);
+    accept = below_exp(c->rng, -dE / c->temperature);
   } else {
     accept = 0;
   }
@@ -150,8 +154,7 @@ static int decide(lw_chain *c, int kind, double dE, int forbidden)
       s->crowded++; /* a constraint the row checks only here (system.h) */
       accept = 0;
     } else if (d2 > 0.0) {
-      const double x = -d2 / c->temperature; /* defer is off at T = 0 */
-      accept = x > -745.0 && gsl_rng_uniform(c->rng) < exp(x);
+      accept = below_exp(c->rng, -d2 / c->temperature); /* (defer is off at T = 0) */
     }
   }
   if (accept) {

@@ -316,7 +316,7 @@ static jet jsmooth(jet x)
 {
   if (x.v <= 0.0) return jc(0.0);
   if (x.v >= 1.0) return jc(1.0);
-  double t = x.v, r = t * t * t * (10.0 + t * (6.0 * t - 15.0)), dr = 30.0 * t * t * (1.0 - t) * (1.0 - t);
+  double dr, r = lw_pair_ramp(x.v, &dr);
   return jmake1(r, x.i, dr);
 }
 
@@ -907,9 +907,9 @@ static double near_weight(double u, double *du)
   *du = 0.0;
   if (u >= 1.0) return 0.0;
   if (u <= 0.5) return 1.0;
-  double t = 2.0 * (1.0 - u);
-  *du = -60.0 * t * t * (1.0 - t) * (1.0 - t);
-  return t * t * t * (10.0 + t * (6.0 * t - 15.0));
+  double dt, w = lw_pair_ramp(2.0 * (1.0 - u), &dt);
+  *du = -2.0 * dt;
+  return w;
 }
 
 /*

@@ -481,7 +481,7 @@ static inline double smooth_step(double x)
 {
   if (x <= 0.0) return 0.0;
   if (x >= 1.0) return 1.0;
-  return x * x * x * (10.0 + x * (6.0 * x - 15.0));
+  return lw_pair_ramp(x, NULL);
 }
 
 /* The 6-node rule of a piece, computed once: copies of the piece on the
@@ -906,8 +906,7 @@ static inline double near_weight(double u)
 {
   if (u >= 1.0) return 0.0;
   if (u <= 0.5) return 1.0;
-  double t = 2.0 * (1.0 - u);
-  return t * t * t * (10.0 + t * (6.0 * t - 15.0));
+  return lw_pair_ramp(2.0 * (1.0 - u), NULL);
 }
 
 int lw_pair_bezier_before(const double a[8], const double b[8])
@@ -925,10 +924,11 @@ double lw_pair_order_weight(const double a[8], const double b[8], double dwa[8],
   const double band = LW_PAIR_ORDER_BAND * (fabs(ax) + fabs(ay) + fabs(bx) + fabs(by));
   const double gap = b[0] - a[0]; /* >= 0 in this order */
   if (!(gap < band)) return 1.0;
-  const double x = gap / band, w = 0.5 + 0.5 * x * x * x * (10.0 + x * (6.0 * x - 15.0));
+  double dr;
+  const double x = gap / band, w = 0.5 + 0.5 * lw_pair_ramp(x, &dr);
   if (dwa && dwb) {
-    /* dw/dx = 15 x^2 (1 - x)^2; x = gap / band */
-    const double dwdx = 15.0 * x * x * (1.0 - x) * (1.0 - x), dgap = dwdx / band, dband = -dwdx * x / band;
+    /* x = gap / band */
+    const double dwdx = 0.5 * dr, dgap = dwdx / band, dband = -dwdx * x / band;
     const double s = LW_PAIR_ORDER_BAND * dband;
     dwb[0] += dgap;
     dwa[0] -= dgap;
@@ -1008,7 +1008,8 @@ __attribute__((target("avx2"))) static void near_sums4(const lw_pair_sample *sa,
           use, _mm256_mul_pd(_mm256_mul_pd(adl, dl), _mm256_sub_pd(_mm256_div_pd(one, _mm256_sqrt_pd(r2)), inv)));
       const __m256d is_near = _mm256_cmp_pd(r2, rho2, _CMP_LT_OQ);
       if (_mm256_movemask_pd(is_near)) {
-        /* near_weight(sqrt(r2 / rho2)) where near: 1 to u = 0.5, 0 from 1 */
+        /* near_weight(sqrt(r2 / rho2)) where near: 1 to u = 0.5, 0 from 1
+        ** (lw_pair_ramp's operations, lane by lane) */
         const __m256d u = _mm256_sqrt_pd(_mm256_div_pd(r2, rho2));
         const __m256d t = _mm256_mul_pd(_mm256_set1_pd(2.0), _mm256_sub_pd(one, u));
         const __m256d poly = _mm256_add_pd(_mm256_set1_pd(10.0),

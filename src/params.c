@@ -1077,6 +1077,13 @@ static int at_default(const lw_params *p, const lw_param_def *d)
   return 0;
 }
 
+int lw_params_line(const lw_params *p, const char *section, const char *key)
+{
+  const lw_param_def *d = lw_params_find(section, key);
+  if (!d) abort(); /* (a programming error, found by any test that reaches it) */
+  return p->line[d - lw_param_table];
+}
+
 int lw_params_kept(const lw_params *p, const char *section, const char *key)
 {
   const lw_param_def *d = lw_params_find(section, key);
@@ -1518,16 +1525,22 @@ void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size
   if (p->file[0]) snprintf(buf, n, "%s (not set: the default, %s)", p->file, d->def[0] ? d->def : "empty");
   else snprintf(buf, n, "default");
   if (p->preset != LW_PRESET_PHOTO || p->of_run) return;
+  /* where the preset was asked for, as a key's line (a scene's "preset =
+  ** photo" without an image was refused as "scene.preset = photo: key
+  ** 'scene.potential'", naming no file) */
+  char at[LW_PATH_MAX + 32];
+  lw_params_origin(p, lw_params_find("scene", "preset"), at, sizeof at);
   for (size_t k = 0; k < sizeof photo_preset / sizeof photo_preset[0]; k++)
     if (!strcmp(photo_preset[k].section, d->section) && !strcmp(photo_preset[k].key, d->key)) {
-      if (photo_preset[k].text) snprintf(buf, n, "scene.preset = photo");
-      else snprintf(buf, n, "scene.preset = photo (%g pen widths of %g mm)", photo_preset[k].pens, p->pen_width);
+      if (photo_preset[k].text) snprintf(buf, n, "%s (scene.preset = photo)", at);
+      else snprintf(buf, n, "%s (scene.preset = photo, %g pen widths of %g mm)", at, photo_preset[k].pens,
+                    p->pen_width);
       return;
     }
   /* the two the preset works out from the page and the blur (apply_preset) */
   if ((!strcmp(d->section, "anneal") && !strcmp(d->key, "domains")) ||
       (!strcmp(d->section, "energy") && !strcmp(d->key, "tone_quadrature")))
-    snprintf(buf, n, "scene.preset = photo");
+    snprintf(buf, n, "%s (scene.preset = photo)", at);
 }
 
 /* orientation = auto: the picture's header says which way it lies.  A
@@ -1570,7 +1583,7 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
   char where[LW_PATH_MAX + 32], where_page[LW_PATH_MAX + 32];
   /* a scene.ini that a run wrote before the key was one runs again as that
   ** run did (the hash of a resume's leaves the missing key out) */
-  if (p->run_header && !p->line[lw_params_find("anneal", "seed_version") - lw_param_table]) p->seed_version = 1;
+  if (p->run_header && !lw_params_line(p, "anneal", "seed_version")) p->seed_version = 1;
   /* the driver decides the presets' keys below */
   if (!lw_driver_of(p, err)) return err->code;
   /* before the page is sized, which the orientation decides */
@@ -1708,7 +1721,7 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
   }
   char expected[256], unseen[96];
   if (!assign(p, d, eq + 1, expected, sizeof expected))
-    return lw_error_set(err, LW_EUSAGE, "--set %s.%s: expected %s, got '%s'%s", section, key,
+    return lw_error_set(err, LW_EUSAGE, "--set: key '%s.%s': expected %s, got '%s'%s", section, key,
                         expected, eq + 1, lw_params_unseen_char(eq + 1, unseen, sizeof unseen));
   p->line[d - lw_param_table] = -1;
   return LW_OK;

@@ -14,6 +14,7 @@
 #include "linewise/particles_io.h"
 #include "linewise/particles_place.h"
 #include "linewise/state.h"
+#include "linewise/system.h"
 
 const char *const lw_particles_move_names[LW_PMOVE_ALL] = {"translate", "rotate", "birth", "death"};
 
@@ -779,7 +780,7 @@ double lw_particles_evaluate(const lw_particles *p, lw_particles_prop *pr, uint3
     if (external(s, x, e_new)) {
       for (int t = 0; t < LW_PTERM_COUNT; t++) pr->dterm[t] = 0.0;
       pr->dterm[LW_PTERM_BOUNDARY] = INFINITY;
-      if (forbidden) *forbidden = 1;
+      if (forbidden) *forbidden = LW_PROPOSE_IRREGULAR;
       return pr->dE = INFINITY;
     }
     external(s, xo, e_old);
@@ -851,7 +852,7 @@ double lw_particles_propose_in(const lw_particles *p, lw_particles_prop *pr, int
   /* a step that is not finite goes on to evaluate, which rejects it as NaN */
   if (isfinite(x[0] + x[1]) && !(x[0] >= box[0] && x[1] >= box[1] && x[0] <= box[2] && x[1] <= box[3])) {
     identity(pr); /* refused: never committed */
-    if (forbidden) *forbidden = 2;
+    if (forbidden) *forbidden = LW_PROPOSE_OUTSIDE;
     return pr->dE = INFINITY;
   }
   return lw_particles_evaluate(p, pr, (uint32_t)site, x, q, forbidden);

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "linewise/particles_geom.h"
+#include "linewise/system.h"
 
 /* The annulus times the slab: the volume over which an anchor spreads its
 ** births, in r0^3. */
@@ -73,7 +74,7 @@ static double nothing(lw_particles_prop *pr, double dE, int *forbidden, int why)
 static double birth(const lw_particles *p, lw_particles_prop *pr, gsl_rng *rng, int *forbidden)
 {
   const lw_particles_setup *s = p->setup;
-  if (p->n >= s->max_count) return nothing(pr, INFINITY, forbidden, 1);
+  if (p->n >= s->max_count) return nothing(pr, INFINITY, forbidden, LW_PROPOSE_IRREGULAR);
   /* none to be born beside (the last one's death is refused by its
   ** reverse, so only a test's walk gets here): no proposal */
   if (p->n == 0) return nothing(pr, 0.0, forbidden, 0);
@@ -101,7 +102,8 @@ static double birth(const lw_particles *p, lw_particles_prop *pr, gsl_rng *rng, 
   pr->k = (uint32_t)p->n;
   pr->identity = 0;
   double e[LW_PTERM_COUNT] = {0};
-  if (lw_particles_site_energy(p, UINT32_MAX, pr->x, pr->n, e)) return nothing(pr, INFINITY, forbidden, 1);
+  if (lw_particles_site_energy(p, UINT32_MAX, pr->x, pr->n, e))
+    return nothing(pr, INFINITY, forbidden, LW_PROPOSE_IRREGULAR);
   e[LW_PTERM_CHEM] = s->chem;
   double dE = 0.0;
   for (int t = 0; t < LW_PTERM_COUNT; t++) dE += pr->dterm[t] = e[t];

@@ -468,7 +468,7 @@ static lw_status layer_targets(lw_scene *sc, const lw_params *p, lw_error *err)
 ** default). */
 static int potential_paper(const lw_params *p)
 {
-  const int before = p->run_written && !p->line[lw_params_find("scene", "potential_paper") - lw_param_table];
+  const int before = p->run_written && !lw_params_line(p, "scene", "potential_paper");
   return p->potential_paper && !before;
 }
 
@@ -561,7 +561,7 @@ static lw_status build_field(lw_scene *sc, const lw_params *p, double cx, double
   f->cy = cy;
   /* a run begun before 2026-12-05 has no line for it: no core, as it ran
   ** (a scene.ini written by hand beside a state takes the default) */
-  const int before = p->run_written && !p->line[lw_params_find("scene", "field_core") - lw_param_table];
+  const int before = p->run_written && !lw_params_line(p, "scene", "field_core");
   f->core = before ? 0.0 : p->field_core < 0.0 ? p->segment_length : p->field_core;
   f->ux = cos(p->field_angle * DEG);
   f->uy = sin(p->field_angle * DEG);

@@ -397,7 +397,7 @@ static double nothing(lw_proposal *p, int *forbidden)
 
 /* A proposal of the kind at global node k (a point or vector move) or on
 ** its spline (a rigid move); with a box (domains.h), rejected (+inf,
-** *forbidden = 2) if the spline would leave it. */
+** LW_PROPOSE_OUTSIDE) if the spline would leave it. */
 static double propose_on(const lw_model *m, const lw_td *td, lw_proposal *p, int kind, size_t at, uint32_t i,
                          double st, gsl_rng *rng, int *forbidden, const double *box)
 {
@@ -456,7 +456,7 @@ static double propose_on(const lw_model *m, const lw_td *td, lw_proposal *p, int
     /* NaN fails every comparison: outside, so rejected */
     if (!(b[0] >= box[0] && b[1] >= box[1] && b[2] <= box[2] && b[3] <= box[3])) {
       p->spline = i;
-      *forbidden = 2;
+      *forbidden = LW_PROPOSE_OUTSIDE;
       return INFINITY;
     }
   }
@@ -469,7 +469,7 @@ static double propose_on(const lw_model *m, const lw_td *td, lw_proposal *p, int
     p->log_ratio = n_node == 1 ? lw_td_prior_change(td, src, nn, node0, &nd[0])
                                : lw_td_prior(td, nd, nn) - lw_td_prior(td, src, nn);
   }
-  *forbidden = p->crowded ? 3 : p->irregular;
+  *forbidden = p->crowded ? LW_PROPOSE_CROWDED : p->irregular ? LW_PROPOSE_IRREGULAR : 0;
   return p->dE;
 }
 
@@ -836,7 +836,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
   if (kind == LW_MOVE_SPLIT || kind == LW_MOVE_JOIN) {
     if (N < (kind == LW_MOVE_JOIN ? 2u : 1u)) return nothing(p, forbidden);
     const double dE = kind == LW_MOVE_SPLIT ? propose_split(s, p, rng) : propose_join(s, p, rng);
-    *forbidden = !p->splice ? 0 : p->crowded ? 3 : p->irregular;
+    *forbidden = !p->splice ? 0 : p->crowded ? LW_PROPOSE_CROWDED : p->irregular ? LW_PROPOSE_IRREGULAR : 0;
     return dE;
   }
   if (kind == LW_MOVE_BIRTH) {
@@ -885,7 +885,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
       p->log_ratio = lw[2] - lw[3] + lr;
     }
   }
-  *forbidden = p->crowded ? 3 : p->irregular;
+  *forbidden = p->crowded ? LW_PROPOSE_CROWDED : p->irregular ? LW_PROPOSE_IRREGULAR : 0;
   return p->dE;
 }
 

@@ -675,7 +675,9 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       }
       char batch[32] = "", closed[8] = "", drift[32] = "";
       if (s->sd > 0.0) snprintf(closed, sizeof closed, "%d", s->window > 0);
-      if (!isnan(s->drift_z)) snprintf(drift, sizeof drift, "%.3g", s->drift_z);
+      /* (as summary.json's observables: halves of a column without spread
+      ** have no difference to weigh, and read 0 here, null there) */
+      if (s->sd > 0.0 && !isnan(s->drift_z)) snprintf(drift, sizeof drift, "%.3g", s->drift_z);
       if (!isnan(s->batch_ratio)) snprintf(batch, sizeof batch, "%.4g", s->batch_ratio); /* 1.501 warns, 1.5 not */
       char se[32] = "", sd[32] = ""; /* one row: none */
       if (s->n > 1) {

@@ -471,9 +471,12 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
   ** widths it sized a length from; the file's own keys name their line */
   char where[256];
   lw_params_origin(&p, lw_params_find("energy", "tone_blur"), where, sizeof where);
-  cr_assert_str_eq(where, "scene.preset = photo (3 pen widths of 0.35 mm)");
+  char want[sizeof p.file + 64];
+  snprintf(want, sizeof want, "%s:2 (scene.preset = photo, 3 pen widths of 0.35 mm)", p.file);
+  cr_assert_str_eq(where, want);
   lw_params_origin(&p, lw_params_find("energy", "tone"), where, sizeof where);
-  cr_assert_str_eq(where, "scene.preset = photo");
+  snprintf(want, sizeof want, "%s:2 (scene.preset = photo)", p.file);
+  cr_assert_str_eq(where, want);
   lw_params_origin(&p, lw_params_find("output", "pen_width"), where, sizeof where);
   cr_assert(strstr(where, ":5"), "%s", where);
   lw_params_origin(&p, lw_params_find("energy", "strain_mode"), where, sizeof where);

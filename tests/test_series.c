@@ -608,6 +608,26 @@ Test(trace, runs_of_one_constant_value_agree_exactly, .init = make_dir, .fini = 
   for (int r = 0; r < 6; r++) lw_trace_free(t[r]);
 }
 
+/* A column without spread has no autocorrelation, window or halves to
+** weigh: `stats --csv` left drift_z 0 where tau, n_eff and window_closed
+** are empty and summary.json's observables null. */
+Test(trace, a_column_without_spread_leaves_its_checks_empty, .init = make_dir, .fini = remove_dir)
+{
+  char text[4096] = "sweep,temperature,c\n", path[128], out[1024];
+  for (int r = 1; r <= 40; r++) snprintf(text + strlen(text), sizeof text - strlen(text), "%d,1,50\n", r);
+  write_trace("flat.csv", text, path, sizeof path);
+  lw_error err;
+  lw_trace *t = lw_trace_read(path, &err);
+  cr_assert_not_null(t, "%s", err.msg);
+  const char *paths[1] = {path};
+  lw_trace_select sel[1] = {{.from = -1, .to = -1, .csv = 1}};
+  FILE *f = fmemopen(out, sizeof out, "w");
+  cr_assert_eq(lw_trace_stats_runs((const lw_trace *const *)&t, paths, sel, 1, f, &err), LW_OK, "%s", err.msg);
+  fclose(f);
+  cr_assert(strstr(out, "\nc,40,50,0,0,,,,,\n"), "%s", out);
+  lw_trace_free(t);
+}
+
 /* Runs of one law whose error bars differ (one run's values a tenth the
 ** others'): p_runs must be uniform, as for equal error bars.  Of 60 sets
 ** of 4 agreeing runs, p_runs < 0.05 is binomial (60, 0.05): mean 3, sd

@@ -55,6 +55,18 @@ double lw_pair_segments_exact(const double a[8], const double b[8], double cutof
 ** same bits there) and 1 at the band's edge. */
 #define LW_PAIR_ORDER_BAND 0.02
 
+/* The C2 ramp of every blend of the near field: t^3 (10 + t (6 t - 15)), 0
+** at t = 0 and 1 at t = 1 with its first and second derivatives 0 at both,
+** for t in [0, 1]; its derivative 30 t^2 (1 - t)^2 into *dt (NULL: not
+** wanted).  One copy, so that the energy (pairnear.c) and its gradient
+** (pairgrad.c) blend alike; pairnear.c's four-lane walk writes the same
+** operations in vector form. */
+static inline double lw_pair_ramp(double t, double *dt)
+{
+  if (dt) *dt = 30.0 * t * t * (1.0 - t) * (1.0 - t);
+  return t * t * t * (10.0 + t * (6.0 * t - 15.0));
+}
+
 /* The weight of X(a, b) against X(b, a) for a pair in lw_pair_bezier_before's
 ** order, and its derivatives by a's and b's control points (NULL: not
 ** wanted); 1 outside the band. */

@@ -371,6 +371,13 @@ int lw_params_write(const lw_params *p, FILE *f);
 ** every key, only --set counts. */
 int lw_params_given(const lw_params *p, const lw_param_def *d);
 
+/* Where section.key was read (p->line): > 0 its line in p->file, < 0 an
+** option (--set, --seed), 0 nowhere (a run's scene.ini writes every key,
+** so 0 there is a key of a later release).  section.key must be a key of
+** the table: a name no key has aborts (a key renamed without its readers
+** read another key's line). */
+int lw_params_line(const lw_params *p, const char *section, const char *key);
+
 /* Whether section.key holds a run's own value: read from a run's scene.ini
 ** by resume or energy, not set over it with --set.  A check a later release
 ** adds leaves such a value as the run began with it. */

@@ -77,11 +77,17 @@ typedef struct {
 } lw_idle_rule;
 #define LW_IDLE_RULES_MAX 24
 
-/* *forbidden of a proposal that is none (lw_system_type.propose). */
-#define LW_PROPOSE_NOTHING 4
-/* *forbidden of a proposal that could not be evaluated for want of memory:
-** the chain stops (lw_chain_step < 0) rather than count it as rejected. */
-#define LW_PROPOSE_NOMEM 5
+/* *forbidden of a proposal (lw_system_type.propose; 0: a move to decide).
+** The chain counts each refusal apart (lw_move_stats, summary.json's
+** rejected_*): a number of a row's own would be counted as what it happens
+** to equal here. */
+enum {
+  LW_PROPOSE_IRREGULAR = 1, /* a forbidden state: a segment the quadrature cannot trust, beyond the range */
+  LW_PROPOSE_OUTSIDE = 2,   /* a part outside its domain's box (propose_in) or the frame */
+  LW_PROPOSE_CROWDED = 3,   /* closer to another stroke than a hard spacing rule allows */
+  LW_PROPOSE_NOTHING = 4,   /* no proposal: no part free to make the move; counted nowhere */
+  LW_PROPOSE_NOMEM = 5      /* not evaluated for want of memory: the chain stops (lw_chain_step < 0) */
+};
 
 struct lw_system_type {
   const char *name;                   /* [scene] system = name */
@@ -138,11 +144,10 @@ struct lw_system_type {
   ** is 0, never tuned, and summary.json writes null for it.  propose:
   ** draws one proposal of kind k with step `step` from rng into prop (the
   ** chain's scratch) and returns dE (NaN: undefined,
-  ** rejected and counted; +inf forbidden), with *forbidden = 1 when it is
-  ** refused for a forbidden state, 3 when for coming closer to another
-  ** stroke than a hard spacing rule allows (each counted apart), and
-  ** LW_PROPOSE_NOTHING (dE 0) when no part is free to make a move of kind k
-  ** (every particle pinned for it): no proposal, counted nowhere.  The state is not
+  ** rejected and counted; +inf forbidden), with *forbidden one of
+  ** LW_PROPOSE_* where it is refused (LW_PROPOSE_NOTHING with dE 0 when no
+  ** part is free to make a move of kind k, every particle pinned for it:
+  ** no proposal, counted nowhere).  The state is not
   ** changed, but caches may be filled: one thread per state.  commit applies
   ** the last proposal (LW_ENOMEM leaves the state as it was). */
   void (*moves)(const lw_params *p, double *weight, double *step, double *target);
@@ -181,7 +186,7 @@ struct lw_system_type {
   ** the scene cannot be split (a term that is not local).  group() gives
   ** the box of the sites that move together from `site` on (for splines
   ** the node's spline) and their count.  propose_in() is propose_at()
-  ** rejecting (dE = +inf, *forbidden = 2) a move whose box leaves `box`;
+  ** rejecting (dE = +inf, LW_PROPOSE_OUTSIDE) a move whose box leaves `box`;
   ** commit_part() commits keeping the running totals' changes in prop,
   ** merge() adds them to the state's.  Moves in disjoint domains, more than
   ** twice the reach apart, may then run in parallel, each with its own prop. */
