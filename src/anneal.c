@@ -382,9 +382,14 @@ static int parse_ladder(const lw_params *p, const char *text, const char *where,
     size_t len = 0;
     double v;
     while (*(w += len + strspn(w + len, " \t,")) && lw_number_parse_n(w, len = strcspn(w, " \t,"), &v)) {}
+    char word[64], unseen[96];
     len = strcspn(w, " \t,");
-    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': '%.*s' is not a temperature; expected finite "
-                        "numbers such as 0.5 or 2e-3", where, len > 60 ? 60 : (int)len, w), 0;
+    snprintf(word, sizeof word, "%.*s%s", len > 60 ? 57 : (int)len, w, len > 60 ? "..." : "");
+    /* (a no-break space between two numbers shows as "'1 2' is not a
+    ** temperature") */
+    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': '%s' is not a temperature; expected finite "
+                        "numbers such as 0.5 or 2e-3%s", where, word, lw_params_unseen_char(word, unseen,
+                                                                                             sizeof unseen)), 0;
   }
   if (n < 2 || n > LW_TEMPERING_MAX)
     return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%.120s%s'%s",
@@ -478,10 +483,13 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
                         "holds; expected one process (mpirun -n 1, or linewise) for %d", where, a->net->size);
   }
   if (a->net && a->n_rep < a->net->size) {
-    /* the key that set the count: the ladder's length, where one is given
-    ** (replicas "not set: the default, 1" was blamed for a ladder of 3) */
-    const char *key = lw_params_given(p, lw_params_find("tempering", "ladder")) ? "ladder"
-                      : lw_params_given(p, lw_params_find("tempering", "ladder_file")) ? "ladder_file" : "replicas";
+    /* the key that set the count: the ladder's length, where there is one
+    ** (replicas "not set: the default, 1" was blamed for a ladder of 3; a
+    ** resume, the line "replicas = 1" of the run's scene.ini), read from
+    ** its file where the scene names one (read_ladder_file has put the
+    ** file's ladder in its place) */
+    const char *key = !p->ladder[0] ? "replicas"
+                      : !p->of_run && lw_params_line(p, "tempering", "ladder_file") ? "ladder_file" : "ladder";
     lw_params_origin(p, lw_params_find("tempering", key), where, sizeof where);
     return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.%s': %d replicas for %d processes; expected at least one "
                         "replica per process%s", where, key, a->n_rep, a->net->size,
@@ -1054,8 +1062,8 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   }
   /* the run before (a final.gcode, a replica state or a film of it beside
   ** the new drawing would be taken for the new run's) waits until the new
-  ** run's first checkpoint (lw_anneal_checkpoint drops it), or comes back
-  ** if the set-up fails (runfiles.h) */
+  ** run's first sweep (drop_stash), or comes back if the set-up or that
+  ** sweep fails (runfiles.h) */
   int back;
   if ((s = lw_runfiles_recover(dir, &back, err)) || (s = lw_runfiles_check_free(dir, err))) return s;
   if (lw_rundir_holds_run(dir)) {
@@ -2089,6 +2097,9 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 
 void lw_anneal_free(lw_anneal *a)
 {
+  /* a run given up after its first checkpoint without a sweep (a program's
+  ** start then free) stands, as the next run or resume there would keep it */
+  drop_stash(a);
   if (a->trace) fclose(a->trace);
   lw_dynamics_free(a->dyn);
   /* the chains first: tempering swaps systems between them */

@@ -588,9 +588,6 @@ static int watched_fail(watcher *w, const lw_error *err)
   return fail(err);
 }
 
-/* A run that failed to write (a full disk) says that state.lw still holds
-** its last checkpoint, and how to go on: the last this process wrote, or
-** the one the loop began from (the set-up's, or the one a resume read). */
 /* The run set aside could not all be removed once this one replaced it:
 ** said under --quiet too (what is left takes disk space, and the next run or
 ** resume there tries again). */
@@ -600,6 +597,9 @@ static void say_stash_left(lw_anneal *a)
   a->stash_left[0] = 0;
 }
 
+/* A run that failed to write (a full disk) says that state.lw still holds
+** its last checkpoint, and how to go on: the last this process wrote, or
+** the one the loop began from (the set-up's, or the one a resume read). */
 static int loop_fail(lw_anneal *a, long began, watcher *w, lw_error *err)
 {
   /* a run that failed before its first sweep was done gives the directory
@@ -649,7 +649,9 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
 #endif
   /* the checkpoint of the end (lw_anneal_finish's first step) is written
   ** here, so that a second signal while the files are drawn names it */
-  if ((a->saved != a->sweep + 1 || a->stashed) && lw_anneal_checkpoint(a, err))
+  /* (a stop before the first sweep keeps the new run: its checkpoint drops
+  ** the run set aside, which an end keeps until its files are drawn) */
+  if ((a->saved != a->sweep + 1 || (stopped && a->stashed)) && lw_anneal_checkpoint(a, err))
     return loop_fail(a, pg.start_sweep, w, err);
   say_stash_left(a);
   if (stopped) {

@@ -1527,20 +1527,22 @@ void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size
   if (p->preset != LW_PRESET_PHOTO || p->of_run) return;
   /* where the preset was asked for, as a key's line (a scene's "preset =
   ** photo" without an image was refused as "scene.preset = photo: key
-  ** 'scene.potential'", naming no file) */
-  char at[LW_PATH_MAX + 32];
-  lw_params_origin(p, lw_params_find("scene", "preset"), at, sizeof at);
-  for (size_t k = 0; k < sizeof photo_preset / sizeof photo_preset[0]; k++)
+  ** 'scene.potential'", naming no file); none for a preset a program set */
+  char at[LW_PATH_MAX + 32] = "", sized[64] = "";
+  if (lw_params_line(p, "scene", "preset")) lw_params_origin(p, lw_params_find("scene", "preset"), at, sizeof at);
+  int filled = 0;
+  for (size_t k = 0; !filled && k < sizeof photo_preset / sizeof photo_preset[0]; k++)
     if (!strcmp(photo_preset[k].section, d->section) && !strcmp(photo_preset[k].key, d->key)) {
-      if (photo_preset[k].text) snprintf(buf, n, "%s (scene.preset = photo)", at);
-      else snprintf(buf, n, "%s (scene.preset = photo, %g pen widths of %g mm)", at, photo_preset[k].pens,
-                    p->pen_width);
-      return;
+      filled = 1;
+      if (!photo_preset[k].text)
+        snprintf(sized, sizeof sized, "%g pen widths of %g mm", photo_preset[k].pens, p->pen_width);
     }
-  /* the two the preset works out from the page and the blur (apply_preset) */
-  if ((!strcmp(d->section, "anneal") && !strcmp(d->key, "domains")) ||
-      (!strcmp(d->section, "energy") && !strcmp(d->key, "tone_quadrature")))
-    snprintf(buf, n, "%s (scene.preset = photo)", at);
+  /* and the two it works out from the page and the blur (apply_preset) */
+  filled = filled || (!strcmp(d->section, "anneal") && !strcmp(d->key, "domains")) ||
+           (!strcmp(d->section, "energy") && !strcmp(d->key, "tone_quadrature"));
+  if (!filled) return;
+  if (at[0]) snprintf(buf, n, "%s (scene.preset = photo%s%s)", at, sized[0] ? ", " : "", sized);
+  else snprintf(buf, n, "scene.preset = photo%s%s%s", sized[0] ? " (" : "", sized, sized[0] ? ")" : "");
 }
 
 /* orientation = auto: the picture's header says which way it lies.  A

@@ -16,18 +16,23 @@ END {
     marker = i
   }
   if (!marker || !moved) { print "no stash: " moved " files moved, marker at line " marker; exit 1 }
+  # the run's directory: the marker's path less /.replaced/.moving
+  split(line[marker], q, "\""); dir = q[2]; sub(/\/\.replaced\/\.moving$/, "", dir); sub(/.*\//, "", dir)
   dir_synced = stash_synced = 0
   for (j = last + 1; j < marker; j++) {
     if (pid[j] != pid[marker] || line[j] !~ /fsync\(/) continue
-    if (line[j] ~ /\/\.replaced>\)/) stash_synced = 1
-    else if (line[j] ~ />\)/) dir_synced = 1
+    if (index(line[j], "/" dir "/.replaced>)")) stash_synced = 1
+    else if (index(line[j], "/" dir ">)")) dir_synced = 1
   }
   after = ""
   for (j = marker + 1; j <= NR && after == ""; j++) if (pid[j] == pid[marker]) after = line[j]
   bad = 0
   if (!dir_synced) { bad++; print "directory not synced before the marker: " line[marker] }
   if (!stash_synced) { bad++; print "stash not synced before the marker: " line[marker] }
-  if (after !~ /fsync\(.*\/\.replaced>\)/) { bad++; print "stash not synced after the marker: " after }
+  if (!index(after, "fsync(") || !index(after, "/" dir "/.replaced>)")) {
+    bad++
+    print "stash not synced after the marker: " after
+  }
   print moved " files moved"
   exit !(moved >= 3 && bad == 0)
 }

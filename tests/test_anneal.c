@@ -381,6 +381,9 @@ Test(run, a_stop_during_the_set_up_puts_the_run_before_back)
   cr_assert(!a.gave_way);
   lw_anneal_free(&a);
   cr_assert_eq(sh("grep -qx 'seed = 43' %s/r/state.lw", dir), 0, "the run before is still there");
+  /* and, given up without a sweep, stands: the run it replaced, kept aside
+  ** until a first sweep, went with the free (it stayed in r/.replaced) */
+  cr_assert_eq(sh("test ! -e %s/r/.replaced", dir), 0, "the run it replaced is left aside");
 }
 
 /* A second signal ends the process at once and names the checkpoint a

@@ -99,6 +99,13 @@ Test(dynamics_cli, a_run_that_fails_at_its_first_step_gives_the_run_it_replaced_
   cr_assert_eq(sh("cd %s && grep -q '^linewise: the dynamics.*; the run that was in r is back as it was$' err.txt && "
                   "test $(wc -l < err.txt) = 1 && diff -r -x .lock kept r && test ! -e r/.replaced", dir), 0, "%s",
                lw_test_slurp("%s/err.txt", dir));
+  /* so does a run of no sweep whose final files cannot be written (a full
+  ** disk, by strace): its end checkpoint dropped the run set aside first */
+  cr_assert_eq(sh("cd %s && ASAN_OPTIONS=detect_leaks=0 strace -f -o /dev/null -P r/final.svg.tmp "
+                  "-e trace=openat -e inject=openat:error=ENOSPC %s run %s/params/minimal.ini --set anneal.sweeps=0 "
+                  "--out r --quiet 2> err.txt; test $? -eq 1 && grep -q '; the run that was in r is back as it was$' "
+                  "err.txt && diff -r -x .lock kept r && test ! -e r/.replaced", dir, lw_test_bin(), lw_test_root()),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* the same run with a step it can take replaces it, the run set aside gone */
   cr_assert_eq(sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=2 --set scene.driver=dynamics "
                   "--set dynamics.dt=1e-4 --out r --quiet && grep -q '^driver = dynamics' r/scene.ini && "

@@ -477,6 +477,14 @@ Test(params, photo_preset_scales_with_the_pen_and_the_page)
   lw_params_origin(&p, lw_params_find("energy", "tone"), where, sizeof where);
   snprintf(want, sizeof want, "%s:2 (scene.preset = photo)", p.file);
   cr_assert_str_eq(where, want);
+  /* a preset a program set has no line to name (it named itself, forever) */
+  static lw_params q;
+  lw_params_defaults(&q);
+  q.preset = LW_PRESET_PHOTO;
+  lw_params_origin(&q, lw_params_find("energy", "tone"), where, sizeof where);
+  cr_assert_str_eq(where, "scene.preset = photo");
+  lw_params_origin(&q, lw_params_find("energy", "tone_blur"), where, sizeof where);
+  cr_assert_str_eq(where, "scene.preset = photo (3 pen widths of 0.3 mm)");
   lw_params_origin(&p, lw_params_find("output", "pen_width"), where, sizeof where);
   cr_assert(strstr(where, ":5"), "%s", where);
   lw_params_origin(&p, lw_params_find("energy", "strain_mode"), where, sizeof where);

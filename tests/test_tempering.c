@@ -541,6 +541,9 @@ Test(ptrun, a_ladder_file_runs_as_its_ladder_given_by_set)
     {"[tempering]\nladder = 1 2x 4\n", "", "lad.ini:2: key 'tempering.ladder': '2x' is not a temperature; expected "
      "finite numbers"},
     {"[tempering]\nladder = 1, 2, nan, 4\n", "", "lad.ini:2: key 'tempering.ladder': 'nan' is not a temperature"},
+    /* a no-break space between two numbers is named ("'1 2' is not a temperature") */
+    {"[tempering]\nladder = 1\302\2402 4\n", "", "is not a temperature; expected finite numbers such as 0.5 or "
+     "2e-3 (byte 2 is a no-break space"},
     /* values before the count: "1 2 2" was sent to replicas = 3 first */
     {"[tempering]\nladder = 1 2 2\n", "", "lad.ini:2: key 'tempering.ladder': expected increasing positive"},
     {"[tempering]\nladder = 1 2 3 4\n", "--set 'tempering.ladder=1 2 3 5'",

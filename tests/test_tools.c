@@ -319,7 +319,7 @@ Test(tools, ctrl_c_or_a_hang_up_waits_for_the_slowest_run)
                     "[ $i -lt 1500 ]; do sleep 0.02; i=$((i+1)); done; kill -KILL -$p 2>/dev/null; test $i -lt 1500 && "
                     "flock -n $a/.lock true && flock -n $b/.lock true",
                     dir, "bash", tool("param-sweep"), scene(), env("LW_BIN"), dir, dir, dir, dir, dir, dir, dir, sig[k]),
-                 0, "SIG%s: %s", sig[k], err_txt());
+                 0, "SIG%s: %s", sig[k], lw_test_slurp("%s/w.err", dir));
     char *e = lw_test_slurp("%s/w.err", dir);
     const char *last = strstr(e, "param-sweep: interrupted: no further run started, and the runs in progress stopped");
     cr_assert(last && !strstr(last, "\n["), "SIG%s: %s", sig[k], e);
@@ -664,7 +664,7 @@ Test(tools, bad_usage_exits_2_with_one_message_and_writes_nothing)
   cr_assert_eq(sh("%s %s --seeds 1,2 --set energy.bending=abc --bin %s --out %s/t", tool("seed-sweep"), scene(),
                   env("LW_BIN"), dir), 1);
   cr_assert_eq(sh("%s %s --seeds 1,2 " TINY " --bin %s --out %s/t", tool("seed-sweep"), scene(), env("LW_BIN"), dir),
-               0);
+               0, "%s", err_txt());
   cr_assert_eq(sh("test -s %s/t/seed-1/summary.json && test -s %s/t/seed-2/summary.json", dir, dir), 0);
   cr_assert_eq(sh("%s --gather-only %s", tool("seed-sweep"), dir), 2, "not a sweep directory");
   /* every tool: --help prints its usage (exit 0), nothing at all is bad usage (exit 2) */

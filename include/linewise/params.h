@@ -397,9 +397,10 @@ void lw_params_write_doc(FILE *f, void (*read_by)(const lw_param_def *d, char *b
 /* The definition of section.key, or NULL. */
 const lw_param_def *lw_params_find(const char *section, const char *key);
 
-/* Where a parameter was set, for messages: "scene.ini:12", "--set", "scene.preset = photo"
-** (with the pen widths a length was sized from), "scene.ini (default)", or
-** "default" for parameters read from no file. */
+/* Where a parameter was set, for messages: "scene.ini:12", "--set",
+** "scene.ini:2 (scene.preset = photo)" for a key the preset filled (with the
+** pen widths a length was sized from), "scene.ini (not set: the default,
+** 1)", or "default" for parameters read from no file. */
 void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size_t n);
 
 /* Prefixes the message in err with where section.key was set and the key:

@@ -9,11 +9,13 @@
 ** Other files in the directory or its subdirectories are the user's.
 **
 ** A run made again in a directory that holds a run replaces it, but only
-** once its own first checkpoint is written: until then the run before waits
-** in DIR/.replaced, moved there by renames (which take no room on a full
-** disk), and it comes back if the set-up fails.  A process killed in
-** between leaves the stash; the next run or resume there settles it under
-** the directory's lock (lw_runfiles_recover).  A marker inside says what
+** once it has done its first sweep (its first checkpoint under MPI): until
+** then the run before waits in DIR/.replaced, moved there by renames (which
+** take no room on a full disk), and it comes back if the set-up or that
+** sweep fails (lw_anneal_undo_start).  A process killed in between leaves
+** the stash; the next run or resume there settles it under the directory's
+** lock (lw_runfiles_recover): back before the new run's first checkpoint,
+** gone after it.  A marker inside says what
 ** the stash holds: .moving while the run before is being moved (some of its
 ** files may still be in DIR), .moved once all are (every run file in DIR is
 ** the new run's), .restoring while it moves back (a run file in DIR with a
@@ -57,7 +59,7 @@ lw_status lw_runfiles_stash(const char *dir, lw_error *err);
 ** is left stays in the stash, and err names it. */
 lw_status lw_runfiles_unstash(const char *dir, lw_error *err);
 
-/* Removes the stash: the new run has its first checkpoint.  LW_EIO where a
+/* Removes the stash: the new run stands (its first sweep is done).  LW_EIO where a
 ** file of it cannot be removed (the stash stays, saying what it holds). */
 lw_status lw_runfiles_drop(const char *dir, lw_error *err);
 
