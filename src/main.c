@@ -926,7 +926,7 @@ static int cmd_run(int argc, char **argv)
       out = v;
       i++;
     } else if (!strcmp(argv[i], "--seed")) {
-      if (!parse_count("--seed", v, 4294967295.0, &seed, &err)) return fail(&err);
+      if (!parse_count("--seed", v, LW_SEED_MAX, &seed, &err)) return fail(&err);
       char buf[64];
       snprintf(buf, sizeof buf, "anneal.seed=%ld", seed);
       if (lw_params_set(&p, buf, &err)) return fail(&err);

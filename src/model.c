@@ -1036,12 +1036,17 @@ static inline int own_sample(const lw_pair_filter *f, uint32_t e)
 ** them: min_spacing is a fraction of the cell).  Edge cells hold the points
 ** clamped from beyond the grid on their outer sides only, so the facing
 ** sides bound them too. */
+/* The reach of a cell-face test grown for the rounding of a point's cell
+** and of the face's distance: a pair at the reach itself is never pruned by
+** a face that rounding put a hair too far (crowding and closes_in). */
+#define CELL_FACE_SLACK (1.0 + 1e-8)
+
 static size_t crowding(const lw_cellgrid *grid, const lw_pair_sample *ps, size_t n, const lw_pair_filter *f,
                        double d2)
 {
   lw_cellgrid view;
   const lw_cellgrid *g = lw_cellgrid_plane(grid, f->plane, &view);
-  const double far2 = d2 * (1.0 + 1e-8);
+  const double far2 = d2 * CELL_FACE_SLACK;
   size_t count = 0;
   for (size_t k = 0; k < n; k++) {
     const lw_cell *near[9];
@@ -1296,8 +1301,10 @@ static int closes_in(const lw_model *m, const lw_pair_sample *now, const lw_pair
   lw_cellgrid view;
   const lw_cellgrid *g = lw_cellgrid_plane(m->grid, f->plane, &view);
   const lw_quad *quad = m->terms.ctx[m->terms.pair].quad;
-  const double far2 = d2 * (1.0 + 1e-8), spacing = m->scene->min_spacing;
+  const double far2 = d2 * CELL_FACE_SLACK, spacing = m->scene->min_spacing;
   crowd_candidate cand[CROWD_CANDIDATES];
+  /* (gathered a little wider again: none that a point's own scan of its
+  ** cells would find may be missing) */
   const int n_cand = crowd_candidates(m, g, now, n, sqrt(far2) * (1.0 + 1e-6), f, mg, np, cand);
   const double side = 1.0 / g->inv_h;
   for (size_t k = 0; k < n; k++) {

@@ -395,7 +395,7 @@ const lw_param_def lw_param_table[] = {
       "Cooling rate of the adaptive schedule: T <- T exp(-lambda T / sigma_E)."),
   STRING("anneal", "table", table, "", "path",
          "Table schedule file: lines 'step temperature' (relative to the scene file)."),
-  NUM("anneal", "seed", LW_PT_WHOLE, seed, "1", "", 0, 4294967295.0, 0,
+  NUM("anneal", "seed", LW_PT_WHOLE, seed, "1", "", 0, LW_SEED_MAX, 0,
       "Seed of the random number generator; the same scene and seed give the same run."),
   NUM("anneal", "seed_version", LW_PT_INT, seed_version, "2", "", 1, 2, 0,
       "How the seed makes the seeds of the run's random streams. 2: distinct seeds never "

@@ -25,6 +25,9 @@ extern "C" {
 /* The largest text field (scene.polygon); buffers that hold any value are
 ** sized by it. */
 #define LW_PARAM_TEXT_MAX 8192
+/* A run's seed: 0 to 2^32 - 1, in anneal.seed, --seed and state.lw alike (a
+** wider key alone would write states that resume refused). */
+#define LW_SEED_MAX 4294967295.0
 
 /* LW_PT_WHOLE: a whole number beyond int's range (the seed), held in a double. */
 typedef enum { LW_PT_DOUBLE, LW_PT_INT, LW_PT_WHOLE, LW_PT_CHOICE, LW_PT_STRING } lw_param_type;
