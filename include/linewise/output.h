@@ -94,8 +94,10 @@ int lw_output_colors_parse(const char *list, unsigned char (*rgb)[3], int max);
 
 /* The plotter SVG, written atomically: width and height in mm, viewBox in
 ** mm (user unit = 1 mm), one Inkscape layer group per pen in pen order
-** (id "pen<k>", label "pen <k> (<width> mm)", or "<name> (<width> mm)" for a
-** named pen), one path per spline with
+** (id "pen<k>", label "<k> pen (<width> mm)", or "<k> <name> (<width> mm)"
+** for a named pen: AxiDraw's software plots a layer by its leading number;
+** with page->multiply each group's style is mix-blend-mode:multiply), one
+** path per spline with
 ** M and C commands only.  A reversed path lists the control points of its
 ** segments backwards, last segment first, so it is the same curve.
 ** LW_EINPUT for a bad page or plot or a non-finite coordinate, LW_EIO when
