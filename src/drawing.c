@@ -22,8 +22,8 @@ static lw_status drawing_page(const lw_params *p, lw_output_page *page, lw_error
   if (p->pen_colors[0] && lw_output_colors_parse(p->pen_colors, rgb, LW_PLOT_PENS_MAX) != p->pens) {
     char where[LW_PATH_MAX + 32];
     lw_params_origin(p, lw_params_find("output", "pen_colors"), where, sizeof where);
-    return lw_error_set(err, LW_EINPUT, "%s: key 'output.pen_colors': expected %d colours, got '%s'", where,
-                        p->pens, p->pen_colors);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'output.pen_colors': expected %d colour%s, got '%s'", where,
+                        p->pens, p->pens == 1 ? "" : "s", p->pen_colors);
   }
   for (int k = 0; k < p->pens; k++) {
     page->pen[k].width_mm = p->pen_width;

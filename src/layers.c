@@ -43,9 +43,11 @@ static lw_status per_layer(const lw_params *p, const char *key, const char *text
   double got[LW_LAYERS_MAX];
   int count = lw_number_list(text, p->of_run ? 1 : 2, got, LW_LAYERS_MAX);
   if (count < 0)
-    return bad(p, key, err, "expected %d numbers (one a layer), got '%s'%s", n, text, lw_number_list_hint(count));
+    return bad(p, key, err, "expected %d number%s (one a layer), got '%s'%s", n, n == 1 ? "" : "s", text,
+               lw_number_list_hint(count));
   if (count != n)
-    return bad(p, key, err, "expected %d numbers (one a layer of layers.names), got %d", n, count);
+    return bad(p, key, err, "expected %d number%s (one a layer of layers.names), got %d", n, n == 1 ? "" : "s",
+               count);
   for (int k = 0; k < n; k++) {
     if (!(got[k] >= lo && got[k] <= hi))
       return bad(p, key, err, "expected values from %g to %g, got %g for layer %d", lo, hi, got[k], k + 1);
@@ -125,8 +127,8 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
   if (p->ly_colors[0]) {
     int count = lw_output_colors_parse(p->ly_colors, rgb, LW_LAYERS_MAX);
     if (count != n)
-      return bad(p, "colors", err, "expected %d colours '#rrggbb' or '#rgb' (one a layer), got '%s'", n,
-                 p->ly_colors);
+      return bad(p, "colors", err, "expected %d colour%s '#rrggbb' or '#rgb' (one a layer), got '%s'", n,
+                 n == 1 ? "" : "s", p->ly_colors);
   } else if (ls->source == LW_LSRC_CMYK) {
     memcpy(rgb, process, sizeof process);
   } else if (ls->source == LW_LSRC_PALETTE) {

@@ -1650,8 +1650,8 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
   if (p->pen_colors[0] && !p->ly_names[0] && lw_output_colors_parse(p->pen_colors, rgb, LW_PLOT_PENS_MAX) != p->pens) {
     lw_params_origin(p, lw_params_find("output", "pen_colors"), where, sizeof where);
     return lw_error_set(err, LW_EINPUT,
-                        "%s: key 'output.pen_colors': expected %d colours '#rrggbb' or '#rgb' (one per pen), got '%s'",
-                        where, p->pens, p->pen_colors);
+                        "%s: key 'output.pen_colors': expected %d colour%s '#rrggbb' or '#rgb' (one per pen), got '%s'",
+                        where, p->pens, p->pens == 1 ? "" : "s", p->pen_colors);
   }
   /* A G-code sender takes a line as a command: an empty pen line would draw
   ** every travel, a byte past ASCII is refused by most controllers. */

@@ -104,7 +104,11 @@ static void paint(cairo_t *cr, const lw_particles *p, const depth_key *order, in
     cairo_save(cr);
     cairo_translate(cr, px, py);
     cairo_rotate(cr, angle);
-    cairo_scale(cr, s->disc * scale, s->disc * scale * fmax(fabs(nv), 0.03));
+    /* (a disc of 1e-200 mm made a matrix cairo cannot invert, and the run
+    ** lost its preview and summary.json at the end: a thousandth of a
+    ** pixel draws the same nothing) */
+    const double r = fmax(s->disc * scale, 1e-3);
+    cairo_scale(cr, r, r * fmax(fabs(nv), 0.03));
     cairo_arc(cr, 0, 0, 1, 0, 2 * M_PI);
     cairo_restore(cr);
     if (nv >= 0) cairo_set_source_rgb(cr, 0.25 * shade, 0.55 * shade, 0.9 * shade);

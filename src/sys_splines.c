@@ -690,8 +690,9 @@ static double join_scan(spl_state *s, const lw_node *en, int te, int layer, uint
 */
 static double split_log_ratio(spl_state *s, const lw_node *jn, size_t n, size_t c, int r, const lw_node *fp,
                               const lw_node *bp, size_t n_x, size_t n_split, uint32_t skip_f, uint32_t skip_b,
-                              int pieces_live, int layer)
+                              int pieces_live, int layer, int *nomem)
 {
+  *nomem = 0;
   const spl_setup *su = s->setup;
   const lw_td *td = &su->td;
   const size_t nb = n - 1 - c;
@@ -700,13 +701,13 @@ static double split_log_ratio(spl_state *s, const lw_node *jn, size_t n, size_t 
   if (r != 1) {
     const lw_node ends[2] = {bp[0], bp[nb]};
     const double z = join_scan(s, &fp[c], 1, layer, skip_f, pieces_live ? NULL : ends, -1.0, 0.0, NULL, NULL);
-    if (isnan(z)) return NAN;
+    if (isnan(z)) return *nomem = 1, NAN;
     log_add(lg - z, &mx, &sum);
   }
   if (r != 2) {
     const lw_node ends[2] = {fp[0], fp[c]};
     const double z = join_scan(s, &bp[0], 0, layer, skip_b, pieces_live ? NULL : ends, -1.0, 0.0, NULL, NULL);
-    if (isnan(z)) return NAN;
+    if (isnan(z)) return *nomem = 1, NAN;
     log_add(lg - z, &mx, &sum);
   }
   double lq = lw_td_prior(td, fp, c + 1) + lw_td_prior(td, bp, nb + 1) - lw_td_prior(td, jn, n + 1);
@@ -754,8 +755,11 @@ static double propose_split(spl_state *s, lw_proposal *p, gsl_rng *rng)
   lw_node *fp = p->node, *bp = p->node + c + 1;
   copy_nodes(fp, src, c + 1, r == 1);
   copy_nodes(bp, src + c + 1, n - c, r == 2);
-  const double lr = split_log_ratio(s, src, n, c, r, fp, bp, lw_model_count(m) + 1, n_split, j, j, 0, spline_layer(sp, j));
-  if (isnan(lr)) return out_of_memory(p); /* (its scans' NaN) */
+  int nomem;
+  const double lr = split_log_ratio(s, src, n, c, r, fp, bp, lw_model_count(m) + 1, n_split, j, j, 0,
+                                    spline_layer(sp, j), &nomem);
+  /* (a NaN of its own arithmetic, an absurd prior, is a move refused: mc.c) */
+  if (nomem) return out_of_memory(p);
   const size_t nodes[2] = {c + 1, n - c};
   const double rest[2] = {(double)c * td->length, (double)(n - 1 - c) * td->length};
   lw_model_propose_regroup(m, p, &j, 1, NULL, nodes, 2, rest, 0);
@@ -803,8 +807,9 @@ static double propose_join(spl_state *s, lw_proposal *p, gsl_rng *rng)
   if (count_splittable(s, SIZE_MAX, NULL) == SIZE_MAX) return out_of_memory(p);
   const size_t n_split = count_splittable(s, SIZE_MAX, NULL) - (size_t)splittable(td, sp, f) -
                          (size_t)splittable(td, sp, b) + 1;
-  const double lr = -split_log_ratio(s, p->node, n, c, r, fp, bp, N, n_split, f, b, 1, layer);
-  if (isnan(lr)) return out_of_memory(p);
+  int nomem;
+  const double lr = -split_log_ratio(s, p->node, n, c, r, fp, bp, N, n_split, f, b, 1, layer, &nomem);
+  if (nomem) return out_of_memory(p);
   const uint32_t old[2] = {x, y};
   const size_t nodes = n + 1;
   const double rest = (double)n * td->length;

@@ -101,6 +101,16 @@ Test(particles_cli, the_sheet_example_runs_and_writes_a_valid_ply)
   cr_assert_lt(e1, e0, "annealing lowers the energy: %g -> %g", e0, e1);
 }
 
+/* A disc of 1e-200 mm (in range) made a matrix cairo cannot invert: the run
+** annealed, then lost its preview and summary.json.  It draws its dots. */
+Test(particles_cli, a_vanishing_disc_still_draws_its_preview)
+{
+  cr_assert_eq(sh("%s run %s/params/particles-sheet.ini --out %s/tiny --quiet --set anneal.sweeps=4 --set "
+                  "particles.disc=1e-200 2> %s/err.txt && test -s %s/tiny/final.png && test -s %s/tiny/summary.json",
+                  lw_test_bin(), getenv("LW_ROOT"), dir, dir, dir, dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+}
+
 Test(particles_cli, stop_and_resume_give_the_bytes_of_an_uninterrupted_run)
 {
   write_scene();

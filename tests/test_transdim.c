@@ -901,6 +901,22 @@ static void same_bytes_by_threads_and_resume(const char *dir, int s1, int s2)
   }
 }
 
+/* A split prior so narrow that its variance underflows (moves.prior_sd =
+** 1e-200, in range): its density was inf - inf, a NaN Hastings factor the
+** split took for its scans' want of memory, and the run stopped at sweep 0
+** "out of memory".  The splits are proposed and refused, and the run ends. */
+Test(transdim, a_split_prior_too_narrow_for_its_variance_refuses_splits_and_runs)
+{
+  char dir[64];
+  cr_assert_eq(lw_test_dir_make(dir, "narrow"), 0);
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=20 --set anneal.steps=2 "
+                          "--set moves.fixed_count=0 --set moves.split=0.01 --set moves.prior_sd=1e-200 --out ps "
+                          "--quiet 2> err.txt && grep -A12 '\"proposed\"' ps/summary.json | grep -q '\"split\": [1-9]'",
+                          dir, lw_test_bin(), lw_test_root()),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(lw_test_dir_remove(dir), 0);
+}
+
 /* Same scene and seed => byte-identical outputs for any thread count, and a
 ** run stopped and resumed twice ends where the uninterrupted one does. */
 Test(transdim, runs_are_deterministic_and_resume_bit_exactly, .timeout = 300)
