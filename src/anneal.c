@@ -382,14 +382,17 @@ static int parse_ladder(const lw_params *p, const char *text, const char *where,
     size_t len = 0;
     double v;
     while (*(w += len + strspn(w + len, " \t,")) && lw_number_parse_n(w, len = strcspn(w, " \t,"), &v)) {}
-    char word[64], unseen[96];
+    /* the word whole for what it hides (a no-break space between two
+    ** numbers shows as "'1 2' is not a temperature"), shown cut between
+    ** two characters */
+    char whole[256], unseen[96];
     len = strcspn(w, " \t,");
-    snprintf(word, sizeof word, "%.*s%s", len > 60 ? 57 : (int)len, w, len > 60 ? "..." : "");
-    /* (a no-break space between two numbers shows as "'1 2' is not a
-    ** temperature") */
-    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': '%s' is not a temperature; expected finite "
-                        "numbers such as 0.5 or 2e-3%s", where, word, lw_params_unseen_char(word, unseen,
-                                                                                             sizeof unseen)), 0;
+    snprintf(whole, sizeof whole, "%.*s", (int)(len < sizeof whole ? len : sizeof whole - 1), w);
+    size_t cut = len > 60 ? 57 : len;
+    while (cut < len && cut > 0 && ((unsigned char)w[cut] & 0xC0) == 0x80) cut--;
+    return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': '%.*s%s' is not a temperature; expected finite "
+                        "numbers such as 0.5 or 2e-3%s", where, (int)cut, w, cut < len ? "..." : "",
+                        lw_params_unseen_char(whole, unseen, sizeof unseen)), 0;
   }
   if (n < 2 || n > LW_TEMPERING_MAX)
     return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%.120s%s'%s",
@@ -449,6 +452,7 @@ static lw_status read_ladder_file(lw_anneal *a, lw_error *err)
   if (!s) {
     snprintf(p->ladder, sizeof p->ladder, "%s", f->ladder);
     p->ladder_file[0] = '\0';
+    a->ladder_from_file = 1;
   }
   free(f);
   return s;
@@ -488,8 +492,7 @@ static lw_status setup_ladder(lw_anneal *a, double *ladder, lw_error *err)
     ** resume, the line "replicas = 1" of the run's scene.ini), read from
     ** its file where the scene names one (read_ladder_file has put the
     ** file's ladder in its place) */
-    const char *key = !p->ladder[0] ? "replicas"
-                      : !p->of_run && lw_params_line(p, "tempering", "ladder_file") ? "ladder_file" : "ladder";
+    const char *key = !p->ladder[0] ? "replicas" : a->ladder_from_file ? "ladder_file" : "ladder";
     lw_params_origin(p, lw_params_find("tempering", key), where, sizeof where);
     return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.%s': %d replicas for %d processes; expected at least one "
                         "replica per process%s", where, key, a->n_rep, a->net->size,

@@ -106,7 +106,7 @@ static void paint(cairo_t *cr, const lw_particles *p, const depth_key *order, in
     cairo_rotate(cr, angle);
     /* (a disc of 1e-200 mm made a matrix cairo cannot invert, and the run
     ** lost its preview and summary.json at the end: a thousandth of a
-    ** pixel draws the same nothing) */
+    ** pixel draws the same dot, its outline) */
     const double r = fmax(s->disc * scale, 1e-3);
     cairo_scale(cr, r, r * fmax(fabs(nv), 0.03));
     cairo_arc(cr, 0, 0, 1, 0, 2 * M_PI);

@@ -350,7 +350,8 @@ static lw_status read_v1(lw_state *st, reader *r, lw_error *err)
   if (!*val || strlen(val) >= sizeof st->scene) return bad(r, err, "scene", "a file name", val);
   strcpy(st->scene, val);
   if ((s = expect_key(r, "seed", &val, err))) return s;
-  if (!lw_number_parse_whole(val, 0, LW_SEED_MAX, &v)) return bad(r, err, "seed", "a whole number from 0 to 2^32 - 1", val);
+  if (!lw_number_parse_whole(val, 0, LW_SEED_MAX, &v))
+    return bad(r, err, "seed", "a whole number from 0 to 2^32 - 1", val);
   st->seed = (unsigned long)v;
   if ((s = expect_key(r, "sweep", &val, err))) return s;
   if (!lw_number_parse_whole(val, 0, LW_STATE_SWEEP_MAX, &v)) return bad(r, err, "sweep", "a whole number from 0 to 1e15", val);

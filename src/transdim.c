@@ -6,7 +6,6 @@
 */
 #include "linewise/transdim.h"
 
-#include <float.h>
 #include <gsl/gsl_math.h>
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_sf_bessel.h>
@@ -95,17 +94,9 @@ static double log_first_point(const lw_td *td, double x, double y)
   return log(td->uniform * exp(lp) + td->dark_scale * d);
 }
 
-/* log of the isotropic 2-D Gaussian density N(d; 0, s^2) at offset d.
-** Where s^2 is no normal number (moves.prior_sd = 1e-200: inf - inf, a NaN
-** Hastings factor that the split took for its scans' want of memory) the
-** same in logs and ratios, which keep their range; elsewhere the bits of
-** the plain form. */
+/* log of the isotropic 2-D Gaussian density N(d; 0, s^2) at offset d. */
 static double log_gauss2(double dx, double dy, double s)
 {
-  if (!(s * s >= DBL_MIN)) {
-    const double u = dx / s, v = dy / s;
-    return -log(2.0 * M_PI) - 2.0 * log(s) - 0.5 * (u * u + v * v);
-  }
   return -log(2.0 * M_PI * s * s) - 0.5 * (dx * dx + dy * dy) / (s * s);
 }
 

@@ -98,7 +98,8 @@ Test(dynamics_cli, a_run_that_fails_at_its_first_step_gives_the_run_it_replaced_
   ** on disk, tests/unstash-order.awk) */
   cr_assert_eq(sh("cd %s && ASAN_OPTIONS=detect_leaks=0 strace -f -y -e trace=fsync,rename,renameat,renameat2,unlink,"
                   "unlinkat -o st.txt %s run %s/params/minimal.ini --set anneal.sweeps=20 --set scene.driver=dynamics "
-                  "--set dynamics.dt=1e6 --out r --quiet 2> err.txt", dir, lw_test_bin(), lw_test_root()), 1);
+                  "--set dynamics.dt=1e6 --set output.frames_every=1 --out r --quiet 2> err.txt", dir, lw_test_bin(),
+                  lw_test_root()), 1);
   cr_assert_eq(sh("cd %s && awk -f %s/tests/unstash-order.awk st.txt > order.txt", dir, lw_test_root()), 0, "%s",
                lw_test_slurp("%s/order.txt", dir));
   cr_assert_eq(sh("cd %s && grep -q '^linewise: the dynamics.*; the run that was in r is back as it was$' err.txt && "

@@ -150,8 +150,8 @@ Test(mpi, more_processes_than_replicas_is_refused_before_anything_is_written)
   cr_assert_neq(sh("test -e %s/x", dir), 0, "an output directory was created for bad input");
   /* a ladder sets the count: its key is named, not replicas "not set: the
   ** default, 1" */
-  cr_assert_eq(sh(MPIRUN " -n 3 %s run %s/s.ini --set tempering.replicas=1 --set 'tempering.ladder=1 2' --out %s/x --quiet 2>%s/err.txt", m,
-                  dir, dir, dir), 2);
+  cr_assert_eq(sh(MPIRUN " -n 3 %s run %s/s.ini --set tempering.replicas=1 --set 'tempering.ladder=1 2' --out %s/x "
+                  "--quiet 2>%s/err.txt", m, dir, dir, dir), 2);
   cr_assert_eq(sh("grep -q \"^linewise: --set: key 'tempering.ladder': 2 replicas for 3 processes; expected at least "
                   "one replica per process (the ladder's temperatures set the count)$\" %s/err.txt", dir), 0, "%s",
                lw_test_slurp("%s/err.txt", dir));
@@ -162,10 +162,15 @@ Test(mpi, more_processes_than_replicas_is_refused_before_anything_is_written)
                   "&& grep -q \"^linewise: --set: key 'tempering.ladder_file': 2 replicas for 3 processes\" err.txt",
                   dir, m), 0, "%s", lw_test_slurp("%s/err.txt", dir));
   cr_assert_eq(sh("cd %s && %s run s.ini --set tempering.replicas=1 --set 'tempering.ladder=1 2' --set "
-                  "anneal.sweeps=2 --set tempering.tune_ladder=fixed --out two --quiet && " MPIRUN " -n 3 %s resume two --quiet 2> err.txt; test $? -ne 0 "
+                  "anneal.sweeps=2 --set tempering.tune_ladder=fixed --out two --quiet && " MPIRUN " -n 3 %s resume "
+                  "two --quiet 2> err.txt; test $? -ne 0 "
                   "&& grep -q \"^linewise: two/scene.ini:$(grep -n '^ladder = ' two/scene.ini | cut -d: -f1): key "
                   "'tempering.ladder': 2 replicas for 3 processes\" err.txt", dir, lw_test_bin(), m), 0, "%s",
                lw_test_slurp("%s/err.txt", dir));
+  /* a new run from that scene.ini, whose empty ladder_file line was blamed */
+  cr_assert_eq(sh("cd %s && cp two/scene.ini again.ini && " MPIRUN " -n 3 %s run again.ini --out x --quiet 2> err.txt; "
+                  "test $? -ne 0 && grep -q \"^linewise: again.ini:$(grep -n '^ladder = ' again.ini | cut -d: -f1): "
+                  "key 'tempering.ladder': 2 replicas\" err.txt", dir, m), 0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* the dynamics moves one system: the driver is what to change, not the
   ** replicas it leaves idle (the message asked for more of them) */
   cr_assert_eq(sh(MPIRUN " -n 2 %s run %s/params/wire.ini --set tempering.replicas=2 --out %s/x --quiet 2>%s/err.txt",

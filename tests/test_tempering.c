@@ -544,6 +544,15 @@ Test(ptrun, a_ladder_file_runs_as_its_ladder_given_by_set)
     /* a no-break space between two numbers is named ("'1 2' is not a temperature") */
     {"[tempering]\nladder = 1\302\2402 4\n", "", "is not a temperature; expected finite numbers such as 0.5 or "
      "2e-3 (byte 2 is a no-break space"},
+    /* past the 60 bytes shown too, and a long word is cut between characters
+    ** (a cut é was said to be a byte that is no text) */
+    {"[tempering]\nladder = 1 12345678901234567890123456789012345678901234567890123456789012345\302\2402\n", "",
+     "...' is not a temperature; expected finite numbers such as 0.5 or 2e-3 (byte 66 is a no-break space"},
+    {"[tempering]\nladder = 1 \303\251\303\251\303\251\303\251\303\251\303\251\303\251\303\251\303\251\303\251"
+     "\303\251\303\251\303\251\303\251\303\251\303\251\303\251\303\251\303\251\303\251\303\251\303\251"
+     "\303\251\303\251\303\251\303\251\303\251\303\251\303\251\303\251\303\251\303\251\303\251\303\251"
+     "\303\251\303\251\303\251\303\251\303\251\303\251\n", "",
+     "\303\251...' is not a temperature; expected finite numbers such as 0.5 or 2e-3\n"},
     /* values before the count: "1 2 2" was sent to replicas = 3 first */
     {"[tempering]\nladder = 1 2 2\n", "", "lad.ini:2: key 'tempering.ladder': expected increasing positive"},
     {"[tempering]\nladder = 1 2 3 4\n", "--set 'tempering.ladder=1 2 3 5'",

@@ -65,6 +65,7 @@ typedef struct lw_anneal {
   int extending, new_end;      /* a resume to settle before its first sweep (anneal.c) */
   int fresh;                   /* the set-up has written files and no checkpoint yet */
   int stashed;                 /* the run it replaces is set aside until its first sweep (runfiles.h) */
+  int ladder_from_file;        /* tempering.ladder was read from tempering.ladder_file (for messages) */
   int put_back;                /* a set-up that failed put the run it was to replace back */
   int gave_way;                /* the set-up failed as a stop was asked (lw_phase_stopping) */
   char stash_left[LW_ERROR_MSG]; /* why the run replaced stayed in DIR/.replaced ("": it went) */
