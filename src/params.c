@@ -946,7 +946,9 @@ static size_t list_chunk(const char *s, size_t soft, size_t hard)
   size_t len = strlen(s), best = 0;
   if (len <= soft) return len;
   for (size_t k = 1; k + 1 < len && k <= hard; k++) {
-    int lone = s[k] == ' ' && s[k - 1] != ' ' && s[k - 1] != '\t' && s[k + 1] != ' ' && s[k + 1] != '\t';
+    /* (a line that goes on may not begin as a comment or a section does) */
+    int lone = s[k] == ' ' && s[k - 1] != ' ' && s[k - 1] != '\t' && s[k + 1] != ' ' && s[k + 1] != '\t' &&
+               !strchr(";#[", s[k + 1]);
     if (!lone) continue;
     if (k > soft && best) break;
     best = k;
@@ -964,6 +966,9 @@ int lw_params_write_list(FILE *f, const lw_param_def *d, const char *value)
     if (f) fprintf(f, "%s = %s\n", d->key, value);
     return 1;
   }
+  /* the reader takes a line that goes on with '=' or ':' for a key (a
+  ** fuzzed polygon's run wrote a scene.ini that read back as key 'scene.') */
+  if (strpbrk(value, "=:")) return 0;
   for (int first = 1; *value; first = 0) {
     size_t n = list_chunk(value, LIST_LINE, hard);
     if (!n) return 0;
@@ -1042,6 +1047,9 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     else if (!lw_params_text_reads_back(text))
       snprintf(expected, n, "text without control characters, blanks at either end, or ';' at the "
                             "start or after a blank");
+    else if (d->list && !lw_params_write_list(NULL, d, text) && strpbrk(text, "=:"))
+      snprintf(expected, n, "a list without '=' or ':' (one longer than a line goes on over lines, which cannot "
+               "hold them)");
     else if (d->list && !lw_params_write_list(NULL, d, text))
       snprintf(expected, n, "entries of at most %zu bytes each", line_cap(d));
     else {
@@ -1207,9 +1215,13 @@ static int continue_list(reader_ctx *rc)
   }
   snprintf(value + len, d->size - len, "%s%.*s", len ? " " : "", (int)n, h);
   if (!lw_params_write_list(NULL, d, value)) {
-    lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' goes on with a part of over %zu bytes without a single "
-                 "blank: expected entries with single blanks between them", rc->p->file, rc->line, d->section,
-                 d->key, line_cap(d));
+    if (strpbrk(value, "=:"))
+      lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' goes on over lines with '=' or ':' in it: expected a "
+                   "list without them", rc->p->file, rc->line, d->section, d->key);
+    else
+      lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' goes on with a part of over %zu bytes without a single "
+                   "blank: expected entries with single blanks between them", rc->p->file, rc->line, d->section,
+                   d->key, line_cap(d));
     rc->failed = 1;
     return 1;
   }
