@@ -1047,12 +1047,12 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     else if (!lw_params_text_reads_back(text))
       snprintf(expected, n, "text without control characters, blanks at either end, or ';' at the "
                             "start or after a blank");
-    else if (d->list && !lw_params_write_list(NULL, d, text) && strpbrk(text, "=:"))
-      snprintf(expected, n, "a list without '=' or ':' (one longer than a line goes on over lines, which cannot "
-               "hold them)");
-    else if (d->list && !lw_params_write_list(NULL, d, text))
-      snprintf(expected, n, "entries of at most %zu bytes each", line_cap(d));
-    else {
+    else if (d->list && !lw_params_write_list(NULL, d, text)) {
+      if (strpbrk(text, "=:"))
+        snprintf(expected, n, "a list without '=' or ':' (one longer than a line goes on over lines, which cannot "
+                 "hold them)");
+      else snprintf(expected, n, "entries of at most %zu bytes each", line_cap(d));
+    } else {
       strcpy(base, text);
       ok = 1;
     }

@@ -384,6 +384,13 @@ static double out_of_memory(lw_proposal *p)
   return NAN;
 }
 
+/* The refusal an evaluated proposal carries (system.h), for the chain to
+** count apart; one that is both is counted as crowded. */
+static int refusal(const lw_proposal *p)
+{
+  return p->crowded ? LW_PROPOSE_CROWDED : p->irregular ? LW_PROPOSE_IRREGULAR : 0;
+}
+
 /* No line to move, kill, grow, shrink or split (none to join with, for a
 ** join): no proposal (system.h), counted nowhere.  A page whose lines had
 ** all died counted every such move as a rejection, and a death's acceptance
@@ -469,7 +476,7 @@ static double propose_on(const lw_model *m, const lw_td *td, lw_proposal *p, int
     p->log_ratio = n_node == 1 ? lw_td_prior_change(td, src, nn, node0, &nd[0])
                                : lw_td_prior(td, nd, nn) - lw_td_prior(td, src, nn);
   }
-  *forbidden = p->crowded ? LW_PROPOSE_CROWDED : p->irregular ? LW_PROPOSE_IRREGULAR : 0;
+  *forbidden = refusal(p);
   return p->dE;
 }
 
@@ -841,7 +848,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
   if (kind == LW_MOVE_SPLIT || kind == LW_MOVE_JOIN) {
     if (N < (kind == LW_MOVE_JOIN ? 2u : 1u)) return nothing(p, forbidden);
     const double dE = kind == LW_MOVE_SPLIT ? propose_split(s, p, rng) : propose_join(s, p, rng);
-    *forbidden = !p->splice ? 0 : p->crowded ? LW_PROPOSE_CROWDED : p->irregular ? LW_PROPOSE_IRREGULAR : 0;
+    *forbidden = p->splice ? refusal(p) : 0;
     return dE;
   }
   if (kind == LW_MOVE_BIRTH) {
@@ -890,7 +897,7 @@ static double propose_td(spl_state *s, lw_proposal *p, int kind, gsl_rng *rng, i
       p->log_ratio = lw[2] - lw[3] + lr;
     }
   }
-  *forbidden = p->crowded ? LW_PROPOSE_CROWDED : p->irregular ? LW_PROPOSE_IRREGULAR : 0;
+  *forbidden = refusal(p);
   return p->dE;
 }
 
