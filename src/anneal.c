@@ -17,7 +17,6 @@
 #include <string.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "linewise/checkpoint.h"
@@ -34,14 +33,7 @@
 #include "linewise/trace.h"
 #include "linewise/version.h"
 
-static double now_seconds(void)
-{
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-double lw_anneal_seconds(const lw_anneal *a) { return a->wall_before + now_seconds() - a->wall_start; }
+double lw_anneal_seconds(const lw_anneal *a) { return a->wall_before + lw_phase_clock() - a->wall_start; }
 
 double lw_anneal_temperature(const lw_anneal *a) { return a->chain ? a->chain->temperature : 0.0; }
 
@@ -131,7 +123,7 @@ void lw_anneal_ladder_note(const lw_anneal *a, char *buf, size_t n)
 
 void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n)
 {
-  const double wall = now_seconds() - a->wall_start;
+  const double wall = lw_phase_clock() - a->wall_start;
   buf[0] = '\0';
   if (!(a->ckpt_seconds > 1.0 && a->ckpt_seconds > wall / 3.0)) return;
   /* (no figures of this run: a sweep shows each distinct note once) */
@@ -976,7 +968,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   memset(a, 0, sizeof *a);
   a->net = net;
   a->pause_at = -1;
-  a->wall_start = now_seconds();
+  a->wall_start = lw_phase_clock();
   a->params = *p;
   lw_status s;
   /* every file is written with '.': a program that set a decimal-comma
@@ -1166,9 +1158,9 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
   if (se || (se = lw_anneal_settle(a, err))) return se;
   const char *was = lw_phase_get(NULL);
   lw_phase_set("writing state.lw");
-  const double t0 = now_seconds();
+  const double t0 = lw_phase_clock();
   lw_status s = a->net ? a->net->checkpoint(a->net, a, err) : lw_checkpoint_write(a, err);
-  a->ckpt_seconds += now_seconds() - t0;
+  a->ckpt_seconds += lw_phase_clock() - t0;
   lw_phase_set(was);
   if (!s) a->saved = a->sweep + 1;
   if (s) return s;
@@ -1335,7 +1327,7 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
 {
   memset(a, 0, sizeof *a);
   a->net = net;
-  a->wall_start = now_seconds();
+  a->wall_start = lw_phase_clock();
   lw_status sd = dir_fits(a, dir, err);
   if (sd) return sd;
   snprintf(a->dir, sizeof a->dir, "%s", dir);
@@ -1808,9 +1800,9 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
   ** program's trace.csv took decimal commas for a hundred rows first) */
   lw_status s = lw_number_locale_ok(err);
   if (s || (s = lw_anneal_settle(a, err))) return s;
-  const double t0 = now_seconds();
+  const double t0 = lw_phase_clock();
   s = sweep_once(a, err);
-  a->sweep_seconds += now_seconds() - t0;
+  a->sweep_seconds += lw_phase_clock() - t0;
   if (!s) drop_stash(a);
   return s;
 }

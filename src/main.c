@@ -92,7 +92,7 @@ static const char usage[] =
   "                          column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs)\n"
   "  params              every scene parameter as Markdown (the table of docs/PARAMETERS.md)\n"
   "  schedules           the schedules' formulas as Markdown (the table of docs/SCHEDULES.md)\n"
-  "  version             the release (also --version, -V)\n"
+  "  version             the release and its pair kernels' SIMD widths (also --version, -V)\n"
   "  help                this text\n"
   "  --                  ends the options: a path after it may begin with '-'\n"
   "\n"
@@ -1154,6 +1154,18 @@ static int cmd_stats(int argc, char **argv)
                  base.from, base.to);
   if (!dir) lw_error_set(&err, LW_ENOMEM, "out of memory");
   else if (!err.code && !k) lw_error_set(&err, LW_EUSAGE, "stats: expected a run directory %s", use);
+  /* a glob of a sweep's directory names its files too (sweep.conf,
+  ** sweep.csv: "sweep.conf/scene.ini: ... Not a directory"): beside a
+  ** directory, what is a file is left out, with a note */
+  int dirs = 0;
+  struct stat sd;
+  for (int r = 0; !err.code && r < k; r++) dirs += !stat(dir[r], &sd) && S_ISDIR(sd.st_mode);
+  for (int r = 0; !err.code && dirs && r < k; r++) {
+    if (stat(dir[r], &sd) || S_ISDIR(sd.st_mode)) continue;
+    fprintf(stderr, "linewise: note: %s is a file, not a run directory: left out\n", dir[r]);
+    memmove(dir + r, dir + r + 1, (size_t)(k - r - 1) * sizeof *dir);
+    k--, r--;
+  }
   /* a run named twice (a sweep's `best` link beside its seed-N, as a glob
   ** of the sweep's directory gives) would count as two agreeing runs: it is
   ** counted once, by the name that is not a link */
@@ -1197,6 +1209,12 @@ static int cmd_stats(int argc, char **argv)
     lw_path_join(where, sizeof where, dir[r], "trace.csv");
     if (!(path[r] = strdup(where))) lw_error_set(&err, LW_ENOMEM, "out of memory");
     else t[r] = lw_trace_read(where, &err);
+    /* pooled with finished runs, a run stopped on the way counted as one of
+    ** them, its shorter stretch shown only by its row count */
+    lw_path_join(where, sizeof where, dir[r], "summary.json");
+    if (!err.code && k > 1 && access(where, F_OK))
+      fprintf(stderr, "linewise: note: %s has no summary.json: the run has not finished, and its rows end short of "
+              "its scene's\n", dir[r]);
   }
   if (!err.code) {
     failed = -1;

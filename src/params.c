@@ -363,8 +363,8 @@ const lw_param_def lw_param_table[] = {
       "(fixed_count = 0)."),
   NUM("moves", "max_segments", LW_PT_INT, max_segments, "16", "", 1, 1e5, 0,
       "Grow never makes a spline longer than this many segments (fixed_count = 0); shrink never "
-      "below one. At least init.segments (the count placed and born splines start with); the default "
-      "value, 16, gives way to a larger init.segments."),
+      "below one. At least init.segments (the count placed and born splines start with); unset, "
+      "it is 16 or init.segments where that is larger (a run's scene.ini writes the cap in force)."),
   NUM("moves", "split", LW_PT_DOUBLE, mix_split, "0", "", 0, 1e6, 0,
       "Relative frequency of splits: an inner segment of a spline of 3 or more segments removed, "
       "leaving two splines with the nodes as they were (fixed_count = 0; 0 = none)."),
@@ -785,8 +785,9 @@ const lw_param_def lw_param_table[] = {
       "Rigidity beta of that energy."),
   NUM("nurbs", "gauss", LW_PT_INT, nb_gauss, "10", "", 1, 64, 0,
       "Gauss-Legendre points per knot span for the matrices M, D and K: at least as many in all as "
-      "control points (fewer leave motions that the energy does not see); `order` points make the "
-      "matrices of a polynomial curve exact."),
+      "control points (fewer leave motions that the energy does not see), so at least 2 (a curve "
+      "has fewer spans than points; 1 is read only in a run begun before 2026-12-05); `order` "
+      "points make the matrices of a polynomial curve exact."),
   NUM("nurbs", "fixed", LW_PT_INT, nb_fixed, "0", "", 0, 1e9, 0,
       "Control points held at each end (1 = the ends of the curve; 2 = its end tangents too). "
       "Monte Carlo and the dynamics move only the others. Gravity is the [dynamics] "
@@ -1657,6 +1658,14 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
   if (steps_unset) assign(p, steps, steps->def, expected, sizeof expected);
   apply_preset(p);
   if (steps_unset && !strcmp(p->schedule, "constant")) assign(p, steps, "1", expected, sizeof expected);
+  /* An unset cap gives way to a larger init.segments, and the run's
+  ** scene.ini says so (it wrote 16 over a cap of init.segments, and an
+  ** explicit 16 was taken for the default and raised without a word); a
+  ** 16 that an earlier release's run wrote there was such a default. */
+  const lw_param_def *cap = lw_params_find("moves", "max_segments");
+  const int cap_line = p->line[cap - lw_param_table];
+  if (!p->of_run && p->max_segments < p->segments && at_default(p, cap) && (!cap_line || (p->run_header && cap_line > 0)))
+    p->max_segments = p->segments;
   unsigned char rgb[LW_PLOT_PENS_MAX][3];
   /* (with layers the pens are theirs, which the scene says first) */
   if (p->pen_colors[0] && !p->ly_names[0] && lw_output_colors_parse(p->pen_colors, rgb, LW_PLOT_PENS_MAX) != p->pens) {

@@ -12,7 +12,7 @@
 static _Atomic(const char *) phase_what;
 static _Atomic double phase_since;
 
-static double now(void)
+double lw_phase_clock(void)
 {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -21,7 +21,7 @@ static double now(void)
 
 void lw_phase_set(const char *what)
 {
-  atomic_store(&phase_since, now());
+  atomic_store(&phase_since, lw_phase_clock());
   atomic_store(&phase_what, what);
 }
 
@@ -66,7 +66,7 @@ long lw_phase_last_commit(long *pending)
 const char *lw_phase_get(double *seconds)
 {
   const char *what = atomic_load(&phase_what);
-  if (seconds) *seconds = what ? now() - atomic_load(&phase_since) : 0.0;
+  if (seconds) *seconds = what ? lw_phase_clock() - atomic_load(&phase_since) : 0.0;
   return what;
 }
 

@@ -29,11 +29,11 @@
 ** order).
 */
 #include "linewise/quench.h"
+#include "linewise/phase.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #define MEMORY 5         /* step pairs kept: 2 MEMORY + 6 vectors of n doubles in all */
 #define HALVINGS_MAX 50  /* a step of 2^-50 of the first is nothing */
@@ -73,13 +73,6 @@ typedef struct {
   long evaluations, forbidden, holds;
   int away;                        /* the state stands at a rejected trial, not at x */
 } lbfgs;
-
-static double seconds_now(void)
-{
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static double dot(const double *u, const double *v, size_t n)
 {
@@ -283,7 +276,7 @@ static void lbfgs_free(lbfgs *q)
 lw_status lw_quench_run(lw_system *sys, const lw_quench_opts *o, lw_quench_report *r, lw_error *err)
 {
   const lw_system_type *t = sys->type;
-  const double t0 = seconds_now();
+  const double t0 = lw_phase_clock();
   memset(r, 0, sizeof *r);
   r->ended = LW_QUENCH_NO_DESCENT;
   r->energy_before = r->energy_after = t->total(sys->state);
@@ -374,7 +367,7 @@ out:
   r->evaluations = q.evaluations;
   r->forbidden = q.forbidden;
   r->holds = q.holds;
-  r->seconds = seconds_now() - t0;
+  r->seconds = lw_phase_clock() - t0;
   lbfgs_free(&q);
   return st;
 }

@@ -674,11 +674,12 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   sc->transdim = !p->fixed_count;
   /* a cap below the placed splines' count was raised to it without a word,
   ** and lines grew past the cap the scene set (births start at init.segments
-  ** under init.from too); the default's value gives way (a run's scene.ini
-  ** writes it), and a run begun before 2026-12-05 keeps its cap */
+  ** under init.from too); an unset cap gives way (lw_params_resolve raises
+  ** it, and parameters not resolved keep the default's value), and a run
+  ** begun before 2026-12-05 keeps its cap */
   const lw_param_def *cap = lw_params_find("moves", "max_segments");
-  if (sc->transdim && p->max_segments < p->segments && strtod(cap->def, NULL) != p->max_segments &&
-      !lw_params_kept(p, "moves", "max_segments"))
+  const int cap_unset = !lw_params_line(p, "moves", "max_segments") && strtod(cap->def, NULL) == p->max_segments;
+  if (sc->transdim && p->max_segments < p->segments && !cap_unset && !lw_params_kept(p, "moves", "max_segments"))
     return bad_key(p, "moves", "max_segments", LW_EINPUT, err, "expected at least init.segments = %d, the count "
                    "placed and born splines start with, got %d", p->segments, p->max_segments);
   sc->max_segments = (size_t)(p->max_segments > p->segments ? p->max_segments : p->segments);

@@ -264,6 +264,7 @@ static int flagged(const column_stats *c, int k)
 static void warn(FILE *out, const lw_trace *t, const column_stats *cs, int k, int what, const char *text)
 {
   int any = 0;
+  if (!out) return;
   for (size_t c = 0; c < t->n_cols; c++) {
     if (is_coordinate(t->name[c]) || !cs[c].run[0].n || !has_problem(&cs[c], k, what)) continue;
     fprintf(out, "%s%s", any ? ", " : "warning: ", t->name[c]);
@@ -418,9 +419,9 @@ static void stretch_line(FILE *out, const char *lead, const lw_trace *t, const c
   fprintf(out, "%s%s: sweeps %.0f to %.0f", lead, path, at(t, row[0], sweep), at(t, row[n - 1], sweep));
   if (temp >= 0 && tlo == thi) fprintf(out, " at temperature %.6g", tlo);
   else if (temp >= 0) fprintf(out, " at temperatures %.6g to %.6g", tlo, thi);
-  fprintf(out, ": %zu rows", n);
+  fprintf(out, ": %zu row%s", n, n == 1 ? "" : "s");
   if (every != 1.0) fprintf(out, ", one every %.6g sweeps", every);
-  if (tuned) fprintf(out, " (%zu rows of tuning sweeps left out)", tuned);
+  if (tuned) fprintf(out, " (%zu row%s of tuning sweeps left out)", tuned, tuned == 1 ? "" : "s");
   fputc('\n', out);
 }
 
@@ -535,21 +536,71 @@ static int frozen_runs(const lw_trace *t, const column_stats *cs, int k)
   return frozen;
 }
 
-/* Whether every run's rows are the first run's, value for value: one seed
-** run twice, or seeds that changed nothing (a scene that draws no random
-** number), which the comparison took for k agreeing runs (R_hat 0.99,
-** p_runs 1). */
-static int identical_runs(const lw_trace *const *t, size_t *const *row, const size_t *n, int k)
+/* Whether run r's rows are run q's, value for value (NaN for NaN). */
+static int same_rows(const lw_trace *const *t, size_t *const *row, const size_t *n, int q, int r)
 {
-  for (int r = 1; r < k; r++) {
-    if (n[r] != n[0]) return 0;
-    for (size_t i = 0; i < n[0]; i++)
-      for (size_t c = 0; c < t[0]->n_cols; c++) {
-        const double a = at(t[0], row[0][i], (int)c), b = at(t[r], row[r][i], (int)c);
-        if (a != b && !(isnan(a) && isnan(b))) return 0;
-      }
-  }
+  if (n[r] != n[q]) return 0;
+  for (size_t i = 0; i < n[q]; i++)
+    for (size_t c = 0; c < t[q]->n_cols; c++) {
+      const double a = at(t[q], row[q][i], (int)c), b = at(t[r], row[r][i], (int)c);
+      if (a != b && !(isnan(a) && isnan(b))) return 0;
+    }
   return 1;
+}
+
+/* A hash of a run's rows that equal rows share (0 and -0, any NaN, alike),
+** so that only runs of one hash are compared value for value: 64-bit FNV-1a
+** over the values' bits. */
+static unsigned long long rows_hash(const lw_trace *t, const size_t *row, size_t n)
+{
+  unsigned long long h = 1469598103934665603ULL;
+  for (size_t i = 0; i < n; i++)
+    for (size_t c = 0; c < t->n_cols; c++) {
+      double v = at(t, row[i], (int)c);
+      if (isnan(v)) v = NAN;
+      if (v == 0.0) v = 0.0;
+      unsigned char b[sizeof v];
+      memcpy(b, &v, sizeof v);
+      for (size_t j = 0; j < sizeof v; j++) h = (h ^ b[j]) * 1099511628211ULL;
+    }
+  return h;
+}
+
+/* Runs whose rows are another's, value for value: one seed run twice, or
+** seeds that changed nothing (a scene that draws no random number), which
+** the comparison took for agreeing runs (R_hat 0.99, p_runs 1); pooled, such
+** a run counts twice and the error bar is too small (one seed twice among
+** four: 16 % small).  All alike is one warning, else one a set of twins.
+** (Out of memory for the hashes: no warning.) */
+static void warn_twins(FILE *out, const lw_trace *const *t, size_t *const *row, const size_t *n, const char *const *path,
+                       int k)
+{
+  int *twin = malloc((size_t)k * sizeof *twin); /* the first run that run r repeats, or r */
+  unsigned long long *h = malloc((size_t)k * sizeof *h);
+  int distinct = 0;
+  for (int r = 0; twin && h && r < k; r++) {
+    h[r] = rows_hash(t[r], row[r], n[r]);
+    twin[r] = r;
+    for (int q = 0; q < r && twin[r] == r; q++)
+      if (twin[q] == q && h[q] == h[r] && same_rows(t, row, n, q, r)) twin[r] = q;
+    distinct += twin[r] == r;
+  }
+  if (twin && h && distinct == 1)
+    fprintf(out, "warning: the %d runs are the same, row for row: one seed run twice, or seeds that change "
+            "nothing (a scene that draws no random number, as the dynamics from init.from or the D-NURBS dynamics), "
+            "so they are one run, and R_hat and p_runs say nothing\n", k);
+  for (int q = 0; twin && h && distinct > 1 && q < k; q++) {
+    int copies = 0;
+    for (int r = q + 1; r < k; r++) copies += twin[r] == q;
+    if (!copies) continue;
+    fprintf(out, "warning: %s", path[q]);
+    for (int r = q + 1; r < k; r++)
+      if (twin[r] == q) fprintf(out, "%s%s", --copies ? ", " : " and ", path[r]);
+    fprintf(out, " are the same run, row for row (one seed run twice): pooled, it counts as more than one, so "
+            "the error bars are too small and R_hat and p_runs too kind; leave all but one out\n");
+  }
+  free(twin);
+  free(h);
 }
 
 lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
@@ -710,30 +761,31 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
             "its columns' means are one state's and their error bars 0 say nothing of the distribution (a step "
             "too large, or a temperature too low, for the moves)\n",
             k > 1 ? (frozen > 1 ? "runs" : "a run") : "the run", frozen > 1 ? "their" : "its");
-  if (apart && k > 1 && identical_runs(t, row, n, k))
-    fprintf(apart, "warning: the %d runs are the same, row for row: one seed run twice, or seeds that change "
-            "nothing (a scene that draws no random number, as the dynamics from init.from or the D-NURBS dynamics), "
-            "so they are one run, and R_hat and p_runs say nothing\n", k);
-  if (!csv) {
-    warn(out, t[0], cs, k, WARN_OPEN, "the autocorrelation did not die out within half the rows: tau is a lower "
-         "bound and the error bar too small (a longer stretch is needed)");
-    warn(out, t[0], cs, k, WARN_ONE, k > 1 ? "a run of one row, which has no error bar of its own: the error bar "
-         "above is the spread of the runs' means over sqrt(runs), and the runs are not compared (R_hat and p_runs "
-         "empty)" : "one row: a mean and no error bar (a longer stretch is needed)");
-    warn(out, t[0], cs, k, WARN_FEW, k > 1 ? "fewer than 25 independent samples in a run (n_eff above sums the "
-         "runs): that run's error bar, and the test of the runs against each other, are rough"
-         : "fewer than 25 independent samples: the error bar is rough");
-    warn(out, t[0], cs, k, WARN_BATCH, "the means of 20 batches spread more than 1.5 times the error bar allows "
-         "(by chance 1 time in 700): a slower mode the autocorrelation window missed, so the error bar is too small "
-         "(batch_ratio in --csv is the factor; run longer, or trust the larger bar)");
-    warn(out, t[0], cs, k, WARN_DRIFT, "the first and second halves differ by more than 4 standard errors: not yet "
-         "stationary (start later with --from), or, where the batch means warn too, the same slow mode (run longer)");
-    warn(out, t[0], cs, k, WARN_RUNS, "the runs disagree beyond their error bars (p_runs < 0.001 or R_hat > 1.1): "
-         "not converged, or the stretches too short for their error bars");
-    warn(out, t[0], cs, k, WARN_COARSE, "the values are about uncorrelated at their spacing, so tau_sweeps is at "
-         "most half of it, not a measurement (the error bar holds; rows more often, output.trace_every, measure "
-         "it)");
-  }
+  if (apart && k > 1) warn_twins(apart, t, row, n, path, k);
+  /* the table's warnings; with --csv, those of one run are its columns
+  ** (window_closed, n and n_eff, drift_z, batch_ratio), and of several runs
+  ** only r_hat and p_runs: the rest go apart, where a script sees that the
+  ** error bars are lower bounds (they went nowhere) */
+  FILE *per_column = csv ? (k > 1 ? apart : NULL) : out, *in_table = csv ? NULL : out;
+  warn(per_column, t[0], cs, k, WARN_OPEN, "the autocorrelation did not die out within half the rows: tau is a lower "
+       "bound and the error bar too small (a longer stretch is needed)");
+  warn(in_table, t[0], cs, k, WARN_ONE, k > 1 ? "a run of one row, which has no error bar of its own: the error bar "
+       "above is the spread of the runs' means over sqrt(runs), and the runs are not compared (R_hat and p_runs "
+       "empty)" : "one row: a mean and no error bar (a longer stretch is needed)");
+  warn(per_column, t[0], cs, k, WARN_FEW, k > 1 ? "fewer than 25 independent samples in a run (n_eff sums the "
+       "runs): that run's error bar, and the test of the runs against each other, are rough"
+       : "fewer than 25 independent samples: the error bar is rough");
+  warn(per_column, t[0], cs, k, WARN_BATCH, "the means of 20 batches spread more than 1.5 times the error bar allows "
+       "(by chance 1 time in 700): a slower mode the autocorrelation window missed, so the error bar is too small "
+       "(batch_ratio in --csv is the factor; run longer, or trust the larger bar)");
+  warn(per_column, t[0], cs, k, WARN_DRIFT, "the first and second halves differ by more than 4 standard errors: not "
+       "yet stationary (start later with --from), or, where the batch means warn too, the same slow mode (run "
+       "longer)");
+  warn(in_table, t[0], cs, k, WARN_RUNS, "the runs disagree beyond their error bars (p_runs < 0.001 or R_hat > 1.1): "
+       "not converged, or the stretches too short for their error bars");
+  warn(per_column, t[0], cs, k, WARN_COARSE, "the values are about uncorrelated at their spacing, so tau_sweeps is "
+       "at most half of it, not a measurement (the error bar holds; rows more often, output.trace_every, measure "
+       "it)");
 done:
   for (int r = 0; row && r < k; r++) free(row[r]);
   for (int r = 0; heat && r < k; r++) lw_trace_free(heat[r]);

@@ -635,9 +635,10 @@ Test(run, a_move_with_no_line_left_is_no_proposal)
 
 /* A cap on the segments below the count the placed splines start with was
 ** raised to it without a word, and lines grew past the cap the scene set,
-** with init.from too (births start at init.segments).  The default's value,
-** 16, gives way to a larger init.segments (a run's scene.ini writes it, and
-** a run of that file must not be refused), and so does a run's own value. */
+** with init.from too (births start at init.segments).  An unset cap, 16,
+** gives way to a larger init.segments, and the run's scene.ini says so (it
+** wrote 16, and an explicit 16 was raised without a word while 17 was
+** refused); a 16 that an earlier release's run wrote there gives way too. */
 Test(run, a_segment_cap_below_the_placed_count_is_refused)
 {
   const char *b = getenv("LW_BIN");
@@ -646,10 +647,15 @@ Test(run, a_segment_cap_below_the_placed_count_is_refused)
                   "at least init.segments = 4, the count placed and born splines start with, got 3\" %s/cap.txt && "
                   "! test -e %s/cap", b, lw_test_root(), dir, dir, dir, dir), 0);
   cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/cap --quiet --set moves.fixed_count=0 --set init.segments=20 "
-                  "--set init.segment_length=1.5 --set anneal.sweeps=2 && %s run %s/cap/scene.ini --out %s/cap2 "
-                  "--quiet && %s run %s/params/minimal.ini --out %s/cap16 --quiet --set moves.fixed_count=0 --set "
-                  "init.segments=20 --set init.segment_length=1.5 --set moves.max_segments=16 --set anneal.sweeps=2",
-                  b, lw_test_root(), dir, b, dir, dir, b, lw_test_root(), dir), 0);
+                  "--set init.segment_length=1.5 --set anneal.sweeps=2 && grep -qx 'max_segments = 20' %s/cap/scene.ini "
+                  "&& %s run %s/cap/scene.ini --out %s/cap2 --quiet && sed 's/^max_segments = 20$/max_segments = 16/' "
+                  "%s/cap/scene.ini > %s/old.ini && %s run %s/old.ini --out %s/cap3 --quiet && grep -qx "
+                  "'max_segments = 20' %s/cap3/scene.ini", b, lw_test_root(), dir, dir, b, dir, dir, dir, dir, b, dir,
+                  dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/cap16 --quiet --set moves.fixed_count=0 --set init.segments=20 "
+                  "--set init.segment_length=1.5 --set moves.max_segments=16 2>%s/cap.txt; test $? -eq 2 && grep -qF "
+                  "'expected at least init.segments = 20' %s/cap.txt && ! test -e %s/cap16", b, lw_test_root(), dir, dir,
+                  dir, dir), 0);
   cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/from --quiet --set moves.fixed_count=0 --set "
                   "moves.max_segments=3 --set init.from=%s/cap/state.lw --set anneal.sweeps=0 2>%s/cap.txt; "
                   "test $? -eq 2 && grep -qF 'got 3' %s/cap.txt", b, lw_test_root(), dir, dir, dir, dir), 0);

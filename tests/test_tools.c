@@ -274,6 +274,39 @@ Test(tools, identical_runs_have_a_standard_deviation_of_zero)
   out = err_txt();
   cr_assert(strstr(out, "linewise: warning: the 2 runs are the same, row for row"), "%s", out);
   free(out);
+  /* two of three the same (one seed twice in a sweep of several): it was
+  ** said only when all were, and the twin's weight made the error bars
+  ** 15 to 27 % small; "other" is seed-3 with one value changed, and has
+  ** no summary.json (a run stopped on the way, pooled unsaid) */
+  cr_assert_eq(sh("cd %s/w && cp -r seed-3 other && rm other/summary.json && awk -F, -v OFS=, 'NR > 1 && !d { $2 = "
+                  "$2 + 1; d = 1 } 1' seed-3/trace.csv > other/trace.csv && %s stats seed-1 seed-2 other", dir,
+                  env("LW_BIN")), 0, "%s", err_txt());
+  out = out_txt();
+  char *errs = err_txt();
+  cr_assert(strstr(out, "warning: seed-1/trace.csv and seed-2/trace.csv are the same run, row for row (one seed run "
+                        "twice)") && !strstr(out, "runs are the same"), "%s", out);
+  cr_assert(strstr(errs, "linewise: note: other has no summary.json: the run has not finished"), "%s", errs);
+  free(errs);
+  /* the pooled CSV carries no window, batch or sample-count column: the
+  ** table's warnings of those go to stderr (they went nowhere, and a script
+  ** took lower bounds for error bars) */
+  cr_assert_eq(sh("cd %s/w && %s stats seed-1 seed-2 other --csv", dir, env("LW_BIN")), 0, "%s", err_txt());
+  errs = err_txt();
+  int lines = 0;
+  for (char *l = strstr(out, "\nwarning: "); l; l = strstr(l + 1, "\nwarning: "), lines++) {
+    char want[1024];
+    snprintf(want, sizeof want, "linewise: %.*s\n", (int)strcspn(l + 1, "\n"), l + 1);
+    cr_assert(strstr(errs, want) || strstr(want, "disagree beyond their error bars"), "%s not in:\n%s", want, errs);
+  }
+  cr_assert_geq(lines, 2, "%s", out);
+  free(errs);
+  free(out);
+  /* a glob of the sweep's directory: its files are left out, best counted once */
+  cr_assert_eq(sh("cd %s/w && %s stats *", dir, env("LW_BIN")), 0, "%s", err_txt());
+  errs = err_txt();
+  cr_assert(strstr(errs, "linewise: note: sweep.conf is a file, not a run directory: left out\n") &&
+            strstr(errs, "linewise: note: best is the run in "), "%s", errs);
+  free(errs);
 }
 
 /* Ctrl-C to the whole sweep (its process group; INT at its default, as in a

@@ -26,6 +26,10 @@ void lw_phase_set(const char *what);
 /* The current phase (NULL: none) and, in *seconds, how long it has lasted. */
 const char *lw_phase_get(double *seconds);
 
+/* Seconds on the monotonic clock (the phases' clock, and the runs' wall
+** time): differences only. */
+double lw_phase_clock(void);
+
 /* Whether the run has written nothing yet, so that a signal may end it at
 ** once, even in a set-up of minutes, and lose nothing (main.c): the command
 ** line sets it (lw_phase_hold) before it starts or resumes a run, and the
