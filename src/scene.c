@@ -211,25 +211,14 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
     snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_flatten: paper tones %.3f to %.3f divided out",
              used ? "; " : "", lo, hi);
   }
-  if (p->image_levels > 0) {
-    double lo, hi;
-    if ((st = lw_image_levels(sc->image, p->image_levels, &lo, &hi, err))) return st;
-    size_t used = strlen(sc->note);
-    if (lo > 0.0 || hi < 1.0)
-      snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_levels: tones %.3f to %.3f stretched to 0 to 1",
-               used ? "; " : "", lo, hi);
-    else /* a plateau of paper or of black at an end keeps its end */
-      snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_levels: the tones left as they are",
-               used ? "; " : "");
-  }
-  /* The tone curve takes the picture under its transparency (image.h).  A
-  ** blur spreads the picture's edge onto its transparent side, so the curve
-  ** takes the alpha blurred alike: with the sharp one, the spread edge was
-  ** left out of the curve (an inverted picture got a ring of ink). */
+  /* The levels and the tone curve take the picture under its transparency
+  ** (image.h).  A blur spreads the picture's edge onto its transparent side,
+  ** so they take the alpha blurred alike: with the sharp one, the spread
+  ** edge was left out of the curve (an inverted picture got a ring of ink). */
   const int curve = p->image_invert || p->image_gamma != 1.0 || p->image_contrast != 1.0;
   const size_t npx = (size_t)sc->image->width * (size_t)sc->image->height;
   float *cover = NULL;
-  if (sc->image->alpha && curve && p->image_blur > 0) {
+  if (sc->image->alpha && (curve || p->image_levels > 0) && p->image_blur > 0) {
     if (!(cover = malloc(npx * sizeof *cover)))
       return lw_error_set(err, LW_ENOMEM, "out of memory for the picture's transparency");
     memcpy(cover, sc->image->alpha, npx * sizeof *cover);
@@ -238,6 +227,20 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
       free(cover);
       return st;
     }
+  }
+  if (p->image_levels > 0) {
+    double lo, hi;
+    if ((st = lw_image_levels(sc->image, cover ? cover : sc->image->alpha, p->image_levels, &lo, &hi, err))) {
+      free(cover);
+      return st;
+    }
+    size_t used = strlen(sc->note);
+    if (lo > 0.0 || hi < 1.0)
+      snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_levels: tones %.3f to %.3f stretched to 0 to 1",
+               used ? "; " : "", lo, hi);
+    else /* a plateau of paper or of black at an end keeps its end */
+      snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_levels: the tones left as they are",
+               used ? "; " : "");
   }
   lw_image_tone_curve(sc->image, cover ? cover : sc->image->alpha, p->image_gamma, p->image_contrast,
                       p->image_invert);

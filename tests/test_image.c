@@ -558,7 +558,7 @@ Test(image, levels_stretch_the_tones_between_the_quantiles)
   float *orig = malloc(n * sizeof *orig);
   memcpy(orig, img->tone, n * sizeof *orig);
   double lo, hi;
-  cr_assert_eq(lw_image_levels(img, 0.01, &lo, &hi, NULL), LW_OK);
+  cr_assert_eq(lw_image_levels(img, img->alpha, 0.01, &lo, &hi, NULL), LW_OK);
   cr_assert(fabs(lo - (a + 0.01 * (b - a))) < bin + step, "lo %g", lo);
   cr_assert(fabs(hi - (b - 0.01 * (b - a))) < bin + step, "hi %g", hi);
   int black = 0, white = 0;
@@ -573,9 +573,40 @@ Test(image, levels_stretch_the_tones_between_the_quantiles)
             "black %d, white %d", black, white);
   /* clip 0: the darkest and lightest pixels themselves */
   memcpy(img->tone, orig, n * sizeof *orig);
-  cr_assert_eq(lw_image_levels(img, 0, &lo, &hi, NULL), LW_OK);
+  cr_assert_eq(lw_image_levels(img, img->alpha, 0, &lo, &hi, NULL), LW_OK);
   cr_assert(fabs(lo - a) < bin && fabs(hi - b) < bin, "%g %g", lo, hi);
   free(orig);
+  lw_image_free(img);
+}
+
+/* A half-transparent picture (a faded overlay, a soft cut-out) keeps its
+** transparency through the levels: its own tones, under the paper the alpha
+** lets through, are stretched, and composited again.  The levels were taken
+** of the composite and stretched it: with the tone curve's taking apart
+** after, its darks went to one grey (gamma 1.2), or it came out opaque. */
+Test(image, levels_stretch_the_picture_under_its_transparency)
+{
+  const int n = 1000;
+  lw_image *img = lw_image_new(n, 1, 1, NULL);
+  for (int k = 0; k < n; k++) {
+    const double own = 0.2 + 0.4 * k / (n - 1), a = 0.5;
+    img->alpha[k] = (float)a;
+    img->tone[k] = (float)(a * own + 1.0 - a);
+  }
+  double lo, hi;
+  cr_assert_eq(lw_image_levels(img, img->alpha, 0, &lo, &hi, NULL), LW_OK);
+  cr_assert(fabs(lo - 0.2) < 1e-3 && fabs(hi - 0.6) < 1e-3, "the picture's own levels: %g %g", lo, hi);
+  for (int k = 0; k < n; k++) {
+    const double own = 0.2 + 0.4 * k / (n - 1), want = 0.5 * fmin(fmax((own - lo) / (hi - lo), 0), 1) + 0.5;
+    cr_assert(fabs(img->tone[k] - want) < 1e-5, "%d: %g, want %g (half ink at most)", k, img->tone[k], want);
+  }
+  /* then the tone curve takes the picture out from under it again: the
+  ** stretched own tones, gamma applied, still at half ink */
+  lw_image_tone_curve(img, img->alpha, 1.2, 1.0, 0);
+  for (int k = 0; k < n; k += 111) {
+    const double own = 0.2 + 0.4 * k / (n - 1), t = fmin(fmax((own - lo) / (hi - lo), 0), 1);
+    cr_assert(fabs(img->tone[k] - (0.5 * pow(t, 1.2) + 0.5)) < 1e-5, "%d: %g", k, img->tone[k]);
+  }
   lw_image_free(img);
 }
 
@@ -592,7 +623,7 @@ Test(image, levels_skip_transparent_pixels_and_cap_the_stretch)
     img->alpha[2 * k + 1] = k % 2 ? 0.0f : 0.49f;
   }
   double lo, hi;
-  cr_assert_eq(lw_image_levels(img, 0.05, &lo, &hi, NULL), LW_OK);
+  cr_assert_eq(lw_image_levels(img, img->alpha, 0.05, &lo, &hi, NULL), LW_OK);
   cr_assert(fabs(lo - 0.315) < 1e-3 && fabs(hi - 0.585) < 1e-3, "%g %g", lo, hi);
   for (int k = 0; k < n; k++) cr_assert_eq(img->tone[2 * k + 1], 1.0f);
   lw_image_free(img);
@@ -603,7 +634,7 @@ Test(image, levels_skip_transparent_pixels_and_cap_the_stretch)
   for (int m = 0; m < 2; m++) {
     img = lw_image_new(n, 1, 0, NULL);
     for (int k = 0; k < n; k++) img->tone[k] = (float)(mid[m] + 0.01 * (2.0 * k / (n - 1) - 1.0));
-    cr_assert_eq(lw_image_levels(img, 0.01, &lo, &hi, NULL), LW_OK);
+    cr_assert_eq(lw_image_levels(img, img->alpha, 0.01, &lo, &hi, NULL), LW_OK);
     cr_assert(fabs(hi - lo - LW_IMAGE_LEVELS_MIN_SPAN) < 1e-12 && lo >= 0 && hi <= 1, "%g %g", lo, hi);
     if (m == 0) cr_assert(fabs(0.5 * (lo + hi) - 0.5) < 1e-3, "%g %g", lo, hi);
     else cr_assert(hi == 1.0, "%g", hi);
@@ -628,14 +659,14 @@ Test(image, levels_leave_a_flat_colour_at_either_end_as_it_is)
     img->alpha[k] = k < 500 ? 1.0f : 0.0f; /* transparent paper */
   }
   double lo, hi;
-  cr_assert_eq(lw_image_levels(img, 0.01, &lo, &hi, NULL), LW_OK);
+  cr_assert_eq(lw_image_levels(img, img->alpha, 0.01, &lo, &hi, NULL), LW_OK);
   cr_assert(lo == 0.0 && hi == 1.0, "levels %g to %g", lo, hi);
   cr_assert(img->tone[0] == 0.33f && img->tone[450] == 0.26f && img->tone[600] == 1.0f);
   for (int k = 0; k < n; k++) {
     img->tone[k] = k < 400 ? 0.33f : (float)(0.1 + 0.2 * (k - 400) / (n - 401));
     img->alpha[k] = 1.0f;
   }
-  cr_assert_eq(lw_image_levels(img, 0.01, &lo, &hi, NULL), LW_OK);
+  cr_assert_eq(lw_image_levels(img, img->alpha, 0.01, &lo, &hi, NULL), LW_OK);
   cr_assert(hi == 1.0 && fabs(lo - 0.102) < 2e-3, "levels %g to %g", lo, hi);
   lw_image_free(img);
 }
