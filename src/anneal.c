@@ -650,6 +650,7 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
                            *const ends[] = {"tempering.t_min", "tempering.t_max", NULL},
                            *const seed[] = {"anneal.seed", "anneal.seed_version", NULL},
                            *const gravity[] = {"dynamics.gravity_x", "dynamics.gravity_y", NULL},
+                           *const pin_vectors[] = {"dynamics.pin_vectors", NULL},
                            *const machine[] = {"plot.tolerance", "plot.turn", "plot.bed_width", "plot.bed_height",
                                                NULL},
                            *const gcode[] = {"plot.gcode_travel", "plot.gcode_pen_up", "plot.gcode_pen_down", NULL},
@@ -681,6 +682,7 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
       /* (a seed sweep of the whip gave identical "independent" runs) */
       {seed, lw_driver_is_motion(p) && p->from[0], "the dynamics from init.from draws no random number"},
       {gravity, p->dyn_rho == 0.0, "dynamics.rho = 0: no mass to weigh"},
+      {pin_vectors, p->dyn_pin == LW_PIN_NONE, "dynamics.pin = none"},
       /* (a bed too small for the page passed unchecked, without a word) */
       {machine, !p->hpgl && !p->gcode, "neither output.hpgl nor output.gcode"},
       {gcode, !p->gcode, "output.gcode = 0"},

@@ -245,7 +245,10 @@ static lw_quench_end end_now(const lw_quench_opts *o, long it, double gnorm, con
   if (gnorm <= o->tol) return LW_QUENCH_CONVERGED;
   if (it >= o->max_iter) return LW_QUENCH_ITERATIONS;
   if (o->stop && *o->stop) return LW_QUENCH_STOPPED;
-  if (it >= LW_QUENCH_WINDOW && back[it % LW_QUENCH_WINDOW] - e < o->stall * (e_start - e) &&
+  /* (stall 0 is never: the test read "energy rose over the window", which
+  ** the approximate Wolfe steps allow by rounding, and a quench told never to
+  ** stall said "stalled") */
+  if (o->stall > 0.0 && it >= LW_QUENCH_WINDOW && back[it % LW_QUENCH_WINDOW] - e < o->stall * (e_start - e) &&
       !(gnorm < LW_QUENCH_STALL_GRADIENT * back_g[it % LW_QUENCH_WINDOW]))
     return LW_QUENCH_STALLED;
   return LW_QUENCH_RUNNING;

@@ -1353,6 +1353,8 @@ static void *mass_new(const void *state, const lw_params *p, double density, lw_
   }
   lw_spline_mass *m = lw_spline_mass_new(sp, &s->m->scene->quad, density, pin, err);
   free(pin);
+  /* (too few nodes: the one input of the message, named as every key is) */
+  if (!m && err->code == LW_EINPUT) lw_params_blame(p, "energy", "quadrature", err);
   return m;
 }
 

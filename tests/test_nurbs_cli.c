@@ -254,6 +254,30 @@ Test(nurbs_cli, free_weights_resume_to_the_same_bytes_under_dynamics_and_monte_c
   }
 }
 
+/* anneal.quench_stall = 0 is "never": the test read "the energy rose over
+** the last 50 iterations", which the approximate Wolfe steps allow by
+** rounding, and this quench of free weights (badly conditioned: refined 8
+** times, from an annealed state) said "stalled" after 1,900 iterations.  It
+** goes on to quench_iterations, and at the default share it stalls short of
+** the minimum (1.5e-2 above it), as the key's text says. */
+Test(nurbs_cli, a_quench_told_never_to_stall_does_not)
+{
+  const char *set = "--set scene.driver=metropolis --set nurbs.free_weights=1 --set 'nurbs.weights=1 1.2 1 0.8 1 1.2 1' "
+                    "--set nurbs.refine=8 --set anneal.sweeps=200 --set anneal.quench=bfgs --set output.frames_every=0";
+  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/q0 --quiet %s --set anneal.quench_stall=0", lw_test_bin(),
+                  lw_test_root(), dir, set), 0);
+  char *js = lw_test_slurp("%s/q0/summary.json", dir);
+  cr_assert(js && strstr(js, "\"ended\": \"iterations\"") && strstr(js, "\"iterations\": 2000,"), "%s", js);
+  /* all weights 1 is a point of the free space: its minimum, 3193.4015741514 */
+  const char *after = strstr(js, "\"energy_after\": ");
+  cr_assert(after && strtod(after + 16, NULL) < 3193.4015741514 + 1e-6, "%.60s", after);
+  free(js);
+  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/q5 --quiet %s", lw_test_bin(), lw_test_root(), dir, set), 0);
+  js = lw_test_slurp("%s/q5/summary.json", dir);
+  cr_assert(js && strstr(js, "\"ended\": \"stalled\""), "%s", js);
+  free(js);
+}
+
 Test(nurbs_cli, free_weights_refuse_a_free_scale_and_the_review_scheme)
 {
   refused("points = 0 0 1 1 2 0 3 1 4 0 5 1 6 0\\nfree_weights = 1\\n",
