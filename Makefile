@@ -6,7 +6,7 @@ CC      ?= cc
 PREFIX  ?= /usr/local
 BUILD   ?= build
 BIN     ?= bin
-PKGS    := gsl cairo inih zlib
+PKGS    := gsl cairo inih zlib libpng
 OPT     ?= -O2
 CFLAGS  ?= $(OPT) -g
 # -ffp-contract=off: no fused multiply-add, which clang makes by default where the
@@ -23,7 +23,7 @@ DEPFLAGS := -MMD -MP
 
 # locales: the locale test builds a decimal-comma locale with localedef;
 # strace: the signal tests send a signal as a chosen file opens (inject=)
-DEBS    := build-essential pkg-config libgsl-dev libcairo2-dev libinih-dev libstb-dev zlib1g-dev \
+DEBS    := build-essential pkg-config libgsl-dev libcairo2-dev libpng-dev libinih-dev libstb-dev zlib1g-dev \
            libcriterion-dev gnuplot-nox clang libclang-rt-dev locales strace
 
 LIB_SRC := $(filter-out src/main.c,$(wildcard src/*.c))
