@@ -643,8 +643,10 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
                            *const polygon[] = {"scene.polygon", NULL}, *const mask[] = {"scene.mask_image", NULL},
                            *const orientation[] = {"scene.orientation", NULL},
                            *const picture[] = {"scene.image_width", "scene.image_blur", "scene.image_flatten",
-                                               "scene.image_levels", "scene.image_gamma", "scene.image_contrast",
-                                               "scene.image_invert", NULL},
+                                               "scene.image_levels", "scene.image_levels_alpha",
+                                               "scene.image_gamma", "scene.image_contrast", "scene.image_invert",
+                                               NULL},
+                           *const levels_alpha[] = {"scene.image_levels_alpha", NULL},
                            *const ladder[] = {"tempering.t_min", "tempering.t_max", "tempering.exchange_every",
                                               "tempering.tune_ladder", "tempering.ladder_sweeps", NULL},
                            *const ends[] = {"tempering.t_min", "tempering.t_max", NULL},
@@ -677,12 +679,13 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
       {orientation, p->page == LW_PAGE_CUSTOM && !(p->preset == LW_PRESET_PHOTO && p->orientation == LW_ORIENT_AUTO),
        "no scene.page names a size"},
       {picture, !p->image[0], "no scene.image"},
+      {levels_alpha, p->image[0] && p->image_levels == 0.0, "scene.image_levels = 0"},
       {ladder, a->n_rep == 1, "one replica"},
       {ends, a->n_rep > 1 && p->ladder[0], "tempering.ladder names the temperatures"},
       /* (a seed sweep of the whip gave identical "independent" runs) */
       {seed, lw_driver_is_motion(p) && p->from[0], "the dynamics from init.from draws no random number"},
       {gravity, p->dyn_rho == 0.0, "dynamics.rho = 0: no mass to weigh"},
-      {pin_vectors, p->dyn_pin == LW_PIN_NONE, "dynamics.pin = none"},
+      {pin_vectors, lw_driver_is_motion(p) && p->dyn_pin == LW_PIN_NONE, "dynamics.pin = none"},
       /* (a bed too small for the page passed unchecked, without a word) */
       {machine, !p->hpgl && !p->gcode, "neither output.hpgl nor output.gcode"},
       {gcode, !p->gcode, "output.gcode = 0"},
@@ -1017,6 +1020,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
       return err->code;
     }
   if ((s = build(a, all, ladder, err)) || (s = check_quench(a, err))) return s;
+  a->totals_fresh = 1;
   /* where the photo preset's count of domains gave way to a move's reach (a
   ** picture of a few pixels: domains.c), scene.ini, which a resume reads as
   ** given, holds the count the run took (it held the page's, refused there) */
@@ -1788,6 +1792,7 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
     if (a->net) s = a->net->drift(a->net, a, s, err);
     if (s) return s;
     for (int r = 0; r < n; r++) a->size_peak[r] = replica_size(a, r);
+    a->totals_fresh = 1;
   }
   /* after the recomputation: a row shows the totals a checkpoint here keeps */
   if (a->sweep % p->trace_every == 0 || lw_anneal_done(a)) trace_row(a);
@@ -1803,6 +1808,7 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
   lw_status s = lw_number_locale_ok(err);
   if (s || (s = lw_anneal_settle(a, err))) return s;
   const double t0 = lw_phase_clock();
+  a->totals_fresh = 0;
   s = sweep_once(a, err);
   a->sweep_seconds += lw_phase_clock() - t0;
   if (!s) drop_stash(a);
@@ -2052,7 +2058,10 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
   ** keep the rounding of every commit since the last check, which the drift
   ** check's floor of 1 lets pass below an energy of 1 (a particle cloud fallen
   ** from 72487 to 2e-4 in 20 sweeps read 3.4e-7 off in its 7th digit) */
-  if (a->sys_type->refresh(a->sys->state) != LW_OK) return lw_error_set(err, LW_ENOMEM, "out of memory");
+  /* (not where they are already: a redraw, anneal.sweeps = 0, built the
+  ** model twice, 12 % of its time at 4000 splines; the same bits) */
+  if (!a->totals_fresh && a->sys_type->refresh(a->sys->state) != LW_OK)
+    return lw_error_set(err, LW_ENOMEM, "out of memory");
   if (a->params.quench == LW_QUENCH_BFGS && !a->quenched) {
     lw_phase_set("quenching to the nearest minimum");
     /* the dynamics' pins hold in its quench too */

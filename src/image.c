@@ -1323,24 +1323,24 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
 ** They were taken of the composite, and stretched it, which the tone curve
 ** then took apart as if it were still a t + 1 - a: a half-transparent
 ** picture's darks went to one grey, or it came out opaque. */
-static double own_tone(const lw_image *img, const float *alpha, size_t k)
+static double own_tone(const lw_image *img, const float *under, size_t k)
 {
-  const double a = alpha ? alpha[k] : 1.0;
+  const double a = under ? under[k] : 1.0;
   if (!(a < 1.0)) return img->tone[k];
   if (!(a > 0.0)) return 1.0;
   const double t = (img->tone[k] - (1.0 - a)) / a;
   return t < 0 ? 0 : (t > 1 ? 1 : t);
 }
 
-lw_status lw_image_levels(lw_image *img, const float *alpha, double clip, double *lo, double *hi, lw_error *err)
+lw_status lw_image_levels(lw_image *img, const float *under, double clip, double *lo, double *hi, lw_error *err)
 {
   size_t n = (size_t)img->width * (size_t)img->height;
   size_t *hist = calloc(LEVELS_BINS, sizeof *hist);
   if (!hist) return lw_error_set(err, LW_ENOMEM, "out of memory for the picture's levels");
   size_t count = 0;
   for (size_t k = 0; k < n; k++) {
-    if (alpha && alpha[k] < 0.5f) continue;
-    int b = (int)(own_tone(img, alpha, k) * LEVELS_BINS);
+    if (img->alpha && img->alpha[k] < 0.5f) continue;
+    int b = (int)(own_tone(img, under, k) * LEVELS_BINS);
     hist[b < 0 ? 0 : (b >= LEVELS_BINS ? LEVELS_BINS - 1 : b)]++;
     count++;
   }
@@ -1367,9 +1367,9 @@ lw_status lw_image_levels(lw_image *img, const float *alpha, double clip, double
   }
   const double scale = 1.0 / (h - l);
   for (size_t k = 0; k < n; k++) {
-    const double a = alpha ? alpha[k] : 1.0;
+    const double a = under ? under[k] : 1.0;
     if (!(a > 0.0)) continue; /* paper alone: white, as loaded */
-    double t = (own_tone(img, alpha, k) - l) * scale;
+    double t = (own_tone(img, under, k) - l) * scale;
     t = t < 0 ? 0 : (t > 1 ? 1 : t);
     img->tone[k] = (float)(a < 1.0 ? a * t + (1.0 - a) : t);
   }

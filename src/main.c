@@ -1154,17 +1154,21 @@ static int cmd_stats(int argc, char **argv)
                  base.from, base.to);
   if (!dir) lw_error_set(&err, LW_ENOMEM, "out of memory");
   else if (!err.code && !k) lw_error_set(&err, LW_EUSAGE, "stats: expected a run directory %s", use);
-  /* a glob of a sweep's directory names its files too (sweep.conf,
-  ** sweep.csv: "sweep.conf/scene.ini: ... Not a directory"): beside a
-  ** directory, what is a file is left out, with a note */
-  int dirs = 0;
+  /* a glob of a sweep's directory names its own files too (sweep.conf,
+  ** sweep.csv: "sweep.conf/scene.ini: ... Not a directory"), which are left
+  ** out with a note; anything else that is no directory is refused as such
+  ** (a trace.csv named for its run) */
   struct stat sd;
-  for (int r = 0; !err.code && r < k; r++) dirs += !stat(dir[r], &sd) && S_ISDIR(sd.st_mode);
-  for (int r = 0; !err.code && dirs && r < k; r++) {
+  for (int r = 0; !err.code && r < k; r++) {
     if (stat(dir[r], &sd) || S_ISDIR(sd.st_mode)) continue;
-    fprintf(stderr, "linewise: note: %s is a file, not a run directory: left out\n", dir[r]);
-    memmove(dir + r, dir + r + 1, (size_t)(k - r - 1) * sizeof *dir);
-    k--, r--;
+    const char *name = strrchr(dir[r], '/') ? strrchr(dir[r], '/') + 1 : dir[r];
+    if (k > 1 && (!strcmp(name, "sweep.conf") || !strcmp(name, "sweep.csv"))) {
+      fprintf(stderr, "linewise: note: %s is a sweep's own file, not a run: left out\n", dir[r]);
+      memmove(dir + r, dir + r + 1, (size_t)(k - r - 1) * sizeof *dir);
+      k--, r--;
+    } else {
+      lw_error_set(&err, LW_EUSAGE, "stats: %s is not a directory: expected run directories %s", dir[r], use);
+    }
   }
   /* a run named twice (a sweep's `best` link beside its seed-N, as a glob
   ** of the sweep's directory gives) would count as two agreeing runs: it is
@@ -1223,9 +1227,11 @@ static int cmd_stats(int argc, char **argv)
     size_t warned_len = 0;
     FILE *w = base.csv ? open_memstream(&warned, &warned_len) : NULL;
     for (int r = 0; r < k; r++) sel[r].csv_warnings = w;
-    if (reweight)
+    if (reweight) {
       lw_trace_reweight((const lw_trace *const *)t, (const char *const *)path, sel, k, (int)reweight, stdout, &err);
-    else
+      if (!err.code && k > 1)
+        lw_trace_warn_twins((const lw_trace *const *)t, (const char *const *)path, sel, k, w ? w : stdout);
+    } else
       lw_trace_stats_runs((const lw_trace *const *)t, (const char *const *)path, sel, k, stdout, &err);
     if (w) fclose(w);
     for (char *line = warned; line && *line;) {

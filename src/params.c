@@ -110,6 +110,12 @@ const lw_param_def lw_param_table[] = {
       "picture's pixels turn black and white, the tones between stretched linearly (at most "
       "20 times), so that a dim or hazy picture uses the whole range. 0 = off; the photo "
       "preset sets 0.01."),
+  NUM("scene", "image_levels_alpha", LW_PT_INT, image_levels_alpha, "1", "", 0, 1, 0,
+      "A picture with transparency under image_levels: 1 = the levels and their stretch are of "
+      "the picture under its alpha, composited over white paper again after (a half-transparent "
+      "picture stays so); 0 = of the picture composited over white, as runs before 2026-12-06 "
+      "(their darks went to one grey; a run of theirs, whose scene.ini has no line for this key, "
+      "resumes so)."),
   NUM("scene", "image_gamma", LW_PT_DOUBLE, image_gamma, "1", "", 0, 100, LW_MIN_OPEN,
       "Tone curve t <- t^gamma (after `image_invert`): above 1 darkens the mid-tones."),
   NUM("scene", "image_contrast", LW_PT_DOUBLE, image_contrast, "1", "", 0, 100, 0,
@@ -364,7 +370,8 @@ const lw_param_def lw_param_table[] = {
   NUM("moves", "max_segments", LW_PT_INT, max_segments, "16", "", 1, 1e5, 0,
       "Grow never makes a spline longer than this many segments (fixed_count = 0); shrink never "
       "below one. At least init.segments (the count placed and born splines start with); unset, "
-      "it is 16 or init.segments where that is larger (a run's scene.ini writes the cap in force)."),
+      "it is 16 or init.segments where that is larger, and so is the 16 a run's scene.ini writes "
+      "where it was unset."),
   NUM("moves", "split", LW_PT_DOUBLE, mix_split, "0", "", 0, 1e6, 0,
       "Relative frequency of splits: an inner segment of a spline of 3 or more segments removed, "
       "leaving two splines with the nodes as they were (fixed_count = 0; 0 = none)."),
@@ -1660,14 +1667,6 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
   if (steps_unset) assign(p, steps, steps->def, expected, sizeof expected);
   apply_preset(p);
   if (steps_unset && !strcmp(p->schedule, "constant")) assign(p, steps, "1", expected, sizeof expected);
-  /* An unset cap gives way to a larger init.segments, and the run's
-  ** scene.ini says so (it wrote 16 over a cap of init.segments, and an
-  ** explicit 16 was taken for the default and raised without a word); a
-  ** 16 that an earlier release's run wrote there was such a default. */
-  const lw_param_def *cap = lw_params_find("moves", "max_segments");
-  const int cap_line = p->line[cap - lw_param_table];
-  if (!p->of_run && p->max_segments < p->segments && at_default(p, cap) && (!cap_line || (p->run_header && cap_line > 0)))
-    p->max_segments = p->segments;
   unsigned char rgb[LW_PLOT_PENS_MAX][3];
   /* (with layers the pens are theirs, which the scene says first) */
   if (p->pen_colors[0] && !p->ly_names[0] && lw_output_colors_parse(p->pen_colors, rgb, LW_PLOT_PENS_MAX) != p->pens) {

@@ -218,7 +218,10 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
   const int curve = p->image_invert || p->image_gamma != 1.0 || p->image_contrast != 1.0;
   const size_t npx = (size_t)sc->image->width * (size_t)sc->image->height;
   float *cover = NULL;
-  if (sc->image->alpha && (curve || p->image_levels > 0) && p->image_blur > 0) {
+  /* (a run begun before 2026-12-06, whose scene.ini has no line for the
+  ** key, stretched the composite: potential_paper below) */
+  const int levels_under = p->image_levels_alpha && !(p->run_written && !lw_params_line(p, "scene", "image_levels_alpha"));
+  if (sc->image->alpha && (curve || (p->image_levels > 0 && levels_under)) && p->image_blur > 0) {
     if (!(cover = malloc(npx * sizeof *cover)))
       return lw_error_set(err, LW_ENOMEM, "out of memory for the picture's transparency");
     memcpy(cover, sc->image->alpha, npx * sizeof *cover);
@@ -230,7 +233,8 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
   }
   if (p->image_levels > 0) {
     double lo, hi;
-    if ((st = lw_image_levels(sc->image, cover ? cover : sc->image->alpha, p->image_levels, &lo, &hi, err))) {
+    const float *under = levels_under ? (cover ? cover : sc->image->alpha) : NULL;
+    if ((st = lw_image_levels(sc->image, under, p->image_levels, &lo, &hi, err))) {
       free(cover);
       return st;
     }
@@ -677,11 +681,13 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
   sc->transdim = !p->fixed_count;
   /* a cap below the placed splines' count was raised to it without a word,
   ** and lines grew past the cap the scene set (births start at init.segments
-  ** under init.from too); an unset cap gives way (lw_params_resolve raises
-  ** it, and parameters not resolved keep the default's value), and a run
-  ** begun before 2026-12-05 keeps its cap */
+  ** under init.from too); an unset cap gives way, as does the default's
+  ** value in a run's scene.ini, which writes every key (an explicit 16 in a
+  ** scene was taken for the default and raised, where 17 was refused), and a
+  ** run begun before 2026-12-05 keeps its cap */
   const lw_param_def *cap = lw_params_find("moves", "max_segments");
-  const int cap_unset = !lw_params_line(p, "moves", "max_segments") && strtod(cap->def, NULL) == p->max_segments;
+  const int cap_line = lw_params_line(p, "moves", "max_segments");
+  const int cap_unset = strtod(cap->def, NULL) == p->max_segments && (!cap_line || (p->run_header && cap_line > 0));
   if (sc->transdim && p->max_segments < p->segments && !cap_unset && !lw_params_kept(p, "moves", "max_segments"))
     return bad_key(p, "moves", "max_segments", LW_EINPUT, err, "expected at least init.segments = %d, the count "
                    "placed and born splines start with, got %d", p->segments, p->max_segments);

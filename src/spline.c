@@ -24,7 +24,10 @@ lw_splines *lw_splines_new(size_t n_splines, const size_t *segments, lw_error *e
   sp->n_segments = n_nodes - n_splines;
   sp->node = calloc(n_nodes ? n_nodes : 1, sizeof *sp->node);
   sp->first = malloc((n_splines + 1) * sizeof *sp->first);
-  sp->seg_spline = malloc((sp->n_segments ? sp->n_segments : 1) * sizeof *sp->seg_spline);
+  /* as many as the nodes, cap_nodes below: an append that fits in the nodes
+  ** wrote past n_segments of them (splines that died, then a longer one born
+  ** into their room after a renumbering or a resume: a heap overflow) */
+  sp->seg_spline = malloc((n_nodes ? n_nodes : 1) * sizeof *sp->seg_spline);
   sp->rest_length = malloc((n_splines ? n_splines : 1) * sizeof *sp->rest_length);
   if (!sp->node || !sp->first || !sp->seg_spline || !sp->rest_length) goto nomem;
   size_t k = 0, g = 0;

@@ -27,7 +27,7 @@ lw_spline_mass *lw_spline_mass_new(const lw_splines *sp, const lw_quad *q, doubl
 {
   if (q->n < 4) {
     lw_error_set(err, LW_EINPUT, "expected at least 4 nodes a segment under the dynamics, got %d: with fewer the "
-                 "kinetic energy's mass matrix is singular", q->n);
+                 "mass matrix (and the massless flow's damping matrix, its multiple) is singular", q->n);
     return NULL;
   }
   lw_spline_mass *m = calloc(1, sizeof *m);

@@ -536,11 +536,11 @@ static int frozen_runs(const lw_trace *t, const column_stats *cs, int k)
   return frozen;
 }
 
-/* Whether run r's rows are run q's, value for value (NaN for NaN). */
-static int same_rows(const lw_trace *const *t, size_t *const *row, const size_t *n, int q, int r)
+/* Whether the first m rows of runs q and r hold the same values (NaN for
+** NaN). */
+static int same_rows(const lw_trace *const *t, size_t *const *row, int q, int r, size_t m)
 {
-  if (n[r] != n[q]) return 0;
-  for (size_t i = 0; i < n[q]; i++)
+  for (size_t i = 0; i < m; i++)
     for (size_t c = 0; c < t[q]->n_cols; c++) {
       const double a = at(t[q], row[q][i], (int)c), b = at(t[r], row[r][i], (int)c);
       if (a != b && !(isnan(a) && isnan(b))) return 0;
@@ -548,59 +548,56 @@ static int same_rows(const lw_trace *const *t, size_t *const *row, const size_t 
   return 1;
 }
 
-/* A hash of a run's rows that equal rows share (0 and -0, any NaN, alike),
-** so that only runs of one hash are compared value for value: 64-bit FNV-1a
-** over the values' bits. */
-static unsigned long long rows_hash(const lw_trace *t, const size_t *row, size_t n)
-{
-  unsigned long long h = 1469598103934665603ULL;
-  for (size_t i = 0; i < n; i++)
-    for (size_t c = 0; c < t->n_cols; c++) {
-      double v = at(t, row[i], (int)c);
-      if (isnan(v)) v = NAN;
-      if (v == 0.0) v = 0.0;
-      unsigned char b[sizeof v];
-      memcpy(b, &v, sizeof v);
-      for (size_t j = 0; j < sizeof v; j++) h = (h ^ b[j]) * 1099511628211ULL;
-    }
-  return h;
-}
-
-/* Runs whose rows are another's, value for value: one seed run twice, or
-** seeds that changed nothing (a scene that draws no random number), which
-** the comparison took for agreeing runs (R_hat 0.99, p_runs 1); pooled, such
-** a run counts twice and the error bar is too small (one seed twice among
-** four: 16 % small).  All alike is one warning, else one a set of twins.
-** (Out of memory for the hashes: no warning.) */
+/* Runs whose rows are another's, value for value over the rows both have:
+** one seed run twice, a copy of a run stopped earlier (its rows the first of
+** the other's), or seeds that changed nothing (a scene that draws no random
+** number), which the comparison took for agreeing runs (R_hat 0.99, p_runs
+** 1); pooled, such a run counts twice and the error bar is too small (one
+** seed twice among four: 16 % small).  All alike is one warning, else one a
+** set of twins.  Only runs whose first rows agree are compared further. */
 static void warn_twins(FILE *out, const lw_trace *const *t, size_t *const *row, const size_t *n, const char *const *path,
                        int k)
 {
   int *twin = malloc((size_t)k * sizeof *twin); /* the first run that run r repeats, or r */
-  unsigned long long *h = malloc((size_t)k * sizeof *h);
-  int distinct = 0;
-  for (int r = 0; twin && h && r < k; r++) {
-    h[r] = rows_hash(t[r], row[r], n[r]);
+  int distinct = 0, same_length = 1;
+  for (int r = 0; twin && r < k; r++) {
     twin[r] = r;
-    for (int q = 0; q < r && twin[r] == r; q++)
-      if (twin[q] == q && h[q] == h[r] && same_rows(t, row, n, q, r)) twin[r] = q;
+    for (int q = 0; q < r && twin[r] == r; q++) {
+      const size_t m = n[q] < n[r] ? n[q] : n[r];
+      if (twin[q] == q && m && same_rows(t, row, q, r, 1) && same_rows(t, row, q, r, m)) twin[r] = q;
+    }
     distinct += twin[r] == r;
+    same_length &= n[r] == n[0];
   }
-  if (twin && h && distinct == 1)
+  if (twin && distinct == 1 && same_length)
     fprintf(out, "warning: the %d runs are the same, row for row: one seed run twice, or seeds that change "
             "nothing (a scene that draws no random number, as the dynamics from init.from or the D-NURBS dynamics), "
             "so they are one run, and R_hat and p_runs say nothing\n", k);
-  for (int q = 0; twin && h && distinct > 1 && q < k; q++) {
+  for (int q = 0; twin && !(distinct == 1 && same_length) && q < k; q++) {
     int copies = 0;
     for (int r = q + 1; r < k; r++) copies += twin[r] == q;
     if (!copies) continue;
     fprintf(out, "warning: %s", path[q]);
     for (int r = q + 1; r < k; r++)
       if (twin[r] == q) fprintf(out, "%s%s", --copies ? ", " : " and ", path[r]);
-    fprintf(out, " are the same run, row for row (one seed run twice): pooled, it counts as more than one, so "
-            "the error bars are too small and R_hat and p_runs too kind; leave all but one out\n");
+    fprintf(out, " are one run, row for row over the rows they share (one seed run twice, or a copy of a run "
+            "stopped earlier): pooled, it counts as more than one, so the error bars are too small and R_hat and "
+            "p_runs too kind; leave all but one out\n");
   }
   free(twin);
-  free(h);
+}
+
+void lw_trace_warn_twins(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
+                         FILE *out)
+{
+  size_t **row = calloc((size_t)k, sizeof *row), *n = calloc((size_t)k, sizeof *n), tuned;
+  lw_error e;
+  int ok = row && n;
+  for (int r = 0; ok && r < k; r++) ok = !lw_trace_rows(t[r], path[r], &sel[r], &row[r], &n[r], &tuned, &e);
+  if (ok) warn_twins(out, t, row, n, path, k);
+  for (int r = 0; row && r < k; r++) free(row[r]);
+  free(row);
+  free(n);
 }
 
 lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
@@ -765,11 +762,11 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
   /* the table's warnings; with --csv, those of one run are its columns
   ** (window_closed, n and n_eff, drift_z, batch_ratio), and of several runs
   ** only r_hat and p_runs: the rest go apart, where a script sees that the
-  ** error bars are lower bounds (they went nowhere) */
+  ** error bars are lower bounds or absent (they went nowhere) */
   FILE *per_column = csv ? (k > 1 ? apart : NULL) : out, *in_table = csv ? NULL : out;
   warn(per_column, t[0], cs, k, WARN_OPEN, "the autocorrelation did not die out within half the rows: tau is a lower "
        "bound and the error bar too small (a longer stretch is needed)");
-  warn(in_table, t[0], cs, k, WARN_ONE, k > 1 ? "a run of one row, which has no error bar of its own: the error bar "
+  warn(per_column, t[0], cs, k, WARN_ONE, k > 1 ? "a run of one row, which has no error bar of its own: the error bar "
        "above is the spread of the runs' means over sqrt(runs), and the runs are not compared (R_hat and p_runs "
        "empty)" : "one row: a mean and no error bar (a longer stretch is needed)");
   warn(per_column, t[0], cs, k, WARN_FEW, k > 1 ? "fewer than 25 independent samples in a run (n_eff sums the "

@@ -636,9 +636,10 @@ Test(run, a_move_with_no_line_left_is_no_proposal)
 /* A cap on the segments below the count the placed splines start with was
 ** raised to it without a word, and lines grew past the cap the scene set,
 ** with init.from too (births start at init.segments).  An unset cap, 16,
-** gives way to a larger init.segments, and the run's scene.ini says so (it
-** wrote 16, and an explicit 16 was raised without a word while 17 was
-** refused); a 16 that an earlier release's run wrote there gives way too. */
+** gives way to a larger init.segments, as does the 16 a run's scene.ini
+** writes (a run of that file must not be refused, and gets no note of a key
+** it never set); an explicit 16 was taken for the default and raised
+** without a word, where 17 was refused. */
 Test(run, a_segment_cap_below_the_placed_count_is_refused)
 {
   const char *b = getenv("LW_BIN");
@@ -647,11 +648,9 @@ Test(run, a_segment_cap_below_the_placed_count_is_refused)
                   "at least init.segments = 4, the count placed and born splines start with, got 3\" %s/cap.txt && "
                   "! test -e %s/cap", b, lw_test_root(), dir, dir, dir, dir), 0);
   cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/cap --quiet --set moves.fixed_count=0 --set init.segments=20 "
-                  "--set init.segment_length=1.5 --set anneal.sweeps=2 && grep -qx 'max_segments = 20' %s/cap/scene.ini "
-                  "&& %s run %s/cap/scene.ini --out %s/cap2 --quiet && sed 's/^max_segments = 20$/max_segments = 16/' "
-                  "%s/cap/scene.ini > %s/old.ini && %s run %s/old.ini --out %s/cap3 --quiet && grep -qx "
-                  "'max_segments = 20' %s/cap3/scene.ini", b, lw_test_root(), dir, dir, b, dir, dir, dir, dir, b, dir,
-                  dir, dir), 0);
+                  "--set init.segment_length=1.5 --set anneal.sweeps=2 && %s run %s/cap/scene.ini --out %s/cap2 "
+                  "--quiet && %s run %s/cap/scene.ini --out %s/cap3 --set moves.fixed_count=1 2>%s/cap.txt && ! grep -q "
+                  "'no effect.*max_segments' %s/cap.txt", b, lw_test_root(), dir, b, dir, dir, b, dir, dir, dir, dir), 0);
   cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/cap16 --quiet --set moves.fixed_count=0 --set init.segments=20 "
                   "--set init.segment_length=1.5 --set moves.max_segments=16 2>%s/cap.txt; test $? -eq 2 && grep -qF "
                   "'expected at least init.segments = 20' %s/cap.txt && ! test -e %s/cap16", b, lw_test_root(), dir, dir,
@@ -659,6 +658,28 @@ Test(run, a_segment_cap_below_the_placed_count_is_refused)
   cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/from --quiet --set moves.fixed_count=0 --set "
                   "moves.max_segments=3 --set init.from=%s/cap/state.lw --set anneal.sweeps=0 2>%s/cap.txt; "
                   "test $? -eq 2 && grep -qF 'got 3' %s/cap.txt", b, lw_test_root(), dir, dir, dir, dir), 0);
+}
+
+/* Splines that die, then longer ones born into their room: the node arrays
+** had room, the segments' owners did not (lw_splines_new sized them by its
+** segments, and every renumbering, anneal.check_every, and every resume made
+** the splines anew), and this ideal gas of births of 1 to 3 segments aborted
+** with "realloc(): invalid next size" at sweep 2568 (a heap overflow, found
+** by a helper's statistics of the moves).  It runs to its end, and the
+** splines' own test (transdim) checks the room under AddressSanitizer. */
+Test(run, births_longer_than_the_dead_stay_in_the_arrays)
+{
+  char path[128];
+  snprintf(path, sizeof path, "%s/gas.ini", dir);
+  FILE *f = fopen(path, "w");
+  cr_assert_not_null(f);
+  fputs("[scene]\nwidth = 60\nheight = 40\n[init]\nsplines = 3\nsegments = 2\nsegment_length = 5\n[energy]\n"
+        "min_speed = 0\nregularity = 0\nchem_spline = -0.6931471805599453\n[moves]\nfixed_count = 0\npoint = 0\n"
+        "vector = 0\ntranslate = 0\nrotate = 0\nbirth = 1\ndeath = 1\ngrow = 0\nshrink = 0\nbirth_spread = 0.3\n"
+        "max_segments = 3\n[anneal]\nschedule = constant\nt_start = 1\nt_end = 1\nsweeps = 6000\nseed = 9\n", f);
+  cr_assert_eq(fclose(f), 0);
+  cr_assert_eq(sh("%s run %s/gas.ini --out %s/gas --quiet && grep -q '\"sweeps\": 6000' %s/gas/summary.json",
+                  getenv("LW_BIN"), dir, dir, dir), 0);
 }
 
 static int compare_ulong(const void *a, const void *b)

@@ -558,7 +558,7 @@ Test(image, levels_stretch_the_tones_between_the_quantiles)
   float *orig = malloc(n * sizeof *orig);
   memcpy(orig, img->tone, n * sizeof *orig);
   double lo, hi;
-  cr_assert_eq(lw_image_levels(img, img->alpha, 0.01, &lo, &hi, NULL), LW_OK);
+  cr_assert_eq(lw_image_levels(img, NULL, 0.01, &lo, &hi, NULL), LW_OK);
   cr_assert(fabs(lo - (a + 0.01 * (b - a))) < bin + step, "lo %g", lo);
   cr_assert(fabs(hi - (b - 0.01 * (b - a))) < bin + step, "hi %g", hi);
   int black = 0, white = 0;
@@ -573,7 +573,7 @@ Test(image, levels_stretch_the_tones_between_the_quantiles)
             "black %d, white %d", black, white);
   /* clip 0: the darkest and lightest pixels themselves */
   memcpy(img->tone, orig, n * sizeof *orig);
-  cr_assert_eq(lw_image_levels(img, img->alpha, 0, &lo, &hi, NULL), LW_OK);
+  cr_assert_eq(lw_image_levels(img, NULL, 0, &lo, &hi, NULL), LW_OK);
   cr_assert(fabs(lo - a) < bin && fabs(hi - b) < bin, "%g %g", lo, hi);
   free(orig);
   lw_image_free(img);
@@ -610,6 +610,35 @@ Test(image, levels_stretch_the_picture_under_its_transparency)
   lw_image_free(img);
 }
 
+/* Thin strokes on transparent paper, blurred (image_blur): the blurred
+** alpha is under one half everywhere, and counting the pixels by it left
+** only the border's (the levels came out 0 to 0.159 and the picture white);
+** they are counted by the picture's own alpha, and read under the blurred
+** one. */
+Test(image, levels_of_blurred_strokes_on_transparent_paper)
+{
+  const int w = 60, h = 200;
+  lw_image *img = lw_image_new(w, h, 1, NULL);
+  float *cover = malloc((size_t)w * h * sizeof *cover);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      const double own = 0.15 + 0.5 * y / (h - 1), a = x == 30 ? 1.0 : 0.0;
+      img->alpha[y * w + x] = (float)a;
+      img->tone[y * w + x] = (float)(a * own + 1.0 - a);
+    }
+  memcpy(cover, img->alpha, (size_t)w * h * sizeof *cover);
+  cr_assert_eq(lw_image_blur(img, 4.0, NULL), LW_OK);
+  cr_assert_eq(lw_image_blur_plane(cover, w, h, 4.0, NULL), LW_OK);
+  float most = 0;
+  for (int k = 0; k < w * h; k++) most = fmaxf(most, cover[k]);
+  cr_assert_lt(most, 0.5f, "the blurred stroke is under half opaque everywhere");
+  double lo, hi;
+  cr_assert_eq(lw_image_levels(img, cover, 0, &lo, &hi, NULL), LW_OK);
+  cr_assert(fabs(lo - 0.15) < 0.01 && fabs(hi - 0.65) < 0.01, "the strokes' own levels: %g %g", lo, hi);
+  free(cover);
+  lw_image_free(img);
+}
+
 /* Transparent pixels (white after compositing) are not counted and stay
 ** white; a flat picture is stretched at most 1 / LW_IMAGE_LEVELS_MIN_SPAN
 ** times, about its middle, and inside [0, 1] near white. */
@@ -623,7 +652,7 @@ Test(image, levels_skip_transparent_pixels_and_cap_the_stretch)
     img->alpha[2 * k + 1] = k % 2 ? 0.0f : 0.49f;
   }
   double lo, hi;
-  cr_assert_eq(lw_image_levels(img, img->alpha, 0.05, &lo, &hi, NULL), LW_OK);
+  cr_assert_eq(lw_image_levels(img, NULL, 0.05, &lo, &hi, NULL), LW_OK);
   cr_assert(fabs(lo - 0.315) < 1e-3 && fabs(hi - 0.585) < 1e-3, "%g %g", lo, hi);
   for (int k = 0; k < n; k++) cr_assert_eq(img->tone[2 * k + 1], 1.0f);
   lw_image_free(img);
@@ -634,7 +663,7 @@ Test(image, levels_skip_transparent_pixels_and_cap_the_stretch)
   for (int m = 0; m < 2; m++) {
     img = lw_image_new(n, 1, 0, NULL);
     for (int k = 0; k < n; k++) img->tone[k] = (float)(mid[m] + 0.01 * (2.0 * k / (n - 1) - 1.0));
-    cr_assert_eq(lw_image_levels(img, img->alpha, 0.01, &lo, &hi, NULL), LW_OK);
+    cr_assert_eq(lw_image_levels(img, NULL, 0.01, &lo, &hi, NULL), LW_OK);
     cr_assert(fabs(hi - lo - LW_IMAGE_LEVELS_MIN_SPAN) < 1e-12 && lo >= 0 && hi <= 1, "%g %g", lo, hi);
     if (m == 0) cr_assert(fabs(0.5 * (lo + hi) - 0.5) < 1e-3, "%g %g", lo, hi);
     else cr_assert(hi == 1.0, "%g", hi);
@@ -659,14 +688,14 @@ Test(image, levels_leave_a_flat_colour_at_either_end_as_it_is)
     img->alpha[k] = k < 500 ? 1.0f : 0.0f; /* transparent paper */
   }
   double lo, hi;
-  cr_assert_eq(lw_image_levels(img, img->alpha, 0.01, &lo, &hi, NULL), LW_OK);
+  cr_assert_eq(lw_image_levels(img, NULL, 0.01, &lo, &hi, NULL), LW_OK);
   cr_assert(lo == 0.0 && hi == 1.0, "levels %g to %g", lo, hi);
   cr_assert(img->tone[0] == 0.33f && img->tone[450] == 0.26f && img->tone[600] == 1.0f);
   for (int k = 0; k < n; k++) {
     img->tone[k] = k < 400 ? 0.33f : (float)(0.1 + 0.2 * (k - 400) / (n - 401));
     img->alpha[k] = 1.0f;
   }
-  cr_assert_eq(lw_image_levels(img, img->alpha, 0.01, &lo, &hi, NULL), LW_OK);
+  cr_assert_eq(lw_image_levels(img, NULL, 0.01, &lo, &hi, NULL), LW_OK);
   cr_assert(hi == 1.0 && fabs(lo - 0.102) < 2e-3, "levels %g to %g", lo, hi);
   lw_image_free(img);
 }

@@ -115,6 +115,11 @@ Test(nurbs_cli, monte_carlo_heat_capacity_is_half_the_free_coordinates)
   cr_assert_eq(sh("OMP_NUM_THREADS=1 %s stats %s/pt --reweight 5 --csv > %s/rw1.csv && OMP_NUM_THREADS=3 %s stats "
                   "%s/pt --reweight 5 --csv > %s/rw3.csv && cmp -s %s/rw.csv %s/rw1.csv && cmp -s %s/rw.csv %s/rw3.csv",
                   lw_test_bin(), dir, dir, lw_test_bin(), dir, dir, dir, dir, dir, dir), 0);
+  /* a copy of the run pooled with it is said to be one run (the
+  ** reweighting took its rungs for twice the samples, unsaid) */
+  cr_assert_eq(sh("cp -r %s/pt %s/ptc && %s stats %s/pt %s/ptc --reweight 5 --csv 2>%s/rw.err >/dev/null && grep -q "
+                  "'^linewise: warning: the 2 runs are the same, row for row' %s/rw.err", dir, dir,
+                  lw_test_bin(), dir, dir, dir, dir), 0, "%s", lw_test_slurp("%s/rw.err", dir));
   csv = lw_test_slurp("%s/rw.csv", dir);
   const char *line = strchr(csv, '\n') + 1;
   double t0 = 0, e0 = 0, se0 = 0;

@@ -283,8 +283,8 @@ Test(tools, identical_runs_have_a_standard_deviation_of_zero)
                   env("LW_BIN")), 0, "%s", err_txt());
   out = out_txt();
   char *errs = err_txt();
-  cr_assert(strstr(out, "warning: seed-1/trace.csv and seed-2/trace.csv are the same run, row for row (one seed run "
-                        "twice)") && !strstr(out, "runs are the same"), "%s", out);
+  cr_assert(strstr(out, "warning: seed-1/trace.csv and seed-2/trace.csv are one run, row for row over the rows they "
+                        "share") && !strstr(out, "runs are the same"), "%s", out);
   cr_assert(strstr(errs, "linewise: note: other has no summary.json: the run has not finished"), "%s", errs);
   free(errs);
   /* the pooled CSV carries no window, batch or sample-count column: the
@@ -301,11 +301,24 @@ Test(tools, identical_runs_have_a_standard_deviation_of_zero)
   cr_assert_geq(lines, 2, "%s", out);
   free(errs);
   free(out);
-  /* a glob of the sweep's directory: its files are left out, best counted once */
+  /* a copy of a run stopped earlier (its rows the first of the other's),
+  ** under --reweight too, which pooled every rung unsaid */
+  cr_assert_eq(sh("cd %s/w && cp -r other part && head -n -5 other/trace.csv > part/trace.csv && %s stats other part "
+                  "seed-1", dir, env("LW_BIN")), 0, "%s", err_txt());
+  out = out_txt();
+  cr_assert(strstr(out, "warning: other/trace.csv and part/trace.csv are one run, row for row over the rows they "
+                        "share (one seed run twice, or a copy of a run stopped earlier)"), "%s", out);
+  free(out);
+  /* a glob of the sweep's directory: its own files are left out, best
+  ** counted once; another file is refused as no directory */
   cr_assert_eq(sh("cd %s/w && %s stats *", dir, env("LW_BIN")), 0, "%s", err_txt());
   errs = err_txt();
-  cr_assert(strstr(errs, "linewise: note: sweep.conf is a file, not a run directory: left out\n") &&
+  cr_assert(strstr(errs, "linewise: note: sweep.conf is a sweep's own file, not a run: left out\n") &&
             strstr(errs, "linewise: note: best is the run in "), "%s", errs);
+  free(errs);
+  cr_assert_eq(sh("cd %s/w && %s stats seed-1/trace.csv seed-2", dir, env("LW_BIN")), 2, "%s", err_txt());
+  errs = err_txt();
+  cr_assert(strstr(errs, "linewise: stats: seed-1/trace.csv is not a directory: expected run directories"), "%s", errs);
   free(errs);
 }
 

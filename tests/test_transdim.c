@@ -116,6 +116,24 @@ static void tally(lw_chain *c, long samples, int thin, unsigned long *nc, unsign
 
 /* Births and deaths alone: N is Poisson with mean exp(-mu_s / T), whatever
 ** the shapes the births draw (NUMERICS.md). */
+/* Room for the segments of every node: two splines of one segment die, and
+** one of three segments comes into their four nodes (lw_splines_new sized
+** the segments' owners by its own segments: a write past them, which
+** AddressSanitizer names, `make asan`). */
+Test(transdim, a_longer_spline_born_into_the_room_of_dead_ones_fits)
+{
+  const size_t segs[2] = {1, 1};
+  lw_splines *sp = lw_splines_new(2, segs, NULL);
+  cr_assert_not_null(sp);
+  const unsigned char dead[2] = {1, 1};
+  lw_splines_compact(sp, dead);
+  const lw_node nodes[4] = {{0, 0, 1, 0}, {1, 0, 1, 0}, {2, 0, 1, 0}, {3, 0, 1, 0}};
+  cr_assert_eq(lw_splines_append(sp, nodes, 4, 3.0, 0), LW_OK);
+  cr_assert(sp->n_segments == 3 && sp->n_splines == 1);
+  for (size_t g = 0; g < 3; g++) cr_assert_eq(sp->seg_spline[g], 0u);
+  lw_splines_free(sp);
+}
+
 Test(transdim, ideal_gas_count_is_poisson)
 {
   lw_params p;

@@ -126,11 +126,11 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
 
 /* Auto levels: stretches the tone linearly so that the darkest share `clip`
 ** of the picture's pixels turn black and the lightest share `clip` white,
-** clipped to [0, 1].  With a transparency alpha (NULL: opaque; the
-** picture's, blurred as its tone was) the levels and the stretch are of the
-** picture under it, not of the white paper it lets through (the tone is
-** composited over white: a t + 1 - a, and stays so); pixels less than half
-** opaque are not counted.  The
+** clipped to [0, 1].  Pixels less than half opaque (img->alpha) are not
+** counted.  With a transparency `under` (the picture's alpha, blurred as its
+** tone was; NULL: the tone as it is, composited over white) the levels and
+** the stretch are of the picture under it, not of the white paper it lets
+** through (the tone is a t + 1 - a, and stays so).  The
 ** stretch is at most 1 / LW_IMAGE_LEVELS_MIN_SPAN: a flatter picture is
 ** widened about its middle tone, so that sensor noise on a blank page is
 ** not blown up into structure.  An end whose level falls on a flat area,
@@ -142,7 +142,7 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
 ** LW_ENOMEM with err set. */
 #define LW_IMAGE_LEVELS_MIN_SPAN 0.05
 #define LW_IMAGE_LEVELS_PLATEAU 0.05
-lw_status lw_image_levels(lw_image *img, const float *alpha, double clip, double *lo, double *hi, lw_error *err);
+lw_status lw_image_levels(lw_image *img, const float *under, double clip, double *lo, double *hi, lw_error *err);
 
 /* The tone curve, in this order:
 **     t <- 1 - t                         if invert

@@ -110,6 +110,13 @@ lw_status lw_trace_stats(const lw_trace *t, const char *path, const lw_trace_sel
 lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
                               FILE *out, lw_error *err);
 
+/* Warns on out of runs among the k that are one run over the rows they
+** share, each over its own stretch (sel[r]): the same seed twice, or a copy
+** stopped earlier (lw_trace_stats_runs says it too; the reweighting pools
+** rungs, and says it with this). */
+void lw_trace_warn_twins(const lw_trace *const *t, const char *const *path, const lw_trace_select *sel, int k,
+                         FILE *out);
+
 #ifdef __cplusplus
 }
 #endif
