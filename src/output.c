@@ -13,7 +13,9 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 void lw_output_page_init(lw_output_page *page, double width_mm, double height_mm)
@@ -68,7 +70,10 @@ FILE *lw_output_open_tmp(const char *path, char *tmp, size_t n, lw_error *err)
   }
   /* a stale one (a kill as it was written) or a link goes, not what it
   ** names; O_EXCL then refuses one put back in between */
-  if (unlink(tmp) && errno != ENOENT) {
+  struct stat sb;
+  /* (a read-only file system refuses to unlink what is not there too: the
+  ** write is what failed, and the open below says so) */
+  if (unlink(tmp) && errno != ENOENT && !(errno == EROFS && lstat(tmp, &sb) && errno == ENOENT)) {
     lw_error_set(err, LW_EIO, "%s: cannot remove %s: %s", path, tmp, strerror(errno));
     return NULL;
   }
@@ -120,6 +125,22 @@ static void sync_directory_of(const char *path)
   lw_output_sync_dir(dir);
 }
 
+/* Why a write long before the commit failed, where the stream kept only
+** that it did (a large fwrite fails in its own write; the flush after has
+** nothing left to write, and under MPI a full disk read "I/O error"): the
+** file system full, or the file at the size limit; 0 if neither. */
+static int lost_write_error(FILE *f)
+{
+  struct statvfs v;
+  struct stat st;
+  struct rlimit r;
+  if (!fstatvfs(fileno(f), &v) && (v.f_bavail == 0 || v.f_bfree == 0)) return ENOSPC;
+  if (!getrlimit(RLIMIT_FSIZE, &r) && r.rlim_cur != RLIM_INFINITY && !fstat(fileno(f), &st) &&
+      (rlim_t)st.st_size >= r.rlim_cur)
+    return EFBIG;
+  return 0;
+}
+
 lw_status lw_output_commit(FILE *f, const char *tmp, const char *path, lw_error *err)
 {
   /* ferror first: a failed fprintf long ago leaves the stream flagged even
@@ -129,6 +150,7 @@ lw_status lw_output_commit(FILE *f, const char *tmp, const char *path, lw_error 
     bad = 1;
     e = errno;
   }
+  if (bad && !e) e = lost_write_error(f);
   if (fclose(f)) {
     bad = 1;
     if (!e) e = errno;

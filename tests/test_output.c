@@ -8,6 +8,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -418,6 +420,33 @@ Test(output, atomic_write_failed_rename_removes_tmp)
   cr_assert(S_ISDIR(st.st_mode));
   cr_assert_eq(count_tmp(dir), 0);
   lw_splines_free(sp);
+  remove_dir(dir);
+}
+
+/* A write that failed inside a large fwrite leaves the stream flagged with
+** nothing for the flush to fail on: the commit named no cause ("I/O
+** error"; linewise-mpi's state.lw on a full disk).  The cause is found from
+** the file: here the size limit (the test's own process: Criterion forks
+** one a test), as a full file system would be. */
+Test(output, a_write_that_failed_long_before_the_commit_is_named)
+{
+  char dir[64], path[128], tmp[LW_OUTPUT_PATH_MAX];
+  make_dir(dir);
+  snprintf(path, sizeof path, "%s/state.lw", dir);
+  signal(SIGXFSZ, SIG_IGN);
+  struct rlimit r = {4096, RLIM_INFINITY};
+  getrlimit(RLIMIT_FSIZE, &r);
+  r.rlim_cur = 4096;
+  cr_assert_eq(setrlimit(RLIMIT_FSIZE, &r), 0);
+  lw_error err;
+  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, &err);
+  cr_assert_not_null(f, "%s", err.msg);
+  static char block[65536];
+  memset(block, 'x', sizeof block);
+  cr_assert_lt(fwrite(block, 1, sizeof block, f), sizeof block);
+  cr_assert_eq(lw_output_commit(f, tmp, path, &err), LW_EIO);
+  cr_assert(strstr(err.msg, "state.lw: write failed: File too large"), "%s", err.msg);
+  cr_assert_eq(count_tmp(dir), 0);
   remove_dir(dir);
 }
 

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "linewise/anneal.h"
 #include "linewise/checkpoint.h"
@@ -334,10 +335,11 @@ void lw_mpi_report(lw_anneal_net *net, const lw_anneal *a, int quiet)
   if (quiet || net->rank || m->sweeps < 2) return;
   double sweep = wall / (double)(m->sweeps - 1); /* from the end of the first sweep */
   /* each move was counted by both of its processes */
-  fprintf(stderr, "linewise: MPI: %d processes, %d replicas, %d threads each: %.3f ms a sweep; exchange steps %.3f "
+  fprintf(stderr, "linewise: MPI: %d process%s, %d replicas, %d thread%s each: %.3f ms a sweep; exchange steps %.3f "
           "ms a sweep (%.1f %%) on the quickest process, %.3f ms (%.1f %%) on the one that waited longest; %.2f "
           "chain moves a sweep of %zu bytes; alone, one reduction of %zu words %.1f us, one chain move %.1f us\n",
-          net->size, a->n_rep, omp_get_max_threads(), 1e3 * sweep, 1e3 * lo, 100.0 * lo / sweep, 1e3 * hi,
+          net->size, net->size == 1 ? "" : "es", a->n_rep, omp_get_max_threads(), omp_get_max_threads() == 1 ? "" : "s",
+          1e3 * sweep, 1e3 * lo, 100.0 * lo / sweep, 1e3 * hi,
           100.0 * hi / sweep, (double)moves / 2.0 / (double)m->sweeps, chain_bytes(a->chains[0]), m->buf_len,
           1e6 * reduce, 1e6 * move);
 }
@@ -513,8 +515,14 @@ lw_anneal_net *lw_mpi_init(int *argc, char ***argv, volatile sig_atomic_t *stop)
     MPI_Comm_size(node, &on_node);
     MPI_Comm_free(&node);
   }
+  /* A process mpirun bound to some cores (Open MPI binds each to one core
+  ** by default with two processes or fewer, `--map-by ...:pe=T` to T) has
+  ** those: omp_get_num_procs counts them, and divided again among the
+  ** node's processes gave pe=8 two processes four threads each. */
   if (!getenv("OMP_NUM_THREADS")) {
-    int t = omp_get_num_procs() / on_node;
+    const long node_cores = sysconf(_SC_NPROCESSORS_ONLN);
+    const int mine = omp_get_num_procs();
+    int t = node_cores > 0 && mine < node_cores ? mine : (int)((node_cores > 0 ? node_cores : mine) / on_node);
     omp_set_num_threads(t > 0 ? t : 1);
   }
   m.net.share = share;
