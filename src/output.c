@@ -574,7 +574,8 @@ lw_status lw_output_png_surface(cairo_surface_t *surf, const char *path, lw_erro
     lw_status s = png_write_rgb(surf, f, &k);
     if (s) {
       lw_output_abort(f, tmp);
-      return lw_error_set(err, s, "%s: writing the PNG failed: %s", path, k.sink.error ? strerror(k.sink.error) : k.why);
+      return lw_error_set(err, s, "%s: writing the PNG failed: %s", path,
+                          k.sink.error ? strerror(k.sink.error) : k.why);
     }
     return lw_output_commit(f, tmp, path, err);
   }

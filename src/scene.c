@@ -220,7 +220,8 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
   float *cover = NULL;
   /* (a run begun before 2026-12-06, whose scene.ini has no line for the
   ** key, stretched the composite: potential_paper below) */
-  const int levels_under = p->image_levels_alpha && !(p->run_written && !lw_params_line(p, "scene", "image_levels_alpha"));
+  const int levels_under =
+      p->image_levels_alpha && !(p->run_written && !lw_params_line(p, "scene", "image_levels_alpha"));
   if (sc->image->alpha && (curve || (p->image_levels > 0 && levels_under)) && p->image_blur > 0) {
     if (!(cover = malloc(npx * sizeof *cover)))
       return lw_error_set(err, LW_ENOMEM, "out of memory for the picture's transparency");

@@ -555,8 +555,8 @@ static int same_rows(const lw_trace *const *t, size_t *const *row, int q, int r,
 ** 1); pooled, such a run counts twice and the error bar is too small (one
 ** seed twice among four: 16 % small).  All alike is one warning, else one a
 ** set of twins.  Only runs whose first rows agree are compared further. */
-static void warn_twins(FILE *out, const lw_trace *const *t, size_t *const *row, const size_t *n, const char *const *path,
-                       int k)
+static void warn_twins(FILE *out, const lw_trace *const *t, size_t *const *row, const size_t *n,
+                       const char *const *path, int k)
 {
   int *twin = malloc((size_t)k * sizeof *twin); /* the first run that run r repeats, or r */
   int distinct = 0, same_length = 1;

@@ -649,12 +649,13 @@ Test(run, a_segment_cap_below_the_placed_count_is_refused)
                   "! test -e %s/cap", b, lw_test_root(), dir, dir, dir, dir), 0);
   cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/cap --quiet --set moves.fixed_count=0 --set init.segments=20 "
                   "--set init.segment_length=1.5 --set anneal.sweeps=2 && %s run %s/cap/scene.ini --out %s/cap2 "
-                  "--quiet && %s run %s/cap/scene.ini --out %s/cap3 --set moves.fixed_count=1 2>%s/cap.txt && ! grep -q "
-                  "'no effect.*max_segments' %s/cap.txt", b, lw_test_root(), dir, b, dir, dir, b, dir, dir, dir, dir), 0);
-  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/cap16 --quiet --set moves.fixed_count=0 --set init.segments=20 "
-                  "--set init.segment_length=1.5 --set moves.max_segments=16 2>%s/cap.txt; test $? -eq 2 && grep -qF "
-                  "'expected at least init.segments = 20' %s/cap.txt && ! test -e %s/cap16", b, lw_test_root(), dir, dir,
+                  "--quiet && %s run %s/cap/scene.ini --out %s/cap3 --set moves.fixed_count=1 2>%s/cap.txt && "
+                  "! grep -q 'no effect.*max_segments' %s/cap.txt", b, lw_test_root(), dir, b, dir, dir, b, dir, dir,
                   dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/cap16 --quiet --set moves.fixed_count=0 --set "
+                  "init.segments=20 --set init.segment_length=1.5 --set moves.max_segments=16 2>%s/cap.txt; test $? "
+                  "-eq 2 && grep -qF 'expected at least init.segments = 20' %s/cap.txt && ! test -e %s/cap16", b,
+                  lw_test_root(), dir, dir, dir, dir), 0);
   cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/from --quiet --set moves.fixed_count=0 --set "
                   "moves.max_segments=3 --set init.from=%s/cap/state.lw --set anneal.sweeps=0 2>%s/cap.txt; "
                   "test $? -eq 2 && grep -qF 'got 3' %s/cap.txt", b, lw_test_root(), dir, dir, dir, dir), 0);

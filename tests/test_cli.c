@@ -1556,9 +1556,10 @@ Test(cli, a_signal_that_gives_the_directory_back_does_not_exit_0)
     int rc;
   } stop[] = {{"TERM", 143}, {"HUP", 129}, {"INT", 130}};
   for (size_t k = 0; k < sizeof stop / sizeof stop[0]; k++) {
-    cr_expect_eq(lw_test_sh("cd %s && env --default-signal=%s strace -o /dev/null -P r/state.lw.tmp -e trace=openat "
-                            "-e inject=openat:signal=%s %s run %s/params/minimal.ini --seed 2 --out r --quiet --set "
-                            "anneal.sweeps=10 2> err.txt", dir, stop[k].sig, stop[k].sig, lw_test_bin(), lw_test_root()),
+    cr_expect_eq(lw_test_sh("cd %s && env --default-signal=%s strace -o /dev/null -P r/state.lw.tmp -e "
+                            "trace=openat -e inject=openat:signal=%s %s run %s/params/minimal.ini --seed 2 --out r "
+                            "--quiet --set anneal.sweeps=10 2> err.txt", dir, stop[k].sig, stop[k].sig, lw_test_bin(),
+                            lw_test_root()),
                  stop[k].rc, "SIG%s", stop[k].sig);
     cr_expect_eq(lw_test_sh("cd %s && grep -qx 'linewise: stopped during the set-up; the run that was in r is back as "
                             "it was' err.txt && rm -f r/.lock && diff -r r before", dir), 0, "SIG%s: %s", stop[k].sig,

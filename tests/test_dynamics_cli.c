@@ -124,7 +124,8 @@ Test(dynamics_cli, scenes_the_driver_cannot_move_are_refused_with_the_key)
     const char *set, *want;
   } bad[] = {
     {"--set dynamics.rho=0 --set dynamics.gamma=0", "key 'dynamics.gamma': a massless motion"},
-    {"--set energy.quadrature=3", "key 'energy.quadrature': expected at least 4 nodes a segment under the dynamics, got 3"},
+    {"--set energy.quadrature=3",
+     "key 'energy.quadrature': expected at least 4 nodes a segment under the dynamics, got 3"},
     {"--set dynamics.dt=0", "dynamics.dt"},
     {"--set dynamics.pin=both", "dynamics.pin"},
     {"--set dynamics.dashpot=1", "key 'dynamics.dashpot': the splines system reads it under no driver (read by: "
@@ -146,8 +147,9 @@ Test(dynamics_cli, scenes_the_driver_cannot_move_are_refused_with_the_key)
                   dir, dir, dir), 0);
   /* the vectors of no pinned end (a setting that did nothing, unsaid) */
   cr_assert_eq(sh("%s run %s/params/hanging.ini --out %s/pv --stop-at 0 --set dynamics.pin=none --set "
-                  "dynamics.pin_vectors=1 2>%s/err.txt && grep -qF 'these keys have no effect here: dynamics.pin_vectors "
-                  "(--set: dynamics.pin = none)' %s/err.txt", lw_test_bin(), lw_test_root(), dir, dir, dir), 0);
+                  "dynamics.pin_vectors=1 2>%s/err.txt && grep -qF 'these keys have no effect here: "
+                  "dynamics.pin_vectors (--set: dynamics.pin = none)' %s/err.txt", lw_test_bin(), lw_test_root(), dir,
+                  dir, dir), 0);
   /* what the particle system cannot take: the review's scheme (its
   ** quaternions are constrained), the splines' load and pins (its own are
   ** particles.gravity and particles.pinned) */

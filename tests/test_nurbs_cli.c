@@ -267,8 +267,9 @@ Test(nurbs_cli, free_weights_resume_to_the_same_bytes_under_dynamics_and_monte_c
 ** the minimum (1.5e-2 above it), as the key's text says. */
 Test(nurbs_cli, a_quench_told_never_to_stall_does_not)
 {
-  const char *set = "--set scene.driver=metropolis --set nurbs.free_weights=1 --set 'nurbs.weights=1 1.2 1 0.8 1 1.2 1' "
-                    "--set nurbs.refine=8 --set anneal.sweeps=200 --set anneal.quench=bfgs --set output.frames_every=0";
+  const char *set = "--set scene.driver=metropolis --set nurbs.free_weights=1 "
+                    "--set 'nurbs.weights=1 1.2 1 0.8 1 1.2 1' --set nurbs.refine=8 --set anneal.sweeps=200 "
+                    "--set anneal.quench=bfgs --set output.frames_every=0";
   cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/q0 --quiet %s --set anneal.quench_stall=0", lw_test_bin(),
                   lw_test_root(), dir, set), 0);
   char *js = lw_test_slurp("%s/q0/summary.json", dir);

@@ -357,8 +357,8 @@ Test(tools, ctrl_c_or_a_hang_up_waits_for_the_slowest_run)
 {
   static const char *const sig[] = {"INT", "HUP"};
   for (int k = 0; k < 2; k++) {
-    cr_assert_eq(sh("rm -rf %s/w && (setsid env --default-signal=INT,HUP %s %s %s --vary init.splines=2,600 --seeds 1 -j 2 "
-                    "--threads 1 --set anneal.sweeps=1000000 --set scene.width=300 --bin %s --out %s/w >%s/w.out "
+    cr_assert_eq(sh("rm -rf %s/w && (setsid env --default-signal=INT,HUP %s %s %s --vary init.splines=2,600 --seeds 1 "
+                    "-j 2 --threads 1 --set anneal.sweeps=1000000 --set scene.width=300 --bin %s --out %s/w >%s/w.out "
                     "2>%s/w.err & echo $! >%s/w.pid); a=%s/w/init.splines=2__seed-1; b=%s/w/init.splines=600__seed-1; "
                     "i=0; while [ $i -lt 1500 ] && ! { test -s $a/state.lw && test -s $b/state.lw; }; do sleep 0.02; "
                     "i=$((i+1)); done; p=$(cat %s/w.pid); kill -%s -$p; i=0; while kill -0 $p 2>/dev/null && "
