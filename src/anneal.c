@@ -1792,7 +1792,6 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
     if (a->net) s = a->net->drift(a->net, a, s, err);
     if (s) return s;
     for (int r = 0; r < n; r++) a->size_peak[r] = replica_size(a, r);
-    a->totals_fresh = 1;
   }
   /* after the recomputation: a row shows the totals a checkpoint here keeps */
   if (a->sweep % p->trace_every == 0 || lw_anneal_done(a)) trace_row(a);

@@ -1154,16 +1154,17 @@ static int cmd_stats(int argc, char **argv)
                  base.from, base.to);
   if (!dir) lw_error_set(&err, LW_ENOMEM, "out of memory");
   else if (!err.code && !k) lw_error_set(&err, LW_EUSAGE, "stats: expected a run directory %s", use);
-  /* a glob of a sweep's directory names its own files too (sweep.conf,
-  ** sweep.csv: "sweep.conf/scene.ini: ... Not a directory"), which are left
-  ** out with a note; anything else that is no directory is refused as such
-  ** (a trace.csv named for its run) */
+  /* a glob of a sweep's directory names its files too (sweep.conf,
+  ** sweep.csv, plot-sweep's sweep.png, a Slurm log: "sweep.conf/scene.ini:
+  ** ... Not a directory"), which are left out with a note; a trace.csv named
+  ** for its run is refused (pooled without it, a script got fewer runs
+  ** than it named) */
   struct stat sd;
   for (int r = 0; !err.code && r < k; r++) {
     if (stat(dir[r], &sd) || S_ISDIR(sd.st_mode)) continue;
     const char *name = strrchr(dir[r], '/') ? strrchr(dir[r], '/') + 1 : dir[r];
-    if (k > 1 && (!strcmp(name, "sweep.conf") || !strcmp(name, "sweep.csv"))) {
-      fprintf(stderr, "linewise: note: %s is a sweep's own file, not a run: left out\n", dir[r]);
+    if (k > 1 && strcmp(name, "trace.csv")) {
+      fprintf(stderr, "linewise: note: %s is no run directory: left out\n", dir[r]);
       memmove(dir + r, dir + r + 1, (size_t)(k - r - 1) * sizeof *dir);
       k--, r--;
     } else {

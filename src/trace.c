@@ -581,8 +581,8 @@ static void warn_twins(FILE *out, const lw_trace *const *t, size_t *const *row, 
     for (int r = q + 1; r < k; r++)
       if (twin[r] == q) fprintf(out, "%s%s", --copies ? ", " : " and ", path[r]);
     fprintf(out, " are one run, row for row over the rows they share (one seed run twice, or a copy of a run "
-            "stopped earlier): pooled, it counts as more than one, so the error bars are too small and R_hat and "
-            "p_runs too kind; leave all but one out\n");
+            "stopped earlier): pooled, it counts as more than one, so the error bars are too small and the runs' "
+            "agreement too kind; leave all but one out\n");
   }
   free(twin);
 }

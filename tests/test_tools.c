@@ -309,11 +309,12 @@ Test(tools, identical_runs_have_a_standard_deviation_of_zero)
   cr_assert(strstr(out, "warning: other/trace.csv and part/trace.csv are one run, row for row over the rows they "
                         "share (one seed run twice, or a copy of a run stopped earlier)"), "%s", out);
   free(out);
-  /* a glob of the sweep's directory: its own files are left out, best
-  ** counted once; another file is refused as no directory */
-  cr_assert_eq(sh("cd %s/w && %s stats *", dir, env("LW_BIN")), 0, "%s", err_txt());
+  /* a glob of the sweep's directory: its files are left out (plot-sweep's
+  ** picture too), best counted once; a run's trace.csv is refused */
+  cr_assert_eq(sh("cd %s/w && touch sweep.png && %s stats *", dir, env("LW_BIN")), 0, "%s", err_txt());
   errs = err_txt();
-  cr_assert(strstr(errs, "linewise: note: sweep.conf is a sweep's own file, not a run: left out\n") &&
+  cr_assert(strstr(errs, "linewise: note: sweep.conf is no run directory: left out\n") &&
+            strstr(errs, "linewise: note: sweep.png is no run directory: left out\n") &&
             strstr(errs, "linewise: note: best is the run in "), "%s", errs);
   free(errs);
   cr_assert_eq(sh("cd %s/w && %s stats seed-1/trace.csv seed-2", dir, env("LW_BIN")), 2, "%s", err_txt());

@@ -88,8 +88,8 @@ typedef struct lw_anneal {
   double ckpt_seconds;         /* of it, writing checkpoints (lw_anneal_checkpoint_note) */
   lw_move_stats trace_mark[LW_MOVES_MAX]; /* stats at the last trace row */
   int quenched;                /* 1 once lw_anneal_finish has quenched (anneal.quench) */
-  int totals_fresh;            /* the running energies are the state's, recomputed, and no move
-                               ** since (the set-up's, or a sweep's drift check) */
+  int totals_fresh;            /* the running energies are the set-up's, recomputed, and no
+                               ** sweep since (a drift check may keep the running ones) */
   lw_quench_report quench;     /* what the quench did */
   const volatile sig_atomic_t *stop; /* not NULL: set (by a signal) stops a quench under way,
                                ** and lw_anneal_finish then draws nothing (not owned) */

@@ -1,13 +1,14 @@
 /* mpi_tempering.c -- the hooks of anneal_net.h over MPI (mpi_tempering.h). */
+#define _GNU_SOURCE /* sched_getaffinity */
 #include "linewise/mpi_tempering.h"
 
 #include <mpi.h>
 #include <omp.h>
+#include <sched.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "linewise/anneal.h"
 #include "linewise/checkpoint.h"
@@ -505,24 +506,36 @@ lw_anneal_net *lw_mpi_init(int *argc, char ***argv, volatile sig_atomic_t *stop)
   MPI_Comm_rank(comm, &my_rank);
   m.net.rank = my_rank;
   MPI_Comm_size(comm, &m.net.size);
-  /* Threads: the node's cores shared among its processes, unless
-  ** OMP_NUM_THREADS or --threads says otherwise.  OpenMP's default (all
-  ** cores in every process) oversubscribes the node P times, and spinning
-  ** threads of one process then starve the others at each reduction. */
+  /* Threads: the cores a process may use shared among the node's processes
+  ** that may use them too, unless OMP_NUM_THREADS or --threads says
+  ** otherwise.  OpenMP's default (all of them in every process) oversubscribes
+  ** P times, and spinning threads of one process then starve the others at
+  ** each reduction.  A process mpirun bound to its own cores (Open MPI binds
+  ** each to one core with two processes or fewer, `--map-by ...:pe=T` to T)
+  ** shares them with none; unbound, inside a cpuset or a container smaller
+  ** than the node, all share the set (the node's core count would give each
+  ** all of it, and the whole node's divided would give bound ones too few). */
   MPI_Comm node;
-  int on_node = 1;
+  int on_node = 1, sharing = 0;
+  cpu_set_t mine;
+  CPU_ZERO(&mine);
+  const int known = !sched_getaffinity(0, sizeof mine, &mine) && CPU_COUNT(&mine) > 0;
   if (MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node) == MPI_SUCCESS) {
     MPI_Comm_size(node, &on_node);
+    unsigned char *all = malloc((size_t)on_node * sizeof mine);
+    if (all && MPI_Allgather(&mine, (int)sizeof mine, MPI_BYTE, all, (int)sizeof mine, MPI_BYTE, node) == MPI_SUCCESS)
+      for (int q = 0; q < on_node; q++) {
+        cpu_set_t other, both;
+        memcpy(&other, all + (size_t)q * sizeof mine, sizeof other);
+        CPU_AND(&both, &other, &mine);
+        sharing += CPU_COUNT(&both) > 0;
+      }
+    free(all);
     MPI_Comm_free(&node);
   }
-  /* A process mpirun bound to some cores (Open MPI binds each to one core
-  ** by default with two processes or fewer, `--map-by ...:pe=T` to T) has
-  ** those: omp_get_num_procs counts them, and divided again among the
-  ** node's processes gave pe=8 two processes four threads each. */
+  if (!known || sharing < 1) sharing = on_node;
   if (!getenv("OMP_NUM_THREADS")) {
-    const long node_cores = sysconf(_SC_NPROCESSORS_ONLN);
-    const int mine = omp_get_num_procs();
-    int t = node_cores > 0 && mine < node_cores ? mine : (int)((node_cores > 0 ? node_cores : mine) / on_node);
+    const int t = (known ? CPU_COUNT(&mine) : omp_get_num_procs()) / sharing;
     omp_set_num_threads(t > 0 ? t : 1);
   }
   m.net.share = share;
