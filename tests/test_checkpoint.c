@@ -496,55 +496,42 @@ Test(checkpoint, a_step_outside_the_tuned_range_that_nothing_tuned_resumes)
   }
 }
 
-/* tests/fixtures/v3/levels: a run of levels.ini (a half-transparent
-** picture under image_levels) written by the release before the levels
-** were of the picture under its transparency (2026-12-06), stopped at sweep
-** 12 of 30, and levels-whole that release's uninterrupted run.  Its
-** scene.ini has no scene.image_levels_alpha line: resumed, it keeps the
-** levels it ran with and ends on that release's files to the bit; it was
-** refused, the running potential term not the state's. */
-Test(checkpoint, a_run_from_before_the_levels_under_alpha_resumes_to_its_own_end)
+/* tests/fixtures/<v>/<name>: a run of <name>.ini (its picture <name>.png)
+** written by a release before an energy change that a key keeps for it,
+** stopped at sweep 12 of 30, and <name>-whole that release's uninterrupted
+** run.  Its scene.ini has no line for the key: resumed, it keeps the energy
+** it ran with and ends on that release's files to the bit (it was refused,
+** the running potential term not the state's); a new run of the same scene
+** takes the new energy, another potential. */
+static void resume_from_before(const char *v, const char *name, const char *key)
 {
-  cr_assert_eq(lw_test_sh("cp -r %s/tests/fixtures/v3 %s/v3 && cd %s/v3 && "
-                          "sed -i \"s|^image = .*|image = $PWD/levels.png|\" levels/scene.ini && "
-                          "! grep -q '^image_levels_alpha' levels/scene.ini", lw_test_root(), dir, dir), 0);
-  cr_assert_eq(lw_test_sh("%s resume %s/v3/levels --quiet 2> %s/err.txt", lw_test_bin(), dir, dir), 0, "%s",
+  cr_assert_eq(lw_test_sh("cp -r %s/tests/fixtures/%s %s/%s && cd %s/%s && sed -i \"s|^image = .*|image = "
+                          "$PWD/%s.png|\" %s/scene.ini && ! grep -q '^%s' %s/scene.ini", lw_test_root(), v, dir, v, dir,
+                          v, name, name, key, name), 0);
+  cr_assert_eq(lw_test_sh("%s resume %s/%s/%s --quiet 2> %s/err.txt", lw_test_bin(), dir, v, name, dir), 0, "%s",
                lw_test_slurp("%s/err.txt", dir));
+  static const char *const file[] = {"state.lw", "trace.csv"};
   for (int f = 0; f < 2; f++)
-    cr_expect_eq(lw_test_sh("cmp -s %s/v3/levels/%s %s/v3/levels-whole/%s", dir, f ? "trace.csv" : "state.lw", dir,
-                            f ? "trace.csv" : "state.lw"), 0, "%s differs from the old release's run",
-                 f ? "trace.csv" : "state.lw");
-  /* a new run of the same scene takes the levels under the alpha: another potential */
-  cr_assert_eq(lw_test_sh("cd %s/v3 && %s run levels.ini --set init.from=levels/state.lw --set anneal.sweeps=0 --out "
-                          "fresh --quiet && %s energy levels | grep '^potential ' > a.txt && "
-                          "grep -q '\"potential\": ' fresh/summary.json && "
-                          "! grep -q \"\\\"potential\\\": $(cut -d' ' -f2 a.txt)\" fresh/summary.json", dir,
-                          lw_test_bin(), lw_test_bin()), 0);
+    cr_expect_eq(lw_test_sh("cmp -s %s/%s/%s/%s %s/%s/%s-whole/%s", dir, v, name, file[f], dir, v, name, file[f]), 0,
+                 "%s differs from the old release's run", file[f]);
+  cr_assert_eq(lw_test_sh("cd %s/%s && %s run %s.ini --set init.from=%s/state.lw --set anneal.sweeps=0 --out fresh "
+                          "--quiet && %s energy %s | grep '^potential ' > a.txt && grep -q '\"potential\": ' "
+                          "fresh/summary.json && ! grep -q \"\\\"potential\\\": $(cut -d' ' -f2 a.txt)\" "
+                          "fresh/summary.json", dir, v, lw_test_bin(), name, name, lw_test_bin(), name), 0);
 }
 
-/* tests/fixtures/v2/paper: a run of paper.ini written by the release before
-** the blurred potential read white paper beyond the picture (2026-12-06),
-** stopped at sweep 12 of 30, and paper-whole that release's uninterrupted
-** run.  Its scene.ini has no scene.potential_paper line: resumed, it keeps
-** the potential it ran with (the picture's dark bottom edge continued below
-** it) and ends on that release's files to the bit; it was refused, the
-** running potential term not the state's. */
+/* v2/paper: from before the blurred potential read white paper beyond the
+** picture (2026-12-06; scene.potential_paper): its potential continued the
+** picture's dark bottom edge below it. */
 Test(checkpoint, a_run_from_before_the_white_paper_resumes_to_its_own_end)
 {
-  cr_assert_eq(lw_test_sh("cp -r %s/tests/fixtures/v2 %s/v2 && cd %s/v2 && "
-                          "sed -i \"s|^image = .*|image = $PWD/paper.png|\" paper/scene.ini && "
-                          "! grep -q '^potential_paper' paper/scene.ini", lw_test_root(), dir, dir), 0);
-  cr_assert_eq(lw_test_sh("%s resume %s/v2/paper --quiet 2> %s/err.txt", lw_test_bin(), dir, dir), 0, "%s",
-               lw_test_slurp("%s/err.txt", dir));
-  for (int f = 0; f < 2; f++)
-    cr_expect_eq(lw_test_sh("cmp -s %s/v2/paper/%s %s/v2/paper-whole/%s", dir, f ? "trace.csv" : "state.lw", dir,
-                            f ? "trace.csv" : "state.lw"), 0, "%s differs from the old release's run",
-                 f ? "trace.csv" : "state.lw");
-  /* a new run of the same scene reads the paper: another potential */
-  cr_assert_eq(lw_test_sh("cd %s/v2 && %s run paper.ini --set init.from=paper/state.lw --set anneal.sweeps=0 --out "
-                          "fresh --quiet && %s energy paper | grep '^potential ' > a.txt && "
-                          "grep -q '\"potential\": ' fresh/summary.json && "
-                          "! grep -q \"\\\"potential\\\": $(cut -d' ' -f2 a.txt)\" fresh/summary.json", dir,
-                          lw_test_bin(), lw_test_bin()), 0);
+  resume_from_before("v2", "paper", "potential_paper");
+}
+
+/* v3/levels: from before the levels of a half-transparent picture were of
+** the picture under its transparency (2026-12-06; scene.image_levels_alpha). */
+Test(checkpoint, a_run_from_before_the_levels_under_alpha_resumes_to_its_own_end)
+{
+  resume_from_before("v3", "levels", "image_levels_alpha");
 }
 
