@@ -554,7 +554,7 @@ static int same_rows(const lw_trace *const *t, size_t *const *row, int q, int r,
 ** number), which the comparison took for agreeing runs (R_hat 0.99, p_runs
 ** 1); pooled, such a run counts twice and the error bar is too small (one
 ** seed twice among four: 16 % small).  All alike is one warning, else one a
-** set of twins.  Only runs whose first rows agree are compared further. */
+** set of twins.  (Other runs part at their first row: k^2 / 2 rows.) */
 static void warn_twins(FILE *out, const lw_trace *const *t, size_t *const *row, const size_t *n,
                        const char *const *path, int k)
 {
@@ -564,7 +564,7 @@ static void warn_twins(FILE *out, const lw_trace *const *t, size_t *const *row, 
     twin[r] = r;
     for (int q = 0; q < r && twin[r] == r; q++) {
       const size_t m = n[q] < n[r] ? n[q] : n[r];
-      if (twin[q] == q && m && same_rows(t, row, q, r, 1) && same_rows(t, row, q, r, m)) twin[r] = q;
+      if (twin[q] == q && m && same_rows(t, row, q, r, m)) twin[r] = q;
     }
     distinct += twin[r] == r;
     same_length &= n[r] == n[0];
