@@ -611,8 +611,24 @@ lw_particles *lw_particles_new_from(const lw_particles_setup *s, size_t n, const
     [LW_PTERM_CHEM] = "a chemical potential near what a double holds (particles.chem)"};
   for (int t = 0; t < LW_PTERM_COUNT; t++)
     if (!isfinite(p->term[t])) {
-      lw_error_set(err, LW_EINPUT, "the %s energy of the particles is not finite: %s", lw_pterm_names[t],
-                   why[t] ? why[t] : "two of them (nearly) coincide, or particles.r0 is near what a double holds");
+      /* a pair term's: the closest two named (the search is of a failed
+      ** start only, and of a count that a quadratic scan finishes in a
+      ** second) */
+      char pair[160] = "";
+      size_t a = 0, b = 0;
+      double best = INFINITY;
+      for (size_t i = 0; !why[t] && n <= 20000 && i < n; i++)
+        for (size_t j = i + 1; j < n; j++) {
+          const double dx = x[3 * i] - x[3 * j], dy = x[3 * i + 1] - x[3 * j + 1], dz = x[3 * i + 2] - x[3 * j + 2];
+          const double d2 = dx * dx + dy * dy + dz * dz;
+          if (d2 < best) best = d2, a = i, b = j;
+        }
+      if (isfinite(best)) /* (hypot: 1e-300 apart squared is 0) */
+        snprintf(pair, sizeof pair, " (particles %zu and %zu, counted from 1, are %.3g apart)", a + 1, b + 1,
+                 hypot(hypot(x[3 * a] - x[3 * b], x[3 * a + 1] - x[3 * b + 1]), x[3 * a + 2] - x[3 * b + 2]));
+      lw_error_set(err, LW_EINPUT, "the %s energy of the particles is not finite: %s%s", lw_pterm_names[t],
+                   why[t] ? why[t] : "two of them (nearly) coincide, or particles.r0 is near what a double holds",
+                   pair);
       goto fail;
     }
   return p;
@@ -710,6 +726,8 @@ lw_particles *lw_particles_new(const lw_particles_setup *s, unsigned long seed, 
     goto out;
   }
   p = lw_particles_new_from(s, n, x, q, pin, err);
+  /* (points alone: they are what the start is refused for, counted as read) */
+  if (!p && key && err && err->code == LW_EINPUT && s->n_points && !s->count) *key = "points";
 out:
   free(x);
   free(q);

@@ -44,7 +44,7 @@ static void *state_new(const void *setup, const lw_params *p, unsigned long seed
       return NULL;
     }
     lw_particles *pt = lw_particles_new(setup, seed, &key, err);
-    if (!pt && key) lw_params_blame(p, "particles", key, err); /* the pattern found no room */
+    if (!pt && key) lw_params_blame(p, "particles", key, err); /* no room for the pattern, or the points */
     return pt;
   }
   lw_state st;

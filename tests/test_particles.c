@@ -949,6 +949,18 @@ Test(particles, point_files_are_read_and_bad_ones_name_file_line_and_what_was_ex
   cr_assert(!strcmp(key, "points") && strstr(err.msg, "points 1 and 3 are both at (-0, 0, 0)"), "%s: %s", key,
             err.msg);
   lw_particles_setup_free(su);
+  /* two a hair apart pass that check and make the repulsion infinite: the
+  ** points key and the pair are named (it said only "two of them") */
+  write_file("near.xyz", "0 0 0\n5 0 0\n1e-300 0 0\n", path, sizeof path);
+  strcpy(prm.pt_points, "near.xyz");
+  prm.pt_count = 0;
+  su = lw_particles_setup_new(&prm, &err);
+  cr_assert_not_null(su, "%s", err.msg);
+  cr_assert_eq(lw_particles_check_start(su, &key, &err), LW_OK, "%s", err.msg);
+  cr_assert_null(lw_particles_new(su, 1, &key, &err));
+  cr_assert(key && !strcmp(key, "points") && strstr(err.msg, "(particles 1 and 3, counted from 1, are 1e-300 apart)"),
+            "%s: %s", key ? key : "(none)", err.msg);
+  lw_particles_setup_free(su);
 }
 
 Test(particles, bad_keys_name_file_line_and_key)
