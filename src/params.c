@@ -624,7 +624,9 @@ const lw_param_def lw_param_table[] = {
          "the photo preset sets it). Without layers, every line is of one pen."),
   STRING("layers", "colors", ly_colors, "", "",
          "Pen colour of each layer, `#rrggbb` or `#rgb`; empty = black (tone) or cyan, magenta, "
-         "yellow, black (cmyk). `palette` needs them: they are the pens the picture is separated into."),
+         "yellow, black (cmyk). `palette` needs them: they are the pens the picture is separated into, "
+         "and so are they under `cmyk` when given (real inks' colours separate into those inks; a "
+         "redraw that recolours a run scores each pen against the new separation)."),
   STRING("layers", "turn", ly_turn, "", "degrees",
          "Each layer's field is the scene's field (scene.field) turned by this angle, e.g. `0 90` "
          "for cross-hatching along and across the flow. Empty = 0 for every layer."),
