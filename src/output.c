@@ -519,7 +519,7 @@ static void png_sink_warning(png_structp pp, png_const_charp msg) { (void)pp, (v
 ** 556 kB in about half cairo's time, against 739 kB; a wire's frame 6.2 kB
 ** against 5.7; levels 1 to 3 doubled a frame, a run-length deflate the
 ** preview). */
-static lw_status png_write_rgb(cairo_surface_t *surf, FILE *f, png_sink *k)
+static lw_status png_write_rgb(cairo_surface_t *surf, png_sink *k)
 {
   const int w = cairo_image_surface_get_width(surf), h = cairo_image_surface_get_height(surf),
             stride = cairo_image_surface_get_stride(surf);
@@ -571,7 +571,7 @@ lw_status lw_output_png_surface(cairo_surface_t *surf, const char *path, lw_erro
   cairo_surface_flush(surf);
   if (cairo_image_surface_get_format(surf) == CAIRO_FORMAT_RGB24) {
     png_sink k = {{f, 0}, ""};
-    lw_status s = png_write_rgb(surf, f, &k);
+    lw_status s = png_write_rgb(surf, &k);
     if (s) {
       lw_output_abort(f, tmp);
       return lw_error_set(err, s, "%s: writing the PNG failed: %s", path,
