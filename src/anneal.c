@@ -2059,8 +2059,19 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
   ** from 72487 to 2e-4 in 20 sweeps read 3.4e-7 off in its 7th digit) */
   /* (not where they are already: a redraw, anneal.sweeps = 0, built the
   ** model twice, 12 % of its time at 4000 splines; the same bits) */
-  if (!a->totals_fresh && a->sys_type->refresh(a->sys->state) != LW_OK)
-    return lw_error_set(err, LW_ENOMEM, "out of memory");
+  /* the recomputation's drift counts too: a run shorter than check_every
+  ** said 0 in max_relative_drift, as if its totals had been exact */
+  /* (against the size now, not the peak since the last check as a sweep's
+  ** check: a resumed process starts its peaks at the state it read, and its
+  ** summary.json would differ from the run's that never stopped) */
+  if (!a->totals_fresh) {
+    double run[LW_SYSTEM_TERMS_MAX], fresh[LW_SYSTEM_TERMS_MAX];
+    a->sys_type->terms(a->sys->state, run);
+    if (a->sys_type->refresh(a->sys->state) != LW_OK) return lw_error_set(err, LW_ENOMEM, "out of memory");
+    a->sys_type->terms(a->sys->state, fresh);
+    const double d = lw_system_drift(run, fresh, a->sys_type->n_terms);
+    if (d > a->max_drift) a->max_drift = d;
+  }
   if (a->params.quench == LW_QUENCH_BFGS && !a->quenched) {
     lw_phase_set("quenching to the nearest minimum");
     /* the dynamics' pins hold in its quench too */

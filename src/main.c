@@ -1215,11 +1215,31 @@ static int cmd_stats(int argc, char **argv)
     if (!(path[r] = strdup(where))) lw_error_set(&err, LW_ENOMEM, "out of memory");
     else t[r] = lw_trace_read(where, &err);
     /* pooled with finished runs, a run stopped on the way counted as one of
-    ** them, its shorter stretch shown only by its row count */
+    ** them, its shorter stretch shown only by its row count; one that has
+    ** not reached the stretch yet is left out (a preempted task of a sweep
+    ** refused the whole pool) */
     lw_path_join(where, sizeof where, dir[r], "summary.json");
-    if (!err.code && k > 1 && access(where, F_OK))
-      fprintf(stderr, "linewise: note: %s has no summary.json: the run has not finished, and its rows end short of "
-              "its scene's\n", dir[r]);
+    if (err.code || k < 2 || !access(where, F_OK)) continue;
+    const int sweep = lw_trace_column(t[r], "sweep");
+    const double last = sweep >= 0 && t[r]->n_rows ? t[r]->v[(t[r]->n_rows - 1) * t[r]->n_cols + (size_t)sweep] : 0;
+    size_t *rows = NULL, n_rows = 0, tuned = 0;
+    lw_error short_err = {0};
+    if (!lw_trace_rows(t[r], path[r], &sel[r], &rows, &n_rows, &tuned, &short_err)) {
+      fprintf(stderr, "linewise: note: %s has no summary.json: the run has not finished (its rows end at sweep %.0f "
+              "of %ld), and it is pooled with its %zu rows\n", dir[r], last, sel[r].sweeps, n_rows);
+    } else {
+      fprintf(stderr, "linewise: note: %s has no summary.json and no row to pool yet (%s): left out\n", dir[r],
+              short_err.msg);
+      lw_trace_free(t[r]);
+      free(path[r]);
+      memmove(dir + r, dir + r + 1, (size_t)(k - r - 1) * sizeof *dir);
+      memmove(t + r, t + r + 1, (size_t)(k - r - 1) * sizeof *t);
+      memmove(sel + r, sel + r + 1, (size_t)(k - r - 1) * sizeof *sel);
+      memmove(path + r, path + r + 1, (size_t)(k - r - 1) * sizeof *path);
+      t[k - 1] = NULL, path[k - 1] = NULL;
+      k--, r--;
+    }
+    free(rows);
   }
   if (!err.code) {
     failed = -1;

@@ -237,17 +237,18 @@ Test(tools, seed_sweep_gathers_every_summary_and_links_the_best)
   free(out);
   free(t.text);
   /* written aside under mktemp's names (0600), then given what the umask
-  ** gives a new file, and nothing left beside them */
+  ** gives a new file, and nothing left beside them but the lock a task
+  ** holds while it runs */
   cr_assert_eq(sh("cd %s/s && test $(stat -c %%a sweep.csv) = 640 && test $(stat -c %%a sweep.conf) = 640 && "
-                  "test -z \"$(ls -A | grep '^\\.')\"", dir), 0);
+                  "test $(stat -c %%a sweep.plan) = 640 && test \"$(ls -A | grep '^\\.')\" = .sweep.running", dir), 0);
   /* a directory whose name ends in a line break (dirname drops it: the
   ** temporaries were sought in another directory, and the sweep failed) */
   cr_assert_eq(sh("cd %s && %s %s --seeds 1 " TINY " --bin %s --out 'n\n' && test -s 'n\n/sweep.csv' && "
                   "test -L 'n\n/best'", dir, tool("seed-sweep"), scene(), env("LW_BIN")), 0, "%s", err_txt());
   /* and one named with a leading '-' (mkdir and mv took it for options) */
   cr_assert_eq(sh("cd %s && %s %s --seeds 1 " TINY " --bin %s --out -d && test -s ./-d/sweep.csv && "
-                  "test -L ./-d/best && test -z \"$(ls -A ./-d | grep '^\\.')\"", dir, tool("seed-sweep"), scene(),
-                  env("LW_BIN")), 0, "%s", err_txt());
+                  "test -L ./-d/best && test \"$(ls -A ./-d | grep '^\\.')\" = .sweep.running", dir, tool("seed-sweep"),
+                  scene(), env("LW_BIN")), 0, "%s", err_txt());
 }
 
 /* Runs that agree to the last bit have no spread: the sums of e and e^2
@@ -308,6 +309,17 @@ Test(tools, identical_runs_have_a_standard_deviation_of_zero)
   out = out_txt();
   cr_assert(strstr(out, "warning: other/trace.csv and part/trace.csv are one run, row for row over the rows they "
                         "share (one seed run twice, or a copy of a run stopped earlier)"), "%s", out);
+  free(out);
+  /* a run stopped before the stretch (a preempted task of a sweep) is left
+  ** out with a note: it refused the whole pool ("no row from sweep 30") */
+  cr_assert_eq(sh("cd %s/w && cp -r other early && awk -F, 'NR == 1 || $1 <= 20' other/trace.csv > early/trace.csv && "
+                  "%s stats seed-1 early seed-2 --from 30", dir, env("LW_BIN")), 0, "%s", err_txt());
+  out = out_txt();
+  errs = err_txt();
+  cr_assert(strstr(errs, "linewise: note: early has no summary.json and no row to pool yet (early/trace.csv: no row "
+                         "from sweep 30 to ") && strstr(errs, "): left out\n"), "%s", errs);
+  cr_assert(strstr(out, "2 runs:\n") && !strstr(out, "early"), "%s", out);
+  free(errs);
   free(out);
   /* a glob of the sweep's directory: its files are left out (plot-sweep's
   ** picture too), best counted once; a run's trace.csv is refused */
@@ -658,6 +670,19 @@ Test(tools, job_array_tasks_then_gather_only)
   snprintf(path, sizeof path, "%s/j/sweep.csv", dir);
   cr_assert_neq(access(path, F_OK), 0, "a task does not gather");
   cr_assert_eq(sh("%s --gather-only %s/j", tool("seed-sweep"), dir), 0, "%s", err_txt());
+  /* a gather after an array where a task did not finish fails, naming it
+  ** (it said "3 finished runs gathered" with exit 0, so the dependent job of
+  ** the recipe passed); the table holds the finished ones */
+  cr_assert_eq(sh("rm %s/j/seed-6/summary.json && mkdir %s/j/seed-9 && %s --gather-only %s/j", dir, dir,
+                  tool("seed-sweep"), dir), 1);
+  char *errs = err_txt();
+  cr_assert(strstr(errs, "/j/seed-6: not finished: stopped on the way (rerun the sweep to resume it)\n") &&
+                strstr(errs, "1 of 3 planned runs have not finished; sweep.csv holds the 2 that have\n") &&
+                !strstr(errs, "seed-9"), "%s", errs);
+  free(errs);
+  cr_assert_eq(sh("SLURM_ARRAY_TASK_ID=2 SLURM_SUBMIT_DIR=%s %s %s --seeds 5-7 " TINY " --bin %s --out %s/j && "
+                  "%s --gather-only %s/j", env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir,
+                  tool("seed-sweep"), dir), 0, "%s", err_txt());
   csv t;
   csv_read(&t, path);
   cr_assert_eq(t.nrow, 3);
@@ -672,6 +697,32 @@ Test(tools, job_array_tasks_then_gather_only)
                   env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir),
                2);
   free(t.text);
+  /* LINEWISE_TOOLS naming an install's bin/ (linewise-param-sweep there) */
+  cr_assert_eq(sh("mkdir -p %s/inst && ln -sf %s %s/inst/linewise-param-sweep && SLURM_ARRAY_TASK_ID=1 "
+                  "SLURM_SUBMIT_DIR=/nonexistent LINEWISE_TOOLS=%s/inst %s %s --seeds 8 " TINY " --bin %s --out %s/i",
+                  dir, tool("param-sweep"), dir, dir, tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir),
+               0, "%s", err_txt());
+}
+
+/* Two job arrays of other settings started together into one --out: the
+** second's tasks are refused while the first's run (each ran with its own
+** settings, and sweep.conf named one of them); with none running and no run
+** kept, the directory is the new sweep's, as after a --set typo.  A task of
+** the first array holds .sweep.running: here flock stands in for it. */
+Test(tools, a_sweep_of_other_settings_is_refused_while_one_runs)
+{
+  cr_assert_eq(sh("%s %s --seeds 1 --set energy.bending=abc --bin %s --out %s/r", tool("seed-sweep"), scene(),
+                  env("LW_BIN"), dir), 1);
+  cr_assert_eq(sh("flock -s %s/r/.sweep.running env SLURM_ARRAY_TASK_ID=1 SLURM_SUBMIT_DIR=%s %s %s --seeds 1 " TINY
+                  " --bin %s --out %s/r", dir, env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir),
+               2);
+  char *errs = err_txt();
+  cr_assert(strstr(errs, "/r/sweep.conf: a sweep is running in this directory of another scene, --set or --vary keys "
+                         "(it has: set energy.bending=abc; this sweep: set anneal.sweeps=20;"), "%s", errs);
+  free(errs);
+  cr_assert_eq(sh("SLURM_ARRAY_TASK_ID=1 SLURM_SUBMIT_DIR=%s %s %s --seeds 1 " TINY " --bin %s --out %s/r",
+                  env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
+  cr_assert_eq(sh("grep -qx 'set anneal.sweeps=20' %s/r/sweep.conf && test -s %s/r/seed-1/summary.json", dir, dir), 0);
 }
 
 Test(tools, bad_usage_exits_2_with_one_message_and_writes_nothing)
