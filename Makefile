@@ -252,7 +252,7 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	      "$$(printf '%s' $(call shell_quote,$(PREFIX)) | sed 's/\\/\\e/g')"; \
 	  } > $(D)/share/man/man1/linewise-$$t.1 || exit 1; done
 	install -m 644 tools/slurm-sweep.sbatch tools/slurm-tempering.sbatch $(D)/share/linewise/
-	install -m 644 README.md docs/*.md docs/*.png $(D)/share/doc/linewise/
+	install -m 644 README.md docs/*.md docs/*.png tests/embed.cpp $(D)/share/doc/linewise/
 
 uninstall:
 	for f in $(INSTALLED); do rm -rf $(D)/$$f || exit 1; done

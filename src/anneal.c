@@ -35,7 +35,18 @@
 
 double lw_anneal_seconds(const lw_anneal *a) { return a->wall_before + lw_phase_clock() - a->wall_start; }
 
-double lw_anneal_temperature(const lw_anneal *a) { return a->chain ? a->chain->temperature : 0.0; }
+/* (NAN, not the chain's 0, before the first sweep of a new run sets it:
+** t_start is not the chain's until then) */
+double lw_anneal_temperature(const lw_anneal *a) { return a->chain && a->block >= 0 ? a->chain->temperature : NAN; }
+
+/* LW_EUSAGE after lw_anneal_finish (anneal.h): a program that swept on
+** after it continued a quenched state, or drew the final files twice. */
+static lw_status refuse_finished(const lw_anneal *a, const char *what, lw_error *err)
+{
+  if (!a->finished) return LW_OK;
+  return lw_error_set(err, LW_EUSAGE, "%s: the run in %s has finished (lw_anneal_finish); only lw_anneal_free may "
+                      "follow", what, a->dir);
+}
 
 double lw_anneal_acceptance(const lw_anneal *a)
 {
@@ -1160,8 +1171,9 @@ lw_status lw_anneal_settle(lw_anneal *a, lw_error *err)
 
 lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
 {
-  lw_status se = lw_number_locale_ok(err); /* (the locale changed since the start) */
-  if (se || (se = lw_anneal_settle(a, err))) return se;
+  lw_status se = refuse_finished(a, "lw_anneal_checkpoint", err);
+  /* (the locale changed since the start) */
+  if (se || (se = lw_number_locale_ok(err)) || (se = lw_anneal_settle(a, err))) return se;
   const char *was = lw_phase_get(NULL);
   lw_phase_set("writing state.lw");
   const double t0 = lw_phase_clock();
@@ -1804,8 +1816,8 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
 {
   /* (the locale changed since the start: checked at a checkpoint only, a
   ** program's trace.csv took decimal commas for a hundred rows first) */
-  lw_status s = lw_number_locale_ok(err);
-  if (s || (s = lw_anneal_settle(a, err))) return s;
+  lw_status s = refuse_finished(a, "lw_anneal_sweep", err);
+  if (s || (s = lw_number_locale_ok(err)) || (s = lw_anneal_settle(a, err))) return s;
   const double t0 = lw_phase_clock();
   a->totals_fresh = 0;
   s = sweep_once(a, err);
@@ -2044,14 +2056,15 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
 
 lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
 {
-  lw_status s = lw_number_locale_ok(err);
-  if (s) return s;
+  lw_status s = refuse_finished(a, "lw_anneal_finish", err);
+  if (s || (s = lw_number_locale_ok(err))) return s;
   /* the last sweep's checkpoint, where one fell due, holds this state
   ** already: written again, the same bytes (1.3 s at 1e5 splines); its
   ** timings were taken before that sweep's time was added */
   if (a->saved != a->sweep + 1) s = lw_anneal_checkpoint(a, err);
   else s = writes_files(a) ? lw_checkpoint_write_timing(a, err) : LW_OK;
   if (s) return s;
+  a->finished = 1;
   if (!rung_here(a, 0)) return LW_OK; /* the process of the coldest replica draws it */
   /* summary.json's energies are the state's, recomputed: the running totals
   ** keep the rounding of every commit since the last check, which the drift

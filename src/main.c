@@ -458,7 +458,7 @@ static void progress_state(const lw_anneal *a, int digits, char *buf, size_t n)
   if (a->dyn)
     snprintf(buf, n, "t %.*g  E %.*g  K %.*g", digits, a->dyn->time, digits + 2, lw_anneal_energy(a), digits,
              lw_dynamics_kinetic(a->dyn));
-  else if (isnan(lw_anneal_acceptance(a)) && lw_anneal_temperature(a) == 0.0) /* before the first sweep sets it */
+  else if (isnan(lw_anneal_temperature(a))) /* before the first sweep sets it */
     snprintf(buf, n, "T -  E %.*g  acc -", digits + 2, lw_anneal_energy(a));
   else if (isnan(lw_anneal_acceptance(a)))
     snprintf(buf, n, "T %.*g  E %.*g  acc -", digits, lw_anneal_temperature(a), digits + 2, lw_anneal_energy(a));

@@ -13,6 +13,8 @@
 #include <ini.h>
 #include <limits.h>
 #include <math.h>
+#include <pthread.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -1380,12 +1382,21 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
   if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open scene file: %s", path, strerror(errno));
   /* inih's continuation lines off: an indented line without '=' would
   ** glue a typo onto any value above (an indented key = value is a key);
-  ** only a list goes on (continue_list). */
+  ** only a list goes on (continue_list).  Debian's inih takes these as
+  ** globals: set for this parse alone, under a lock, and put back, since
+  ** a program that embeds the library may parse its own files with inih
+  ** (they stayed set, and its continuation lines became errors). */
+  static pthread_mutex_t inih_settings = PTHREAD_MUTEX_INITIALIZER;
+  pthread_mutex_lock(&inih_settings);
+  const bool multiline = ini_allow_multiline, stop_first = ini_stop_on_first_error;
   ini_allow_multiline = false;
   ini_stop_on_first_error = true;
   reader_ctx rc = {p, f, 0, err, 0, NULL, 0, NULL};
   errno = 0;
   int r = ini_parse_stream(read_line, &rc, on_key, &rc);
+  ini_allow_multiline = multiline;
+  ini_stop_on_first_error = stop_first;
+  pthread_mutex_unlock(&inih_settings);
   int read_error = ferror(f) ? (errno ? errno : EIO) : 0;
   fclose(f);
   free(rc.buf);

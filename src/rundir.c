@@ -4,6 +4,7 @@
 #include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/file.h>
@@ -16,13 +17,16 @@
 /* The locks this process holds, by the lock file's identity: flock locks
 ** of two open files conflict even within one process, so a second lock of
 ** a held directory (a default directory chosen, then started) must find
-** the first.  A hold is a slot's index + 1. */
+** the first.  A hold is a slot's index + 1.  Runs of a program that embeds
+** the library may start in threads of their own (anneal.h): the table is
+** theirs together, under held_lock (two could take one free slot). */
 #define HELD_MAX 64
 static struct {
   dev_t dev;
   ino_t ino;
   int fd, count;
 } held[HELD_MAX];
+static pthread_mutex_t held_lock = PTHREAD_MUTEX_INITIALIZER;
 
 lw_status lw_rundir_make(const char *dir, lw_error *err)
 {
@@ -145,6 +149,44 @@ lw_status lw_rundir_writable(const char *dir, lw_error *err)
                       strerror(e));
 }
 
+/* The lock of dir's lock file fd (st its identity) into the table: the
+** hold this process has on it already, or a new one.  Called under
+** held_lock. */
+static lw_status hold_lock(const char *dir, const char *path, int fd, const struct stat *st, int *hold,
+                           lw_error *err)
+{
+  int k, free_slot = -1;
+  for (k = 0; k < HELD_MAX; k++) {
+    if (held[k].count && held[k].dev == st->st_dev && held[k].ino == st->st_ino) {
+      close(fd);
+      held[k].count++;
+      *hold = k + 1;
+      return LW_OK;
+    }
+    if (!held[k].count && free_slot < 0) free_slot = k;
+  }
+  if (free_slot < 0) {
+    close(fd);
+    return lw_error_set(err, LW_ERUN, "%s: more than %d run directories open in one process", dir, HELD_MAX);
+  }
+  if (flock(fd, LOCK_EX | LOCK_NB)) {
+    int e = errno;
+    close(fd);
+    if (e == EWOULDBLOCK)
+      return lw_error_set(err, LW_EUSAGE, "%s: another linewise process is writing this run directory (it holds "
+                          "%s); wait for it to end, or write another directory", dir, path);
+    /* no locks here (EBADF: an NFS lock on a file we could only read) */
+    if (e == ENOLCK || e == EOPNOTSUPP || e == ENOSYS || e == EINVAL || e == EBADF) return LW_OK;
+    return lw_error_set(err, LW_EIO, "%s: cannot lock the run directory: %s", path, strerror(e));
+  }
+  held[free_slot].dev = st->st_dev;
+  held[free_slot].ino = st->st_ino;
+  held[free_slot].fd = fd;
+  held[free_slot].count = 1;
+  *hold = free_slot + 1;
+  return LW_OK;
+}
+
 lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
 {
   char path[LW_PATH_MAX + 16];
@@ -167,42 +209,17 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
     return lw_error_set(err, LW_EIO, "%s: cannot open the run directory's lock: %s%s", path, strerror(e),
                         e == ELOOP ? " (a symbolic link, which linewise does not follow: remove it)" : "");
   }
-  int k, free_slot = -1;
-  for (k = 0; k < HELD_MAX; k++) {
-    if (held[k].count && held[k].dev == st.st_dev && held[k].ino == st.st_ino) {
-      close(fd);
-      held[k].count++;
-      *hold = k + 1;
-      return LW_OK;
-    }
-    if (!held[k].count && free_slot < 0) free_slot = k;
-  }
-  if (free_slot < 0) {
-    close(fd);
-    return lw_error_set(err, LW_ERUN, "%s: more than %d run directories open in one process", dir, HELD_MAX);
-  }
-  if (flock(fd, LOCK_EX | LOCK_NB)) {
-    int e = errno;
-    close(fd);
-    if (e == EWOULDBLOCK)
-      return lw_error_set(err, LW_EUSAGE, "%s: another linewise process is writing this run directory (it holds "
-                          "%s); wait for it to end, or write another directory", dir, path);
-    /* no locks here (EBADF: an NFS lock on a file we could only read) */
-    if (e == ENOLCK || e == EOPNOTSUPP || e == ENOSYS || e == EINVAL || e == EBADF) return LW_OK;
-    return lw_error_set(err, LW_EIO, "%s: cannot lock the run directory: %s", path, strerror(e));
-  }
-  held[free_slot].dev = st.st_dev;
-  held[free_slot].ino = st.st_ino;
-  held[free_slot].fd = fd;
-  held[free_slot].count = 1;
-  *hold = free_slot + 1;
-  return LW_OK;
+  pthread_mutex_lock(&held_lock);
+  s = hold_lock(dir, path, fd, &st, hold, err);
+  pthread_mutex_unlock(&held_lock);
+  return s;
 }
 
 void lw_rundir_unlock(int hold)
 {
-  if (hold < 1 || hold > HELD_MAX || !held[hold - 1].count) return;
-  if (!--held[hold - 1].count) close(held[hold - 1].fd);
+  pthread_mutex_lock(&held_lock);
+  if (hold >= 1 && hold <= HELD_MAX && held[hold - 1].count && !--held[hold - 1].count) close(held[hold - 1].fd);
+  pthread_mutex_unlock(&held_lock);
 }
 
 const char *lw_rundir_shell_word(const char *dir, char *buf, size_t n)

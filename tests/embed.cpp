@@ -11,6 +11,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include <gsl/gsl_errno.h>
+
 #include "linewise/anneal.h"
 
 int main(int argc, char **argv)
@@ -23,6 +25,7 @@ int main(int argc, char **argv)
   // a program that takes the user's locale keeps LC_NUMERIC at "C" (README)
   std::setlocale(LC_ALL, "");
   std::setlocale(LC_NUMERIC, "C");
+  gsl_set_error_handler(lw_gsl_handler); // "out of memory", not GSL's abort (README)
   static lw_params p; // tens of kilobytes: not on the stack
   static lw_anneal a;
   lw_error err;

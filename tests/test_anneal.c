@@ -414,6 +414,31 @@ static void start_run(const char *extra, const char *name, lw_anneal *a)
   cr_assert_eq(lw_anneal_start(a, &p, out, &err), LW_OK, "%s", err.msg);
 }
 
+/* A program that embeds the library: the temperature is NAN until the first
+** sweep sets it (it read 0 under t_start 0.5), and after lw_anneal_finish
+** a sweep, a checkpoint or a second finish are refused (a sweep went on
+** from the quenched state to sweep 21 of 20, and a second finish drew the
+** files again) */
+Test(run, a_finished_run_takes_no_more_sweeps)
+{
+  lw_anneal a;
+  lw_error err;
+  start_run("[anneal]\nquench = bfgs\n", "f", &a);
+  cr_assert(isnan(lw_anneal_temperature(&a)), "%g", lw_anneal_temperature(&a));
+  while (!lw_anneal_done(&a)) cr_assert_eq(lw_anneal_sweep(&a, &err), LW_OK, "%s", err.msg);
+  cr_assert(lw_anneal_temperature(&a) > 0.0);
+  cr_assert_eq(lw_anneal_finish(&a, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(sh("cp %s/f/state.lw %s/f.lw", dir, dir), 0);
+  const long sweep = a.sweep;
+  cr_assert_eq(lw_anneal_sweep(&a, &err), LW_EUSAGE);
+  cr_assert(strstr(err.msg, "lw_anneal_sweep: the run in ") && strstr(err.msg, "has finished"), "%s", err.msg);
+  cr_assert_eq(lw_anneal_checkpoint(&a, &err), LW_EUSAGE);
+  cr_assert_eq(lw_anneal_finish(&a, &err), LW_EUSAGE);
+  cr_assert_eq(a.sweep, sweep);
+  cr_assert_eq(sh("cmp -s %s/f/state.lw %s/f.lw", dir, dir), 0, "state.lw keeps the annealed state");
+  lw_anneal_free(&a);
+}
+
 Test(run, a_checkpoint_is_marked_committed_as_state_lw_is)
 {
   lw_anneal a;

@@ -1,5 +1,6 @@
 /* test_params.c -- the parameter table, INI reading, overrides and errors. */
 #include <criterion/criterion.h>
+#include <ini.h>
 #include <locale.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -64,6 +65,27 @@ Test(params, defaults_cover_every_key_and_read_back)
                                                                     : sizeof(int);
     cr_assert(!memcmp(a, b, n), "%s.%s differs after a round trip", d->section, d->key);
   }
+}
+
+/* inih's settings are the host program's: a scene read leaves them as they
+** were (it left continuation lines off and parses stopped at the first
+** error, for a program that embeds the library and reads its own files
+** with inih) */
+Test(params, a_scene_read_leaves_inihs_settings_as_they_were)
+{
+  ini_allow_multiline = true;
+  ini_stop_on_first_error = false;
+  static lw_params p;
+  lw_error err;
+  cr_assert_eq(read_text("[anneal]\nsweeps = 7\n", &p, &err), LW_OK, "%s", err.msg);
+  cr_assert_eq(p.sweeps, 7);
+  cr_assert(ini_allow_multiline && !ini_stop_on_first_error);
+  /* and a bad one too */
+  cr_assert_neq(read_text("[anneal]\nsweeps = 7\n  typo\n", &p, &err), LW_OK);
+  cr_assert(ini_allow_multiline && !ini_stop_on_first_error);
+  ini_allow_multiline = false, ini_stop_on_first_error = true;
+  cr_assert_neq(read_text("[anneal]\nsweeps = 7\n  typo\n", &p, &err), LW_OK);
+  cr_assert(!ini_allow_multiline && ini_stop_on_first_error);
 }
 
 Test(params, reads_values_and_records_lines)

@@ -88,6 +88,8 @@ typedef struct lw_anneal {
   double ckpt_seconds;         /* of it, writing checkpoints (lw_anneal_checkpoint_note) */
   lw_move_stats trace_mark[LW_MOVES_MAX]; /* stats at the last trace row */
   int quenched;                /* 1 once lw_anneal_finish has quenched (anneal.quench) */
+  int finished;                /* 1 once lw_anneal_finish was called: sweeps, checkpoints and a
+                               ** second finish are refused (the state may be quenched) */
   int totals_fresh;            /* the running energies are the set-up's, recomputed, and no
                                ** sweep since (a drift check may keep the running ones) */
   lw_quench_report quench;     /* what the quench did */
@@ -164,8 +166,11 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err);
 ** the quenched state.  state.lw keeps the annealed state: the quench is a
 ** function of it, so a resumed run quenches to the same bytes, and a run
 ** resumed for more sweeps continues the chain as an uninterrupted longer
-** run would.  After it only lw_anneal_free: the quench left the coldest
-** replica quenched, and a checkpoint then would save that state. */
+** run would.  After it, whatever it returned, only lw_anneal_free: the
+** quench left the coldest replica quenched, and a checkpoint then would save
+** that state; lw_anneal_sweep, lw_anneal_checkpoint and lw_anneal_finish
+** refuse (LW_EUSAGE).  A start needs a zeroed or freed lw_anneal (a second
+** start over a running one leaks it and keeps its directory locked). */
 lw_status lw_anneal_finish(lw_anneal *a, lw_error *err);
 
 void lw_anneal_free(lw_anneal *a);
@@ -188,8 +193,9 @@ const char *lw_anneal_key_values(const lw_param_def *d);
 lw_status lw_anneal_check_keys(const lw_params *p, char *unread, size_t size, lw_error *err);
 
 
-/* Current temperature, energy and overall acceptance (for progress displays;
-** NAN before any proposal). */
+/* Current temperature, energy and overall acceptance (for progress displays):
+** the temperature NAN before a new run's first sweep sets it (and under
+** dynamics), the acceptance NAN before any proposal. */
 double lw_anneal_temperature(const lw_anneal *a);
 double lw_anneal_energy(const lw_anneal *a);
 double lw_anneal_acceptance(const lw_anneal *a);
