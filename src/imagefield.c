@@ -10,42 +10,87 @@
 ** and beyond short of white by up to twice the darkness its Gaussian carries
 ** past 256 pixels (docs/NUMERICS.md, "The potential between the nodes"). */
 #define POTENTIAL_PAD_MAX 256
+/* Pixels wider than this many mm on the page are read through a finer grid
+** (refine()), of at most POTENTIAL_NODES_MAX nodes. */
+#define POTENTIAL_NODE_MM 1.0
+#define POTENTIAL_NODES_MAX (4L << 20)
+
+/* The nodes a side of each pixel: 1, or where a pixel is wider than
+** POTENTIAL_NODE_MM the odd count that brings the nodes that close (odd, so
+** that the pixel centres are nodes and the bilinear reading of the picture
+** between them is the same), fewer where the grid would pass its cap.  The
+** grid's outer ring, white paper, lies one node beyond the picture's edge
+** pixels' centres: with a node a pixel a picture of a few pixels 89 mm wide
+** faded to white from its one pixel's centre, a pyramid, where its pixel is
+** a square of its tone. */
+static int refine(int w, int h, double pixel)
+{
+  int k = (int)fmin(ceil(pixel / POTENTIAL_NODE_MM), 4097.0);
+  k += !(k & 1);
+  while (k > 1 && ((long)w * k + 2) * ((long)h * k + 2) > POTENTIAL_NODES_MAX) k -= 2;
+  return k;
+}
+
+/* The picture's tone^power at node (i, j) of the grid of k nodes a pixel
+** (0 <= i < w k): bilinear between the pixel centres, the edge pixels' tone
+** out to the picture's edge; t holds tone^power by pixel. */
+static double tone_at(const double *t, int w, int h, int k, int i, int j)
+{
+  if (k == 1) return t[(size_t)j * (size_t)w + (size_t)i];
+  const double u = fmin(fmax((i + 0.5) / k - 0.5, 0.0), w - 1.0), v = fmin(fmax((j + 0.5) / k - 0.5, 0.0), h - 1.0);
+  const int i0 = (int)fmin(floor(u), w - 2.0 < 0 ? 0 : w - 2.0), j0 = (int)fmin(floor(v), h - 2.0 < 0 ? 0 : h - 2.0);
+  const int i1 = i0 + (w > 1), j1 = j0 + (h > 1);
+  const double a = u - i0, b = v - j0;
+  const double *r0 = t + (size_t)j0 * (size_t)w, *r1 = t + (size_t)j1 * (size_t)w;
+  return (1.0 - b) * ((1.0 - a) * r0[i0] + a * r0[i1]) + b * ((1.0 - a) * r1[i0] + a * r1[i1]);
+}
 
 lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, double sigma,
                                    int paper, lw_error *err)
 {
-  const int w = img->width, h = img->height;
+  const int k = refine(img->width, img->height, pl->pixel);
+  const int w = img->width * k, h = img->height * k;
+  const double node = pl->pixel / k;
+  sigma *= k;
+  /* tone^power by pixel */
+  const size_t n_px = (size_t)img->width * (size_t)img->height;
+  double *t = malloc(n_px * sizeof *t);
+  if (!t) {
+    lw_error_set(err, LW_ENOMEM, "out of memory for a potential of %d x %d pixels", img->width, img->height);
+    return NULL;
+  }
+  for (size_t q = 0; q < n_px; q++) t[q] = power == 1.0 ? img->tone[q] : pow(img->tone[q], power);
   /* blurred, the picture is blurred on its paper: white as far as the blur
   ** reaches, so Phi rises to 1 beyond the picture without a step; without
   ** the paper the blur repeats the edge pixels and the ring continues them */
   const int m = sigma > 0.0 && paper ? (int)fmin(ceil(4.0 * sigma) + 1.0, POTENTIAL_PAD_MAX) : 0;
   const int pw = w + 2 * m, ph = h + 2 * m, W = pw + 2, H = ph + 2;
-  /* node (i, j) is the centre of pixel (i - 1 - m, j - 1 - m); the outer ring
-  ** is white, or blurred continues the padded plane */
-  lw_grid2d *g = lw_grid2d_new(W, H, 1, pl->x0 - (m + 0.5) * pl->pixel, pl->y0 - (m + 0.5) * pl->pixel, pl->pixel,
-                               pl->pixel, err);
-  if (!g) return NULL;
+  /* node (i, j) is the centre of fine pixel (i - 1 - m, j - 1 - m); the outer
+  ** ring is white, or blurred continues the padded plane */
+  lw_grid2d *g = lw_grid2d_new(W, H, 1, pl->x0 - (m + 0.5) * node, pl->y0 - (m + 0.5) * node, node, node, err);
   /* blurred, Phi goes through the blur's float plane; else straight in */
   float *phi = NULL;
-  if (sigma > 0.0) {
+  if (g && sigma > 0.0) {
     if (!(phi = malloc((size_t)pw * (size_t)ph * sizeof *phi))) {
       lw_error_set(err, LW_ENOMEM, "out of memory for a potential of %d x %d pixels", pw, ph);
-      lw_grid2d_free(g);
-      return NULL;
-    }
-    for (int j = 0; j < ph; j++)
-      for (int i = 0; i < pw; i++) {
-        const int x = i - m, y = j - m;
-        const float t = x >= 0 && x < w && y >= 0 && y < h ? img->tone[(size_t)y * (size_t)w + (size_t)x] : 1.0f;
-        phi[(size_t)j * (size_t)pw + (size_t)i] = (float)(power == 1.0 ? t : pow(t, power));
+    } else {
+      for (int j = 0; j < ph; j++)
+        for (int i = 0; i < pw; i++) {
+          const int x = i - m, y = j - m;
+          phi[(size_t)j * (size_t)pw + (size_t)i] =
+              x >= 0 && x < w && y >= 0 && y < h ? (float)tone_at(t, img->width, img->height, k, x, y) : 1.0f;
+        }
+      if (lw_image_blur_plane(phi, pw, ph, sigma, err)) {
+        free(phi);
+        phi = NULL;
       }
-    if (lw_image_blur_plane(phi, pw, ph, sigma, err)) {
-      free(phi);
+    }
+    if (!phi) {
       lw_grid2d_free(g);
-      return NULL;
+      g = NULL;
     }
   }
-  for (int j = 0; j < H; j++)
+  for (int j = 0; g && j < H; j++)
     for (int i = 0; i < W; i++) {
       const int inner = i >= 1 && i <= w && j >= 1 && j <= h;
       double v = 1.0;
@@ -53,12 +98,12 @@ lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl
         const int ii = i < 1 ? 0 : (i > pw ? pw - 1 : i - 1), jj = j < 1 ? 0 : (j > ph ? ph - 1 : j - 1);
         v = phi[(size_t)jj * (size_t)pw + (size_t)ii];
       } else if (inner) {
-        const float t = img->tone[(size_t)(j - 1) * (size_t)w + (size_t)(i - 1)];
-        v = power == 1.0 ? t : pow(t, power);
+        v = tone_at(t, img->width, img->height, k, i - 1, j - 1);
       }
       g->data[(size_t)j * W + (size_t)i] = v;
     }
   free(phi);
+  free(t);
   return g;
 }
 

@@ -212,7 +212,10 @@ const lw_param_def lw_param_table[] = {
   NUM("energy", "potential", LW_PT_DOUBLE, potential_coef, "0", "energy / mm", -1e12, 1e12, 0,
       "Q: potential Q * integral of Phi dl draws lines to low Phi (dark tone). 0 = off."),
   NUM("energy", "field", LW_PT_DOUBLE, field_coef, "0", "energy / mm", -1e12, 1e12, 0,
-      "P: field P * integral of r'.v ds; negative P rewards alignment with v. 0 = off."),
+      "P: field P * integral of r'.v ds; negative P rewards alignment with v. 0 = off. It pays per "
+      "millimetre of aligned line, so a |P| far above the strain and bending weights buys length: "
+      "on a vortex with strain 20 and bending 2, P = -10 drew clean circles (alignment 0.9999), "
+      "-100 longer crossing arcs (0.978)."),
   CHOICE("energy", "field_mode", field_mode, "axial", "axial|signed",
          "axial integrates |r'.v| (lines have no direction); signed integrates r'.v."),
   NUM("energy", "pair", LW_PT_DOUBLE, pair, "0", "energy / mm", 0, 1e12, 0,

@@ -149,6 +149,49 @@ Test(imagefield, potential_is_the_tone_and_white_beyond_the_picture)
   lw_image_free(img);
 }
 
+/* Pixels wider than a millimetre are read through a finer grid (an odd
+** number of nodes a pixel, so that the pixel centres are nodes): Phi is the
+** bilinear reading between the centres as before, and the picture's edge
+** pixels keep their tone out to the picture's edge, where it turns white
+** within a node.  With a node a pixel a picture of one pixel 50 mm wide
+** faded to white from its centre, a pyramid the anneal drew as a blob. */
+Test(imagefield, a_picture_of_wide_pixels_keeps_its_tone_to_its_edge)
+{
+  lw_image *img = lw_image_new(1, 1, 0, NULL);
+  img->tone[0] = 0.3f;
+  lw_image_place pl = {10, 20, 50};
+  lw_potential f = {.kind = LW_POTENTIAL_GRID};
+  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, 1, NULL);
+  cr_assert_not_null(f.grid);
+  cr_assert(f.grid->hx <= 1.0 && f.grid->hx > 0.9, "node spacing %g", f.grid->hx);
+  for (double x = 10.5; x < 60; x += 1.0)
+    for (double y = 20.5; y < 70; y += 7.0)
+      cr_assert(fabs(lw_potential_eval(&f, x, y) - 0.3) < 1e-6, "Phi(%g, %g) = %g", x, y, lw_potential_eval(&f, x, y));
+  cr_assert(lw_potential_eval(&f, 61, 45) == 1.0 && lw_potential_eval(&f, 35, 19) == 1.0, "white a node beyond");
+  lw_potential_clear(&f);
+  lw_image_free(img);
+  /* two pixels 3 mm wide, 0.2 and 0.8: 3 nodes a pixel, the centres' tones
+  ** at the centres and the line between them as before; the outer halves
+  ** of the pixels keep their tones */
+  img = lw_image_new(2, 1, 0, NULL);
+  img->tone[0] = 0.2f, img->tone[1] = 0.8f;
+  pl = (lw_image_place){0, 0, 3};
+  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, 1, NULL);
+  cr_assert_not_null(f.grid);
+  cr_assert_float_eq(f.grid->hx, 1.0, 1e-12);
+  const double at[][2] = {{1.5, 0.2}, {4.5, 0.8}, {3.0, 0.5}, {2.25, 0.35}, {0.5, 0.2}, {5.5, 0.8}};
+  for (size_t q = 0; q < sizeof at / sizeof *at; q++)
+    cr_assert(fabs(lw_potential_eval(&f, at[q][0], 1.5) - at[q][1]) < 1e-6, "Phi(%g) = %g", at[q][0],
+              lw_potential_eval(&f, at[q][0], 1.5));
+  lw_potential_clear(&f);
+  /* pixels of a millimetre or less: a node a pixel, as before */
+  pl.pixel = 1.0;
+  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, 1, NULL);
+  cr_assert(f.grid->nx == 4 && f.grid->ny == 3 && f.grid->hx == 1.0);
+  lw_potential_clear(&f);
+  lw_image_free(img);
+}
+
 Test(imagefield, a_blurred_potential_spreads_phi_and_keeps_its_sum)
 {
   /* scene.potential_blur: one white pixel on black, power 8, blurred by 2
