@@ -46,9 +46,9 @@ static double tone_at(const double *t, int w, int h, int k, int i, int j)
 }
 
 lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, double sigma,
-                                   int paper, lw_error *err)
+                                   int paper, int fine, lw_error *err)
 {
-  const int k = refine(img->width, img->height, pl->pixel);
+  const int k = fine ? refine(img->width, img->height, pl->pixel) : 1;
   const int w = img->width * k, h = img->height * k;
   const double node = pl->pixel / k;
   sigma *= k;

@@ -152,6 +152,12 @@ const lw_param_def lw_param_table[] = {
       "1 beyond its edge (no line lies off the picture for free); 0 = the blur continues the picture's "
       "edge pixels beyond it, as runs before 2026-12-06 did (a run of theirs, whose scene.ini has no "
       "line for this key, resumes so; docs/NUMERICS.md, \"The potential between the nodes\")."),
+  NUM("scene", "potential_fine", LW_PT_INT, potential_fine, "1", "", 0, 1, 0,
+      "potential = image: 1 = where a pixel is wider than 1 mm on the page, Phi lies on a finer grid "
+      "(nodes no more than 1 mm apart), and the picture's edge pixels keep their tone out to its edge; "
+      "0 = a node a pixel, Phi turning white from the edge pixels' centres, as runs before this key "
+      "(a picture of one wide pixel was a pyramid; a run of theirs, whose scene.ini has no line for "
+      "this key, resumes so; docs/IMAGES.md)."),
   CHOICE("scene", "field", field, "constant", "constant|radial|vortex|waves|etf|gradient",
          "Vector field v read by the field term (unit length): constant along `field_angle`, "
          "radial from the centre, vortex around it (v = (-(y - cy), x - cx) / r: clockwise as seen on "

@@ -480,6 +480,13 @@ static int potential_paper(const lw_params *p)
   return p->potential_paper && !before;
 }
 
+/* The same for the finer grid of wide pixels (scene.potential_fine). */
+static int potential_fine(const lw_params *p)
+{
+  const int before = p->run_written && !lw_params_line(p, "scene", "potential_fine");
+  return p->potential_fine && !before;
+}
+
 /* The layers' targets, fields, potentials and tone rasters (layers.h). */
 static lw_status build_layers(lw_scene *sc, const lw_params *p, lw_error *err)
 {
@@ -513,7 +520,7 @@ static lw_status build_layers(lw_scene *sc, const lw_params *p, lw_error *err)
       if (sc->potential.kind == LW_POTENTIAL_GRID &&
           !(l->potential.grid = lw_imagefield_potential(l->target, &sc->image_place, p->potential_power,
                                                         p->potential_blur / sc->image_place.pixel,
-                                                        potential_paper(p), err)))
+                                                        potential_paper(p), potential_fine(p), err)))
         return err->code;
     }
     if (sc->on[LW_TERM_TONE]) {
@@ -554,7 +561,8 @@ static lw_status build_potential(lw_scene *sc, const lw_params *p, double cx, do
     if (!sc->image) return bad_key(p, "scene", "potential", LW_EINPUT, err, "'image' needs scene.image");
     f->kind = LW_POTENTIAL_GRID;
     if (!(f->grid = lw_imagefield_potential(sc->image, &sc->image_place, p->potential_power,
-                                            p->potential_blur / sc->image_place.pixel, potential_paper(p), err)))
+                                            p->potential_blur / sc->image_place.pixel, potential_paper(p),
+                                            potential_fine(p), err)))
       return err->code;
     break;
   }

@@ -1398,7 +1398,8 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
                                       "layers.turn", NULL},
                            *const potential[] = {"scene.potential", "scene.potential_value", "scene.potential_angle",
                                                  "scene.potential_scale", "scene.potential_power",
-                                                 "scene.potential_blur", "scene.potential_paper", NULL},
+                                                 "scene.potential_blur", "scene.potential_paper",
+                                                 "scene.potential_fine", NULL},
                            *const angle[] = {"scene.field_angle", NULL}, *const sigma[] = {"scene.field_sigma", NULL},
                            *const flat[] = {"scene.field_flat", NULL},
                            *const waves[] = {"scene.field_wavelength", "scene.field_amplitude", NULL},
@@ -1406,7 +1407,7 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
                            *const ramp[] = {"scene.potential_angle", NULL},
                            *const scale[] = {"scene.potential_scale", NULL},
                            *const picture[] = {"scene.potential_power", "scene.potential_blur",
-                                               "scene.potential_paper", NULL},
+                                               "scene.potential_paper", "scene.potential_fine", NULL},
                            *const paper[] = {"scene.potential_paper", NULL},
                            *const centre[] = {"scene.center_x", "scene.center_y", NULL},
                            *const core[] = {"scene.field_core", NULL};

@@ -131,7 +131,7 @@ Test(imagefield, potential_is_the_tone_and_white_beyond_the_picture)
   for (int k = 0; k < 35; k++) img->tone[k] = (float)urand(0, 1);
   lw_image_place pl = {3, 4, 2};
   lw_potential f = {.kind = LW_POTENTIAL_GRID};
-  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, 1, NULL);
+  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, 1, 1, NULL);
   for (int j = 0; j < 5; j++)
     for (int i = 0; i < 7; i++)
       cr_assert(fabs(lw_potential_eval(&f, 3 + 2 * (i + 0.5), 4 + 2 * (j + 0.5)) - img->tone[j * 7 + i]) < 1e-7);
@@ -139,7 +139,7 @@ Test(imagefield, potential_is_the_tone_and_white_beyond_the_picture)
   cr_assert(lw_potential_eval(&f, 3 + 14 + 1, 9) == 1.0, "a pixel beyond the right edge is white");
   lw_potential_clear(&f);
   /* scene.potential_power: Phi = tone^power, white still 1 */
-  f.grid = lw_imagefield_potential(img, &pl, 3.0, 0.0, 1, NULL);
+  f.grid = lw_imagefield_potential(img, &pl, 3.0, 0.0, 1, 1, NULL);
   for (int j = 0; j < 5; j++)
     for (int i = 0; i < 7; i++)
       cr_assert(fabs(lw_potential_eval(&f, 3 + 2 * (i + 0.5), 4 + 2 * (j + 0.5)) - pow(img->tone[j * 7 + i], 3)) <
@@ -161,13 +161,18 @@ Test(imagefield, a_picture_of_wide_pixels_keeps_its_tone_to_its_edge)
   img->tone[0] = 0.3f;
   lw_image_place pl = {10, 20, 50};
   lw_potential f = {.kind = LW_POTENTIAL_GRID};
-  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, 1, NULL);
+  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, 1, 1, NULL);
   cr_assert_not_null(f.grid);
   cr_assert(f.grid->hx <= 1.0 && f.grid->hx > 0.9, "node spacing %g", f.grid->hx);
   for (double x = 10.5; x < 60; x += 1.0)
     for (double y = 20.5; y < 70; y += 7.0)
       cr_assert(fabs(lw_potential_eval(&f, x, y) - 0.3) < 1e-6, "Phi(%g, %g) = %g", x, y, lw_potential_eval(&f, x, y));
   cr_assert(lw_potential_eval(&f, 61, 45) == 1.0 && lw_potential_eval(&f, 35, 19) == 1.0, "white a node beyond");
+  lw_potential_clear(&f);
+  /* scene.potential_fine = 0 (and a run begun before it): a node a pixel */
+  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, 1, 0, NULL);
+  cr_assert(f.grid->nx == 3 && f.grid->ny == 3 && f.grid->hx == 50.0);
+  cr_assert_float_eq(lw_potential_eval(&f, 10.0, 45.0), 0.65, 1e-6);
   lw_potential_clear(&f);
   lw_image_free(img);
   /* two pixels 3 mm wide, 0.2 and 0.8: 3 nodes a pixel, the centres' tones
@@ -176,7 +181,7 @@ Test(imagefield, a_picture_of_wide_pixels_keeps_its_tone_to_its_edge)
   img = lw_image_new(2, 1, 0, NULL);
   img->tone[0] = 0.2f, img->tone[1] = 0.8f;
   pl = (lw_image_place){0, 0, 3};
-  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, 1, NULL);
+  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, 1, 1, NULL);
   cr_assert_not_null(f.grid);
   cr_assert_float_eq(f.grid->hx, 1.0, 1e-12);
   const double at[][2] = {{1.5, 0.2}, {4.5, 0.8}, {3.0, 0.5}, {2.25, 0.35}, {0.5, 0.2}, {5.5, 0.8}};
@@ -186,7 +191,7 @@ Test(imagefield, a_picture_of_wide_pixels_keeps_its_tone_to_its_edge)
   lw_potential_clear(&f);
   /* pixels of a millimetre or less: a node a pixel, as before */
   pl.pixel = 1.0;
-  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, 1, NULL);
+  f.grid = lw_imagefield_potential(img, &pl, 1.0, 0.0, 1, 1, NULL);
   cr_assert(f.grid->nx == 4 && f.grid->ny == 3 && f.grid->hx == 1.0);
   lw_potential_clear(&f);
   lw_image_free(img);
@@ -207,7 +212,7 @@ Test(imagefield, a_blurred_potential_spreads_phi_and_keeps_its_sum)
   img->tone[10 * 21 + 10] = 1.0f;
   lw_image_place pl = {0, 0, 1};
   lw_potential f = {.kind = LW_POTENTIAL_GRID};
-  f.grid = lw_imagefield_potential(img, &pl, 8.0, 2.0, 1, NULL);
+  f.grid = lw_imagefield_potential(img, &pl, 8.0, 2.0, 1, 1, NULL);
   cr_assert_not_null(f.grid);
   double dark = 0.0;
   for (int j = -12; j < 33; j++)
@@ -227,7 +232,7 @@ Test(imagefield, a_blurred_potential_spreads_phi_and_keeps_its_sum)
   lw_potential_clear(&f);
   /* without the paper (scene.potential_paper = 0, runs before 2026-12-06)
   ** the blur repeats the edge and Phi continues it: black beyond */
-  f.grid = lw_imagefield_potential(img, &pl, 8.0, 2.0, 0, NULL);
+  f.grid = lw_imagefield_potential(img, &pl, 8.0, 2.0, 0, 1, NULL);
   cr_assert_not_null(f.grid);
   cr_assert(lw_potential_eval(&f, -50, 3) < 1e-6 &&
                 lw_potential_eval(&f, -0.5, 10.5) == lw_potential_eval(&f, 0.5, 10.5),

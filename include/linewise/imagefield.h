@@ -51,9 +51,13 @@ extern "C" {
 ** beyond the picture without a step between two quadrature nodes.  With
 ** paper 0 the blur repeats the picture's edge pixels and Phi continues the
 ** edge beyond it (as before 2026-12-06: a line beyond a dark edge costs
-** nothing there). */
+** nothing there).  With fine, where a pixel is wider than 1 mm the grid has
+** an odd number of nodes a pixel, no more than 1 mm apart (at most 4
+** million nodes): the same bilinear reading between the pixel centres, and
+** the edge pixels' tone out to the picture's edge; without, a node a pixel
+** (as before 2026-12-06: Phi turned white from the edge pixels' centres). */
 lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, double sigma,
-                                   int paper, lw_error *err);
+                                   int paper, int fine, lw_error *err);
 
 /* angle: the fallback direction, radians (0 = +x, pi/2 = +y, down). */
 lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, double sigma_mm, double flat,

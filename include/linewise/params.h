@@ -104,6 +104,7 @@ typedef struct {
   double potential_power;     /* potential = image: Phi = tone^power */
   double potential_blur;      /* potential = image: sigma of Phi's blur, mm; 0 = none */
   int potential_paper;        /* 1: the blur reads white paper beyond the picture; 0: its edge continued */
+  int potential_fine;         /* 1: pixels wider than 1 mm read through a finer grid; 0: a node a pixel */
   int field;                  /* LW_FLD_* */
   double field_angle;         /* constant field direction (etf fallback), degrees */
   double field_sigma;         /* etf tensor smoothing, mm */
