@@ -1046,6 +1046,24 @@ static int reflect(long i, int n)
   return (int)(m < n ? m : 2L * n - 1 - m);
 }
 
+/* Inside a parallel region: whether some thread of the team lacks what it
+** needed (has 0), the same answer on every thread, so that they all go into
+** the region's work-sharing loops or none does (a thread whose scratch
+** failed skipped the loops the others waited in: undefined in OpenMP, a
+** hang where it ends); *failed, shared, is set. */
+static int team_lacks(int has, int *failed)
+{
+  if (!has) {
+#pragma omp atomic write
+    *failed = 1;
+  }
+#pragma omp barrier
+  int any;
+#pragma omp atomic read
+  any = *failed;
+  return any;
+}
+
 /* One axis of the blur over `count` lines of length n: element i of line l
 ** sits at p[l * lstride + i * estride], and
 **     out[x] = sum_t kern[t] ext[x + t],   ext[i] = line[reflect(i - off)].
@@ -1056,11 +1074,10 @@ static lw_status blur_axis(float *p, int n, int count, size_t estride, size_t ls
                            int taps, int off)
 {
   int failed = 0;
-#pragma omp parallel reduction(| : failed)
+#pragma omp parallel
   {
     float *ext = malloc(((size_t)n + (size_t)taps) * sizeof *ext);
-    failed = !ext;
-    if (ext) {
+    if (!team_lacks(ext != NULL, &failed)) {
 #pragma omp for schedule(static)
       for (int l = 0; l < count; l++) {
         float *q = p + (size_t)l * lstride;
@@ -1167,12 +1184,11 @@ static lw_status blur_sparse(float *plane, int w, int h, const double *kx, int t
   int failed = !rows || !grid || !wx;
   if (!failed) {
     for (int x = 0; x < w; x++) lw_image_cubic_weights((double)(x % f) / f, wx + 4 * (size_t)x);
-#pragma omp parallel reduction(| : failed)
+#pragma omp parallel
     {
       const int longest = (w > h ? w : h) + 3 * f + (tx > ty ? tx : ty);
       float *ext = malloc((size_t)longest * sizeof *ext);
-      failed = !ext;
-      if (!failed) {
+      if (!team_lacks(ext != NULL, &failed)) {
         /* rows at every f-th column, then those columns at every f-th row */
 #pragma omp for schedule(static)
         for (int y = 0; y < h; y++)

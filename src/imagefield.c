@@ -15,6 +15,13 @@
 #define POTENTIAL_NODE_MM 1.0
 #define POTENTIAL_NODES_MAX (4L << 20)
 
+/* The white paper around a picture blurred by sigma nodes, k nodes a pixel,
+** in nodes (0 without the paper). */
+static int pad(double sigma, int k, int paper)
+{
+  return sigma > 0.0 && paper ? (int)fmin(ceil(4.0 * sigma) + 1.0, (double)POTENTIAL_PAD_MAX * k) : 0;
+}
+
 /* The nodes a side of each pixel: 1, or where a pixel is wider than
 ** POTENTIAL_NODE_MM the odd count that brings the nodes that close (odd, so
 ** that the pixel centres are nodes and the bilinear reading of the picture
@@ -23,11 +30,13 @@
 ** pixels' centres: with a node a pixel a picture of a few pixels 89 mm wide
 ** faded to white from its one pixel's centre, a pyramid, where its pixel is
 ** a square of its tone. */
-static int refine(int w, int h, double pixel)
+static int refine(int w, int h, double pixel, double sigma, int paper)
 {
   int k = (int)fmin(ceil(pixel / POTENTIAL_NODE_MM), 4097.0);
   k += !(k & 1);
-  while (k > 1 && ((long)w * k + 2) * ((long)h * k + 2) > POTENTIAL_NODES_MAX) k -= 2;
+  while (k > 1 && ((long)w * k + 2 * pad(sigma * k, k, paper) + 2) * ((long)h * k + 2 * pad(sigma * k, k, paper) + 2) >
+                      POTENTIAL_NODES_MAX)
+    k -= 2;
   return k;
 }
 
@@ -48,7 +57,7 @@ static double tone_at(const double *t, int w, int h, int k, int i, int j)
 lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, double sigma,
                                    int paper, int fine, lw_error *err)
 {
-  const int k = fine ? refine(img->width, img->height, pl->pixel) : 1;
+  const int k = fine ? refine(img->width, img->height, pl->pixel, sigma, paper) : 1;
   const int w = img->width * k, h = img->height * k;
   const double node = pl->pixel / k;
   sigma *= k;
@@ -63,7 +72,7 @@ lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl
   /* blurred, the picture is blurred on its paper: white as far as the blur
   ** reaches, so Phi rises to 1 beyond the picture without a step; without
   ** the paper the blur repeats the edge pixels and the ring continues them */
-  const int m = sigma > 0.0 && paper ? (int)fmin(ceil(4.0 * sigma) + 1.0, POTENTIAL_PAD_MAX) : 0;
+  const int m = pad(sigma, k, paper);
   const int pw = w + 2 * m, ph = h + 2 * m, W = pw + 2, H = ph + 2;
   /* node (i, j) is the centre of fine pixel (i - 1 - m, j - 1 - m); the outer
   ** ring is white, or blurred continues the padded plane */

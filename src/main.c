@@ -1198,17 +1198,15 @@ static int cmd_stats(int argc, char **argv)
   if (!err.code && !path) lw_error_set(&err, LW_ENOMEM, "out of memory");
   static lw_params p;
   int failed = -1, other_driver = -1; /* the run an error is of; the first run of another driver than run 0's */
-  char driver0[sizeof p.driver] = "", driver1[sizeof p.driver] = "";
+  /* each run's driver, compared once the runs left out are gone */
+  char(*driver)[sizeof p.driver] = path ? calloc((size_t)k, sizeof *driver) : NULL;
+  if (!err.code && !driver) lw_error_set(&err, LW_ENOMEM, "out of memory");
   for (int r = 0; !err.code && r < k; r++) {
     char where[LW_PATH_MAX + 32];
     lw_path_join(where, sizeof where, dir[r], "scene.ini");
     failed = r;
     if (lw_params_read_run(&p, where, 1, &err)) break;
-    if (!r) snprintf(driver0, sizeof driver0, "%s", p.driver);
-    else if (other_driver < 0 && strcmp(p.driver, driver0)) {
-      other_driver = r;
-      snprintf(driver1, sizeof driver1, "%s", p.driver);
-    }
+    snprintf(driver[r], sizeof driver[r], "%s", p.driver);
     sel[r] = base;
     lw_trace_select_of(&p, &sel[r]);
     lw_path_join(where, sizeof where, dir[r], "trace.csv");
@@ -1236,11 +1234,14 @@ static int cmd_stats(int argc, char **argv)
       memmove(t + r, t + r + 1, (size_t)(k - r - 1) * sizeof *t);
       memmove(sel + r, sel + r + 1, (size_t)(k - r - 1) * sizeof *sel);
       memmove(path + r, path + r + 1, (size_t)(k - r - 1) * sizeof *path);
+      memmove(driver + r, driver + r + 1, (size_t)(k - r - 1) * sizeof *driver);
       t[k - 1] = NULL, path[k - 1] = NULL;
       k--, r--;
     }
     free(rows);
   }
+  for (int r = 1; !err.code && other_driver < 0 && r < k; r++)
+    if (strcmp(driver[r], driver[0])) other_driver = r;
   if (!err.code) {
     failed = -1;
     /* with --csv the warnings no column carries go to stderr, a line each */
@@ -1265,7 +1266,7 @@ static int cmd_stats(int argc, char **argv)
     if (!err.code && other_driver >= 0)
       fprintf(stderr, "linewise: note: the runs ran under different drivers (%s: %s, %s: %s): their means sample one "
               "distribution, their acceptances, steps and autocorrelation times are each of its own chain\n", dir[0],
-              driver0, dir[other_driver], driver1);
+              driver[0], dir[other_driver], driver[other_driver]);
   }
   /* (the run the error is of may wait aside: "no rows yet" of the run that
   ** was killed replacing it said nothing of it); a statistics' error begins
@@ -1277,6 +1278,7 @@ static int cmd_stats(int argc, char **argv)
     lw_trace_free(t[r]);
     free(path[r]);
   }
+  free(driver);
   free(path);
   free(sel);
   free(t);

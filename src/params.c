@@ -734,7 +734,8 @@ const lw_param_def lw_param_table[] = {
       "Energy of each particle, the term chem N (minus the chemical potential, against a "
       "density of one particle per r0^3): higher makes fewer. 0 = off."),
   NUM("particles", "max_count", LW_PT_INT, pt_max_count, "100000", "", 1, 1e7, 0,
-      "Births stop at this many particles. With births or deaths the cell grid is sized for this many "
+      "Births stop at this many particles (a start above it is said before the run: no birth until deaths "
+      "bring the count under it). With births or deaths the cell grid is sized for this many "
       "whatever the count (so that a resumed run adds in the same order): a start far above it runs slower."),
   NUM("dynamics", "rho", LW_PT_DOUBLE, dyn_rho, "1", "mass/mm", 0, 1e12, 0,
       "Line density rho of the kinetic energy (rho/2) int |dr/dt|^2 dl; for particles the mass of "

@@ -7,6 +7,7 @@
 #include <gsl/gsl_math.h>
 #include <gsl/gsl_randist.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -145,6 +146,11 @@ lw_particles_setup *lw_particles_setup_new(const lw_params *p, lw_error *err)
   s->view[2] = sin(el);
   s->png_size = p->pt_png_size;
   s->disc = p->pt_disc * p->pt_r0;
+  /* (a start above the cap is a state the chain leaves and never comes
+  ** back to: allowed, but said, since it was kept without a word) */
+  if (s->birth > 0.0 && s->n_points + s->count > s->max_count)
+    snprintf(s->note, sizeof s->note, "the start's %zu particles are more than particles.max_count = %zu: no birth "
+             "until deaths bring the count under it", s->n_points + s->count, s->max_count);
   setup_box(s);
   return s;
 fail:

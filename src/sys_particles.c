@@ -32,7 +32,7 @@ static void *setup_new(const lw_params *p, lw_error *err) { return lw_particles_
 
 static void setup_free(void *setup) { lw_particles_setup_free(setup); }
 
-static const char *note(const void *setup) { return ""; }
+static const char *note(const void *setup) { return ((const lw_particles_setup *)setup)->note; }
 
 /* The particles of the state [init] from names, if any, else the set-up's placement. */
 static void *state_new(const void *setup, const lw_params *p, unsigned long seed, lw_error *err)

@@ -166,10 +166,11 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err);
 ** the quenched state.  state.lw keeps the annealed state: the quench is a
 ** function of it, so a resumed run quenches to the same bytes, and a run
 ** resumed for more sweeps continues the chain as an uninterrupted longer
-** run would.  After it, whatever it returned, only lw_anneal_free: the
-** quench left the coldest replica quenched, and a checkpoint then would save
-** that state; lw_anneal_sweep, lw_anneal_checkpoint and lw_anneal_finish
-** refuse (LW_EUSAGE).  A start needs a zeroed or freed lw_anneal (a second
+** run would.  Once it has written that state.lw, whatever it returns, only
+** lw_anneal_free: the quench left the coldest replica quenched, and a
+** checkpoint then would save that state; lw_anneal_sweep,
+** lw_anneal_checkpoint and lw_anneal_finish refuse (LW_EUSAGE).  A finish
+** that failed before (the checkpoint's write) may be called again.  A start needs a zeroed or freed lw_anneal (a second
 ** start over a running one leaks it and keeps its directory locked). */
 lw_status lw_anneal_finish(lw_anneal *a, lw_error *err);
 

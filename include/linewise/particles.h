@@ -98,6 +98,7 @@ typedef struct {
   double chem;                  /* energy per particle */
   double birth, death;          /* mix weights; both 0: the count is fixed */
   size_t max_count;             /* births stop there */
+  char note[192];               /* for the command line before the run, or "" */
   /* preview */
   double view[3];               /* unit vector toward the viewer */
   int png_size;                 /* pixels */
