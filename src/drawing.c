@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "linewise/plotter.h"
 #include "linewise/spacing.h"
@@ -210,11 +211,20 @@ static lw_status close_share(const lw_params *p, const lw_scene *sc, const lw_st
 
 void lw_drawing_note(const lw_params *p, char *note, size_t n)
 {
+  if (!p->hpgl) return;
+  /* HP-GL/1 takes coordinates to 32,767 units: a page past that without a
+  ** bed to check against wrote them unsaid (an A1 page reached 33,642) */
+  const double reach = LW_HPGL_COORD_MAX / LW_HPGL_UNITS_PER_MM, side = fmax(p->width, p->height);
+  size_t used = strlen(note);
+  if (side > reach && !(p->plot_bed_w > 0.0 && p->plot_bed_h > 0.0) && used < n)
+    snprintf(note + used, n - used, "%sthe page is %g mm on its long side, past the %g mm (%g units) HP-GL/1 "
+             "coordinates reach: final.hpgl may hold points the plotter cannot take (plot.bed_width and "
+             "plot.bed_height, set to its reach, refuse those)", used ? "; " : "", side, reach, LW_HPGL_COORD_MAX);
   const double vs = p->speed_down / 10.0, asked = round(100.0 * fmin(fmax(vs, LW_HPGL_VS_MIN), LW_HPGL_VS_MAX)) / 100.0;
   /* VS has two decimals (0.1 mm/s): at a few mm/s its rounding is a few per
   ** cent (1.234 mm/s was written 1.2: 2.8 % slower than the plot time) */
-  if (!p->hpgl || fabs(asked - vs) <= 0.01 * vs) return;
-  size_t used = strlen(note);
+  if (fabs(asked - vs) <= 0.01 * vs) return;
+  used = strlen(note);
   const int past = vs < LW_HPGL_VS_MIN || vs > LW_HPGL_VS_MAX;
   if (used < n)
     snprintf(note + used, n - used, "%splot.speed_down = %g mm/s is %s (%g to %g mm/s, in steps of 0.1): final.hpgl "
@@ -293,8 +303,14 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
     lw_path_join(path, sizeof path, dir, g ? "final.gcode" : "final.hpgl");
     if ((s = lw_plotter_check(st, &page, &po, g, path, err)) && err) {
       size_t n = strlen(err->msg);
-      snprintf(err->msg + n, sizeof err->msg - n, "; no drawing was written, and the annealed state is in "
-               "%s/state.lw: redraw it with other plot keys (docs/FORMATS.md, \"Redrawing a finished run\")", dir);
+      /* (a resumed run's end: the files of its earlier end stay, and a
+      ** plotter was sent a final.gcode its state.lw had moved on from) */
+      char svg[LW_OUTPUT_PATH_MAX];
+      lw_path_join(svg, sizeof svg, dir, "final.svg");
+      snprintf(err->msg + n, sizeof err->msg - n, "; no drawing was written%s, and the annealed state is in "
+               "%s/state.lw: redraw it with other plot keys (docs/FORMATS.md, \"Redrawing a finished run\")",
+               access(svg, F_OK) ? "" : " (the final files there are of the run's earlier end, not of this state)",
+               dir);
     }
   }
   if (s) {

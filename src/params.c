@@ -609,7 +609,9 @@ const lw_param_def lw_param_table[] = {
          "plot.speed_up), for machines whose rapids shake a lifted pen or outrun its servo."),
   STRING("plot", "gcode_pen_up", gcode_pen_up, "G0 Z5", "",
          "The G-code line that lifts the pen in final.gcode, written as it is: `G0 Z5` for a pen on the "
-         "Z axis, `M5` or `M3 S30` for a servo on a GRBL fork. One line of printable ASCII."),
+         "Z axis, `M5` or `M3 S30` for a servo on a GRBL fork. One line of printable ASCII. It comes before "
+         "any feed is set: a G1 here needs its own F (GRBL refuses G1 without one, error 22), and GRBL "
+         "takes lines of up to 79 characters (spaces and comments aside)."),
   STRING("plot", "gcode_pen_down", gcode_pen_down, "G1 Z0 F500", "",
          "The G-code line that lowers the pen in final.gcode, written as it is (a feed it sets is "
          "replaced by plot.speed_down on the first drawing move); e.g. `M3 S90 G4 P0.2` for a servo "

@@ -97,12 +97,25 @@ static extent reach(const lw_strokes *s, const lw_output_page *page, const lw_pl
   return e;
 }
 
-/* The axis (0, 1) along which e leaves the bed, or -1. */
-static int off_bed(const extent *e, const double bed[2])
+/* The first axis (0, 1) from `from` on along which e leaves the bed, or -1. */
+static int off_bed(const extent *e, const double bed[2], int from)
 {
-  for (int k = 0; k < 2; k++)
+  for (int k = from; k < 2; k++)
     if (bed[k] > 0.0 && !(e->lo[k] >= -BED_SLACK && e->hi[k] <= bed[k] + BED_SLACK)) return k;
   return -1;
+}
+
+/* Where e leaves the bed along axis k, into buf. */
+static void past_bed(const extent *e, const double bed[2], int k, char *buf, size_t n)
+{
+  /* below 0 is past the machine's origin, not its bed's far side (a
+  ** stroke at x = -3 was blamed on the bed's width) */
+  if (e->lo[k] < -BED_SLACK)
+    snprintf(buf, n, "%c = %.3f to %.3f mm on the machine, past its origin (%c below 0)", "xy"[k], e->lo[k], e->hi[k],
+             "xy"[k]);
+  else
+    snprintf(buf, n, "%c = %.3f to %.3f mm on the machine, past its bed of %g mm (plot.bed_%s)", "xy"[k], e->lo[k],
+             e->hi[k], bed[k], k ? "height" : "width");
 }
 
 lw_status lw_plotter_check(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o, int gcode,
@@ -121,20 +134,22 @@ lw_status lw_plotter_check(const lw_strokes *s, const lw_output_page *page, cons
                           "expected at most %g", path, k / 8, fabs(s->b[k]), LW_PLOTTER_MM_MAX);
   if (o->bed[0] > 0.0 || o->bed[1] > 0.0) {
     extent e = reach(s, page, o, o->turn);
-    int k = off_bed(&e, o->bed);
+    int k = off_bed(&e, o->bed, 0);
     if (k >= 0) {
       /* the other turn only where the drawing would fit the bed with it */
       extent t = reach(s, page, o, !o->turn);
       char turn[64] = "";
-      if (off_bed(&t, o->bed) < 0) snprintf(turn, sizeof turn, " or the other turn (plot.turn = %d)", o->turn ? 0 : 90);
-      /* below 0 is past the machine's origin, not its bed's far side (a
-      ** stroke at x = -3 was blamed on the bed's width) */
-      char past[96];
-      if (e.lo[k] < -BED_SLACK) snprintf(past, sizeof past, "past its origin (%c below 0)", "xy"[k]);
-      else snprintf(past, sizeof past, "past its bed of %g mm (plot.bed_%s)", o->bed[k], k ? "height" : "width");
-      return lw_error_set(err, LW_EINPUT, "%s: the drawing reaches %c = %.3f to %.3f mm on the machine, %s: expected "
-                          "plot.crop = 1 (which cuts the strokes to the page inside its margin)%s%s", path, "xy"[k],
-                          e.lo[k], e.hi[k], past, turn[0] ? ", a wider margin" : " or a wider margin", turn);
+      if (off_bed(&t, o->bed, 0) < 0)
+        snprintf(turn, sizeof turn, " or the other turn (plot.turn = %d)", o->turn ? 0 : 90);
+      /* both axes, where both are off (one named, then the other refused
+      ** once that was mended) */
+      char past[2][160] = {"", ""};
+      past_bed(&e, o->bed, k, past[0], sizeof past[0]);
+      const int k2 = off_bed(&e, o->bed, k + 1);
+      if (k2 >= 0) past_bed(&e, o->bed, k2, past[1], sizeof past[1]);
+      return lw_error_set(err, LW_EINPUT, "%s: the drawing reaches %s%s%s: expected plot.crop = 1 (which cuts the "
+                          "strokes to the page inside its margin)%s%s", path, past[0], k2 >= 0 ? ", and " : "",
+                          past[1], turn[0] ? ", a wider margin in a new run" : " or a wider margin in a new run", turn);
     }
   }
   if (!gcode) return LW_OK;

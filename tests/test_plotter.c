@@ -499,6 +499,13 @@ Test(plotter, a_drawing_past_the_bed_is_refused_and_travel_can_feed)
     cr_assert_eq(lw_plotter_check(s, &page, &o, 1, path, &err), LW_EINPUT);
     cr_assert(strstr(err.msg, "the drawing reaches x = -3.000 to 83.000 mm on the machine, past its origin (x below "
                               "0): expected plot.crop = 1"), "%s", err.msg);
+    /* past on both axes: both said (the second was refused once the first
+    ** was mended) */
+    o.bed[1] = 50;
+    cr_assert_eq(lw_plotter_check(s, &page, &o, 1, path, &err), LW_EINPUT);
+    cr_assert(strstr(err.msg, "past its origin (x below 0), and y = ") &&
+                  strstr(err.msg, "mm on the machine, past its bed of 50 mm (plot.bed_height): expected plot.crop = 1"),
+              "%s", err.msg);
   }
   for (size_t k = 0; k < s->n_segs; k++)
     for (int c = 0; c < 8; c += 2) s->b[8 * k + (size_t)c] += 8.0;
@@ -571,5 +578,21 @@ Test(plotter, a_page_past_the_bed_is_refused_before_the_run)
             strstr(err, "no drawing was written, and the annealed state is in "), "%s", err);
   free(err);
   cr_assert_eq(lw_test_sh("cd %s/t && test -s state.lw && ! ls final.* 2>/dev/null", dir), 0);
+  /* a resumed run whose end is refused so keeps the files of its earlier
+  ** end, and says they are not of this state (a plotter was sent them) */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set energy.boundary=0 --set "
+                          "scene.margin=0 --set anneal.t_start=5 --set anneal.t_end=1 --set anneal.sweeps=100 --quiet "
+                          "--out %s/u && sed -i 's/^bed_width = .*/bed_width = 100/; s/^crop = .*/crop = 0/' "
+                          "%s/u/scene.ini && %s resume %s/u --sweeps 5 --quiet 2> %s/err.txt", bin, root, dir, dir,
+                          bin, dir, dir), 1);
+  err = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(err, "no drawing was written (the final files there are of the run's earlier end, not of this "
+                        "state), and the annealed state is in "), "%s", err);
+  free(err);
+  cr_assert_eq(lw_test_sh("test -s %s/u/final.gcode", dir), 0, "nothing already written is lost");
+  /* a page past HP-GL/1's 32,767 units without a bed is said before the run */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set scene.width=900 --set scene.height=300 --set "
+                          "output.hpgl=1 --stop-at 0 --out %s/w 2>&1 | grep -q 'note: the page is 900 mm on its long "
+                          "side, past the 819.175 mm (32767 units) HP-GL/1 coordinates reach'", bin, root, dir), 0);
   lw_test_sh("rm -rf %s", dir);
 }

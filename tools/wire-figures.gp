@@ -10,7 +10,7 @@ set terminal pngcairo size 900,520 font 'sans,10'
 set grid
 set xlabel 't (s)'
 set ylabel 'height of the midpoint c(0.5) (m)'
-set key bottom right
+set key below
 
 set output sprintf('%s/nurbs-figure8.png', out)
 set title 'Elastic wire (review, Figure 8): midpoint from rest at y = 5, alpha 35, beta 10, mu 30, dt 0.008 s'
@@ -21,7 +21,7 @@ plot f('gamma0.dat') using 1:3 with lines lw 2 title 'gamma = 0, leapfrog', \
 
 set output sprintf('%s/nurbs-figure9.png', out)
 set xrange [0:8]
-set key bottom right opaque
+set key below
 set multiplot layout 1,2 title 'Sensitivity to alpha and beta (review, Figure 9): gamma = 0, leapfrog, dt 0.008 s'
 set title 'beta = 10'
 plot f('alpha10.dat') using 1:3 with lines title 'alpha = 10', \

@@ -53,6 +53,7 @@ extern "C" {
 #endif
 
 #define LW_HPGL_UNITS_PER_MM 40.0   /* HP-GL plotter units: 0.025 mm */
+#define LW_HPGL_COORD_MAX 32767.0   /* HP-GL/1's largest coordinate, units */
 #define LW_GCODE_DECIMALS 3         /* G-code coordinates: 0.001 mm */
 #define LW_PLOTTER_CHORDS_MAX 65536 /* chords of one segment at most */
 #define LW_HPGL_VS_MIN 0.01        /* HP-GL's VS, cm/s: 0 < v < 128 */
