@@ -235,7 +235,9 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
   if (p->image_levels > 0) {
     double lo, hi;
     const float *under = levels_under ? (cover ? cover : sc->image->alpha) : NULL;
-    if ((st = lw_image_levels(sc->image, under, p->image_levels, &lo, &hi, err))) {
+    /* (a run begun before the key: the clip's bin alone) */
+    const int tail = p->image_levels_flat && !(p->run_written && !lw_params_line(p, "scene", "image_levels_flat"));
+    if ((st = lw_image_levels(sc->image, under, p->image_levels, tail, &lo, &hi, err))) {
       free(cover);
       return st;
     }

@@ -138,11 +138,15 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
 ** LW_IMAGE_LEVELS_PLATEAU of the pixels, is not stretched: a graphic's
 ** flat colours would turn white or black whole (a logo's red disc, its
 ** lightest colour, vanished), where a photograph's ends are tails of a few
-** pixels a tone.  *lo and *hi receive the tones that became 0 and 1.
+** pixels a tone; with `tail`, also where such a tone has no more than
+** LW_IMAGE_LEVELS_PLATEAU of the pixels beyond it (anti-aliasing or a JPEG's
+** ringing past a flat colour; scene.image_levels_flat, 0 for runs begun
+** before it).  *lo and *hi receive the tones that became 0 and 1.
 ** LW_ENOMEM with err set. */
 #define LW_IMAGE_LEVELS_MIN_SPAN 0.05
 #define LW_IMAGE_LEVELS_PLATEAU 0.05
-lw_status lw_image_levels(lw_image *img, const float *under, double clip, double *lo, double *hi, lw_error *err);
+lw_status lw_image_levels(lw_image *img, const float *under, double clip, int tail, double *lo, double *hi,
+                          lw_error *err);
 
 /* The tone curve, in this order:
 **     t <- 1 - t                         if invert

@@ -96,6 +96,7 @@ typedef struct {
   double image_contrast;      /* tone curve slope about 1/2 */
   double image_levels;        /* auto levels: share clipped at each end; 0 = off */
   int image_levels_alpha;     /* 1: the levels are of the picture under its alpha; 0: of the composite */
+  int image_levels_flat;      /* 1: a flat colour with a thin tail beyond it keeps its end too */
   int image_invert;           /* 1 = t <- 1 - t first */
   int potential;              /* LW_POT_* */
   double potential_value;     /* constant Phi */
