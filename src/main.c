@@ -140,6 +140,35 @@ static const char *dash_hint(const char *arg)
   return buf;
 }
 
+/* " (did you mean 'X'?)" for the word of `list` (NULL-ended) nearest to a
+** word that is none of them, or "": a typed --sed or rnu said only "unknown". */
+static const char *nearest(const char *word, const char *const *list)
+{
+  static char buf[96];
+  const char *hit = NULL;
+  int best = 2 + (int)strlen(word) / 4; /* a suggestion is nearer than this */
+  for (; *list; list++) {
+    /* two letters swapped (rnu for run) are one slip, not two */
+    int d = lw_params_edit_distance(word, *list);
+    if (d == 2 && strlen(word) == strlen(*list)) {
+      int count[256] = {0}, same = 1;
+      for (const unsigned char *c = (const unsigned char *)word; *c; c++) count[*c]++;
+      for (const unsigned char *c = (const unsigned char *)*list; *c; c++) same &= --count[*c] >= 0;
+      if (same) d = 1;
+    }
+    if (d < best) best = d, hit = *list;
+  }
+  buf[0] = '\0';
+  if (hit) snprintf(buf, sizeof buf, " (did you mean '%s'?)", hit);
+  return buf;
+}
+
+static const char *const run_options[] = {"--out", "--seed", "--set", "--threads", "--stop-at", "--quiet", NULL},
+                         *const resume_options[] = {"--sweeps", "--stop-at", "--threads", "--quiet", NULL},
+                         *const stats_options[] = {"--from", "--to", "--csv", "--reweight", NULL},
+                         *const commands[] = {"run", "resume", "energy", "stats", "params", "schedules", "help",
+                                              "--help", "--version", NULL};
+
 /* A run directory's path must leave room for the names of the files in it
 ** (DIR/frames/frame-000000.png and the like): paths are held in
 ** LW_PATH_MAX bytes, and a longer one would be cut to another directory. */
@@ -889,8 +918,9 @@ static int cmd_run(int argc, char **argv)
       continue;
     }
     if (argv[i][0] == '-' && strcmp(argv[i], "--quiet")) {
-      lw_error_set(&err, LW_EUSAGE, "run: unknown option '%s' (try 'linewise --help')%s%s", argv[i],
-                   dash_hint(argv[i]), !strcmp(argv[i], "--sweeps") ? " (a run's length is --set anneal.sweeps=N; "
+      lw_error_set(&err, LW_EUSAGE, "run: unknown option '%s'%s (try 'linewise --help')%s%s", argv[i],
+                   strcmp(argv[i], "--sweeps") ? nearest(argv[i], run_options) : "", dash_hint(argv[i]),
+                   !strcmp(argv[i], "--sweeps") ? " (a run's length is --set anneal.sweeps=N; "
                    "--sweeps extends a finished run under resume)" : "");
       return fail(&err);
     }
@@ -1025,6 +1055,14 @@ static int cmd_run(int argc, char **argv)
     fprintf(stderr, "linewise: scene %s, seed %lu, %s, into %s\n", scene, a.seed, size, dir);
     fprintf(stderr, "linewise: resolved parameters:\n");
     lw_params_write(&a.params, stderr);
+  } else if (!out && (!net || !net->rank)) {
+    /* a directory chosen past out/<name>, which holds a run, said even
+    ** quiet: a later `stats out/<name>` read the earlier run unsaid */
+    const char *base = strrchr(scene, '/') ? strrchr(scene, '/') + 1 : scene;
+    char plain[LW_PATH_MAX];
+    snprintf(plain, sizeof plain, "out/%.*s", (int)strcspn(base, "."), base);
+    if (strcmp(dir, plain))
+      fprintf(stderr, "linewise: into %s (%s holds a run; --out names the directory)\n", dir, plain);
   }
   int rc = anneal_loop(&a, stop_at, quiet, asked, &w, &err);
   lw_anneal_free(&a);
@@ -1049,7 +1087,8 @@ static int cmd_resume(int argc, char **argv)
       if (used < 0) return fail(&err);
       if (used == 2) i++;
     } else if (argv[i][0] == '-' || dir) {
-      lw_error_set(&err, LW_EUSAGE, "resume: unexpected '%s' %s%s", argv[i], RESUME_USAGE, dash_hint(argv[i]));
+      lw_error_set(&err, LW_EUSAGE, "resume: unexpected '%s'%s %s%s", argv[i],
+                   argv[i][0] == '-' ? nearest(argv[i], resume_options) : "", RESUME_USAGE, dash_hint(argv[i]));
       return fail(&err);
     } else {
       dir = trim_slashes(argv[i]);
@@ -1138,7 +1177,8 @@ static int cmd_stats(int argc, char **argv)
       }
       i++;
     } else if (argv[i][0] == '-') {
-      lw_error_set(&err, LW_EUSAGE, "stats: unexpected '%s' %s%s", argv[i], use, dash_hint(argv[i]));
+      lw_error_set(&err, LW_EUSAGE, "stats: unexpected '%s'%s %s%s", argv[i], nearest(argv[i], stats_options), use,
+                   dash_hint(argv[i]));
       break;
     } else if (dir_fits("stats", argv[i], &err)) {
       break;
@@ -1556,6 +1596,6 @@ static int command(int argc, char **argv)
     lw_params_write_doc(stdout, lw_anneal_key_readers, lw_anneal_key_values);
     return 0;
   }
-  fprintf(stderr, "linewise: unknown command '%s' (try 'linewise --help')\n", argv[1]);
+  fprintf(stderr, "linewise: unknown command '%s'%s (try 'linewise --help')\n", argv[1], nearest(argv[1], commands));
   return 2;
 }

@@ -866,10 +866,7 @@ static int section_known(const char *section)
   return 0;
 }
 
-/* Edit distance (insertions, deletions, substitutions) of two names, case
-** aside (WIDTH had no suggestion, Width had); names longer than any
-** parameter's are far from everything. */
-static int edit_distance(const char *a, const char *b)
+int lw_params_edit_distance(const char *a, const char *b)
 {
   size_t la = strlen(a), lb = strlen(b);
   int row[64];
@@ -898,7 +895,7 @@ static void suggest_key(const char *section, const char *key, char *out, size_t 
   int best = 2 + (int)strlen(key) / 4; /* a suggestion is nearer than this */
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
-    int dist = edit_distance(key, d->key) + (strcmp(section, d->section) != 0);
+    int dist = lw_params_edit_distance(key, d->key) + (strcmp(section, d->section) != 0);
     if (dist < best) best = dist, hit = d;
   }
   if (hit) snprintf(out, n, "; did you mean '%s.%s'?", hit->section, hit->key);
@@ -911,7 +908,7 @@ static void suggest_section(const char *section, char *out, size_t n)
   const char *hit = NULL;
   int best = 3; /* a suggestion is nearer than this */
   for (size_t i = 0; i < lw_param_count; i++) {
-    int dist = edit_distance(section, lw_param_table[i].section);
+    int dist = lw_params_edit_distance(section, lw_param_table[i].section);
     if (dist < best) best = dist, hit = lw_param_table[i].section;
   }
   if (hit) snprintf(out, n, "; did you mean [%s]?", hit);
@@ -1751,8 +1748,18 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
 {
   const char *dot = strchr(assignment, '.');
   const char *eq = strchr(assignment, '=');
-  if (!dot || !eq || dot > eq)
-    return lw_error_set(err, LW_EUSAGE, "--set '%s': expected section.key=value", assignment);
+  if (!dot || !eq || dot > eq) {
+    /* a key without its section: the sections that have it ("pen_width=0.5"
+    ** said only what was expected) */
+    char hint[160] = "";
+    const size_t lk = eq && (!dot || dot > eq) ? (size_t)(eq - assignment) : 0;
+    for (size_t i = 0, n = 0; lk && i < lw_param_count && n + 40 < sizeof hint; i++)
+      if (strlen(lw_param_table[i].key) == lk && !strncmp(lw_param_table[i].key, assignment, lk))
+        n += (size_t)snprintf(hint + n, sizeof hint - n, "%s'%s.%s=%s'", n ? " or " : " (did you mean ",
+                              lw_param_table[i].section, lw_param_table[i].key, eq + 1);
+    if (hint[0]) snprintf(hint + strlen(hint), sizeof hint - strlen(hint), "?)");
+    return lw_error_set(err, LW_EUSAGE, "--set '%s': expected section.key=value%s", assignment, hint);
+  }
   char section[64], key[64];
   size_t ls = (size_t)(dot - assignment), lk = (size_t)(eq - dot - 1);
   if (ls >= sizeof section || lk >= sizeof key)

@@ -146,8 +146,16 @@ static void dark_note(lw_scene *sc, const lw_params *p)
       seen++;
       dark += im->tone[k] <= DARK_TONE;
     }
-  if (!seen || (double)dark <= DARK_SHARE * (double)seen || (double)dark_all <= DARK_SHARE * (double)seen_all) return;
   size_t used = strlen(sc->note);
+  /* a picture transparent everywhere is white paper: the empty drawing that
+  ** follows blamed the price of line (an exporter's alpha of 0) */
+  if (!seen_all && im->alpha) {
+    snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image: the picture is transparent everywhere (its "
+             "alpha under one half at every pixel), so it is all white paper and asks for no line; a picture saved "
+             "with an alpha of 0 by mistake draws once saved without its alpha channel", used ? "; " : "");
+    return;
+  }
+  if (!seen || (double)dark <= DARK_SHARE * (double)seen || (double)dark_all <= DARK_SHARE * (double)seen_all) return;
   snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image: %.0f %% of the picture is %.0f %% dark or darker "
            "after its tone curve, so the lines there can only hatch evenly at their densest and little of the picture "
            "shows; scene.image_gamma below 1 lightens its mid-tones, %s (docs/IMAGES.md, \"What the preset does not "

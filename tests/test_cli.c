@@ -1482,6 +1482,12 @@ Test(cli, usage_errors_exit_2_in_one_line_and_write_nothing)
       {"stats r --reweight", "--reweight: expected a whole number from 2 to 10000, got ''"}, /* (was '(null)') */
       {"stats r --zap", "stats: unexpected '--zap' (usage: linewise stats DIR..."},
       {"frobnicate", "unknown command 'frobnicate' (try 'linewise --help')"},
+      /* a slip is met with what was meant (it said only "unknown") */
+      {"rnu M", "unknown command 'rnu' (did you mean 'run'?) (try 'linewise --help')"},
+      {"run M --sed 3", "run: unknown option '--sed' (did you mean '--seed'?)"},
+      {"resume r --sweep 3", "resume: unexpected '--sweep' (did you mean '--sweeps'?) (usage"},
+      {"stats r --form 3", "stats: unexpected '--form' (did you mean '--from'?) (usage"},
+      {"run M --set seed=3", "--set 'seed=3': expected section.key=value (did you mean 'anneal.seed=3'?)"},
   };
   for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
     char args[256] = "";

@@ -151,6 +151,25 @@ Test(image_cli, bad_pictures_exit_2_with_one_line_and_touch_nothing)
 ** line in the run's scene.ini was past what the INI reader takes, so the
 ** run went and its resume, energy and redraw all failed.  It is refused
 ** before anything is written, naming the key. */
+/* A picture transparent everywhere (an exporter's alpha of 0) is all white
+** paper: said before the run, where the empty drawing after it blamed the
+** price of line */
+Test(image_cli, a_picture_transparent_everywhere_is_said_before_the_run)
+{
+  float g[64], a[64];
+  for (int k = 0; k < 64; k++) g[k] = 0.2f, a[k] = 0.0f;
+  lw_test_png(lw_test_path("clear.png"), 8, 8, g, a);
+  write_scene("clear.png");
+  char errs[4096];
+  cr_assert_eq(run("run scene.ini --stop-at 0 --out out", errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "scene.image: the picture is transparent everywhere (its alpha under one half at every "
+                         "pixel), so it is all white paper"), "%s", errs);
+  for (int k = 0; k < 64; k++) a[k] = k == 9 ? 1.0f : 0.0f;
+  lw_test_png(lw_test_path("clear.png"), 8, 8, g, a);
+  cr_assert_eq(run("run scene.ini --stop-at 0 --out out2", errs, sizeof errs), 0, "%s", errs);
+  cr_assert_null(strstr(errs, "transparent everywhere"), "one opaque pixel: %s", errs);
+}
+
 Test(image_cli, a_path_too_long_for_the_runs_scene_file_is_refused_before_the_run)
 {
   char deep[300], name[200];

@@ -40,6 +40,17 @@ Test(rundir, runs_started_together_without_out_each_get_their_own_directory)
   cr_assert_eq(sh("test $(ls -d %s/out/minimal* | wc -l) = 3", dir), 0);
 }
 
+/* A directory chosen past out/<name> is named even under --quiet (a later
+** `stats out/<name>` read the earlier run unsaid); out/<name> itself is not. */
+Test(rundir, a_run_into_another_default_directory_says_so_even_quiet)
+{
+  for (int k = 0; k < 2; k++)
+    cr_assert_eq(sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=5 --quiet 2> err%d.txt", dir,
+                    lw_test_bin(), lw_test_root(), k), 0);
+  cr_assert_eq(sh("cd %s && test ! -s err0.txt && grep -qx 'linewise: into out/minimal-2 (out/minimal holds a run; "
+                  "--out names the directory)' err1.txt", dir), 0);
+}
+
 /* While another process holds DIR/.lock, run, resume and a redraw into
 ** DIR exit 2 with one line and leave the run there as it was; once it
 ** lets go, they go on. */

@@ -419,6 +419,11 @@ lw_status lw_params_blame(const lw_params *p, const char *section, const char *k
 ** delete it or type a plain space)", or "" if there is none.  buf holds it. */
 const char *lw_params_unseen_char(const char *value, char *buf, size_t n);
 
+/* Edit distance (insertions, deletions, substitutions) of two names, case
+** aside (WIDTH had no suggestion, Width had), for "did you mean"; names of
+** 64 bytes or more are far from everything. */
+int lw_params_edit_distance(const char *a, const char *b);
+
 #ifdef __cplusplus
 }
 #endif
