@@ -626,6 +626,27 @@ static void say_stash_left(lw_anneal *a)
   a->stash_left[0] = 0;
 }
 
+/* libgomp ends the process (exit 1, "libgomp: Thread creation failed") where
+** it cannot start a team's threads, which may first happen after the set-up
+** (a team larger than the last: libgomp lets the threads a smaller team left
+** idle go): the run set aside then comes back too, as after a failure
+** linewise catches.  It took a finished drawing with it (an address-space
+** limit and eight threads).  A no-op once the first sweep dropped it, and
+** after lw_anneal_free. */
+static lw_anneal *run_starting;
+
+static void undo_start_at_exit(void)
+{
+  lw_anneal *a = run_starting;
+  run_starting = NULL;
+  if (!a || !a->stashed) return;
+  char word[LW_RUNDIR_WORD_MAX];
+  lw_rundir_shell_word(a->dir, word, sizeof word);
+  if (lw_anneal_undo_start(a))
+    fprintf(stderr, "linewise: the process ended before the run's first sweep was done; the run that was in %s is "
+            "back as it was\n", word);
+}
+
 /* A run that failed to write (a full disk) says that state.lw still holds
 ** its last checkpoint, and how to go on: the last this process wrote, or
 ** the one the loop began from (the set-up's, or the one a resume read). */
@@ -1033,6 +1054,8 @@ static int cmd_run(int argc, char **argv)
   }
   made_what = 0;
   checkpointed = 1;
+  run_starting = &a;
+  atexit(undo_start_at_exit);
   watcher_settle(&w);
   say_stash_left(&a); /* (an MPI run's first checkpoint drops the run set aside) */
   /* under --quiet too: a seed sweep over an old run's scene.ini brought back
@@ -1486,20 +1509,41 @@ static int main_stack_too_small(void)
 ** sizes it ignores; reading the variables here let "+16K", "16K\r" and a
 ** GOMP_STACKSIZE behind a bad OMP_STACKSIZE through to the crash.  Only a
 ** run of more than one thread has such threads. */
+/* libgomp ends the process (exit 1, "libgomp: Thread creation failed") where
+** it cannot start a team's threads (an address-space limit, ulimit -v, with
+** eight threads of 8 MiB stacks, or a limit on processes): the first team
+** is therefore started here, before anything is written, and this says what
+** to do.  Started first in the run, after its set-up's state.lw, it took a
+** finished run in the directory with it. */
+static volatile sig_atomic_t team_starting;
+static int team_wanted;
+
+static void team_failed(void)
+{
+  if (team_starting)
+    fprintf(stderr, "linewise: OpenMP could not start %d threads (the memory limit, ulimit -v, or the processes "
+            "allowed); nothing was written: give --threads fewer, or more room\n", team_wanted);
+}
+
 static int thread_stack_too_small(int argc, char **argv)
 {
-  if (argc < 2 || (strcmp(argv[1], "run") && strcmp(argv[1], "resume")) || threads_asked(argc, argv) < 2) return 0;
+  const int n = argc < 2 || (strcmp(argv[1], "run") && strcmp(argv[1], "resume")) ? 1 : threads_asked(argc, argv);
+  if (n < 2) return 0;
   size_t size = 0;
-#if defined(__GLIBC__)
-#pragma omp parallel num_threads(2)
+  team_wanted = n;
+  team_starting = 1;
+  atexit(team_failed);
+#pragma omp parallel num_threads(n)
   if (omp_get_thread_num() == 1) {
+#if defined(__GLIBC__)
     pthread_attr_t at;
     if (!pthread_getattr_np(pthread_self(), &at)) {
       if (pthread_attr_getstacksize(&at, &size)) size = 0;
       pthread_attr_destroy(&at);
     }
-  }
 #endif
+  }
+  team_starting = 0;
   if (!size || size >= STACK_NEEDED_KIB * 1024) return 0;
   char set[160] = "";
   static const char *const name[] = {"OMP_STACKSIZE", "GOMP_STACKSIZE"};

@@ -1675,11 +1675,18 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
                               "it, turned to each picture), or scene.orientation = %s to keep the page so",
                               where, names[k], *value[k], page_name, w, h, where_page, names[k],
                               landscape ? "portrait" : "landscape");
+        /* the way out is the other key's: a size given over the file's page
+        ** needs the page custom (it pointed at the width it refused) */
+        char out[160];
+        if (p->line[d - lw_param_table] < 0 && p->line[dp - lw_param_table] > 0)
+          snprintf(out, sizeof out, "for a size of your own, give --set scene.page=custom too");
+        else
+          snprintf(out, sizeof out, "over a size in the scene file, give --set scene.width=%g --set scene.height=%g "
+                   "too", w, h);
         return lw_error_set(err, LW_EINPUT,
                             "%s: key 'scene.%s' = %.12g mm conflicts with scene.page = %s (%g x %g mm, set at %s): "
-                            "expected %g or no %s (over a size in the scene file, give --set scene.width=%g "
-                            "--set scene.height=%g too)",
-                            where, names[k], *value[k], page_name, w, h, where_page, want[k], names[k], w, h);
+                            "expected %g or no %s (%s)",
+                            where, names[k], *value[k], page_name, w, h, where_page, want[k], names[k], out);
       }
       *value[k] = want[k];
     }

@@ -278,6 +278,16 @@ Test(params, named_pages_set_the_size)
   cr_assert_eq(lw_params_set(&p, "scene.width=100", &err), LW_OK);
   cr_assert_eq(lw_params_resolve(&p, &err), LW_EINPUT);
   cr_assert(strstr(err.msg, "--set: key 'scene.width'"), "%s", err.msg);
+  /* a size given over the file's page is told the page custom (it was told
+  ** to give the page's own width) */
+  cr_assert_eq(read_text("[scene]\npage = a4\n", &p, &err), LW_OK);
+  cr_assert_eq(lw_params_set(&p, "scene.width=100", &err), LW_OK);
+  cr_assert_eq(lw_params_resolve(&p, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "expected 210 or no width (for a size of your own, give --set scene.page=custom too)"),
+            "%s", err.msg);
+  cr_assert_eq(lw_params_set(&p, "scene.page=custom", &err), LW_OK);
+  cr_assert_eq(lw_params_set(&p, "scene.height=50", &err), LW_OK);
+  cr_assert_eq(lw_params_resolve(&p, &err), LW_OK, "%s", err.msg);
 }
 
 Test(params, pen_colours_match_the_pens)
