@@ -1750,10 +1750,19 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
   ** chain, stream and system, so the thread count cannot change the result. */
   /* Threads go to the rungs first; a rung split into domains runs its
   ** share of the rest there (domains.h). */
-#pragma omp parallel for schedule(static, 1) reduction(| : failed) num_threads(m < omp_get_max_threads() ? m : omp_get_max_threads()) if (m > 1)
-  for (int i = 0; i < m; i++) {
-    a->chains[here[i]]->tuning = tuning;
-    if (lw_chain_sweep(a->chains[here[i]]) != LW_OK) failed = 1;
+  /* (one rung outside any parallel region: under an inactive one, `if
+  ** (m > 1)`, its domains' team was a nested one, which libgomp starts anew
+  ** at every sweep, 4 threads a sweep, where a team of the top level keeps
+  ** its threads; under a memory limit a sweep then ended the process) */
+  if (m == 1) {
+    a->chains[here[0]]->tuning = tuning;
+    failed = lw_chain_sweep(a->chains[here[0]]) != LW_OK;
+  } else {
+#pragma omp parallel for schedule(static, 1) reduction(| : failed) num_threads(m < omp_get_max_threads() ? m : omp_get_max_threads())
+    for (int i = 0; i < m; i++) {
+      a->chains[here[i]]->tuning = tuning;
+      if (lw_chain_sweep(a->chains[here[i]]) != LW_OK) failed = 1;
+    }
   }
   lw_status s;
   if (a->net && (s = a->net->share(a->net, a, failed, err))) return s;

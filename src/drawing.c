@@ -481,12 +481,12 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
   else snprintf(close, sizeof close, "%.4f (of the line within a pen width of another stroke)", d->close_share);
   size_t k = 0;
   int w = snprintf(buf, n,
-                   "linewise: %zu path%s (%zu stroke%s: %zu joins, %zu cut by the crop, %zu outside it, %zu too "
+                   "linewise: %zu path%s (%zu stroke%s: %zu join%s, %zu cut by the crop, %zu outside it, %zu too "
                    "short); pen-up travel %.1f mm in index order, %.1f mm as plotted\n"
                    "linewise: plot time about %s (%.0f s: %.0f mm pen down, %zu lift%s); close share %s\n",
                    d->paths, d->paths == 1 ? "" : "s", r->lifts_before, r->lifts_before == 1 ? "" : "s", r->joins,
-                   r->cut, r->outside, r->dropped, d->travel_before, d->travel_after, clock, d->time_s,
-                   d->pen_down_mm, r->lifts_after, r->lifts_after == 1 ? "" : "s", close);
+                   r->joins == 1 ? "" : "s", r->cut, r->outside, r->dropped, d->travel_before, d->travel_after, clock,
+                   d->time_s, d->pen_down_mm, r->lifts_after, r->lifts_after == 1 ? "" : "s", close);
   if (w < 0 || (size_t)w >= n) return;
   k = (size_t)w;
   if (d->off_page) {

@@ -631,20 +631,28 @@ static void say_stash_left(lw_anneal *a)
 ** (a team larger than the last: libgomp lets the threads a smaller team left
 ** idle go): the run set aside then comes back too, as after a failure
 ** linewise catches.  It took a finished drawing with it (an address-space
-** limit and eight threads).  A no-op once the first sweep dropped it, and
-** after lw_anneal_free. */
-static lw_anneal *run_starting;
+** limit and eight threads).  Later, the checkpoint a resume takes up is
+** named, as after any failure.  A no-op after lw_anneal_free (a run that
+** ended, or failed in linewise's own words). */
+static lw_anneal *run_going;
 
-static void undo_start_at_exit(void)
+static void run_ended_at_exit(void)
 {
-  lw_anneal *a = run_starting;
-  run_starting = NULL;
-  if (!a || !a->stashed) return;
+  lw_anneal *a = run_going;
+  run_going = NULL;
+  if (!a || !a->dir[0]) return;
   char word[LW_RUNDIR_WORD_MAX];
   lw_rundir_shell_word(a->dir, word, sizeof word);
-  if (lw_anneal_undo_start(a))
-    fprintf(stderr, "linewise: the process ended before the run's first sweep was done; the run that was in %s is "
-            "back as it was\n", word);
+  if (a->stashed) {
+    if (lw_anneal_undo_start(a))
+      fprintf(stderr, "linewise: the process ended before the run's first sweep was done; the run that was in %s is "
+              "back as it was\n", word);
+    return;
+  }
+  const long at = lw_phase_last_commit(NULL);
+  if (at >= 0)
+    fprintf(stderr, "linewise: the process ended at sweep %ld; %s/state.lw holds the checkpoint of sweep %ld ('linewise "
+            "resume %s' continues)\n", a->sweep, a->dir, at, word);
 }
 
 /* A run that failed to write (a full disk) says that state.lw still holds
@@ -1054,8 +1062,8 @@ static int cmd_run(int argc, char **argv)
   }
   made_what = 0;
   checkpointed = 1;
-  run_starting = &a;
-  atexit(undo_start_at_exit);
+  run_going = &a;
+  atexit(run_ended_at_exit);
   watcher_settle(&w);
   say_stash_left(&a); /* (an MPI run's first checkpoint drops the run set aside) */
   /* under --quiet too: a seed sweep over an old run's scene.ini brought back
@@ -1151,6 +1159,8 @@ static int cmd_resume(int argc, char **argv)
     return watched_fail(&w, &err);
   }
   if (a.pause_at >= 0 && (stop_at < 0 || a.pause_at < stop_at)) stop_at = a.pause_at;
+  run_going = &a;
+  atexit(run_ended_at_exit);
   watcher_settle(&w);
   if (!quiet) fprintf(stderr, "linewise: resuming %s at sweep %ld of %ld\n", dir, a.sweep, a.end_sweep);
   int rc = anneal_loop(&a, stop_at, quiet, asked, &w, &err);

@@ -17,6 +17,7 @@
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <sys/types.h>
 
@@ -1678,7 +1679,7 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
         /* the way out is the other key's: a size given over the file's page
         ** needs the page custom (it pointed at the width it refused) */
         char out[160];
-        if (p->line[d - lw_param_table] < 0 && p->line[dp - lw_param_table] > 0)
+        if (p->line[d - lw_param_table] < 0)
           snprintf(out, sizeof out, "for a size of your own, give --set scene.page=custom too");
         else
           snprintf(out, sizeof out, "over a size in the scene file, give --set scene.width=%g --set scene.height=%g "
@@ -1761,9 +1762,9 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
     char hint[160] = "";
     const size_t lk = eq && (!dot || dot > eq) ? (size_t)(eq - assignment) : 0;
     for (size_t i = 0, n = 0; lk && i < lw_param_count && n + 40 < sizeof hint; i++)
-      if (strlen(lw_param_table[i].key) == lk && !strncmp(lw_param_table[i].key, assignment, lk))
-        n += (size_t)snprintf(hint + n, sizeof hint - n, "%s'%s.%s=%s'", n ? " or " : " (did you mean ",
-                              lw_param_table[i].section, lw_param_table[i].key, eq + 1);
+      if (strlen(lw_param_table[i].key) == lk && !strncasecmp(lw_param_table[i].key, assignment, lk))
+        n += (size_t)snprintf(hint + n, sizeof hint - n, "%s'%s.%s'", n ? " or " : " (did you mean ",
+                              lw_param_table[i].section, lw_param_table[i].key);
     if (hint[0]) snprintf(hint + strlen(hint), sizeof hint - strlen(hint), "?)");
     return lw_error_set(err, LW_EUSAGE, "--set '%s': expected section.key=value%s", assignment, hint);
   }

@@ -110,12 +110,12 @@ static void past_bed(const extent *e, const double bed[2], int k, char *buf, siz
 {
   /* below 0 is past the machine's origin, not its bed's far side (a
   ** stroke at x = -3 was blamed on the bed's width) */
-  if (e->lo[k] < -BED_SLACK)
-    snprintf(buf, n, "%c = %.3f to %.3f mm on the machine, past its origin (%c below 0)", "xy"[k], e->lo[k], e->hi[k],
-             "xy"[k]);
-  else
-    snprintf(buf, n, "%c = %.3f to %.3f mm on the machine, past its bed of %g mm (plot.bed_%s)", "xy"[k], e->lo[k],
-             e->hi[k], bed[k], k ? "height" : "width");
+  const int below = e->lo[k] < -BED_SLACK, beyond = bed[k] > 0.0 && e->hi[k] > bed[k] + BED_SLACK;
+  char origin[32] = "", far[64] = "";
+  if (below) snprintf(origin, sizeof origin, "its origin (%c below 0)", "xy"[k]);
+  if (beyond) snprintf(far, sizeof far, "its bed of %g mm (plot.bed_%s)", bed[k], k ? "height" : "width");
+  snprintf(buf, n, "%c = %.3f to %.3f mm on the machine, past %s%s%s", "xy"[k], e->lo[k], e->hi[k], origin,
+           below && beyond ? " and " : "", far);
 }
 
 lw_status lw_plotter_check(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o, int gcode,

@@ -148,11 +148,15 @@ static void dark_note(lw_scene *sc, const lw_params *p)
     }
   size_t used = strlen(sc->note);
   /* a picture transparent everywhere is white paper: the empty drawing that
-  ** follows blamed the price of line (an exporter's alpha of 0) */
-  if (!seen_all && im->alpha) {
+  ** follows blamed the price of line (an exporter's alpha of 0); every pixel
+  ** is asked, not the grid's (thin lines between its rows were missed) */
+  int clear = im->alpha != NULL;
+  for (size_t k = 0, n = (size_t)im->width * (size_t)im->height; clear && k < n; k++)
+    clear = im->alpha[k] < 0.5f / 255.0f;
+  if (clear) {
     snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image: the picture is transparent everywhere (its "
-             "alpha under one half at every pixel), so it is all white paper and asks for no line; a picture saved "
-             "with an alpha of 0 by mistake draws once saved without its alpha channel", used ? "; " : "");
+             "alpha is 0 at every pixel), so it is all white paper and asks for no line; a picture saved with an "
+             "alpha of 0 by mistake draws once saved without its alpha channel", used ? "; " : "");
     return;
   }
   if (!seen || (double)dark <= DARK_SHARE * (double)seen || (double)dark_all <= DARK_SHARE * (double)seen_all) return;

@@ -1487,7 +1487,7 @@ Test(cli, usage_errors_exit_2_in_one_line_and_write_nothing)
       {"run M --sed 3", "run: unknown option '--sed' (did you mean '--seed'?)"},
       {"resume r --sweep 3", "resume: unexpected '--sweep' (did you mean '--sweeps'?) (usage"},
       {"stats r --form 3", "stats: unexpected '--form' (did you mean '--from'?) (usage"},
-      {"run M --set seed=3", "--set 'seed=3': expected section.key=value (did you mean 'anneal.seed=3'?)"},
+      {"run M --set seed=3", "--set 'seed=3': expected section.key=value (did you mean 'anneal.seed'?)"},
   };
   for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
     char args[256] = "";
