@@ -655,7 +655,8 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
                            *const orientation[] = {"scene.orientation", NULL},
                            *const picture[] = {"scene.image_width", "scene.image_blur", "scene.image_flatten",
                                                "scene.image_levels", "scene.image_levels_alpha",
-                                               "scene.image_levels_flat", "scene.image_gamma", "scene.image_contrast", "scene.image_invert",
+                                               "scene.image_levels_flat", "scene.image_gamma", "scene.image_contrast",
+                                               "scene.image_invert",
                                                NULL},
                            *const levels_alpha[] = {"scene.image_levels_alpha", "scene.image_levels_flat", NULL},
                            *const ladder[] = {"tempering.t_min", "tempering.t_max", "tempering.exchange_every",
@@ -1758,7 +1759,8 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
     a->chains[here[0]]->tuning = tuning;
     failed = lw_chain_sweep(a->chains[here[0]]) != LW_OK;
   } else {
-#pragma omp parallel for schedule(static, 1) reduction(| : failed) num_threads(m < omp_get_max_threads() ? m : omp_get_max_threads())
+#pragma omp parallel for schedule(static, 1) reduction(| : failed) \
+    num_threads(m < omp_get_max_threads() ? m : omp_get_max_threads())
     for (int i = 0; i < m; i++) {
       a->chains[here[i]]->tuning = tuning;
       if (lw_chain_sweep(a->chains[here[i]]) != LW_OK) failed = 1;

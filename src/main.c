@@ -651,8 +651,8 @@ static void run_ended_at_exit(void)
   }
   const long at = lw_phase_last_commit(NULL);
   if (at >= 0)
-    fprintf(stderr, "linewise: the process ended at sweep %ld; %s/state.lw holds the checkpoint of sweep %ld ('linewise "
-            "resume %s' continues)\n", a->sweep, a->dir, at, word);
+    fprintf(stderr, "linewise: the process ended at sweep %ld; %s/state.lw holds the checkpoint of sweep %ld "
+            "('linewise resume %s' continues)\n", a->sweep, a->dir, at, word);
 }
 
 /* A run that failed to write (a full disk) says that state.lw still holds
@@ -1513,12 +1513,6 @@ static int main_stack_too_small(void)
   return 1;
 }
 
-/* OpenMP's threads' stack, measured on one of them: libgomp sizes it from
-** OMP_STACKSIZE, or GOMP_STACKSIZE where that is unset, empty or not a size
-** it reads, or else ulimit -s, each with its own rules for blanks, signs and
-** sizes it ignores; reading the variables here let "+16K", "16K\r" and a
-** GOMP_STACKSIZE behind a bad OMP_STACKSIZE through to the crash.  Only a
-** run of more than one thread has such threads. */
 /* libgomp ends the process (exit 1, "libgomp: Thread creation failed") where
 ** it cannot start a team's threads (an address-space limit, ulimit -v, with
 ** eight threads of 8 MiB stacks, or a limit on processes): the first team
@@ -1535,6 +1529,12 @@ static void team_failed(void)
             "allowed); nothing was written: give --threads fewer, or more room\n", team_wanted);
 }
 
+/* OpenMP's threads' stack, measured on one of them: libgomp sizes it from
+** OMP_STACKSIZE, or GOMP_STACKSIZE where that is unset, empty or not a size
+** it reads, or else ulimit -s, each with its own rules for blanks, signs and
+** sizes it ignores; reading the variables here let "+16K", "16K\r" and a
+** GOMP_STACKSIZE behind a bad OMP_STACKSIZE through to the crash.  Only a
+** run of more than one thread has such threads. */
 static int thread_stack_too_small(int argc, char **argv)
 {
   const int n = argc < 2 || (strcmp(argv[1], "run") && strcmp(argv[1], "resume")) ? 1 : threads_asked(argc, argv);

@@ -1525,8 +1525,8 @@ Test(cli, usage_errors_exit_2_in_one_line_and_write_nothing)
 Test(cli, a_process_ended_by_openmp_puts_the_run_before_back)
 {
   if (strstr(lw_test_bin(), "asan")) cr_skip_test("an AddressSanitizer build cannot run under ulimit -v");
-  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=5 --out g --quiet && cp -a g g0 && "
-                          "rm g0/.lock", dir, lw_test_bin(), lw_test_root()), 0);
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=5 --out g --quiet && "
+                          "cp -a g g0 && rm g0/.lock", dir, lw_test_bin(), lw_test_root()), 0);
   const int rc = lw_test_sh("cd %s && (ulimit -v 120000; OMP_WAIT_POLICY=passive %s run %s/params/example.ini --out g "
                             "--threads 8 --seed 9 --set anneal.sweeps=3 --quiet 2> err.txt)", dir, lw_test_bin(),
                             lw_test_root());

@@ -240,7 +240,8 @@ Test(tools, seed_sweep_gathers_every_summary_and_links_the_best)
   ** gives a new file, and nothing left beside them but the locks of the
   ** sweep's tasks */
   cr_assert_eq(sh("cd %s/s && test $(stat -c %%a sweep.csv) = 640 && test $(stat -c %%a sweep.conf) = 640 && "
-                  "test $(stat -c %%a sweep.plan) = 640 && test \"$(ls -A | grep '^\\.' | paste -sd' ')\" = '.sweep.lock .sweep.running'", dir), 0);
+                  "test $(stat -c %%a sweep.plan) = 640 && "
+                  "test \"$(ls -A | grep '^\\.' | paste -sd' ')\" = '.sweep.lock .sweep.running'", dir), 0);
   /* a directory whose name ends in a line break (dirname drops it: the
   ** temporaries were sought in another directory, and the sweep failed) */
   cr_assert_eq(sh("cd %s && %s %s --seeds 1 " TINY " --bin %s --out 'n\n' && test -s 'n\n/sweep.csv' && "
