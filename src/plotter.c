@@ -74,10 +74,14 @@ static void walk_path(const lw_strokes *s, size_t k, const lw_output_page *page,
 }
 
 /* The box of every point the files would visit, on the machine's axes; a
-** point on the bed's edge within HP-GL's half grid step is on it. */
-#define BED_SLACK (0.5 / LW_HPGL_UNITS_PER_MM)
+** point on the bed's edge within half the file's grid step is on it (HP-GL's
+** 0.0125 mm; G-code's 0.0005 mm: a point 0.012 mm past a GRBL bed, whose
+** three decimals kept it past, passed). */
+#define HPGL_SLACK (0.5 / LW_HPGL_UNITS_PER_MM)
+#define GCODE_SLACK 0.0005
 typedef struct {
   double lo[2], hi[2];
+  double slack;
 } extent;
 
 static void extend(void *ctx, double x, double y)
@@ -87,12 +91,13 @@ static void extend(void *ctx, double x, double y)
   e->lo[1] = fmin(e->lo[1], y), e->hi[1] = fmax(e->hi[1], y);
 }
 
-/* The box of the drawing on the machine's axes under turn `turn`. */
-static extent reach(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o, int turn)
+/* The box of the drawing on the machine's axes under turn `turn`, for the
+** G-code file or the HP-GL one. */
+static extent reach(const lw_strokes *s, const lw_output_page *page, const lw_plotter_options *o, int turn, int gcode)
 {
   lw_plotter_options t = *o;
   t.turn = turn;
-  extent e = {{INFINITY, INFINITY}, {-INFINITY, -INFINITY}};
+  extent e = {{INFINITY, INFINITY}, {-INFINITY, -INFINITY}, gcode ? GCODE_SLACK : HPGL_SLACK};
   for (size_t j = 0; j < s->n; j++) walk_path(s, j, page, &t, extend, &e);
   return e;
 }
@@ -101,7 +106,7 @@ static extent reach(const lw_strokes *s, const lw_output_page *page, const lw_pl
 static int off_bed(const extent *e, const double bed[2], int from)
 {
   for (int k = from; k < 2; k++)
-    if (bed[k] > 0.0 && !(e->lo[k] >= -BED_SLACK && e->hi[k] <= bed[k] + BED_SLACK)) return k;
+    if (bed[k] > 0.0 && !(e->lo[k] >= -e->slack && e->hi[k] <= bed[k] + e->slack)) return k;
   return -1;
 }
 
@@ -110,7 +115,7 @@ static void past_bed(const extent *e, const double bed[2], int k, char *buf, siz
 {
   /* below 0 is past the machine's origin, not its bed's far side (a
   ** stroke at x = -3 was blamed on the bed's width) */
-  const int below = e->lo[k] < -BED_SLACK, beyond = bed[k] > 0.0 && e->hi[k] > bed[k] + BED_SLACK;
+  const int below = e->lo[k] < -e->slack, beyond = bed[k] > 0.0 && e->hi[k] > bed[k] + e->slack;
   char origin[32] = "", far[64] = "";
   if (below) snprintf(origin, sizeof origin, "its origin (%c below 0)", "xy"[k]);
   if (beyond) snprintf(far, sizeof far, "its bed of %g mm (plot.bed_%s)", bed[k], k ? "height" : "width");
@@ -133,11 +138,11 @@ lw_status lw_plotter_check(const lw_strokes *s, const lw_output_page *page, cons
       return lw_error_set(err, LW_EINPUT, "%s: a control point of segment %zu lies %g mm from the origin: "
                           "expected at most %g", path, k / 8, fabs(s->b[k]), LW_PLOTTER_MM_MAX);
   if (o->bed[0] > 0.0 || o->bed[1] > 0.0) {
-    extent e = reach(s, page, o, o->turn);
+    extent e = reach(s, page, o, o->turn, gcode);
     int k = off_bed(&e, o->bed, 0);
     if (k >= 0) {
       /* the other turn only where the drawing would fit the bed with it */
-      extent t = reach(s, page, o, !o->turn);
+      extent t = reach(s, page, o, !o->turn, gcode);
       char turn[64] = "";
       if (off_bed(&t, o->bed, 0) < 0)
         snprintf(turn, sizeof turn, " or the other turn (plot.turn = %d)", o->turn ? 0 : 90);

@@ -489,6 +489,14 @@ Test(plotter, a_drawing_past_the_bed_is_refused_and_travel_can_feed)
   o.turn = 1, o.bed[0] = 90, o.bed[1] = 100;
   cr_assert_eq(lw_plotter_check(s, &page, &o, 1, path, NULL), LW_OK);
   o.turn = 0;
+  /* a point 0.01 mm past the bed: on it within HP-GL's half unit (0.0125
+  ** mm, where it rounds onto the edge), past it in G-code, whose three
+  ** decimals keep it past (GRBL's soft limit) */
+  o.bed[0] = 91.0 - 0.01, o.bed[1] = 200;
+  cr_assert_eq(lw_plotter_check(s, &page, &o, 0, path, NULL), LW_OK);
+  cr_assert_eq(lw_plotter_check(s, &page, &o, 1, path, NULL), LW_EINPUT);
+  o.bed[0] = 91.0 - 0.0004;
+  cr_assert_eq(lw_plotter_check(s, &page, &o, 1, path, NULL), LW_OK);
   /* a drawing left of the machine's origin is past the origin, not the
   ** bed's width, which it fits (it was blamed on plot.bed_width) */
   for (size_t k = 0; k < s->n_segs; k++)
