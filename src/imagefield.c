@@ -42,10 +42,15 @@ static int refine(int w, int h, double pixel, double sigma, int paper)
 
 /* The picture's tone^power at node (i, j) of the grid of k nodes a pixel
 ** (0 <= i < w k): bilinear between the pixel centres, the edge pixels' tone
-** out to the picture's edge; t holds tone^power by pixel. */
-static double tone_at(const double *t, int w, int h, int k, int i, int j)
+** out to the picture's edge; t holds tone^power by pixel (k > 1 only: a
+** node a pixel reads the picture, with no plane the size of the picture). */
+static double tone_at(const lw_image *img, double power, const double *t, int k, int i, int j)
 {
-  if (k == 1) return t[(size_t)j * (size_t)w + (size_t)i];
+  const int w = img->width, h = img->height;
+  if (k == 1) {
+    const float v = img->tone[(size_t)j * (size_t)w + (size_t)i];
+    return power == 1.0 ? v : pow(v, power);
+  }
   const double u = fmin(fmax((i + 0.5) / k - 0.5, 0.0), w - 1.0), v = fmin(fmax((j + 0.5) / k - 0.5, 0.0), h - 1.0);
   const int i0 = (int)fmin(floor(u), w - 2.0 < 0 ? 0 : w - 2.0), j0 = (int)fmin(floor(v), h - 2.0 < 0 ? 0 : h - 2.0);
   const int i1 = i0 + (w > 1), j1 = j0 + (h > 1);
@@ -61,14 +66,16 @@ lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl
   const int w = img->width * k, h = img->height * k;
   const double node = pl->pixel / k;
   sigma *= k;
-  /* tone^power by pixel */
+  /* tone^power by pixel, for the finer grid's interpolation */
   const size_t n_px = (size_t)img->width * (size_t)img->height;
-  double *t = malloc(n_px * sizeof *t);
-  if (!t) {
-    lw_error_set(err, LW_ENOMEM, "out of memory for a potential of %d x %d pixels", img->width, img->height);
-    return NULL;
+  double *t = NULL;
+  if (k > 1) {
+    if (!(t = malloc(n_px * sizeof *t))) {
+      lw_error_set(err, LW_ENOMEM, "out of memory for a potential of %d x %d pixels", img->width, img->height);
+      return NULL;
+    }
+    for (size_t q = 0; q < n_px; q++) t[q] = power == 1.0 ? img->tone[q] : pow(img->tone[q], power);
   }
-  for (size_t q = 0; q < n_px; q++) t[q] = power == 1.0 ? img->tone[q] : pow(img->tone[q], power);
   /* blurred, the picture is blurred on its paper: white as far as the blur
   ** reaches, so Phi rises to 1 beyond the picture without a step; without
   ** the paper the blur repeats the edge pixels and the ring continues them */
@@ -87,7 +94,7 @@ lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl
         for (int i = 0; i < pw; i++) {
           const int x = i - m, y = j - m;
           phi[(size_t)j * (size_t)pw + (size_t)i] =
-              x >= 0 && x < w && y >= 0 && y < h ? (float)tone_at(t, img->width, img->height, k, x, y) : 1.0f;
+              x >= 0 && x < w && y >= 0 && y < h ? (float)tone_at(img, power, t, k, x, y) : 1.0f;
         }
       if (lw_image_blur_plane(phi, pw, ph, sigma, err)) {
         free(phi);
@@ -107,7 +114,7 @@ lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl
         const int ii = i < 1 ? 0 : (i > pw ? pw - 1 : i - 1), jj = j < 1 ? 0 : (j > ph ? ph - 1 : j - 1);
         v = phi[(size_t)jj * (size_t)pw + (size_t)ii];
       } else if (inner) {
-        v = tone_at(t, img->width, img->height, k, i - 1, j - 1);
+        v = tone_at(img, power, t, k, i - 1, j - 1);
       }
       g->data[(size_t)j * W + (size_t)i] = v;
     }

@@ -115,6 +115,26 @@ static lw_status scored_side_ok(const lw_params *p, const char *section, const c
                  "scene.image_width)", img->width, img->height, LW_FIDELITY_SIDE_MAX);
 }
 
+/* Whether a run begun before scene key `key` came has no line for it in its
+** scene.ini: it resumes with the key's old behaviour, as it ran (a scene.ini
+** written by hand beside a state takes the default).  The keys of
+** 2026-12-05 and 06: field_core, image_levels_alpha, image_levels_flat,
+** potential_paper, potential_fine. */
+static int before_key(const lw_params *p, const char *key)
+{
+  return p->run_written && !lw_params_line(p, "scene", key);
+}
+
+/* The potential of picture img (the scene's, or a layer's target) placed as
+** the scene's picture, with the blur's paper and the wide pixels' finer grid
+** where the run's keys ask for them. */
+static lw_grid2d *image_potential(const lw_scene *sc, const lw_image *img, const lw_params *p, lw_error *err)
+{
+  return lw_imagefield_potential(img, &sc->image_place, p->potential_power, p->potential_blur / sc->image_place.pixel,
+                                 p->potential_paper && !before_key(p, "potential_paper"),
+                                 p->potential_fine && !before_key(p, "potential_fine"), err);
+}
+
 /* A picture dark nearly all over asks for the densest lines nearly
 ** everywhere: an even hatch, with only its lights as gaps (skimage's rocket
 ** at night, 60 % of it 80 % dark; the Hubble deep field, 95 %), which the
@@ -233,7 +253,7 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
   /* (a run begun before 2026-12-06, whose scene.ini has no line for the
   ** key, stretched the composite: potential_paper below) */
   const int levels_under =
-      p->image_levels_alpha && !(p->run_written && !lw_params_line(p, "scene", "image_levels_alpha"));
+      p->image_levels_alpha && !before_key(p, "image_levels_alpha");
   if (sc->image->alpha && (curve || (p->image_levels > 0 && levels_under)) && p->image_blur > 0) {
     if (!(cover = malloc(npx * sizeof *cover)))
       return lw_error_set(err, LW_ENOMEM, "out of memory for the picture's transparency");
@@ -248,7 +268,7 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
     double lo, hi;
     const float *under = levels_under ? (cover ? cover : sc->image->alpha) : NULL;
     /* (a run begun before the key: the clip's bin alone) */
-    const int tail = p->image_levels_flat && !(p->run_written && !lw_params_line(p, "scene", "image_levels_flat"));
+    const int tail = p->image_levels_flat && !before_key(p, "image_levels_flat");
     if ((st = lw_image_levels(sc->image, under, p->image_levels, tail, &lo, &hi, err))) {
       free(cover);
       return st;
@@ -484,22 +504,6 @@ static lw_status layer_targets(lw_scene *sc, const lw_params *p, lw_error *err)
   return st;
 }
 
-/* Whether a blurred picture's potential reads white paper beyond it: a run
-** begun before 2026-12-06 has no line for the key and resumes with the edge
-** continued, as it ran (a scene.ini written by hand beside a state takes the
-** default). */
-static int potential_paper(const lw_params *p)
-{
-  const int before = p->run_written && !lw_params_line(p, "scene", "potential_paper");
-  return p->potential_paper && !before;
-}
-
-/* The same for the finer grid of wide pixels (scene.potential_fine). */
-static int potential_fine(const lw_params *p)
-{
-  const int before = p->run_written && !lw_params_line(p, "scene", "potential_fine");
-  return p->potential_fine && !before;
-}
 
 /* The layers' targets, fields, potentials and tone rasters (layers.h). */
 static lw_status build_layers(lw_scene *sc, const lw_params *p, lw_error *err)
@@ -532,9 +536,7 @@ static lw_status build_layers(lw_scene *sc, const lw_params *p, lw_error *err)
       l->potential = sc->potential;
       l->potential.grid = NULL;
       if (sc->potential.kind == LW_POTENTIAL_GRID &&
-          !(l->potential.grid = lw_imagefield_potential(l->target, &sc->image_place, p->potential_power,
-                                                        p->potential_blur / sc->image_place.pixel,
-                                                        potential_paper(p), potential_fine(p), err)))
+          !(l->potential.grid = image_potential(sc, l->target, p, err)))
         return err->code;
     }
     if (sc->on[LW_TERM_TONE]) {
@@ -574,9 +576,7 @@ static lw_status build_potential(lw_scene *sc, const lw_params *p, double cx, do
   case LW_POT_IMAGE:
     if (!sc->image) return bad_key(p, "scene", "potential", LW_EINPUT, err, "'image' needs scene.image");
     f->kind = LW_POTENTIAL_GRID;
-    if (!(f->grid = lw_imagefield_potential(sc->image, &sc->image_place, p->potential_power,
-                                            p->potential_blur / sc->image_place.pixel, potential_paper(p),
-                                            potential_fine(p), err)))
+    if (!(f->grid = image_potential(sc, sc->image, p, err)))
       return err->code;
     break;
   }
@@ -591,8 +591,7 @@ static lw_status build_field(lw_scene *sc, const lw_params *p, double cx, double
   f->cy = cy;
   /* a run begun before 2026-12-05 has no line for it: no core, as it ran
   ** (a scene.ini written by hand beside a state takes the default) */
-  const int before = p->run_written && !lw_params_line(p, "scene", "field_core");
-  f->core = before ? 0.0 : p->field_core < 0.0 ? p->segment_length : p->field_core;
+  f->core = before_key(p, "field_core") ? 0.0 : p->field_core < 0.0 ? p->segment_length : p->field_core;
   f->ux = cos(p->field_angle * DEG);
   f->uy = sin(p->field_angle * DEG);
   f->wavelength = p->field_wavelength;
