@@ -1135,6 +1135,7 @@ static lw_status write_start(lw_anneal *a, lw_anneal_net *net, lw_error *err)
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
   if (!f) return err->code;
   fprintf(f, "%s\n", LW_RUN_SCENE_HEADER);
+  lw_params_write_files(&a->params, f);
   lw_params_write(&a->params, f);
   if ((s = lw_output_commit(f, tmp, path, err))) return s;
   if ((s = open_trace(a, 1, err))) return s;

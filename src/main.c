@@ -1073,6 +1073,11 @@ static int cmd_run(int argc, char **argv)
     fprintf(stderr, "linewise: note: anneal.seed_version = 1: %s is a run's scene.ini from before 2026-12-06, so this "
             "run seeds as that one did, where two seeds could draw the same numbers; --set anneal.seed_version=2 for "
             "a new study (docs/NUMERICS.md, \"Random numbers\")\n", scene);
+  char changed[LW_PARAMS_FILES_MAX * (LW_PATH_MAX + 40)];
+  const int n_changed = lw_params_files_changed(&a.params, changed, sizeof changed);
+  if (n_changed && (!net || !net->rank))
+    fprintf(stderr, "linewise: note: %s changed since the run that wrote %s read %s: this run does not repeat that "
+            "one\n", changed, scene, n_changed > 1 ? "them" : "it");
   if (!quiet) {
     const char *note = a.sys_type->note(a.setup);
     char size[128];

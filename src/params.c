@@ -7,6 +7,7 @@
 ** count at the moment the handler runs is the line of that key.
 */
 #include "linewise/params.h"
+#include "linewise/version.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -1196,6 +1197,10 @@ lw_status lw_params_blame(const lw_params *p, const char *section, const char *k
                       strstr(msg, "U+") ? "" : unseen);
 }
 
+#define LW_PARAMS_FILE_LINE "; file "
+
+static void read_file_line(lw_params *p, const char *text);
+
 typedef struct {
   lw_params *p;
   FILE *f;
@@ -1205,6 +1210,7 @@ typedef struct {
   char *buf;     /* getline's buffer */
   size_t cap;
   const lw_param_def *list; /* the list key of the line before, which an indented line goes on */
+  int content;   /* a line neither blank nor a comment has been read */
 } reader_ctx;
 
 /* An indented line without '=' or ':' after a list's line goes on with the list,
@@ -1298,11 +1304,17 @@ static char *read_line(char *str, int num, void *stream)
     rc->failed = 1;
     return NULL;
   }
-  if (rc->line == 1 && !strncmp(rc->buf, LW_RUN_SCENE_HEADER, strlen(LW_RUN_SCENE_HEADER)))
-  {
+  /* A run's header among the comments above the first section: a published
+  ** scene.ini with a line of notes added above it, or saved by an editor that
+  ** puts a BOM first, is still that run's (its random numbers, its presets). */
+  const char *text = rc->buf + (rc->line == 1 && !strncmp(rc->buf, "\xEF\xBB\xBF", 3) ? 3 : 0);
+  text += strspn(text, " \t");
+  if (!rc->content && !strncmp(text, LW_RUN_SCENE_HEADER, strlen(LW_RUN_SCENE_HEADER))) {
     rc->p->run_written = rc->p->of_run;
     rc->p->run_header = 1;
   }
+  if (!rc->content && rc->p->run_header) read_file_line(rc->p, text);
+  if (*text && !strchr(";#\r\n", *text)) rc->content = 1;
   /* inih would end the value at a NUL byte and drop the rest unseen */
   if (memchr(rc->buf, '\0', (size_t)len)) {
     lw_error_set(rc->err, LW_EINPUT, "%s:%d: a NUL byte inside the line (UTF-16 text, as some editors save "
@@ -1406,7 +1418,7 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
   const bool multiline = ini_allow_multiline, stop_first = ini_stop_on_first_error;
   ini_allow_multiline = false;
   ini_stop_on_first_error = true;
-  reader_ctx rc = {p, f, 0, err, 0, NULL, 0, NULL};
+  reader_ctx rc = {p, f, 0, err, 0, NULL, 0, NULL, 0};
   errno = 0;
   int r = ini_parse_stream(read_line, &rc, on_key, &rc);
   ini_allow_multiline = multiline;
@@ -1907,6 +1919,72 @@ int lw_params_write(const lw_params *p, FILE *f)
     else fprintf(f, "%s = %s\n", d->key, buf);
   }
   return ferror(f) ? -1 : 0;
+}
+
+/* The files a run reads as it starts: every key naming one, but a file its
+** settings leave idle (init.from is read at the start, though the rest of
+** the run never reads it again). */
+static int file_read_at_start(const lw_params *p, const lw_param_def *d)
+{
+  const char *path = (const char *)p + d->offset;
+  return d->type == LW_PT_STRING && !strcmp(d->unit, "path") && path[0] &&
+         (!lw_params_file_idle(p, d) || (!strcmp(d->section, "init") && !strcmp(d->key, "from")));
+}
+
+/* The FNV-1a hash of a regular file's bytes into *h; nonzero where it is
+** no regular file or cannot be read. */
+static int file_hash(const char *path, unsigned long long *h)
+{
+  char text[32];
+  int unread;
+  file_text(path, text, sizeof text, &unread);
+  return unread || strncmp(text, "file ", 5) || sscanf(text + 5, "%16llx", h) != 1;
+}
+
+int lw_params_write_files(const lw_params *p, FILE *f)
+{
+  fprintf(f, "; written by linewise %s\n", LW_VERSION);
+  for (size_t i = 0; i < lw_param_count; i++) {
+    const lw_param_def *d = &lw_param_table[i];
+    unsigned long long h;
+    if (file_read_at_start(p, d) && !file_hash((const char *)p + d->offset, &h))
+      fprintf(f, "%s%s.%s: fnv1a-64 %016llx\n", LW_PARAMS_FILE_LINE, d->section, d->key, h);
+  }
+  return ferror(f) ? -1 : 0;
+}
+
+/* A "; file section.key: fnv1a-64 HEX" line of a run's scene.ini kept in p
+** (lw_params_write_files); any other comment is the scene's own. */
+static void read_file_line(lw_params *p, const char *text)
+{
+  char name[80];
+  unsigned long long h;
+  if (strncmp(text, LW_PARAMS_FILE_LINE, strlen(LW_PARAMS_FILE_LINE)) || p->n_files >= LW_PARAMS_FILES_MAX ||
+      sscanf(text + strlen(LW_PARAMS_FILE_LINE), "%79[^:]: fnv1a-64 %16llx", name, &h) != 2)
+    return;
+  char *dot = strchr(name, '.');
+  const lw_param_def *d = dot ? (*dot = '\0', lw_params_find(name, dot + 1)) : NULL;
+  if (!d) return;
+  p->file_key[p->n_files] = (unsigned short)(d - lw_param_table);
+  p->file_hash[p->n_files++] = h;
+}
+
+int lw_params_files_changed(const lw_params *p, char *buf, size_t n)
+{
+  int changed = 0;
+  size_t used = 0;
+  if (n) buf[0] = '\0';
+  for (int k = 0; k < p->n_files; k++) {
+    const lw_param_def *d = &lw_param_table[p->file_key[k]];
+    const char *path = (const char *)p + d->offset;
+    unsigned long long h;
+    if (path[0] && !file_hash(path, &h) && h == p->file_hash[k]) continue;
+    if (used < n)
+      used += (size_t)snprintf(buf + used, n - used, "%s%s.%s (%s)", changed ? ", " : "", d->section, d->key,
+                               path[0] ? path : "now none");
+    changed++;
+  }
+  return changed;
 }
 
 void lw_params_write_doc(FILE *f, void (*read_by)(const lw_param_def *d, char *buf, size_t n),

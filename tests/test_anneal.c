@@ -760,6 +760,11 @@ Test(run, distinct_seeds_never_share_a_streams_numbers)
       {LW_RUN_SCENE_HEADER "\n[anneal]\nseed = 5\n", 1},
       {LW_RUN_SCENE_HEADER "\n[anneal]\nseed = 5\nseed_version = 2\n", 2},
       {"[anneal]\nseed = 5\n", 2},
+      /* a published scene.ini annotated above its header, or saved with a BOM */
+      {"; data of Smith et al.\n\n" LW_RUN_SCENE_HEADER "\n[anneal]\nseed = 5\n", 1},
+      {"\xEF\xBB\xBF" LW_RUN_SCENE_HEADER "\r\n[anneal]\r\nseed = 5\r\n", 1},
+      /* the header below a section is a comment of the scene's own */
+      {"[anneal]\n" LW_RUN_SCENE_HEADER "\nseed = 5\n", 2},
   };
   for (size_t k = 0; k < sizeof file / sizeof *file; k++) {
     char path[128];

@@ -263,6 +263,33 @@ Test(image_cli, a_run_with_a_relative_picture_resumes_and_recomputes_anywhere)
             strstr(errs, ") edited since the run started, or the file it names changed"), "%s", errs);
 }
 
+/* A run's scene.ini records the files the run read (the picture, a start
+** state) by their bytes: running it again says where one has changed since,
+** under --quiet too, as a study repeating a published run needs, and says
+** nothing where all are as they were. */
+Test(image_cli, running_a_runs_scene_again_says_which_files_changed_since)
+{
+  write_picture("pic.png", 50, 40);
+  write_scene("pic.png");
+  char errs[8192];
+  cr_assert_eq(run("run scene.ini --out a --quiet", errs, sizeof errs), 0, "%s", errs);
+  char *ini = lw_test_slurp("%s/a/scene.ini", lw_test_dir);
+  cr_assert(strstr(ini, "\n; file scene.image: fnv1a-64 ") && !strstr(ini, "; file init.from"), "%s", ini);
+  free(ini);
+  cr_assert_eq(run("run a/scene.ini --out b --quiet --set init.from=a/state.lw", errs, sizeof errs), 0, "%s", errs);
+  cr_assert(!strstr(errs, "changed since"), "%s", errs);
+  cr_assert_eq(run("run b/scene.ini --out c --quiet", errs, sizeof errs), 0, "%s", errs);
+  cr_assert(!strstr(errs, "changed since"), "%s", errs);
+  cr_assert_eq(lw_test_sh("cmp -s %s/b/final.svg %s/c/final.svg", lw_test_dir, lw_test_dir), 0, "the same run");
+  /* the start state and the picture both changed: both named, once */
+  write_picture("pic.png", 40, 50);
+  cr_assert_eq(lw_test_sh("cp %s/c/state.lw %s/a/state.lw", lw_test_dir, lw_test_dir), 0);
+  cr_assert_eq(run("run b/scene.ini --out d --quiet", errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "linewise: note: scene.image (") && strstr(errs, "/pic.png), init.from (") &&
+            strstr(errs, "/a/state.lw) changed since the run that wrote b/scene.ini read them: this run does not "
+                         "repeat that one\n"), "%s", errs);
+}
+
 /* A budget or width that leaves a picture's short side under 4 pixels (or
 ** its own, if fewer) loses its shape to the rounding (a 20000 x 20 panorama
 ** at 1 x 1 filled a square page): refused, naming the key and the least

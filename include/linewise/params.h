@@ -22,6 +22,7 @@ extern "C" {
 
 #define LW_PATH_MAX 1024
 #define LW_PARAM_MAX 256 /* capacity of lw_params.line; the table is checked against it */
+#define LW_PARAMS_FILES_MAX 8 /* files a run reads as it starts, recorded in its scene.ini */
 /* The largest text field (scene.polygon); buffers that hold any value are
 ** sized by it. */
 #define LW_PARAM_TEXT_MAX 8192
@@ -282,9 +283,15 @@ typedef struct {
   char file[LW_PATH_MAX];
   int line[LW_PARAM_MAX];
   int of_run;                 /* read from a run's scene.ini (lw_params_read_run) */
-  int run_written;            /* and that file's first line is a run's header (LW_RUN_SCENE_HEADER):
-                              ** linewise wrote it, not a hand beside a hand-made state */
-  int run_header;             /* the scene file's first line is that header, whatever reads it */
+  int run_written;            /* and that file carries a run's header (LW_RUN_SCENE_HEADER) among the
+                              ** comments above its first section: linewise wrote it, not a hand */
+  int run_header;             /* the scene file carries that header there, whatever reads it */
+  /* The files the run that wrote that scene.ini read as it started, by the
+  ** hash of their bytes (lw_params_write_files), that running it again may
+  ** tell one changed since. */
+  int n_files;
+  unsigned short file_key[LW_PARAMS_FILES_MAX];
+  unsigned long long file_hash[LW_PARAMS_FILES_MAX];
 } lw_params;
 
 /* Fills p with every default. */
@@ -371,6 +378,16 @@ int lw_params_file_idle(const lw_params *p, const lw_param_def *d);
 
 /* Writes every parameter as an INI file that reads back to the same values. */
 int lw_params_write(const lw_params *p, FILE *f);
+
+/* Comment lines for a run's scene.ini, below its header: the release, and
+** each file the run reads as it starts (a picture, a start state, a table)
+** as "; file section.key: fnv1a-64 <16 hex digits>".  Reading that
+** scene.ini again keeps them (lw_params.file_hash). */
+int lw_params_write_files(const lw_params *p, FILE *f);
+
+/* The keys among p's recorded files whose bytes differ now or cannot be
+** read, as "scene.image (PATH)" joined by ", " in buf; returns how many. */
+int lw_params_files_changed(const lw_params *p, char *buf, size_t n);
 
 /* Whether the scene gives key d a value of its own: from its file or
 ** --set, and other than the default.  Of a run's scene.ini, which writes
