@@ -174,8 +174,22 @@ static const char *const run_options[] = {"--out", "--seed", "--set", "--threads
 ** LW_PATH_MAX bytes, and a longer one would be cut to another directory. */
 #define RUN_DIR_MAX (LW_PATH_MAX - 64)
 
+/* A path with a control character in it: a script saved with CRLF line
+** ends hands its last argument a CR, and the run went into a directory
+** named "out\r" that no one can type (--set refused the same CR). */
+static lw_status path_plain(const char *what, const char *path, lw_error *err)
+{
+  for (const char *c = path; *c; c++)
+    if ((unsigned char)*c < 0x20 || *c == 0x7f)
+      return lw_error_set(err, LW_EUSAGE, "%s: byte %zu of '%s' is 0x%02X, a control character%s: expected a path "
+                          "without one", what, (size_t)(c - path) + 1, path, (unsigned char)*c,
+                          *c == '\r' ? " (a CR: a script saved with CRLF line ends?)" : "");
+  return LW_OK;
+}
+
 static lw_status dir_fits(const char *what, const char *dir, lw_error *err)
 {
+  if (path_plain(what, dir, err)) return err->code;
   if (strlen(dir) <= RUN_DIR_MAX) return LW_OK;
   return lw_error_set(err, LW_EUSAGE, "%s: a path of %zu bytes, longer than the %d a run directory may have (a "
                       "relative path is shorter)", what, strlen(dir), RUN_DIR_MAX);
@@ -672,8 +686,14 @@ static int loop_fail(lw_anneal *a, long began, watcher *w, lw_error *err)
                   "left of it is in %s/" LW_RUNFILES_STASH, word, word);
     return watched_fail(w, err);
   }
-  /* memory too: the drawing's joins can run out after hours of sweeps */
-  if (err->code == LW_EIO || err->code == LW_ENOMEM) {
+  /* memory too: the drawing's joins can run out after hours of sweeps; not
+  ** where the directory itself went (removed during the run) */
+  char state[LW_PATH_MAX + 16];
+  snprintf(state, sizeof state, "%s/state.lw", a->dir);
+  if (err->code == LW_EIO && access(state, F_OK)) {
+    size_t n = strlen(err->msg);
+    snprintf(err->msg + n, sizeof err->msg - n, "; %s is gone, and the run with it", state);
+  } else if (err->code == LW_EIO || err->code == LW_ENOMEM) {
     size_t n = strlen(err->msg);
     char word[LW_RUNDIR_WORD_MAX];
     snprintf(err->msg + n, sizeof err->msg - n, "; %s/state.lw holds the checkpoint of sweep %ld: 'linewise "
@@ -867,11 +887,28 @@ static int taken(const char *dir)
          lw_rundir_foreign(dir, "state.lw") || lw_runfiles_check_free(dir, NULL) || lw_runfiles_stashed(dir);
 }
 
+/* The run's name, out/<name>: the scene file's name without its extension
+** and leading dots (*base, its length returned): "cat.v2.ini" is not
+** "cat.v1.ini"'s out/cat-2, and ".ini" (nothing before its dot) wrote into
+** out/ itself. */
+static int scene_name(const char *scene, const char **base)
+{
+  const char *b = strrchr(scene, '/') ? strrchr(scene, '/') + 1 : scene;
+  const char *ext = strrchr(b, '.');
+  int n = ext ? (int)(ext - b) : (int)strlen(b);
+  while (n > 0 && *b == '.') b++, n--;
+  if (!n) {
+    b = "scene";
+    n = 5;
+  }
+  *base = b;
+  return n;
+}
+
 static lw_status default_dir(char *dir, size_t size, const char *scene, int *hold, int *made, lw_error *err)
 {
-  const char *base = strrchr(scene, '/');
-  base = base ? base + 1 : scene;
-  const int n = (int)strcspn(base, ".");
+  const char *base;
+  const int n = scene_name(scene, &base);
   *hold = *made = 0;
   lw_status s = LW_OK;
 #ifdef LW_MPI
@@ -966,7 +1003,7 @@ static int cmd_run(int argc, char **argv)
     return fail(&err);
   }
   /* resolved once --set has applied: lw_anneal_start */
-  if (lw_params_read_unresolved(&p, scene, &err)) return fail(&err);
+  if (path_plain("run", scene, &err) || lw_params_read_unresolved(&p, scene, &err)) return fail(&err);
   for (int i = 0; i < argc; i++) {
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
     if (!strcmp(argv[i], "--set")) {
@@ -1094,9 +1131,10 @@ static int cmd_run(int argc, char **argv)
   } else if (!out && (!net || !net->rank)) {
     /* a directory chosen past out/<name>, which holds a run, said even
     ** quiet: a later `stats out/<name>` read the earlier run unsaid */
-    const char *base = strrchr(scene, '/') ? strrchr(scene, '/') + 1 : scene;
+    const char *base;
+    const int n = scene_name(scene, &base);
     char plain[LW_PATH_MAX];
-    snprintf(plain, sizeof plain, "out/%.*s", (int)strcspn(base, "."), base);
+    snprintf(plain, sizeof plain, "out/%.*s", n, base);
     if (strcmp(dir, plain))
       fprintf(stderr, "linewise: into %s (%s holds a run; --out names the directory)\n", dir, plain);
   }

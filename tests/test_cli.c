@@ -1015,6 +1015,34 @@ Test(cli, a_run_without_out_never_replaces_another)
                           "grep -q 'seed = 9' out/s/scene.ini && ! test -e out/s-4",
                           dir, b),
                0, "--out replaces the run it names");
+  /* the name is the file's without its extension: a name all extension
+  ** wrote its run into out/ itself, and cat.v2.ini went to out/cat */
+  cr_assert_eq(lw_test_sh("cd %s && cp s.ini .ini && cp s.ini c.v2.ini && %s run .ini --quiet --set anneal.sweeps=2 "
+                          "&& %s run c.v2.ini --quiet --set anneal.sweeps=2 && test -f out/scene/final.svg && "
+                          "test -f out/c.v2/final.svg && ! test -e out/final.svg", dir, b, b),
+               0);
+  /* a CR a script saved with CRLF line ends puts at the end of --out or of
+  ** the scene's path: refused, not a directory named "r\r" */
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --quiet --out \"$(printf 'r\\r')\" 2>err.txt; test $? -eq 2 && "
+                          "grep -qx \"linewise: --out: byte 2 of 'r?' is 0x0D, a control character (a CR: a script "
+                          "saved with CRLF line ends?): expected a path without one\" err.txt && ! ls | grep -q '^r'",
+                          dir, b),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+}
+
+/* A run whose directory is removed while it runs ends at its next
+** checkpoint (exit 1) saying so, not offering a resume of what is gone. */
+Test(cli, a_run_whose_directory_is_removed_says_it_is_gone)
+{
+  write_file("s.ini", scene_text);
+  cr_assert_eq(lw_test_sh("cd %s && { %s run s.ini --quiet --out g/r --set anneal.sweeps=1000000 "
+                          "--set output.checkpoint_every=1 2>err.txt & p=$!; i=0; while [ $i -lt 3000 ] && "
+                          "! test -f g/r/state.lw; do sleep 0.01; i=$((i+1)); done; rm -rf g; wait $p; test $? -eq 1; }",
+                          dir, lw_test_bin()),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  char *e = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(e, "g/r/state.lw is gone, and the run with it\n") && !strstr(e, "resume"), "%s", e);
+  free(e);
 }
 
 /* A run into a directory that held another leaves none of the old run's
