@@ -1387,6 +1387,14 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
                         "nothing to resume: run it again", dir);
   lw_status s = lw_state_read(&st, path, err);
   if (s) return s;
+  /* the run goes on writing scene = scene.ini: another name left it naming
+  ** a file it never had */
+  if (strcmp(st.scene, "scene.ini")) {
+    s = lw_error_set(err, LW_EINPUT, "%s: [run] scene: expected scene.ini, the scene of the run directory, got '%s' "
+                     "(a state not of a run: 'linewise run SCENE --set init.from=%s' starts a run from it)", path,
+                     st.scene, path);
+    goto out;
+  }
   lw_path_join(scene_path, sizeof scene_path, dir, st.scene);
   double ladder[LW_TEMPERING_MAX];
   long trace_bytes = -1;

@@ -1030,6 +1030,21 @@ Test(cli, a_run_without_out_never_replaces_another)
                0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
+/* resume goes on writing "scene = scene.ini" into state.lw: a state naming
+** another scene is refused (the run it rewrote named a scene.ini it never
+** had, and could be neither extended nor measured), energy reads it. */
+Test(cli, resume_refuses_a_state_of_another_scene_file)
+{
+  write_file("s.ini", scene_text);
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --quiet --out o --set anneal.sweeps=2 && cp o/scene.ini o/my.ini && "
+                          "sed -i 's/^scene = scene.ini$/scene = my.ini/' o/state.lw && %s energy o >/dev/null && "
+                          "cp o/state.lw before.lw && { %s resume o --sweeps 2 2>err.txt; test $? -eq 2; } && "
+                          "cmp -s before.lw o/state.lw && grep -q \"o/state.lw: \\[run\\] scene: expected scene.ini, "
+                          "the scene of the run directory, got 'my.ini'\" err.txt", dir, lw_test_bin(), lw_test_bin(),
+                          lw_test_bin()),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+}
+
 /* A run whose directory is removed while it runs ends at its next
 ** checkpoint (exit 1) saying so, not offering a resume of what is gone. */
 Test(cli, a_run_whose_directory_is_removed_says_it_is_gone)
