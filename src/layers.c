@@ -151,6 +151,9 @@ void lw_layers_share(lw_layers_spec *ls, const lw_image *const *target)
   for (int k = 0; target && k < ls->n; k++) {
     const size_t n = (size_t)target[k]->width * (size_t)target[k]->height;
     for (size_t q = 0; q < n; q++) ink[k] += 1.0 - target[k]->tone[q];
+    /* a fine pen's layer was given splines by its ink alone and drew 0.34 of
+    ** a full tone that a wide pen's drew at 0.52 */
+    ink[k] /= ls->spec[k].pen_width;
     total += ink[k];
   }
   ls->cum[0] = 0.0;

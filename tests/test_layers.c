@@ -592,6 +592,30 @@ Test(layers, each_layer_gets_splines_by_its_share_of_the_ink)
   }
 }
 
+/* A layer's share is its ink over its pen's width: two layers of the same
+** ink in pens of 0.2 and 0.8 mm take 4/5 and 1/5 of the splines (by ink
+** alone, half each, the fine pen drew 0.34 of a full tone the wide one
+** drew at 0.52). */
+Test(layers, a_layers_share_is_its_ink_over_its_pens_width)
+{
+  lw_error err;
+  lw_image *a = lw_image_new(4, 3, 0, &err), *b = lw_image_new(4, 3, 0, &err);
+  cr_assert(a && b);
+  for (int q = 0; q < 12; q++) a->tone[q] = b->tone[q] = q % 2 ? 0.25f : 1.0f;
+  lw_layers_spec ls = {.n = 2};
+  ls.spec[0].pen_width = 0.2;
+  ls.spec[1].pen_width = 0.8;
+  const lw_image *t[2] = {a, b};
+  lw_layers_share(&ls, t);
+  cr_expect_float_eq(ls.cum[1], 0.8, 1e-12);
+  cr_expect_eq(ls.cum[2], 1.0);
+  ls.spec[1].pen_width = 0.2; /* equal pens: the ink alone */
+  lw_layers_share(&ls, t);
+  cr_expect_float_eq(ls.cum[1], 0.5, 1e-12);
+  lw_image_free(a);
+  lw_image_free(b);
+}
+
 Test(layers, the_gradient_reads_each_layers_field_and_potential)
 {
   /* Layers with turned fields and their own potentials: the gradient of

@@ -4,8 +4,8 @@
 **
 ** A scene with [layers] names = "a b ..." has L layers, and each spline
 ** belongs to one, a function of its index alone (lw_layers_of): with the
-** layers' shares s_k (the ink of each target over the ink of all, equal
-** shares without a picture) and the golden-ratio sequence
+** layers' shares s_k (the ink of each target over its pen's width, over the
+** sum of those; equal shares without a picture) and the golden-ratio sequence
 ** x_i = frac((i + 1) phi), phi = (sqrt 5 - 1) / 2, spline i is of the
 ** layer k with s_0 + .. + s_(k-1) <= x_i < s_0 + .. + s_k.  The sequence
 ** is evenly spread for every count, so each layer gets its share of any
@@ -107,8 +107,10 @@ typedef struct {
 ** file, line and key and what was expected. */
 lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err);
 
-/* The shares of the layers from the ink (1 - tone) of their targets, or
-** equal shares when there is no ink at all. */
+/* The shares of the layers from the ink (1 - tone) of their targets, each
+** over its pen's width (a line of a pen half as wide lays half the ink, as
+** the count of init.coverage has it), or equal shares when there is no ink
+** at all. */
 void lw_layers_share(lw_layers_spec *ls, const lw_image *const *target);
 
 /* The layer whose share holds u in [0, 1): a birth's layer for u uniform
