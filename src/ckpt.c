@@ -163,7 +163,7 @@ static lw_status parse(lw_ckpt *c, lw_error *err)
     char *eol = nl ? nl : end;
     line++;
     if (memchr(p, '\0', (size_t)(eol - p)))
-      return lw_error_set(err, LW_EINPUT, "%s:%d: a NUL byte inside the line", c->path, line);
+      return lw_error_set(err, LW_EINPUT, "%s:%d: " LW_TEXT_NUL_LINE, c->path, line);
     char *s = trim(p, eol);
     p = eol + 1;
     if (!*s || *s == '#') continue;

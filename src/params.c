@@ -792,7 +792,8 @@ const lw_param_def lw_param_table[] = {
        "The control points as numbers `x y x y ...` (y up; at least `order` points; coordinates within "
        "+-1e9; a long list goes on over indented lines)."),
   STRING("nurbs", "file", nb_file, "", "path",
-         "A file of control points, one `x y` or `x y w` a line (`#` starts a comment), relative "
+         "A file of control points, one `x y` or `x y w` a line (blanks, commas or ', ' between the "
+         "numbers, as CSV; `#` starts a comment), relative "
          "to the scene file; used instead of `points` and `weights` (which hold some 300 points "
          "over indented lines: a file suits a curve made by another program)."),
   LIST("nurbs", "weights", nb_weights, "", "",
@@ -1020,8 +1021,17 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     double v;
     const int whole = d->type != LW_PT_DOUBLE;
     range_text(d, range, sizeof range);
-    if (!lw_number_parse(text, &v)) {
-      snprintf(expected, n, "a %s %s", whole ? "whole number" : "number", range);
+    /* "0,01" from a comma locale, and "1.000" (a thousand there) that read
+    ** as one sweep */
+    const char *mark = strpbrk(text, ",."), *after = mark ? mark + 1 : NULL;
+    const int comma = mark && *mark == ',' && mark > text && isdigit((unsigned char)mark[-1]) &&
+                      isdigit((unsigned char)*after);
+    const int thousands = whole && mark && *mark == '.' && mark > text && isdigit((unsigned char)mark[-1]) &&
+                          strspn(after, "0123456789") == 3 && !after[3];
+    if (!lw_number_parse(text, &v) || thousands) {
+      snprintf(expected, n, "a %s %s%s", whole ? "whole number" : "number", range,
+               comma ? " (a decimal comma? numbers take a point: 0.5, not 0,5)"
+               : thousands ? " (a point as a thousands separator? write 1000, not 1.000)" : "");
       return 0;
     }
     if (whole && v != floor(v)) {
@@ -1317,8 +1327,7 @@ static char *read_line(char *str, int num, void *stream)
   if (*text && !strchr(";#\r\n", *text)) rc->content = 1;
   /* inih would end the value at a NUL byte and drop the rest unseen */
   if (memchr(rc->buf, '\0', (size_t)len)) {
-    lw_error_set(rc->err, LW_EINPUT, "%s:%d: a NUL byte inside the line (UTF-16 text, as some editors save "
-                 "'Unicode', has one in every other byte): expected UTF-8 or ASCII text", rc->p->file, rc->line);
+    lw_error_set(rc->err, LW_EINPUT, "%s:%d: " LW_TEXT_NUL_LINE, rc->p->file, rc->line);
     rc->failed = 1;
     return NULL;
   }

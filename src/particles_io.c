@@ -99,7 +99,7 @@ static lw_status read_text(FILE *f, const char *path, points *pt, lw_error *err)
   if (!s && len == -2 && errno == ENOMEM)
     s = lw_error_set(err, LW_ENOMEM, "%s:%ld: out of memory reading the line", path, line + 1);
   else if (!s && ferror(f)) s = lw_error_set(err, LW_EIO, "%s: read error", path);
-  else if (!s && len == -2) s = lw_error_set(err, LW_EINPUT, "%s:%ld: a NUL byte inside the line", path, line);
+  else if (!s && len == -2) s = lw_error_set(err, LW_EINPUT, "%s:%ld: " LW_TEXT_NUL_LINE, path, line);
   else if (!s && pt->n == 0)
     s = lw_error_set(err, LW_EINPUT, "%s:%ld: expected at least one point 'x y z [nx ny nz]', found none", path, line);
   free(buf);

@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "linewise/number.h"
 
@@ -75,11 +76,16 @@ static ptype type_of(const char *s)
 
 int lw_ply_detect(FILE *f)
 {
-  char head[8] = {0};
-  size_t got = fread(head, 1, 8, f);
+  /* "ply" in any case and blanks after it are a PLY file still, refused by
+  ** its header's reader with a PLY message (a trailing blank was read as a
+  ** text point file: "expected 'x y z' ..., got 'ply '") */
+  char head[24] = {0};
+  size_t got = fread(head, 1, sizeof head - 1, f);
   rewind(f);
   const size_t b = got >= 3 && !memcmp(head, "\xEF\xBB\xBF", 3) ? 3 : 0; /* a byte-order mark (number.h) */
-  return got >= b + 4 && (!memcmp(head + b, "ply\n", 4) || (got >= b + 5 && !memcmp(head + b, "ply\r\n", 5)));
+  if (got < b + 4 || strncasecmp(head + b, "ply", 3)) return 0;
+  const char *end = head + b + 3 + strspn(head + b + 3, " \t");
+  return *end == '\n' || (end[0] == '\r' && end[1] == '\n');
 }
 
 /* Why the next line did not come where it was not the file's end: out of
@@ -102,6 +108,7 @@ static lw_status bad_line(reader *r, const char *expected, const char *got)
 static lw_status read_header(reader *r, const char *const *names, int n_names, elem *el, int *n_el)
 {
   char *s = next_line(r);
+  for (size_t n = s ? strlen(s) : 0; n && (s[n - 1] == ' ' || s[n - 1] == '\t');) s[--n] = '\0'; /* as after words */
   if (!s || strcmp(s, "ply")) return bad_line(r, "the PLY magic line 'ply'", s ? s : "");
   if (!(s = next_line(r))) return bad_line(r, "'format ascii 1.0' (or binary_little_endian, binary_big_endian)", "");
   char *save, *w = strtok_r(s, " \t", &save), *kind = strtok_r(NULL, " \t", &save),

@@ -275,7 +275,7 @@ lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err
         /* a directory, say: the user named the wrong file, so it is bad input */
         status = lw_error_set(err, LW_EINPUT, "%s:%ld: cannot read schedule table: %s", path, lineno + 1,
                               strerror(errno ? errno : EIO));
-      else status = lw_error_set(err, LW_EINPUT, "%s:%ld: a NUL byte inside the line", path, lineno);
+      else status = lw_error_set(err, LW_EINPUT, "%s:%ld: " LW_TEXT_NUL_LINE, path, lineno);
     }
     if (len < 0) break;
     const char *cr = strchr(line, '\r'); /* before the comment is cut: "0 10 # hot\r150 1" hid its rows */

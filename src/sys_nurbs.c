@@ -100,12 +100,14 @@ static lw_status read_file(const lw_params *p, double **P, size_t *np, double **
   while ((len = lw_text_next_line(f, &line, &cap, &lineno)) >= 0) {
     line[strcspn(line, "#")] = '\0';
     double v[4];
-    int k = lw_number_list(line, 0, v, 4);
+    /* commas between the numbers too, as a spreadsheet's CSV writes them */
+    int k = lw_number_list(line, 2, v, 4);
     if (k == 0) continue;
     if ((k != 2 && k != 3) || (per && k != per) || (k == 3 && !(v[2] > 0.0))) {
-      lw_error_set(err, LW_EINPUT, "%s:%ld: expected %s, got '%.60s'", path, lineno,
+      lw_error_set(err, LW_EINPUT, "%s:%ld: expected %s, got '%.60s'%s", path, lineno,
                    per == 2 ? "'x y' like the lines before" : per == 3 ? "'x y w' (w > 0) like the lines before"
-                                                                      : "'x y' or 'x y w' (w > 0)", line);
+                                                                      : "'x y' or 'x y w' (w > 0)", line,
+                   lw_number_list_hint(k));
       st = lw_params_blame(p, "nurbs", "file", err);
       break;
     }
@@ -119,7 +121,7 @@ static lw_status read_file(const lw_params *p, double **P, size_t *np, double **
     if (errno == ENOMEM) st = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
     else {
       lw_error_set(err, LW_EINPUT, "%s:%ld: %s", path, lineno + (ferror(f) != 0),
-                   ferror(f) ? "cannot read" : "a NUL byte inside the line");
+                   ferror(f) ? "cannot read" : LW_TEXT_NUL_LINE);
       st = lw_params_blame(p, "nurbs", "file", err);
     }
   }

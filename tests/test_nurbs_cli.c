@@ -186,6 +186,10 @@ Test(nurbs_cli, bad_knots_and_weights_exit_2_naming_file_line_and_key)
   cr_assert_eq(sh("printf '# wire\\n0 0 1\\n1 1 1\\n2 0\\n' > %s/p.txt", dir), 0);
   refused("file = p.txt\\n", "bad.ini:4: key .nurbs.file.: .*p.txt:4: expected .x y w. (w > 0) like the lines before");
   refused("file = none.txt\\n", "bad.ini:4: key .nurbs.file.: .*none.txt: cannot read");
+  /* decimal commas in a file of commas and blanks: said so */
+  cr_assert_eq(sh("printf '0 0\\n-4,17 5\\n' > %s/dc.txt", dir), 0);
+  refused("file = dc.txt\\n", "bad.ini:4: key .nurbs.file.: .*dc.txt:2: expected .x y. like the lines before, got "
+          ".-4,17 5. (a comma between digits, and blanks between numbers: decimal commas?");
 }
 
 Test(nurbs_cli, a_points_file_holds_a_long_curve)
@@ -196,6 +200,9 @@ Test(nurbs_cli, a_points_file_holds_a_long_curve)
   cr_assert_eq(sh("printf '[scene]\\nsystem = nurbs\\n[nurbs]\\nfile = long.txt\\nalpha = 1\\nbeta = 0.1\\nfixed = 2\\n"
                   "[anneal]\\nsweeps = 20\\n' > %s/long.ini", dir), 0);
   cr_assert_eq(sh("%s run %s/long.ini --out %s/long --quiet", lw_test_bin(), dir, dir), 0);
+  /* the same points as a spreadsheet's CSV: the same run */
+  cr_assert_eq(sh("cd %s && sed 's/ /,/g' long.txt > long.csv && sed 's/long.txt/long.csv/' long.ini > csv.ini && "
+                  "%s run csv.ini --out csv --quiet && cmp -s long/final.svg csv/final.svg", dir, lw_test_bin()), 0);
   cr_assert_eq(sh("grep -q '\"control_points\": 60' %s/long/summary.json && grep -q '\"fixed\": 4' "
                   "%s/long/summary.json", dir, dir), 0);
   /* the file is named from the scene's directory, the run's scene.ini lives

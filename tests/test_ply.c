@@ -137,6 +137,16 @@ Test(ply, the_three_formats_give_the_same_points_around_other_elements_and_lists
     else write_ascii(path);
     read_points(path, LW_OK, NULL);
   }
+  /* blanks after the magic, as an editor leaves them (read as a text point
+  ** file, and refused as one) */
+  char *text = lw_test_slurp("%s", path);
+  char *spaced = malloc(strlen(text) + 4);
+  sprintf(spaced, "ply \t%s", text + 3);
+  cr_assert_eq(lw_test_write_text(dir, "spaced.ply", spaced), 0);
+  snprintf(path, sizeof path, "%s/spaced.ply", dir);
+  read_points(path, LW_OK, NULL);
+  free(spaced);
+  free(text);
 }
 
 /* Each bad file and what its one message must say. */
@@ -171,6 +181,9 @@ Test(ply, every_refusal_names_the_file_and_where)
       {"ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float x\nproperty float y\n"
        "property float z\nend_header\n1 5 2 3\n", "expected the vertex property 'x'"},
       {"ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nend_header\n", "expected at least one vertex"},
+      /* told a PLY file by its magic in any case: refused as PLY, not read
+      ** as a text point file ("expected 'x y z'") */
+      {"PLY\nformat ascii 1.0\nend_header\n", ":1: expected the PLY magic line 'ply', got 'PLY'"},
   };
   char path[128];
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {

@@ -65,6 +65,10 @@ long lw_text_next_line(FILE *f, char **buf, size_t *cap, long *line);
 #define LW_TEXT_LINE_MAX (64L << 20)
 ssize_t lw_text_getline(char **buf, size_t *cap, FILE *f);
 
+/* What every text reader says of a line with a NUL byte in it (-2 above). */
+#define LW_TEXT_NUL_LINE "a NUL byte inside the line (UTF-16 text, as some editors save 'Unicode', has one in " \
+                         "every other byte): expected UTF-8 or ASCII text"
+
 /* LW_EINPUT with err where path names a FIFO or a socket, which a reader
 ** would wait on for ever (opening a FIFO waits for a writer); else LW_OK. */
 lw_status lw_text_not_fifo(const char *path, lw_error *err);
