@@ -382,6 +382,33 @@ Test(cli, every_simd_width_writes_the_same_files)
                  0, "%s", lanes[k]);
 }
 
+/* NUMERICS.md promises the same files from GCC and clang builds (the
+** Makefile's -ffp-contract=off: clang fused a multiply and an add where
+** -march allowed it): a clang build of the same sources writes the bytes of
+** this build for a picture scene, a tempering NURBS wire and growing
+** particles.  Needs clang (make deps installs it). */
+Test(cli, a_clang_build_writes_the_same_files, .timeout = 300)
+{
+  if (lw_test_sh("command -v clang >/dev/null"))
+    cr_skip_test("clang is not installed (make deps installs it)");
+  cr_assert_eq(lw_test_sh("mkdir -p %s/cl && cp -r %s/Makefile %s/src %s/include %s/cl && cd %s/cl && "
+                          "make -j2 CC=clang bin/linewise >make.log 2>&1", dir, lw_test_root(), lw_test_root(),
+                          lw_test_root(), dir, dir),
+               0, "%s", lw_test_slurp("%s/cl/make.log", dir));
+  static const char *const run[][2] = {
+      {"example", "--set anneal.sweeps=3 --set output.png_scale=1"},
+      {"wire-ladder", "--set anneal.sweeps=20"},
+      {"particles-grow", "--set anneal.sweeps=20"},
+  };
+  for (size_t k = 0; k < sizeof run / sizeof *run; k++) {
+    cr_assert_eq(lw_test_sh("cd %s && for b in %s:gcc cl/bin/linewise:clang; do ${b%%:*} run %s/params/%s.ini "
+                            "--threads 2 --quiet %s --out ${b##*:}-%zu || exit 1; done && for f in state.lw trace.csv "
+                            "final.png; do cmp gcc-%zu/$f clang-%zu/$f || exit 1; done",
+                            dir, lw_test_bin(), lw_test_root(), run[k][0], run[k][1], k, k, k),
+                 0, "%s", run[k][0]);
+  }
+}
+
 /* A key the scene's system reads under no driver is refused before
 ** anything is written, naming where it was set and who reads it; the
 ** default, named, is not; a key only the other driver reads is noted and the
