@@ -184,6 +184,35 @@ static double number_after(const char *text, const char *label)
   return at ? strtod(at + strlen(label), NULL) : NAN;
 }
 
+static int exists(const char *name);
+
+/* Writes an executable script dir/name from a format (a fake tool for the
+** tests to put first on PATH or pass as --bin). */
+static void write_script(const char *name, const char *fmt, ...)
+{
+  char path[256];
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  FILE *f = fopen(path, "w");
+  cr_assert_not_null(f, "%s", path);
+  va_list ap;
+  va_start(ap, fmt);
+  vfprintf(f, fmt, ap);
+  va_end(ap);
+  cr_assert_eq(fclose(f), 0);
+  cr_assert_eq(chmod(path, 0755), 0);
+}
+
+/* Whether text holds a message of bash or a tool rather than the script's
+** own (bash's "line 744: ...", "printf: write error", "tail: cannot open"). */
+static int raw_error(const char *text)
+{
+  static const char *const raw[] = {": line ", "integer expression", "write error", "tail:", "mkdir:", "mv:",
+                                    "printf:", "echo:", "No such file or directory"};
+  for (size_t i = 0; i < sizeof raw / sizeof *raw; i++)
+    if (strstr(text, raw[i])) return 1;
+  return 0;
+}
+
 /* ---- seed-sweep ------------------------------------------------------- */
 
 Test(tools, seed_sweep_gathers_every_summary_and_links_the_best)
@@ -739,11 +768,101 @@ Test(tools, a_sweep_of_other_settings_is_refused_while_one_runs)
   cr_assert_eq(sh("SLURM_ARRAY_TASK_ID=1 SLURM_SUBMIT_DIR=%s %s %s --seeds 1 " TINY " --bin %s --out %s/r",
                   env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
   cr_assert_eq(sh("grep -qx 'set anneal.sweeps=20' %s/r/sweep.conf && test -s %s/r/seed-1/summary.json", dir, dir), 0);
-  /* where the lock files cannot be opened (nor locked: a file system
-  ** without flock), the check is made without them, as before */
-  cr_assert_eq(sh("mkdir %s/n && ln -s /nonexistent/x %s/n/.sweep.lock && SLURM_ARRAY_TASK_ID=1 SLURM_SUBMIT_DIR=%s "
-                  "%s %s --seeds 1 " TINY " --bin %s --out %s/n && test -s %s/n/seed-1/summary.json", dir, dir,
-                  env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir, dir), 0, "%s", err_txt());
+  /* where the lock files cannot be locked (a file system without flock),
+  ** the check is made without them, as before */
+  cr_assert_eq(sh("mkdir %s/fl", dir), 0);
+  write_script("fl/flock", "#!/bin/sh\nexit 1\n");
+  cr_assert_eq(sh("PATH=%s/fl:$PATH SLURM_ARRAY_TASK_ID=1 SLURM_SUBMIT_DIR=%s %s %s --seeds 1 " TINY " --bin %s --out "
+                  "%s/n && test -s %s/n/seed-1/summary.json", dir, env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(),
+                  env("LW_BIN"), dir, dir), 0, "%s", err_txt());
+}
+
+/* A lock planted as a link had the sweep's open make the file it named
+** (another user's, in a shared sweep folder), and a FIFO there held the sweep
+** forever: both are refused with one line.  The sweep's own notes lay at
+** names made of one mktemp name (.sweep-notes.X.rc, .xargs), known while it
+** ran: they are in a directory of their own, which only the sweep may write. */
+Test(tools, a_sweep_takes_no_lock_that_is_a_link_or_no_file)
+{
+  static const char *const lock[] = {".sweep.lock", ".sweep.running"};
+  for (int k = 0; k < 2; k++) {
+    cr_assert_eq(sh("rm -rf %s/l && mkdir %s/l && ln -s %s/victim %s/l/%s", dir, dir, dir, dir, lock[k]), 0);
+    cr_assert_eq(sh("%s %s --seeds 1 " TINY " --bin %s --out %s/l", tool("seed-sweep"), scene(), env("LW_BIN"), dir),
+                 2, "%s", lock[k]);
+    char *e = err_txt();
+    cr_assert(strstr(e, lock[k]) && strstr(e, "a symbolic link") && strchr(e, '\n') == e + strlen(e) - 1, "%s", e);
+    free(e);
+    cr_assert(!exists("victim"), "%s: the file a planted link names was made", lock[k]);
+    cr_assert(!exists("l/seed-1"), "%s: a run started", lock[k]);
+  }
+  cr_assert_eq(sh("rm -rf %s/l && mkdir %s/l && mkfifo %s/l/.sweep.lock && timeout 20 %s %s --seeds 1 " TINY
+                  " --bin %s --out %s/l", dir, dir, dir, tool("seed-sweep"), scene(), env("LW_BIN"), dir), 2,
+               "a FIFO as the lock");
+  char *e = err_txt();
+  cr_assert(strstr(e, ".sweep.lock: a symbolic link or not a plain file"), "%s", e);
+  free(e);
+  /* what a run sees of the notes: a file in a directory of the sweep's own
+  ** (0700), not beside the runs */
+  write_script("notes-linewise", "#!/bin/sh\nd=${LW_SWEEP_NOTES%%/*}\nstat -c '%%a %%n' \"$d\" >>%s/notes.txt\n"
+               "exec %s \"$@\"\n", dir, env("LW_BIN"));
+  cr_assert_eq(sh("%s %s --seeds 1 " TINY " --bin %s/notes-linewise --out %s/m", tool("seed-sweep"), scene(), dir,
+                  dir), 0, "%s", err_txt());
+  char *notes = lw_test_slurp("%s/notes.txt", dir), want[128];
+  snprintf(want, sizeof want, "700 %s/m/.sweep-notes.", dir);
+  cr_assert(notes && !strncmp(notes, want, strlen(want)), "%s", notes ? notes : "(none)");
+  free(notes);
+  cr_assert_eq(sh("test -z \"$(ls -A %s/m | grep notes)\"", dir), 0, "the notes left behind");
+}
+
+/* xargs's status reached the sweep through a file, which a full disk left
+** empty: "integer expression expected", and a sweep whose run failed exited
+** 0.  Here the file reads back empty as on a full disk (a link to
+** /dev/null, planted at its name once xargs returns); a failed run is a
+** failed sweep whatever became of such a file. */
+Test(tools, a_failed_run_fails_the_sweep_on_a_full_disk)
+{
+  cr_assert_eq(sh("mkdir %s/px", dir), 0);
+  write_script("px/xargs", "#!/bin/sh\n%s \"$@\"\nrc=$?\nln -sf /dev/null \"$LW_SWEEP_NOTES.rc\"\nexit $rc\n",
+               "$(PATH=/usr/local/bin:/usr/bin:/bin command -v xargs)");
+  int rc = sh("PATH=%s/px:$PATH %s %s --vary init.splines=4,-1 --seeds 1 --set anneal.sweeps=20 --bin %s --out %s/f",
+              dir, tool("param-sweep"), scene(), env("LW_BIN"), dir);
+  char *e = err_txt();
+  cr_assert_eq(rc, 1, "%s", e);
+  cr_assert(strstr(e, "some runs failed") && !raw_error(e), "%s", e);
+  free(e);
+}
+
+/* A run's log that cannot be made (a full disk, no inodes left; here a
+** directory in its place) left a reason of nothing after "FAILED (exit 1): "
+** among bash's and tail's words, and pointed at a log that is not there; a
+** log a full disk left empty (here: a linewise that says nothing) said
+** nothing either; a run directory that cannot be made, and a sweep.conf that
+** cannot be written (a file-size limit, as a full disk), said it twice, the
+** tool's line and the sweep's.  Each is one line of the sweep's. */
+Test(tools, a_run_whose_log_cannot_be_written_is_said_so)
+{
+  write_script("quiet-linewise", "#!/bin/sh\ncase \"$*\" in *'--seed 2 '*) exit 1 ;; esac\nexec %s \"$@\"\n",
+               env("LW_BIN"));
+  cr_assert_eq(sh("mkdir -p %s/g/seed-3/linewise.log && touch %s/g/seed-4", dir, dir), 0);
+  cr_assert_eq(sh("%s %s --seeds 1-4 -j 1 " TINY " --bin %s/quiet-linewise --out %s/g", tool("seed-sweep"), scene(),
+                  dir, dir), 1);
+  char *e = err_txt();
+  cr_assert(!raw_error(e), "%s", e);
+  cr_assert(strstr(e, "seed-2: FAILED (exit 1): its linewise.log is empty"), "%s", e);
+  cr_assert(strstr(e, "seed-3: FAILED: its linewise.log could not be written (Is a directory); the run was not "
+                      "started\n"), "%s", e);
+  cr_assert(strstr(e, "seed-3: not finished: failed or not started (it has no linewise.log to say which)"), "%s", e);
+  cr_assert(strstr(e, "seed-4: FAILED: ") && strstr(e, "/g/seed-4: cannot create directory: File exists\n"), "%s",
+            e);
+  free(e);
+  cr_assert_eq(sh("test -s %s/g/seed-1/summary.json", dir), 0, "the other runs go on");
+  /* (its words through a pipe: the limit holds for every file it writes) */
+  cr_assert_eq(sh("(trap '' XFSZ; ulimit -f 0; %s %s --seeds 1 " TINY " --bin %s --out %s/c 2>&1; echo \"exit $?\") | "
+                  "cat", tool("seed-sweep"), scene(), env("LW_BIN"), dir), 0);
+  e = out_txt();
+  cr_assert(strstr(e, "/c/sweep.conf: cannot write: File too large\nexit 1\n") && strchr(e, '\n') < strstr(e, "exit"),
+            "%s", e);
+  free(e);
 }
 
 Test(tools, bad_usage_exits_2_with_one_message_and_writes_nothing)
@@ -1010,6 +1129,12 @@ Test(tools, a_sweep_writes_no_log_through_a_link)
   cr_assert_eq(sh("grep -qx keep %s/victim && test $(wc -l < %s/victim) -eq 1", dir, dir), 0,
                "the log was written through the link");
   cr_assert_eq(sh("test -s %s/s/seed-2/summary.json", dir), 0, "the other run did not finish");
+  /* a FIFO there held the run's task, and the sweep, forever */
+  cr_assert_eq(sh("mkdir -p %s/f/seed-1 && mkfifo %s/f/seed-1/linewise.log && timeout 20 %s %s --seeds 1-2 " TINY
+                  " --bin %s --out %s/f", dir, dir, tool("seed-sweep"), scene(), env("LW_BIN"), dir), 1);
+  e = err_txt();
+  cr_assert(strstr(e, "seed-1/linewise.log: a symbolic link or a FIFO"), "%s", e);
+  free(e);
 }
 
 Test(tools, plot_sweep_draws_a_png_beside_the_csv)
