@@ -1137,6 +1137,49 @@ Test(tools, a_sweep_writes_no_log_through_a_link)
   free(e);
 }
 
+/* gnuplot says nothing of a picture it could not write: on a nearly full
+** disk an empty or cut-off PNG replaced a good one, with exit 0; on a full
+** one, every line of the script said "echo: write error", then mv, then exit
+** 2.  Here a file-size limit stands in for the disk: gnuplot's pictures are
+** cut off at 4 KiB (SIGXFSZ ignored, as a full disk gives ENOSPC and no
+** signal), or the script at 512 bytes.  The good plots stay, with one line a
+** plot and exit 1, and no temporary is left. */
+Test(tools, a_plot_that_cannot_be_written_whole_leaves_the_earlier_one)
+{
+  cr_assert_eq(sh("%s run %s " TINY " --quiet --out %s/r", env("LW_BIN"), scene(), dir), 0);
+  cr_assert_eq(sh("%s %s/r && cp -r %s/r/plots %s/good", tool("plot-run"), dir, dir, dir), 0, "%s", err_txt());
+  cr_assert_eq(sh("mkdir %s/pg", dir), 0);
+  write_script("pg/gnuplot", "#!/bin/sh\ntrap '' XFSZ\nulimit -f 8\nexec %s \"$@\"\n",
+               "$(PATH=/usr/local/bin:/usr/bin:/bin command -v gnuplot)");
+  cr_assert_eq(sh("PATH=%s/pg:$PATH %s %s/r", dir, tool("plot-run"), dir), 1, "%s", err_txt());
+  char *e = err_txt();
+  cr_assert(strstr(e, "plot-run: ") && strstr(e, "/r/plots/energy.png: gnuplot's picture was not written whole (a "
+                                                 "full disk?); the earlier one is kept\n") && !raw_error(e), "%s", e);
+  free(e);
+  cr_assert_eq(sh("for f in energy temperature acceptance; do cmp %s/good/$f.png %s/r/plots/$f.png || exit 1; done && "
+                  "test -z \"$(ls -A %s/r/plots | grep tmp)\"", dir, dir, dir), 0,
+               "a plot was replaced, or a temporary left");
+  cr_assert_eq(sh("(trap '' XFSZ; ulimit -f 1; %s %s/r)", tool("plot-run"), dir), 1);
+  e = err_txt();
+  cr_assert(strstr(e, ".plot.gp.tmp: gnuplot's script could not be written whole") &&
+            strchr(e, '\n') == e + strlen(e) - 1, "%s", e);
+  free(e);
+  cr_assert_eq(sh("for f in energy temperature acceptance; do cmp %s/good/$f.png %s/r/plots/$f.png || exit 1; done && "
+                  "test -z \"$(ls -A %s/r/plots | grep tmp)\"", dir, dir, dir), 0);
+  /* plot-sweep: an empty picture (no room at all) */
+  write_text("seeds.csv", "seed,energy_total,run\n1,2.5,seed-1\n2,1.75,seed-2\n");
+  cr_assert_eq(sh("%s %s/seeds.csv && cp %s/seeds.png %s/seeds.good", tool("plot-sweep"), dir, dir, dir), 0, "%s",
+               err_txt());
+  write_script("pg/gnuplot", "#!/bin/sh\ntrap '' XFSZ\nulimit -f 0\nexec %s \"$@\"\n",
+               "$(PATH=/usr/local/bin:/usr/bin:/bin command -v gnuplot)");
+  cr_assert_eq(sh("PATH=%s/pg:$PATH %s %s/seeds.csv", dir, tool("plot-sweep"), dir), 1, "%s", err_txt());
+  e = err_txt();
+  cr_assert(strstr(e, "seeds.png: gnuplot's picture was not written whole (a full disk?); the earlier one is "
+                      "kept\n") && strchr(e, '\n') == e + strlen(e) - 1, "%s", e);
+  free(e);
+  cr_assert_eq(sh("cmp %s/seeds.good %s/seeds.png && test ! -e %s/seeds.png.tmp", dir, dir, dir), 0);
+}
+
 Test(tools, plot_sweep_draws_a_png_beside_the_csv)
 {
   write_text("seeds.csv", "seed,energy_total,energy_bending,proposals_per_second,wall_seconds,run\n"
