@@ -55,6 +55,19 @@ all: $(BIN)/linewise $(PICTURE) $(MPI_BIN)
 $(BUILD)/obj/%.o: src/%.c | $(BUILD)/obj
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(DEPFLAGS) $(LW_CPPFLAGS) $(CPPFLAGS) -c $< -o $@
 
+# The commit a build is made from, "-dirty" with changes not committed, or
+# "unknown" outside a git checkout: `linewise --version`, summary.json and a
+# run's scene.ini name it, as a release spans many changes of the files.
+# version.o alone is compiled again when it changes ($(BUILD)/build-id is
+# rewritten only then).
+LW_BUILD_ID := $(or $(shell git rev-parse --short=12 HEAD 2>/dev/null),unknown)$(if $(shell git status \
+               --porcelain --untracked-files=no 2>/dev/null | head -c1),-dirty)
+$(BUILD)/build-id: FORCE | $(BUILD)/obj
+	@echo '$(LW_BUILD_ID)' > $@.tmp && if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv $@.tmp $@; fi
+$(BUILD)/obj/version.o build-fuzz/obj/version.o: LW_CPPFLAGS += -DLW_BUILD_ID='"$(LW_BUILD_ID)"'
+$(BUILD)/obj/version.o build-fuzz/obj/version.o: $(BUILD)/build-id
+FORCE:
+
 $(BUILD)/liblinewise.a: $(LIB_OBJ)
 	rm -f $@ && ar rcs $@ $^
 

@@ -1935,6 +1935,7 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json_init(&j, f);
   lw_json_begin_object(&j);
   lw_json_key(&j, "version"); lw_json_string(&j, LW_VERSION); /* the release that wrote it */
+  lw_json_key(&j, "build"); lw_json_string(&j, lw_version_build());
   lw_json_key(&j, "seed"); lw_json_int(&j, (long long)a->seed);
   lw_json_key(&j, "sweeps"); lw_json_int(&j, a->sweep);
   lw_json_key(&j, "system"); lw_json_string(&j, t->name);

@@ -1676,7 +1676,7 @@ static int command(int argc, char **argv)
       return 2;
     }
     if (!listing) {
-      printf("linewise %s\n", LW_VERSION);
+      printf("linewise %s\nbuild %s\n", LW_VERSION, lw_version_build());
       /* what a porter checks the same-bits promise against (LW_LANES) */
       printf("pair kernels %d lanes, cell scan %d lanes (LW_LANES=2 or 4 narrows them; every width gives the same "
              "bits)\n", lw_vec_wide() ? 4 : 2, lw_vec_lanes());

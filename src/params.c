@@ -1952,7 +1952,7 @@ static int file_hash(const char *path, unsigned long long *h)
 
 int lw_params_write_files(const lw_params *p, FILE *f)
 {
-  fprintf(f, "; written by linewise %s\n", LW_VERSION);
+  fprintf(f, "; written by linewise %s, build %s\n", LW_VERSION, lw_version_build());
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
     unsigned long long h;

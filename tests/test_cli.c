@@ -349,15 +349,20 @@ Test(cli, the_version_is_the_man_pages_and_the_summarys)
   static const char *const ask[] = {"--version", "version", "-V"};
   for (size_t k = 0; k < sizeof ask / sizeof ask[0]; k++) {
     cr_assert_eq(run(ask[k], out, sizeof out, errs, sizeof errs), 0, "%s", ask[k]);
-    cr_assert(!strncmp(out, want, strlen(want)) && !strncmp(out + strlen(want), "pair kernels ", 13), "%s: %s",
-              ask[k], out);
+    /* and the commit it was built from (version.h), "unknown" outside git */
+    const char *build = out + strlen(want), *eol = strchr(build, '\n');
+    cr_assert(!strncmp(out, want, strlen(want)) && !strncmp(build, "build ", 6) && eol &&
+              (size_t)(eol - build) == 6 + strlen(lw_version_build()) && !strncmp(eol + 1, "pair kernels ", 13),
+              "%s: %s", ask[k], out);
   }
   cr_assert_eq(lw_test_sh("grep -q '^.TH LINEWISE 1 \"[0-9]*\" \"linewise %s\"' %s/docs/linewise.1", LW_VERSION,
                           lw_test_root()),
                0, "docs/linewise.1 names another release than %s", LW_VERSION);
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set anneal.sweeps=2 --out %s/v --quiet && "
-                          "grep -q '^  \"version\": \"%s\",$' %s/v/summary.json",
-                          lw_test_bin(), lw_test_root(), dir, LW_VERSION, dir),
+                          "grep -q '^  \"version\": \"%s\",$' %s/v/summary.json && "
+                          "grep -q '^  \"build\": \"[0-9a-f]\\{12\\}\\(-dirty\\)\\?\",$\\|^  \"build\": \"unknown\",$' "
+                          "%s/v/summary.json && grep -q '^; written by linewise %s, build ' %s/v/scene.ini",
+                          lw_test_bin(), lw_test_root(), dir, LW_VERSION, dir, dir, LW_VERSION, dir),
                0);
 }
 

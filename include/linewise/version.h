@@ -8,4 +8,9 @@
 
 #define LW_VERSION "2026.12"
 
+/* The commit the build was made from (12 hex digits, "-dirty" after them
+** where files differed from it), or "unknown" outside a git checkout: a
+** release spans many changes that alter a run's files. */
+const char *lw_version_build(void);
+
 #endif
