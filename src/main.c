@@ -9,6 +9,7 @@
 #include <errno.h>
 #include <gsl/gsl_errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <math.h>
 #include <omp.h>
 #include <pthread.h>
@@ -185,6 +186,31 @@ static lw_status path_plain(const char *what, const char *path, lw_error *err)
                           "without one", what, (size_t)(c - path) + 1, path, (unsigned char)*c,
                           *c == '\r' ? " (a CR: a script saved with CRLF line ends?)" : "");
   return LW_OK;
+}
+
+/* A bundled scene named without its folder ("linewise run example.ini" as
+** the README's bin/linewise run params/example.ini, from an install or
+** another directory) that is not here: where the bundled one is, beside
+** this binary's install (PREFIX/share/linewise/params) or checkout. */
+static void bundled_hint(const char *scene, lw_error *err)
+{
+  char exe[LW_PATH_MAX], path[2 * LW_PATH_MAX];
+  const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+  if (n <= 0 || !strstr(err->msg, ": cannot open scene file: ") || !access(scene, F_OK)) return;
+  exe[n] = '\0';
+  char *slash = strrchr(exe, '/');
+  if (slash) *slash = '\0';
+  const char *base = strrchr(scene, '/') ? strrchr(scene, '/') + 1 : scene;
+  static const char *const under[] = {"/../share/linewise/params/", "/../params/"};
+  for (int k = 0; k < 2; k++) {
+    snprintf(path, sizeof path, "%s%s%s", exe, under[k], base);
+    char real[PATH_MAX];
+    if (!access(path, R_OK) && realpath(path, real)) {
+      const size_t m = strlen(err->msg);
+      snprintf(err->msg + m, sizeof err->msg - m, " (the bundled %.200s is %.1000s)", base, real);
+      return;
+    }
+  }
 }
 
 static lw_status dir_fits(const char *what, const char *dir, lw_error *err)
@@ -1003,7 +1029,11 @@ static int cmd_run(int argc, char **argv)
     return fail(&err);
   }
   /* resolved once --set has applied: lw_anneal_start */
-  if (path_plain("run", scene, &err) || lw_params_read_unresolved(&p, scene, &err)) return fail(&err);
+  if (path_plain("run", scene, &err)) return fail(&err);
+  if (lw_params_read_unresolved(&p, scene, &err)) {
+    bundled_hint(scene, &err);
+    return fail(&err);
+  }
   for (int i = 0; i < argc; i++) {
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
     if (!strcmp(argv[i], "--set")) {

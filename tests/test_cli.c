@@ -1077,6 +1077,19 @@ Test(cli, resume_refuses_a_state_of_another_scene_file)
                0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
+/* A bundled scene named without its folder, from another directory (or
+** from an install, whose scenes are in PREFIX/share/linewise/params): the
+** message says where the bundled one is; another name gets no hint. */
+Test(cli, a_bundled_scene_named_alone_elsewhere_is_pointed_to)
+{
+  cr_assert_eq(lw_test_sh("R=$(cd %s && pwd -P) && cd %s && { %s run example.ini 2>err.txt; test $? -eq 2; } && "
+                          "grep -qx \"linewise: example.ini: cannot open scene file: No such file or directory (the "
+                          "bundled example.ini is $R/params/example.ini)\" err.txt && { %s run nothere.ini 2>err.txt; "
+                          "test $? -eq 2; } && grep -qx 'linewise: nothere.ini: cannot open scene file: No such file or "
+                          "directory' err.txt", lw_test_root(), dir, lw_test_bin(), lw_test_bin()),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+}
+
 /* A run whose directory is removed while it runs ends at its next
 ** checkpoint (exit 1) saying so, not offering a resume of what is gone. */
 Test(cli, a_run_whose_directory_is_removed_says_it_is_gone)
