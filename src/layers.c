@@ -134,7 +134,7 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
   } else if (ls->source == LW_LSRC_PALETTE) {
     return bad(p, "source", err, "'palette' needs layers.colors: the pens to separate the picture into");
   }
-  lw_layers_share(ls, NULL);
+  lw_layers_share(ls, NULL, 0);
   for (int k = 0; k < n; k++) {
     ls->spec[k].turn = turn[k] * M_PI / 180.0;
     ls->spec[k].tone_min = lo[k];
@@ -145,7 +145,7 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
   return LW_OK;
 }
 
-void lw_layers_share(lw_layers_spec *ls, const lw_image *const *target)
+void lw_layers_share(lw_layers_spec *ls, const lw_image *const *target, int by_width)
 {
   double ink[LW_LAYERS_MAX] = {0}, total = 0.0;
   for (int k = 0; target && k < ls->n; k++) {
@@ -153,7 +153,7 @@ void lw_layers_share(lw_layers_spec *ls, const lw_image *const *target)
     for (size_t q = 0; q < n; q++) ink[k] += 1.0 - target[k]->tone[q];
     /* a fine pen's layer was given splines by its ink alone and drew 0.34 of
     ** a full tone that a wide pen's drew at 0.52 */
-    ink[k] /= ls->spec[k].pen_width;
+    if (by_width) ink[k] /= ls->spec[k].pen_width;
     total += ink[k];
   }
   ls->cum[0] = 0.0;

@@ -1140,6 +1140,15 @@ static int cmd_run(int argc, char **argv)
     fprintf(stderr, "linewise: note: anneal.seed_version = 1: %s is a run's scene.ini from before 2026-12-06, so this "
             "run seeds as that one did, where two seeds could draw the same numbers; --set anneal.seed_version=2 for "
             "a new study (docs/NUMERICS.md, \"Random numbers\")\n", scene);
+  /* a release spans changes that draw a scene otherwise (each keeps a run
+  ** begun before on resume, not a new run of its scene.ini) */
+  char this_build[64];
+  snprintf(this_build, sizeof this_build, "%s, build %s", LW_VERSION, lw_version_build());
+  if (a.params.run_header && strcmp(a.params.run_build, this_build) && (!net || !net->rank))
+    fprintf(stderr, "linewise: note: %s was written by %s%s; this is linewise %s, which may draw it otherwise where "
+            "its behaviour changed since (docs/FORMATS.md, \"Runs of older releases\")\n", scene,
+            a.params.run_build[0] ? "linewise " : "an earlier linewise, which recorded no build",
+            a.params.run_build, this_build);
   char changed[LW_PARAMS_FILES_MAX * (LW_PATH_MAX + 40)];
   const int n_changed = lw_params_files_changed(&a.params, changed, sizeof changed);
   if (n_changed && (!net || !net->rank))

@@ -660,6 +660,10 @@ const lw_param_def lw_param_table[] = {
          "Pen width of each layer (its SVG stroke and its tone footprint); empty = output.pen_width each. "
          "The spacing (energy.min_spacing) and the close share stay of output.pen_width: a wider layer's "
          "strokes may run into each other's ink."),
+  NUM("layers", "share_width", LW_PT_INT, ly_share_width, "1", "", 0, 1, 0,
+      "1 = a layer's share of the splines is its ink over its pen width (a fine pen's layer gets more lines); "
+      "0 = its ink alone, as runs before this key (a 0.2 mm pen drew 0.34 of a full tone beside a 0.8 mm "
+      "pen's 0.52; a run of theirs, whose scene.ini has no line for this key, resumes so)."),
   NUM("particles", "count", LW_PT_INT, pt_count, "100", "", 0, 1e7, 0,
       "Particles placed by `pattern` (after those of `points`, if any)."),
   CHOICE("particles", "pattern", pt_pattern, "plane", "cloud|plane|sphere",
@@ -1208,6 +1212,7 @@ lw_status lw_params_blame(const lw_params *p, const char *section, const char *k
 }
 
 #define LW_PARAMS_FILE_LINE "; file "
+#define LW_PARAMS_WRITTEN_LINE "; written by linewise "
 
 static void read_file_line(lw_params *p, const char *text);
 
@@ -1952,7 +1957,7 @@ static int file_hash(const char *path, unsigned long long *h)
 
 int lw_params_write_files(const lw_params *p, FILE *f)
 {
-  fprintf(f, "; written by linewise %s, build %s\n", LW_VERSION, lw_version_build());
+  fprintf(f, "%s%s, build %s\n", LW_PARAMS_WRITTEN_LINE, LW_VERSION, lw_version_build());
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
     unsigned long long h;
@@ -1963,17 +1968,23 @@ int lw_params_write_files(const lw_params *p, FILE *f)
 }
 
 /* A "; file section.key: fnv1a-64 HEX" line of a run's scene.ini kept in p
-** (lw_params_write_files); any other comment is the scene's own. */
+** (lw_params_write_files), and its "; written by linewise" line; any other
+** comment is the scene's own. */
 static void read_file_line(lw_params *p, const char *text)
 {
   char name[80];
   unsigned long long h;
+  if (!strncmp(text, LW_PARAMS_WRITTEN_LINE, strlen(LW_PARAMS_WRITTEN_LINE))) {
+    snprintf(p->run_build, sizeof p->run_build, "%.*s", (int)strcspn(text + strlen(LW_PARAMS_WRITTEN_LINE), "\r\n"),
+             text + strlen(LW_PARAMS_WRITTEN_LINE));
+    return;
+  }
   if (strncmp(text, LW_PARAMS_FILE_LINE, strlen(LW_PARAMS_FILE_LINE)) || p->n_files >= LW_PARAMS_FILES_MAX ||
       sscanf(text + strlen(LW_PARAMS_FILE_LINE), "%79[^:]: fnv1a-64 %16llx", name, &h) != 2)
     return;
   char *dot = strchr(name, '.');
   const lw_param_def *d = dot ? (*dot = '\0', lw_params_find(name, dot + 1)) : NULL;
-  if (!d) return;
+  if (!d || d->type != LW_PT_STRING || strcmp(d->unit, "path")) return; /* (a line edited by hand) */
   p->file_key[p->n_files] = (unsigned short)(d - lw_param_table);
   p->file_hash[p->n_files++] = h;
 }
@@ -1987,7 +1998,8 @@ int lw_params_files_changed(const lw_params *p, char *buf, size_t n)
     const lw_param_def *d = &lw_param_table[p->file_key[k]];
     const char *path = (const char *)p + d->offset;
     unsigned long long h;
-    if (path[0] && !file_hash(path, &h) && h == p->file_hash[k]) continue;
+    /* a file given by --set is another on purpose (a sweep over pictures) */
+    if (p->line[p->file_key[k]] == -1 || (path[0] && !file_hash(path, &h) && h == p->file_hash[k])) continue;
     if (used < n)
       used += (size_t)snprintf(buf + used, n - used, "%s%s.%s (%s)", changed ? ", " : "", d->section, d->key,
                                path[0] ? path : "now none");

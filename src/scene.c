@@ -119,10 +119,15 @@ static lw_status scored_side_ok(const lw_params *p, const char *section, const c
 ** scene.ini: it resumes with the key's old behaviour, as it ran (a scene.ini
 ** written by hand beside a state takes the default).  The keys of
 ** 2026-12-05 and 06: field_core, image_levels_alpha, image_levels_flat,
-** potential_paper, potential_fine. */
+** potential_paper, potential_fine, layers.share_width. */
+static int before_key_of(const lw_params *p, const char *section, const char *key)
+{
+  return p->run_written && !lw_params_line(p, section, key);
+}
+
 static int before_key(const lw_params *p, const char *key)
 {
-  return p->run_written && !lw_params_line(p, "scene", key);
+  return before_key_of(p, "scene", key);
 }
 
 /* The potential of picture img (the scene's, or a layer's target) placed as
@@ -522,7 +527,7 @@ static lw_status build_layers(lw_scene *sc, const lw_params *p, lw_error *err)
     if ((st = layer_targets(sc, p, err))) return st;
     const lw_image *t[LW_LAYERS_MAX];
     for (int k = 0; k < sc->layers.n; k++) t[k] = sc->layer[k].target;
-    lw_layers_share(&sc->layers, t);
+    lw_layers_share(&sc->layers, t, p->ly_share_width && !before_key_of(p, "layers", "share_width"));
   }
   for (int k = 0; k < sc->layers.n; k++) {
     lw_layer *l = &sc->layer[k];

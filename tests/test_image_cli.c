@@ -288,6 +288,28 @@ Test(image_cli, running_a_runs_scene_again_says_which_files_changed_since)
   cr_assert(strstr(errs, "linewise: note: scene.image (") && strstr(errs, "/pic.png), init.from (") &&
             strstr(errs, "/a/state.lw) changed since the run that wrote b/scene.ini read them: this run does not "
                          "repeat that one\n"), "%s", errs);
+  /* a file --set names is another on purpose: not said (a sweep over
+  ** pictures said it at every run); a hash line edited onto a key that
+  ** names no file is the scene's comment */
+  cr_assert_eq(run("run b/scene.ini --out e --quiet --set scene.image=pic.png --set init.from=c/state.lw", errs,
+                   sizeof errs), 0, "%s", errs);
+  cr_assert(!strstr(errs, "changed since"), "%s", errs);
+  cr_assert_eq(lw_test_sh("cd %s && sed '2a ; file anneal.sweeps: fnv1a-64 0000000000000000' e/scene.ini > odd.ini",
+                          lw_test_dir), 0);
+  cr_assert_eq(run("run odd.ini --out f --quiet", errs, sizeof errs), 0, "%s", errs);
+  cr_assert(!strstr(errs, "changed since"), "%s", errs);
+  /* another build's scene.ini: said, as it may draw otherwise */
+  cr_assert_eq(lw_test_sh("cd %s && sed 's/^; written by linewise .*/; written by linewise 2026.12, build 0123/' "
+                          "e/scene.ini > other.ini && grep -v '^; written by' e/scene.ini > older.ini", lw_test_dir),
+               0);
+  cr_assert_eq(run("run other.ini --out g --quiet", errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "linewise: note: other.ini was written by linewise 2026.12, build 0123; this is linewise "),
+            "%s", errs);
+  cr_assert_eq(run("run older.ini --out h --quiet", errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "linewise: note: older.ini was written by an earlier linewise, which recorded no build; "),
+            "%s", errs);
+  cr_assert_eq(run("run e/scene.ini --out i --quiet", errs, sizeof errs), 0, "%s", errs);
+  cr_assert(!strstr(errs, "note"), "%s", errs);
 }
 
 /* A budget or width that leaves a picture's short side under 4 pixels (or

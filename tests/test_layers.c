@@ -606,11 +606,13 @@ Test(layers, a_layers_share_is_its_ink_over_its_pens_width)
   ls.spec[0].pen_width = 0.2;
   ls.spec[1].pen_width = 0.8;
   const lw_image *t[2] = {a, b};
-  lw_layers_share(&ls, t);
+  lw_layers_share(&ls, t, 1);
   cr_expect_float_eq(ls.cum[1], 0.8, 1e-12);
   cr_expect_eq(ls.cum[2], 1.0);
+  lw_layers_share(&ls, t, 0); /* layers.share_width = 0, runs before it: the ink alone */
+  cr_expect_float_eq(ls.cum[1], 0.5, 1e-12);
   ls.spec[1].pen_width = 0.2; /* equal pens: the ink alone */
-  lw_layers_share(&ls, t);
+  lw_layers_share(&ls, t, 1);
   cr_expect_float_eq(ls.cum[1], 0.5, 1e-12);
   lw_image_free(a);
   lw_image_free(b);

@@ -108,10 +108,10 @@ typedef struct {
 lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err);
 
 /* The shares of the layers from the ink (1 - tone) of their targets, each
-** over its pen's width (a line of a pen half as wide lays half the ink, as
-** the count of init.coverage has it), or equal shares when there is no ink
-** at all. */
-void lw_layers_share(lw_layers_spec *ls, const lw_image *const *target);
+** over its pen's width where by_width (a line of a pen half as wide lays
+** half the ink, as the count of init.coverage has it; layers.share_width),
+** or equal shares when there is no ink at all. */
+void lw_layers_share(lw_layers_spec *ls, const lw_image *const *target, int by_width);
 
 /* The layer whose share holds u in [0, 1): a birth's layer for u uniform
 ** (ls->n > 0). */

@@ -222,6 +222,7 @@ typedef struct {
   char ly_turn[LW_PATH_MAX];  /* degrees a layer, or empty */
   char ly_tone_min[LW_PATH_MAX], ly_tone_max[LW_PATH_MAX]; /* a tone a layer, or empty */
   char ly_pen_width[LW_PATH_MAX]; /* mm a layer, or empty */
+  int ly_share_width;         /* a layer's share over its pen width (0: its ink alone, runs before) */
   /* [particles] (system = particles; particles.h) */
   int pt_count;               /* particles placed by the pattern */
   int pt_pattern;             /* LW_PPATTERN_* */
@@ -292,6 +293,7 @@ typedef struct {
   int n_files;
   unsigned short file_key[LW_PARAMS_FILES_MAX];
   unsigned long long file_hash[LW_PARAMS_FILES_MAX];
+  char run_build[64];         /* and the release and build that wrote it ("2026.12, build ..."), or "" */
 } lw_params;
 
 /* Fills p with every default. */
@@ -386,7 +388,8 @@ int lw_params_write(const lw_params *p, FILE *f);
 int lw_params_write_files(const lw_params *p, FILE *f);
 
 /* The keys among p's recorded files whose bytes differ now or cannot be
-** read, as "scene.image (PATH)" joined by ", " in buf; returns how many. */
+** read (but those --set names), as "scene.image (PATH)" joined by ", " in
+** buf; returns how many. */
 int lw_params_files_changed(const lw_params *p, char *buf, size_t n);
 
 /* Whether the scene gives key d a value of its own: from its file or
