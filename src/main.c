@@ -123,6 +123,10 @@ static lw_status load_run_dir(const char *dir, lw_params *p, lw_state *st, char 
   lw_path_join(path, n, dir, "state.lw");
   lw_status s = lw_state_read(st, path, err);
   if (s) return s;
+  if ((s = lw_state_scene_beside(st, path, err))) {
+    lw_state_clear(st);
+    return s;
+  }
   lw_path_join(scene_path, sizeof scene_path, dir, st->scene);
   if ((s = lw_params_read_run(p, scene_path, 1, err))) lw_state_clear(st);
   return s;

@@ -241,23 +241,14 @@ lw_status lw_state_missing_section(const lw_ckpt *c, const char *section, lw_err
   return lw_ckpt_missing(c, what, "a state of another system", err);
 }
 
-/* The scene a state names is a file beside it: a path elsewhere ("/etc/x",
-** "../other/scene.ini") had resume read and parse any file, and the run it
-** rewrote then named a scene.ini it never had. */
-static int scene_name_ok(const char *name, size_t cap)
-{
-  return *name && strlen(name) < cap && !strchr(name, '/') && strcmp(name, ".") && strcmp(name, "..");
-}
-
 static lw_status read_v2(lw_state *st, lw_ckpt *c, lw_error *err)
 {
   const char *path = lw_ckpt_path(c);
   int line = 0;
   const char *scene = lw_ckpt_text(c, "run", "scene", &line);
   if (!scene) return lw_ckpt_missing(c, "[run] scene", "not a state of a run", err);
-  if (!scene_name_ok(scene, sizeof st->scene))
-    return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene: expected the name of a file beside the state (no '/'), "
-                        "got '%.60s'", path, line, scene);
+  if (!*scene || strlen(scene) >= sizeof st->scene)
+    return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene: expected a file name, got '%.60s'", path, line, scene);
   strcpy(st->scene, scene);
   long seed;
   lw_status s;
@@ -356,8 +347,7 @@ static lw_status read_v1(lw_state *st, reader *r, lw_error *err)
   char *val, *c;
   lw_status s;
   if ((s = expect_key(r, "scene", &val, err))) return s;
-  if (!scene_name_ok(val, sizeof st->scene))
-    return bad(r, err, "scene", "the name of a file beside the state (no '/')", val);
+  if (!*val || strlen(val) >= sizeof st->scene) return bad(r, err, "scene", "a file name", val);
   strcpy(st->scene, val);
   if ((s = expect_key(r, "seed", &val, err))) return s;
   if (!lw_number_parse_whole(val, 0, LW_SEED_MAX, &v))
@@ -464,4 +454,11 @@ lw_status lw_state_write(const lw_state *st, const char *path, lw_error *err)
   lw_state_put_header(&w, st);
   lw_state_put_splines(&w, "system splines", st->sp);
   return lw_ckpt_commit(&w, err);
+}
+
+lw_status lw_state_scene_beside(const lw_state *st, const char *path, lw_error *err)
+{
+  if (!strchr(st->scene, '/') && strcmp(st->scene, ".") && strcmp(st->scene, "..")) return LW_OK;
+  return lw_error_set(err, LW_EINPUT, "%s: [run] scene: expected the name of a file beside the state (no '/'), got "
+                      "'%.60s'", path, st->scene);
 }

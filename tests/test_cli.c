@@ -1075,6 +1075,15 @@ Test(cli, resume_refuses_a_state_of_another_scene_file)
                           "the scene of the run directory, got 'my.ini'\" err.txt", dir, lw_test_bin(), lw_test_bin(),
                           lw_test_bin()),
                0, "%s", lw_test_slurp("%s/err.txt", dir));
+  /* energy reads the scene beside the state alone (it read and parsed any
+  ** file a state named: /etc/passwd's first key echoed); a start state
+  ** (init.from) never reads its scene, and may name any */
+  cr_assert_eq(lw_test_sh("cd %s && sed -i 's|^scene = my.ini$|scene = ../s.ini|' o/state.lw && "
+                          "{ %s energy o 2>err.txt; test $? -eq 2; } && grep -qx \"linewise: o/state.lw: \\[run\\] "
+                          "scene: expected the name of a file beside the state (no '/'), got '../s.ini'\" err.txt && "
+                          "%s run s.ini --quiet --out p --set anneal.sweeps=2 --set init.from=o/state.lw 2>err.txt",
+                          dir, lw_test_bin(), lw_test_bin()),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
 /* A bundled scene named without its folder, from another directory (or

@@ -140,10 +140,6 @@ Test(state, format_2_malformed_files_name_line_section_and_key)
   expect_bad("linewise-state 2\n[run]\nscene s.ini\n", ":3:", "key = value");
   expect_bad("linewise-state 2\n[run]\n[run]\n", ":3:", "[run] repeated");
   expect_bad("linewise-state 2\n[run\n", ":2:", "section");
-  /* the scene is a file beside the state: resume read any file it named */
-  expect_bad("linewise-state 2\n[run]\nscene = /etc/passwd\nseed = 1\nsweep = 0\n", ":3:", "beside the state");
-  expect_bad("linewise-state 2\n[run]\nscene = ../o/scene.ini\nseed = 1\nsweep = 0\n", ":3:", "beside the state");
-  expect_bad("linewise-state 2\n[run]\nscene = ..\nseed = 1\nsweep = 0\n", ":3:", "beside the state");
   expect_bad("linewise-state 2\n[run]\nscene = s.ini\nseed = 0x1\nsweep = 0\n", ":4:", "[run] seed");
   expect_bad("linewise-state 2\n[run]\nscene = s.ini\nseed = 1\nsweep = 1e16\n", ":5:", "[run] sweep");
   snprintf(buf, sizeof buf, "%ssplines = 1\nspline = 1 3\nnode = 0 0 1 0\nnode = 1 0 1 0x1\n", head);

@@ -47,6 +47,12 @@ typedef struct {
 /* Reads path into st; messages name the file, line, section and key. */
 lw_status lw_state_read(lw_state *st, const char *path, lw_error *err);
 
+/* Whether the scene st (read from path) names is a file beside it, as a
+** reader of the run directory (energy) needs: a path elsewhere ("/etc/x",
+** "../o/scene.ini") had any file read and parsed.  A start state
+** (init.from) never reads its scene. */
+lw_status lw_state_scene_beside(const lw_state *st, const char *path, lw_error *err);
+
 /* Writes a plain state (scene, seed, sweep, splines) atomically. */
 lw_status lw_state_write(const lw_state *st, const char *path, lw_error *err);
 
