@@ -60,8 +60,11 @@ $(BUILD)/obj/%.o: src/%.c | $(BUILD)/obj
 # run's scene.ini name it, as a release spans many changes of the files.
 # version.o alone is compiled again when it changes ($(BUILD)/build-id is
 # rewritten only then).
-LW_BUILD_ID := $(or $(shell git rev-parse --short=12 HEAD 2>/dev/null),unknown)$(if $(shell git status \
-               --porcelain --untracked-files=no 2>/dev/null | head -c1),-dirty)
+# (the checkout's own: a copy inside another repository, a paper's, named
+# that one's commit; and a source file not yet added counts as a change)
+LW_GIT_TOP  := $(shell git rev-parse --show-toplevel 2>/dev/null)
+LW_BUILD_ID := $(if $(filter $(realpath $(CURDIR)),$(realpath $(LW_GIT_TOP))),$(shell git rev-parse --short=12 \
+               HEAD)$(if $(shell git status --porcelain -- src include Makefile 2>/dev/null | head -c1),-dirty),unknown)
 $(BUILD)/build-id: FORCE | $(BUILD)/obj
 	@echo '$(LW_BUILD_ID)' > $@.tmp && if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv $@.tmp $@; fi
 $(BUILD)/obj/version.o build-fuzz/obj/version.o: LW_CPPFLAGS += -DLW_BUILD_ID='"$(LW_BUILD_ID)"'
