@@ -1182,6 +1182,18 @@ Test(tools, a_plot_that_cannot_be_written_whole_leaves_the_earlier_one)
                       "kept\n") && strchr(e, '\n') == e + strlen(e) - 1, "%s", e);
   free(e);
   cr_assert_eq(sh("cmp %s/seeds.good %s/seeds.png && test ! -e %s/seeds.png.tmp", dir, dir, dir), 0);
+  /* a file-size limit that kills gnuplot (SIGXFSZ, as a batch system sets
+  ** it): said so, exit 1, the earlier pictures kept ("gnuplot failed: ",
+  ** nothing after it, exit 2) */
+  write_script("pg/gnuplot", "#!/bin/sh\nulimit -f 8\nexec %s \"$@\"\n",
+               "$(PATH=/usr/local/bin:/usr/bin:/bin command -v gnuplot)");
+  cr_assert_eq(sh("PATH=%s/pg:$PATH %s %s/r", dir, tool("plot-run"), dir), 1, "%s", err_txt());
+  e = err_txt();
+  cr_assert(!strcmp(e, "plot-run: gnuplot was killed by SIGXFSZ (a file-size limit: ulimit -f); the earlier pictures "
+                       "are kept\n"), "%s", e);
+  free(e);
+  cr_assert_eq(sh("for f in energy temperature acceptance; do cmp %s/good/$f.png %s/r/plots/$f.png || exit 1; done && "
+                  "test -z \"$(ls -A %s/r/plots | grep tmp)\"", dir, dir, dir), 0);
 }
 
 Test(tools, plot_sweep_draws_a_png_beside_the_csv)
