@@ -200,11 +200,14 @@ static void bundled_hint(const char *scene, lw_error *err)
 {
   char exe[LW_PATH_MAX], path[2 * LW_PATH_MAX];
   const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-  if (n <= 0 || !strstr(err->msg, ": cannot open scene file: ") || !access(scene, F_OK)) return;
+  const size_t len = strlen(scene);
+  if (n <= 0 || !strstr(err->msg, ": cannot open scene file: ") || !access(scene, F_OK) || strchr(scene, '/') ||
+      len < 4 || strcmp(scene + len - 4, ".ini"))
+    return;
   exe[n] = '\0';
   char *slash = strrchr(exe, '/');
   if (slash) *slash = '\0';
-  const char *base = strrchr(scene, '/') ? strrchr(scene, '/') + 1 : scene;
+  const char *base = scene;
   static const char *const under[] = {"/../share/linewise/params/", "/../params/"};
   for (int k = 0; k < 2; k++) {
     snprintf(path, sizeof path, "%s%s%s", exe, under[k], base);
@@ -917,16 +920,16 @@ static int taken(const char *dir)
          lw_rundir_foreign(dir, "state.lw") || lw_runfiles_check_free(dir, NULL) || lw_runfiles_stashed(dir);
 }
 
-/* The run's name, out/<name>: the scene file's name without its extension
-** and leading dots (*base, its length returned): "cat.v2.ini" is not
+/* The run's name, out/<name>: the scene file's name without its leading
+** dots and extension (*base, its length returned): "cat.v2.ini" is not
 ** "cat.v1.ini"'s out/cat-2, and ".ini" (nothing before its dot) wrote into
-** out/ itself. */
+** out/ itself; "scene" where nothing is left ("..."). */
 static int scene_name(const char *scene, const char **base)
 {
   const char *b = strrchr(scene, '/') ? strrchr(scene, '/') + 1 : scene;
+  b += strspn(b, "."); /* a hidden file's dot is no extension: .hidden is out/hidden */
   const char *ext = strrchr(b, '.');
   int n = ext ? (int)(ext - b) : (int)strlen(b);
-  while (n > 0 && *b == '.') b++, n--;
   if (!n) {
     b = "scene";
     n = 5;

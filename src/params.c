@@ -1030,12 +1030,13 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     const char *mark = strpbrk(text, ",."), *after = mark ? mark + 1 : NULL;
     const int comma = mark && *mark == ',' && mark > text && isdigit((unsigned char)mark[-1]) &&
                       isdigit((unsigned char)*after);
-    const int thousands = whole && mark && *mark == '.' && mark > text && isdigit((unsigned char)mark[-1]) &&
+    const int thousands = whole && mark && mark > text && isdigit((unsigned char)mark[-1]) &&
                           strspn(after, "0123456789") == 3 && !after[3];
     if (!lw_number_parse(text, &v) || thousands) {
-      snprintf(expected, n, "a %s %s%s", whole ? "whole number" : "number", range,
-               comma ? " (a decimal comma? numbers take a point: 0.5, not 0,5)"
-               : thousands ? " (a point as a thousands separator? write 1000, not 1.000)" : "");
+      char hint[64] = "";
+      if (thousands) snprintf(hint, sizeof hint, " (a thousands separator? write 1000, not 1%c000)", *mark);
+      else if (comma) snprintf(hint, sizeof hint, " (a decimal comma? numbers take a point: 0.5, not 0,5)");
+      snprintf(expected, n, "a %s %s%s", whole ? "whole number" : "number", range, hint);
       return 0;
     }
     if (whole && v != floor(v)) {

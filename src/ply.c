@@ -51,6 +51,7 @@ typedef struct {
   size_t cap;
   lw_error *err;
   int oom; /* a line could not be held: not the end of the file, which the messages would say */
+  int nul; /* a NUL byte in a header or ASCII line (read as its end: "got ''") */
 } reader;
 
 /* The next line into r->buf without its line end, or NULL at the end. */
@@ -59,6 +60,11 @@ static char *next_line(reader *r)
   ssize_t len = lw_text_getline(&r->buf, &r->cap, r->f);
   r->oom = len == -2;
   if (len < 0) return NULL;
+  if (memchr(r->buf, '\0', (size_t)len)) {
+    r->nul = 1;
+    r->line++;
+    return NULL;
+  }
   if (++r->line == 1) {
     lw_text_drop_bom(r->buf);
     len = (ssize_t)strlen(r->buf);
@@ -79,7 +85,7 @@ int lw_ply_detect(FILE *f)
   /* "ply" in any case and blanks after it are a PLY file still, refused by
   ** its header's reader with a PLY message (a trailing blank was read as a
   ** text point file: "expected 'x y z' ..., got 'ply '") */
-  char head[24] = {0};
+  char head[256] = {0};
   size_t got = fread(head, 1, sizeof head - 1, f);
   rewind(f);
   const size_t b = got >= 3 && !memcmp(head, "\xEF\xBB\xBF", 3) ? 3 : 0; /* a byte-order mark (number.h) */
@@ -94,13 +100,14 @@ int lw_ply_detect(FILE *f)
 static lw_status not_read(const reader *r)
 {
   if (r->oom) return lw_error_set(r->err, LW_ENOMEM, "%s:%ld: out of memory reading the line", r->path, r->line + 1);
+  if (r->nul) return lw_error_set(r->err, LW_EINPUT, "%s:%ld: " LW_TEXT_NUL_LINE, r->path, r->line);
   if (ferror(r->f)) return lw_error_set(r->err, LW_EIO, "%s:%ld: read error", r->path, r->line + 1);
   return LW_OK;
 }
 
 static lw_status bad_line(reader *r, const char *expected, const char *got)
 {
-  if (r->oom || ferror(r->f)) return not_read(r);
+  if (r->oom || r->nul || ferror(r->f)) return not_read(r);
   return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected %s, got '%.60s'", r->path, r->line, expected, got);
 }
 
@@ -179,7 +186,7 @@ static lw_status read_header(reader *r, const char *const *names, int n_names, e
     }
     return bad_line(r, "a header line (comment, element, property or end_header)", w);
   }
-  if (r->oom || ferror(r->f)) return not_read(r);
+  if (r->oom || r->nul || ferror(r->f)) return not_read(r);
   return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected 'end_header', found the end of the file", r->path, r->line);
 }
 
@@ -245,7 +252,7 @@ static lw_status ascii_instance(reader *r, const elem *e, size_t index, double *
 {
   char *s;
   do {
-    if (!(s = next_line(r)) && (r->oom || ferror(r->f))) return not_read(r);
+    if (!(s = next_line(r)) && (r->oom || r->nul || ferror(r->f))) return not_read(r);
     if (!s)
       return lw_error_set(r->err, LW_EINPUT, "%s:%ld: expected %zu %s lines, the file ends after %zu", r->path, r->line,
                           e->count, e->name, index);
@@ -298,7 +305,7 @@ lw_status lw_ply_read_vertices(FILE *f, const char *path, const char *const *nam
   *n = 0;
   *values = NULL;
   *found = 0;
-  reader r = {f, path, ASCII, 0, NULL, 0, err, 0};
+  reader r = {f, path, ASCII, 0, NULL, 0, err, 0, 0};
   elem el[ELEMS_MAX];
   int n_el = 0;
   lw_status s = read_header(&r, names, n_names, el, &n_el);

@@ -1047,11 +1047,13 @@ Test(cli, a_run_without_out_never_replaces_another)
                           "grep -q 'seed = 9' out/s/scene.ini && ! test -e out/s-4",
                           dir, b),
                0, "--out replaces the run it names");
-  /* the name is the file's without its extension: a name all extension
-  ** wrote its run into out/ itself, and cat.v2.ini went to out/cat */
-  cr_assert_eq(lw_test_sh("cd %s && cp s.ini .ini && cp s.ini c.v2.ini && %s run .ini --quiet --set anneal.sweeps=2 "
-                          "&& %s run c.v2.ini --quiet --set anneal.sweeps=2 && test -f out/scene/final.svg && "
-                          "test -f out/c.v2/final.svg && ! test -e out/final.svg", dir, b, b),
+  /* the name is the file's without its leading dots and extension: ".ini"
+  ** (nothing before its dot) wrote its run into out/ itself, and cat.v2.ini
+  ** went to out/cat */
+  cr_assert_eq(lw_test_sh("cd %s && cp s.ini .ini && cp s.ini c.v2.ini && cp s.ini .h && %s run .ini --quiet "
+                          "--set anneal.sweeps=2 && %s run c.v2.ini --quiet --set anneal.sweeps=2 && %s run .h --quiet "
+                          "--set anneal.sweeps=2 && test -f out/ini/final.svg && test -f out/c.v2/final.svg && "
+                          "test -f out/h/final.svg && ! test -e out/final.svg", dir, b, b, b),
                0);
   /* a CR a script saved with CRLF line ends puts at the end of --out or of
   ** the scene's path: refused, not a directory named "r\r" */

@@ -184,6 +184,8 @@ Test(ply, every_refusal_names_the_file_and_where)
       /* told a PLY file by its magic in any case: refused as PLY, not read
       ** as a text point file ("expected 'x y z'") */
       {"PLY\nformat ascii 1.0\nend_header\n", ":1: expected the PLY magic line 'ply', got 'PLY'"},
+      /* blanks past the first bytes still a PLY file's (26 read it as text) */
+      {"ply                          \nformat ascii 2.0\nend_header\n", ":2: expected 'format ascii 1.0'"},
   };
   char path[128];
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
@@ -192,6 +194,12 @@ Test(ply, every_refusal_names_the_file_and_where)
     snprintf(path, sizeof path, "%s/bad%zu.ply", dir, k);
     read_points(path, LW_EINPUT, bad[k].msg);
   }
+  /* a NUL byte in a header or an ASCII line: UTF-16 named ("got ''") */
+  snprintf(path, sizeof path, "%s/nul.ply", dir);
+  FILE *z = fopen(path, "wb");
+  fwrite("ply\nformat ascii 1.0\nelem\0ent vertex 1\n", 1, 39, z);
+  fclose(z);
+  read_points(path, LW_EINPUT, ":3: a NUL byte inside the line (UTF-16 text");
   /* binary: cut short inside the last vertex, and a value that is not finite */
   snprintf(path, sizeof path, "%s/cut.ply", dir);
   write_binary(path, 0, 2);
