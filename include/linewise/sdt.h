@@ -11,7 +11,9 @@
 ** boundary term reads (boundary.h): negative inside, positive outside, in
 ** millimetres, sampled at pixel centres.  A pixel's value is the distance
 ** to the nearest pixel centre on the other side, less half a pixel, so the
-** zero level runs along the pixel edges between inside and outside:
+** zero level runs along the pixel edges between inside and outside (read
+** bilinearly, it cuts an outside pixel's corner among inside pixels by up to
+** 0.27 px along each side; docs/IMAGES.md):
 **     inside:  d = -(D_out - 1/2) px      outside:  d = D_in - 1/2 px
 ** The grid carries one extra ring of outside pixels around the picture, so
 ** bilinear interpolation never reads an inside value beyond the picture's
