@@ -306,6 +306,9 @@ lw_status lw_output_svg_strokes(const lw_strokes *s, const lw_output_page *page,
   fputc(' ', f);
   put_mm(f, page->height_mm);
   fputs("\">\n", f);
+  /* a pen's own strokes multiply too where they cross or overlap, as in
+  ** final.png (the group's style alone painted them over each other flat) */
+  if (page->multiply) fputs("  <style>path { mix-blend-mode: multiply }</style>\n", f);
   for (int k = 0; k < page->n_pens; k++) {
     const lw_output_pen *pen = &page->pen[k];
     char color[8];

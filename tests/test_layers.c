@@ -913,6 +913,10 @@ Test(layers, the_svg_has_one_group_a_pen_with_its_colour_and_width)
   int groups = 0;
   for (const char *c = svg; (c = strstr(c, "<g ")); c++) groups++;
   cr_assert_eq(groups, 4, "one group a pen");
+  /* a pen's own strokes multiply where they overlap, as in final.png (a
+  ** viewer showed them flat: RMSE 0.013 against final.png, now 0.0008) */
+  const char *style = strstr(svg, "\n  <style>path { mix-blend-mode: multiply }</style>\n");
+  cr_assert(style && style < strstr(svg, "<g "), "%s", svg);
   for (int k = 0; k < 4; k++) {
     char id[32], head[128], stroke[64];
     snprintf(id, sizeof id, "id=\"pen%d\"", k + 1);
