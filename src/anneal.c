@@ -753,15 +753,23 @@ static double memory_limit(const char **by)
 
 /* A start whose replicas here would not fit the memory this process may use
 ** is refused before its placement, naming the key that sets its size. */
-static lw_status fits_memory(const lw_anneal *a, lw_error *err)
+static lw_status fits_memory(lw_anneal *a, lw_error *err)
 {
   const lw_system_type *t = a->sys_type;
   char what[160] = "";
   const char *key = NULL, *by;
-  const double one = t->start_bytes ? t->start_bytes(a->setup, &a->params, what, sizeof what, &key) : 0.0;
+  double peak = 0.0;
+  const double one = t->start_bytes ? t->start_bytes(a->setup, &a->params, what, sizeof what, &key, &peak) : 0.0;
   int here = 0;
   for (int r = 0; r < a->n_rep; r++) here += rung_here(a, r);
   const double limit = memory_limit(&by), bytes = one * here;
+  /* past the peak (the drawing's: the run anneals for hours, then fails;
+  ** its state resumes with more memory) told, not refused: a fit, not a bound */
+  if (!(bytes > limit) && peak > 0.0 && peak + one * (here - 1) > limit)
+    snprintf(a->memory_note, sizeof a->memory_note, "%s may take about %.3g GB at the drawing, more than the %.3g GB "
+             "of %s: a run past it fails there (its state kept, to resume with more memory); fewer splines or a "
+             "wider output.pen_width take less (docs/PERFORMANCE.md, \"Memory\")", what,
+             (peak + one * (here - 1)) / 1e9, limit / 1e9, by);
   if (!(bytes > limit) || !key) return LW_OK;
   char reps[48] = "";
   if (here > 1) snprintf(reps, sizeof reps, " in %d replicas", here);

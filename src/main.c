@@ -1147,6 +1147,7 @@ static int cmd_run(int argc, char **argv)
     fprintf(stderr, "linewise: note: anneal.seed_version = 1: %s is a run's scene.ini from before 2026-12-06, so this "
             "run seeds as that one did, where two seeds could draw the same numbers; --set anneal.seed_version=2 for "
             "a new study (docs/NUMERICS.md, \"Random numbers\")\n", scene);
+  if (a.memory_note[0] && (!net || !net->rank)) fprintf(stderr, "linewise: note: %s\n", a.memory_note);
   /* a release spans changes that draw a scene otherwise (each keeps a run
   ** begun before on resume, not a new run of its scene.ini) */
   char this_build[64];

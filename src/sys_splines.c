@@ -18,6 +18,7 @@
 #include "linewise/gradient.h"
 #include "linewise/hilbert.h"
 #include "linewise/init.h"
+#include "linewise/output.h"
 #include "linewise/splmass.h"
 #include "linewise/transdim.h"
 
@@ -97,6 +98,23 @@ static void long_splines_note(const lw_params *p, char *note, size_t n)
              p->segments);
 }
 
+/* The run's peak, at its drawing, for `segments` segments: a fit to 64
+** measured runs (docs/PERFORMANCE.md, "Memory"): 4 MB, 615 bytes a segment,
+** 39 a point of the close share (which reads the lines every half pen
+** width), 57 a picture pixel (and 8 more a layer), 3.2 a pixel of
+** final.png; with room for the worst miss held out (16 %, a four-pen
+** picture), 1.3 times that and 10 MB more. */
+static double drawing_peak(const spl_setup *su, const lw_params *p, double segments)
+{
+  const lw_scene *sc = &su->scene;
+  const double points = segments * p->segment_length / (0.5 * p->pen_width);
+  double pixels = 0.0, png = 0.0;
+  if (sc->image) pixels = (double)sc->image->width * sc->image->height * (1.0 + 0.14 * sc->layers.n);
+  const double longest = fmax(sc->width, sc->height), k = fmin(p->png_scale, LW_OUTPUT_PNG_MAX_PX / longest);
+  if (longest > 0.0 && k > 0.0) png = sc->width * k * sc->height * k;
+  return 1.3 * (4e6 + 615.0 * segments + 38.7 * points + 57.0 * pixels + 3.2 * png) + 10e6;
+}
+
 /* Under the least a segment's model was measured to take at its peak
 ** (docs/PERFORMANCE.md: 361 to 865 bytes), so that what would fit is never
 ** refused. */
@@ -105,12 +123,15 @@ static void long_splines_note(const lw_params *p, char *note, size_t n)
 /* (system.h) The placed splines' model: 1e8 splines filled 3 GB in 15 s
 ** without a word, on their way to 160 GB, and a coverage's count was shown
 ** only once placed. */
-static double start_bytes(const void *setup, const lw_params *p, char *what, size_t n, const char **key)
+static double start_bytes(const void *setup, const lw_params *p, char *what, size_t n, const char **key,
+                          double *peak)
 {
   const spl_setup *su = setup;
   size_t count = (size_t)p->splines;
   lw_error e2; /* a count the placement refuses is refused there, with its own message */
+  *peak = 0.0;
   if (p->from[0] || (!count && lw_init_count(&su->scene, p, &count, &e2))) return 0.0;
+  *peak = drawing_peak(su, p, (double)count * p->segments);
   snprintf(what, n, "%zu splines of %d segments%s (%.0f bytes a segment at least)", count, p->segments,
            p->splines ? "" : " (from init.coverage)", SEGMENT_BYTES_LEAST);
   *key = p->splines ? "init.splines" : "init.coverage";

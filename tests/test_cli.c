@@ -1964,6 +1964,19 @@ Test(cli, a_start_past_the_machines_memory_is_refused_before_placing)
                           "--stop-at 0 --threads 1 --out %s/h' 2>%s/err.txt; test $? -eq 2 && grep -q 'take at least "
                           "1.44 GB, more than the 1.02 GB of this process.s address space (ulimit -v)' %s/err.txt",
                           lw_test_bin(), lw_test_root(), dir, dir, dir), 0);
+  /* one that fits its splines but not the drawing's peak (the close share's
+  ** points: 20,000 splines of 4 on a page of 2 m^2 peaked at 227 MB) is
+  ** told, even quiet, and runs; with room, nothing is said */
+  cr_assert_eq(lw_test_sh("sh -c 'ulimit -v 280000; %s run %s/params/minimal.ini --set init.splines=20000 --set "
+                          "scene.width=1414 --set scene.height=1414 --stop-at 0 --threads 1 --quiet --out %s/m' "
+                          "2>%s/err.txt && grep -q '^linewise: note: 20000 splines of 4 segments (360 bytes a segment "
+                          "at least) may take about 0.364 GB at the drawing, more than the 0.287 GB of this "
+                          "process.s address space (ulimit -v): a run past it fails there' %s/err.txt && "
+                          "sh -c 'ulimit -v 2000000; %s run %s/params/minimal.ini --set init.splines=20000 --set "
+                          "scene.width=1414 --set scene.height=1414 --stop-at 0 --threads 1 --quiet --out %s/m' "
+                          "2>%s/err.txt && ! grep -q 'at the drawing' %s/err.txt", lw_test_bin(), lw_test_root(), dir,
+                          dir, dir, lw_test_bin(), lw_test_root(), dir, dir, dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
 /* FORMATS' redraw (no sweeps) of a tempering run that tuned its ladder: it

@@ -57,6 +57,7 @@ typedef struct lw_anneal {
   char unread[1024];           /* keys the scene sets that only other drivers read, where set, or "" */
   char idle[4096];             /* keys the scene sets that its other settings leave idle, where and why */
   char schedule_note[512];     /* a schedule whose steps never reach its end (lw_anneal_start), or "" */
+  char memory_note[512];       /* a run expected to take more memory at its peak than it may, or "" */
   unsigned long seed;
   long sweep;                  /* sweeps done */
   long saved;                  /* sweep + 1 at the last checkpoint this process wrote; 0 none */

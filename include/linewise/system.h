@@ -128,8 +128,11 @@ struct lw_system_type {
   ** start will take, with in *what its size ("100 splines of 4 segments")
   ** and in *key the key that sets it ("section.key"), so that a start past the machine's
   ** memory is refused before its placement (anneal.c); 0 where unknown (a
-  ** state read from a file). */
-  double (*start_bytes)(const void *setup, const lw_params *p, char *what, size_t n, const char **key);
+  ** state read from a file).  In *peak the run's expected peak, its
+  ** drawing's (a measured fit, with room), that a run past it is told
+  ** before it anneals for hours; 0 where unknown. */
+  double (*start_bytes)(const void *setup, const lw_params *p, char *what, size_t n, const char **key,
+                        double *peak);
 
   /* The initial state of a run: placed from `seed` (a stream of its own) or
   ** read from the file the parameters name; copies for the replicas. */
