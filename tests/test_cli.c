@@ -1096,8 +1096,8 @@ Test(cli, a_bundled_scene_named_alone_elsewhere_is_pointed_to)
   cr_assert_eq(lw_test_sh("R=$(cd %s && pwd -P) && cd %s && { %s run example.ini 2>err.txt; test $? -eq 2; } && "
                           "grep -qx \"linewise: example.ini: cannot open scene file: No such file or directory (the "
                           "bundled example.ini is $R/params/example.ini)\" err.txt && { %s run nothere.ini 2>err.txt; "
-                          "test $? -eq 2; } && grep -qx 'linewise: nothere.ini: cannot open scene file: No such file or "
-                          "directory' err.txt", lw_test_root(), dir, lw_test_bin(), lw_test_bin()),
+                          "test $? -eq 2; } && grep -qx 'linewise: nothere.ini: cannot open scene file: No such "
+                          "file or directory' err.txt", lw_test_root(), dir, lw_test_bin(), lw_test_bin()),
                0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
@@ -1108,7 +1108,8 @@ Test(cli, a_run_whose_directory_is_removed_says_it_is_gone)
   write_file("s.ini", scene_text);
   cr_assert_eq(lw_test_sh("cd %s && { %s run s.ini --quiet --out g/r --set anneal.sweeps=1000000 "
                           "--set output.checkpoint_every=1 2>err.txt & p=$!; i=0; while [ $i -lt 3000 ] && "
-                          "! test -f g/r/state.lw; do sleep 0.01; i=$((i+1)); done; rm -rf g; wait $p; test $? -eq 1; }",
+                          "! test -f g/r/state.lw; do sleep 0.01; i=$((i+1)); done; rm -rf g; wait $p; "
+                          "test $? -eq 1; }",
                           dir, lw_test_bin()),
                0, "%s", lw_test_slurp("%s/err.txt", dir));
   char *e = lw_test_slurp("%s/err.txt", dir);
