@@ -232,10 +232,16 @@ wire-figures: $(BUILD)/wire-midpoint
 # prefix from where it lies, so a copy installed under DESTDIR, or moved, is
 # found with PKG_CONFIG_PATH alone (--define-variable=prefix= would move
 # cairo's and GSL's paths with it).
+# The files install writes, each by its name: uninstall removes those and
+# then the folders left empty (it removed share/linewise whole, with a
+# scene the user had saved beside the bundled ones).
 INSTALLED := bin/linewise bin/linewise-mpi $(TOOLS:%=bin/linewise-%) bin/linewise-animate \
-             share/linewise share/doc/linewise share/man/man1/linewise.1 \
-             $(TOOLS:%=share/man/man1/linewise-%.1) share/man/man1/linewise-animate.1 \
-             lib/liblinewise.a lib/pkgconfig/linewise.pc include/linewise
+             $(patsubst %,share/linewise/params/%,$(notdir $(wildcard params/*.ini params/*.lw) $(PICTURE))) \
+             share/linewise/slurm-sweep.sbatch share/linewise/slurm-tempering.sbatch \
+             $(patsubst %,share/doc/linewise/%,README.md $(notdir $(wildcard docs/*.md docs/*.png)) embed.cpp) \
+             share/man/man1/linewise.1 $(TOOLS:%=share/man/man1/linewise-%.1) share/man/man1/linewise-animate.1 \
+             lib/liblinewise.a lib/pkgconfig/linewise.pc $(wildcard include/linewise/*.h)
+INSTALLED_DIRS := share/linewise/params share/linewise share/doc/linewise include/linewise
 LW_VERSION := $(shell sed -n 's/^\#define LW_VERSION "\(.*\)"/\1/p' include/linewise/version.h)
 # The install's root, quoted for the shell: a DESTDIR or PREFIX with a blank
 # stays one path (unquoted, uninstall removed the directory before the blank),
@@ -271,7 +277,9 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	install -m 644 README.md docs/*.md docs/*.png tests/embed.cpp $(D)/share/doc/linewise/
 
 uninstall:
-	for f in $(INSTALLED); do rm -rf $(D)/$$f || exit 1; done
+	for f in $(INSTALLED); do rm -f $(D)/$$f || exit 1; done
+	for d in $(INSTALLED_DIRS); do if [ -d $(D)/$$d ]; then rmdir $(D)/$$d 2>/dev/null || \
+	  echo "uninstall: $$d kept: files not installed are in it" >&2; fi; done
 
 clean:
 	rm -rf build build-asan build-fuzz bin $(PICTURE)

@@ -923,6 +923,14 @@ Test(tools, bad_usage_exits_2_with_one_message_and_writes_nothing)
   for (size_t i = 0; i < sizeof fps / sizeof *fps; i++)
     cr_assert_eq(sh("%s %s/an '%s' 2> %s/an.err; test $? -eq 2 && grep -q \"FPS: expected a number above 0, got "
                     "'%s'\" %s/an.err", tool("animate.sh"), dir, fps[i], dir, fps[i], dir), 0, "FPS %s", fps[i]);
+  /* ffmpeg is given no input: it reads one for keys, and ate the rest of a
+  ** `while read` loop's list of runs (a stand-in ffmpeg that would read it) */
+  cr_assert_eq(sh("mkdir -p %s/ff && printf 'n=0; while read -r l; do n=$((n+1)); done; echo $n > %s/ff/read; "
+                  "for a; do out=$a; done; : > \"$out\"\\n' > %s/ff/ffmpeg && chmod +x %s/ff/ffmpeg", dir, dir, dir,
+                  dir), 0);
+  cr_assert_eq(sh("cd %s && printf 'an\\nan\\n' | while read -r d; do PATH=%s/ff:$PATH %s \"$d\" || exit 1; done && "
+                  "test \"$(cat ff/read)\" = 0 && test -e an/animation.mp4", dir, dir, tool("animate.sh")), 0, "%s",
+               err_txt());
 }
 
 /* ---- plots ------------------------------------------------------------ */
@@ -1327,7 +1335,14 @@ Test(tools, install_runs_every_scene_away_from_the_checkout_and_uninstall_remove
                   "  { ! command -v groff || test -z \"$(groff -man -ww -z $m 2>&1)\"; } "
                   "  || { echo $t >&2; exit 1; }; done", dir),
                0, "%s", err_txt());
-  cr_assert_eq(sh("cd %s && make -s -C %s uninstall DESTDIR=\"$PWD/ro ot\" PREFIX=/usr && "
-                  "test -z \"$(find 'ro ot' -type f)\" && grep -qx mine ro/keep", dir, env("LW_ROOT")),
+  /* a scene the user saved beside the bundled ones stays (uninstall removed
+  ** share/linewise whole), and its folder with it, said */
+  cr_assert_eq(sh("cd %s && echo mine > 'ro ot/usr/share/linewise/params/my.ini' && { make -s -C %s uninstall "
+                  "DESTDIR=\"$PWD/ro ot\" PREFIX=/usr && test \"$(find 'ro ot' -type f)\" = "
+                  "'ro ot/usr/share/linewise/params/my.ini' && grep -qx mine ro/keep && "
+                  "test ! -e 'ro ot/usr/bin/linewise'; }", dir, env("LW_ROOT")),
                0, "%s", err_txt());
+  char *kept = err_txt();
+  cr_assert(strstr(kept, "uninstall: share/linewise/params kept: files not installed are in it\n"), "%s", kept);
+  free(kept);
 }

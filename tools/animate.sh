@@ -53,7 +53,9 @@ for f in $(ls -- "$abs/frames" | grep '^frame-[0-9]*\.png$' | sort -t- -k2n); do
 done
 # written beside the links and moved into place whole: a signal left a
 # 48-byte animation.mp4 that no player opens
-(cd "$tmp" && ffmpeg -loglevel error -y -framerate "$fps" -i %08d.png \
-  -vf "pad=ceil(iw/2)*2:ceil(ih/2)*2:color=white" -c:v libx264 -pix_fmt yuv420p animation.mp4)
+# (-nostdin: ffmpeg reads its input for keys, and ate the rest of a
+# `while read` loop's list of runs)
+(cd "$tmp" && ffmpeg -nostdin -loglevel error -y -framerate "$fps" -i %08d.png \
+  -vf "pad=ceil(iw/2)*2:ceil(ih/2)*2:color=white" -c:v libx264 -pix_fmt yuv420p animation.mp4 </dev/null)
 mv -f "$tmp/animation.mp4" "$abs/animation.mp4"
 echo "$dir/animation.mp4"
