@@ -31,6 +31,7 @@
 #include "linewise/runfiles.h"
 #include "linewise/state.h"
 #include "linewise/trace.h"
+#include "linewise/memlimit.h"
 #include "linewise/version.h"
 
 double lw_anneal_seconds(const lw_anneal *a) { return a->wall_before + lw_phase_clock() - a->wall_start; }
@@ -726,31 +727,6 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
   if (m >= size && size > 4) strcpy(idle + size - 4, "..."); /* cut: said so */
 }
 
-/* The system's row and its set-up of the scene; a quench needs a row with
-** a gradient. */
-/* The memory this process may use: the machine's, or less where its address
-** space (ulimit -v) or its cgroup (a batch job's memory.max) is limited; in
-** *by what limits it. */
-static double memory_limit(const char **by)
-{
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-  double limit = pages > 0 && page > 0 ? (double)pages * (double)page : INFINITY;
-  *by = "this machine's memory";
-  struct rlimit rl;
-  if (!getrlimit(RLIMIT_AS, &rl) && rl.rlim_cur != RLIM_INFINITY && (double)rl.rlim_cur < limit) {
-    limit = (double)rl.rlim_cur;
-    *by = "this process's address space (ulimit -v)";
-  }
-  FILE *f = fopen("/sys/fs/cgroup/memory.max", "r");
-  double cg;
-  if (f && fscanf(f, "%lf", &cg) == 1 && cg > 0 && cg < limit) {
-    limit = cg;
-    *by = "this cgroup's memory.max";
-  }
-  if (f) fclose(f);
-  return limit;
-}
-
 /* A start whose replicas here would not fit the memory this process may use
 ** is refused before its placement, naming the key that sets its size. */
 static lw_status fits_memory(lw_anneal *a, lw_error *err)
@@ -762,14 +738,15 @@ static lw_status fits_memory(lw_anneal *a, lw_error *err)
   const double one = t->start_bytes ? t->start_bytes(a->setup, &a->params, what, sizeof what, &key, &peak) : 0.0;
   int here = 0;
   for (int r = 0; r < a->n_rep; r++) here += rung_here(a, r);
-  const double limit = memory_limit(&by), bytes = one * here;
-  /* past the peak (the drawing's: the run anneals for hours, then fails;
-  ** its state resumes with more memory) told, not refused: a fit, not a bound */
+  const double limit = lw_memory_limit(&by), bytes = one * here;
+  /* past the peak (the drawing's, the close share's points above all: the
+  ** run annealed for hours, then lost its close share or its preview) told,
+  ** not refused: a fit with room, not a bound */
   if (!(bytes > limit) && peak > 0.0 && peak + one * (here - 1) > limit)
-    snprintf(a->memory_note, sizeof a->memory_note, "%s may take about %.3g GB at the drawing, more than the %.3g GB "
-             "of %s: a run past it fails there (its state kept, to resume with more memory); fewer splines or a "
-             "wider output.pen_width take less (docs/PERFORMANCE.md, \"Memory\")", what,
-             (peak + one * (here - 1)) / 1e9, limit / 1e9, by);
+    snprintf(a->memory_note, sizeof a->memory_note, "%s may take up to about %.3g GB at the drawing, more than the "
+             "%.3g GB of %s: short of it the drawing leaves out its close share (summary.json's close_share null) "
+             "or fails (its state kept, to resume with more memory); fewer splines or a wider output.pen_width take "
+             "less (docs/PERFORMANCE.md, \"Memory\")", what, (peak + one * (here - 1)) / 1e9, limit / 1e9, by);
   if (!(bytes > limit) || !key) return LW_OK;
   char reps[48] = "";
   if (here > 1) snprintf(reps, sizeof reps, " in %d replicas", here);
@@ -781,6 +758,8 @@ static lw_status fits_memory(lw_anneal *a, lw_error *err)
   return lw_params_blame(&a->params, section, dot ? dot + 1 : key, err);
 }
 
+/* The system's row and its set-up of the scene; a quench needs a row with
+** a gradient. */
 static lw_status setup_system(lw_anneal *a, lw_error *err)
 {
   if (!(a->sys_type = lw_system_of(&a->params, err))) return err->code;

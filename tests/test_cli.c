@@ -1974,8 +1974,9 @@ Test(cli, a_start_past_the_machines_memory_is_refused_before_placing)
   cr_assert_eq(lw_test_sh("sh -c 'ulimit -v 280000; %s run %s/params/minimal.ini --set init.splines=20000 --set "
                           "scene.width=1414 --set scene.height=1414 --stop-at 0 --threads 1 --quiet --out %s/m' "
                           "2>%s/err.txt && grep -q '^linewise: note: 20000 splines of 4 segments (360 bytes a segment "
-                          "at least) may take about 0.364 GB at the drawing, more than the 0.287 GB of this "
-                          "process.s address space (ulimit -v): a run past it fails there' %s/err.txt && "
+                          "at least) may take up to about 0.364 GB at the drawing, more than the 0.287 GB of this "
+                          "process.s address space (ulimit -v): short of it the drawing leaves out its close share' "
+                          "%s/err.txt && "
                           "sh -c 'ulimit -v 2000000; %s run %s/params/minimal.ini --set init.splines=20000 --set "
                           "scene.width=1414 --set scene.height=1414 --stop-at 0 --threads 1 --quiet --out %s/m' "
                           "2>%s/err.txt && ! grep -q 'at the drawing' %s/err.txt", lw_test_bin(), lw_test_root(), dir,
