@@ -207,14 +207,13 @@ static void bundled_hint(const char *scene, lw_error *err)
   exe[n] = '\0';
   char *slash = strrchr(exe, '/');
   if (slash) *slash = '\0';
-  const char *base = scene;
   static const char *const under[] = {"/../share/linewise/params/", "/../params/"};
   for (int k = 0; k < 2; k++) {
-    snprintf(path, sizeof path, "%s%s%s", exe, under[k], base);
+    snprintf(path, sizeof path, "%s%s%s", exe, under[k], scene);
     char real[PATH_MAX];
     if (!access(path, R_OK) && realpath(path, real)) {
       const size_t m = strlen(err->msg);
-      snprintf(err->msg + m, sizeof err->msg - m, " (the bundled %.200s is %.1000s)", base, real);
+      snprintf(err->msg + m, sizeof err->msg - m, " (the bundled %.200s is %.1000s)", scene, real);
       return;
     }
   }
