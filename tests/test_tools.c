@@ -1258,6 +1258,21 @@ Test(tools, thread_scaling_times_each_count_and_checks_the_bytes)
   char *err = err_txt();
   cr_assert(strstr(err, "thread-scaling: --threads: expected whole numbers >= 1, got '0'"), "%s", err);
   free(err);
+  /* an unknown option named (the usage alone said nothing of it), an empty
+  ** list refused (it ran the default); the default counts are the cores it
+  ** may use (taskset to one: one count, where getconf counted the machine's) */
+  cr_assert_eq(sh("%s %s/params/minimal.ini --bogus", tool("thread-scaling"), env("LW_ROOT")), 2);
+  err = err_txt();
+  cr_assert(!strcmp(err, "thread-scaling: unknown option '--bogus' (try 'thread-scaling --help')\n"), "%s", err);
+  free(err);
+  cr_assert_eq(sh("%s %s/params/minimal.ini --threads ''", tool("thread-scaling"), env("LW_ROOT")), 2);
+  if (!sh("command -v taskset")) {
+    cr_assert_eq(sh("taskset -c 0 %s %s/params/minimal.ini --reps 1 --bin %s/fake", tool("thread-scaling"),
+                    env("LW_ROOT"), dir), 0, "%s", err_txt());
+    out = out_txt();
+    cr_assert(strstr(out, " on 1 cores (nproc),") && !strstr(out, "\n       2 "), "%s", out);
+    free(out);
+  }
 }
 
 /* ---- make install ------------------------------------------------------ */
