@@ -245,7 +245,8 @@ INSTALLED_DIRS := share/linewise/params share/linewise share/doc/linewise includ
 LW_VERSION := $(shell sed -n 's/^\#define LW_VERSION "\(.*\)"/\1/p' include/linewise/version.h)
 # The install's root, quoted for the shell: a DESTDIR or PREFIX with a blank
 # stays one path (unquoted, uninstall removed the directory before the blank),
-# and one with $, ` or " is taken as it is (single quotes, a ' in it escaped).
+# and one with ` or " is taken as it is (single quotes, a ' in it escaped); a
+# $ is make's own, as everywhere in a make variable (write $$).
 shell_quote = '$(subst ','\'',$(1))'
 D = $(call shell_quote,$(DESTDIR)$(PREFIX))
 install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
@@ -277,7 +278,8 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	install -m 644 README.md docs/*.md docs/*.png tests/embed.cpp $(D)/share/doc/linewise/
 
 uninstall:
-	for f in $(INSTALLED); do rm -f $(D)/$$f || exit 1; done
+	n=0; for f in $(INSTALLED); do if [ -e $(D)/$$f ]; then rm -f $(D)/$$f || exit 1; n=$$((n + 1)); fi; done; \
+	  [ $$n -gt 0 ] || echo "uninstall: no file of linewise's in $(D) (installed with another PREFIX?)" >&2
 	for d in $(INSTALLED_DIRS); do if [ -d $(D)/$$d ]; then rmdir $(D)/$$d 2>/dev/null || \
 	  echo "uninstall: $$d kept: files not installed are in it" >&2; fi; done
 

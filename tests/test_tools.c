@@ -1360,4 +1360,10 @@ Test(tools, install_runs_every_scene_away_from_the_checkout_and_uninstall_remove
   char *kept = err_txt();
   cr_assert(strstr(kept, "uninstall: share/linewise/params kept: files not installed are in it\n"), "%s", kept);
   free(kept);
+  /* where nothing of it is (another PREFIX than install's), said */
+  cr_assert_eq(sh("cd %s && make -s -C %s uninstall DESTDIR=\"$PWD/ro ot\" PREFIX=/opt", dir, env("LW_ROOT")), 0);
+  kept = err_txt();
+  cr_assert(strstr(kept, "uninstall: no file of linewise's in ") && strstr(kept, "ro ot/opt' (installed with another "
+                                                                              "PREFIX?)\n"), "%s", kept);
+  free(kept);
 }
