@@ -1251,6 +1251,8 @@ static int cmd_resume(int argc, char **argv)
   run_going = &a;
   atexit(run_ended_at_exit);
   watcher_settle(&w);
+  /* a resume under the limit that failed its drawing failed again unsaid */
+  if (a.memory_note[0] && (!net || !net->rank)) fprintf(stderr, "linewise: note: %s\n", a.memory_note);
   if (!quiet) fprintf(stderr, "linewise: resuming %s at sweep %ld of %ld\n", dir, a.sweep, a.end_sweep);
   int rc = anneal_loop(&a, stop_at, quiet, asked, &w, &err);
   lw_anneal_free(&a);

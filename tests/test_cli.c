@@ -1983,6 +1983,11 @@ Test(cli, a_start_past_the_machines_memory_is_refused_before_placing)
                           "2>%s/err.txt && ! grep -q 'at the drawing' %s/err.txt", lw_test_bin(), lw_test_root(), dir,
                           dir, dir, lw_test_bin(), lw_test_root(), dir, dir, dir),
                0, "%s", lw_test_slurp("%s/err.txt", dir));
+  /* and a resume under the limit its drawing failed under (it failed again unsaid) */
+  cr_assert_eq(lw_test_sh("sh -c 'ulimit -v 280000; %s resume %s/m --stop-at 0 --threads 1 --quiet' 2>%s/err.txt && "
+                          "grep -q '^linewise: note: 20000 splines of 4 segments .* may take up to about 0.364 GB at "
+                          "the drawing' %s/err.txt", lw_test_bin(), dir, dir, dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
 /* FORMATS' redraw (no sweeps) of a tempering run that tuned its ladder: it
