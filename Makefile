@@ -55,13 +55,13 @@ all: $(BIN)/linewise $(PICTURE) $(MPI_BIN)
 $(BUILD)/obj/%.o: src/%.c | $(BUILD)/obj
 	$(CC) $(WARN) $(CFLAGS) $(OMP) $(DEPFLAGS) $(LW_CPPFLAGS) $(CPPFLAGS) -c $< -o $@
 
-# The commit a build is made from, "-dirty" with changes not committed, or
-# "unknown" outside a git checkout: `linewise --version`, summary.json and a
-# run's scene.ini name it, as a release spans many changes of the files.
+# The commit a build is made from, "-dirty" where src/, include/ or this file
+# differ from it (a source file not yet added too), or "unknown" outside
+# linewise's own checkout (a copy inside another repository, a paper's,
+# named that one's commit): `linewise --version`, summary.json and a run's
+# scene.ini name it, as a release spans many changes of a run's files.
 # version.o alone is compiled again when it changes ($(BUILD)/build-id is
 # rewritten only then).
-# (the checkout's own: a copy inside another repository, a paper's, named
-# that one's commit; and a source file not yet added counts as a change)
 LW_GIT_TOP  := $(shell git rev-parse --show-toplevel 2>/dev/null)
 LW_BUILD_ID := $(if $(filter $(realpath $(CURDIR)),$(realpath $(LW_GIT_TOP))),$(shell git rev-parse --short=12 \
                HEAD)$(if $(shell git status --porcelain -- src include Makefile 2>/dev/null | head -c1),-dirty),unknown)
