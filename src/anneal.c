@@ -1922,6 +1922,9 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json_begin_object(&j);
   lw_json_key(&j, "version"); lw_json_string(&j, LW_VERSION); /* the release that wrote it */
   lw_json_key(&j, "build"); lw_json_string(&j, lw_version_build());
+  char libs[256];
+  lw_version_libraries(libs, sizeof libs);
+  lw_json_key(&j, "libraries"); lw_json_string(&j, libs);
   lw_json_key(&j, "seed"); lw_json_int(&j, (long long)a->seed);
   lw_json_key(&j, "sweeps"); lw_json_int(&j, a->sweep);
   lw_json_key(&j, "system"); lw_json_string(&j, t->name);

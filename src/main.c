@@ -663,6 +663,28 @@ static int watched_fail(watcher *w, const lw_error *err)
   return fail(err);
 }
 
+/* The libraries of `here` (lw_version_libraries: "name version, ...") whose
+** version differs from `there`'s, as "cairo 1.14.0 then, 1.16.0 now"; 0
+** where none does. */
+static int libraries_changed(const char *there, const char *here, char *buf, size_t n)
+{
+  int changed = 0;
+  size_t used = 0;
+  buf[0] = '\0';
+  for (const char *h = here; *h; h += strcspn(h, ","), h += strspn(h, ", ")) {
+    const size_t len = strcspn(h, ","), name = strcspn(h, " ");
+    const char *t = there;
+    while (*t && (strncmp(t, h, name + 1) != 0)) t += strcspn(t, ","), t += strspn(t, ", ");
+    const size_t tlen = strcspn(t, ",");
+    if (*t && tlen == len && !strncmp(t, h, len)) continue;
+    if (used < n)
+      used += (size_t)snprintf(buf + used, n - used, "%s%.*s %.*s then, %.*s now", changed++ ? "; " : "",
+                               (int)name, h, *t ? (int)(tlen - name - 1) : 4, *t ? t + name + 1 : "none",
+                               (int)(len - name - 1), h + name + 1);
+  }
+  return changed;
+}
+
 /* The run set aside could not all be removed once this one replaced it:
 ** said under --quiet too (what is left takes disk space, and the next run or
 ** resume there tries again). */
@@ -1156,6 +1178,15 @@ static int cmd_run(int argc, char **argv)
             "its behaviour changed since (docs/FORMATS.md, \"Runs of older releases\")\n", scene,
             a.params.run_build[0] ? "linewise " : "an earlier linewise, which recorded no build",
             a.params.run_build, this_build);
+  /* the same build on other libraries may round otherwise: the scientist
+  ** repeating a run to the bit is told before comparing files */
+  char libs[sizeof a.params.run_libraries], libs_changed[2 * sizeof libs];
+  lw_version_libraries(libs, sizeof libs);
+  if (a.params.run_header && a.params.run_libraries[0] && (!net || !net->rank) &&
+      libraries_changed(a.params.run_libraries, libs, libs_changed, sizeof libs_changed))
+    fprintf(stderr, "linewise: note: %s was run on other libraries (%s): the last bits of state.lw and trace.csv and "
+            "the bytes of final.png may differ from that run's (docs/NUMERICS.md, \"How far the same bits reach\")\n",
+            scene, libs_changed);
   char changed[LW_PARAMS_FILES_MAX * (LW_PATH_MAX + 40)];
   const int n_changed = lw_params_files_changed(&a.params, changed, sizeof changed);
   if (n_changed && (!net || !net->rank))
@@ -1728,6 +1759,9 @@ static int command(int argc, char **argv)
       /* what a porter checks the same-bits promise against (LW_LANES) */
       printf("pair kernels %d lanes, cell scan %d lanes (LW_LANES=2 or 4 narrows them; every width gives the same "
              "bits)\n", lw_vec_wide() ? 4 : 2, lw_vec_lanes());
+      char libs[256];
+      lw_version_libraries(libs, sizeof libs);
+      printf("libraries %s\ncompiler %s\n", libs, lw_version_compiler());
       return 0;
     }
   }

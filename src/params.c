@@ -1214,6 +1214,7 @@ lw_status lw_params_blame(const lw_params *p, const char *section, const char *k
 
 #define LW_PARAMS_FILE_LINE "; file "
 #define LW_PARAMS_WRITTEN_LINE "; written by linewise "
+#define LW_PARAMS_LIBRARIES_LINE "; libraries "
 
 static void read_file_line(lw_params *p, const char *text);
 
@@ -1959,6 +1960,9 @@ static int file_hash(const char *path, unsigned long long *h)
 int lw_params_write_files(const lw_params *p, FILE *f)
 {
   fprintf(f, "%s%s, build %s\n", LW_PARAMS_WRITTEN_LINE, LW_VERSION, lw_version_build());
+  char libs[sizeof p->run_libraries];
+  lw_version_libraries(libs, sizeof libs);
+  fprintf(f, "%s%s\n", LW_PARAMS_LIBRARIES_LINE, libs);
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
     unsigned long long h;
@@ -1969,8 +1973,8 @@ int lw_params_write_files(const lw_params *p, FILE *f)
 }
 
 /* A "; file section.key: fnv1a-64 HEX" line of a run's scene.ini kept in p
-** (lw_params_write_files), and its "; written by linewise" line; any other
-** comment is the scene's own. */
+** (lw_params_write_files), its "; written by linewise" and "; libraries"
+** lines; any other comment is the scene's own. */
 static void read_file_line(lw_params *p, const char *text)
 {
   char name[80];
@@ -1978,6 +1982,11 @@ static void read_file_line(lw_params *p, const char *text)
   if (!strncmp(text, LW_PARAMS_WRITTEN_LINE, strlen(LW_PARAMS_WRITTEN_LINE))) {
     snprintf(p->run_build, sizeof p->run_build, "%.*s", (int)strcspn(text + strlen(LW_PARAMS_WRITTEN_LINE), "\r\n"),
              text + strlen(LW_PARAMS_WRITTEN_LINE));
+    return;
+  }
+  if (!strncmp(text, LW_PARAMS_LIBRARIES_LINE, strlen(LW_PARAMS_LIBRARIES_LINE))) {
+    snprintf(p->run_libraries, sizeof p->run_libraries, "%.*s",
+             (int)strcspn(text + strlen(LW_PARAMS_LIBRARIES_LINE), "\r\n"), text + strlen(LW_PARAMS_LIBRARIES_LINE));
     return;
   }
   if (strncmp(text, LW_PARAMS_FILE_LINE, strlen(LW_PARAMS_FILE_LINE)) || p->n_files >= LW_PARAMS_FILES_MAX ||

@@ -4,6 +4,7 @@
 ** sets it).
 */
 #include <criterion/criterion.h>
+#include <gsl/gsl_version.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -364,6 +365,35 @@ Test(cli, the_version_is_the_man_pages_and_the_summarys)
                           "%s/v/summary.json && grep -q '^; written by linewise %s, build ' %s/v/scene.ini",
                           lw_test_bin(), lw_test_root(), dir, LW_VERSION, dir, dir, LW_VERSION, dir),
                0);
+}
+
+/* The libraries the process runs with are --version's, summary.json's and
+** scene.ini's; run of a scene.ini run on another version of one names it,
+** and of one run on these says nothing of libraries. */
+Test(cli, the_libraries_are_named_and_a_change_of_them_said)
+{
+  char libs[256], out[1024], errs[256];
+  lw_version_libraries(libs, sizeof libs);
+  cr_assert(strstr(libs, "GSL " GSL_VERSION ", cairo ") && strstr(libs, ", zlib "), "%s", libs);
+  cr_assert_eq(run("--version", out, sizeof out, errs, sizeof errs), 0);
+  char want[300];
+  snprintf(want, sizeof want, "\nlibraries %s\ncompiler %s\n", libs, lw_version_compiler());
+  cr_assert(strstr(out, want) && strncmp(lw_version_compiler(), "unknown", 7), "%s", out);
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set anneal.sweeps=2 --out %s/a --quiet && "
+                          "grep -qxF '  \"libraries\": \"%s\",' %s/a/summary.json && "
+                          "grep -qxF '; libraries %s' %s/a/scene.ini && "
+                          "{ %s run %s/a/scene.ini --set anneal.sweeps=2 --out %s/b --quiet 2>%s/b.txt; } && "
+                          "! grep -q 'libraries' %s/b.txt && sed -i 's/^; libraries \\(.*\\)cairo [^,]*/; "
+                          "libraries \\1cairo 0.0.1/' %s/a/scene.ini && "
+                          "{ %s run %s/a/scene.ini --set anneal.sweeps=2 --out %s/c --quiet 2>%s/c.txt; }",
+                          lw_test_bin(), lw_test_root(), dir, libs, dir, libs, dir, lw_test_bin(), dir, dir, dir, dir,
+                          dir, lw_test_bin(), dir, dir, dir),
+               0, "%s", lw_test_slurp("%s/b.txt", dir));
+  const char *said = lw_test_slurp("%s/c.txt", dir);
+  const char *cairo = strstr(libs, "cairo ") + 6;
+  snprintf(want, sizeof want, "was run on other libraries (cairo 0.0.1 then, %.*s now): the last bits",
+           (int)strcspn(cairo, ","), cairo);
+  cr_assert(strstr(said, want), "%s", said);
 }
 
 /* LW_LANES narrows the SIMD kernels, so that one machine checks the promise

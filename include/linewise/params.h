@@ -294,6 +294,7 @@ typedef struct {
   unsigned short file_key[LW_PARAMS_FILES_MAX];
   unsigned long long file_hash[LW_PARAMS_FILES_MAX];
   char run_build[64];         /* and the release and build that wrote it ("2026.12, build ..."), or "" */
+  char run_libraries[256];    /* and the libraries it ran on (lw_version_libraries), or "" */
 } lw_params;
 
 /* Fills p with every default. */
