@@ -249,6 +249,8 @@ LW_VERSION := $(shell sed -n 's/^\#define LW_VERSION "\(.*\)"/\1/p' include/line
 # $ is make's own, as everywhere in a make variable (write $$).
 shell_quote = '$(subst ','\'',$(1))'
 D = $(call shell_quote,$(DESTDIR)$(PREFIX))
+# (the files a redirection writes take the umask, 077 a root's on many a
+# shared machine: chmod makes them every user's, as install -m does)
 install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	install -d $(D)/bin $(D)/share/linewise/params $(D)/share/doc/linewise
 	install -d $(D)/lib/pkgconfig $(D)/include/linewise $(D)/share/man/man1
@@ -258,6 +260,7 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	  'Name: linewise' 'Description: elastic Bezier curves annealed into line art (the library of linewise)' \
 	  'Version: $(LW_VERSION)' 'Requires: $(PKGS)' 'Libs: -L$${libdir} -llinewise -fopenmp -lm' \
 	  'Cflags: -I$${includedir}' > $(D)/lib/pkgconfig/linewise.pc
+	chmod 644 $(D)/lib/pkgconfig/linewise.pc
 	install -m 755 $(BIN)/linewise $(MPI_BIN) $(D)/bin/
 	install -m 644 params/*.ini params/*.lw $(PICTURE) $(D)/share/linewise/params/
 	install -m 644 docs/linewise.1 $(D)/share/man/man1/linewise.1
@@ -273,7 +276,7 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	    printf '%s\n' "$$help" | sed 's/\\/\\e/g; s/^[.'"'"']/\\\&&/'; \
 	    printf '.fi\n.SH SEE ALSO\n.BR linewise (1),\nREADME.md in %s/share/doc/linewise.\n' \
 	      "$$(printf '%s' $(call shell_quote,$(PREFIX)) | sed 's/\\/\\e/g')"; \
-	  } > $(D)/share/man/man1/linewise-$$t.1 || exit 1; done
+	  } > $(D)/share/man/man1/linewise-$$t.1 && chmod 644 $(D)/share/man/man1/linewise-$$t.1 || exit 1; done
 	install -m 644 tools/slurm-sweep.sbatch tools/slurm-tempering.sbatch $(D)/share/linewise/
 	install -m 644 README.md docs/*.md docs/*.png tests/embed.cpp $(D)/share/doc/linewise/
 

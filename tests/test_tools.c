@@ -1277,9 +1277,10 @@ Test(tools, thread_scaling_times_each_count_and_checks_the_bytes)
 
 /* ---- make install ------------------------------------------------------ */
 
-/* A program embeds the installed library, in C++ too: tests/embed.cpp,
-** built with nothing but what linewise.pc names, makes the run `linewise
-** run` makes, to the byte but for summary.json's clock.  Every header
+/* A program embeds the installed library, in C++ too, installed under any
+** umask: tests/embed.cpp, built with nothing but what linewise.pc names,
+** makes the run `linewise run` makes, to the byte but for summary.json's
+** clock.  Every header
 ** compiles in C++ with those flags (cairo's too: moved with the prefix, they
 ** were lost), and the library defines no global name but lw_ ones (its
 ** stb_image was global, and a program with its own either failed to link
@@ -1287,7 +1288,13 @@ Test(tools, thread_scaling_times_each_count_and_checks_the_bytes)
 Test(tools, an_installed_library_embeds_in_cxx_through_its_pkg_config, .timeout = 120)
 {
   if (sh("{ command -v c++ && command -v pkg-config; }")) cr_skip_test("no c++ or pkg-config here");
-  cr_assert_eq(sh("make -s -C %s install DESTDIR=%s/lib PREFIX=/usr", env("LW_ROOT"), dir), 0, "%s", err_txt());
+  /* under a root's umask of 077, every file for every user to read */
+  cr_assert_eq(sh("umask 077 && make -s -C %s install DESTDIR=%s/lib PREFIX=/usr", env("LW_ROOT"), dir), 0, "%s",
+               err_txt());
+  cr_assert_eq(sh("find %s/lib ! -perm -o=r", dir), 0);
+  char *unreadable = out_txt();
+  cr_assert_eq(unreadable[0], '\0', "not every user's to read: %s", unreadable);
+  free(unreadable);
   cr_assert_eq(sh("cd %s && flags=$(PKG_CONFIG_PATH=lib/usr/lib/pkgconfig pkg-config --cflags --libs linewise) && "
                   "c++ -Wall -Werror -o embed lib/usr/share/doc/linewise/embed.cpp $flags && "
                   "for h in lib/usr/include/linewise/*.h; do echo \"#include \\\"linewise/${h##*/}\\\"\"; "
