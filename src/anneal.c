@@ -1256,7 +1256,10 @@ static lw_status truncate_trace(lw_anneal *a, long bytes, lw_error *err)
       return lw_error_set(err, LW_EINPUT, "%s: the rows %s counts end at sweep %ld, but it is at sweep %ld (a row "
                           "every %ld sweeps): the state or the trace was edited, or is of another run",
                           path, state, last, a->sweep, every);
-    if (truncate(path, bytes)) return lw_error_set(err, LW_EIO, "%s: cannot truncate: %s", path, strerror(errno));
+    /* (a FUSE FAT refuses a truncate to the size a file has: every clean
+    ** stop's resume failed there) */
+    if (sb.st_size != bytes && truncate(path, bytes))
+      return lw_error_set(err, LW_EIO, "%s: cannot truncate: %s", path, strerror(errno));
     return open_trace(a, 0, err);
   }
   FILE *in = fopen(path, "r");

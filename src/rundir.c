@@ -149,6 +149,9 @@ lw_status lw_rundir_writable(const char *dir, lw_error *err)
                       strerror(e));
 }
 
+#define LW_RUNDIR_BUSY "%s: another linewise process is writing this run directory (it holds %s); wait for it to " \
+                       "end, or write another directory"
+
 /* The lock of dir's lock file fd (st its identity) into the table: the
 ** hold this process has on it already, or a new one.  Called under
 ** held_lock. */
@@ -173,8 +176,7 @@ static lw_status hold_lock(const char *dir, const char *path, int fd, const stru
     int e = errno;
     close(fd);
     if (e == EWOULDBLOCK)
-      return lw_error_set(err, LW_EUSAGE, "%s: another linewise process is writing this run directory (it holds "
-                          "%s); wait for it to end, or write another directory", dir, path);
+      return lw_error_set(err, LW_EUSAGE, LW_RUNDIR_BUSY, dir, path);
     /* no locks here (EBADF: an NFS lock on a file we could only read) */
     if (e == ENOLCK || e == EOPNOTSUPP || e == ENOSYS || e == EINVAL || e == EBADF) return LW_OK;
     return lw_error_set(err, LW_EIO, "%s: cannot lock the run directory: %s", path, strerror(e));
@@ -198,7 +200,17 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
   ** directory may read the lock file the first one made, and a local flock
   ** needs no more) */
   lw_status s = lw_rundir_writable(dir, err);
-  if (s) return s;
+  if (s) {
+    /* a run another user is writing is busy before it is theirs: its files'
+    ** modes were said, and the run going on not */
+    int probe = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    if (probe >= 0) {
+      const int busy = flock(probe, LOCK_SH | LOCK_NB) && errno == EWOULDBLOCK;
+      close(probe);
+      if (busy) return lw_error_set(err, LW_EUSAGE, LW_RUNDIR_BUSY, dir, path);
+    }
+    return s;
+  }
   /* never through a link: one planted there made a root's run create any file */
   int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0666);
   if (fd < 0 && errno == EACCES) fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW);

@@ -75,6 +75,30 @@ Test(rundir, a_directory_another_process_writes_is_refused)
   cr_assert_eq(sh("%s resume %s/r --quiet && test -s %s/r/summary.json", lw_test_bin(), dir, dir), 0);
 }
 
+/* A run another user is writing, in a directory this one may not write,
+** is said busy: before, the files' modes were said ("cannot write over the
+** run's trace"), and the run going on not; once it ends, the modes are. */
+Test(rundir, another_users_run_going_on_is_said_busy_before_its_modes)
+{
+  if (geteuid() || sh("setpriv --reuid=65534 --regid=65534 --clear-groups %s --version >/dev/null", lw_test_bin()))
+    cr_skip_test("needs root, setpriv, and a binary user nobody may run");
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/r --quiet --set anneal.sweeps=20 --stop-at 10 && "
+                  "chmod 755 %s", lw_test_bin(), lw_test_root(), dir, dir), 0);
+  char path[128];
+  snprintf(path, sizeof path, "%s/r/.lock", dir);
+  int fd = open(path, O_RDWR);
+  cr_assert(fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0, "the test takes the lock");
+  static const char *const said[] = {"another linewise process is writing this run directory",
+                                     "expected a run directory this user can write"};
+  for (int k = 0; k < 2; k++) {
+    if (k) close(fd);
+    cr_assert_eq(sh("setpriv --reuid=65534 --regid=65534 --clear-groups %s resume %s/r 2> %s/err.txt",
+                    lw_test_bin(), dir, dir), 2);
+    cr_assert_eq(sh("grep -q '%s' %s/err.txt && test $(wc -l < %s/err.txt) = 1", said[k], dir, dir), 0, "%s",
+                 lw_test_slurp("%s/err.txt", dir));
+  }
+}
+
 /* The lock is per process: taken twice here it is held once, and let go
 ** when the last hold goes. */
 Test(rundir, a_process_may_hold_its_own_lock_twice)
