@@ -283,8 +283,10 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 uninstall:
 	n=0; for f in $(INSTALLED); do if [ -e $(D)/$$f ]; then rm -f $(D)/$$f || exit 1; n=$$((n + 1)); fi; done; \
 	  [ $$n -gt 0 ] || echo "uninstall: no file of linewise's in $(D) (installed with another PREFIX?)" >&2
-	for d in $(INSTALLED_DIRS); do if [ -d $(D)/$$d ]; then rmdir $(D)/$$d 2>/dev/null || \
-	  echo "uninstall: $$d kept: files not installed are in it" >&2; fi; done
+	# (a folder kept for a kept one inside it is not said again)
+	kept=; for d in $(INSTALLED_DIRS); do if [ -d $(D)/$$d ] && ! rmdir $(D)/$$d 2>/dev/null; then \
+	  case " $$kept" in *" $$d/"*) ;; *) echo "uninstall: $$d kept: files not installed are in it" >&2 ;; esac; \
+	  kept="$$kept $$d"; fi; done
 
 clean:
 	rm -rf build build-asan build-fuzz bin $(PICTURE)

@@ -93,7 +93,7 @@ static const char usage[] =
   "                          column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs)\n"
   "  params              every scene parameter as Markdown (the table of docs/PARAMETERS.md)\n"
   "  schedules           the schedules' formulas as Markdown (the table of docs/SCHEDULES.md)\n"
-  "  version             the release and its pair kernels' SIMD widths (also --version, -V)\n"
+  "  version             the release, build, SIMD widths, libraries, compiler (also --version, -V)\n"
   "  help                this text\n"
   "  --                  ends the options: a path after it may begin with '-'\n"
   "\n"
