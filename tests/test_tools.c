@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -391,8 +392,8 @@ Test(tools, ctrl_c_stops_the_sweep_after_its_runs_have_saved)
                   "bash", tool("seed-sweep"), scene(), env("LW_BIN"), dir, dir, dir, dir, dir, dir, dir, dir, dir, dir),
                0, "%s", err_txt());
   char *e = lw_test_slurp("%s/i.err", dir);
-  cr_assert(strstr(e, "seed-sweep: interrupted: no further run started, and the runs in progress stopped (each said "
-                      "how); rerun the sweep to go on") && strstr(e, "[1/3] seed-1: interrupted, state saved"), "%s", e);
+  cr_assert(strstr(e, "seed-sweep: interrupted: no further run started, and each run in progress said how it ended (")
+            && strstr(e, "; rerun the sweep to go on") && strstr(e, "[1/3] seed-1: interrupted, state saved"), "%s", e);
   free(e);
   cr_assert_eq(lw_test_sh("grep -q '^sweep = [1-9]' %s/i/seed-1/state.lw", dir), 0);
 }
@@ -418,7 +419,7 @@ Test(tools, ctrl_c_or_a_hang_up_waits_for_the_slowest_run)
                     dir, "bash", tool("param-sweep"), scene(), env("LW_BIN"), dir, dir, dir, dir, dir, dir, dir, sig[k]),
                  0, "SIG%s: %s", sig[k], lw_test_slurp("%s/w.err", dir));
     char *e = lw_test_slurp("%s/w.err", dir);
-    const char *last = strstr(e, "param-sweep: interrupted: no further run started, and the runs in progress stopped");
+    const char *last = strstr(e, "param-sweep: interrupted: no further run started, and each run in progress said how");
     cr_assert(last && !strstr(last, "\n["), "SIG%s: %s", sig[k], e);
     cr_assert(strstr(e, "[1/2] init.splines=2__seed-1: interrupted, state saved") &&
                   strstr(e, "[2/2] init.splines=600__seed-1: interrupted, state saved"), "SIG%s: %s", sig[k], e);
@@ -833,6 +834,69 @@ Test(tools, a_failed_run_fails_the_sweep_on_a_full_disk)
   char *e = err_txt();
   cr_assert_eq(rc, 1, "%s", e);
   cr_assert(strstr(e, "some runs failed") && !raw_error(e), "%s", e);
+  free(e);
+}
+
+/* On a file system without symbolic links (FAT, some network shares) a
+** whole sweep exits 0 and names its best run (it said "could not link" and
+** exited 1 every time); ln is faked to fail as FAT's does. */
+Test(tools, a_sweep_where_no_link_can_be_made_names_its_best_run)
+{
+  cr_assert_eq(sh("cd %s && mkdir fake && printf '#!/bin/sh\necho \"ln: failed to create symbolic link: Operation not "
+                  "permitted\" >&2; exit 1\n' > fake/ln && chmod +x fake/ln && PATH=$PWD/fake:$PATH bash %s %s "
+                  "--seeds 1-2 -j 1 --bin %s " TINY " --out s", dir, tool("seed-sweep"), scene(), env("LW_BIN")),
+               0, "%s", err_txt());
+  char *out = out_txt();
+  cr_assert(strstr(out, "seed-sweep: best run: seed-") &&
+                strstr(out, " (this file system takes no symbolic links, so s/best is not made)\n"), "%s", out);
+  free(out);
+  cr_assert_eq(sh("test ! -e %s/s/best && test -s %s/s/sweep.csv", dir, dir), 0);
+}
+
+/* A run another process writes (a second sweep into the same directory) is
+** said so, by this attempt's own line of the shared log (the last line, a
+** progress line of the other run, was given as the reason), and the gather
+** says it is still running, not stopped. */
+Test(tools, a_run_another_process_writes_is_said_running)
+{
+  cr_assert_eq(sh("%s run %s --seed 1 --stop-at 2 --out %s/s/seed-1 --quiet " TINY " && echo 'sweep 10/20 T 0.1' >> "
+                  "%s/s/seed-1/linewise.log", env("LW_BIN"), scene(), dir, dir),
+               0, "%s", err_txt());
+  char path[128];
+  snprintf(path, sizeof path, "%s/s/seed-1/.lock", dir);
+  int fd = open(path, O_RDWR);
+  cr_assert(fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0, "the test takes the lock");
+  cr_assert_eq(sh("bash %s %s --seeds 1-2 -j 1 --bin %s " TINY " --out %s/s", tool("seed-sweep"), scene(),
+                  env("LW_BIN"), dir),
+               1);
+  close(fd);
+  char *e = err_txt();
+  cr_assert(strstr(e, "[1/2] seed-1: FAILED (exit 2): linewise: ") &&
+                strstr(e, "seed-1: another linewise process is writing this run directory") &&
+                strstr(e, "/s/seed-1: not finished: still running in another process (a second sweep into this "
+                          "directory?)"), "%s", e);
+  free(e);
+}
+
+/* A finished sweep another user made, in a directory this one may only
+** read, is gathered again by the same command, every run skipped (its
+** notes went into the directory: refused at once), and the table it may
+** not write is said, exit 2 (a place the user chose, not a failed run). */
+Test(tools, a_finished_sweep_another_user_made_is_read_not_refused)
+{
+  if (geteuid() || sh("setpriv --reuid=65534 --regid=65534 --clear-groups bash %s --help", tool("seed-sweep")))
+    cr_skip_test("needs root, setpriv, and tools user nobody may run");
+  char cmd[3500];
+  snprintf(cmd, sizeof cmd, "bash %s %s --seeds 1-2 -j 1 --bin %s " TINY " --out %s/s", tool("seed-sweep"), scene(),
+           env("LW_BIN"), dir);
+  cr_assert_eq(sh("{ %s && chmod 755 %s; }", cmd, dir), 0, "%s", err_txt());
+  cr_assert_eq(sh("cd / && setpriv --reuid=65534 --regid=65534 --clear-groups %s", cmd), 2, "%s", err_txt());
+  char *out = out_txt(), *e = err_txt();
+  cr_assert(strstr(out, "[1/2] seed-1: finished already") && strstr(out, "[2/2] seed-2: finished already"), "%s",
+            out);
+  cr_assert(strstr(e, "/s/sweep.csv: could not write: Permission denied\n") && !strstr(e, "cannot create a file"),
+            "%s", e);
+  free(out);
   free(e);
 }
 
