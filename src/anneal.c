@@ -135,10 +135,13 @@ void lw_anneal_ladder_note(const lw_anneal *a, char *buf, size_t n)
 void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n)
 {
   const double wall = lw_phase_clock() - a->wall_start;
+  /* every write at the fastest one's time: a process stopped (SIGSTOP, a
+  ** batch system's suspend) during one write was told to checkpoint less */
+  const double cost = fmin(a->ckpt_seconds, a->ckpt_fastest * a->ckpt_count);
   buf[0] = '\0';
-  if (!(a->ckpt_seconds > 1.0 && a->ckpt_seconds > wall / 3.0)) return;
+  if (!(cost > 1.0 && cost > wall / 3.0)) return;
   /* (no figures of this run: a sweep shows each distinct note once) */
-  const char *share = a->ckpt_seconds > wall / 2.0 ? "most" : "over a third";
+  const char *share = cost > wall / 2.0 ? "most" : "over a third";
   if (a->params.checkpoint_every < a->end_sweep)
     snprintf(buf, n, "writing state.lw every %d sweeps (output.checkpoint_every) took %s of this run's time: a "
              "larger value costs less, and a killed run then loses more sweeps", a->params.checkpoint_every, share);
@@ -1166,7 +1169,9 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
   lw_phase_set("writing state.lw");
   const double t0 = lw_phase_clock();
   lw_status s = a->net ? a->net->checkpoint(a->net, a, err) : lw_checkpoint_write(a, err);
-  a->ckpt_seconds += lw_phase_clock() - t0;
+  const double took = lw_phase_clock() - t0;
+  a->ckpt_seconds += took;
+  if (!a->ckpt_count++ || took < a->ckpt_fastest) a->ckpt_fastest = took;
   lw_phase_set(was);
   if (!s) a->saved = a->sweep + 1;
   if (s) return s;
@@ -1445,14 +1450,25 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   dir_file(path, sizeof path, a, "timing.txt");
   lw_error fifo; /* (a FIFO there is no timing: opening it would wait for ever) */
   FILE *tf = lw_text_not_fifo(path, &fifo) ? NULL : fopen(path, "r");
+  /* Without the sweeps' time before (timing.txt lost, as where state.lw and
+  ** scene.ini alone were copied to another machine, or from before
+  ** 2026-12-04), the rate counts this process's proposals over its own
+  ** sweeps: every proposal over them gave a rate many times too high. */
+  int timed = 0;
   if (tf) {
-    if (fscanf(tf, "wall_seconds %lf", &a->wall_before) != 1 || !(a->wall_before >= 0 && a->wall_before < 1e12))
-      a->wall_before = 0;
-    /* (absent before 2026-12-04: the rate then counts this process's sweeps) */
+    timed = fscanf(tf, "wall_seconds %lf", &a->wall_before) == 1 && a->wall_before >= 0 && a->wall_before < 1e12;
+    if (!timed) a->wall_before = 0;
     if (fscanf(tf, " sweep_seconds %lf", &a->sweep_seconds) != 1 ||
         !(a->sweep_seconds >= 0 && a->sweep_seconds < 1e12))
-      a->sweep_seconds = 0;
+      a->sweep_seconds = 0, timed = 0;
+    if (timed && fscanf(tf, " untimed_proposals %lu", &a->untimed) != 1) a->untimed = 0;
     fclose(tf);
+  }
+  if (!timed) {
+    a->wall_before = a->sweep_seconds = 0;
+    a->untimed = 0;
+    for (int k = 0; a->chain && k < a->chain->n_moves; k++) a->untimed += a->chain->stats[k].proposed;
+    a->untimed_said = 1;
   }
   if (a->end_sweep < 0) a->end_sweep = a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep;
   const long saved_end = a->end_sweep;
@@ -1947,7 +1963,8 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json_key(&j, "sweep_seconds"); lw_json_number(&j, a->sweep_seconds);
   if (mc) {
     lw_json_key(&j, "proposals_per_second"); /* of the sweeps of the whole run */
-    lw_json_number(&j, a->sweep_seconds > 0 ? (double)prop / a->sweep_seconds : 0.0);
+    lw_json_number(&j, a->sweep_seconds > 0 && prop >= a->untimed ? (double)(prop - a->untimed) / a->sweep_seconds
+                                                                    : 0.0);
     lw_json_key(&j, "max_relative_drift"); lw_json_number(&j, a->max_drift);
     lw_json_key(&j, "temperature_final"); /* none where no sweep ran (a redraw) */
     if (a->sweep > 0) lw_json_number(&j, c->temperature);

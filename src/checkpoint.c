@@ -258,6 +258,7 @@ lw_status lw_checkpoint_write_timing(const lw_anneal *a, lw_error *err)
   FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
   if (!f) return err->code;
   fprintf(f, "wall_seconds %.6f\nsweep_seconds %.6f\n", lw_anneal_seconds(a), a->sweep_seconds);
+  if (a->untimed) fprintf(f, "untimed_proposals %lu\n", a->untimed);
   return lw_output_commit(f, tmp, path, err);
 }
 

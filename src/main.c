@@ -1284,6 +1284,10 @@ static int cmd_resume(int argc, char **argv)
   watcher_settle(&w);
   /* a resume under the limit that failed its drawing failed again unsaid */
   if (a.memory_note[0] && (!net || !net->rank)) fprintf(stderr, "linewise: note: %s\n", a.memory_note);
+  /* (under --quiet too: a study's rates were many times too high unsaid) */
+  if (a.untimed_said && !lw_anneal_done(&a) && (!net || !net->rank))
+    fprintf(stderr, "linewise: note: %s/timing.txt is missing or unreadable: summary.json's wall_seconds and "
+            "sweep_seconds count from this resume on, and proposals_per_second this resume's proposals\n", dir);
   if (!quiet) fprintf(stderr, "linewise: resuming %s at sweep %ld of %ld\n", dir, a.sweep, a.end_sweep);
   int rc = anneal_loop(&a, stop_at, quiet, asked, &w, &err);
   lw_anneal_free(&a);

@@ -396,6 +396,30 @@ Test(cli, the_libraries_are_named_and_a_change_of_them_said)
   cr_assert(strstr(said, want), "%s", said);
 }
 
+/* A resume without timing.txt (state.lw and scene.ini copied elsewhere)
+** says so, and its rate counts its own proposals over its own sweeps, on
+** later resumes too (timing.txt's untimed_proposals): every proposal over
+** them gave a rate many times too high, unsaid. */
+Test(cli, a_resume_without_its_timing_rates_its_own_proposals)
+{
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=60 --stop-at 40 --out t --quiet "
+                          "&& rm t/timing.txt && { %s resume t --quiet --sweeps 10 2> t1.txt; } && "
+                          "{ %s resume t --quiet 2> t2.txt; }",
+                          dir, lw_test_bin(), lw_test_root(), lw_test_bin(), lw_test_bin()),
+               0);
+  cr_assert(strstr(lw_test_slurp("%s/t1.txt", dir), "linewise: note: t/timing.txt is missing or unreadable: "
+                                 "summary.json's wall_seconds and sweep_seconds count from this resume on"));
+  cr_assert_eq(lw_test_slurp("%s/t2.txt", dir)[0], '\0', "said again: %s", lw_test_slurp("%s/t2.txt", dir));
+  /* proposals_per_second x sweep_seconds = proposals less those of the 40
+  ** sweeps before the timing was lost, which timing.txt counts */
+  cr_assert_eq(lw_test_sh("cd %s/t && u=$(awk '/^untimed_proposals/ { print $2 }' timing.txt) && test \"$u\" -gt 0 && "
+                          "awk -F'[:,]' -v u=$u '/\"proposals\"/ { p = $2 } /\"sweep_seconds\"/ { s = $2 } "
+                          "/\"proposals_per_second\"/ { r = $2 } END { d = r * s - (p - u); "
+                          "exit !(s > 0 && u == p * 40 / 60 && d * d < 1e-6 * p * p) }' summary.json",
+                          dir),
+               0, "%s", lw_test_slurp("%s/t/timing.txt", dir));
+}
+
 /* LW_LANES narrows the SIMD kernels, so that one machine checks the promise
 ** that every width gives the same bits end to end: runs with every term
 ** and the near field on, at 2, 4 and the processor's lanes, write the same
