@@ -40,9 +40,14 @@ lw_status lw_rundir_make(const char *dir, lw_error *err)
       ** permission, a read-only mount) is the user's choice (exit 2, as
       ** --out naming a file); a disk that is full or fails is the machine's */
       if (mkdir(buf, 0777) && errno != EEXIST) {
-        const int machine = errno == ENOSPC || errno == EIO || errno == EDQUOT || errno == ENOMEM;
-        return lw_error_set(err, machine ? LW_EIO : LW_EUSAGE, "%s: cannot create directory: %s", buf,
-                            strerror(errno));
+        const int e = errno, machine = e == ENOSPC || e == EIO || e == EDQUOT || e == ENOMEM;
+        /* a relative one under a working directory a log does not show (cron's
+        ** /, a read-only folder): "out: cannot create directory" said no where */
+        char cwd[LW_PATH_MAX] = "";
+        if (!machine && buf[0] != '/' && !getcwd(cwd, sizeof cwd)) cwd[0] = '\0';
+        return lw_error_set(err, machine ? LW_EIO : LW_EUSAGE, "%s: cannot create directory: %s%s%s%s", buf,
+                            strerror(e), cwd[0] ? " (in the working directory " : "", cwd,
+                            cwd[0] ? "; --out names another place)" : "");
       }
       *c = save;
       if (!save) break;

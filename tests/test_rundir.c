@@ -99,6 +99,19 @@ Test(rundir, another_users_run_going_on_is_said_busy_before_its_modes)
   }
 }
 
+/* A directory that cannot be made under the working directory names it (a
+** cron job's "out: cannot create directory" said no where), and --out. */
+Test(rundir, a_relative_directory_that_cannot_be_made_names_the_working_directory)
+{
+  cr_assert_eq(sh("cd %s && touch f && %s run %s/params/minimal.ini --out f/x --quiet 2> err.txt", dir, lw_test_bin(),
+                  lw_test_root()),
+               2);
+  char want[256];
+  snprintf(want, sizeof want, "linewise: f/x: cannot create directory: Not a directory (in the working directory %s; "
+           "--out names another place)\n", dir);
+  cr_assert_str_eq(lw_test_slurp("%s/err.txt", dir), want);
+}
+
 /* The lock is per process: taken twice here it is held once, and let go
 ** when the last hold goes. */
 Test(rundir, a_process_may_hold_its_own_lock_twice)
