@@ -283,10 +283,11 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 uninstall:
 	n=0; for f in $(INSTALLED); do if [ -e $(D)/$$f ]; then rm -f $(D)/$$f || exit 1; n=$$((n + 1)); fi; done; \
 	  [ $$n -gt 0 ] || echo "uninstall: no file of linewise's in $(D) (installed with another PREFIX?)" >&2
-	# (a folder kept for a kept one inside it is not said again)
-	kept=; for d in $(INSTALLED_DIRS); do if [ -d $(D)/$$d ] && ! rmdir $(D)/$$d 2>/dev/null; then \
-	  case " $$kept" in *" $$d/"*) ;; *) echo "uninstall: $$d kept: files not installed are in it" >&2 ;; esac; \
-	  kept="$$kept $$d"; fi; done
+	# (a folder that holds nothing but a kept one is not said again)
+	root=$(D); kept=; for d in $(INSTALLED_DIRS); do if [ -d "$$root/$$d" ] && ! rmdir "$$root/$$d" 2>/dev/null; then \
+	  own=; for e in "$$root/$$d"/* "$$root/$$d"/.[!.]*; do [ -e "$$e" ] || [ -L "$$e" ] || continue; \
+	    case " $$kept " in *" $${e#"$$root/"} "*) ;; *) own=1 ;; esac; done; \
+	  [ -z "$$own" ] || echo "uninstall: $$d kept: files not installed are in it" >&2; kept="$$kept $$d"; fi; done
 
 clean:
 	rm -rf build build-asan build-fuzz bin $(PICTURE)

@@ -663,24 +663,49 @@ static int watched_fail(watcher *w, const lw_error *err)
   return fail(err);
 }
 
-/* The libraries of `here` (lw_version_libraries: "name version, ...") whose
-** version differs from `there`'s, as "cairo 1.14.0 then, 1.16.0 now"; 0
-** where none does. */
+/* The next item at *p of a libraries list ("name version, ..."), blanks
+** about its parts aside: 0 past the last. */
+typedef struct {
+  const char *name, *version;
+  int name_len, version_len;
+} library_item;
+
+static int next_library(const char **p, library_item *it)
+{
+  const char *s = *p + strspn(*p, " ,");
+  if (!*s) return 0;
+  int len = (int)strcspn(s, ",");
+  *p = s + len;
+  while (len && s[len - 1] == ' ') len--;
+  it->name = s;
+  it->name_len = (int)strcspn(s, " ");
+  if (it->name_len > len) it->name_len = len;
+  it->version = s + it->name_len + strspn(s + it->name_len, " ");
+  it->version_len = (int)(s + len - it->version);
+  if (it->version_len < 0) it->version_len = 0;
+  return 1;
+}
+
+/* The libraries of both lists whose versions differ, as "cairo 1.14.0 then,
+** 1.16.0 now"; 0 where none does.  One only a list names is not said: a
+** release that records another library would say it of every older run. */
 static int libraries_changed(const char *there, const char *here, char *buf, size_t n)
 {
   int changed = 0;
   size_t used = 0;
   buf[0] = '\0';
-  for (const char *h = here; *h; h += strcspn(h, ","), h += strspn(h, ", ")) {
-    const size_t len = strcspn(h, ","), name = strcspn(h, " ");
-    const char *t = there;
-    while (*t && (strncmp(t, h, name + 1) != 0)) t += strcspn(t, ","), t += strspn(t, ", ");
-    const size_t tlen = strcspn(t, ",");
-    if (*t && tlen == len && !strncmp(t, h, len)) continue;
+  library_item h, t;
+  for (const char *ph = here; next_library(&ph, &h);) {
+    int found = 0;
+    for (const char *pt = there; !found && next_library(&pt, &t);)
+      found = t.name_len == h.name_len && !strncmp(t.name, h.name, (size_t)h.name_len);
+    if (!found || (t.version_len == h.version_len && !strncmp(t.version, h.version, (size_t)h.version_len)))
+      continue;
     if (used < n)
-      used += (size_t)snprintf(buf + used, n - used, "%s%.*s %.*s then, %.*s now", changed++ ? "; " : "",
-                               (int)name, h, *t ? (int)(tlen - name - 1) : 4, *t ? t + name + 1 : "none",
-                               (int)(len - name - 1), h + name + 1);
+      used += (size_t)snprintf(buf + used, n - used, "%s%.*s %.*s then, %.*s now", changed ? "; " : "", h.name_len,
+                               h.name, t.version_len ? t.version_len : 1, t.version_len ? t.version : "?",
+                               h.version_len, h.version);
+    changed++;
   }
   return changed;
 }

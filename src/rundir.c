@@ -9,6 +9,7 @@
 #include <string.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "linewise/params.h"
@@ -177,8 +178,17 @@ static lw_status hold_lock(const char *dir, const char *path, int fd, const stru
     close(fd);
     return lw_error_set(err, LW_ERUN, "%s: more than %d run directories open in one process", dir, HELD_MAX);
   }
-  if (flock(fd, LOCK_EX | LOCK_NB)) {
-    int e = errno;
+  /* a few tries: another process's look at the lock (a busy probe, a
+  ** sweep's gather) holds it shared for a moment, and the run failed as busy */
+  int e = 0;
+  for (int tries = 0; flock(fd, LOCK_EX | LOCK_NB); tries++) {
+    e = errno;
+    if (e != EWOULDBLOCK || tries == 4) break;
+    struct timespec pause = {0, 20000000};
+    nanosleep(&pause, NULL);
+    e = 0;
+  }
+  if (e) {
     close(fd);
     if (e == EWOULDBLOCK)
       return lw_error_set(err, LW_EUSAGE, LW_RUNDIR_BUSY, dir, path);
@@ -208,7 +218,10 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
   if (s) {
     /* a run another user is writing is busy before it is theirs: its files'
     ** modes were said, and the run going on not */
-    int probe = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    /* (non-blocking: a FIFO planted there held the open for ever) */
+    int probe = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+    struct stat ps;
+    if (probe >= 0 && (fstat(probe, &ps) || !S_ISREG(ps.st_mode))) close(probe), probe = -1;
     if (probe >= 0) {
       const int busy = flock(probe, LOCK_SH | LOCK_NB) && errno == EWOULDBLOCK;
       close(probe);
@@ -218,13 +231,18 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
   }
   /* never through a link: one planted there made a root's run create any file */
   int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0666);
-  if (fd < 0 && errno == EACCES) fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+  if (fd < 0 && errno == EACCES) fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
   struct stat st;
   if (fd < 0 || fstat(fd, &st)) {
     int e = errno;
     if (fd >= 0) close(fd);
     return lw_error_set(err, LW_EIO, "%s: cannot open the run directory's lock: %s%s", path, strerror(e),
                         e == ELOOP ? " (a symbolic link, which linewise does not follow: remove it)" : "");
+  }
+  if (!S_ISREG(st.st_mode)) {
+    close(fd);
+    return lw_error_set(err, LW_EINPUT, "%s: not a regular file (a FIFO, a device or a folder): the run directory's "
+                        "lock is a file of its own; remove it", path);
   }
   pthread_mutex_lock(&held_lock);
   s = hold_lock(dir, path, fd, &st, hold, err);

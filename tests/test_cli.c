@@ -383,11 +383,16 @@ Test(cli, the_libraries_are_named_and_a_change_of_them_said)
                           "grep -qxF '  \"libraries\": \"%s\",' %s/a/summary.json && "
                           "grep -qxF '; libraries %s' %s/a/scene.ini && "
                           "{ %s run %s/a/scene.ini --set anneal.sweeps=2 --out %s/b --quiet 2>%s/b.txt; } && "
-                          "! grep -q 'libraries' %s/b.txt && sed -i 's/^; libraries \\(.*\\)cairo [^,]*/; "
+                          "! grep -q 'libraries' %s/b.txt && "
+                          /* blanks about the items, and a library the run's build did not record, are no change */
+                          "sed 's/^; libraries \\(.*\\), \\(.*\\)$/; libraries  \\1 ,  \\2 , foo 1.0 /' %s/a/scene.ini "
+                          "> %s/d.ini && grep -q '^; libraries  .* , foo 1.0 $' %s/d.ini && "
+                          "{ %s run %s/d.ini --set anneal.sweeps=2 --out %s/d --quiet 2>%s/d.txt; } && "
+                          "! grep -q 'libraries' %s/d.txt && sed -i 's/^; libraries \\(.*\\)cairo [^,]*/; "
                           "libraries \\1cairo 0.0.1/' %s/a/scene.ini && "
                           "{ %s run %s/a/scene.ini --set anneal.sweeps=2 --out %s/c --quiet 2>%s/c.txt; }",
                           lw_test_bin(), lw_test_root(), dir, libs, dir, libs, dir, lw_test_bin(), dir, dir, dir, dir,
-                          dir, lw_test_bin(), dir, dir, dir),
+                          dir, dir, dir, lw_test_bin(), dir, dir, dir, dir, dir, lw_test_bin(), dir, dir, dir),
                0, "%s", lw_test_slurp("%s/b.txt", dir));
   const char *said = lw_test_slurp("%s/c.txt", dir);
   const char *cairo = strstr(libs, "cairo ") + 6;

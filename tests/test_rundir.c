@@ -99,6 +99,23 @@ Test(rundir, another_users_run_going_on_is_said_busy_before_its_modes)
   }
 }
 
+/* A lock that is a FIFO is refused, by root and by another user, at once:
+** the busy probe of another user's run opened it for reading and waited
+** for a writer for ever. */
+Test(rundir, a_lock_that_is_a_fifo_is_refused_at_once)
+{
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --out %s/r --quiet --set anneal.sweeps=20 --stop-at 10 && "
+                  "rm %s/r/.lock && mkfifo -m 644 %s/r/.lock && chmod 755 %s", lw_test_bin(), lw_test_root(), dir, dir,
+                  dir, dir), 0);
+  cr_assert_eq(sh("timeout 20 %s resume %s/r 2> %s/err.txt", lw_test_bin(), dir, dir), 2);
+  cr_assert_eq(sh("grep -q 'r/.lock: not a regular file (a FIFO, a device or a folder)' %s/err.txt", dir), 0, "%s",
+               lw_test_slurp("%s/err.txt", dir));
+  if (geteuid() || sh("setpriv --reuid=65534 --regid=65534 --clear-groups %s --version >/dev/null", lw_test_bin()))
+    return; /* (the other user's case needs root and setpriv) */
+  cr_assert_eq(sh("timeout 20 setpriv --reuid=65534 --regid=65534 --clear-groups %s resume %s/r 2> %s/err.txt",
+                  lw_test_bin(), dir, dir), 2, "%s", lw_test_slurp("%s/err.txt", dir));
+}
+
 /* A directory that cannot be made under the working directory names it (a
 ** cron job's "out: cannot create directory" said no where), and --out. */
 Test(rundir, a_relative_directory_that_cannot_be_made_names_the_working_directory)

@@ -851,6 +851,12 @@ Test(tools, a_sweep_where_no_link_can_be_made_names_its_best_run)
                 strstr(out, " (this file system takes no symbolic links, so s/best is not made)\n"), "%s", out);
   free(out);
   cr_assert_eq(sh("test ! -e %s/s/best && test -s %s/s/sweep.csv", dir, dir), 0);
+  /* a gather alone still fails where a planned run has not finished */
+  cr_assert_eq(sh("cd %s && rm -r s/seed-2 && PATH=$PWD/fake:$PATH bash %s --gather-only s", dir, tool("seed-sweep")),
+               1);
+  char *e = err_txt();
+  cr_assert(strstr(e, "seed-sweep: 1 of 2 planned runs have not finished"), "%s", e);
+  free(e);
 }
 
 /* A run another process writes (a second sweep into the same directory) is
@@ -873,8 +879,22 @@ Test(tools, a_run_another_process_writes_is_said_running)
   char *e = err_txt();
   cr_assert(strstr(e, "[1/2] seed-1: FAILED (exit 2): linewise: ") &&
                 strstr(e, "seed-1: another linewise process is writing this run directory") &&
-                strstr(e, "/s/seed-1: not finished: still running in another process (a second sweep into this "
-                          "directory?)"), "%s", e);
+                strstr(e, "/s/seed-1: not finished: still running in another process (a task of this sweep, or a "
+                          "second sweep)"), "%s", e);
+  free(e);
+  /* a run that failed for its own reason while a second sweep's refusal
+  ** went into the log after its line is given its own (exit 1, not the
+  ** busy directory's 2); a line before this attempt is none of its */
+  write_script("raced-linewise", "#!/bin/sh\necho 'linewise: t.csv: write failed: No space left on device'\n"
+               "echo 'linewise: s2/seed-1: another linewise process is writing this run directory (it holds "
+               "s2/seed-1/.lock)'\nexit 1\n");
+  cr_assert_eq(sh("mkdir -p %s/s2/seed-1 && echo 'linewise: an earlier line' > %s/s2/seed-1/linewise.log && "
+                  "bash %s %s --seeds 1 -j 1 --bin %s/raced-linewise " TINY " --out %s/s2", dir, dir,
+                  tool("seed-sweep"), scene(), dir, dir),
+               1);
+  e = err_txt();
+  cr_assert(strstr(e, "[1/1] seed-1: FAILED (exit 1): linewise: t.csv: write failed: No space left on device\n"), "%s",
+            e);
   free(e);
 }
 
@@ -916,7 +936,7 @@ Test(tools, a_run_whose_log_cannot_be_written_is_said_so)
                   dir, dir), 1);
   char *e = err_txt();
   cr_assert(!raw_error(e), "%s", e);
-  cr_assert(strstr(e, "seed-2: FAILED (exit 1): its linewise.log is empty"), "%s", e);
+  cr_assert(strstr(e, "seed-2: FAILED (exit 1): it wrote nothing into its linewise.log"), "%s", e);
   cr_assert(strstr(e, "seed-3: FAILED: its linewise.log could not be written (Is a directory); the run was not "
                       "started\n"), "%s", e);
   cr_assert(strstr(e, "seed-3: not finished: failed or not started (it has no linewise.log to say which)"), "%s", e);
