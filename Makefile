@@ -4,6 +4,9 @@
 
 CC      ?= cc
 PREFIX  ?= /usr/local
+# the library's folder under PREFIX (a multiarch one: lib/x86_64-linux-gnu)
+LIBDIR  ?= lib
+PKG_CONFIG ?= pkg-config
 BUILD   ?= build
 BIN     ?= bin
 PKGS    := gsl cairo inih zlib libpng
@@ -14,8 +17,8 @@ CFLAGS  ?= $(OPT) -g
 WARN    := -std=c11 -ffp-contract=off -Wall -Wextra -Wshadow -Wstrict-prototypes -Wno-unused-parameter
 # What the build needs, apart from CPPFLAGS and LDLIBS, which a packager may set on the
 # command line (make CPPFLAGS="$(dpkg-buildflags --get CPPFLAGS)") and so replace.
-LW_CPPFLAGS := -Iinclude -D_POSIX_C_SOURCE=200809L $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
-LW_LDLIBS := $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lm
+LW_CPPFLAGS := -Iinclude -D_POSIX_C_SOURCE=200809L $(shell $(PKG_CONFIG) --cflags $(PKGS) 2>/dev/null)
+LW_LDLIBS := $(shell $(PKG_CONFIG) --libs $(PKGS) 2>/dev/null) -lm
 OMP     := -fopenmp
 # Each object lists the headers it includes in a .d file beside it, so a
 # header's change rebuilds only what includes it.
@@ -72,7 +75,7 @@ $(BUILD)/obj/version.o build-fuzz/obj/version.o: $(BUILD)/build-id
 FORCE:
 
 $(BUILD)/liblinewise.a: $(LIB_OBJ)
-	rm -f $@ && ar rcs $@ $^
+	rm -f $@ && $(AR) rcs $@ $^
 
 # (main.c alone, so any header's change compiles it again)
 $(BIN)/linewise: src/main.c $(wildcard include/linewise/*.h) $(BUILD)/liblinewise.a | $(BIN)
@@ -239,8 +242,9 @@ INSTALLED := bin/linewise bin/linewise-mpi $(TOOLS:%=bin/linewise-%) bin/linewis
              $(patsubst %,share/linewise/params/%,$(notdir $(wildcard params/*.ini params/*.lw) $(PICTURE))) \
              share/linewise/slurm-sweep.sbatch share/linewise/slurm-tempering.sbatch \
              $(patsubst %,share/doc/linewise/%,README.md $(notdir $(wildcard docs/*.md docs/*.png)) embed.cpp) \
-             share/man/man1/linewise.1 $(TOOLS:%=share/man/man1/linewise-%.1) share/man/man1/linewise-animate.1 \
-             lib/liblinewise.a lib/pkgconfig/linewise.pc $(wildcard include/linewise/*.h)
+             share/man/man1/linewise.1 share/man/man1/linewise-mpi.1 $(TOOLS:%=share/man/man1/linewise-%.1) \
+             share/man/man1/linewise-animate.1 $(LIBDIR)/liblinewise.a $(LIBDIR)/pkgconfig/linewise.pc \
+             $(wildcard include/linewise/*.h)
 INSTALLED_DIRS := share/linewise/params share/linewise share/doc/linewise include/linewise
 LW_VERSION := $(shell sed -n 's/^\#define LW_VERSION "\(.*\)"/\1/p' include/linewise/version.h)
 # The install's root, quoted for the shell: a DESTDIR or PREFIX with a blank
@@ -249,21 +253,25 @@ LW_VERSION := $(shell sed -n 's/^\#define LW_VERSION "\(.*\)"/\1/p' include/line
 # $ is make's own, as everywhere in a make variable (write $$).
 shell_quote = '$(subst ','\'',$(1))'
 D = $(call shell_quote,$(DESTDIR)$(PREFIX))
+# linewise.pc's way up from $(LIBDIR)/pkgconfig to the prefix: ../.. for lib
+PC_UP := $(shell printf '%s' '$(LIBDIR)' | sed 's,[^/][^/]*,..,g')/..
 # (the files a redirection writes take the umask, 077 a root's on many a
 # shared machine: chmod makes them every user's, as install -m does)
 install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	install -d $(D)/bin $(D)/share/linewise/params $(D)/share/doc/linewise
-	install -d $(D)/lib/pkgconfig $(D)/include/linewise $(D)/share/man/man1
-	install -m 644 $(BUILD)/liblinewise.a $(D)/lib/
+	install -d $(D)/$(LIBDIR)/pkgconfig $(D)/include/linewise $(D)/share/man/man1
+	install -m 644 $(BUILD)/liblinewise.a $(D)/$(LIBDIR)/
 	install -m 644 include/linewise/*.h $(D)/include/linewise/
-	printf '%s\n' 'prefix=$${pcfiledir}/../..' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
+	printf '%s\n' 'prefix=$${pcfiledir}/$(PC_UP)' 'libdir=$${prefix}/$(LIBDIR)' 'includedir=$${prefix}/include' '' \
 	  'Name: linewise' 'Description: elastic Bezier curves annealed into line art (the library of linewise)' \
 	  'Version: $(LW_VERSION)' 'Requires: $(PKGS)' 'Libs: -L$${libdir} -llinewise -fopenmp -lm' \
-	  'Cflags: -I$${includedir}' > $(D)/lib/pkgconfig/linewise.pc
-	chmod 644 $(D)/lib/pkgconfig/linewise.pc
+	  'Cflags: -I$${includedir}' > $(D)/$(LIBDIR)/pkgconfig/linewise.pc
+	chmod 644 $(D)/$(LIBDIR)/pkgconfig/linewise.pc
 	install -m 755 $(BIN)/linewise $(MPI_BIN) $(D)/bin/
 	install -m 644 params/*.ini params/*.lw $(PICTURE) $(D)/share/linewise/params/
 	install -m 644 docs/linewise.1 $(D)/share/man/man1/linewise.1
+	if [ -n '$(MPI_BIN)' ]; then echo '.so man1/linewise.1' > $(D)/share/man/man1/linewise-mpi.1 && \
+	  chmod 644 $(D)/share/man/man1/linewise-mpi.1; fi
 	for t in $(TOOLS); do install -m 755 tools/$$t $(D)/bin/linewise-$$t || exit 1; done
 	install -m 755 tools/animate.sh $(D)/bin/linewise-animate
 	# each tool's man page: its line of tools/whatis, then its --help as it is

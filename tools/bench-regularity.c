@@ -484,9 +484,9 @@ void bench_regularity_cost(bench_ctx *b)
              "the ratio is the median over the rounds (+- the median absolute deviation).\n\n"
              "| checks | ns per evaluation |\n|---|---|\n"
              "| off (as before) | %.0f |\n| on (defaults) | %.0f |\n\n"
-             "Ratio on / off: **%.3f +- %.3f**. Of the %ld new segments, %ld are refused (the rest pass\n"
+             "Ratio on / off: **%.3f +- %.3f**. Of the %ld new segments, %ld %s refused (the rest pass\n"
              "the cheap bounds or the exact tests).\n\n",
-          nt, p.min_speed, p.regularity, rounds, off_ns, on_ns, med, mad, segs, doubt);
+          nt, p.min_speed, p.regularity, rounds, off_ns, on_ns, med, mad, segs, doubt, doubt == 1 ? "is" : "are");
   free(ratio);
   free(ns_off);
   free(ns_on);
