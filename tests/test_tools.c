@@ -1017,6 +1017,16 @@ Test(tools, bad_usage_exits_2_with_one_message_and_writes_nothing)
   cr_assert_eq(sh("cd %s && printf 'an\\nan\\n' | while read -r d; do PATH=%s/ff:$PATH %s \"$d\" || exit 1; done && "
                   "test \"$(cat ff/read)\" = 0 && test -e an/animation.mp4", dir, dir, tool("animate.sh")), 0, "%s",
                err_txt());
+  /* a run another user may only read: said so, exit 2 (mktemp's words and
+  ** exit 1 before) */
+  if (geteuid() || sh("setpriv --reuid=65534 --regid=65534 --clear-groups sh %s --help", tool("animate.sh"))) return;
+  cr_assert_eq(sh("chmod 755 %s && cd %s && PATH=%s/ff:$PATH setpriv --reuid=65534 --regid=65534 --clear-groups sh %s "
+                  "an", dir, dir, dir, tool("animate.sh")),
+               2);
+  char *e = err_txt();
+  cr_assert(!strcmp(e, "animate.sh: an: cannot write animation.mp4 there: Permission denied (copy the run's frames to "
+                       "a folder of your own)\n"), "%s", e);
+  free(e);
 }
 
 /* ---- plots ------------------------------------------------------------ */
@@ -1090,6 +1100,35 @@ Test(tools, plot_run_draws_energy_temperature_and_acceptance)
   cr_assert_eq(sh("%s %s/o", tool("plot-run"), dir), 0, "%s", err_txt());
   check_png("o/plots/swaps.png");
   check_png("o/plots/observables.png");
+}
+
+/* A run this user may only read is plotted into a folder of their own
+** (--out; a run's own plots/ needed write access to the run); a standard
+** output that is closed fails the script, exit 1, once every plot is in
+** place (a reader gone, `| head -1`, killed it half way by SIGPIPE); the
+** plots of a run another user may not read are said unreadable, not "not a
+** run directory". */
+Test(tools, plot_run_writes_elsewhere_and_says_a_lost_output)
+{
+  cr_assert_eq(sh("%s run %s " TINY " --quiet --out %s/r", env("LW_BIN"), scene(), dir), 0);
+  cr_assert_eq(sh("%s %s/r --out %s/mine/p", tool("plot-run"), dir, dir), 0, "%s", err_txt());
+  check_png("mine/p/energy.png");
+  check_png("mine/p/acceptance.png");
+  cr_assert(!exists("r/plots"), "the run's own folder untouched");
+  cr_assert_eq(sh("{ %s %s/r >&-; }", tool("plot-run"), dir), 1);
+  char *e = err_txt();
+  cr_assert(strstr(e, "plot-run: the standard output could not be written (closed, full, or its reader gone); the "
+                      "plots are written\n"), "%s", e);
+  free(e);
+  check_png("r/plots/temperature.png");
+  cr_assert_eq(sh("test -z \"$(ls -A %s/r/plots | grep tmp)\"", dir), 0, "temporaries left");
+  if (geteuid() || sh("setpriv --reuid=65534 --regid=65534 --clear-groups bash %s --help", tool("plot-run"))) return;
+  cr_assert_eq(sh("chmod 755 %s && chmod 700 %s/r && cd / && setpriv --reuid=65534 --regid=65534 --clear-groups "
+                  "bash %s %s/r --out /tmp/nobody-plots", dir, dir, tool("plot-run"), dir),
+               2);
+  e = err_txt();
+  cr_assert(strstr(e, "/r/trace.csv: cannot read: Permission denied\n"), "%s", e);
+  free(e);
 }
 
 static void write_text(const char *name, const char *text)

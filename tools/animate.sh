@@ -31,6 +31,12 @@ if [ ! -d "$dir" ]; then
   echo "${0##*/}: $dir: no such directory (expected a run directory)" >&2
   exit 2
 fi
+# (another user's run this one may not read: "has no frames" pointed the
+# wrong way)
+if { [ -d "$dir/frames" ] && { [ ! -r "$dir/frames" ] || [ ! -x "$dir/frames" ]; }; } || [ ! -x "$dir" ]; then
+  echo "${0##*/}: $dir/frames: cannot read: Permission denied" >&2
+  exit 2
+fi
 if [ ! -d "$dir/frames" ] || [ -z "$(ls -- "$dir/frames" 2>/dev/null | grep '^frame-[0-9]*\.png$')" ]; then
   echo "${0##*/}: $dir/frames has no frames (set output.frames_every in the scene)" >&2
   exit 2
@@ -40,7 +46,14 @@ command -v ffmpeg >/dev/null 2>&1 || { echo "${0##*/}: ffmpeg not found (make de
 # read RUN_DIR itself as a pattern ("run[1]" took run1's frames), so they
 # are linked as 1, 2, 3, ... in a directory of our own, in sweep order.
 abs=$(CDPATH= cd -P -- "$dir" >/dev/null && pwd -P) # CDPATH would make cd print the directory
-tmp=$(mktemp -d "$abs/.animate.XXXXXX") || exit 1 # beside the video: its rename is whole
+# beside the video: its rename is whole; a run this user may only read is
+# said so (mktemp's own words, exit 1, before)
+if ! tmp=$(mktemp -d "$abs/.animate.XXXXXX" 2>&1); then
+  why=${tmp##*: }
+  echo "${0##*/}: $dir: cannot write animation.mp4 there: $why (copy the run's frames to a folder of your own)" >&2
+  case $why in 'No space left on device' | 'Disk quota exceeded' | 'Input/output error') exit 1 ;; esac
+  exit 2
+fi
 # dash runs no EXIT trap when a signal ends it: the signals exit through it
 trap 'rm -rf "$tmp"' EXIT
 trap 'exit 129' HUP
