@@ -200,20 +200,25 @@ static void bundled_hint(const char *scene, lw_error *err)
 {
   char exe[LW_PATH_MAX], path[2 * LW_PATH_MAX];
   const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-  const size_t len = strlen(scene);
-  if (n <= 0 || !strstr(err->msg, ": cannot open scene file: ") || !access(scene, F_OK) || strchr(scene, '/') ||
-      len < 4 || strcmp(scene + len - 4, ".ini"))
+  /* the README's own form, params/example.ini, away from the checkout, and
+  ** a bare name without its .ini, are the same bundled scene */
+  const char *bare = strncmp(scene, "params/", 7) ? scene : scene + 7;
+  const size_t len = strlen(bare);
+  if (n <= 0 || !strstr(err->msg, ": cannot open scene file: ") || !access(scene, F_OK) || strchr(bare, '/') ||
+      !len || len > 200)
     return;
+  char name[256];
+  snprintf(name, sizeof name, "%s%s", bare, len > 4 && !strcmp(bare + len - 4, ".ini") ? "" : ".ini");
   exe[n] = '\0';
   char *slash = strrchr(exe, '/');
   if (slash) *slash = '\0';
   static const char *const under[] = {"/../share/linewise/params/", "/../params/"};
   for (int k = 0; k < 2; k++) {
-    snprintf(path, sizeof path, "%s%s%s", exe, under[k], scene);
+    snprintf(path, sizeof path, "%s%s%s", exe, under[k], name);
     char real[PATH_MAX];
     if (!access(path, R_OK) && realpath(path, real)) {
       const size_t m = strlen(err->msg);
-      snprintf(err->msg + m, sizeof err->msg - m, " (the bundled %.200s is %.1000s)", scene, real);
+      snprintf(err->msg + m, sizeof err->msg - m, " (the bundled %s is %.1000s)", name, real);
       return;
     }
   }

@@ -1150,7 +1150,8 @@ Test(cli, resume_refuses_a_state_of_another_scene_file)
 /* A bundled scene named without its folder, from another directory (or
 ** from an install, whose scenes are in PREFIX/share/linewise/params): the
 ** message says where the bundled one is, found beside the binary (a build
-** elsewhere, make asan's, has none to point to); another name gets no hint. */
+** elsewhere, make asan's, has none to point to); another name gets no hint;
+** the README's params/NAME.ini and a bare NAME get it too. */
 Test(cli, a_bundled_scene_named_alone_elsewhere_is_pointed_to)
 {
   if (lw_test_sh("test -f \"$(dirname \"$(readlink -f %s)\")/../params/example.ini\"", lw_test_bin()))
@@ -1160,6 +1161,11 @@ Test(cli, a_bundled_scene_named_alone_elsewhere_is_pointed_to)
                           "bundled example.ini is $R/params/example.ini)\" err.txt && { %s run nothere.ini 2>err.txt; "
                           "test $? -eq 2; } && grep -qx 'linewise: nothere.ini: cannot open scene file: No such "
                           "file or directory' err.txt", lw_test_root(), dir, lw_test_bin(), lw_test_bin()),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  /* the README's form, params/example.ini, and a bare name too */
+  cr_assert_eq(lw_test_sh("R=$(cd %s && pwd -P) && cd %s && { %s run params/minimal.ini 2>err.txt; %s run minimal "
+                          "2>>err.txt; } ; test \"$(grep -c \"(the bundled minimal.ini is $R/params/minimal.ini)$\" "
+                          "err.txt)\" = 2", lw_test_root(), dir, lw_test_bin(), lw_test_bin()),
                0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
