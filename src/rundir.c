@@ -2,6 +2,7 @@
 #include "linewise/rundir.h"
 
 #include <ctype.h>
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <pthread.h>
@@ -147,9 +148,21 @@ lw_status lw_rundir_writable(const char *dir, lw_error *err)
     e = EACCES, what = "cannot read the run directory's lock";
   struct stat sd, sf;
   const uid_t me = geteuid();
-  for (size_t k = 0; k < 3 && !e && me && !stat(dir, &sd) && (sd.st_mode & sticky) && sd.st_uid != me; k++)
+  const int foreign_sticky = me && !stat(dir, &sd) && (sd.st_mode & sticky) && sd.st_uid != me;
+  for (size_t k = 0; k < 3 && !e && foreign_sticky; k++)
     if (snprintf(path, sizeof path, "%s/%s", dir, renamed[k]) < (int)sizeof path && !stat(path, &sf) && sf.st_uid != me)
       e = EPERM, what = "cannot replace another user's file in a sticky directory";
+  /* another user's X.tmp left there: the checkpoint that would remove it
+  ** failed at its sweep, the sweeps since the last one lost */
+  DIR *d = !e && foreign_sticky ? opendir(dir) : NULL;
+  for (struct dirent *de; d && !e && (de = readdir(d));) {
+    const size_t len = strlen(de->d_name);
+    if (len > 4 && !strcmp(de->d_name + len - 4, ".tmp") &&
+        snprintf(path, sizeof path, "%s/%s", dir, de->d_name) < (int)sizeof path && !lstat(path, &sf) &&
+        sf.st_uid != me)
+      e = EPERM, what = "cannot replace another user's file in a sticky directory";
+  }
+  if (d) closedir(d);
   if (!e) return LW_OK;
   return lw_error_set(err, LW_EINPUT, "%s: %s: %s; expected a run directory this user can write", path, what,
                       strerror(e));

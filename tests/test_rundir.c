@@ -116,6 +116,24 @@ Test(rundir, a_lock_that_is_a_fifo_is_refused_at_once)
                   lw_test_bin(), dir, dir), 2, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
+/* Another user's X.tmp left in a sticky run directory is refused before a
+** resume starts (the checkpoint that would remove it failed at its sweep,
+** the sweeps since the last one lost); without it the resume goes on. */
+Test(rundir, another_users_leftover_in_a_sticky_directory_is_refused_at_once)
+{
+  if (geteuid() || sh("setpriv --reuid=65534 --regid=65534 --clear-groups %s --version >/dev/null", lw_test_bin()))
+    cr_skip_test("needs root, setpriv, and a binary user nobody may run");
+  cr_assert_eq(sh("chmod 755 %s && %s run %s/params/minimal.ini --out %s/r --quiet --set anneal.sweeps=20 --stop-at 5 "
+                  "&& chmod 1777 %s/r && chown 65534 %s/r/* && touch %s/r/state.lw.tmp", dir, lw_test_bin(),
+                  lw_test_root(), dir, dir, dir, dir),
+               0);
+  static const char *const nobody = "setpriv --reuid=65534 --regid=65534 --clear-groups";
+  cr_assert_eq(sh("%s %s resume %s/r --quiet 2> %s/err.txt", nobody, lw_test_bin(), dir, dir), 2);
+  cr_assert_eq(sh("grep -q 'r/state.lw.tmp: cannot replace another user.s file in a sticky directory' %s/err.txt", dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh("rm %s/r/state.lw.tmp && %s %s resume %s/r --quiet", dir, nobody, lw_test_bin(), dir), 0);
+}
+
 /* A directory that cannot be made under the working directory names it (a
 ** cron job's "out: cannot create directory" said no where), and --out. */
 Test(rundir, a_relative_directory_that_cannot_be_made_names_the_working_directory)
