@@ -547,6 +547,18 @@ static void progress_state(const lw_anneal *a, int digits, char *buf, size_t n)
              digits - 1, lw_anneal_acceptance(a));
 }
 
+/* A time in seconds, or h:mm:ss from an hour on (a run of days read
+** "left 259200s"). */
+static const char *duration_text(double s, int decimals, char *buf, size_t n)
+{
+  if (!(s >= 3600.0)) snprintf(buf, n, "%.*fs", decimals, s);
+  else {
+    const long t = lround(s);
+    snprintf(buf, n, "%ld:%02ld:%02ld", t / 3600, t / 60 % 60, t % 60);
+  }
+  return buf;
+}
+
 static void progress_show(progress *pg, const lw_anneal *a, int final)
 {
   if (pg->quiet) return;
@@ -561,7 +573,7 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
     char state[160];
     progress_state(a, 4, state, sizeof state);
     char rest[32] = "-"; /* unknown before a sweep has taken its time */
-    if (done > 0 || a->sweep >= a->end_sweep) snprintf(rest, sizeof rest, "%.0fs", left);
+    if (done > 0 || a->sweep >= a->end_sweep) duration_text(left, 0, rest, sizeof rest);
     char text[224];
     int len = snprintf(text, sizeof text, "sweep %ld/%ld  %s  left %s ", a->sweep, a->end_sweep, state, rest);
     /* a line longer than the terminal wraps, and each redraw then starts a
@@ -590,8 +602,10 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
     char state[160];
     progress_state(a, 6, state, sizeof state);
     char rest[32] = "-";
-    if (done > 0 || a->sweep >= a->end_sweep) snprintf(rest, sizeof rest, "%.1fs", left);
-    fprintf(stderr, "sweep %ld/%ld %s elapsed %.1fs left %s\n", a->sweep, a->end_sweep, state, t, rest);
+    if (done > 0 || a->sweep >= a->end_sweep) duration_text(left, 1, rest, sizeof rest);
+    char elapsed[32];
+    fprintf(stderr, "sweep %ld/%ld %s elapsed %s left %s\n", a->sweep, a->end_sweep, state,
+            duration_text(t, 1, elapsed, sizeof elapsed), rest);
     while (pg->next_plain <= a->sweep) pg->next_plain += total / 10 > 0 ? total / 10 : 1;
   }
 }
