@@ -255,9 +255,15 @@ shell_quote = '$(subst ','\'',$(1))'
 D = $(call shell_quote,$(DESTDIR)$(PREFIX))
 # linewise.pc's way up from $(LIBDIR)/pkgconfig to the prefix: ../.. for lib
 PC_UP := $(shell printf '%s' '$(LIBDIR)' | sed 's,[^/][^/]*,..,g')/..
+# (an absolute one, as GNU's libdir, went under PREFIX twice unsaid, and a .
+# or .. made linewise.pc point beside the headers)
+check_libdir = case '$(LIBDIR)' in '' | /* | . | .. | ./* | ../* | */. | */.. | */./* | */../*) \
+  echo "LIBDIR=$(LIBDIR): expected a folder under PREFIX, as lib or lib/x86_64-linux-gnu (no leading /, . or ..)" >&2; \
+  exit 2 ;; esac
 # (the files a redirection writes take the umask, 077 a root's on many a
 # shared machine: chmod makes them every user's, as install -m does)
 install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
+	@$(check_libdir)
 	install -d $(D)/bin $(D)/share/linewise/params $(D)/share/doc/linewise
 	install -d $(D)/$(LIBDIR)/pkgconfig $(D)/include/linewise $(D)/share/man/man1
 	install -m 644 $(BUILD)/liblinewise.a $(D)/$(LIBDIR)/
@@ -289,6 +295,7 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	install -m 644 README.md docs/*.md docs/*.png tests/embed.cpp $(D)/share/doc/linewise/
 
 uninstall:
+	@$(check_libdir)
 	n=0; for f in $(INSTALLED); do if [ -e $(D)/$$f ]; then rm -f $(D)/$$f || exit 1; n=$$((n + 1)); fi; done; \
 	  [ $$n -gt 0 ] || echo "uninstall: no file of linewise's in $(D) (installed with another PREFIX?)" >&2
 	# (a folder that holds nothing but a kept one is not said again)

@@ -551,7 +551,7 @@ static void progress_state(const lw_anneal *a, int digits, char *buf, size_t n)
 ** "left 259200s"). */
 static const char *duration_text(double s, int decimals, char *buf, size_t n)
 {
-  if (!(s >= 3600.0)) snprintf(buf, n, "%.*fs", decimals, s);
+  if (!(s >= 3599.5)) snprintf(buf, n, "%.*fs", decimals, s); /* (3599.7 read "3600s") */
   else {
     const long t = lround(s);
     snprintf(buf, n, "%ld:%02ld:%02ld", t / 3600, t / 60 % 60, t % 60);

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "linewise/params.h"
+#include "linewise/runfiles.h"
 #include "linewise/state.h"
 
 /* The locks this process holds, by the lock file's identity: flock locks
@@ -152,14 +153,13 @@ lw_status lw_rundir_writable(const char *dir, lw_error *err)
   for (size_t k = 0; k < 3 && !e && foreign_sticky; k++)
     if (snprintf(path, sizeof path, "%s/%s", dir, renamed[k]) < (int)sizeof path && !stat(path, &sf) && sf.st_uid != me)
       e = EPERM, what = "cannot replace another user's file in a sticky directory";
-  /* another user's X.tmp left there: the checkpoint that would remove it
-  ** failed at its sweep, the sweeps since the last one lost */
+  /* another user's write of a run file left there (state.lw.tmp): the
+  ** checkpoint that would remove it failed at its sweep, the sweeps since
+  ** the last one lost (a file of theirs of another name is theirs) */
   DIR *d = !e && foreign_sticky ? opendir(dir) : NULL;
   for (struct dirent *de; d && !e && (de = readdir(d));) {
-    const size_t len = strlen(de->d_name);
-    if (len > 4 && !strcmp(de->d_name + len - 4, ".tmp") &&
-        snprintf(path, sizeof path, "%s/%s", dir, de->d_name) < (int)sizeof path && !lstat(path, &sf) &&
-        sf.st_uid != me)
+    if (lw_runfiles_is_write(de->d_name) && snprintf(path, sizeof path, "%s/%s", dir, de->d_name) < (int)sizeof path &&
+        !lstat(path, &sf) && S_ISREG(sf.st_mode) && sf.st_uid != me)
       e = EPERM, what = "cannot replace another user's file in a sticky directory";
   }
   if (d) closedir(d);

@@ -1111,7 +1111,12 @@ Test(tools, plot_run_draws_energy_temperature_and_acceptance)
 Test(tools, plot_run_writes_elsewhere_and_says_a_lost_output)
 {
   cr_assert_eq(sh("%s run %s " TINY " --quiet --out %s/r", env("LW_BIN"), scene(), dir), 0);
-  cr_assert_eq(sh("%s %s/r --out %s/mine/p", tool("plot-run"), dir, dir), 0, "%s", err_txt());
+  /* a hidden .tmp of the user's there stays (every one went) */
+  cr_assert_eq(sh("mkdir -p %s/mine/p && echo draft > %s/mine/p/.draft.tmp && %s %s/r --out %s/mine/p/", dir, dir,
+                  tool("plot-run"), dir, dir),
+               0, "%s", err_txt());
+  cr_assert_eq(sh("grep -qx draft %s/mine/p/.draft.tmp", dir), 0);
+  cr_assert_eq(sh("%s %s/r --out %s/a --out %s/b", tool("plot-run"), dir, dir, dir), 2);
   check_png("mine/p/energy.png");
   check_png("mine/p/acceptance.png");
   cr_assert(!exists("r/plots"), "the run's own folder untouched");
@@ -1488,6 +1493,13 @@ Test(tools, install_runs_every_scene_away_from_the_checkout_and_uninstall_remove
                   "  { ! command -v groff || test -z \"$(groff -man -ww -z $m 2>&1)\"; } "
                   "  || { echo $t >&2; exit 1; }; done", dir),
                0, "%s", err_txt());
+  /* a LIBDIR not under PREFIX (GNU's absolute libdir went under it twice) is refused */
+  cr_assert_eq(sh("cd %s && make -s -C %s install DESTDIR=\"$PWD/ro ot\" PREFIX=/usr LIBDIR=/usr/lib", dir,
+                  env("LW_ROOT")),
+               2);
+  char *e = err_txt();
+  cr_assert(strstr(e, "LIBDIR=/usr/lib: expected a folder under PREFIX"), "%s", e);
+  free(e);
   /* linewise-mpi's is linewise's, where it is installed */
   cr_assert_eq(sh("cd '%s/ro ot/usr' && { test ! -e bin/linewise-mpi || grep -qx '.so man1/linewise.1' "
                   "share/man/man1/linewise-mpi.1; }", dir),

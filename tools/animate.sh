@@ -3,6 +3,8 @@
 # RUN_DIR/animation.mp4 (H.264, yuv420p: plays in browsers and players).
 # Needs ffmpeg: `make deps-animation` installs it.
 set -eu
+# the tools' words are matched below (a full disk is the machine's: exit 1)
+export LC_ALL=C
 # a closed standard stream would fail the checks below (awk cannot close
 # it) or be the first file opened: /dev/null stands in
 (exec 9>&1) 2>/dev/null || exec >/dev/null
@@ -50,8 +52,12 @@ abs=$(CDPATH= cd -P -- "$dir" >/dev/null && pwd -P) # CDPATH would make cd print
 # said so (mktemp's own words, exit 1, before)
 if ! tmp=$(mktemp -d "$abs/.animate.XXXXXX" 2>&1); then
   why=${tmp##*: }
+  case $why in
+  'No space left on device' | 'Disk quota exceeded' | 'Input/output error')
+    echo "${0##*/}: $dir: cannot write animation.mp4 there: $why" >&2
+    exit 1 ;;
+  esac
   echo "${0##*/}: $dir: cannot write animation.mp4 there: $why (copy the run's frames to a folder of your own)" >&2
-  case $why in 'No space left on device' | 'Disk quota exceeded' | 'Input/output error') exit 1 ;; esac
   exit 2
 fi
 # dash runs no EXIT trap when a signal ends it: the signals exit through it
@@ -62,6 +68,11 @@ trap 'exit 143' TERM
 n=0
 for f in $(ls -- "$abs/frames" | grep '^frame-[0-9]*\.png$' | sort -t- -k2n); do
   n=$((n + 1))
+  # (ffmpeg said only "Could find no file" of frames it may not read)
+  if [ ! -r "$abs/frames/$f" ]; then
+    echo "${0##*/}: $dir/frames/$f: cannot read: Permission denied" >&2
+    exit 2
+  fi
   ln -s "$abs/frames/$f" "$tmp/$(printf %08d "$n").png"
 done
 # written beside the links and moved into place whole: a signal left a

@@ -829,8 +829,12 @@ static int same_title(const char *a, const char *b)
   return la == lb && !strncmp(a, b, la);
 }
 
-/* The sections of the document at path that this run did not write (one
-** written by hand, "## Memory"), each kept after the written section it
+/* A section written by hand carries this line: a full run keeps it (a
+** section the bench once wrote and no longer does is not kept for ever). */
+#define KEPT_MARK "<!-- written by hand: make bench keeps this section -->"
+
+/* The sections of the document at path that carry KEPT_MARK and that this
+** run did not write ("## Memory"), each kept after the written section it
 ** followed there, into out: a full run rewrote the file and lost them. */
 static void keep_hand_sections(const char *path, const char *fresh, size_t n_fresh, FILE *out)
 {
@@ -840,7 +844,8 @@ static void keep_hand_sections(const char *path, const char *fresh, size_t n_fre
   if (f) {
     FILE *m = open_memstream(&old, &n_old);
     int ch;
-    while (m && (ch = getc(f)) != EOF) putc(ch, m);
+    while (m && (ch = getc(f)) != EOF)
+      if (ch != '\r') putc(ch, m); /* (a checkout's CRLF: no title matched) */
     if (m) fclose(m);
     fclose(f);
   }
@@ -852,7 +857,8 @@ static void keep_hand_sections(const char *path, const char *fresh, size_t n_fre
   for (int i = 0; i < o.n; i++) {
     int k = 0;
     while (k < w.n && !same_title(o.at[i], w.at[k])) k++;
-    after[i] = k < w.n ? -2 : written;
+    const char *mark = strstr(o.at[i], KEPT_MARK);
+    after[i] = k < w.n || !mark || mark >= o.at[i + 1] ? -2 : written;
     if (k < w.n) written = k;
   }
   fwrite(fresh, 1, (size_t)(w.at[0] - fresh), out);
