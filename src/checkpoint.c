@@ -29,6 +29,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "linewise/anneal_net.h"
 #include "linewise/model.h"
 #include "linewise/number.h"
 #include "linewise/output.h"
@@ -253,9 +254,13 @@ lw_status lw_checkpoint_put_system(lw_ckpt_writer *w, const lw_anneal *a, int k,
 
 lw_status lw_checkpoint_write_timing(const lw_anneal *a, lw_error *err)
 {
-  char path[LW_PATH_MAX + 32], tmp[LW_PATH_MAX + 64];
+  char path[LW_PATH_MAX + 32], aside[LW_PATH_MAX + 40], tmp[LW_PATH_MAX + 64];
   dir_file(path, sizeof path, a, "timing.txt");
-  FILE *f = lw_output_open_tmp(path, tmp, sizeof tmp, err);
+  /* a spread run's process that draws, not the first, writes it after the
+  ** drawing under a name of its own: the first's checkpoint may still be
+  ** writing timing.txt.tmp, and each would remove the other's */
+  snprintf(aside, sizeof aside, "%s%s", path, a->net && a->net->rank ? ".drawn" : "");
+  FILE *f = lw_output_open_tmp(aside, tmp, sizeof tmp, err);
   if (!f) return err->code;
   fprintf(f, "wall_seconds %.6f\nsweep_seconds %.6f\n", lw_anneal_seconds(a), a->sweep_seconds);
   if (a->untimed) fprintf(f, "untimed_proposals %lu\n", a->untimed);

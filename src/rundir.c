@@ -130,11 +130,28 @@ static int denied(const char *path, int dir)
 ** script that retries on 1 retried it for ever.  The run writes trace.csv
 ** in place and the lock, and the rest by rename, which needs only the
 ** directory, unless it is sticky (/tmp-like) and the file another user's. */
+#define LW_RUNDIR_BUSY "%s: another linewise process is writing this run directory (it holds %s); wait for it to " \
+                       "end, or write another directory"
+
+/* Whether another process holds dir's lock, looked at without taking it
+** for long (a shared lock at once let go); non-blocking: a FIFO planted
+** there held the open for ever. */
+static int lock_busy(const char *dir)
+{
+  char path[LW_PATH_MAX + 16];
+  if (snprintf(path, sizeof path, "%s/.lock", dir) >= (int)sizeof path) return 0;
+  int fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+  struct stat st;
+  if (fd < 0) return 0;
+  const int busy = !fstat(fd, &st) && S_ISREG(st.st_mode) && flock(fd, LOCK_SH | LOCK_NB) && errno == EWOULDBLOCK;
+  close(fd);
+  return busy;
+}
+
 lw_status lw_rundir_writable(const char *dir, lw_error *err)
 {
   /* (plots: a new run moves tools/plot-run's plots aside with the rest) */
-  static const char *const inside[] = {"", "frames", "samples", "plots"},
-                    *const renamed[] = {"state.lw", "scene.ini", "summary.json"};
+  static const char *const inside[] = {"", "frames", "samples", "plots"};
   const mode_t sticky = 01000; /* S_ISVTX, which POSIX leaves to XSI */
   char path[LW_PATH_MAX + 16];
   const char *what = NULL;
@@ -149,27 +166,28 @@ lw_status lw_rundir_writable(const char *dir, lw_error *err)
     e = EACCES, what = "cannot read the run directory's lock";
   struct stat sd, sf;
   const uid_t me = geteuid();
+  /* another user's run file there (state.lw, a replica-K.lw, a write left,
+  ** state.lw.tmp): the checkpoint that would replace it failed at its
+  ** sweep, the sweeps since the last one lost (a file of theirs of another
+  ** name is theirs) */
   const int foreign_sticky = me && !stat(dir, &sd) && (sd.st_mode & sticky) && sd.st_uid != me;
-  for (size_t k = 0; k < 3 && !e && foreign_sticky; k++)
-    if (snprintf(path, sizeof path, "%s/%s", dir, renamed[k]) < (int)sizeof path && !stat(path, &sf) && sf.st_uid != me)
-      e = EPERM, what = "cannot replace another user's file in a sticky directory";
-  /* another user's write of a run file left there (state.lw.tmp): the
-  ** checkpoint that would remove it failed at its sweep, the sweeps since
-  ** the last one lost (a file of theirs of another name is theirs) */
   DIR *d = !e && foreign_sticky ? opendir(dir) : NULL;
   for (struct dirent *de; d && !e && (de = readdir(d));) {
-    if (lw_runfiles_is_write(de->d_name) && snprintf(path, sizeof path, "%s/%s", dir, de->d_name) < (int)sizeof path &&
+    if (lw_runfiles_is_top(de->d_name) && snprintf(path, sizeof path, "%s/%s", dir, de->d_name) < (int)sizeof path &&
         !lstat(path, &sf) && S_ISREG(sf.st_mode) && sf.st_uid != me)
       e = EPERM, what = "cannot replace another user's file in a sticky directory";
   }
   if (d) closedir(d);
   if (!e) return LW_OK;
+  /* a run another user is writing is busy before it is theirs: its files'
+  ** modes were said, and the run going on not */
+  if (lock_busy(dir)) {
+    snprintf(path, sizeof path, "%s/.lock", dir);
+    return lw_error_set(err, LW_EUSAGE, LW_RUNDIR_BUSY, dir, path);
+  }
   return lw_error_set(err, LW_EINPUT, "%s: %s: %s; expected a run directory this user can write", path, what,
                       strerror(e));
 }
-
-#define LW_RUNDIR_BUSY "%s: another linewise process is writing this run directory (it holds %s); wait for it to " \
-                       "end, or write another directory"
 
 /* The lock of dir's lock file fd (st its identity) into the table: the
 ** hold this process has on it already, or a new one.  Called under
@@ -228,20 +246,7 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
   ** directory may read the lock file the first one made, and a local flock
   ** needs no more) */
   lw_status s = lw_rundir_writable(dir, err);
-  if (s) {
-    /* a run another user is writing is busy before it is theirs: its files'
-    ** modes were said, and the run going on not */
-    /* (non-blocking: a FIFO planted there held the open for ever) */
-    int probe = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
-    struct stat ps;
-    if (probe >= 0 && (fstat(probe, &ps) || !S_ISREG(ps.st_mode))) close(probe), probe = -1;
-    if (probe >= 0) {
-      const int busy = flock(probe, LOCK_SH | LOCK_NB) && errno == EWOULDBLOCK;
-      close(probe);
-      if (busy) return lw_error_set(err, LW_EUSAGE, LW_RUNDIR_BUSY, dir, path);
-    }
-    return s;
-  }
+  if (s) return s;
   /* never through a link: one planted there made a root's run create any file */
   int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0666);
   if (fd < 0 && errno == EACCES) fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);

@@ -45,12 +45,12 @@ static int in_group(const char *name, const char *prefix, const char *suffix)
   return nd > 0 && !strncmp(rest, suffix, ns) && (!rest[ns] || !strcmp(rest + ns, ".tmp"));
 }
 
-int lw_runfiles_is_write(const char *name)
+int lw_runfiles_is_top(const char *name)
 {
-  const size_t n = strlen(name);
-  if (n < 5 || strcmp(name + n - 4, ".tmp")) return 0;
+  size_t n = strlen(name);
+  if (n > 4 && !strcmp(name + n - 4, ".tmp")) n -= 4;
   for (size_t i = 0; i < sizeof top_files / sizeof top_files[0]; i++)
-    if (strlen(top_files[i]) == n - 4 && !strncmp(name, top_files[i], n - 4)) return 1;
+    if (strlen(top_files[i]) == n && !strncmp(name, top_files[i], n)) return 1;
   return in_group(name, "replica-", ".lw");
 }
 

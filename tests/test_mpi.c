@@ -200,7 +200,7 @@ Test(mpi, a_failed_first_checkpoint_puts_the_run_before_back)
 /* The observables in the trace are the coldest rung's, whichever process
 ** sweeps its replica: the same bytes as one process, and summary.json's
 ** statistics of them the same text. */
-Test(mpi, observables_come_from_the_process_of_the_coldest_rung)
+Test(mpi, observables_and_timing_come_from_the_process_of_the_coldest_rung)
 {
   const char *m = mpi_bin(), *b = lw_test_bin();
   write_scene();
@@ -216,6 +216,13 @@ Test(mpi, observables_come_from_the_process_of_the_coldest_rung)
                     "sed -n '/\"observables\"/,/}/p' %s/%s/summary.json > %s/o2 && test -s %s/o1 && cmp -s %s/o1 %s/o2",
                     dir, dir, dir, k ? "p4" : "p2", dir, dir, dir, dir),
                  0, "summary.json's observables differ");
+  /* timing.txt counts the drawing, whichever process drew (one other than
+  ** the first left it out, and an extension's wall time went down) */
+  for (int k = 0; k < 2; k++)
+    cr_assert_eq(sh("awk -F': ' '/\"wall_seconds\"/ { s = $2 + 0 } END { print s }' %s/%s/summary.json > %s/sw && "
+                    "awk -v s=\"$(cat %s/sw)\" '/^wall_seconds/ { ok = $2 >= s - 1e-6 } END { exit !ok }' "
+                    "%s/%s/timing.txt", dir, k ? "p4" : "p2", dir, dir, dir, k ? "p4" : "p2"),
+                 0, "%s: timing.txt's wall time is short of summary.json's", k ? "p4" : "p2");
 }
 
 /* Starts a long run on 2 processes in the background (mpirun's status into

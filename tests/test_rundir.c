@@ -96,6 +96,11 @@ Test(rundir, another_users_run_going_on_is_said_busy_before_its_modes)
                     lw_test_bin(), dir, dir), 2);
     cr_assert_eq(sh("grep -q '%s' %s/err.txt && test $(wc -l < %s/err.txt) = 1", said[k], dir, dir), 0, "%s",
                  lw_test_slurp("%s/err.txt", dir));
+    /* and run --out into it, which looked at the modes alone */
+    cr_assert_eq(sh("setpriv --reuid=65534 --regid=65534 --clear-groups %s run %s/params/minimal.ini --out %s/r "
+                    "2> %s/err.txt", lw_test_bin(), lw_test_root(), dir, dir), 2);
+    cr_assert_eq(sh("grep -q '%s' %s/err.txt && test $(wc -l < %s/err.txt) = 1", said[k], dir, dir), 0, "%s",
+                 lw_test_slurp("%s/err.txt", dir));
   }
 }
 
@@ -136,6 +141,13 @@ Test(rundir, another_users_leftover_in_a_sticky_directory_is_refused_at_once)
   cr_assert_eq(sh("rm %s/r/state.lw.tmp && touch %s/r/notes.tmp && mkdir %s/r/old.tmp && %s %s resume %s/r --quiet",
                   dir, dir, dir, nobody, lw_test_bin(), dir),
                0);
+  /* any run file of theirs (a replica's, a drawing) the run would replace:
+  ** an extension failed after its sweeps, exit 1 */
+  cr_assert_eq(sh("chown 0 %s/r/final.svg && %s %s resume %s/r --quiet --sweeps 5 2> %s/err.txt", dir, nobody,
+                  lw_test_bin(), dir, dir),
+               2);
+  cr_assert_eq(sh("grep -q 'r/final.svg: cannot replace another user.s file in a sticky directory' %s/err.txt", dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
 /* A directory that cannot be made under the working directory names it (a

@@ -87,7 +87,7 @@ typedef struct lw_anneal {
   double sweep_seconds;        /* seconds in sweeps, with the processes before (timing.txt) */
   double wall_start;           /* monotonic clock at start of this process */
   double ckpt_seconds;         /* of it, writing checkpoints (lw_anneal_checkpoint_note) */
-  double ckpt_fastest;         /* the fastest of those writes, and how many there were: a */
+  double ckpt_longest;         /* the longest of those writes, and how many there were: a */
   int ckpt_count;              /* process suspended during one is not a checkpoint's cost */
   unsigned long untimed;       /* proposals of sweeps no timing.txt timed (a resume without
                                ** one), which proposals_per_second leaves out */

@@ -46,7 +46,8 @@ int lw_rundir_foreign(const char *dir, const char *name);
 int lw_rundir_unstarted(const char *dir);
 
 /* LW_EINPUT with a message where this process may not write into dir or
-** over a run's files there (read-only, another user's); LW_OK otherwise,
+** over a run's files there (read-only, another user's); LW_EUSAGE, said
+** busy, where another process holds dir's lock besides; LW_OK otherwise,
 ** also where dir is not there yet. */
 lw_status lw_rundir_writable(const char *dir, lw_error *err);
 

@@ -63,9 +63,10 @@ lw_status lw_runfiles_unstash(const char *dir, lw_error *err);
 ** file of it cannot be removed (the stash stays, saying what it holds). */
 lw_status lw_runfiles_drop(const char *dir, lw_error *err);
 
-/* Whether the name of an entry of a run directory is a write of one of its
-** files under way or cut off ("state.lw.tmp", "replica-3.lw.tmp"). */
-int lw_runfiles_is_write(const char *name);
+/* Whether the name of an entry of a run directory is one of the run's own
+** files there ("state.lw", "replica-3.lw"), or a write of one under way or
+** cut off ("state.lw.tmp"). */
+int lw_runfiles_is_top(const char *name);
 
 /* Removes dir's run files: a set-up that failed where no run was before. */
 void lw_runfiles_remove(const char *dir);
