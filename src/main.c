@@ -794,8 +794,11 @@ static int loop_fail(lw_anneal *a, long began, watcher *w, lw_error *err)
   } else if (err->code == LW_EIO || err->code == LW_ENOMEM) {
     size_t n = strlen(err->msg);
     char word[LW_RUNDIR_WORD_MAX];
+    /* (state.lw is committed before the replicas' files: one of those that
+    ** failed left the newer checkpoint, which the message named the older) */
+    const long at = a->saved > 0 ? a->saved - 1 : began, committed = lw_phase_last_commit(NULL);
     snprintf(err->msg + n, sizeof err->msg - n, "; %s/state.lw holds the checkpoint of sweep %ld: 'linewise "
-             "resume %s' continues from it once %s", a->dir, a->saved > 0 ? a->saved - 1 : began,
+             "resume %s' continues from it once %s", a->dir, committed > at ? committed : at,
              lw_rundir_shell_word(a->dir, word, sizeof word),
              err->code == LW_EIO ? "the files can be written" : "there is more memory");
   }
@@ -1329,7 +1332,7 @@ static int cmd_resume(int argc, char **argv)
   /* a resume under the limit that failed its drawing failed again unsaid */
   if (a.memory_note[0] && (!net || !net->rank)) fprintf(stderr, "linewise: note: %s\n", a.memory_note);
   /* (under --quiet too: a study's rates were many times too high unsaid) */
-  if (a.untimed_said && !lw_anneal_done(&a) && (!net || !net->rank))
+  if (a.untimed_said && (!net || !net->rank))
     fprintf(stderr, "linewise: note: %s/timing.txt is missing or unreadable: summary.json's wall_seconds and "
             "sweep_seconds count from this resume on, and proposals_per_second this resume's proposals\n", dir);
   if (!quiet) fprintf(stderr, "linewise: resuming %s at sweep %ld of %ld\n", dir, a.sweep, a.end_sweep);

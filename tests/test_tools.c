@@ -708,6 +708,13 @@ Test(tools, job_array_tasks_then_gather_only)
   char path[128];
   snprintf(path, sizeof path, "%s/j/sweep.csv", dir);
   cr_assert_neq(access(path, F_OK), 0, "a task does not gather");
+  /* a task number with a leading zero is that number (08 read as octal was refused) */
+  cr_assert_eq(sh("%s %s --seeds 5-14 " TINY " --bin %s --out %s/z --task 08", tool("seed-sweep"), scene(),
+                  env("LW_BIN"), dir),
+               0, "%s", err_txt());
+  char *zo = out_txt();
+  cr_assert(strstr(zo, "[8/10] seed-12: ran"), "%s", zo);
+  free(zo);
   cr_assert_eq(sh("%s --gather-only %s/j", tool("seed-sweep"), dir), 0, "%s", err_txt());
   /* a gather after an array where a task did not finish fails, naming it
   ** (it said "3 finished runs gathered" with exit 0, so the dependent job of
