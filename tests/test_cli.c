@@ -431,13 +431,13 @@ Test(cli, a_failed_replica_file_names_the_checkpoint_state_lw_holds)
 {
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/lj13.ini --set anneal.sweeps=300 --set tempering.replicas=2 "
                           "--set output.checkpoint_every=100 --out r --quiet --stop-at 100 && rm r/replica-1.lw && "
-                          "mkdir -p r/replica-1.lw/x && { %s resume r --quiet --stop-at 200 2> e.txt; test $? -eq 1; } && "
-                          "grep -qx 'sweep = 200' r/state.lw",
+                          "mkdir -p r/replica-1.lw/x && { %s resume r --quiet --stop-at 200 2> e.txt; "
+                          "test $? -eq 1; } && grep -qx 'sweep = 200' r/state.lw",
                           dir, lw_test_bin(), lw_test_root(), lw_test_bin()),
                0, "%s", lw_test_slurp("%s/e.txt", dir));
   const char *e = lw_test_slurp("%s/e.txt", dir);
-  cr_assert(strstr(e, "r/replica-1.lw: cannot replace: ") && strstr(e, "r/state.lw holds the checkpoint of sweep 200: "),
-            "%s", e);
+  cr_assert(strstr(e, "r/replica-1.lw: cannot replace: ") &&
+                strstr(e, "r/state.lw holds the checkpoint of sweep 200: "), "%s", e);
 }
 
 /* LW_LANES narrows the SIMD kernels, so that one machine checks the promise
