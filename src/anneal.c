@@ -364,8 +364,10 @@ static lw_status absolute_paths(lw_anneal *a, lw_error *err)
     char where[LW_PATH_MAX + 32];
     if (len > cap || (was[0] && path[0] != '/')) {
       lw_params_origin(&a->params, d, where, sizeof where);
-      char size[48] = "too long";
-      if (path[0] == '/') snprintf(size, sizeof size, "%zu bytes", len);
+      /* (the path itself: links are followed, so a short link to a deep
+      ** folder measures the deep path) */
+      char size[LW_PATH_MAX + 48] = "too long";
+      if (path[0] == '/') snprintf(size, sizeof size, "%zu bytes ('%s')", len, path);
       return lw_error_set(err, LW_EINPUT, "%s: key '%s.%s': '%s' made absolute is %s, and the run's scene.ini "
                           "(which resume reads) holds %zu on its line; move the file, or run from a shorter path",
                           where, d->section, d->key, was, size, cap);
@@ -374,10 +376,15 @@ static lw_status absolute_paths(lw_anneal *a, lw_error *err)
     ** name is written into scene.ini: resume would look for "Fotos" */
     if (!lw_params_text_reads_back(path)) {
       lw_params_origin(&a->params, d, where, sizeof where);
+      /* (a newline in a folder's name, shown as '?', was blamed on ';') */
+      const char *c = path;
+      while ((unsigned char)*c >= 0x20 || *c == '\t') c++;
+      char why[96] = "';' after a blank begins a comment there, and blanks at either end are dropped";
+      if (*c) snprintf(why, sizeof why, "byte %zu is a control character (0x%02X), which ends or breaks a line there",
+                       (size_t)(c - path) + 1, (unsigned char)*c);
       return lw_error_set(err, LW_EINPUT, "%s: key '%s.%s': '%s' made absolute is '%s', which the run's "
-                          "scene.ini (which resume reads) cannot hold: ';' after a blank begins a comment there, "
-                          "and blanks at either end are dropped; rename the file or its folder",
-                          where, d->section, d->key, was, path);
+                          "scene.ini (which resume reads) cannot hold: %s; rename the file or its folder",
+                          where, d->section, d->key, was, path, why);
     }
   }
   return LW_OK;

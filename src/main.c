@@ -909,13 +909,16 @@ static int takes_value(const char *arg)
   return 0;
 }
 
-/* A count on the command line from 0 to max, read by the parser of scene
-** keys; sweep counts stop at 1e15, so sweep + count cannot overflow. */
-static int parse_count(const char *opt, const char *v, double max, long *out, lw_error *err)
+/* A count on the command line from lo to max, read by the parser of scene
+** keys ("1.000" refused as --set refuses it: a thousand in a comma locale);
+** sweep counts stop at 1e15, so sweep + count cannot overflow. */
+static int parse_count(const char *opt, const char *v, double lo, double max, long *out, lw_error *err)
 {
   long long n;
-  if (!v || !lw_number_parse_whole(v, 0, max, &n)) {
-    lw_error_set(err, LW_EUSAGE, "%s: expected a whole number from 0 to %.0f, got '%s'", opt, max, v ? v : "");
+  char hint[64] = "";
+  if (!v || lw_number_separator_hint(v, 1, hint, sizeof hint) || !lw_number_parse_whole(v, lo, max, &n)) {
+    lw_error_set(err, LW_EUSAGE, "%s: expected a whole number from %.0f to %.0f, got '%s'%s", opt, lo, max, v ? v : "",
+                 hint);
     return 0;
   }
   *out = (long)n;
@@ -927,10 +930,7 @@ static int parse_count(const char *opt, const char *v, double max, long *out, lw
 static int set_threads(const char *v, lw_error *err)
 {
   long t;
-  if (!parse_count("--threads", v, 4096, &t, err) || t < 1) {
-    lw_error_set(err, LW_EUSAGE, "--threads: expected a whole number from 1 to 4096, got '%s'", v ? v : "");
-    return 0;
-  }
+  if (!parse_count("--threads", v, 1, 4096, &t, err)) return 0;
   omp_set_num_threads((int)t);
   return 1;
 }
@@ -941,7 +941,7 @@ static int set_threads(const char *v, lw_error *err)
 static int shared_option(char **argv, int argc, int i, long *stop_at, int *quiet, lw_error *err)
 {
   const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-  if (!strcmp(argv[i], "--stop-at")) return parse_count("--stop-at", v, LW_STATE_SWEEP_MAX, stop_at, err) ? 2 : -1;
+  if (!strcmp(argv[i], "--stop-at")) return parse_count("--stop-at", v, 0, LW_STATE_SWEEP_MAX, stop_at, err) ? 2 : -1;
   if (!strcmp(argv[i], "--threads")) return set_threads(v, err) ? 2 : -1;
   if (!strcmp(argv[i], "--quiet")) {
     *quiet = 1;
@@ -1127,7 +1127,7 @@ static int cmd_run(int argc, char **argv)
       out = v;
       i++;
     } else if (!strcmp(argv[i], "--seed")) {
-      if (!parse_count("--seed", v, LW_SEED_MAX, &seed, &err)) return fail(&err);
+      if (!parse_count("--seed", v, 0, LW_SEED_MAX, &seed, &err)) return fail(&err);
       char buf[64];
       snprintf(buf, sizeof buf, "anneal.seed=%ld", seed);
       if (lw_params_set(&p, buf, &err)) return fail(&err);
@@ -1279,7 +1279,7 @@ static int cmd_resume(int argc, char **argv)
   for (int i = 0; i < argc; i++) {
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
     if (!strcmp(argv[i], "--sweeps")) {
-      if (!parse_count("--sweeps", v, LW_STATE_SWEEP_MAX, &more, &err)) return fail(&err);
+      if (!parse_count("--sweeps", v, 0, LW_STATE_SWEEP_MAX, &more, &err)) return fail(&err);
       i++;
     } else if ((used = shared_option(argv, argc, i, &stop_at, &quiet, &err)) != 0) {
       if (used < 0) return fail(&err);
@@ -1371,16 +1371,12 @@ static int cmd_stats(int argc, char **argv)
   for (int i = 0; dir && i < argc; i++) {
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
     if (!strcmp(argv[i], "--from") || !strcmp(argv[i], "--to")) {
-      if (!parse_count(argv[i], v, LW_STATE_SWEEP_MAX, argv[i][2] == 'f' ? &base.from : &base.to, &err)) break;
+      if (!parse_count(argv[i], v, 0, LW_STATE_SWEEP_MAX, argv[i][2] == 'f' ? &base.from : &base.to, &err)) break;
       i++;
     } else if (!strcmp(argv[i], "--csv")) {
       base.csv = 1;
     } else if (!strcmp(argv[i], "--reweight")) {
-      if (!parse_count(argv[i], v, LW_REWEIGHT_TEMPS_MAX, &reweight, &err) || reweight < 2) {
-        lw_error_set(&err, LW_EUSAGE, "--reweight: expected a whole number from 2 to %d, got '%s'",
-                     LW_REWEIGHT_TEMPS_MAX, v ? v : "");
-        break;
-      }
+      if (!parse_count(argv[i], v, 2, LW_REWEIGHT_TEMPS_MAX, &reweight, &err)) break;
       i++;
     } else if (argv[i][0] == '-') {
       lw_error_set(&err, LW_EUSAGE, "stats: unexpected '%s'%s %s%s", argv[i], nearest(argv[i], stats_options), use,

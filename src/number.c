@@ -69,6 +69,27 @@ int lw_number_parse_whole(const char *s, double lo, double hi, long long *out)
   return 1;
 }
 
+int lw_number_separator_hint(const char *s, int whole, char *hint, size_t n)
+{
+  static const char digits[] = "0123456789";
+  const char *p = s + (*s == '+' || *s == '-');
+  const size_t lead = strspn(p, digits);
+  const char sep = p[lead] == '.' || p[lead] == ',' ? p[lead] : 0;
+  int groups = 0;
+  if (sep && lead >= 1 && lead <= 3) {
+    const char *q = p + lead;
+    for (; *q == sep && strspn(q + 1, digits) == 3; q += 4) groups++;
+    if (*q) groups = 0;
+  }
+  const char *comma = strchr(s, ',');
+  if (groups && (whole || groups > 1))
+    snprintf(hint, n, " (a thousands separator? write 1000, not 1%c000)", sep);
+  else if (comma && comma > s && is_digit(comma[-1]) && is_digit(comma[1]))
+    snprintf(hint, n, " (a decimal comma? numbers take a point: 0.5, not 0,5)");
+  else if (n) *hint = '\0';
+  return groups && whole;
+}
+
 int lw_number_list(const char *s, int commas, double *out, int max)
 {
   const char *sep = commas ? " \t," : " \t";

@@ -1025,17 +1025,9 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     double v;
     const int whole = d->type != LW_PT_DOUBLE;
     range_text(d, range, sizeof range);
-    /* "0,01" from a comma locale, and "1.000" (a thousand there) that read
-    ** as one sweep */
-    const char *mark = strpbrk(text, ",."), *after = mark ? mark + 1 : NULL;
-    const int comma = mark && *mark == ',' && mark > text && isdigit((unsigned char)mark[-1]) &&
-                      isdigit((unsigned char)*after);
-    const int thousands = whole && mark && mark > text && isdigit((unsigned char)mark[-1]) &&
-                          strspn(after, "0123456789") == 3 && !after[3];
+    char hint[64];
+    const int thousands = lw_number_separator_hint(text, whole, hint, sizeof hint);
     if (!lw_number_parse(text, &v) || thousands) {
-      char hint[64] = "";
-      if (thousands) snprintf(hint, sizeof hint, " (a thousands separator? write 1000, not 1%c000)", *mark);
-      else if (comma) snprintf(hint, sizeof hint, " (a decimal comma? numbers take a point: 0.5, not 0,5)");
       snprintf(expected, n, "a %s %s%s", whole ? "whole number" : "number", range, hint);
       return 0;
     }
@@ -1203,13 +1195,16 @@ lw_status lw_params_blame(const lw_params *p, const char *section, const char *k
   lw_params_origin(p, lw_params_find(section, key), where, sizeof where);
   snprintf(msg, sizeof msg, "%s", err->msg);
   /* a schedule's name or a file's path with a no-break space is refused
-  ** after the reading, by the module the value names */
+  ** after the reading, by the module the value names; a path that finds
+  ** its file holds its bytes rightly (a Latin-1 name), whatever else is
+  ** wrong ("delete it" followed "not an image") */
   char value[LW_PARAM_TEXT_MAX] = "", unseen[96];
   const lw_param_def *d = lw_params_find(section, key);
+  struct stat sb;
   if (d) value_text(p, d, value, sizeof value);
   lw_params_unseen_char(value, unseen, sizeof unseen);
   return lw_error_set(err, err->code, "%s: key '%s.%s': %s%s", where, section, key, msg,
-                      strstr(msg, "U+") ? "" : unseen);
+                      strstr(msg, "U+") || (value[0] && !stat(value, &sb)) ? "" : unseen);
 }
 
 #define LW_PARAMS_FILE_LINE "; file "

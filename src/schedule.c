@@ -294,10 +294,13 @@ lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err
       status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected 'step temperature', got '%s'", path, lineno, shown);
       break;
     }
-    /* Whole numbers only, up to 2^53 where doubles still count every block. */
-    if (!parse_number(tok[0], &bv) || bv < 0 || bv != floor(bv) || bv > 9007199254740992.0) {
-      status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected a step number (a whole number >= 0), got '%.40s'",
-                            path, lineno, tok[0]);
+    /* Whole numbers only, up to 2^53 where doubles still count every block;
+    ** "1.000" is a thousand in a comma locale, not step 1 */
+    char hint[64];
+    if (lw_number_separator_hint(tok[0], 1, hint, sizeof hint) || !parse_number(tok[0], &bv) || bv < 0 ||
+        bv != floor(bv) || bv > 9007199254740992.0) {
+      status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected a step number (a whole number >= 0), got '%.40s'%s",
+                            path, lineno, tok[0], hint);
       break;
     }
     bv += 0.0; /* -0 -> +0 */
@@ -309,8 +312,9 @@ lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err
     }
     /* (the bounds of anneal.t_start and t_end: a row of 1e308 passed them) */
     if (!parse_number(tok[1], &tv) || tv < 0 || tv > 1e300) {
-      status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected a temperature from 0 to 1e300, got '%.40s'",
-                            path, lineno, tok[1]);
+      lw_number_separator_hint(tok[1], 0, hint, sizeof hint);
+      status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected a temperature from 0 to 1e300, got '%.40s'%s",
+                            path, lineno, tok[1], hint);
       break;
     }
     if (n == rows_cap) {

@@ -85,24 +85,44 @@ static int node_values(const char *text, lw_node *nd)
 }
 
 /* Collects splines one by one (the segment counts are only known as they
-** come) and builds the lw_splines at the end. */
+** come) and builds the lw_splines at the end.  The arrays grow with the
+** splines read, not with the count the file claims: a damaged count of 1e8
+** took 2 GB first, and under a memory limit was said "out of memory"
+** where the file was cut short. */
 typedef struct {
   size_t ns, *segs;
   double *rest;
   int *layer;             /* -1: none (every spline alike) */
+  size_t scap;            /* splines the three arrays above hold */
   lw_node *nodes;
   size_t nn, cap;
 } collect;
 
 static int collect_init(collect *c, size_t ns)
 {
-  *c = (collect){.ns = ns, .cap = 1024};
-  c->segs = malloc((ns ? ns : 1) * sizeof *c->segs);
-  c->rest = malloc((ns ? ns : 1) * sizeof *c->rest);
-  c->layer = malloc((ns ? ns : 1) * sizeof *c->layer);
+  *c = (collect){.ns = ns, .scap = ns < 1024 ? (ns ? ns : 1) : 1024, .cap = 1024};
+  c->segs = malloc(c->scap * sizeof *c->segs);
+  c->rest = malloc(c->scap * sizeof *c->rest);
+  c->layer = malloc(c->scap * sizeof *c->layer);
   c->nodes = malloc(c->cap * sizeof *c->nodes);
   if (c->layer && !ns) c->layer[0] = -1;
   return c->segs && c->rest && c->layer && c->nodes;
+}
+
+/* Room for spline i (i < c->ns); 1 if there is. */
+static int collect_room(collect *c, size_t i)
+{
+  if (i < c->scap) return 1;
+  size_t grown = 2 * c->scap < c->ns ? 2 * c->scap : c->ns;
+  size_t *s = realloc(c->segs, grown * sizeof *s);
+  if (s) c->segs = s;
+  double *r = s ? realloc(c->rest, grown * sizeof *r) : NULL;
+  if (r) c->rest = r;
+  int *l = r ? realloc(c->layer, grown * sizeof *l) : NULL;
+  if (!l) return 0;
+  c->layer = l;
+  c->scap = grown;
+  return 1;
 }
 
 static int collect_node(collect *c, lw_node nd)
@@ -202,6 +222,10 @@ lw_status lw_state_get_splines(lw_ckpt *c, const char *section, lw_splines **out
     if (!more) {
       s = lw_error_set(err, LW_EINPUT, "%s:%d: [%s] splines: %lld, but the section ends after %zu of them%s",
                        path, count_line, section, ns, i, lw_ckpt_cut_hint(c, section));
+      break;
+    }
+    if (!collect_room(&col, i)) {
+      s = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
       break;
     }
     if (strcmp(key, "spline") || !spline_header(val, &col.segs[i], &col.rest[i], &col.layer[i])) {
@@ -375,6 +399,10 @@ static lw_status read_v1(lw_state *st, reader *r, lw_error *err)
   }
   for (size_t i = 0; i < col.ns && !s; i++) {
     if ((s = expect_key(r, "spline", &val, err))) break;
+    if (!collect_room(&col, i)) {
+      s = lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
+      break;
+    }
     col.layer[i] = -1;
     if (!spline_header(val, &col.segs[i], &col.rest[i], NULL)) {
       s = bad(r, err, "spline", "'<segments >= 1> <rest length > 0>'", val);

@@ -339,6 +339,13 @@ Test(cli, an_unseen_character_is_named_in_the_values_refused_after_reading)
               "%s", errs);
     cr_assert_eq(strchr(errs, '\n'), errs + strlen(errs) - 1, "one line: %s", errs);
   }
+  /* but a file that is found holds its bytes rightly (a Latin-1 name):
+  ** what is wrong with it is said without "delete it" */
+  write_file("M\xfcller.png", "not an image");
+  write_file("latin.ini", "[scene]\nimage = M\xfcller.png\n");
+  snprintf(args, sizeof args, "run %s/latin.ini --out %s/latin --quiet", dir, dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
+  cr_assert(strstr(errs, "key 'scene.image'") && strstr(errs, "not an image") && !strstr(errs, "delete it"), "%s", errs);
 }
 
 /* The release, as --version, version and -V give it, is the man page's and
@@ -1654,6 +1661,14 @@ Test(cli, usage_errors_exit_2_in_one_line_and_write_nothing)
       {"run M --threads 0", "--threads: expected a whole number from 1 to 4096, got '0'"},
       {"run M --seed -1", "--seed: expected a whole number from 0 to 4294967295, got '-1'"},
       {"run M --stop-at x", "--stop-at: expected a whole number from 0 to"},
+      /* "1.000", a thousand in a comma locale, is refused as --set refuses
+      ** it (the options read it as 1: seed 1, 10 more sweeps for 10.000) */
+      {"run M --seed 1.000", "got '1.000' (a thousands separator? write 1000, not 1.000)"},
+      {"run M --threads 1.000", "--threads: expected a whole number from 1 to 4096, got '1.000' (a thousands"},
+      {"run M --seed 1,5", "got '1,5' (a decimal comma? numbers take a point"},
+      {"run M --set anneal.sweeps=10.000.000", "(a thousands separator? write 1000, not 1.000), got '10.000.000'"},
+      {"resume r --sweeps 10.000", "--sweeps: expected a whole number from 0 to 1000000000000000, got '10.000' (a"},
+      {"stats r --reweight 2.000", "--reweight: expected a whole number from 2 to 10000, got '2.000' (a thousands"},
       {"resume", "resume: expected a run directory (usage: linewise resume DIR"},
       {"resume r r", "resume: unexpected 'r' (usage: linewise resume DIR"},
       {"resume r --sweeps -3", "--sweeps: expected a whole number from 0 to"},
@@ -1697,6 +1712,22 @@ Test(cli, usage_errors_exit_2_in_one_line_and_write_nothing)
 ** caught, a GOMP_STACKSIZE behind a bad OMP_STACKSIZE too (reading the
 ** variables here let "+16K" and "16K" with a carriage return through).  A
 ** stack of the needed 256 KiB runs. */
+/* A state whose spline count was damaged up to 1e8 is said cut short under
+** a memory limit too: the reader took memory for the count first, and said
+** "out of memory for 100000000 splines" (exit 1) where 2 GB did not fit. */
+Test(cli, a_damaged_spline_count_is_said_under_a_memory_limit_too)
+{
+  if (strstr(lw_test_bin(), "asan")) cr_skip_test("an AddressSanitizer build cannot run under ulimit -v");
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=5 --out g --quiet && "
+                          "sed -i 's/^splines = 20$/splines = 100000000/' g/state.lw && grep -q '^splines = 1000' "
+                          "g/state.lw", dir, lw_test_bin(), lw_test_root()), 0);
+  cr_assert_eq(lw_test_sh("cd %s && (ulimit -v 400000; %s energy g 2> err.txt)", dir, lw_test_bin()), 2);
+  char *msg = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(msg, "g/state.lw:") && strstr(msg, "splines: 100000000, but the section ends after 20 of them"),
+            "%s", msg);
+  free(msg);
+}
+
 /* libgomp ends the process (exit 1) where it cannot start a team's threads,
 ** which may first happen after the set-up: under an address-space limit
 ** eight threads' stacks did not fit, and the finished run in the directory

@@ -210,6 +210,17 @@ Test(image_cli, a_path_the_runs_scene_file_would_cut_at_a_semicolon_is_refused_b
                          "scene.ini:4: key 'scene.image': 'good.png' made absolute is '/",
                          "Fotos ;alt/good.png', which the run's scene.ini (which resume reads) cannot hold: "
                          "';' after a blank begins a comment there");
+  /* a newline in a folder's name (reached through a link: a scene's own
+  ** path with one is refused first) is named as such; it shows as '?', and
+  ** the message blamed a ';' */
+  cr_assert_eq(mkdir(lw_test_path("cw\nd"), 0777), 0);
+  cr_assert_eq(symlink("cw\nd", lw_test_path("cwl")), 0);
+  write_picture("cw\nd/good.png", 64, 48);
+  write_text("cw\nd/scene.ini", text);
+  refused_before_the_run("run cwl/scene.ini --out out", "scene.ini:4: key 'scene.image': 'good.png' made absolute ",
+                         "which the run's scene.ini (which resume reads) cannot hold: byte ");
+  refused_before_the_run("run cwl/scene.ini --out out", "cw?d/good.png'",
+                         "is a control character (0x0A), which ends or breaks a line there; rename the file");
 }
 
 /* The drawing's score renders the picture's pixels, and cairo draws at most

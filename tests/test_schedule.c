@@ -269,6 +269,9 @@ Test(schedule, table_rejects_malformed_files_with_line_numbers)
     {"-1 1\n", 1, "step number"},
     {"1.5 1\n", 1, "step number"},
     {"1e300 1\n", 1, "step number"},
+    /* a comma locale's writing: "1.000" is a thousand there (it read as step 1) */
+    {"0 1\n1.000 0.5\n", 2, "got '1.000' (a thousands separator? write 1000, not 1.000)"},
+    {"0 0,5\n", 1, "got '0,5' (a decimal comma? numbers take a point"},
     {"0 -1\n", 1, "temperature"},
     {"0 -1e-300\n", 1, "temperature"},
     {"0 nan\n", 1, "temperature"},

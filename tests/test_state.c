@@ -29,17 +29,22 @@ static void remove_dir(void)
 
 TestSuite(state, .init = make_dir, .fini = remove_dir);
 
+/* (2500 splines with layers: the reader's arrays grow past their first 1024) */
 Test(state, round_trip_is_bit_exact)
 {
-  size_t segs[3] = {1, 4, 2};
-  lw_state st = {.scene = "scene.ini", .seed = 12345, .sweep = 678, .sp = lw_splines_new(3, segs, NULL)};
+  enum { N = 2500 };
+  size_t segs[N];
+  for (size_t i = 0; i < N; i++) segs[i] = 1 + i % 4;
+  lw_state st = {.scene = "scene.ini", .seed = 12345, .sweep = 678, .sp = lw_splines_new(N, segs, NULL)};
+  cr_assert_eq(lw_splines_layers_alloc(st.sp), LW_OK);
+  for (size_t i = 0; i < N; i++) st.sp->layer[i] = (uint8_t)(i % 3);
   gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
   for (size_t k = 0; k < st.sp->n_nodes; k++) {
     /* high-entropy values across many magnitudes */
     double s = pow(10.0, 12 * gsl_rng_uniform(r) - 6);
     st.sp->node[k] = (lw_node){s * (gsl_rng_uniform(r) - 0.5), s * gsl_rng_uniform(r), -s / 3, M_PI * s};
   }
-  for (int i = 0; i < 3; i++) st.sp->rest_length[i] = 1.0 / (i + 3.0);
+  for (int i = 0; i < N; i++) st.sp->rest_length[i] = 1.0 / (i + 3.0);
   char path[128];
   snprintf(path, sizeof path, "%s/state.lw", dir);
   lw_error err;
@@ -49,10 +54,12 @@ Test(state, round_trip_is_bit_exact)
   cr_assert_str_eq(back.scene, "scene.ini");
   cr_assert_eq(back.seed, 12345);
   cr_assert_eq(back.sweep, 678);
-  cr_assert_eq(back.sp->n_splines, 3);
+  cr_assert_eq(back.sp->n_splines, N);
   cr_assert_eq(back.sp->n_nodes, st.sp->n_nodes);
   cr_assert(!memcmp(back.sp->node, st.sp->node, st.sp->n_nodes * sizeof(lw_node)), "nodes differ");
-  cr_assert(!memcmp(back.sp->rest_length, st.sp->rest_length, 3 * sizeof(double)));
+  cr_assert(!memcmp(back.sp->rest_length, st.sp->rest_length, N * sizeof(double)));
+  cr_assert(!memcmp(back.sp->first, st.sp->first, (N + 1) * sizeof *st.sp->first), "segment counts differ");
+  cr_assert(back.sp->layer && !memcmp(back.sp->layer, st.sp->layer, N), "layers differ");
   char tmp[160];
   snprintf(tmp, sizeof tmp, "%s.tmp", path);
   cr_assert(access(tmp, F_OK) != 0, "temporary file left behind");

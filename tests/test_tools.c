@@ -1090,6 +1090,44 @@ Test(tools, sweeps_and_plots_take_any_directory_name)
   check_png("v=2 {}/v=3.png");
 }
 
+/* A scene named like an option follows "--", as for linewise, and is said
+** a file where it is taken for an option; the tasks the sweep starts get it
+** too (they are started with --task after the sweep's words).  A newline
+** in the scene's path is refused before anything is made (it split
+** sweep.conf's line, and every run failed).  The cores a sweep counts are
+** the machine's, whatever OMP_NUM_THREADS says (nproc answers it: a
+** login's =1 ran one run at a time). */
+Test(tools, a_scene_named_like_an_option_follows_double_dash)
+{
+  cr_assert_eq(sh("cd %s && cp %s ./-m.ini", dir, scene()), 0);
+  cr_assert_eq(sh("cd %s && %s -m.ini --seeds 1", dir, tool("seed-sweep")), 2);
+  char *errs = err_txt();
+  cr_assert(strstr(errs, "unknown option '-m.ini' (try 'seed-sweep --help'; a file of that name: ./-m.ini)"), "%s",
+            errs);
+  free(errs);
+  cr_assert_eq(sh("cd %s && %s --seeds 1-2 -j 2 " TINY " --bin %s --out sw -- -m.ini </dev/null", dir,
+                  tool("seed-sweep"), env("LW_BIN")), 0, "%s", err_txt());
+  cr_assert_eq(sh("cd %s && test -s sw/seed-1/summary.json && test -s sw/seed-2/summary.json && "
+                  "test $(wc -l < sw/sweep.csv) -eq 3", dir), 0);
+  cr_assert_eq(sh("cd %s && %s --out sw.png -- sw/sweep.csv </dev/null", dir, tool("plot-sweep")), 0, "%s", err_txt());
+  check_png("sw.png");
+  cr_assert_eq(sh("cd %s && cp %s 'm\nx.ini' && %s 'm\nx.ini' --seeds 1 --out nl", dir, scene(),
+                  tool("seed-sweep")), 2);
+  errs = err_txt();
+  cr_assert(strstr(errs, "'m?x.ini': a control character in the scene file's path"), "%s", errs);
+  free(errs);
+  cr_assert(!exists("nl"), "a sweep directory was made");
+  cr_assert_eq(sh("cd %s && OMP_NUM_THREADS=1 %s %s --seeds 1 " TINY " --bin %s --out om </dev/null", dir,
+                  tool("seed-sweep"), scene(), env("LW_BIN")), 0, "%s", err_txt());
+  char *said = out_txt();
+  cr_assert_eq(sh("env -u OMP_NUM_THREADS nproc"), 0);
+  char *cores = out_txt(), want[128];
+  snprintf(want, sizeof want, "seed-sweep: 1 runs into om, %ld at a time", strtol(cores, NULL, 10));
+  cr_assert(!strncmp(said, want, strlen(want)), "'%s' is not '%s...'", said, want);
+  free(said);
+  free(cores);
+}
+
 Test(tools, plot_run_draws_energy_temperature_and_acceptance)
 {
   cr_assert_eq(sh("%s run %s " TINY " --quiet --out %s/r", env("LW_BIN"), scene(), dir), 0);

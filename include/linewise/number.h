@@ -73,6 +73,15 @@ ssize_t lw_text_getline(char **buf, size_t *cap, FILE *f);
 ** would wait on for ever (opening a FIFO waits for a writer); else LW_OK. */
 lw_status lw_text_not_fifo(const char *path, lw_error *err);
 
+/* What a number in a comma or a point locale's writing means to say, as a
+** hint to add to a message (into hint, "" if none): digits grouped in
+** threes by '.' or ',' ("1.000", "10.000.000", "1,000,000") are a
+** thousands separator where a whole number is wanted (whole) or the groups
+** are more than one; a comma between digits otherwise is a decimal comma.
+** Returns 1 where s must be refused although it parses: "1.000" for a
+** whole number, which read as one sweep, or seed 1. */
+int lw_number_separator_hint(const char *s, int whole, char *hint, size_t n);
+
 /* Splits s at blanks (commas too when `commas` is 1 or 2) into at most max
 ** numbers; returns how many tokens there were (more than max are counted
 ** but not stored), or -1 if a token is not a number.  With commas 2, -2
