@@ -345,7 +345,8 @@ Test(cli, an_unseen_character_is_named_in_the_values_refused_after_reading)
   write_file("latin.ini", "[scene]\nimage = M\xfcller.png\n");
   snprintf(args, sizeof args, "run %s/latin.ini --out %s/latin --quiet", dir, dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2);
-  cr_assert(strstr(errs, "key 'scene.image'") && strstr(errs, "not an image") && !strstr(errs, "delete it"), "%s", errs);
+  cr_assert(strstr(errs, "key 'scene.image'") && strstr(errs, "not an image") && !strstr(errs, "delete it"), "%s",
+            errs);
 }
 
 /* The release, as --version, version and -V give it, is the man page's and

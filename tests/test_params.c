@@ -152,7 +152,8 @@ Test(params, bad_input_names_file_line_and_key)
   expect_error("[anneal]\nsweeps = 1.000\n", ":2:", "anneal.sweeps", "(a thousands separator? write 1000, not 1.000)");
   expect_error("[anneal]\nsweeps = 1,000\n", ":2:", "anneal.sweeps", "(a thousands separator? write 1000, not 1,000)");
   expect_error("[anneal]\nsweeps = 10.000.000\n", ":2:", "anneal.sweeps", "(a thousands separator? write 1000");
-  expect_error("[anneal]\nt_end = 1,000,000\n", ":2:", "anneal.t_end", "(a thousands separator? write 1000, not 1,000)");
+  expect_error("[anneal]\nt_end = 1,000,000\n", ":2:", "anneal.t_end",
+               "(a thousands separator? write 1000, not 1,000)");
   expect_error("[anneal]\nt_end = 1,000\n", ":2:", "anneal.t_end", "(a decimal comma? numbers take a point");
   cr_assert_eq(read_text("[anneal]\nsweeps = 1.0\nt_end = 0.002\n", &q, &err), LW_OK, "%s", err.msg);
   expect_error("[scene]\nboundary = hexagon\n", ":2:", "scene.boundary", "rect|circle|polygon");
