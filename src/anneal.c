@@ -166,6 +166,15 @@ void lw_anneal_drift_note(const lw_anneal *a, char *buf, size_t n)
              "row; please report it)", a->row_drift, a->params.system);
 }
 
+void lw_anneal_observables_note(const lw_anneal *a, char *buf, size_t n)
+{
+  char word[LW_RUNDIR_WORD_MAX];
+  buf[0] = '\0';
+  if (a->observables_lost[0])
+    snprintf(buf, n, "summary.json's observables are null: %s ('linewise stats %s' gives them where the memory "
+             "allows)", a->observables_lost, lw_rundir_shell_word(a->dir, word, sizeof word));
+}
+
 /* Temperature step of sweep s: the sweeps are shared out evenly; past the
 ** end the last step holds. */
 static long block_of(const lw_anneal *a, long s)
@@ -749,22 +758,24 @@ static lw_status fits_memory(lw_anneal *a, lw_error *err)
   const lw_system_type *t = a->sys_type;
   char what[160] = "";
   const char *key = NULL, *by;
-  double peak = 0.0;
-  const double one = t->start_bytes ? t->start_bytes(a->setup, &a->params, what, sizeof what, &key, &peak) : 0.0;
+  double peak = 0.0, replica = 0.0;
+  const double one =
+      t->start_bytes ? t->start_bytes(a->setup, &a->params, what, sizeof what, &key, &peak, &replica) : 0.0;
   int here = 0;
   for (int r = 0; r < a->n_rep; r++) here += rung_here(a, r);
   const double limit = lw_memory_limit(&by), bytes = one * here;
+  char reps[48] = "";
+  if (here > 1) snprintf(reps, sizeof reps, " in %d replicas", here);
   /* past the peak (the drawing's, the close share's points above all: the
   ** run annealed for hours, then lost its close share or its preview) told,
   ** not refused: a fit with room, not a bound */
-  if (!(bytes > limit) && peak > 0.0 && peak + one * (here - 1) > limit)
-    snprintf(a->memory_note, sizeof a->memory_note, "%s may take up to about %.3g GB at the drawing, more than the "
-             "%.3g GB of %s: short of it the drawing leaves out its close share (summary.json's close_share null) "
-             "or fails (its state kept, to resume with more memory); fewer splines or a wider output.pen_width take "
-             "less (docs/PERFORMANCE.md, \"Memory\")", what, (peak + one * (here - 1)) / 1e9, limit / 1e9, by);
+  if (!(bytes > limit) && peak > 0.0 && peak + replica * (here - 1) > limit)
+    snprintf(a->memory_note, sizeof a->memory_note, "%s%s may take up to about %.3g GB at the drawing, more than "
+             "the %.3g GB of %s: short of it the drawing leaves out its scores (summary.json's close_share and "
+             "fidelity null) or fails (its state kept, to resume with more memory); fewer splines%s or a wider "
+             "output.pen_width take less (docs/PERFORMANCE.md, \"Memory\")", what, here > 1 ? reps : "",
+             (peak + replica * (here - 1)) / 1e9, limit / 1e9, by, here > 1 ? " or replicas" : "");
   if (!(bytes > limit) || !key) return LW_OK;
-  char reps[48] = "";
-  if (here > 1) snprintf(reps, sizeof reps, " in %d replicas", here);
   lw_error_set(err, LW_EINPUT, "%s take at least %.3g GB%s, more than the %.3g GB of %s: expected a smaller %s",
                what, bytes / 1e9, reps, limit / 1e9, by, key);
   const char *dot = strchr(key, '.');
@@ -1884,7 +1895,7 @@ static void put_per_move(lw_json *j, const char *key, const lw_chain *c, const l
 ** read back from trace.csv, which the checkpoint before has flushed; null
 ** where the trace has no such stretch.  The effective samples let a sweep's table show the error bars
 ** too rough to trust (under 25, as `linewise stats` warns). */
-static void put_observables(const lw_anneal *a, lw_json *j)
+static void put_observables(lw_anneal *a, lw_json *j)
 {
   char path[LW_PATH_MAX + 32], key[96];
   dir_file(path, sizeof path, a, "trace.csv");
@@ -1896,8 +1907,13 @@ static void put_observables(const lw_anneal *a, lw_json *j)
   double *x = NULL;
   lw_trace *h = NULL; /* t with its heat capacities */
   lw_json_key(j, "observables");
-  if (!t || lw_trace_rows(t, path, &sel, &rows, &n, &tuned, &e) || !(x = malloc(n * sizeof *x)) ||
+  lw_status rs = LW_OK;
+  a->observables_lost[0] = '\0';
+  if (!t || (rs = lw_trace_rows(t, path, &sel, &rows, &n, &tuned, &e)) || !(x = malloc(n * sizeof *x)) ||
       !(h = lw_trace_with_heat_capacity(t, rows, n, path, &e))) {
+    /* null too where no row qualifies (documented, and nothing to say) */
+    if (rs != LW_EINPUT)
+      snprintf(a->observables_lost, sizeof a->observables_lost, "%.500s", t && !rs && !x ? "out of memory" : e.msg);
     lw_json_null(j);
   } else {
     const int sweep = lw_trace_column(t, "sweep");

@@ -318,8 +318,9 @@ static int cmd_energy(int argc, char **argv)
   double total = setup ? t->energy(setup, &st, path, term, &err) : NAN;
   /* the run's sections are read by resume, not here; an unknown one is
   ** refused all the same, as every reader of a state does (after the row,
-  ** whose message names a state of another system better) */
-  if (!err.code && st.doc) lw_checkpoint_sections_known(st.doc, p.system, &err);
+  ** whose message names a state of another system better); format 1's run
+  ** data, the upgrade's under resume, is no section of a newer linewise */
+  if (!err.code && st.doc && st.version != 1) lw_checkpoint_sections_known(st.doc, p.system, &err);
   if (err.code) rc = fail(&err);
   else {
     for (int k = 0; k < t->n_terms; k++)
@@ -877,8 +878,15 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
     lw_anneal_checkpoint_note(a, drawn, sizeof drawn);
     if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
-    lw_anneal_drift_note(a, drawn, sizeof drawn);
-    if (drawn[0]) fprintf(stderr, "linewise: warning: %s\n", drawn);
+  }
+  /* the warnings, of numbers the run got wrong or left out, under --quiet
+  ** too: a study's script reads its log (its statistics went null unsaid) */
+  if (drew) {
+    char warning[1024];
+    lw_anneal_drift_note(a, warning, sizeof warning);
+    if (warning[0]) fprintf(stderr, "linewise: warning: %s\n", warning);
+    lw_anneal_observables_note(a, warning, sizeof warning);
+    if (warning[0]) fprintf(stderr, "linewise: warning: %s\n", warning);
   }
   if (!quiet) {
     if (a->quenched)

@@ -75,19 +75,26 @@ int lw_number_separator_hint(const char *s, int whole, char *hint, size_t n)
   const char *p = s + (*s == '+' || *s == '-');
   const size_t lead = strspn(p, digits);
   const char sep = p[lead] == '.' || p[lead] == ',' ? p[lead] : 0;
-  int groups = 0;
-  if (sep && lead >= 1 && lead <= 3) {
+  int groups = 0, fraction = 0;
+  /* (a leading group of zeros is 0 in every writing: "0.000" reads) */
+  if (sep && lead >= 1 && lead <= 3 && strspn(p, "0") < lead) {
     const char *q = p + lead;
     for (; *q == sep && strspn(q + 1, digits) == 3; q += 4) groups++;
+    /* and the other mark after them, a fraction: "1,000.5", "1.000,5" */
+    const size_t tail = strlen(q + 1);
+    if (groups && *q == (sep == '.' ? ',' : '.') && tail && strspn(q + 1, digits) == tail) {
+      q += 1 + tail;
+      fraction = 1;
+    }
     if (*q) groups = 0;
   }
   const char *comma = strchr(s, ',');
-  if (groups && (whole || groups > 1))
+  if (groups && (whole || groups > 1 || fraction))
     snprintf(hint, n, " (a thousands separator? write 1000, not 1%c000)", sep);
   else if (comma && comma > s && is_digit(comma[-1]) && is_digit(comma[1]))
     snprintf(hint, n, " (a decimal comma? numbers take a point: 0.5, not 0,5)");
   else if (n) *hint = '\0';
-  return groups && whole;
+  return groups && whole && !fraction;
 }
 
 int lw_number_list(const char *s, int commas, double *out, int max)

@@ -1173,6 +1173,22 @@ const char *lw_params_unseen_char(const char *value, char *buf, size_t n)
                  unseen[k].name, unseen[k].code);
         return buf;
       }
+  /* look-alikes of what a number is written with: a word processor's minus
+  ** sign, and the full-width forms of an East Asian input method ("２０") */
+  for (const unsigned char *c = (const unsigned char *)value; *c; c++) {
+    const size_t at = (size_t)(c - (const unsigned char *)value) + 1;
+    if (c[0] == 0xe2 && c[1] == 0x88 && c[2] == 0x92) {
+      snprintf(buf, n, " (byte %zu is a minus sign, U+2212: type '-')", at);
+      return buf;
+    }
+    if (c[0] == 0xef && ((c[1] == 0xbc && c[2] >= 0x81 && c[2] <= 0xbf) || (c[1] == 0xbd && c[2] >= 0x80 &&
+                                                                            c[2] <= 0x9e))) {
+      const unsigned code = 0xf000u | (c[1] & 0x3fu) << 6 | (c[2] & 0x3fu);
+      snprintf(buf, n, " (byte %zu is a full-width '%c', U+%04X: type '%c')", at, (char)(code - 0xfee0),
+               code, (char)(code - 0xfee0));
+      return buf;
+    }
+  }
   /* a control character or a byte that is no UTF-8 (0xFF, a Latin-1 letter)
   ** shows as nothing or as garbage in the message: its number, then */
   for (size_t i = 0; value[i];) {
@@ -1378,10 +1394,14 @@ static int on_key(void *user, const char *section, const char *key, const char *
   }
   const lw_param_def *d = lw_params_find(section, key); /* the section is known: read_line checked it */
   if (!d) {
+    /* (a no-break space inside the name prints like a blank: named, by
+    ** its byte in the name as the message quotes it) */
+    char unseen[96], name[512]; /* (a line holds 198 bytes) */
+    snprintf(name, sizeof name, "%s.%s", section, key);
     suggest_key(section, key, hint, sizeof hint);
     lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' is not a parameter%s (see `linewise params` or "
-                 "docs/PARAMETERS.md)",
-                 rc->p->file, rc->line, section, key, hint);
+                 "docs/PARAMETERS.md)%s",
+                 rc->p->file, rc->line, section, key, hint, lw_params_unseen_char(name, unseen, sizeof unseen));
     return 0;
   }
   int *line = &rc->p->line[d - lw_param_table];
@@ -1805,11 +1825,11 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
     return lw_error_set(err, LW_EUSAGE, "--set '%s': blanks around the name; expected section.key=value "
                         "without them", assignment);
   if (!d) {
-    char hint[96];
+    char hint[96], unseen[96], name[sizeof section + sizeof key];
+    snprintf(name, sizeof name, "%s.%s", section, key);
     suggest_key(section, key, hint, sizeof hint);
-    return lw_error_set(err, LW_EUSAGE, "--set %s.%s: not a parameter%s (see `linewise params` or docs/PARAMETERS.md)",
-                        section, key,
-                        hint);
+    return lw_error_set(err, LW_EUSAGE, "--set %s.%s: not a parameter%s (see `linewise params` or docs/PARAMETERS.md)%s",
+                        section, key, hint, lw_params_unseen_char(name, unseen, sizeof unseen));
   }
   char expected[256], unseen[96];
   if (!assign(p, d, eq + 1, expected, sizeof expected))

@@ -175,16 +175,22 @@ lw_particles *lw_particles_get(const lw_particles_setup *s, lw_ckpt *c, const ch
   }
   long count;
   if (lw_ckpt_whole(c, section, "count", &count, 1, UINT32_MAX / 2, 1, err)) return NULL;
-  size_t n = (size_t)count, pos = 0, i = 0;
-  double *x = malloc(3 * n * sizeof *x), *q = malloc(4 * n * sizeof *q);
-  unsigned char *pin = malloc(n);
+  size_t n = (size_t)count, pos = 0, i = 0, lines = 0;
+  const char *key, *val;
+  int line = 0;
+  /* memory for the particles there are, not for the count the file claims:
+  ** a damaged count of 1e8 was said "out of memory" under a batch job's
+  ** limit, where the file was cut short */
+  while (lw_ckpt_next(c, section, &pos, &key, &val, &line)) lines += !strcmp(key, "particle");
+  pos = 0;
+  const size_t room = lines < n ? (lines ? lines : 1) : n;
+  double *x = malloc(3 * room * sizeof *x), *q = malloc(4 * room * sizeof *q);
+  unsigned char *pin = malloc(room);
   lw_particles *p = NULL;
   if (!x || !q || !pin) {
     lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu particles", path, n);
     goto out;
   }
-  const char *key, *val;
-  int line = 0;
   while (lw_ckpt_next(c, section, &pos, &key, &val, &line)) {
     if (!strcmp(key, "count")) continue;
     double v[9];

@@ -120,18 +120,26 @@ static double drawing_peak(const spl_setup *su, const lw_params *p, double segme
 ** refused. */
 #define SEGMENT_BYTES_LEAST 360.0
 
+/* What a further tempering replica adds to the peak, a segment: 494 bytes
+** measured on minimal.ini, 745 under the photo preset (docs/PERFORMANCE.md,
+** "Memory"), with the drawing's room of 1.3 times the most.  The least
+** above counted for it, and a run of 16 replicas annealed to its end past
+** the memory, unwarned, then failed at its drawing. */
+#define REPLICA_SEGMENT_BYTES 970.0
+
 /* (system.h) The placed splines' model: 1e8 splines filled 3 GB in 15 s
 ** without a word, on their way to 160 GB, and a coverage's count was shown
 ** only once placed. */
 static double start_bytes(const void *setup, const lw_params *p, char *what, size_t n, const char **key,
-                          double *peak)
+                          double *peak, double *replica)
 {
   const spl_setup *su = setup;
   size_t count = (size_t)p->splines;
   lw_error e2; /* a count the placement refuses is refused there, with its own message */
-  *peak = 0.0;
+  *peak = *replica = 0.0;
   if (p->from[0] || (!count && lw_init_count(&su->scene, p, &count, &e2))) return 0.0;
   *peak = drawing_peak(su, p, (double)count * p->segments);
+  *replica = REPLICA_SEGMENT_BYTES * (double)count * p->segments;
   snprintf(what, n, "%zu splines of %d segments%s (%.0f bytes a segment at least)", count, p->segments,
            p->splines ? "" : " (from init.coverage)", SEGMENT_BYTES_LEAST);
   *key = p->splines ? "init.splines" : "init.coverage";

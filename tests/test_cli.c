@@ -1706,17 +1706,30 @@ Test(cli, usage_errors_exit_2_in_one_line_and_write_nothing)
   }
 }
 
-/* A stack too small for a run (OpenMP's threads, the main thread of ulimit
-** -s) is refused in one line before anything is written; before, the photo
-** preset died of a segmentation fault mid-run at OMP_STACKSIZE=16K.  The
-** threads' stack is measured on one, so every spelling libgomp reads is
-** caught, a GOMP_STACKSIZE behind a bad OMP_STACKSIZE too (reading the
-** variables here let "+16K" and "16K" with a carriage return through).  A
-** stack of the needed 256 KiB runs. */
+/* The end of a run reads its trace for summary.json's observables: where
+** memory runs out there they are null, and the run says so under --quiet
+** too (a study's statistics went null with exit 0 and nothing said).  The
+** limit lets the run through (it needs under 30 MB) but not twice its
+** 11 MB trace beside it. */
+Test(cli, observables_lost_for_want_of_memory_are_said)
+{
+  if (strstr(lw_test_bin(), "asan")) cr_skip_test("an AddressSanitizer build cannot run under ulimit -v");
+  cr_assert_eq(lw_test_sh("cd %s && (ulimit -v 36000; %s run %s/params/lj13.ini --out o --threads 1 --quiet --set "
+                          "output.trace_every=1 --set output.observables=1 --set anneal.sweeps=20000 2> err.txt)", dir,
+                          lw_test_bin(), lw_test_root()), 0);
+  char *msg = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(msg, "linewise: warning: summary.json's observables are null: ") && strstr(msg, "out of memory") &&
+            strstr(msg, "('linewise stats o' gives them where the memory allows)\n"), "%s", msg);
+  free(msg);
+  cr_assert_eq(lw_test_sh("cd %s && grep -q '\"observables\": null' o/summary.json && %s stats o | grep -q obs_",
+                          dir, lw_test_bin()), 0);
+}
+
 /* A state whose spline count was damaged up to 1e8 is said cut short under
 ** a memory limit too: the reader took memory for the count first, and said
-** "out of memory for 100000000 splines" (exit 1) where 2 GB did not fit. */
-Test(cli, a_damaged_spline_count_is_said_under_a_memory_limit_too)
+** "out of memory for 100000000 splines" (exit 1) where 2 GB did not fit.
+** So is a particle count. */
+Test(cli, a_damaged_count_is_said_under_a_memory_limit_too)
 {
   if (strstr(lw_test_bin(), "asan")) cr_skip_test("an AddressSanitizer build cannot run under ulimit -v");
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=5 --out g --quiet && "
@@ -1726,6 +1739,13 @@ Test(cli, a_damaged_spline_count_is_said_under_a_memory_limit_too)
   char *msg = lw_test_slurp("%s/err.txt", dir);
   cr_assert(strstr(msg, "g/state.lw:") && strstr(msg, "splines: 100000000, but the section ends after 20 of them"),
             "%s", msg);
+  free(msg);
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/particles-sheet.ini --set anneal.sweeps=2 --out p --quiet && "
+                          "sed -i 's/^count = 127$/count = 100000000/' p/state.lw && grep -q '^count = 1000' "
+                          "p/state.lw", dir, lw_test_bin(), lw_test_root()), 0);
+  cr_assert_eq(lw_test_sh("cd %s && (ulimit -v 400000; %s energy p 2> err.txt)", dir, lw_test_bin()), 2);
+  msg = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(msg, "p/state.lw: [system particles]: count = 100000000, but 127 particle lines"), "%s", msg);
   free(msg);
 }
 
@@ -1765,6 +1785,13 @@ Test(cli, a_process_ended_by_openmp_puts_the_run_before_back)
   cr_assert_eq(lw_test_sh("test ! -e %s/t", dir), 0);
 }
 
+/* A stack too small for a run (OpenMP's threads, the main thread of ulimit
+** -s) is refused in one line before anything is written; before, the photo
+** preset died of a segmentation fault mid-run at OMP_STACKSIZE=16K.  The
+** threads' stack is measured on one, so every spelling libgomp reads is
+** caught, a GOMP_STACKSIZE behind a bad OMP_STACKSIZE too (reading the
+** variables here let "+16K" and "16K" with a carriage return through).  A
+** stack of the needed 256 KiB runs. */
 Test(cli, a_stack_too_small_is_refused_before_the_run)
 {
   static const struct {
@@ -2088,12 +2115,20 @@ Test(cli, a_start_past_the_machines_memory_is_refused_before_placing)
                           "scene.width=1414 --set scene.height=1414 --stop-at 0 --threads 1 --quiet --out %s/m' "
                           "2>%s/err.txt && grep -q '^linewise: note: 20000 splines of 4 segments (360 bytes a segment "
                           "at least) may take up to about 0.364 GB at the drawing, more than the 0.287 GB of this "
-                          "process.s address space (ulimit -v): short of it the drawing leaves out its close share' "
+                          "process.s address space (ulimit -v): short of it the drawing leaves out its scores' "
                           "%s/err.txt && "
                           "sh -c 'ulimit -v 2000000; %s run %s/params/minimal.ini --set init.splines=20000 --set "
                           "scene.width=1414 --set scene.height=1414 --stop-at 0 --threads 1 --quiet --out %s/m' "
                           "2>%s/err.txt && ! grep -q 'at the drawing' %s/err.txt", lw_test_bin(), lw_test_root(), dir,
                           dir, dir, lw_test_bin(), lw_test_root(), dir, dir, dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  /* each further replica counted as measured (the least a segment, 360
+  ** bytes, was: 16 replicas of example.ini annealed to their end past
+  ** 125 MB unwarned, then failed at the drawing) */
+  cr_assert_eq(lw_test_sh("sh -c 'ulimit -v 125000; %s run %s/params/example.ini --set tempering.replicas=16 "
+                          "--stop-at 0 --threads 1 --quiet --out %s/r16' 2>%s/err.txt && grep -q '^linewise: note: "
+                          "1284 splines of 5 segments .* in 16 replicas may take up to about 0.1[0-9]* GB at the "
+                          "drawing, more than the 0.128 GB' %s/err.txt", lw_test_bin(), lw_test_root(), dir, dir, dir),
                0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* and a resume under the limit its drawing failed under (it failed again unsaid) */
   cr_assert_eq(lw_test_sh("sh -c 'ulimit -v 280000; %s resume %s/m --stop-at 0 --threads 1 --quiet' 2>%s/err.txt && "

@@ -239,6 +239,53 @@ Test(image_cli, a_picture_too_long_to_score_is_refused_before_the_run)
                          "picture's pixels", "and cairo renders at most 32767 a side");
 }
 
+/* The fidelity score's want of memory leaves it out, as the close share's
+** does (null, and said): the run annealed, drew final.svg, then ended with
+** exit 1 and no summary.json.  A 2000 x 2000 reference beside a small
+** scene: the run needs some 10 MB, the score over 100. */
+Test(image_cli, a_fidelity_score_out_of_memory_is_left_out_and_said)
+{
+  if (strstr(getenv("LW_BIN"), "asan")) cr_skip_test("an AddressSanitizer build cannot run under ulimit -v");
+  enum { SIDE = 2000 };
+  static char ref[32 + SIDE * SIDE];
+  int n = snprintf(ref, sizeof ref, "P5\n%d %d\n255\n", SIDE, SIDE);
+  for (int i = 0; i < SIDE * SIDE; i++) ref[n + i] = (char)(i % 253);
+  lw_test_write(lw_test_path("ref.pgm"), ref, (size_t)n + SIDE * SIDE);
+  char errs[4096], cmd[512];
+  snprintf(cmd, sizeof cmd, "run %s/params/minimal.ini --out out --threads 1 --set anneal.sweeps=2 --set "
+           "output.fidelity_reference=ref.pgm", getenv("LW_ROOT"));
+  cr_assert_eq(run(cmd, errs, sizeof errs), 0, "%s", errs); /* with room, it is scored */
+  cr_assert_eq(lw_test_sh("grep -q '\"fidelity\": {' %s", lw_test_path("out/summary.json")), 0);
+  cr_assert_eq(lw_test_sh("cd %s && (ulimit -v 60000; %s %s 2> err.txt)", lw_test_dir, getenv("LW_BIN"), cmd), 0,
+               "%s", lw_test_slurp("%s", lw_test_path("err.txt")));
+  char *said = lw_test_slurp("%s", lw_test_path("err.txt"));
+  cr_assert(strstr(said, "linewise: fidelity not measured (out of memory)\n") && strstr(said, "linewise: done: "),
+            "%s", said);
+  free(said);
+  cr_assert_eq(lw_test_sh("grep -q '\"fidelity\": null' %s", lw_test_path("out/summary.json")), 0);
+}
+
+/* A light picture's darkest is a light grey, which the levels' stretch makes
+** black (a pale sky drew at the darkest density): the note says so, and how
+** to keep it light; a picture with dark in it is stretched unremarked. */
+Test(image_cli, levels_that_turn_a_light_picture_dark_are_said)
+{
+  enum { W = 64, H = 48 };
+  float g[W * H];
+  for (int j = 0; j < H; j++)
+    for (int i = 0; i < W; i++) g[j * W + i] = (float)(0.5 + 0.5 * i / (W - 1)); /* 0.5 to 1: a pale sky */
+  lw_test_png(lw_test_path("light.png"), W, H, g, NULL);
+  write_scene("light.png");
+  char errs[4096];
+  cr_assert_eq(run("run scene.ini --out out --set scene.image_levels=0.01", errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "scene.image_levels: tones 0.") && strstr(errs, "stretched to 0 to 1 (its darkest, a light "
+            "grey, now draws as black: scene.image_levels = 0 keeps a light picture light)"), "%s", errs);
+  write_picture("dark.png", W, H);
+  write_scene("dark.png");
+  cr_assert_eq(run("run scene.ini --out out --set scene.image_levels=0.01", errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "stretched to 0 to 1") && !strstr(errs, "now draws as black"), "%s", errs);
+}
+
 Test(image_cli, a_large_picture_is_downsampled_with_a_note)
 {
   write_picture("big.png", 120, 100);

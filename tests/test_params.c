@@ -155,6 +155,9 @@ Test(params, bad_input_names_file_line_and_key)
   expect_error("[anneal]\nt_end = 1,000,000\n", ":2:", "anneal.t_end",
                "(a thousands separator? write 1000, not 1,000)");
   expect_error("[anneal]\nt_end = 1,000\n", ":2:", "anneal.t_end", "(a decimal comma? numbers take a point");
+  expect_error("[anneal]\nt_end = 1,000.5\n", ":2:", "anneal.t_end", "(a thousands separator? write 1000, not 1,000)");
+  expect_error("[anneal]\nt_end = 1.000,5\n", ":2:", "anneal.t_end", "(a thousands separator? write 1000, not 1.000)");
+  cr_assert_eq(read_text("[anneal]\nseed = 0.000\nsweeps = 1.0000\n", &q, &err), LW_OK, "%s", err.msg); /* 0 and 1 */
   cr_assert_eq(read_text("[anneal]\nsweeps = 1.0\nt_end = 0.002\n", &q, &err), LW_OK, "%s", err.msg);
   expect_error("[scene]\nboundary = hexagon\n", ":2:", "scene.boundary", "rect|circle|polygon");
   expect_error("[scene]\nwidth = 1\nwidth = 2\n", ":3:", "scene.width", "repeated");
@@ -163,13 +166,24 @@ Test(params, bad_input_names_file_line_and_key)
   /* a character that prints like a blank, or like nothing, is named */
   expect_error("[scene]\nwidth = 50\xc2\xa0\n", ":2:", "scene.width",
                "got '50\xc2\xa0' (byte 3 is a no-break space, U+00A0: delete it or type a plain space)");
+  /* in a key's name too, by its byte in the name the message quotes */
+  expect_error("[init]\n\xc2\xa0splines = 3\n", ":2:", "init.\xc2\xa0splines' is not a parameter; did you mean "
+               "'init.splines'?", "(byte 6 is a no-break space, U+00A0: delete it or type a plain space)");
+  cr_assert_eq(lw_params_set(&q, "init.spl\xc2\xa0ines=3", &err), LW_EUSAGE);
+  cr_assert(strstr(err.msg, "--set init.spl\xc2\xa0ines: not a parameter; did you mean 'init.splines'?") &&
+            strstr(err.msg, "(byte 9 is a no-break space, U+00A0"), "%s", err.msg);
   cr_assert_eq(lw_params_set(&q, "energy.pair=\xef\xbb\xbf" "1", &err), LW_EUSAGE);
   cr_assert(strstr(err.msg, "(byte 1 is a byte-order mark, U+FEFF"), "%s", err.msg);
   /* and a byte that is no text (no UTF-8, or a control character) by its number; a letter of UTF-8 is text */
-  const char *stray[3][2] = {{"bark\xff" "er", "(byte 5 is 0xFF, not a character of text: delete it)"},
-                             {"me\x01tropolis", "(byte 3 is 0x01, not a character of text"},
-                             {"m\xc3\xa9tropolis", NULL}};
-  for (int k = 0; k < 3; k++) {
+  /* and the look-alikes of a number's characters, by what to type instead */
+  const char *stray[][2] = {{"bark\xff" "er", "(byte 5 is 0xFF, not a character of text: delete it)"},
+                            {"me\x01tropolis", "(byte 3 is 0x01, not a character of text"},
+                            {"m\xc3\xa9tropolis", NULL},
+                            {"\xe2\x88\x92" "1", "(byte 1 is a minus sign, U+2212: type '-')"},
+                            {"1\xef\xbc\x90", "(byte 2 is a full-width '0', U+FF10: type '0')"},
+                            {"0\xef\xbc\x8e" "5", "(byte 2 is a full-width '.', U+FF0E: type '.')"},
+                            {"\xef\xbd\x9e", "(byte 1 is a full-width '~', U+FF5E: type '~')"}};
+  for (size_t k = 0; k < sizeof stray / sizeof stray[0]; k++) {
     char buf[96];
     lw_params_unseen_char(stray[k][0], buf, sizeof buf);
     cr_assert(stray[k][1] ? strstr(buf, stray[k][1]) != NULL : !buf[0], "%s: '%s'", stray[k][0], buf);

@@ -1090,9 +1090,11 @@ Test(tools, sweeps_and_plots_take_any_directory_name)
   check_png("v=2 {}/v=3.png");
 }
 
-/* A scene named like an option follows "--", as for linewise, and is said
-** a file where it is taken for an option; the tasks the sweep starts get it
-** too (they are started with --task after the sweep's words).  A newline
+/* The word after "--" is the scene whatever it is named, and a scene named
+** like an option is said a file where it is taken for one; options may
+** follow it, as the sweep's own tasks and the Slurm recipe append --task
+** (once every task failed), and after a scene named before it "--" is
+** nothing more (a wrapper's trailing one: every task failed).  A newline
 ** in the scene's path is refused before anything is made (it split
 ** sweep.conf's line, and every run failed).  The cores a sweep counts are
 ** the machine's, whatever OMP_NUM_THREADS says (nproc answers it: a
@@ -1109,6 +1111,13 @@ Test(tools, a_scene_named_like_an_option_follows_double_dash)
                   tool("seed-sweep"), env("LW_BIN")), 0, "%s", err_txt());
   cr_assert_eq(sh("cd %s && test -s sw/seed-1/summary.json && test -s sw/seed-2/summary.json && "
                   "test $(wc -l < sw/sweep.csv) -eq 3", dir), 0);
+  cr_assert_eq(sh("cd %s && %s --seeds 1-3 " TINY " --bin %s --out sw -- -m.ini --threads 1 --task 3 </dev/null", dir,
+                  tool("seed-sweep"), env("LW_BIN")), 0, "%s", err_txt());
+  cr_assert_eq(sh("cd %s && %s %s --seeds 1 " TINY " --bin %s --out tr -- </dev/null", dir, tool("seed-sweep"),
+                  scene(), env("LW_BIN")), 0, "%s", err_txt());
+  cr_assert_eq(sh("cd %s && test -s sw/seed-3/summary.json && test -s tr/seed-1/summary.json", dir), 0);
+  cr_assert_eq(sh("cd %s && %s --threads 1 --reps 1 " TINY " --bin %s -- -m.ini </dev/null", dir,
+                  tool("thread-scaling"), env("LW_BIN")), 0, "%s", err_txt());
   cr_assert_eq(sh("cd %s && %s --out sw.png -- sw/sweep.csv </dev/null", dir, tool("plot-sweep")), 0, "%s", err_txt());
   check_png("sw.png");
   cr_assert_eq(sh("cd %s && cp %s 'm\nx.ini' && %s 'm\nx.ini' --seeds 1 --out nl", dir, scene(),

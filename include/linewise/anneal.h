@@ -77,6 +77,8 @@ typedef struct lw_anneal {
   lw_block_stats prev;         /* energy statistics of the previous step */
   double acc_n, acc_sum, acc_sumsq; /* this step's energy samples (after tuning) */
   double max_drift;            /* largest relative drift seen at a check */
+  char observables_lost[512];  /* why summary.json's observables are null where rows were
+                               ** there to sum (out of memory reading the trace), or "" */
   double row_drift;            /* the same over the largest size since the check before, by
                                ** this process (lw_anneal_drift_note; not kept in state.lw) */
   double size_peak[LW_TEMPERING_MAX]; /* by replica: the largest sum of the terms' magnitudes
@@ -227,6 +229,10 @@ void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n);
 ** shipped rows drift by about 1e-14. */
 #define LW_ANNEAL_DRIFT_NOTE 1e-6
 void lw_anneal_drift_note(const lw_anneal *a, char *buf, size_t n);
+/* Into buf, "" or what a user is told where summary.json's observables are
+** null for want of memory (or a trace that could not be read): a study's
+** statistics were gone from a run that ended with exit 0 and nothing said. */
+void lw_anneal_observables_note(const lw_anneal *a, char *buf, size_t n);
 double lw_anneal_seconds(const lw_anneal *a);
 
 #ifdef __cplusplus

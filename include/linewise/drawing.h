@@ -35,7 +35,8 @@
 **                            another path: spacing.h)
 **     "fidelity": {"mse": ..., "ssim": ..., "orientation": ...,
 **                  "sigma_mm": ..., "pens": [{"mse", "ssim",
-**                  "orientation"}, ...]}   (with a target; pens if > 1)
+**                  "orientation"}, ...]}   (with a target; pens if > 1;
+**                                           null where memory ran out)
 */
 #ifndef LINEWISE_DRAWING_H
 #define LINEWISE_DRAWING_H
@@ -61,7 +62,8 @@ typedef struct {
   double crop_mm[4];                  /* x0 y0 x1 y1 */
   double pen_down_mm;                 /* ink length */
   double time_s;                      /* plot time estimate */
-  int has_fidelity;                   /* a target tone or a reference was given */
+  int has_fidelity;                   /* a target tone or a reference was given, and scored */
+  int fidelity_lost;                  /* one was given, and memory ran out scoring it (null) */
   char reference[LW_PATH_MAX];        /* output.fidelity_reference scored against, or empty */
   lw_fidelity fidelity;               /* of all pens */
   int n_pens;

@@ -145,6 +145,10 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
 ** LW_ENOMEM with err set. */
 #define LW_IMAGE_LEVELS_MIN_SPAN 0.05
 #define LW_IMAGE_LEVELS_PLATEAU 0.05
+/* A *lo from this tone up is a light picture's darkest (a pale sky's 0.45,
+** a white board's 0.68; a dim photograph's, the moon's, 0.23), which the
+** stretch turns black: the run's note says so, and how to keep it light. */
+#define LW_IMAGE_LEVELS_LIGHT 0.35
 lw_status lw_image_levels(lw_image *img, const float *under, double clip, int tail, double *lo, double *hi,
                           lw_error *err);
 

@@ -75,9 +75,10 @@ lw_status lw_text_not_fifo(const char *path, lw_error *err);
 
 /* What a number in a comma or a point locale's writing means to say, as a
 ** hint to add to a message (into hint, "" if none): digits grouped in
-** threes by '.' or ',' ("1.000", "10.000.000", "1,000,000") are a
-** thousands separator where a whole number is wanted (whole) or the groups
-** are more than one; a comma between digits otherwise is a decimal comma.
+** threes by '.' or ',' ("1.000", "10.000.000", "1,000,000", "1,000.5") are
+** a thousands separator where a whole number is wanted (whole), the groups
+** are more than one or a fraction follows them; a comma between digits
+** otherwise is a decimal comma.  A leading group of zeros ("0.000") is none.
 ** Returns 1 where s must be refused although it parses: "1.000" for a
 ** whole number, which read as one sweep, or seed 1. */
 int lw_number_separator_hint(const char *s, int whole, char *hint, size_t n);

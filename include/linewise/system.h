@@ -130,9 +130,10 @@ struct lw_system_type {
   ** memory is refused before its placement (anneal.c); 0 where unknown (a
   ** state read from a file).  In *peak the run's expected peak, its
   ** drawing's (a measured fit, with room), that a run past it is told
-  ** before it anneals for hours; 0 where unknown. */
+  ** before it anneals for hours, and in *replica what each further
+  ** replica adds to it (the same); 0 where unknown. */
   double (*start_bytes)(const void *setup, const lw_params *p, char *what, size_t n, const char **key,
-                        double *peak);
+                        double *peak, double *replica);
 
   /* The initial state of a run: placed from `seed` (a stream of its own) or
   ** read from the file the parameters name; copies for the replicas. */
