@@ -1828,8 +1828,9 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
     char hint[96], unseen[96], name[sizeof section + sizeof key];
     snprintf(name, sizeof name, "%s.%s", section, key);
     suggest_key(section, key, hint, sizeof hint);
-    return lw_error_set(err, LW_EUSAGE, "--set %s.%s: not a parameter%s (see `linewise params` or docs/PARAMETERS.md)%s",
-                        section, key, hint, lw_params_unseen_char(name, unseen, sizeof unseen));
+    return lw_error_set(err, LW_EUSAGE,
+                        "--set %s.%s: not a parameter%s (see `linewise params` or docs/PARAMETERS.md)%s", section, key,
+                        hint, lw_params_unseen_char(name, unseen, sizeof unseen));
   }
   char expected[256], unseen[96];
   if (!assign(p, d, eq + 1, expected, sizeof expected))
