@@ -639,6 +639,28 @@ Test(run, a_running_energy_that_does_not_add_up_is_said)
   }
 }
 
+/* The adaptive rule's step is the one the block's energies ask for: each
+** block's sample standard deviation (n - 1) of the total, recomputed from a
+** trace of every sweep (no tuning sweeps, which the rule leaves out), gives
+** the next block's temperature T exp(-lambda T / sd) to the trace's ten
+** digits (1e-8; the rule's own tests took the block's statistics as given,
+** and an sd over n, 9 % colder steps, went by). */
+Test(run, the_adaptive_rule_steps_by_each_blocks_own_spread)
+{
+  const char *b = getenv("LW_BIN");
+  char path[128];
+  write_scene("", path, sizeof path);
+  cr_assert_eq(sh("%s run %s --out %s/a --quiet --set output.trace_every=1 --set moves.tune_sweeps=0 --set "
+                  "anneal.t_end=0.0001", b, path, dir), 0);
+  cr_assert_eq(sh("awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == \"total\") c = i; next } "
+                  "{ k = int(($1 - 1) / 20); if (k != cur && n) { sd[cur] = sqrt((q - s * s / n) / (n - 1)); "
+                  "n = s = q = 0 } cur = k; n++; s += $c; q += $c * $c; t[k] = $2 } "
+                  "END { for (k = 0; k < 5; k++) { w = t[k] * exp(-0.7 * t[k] / sd[k]); if (w < 0.0001) w = 0.0001; "
+                  "r = t[k + 1] / w - 1; if (!(r < 1e-8 && r > -1e-8)) { print k, t[k + 1], w; bad++ } } "
+                  "exit !(c && bad == 0) }' %s/a/trace.csv > %s/bad.txt", dir, dir), 0, "%s",
+               lw_test_slurp("%s/bad.txt", dir));
+}
+
 /* With more steps than sweeps some steps have no sweep; each still takes its
 ** turn of the adaptive rule, unmeasured (the geometric ratio): the rule
 ** cooled one ratio per sweep instead, and ended 12 times above the step it

@@ -206,13 +206,12 @@ static const lw_system_type gauss_type = {
     .files = "", .draw = gs_draw, .summary = gs_summary, .describe = gs_describe,
 };
 
-/* A system of the gauss row and a chain on it at temperature T. */
-static lw_chain *gauss_chain(double T, unsigned long seed)
+/* A system of row t and a chain on it at temperature T. */
+static lw_chain *row_chain(const lw_system_type *t, double T, unsigned long seed)
 {
   lw_params p;
   lw_params_defaults(&p);
   lw_error err;
-  const lw_system_type *t = &gauss_type;
   void *setup = t->setup_new(&p, &err);
   lw_system *sys = lw_system_wrap(t, t->state_new(setup, &p, 0, &err), &err);
   cr_assert_not_null(sys);
@@ -223,6 +222,8 @@ static lw_chain *gauss_chain(double T, unsigned long seed)
   c->temperature = T;
   return c;
 }
+
+static lw_chain *gauss_chain(double T, unsigned long seed) { return row_chain(&gauss_type, T, seed); }
 
 static void gauss_chain_free(lw_chain *c)
 {
@@ -263,6 +264,44 @@ static void sample_gaussian(lw_chain *c, double T, batch_mean *m1, batch_mean *m
       bm_add(&m2[i], z * z);
     }
   }
+}
+
+/* The test row with every move's dE exactly 0, as where a pair term's
+** cutoff leaves a moved part no partner. */
+static double flat_propose(void *state, void *prop, int kind, double step, gsl_rng *rng, int *forbidden)
+{
+  gs_propose(state, prop, kind, step, rng, forbidden);
+  gs_prop *p = prop;
+  p->dterm[0] = p->dterm[1] = 0.0;
+  return 0.0;
+}
+
+/* A move of no energy change is taken, at T = 0 too (the greedy descent
+** moves along a level: docs/NUMERICS.md, "Acceptance"), and at T > 0
+** without a random draw (Metropolis draws none where x >= 0), so a hot and
+** a cold chain of one seed walk the same steps.  A rule of dE < 0 rejected
+** them at T = 0 and drew for each at T > 0 (a mutant the suites let by). */
+Test(system, a_move_of_no_energy_change_is_taken_without_a_draw)
+{
+  static lw_system_type flat;
+  flat = gauss_type;
+  flat.name = "flat";
+  flat.propose = flat_propose;
+  lw_chain *hot = row_chain(&flat, 0.7, 5), *cold = row_chain(&flat, 0.0, 5);
+  for (int s = 0; s < 200; s++) {
+    cr_assert_eq(lw_chain_sweep(hot), LW_OK);
+    cr_assert_eq(lw_chain_sweep(cold), LW_OK);
+  }
+  for (int k = 0; k < 2; k++) {
+    cr_assert(cold->stats[k].proposed > 0 && cold->stats[k].accepted == cold->stats[k].proposed, "kind %d: %lu of %lu",
+              k, cold->stats[k].accepted, cold->stats[k].proposed);
+    cr_assert_eq(hot->stats[k].accepted, hot->stats[k].proposed, "kind %d", k);
+  }
+  const gs_state *h = hot->sys->state, *c = cold->sys->state;
+  cr_assert(!memcmp(h->x, c->x, sizeof h->x), "the hot chain drew for its decisions: (%g %g %g) against (%g %g %g)",
+            h->x[0], h->x[1], h->x[2], c->x[0], c->x[1], c->x[2]);
+  gauss_chain_free(hot);
+  gauss_chain_free(cold);
 }
 
 Test(system, the_chain_samples_a_test_row_exactly)
