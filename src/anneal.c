@@ -10,6 +10,7 @@
 #include <float.h>
 #include <gsl/gsl_math.h>
 #include <stdarg.h>
+#include <malloc.h>
 #include <math.h>
 #include <stddef.h>
 #include <omp.h>
@@ -171,8 +172,8 @@ void lw_anneal_observables_note(const lw_anneal *a, char *buf, size_t n)
   char word[LW_RUNDIR_WORD_MAX];
   buf[0] = '\0';
   if (a->observables_lost[0])
-    snprintf(buf, n, "summary.json's observables are null: %s ('linewise stats %s' gives them where the memory "
-             "allows)", a->observables_lost, lw_rundir_shell_word(a->dir, word, sizeof word));
+    snprintf(buf, n, "summary.json's observables are null: %s ('linewise stats %s' computes them from trace.csv, "
+             "given the memory)", a->observables_lost, lw_rundir_shell_word(a->dir, word, sizeof word));
 }
 
 /* Temperature step of sweep s: the sweeps are shared out evenly; past the
@@ -268,7 +269,7 @@ static lw_status setup_schedule(lw_anneal *a, lw_error *err)
   char unseen[96];
   if (!a->sched_type)
     return lw_error_set(err, LW_EINPUT, "%s: key 'anneal.schedule': expected one of %s, got '%s'%s", where,
-                        lw_schedule_names(), p->schedule, lw_params_unseen_char(p->schedule, unseen, sizeof unseen));
+                        lw_schedule_names(), p->schedule, lw_text_unseen_char(p->schedule, unseen, sizeof unseen));
   a->sched.t_start = p->t_start;
   a->sched.t_end = p->t_end;
   a->sched.blocks = p->steps;
@@ -420,7 +421,7 @@ static int parse_ladder(const lw_params *p, const char *text, const char *where,
     while (cut < len && cut > 0 && ((unsigned char)w[cut] & 0xC0) == 0x80) cut--;
     return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': '%.*s%s' is not a temperature; expected finite "
                         "numbers such as 0.5 or 2e-3%s", where, (int)cut, w, cut < len ? "..." : "",
-                        lw_params_unseen_char(whole, unseen, sizeof unseen)), 0;
+                        lw_text_unseen_char(whole, unseen, sizeof unseen)), 0;
   }
   if (n < 2 || n > LW_TEMPERING_MAX)
     return lw_error_set(err, LW_EINPUT, "%s: key 'tempering.ladder': expected 2 to %d temperatures, got '%.120s%s'%s",
@@ -751,33 +752,72 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
   if (m >= size && size > 4) strcpy(idle + size - 4, "..."); /* cut: said so */
 }
 
+/* The run's expected peak against its limit (a->mem), said in memory_note
+** where past it: told, not refused (a fit with room, not a bound).  The
+** drawing's, the close share's points above all: the run annealed for hours,
+** then lost its close share or its preview. */
+static void memory_note(lw_anneal *a)
+{
+  const double peak = a->mem.peak + a->mem.replica * (a->mem.here - 1);
+  char reps[48] = "";
+  if (a->mem.here > 1) snprintf(reps, sizeof reps, " in %d replicas", a->mem.here);
+  a->memory_note[0] = '\0';
+  if (a->mem.peak > 0.0 && peak > a->mem.limit)
+    snprintf(a->memory_note, sizeof a->memory_note, "%s%s may take up to about %.3g GB at the drawing, more than "
+             "the %.3g GB of %s: short of it the drawing leaves out its scores (summary.json's close_share and "
+             "fidelity null) or fails (its state kept, to resume with more memory); fewer splines%s or a wider "
+             "output.pen_width take less (docs/PERFORMANCE.md, \"Memory\")", a->mem.what, reps, peak / 1e9,
+             a->mem.limit / 1e9, a->mem.by, a->mem.here > 1 ? " or replicas" : "");
+}
+
+/* The heap's bytes in use, or -1 where the C library does not say. */
+static double heap_bytes(void)
+{
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || __GLIBC_MINOR__ >= 33)
+  const struct mallinfo2 mi = mallinfo2();
+  return (double)mi.uordblks + (double)mi.hblkhd;
+#else
+  return -1.0;
+#endif
+}
+
+/* The further replicas measured as they were made, from `before` (the
+** first state made) to now (every replica built, its chain and domains
+** too): each one's share of the heap's growth, with the fit's room, counts
+** in the note where it is more than the row's estimate (1.8 MB each of a
+** picture scene's 50 splines, their pair grids, rasters and 25 domains,
+** where 970 bytes a segment counted 0.24). */
+static void replicas_measured(lw_anneal *a, double before)
+{
+  const double after = heap_bytes();
+  if (a->n_rep < 2 || before < 0.0 || after < before) return;
+  const double each = 1.3 * (after - before) / (a->n_rep - 1);
+  if (!(each > a->mem.replica)) return;
+  a->mem.replica = each;
+  memory_note(a);
+}
+
 /* A start whose replicas here would not fit the memory this process may use
 ** is refused before its placement, naming the key that sets its size. */
 static lw_status fits_memory(lw_anneal *a, lw_error *err)
 {
   const lw_system_type *t = a->sys_type;
-  char what[160] = "";
-  const char *key = NULL, *by;
-  double peak = 0.0, replica = 0.0;
-  const double one =
-      t->start_bytes ? t->start_bytes(a->setup, &a->params, what, sizeof what, &key, &peak, &replica) : 0.0;
+  const char *key = NULL;
+  a->mem.peak = a->mem.replica = 0.0;
+  a->mem.what[0] = '\0';
+  const double one = t->start_bytes ? t->start_bytes(a->setup, &a->params, a->mem.what, sizeof a->mem.what, &key,
+                                                     &a->mem.peak, &a->mem.replica) : 0.0;
   int here = 0;
   for (int r = 0; r < a->n_rep; r++) here += rung_here(a, r);
-  const double limit = lw_memory_limit(&by), bytes = one * here;
+  a->mem.here = here;
+  a->mem.limit = lw_memory_limit(&a->mem.by);
+  const double limit = a->mem.limit, bytes = one * here;
   char reps[48] = "";
   if (here > 1) snprintf(reps, sizeof reps, " in %d replicas", here);
-  /* past the peak (the drawing's, the close share's points above all: the
-  ** run annealed for hours, then lost its close share or its preview) told,
-  ** not refused: a fit with room, not a bound */
-  if (!(bytes > limit) && peak > 0.0 && peak + replica * (here - 1) > limit)
-    snprintf(a->memory_note, sizeof a->memory_note, "%s%s may take up to about %.3g GB at the drawing, more than "
-             "the %.3g GB of %s: short of it the drawing leaves out its scores (summary.json's close_share and "
-             "fidelity null) or fails (its state kept, to resume with more memory); fewer splines%s or a wider "
-             "output.pen_width take less (docs/PERFORMANCE.md, \"Memory\")", what, here > 1 ? reps : "",
-             (peak + replica * (here - 1)) / 1e9, limit / 1e9, by, here > 1 ? " or replicas" : "");
+  if (!(bytes > limit)) memory_note(a);
   if (!(bytes > limit) || !key) return LW_OK;
   lw_error_set(err, LW_EINPUT, "%s take at least %.3g GB%s, more than the %.3g GB of %s: expected a smaller %s",
-               what, bytes / 1e9, reps, limit / 1e9, by, key);
+               a->mem.what, bytes / 1e9, reps, limit / 1e9, a->mem.by, key);
   const char *dot = strchr(key, '.');
   char section[32];
   snprintf(section, sizeof section, "%.*s", dot ? (int)(dot - key) : 0, key);
@@ -1032,7 +1072,8 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   void *all[LW_TEMPERING_MAX] = {t->state_new(a->setup, &a->params, stream_seed(a, 0), err)};
   if (!all[0]) return err->code;
   /* every replica starts from the same state; their streams part them */
-  for (int r = 1; r < a->n_rep; r++)
+  const double heap = heap_bytes();
+  for (int r = 1; r < a->n_rep; r++) {
     if (!(all[r] = t->state_copy(all[0], err))) {
       for (int q = 0; q < r; q++) t->state_free(all[q]);
       /* the replicas are what is too many, more than the scene */
@@ -1044,7 +1085,9 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
       }
       return err->code;
     }
+  }
   if ((s = build(a, all, ladder, err)) || (s = check_quench(a, err))) return s;
+  replicas_measured(a, heap);
   a->totals_fresh = 1;
   /* where the photo preset's count of domains gave way to a move's reach (a
   ** picture of a few pixels: domains.c), scene.ini, which a resume reads as
@@ -1425,13 +1468,18 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
     goto out;
   a->seed = st.seed;
   a->sweep = st.sweep;
-  for (int k = 0; k < a->n_rep && !s; k++) s = rung_state(a, &st, k, &all[k], &rep[k], err);
+  double heap = -1.0;
+  for (int k = 0; k < a->n_rep && !s; k++) {
+    s = rung_state(a, &st, k, &all[k], &rep[k], err);
+    if (k == 0) heap = heap_bytes();
+  }
   if (s) {
     for (int k = 0; k < a->n_rep; k++)
       if (all[k]) a->sys_type->state_free(all[k]);
     goto out;
   }
   if ((s = build(a, all, ladder, err)) || (s = check_quench(a, err))) goto out;
+  replicas_measured(a, heap);
   if (st.version == 1 && (s = lw_checkpoint_upgrade_v1(st.doc, rep, a->n_rep, err))) goto out;
   if ((s = lw_checkpoint_restore(a, st.doc, &trace_bytes, err))) goto out;
   if (!a->dyn && a->block != (a->sweep ? block_of(a, a->sweep - 1) : -1)) {

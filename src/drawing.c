@@ -484,6 +484,17 @@ static void clock_text(double s, char *buf, size_t n)
   else snprintf(buf, n, "%ld:%02ld", m, sec);
 }
 
+void lw_drawing_lost_text(const lw_drawing_report *d, char *buf, size_t n)
+{
+  const int close = isnan(d->close_share), fid = d->fidelity_lost;
+  if (!n) return;
+  buf[0] = '\0';
+  if (close || fid)
+    snprintf(buf, n, "memory ran out scoring the drawing: summary.json's %s null (a redraw where there is more "
+             "memory scores it: docs/FORMATS.md, \"Redrawing a finished run\")",
+             close && fid ? "close_share and fidelity are" : close ? "close_share is" : "fidelity is");
+}
+
 void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
 {
   const lw_strokes_report *r = &d->post;
@@ -519,7 +530,6 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
                  d->pen_name[p][0] ? " " : "", d->pen_name[p]);
     if (w < 0 || (k += (size_t)w) >= n) return;
   }
-  if (d->fidelity_lost) snprintf(buf + k, n - k, "linewise: fidelity not measured (out of memory)\n");
   if (!d->has_fidelity) return;
   char o[40];
   w = snprintf(buf + k, n - k,

@@ -5,6 +5,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "linewise/number.h"
+
 /* What a run reads under any driver: its length, seed, quench and outputs. */
 #define RUN_KEYS "scene.system", "scene.driver", "anneal.sweeps", "anneal.seed", "anneal.seed_version", \
     "anneal.quench", "anneal.quench_tol", "anneal.quench_iterations", "anneal.quench_stall", \
@@ -55,7 +57,7 @@ const lw_driver_type *lw_driver_of(const lw_params *p, lw_error *err)
     char where[LW_PATH_MAX + 32], unseen[96];
     lw_params_origin(p, lw_params_find("scene", "driver"), where, sizeof where);
     lw_error_set(err, LW_EINPUT, "%s: key 'scene.driver': expected one of %s, got '%s'%s", where, lw_driver_names(),
-                 p->driver, lw_params_unseen_char(p->driver, unseen, sizeof unseen));
+                 p->driver, lw_text_unseen_char(p->driver, unseen, sizeof unseen));
   }
   return t;
 }

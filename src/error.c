@@ -15,9 +15,19 @@ lw_status lw_error_set(lw_error *err, lw_status code, const char *fmt, ...)
     vsnprintf(err->msg, sizeof err->msg, fmt, ap);
     va_end(ap);
     /* a message quotes input, which may be binary: no control character
-    ** reaches the terminal, and the message stays one line */
-    for (char *c = err->msg; *c; c++)
-      if ((unsigned char)*c < 0x20 || *c == 0x7f) *c = '?';
+    ** reaches the terminal, and the message stays one line; nor does a C1
+    ** control of UTF-8 (U+0085 ends a line too) or a bidi override (U+202E
+    ** shows the rest of a file's name reversed), each one '?' */
+    unsigned char *to = (unsigned char *)err->msg;
+    for (const unsigned char *c = to; *c; c++) {
+      const int c1 = c[0] == 0xc2 && c[1] >= 0x80 && c[1] <= 0x9f;
+      const int bidi = c[0] == 0xe2 && ((c[1] == 0x80 && c[2] >= 0xaa && c[2] <= 0xae) ||
+                                        (c[1] == 0x81 && c[2] >= 0xa6 && c[2] <= 0xa9));
+      if (*c < 0x20 || *c == 0x7f || c1 || bidi) *to++ = '?';
+      else *to++ = *c;
+      c += c1 ? 1 : bidi ? 2 : 0;
+    }
+    *to = '\0';
     err->code = code;
   }
   return code;

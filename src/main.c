@@ -887,6 +887,8 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     if (warning[0]) fprintf(stderr, "linewise: warning: %s\n", warning);
     lw_anneal_observables_note(a, warning, sizeof warning);
     if (warning[0]) fprintf(stderr, "linewise: warning: %s\n", warning);
+    a->sys_type->describe(a->sys->state, LW_DESCRIBE_LOST, warning, sizeof warning);
+    if (warning[0]) fprintf(stderr, "linewise: warning: %s\n", warning);
   }
   if (!quiet) {
     if (a->quenched)
@@ -923,8 +925,9 @@ static int takes_value(const char *arg)
 static int parse_count(const char *opt, const char *v, double lo, double max, long *out, lw_error *err)
 {
   long long n;
-  char hint[64] = "";
+  char hint[96] = "";
   if (!v || lw_number_separator_hint(v, 1, hint, sizeof hint) || !lw_number_parse_whole(v, lo, max, &n)) {
+    if (v && !hint[0]) lw_text_unseen_char(v, hint, sizeof hint); /* a minus sign U+2212, a full-width digit */
     lw_error_set(err, LW_EUSAGE, "%s: expected a whole number from %.0f to %.0f, got '%s'%s", opt, lo, max, v ? v : "",
                  hint);
     return 0;

@@ -161,6 +161,57 @@ ssize_t lw_text_getline(char **buf, size_t *cap, FILE *f)
   return (ssize_t)len;
 }
 
+/* A no-break space that a word processor put after "50" showed as "got
+** '50 '", and ordinary trailing blanks are accepted, so the message names it. */
+const char *lw_text_unseen_char(const char *value, char *buf, size_t n)
+{
+  static const struct { const char *utf8, *name; unsigned code; } unseen[] = {
+    {"\xc2\xa0", "a no-break space", 0xa0},         {"\xe2\x80\xaf", "a narrow no-break space", 0x202f},
+    {"\xe2\x80\x89", "a thin space", 0x2009},       {"\xe3\x80\x80", "an ideographic space", 0x3000},
+    {"\xe2\x80\x8b", "a zero-width space", 0x200b}, {"\xef\xbb\xbf", "a byte-order mark", 0xfeff},
+    {"\xe2\x81\xa0", "a word joiner", 0x2060},    {"\xe2\x80\x82", "an en space", 0x2002},
+    {"\xe2\x80\x83", "an em space", 0x2003},       {"\xe2\x80\x87", "a figure space", 0x2007},
+  };
+  buf[0] = '\0';
+  for (const char *c = value; *c; c++)
+    for (size_t k = 0; k < sizeof unseen / sizeof unseen[0]; k++)
+      if (!strncmp(c, unseen[k].utf8, strlen(unseen[k].utf8))) {
+        snprintf(buf, n, " (byte %zu is %s, U+%04X: delete it or type a plain space)", (size_t)(c - value) + 1,
+                 unseen[k].name, unseen[k].code);
+        return buf;
+      }
+  /* look-alikes of what a number is written with: a word processor's minus
+  ** sign, and the full-width forms of an East Asian input method ("２０") */
+  for (const unsigned char *c = (const unsigned char *)value; *c; c++) {
+    const size_t at = (size_t)(c - (const unsigned char *)value) + 1;
+    if (c[0] == 0xe2 && c[1] == 0x88 && c[2] == 0x92) {
+      snprintf(buf, n, " (byte %zu is a minus sign, U+2212: type '-')", at);
+      return buf;
+    }
+    if (c[0] == 0xef && ((c[1] == 0xbc && c[2] >= 0x81 && c[2] <= 0xbf) || (c[1] == 0xbd && c[2] >= 0x80 &&
+                                                                            c[2] <= 0x9e))) {
+      const unsigned code = 0xf000u | (c[1] & 0x3fu) << 6 | (c[2] & 0x3fu);
+      snprintf(buf, n, " (byte %zu is a full-width '%c', U+%04X: type '%c')", at, (char)(code - 0xfee0),
+               code, (char)(code - 0xfee0));
+      return buf;
+    }
+  }
+  /* a control character or a byte that is no UTF-8 (0xFF, a Latin-1 letter)
+  ** shows as nothing or as garbage in the message: its number, then */
+  for (size_t i = 0; value[i];) {
+    const unsigned char b = (unsigned char)value[i];
+    size_t len = b < 0x80 ? 1 : (b & 0xe0) == 0xc0 ? 2 : (b & 0xf0) == 0xe0 ? 3 : (b & 0xf8) == 0xf0 ? 4 : 0;
+    int bad = !len || (b < 0x20 && b != '\t') || b == 0x7f;
+    for (size_t k = 1; k < len && !bad; k++) bad = ((unsigned char)value[i + k] & 0xc0) != 0x80;
+    if (bad) {
+      snprintf(buf, n, " (byte %zu is 0x%02X, not a character of text: delete it)", i + 1, b);
+      return buf;
+    }
+    i += len;
+  }
+  return buf;
+}
+
 lw_status lw_text_not_fifo(const char *path, lw_error *err)
 {
   struct stat sb;

@@ -1154,57 +1154,6 @@ int lw_params_named(const char *const *patterns, const lw_param_def *d)
 
 static void value_text(const lw_params *p, const lw_param_def *d, char *buf, size_t n);
 
-/* A no-break space that a word processor put after "50" showed as "got
-** '50 '", and ordinary trailing blanks are accepted, so the message names it. */
-const char *lw_params_unseen_char(const char *value, char *buf, size_t n)
-{
-  static const struct { const char *utf8, *name; unsigned code; } unseen[] = {
-    {"\xc2\xa0", "a no-break space", 0xa0},         {"\xe2\x80\xaf", "a narrow no-break space", 0x202f},
-    {"\xe2\x80\x89", "a thin space", 0x2009},       {"\xe3\x80\x80", "an ideographic space", 0x3000},
-    {"\xe2\x80\x8b", "a zero-width space", 0x200b}, {"\xef\xbb\xbf", "a byte-order mark", 0xfeff},
-    {"\xe2\x81\xa0", "a word joiner", 0x2060},    {"\xe2\x80\x82", "an en space", 0x2002},
-    {"\xe2\x80\x83", "an em space", 0x2003},       {"\xe2\x80\x87", "a figure space", 0x2007},
-  };
-  buf[0] = '\0';
-  for (const char *c = value; *c; c++)
-    for (size_t k = 0; k < sizeof unseen / sizeof unseen[0]; k++)
-      if (!strncmp(c, unseen[k].utf8, strlen(unseen[k].utf8))) {
-        snprintf(buf, n, " (byte %zu is %s, U+%04X: delete it or type a plain space)", (size_t)(c - value) + 1,
-                 unseen[k].name, unseen[k].code);
-        return buf;
-      }
-  /* look-alikes of what a number is written with: a word processor's minus
-  ** sign, and the full-width forms of an East Asian input method ("２０") */
-  for (const unsigned char *c = (const unsigned char *)value; *c; c++) {
-    const size_t at = (size_t)(c - (const unsigned char *)value) + 1;
-    if (c[0] == 0xe2 && c[1] == 0x88 && c[2] == 0x92) {
-      snprintf(buf, n, " (byte %zu is a minus sign, U+2212: type '-')", at);
-      return buf;
-    }
-    if (c[0] == 0xef && ((c[1] == 0xbc && c[2] >= 0x81 && c[2] <= 0xbf) || (c[1] == 0xbd && c[2] >= 0x80 &&
-                                                                            c[2] <= 0x9e))) {
-      const unsigned code = 0xf000u | (c[1] & 0x3fu) << 6 | (c[2] & 0x3fu);
-      snprintf(buf, n, " (byte %zu is a full-width '%c', U+%04X: type '%c')", at, (char)(code - 0xfee0),
-               code, (char)(code - 0xfee0));
-      return buf;
-    }
-  }
-  /* a control character or a byte that is no UTF-8 (0xFF, a Latin-1 letter)
-  ** shows as nothing or as garbage in the message: its number, then */
-  for (size_t i = 0; value[i];) {
-    const unsigned char b = (unsigned char)value[i];
-    size_t len = b < 0x80 ? 1 : (b & 0xe0) == 0xc0 ? 2 : (b & 0xf0) == 0xe0 ? 3 : (b & 0xf8) == 0xf0 ? 4 : 0;
-    int bad = !len || (b < 0x20 && b != '\t') || b == 0x7f;
-    for (size_t k = 1; k < len && !bad; k++) bad = ((unsigned char)value[i + k] & 0xc0) != 0x80;
-    if (bad) {
-      snprintf(buf, n, " (byte %zu is 0x%02X, not a character of text: delete it)", i + 1, b);
-      return buf;
-    }
-    i += len;
-  }
-  return buf;
-}
-
 lw_status lw_params_blame(const lw_params *p, const char *section, const char *key, lw_error *err)
 {
   char where[LW_PATH_MAX + 32], msg[LW_ERROR_MSG];
@@ -1218,7 +1167,7 @@ lw_status lw_params_blame(const lw_params *p, const char *section, const char *k
   const lw_param_def *d = lw_params_find(section, key);
   struct stat sb;
   if (d) value_text(p, d, value, sizeof value);
-  lw_params_unseen_char(value, unseen, sizeof unseen);
+  lw_text_unseen_char(value, unseen, sizeof unseen);
   return lw_error_set(err, err->code, "%s: key '%s.%s': %s%s", where, section, key, msg,
                       strstr(msg, "U+") || (value[0] && !stat(value, &sb)) ? "" : unseen);
 }
@@ -1401,7 +1350,7 @@ static int on_key(void *user, const char *section, const char *key, const char *
     suggest_key(section, key, hint, sizeof hint);
     lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s' is not a parameter%s (see `linewise params` or "
                  "docs/PARAMETERS.md)%s",
-                 rc->p->file, rc->line, section, key, hint, lw_params_unseen_char(name, unseen, sizeof unseen));
+                 rc->p->file, rc->line, section, key, hint, lw_text_unseen_char(name, unseen, sizeof unseen));
     return 0;
   }
   int *line = &rc->p->line[d - lw_param_table];
@@ -1414,7 +1363,7 @@ static int on_key(void *user, const char *section, const char *key, const char *
   if (!assign(rc->p, d, value, expected, sizeof expected)) {
     lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s': expected %s, got '%s'%s",
                  rc->p->file, rc->line, section, key, expected, value,
-                 lw_params_unseen_char(value, unseen, sizeof unseen));
+                 lw_text_unseen_char(value, unseen, sizeof unseen));
     return 0;
   }
   *line = rc->line;
@@ -1830,12 +1779,12 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
     suggest_key(section, key, hint, sizeof hint);
     return lw_error_set(err, LW_EUSAGE,
                         "--set %s.%s: not a parameter%s (see `linewise params` or docs/PARAMETERS.md)%s", section, key,
-                        hint, lw_params_unseen_char(name, unseen, sizeof unseen));
+                        hint, lw_text_unseen_char(name, unseen, sizeof unseen));
   }
   char expected[256], unseen[96];
   if (!assign(p, d, eq + 1, expected, sizeof expected))
     return lw_error_set(err, LW_EUSAGE, "--set: key '%s.%s': expected %s, got '%s'%s", section, key,
-                        expected, eq + 1, lw_params_unseen_char(eq + 1, unseen, sizeof unseen));
+                        expected, eq + 1, lw_text_unseen_char(eq + 1, unseen, sizeof unseen));
   p->line[d - lw_param_table] = -1;
   return LW_OK;
 }

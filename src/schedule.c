@@ -290,15 +290,17 @@ lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err
     int ntok = split(line, tok);
     if (ntok == 0) continue;
     double bv, tv;
+    char hint[96];
     if (ntok != 2) {
-      status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected 'step temperature', got '%s'", path, lineno, shown);
+      status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected 'step temperature', got '%s'%s", path, lineno, shown,
+                            lw_text_unseen_char(shown, hint, sizeof hint));
       break;
     }
     /* Whole numbers only, up to 2^53 where doubles still count every block;
     ** "1.000" is a thousand in a comma locale, not step 1 */
-    char hint[64];
     if (lw_number_separator_hint(tok[0], 1, hint, sizeof hint) || !parse_number(tok[0], &bv) || bv < 0 ||
         bv != floor(bv) || bv > 9007199254740992.0) {
+      if (!hint[0]) lw_text_unseen_char(tok[0], hint, sizeof hint);
       status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected a step number (a whole number >= 0), got '%.40s'%s",
                             path, lineno, tok[0], hint);
       break;
@@ -313,6 +315,7 @@ lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err
     /* (the bounds of anneal.t_start and t_end: a row of 1e308 passed them) */
     if (!parse_number(tok[1], &tv) || tv < 0 || tv > 1e300) {
       lw_number_separator_hint(tok[1], 0, hint, sizeof hint);
+      if (!hint[0]) lw_text_unseen_char(tok[1], hint, sizeof hint);
       status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected a temperature from 0 to 1e300, got '%.40s'%s",
                             path, lineno, tok[1], hint);
       break;

@@ -1154,7 +1154,9 @@ static void describe(const void *state, int what, char *buf, size_t n)
              s->s ? ", free weights" : "");
   else if (what == LW_DESCRIBE_FORBIDDEN)
     snprintf(buf, n, "an energy that is not finite");
-  else
+  else if (what == LW_DESCRIBE_LOST) {
+    if (n) buf[0] = '\0';
+  } else
     /* (weights 1e8 apart drew 0.29 from a curve of size 1, and only this
     ** number said so) */
     snprintf(buf, n, "linewise: final.svg: %zu cubic Beziers, at most %.3g from the curve%s%s\n", s->beziers,

@@ -1355,6 +1355,7 @@ static void describe(const void *state, int what, char *buf, size_t n)
   const lw_drawing_report *d = &s->drawing;
   if (what == LW_DESCRIBE_SIZE) snprintf(buf, n, "%zu splines, %zu segments", sp->n_splines, sp->n_segments);
   else if (what == LW_DESCRIBE_FORBIDDEN) snprintf(buf, n, "a segment irregular or outside the boundary");
+  else if (what == LW_DESCRIBE_LOST) lw_drawing_lost_text(d, buf, n);
   else lw_drawing_report_text(d, buf, n);
 }
 

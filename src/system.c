@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "linewise/number.h"
 #include "linewise/sys_nurbs.h"
 #include "linewise/sys_particles.h"
 #include "linewise/sys_splines.h"
@@ -43,7 +44,7 @@ const lw_system_type *lw_system_of(const lw_params *p, lw_error *err)
     char where[LW_PATH_MAX + 32], unseen[96];
     lw_params_origin(p, lw_params_find("scene", "system"), where, sizeof where);
     lw_error_set(err, LW_EINPUT, "%s: key 'scene.system': expected one of %s, got '%s'%s", where, lw_system_names(),
-                 p->system, lw_params_unseen_char(p->system, unseen, sizeof unseen));
+                 p->system, lw_text_unseen_char(p->system, unseen, sizeof unseen));
   }
   if (t && t->variant) t = t->variant(p);
   return t && lw_system_row_fits(t, err) ? t : NULL;

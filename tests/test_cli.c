@@ -1667,6 +1667,7 @@ Test(cli, usage_errors_exit_2_in_one_line_and_write_nothing)
       {"run M --seed 1.000", "got '1.000' (a thousands separator? write 1000, not 1.000)"},
       {"run M --threads 1.000", "--threads: expected a whole number from 1 to 4096, got '1.000' (a thousands"},
       {"run M --seed 1,5", "got '1,5' (a decimal comma? numbers take a point"},
+      {"run M --seed \xe2\x88\x92" "1", "got '\xe2\x88\x92" "1' (byte 1 is a minus sign, U+2212: type '-')"},
       {"run M --set anneal.sweeps=10.000.000", "(a thousands separator? write 1000, not 1.000), got '10.000.000'"},
       {"resume r --sweeps 10.000", "--sweeps: expected a whole number from 0 to 1000000000000000, got '10.000' (a"},
       {"stats r --reweight 2.000", "--reweight: expected a whole number from 2 to 10000, got '2.000' (a thousands"},
@@ -1719,7 +1720,7 @@ Test(cli, observables_lost_for_want_of_memory_are_said)
                           lw_test_bin(), lw_test_root()), 0);
   char *msg = lw_test_slurp("%s/err.txt", dir);
   cr_assert(strstr(msg, "linewise: warning: summary.json's observables are null: ") && strstr(msg, "out of memory") &&
-            strstr(msg, "('linewise stats o' gives them where the memory allows)\n"), "%s", msg);
+            strstr(msg, "('linewise stats o' computes them from trace.csv, given the memory)\n"), "%s", msg);
   free(msg);
   cr_assert_eq(lw_test_sh("cd %s && grep -q '\"observables\": null' o/summary.json && %s stats o | grep -q obs_",
                           dir, lw_test_bin()), 0);
@@ -2130,6 +2131,14 @@ Test(cli, a_start_past_the_machines_memory_is_refused_before_placing)
                           "1284 splines of 5 segments .* in 16 replicas may take up to about 0.1[0-9]* GB at the "
                           "drawing, more than the 0.128 GB' %s/err.txt", lw_test_bin(), lw_test_root(), dir, dir, dir),
                0, "%s", lw_test_slurp("%s/err.txt", dir));
+  /* and as they were made where that is more: few splines on a picture,
+  ** each replica's grid, raster and domains (64 of 50 splines annealed past
+  ** 158 MB unwarned, then failed at the drawing) */
+  cr_assert_eq(lw_test_sh("sh -c 'ulimit -v 158000; %s run %s/params/example.ini --set init.splines=50 --set "
+                          "tempering.replicas=64 --stop-at 0 --threads 1 --quiet --out %s/r64' 2>%s/err.txt && grep -q "
+                          "'^linewise: note: 50 splines of 5 segments .* in 64 replicas may take up to about [0-9.]* "
+                          "GB at the drawing, more than the 0.162 GB' %s/err.txt", lw_test_bin(), lw_test_root(), dir,
+                          dir, dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* and a resume under the limit its drawing failed under (it failed again unsaid) */
   cr_assert_eq(lw_test_sh("sh -c 'ulimit -v 280000; %s resume %s/m --stop-at 0 --threads 1 --quiet' 2>%s/err.txt && "
                           "grep -q '^linewise: note: 20000 splines of 4 segments .* may take up to about 0.364 GB at "

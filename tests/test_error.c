@@ -1,6 +1,6 @@
 /*
 ** test_error.c -- GSL's errors in a program that uses the library
-** (lw_gsl_handler, error.h).
+** (lw_gsl_handler, error.h), and what a message may show.
 */
 #include <criterion/criterion.h>
 #include <criterion/redirect.h>
@@ -63,4 +63,22 @@ Test(error, the_programs_gsl_handler_survives_the_librarys_threads)
   gsl_error("after", __FILE__, __LINE__, GSL_EDOM);
   cr_assert_eq(program_handler_calls, 1);
   gsl_set_error_handler(old);
+}
+
+/* A message quotes input, which may hold anything: what would move the
+** terminal's cursor or break the line (a control character, DEL, a C1
+** control such as U+0085, NEXT LINE) or show the rest of a file's name
+** reversed (a bidi override, U+202E: "a\u202egnp.exe" reads "aexe.png") is
+** one '?' each; UTF-8 letters stay. */
+Test(error, a_message_shows_no_control_or_bidi_character)
+{
+  lw_error err;
+  cr_assert_eq(lw_error_set(&err, LW_EINPUT, "%s: x", "a\nb\tc\x7f" "d\xc2\x85" "e\xe2\x80\xae" "f\xe2\x81\xa6" "g"),
+               LW_EINPUT);
+  cr_assert_str_eq(err.msg, "a?b?c?d?e?f?g: x");
+  cr_assert_eq(lw_error_set(&err, LW_EIO, "%s", "M\xc3\xbcller \xe6\x97\xa5 \xe2\x80\x94 \xc2\xa0."), LW_EIO);
+  cr_assert_str_eq(err.msg, "M\xc3\xbcller \xe6\x97\xa5 \xe2\x80\x94 \xc2\xa0.",
+                   "letters, a dash, a no-break space stay");
+  cr_assert_eq(lw_error_set(&err, LW_EIO, "%s", "end\xc2"), LW_EIO); /* a sequence cut at the end */
+  cr_assert_str_eq(err.msg, "end\xc2");
 }

@@ -259,10 +259,17 @@ Test(image_cli, a_fidelity_score_out_of_memory_is_left_out_and_said)
   cr_assert_eq(lw_test_sh("cd %s && (ulimit -v 60000; %s %s 2> err.txt)", lw_test_dir, getenv("LW_BIN"), cmd), 0,
                "%s", lw_test_slurp("%s", lw_test_path("err.txt")));
   char *said = lw_test_slurp("%s", lw_test_path("err.txt"));
-  cr_assert(strstr(said, "linewise: fidelity not measured (out of memory)\n") && strstr(said, "linewise: done: "),
-            "%s", said);
+  cr_assert(strstr(said, "linewise: warning: memory ran out scoring the drawing: summary.json's fidelity is null (a "
+                   "redraw where there is more memory scores it") && strstr(said, "linewise: done: "), "%s", said);
   free(said);
   cr_assert_eq(lw_test_sh("grep -q '\"fidelity\": null' %s", lw_test_path("out/summary.json")), 0);
+  /* said under --quiet too, and alone: a number the run left out */
+  cr_assert_eq(lw_test_sh("cd %s && (ulimit -v 60000; %s %s --quiet 2> err.txt)", lw_test_dir, getenv("LW_BIN"), cmd),
+               0);
+  said = lw_test_slurp("%s", lw_test_path("err.txt"));
+  cr_assert(!strncmp(said, "linewise: warning: memory ran out scoring the drawing: ", 55) &&
+            strchr(said, '\n') == said + strlen(said) - 1, "%s", said);
+  free(said);
 }
 
 /* A light picture's darkest is a light grey, which the levels' stretch makes
@@ -280,6 +287,10 @@ Test(image_cli, levels_that_turn_a_light_picture_dark_are_said)
   cr_assert_eq(run("run scene.ini --out out --set scene.image_levels=0.01", errs, sizeof errs), 0, "%s", errs);
   cr_assert(strstr(errs, "scene.image_levels: tones 0.") && strstr(errs, "stretched to 0 to 1 (its darkest, a light "
             "grey, now draws as black: scene.image_levels = 0 keeps a light picture light)"), "%s", errs);
+  /* (inverted after the levels, its darkest draws as paper) */
+  cr_assert_eq(run("run scene.ini --out out --set scene.image_levels=0.01 --set scene.image_invert=1", errs,
+                   sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "stretched to 0 to 1") && !strstr(errs, "now draws as black"), "%s", errs);
   write_picture("dark.png", W, H);
   write_scene("dark.png");
   cr_assert_eq(run("run scene.ini --out out --set scene.image_levels=0.01", errs, sizeof errs), 0, "%s", errs);

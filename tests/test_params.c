@@ -9,6 +9,7 @@
 
 #include "linewise/anneal.h"
 #include "linewise/driver.h"
+#include "linewise/number.h"
 #include "linewise/params.h"
 #include "linewise/rundir.h"
 #include "linewise/scene.h"
@@ -157,7 +158,8 @@ Test(params, bad_input_names_file_line_and_key)
   expect_error("[anneal]\nt_end = 1,000\n", ":2:", "anneal.t_end", "(a decimal comma? numbers take a point");
   expect_error("[anneal]\nt_end = 1,000.5\n", ":2:", "anneal.t_end", "(a thousands separator? write 1000, not 1,000)");
   expect_error("[anneal]\nt_end = 1.000,5\n", ":2:", "anneal.t_end", "(a thousands separator? write 1000, not 1.000)");
-  cr_assert_eq(read_text("[anneal]\nseed = 0.000\nsweeps = 1.0000\n", &q, &err), LW_OK, "%s", err.msg); /* 0 and 1 */
+  cr_assert_eq(read_text("[anneal]\nseed = 0.000\nsweeps = 1.0000\n", &q, &err), LW_OK, "%s", err.msg);
+  cr_assert(q.seed == 0.0 && q.sweeps == 1, "seed %g, sweeps %d", q.seed, q.sweeps);
   cr_assert_eq(read_text("[anneal]\nsweeps = 1.0\nt_end = 0.002\n", &q, &err), LW_OK, "%s", err.msg);
   expect_error("[scene]\nboundary = hexagon\n", ":2:", "scene.boundary", "rect|circle|polygon");
   expect_error("[scene]\nwidth = 1\nwidth = 2\n", ":3:", "scene.width", "repeated");
@@ -185,7 +187,7 @@ Test(params, bad_input_names_file_line_and_key)
                             {"\xef\xbd\x9e", "(byte 1 is a full-width '~', U+FF5E: type '~')"}};
   for (size_t k = 0; k < sizeof stray / sizeof stray[0]; k++) {
     char buf[96];
-    lw_params_unseen_char(stray[k][0], buf, sizeof buf);
+    lw_text_unseen_char(stray[k][0], buf, sizeof buf);
     cr_assert(stray[k][1] ? strstr(buf, stray[k][1]) != NULL : !buf[0], "%s: '%s'", stray[k][0], buf);
   }
 }

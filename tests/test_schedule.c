@@ -272,6 +272,10 @@ Test(schedule, table_rejects_malformed_files_with_line_numbers)
     /* a comma locale's writing: "1.000" is a thousand there (it read as step 1) */
     {"0 1\n1.000 0.5\n", 2, "got '1.000' (a thousands separator? write 1000, not 1.000)"},
     {"0 0,5\n", 1, "got '0,5' (a decimal comma? numbers take a point"},
+    /* and a look-alike character, by what to type instead */
+    {"0 1\n1000 0\xef\xbc\x8e" "5\n", 2, "(byte 2 is a full-width '.', U+FF0E: type '.')"},
+    {"0 1\n1000\xc2\xa0" "0.5\n", 2, "(byte 5 is a no-break space, U+00A0"},
+    {"\xef\xbc\x90 1\n", 1, "step number (a whole number >= 0), got '\xef\xbc\x90' (byte 1 is a full-width '0'"},
     {"0 -1\n", 1, "temperature"},
     {"0 -1e-300\n", 1, "temperature"},
     {"0 nan\n", 1, "temperature"},

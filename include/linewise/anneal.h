@@ -58,6 +58,12 @@ typedef struct lw_anneal {
   char idle[4096];             /* keys the scene sets that its other settings leave idle, where and why */
   char schedule_note[512];     /* a schedule whose steps never reach its end (lw_anneal_start), or "" */
   char memory_note[512];       /* a run expected to take more memory at its peak than it may, or "" */
+  struct {                     /* what memory_note is made of (anneal.c) */
+    double peak, replica, limit; /* the drawing's peak, a further replica's bytes, the limit */
+    int here;                  /* replicas in this process */
+    const char *by;            /* what sets the limit */
+    char what[160];            /* the start's size */
+  } mem;
   unsigned long seed;
   long sweep;                  /* sweeps done */
   long saved;                  /* sweep + 1 at the last checkpoint this process wrote; 0 none */

@@ -69,6 +69,13 @@ ssize_t lw_text_getline(char **buf, size_t *cap, FILE *f);
 #define LW_TEXT_NUL_LINE "a NUL byte inside the line (UTF-16 text, as some editors save 'Unicode', has one in " \
                          "every other byte): expected UTF-8 or ASCII text"
 
+/* Names a character in value that prints like a blank or like nothing, or
+** like a character of a number it is not (a minus sign, a full-width
+** digit), or a byte that is no text, for a message that shows the value:
+** " (byte K is a no-break space, U+00A0: delete it or type a plain space)",
+** or "" if there is none.  buf holds it. */
+const char *lw_text_unseen_char(const char *value, char *buf, size_t n);
+
 /* LW_EINPUT with err where path names a FIFO or a socket, which a reader
 ** would wait on for ever (opening a FIFO waits for a writer); else LW_OK. */
 lw_status lw_text_not_fifo(const char *path, lw_error *err);

@@ -435,10 +435,6 @@ void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size
 ** key's error.  Returns err->code. */
 lw_status lw_params_blame(const lw_params *p, const char *section, const char *key, lw_error *err);
 
-/* Names a character in value that prints like a blank or like nothing, for
-** a message that shows the value: " (byte K is a no-break space, U+00A0:
-** delete it or type a plain space)", or "" if there is none.  buf holds it. */
-const char *lw_params_unseen_char(const char *value, char *buf, size_t n);
 
 /* Edit distance (insertions, deletions, substitutions) of two names, case
 ** aside (WIDTH had no suggestion, Width had), for "did you mean"; names of

@@ -267,7 +267,9 @@ struct lw_system_type {
   ** segments"), what the final drawing reported (LW_DESCRIBE_DRAWING,
   ** whole lines "linewise: ...\n", or "") or what makes a state forbidden
   ** (LW_DESCRIBE_FORBIDDEN, "a segment irregular or outside the boundary",
-  ** or "" where nothing does); files names the drawing files. */
+  ** or "" where nothing does), or what the final drawing's report left out
+  ** (LW_DESCRIBE_LOST: a score memory ran short for, said as a warning under
+  ** --quiet too; "" where nothing); files names the drawing files. */
   /* Gradient-based drivers (dynamics, quench; gradient.h): the state as a
   ** vector of n_coords() generalised coordinates (for splines the nodes'
   ** px py vx vy in node order), set_coords() moves the state there and
@@ -373,7 +375,7 @@ struct lw_system_type {
 
 #define LW_DRAW_START (-2)
 #define LW_DRAW_FINAL (-1)
-enum { LW_DESCRIBE_SIZE, LW_DESCRIBE_DRAWING, LW_DESCRIBE_FORBIDDEN };
+enum { LW_DESCRIBE_SIZE, LW_DESCRIBE_DRAWING, LW_DESCRIBE_FORBIDDEN, LW_DESCRIBE_LOST };
 
 /* One instance: the row and a state (owned). */
 typedef struct {
