@@ -285,8 +285,10 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
     if (lo > 0.0 || hi < 1.0)
       snprintf(sc->note + used, sizeof sc->note - used,
                "%sscene.image_levels: tones %.3f to %.3f stretched to 0 to 1%s", used ? "; " : "", lo, hi,
-               lo >= LW_IMAGE_LEVELS_LIGHT && !p->image_invert ? " (its darkest, a light grey, now draws as black: scene.image_levels = 0 "
-               "keeps a light picture light)" : "");
+               lo >= LW_IMAGE_LEVELS_LIGHT && !p->image_invert
+                   ? " (its darkest, a light grey, now draws as black: scene.image_levels = 0 keeps a light picture "
+                     "light)"
+                   : "");
     else /* a plateau of paper or of black at an end keeps its end */
       snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_levels: the tones left as they are",
                used ? "; " : "");
