@@ -1423,3 +1423,82 @@ Test(trace, runs_with_rungs_at_other_temperatures_are_not_compared_rung_by_rung,
     lw_trace_free(t[1]);
   }
 }
+
+/* A column of one run's or of the runs' CSV (the header names it). */
+static double csv_value(const char *csv, const char *row, const char *col)
+{
+  const char *line = strstr(csv, row);
+  cr_assert_not_null(line, "%s", csv);
+  line += *line == '\n';
+  const size_t len = strlen(col);
+  int at = 0;
+  for (const char *h = csv; *h != '\n'; h = strchr(h, ',') + 1, at++) {
+    cr_assert(*h, "no column %s: %s", col, csv);
+    if (!strncmp(h, col, len) && (h[len] == ',' || h[len] == '\n')) break;
+    cr_assert(strchr(h, ','), "no column %s: %s", col, csv);
+  }
+  for (int c = 0; c < at; c++) line = strchr(line, ',') + 1;
+  return strtod(line, NULL);
+}
+
+/* The runs' pooled statistics are their definitions (combine in trace.c),
+** taken from each run's own: the mean of the means, the error bar
+** sqrt(sum se^2) / k, tau in sweeps the mean of the runs' (rows 2 sweeps
+** apart), R-hat sqrt(((n - 1) / n W + B) / W), p_runs the chi-square of the
+** means about their 1/se^2-weighted mean with k - 1 degrees of freedom.  A
+** mutation pass found each of these free to change (an error bar sqrt(k)
+** too large, tau in rows, k degrees of freedom, R-hat without (n - 1) / n):
+** only the extremes were tested.  The CSV's 4 digits set the tolerance,
+** 1 % (each of those changes moves its value 4 % or more at 8 rows). */
+Test(trace, the_runs_pooled_statistics_are_their_definitions, .init = make_dir, .fini = remove_dir)
+{
+  enum { K = 3, ROWS = 8 };
+  char path[K][128], one[K][2048], all[2048];
+  const char *paths[K];
+  lw_trace *t[K];
+  lw_trace_select sel[K];
+  lw_error err;
+  for (int r = 0; r < K; r++) {
+    char name[32], text[1024] = "sweep,temperature,x\n";
+    for (int i = 1; i <= ROWS; i++)
+      snprintf(text + strlen(text), sizeof text - strlen(text), "%d,1,%.17g\n", 2 * i, 0.3 * r + sin(1.7 * i + r));
+    snprintf(name, sizeof name, "p-%d.csv", r);
+    write_trace(name, text, path[r], sizeof path[r]);
+    paths[r] = path[r];
+    t[r] = lw_trace_read(path[r], &err);
+    cr_assert_not_null(t[r], "%s", err.msg);
+    sel[r] = (lw_trace_select){.from = -1, .to = -1, .csv = 1};
+    FILE *f = fmemopen(one[r], sizeof one[r], "w");
+    cr_assert_eq(lw_trace_stats_runs((const lw_trace *const *)&t[r], &paths[r], &sel[r], 1, f, &err), LW_OK, "%s",
+                 err.msg);
+    fclose(f);
+  }
+  FILE *f = fmemopen(all, sizeof all, "w");
+  cr_assert_eq(lw_trace_stats_runs((const lw_trace *const *)t, paths, sel, K, f, &err), LW_OK, "%s", err.msg);
+  fclose(f);
+  double m = 0, se2 = 0, tau = 0, w = 0, n = 0, mean[K], se[K];
+  for (int r = 0; r < K; r++) {
+    mean[r] = csv_value(one[r], "\nx,", "mean");
+    se[r] = csv_value(one[r], "\nx,", "stderr");
+    const double sd = csv_value(one[r], "\nx,", "sd"), rows = csv_value(one[r], "\nx,", "n");
+    m += mean[r] / K;
+    se2 += se[r] * se[r];
+    tau += csv_value(one[r], "\nx,", "tau_sweeps") / K;
+    w += sd * sd * rows / (rows - 1) / K;
+    n += rows / K;
+  }
+  double b = 0, sw = 0, swm = 0, chi2 = 0;
+  for (int r = 0; r < K; r++) {
+    b += (mean[r] - m) * (mean[r] - m) / (K - 1);
+    sw += 1 / (se[r] * se[r]);
+    swm += mean[r] / (se[r] * se[r]);
+  }
+  for (int r = 0; r < K; r++) chi2 += (mean[r] - swm / sw) * (mean[r] - swm / sw) / (se[r] * se[r]);
+  const double want[5] = {m, sqrt(se2) / K, tau, sqrt(((n - 1) / n * w + b) / w), gsl_cdf_chisq_Q(chi2, K - 1)};
+  const char *col[5] = {"mean", "stderr", "tau_sweeps", "r_hat", "p_runs"};
+  for (int q = 0; q < 5; q++) {
+    const double got = csv_value(all, "\nx,", col[q]);
+    cr_assert(fabs(got / want[q] - 1) < 0.01, "%s: %g, by its definition %g\n%s", col[q], got, want[q], all);
+  }
+  for (int r = 0; r < K; r++) lw_trace_free(t[r]);
+}
