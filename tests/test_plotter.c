@@ -373,6 +373,30 @@ Test(plotter, pens_without_paths_are_not_asked_for)
   lw_test_sh("rm -rf %s", dir);
 }
 
+/* A path that rounds to one point of HP-GL's 0.025 mm is a dot, PD at the
+** point the pen was lifted to (docs/FORMATS.md): without it such a path
+** drew nothing, and a mutation that left it out passed. */
+Test(plotter, a_path_that_rounds_to_one_point_is_a_dot)
+{
+  char dir[64], path[128];
+  cr_assert_eq(lw_test_dir_make(dir, "plotter"), 0);
+  lw_strokes *s = lw_strokes_new(1, NULL);
+  double dot[8] = {10, 10, 10.003, 10, 10.006, 10, 10.009, 10}, line[8] = {20, 10, 25, 10, 30, 10, 35, 10};
+  cr_assert_eq(lw_strokes_add(s, 0, 0, 0, 0, dot, 1, NULL), LW_OK);
+  cr_assert_eq(lw_strokes_add(s, 0, 0, 0, 0, line, 1, NULL), LW_OK);
+  lw_output_page page;
+  lw_output_page_init(&page, PAGE_W, PAGE_H);
+  lw_plotter_options o = options();
+  snprintf(path, sizeof path, "%s/final.hpgl", dir);
+  cr_assert_eq(lw_output_hpgl_strokes(s, &page, &o, path, NULL), LW_OK);
+  char *text = lw_test_slurp("%s", path);
+  const char *dotted = strstr(text, "PU400,");
+  cr_assert(dotted && !strncmp(strchr(dotted, ';'), ";\nPD;\n", 6), "%s", text);
+  free(text);
+  lw_strokes_free(s);
+  lw_test_sh("rm -rf %s", dir);
+}
+
 Test(plotter, bad_options_leave_the_old_file)
 {
   char dir[64], path[128];

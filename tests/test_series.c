@@ -162,6 +162,10 @@ Test(series, the_halves_and_batches_checks_are_their_definitions)
   for (size_t t = n / 2; t < n; t++) x[t] += 0.3; /* a drift to measure */
   lw_series_stats s;
   lw_series_stats_of(x, n, &s);
+  /* sd over n, as docs/FORMATS.md says ("The error bar"), which the runs'
+  ** pooling assumes (an sd over n - 1 passed every test) */
+  const double sd_n = sqrt(gsl_stats_variance(x, 1, n) * (double)(n - 1) / (double)n);
+  cr_assert(fabs(s.sd / sd_n - 1.0) < 1e-12, "sd %.15g, over n %.15g", s.sd, sd_n);
   double se2 = 0.0, m[2];
   const size_t len[2] = {n / 2, n - n / 2};
   for (int k = 0; k < 2; k++) {

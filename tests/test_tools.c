@@ -586,6 +586,7 @@ Test(tools, param_sweep_crosses_every_value_with_every_seed)
   const char *args = "%s %s --vary anneal.t_start=1,0.5 --vary energy.pair=0,0.02 --seeds 3-4 -j 2 " TINY
                      " --bin %s --out %s/p";
   cr_assert_eq(sh(args, tool("param-sweep"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
+  char *said = out_txt();
   csv t;
   char path[128];
   snprintf(path, sizeof path, "%s/p/sweep.csv", dir);
@@ -620,6 +621,24 @@ Test(tools, param_sweep_crosses_every_value_with_every_seed)
     cr_assert_eq(cell(&t, r, "energy_pair")[0] == '\0', !j, "%s: energy_pair '%s'", run, cell(&t, r, "energy_pair"));
   }
   for (int i = 0; i < 8; i++) cr_assert_eq(seen[i / 4][i / 2 % 2][i % 2], 1, "combination %d seen %d times", i, seen[i / 4][i / 2 % 2][i % 2]);
+  /* each point's printed line: its two seeds' best and mean, as the awk
+  ** computes them (a + (b - a) / 2; a mutant that merged the points into
+  ** one line passed) */
+  for (int r = 0; r < t.nrow; r++) {
+    const char *ts = cell(&t, r, "anneal.t_start"), *pair = cell(&t, r, "energy.pair");
+    int other = -1;
+    for (int q = 0; q < t.nrow; q++)
+      if (q != r && !strcmp(cell(&t, q, "anneal.t_start"), ts) && !strcmp(cell(&t, q, "energy.pair"), pair)) other = q;
+    cr_assert(other >= 0);
+    const int first = r < other ? r : other, second = r < other ? other : r;
+    const double a = atof(cell(&t, first, "energy_total")), b = atof(cell(&t, second, "energy_total"));
+    const int best = b < a ? second : first;
+    char want[256];
+    snprintf(want, sizeof want, "  anneal.t_start=%s energy.pair=%s: 2 runs: best %.10g (seed %s), mean %.10g, std ",
+             ts, pair, b < a ? b : a, cell(&t, best, "seed"), a + (b - a) / 2);
+    cr_assert(strstr(said, want), "'%s' is not in:\n%s", want, said);
+  }
+  free(said);
   /* --list is the same plan */
   cr_assert_eq(sh("%s %s --vary anneal.t_start=1,0.5 --vary energy.pair=0,0.02 --seeds 3-4 --list | wc -l",
                   tool("param-sweep"), scene()), 0);
