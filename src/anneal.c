@@ -1080,8 +1080,14 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
       if (err->code == LW_ENOMEM) {
         char msg[LW_ERROR_MSG];
         snprintf(msg, sizeof msg, "%s", err->msg);
-        lw_error_set(err, LW_ENOMEM, "%s, at replica %d of %d (tempering.replicas: each holds the whole scene)",
-                     msg, r + 1, a->n_rep);
+        /* (under ulimit -v the threads' malloc arenas, 64 MiB of address
+        ** space each, ran out with 8 threads where 4 fitted: the replicas were
+        ** blamed alone) */
+        const char *by;
+        const int arenas = omp_get_max_threads() > 1 && lw_memory_limit(&by) < INFINITY && strstr(by, "ulimit");
+        lw_error_set(err, LW_ENOMEM, "%s, at replica %d of %d (tempering.replicas: each holds the whole scene%s)",
+                     msg, r + 1, a->n_rep, arenas ? "; under ulimit -v each thread's malloc arena counts too: fewer "
+                     "--threads or MALLOC_ARENA_MAX=1 (docs/PERFORMANCE.md, \"Memory limits\")" : "");
       }
       return err->code;
     }

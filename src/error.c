@@ -7,6 +7,33 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+/* The length of the UTF-8 sequence at c (2 to 4), its code point in *cp;
+** 0 where c begins none (a stray continuation byte, an overlong form, a
+** surrogate, a sequence cut short). */
+static int utf8_at(const unsigned char *c, unsigned *cp)
+{
+  const int len = c[0] >= 0xc2 && c[0] <= 0xdf ? 2 : c[0] >= 0xe0 && c[0] <= 0xef ? 3 : c[0] >= 0xf0 && c[0] <= 0xf4 ? 4
+                                                                                                                   : 0;
+  unsigned v = c[0] & (len == 2 ? 0x1fu : len == 3 ? 0x0fu : 0x07u);
+  for (int k = 1; k < len; k++) {
+    if ((c[k] & 0xc0) != 0x80) return 0;
+    v = v << 6 | (c[k] & 0x3fu);
+  }
+  if (!len || (len == 3 && v < 0x800) || (len == 4 && (v < 0x10000 || v > 0x10ffff)) || (v >= 0xd800 && v <= 0xdfff))
+    return 0;
+  *cp = v;
+  return len;
+}
+
+/* What a terminal takes for a command or a line's end, or shows text
+** around reversed: C1 controls, the bidi marks and overrides, the line and
+** paragraph separators. */
+static int unseen_control(unsigned cp)
+{
+  return (cp >= 0x80 && cp <= 0x9f) || (cp >= 0x202a && cp <= 0x202e) || (cp >= 0x2066 && cp <= 0x2069) ||
+         cp == 0x200e || cp == 0x200f || cp == 0x061c || cp == 0x2028 || cp == 0x2029;
+}
+
 lw_status lw_error_set(lw_error *err, lw_status code, const char *fmt, ...)
 {
   if (err) {
@@ -16,16 +43,19 @@ lw_status lw_error_set(lw_error *err, lw_status code, const char *fmt, ...)
     va_end(ap);
     /* a message quotes input, which may be binary: no control character
     ** reaches the terminal, and the message stays one line; nor does a C1
-    ** control of UTF-8 (U+0085 ends a line too) or a bidi override (U+202E
-    ** shows the rest of a file's name reversed), each one '?' */
+    ** control, of UTF-8 or a lone byte of an 8-bit terminal's (U+0085 ends
+    ** a line too, 0x9B begins a command), or a bidi override (U+202E shows
+    ** the rest of a file's name reversed), each one '?'; a byte that begins
+    ** no character otherwise (a Latin-1 name's) stays */
     unsigned char *to = (unsigned char *)err->msg;
-    for (const unsigned char *c = to; *c; c++) {
-      const int c1 = c[0] == 0xc2 && c[1] >= 0x80 && c[1] <= 0x9f;
-      const int bidi = c[0] == 0xe2 && ((c[1] == 0x80 && c[2] >= 0xaa && c[2] <= 0xae) ||
-                                        (c[1] == 0x81 && c[2] >= 0xa6 && c[2] <= 0xa9));
-      if (*c < 0x20 || *c == 0x7f || c1 || bidi) *to++ = '?';
-      else *to++ = *c;
-      c += c1 ? 1 : bidi ? 2 : 0;
+    for (const unsigned char *c = to; *c;) {
+      unsigned cp = *c;
+      const int len = *c < 0x80 ? 1 : utf8_at(c, &cp);
+      const int bad = len ? cp < 0x20 || cp == 0x7f || unseen_control(cp) : *c <= 0x9f;
+      if (bad) *to++ = '?';
+      else
+        for (int k = 0; k < (len ? len : 1); k++) *to++ = c[k];
+      c += len ? len : 1;
     }
     *to = '\0';
     err->code = code;

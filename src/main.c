@@ -1667,8 +1667,10 @@ static int narrow_lanes(void)
   const char *v = getenv("LW_LANES");
   if (!v || !*v) return 0;
   if (strcmp(v, "2") && strcmp(v, "4") && strcmp(v, "8")) {
-    fprintf(stderr, "linewise: environment LW_LANES: expected 2, 4 or 8 (the widest the processor has), got '%s'\n",
-            v);
+    lw_error err; /* (through lw_error_set, which shows no control character) */
+    lw_error_set(&err, LW_EUSAGE, "environment LW_LANES: expected 2, 4 or 8 (the widest the processor has), got '%s'",
+                 v);
+    fprintf(stderr, "linewise: %s\n", err.msg);
     return -1;
   }
   if (v[0] == '2') lw_vec_set_wide(0);
@@ -1833,6 +1835,7 @@ static int command(int argc, char **argv)
     lw_params_write_doc(stdout, lw_anneal_key_readers, lw_anneal_key_values);
     return 0;
   }
-  fprintf(stderr, "linewise: unknown command '%s'%s (try 'linewise --help')\n", argv[1], nearest(argv[1], commands));
-  return 2;
+  lw_error err;
+  lw_error_set(&err, LW_EUSAGE, "unknown command '%s'%s (try 'linewise --help')", argv[1], nearest(argv[1], commands));
+  return fail(&err);
 }

@@ -540,18 +540,6 @@ fail:
   return NAN;
 }
 
-double lw_model_raster_bytes(const lw_scene *sc)
-{
-  lw_term_set ts;
-  term_set_init(&ts, sc);
-  double bytes = 0.0;
-  for (int k = 0; k < ts.n_raster; k++) {
-    const lw_tone *tn = ts.ctx[ts.raster[k]].data;
-    bytes += (ts.n_layers ? ts.n_layers : 1) * (double)tn->w * (double)tn->h * sizeof(int64_t);
-  }
-  return bytes;
-}
-
 double lw_energy_raster(const lw_scene *sc, const lw_splines *sp, int t, int64_t **out, lw_error *err)
 {
   lw_term_set ts;

@@ -86,9 +86,11 @@ static lw_status read_text(FILE *f, const char *path, points *pt, lw_error *err)
       break;
     }
     if (k != 3 && k != 6) {
+      char unseen[96]; /* (a minus sign or a no-break space: the file is found, so the key's blame says none) */
       s = k < 0 ? lw_error_set(err, LW_EINPUT,
                                "%s:%ld: expected 'x y z' or 'x y z nx ny nz' (finite numbers), got '%.80s'%s", path,
-                               line, buf, lw_number_list_hint(k))
+                               line, buf, k == -2 ? lw_number_list_hint(k) : lw_text_unseen_char(buf, unseen,
+                                                                                                   sizeof unseen))
                 : lw_error_set(err, LW_EINPUT, "%s:%ld: expected 3 numbers (x y z) or 6 (x y z nx ny nz), got %d",
                                path, line, k);
       break;

@@ -285,15 +285,21 @@ lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err
       break;
     }
     line[strcspn(line, "#")] = '\0';
-    char shown[64], *tok[3];
-    snprintf(shown, sizeof shown, "%s", line + strspn(line, " \t"));
+    /* the row as shown, cut at a character's start and said cut, and what
+    ** it holds unseen (of the whole row: a cut 'é' was "delete it") */
+    const char *row = line + strspn(line, " \t");
+    char shown[64], hint[96], *tok[3];
+    size_t cut = strlen(row);
+    if (cut > 56)
+      for (cut = 56; cut && ((unsigned char)row[cut] & 0xC0) == 0x80;) cut--;
+    snprintf(shown, sizeof shown, "%.*s%s", (int)cut, row, row[cut] ? "..." : "");
+    lw_text_unseen_char(row, hint, sizeof hint);
     int ntok = split(line, tok);
     if (ntok == 0) continue;
     double bv, tv;
-    char hint[96];
     if (ntok != 2) {
       status = lw_error_set(err, LW_EINPUT, "%s:%ld: expected 'step temperature', got '%s'%s", path, lineno, shown,
-                            lw_text_unseen_char(shown, hint, sizeof hint));
+                            hint);
       break;
     }
     /* Whole numbers only, up to 2^53 where doubles still count every block;

@@ -104,10 +104,11 @@ static lw_status read_file(const lw_params *p, double **P, size_t *np, double **
     int k = lw_number_list(line, 2, v, 4);
     if (k == 0) continue;
     if ((k != 2 && k != 3) || (per && k != per) || (k == 3 && !(v[2] > 0.0))) {
+      char unseen[96]; /* (a minus sign or a no-break space: the file is found, so the key's blame says none) */
       lw_error_set(err, LW_EINPUT, "%s:%ld: expected %s, got '%.60s'%s", path, lineno,
                    per == 2 ? "'x y' like the lines before" : per == 3 ? "'x y w' (w > 0) like the lines before"
                                                                       : "'x y' or 'x y w' (w > 0)", line,
-                   lw_number_list_hint(k));
+                   k == -2 ? lw_number_list_hint(k) : lw_text_unseen_char(line, unseen, sizeof unseen));
       st = lw_params_blame(p, "nurbs", "file", err);
       break;
     }

@@ -538,34 +538,48 @@ static int frozen_runs(const lw_trace *t, const column_stats *cs, int k)
 
 /* Whether the first m rows of runs q and r hold the same values (NaN for
 ** NaN). */
-static int same_rows(const lw_trace *const *t, size_t *const *row, int q, int r, size_t m)
+static int one_chain(const lw_trace *a, const lw_trace *b)
 {
-  for (size_t i = 0; i < m; i++)
-    for (size_t c = 0; c < t[q]->n_cols; c++) {
-      const double a = at(t[q], row[q][i], (int)c), b = at(t[r], row[r][i], (int)c);
-      if (a != b && !(isnan(a) && isnan(b))) return 0;
+  const int sa = lw_trace_column(a, "sweep"), sb = lw_trace_column(b, "sweep");
+  if (sa < 0 || sb < 0 || a->n_cols != b->n_cols) return 0;
+  size_t i = 0, j = 0, common = 0;
+  while (i < a->n_rows && j < b->n_rows) {
+    const double x = at(a, i, sa), y = at(b, j, sb);
+    if (x != y) {
+      i += x < y;
+      j += y < x;
+      continue;
     }
-  return 1;
+    for (size_t c = 0; c < a->n_cols; c++) {
+      /* (rates over each row's own window, which trace_every sets) */
+      if (!strncmp(a->name[c], "acc_", 4) || !strncmp(a->name[c], "swap", 4)) continue;
+      const double u = at(a, i, (int)c), v = at(b, j, (int)c);
+      if (u != v && !(isnan(u) && isnan(v))) return 0;
+    }
+    common++, i++, j++;
+  }
+  return common >= 2;
 }
 
-/* Runs whose rows are another's, value for value over the rows both have:
-** one seed run twice, a copy of a run stopped earlier (its rows the first of
-** the other's), or seeds that changed nothing (a scene that draws no random
-** number), which the comparison took for agreeing runs (R_hat 0.99, p_runs
-** 1); pooled, such a run counts twice and the error bar is too small (one
-** seed twice among four: 16 % small).  All alike is one warning, else one a
-** set of twins.  (Other runs part at their first row: k^2 / 2 rows.) */
-static void warn_twins(FILE *out, const lw_trace *const *t, size_t *const *row, const size_t *n,
-                       const char *const *path, int k)
+/* Runs that are one chain, another's rows value for value at the sweeps both
+** traces record (the whole traces, their columns but the rates over a row's
+** window): one seed run twice, a copy of a run stopped earlier, the same
+** seed with a later stats_from or another trace_every (rows of one sweep
+** compared, not the stretches' i-th: those went unwarned, as did any pair
+** the heat capacities of their own stretches told apart), or seeds that
+** changed nothing (a scene that draws no random number), which the
+** comparison took for agreeing runs (R_hat 0.99, p_runs 1); pooled, such a
+** run counts twice and the error bar is too small (one seed twice among
+** four: 16 % small).  All alike is one warning, else one a set of twins.
+** (Other runs part at their first common row: k^2 / 2 rows.) */
+static void warn_twins(FILE *out, const lw_trace *const *t, const size_t *n, const char *const *path, int k)
 {
   int *twin = malloc((size_t)k * sizeof *twin); /* the first run that run r repeats, or r */
   int distinct = 0, same_length = 1;
   for (int r = 0; twin && r < k; r++) {
     twin[r] = r;
-    for (int q = 0; q < r && twin[r] == r; q++) {
-      const size_t m = n[q] < n[r] ? n[q] : n[r];
-      if (twin[q] == q && m && same_rows(t, row, q, r, m)) twin[r] = q;
-    }
+    for (int q = 0; q < r && twin[r] == r; q++)
+      if (twin[q] == q && n[q] && n[r] && one_chain(t[q], t[r])) twin[r] = q;
     distinct += twin[r] == r;
     same_length &= n[r] == n[0];
   }
@@ -581,8 +595,8 @@ static void warn_twins(FILE *out, const lw_trace *const *t, size_t *const *row, 
     for (int r = q + 1; r < k; r++)
       if (twin[r] == q) fprintf(out, "%s%s", --copies ? ", " : " and ", path[r]);
     fprintf(out, " are one run, row for row over the rows they share (one seed run twice, or a copy of a run "
-            "stopped earlier): pooled, it counts as more than one, so the error bars are too small and the runs' "
-            "agreement too kind; leave all but one out\n");
+            "stopped earlier or traced otherwise): pooled, it counts as more than one, so the error bars are too small "
+            "and the runs' agreement too kind; leave all but one out\n");
   }
   free(twin);
 }
@@ -594,7 +608,7 @@ void lw_trace_warn_twins(const lw_trace *const *t, const char *const *path, cons
   lw_error e;
   int ok = row && n;
   for (int r = 0; ok && r < k; r++) ok = !lw_trace_rows(t[r], path[r], &sel[r], &row[r], &n[r], &tuned, &e);
-  if (ok) warn_twins(out, t, row, n, path, k);
+  if (ok) warn_twins(out, t, n, path, k);
   for (int r = 0; row && r < k; r++) free(row[r]);
   free(row);
   free(n);
@@ -625,6 +639,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     if (!(heat[r] = lw_trace_with_heat_capacity(t[r], row[r], n[r], path[r], err)))
       status = err ? err->code : LW_ENOMEM;
   if (status) goto done;
+  const lw_trace *const *raw = t; /* (the twins are of the runs' own columns) */
   t = (const lw_trace *const *)heat;
   double tlo = INFINITY, thi = -INFINITY;
   for (int r = 0; r < k; r++) temperature_range(t[r], row[r], n[r], &tlo, &thi);
@@ -758,7 +773,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
             "its columns' means are one state's and their error bars 0 say nothing of the distribution (a step "
             "too large, or a temperature too low, for the moves)\n",
             k > 1 ? (frozen > 1 ? "runs" : "a run") : "the run", frozen > 1 ? "their" : "its");
-  if (apart && k > 1) warn_twins(apart, t, row, n, path, k);
+  if (apart && k > 1) warn_twins(apart, raw, n, path, k);
   /* the table's warnings; with --csv, those of one run are its columns
   ** (window_closed, n and n_eff, drift_z, batch_ratio), and of several runs
   ** only r_hat and p_runs: the rest go apart, where a script sees that the

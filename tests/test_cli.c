@@ -1726,6 +1726,31 @@ Test(cli, observables_lost_for_want_of_memory_are_said)
                           dir, lw_test_bin()), 0);
 }
 
+/* Monte Carlo runs of one chain are said one run: a copy stopped earlier,
+** the same seed with a later stats_from or another trace_every (their rows
+** compared at the sweeps both record).  Each went unwarned: the stretches'
+** i-th rows were compared, heat capacities of each stretch's own mean among
+** them, and pooled the error bars were up to sqrt(2) small.  Another seed
+** is not. */
+Test(cli, runs_of_one_chain_are_said_one_run_however_traced)
+{
+  static const char *const runs[][2] = {{"a", ""}, {"b", "--stop-at 800"},
+                                         {"c", "--set output.stats_from=600"}, {"d", "--set output.trace_every=1"},
+                                         {"e", "--seed 2"}};
+  for (size_t k = 0; k < 5; k++)
+    cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/wlc.ini --out %s --quiet --set anneal.sweeps=1200 --set "
+                            "output.stats_from=300 --set output.trace_every=5 --seed 1 %s", dir, lw_test_bin(),
+                            lw_test_root(), runs[k][0], runs[k][1]), 0, "%s", runs[k][0]);
+  static const char *const twin[] = {"b", "c", "d"};
+  for (size_t k = 0; k < 3; k++) {
+    cr_assert_eq(lw_test_sh("cd %s && %s stats a %s e > out.txt 2> err.txt", dir, lw_test_bin(), twin[k]), 0);
+    char *out = lw_test_slurp("%s/out.txt", dir), want[128];
+    snprintf(want, sizeof want, "warning: a/trace.csv and %s/trace.csv are one run, row for row", twin[k]);
+    cr_assert(strstr(out, want) && !strstr(out, "e/trace.csv are one run"), "%s", out);
+    free(out);
+  }
+}
+
 /* A state whose spline count was damaged up to 1e8 is said cut short under
 ** a memory limit too: the reader took memory for the count first, and said
 ** "out of memory for 100000000 splines" (exit 1) where 2 GB did not fit.

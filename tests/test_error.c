@@ -81,4 +81,10 @@ Test(error, a_message_shows_no_control_or_bidi_character)
                    "letters, a dash, a no-break space stay");
   cr_assert_eq(lw_error_set(&err, LW_EIO, "%s", "end\xc2"), LW_EIO); /* a sequence cut at the end */
   cr_assert_str_eq(err.msg, "end\xc2");
+  /* a lone C1 byte (an 8-bit terminal's CSI), an overlong NEXT LINE, the
+  ** line separator and a right-to-left mark are '?' too; a Latin-1 name's
+  ** bytes stay */
+  cr_assert_eq(lw_error_set(&err, LW_EIO, "%s", "a\x9b" "2J \xc0\x85 b\xe2\x80\xa8" "c\xe2\x80\x8f" "d M\xfcller"),
+               LW_EIO);
+  cr_assert_str_eq(err.msg, "a?2J \xc0? b?c?d M\xfcller");
 }

@@ -190,6 +190,10 @@ Test(nurbs_cli, bad_knots_and_weights_exit_2_naming_file_line_and_key)
   cr_assert_eq(sh("printf '0 0\\n-4,17 5\\n' > %s/dc.txt", dir), 0);
   refused("file = dc.txt\\n", "bad.ini:4: key .nurbs.file.: .*dc.txt:2: expected .x y. like the lines before, got "
           ".-4,17 5. (a comma between digits, and blanks between numbers: decimal commas?");
+  /* a word processor's minus sign, named (the file is found: the key's blame says nothing of it) */
+  cr_assert_eq(sh("printf '0 0\\n1 \\342\\210\\2221\\n' > %s/ms.txt", dir), 0);
+  refused("file = ms.txt\n", "bad.ini:4: key .nurbs.file.: .*ms.txt:2: expected .x y. like the lines before, got "
+          ".* .byte 3 is a minus sign, U.2212: type .-..");
 }
 
 Test(nurbs_cli, a_points_file_holds_a_long_curve)

@@ -299,6 +299,20 @@ Test(schedule, table_rejects_malformed_files_with_line_numbers)
     cr_assert(s.n_table == 0 && !s.table_block && !s.table_temp, "case %zu: s unchanged", i);
     unlink(path);
   }
+  /* a long row is shown cut at a character's start and said cut; a letter
+  ** the cut fell in is no byte to delete (the hint was of the cut copy) */
+  {
+    char path[64], row[128] = "0 1\n1000 0.5 ";
+    for (int i = 0; i < 53; i++) strcat(row, "x");
+    strcat(row, "\xc3\xa9x\n");
+    temp_file(path, row);
+    lw_schedule s = {.blocks = 10};
+    lw_error err;
+    cr_assert_eq(lw_schedule_read_table(&s, path, &err), LW_EINPUT);
+    cr_assert(strstr(err.msg, "xxx...'") && !strstr(err.msg, "\xc3'") && !strstr(err.msg, "delete it"), "%s",
+              err.msg);
+    unlink(path);
+  }
   /* a NUL byte would end the line early as a string: refused, not cut */
   {
     char path[64];

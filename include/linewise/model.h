@@ -378,10 +378,6 @@ double lw_energy_compute(const lw_scene *sc, const lw_splines *sp, double term[L
 ** LW_ENOMEM through err. */
 double lw_energy_raster(const lw_scene *sc, const lw_splines *sp, int t, int64_t **out, lw_error *err);
 
-/* The bytes of the rasters a model of sc holds (the tone term's, a plane a
-** layer), whatever its splines: each replica has its own. */
-double lw_model_raster_bytes(const lw_scene *sc);
-
 #ifdef __cplusplus
 }
 #endif
