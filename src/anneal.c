@@ -770,6 +770,17 @@ static void memory_note(lw_anneal *a)
              a->mem.limit / 1e9, a->mem.by, a->mem.here > 1 ? " or replicas" : "");
 }
 
+/* The threads a parallel region may start (1 built without OpenMP, as the
+** fuzz harnesses are: a call of OpenMP's own left them unlinked). */
+static int threads_most(void)
+{
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+
 /* The heap's bytes in use, or -1 where the C library does not say. */
 static double heap_bytes(void)
 {
@@ -1084,7 +1095,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
         ** space each, ran out with 8 threads where 4 fitted: the replicas were
         ** blamed alone) */
         const char *by;
-        const int arenas = omp_get_max_threads() > 1 && lw_memory_limit(&by) < INFINITY && strstr(by, "ulimit");
+        const int arenas = threads_most() > 1 && lw_memory_limit(&by) < INFINITY && strstr(by, "ulimit");
         lw_error_set(err, LW_ENOMEM, "%s, at replica %d of %d (tempering.replicas: each holds the whole scene%s)",
                      msg, r + 1, a->n_rep, arenas ? "; under ulimit -v each thread's malloc arena counts too: fewer "
                      "--threads or MALLOC_ARENA_MAX=1 (docs/PERFORMANCE.md, \"Memory limits\")" : "");
