@@ -291,7 +291,7 @@ lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err
     char shown[64], hint[96], *tok[3];
     size_t cut = strlen(row);
     if (cut > 56)
-      for (cut = 56; cut && ((unsigned char)row[cut] & 0xC0) == 0x80;) cut--;
+      for (cut = 56; cut > 53 && ((unsigned char)row[cut] & 0xC0) == 0x80;) cut--; /* (3 continuation bytes at most) */
     snprintf(shown, sizeof shown, "%.*s%s", (int)cut, row, row[cut] ? "..." : "");
     lw_text_unseen_char(row, hint, sizeof hint);
     int ntok = split(line, tok);

@@ -1749,6 +1749,16 @@ Test(cli, runs_of_one_chain_are_said_one_run_however_traced)
     cr_assert(strstr(out, want) && !strstr(out, "e/trace.csv are one run"), "%s", out);
     free(out);
   }
+  /* a study of end states, one row a run: a seed twice is said too */
+  for (int k = 0; k < 3; k++)
+    cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/wlc.ini --out one%d --quiet --set anneal.sweeps=600 --set "
+                            "output.stats_from=300 --set output.trace_every=600 --seed %d", dir, lw_test_bin(),
+                            lw_test_root(), k, k < 2 ? 1 : 2), 0);
+  cr_assert_eq(lw_test_sh("cd %s && %s stats one0 one1 one2 > out.txt 2> err.txt", dir, lw_test_bin()), 0);
+  char *out = lw_test_slurp("%s/out.txt", dir);
+  cr_assert(strstr(out, "warning: one0/trace.csv and one1/trace.csv are one run") &&
+            !strstr(out, "one2/trace.csv are one run"), "%s", out);
+  free(out);
 }
 
 /* A state whose spline count was damaged up to 1e8 is said cut short under
