@@ -7,10 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-/* The length of the UTF-8 sequence at c (2 to 4), its code point in *cp;
-** 0 where c begins none (a stray continuation byte, an overlong form, a
-** surrogate, a sequence cut short). */
-static int utf8_at(const unsigned char *c, unsigned *cp)
+int lw_utf8_at(const unsigned char *c, unsigned *cp)
 {
   const int len = c[0] >= 0xc2 && c[0] <= 0xdf ? 2 : c[0] >= 0xe0 && c[0] <= 0xef ? 3 : c[0] >= 0xf0 && c[0] <= 0xf4 ? 4
                                                                                                                    : 0;
@@ -50,7 +47,7 @@ lw_status lw_error_set(lw_error *err, lw_status code, const char *fmt, ...)
     unsigned char *to = (unsigned char *)err->msg;
     for (const unsigned char *c = to; *c;) {
       unsigned cp = *c;
-      const int len = *c < 0x80 ? 1 : utf8_at(c, &cp);
+      const int len = *c < 0x80 ? 1 : lw_utf8_at(c, &cp);
       const int bad = len ? cp < 0x20 || cp == 0x7f || unseen_control(cp) : *c <= 0x9f;
       if (bad) *to++ = '?';
       else

@@ -200,14 +200,13 @@ const char *lw_text_unseen_char(const char *value, char *buf, size_t n)
   ** shows as nothing or as garbage in the message: its number, then */
   for (size_t i = 0; value[i];) {
     const unsigned char b = (unsigned char)value[i];
-    size_t len = b < 0x80 ? 1 : (b & 0xe0) == 0xc0 ? 2 : (b & 0xf0) == 0xe0 ? 3 : (b & 0xf8) == 0xf0 ? 4 : 0;
-    int bad = !len || (b < 0x20 && b != '\t') || b == 0x7f;
-    for (size_t k = 1; k < len && !bad; k++) bad = ((unsigned char)value[i + k] & 0xc0) != 0x80;
-    if (bad) {
+    unsigned cp;
+    const int len = b < 0x80 ? 1 : lw_utf8_at((const unsigned char *)value + i, &cp);
+    if (!len || (b < 0x20 && b != '\t') || b == 0x7f) {
       snprintf(buf, n, " (byte %zu is 0x%02X, not a character of text: delete it)", i + 1, b);
       return buf;
     }
-    i += len;
+    i += (size_t)len;
   }
   return buf;
 }

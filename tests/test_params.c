@@ -181,6 +181,7 @@ Test(params, bad_input_names_file_line_and_key)
   const char *stray[][2] = {{"bark\xff" "er", "(byte 5 is 0xFF, not a character of text: delete it)"},
                             {"me\x01tropolis", "(byte 3 is 0x01, not a character of text"},
                             {"m\xc3\xa9tropolis", NULL},
+                            {"1\xc0\x85", "(byte 2 is 0xC0, not a character of text"}, /* an overlong form */
                             {"\xe2\x88\x92" "1", "(byte 1 is a minus sign, U+2212: type '-')"},
                             {"1\xef\xbc\x90", "(byte 2 is a full-width '0', U+FF10: type '0')"},
                             {"0\xef\xbc\x8e" "5", "(byte 2 is a full-width '.', U+FF0E: type '.')"},

@@ -38,6 +38,12 @@ lw_status lw_error_set(lw_error *err, lw_status code, const char *fmt, ...)
 #endif
     ;
 
+/* The length of the UTF-8 sequence at c (2 to 4), its code point in *cp;
+** 0 where c begins none (a stray continuation byte, an overlong form, a
+** surrogate, a sequence cut short).  What the messages and the readers'
+** hints take for a character. */
+int lw_utf8_at(const unsigned char *c, unsigned *cp);
+
 /* Clears err to LW_OK with an empty message. */
 void lw_error_clear(lw_error *err);
 
