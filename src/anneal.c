@@ -1093,9 +1093,10 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
         snprintf(msg, sizeof msg, "%s", err->msg);
         /* (under ulimit -v the threads' malloc arenas, 64 MiB of address
         ** space each, ran out with 8 threads where 4 fitted: the replicas were
-        ** blamed alone) */
-        const char *by;
-        const int arenas = threads_most() > 1 && lw_memory_limit(&by) < INFINITY && strstr(by, "ulimit");
+        ** blamed alone; not where MALLOC_ARENA_MAX=1 already keeps one) */
+        const char *by, *arena_max = getenv("MALLOC_ARENA_MAX");
+        const int arenas = threads_most() > 1 && lw_memory_limit(&by) < INFINITY && strstr(by, "ulimit") &&
+                           !(arena_max && !strcmp(arena_max, "1"));
         lw_error_set(err, LW_ENOMEM, "%s, at replica %d of %d (tempering.replicas: each holds the whole scene%s)",
                      msg, r + 1, a->n_rep, arenas ? "; under ulimit -v each thread's malloc arena counts too: fewer "
                      "--threads or MALLOC_ARENA_MAX=1 (docs/PERFORMANCE.md, \"Memory limits\")" : "");
