@@ -981,13 +981,21 @@ static void trace_header_end(lw_anneal *a)
   fprintf(a->trace, "\n");
 }
 
+/* A trace's number, after its comma: every digit that reads back (trace
+** rows are few, the %.17g at most twice a number). */
+static void trace_number(lw_anneal *a, double v)
+{
+  fputc(',', a->trace);
+  lw_number_print_exact(a->trace, v);
+}
+
 static void trace_row_end(lw_anneal *a, const double *v)
 {
   const lw_system_type *t = a->sys_type;
   if (a->params.observables) {
     for (int k = 0; k < t->n_observables; k++)
       if (isnan(v[k])) fprintf(a->trace, ",");
-      else fprintf(a->trace, ",%.10g", v[k]);
+      else trace_number(a, v[k]);
   }
   fprintf(a->trace, "\n");
 }
@@ -1604,17 +1612,21 @@ static void trace_row(lw_anneal *a)
   t->terms(a->sys->state, term);
   if (a->dyn) {
     double kin = lw_dynamics_kinetic(a->dyn), pot = lw_system_total(a->sys);
-    fprintf(a->trace, "%ld,%.10g", a->sweep, a->dyn->time);
+    fprintf(a->trace, "%ld", a->sweep);
+    trace_number(a, a->dyn->time);
     for (int k = 0; k < t->n_terms; k++)
-      if (t->term_on(a->setup, k)) fprintf(a->trace, ",%.10g", term[k]);
-    fprintf(a->trace, ",%.17g,%.17g,%.17g", pot, kin, pot + kin);
+      if (t->term_on(a->setup, k)) trace_number(a, term[k]);
+    trace_number(a, pot);
+    trace_number(a, kin);
+    trace_number(a, pot + kin);
     trace_row_end(a, v);
     return;
   }
-  fprintf(a->trace, "%ld,%.10g", a->sweep, c->temperature);
+  fprintf(a->trace, "%ld", a->sweep);
+  trace_number(a, c->temperature);
   for (int k = 0; k < t->n_terms; k++)
-    if (t->term_on(a->setup, k)) fprintf(a->trace, ",%.10g", term[k]);
-  fprintf(a->trace, ",%.10g", rung_energy(a, 0));
+    if (t->term_on(a->setup, k)) trace_number(a, term[k]);
+  trace_number(a, rung_energy(a, 0));
   for (int k = 0; k < c->n_moves; k++) {
     unsigned long p = c->stats[k].proposed - a->trace_mark[k].proposed;
     unsigned long acc = c->stats[k].accepted - a->trace_mark[k].accepted;
@@ -1623,8 +1635,10 @@ static void trace_row(lw_anneal *a)
     a->trace_mark[k] = c->stats[k];
   }
   if (a->pt) {
-    for (int k = 0; k < a->n_rep; k++)
-      fprintf(a->trace, ",%.10g,%.10g", a->chains[k]->temperature, rung_energy(a, k));
+    for (int k = 0; k < a->n_rep; k++) {
+      trace_number(a, a->chains[k]->temperature);
+      trace_number(a, rung_energy(a, k));
+    }
     /* swap acceptance since the previous row */
     for (int k = 0; k + 1 < a->n_rep; k++) {
       unsigned long tried = a->pt->tried[k] - a->swap_mark[2 * k];

@@ -61,6 +61,14 @@ int lw_number_parse_n(const char *s, size_t len, double *out)
 
 int lw_number_parse(const char *s, double *out) { return lw_number_parse_n(s, strlen(s), out); }
 
+void lw_number_print_exact(FILE *f, double v)
+{
+  char buf[32];
+  snprintf(buf, sizeof buf, "%.15g", v);
+  if (strtod(buf, NULL) != v) snprintf(buf, sizeof buf, "%.17g", v);
+  fputs(buf, f);
+}
+
 int lw_number_parse_whole(const char *s, double lo, double hi, long long *out)
 {
   double v;

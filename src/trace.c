@@ -210,7 +210,7 @@ static long default_from(const lw_trace *t, int sweep)
   return (long)at(t, r, sweep);
 }
 
-enum { WARN_OPEN, WARN_FEW, WARN_ONE, WARN_DRIFT, WARN_BATCH, WARN_RUNS, WARN_COARSE };
+enum { WARN_OPEN, WARN_FEW, WARN_ONE, WARN_DRIFT, WARN_BATCH, WARN_RUNS, WARN_COARSE, WARN_ROUNDED };
 
 /* A column's statistics: per run (k of them), and with several runs what
 ** they say together. */
@@ -221,6 +221,9 @@ typedef struct {
   int coarse;           /* a run's values about uncorrelated at their spacing of more than a sweep: tau at
                         ** its floor of half a value, tau_sweeps a bound (wire-ladder at trace_every 1000
                         ** read 500 sweeps against the 17 of every row) */
+  int rounded;          /* a run's values all printed to 10 digits (traces before 2026-12-07), their spread
+                        ** under 3 steps of the last one: the rounding's variance, step^2 / 12, is over 1 %
+                        ** of theirs (and a heat capacity of that energy is off by as much) */
   double r_hat;         /* Gelman and Rubin's potential scale reduction */
   double p_runs;        /* chi-square probability of the runs' means under their error bars */
 } column_stats;
@@ -249,6 +252,7 @@ static int has_problem(const column_stats *c, int k, int what)
 {
   if (what == WARN_RUNS) return k > 1 && !isnan(c->p_runs) && (c->p_runs < 1e-3 || c->r_hat > 1.1);
   if (what == WARN_COARSE) return c->coarse;
+  if (what == WARN_ROUNDED) return c->rounded;
   for (int r = 0; r < k; r++)
     if (run_problem(&c->run[r], what)) return 1;
   return 0;
@@ -257,7 +261,7 @@ static int has_problem(const column_stats *c, int k, int what)
 static int flagged(const column_stats *c, int k)
 {
   return has_problem(c, k, WARN_OPEN) || has_problem(c, k, WARN_FEW) || has_problem(c, k, WARN_ONE) ||
-         has_problem(c, k, WARN_BATCH) || has_problem(c, k, WARN_RUNS);
+         has_problem(c, k, WARN_BATCH) || has_problem(c, k, WARN_RUNS) || has_problem(c, k, WARN_ROUNDED);
 }
 
 /* One line naming every column with problem `what`, or nothing. */
@@ -435,6 +439,25 @@ int lw_trace_rungs(const lw_trace *t, int *energy, int *temp, int max)
     if ((energy[n] = lw_trace_column(t, e)) < 0 || (temp[n] = lw_trace_column(t, tt)) < 0) break;
   }
   return n;
+}
+
+/* Whether a run's column of spread sd has every value in the given rows at
+** 10 significant digits, the trace's print before 2026-12-07, and spreads
+** under 3 steps of the last digit (WARN_ROUNDED).  A value written in full
+** is at 10 digits by chance about once in 10^7. */
+static int rounded_column(const lw_trace *t, const size_t *row, size_t n, int col, double sd)
+{
+  double most = 0.0;
+  if (!(sd > 0.0)) return 0;
+  for (size_t i = 0; i < n; i++) {
+    double v = at(t, row[i], col);
+    char buf[32];
+    if (isnan(v)) continue;
+    snprintf(buf, sizeof buf, "%.10g", v);
+    if (strtod(buf, NULL) != v) return 0;
+    if (fabs(v) > most) most = fabs(v);
+  }
+  return most > 0.0 && sd < 3.0 * pow(10.0, floor(log10(most)) - 9.0);
 }
 
 /* The energy columns whose fluctuations make a heat capacity, each with its
@@ -678,6 +701,16 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       const lw_series_stats *s = &cs[c].run[r];
       /* (not a relaxation's: the drift test speaks for it) */
       cs[c].coarse |= s->n > 1 && s->sd > 0.0 && s->tau < 0.75 && gap[r] > 1.0 && !(fabs(s->drift_z) > 4.0);
+      if (c < raw[r]->n_cols) cs[c].rounded |= rounded_column(t[r], row[r], n[r], (int)c, s->sd);
+    }
+    /* a heat capacity is of its energy's fluctuations: rounded with them */
+    const char *hc = strstr(t[0]->name[c], "heat_capacity");
+    if (c >= raw[0]->n_cols && hc) {
+      char src[64];
+      snprintf(src, sizeof src, "%.*s%s", (int)(hc - t[0]->name[c]), t[0]->name[c], hc == t[0]->name[c] ? "total"
+               : "energy");
+      const int e = lw_trace_column(raw[0], src);
+      if (e >= 0) cs[c].rounded = cs[e].rounded;
     }
     cs[c].tau_sweeps = cs[c].run[0].tau * gap[0];
     if (empty) {
@@ -787,6 +820,9 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
             "too large, or a temperature too low, for the moves)\n",
             k > 1 ? (frozen > 1 ? "runs" : "a run") : "the run", frozen > 1 ? "their" : "its");
   if (apart && k > 1) warn_twins(apart, raw, n, path, k);
+  warn(apart, t[0], cs, k, WARN_ROUNDED, "printed to 10 digits (trace.csv before 2026-12-07), which is coarse "
+       "against their spread: the rounding's variance is over 1 % of theirs, so their error bars and a heat "
+       "capacity from them are off by as much or more (a run of this version writes every digit)");
   /* the table's warnings; with --csv, those of one run are its columns
   ** (window_closed, n and n_eff, drift_z, batch_ratio), and of several runs
   ** only r_hat and p_runs: the rest go apart, where a script sees that the

@@ -1726,6 +1726,26 @@ Test(cli, observables_lost_for_want_of_memory_are_said)
                           dir, lw_test_bin()), 0);
 }
 
+/* The trace writes every digit that reads back: at T = 1e-7 the harmonic
+** wire's energy (3193.4) fluctuates by 2e-7, under the last of the 10
+** digits it was written to before, and its heat capacity, exactly 5 by
+** equipartition (params/wire-ladder.ini), read 21.9 +- 0.6.  Within 4 of
+** its own error bars now (fixed seed). */
+Test(cli, a_heat_capacity_at_a_low_temperature_reads_the_trace_in_full)
+{
+  char out[8192], errs[2048], args[1024];
+  snprintf(args, sizeof args, "run %s/params/wire-ladder.ini --out %s/low --quiet --set tempering.ladder= --set "
+           "tempering.replicas=1 --set anneal.t_start=1e-7 --set output.stats_from=20000", lw_test_root(), dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  snprintf(args, sizeof args, "stats %s/low --csv", dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  const char *h = strstr(out, "\nheat_capacity,");
+  double c, se;
+  cr_assert(h && sscanf(h, "\nheat_capacity,%*d,%lf,%lf", &c, &se) == 2, "%s", out);
+  cr_assert(fabs(c - 5.0) < 4.0 * se && se < 1.0, "C = %g +- %g against 5", c, se);
+  cr_assert(!strstr(errs, "printed to 10 digits"), "%s", errs);
+}
+
 /* Monte Carlo runs of one chain are said one run: a copy stopped earlier,
 ** the same seed with a later stats_from or another trace_every (their rows
 ** compared at the sweeps both record).  Each went unwarned: the stretches'

@@ -462,6 +462,37 @@ Test(trace, the_default_stretch_is_the_final_temperature_less_its_tuning_sweeps,
   lw_trace_free(t);
 }
 
+/* A trace printed to 10 digits (before 2026-12-07) rounds the fluctuations
+** of a large energy at a low temperature: E = 3193.416162... with an sd of
+** 2e-7 became a few values 1e-6 apart, and its heat capacity read
+** 21.9 for 5 unwarned.  Such a column, and the heat capacity of it, are
+** said; a column of the same spread written in full is not. */
+Test(trace, a_column_rounded_to_ten_digits_against_its_spread_is_said, .init = make_dir, .fini = remove_dir)
+{
+  char text[16384], out[4096];
+  int k = snprintf(text, sizeof text, "sweep,temperature,total,obs_full,obs_count\n");
+  for (int s = 1; s <= 200; s++) {
+    double e = 3193.416162 + 6e-7 * sin(0.7 * s * s);
+    k += snprintf(text + k, sizeof text - (size_t)k, "%d,1e-07,%.10g,%.17g,%d\n", s, e, e + 1e-9, 100 + s % 3);
+  }
+  lw_trace *t = trace_of(text);
+  lw_trace_select sel = {.from = -1, .to = -1};
+  report_of(t, &sel, out, sizeof out);
+  cr_assert(strstr(out, "warning: total, heat_capacity: printed to 10 digits (trace.csv before 2026-12-07)"), "%s",
+            out);
+  cr_assert(strstr(out, "\nheat_capacity ") && strstr(strstr(out, "\nheat_capacity "), " *\n"), "%s", out);
+  lw_trace_free(t);
+  /* in full, the same values are not (nor whole numbers that spread) */
+  k = snprintf(text, sizeof text, "sweep,temperature,total,obs_count\n");
+  for (int s = 1; s <= 200; s++)
+    k += snprintf(text + k, sizeof text - (size_t)k, "%d,1e-07,%.17g,%d\n", s, 3193.416162 + 6e-7 * sin(0.7 * s * s),
+                  100 + s % 3);
+  t = trace_of(text);
+  report_of(t, &sel, out, sizeof out);
+  cr_assert(!strstr(out, "printed to 10 digits"), "%s", out);
+  lw_trace_free(t);
+}
+
 Test(trace, the_temperature_warning_needs_a_temperature_that_changes, .init = make_dir, .fini = remove_dir)
 {
   /* a dynamics trace has no temperature column: nothing to warn of; a
