@@ -982,11 +982,13 @@ static void trace_header_end(lw_anneal *a)
 }
 
 /* A trace's number, after its comma: every digit that reads back (trace
-** rows are few, the %.17g at most twice a number). */
-static void trace_number(lw_anneal *a, double v)
+** rows are few, the %.17g at most twice a number), or as a run from before
+** output.trace_exact wrote it; the dynamics' energies were %.17g there. */
+static void trace_number(lw_anneal *a, double v, int energy)
 {
   fputc(',', a->trace);
-  lw_number_print_exact(a->trace, v);
+  if (a->params.trace_exact) lw_number_print_exact(a->trace, v);
+  else fprintf(a->trace, a->dyn && energy ? "%.17g" : "%.10g", v);
 }
 
 static void trace_row_end(lw_anneal *a, const double *v)
@@ -995,7 +997,7 @@ static void trace_row_end(lw_anneal *a, const double *v)
   if (a->params.observables) {
     for (int k = 0; k < t->n_observables; k++)
       if (isnan(v[k])) fprintf(a->trace, ",");
-      else trace_number(a, v[k]);
+      else trace_number(a, v[k], 0);
   }
   fprintf(a->trace, "\n");
 }
@@ -1613,20 +1615,20 @@ static void trace_row(lw_anneal *a)
   if (a->dyn) {
     double kin = lw_dynamics_kinetic(a->dyn), pot = lw_system_total(a->sys);
     fprintf(a->trace, "%ld", a->sweep);
-    trace_number(a, a->dyn->time);
+    trace_number(a, a->dyn->time, 0);
     for (int k = 0; k < t->n_terms; k++)
-      if (t->term_on(a->setup, k)) trace_number(a, term[k]);
-    trace_number(a, pot);
-    trace_number(a, kin);
-    trace_number(a, pot + kin);
+      if (t->term_on(a->setup, k)) trace_number(a, term[k], 0);
+    trace_number(a, pot, 1);
+    trace_number(a, kin, 1);
+    trace_number(a, pot + kin, 1);
     trace_row_end(a, v);
     return;
   }
   fprintf(a->trace, "%ld", a->sweep);
-  trace_number(a, c->temperature);
+  trace_number(a, c->temperature, 0);
   for (int k = 0; k < t->n_terms; k++)
-    if (t->term_on(a->setup, k)) trace_number(a, term[k]);
-  trace_number(a, rung_energy(a, 0));
+    if (t->term_on(a->setup, k)) trace_number(a, term[k], 0);
+  trace_number(a, rung_energy(a, 0), 0);
   for (int k = 0; k < c->n_moves; k++) {
     unsigned long p = c->stats[k].proposed - a->trace_mark[k].proposed;
     unsigned long acc = c->stats[k].accepted - a->trace_mark[k].accepted;
@@ -1636,8 +1638,8 @@ static void trace_row(lw_anneal *a)
   }
   if (a->pt) {
     for (int k = 0; k < a->n_rep; k++) {
-      trace_number(a, a->chains[k]->temperature);
-      trace_number(a, rung_energy(a, k));
+      trace_number(a, a->chains[k]->temperature, 0);
+      trace_number(a, rung_energy(a, k), 0);
     }
     /* swap acceptance since the previous row */
     for (int k = 0; k + 1 < a->n_rep; k++) {

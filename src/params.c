@@ -502,6 +502,11 @@ const lw_param_def lw_param_table[] = {
       "time, and the run says so at its end; thousands of sweeps between them suit a study."),
   NUM("output", "trace_every", LW_PT_INT, trace_every, "1", "sweeps", 1, 2e9, 0,
       "Sweeps per row of trace.csv."),
+  NUM("output", "trace_exact", LW_PT_INT, trace_exact, "1", "", 0, 1, 0,
+      "1 = trace.csv's numbers with every digit that reads back (%.15g, else %.17g); 0 = at 10 "
+      "significant digits, as runs before 2026-12-07 (a run of theirs, whose scene.ini has no "
+      "line for this key, resumes and reruns so). 10 digits round away a large energy's fluctuations at a "
+      "low temperature, and its heat capacity with them; `linewise stats` says where."),
   NUM("output", "observables", LW_PT_INT, observables, "0", "", 0, 1, 0,
       "1 adds the system's observables to every row of trace.csv (columns obs_<name>: for splines "
       "the count and the means over the splines of length, squared end-to-end distance, squared "
@@ -1628,6 +1633,7 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
   /* a scene.ini that a run wrote before the key was one runs again as that
   ** run did (the hash of a resume's leaves the missing key out) */
   if (p->run_header && !lw_params_line(p, "anneal", "seed_version")) p->seed_version = 1;
+  if (p->run_header && !lw_params_line(p, "output", "trace_exact")) p->trace_exact = 0;
   /* the driver decides the presets' keys below */
   if (!lw_driver_of(p, err)) return err->code;
   /* before the page is sized, which the orientation decides */

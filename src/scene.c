@@ -144,10 +144,13 @@ static lw_grid2d *image_potential(const lw_scene *sc, const lw_image *img, const
 ** everywhere: an even hatch, with only its lights as gaps (skimage's rocket
 ** at night, 60 % of it 80 % dark; the Hubble deep field, 95 %), which the
 ** scores do not show (the best SSIM of 11 photographs).  Said before the run,
-** with the keys that lighten it: counted over the picture's opaque pixels
-** inside the frame (a mask's dark outside is never drawn), on a grid of at
-** most about 250,000 of them, and only where the tone curve makes the
-** target (a colour separation takes the channels without it). */
+** with the keys that lighten it: counted over the picture's pixels inside
+** the frame (a mask's dark outside is never drawn), on a grid of at most
+** about 250,000 of them, and only where the tone curve makes the target (a
+** colour separation takes the channels without it).  A transparent pixel
+** counts as the white paper it shows (its tone is composited over white):
+** a black logo on transparent paper, a fifth of the picture, was said dark
+** all over, and the advice (invert) left nothing to draw. */
 #define DARK_TONE 0.2  /* 80 % dark or darker */
 #define DARK_SHARE 0.5 /* of the picture's opaque pixels in the frame */
 static void dark_note(lw_scene *sc, const lw_params *p)
@@ -163,7 +166,6 @@ static void dark_note(lw_scene *sc, const lw_params *p)
   for (int j = 0; j < im->height; j += step)
     for (int i = 0; i < im->width; i += step) {
       const size_t k = (size_t)j * (size_t)im->width + (size_t)i;
-      if (im->alpha && im->alpha[k] < 0.5f) continue;
       seen_all++;
       dark_all += im->tone[k] <= DARK_TONE;
       if (!lw_boundary_inside(&sc->boundary, pl->x0 + (i + 0.5) * pl->pixel, pl->y0 + (j + 0.5) * pl->pixel))

@@ -686,6 +686,22 @@ Test(image_cli, a_picture_dark_nearly_all_over_gets_a_note)
   picture_scene("glyphs.png", "boundary = mask\nmask = image\nmask_image = glyphs.png\n[energy]\ntone = 1\n", &sc);
   cr_assert_null(strstr(sc.note, "dark or darker"), "%s", sc.note);
   lw_scene_clear(&sc);
+  /* dark where opaque, transparent paper beside it: a logo of a fifth of
+  ** the picture is not dark all over (it was: 100 % of its opaque pixels),
+  ** one of three fifths is */
+  static const int opaque_fifths[] = {1, 3};
+  for (int c = 0; c < 2; c++) {
+    float g[PICTURE_W * PICTURE_H], a[PICTURE_W * PICTURE_H];
+    for (int j = 0; j < PICTURE_H; j++)
+      for (int i = 0; i < PICTURE_W; i++) {
+        g[j * PICTURE_W + i] = 0.1f;
+        a[j * PICTURE_W + i] = i < opaque_fifths[c] * PICTURE_W / 5 ? 1.0f : 0.0f;
+      }
+    lw_test_png(lw_test_path("logo.png"), PICTURE_W, PICTURE_H, g, a);
+    picture_scene("logo.png", "[energy]\ntone = 1\n", &sc);
+    cr_assert_eq(strstr(sc.note, "dark or darker") != NULL, c == 1, "%d fifths: %s", opaque_fifths[c], sc.note);
+    lw_scene_clear(&sc);
+  }
 }
 
 /* A panorama keeps its shape inside the frame: 400 x 3 pixels in a 40 x 30

@@ -188,6 +188,7 @@ typedef struct {
   int checkpoint_every;       /* sweeps between state.lw checkpoints */
   int trace_every;            /* sweeps per trace.csv row */
   int observables;            /* 1 = the system's observables in trace.csv */
+  int trace_exact;            /* 1 = trace.csv's numbers read back exactly; 0 = at 10 digits (runs before) */
   int stats_from;             /* first sweep of the stretch the statistics take (0: the final temperature's) */
   int samples_every;          /* sweeps between samples/sample-SSSSSS.csv (0: none) */
   double pen_width;           /* stroke of every pen, mm */
