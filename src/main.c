@@ -1203,7 +1203,13 @@ static int cmd_run(int argc, char **argv)
       return stop_requested && stop_requested != SIGINT ? 128 + stop_requested : 0;
     }
     const size_t n = strlen(err.msg);
-    if (err.code == LW_EIO && !lw_phase_unwritten())
+    char state[LW_PATH_MAX + 16];
+    snprintf(state, sizeof state, "%s/state.lw", dir);
+    /* (the directory removed after the set-up's checkpoint, before its last
+    ** file: "wrote no checkpoint" was said of the one that went with it) */
+    if (err.code == LW_EIO && a.saved > 0 && access(state, F_OK))
+      snprintf(err.msg + n, sizeof err.msg - n, "; %s is gone, and the run with it", state);
+    else if (err.code == LW_EIO && !lw_phase_unwritten())
       snprintf(err.msg + n, sizeof err.msg - n, "; the run wrote no checkpoint%s: run it again once the files can "
                "be written", back ? ", and the run that was in the directory is back as it was"
                          : lw_runfiles_stashed(dir) ? ", and the run that was in the directory waits in "
