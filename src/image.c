@@ -684,6 +684,12 @@ static const char *format_name(const unsigned char *d, size_t n)
 static const char *foreign_format(const unsigned char *d, size_t n)
 {
   if (n >= 12 && !memcmp(d, "RIFF", 4) && !memcmp(d + 8, "WEBP", 4)) return "a WebP";
+  /* the Netpbm kinds but the binary PGM/PPM (P5, P6) that are read */
+  if (n >= 3 && d[0] == 'P' && strchr(" \t\r\n", d[2]) && d[2]) {
+    static const char *const pnm[] = {['1'] = "a plain-text PBM (P1)", ['2'] = "a plain-text PGM (P2)",
+                                      ['3'] = "a plain-text PPM (P3)", ['4'] = "a PBM (P4)", ['7'] = "a PAM (P7)"};
+    if (d[1] < sizeof pnm / sizeof pnm[0] && pnm[d[1]]) return pnm[d[1]];
+  }
   if (n >= 4 && (!memcmp(d, "II*\0", 4) || !memcmp(d, "MM\0*", 4) || !memcmp(d, "II+\0", 4) || !memcmp(d, "MM\0+", 4)))
     return "a TIFF";
   if (n >= 12 && !memcmp(d + 4, "ftyp", 4)) {
@@ -855,6 +861,10 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
   if (st) return st;
   int w, h, ch;
   if (!stbi_info_from_memory(data, (int)size, &w, &h, &ch)) return not_decoded(data, size, name, err);
+  /* a BMP's rows stored top down, as a negative height (legal in every
+  ** header), come out of the decoder upright: its size is the height's
+  ** magnitude (they were all refused as damaged) */
+  if (!strcmp(format_name(data, size), "BMP") && h < 0 && h > INT_MIN) h = -h;
   if (w < 1 || h < 1) /* stb_image passes a BMP of width 0 */
     return lw_error_set(err, LW_EINPUT, "%s: the %s is damaged: %d x %d pixels", name, format_name(data, size), w, h);
   const int comps = !strcmp(format_name(data, size), "JPEG") ? jpeg_components(data, size) : 0;

@@ -80,6 +80,21 @@ Test(image, rgb_becomes_rec709_luma_with_row_0_at_the_top)
   for (int k = 0; k < 6; k++)
     cr_assert(fabs(img->tone[k] - want[k]) < 1e-6, "pixel %d: %g, want %g", k, img->tone[k], want[k]);
   lw_image_free(img);
+  /* the same picture stored top down, as a negative height (legal in
+  ** every BMP header; each was refused as "damaged: 3 x -2 pixels"): the
+  ** same pixels, the same way up */
+  unsigned char t[256];
+  memcpy(t, b, n);
+  const int h = -2;
+  for (int k = 0; k < 4; k++) t[22 + k] = (unsigned char)((unsigned)h >> (8 * k));
+  memcpy(t + 54, b + 54 + 12, 12); /* rows of 9 bytes padded to 12, swapped */
+  memcpy(t + 54 + 12, b + 54, 12);
+  img = lw_image_decode(t, n, "t.bmp", 1e6, &info, &err);
+  cr_assert_not_null(img, "%s", err.msg);
+  cr_assert(info.width == 3 && info.height == 2, "%d x %d", info.width, info.height);
+  for (int k = 0; k < 6; k++)
+    cr_assert(fabs(img->tone[k] - want[k]) < 1e-6, "top down, pixel %d: %g, want %g", k, img->tone[k], want[k]);
+  lw_image_free(img);
 }
 
 Test(image, pgm_and_ppm_any_maxval_and_truncation)
@@ -1182,6 +1197,13 @@ Test(image, foreign_formats_are_named_and_a_huge_jpeg_is_too_large)
     {"\0\0\0\x0cJXL \r\n\x87\n", 12, "a JPEG XL file"},
     {"II+\0\x08\0\0\0", 8, "a TIFF file"},
     {"\xef\xbb\xbf\n  <svg xmlns=", 16, "an SVG file"},
+    /* the Netpbm kinds but the binary PGM and PPM read (a generic "not of
+    ** any known type, or corrupt" before) */
+    {"P2\n2 1\n255\n0 9\n", 15, "a plain-text PGM (P2) file"},
+    {"P3 1 1 255 0 0 0\n", 17, "a plain-text PPM (P3) file"},
+    {"P1\n1 1\n0\n", 10, "a plain-text PBM (P1) file"},
+    {"P4\n8 1\n\xff", 8, "a PBM (P4) file"},
+    {"P7\nWIDTH 1\n", 11, "a PAM (P7) file"},
   };
   lw_error err;
   for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
