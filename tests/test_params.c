@@ -115,6 +115,27 @@ static void expect_error(const char *text, const char *line, const char *key, co
   if (expected) cr_assert(strstr(err.msg, expected), "message '%s' lacks '%s'", err.msg, expected);
 }
 
+/* Every number key's open end is refused at the end itself, by the range
+** check (a step of 0 freezes its moves; an image_gamma of 0 is no curve). */
+Test(params, every_open_end_of_a_range_is_refused_at_the_end)
+{
+  int checked = 0;
+  for (size_t i = 0; i < lw_param_count; i++) {
+    const lw_param_def *d = &lw_param_table[i];
+    if (d->type != LW_PT_DOUBLE && d->type != LW_PT_INT && d->type != LW_PT_WHOLE) continue;
+    for (int end = 0; end < 2; end++) {
+      if (!(d->open & (end ? LW_MAX_OPEN : LW_MIN_OPEN))) continue;
+      char text[256], key[96], range[64];
+      snprintf(text, sizeof text, "[%s]\n%s = %.17g\n", d->section, d->key, end ? d->max : d->min);
+      snprintf(key, sizeof key, "%s.%s", d->section, d->key);
+      snprintf(range, sizeof range, end ? "< %.10g, got" : "> %.10g and", end ? d->max : d->min);
+      expect_error(text, ":2:", key, range);
+      checked++;
+    }
+  }
+  cr_assert_gt(checked, 10, "only %d open ends", checked);
+}
+
 Test(params, bad_input_names_file_line_and_key)
 {
   expect_error("[scene]\nwidth = 100\nwidht = 3\n", ":3:", "scene.widht", "not a parameter");
@@ -153,6 +174,9 @@ Test(params, bad_input_names_file_line_and_key)
   expect_error("[anneal]\nsweeps = 1.000\n", ":2:", "anneal.sweeps", "(a thousands separator? write 1000, not 1.000)");
   expect_error("[anneal]\nsweeps = 1,000\n", ":2:", "anneal.sweeps", "(a thousands separator? write 1000, not 1,000)");
   expect_error("[anneal]\nsweeps = 10.000.000\n", ":2:", "anneal.sweeps", "(a thousands separator? write 1000");
+  /* a leading group of three digits too: one hundred thousand */
+  expect_error("[anneal]\nsweeps = 100.000\n", ":2:", "anneal.sweeps", "(a thousands separator? write 1000");
+  expect_error("[anneal]\nsweeps = 250,000\n", ":2:", "anneal.sweeps", "(a thousands separator? write 1000");
   expect_error("[anneal]\nt_end = 1,000,000\n", ":2:", "anneal.t_end",
                "(a thousands separator? write 1000, not 1,000)");
   expect_error("[anneal]\nt_end = 1,000\n", ":2:", "anneal.t_end", "(a decimal comma? numbers take a point");
