@@ -621,13 +621,13 @@ const lw_param_def lw_param_table[] = {
          "plot.speed_up), for machines whose rapids shake a lifted pen or outrun its servo."),
   STRING("plot", "gcode_pen_up", gcode_pen_up, "G0 Z5", "",
          "The G-code line that lifts the pen in final.gcode, written as it is: `G0 Z5` for a pen on the "
-         "Z axis, `M5` or `M3 S30` for a servo on a GRBL fork. One line of printable ASCII. It comes before "
-         "any feed is set: a G1 here needs its own F (GRBL refuses G1 without one, error 22), and GRBL "
-         "takes lines of up to 79 characters (spaces and comments aside)."),
+         "Z axis, `M5` or `M3 S30` for a servo on a GRBL fork. One line of printable ASCII, at most 79 "
+         "characters (GRBL's line buffer). The file sets the feed of plot.speed_down before it (`G94 F...`), "
+         "so a G1 here without an F of its own moves at that."),
   STRING("plot", "gcode_pen_down", gcode_pen_down, "G1 Z0 F500", "",
          "The G-code line that lowers the pen in final.gcode, written as it is (a feed it sets is "
          "replaced by plot.speed_down on the first drawing move); e.g. `M3 S90 G4 P0.2` for a servo "
-         "that needs 0.2 s to settle. One line of printable ASCII."),
+         "that needs 0.2 s to settle. One line of printable ASCII, at most 79 characters."),
   STRING("layers", "names", ly_names, "", "",
          "Hatching layers or colour pens: one name a layer (ASCII letters, digits, `-`, `_`, `.`; it labels "
          "the pen's SVG layer, so no two alike), separated by blanks or commas (at most 16). Each "
@@ -1715,8 +1715,19 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
     if (lw_plotter_gcode_line_ok(pen_line[k])) continue;
     lw_params_origin(p, lw_params_find("plot", pen_key[k]), where, sizeof where);
     return lw_error_set(err, LW_EINPUT,
-                        "%s: key 'plot.%s' = '%s': expected a G-code line of printable ASCII (output.gcode = 1)",
-                        where, pen_key[k], pen_line[k]);
+                        "%s: key 'plot.%s' = '%s': expected a G-code line of printable ASCII, at most %d characters "
+                        "(output.gcode = 1)", where, pen_key[k], pen_line[k], LW_PLOTTER_GCODE_LINE_MAX);
+  }
+  /* a feed is written to the thousandth of a mm/min: below half of one it
+  ** would be F0, which GRBL refuses (error 22) */
+  const char *speed_key[2] = {"speed_down", "speed_up"};
+  const double speed[2] = {p->speed_down, p->speed_up};
+  for (int k = 0; p->gcode && k < 1 + (p->gcode_travel == 1); k++) {
+    if (60.0 * speed[k] >= 0.0005) continue;
+    lw_params_origin(p, lw_params_find("plot", speed_key[k]), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'plot.%s' = %g mm/s: final.gcode's feed (mm/min, to the thousandth) "
+                        "would be F0, which GRBL refuses; expected at least 1e-05 mm/s (output.gcode = 1)", where,
+                        speed_key[k], speed[k]);
   }
   /* With crop (the default) every stroke is cut inside the page inset by
   ** the margin, so that box decides, on the machine's axes, before a long

@@ -33,7 +33,15 @@ int lw_plotter_gcode_line_ok(const char *line)
 {
   for (const char *c = line; *c; c++)
     if (*c < 0x20 || *c >= 0x7f) return 0;
-  return line[0] != '\0';
+  return line[0] != '\0' && strlen(line) <= LW_PLOTTER_GCODE_LINE_MAX;
+}
+
+/* A feed, mm/min: to the thousandth, so that a slow pen is not F0, which
+** GRBL refuses (a whole number or a tenth took 0.00001 mm/s to F0). */
+static void put_feed(FILE *f, double mm_per_s)
+{
+  fputs(" F", f);
+  lw_output_put_fixed(f, 60.0 * mm_per_s, 3);
 }
 
 /* Page millimetres (y down) to the machine's (y up): the page's lower-left
@@ -163,8 +171,8 @@ lw_status lw_plotter_check(const lw_strokes *s, const lw_output_page *page, cons
   const char *line[2] = {o->pen_up, o->pen_down}, *what[2] = {"pen-up", "pen-down"};
   for (int k = 0; k < 2; k++) {
     if (!line[k] || !lw_plotter_gcode_line_ok(line[k]))
-      return lw_error_set(err, LW_EINPUT, "%s: the %s line '%s': expected one line of printable ASCII", path,
-                          what[k], line[k] ? line[k] : "");
+      return lw_error_set(err, LW_EINPUT, "%s: the %s line '%s': expected one line of printable ASCII, at most "
+                          "%d characters", path, what[k], line[k] ? line[k] : "", LW_PLOTTER_GCODE_LINE_MAX);
   }
   return LW_OK;
 }
@@ -247,10 +255,7 @@ static void travel(FILE *f, const lw_plotter_options *o, long long x, long long 
 {
   fputs(o->travel_feed ? "G1" : "G0", f);
   put_xy(f, x, y);
-  if (o->travel_feed) {
-    fputs(" F", f);
-    lw_output_put_fixed(f, 60.0 * o->speed_up, 1);
-  }
+  if (o->travel_feed) put_feed(f, o->speed_up);
   fputc('\n', f);
 }
 
@@ -266,10 +271,7 @@ static void gcode_point(void *ctx, double x, double y)
     fputs("G1", g->f);
     put_xy(g->f, px, py);
     /* the pen-down line may set a feed of its own (G1 Z0 F...) */
-    if (g->drawn++ == 0) {
-      fputs(" F", g->f);
-      lw_output_put_fixed(g->f, 60.0 * g->o->speed_down, 1);
-    }
+    if (g->drawn++ == 0) put_feed(g->f, g->o->speed_down);
     fputc('\n', g->f);
   }
   g->x = px;
@@ -299,7 +301,9 @@ lw_status lw_output_gcode_strokes(const lw_strokes *s, const lw_output_page *pag
   lw_output_put_fixed(f, page->width_mm, LW_OUTPUT_SVG_DECIMALS);
   fputs(" x ", f);
   lw_output_put_fixed(f, page->height_mm, LW_OUTPUT_SVG_DECIMALS);
-  fputs(o->turn ? " mm turned a quarter turn counterclockwise, origin at its top-left corner, its top edge "
+  /* (lines of at most 79 characters: a sender that counts them into
+  ** GRBL's 128-byte buffer stalled on a page's 131) */
+  fputs(o->turn ? " mm\n; turned a quarter turn counterclockwise, origin at its top-left corner,\n; its top edge "
                   "along y\n" : " mm, origin at its lower-left corner, y up\n", f);
   int first = 0; /* the first pen that draws: a pen that draws nothing is not asked for */
   while (first + 1 < s->n_pens && s->pen_first[first] == s->pen_first[first + 1]) first++;
@@ -312,7 +316,11 @@ lw_status lw_output_gcode_strokes(const lw_strokes *s, const lw_output_page *pag
   } else {
     fputs("; an empty drawing: no pen is asked for\n", f);
   }
-  fprintf(f, "G21\nG90\n%s\n", o->pen_up);
+  /* the feed set before the pen lines, whose G1 without an F of its own
+  ** would be refused before any (GRBL's error 22) */
+  fputs("G21\nG90\nG94", f);
+  put_feed(f, o->speed_down);
+  fprintf(f, "\n%s\n", o->pen_up);
   for (int k = first; k < s->n_pens; k++) {
     size_t a, z;
     lw_strokes_pen_range(s, k, &a, &z);

@@ -273,17 +273,25 @@ Test(plotter, gcode_reads_back_and_moves_the_pen_in_order)
   char *text = written(lw_output_gcode_strokes, "final.gcode", 0, dir, &s);
   lw_plotter_options o = options();
   static polyline pl[3];
-  int down = 0, pen = 1, paths = 0, pauses = 0, ended = 0, units = 0, absolute = 0, feed_next = 0;
+  int down = 0, pen = 1, paths = 0, pauses = 0, ended = 0, units = 0, absolute = 0, feed_next = 0, feed = 0;
   for (char *line = strtok(text, "\n"); line; line = strtok(NULL, "\n")) {
     cr_assert(!ended, "'%s' after M2", line);
     if (line[0] == ';') {
       if (strstr(line, "load pen 2 (cyan, #00ffff, 0.5 mm)")) cr_assert_eq(pauses, 0, "the note comes before M0");
       continue;
     }
+    /* GRBL's line buffer */
+    cr_assert_leq(strlen(line), 79, "'%s'", line);
     if (!strcmp(line, "G21")) units = 1;
     else if (!strcmp(line, "G90")) absolute = 1;
-    else if (!strcmp(line, o.pen_up)) down = 0;
-    else if (!strcmp(line, o.pen_down)) {
+    else if (!strncmp(line, "G94 F", 5)) {
+      /* a feed before any pen line, whose G1 without one GRBL refused */
+      cr_assert_eq(atof(line + 5), 3000.0, "'%s'", line);
+      feed = 1;
+    } else if (!strcmp(line, o.pen_up)) {
+      cr_assert(feed, "a pen line before the feed");
+      down = 0;
+    } else if (!strcmp(line, o.pen_down)) {
       cr_assert(!down && paths > 0);
       down = feed_next = 1;
     } else if (!strcmp(line, "M0")) {
@@ -321,6 +329,33 @@ Test(plotter, gcode_reads_back_and_moves_the_pen_in_order)
   cr_assert_eq(paths, 3);
   cr_assert(pl[0].pen == 1 && pl[1].pen == 1 && pl[2].pen == 2);
   for (size_t k = 0; k < 3; k++) assert_matches(s, k, &pl[k], GCODE_ROUND + 1e-12);
+  free(text);
+  lw_strokes_free(s);
+  lw_test_sh("rm -rf %s", dir);
+}
+
+/* Every line of final.gcode fits GRBL's line buffer, the turned page's
+** header too (131 characters, which a sender counting into GRBL's 128-byte
+** buffer never sent); a slow pen's feed is to the thousandth (0.00001 mm/s
+** was F0, which GRBL refuses), and travels at feed set theirs. */
+Test(plotter, gcode_lines_fit_grbl_and_a_slow_feed_is_not_zero)
+{
+  char dir[64], path[128];
+  lw_strokes *s;
+  char *text = written(lw_output_gcode_strokes, "final.gcode", 1, dir, &s);
+  cr_assert(strstr(text, "counterclockwise"), "%s", text);
+  for (char *line = strtok(text, "\n"); line; line = strtok(NULL, "\n"))
+    cr_assert_leq(strlen(line), 79, "'%s'", line);
+  free(text);
+  lw_output_page page = page_of();
+  lw_plotter_options o = options();
+  o.speed_down = 0.01;
+  o.speed_up = 0.0001;
+  o.travel_feed = 1;
+  snprintf(path, sizeof path, "%s/slow.gcode", dir);
+  cr_assert_eq(lw_output_gcode_strokes(s, &page, &o, path, NULL), LW_OK);
+  text = lw_test_slurp("%s", path);
+  cr_assert(strstr(text, "\nG94 F0.6\n") && strstr(text, " F0.006\n") && !strstr(text, " F0\n"), "%s", text);
   free(text);
   lw_strokes_free(s);
   lw_test_sh("rm -rf %s", dir);
@@ -472,6 +507,25 @@ Test(plotter, command_line_writes_the_same_files_for_the_same_seed)
   cr_assert(strstr(errs, "key 'plot.gcode_pen_up'") && strstr(errs, "expected a G-code line"), "%s", errs);
   free(errs);
   cr_assert_neq(lw_test_sh("test -e %s/bad", dir), 0, "nothing written");
+  /* so is one past GRBL's 79 characters, and a speed whose feed would be
+  ** F0 (drawing, or travelling at feed) */
+  static const char *const bad[][2] = {
+    {"'plot.gcode_pen_down=M3 S90 G4 P0.2 %0*d'", "key 'plot.gcode_pen_down'"},
+    {"plot.speed_down=0.000001", "key 'plot.speed_down' = 1e-06 mm/s: final.gcode's feed"},
+    {"plot.speed_up=0.000001 --set plot.gcode_travel=feed", "key 'plot.speed_up' = 1e-06 mm/s"},
+  };
+  for (int k = 0; k < 3; k++) {
+    char keys[160];
+    snprintf(keys, sizeof keys, bad[k][0], 70, 0);
+    cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set %s --quiet --out %s/bad "
+                            "2>%s/err.txt", bin, root, keys, dir, dir), 2, "%s", keys);
+    errs = lw_test_slurp("%s/err.txt", dir);
+    cr_assert(strstr(errs, bad[k][1]), "%s", errs);
+    free(errs);
+  }
+  /* travelling by rapids, no feed is written of speed_up */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set plot.speed_up=0.000001 --quiet "
+                          "--set anneal.sweeps=0 --out %s/rapid", bin, root, dir), 0);
   lw_test_sh("rm -rf %s", dir);
 }
 

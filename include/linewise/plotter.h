@@ -75,7 +75,9 @@ typedef struct {
 size_t lw_plotter_chords(const double *b, double tol);
 
 /* 1 when line is one G-code line a controller takes: not empty, printable
-** ASCII only. */
+** ASCII only, at most LW_PLOTTER_GCODE_LINE_MAX characters (GRBL's line
+** buffer holds 80 with its end). */
+#define LW_PLOTTER_GCODE_LINE_MAX 79
 int lw_plotter_gcode_line_ok(const char *line);
 
 /* What writing final.hpgl (gcode 0) or final.gcode (1) of the paths s
