@@ -218,8 +218,24 @@ static lw_status close_share(const lw_params *p, const lw_scene *sc, const lw_st
   return s;
 }
 
+/* A G-code feed's rounding to the thousandth of a mm/min, where it is more
+** than 1 % (below 0.05 mm/min; F0 is refused, params.c), as HP-GL's VS. */
+static void gcode_feed_note(const lw_params *p, char *note, size_t n)
+{
+  const char *key[2] = {"speed_down", "speed_up"};
+  const double v[2] = {p->speed_down, p->speed_up};
+  for (int k = 0; p->gcode && k < 1 + (p->gcode_travel == 1); k++) {
+    const double f = 60.0 * v[k], written = round(1000.0 * f) / 1000.0;
+    const size_t used = strlen(note);
+    if (fabs(written - f) > 0.01 * f && used < n)
+      snprintf(note + used, n - used, "%splot.%s = %g mm/s is F%g in final.gcode (mm/min to the thousandth), "
+               "%.0f %% off", used ? "; " : "", key[k], v[k], written, 100.0 * fabs(written - f) / f);
+  }
+}
+
 void lw_drawing_note(const lw_params *p, char *note, size_t n)
 {
+  gcode_feed_note(p, note, n);
   if (!p->hpgl) return;
   /* HP-GL/1 takes coordinates to 32,767 units: a page past that without a
   ** bed to check against wrote them unsaid (an A1 page reached 33,642) */

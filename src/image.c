@@ -685,7 +685,7 @@ static const char *foreign_format(const unsigned char *d, size_t n)
 {
   if (n >= 12 && !memcmp(d, "RIFF", 4) && !memcmp(d + 8, "WEBP", 4)) return "a WebP";
   /* the Netpbm kinds but the binary PGM/PPM (P5, P6) that are read */
-  if (n >= 3 && d[0] == 'P' && strchr(" \t\r\n", d[2]) && d[2]) {
+  if (n >= 3 && d[0] == 'P' && strchr(" \t\r\n#", d[2]) && d[2]) {
     static const char *const pnm[] = {['1'] = "a plain-text PBM (P1)", ['2'] = "a plain-text PGM (P2)",
                                       ['3'] = "a plain-text PPM (P3)", ['4'] = "a PBM (P4)", ['7'] = "a PAM (P7)"};
     if (d[1] < sizeof pnm / sizeof pnm[0] && pnm[d[1]]) return pnm[d[1]];

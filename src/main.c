@@ -791,7 +791,8 @@ static int loop_fail(lw_anneal *a, long began, watcher *w, lw_error *err)
   snprintf(state, sizeof state, "%s/state.lw", a->dir);
   if (err->code == LW_EIO && access(state, F_OK)) {
     size_t n = strlen(err->msg);
-    snprintf(err->msg + n, sizeof err->msg - n, "; %s is gone, and the run with it", state);
+    snprintf(err->msg + n, sizeof err->msg - n, "; %s is no longer there: the run's directory was removed or moved, "
+             "so the run ends (moved, it resumes from its last checkpoint where it is now)", state);
   } else if (err->code == LW_EIO || err->code == LW_ENOMEM) {
     size_t n = strlen(err->msg);
     char word[LW_RUNDIR_WORD_MAX];
@@ -1208,7 +1209,8 @@ static int cmd_run(int argc, char **argv)
     /* (the directory removed after the set-up's checkpoint, before its last
     ** file: "wrote no checkpoint" was said of the one that went with it) */
     if (err.code == LW_EIO && a.saved > 0 && access(state, F_OK))
-      snprintf(err.msg + n, sizeof err.msg - n, "; %s is gone, and the run with it", state);
+      snprintf(err.msg + n, sizeof err.msg - n, "; %s is no longer there: the run's directory was removed or moved, "
+               "so the run ends (moved, it resumes from its last checkpoint where it is now)", state);
     else if (err.code == LW_EIO && !lw_phase_unwritten())
       snprintf(err.msg + n, sizeof err.msg - n, "; the run wrote no checkpoint%s: run it again once the files can "
                "be written", back ? ", and the run that was in the directory is back as it was"

@@ -505,7 +505,7 @@ const lw_param_def lw_param_table[] = {
   NUM("output", "trace_exact", LW_PT_INT, trace_exact, "1", "", 0, 1, 0,
       "1 = trace.csv's numbers with every digit that reads back (%.15g, else %.17g); 0 = at 10 "
       "significant digits, as runs before 2026-12-07 (a run of theirs, whose scene.ini has no "
-      "line for this key, resumes and reruns so). 10 digits round away a large energy's fluctuations at a "
+      "line for this key, resumes so; a new run of its scene.ini writes every digit). 10 digits round away a large energy's fluctuations at a "
       "low temperature, and its heat capacity with them; `linewise stats` says where."),
   NUM("output", "observables", LW_PT_INT, observables, "0", "", 0, 1, 0,
       "1 adds the system's observables to every row of trace.csv (columns obs_<name>: for splines "
@@ -1633,7 +1633,9 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
   /* a scene.ini that a run wrote before the key was one runs again as that
   ** run did (the hash of a resume's leaves the missing key out) */
   if (p->run_header && !lw_params_line(p, "anneal", "seed_version")) p->seed_version = 1;
-  if (p->run_header && !lw_params_line(p, "output", "trace_exact")) p->trace_exact = 0;
+  /* (a resume only: a new run of such a scene.ini writes every digit, its
+  ** statistics whole; the resumed trace stays of one kind) */
+  if (p->run_written && !lw_params_line(p, "output", "trace_exact")) p->trace_exact = 0;
   /* the driver decides the presets' keys below */
   if (!lw_driver_of(p, err)) return err->code;
   /* before the page is sized, which the orientation decides */
@@ -1726,7 +1728,7 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
     if (60.0 * speed[k] >= 0.0005) continue;
     lw_params_origin(p, lw_params_find("plot", speed_key[k]), where, sizeof where);
     return lw_error_set(err, LW_EINPUT, "%s: key 'plot.%s' = %g mm/s: final.gcode's feed (mm/min, to the thousandth) "
-                        "would be F0, which GRBL refuses; expected at least 1e-05 mm/s (output.gcode = 1)", where,
+                        "would be F0, which GRBL refuses; expected more than 8.33e-06 mm/s (output.gcode = 1)", where,
                         speed_key[k], speed[k]);
   }
   /* With crop (the default) every stroke is cut inside the page inset by

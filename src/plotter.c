@@ -304,7 +304,7 @@ lw_status lw_output_gcode_strokes(const lw_strokes *s, const lw_output_page *pag
   /* (lines of at most 79 characters: a sender that counts them into
   ** GRBL's 128-byte buffer stalled on a page's 131) */
   fputs(o->turn ? " mm\n; turned a quarter turn counterclockwise, origin at its top-left corner,\n; its top edge "
-                  "along y\n" : " mm, origin at its lower-left corner, y up\n", f);
+                  "along y\n" : " mm\n; origin at its lower-left corner, y up\n", f);
   int first = 0; /* the first pen that draws: a pen that draws nothing is not asked for */
   while (first + 1 < s->n_pens && s->pen_first[first] == s->pen_first[first + 1]) first++;
   size_t a0, z0;

@@ -284,6 +284,7 @@ typedef struct {
   int *run;          /* K: the trace each state came from */
   size_t *rows;      /* K: the rows its samples were thinned from */
   int open;          /* states whose autocorrelation window did not close */
+  int rounded;       /* states whose energies are printed coarsely (lw_trace_rounded) */
   int n_swaps;        /* neighbour pairs with an exchange column: */
   double *swap;       /* their acceptance over the rows (NAN: none), */
   double *swap_b;     /* 2 each: their rungs' inverse temperatures, */
@@ -386,6 +387,7 @@ static lw_status gather(const lw_trace *const *t, const char *const *path, const
       size_t g = (size_t)ceil(2.0 * fmax(tau, 0.5));
       if (c > g * LW_REWEIGHT_SAMPLES) g = (c + LW_REWEIGHT_SAMPLES - 1) / LW_REWEIGHT_SAMPLES;
       s->open += !window;
+      s->rounded += lw_trace_rounded(x, c);
       size_t at = s->first[s->K];
       for (size_t i = 0; i < c; i += g) s->E[at++] = x[i];
       s->beta[s->K] = 1.0 / T;
@@ -841,6 +843,10 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
             "in equilibrium, or stuck in a basin; start later with --from, or run longer), and the table mixes "
             "them\n", tab.inconsistent, tab.inconsistent > 1 ? "s'" : "'s", tab.inconsistent > 1 ? "their" : "its",
             tab.worst_t, tab.worst_own, tab.worst_se, tab.worst_rw);
+  if (apart && s.rounded)
+    fprintf(apart, "warning: %d rung%s energies are printed to 10 digits (a run begun before 2026-12-07), which is "
+            "coarse against their spread: the rounding adds to their variance, and the heat capacities are too "
+            "large (a new run writes every digit)\n", s.rounded, s.rounded > 1 ? "s'" : "'s");
   if (apart && s.open)
     fprintf(apart, "warning: %d rung%s autocorrelation window did not close: thinned by too little, the error "
             "bars are too small (a longer stretch is needed)\n", s.open, s.open > 1 ? "s'" : "'s");

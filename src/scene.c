@@ -152,7 +152,7 @@ static lw_grid2d *image_potential(const lw_scene *sc, const lw_image *img, const
 ** a black logo on transparent paper, a fifth of the picture, was said dark
 ** all over, and the advice (invert) left nothing to draw. */
 #define DARK_TONE 0.2  /* 80 % dark or darker */
-#define DARK_SHARE 0.5 /* of the picture's opaque pixels in the frame */
+#define DARK_SHARE 0.5 /* of the picture's pixels in the frame, and of all of them */
 static void dark_note(lw_scene *sc, const lw_params *p)
 {
   if (!sc->on[LW_TERM_TONE] && !(sc->on[LW_TERM_POTENTIAL] && p->potential == LW_POT_IMAGE)) return;

@@ -441,23 +441,29 @@ int lw_trace_rungs(const lw_trace *t, int *energy, int *temp, int max)
   return n;
 }
 
-/* Whether a run's column of spread sd has every value in the given rows at
-** 10 significant digits, the trace's print before 2026-12-07, and spreads
-** under 3 steps of the last digit (WARN_ROUNDED).  A value written in full
-** is at 10 digits by chance about once in 10^7. */
-static int rounded_column(const lw_trace *t, const size_t *row, size_t n, int col, double sd)
+/* Whether values x[n] of spread sd are all at 10 significant digits, the
+** trace's print before 2026-12-07, and spread under 3 steps of the last
+** digit (WARN_ROUNDED).  A value written in full is at 10 digits by chance
+** about once in 10^7. */
+static int rounded_values(const double *x, size_t n, double sd)
 {
   double most = 0.0;
   if (!(sd > 0.0)) return 0;
   for (size_t i = 0; i < n; i++) {
-    double v = at(t, row[i], col);
     char buf[32];
-    if (isnan(v)) continue;
-    snprintf(buf, sizeof buf, "%.10g", v);
-    if (strtod(buf, NULL) != v) return 0;
-    if (fabs(v) > most) most = fabs(v);
+    snprintf(buf, sizeof buf, "%.10g", x[i]);
+    if (strtod(buf, NULL) != x[i]) return 0;
+    if (fabs(x[i]) > most) most = fabs(x[i]);
   }
   return most > 0.0 && sd < 3.0 * pow(10.0, floor(log10(most)) - 9.0);
+}
+
+int lw_trace_rounded(const double *x, size_t n)
+{
+  double m = 0.0, s = 0.0;
+  for (size_t i = 0; i < n; i++) m += (x[i] - m) / (double)(i + 1);
+  for (size_t i = 0; i < n; i++) s += (x[i] - m) * (x[i] - m);
+  return n > 1 && rounded_values(x, n, sqrt(s / (double)(n - 1)));
 }
 
 /* The energy columns whose fluctuations make a heat capacity, each with its
@@ -588,8 +594,10 @@ static int one_chain(const lw_trace *a, const lw_trace *b)
     }
     for (size_t c = 0; same && c < a->n_cols; c++) {
       if (in_b[c] < 0) continue;
+      /* (to 10 digits: a trace of before 2026-12-07 beside the same seed's
+      ** run again, in full) */
       const double u = at(a, i, (int)c), v = at(b, j, in_b[c]);
-      same = u == v || (isnan(u) && isnan(v));
+      same = u == v || (isnan(u) && isnan(v)) || fabs(u - v) <= 6e-10 * fmax(fabs(u), fabs(v));
     }
     common++, i++, j++;
   }
@@ -691,6 +699,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     int empty = 0;
     for (int r = 0; r < k; r++) {
       lw_trace_column_stats(t[r], row[r], n[r], (int)c, x, &cs[c].run[r]);
+      if (c < raw[r]->n_cols) cs[c].rounded |= rounded_values(x, cs[c].run[r].n, cs[c].run[r].sd);
       if (cs[c].run[r].n > 1 && isnan(cs[c].run[r].tau)) {
         status = lw_error_set(err, LW_ENOMEM, "%s: out of memory for the autocorrelation of %s", path[r],
                               t[0]->name[c]);
@@ -701,7 +710,6 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       const lw_series_stats *s = &cs[c].run[r];
       /* (not a relaxation's: the drift test speaks for it) */
       cs[c].coarse |= s->n > 1 && s->sd > 0.0 && s->tau < 0.75 && gap[r] > 1.0 && !(fabs(s->drift_z) > 4.0);
-      if (c < raw[r]->n_cols) cs[c].rounded |= rounded_column(t[r], row[r], n[r], (int)c, s->sd);
     }
     /* a heat capacity is of its energy's fluctuations: rounded with them */
     const char *hc = strstr(t[0]->name[c], "heat_capacity");
@@ -820,9 +828,9 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
             "too large, or a temperature too low, for the moves)\n",
             k > 1 ? (frozen > 1 ? "runs" : "a run") : "the run", frozen > 1 ? "their" : "its");
   if (apart && k > 1) warn_twins(apart, raw, n, path, k);
-  warn(apart, t[0], cs, k, WARN_ROUNDED, "printed to 10 digits (trace.csv before 2026-12-07), which is coarse "
+  warn(apart, t[0], cs, k, WARN_ROUNDED, "printed to 10 digits (a run begun before 2026-12-07), which is coarse "
        "against their spread: the rounding's variance is over 1 % of theirs, so their error bars and a heat "
-       "capacity from them are off by as much or more (a run of this version writes every digit)");
+       "capacity from them are off by as much or more (a new run writes every digit)");
   /* the table's warnings; with --csv, those of one run are its columns
   ** (window_closed, n and n_eff, drift_z, batch_ratio), and of several runs
   ** only r_hat and p_runs: the rest go apart, where a script sees that the

@@ -39,7 +39,10 @@ static void resume_fixture_matches_fresh_run(const char *name, const char *const
   ** as an earlier sweep (22 of "221,..."), must go, not stay */
   cr_assert_eq(lw_test_sh("printf '26,0.1\n22' >> %s/old/trace.csv", dir), 0);
   cr_assert_eq(lw_test_sh("%s resume %s/old --quiet", lw_test_bin(), dir), 0, "the old run directory does not resume");
-  cr_assert_eq(lw_test_sh("%s run %s/old/scene.ini --out %s/fresh --quiet", lw_test_bin(), dir, dir), 0);
+  /* (at the old trace's 10 digits, which a resume keeps and a new run of
+  ** its scene.ini leaves for every digit) */
+  cr_assert_eq(lw_test_sh("%s run %s/old/scene.ini --out %s/fresh --quiet --set output.trace_exact=0", lw_test_bin(),
+                          dir, dir), 0);
   /* but for scene_hash and scene_keys: the old scene.ini lacks the keys
   ** added since, which a resume leaves out of the hash and a fresh run of it
   ** writes in; and size_peak, which a resume of a file without it begins at

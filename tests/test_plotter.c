@@ -511,7 +511,7 @@ Test(plotter, command_line_writes_the_same_files_for_the_same_seed)
   ** F0 (drawing, or travelling at feed) */
   static const char *const bad[][2] = {
     {"'plot.gcode_pen_down=M3 S90 G4 P0.2 %0*d'", "key 'plot.gcode_pen_down'"},
-    {"plot.speed_down=0.000001", "key 'plot.speed_down' = 1e-06 mm/s: final.gcode's feed"},
+    {"plot.speed_down=0.0000083", "key 'plot.speed_down' = 8.3e-06 mm/s: final.gcode's feed"},
     {"plot.speed_up=0.000001 --set plot.gcode_travel=feed", "key 'plot.speed_up' = 1e-06 mm/s"},
   };
   for (int k = 0; k < 3; k++) {
@@ -523,6 +523,13 @@ Test(plotter, command_line_writes_the_same_files_for_the_same_seed)
     cr_assert(strstr(errs, bad[k][1]), "%s", errs);
     free(errs);
   }
+  /* a feed rounded by more than 1 % is said, as HP-GL's VS */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set plot.speed_down=0.00001 "
+                          "--set anneal.sweeps=0 --out %s/slow 2>%s/err.txt", bin, root, dir, dir), 0);
+  errs = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(errs, "note: plot.speed_down = 1e-05 mm/s is F0.001 in final.gcode (mm/min to the thousandth), "
+                    "67 % off"), "%s", errs);
+  free(errs);
   /* travelling by rapids, no feed is written of speed_up */
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set plot.speed_up=0.000001 --quiet "
                           "--set anneal.sweeps=0 --out %s/rapid", bin, root, dir), 0);

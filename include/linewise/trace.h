@@ -78,6 +78,12 @@ lw_trace *lw_trace_with_heat_capacity(const lw_trace *t, const size_t *rows, siz
 /* The rows' spacing in sweeps (output.trace_every), from the first two. */
 double lw_trace_every(const lw_trace *t);
 
+/* Whether the n values (a column's, or a rung's energies) are all at 10
+** significant digits, as traces were printed before 2026-12-07, and spread
+** under 3 steps of the last digit: the rounding's variance is then over 1 %
+** of theirs, and a heat capacity of them off by as much or more. */
+int lw_trace_rounded(const double *x, size_t n);
+
 /* The statistics of column col over the n rows, empty fields skipped (out->n
 ** = 0 when every one is empty); x is scratch for n values. */
 void lw_trace_column_stats(const lw_trace *t, const size_t *rows, size_t n, int col, double *x, lw_series_stats *out);
