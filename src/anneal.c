@@ -174,6 +174,10 @@ void lw_anneal_observables_note(const lw_anneal *a, char *buf, size_t n)
   if (a->observables_lost[0])
     snprintf(buf, n, "summary.json's observables are null: %s ('linewise stats %s' computes them from trace.csv, "
              "given the memory)", a->observables_lost, lw_rundir_shell_word(a->dir, word, sizeof word));
+  else if (a->observables_rounded[0])
+    snprintf(buf, n, "summary.json's statistics of %s are of values trace.csv prints to 10 digits (output.trace_exact = 0, as "
+             "runs begun before 2026-12-07), which is coarse against their spread: their error bars and a heat "
+             "capacity are off by over 1 %% (a new run writes every digit)", a->observables_rounded);
 }
 
 /* Temperature step of sweep s: the sweeps are shared out evenly; past the
@@ -1977,6 +1981,27 @@ static void put_per_move(lw_json *j, const char *key, const lw_chain *c, const l
 ** read back from trace.csv, which the checkpoint before has flushed; null
 ** where the trace has no such stretch.  The effective samples let a sweep's table show the error bars
 ** too rough to trust (under 25, as `linewise stats` warns). */
+/* Where the run prints its trace to 10 digits (output.trace_exact = 0),
+** names an observable whose values x[m] (a heat capacity: its energy's, in
+** t) are coarse against their spread (lw_trace_rounded) in
+** a->observables_rounded.  x is overwritten. */
+static void observable_rounded(lw_anneal *a, const lw_trace *t, const size_t *rows, size_t n, const char *name,
+                               int obs, double *x, size_t m)
+{
+  if (!obs) { /* replicaK_heat_capacity of replicaK_energy, heat_capacity of total */
+    char src[64];
+    const size_t keep = strlen(name) - strlen("heat_capacity");
+    snprintf(src, sizeof src, "%.*s%s", (int)keep, name, keep ? "energy" : "total");
+    const int e = lw_trace_column(t, src);
+    m = 0;
+    for (size_t i = 0; e >= 0 && i < n; i++)
+      if (!isnan(t->v[rows[i] * t->n_cols + (size_t)e])) x[m++] = t->v[rows[i] * t->n_cols + (size_t)e];
+  }
+  const size_t used = strlen(a->observables_rounded);
+  if (lw_trace_rounded(x, m) && used < sizeof a->observables_rounded)
+    snprintf(a->observables_rounded + used, sizeof a->observables_rounded - used, "%s%s", used ? ", " : "", name);
+}
+
 static void put_observables(lw_anneal *a, lw_json *j)
 {
   char path[LW_PATH_MAX + 32], key[96];
@@ -1990,7 +2015,7 @@ static void put_observables(lw_anneal *a, lw_json *j)
   lw_trace *h = NULL; /* t with its heat capacities */
   lw_json_key(j, "observables");
   lw_status rs = LW_OK;
-  a->observables_lost[0] = '\0';
+  a->observables_lost[0] = a->observables_rounded[0] = '\0';
   if (!t || (rs = lw_trace_rows(t, path, &sel, &rows, &n, &tuned, &e)) || !(x = malloc(n * sizeof *x)) ||
       !(h = lw_trace_with_heat_capacity(t, rows, n, path, &e))) {
     /* null too where no row qualifies (documented, and nothing to say) */
@@ -2011,6 +2036,7 @@ static void put_observables(lw_anneal *a, lw_json *j)
       if (!obs && !heat) continue;
       lw_series_stats st;
       lw_trace_column_stats(h, rows, n, (int)k, x, &st);
+      if (!a->params.trace_exact) observable_rounded(a, t, rows, n, name, obs, x, st.n);
       const char *suffix[7] = {"", "_stderr", "_tau_sweeps", "_n_eff", "_window_closed", "_drift_z", "_batch_ratio"};
       const double value[7] = {st.mean, st.stderr_mean, st.tau * lw_trace_column_gap(every, n, &st), st.n_eff,
                                st.window > 0, st.drift_z, st.batch_ratio};

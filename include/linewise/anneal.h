@@ -83,6 +83,8 @@ typedef struct lw_anneal {
   lw_block_stats prev;         /* energy statistics of the previous step */
   double acc_n, acc_sum, acc_sumsq; /* this step's energy samples (after tuning) */
   double max_drift;            /* largest relative drift seen at a check */
+  char observables_rounded[256]; /* summary.json's observables of values printed to 10 digits that
+                                 ** spread under 3 steps of the last (a resumed run of before 2026-12-07) */
   char observables_lost[512];  /* why summary.json's observables are null where rows were
                                ** there to sum (out of memory reading the trace), or "" */
   double row_drift;            /* the same over the largest size since the check before, by
