@@ -159,22 +159,26 @@ fuzz: fuzz-build
 	    build-fuzz/corpus/$$t tests/fuzz/corpus/$$t || exit 1; \
 	done
 
+# apt-get installs as root only: said, with the way, before it fails on its
+# lock file
+AS_ROOT = { [ "$$(id -u)" = 0 ] || { echo "the packages install with apt-get, as root: sudo make $@" >&2; exit 1; }; } &&
+
 deps:
 	@missing=""; for p in $(DEBS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
 	if [ -n "$$missing" ]; then \
-	  echo "installing:$$missing"; apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
+	  echo "installing:$$missing"; $(AS_ROOT) apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
 	else echo "all build dependencies present"; fi
 
 # Open MPI for the MPI build (make mpi) only.
 deps-mpi:
 	@missing=""; for p in $(MPI_DEBS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
 	if [ -n "$$missing" ]; then \
-	  echo "installing:$$missing"; apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
+	  echo "installing:$$missing"; $(AS_ROOT) apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
 	else echo "all MPI dependencies present"; fi
 
 # ffmpeg for tools/animate.sh only: not needed to build or test.
 deps-animation:
-	@dpkg -s ffmpeg >/dev/null 2>&1 || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ffmpeg; }
+	@dpkg -s ffmpeg >/dev/null 2>&1 || { $(AS_ROOT) apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ffmpeg; }
 
 run: bin/linewise $(PICTURE)
 	bin/linewise run params/example.ini --out out/example

@@ -721,6 +721,17 @@ static const char *foreign_format(const unsigned char *d, size_t n)
   return NULL;
 }
 
+const char *lw_image_kind(const unsigned char *d, size_t n)
+{
+  static const char *const readable[] = {"PNG", "a PNG", "JPEG", "a JPEG", "BMP", "a BMP", "GIF", "a GIF"};
+  const char *name = format_name(d, n);
+  for (size_t k = 0; k < sizeof readable / sizeof *readable; k += 2)
+    if (!strcmp(name, readable[k])) return readable[k + 1];
+  if (n >= 3 && d[0] == 'P' && (d[1] == '5' || d[1] == '6') && strchr(" \t\r\n#", d[2]) && d[2])
+    return d[1] == '5' ? "a PGM" : "a PPM";
+  return foreign_format(d, n);
+}
+
 /* Why the decoder refuses a picture as too large, or NULL: a side past
 ** 2^24 pixels, or more bytes of pixels (width x height x channels, a
 ** palette's counted as 4) than it allocates: 2^30 for a PNG, INT_MAX for
@@ -972,7 +983,16 @@ static unsigned char *read_picture_file(const char *path, size_t *size_out, lw_e
   }
   FILE *f = fopen(path, "rb");
   if (!f) {
-    lw_error_set(err, LW_EINPUT, "%s: cannot open the image: %s", path, strerror(errno));
+    /* what a missing picture's name most often holds by mistake: a ~ the
+    ** shell leaves after '=' (photos live in ~/Pictures), quotes a scene
+    ** file keeps as part of the value */
+    const int e = errno, tilde = !strncmp(path, "~/", 2) || strstr(path, "/~/");
+    const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+    const int quoted = e == ENOENT && (base[0] == '"' || base[0] == '\'');
+    lw_error_set(err, LW_EINPUT, "%s: cannot open the image: %s%s", path, strerror(e),
+                 e != ENOENT ? ""
+                 : tilde ? " (the shell does not expand ~ after '=': write $HOME/... instead)"
+                 : quoted ? " (quotes in a scene file are part of the value: write the name without them)" : "");
     return NULL;
   }
   if (fstat(fileno(f), &sb) || !S_ISREG(sb.st_mode)) {

@@ -135,13 +135,18 @@ static lw_status load_run_dir(const char *dir, lw_params *p, lw_state *st, char 
 static lw_status set_option(lw_params *p, const char *assignment, lw_error *err);
 
 /* For an argument refused as an option: a file or directory of that name
-** is what was meant, and "./" says so (options are read before names). */
+** is what was meant, and "./" says so (options are read before names); or
+** --out=DIR, the form of other programs, is two words here. */
 static const char *dash_hint(const char *arg)
 {
   static char buf[LW_PATH_MAX + 64];
   buf[0] = '\0';
+  const char *eq = strchr(arg, '=');
   if (arg[0] == '-' && access(arg, F_OK) == 0)
     snprintf(buf, sizeof buf, " ('%s' is a file or directory here: write './%s', or '--' before it)", arg, arg);
+  else if (!strncmp(arg, "--", 2) && eq && eq > arg + 2) /* --out=DIR, as other programs take it */
+    snprintf(buf, sizeof buf, " (an option and its value are two words: write '%.*s %.*s')", (int)(eq - arg), arg,
+             LW_PATH_MAX, eq + 1);
   return buf;
 }
 
@@ -1208,7 +1213,7 @@ static int cmd_run(int argc, char **argv)
     snprintf(state, sizeof state, "%s/state.lw", dir);
     /* (the directory removed after the set-up's checkpoint, before its last
     ** file: "wrote no checkpoint" was said of the one that went with it) */
-    if (err.code == LW_EIO && a.saved > 0 && access(state, F_OK))
+    if (err.code == LW_EIO && lw_phase_last_commit(NULL) >= 0 && access(state, F_OK))
       snprintf(err.msg + n, sizeof err.msg - n, "; %s is no longer there: the run's directory was removed or moved, "
                "so the run ends (moved, it resumes from its last checkpoint where it is now)", state);
     else if (err.code == LW_EIO && !lw_phase_unwritten())

@@ -1392,6 +1392,21 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
   if (lw_text_not_fifo(path, err)) return err->code;
   FILE *f = fopen(path, "r");
   if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open scene file: %s", path, strerror(errno));
+  /* a photo where the scene goes ("linewise run my-photo.jpg") was "a NUL
+  ** byte inside the line (UTF-16 text ...)" */
+  unsigned char head[64];
+  const size_t got = fread(head, 1, sizeof head, f);
+  const char *kind = lw_image_kind(head, got);
+  if (kind) {
+    fclose(f);
+    const int readable = strstr("a PNG|a JPEG|a BMP|a GIF|a PGM|a PPM", kind) != NULL;
+    if (readable)
+      return lw_error_set(err, LW_EINPUT, "%s: %s picture, not a scene file: a scene draws it, e.g. 'linewise run "
+                          "params/photo.ini --set scene.image=%s' (README, \"Pictures\")", path, kind, path);
+    return lw_error_set(err, LW_EINPUT, "%s: %s file, not a scene file (a scene file is text: '[section]' and 'key = "
+                        "value' lines; README, \"Using it\")", path, kind);
+  }
+  rewind(f);
   /* inih's continuation lines off: an indented line without '=' would
   ** glue a typo onto any value above (an indented key = value is a key);
   ** only a list goes on (continue_list).  Debian's inih takes these as

@@ -1170,6 +1170,35 @@ Test(cli, resume_refuses_a_state_of_another_scene_file)
                0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
+/* A workshop's slips, each said in one line with its way out: a photo where
+** the scene goes (it was "a NUL byte inside the line (UTF-16 text ...)"), a
+** drawing's SVG there, a ~ the shell left after '=', quotes a scene file
+** keeps in a value, and --out=DIR as other programs take it. */
+Test(cli, a_students_slips_are_said_with_the_way_out)
+{
+  static const char *const cases[][2] = {
+    {"run %s/params/picture.png", "picture.png: a PNG picture, not a scene file: a scene draws it, e.g. 'linewise "
+     "run params/photo.ini --set scene.image="},
+    {"run d.svg", "d.svg: an SVG file, not a scene file (a scene file is text"},
+    {"run %s/params/minimal.ini --quiet --out t --set scene.image=~/Pictures/cat.jpg",
+     "/~/Pictures/cat.jpg: cannot open the image: No such file or directory (the shell does not expand ~ after '=': "
+     "write $HOME/... instead)"},
+    {"run q.ini --quiet --out t", "/\"my photo.jpg\": cannot open the image: No such file or directory (quotes in a "
+     "scene file are part of the value: write the name without them)"},
+    {"run %s/params/minimal.ini --out=t", "(an option and its value are two words: write '--out t')"},
+  };
+  write_file("d.svg", "<svg xmlns=\"http://www.w3.org/2000/svg\"></svg>\n");
+  write_file("q.ini", "[scene]\nimage = \"my photo.jpg\"\n");
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    char args[512];
+    snprintf(args, sizeof args, cases[k][0], lw_test_root());
+    cr_assert_eq(lw_test_sh("cd %s && %s %s > out.txt 2> err.txt", dir, lw_test_bin(), args), 2, "%s", args);
+    char *e = lw_test_slurp("%s/err.txt", dir);
+    cr_assert(e && strstr(e, cases[k][1]) && strchr(e, '\n') == e + strlen(e) - 1, "%s: %s", args, e);
+    free(e);
+  }
+}
+
 /* A bundled scene named without its folder, from another directory (or
 ** from an install, whose scenes are in PREFIX/share/linewise/params): the
 ** message says where the bundled one is, found beside the binary (a build

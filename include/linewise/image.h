@@ -59,6 +59,11 @@ void lw_image_free(lw_image *img);
 ** while it is converted.  info (may be NULL) receives what the file held.  LW_EINPUT for
 ** anything that is not a decodable picture, naming `name` and the decoder's
 ** reason. */
+/* The picture format of a file beginning with the n bytes d, with its
+** article ("a JPEG", "a HEIC"), read or not, or NULL: a picture given where
+** a scene file goes is said to be one. */
+const char *lw_image_kind(const unsigned char *d, size_t n);
+
 lw_image *lw_image_decode(const unsigned char *data, size_t size, const char *name,
                           double max_pixels, lw_image_info *info, lw_error *err);
 
