@@ -166,14 +166,14 @@ AS_ROOT = { [ "$$(id -u)" = 0 ] || { echo "the packages install with apt-get, as
 deps:
 	@missing=""; for p in $(DEBS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
 	if [ -n "$$missing" ]; then \
-	  echo "installing:$$missing"; $(AS_ROOT) apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
+	  $(AS_ROOT) echo "installing:$$missing" && apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
 	else echo "all build dependencies present"; fi
 
 # Open MPI for the MPI build (make mpi) only.
 deps-mpi:
 	@missing=""; for p in $(MPI_DEBS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
 	if [ -n "$$missing" ]; then \
-	  echo "installing:$$missing"; $(AS_ROOT) apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
+	  $(AS_ROOT) echo "installing:$$missing" && apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
 	else echo "all MPI dependencies present"; fi
 
 # ffmpeg for tools/animate.sh only: not needed to build or test.

@@ -986,13 +986,13 @@ static unsigned char *read_picture_file(const char *path, size_t *size_out, lw_e
     /* what a missing picture's name most often holds by mistake: a ~ the
     ** shell leaves after '=' (photos live in ~/Pictures), quotes a scene
     ** file keeps as part of the value */
-    const int e = errno, tilde = !strncmp(path, "~/", 2) || strstr(path, "/~/");
-    const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
-    const int quoted = e == ENOENT && (base[0] == '"' || base[0] == '\'');
+    const int e = errno, tilde = path[0] == '~' || strstr(path, "/~");
+    const int quoted = strchr("\"'", path[0]) || strstr(path, "/\"") || strstr(path, "/'");
     lw_error_set(err, LW_EINPUT, "%s: cannot open the image: %s%s", path, strerror(e),
                  e != ENOENT ? ""
-                 : tilde ? " (the shell does not expand ~ after '=': write $HOME/... instead)"
-                 : quoted ? " (quotes in a scene file are part of the value: write the name without them)" : "");
+                 : tilde ? " (a ~ is not expanded here, nor after '=' by the shell: write the whole path)"
+                 : quoted ? " (quotes in a scene file or inside --set's value are part of the name: write it "
+                            "without them)" : "");
     return NULL;
   }
   if (fstat(fileno(f), &sb) || !S_ISREG(sb.st_mode)) {

@@ -134,19 +134,33 @@ static lw_status load_run_dir(const char *dir, lw_params *p, lw_state *st, char 
 
 static lw_status set_option(lw_params *p, const char *assignment, lw_error *err);
 
-/* For an argument refused as an option: a file or directory of that name
-** is what was meant, and "./" says so (options are read before names); or
-** --out=DIR, the form of other programs, is two words here. */
-static const char *dash_hint(const char *arg)
+/* For an argument refused as an option of a command whose options are
+** `options` (NULL-ended; NULL: it has only --set): a file or directory of
+** that name is what was meant, and "./" says so (options are read before
+** names); or an option of it given as --out=DIR, the form of other
+** programs, which is two words here (an option without a value says so). */
+static const char *dash_hint(const char *arg, const char *const *options)
 {
-  static char buf[LW_PATH_MAX + 64];
+  static const char *const flags[] = {"--quiet", "--csv", NULL}, *const set_only[] = {"--set", NULL};
+  static char buf[LW_PATH_MAX + 96];
   buf[0] = '\0';
   const char *eq = strchr(arg, '=');
-  if (arg[0] == '-' && access(arg, F_OK) == 0)
+  if (arg[0] == '-' && access(arg, F_OK) == 0) {
     snprintf(buf, sizeof buf, " ('%s' is a file or directory here: write './%s', or '--' before it)", arg, arg);
-  else if (!strncmp(arg, "--", 2) && eq && eq > arg + 2) /* --out=DIR, as other programs take it */
-    snprintf(buf, sizeof buf, " (an option and its value are two words: write '%.*s %.*s')", (int)(eq - arg), arg,
-             LW_PATH_MAX, eq + 1);
+    return buf;
+  }
+  if (strncmp(arg, "--", 2) || !eq) return buf;
+  const size_t len = (size_t)(eq - arg);
+  int known = 0, flag = 0;
+  for (const char *const *o = options ? options : set_only; *o; o++)
+    known |= strlen(*o) == len && !strncmp(*o, arg, len);
+  for (const char *const *o = flags; *o; o++) flag |= strlen(*o) == len && !strncmp(*o, arg, len);
+  char word[LW_RUNDIR_WORD_MAX];
+  if (known && flag)
+    snprintf(buf, sizeof buf, " (%.*s takes no value)", (int)len, arg);
+  else if (known)
+    snprintf(buf, sizeof buf, " (an option and its value are two words: write '%.*s %s')", (int)len, arg,
+             lw_rundir_shell_word(eq + 1, word, sizeof word));
   return buf;
 }
 
@@ -274,7 +288,7 @@ static int cmd_energy(int argc, char **argv)
     }
     if (argv[i][0] == '-' || dir) {
       lw_error_set(&err, LW_EUSAGE, "energy: expected one run directory and --set options, got '%s' "
-                   "(usage: linewise energy DIR [--set SEC.KEY=VAL]...)%s", argv[i], dash_hint(argv[i]));
+                   "(usage: linewise energy DIR [--set SEC.KEY=VAL]...)%s", argv[i], dash_hint(argv[i], NULL));
       return fail(&err);
     }
     dir = trim_slashes(argv[i]);
@@ -1103,7 +1117,7 @@ static int cmd_run(int argc, char **argv)
     }
     if (argv[i][0] == '-' && strcmp(argv[i], "--quiet")) {
       lw_error_set(&err, LW_EUSAGE, "run: unknown option '%s'%s (try 'linewise --help')%s%s", argv[i],
-                   strcmp(argv[i], "--sweeps") ? nearest(argv[i], run_options) : "", dash_hint(argv[i]),
+                   strcmp(argv[i], "--sweeps") ? nearest(argv[i], run_options) : "", dash_hint(argv[i], run_options),
                    !strcmp(argv[i], "--sweeps") ? " (a run's length is --set anneal.sweeps=N; "
                    "--sweeps extends a finished run under resume)" : "");
       return fail(&err);
@@ -1211,9 +1225,15 @@ static int cmd_run(int argc, char **argv)
     const size_t n = strlen(err.msg);
     char state[LW_PATH_MAX + 16];
     snprintf(state, sizeof state, "%s/state.lw", dir);
-    /* (the directory removed after the set-up's checkpoint, before its last
-    ** file: "wrote no checkpoint" was said of the one that went with it) */
-    if (err.code == LW_EIO && lw_phase_last_commit(NULL) >= 0 && access(state, F_OK))
+    /* (the directory removed or moved during the set-up: "wrote no
+    ** checkpoint" was said of one that went with it, and "the run that was
+    ** in the directory is back as it was" of a run set aside in it, gone or
+    ** moved along) */
+    if (err.code == LW_EIO && access(dir, F_OK))
+      snprintf(err.msg + n, sizeof err.msg - n, "; %s is no longer there: the run's directory was removed or moved "
+               "during the set-up (moved, 'linewise resume' where it is now puts back the run that was there, or "
+               "goes on from this run's checkpoint)", dir);
+    else if (err.code == LW_EIO && lw_phase_last_commit(NULL) >= 0 && access(state, F_OK))
       snprintf(err.msg + n, sizeof err.msg - n, "; %s is no longer there: the run's directory was removed or moved, "
                "so the run ends (moved, it resumes from its last checkpoint where it is now)", state);
     else if (err.code == LW_EIO && !lw_phase_unwritten())
@@ -1310,7 +1330,7 @@ static int cmd_resume(int argc, char **argv)
       if (used == 2) i++;
     } else if (argv[i][0] == '-' || dir) {
       lw_error_set(&err, LW_EUSAGE, "resume: unexpected '%s'%s %s%s", argv[i],
-                   argv[i][0] == '-' ? nearest(argv[i], resume_options) : "", RESUME_USAGE, dash_hint(argv[i]));
+                   argv[i][0] == '-' ? nearest(argv[i], resume_options) : "", RESUME_USAGE, dash_hint(argv[i], resume_options));
       return fail(&err);
     } else {
       dir = trim_slashes(argv[i]);
@@ -1404,7 +1424,7 @@ static int cmd_stats(int argc, char **argv)
       i++;
     } else if (argv[i][0] == '-') {
       lw_error_set(&err, LW_EUSAGE, "stats: unexpected '%s'%s %s%s", argv[i], nearest(argv[i], stats_options), use,
-                   dash_hint(argv[i]));
+                   dash_hint(argv[i], stats_options));
       break;
     } else if (dir_fits("stats", argv[i], &err)) {
       break;

@@ -1394,15 +1394,26 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
   if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open scene file: %s", path, strerror(errno));
   /* a photo where the scene goes ("linewise run my-photo.jpg") was "a NUL
   ** byte inside the line (UTF-16 text ...)" */
-  unsigned char head[64];
+  unsigned char head[512];
   const size_t got = fread(head, 1, sizeof head, f);
   const char *kind = lw_image_kind(head, got);
+  /* (the two-letter marks of BMP and Netpbm begin text too: "BMx = 1" is a
+  ** key; an SVG's XML prologue begins any XML or HTML: one without <svg near
+  ** the start is not called a picture) */
+  const unsigned char *nl = memchr(head, '\n', got);
+  const size_t line = nl ? (size_t)(nl - head) : got;
+  if (kind && (!strcmp(kind, "a BMP") || head[0] == 'P') && memchr(head, '=', line)) kind = NULL;
+  int svg_tag = 0;
+  for (size_t k = 0; k + 4 <= got && !svg_tag; k++) svg_tag = !memcmp(head + k, "<svg", 4);
+  if (kind && !strcmp(kind, "an SVG") && !svg_tag) kind = "an XML or HTML";
   if (kind) {
     fclose(f);
     const int readable = strstr("a PNG|a JPEG|a BMP|a GIF|a PGM|a PPM", kind) != NULL;
+    char word[LW_RUNDIR_WORD_MAX];
     if (readable)
       return lw_error_set(err, LW_EINPUT, "%s: %s picture, not a scene file: a scene draws it, e.g. 'linewise run "
-                          "params/photo.ini --set scene.image=%s' (README, \"Pictures\")", path, kind, path);
+                          "params/photo.ini --set scene.image=%s' (README, \"Pictures\")", path, kind,
+                          lw_rundir_shell_word(path, word, sizeof word));
     return lw_error_set(err, LW_EINPUT, "%s: %s file, not a scene file (a scene file is text: '[section]' and 'key = "
                         "value' lines; README, \"Using it\")", path, kind);
   }

@@ -844,7 +844,8 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
             "them\n", tab.inconsistent, tab.inconsistent > 1 ? "s'" : "'s", tab.inconsistent > 1 ? "their" : "its",
             tab.worst_t, tab.worst_own, tab.worst_se, tab.worst_rw);
   if (apart && s.rounded)
-    fprintf(apart, "warning: %d rung%s energies are printed to 10 digits (a run begun before 2026-12-07), which is "
+    fprintf(apart, "warning: %d rung%s energies are printed to 10 digits (output.trace_exact = 0, as runs begun before "
+            "2026-12-07), which is "
             "coarse against their spread: the rounding adds to their variance, and the heat capacities are too "
             "large (a new run writes every digit)\n", s.rounded, s.rounded > 1 ? "s'" : "'s");
   if (apart && s.open)

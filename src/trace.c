@@ -828,7 +828,8 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
             "too large, or a temperature too low, for the moves)\n",
             k > 1 ? (frozen > 1 ? "runs" : "a run") : "the run", frozen > 1 ? "their" : "its");
   if (apart && k > 1) warn_twins(apart, raw, n, path, k);
-  warn(apart, t[0], cs, k, WARN_ROUNDED, "printed to 10 digits (a run begun before 2026-12-07), which is coarse "
+  warn(apart, t[0], cs, k, WARN_ROUNDED, "printed to 10 digits (output.trace_exact = 0, as runs begun before "
+       "2026-12-07), which is coarse "
        "against their spread: the rounding's variance is over 1 % of theirs, so their error bars and a heat "
        "capacity from them are off by as much or more (a new run writes every digit)");
   /* the table's warnings; with --csv, those of one run are its columns

@@ -1173,7 +1173,8 @@ Test(cli, resume_refuses_a_state_of_another_scene_file)
 /* A workshop's slips, each said in one line with its way out: a photo where
 ** the scene goes (it was "a NUL byte inside the line (UTF-16 text ...)"), a
 ** drawing's SVG there, a ~ the shell left after '=', quotes a scene file
-** keeps in a value, and --out=DIR as other programs take it. */
+** keeps in a value (before a folder too), and --out=DIR as other programs
+** take it (of a command's options only, and not of one without a value). */
 Test(cli, a_students_slips_are_said_with_the_way_out)
 {
   static const char *const cases[][2] = {
@@ -1181,20 +1182,30 @@ Test(cli, a_students_slips_are_said_with_the_way_out)
      "run params/photo.ini --set scene.image="},
     {"run d.svg", "d.svg: an SVG file, not a scene file (a scene file is text"},
     {"run %s/params/minimal.ini --quiet --out t --set scene.image=~/Pictures/cat.jpg",
-     "/~/Pictures/cat.jpg: cannot open the image: No such file or directory (the shell does not expand ~ after '=': "
-     "write $HOME/... instead)"},
-    {"run q.ini --quiet --out t", "/\"my photo.jpg\": cannot open the image: No such file or directory (quotes in a "
-     "scene file are part of the value: write the name without them)"},
+     "/~/Pictures/cat.jpg: cannot open the image: No such file or directory (a ~ is not expanded here, nor after '=' "
+     "by the shell: write the whole path)"},
+    {"run q.ini --quiet --out t", "/\"photos/my photo.jpg\": cannot open the image: No such file or directory (quotes "
+     "in a scene file or inside --set's value are part of the name: write it without them)"},
     {"run %s/params/minimal.ini --out=t", "(an option and its value are two words: write '--out t')"},
+    {"run %s/params/minimal.ini '--out=my t'", "write '--out \"my t\"')"},
+    {"run %s/params/minimal.ini --quiet=1", "(--quiet takes no value)"},
+    /* not said of what is not an option of the command, nor of HTML or of
+    ** text that begins as a BMP does */
+    {"resume t --out=t", "resume: unexpected '--out=t' (usage: "},
+    {"run h.ini", "h.ini: an XML or HTML file, not a scene file"},
+    {"run bm.ini", "bm.ini:1: key 'BMx' comes before any [section]"},
   };
+  write_file("h.ini", "\n<!DOCTYPE html>\n<html>\n");
+  write_file("bm.ini", "BMx = 1\n");
   write_file("d.svg", "<svg xmlns=\"http://www.w3.org/2000/svg\"></svg>\n");
-  write_file("q.ini", "[scene]\nimage = \"my photo.jpg\"\n");
+  write_file("q.ini", "[scene]\nimage = \"photos/my photo.jpg\"\n");
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
     char args[512];
     snprintf(args, sizeof args, cases[k][0], lw_test_root());
     cr_assert_eq(lw_test_sh("cd %s && %s %s > out.txt 2> err.txt", dir, lw_test_bin(), args), 2, "%s", args);
     char *e = lw_test_slurp("%s/err.txt", dir);
-    cr_assert(e && strstr(e, cases[k][1]) && strchr(e, '\n') == e + strlen(e) - 1, "%s: %s", args, e);
+    cr_assert(e && strstr(e, cases[k][1]) && strchr(e, '\n') == e + strlen(e) - 1 &&
+              (k != 7 || !strstr(e, "two words")), "%s: %s", args, e);
     free(e);
   }
 }
