@@ -175,9 +175,10 @@ void lw_anneal_observables_note(const lw_anneal *a, char *buf, size_t n)
     snprintf(buf, n, "summary.json's observables are null: %s ('linewise stats %s' computes them from trace.csv, "
              "given the memory)", a->observables_lost, lw_rundir_shell_word(a->dir, word, sizeof word));
   else if (a->observables_rounded[0])
-    snprintf(buf, n, "summary.json's statistics of %s are of values trace.csv prints to 10 digits (output.trace_exact = 0, as "
-             "runs begun before 2026-12-07), which is coarse against their spread: their error bars and a heat "
-             "capacity are off by over 1 %% (a new run writes every digit)", a->observables_rounded);
+    snprintf(buf, n, "summary.json's statistics of %s are of values trace.csv prints to 10 digits "
+             "(output.trace_exact = 0, as runs begun before 2026-12-07), which is coarse against their spread: their "
+             "error bars and a heat capacity are off by over 1 %% (a new run writes every digit)",
+             a->observables_rounded);
 }
 
 /* Temperature step of sweep s: the sweeps are shared out evenly; past the
@@ -1975,12 +1976,6 @@ static void put_per_move(lw_json *j, const char *key, const lw_chain *c, const l
   lw_json_end_object(j);
 }
 
-/* summary.json's observables: each obs_ column's, and each heat capacity's
-** (trace.h), mean, standard error, autocorrelation time and effective
-** samples over the stretch that `linewise stats` takes by default (trace.h),
-** read back from trace.csv, which the checkpoint before has flushed; null
-** where the trace has no such stretch.  The effective samples let a sweep's table show the error bars
-** too rough to trust (under 25, as `linewise stats` warns). */
 /* Where the run prints its trace to 10 digits (output.trace_exact = 0),
 ** names an observable whose values x[m] (a heat capacity: its energy's, in
 ** t) are coarse against their spread (lw_trace_rounded) in
@@ -2002,6 +1997,12 @@ static void observable_rounded(lw_anneal *a, const lw_trace *t, const size_t *ro
     snprintf(a->observables_rounded + used, sizeof a->observables_rounded - used, "%s%s", used ? ", " : "", name);
 }
 
+/* summary.json's observables: each obs_ column's, and each heat capacity's
+** (trace.h), mean, standard error, autocorrelation time and effective
+** samples over the stretch that `linewise stats` takes by default (trace.h),
+** read back from trace.csv, which the checkpoint before has flushed; null
+** where the trace has no such stretch.  The effective samples let a sweep's table show the error bars
+** too rough to trust (under 25, as `linewise stats` warns). */
 static void put_observables(lw_anneal *a, lw_json *j)
 {
   char path[LW_PATH_MAX + 32], key[96];

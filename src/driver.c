@@ -10,8 +10,8 @@
 /* What a run reads under any driver: its length, seed, quench and outputs. */
 #define RUN_KEYS "scene.system", "scene.driver", "anneal.sweeps", "anneal.seed", "anneal.seed_version", \
     "anneal.quench", "anneal.quench_tol", "anneal.quench_iterations", "anneal.quench_stall", \
-    "output.checkpoint_every", "output.trace_every", "output.trace_exact", "output.observables", "output.samples_every", \
-    "output.stats_from", "output.frames_every"
+    "output.checkpoint_every", "output.trace_every", "output.trace_exact", "output.observables", \
+    "output.samples_every", "output.stats_from", "output.frames_every"
 
 /* A chain: its schedule, its ladder, its tuning and its recomputations
 ** from scratch; a motion: its time step, damping and density (rho = 0: the

@@ -1330,7 +1330,8 @@ static int cmd_resume(int argc, char **argv)
       if (used == 2) i++;
     } else if (argv[i][0] == '-' || dir) {
       lw_error_set(&err, LW_EUSAGE, "resume: unexpected '%s'%s %s%s", argv[i],
-                   argv[i][0] == '-' ? nearest(argv[i], resume_options) : "", RESUME_USAGE, dash_hint(argv[i], resume_options));
+                   argv[i][0] == '-' ? nearest(argv[i], resume_options) : "", RESUME_USAGE,
+                   dash_hint(argv[i], resume_options));
       return fail(&err);
     } else {
       dir = trim_slashes(argv[i]);

@@ -505,7 +505,8 @@ const lw_param_def lw_param_table[] = {
   NUM("output", "trace_exact", LW_PT_INT, trace_exact, "1", "", 0, 1, 0,
       "1 = trace.csv's numbers with every digit that reads back (%.15g, else %.17g); 0 = at 10 "
       "significant digits, as runs before 2026-12-07 (a run of theirs, whose scene.ini has no "
-      "line for this key, resumes so; a new run of its scene.ini writes every digit). 10 digits round away a large energy's fluctuations at a "
+      "line for this key, resumes so; a new run of its scene.ini writes every digit). 10 digits round away a "
+      "large energy's fluctuations at a "
       "low temperature, and its heat capacity with them; `linewise stats` says where."),
   NUM("output", "observables", LW_PT_INT, observables, "0", "", 0, 1, 0,
       "1 adds the system's observables to every row of trace.csv (columns obs_<name>: for splines "

@@ -449,13 +449,16 @@ static int rounded_values(const double *x, size_t n, double sd)
 {
   double most = 0.0;
   if (!(sd > 0.0)) return 0;
+  for (size_t i = 0; i < n; i++)
+    if (fabs(x[i]) > most) most = fabs(x[i]);
+  if (!(most > 0.0 && sd < 3.0 * pow(10.0, floor(log10(most)) - 9.0))) return 0;
+  /* (the digits last: a print each, and only of a column so narrow) */
   for (size_t i = 0; i < n; i++) {
     char buf[32];
     snprintf(buf, sizeof buf, "%.10g", x[i]);
     if (strtod(buf, NULL) != x[i]) return 0;
-    if (fabs(x[i]) > most) most = fabs(x[i]);
   }
-  return most > 0.0 && sd < 3.0 * pow(10.0, floor(log10(most)) - 9.0);
+  return 1;
 }
 
 int lw_trace_rounded(const double *x, size_t n)

@@ -1799,8 +1799,8 @@ Test(cli, a_heat_capacity_at_a_low_temperature_reads_the_trace_in_full)
            "tempering.replicas=1 --set anneal.t_start=1e-7 --set output.stats_from=20000 --set output.observables=1 "
            "--set output.trace_exact=0", lw_test_root(), dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
-  cr_assert(strstr(errs, "linewise: warning: summary.json's statistics of heat_capacity are of values trace.csv prints to 10 digits"),
-            "%s", errs);
+  cr_assert(strstr(errs, "linewise: warning: summary.json's statistics of heat_capacity are of values trace.csv "
+                          "prints to 10 digits"), "%s", errs);
   /* three rungs at 10 digits: stats --reweight says so too */
   snprintf(args, sizeof args, "run %s/params/wire-ladder.ini --out %s/rungs --quiet --set 'tempering.ladder=1e-7 "
            "2e-7 4e-7' --set anneal.t_start=1e-7 --set output.stats_from=20000 --set output.trace_exact=0",

@@ -478,9 +478,8 @@ Test(trace, a_column_rounded_to_ten_digits_against_its_spread_is_said, .init = m
   lw_trace *t = trace_of(text);
   lw_trace_select sel = {.from = -1, .to = -1};
   report_of(t, &sel, out, sizeof out);
-  cr_assert(strstr(out, "warning: total, heat_capacity: printed to 10 digits (output.trace_exact = 0, as runs begun before "
-            "2026-12-07)"), "%s",
-            out);
+  cr_assert(strstr(out, "warning: total, heat_capacity: printed to 10 digits (output.trace_exact = 0, as runs begun "
+                        "before 2026-12-07)"), "%s", out);
   cr_assert(strstr(out, "\nheat_capacity ") && strstr(strstr(out, "\nheat_capacity "), " *\n"), "%s", out);
   lw_trace_free(t);
   /* in full, the same values are not (nor whole numbers that spread) */
