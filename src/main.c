@@ -1022,10 +1022,21 @@ static int taken(const char *dir)
 /* The run's name, out/<name>: the scene file's name without its leading
 ** dots and extension (*base, its length returned): "cat.v2.ini" is not
 ** "cat.v1.ini"'s out/cat-2, and ".ini" (nothing before its dot) wrote into
-** out/ itself; "scene" where nothing is left ("..."). */
+** out/ itself; "scene" where nothing is left ("...").  A file named
+** scene.ini, as a run's, takes its folder's name: a redraw of
+** out/mine/scene.ini went to out/scene, where its user did not look. */
 static int scene_name(const char *scene, const char **base)
 {
   const char *b = strrchr(scene, '/') ? strrchr(scene, '/') + 1 : scene;
+  if (!strcmp(b, "scene.ini") && b - scene >= 2 && b[-2] != '/' && b[-2] != '.') {
+    const char *folder = b - 1; /* the slash before scene.ini */
+    while (folder > scene && folder[-1] != '/') folder--;
+    folder += strspn(folder, "."); /* (.hidden/scene.ini: out/hidden) */
+    if (folder < b - 1) {
+      *base = folder;
+      return (int)(b - 1 - folder);
+    }
+  }
   b += strspn(b, "."); /* a hidden file's dot is no extension: .hidden is out/hidden */
   const char *ext = strrchr(b, '.');
   int n = ext ? (int)(ext - b) : (int)strlen(b);

@@ -1137,6 +1137,12 @@ Test(cli, a_run_without_out_never_replaces_another)
                           "--set anneal.sweeps=2 && test -f out/ini/final.svg && test -f out/c.v2/final.svg && "
                           "test -f out/h/final.svg && ! test -e out/final.svg", dir, b, b, b),
                0);
+  /* a file named scene.ini, as a run's, takes its folder's name: a redraw
+  ** of out/t/scene.ini went to out/scene */
+  cr_assert_eq(lw_test_sh("cd %s && %s run out/t/scene.ini --set init.from=out/t/state.lw --set anneal.sweeps=0 "
+                          "--quiet 2>err.txt && test -f out/t-2/final.svg && ! test -e out/scene && grep -qx "
+                          "'linewise: into out/t-2 (out/t holds a run; --out names the directory)' err.txt", dir, b),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* a CR a script saved with CRLF line ends puts at the end of --out or of
   ** the scene's path: refused, not a directory named "r\r" */
   cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --quiet --out \"$(printf 'r\\r')\" 2>err.txt; test $? -eq 2 && "
