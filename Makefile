@@ -245,11 +245,11 @@ wire-figures: $(BUILD)/wire-midpoint
 INSTALLED := bin/linewise bin/linewise-mpi $(TOOLS:%=bin/linewise-%) bin/linewise-animate \
              $(patsubst %,share/linewise/params/%,$(notdir $(wildcard params/*.ini params/*.lw) $(PICTURE))) \
              share/linewise/slurm-sweep.sbatch share/linewise/slurm-tempering.sbatch \
-             $(patsubst %,share/doc/linewise/%,README.md $(notdir $(wildcard docs/*.md docs/*.png)) embed.cpp) \
+             $(patsubst %,share/doc/linewise/%,README.md $(wildcard docs/*.md docs/*.png) embed.cpp) \
              share/man/man1/linewise.1 share/man/man1/linewise-mpi.1 $(TOOLS:%=share/man/man1/linewise-%.1) \
              share/man/man1/linewise-animate.1 $(LIBDIR)/liblinewise.a $(LIBDIR)/pkgconfig/linewise.pc \
              $(wildcard include/linewise/*.h)
-INSTALLED_DIRS := share/linewise/params share/linewise share/doc/linewise include/linewise
+INSTALLED_DIRS := share/linewise/params share/linewise share/doc/linewise/docs share/doc/linewise include/linewise
 LW_VERSION := $(shell sed -n 's/^\#define LW_VERSION "\(.*\)"/\1/p' include/linewise/version.h)
 # The install's root, quoted for the shell: a DESTDIR or PREFIX with a blank
 # stays one path (unquoted, uninstall removed the directory before the blank),
@@ -268,7 +268,7 @@ check_libdir = case '$(LIBDIR)' in '' | /* | . | .. | ./* | ../* | */. | */.. | 
 # shared machine: chmod makes them every user's, as install -m does)
 install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	@$(check_libdir)
-	install -d $(D)/bin $(D)/share/linewise/params $(D)/share/doc/linewise
+	install -d $(D)/bin $(D)/share/linewise/params $(D)/share/doc/linewise/docs
 	install -d $(D)/$(LIBDIR)/pkgconfig $(D)/include/linewise $(D)/share/man/man1
 	install -m 644 $(BUILD)/liblinewise.a $(D)/$(LIBDIR)/
 	install -m 644 include/linewise/*.h $(D)/include/linewise/
@@ -296,7 +296,9 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	      "$$(printf '%s' $(call shell_quote,$(PREFIX)) | sed 's/\\/\\e/g')"; \
 	  } > $(D)/share/man/man1/linewise-$$t.1 && chmod 644 $(D)/share/man/man1/linewise-$$t.1 || exit 1; done
 	install -m 644 tools/slurm-sweep.sbatch tools/slurm-tempering.sbatch $(D)/share/linewise/
-	install -m 644 README.md docs/*.md docs/*.png tests/embed.cpp $(D)/share/doc/linewise/
+	# (docs/ beside README, as in the source: README's links are to docs/X.md)
+	install -m 644 README.md tests/embed.cpp $(D)/share/doc/linewise/
+	install -m 644 docs/*.md docs/*.png $(D)/share/doc/linewise/docs/
 
 uninstall:
 	@$(check_libdir)

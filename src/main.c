@@ -221,11 +221,15 @@ static void bundled_hint(const char *scene, lw_error *err)
   const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
   /* the README's own form, params/example.ini, away from the checkout, and
   ** a bare name without its .ini, are the same bundled scene */
+  /* (a picture given as the scene: the hint's params/photo.ini, away from
+  ** the checkout, is the bundled one) */
+  if (strstr(err->msg, " picture, not a scene file: a scene draws it") && access("params/photo.ini", F_OK))
+    scene = "photo.ini";
+  else if (!strstr(err->msg, ": cannot open scene file: ") || !access(scene, F_OK))
+    return;
   const char *bare = strncmp(scene, "params/", 7) ? scene : scene + 7;
   const size_t len = strlen(bare);
-  if (n <= 0 || !strstr(err->msg, ": cannot open scene file: ") || !access(scene, F_OK) || strchr(bare, '/') ||
-      !len || len > 200)
-    return;
+  if (n <= 0 || strchr(bare, '/') || !len || len > 200) return;
   char name[256];
   snprintf(name, sizeof name, "%s%s", bare, len > 4 && !strcmp(bare + len - 4, ".ini") ? "" : ".ini");
   exe[n] = '\0';
@@ -234,10 +238,11 @@ static void bundled_hint(const char *scene, lw_error *err)
   static const char *const under[] = {"/../share/linewise/params/", "/../params/"};
   for (int k = 0; k < 2; k++) {
     snprintf(path, sizeof path, "%s%s%s", exe, under[k], name);
-    char real[PATH_MAX];
+    char real[PATH_MAX], word[LW_RUNDIR_WORD_MAX];
     if (!access(path, R_OK) && realpath(path, real)) {
       const size_t m = strlen(err->msg);
-      snprintf(err->msg + m, sizeof err->msg - m, " (the bundled %s is %.1000s)", name, real);
+      snprintf(err->msg + m, sizeof err->msg - m, " (the bundled %s is %.1000s)", name,
+               lw_rundir_shell_word(real, word, sizeof word));
       return;
     }
   }

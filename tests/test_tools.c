@@ -1563,7 +1563,10 @@ Test(tools, install_runs_every_scene_away_from_the_checkout_and_uninstall_remove
   cr_assert(strstr(out, "usage: linewise-seed-sweep SCENE.ini") && strstr(out, "usage: linewise-plot-run RUN_DIR"),
             "%s", out);
   free(out);
-  cr_assert_eq(sh("test -s '%s/ro ot/usr/share/doc/linewise/PARAMETERS.md'", dir), 0);
+  cr_assert_eq(sh("test -s '%s/ro ot/usr/share/doc/linewise/docs/PARAMETERS.md'", dir), 0);
+  /* README's links to docs/ hold where it is installed */
+  cr_assert_eq(sh("cd '%s/ro ot/usr/share/doc/linewise' && for t in $(grep -o '](docs/[^)#]*' README.md | cut -c3-); do "
+                  "test -e \"$t\" || exit 1; done", dir), 0);
   /* a man page for each tool: its NAME, and its --help under the name it is installed by */
   cr_assert_eq(sh("cd '%s/ro ot/usr' && for t in seed-sweep param-sweep plot-run plot-sweep thread-scaling animate; do "
                   "  m=share/man/man1/linewise-$t.1; grep -q \"^linewise-$t .- [a-z]\" $m && "
