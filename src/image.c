@@ -721,14 +721,16 @@ static const char *foreign_format(const unsigned char *d, size_t n)
   return NULL;
 }
 
-const char *lw_image_kind(const unsigned char *d, size_t n)
+const char *lw_image_kind(const unsigned char *d, size_t n, int *readable)
 {
-  static const char *const readable[] = {"PNG", "a PNG", "JPEG", "a JPEG", "BMP", "a BMP", "GIF", "a GIF"};
+  static const char *const read[] = {"PNG", "a PNG", "JPEG", "a JPEG", "BMP", "a BMP", "GIF", "a GIF"};
   const char *name = format_name(d, n);
-  for (size_t k = 0; k < sizeof readable / sizeof *readable; k += 2)
-    if (!strcmp(name, readable[k])) return readable[k + 1];
+  if (readable) *readable = 1;
+  for (size_t k = 0; k < sizeof read / sizeof *read; k += 2)
+    if (!strcmp(name, read[k])) return read[k + 1];
   if (n >= 3 && d[0] == 'P' && (d[1] == '5' || d[1] == '6') && strchr(" \t\r\n#", d[2]) && d[2])
     return d[1] == '5' ? "a PGM" : "a PPM";
+  if (readable) *readable = 0;
   return foreign_format(d, n);
 }
 

@@ -219,14 +219,14 @@ static void bundled_hint(const char *scene, lw_error *err)
 {
   char exe[LW_PATH_MAX], path[2 * LW_PATH_MAX];
   const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-  /* the README's own form, params/example.ini, away from the checkout, and
-  ** a bare name without its .ini, are the same bundled scene */
   /* (a picture given as the scene: the hint's params/photo.ini, away from
   ** the checkout, is the bundled one) */
   if (strstr(err->msg, " picture, not a scene file: a scene draws it") && access("params/photo.ini", F_OK))
     scene = "photo.ini";
   else if (!strstr(err->msg, ": cannot open scene file: ") || !access(scene, F_OK))
     return;
+  /* the README's own form, params/example.ini, away from the checkout, and
+  ** a bare name without its .ini, are the same bundled scene */
   const char *bare = strncmp(scene, "params/", 7) ? scene : scene + 7;
   const size_t len = strlen(bare);
   if (n <= 0 || strchr(bare, '/') || !len || len > 200) return;

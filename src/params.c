@@ -504,10 +504,10 @@ const lw_param_def lw_param_table[] = {
       "Sweeps per row of trace.csv."),
   NUM("output", "trace_exact", LW_PT_INT, trace_exact, "1", "", 0, 1, 0,
       "1 = trace.csv's numbers with every digit that reads back (%.15g, else %.17g); 0 = at 10 "
-      "significant digits, as runs before 2026-12-07 (a run of theirs, whose scene.ini has no "
-      "line for this key, resumes so; a new run of its scene.ini writes every digit). 10 digits round away a "
-      "large energy's fluctuations at a "
-      "low temperature, and its heat capacity with them; `linewise stats` says where."),
+      "significant digits, as runs before 2026-12-07 (a run of theirs, whose scene.ini has no line "
+      "for this key, resumes so; a new run of its scene.ini writes every digit). 10 digits round "
+      "away a large energy's fluctuations at a low temperature, and its heat capacity with them; "
+      "`linewise stats` says where."),
   NUM("output", "observables", LW_PT_INT, observables, "0", "", 0, 1, 0,
       "1 adds the system's observables to every row of trace.csv (columns obs_<name>: for splines "
       "the count and the means over the splines of length, squared end-to-end distance, squared "
@@ -1397,7 +1397,8 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
   ** byte inside the line (UTF-16 text ...)" */
   unsigned char head[512];
   const size_t got = fread(head, 1, sizeof head, f);
-  const char *kind = lw_image_kind(head, got);
+  int readable;
+  const char *kind = lw_image_kind(head, got, &readable);
   /* (the two-letter marks of BMP and Netpbm begin text too: "BMx = 1" is a
   ** key; an SVG's XML prologue begins any XML or HTML: one without <svg near
   ** the start is not called a picture) */
@@ -1409,7 +1410,6 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
   if (kind && !strcmp(kind, "an SVG") && !svg_tag) kind = "an XML or HTML";
   if (kind) {
     fclose(f);
-    const int readable = strstr("a PNG|a JPEG|a BMP|a GIF|a PGM|a PPM", kind) != NULL;
     char word[LW_RUNDIR_WORD_MAX];
     if (readable)
       return lw_error_set(err, LW_EINPUT, "%s: %s picture, not a scene file: a scene draws it, e.g. 'linewise run "

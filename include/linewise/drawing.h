@@ -91,13 +91,13 @@ lw_status lw_drawing_frame(const lw_params *p, const lw_scene *sc, const lw_spli
 /* The report's members of summary.json (into the open object of j). */
 void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep);
 
-/* The report's lines for the command line ("linewise: ...\n" each) into
-** buf[n]. */
 /* Into buf, "" or what the report left out for want of memory (its close
 ** share, its fidelity: null in summary.json), without "linewise: " or a
 ** line end. */
 void lw_drawing_lost_text(const lw_drawing_report *d, char *buf, size_t n);
 
+/* The report's lines for the command line ("linewise: ...\n" each) into
+** buf[n]. */
 void lw_drawing_report_text(const lw_drawing_report *rep, char *buf, size_t n);
 
 #ifdef __cplusplus

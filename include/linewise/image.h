@@ -52,6 +52,12 @@ typedef struct {
 lw_image *lw_image_new(int w, int h, int with_alpha, lw_error *err);
 void lw_image_free(lw_image *img);
 
+/* The picture format of a file beginning with the n bytes d, with its
+** article ("a JPEG", "a HEIC"), or NULL; *readable (may be NULL) 1 where
+** linewise decodes it.  A picture given where a scene file goes is said to
+** be one. */
+const char *lw_image_kind(const unsigned char *d, size_t n, int *readable);
+
 /* Decodes a PNG, JPEG, GIF (its first picture), BMP or PGM/PPM file held
 ** in memory; `name` only labels messages.  If the picture has more than
 ** max_pixels pixels it is box-filtered down (same aspect ratio; a strip
@@ -59,11 +65,6 @@ void lw_image_free(lw_image *img);
 ** while it is converted.  info (may be NULL) receives what the file held.  LW_EINPUT for
 ** anything that is not a decodable picture, naming `name` and the decoder's
 ** reason. */
-/* The picture format of a file beginning with the n bytes d, with its
-** article ("a JPEG", "a HEIC"), read or not, or NULL: a picture given where
-** a scene file goes is said to be one. */
-const char *lw_image_kind(const unsigned char *d, size_t n);
-
 lw_image *lw_image_decode(const unsigned char *data, size_t size, const char *name,
                           double max_pixels, lw_image_info *info, lw_error *err);
 

@@ -436,7 +436,6 @@ void lw_params_origin(const lw_params *p, const lw_param_def *d, char *buf, size
 ** key's error.  Returns err->code. */
 lw_status lw_params_blame(const lw_params *p, const char *section, const char *key, lw_error *err);
 
-
 /* Edit distance (insertions, deletions, substitutions) of two names, case
 ** aside (WIDTH had no suggestion, Width had), for "did you mean"; names of
 ** 64 bytes or more are far from everything. */
