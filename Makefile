@@ -41,7 +41,7 @@ LIB_OBJ := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_OBJ := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%.o) $(BUILD)/tests/stb_write.o
 # The fuzz harnesses, compiled with cc into the suite, which replays the corpus.
-FUZZ_NAMES := params state resume energy image points trace
+FUZZ_NAMES := params state resume energy image points trace fieldfile
 FUZZ_REPLAY_OBJ := $(FUZZ_NAMES:%=$(BUILD)/tests/fuzz_%.o)
 TEST_JOBS ?= 2
 # study tools (shell, gnuplot), installed as linewise-<name>
@@ -243,7 +243,7 @@ wire-figures: $(BUILD)/wire-midpoint
 # then the folders left empty (it removed share/linewise whole, with a
 # scene the user had saved beside the bundled ones).
 INSTALLED := bin/linewise bin/linewise-mpi $(TOOLS:%=bin/linewise-%) bin/linewise-animate \
-             $(patsubst %,share/linewise/params/%,$(notdir $(wildcard params/*.ini params/*.lw) $(PICTURE))) \
+             $(patsubst %,share/linewise/params/%,$(notdir $(wildcard params/*.ini params/*.lw params/*.txt) $(PICTURE))) \
              share/linewise/slurm-sweep.sbatch share/linewise/slurm-tempering.sbatch \
              $(patsubst %,share/doc/linewise/%,README.md $(wildcard docs/*.md docs/*.png) embed.cpp) \
              share/man/man1/linewise.1 share/man/man1/linewise-mpi.1 $(TOOLS:%=share/man/man1/linewise-%.1) \
@@ -278,7 +278,7 @@ install: $(BIN)/linewise $(PICTURE) $(MPI_BIN) $(BUILD)/liblinewise.a
 	  'Cflags: -I$${includedir}' > $(D)/$(LIBDIR)/pkgconfig/linewise.pc
 	chmod 644 $(D)/$(LIBDIR)/pkgconfig/linewise.pc
 	install -m 755 $(BIN)/linewise $(MPI_BIN) $(D)/bin/
-	install -m 644 params/*.ini params/*.lw $(PICTURE) $(D)/share/linewise/params/
+	install -m 644 params/*.ini params/*.lw params/*.txt $(PICTURE) $(D)/share/linewise/params/
 	install -m 644 docs/linewise.1 $(D)/share/man/man1/linewise.1
 	if [ -n '$(MPI_BIN)' ]; then echo '.so man1/linewise.1' > $(D)/share/man/man1/linewise-mpi.1 && \
 	  chmod 644 $(D)/share/man/man1/linewise-mpi.1; fi

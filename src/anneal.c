@@ -683,6 +683,8 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
   const unsigned needs = a->sched_type ? a->sched_type->needs : ~0u; /* (dynamics: noted as unread) */
   static const char *const table[] = {"anneal.table", NULL}, *const lambda[] = {"anneal.lambda", NULL},
                            *const polygon[] = {"scene.polygon", NULL}, *const mask[] = {"scene.mask_image", NULL},
+                           *const field_file[] = {"scene.field_file", "scene.field_file_y", "scene.field_file_scale",
+                                                  NULL},
                            *const orientation[] = {"scene.orientation", NULL},
                            *const picture[] = {"scene.image_width", "scene.image_blur", "scene.image_flatten",
                                                "scene.image_levels", "scene.image_levels_alpha",
@@ -717,6 +719,7 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
        "a constant schedule keeps the rungs at the ladder"},
       {polygon, p->boundary != LW_BND_POLYGON, "scene.boundary is not polygon"},
       {mask, lw_params_file_idle(p, lw_params_find("scene", "mask_image")), "scene.mask is not image"},
+      {field_file, p->field != LW_FLD_FILE, "scene.field is not file"},
       /* (the photo preset's own auto, which a run's scene.ini holds: a redraw
       ** from it noted a key its user never set) */
       {orientation, p->page == LW_PAGE_CUSTOM && !(p->preset == LW_PRESET_PHOTO && p->orientation == LW_ORIENT_AUTO),

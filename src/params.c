@@ -165,13 +165,14 @@ const lw_param_def lw_param_table[] = {
       "0 = a node a pixel, Phi turning white from the edge pixels' centres, as runs before this key "
       "(a picture of one wide pixel was a pyramid; a run of theirs, whose scene.ini has no line for "
       "this key, resumes so; docs/IMAGES.md)."),
-  CHOICE("scene", "field", field, "constant", "constant|radial|vortex|waves|etf|gradient",
+  CHOICE("scene", "field", field, "constant", "constant|radial|vortex|waves|etf|gradient|file",
          "Vector field v read by the field term (unit length): constant along `field_angle`, "
          "radial from the centre, vortex around it (v = (-(y - cy), x - cx) / r: clockwise as seen on "
          "the page, whose y points down; both fall to 0 within `field_core` of the centre), waves "
          "tangent to y = A sin(2 pi x / wavelength) (x from the page's left edge), "
          "etf (the picture's edge tangent flow: along edges and isophotes; needs field_mode = axial) "
-         "or gradient (the picture's tone gradient, toward lighter tone). "
+         "gradient (the picture's tone gradient, toward lighter tone) "
+         "or file (a grid of vectors u v from `field_file`: docs/FORMATS.md, \"Field files\"). "
          "Built only when [energy] field is non-zero."),
   NUM("scene", "field_angle", LW_PT_DOUBLE, field_angle, "0", "degrees", -360, 360, 0,
       "Direction of the constant field, and of etf where the picture is flat (0 = +x, 90 = +y, down the page)."),
@@ -195,6 +196,19 @@ const lw_param_def lw_param_table[] = {
       "refused)."),
   NUM("scene", "center_y", LW_PT_DOUBLE, center_y, "-1", "mm", -1, 1e7, 0,
       "See center_x."),
+  STRING("scene", "field_file", field_file, "", "path",
+         "field = file: the grid of vectors, relative to the scene file: NumPy .npy of shape (rows, columns, 2) "
+         "or text, a row a line, u v for each node (docs/FORMATS.md, \"Field files\"). The grid covers the "
+         "picture where the scene has one, else it is fitted into the page inset by `margin` as a picture of "
+         "columns x rows pixels would be; a node is a pixel's centre. A cell that is NaN or infinite has no field."),
+  CHOICE("scene", "field_file_y", field_file_y, "up", "up|down",
+         "Which way field_file's rows and its v go: up, the first row at the bottom of the grid and v up the "
+         "page (NumPy's meshgrid of increasing y, matplotlib's origin = 'lower'); down, the first row at the "
+         "top and v down the page (a picture's rows, the page's y)."),
+  CHOICE("scene", "field_file_scale", field_file_scale, "unit", "unit|max|none",
+         "What field_file's lengths mean: unit, each vector made length 1 (the lines follow its direction "
+         "alone, however weak the flow); max, all divided by the longest (a weak flow steers less); none, as "
+         "given (the field term's weight times the file's units)."),
   CHOICE("scene", "mask", mask, "none", "none|alpha|image",
          "Where the inside of boundary = mask comes from: the alpha channel of `image` "
          "(opaque is inside), or the picture `mask_image` (opaque and dark is inside). "
@@ -1903,6 +1917,7 @@ int lw_params_file_idle(const lw_params *p, const lw_param_def *d)
     const lw_schedule_type *t = lw_driver_is_motion(p) ? NULL : lw_schedule_find(p->schedule);
     return !t || !(t->needs & LW_SCHEDULE_USES_TABLE);
   }
+  if (!strcmp(d->section, "scene") && !strcmp(d->key, "field_file")) return p->field != LW_FLD_FILE;
   return !strcmp(d->section, "scene") && !strcmp(d->key, "mask_image") && p->mask != LW_MASK_IMAGE;
 }
 

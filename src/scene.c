@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "linewise/fidelity.h"
+#include "linewise/fieldfile.h"
 #include "linewise/imagefield.h"
 #include "linewise/number.h"
 #include "linewise/sdt.h"
@@ -597,6 +598,69 @@ static lw_status build_potential(lw_scene *sc, const lw_params *p, double cx, do
   return LW_OK;
 }
 
+/* scene.field = file: the grid of field_file, turned the page's way up,
+** its lengths as field_file_scale says, placed over the picture (or where
+** a picture of its shape would lie). */
+static lw_status field_from_file(lw_scene *sc, const lw_params *p, lw_error *err)
+{
+  if (!p->field_file[0]) return bad_key(p, "scene", "field", LW_EINPUT, err, "'file' needs scene.field_file");
+  char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
+  lw_path_dir(dir, sizeof dir, p->file);
+  lw_path_join(full, sizeof full, dir, p->field_file);
+  lw_error e2;
+  lw_grid2d *g = sc->field.grid = lw_fieldfile_read(full, 2, &e2);
+  if (!g) return bad_key(p, "scene", "field_file", e2.code, err, "%s", e2.msg);
+  /* a node with a component not finite is a masked cell: no field there */
+  const size_t nodes = (size_t)g->nx * (size_t)g->ny;
+  size_t bad = 0;
+  for (size_t k = 0; k < nodes; k++)
+    if (!isfinite(g->data[2 * k]) || !isfinite(g->data[2 * k + 1])) {
+      g->data[2 * k] = g->data[2 * k + 1] = 0.0;
+      bad++;
+    }
+  if (p->field_file_y == LW_FFY_UP) {
+    const size_t row = 2 * (size_t)g->nx;
+    for (int j = 0; j < g->ny / 2; j++)
+      for (size_t k = 0; k < row; k++) {
+        double *a = g->data + (size_t)j * row + k, *b = g->data + (size_t)(g->ny - 1 - j) * row + k, t = *a;
+        *a = *b;
+        *b = t;
+      }
+    for (size_t k = 0; k < nodes; k++) g->data[2 * k + 1] = -g->data[2 * k + 1];
+  }
+  double longest = 0.0;
+  for (size_t k = 0; k < nodes; k++) longest = fmax(longest, hypot(g->data[2 * k], g->data[2 * k + 1]));
+  if (!(longest > 0.0) || !isfinite(longest))
+    return bad_key(p, "scene", "field_file", LW_EINPUT, err, "%s: %s: expected a vector with a length somewhere",
+                   full, !(longest > 0.0) ? (bad ? "every vector is zero or not finite" : "every vector is zero")
+                                          : "a vector too long to measure (its length overflows)");
+  for (size_t k = 0; k < nodes && p->field_file_scale != LW_FFS_NONE; k++) {
+    double *d = g->data + 2 * k, n = p->field_file_scale == LW_FFS_MAX ? longest : hypot(d[0], d[1]);
+    if (n > 0.0) d[0] /= n, d[1] /= n;
+  }
+  /* over the picture, whatever its shape: a grid of another shape than the
+  ** picture's would stretch the field over it, so it is refused */
+  const lw_image_place pl = sc->image ? sc->image_place
+                                      : lw_image_fit(g->nx, g->ny, p->margin, p->margin, p->width - p->margin,
+                                                     p->height - p->margin);
+  const double w = sc->image ? sc->image->width * pl.pixel : g->nx * pl.pixel;
+  const double h = sc->image ? sc->image->height * pl.pixel : g->ny * pl.pixel;
+  if (sc->image && fabs((double)g->nx * h / w - g->ny) > 1.0)
+    return bad_key(p, "scene", "field_file", LW_EINPUT, err, "%s: a grid of %d columns x %d rows over a %d x %d "
+                   "picture: expected the picture's shape (%d columns take %.0f rows), or no scene.image", full, g->nx,
+                   g->ny, sc->image->width, sc->image->height, g->nx, (double)g->nx * h / w);
+  g->hx = w / g->nx;
+  g->hy = h / g->ny;
+  g->x0 = pl.x0 + 0.5 * g->hx;
+  g->y0 = pl.y0 + 0.5 * g->hy;
+  if (bad) {
+    size_t used = strlen(sc->note);
+    snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field_file: %zu of the %zu nodes not finite (NaN or "
+             "infinite): no field there", used ? "; " : "", bad, nodes);
+  }
+  return LW_OK;
+}
+
 /* The field the scene names, about the page point (cx, cy). */
 static lw_status build_field(lw_scene *sc, const lw_params *p, double cx, double cy, lw_error *err)
 {
@@ -613,9 +677,10 @@ static lw_status build_field(lw_scene *sc, const lw_params *p, double cx, double
   static const lw_field_kind kinds[] = {
     [LW_FLD_CONSTANT] = LW_FIELD_CONSTANT, [LW_FLD_RADIAL] = LW_FIELD_RADIAL,
     [LW_FLD_VORTEX] = LW_FIELD_VORTEX, [LW_FLD_WAVES] = LW_FIELD_WAVES,
-    [LW_FLD_ETF] = LW_FIELD_GRID_AXIAL, [LW_FLD_GRADIENT] = LW_FIELD_GRID,
+    [LW_FLD_ETF] = LW_FIELD_GRID_AXIAL, [LW_FLD_GRADIENT] = LW_FIELD_GRID, [LW_FLD_FILE] = LW_FIELD_GRID,
   };
   f->kind = kinds[p->field];
+  if (p->field == LW_FLD_FILE) return field_from_file(sc, p, err);
   if (p->field == LW_FLD_ETF || p->field == LW_FLD_GRADIENT) {
     const char *name = p->field == LW_FLD_ETF ? "etf" : "gradient";
     if (!sc->image) return bad_key(p, "scene", "field", LW_EINPUT, err, "'%s' needs scene.image", name);

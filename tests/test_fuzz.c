@@ -20,6 +20,7 @@ int lw_fuzz_energy_one(const uint8_t *data, size_t size);
 int lw_fuzz_image_one(const uint8_t *data, size_t size);
 int lw_fuzz_points_one(const uint8_t *data, size_t size);
 int lw_fuzz_trace_one(const uint8_t *data, size_t size);
+int lw_fuzz_fieldfile_one(const uint8_t *data, size_t size);
 
 /* The harnesses' scratch files go to TMPDIR (fuzz_util.h): a directory of
 ** the suite's, removed after, so that a replay leaves none in /tmp (each
@@ -99,4 +100,9 @@ Test(fuzz, points_corpus_replays_clean)
 Test(fuzz, trace_corpus_replays_clean)
 {
   cr_assert_geq(replay("trace", lw_fuzz_trace_one), 4, "the trace corpus lost its seeds");
+}
+
+Test(fuzz, fieldfile_corpus_replays_clean)
+{
+  cr_assert_geq(replay("fieldfile", lw_fuzz_fieldfile_one), 6, "the fieldfile corpus lost its seeds");
 }

@@ -855,7 +855,8 @@ Test(image_cli, every_bundled_scene_builds)
 {
   const char *root = getenv("LW_ROOT");
   cr_assert_not_null(root);
-  const char *names[] = {"example.ini", "study.ini", "flow.ini", "minimal.ini", "photo.ini", "hatch.ini", "colour.ini"};
+  const char *names[] = {"example.ini", "study.ini", "flow.ini", "minimal.ini", "photo.ini", "hatch.ini", "colour.ini",
+                         "dipole.ini"};
   for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
     char path[1024];
     snprintf(path, sizeof path, "%s/params/%s", root, names[k]);

@@ -63,7 +63,9 @@ enum {
 enum { LW_ORIENT_PORTRAIT, LW_ORIENT_LANDSCAPE, LW_ORIENT_AUTO };
 enum { LW_BND_RECT, LW_BND_CIRCLE, LW_BND_POLYGON, LW_BND_MASK };
 enum { LW_POT_CONSTANT, LW_POT_RAMP, LW_POT_RADIAL, LW_POT_IMAGE };
-enum { LW_FLD_CONSTANT, LW_FLD_RADIAL, LW_FLD_VORTEX, LW_FLD_WAVES, LW_FLD_ETF, LW_FLD_GRADIENT };
+enum { LW_FLD_CONSTANT, LW_FLD_RADIAL, LW_FLD_VORTEX, LW_FLD_WAVES, LW_FLD_ETF, LW_FLD_GRADIENT, LW_FLD_FILE };
+enum { LW_FFY_UP, LW_FFY_DOWN };
+enum { LW_FFS_UNIT, LW_FFS_MAX, LW_FFS_NONE };
 enum { LW_MASK_NONE, LW_MASK_ALPHA, LW_MASK_IMAGE };
 enum { LW_STRAIN_SPLINE, LW_STRAIN_SEGMENT };
 enum { LW_FIELDMODE_AXIAL, LW_FIELDMODE_SIGNED };
@@ -115,6 +117,9 @@ typedef struct {
   double field_amplitude;     /* waves, mm */
   double field_core;          /* radial, vortex: core radius, mm; -1 = init.segment_length */
   double center_x, center_y;  /* centre of radial/vortex presets, mm; -1 = page centre */
+  char field_file[LW_PATH_MAX]; /* field = file: the grid's .npy or text file */
+  int field_file_y;           /* LW_FFY_*: the file's rows and v from the bottom up, or from the top down */
+  int field_file_scale;       /* LW_FFS_*: each vector made unit, all divided by the longest, or as given */
   int mask;                   /* LW_MASK_* */
   char mask_image[LW_PATH_MAX]; /* picture of mask = image */
   char driver[64];            /* a name from the driver table (driver.h) */

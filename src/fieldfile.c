@@ -1,0 +1,388 @@
+/* fieldfile.c -- a grid of values from a .npy or a text file (fieldfile.h). */
+#include "linewise/fieldfile.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+
+#include "linewise/image.h"
+#include "linewise/number.h"
+
+#define NPY_MAGIC "\x93NUMPY"
+/* np.save pads its header to 64 bytes or so; a megabyte is no header */
+#define NPY_HEADER_MAX (1L << 20)
+#define NPY_DIMS_MAX 8
+
+typedef struct {
+  char kind;        /* 'f', 'i' or 'u' */
+  int size;         /* bytes a value */
+  int swap;         /* the file's byte order is not this machine's */
+  int fortran;      /* first index fastest */
+  int ndim;
+  long long shape[NPY_DIMS_MAX];
+  long data_at;     /* the array's first byte in the file */
+} npy_header;
+
+/* What follows key in a header dict (after its ':' and blanks), or NULL. */
+static const char *npy_value_of(const char *dict, const char *key)
+{
+  char quoted[2][32];
+  snprintf(quoted[0], sizeof quoted[0], "'%s'", key);
+  snprintf(quoted[1], sizeof quoted[1], "\"%s\"", key);
+  for (int q = 0; q < 2; q++) {
+    const char *at = strstr(dict, quoted[q]);
+    if (!at) continue;
+    at += strlen(quoted[q]);
+    at += strspn(at, " \t");
+    if (*at++ != ':') return NULL;
+    return at + strspn(at, " \t");
+  }
+  return NULL;
+}
+
+static int host_little(void)
+{
+  const uint16_t one = 1;
+  return *(const unsigned char *)&one == 1;
+}
+
+/* The dtype text (descr) into h: byte order, kind, size. */
+static int npy_dtype(const char *descr, npy_header *h)
+{
+  char order = '=';
+  if (strchr("<>|=", *descr) && *descr) order = *descr++;
+  h->kind = *descr++;
+  char *end;
+  long size = strtol(descr, &end, 10);
+  if (*end || end == descr) return 0;
+  h->size = (int)size;
+  const int ok = (h->kind == 'f' && (size == 4 || size == 8)) ||
+                 ((h->kind == 'i' || h->kind == 'u') && (size == 1 || size == 2 || size == 4 || size == 8));
+  h->swap = size > 1 && ((order == '<' && !host_little()) || (order == '>' && host_little()));
+  return ok;
+}
+
+/* The shape tuple "(a, b, c)" (or "(a, b, c,)", "()") into h. */
+static int npy_shape(const char *s, npy_header *h)
+{
+  if (*s++ != '(') return 0;
+  h->ndim = 0;
+  for (;;) {
+    s += strspn(s, " \t");
+    if (*s == ')') return 1;
+    if (!isdigit((unsigned char)*s) || h->ndim == NPY_DIMS_MAX) return 0;
+    char *end;
+    errno = 0;
+    long long v = strtoll(s, &end, 10);
+    if (errno) return 0;
+    h->shape[h->ndim++] = v;
+    s = end + strspn(end, " \t");
+    if (*s == ',') s++;
+    else if (*s != ')') return 0;
+  }
+}
+
+/* The shape as text, "(3, 4, 2)", into buf. */
+static const char *shape_text(const npy_header *h, char *buf, size_t n)
+{
+  size_t used = (size_t)snprintf(buf, n, "(");
+  for (int k = 0; k < h->ndim && used < n; k++)
+    used += (size_t)snprintf(buf + used, n - used, "%s%lld", k ? ", " : "", h->shape[k]);
+  if (used < n) snprintf(buf + used, n - used, "%s)", h->ndim == 1 ? "," : "");
+  return buf;
+}
+
+static lw_status npy_read_header(FILE *f, const char *path, npy_header *h, lw_error *err)
+{
+  unsigned char head[12];
+  if (fread(head, 1, 10, f) != 10) return lw_error_set(err, LW_EINPUT, "%s: the NumPy file ends in its header", path);
+  const int major = head[6], minor = head[7];
+  if (major < 1 || major > 3)
+    return lw_error_set(err, LW_EINPUT, "%s: NumPy format version %d.%d: expected 1.0, 2.0 or 3.0 (np.save writes "
+                        "them)", path, major, minor);
+  unsigned long len = (unsigned long)head[8] | (unsigned long)head[9] << 8;
+  long at = 10;
+  if (major > 1) {
+    if (fread(head + 10, 1, 2, f) != 2)
+      return lw_error_set(err, LW_EINPUT, "%s: the NumPy file ends in its header", path);
+    len |= (unsigned long)head[10] << 16 | (unsigned long)head[11] << 24;
+    at = 12;
+  }
+  if (len > NPY_HEADER_MAX)
+    return lw_error_set(err, LW_EINPUT, "%s: a NumPy header of %lu bytes: expected at most %ld (np.save writes "
+                        "about 128)", path, len, NPY_HEADER_MAX);
+  char *dict = malloc(len + 1);
+  if (!dict) return lw_error_set(err, LW_ENOMEM, "%s: out of memory for the NumPy header", path);
+  lw_status s = LW_OK;
+  if (fread(dict, 1, len, f) != len) s = lw_error_set(err, LW_EINPUT, "%s: the NumPy file ends in its header", path);
+  dict[len] = '\0';
+  h->data_at = at + (long)len;
+  const char *descr = s ? NULL : npy_value_of(dict, "descr"), *order = npy_value_of(dict, "fortran_order"),
+             *shape = npy_value_of(dict, "shape");
+  char dtype[24] = "";
+  if (!s && (!descr || !order || !shape || strlen(dict) != len))
+    s = lw_error_set(err, LW_EINPUT, "%s: a NumPy header without 'descr', 'fortran_order' and 'shape': expected a "
+                     "file np.save wrote", path);
+  else if (!s && (*descr == '[' || (*descr != '\'' && *descr != '"')))
+    s = lw_error_set(err, LW_EINPUT, "%s: a NumPy array of records (a structured dtype): expected a plain array of "
+                     "numbers", path);
+  if (!s) {
+    size_t n = strcspn(descr + 1, "'\"");
+    snprintf(dtype, sizeof dtype, "%.*s", (int)(n < sizeof dtype ? n : sizeof dtype - 1), descr + 1);
+    if (n >= sizeof dtype || !npy_dtype(dtype, h))
+      s = lw_error_set(err, LW_EINPUT, "%s: a NumPy array of dtype '%s': expected floats (f4, f8) or integers "
+                       "(i1..i8, u1..u8); arr.astype(float) makes one", path, dtype);
+  }
+  if (!s) {
+    h->fortran = !strncmp(order, "True", 4);
+    if (!h->fortran && strncmp(order, "False", 5))
+      s = lw_error_set(err, LW_EINPUT, "%s: the NumPy header's fortran_order: expected True or False", path);
+    else if (!npy_shape(shape, h))
+      s = lw_error_set(err, LW_EINPUT, "%s: the NumPy header's shape: expected a tuple of whole numbers", path);
+  }
+  free(dict);
+  return s;
+}
+
+/* The value of the size bytes at b (in the file's byte order). */
+static double npy_number(const unsigned char *b, const npy_header *h)
+{
+  unsigned char v[8];
+  for (int k = 0; k < h->size; k++) v[k] = h->swap ? b[h->size - 1 - k] : b[k];
+  if (h->kind == 'f') {
+    if (h->size == 4) {
+      float x;
+      memcpy(&x, v, 4);
+      return x;
+    }
+    double x;
+    memcpy(&x, v, 8);
+    return x;
+  }
+  switch (h->size * (h->kind == 'i' ? -1 : 1)) {
+  case -1: return (int8_t)v[0];
+  case 1: return v[0];
+  case -2: { int16_t x; memcpy(&x, v, 2); return x; }
+  case 2: { uint16_t x; memcpy(&x, v, 2); return x; }
+  case -4: { int32_t x; memcpy(&x, v, 4); return x; }
+  case 4: { uint32_t x; memcpy(&x, v, 4); return x; }
+  case -8: { int64_t x; memcpy(&x, v, 8); return (double)x; }
+  default: { uint64_t x; memcpy(&x, v, 8); return (double)x; }
+  }
+}
+
+static lw_grid2d *read_npy(FILE *f, const char *path, int ncomp, lw_error *err)
+{
+  npy_header h;
+  char shape[160];
+  if (npy_read_header(f, path, &h, err)) return NULL;
+  const int fits = (h.ndim == 3 && h.shape[2] == ncomp) || (ncomp == 1 && h.ndim == 2);
+  if (!fits) {
+    lw_error_set(err, LW_EINPUT, "%s: a NumPy array of shape %s: expected %s", path,
+                 shape_text(&h, shape, sizeof shape),
+                 ncomp == 2 ? "(rows, columns, 2), u and v last (np.stack([u, v], axis=-1) makes one)"
+                            : "(rows, columns)");
+    return NULL;
+  }
+  const long long ny = h.shape[0], nx = h.shape[1];
+  if (nx < 1 || ny < 1 || nx > LW_FIELDFILE_NODES_MAX || ny > LW_FIELDFILE_NODES_MAX ||
+      nx * ny > LW_FIELDFILE_NODES_MAX) {
+    lw_error_set(err, LW_EINPUT, "%s: a NumPy array of shape %s: expected at least 1 and at most %ld nodes "
+                 "(rows x columns)", path, shape_text(&h, shape, sizeof shape), LW_FIELDFILE_NODES_MAX);
+    return NULL;
+  }
+  const long long count = nx * ny * ncomp, bytes = count * h.size;
+  struct stat st;
+  if (!fstat(fileno(f), &st) && S_ISREG(st.st_mode) && st.st_size - h.data_at != bytes) {
+    lw_error_set(err, LW_EINPUT, "%s: %lld bytes after the NumPy header, where its shape %s of %c%d holds %lld: %s",
+                 path, (long long)(st.st_size - h.data_at), shape_text(&h, shape, sizeof shape), h.kind, h.size, bytes,
+                 st.st_size - h.data_at < bytes ? "the file is cut short" : "expected the file to end there");
+    return NULL;
+  }
+  lw_grid2d *g = lw_grid2d_new((int)nx, (int)ny, ncomp, 0.0, 0.0, 1.0, 1.0, err);
+  if (!g) return NULL;
+  unsigned char block[8192];
+  long long done = 0;
+  long long j = 0, i = 0, c = 0; /* (Fortran order: j fastest, then i, then c) */
+  while (done < count) {
+    const long long want = count - done < (long long)(sizeof block) / h.size ? count - done
+                                                                             : (long long)(sizeof block) / h.size;
+    if (fread(block, (size_t)h.size, (size_t)want, f) != (size_t)want) {
+      lw_error_set(err, ferror(f) ? LW_EIO : LW_EINPUT, "%s: %s after %lld of its %lld values", path,
+                   ferror(f) ? "read error" : "the NumPy file ends", done, count);
+      lw_grid2d_free(g);
+      return NULL;
+    }
+    for (long long k = 0; k < want; k++, done++) {
+      const double v = npy_number(block + k * h.size, &h);
+      if (!h.fortran) {
+        g->data[done] = v;
+        continue;
+      }
+      g->data[(j * nx + i) * ncomp + c] = v;
+      if (++j == ny) {
+        j = 0;
+        if (++i == nx) {
+          i = 0;
+          c++;
+        }
+      }
+    }
+  }
+  return g;
+}
+
+/* A word that names a value not finite, as np.savetxt and printf write it
+** ("nan", "-inf", "Infinity"), into *v; 1 if it is one. */
+static int nonfinite_word(const char *s, size_t len, double *v)
+{
+  int neg = 0;
+  if (len && (*s == '-' || *s == '+')) {
+    neg = *s == '-';
+    s++;
+    len--;
+  }
+  if ((len == 3 && !strncasecmp(s, "nan", 3))) {
+    *v = NAN;
+    return 1;
+  }
+  if ((len == 3 && !strncasecmp(s, "inf", 3)) || (len == 8 && !strncasecmp(s, "infinity", 8))) {
+    *v = neg ? -INFINITY : INFINITY;
+    return 1;
+  }
+  return 0;
+}
+
+/* The values grown as the text's rows come. */
+typedef struct {
+  double *v;
+  size_t n, cap;
+} values;
+
+static int values_push(values *a, double v)
+{
+  if (a->n == a->cap) {
+    size_t cap = a->cap ? 2 * a->cap : 1024;
+    double *nv = realloc(a->v, cap * sizeof *nv);
+    if (!nv) return -1;
+    a->v = nv;
+    a->cap = cap;
+  }
+  a->v[a->n++] = v;
+  return 0;
+}
+
+/* One row of text into a; its count of values into *got, or an error. */
+static lw_status text_row(char *s, const char *path, long line, values *a, long *got, lw_error *err)
+{
+  *got = 0;
+  int comma = 1; /* (the line's start counts as one: a leading comma is an empty value) */
+  for (;;) {
+    s += strspn(s, " \t\r");
+    if (!*s) return LW_OK;
+    if (*s == ',') {
+      if (comma) break;
+      comma = 1;
+      s++;
+      continue;
+    }
+    const size_t len = strcspn(s, " \t\r,");
+    double v;
+    if (!lw_number_parse_n(s, len, &v) && !nonfinite_word(s, len, &v)) {
+      char unseen[96];
+      return lw_error_set(err, LW_EINPUT, "%s:%ld: value %ld of the row, '%.*s', is not a number%s%s", path, line,
+                          *got + 1, (int)(len < 40 ? len : 40), s,
+                          memchr(s, ';', len) ? " (values separated by ';': expected blanks or commas, and '.' as "
+                                                "the decimal point)" : "",
+                          lw_text_unseen_char(s, unseen, sizeof unseen));
+    }
+    if ((long)a->n >= LW_FIELDFILE_NODES_MAX * 2 + 2 || values_push(a, v))
+      return (long)a->n >= LW_FIELDFILE_NODES_MAX * 2 + 2
+             ? lw_error_set(err, LW_EINPUT, "%s:%ld: more than %ld nodes: expected at most that many", path, line,
+                            LW_FIELDFILE_NODES_MAX)
+             : lw_error_set(err, LW_ENOMEM, "%s:%ld: out of memory for the grid's values", path, line);
+    ++*got;
+    comma = 0;
+    s += len;
+  }
+  /* a comma first, or two with only blanks between: "1,,2" read as 1 2
+  ** would shift every value after a blank cell by one node */
+  return lw_error_set(err, LW_EINPUT, "%s:%ld: an empty value after value %ld of the row: expected a number in "
+                      "every field (nan for a cell without one)", path, line, *got);
+}
+
+static lw_grid2d *read_text(FILE *f, const char *path, int ncomp, lw_error *err)
+{
+  values a = {NULL, 0, 0};
+  char *buf = NULL;
+  size_t bcap = 0;
+  long line = 0, first_line = 0, width = 0, rows = 0, len, got;
+  lw_status s = LW_OK;
+  while (!s && (len = lw_text_next_line(f, &buf, &bcap, &line)) >= 0) {
+    char *hash = strchr(buf, '#');
+    if (hash) *hash = '\0';
+    if ((s = text_row(buf, path, line, &a, &got, err)) || !got) continue;
+    if (!width) {
+      width = got;
+      first_line = line;
+      if (width % ncomp)
+        s = lw_error_set(err, LW_EINPUT, "%s:%ld: %ld values in the first row: expected u v for each node, an even "
+                         "count", path, line, width);
+    } else if (got != width) {
+      s = lw_error_set(err, LW_EINPUT, "%s:%ld: %ld values, where the first row (line %ld) has %ld: expected every "
+                       "row as long", path, line, got, first_line, width);
+    }
+    rows++;
+  }
+  if (!s && len == -2 && errno == ENOMEM)
+    s = lw_error_set(err, LW_ENOMEM, "%s:%ld: out of memory reading the line", path, line + 1);
+  else if (!s && ferror(f)) s = lw_error_set(err, LW_EIO, "%s: read error", path);
+  else if (!s && len == -2) s = lw_error_set(err, LW_EINPUT, "%s:%ld: " LW_TEXT_NUL_LINE, path, line);
+  else if (!s && !rows)
+    s = lw_error_set(err, LW_EINPUT, "%s: expected rows of numbers (%s), found none", path,
+                     ncomp == 2 ? "u v for each node of a row" : "a value for each node of a row");
+  free(buf);
+  lw_grid2d *g = s ? NULL : lw_grid2d_new((int)(width / ncomp), (int)rows, ncomp, 0.0, 0.0, 1.0, 1.0, err);
+  if (g) {
+    /* the grid takes the values read (the same count: rows x width) */
+    free(g->data);
+    g->data = a.v;
+    return g;
+  }
+  free(a.v);
+  return NULL;
+}
+
+lw_grid2d *lw_fieldfile_read(const char *path, int ncomp, lw_error *err)
+{
+  if (lw_text_not_fifo(path, err)) return NULL;
+  FILE *f = fopen(path, "rb");
+  if (!f) {
+    lw_error_set(err, LW_EINPUT, "%s: cannot open the field file: %s", path, strerror(errno));
+    return NULL;
+  }
+  unsigned char head[16];
+  const size_t n = fread(head, 1, sizeof head, f);
+  rewind(f);
+  int readable;
+  const char *picture = lw_image_kind(head, n, &readable);
+  lw_grid2d *g = NULL;
+  if (n >= 6 && !memcmp(head, NPY_MAGIC, 6)) {
+    g = read_npy(f, path, ncomp, err);
+  } else if (n >= 4 && !memcmp(head, "PK\x03\x04", 4)) {
+    lw_error_set(err, LW_EINPUT, "%s: a zip archive (np.savez writes one): expected one array, as np.save or "
+                 "np.savetxt writes it", path);
+  } else if (picture) {
+    lw_error_set(err, LW_EINPUT, "%s: %s picture: expected a grid of numbers (.npy or text); a picture's own field "
+                 "is scene.field = etf or gradient", path, picture);
+  } else {
+    g = read_text(f, path, ncomp, err);
+  }
+  fclose(f);
+  return g;
+}
