@@ -1961,7 +1961,9 @@ lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err)
   a->totals_fresh = 0;
   s = sweep_once(a, err);
   a->sweep_seconds += lw_phase_clock() - t0;
-  if (!s) drop_stash(a);
+  /* (a stop asked during the first sweep keeps the run set aside: the
+  ** caller may give way, lw_anneal_undo_start) */
+  if (!s && !lw_phase_stopping()) drop_stash(a);
   return s;
 }
 

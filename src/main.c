@@ -852,10 +852,26 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
 #ifdef LW_MPI
   lw_mpi_report(net, a, quiet);
 #endif
+  /* a signal before the new run's first sweep is done makes it give way, as
+  ** one in its set-up does: the run it was to replace comes back (stopped
+  ** "after sweep 0" or 1, the new run took that run's place, unsaid, where
+  ** the README promised it back until the first sweep; a Ctrl-C just after
+  ** starting a large scene into a directory by mistake cost the run there) */
+  if (stopped && stop_requested && a->stashed && !net) {
+    if (!lw_anneal_undo_start(a)) {
+      lw_error_set(err, LW_ERUN, "%s: stopped before the first sweep, and the run that was there waits in %s/"
+                   LW_RUNFILES_STASH " (linewise puts it back when it next runs or resumes there)", a->dir, a->dir);
+      return watched_fail(w, err);
+    }
+    watcher_stop(w, LW_PHASE_STOPPED);
+    fprintf(stderr, "linewise: stopped before the first sweep; the run that was in %s is back as it was\n", a->dir);
+    return stop_requested != SIGINT ? 128 + stop_requested : 0; /* (SIGINT by itself, in main) */
+  }
   /* the checkpoint of the end (lw_anneal_finish's first step) is written
   ** here, so that a second signal while the files are drawn names it */
-  /* (a stop before the first sweep keeps the new run: its checkpoint drops
-  ** the run set aside, which an end keeps until its files are drawn) */
+  /* (a stop with the run before still aside, a --stop-at before the first
+  ** sweep: its checkpoint drops that run, which an end keeps until its files
+  ** are drawn) */
   if ((a->saved != a->sweep + 1 || (stopped && a->stashed)) && lw_anneal_checkpoint(a, err))
     return loop_fail(a, pg.start_sweep, w, err);
   say_stash_left(a);
@@ -1106,6 +1122,22 @@ static void unmake_dir(const char *dir, int hold, int made)
   lw_rundir_unlock(hold);
 }
 
+/* The --out directory locked for this run before its set-up, made first
+** where its parent is there (*made 1): locked only as the run started, a
+** second run into it during a set-up of seconds finished, and then the first
+** took the directory and wrote over that result, both exiting 0.  A path of
+** several new folders is made as the run starts, as before. */
+static lw_status claim_out(const char *dir, int *hold, int *made, lw_error *err)
+{
+  if (access(dir, F_OK)) {
+    char parent[LW_PATH_MAX];
+    lw_path_dir(parent, sizeof parent, dir);
+    if (access(parent, F_OK) || mkdir(dir, 0777)) return LW_OK; /* (the run's start says what is wrong) */
+    *made = 1;
+  }
+  return lw_rundir_lock(dir, hold, err);
+}
+
 static int cmd_run(int argc, char **argv)
 {
   lw_error err;
@@ -1191,11 +1223,6 @@ static int cmd_run(int argc, char **argv)
   if (out) snprintf(dir, sizeof dir, "%s", out);
   else if (default_dir(dir, sizeof dir, scene, &hold, &made, &err)) return fail(&err);
   name_run_dir(dir);
-  if (made) {
-    snprintf(made_dir, sizeof made_dir, "%s", dir);
-    lw_path_join(made_lock, sizeof made_lock, dir, ".lock");
-    made_what = made;
-  }
   /* the run writes its resolved parameters to DIR/scene.ini: over a run's
   ** (a run made again in place), never over a scene file a person wrote,
   ** the one this run reads included */
@@ -1210,9 +1237,14 @@ static int cmd_run(int argc, char **argv)
   ** leave the others waiting: there process 0 checks under its lock) */
   if (!net && (lw_runfiles_check_free(dir, &err) || lw_runfiles_check_stash(dir, &err))) return fail(&err);
   /* before a set-up of minutes, not after it */
-  if (lw_rundir_writable(dir, &err)) {
+  if (lw_rundir_writable(dir, &err) || (out && !net && claim_out(dir, &hold, &made, &err))) {
     unmake_dir(dir, hold, made);
     return fail(&err);
+  }
+  if (made) {
+    snprintf(made_dir, sizeof made_dir, "%s", dir);
+    lw_path_join(made_lock, sizeof made_lock, dir, ".lock");
+    made_what = made;
   }
   static lw_anneal a;
   watcher w;

@@ -75,6 +75,22 @@ Test(rundir, a_directory_another_process_writes_is_refused)
   cr_assert_eq(sh("%s resume %s/r --quiet && test -s %s/r/summary.json", lw_test_bin(), dir, dir), 0);
 }
 
+/* A run into --out DIR holds DIR's lock from before its set-up: a second
+** run into DIR started during a first's set-up of seconds finished, then the
+** first took DIR and wrote over its result, both exiting 0.  Now the second
+** is refused (exit 2), and DIR holds the first run's files. */
+Test(rundir, a_run_into_a_directory_whose_run_is_setting_up_is_refused, .timeout = 60)
+{
+  cr_assert_eq(sh("cd %s && { %s run %s/params/minimal.ini --out d --quiet --threads 1 --set init.splines=20000 "
+                  "--set scene.width=2000 --set scene.height=2000 --set anneal.sweeps=0 --seed 1 & } && sleep 0.3 && "
+                  "{ %s run %s/params/minimal.ini --out d --quiet --threads 1 --set anneal.sweeps=2 --seed 2 "
+                  "2> err.txt; echo $? > second.txt; wait; }", dir, lw_test_bin(), lw_test_root(), lw_test_bin(),
+                  lw_test_root()), 0);
+  cr_assert_eq(sh("cd %s && test \"$(cat second.txt)\" = 2 && grep -q 'd: another linewise process is writing this run "
+                  "directory' err.txt && grep -q '\"seed\": 1,' d/summary.json", dir), 0, "%s",
+               lw_test_slurp("%s/err.txt", dir));
+}
+
 /* A run another user is writing, in a directory this one may not write,
 ** is said busy: before, the files' modes were said ("cannot write over the
 ** run's trace"), and the run going on not; once it ends, the modes are. */
