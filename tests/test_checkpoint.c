@@ -262,8 +262,11 @@ Test(checkpoint, a_state_cut_short_is_said_to_be)
   /* in [run], in [chain]'s rng, after it (of 13899 bytes), and 4 bytes into the last number */
   static const long at[] = {300, 5000, 11220, -5};
   for (size_t i = 0; i < sizeof at / sizeof at[0]; i++) {
-    lw_test_sh("rm -rf %s/x && cp -r %s/r %s/x && truncate -s %s%ld %s/x/state.lw", dir, dir, dir,
-               at[i] < 0 ? "-" : "", at[i] < 0 ? -at[i] : at[i], dir);
+    /* (a byte less where the cut falls at a line's end: the state's bytes
+    ** move with its keys) */
+    lw_test_sh("rm -rf %s/x && cp -r %s/r %s/x && truncate -s %s%ld %s/x/state.lw && "
+               "if test \"$(tail -c 1 %s/x/state.lw)\" = ''; then truncate -s -1 %s/x/state.lw; fi", dir, dir, dir,
+               at[i] < 0 ? "-" : "", at[i] < 0 ? -at[i] : at[i], dir, dir, dir);
     cr_assert_eq(lw_test_sh("test \"$(tail -c 1 %s/x/state.lw)\" != ''", dir), 0, "cut inside a line");
     cr_expect_eq(lw_test_sh("%s resume %s/x --quiet 2>%s/err.txt", lw_test_bin(), dir, dir), 2, "cut at %ld", at[i]);
     cr_expect(err_has(": the file ends inside this line: cut short (a partial copy, a full disk?)"), "cut at %ld",

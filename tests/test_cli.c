@@ -804,10 +804,12 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
 Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_error)
 {
   write_file("s.ini", scene_text);
-  /* the signal once the run directory is there: the handlers are set by
-  ** then (a fixed sleep raced a slow start, as under the sanitizers) */
+  /* the signal once the run's first file is there: its set-up has written
+  ** (a fixed sleep raced a slow start, as under the sanitizers; the
+  ** directory itself is made and locked before the set-up) */
   cr_assert_eq(lw_test_sh("%s run %s/s.ini --out %s/sig --quiet --set init.splines=200 --set anneal.sweeps=1 & "
-                          "p=$!; i=0; while [ $i -lt 500 ] && ! test -d %s/sig; do sleep 0.01; i=$((i+1)); done; "
+                          "p=$!; i=0; while [ $i -lt 500 ] && ! test -e %s/sig/scene.ini; do sleep 0.01; "
+                          "i=$((i+1)); done; "
                           "kill -TERM $p; wait $p", lw_test_bin(), dir, dir, dir), 0);
   cr_assert_eq(lw_test_sh("test -f %s/sig/state.lw && ! test -e %s/sig/state.lw.tmp", dir, dir), 0);
   cr_assert_eq(lw_test_sh("%s resume %s/sig --quiet", lw_test_bin(), dir), 0);
