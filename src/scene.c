@@ -910,6 +910,56 @@ static void note_blur_gaps(lw_scene *sc, const lw_params *p)
   }
 }
 
+/* The field's own detail finer than the samples along a segment: there the
+** annealing bends segments between the samples to follow the field where
+** they are and not between them, and the quadrature misses what it costs
+** (an adversary, 2026-12-07: field = gradient on params/study.ini hid
+** 1.9e-2 of the field term, 19 % unblurred at 600 pixels; waves of 4 mm
+** 3 %, 16 mm 8e-4, 30 mm 2e-8).  The scale: the blur or pixels the
+** picture's field varies over, a data grid's node spacing, or the length
+** over which the waves turn a radian, 1 / (k^2 A).  No check holds a
+** segment to it (docs/NUMERICS.md, "What the clearance does not cover"). */
+static void note_field_detail(lw_scene *sc, const lw_params *p)
+{
+  if (!sc->on[LW_TERM_FIELD]) return;
+  const double gap = p->segment_length * sc->quad.spacing, px = sc->image ? sc->image_place.pixel : 0.0;
+  const double k = 2.0 * M_PI / p->field_wavelength, etf = hypot(p->field_sigma, p->image_blur);
+  double scale;
+  const char *what, *closes;
+  switch (p->field) {
+  case LW_FLD_ETF:
+    scale = etf > 0.0 ? etf : px;
+    what = etf > 0.0 ? "scene.field_sigma with scene.image_blur" : "the picture's pixels";
+    closes = "a wider scene.field_sigma";
+    break;
+  case LW_FLD_GRADIENT:
+    scale = p->image_blur > 0.0 ? p->image_blur : px;
+    what = p->image_blur > 0.0 ? "scene.image_blur" : "the picture's pixels";
+    closes = "a wider scene.image_blur";
+    break;
+  case LW_FLD_FILE:
+    scale = fmin(sc->field.grid->hx, sc->field.grid->hy);
+    what = "the spacing of scene.field_file's nodes on the page";
+    closes = "a smoother grid, its detail coarser than the samples,";
+    break;
+  case LW_FLD_WAVES:
+    scale = p->field_amplitude != 0.0 ? 1.0 / (k * k * fabs(p->field_amplitude)) : INFINITY;
+    what = "the length over which the waves turn a radian, wavelength^2 / (4 pi^2 amplitude)";
+    closes = "a longer scene.field_wavelength or a smaller amplitude";
+    break;
+  default:
+    return; /* (constant; radial and vortex: their core, scene.field_core, has its own stated accuracy) */
+  }
+  if (!(gap > scale)) return;
+  char more[96] = "";
+  if (sc->quad.n < LW_QUAD_MAX) snprintf(more, sizeof more, " or more nodes (energy.quadrature)");
+  size_t used = strlen(sc->note);
+  snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field: the placed segments' samples lie up to %.3g mm "
+           "apart, more than the field's detail (%.3g mm: %s): annealed segments can bend between the samples, the "
+           "field's term hidden from the quadrature (docs/NUMERICS.md); %s%s closes it", used ? "; " : "", gap,
+           scale, what, closes, more);
+}
+
 /* The pair term's product rule alone, with nothing to keep strokes apart:
 ** where they touch or cross it misses energy, and the chain finds such
 ** states (a photograph annealed so read its pair energy 11.6 % low). */
@@ -931,6 +981,7 @@ lw_status lw_scene_init(lw_scene *sc, const lw_params *p, lw_error *err)
     lw_scene_clear(sc);
   } else {
     note_blur_gaps(sc, p);
+    note_field_detail(sc, p);
     note_pair_unguarded(sc, p);
   }
   return st;
