@@ -893,11 +893,16 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
   ** the format tests before it.  A reason the load did not change is not
   ** given. */
   const char *before = stbi_failure_reason();
+  errno = 0;
   void *pix = bits == 16 ? (void *)stbi_load_16_from_memory(data, (int)size, &w, &h, &ch, 0)
                          : (void *)stbi_load_from_memory(data, (int)size, &w, &h, &ch, 0);
   if (!pix) {
     const char *why = stbi_failure_reason();
-    if (why && why != before && (!strcmp(why, "outofmem") || !strcmp(why, "Out of memory")))
+    /* (a PNG's inflate sets no reason where its buffer cannot be had: the
+    ** failed malloc's errno tells memory from damage, which was said) */
+    const int nomem = why && why != before ? !strcmp(why, "outofmem") || !strcmp(why, "Out of memory")
+                                           : errno == ENOMEM;
+    if (nomem)
       return lw_error_set(err, LW_ENOMEM, "%s: out of memory decoding the %s (%d x %d pixels)", name,
                           format_name(data, size), w, h);
     return lw_error_set(err, LW_EINPUT, "%s: the %s is damaged or cut short: it does not decode%s%s%s", name,

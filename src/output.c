@@ -562,6 +562,17 @@ static lw_status png_write_rgb(cairo_surface_t *surf, png_sink *k)
   return LW_OK;
 }
 
+cairo_surface_t *lw_output_white_surface(int w, int h)
+{
+  cairo_surface_t *s = cairo_image_surface_create(CAIRO_FORMAT_RGB24, w, h);
+  if (cairo_surface_status(s) == CAIRO_STATUS_SUCCESS) {
+    cairo_surface_flush(s);
+    memset(cairo_image_surface_get_data(s), 0xff, (size_t)cairo_image_surface_get_stride(s) * (size_t)h);
+    cairo_surface_mark_dirty(s);
+  }
+  return s;
+}
+
 lw_status lw_output_png_surface(cairo_surface_t *surf, const char *path, lw_error *err)
 {
   /* To a stream on our temporary file rather than
@@ -604,15 +615,13 @@ lw_status lw_output_png_strokes(const lw_strokes *st, const lw_output_page *page
                         px_per_mm);
 
   /* RGB24: the preview is opaque, and the PNG needs no alpha channel. */
-  cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, w, h);
+  cairo_surface_t *surf = lw_output_white_surface(w, h);
   cairo_t *cr = cairo_create(surf);
   if (cairo_status(cr)) {
     s = lw_error_set(err, LW_ENOMEM, "%s: cannot make a %d x %d preview: %s", path, w, h,
                      cairo_status_to_string(cairo_status(cr)));
     goto done;
   }
-  cairo_set_source_rgb(cr, 1, 1, 1);
-  cairo_paint(cr);
   /* Draw in mm: the line width is then the pen width in page units. */
   cairo_scale(cr, k, k);
   draw(cr, st, page, tone, 1);

@@ -90,8 +90,6 @@ static void paint(cairo_t *cr, const lw_particles *p, const depth_key *order, in
   }
   double span = fmax(hi[0] - lo[0], hi[1] - lo[1]) + 2.0 * s->disc;
   double scale = 0.92 * size / span, cu = 0.5 * (lo[0] + hi[0]), cw = 0.5 * (lo[1] + hi[1]);
-  cairo_set_source_rgb(cr, 1, 1, 1);
-  cairo_paint(cr);
   cairo_set_line_width(cr, fmax(1.0, 0.04 * s->disc * scale));
   for (size_t o = 0; o < p->n; o++) {
     size_t i = order[o].i;
@@ -128,7 +126,7 @@ lw_status lw_particles_write_png(const lw_particles *p, const char *path, int fr
   if (!order) return lw_error_set(err, LW_ENOMEM, "%s: out of memory for the preview", path);
   for (size_t i = 0; i < p->n; i++) order[i] = (depth_key){lw_v3_dot(p->x + 3 * i, s->view), i};
   qsort(order, p->n, sizeof *order, depth_cmp);
-  cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, size, size);
+  cairo_surface_t *surf = lw_output_white_surface(size, size);
   cairo_t *cr = cairo_create(surf);
   lw_status st = LW_OK;
   if (cairo_status(cr)) {

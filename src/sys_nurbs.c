@@ -1024,10 +1024,8 @@ static lw_status write_png(const lw_nurbs_state *s, const double b[4], const cha
   if (!lw_output_png_size(&box, s->su->png_scale, &W, &H, &scale))
     return lw_error_set(err, LW_ERUN, "%s: the curve's box (%g to %g, %g to %g) cannot be drawn", path, b[0], b[2],
                         b[1], b[3]);
-  cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);
+  cairo_surface_t *surf = lw_output_white_surface(W, H);
   cairo_t *cr = cairo_create(surf);
-  cairo_set_source_rgb(cr, 1, 1, 1);
-  cairo_paint(cr);
   cairo_translate(cr, 0, H);
   cairo_scale(cr, scale, -scale);
   cairo_translate(cr, -b[0], -b[1]);

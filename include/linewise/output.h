@@ -125,6 +125,12 @@ lw_status lw_output_pdf(const lw_splines *sp, const lw_output_page *page, const 
 lw_status lw_output_frame(const char *dir, long sweep, const lw_splines *sp, const lw_output_page *page,
                           const lw_plot *plot, const lw_grid2d *tone, double px_per_mm, lw_error *err);
 
+/* An RGB24 surface of w x h pixels, white: its bytes set, where a
+** cairo_paint of white, out of memory inside cairo, was dropped without a
+** status, and the preview came out black with exit 0 (a fault injector's
+** find).  The caller checks cairo_surface_status and destroys it. */
+cairo_surface_t *lw_output_white_surface(int w, int h);
+
 /* Writes surf as a PNG to path through a temporary file and
 ** lw_output_commit; a failed write names the file and the reason (errno,
 ** which cairo's own message leaves out). */
