@@ -1861,6 +1861,12 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
       if (k > a->block + 1) a->t_prev = a->t_sched;
       a->t_sched = step_temperature(a, k, a->block >= 0 && k == a->block + 1);
     }
+    /* (schedule.h's promise, which a new schedule's function may break: a
+    ** run at T < 0 climbed the energy and reported its t_end) */
+    if (!(a->t_sched >= 0.0) || !isfinite(a->t_sched))
+      return lw_error_set(err, LW_ERUN, "anneal.schedule = %s gave the temperature %g at step %ld: expected a finite "
+                          "temperature >= 0 (a fault of the schedule's function, include/linewise/schedule.h)",
+                          a->sched_type->name, a->t_sched, b);
     set_temperatures(a);
     a->block = b;
     a->acc_n = a->acc_sum = a->acc_sumsq = 0.0;

@@ -331,20 +331,27 @@ static void grad_chemical(const double *seg_len, size_t n_seg, double length, do
   for (size_t m = 0; m < n_seg; m++) dlen[m] += c->coef * mu[1];
 }
 
-const char *const lw_term_names[LW_TERM_COUNT] = {"strain", "bending", "potential", "field",
-                                                  "pair", "boundary", "user", "parametrisation",
-                                                  "load", "tone", "chemical"};
+/* (by id: an entry left out is NULL, which tests/test_terms.c finds, where
+** a list by position shifted every name after it) */
+const char *const lw_term_names[LW_TERM_COUNT] = {
+  [LW_TERM_STRAIN] = "strain", [LW_TERM_BENDING] = "bending", [LW_TERM_POTENTIAL] = "potential",
+  [LW_TERM_FIELD] = "field", [LW_TERM_PAIR] = "pair", [LW_TERM_BOUNDARY] = "boundary", [LW_TERM_USER] = "user",
+  [LW_TERM_PARAM] = "parametrisation", [LW_TERM_LOAD] = "load", [LW_TERM_TONE] = "tone",
+  [LW_TERM_CHEMICAL] = "chemical",
+};
 
 const lw_term_type lw_term_types[LW_TERM_COUNT] = {
-  {LW_TERM_STRAIN, .spline = spline_strain, .spline_change = change_strain, .spline_grad = grad_strain},
-  {LW_TERM_BENDING, .segment = seg_bending, .segment_grad = grad_bending},
-  {LW_TERM_POTENTIAL, .segment = seg_potential, .segment_grad = grad_potential},
-  {LW_TERM_FIELD, .segment = seg_field, .segment_grad = grad_field},
-  {LW_TERM_PAIR, .pairwise = 1}, /* lw_pair_gradient (gradient.h) */
-  {LW_TERM_BOUNDARY, .segment = seg_boundary, .segment_grad = grad_boundary},
-  {LW_TERM_USER, .segment = seg_user}, /* no gradient: the caller's function is opaque */
-  {LW_TERM_PARAM, .segment = seg_param, .segment_grad = grad_param},
-  {LW_TERM_LOAD, .segment = seg_load, .segment_grad = grad_load},
-  {LW_TERM_TONE, .raster = 1}, /* its gradient: lw_tone_sample_grad, summed in gradient.c */
-  {LW_TERM_CHEMICAL, .spline = spline_chemical, .spline_change = change_chemical, .spline_grad = grad_chemical},
+  [LW_TERM_STRAIN] = {LW_TERM_STRAIN, .spline = spline_strain, .spline_change = change_strain,
+                      .spline_grad = grad_strain},
+  [LW_TERM_BENDING] = {LW_TERM_BENDING, .segment = seg_bending, .segment_grad = grad_bending},
+  [LW_TERM_POTENTIAL] = {LW_TERM_POTENTIAL, .segment = seg_potential, .segment_grad = grad_potential},
+  [LW_TERM_FIELD] = {LW_TERM_FIELD, .segment = seg_field, .segment_grad = grad_field},
+  [LW_TERM_PAIR] = {LW_TERM_PAIR, .pairwise = 1}, /* lw_pair_gradient (gradient.h) */
+  [LW_TERM_BOUNDARY] = {LW_TERM_BOUNDARY, .segment = seg_boundary, .segment_grad = grad_boundary},
+  [LW_TERM_USER] = {LW_TERM_USER, .segment = seg_user}, /* no gradient: the caller's function is opaque */
+  [LW_TERM_PARAM] = {LW_TERM_PARAM, .segment = seg_param, .segment_grad = grad_param},
+  [LW_TERM_LOAD] = {LW_TERM_LOAD, .segment = seg_load, .segment_grad = grad_load},
+  [LW_TERM_TONE] = {LW_TERM_TONE, .raster = 1}, /* its gradient: lw_tone_sample_grad, summed in gradient.c */
+  [LW_TERM_CHEMICAL] = {LW_TERM_CHEMICAL, .spline = spline_chemical, .spline_change = change_chemical,
+                        .spline_grad = grad_chemical},
 };

@@ -213,6 +213,42 @@ Test(gradient, parametrisation)
   lw_scene_clear(&sc);
 }
 
+/* Every term a scene's keys turn on, all on at once, each against its
+** central differences: a term added later is covered here once it is on
+** (a contributor's wrong sign in a new term's gradient passed every suite,
+** and the quench stalled far above its minimum).  The tone needs a picture
+** (tone_term below), the user term has no gradient (user_term_refused), and
+** the pair term's near field is checked in tests/test_pairgrad.c, within
+** its own rounding (its sum here differs from the energy's in the last
+** bits). */
+Test(gradient, every_term_at_once)
+{
+  lw_params p = base_params();
+  p.strain = 2;
+  p.bending = 0.8;
+  p.potential_coef = 0.5;
+  p.potential = LW_POT_RADIAL;
+  p.field_coef = -0.4;
+  p.field = LW_FLD_VORTEX;
+  p.pair = 0.05;
+  p.pair_cutoff = 8;
+  p.boundary_coef = 0.3;
+  p.parametrisation = 0.6;
+  p.dyn_force_x = 0.02;
+  p.dyn_force_y = -0.03;
+  p.chem_spline = 0.4;
+  p.chem_length = -0.02;
+  lw_scene sc;
+  scene_with(&sc, &p);
+  for (int t = 0; t < LW_TERM_COUNT; t++) {
+    cr_assert(sc.on[t] || t == LW_TERM_TONE || t == LW_TERM_USER,
+              "term %s is off here: turn it on (tests/test_gradient.c) so that its gradient is checked",
+              lw_term_names[t]);
+    if (sc.on[t] && t != LW_TERM_PAIR) check_scene(&sc, t, lw_term_names[t]);
+  }
+  lw_scene_clear(&sc);
+}
+
 /* A grid of random values over the page (spacing ~ 7 mm: several cells per
 ** segment), ncomp values a node. */
 static lw_grid2d *random_grid(int ncomp, uint64_t seed)

@@ -33,6 +33,36 @@ static void temp_file(char path[64], const char *text)
   close(fd);
 }
 
+/* Every row of the table, a schedule added later included (schedule.h
+** promises: a temperature finite and >= 0; the analytic ones, reading
+** t_start and t_end and neither a table nor their own past, hit both ends
+** and are monotone between them).  A contributor's cosine schedule that
+** heated half way (1 - cos for 1 + cos) passed every suite, as one that
+** went below 0 did: the formula test above lists its schedules by hand. */
+Test(schedule, every_row_keeps_the_promises_of_the_table)
+{
+  for (const lw_schedule_type *const *tp = lw_schedule_types; *tp; tp++) {
+    const lw_schedule_type *t = *tp;
+    if (t->needs & LW_SCHEDULE_USES_TABLE) continue; /* (its rows are the user's: table_* below) */
+    const int analytic = (t->needs & LW_SCHEDULE_USES_END) && !(t->needs & LW_SCHEDULE_RECURSIVE);
+    const long Bs[] = {1, 2, 5, 101};
+    for (size_t i = 0; i < sizeof Bs / sizeof *Bs; i++) {
+      lw_schedule s = {.t_start = 2.0, .t_end = 0.05, .blocks = Bs[i], .lambda = 0.7};
+      cr_assert_eq(lw_schedule_check(t, &s, NULL), LW_OK, "%s", t->name);
+      double T[101];
+      lw_schedule_run(t, &s, T);
+      for (long b = 0; b < s.blocks; b++) {
+        cr_assert(isfinite(T[b]) && T[b] >= 0.0, "%s B=%ld: T_%ld = %g", t->name, s.blocks, b, T[b]);
+        if (analytic && b > 0)
+          cr_assert(T[b] <= T[b - 1] && T[b] >= s.t_end, "%s B=%ld: T_%ld = %.17g after %.17g, not monotone "
+                    "between t_start and t_end", t->name, s.blocks, b, T[b], T[b - 1]);
+      }
+      cr_assert_eq(T[0], s.t_start, "%s: T_0 = %.17g", t->name, T[0]);
+      if (analytic && s.blocks > 1) cr_assert_eq(T[s.blocks - 1], s.t_end, "%s: the last block", t->name);
+    }
+  }
+}
+
 Test(schedule, analytic_endpoints_monotone_and_formula)
 {
   const lw_schedule_type *types[] = {&lw_schedule_linear, &lw_schedule_geometric, &lw_schedule_logarithmic};

@@ -395,7 +395,47 @@ static lw_params all_terms(void)
   p.pair = 0.05;
   p.pair_cutoff = 8;
   p.boundary_coef = 0.2;
+  p.parametrisation = 0.3;
+  p.dyn_force_x = 0.02;
+  p.dyn_force_y = -0.05;
+  p.chem_spline = 0.4;
+  p.chem_length = -0.01;
   return p;
+}
+
+/* The terms no scene without a picture or a program turns on: the tone
+** (a picture's, tests/test_tone.c) and the user term (a program's
+** function, lw_scene_set_user_term). */
+static int needs_more_than_keys(int t) { return t == LW_TERM_TONE || t == LW_TERM_USER; }
+
+/* all_terms() turns on every term a scene's keys can, so that the tests on
+** it cover a term added later: one left off there fails here. */
+Test(terms, the_all_terms_scene_turns_every_term_on)
+{
+  lw_params p = all_terms();
+  lw_scene sc;
+  scene_with(&sc, &p);
+  for (int t = 0; t < LW_TERM_COUNT; t++)
+    if (!needs_more_than_keys(t))
+      cr_assert(sc.on[t], "term %s is off in all_terms() (tests/test_terms.c): turn it on there, and in "
+                "every_term_at_once (tests/test_gradient.c), so that their tests cover it", lw_term_names[t]);
+  lw_scene_clear(&sc);
+}
+
+/* Every term has its name (an entry left out of lw_term_names is NULL, and
+** every run crashed on it) and its own row of one kind. */
+Test(terms, every_term_has_a_name_and_a_row_of_one_kind)
+{
+  for (int t = 0; t < LW_TERM_COUNT; t++) {
+    cr_assert_not_null(lw_term_names[t], "term %d has no name in lw_term_names (src/terms.c)", t);
+    for (int u = 0; u < t; u++) cr_assert_str_neq(lw_term_names[t], lw_term_names[u]);
+    const lw_term_type *r = &lw_term_types[t];
+    cr_assert_eq((int)r->id, t, "lw_term_types[%d] holds term %d", t, (int)r->id);
+    const int kinds = (r->segment != NULL) + (r->spline != NULL) + (r->pairwise != 0) + (r->raster != 0);
+    cr_assert_eq(kinds, 1, "term %s: %d kinds (segment, spline, pairwise, raster): expected one", lw_term_names[t],
+                 kinds);
+    cr_assert(!r->spline == !r->spline_change, "term %s: a spline term needs spline_change", lw_term_names[t]);
+  }
 }
 
 Test(terms, degenerate_input_never_gives_nan)
@@ -606,6 +646,7 @@ Test(terms, every_row_reads_its_own_context_only)
       [LW_TERM_FIELD] = lw_term_field(&s, &sc.quad, &sc.field, sc.field_axial),
       [LW_TERM_BOUNDARY] = lw_term_boundary(&s, &sc.quad, &sc.boundary),
       [LW_TERM_PARAM] = lw_term_parametrisation(&s, &sc.quad),
+      [LW_TERM_LOAD] = lw_term_load(&s, sc.load),
   };
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     if (!lw_term_types[t].segment || t == LW_TERM_USER) continue;

@@ -1,5 +1,5 @@
 /*
-** driver.h -- what moves a system between sweeps (DESIGN.md section 5),
+** driver.h -- what moves a system between sweeps (docs/SYSTEMS.md),
 ** one table row each, in the style of the system rows (system.h) and the
 ** schedules (schedule.h).  `[scene] driver` names a row.
 **
@@ -44,7 +44,10 @@ typedef struct lw_driver_type {
   ** symmetric move), x from -infinity to +infinity; the chain draws one
   ** uniform number for each decision at T > 0, runs without delayed
   ** acceptance, whose second stage is Metropolis's, and tunes its steps to
-  ** each target as a share of accept(0) (mc.h).  NULL: Metropolis, min(1,
+  ** each target as a share of accept(0) (mc.h), the acceptance of the
+  ** smallest steps: so accept must be continuous at 0 (a greedy rule, 1 at
+  ** x >= 0 and 0 below, takes half its smallest steps, and tuned its steps
+  ** to 1e-12 mm chasing a target above that).  NULL: Metropolis, min(1,
   ** e^x), drawing nothing where x >= 0 (and delayed acceptance where the
   ** scene asks) */
   double (*accept)(double x);

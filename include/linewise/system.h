@@ -1,7 +1,7 @@
 /*
 ** system.h -- a system type as a table row (in the style of gsl_rng_type
 ** and the schedule table): what the degrees of freedom are, and everything
-** the drivers need to know about them (DESIGN.md section 5).
+** the drivers need to know about them (docs/SYSTEMS.md).
 **
 ** The drivers -- the Metropolis chain (mc.h), the tempering ladder, step
 ** tuning, the run loop and its checkpoints, trace and summary (anneal.c) --
