@@ -144,24 +144,29 @@ static lw_grid2d *pixel_grid(const lw_image *img, const lw_image_place *pl, lw_e
                        pl->pixel, pl->pixel, err);
 }
 
-lw_grid2d *lw_imagefield_gradient(const lw_image *img, const lw_image_place *pl, double flat, lw_error *err)
+lw_grid2d *lw_imagefield_gradient(const lw_image *img, const lw_image_place *pl, double flat, double *gentle,
+                                  lw_error *err)
 {
   lw_grid2d *g = pixel_grid(img, pl, err);
   if (!g) return NULL;
+  size_t faded = 0;
   for (int j = 0; j < img->height; j++)
     for (int i = 0; i < img->width; i++) {
       double gx, gy;
       sobel(img, pl->pixel, i, j, &gx, &gy);
-      double n = fmax(sqrt(gx * gx + gy * gy), flat);
+      const double slope = sqrt(gx * gx + gy * gy);
+      faded += slope > 0.0 && slope < flat;
+      double n = fmax(slope, flat);
       double *d = g->data + 2 * ((size_t)j * (size_t)img->width + (size_t)i);
       d[0] = n > 0 ? gx / n : 0.0;
       d[1] = n > 0 ? gy / n : 0.0;
     }
+  if (gentle) *gentle = (double)faded / ((double)img->width * (double)img->height);
   return g;
 }
 
 lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, double sigma_mm, double flat,
-                             double angle, lw_error *err)
+                             double angle, double *gentle, lw_error *err)
 {
   const int w = img->width, h = img->height;
   const size_t n = (size_t)w * (size_t)h;
@@ -194,12 +199,16 @@ lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, doub
     }
   const double fc = flat * flat * cos(2 * angle), fs = flat * flat * sin(2 * angle);
   const double uc = cos(2 * angle), us = sin(2 * angle);
+  size_t fallback = 0;
   for (size_t k = 0; k < n; k++) {
-    double tx = (double)J22[k] - J11[k] + fc, ty = -2.0 * J12[k] + fs;
+    const double ax = (double)J22[k] - J11[k], ay = -2.0 * J12[k], own = ax * ax + ay * ay;
+    fallback += own > 0.0 && own < flat * flat * flat * flat;
+    double tx = ax + fc, ty = ay + fs;
     double m = sqrt(tx * tx + ty * ty);
     g->data[2 * k] = m > 0 ? tx / m : uc;
     g->data[2 * k + 1] = m > 0 ? ty / m : us;
   }
   free(J);
+  if (gentle) *gentle = (double)fallback / (double)n;
   return g;
 }

@@ -688,11 +688,19 @@ static lw_status build_field(lw_scene *sc, const lw_params *p, double cx, double
     if (p->field == LW_FLD_ETF && !sc->field_axial)
       return bad_key(p, "scene", "field", LW_EINPUT, err,
                      "'etf' is a direction without sign: it needs energy.field_mode = axial");
+    double gentle;
     f->grid = p->field == LW_FLD_ETF
               ? lw_imagefield_etf(sc->image, &sc->image_place, p->field_sigma, p->field_flat,
-                                  p->field_angle * DEG, err)
-              : lw_imagefield_gradient(sc->image, &sc->image_place, p->field_flat, err);
+                                  p->field_angle * DEG, &gentle, err)
+              : lw_imagefield_gradient(sc->image, &sc->image_place, p->field_flat, &gentle, err);
     if (!f->grid) return err->code;
+    if (gentle > 0.5) {
+      size_t used = strlen(sc->note);
+      snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field_flat: over %.0f %% of the picture its tone "
+               "changes, but slower than field_flat (%g tone/mm), where the field %s; a smaller field_flat follows a "
+               "smooth picture there (docs/IMAGES.md)", used ? "; " : "", 100.0 * gentle, p->field_flat,
+               p->field == LW_FLD_ETF ? "turns to field_angle" : "fades to 0");
+    }
   }
   return LW_OK;
 }

@@ -399,3 +399,35 @@ Test(fieldfile, a_field_finer_than_the_samples_gets_a_note)
     lw_scene_clear(&sc);
   }
 }
+
+/* A smooth picture (a scientist's field drawn as tones, 0..1 over a page)
+** changes slower than the default field_flat nearly everywhere: the field
+** was field_angle's (etf) or 0 (gradient) there, unsaid.  Said now; not
+** where field_flat is below its slope. */
+Test(fieldfile, a_picture_smoother_than_field_flat_gets_a_note)
+{
+  const char *pic = lw_test_path("ramp.png");
+  float g[64 * 64];
+  for (int k = 0; k < 64 * 64; k++) g[k] = (float)(0.3 + 0.4 * (k % 64) / 63.0); /* 0.0044 tone/mm */
+  lw_test_png(pic, 64, 64, g, NULL);
+  for (int field = LW_FLD_ETF; field <= LW_FLD_GRADIENT; field++)
+    for (int smaller = 0; smaller < 2; smaller++) {
+      lw_params p;
+      lw_params_defaults(&p);
+      p.width = p.height = 100;
+      p.margin = 5;
+      p.field_coef = -1;
+      p.field = field;
+      p.field_mode = field == LW_FLD_ETF ? LW_FIELDMODE_AXIAL : LW_FIELDMODE_SIGNED;
+      p.field_flat = smaller ? 1e-3 : 0.01;
+      snprintf(p.image, sizeof p.image, "%s", pic);
+      lw_scene sc;
+      lw_error err;
+      cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
+      if (smaller) cr_assert_null(strstr(sc.note, "field_flat"), "%s", sc.note);
+      else
+        cr_assert(strstr(sc.note, "scene.field_flat: over") &&
+                  strstr(sc.note, field == LW_FLD_ETF ? "turns to field_angle" : "fades to 0"), "%s", sc.note);
+      lw_scene_clear(&sc);
+    }
+}

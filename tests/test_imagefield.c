@@ -49,7 +49,7 @@ Test(imagefield, etf_runs_along_straight_stripes)
   lw_image *img = picture(160, 140, stripes);
   lw_image_place pl = {5, 7, 0.25}; /* 4 pixels per mm */
   lw_field f = {.kind = LW_FIELD_GRID_AXIAL};
-  f.grid = lw_imagefield_etf(img, &pl, 1.0, 1e-3, 0.0, NULL);
+  f.grid = lw_imagefield_etf(img, &pl, 1.0, 1e-3, 0.0, NULL, NULL);
   cr_assert_not_null(f.grid);
   /* along the stripes = perpendicular to their normal */
   double tx = -sin(stripe_angle), ty = cos(stripe_angle), worst = 0;
@@ -71,7 +71,7 @@ Test(imagefield, etf_is_tangential_on_concentric_rings)
   lw_image *img = picture(160, 140, rings);
   lw_image_place pl = {0, 0, 1};
   lw_field f = {.kind = LW_FIELD_GRID_AXIAL};
-  f.grid = lw_imagefield_etf(img, &pl, 2.0, 1e-3, 0.0, NULL);
+  f.grid = lw_imagefield_etf(img, &pl, 2.0, 1e-3, 0.0, NULL, NULL);
   cr_assert_not_null(f.grid);
   double worst = 0, mean = 0;
   rng_seed(22);
@@ -98,7 +98,7 @@ Test(imagefield, etf_falls_back_to_field_angle_where_flat)
   lw_image_place pl = {0, 0, 0.5};
   lw_field f = {.kind = LW_FIELD_GRID_AXIAL};
   const double a = 1.1;
-  f.grid = lw_imagefield_etf(img, &pl, 1.0, 0.01, a, NULL);
+  f.grid = lw_imagefield_etf(img, &pl, 1.0, 0.01, a, NULL, NULL);
   double vx, vy;
   lw_field_eval(&f, 7.3, 9.1, &vx, &vy);
   cr_assert(fabs(vx - cos(a)) < 1e-9 && fabs(vy - sin(a)) < 1e-9, "(%g, %g)", vx, vy);
@@ -111,13 +111,13 @@ Test(imagefield, gradient_points_to_lighter_and_fades_where_flat)
   lw_image *img = picture(200, 20, ramp);
   lw_image_place pl = {0, 0, 0.5}; /* slope 1/200 per pixel = 0.01 tone per mm */
   lw_field f = {.kind = LW_FIELD_GRID};
-  f.grid = lw_imagefield_gradient(img, &pl, 0.005, NULL);
+  f.grid = lw_imagefield_gradient(img, &pl, 0.005, NULL, NULL);
   double vx, vy;
   lw_field_eval(&f, 50.2, 5.1, &vx, &vy);
   cr_assert(fabs(vx - 1) < 1e-4 && fabs(vy) < 1e-6, "(%g, %g)", vx, vy);
   lw_field_clear(&f);
   /* with the flatness threshold above the slope the length is slope / flat */
-  f.grid = lw_imagefield_gradient(img, &pl, 0.04, NULL);
+  f.grid = lw_imagefield_gradient(img, &pl, 0.04, NULL, NULL);
   lw_field_eval(&f, 50.2, 5.1, &vx, &vy);
   cr_assert(fabs(vx - 0.25) < 1e-4, "%g", vx);
   lw_field_clear(&f);

@@ -59,11 +59,19 @@ extern "C" {
 lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, double sigma,
                                    int paper, int fine, lw_error *err);
 
-/* angle: the fallback direction, radians (0 = +x, pi/2 = +y, down). */
+/* angle: the fallback direction, radians (0 = +x, pi/2 = +y, down).
+** *gentle (may be NULL): the share of the pixels where the picture's
+** (smoothed) structure is there but under flat, so that the fallback
+** decides: a smooth picture of a scientist's field, 0..1 over a page, changes
+** by about 0.01 tone/mm everywhere, and the default field_flat made most of
+** its field the fallback's, unsaid. */
 lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, double sigma_mm, double flat,
-                             double angle, lw_error *err);
+                             double angle, double *gentle, lw_error *err);
 
-lw_grid2d *lw_imagefield_gradient(const lw_image *img, const lw_image_place *pl, double flat, lw_error *err);
+/* *gentle (may be NULL): the share of the pixels whose tone changes, but
+** slower than flat, where the field fades. */
+lw_grid2d *lw_imagefield_gradient(const lw_image *img, const lw_image_place *pl, double flat, double *gentle,
+                                  lw_error *err);
 
 #ifdef __cplusplus
 }
