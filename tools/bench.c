@@ -203,12 +203,15 @@ static void bench_throughput(bench_ctx *b)
   for (int t = 0; t < 2; t++)
     fprintf(d, "- at about %.0f neighbours %.0f proposals a second, against %.0f: %s.\n", mean_neighbours(r[row[t]].model),
             1e9 / ns[row[t]], target[t], 1e9 / ns[row[t]] >= target[t] ? "met" : "not met");
-  fprintf(d, "\nThe sample-gap and clearance checks added on 2026-12-04 (docs/NUMERICS.md, \"Regular\n"
-             "segments\") take 0.9 %% of a run's instructions (callgrind, params/flow.ini, 40 sweeps: the\n"
-             "frame's exact check 0.65 %%, the pair gaps 0.19 %%, the boundary term's own sum 0.06 %% more).\n");
+  fprintf(d, "\nThe sample-gap and clearance checks of docs/NUMERICS.md (\"Regular segments\") took 0.77 %% of\n"
+             "params/flow.ini's instructions over 40 sweeps when last measured (callgrind, 2026-12-06: the\n"
+             "frame's check answers a segment whose four control points clear a convex frame after those\n"
+             "four distances, 420 instructions a call); \"Throughput: earlier runs\" below has the history.\n");
   fprintf(d, "\nThe machine is shared and its speed moves by up to a fifth between runs;\n"
              "the column \"x cost without pair\" (each row's time over the row without the pair term, in\n"
-             "the same blocks) moves less. That row ran at %.0f proposals a second here, at which speed\n"
+             "the same blocks) moves less at a moderate load, but under a heavy one (a load of 8 on 2\n"
+             "cores, a reviewer's 2026-12-07 runs) it rose by 25 to 45 %%: the pair rows suffer more from\n"
+             "shared caches. That row ran at %.0f proposals a second here, at which speed\n"
              "the targets allow the near-field rows %.1f and %.1f times its cost (%.1f and %.1f measured).\n"
              "Those rows' chains decide in two stages (`anneal.delayed_acceptance`): the acceptance is\n"
              "that of both; their extra bytes a segment are mostly the pair slots. That is the model\n"
@@ -217,7 +220,10 @@ static void bench_throughput(bench_ctx *b)
              "(measured 2026-12-05 at 100,000 splines of the Scaling scene: a peak of 514 bytes a\n"
              "segment with the near field at 1.5, 375 with it off; on params/minimal.ini's denser random\n"
              "start, 1.4 mm of line a mm^2, 865 at 50,000 splines against 361. Before the list held each\n"
-             "sample's near segments once, 581 and 1,465). Where a proposal's\n"
+             "sample's near segments once, 581 and 1,465). A start whose splines would take more than\n"
+             "the machine's memory at 360 bytes a segment (the least measured) is refused before its\n"
+             "placement, naming the count (`init.splines` or the one `init.coverage` works out); one that\n"
+             "fits that but not the peak is told (see \"Memory\"). Where a proposal's\n"
              "time goes, and what was measured and kept or not on the way to this speed: docs/NUMERICS.md,\n"
              "\"Pair term: near field\", from \"Where the time goes\" on.\n\n",
           1e9 / ns[0], 1e9 / ns[0] / target[0], 1e9 / ns[0] / target[1], ratio[row[0]], ratio[row[1]]);
