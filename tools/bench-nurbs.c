@@ -123,7 +123,7 @@ void bench_nurbs(bench_ctx *b)
              "10 Gauss points a span, ends held) with n control points on uniform knots, started\n"
              "straight. The leapfrog is explicit: it runs at omega_max dt = 1 (its stable limit is 2; the\n"
              "highest frequency grows as n^2 through the beta term), the review's implicit scheme at\n"
-             "the review's dt = 0.008 s. Each figure is the median of %d blocks of at least %g s of time steps through\n"
+             "the review's dt = 0.008 s. Each figure is the median of %d blocks of at least %g s (wall time) of time steps through\n"
              "the system's row (`lw_dynamics_step`). Assembly is the set-up's banded K, M and b. The\n"
              "review's scheme solves ((1 + h c/2) M + h^2 K) delta = r by conjugate gradients (the most\n"
              "iterations a step took is shown), preconditioned by the banded Cholesky factor of that\n"
