@@ -576,7 +576,10 @@ static void bench_terms(bench_ctx *b)
              "together. Evaluation: the same %d proposals (point and vector moves of 0.2 mm) evaluated\n"
              "and never committed, which is the energy terms' own cost; extra: over the scene with no\n"
              "term at all, which still samples the two segments and sums dE. Chain: the Metropolis walk\n"
-             "itself after tuning at T = %g, so acceptance, and with it the commits, differ.\n\n"
+             "itself after tuning at T = %g, so acceptance, and with it the commits, differ. Its lines\n"
+             "are placed with the frame alone, not traced along the field as Throughput's are, so more of\n"
+             "them cross, the near field's costliest case: a pair row here costs 2 to 2.5 times\n"
+             "Throughput's (a reviewer's runs, 2026-12-07), which is the table to budget a run by.\n\n"
              "| terms | ns per evaluation | extra ns | ns per chain proposal | acceptance | bytes per segment |\n"
              "|---|---|---|---|---|---|\n",
           nt, BENCH_T);
