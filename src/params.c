@@ -943,19 +943,21 @@ static void suggest_section(const char *section, char *out, size_t n)
 }
 
 /* Index of word in "a|b|c", or -1. */
-static int choice_index(const char *choices, const char *word)
+static int choice_index_cased(const char *choices, const char *word, int fold)
 {
   size_t n = strlen(word);
   int idx = 0;
   for (const char *c = choices; *c; idx++) {
     const char *bar = strchr(c, '|');
     size_t len = bar ? (size_t)(bar - c) : strlen(c);
-    if (len == n && !strncmp(c, word, n)) return idx;
+    if (len == n && !(fold ? strncasecmp(c, word, n) : strncmp(c, word, n))) return idx;
     if (!bar) break;
     c = bar + 1;
   }
   return -1;
 }
+
+static int choice_index(const char *choices, const char *word) { return choice_index_cased(choices, word, 0); }
 
 /* The idx-th word of "a|b|c" into buf. */
 static void choice_name(const char *choices, int idx, char *buf, size_t n)
@@ -1068,7 +1070,12 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
   case LW_PT_CHOICE: {
     int idx = choice_index(d->choices, text);
     if (idx < 0) {
-      snprintf(expected, n, "one of %s", d->choices);
+      /* (a page named as printed, "A4", was refused without a word of why) */
+      const int folded = choice_index_cased(d->choices, text, 1);
+      char word[64] = "";
+      if (folded >= 0) choice_name(d->choices, folded, word, sizeof word);
+      snprintf(expected, n, "one of %s%s%s%s", d->choices, folded >= 0 ? " (in lower case: '" : "", word,
+               folded >= 0 ? "')" : "");
       return 0;
     }
     *(int *)base = idx;

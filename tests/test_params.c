@@ -911,3 +911,18 @@ Test(params, a_decimal_comma_locale_is_refused_with_the_way_round)
                0, "trace.csv took a row in the comma locale");
   lw_test_dir_remove(dir);
 }
+
+/* A choice given in other case ("A4", as a page is printed) is refused with
+** the word to type; one that matches none in any case has no such hint. */
+Test(params, a_choice_in_other_case_is_named_in_lower_case)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  lw_error err;
+  cr_assert_neq(lw_params_set(&p, "scene.page=A4", &err), LW_OK);
+  cr_assert(strstr(err.msg, "(in lower case: 'a4'), got 'A4'"), "%s", err.msg);
+  cr_assert_neq(lw_params_set(&p, "scene.field=Vortex", &err), LW_OK);
+  cr_assert(strstr(err.msg, "(in lower case: 'vortex')"), "%s", err.msg);
+  cr_assert_neq(lw_params_set(&p, "scene.page=b5", &err), LW_OK);
+  cr_assert_null(strstr(err.msg, "lower case"), "%s", err.msg);
+}
