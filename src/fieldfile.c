@@ -277,43 +277,71 @@ static int values_push(values *a, double v)
   return 0;
 }
 
-/* One row of text into a; its count of values into *got, or an error. */
+/* A token strtod reads whole but that is out of a double's range ("1e400",
+** "1e-400", as NumPy reads them: infinite, 0) into *v; 1 if it is one. */
+static int out_of_range(const char *s, size_t len, double *v)
+{
+  char tok[64], *end;
+  if (len >= sizeof tok || !len || !strchr("+-.0123456789", *s)) return 0;
+  memcpy(tok, s, len);
+  tok[len] = '\0';
+  *v = strtod(tok, &end);
+  return *end == '\0';
+}
+
+/* One row of text into a; its count of values into *got, or an error.
+** Values are separated by blanks or by commas: a row with both a comma
+** tight between two values and blanks alone between two others is refused,
+** as "0,5 0,7" (decimal commas) read as four values silently doubled the
+** nodes. */
 static lw_status text_row(char *s, const char *path, long line, values *a, long *got, lw_error *err)
 {
   *got = 0;
-  int comma = 1; /* (the line's start counts as one: a leading comma is an empty value) */
+  int comma = 1;                /* (the line's start counts as one: a leading comma is an empty value) */
+  int blanks = 0, tight = 0, blank_sep = 0, tight_sep = 0;
   for (;;) {
-    s += strspn(s, " \t\r");
-    if (!*s) return LW_OK;
+    const size_t skip = strspn(s, " \t");
+    blanks |= skip > 0;
+    s += skip;
+    if (!*s) break;
     if (*s == ',') {
-      if (comma) break;
+      if (comma) return lw_error_set(err, LW_EINPUT, "%s:%ld: an empty value after value %ld of the row: expected "
+                                     "a number in every field (nan for a cell without one)", path, line, *got);
+      tight = !blanks && s[1] != ' ' && s[1] != '\t';
       comma = 1;
       s++;
       continue;
     }
-    const size_t len = strcspn(s, " \t\r,");
-    double v;
-    if (!lw_number_parse_n(s, len, &v) && !nonfinite_word(s, len, &v)) {
-      char unseen[96];
-      return lw_error_set(err, LW_EINPUT, "%s:%ld: value %ld of the row, '%.*s', is not a number%s%s", path, line,
-                          *got + 1, (int)(len < 40 ? len : 40), s,
-                          memchr(s, ';', len) ? " (values separated by ';': expected blanks or commas, and '.' as "
-                                                "the decimal point)" : "",
-                          lw_text_unseen_char(s, unseen, sizeof unseen));
+    if (*got) {
+      blank_sep |= !comma;
+      tight_sep |= comma && tight;
     }
-    if ((long)a->n >= LW_FIELDFILE_NODES_MAX * 2 + 2 || values_push(a, v))
-      return (long)a->n >= LW_FIELDFILE_NODES_MAX * 2 + 2
+    const size_t len = strcspn(s, " \t,");
+    double v;
+    if (!lw_number_parse_n(s, len, &v) && !nonfinite_word(s, len, &v) && !out_of_range(s, len, &v)) {
+      char unseen[96];
+      const char *hint = memchr(s, ';', len) ? " (values separated by ';': expected blanks or commas, and '.' as "
+                                               "the decimal point)"
+                         : memchr(s, '\r', len) ? " (a carriage return inside the line: old Mac line ends? expected "
+                                                  "LF or CRLF)"
+                                                : lw_text_unseen_char(s, unseen, sizeof unseen);
+      return lw_error_set(err, LW_EINPUT, "%s:%ld: value %ld of the row, '%.*s', is not a number%s", path, line,
+                          *got + 1, (int)(len < 40 ? len : 40), s, hint);
+    }
+    if (a->n >= (size_t)LW_FIELDFILE_NODES_MAX * 2 || values_push(a, v))
+      return a->n >= (size_t)LW_FIELDFILE_NODES_MAX * 2
              ? lw_error_set(err, LW_EINPUT, "%s:%ld: more than %ld nodes: expected at most that many", path, line,
                             LW_FIELDFILE_NODES_MAX)
              : lw_error_set(err, LW_ENOMEM, "%s:%ld: out of memory for the grid's values", path, line);
     ++*got;
-    comma = 0;
+    comma = blanks = 0;
     s += len;
   }
-  /* a comma first, or two with only blanks between: "1,,2" read as 1 2
-  ** would shift every value after a blank cell by one node */
-  return lw_error_set(err, LW_EINPUT, "%s:%ld: an empty value after value %ld of the row: expected a number in "
-                      "every field (nan for a cell without one)", path, line, *got);
+  if (blank_sep && tight_sep)
+    return lw_error_set(err, LW_EINPUT, "%s:%ld: values separated by blanks, and by commas tight between digits "
+                        "(decimal commas?): expected '.' as the decimal point, and blanks or commas between values",
+                        path, line);
+  return LW_OK;
 }
 
 static lw_grid2d *read_text(FILE *f, const char *path, int ncomp, lw_error *err)
@@ -337,7 +365,9 @@ static lw_grid2d *read_text(FILE *f, const char *path, int ncomp, lw_error *err)
       s = lw_error_set(err, LW_EINPUT, "%s:%ld: %ld values, where the first row (line %ld) has %ld: expected every "
                        "row as long", path, line, got, first_line, width);
     }
-    rows++;
+    if (!s && ++rows * (width / ncomp) > LW_FIELDFILE_NODES_MAX)
+      s = lw_error_set(err, LW_EINPUT, "%s:%ld: more than %ld nodes: expected at most that many", path, line,
+                       LW_FIELDFILE_NODES_MAX);
   }
   if (!s && len == -2 && errno == ENOMEM)
     s = lw_error_set(err, LW_ENOMEM, "%s:%ld: out of memory reading the line", path, line + 1);

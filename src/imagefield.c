@@ -201,8 +201,10 @@ lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, doub
   const double uc = cos(2 * angle), us = sin(2 * angle);
   size_t fallback = 0;
   for (size_t k = 0; k < n; k++) {
+    /* (weak but coherent: a direction the picture has, under the fallback;
+    ** noise has none, and a noisy grey card counted in full) */
     const double ax = (double)J22[k] - J11[k], ay = -2.0 * J12[k], own = ax * ax + ay * ay;
-    fallback += own > 0.0 && own < flat * flat * flat * flat;
+    fallback += own > 0.0 && own < flat * flat * flat * flat && sqrt(own) > 0.5 * ((double)J11[k] + J22[k]);
     double tx = ax + fc, ty = ay + fs;
     double m = sqrt(tx * tx + ty * ty);
     g->data[2 * k] = m > 0 ? tx / m : uc;

@@ -694,11 +694,13 @@ static lw_status build_field(lw_scene *sc, const lw_params *p, double cx, double
                                   p->field_angle * DEG, &gentle, err)
               : lw_imagefield_gradient(sc->image, &sc->image_place, p->field_flat, &gentle, err);
     if (!f->grid) return err->code;
-    if (gentle > 0.5) {
+    /* (three quarters: the bundled picture's smooth parts, blurred, are
+    ** over half of it, and a gradient hatching there is meant to fade) */
+    if (gentle > 0.75) {
       size_t used = strlen(sc->note);
-      snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field_flat: over %.0f %% of the picture its tone "
+      snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field_flat: over %d %% of the picture its tone "
                "changes, but slower than field_flat (%g tone/mm), where the field %s; a smaller field_flat follows a "
-               "smooth picture there (docs/IMAGES.md)", used ? "; " : "", 100.0 * gentle, p->field_flat,
+               "smooth picture there (docs/IMAGES.md)", used ? "; " : "", (int)(100.0 * gentle), p->field_flat,
                p->field == LW_FLD_ETF ? "turns to field_angle" : "fades to 0");
     }
   }
@@ -927,6 +929,30 @@ static void note_blur_gaps(lw_scene *sc, const lw_params *p)
 ** picture's field varies over, a data grid's node spacing, or the length
 ** over which the waves turn a radian, 1 / (k^2 A).  No check holds a
 ** segment to it (docs/NUMERICS.md, "What the clearance does not cover"). */
+/* The share of a field grid's node pairs (neighbours along x or y, both
+** with a direction) over which the field turns faster than a radian in
+** `len` mm (axial: the angle between the axes): a data field's own detail,
+** which its node spacing alone is not (a smooth field sampled finely was
+** noted, a checkerboard of 1.2 mm not). */
+static double grid_turning_share(const lw_grid2d *g, int axial, double len)
+{
+  size_t pairs = 0, fast = 0;
+  for (int j = 0; j < g->ny; j++)
+    for (int i = 0; i < g->nx; i++) {
+      const double *a = g->data + 2 * ((size_t)j * (size_t)g->nx + (size_t)i), la = hypot(a[0], a[1]);
+      for (int d = 0; d < 2; d++) {
+        if (d ? j + 1 >= g->ny : i + 1 >= g->nx) continue;
+        const double *b = d ? a + 2 * (size_t)g->nx : a + 2, lb = hypot(b[0], b[1]);
+        if (!(la > 0.0 && lb > 0.0)) continue;
+        double c = (a[0] * b[0] + a[1] * b[1]) / (la * lb);
+        c = fmin(1.0, fmax(-1.0, axial ? fabs(c) : c));
+        pairs++;
+        fast += acos(c) * len > (d ? g->hy : g->hx);
+      }
+    }
+  return pairs ? (double)fast / (double)pairs : 0.0;
+}
+
 static void note_field_detail(lw_scene *sc, const lw_params *p)
 {
   if (!sc->on[LW_TERM_FIELD]) return;
@@ -934,6 +960,7 @@ static void note_field_detail(lw_scene *sc, const lw_params *p)
   const double k = 2.0 * M_PI / p->field_wavelength, etf = hypot(p->field_sigma, p->image_blur);
   double scale;
   const char *what, *closes;
+  char turning[160];
   switch (p->field) {
   case LW_FLD_ETF:
     scale = etf > 0.0 ? etf : px;
@@ -945,11 +972,16 @@ static void note_field_detail(lw_scene *sc, const lw_params *p)
     what = p->image_blur > 0.0 ? "scene.image_blur" : "the picture's pixels";
     closes = "a wider scene.image_blur";
     break;
-  case LW_FLD_FILE:
-    scale = fmin(sc->field.grid->hx, sc->field.grid->hy);
-    what = "the spacing of scene.field_file's nodes on the page";
-    closes = "a smoother grid, its detail coarser than the samples,";
+  case LW_FLD_FILE: {
+    /* (a tenth of the grid turning a radian within the samples' spacing) */
+    const double share = grid_turning_share(sc->field.grid, sc->field_axial, gap);
+    scale = share > 0.1 ? 0.0 : INFINITY;
+    snprintf(turning, sizeof turning, "scene.field_file's field turns a radian within it between %.0f %% of its "
+             "neighbouring nodes", 100.0 * share);
+    what = turning;
+    closes = "a smoother field";
     break;
+  }
   case LW_FLD_WAVES:
     scale = p->field_amplitude != 0.0 ? 1.0 / (k * k * fabs(p->field_amplitude)) : INFINITY;
     what = "the length over which the waves turn a radian, wavelength^2 / (4 pi^2 amplitude)";
@@ -962,10 +994,13 @@ static void note_field_detail(lw_scene *sc, const lw_params *p)
   char more[96] = "";
   if (sc->quad.n < LW_QUAD_MAX) snprintf(more, sizeof more, " or more nodes (energy.quadrature)");
   size_t used = strlen(sc->note);
+  char detail[200];
+  if (p->field == LW_FLD_FILE) snprintf(detail, sizeof detail, "%s", what);
+  else snprintf(detail, sizeof detail, "%.3g mm: %s", scale, what);
   snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field: the placed segments' samples lie up to %.3g mm "
-           "apart, more than the field's detail (%.3g mm: %s): annealed segments can bend between the samples, the "
-           "field's term hidden from the quadrature (docs/NUMERICS.md); %s%s closes it", used ? "; " : "", gap,
-           scale, what, closes, more);
+           "apart, more than the field's detail (%s): annealed segments can bend between the samples, the field's "
+           "term hidden from the quadrature (docs/NUMERICS.md); %s%s closes it", used ? "; " : "", gap, detail,
+           closes, more);
 }
 
 /* The pair term's product rule alone, with nothing to keep strokes apart:

@@ -107,7 +107,7 @@ Test(fieldfile, text_reads_blanks_commas_comments_and_nan)
 {
   const char *path = lw_test_path("f.csv");
   static const char text[] = "# u v pairs, as np.savetxt writes them\r\n"
-                             "0 -0.5, 1,-1.5\t2 -2.5   # a comment\r\n"
+                             "0 -0.5, 1, -1.5\t2 -2.5   # a comment\r\n"
                              "\n"
                              "10,-10.5,11,-11.5,12,-12.5\n";
   lw_test_write(path, text, sizeof text - 1);
@@ -116,12 +116,13 @@ Test(fieldfile, text_reads_blanks_commas_comments_and_nan)
   cr_assert_not_null(g, "%s", err.msg);
   assert_field(g, 0);
   lw_grid2d_free(g);
-  static const char masked[] = "nan NaN 1 2\n-inf 0 3 Infinity\n";
+  /* (1e400 and 1e-400 as NumPy reads them: infinite, 0) */
+  static const char masked[] = "nan NaN 1 2\n-inf 0 3 1e400\n1e-400 0 0 0\n";
   lw_test_write(path, masked, sizeof masked - 1);
   g = lw_fieldfile_read(path, 2, &err);
   cr_assert_not_null(g, "%s", err.msg);
   cr_assert(isnan(g->data[0]) && isnan(g->data[1]) && g->data[2] == 1 && g->data[3] == 2);
-  cr_assert(isinf(g->data[4]) && g->data[4] < 0 && g->data[5] == 0 && isinf(g->data[7]));
+  cr_assert(isinf(g->data[4]) && g->data[4] < 0 && g->data[5] == 0 && isinf(g->data[7]) && g->data[8] == 0);
   cr_assert_eq(lw_grid2d_sanitize(g), 4);
   lw_grid2d_free(g);
 }
@@ -166,6 +167,10 @@ Test(fieldfile, text_refused_says_the_line_and_what_was_expected)
   REFUSED("semicolon.txt", "0,5;0,7\n", ";", "decimal point");
   REFUSED("none.txt", "# nothing\n\n", "found none");
   REFUSED("nul.txt", "1 2\0 3 4\n", ":1:", "NUL");
+  /* decimal commas between blanks, and old Mac line ends, read silently as
+  ** twice the nodes and as one row */
+  REFUSED("comma.txt", "0,5 0,7 1,0 0,2\n", ":1:", "decimal commas?");
+  REFUSED("cr.txt", "1 0 1 0\r0 1 0 1\r", ":1:", "old Mac line ends");
 }
 
 Test(fieldfile, npy_refused_says_what_was_expected)
@@ -362,12 +367,15 @@ Test(fieldfile, a_field_finer_than_the_samples_gets_a_note)
   static const struct {
     int field;
     double blur, wavelength;
-    int grid; /* a file of grid x grid nodes */
+    int grid; /* a file of grid x grid nodes, its u (i % 3 or, smooth, i / grid) */
+    int smooth;
     const char *note;
   } cases[] = {
-    {LW_FLD_GRADIENT, 0.5, 0, 0, "(0.5 mm: scene.image_blur)"}, {LW_FLD_GRADIENT, 4, 0, 0, NULL},
-    {LW_FLD_WAVES, 0, 4, 0, "the waves turn a radian"}, {LW_FLD_WAVES, 0, 70, 0, NULL},
-    {LW_FLD_FILE, 0, 0, 200, "scene.field_file's nodes"}, {LW_FLD_FILE, 0, 0, 8, NULL},
+    {LW_FLD_GRADIENT, 0.5, 0, 0, 0, "(0.5 mm: scene.image_blur)"}, {LW_FLD_GRADIENT, 4, 0, 0, 0, NULL},
+    {LW_FLD_WAVES, 0, 4, 0, 0, "the waves turn a radian"}, {LW_FLD_WAVES, 0, 70, 0, 0, NULL},
+    /* the field's turning, not its nodes' spacing: a fine grid of a smooth field has no note */
+    {LW_FLD_FILE, 0, 0, 200, 0, "field_file's field turns a radian within it between"},
+    {LW_FLD_FILE, 0, 0, 8, 0, NULL}, {LW_FLD_FILE, 0, 0, 200, 1, NULL},
   };
   for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
     lw_params p;
@@ -385,7 +393,8 @@ Test(fieldfile, a_field_finer_than_the_samples_gets_a_note)
       snprintf(p.field_file, sizeof p.field_file, "%s", lw_test_path("grid.txt"));
       FILE *f = fopen(p.field_file, "w");
       for (int j = 0; j < cases[c].grid; j++)
-        for (int i = 0; i < cases[c].grid; i++) fprintf(f, "%d 1%c", i % 3, i == cases[c].grid - 1 ? '\n' : ' ');
+        for (int i = 0; i < cases[c].grid; i++)
+          fprintf(f, "%g 1%c", cases[c].smooth ? (double)i / cases[c].grid : i % 3, i == cases[c].grid - 1 ? '\n' : ' ');
       fclose(f);
     }
     lw_scene sc;

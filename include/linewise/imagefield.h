@@ -61,7 +61,8 @@ lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl
 
 /* angle: the fallback direction, radians (0 = +x, pi/2 = +y, down).
 ** *gentle (may be NULL): the share of the pixels where the picture's
-** (smoothed) structure is there but under flat, so that the fallback
+** (smoothed) structure is there, coherent (its anisotropy above half its
+** trace: a direction, not noise) but under flat, so that the fallback
 ** decides: a smooth picture of a scientist's field, 0..1 over a page, changes
 ** by about 0.01 tone/mm everywhere, and the default field_flat made most of
 ** its field the fallback's, unsaid. */
