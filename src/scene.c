@@ -638,14 +638,16 @@ static lw_status field_from_file(lw_scene *sc, const lw_params *p, lw_error *err
     double *d = g->data + 2 * k, n = p->field_file_scale == LW_FFS_MAX ? longest : hypot(d[0], d[1]);
     if (n > 0.0) d[0] /= n, d[1] /= n;
   }
-  /* over the picture, whatever its shape: a grid of another shape than the
-  ** picture's would stretch the field over it, so it is refused */
+  /* over the picture: a grid of another shape than the picture's would
+  ** stretch the field over it, so it is refused; its rows (or columns) may
+  ** be the picture's shape rounded (3 columns over a 2:1 picture take 1.5
+  ** rows: 1 or 2) */
   const lw_image_place pl = sc->image ? sc->image_place
                                       : lw_image_fit(g->nx, g->ny, p->margin, p->margin, p->width - p->margin,
                                                      p->height - p->margin);
   const double w = sc->image ? sc->image->width * pl.pixel : g->nx * pl.pixel;
   const double h = sc->image ? sc->image->height * pl.pixel : g->ny * pl.pixel;
-  if (sc->image && fabs((double)g->nx * h / w - g->ny) > 1.0)
+  if (sc->image && fabs((double)g->nx * h / w - g->ny) > 0.5 && fabs((double)g->ny * w / h - g->nx) > 0.5)
     return bad_key(p, "scene", "field_file", LW_EINPUT, err, "%s: a grid of %d columns x %d rows over a %d x %d "
                    "picture: expected the picture's shape (%d columns take %.0f rows), or no scene.image", full, g->nx,
                    g->ny, sc->image->width, sc->image->height, g->nx, (double)g->nx * h / w);

@@ -51,13 +51,13 @@ static const char *write_npy(const char *name, int major, const char *descr, int
     const int j = fortran ? e % 2 : e / 6, i = fortran ? e / 2 % 3 : e / 2 % 3, c = fortran ? e / 6 : e % 2;
     const double v = value(j, i, c);
     unsigned char b[8];
-    if (size == 8) memcpy(b, &v, 8);
-    else if (size == 4 && descr[1] == 'f') {
+    if (descr[1] == 'f' && size == 8) memcpy(b, &v, 8);
+    else if (descr[1] == 'f') {
       float f = (float)v;
       memcpy(b, &f, 4);
-    } else {
-      int32_t k = (int32_t)floor(v); /* (integers: v's whole part) */
-      memcpy(b, &k, 4);
+    } else { /* (integers: v's whole part, in the dtype's size, its low byte first) */
+      const int64_t k = (int64_t)floor(v);
+      for (int q = 0; q < size; q++) b[q] = (unsigned char)((uint64_t)k >> (8 * q));
     }
     for (int k = 0; k < size; k++) buf[at + (size_t)k] = big ? b[size - 1 - k] : b[k];
     at += (size_t)size;
@@ -90,6 +90,7 @@ Test(fieldfile, npy_reads_both_byte_orders_both_index_orders_and_integers)
   } cases[] = {
     {1, "<f8", 8, 0, 0, 0}, {1, ">f8", 8, 1, 0, 0}, {1, "<f4", 4, 0, 1, 0},
     {2, ">f4", 4, 1, 1, 0}, {3, "<i4", 4, 0, 0, 1}, {1, ">i4", 4, 1, 1, 1},
+    {1, "|i1", 1, 0, 0, 1}, {2, ">i2", 2, 1, 0, 1}, {1, "<i2", 2, 0, 1, 1}, {1, ">i8", 8, 1, 0, 1},
   };
   for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
     char name[32];
@@ -164,6 +165,7 @@ Test(fieldfile, text_refused_says_the_line_and_what_was_expected)
   REFUSED("short.txt", "1 2 3 4\n# c\n1 2\n", ":3:", "2 values", "line 1", "has 4");
   REFUSED("word.txt", "1 2\n3 u0\n", ":2:", "value 2", "'u0'", "not a number");
   REFUSED("empty.txt", "1,,2,3\n", ":1:", "empty value");
+  REFUSED("first.txt", ",1,0,1,0\n", ":1:", "empty value after value 0");
   REFUSED("semicolon.txt", "0,5;0,7\n", ";", "decimal point");
   REFUSED("none.txt", "# nothing\n\n", "found none");
   REFUSED("nul.txt", "1 2\0 3 4\n", ":1:", "NUL");
@@ -186,6 +188,8 @@ Test(fieldfile, npy_refused_says_what_was_expected)
               "at most");
   REFUSED_NPY("cut.npy", "{'descr': '<f8', 'fortran_order': False, 'shape': (1, 1, 2), }\n",
               "\0\0\0\0\0\0\xf0\x3f", "cut short");
+  REFUSED_NPY("long.npy", "{'descr': '|u1', 'fortran_order': False, 'shape': (1, 1, 2), }\n", "\1\2\3",
+              "expected the file to end there");
   REFUSED_NPY("order.npy", "{'descr': '<f8', 'fortran_order': maybe, 'shape': (1, 1, 2), }\n", "",
               "True or False");
   static const char version[] = "\x93NUMPY\x09\x00\x10\x00{}";
@@ -269,7 +273,8 @@ Test(fieldfile, scale_makes_vectors_unit_divides_by_the_longest_or_keeps_them)
 Test(fieldfile, the_grid_covers_the_picture_and_a_grid_of_another_shape_is_refused)
 {
   /* a 40 x 20 picture fitted into 90 x 40 mm lies 80 x 40 mm, from x 10 */
-  const char *pic = lw_test_path("wide.png");
+  char pic[256]; /* (lw_test_path's results last four calls) */
+  snprintf(pic, sizeof pic, "%s", lw_test_path("wide.png"));
   float g[40 * 20];
   for (int k = 0; k < 40 * 20; k++) g[k] = 0.5f;
   lw_test_png(pic, 40, 20, g, NULL);
@@ -289,6 +294,30 @@ Test(fieldfile, the_grid_covers_the_picture_and_a_grid_of_another_shape_is_refus
   cr_assert_neq(field_scene(&sc, "1 0 2 0\n3 0 4 0\n5 0 6 0\n7 0 8 0\n", LW_FFY_DOWN, LW_FFS_NONE, pic, &err), LW_OK);
   cr_assert(strstr(err.msg, "2 columns x 4 rows") && strstr(err.msg, "40 x 20 picture") &&
             strstr(err.msg, "scene.field_file"), "%s", err.msg);
+  /* a row off is a stretch of 2 on a grid this coarse: refused; 3 columns
+  ** take 1.5 rows, so 2 rows are the shape rounded */
+  cr_assert_neq(field_scene(&sc, "1 0 2 0\n3 0 4 0\n", LW_FFY_DOWN, LW_FFS_NONE, pic, &err), LW_OK);
+  cr_assert(strstr(err.msg, "2 columns x 2 rows"), "%s", err.msg);
+  cr_assert_eq(field_scene(&sc, "1 0 2 0 3 0\n4 0 5 0 6 0\n", LW_FFY_DOWN, LW_FFS_NONE, pic, &err), LW_OK, "%s",
+               err.msg);
+  lw_scene_clear(&sc);
+}
+
+Test(fieldfile, a_grid_of_its_own_shape_lies_as_a_picture_of_that_shape)
+{
+  /* 4 columns x 2 rows fitted into 90 x 40 mm: 80 x 40 mm from x 10, nodes
+  ** 20 mm apart from (20, 15) */
+  lw_scene sc;
+  lw_error err;
+  cr_assert_eq(field_scene(&sc, "1 0 2 0 3 0 4 0\n5 0 6 0 7 0 8 0\n", LW_FFY_DOWN, LW_FFS_NONE, NULL, &err), LW_OK,
+               "%s", err.msg);
+  const double at[4][3] = {{20, 15, 1}, {80, 15, 4}, {20, 35, 5}, {60, 35, 7}};
+  for (int k = 0; k < 4; k++) {
+    double v[2];
+    lw_field_eval(&sc.field, at[k][0], at[k][1], &v[0], &v[1]);
+    cr_assert_eq(v[0], at[k][2], "at (%g, %g): %g, expected %g", at[k][0], at[k][1], v[0], at[k][2]);
+  }
+  lw_scene_clear(&sc);
 }
 
 Test(fieldfile, cells_not_finite_are_noted_and_a_file_without_a_vector_refused)
@@ -360,7 +389,8 @@ Test(fieldfile, a_run_follows_the_file_and_a_bad_file_is_refused_before_it)
 ** detail, and says nothing where the detail is wider than the samples. */
 Test(fieldfile, a_field_finer_than_the_samples_gets_a_note)
 {
-  const char *pic = lw_test_path("grey.png");
+  char pic[256];
+  snprintf(pic, sizeof pic, "%s", lw_test_path("grey.png"));
   float g[64 * 64];
   for (int k = 0; k < 64 * 64; k++) g[k] = (float)(0.5 + 0.4 * sin(k % 64 * 0.3));
   lw_test_png(pic, 64, 64, g, NULL);
@@ -415,12 +445,16 @@ Test(fieldfile, a_field_finer_than_the_samples_gets_a_note)
 ** where field_flat is below its slope. */
 Test(fieldfile, a_picture_smoother_than_field_flat_gets_a_note)
 {
-  const char *pic = lw_test_path("ramp.png");
+  /* a ramp over the whole picture, and one over 60 % of it beside white
+  ** paper (flat: not counted), which is under the note's three quarters */
   float g[64 * 64];
   for (int k = 0; k < 64 * 64; k++) g[k] = (float)(0.3 + 0.4 * (k % 64) / 63.0); /* 0.0044 tone/mm */
-  lw_test_png(pic, 64, 64, g, NULL);
+  lw_test_png(lw_test_path("ramp.png"), 64, 64, g, NULL);
+  for (int k = 0; k < 64 * 64; k++) g[k] = k % 64 < 26 ? 1.0f : (float)(0.3 + 0.4 * (k % 64) / 63.0);
+  lw_test_png(lw_test_path("part.png"), 64, 64, g, NULL);
   for (int field = LW_FLD_ETF; field <= LW_FLD_GRADIENT; field++)
-    for (int smaller = 0; smaller < 2; smaller++) {
+    for (int smaller = 0; smaller < 3; smaller++) {
+      const char *pic = lw_test_path(smaller == 2 ? "part.png" : "ramp.png");
       lw_params p;
       lw_params_defaults(&p);
       p.width = p.height = 100;
@@ -428,7 +462,7 @@ Test(fieldfile, a_picture_smoother_than_field_flat_gets_a_note)
       p.field_coef = -1;
       p.field = field;
       p.field_mode = field == LW_FLD_ETF ? LW_FIELDMODE_AXIAL : LW_FIELDMODE_SIGNED;
-      p.field_flat = smaller ? 1e-3 : 0.01;
+      p.field_flat = smaller == 1 ? 1e-3 : 0.01;
       snprintf(p.image, sizeof p.image, "%s", pic);
       lw_scene sc;
       lw_error err;
