@@ -244,7 +244,9 @@ const lw_param_def lw_param_table[] = {
       "on a vortex with strain 20 and bending 2, P = -10 drew clean circles (alignment 0.9999), "
       "-100 longer crossing arcs (0.978)."),
   CHOICE("energy", "field_mode", field_mode, "axial", "axial|signed",
-         "axial integrates |r'.v| (lines have no direction); signed integrates r'.v."),
+         "axial integrates |r'.v| (lines have no direction); signed integrates r'.v (lines run along v: the "
+         "drawing's paths keep that direction only with output.order = none, which the plotter's order would "
+         "turn where it saves travel)."),
   NUM("energy", "pair", LW_PT_DOUBLE, pair, "0", "energy / mm", 0, 1e12, 0,
       "C: pair repulsion C * double integral of dl dl / r between different splines. 0 = off."),
   NUM("energy", "pair_cutoff", LW_PT_DOUBLE, pair_cutoff, "5", "mm", 0, 1e7, 0,
