@@ -922,15 +922,6 @@ static void note_blur_gaps(lw_scene *sc, const lw_params *p)
   }
 }
 
-/* The field's own detail finer than the samples along a segment: there the
-** annealing bends segments between the samples to follow the field where
-** they are and not between them, and the quadrature misses what it costs
-** (an adversary, 2026-12-07: field = gradient on params/study.ini hid
-** 1.9e-2 of the field term, 19 % unblurred at 600 pixels; waves of 4 mm
-** 3 %, 16 mm 8e-4, 30 mm 2e-8).  The scale: the blur or pixels the
-** picture's field varies over, a data grid's node spacing, or the length
-** over which the waves turn a radian, 1 / (k^2 A).  No check holds a
-** segment to it (docs/NUMERICS.md, "What the clearance does not cover"). */
 /* The share of a field grid's node pairs (neighbours along x or y, both
 ** with a direction) over which the field turns faster than a radian in
 ** `len` mm (axial: the angle between the axes): a data field's own detail,
@@ -955,14 +946,26 @@ static double grid_turning_share(const lw_grid2d *g, int axial, double len)
   return pairs ? (double)fast / (double)pairs : 0.0;
 }
 
+/* The field's own detail finer than the samples along a segment: there the
+** annealing bends segments between the samples to follow the field where
+** they are and not between them, and the quadrature misses what it costs
+** (an adversary, 2026-12-07: field = gradient on params/study.ini hid
+** 1.9e-2 of the field term, 19 % unblurred at 600 pixels; waves of 4 mm
+** 3 %, 16 mm 8e-4, 30 mm 2e-8; a checkerboard of directions in a field
+** file, nodes 1.2 mm apart, 1.3e-2).  The detail: the blur or pixels the
+** picture's field varies over, the length over which the waves turn a
+** radian, 1 / (k^2 A), or a field file's own turning (a tenth of its
+** neighbouring nodes turning a radian within the samples' spacing).  No
+** check holds a segment to it (docs/NUMERICS.md, "What the clearance does
+** not cover"). */
 static void note_field_detail(lw_scene *sc, const lw_params *p)
 {
   if (!sc->on[LW_TERM_FIELD]) return;
   const double gap = p->segment_length * sc->quad.spacing, px = sc->image ? sc->image_place.pixel : 0.0;
   const double k = 2.0 * M_PI / p->field_wavelength, etf = hypot(p->field_sigma, p->image_blur);
-  double scale;
-  const char *what, *closes;
-  char turning[160];
+  double scale = INFINITY, share;
+  const char *what = "", *closes;
+  char detail[200];
   switch (p->field) {
   case LW_FLD_ETF:
     scale = etf > 0.0 ? etf : px;
@@ -974,31 +977,27 @@ static void note_field_detail(lw_scene *sc, const lw_params *p)
     what = p->image_blur > 0.0 ? "scene.image_blur" : "the picture's pixels";
     closes = "a wider scene.image_blur";
     break;
-  case LW_FLD_FILE: {
-    /* (a tenth of the grid turning a radian within the samples' spacing) */
-    const double share = grid_turning_share(sc->field.grid, sc->field_axial, gap);
-    scale = share > 0.1 ? 0.0 : INFINITY;
-    snprintf(turning, sizeof turning, "scene.field_file's field turns a radian within it between %.0f %% of its "
-             "neighbouring nodes", 100.0 * share);
-    what = turning;
-    closes = "a smoother field";
-    break;
-  }
   case LW_FLD_WAVES:
-    scale = p->field_amplitude != 0.0 ? 1.0 / (k * k * fabs(p->field_amplitude)) : INFINITY;
+    if (p->field_amplitude != 0.0) scale = 1.0 / (k * k * fabs(p->field_amplitude));
     what = "the length over which the waves turn a radian, wavelength^2 / (4 pi^2 amplitude)";
     closes = "a longer scene.field_wavelength or a smaller amplitude";
+    break;
+  case LW_FLD_FILE:
+    if (!((share = grid_turning_share(sc->field.grid, sc->field_axial, gap)) > 0.1)) return;
+    snprintf(detail, sizeof detail, "scene.field_file's field turns a radian within it between %.0f %% of its "
+             "neighbouring nodes", 100.0 * share);
+    closes = "a smoother field";
     break;
   default:
     return; /* (constant; radial and vortex: their core, scene.field_core, has its own stated accuracy) */
   }
-  if (!(gap > scale)) return;
+  if (p->field != LW_FLD_FILE) {
+    if (!(gap > scale)) return;
+    snprintf(detail, sizeof detail, "%.3g mm: %s", scale, what);
+  }
   char more[96] = "";
   if (sc->quad.n < LW_QUAD_MAX) snprintf(more, sizeof more, " or more nodes (energy.quadrature)");
   size_t used = strlen(sc->note);
-  char detail[200];
-  if (p->field == LW_FLD_FILE) snprintf(detail, sizeof detail, "%s", what);
-  else snprintf(detail, sizeof detail, "%.3g mm: %s", scale, what);
   snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field: the placed segments' samples lie up to %.3g mm "
            "apart, more than the field's detail (%s): annealed segments can bend between the samples, the field's "
            "term hidden from the quadrature (docs/NUMERICS.md); %s%s closes it", used ? "; " : "", gap, detail,
