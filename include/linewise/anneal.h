@@ -151,7 +151,9 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
 lw_status lw_anneal_settle(lw_anneal *a, lw_error *err);
 
 /* One sweep with everything that falls due after it (trace row, drift check,
-** checkpoint). */
+** checkpoint).  A run's first sweep drops the run it replaced (set aside in
+** DIR/.replaced), but for a stop asked meanwhile (lw_phase_stop): then the
+** caller may still give way with lw_anneal_undo_start. */
 lw_status lw_anneal_sweep(lw_anneal *a, lw_error *err);
 
 static inline int lw_anneal_done(const lw_anneal *a) { return a->sweep >= a->end_sweep; }

@@ -11,13 +11,16 @@
 **
 **   Text: one grid row a line, ncomp values a node in a row ("u v u v ..."
 **   for a field: np.savetxt(path, F.reshape(rows, -1)) of an array F of
-**   shape (rows, columns, 2)), numbers separated by blanks or commas; '#'
-**   starts a comment; blank lines are skipped; every row holds as many
-**   values as the first.
+**   shape (rows, columns, 2)), numbers separated by blanks or commas (not
+**   both blanks and commas tight between digits: "0,5 0,7" has decimal
+**   commas); '#' starts a comment; blank lines are skipped; every row holds
+**   as many values as the first; a carriage return inside a line (old Mac
+**   line ends) is refused.
 **
-** Values may be NaN or infinite ("nan", "inf" in text, as np.savetxt writes
-** a masked cell): they are kept as they are, for the caller to count and
-** treat (lw_grid2d_sanitize).  Row 0 is the file's first row; the grid's
+** Values may be NaN or infinite ("nan", "inf", and "1e400" in text, as
+** np.savetxt writes a masked cell and NumPy reads an overflow; "1e-400" is
+** 0): they are kept as they are, for the caller to count and treat (the
+** scene makes such a node's vector 0).  Row 0 is the file's first row; the grid's
 ** placement (x0, y0, hx, hy) is left at 0, 0, 1, 1.  Errors name the file
 ** and, in text, the line and the value, and say what was expected.
 */
