@@ -1215,6 +1215,7 @@ static void drop_stash(lw_anneal *a)
   if (!a->stashed || a->fresh) return;
   if (lw_runfiles_drop(a->dir, &e)) snprintf(a->stash_left, sizeof a->stash_left, "%s", e.msg);
   a->stashed = 0;
+  lw_phase_stash(0);
 }
 
 /* The new run's first files, up to its first checkpoint (net: the first is
@@ -1280,11 +1281,13 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
   if (s) return s;
   const int first = a->fresh;
   a->fresh = 0;
-  if (first) lw_phase_stash(0); /* (a stop no longer makes the new run give way) */
-  /* the run set aside goes with the first sweep (drop_stash); a spread
-  ** run's with the first checkpoint, its processes failing together only
-  ** at a sweep */
-  if (!first || a->net) drop_stash(a);
+  /* (a stop still makes the new run give way, until its first sweep) */
+  if (first) lw_phase_stash(a->stashed && !a->net ? 3 : 0);
+  /* the run set aside goes with the first sweep (drop_stash), a stop asked
+  ** in it aside (its checkpoint, checkpoint_every = 1, dropped the run a stop
+  ** was to put back); a spread run's with the first checkpoint, its
+  ** processes failing together only at a sweep */
+  if (a->net || (!first && !lw_phase_stopping())) drop_stash(a);
   return LW_OK;
 }
 

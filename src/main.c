@@ -515,7 +515,7 @@ static void on_signal(int sig)
 #ifdef LW_MPI
   const int gives_way = 0; /* (a spread run's processes stop together, at a sweep) */
 #else
-  const int gives_way = lw_phase_stashed() == 1;
+  const int gives_way = lw_phase_stashed() == 1 || lw_phase_stashed() == 3;
 #endif
   if (!second && (files || on_terminal)) {
     ssize_t w = files       ? write(2, last + !on_terminal, sizeof last - 1 - !on_terminal)
@@ -532,10 +532,17 @@ static void on_signal(int sig)
     static const char part[] = "\nlinewise: a second signal: stopped at once as the run's first checkpoint was "
                                "written; linewise's next run or resume there goes on from it, or, where it was not "
                                "written, puts the run that was in the directory back\n";
+    static const char back_half[] = "\nlinewise: a second signal: stopped at once as the run that was in the "
+                                    "directory was being put back; linewise's next run or resume there puts the "
+                                    "rest of it back\n";
     const int stash = lw_phase_stashed();
     /* (a first checkpoint committed within the set-up counts: "nothing to
-    ** resume" was said beside a state.lw that resumed) */
-    if (checkpointed || lw_phase_last_commit(NULL) >= 0) {
+    ** resume" was said beside a state.lw that resumed; while the run before
+    ** comes back the checkpoint said is going) */
+    if (stash == 4) {
+      ssize_t w = write(2, back_half + !on_terminal, sizeof back_half - 1 - !on_terminal);
+      (void)w;
+    } else if (checkpointed || lw_phase_last_commit(NULL) >= 0) {
       say_second();
     } else {
       ssize_t w = stash == 1 ? write(2, kept + !on_terminal, sizeof kept - 1 - !on_terminal)
@@ -858,11 +865,13 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
   ** the README promised it back until the first sweep; a Ctrl-C just after
   ** starting a large scene into a directory by mistake cost the run there) */
   if (stopped && stop_requested && a->stashed && !net) {
+    lw_phase_stash(4);
     if (!lw_anneal_undo_start(a)) {
       lw_error_set(err, LW_ERUN, "%s: stopped before the first sweep, and the run that was there waits in %s/"
                    LW_RUNFILES_STASH " (linewise puts it back when it next runs or resumes there)", a->dir, a->dir);
       return watched_fail(w, err);
     }
+    lw_phase_stash(0);
     watcher_stop(w, LW_PHASE_STOPPED);
     fprintf(stderr, "linewise: stopped before the first sweep; the run that was in %s is back as it was\n", a->dir);
     return stop_requested != SIGINT ? 128 + stop_requested : 0; /* (SIGINT by itself, in main) */
@@ -1126,16 +1135,29 @@ static void unmake_dir(const char *dir, int hold, int made)
 ** where its parent is there (*made 1): locked only as the run started, a
 ** second run into it during a set-up of seconds finished, and then the first
 ** took the directory and wrote over that result, both exiting 0.  A path of
-** several new folders is made as the run starts, as before. */
+** several new folders is made as the run starts, as before.  A directory
+** that cannot be made is said now, not after the set-up; one that another
+** run made and removed again as this one came (a signal in its set-up) is
+** made again. */
 static lw_status claim_out(const char *dir, int *hold, int *made, lw_error *err)
 {
-  if (access(dir, F_OK)) {
-    char parent[LW_PATH_MAX];
-    lw_path_dir(parent, sizeof parent, dir);
-    if (access(parent, F_OK) || mkdir(dir, 0777)) return LW_OK; /* (the run's start says what is wrong) */
-    *made = 1;
+  for (int tries = 0;; tries++) {
+    *made = 0;
+    if (access(dir, F_OK)) {
+      char parent[LW_PATH_MAX];
+      lw_path_dir(parent, sizeof parent, dir);
+      if (access(parent, F_OK)) return LW_OK;
+      if (mkdir(dir, 0777)) {
+        if (errno == EEXIST && !access(dir, F_OK)) continue; /* (made meanwhile by another) */
+        return lw_rundir_make(dir, err); /* (its message: a link to nowhere, a read-only place) */
+      }
+      *made = 1;
+    }
+    lw_status s = lw_rundir_lock(dir, hold, err);
+    /* (a directory this run made but another locked meanwhile is theirs) */
+    if (s && *made && !access(dir, F_OK)) *made = 0;
+    if (!s || !access(dir, F_OK) || tries == 4) return s;
   }
-  return lw_rundir_lock(dir, hold, err);
 }
 
 static int cmd_run(int argc, char **argv)

@@ -247,25 +247,36 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
   ** needs no more) */
   lw_status s = lw_rundir_writable(dir, err);
   if (s) return s;
-  /* never through a link: one planted there made a root's run create any file */
-  int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0666);
-  if (fd < 0 && errno == EACCES) fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
-  struct stat st;
-  if (fd < 0 || fstat(fd, &st)) {
-    int e = errno;
-    if (fd >= 0) close(fd);
-    return lw_error_set(err, LW_EIO, "%s: cannot open the run directory's lock: %s%s", path, strerror(e),
-                        e == ELOOP ? " (a symbolic link, which linewise does not follow: remove it)" : "");
+  /* A run that ends before its first files removes the lock file it holds
+  ** (and the directory it made): a process that opened that file before
+  ** then and locks it after holds a lock no one else sees, and it once set
+  ** up beside another run and removed that run's lock on its way out.  So
+  ** a lock counts only while its file is still the one at the path: else
+  ** the one there now is taken, afresh. */
+  for (int tries = 0;; tries++) {
+    /* never through a link: one planted there made a root's run create any file */
+    int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0666);
+    if (fd < 0 && errno == EACCES) fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+    struct stat st, now;
+    if (fd < 0 || fstat(fd, &st)) {
+      int e = errno;
+      if (fd >= 0) close(fd);
+      return lw_error_set(err, LW_EIO, "%s: cannot open the run directory's lock: %s%s", path, strerror(e),
+                          e == ELOOP ? " (a symbolic link, which linewise does not follow: remove it)" : "");
+    }
+    if (!S_ISREG(st.st_mode)) {
+      close(fd);
+      return lw_error_set(err, LW_EINPUT, "%s: not a regular file (a FIFO, a device or a folder): the run "
+                          "directory's lock is a file of its own; remove it", path);
+    }
+    pthread_mutex_lock(&held_lock);
+    s = hold_lock(dir, path, fd, &st, hold, err);
+    pthread_mutex_unlock(&held_lock);
+    if (s || !*hold || (!lstat(path, &now) && now.st_dev == st.st_dev && now.st_ino == st.st_ino)) return s;
+    lw_rundir_unlock(*hold);
+    *hold = 0;
+    if (tries == 8) return lw_error_set(err, LW_EUSAGE, LW_RUNDIR_BUSY, dir, path);
   }
-  if (!S_ISREG(st.st_mode)) {
-    close(fd);
-    return lw_error_set(err, LW_EINPUT, "%s: not a regular file (a FIFO, a device or a folder): the run directory's "
-                        "lock is a file of its own; remove it", path);
-  }
-  pthread_mutex_lock(&held_lock);
-  s = hold_lock(dir, path, fd, &st, hold, err);
-  pthread_mutex_unlock(&held_lock);
-  return s;
 }
 
 void lw_rundir_unlock(int hold)

@@ -40,10 +40,12 @@ void lw_phase_hold(void);
 void lw_phase_writing(void);
 int lw_phase_unwritten(void);
 
-/* Whether the run before waits in DIR/.replaced (runfiles.h) until the new
-** run's first checkpoint, for a signal handler's message: 0 no, 1 it does
-** (a stop puts it back), 2 that checkpoint is being committed (the run
-** before goes).  Lock-free too. */
+/* Whether the run before waits in DIR/.replaced (runfiles.h), for a signal
+** handler's message: 0 no, 1 it does until the new run's first checkpoint
+** (a stop puts it back), 2 that checkpoint is being committed, 3 it is
+** committed and the run before waits for the first sweep (a stop still
+** puts it back; a kill keeps the checkpoint), 4 the run before is being put
+** back.  Lock-free too. */
 void lw_phase_stash(int on);
 int lw_phase_stashed(void);
 

@@ -53,7 +53,9 @@ lw_status lw_rundir_writable(const char *dir, lw_error *err);
 
 /* Takes the lock of the existing directory dir for this process: LW_OK and
 ** *hold set (0 where the file system has no locks), or LW_EUSAGE naming the
-** directory when another process holds it.  A second call for a directory
+** directory when another process holds it.  The lock is on the file at
+** dir/.lock when it is taken (one removed meanwhile by the run that held
+** it is let go and the new one taken), so that a holder may remove it.  A second call for a directory
 ** this process holds succeeds; each needs its lw_rundir_unlock. */
 lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err);
 
