@@ -684,7 +684,7 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
   static const char *const table[] = {"anneal.table", NULL}, *const lambda[] = {"anneal.lambda", NULL},
                            *const polygon[] = {"scene.polygon", NULL}, *const mask[] = {"scene.mask_image", NULL},
                            *const field_file[] = {"scene.field_file", "scene.field_file_y", "scene.field_file_scale",
-                                                  NULL},
+                                                  "scene.field_file_layout", NULL},
                            *const orientation[] = {"scene.orientation", NULL},
                            *const picture[] = {"scene.image_width", "scene.image_blur", "scene.image_flatten",
                                                "scene.image_levels", "scene.image_levels_alpha",

@@ -136,7 +136,9 @@ static lw_status npy_read_header(FILE *f, const char *path, npy_header *h, lw_er
     snprintf(dtype, sizeof dtype, "%.*s", (int)(n < sizeof dtype ? n : sizeof dtype - 1), descr + 1);
     if (n >= sizeof dtype || !npy_dtype(dtype, h))
       s = lw_error_set(err, LW_EINPUT, "%s: a NumPy array of dtype '%s': expected floats (f4, f8) or integers "
-                       "(i1..i8, u1..u8); arr.astype(float) makes one", path, dtype);
+                       "(i1..i8, u1..u8); %s", path, dtype,
+                       strchr(dtype, 'c') ? "a complex u + iv is np.stack([z.real, z.imag], axis=-1)"
+                                          : "arr.astype(float) makes one");
   }
   if (!s) {
     h->fortran = !strncmp(order, "True", 4);
@@ -354,7 +356,16 @@ static lw_grid2d *read_text(FILE *f, const char *path, int ncomp, lw_error *err)
   while (!s && (len = lw_text_next_line(f, &buf, &bcap, &line)) >= 0) {
     char *hash = strchr(buf, '#');
     if (hash) *hash = '\0';
-    if ((s = text_row(buf, path, line, &a, &got, err)) || !got) continue;
+    if ((s = text_row(buf, path, line, &a, &got, err))) {
+      /* (a header row of names, as a spreadsheet or ParaView writes one) */
+      if (!rows && s == LW_EINPUT && strpbrk(buf, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ")) {
+        const size_t used = strlen(err->msg);
+        snprintf(err->msg + used, sizeof err->msg - used, "; a grid holds numbers only (a header row goes after "
+                 "'#'), and a list of points 'x y u v' a line is read with scene.field_file_layout = points");
+      }
+      continue;
+    }
+    if (!got) continue;
     if (!width) {
       width = got;
       first_line = line;
@@ -376,6 +387,11 @@ static lw_grid2d *read_text(FILE *f, const char *path, int ncomp, lw_error *err)
   else if (!s && !rows)
     s = lw_error_set(err, LW_EINPUT, "%s: expected rows of numbers (%s), found none", path,
                      ncomp == 2 ? "u v for each node of a row" : "a value for each node of a row");
+  /* four values a line over many lines is a list of points (gnuplot's
+  ** "x y u v"), which read as a grid of two columns drew nonsense */
+  else if (!s && ncomp == 2 && width == 4 && rows >= 8)
+    s = lw_error_set(err, LW_EINPUT, "%s: a grid of 2 columns x %ld rows: a list of points 'x y u v' a line? "
+                     "scene.field_file_layout = points reads one; a grid so narrow is refused as one", path, rows);
   free(buf);
   lw_grid2d *g = s ? NULL : lw_grid2d_new((int)(width / ncomp), (int)rows, ncomp, 0.0, 0.0, 1.0, 1.0, err);
   if (g) {
@@ -388,7 +404,134 @@ static lw_grid2d *read_text(FILE *f, const char *path, int ncomp, lw_error *err)
   return NULL;
 }
 
-lw_grid2d *lw_fieldfile_read(const char *path, int ncomp, lw_error *err)
+static int cmp_double(const void *pa, const void *pb)
+{
+  const double a = *(const double *)pa, b = *(const double *)pb;
+  return (a > b) - (a < b);
+}
+
+/* The distinct values of v[0..n) (sorted in place) within tol of each other
+** into u (n values); their count. */
+static size_t distinct(double *v, size_t n, double tol, double *u)
+{
+  qsort(v, n, sizeof *v, cmp_double);
+  size_t m = 0;
+  for (size_t k = 0; k < n; k++)
+    if (!m || v[k] - u[m - 1] > tol) u[m++] = v[k];
+  return m;
+}
+
+/* The even spacing of the m sorted values u, or 0 (with *worst the widest
+** gap) where they are not evenly spaced to a thousandth of it. */
+static double even_spacing(const double *u, size_t m, double *worst)
+{
+  if (m < 2) return *worst = 0.0;
+  const double h = (u[m - 1] - u[0]) / (double)(m - 1);
+  *worst = 0.0;
+  for (size_t k = 1; k < m; k++) *worst = fmax(*worst, fabs(u[k] - u[k - 1] - h));
+  return *worst <= 1e-3 * h ? h : 0.0;
+}
+
+/* A list of points, "x y" and the ncomp values a line (a header row of
+** names first, as a spreadsheet or ParaView writes one, is skipped), onto
+** the regular grid they sample: rows by ascending y, hx and hy the
+** spacings, (x0, y0) the least x and y. */
+static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *err)
+{
+  values a = {NULL, 0, 0};
+  char *buf = NULL;
+  size_t bcap = 0;
+  long line = 0, len, got, rows = 0;
+  const long width = 2 + ncomp;
+  lw_status s = LW_OK;
+  while (!s && (len = lw_text_next_line(f, &buf, &bcap, &line)) >= 0) {
+    char *hash = strchr(buf, '#');
+    if (hash) *hash = '\0';
+    const size_t before = a.n;
+    lw_error e2;
+    if ((s = text_row(buf, path, line, &a, &got, &e2))) {
+      /* (the first row a header of names: "x,y,u,v", "\"Points:0\",...") */
+      const int header = !rows && s == LW_EINPUT && strpbrk(buf, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ");
+      if (header) {
+        a.n = before;
+        s = LW_OK;
+        rows = -1; /* (one header only) */
+        continue;
+      }
+      *err = e2;
+      break;
+    }
+    if (!got) continue;
+    if (got != width)
+      s = lw_error_set(err, LW_EINPUT, "%s:%ld: %ld values: expected %ld a line (x y, then %s)", path, line, got,
+                       width, ncomp == 2 ? "u v" : "the value");
+    rows = rows < 0 ? 1 : rows + 1;
+  }
+  if (!s && len == -2) s = lw_error_set(err, errno == ENOMEM ? LW_ENOMEM : LW_EINPUT, "%s:%ld: %s", path, line,
+                                        errno == ENOMEM ? "out of memory reading the line" : LW_TEXT_NUL_LINE);
+  else if (!s && ferror(f)) s = lw_error_set(err, LW_EIO, "%s: read error", path);
+  else if (!s && rows <= 0) s = lw_error_set(err, LW_EINPUT, "%s: expected points 'x y %s' a line, found none", path,
+                                             ncomp == 2 ? "u v" : "value");
+  free(buf);
+  const size_t n = s ? 0 : a.n / (size_t)width;
+  double *xs = n ? malloc(4 * n * sizeof *xs) : NULL;
+  if (!s && !xs) s = lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu points", path, n);
+  lw_grid2d *g = NULL;
+  if (!s) {
+    double *ys = xs + n, *ux = xs + 2 * n, *uy = xs + 3 * n, wx, wy;
+    for (size_t k = 0; k < n; k++) {
+      xs[k] = a.v[k * (size_t)width];
+      ys[k] = a.v[k * (size_t)width + 1];
+      if (!isfinite(xs[k]) || !isfinite(ys[k]))
+        s = lw_error_set(err, LW_EINPUT, "%s: point %zu at (%g, %g): expected finite coordinates", path, k + 1,
+                         xs[k], ys[k]);
+    }
+    size_t nx = 0, ny = 0;
+    if (!s) {
+      double lo = xs[0], hi = xs[0], ylo = ys[0], yhi = ys[0];
+      for (size_t k = 0; k < n; k++) lo = fmin(lo, xs[k]), hi = fmax(hi, xs[k]), ylo = fmin(ylo, ys[k]),
+                                    yhi = fmax(yhi, ys[k]);
+      nx = distinct(xs, n, 1e-9 * fmax(hi - lo, 1e-300), ux);
+      ny = distinct(ys, n, 1e-9 * fmax(yhi - ylo, 1e-300), uy);
+    }
+    double hx = 0, hy = 0;
+    if (!s && nx * ny != n)
+      s = lw_error_set(err, LW_EINPUT, "%s: %zu points over %zu distinct x and %zu distinct y: expected every node of "
+                       "a regular grid once (%zu points)", path, n, nx, ny, nx * ny);
+    else if (!s && ((nx > 1 && !(hx = even_spacing(ux, nx, &wx))) || (ny > 1 && !(hy = even_spacing(uy, ny, &wy)))))
+      s = lw_error_set(err, LW_EINPUT, "%s: the %s spacing is uneven (off by up to %g): expected a regular grid (a "
+                       "stretched one resampled to even spacing)", path, nx > 1 && !hx ? "x" : "y",
+                       nx > 1 && !hx ? wx : wy);
+    if (!s && nx * ny > (size_t)LW_FIELDFILE_NODES_MAX)
+      s = lw_error_set(err, LW_EINPUT, "%s: %zu points: expected at most %ld", path, n, LW_FIELDFILE_NODES_MAX);
+    if (!s) {
+      if (!hx) hx = hy ? hy : 1.0;
+      if (!hy) hy = hx;
+      g = lw_grid2d_new((int)nx, (int)ny, ncomp, ux[0], uy[0], hx, hy, err);
+    }
+    unsigned char *seen = g ? calloc(nx * ny, 1) : NULL;
+    if (g && !seen) s = lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu points", path, n);
+    for (size_t k = 0; seen && !s && k < n; k++) {
+      const double *pt = a.v + k * (size_t)width;
+      const size_t i = (size_t)lround((pt[0] - g->x0) / hx), j = (size_t)lround((pt[1] - g->y0) / hy);
+      if (seen[j * nx + i]++)
+        s = lw_error_set(err, LW_EINPUT, "%s: point %zu at (%g, %g) is there twice: expected every node of a regular "
+                         "grid once", path, k + 1, pt[0], pt[1]);
+      double *d = g->data + (j * nx + i) * (size_t)ncomp;
+      for (int c = 0; c < ncomp; c++) d[c] = pt[2 + c];
+    }
+    free(seen);
+    if (s) {
+      lw_grid2d_free(g);
+      g = NULL;
+    }
+  }
+  free(xs);
+  free(a.v);
+  return g;
+}
+
+lw_grid2d *lw_fieldfile_read(const char *path, int ncomp, int points, lw_error *err)
 {
   if (lw_text_not_fifo(path, err)) return NULL;
   FILE *f = fopen(path, "rb");
@@ -403,7 +546,9 @@ lw_grid2d *lw_fieldfile_read(const char *path, int ncomp, lw_error *err)
   const char *picture = lw_image_kind(head, n, &readable);
   lw_grid2d *g = NULL;
   if (n >= 6 && !memcmp(head, NPY_MAGIC, 6)) {
-    g = read_npy(f, path, ncomp, err);
+    if (points) lw_error_set(err, LW_EINPUT, "%s: a NumPy array, where scene.field_file_layout = points reads a text "
+                             "list of points 'x y u v': expected grid for an array", path);
+    else g = read_npy(f, path, ncomp, err);
   } else if (n >= 4 && !memcmp(head, "PK\x03\x04", 4)) {
     lw_error_set(err, LW_EINPUT, "%s: a zip archive (np.savez writes one): expected one array, as np.save or "
                  "np.savetxt writes it", path);
@@ -411,7 +556,7 @@ lw_grid2d *lw_fieldfile_read(const char *path, int ncomp, lw_error *err)
     lw_error_set(err, LW_EINPUT, "%s: %s picture: expected a grid of numbers (.npy or text); a picture's own field "
                  "is scene.field = etf or gradient", path, picture);
   } else {
-    g = read_text(f, path, ncomp, err);
+    g = points ? read_points(f, path, ncomp, err) : read_text(f, path, ncomp, err);
   }
   fclose(f);
   return g;

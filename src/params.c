@@ -209,6 +209,11 @@ const lw_param_def lw_param_table[] = {
          "What field_file's lengths mean: unit, each vector made length 1 (the lines follow its direction "
          "alone, however weak the flow); max, all divided by the longest (a weak flow steers less); none, as "
          "given (the field term's weight times the file's units)."),
+  CHOICE("scene", "field_file_layout", field_file_layout, "grid", "grid|points",
+         "How field_file lays out its vectors: grid, a row of nodes a line, u v for each, on square cells; "
+         "points, a text list of 'x y u v' a line (a header row of names allowed: ParaView's or a spreadsheet's "
+         "CSV, gnuplot's blocks) sampling a regular grid, each node once, its cells as wide and tall as x and y "
+         "space them."),
   CHOICE("scene", "mask", mask, "none", "none|alpha|image",
          "Where the inside of boundary = mask comes from: the alpha channel of `image` "
          "(opaque is inside), or the picture `mask_image` (opaque and dark is inside). "

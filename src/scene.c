@@ -608,7 +608,7 @@ static lw_status field_from_file(lw_scene *sc, const lw_params *p, lw_error *err
   lw_path_dir(dir, sizeof dir, p->file);
   lw_path_join(full, sizeof full, dir, p->field_file);
   lw_error e2;
-  lw_grid2d *g = sc->field.grid = lw_fieldfile_read(full, 2, &e2);
+  lw_grid2d *g = sc->field.grid = lw_fieldfile_read(full, 2, p->field_file_layout == LW_FFL_POINTS, &e2);
   if (!g) return bad_key(p, "scene", "field_file", e2.code, err, "%s", e2.msg);
   /* a node with a component not finite is a masked cell: no field there */
   const size_t nodes = (size_t)g->nx * (size_t)g->ny;
@@ -641,16 +641,27 @@ static lw_status field_from_file(lw_scene *sc, const lw_params *p, lw_error *err
   /* over the picture: a grid of another shape than the picture's would
   ** stretch the field over it, so it is refused; its rows (or columns) may
   ** be the picture's shape rounded (3 columns over a 2:1 picture take 1.5
-  ** rows: 1 or 2) */
-  const lw_image_place pl = sc->image ? sc->image_place
-                                      : lw_image_fit(g->nx, g->ny, p->margin, p->margin, p->width - p->margin,
-                                                     p->height - p->margin);
-  const double w = sc->image ? sc->image->width * pl.pixel : g->nx * pl.pixel;
-  const double h = sc->image ? sc->image->height * pl.pixel : g->ny * pl.pixel;
-  if (sc->image && fabs((double)g->nx * h / w - g->ny) > 0.5 && fabs((double)g->ny * w / h - g->nx) > 0.5)
-    return bad_key(p, "scene", "field_file", LW_EINPUT, err, "%s: a grid of %d columns x %d rows over a %d x %d "
-                   "picture: expected the picture's shape (%d columns take %.0f rows), or no scene.image", full, g->nx,
-                   g->ny, sc->image->width, sc->image->height, g->nx, (double)g->nx * h / w);
+  ** rows: 1 or 2).  Else fitted into the margin box as a picture of its
+  ** shape: nx by ny cells of the spacings the file gives (1 by 1 a grid's). */
+  const double cw = g->nx * g->hx, ch = g->ny * g->hy; /* the grid's extent, the file's units */
+  lw_image_place pl = {0, 0, 0};
+  double w, h;
+  if (sc->image) {
+    pl = sc->image_place;
+    w = sc->image->width * pl.pixel;
+    h = sc->image->height * pl.pixel;
+    const double rows = g->nx * h * g->hx / (w * g->hy), cols = g->ny * w * g->hy / (h * g->hx);
+    if (fabs(rows - g->ny) > 0.5 && fabs(cols - g->nx) > 0.5)
+      return bad_key(p, "scene", "field_file", LW_EINPUT, err, "%s: a grid of %d columns x %d rows over a %d x %d "
+                     "picture: expected the picture's shape (%d columns take %.0f rows), or no scene.image", full,
+                     g->nx, g->ny, sc->image->width, sc->image->height, g->nx, rows);
+  } else {
+    const double bw = p->width - 2 * p->margin, bh = p->height - 2 * p->margin, s = fmin(bw / cw, bh / ch);
+    w = cw * s;
+    h = ch * s;
+    pl.x0 = p->margin + 0.5 * (bw - w);
+    pl.y0 = p->margin + 0.5 * (bh - h);
+  }
   g->hx = w / g->nx;
   g->hy = h / g->ny;
   g->x0 = pl.x0 + 0.5 * g->hx;

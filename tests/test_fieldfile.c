@@ -97,7 +97,7 @@ Test(fieldfile, npy_reads_both_byte_orders_both_index_orders_and_integers)
     snprintf(name, sizeof name, "f%zu.npy", k);
     const char *path = write_npy(name, cases[k].major, cases[k].descr, cases[k].size, cases[k].big, cases[k].fortran);
     lw_error err;
-    lw_grid2d *g = lw_fieldfile_read(path, 2, &err);
+    lw_grid2d *g = lw_fieldfile_read(path, 2, 0, &err);
     cr_assert_not_null(g, "%s: %s", cases[k].descr, err.msg);
     assert_field(g, cases[k].integers);
     lw_grid2d_free(g);
@@ -113,14 +113,14 @@ Test(fieldfile, text_reads_blanks_commas_comments_and_nan)
                              "10,-10.5,11,-11.5,12,-12.5\n";
   lw_test_write(path, text, sizeof text - 1);
   lw_error err;
-  lw_grid2d *g = lw_fieldfile_read(path, 2, &err);
+  lw_grid2d *g = lw_fieldfile_read(path, 2, 0, &err);
   cr_assert_not_null(g, "%s", err.msg);
   assert_field(g, 0);
   lw_grid2d_free(g);
   /* (1e400 and 1e-400 as NumPy reads them: infinite, 0) */
   static const char masked[] = "nan NaN 1 2\n-inf 0 3 1e400\n1e-400 0 0 0\n";
   lw_test_write(path, masked, sizeof masked - 1);
-  g = lw_fieldfile_read(path, 2, &err);
+  g = lw_fieldfile_read(path, 2, 0, &err);
   cr_assert_not_null(g, "%s", err.msg);
   cr_assert(isnan(g->data[0]) && isnan(g->data[1]) && g->data[2] == 1 && g->data[3] == 2);
   cr_assert(isinf(g->data[4]) && g->data[4] < 0 && g->data[5] == 0 && isinf(g->data[7]) && g->data[8] == 0);
@@ -134,7 +134,7 @@ static void refused(const char *name, const void *bytes, size_t n, const char *c
   const char *path = lw_test_path(name);
   lw_test_write(path, bytes, n);
   lw_error err;
-  lw_grid2d *g = lw_fieldfile_read(path, 2, &err);
+  lw_grid2d *g = lw_fieldfile_read(path, 2, 0, &err);
   cr_assert_null(g, "%s was read", name);
   cr_assert_eq(err.code, LW_EINPUT, "%s: code %d (%s)", name, err.code, err.msg);
   cr_assert(strstr(err.msg, path), "%s: the message does not name the file: %s", name, err.msg);
@@ -173,6 +173,10 @@ Test(fieldfile, text_refused_says_the_line_and_what_was_expected)
   ** twice the nodes and as one row */
   REFUSED("comma.txt", "0,5 0,7 1,0 0,2\n", ":1:", "decimal commas?");
   REFUSED("cr.txt", "1 0 1 0\r0 1 0 1\r", ":1:", "old Mac line ends");
+  /* a header row, and a list of points (gnuplot's "x y u v") read as a grid of 2 columns */
+  REFUSED("header.csv", "x,y,u,v\n0,0,1,0\n", ":1:", "'x', is not a number", "field_file_layout = points");
+  REFUSED("xyuv.dat", "0 0 1 0\n1 0 1 0\n2 0 1 0\n3 0 1 0\n0 1 1 0\n1 1 1 0\n2 1 1 0\n3 1 1 0\n",
+          "2 columns x 8 rows", "field_file_layout = points");
 }
 
 Test(fieldfile, npy_refused_says_what_was_expected)
@@ -180,6 +184,8 @@ Test(fieldfile, npy_refused_says_what_was_expected)
   REFUSED_NPY("shape.npy", "{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }\n", "", "(2, 3)",
               "(rows, columns, 2)");
   REFUSED_NPY("complex.npy", "{'descr': '<c16', 'fortran_order': False, 'shape': (1, 1, 2), }\n", "", "'<c16'",
+              "z.real, z.imag");
+  REFUSED_NPY("bool.npy", "{'descr': '|b1', 'fortran_order': False, 'shape': (1, 1, 2), }\n", "", "'|b1'",
               "astype");
   REFUSED_NPY("records.npy", "{'descr': [('u', '<f8')], 'fortran_order': False, 'shape': (1,), }\n", "",
               "structured");
@@ -203,7 +209,7 @@ Test(fieldfile, a_picture_is_named_with_where_its_field_comes_from)
   const float g[4] = {0, 1, 1, 0};
   lw_test_png(path, 2, 2, g, NULL);
   lw_error err;
-  cr_assert_null(lw_fieldfile_read(path, 2, &err));
+  cr_assert_null(lw_fieldfile_read(path, 2, 0, &err));
   cr_assert(strstr(err.msg, "a PNG picture") && strstr(err.msg, "etf or gradient"), "%s", err.msg);
 }
 
@@ -473,4 +479,68 @@ Test(fieldfile, a_picture_smoother_than_field_flat_gets_a_note)
                   strstr(sc.note, field == LW_FLD_ETF ? "turns to field_angle" : "fades to 0"), "%s", sc.note);
       lw_scene_clear(&sc);
     }
+}
+
+/* A list of points (ParaView's CSV, gnuplot's blocks): "x y u v" a line in
+** any order, a header row of names, onto the regular grid it samples, rows
+** by ascending y, its spacings kept (here 2 in x, 1 in y). */
+Test(fieldfile, a_list_of_points_reads_onto_its_grid)
+{
+  const char *path = lw_test_path("points.csv");
+  static const char text[] = "\"Points:0\",\"Points:1\",\"U:0\",\"U:1\"\n"
+                             "4,1,12,-12.5\n0,0,0,-0.5\n2,0,1,-1.5\n\n# a block\n"
+                             "0,1,10,-10.5\n4,0,2,-2.5\n2,1,11,-11.5\n";
+  lw_test_write(path, text, sizeof text - 1);
+  lw_error err;
+  lw_grid2d *g = lw_fieldfile_read(path, 2, 1, &err);
+  cr_assert_not_null(g, "%s", err.msg);
+  assert_field(g, 0);
+  cr_assert(g->hx == 2 && g->hy == 1 && g->x0 == 0 && g->y0 == 0, "spacing %g, %g from (%g, %g)", g->hx, g->hy,
+            g->x0, g->y0);
+  lw_grid2d_free(g);
+  static const struct {
+    const char *text, *word;
+  } bad[] = {
+    {"0 0 1 0\n1 0 1 0\n0 1 1 0\n", "3 points over 2 distinct x and 2 distinct y"},
+    {"0 0 1 0\n1 0 1 0\n3 0 1 0\n", "x spacing is uneven"},
+    {"0 0 1 0\n1 0 1 0\n0 0 1 0\n2 0 1 0\n0 1 1 0\n1 1 1 0\n", "twice"},
+    {"0 0 1 0 5\n", "5 values: expected 4 a line"},
+    {"x y u v\nx y u v\n", "'x', is not a number"},
+  };
+  for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
+    lw_test_write(path, bad[k].text, strlen(bad[k].text));
+    cr_assert_null(lw_fieldfile_read(path, 2, 1, &err), "case %zu read", k);
+    cr_assert(strstr(err.msg, bad[k].word), "case %zu: %s", k, err.msg);
+  }
+}
+
+/* A list of points lies on the page with its cells' own shape: 3 x 2
+** nodes 2 and 1 apart span 6 x 2, fitted into 90 x 40 mm as 90 x 30 from
+** (5, 10); the first row (the least y) at the bottom, v up the page. */
+Test(fieldfile, a_list_of_points_keeps_its_aspect)
+{
+  lw_params p;
+  lw_params_defaults(&p);
+  p.width = 100;
+  p.height = 50;
+  p.margin = 5;
+  p.field_coef = -1;
+  p.field_mode = LW_FIELDMODE_SIGNED;
+  p.field = LW_FLD_FILE;
+  p.field_file_layout = LW_FFL_POINTS;
+  p.field_file_scale = LW_FFS_NONE;
+  snprintf(p.field_file, sizeof p.field_file, "%s", lw_test_path("aspect.txt"));
+  static const char text[] = "x y u v\n0 0 1 1\n2 0 2 1\n4 0 3 1\n0 1 4 1\n2 1 5 1\n4 1 6 1\n";
+  lw_test_write(p.field_file, text, sizeof text - 1);
+  lw_scene sc;
+  lw_error err;
+  cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
+  cr_assert(fabs(sc.field.grid->hx - 30) < 1e-12 && fabs(sc.field.grid->hy - 15) < 1e-12, "cells %g x %g mm",
+            sc.field.grid->hx, sc.field.grid->hy);
+  double v[2];
+  lw_field_eval(&sc.field, 20, 32.5, &v[0], &v[1]); /* the least x and y: bottom left */
+  cr_assert(v[0] == 1 && v[1] == -1, "(%g, %g)", v[0], v[1]);
+  lw_field_eval(&sc.field, 80, 17.5, &v[0], &v[1]); /* the greatest: top right */
+  cr_assert(v[0] == 6 && v[1] == -1, "(%g, %g)", v[0], v[1]);
+  lw_scene_clear(&sc);
 }

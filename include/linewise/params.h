@@ -66,6 +66,7 @@ enum { LW_POT_CONSTANT, LW_POT_RAMP, LW_POT_RADIAL, LW_POT_IMAGE };
 enum { LW_FLD_CONSTANT, LW_FLD_RADIAL, LW_FLD_VORTEX, LW_FLD_WAVES, LW_FLD_ETF, LW_FLD_GRADIENT, LW_FLD_FILE };
 enum { LW_FFY_UP, LW_FFY_DOWN };
 enum { LW_FFS_UNIT, LW_FFS_MAX, LW_FFS_NONE };
+enum { LW_FFL_GRID, LW_FFL_POINTS };
 enum { LW_MASK_NONE, LW_MASK_ALPHA, LW_MASK_IMAGE };
 enum { LW_STRAIN_SPLINE, LW_STRAIN_SEGMENT };
 enum { LW_FIELDMODE_AXIAL, LW_FIELDMODE_SIGNED };
@@ -120,6 +121,7 @@ typedef struct {
   char field_file[LW_PATH_MAX]; /* field = file: the grid's .npy or text file */
   int field_file_y;           /* LW_FFY_*: the file's rows and v from the bottom up, or from the top down */
   int field_file_scale;       /* LW_FFS_*: each vector made unit, all divided by the longest, or as given */
+  int field_file_layout;      /* LW_FFL_*: a grid of u v, or a list of points x y u v */
   int mask;                   /* LW_MASK_* */
   char mask_image[LW_PATH_MAX]; /* picture of mask = image */
   char driver[64];            /* a name from the driver table (driver.h) */
