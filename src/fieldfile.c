@@ -432,17 +432,55 @@ static double even_spacing(const double *u, size_t m, double *worst)
   return *worst <= 1e-3 * h ? h : 0.0;
 }
 
-/* A list of points, "x y" and the ncomp values a line (a header row of
-** names first, as a spreadsheet or ParaView writes one, is skipped), onto
-** the regular grid they sample: rows by ascending y, hx and hy the
-** spacings, (x0, y0) the least x and y. */
+/* Which column of a header row of names (tokens of line, lower case, quotes
+** and a leading Tecplot "variables" dropped) holds x, y, u and v into
+** col: x or points:0, y or points:1, u or vx, v or vy, else the first
+** vector NAME:0 and NAME:1 besides the points (ParaView's "U:0", "U:1").
+** The count of names, or 0 where x, y, u and v are not all named. */
+static long header_columns(const char *line, int col[4])
+{
+  char copy[4096], *save = NULL, *names[64];
+  long n = 0;
+  snprintf(copy, sizeof copy, "%s", line);
+  for (char *t = strtok_r(copy, " \t,;=", &save); t && n < 64; t = strtok_r(NULL, " \t,;=", &save)) {
+    t += strspn(t, "\"'");
+    t[strcspn(t, "\"'")] = '\0';
+    for (char *c = t; *c; c++) *c = (char)tolower((unsigned char)*c);
+    if (*t && !(n == 0 && !strcmp(t, "variables"))) names[n++] = t;
+  }
+  static const char *const own[4][4] = {{"x", "points:0", "coordinates:0", NULL}, {"y", "points:1", "coordinates:1",
+                                        NULL}, {"u", "vx", "ux", NULL}, {"v", "vy", "uy", NULL}};
+  for (int c = 0; c < 4; c++) {
+    col[c] = -1;
+    for (long k = 0; k < n && col[c] < 0; k++)
+      for (int w = 0; own[c][w] && col[c] < 0; w++)
+        if (!strcmp(names[k], own[c][w])) col[c] = (int)k;
+  }
+  for (long k = 0; k < n && (col[2] < 0 || col[3] < 0); k++) {
+    const size_t stem = strlen(names[k]) - 2;
+    if (strlen(names[k]) < 3 || strcmp(names[k] + stem, ":0") || !strncmp(names[k], "points", stem) ||
+        !strncmp(names[k], "coordinates", stem))
+      continue;
+    for (long m = 0; m < n; m++)
+      if (strlen(names[m]) == stem + 2 && !strncmp(names[m], names[k], stem) && !strcmp(names[m] + stem, ":1")) {
+        col[2] = (int)k;
+        col[3] = (int)m;
+      }
+  }
+  return col[0] >= 0 && col[1] >= 0 && col[2] >= 0 && col[3] >= 0 ? n : 0;
+}
+
+/* A list of points, "x y u v" a line, onto the regular grid they sample:
+** rows by ascending y, hx and hy the spacings, (x0, y0) the least x and y.
+** Lines of words before the first point are a header row, whose names say
+** the columns (header_columns), or a title (Tecplot's TITLE and ZONE). */
 static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *err)
 {
   values a = {NULL, 0, 0};
   char *buf = NULL;
   size_t bcap = 0;
-  long line = 0, len, got, rows = 0;
-  const long width = 2 + ncomp;
+  long line = 0, len, got, rows = 0, width = 4;
+  int col[4] = {0, 1, 2, 3};
   lw_status s = LW_OK;
   while (!s && (len = lw_text_next_line(f, &buf, &bcap, &line)) >= 0) {
     char *hash = strchr(buf, '#');
@@ -450,12 +488,15 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
     const size_t before = a.n;
     lw_error e2;
     if ((s = text_row(buf, path, line, &a, &got, &e2))) {
-      /* (the first row a header of names: "x,y,u,v", "\"Points:0\",...") */
-      const int header = !rows && s == LW_EINPUT && strpbrk(buf, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ");
-      if (header) {
+      int named[4];
+      const long names = header_columns(buf, named);
+      if (!rows && s == LW_EINPUT && strpbrk(buf, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ")) {
+        if (names) {
+          width = names;
+          memcpy(col, named, sizeof col);
+        }
         a.n = before;
         s = LW_OK;
-        rows = -1; /* (one header only) */
         continue;
       }
       *err = e2;
@@ -463,9 +504,9 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
     }
     if (!got) continue;
     if (got != width)
-      s = lw_error_set(err, LW_EINPUT, "%s:%ld: %ld values: expected %ld a line (x y, then %s)", path, line, got,
-                       width, ncomp == 2 ? "u v" : "the value");
-    rows = rows < 0 ? 1 : rows + 1;
+      s = lw_error_set(err, LW_EINPUT, "%s:%ld: %ld values: expected %ld a line (%s)", path, line, got, width,
+                       width == 4 ? "x y u v" : "as the header row names");
+    rows++;
   }
   if (!s && len == -2) s = lw_error_set(err, errno == ENOMEM ? LW_ENOMEM : LW_EINPUT, "%s:%ld: %s", path, line,
                                         errno == ENOMEM ? "out of memory reading the line" : LW_TEXT_NUL_LINE);
@@ -480,8 +521,8 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
   if (!s) {
     double *ys = xs + n, *ux = xs + 2 * n, *uy = xs + 3 * n, wx, wy;
     for (size_t k = 0; k < n; k++) {
-      xs[k] = a.v[k * (size_t)width];
-      ys[k] = a.v[k * (size_t)width + 1];
+      xs[k] = a.v[k * (size_t)width + (size_t)col[0]];
+      ys[k] = a.v[k * (size_t)width + (size_t)col[1]];
       if (!isfinite(xs[k]) || !isfinite(ys[k]))
         s = lw_error_set(err, LW_EINPUT, "%s: point %zu at (%g, %g): expected finite coordinates", path, k + 1,
                          xs[k], ys[k]);
@@ -512,13 +553,13 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
     unsigned char *seen = g ? calloc(nx * ny, 1) : NULL;
     if (g && !seen) s = lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu points", path, n);
     for (size_t k = 0; seen && !s && k < n; k++) {
-      const double *pt = a.v + k * (size_t)width;
-      const size_t i = (size_t)lround((pt[0] - g->x0) / hx), j = (size_t)lround((pt[1] - g->y0) / hy);
+      const double *pt = a.v + k * (size_t)width, px = pt[col[0]], py = pt[col[1]];
+      const size_t i = (size_t)lround((px - g->x0) / hx), j = (size_t)lround((py - g->y0) / hy);
       if (seen[j * nx + i]++)
         s = lw_error_set(err, LW_EINPUT, "%s: point %zu at (%g, %g) is there twice: expected every node of a regular "
-                         "grid once", path, k + 1, pt[0], pt[1]);
+                         "grid once", path, k + 1, px, py);
       double *d = g->data + (j * nx + i) * (size_t)ncomp;
-      for (int c = 0; c < ncomp; c++) d[c] = pt[2 + c];
+      for (int c = 0; c < ncomp; c++) d[c] = pt[col[2 + c]];
     }
     free(seen);
     if (s) {
@@ -556,7 +597,7 @@ lw_grid2d *lw_fieldfile_read(const char *path, int ncomp, int points, lw_error *
     lw_error_set(err, LW_EINPUT, "%s: %s picture: expected a grid of numbers (.npy or text); a picture's own field "
                  "is scene.field = etf or gradient", path, picture);
   } else {
-    g = points ? read_points(f, path, ncomp, err) : read_text(f, path, ncomp, err);
+    g = points && ncomp == 2 ? read_points(f, path, ncomp, err) : read_text(f, path, ncomp, err);
   }
   fclose(f);
   return g;

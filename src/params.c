@@ -211,9 +211,9 @@ const lw_param_def lw_param_table[] = {
          "given (the field term's weight times the file's units)."),
   CHOICE("scene", "field_file_layout", field_file_layout, "grid", "grid|points",
          "How field_file lays out its vectors: grid, a row of nodes a line, u v for each, on square cells; "
-         "points, a text list of 'x y u v' a line (a header row of names allowed: ParaView's or a spreadsheet's "
-         "CSV, gnuplot's blocks) sampling a regular grid, each node once, its cells as wide and tall as x and y "
-         "space them."),
+         "points, a text list of 'x y u v' a line (a header row's names choosing the columns: ParaView's or a "
+         "spreadsheet's CSV, Tecplot's VARIABLES; gnuplot's blocks) sampling a regular grid, each node once, its "
+         "cells as wide and tall as x and y space them."),
   CHOICE("scene", "mask", mask, "none", "none|alpha|image",
          "Where the inside of boundary = mask comes from: the alpha channel of `image` "
          "(opaque is inside), or the picture `mask_image` (opaque and dark is inside). "

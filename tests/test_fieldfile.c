@@ -498,6 +498,21 @@ Test(fieldfile, a_list_of_points_reads_onto_its_grid)
   cr_assert(g->hx == 2 && g->hy == 1 && g->x0 == 0 && g->y0 == 0, "spacing %g, %g from (%g, %g)", g->hx, g->hy,
             g->x0, g->y0);
   lw_grid2d_free(g);
+  /* the columns by the header's names: ParaView's vector first with a third
+  ** component, and Tecplot's title, VARIABLES and ZONE lines */
+  static const char *const named[] = {
+    "\"U:0\",\"U:1\",\"U:2\",\"Points:0\",\"Points:1\",\"Points:2\"\n12,-12.5,0,4,1,0\n0,-0.5,0,0,0,0\n"
+    "1,-1.5,0,2,0,0\n10,-10.5,0,0,1,0\n2,-2.5,0,4,0,0\n11,-11.5,0,2,1,0\n",
+    "TITLE = \"flow\"\nVARIABLES = \"X\", \"Y\", \"U\", \"V\"\nZONE I=3, J=2, F=POINT\n0 0 0 -0.5\n2 0 1 -1.5\n"
+    "4 0 2 -2.5\n0 1 10 -10.5\n2 1 11 -11.5\n4 1 12 -12.5\n",
+  };
+  for (size_t k = 0; k < sizeof named / sizeof *named; k++) {
+    lw_test_write(path, named[k], strlen(named[k]));
+    g = lw_fieldfile_read(path, 2, 1, &err);
+    cr_assert_not_null(g, "case %zu: %s", k, err.msg);
+    assert_field(g, 0);
+    lw_grid2d_free(g);
+  }
   static const struct {
     const char *text, *word;
   } bad[] = {
@@ -505,7 +520,8 @@ Test(fieldfile, a_list_of_points_reads_onto_its_grid)
     {"0 0 1 0\n1 0 1 0\n3 0 1 0\n", "x spacing is uneven"},
     {"0 0 1 0\n1 0 1 0\n0 0 1 0\n2 0 1 0\n0 1 1 0\n1 1 1 0\n", "twice"},
     {"0 0 1 0 5\n", "5 values: expected 4 a line"},
-    {"x y u v\nx y u v\n", "'x', is not a number"},
+    {"x y u v\nx y u v\n", "found none"},
+    {"x y u v\n0 0 1 0\nx y u v\n", ":3: value 1 of the row, 'x', is not a number"},
   };
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
     lw_test_write(path, bad[k].text, strlen(bad[k].text));

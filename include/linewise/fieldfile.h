@@ -38,10 +38,11 @@ extern "C" {
 #define LW_FIELDFILE_NODES_MAX (1L << 24)
 
 /* The grid in the file at path with ncomp (1 or 2) values a node; NULL and
-** err set on failure.  points: the file is a text list of points, "x y"
-** and the ncomp values a line (a header row of names first is skipped;
-** ParaView's and a spreadsheet's CSV, gnuplot's blocks), in any order, that
-** sample a regular grid, each node once: the grid's rows by ascending y,
+** err set on failure.  points (with ncomp 2): the file is a text list of
+** points, "x y u v" a line, in any order, that sample a regular grid, each
+** node once (lines of words before the first point are a header row whose
+** names say the columns -- x or points:0, y, u or vx or NAME:0, v -- as
+** ParaView's, a spreadsheet's or Tecplot's VARIABLES line, or a title): the grid's rows by ascending y,
 ** (x0, y0) the least x and y, hx and hy the spacings (their aspect the
 ** cells'; a grid file's are 1). */
 lw_grid2d *lw_fieldfile_read(const char *path, int ncomp, int points, lw_error *err);
