@@ -203,10 +203,14 @@ static void bench_throughput(bench_ctx *b)
   for (int t = 0; t < 2; t++)
     fprintf(d, "- at about %.0f neighbours %.0f proposals a second, against %.0f: %s.\n", mean_neighbours(r[row[t]].model),
             1e9 / ns[row[t]], target[t], 1e9 / ns[row[t]] >= target[t] ? "met" : "not met");
-  fprintf(d, "\nThe sample-gap and clearance checks of docs/NUMERICS.md (\"Regular segments\") took 0.77 %% of\n"
-             "params/flow.ini's instructions over 40 sweeps when last measured (callgrind, 2026-12-06: the\n"
-             "frame's check answers a segment whose four control points clear a convex frame after those\n"
-             "four distances, 420 instructions a call); \"Throughput: earlier runs\" below has the history.\n");
+  fprintf(d, "\nThe sample-gap and clearance checks of docs/NUMERICS.md (\"Regular segments\") took 1.07 %% of\n"
+             "params/flow.ini's instructions over 40 sweeps when last measured (callgrind, 2026-12-07: the\n"
+             "frame's check 0.79 %%, answering a segment whose four control points clear a convex frame\n"
+             "after those four distances, 420 instructions a call; the pair gaps 0.28 %%); \"Throughput:\n"
+             "earlier runs\" below has the history. Under valgrind the processor shows no AVX-512, so\n"
+             "callgrind's counts are of the narrower kernels' code (the tone's splat counted 43 %% of the\n"
+             "example's sweeps there, about 22 %% natively; the grid lookups and the spacing's scan, which\n"
+             "wait on memory, look 3 to 4 times cheaper than they are): shares of time are perf's.\n");
   fprintf(d, "\nThe machine is shared and its speed moves by up to a fifth between runs;\n"
              "the column \"x cost without pair\" (each row's time over the row without the pair term, in\n"
              "the same blocks) moves less at a moderate load, but under a heavy one (a load of 8 on 2\n"
