@@ -1213,9 +1213,9 @@ static void drop_stash(lw_anneal *a)
 {
   lw_error e;
   if (!a->stashed || a->fresh) return;
+  lw_phase_stash(0); /* (first: a signal while it goes said it would come back) */
   if (lw_runfiles_drop(a->dir, &e)) snprintf(a->stash_left, sizeof a->stash_left, "%s", e.msg);
   a->stashed = 0;
-  lw_phase_stash(0);
 }
 
 /* The new run's first files, up to its first checkpoint (net: the first is
@@ -1458,9 +1458,13 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   lw_ckpt *rep[LW_TEMPERING_MAX] = {NULL};
   lw_phase_set("reading state.lw and rebuilding the energy");
   /* (a directory that holds no run has no state.lw to read, which says so,
-  ** and gets no lock file) */
+  ** and gets no lock file; but one with a lock file is locked first: a run
+  ** setting up there holds it, and its files, come meanwhile, were resumed
+  ** beside it, or it was said to hold no run) */
+  char lock_path[LW_PATH_MAX + 16];
+  snprintf(lock_path, sizeof lock_path, "%s/.lock", dir);
   lw_status sl = LW_OK;
-  if (writes_files(a) && (lw_rundir_holds_run(dir) || lw_runfiles_stashed(dir))) {
+  if (writes_files(a) && (lw_rundir_holds_run(dir) || lw_runfiles_stashed(dir) || !access(lock_path, F_OK))) {
     int back;
     sl = lw_rundir_lock(dir, &a->dir_hold, err);
     /* a run made again there was stopped in its set-up: the run before

@@ -534,7 +534,8 @@ static void on_signal(int sig)
                                "written, puts the run that was in the directory back\n";
     static const char back_half[] = "\nlinewise: a second signal: stopped at once as the run that was in the "
                                     "directory was being put back; linewise's next run or resume there puts the "
-                                    "rest of it back\n";
+                                    "rest of it back, or, where the put-back had not begun, goes on from this "
+                                    "run's checkpoint\n";
     const int stash = lw_phase_stashed();
     /* (a first checkpoint committed within the set-up counts: "nothing to
     ** resume" was said beside a state.lw that resumed; while the run before

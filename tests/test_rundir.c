@@ -91,6 +91,20 @@ Test(rundir, a_run_into_a_directory_whose_run_is_setting_up_is_refused, .timeout
                lw_test_slurp("%s/err.txt", dir));
 }
 
+/* A resume into a directory whose run is setting up (only its lock there)
+** is said busy: it was told the directory holds no run ("run it again"),
+** and, where the run's files came as it looked, resumed beside the run. */
+Test(rundir, a_resume_into_a_run_setting_up_is_said_busy, .timeout = 60)
+{
+  cr_assert_eq(sh("cd %s && { %s run %s/params/minimal.ini --out d --quiet --threads 1 --set init.splines=30000 "
+                  "--set scene.width=2000 --set scene.height=2000 --set anneal.sweeps=2 & } && "
+                  "until test -e d/.lock; do sleep 0.01; done && "
+                  "{ %s resume d --quiet 2> err.txt; echo $? > rc.txt; wait; }", dir, lw_test_bin(), lw_test_root(),
+                  lw_test_bin()), 0);
+  cr_assert_eq(sh("cd %s && test \"$(cat rc.txt)\" = 2 && grep -q 'd: another linewise process is writing this run "
+                  "directory' err.txt", dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+}
+
 /* A run another user is writing, in a directory this one may not write,
 ** is said busy: before, the files' modes were said ("cannot write over the
 ** run's trace"), and the run going on not; once it ends, the modes are. */
