@@ -457,9 +457,9 @@ static long header_columns(const char *line, int col[4])
         if (!strcmp(names[k], own[c][w])) col[c] = (int)k;
   }
   for (long k = 0; k < n && (col[2] < 0 || col[3] < 0); k++) {
-    const size_t stem = strlen(names[k]) - 2;
-    if (strlen(names[k]) < 3 || strcmp(names[k] + stem, ":0") || !strncmp(names[k], "points", stem) ||
-        !strncmp(names[k], "coordinates", stem))
+    const size_t len = strlen(names[k]), stem = len - 2;
+    if (len < 3 || strcmp(names[k] + stem, ":0") || (stem == 6 && !strncmp(names[k], "points", 6)) ||
+        (stem == 11 && !strncmp(names[k], "coordinates", 11)))
       continue;
     for (long m = 0; m < n; m++)
       if (strlen(names[m]) == stem + 2 && !strncmp(names[m], names[k], stem) && !strcmp(names[m] + stem, ":1")) {
