@@ -213,9 +213,9 @@ Test(fieldfile, a_picture_is_named_with_where_its_field_comes_from)
   cr_assert(strstr(err.msg, "a PNG picture") && strstr(err.msg, "etf or gradient"), "%s", err.msg);
 }
 
-/* A scene of a 100 x 50 mm page (margin 5) with its field from the text in
-** file (y and scale as given), or NULL and the message in err. */
-static lw_status field_scene(lw_scene *sc, const char *text, int y, int scale, const char *image, lw_error *err)
+/* The parameters of a 100 x 50 mm page (margin 5) with a signed field from
+** the text in a file (y and scale as given). */
+static lw_params field_params(const char *text, int y, int scale, const char *image)
 {
   lw_params p;
   lw_params_defaults(&p);
@@ -230,6 +230,13 @@ static lw_status field_scene(lw_scene *sc, const char *text, int y, int scale, c
   snprintf(p.field_file, sizeof p.field_file, "%s", lw_test_path("scene.txt"));
   lw_test_write(p.field_file, text, strlen(text));
   if (image) snprintf(p.image, sizeof p.image, "%s", image);
+  return p;
+}
+
+/* A scene of field_params, or the status and the message in err. */
+static lw_status field_scene(lw_scene *sc, const char *text, int y, int scale, const char *image, lw_error *err)
+{
+  const lw_params p = field_params(text, y, scale, image);
   return lw_scene_init(sc, &p, err);
 }
 
@@ -535,19 +542,9 @@ Test(fieldfile, a_list_of_points_reads_onto_its_grid)
 ** (5, 10); the first row (the least y) at the bottom, v up the page. */
 Test(fieldfile, a_list_of_points_keeps_its_aspect)
 {
-  lw_params p;
-  lw_params_defaults(&p);
-  p.width = 100;
-  p.height = 50;
-  p.margin = 5;
-  p.field_coef = -1;
-  p.field_mode = LW_FIELDMODE_SIGNED;
-  p.field = LW_FLD_FILE;
+  lw_params p = field_params("x y u v\n0 0 1 1\n2 0 2 1\n4 0 3 1\n0 1 4 1\n2 1 5 1\n4 1 6 1\n", LW_FFY_UP,
+                              LW_FFS_NONE, NULL);
   p.field_file_layout = LW_FFL_POINTS;
-  p.field_file_scale = LW_FFS_NONE;
-  snprintf(p.field_file, sizeof p.field_file, "%s", lw_test_path("aspect.txt"));
-  static const char text[] = "x y u v\n0 0 1 1\n2 0 2 1\n4 0 3 1\n0 1 4 1\n2 1 5 1\n4 1 6 1\n";
-  lw_test_write(p.field_file, text, sizeof text - 1);
   lw_scene sc;
   lw_error err;
   cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
