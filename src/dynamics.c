@@ -190,14 +190,9 @@ static lw_status not_converged(const lw_dynamics *d, const char *what, lw_error 
                       "(now %g s)", what, d->time, d->steps, d->dt);
 }
 
-/* Half a step of the damping: gamma's uniform decay, which commutes with the
-** pair dampers, and theirs forward (first half) or back (second half). */
-static void damp(lw_dynamics *d, double h, int second)
+/* Half a step of the pair dampers, forward (first half) or back (second). */
+static void damp_pairs(lw_dynamics *d, double h, int second)
 {
-  if (d->gamma != 0.0) {
-    double f = exp(-d->gamma / d->rho * h);
-    for (size_t i = 0; i < d->n; i++) d->pi[i] *= f;
-  }
   if (d->pair_dampers) d->pairs_took += d->type->damp_pairs(d->state, d->mass, h, second, d->pi);
 }
 
@@ -207,13 +202,22 @@ static lw_status leapfrog(lw_dynamics *d, lw_error *err)
   size_t n = d->n;
   double h = d->dt, *pih = d->pi1, *x1 = d->x1;
   lw_status s;
-  damp(d, 0.5 * h, 0);
-  /* pi+ = pi - h/2 dH/dx(x, pi+), M factored at x */
+  /* gamma's decay inside each half kick, as the exact flow of
+  ** pi' = -G - (gamma/rho) pi for a fixed force G: pi <- f pi - kick G with
+  ** f = exp(-z), kick = h/2 (1 - f)/z, z = gamma h / 2 rho (f = 1 and kick =
+  ** h/2 to the bit without damping).  Decaying pi in half steps on either
+  ** side of the undamped kicks instead moved every overdamped step by
+  ** -h^2/2 M^-1 grad E whatever gamma was: a 1000 times more viscous
+  ** medium gave the same motion; now the step tends to -(h/gamma) grad E,
+  ** the massless flow's (docs/NUMERICS.md, "Integrator") */
+  const double z = d->gamma / d->rho * 0.5 * h, f = exp(-z), kick = 0.5 * h * (z > 0.0 ? -expm1(-z) / z : 1.0);
+  damp_pairs(d, 0.5 * h, 0);
+  /* pi+ = f pi - kick dH/dx(x, pi+), M factored at x */
   memcpy(pih, d->pi, n * sizeof *pih);
   int it = 0;
   for (;;) {
     dh_dx(d, d->x, pih, d->u);
-    for (size_t i = 0; i < n; i++) d->u[i] = d->pi[i] - 0.5 * h * d->u[i];
+    for (size_t i = 0; i < n; i++) d->u[i] = f * d->pi[i] - kick * d->u[i];
     int done = converged(d->u, pih, n);
     memcpy(pih, d->u, n * sizeof *pih);
     if (done) break;
@@ -256,10 +260,10 @@ static lw_status leapfrog(lw_dynamics *d, lw_error *err)
                         LW_DYNAMICS_FORBIDDEN_HINT);
   }
   memcpy(d->x, x1, n * sizeof *x1);
-  /* pi' = pi+ - h/2 dH/dx(x', pi+) */
+  /* pi' = f pi+ - kick dH/dx(x', pi+) */
   dh_dx(d, d->x, pih, d->u);
-  for (size_t i = 0; i < n; i++) d->pi[i] = t->mass_pinned(d->mass, i) ? 0.0 : pih[i] - 0.5 * h * d->u[i];
-  damp(d, 0.5 * h, 1);
+  for (size_t i = 0; i < n; i++) d->pi[i] = t->mass_pinned(d->mass, i) ? 0.0 : f * pih[i] - kick * d->u[i];
+  damp_pairs(d, 0.5 * h, 1);
   d->time += h;
   return LW_OK;
 }

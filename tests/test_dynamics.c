@@ -592,3 +592,39 @@ Test(dynamics, the_massless_flow_never_rises_and_reaches_the_minimum)
   lw_dynamics_free(d);
   rig_close(&r);
 }
+
+Test(dynamics, heavy_damping_moves_as_the_massless_flow_does)
+{
+  /* Where gamma dt / rho >> 1 the momenta forget each step, and the motion
+  ** is the gradient flow of the damping, whose rate is 1/gamma: at ten times
+  ** gamma, a tenth of the way in the same time.  The split that decayed the
+  ** momenta in half steps around undamped kicks moved every such step by
+  ** -dt^2/2 M^-1 grad E whatever gamma was. */
+  const double S = 10, Q = 1, L0 = 0.95 * 32, T = 2.0;
+  double drop[2][2]; /* [gamma 2000, 20000][inertial, massless] */
+  for (int g = 0; g < 2; g++)
+    for (int massless = 0; massless < 2; massless++) {
+      rig r;
+      rig_open(&r, 3, S, 0, Q, 3);
+      rig_arc(&r, 40, 0.8, L0);
+      r.p.dyn_rho = massless ? 0.0 : 1.0;
+      r.p.dyn_gamma = g ? 20000.0 : 2000.0;
+      r.p.dyn_dt = 0.01; /* gamma dt / 2 rho = 10 and 100 */
+      lw_error err;
+      lw_dynamics *d = lw_dynamics_new(&lw_system_splines, r.sys->state, &r.p, &err);
+      cr_assert_not_null(d, "%s", err.msg);
+      const double e0 = d->energy;
+      while (d->time < T - 1e-9) cr_assert_eq(lw_dynamics_step(d, &err), LW_OK, "%s", err.msg);
+      drop[g][massless] = e0 - d->energy;
+      lw_dynamics_free(d);
+      rig_close(&r);
+    }
+  cr_log_info("energy drops: gamma 2000 %.6g (massless %.6g), 20000 %.6g (massless %.6g)", drop[0][0], drop[0][1],
+              drop[1][0], drop[1][1]);
+  for (int g = 0; g < 2; g++)
+    cr_assert(fabs(drop[g][0] - drop[g][1]) <= 0.02 * drop[g][1], "gamma %s: the motion lowered E by %.6g, the "
+              "massless flow by %.6g", g ? "20000" : "2000", drop[g][0], drop[g][1]);
+  /* still far from the minimum, where the drop is near linear in 1/gamma */
+  cr_assert(drop[1][0] > 0.08 * drop[0][0] && drop[1][0] < 0.12 * drop[0][0], "ten times gamma: %.6g against %.6g",
+            drop[1][0], drop[0][0]);
+}
