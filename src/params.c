@@ -204,7 +204,8 @@ const lw_param_def lw_param_table[] = {
   CHOICE("scene", "field_file_y", field_file_y, "up", "up|down",
          "Which way field_file's rows and its v go: up, the first row at the bottom of the grid and v up the "
          "page (NumPy's meshgrid of increasing y, matplotlib's origin = 'lower'); down, the first row at the "
-         "top and v down the page (a picture's rows, the page's y)."),
+         "top and v down the page (a picture's rows, the page's y). In a list of points: the way its y "
+         "column grows, up (north up, as GIS tools write it) or down the page."),
   CHOICE("scene", "field_file_scale", field_file_scale, "unit", "unit|max|none",
          "What field_file's lengths mean: unit, each vector made length 1 (the lines follow its direction "
          "alone, however weak the flow); max, all divided by the longest (a weak flow steers less); none, as "
@@ -288,7 +289,7 @@ const lw_param_def lw_param_table[] = {
       "inside the Bernstein ellipse of this parameter around it is forbidden; Gauss-Legendre's "
       "error falls like rho^-2n with it (docs/NUMERICS.md, docs/ACCURACY.md). 1 or less = no check."),
   NUM("energy", "parametrisation", LW_PT_DOUBLE, parametrisation, "0", "energy / mm", 0, 1e12, 0,
-      "G: parametrisation G * integral of (|r'| - l)^2 ds / l per segment (l = its length) holds "
+      "G: parametrisation G * integral of (|r'| - l)^2 dt / l per segment (l = its length) holds "
       "the handle lengths that leave a segment's shape unchanged (docs/NUMERICS.md). 0 = off."),
   NUM("energy", "quadrature", LW_PT_INT, quadrature, "8", "nodes", 2, 64, 0,
       "Gauss-Legendre nodes per segment for every integral but the pair and tone terms' where "
