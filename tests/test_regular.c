@@ -93,6 +93,17 @@ Test(regular, the_cheap_bounds_never_disagree_with_the_exact_tests)
     if (rho > 1.0 + 1e-6 && isfinite(rho)) {
       cr_assert(lw_segment_check(&nd[0], &nd[1], 0, rho * (1 - 1e-9)), "case %d: rho %.17g refused", it, rho);
       cr_assert(!lw_segment_check(&nd[0], &nd[1], 0, rho * (1 + 1e-9)), "case %d: rho %.17g passed", it, rho);
+      /* the ellipse test does not depend on the scale: a segment 2^-900 or
+      ** 2^400 times as large (exactly) gets the same answers, its squares
+      ** not vanishing (the cheap bounds' squares overflow past about 2^500,
+      ** where the check refuses) */
+      for (int e = -900; e <= 400; e += 1300) {
+        lw_node sc[2];
+        for (int k = 0; k < 2; k++)
+          sc[k] = (lw_node){ldexp(nd[k].px, e), ldexp(nd[k].py, e), ldexp(nd[k].vx, e), ldexp(nd[k].vy, e)};
+        cr_assert(lw_segment_check(&sc[0], &sc[1], 0, rho * (1 - 1e-9)), "case %d at 2^%d: refused", it, e);
+        cr_assert(!lw_segment_check(&sc[0], &sc[1], 0, rho * (1 + 1e-9)), "case %d at 2^%d: passed", it, e);
+      }
     }
   }
 }
