@@ -278,6 +278,26 @@ static void stash_note(lw_error *err, const char *dir)
              lw_rundir_shell_word(dir, word, sizeof word));
 }
 
+/* A state an earlier release wrote that a later check refuses (since
+** 2026-12-04 a segment too long for the pair cutoff, a line within the
+** boundary's clearance): the message said to raise a key, which a resume
+** cannot, and not why a run that ran cannot go on (an upgrading study's find). */
+static void older_state_note(const lw_params *p, const char *dir, lw_error *err)
+{
+  char this_build[64], word[LW_RUNDIR_WORD_MAX];
+  snprintf(this_build, sizeof this_build, "%s, build %s", LW_VERSION, lw_version_build());
+  if (err->code != LW_EINPUT || !p->run_header || !strcmp(p->run_build, this_build) ||
+      (!strstr(err->msg, "too long for the pair cutoff") && !strstr(err->msg, "boundary energy is not finite")))
+    return;
+  const size_t n = strlen(err->msg);
+  lw_rundir_shell_word(dir, word, sizeof word);
+  snprintf(err->msg + n, sizeof err->msg - n, " (the run was begun by %s%s, which let this state through: it does "
+           "not resume here ('linewise energy' measures it with that key changed by --set); a redraw of it is a "
+           "new run, 'linewise run %s/scene.ini --set init.from=%s/state.lw "
+           "--set anneal.sweeps=0' with that key set there too: docs/FORMATS.md, \"Runs of older releases\")",
+           p->run_build[0] ? "linewise " : "an earlier linewise", p->run_build, word, word);
+}
+
 /* energy DIR [--set SEC.KEY=VAL]...: the state's energy with its scene, or
 ** with keys of it changed (the quadrature's nodes, to see what the run's
 ** leave out: docs/NUMERICS.md, "The potential between the nodes"). */
@@ -345,6 +365,7 @@ static int cmd_energy(int argc, char **argv)
   ** whose message names a state of another system better); format 1's run
   ** data, the upgrade's under resume, is no section of a newer linewise */
   if (!err.code && st.doc && st.version != 1) lw_checkpoint_sections_known(st.doc, p.system, &err);
+  older_state_note(&p, dir, &err);
   if (err.code) rc = fail(&err);
   else {
     for (int k = 0; k < t->n_terms; k++)
@@ -1428,6 +1449,7 @@ static int cmd_resume(int argc, char **argv)
     s = lw_error_set(&err, LW_EUSAGE, "--stop-at %ld: the run in %s stands at sweep %ld already; expected %ld or more",
                      stop_at, dir, a.sweep, a.sweep);
   if (spread_start(s, &a, 0, &err) || lw_anneal_settle(&a, &err)) {
+    older_state_note(&a.params, dir, &err);
     lw_anneal_free(&a);
     /* a full disk as an extension starts said only "write failed" */
     if (err.code == LW_EIO) {

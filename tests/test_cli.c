@@ -720,6 +720,39 @@ Test(cli, a_state_without_a_later_term_resumes_and_unknown_keys_are_refused)
   }
 }
 
+/* A state an earlier release let through and a later check refuses (a run
+** begun before 2026-12-04, its scene.ini without a scene hash): resume and
+** energy say so and how to go on, not only which key to raise (which a
+** resume cannot); the same state of this build is refused without it. */
+Test(cli, an_older_releases_state_a_later_check_refuses_says_what_is_left)
+{
+  const char *root = getenv("LW_ROOT");
+  cr_assert_not_null(root);
+  char out[1024], errs[2048], args[512];
+  snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/o --set anneal.sweeps=3 --quiet", root, dir);
+  cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+  /* as that release wrote it: no scene hash; a cutoff the state's segments outgrow */
+  cr_assert_eq(lw_test_sh("cd %s && sed -i '/^scene_hash\\|^scene_keys/d' o/state.lw && sed -i "
+                          "'s/^pair_cutoff = .*/pair_cutoff = 0.3/' o/scene.ini && cp -r o same && sed -i "
+                          "'s/^; written by linewise .*/; written by linewise 2026.12, build 0123/' o/scene.ini", dir),
+               0);
+  static const char *const cmd[] = {"resume %s/o --quiet", "energy %s/o", "resume %s/same --quiet"};
+  for (int k = 0; k < 3; k++) {
+    snprintf(args, sizeof args, cmd[k], dir);
+    cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", args);
+    cr_assert(strstr(errs, "too long for the pair cutoff"), "%s: %s", args, errs);
+    if (k == 2) {
+      cr_assert(!strstr(errs, "begun by"), "this build's own run: %s", errs);
+      continue;
+    }
+    cr_assert(strstr(errs, "(the run was begun by linewise 2026.12, build 0123, which let this state through: ") &&
+              strstr(errs, "/o/state.lw --set anneal.sweeps=0' with that key set there") &&
+              strstr(errs, "\"Runs of older releases\")\n"), "%s: %s", args, errs);
+    cr_assert_eq(strstr(errs, "linewise:"), errs, "one message: %s", errs);
+    cr_assert_null(strstr(errs + 1, "linewise:"), "one message: %s", errs);
+  }
+}
+
 /* Bad input of every kind exits 2 with one message naming the file, line
 ** and key (issue 21: each of these exited 1, 0 or 139, or read garbage). */
 Test(cli, hostile_input_exits_2_naming_file_line_and_key)
