@@ -1569,21 +1569,22 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   ** scene.ini alone were copied to another machine, or from before
   ** 2026-12-04), the rate counts this process's proposals over its own
   ** sweeps: every proposal over them gave a rate many times too high. */
-  int timed = 0;
+  int timed = 0, wall = 0;
   if (tf) {
-    timed = fscanf(tf, "wall_seconds %lf", &a->wall_before) == 1 && a->wall_before >= 0 && a->wall_before < 1e12;
-    if (!timed) a->wall_before = 0;
-    if (fscanf(tf, " sweep_seconds %lf", &a->sweep_seconds) != 1 ||
-        !(a->sweep_seconds >= 0 && a->sweep_seconds < 1e12))
-      a->sweep_seconds = 0, timed = 0;
+    wall = fscanf(tf, "wall_seconds %lf", &a->wall_before) == 1 && a->wall_before >= 0 && a->wall_before < 1e12;
+    if (!wall) a->wall_before = 0;
+    timed = wall && fscanf(tf, " sweep_seconds %lf", &a->sweep_seconds) == 1 && a->sweep_seconds >= 0 &&
+            a->sweep_seconds < 1e12;
     if (timed && fscanf(tf, " untimed_proposals %lu", &a->untimed) != 1) a->untimed = 0;
     fclose(tf);
   }
   if (!timed) {
-    a->wall_before = a->sweep_seconds = 0;
+    /* (a release before 2026-12-04 wrote the wall time alone: kept, where
+    ** it was said missing and thrown away) */
+    a->sweep_seconds = 0;
     a->untimed = 0;
     for (int k = 0; a->chain && k < a->chain->n_moves; k++) a->untimed += a->chain->stats[k].proposed;
-    a->untimed_said = 1;
+    a->untimed_said = wall ? 2 : 1;
   }
   if (a->end_sweep < 0) a->end_sweep = a->params.sweeps > a->sweep ? a->params.sweeps : a->sweep;
   const long saved_end = a->end_sweep;

@@ -1470,7 +1470,11 @@ static int cmd_resume(int argc, char **argv)
   /* a resume under the limit that failed its drawing failed again unsaid */
   if (a.memory_note[0] && (!net || !net->rank)) fprintf(stderr, "linewise: note: %s\n", a.memory_note);
   /* (under --quiet too: a study's rates were many times too high unsaid) */
-  if (a.untimed_said && (!net || !net->rank))
+  if (a.untimed_said == 2 && (!net || !net->rank))
+    fprintf(stderr, "linewise: note: %s/timing.txt, of a release before 2026-12-04, has the wall time alone: "
+            "summary.json's sweep_seconds counts from this resume on, and proposals_per_second this resume's "
+            "proposals\n", dir);
+  else if (a.untimed_said && (!net || !net->rank))
     fprintf(stderr, "linewise: note: %s/timing.txt is missing or unreadable: summary.json's wall_seconds and "
             "sweep_seconds count from this resume on, and proposals_per_second this resume's proposals\n", dir);
   if (!quiet) fprintf(stderr, "linewise: resuming %s at sweep %ld of %ld\n", dir, a.sweep, a.end_sweep);

@@ -431,6 +431,18 @@ Test(cli, a_resume_without_its_timing_rates_its_own_proposals)
                           "exit !(s > 0 && u == p * 40 / 60 && d * d < 1e-6 * p * p) }' summary.json",
                           dir),
                0, "%s", lw_test_slurp("%s/t/timing.txt", dir));
+  /* a release before 2026-12-04 wrote the wall time alone: it counts on
+  ** (it was said missing and dropped), the sweeps' time from the resume */
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=60 --stop-at 40 --out w --quiet "
+                          "&& echo 'wall_seconds 1000' > w/timing.txt && { %s resume w --quiet 2> w1.txt; }",
+                          dir, lw_test_bin(), lw_test_root(), lw_test_bin()),
+               0);
+  cr_assert(strstr(lw_test_slurp("%s/w1.txt", dir), "linewise: note: w/timing.txt, of a release before 2026-12-04, "
+                                 "has the wall time alone: summary.json's sweep_seconds counts from this resume on"),
+            "%s", lw_test_slurp("%s/w1.txt", dir));
+  cr_assert_eq(lw_test_sh("cd %s/w && awk -F'[:,]' '/\"wall_seconds\"/ { w = $2 } /\"sweep_seconds\"/ { s = $2 } "
+                          "END { exit !(w > 1000 && w < 1100 && s > 0 && s < 100) }' summary.json", dir),
+               0, "%s", lw_test_slurp("%s/w/summary.json", dir));
 }
 
 /* A checkpoint whose state.lw was committed but whose replica file could

@@ -101,7 +101,8 @@ typedef struct lw_anneal {
   int ckpt_count;              /* process suspended during one is not a checkpoint's cost */
   unsigned long untimed;       /* proposals of sweeps no timing.txt timed (a resume without
                                ** one), which proposals_per_second leaves out */
-  int untimed_said;            /* this resume found no timing.txt to go on from (said by resume) */
+  int untimed_said;            /* this resume found no timing.txt to go on from (1), or one with the wall
+                               ** time alone (2, before 2026-12-04): said by resume */
   lw_move_stats trace_mark[LW_MOVES_MAX]; /* stats at the last trace row */
   int quenched;                /* 1 once lw_anneal_finish has quenched (anneal.quench) */
   int finished;                /* 1 once lw_anneal_finish was called: sweeps, checkpoints and a
