@@ -325,14 +325,34 @@ static lw_status check_stable(lw_dynamics *d, lw_error *err)
 {
   const double h = d->energy + lw_dynamics_kinetic(d);
   if (isnan(d->h_ref)) {
-    d->h_ref = h;
+    d->h_ref = d->h_min = d->h_last = h;
+    d->h_min_time = d->time;
+    d->k_max = h - d->energy;
     d->h_scale = fabs(d->energy) + (h - d->energy);
     if (!(d->h_scale > 0.0)) d->h_scale = 1.0;
     return LW_OK;
   }
+  d->h_last = h;
+  d->k_max = fmax(d->k_max, h - d->energy);
+  if (h < d->h_min) {
+    d->h_min = h;
+    d->h_min_time = d->time;
+  }
   if (h - d->h_ref <= LW_DYN_BLOWUP * d->h_scale) return LW_OK;
   return lw_error_set(err, LW_EINPUT, "the motion is unstable at t = %g s: the energy E + K rose from %g to %g: "
                       "lower dynamics.dt (now %g s)", d->time, d->h_ref, h, d->dt);
+}
+
+void lw_dynamics_rise_note(const lw_dynamics *d, char *buf, size_t n)
+{
+  buf[0] = '\0';
+  if (!(d->rho > 0.0) || (d->gamma == 0.0 && !d->pair_dampers) || isnan(d->h_ref)) return;
+  const double rise = d->h_last - d->h_min, scale = (d->h_ref - d->h_min) + d->k_max;
+  if (rise > LW_DYN_RISE_NOTE * scale && rise > 0.0)
+    snprintf(buf, n, "the damped motion's E + K ended %.3g above its lowest (%.10g at t = %g s), %.2g of the energy "
+             "in motion (damped plus the most kinetic), where damping only lowers it: a mode the step cannot hold "
+             "was growing; lower dynamics.dt (now %g s) and run it again", rise, d->h_min, d->h_min_time,
+             rise / scale, d->dt);
 }
 
 lw_status lw_dynamics_step(lw_dynamics *d, lw_error *err)

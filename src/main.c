@@ -959,6 +959,10 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     if (warning[0]) fprintf(stderr, "linewise: warning: %s\n", warning);
     lw_anneal_observables_note(a, warning, sizeof warning);
     if (warning[0]) fprintf(stderr, "linewise: warning: %s\n", warning);
+    if (a->dyn) {
+      lw_dynamics_rise_note(a->dyn, warning, sizeof warning);
+      if (warning[0]) fprintf(stderr, "linewise: warning: %s\n", warning);
+    }
     a->sys_type->describe(a->sys->state, LW_DESCRIBE_LOST, warning, sizeof warning);
     if (warning[0]) fprintf(stderr, "linewise: warning: %s\n", warning);
   }

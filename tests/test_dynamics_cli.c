@@ -369,6 +369,24 @@ Test(dynamics_cli, an_unstable_motion_stops_and_names_the_step)
   cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "s", "0.002", dir), 0);
 }
 
+/* The hanging lines at 30 ms with the regularity checks off: a mode the step
+** cannot hold grows under the damping, below the blow-up; the run ends
+** "done" (exit 0), which a warning now qualifies (an engineer's run: lines
+** strained 16 %, E + K up 300 from its lowest, unsaid); at the scene's own
+** 10 ms, none. */
+Test(dynamics_cli, a_damped_motion_whose_energy_rose_is_warned_of)
+{
+  const char *run = "%s run %s/params/hanging.ini --out %s/%s --quiet --set dynamics.dt=%s "
+                    "--set dynamics.steps_per_sweep=10 --set anneal.sweeps=42 --set energy.min_speed=0 "
+                    "--set energy.regularity=0 --set output.frames_every=0 2>%s/err.txt";
+  cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "r", "0.03", dir), 0);
+  cr_assert_eq(sh("grep -q \"^linewise: warning: the damped motion's E + K ended [0-9.e+]* above its lowest .*lower "
+                  "dynamics.dt (now 0.03 s)\" %s/err.txt && test $(wc -l < %s/err.txt) -eq 1", dir, dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "s", "0.01", dir), 0);
+  cr_assert_eq(lw_test_slurp("%s/err.txt", dir)[0], '\0', "%s", lw_test_slurp("%s/err.txt", dir));
+}
+
 /* The hanging lines on a step of 50 ms: a segment goes irregular or out
 ** of the frame within three steps.  The run stops there, a failure of the
 ** run (exit 1) whose message names the time and both ways out (a shorter

@@ -76,6 +76,8 @@ typedef struct {
   double *work;              /* the review scheme's scratch (dyn_review.h), or NULL */
   unsigned char *held;       /* massless: the coordinates a step holds (n) */
   double h_ref, h_scale;     /* E + K and |E| + K before the first step here (NAN: not yet) */
+  double h_min, h_min_time;  /* the lowest E + K since, and when */
+  double h_last, k_max;      /* E + K after the last step, the most K since */
   int pair_dampers;          /* 1 if the scene names dampers between neighbours */
   double pairs_took;         /* the kinetic energy they took since this driver began */
 } lw_dynamics;
@@ -84,6 +86,17 @@ typedef struct {
 ** (damping only lowers it, the leapfrog's error is O(dt^2)): beyond it the
 ** motion is unstable, its step too long, and it stops. */
 #define LW_DYN_BLOWUP 100.0
+
+/* A damped motion whose E + K ends more than this share of (the energy the
+** damping took + the most kinetic energy) above its lowest is said to have
+** risen (lw_dynamics_rise_note): a mode the step cannot hold was growing,
+** below the blow-up above (an engineer's run at a step too long ended
+** "done", its lines strained 16 %, E + K up 550 from its lowest). */
+#define LW_DYN_RISE_NOTE 0.01
+
+/* A warning into buf (n bytes) where a damped motion's E + K ended risen
+** from its lowest by more than LW_DYN_RISE_NOTE, else "". */
+void lw_dynamics_rise_note(const lw_dynamics *d, char *buf, size_t n);
 
 /* What a motion that reached a forbidden state (+inf energy) can do: a
 ** step too long gets there where a shorter one does not; a motion that
