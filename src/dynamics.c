@@ -338,6 +338,18 @@ static lw_status check_stable(lw_dynamics *d, lw_error *err)
     d->h_min = h;
     d->h_min_time = d->time;
   }
+  /* Heavily damped (gamma dt / 2 rho >= 1) a step is the massless flow's
+  ** Euler step, -(dt/gamma) grad E, stable only below 2 gamma over the
+  ** stiffest curvature, and nothing halves it: past that E rose 40 % and
+  ** the run ended "done" (the check below waits for a hundredfold).  Damped,
+  ** E + K cannot pass its start by more than the most kinetic energy (a
+  ** step's error is a part of it; 1e-9 of the scale for rounding at rest). */
+  if (d->gamma / d->rho * 0.5 * d->dt >= 1.0 && h - d->h_ref > d->k_max + 1e-9 * d->h_scale)
+    return lw_error_set(err, LW_EINPUT, "the heavily damped motion is unstable at t = %g s: its energy E + K rose from "
+                        "%g to %g, past its start by more than its kinetic energy ever was (a step this long is an "
+                        "Euler step of the massless flow, stable only below 2 gamma over the stiffest curvature): "
+                        "lower dynamics.dt (now %g s), or take rho = 0, whose steps halve where they must", d->time,
+                        d->h_ref, h, d->dt);
   if (h - d->h_ref <= LW_DYN_BLOWUP * d->h_scale) return LW_OK;
   return lw_error_set(err, LW_EINPUT, "the motion is unstable at t = %g s: the energy E + K rose from %g to %g: "
                       "lower dynamics.dt (now %g s)", d->time, d->h_ref, h, d->dt);

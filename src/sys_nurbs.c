@@ -753,13 +753,30 @@ static void mass_free(void *mass)
 ** quotients rise toward omega^2 from below, so a refusal on it is never
 ** wrong. L is the factor of rho M1 with the held points (mass_new). */
 /* The spectral radius of one damped leapfrog step on a mode of frequency
-** omega: the velocity decays by f = exp(-c dt / 2) (c = gamma / rho) before
-** and after the kick-drift-kick, whose matrix then has trace
-** (1 - omega^2 dt^2 / 2)(1 + f^2) and determinant f^2. */
+** omega: each half kick decays the velocity by f = exp(-c dt / 2) (c = gamma
+** / rho) as it kicks by (1 - f) / c (dynamics.c), so the step's matrix has
+** trace 1 + f^2 - omega^2 dt (1 - f^2) / c and determinant f^2: stable while
+** omega^2 dt^2 < 4 z coth z, z = c dt / 2 (2 / omega at c = 0, about
+** 2 c / omega^2 where z >> 1). */
 static double leapfrog_growth(double omega, double dt, double c)
 {
-  const double f2 = exp(-c * dt), tr = (1.0 - 0.5 * omega * omega * dt * dt) * (1.0 + f2), disc = tr * tr - 4.0 * f2;
+  const double f2 = exp(-c * dt), kick = c > 0.0 ? -expm1(-c * dt) / c : dt;
+  const double tr = 1.0 + f2 - omega * omega * dt * kick, disc = tr * tr - 4.0 * f2;
   return disc < 0.0 ? sqrt(f2) : 0.5 * (fabs(tr) + sqrt(disc));
+}
+
+/* The longest step whose growth stays at most 1 (one crossing: the growth's
+** condition divided by dt rises with it), by bisection. */
+static double leapfrog_limit(double omega, double c)
+{
+  double lo = 0.0, hi = 2.0 / omega;
+  while (leapfrog_growth(omega, hi, c) <= 1.0 && hi < 1e300) lo = hi, hi *= 2.0;
+  for (int it = 0; it < 200 && hi - lo > 1e-15 * hi; it++) {
+    const double mid = 0.5 * (lo + hi);
+    if (leapfrog_growth(omega, mid, c) <= 1.0) lo = mid;
+    else hi = mid;
+  }
+  return lo;
 }
 
 static double highest_omega(const lw_nurbs_setup *su, const double *M, const double *L, lw_error *err)
@@ -818,18 +835,21 @@ static void *mass_new(const void *state, const lw_params *p, double density, lw_
     return NULL;
   }
   /* the undamped leapfrog is stable for omega_max dt < 2, a damped one
-  ** while its step's growth (leapfrog_growth) stays below 1: refuse a step
-  ** past that before anything is written (gamma = 0.1 ran on to t = 0.016 s
-  ** first); the implicit motion and the massless flow are left to the run's
-  ** own check of E + K */
+  ** while its step's growth (leapfrog_growth) stays below 1, which heavy
+  ** damping puts far past that: refuse a step past it before anything is
+  ** written (gamma = 0.1 ran on to t = 0.016 s first); the implicit motion
+  ** and the massless flow are left to the run's own check of E + K */
   if (p->dyn_rho > 0.0 && p->dyn_integrator == LW_INTEGRATOR_LEAPFROG) {
-    double omega = highest_omega(su, m->M, m->L, err);
-    if (isnan(omega) || (p->dyn_gamma == 0.0 ? omega * p->dyn_dt >= 2.0
-                                              : leapfrog_growth(omega, p->dyn_dt, p->dyn_gamma / p->dyn_rho) > 1.0)) {
+    double omega = highest_omega(su, m->M, m->L, err), c = p->dyn_gamma / p->dyn_rho;
+    if (isnan(omega) || (p->dyn_gamma == 0.0 ? omega * p->dyn_dt >= 2.0 : leapfrog_growth(omega, p->dyn_dt, c) > 1.0)) {
       if (!isnan(omega)) {
-        lw_error_set(err, LW_EINPUT, "%g s is past the leapfrog's stability limit 2 / omega_max = %.3g s of this "
+        const double limit = p->dyn_gamma == 0.0 ? 2.0 / omega : leapfrog_limit(omega, c);
+        char what[64] = "2 / omega_max =";
+        if (p->dyn_gamma != 0.0) snprintf(what, sizeof what, "at gamma = %g,", p->dyn_gamma);
+        lw_error_set(err, LW_EINPUT, "%g s is past the leapfrog's stability limit %s %.3g s%s of this "
                      "curve (omega_max = %.4g /s, %zu control points): take dt <= %.2g, or integrator = review "
-                     "(stable at any dt; it damps the high modes)", p->dyn_dt, 2.0 / omega, omega, m->n, 1.8 / omega);
+                     "(stable at any dt; it damps the high modes)", p->dyn_dt, what, limit, p->dyn_gamma != 0.0 ? "," : "", omega,
+                     m->n, 0.9 * limit);
         lw_params_blame(p, "dynamics", "dt", err);
       }
       mass_free(m);

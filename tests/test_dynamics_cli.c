@@ -367,6 +367,18 @@ Test(dynamics_cli, an_unstable_motion_stops_and_names_the_step)
   cr_assert_eq(sh("grep -q 'the motion is unstable at t = .*: lower dynamics.dt (now 0.05 s)' %s/err.txt", dir), 0);
   cr_assert_eq(sh("test -s %s/u/state.lw && grep -q '^sweep = 0$' %s/u/state.lw", dir, dir), 0);
   cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), dir, "s", "0.002", dir), 0);
+  /* heavily damped (gamma dt / 2 rho = 50), a step is an Euler step of the
+  ** massless flow, unstable past 2 gamma over the stiffest curvature: its
+  ** E rose 40 % and the run ended "done"; at a tenth of the step it runs */
+  const char *heavy = "%s run %s/params/whip.ini --out %s/%s --quiet --set dynamics.rho=1e-4 --set dynamics.gamma=1 "
+                      "--set dynamics.dt=%s --set dynamics.steps_per_sweep=1 --set anneal.sweeps=30 "
+                      "--set output.frames_every=0 2>%s/err.txt";
+  cr_assert_eq(sh(heavy, lw_test_bin(), lw_test_root(), dir, "h", "0.01", dir), 1);
+  cr_assert_eq(sh("grep -q 'the heavily damped motion is unstable at t = 0.01 s: .*lower dynamics.dt (now 0.01 s), "
+                  "or take rho = 0' %s/err.txt", dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh(heavy, lw_test_bin(), lw_test_root(), dir, "k", "0.001", dir), 0, "%s",
+               lw_test_slurp("%s/err.txt", dir));
 }
 
 /* The hanging lines at 30 ms with the regularity checks off: a mode the step
