@@ -658,10 +658,14 @@ Test(tools, failed_runs_are_reported_and_the_others_finish)
   int rc = sh("%s %s --vary init.splines=4,-1 --seeds 1-2 --set anneal.sweeps=20 --bin %s --out %s/f", tool("param-sweep"),
               scene(), env("LW_BIN"), dir);
   char *errs = err_txt();
-  cr_assert_eq(rc, 1, "%s", errs);
-  const char *first = strstr(errs, "FAILED (exit 2)");
-  cr_assert(first && strstr(first + 1, "FAILED (exit 2)"), "two failures reported: %s", errs);
-  cr_assert(strstr(errs, "init.splines"), "the reason is shown: %s", errs);
+  /* refused input, each reason in full once (a typo's was printed a run),
+  ** their folders gone, the sweep's exit bad input's */
+  cr_assert_eq(rc, 2, "%s", errs);
+  const char *first = strstr(errs, "FAILED (exit 2): linewise: --set: key 'init.splines'");
+  cr_assert(first && !strstr(first + 1, "FAILED (exit 2): linewise:") &&
+              strstr(errs, "FAILED (exit 2): refused as init.splines=-1__seed-"), "one reason, in full once: %s", errs);
+  cr_assert(strstr(errs, "param-sweep: runs were refused their input"), "%s", errs);
+  cr_assert_eq(sh("test ! -e %s/f/init.splines=-1__seed-1 && test ! -e %s/f/init.splines=-1__seed-2", dir, dir), 0);
   csv t;
   char path[128];
   snprintf(path, sizeof path, "%s/f/sweep.csv", dir);
@@ -670,6 +674,12 @@ Test(tools, failed_runs_are_reported_and_the_others_finish)
   for (int r = 0; r < 2; r++) cr_assert_str_eq(cell(&t, r, "init.splines"), "4");
   free(errs);
   free(t.text);
+  /* the value corrected into the same --out: the refused runs leave the
+  ** plan, which kept a gather failing for good */
+  cr_assert_eq(sh("%s %s --vary init.splines=4,5 --seeds 1-2 --set anneal.sweeps=20 --bin %s --out %s/f",
+                  tool("param-sweep"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
+  cr_assert_eq(sh("%s --gather-only %s/f && ! grep -qF init.splines=-1 %s/f/sweep.plan", tool("param-sweep"), dir, dir),
+               0, "%s", err_txt());
 }
 
 /* A run stopped by a signal to it alone (here: --stop-at, which ends a run as
@@ -793,7 +803,7 @@ Test(tools, job_array_tasks_then_gather_only)
 Test(tools, a_sweep_of_other_settings_is_refused_while_one_runs)
 {
   cr_assert_eq(sh("%s %s --seeds 1 --set energy.bending=abc --bin %s --out %s/r", tool("seed-sweep"), scene(),
-                  env("LW_BIN"), dir), 1);
+                  env("LW_BIN"), dir), 2);
   cr_assert_eq(sh("flock -s %s/r/.sweep.running env SLURM_ARRAY_TASK_ID=1 SLURM_SUBMIT_DIR=%s %s %s --seeds 1 " TINY
                   " --bin %s --out %s/r", dir, env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir),
                2);
@@ -863,8 +873,8 @@ Test(tools, a_failed_run_fails_the_sweep_on_a_full_disk)
   int rc = sh("PATH=%s/px:$PATH %s %s --vary init.splines=4,-1 --seeds 1 --set anneal.sweeps=20 --bin %s --out %s/f",
               dir, tool("param-sweep"), scene(), env("LW_BIN"), dir);
   char *e = err_txt();
-  cr_assert_eq(rc, 1, "%s", e);
-  cr_assert(strstr(e, "some runs failed") && !raw_error(e), "%s", e);
+  cr_assert_eq(rc, 2, "%s", e);
+  cr_assert(strstr(e, "runs were refused their input") && !raw_error(e), "%s", e);
   free(e);
 }
 
@@ -1021,7 +1031,7 @@ Test(tools, bad_usage_exits_2_with_one_message_and_writes_nothing)
   /* but a sweep whose every run was refused (a --set typo) left nothing to
   ** guard, and the corrected one takes its directory */
   cr_assert_eq(sh("%s %s --seeds 1,2 --set energy.bending=abc --bin %s --out %s/t", tool("seed-sweep"), scene(),
-                  env("LW_BIN"), dir), 1);
+                  env("LW_BIN"), dir), 2);
   cr_assert_eq(sh("%s %s --seeds 1,2 " TINY " --bin %s --out %s/t", tool("seed-sweep"), scene(), env("LW_BIN"), dir),
                0, "%s", err_txt());
   cr_assert_eq(sh("test -s %s/t/seed-1/summary.json && test -s %s/t/seed-2/summary.json", dir, dir), 0);
