@@ -795,6 +795,32 @@ Test(tools, job_array_tasks_then_gather_only)
                0, "%s", err_txt());
 }
 
+/* A file the scene names (here its schedule's table, beside it) changed
+** under a finished sweep: the rerun is refused naming it, where it skipped
+** the finished runs and gathered them beside new ones of the other file, one
+** table of two scenes; the same file again, or a sweep.conf from before the
+** files were named, reruns as before. */
+Test(tools, a_file_the_scene_names_changed_under_a_sweep_is_refused)
+{
+  cr_assert_eq(sh("mkdir %s/sc && cd %s/sc && printf '0 0.5\\n1 0.1\\n' > t.txt && printf '[scene]\\nwidth = 60\\n"
+                  "height = 60\\n[anneal]\\nschedule = table\\ntable = t.txt ; the schedule\\n' > s.ini && true", dir, dir),
+               0);
+  const char *sweep = "%s %s/sc/s.ini --seeds %s " TINY " --bin %s --out %s/w";
+  cr_assert_eq(sh(sweep, tool("seed-sweep"), dir, "1", env("LW_BIN"), dir), 0, "%s", err_txt());
+  cr_assert_eq(sh("grep -qx 'file anneal.table [0-9]* 12' %s/w/sweep.conf", dir), 0, "%s",
+               lw_test_slurp("%s/w/sweep.conf", dir));
+  cr_assert_eq(sh(sweep, tool("seed-sweep"), dir, "1-2", env("LW_BIN"), dir), 0, "%s", err_txt());
+  cr_assert_eq(sh("printf '0 0.4\\n1 0.1\\n' > %s/sc/t.txt && true", dir), 0);
+  cr_assert_eq(sh(sweep, tool("seed-sweep"), dir, "1-3", env("LW_BIN"), dir), 2);
+  char *e = err_txt();
+  cr_assert(strstr(e, "/w/sweep.conf: this directory holds a sweep of another scene, --set or --vary keys, or of "
+                      "files they name (it has: file anneal.table ") && !strstr(e, "seed-3"), "%s", e);
+  free(e);
+  /* a sweep.conf of before: no file lines, the same sweep */
+  cr_assert_eq(sh("sed -i '/^file /d' %s/w/sweep.conf", dir), 0);
+  cr_assert_eq(sh(sweep, tool("seed-sweep"), dir, "1-2", env("LW_BIN"), dir), 0, "%s", err_txt());
+}
+
 /* Two job arrays of other settings started together into one --out: the
 ** second's tasks are refused while the first's run (each ran with its own
 ** settings, and sweep.conf named one of them); with none running and no run
@@ -808,8 +834,9 @@ Test(tools, a_sweep_of_other_settings_is_refused_while_one_runs)
                   " --bin %s --out %s/r", dir, env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir),
                2);
   char *errs = err_txt();
-  cr_assert(strstr(errs, "/r/sweep.conf: a sweep is running in this directory of another scene, --set or --vary keys "
-                         "(it has: set energy.bending=abc; this sweep: set anneal.sweeps=20;"), "%s", errs);
+  cr_assert(strstr(errs, "/r/sweep.conf: a sweep is running in this directory of another scene, --set or --vary keys, "
+                         "or of files they name (it has: set energy.bending=abc; this sweep: set anneal.sweeps=20;"),
+            "%s", errs);
   free(errs);
   cr_assert_eq(sh("SLURM_ARRAY_TASK_ID=1 SLURM_SUBMIT_DIR=%s %s %s --seeds 1 " TINY " --bin %s --out %s/r",
                   env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
