@@ -1032,6 +1032,9 @@ Test(tools, bad_usage_exits_2_with_one_message_and_writes_nothing)
     {"--seeds 1,1", "twice"},
     {"--seeds 1 --seeds 1-2", "seed 1 is listed twice: in '1' and in '1-2'"}, /* two runs shared a directory */
     {"--seeds 1 --vary anneal.seed=1,2", "--seeds"},
+    /* (the runs took --seeds' and --vary's values, sweep.conf the --set's) */
+    {"--seeds 1 --set anneal.seed=5", "--set anneal.seed: every run's seed comes from --seeds"},
+    {"--seeds 1 --set anneal.sweeps=20 --vary anneal.sweeps=10,30", "varied by --vary too"},
     {"--seeds 1 --vary scene.width=a/b", "scene.width"},
     {"--seeds 1 --vary width=3", "section.key"},
     {"--seeds 1 -j 0", "-j"},
