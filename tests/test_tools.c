@@ -665,7 +665,8 @@ Test(tools, failed_runs_are_reported_and_the_others_finish)
   cr_assert(first && !strstr(first + 1, "FAILED (exit 2): linewise:") &&
               strstr(errs, "FAILED (exit 2): refused as init.splines=-1__seed-"), "one reason, in full once: %s", errs);
   cr_assert(strstr(errs, "param-sweep: runs were refused their input"), "%s", errs);
-  cr_assert_eq(sh("test ! -e %s/f/init.splines=-1__seed-1 && test ! -e %s/f/init.splines=-1__seed-2", dir, dir), 0);
+  cr_assert_eq(sh("test \"$(sort %s/f/sweep.refused | paste -sd' ')\" = 'init.splines=-1__seed-1 init.splines=-1__seed-2'",
+                  dir), 0, "%s", lw_test_slurp("%s/f/sweep.refused", dir));
   csv t;
   char path[128];
   snprintf(path, sizeof path, "%s/f/sweep.csv", dir);
@@ -680,6 +681,11 @@ Test(tools, failed_runs_are_reported_and_the_others_finish)
                   tool("param-sweep"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
   cr_assert_eq(sh("%s --gather-only %s/f && ! grep -qF init.splines=-1 %s/f/sweep.plan", tool("param-sweep"), dir, dir),
                0, "%s", err_txt());
+  /* a refusal beside a failure of another kind (a file where a run's folder
+  ** goes) is a failed sweep, exit 1, not bad input */
+  cr_assert_eq(sh("mkdir %s/g && touch %s/g/init.splines=4__seed-1 && %s %s --vary init.splines=-1,4 --seeds 1 "
+                  "--set anneal.sweeps=20 --bin %s --out %s/g", dir, dir, tool("param-sweep"), scene(), env("LW_BIN"),
+                  dir), 1, "%s", err_txt());
 }
 
 /* A run stopped by a signal to it alone (here: --stop-at, which ends a run as
@@ -819,6 +825,24 @@ Test(tools, a_file_the_scene_names_changed_under_a_sweep_is_refused)
   /* a sweep.conf of before: no file lines, the same sweep */
   cr_assert_eq(sh("sed -i '/^file /d' %s/w/sweep.conf", dir), 0);
   cr_assert_eq(sh(sweep, tool("seed-sweep"), dir, "1-2", env("LW_BIN"), dir), 0, "%s", err_txt());
+  /* inih's other spellings, a BOM and 'key: value', and a --vary over files
+  ** (each value's file; the scene's own, which no run reads, is not) */
+  cr_assert_eq(sh("cd %s/sc && cp t.txt u.txt && printf '\\357\\273\\277[anneal]\\nschedule = table\\n"
+                  "table: t.txt\\n[scene]\\nwidth = 60\\nheight = 60\\n' > b.ini && true", dir),
+               0);
+  const char *vary = "cd %s/sc && %s b.ini --seeds 1 %s " TINY " --bin %s --out %s/%s";
+  cr_assert_eq(sh(vary, dir, tool("param-sweep"), "", env("LW_BIN"), dir, "b"), 0, "%s", err_txt());
+  cr_assert_eq(sh(vary, dir, tool("param-sweep"), "--vary anneal.table=t.txt,u.txt", env("LW_BIN"), dir, "v"), 0,
+               "%s", err_txt());
+  cr_assert_eq(sh("grep -q '^file anneal.table ' %s/b/sweep.conf && grep -q '^file anneal.table=u.txt ' "
+                  "%s/v/sweep.conf && ! grep -q '^file anneal.table ' %s/v/sweep.conf", dir, dir, dir),
+               0);
+  cr_assert_eq(sh("printf '0 0.3\\n1 0.1\\n' > %s/sc/u.txt && true", dir), 0);
+  cr_assert_eq(sh(vary, dir, tool("param-sweep"), "--vary anneal.table=t.txt,u.txt", env("LW_BIN"), dir, "v"), 2);
+  cr_assert(strstr(lw_test_slurp("%s/err.txt", dir), "(it has: file anneal.table=u.txt "), "%s",
+            lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh("printf '0 0.2\\n1 0.1\\n' > %s/sc/t.txt && true", dir), 0);
+  cr_assert_eq(sh(vary, dir, tool("param-sweep"), "", env("LW_BIN"), dir, "b"), 2);
 }
 
 /* Two job arrays of other settings started together into one --out: the
