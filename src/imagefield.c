@@ -144,29 +144,30 @@ static lw_grid2d *pixel_grid(const lw_image *img, const lw_image_place *pl, lw_e
                        pl->pixel, pl->pixel, err);
 }
 
-lw_grid2d *lw_imagefield_gradient(const lw_image *img, const lw_image_place *pl, double flat, double *gentle,
-                                  lw_error *err)
+lw_grid2d *lw_imagefield_gradient(const lw_image *img, const lw_image_place *pl, double flat,
+                                  double gentle[LW_IMAGEFIELD_GENTLE], lw_error *err)
 {
   lw_grid2d *g = pixel_grid(img, pl, err);
   if (!g) return NULL;
-  size_t faded = 0;
+  size_t faded[LW_IMAGEFIELD_GENTLE] = {0};
   for (int j = 0; j < img->height; j++)
     for (int i = 0; i < img->width; i++) {
       double gx, gy;
       sobel(img, pl->pixel, i, j, &gx, &gy);
       const double slope = sqrt(gx * gx + gy * gy);
-      faded += slope > 0.0 && slope < flat;
+      for (int k = 0, f = 1; k < LW_IMAGEFIELD_GENTLE; k++, f *= 10) faded[k] += slope > 0.0 && slope * f < flat;
       double n = fmax(slope, flat);
       double *d = g->data + 2 * ((size_t)j * (size_t)img->width + (size_t)i);
       d[0] = n > 0 ? gx / n : 0.0;
       d[1] = n > 0 ? gy / n : 0.0;
     }
-  if (gentle) *gentle = (double)faded / ((double)img->width * (double)img->height);
+  for (int k = 0; gentle && k < LW_IMAGEFIELD_GENTLE; k++)
+    gentle[k] = (double)faded[k] / ((double)img->width * (double)img->height);
   return g;
 }
 
 lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, double sigma_mm, double flat,
-                             double angle, double *gentle, lw_error *err)
+                             double angle, double gentle[LW_IMAGEFIELD_GENTLE], lw_error *err)
 {
   const int w = img->width, h = img->height;
   const size_t n = (size_t)w * (size_t)h;
@@ -199,18 +200,19 @@ lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, doub
     }
   const double fc = flat * flat * cos(2 * angle), fs = flat * flat * sin(2 * angle);
   const double uc = cos(2 * angle), us = sin(2 * angle);
-  size_t fallback = 0;
+  size_t fallback[LW_IMAGEFIELD_GENTLE] = {0};
   for (size_t k = 0; k < n; k++) {
     /* (weak but coherent: a direction the picture has, under the fallback;
     ** noise has none, and a noisy grey card counted in full) */
     const double ax = (double)J22[k] - J11[k], ay = -2.0 * J12[k], own = ax * ax + ay * ay;
-    fallback += own > 0.0 && own < flat * flat * flat * flat && sqrt(own) > 0.5 * ((double)J11[k] + J22[k]);
+    if (own > 0.0 && sqrt(own) > 0.5 * ((double)J11[k] + J22[k]))
+      for (int e = 0; e < LW_IMAGEFIELD_GENTLE; e++) fallback[e] += own * pow(10.0, 4 * e) < flat * flat * flat * flat;
     double tx = ax + fc, ty = ay + fs;
     double m = sqrt(tx * tx + ty * ty);
     g->data[2 * k] = m > 0 ? tx / m : uc;
     g->data[2 * k + 1] = m > 0 ? ty / m : us;
   }
   free(J);
-  if (gentle) *gentle = (double)fallback / (double)n;
+  for (int e = 0; gentle && e < LW_IMAGEFIELD_GENTLE; e++) gentle[e] = (double)fallback[e] / (double)n;
   return g;
 }

@@ -701,20 +701,25 @@ static lw_status build_field(lw_scene *sc, const lw_params *p, double cx, double
     if (p->field == LW_FLD_ETF && !sc->field_axial)
       return bad_key(p, "scene", "field", LW_EINPUT, err,
                      "'etf' is a direction without sign: it needs energy.field_mode = axial");
-    double gentle;
+    double gentle[LW_IMAGEFIELD_GENTLE];
     f->grid = p->field == LW_FLD_ETF
               ? lw_imagefield_etf(sc->image, &sc->image_place, p->field_sigma, p->field_flat,
-                                  p->field_angle * DEG, &gentle, err)
-              : lw_imagefield_gradient(sc->image, &sc->image_place, p->field_flat, &gentle, err);
+                                  p->field_angle * DEG, gentle, err)
+              : lw_imagefield_gradient(sc->image, &sc->image_place, p->field_flat, gentle, err);
     if (!f->grid) return err->code;
     /* (three quarters: the bundled picture's smooth parts, blurred, are
     ** over half of it, and a gradient hatching there is meant to fade) */
-    if (gentle > 0.75) {
+    if (gentle[0] > 0.75) {
       size_t used = strlen(sc->note);
-      snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field_flat: over %d %% of the picture its tone "
-               "changes, but slower than field_flat (%g tone/mm), where the field %s; a smaller field_flat follows a "
-               "smooth picture there (docs/IMAGES.md)", used ? "; " : "", (int)(100.0 * gentle), p->field_flat,
-               p->field == LW_FLD_ETF ? "turns to field_angle" : "fades to 0");
+      used += (size_t)snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field_flat: over %d %% of the "
+                               "picture its tone changes, but slower than field_flat (%g tone/mm), where the field "
+                               "%s; a smaller field_flat follows a smooth picture there (", used ? "; " : "",
+                               (int)(100.0 * gentle[0]), p->field_flat,
+                               p->field == LW_FLD_ETF ? "turns to field_angle" : "fades to 0");
+      for (int k = 1; k < LW_IMAGEFIELD_GENTLE && used < sizeof sc->note; k++)
+        used += (size_t)snprintf(sc->note + used, sizeof sc->note - used, "%s%g leaves %d %%", k > 1 ? ", " : "",
+                                 p->field_flat * pow(10.0, -k), (int)(100.0 * gentle[k] + 0.5));
+      if (used < sizeof sc->note) snprintf(sc->note + used, sizeof sc->note - used, "; docs/IMAGES.md)");
     }
   }
   return LW_OK;

@@ -59,20 +59,26 @@ extern "C" {
 lw_grid2d *lw_imagefield_potential(const lw_image *img, const lw_image_place *pl, double power, double sigma,
                                    int paper, int fine, lw_error *err);
 
-/* angle: the fallback direction, radians (0 = +x, pi/2 = +y, down).
-** *gentle (may be NULL): the share of the pixels where the picture's
-** (smoothed) structure is there, coherent (its anisotropy above half its
-** trace: a direction, not noise) but under flat, so that the fallback
-** decides: a smooth picture of a scientist's field, 0..1 over a page, changes
-** by about 0.01 tone/mm everywhere, and the default field_flat made most of
-** its field the fallback's, unsaid. */
-lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, double sigma_mm, double flat,
-                             double angle, double *gentle, lw_error *err);
+/* gentle[k] (gentle may be NULL): under flat / 10^k, k < LW_IMAGEFIELD_GENTLE,
+** the share of the pixels the field_flat rule below decides: so that a
+** note can say which smaller field_flat would follow the picture (a height
+** map's contours were lost at the default, and the note named no value). */
+#define LW_IMAGEFIELD_GENTLE 3
 
-/* *gentle (may be NULL): the share of the pixels whose tone changes, but
-** slower than flat, where the field fades. */
-lw_grid2d *lw_imagefield_gradient(const lw_image *img, const lw_image_place *pl, double flat, double *gentle,
-                                  lw_error *err);
+/* angle: the fallback direction, radians (0 = +x, pi/2 = +y, down).
+** gentle: the shares of the pixels where the picture's (smoothed) structure
+** is there, coherent (its anisotropy above half its trace: a direction, not
+** noise) but under the flat, so that the fallback decides: a smooth picture
+** of a scientist's field, 0..1 over a page, changes by about 0.01 tone/mm
+** everywhere, and the default field_flat made most of its field the
+** fallback's, unsaid. */
+lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, double sigma_mm, double flat,
+                             double angle, double gentle[LW_IMAGEFIELD_GENTLE], lw_error *err);
+
+/* gentle: the shares of the pixels whose tone changes, but slower than the
+** flat, where the field fades. */
+lw_grid2d *lw_imagefield_gradient(const lw_image *img, const lw_image_place *pl, double flat,
+                                  double gentle[LW_IMAGEFIELD_GENTLE], lw_error *err);
 
 #ifdef __cplusplus
 }
