@@ -201,12 +201,14 @@ lw_grid2d *lw_imagefield_etf(const lw_image *img, const lw_image_place *pl, doub
   const double fc = flat * flat * cos(2 * angle), fs = flat * flat * sin(2 * angle);
   const double uc = cos(2 * angle), us = sin(2 * angle);
   size_t fallback[LW_IMAGEFIELD_GENTLE] = {0};
+  double below[LW_IMAGEFIELD_GENTLE]; /* (flat / 10^e)^4 */
+  for (int e = 0; e < LW_IMAGEFIELD_GENTLE; e++) below[e] = pow(flat * pow(10.0, -e), 4);
   for (size_t k = 0; k < n; k++) {
     /* (weak but coherent: a direction the picture has, under the fallback;
     ** noise has none, and a noisy grey card counted in full) */
     const double ax = (double)J22[k] - J11[k], ay = -2.0 * J12[k], own = ax * ax + ay * ay;
     if (own > 0.0 && sqrt(own) > 0.5 * ((double)J11[k] + J22[k]))
-      for (int e = 0; e < LW_IMAGEFIELD_GENTLE; e++) fallback[e] += own * pow(10.0, 4 * e) < flat * flat * flat * flat;
+      for (int e = 0; e < LW_IMAGEFIELD_GENTLE; e++) fallback[e] += own < below[e];
     double tx = ax + fc, ty = ay + fs;
     double m = sqrt(tx * tx + ty * ty);
     g->data[2 * k] = m > 0 ? tx / m : uc;
