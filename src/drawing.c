@@ -437,6 +437,7 @@ void lw_drawing_report_json(lw_json *j, const lw_drawing_report *rep)
   count(j, "cut", r->cut);
   count(j, "outside", r->outside);
   count(j, "dropped", r->dropped);
+  count(j, "off_page", rep->off_page);
   lw_json_key(j, "crop_mm");
   if (rep->cropped) {
     lw_json_begin_array(j);
@@ -505,10 +506,17 @@ void lw_drawing_lost_text(const lw_drawing_report *d, char *buf, size_t n)
   const int close = isnan(d->close_share), fid = d->fidelity_lost;
   if (!n) return;
   buf[0] = '\0';
+  int w = 0;
   if (close || fid)
-    snprintf(buf, n, "memory ran out scoring the drawing: summary.json's %s null (a redraw where there is more "
-             "memory scores it: docs/FORMATS.md, \"Redrawing a finished run\")",
-             close && fid ? "close_share and fidelity are" : close ? "close_share is" : "fidelity is");
+    w = snprintf(buf, n, "memory ran out scoring the drawing: summary.json's %s null (a redraw where there is more "
+                 "memory scores it: docs/FORMATS.md, \"Redrawing a finished run\")",
+                 close && fid ? "close_share and fidelity are" : close ? "close_share is" : "fidelity is");
+  /* (said under --quiet too, as a warning: the plotter's files drive the pen
+  ** off the paper, and a quiet script heard nothing) */
+  if (d->off_page && w >= 0 && (size_t)w < n)
+    snprintf(buf + w, n - (size_t)w, "%s%zu path%s reach%s past the page's edge (plot.crop = 0 keeps them whole): a "
+             "plotter would draw off the paper", w ? "; " : "", d->off_page, d->off_page == 1 ? "" : "s",
+             d->off_page == 1 ? "es" : "");
 }
 
 void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
@@ -528,11 +536,6 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
                    d->time_s, d->pen_down_mm, r->lifts_after, r->lifts_after == 1 ? "" : "s", close);
   if (w < 0 || (size_t)w >= n) return;
   k = (size_t)w;
-  if (d->off_page) {
-    w = snprintf(buf + k, n - k, "linewise: %zu paths reach past the page's edge (plot.crop = 0 keeps them whole): a "
-                 "plotter would draw off the paper\n", d->off_page);
-    if (w < 0 || (k += (size_t)w) >= n) return;
-  }
   if (!d->paths) {
     w = snprintf(buf + k, n - k, "linewise: the drawing is empty: final.svg has no path%s%s\n",
                  d->empty_why[0] ? ": " : "", d->empty_why);

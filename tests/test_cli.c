@@ -2457,6 +2457,15 @@ Test(cli, paths_past_the_page_kept_by_crop_0_are_said)
       cr_assert(c, "%s", errs);
       while (c > errs && c[-1] >= '0' && c[-1] <= '9') c--;
       past = strtoul(c, NULL, 10);
+      /* a warning, said under --quiet too, and counted in summary.json */
+      cr_assert_eq(c - strlen("linewise: warning: "), strstr(errs, "linewise: warning: "), "%s", errs);
+      char quiet[sizeof args + 16];
+      snprintf(quiet, sizeof quiet, "%s --quiet", args);
+      memcpy(strstr(quiet, "/h0 --quiet"), "/q0", 3);
+      cr_assert_eq(run(quiet, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
+      cr_assert_null(strstr(errs, "paths ("), "quiet: %s", errs);
+      cr_assert(strstr(errs, "linewise: warning: ") && strstr(errs, " past the page's edge"), "%s", errs);
+      cr_assert_eq(lw_test_sh("grep -q '\"off_page\": %zu,' %s/q0/summary.json", past, dir), 0);
     } else {
       cr_assert(c && !strstr(errs, "reach past the page"), "%s", errs);
       while (c > errs && c[-1] >= '0' && c[-1] <= '9') c--;
