@@ -323,17 +323,22 @@ Test(nurbs_cli, a_refined_wire_runs_resumes_and_refuses_a_step_past_its_stabilit
                0);
   /* damped lightly too (gamma = 0.1 ran on to t = 0.016 s before failing),
   ** with the limit at that damping; heavily, the decay within the kicks
-  ** holds it (z = gamma dt / 2 rho = 4000: stable to about 2 gamma / rho
-  ** omega_max^2 = 0.29 s), and it runs; the bundled Figure 8b damping at the
+  ** holds it (z = gamma dt / 2 rho = 133 at rho = 30: stable to about
+  ** 2 gamma / rho omega_max^2 = 0.00977 s, 12.8 times 2 / omega_max), and it
+  ** runs, refused just past it; the bundled Figure 8b damping at the
   ** unrefined wire's own dt runs */
-  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/d --quiet %s --set dynamics.gamma=0.1 2> %s/err.txt; test $? "
-                  "-eq 2 && grep -q 'past the leapfrog.s stability limit at gamma = 0.1, 0.000766 s, of this curve .*take dt <= "
-                  "0.00069' %s/err.txt && ! test -e %s/d",
-                  lw_test_bin(), lw_test_root(), dir, wire, dir, dir, dir),
+  const char *damped = "%s run %s/params/wire.ini --out %s/d --quiet %s --set dynamics.gamma=%s --set dynamics.dt=%s "
+                       "--set anneal.sweeps=2 2> %s/err.txt";
+  cr_assert_eq(sh(damped, lw_test_bin(), lw_test_root(), dir, wire, "0.1", "0.008", dir), 2);
+  cr_assert_eq(sh("grep -q 'past the leapfrog.s stability limit at gamma = 0.1, 0.000766 s, of this curve .*take dt "
+                  "<= 0.00069' %s/err.txt && ! test -e %s/d", dir, dir),
                0, "%s", lw_test_slurp("%s/err.txt", dir));
-  cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/d --quiet %s --set dynamics.gamma=1e6 --set anneal.sweeps=2",
-                  lw_test_bin(), lw_test_root(), dir, wire),
-               0);
+  cr_assert_eq(sh(damped, lw_test_bin(), lw_test_root(), dir, wire, "1e6", "0.0098", dir), 2);
+  cr_assert_eq(sh("grep -q 'stability limit at gamma = 1e+06, 0.00977 s, of this curve .*take dt <= 0.0088' "
+                  "%s/err.txt", dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(sh(damped, lw_test_bin(), lw_test_root(), dir, wire, "1e6", "0.0097", dir), 0, "%s",
+               lw_test_slurp("%s/err.txt", dir));
   cr_assert_eq(sh("%s run %s/params/wire.ini --out %s/d --quiet --set dynamics.gamma=5 --set anneal.sweeps=2",
                   lw_test_bin(), lw_test_root(), dir), 0);
   /* which takes the review's dt on the refined wire, in one CG iteration a step */
