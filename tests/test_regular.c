@@ -73,6 +73,17 @@ Test(regular, min_speed_finds_cusps_and_interior_minima)
   lw_node s0 = {0, 0, 2, 0}, s1 = {6, 0, 2, 0};
   cr_assert_float_eq(lw_segment_min_speed(&s0, &s1), 6.0, 1e-12);
   cr_assert(lw_segment_rho(&s0, &s1) == INFINITY);
+  /* the exact ellipse test's degenerate cases (a mutation tester's finds):
+  ** a straight segment whose hodograph 3 (t - 2)^2 has a double root (a
+  ** zero discriminant), rho 5.83, passes at 2.6; a zero speed at t = 0 with
+  ** B = 0 (no second root: q = 0), and a point, are refused */
+  lw_node d0 = {0, 0, 4, 0}, d1 = {7, 0, 1, 0};
+  cr_assert(lw_segment_check(&d0, &d1, 0.0, 2.6) && lw_segment_check(&d0, &d1, 0.4, 2.6));
+  cr_assert_float_eq(lw_segment_rho(&d0, &d1), 3.0 + sqrt(8.0), 1e-12);
+  cr_assert(!lw_segment_check(&d0, &d1, 0.0, 5.9), "the double root at t = 2 lies inside rho 5.9");
+  lw_node z0 = {0, 0, 0, 0}, z1 = {1, 0, 1, 0}, p1 = {0, 0, 0, 0};
+  cr_assert(!lw_segment_check(&z0, &z1, 0.0, 2.6), "zero speed at t = 0");
+  cr_assert(!lw_segment_check(&z0, &p1, 0.0, 2.6), "a point");
   /* non-finite input is never regular */
   lw_node bad = {NAN, 0, 1, 0};
   cr_assert(!lw_segment_check(&bad, &s1, 0.1, 0.0));
