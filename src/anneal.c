@@ -1569,12 +1569,15 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   ** scene.ini alone were copied to another machine, or from before
   ** 2026-12-04), the rate counts this process's proposals over its own
   ** sweeps: every proposal over them gave a rate many times too high. */
-  int timed = 0, wall = 0;
+  int timed = 0, wall = 0, got = 0;
   if (tf) {
     wall = fscanf(tf, "wall_seconds %lf", &a->wall_before) == 1 && a->wall_before >= 0 && a->wall_before < 1e12;
     if (!wall) a->wall_before = 0;
-    timed = wall && fscanf(tf, " sweep_seconds %lf", &a->sweep_seconds) == 1 && a->sweep_seconds >= 0 &&
+    timed = wall && (got = fscanf(tf, " sweep_seconds %lf", &a->sweep_seconds)) == 1 && a->sweep_seconds >= 0 &&
             a->sweep_seconds < 1e12;
+    /* (the wall time alone is an older release's; a line after it that is
+    ** no sweep time is damage: unreadable, timed from here on) */
+    if (wall && !timed && got != EOF) a->wall_before = 0, wall = 0;
     if (timed && fscanf(tf, " untimed_proposals %lu", &a->untimed) != 1) a->untimed = 0;
     fclose(tf);
   }
