@@ -205,7 +205,7 @@ const lw_param_def lw_param_table[] = {
          "Which way field_file's rows and its v go: up, the first row at the bottom of the grid and v up the "
          "page (NumPy's meshgrid of increasing y, matplotlib's origin = 'lower'); down, the first row at the "
          "top and v down the page (a picture's rows, the page's y). In a list of points: the way its y "
-         "column grows, up (north up, as GIS tools write it) or down the page."),
+         "column and v grow, up (north up, as GIS tools write them) or down the page."),
   CHOICE("scene", "field_file_scale", field_file_scale, "unit", "unit|max|none",
          "What field_file's lengths mean: unit, each vector made length 1 (the lines follow its direction "
          "alone, however weak the flow); max, all divided by the longest (a weak flow steers less); none, as "

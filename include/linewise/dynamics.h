@@ -91,7 +91,7 @@ typedef struct {
 ** damping took + the most kinetic energy) above its lowest is said to have
 ** risen (lw_dynamics_rise_note): a mode the step cannot hold was growing,
 ** below the blow-up above (an engineer's run at a step too long ended
-** "done", its lines strained 16 %, E + K up 550 from its lowest). */
+** "done", its lines strained 16 %, E + K up hundreds from its lowest). */
 #define LW_DYN_RISE_NOTE 0.01
 
 /* A warning into buf (n bytes) where a damped motion's E + K ended risen
