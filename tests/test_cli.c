@@ -755,17 +755,25 @@ Test(cli, an_older_releases_state_a_later_check_refuses_says_what_is_left)
                           "'s/^pair_cutoff = .*/pair_cutoff = 0.3/' o/scene.ini && cp -r o same && sed -i "
                           "'s/^; written by linewise .*/; written by linewise 2026.12, build 0123/' o/scene.ini", dir),
                0);
-  static const char *const cmd[] = {"resume %s/o --quiet", "energy %s/o", "resume %s/same --quiet"};
-  for (int k = 0; k < 3; k++) {
+  /* and a line within the boundary's clearance */
+  cr_assert_eq(lw_test_sh("cd %s && cp -r same b && sed -i 's/^pair_cutoff = .*/pair_cutoff = 6/; "
+                          "s/^boundary_clearance = .*/boundary_clearance = 100/; "
+                          "s/^; written by linewise .*/; written by linewise 2026.12, build 0123/' b/scene.ini", dir),
+               0);
+  static const char *const cmd[] = {"resume %s/o --quiet", "energy %s/o", "resume %s/same --quiet",
+                                    "resume %s/b --quiet"};
+  for (int k = 0; k < 4; k++) {
     snprintf(args, sizeof args, cmd[k], dir);
     cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 2, "%s", args);
-    cr_assert(strstr(errs, "too long for the pair cutoff"), "%s: %s", args, errs);
+    cr_assert(strstr(errs, k == 3 ? "boundary energy is not finite" : "too long for the pair cutoff"), "%s: %s",
+              args, errs);
     if (k == 2) {
       cr_assert(!strstr(errs, "begun by"), "this build's own run: %s", errs);
       continue;
     }
     cr_assert(strstr(errs, "(the run was begun by linewise 2026.12, build 0123, which let this state through: ") &&
-              strstr(errs, "/o/state.lw --set anneal.sweeps=0' with that key set there") &&
+              strstr(errs, k == 3 ? "/b/state.lw --set anneal.sweeps=0' with that key set there" :
+                                    "/o/state.lw --set anneal.sweeps=0' with that key set there") &&
               strstr(errs, "\"Runs of older releases\")\n"), "%s: %s", args, errs);
     cr_assert_eq(strstr(errs, "linewise:"), errs, "one message: %s", errs);
     cr_assert_null(strstr(errs + 1, "linewise:"), "one message: %s", errs);

@@ -675,6 +675,10 @@ Test(tools, failed_runs_are_reported_and_the_others_finish)
   for (int r = 0; r < 2; r++) cr_assert_str_eq(cell(&t, r, "init.splines"), "4");
   free(errs);
   free(t.text);
+  /* the same sweep again: its refused runs stay planned (they are its own) */
+  cr_assert_eq(sh("%s %s --vary init.splines=4,-1 --seeds 1-2 --set anneal.sweeps=20 --bin %s --out %s/f",
+                  tool("param-sweep"), scene(), env("LW_BIN"), dir), 2);
+  cr_assert_eq(sh("test $(grep -c 'init.splines=-1' %s/f/sweep.plan) = 2", dir), 0);
   /* the value corrected into the same --out: the refused runs leave the
   ** plan, which kept a gather failing for good */
   cr_assert_eq(sh("%s %s --vary init.splines=4,5 --seeds 1-2 --set anneal.sweeps=20 --bin %s --out %s/f",
