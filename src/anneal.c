@@ -1578,7 +1578,13 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
     /* (the wall time alone is an older release's; a line after it that is
     ** no sweep time is damage: unreadable, timed from here on) */
     if (wall && !timed && got != EOF) a->wall_before = 0, wall = 0;
-    if (timed && fscanf(tf, " untimed_proposals %lu", &a->untimed) != 1) a->untimed = 0;
+    /* (a count that is no whole number from 0 to 2^53 is damage: "-7" read
+    ** as 2^64 - 7 gave a rate of 0) */
+    double untimed = 0.0;
+    got = timed ? fscanf(tf, " untimed_proposals %lf", &untimed) : EOF;
+    if (got == 1 && untimed >= 0.0 && untimed <= 9007199254740992.0 && untimed == floor(untimed))
+      a->untimed = (unsigned long)untimed;
+    else if (got != EOF) timed = 0, a->wall_before = 0, wall = 0;
     fclose(tf);
   }
   if (!timed) {

@@ -461,6 +461,10 @@ lw_status lw_ckpt_unread(const lw_ckpt *c, lw_error *err)
 
 lw_status lw_ckpt_begin(lw_ckpt_writer *w, const char *path, const char *header, lw_error *err)
 {
+  /* (a host that set a comma locale wrote "30,94 12,68" and LW_OK: a state
+  ** that neither it nor linewise could read back) */
+  lw_error mine;
+  if (lw_number_locale_ok(err ? err : &mine)) return err ? err->code : LW_EINPUT;
   snprintf(w->path, sizeof w->path, "%s", path);
   w->f = lw_output_open_tmp(w->path, w->tmp, sizeof w->tmp, err);
   if (!w->f) return err ? err->code : LW_EIO;

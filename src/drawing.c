@@ -514,9 +514,9 @@ void lw_drawing_lost_text(const lw_drawing_report *d, char *buf, size_t n)
   /* (said under --quiet too, as a warning: the plotter's files drive the pen
   ** off the paper, and a quiet script heard nothing) */
   if (d->off_page && w >= 0 && (size_t)w < n)
-    snprintf(buf + w, n - (size_t)w, "%s%zu path%s reach%s past the page's edge (plot.crop = 0 keeps them whole): a "
+    snprintf(buf + w, n - (size_t)w, "%s%zu path%s reach%s past the page's edge (plot.crop = 0 keeps %s whole): a "
              "plotter would draw off the paper", w ? "; " : "", d->off_page, d->off_page == 1 ? "" : "s",
-             d->off_page == 1 ? "es" : "");
+             d->off_page == 1 ? "es" : "", d->off_page == 1 ? "it" : "them");
 }
 
 void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)

@@ -359,8 +359,8 @@ void lw_dynamics_rise_note(const lw_dynamics *d, char *buf, size_t n)
 {
   buf[0] = '\0';
   if (!(d->rho > 0.0) || (d->gamma == 0.0 && !d->pair_dampers) || isnan(d->h_ref)) return;
-  const double rise = d->h_last - d->h_min, scale = (d->h_ref - d->h_min) + d->k_max;
-  if (rise > LW_DYN_RISE_NOTE * scale && rise > 0.0)
+  const double rise = d->h_last - d->h_min, took = d->h_ref - d->h_min, scale = took + d->k_max;
+  if (rise > LW_DYN_RISE_NOTE * scale && took > d->k_max && rise > 1e-9 * d->h_scale)
     snprintf(buf, n, "the damped motion's E + K ended %.3g above its lowest (%.10g at t = %g s), %.2g of the energy "
              "in motion (damped plus the most kinetic), where damping only lowers it: a mode the step cannot hold "
              "was growing; lower dynamics.dt (now %g s) and run it again", rise, d->h_min, d->h_min_time,

@@ -88,8 +88,10 @@ double lw_energy_gradient(const lw_scene *sc, const lw_splines *sp, unsigned ter
   for (int t = 0; t < LW_TERM_COUNT; t++) {
     const lw_term_type *r = &lw_term_types[t];
     if (sc->on[t] && selected(term_mask, t) && !r->segment_grad && !r->spline_grad && !r->pairwise && !r->raster) {
-      lw_error_set(err, LW_EINPUT, "the %s term has no gradient (energy.%s): the dynamics and the quench need "
-                   "one; leave the term out", lw_term_names[t], lw_term_names[t]);
+      /* (the user term has no key: it named 'energy.user', no parameter) */
+      lw_error_set(err, LW_EINPUT, "the %s term has no gradient (%s%s): the dynamics and the quench need one; "
+                   "leave the term out", lw_term_names[t], t == LW_TERM_USER ? "the library's " : "energy.",
+                   t == LW_TERM_USER ? "lw_scene_set_user_term" : lw_term_names[t]);
       return NAN;
     }
   }

@@ -286,11 +286,15 @@ static void older_state_note(const lw_params *p, const char *dir, lw_error *err)
 {
   char this_build[64], word[LW_RUNDIR_WORD_MAX];
   snprintf(this_build, sizeof this_build, "%s, build %s", LW_VERSION, lw_version_build());
+  /* (without a clearance a boundary refusal is a line outside the frame,
+  ** which no release let through) */
   if (err->code != LW_EINPUT || !p->run_header || !strcmp(p->run_build, this_build) ||
-      (!strstr(err->msg, "too long for the pair cutoff") && !strstr(err->msg, "boundary energy is not finite")))
+      (!strstr(err->msg, "too long for the pair cutoff") &&
+       !(strstr(err->msg, "boundary energy is not finite") && p->boundary_clearance > 0.0)))
     return;
   const size_t n = strlen(err->msg);
-  lw_rundir_shell_word(dir, word, sizeof word);
+  /* (a path that long would cut the message short of its end: DIR then) */
+  if (strlen(lw_rundir_shell_word(dir, word, sizeof word)) > 256) snprintf(word, sizeof word, "DIR");
   snprintf(err->msg + n, sizeof err->msg - n, " (the run was begun by %s%s, which let this state through: it does "
            "not resume here ('linewise energy' measures it with that key changed by --set); a redraw of it is a "
            "new run, 'linewise run %s/scene.ini --set init.from=%s/state.lw "

@@ -1975,7 +1975,9 @@ int lw_params_write(const lw_params *p, FILE *f)
     if (d->list) lw_params_write_list(f, d, buf);
     else fprintf(f, "%s = %s\n", d->key, buf);
   }
-  return ferror(f) ? -1 : 0;
+  /* (a comma locale wrote "t_end = 0,01" and 0: no scene reads it back) */
+  lw_error comma;
+  return ferror(f) || lw_number_locale_ok(&comma) ? -1 : 0;
 }
 
 /* The files a run reads as it starts: every key naming one, but a file its

@@ -711,14 +711,17 @@ static lw_status build_field(lw_scene *sc, const lw_params *p, double cx, double
     ** over half of it, and a gradient hatching there is meant to fade) */
     if (gentle[0] > 0.75) {
       size_t used = strlen(sc->note);
-      used += (size_t)snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field_flat: over %d %% of the "
-                               "picture its tone changes, but slower than field_flat (%g tone/mm), where the field "
-                               "%s; a smaller field_flat follows a smooth picture there (", used ? "; " : "",
-                               (int)(100.0 * gentle[0]), p->field_flat,
-                               p->field == LW_FLD_ETF ? "turns to field_angle" : "fades to 0");
+      /* (shares rounded down alike: a tenth of field_flat, rounded up, left
+      ** "100 %" where field_flat itself left "over 99 %") */
+      char share[32] = "all";
+      if (gentle[0] < 1.0) snprintf(share, sizeof share, "over %d %%", (int)(100.0 * gentle[0]));
+      used += (size_t)snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field_flat: %s of the picture "
+                               "its tone changes, but slower than field_flat (%g tone/mm), where the field %s; a "
+                               "smaller field_flat follows a smooth picture there (", used ? "; " : "", share,
+                               p->field_flat, p->field == LW_FLD_ETF ? "turns to field_angle" : "fades to 0");
       for (int k = 1; k < LW_IMAGEFIELD_GENTLE && used < sizeof sc->note; k++)
         used += (size_t)snprintf(sc->note + used, sizeof sc->note - used, "%s%g leaves %d %%", k > 1 ? ", " : "",
-                                 p->field_flat * pow(10.0, -k), (int)(100.0 * gentle[k] + 0.5));
+                                 p->field_flat * pow(10.0, -k), (int)(100.0 * gentle[k]));
       if (used < sizeof sc->note) snprintf(sc->note + used, sizeof sc->note - used, "; docs/IMAGES.md)");
     }
   }

@@ -14,12 +14,18 @@
 #include <gsl/gsl_errno.h>
 
 #include "linewise/anneal.h"
+#include "linewise/memlimit.h"
+#include "linewise/version.h"
 
 int main(int argc, char **argv)
 {
   const bool resume = argc == 4 && !std::strcmp(argv[1], "--resume");
   if (argc != 3 && !resume) {
-    std::fprintf(stderr, "usage: embed SCENE.ini DIR | embed --resume DIR N\n");
+    // (which library, and the memory it sees: two headers that lacked
+    // extern "C", so a C++ host could not link these calls)
+    const char *by = "";
+    std::fprintf(stderr, "usage: embed SCENE.ini DIR | embed --resume DIR N (linewise %s, build %s; %g bytes, %s)\n",
+                 LW_VERSION, lw_version_build(), lw_memory_limit(&by), by);
     return 2;
   }
   // a program that takes the user's locale keeps LC_NUMERIC at "C" (README)

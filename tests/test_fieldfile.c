@@ -482,8 +482,9 @@ Test(fieldfile, a_picture_smoother_than_field_flat_gets_a_note)
       cr_assert_eq(lw_scene_init(&sc, &p, &err), LW_OK, "%s", err.msg);
       if (smaller) cr_assert_null(strstr(sc.note, "field_flat"), "%s", sc.note);
       else
-        /* with the value that follows it (the ramp's 0.0044 tone/mm) */
-        cr_assert(strstr(sc.note, "scene.field_flat: over") &&
+        /* with the value that follows it (the ramp's 0.0044 tone/mm); all of
+        ** it, not "over 100 %" */
+        cr_assert(strstr(sc.note, "scene.field_flat: all of the picture its tone changes") &&
                   strstr(sc.note, field == LW_FLD_ETF ? "turns to field_angle" : "fades to 0") &&
                   strstr(sc.note, "smooth picture there (0.001 leaves 0 %, 0.0001 leaves 0 %; docs/IMAGES.md)"),
                   "%s", sc.note);

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "linewise/anneal.h"
+#include "linewise/ckpt.h"
 #include "linewise/driver.h"
 #include "linewise/number.h"
 #include "linewise/params.h"
@@ -904,7 +905,19 @@ Test(params, a_decimal_comma_locale_is_refused_with_the_way_round)
   cr_assert_not_null(setlocale(LC_NUMERIC, "de_DE.UTF-8"));
   cr_assert_eq(lw_anneal_sweep(&a, &err), LW_EUSAGE);
   cr_assert(strstr(err.msg, "LC_NUMERIC"), "%s", err.msg);
+  /* the library's own writers, called by a host, refuse too (a state of
+  ** "30,94 12,68" and a scene of "t_end = 0,01" were written with success) */
+  lw_ckpt_writer w;
+  char path[128];
+  snprintf(path, sizeof path, "%s/state.lw", dir);
+  cr_assert_eq(lw_ckpt_begin(&w, path, "linewise-state 2", &err), LW_EUSAGE);
+  cr_assert(strstr(err.msg, "LC_NUMERIC"), "%s", err.msg);
+  cr_assert_neq(access(path, F_OK), 0);
+  FILE *f = fopen("/dev/null", "w");
+  cr_assert_eq(lw_params_write(&p, f), -1, "a scene of decimal commas written");
   setlocale(LC_NUMERIC, "C");
+  cr_assert_eq(lw_params_write(&p, f), 0);
+  fclose(f);
   lw_anneal_free(&a);
   cr_assert_eq(lw_test_sh("test $(awk -F, 'NR == 1 { n = NF } NF != n' %s/trace.csv | wc -l) -eq 0 && "
                           "test $(wc -l < %s/trace.csv) -eq 2", out, out),

@@ -16,6 +16,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "linewise/version.h"
 #include "testutil.h"
 
 static char dir[64];
@@ -1589,6 +1590,13 @@ Test(tools, an_installed_library_embeds_in_cxx_through_its_pkg_config, .timeout 
   char *names = out_txt();
   cr_assert_eq(names[0], '\0', "global names outside lw_: %s", names);
   free(names);
+  /* (its usage line names the release and build, and the memory it sees:
+  ** version.h and memlimit.h lacked extern "C", and a C++ host could not
+  ** link them) */
+  cr_assert_eq(sh("cd %s && ./embed", dir), 2);
+  char *usage = err_txt();
+  cr_assert(strstr(usage, "(linewise " LW_VERSION ", build "), "%s", usage);
+  free(usage);
   cr_assert_eq(sh("cd %s && { ./embed %s e && %s run %s --quiet --out c; }", dir, scene(), env("LW_BIN"), scene()),
                0, "%s", err_txt());
   cr_assert_eq(sh("cd %s && for f in state.lw trace.csv final.svg scene.ini; do cmp e/$f c/$f || exit 1; done && "

@@ -123,7 +123,8 @@ typedef struct lw_anneal {
 ** dir (bad input is reported before anything is written).  The directory's
 ** lock keeps other processes out, not this one: a program must not run two
 ** anneals into one directory at once (the second would replace the first's
-** files); runs into other directories may go on in threads of their own.
+** files); runs into other directories may go on in threads of their own,
+** up to 64 open at once in one process (LW_ERUN past that).
 ** The threads a run uses are OpenMP's (omp_set_num_threads, OMP_NUM_THREADS),
 ** and its results do not depend on their count (a run of several rungs split
 ** into domains, on more threads than rungs, nests its parallel regions: it

@@ -91,8 +91,11 @@ typedef struct {
 ** damping took + the most kinetic energy) above its lowest is said to have
 ** risen (lw_dynamics_rise_note): a mode the step cannot hold was growing,
 ** below the blow-up above (an engineer's run at a step too long ended
-** "done", its lines strained 16 %, E + K up hundreds from its lowest). */
-#define LW_DYN_RISE_NOTE 0.01
+** "done", its lines strained 16 %, E + K up hundreds from its lowest).  Only
+** where the damping took more than the most kinetic energy (a barely damped
+** stable motion's energy error wobbles by a percent or two of it) and past
+** rounding (a resume at rest rose by 1e-11, "0.5 of the energy in motion"). */
+#define LW_DYN_RISE_NOTE 0.1
 
 /* A warning into buf (n bytes) where a damped motion's E + K ended risen
 ** from its lowest by more than LW_DYN_RISE_NOTE, else "". */

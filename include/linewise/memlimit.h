@@ -6,6 +6,10 @@
 #ifndef LINEWISE_MEMLIMIT_H
 #define LINEWISE_MEMLIMIT_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* The least of the limits, in bytes (INFINITY where none is known), and in
 ** *by what sets it ("this machine's memory", ...). */
 double lw_memory_limit(const char **by);
@@ -17,5 +21,9 @@ double lw_memory_limit(const char **by);
 ** sought without its leading parts (the container sees its own group as
 ** the root).  INFINITY where none is set. */
 double lw_memory_cgroup_limit(const char *cgroup_text, const char *root);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

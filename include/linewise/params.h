@@ -387,7 +387,9 @@ unsigned long long lw_params_run_hash(const lw_params *p, lw_run_keys *keys);
 ** given as having no effect. */
 int lw_params_file_idle(const lw_params *p, const lw_param_def *d);
 
-/* Writes every parameter as an INI file that reads back to the same values. */
+/* Writes every parameter as an INI file that reads back to the same values;
+** -1 where writing failed, or the locale writes decimal commas (setlocale's
+** LC_NUMERIC: the file would not read back). */
 int lw_params_write(const lw_params *p, FILE *f);
 
 /* Comment lines for a run's scene.ini, below its header: the release, and

@@ -10,6 +10,10 @@
 
 #define LW_VERSION "2026.12"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* The commit the build was made from (12 hex digits, "-dirty" after them
 ** where files differed from it), or "unknown" outside a git checkout: a
 ** release spans many changes that alter a run's files. */
@@ -21,5 +25,9 @@ const char *lw_version_build(void);
 ** 1.6.39, zlib 1.2.13", cut to n bytes. */
 const char *lw_version_compiler(void);
 void lw_version_libraries(char *buf, size_t n);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif
