@@ -495,7 +495,11 @@ typedef struct {
 
 static double table_temperature(const rw_table *tab, int j)
 {
-  return tab->tlo * pow(tab->thi / tab->tlo, (double)j / (tab->n_temps - 1));
+  const double x = (double)j / (tab->n_temps - 1), r = tab->thi / tab->tlo;
+  /* (a ladder from 1e-300 to 1e300: the ratio overflowed, every temperature
+  ** after the first inf; its logarithms do not) */
+  if (r < INFINITY) return tab->tlo * pow(r, x);
+  return j == tab->n_temps - 1 ? tab->thi : exp(log(tab->tlo) + (log(tab->thi) - log(tab->tlo)) * x);
 }
 
 /* The B resamples' estimates about est, summed: d and d^2 of the energy
@@ -824,7 +828,10 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
       double m = sum[2 * v] / B;
       se[v] = sqrt(fmax(sum[2 * v + 1] / B - m * m, 0.0) * B / (B - 1));
     }
-    if (in_gap(&tab, j))
+    /* (an estimate past the doubles at a ladder's extreme ends, 1e-300:
+    ** "-nan" where the documented row is empty) */
+    const int defined = isfinite(est[0]) && isfinite(est[1]) && isfinite(se[0]) && isfinite(se[1]);
+    if (in_gap(&tab, j) || !defined)
       fprintf(out, sel[0].csv ? "%.10g,,,,\n" : "%15.6g %17s %11s %15s %11s\n", T, "-", "-", "-", "-");
     else if (sel[0].csv)
       fprintf(out, "%.10g,%.10g,%.4g,%.10g,%.4g\n", T, est[0], se[0], est[1], se[1]);
@@ -836,7 +843,8 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
   for (int g = 0; apart && g < tab.n_gaps; g++)
     fprintf(apart, "warning: no estimate between T = %.6g and %.6g: the rungs there share almost no energies "
             "(overlap %.3g, under %g), and each side is reweighted alone (more rungs between them)\n",
-            1.0 / tab.gap[g].b_hi, 1.0 / tab.gap[g].b_lo, tab.gap[g].overlap, LW_REWEIGHT_OVERLAP_MIN);
+            1.0 / tab.gap[g].b_hi, 1.0 / tab.gap[g].b_lo, isnan(tab.gap[g].overlap) ? 0.0 : tab.gap[g].overlap,
+            LW_REWEIGHT_OVERLAP_MIN);
   if (apart && tab.inconsistent)
     fprintf(apart, "warning: %d rung%s own mean energy is not what the reweighting gives at %s temperature (the "
             "worst: T = %.6g, %.10g +- %.2g, reweighted %.10g): the rungs do not sample one system's laws (one not "

@@ -524,7 +524,9 @@ lw_trace *lw_trace_with_heat_capacity(const lw_trace *t, const size_t *rows, siz
     }
     /* one energy has no variance, and two give two equal squares (an error
     ** bar of 0): left empty */
-    if (!same || !(T > 0.0) || m < 3) continue;
+    /* (a temperature whose square underflows or overflows, 1e-170: Var(E) /
+    ** T^2 printed inf and -nan where summary.json has null) */
+    if (!same || !(T * T > 0.0 && T * T < INFINITY) || m < 3) continue;
     for (size_t i = 0; i < n; i++) {
       double d = at(t, rows[i], energy[j]) - mean;
       h->v[rows[i] * cols + t->n_cols + (size_t)j] = d * d / (T * T);

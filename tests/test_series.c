@@ -754,6 +754,14 @@ Test(trace, the_heat_capacity_is_the_energy_variance_over_t_squared, .init = mak
   report_of(t, &sel, out, sizeof out);
   cr_assert(strstr(out, "\nheat_capacity,4,0.25,"), "Var 1 / T^2 4: %s", out);
   lw_trace_free(t);
+  /* at a temperature whose square underflows (1e-170, a legal t_start) it
+  ** is undefined, as at 0: empty fields, where it printed inf and -nan */
+  write_trace("v.csv", "sweep,temperature,total\n1,1e-170,1\n2,1e-170,3\n3,1e-170,1\n4,1e-170,3\n", path,
+              sizeof path);
+  t = lw_trace_read(path, &err);
+  report_of(t, &sel, out, sizeof out);
+  cr_assert(strstr(out, "\nheat_capacity,0,,") && !strstr(out, "inf") && !strstr(out, "nan"), "%s", out);
+  lw_trace_free(t);
   free(text);
   gsl_rng_free(r);
 }
@@ -1044,6 +1052,20 @@ Test(reweight, rungs_that_share_no_energies_give_no_estimate_between_them, .init
   cr_assert(strstr(out, "warning: no estimate between T = 1 and 2: the rungs there share almost no energies")
             && strstr(out, "warning: no estimate between T = 2 and 2.5:") && strstr(out, "overlap at least "), "%s",
             out);
+  /* a ladder from 1e-300 to 1e300, allowed: its temperatures (the ratio of
+  ** its ends overflowed: inf after the first), and no inf or nan printed */
+  k = (size_t)snprintf(text, cap, "sweep,temperature,total,replica0_temperature,replica0_energy,"
+                                  "replica1_temperature,replica1_energy,replica2_temperature,replica2_energy\n");
+  for (size_t t = 0; t < rows; t++) {
+    double e[3];
+    for (int q = 0; q < 3; q++) e[q] = 100.0 * (q + 1) + gsl_ran_gaussian(r, 1.0);
+    k += (size_t)snprintf(text + k, cap - k, "%zu,1e-300,%.17g,1e-300,%.17g,1,%.17g,1e300,%.17g\n", t + 1, e[0], e[0],
+                          e[1], e[2]);
+  }
+  write_trace("wide.csv", text, path, sizeof path);
+  table_of(path, 3, 1, out, sizeof out);
+  cr_assert(strstr(out, "\n1e-300,") && strstr(out, "\n1,") && strstr(out, "\n1e+300,") && !strstr(out, "inf") &&
+            !strstr(out, "nan"), "%s", out);
   free(text);
   gsl_rng_free(r);
 }
