@@ -848,8 +848,8 @@ static void *mass_new(const void *state, const lw_params *p, double density, lw_
         if (p->dyn_gamma != 0.0) snprintf(what, sizeof what, "at gamma = %g,", p->dyn_gamma);
         lw_error_set(err, LW_EINPUT, "%g s is past the leapfrog's stability limit %s %.3g s%s of this "
                      "curve (omega_max = %.4g /s, %zu control points): take dt <= %.2g, or integrator = review "
-                     "(stable at any dt; it damps the high modes)", p->dyn_dt, what, limit, p->dyn_gamma != 0.0 ? "," : "", omega,
-                     m->n, 0.9 * limit);
+                     "(stable at any dt; it damps the high modes)", p->dyn_dt, what, limit,
+                     p->dyn_gamma != 0.0 ? "," : "", omega, m->n, 0.9 * limit);
         lw_params_blame(p, "dynamics", "dt", err);
       }
       mass_free(m);

@@ -666,8 +666,9 @@ Test(tools, failed_runs_are_reported_and_the_others_finish)
   cr_assert(first && !strstr(first + 1, "FAILED (exit 2): linewise:") &&
               strstr(errs, "FAILED (exit 2): refused as init.splines=-1__seed-"), "one reason, in full once: %s", errs);
   cr_assert(strstr(errs, "param-sweep: runs were refused their input"), "%s", errs);
-  cr_assert_eq(sh("test \"$(sort %s/f/sweep.refused | paste -sd' ')\" = 'init.splines=-1__seed-1 init.splines=-1__seed-2'",
-                  dir), 0, "%s", lw_test_slurp("%s/f/sweep.refused", dir));
+  cr_assert_eq(sh("test \"$(sort %s/f/sweep.refused | paste -sd' ')\" = "
+                  "'init.splines=-1__seed-1 init.splines=-1__seed-2'", dir),
+               0, "%s", lw_test_slurp("%s/f/sweep.refused", dir));
   csv t;
   char path[128];
   snprintf(path, sizeof path, "%s/f/sweep.csv", dir);
@@ -814,7 +815,8 @@ Test(tools, job_array_tasks_then_gather_only)
 Test(tools, a_file_the_scene_names_changed_under_a_sweep_is_refused)
 {
   cr_assert_eq(sh("mkdir %s/sc && cd %s/sc && printf '0 0.5\\n1 0.1\\n' > t.txt && printf '[scene]\\nwidth = 60\\n"
-                  "height = 60\\n[anneal]\\nschedule = table\\ntable = t.txt ; the schedule\\n' > s.ini && true", dir, dir),
+                  "height = 60\\n[anneal]\\nschedule = table\\ntable = t.txt ; the schedule\\n' > s.ini && true",
+                  dir, dir),
                0);
   const char *sweep = "%s %s/sc/s.ini --seeds %s " TINY " --bin %s --out %s/w";
   cr_assert_eq(sh(sweep, tool("seed-sweep"), dir, "1", env("LW_BIN"), dir), 0, "%s", err_txt());
