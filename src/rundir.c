@@ -156,6 +156,11 @@ lw_status lw_rundir_writable(const char *dir, lw_error *err)
   char path[LW_PATH_MAX + 16];
   const char *what = NULL;
   int e = 0;
+  /* (a library host's run into a file's path was told "Permission denied") */
+  struct stat sd, sf;
+  if (!stat(dir, &sd) && !S_ISDIR(sd.st_mode))
+    return lw_error_set(err, LW_EINPUT, "%s: not a directory (a file of that name is there); expected a run "
+                        "directory", dir);
   for (size_t k = 0; k < sizeof inside / sizeof inside[0] && !e; k++)
     if (snprintf(path, sizeof path, "%s%s%s", dir, k ? "/" : "", inside[k]) < (int)sizeof path && (e = denied(path, 1)))
       what = k ? "cannot write into it" : "cannot write into the run directory";
@@ -164,7 +169,6 @@ lw_status lw_rundir_writable(const char *dir, lw_error *err)
   if (!e && snprintf(path, sizeof path, "%s/.lock", dir) < (int)sizeof path && !access(path, F_OK) &&
       access(path, R_OK) && errno == EACCES)
     e = EACCES, what = "cannot read the run directory's lock";
-  struct stat sd, sf;
   const uid_t me = geteuid();
   /* another user's run file there (state.lw, a replica-K.lw, a write left,
   ** state.lw.tmp): the checkpoint that would replace it failed at its

@@ -29,6 +29,19 @@ TestSuite(rundir, .init = make_dir, .fini = remove_dir);
 ** them shared out/minimal (4 times in 4), and a summary.json of seed 1 sat
 ** beside a scene.ini of seed 2.  Each now has its own directory, whose
 ** files all are its own. */
+/* A path that names a file is no run directory, said so (a library host's
+** run into one was told "Permission denied"). */
+Test(rundir, a_file_is_no_run_directory)
+{
+  char path[128];
+  snprintf(path, sizeof path, "%s/afile", dir);
+  cr_assert_eq(lw_test_sh("touch %s", path), 0);
+  lw_error err;
+  cr_assert_eq(lw_rundir_writable(path, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "afile: not a directory (a file of that name is there)"), "%s", err.msg);
+  cr_assert_eq(lw_rundir_writable(dir, &err), LW_OK, "%s", err.msg);
+}
+
 Test(rundir, runs_started_together_without_out_each_get_their_own_directory)
 {
   cr_assert_eq(sh("cd %s && for s in 1 2 3; do %s run %s/params/minimal.ini --set anneal.sweeps=400 --threads 1 "
