@@ -445,18 +445,16 @@ Test(cli, a_resume_without_its_timing_rates_its_own_proposals)
                0, "%s", lw_test_slurp("%s/w/summary.json", dir));
   /* a sweep time there that is no number is damage, not an older release;
   ** so is a count of proposals below 0 ("-7" was read as 2^64 - 7) */
-  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=60 --stop-at 40 --out y --quiet "
-                          "&& printf 'wall_seconds 1000\\nsweep_seconds 5\\nuntimed_proposals -7\\n' > y/timing.txt "
-                          "&& { %s resume y --quiet 2> y1.txt; }", dir, lw_test_bin(), lw_test_root(), lw_test_bin()),
-               0);
-  cr_assert(strstr(lw_test_slurp("%s/y1.txt", dir), "linewise: note: y/timing.txt is missing or unreadable: "),
-            "%s", lw_test_slurp("%s/y1.txt", dir));
-  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=60 --stop-at 40 --out x --quiet "
-                          "&& printf 'wall_seconds 1000\\nsweep_seconds garbage\\n' > x/timing.txt && "
-                          "{ %s resume x --quiet 2> x1.txt; }", dir, lw_test_bin(), lw_test_root(), lw_test_bin()),
-               0);
-  cr_assert(strstr(lw_test_slurp("%s/x1.txt", dir), "linewise: note: x/timing.txt is missing or unreadable: "),
-            "%s", lw_test_slurp("%s/x1.txt", dir));
+  static const char *const damaged[] = {"wall_seconds 1000\\nsweep_seconds garbage\\n",
+                                        "wall_seconds 1000\\nsweep_seconds 5\\nuntimed_proposals -7\\n"};
+  for (int k = 0; k < 2; k++) {
+    cr_assert_eq(lw_test_sh("cd %s && rm -rf x && %s run %s/params/minimal.ini --set anneal.sweeps=60 --stop-at 40 "
+                            "--out x --quiet && printf '%s' > x/timing.txt && { %s resume x --quiet 2> x1.txt; }", dir,
+                            lw_test_bin(), lw_test_root(), damaged[k], lw_test_bin()),
+                 0);
+    cr_assert(strstr(lw_test_slurp("%s/x1.txt", dir), "linewise: note: x/timing.txt is missing or unreadable: "),
+              "%s: %s", damaged[k], lw_test_slurp("%s/x1.txt", dir));
+  }
 }
 
 /* A checkpoint whose state.lw was committed but whose replica file could
