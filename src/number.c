@@ -61,12 +61,17 @@ int lw_number_parse_n(const char *s, size_t len, double *out)
 
 int lw_number_parse(const char *s, double *out) { return lw_number_parse_n(s, strlen(s), out); }
 
+char *lw_number_format_exact(char *buf, size_t n, double v)
+{
+  snprintf(buf, n, "%.15g", v);
+  if (strtod(buf, NULL) != v) snprintf(buf, n, "%.17g", v);
+  return buf;
+}
+
 void lw_number_print_exact(FILE *f, double v)
 {
   char buf[32];
-  snprintf(buf, sizeof buf, "%.15g", v);
-  if (strtod(buf, NULL) != v) snprintf(buf, sizeof buf, "%.17g", v);
-  fputs(buf, f);
+  fputs(lw_number_format_exact(buf, sizeof buf, v), f);
 }
 
 int lw_number_parse_whole(const char *s, double lo, double hi, long long *out)

@@ -11,6 +11,7 @@
 
 #include "linewise/mc.h"
 #include "linewise/series.h"
+#include "linewise/number.h"
 
 /* Energies are taken about their mean, so the exponents stay near the
 ** spread of beta E rather than its size. */
@@ -499,7 +500,7 @@ static double table_temperature(const rw_table *tab, int j)
   /* (a ladder from 1e-300 to 1e300: the ratio overflowed, every temperature
   ** after the first inf; its logarithms do not) */
   if (r < INFINITY) return tab->tlo * pow(r, x);
-  return j == tab->n_temps - 1 ? tab->thi : exp(log(tab->tlo) + (log(tab->thi) - log(tab->tlo)) * x);
+  return j == 0 ? tab->tlo : j == tab->n_temps - 1 ? tab->thi : exp(log(tab->tlo) + (log(tab->thi) - log(tab->tlo)) * x);
 }
 
 /* The B resamples' estimates about est, summed: d and d^2 of the energy
@@ -831,10 +832,19 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
     /* (an estimate past the doubles at a ladder's extreme ends, 1e-300:
     ** "-nan" where the documented row is empty) */
     const int defined = isfinite(est[0]) && isfinite(est[1]) && isfinite(se[0]) && isfinite(se[1]);
+    /* (the CSV's every digit: a row's T matched no T a script computed) */
+    char c[5][32];
+    if (sel[0].csv) {
+      lw_number_format_exact(c[0], sizeof c[0], T);
+      for (int v = 0; v < 2; v++) {
+        lw_number_format_exact(c[1 + 2 * v], sizeof c[0], est[v]);
+        lw_number_format_exact(c[2 + 2 * v], sizeof c[0], se[v]);
+      }
+    }
     if (in_gap(&tab, j) || !defined)
-      fprintf(out, sel[0].csv ? "%.10g,,,,\n" : "%15.6g %17s %11s %15s %11s\n", T, "-", "-", "-", "-");
+      sel[0].csv ? fprintf(out, "%s,,,,\n", c[0]) : fprintf(out, "%15.6g %17s %11s %15s %11s\n", T, "-", "-", "-", "-");
     else if (sel[0].csv)
-      fprintf(out, "%.10g,%.10g,%.4g,%.10g,%.4g\n", T, est[0], se[0], est[1], se[1]);
+      fprintf(out, "%s,%s,%s,%s,%s\n", c[0], c[1], c[2], c[3], c[4]);
     else
       fprintf(out, "%15.6g %17.10g %11.4g %15.6g %11.4g\n", T, est[0], se[0], est[1], se[1]);
   }

@@ -245,6 +245,14 @@ static int run_problem(const lw_series_stats *s, int what)
   }
 }
 
+/* A statistic's cell: for --csv every digit that reads back (scripts read
+** it, and it gave 4 where summary.json gave 17), for the table fmt. */
+static void stat_cell(char *buf, size_t n, int csv, const char *fmt, double v)
+{
+  if (csv) lw_number_format_exact(buf, n, v);
+  else snprintf(buf, n, fmt, v);
+}
+
 /* Whether column c has problem `what` in any of its k runs, or (WARN_RUNS)
 ** across them: means further apart than their error bars allow (p < 1e-3)
 ** or a potential scale reduction above 1.1. */
@@ -765,22 +773,22 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       char tau[32] = "-", neff[32] = "-", rh[32] = "-", pr[32] = "-";
       if (csv) tau[0] = neff[0] = rh[0] = pr[0] = '\0'; /* a value that is not there: empty, as for one run */
       if (q->sd > 0.0) {
-        snprintf(tau, sizeof tau, "%.4g", q->tau_sweeps);
-        snprintf(neff, sizeof neff, csv ? "%.4g" : "%.0f", q->n_eff);
+        stat_cell(tau, sizeof tau, csv, "%.4g", q->tau_sweeps);
+        stat_cell(neff, sizeof neff, csv, "%.0f", q->n_eff);
       }
       if (!isnan(q->p_runs)) {
-        snprintf(rh, sizeof rh, "%.4g", q->r_hat);
-        snprintf(pr, sizeof pr, "%.3g", q->p_runs);
+        stat_cell(rh, sizeof rh, csv, "%.4g", q->r_hat);
+        stat_cell(pr, sizeof pr, csv, "%.3g", q->p_runs);
       }
       char sd[32] = "-";
       if (csv) sd[0] = '\0';
-      if (!isnan(q->sd)) snprintf(sd, sizeof sd, "%.4g", q->sd);
+      if (!isnan(q->sd)) stat_cell(sd, sizeof sd, csv, "%.4g", q->sd);
       /* a mean over other temperatures in other runs is no one ensemble's */
       char mean[32] = "-", se[32] = "-";
       if (csv) mean[0] = se[0] = '\0';
       if (!q->mixed) {
-        snprintf(mean, sizeof mean, csv ? "%.10g" : "%.9g", q->mean);
-        snprintf(se, sizeof se, "%.4g", q->stderr_mean);
+        stat_cell(mean, sizeof mean, csv, "%.9g", q->mean);
+        stat_cell(se, sizeof se, csv, "%.4g", q->stderr_mean);
       }
       if (csv)
         fprintf(out, "%s,%d,%zu,%s,%s,%s,%s,%s,%s,%s\n", name, k, rows, mean, se, sd, tau, neff, rh, pr);
@@ -792,22 +800,22 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       ** the table's '-' and summary.json's null */
       char tau[32] = "", neff[32] = "";
       if (s->sd > 0.0) {
-        snprintf(tau, sizeof tau, "%.4g", q->tau_sweeps);
-        snprintf(neff, sizeof neff, "%.4g", s->n_eff);
+        lw_number_format_exact(tau, sizeof tau, q->tau_sweeps);
+        lw_number_format_exact(neff, sizeof neff, s->n_eff);
       }
-      char batch[32] = "", closed[8] = "", drift[32] = "";
+      char batch[32] = "", closed[8] = "", drift[32] = "", mean[32];
       if (s->sd > 0.0) snprintf(closed, sizeof closed, "%d", s->window > 0);
       /* (as summary.json's observables: halves of a column without spread
       ** have no difference to weigh, and read 0 here, null there) */
-      if (s->sd > 0.0 && !isnan(s->drift_z)) snprintf(drift, sizeof drift, "%.3g", s->drift_z);
-      if (!isnan(s->batch_ratio)) snprintf(batch, sizeof batch, "%.4g", s->batch_ratio); /* 1.501 warns, 1.5 not */
+      if (s->sd > 0.0 && !isnan(s->drift_z)) lw_number_format_exact(drift, sizeof drift, s->drift_z);
+      if (!isnan(s->batch_ratio)) lw_number_format_exact(batch, sizeof batch, s->batch_ratio);
       char se[32] = "", sd[32] = ""; /* one row: none */
       if (s->n > 1) {
-        snprintf(se, sizeof se, "%.4g", s->stderr_mean);
-        snprintf(sd, sizeof sd, "%.4g", s->sd);
+        lw_number_format_exact(se, sizeof se, s->stderr_mean);
+        lw_number_format_exact(sd, sizeof sd, s->sd);
       }
-      fprintf(out, "%s,%zu,%.10g,%s,%s,%s,%s,%s,%s,%s\n", name, s->n, s->mean, se, sd, tau, neff, closed, drift,
-              batch);
+      fprintf(out, "%s,%zu,%s,%s,%s,%s,%s,%s,%s,%s\n", name, s->n, lw_number_format_exact(mean, sizeof mean, s->mean),
+              se, sd, tau, neff, closed, drift, batch);
     } else if (s->n == 1) {
       fprintf(out, "%-*s %15.9g %11s %11s %11s %9s *\n", width, name, s->mean, "-", "-", "-", "-");
     } else if (!(s->sd > 0.0)) {

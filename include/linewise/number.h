@@ -42,6 +42,9 @@ int lw_number_parse(const char *s, double *out);
 ** heat capacity of a 10-coordinate harmonic wire read 21.9 for 5. */
 void lw_number_print_exact(FILE *f, double v);
 
+/* The same into buf (n bytes, at least 32), returned. */
+char *lw_number_format_exact(char *buf, size_t n, double v);
+
 /* The whole string s as a whole number in [lo, hi] (|lo|, |hi| <= 2^53, so
 ** every value is exact); "1e3" counts as 1000.  1 on success. */
 int lw_number_parse_whole(const char *s, double lo, double hi, long long *out);
