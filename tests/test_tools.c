@@ -386,20 +386,26 @@ Test(tools, identical_runs_have_a_standard_deviation_of_zero)
 ** returned at once, xargs dead, while its runs still wrote (a rerun met their
 ** locks); run in the background of a script, INT is ignored on entry, which
 ** env --default-signal undoes here.  The signal comes 0.3 s after the first
-** checkpoints: at them, a loaded machine stopped a run at sweep 0. */
+** checkpoints: at them, a loaded machine stopped a run at sweep 0.
+** The sweep is the first of a shell loop's: it ends by SIGINT, so the loop
+** stops with it (it exited 1, and bash started the loop's next sweep). */
 Test(tools, ctrl_c_stops_the_sweep_after_its_runs_have_saved)
 {
-  cr_assert_eq(sh("(setsid env --default-signal=INT %s %s %s --seeds 1-3 -j 2 --threads 1 --set anneal.sweeps=1000000 "
-                  "--bin %s --out %s/i >%s/i.out 2>%s/i.err & echo $! >%s/i.pid); i=0; while [ $i -lt 1000 ] && ! { "
+  cr_assert_eq(sh("(setsid env --default-signal=INT bash -c 'for o in i i2; do %s %s %s --seeds 1-3 -j 2 --threads 1 "
+                  "--set anneal.sweeps=1000000 --bin %s --out %s/$o; done; echo the loop went on' >%s/i.out 2>%s/i.err "
+                  "& echo $! >%s/i.pid); i=0; while [ $i -lt 1000 ] && ! { "
                   "test -s %s/i/seed-1/state.lw && test -s %s/i/seed-2/state.lw; }; do sleep 0.02; i=$((i+1)); done; "
                   "sleep 0.3; p=$(cat %s/i.pid); kill -INT -$p; i=0; while kill -0 $p 2>/dev/null && "
                   "[ $i -lt 1500 ]; do sleep 0.02; i=$((i+1)); done; kill -KILL -$p 2>/dev/null; test $i -lt 1500 && "
                   "flock -n %s/i/seed-1/.lock true && flock -n %s/i/seed-2/.lock true && ! test -e %s/i/seed-3",
                   "bash", tool("seed-sweep"), scene(), env("LW_BIN"), dir, dir, dir, dir, dir, dir, dir, dir, dir, dir),
                0, "%s", err_txt());
-  char *e = lw_test_slurp("%s/i.err", dir);
+  char *e = lw_test_slurp("%s/i.err", dir), *o = lw_test_slurp("%s/i.out", dir);
   cr_assert(strstr(e, "seed-sweep: interrupted: no further run started, and each run in progress said how it ended (")
             && strstr(e, "; rerun the sweep to go on") && strstr(e, "[1/3] seed-1: interrupted, state saved"), "%s", e);
+  cr_assert(!strstr(o, "the loop went on") && !exists("i2"), "%s%s", o, e);
+  cr_assert_eq(sh("test -z \"$(ls -A %s/i | grep notes)\"", dir), 0, "the notes left behind");
+  free(o);
   free(e);
   cr_assert_eq(lw_test_sh("grep -q '^sweep = [1-9]' %s/i/seed-1/state.lw", dir), 0);
 }
@@ -916,6 +922,11 @@ Test(tools, a_sweep_takes_no_lock_that_is_a_link_or_no_file)
   cr_assert(notes && !strncmp(notes, want, strlen(want)), "%s", notes ? notes : "(none)");
   free(notes);
   cr_assert_eq(sh("test -z \"$(ls -A %s/m | grep notes)\"", dir), 0, "the notes left behind");
+  /* a sweep killed outright (SIGKILL) never ran its EXIT trap: its notes go
+  ** with the next sweep into the directory */
+  cr_assert_eq(sh("mkdir %s/m/.sweep-notes.kiLLed && : >%s/m/.sweep-notes.kiLLed/notes && %s %s --seeds 1 " TINY
+                  " --bin %s --out %s/m", dir, dir, tool("seed-sweep"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
+  cr_assert(!exists("m/.sweep-notes.kiLLed"), "a killed sweep's notes were left for good");
 }
 
 /* xargs's status reached the sweep through a file, which a full disk left
@@ -1476,11 +1487,27 @@ Test(tools, a_plot_that_cannot_be_written_whole_leaves_the_earlier_one)
                "$(PATH=/usr/local/bin:/usr/bin:/bin command -v gnuplot)");
   cr_assert_eq(sh("PATH=%s/pg:$PATH %s %s/r", dir, tool("plot-run"), dir), 1, "%s", err_txt());
   e = err_txt();
-  cr_assert(!strcmp(e, "plot-run: gnuplot was killed by SIGXFSZ (a file-size limit: ulimit -f); the earlier pictures "
-                       "are kept\n"), "%s", e);
+  static const char why[] = ".png: gnuplot's picture was not written whole (gnuplot was killed by SIGXFSZ (a file-size "
+                            "limit: ulimit -f))";
+  cr_assert(strstr(e, "/r/plots/energy.png: ") && !raw_error(e), "%s", e);
+  for (const char *l = e; *l; l = strchr(l, '\n') + 1)
+    cr_assert(!strncmp(l, "plot-run: ", 10) && strstr(l, why) && strstr(l, why) < strchr(l, '\n') &&
+                  !strncmp(strstr(l, why) + strlen(why), "; the earlier one is kept\n", 26), "%s", e);
   free(e);
   cr_assert_eq(sh("for f in energy temperature acceptance; do cmp %s/good/$f.png %s/r/plots/$f.png || exit 1; done && "
                   "test -z \"$(ls -A %s/r/plots | grep tmp)\"", dir, dir, dir), 0);
+  /* the limit reached at the last plot: those drawn before it are whole and
+  ** kept (they went with it) */
+  write_script("pg/gnuplot", "#!/bin/sh\n%s \"$@\"\nf=%s/r/plots/.acceptance.png.tmp\ntest -s $f && truncate -s 100 $f"
+               " && kill -XFSZ $$\n", "$(PATH=/usr/local/bin:/usr/bin:/bin command -v gnuplot)", dir);
+  cr_assert_eq(sh("rm -r %s/r/plots && PATH=%s/pg:$PATH %s %s/r", dir, dir, tool("plot-run"), dir), 1, "%s",
+               err_txt());
+  e = err_txt();
+  cr_assert(!strncmp(e, "plot-run: ", 10) && strstr(e, "/r/plots/acceptance") && strstr(e, why) &&
+                strchr(e, '\n') == e + strlen(e) - 1, "%s", e);
+  free(e);
+  cr_assert_eq(sh("for f in energy temperature; do cmp %s/good/$f.png %s/r/plots/$f.png || exit 1; done && "
+                  "test -z \"$(ls -A %s/r/plots | grep 'tmp\\|acceptance')\"", dir, dir, dir), 0);
 }
 
 Test(tools, plot_sweep_draws_a_png_beside_the_csv)
@@ -1489,6 +1516,18 @@ Test(tools, plot_sweep_draws_a_png_beside_the_csv)
                           "1,2.5,1.5,1000,0.1,seed-1\n2,1.75,1.25,1100,0.1,seed-2\n3,2.125,1,900,0.1,seed-3\n");
   cr_assert_eq(sh("%s %s/seeds.csv", tool("plot-sweep"), dir), 0, "%s", err_txt());
   check_png("seeds.png");
+  /* a standard output that is full, or whose reader is gone: one line, the
+  ** plot written (bash's raw "write error", or death by SIGPIPE) */
+  cr_assert_eq(sh("rm %s/seeds.png && { %s %s/seeds.csv >/dev/full; }", dir, tool("plot-sweep"), dir), 1);
+  char *e = err_txt();
+  cr_assert(!strcmp(e, "plot-sweep: the standard output could not be written (closed, full, or its reader gone); the "
+                       "plot is written\n"), "%s", e);
+  free(e);
+  check_png("seeds.png");
+  cr_assert_eq(sh("{ %s %s/seeds.csv; echo $? >%s/ps.rc; } | head -c 0", tool("plot-sweep"), dir, dir), 0);
+  e = lw_test_slurp("%s/ps.rc", dir);
+  cr_assert(!strcmp(e, "1\n"), "%s", e);
+  free(e);
   write_text("params.csv", "seed,energy.bending,energy_total,wall_seconds,run\n"
                            "1,0.5,2.5,0.1,a\n2,0.5,1.5,0.1,b\n1,2,3.5,0.1,c\n2,2,3.25,0.1,d\n");
   cr_assert_eq(sh("%s %s/params.csv --y wall_seconds", tool("plot-sweep"), dir), 0, "%s", err_txt());
