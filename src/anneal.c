@@ -10,6 +10,7 @@
 #include <float.h>
 #include <gsl/gsl_math.h>
 #include <stdarg.h>
+#include <limits.h>
 #include <malloc.h>
 #include <math.h>
 #include <stddef.h>
@@ -155,6 +156,19 @@ void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n)
   else /* (no checkpoint between the first and the last: the key would change nothing) */
     snprintf(buf, n, "writing state.lw at the start and the end took %s of this run's time%s", share,
              a->n_rep > 1 ? " (it and a replica-K.lw for each rung, each synced to disk)" : "");
+}
+
+void lw_anneal_frames_note(const lw_anneal *a, char *buf, size_t n)
+{
+  buf[0] = '\0';
+  long now;
+  unsigned w, h;
+  if (!a->frame_before.have || !lw_runfiles_frame_size(a->dir, LONG_MAX, &now, &w, &h) ||
+      now == a->frame_before.sweep || (w == a->frame_before.w && h == a->frame_before.h))
+    return;
+  snprintf(buf, n, "%s/frames/ mixes sizes: its frames to sweep %ld are %u x %u pixels, this resume's %u x %u (a "
+           "drawing key of scene.ini, output.png_scale say, was edited): a film of them is scaled to one size",
+           a->dir, a->frame_before.sweep, a->frame_before.w, a->frame_before.h, w, h);
 }
 
 void lw_anneal_drift_note(const lw_anneal *a, char *buf, size_t n)
@@ -1254,6 +1268,10 @@ lw_status lw_anneal_settle(lw_anneal *a, lw_error *err)
 {
   if (!a->extending) return LW_OK;
   a->extending = 0;
+  /* a killed run's frames and samples past the checkpoint are written again,
+  ** unless scene.ini's interval was edited: those off the new grid stayed,
+  ** a film of steps 5 then 20 with 105, 110 and 115 among the 20s */
+  lw_runfiles_drop_off_grid(a->dir, a->sweep, a->end_sweep, a->params.frames_every, a->params.samples_every);
   if (a->new_end) {
     lw_status s = lw_checkpoint_write(a, err);
     if (s) return s;
@@ -1606,7 +1624,12 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   /* (every process of an MPI run: one that writes nothing must still stop
   ** with the others, not at once) */
   lw_phase_writing();
-  if (writes_files(a)) s = truncate_trace(a, trace_bytes, err);
+  /* (a link planted as frames/ was found at the first frame, the sweeps
+  ** since the checkpoint run for nothing) */
+  if (writes_files(a)) s = lw_runfiles_check_links(a->dir, err) ? err->code : truncate_trace(a, trace_bytes, err);
+  a->frame_before.have = a->params.frames_every &&
+                         lw_runfiles_frame_size(a->dir, a->sweep, &a->frame_before.sweep, &a->frame_before.w,
+                                                &a->frame_before.h);
   /* nothing else is written yet: the caller may still refuse to go on */
   a->extending = !s && writes_files(a) && !lw_anneal_done(a);
   a->new_end = a->end_sweep != saved_end;
@@ -1763,7 +1786,10 @@ static lw_status write_sample(lw_anneal *a, lw_error *err)
 static lw_status sweep_files(lw_anneal *a, lw_error *err)
 {
   const lw_params *p = &a->params;
-  if (p->frames_every && a->sweep % p->frames_every == 0 && rung_here(a, 0) &&
+  /* the end has a frame as it has a trace row, on the grid or not: the film
+  ** ended short of the drawing (at 180 of 200, at 0 with frames_every past
+  ** the sweeps) */
+  if (p->frames_every && (a->sweep % p->frames_every == 0 || lw_anneal_done(a)) && rung_here(a, 0) &&
       a->sys_type->draw(a->sys->state, p, a->dir, a->sweep, err))
     return err->code;
   if (p->samples_every && a->sweep % p->samples_every == 0 && rung_here(a, 0) && write_sample(a, err))

@@ -954,6 +954,8 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
     lw_anneal_checkpoint_note(a, drawn, sizeof drawn);
     if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
+    lw_anneal_frames_note(a, drawn, sizeof drawn);
+    if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
   }
   /* the warnings, of numbers the run got wrong or left out, under --quiet
   ** too: a study's script reads its log (its statistics went null unsaid) */
@@ -978,11 +980,14 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     /* the plotter's files beside the system's own, where the drawing wrote
     ** them (whichever process drew it; a run removes those of the run before) */
     static const char *const extra[] = {"final.pdf", "final.hpgl", "final.gcode"};
-    char files[64] = "", path[LW_PATH_MAX + 16];
+    char files[96] = "", path[LW_PATH_MAX + 16];
     for (int k = 0; k < 3; k++) {
       lw_path_join(path, sizeof path, a->dir, extra[k]);
       if (!access(path, F_OK)) snprintf(files + strlen(files), sizeof files - strlen(files), ", %s", extra[k]);
     }
+    /* (the film and the samples, which a user looked for by the docs) */
+    if (a->params.frames_every) snprintf(files + strlen(files), sizeof files - strlen(files), ", frames/");
+    if (a->params.samples_every) snprintf(files + strlen(files), sizeof files - strlen(files), ", samples/");
     fprintf(stderr, "linewise: done: %s/%s%s, summary.json, trace.csv, state.lw\n", a->dir, a->sys_type->files, files);
   }
   return 0;

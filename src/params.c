@@ -245,7 +245,8 @@ const lw_param_def lw_param_table[] = {
   NUM("energy", "potential", LW_PT_DOUBLE, potential_coef, "0", "energy / mm", -1e12, 1e12, 0,
       "Q: potential Q * integral of Phi dl draws lines to low Phi (dark tone). 0 = off."),
   NUM("energy", "field", LW_PT_DOUBLE, field_coef, "0", "energy / mm", -1e12, 1e12, 0,
-      "P: field P * integral of r'.v ds; negative P rewards alignment with v. 0 = off. It pays per "
+      "P: field P * integral of r'.v dt (signed fields) or |r'.v| dt (axial), r' = dr/dt on each segment's "
+      "t in [0, 1]: the line's length along v; negative P rewards alignment with v. 0 = off. It pays per "
       "millimetre of aligned line, so a |P| far above the strain and bending weights buys length: "
       "on a vortex with strain 20 and bending 2, P = -10 drew clean circles (alignment 0.9999), "
       "-100 longer crossing arcs (0.978)."),
@@ -519,7 +520,7 @@ const lw_param_def lw_param_table[] = {
       "Warm-up sweeps of ladder tuning (tune_ladder = equal); fewer than anneal.sweeps, since the "
       "swap statistics and ladder.ini come after it."),
   NUM("output", "checkpoint_every", LW_PT_INT, checkpoint_every, "100", "sweeps", 1, 2e9, 0,
-      "Sweeps between checkpoints of state.lw (also written at the end and on SIGINT/SIGTERM). Each is "
+      "Sweeps between checkpoints of state.lw (also written at the end and on SIGINT, SIGTERM, SIGHUP and SIGXCPU). Each is "
       "written whole and synced to disk: for a small system (sweeps of microseconds) that is most of the "
       "time, and the run says so at its end; thousands of sweeps between them suit a study."),
   NUM("output", "trace_every", LW_PT_INT, trace_every, "1", "sweeps", 1, 2e9, 0,
@@ -579,7 +580,7 @@ const lw_param_def lw_param_table[] = {
       "(at half strength). Needs an image."),
   NUM("output", "frames_every", LW_PT_INT, frames_every, "0", "sweeps", 0, 2e9, 0,
       "Sweeps between animation frames frames/frame-SSSSSS.png (SSSSSS = the sweep; the first, 000000, "
-      "is the start). 0 = none."),
+      "is the start, and the run's end has one, on the grid or not). 0 = none."),
   NUM("output", "fidelity_sigma", LW_PT_DOUBLE, fidelity_sigma, "1", "mm", 1e-6, 1e4, 0,
       "Gaussian blur applied to both the rendered lines and the target (the ink asked for, "
       "energy.tone_ink * darkness) before the fidelity score (MSE, SSIM) compares them; about "
@@ -730,8 +731,8 @@ const lw_param_def lw_param_table[] = {
          "Distance weighting w of the co-planarity, co-normality and co-circularity terms: "
          "poly (1 - r^2/R^2)^3; gauss exp(-r^2 / 2 sigma^2); aniso the seed's "
          "exp(-(x^2+y^2)/2a^2 - z^2/2b^2) in each particle's frame, a = sigma, b = "
-         "sigma_normal, averaged over the two ends; the Gaussians shifted to reach 0 at R "
-         "(docs/NUMERICS.md)."),
+         "sigma_normal, averaged over the two ends; the Gaussians shifted by g_R to reach 0 at R "
+         "and scaled by 1 / (1 - g_R) to stay 1 at 0 (docs/NUMERICS.md)."),
   NUM("particles", "sigma", LW_PT_DOUBLE, pt_sigma, "1", "r0", 0, 100, LW_MIN_OPEN,
       "sigma_r of weight = gauss, and the in-plane a of weight = aniso."),
   NUM("particles", "sigma_normal", LW_PT_DOUBLE, pt_sigma_normal, "0.5", "r0", 0, 100, LW_MIN_OPEN,

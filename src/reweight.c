@@ -814,8 +814,8 @@ lw_status lw_trace_reweight(const lw_trace *const *t, const char *const *path, c
   } else {
     double thin = 0.0;
     for (int q = 0; q < K; q++) thin = fmax(thin, s.thin[q]);
-    char overlap[64] = ""; /* (none with one temperature) */
-    if (!isnan(tab.lowest)) snprintf(overlap, sizeof overlap, ", neighbouring temperatures' overlap at least %.3g",
+    char overlap[64] = ""; /* (none with one rung) */
+    if (!isnan(tab.lowest)) snprintf(overlap, sizeof overlap, ", neighbouring rungs' overlap at least %.3g",
                                      tab.lowest);
     fprintf(out, "reweighted over %d rung%s from T = %.6g to %.6g: %zu samples (each rung's rows thinned to one "
             "every 2 tau, at most every %.0f), %d iterations, %d bootstrap resamples%s\n", K, K > 1 ? "s" : "",

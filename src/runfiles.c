@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -142,11 +143,8 @@ static int add_found(const char *rel, void *ctx)
 enum { NOT_OURS, MOVING, MOVED, RESTORING, EMPTY };
 static int stash_marker(const char *dir);
 
-lw_status lw_runfiles_check_free(const char *dir, lw_error *err)
+lw_status lw_runfiles_check_links(const char *dir, lw_error *err)
 {
-  /* a frames/, samples/ or plots/ that is a link (planted in a shared
-  ** directory) is refused whether or not this run writes there: one that
-  ** writes none ran, and left the link in its directory */
   for (size_t k = 1; k < sizeof groups / sizeof groups[0]; k++) {
     char path[LW_PATH_MAX + 16];
     struct stat sb;
@@ -155,6 +153,16 @@ lw_status lw_runfiles_check_free(const char *dir, lw_error *err)
       return lw_error_set(err, LW_EINPUT, "%s: a symbolic link, not a folder: a run writes its %s only into its own "
                           "directory; remove it (nothing was written)", path, groups[k].sub);
   }
+  return LW_OK;
+}
+
+lw_status lw_runfiles_check_free(const char *dir, lw_error *err)
+{
+  /* a frames/, samples/ or plots/ that is a link (planted in a shared
+  ** directory) is refused whether or not this run writes there: one that
+  ** writes none ran, and left the link in its directory */
+  lw_status s = lw_runfiles_check_links(dir, err);
+  if (s) return s;
   /* (an empty stash, which recovery removes, holds no run) */
   const int stash = lw_runfiles_stashed(dir) && stash_marker(dir) != EMPTY;
   if (stash || lw_rundir_holds_run(dir)) return LW_OK;
@@ -420,4 +428,66 @@ lw_status lw_runfiles_recover(const char *dir, int *back, lw_error *err)
   s = lw_runfiles_unstash(dir, err);
   *back = !s;
   return s;
+}
+
+/* The sweep in a frame's or a sample's name (in_group's), or -1. */
+static long group_sweep(const char *name, const char *prefix)
+{
+  const char *digits = name + strlen(prefix);
+  char *end;
+  errno = 0;
+  const long s = strtol(digits, &end, 10);
+  return errno || end == digits ? -1 : s;
+}
+
+void lw_runfiles_drop_off_grid(const char *dir, long after, long end, long frames_every, long samples_every)
+{
+  const long every[] = {0, frames_every, samples_every};
+  char path[2 * LW_PATH_MAX + 8];
+  for (size_t g = 1; g <= 2; g++) {
+    snprintf(path, sizeof path, "%s/%s", dir, groups[g].sub);
+    DIR *d = opendir(path);
+    if (!d) continue;
+    for (struct dirent *e; (e = readdir(d));) {
+      if (!in_group(e->d_name, groups[g].prefix, groups[g].suffix)) continue;
+      const long s = group_sweep(e->d_name, groups[g].prefix);
+      if (s <= after || s == end || (every[g] && s % every[g] == 0)) continue;
+      snprintf(path, sizeof path, "%s/%s/%s", dir, groups[g].sub, e->d_name);
+      unlink(path);
+    }
+    closedir(d);
+  }
+}
+
+int lw_runfiles_frame_size(const char *dir, long at_most, long *sweep, unsigned *w, unsigned *h)
+{
+  char path[2 * LW_PATH_MAX + 8], name[64] = "";
+  snprintf(path, sizeof path, "%s/frames", dir);
+  DIR *d = opendir(path);
+  if (!d) return 0;
+  long best = -1;
+  for (struct dirent *e; (e = readdir(d));) {
+    const size_t n = strlen(e->d_name);
+    if (!in_group(e->d_name, "frame-", ".png") || !strcmp(e->d_name + n - 4, ".tmp") || n >= sizeof name) continue;
+    const long s = group_sweep(e->d_name, "frame-");
+    if (s > best && s <= at_most) {
+      best = s;
+      memcpy(name, e->d_name, n + 1);
+    }
+  }
+  closedir(d);
+  if (best < 0) return 0;
+  snprintf(path, sizeof path, "%s/frames/%s", dir, name);
+  /* PNG's signature, then IHDR's length and type, then its width and
+  ** height, big-endian */
+  unsigned char b[24];
+  FILE *f = fopen(path, "rb");
+  if (!f) return 0;
+  const size_t got = fread(b, 1, sizeof b, f);
+  fclose(f);
+  if (got != sizeof b || memcmp(b, "\x89PNG\r\n\x1a\n", 8) || memcmp(b + 12, "IHDR", 4)) return 0;
+  *sweep = best;
+  *w = (unsigned)b[16] << 24 | (unsigned)b[17] << 16 | (unsigned)b[18] << 8 | b[19];
+  *h = (unsigned)b[20] << 24 | (unsigned)b[21] << 16 | (unsigned)b[22] << 8 | b[23];
+  return 1;
 }

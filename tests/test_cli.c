@@ -413,6 +413,43 @@ Test(cli, the_libraries_are_named_and_a_change_of_them_said)
 ** says so, and its rate counts its own proposals over its own sweeps, on
 ** later resumes too (timing.txt's untimed_proposals): every proposal over
 ** them gave a rate many times too high, unsaid. */
+/* The film ends on the drawing: the end has a frame, on the frames_every
+** grid or not (a film of 200 sweeps at every 30 ended at 180).  A killed
+** run resumed after its interval was edited (the run's frames past the
+** checkpoint stand in for the killed part's: 16 and 25 off the new grid,
+** 20 on it): those off the grid go (the film had steps of 5 and then 20,
+** with 105, 110 and 115 among the 20s), and a size edited too is said. */
+Test(cli, the_film_ends_on_the_drawing_and_a_resume_keeps_one_grid)
+{
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=23 --set output.frames_every=5 "
+                          "--out f --quiet && test \"$(ls f/frames | tr '\\n' ' ')\" = 'frame-000000.png "
+                          "frame-000005.png frame-000010.png frame-000015.png frame-000020.png frame-000023.png '",
+                          dir, lw_test_bin(), lw_test_root()),
+               0);
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=40 --set output.frames_every=5 "
+                          "--out k --quiet --stop-at 15 && for s in 16 20 25; do cp k/frames/frame-000015.png "
+                          "k/frames/frame-0000$s.png; done && sed -i 's/^frames_every = 5$/frames_every = 10/; 146s/^"
+                          "png_scale = 4$/png_scale = 2/' k/scene.ini && grep -qx 'png_scale = 2' k/scene.ini && "
+                          "{ %s resume k 2> k.err; }", dir, lw_test_bin(), lw_test_root(), lw_test_bin()),
+               0);
+  cr_assert_eq(lw_test_sh("cd %s && test \"$(ls k/frames | tr '\\n' ' ')\" = 'frame-000000.png frame-000005.png "
+                          "frame-000010.png frame-000015.png frame-000020.png frame-000030.png frame-000040.png ' && "
+                          "! cmp -s k/frames/frame-000015.png k/frames/frame-000020.png", dir),
+               0);
+  char *e = lw_test_slurp("%s/k.err", dir);
+  cr_assert(strstr(e, "linewise: note: k/frames/ mixes sizes: its frames to sweep 15 are 400 x 400 pixels, this "
+                      "resume's 200 x 200 (a drawing key of scene.ini"), "%s", e);
+  free(e);
+  /* a frames/ planted as a link is refused before the sweeps, as a run's
+  ** is (it was found at the first frame, the sweeps since the checkpoint
+  ** run for nothing) */
+  cr_assert_eq(lw_test_sh("cd %s && cp k/state.lw k.lw && mv k/frames kf && mkdir vf && ln -s ../vf k/frames && "
+                          "{ %s resume k --sweeps 10 --quiet 2> l.err; test $? = 2; } && cmp k.lw k/state.lw && "
+                          "test -z \"$(ls vf)\" && grep -q 'k/frames: a symbolic link, not a folder' l.err", dir,
+                          lw_test_bin()),
+               0, "%s", lw_test_slurp("%s/l.err", dir));
+}
+
 Test(cli, a_resume_without_its_timing_rates_its_own_proposals)
 {
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=60 --stop-at 40 --out t --quiet "

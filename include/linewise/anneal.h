@@ -70,6 +70,11 @@ typedef struct lw_anneal {
   long end_sweep;              /* stop after this sweep */
   long pause_at;               /* resume --sweeps N short of end_sweep: stop there as --stop-at does (-1: none) */
   int extending, new_end;      /* a resume to settle before its first sweep (anneal.c) */
+  struct {                     /* the newest frame a resume found (lw_anneal_frames_note) */
+    int have;
+    long sweep;
+    unsigned w, h;
+  } frame_before;
   int fresh;                   /* the set-up has written files and no checkpoint yet */
   int stashed;                 /* the run it replaces is set aside until its first sweep (runfiles.h) */
   int ladder_from_file;        /* tempering.ladder was read from tempering.ladder_file (for messages) */
@@ -235,6 +240,9 @@ void lw_anneal_ladder_note(const lw_anneal *a, char *buf, size_t n);
 ** over a second, writing checkpoints: fsync'd state of a small system
 ** every output.checkpoint_every sweeps made a 1-second study take 8. */
 void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n);
+/* A note (else "") when the frames a resumed run drew differ in size from
+** those before it (a drawing key edited in scene.ini): the film mixes them. */
+void lw_anneal_frames_note(const lw_anneal *a, char *buf, size_t n);
 /* A note (else "") when a recomputation from scratch moved the running
 ** energy by more than LW_ANNEAL_DRIFT_NOTE of its size (row_drift): a
 ** system row whose commits do not add up its moves' dE (system.h); the

@@ -43,6 +43,10 @@ extern "C" {
 ** where dir's frames, samples or plots is a symbolic link. */
 lw_status lw_runfiles_check_free(const char *dir, lw_error *err);
 
+/* LW_EINPUT where dir's frames/, samples/ or plots/ is a symbolic link: a
+** run writes only into its own directory. */
+lw_status lw_runfiles_check_links(const char *dir, lw_error *err);
+
 /* LW_EUSAGE where dir/.replaced is there and is not linewise's stash (a
 ** link, a file, a folder of the user's), which a run there would refuse. */
 lw_status lw_runfiles_check_stash(const char *dir, lw_error *err);
@@ -76,6 +80,17 @@ void lw_runfiles_remove(const char *dir);
 ** where dir/.replaced is not linewise's stash (a link, a file, a folder of
 ** the user's): nothing is touched. */
 lw_status lw_runfiles_recover(const char *dir, int *back, lw_error *err);
+
+/* Removes dir's frames and samples of sweeps past `after` that lie off the
+** grid of frames_every and samples_every (0: no grid) and are not of the
+** run's end `end`: a killed run's, resumed under another interval, which
+** the resumed run never writes over.  Best effort: a file that stays is
+** an extra picture, not a wrong one. */
+void lw_runfiles_drop_off_grid(const char *dir, long after, long end, long frames_every, long samples_every);
+
+/* The size of dir/frames' newest frame of a sweep at most at_most: 1 with
+** *sweep, *w and *h set, 0 where there is none or it cannot be read. */
+int lw_runfiles_frame_size(const char *dir, long at_most, long *sweep, unsigned *w, unsigned *h);
 
 #ifdef __cplusplus
 }
