@@ -789,6 +789,14 @@ Test(tools, job_array_tasks_then_gather_only)
   errs = err_txt();
   cr_assert(strstr(errs, "1 of 3 planned runs have not finished") && !strstr(errs, "notes"), "%s", errs);
   free(errs);
+  /* a plan's name with a terminal's control bytes (a shared sweep's): shown
+  ** as ?, as linewise shows them (it set the title and cleared the screen) */
+  cr_assert_eq(sh("cp %s/plan %s/plan.kept && printf '\\033[2Jx\\n' >> %s/plan && mv %s/plan %s/j/sweep.plan && "
+                  "%s --gather-only %s/j", dir, dir, dir, dir, dir, tool("seed-sweep"), dir), 1);
+  errs = err_txt();
+  cr_assert(strstr(errs, "/j/?[2Jx: not finished: never started\n") && !strchr(errs, '\033'), "%s", errs);
+  free(errs);
+  cr_assert_eq(sh("mv %s/plan.kept %s/plan", dir, dir), 0);
   cr_assert_eq(sh("mv %s/plan %s/j/sweep.plan && SLURM_ARRAY_TASK_ID=1 SLURM_SUBMIT_DIR=%s %s %s --seeds 5-7 " TINY
                   " --bin %s --out %s/j && %s --gather-only %s/j", dir, dir, env("LW_ROOT"), tool("slurm-sweep.sbatch"),
                   scene(), env("LW_BIN"), dir, tool("seed-sweep"), dir), 0, "%s", err_txt());
@@ -927,6 +935,15 @@ Test(tools, a_sweep_takes_no_lock_that_is_a_link_or_no_file)
   cr_assert_eq(sh("mkdir %s/m/.sweep-notes.kiLLed && : >%s/m/.sweep-notes.kiLLed/notes && %s %s --seeds 1 " TINY
                   " --bin %s --out %s/m", dir, dir, tool("seed-sweep"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
   cr_assert(!exists("m/.sweep-notes.kiLLed"), "a killed sweep's notes were left for good");
+  /* a run's folder planted as a link: the run was written where it pointed
+  ** and left out of the table unsaid, exit 0 */
+  cr_assert_eq(sh("rm -r %s/m/seed-1 && mkdir %s/vict && ln -s ../vict %s/m/seed-1 && %s %s --seeds 1 " TINY
+                  " --bin %s --out %s/m", dir, dir, dir, tool("seed-sweep"), scene(), env("LW_BIN"), dir), 1);
+  e = err_txt();
+  cr_assert(strstr(e, "[1/1] seed-1: FAILED: ") && strstr(e, "/m/seed-1: a symbolic link; a sweep writes its runs only "
+                                                         "into its own directory: remove it\n"), "%s", e);
+  free(e);
+  cr_assert_eq(sh("test -z \"$(ls -A %s/vict)\"", dir), 0, "a run was written through the link");
 }
 
 /* xargs's status reached the sweep through a file, which a full disk left
@@ -1130,6 +1147,14 @@ Test(tools, bad_usage_exits_2_with_one_message_and_writes_nothing)
   cr_assert_eq(sh("cd %s && printf 'an\\nan\\n' | while read -r d; do PATH=%s/ff:$PATH %s \"$d\" || exit 1; done && "
                   "test \"$(cat ff/read)\" = 0 && test -e an/animation.mp4", dir, dir, tool("animate.sh")), 0, "%s",
                err_txt());
+  /* a FIFO among the frames (an archive can carry one), or as plot-run's
+  ** trace: it held ffmpeg, or the script, for ever, deaf to SIGTERM */
+  cr_assert_eq(sh("mkfifo %s/an/frames/frame-000001.png && PATH=%s/ff:$PATH timeout -s KILL 20 %s %s/an", dir, dir,
+                  tool("animate.sh"), dir), 2);
+  cr_assert(strstr(err_txt(), "an/frames/frame-000001.png: not a regular file\n"), "%s", err_txt());
+  cr_assert_eq(sh("rm %s/an/frames/frame-000001.png && mkdir %s/fr && mkfifo %s/fr/trace.csv && timeout -s KILL 20 %s "
+                  "%s/fr", dir, dir, dir, tool("plot-run"), dir), 2);
+  cr_assert(strstr(err_txt(), "fr/trace.csv: not a regular file\n"), "%s", err_txt());
   /* a run another user may only read: said so, exit 2 (mktemp's words and
   ** exit 1 before) */
   if (geteuid() || sh("setpriv --reuid=65534 --regid=65534 --clear-groups sh %s --help", tool("animate.sh"))) return;

@@ -68,6 +68,11 @@ trap 'exit 143' TERM
 n=0
 for f in $(ls -- "$abs/frames" | grep '^frame-[0-9]*\.png$' | sort -t- -k2n); do
   n=$((n + 1))
+  # (a FIFO held ffmpeg, and this script, for ever)
+  if [ ! -f "$abs/frames/$f" ]; then
+    echo "${0##*/}: $dir/frames/$f: not a regular file" >&2
+    exit 2
+  fi
   # (ffmpeg said only "Could find no file" of frames it may not read)
   if [ ! -r "$abs/frames/$f" ]; then
     echo "${0##*/}: $dir/frames/$f: cannot read: Permission denied" >&2
