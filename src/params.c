@@ -646,12 +646,13 @@ const lw_param_def lw_param_table[] = {
   STRING("plot", "gcode_pen_up", gcode_pen_up, "G0 Z5", "",
          "The G-code line that lifts the pen in final.gcode, written as it is: `G0 Z5` for a pen on the "
          "Z axis, `M5` or `M3 S30` for a servo on a GRBL fork. One line of printable ASCII, at most 79 "
-         "characters (GRBL's line buffer). The file sets the feed of plot.speed_down before it (`G94 F...`), "
+         "characters (GRBL's line buffer), with no X or Y word (a move across the page, which the bed check "
+         "would not see) nor GRBL system command ($) outside a ( comment ): refused. The file sets the feed of plot.speed_down before it (`G94 F...`), "
          "so a G1 here without an F of its own moves at that."),
   STRING("plot", "gcode_pen_down", gcode_pen_down, "G1 Z0 F500", "",
          "The G-code line that lowers the pen in final.gcode, written as it is (a feed it sets is "
          "replaced by plot.speed_down on the first drawing move); e.g. `M3 S90 G4 P0.2` for a servo "
-         "that needs 0.2 s to settle. One line of printable ASCII, at most 79 characters."),
+         "that needs 0.2 s to settle. One line as plot.gcode_pen_up's."),
   STRING("layers", "names", ly_names, "", "",
          "Hatching layers or colour pens: one name a layer (ASCII letters, digits, `-`, `_`, `.`; it labels "
          "the pen's SVG layer, so no two alike), separated by blanks or commas (at most 16). Each "
@@ -1771,11 +1772,11 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
   ** every travel, a byte past ASCII is refused by most controllers. */
   const char *pen_key[2] = {"gcode_pen_up", "gcode_pen_down"}, *pen_line[2] = {p->gcode_pen_up, p->gcode_pen_down};
   for (int k = 0; p->gcode && k < 2; k++) {
-    if (lw_plotter_gcode_line_ok(pen_line[k])) continue;
+    const char *fault = lw_plotter_gcode_line_fault(pen_line[k]);
+    if (!fault) continue;
     lw_params_origin(p, lw_params_find("plot", pen_key[k]), where, sizeof where);
-    return lw_error_set(err, LW_EINPUT,
-                        "%s: key 'plot.%s' = '%s': expected a G-code line of printable ASCII, at most %d characters "
-                        "(output.gcode = 1)", where, pen_key[k], pen_line[k], LW_PLOTTER_GCODE_LINE_MAX);
+    return lw_error_set(err, LW_EINPUT, "%s: key 'plot.%s' = '%s': %s (output.gcode = 1)", where, pen_key[k],
+                        pen_line[k], fault);
   }
   /* a feed is written to the thousandth of a mm/min: below half of one it
   ** would be F0, which GRBL refuses (error 22) */

@@ -29,11 +29,37 @@ size_t lw_plotter_chords(const double *b, double tol)
   return n > LW_PLOTTER_CHORDS_MAX ? LW_PLOTTER_CHORDS_MAX : (size_t)n;
 }
 
-int lw_plotter_gcode_line_ok(const char *line)
+#define SPELLED_(x) #x
+#define SPELLED(x) SPELLED_(x)
+
+const char *lw_plotter_gcode_line_fault(const char *line)
 {
+  static const char *const ascii = "expected one line of printable ASCII, at most " SPELLED(LW_PLOTTER_GCODE_LINE_MAX)
+                                   " characters";
+  if (!line || !line[0] || strlen(line) > LW_PLOTTER_GCODE_LINE_MAX) return ascii;
   for (const char *c = line; *c; c++)
-    if (*c < 0x20 || *c >= 0x7f) return 0;
-  return line[0] != '\0' && strlen(line) <= LW_PLOTTER_GCODE_LINE_MAX;
+    if (*c < 0x20 || *c >= 0x7f) return ascii;
+  /* a pen line is written at every lift and every lowering: a move in the
+  ** page's plane there (a shared scene's G0 X-900 Y-900) drove the head
+  ** off the bed at each stroke, unseen by the bed check and the plot time,
+  ** and a GRBL system command ($RST=* resets every setting) ran as often */
+  int depth = 0; /* inside a ( comment ) */
+  for (const char *c = line; *c; c++) {
+    if (*c == '(') depth++;
+    else if (*c == ')' && depth) depth--;
+    else if (depth) continue;
+    else if (*c == '$')
+      return "a GRBL system command ($), which changes the machine's settings or state: expected a line that "
+             "only lifts or lowers the pen";
+    else if (strchr("XxYy", *c)) {
+      const char *v = c + 1;
+      while (*v == ' ') v++;
+      if (*v && strchr("+-.0123456789", *v))
+        return "a move across the page (an X or Y word), which the bed check and the plot time do not see: "
+               "expected a line that only lifts or lowers the pen";
+    }
+  }
+  return NULL;
 }
 
 /* A feed, mm/min: to the thousandth, so that a slow pen is not F0, which
@@ -170,9 +196,8 @@ lw_status lw_plotter_check(const lw_strokes *s, const lw_output_page *page, cons
     return lw_error_set(err, LW_EINPUT, "%s: pen-up speed %g mm/s: expected a positive number", path, o->speed_up);
   const char *line[2] = {o->pen_up, o->pen_down}, *what[2] = {"pen-up", "pen-down"};
   for (int k = 0; k < 2; k++) {
-    if (!line[k] || !lw_plotter_gcode_line_ok(line[k]))
-      return lw_error_set(err, LW_EINPUT, "%s: the %s line '%s': expected one line of printable ASCII, at most "
-                          "%d characters", path, what[k], line[k] ? line[k] : "", LW_PLOTTER_GCODE_LINE_MAX);
+    const char *fault = lw_plotter_gcode_line_fault(line[k]);
+    if (fault) return lw_error_set(err, LW_EINPUT, "%s: the %s line '%s': %s", path, what[k], line[k] ? line[k] : "", fault);
   }
   return LW_OK;
 }

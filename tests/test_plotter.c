@@ -504,17 +504,29 @@ Test(plotter, command_line_writes_the_same_files_for_the_same_seed)
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set plot.gcode_pen_up= --quiet "
                           "--out %s/bad 2>%s/err.txt", bin, root, dir, dir), 2);
   char *errs = lw_test_slurp("%s/err.txt", dir);
-  cr_assert(strstr(errs, "key 'plot.gcode_pen_up'") && strstr(errs, "expected a G-code line"), "%s", errs);
+  cr_assert(strstr(errs, "key 'plot.gcode_pen_up'") && strstr(errs, "expected one line of printable ASCII"), "%s",
+            errs);
   free(errs);
   cr_assert_neq(lw_test_sh("test -e %s/bad", dir), 0, "nothing written");
-  /* so is one past GRBL's 79 characters, and a speed whose feed would be
-  ** F0 (drawing, or travelling at feed) */
+  /* so is one past GRBL's 79 characters, a speed whose feed would be F0
+  ** (drawing, or travelling at feed), and a pen line that moves across the
+  ** page or is a GRBL system command (a shared scene's, run at every
+  ** stroke: G0 X-900 Y-900 drove the head off the bed unseen, $RST=* reset
+  ** the machine's settings); a Z move, a servo's S, a dwell's P and an X in
+  ** a comment are pen lines */
   static const char *const bad[][2] = {
     {"'plot.gcode_pen_down=M3 S90 G4 P0.2 %0*d'", "key 'plot.gcode_pen_down'"},
     {"plot.speed_down=0.0000083", "key 'plot.speed_down' = 8.3e-06 mm/s: final.gcode's feed"},
     {"plot.speed_up=0.000001 --set plot.gcode_travel=feed", "key 'plot.speed_up' = 1e-06 mm/s"},
+    {"'plot.gcode_pen_down=G0 X-900 Y-900'", "key 'plot.gcode_pen_down' = 'G0 X-900 Y-900': a move across the page "
+                                              "(an X or Y word), which the bed check and the plot time do not see"},
+    {"'plot.gcode_pen_up=G1 Z5 y .5'", "key 'plot.gcode_pen_up' = 'G1 Z5 y .5': a move across the page"},
+    {"'plot.gcode_pen_up=$RST=*'", "key 'plot.gcode_pen_up' = '$RST=*': a GRBL system command ($)"},
   };
-  for (int k = 0; k < 3; k++) {
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set anneal.sweeps=0 --quiet --out "
+                          "%s/servo --set 'plot.gcode_pen_down=M3 S90 G4 P0.2 (X axis: 0)' --set "
+                          "'plot.gcode_pen_up=G0 Z5 (lift $5)'", bin, root, dir), 0);
+  for (int k = 0; k < 6; k++) {
     char keys[160];
     snprintf(keys, sizeof keys, bad[k][0], 70, 0);
     cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set %s --quiet --out %s/bad "

@@ -74,11 +74,13 @@ typedef struct {
 ** LW_PLOTTER_CHORDS_MAX. */
 size_t lw_plotter_chords(const double *b, double tol);
 
-/* 1 when line is one G-code line a controller takes: not empty, printable
+/* NULL when line is a pen line a controller takes: not empty, printable
 ** ASCII only, at most LW_PLOTTER_GCODE_LINE_MAX characters (GRBL's line
-** buffer holds 80 with its end). */
+** buffer holds 80 with its end), and no move across the page (an X or Y
+** word) nor GRBL system command ($) outside its ( comments ); else what is
+** wrong, as "expected ..." or "a ...: expected ...". */
 #define LW_PLOTTER_GCODE_LINE_MAX 79
-int lw_plotter_gcode_line_ok(const char *line);
+const char *lw_plotter_gcode_line_fault(const char *line);
 
 /* What writing final.hpgl (gcode 0) or final.gcode (1) of the paths s
 ** would refuse, without writing: the drawing checks it before any of its
