@@ -169,8 +169,11 @@ lw_status lw_plotter_check(const lw_strokes *s, const lw_output_page *page, cons
                         o->speed_down);
   for (size_t k = 0; k < 8 * s->n_segs; k++)
     if (fabs(s->b[k]) > LW_PLOTTER_MM_MAX)
-      return lw_error_set(err, LW_EINPUT, "%s: a control point of segment %zu lies %g mm from the origin: "
-                          "expected at most %g", path, k / 8, fabs(s->b[k]), LW_PLOTTER_MM_MAX);
+      /* (%g wrote both as 1e+08, and "segment N" counted the strokes' pieces,
+      ** which no file of the user's numbers) */
+      return lw_error_set(err, LW_EINPUT, "%s: a stroke reaches %c = %.10g mm: expected coordinates within %.10g mm "
+                          "of the page's corner; plot.crop = 1 cuts the strokes to the page", path, "xy"[k % 2],
+                          s->b[k], LW_PLOTTER_MM_MAX);
   if (o->bed[0] > 0.0 || o->bed[1] > 0.0) {
     extent e = reach(s, page, o, o->turn, gcode);
     int k = off_bed(&e, o->bed, 0);

@@ -614,6 +614,18 @@ Test(plotter, a_drawing_past_the_bed_is_refused_and_travel_can_feed)
   }
   for (size_t k = 0; k < s->n_segs; k++)
     for (int c = 0; c < 8; c += 2) s->b[8 * k + (size_t)c] += 8.0;
+  /* a point past the files' reach: its coordinate and the limit in full
+  ** (%g wrote "lies 1e+08 mm ...: expected at most 1e+08") */
+  {
+    lw_error err = {0};
+    o.bed[0] = o.bed[1] = 0;
+    const double kept = s->b[5];
+    s->b[5] = -100000020.0;
+    cr_assert_eq(lw_plotter_check(s, &page, &o, 0, path, &err), LW_EINPUT);
+    cr_assert(strstr(err.msg, ": a stroke reaches y = -100000020 mm: expected coordinates within 100000000 mm of the "
+                              "page's corner; plot.crop = 1 cuts"), "%s", err.msg);
+    s->b[5] = kept;
+  }
   /* travel by feed: each path's start and the way home are G1 at speed_up
   ** (150 mm/s: F9000), each path's first drawing move sets speed_down again */
   o.bed[0] = o.bed[1] = 0;
