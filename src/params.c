@@ -613,7 +613,7 @@ const lw_param_def lw_param_table[] = {
       "Paths shorter than this (in widths of their pen, as for `join_distance`), after joining "
       "and cropping, are left "
       "out: below about three widths a stroke prints as a dot and costs a whole pen lift. 0 = "
-      "keep all."),
+      "keep all but those under 0.0001 mm, a point at the files' precision."),
   NUM("plot", "speed_down", LW_PT_DOUBLE, speed_down, "50", "mm/s", 0, 1e5, LW_MIN_OPEN,
       "Pen-down speed for the plot time estimate, and the speed final.hpgl (VS, in cm/s) and "
       "final.gcode (F, in mm/min) draw at. The default is an AxiDraw's at its default "

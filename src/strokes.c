@@ -632,7 +632,7 @@ lw_strokes *lw_strokes_drop(const lw_strokes *in, const double *min_length, lw_s
   if (!out) return NULL;
   for (int q = 0; q < in->n_pens; q++)
     for (size_t k = in->pen_first[q]; k < in->pen_first[q + 1]; k++) {
-      if (min_length[q] > 0 && lw_strokes_length(in, k) < min_length[q]) {
+      if (lw_strokes_length(in, k) < fmax(min_length[q], LW_STROKES_DOT_MM)) {
         rep->dropped++;
         continue;
       }
@@ -716,8 +716,8 @@ lw_strokes *lw_strokes_prepare(const lw_splines *sp, const lw_plot *plot, const 
   lw_strokes *s = lw_strokes_from_plot(sp, plot, err), *t;
   if (!s) return NULL;
   rep->lifts_before = s->n;
-  int join = 0, drop = 0;
-  for (int k = 0; k < s->n_pens; k++) join |= o->join_dist[k] > 0, drop |= o->min_length[k] > 0;
+  int join = 0;
+  for (int k = 0; k < s->n_pens; k++) join |= o->join_dist[k] > 0;
   if (join) {
     t = lw_strokes_join(s, o->join_dist, o->join_angle, rep, err);
     lw_strokes_free(s);
@@ -728,11 +728,9 @@ lw_strokes *lw_strokes_prepare(const lw_splines *sp, const lw_plot *plot, const 
     lw_strokes_free(s);
     if (!(s = t)) return NULL;
   }
-  if (drop) {
-    t = lw_strokes_drop(s, o->min_length, rep, err);
-    lw_strokes_free(s);
-    if (!(s = t)) return NULL;
-  }
+  t = lw_strokes_drop(s, o->min_length, rep, err);
+  lw_strokes_free(s);
+  if (!(s = t)) return NULL;
   if (lw_strokes_order(s, o->order, o->home_x, o->home_y, o->home_back, rep, err)) return fail(s);
   rep->lifts_after = s->n;
   return s;

@@ -172,6 +172,16 @@ Test(strokes, drops_paths_shorter_than_the_minimum)
   cr_assert_eq(d->src[0], 1);
   cr_assert_eq(d->src[1], 2);
   lw_strokes_free(d);
+  /* min_length 0 keeps all but a point at the files' precision (written
+  ** "M 50 50 C 50 50 50 50 50 50", a laser firing on one spot) */
+  add_line(s, 0, 3, 50, 50, 50.00002, 50);
+  add_line(s, 0, 4, 50, 50, 50 + 1.5 * LW_STROKES_DOT_MM, 50);
+  memset(&rep, 0, sizeof rep);
+  d = lw_strokes_drop(s, (const double[]){0.0}, &rep, NULL);
+  cr_assert_eq(rep.dropped, 1);
+  cr_assert_eq(d->n, 4);
+  cr_assert_eq(d->src[3], 4);
+  lw_strokes_free(d);
   lw_strokes_free(s);
 }
 

@@ -32,7 +32,10 @@
 **      each holding at most one root, found by bisection to the last bit.
 **      A piece is the exact sub-curve between two roots (de Casteljau),
 **      its end points clamped into the rectangle (a move of ~1e-15 mm).
-**   3. drop: paths shorter than `min_length` are left out.
+**   3. drop: paths shorter than `min_length` are left out, and whatever it
+**      is those shorter than LW_STROKES_DOT_MM: a dot at the files'
+**      precision (the SVG's "M 50 50 C 50 50 50 50 50 50", a laser firing
+**      on one spot), which plot.min_length = 0 kept.
 **   4. order: each pen's paths as plot.h orders them (greedy, 2-opt).
 ** Join comes before crop, so a bridge never leaves the rectangle, and drop
 ** after both, so short pieces that join into a long path stay, and the
@@ -112,6 +115,7 @@ lw_strokes *lw_strokes_join(const lw_strokes *in, const double *dist, double ang
                             lw_error *err);
 lw_strokes *lw_strokes_crop(const lw_strokes *in, double x0, double y0, double x1, double y1,
                             lw_strokes_report *rep, lw_error *err);
+#define LW_STROKES_DOT_MM 1e-4 /* two of final.svg's last decimals (mm) */
 lw_strokes *lw_strokes_drop(const lw_strokes *in, const double *min_length, lw_strokes_report *rep, lw_error *err);
 
 /* Step 4 in place: orders each pen's paths from home (hx, hy) and sets
