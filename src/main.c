@@ -581,13 +581,42 @@ static void on_signal(int sig)
 }
 
 /* Progress on stderr: a bar redrawn in place on a terminal, one plain line
-** per tenth of the run otherwise, nothing with --quiet. */
+** per tenth of the run otherwise (and every PLAIN_SECONDS at least: a job
+** of ten hours said nothing for its first), nothing with --quiet. */
+#define PLAIN_SECONDS 600.0
+/* The time left is taken at the rate of the recent sweeps, between the
+** marks: a job suspended for an hour early on (SIGSTOP, a batch system)
+** read hours left to its end at the rate of all its sweeps. */
+#define MARK_SECONDS 30.0
 typedef struct {
   int quiet, tty;
   long start_sweep, next_plain, last_plain;
-  double swept_from; /* the clock when the first sweep began: set-up (a large
-                     ** picture's decoding, the placement) is not a sweep's cost */
+  double plain_t;    /* when the last plain line was shown */
+  double mark_t[2];  /* the older and the newer mark: clock and sweep, from the
+                     ** first sweep's start (a large picture's decoding, the
+                     ** placement, is not a sweep's cost) */
+  long mark_sweep[2];
 } progress;
+
+static void progress_init(progress *pg, int quiet, const lw_anneal *a)
+{
+  const double t = lw_anneal_seconds(a);
+  *pg = (progress){quiet, isatty(2), a->sweep, a->sweep, -1, t, {t, t}, {a->sweep, a->sweep}};
+}
+
+/* The seconds left at the recent rate: since the older mark, which moves up
+** to the newer one (and that to now) where `move` says (a bar: every
+** MARK_SECONDS; plain lines: at each, so that the rate is the last line's
+** stretch), at the whole run's before the marks have moved. */
+static double progress_left(progress *pg, const lw_anneal *a, double t, int move)
+{
+  if (move) {
+    pg->mark_t[0] = pg->mark_t[1], pg->mark_sweep[0] = pg->mark_sweep[1];
+    pg->mark_t[1] = t, pg->mark_sweep[1] = a->sweep;
+  }
+  const long done = a->sweep - pg->mark_sweep[0];
+  return done > 0 ? (t - pg->mark_t[0]) / (double)done * (double)(a->end_sweep - a->sweep) : 0.0;
+}
 
 /* What moves: the temperature and acceptance of the chain, or the clock
 ** and kinetic energy of the dynamics. */
@@ -622,12 +651,11 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
   if (pg->quiet) return;
   double t = lw_anneal_seconds(a);
   long done = a->sweep - pg->start_sweep, total = a->end_sweep - pg->start_sweep;
-  double per = done > 0 ? (t - pg->swept_from) / (double)done : 0.0;
-  double left = per * (double)(a->end_sweep - a->sweep);
   if (pg->tty) {
     static double shown = -1;
     if (!final && t - shown < 0.2) return;
     shown = t;
+    const double left = progress_left(pg, a, t, t - pg->mark_t[1] >= MARK_SECONDS);
     char state[160];
     progress_state(a, 4, state, sizeof state);
     char rest[32] = "-"; /* unknown before a sweep has taken its time */
@@ -655,8 +683,11 @@ static void progress_show(progress *pg, const lw_anneal *a, int final)
     fprintf(stderr, "\r%.*s%*s", len, line, shown_len > len ? shown_len - len : 0, "");
     shown_len = len;
     if (final) fputc('\n', stderr);
-  } else if ((final && a->sweep != pg->last_plain) || a->sweep >= pg->next_plain) {
+  } else if ((final && a->sweep != pg->last_plain) || a->sweep >= pg->next_plain ||
+             (a->sweep != pg->last_plain && t - pg->plain_t >= PLAIN_SECONDS)) {
     pg->last_plain = a->sweep;
+    pg->plain_t = t;
+    const double left = progress_left(pg, a, t, 1);
     char state[160];
     progress_state(a, 6, state, sizeof state);
     char rest[32] = "-";
@@ -870,7 +901,8 @@ static int loop_fail(lw_anneal *a, long began, watcher *w, lw_error *err)
 static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher *w, lw_error *err)
 {
   a->stop = &stop_requested;
-  progress pg = {quiet, isatty(2), a->sweep, a->sweep, -1, lw_anneal_seconds(a)};
+  progress pg;
+  progress_init(&pg, quiet, a);
   /* a signal during start-up stops before the first sweep; the processes
   ** of an MPI run stop together, at the sweep where one of them was asked */
   int stopped = ((net ? net->stop_agreed : stop_requested) || (stop_at >= 0 && a->sweep >= stop_at)) &&
