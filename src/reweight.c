@@ -385,7 +385,9 @@ static lw_status gather(const lw_trace *const *t, const char *const *path, const
         st = lw_error_set(err, LW_ENOMEM, "%s: out of memory for the autocorrelation of rung %d", path[r], q);
         goto done;
       }
-      size_t g = (size_t)ceil(2.0 * fmax(tau, 0.5));
+      /* (rounded, not raised: uncorrelated rows read a tau of 0.5 and a
+      ** little noise, and every other one was thrown away) */
+      size_t g = (size_t)lround(2.0 * fmax(tau, 0.5));
       if (c > g * LW_REWEIGHT_SAMPLES) g = (c + LW_REWEIGHT_SAMPLES - 1) / LW_REWEIGHT_SAMPLES;
       s->open += !window;
       s->rounded += lw_trace_rounded(x, c);

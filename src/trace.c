@@ -309,21 +309,25 @@ static void combine(column_stats *c, int k, const double *gap)
   ** runs fail p < 0.001 in 37 % of trials).  A run without spread fixes the
   ** mean (all such runs must agree on it), and the others count a degree of
   ** freedom each. */
-  double b = 0.0, chi2 = 0.0, sw = 0.0, swm = 0.0, m_exact = 0.0;
+  double b = 0.0, chi2 = 0.0, sw = 0.0, swm = 0.0, m_exact = 0.0, ref = NAN;
   int n_exact = 0, apart = 0;
   for (int r = 0; r < k; r++) {
     const lw_series_stats *s = &c->run[r];
     b += (s->mean - m) * (s->mean - m) / (k - 1);
     if (s->stderr_mean > 0.0) {
+      /* the average as a step from the first such mean: equal means give it
+      ** exactly, and a chi-square of 0 (their sum's rounding read p_runs
+      ** 0.99999999999993 for a run named twice) */
+      if (isnan(ref)) ref = s->mean;
       sw += 1.0 / (s->stderr_mean * s->stderr_mean);
-      swm += s->mean / (s->stderr_mean * s->stderr_mean);
+      swm += (s->mean - ref) / (s->stderr_mean * s->stderr_mean);
     } else {
       apart |= n_exact && s->mean != m_exact;
       m_exact = s->mean;
       n_exact++;
     }
   }
-  double m_w = n_exact ? m_exact : swm / sw;
+  double m_w = n_exact ? m_exact : ref + swm / sw;
   for (int r = 0; r < k; r++) {
     const lw_series_stats *s = &c->run[r];
     if (s->stderr_mean > 0.0) chi2 += (s->mean - m_w) * (s->mean - m_w) / (s->stderr_mean * s->stderr_mean);
@@ -859,7 +863,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
        "runs): that run's error bar, and the test of the runs against each other, are rough"
        : "fewer than 25 independent samples: the error bar is rough");
   warn(per_column, t[0], cs, k, WARN_BATCH, "the means of 20 batches spread more than 1.5 times the error bar allows "
-       "(by chance 1 time in 700): a slower mode the autocorrelation window missed, so the error bar is too small "
+       "(by chance 1 time in 700): a slower mode the autocorrelation time missed, so the error bar is too small "
        "(batch_ratio in --csv is the factor; run longer, or trust the larger bar)");
   warn(per_column, t[0], cs, k, WARN_DRIFT, "the first and second halves differ by more than 4 standard errors: not "
        "yet stationary (start later with --from), or, where the batch means warn too, the same slow mode (run "
