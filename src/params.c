@@ -854,7 +854,8 @@ const lw_param_def lw_param_table[] = {
       "Gauss-Legendre points per knot span for the matrices M, D and K: at least as many in all as "
       "control points (fewer leave motions that the energy does not see), so at least 2 (a curve "
       "has fewer spans than points; 1 is read only in a run begun before 2026-12-05); `order` "
-      "points make the matrices of a polynomial curve exact."),
+      "points make the matrices of a polynomial curve exact. A span whose weights differ by more than "
+      "a factor 2 takes them on each of its pieces toward its ends (docs/NURBS.md)."),
   NUM("nurbs", "fixed", LW_PT_INT, nb_fixed, "0", "", 0, 1e9, 0,
       "Control points held at each end (1 = the ends of the curve; 2 = its end tangents too). "
       "Monte Carlo and the dynamics move only the others. Gravity is the [dynamics] "

@@ -8,6 +8,7 @@
 ** Carlo's weight move.
 */
 #include <criterion/criterion.h>
+#include <gsl/gsl_errno.h>
 #include <gsl/gsl_integration.h>
 #include <math.h>
 #include <stdlib.h>
@@ -350,4 +351,67 @@ Test(nurbs_weights, the_quench_of_a_refined_wire_alternates_the_points_solve_and
   free(x0);
   free(x1);
   fwire_close(&w);
+}
+
+/* Weights far apart turn the rational basis within about q^(-1/3) of a
+** span's ends, q their ratio: ten Gauss points spread over a span stepped
+** over the turn, and an anneal put the curve's bends there (a wire of
+** weights 1e-4 read an elastic energy 18 times below its own, 1e10 times
+** at 1e-12 from a state file).  The matrices' energy against an adaptive
+** integral (GSL's QAG, 61 points) of 1/2 (alpha |c_u|^2 + beta |c_uu|^2) over each
+** span, weights from 2 to 1e12 apart, the middle ones light or every
+** other one. */
+typedef struct {
+  lw_nurbs *c;
+  double alpha, beta;
+} elastic_ctx;
+
+static double elastic_density(double u, void *ctx)
+{
+  const elastic_ctx *e = ctx;
+  const size_t k = (size_t)e->c->order;
+  double R[3 * LW_NURBS_ORDER_MAX], cu[2] = {0, 0}, cuu[2] = {0, 0};
+  const size_t first = lw_nurbs_rational(e->c, u, R);
+  for (size_t i = 0; i < k; i++)
+    for (int d = 0; d < 2; d++) {
+      cu[d] += R[k + i] * e->c->P[2 * (first + i) + (size_t)d];
+      cuu[d] += R[2 * k + i] * e->c->P[2 * (first + i) + (size_t)d];
+    }
+  return 0.5 * (e->alpha * (cu[0] * cu[0] + cu[1] * cu[1]) + e->beta * (cuu[0] * cuu[0] + cuu[1] * cuu[1]));
+}
+
+Test(nurbs_weights, weights_far_apart_keep_the_elastic_energy_of_the_curve)
+{
+  const double knot[] = {0, 0, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1, 1};
+  const double P[] = {-5, 5, -4, 6.5, -2.5, 3.5, 0, 6, 2.5, 4, 4, 6.5, 5, 5};
+  static const double eps[] = {0.5, 0.25, 0.125, 1e-2, 1e-4, 1e-8, 1e-12};
+  gsl_integration_workspace *ws = gsl_integration_workspace_alloc(4000);
+  gsl_error_handler_t *was = gsl_set_error_handler_off();
+  for (int light = 0; light < 2; light++)
+    for (size_t e = 0; e < sizeof eps / sizeof *eps; e++) {
+      double w[7];
+      for (int i = 0; i < 7; i++) w[i] = (light ? i % 2 : i > 0 && i < 6) ? eps[e] : 1.0;
+      lw_error err = {0};
+      lw_nurbs *c = lw_nurbs_new(4, 7, knot, P, w, &err);
+      cr_assert_not_null(c, "%s", err.msg);
+      lw_dnurbs *d = lw_dnurbs_new(c, 35, 10, 10, &err);
+      cr_assert_not_null(d, "%s", err.msg);
+      const double got = lw_band_energy(d->K, 7, 4, P);
+      elastic_ctx ctx = {c, 35, 10};
+      gsl_function f = {elastic_density, &ctx};
+      double want = 0;
+      for (int s = 3; s < 7; s++) {
+        double part, abserr;
+        const int st = gsl_integration_qag(&f, knot[s], knot[s + 1], 0, 1e-11, 4000, GSL_INTEG_GAUSS61, ws, &part, &abserr);
+        cr_assert(!st || abserr < 1e-9 * fabs(part), "QAGS: %s, %g +- %g", gsl_strerror(st), part, abserr);
+        want += part;
+      }
+      cr_log_info("weights %g (%s): elastic %.12g, adaptive %.12g", eps[e], light ? "every other" : "the middle",
+                  got, want);
+      cr_assert(fabs(got / want - 1) < 1e-6, "weights %g: %.12g against %.12g", eps[e], got, want);
+      lw_dnurbs_free(d);
+      lw_nurbs_free(c);
+    }
+  gsl_set_error_handler(was);
+  gsl_integration_workspace_free(ws);
 }
