@@ -200,7 +200,8 @@ lw_status lw_plotter_check(const lw_strokes *s, const lw_output_page *page, cons
   const char *line[2] = {o->pen_up, o->pen_down}, *what[2] = {"pen-up", "pen-down"};
   for (int k = 0; k < 2; k++) {
     const char *fault = lw_plotter_gcode_line_fault(line[k]);
-    if (fault) return lw_error_set(err, LW_EINPUT, "%s: the %s line '%s': %s", path, what[k], line[k] ? line[k] : "", fault);
+    if (fault)
+      return lw_error_set(err, LW_EINPUT, "%s: the %s line '%s': %s", path, what[k], line[k] ? line[k] : "", fault);
   }
   return LW_OK;
 }

@@ -402,7 +402,8 @@ Test(nurbs_weights, weights_far_apart_keep_the_elastic_energy_of_the_curve)
       double want = 0;
       for (int s = 3; s < 7; s++) {
         double part, abserr;
-        const int st = gsl_integration_qag(&f, knot[s], knot[s + 1], 0, 1e-11, 4000, GSL_INTEG_GAUSS61, ws, &part, &abserr);
+        const int st =
+            gsl_integration_qag(&f, knot[s], knot[s + 1], 0, 1e-11, 4000, GSL_INTEG_GAUSS61, ws, &part, &abserr);
         cr_assert(!st || abserr < 1e-9 * fabs(part), "QAGS: %s, %g +- %g", gsl_strerror(st), part, abserr);
         want += part;
       }

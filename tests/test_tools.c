@@ -933,7 +933,8 @@ Test(tools, a_sweep_takes_no_lock_that_is_a_link_or_no_file)
   /* a sweep killed outright (SIGKILL) never ran its EXIT trap: its notes go
   ** with the next sweep into the directory */
   cr_assert_eq(sh("mkdir %s/m/.sweep-notes.kiLLed && : >%s/m/.sweep-notes.kiLLed/notes && %s %s --seeds 1 " TINY
-                  " --bin %s --out %s/m", dir, dir, tool("seed-sweep"), scene(), env("LW_BIN"), dir), 0, "%s", err_txt());
+                  " --bin %s --out %s/m", dir, dir, tool("seed-sweep"), scene(), env("LW_BIN"), dir),
+               0, "%s", err_txt());
   cr_assert(!exists("m/.sweep-notes.kiLLed"), "a killed sweep's notes were left for good");
   /* a run's folder planted as a link: the run was written where it pointed
   ** and left out of the table unsaid, exit 0 */
