@@ -158,6 +158,18 @@ Test(checkpoint, every_run_data_value_is_checked_on_resume)
     /* a count the lines do not hold, and a node line missing, said so */
     {"s/^splines = \\([0-9]*\\)$/splines = 1\\1/", "but the section ends after"},
     {"0,/^node = /{//d}", "segments have"},
+    /* at each check's edge (a mutation tester's: each survived a looser
+    ** check): the counts' sum one past proposed, one more accepted, nan past
+    ** the chain's, a fraction; an energy off by some 5e-5 of itself; an sd
+    ** of -1 */
+    {"s/^moves.point = \\([0-9]*\\) .*/moves.point = \\1 \\1 1 0/", "+ crowded + outside <= proposed"},
+    {"s/^window.point = .*/window.point = 6 7/", "[chain] window.point: more accepted (7) than proposed (6)"},
+    {"s/^trace_mark.point = \\([0-9]*\\) \\([0-9]*\\) .*/trace_mark.point = \\1 \\2 5/",
+     "[run] trace_mark.point: beyond"},
+    {"s/^moves.point = \\([0-9]*\\) /moves.point = \\1.5 /", "[chain] moves.point: expected 4 to 6 whole numbers"},
+    {"s/^\\(energy.bending = [0-9]*\\.[0-9]\\{4\\}\\)[0-4]/\\19/; t; "
+     "s/^\\(energy.bending = [0-9]*\\.[0-9]\\{4\\}\\)[5-9]/\\10/", "but the state is at "},
+    {"s/^prev_stats = .*/prev_stats = 0 -1 0/", "[run] prev_stats: expected 'mean sd samples' with sd >= 0"},
   };
   stopped_run();
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
@@ -168,6 +180,13 @@ Test(checkpoint, every_run_data_value_is_checked_on_resume)
   }
   /* unedited, the copy resumes: the edits above are what was refused */
   cr_assert_eq(resume_edited("s/^sweep = 20$/sweep = 20/"), 0);
+  /* the sweep edited forward within its temperature step (a step's edge,
+  ** as at 20, is the schedule's check): past the trace's rows */
+  cr_assert_eq(lw_test_sh("rm -rf %s/r && %s run %s/tests/fixtures/v1/plain.ini --out %s/r --stop-at 21 --quiet",
+                          dir, lw_test_bin(), lw_test_root(), dir), 0);
+  cr_assert_eq(resume_edited("s/^sweep = 21$/sweep = 22/"), 2);
+  cr_assert(err_has("x/state.lw counts end at sweep 21, but it is at sweep 22"), "%s",
+            lw_test_slurp("%s/err.txt", dir));
 }
 
 /* A run whose trace.csv is gone is refused by resume (state.lw counts its
@@ -195,7 +214,10 @@ Test(checkpoint, a_tempering_sections_values_are_refused_naming_line_and_key)
                0);
   static const struct { const char *sed, *key, *msg; } bad[] = {
     {"s/^ladder = .*/ladder = 0.01 0.001 1/", "ladder", "expected increasing temperatures"},
+    {"s/^ladder = .*/ladder = 0.01 0.01 1/", "ladder", "expected increasing temperatures"},
     {"s/^at_label = .*/at_label = 0 2 0 1 2 1/", "at_label", "expected a permutation of the replicas"},
+    {"s/^at_label = \\([0-9]\\) [0-9]/at_label = \\1 3/", "at_label",
+     "expected a permutation of the replicas, each with a direction 0, 1 or 2"},
     {"s/^swaps = .*/swaps = 5 6 5 0/", "swaps", "more accepted than tried at pair 0"},
     {"s/^window = .*/window = 9 0 5 0/", "window", "9 tried at pair 0, beyond the 5 of swaps"},
     {"s/^trace_mark = .*/trace_mark = 9 0 5 0/", "trace_mark", "9 tried at pair 0, beyond the 5 of swaps"},

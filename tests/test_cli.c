@@ -2159,7 +2159,9 @@ Test(cli, an_extension_a_full_disk_stops_says_how_to_go_on)
 ** after it: strace sees fsync of the temporary file, the rename, then fsync
 ** of the directory.  Without the first, a power cut could leave an empty
 ** state.lw, the run's only checkpoint (a helper's mutant dropped the fsync
-** and every test passed); without the second, the old one. */
+** and every test passed); without the second, the old one.  The trace,
+** whose bytes state.lw counts, is synced before each state.lw's rename (a
+** mutant that left that out passed too). */
 Test(cli, every_file_a_run_replaces_is_synced_before_and_its_rename_after)
 {
   /* (LeakSanitizer cannot run under ptrace: make asan's build leaves it out here) */

@@ -30,6 +30,18 @@ Test(dynamics_cli, the_hanging_lines_settle_and_resume_gives_the_same_bytes)
   const char *same[] = {"state.lw", "trace.csv", "final.svg"};
   for (int k = 0; k < 3; k++)
     cr_assert_eq(sh("cmp -s %s/a/%s %s/b/%s", dir, same[k], dir, same[k]), 0, "%s differs after a resume", same[k]);
+  /* and summary.json's account of the motion (a halvings count written in
+  ** the steps' place would leave both state.lw alike) */
+  cr_assert_eq(sh("for r in a b; do sed -n '/^  \"dynamics\": {/,/^  }/p' %s/$r/summary.json > %s/$r.dyn; done && "
+                  "grep -q '\"halvings\": 0,' %s/a.dyn && cmp -s %s/a.dyn %s/b.dyn", dir, dir, dir, dir, dir),
+               0, "summary.json's dynamics differ after a resume");
+  /* a momentum line lost (an edited or damaged file): refused, not read
+  ** onto the next coordinates */
+  cr_assert_eq(sh("%s run %s/params/hanging.ini --out %s/c --quiet %s --stop-at 23 && sed -i "
+                  "'0,/^momentum = /{/^momentum = /d}' %s/c/state.lw && { %s resume %s/c --quiet 2> %s/c.err; "
+                  "test $? = 2; } && grep -q 'c/state.lw: \\[dynamics\\] momentum: 404 of the system.s 408 "
+                  "coordinates' %s/c.err", lw_test_bin(), lw_test_root(), dir, set, dir, lw_test_bin(), dir, dir, dir),
+               0, "%s", lw_test_slurp("%s/c.err", dir));
   /* the trace has the clock and the energies, and the motion dies down */
   cr_assert_eq(sh("head -1 %s/a/trace.csv | grep -q '^sweep,time,strain,bending,parametrisation,load,"
                   "potential_energy,kinetic,total$'", dir), 0);
