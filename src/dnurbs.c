@@ -23,12 +23,18 @@ typedef void gauss_fn(void *ctx, lw_nurbs *c, double u, double wq, size_t first,
 ** Gauss points.  Up to a ratio of 2 (a circle's arcs, 1.4) the span is
 ** whole, as it was: its energy then within 1e-7 (2.4e-6 whole at 4, 1e-1
 ** at 100). */
+#define SPAN_HALVINGS_MAX 30
 static int span_halvings(const lw_nurbs *c, size_t s)
 {
   const size_t k = (size_t)c->order;
   double lo = c->w[s + 1 - k], hi = lo;
   for (size_t i = s + 2 - k; i <= s; i++) lo = fmin(lo, c->w[i]), hi = fmax(hi, c->w[i]);
   const double q = hi / lo;
+  /* pieces of h 2^-30 resolve a ratio of 1e27, past which a piece's Gauss
+  ** points crowd the span's ends to rounding; a ratio past the doubles
+  ** (a log weight of -709) made the count undefined, and spans fell out of
+  ** the energy */
+  if (!(q <= 0x1p90)) return SPAN_HALVINGS_MAX;
   return q > 2.0 ? (int)ceil(log2(cbrt(q))) : 0;
 }
 

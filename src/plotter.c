@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Coordinates past this (mm) are refused before anything is written: far
@@ -43,19 +44,33 @@ const char *lw_plotter_gcode_line_fault(const char *line)
   ** page's plane there (a shared scene's G0 X-900 Y-900) drove the head
   ** off the bed at each stroke, unseen by the bed check and the plot time,
   ** and a GRBL system command ($RST=* resets every setting) ran as often */
-  int depth = 0; /* inside a ( comment ) */
-  for (const char *c = line; *c; c++) {
-    if (*c == '(') depth++;
-    else if (*c == ')' && depth) depth--;
-    else if (depth) continue;
-    else if (*c == '$')
+  /* A ( comment ) ends at its first ')', as controllers read it (counted
+  ** as nesting, "(( ) X-900 )" hid a live move), and ';' ends the line. */
+  int in_comment = 0;
+  for (const char *c = line; *c && *c != ';'; c++) {
+    if (in_comment) {
+      in_comment = *c != ')';
+      continue;
+    }
+    if (*c == '(') {
+      in_comment = 1;
+      continue;
+    }
+    const char *v = c + 1;
+    while (*v == ' ') v++;
+    const int number = *v && strchr("+-.0123456789", *v);
+    if (*c == '$')
       return "a GRBL system command ($), which changes the machine's settings or state: expected a line that "
              "only lifts or lowers the pen";
-    else if (strchr("XxYy", *c)) {
-      const char *v = c + 1;
-      while (*v == ' ') v++;
-      if (*v && strchr("+-.0123456789", *v))
-        return "a move across the page (an X or Y word), which the bed check and the plot time do not see: "
+    if (strchr("XxYy", *c) && number)
+      return "a move across the page (an X or Y word), which the bed check and the plot time do not see: "
+             "expected a line that only lifts or lowers the pen";
+    /* G28 and G30 go to stored positions across the page; G91 makes the
+    ** drawing's moves after it relative, G92 shifts its coordinates */
+    if (strchr("Gg", *c) && number) {
+      const long g = strtol(v, NULL, 10);
+      if (g == 28 || g == 30 || g == 91 || g == 92)
+        return "G28, G30, G91 or G92, which move across the page or change how the drawing's moves are read: "
                "expected a line that only lifts or lowers the pen";
     }
   }

@@ -513,7 +513,7 @@ Test(plotter, command_line_writes_the_same_files_for_the_same_seed)
   ** page or is a GRBL system command (a shared scene's, run at every
   ** stroke: G0 X-900 Y-900 drove the head off the bed unseen, $RST=* reset
   ** the machine's settings); a Z move, a servo's S, a dwell's P and an X in
-  ** a comment are pen lines */
+  ** a comment, ( ) or after a ';', are pen lines */
   static const char *const bad[][2] = {
     {"'plot.gcode_pen_down=M3 S90 G4 P0.2 %0*d'", "key 'plot.gcode_pen_down'"},
     {"plot.speed_down=0.0000083", "key 'plot.speed_down' = 8.3e-06 mm/s: final.gcode's feed"},
@@ -522,11 +522,18 @@ Test(plotter, command_line_writes_the_same_files_for_the_same_seed)
                                               "(an X or Y word), which the bed check and the plot time do not see"},
     {"'plot.gcode_pen_up=G1 Z5 y .5'", "key 'plot.gcode_pen_up' = 'G1 Z5 y .5': a move across the page"},
     {"'plot.gcode_pen_up=$RST=*'", "key 'plot.gcode_pen_up' = '$RST=*': a GRBL system command ($)"},
+    /* a comment ends at its first ')' (counted as nesting, the move after
+    ** it went through); homing, relative moves and offsets */
+    {"'plot.gcode_pen_up=G0 Z5 (( ) X-900 Y-900 )'", "key 'plot.gcode_pen_up' = 'G0 Z5 (( ) X-900 Y-900 )': a move"},
+    {"'plot.gcode_pen_up=G28'", "key 'plot.gcode_pen_up' = 'G28': G28, G30, G91 or G92, which move across the page"},
+    {"'plot.gcode_pen_down=G91 G1 Z-5'", "key 'plot.gcode_pen_down' = 'G91 G1 Z-5': G28, G30, G91 or G92"},
   };
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set anneal.sweeps=0 --quiet --out "
                           "%s/servo --set 'plot.gcode_pen_down=M3 S90 G4 P0.2 (X axis: 0)' --set "
                           "'plot.gcode_pen_up=G0 Z5 (lift $5)'", bin, root, dir), 0);
-  for (int k = 0; k < 6; k++) {
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set anneal.sweeps=0 --quiet --out "
+                          "%s/servo2 --set 'plot.gcode_pen_up=M5;lift X0 $'", bin, root, dir), 0, "a ; comment");
+  for (int k = 0; k < 9; k++) {
     char keys[160];
     snprintf(keys, sizeof keys, bad[k][0], 70, 0);
     cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set %s --quiet --out %s/bad "

@@ -77,8 +77,9 @@ size_t lw_plotter_chords(const double *b, double tol);
 /* NULL when line is a pen line a controller takes: not empty, printable
 ** ASCII only, at most LW_PLOTTER_GCODE_LINE_MAX characters (GRBL's line
 ** buffer holds 80 with its end), and no move across the page (an X or Y
-** word) nor GRBL system command ($) outside its ( comments ); else what is
-** wrong, as "expected ..." or "a ...: expected ...". */
+** word, G28, G30), change of how the drawing's moves are read (G91, G92)
+** nor GRBL system command ($) outside its comments (( ... ), or after ';');
+** else what is wrong, as "expected ..." or "a ...: expected ...". */
 #define LW_PLOTTER_GCODE_LINE_MAX 79
 const char *lw_plotter_gcode_line_fault(const char *line);
 
