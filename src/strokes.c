@@ -336,7 +336,30 @@ static void append_piece(const lw_strokes *in, size_t k, int backward, double *b
   }
 }
 
-/* Joins the n paths of one pen starting at path base into out. */
+/* The first band's reach: about the spacing of the n ends (a few
+** candidates each), or dist where that is smaller. */
+static double first_band(const double *pt, size_t ne, double dist)
+{
+  double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL};
+  for (size_t e = 0; e < ne; e++)
+    for (int c = 0; c < 2; c++) {
+      lo[c] = fmin(lo[c], pt[2 * e + c]);
+      hi[c] = fmax(hi[c], pt[2 * e + c]);
+    }
+  const double w = hi[0] - lo[0], h = hi[1] - lo[1];
+  /* ends along one line: their spacing along it */
+  double spacing = w * h > 0 ? sqrt(w * h / (double)ne) : fmax(w, h) / (double)ne;
+  return spacing > 0 && spacing < dist ? spacing : dist;
+}
+
+/* Joins the n paths of one pen starting at path base into out.  Pairs of
+** ends are joined greedily, nearest first.  A distance far past the ends'
+** spacing (a pen "joined whole") would have every pair a candidate, n^2
+** of them (4.7 GB at 20,000 paths); so candidates are gathered in bands of
+** distance, each twice the one before, among the ends still free: a pair
+** with an end already joined could never be taken, and a band's pairs all
+** come after the bands before in the nearest-first order, so the joins are
+** those of one sorted list of every pair. */
 static lw_status join_pen(const lw_strokes *in, int pen, size_t base, size_t n, double dist, double cos_max,
                           lw_strokes_report *rep, lw_strokes *out, lw_error *err)
 {
@@ -353,42 +376,48 @@ static lw_status join_pen(const lw_strokes *in, int pen, size_t base, size_t n, 
   if (!pt || !dir || !sx || !link || !parent || !seen || !buf) goto nomem;
   for (size_t e = 0; e < ne; e++) {
     end_of(in, base, e, pt + 2 * e, dir + 2 * e);
-    sx[e] = (by_x_item){pt[2 * e], e};
     link[e] = SIZE_MAX;
   }
-  qsort(sx, ne, sizeof *sx, by_x);
-  for (size_t i = 0; i < ne; i++)
-    for (size_t j = i + 1; j < ne && sx[j].x - sx[i].x <= dist; j++) {
-      size_t a = sx[i].e, b = sx[j].e;
-      if (a / 2 == b / 2) continue;
-      const double gx = pt[2 * b] - pt[2 * a], gy = pt[2 * b + 1] - pt[2 * a + 1], d = hypot(gx, gy);
-      /* out of one end, into the other: the turn is between dir[a] and -dir[b] */
-      double c = -(dir[2 * a] * dir[2 * b] + dir[2 * a + 1] * dir[2 * b + 1]);
-      if (d > dist || c < cos_max) continue;
+  for (size_t k = 0; k < n; k++) parent[k] = k;
+  for (double below = -1.0, reach = first_band(pt, ne, dist); below < dist;
+       below = reach, reach = fmin(2 * reach, dist)) {
+    size_t nx = 0;
+    for (size_t e = 0; e < ne; e++)
+      if (link[e] == SIZE_MAX) sx[nx++] = (by_x_item){pt[2 * e], e};
+    qsort(sx, nx, sizeof *sx, by_x);
+    n_cand = 0;
+    for (size_t i = 0; i < nx; i++)
+      for (size_t j = i + 1; j < nx && sx[j].x - sx[i].x <= reach; j++) {
+        size_t a = sx[i].e, b = sx[j].e;
+        if (a / 2 == b / 2) continue;
+        const double gx = pt[2 * b] - pt[2 * a], gy = pt[2 * b + 1] - pt[2 * a + 1], d = hypot(gx, gy);
+        /* out of one end, into the other: the turn is between dir[a] and -dir[b] */
+        double c = -(dir[2 * a] * dir[2 * b] + dir[2 * a + 1] * dir[2 * b + 1]);
+        if (d > reach || d <= below || c < cos_max) continue;
       /* and the gap leads on from each end: two strokes side by side, the
       ** one starting behind where the other ends, align but would be bridged
       ** by a hook back over the ink (a tenth of the distance is let through:
       ** ends that overlap by a hair) */
-      if (cos_max > -1.0 && (gx * dir[2 * a] + gy * dir[2 * a + 1] < -0.1 * dist ||
-                             -(gx * dir[2 * b] + gy * dir[2 * b + 1]) < -0.1 * dist))
-        continue;
-      if (n_cand == cap) {
-        cap = cap ? 2 * cap : 64;
-        join_cand *nc = realloc(cand, cap * sizeof *nc);
-        if (!nc) goto nomem;
-        cand = nc;
+        if (cos_max > -1.0 && (gx * dir[2 * a] + gy * dir[2 * a + 1] < -0.1 * dist ||
+                               -(gx * dir[2 * b] + gy * dir[2 * b + 1]) < -0.1 * dist))
+          continue;
+        if (n_cand == cap) {
+          cap = cap ? 2 * cap : 64;
+          join_cand *nc = realloc(cand, cap * sizeof *nc);
+          if (!nc) goto nomem;
+          cand = nc;
+        }
+        cand[n_cand++] = (join_cand){d, a < b ? a : b, a < b ? b : a};
       }
-      cand[n_cand++] = (join_cand){d, a < b ? a : b, a < b ? b : a};
+    if (n_cand) qsort(cand, n_cand, sizeof *cand, by_gap);
+    for (size_t c = 0; c < n_cand; c++) {
+      size_t a = cand[c].a, b = cand[c].b, ra = find(parent, a / 2), rb = find(parent, b / 2);
+      if (link[a] != SIZE_MAX || link[b] != SIZE_MAX || ra == rb) continue;
+      link[a] = b;
+      link[b] = a;
+      parent[ra] = rb;
+      rep->joins++;
     }
-  if (n_cand) qsort(cand, n_cand, sizeof *cand, by_gap);
-  for (size_t k = 0; k < n; k++) parent[k] = k;
-  for (size_t c = 0; c < n_cand; c++) {
-    size_t a = cand[c].a, b = cand[c].b, ra = find(parent, a / 2), rb = find(parent, b / 2);
-    if (link[a] != SIZE_MAX || link[b] != SIZE_MAX || ra == rb) continue;
-    link[a] = b;
-    link[b] = a;
-    parent[ra] = rb;
-    rep->joins++;
   }
   /* every chain is open (no cycles), so it is walked from a free end */
   for (size_t p = 0; p < n; p++) {

@@ -158,6 +158,185 @@ Test(strokes, each_pen_joins_and_drops_by_its_own_width)
   lw_strokes_free(s);
 }
 
+/* ---- the joins against every pair sorted at once --------------------------- */
+
+typedef struct {
+  double d;
+  size_t a, b;
+} ref_pair;
+
+static int ref_by_gap(const void *pa, const void *pb)
+{
+  const ref_pair *x = pa, *y = pb;
+  if (x->d != y->d) return x->d < y->d ? -1 : 1;
+  if (x->a != y->a) return x->a < y->a ? -1 : 1;
+  return (x->b > y->b) - (x->b < y->b);
+}
+
+static size_t ref_root(size_t *up, size_t k)
+{
+  while (up[k] != k) k = up[k];
+  return k;
+}
+
+/* End e of straight path e / 2 (strokes.h's order: 2k its start, 2k + 1 its
+** end): the point, and the direction out of the path there. */
+static void ref_end(const lw_strokes *s, size_t e, double *pt, double *out)
+{
+  const double *b = seg(s, e / 2, 0), *p = b + (e & 1 ? 6 : 0), *q = b + (e & 1 ? 0 : 6);
+  const double len = hypot(p[0] - q[0], p[1] - q[1]);
+  pt[0] = p[0];
+  pt[1] = p[1];
+  out[0] = (p[0] - q[0]) / len;
+  out[1] = (p[1] - q[1]) / len;
+}
+
+/* The joins strokes.h describes, taken from one list of every pair of ends
+** of one pen of straight one-segment paths: for each chain its two free
+** ends' points, as 4 numbers in the order the chains' first paths come. */
+static size_t ref_join(const lw_strokes *s, double dist, double angle, double *chains)
+{
+  const size_t n = s->n, ne = 2 * n;
+  const double cos_max = cos(angle) - 1e-12;
+  double *pt = malloc(ne * 2 * sizeof *pt), *dir = malloc(ne * 2 * sizeof *dir);
+  size_t *link = malloc(ne * sizeof *link), *up = malloc(n * sizeof *up), np = 0;
+  ref_pair *pairs = malloc(ne * ne / 2 * sizeof *pairs);
+  for (size_t e = 0; e < ne; e++) {
+    ref_end(s, e, pt + 2 * e, dir + 2 * e);
+    link[e] = SIZE_MAX;
+  }
+  for (size_t a = 0; a < ne; a++)
+    for (size_t b = a + 1; b < ne; b++) {
+      const double gx = pt[2 * b] - pt[2 * a], gy = pt[2 * b + 1] - pt[2 * a + 1], d = hypot(gx, gy);
+      const double c = -(dir[2 * a] * dir[2 * b] + dir[2 * a + 1] * dir[2 * b + 1]);
+      const int hook = gx * dir[2 * a] + gy * dir[2 * a + 1] < -0.1 * dist ||
+                       -(gx * dir[2 * b] + gy * dir[2 * b + 1]) < -0.1 * dist;
+      if (a / 2 != b / 2 && d <= dist && c >= cos_max && !(cos_max > -1.0 && hook))
+        pairs[np++] = (ref_pair){d, a, b};
+    }
+  qsort(pairs, np, sizeof *pairs, ref_by_gap);
+  for (size_t k = 0; k < n; k++) up[k] = k;
+  size_t joins = 0;
+  for (size_t p = 0; p < np; p++) {
+    const size_t a = pairs[p].a, b = pairs[p].b, ra = ref_root(up, a / 2), rb = ref_root(up, b / 2);
+    if (link[a] != SIZE_MAX || link[b] != SIZE_MAX || ra == rb) continue;
+    link[a] = b;
+    link[b] = a;
+    up[ra] = rb;
+    joins++;
+  }
+  /* each chain from its free end of lower index to the other */
+  size_t m = 0;
+  for (size_t e = 0; e < ne; e++) {
+    if (link[e] != SIZE_MAX) continue;
+    size_t f = e ^ 1;
+    while (link[f] != SIZE_MAX) f = link[f] ^ 1;
+    if (f < e) continue;
+    memcpy(chains + 4 * m, pt + 2 * e, 2 * sizeof *chains);
+    memcpy(chains + 4 * m + 2, pt + 2 * f, 2 * sizeof *chains);
+    m++;
+  }
+  free(pt);
+  free(dir);
+  free(link);
+  free(up);
+  free(pairs);
+  return joins;
+}
+
+static int by_four(const void *pa, const void *pb)
+{
+  const double *x = pa, *y = pb;
+  for (int c = 0; c < 4; c++)
+    if (x[c] != y[c]) return x[c] < y[c] ? -1 : 1;
+  return 0;
+}
+
+/* A path's two ends, the smaller (x, then y) first, so that the direction
+** a chain is walked in does not count. */
+static void ends_in_order(double *four)
+{
+  if (four[0] > four[2] || (four[0] == four[2] && four[1] > four[3])) {
+    double t[2] = {four[0], four[1]};
+    four[0] = four[2];
+    four[1] = four[3];
+    four[2] = t[0];
+    four[3] = t[1];
+  }
+}
+
+/* The joins are gathered band by band of distance among the ends still
+** free (strokes.c), so that a distance past the ends' spacing costs no n^2
+** candidates; they must be the joins of one list of every pair, sorted.
+** 300 random straight paths on 50 x 50 mm, distances from a tenth of the
+** ends' spacing to the whole page, a tight angle and any. */
+Test(strokes, joins_by_bands_are_those_of_every_pair_sorted)
+{
+  unsigned long long r = 12345;
+  const size_t n = 300;
+  lw_strokes *s = lw_strokes_new(1, NULL);
+  for (size_t k = 0; k < n; k++) {
+    double u[4];
+    for (int c = 0; c < 4; c++) {
+      r = r * 6364136223846793005ULL + 1442695040888963407ULL;
+      u[c] = (double)(r >> 11) / 9007199254740992.0;
+    }
+    const double len = 1 + 4 * u[2], th = 2 * M_PI * u[3];
+    add_line(s, 0, k, 50 * u[0], 50 * u[1], 50 * u[0] + len * cos(th), 50 * u[1] + len * sin(th));
+  }
+  const double dists[] = {0.1, 0.5, 2, 8, 30, 1e6}, angles[] = {30 * M_PI / 180, M_PI};
+  double *want = malloc(4 * n * sizeof *want), *got = malloc(4 * n * sizeof *got);
+  for (size_t i = 0; i < sizeof dists / sizeof *dists; i++)
+    for (size_t k = 0; k < 2; k++) {
+      const size_t joins = ref_join(s, dists[i], angles[k], want);
+      lw_strokes_report rep = {0};
+      lw_strokes *j = lw_strokes_join(s, (const double[]){dists[i]}, angles[k], &rep, NULL);
+      cr_assert_not_null(j);
+      cr_assert_eq(rep.joins, joins, "distance %g, angle %g: %zu joins, every pair sorted %zu", dists[i],
+                   angles[k], rep.joins, joins);
+      cr_assert_eq(j->n, n - joins);
+      for (size_t p = 0; p < j->n; p++) {
+        const double *first = seg(j, p, 0), *last = seg(j, p, segs(j, p) - 1);
+        double *g = got + 4 * p;
+        g[0] = first[0];
+        g[1] = first[1];
+        g[2] = last[6];
+        g[3] = last[7];
+        ends_in_order(g);
+        ends_in_order(want + 4 * p);
+      }
+      qsort(got, j->n, 4 * sizeof *got, by_four);
+      qsort(want, j->n, 4 * sizeof *want, by_four);
+      cr_assert_eq(memcmp(got, want, 4 * j->n * sizeof *got), 0, "distance %g, angle %g: other chains", dists[i],
+                   angles[k]);
+      lw_strokes_free(j);
+    }
+  free(want);
+  free(got);
+  lw_strokes_free(s);
+}
+
+/* A pen joined whole: 20,000 paths and a distance of a kilometre, any
+** turn, make one path (every pair a candidate took 4.7 GB). */
+Test(strokes, a_pen_joined_whole_takes_no_candidate_per_pair)
+{
+  const size_t n = 20000;
+  lw_strokes *s = lw_strokes_new(1, NULL);
+  for (size_t k = 0; k < n; k++) {
+    const double x = (double)(k % 200), y = (double)(k / 200);
+    add_line(s, 0, k, x, y, x + 0.5, y + 0.25);
+  }
+  lw_strokes_report rep = {0};
+  lw_strokes *j = lw_strokes_join(s, (const double[]){1e6}, M_PI, &rep, NULL);
+  cr_assert_not_null(j);
+  cr_assert_eq(rep.joins, n - 1);
+  cr_assert_eq(j->n, 1);
+  cr_assert_eq(segs(j, 0), 2 * n - 1, "every path and a bridge between each two");
+  lw_strokes_free(j);
+  lw_strokes_free(s);
+}
+
+
 Test(strokes, drops_paths_shorter_than_the_minimum)
 {
   lw_strokes *s = lw_strokes_new(1, NULL);
