@@ -229,11 +229,14 @@ static int along_curve(const lw_scene *sc, lw_splines *sp, lw_error *err)
 
 /* A model on sp (owned) after checking that the splines read from path are
 ** allowed for the scene and that their energy is finite (where: path and
-** the section, for that message). */
+** the section, for that message); renumbered along the page's curve if
+** renumber, after the checks, whose messages count splines as the file
+** does. */
 static spl_state *state_from_file(const spl_setup *su, lw_splines *sp, const char *path, const char *where,
-                                  lw_error *err)
+                                  int renumber, lw_error *err)
 {
-  if (lw_model_check_regular(&su->scene, sp, path, err) || lw_model_check_layers(&su->scene, sp, path, err)) {
+  if (lw_model_check_regular(&su->scene, sp, path, err) || lw_model_check_layers(&su->scene, sp, path, err) ||
+      (renumber && along_curve(&su->scene, sp, err) < 0)) {
     lw_splines_free(sp);
     return NULL;
   }
@@ -280,11 +283,7 @@ static void *state_new(const void *setup, const lw_params *p, unsigned long seed
     /* Renumbered for the sweeps' sake only: a run of no sweeps (a redraw)
     ** keeps the state's numbering, and so its drawing's path ids, pens
     ** and order. */
-    if (p->sweeps > 0 && along_curve(&su->scene, sp, err) < 0) {
-      lw_splines_free(sp);
-      return NULL;
-    }
-    spl_state *s = state_from_file(su, sp, p->from, p->from, err);
+    spl_state *s = state_from_file(su, sp, p->from, p->from, p->sweeps > 0, err);
     if (!s && err->code == LW_EINPUT) lw_params_blame(p, "init", "from", err);
     return s;
   }
@@ -1149,7 +1148,7 @@ static void *load(const void *setup, lw_state *st, const char *section, const ch
   }
   char where[LW_PATH_MAX + 64];
   snprintf(where, sizeof where, "%s: [%s]", path, section);
-  return state_from_file(su, sp, path, where, err);
+  return state_from_file(su, sp, path, where, 0, err);
 }
 
 static void set_terms(void *state, const double *term)

@@ -2466,6 +2466,20 @@ Test(cli, an_irregular_segment_is_refused_naming_the_test_that_failed)
                           b, dir, dir, dir, dir, dir), 0);
 }
 
+/* A state given as init.from is renumbered along the page for the sweeps;
+** its irregular segment was named by the spline's new number (3 for the
+** file's third spline, 2 from 0) */
+Test(cli, an_irregular_segment_of_init_from_is_named_as_the_file_counts)
+{
+  cr_assert_eq(lw_test_sh("awk '/^spline =/ {s++; n = 0} /^node/ && s == 3 && ++n == 5 {$5 = 0; $6 = 0} {print}' "
+                          "%s/params/hanging.lw > %s/bent.lw", lw_test_root(), dir), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/params/hanging.ini --set init.from=%s/bent.lw --stop-at 0 --out %s/h --quiet "
+                          "2>%s/err.txt; test $? -eq 2", lw_test_bin(), lw_test_root(), dir, dir, dir), 0);
+  char *e = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(e, "bent.lw: spline 2, segment 3 is irregular: "), "%s", e);
+  free(e);
+}
+
 /* An empty drawing says what removed its lines (it said only "final.svg has
 ** no path"): here every stroke is under plot.min_length's 3 pen widths. */
 Test(cli, an_empty_drawing_says_what_removed_its_lines)
