@@ -279,12 +279,13 @@ static int values_push(values *a, double v)
   return 0;
 }
 
-/* A token strtod reads whole but that is out of a double's range ("1e400",
-** "1e-400", as NumPy reads them: infinite, 0) into *v; 1 if it is one. */
+/* A decimal token strtod reads whole but that is out of a double's range
+** ("1e400", "1e-400", as NumPy reads them: infinite, 0) into *v; 1 if it
+** is one.  (Hex, "0x10", strtod reads too: refused as everywhere.) */
 static int out_of_range(const char *s, size_t len, double *v)
 {
   char tok[64], *end;
-  if (len >= sizeof tok || !len || !strchr("+-.0123456789", *s)) return 0;
+  if (len >= sizeof tok || !len || !strchr("+-.0123456789", *s) || strspn(s, "+-.0123456789eE") < len) return 0;
   memcpy(tok, s, len);
   tok[len] = '\0';
   *v = strtod(tok, &end);

@@ -164,6 +164,9 @@ Test(fieldfile, text_refused_says_the_line_and_what_was_expected)
   REFUSED("odd.txt", "1 2 3\n", ":1:", "even count");
   REFUSED("short.txt", "1 2 3 4\n# c\n1 2\n", ":3:", "2 values", "line 1", "has 4");
   REFUSED("word.txt", "1 2\n3 u0\n", ":2:", "value 2", "'u0'", "not a number");
+  /* hex, which strtod reads (the out-of-range reading let it through) */
+  REFUSED("hex.txt", "1 2\n3 0x10\n", ":2:", "value 2", "'0x10'", "not a number");
+  REFUSED("hexfloat.txt", "1 0X1p3\n", ":1:", "value 2", "not a number");
   REFUSED("empty.txt", "1,,2,3\n", ":1:", "empty value");
   REFUSED("first.txt", ",1,0,1,0\n", ":1:", "empty value after value 0");
   REFUSED("semicolon.txt", "0,5;0,7\n", ";", "decimal point");
