@@ -1582,7 +1582,7 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   set_temperatures(a);
   dir_file(path, sizeof path, a, "timing.txt");
   lw_error fifo; /* (a FIFO there is no timing: opening it would wait for ever) */
-  FILE *tf = lw_text_not_fifo(path, &fifo) ? NULL : fopen(path, "r");
+  FILE *tf = lw_text_plain_file(path, &fifo) ? NULL : fopen(path, "r");
   /* Without the sweeps' time before (timing.txt lost, as where state.lw and
   ** scene.ini alone were copied to another machine, or from before
   ** 2026-12-04), the rate counts this process's proposals over its own

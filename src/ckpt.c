@@ -206,7 +206,7 @@ lw_status lw_ckpt_read(lw_ckpt **out, const char *path, lw_error *err)
 {
   *out = NULL;
   if (lw_number_locale_ok(err)) return err->code; /* (resume and energy read it first) */
-  if (lw_text_not_fifo(path, err)) return err->code;
+  if (lw_text_plain_file(path, err)) return err->code;
   lw_ckpt *c = lw_ckpt_new(path);
   if (!c) return lw_error_set(err, LW_ENOMEM, "%s: out of memory", path);
   FILE *f = fopen(path, "rb");

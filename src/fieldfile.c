@@ -575,7 +575,7 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
 
 lw_grid2d *lw_fieldfile_read(const char *path, int ncomp, int points, lw_error *err)
 {
-  if (lw_text_not_fifo(path, err)) return NULL;
+  if (lw_text_plain_file(path, err)) return NULL;
   FILE *f = fopen(path, "rb");
   if (!f) {
     lw_error_set(err, LW_EINPUT, "%s: cannot open the field file: %s", path, strerror(errno));

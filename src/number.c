@@ -224,12 +224,12 @@ const char *lw_text_unseen_char(const char *value, char *buf, size_t n)
   return buf;
 }
 
-lw_status lw_text_not_fifo(const char *path, lw_error *err)
+lw_status lw_text_plain_file(const char *path, lw_error *err)
 {
   struct stat sb;
-  if (stat(path, &sb) || (!S_ISFIFO(sb.st_mode) && !S_ISSOCK(sb.st_mode))) return LW_OK;
+  if (stat(path, &sb) || (!S_ISFIFO(sb.st_mode) && !S_ISSOCK(sb.st_mode) && !S_ISDIR(sb.st_mode))) return LW_OK;
   return lw_error_set(err, LW_EINPUT, "%s: a %s, not a file: expected a file, which linewise reads whole", path,
-                      S_ISFIFO(sb.st_mode) ? "FIFO (named pipe)" : "socket");
+                      S_ISFIFO(sb.st_mode) ? "FIFO (named pipe)" : S_ISSOCK(sb.st_mode) ? "socket" : "folder");
 }
 
 long lw_text_next_line(FILE *f, char **buf, size_t *cap, long *line)

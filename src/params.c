@@ -1424,7 +1424,12 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
     return lw_error_set(err, LW_EINPUT, "%.80s...: the scene file's path is %zu bytes; expected at most %zu",
                         path, strlen(path), sizeof p->file - 1);
   snprintf(p->file, sizeof p->file, "%s", path);
-  if (lw_text_not_fifo(path, err)) return err->code;
+  struct stat sb;
+  if (!stat(path, &sb) && S_ISDIR(sb.st_mode))
+    return lw_error_set(err, LW_EINPUT, "%s: a folder, not a scene file: %s", path,
+                        lw_rundir_holds_run(path) ? "it holds a run, which 'linewise resume' continues"
+                                                  : "expected a scene file (.ini, as params/example.ini)");
+  if (lw_text_plain_file(path, err)) return err->code;
   FILE *f = fopen(path, "r");
   if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open scene file: %s", path, strerror(errno));
   /* a photo where the scene goes ("linewise run my-photo.jpg") was "a NUL

@@ -136,7 +136,7 @@ lw_status lw_particles_read_points(const char *path, size_t *n, double **x, doub
   *n = 0;
   *x = *normal = NULL;
   *has_normal = NULL;
-  if (lw_text_not_fifo(path, err)) return err->code;
+  if (lw_text_plain_file(path, err)) return err->code;
   FILE *f = fopen(path, "rb");
   if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open point file: %s", path, strerror(errno));
   points pt = {0};

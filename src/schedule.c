@@ -259,7 +259,7 @@ static int split(char *c, char *tok[3])
 
 lw_status lw_schedule_read_table(lw_schedule *s, const char *path, lw_error *err)
 {
-  if (lw_text_not_fifo(path, err)) return err->code;
+  if (lw_text_plain_file(path, err)) return err->code;
   FILE *f = fopen(path, "r");
   if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open schedule table: %s", path, strerror(errno));
   char *line = NULL;

@@ -434,7 +434,7 @@ static lw_status read_v1(lw_state *st, reader *r, lw_error *err)
 lw_status lw_state_read(lw_state *st, const char *path, lw_error *err)
 {
   memset(st, 0, sizeof *st);
-  if (lw_text_not_fifo(path, err)) return err->code;
+  if (lw_text_plain_file(path, err)) return err->code;
   reader r = {fopen(path, "r"), path, 0, NULL, 0, 0, 0};
   if (!r.f) return lw_error_set(err, LW_EINPUT, "%s: cannot open state file: %s", path, strerror(errno));
   lw_status s = LW_OK;

@@ -87,7 +87,7 @@ static lw_status read_file(const lw_params *p, double **P, size_t *np, double **
   char dir[LW_PATH_MAX], path[2 * LW_PATH_MAX + 2], *line = NULL;
   lw_path_dir(dir, sizeof dir, p->file);
   lw_path_join(path, sizeof path, dir, p->nb_file);
-  if (lw_text_not_fifo(path, err)) return lw_params_blame(p, "nurbs", "file", err);
+  if (lw_text_plain_file(path, err)) return lw_params_blame(p, "nurbs", "file", err);
   FILE *f = fopen(path, "r");
   if (!f) {
     lw_error_set(err, LW_EINPUT, "%s: cannot read: %s", path, strerror(errno));

@@ -73,7 +73,7 @@ static lw_status read_row(const lw_trace *t, const char *line, size_t line_no, d
 
 lw_trace *lw_trace_read(const char *path, lw_error *err)
 {
-  if (lw_number_locale_ok(err) || lw_text_not_fifo(path, err)) return NULL;
+  if (lw_number_locale_ok(err) || lw_text_plain_file(path, err)) return NULL;
   FILE *f = fopen(path, "r");
   if (!f) {
     lw_error_set(err, errno == ENOENT ? LW_EINPUT : LW_EIO, "%s: cannot read: %s", path, strerror(errno));

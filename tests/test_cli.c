@@ -847,7 +847,7 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
     fclose(f);
   }
   static const struct { const char *args, *msg; } bad[] = {
-    {"run %s", "cannot read scene file: Is a directory"},
+    {"run %s", "a folder, not a scene file: expected a scene file (.ini, as params/example.ini)"},
     {"run %s/s.ini --out ''", "--out: expected a directory"},
     {"run %s/s.ini --out /dev/null", "--out: expected a directory, got '/dev/null' (not a directory)"},
     {"run %s/s.ini --out /etc/passwd", "--out: expected a directory, got '/etc/passwd' (a file)"},
@@ -880,7 +880,7 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
     {"run %s/s.ini --set 'anneal.sweeps =5'", "--set 'anneal.sweeps =5': blanks around the name"},
     {"run %s/te.ini", "te.ini:3: key 'anneal.t_end': schedule geometric: t_end must be a finite number > 0"},
     {"run %s/s.ini --set anneal.t_start=-0", "--set: key 'anneal.t_start': schedule geometric: t_start must be"},
-    {"energy %s", "state.lw: cannot read state file: Is a directory"},
+    {"energy %s", "state.lw: a folder, not a file: expected a file, which linewise reads whole"},
     /* the margin sets a polygon's crop (no picture): it annealed, then failed */
     {"run %s/s.ini --set scene.boundary=polygon --set 'scene.polygon=10 10 90 10 50 70' --set scene.margin=40",
      "--set: key 'scene.margin': expected less than half the page (100 x 80 mm), got 40"},
@@ -1729,6 +1729,8 @@ Test(cli, a_fifo_or_an_endless_file_named_by_a_key_is_refused_at_once)
     {"init.from=/dev/zero%.0s", "key 'init.from': /dev/zero:1: header: expected 'linewise-state <version>', got "
                                "binary bytes%.0s"},
     {"anneal.schedule=table --set anneal.table=/dev/zero%.0s", "key 'anneal.table': /dev/zero:1: a NUL byte%.0s"},
+    /* a folder: "read error" and exit 1 for some, a line 1 for the table */
+    {"anneal.schedule=table --set anneal.table=%s", "key 'anneal.table': %s: a folder, not a file"},
   };
   for (size_t k = 0; k < sizeof sets / sizeof sets[0]; k++) {
     char set[256], want[256], args[1024];
@@ -1743,6 +1745,11 @@ Test(cli, a_fifo_or_an_endless_file_named_by_a_key_is_refused_at_once)
   }
   cr_assert_eq(lw_test_sh("timeout 60 %s run %s/fifo 2>&1 | grep -q 'fifo: a FIFO (named pipe), not a file'",
                           lw_test_bin(), dir), 0);
+  const char *keys[][2] = {{"particles-sheet", "particles.points"}, {"dipole", "scene.field_file"}};
+  for (int k = 0; k < 2; k++)
+    cr_assert_eq(lw_test_sh("{ %s run %s/params/%s.ini --out %s/o --quiet --set %s=%s; test $? -eq 2; } 2>&1 | "
+                            "grep -q \"key '%s': %s: a folder, not a file\"", lw_test_bin(), lw_test_root(), keys[k][0],
+                            dir, keys[k][1], dir, keys[k][1], dir), 0, "%s", keys[k][1]);
   /* a socket too (the check went untested) */
   struct sockaddr_un sa = {.sun_family = AF_UNIX};
   snprintf(sa.sun_path, sizeof sa.sun_path, "%s/sock", dir);

@@ -86,8 +86,10 @@ ssize_t lw_text_getline(char **buf, size_t *cap, FILE *f);
 const char *lw_text_unseen_char(const char *value, char *buf, size_t n);
 
 /* LW_EINPUT with err where path names a FIFO or a socket, which a reader
-** would wait on for ever (opening a FIFO waits for a writer); else LW_OK. */
-lw_status lw_text_not_fifo(const char *path, lw_error *err);
+** would wait on for ever (opening a FIFO waits for a writer), or a folder,
+** whose reading fails with no more than "read error"; else LW_OK (a
+** missing file too: its opening says so). */
+lw_status lw_text_plain_file(const char *path, lw_error *err);
 
 /* What a number in a comma or a point locale's writing means to say, as a
 ** hint to add to a message (into hint, "" if none): digits grouped in
