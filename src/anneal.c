@@ -23,6 +23,7 @@
 #include "linewise/checkpoint.h"
 #include "linewise/domains.h"
 #include "linewise/driver.h"
+#include "linewise/image.h"
 #include "linewise/init.h"
 #include "linewise/json.h"
 #include "linewise/number.h"
@@ -481,9 +482,24 @@ static lw_status read_ladder_file(lw_anneal *a, lw_error *err)
                  unread ? strerror(unread) : "not a regular file");
     return lw_params_blame(p, "tempering", "ladder_file", err);
   }
+  /* (the reader's advice for a picture is to draw it) */
+  unsigned char head[16];
+  FILE *hf = fopen(p->ladder_file, "rb");
+  const size_t got = hf ? fread(head, 1, sizeof head, hf) : 0;
+  if (hf) fclose(hf);
+  const char *picture = lw_image_kind(head, got, NULL);
+  if (picture) {
+    lw_error_set(err, LW_EINPUT, "%s: %s picture, not a ladder file: expected a [tempering] section with ladder = "
+                 "t0 t1 ..., as a run's ladder.ini", p->ladder_file, picture);
+    return lw_params_blame(p, "tempering", "ladder_file", err);
+  }
   lw_params *f = malloc(sizeof *f);
   if (!f) return lw_error_set(err, LW_ENOMEM, "out of memory reading %s", p->ladder_file);
   lw_status s = lw_params_read_unresolved(f, p->ladder_file, err);
+  if (s == LW_EINPUT) {
+    free(f);
+    return lw_params_blame(p, "tempering", "ladder_file", err);
+  }
   const int at = f->line[dl - lw_param_table];
   for (size_t i = 0; !s && i < lw_param_count; i++)
     if (f->line[i] > 0 && &lw_param_table[i] != dl)

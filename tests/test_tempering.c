@@ -558,6 +558,9 @@ Test(ptrun, a_ladder_file_runs_as_its_ladder_given_by_set)
     {"[tempering]\nladder = 1 2 3 4\n", "--set 'tempering.ladder=1 2 3 5'",
      "f.ini:32: key 'tempering.ladder_file': tempering.ladder is given too (--set); expected one of them"},
     {NULL, "", "f.ini:32: key 'tempering.ladder_file': cannot read '"},
+    /* a picture was advised to be drawn, and a file the reader refuses had no key named */
+    {"\\211PNG\\r\\n\\032\\n", "", "lad.ini: a PNG picture, not a ladder file: expected a [tempering] section"},
+    {"[tempering]\\000\n", "", "f.ini:32: key 'tempering.ladder_file': "},
   };
   for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
     if (bad[k].file) cr_assert_eq(sh("printf '%s' > %s/lad.ini", bad[k].file, dir), 0);
