@@ -107,7 +107,8 @@ static double birth(const lw_particles *p, lw_particles_prop *pr, gsl_rng *rng, 
   e[LW_PTERM_CHEM] = s->chem;
   double dE = 0.0;
   for (int t = 0; t < LW_PTERM_COUNT; t++) dE += pr->dterm[t] = e[t];
-  double g = birth_density(p, UINT32_MAX, pr->x, pr->n) * r0 * r0 * r0;
+  /* (g is per r0^3 already, as the reference measure counts volume) */
+  double g = birth_density(p, UINT32_MAX, pr->x, pr->n);
   pr->log_ratio = log(s->death) - log((double)(p->n_loose + 1)) - log(s->birth) - log(g);
   return pr->dE = dE;
 }
@@ -117,7 +118,7 @@ static double death(const lw_particles *p, lw_particles_prop *pr, gsl_rng *rng, 
   const lw_particles_setup *s = p->setup;
   if (!p->n_loose) return nothing(pr, 0.0, forbidden, 0);
   uint32_t k = p->loose[gsl_rng_uniform_int(rng, p->n_loose)];
-  const double *x = p->x + 3 * (size_t)k, *n = p->nrm + 3 * (size_t)k, r0 = s->pair.r0;
+  const double *x = p->x + 3 * (size_t)k, *n = p->nrm + 3 * (size_t)k;
   pr->k = k;
   pr->identity = 0;
   double e[LW_PTERM_COUNT] = {0};
@@ -125,7 +126,7 @@ static double death(const lw_particles *p, lw_particles_prop *pr, gsl_rng *rng, 
   e[LW_PTERM_CHEM] = s->chem;
   double dE = 0.0;
   for (int t = 0; t < LW_PTERM_COUNT; t++) dE += pr->dterm[t] = -e[t];
-  double g = birth_density(p, k, x, n) * r0 * r0 * r0;
+  double g = birth_density(p, k, x, n);
   pr->log_ratio = log(s->birth) + log(g) - log(s->death) + log((double)p->n_loose);
   return pr->dE = dE;
 }

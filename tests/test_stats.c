@@ -835,6 +835,8 @@ Test(stats, co_normal_pairs_follow_the_boltzmann_distribution)
 ** chem is set so that P(2) = P(1).  A Hastings factor that left out the
 ** proposal's position density would move P(2) by vol(S) (1.57 r0^3), one
 ** that left out its normal density would bend c toward the proposal's.
+** In r0's units nothing depends on r0: at r0 = 2 too P(2) = P(1) (a
+** density counted in r0^3 twice put P(2) at 1/9).
 */
 typedef struct {
   double alpha, T;
@@ -877,7 +879,7 @@ static double grow_cdf(double c, const double *par)
   return grow_cdf_table[i] + (u - i) * (grow_cdf_table[i + 1] - grow_cdf_table[i]);
 }
 
-Test(stats, particle_births_and_deaths_follow_the_boltzmann_distribution)
+static void births_and_deaths_at(double r0)
 {
   const int longrun = lw_test_long();
   const grow_case g = {1.0, 0.2};
@@ -893,6 +895,7 @@ Test(stats, particle_births_and_deaths_follow_the_boltzmann_distribution)
   prm.pt_birth = prm.pt_death = 1;
   prm.pt_chem = chem;
   prm.pt_max_count = 2;
+  prm.pt_r0 = r0;
   lw_error err;
   lw_particles_setup *s = lw_particles_setup_new(&prm, &err);
   cr_assert_not_null(s, "%s", err.msg);
@@ -927,15 +930,22 @@ Test(stats, particle_births_and_deaths_follow_the_boltzmann_distribution)
   size_t thin = (size_t)ceil(3 * tau), m = 0;
   for (size_t i = 0; i < n_cs; i += thin) cs[m++] = cs[i];
   double pc = chisq_p(cs, m, grow_cdf, NULL, 20);
-  cr_log_info("births and deaths: K %.5f, chem %.5f; P(2) %.4f +- %.4f (tau %.2f sweeps, %zu sweeps), want 0.5; "
-              "cosines: %zu samples, p %.3g; birth acceptance %.3f, death %.3f", K, chem, f, sd, tau, n, m, pc,
+  cr_log_info("births and deaths at r0 %g: K %.5f, chem %.5f; P(2) %.4f +- %.4f (tau %.2f sweeps, %zu sweeps), "
+              "want 0.5; cosines: %zu samples, p %.3g; birth acceptance %.3f, death %.3f", r0, K, chem, f, sd, tau, n,
+              m, pc,
               (double)c->stats[2].accepted / (double)c->stats[2].proposed,
               (double)c->stats[3].accepted / (double)c->stats[3].proposed);
-  cr_assert_lt(fabs(f - 0.5), 4 * sd, "P(2) = %.4f, want 0.5 +- %.4f (4 sd)", f, 4 * sd);
-  cr_assert(pc > 1e-3, "the born particle's normals: p = %.3g", pc);
+  cr_assert_lt(fabs(f - 0.5), 4 * sd, "r0 %g: P(2) = %.4f, want 0.5 +- %.4f (4 sd)", r0, f, 4 * sd);
+  cr_assert(pc > 1e-3, "r0 %g: the born particle's normals: p = %.3g", r0, pc);
   free(occ);
   free(cs);
   lw_chain_free(c);
   lw_system_free(sys);
   lw_particles_setup_free(s);
+}
+
+Test(stats, particle_births_and_deaths_follow_the_boltzmann_distribution)
+{
+  births_and_deaths_at(1.0);
+  births_and_deaths_at(2.0);
 }
