@@ -518,7 +518,8 @@ const lw_param_def lw_param_table[] = {
          "the first `ladder_sweeps` sweeps (then the ladder is frozen and swap statistics restart)."),
   NUM("tempering", "ladder_sweeps", LW_PT_INT, ladder_sweeps, "200", "sweeps", 0, 2e9, 0,
       "Warm-up sweeps of ladder tuning (tune_ladder = equal); fewer than anneal.sweeps, since the "
-      "swap statistics and ladder.ini come after it."),
+      "swap statistics and ladder.ini come after it. The ladder moves once every 40 exchange steps, so "
+      "fewer than 40 x exchange_every sweeps leave it as given (noted)."),
   NUM("output", "checkpoint_every", LW_PT_INT, checkpoint_every, "100", "sweeps", 1, 2e9, 0,
       "Sweeps between checkpoints of state.lw (also written at the end and on SIGINT, SIGTERM, SIGHUP and "
       "SIGXCPU). Each is "

@@ -451,6 +451,17 @@ Test(ptrun, an_equal_ladder_that_did_not_settle_is_said)
   cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), 0, 10, "--stop-at 0", dir, 0, dir), 0);
   cr_assert_eq(sh("grep -q 'note: tempering.tune_ladder = equal with ladder_sweeps = 0 tunes nothing' %s/err.txt",
                   dir), 0);
+  /* the ladder moves once every 40 exchanges: with fewer in ladder_sweeps
+  ** it stayed as given, ladder.ini's comment saying it was tuned; with none
+  ** the freeze never came (no ladder.ini, no restart of the statistics) */
+  cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), 390, 400, "--set tempering.exchange_every=10 --stop-at 0", dir,
+                  390, dir), 0);
+  cr_assert_eq(sh("grep -q 'note: tempering.ladder_sweeps = 390 holds 39 exchanges (exchange_every = 10), and the "
+                  "ladder moves once every 40: it stays as given$' %s/err.txt", dir), 0);
+  cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), 40, 100, "--set tempering.exchange_every=50", dir, 41, dir), 0);
+  cr_assert_eq(sh("grep -q 'note: tempering.ladder_sweeps = 40 holds 0 exchanges (exchange_every = 50), and the "
+                  "ladder moves once every 40: it stays as given, the swap statistics count from the start and no "
+                  "ladder.ini is written' %s/err.txt && test ! -e %s/l41/ladder.ini", dir, dir), 0);
   for (int after = 2; after <= 20; after += 18) {
     cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), 40, 40 + after, "", dir, after, dir), 0);
     cr_assert_neq(sh("grep -q 'note: the swap rates' %s/err.txt", dir), 0, "%d sweeps after the freeze", after);
