@@ -110,8 +110,22 @@ int lw_number_separator_hint(const char *s, int whole, char *hint, size_t n)
   return groups && whole && !fraction;
 }
 
+int lw_text_empty_field(const char *s)
+{
+  int comma = 1, empty = 0; /* the line's start counts as a comma */
+  for (; *s; s++) {
+    if (*s == ' ' || *s == '\t' || *s == '\r' || *s == '\n') continue;
+    if (*s != ',' && empty) return 1; /* trailing empty fields ("x,y,z,,,": blank normals) are none */
+    empty |= *s == ',' && comma;
+    comma = *s == ',';
+  }
+  return 0;
+}
+
 int lw_number_list(const char *s, int commas, double *out, int max)
 {
+  /* ("0,,5" read as 0 5) */
+  if (commas == 2 && lw_text_empty_field(s)) return -3;
   const char *sep = commas ? " \t," : " \t";
   /* a comma with no blank beside it between two numbers ("0,5"), and a
   ** separator of blanks alone, both in one list */
@@ -136,8 +150,10 @@ int lw_number_list(const char *s, int commas, double *out, int max)
 
 const char *lw_number_list_hint(int count)
 {
-  return count == -2 ? " (a comma between digits, and blanks between numbers: decimal commas? numbers take a point, "
-                       "0.5 not 0,5; a list takes blanks, commas or ', ' between its numbers)" : "";
+  return count == -2   ? " (a comma between digits, and blanks between numbers: decimal commas? numbers take a point, "
+                         "0.5 not 0,5; a list takes blanks, commas or ', ' between its numbers)"
+         : count == -3 ? " (an empty value between two commas: expected a number in every field)"
+                       : "";
 }
 
 void lw_text_drop_bom(char *s)

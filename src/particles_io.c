@@ -49,21 +49,6 @@ static lw_status append(points *pt, const double *v, const double *nrm, const ch
   return LW_OK;
 }
 
-/* Whether a line has an empty field before its last number: a comma first,
-** or two with only blanks between ("1,,2,3" read as 1 2 3, a spreadsheet's
-** blank cell shifting the values after it). */
-static int empty_field(const char *s)
-{
-  int comma = 1, empty = 0; /* the line's start counts as a comma */
-  for (; *s; s++) {
-    if (*s == ' ' || *s == '\t' || *s == '\r' || *s == '\n') continue;
-    if (*s != ',' && empty) return 1; /* trailing empty fields ("x,y,z,,,": blank normals) are none */
-    empty |= *s == ',' && comma;
-    comma = *s == ',';
-  }
-  return 0;
-}
-
 /* The text format: "x y z" or "x y z nx ny nz" a line, blanks or commas
 ** between the numbers. */
 static lw_status read_text(FILE *f, const char *path, points *pt, lw_error *err)
@@ -80,7 +65,7 @@ static lw_status read_text(FILE *f, const char *path, points *pt, lw_error *err)
     double v[6];
     int k = lw_number_list(buf, 2, v, 6);
     if (k == 0) continue;
-    if (empty_field(buf)) {
+    if (lw_text_empty_field(buf)) {
       s = lw_error_set(err, LW_EINPUT, "%s:%ld: expected a number in every field, got an empty one in '%.80s'", path,
                        line, buf);
       break;

@@ -108,7 +108,7 @@ static lw_status read_file(const lw_params *p, double **P, size_t *np, double **
       lw_error_set(err, LW_EINPUT, "%s:%ld: expected %s, got '%.60s'%s", path, lineno,
                    per == 2 ? "'x y' like the lines before" : per == 3 ? "'x y w' (w > 0) like the lines before"
                                                                       : "'x y' or 'x y w' (w > 0)", line,
-                   k == -2 ? lw_number_list_hint(k) : lw_text_unseen_char(line, unseen, sizeof unseen));
+                   k <= -2 ? lw_number_list_hint(k) : lw_text_unseen_char(line, unseen, sizeof unseen));
       st = lw_params_blame(p, "nurbs", "file", err);
       break;
     }

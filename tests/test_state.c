@@ -244,6 +244,14 @@ Test(state, strict_numbers)
   cr_assert_eq(lw_number_list("1, 2 4", 2, list, 4), 3);
   cr_assert_eq(lw_number_list("1 ,2\t3", 2, list, 4), 3);
   cr_assert(strstr(lw_number_list_hint(-2), "0.5 not 0,5") && !*lw_number_list_hint(-1));
+  /* an empty field, which read as none ("0,,5" as 0 5, nurbs.file's point
+  ** (0, 5)), but not at the end (a point cloud's blank normals) */
+  cr_assert_eq(lw_number_list("0,,5", 2, list, 4), -3);
+  cr_assert_eq(lw_number_list("0, ,5", 2, list, 4), -3);
+  cr_assert_eq(lw_number_list(",1 2", 2, list, 4), -3);
+  cr_assert_eq(lw_number_list("1,2,", 2, list, 4), 2);
+  cr_assert_eq(lw_number_list("0,,5", 1, list, 4), 2, "a run's own scene.ini as it was");
+  cr_assert(strstr(lw_number_list_hint(-3), "an empty value between two commas"));
 }
 
 /* Text stops at its first NUL: a line reader returns what came before it,

@@ -107,12 +107,19 @@ int lw_number_separator_hint(const char *s, int whole, char *hint, size_t n);
 ** where a comma stands alone between two numbers ("0,5") in a list that
 ** also has blanks alone between two: "0,5 0,7" is two numbers with decimal
 ** commas more likely than four (and so is the SVG style "10,20 30,40", which
-** "10 20 30 40" says plainly); "1, 2, 3", "1,2,3" and "0 0, 0.5, 1 1" read.
-** A run's own scene.ini takes 1, as older releases wrote any mix. */
+** "10 20 30 40" says plainly); "1, 2, 3", "1,2,3" and "0 0, 0.5, 1 1" read;
+** and -3 where a field is empty (lw_text_empty_field).  A run's own
+** scene.ini takes 1, as older releases wrote any mix. */
 int lw_number_list(const char *s, int commas, double *out, int max);
 
+/* Whether s has an empty field between commas or before the first ("1,,2"
+** read as 1 2: a spreadsheet's blank cell shifting the values after it;
+** ",1"); empty fields at the end ("x,y,z,,,", a point cloud's blank
+** normals) are none. */
+int lw_text_empty_field(const char *s);
+
 /* What to add to a message on a list refused with count (-2: mixed
-** separators), else "". */
+** separators, -3: an empty field), else "". */
 const char *lw_number_list_hint(int count);
 
 #ifdef __cplusplus
