@@ -1869,9 +1869,14 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
                         hint, lw_text_unseen_char(name, unseen, sizeof unseen));
   }
   char expected[256], unseen[96];
-  if (!assign(p, d, eq + 1, expected, sizeof expected))
-    return lw_error_set(err, LW_EUSAGE, "--set: key '%s.%s': expected %s, got '%s'%s", section, key,
-                        expected, eq + 1, lw_text_unseen_char(eq + 1, unseen, sizeof unseen));
+  const char *v = eq + 1;
+  const size_t lv = strlen(v);
+  /* (a scene file's values lose their blanks; a tab showed as '?') */
+  if (!assign(p, d, v, expected, sizeof expected))
+    return lw_error_set(err, LW_EUSAGE, "--set: key '%s.%s': expected %s, got '%s'%s", section, key, expected, v,
+                        lv && (isblank((unsigned char)v[0]) || isblank((unsigned char)v[lv - 1]))
+                            ? " (a blank or tab before or after the value, which --set keeps: expected none)"
+                            : lw_text_unseen_char(v, unseen, sizeof unseen));
   p->line[d - lw_param_table] = -1;
   return LW_OK;
 }

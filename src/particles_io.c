@@ -88,7 +88,9 @@ static lw_status read_text(FILE *f, const char *path, points *pt, lw_error *err)
   else if (!s && ferror(f)) s = lw_error_set(err, LW_EIO, "%s: read error", path);
   else if (!s && len == -2) s = lw_error_set(err, LW_EINPUT, "%s:%ld: " LW_TEXT_NUL_LINE, path, line);
   else if (!s && pt->n == 0)
-    s = lw_error_set(err, LW_EINPUT, "%s:%ld: expected at least one point 'x y z [nx ny nz]', found none", path, line);
+    s = line ? lw_error_set(err, LW_EINPUT, "%s:%ld: expected at least one point 'x y z [nx ny nz]', found none", path,
+                            line)
+             : lw_error_set(err, LW_EINPUT, "%s: an empty file: expected at least one point 'x y z [nx ny nz]'", path);
   free(buf);
   return s;
 }

@@ -144,7 +144,12 @@ static lw_nurbs *curve_of(const lw_params *p, lw_error *err)
   }
   size_t n = np / 2;
   if (np % 2 || n < k) {
-    lw_error_set(err, LW_EINPUT, "expected x y pairs of at least order = %zu control points, got %zu numbers", k, np);
+    if (p->nb_file[0]) /* (its lines are checked one by one: too few of them, or none) */
+      lw_error_set(err, LW_EINPUT, "%s holds %zu control point%s: expected lines 'x y' or 'x y w' of at least "
+                   "order = %zu", p->nb_file, n, n == 1 ? "" : "s", k);
+    else
+      lw_error_set(err, LW_EINPUT, "expected x y pairs of at least order = %zu control points, got %zu numbers", k,
+                   np);
     lw_params_blame(p, "nurbs", p->nb_file[0] ? "file" : "points", err);
     goto out;
   }

@@ -871,6 +871,8 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
     {"run %s/nul.ini", "nul.ini:2: a NUL byte inside the line"},
     {"run %s/s.ini --set scene.width=0x10", "--set: key 'scene.width': expected a number"},
     {"run %s/s.ini --set anneal.seed=1.5", "--set: key 'anneal.seed': expected a whole number >= 0"},
+    /* a tab showed as '?', and nothing said the blank was the fault */
+    {"run %s/s.ini --set 'scene.width=\t100'", "got '?100' (a blank or tab before or after the value, which --set keeps"},
     {"run %s/s.ini --set tempering.replicas=2 --set tempering.t_max=2 --set tempering.tune_ladder=equal "
      "--set tempering.ladder_sweeps=999 --set anneal.sweeps=10",
      "key 'tempering.ladder_sweeps': the ladder is tuned for the first"},
