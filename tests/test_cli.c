@@ -2489,6 +2489,17 @@ Test(cli, an_irregular_segment_of_init_from_is_named_as_the_file_counts)
   free(e);
 }
 
+/* A scene file that sets no key (emptied by mistake, or comments alone)
+** ran the defaults unsaid */
+Test(cli, a_scene_that_sets_no_key_is_noted)
+{
+  cr_assert_eq(lw_test_sh("printf '; nothing yet\\n' > %s/empty.ini && %s run %s/empty.ini --stop-at 0 --out %s/e "
+                          "2>%s/err.txt && grep -q 'note: .*empty.ini sets no key: every value is the default' "
+                          "%s/err.txt && %s run %s/params/minimal.ini --stop-at 0 --out %s/m 2>%s/err.txt && ! grep -q "
+                          "'sets no key' %s/err.txt", dir, lw_test_bin(), dir, dir, dir, dir, lw_test_bin(),
+                          lw_test_root(), dir, dir, dir), 0);
+}
+
 /* An empty drawing says what removed its lines (it said only "final.svg has
 ** no path"): here every stroke is under plot.min_length's 3 pen widths. */
 Test(cli, an_empty_drawing_says_what_removed_its_lines)
