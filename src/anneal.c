@@ -576,8 +576,13 @@ static int key_read(const lw_system_type *t, const lw_driver_type *v, const lw_p
 {
   if (lw_params_named(v->keys, d)) return 1;
   if (lw_params_named(v->ignores, d)) return 0;
+  /* a chain of its own rule runs without delayed acceptance, whose second
+  ** stage is Metropolis's (driver.h): said by the rule, not by each row */
+  if (v->accept && !strcmp(d->section, "anneal") && !strcmp(d->key, "delayed_acceptance")) return 0;
   if (lw_params_named(t->keys_dynamics, d)) return v->kind == LW_DRIVE_MOTION;
   if (lw_params_named(t->keys_metropolis, d)) return v->kind == LW_DRIVE_CHAIN;
+  /* (a row's [moves] keys count under the chains only, wherever it lists them) */
+  if (!strcmp(d->section, "moves") && v->kind != LW_DRIVE_CHAIN) return 0;
   return lw_params_named(t->keys, d);
 }
 

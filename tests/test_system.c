@@ -322,31 +322,52 @@ Test(system, the_chain_samples_a_test_row_exactly)
   gauss_chain_free(c);
 }
 
-/* A chain driver with its own acceptance rule (driver.h, `accept`; the
-** barker row's, e^x / (1 + e^x), whose ratio at x and -x is e^x) samples the
-** test row exactly too: the same batch means as Metropolis (5 standard
-** errors of 50 batches), fewer moves taken (e^x / (1 + e^x) <= min(1, e^x)).
-** The rule's ends: 1 at +infinity, 0 at -infinity, 1/2 at 0, no overflow. */
-Test(system, a_chain_under_another_acceptance_rule_samples_a_test_row_exactly)
+/* Every chain driver with its own acceptance rule (driver.h, `accept`),
+** row by row of the table, so that a new rule is held to it unnamed (a rule
+** sampling exp(-E / 2T) passed every test): a(x) / a(-x) = e^x, which keeps
+** exp(-E/T) (docs/NUMERICS.md, "Acceptance rules"), a within [0, 1] and
+** continuous at 0 (the step tuning aims at a share of a(0)), no overflow at
+** the ends; and it samples the test row exactly: the same batch means as
+** Metropolis (5 standard errors of 50 batches), no more moves taken than
+** Metropolis's min(1, e^x) (Peskun). Barker's row, e^x / (1 + e^x), also
+** to its formula. */
+Test(system, every_chain_under_its_own_acceptance_rule_samples_a_test_row_exactly)
 {
   const double T = 0.7;
-  lw_chain *c = gauss_chain(T, 77), *m = gauss_chain(T, 77);
-  c->accept = lw_driver_barker.accept;
-  cr_assert(c->accept(INFINITY) == 1.0 && c->accept(-INFINITY) == 0.0 && c->accept(0.0) == 0.5 &&
-            c->accept(800.0) == 1.0 && c->accept(-800.0) == 0.0);
-  cr_assert(fabs(c->accept(1.5) - exp(1.5) / (1.0 + exp(1.5))) < 1e-15 &&
-            fabs(c->accept(-2.0) - 1.0 / (1.0 + exp(2.0))) < 1e-15);
-  batch_mean m1[NV], m2[NV];
-  sample_gaussian(c, T, m1, m2);
-  check_gaussian("Barker's chain", m1, m2, T);
-  sample_gaussian(m, T, m1, m2);
-  for (int k = 0; k < 2; k++) {
-    const double rate = (double)c->stats[k].accepted / (double)c->stats[k].proposed,
-                 rate_m = (double)m->stats[k].accepted / (double)m->stats[k].proposed;
-    cr_assert(rate > 0.05 && rate < rate_m, "move %d: Barker took %g of its proposals, Metropolis %g", k, rate, rate_m);
+  int rules = 0;
+  for (int r = 0; lw_driver_types[r]; r++) {
+    const lw_driver_type *v = lw_driver_types[r];
+    if (v->kind != LW_DRIVE_CHAIN || !v->accept) continue;
+    rules++;
+    for (double x = -30.0; x <= 30.0; x += 0.25) {
+      const double a = v->accept(x), b = v->accept(-x);
+      cr_assert(a >= 0.0 && a <= 1.0, "%s: a(%g) = %g", v->name, x, a);
+      cr_assert(fabs(a - exp(x) * b) <= 1e-12 * fmax(a, exp(x) * b), "%s: a(%g) / a(%g) = %.17g, not e^x", v->name, x,
+                -x, a / b);
+    }
+    cr_assert(fabs(v->accept(1e-9) - v->accept(-1e-9)) < 1e-6, "%s: a jumps at 0", v->name);
+    cr_assert(v->accept(INFINITY) <= 1.0 && v->accept(-INFINITY) == 0.0 && v->accept(-800.0) == 0.0 &&
+              v->accept(800.0) <= 1.0 && v->accept(800.0) > 0.0, "%s: the rule's ends", v->name);
+    lw_chain *c = gauss_chain(T, 77), *m = gauss_chain(T, 77);
+    c->accept = v->accept;
+    batch_mean m1[NV], m2[NV];
+    sample_gaussian(c, T, m1, m2);
+    check_gaussian(v->name, m1, m2, T);
+    sample_gaussian(m, T, m1, m2);
+    for (int k = 0; k < 2; k++) {
+      const double rate = (double)c->stats[k].accepted / (double)c->stats[k].proposed,
+                   rate_m = (double)m->stats[k].accepted / (double)m->stats[k].proposed;
+      cr_assert(rate > 0.05 && rate <= rate_m, "%s, move %d: took %g of its proposals, Metropolis %g", v->name, k,
+                rate, rate_m);
+    }
+    gauss_chain_free(c);
+    gauss_chain_free(m);
   }
-  gauss_chain_free(c);
-  gauss_chain_free(m);
+  cr_assert(rules >= 1, "no chain of its own rule in the table");
+  const lw_driver_type *b = &lw_driver_barker;
+  cr_assert(b->accept(INFINITY) == 1.0 && b->accept(0.0) == 0.5 && b->accept(800.0) == 1.0);
+  cr_assert(fabs(b->accept(1.5) - exp(1.5) / (1.0 + exp(1.5))) < 1e-15 &&
+            fabs(b->accept(-2.0) - 1.0 / (1.0 + exp(2.0))) < 1e-15);
 }
 
 /* A proposal a row could not evaluate for want of memory stops the chain

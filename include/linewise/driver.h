@@ -14,8 +14,9 @@
 **
 ** Adding a chain driver with another acceptance rule: a file with its row
 ** (the name, LW_DRIVE_CHAIN, lw_driver_chain_keys, the keys it ignores, its
-** `accept`; driver_barker.c) and one entry in lw_driver_types[] (driver.c);
-** mention it in the help of `[scene] driver` (src/params.c; `make docs`).
+** `accept`; driver_barker.c), one entry in lw_driver_types[] (driver.c) and
+** its extern below; mention it in the help of `[scene] driver` (src/params.c;
+** `make docs`).  tests/test_system.c holds every such row to detailed balance.
 ** Everything else (the key checks and notes, docs/PARAMETERS.md's "read
 ** by", the chain and its step tuning, tempering, summary.json's `driver`,
 ** the statistics' tuning stretch) reads the row.
