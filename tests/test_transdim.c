@@ -1419,11 +1419,12 @@ Test(transdim, splices_keep_the_tone_raster_exact)
 ** proposals of all ten kinds the running terms equal a recomputation from
 ** scratch within 1e-9, and the compacted caches and grid are those a fresh
 ** model builds: the ideal gas of split and join (page 8 l) with 60
-** splines, the pair term (cutoff l, near field on), strain, bending and a
-** chemical potential per length on, where split and join accept 7 % of
-** their proposals.  Wrong code caught: a split that forgot the pieces' pair
-** with each other, or a join that took the halves' cached near fields,
-** fails at the first check. */
+** splines, the pair term (cutoff 1.5 l, near field on), strain, bending and
+** a chemical potential per length on, where split and join accept some
+** of their proposals.  Wrong code caught: a split that forgot the pieces'
+** pair with each other, or a join that took the halves' cached near
+** fields, fails at the first check; so does the pieces' pair compared with
+** the cutoff rather than its square, which a cutoff of 1 could not tell. */
 static void split_join_totals(double near)
 {
   lw_params p;
@@ -1431,7 +1432,7 @@ static void split_join_totals(double near)
   every_splice_gas(&p, T, 60);
   p.pair_near = near;
   p.pair = 0.01;
-  p.pair_cutoff = 1;
+  p.pair_cutoff = 1.5;
   p.strain = 0.1;
   p.bending = 0.002;
   p.chem_length = 0.05;
