@@ -79,6 +79,17 @@ Test(nurbs_cli, monte_carlo_anneals_a_rational_curve_and_bounds_its_svg)
   cr_assert_eq(sh("grep -q elastic %s/e.txt", dir), 0);
 }
 
+/* The mean and stderr of row `name` of `linewise stats --csv`. */
+static void stats_row(const char *csv, const char *name, double *mean, double *se)
+{
+  char key[64];
+  snprintf(key, sizeof key, "\n%s,", name);
+  const char *l = strstr(csv, key);
+  cr_assert_not_null(l, "%s", csv);
+  double n;
+  cr_assert_eq(sscanf(strchr(l + 1, ',') + 1, "%lf,%lf,%lf", &n, mean, se), 3, "%s", l);
+}
+
 Test(nurbs_cli, monte_carlo_heat_capacity_is_half_the_free_coordinates)
 {
   /* The wire's energy is quadratic in its control points (weights frozen,
@@ -96,11 +107,9 @@ Test(nurbs_cli, monte_carlo_heat_capacity_is_half_the_free_coordinates)
   cr_assert_not_null(csv);
   for (int k = 0; k < 3; k++) {
     char key[64];
-    snprintf(key, sizeof key, "\nreplica%d_heat_capacity,", k);
-    const char *l = strstr(csv, key);
-    cr_assert_not_null(l, "%s", csv);
-    double n, c, se;
-    cr_assert_eq(sscanf(strchr(l + 1, ',') + 1, "%lf,%lf,%lf", &n, &c, &se), 3, "%s", l);
+    snprintf(key, sizeof key, "replica%d_heat_capacity", k);
+    double c, se;
+    stats_row(csv, key, &c, &se);
     cr_log_info("rung %d: C = %.4f +- %.4f (5)", k, c, se);
     cr_assert(se > 0 && se < 0.25 && fabs(c - 5.0) < 4 * se, "rung %d: C = %g +- %g, expected 5", k, c, se);
     /* summary.json's observables carry the same, for sweeps over runs */
@@ -136,6 +145,36 @@ Test(nurbs_cli, monte_carlo_heat_capacity_is_half_the_free_coordinates)
     ** bootstrap keeps the rows' correlations, 4.2 % before) */
     cr_assert(fabs(c - 5.0) < 4 * sc && sc < 0.3, "T %g: C = %g +- %g", T, c, sc);
     cr_assert(fabs(e - e0 - 5 * (T - t0)) < 4 * (se + se0), "T %g: <E> %g, from %g", T, e, e0);
+  }
+  free(csv);
+}
+
+/* Under a schedule away from t_start the rungs run at t_k T / t_start, and
+** the exchanges must weigh the rungs' energies by those temperatures: a
+** table held at T = 2 (t_start 1) puts the wire's rungs at 2, 4 and 8, C = 5
+** on each and <E> 5 a unit of temperature apart.  Exchanges weighed by the
+** ladder's own 1, 2, 4 kept every test green and read C = 4.10 +- 0.11 and
+** 3.83 +- 0.09 on the two colder rungs (a mutation tester's find). */
+Test(nurbs_cli, tempering_exchanges_weigh_the_rungs_at_the_schedules_temperature)
+{
+  cr_assert_eq(sh("printf '0 2\\n1 2\\n' > %s/t2.txt && %s run %s/params/wire-ladder.ini --out %s/pt2 --quiet "
+                  "--set anneal.schedule=table --set anneal.table=%s/t2.txt && %s stats %s/pt2 --csv > %s/pt2.csv", dir,
+                  lw_test_bin(), lw_test_root(), dir, dir, lw_test_bin(), dir, dir), 0);
+  char *csv = lw_test_slurp("%s/pt2.csv", dir);
+  cr_assert_not_null(csv);
+  double e[3], se_e[3];
+  for (int k = 0; k < 3; k++) {
+    char key[64];
+    double c, se;
+    snprintf(key, sizeof key, "replica%d_heat_capacity", k);
+    stats_row(csv, key, &c, &se);
+    snprintf(key, sizeof key, "replica%d_energy", k);
+    stats_row(csv, key, &e[k], &se_e[k]);
+    cr_log_info("rung %d at T %d: C = %.4f +- %.4f (5), <E> %.4f +- %.4f", k, 2 << k, c, se, e[k], se_e[k]);
+    cr_assert(se > 0 && fabs(c - 5.0) < 4 * se, "rung %d: C = %g +- %g, expected 5", k, c, se);
+    if (k)
+      cr_assert(fabs(e[k] - e[0] - 5.0 * ((2 << k) - 2)) < 4 * (se_e[k] + se_e[0]), "rung %d: <E> %g, rung 0 %g", k,
+                e[k], e[0]);
   }
   free(csv);
 }
