@@ -382,6 +382,108 @@ Test(stats, sampled_coordinates_follow_the_boltzmann_distribution_with_domains)
   for (int k = 0; k < 3; k++) boltzmann_case(DOMAIN_PERIOD, "2", threads[k]);
 }
 
+/* The vector and translate moves on their own: their proposals must be
+** symmetric as the point move's is (a vector or translate step drawn 1.1
+** times longer to the right kept every test green, shifting <v0.x> by 25
+** standard errors and <p0.x> by 12 in a mutation tester's runs).  400
+** splines in the wells of the domain cases, one kind of move: under vector
+** moves the points stay, and (v0.x, v1.x) is Gaussian as (p0.x, p1.x) is
+** under point moves (basis columns 1 and 3 for 0 and 2); under translate
+** moves the spline keeps its shape, x_q = p0.x s_q + r_q with s_q the
+** points' two basis columns summed, so p0.x is Gaussian with precision
+** (kx / T) sum_q w_q s_q^2 about sum_q w_q s_q (cx - r_q) / sum_q w_q s_q^2.
+** Beside the chi-square, the mean's z-score (records 3 tau apart, so their
+** error bar is about sd / sqrt(n), inflated by the residual correlation's
+** 1.1 at most): |z| < 5, and a shift of 0.02 sd must read z > 5 (160,000
+** records of the vectors: 8 sd of the z-score; 400,000 of the translations,
+** whose mutant above read z = -4.2 and chi-square p = 7e-4 on 160,000). */
+/* v0.x of spline j, or p0.x from its well's centre (a row of wells) */
+static double one_kind_value(const lw_model *m, int kind, size_t j, double period)
+{
+  const lw_node *a = &m->sp->node[m->sp->first[j]];
+  return kind == LW_MOVE_VECTOR ? a->vx : a->px - period * (double)(j % WELL_ROW);
+}
+
+static void one_kind_case(int kind)
+{
+  const int longrun = lw_test_long();
+  /* (the translate move's records come cheaper: tau 1.8 sweeps, where the
+  ** vectors' is 10) */
+  const size_t n_spl = 400, n_keep = (longrun ? 10 : 1) * (kind == LW_MOVE_TRANSLATE ? 1000 : 400);
+  const double T = 0.7, period = DOMAIN_PERIOD;
+  well w = {2.0, 2.0, period / 2, period / 2, period};
+  lw_scene sc;
+  well_scene(&sc, &w);
+  lw_model *m = lw_model_new(&sc, unit_splines(n_spl, &w), NULL);
+  double wt[LW_MOVE_KINDS] = {0}, st[LW_MOVE_KINDS] = {1, 1, 1, 0.1}, tg[LW_MOVE_KINDS] = {0.44, 0.44, 0.3, 0.3};
+  wt[kind] = 1;
+  lw_error err;
+  lw_chain *c = model_chain(m, wt, st, tg, 4243 + (unsigned long)kind, &err);
+  cr_assert_not_null(c, "%s", err.msg);
+  c->temperature = T;
+  const lw_quad *q = &sc.quad;
+  const lw_node *nd = m->sp->node; /* spline 0, at the first well */
+  double mu, sd;
+  if (kind == LW_MOVE_VECTOR) {
+    double M00 = basis_dot(q, 1, 1), M01 = basis_dot(q, 1, 3), M11 = basis_dot(q, 3, 3), b0 = 0.0, b1 = 0.0;
+    for (int i = 0; i < q->n; i++) {
+      double rest = w.cx - q->pos[i][0] * nd[0].px - q->pos[i][2] * nd[1].px;
+      b0 += q->w[i] * rest * q->pos[i][1];
+      b1 += q->w[i] * rest * q->pos[i][3];
+    }
+    double det = M00 * M11 - M01 * M01;
+    mu = (M11 * b0 - M01 * b1) / det;
+    sd = sqrt(T / w.kx * M11 / det);
+  } else {
+    double K = 0.0, b = 0.0, shape = nd[1].px - nd[0].px;
+    for (int i = 0; i < q->n; i++) {
+      double s = q->pos[i][0] + q->pos[i][2],
+             r = shape * q->pos[i][2] + nd[0].vx * q->pos[i][1] + nd[1].vx * q->pos[i][3];
+      K += q->w[i] * s * s;
+      b += q->w[i] * s * (w.cx - r);
+    }
+    mu = b / K;
+    sd = sqrt(T / (w.kx * K));
+  }
+  c->tuning = 1;
+  for (int k = 0; k < 200; k++) lw_chain_sweep(c);
+  c->tuning = 0;
+  const size_t n_pilot = 250;
+  double *x = malloc(n_spl * n_keep * sizeof *x);
+for (size_t t = 0; t < n_pilot; t++) {
+    lw_chain_sweep(c);
+    for (size_t j = 0; j < n_spl; j++) x[j * n_pilot + t] = one_kind_value(m, kind, j, period);
+  }
+  double tau = lw_series_tau(x, n_spl, n_pilot, NULL);
+  cr_assert(tau > 0.5 && tau < 50, "autocorrelation time %.2f sweeps is implausible", tau);
+  long thin = (long)ceil(3.0 * tau);
+  double sum = 0.0;
+  for (size_t t = 0; t < n_keep; t++) {
+    for (long k = 0; k < thin; k++) lw_chain_sweep(c);
+    for (size_t j = 0; j < n_spl; j++) sum += x[t * n_spl + j] = one_kind_value(m, kind, j, period);
+  }
+  const size_t n = n_keep * n_spl;
+  const double se = sd / sqrt((double)n), z = (sum / (double)n - mu) / se;
+  double p = gaussian_chisq_p(x, n, mu, sd, 20), p_wrong_t = gaussian_chisq_p(x, n, mu, sd * sqrt(1.2), 20);
+  cr_log_info("%s moves alone: tau %.2f sweeps, thin %ld, %zu samples: p %.3g (1.2 T: %.3g), mean %.6f against "
+              "%.6f (z %.2f; a shift of 0.02 sd would read %.1f)", c->sys->type->move_names[kind], tau, thin, n, p,
+              p_wrong_t, sum / (double)n, mu, z, 0.02 * sd / se);
+  cr_assert(p > 1e-3, "%s moves: not the Boltzmann distribution, p = %.3g", c->sys->type->move_names[kind], p);
+  cr_assert(p_wrong_t < 1e-3, "the test cannot tell T from 1.2 T: p = %.3g", p_wrong_t);
+  cr_assert(fabs(z) < 5, "%s moves: the mean is %.2f error bars off", c->sys->type->move_names[kind], z);
+  cr_assert(0.02 * sd / se > 5 * 1.1, "the mean's test cannot see a shift of 0.02 sd");
+  free(x);
+  model_chain_free(c);
+  lw_model_free(m);
+  lw_scene_clear(&sc);
+}
+
+Test(stats, vector_and_translate_moves_alone_follow_the_boltzmann_distribution)
+{
+  one_kind_case(LW_MOVE_VECTOR);
+  one_kind_case(LW_MOVE_TRANSLATE);
+}
+
 /* ---- 3. the worm-like chain ----------------------------------------------- */
 
 /*
