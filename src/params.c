@@ -737,7 +737,8 @@ const lw_param_def lw_param_table[] = {
          "poly (1 - r^2/R^2)^3; gauss exp(-r^2 / 2 sigma^2); aniso the seed's "
          "exp(-(x^2+y^2)/2a^2 - z^2/2b^2) in each particle's frame, a = sigma, b = "
          "sigma_normal, averaged over the two ends; the Gaussians shifted by g_R to reach 0 at R "
-         "and scaled by 1 / (1 - g_R) to stay 1 at 0 (docs/NUMERICS.md)."),
+         "and scaled by 1 / (1 - g_R) to stay 1 at 0 (docs/NUMERICS.md): continuous at R with a kink "
+         "there (poly meets 0 with slope 0), so a quench may park pairs at R under them."),
   NUM("particles", "sigma", LW_PT_DOUBLE, pt_sigma, "1", "r0", 0, 100, LW_MIN_OPEN,
       "sigma_r of weight = gauss, and the in-plane a of weight = aniso."),
   NUM("particles", "sigma_normal", LW_PT_DOUBLE, pt_sigma_normal, "0.5", "r0", 0, 100, LW_MIN_OPEN,

@@ -20,7 +20,9 @@ lw_status lw_particles_write_ply(const lw_particles *p, const char *path, lw_err
           p->n);
   for (size_t i = 0; i < p->n; i++) {
     const double *x = p->x + 3 * i, *n = p->nrm + 3 * i;
-    fprintf(f, "%.9g %.9g %.9g %.9g %.9g %.9g\n", x[0], x[1], x[2], n[0], n[1], n[2]);
+    /* every digit, so that a run continued from it starts where this one
+    ** ended (9 put a particle quenched against a floor onto it: outside) */
+    fprintf(f, "%.17g %.17g %.17g %.17g %.17g %.17g\n", x[0], x[1], x[2], n[0], n[1], n[2]);
   }
   return lw_output_commit(f, tmp, path, err);
 }

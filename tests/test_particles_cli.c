@@ -404,6 +404,17 @@ Test(particles_cli, a_quench_lays_the_sheet_on_a_hard_floor)
   cr_assert(fabs(after - (-302.44545 - 63.5)) < 1e-3, "quenched to %.9g", after);
   cr_assert(evaluations < 1.5 * iterations + 50 && forbidden == 0, "%g evaluations, %g forbidden, %g iterations",
             evaluations, forbidden, iterations);
+  /* the sheet lies an ulp above the floor: final.ply to nine digits put it
+  ** on the floor, and the run continued from it (FORMATS.md) was refused,
+  ** "point 1 ... is outside the plane boundary" */
+  cr_assert_eq(sh("%s run %s/params/particles-sheet.ini --out %s/floor2 --quiet --stop-at 0 --set particles.count=0 "
+                  "--set particles.points=%s/floor/final.ply --set particles.boundary=plane --set "
+                  "particles.boundary_z=-0.5 --set particles.alpha_b=0 --set particles.gravity=1 && %s energy %s/floor2 "
+                  "> %s/e2.txt", lw_test_bin(), root, dir, dir, lw_test_bin(), dir, dir),
+               0);
+  /* and it starts where the quench ended (the normals' last bits aside) */
+  cr_assert_eq(sh("awk '/^total/ { d = $2 - (%.17g); f = d < 1e-9 && d > -1e-9 } END { exit !f }' %s/e2.txt", after,
+                  dir), 0, "%s", lw_test_slurp("%s/e2.txt", dir));
 }
 
 /* A gas of 2000 particles with no pair term, under gravity 1 in a sphere of
