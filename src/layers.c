@@ -57,6 +57,45 @@ static lw_status per_layer(const lw_params *p, const char *key, const char *text
 }
 
 static const unsigned char process[4][3] = {{0, 255, 255}, {255, 0, 255}, {255, 255, 0}, {0, 0, 0}};
+static const char *const process_name[4] = {"cyan", "magenta", "yellow", "black"};
+
+/* The process ink nearest rgb (a pen's true colour, #00a0e0 for a cyan). */
+static int nearest_ink(const unsigned char *rgb)
+{
+  int best = 0;
+  double best_d = HUGE_VAL;
+  for (int k = 0; k < 4; k++) {
+    double d = 0.0;
+    for (int c = 0; c < 3; c++) d += ((double)rgb[c] - process[k][c]) * ((double)rgb[c] - process[k][c]);
+    if (d < best_d) {
+      best_d = d;
+      best = k;
+    }
+  }
+  return best;
+}
+
+/* Under a separation a layer draws the ink of its colour, whatever it is
+** called: a layer named for a process ink whose colour is another ink's
+** (cmyk's layers renamed "yellow cyan magenta black" to plot yellow first;
+** cmyk's own names over colours given in another order) labelled its SVG
+** layer and G-code pen with the wrong ink, unsaid. */
+static lw_status names_match_inks(const lw_params *p, const lw_layers_spec *ls, unsigned char (*rgb)[3],
+                                  lw_error *err)
+{
+  if (ls->source == LW_LSRC_TONE) return LW_OK;
+  for (int k = 0; k < ls->n; k++)
+    for (int ink = 0; ink < 4; ink++) {
+      const int near = nearest_ink(rgb[k]);
+      if (strcmp(ls->spec[k].name, process_name[ink]) || near == ink) continue;
+      return bad(p, p->ly_names[0] ? "names" : "colors", err, "layer %d is named '%s', but its colour #%02x%02x%02x is "
+                 "%s ink, which it draws (a separation draws each layer's colour%s): expected the names and "
+                 "layers.colors in one order (to plot yellow first under cmyk: names = yellow cyan magenta black, "
+                 "colors = #ffff00 #00ffff #ff00ff #000000)", k + 1, ls->spec[k].name, rgb[k][0], rgb[k][1], rgb[k][2],
+                 process_name[near], p->ly_colors[0] ? "" : "; cmyk's are cyan, magenta, yellow, black in that order");
+    }
+  return LW_OK;
+}
 
 lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
 {
@@ -134,6 +173,7 @@ lw_status lw_layers_read(const lw_params *p, lw_layers_spec *ls, lw_error *err)
   } else if (ls->source == LW_LSRC_PALETTE) {
     return bad(p, "source", err, "'palette' needs layers.colors: the pens to separate the picture into");
   }
+  if ((st = names_match_inks(p, ls, rgb, err))) return st;
   lw_layers_share(ls, NULL, 0);
   for (int k = 0; k < n; k++) {
     ls->spec[k].turn = turn[k] * M_PI / 180.0;

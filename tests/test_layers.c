@@ -979,6 +979,13 @@ Test(layers, bad_layer_keys_give_one_line_with_file_line_and_key_and_exit_2)
     {"[layers]\nnames = a b\nturn = 0 90 45\n", "scene.ini:10: key 'layers.turn': expected 2 numbers"},
     {"[layers]\nnames = a b\ncolors = #000 #12\n", "scene.ini:10: key 'layers.colors': expected 2 colours"},
     {"[layers]\nnames = a b c\nsource = cmyk\n", "scene.ini:10: key 'layers.source': 'cmyk' needs 4 layers"},
+    /* a layer named for one ink that draws another: cmyk's layers renamed to
+    ** plot yellow first, and cmyk's own names over colours in another order
+    ** (a real cyan pen's colour, #00a0e0, is cyan's) */
+    {"[layers]\nnames = yellow cyan magenta black\nsource = cmyk\n",
+     "scene.ini:9: key 'layers.names': layer 1 is named 'yellow', but its colour #00ffff is cyan ink"},
+    {"[layers]\nsource = cmyk\ncolors = #00a0e0 #ffff00 #ff00ff #000\n",
+     "scene.ini:10: key 'layers.colors': layer 2 is named 'magenta', but its colour #ffff00 is yellow ink"},
     {"[layers]\nnames = a\nsource = palette\n", "scene.ini:10: key 'layers.source': 'palette' needs layers.colors"},
     {"[layers]\nnames = a b\ntone_min = 0 0.6\ntone_max = 1 0.5\n",
      "scene.ini:11: key 'layers.tone_max': expected layers.tone_min < layers.tone_max"},
