@@ -85,8 +85,7 @@ static lw_status names_match_inks(const lw_params *p, const lw_layers_spec *ls, 
 {
   if (ls->source == LW_LSRC_TONE) return LW_OK;
   for (int k = 0; k < ls->n; k++)
-    for (int ink = 0; ink < 4; ink++) {
-      const int near = nearest_ink(rgb[k]);
+    for (int ink = 0, near = nearest_ink(rgb[k]); ink < 4; ink++) {
       if (strcmp(ls->spec[k].name, process_name[ink]) || near == ink) continue;
       return bad(p, p->ly_names[0] ? "names" : "colors", err, "layer %d is named '%s', but its colour #%02x%02x%02x is "
                  "%s ink, which it draws (a separation draws each layer's colour%s): expected the names and "
