@@ -693,6 +693,18 @@ static void schedule_note(const lw_anneal *a, char *buf, size_t n)
   if (s->blocks == 1 && (needs & LW_SCHEDULE_USES_END) && s->t_end != s->t_start && m < n)
     m += (size_t)snprintf(buf + m, n - m, "%sanneal.steps = 1: the run stays at t_start = %g (t_end = %g is the "
                           "temperature of the last of two or more steps)", m ? "; " : "", s->t_start, s->t_end);
+  /* At T = 0 a chain takes a move that lowers the energy and no other,
+  ** whatever its rule: its smallest steps are taken half the time, so a
+  ** target above that shrank the steps to 1e-15 mm, unsaid.  (A share of
+  ** the rule's a(0) is the target: under barker, half of it.) */
+  const lw_driver_type *v = lw_driver_find(p->driver);
+  const double ceiling = v && v->accept ? v->accept(0.0) : 1.0,
+               target = fmax(p->target, p->target_spline) * ceiling;
+  if (s->t_start == 0.0 && p->tune_sweeps > 0 && target >= 0.5 && m < n)
+    m += (size_t)snprintf(buf + m, n - m, "%sthe run tunes its steps at T = 0, where a chain takes its smallest steps "
+                          "half the time: moves.target%s = %g is out of reach there, and the steps shrink to nothing "
+                          "(expected a target below 0.5)", m ? "; " : "", p->target >= p->target_spline ? "" : "_spline",
+                          fmax(p->target, p->target_spline));
   /* a ladder tuned over no sweeps, or while the steps still tune (LJ13's
   ** default 200 of its 2000: swap rates less even than the geometric
   ** start's, two round trips in 40000 sweeps), was silent */

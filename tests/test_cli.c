@@ -684,6 +684,12 @@ Test(cli, keys_the_system_never_reads_are_refused)
     {"--set anneal.sweeps=10 --set anneal.steps=20 --set anneal.schedule=table --set anneal.table=t.txt",
      "linewise: note: anneal.steps = 20 is more than the 10 sweeps: some steps are skipped, and the run ends at step "
      "18 (steps count from 0 to 19), short of the table's last step\n"},
+    /* steps tuned at T = 0 toward more than the half of the smallest steps
+    ** taken there shrank to 1e-15 mm (a greedy descent's steps); barker
+    ** aims at a share of its own half, which is in reach */
+    {"--set anneal.sweeps=3 --set anneal.schedule=constant --set anneal.t_start=0 --set moves.target=0.7",
+     "linewise: note: the run tunes its steps at T = 0, where a chain takes its smallest steps half the time: "
+     "moves.target = 0.7 is out of reach there, and the steps shrink to nothing (expected a target below 0.5)\n"},
   };
   for (size_t k = 0; k < sizeof end / sizeof end[0]; k++) {
     snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/e%zu %s", lw_test_root(), dir, k, end[k].set);
@@ -693,6 +699,9 @@ Test(cli, keys_the_system_never_reads_are_refused)
     cr_assert(strstr(e, end[k].want), "%s: %s", end[k].set, e);
     free(e);
   }
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out bz --set anneal.sweeps=3 --set "
+                          "anneal.schedule=constant --set anneal.t_start=0 --set moves.target=0.7 --set scene.driver=barker "
+                          "2>err.txt >/dev/null && ! grep -q 'at T = 0' err.txt", dir, lw_test_bin(), lw_test_root()), 0);
 }
 
 /* A PDF page past what PDF allows (14,400 points) is refused before the run:
