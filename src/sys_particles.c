@@ -509,6 +509,7 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
 
 /* The rows differ only in their move kinds (sys_particles.h). */
 #define PARTICLES_ROW \
+    .quench_converges = 1, \
     .keys = keys, \
     .keys_dynamics = keys_dynamics, \
     .keys_metropolis = keys_metropolis, \
