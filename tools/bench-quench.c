@@ -99,6 +99,8 @@ void bench_quench(bench_ctx *b)
           "has removed, over its last %d iterations, while the gradient norm falls by less than a\n"
           "tenth over them) ends it. The example's annealed state is further\n"
           "from its minimum than equipartition says: its last sweeps were still lowering the energy.\n"
-          "On smooth scenes the quench converges to quench_tol (tests/test_gradient.c).\n\n",
+          "On smooth scenes the quench converges to quench_tol (tests/test_gradient.c); a rect or\n"
+          "polygon frame's medial axis and the pair cutoff are valleys of kinks it settles into, where\n"
+          "the norm stays at one side's slope (docs/NUMERICS.md, \"Gradients\").\n\n",
           LW_QUENCH_WINDOW);
 }
