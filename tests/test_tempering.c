@@ -432,6 +432,12 @@ Test(ptrun, bad_ladders_are_refused_with_the_line)
   cr_assert_eq(sh("grep -q 'bad.ini:3: key .tempering.ladder.: 4 temperatures for 3 replicas: the ladder sets the "
                   "count, so expected tempering.replicas = 4 or 1 (its default)' %s/err.txt", dir), 0);
   cr_assert_neq(sh("test -e %s/x", dir), 0, "an output directory was created for bad input");
+  /* replicas = 1 given to turn tempering off, under a ladder that sets the
+  ** count, ran every rung unsaid */
+  cr_assert_eq(sh("%s run %s/params/wire-ladder.ini --set tempering.replicas=1 --stop-at 0 --out %s/r1 2>%s/err.txt && "
+                  "grep -q 'note: tempering.replicas = 1 is given, but tempering.ladder has 3 rungs and sets the count: "
+                  "3 replicas run (for one chain, give tempering.ladder empty too)' %s/err.txt", b, lw_test_root(), dir,
+                  dir, dir), 0);
 }
 
 /* tune_ladder = equal says when it could not do its job.  Before the run: a
