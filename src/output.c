@@ -314,15 +314,16 @@ lw_status lw_output_svg_strokes(const lw_strokes *s, const lw_output_page *page,
     char color[8];
     snprintf(color, sizeof color, "#%02x%02x%02x", pen->rgb[0], pen->rgb[1], pen->rgb[2]);
     /* the label begins with the pen's number: AxiDraw's software plots a
-    ** layer by the number its name begins with ("Plot layer 2") */
-    if (page->pen_name[k][0])
-      fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"%d %s (", k + 1, page->pen_name[k]);
-    else fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"%d pen (", k + 1);
-    put_mm(f, pen->width_mm);
+    ** layer by the number its name begins with ("Plot layer 2"); and it
+    ** holds no other digit, since vpype takes every digit of a label for
+    ** the layer's number ("1 cyan (0.35 mm)" was its layer 1035, and four
+    ** pens of 0.35 mm shared one plotter pen): the width is each path's */
+    fprintf(f, "  <g inkscape:groupmode=\"layer\" inkscape:label=\"%d %s\"", k + 1,
+            page->pen_name[k][0] ? page->pen_name[k] : "pen");
     /* layers multiply as inks on paper, as the previews draw them (a browser
     ** or Inkscape showed the top pen opaque where two cross); plotter tools
     ** read no group style */
-    fprintf(f, " mm)\" id=\"pen%d\"%s>\n", k + 1, page->multiply ? " style=\"mix-blend-mode:multiply\"" : "");
+    fprintf(f, " id=\"pen%d\"%s>\n", k + 1, page->multiply ? " style=\"mix-blend-mode:multiply\"" : "");
     size_t a, z;
     lw_strokes_pen_range(s, k, &a, &z);
     for (size_t j = a; j < z; j++) {

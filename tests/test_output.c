@@ -128,7 +128,7 @@ Test(output, svg_paths_are_the_exact_bezier_segments)
   cr_assert_not_null(strstr(svg, " viewBox=\"0 0 210 297\""));
   /* Inkscape layer, namespace declared */
   cr_assert_not_null(strstr(svg, "xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\""));
-  const char *layer = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"1 pen (0.35 mm)\" id=\"pen1\">");
+  const char *layer = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"1 pen\" id=\"pen1\">");
   cr_assert_not_null(layer);
   cr_assert_not_null(strstr(layer, "</g>"));
 
@@ -706,9 +706,9 @@ Test(output, svg_pens_are_layers_and_reversed_paths_are_exact)
   cr_assert_eq(lw_output_svg(sp, &page, &pl, plot_path, &err), LW_OK, "%s", err.msg);
   char *fwd = slurp(fwd_path, NULL), *svg = slurp(plot_path, NULL);
 
-  const char *l1 = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"1 pen (0.35 mm)\" id=\"pen1\">");
-  const char *l2 = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"2 pen (0.7 mm)\" id=\"pen2\">");
-  const char *l3 = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"3 pen (1.25 mm)\" id=\"pen3\">");
+  const char *l1 = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"1 pen\" id=\"pen1\">");
+  const char *l2 = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"2 pen\" id=\"pen2\">");
+  const char *l3 = strstr(svg, "<g inkscape:groupmode=\"layer\" inkscape:label=\"3 pen\" id=\"pen3\">");
   cr_assert(l1 && l2 && l3 && l1 < l2 && l2 < l3, "three layers in pen order:\n%s", svg);
   const char *p1 = strstr(svg, "<path id=\"spline1\""), *p0 = strstr(svg, "<path id=\"spline0\"");
   cr_assert(p1 > l1 && p1 < l2 && p0 > l2 && p0 < l3, "each path in its pen's layer");
