@@ -166,11 +166,13 @@ void bench_photo_tone(bench_ctx *b)
   const double m0 = bench_median(t[0], reps), m1 = bench_median(t[1], reps);
   fprintf(d,
           "`params/photo.ini` sets `energy.tone_quadrature` to the fewest nodes that keep the tone's\n"
-          "samples 0.7 tone_blur apart along a segment or closer (here %d, for segments of 8 and a blur\n"
-          "of 3 pen widths); the other terms keep `quadrature` (6). The bundled picture on A6, the\n"
+          "samples 0.7 tone_blur apart along a segment or closer (here %d, for segments of 8 pen widths\n"
+          "and a blur of 3); the other terms keep `quadrature` (6). The bundled picture on A6, the\n"
           "whole anneal on one thread (CPU seconds, which a shared machine's preemption does not\n"
           "inflate), each run's final tone energy at its own nodes against 32, medians of %d runs\n"
-          "alternated, each setting first in turn:\n\n"
+          "alternated, each setting first in turn (`linewise run params/photo.ini --set\n"
+          "scene.page=a6 --threads 1 [--set energy.tone_quadrature=6]`, then `linewise energy DIR\n"
+          "[--set energy.tone_quadrature=32]`):\n\n"
           "| tone nodes | CPU s | x time | tone energy | at 32 nodes | relative error |\n"
           "|---|---|---|---|---|---|\n"
           "| %d (the preset's) | %.2f | %.2f | %.6g | %.6g | %.1e |\n"
