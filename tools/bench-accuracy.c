@@ -568,10 +568,11 @@ void bench_guide(bench_ctx *b)
   fprintf(d, " |\n");
   fprintf(d, "| `energy.pair_cutoff` | %.1f line spacings | the range of the repulsion (not an approximation of "
              "the uncut sum, see above): the lines on either side are within it; cost grows with the "
-             "neighbours, here as rc^%.1f",
+             "neighbours, as rc^%.1f over cutoffs from 2 mm up (least squares)",
           rc_s, b->cutoff_exponent);
+  /* (the fit is led by the long cutoffs; near this one the cost is flatter) */
   if (c2 >= 0 && row(c, p->pair_cutoff) >= 0)
-    fprintf(d, " (twice the cutoff: %.1f x the time)", c->ratio[c2] / c->ratio[row(c, p->pair_cutoff)]);
+    fprintf(d, "; from this cutoff to twice it, %.1f x the time", c->ratio[c2] / c->ratio[row(c, p->pair_cutoff)]);
   fprintf(d, " |\n");
   if (in0 >= 0 && in15 >= 0)
     fprintf(d, "| `energy.pair_near` | %g | off, touching or crossing curves are off by up to %.0e at 8 nodes, "
