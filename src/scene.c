@@ -284,11 +284,12 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
     size_t used = strlen(sc->note);
     /* a light picture's darkest is a light grey, which the stretch makes
     ** black: a pale sky drew at the darkest density (docs/IMAGES.md);
-    ** inverted after (the tone curve), it makes it paper */
+    ** inverted after (the tone curve), it makes it paper; a hazy one, no
+    ** white in it either, is what the stretch is for */
     if (lo > 0.0 || hi < 1.0)
       snprintf(sc->note + used, sizeof sc->note - used,
                "%sscene.image_levels: tones %.3f to %.3f stretched to 0 to 1%s", used ? "; " : "", lo, hi,
-               lo >= LW_IMAGE_LEVELS_LIGHT && !p->image_invert
+               lo >= LW_IMAGE_LEVELS_LIGHT && hi >= LW_IMAGE_LEVELS_PAPER && !p->image_invert
                    ? " (its darkest, a light grey, now draws as black: scene.image_levels = 0 keeps a light picture "
                      "light)"
                    : "");

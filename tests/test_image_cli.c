@@ -291,6 +291,14 @@ Test(image_cli, levels_that_turn_a_light_picture_dark_are_said)
   cr_assert_eq(run("run scene.ini --out out --set scene.image_levels=0.01 --set scene.image_invert=1", errs,
                    sizeof errs), 0, "%s", errs);
   cr_assert(strstr(errs, "stretched to 0 to 1") && !strstr(errs, "now draws as black"), "%s", errs);
+  /* a hazy picture, 0.5 to 0.7, is no light one: kept light, it drew one
+  ** even mat (a photographer's find) */
+  for (int j = 0; j < H; j++)
+    for (int i = 0; i < W; i++) g[j * W + i] = (float)(0.5 + 0.2 * i / (W - 1));
+  lw_test_png(lw_test_path("haze.png"), W, H, g, NULL);
+  write_scene("haze.png");
+  cr_assert_eq(run("run scene.ini --out out --set scene.image_levels=0.01", errs, sizeof errs), 0, "%s", errs);
+  cr_assert(strstr(errs, "stretched to 0 to 1") && !strstr(errs, "now draws as black"), "%s", errs);
   write_picture("dark.png", W, H);
   write_scene("dark.png");
   cr_assert_eq(run("run scene.ini --out out --set scene.image_levels=0.01", errs, sizeof errs), 0, "%s", errs);

@@ -637,8 +637,12 @@ Test(stats, free_chain_matches_the_worm_like_chain)
   double bias = 0.33 * l0 / lp + fabs(kratky_porod(1.06 * lp, L) / kp - 1.0);
   cr_log_info("wlc R^2 %.4f +- %.4f, Kratky-Porod %.4f (L %.4f): %+.4f, bound %.4f", mean, se, kp, L,
               mean / kp - 1.0, bias);
-  cr_assert(fabs(mean / kp - 1.0) <= bias + 4.0 * se / kp, "<R^2> %.4f +- %.4f against Kratky-Porod %.4f",
-            mean, se, kp);
+  /* one-sided, as the l_p band: both biases lengthen R^2, and a band of
+  ** 4 % either way let a chain 30 % too flexible (R^2 5.1 % short) pass */
+  cr_assert(mean / kp - 1.0 >= -4.0 * se / kp && mean / kp - 1.0 <= bias + 4.0 * se / kp,
+            "<R^2> %.4f +- %.4f against Kratky-Porod %.4f, bias up to %+.4f", mean, se, kp, bias);
+  const double kp_soft = kratky_porod(0.7 * lp, L);
+  cr_assert(mean / kp_soft - 1.0 > bias + 4.0 * se / kp_soft, "no power to see l_p 30 %% short in <R^2>");
   free(cosl);
   free(r2);
   free(arc);

@@ -155,6 +155,10 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
 ** a white board's 0.68; a dim photograph's, the moon's, 0.23), which the
 ** stretch turns black: the run's note says so, and how to keep it light. */
 #define LW_IMAGE_LEVELS_LIGHT 0.35
+/* ... and its lightest, from this tone up, near paper: a hazy photograph's
+** tones lie mid-range (0.50 to 0.71), and the stretch that makes its
+** darkest black is what draws it (kept light, it drew one even mat) */
+#define LW_IMAGE_LEVELS_PAPER 0.85
 lw_status lw_image_levels(lw_image *img, const float *under, double clip, int tail, double *lo, double *hi,
                           lw_error *err);
 
