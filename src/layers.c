@@ -7,6 +7,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 
 #include "linewise/number.h"
 #include "linewise/output.h"
@@ -59,20 +60,22 @@ static lw_status per_layer(const lw_params *p, const char *key, const char *text
 static const unsigned char process[4][3] = {{0, 255, 255}, {255, 0, 255}, {255, 255, 0}, {0, 0, 0}};
 static const char *const process_name[4] = {"cyan", "magenta", "yellow", "black"};
 
-/* The process ink nearest rgb (a pen's true colour, #00a0e0 for a cyan). */
-static int nearest_ink(const unsigned char *rgb)
+/* The process ink rgb is plainly a shade of (a pen's true colour, #00a0e0
+** for a cyan): the nearest, at under half the distance of the next; -1
+** where none is (a grey, white: as near cyan as magenta). */
+static int plain_ink(const unsigned char *rgb)
 {
-  int best = 0;
-  double best_d = HUGE_VAL;
+  double d[4];
+  int best = 0, second = 1;
   for (int k = 0; k < 4; k++) {
-    double d = 0.0;
-    for (int c = 0; c < 3; c++) d += ((double)rgb[c] - process[k][c]) * ((double)rgb[c] - process[k][c]);
-    if (d < best_d) {
-      best_d = d;
-      best = k;
-    }
+    d[k] = 0.0;
+    for (int c = 0; c < 3; c++) d[k] += ((double)rgb[c] - process[k][c]) * ((double)rgb[c] - process[k][c]);
   }
-  return best;
+  if (d[1] < d[0]) best = 1, second = 0;
+  for (int k = 2; k < 4; k++)
+    if (d[k] < d[best]) second = best, best = k;
+    else if (d[k] < d[second]) second = k;
+  return sqrt(d[best]) < 0.5 * sqrt(d[second]) ? best : -1;
 }
 
 /* Under a separation a layer draws the ink of its colour, whatever it is
@@ -83,12 +86,13 @@ static int nearest_ink(const unsigned char *rgb)
 static lw_status names_match_inks(const lw_params *p, const lw_layers_spec *ls, unsigned char (*rgb)[3],
                                   lw_error *err)
 {
-  if (ls->source == LW_LSRC_TONE) return LW_OK;
+  /* (a run begun before the check resumes as it began) */
+  if (ls->source == LW_LSRC_TONE || lw_params_kept(p, "layers", "names")) return LW_OK;
   for (int k = 0; k < ls->n; k++)
-    for (int ink = 0, near = nearest_ink(rgb[k]); ink < 4; ink++) {
-      if (strcmp(ls->spec[k].name, process_name[ink]) || near == ink) continue;
+    for (int ink = 0, near = plain_ink(rgb[k]); ink < 4; ink++) {
+      if (strcasecmp(ls->spec[k].name, process_name[ink]) || near < 0 || near == ink) continue;
       return bad(p, p->ly_names[0] ? "names" : "colors", err, "layer %d is named '%s', but its colour #%02x%02x%02x is "
-                 "%s ink, which it draws (a separation draws each layer's colour%s): expected the names and "
+                 "a %s, which it draws (a separation draws each layer's colour%s): expected the names and "
                  "layers.colors in one order (to plot yellow first under cmyk: names = yellow cyan magenta black, "
                  "colors = #ffff00 #00ffff #ff00ff #000000)", k + 1, ls->spec[k].name, rgb[k][0], rgb[k][1], rgb[k][2],
                  process_name[near], p->ly_colors[0] ? "" : "; cmyk's are cyan, magenta, yellow, black in that order");

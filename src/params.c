@@ -665,8 +665,8 @@ const lw_param_def lw_param_table[] = {
          "layer is a pen of its own (one SVG group) with its own target, field, width and colour; "
          "each spline belongs to one, by its index, the layers getting splines in proportion to "
          "the ink of their targets. Under source = cmyk or palette a layer draws the ink of its colour: "
-         "one named cyan, magenta, yellow or black must have a colour nearest that ink (refused "
-         "otherwise). Needs output.pens = 1 (the layers are the pens). Empty = no "
+         "one named cyan, magenta, yellow or black (any case) must not have a colour plainly another ink's "
+         "(refused). Needs output.pens = 1 (the layers are the pens). Empty = no "
          "layers: one target, one field, the pens of [output]. docs/IMAGES.md, \"Hatching layers "
          "and colour\"."),
   CHOICE("layers", "source", ly_source, "tone", "tone|cmyk|palette",

@@ -984,9 +984,12 @@ Test(layers, bad_layer_keys_give_one_line_with_file_line_and_key_and_exit_2)
     ** plot yellow first, and cmyk's own names over colours in another order
     ** (a real cyan pen's colour, #00a0e0, is cyan's) */
     {"[layers]\nnames = yellow cyan magenta black\nsource = cmyk\n",
-     "scene.ini:9: key 'layers.names': layer 1 is named 'yellow', but its colour #00ffff is cyan ink"},
+     "scene.ini:9: key 'layers.names': layer 1 is named 'yellow', but its colour #00ffff is a cyan"},
     {"[layers]\nsource = cmyk\ncolors = #00a0e0 #ffff00 #ff00ff #000\n",
-     "scene.ini:10: key 'layers.colors': layer 2 is named 'magenta', but its colour #ffff00 is yellow ink"},
+     "scene.ini:10: key 'layers.colors': layer 2 is named 'magenta', but its colour #ffff00 is a yellow"},
+    /* (names are matched whatever their case) */
+    {"[layers]\nnames = Yellow Cyan Magenta Black\nsource = cmyk\n",
+     "scene.ini:9: key 'layers.names': layer 1 is named 'Yellow', but its colour #00ffff is a cyan"},
     {"[layers]\nnames = a\nsource = palette\n", "scene.ini:10: key 'layers.source': 'palette' needs layers.colors"},
     {"[layers]\nnames = a b\ntone_min = 0 0.6\ntone_max = 1 0.5\n",
      "scene.ini:11: key 'layers.tone_max': expected layers.tone_min < layers.tone_max"},
