@@ -651,8 +651,8 @@ const lw_param_def lw_param_table[] = {
          "The G-code line that lifts the pen in final.gcode, written as it is: `G0 Z5` for a pen on the "
          "Z axis, `M5` or `M3 S30` for a servo on a GRBL fork. One line of printable ASCII, at most 79 "
          "characters (GRBL's line buffer), with no X or Y word (a move across the page, which the bed check "
-         "would not see), G28, G30, G91 or G92, a program stop or end (M0, M1, M2, M30, M60), a letter "
-         "without a decimal number, nor GRBL system command ($) outside a comment: refused. The file "
+         "would not see), G28, G30, G91 or G92, a program stop or end (M0, M1, M2, M30, M60), nor GRBL "
+         "system command ($) outside a comment: refused. The file "
          "sets the feed of plot.speed_down before it (`G94 F...`), "
          "so a G1 here without an F of its own moves at that."),
   STRING("plot", "gcode_pen_down", gcode_pen_down, "G1 Z0 F500", "",

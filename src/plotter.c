@@ -2,7 +2,6 @@
 ** plotters that read no SVG (plotter.h). */
 #include "linewise/plotter.h"
 
-#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -62,18 +61,13 @@ const char *lw_plotter_gcode_line_fault(const char *line)
     if (*c == '$')
       return "a GRBL system command ($), which changes the machine's settings or state: expected a line that "
              "only lifts or lowers the pen";
-    if (!isalpha((unsigned char)*c)) continue;
-    /* (a bare "X" is an error on the controller; "Znan" and "Z1e999" are
-    ** no numbers to it either) */
-    if (strchr("XxYy", *c))
+    /* (a word's value only: Klipper's macros, SET_SERVO SERVO=pen, and
+    ** LinuxCNC's parameters, Z#1, are pen lines too) */
+    const int number = *v && strchr("+-.0123456789", *v);
+    if (strchr("XxYy", *c) && number)
       return "a move across the page (an X or Y word), which the bed check and the plot time do not see: "
              "expected a line that only lifts or lowers the pen";
-    const char *d = v + (*v == '+' || *v == '-');
-    const size_t whole = strspn(d, "0123456789"), frac = d[whole] == '.' ? strspn(d + whole + 1, "0123456789") : 0;
-    if (!whole && !frac)
-      return "a letter with no number after it (a G-code word is a letter and a decimal number, as Z5 or M3 "
-             "S90): expected a line that only lifts or lowers the pen";
-    if (strchr("Mm", *c)) {
+    if (strchr("Mm", *c) && number) {
       const long m = strtol(v, NULL, 10);
       if (m == 0 || m == 1 || m == 2 || m == 30 || m == 60)
         return "a program stop or end (M0, M1, M2, M30 or M60), which would halt the plot at its first lift: "
@@ -81,7 +75,7 @@ const char *lw_plotter_gcode_line_fault(const char *line)
     }
     /* G28 and G30 go to stored positions across the page; G91 makes the
     ** drawing's moves after it relative, G92 shifts its coordinates */
-    if (strchr("Gg", *c)) {
+    if (strchr("Gg", *c) && number) {
       const long g = strtol(v, NULL, 10);
       if (g == 28 || g == 30 || g == 91 || g == 92)
         return "G28, G30, G91 or G92, which move across the page or change how the drawing's moves are read: "
