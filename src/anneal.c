@@ -708,9 +708,10 @@ static void schedule_note(const lw_anneal *a, char *buf, size_t n)
   /* replicas = 1 given to turn tempering off, under a scene's ladder that
   ** sets the count: its rungs all ran, unsaid */
   if (a->n_rep > 1 && p->replicas == 1 && !p->of_run && lw_params_line(p, "tempering", "replicas") && m < n)
-    m += (size_t)snprintf(buf + m, n - m, "%stempering.replicas = 1 is given, but tempering.ladder has %d rungs and "
-                          "sets the count: %d replicas run (for one chain, give tempering.ladder empty too)",
-                          m ? "; " : "", a->n_rep, a->n_rep);
+    m += (size_t)snprintf(buf + m, n - m, "%stempering.replicas = 1 is given, but tempering.ladder%s has %d rungs and "
+                          "sets the count: %d replicas run (for one chain, give tempering.ladder%s empty too)",
+                          m ? "; " : "", a->ladder_from_file ? "_file's ladder" : "", a->n_rep, a->n_rep,
+                          a->ladder_from_file ? "_file" : "");
   /* a ladder tuned over no sweeps, or while the steps still tune (LJ13's
   ** default 200 of its 2000: swap rates less even than the geometric
   ** start's, two round trips in 40000 sweeps), was silent */

@@ -1430,9 +1430,10 @@ static int cmd_run(int argc, char **argv)
               a.params.driver, a.unread);
     if (a.idle[0]) fprintf(stderr, "linewise: note: these keys have no effect here: %s\n", a.idle);
     if (a.schedule_note[0]) fprintf(stderr, "linewise: note: %s\n", a.schedule_note);
-    /* (a scene file emptied by mistake ran the defaults unsaid) */
+    /* (a scene file emptied by mistake ran the defaults unsaid; --set
+    ** values are no defaults) */
     size_t given = 0;
-    for (size_t k = 0; k < lw_param_count; k++) given += a.params.line[k] > 0;
+    for (size_t k = 0; k < lw_param_count; k++) given += a.params.line[k] != 0;
     if (!given && !a.params.of_run)
       fprintf(stderr, "linewise: note: %s sets no key: every value is the default (docs/PARAMETERS.md)\n", scene);
     fprintf(stderr, "linewise: scene %s, seed %lu, %s, into %s\n", scene, a.seed, size, dir);

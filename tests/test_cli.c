@@ -2507,6 +2507,9 @@ Test(cli, a_scene_that_sets_no_key_is_noted)
                           "%s/err.txt && %s run %s/params/minimal.ini --stop-at 0 --out %s/m 2>%s/err.txt && ! grep -q "
                           "'sets no key' %s/err.txt", dir, lw_test_bin(), dir, dir, dir, dir, lw_test_bin(),
                           lw_test_root(), dir, dir, dir), 0);
+  /* (with --set the values are no defaults: the note said so anyway) */
+  cr_assert_eq(lw_test_sh("%s run %s/empty.ini --stop-at 0 --out %s/s --set anneal.sweeps=5 2>%s/err.txt && ! grep -q "
+                          "'sets no key' %s/err.txt", lw_test_bin(), dir, dir, dir, dir), 0);
 }
 
 /* An empty drawing says what removed its lines (it said only "final.svg has
