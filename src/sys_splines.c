@@ -235,16 +235,25 @@ static int along_curve(const lw_scene *sc, lw_splines *sp, lw_error *err)
 static spl_state *state_from_file(const spl_setup *su, lw_splines *sp, const char *path, const char *where,
                                   int renumber, lw_error *err)
 {
-  if (lw_model_check_regular(&su->scene, sp, path, err) || lw_model_check_layers(&su->scene, sp, path, err) ||
-      (renumber && along_curve(&su->scene, sp, err) < 0)) {
+  if (lw_model_check_regular(&su->scene, sp, path, err) || lw_model_check_layers(&su->scene, sp, path, err)) {
+    lw_splines_free(sp);
+    return NULL;
+  }
+  /* the file's numbering kept for the finite check's message (the totals
+  ** do not depend on it) */
+  lw_splines *as_read = renumber ? lw_splines_clone(sp) : NULL;
+  if (renumber && !as_read) lw_error_set(err, LW_ENOMEM, "out of memory reading %s", path);
+  if (renumber && (!as_read || along_curve(&su->scene, sp, err) < 0)) {
+    lw_splines_free(as_read);
     lw_splines_free(sp);
     return NULL;
   }
   spl_state *s = state_of(su, lw_model_new(&su->scene, sp, err), 1, err);
-  if (s && lw_checkpoint_check_finite(&su->scene, s->m->sp, s->m->term, where, err)) {
+  if (s && lw_checkpoint_check_finite(&su->scene, as_read ? as_read : s->m->sp, s->m->term, where, err)) {
     state_free(s);
-    return NULL;
+    s = NULL;
   }
+  lw_splines_free(as_read);
   return s;
 }
 

@@ -2496,6 +2496,14 @@ Test(cli, an_irregular_segment_of_init_from_is_named_as_the_file_counts)
   char *e = lw_test_slurp("%s/err.txt", dir);
   cr_assert(strstr(e, "bent.lw: spline 2, segment 3 is irregular: "), "%s", e);
   free(e);
+  /* and so is one whose energy is not finite (the sixth spline moved off the page was called 2) */
+  cr_assert_eq(lw_test_sh("awk '/^spline =/ {s++} /^node/ && s == 6 {$4 = $4 + 500} {print}' %s/params/hanging.lw > "
+                          "%s/off.lw && %s run %s/params/hanging.ini --set init.from=%s/off.lw --set energy.boundary=0.5 "
+                          "--stop-at 0 --out %s/h2 --quiet 2>%s/err.txt; test $? -eq 2", lw_test_root(), dir,
+                          lw_test_bin(), lw_test_root(), dir, dir, dir), 0);
+  e = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(e, "off.lw: spline 5 segment 0 (nodes 0 and 1): the boundary energy is not finite"), "%s", e);
+  free(e);
 }
 
 /* A scene file that sets no key (emptied by mistake, or comments alone)
