@@ -909,7 +909,8 @@ static lw_status fits_memory(lw_anneal *a, lw_error *err)
 static lw_status setup_system(lw_anneal *a, lw_error *err)
 {
   if (!(a->sys_type = lw_system_of(&a->params, err))) return err->code;
-  if (a->sys_type->quench_converges && !lw_params_line(&a->params, "anneal", "quench_stall"))
+  if (a->sys_type->quench_converges && a->sys_type->quench_converges(&a->params) &&
+      !lw_params_line(&a->params, "anneal", "quench_stall"))
     a->params.quench_stall = 0.0;
   if (a->params.quench != LW_QUENCH_NONE && !a->sys_type->gradient) {
     char where[LW_PATH_MAX + 32];

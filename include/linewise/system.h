@@ -366,14 +366,15 @@ struct lw_system_type {
   ** spline,node,px,py,vx,vy), every number with 17 digits, for studies that
   ** read configurations (samples/sample-SSSSSS.csv, docs/FORMATS.md). */
   void (*write_sample)(const void *state, FILE *f);
-  /* Optional (0: no): whether the row's energy is smooth enough that its
-  ** quench runs to anneal.quench_tol where the scene sets no
-  ** anneal.quench_stall (a run starts with 0 there, which its scene.ini
-  ** keeps).  The stall rule, a share of the energy the quench has removed,
-  ** is measured mostly against its first iterations' collapse: on the
-  ** particles' sphere it stopped 88 above the minimum, which 1,089
-  ** iterations (0.24 s) reached. */
-  int quench_converges;
+  /* Optional (NULL: never): whether the scene's energy under this row is
+  ** smooth enough that its quench runs to anneal.quench_tol where the scene
+  ** sets no anneal.quench_stall (a run starts with 0 there, which its
+  ** scene.ini keeps).  The stall rule, a share of the energy the quench has
+  ** removed, is measured mostly against its first iterations' collapse: on
+  ** the particles' sphere it stopped 88 above the minimum, which 1,089
+  ** iterations (0.24 s) reached; a kinked energy (the particles' Gaussian
+  ** weights at R) never reaches quench_tol, and needs the rule. */
+  int (*quench_converges)(const lw_params *p);
 
   const char *files;
   lw_status (*draw)(void *state, const lw_params *p, const char *dir, long sweep, lw_error *err);
