@@ -698,13 +698,15 @@ static void schedule_note(const lw_anneal *a, char *buf, size_t n)
   ** target above that shrank the steps to 1e-15 mm, unsaid.  (A share of
   ** the rule's a(0) is the target: under barker, half of it.) */
   const lw_driver_type *v = lw_driver_find(p->driver);
-  const double ceiling = v && v->accept ? v->accept(0.0) : 1.0,
-               target = fmax(p->target, p->target_spline) * ceiling;
-  if (s->t_start == 0.0 && p->tune_sweeps > 0 && target >= 0.5 && m < n)
+  const double ceiling = v && v->accept ? v->accept(0.0) : 1.0, t0 = table ? s->table_temp[0] : s->t_start;
+  /* (each target only where a move tunes toward it) */
+  const double single = p->mix_point > 0.0 || p->mix_vector > 0.0 ? p->target : 0.0,
+               rigid = p->mix_translate > 0.0 || p->mix_rotate > 0.0 ? p->target_spline : 0.0;
+  if (t0 == 0.0 && p->tune_sweeps > 0 && fmax(single, rigid) * ceiling >= 0.5 && m < n)
     m += (size_t)snprintf(buf + m, n - m, "%sthe run tunes its steps at T = 0, where a chain takes its smallest steps "
                           "half the time: moves.target%s = %g is out of reach there, and the steps shrink to nothing "
-                          "(expected a target below 0.5)", m ? "; " : "", p->target >= p->target_spline ? "" : "_spline",
-                          fmax(p->target, p->target_spline));
+                          "(expected a target below 0.5)", m ? "; " : "", single >= rigid ? "" : "_spline",
+                          fmax(single, rigid));
   /* replicas = 1 given to turn tempering off, under a scene's ladder that
   ** sets the count: its rungs all ran, unsaid */
   if (a->n_rep > 1 && p->replicas == 1 && !p->of_run && lw_params_line(p, "tempering", "replicas") && m < n)

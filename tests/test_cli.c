@@ -690,7 +690,12 @@ Test(cli, keys_the_system_never_reads_are_refused)
     {"--set anneal.sweeps=3 --set anneal.schedule=constant --set anneal.t_start=0 --set moves.target=0.7",
      "linewise: note: the run tunes its steps at T = 0, where a chain takes its smallest steps half the time: "
      "moves.target = 0.7 is out of reach there, and the steps shrink to nothing (expected a target below 0.5)\n"},
+    /* (a table held at 0 too) */
+    {"--set anneal.sweeps=3 --set anneal.steps=3 --set anneal.schedule=table --set anneal.table=t0.txt --set "
+     "moves.target=0.6", "the run tunes its steps at T = 0, where a chain takes its smallest steps half the time: "
+     "moves.target = 0.6 is out of reach there"},
   };
+  write_file("t0.txt", "0 0\n2 0\n");
   for (size_t k = 0; k < sizeof end / sizeof end[0]; k++) {
     snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/e%zu %s", lw_test_root(), dir, k, end[k].set);
     /* (from dir: --set takes the table relative to the current directory) */
@@ -702,6 +707,11 @@ Test(cli, keys_the_system_never_reads_are_refused)
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out bz --set anneal.sweeps=3 --set "
                           "anneal.schedule=constant --set anneal.t_start=0 --set moves.target=0.7 --set scene.driver=barker "
                           "2>err.txt >/dev/null && ! grep -q 'at T = 0' err.txt", dir, lw_test_bin(), lw_test_root()), 0);
+  /* a target no move tunes toward is not noted */
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out bs --set anneal.sweeps=3 --set "
+                          "anneal.schedule=constant --set anneal.t_start=0 --set moves.translate=0 --set moves.rotate=0 "
+                          "--set moves.target_spline=0.6 2>err.txt >/dev/null && ! grep -q 'at T = 0' err.txt", dir,
+                          lw_test_bin(), lw_test_root()), 0);
 }
 
 /* A PDF page past what PDF allows (14,400 points) is refused before the run:
