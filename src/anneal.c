@@ -723,9 +723,10 @@ static void schedule_note(const lw_anneal *a, char *buf, size_t n)
                "stays as given", m ? "; " : "");
     /* (the ladder moves once every LW_TEMPERING_TUNE_EVERY exchanges) */
     else if (p->ladder_sweeps / p->exchange_every < LW_TEMPERING_TUNE_EVERY)
-      snprintf(buf + m, n - m, "%stempering.ladder_sweeps = %d holds %d exchanges (exchange_every = %d), and the "
+      snprintf(buf + m, n - m, "%stempering.ladder_sweeps = %d holds %d exchange%s (exchange_every = %d), and the "
                "ladder moves once every %d: it stays as given%s", m ? "; " : "", p->ladder_sweeps,
-               p->ladder_sweeps / p->exchange_every, p->exchange_every, LW_TEMPERING_TUNE_EVERY,
+               p->ladder_sweeps / p->exchange_every, p->ladder_sweeps / p->exchange_every == 1 ? "" : "s",
+               p->exchange_every, LW_TEMPERING_TUNE_EVERY,
                p->exchange_every > p->ladder_sweeps ? ", the swap statistics count from the start and no ladder.ini "
                                                       "is written" : "");
     else if (p->ladder_sweeps <= p->tune_sweeps)

@@ -707,6 +707,16 @@ Test(cli, keys_the_system_never_reads_are_refused)
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out bz --set anneal.sweeps=3 --set "
                           "anneal.schedule=constant --set anneal.t_start=0 --set moves.target=0.7 --set scene.driver=barker "
                           "2>err.txt >/dev/null && ! grep -q 'at T = 0' err.txt", dir, lw_test_bin(), lw_test_root()), 0);
+  /* a target of exactly 0.5 and target_spline are noted; a run that tunes no steps is not */
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out b5 --set anneal.sweeps=3 --set "
+                          "anneal.schedule=constant --set anneal.t_start=0 --set moves.target=0.5 2>err.txt >/dev/null && "
+                          "grep -q 'moves.target = 0.5 is out of reach' err.txt && %s run %s/params/minimal.ini --out b6 "
+                          "--set anneal.sweeps=3 --set anneal.schedule=constant --set anneal.t_start=0 --set "
+                          "moves.target_spline=0.7 2>err.txt >/dev/null && grep -q 'moves.target_spline = 0.7 is out of "
+                          "reach' err.txt && %s run %s/params/minimal.ini --out b7 --set anneal.sweeps=3 --set "
+                          "anneal.schedule=constant --set anneal.t_start=0 --set moves.target=0.7 --set moves.tune_sweeps=0 "
+                          "2>err.txt >/dev/null && ! grep -q 'at T = 0' err.txt", dir, lw_test_bin(), lw_test_root(),
+                          lw_test_bin(), lw_test_root(), lw_test_bin(), lw_test_root()), 0);
   /* a target no move tunes toward is not noted */
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out bs --set anneal.sweeps=3 --set "
                           "anneal.schedule=constant --set anneal.t_start=0 --set moves.translate=0 --set moves.rotate=0 "
@@ -892,6 +902,7 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
     {"run %s/s.ini --set anneal.seed=1.5", "--set: key 'anneal.seed': expected a whole number >= 0"},
     /* a tab showed as '?', and nothing said the blank was the fault */
     {"run %s/s.ini --set 'scene.width=\t100'", "got '?100' (a blank or tab before or after the value, which --set keeps"},
+    {"run %s/s.ini --set 'scene.width=100 '", "got '100 ' (a blank or tab before or after the value, which --set keeps"},
     {"run %s/s.ini --set tempering.replicas=2 --set tempering.t_max=2 --set tempering.tune_ladder=equal "
      "--set tempering.ladder_sweeps=999 --set anneal.sweeps=10",
      "key 'tempering.ladder_sweeps': the ladder is tuned for the first"},
@@ -2525,6 +2536,9 @@ Test(cli, a_scene_that_sets_no_key_is_noted)
                           "%s/err.txt && %s run %s/params/minimal.ini --stop-at 0 --out %s/m 2>%s/err.txt && ! grep -q "
                           "'sets no key' %s/err.txt", dir, lw_test_bin(), dir, dir, dir, dir, lw_test_bin(),
                           lw_test_root(), dir, dir, dir), 0);
+  /* a run's folder given as the scene says what to do with it */
+  cr_assert_eq(lw_test_sh("%s run %s/m 2>%s/err.txt; test $? -eq 2 && grep -q \"m: a folder, not a scene file: it holds "
+                          "a run, which 'linewise resume' continues\" %s/err.txt", lw_test_bin(), dir, dir, dir), 0);
   /* (with --set the values are no defaults: the note said so anyway) */
   cr_assert_eq(lw_test_sh("%s run %s/empty.ini --stop-at 0 --out %s/s --set anneal.sweeps=5 2>%s/err.txt && ! grep -q "
                           "'sets no key' %s/err.txt", lw_test_bin(), dir, dir, dir, dir), 0);

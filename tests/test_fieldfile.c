@@ -118,7 +118,8 @@ Test(fieldfile, text_reads_blanks_commas_comments_and_nan)
   assert_field(g, 0);
   lw_grid2d_free(g);
   /* (1e400 and 1e-400 as NumPy reads them: infinite, 0) */
-  static const char masked[] = "nan NaN 1 2\n-inf 0 3 1e400\n1e-400 0 0 0\n";
+  /* (capital E too, as Fortran and %E write it) */
+  static const char masked[] = "nan NaN 1 2\n-inf 0 3 1E400\n1e-400 0 0 0\n";
   lw_test_write(path, masked, sizeof masked - 1);
   g = lw_fieldfile_read(path, 2, 0, &err);
   cr_assert_not_null(g, "%s", err.msg);

@@ -987,6 +987,10 @@ Test(layers, bad_layer_keys_give_one_line_with_file_line_and_key_and_exit_2)
      "scene.ini:9: key 'layers.names': layer 1 is named 'yellow', but its colour #00ffff is a cyan"},
     {"[layers]\nsource = cmyk\ncolors = #00a0e0 #ffff00 #ff00ff #000\n",
      "scene.ini:10: key 'layers.colors': layer 2 is named 'magenta', but its colour #ffff00 is a yellow"},
+    /* under a palette: no word of cmyk's order */
+    {"[layers]\nnames = cyan magenta\nsource = palette\ncolors = #ff00ff #00ffff\n",
+     "scene.ini:9: key 'layers.names': layer 1 is named 'cyan', but its colour #ff00ff is a magenta, which it draws (a "
+     "separation draws each layer's colour):"},
     /* (names are matched whatever their case) */
     {"[layers]\nnames = Yellow Cyan Magenta Black\nsource = cmyk\n",
      "scene.ini:9: key 'layers.names': layer 1 is named 'Yellow', but its colour #00ffff is a cyan"},
@@ -1031,6 +1035,11 @@ Test(layers, bad_layer_keys_give_one_line_with_file_line_and_key_and_exit_2)
   cr_assert_eq(run("run bad.ini --out badset --set 'layers.tone_min=0 0.6'", errs, sizeof errs), 2, "%s", errs);
   cr_assert_not_null(strstr(errs, "--set: key 'layers.tone_min': expected layers.tone_min < layers.tone_max"), "%s",
                      errs);
+  /* hatching layers of the tone named for inks draw no separation: left alone */
+  static const char hatch[] = "[scene]\nwidth = 30\nheight = 30\nimage = colour.png\n[init]\nsplines = 5\n"
+                              "segment_length = 2\n[layers]\nnames = cyan magenta\n";
+  lw_test_write(lw_test_path("hatch.ini"), hatch, strlen(hatch));
+  cr_assert_eq(run("run hatch.ini --out hatchnames --set anneal.sweeps=0", errs, sizeof errs), 0, "%s", errs);
 }
 
 /* A CMYK scene whose splines are born and die in their layers: the layer

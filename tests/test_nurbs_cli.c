@@ -235,7 +235,9 @@ Test(nurbs_cli, bad_knots_and_weights_exit_2_naming_file_line_and_key)
           ".* .byte 3 is a minus sign, U.2212: type .-..");
   /* an empty field and too few lines: the point (0, 5) read of "0,,5", and
   ** a message that named no file */
-  cr_assert_eq(sh("printf '0 0\\n0,,5\\n' > %s/ef.txt && printf '# none\\n' > %s/no.txt", dir, dir), 0);
+  cr_assert_eq(sh("printf '0 0\\n0,,5\\n' > %s/ef.txt && printf '# none\\n' > %s/no.txt && printf '0 0\\n1 1\\n' > "
+                  "%s/two.txt", dir, dir, dir), 0);
+  refused("file = two.txt\\n", "bad.ini:4: key .nurbs.file.: .*two.txt holds 2 control points: expected");
   refused("file = ef.txt\\n", "bad.ini:4: key .nurbs.file.: .*ef.txt:2: expected .x y. like the lines before, got "
           ".0,,5. (an empty value between two commas");
   refused("file = no.txt\\n", "bad.ini:4: key .nurbs.file.: .*no.txt holds 0 control points: expected lines .x y. or "

@@ -918,6 +918,9 @@ Test(particles, point_files_are_read_and_bad_ones_name_file_line_and_what_was_ex
     /* a spreadsheet's blank cell: the values after it were read one place on */
     {"1,,2,3\n", "bad.xyz:1: expected a number in every field, got an empty one in '1,,2,3'"},
     {",1,2,3\n", "bad.xyz:1: expected a number in every field"},
+    /* (an empty file was its line 0) */
+    {"", "bad.xyz: an empty file: expected at least one point"},
+    {"//X,Y,Z\n", "bad.xyz:1: expected at least one point"},
     {"# nothing\n\n", "bad.xyz:2: expected at least one point"},
     {NULL, NULL},
   };

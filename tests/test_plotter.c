@@ -531,6 +531,9 @@ Test(plotter, command_line_writes_the_same_files_for_the_same_seed)
     {"plot.gcode_pen_up=M30", "key 'plot.gcode_pen_up' = 'M30': a program stop or end (M0, M1, M2, M30 or M60)"},
     {"'plot.gcode_pen_up=G0 Z5 M2'", "key 'plot.gcode_pen_up' = 'G0 Z5 M2': a program stop or end"},
     {"'plot.gcode_pen_down=M00'", "key 'plot.gcode_pen_down' = 'M00': a program stop or end"},
+    {"'plot.gcode_pen_up=M1 (optional stop)'", "= 'M1 (optional stop)': a program stop or end"},
+    {"'plot.gcode_pen_up=M60 P1'", "= 'M60 P1': a program stop or end"},
+    {"'plot.gcode_pen_up=G0 Z5 m30'", "= 'G0 Z5 m30': a program stop or end"},
   };
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.gcode=1 --set anneal.sweeps=0 --quiet --out "
                           "%s/servo --set 'plot.gcode_pen_down=M3 S90 G4 P0.2 (X axis: 0)' --set "

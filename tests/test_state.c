@@ -248,6 +248,7 @@ Test(state, strict_numbers)
   ** (0, 5)), but not at the end (a point cloud's blank normals) */
   cr_assert_eq(lw_number_list("0,,5", 2, list, 4), -3);
   cr_assert_eq(lw_number_list("0, ,5", 2, list, 4), -3);
+  cr_assert_eq(lw_number_list("0,\t,5", 2, list, 4), -3, "a tab-separated blank cell");
   cr_assert_eq(lw_number_list(",1 2", 2, list, 4), -3);
   cr_assert_eq(lw_number_list("1,2,", 2, list, 4), 2);
   cr_assert_eq(lw_number_list("0,,5", 1, list, 4), 2, "a run's own scene.ini as it was");

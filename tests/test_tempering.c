@@ -438,6 +438,12 @@ Test(ptrun, bad_ladders_are_refused_with_the_line)
                   "grep -q 'note: tempering.replicas = 1 is given, but tempering.ladder has 3 rungs and sets the count: "
                   "3 replicas run (for one chain, give tempering.ladder empty too)' %s/err.txt", b, lw_test_root(), dir,
                   dir, dir), 0);
+  /* two rungs too; and no note where replicas is not given (minimal.ini has no such key) */
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --set tempering.replicas=1 --set 'tempering.ladder=1 2' --stop-at 0 "
+                  "--out %s/r2 2>%s/err.txt && grep -q 'tempering.ladder has 2 rungs' %s/err.txt", b, lw_test_root(),
+                  dir, dir, dir), 0);
+  cr_assert_eq(sh("%s run %s/params/minimal.ini --set 'tempering.ladder=1 2' --stop-at 0 --out %s/r3 2>%s/err.txt && "
+                  "! grep -q 'replicas = 1 is given' %s/err.txt", b, lw_test_root(), dir, dir, dir), 0);
 }
 
 /* tune_ladder = equal says when it could not do its job.  Before the run: a
@@ -468,6 +474,10 @@ Test(ptrun, an_equal_ladder_that_did_not_settle_is_said)
   cr_assert_eq(sh("grep -q 'note: tempering.ladder_sweeps = 40 holds 0 exchanges (exchange_every = 50), and the "
                   "ladder moves once every 40: it stays as given, the swap statistics count from the start and no "
                   "ladder.ini is written' %s/err.txt && test ! -e %s/l41/ladder.ini", dir, dir), 0);
+  /* one exchange at the last tuning sweep: the freeze comes, and ladder.ini */
+  cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), 50, 60, "--set tempering.exchange_every=50", dir, 42, dir), 0);
+  cr_assert_eq(sh("grep -q 'holds 1 exchange (exchange_every = 50), and the ladder moves once every 40: it stays as "
+                  "given$' %s/err.txt && test -e %s/l42/ladder.ini", dir, dir), 0);
   for (int after = 2; after <= 20; after += 18) {
     cr_assert_eq(sh(run, lw_test_bin(), lw_test_root(), 40, 40 + after, "", dir, after, dir), 0);
     cr_assert_neq(sh("grep -q 'note: the swap rates' %s/err.txt", dir), 0, "%d sweeps after the freeze", after);
