@@ -705,16 +705,19 @@ Test(cli, keys_the_system_never_reads_are_refused)
     free(e);
   }
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out bz --set anneal.sweeps=3 --set "
-                          "anneal.schedule=constant --set anneal.t_start=0 --set moves.target=0.7 --set scene.driver=barker "
-                          "2>err.txt >/dev/null && ! grep -q 'at T = 0' err.txt", dir, lw_test_bin(), lw_test_root()), 0);
+                          "anneal.schedule=constant --set anneal.t_start=0 --set moves.target=0.7 --set "
+                          "scene.driver=barker 2>err.txt >/dev/null && ! grep -q 'at T = 0' err.txt", dir, lw_test_bin(),
+                          lw_test_root()), 0);
   /* a target of exactly 0.5 and target_spline are noted; a run that tunes no steps is not */
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out b5 --set anneal.sweeps=3 --set "
-                          "anneal.schedule=constant --set anneal.t_start=0 --set moves.target=0.5 2>err.txt >/dev/null && "
-                          "grep -q 'moves.target = 0.5 is out of reach' err.txt && %s run %s/params/minimal.ini --out b6 "
+                          "anneal.schedule=constant --set anneal.t_start=0 --set moves.target=0.5 2>err.txt "
+                          ">/dev/null && grep -q 'moves.target = 0.5 is out of reach' err.txt && %s run "
+                          "%s/params/minimal.ini --out b6 "
                           "--set anneal.sweeps=3 --set anneal.schedule=constant --set anneal.t_start=0 --set "
                           "moves.target_spline=0.7 2>err.txt >/dev/null && grep -q 'moves.target_spline = 0.7 is out of "
                           "reach' err.txt && %s run %s/params/minimal.ini --out b7 --set anneal.sweeps=3 --set "
-                          "anneal.schedule=constant --set anneal.t_start=0 --set moves.target=0.7 --set moves.tune_sweeps=0 "
+                          "anneal.schedule=constant --set anneal.t_start=0 --set moves.target=0.7 --set "
+                          "moves.tune_sweeps=0 "
                           "2>err.txt >/dev/null && ! grep -q 'at T = 0' err.txt", dir, lw_test_bin(), lw_test_root(),
                           lw_test_bin(), lw_test_root(), lw_test_bin(), lw_test_root()), 0);
   /* a target no move tunes toward is not noted */
@@ -901,7 +904,8 @@ Test(cli, hostile_input_exits_2_naming_file_line_and_key)
     {"run %s/s.ini --set scene.width=0x10", "--set: key 'scene.width': expected a number"},
     {"run %s/s.ini --set anneal.seed=1.5", "--set: key 'anneal.seed': expected a whole number >= 0"},
     /* a tab showed as '?', and nothing said the blank was the fault */
-    {"run %s/s.ini --set 'scene.width=\t100'", "got '?100' (a blank or tab before or after the value, which --set keeps"},
+    {"run %s/s.ini --set 'scene.width=\t100'",
+     "got '?100' (a blank or tab before or after the value, which --set keeps"},
     {"run %s/s.ini --set 'scene.width=100 '", "got '100 ' (a blank or tab before or after the value, which --set keeps"},
     {"run %s/s.ini --set tempering.replicas=2 --set tempering.t_max=2 --set tempering.tune_ladder=equal "
      "--set tempering.ladder_sweeps=999 --set anneal.sweeps=10",
@@ -2519,7 +2523,8 @@ Test(cli, an_irregular_segment_of_init_from_is_named_as_the_file_counts)
   free(e);
   /* and so is one whose energy is not finite (the sixth spline moved off the page was called 2) */
   cr_assert_eq(lw_test_sh("awk '/^spline =/ {s++} /^node/ && s == 6 {$4 = $4 + 500} {print}' %s/params/hanging.lw > "
-                          "%s/off.lw && %s run %s/params/hanging.ini --set init.from=%s/off.lw --set energy.boundary=0.5 "
+                          "%s/off.lw && %s run %s/params/hanging.ini --set init.from=%s/off.lw --set "
+                          "energy.boundary=0.5 "
                           "--stop-at 0 --out %s/h2 --quiet 2>%s/err.txt; test $? -eq 2", lw_test_root(), dir,
                           lw_test_bin(), lw_test_root(), dir, dir, dir), 0);
   e = lw_test_slurp("%s/err.txt", dir);
