@@ -316,6 +316,15 @@ static int by_cell(const void *pa, const void *pb)
   return (x->e > y->e) - (x->e < y->e);
 }
 
+/* The cell of coordinate v from origin o at side h, held within long long
+** (a band narrowed far below a page of metres: cells past it share one,
+** which costs scans, not joins) */
+static long long cell_of(double v, double o, double h)
+{
+  const double c = floor((v - o) / h);
+  return (long long)fmax(-1e18, fmin(1e18, c));
+}
+
 /* The first of the n sorted items in cell (cx, cy), and in *end the item
 ** after its last (both n where the cell is empty). */
 static size_t cell_run(const cell_item *c, size_t n, long long cx, long long cy, size_t *end)
@@ -375,7 +384,7 @@ static double first_band(const double *pt, size_t ne, double dist, double lo[2])
 ** ends are joined greedily, nearest first.  A distance far past the ends'
 ** spacing (a pen "joined whole") would have every pair a candidate, n^2
 ** of them (4.7 GB at 20,000 paths); so candidates are gathered in bands of
-** distance, each twice the one before, among the ends still free: a pair
+** distance, from about the ends' spacing outward, among the ends still free: a pair
 ** with an end already joined could never be taken, and a band's pairs all
 ** come after the bands before in the nearest-first order, so the joins are
 ** those of one sorted list of every pair, whatever the bands' bounds.  A
@@ -415,8 +424,7 @@ static lw_status join_pen(const lw_strokes *in, int pen, size_t base, size_t n, 
     size_t nx = 0;
     for (size_t e = 0; e < ne; e++)
       if (link[e] == SIZE_MAX)
-        cells[nx++] = (cell_item){(long long)floor((pt[2 * e] - origin[0]) / reach),
-                                  (long long)floor((pt[2 * e + 1] - origin[1]) / reach), e};
+        cells[nx++] = (cell_item){cell_of(pt[2 * e], origin[0], reach), cell_of(pt[2 * e + 1], origin[1], reach), e};
     qsort(cells, nx, sizeof *cells, by_cell);
     n_cand = 0;
     for (size_t i = 0; i < nx; i++)
