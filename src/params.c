@@ -488,7 +488,8 @@ const lw_param_def lw_param_table[] = {
   NUM("anneal", "quench_stall", LW_PT_DOUBLE, quench_stall, "0.05", "", 0, 1, 0,
       "The quench stops when its last 50 iterations removed less than this share of the energy it "
       "has removed so far while the gradient norm fell by less than a tenth over them (0: never; "
-      "the particles' default under weight = poly, whose smooth energy the quench takes to quench_tol "
+      "the particles' default under weight = poly with no hard wall, whose smooth energy the quench "
+      "takes to quench_tol "
       "(a sphere of 100 in 0.1 s, a sheet of 1000 in 4 s), where this rule stopped the sphere 88 above "
       "its minimum). "
       "A picture's terms are bilinear in its pixels, so the gradient norm stops falling short of "

@@ -33,8 +33,13 @@ static void *setup_new(const lw_params *p, lw_error *err) { return lw_particles_
 /* The poly weight meets 0 at R with slope 0 (the Lennard-Jones force's step
 ** there aside, which a quench crosses); the Gaussians have a kink at R, where
 ** a quench parks pairs and runs out its iterations (1000 particles under
-** aniso: 2000 iterations, 6.5 s, where the stall rule stopped at 71). */
-static int smooth(const lw_params *p) { return p->pt_weight == LW_PWEIGHT_POLY; }
+** aniso: 2000 iterations, 6.5 s, where the stall rule stopped at 71 to 78),
+** and a hard wall holds what it presses, whose gradient never falls (the
+** sheet on a floor: its norm stays at sqrt(127)). */
+static int smooth(const lw_params *p)
+{
+  return p->pt_weight == LW_PWEIGHT_POLY && (p->pt_boundary == LW_PBOUNDARY_NONE || p->pt_alpha_b > 0.0);
+}
 
 static void setup_free(void *setup) { lw_particles_setup_free(setup); }
 

@@ -396,6 +396,10 @@ Test(particles_cli, a_particle_quench_runs_to_its_minimum)
   cr_assert_eq(sh(run, lw_test_bin(), getenv("LW_ROOT"), dir, "stall", "--set anneal.quench_stall=0.05"), 0);
   snprintf(path, sizeof path, "%s/stall/summary.json", dir);
   cr_assert_eq(sh("grep -q '\"ended\": \"stalled\"' %s", path), 0, "a stall share given is kept");
+  /* a hard wall holds what it presses, whose gradient never falls: 0.05 there */
+  cr_assert_eq(sh(run, lw_test_bin(), getenv("LW_ROOT"), dir, "wall", "--set particles.boundary=plane --set "
+                  "particles.boundary_z=-3 --set particles.alpha_b=0"), 0);
+  cr_assert_eq(sh("grep -qx 'quench_stall = 0.050000000000000003' %s/wall/scene.ini", dir), 0);
 }
 
 Test(particles_cli, a_quench_lays_the_sheet_on_a_hard_floor)

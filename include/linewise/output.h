@@ -94,8 +94,9 @@ int lw_output_colors_parse(const char *list, unsigned char (*rgb)[3], int max);
 
 /* The plotter SVG, written atomically: width and height in mm, viewBox in
 ** mm (user unit = 1 mm), one Inkscape layer group per pen in pen order
-** (id "pen<k>", label "<k> pen (<width> mm)", or "<k> <name> (<width> mm)"
-** for a named pen: AxiDraw's software plots a layer by its leading number;
+** (id "pen<k>", label "<k> pen", or "<k> <name>" for a named pen, no
+** other digit: AxiDraw's software plots a layer by its leading number, and
+** vpype takes a label's every digit for it;
 ** with page->multiply each group's style is mix-blend-mode:multiply), one
 ** path per spline with
 ** M and C commands only.  A reversed path lists the control points of its

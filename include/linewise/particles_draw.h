@@ -1,10 +1,11 @@
 /*
 ** particles_draw.h -- the particle system's drawings: final.ply and final.png.
 **
-** final.ply is ASCII PLY 1.0 with one vertex element of float properties
+** final.ply is ASCII PLY 1.0 with one vertex element of double properties
 ** x y z nx ny nz (the normal is the particle's local z axis), which MeshLab
-** and CloudCompare read as a point cloud with normals.  Floats are written
-** with 9 significant digits, enough to read back the same float.
+** and CloudCompare read as a point cloud with normals.  Doubles are written
+** with 17 significant digits, so a run continued from the file starts where
+** this one ended.
 **
 ** final.png is an orthographic preview from the set-up's view direction v
 ** (particles.view_azimuth and view_elevation): screen axes e1 = z x v
