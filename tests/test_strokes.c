@@ -296,6 +296,25 @@ static void joins_as_reference(const lw_strokes *s, double dist, double angle)
   free(got);
 }
 
+/* n straight strokes of 1 to 5 mm at random turns, starting at random in a
+** square of side box from the origin, the first at (far, far) where far is
+** not 0; a fixed stream from seed. */
+static lw_strokes *random_strokes(size_t n, double box, double far, unsigned long long seed)
+{
+  lw_strokes *s = lw_strokes_new(1, NULL);
+  for (size_t k = 0; k < n; k++) {
+    double u[4];
+    for (int c = 0; c < 4; c++) {
+      seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+      u[c] = (double)(seed >> 11) / 9007199254740992.0;
+    }
+    const double x = k || !far ? box * u[0] : far, y = k || !far ? box * u[1] : far, len = 1 + 4 * u[2],
+                 th = 2 * M_PI * u[3];
+    add_line(s, 0, k, x, y, x + len * cos(th), y + len * sin(th));
+  }
+  return s;
+}
+
 /* The joins are gathered band by band of distance among the ends still
 ** free (strokes.c), so that a distance past the ends' spacing costs no n^2
 ** candidates; they must be the joins of one list of every pair, sorted.
@@ -303,18 +322,7 @@ static void joins_as_reference(const lw_strokes *s, double dist, double angle)
 ** ends' spacing to the whole page, a tight angle and any. */
 Test(strokes, joins_by_bands_are_those_of_every_pair_sorted)
 {
-  unsigned long long r = 12345;
-  const size_t n = 300;
-  lw_strokes *s = lw_strokes_new(1, NULL);
-  for (size_t k = 0; k < n; k++) {
-    double u[4];
-    for (int c = 0; c < 4; c++) {
-      r = r * 6364136223846793005ULL + 1442695040888963407ULL;
-      u[c] = (double)(r >> 11) / 9007199254740992.0;
-    }
-    const double len = 1 + 4 * u[2], th = 2 * M_PI * u[3];
-    add_line(s, 0, k, 50 * u[0], 50 * u[1], 50 * u[0] + len * cos(th), 50 * u[1] + len * sin(th));
-  }
+  lw_strokes *s = random_strokes(300, 50, 0, 12345);
   const double dists[] = {0.1, 0.5, 2, 8, 30, 1e6}, angles[] = {30 * M_PI / 180, M_PI};
   for (size_t i = 0; i < sizeof dists / sizeof dists[0]; i++)
     for (size_t k = 0; k < 2; k++) joins_as_reference(s, dists[i], angles[k]);
@@ -327,18 +335,7 @@ Test(strokes, joins_by_bands_are_those_of_every_pair_sorted)
 ** narrower; the joins are still those of every pair sorted. */
 Test(strokes, a_cluster_beside_an_outlier_joins_as_every_pair_sorted)
 {
-  unsigned long long r = 777;
-  const size_t n = 800;
-  lw_strokes *s = lw_strokes_new(1, NULL);
-  for (size_t k = 0; k < n; k++) {
-    double u[4];
-    for (int c = 0; c < 4; c++) {
-      r = r * 6364136223846793005ULL + 1442695040888963407ULL;
-      u[c] = (double)(r >> 11) / 9007199254740992.0;
-    }
-    const double x = k ? 10 * u[0] : 1000, y = k ? 10 * u[1] : 1000, len = 1 + 4 * u[2], th = 2 * M_PI * u[3];
-    add_line(s, 0, k, x, y, x + len * cos(th), y + len * sin(th));
-  }
+  lw_strokes *s = random_strokes(800, 10, 1000, 777);
   joins_as_reference(s, 1e6, 30 * M_PI / 180);
   joins_as_reference(s, 1e6, M_PI);
   lw_strokes_free(s);
