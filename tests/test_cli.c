@@ -1462,16 +1462,6 @@ Test(cli, a_run_replacing_another_removes_the_files_it_does_not_write_again)
                0, "a stray state.lw let the run clear the directory");
 }
 
-/* The mean and standard error of a column in `linewise stats --csv` output. */
-static void stats_column(const char *csv, const char *name, double *mean, double *se)
-{
-  char key[64];
-  snprintf(key, sizeof key, "\n%s,", name);
-  const char *p = strstr(csv, key);
-  cr_assert_not_null(p, "no column %s in:\n%s", name, csv);
-  long n;
-  cr_assert_eq(sscanf(p + strlen(key), "%ld,%lf,%lf", &n, mean, se), 3, "%s", p);
-}
 
 /* scene.driver = barker: the Monte Carlo chain deciding by Barker's rule
 ** (driver.h).  It reads the chain's keys without a note, names itself in
@@ -1554,9 +1544,9 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
   snprintf(args, sizeof args, "stats %s/wlc --csv", dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
   double L, Lse, r2, r2se, c, cse;
-  stats_column(out, "obs_length", &L, &Lse);
-  stats_column(out, "obs_end2", &r2, &r2se);
-  stats_column(out, "obs_end_cos", &c, &cse);
+  lw_test_stats_row(out, "obs_length", &L, &Lse);
+  lw_test_stats_row(out, "obs_end2", &r2, &r2se);
+  lw_test_stats_row(out, "obs_end_cos", &c, &cse);
   /* a column without spread has no tau and n_eff (it had 0.5 and n) */
   cr_assert(strstr(out, "\nobs_count,4001,50,0,0,,,"), "%s", out);
   double kp = 2.0 * lp * L * (1.0 - lp / L * (1.0 - exp(-L / lp)));

@@ -79,17 +79,6 @@ Test(nurbs_cli, monte_carlo_anneals_a_rational_curve_and_bounds_its_svg)
   cr_assert_eq(sh("grep -q elastic %s/e.txt", dir), 0);
 }
 
-/* The mean and stderr of row `name` of `linewise stats --csv`. */
-static void stats_row(const char *csv, const char *name, double *mean, double *se)
-{
-  char key[64];
-  snprintf(key, sizeof key, "\n%s,", name);
-  const char *l = strstr(csv, key);
-  cr_assert_not_null(l, "%s", csv);
-  double n;
-  cr_assert_eq(sscanf(strchr(l + 1, ',') + 1, "%lf,%lf,%lf", &n, mean, se), 3, "%s", l);
-}
-
 Test(nurbs_cli, monte_carlo_heat_capacity_is_half_the_free_coordinates)
 {
   /* The wire's energy is quadratic in its control points (weights frozen,
@@ -109,7 +98,7 @@ Test(nurbs_cli, monte_carlo_heat_capacity_is_half_the_free_coordinates)
     char key[64];
     snprintf(key, sizeof key, "replica%d_heat_capacity", k);
     double c, se;
-    stats_row(csv, key, &c, &se);
+    lw_test_stats_row(csv, key, &c, &se);
     cr_log_info("rung %d: C = %.4f +- %.4f (5)", k, c, se);
     cr_assert(se > 0 && se < 0.25 && fabs(c - 5.0) < 4 * se, "rung %d: C = %g +- %g, expected 5", k, c, se);
     /* summary.json's observables carry the same, for sweeps over runs */
@@ -167,9 +156,9 @@ Test(nurbs_cli, tempering_exchanges_weigh_the_rungs_at_the_schedules_temperature
     char key[64];
     double c, se;
     snprintf(key, sizeof key, "replica%d_heat_capacity", k);
-    stats_row(csv, key, &c, &se);
+    lw_test_stats_row(csv, key, &c, &se);
     snprintf(key, sizeof key, "replica%d_energy", k);
-    stats_row(csv, key, &e[k], &se_e[k]);
+    lw_test_stats_row(csv, key, &e[k], &se_e[k]);
     cr_log_info("rung %d at T %d: C = %.4f +- %.4f (5), <E> %.4f +- %.4f", k, 2 << k, c, se, e[k], se_e[k]);
     cr_assert(se > 0 && fabs(c - 5.0) < 4 * se, "rung %d: C = %g +- %g, expected 5", k, c, se);
     if (k)

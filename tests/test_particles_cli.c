@@ -647,18 +647,6 @@ Test(particles_cli, the_bundled_seed_patch_grows_into_a_flat_sheet)
   gsl_matrix_free(cov);
 }
 
-/* The heat capacity of rung k from `linewise stats --csv` (mean and
-** standard error). */
-static void rung_heat_capacity(const char *csv, int k, double *c, double *se)
-{
-  char key[64];
-  snprintf(key, sizeof key, "\nreplica%d_heat_capacity,", k);
-  const char *l = strstr(csv, key);
-  cr_assert_not_null(l, "%s", csv);
-  double n;
-  cr_assert_eq(sscanf(strchr(l + 1, ',') + 1, "%lf,%lf,%lf", &n, c, se), 3, "%s", l);
-}
-
 Test(particles_cli, the_lj13_cluster_melts_with_a_heat_capacity_peak, .timeout = 240)
 {
   /* params/lj13.ini over 60,000 sweeps (fixed seed, a trace row every
@@ -689,7 +677,9 @@ Test(particles_cli, the_lj13_cluster_melts_with_a_heat_capacity_peak, .timeout =
   double sw = 0, st = 0, stt = 0, sc = 0, stc = 0;
   for (int k = 0; k < 7; k++) {
     double T = 0.02 * pow(30, k / 15.0), c, se;
-    rung_heat_capacity(csv, k, &c, &se);
+    char row[64];
+    snprintf(row, sizeof row, "replica%d_heat_capacity", k);
+    lw_test_stats_row(csv, row, &c, &se);
     double w = 1 / (se * se);
     sw += w, st += w * T, stt += w * T * T, sc += w * c, stc += w * T * c;
   }

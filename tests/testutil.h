@@ -107,6 +107,17 @@ static inline int lw_test_long(void)
   return e && *e && strcmp(e, "0") != 0;
 }
 
+/* The mean and standard error of row `name` of `linewise stats --csv`. */
+static inline void lw_test_stats_row(const char *csv, const char *name, double *mean, double *se)
+{
+  char key[128];
+  snprintf(key, sizeof key, "\n%s,", name);
+  const char *p = strstr(csv, key);
+  cr_assert_not_null(p, "no row %s in:\n%s", name, csv);
+  long n;
+  cr_assert_eq(sscanf(p + strlen(key), "%ld,%lf,%lf", &n, mean, se), 3, "%s", p);
+}
+
 /* |a - b| <= tol * max(|b|, floor) */
 static inline int lw_close_rel(double a, double b, double tol, double floor)
 {
