@@ -227,7 +227,9 @@ static void acceptance_case(int d, double ratio, unsigned long seed, long N, dou
   double se = fmax(sqrt(var_b / B), sqrt(a * (1.0 - a) / (double)prop_all));
   cr_log_info("acceptance d=%d s/sigma=%.1f domains %s threads %d: %.5f exact %.5f se %.1e (outside %lu)", d, ratio,
               domains ? domains : "off", threads, rate, a, se, c->stats[LW_MOVE_POINT].outside);
-  /* 5 standard errors: a false failure has probability ~ 6e-7 */
+  /* 5 standard errors: se is estimated from 50 batches, so a false failure
+  ** has the probability of |t| > 5 at 49 degrees of freedom, 7.7e-6 (6e-7
+  ** were se exact; the binomial floor only lowers it) */
   cr_assert(fabs(rate - a) <= 5.0 * se,
             "d=%d s/sigma=%.2f domains %s threads %d: acceptance %.5f, exact %.5f, standard error %.2g", d, ratio,
             domains ? domains : "off", threads, rate, a, se);
@@ -351,11 +353,13 @@ static void boltzmann_case(double period, const char *domains, int threads)
   /* Power: the same samples against the Boltzmann distribution of a 20%
   ** higher temperature (sd 9.5% wider), and against a mean off by 0.1
   ** standard deviations, must fail the same test.  The power checks are
-  ** random too: a width off by e gives the chi-square a noncentrality of
-  ** about 2 n e^2, a shift of d sd about n d^2, here 360 and 200 against the
-  ** 43.8 of p = 1e-3 at 19 degrees of freedom, so each fails to reject at
-  ** 6 sd of its spread or more.  (1.1 T and 0.05 sd, 95 and 50, passed
-  ** 4 seeds in 100: a new random stream could fail them.) */
+  ** random too: the noncentrality n sum_b (p_b - 1/20)^2 * 20 over the 20
+  ** bins of the 20,000 samples is 259 for the wider law and 197 for the
+  ** shift (p_b the true law's share of bin b; the binning sees less than
+  ** the 2 n e^2 and n d^2 of the whole sample), against the 43.8 of
+  ** p = 1e-3 at 19 degrees of freedom, so each fails to reject at 6 sd of
+  ** its spread or more.  (1.1 T and 0.05 sd, 73 and 49, passed 4 seeds in
+  ** 100: a new random stream could fail them.) */
   double p_wrong_t = gaussian_chisq_p(x, n, mu, sd * sqrt(1.2), 20);
   double p_wrong_mu = gaussian_chisq_p(x, n, mu + 0.1 * sd, sd, 20);
   cr_log_info("chi-square (domains %s, %d threads): tau %.2f sweeps, thin %ld, %zu samples: p %.3g, wrong T p %.3g, "
