@@ -2207,9 +2207,11 @@ static lw_status write_summary(lw_anneal *a, lw_error *err)
   lw_json_key(&j, "wall_seconds"); lw_json_number(&j, wall);
   lw_json_key(&j, "sweep_seconds"); lw_json_number(&j, a->sweep_seconds);
   if (mc) {
-    lw_json_key(&j, "proposals_per_second"); /* of the sweeps of the whole run */
-    lw_json_number(&j, a->sweep_seconds > 0 && prop >= a->untimed ? (double)(prop - a->untimed) / a->sweep_seconds
-                                                                    : 0.0);
+    /* of the sweeps of the whole run; none where no sweep was timed (a
+    ** redraw), not a 0 that a script averaging rates would count */
+    lw_json_key(&j, "proposals_per_second");
+    if (a->sweep_seconds > 0 && prop >= a->untimed) lw_json_number(&j, (double)(prop - a->untimed) / a->sweep_seconds);
+    else lw_json_null(&j);
     lw_json_key(&j, "max_relative_drift"); lw_json_number(&j, a->max_drift);
     lw_json_key(&j, "temperature_final"); /* none where no sweep ran (a redraw) */
     if (a->sweep > 0) lw_json_number(&j, c->temperature);

@@ -1703,7 +1703,7 @@ static int cmd_stats(int argc, char **argv)
               "distribution, their acceptances, steps and autocorrelation times are each of its own chain\n", dir[0],
               driver[0], dir[other_driver], driver[other_driver]);
   }
-  /* (the run the error is of may wait aside: "no rows yet" of the run that
+  /* (the run the error is of may wait aside: "no rows" of the run that
   ** was killed replacing it said nothing of it); a statistics' error begins
   ** with the trace's path */
   for (int r = 0; err.code && failed < 0 && path && r < k; r++)

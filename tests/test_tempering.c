@@ -619,7 +619,8 @@ Test(ptrun, a_ladder_file_runs_as_its_ladder_given_by_set)
 }
 
 /* A tempering run of no sweep has no temperatures yet: its rungs said 0
-** in summary.json (beside the ladder), where temperature_final was null. */
+** in summary.json (beside the ladder), where temperature_final was null;
+** and no rate of proposals. */
 Test(ptrun, a_run_of_no_sweep_gives_its_rungs_no_temperature)
 {
   const char *run = "%s run %s/params/wire-ladder.ini --threads 1 --quiet --set anneal.sweeps=%d --out %s/z%d";
@@ -629,5 +630,8 @@ Test(ptrun, a_run_of_no_sweep_gives_its_rungs_no_temperature)
                    "grep -q '^  \"temperature_final\": null,$' %s/z%d/summary.json", dir, sweeps, dir, sweeps);
     int ones = sh("grep -q '^      \"temperature\": 1,$' %s/z%d/summary.json", dir, sweeps);
     cr_assert(sweeps ? nulls != 0 && ones == 0 : nulls == 0 && ones != 0, "%d sweeps", sweeps);
+    /* nor a rate: 0 / 0 read 0, which a script averaging rates counted */
+    cr_assert_eq(sh("grep -q '^  \"proposals_per_second\": null,$' %s/z%d/summary.json", dir, sweeps), sweeps != 0,
+                 "%d sweeps", sweeps);
   }
 }
