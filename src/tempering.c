@@ -71,13 +71,18 @@ void lw_tempering_geometric(double *ladder, int n, double t_min, double t_max)
   if (n > 1) ladder[n - 1] = t_max;
 }
 
-/* log of the acceptance ratio of swapping rungs k and k+1.  A rung at T = 0
-** has beta = inf: the swap is then accepted only if it does not raise the
-** cold side's energy; equal temperatures or energies make the swap free. */
+/* log of the acceptance ratio of swapping rungs k and k+1 (k the colder on
+** the ladder).  A rung at T = 0 has beta = inf: the swap is then accepted
+** only if it does not raise the cold side's energy.  So also where a schedule
+** has brought every rung to 0, the limit of the ladder's rule as T falls:
+** a free swap there handed the coldest rung, whose state the run reports,
+** whichever rung's came, the worst of three in a helper's run.  Equal
+** temperatures above 0 (a rounding) or energies make the swap free. */
 static double log_ratio(double tk, double tk1, double ek, double ek1)
 {
   double de = ek - ek1;
-  if (de == 0.0 || tk == tk1) return 0.0;
+  if (de == 0.0) return 0.0;
+  if (tk == tk1) return tk > 0.0 ? 0.0 : de > 0.0 ? INFINITY : -INFINITY;
   double bk = tk > 0.0 ? 1.0 / tk : INFINITY, bk1 = tk1 > 0.0 ? 1.0 / tk1 : INFINITY;
   double x = (bk - bk1) * de;
   return isnan(x) ? -INFINITY : x;

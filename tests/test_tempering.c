@@ -242,9 +242,15 @@ Test(tempering, zero_and_equal_temperatures_are_handled)
   const double ladder[2] = {1.0, 2.0}, zero[2] = {0.0, 0.0}, cold0[2] = {0.0, 1.0};
   lw_error err;
   lw_tempering *pt = lw_tempering_new(2, ladder, 1, &err);
-  /* both at T = 0: the swap changes nothing, it is accepted */
-  const double e[2] = {1.0, 3.0};
-  cr_assert_eq(lw_tempering_exchange(pt, e, zero, NULL), 1);
+  /* both at T = 0 (a schedule brought the ladder there): the ladder's rule
+  ** in the limit, the colder rung by the ladder takes the lower energy (the
+  ** swap was free, and a run reported whichever state came to rung 0) */
+  const double e[2] = {1.0, 3.0}, e_swapped[2] = {3.0, 1.0};
+  for (int s = 0; s < 10; s += 2, pt->steps = 0) {
+    cr_assert_eq(lw_tempering_exchange(pt, e, zero, NULL), 0);
+    pt->steps = 0;
+    cr_assert_eq(lw_tempering_exchange(pt, e_swapped, zero, NULL), 1);
+  }
   pt->steps = 0;
   /* a T = 0 rung never takes a higher energy */
   for (int s = 0; s < 10; s += 2, pt->steps = 0) cr_assert_eq(lw_tempering_exchange(pt, e, cold0, NULL), 0);
