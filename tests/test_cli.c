@@ -681,9 +681,14 @@ Test(cli, keys_the_system_never_reads_are_refused)
     {"--set anneal.sweeps=10 --set anneal.steps=5 --set anneal.schedule=table --set anneal.table=t.txt",
      "linewise: note: anneal.table has rows past step 4, the last of anneal.steps = 5 (steps count from 0): they "
      "are never reached\n"},
-    {"--set anneal.sweeps=10 --set anneal.steps=20 --set anneal.schedule=table --set anneal.table=t.txt",
+    {"--set anneal.sweeps=10 --set anneal.steps=20 --set anneal.schedule=table --set anneal.table=t19.txt",
      "linewise: note: anneal.steps = 20 is more than the 10 sweeps: some steps are skipped, and the run ends at step "
      "18 (steps count from 0 to 19), short of the table's last step\n"},
+    /* a table that stops short of the run holds its last row, which was silent */
+    {"--set anneal.sweeps=40 --set anneal.steps=10 --set anneal.schedule=table --set anneal.table=t.txt",
+     "linewise: note: anneal.table ends at step 5, before the run's last step 9 (anneal.steps = 10, steps count from "
+     "0): its last temperature, 0.01, holds for the 4 steps after it (a row at step 9 ends the table where the run "
+     "does)\n"},
     /* steps tuned at T = 0 toward more than the half of the smallest steps
     ** taken there shrank to 1e-15 mm (a greedy descent's steps); barker
     ** aims at a share of its own half, which is in reach */
@@ -696,6 +701,16 @@ Test(cli, keys_the_system_never_reads_are_refused)
      "moves.target = 0.6 is out of reach there"},
   };
   write_file("t0.txt", "0 0\n2 0\n");
+  write_file("t19.txt", "1 1\n19 0.01\n");
+  /* (one that ends at the run's last step is not noted; one that ends
+  ** before it is not said to fall short where the run skips steps) */
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out e6 --set anneal.sweeps=12 --set anneal.steps=6 "
+                          "--set anneal.schedule=table --set anneal.table=t.txt 2>err.txt >/dev/null && ! grep -q "
+                          "'anneal.table ends' err.txt && %s run %s/params/minimal.ini --out e7 --set anneal.sweeps=10 "
+                          "--set anneal.steps=20 --set anneal.schedule=table --set anneal.table=t.txt 2>err.txt "
+                          ">/dev/null && ! grep -q 'short of' err.txt && grep -q 'anneal.table ends at step 5, before "
+                          "the run.s last step 18' err.txt", dir, lw_test_bin(), lw_test_root(), lw_test_bin(),
+                          lw_test_root()), 0, "%s", lw_test_slurp("%s/err.txt", dir));
   for (size_t k = 0; k < sizeof end / sizeof end[0]; k++) {
     snprintf(args, sizeof args, "run %s/params/minimal.ini --out %s/e%zu %s", lw_test_root(), dir, k, end[k].set);
     /* (from dir: --set takes the table relative to the current directory) */
