@@ -160,6 +160,7 @@ static void row_matches_summary(const csv *t, int r, const char *run)
     else if (!strncmp(h, "fidelity_", 9)) member(js, "fidelity", h + 9, want, sizeof want);
     else if (!strncmp(h, "obs_", 4)) member(js, "observables", h + 4, want, sizeof want);
     else if (!strcmp(h, "seed") || !strcmp(h, "proposals_per_second") || !strcmp(h, "wall_seconds") ||
+             !strcmp(h, "temperature_final") ||
              !strcmp(h, "close_share") || !strcmp(h, "version") || !strcmp(h, "build"))
       member(js, NULL, h, want, sizeof want);
     else continue;
@@ -231,7 +232,8 @@ Test(tools, seed_sweep_gathers_every_summary_and_links_the_best)
   csv_read(&t, path);
   const char *want_cols[] = {"seed", "energy_total", "energy_strain", "energy_bending", "energy_pair",
                              "energy_boundary", "acceptance_point", "acceptance_rotate",
-                             "proposals_per_second", "wall_seconds", "close_share", "version", "build", "run"};
+                             "temperature_final", "proposals_per_second", "wall_seconds", "close_share", "version",
+                             "build", "run"};
   for (size_t i = 0; i < sizeof want_cols / sizeof *want_cols; i++)
     cr_assert(col(&t, want_cols[i]) >= 0, "no column %s", want_cols[i]);
   cr_assert(col(&t, "fidelity_ssim") < 0, "fidelity columns without a picture");
