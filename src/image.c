@@ -866,6 +866,17 @@ static lw_status stb_input_sound(const unsigned char *data, size_t size, const c
   return st;
 }
 
+/* stbi_info, with a BMP's rows stored top down, as a negative height
+** (legal in every header), given the height's magnitude: the decoder gives
+** them upright (they were all refused as damaged, and then again where a
+** scene's picture is first looked at). */
+static int stb_info(const unsigned char *data, size_t size, int *w, int *h, int *ch)
+{
+  if (!stbi_info_from_memory(data, (int)size, w, h, ch)) return 0;
+  if (!strcmp(format_name(data, size), "BMP") && *h < 0 && *h > INT_MIN) *h = -*h;
+  return 1;
+}
+
 static lw_status stb_decode(const unsigned char *data, size_t size, const char *name, decoded *out, lw_error *err)
 {
   if (size > INT_MAX)
@@ -873,11 +884,7 @@ static lw_status stb_decode(const unsigned char *data, size_t size, const char *
   lw_status st = stb_input_sound(data, size, name, err);
   if (st) return st;
   int w, h, ch;
-  if (!stbi_info_from_memory(data, (int)size, &w, &h, &ch)) return not_decoded(data, size, name, err);
-  /* a BMP's rows stored top down, as a negative height (legal in every
-  ** header), come out of the decoder upright: its size is the height's
-  ** magnitude (they were all refused as damaged) */
-  if (!strcmp(format_name(data, size), "BMP") && h < 0 && h > INT_MIN) h = -h;
+  if (!stb_info(data, size, &w, &h, &ch)) return not_decoded(data, size, name, err);
   if (w < 1 || h < 1) /* stb_image passes a BMP of width 0 */
     return lw_error_set(err, LW_EINPUT, "%s: the %s is damaged: %d x %d pixels", name, format_name(data, size), w, h);
   const int comps = !strcmp(format_name(data, size), "JPEG") ? jpeg_components(data, size) : 0;
@@ -1059,7 +1066,7 @@ lw_status lw_image_probe(const char *path, lw_image_info *info, lw_error *err)
     if (size > 0 && size <= INT_MAX) st = stb_input_sound(data, size, path, err);
     if (st)
       ; /* refused before stb_image reads it */
-    else if (size == 0 || size > INT_MAX || !stbi_info_from_memory(data, (int)size, &iw, &ih, &ch))
+    else if (size == 0 || size > INT_MAX || !stb_info(data, size, &iw, &ih, &ch))
       st = not_decoded(data, size, path, err);
     else if (iw < 1 || ih < 1)
       st = lw_error_set(err, LW_EINPUT, "%s: the %s is damaged: %d x %d pixels", path, format_name(data, size), iw, ih);

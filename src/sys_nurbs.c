@@ -401,7 +401,13 @@ static lw_nurbs_state *state_get(const lw_nurbs_setup *su, lw_ckpt *doc, const c
   const char *key, *val;
   int line;
   lw_nurbs_state *s = NULL;
+  int counts = 0;
   while (lw_ckpt_next(doc, section, &pos, &key, &val, &line)) {
+    /* the first was read above; a second passed unseen */
+    if (!strcmp(key, "count") && counts++) {
+      lw_error_set(err, LW_EINPUT, "%s:%d: [%s] count: given twice (expected one line of it)", path, line, section);
+      goto out;
+    }
     if (!strcmp(key, "count")) continue;
     double v[3];
     if (!strcmp(key, "log_weight")) {

@@ -95,6 +95,16 @@ Test(image, rgb_becomes_rec709_luma_with_row_0_at_the_top)
   for (int k = 0; k < 6; k++)
     cr_assert(fabs(img->tone[k] - want[k]) < 1e-6, "top down, pixel %d: %g, want %g", k, img->tone[k], want[k]);
   lw_image_free(img);
+  /* and its size read without decoding it, as a scene's picture is first
+  ** looked at (still "damaged: 3 x -2 pixels" there, a photographer's find) */
+  char path[] = "/tmp/lw_topdown_XXXXXX";
+  int fd = mkstemp(path);
+  cr_assert(fd >= 0);
+  FILE *f = fdopen(fd, "wb");
+  cr_assert(f && fwrite(t, 1, n, f) == n && fclose(f) == 0);
+  cr_assert_eq(lw_image_probe(path, &info, &err), LW_OK, "%s", err.msg);
+  cr_assert(info.width == 3 && info.height == 2, "%d x %d", info.width, info.height);
+  remove(path);
 }
 
 Test(image, pgm_and_ppm_any_maxval_and_truncation)

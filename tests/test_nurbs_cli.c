@@ -409,6 +409,11 @@ Test(nurbs_cli, a_refined_wire_runs_resumes_and_refuses_a_step_past_its_stabilit
   cr_assert_eq(sh("grep -q \"r/state.lw:[0-9]*: \\[system nurbs\\] count: 19 control points, but the scene's curve "
                   "has 11 (its points refined by nurbs.elevate and nurbs.refine)\" %s/err.txt", dir),
                0);
+  /* a second count among the points: refused (it passed unread) */
+  cr_assert_eq(sh("cp -r %s/r %s/c2 && sed -i '0,/^point = /s/^point = .*/&\\ncount = 99/' %s/c2/state.lw && %s energy "
+                  "%s/c2 2> %s/err.txt; test $? -eq 2 && grep -q 'c2/state.lw:[0-9]*: \\[system nurbs\\] count: given "
+                  "twice' %s/err.txt", dir, dir, dir, lw_test_bin(), dir, dir, dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* the energy over the run: the leapfrog keeps E + K (the trace's total) */
   cr_assert_eq(sh("awk -F, 'NR == 2 { h = $7 } NR > 2 { d = $7 - h; if (d < 0) d = -d; if (d > 1e-3 * h) bad = 1 } "
                   "END { exit bad }' %s/r/trace.csv",
