@@ -512,7 +512,8 @@ static lw_status read_ladder_file(lw_anneal *a, lw_error *err)
                      p->file);
   double ladder[LW_TEMPERING_MAX];
   snprintf(where, sizeof where, "%s:%d", f->file, at);
-  if (!s && !parse_ladder(p, f->ladder, where, ladder, err)) s = err->code;
+  /* (its values' faults name the scene's key too, as its lines' do) */
+  if (!s && !parse_ladder(p, f->ladder, where, ladder, err)) s = lw_params_blame(p, "tempering", "ladder_file", err);
   if (!s) {
     snprintf(p->ladder, sizeof p->ladder, "%s", f->ladder);
     p->ladder_file[0] = '\0';

@@ -573,6 +573,8 @@ Test(ptrun, a_ladder_file_runs_as_its_ladder_given_by_set)
     /* the word that is no number is named (said: not 2 to 256 temperatures) */
     {"[tempering]\nladder = 1 2x 4\n", "", "lad.ini:2: key 'tempering.ladder': '2x' is not a temperature; expected "
      "finite numbers"},
+    /* with the scene's key that named the file, as its lines' faults have */
+    {"[tempering]\nladder = 1 2 x\n", "", "f.ini:32: key 'tempering.ladder_file': "},
     {"[tempering]\nladder = 1, 2, nan, 4\n", "", "lad.ini:2: key 'tempering.ladder': 'nan' is not a temperature"},
     /* a no-break space between two numbers is named ("'1 2' is not a temperature") */
     {"[tempering]\nladder = 1\302\2402 4\n", "", "is not a temperature; expected finite numbers such as 0.5 or "
