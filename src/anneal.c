@@ -692,7 +692,7 @@ static void schedule_note(const lw_anneal *a, char *buf, size_t n)
                           (long)p->sweeps, last, s->blocks - 1, table ? "the table's last step" : "t_end");
   if (table && s->table_block[s->n_table - 1] > (double)(s->blocks - 1) && m < n)
     m += (size_t)snprintf(buf + m, n - m, "%sanneal.table has rows past step %ld, the last of anneal.steps = %ld "
-                          "(steps count from 0): they are never reached", m ? "; " : "", s->blocks - 1, s->blocks);
+                          "(steps count from 0): they are never reached", m ? "\n" : "", s->blocks - 1, s->blocks);
   /* a table that ends before the run's last step holds its last row for
   ** the rest, which a table's writer took for the run's end (a helper's
   ** 0.01 at step 9 of 20 held for 55 % of the sweeps, unsaid) */
@@ -700,12 +700,12 @@ static void schedule_note(const lw_anneal *a, char *buf, size_t n)
   if (table && s->table_block[s->n_table - 1] < (double)reached && m < n)
     m += (size_t)snprintf(buf + m, n - m, "%sanneal.table ends at step %g, before the run's last step %ld "
                           "(anneal.steps = %ld, steps count from 0): its last temperature, %g, holds for the %ld "
-                          "steps after it (a row at step %ld ends the table where the run does)", m ? "; " : "",
+                          "steps after it (a row at step %ld ends the table where the run does)", m ? "\n" : "",
                           s->table_block[s->n_table - 1], reached, s->blocks, s->table_temp[s->n_table - 1],
                           reached - (long)s->table_block[s->n_table - 1], reached);
   if (s->blocks == 1 && (needs & LW_SCHEDULE_USES_END) && s->t_end != s->t_start && m < n)
     m += (size_t)snprintf(buf + m, n - m, "%sanneal.steps = 1: the run stays at t_start = %g (t_end = %g is the "
-                          "temperature of the last of two or more steps)", m ? "; " : "", s->t_start, s->t_end);
+                          "temperature of the last of two or more steps)", m ? "\n" : "", s->t_start, s->t_end);
   /* At T = 0 a chain takes a move that lowers the energy and no other,
   ** whatever its rule: its smallest steps are taken half the time, so a
   ** target above that shrank the steps to 1e-15 mm, unsaid.  (A share of
@@ -718,14 +718,14 @@ static void schedule_note(const lw_anneal *a, char *buf, size_t n)
   if (t0 == 0.0 && p->tune_sweeps > 0 && fmax(single, rigid) * ceiling >= 0.5 && m < n)
     m += (size_t)snprintf(buf + m, n - m, "%sthe run tunes its steps at T = 0, where a chain takes its smallest steps "
                           "half the time: moves.target%s = %g is out of reach there, and the steps shrink to nothing "
-                          "(expected a target below 0.5)", m ? "; " : "", single >= rigid ? "" : "_spline",
+                          "(expected a target below 0.5)", m ? "\n" : "", single >= rigid ? "" : "_spline",
                           fmax(single, rigid));
   /* replicas = 1 given to turn tempering off, under a scene's ladder that
   ** sets the count: its rungs all ran, unsaid */
   if (a->n_rep > 1 && p->replicas == 1 && !p->of_run && lw_params_line(p, "tempering", "replicas") && m < n)
     m += (size_t)snprintf(buf + m, n - m, "%stempering.replicas = 1 is given, but tempering.ladder%s has %d rungs and "
                           "sets the count: %d replicas run (for one chain, give tempering.ladder%s empty too)",
-                          m ? "; " : "", a->ladder_from_file ? "_file's ladder" : "", a->n_rep, a->n_rep,
+                          m ? "\n" : "", a->ladder_from_file ? "_file's ladder" : "", a->n_rep, a->n_rep,
                           a->ladder_from_file ? "_file" : "");
   /* a ladder tuned over no sweeps, or while the steps still tune (LJ13's
   ** default 200 of its 2000: swap rates less even than the geometric
@@ -733,11 +733,11 @@ static void schedule_note(const lw_anneal *a, char *buf, size_t n)
   if (a->n_rep > 1 && p->tune_ladder == LW_LADDER_EQUAL && m < n) {
     if (p->ladder_sweeps == 0)
       snprintf(buf + m, n - m, "%stempering.tune_ladder = equal with ladder_sweeps = 0 tunes nothing: the ladder "
-               "stays as given", m ? "; " : "");
+               "stays as given", m ? "\n" : "");
     /* (the ladder moves once every LW_TEMPERING_TUNE_EVERY exchanges) */
     else if (p->ladder_sweeps / p->exchange_every < LW_TEMPERING_TUNE_EVERY)
       snprintf(buf + m, n - m, "%stempering.ladder_sweeps = %d holds %d exchange%s (exchange_every = %d), and the "
-               "ladder moves once every %d: it stays as given%s", m ? "; " : "", p->ladder_sweeps,
+               "ladder moves once every %d: it stays as given%s", m ? "\n" : "", p->ladder_sweeps,
                p->ladder_sweeps / p->exchange_every, p->ladder_sweeps / p->exchange_every == 1 ? "" : "s",
                p->exchange_every, LW_TEMPERING_TUNE_EVERY,
                p->exchange_every > p->ladder_sweeps ? ", the swap statistics count from the start and no ladder.ini "
@@ -745,7 +745,7 @@ static void schedule_note(const lw_anneal *a, char *buf, size_t n)
     else if (p->ladder_sweeps <= p->tune_sweeps)
       snprintf(buf + m, n - m, "%stempering.ladder_sweeps = %d ends within moves.tune_sweeps = %d: the ladder is "
                "tuned on rungs whose steps still tune, far from settled, and may come out less even than where it "
-               "started (a few times tune_sweeps tunes it on settled rungs)", m ? "; " : "", p->ladder_sweeps,
+               "started (a few times tune_sweeps tunes it on settled rungs)", m ? "\n" : "", p->ladder_sweeps,
                p->tune_sweeps);
   }
 }

@@ -229,7 +229,7 @@ static void gcode_feed_note(const lw_params *p, char *note, size_t n)
     const size_t used = strlen(note);
     if (fabs(written - f) > 0.01 * f && used < n)
       snprintf(note + used, n - used, "%splot.%s = %g mm/s is F%g in final.gcode (mm/min to the thousandth), "
-               "%.0f %% off", used ? "; " : "", key[k], v[k], written, 100.0 * fabs(written - f) / f);
+               "%.0f %% off", used ? "\n" : "", key[k], v[k], written, 100.0 * fabs(written - f) / f);
   }
 }
 
@@ -244,7 +244,7 @@ void lw_drawing_note(const lw_params *p, char *note, size_t n)
   if (side > reach && !(p->plot_bed_w > 0.0 && p->plot_bed_h > 0.0) && used < n)
     snprintf(note + used, n - used, "%sthe page is %g mm on its long side, past the %g mm (%g units) HP-GL/1 "
              "coordinates reach: final.hpgl may hold points the plotter cannot take (plot.bed_width and "
-             "plot.bed_height, set to its reach, refuse those)", used ? "; " : "", side, reach, LW_HPGL_COORD_MAX);
+             "plot.bed_height, set to its reach, refuse those)", used ? "\n" : "", side, reach, LW_HPGL_COORD_MAX);
   const double vs = p->speed_down / 10.0, asked = round(100.0 * fmin(fmax(vs, LW_HPGL_VS_MIN), LW_HPGL_VS_MAX)) / 100.0;
   /* VS has two decimals (0.1 mm/s): at a few mm/s its rounding is a few per
   ** cent (1.234 mm/s was written 1.2: 2.8 % slower than the plot time) */
@@ -253,7 +253,7 @@ void lw_drawing_note(const lw_params *p, char *note, size_t n)
   const int past = vs < LW_HPGL_VS_MIN || vs > LW_HPGL_VS_MAX;
   if (used < n)
     snprintf(note + used, n - used, "%splot.speed_down = %g mm/s is %s (%g to %g mm/s, in steps of 0.1): final.hpgl "
-             "asks %g, and the plot time, reckoned at %g, does not hold for the machine", used ? "; " : "",
+             "asks %g, and the plot time, reckoned at %g, does not hold for the machine", used ? "\n" : "",
              p->speed_down, past ? "past what HP-GL's VS takes" : "more than 1 % from what HP-GL's VS writes",
              10.0 * LW_HPGL_VS_MIN, 10.0 * LW_HPGL_VS_MAX, 10.0 * asked, p->speed_down);
 }

@@ -268,6 +268,17 @@ static char *trim_slashes(char *path)
 /* A message about a run directory that could not be read says so where the
 ** run waits in DIR/.replaced, set aside by a run killed as it started (its
 ** files there are not the run's). */
+/* Notes one a line (the scene's and the schedule's builders part them with
+** '\n'): joined by "; " three of a photograph's ran 600 characters. */
+static void print_notes(const char *notes)
+{
+  for (const char *s = notes; *s;) {
+    const size_t len = strcspn(s, "\n");
+    fprintf(stderr, "linewise: note: %.*s\n", (int)len, s);
+    s += len + (s[len] == '\n');
+  }
+}
+
 static void stash_note(lw_error *err, const char *dir)
 {
   const size_t n = strlen(err->msg);
@@ -1424,12 +1435,12 @@ static int cmd_run(int argc, char **argv)
     const char *note = a.sys_type->note(a.setup);
     char size[128];
     a.sys_type->describe(a.sys->state, LW_DESCRIBE_SIZE, size, sizeof size);
-    if (note[0]) fprintf(stderr, "linewise: note: %s\n", note);
+    print_notes(note);
     if (a.unread[0])
       fprintf(stderr, "linewise: note: under driver = %s these keys have no effect: %s\n",
               a.params.driver, a.unread);
     if (a.idle[0]) fprintf(stderr, "linewise: note: these keys have no effect here: %s\n", a.idle);
-    if (a.schedule_note[0]) fprintf(stderr, "linewise: note: %s\n", a.schedule_note);
+    print_notes(a.schedule_note);
     /* (a scene file emptied by mistake ran the defaults unsaid; --set
     ** values are no defaults) */
     size_t given = 0;

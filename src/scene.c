@@ -98,7 +98,7 @@ static lw_image *load_picture(lw_scene *sc, const lw_params *p, const char *sect
     size_t used = strlen(sc->note);
     snprintf(sc->note + used, sizeof sc->note - used,
              "%s%s: %d x %d pixels is more than scene.image_max_pixels (%.0f): downsampled to %d x %d",
-             used ? "; " : "", full, info.width, info.height, p->image_max_pixels, img->width, img->height);
+             used ? "\n" : "", full, info.width, info.height, p->image_max_pixels, img->width, img->height);
   }
   *pl = lw_image_fit(img->width, img->height, p->margin, p->margin, p->width - p->margin,
                      p->height - p->margin);
@@ -184,14 +184,14 @@ static void dark_note(lw_scene *sc, const lw_params *p)
   if (clear) {
     snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image: the picture is transparent everywhere (its "
              "alpha is 0 at every pixel), so it is all white paper and asks for no line; a picture saved with an "
-             "alpha of 0 by mistake draws once saved without its alpha channel", used ? "; " : "");
+             "alpha of 0 by mistake draws once saved without its alpha channel", used ? "\n" : "");
     return;
   }
   if (!seen || (double)dark <= DARK_SHARE * (double)seen || (double)dark_all <= DARK_SHARE * (double)seen_all) return;
   snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image: %.0f %% of the picture is %.0f %% dark or darker "
            "after its tone curve, so the lines there can only hatch evenly at their densest and little of the picture "
            "shows; scene.image_gamma below 1 lightens its mid-tones, %s (docs/IMAGES.md, \"What the preset does not "
-           "draw\")", used ? "; " : "", 100.0 * (double)dark / (double)seen, 100.0 * (1.0 - DARK_TONE),
+           "draw\")", used ? "\n" : "", 100.0 * (double)dark / (double)seen, 100.0 * (1.0 - DARK_TONE),
            p->image_invert ? "scene.image_invert = 0 draws its dark parts (the inversion made it dark)"
                            : "scene.image_invert = 1 draws its light parts");
 }
@@ -212,7 +212,7 @@ static void thin_note(lw_scene *sc, const lw_params *p, const char *key, const l
   snprintf(sc->note + used, sizeof sc->note - used, "%sscene.%s: the %d x %d picture keeps its shape, so it lies on "
            "the page as %.3g x %.3g mm, narrower than two segments (init.segment_length %g mm): few lines or none fit "
            "there; a crop of the picture to a less narrow shape gives it room, and so do shorter segments",
-           used ? "; " : "", key, img->width, img->height, w, h, p->segment_length);
+           used ? "\n" : "", key, img->width, img->height, w, h, p->segment_length);
 }
 
 /* The picture pipeline after loading: resize, blur, flattening, levels, tone curve. */
@@ -249,7 +249,7 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
     if ((st = lw_image_flatten(sc->image, p->image_flatten / sc->image_place.pixel, &lo, &hi, err))) return st;
     size_t used = strlen(sc->note);
     snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_flatten: paper tones %.3f to %.3f divided out",
-             used ? "; " : "", lo, hi);
+             used ? "\n" : "", lo, hi);
   }
   /* The levels and the tone curve take the picture under its transparency
   ** (image.h).  A blur spreads the picture's edge onto its transparent side,
@@ -288,14 +288,14 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
     ** white in it either, is what the stretch is for */
     if (lo > 0.0 || hi < 1.0)
       snprintf(sc->note + used, sizeof sc->note - used,
-               "%sscene.image_levels: tones %.3f to %.3f stretched to 0 to 1%s", used ? "; " : "", lo, hi,
+               "%sscene.image_levels: tones %.3f to %.3f stretched to 0 to 1%s", used ? "\n" : "", lo, hi,
                lo >= LW_IMAGE_LEVELS_LIGHT && hi >= LW_IMAGE_LEVELS_PAPER && !p->image_invert
                    ? " (its darkest, a light grey, now draws as black: scene.image_levels = 0 keeps a light picture "
                      "light)"
                    : "");
     else /* a plateau of paper or of black at an end keeps its end */
       snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_levels: the tones left as they are",
-               used ? "; " : "");
+               used ? "\n" : "");
   }
   lw_image_tone_curve(sc->image, cover ? cover : sc->image->alpha, p->image_gamma, p->image_contrast,
                       p->image_invert);
@@ -402,7 +402,7 @@ static lw_status build_polygon(lw_scene *sc, const lw_params *p, lw_error *err)
         const size_t used = strlen(sc->note);
         if (lo[0] < c0[0] || hi[0] > c1[0] || lo[1] < c0[1] || hi[1] > c1[1])
           snprintf(sc->note + used, sizeof sc->note - used, "%sscene.polygon (x %g to %g, y %g to %g mm) reaches past "
-                   "%s, where plot.crop cuts the drawing", used ? "; " : "", lo[0], hi[0], lo[1], hi[1], box);
+                   "%s, where plot.crop cuts the drawing", used ? "\n" : "", lo[0], hi[0], lo[1], hi[1], box);
       }
     }
     free(xs);
@@ -670,7 +670,7 @@ static lw_status field_from_file(lw_scene *sc, const lw_params *p, lw_error *err
   if (bad) {
     size_t used = strlen(sc->note);
     snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field_file: %zu of the %zu nodes not finite (NaN or "
-             "infinite): no field there", used ? "; " : "", bad, nodes);
+             "infinite): no field there", used ? "\n" : "", bad, nodes);
   }
   return LW_OK;
 }
@@ -718,7 +718,7 @@ static lw_status build_field(lw_scene *sc, const lw_params *p, double cx, double
       if (gentle[0] < 1.0) snprintf(share, sizeof share, "over %d %%", (int)(100.0 * gentle[0]));
       used += (size_t)snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field_flat: %s of the picture "
                                "its tone changes, but slower than field_flat (%g tone/mm), where the field %s; a "
-                               "smaller field_flat follows a smooth picture there (", used ? "; " : "", share,
+                               "smaller field_flat follows a smooth picture there (", used ? "\n" : "", share,
                                p->field_flat, p->field == LW_FLD_ETF ? "turns to field_angle" : "fades to 0");
       for (int k = 1; k < LW_IMAGEFIELD_GENTLE && used < sizeof sc->note; k++)
         used += (size_t)snprintf(sc->note + used, sizeof sc->note - used, "%s%g leaves %d %%", k > 1 ? ", " : "",
@@ -936,7 +936,7 @@ static void note_blur_gaps(lw_scene *sc, const lw_params *p)
     snprintf(sc->note + used, sizeof sc->note - used, "%sthe placed segments' samples lie up to %.3g mm apart, more "
              "than the picture's detail under %s (%.3g mm, with scene.image_blur and the pixels): %s, hidden from "
              "the quadrature (docs/NUMERICS.md); %sa wider blur closes it%s",
-             used ? "; " : "", g[k].gap, g[k].key, g[k].scale,
+             used ? "\n" : "", g[k].gap, g[k].key, g[k].scale,
              held ? "the samples step over it" : "annealed segments can stretch over it", more,
              held ? "" : ", and energy.pair > 0 with a pair_cutoff holds the stretch");
   }
@@ -1020,7 +1020,7 @@ static void note_field_detail(lw_scene *sc, const lw_params *p)
   size_t used = strlen(sc->note);
   snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field: the placed segments' samples lie up to %.3g mm "
            "apart, more than the field's detail (%s): annealed segments can bend between the samples, the field's "
-           "term hidden from the quadrature (docs/NUMERICS.md); %s%s closes it", used ? "; " : "", gap, detail,
+           "term hidden from the quadrature (docs/NUMERICS.md); %s%s closes it", used ? "\n" : "", gap, detail,
            closes, more);
 }
 
@@ -1034,7 +1034,7 @@ static void note_pair_unguarded(lw_scene *sc, const lw_params *p)
   snprintf(sc->note + used, sizeof sc->note - used, "%senergy.pair_near = 0 and energy.min_spacing = 0: strokes may "
            "touch and cross, where the pair term's product rule alone reads their energy low, and the annealing "
            "seeks that out (up to 40 %% where two curves cross, docs/ACCURACY.md); a near field (energy.pair_near = "
-           "1.5) or a spacing keeps the energy whole", used ? "; " : "");
+           "1.5) or a spacing keeps the energy whole", used ? "\n" : "");
 }
 
 lw_status lw_scene_init(lw_scene *sc, const lw_params *p, lw_error *err)

@@ -94,7 +94,7 @@ static void long_splines_note(const lw_params *p, char *note, size_t n)
     snprintf(note + used, n - used, "%sinit.segments = %d: the rigid moves (moves.translate and rotate), %.0f %% of "
              "the proposals, each take all %d segments of their spline along where a point move takes two, so a sweep "
              "grows as the square of the segments; give moves.translate and moves.rotate a small share for long "
-             "splines (docs/PERFORMANCE.md, \"Scaling\")", used ? "; " : "", p->segments, 100.0 * rigid / all,
+             "splines (docs/PERFORMANCE.md, \"Scaling\")", used ? "\n" : "", p->segments, 100.0 * rigid / all,
              p->segments);
 }
 

@@ -702,6 +702,12 @@ Test(cli, keys_the_system_never_reads_are_refused)
   };
   write_file("t0.txt", "0 0\n2 0\n");
   write_file("t19.txt", "1 1\n19 0.01\n");
+  /* two notes, two lines (joined by "; " they ran 600 characters) */
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out e8 --set anneal.sweeps=10 --set anneal.steps=10 "
+                          "--set anneal.schedule=table --set anneal.table=t0.txt --set moves.target=0.6 2>err.txt "
+                          ">/dev/null && grep -q '^linewise: note: anneal.table ends at step 2, .* does)$' err.txt && "
+                          "grep -q '^linewise: note: the run tunes its steps at T = 0, ' err.txt", dir, lw_test_bin(),
+                          lw_test_root()), 0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* (one that ends at the run's last step is not noted; one that ends
   ** before it is not said to fall short where the run skips steps) */
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out e6 --set anneal.sweeps=12 --set anneal.steps=6 "
