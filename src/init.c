@@ -558,10 +558,10 @@ lw_splines *lw_init_random(const lw_scene *sc, size_t n, size_t segments, double
       t = 0; /* placed, if never in room */
     }
     if (t == tries) {
-      char clear[96] = "";
+      char clear[128] = "";
       if (sc->boundary.clearance > 0.0)
-        snprintf(clear, sizeof clear, ", or lower energy.boundary_clearance (%g mm from every edge)",
-                 sc->boundary.clearance);
+        snprintf(clear, sizeof clear, ", or lower energy.boundary_clearance (%g length elements, %g mm here, from "
+                 "every edge)", sc->boundary.clearance, sc->boundary.clearance * segment_length / (double)sc->quad.n);
       lw_error_set(err, LW_EINPUT,
                    "[init]: spline %zu of length %g mm did not fit inside the boundary in %d tries "
                    "(shorten init.segment_length or init.segments%s)", i, L, tries, clear);

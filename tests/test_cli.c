@@ -300,9 +300,11 @@ Test(cli, bad_input_exits_2_with_one_message)
     cr_assert(strstr(errs, "unexpected 'x' (it takes no arguments)"), "%s: %s", bare[k], errs);
   }
   /* splines that do not fit for the boundary's clearance name it too (it
-  ** blamed init.segment_length alone) */
-  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/bc --set energy.boundary_clearance=100 2>%s/err.txt; "
-                          "test $? -eq 2 && grep -q 'or lower energy.boundary_clearance (100 mm from every edge))$' "
+  ** blamed init.segment_length alone), in its unit and in mm (it said the
+  ** elements were mm) */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/bc --set energy.boundary_clearance=100 --set "
+                          "init.segment_length=4 2>%s/err.txt; test $? -eq 2 && grep -q 'or lower "
+                          "energy.boundary_clearance (100 length elements, 50 mm here, from every edge))$' "
                           "%s/err.txt", lw_test_bin(), lw_test_root(), dir, dir, dir), 0, "%s",
                lw_test_slurp("%s/err.txt", dir));
   /* a run directory named like an option: the message says how to name it,
