@@ -335,8 +335,15 @@ static size_t cell_run(const cell_item *c, size_t n, long long cx, long long cy,
     if (c[mid].cx < cx || (c[mid].cx == cx && c[mid].cy < cy)) lo = mid + 1;
     else hi = mid;
   }
-  *end = lo;
-  while (*end < n && c[*end].cx == cx && c[*end].cy == cy) ++*end;
+  /* (the end by halving too: a cell of n ends, as ends that coincide, was
+  ** walked once for each of them) */
+  size_t a = lo, b = n;
+  while (a < b) {
+    size_t mid = a + (b - a) / 2;
+    if (c[mid].cx == cx && c[mid].cy == cy) a = mid + 1;
+    else b = mid;
+  }
+  *end = a;
   return lo;
 }
 
@@ -378,6 +385,25 @@ static double first_band(const double *pt, size_t ne, double dist, double lo[2])
   /* ends along one line: their spacing along it */
   double spacing = w * h > 0 ? sqrt(w * h / (double)ne) : fmax(w, h) / (double)ne;
   return spacing > 0 && spacing < dist ? spacing : dist;
+}
+
+/* The gap between ends a and b where they may be joined in the band
+** (below, reach], else -1. */
+static double joinable_gap(const double *pt, const double *dir, size_t a, size_t b, double below, double reach,
+                           double dist, double cos_max)
+{
+  const double gx = pt[2 * b] - pt[2 * a], gy = pt[2 * b + 1] - pt[2 * a + 1], d = hypot(gx, gy);
+  /* out of one end, into the other: the turn is between dir[a] and -dir[b] */
+  double c = -(dir[2 * a] * dir[2 * b] + dir[2 * a + 1] * dir[2 * b + 1]);
+  if (d > reach || d <= below || c < cos_max) return -1.0;
+  /* and the gap leads on from each end: two strokes side by side, the one
+  ** starting behind where the other ends, align but would be bridged by a
+  ** hook back over the ink (a tenth of the distance is let through: ends
+  ** that overlap by a hair) */
+  if (cos_max > -1.0 && (gx * dir[2 * a] + gy * dir[2 * a + 1] < -0.1 * dist ||
+                         -(gx * dir[2 * b] + gy * dir[2 * b + 1]) < -0.1 * dist))
+    return -1.0;
+  return d;
 }
 
 /* Joins the n paths of one pen starting at path base into out.  Pairs of
@@ -433,18 +459,12 @@ static lw_status join_pen(const lw_strokes *in, int pen, size_t base, size_t n, 
         for (j = k ? j : i + 1; j < z; j++) {
           size_t a = cells[i].e, b = cells[j].e;
           if (a / 2 == b / 2) continue;
-          const double gx = pt[2 * b] - pt[2 * a], gy = pt[2 * b + 1] - pt[2 * a + 1], d = hypot(gx, gy);
-          /* out of one end, into the other: the turn is between dir[a] and -dir[b] */
-          double c = -(dir[2 * a] * dir[2 * b] + dir[2 * a + 1] * dir[2 * b + 1]);
-          if (d > reach || d <= below || c < cos_max) continue;
-          /* and the gap leads on from each end: two strokes side by side,
-          ** the one starting behind where the other ends, align but would
-          ** be bridged by a hook back over the ink (a tenth of the distance
-          ** is let through: ends that overlap by a hair) */
-          if (cos_max > -1.0 && (gx * dir[2 * a] + gy * dir[2 * a + 1] < -0.1 * dist ||
-                                 -(gx * dir[2 * b] + gy * dir[2 * b + 1]) < -0.1 * dist))
-            continue;
-          if (n_cand == budget && shrunk < 20) goto narrower;
+          const double d = joinable_gap(pt, dir, a, b, below, reach, dist, cos_max);
+          if (d < 0.0) continue;
+          if (n_cand == budget) {
+            if (shrunk < 20) goto narrower;
+            goto ties;
+          }
           if (n_cand == cap) {
             cap = cap ? 2 * cap : 64;
             join_cand *nc = realloc(cand, cap * sizeof *nc);
@@ -470,6 +490,38 @@ static lw_status join_pen(const lw_strokes *in, int pen, size_t base, size_t n, 
     ** band after band (hatching at 30 degrees: none ever is a candidate) */
     const double grow = n_cand ? sqrt(4.0 * (double)nx / (double)n_cand) : HUGE_VAL;
     next = fmin(reach * fmax(2.0, grow), dist);
+    continue;
+  ties:
+    /* A band narrowed 20 times (to 4^-20 of its first reach) that still
+    ** holds more candidates than the budget: ends that coincide, or all but
+    ** (strokes from one point: 32,000 took 3 GB of candidates).  Its pairs
+    ** are taken as of one distance, in the order of their ends, which is the
+    ** sorted list's order among equal distances, each end's first partner
+    ** found by a scan of its cells instead of a list. */
+    n_cand = 0;
+    shrunk = 0;
+    for (size_t a = 0; a < ne; a++) {
+      if (link[a] != SIZE_MAX) continue;
+      const long long cx = cell_of(pt[2 * a], origin[0], reach), cy = cell_of(pt[2 * a + 1], origin[1], reach);
+      size_t best = SIZE_MAX;
+      for (int ox = -1; ox <= 1; ox++)
+        for (int oy = -1; oy <= 1; oy++) {
+          size_t z, j = cell_run(cells, nx, cx + ox, cy + oy, &z);
+          for (; j < z; j++) {
+            const size_t b = cells[j].e;
+            if (b <= a || b >= best || a / 2 == b / 2 || link[b] != SIZE_MAX ||
+                joinable_gap(pt, dir, a, b, below, reach, dist, cos_max) < 0.0)
+              continue;
+            if (find(parent, a / 2) != find(parent, b / 2)) best = b;
+          }
+        }
+      if (best == SIZE_MAX) continue;
+      link[a] = best;
+      link[best] = a;
+      parent[find(parent, a / 2)] = find(parent, best / 2);
+      rep->joins++;
+    }
+    next = fmin(2.0 * reach, dist);
     continue;
   narrower:
     shrunk++;

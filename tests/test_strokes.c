@@ -341,6 +341,37 @@ Test(strokes, a_cluster_beside_an_outlier_joins_as_every_pair_sorted)
   lw_strokes_free(s);
 }
 
+/* 600 strokes out of one point, every other one drawn inward: 180,000
+** pairs of ends at distance 0, past the band's budget however narrow
+** (strokes.c takes them as one distance, end by end, without a list: 32,000
+** such strokes took 3 GB); the joins are still those of every pair sorted,
+** whose equal distances go in the order of their ends.  (Ends that only
+** all but coincide, within 4^-20 of the band, are taken as coinciding.) */
+Test(strokes, ends_that_coincide_join_as_every_pair_sorted)
+{
+  lw_strokes *s = lw_strokes_new(1, NULL);
+  unsigned long long seed = 99;
+  for (size_t k = 0; k < 600; k++) {
+    double u[2];
+    for (int c = 0; c < 2; c++) {
+      seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+      u[c] = (double)(seed >> 11) / 9007199254740992.0;
+    }
+    const double len = 1 + 4 * u[0], th = 2 * M_PI * u[1], x = len * cos(th), y = len * sin(th);
+    double b[8];
+    line(b, 0, 0, x, y);
+    if (k % 2) { /* reversed, its end at (0, 0) exactly (x + (0 - x) * 3 / 3 need not be) */
+      for (int c = 0; c < 8; c++) b[c] = (c % 2 ? y : x) - b[c];
+      b[6] = b[7] = 0.0;
+    }
+    cr_assert_eq(lw_strokes_add(s, 0, k, 0, 0, b, 1, NULL), LW_OK);
+  }
+  const double dists[] = {0.5, 1e6}, angles[] = {30 * M_PI / 180, M_PI};
+  for (size_t i = 0; i < 2; i++)
+    for (size_t k = 0; k < 2; k++) joins_as_reference(s, dists[i], angles[k]);
+  lw_strokes_free(s);
+}
+
 /* A pen joined whole: 20,000 paths and a distance of a kilometre, any
 ** turn, make one path (every pair a candidate took 4.7 GB). */
 Test(strokes, a_pen_joined_whole_takes_no_candidate_per_pair)
