@@ -220,6 +220,16 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
 {
   lw_status st = margin_ok(p, err);
   if (st) return st;
+  /* a mask's picture that cannot be read is said before the picture's
+  ** pipeline, not after it (25 s under valgrind; seconds on a photograph) */
+  if (p->boundary == LW_BND_MASK && p->mask == LW_MASK_IMAGE && p->mask_image[0]) {
+    char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
+    lw_path_dir(dir, sizeof dir, p->file);
+    lw_path_join(full, sizeof full, dir, p->mask_image);
+    lw_image_info info;
+    lw_error e2;
+    if (lw_image_probe(full, &info, &e2)) return bad_key(p, "scene", "mask_image", e2.code, err, "%s", e2.msg);
+  }
   sc->image = load_picture(sc, p, "scene", "image", p->image, LW_IMAGE_LUMA, &sc->image_place, err);
   if (!sc->image) return err->code;
   if (p->image_width > 0 && p->image_width != sc->image->width) {

@@ -566,6 +566,10 @@ Test(image_cli, scene_keys_that_need_a_picture_say_so)
     {"[output]\nfield_preview = 1\n", "output.field_preview"},
     {"[output]\npreview_image = 1\n", "output.preview_image"},
     {"[scene]\nmask = image\nmask_image = nowhere.png\nboundary = mask\n", "scene.mask_image"},
+    /* before the picture is loaded and worked (its own fault here was said
+    ** first, after seconds of a photograph's pipeline) */
+    {"[scene]\nimage = p.png\nimage_max_pixels = 4\nmask = image\nmask_image = nowhere.png\nboundary = mask\n",
+     "scene.mask_image"},
   };
   write_picture("p.png", 20, 16); /* no alpha channel */
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
