@@ -698,7 +698,7 @@ static void schedule_note(const lw_anneal *a, char *buf, size_t n)
   ** 0.01 at step 9 of 20 held for 55 % of the sweeps, unsaid) */
   const long reached = last < s->blocks - 1 ? last : s->blocks - 1;
   if (table && s->table_block[s->n_table - 1] < (double)reached && m < n)
-    m += (size_t)snprintf(buf + m, n - m, "%sanneal.table ends at step %g, before the run's last step %ld "
+    m += (size_t)snprintf(buf + m, n - m, "%sanneal.table ends at step %.0f, before the run's last step %ld "
                           "(anneal.steps = %ld, steps count from 0): its last temperature, %g, holds for the %ld "
                           "steps after it (a row at step %ld ends the table where the run does)", m ? "\n" : "",
                           s->table_block[s->n_table - 1], reached, s->blocks, s->table_temp[s->n_table - 1],

@@ -662,14 +662,22 @@ lw_status lw_checkpoint_scene_hash(lw_ckpt *doc, const lw_params *p, lw_run_keys
   ** hash is damaged, not old, and took no edit of scene.ini for one */
   if (!hash && text) return lw_ckpt_missing(doc, "[run] scene_hash", "a line taken out", err);
   if (!hash) return LW_OK;
-  /* (read whether or not the hashes agree: junk there passed where they did) */
-  if (text && (strlen(text) % 4 || strspn(text, "0123456789abcdef") != strlen(text)))
-    return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_keys: expected 4 hexadecimal digits a key, got '%.40s'",
-                        path, kline, text);
-  unsigned long long h = strtoull(hash, NULL, 16);
   if (strlen(hash) != 16 || strspn(hash, "0123456789abcdef") != 16)
     return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_hash: expected 16 hexadecimal digits, got '%s'", path,
                         line, hash);
+  const unsigned long long h = strtoull(hash, NULL, 16);
+  /* and the hash of this release's kind without scene_keys: that line taken
+  ** out (it was "scene.ini edited", nothing edited) */
+  if (!text && h == *scene_hash)
+    return lw_ckpt_missing(doc, "[run] scene_keys", "a line taken out", err);
+  /* (read whether or not the hashes agree, and as many keys as the scene
+  ** hashes where they do: junk there passed, and a cut line misnamed a
+  ** later edit) */
+  if (text && (strlen(text) % 4 || strspn(text, "0123456789abcdef") != strlen(text) ||
+               (h == *scene_hash && strlen(text) / 4 != keys->n)))
+    return lw_error_set(err, LW_EINPUT, "%s:%d: [run] scene_keys: expected 4 hexadecimal digits for each of the %zu "
+                        "keys the scene hashes, got '%.40s%s'", path, kline, keys->n, text,
+                        strlen(text) > 40 ? "..." : "");
   /* files before 2026-12-05 hashed the files' names */
   const unsigned long long mine = text ? *scene_hash : lw_params_run_hash(p, NULL);
   if (h == mine) return LW_OK;
@@ -750,16 +758,17 @@ lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, l
   if ((s = lw_ckpt_whole(doc, "run", "trace_bytes", &tb, 0, (long)COUNT_MAX, 0, err))) return s;
   *trace_bytes = tb;
   /* the marks of the last trace row, which every file since the first
-  ** release has for its moves; optional only where a kind is newer than a
-  ** file, which scene_keys (2026-12-05) dates: one taken out of a newer file
-  ** began the counts at 0, and the first row after the resume read the run's
-  ** acceptance since its start */
-  const int marks_required = lw_ckpt_text(doc, "run", "scene_keys", NULL) != NULL;
+  ** release has for the moves it counts: optional only for a kind newer
+  ** than the file, which then has no [chain] moves.<kind> either.  One
+  ** taken out began the counts at 0, and the first row after the resume
+  ** read the run's acceptance since its start. */
   for (int m = 0; m < a->chain->n_moves; m++) {
     char key[96];
+    snprintf(key, sizeof key, "moves.%s", t->move_names[m]);
+    const int counted = lw_ckpt_text(doc, "chain", key, NULL) != NULL;
     snprintf(key, sizeof key, "trace_mark.%s", t->move_names[m]);
     u[0] = u[1] = u[2] = 0;
-    if ((s = lw_ckpt_counts(doc, "run", key, u, 3, marks_required, err))) return s;
+    if ((s = lw_ckpt_counts(doc, "run", key, u, 3, counted, err))) return s;
     const lw_move_stats *st = &a->chain->stats[m];
     if (u[0] > st->proposed || u[1] > st->accepted || u[2] > st->nan)
       return lw_error_set(err, LW_EINPUT, "%s: [run] %s: beyond the chain's counts (moves.%s)", path, key,

@@ -215,6 +215,15 @@ static lw_status close_share(const lw_params *p, const lw_scene *sc, const lw_st
     lw_error_clear(err);
     s = LW_OK;
   }
+  /* nor past its grid's 2^32 points (a very fine pen over a large drawing:
+  ** exit 2 ended the run before its summary, and its resume again), which
+  ** no memory lifts */
+  if (s == LW_EINPUT) {
+    rep->close_share = NAN;
+    rep->close_past_limit = 1;
+    lw_error_clear(err);
+    s = LW_OK;
+  }
   return s;
 }
 
@@ -503,14 +512,18 @@ static void clock_text(double s, char *buf, size_t n)
 
 void lw_drawing_lost_text(const lw_drawing_report *d, char *buf, size_t n)
 {
-  const int close = isnan(d->close_share), fid = d->fidelity_lost;
+  const int close = isnan(d->close_share) && !d->close_past_limit, fid = d->fidelity_lost;
   if (!n) return;
   buf[0] = '\0';
   int w = 0;
-  if (close || fid)
-    w = snprintf(buf, n, "memory ran out scoring the drawing: summary.json's %s null (a redraw where there is more "
-                 "memory scores it: docs/FORMATS.md, \"Redrawing a finished run\")",
-                 close && fid ? "close_share and fidelity are" : close ? "close_share is" : "fidelity is");
+  if (d->close_past_limit)
+    w = snprintf(buf, n, "the drawing holds 2^32 points or more at half a pen width apart, past the close share's "
+                 "grid: summary.json's close_share is null (a wider output.pen_width, or fewer or shorter lines, "
+                 "scores it)%s", close || fid ? "; " : "");
+  if ((close || fid) && w >= 0 && (size_t)w < n)
+    w += snprintf(buf + w, n - (size_t)w, "memory ran out scoring the drawing: summary.json's %s null (a redraw "
+                  "where there is more memory scores it: docs/FORMATS.md, \"Redrawing a finished run\")",
+                  close && fid ? "close_share and fidelity are" : close ? "close_share is" : "fidelity is");
   /* (said under --quiet too, as a warning: the plotter's files drive the pen
   ** off the paper, and a quiet script heard nothing) */
   if (d->off_page && w >= 0 && (size_t)w < n)
@@ -524,7 +537,8 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
   const lw_strokes_report *r = &d->post;
   char clock[32], close[96];
   clock_text(d->time_s, clock, sizeof clock);
-  if (isnan(d->close_share)) snprintf(close, sizeof close, "not measured (out of memory)");
+  if (isnan(d->close_share))
+    snprintf(close, sizeof close, "not measured (%s)", d->close_past_limit ? "past 2^32 points" : "out of memory");
   else snprintf(close, sizeof close, "%.4f (of the line within a pen width of another stroke)", d->close_share);
   size_t k = 0;
   int w = snprintf(buf, n,

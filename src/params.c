@@ -429,7 +429,9 @@ const lw_param_def lw_param_table[] = {
          "(formulas in docs/SCHEDULES.md)."),
   NUM("anneal", "t_start", LW_PT_DOUBLE, t_start, "1", "energy", 0, 1e300, 0,
       "Temperature of the first step (above 0 for the geometric, logarithmic and adaptive "
-      "schedules, which take ratios or logarithms)."),
+      "schedules, which take ratios or logarithms). Under tempering, what the ladder is "
+      "scaled by: rung k runs at t_k T / t_start, with the table schedule too, whose rows "
+      "set T."),
   NUM("anneal", "t_end", LW_PT_DOUBLE, t_end, "0.01", "energy", 0, 1e300, 0,
       "Temperature of the last step (the floor of the adaptive schedule; above 0 where "
       "`t_start` must be)."),

@@ -180,7 +180,13 @@ lw_particles *lw_particles_get(const lw_particles_setup *s, lw_ckpt *c, const ch
     lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu particles", path, n);
     goto out;
   }
+  int counts = 0;
   while (lw_ckpt_next(c, section, &pos, &key, &val, &line)) {
+    /* the first was read above; a second passed unseen */
+    if (!strcmp(key, "count") && counts++) {
+      lw_error_set(err, LW_EINPUT, "%s:%d: [%s] count: given twice (expected one line of it)", path, line, section);
+      goto out;
+    }
     if (!strcmp(key, "count")) continue;
     double v[9];
     int k = strcmp(key, "particle") ? -1 : lw_number_list(val, 0, v, 9);

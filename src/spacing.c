@@ -53,7 +53,7 @@ lw_status lw_close_share(const double *b, const size_t *owner, const size_t *gro
     const double *z = b + 8 * g;
     n += pieces(z, h);
     if (owner[g] >= UINT32_MAX || (group && group[g] >= UINT32_MAX))
-      return lw_error_set(err, LW_ENOMEM, "close share: stroke %zu exceeds the limit of 2^32", owner[g]);
+      return lw_error_set(err, LW_EINPUT, "close share: stroke %zu exceeds the limit of 2^32", owner[g]);
     for (int k = 0; k < 8; k += 2) {
       x0 = fmin(x0, z[k]);
       x1 = fmax(x1, z[k]);
@@ -62,11 +62,8 @@ lw_status lw_close_share(const double *b, const size_t *owner, const size_t *gro
     }
   }
   if (n == 0) return LW_OK;
-  /* (the score's want of room, as memory's: the run goes on without it,
-  ** where exit 2 ended a run of a very fine pen before its summary, and a
-  ** resume again; 2^32 points would take 170 GB) */
   if (n >= UINT32_MAX)
-    return lw_error_set(err, LW_ENOMEM, "close share: %zu points exceed the grid's limit of 2^32", n);
+    return lw_error_set(err, LW_EINPUT, "close share: %zu points exceed the grid's limit of 2^32", n);
   /* cells at least d wide (a close point lies in the 3 x 3 around), and no
   ** more of them than points */
   double c = d, w = x1 - x0, ht = y1 - y0;

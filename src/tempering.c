@@ -85,6 +85,9 @@ static double log_ratio(double tk, double tk1, double ek, double ek1)
   if (tk == tk1) return tk > 0.0 ? 0.0 : de > 0.0 ? INFINITY : -INFINITY;
   double bk = tk > 0.0 ? 1.0 / tk : INFINITY, bk1 = tk1 > 0.0 ? 1.0 / tk1 : INFINITY;
   double x = (bk - bk1) * de;
+  /* rungs below 1 / DBL_MAX (a schedule may end at 1e-310) have 1/T
+  ** overflow on both: inf - inf refused every swap there */
+  if (isnan(x) && tk > 0.0 && tk1 > 0.0) x = de * ((tk1 - tk) / tk) / tk1;
   return isnan(x) ? -INFINITY : x;
 }
 

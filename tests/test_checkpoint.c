@@ -176,7 +176,12 @@ Test(checkpoint, every_run_data_value_is_checked_on_resume)
     ** and scene_keys' junk, read only where the hashes differed */
     {"/^trace_mark.point = /d", "[run] trace_mark.point: missing"},
     {"/^scene_hash = /d", "[run] scene_hash: missing"},
-    {"s/^scene_keys = .*/scene_keys = 12x4/", "[run] scene_keys: expected 4 hexadecimal digits a key, got '12x4'"},
+    {"s/^scene_keys = .*/scene_keys = 12x4/", "[run] scene_keys: expected 4 hexadecimal digits for each of the "},
+    /* cut short where the hashes agree (a later edit was then "178 keys
+    ** more"), and taken out beside a hash of this kind ("scene.ini was
+    ** edited", nothing was) */
+    {"s/^\\(scene_keys = ........\\).*/\\1/", "[run] scene_keys: expected 4 hexadecimal digits for each of the "},
+    {"/^scene_keys = /d", "[run] scene_keys: missing (a line taken out"},
   };
   stopped_run();
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {

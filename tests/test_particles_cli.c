@@ -173,6 +173,12 @@ Test(particles_cli, energy_recomputes_a_particle_run)
   }
   fclose(f);
   cr_assert(lw_close_rel(v[6], run_total, 1e-9, 1.0), "recomputed %.17g, run %.17g", v[6], run_total);
+  /* a second count among the particles is refused (it passed unread, as
+  ** the NURBS one did) */
+  cr_assert_eq(sh("cp -r %s/e %s/c2 && sed -i '0,/^particle = /s/^particle = .*/&\\ncount = 999/' %s/c2/state.lw && "
+                  "{ %s energy %s/c2 2>%s/err.txt >/dev/null; test $? -eq 2; } && grep -q 'c2/state.lw:[0-9]*: "
+                  "\\[system particles\\] count: given twice' %s/err.txt", dir, dir, dir, lw_test_bin(), dir, dir, dir),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* a damaged particle line is refused with the file and its line */
   cr_assert_eq(sh("sed -i '0,/^particle = /s/^particle = \\([^ ]*\\) /particle = nan /' %s/e/state.lw", dir), 0);
   cr_assert_eq(sh("%s energy %s/e 2>%s/err.txt >/dev/null", lw_test_bin(), dir, dir), 2);

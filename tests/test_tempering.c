@@ -251,6 +251,14 @@ Test(tempering, zero_and_equal_temperatures_are_handled)
     pt->steps = 0;
     cr_assert_eq(lw_tempering_exchange(pt, e_swapped, zero, NULL), 1);
   }
+  /* and below 1 / DBL_MAX, where 1/T overflows on both rungs (every swap
+  ** was refused: inf - inf) */
+  const double tiny[2] = {1e-310, 2e-310};
+  for (int s = 0; s < 10; s += 2, pt->steps = 0) {
+    cr_assert_eq(lw_tempering_exchange(pt, e, tiny, NULL), 0);
+    pt->steps = 0;
+    cr_assert_eq(lw_tempering_exchange(pt, e_swapped, tiny, NULL), 1);
+  }
   pt->steps = 0;
   /* a T = 0 rung never takes a higher energy */
   for (int s = 0; s < 10; s += 2, pt->steps = 0) cr_assert_eq(lw_tempering_exchange(pt, e, cold0, NULL), 0);

@@ -57,6 +57,7 @@ typedef struct {
   double travel_before, travel_after; /* pen-up travel, mm (plot.h) */
   lw_strokes_report post;             /* what the post-pass did */
   double close_share;                 /* share of the length within a pen width of another path */
+  int close_past_limit;               /* its points (two a pen width) past its grid's 2^32: NaN */
   int cropped;                        /* crop_mm holds the rectangle */
   size_t off_page;                    /* uncropped: paths that reach past the page's edge */
   double crop_mm[4];                  /* x0 y0 x1 y1 */

@@ -24,7 +24,8 @@
 **     pi' = pi+ - h/2 dH/dx(x', pi+)                 (explicit)
 **
 ** with dH/dx(x, pi) = grad E(x) - dT/dx(x, M(x)^-1 pi).  Without damping the
-** energy error stays O(h^2) over long times and the momentum of a
+** energy error stays O(h^2) over long times where the energy is smooth (the
+** pair term's near field has kinks: docs/NUMERICS.md, "Integrator") and the momentum of a
 ** translation-invariant scene is kept to rounding.  Damping is the exact
 ** flow pi <- pi exp(-gamma h / 2 rho) for half a step on either side
 ** (Strang splitting: order 2, and exact for the decay alone).  Dampers
@@ -83,7 +84,7 @@ typedef struct {
 } lw_dynamics;
 
 /* With inertia, E + K may not rise by more than this many times h_scale
-** (damping only lowers it, the leapfrog's error is O(dt^2)): beyond it the
+** (damping only lowers it, the leapfrog's error is small): beyond it the
 ** motion is unstable, its step too long, and it stops. */
 #define LW_DYN_BLOWUP 100.0
 
