@@ -816,11 +816,37 @@ Test(tools, job_array_tasks_then_gather_only)
   cr_assert_eq(sh("SLURM_ARRAY_TASK_ID=4 SLURM_SUBMIT_DIR=%s %s %s --seeds 5-7 " TINY " --bin %s --out %s/j",
                   env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir),
                2);
+  /* an array past the site's largest index is split, each part told the
+  ** runs before it: task 1 after 2 runs is run 3 (seed 7); a missing task
+  ** or a bad offset is a usage error, exit 2 (bash's ${VAR:?} exited 1) */
+  cr_assert_eq(sh("rm -r %s/j/seed-7 && SLURM_ARRAY_TASK_ID=1 LINEWISE_TASK_OFFSET=2 SLURM_SUBMIT_DIR=%s %s %s --seeds "
+                  "5-7 " TINY " --bin %s --out %s/j > %s/o.txt && grep -q 'seed-7: ran' %s/o.txt", dir,
+                  env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir, dir, dir),
+               0, "%s", err_txt());
+  cr_assert_eq(sh("SLURM_SUBMIT_DIR=%s %s %s --seeds 5-7 --out %s/j", env("LW_ROOT"), tool("slurm-sweep.sbatch"),
+                  scene(), dir), 2);
+  cr_assert_eq(sh("SLURM_ARRAY_TASK_ID=1 LINEWISE_TASK_OFFSET=x SLURM_SUBMIT_DIR=%s %s %s --seeds 5-7 --out %s/j",
+                  env("LW_ROOT"), tool("slurm-sweep.sbatch"), scene(), dir), 2);
   free(t.text);
   /* LINEWISE_TOOLS naming an install's bin/ (linewise-param-sweep there) */
   cr_assert_eq(sh("mkdir -p %s/inst && ln -sf %s %s/inst/linewise-param-sweep && SLURM_ARRAY_TASK_ID=1 "
                   "SLURM_SUBMIT_DIR=/nonexistent LINEWISE_TOOLS=%s/inst %s %s --seeds 8 " TINY " --bin %s --out %s/i",
                   dir, tool("param-sweep"), dir, dir, tool("slurm-sweep.sbatch"), scene(), env("LW_BIN"), dir),
+               0, "%s", err_txt());
+}
+
+/* slurm-tempering.sbatch hands srun the run with --threads: after the
+** user's arguments it followed a "--" that ended the options, and the run
+** took it for a second scene.  srun stood in for by a script that drops its
+** own options and runs the rest, the plain binary for linewise-mpi. */
+Test(tools, the_tempering_job_keeps_a_scene_after_the_end_of_options)
+{
+  cr_assert_eq(sh("mkdir -p %s/fake && printf '#!/bin/sh\\nwhile [ \"${1#--}\" != \"$1\" ]; do shift; done\\n"
+                  "exec \"$@\"\\n' "
+                  "> %s/fake/srun && chmod +x %s/fake/srun && cp %s %s/-x.ini && cd %s && PATH=%s/fake:$PATH "
+                  "LINEWISE_MPI=%s SLURM_CPUS_PER_TASK=1 bash %s run --set tempering.replicas=2 " TINY " --quiet --out "
+                  "pt -- -x.ini && test -s pt/summary.json", dir, dir, dir, scene(), dir, dir, dir, env("LW_BIN"),
+                  tool("slurm-tempering.sbatch")),
                0, "%s", err_txt());
 }
 
