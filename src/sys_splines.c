@@ -398,7 +398,8 @@ static uint32_t spline_near(const lw_splines *sp, uint32_t hint, size_t k)
   return spline_of_node(sp, k);
 }
 
-static void spline_box(const lw_splines *sp, uint32_t i, size_t node0, size_t n, const lw_node *nd, double b[4]);
+static void spline_box(const lw_splines *sp, uint32_t i, size_t k0, size_t k1, size_t node0, size_t n,
+                       const lw_node *nd, double b[4]);
 
 /* A refused proposal (no spline to remove, a spline at its longest or
 ** shortest, a ghost's site): rejected, dE = +inf. */
@@ -495,9 +496,14 @@ static double propose_on(const lw_model *m, const lw_td *td, lw_proposal *p, int
     }
   }
   if (box) {
+    /* the segments the move changes: the rest lay inside the box when the
+    ** group began (domains.c, cell_holding) and every move taken since kept
+    ** them there, so the answer is the whole spline's (a scan of it made a
+    ** point move on a spline of 150 segments cost 5 times one without
+    ** domains).  A NaN node passes here (fmin and fmax step over it); the
+    ** state's range check refuses it. */
     double b[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
-    spline_box(sp, i, node0, n_node, nd, b);
-    /* NaN fails every comparison: outside, so rejected */
+    spline_box(sp, i, node0 ? node0 - 1 : 0, node0 + n_node, node0, n_node, nd, b);
     if (!(b[0] >= box[0] && b[1] >= box[1] && b[2] <= box[2] && b[3] <= box[3])) {
       p->spline = i;
       *forbidden = LW_PROPOSE_OUTSIDE;
@@ -986,14 +992,16 @@ static double propose_at_once(void *state, void *prop, int kind, size_t k, doubl
 
 /* ---- domain decomposition (system.h, domains.h) ---- */
 
-/* Grows box b (x0, y0, x1, y1) over spline i with nodes [node0, node0 + n)
+/* Grows box b (x0, y0, x1, y1) over segments [k0, k1) of spline i (k1 up
+** to its node count: the last node's point) with nodes [node0, node0 + n)
 ** replaced by nd (n = 0: as it is): the Bezier control points of its
 ** segments, whose convex hull holds every sample of every term. */
-static void spline_box(const lw_splines *sp, uint32_t i, size_t node0, size_t n, const lw_node *nd, double b[4])
+static void spline_box(const lw_splines *sp, uint32_t i, size_t k0, size_t k1, size_t node0, size_t n,
+                       const lw_node *nd, double b[4])
 {
   const lw_node *base = &sp->node[sp->first[i]];
   const size_t nn = sp->first[i + 1] - sp->first[i];
-  for (size_t k = 0; k < nn; k++) {
+  for (size_t k = k0; k < k1 && k < nn; k++) {
     const lw_node *a = k >= node0 && k < node0 + n ? &nd[k - node0] : &base[k];
     double z[8];
     lw_node next = *a;
@@ -1039,7 +1047,7 @@ static size_t group(const void *state, size_t site, double box[4])
   uint32_t i = spline_of_node(sp, site);
   box[0] = box[1] = INFINITY;
   box[2] = box[3] = -INFINITY;
-  spline_box(sp, i, 0, 0, NULL, box);
+  spline_box(sp, i, 0, sp->first[i + 1] - sp->first[i], 0, 0, NULL, box);
   return sp->first[i + 1] - site;
 }
 
