@@ -415,7 +415,15 @@ static int roots_outside(const double h[6], double rho)
   const double m = fmax(fmax(fmax(fabs(ax), fabs(ay)), fmax(fabs(bx), fabs(by))), fmax(fabs(cx), fabs(cy)));
   if (!(m > 0.0 && m <= DBL_MAX)) return 0; /* NaN or infinite; all 0: a point, zero everywhere */
   const int e = -ilogb(m);
-  ax = scalbn(ax, e), ay = scalbn(ay, e), bx = scalbn(bx, e), by = scalbn(by, e), cx = scalbn(cx, e), cy = scalbn(cy, e);
+  /* by one factor where 2^e is a double: the same single rounding as
+  ** scalbn's, six library calls fewer on half of all segment checks */
+  if (e >= DBL_MIN_EXP - 1 && e < DBL_MAX_EXP) {
+    const double k = scalbn(1.0, e);
+    ax *= k, ay *= k, bx *= k, by *= k, cx *= k, cy *= k;
+  } else {
+    ax = scalbn(ax, e), ay = scalbn(ay, e), bx = scalbn(bx, e), by = scalbn(by, e), cx = scalbn(cx, e);
+    cy = scalbn(cy, e);
+  }
   /* d = a square root of B^2 - A C (either: q's sign choice below makes up
   ** for it), from the half-angle formulas without cancellation */
   const double wr = (bx * bx - by * by) - (ax * cx - ay * cy), wi = 2.0 * bx * by - (ax * cy + ay * cx);
