@@ -2151,6 +2151,7 @@ Test(cli, a_stack_too_small_is_refused_before_the_run)
 ** checkpoint opens its file, inside that window. */
 Test(cli, a_signal_that_gives_the_directory_back_does_not_exit_0)
 {
+  lw_test_need_strace();
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out r --quiet --set anneal.sweeps=10 && "
                           "cp -a r before && rm -f before/.lock", dir, lw_test_bin(), lw_test_root()), 0);
   static const struct {
@@ -2197,6 +2198,7 @@ Test(cli, the_resume_command_a_stop_names_pastes_into_a_shell)
 ** run is as it was, and the command it names then extends it. */
 Test(cli, an_extension_a_full_disk_stops_says_how_to_go_on)
 {
+  lw_test_need_strace();
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out m --quiet --set anneal.sweeps=50 && "
                           "cp m/state.lw before.lw", dir, lw_test_bin(), lw_test_root()), 0);
   cr_assert_eq(lw_test_sh("cd %s && strace -o /dev/null -P \"$PWD/m/state.lw.tmp\" -e trace=write "
@@ -2220,6 +2222,7 @@ Test(cli, an_extension_a_full_disk_stops_says_how_to_go_on)
 ** mutant that left that out passed too). */
 Test(cli, every_file_a_run_replaces_is_synced_before_and_its_rename_after)
 {
+  lw_test_need_strace();
   /* (LeakSanitizer cannot run under ptrace: make asan's build leaves it out here) */
   cr_assert_eq(lw_test_sh("cd %s && ASAN_OPTIONS=detect_leaks=0 strace -f -y -e trace=fsync,rename,renameat,renameat2 "
                           "-o st.txt %s run "
@@ -2238,6 +2241,7 @@ Test(cli, every_file_a_run_replaces_is_synced_before_and_its_rename_after)
 ** marker's rename, and the stash after it. */
 Test(cli, a_run_set_aside_is_synced_before_its_marker_says_so)
 {
+  lw_test_need_strace();
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=5 --out r --quiet && "
                           "ASAN_OPTIONS=detect_leaks=0 strace -f -y -e trace=fsync,rename,renameat,renameat2 -o st.txt "
                           "%s run %s/params/minimal.ini --set anneal.sweeps=7 --out r --quiet && "

@@ -104,6 +104,7 @@ Test(dynamics_cli, the_whip_writes_frames)
 ** until the new run's first sweep, and comes back byte for byte. */
 Test(dynamics_cli, a_run_that_fails_at_its_first_step_gives_the_run_it_replaced_back)
 {
+  lw_test_need_strace();
   cr_assert_eq(sh("cd %s && %s run %s/params/minimal.ini --set anneal.sweeps=20 --out r --quiet && cp -rp r kept",
                   dir, lw_test_bin(), lw_test_root()), 0);
   /* (strace: the put-back's marker changes only after what it speaks of is

@@ -34,7 +34,8 @@ TestSuite(mpi, .init = make_dir, .fini = remove_dir);
 static const char *mpi_bin(void)
 {
   const char *b = getenv("LW_MPI_BIN");
-  if (!b || !*b) cr_skip_test("no MPI build: LW_MPI_BIN is not set (make test sets it where mpicc exists; make deps-mpi)");
+  if (!b || !*b) cr_skip_test("no MPI build: LW_MPI_BIN is not set (make test sets it where mpicc exists and mpirun "
+                                      "starts a process; make deps-mpi)");
   if (sh("command -v mpirun >/dev/null 2>&1")) cr_skip_test("mpirun is not installed (make deps-mpi)");
   return b;
 }

@@ -215,6 +215,15 @@ static inline int lw_test_sh(const char *fmt, ...)
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+/* Skips a test that watches a run through strace(1) where strace cannot
+** trace (a container or a build chroot without ptrace), as a test needing
+** clang or MPI skips: it failed there, a packager's build with it. */
+static inline void lw_test_need_strace(void)
+{
+  if (lw_test_sh("strace -o /dev/null true >/dev/null 2>&1"))
+    cr_skip_test("strace cannot trace here (not installed, or no ptrace: make deps installs it)");
+}
+
 /* The text of the file at path, in a static buffer of 1 MiB (cut there): one
 ** file at a time, valid until the next call. */
 static inline char *lw_test_read_text(const char *path)
