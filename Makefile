@@ -110,7 +110,11 @@ $(BUILD)/obj $(BUILD)/tests $(BIN):
 # chroot without a network interface: they failed there, a minute each)
 test: $(BIN)/linewise $(MPI_BIN) $(BUILD)/tests/run $(PICTURE)
 	@mpi=$(if $(MPI_BIN),$(CURDIR)/$(MPI_BIN)); \
-	if [ -n "$$mpi" ] && ! OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 60 \
+	if [ -n "$$mpi" ] && ! command -v mpirun >/dev/null; then \
+	  echo "make test: mpirun is not installed (make deps-mpi): the MPI tests skip" >&2; mpi=; \
+	elif [ -n "$$mpi" ] && ! OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
+	  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan-mpi.supp:print_suppressions=0 \
+	  ASAN_OPTIONS=$${ASAN_OPTIONS:+$$ASAN_OPTIONS:}fast_unwind_on_malloc=0 timeout 60 \
 	  mpirun --oversubscribe -n 1 "$$mpi" --version >/dev/null 2>&1; then \
 	  echo "make test: mpirun cannot start $$mpi here (no network interface?): the MPI tests skip" >&2; mpi=; fi; \
 	echo "LW_BIN=$(CURDIR)/$(BIN)/linewise LW_MPI_BIN=$$mpi LW_ROOT=$(CURDIR) $(BUILD)/tests/run --jobs $(TEST_JOBS)"; \
@@ -189,11 +193,18 @@ deps-animation:
 run: bin/linewise $(PICTURE)
 	bin/linewise run params/example.ini --out out/example
 
-# (run on the machine that builds: its compiler, where a cross build's CC
-# makes programs for another)
+# (run on the machine that builds: its compiler, flags and cairo, where a
+# cross build's CC makes programs for another; dpkg-buildflags gives the
+# _FOR_BUILD flags, and a native build is as before)
 CC_FOR_BUILD ?= $(CC)
+CFLAGS_FOR_BUILD ?= $(CFLAGS)
+CPPFLAGS_FOR_BUILD ?= $(CPPFLAGS)
+LDFLAGS_FOR_BUILD ?= $(LDFLAGS)
+PKG_CONFIG_FOR_BUILD ?= $(PKG_CONFIG)
 $(BUILD)/make-picture: tools/make-picture.c | $(BUILD)/obj
-	$(CC_FOR_BUILD) $(WARN) $(CFLAGS) $(LW_CPPFLAGS) $(CPPFLAGS) $< -o $@ $(LDFLAGS) $(LDLIBS) $(LW_LDLIBS)
+	$(CC_FOR_BUILD) $(WARN) $(CFLAGS_FOR_BUILD) -D_POSIX_C_SOURCE=200809L \
+	  $(shell $(PKG_CONFIG_FOR_BUILD) --cflags cairo 2>/dev/null) $(CPPFLAGS_FOR_BUILD) $< -o $@ \
+	  $(LDFLAGS_FOR_BUILD) $(shell $(PKG_CONFIG_FOR_BUILD) --libs cairo 2>/dev/null) -lm
 
 $(PICTURE): $(BUILD)/make-picture
 	$(BUILD)/make-picture $@

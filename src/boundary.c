@@ -227,7 +227,7 @@ double lw_boundary_distance_grad(const lw_boundary *b, double x, double y, doubl
   if (!isfinite(d)) return d;
   switch (b->kind) {
   case LW_BOUNDARY_RECT: {
-    /* the side that fmax picked in rect_distance, or the offset outside */
+    /* the side that rect_distance took the larger of, or the offset outside */
     double qx = fmax(b->x0 - x, x - b->x1), qy = fmax(b->y0 - y, y - b->y1);
     if (qx > 0 || qy > 0) {
       g[0] = qx > 0 ? qx / d : 0.0;

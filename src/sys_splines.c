@@ -499,9 +499,9 @@ static double propose_on(const lw_model *m, const lw_td *td, lw_proposal *p, int
     /* the segments the move changes: the rest lay inside the box when the
     ** group began (domains.c, cell_holding) and every move taken since kept
     ** them there, so the answer is the whole spline's (a scan of it made a
-    ** point move on a spline of 150 segments cost 5 times one without
-    ** domains).  A NaN node passes here (fmin and fmax step over it); the
-    ** state's range check refuses it. */
+    ** point move on a spline of 150 segments cost 1.6 to 5 times one without
+    ** domains: docs/PERFORMANCE.md).  A NaN node passes here (fmin and fmax
+    ** step over it); the state's range check refuses it. */
     double b[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
     spline_box(sp, i, node0 ? node0 - 1 : 0, node0 + n_node, node0, n_node, nd, b);
     if (!(b[0] >= box[0] && b[1] >= box[1] && b[2] <= box[2] && b[3] <= box[3])) {
