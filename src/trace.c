@@ -362,8 +362,9 @@ lw_status lw_trace_rows(const lw_trace *t, const char *path, const lw_trace_sele
   *n = *tuned = 0;
   int sweep = lw_trace_column(t, "sweep");
   if (sweep < 0) return lw_error_set(err, LW_EINPUT, "%s: no 'sweep' column (expected a trace.csv)", path);
-  if (!t->n_rows) return lw_error_set(err, LW_EINPUT, "%s: no rows (none before a run's first sweep; a run of no sweeps, as a redraw, has none)",
-                                      path);
+  if (!t->n_rows)
+    return lw_error_set(err, LW_EINPUT, "%s: no rows (none before a run's first sweep; a run of no sweeps, as a "
+                        "redraw, has none)", path);
   for (size_t r = 0; r < t->n_rows; r++) {
     double v = at(t, r, sweep);
     if (!(v >= 0.0 && v <= 9007199254740992.0) || v != floor(v))

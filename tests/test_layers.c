@@ -1129,7 +1129,8 @@ Test(layers, the_photo_preset_draws_colour_pens_kept_apart_by_pen_on_any_thread_
   cr_assert_eq(run("run photo.ini --out old --quiet --set layers.apart=all --set anneal.sweeps=4 --stop-at 2", errs,
                    sizeof errs),
                0, "%s", errs);
-  cr_assert_eq(lw_test_sh("sed -i '/^apart = /d' %s/old/scene.ini && sed -i '/^scene_hash = /d; /^scene_keys = /d' %s/old/state.lw",
+  cr_assert_eq(lw_test_sh("sed -i '/^apart = /d' %s/old/scene.ini && "
+                          "sed -i '/^scene_hash = /d; /^scene_keys = /d' %s/old/state.lw",
                           dir, dir), 0);
   cr_assert_eq(run("resume old --quiet", errs, sizeof errs), 0, "%s", errs);
   cr_assert_eq(run("energy old", errs, sizeof errs), 0, "%s", errs);

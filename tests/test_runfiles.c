@@ -195,9 +195,10 @@ Test(runfiles, stats_and_energy_name_the_run_waiting_aside)
   snprintf(r, sizeof r, "%s/r", dir);
   cr_assert_eq(lw_runfiles_stash(r, &err), LW_OK, "%s", err.msg);
   cr_assert_eq(sh("cd %s/r && cp .replaced/scene.ini . && head -1 .replaced/trace.csv > trace.csv", dir), 0);
-  const char *cmd[] = {"stats", "energy"}, *says[] = {"r/trace.csv: no rows (none before a run's first sweep; a run of no sweeps, as a "
-                                                      "redraw, has none); a run there waits in ",
-                                                      "r/state.lw: cannot open state file"};
+  const char *cmd[] = {"stats", "energy"};
+  const char *says[] = {"r/trace.csv: no rows (none before a run's first sweep; a run of no sweeps, as a redraw, has "
+                        "none); a run there waits in ",
+                        "r/state.lw: cannot open state file"};
   for (int k = 0; k < 2; k++) {
     cr_assert_eq(sh("%s %s %s/r > %s/out.txt 2> %s/err.txt", b, cmd[k], dir, dir, dir), 2, "%s", cmd[k]);
     char *msg = lw_test_slurp("%s/err.txt", dir);

@@ -302,7 +302,8 @@ Test(tools, identical_runs_have_a_standard_deviation_of_zero)
   cr_assert_eq(sh("%s %s/params/wire.ini --seeds 1-3 -j 2 --set anneal.sweeps=40 --set output.frames_every=0 "
                   "--bin %s --out %s/w", tool("seed-sweep"), env("LW_ROOT"), env("LW_BIN"), dir), 0, "%s", err_txt());
   char *out = out_txt();
-  cr_assert(strstr(out, "energy_total over 3 runs: best ") && strstr(out, ", std 0, standard error of the mean 0\n"), "%s", out);
+  cr_assert(strstr(out, "energy_total over 3 runs: best ") && strstr(out, ", std 0, standard error of the mean 0\n"),
+            "%s", out);
   free(out);
   /* and stats says they are one run (it read R_hat 0.99 and p_runs 1, agreeing seeds) */
   cr_assert_eq(sh("%s stats %s/w/seed-1 %s/w/seed-2 %s/w/seed-3", env("LW_BIN"), dir, dir, dir), 0, "%s", err_txt());
