@@ -423,6 +423,19 @@ int lw_ckpt_next(lw_ckpt *c, const char *sec, size_t *pos, const char **key, con
   return 1;
 }
 
+lw_status lw_ckpt_single(lw_ckpt *c, const char *sec, const char *key, lw_error *err)
+{
+  const section *s = find_section(c, sec);
+  int seen = 0;
+  for (size_t i = 0; s && i < s->n; i++) {
+    const entry *e = &c->e[s->idx[i]];
+    if (strcmp(c->text + e->key, key) || !seen++) continue;
+    return lw_error_set(err, LW_EINPUT, "%s:%d: [%s] %s: given twice (expected one line of it)", c->path, e->line,
+                        sec, key);
+  }
+  return LW_OK;
+}
+
 lw_status lw_ckpt_known_sections(const lw_ckpt *c, int (*known)(const char *name, const void *ctx), const void *ctx,
                                  lw_error *err)
 {

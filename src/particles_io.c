@@ -163,7 +163,9 @@ lw_particles *lw_particles_get(const lw_particles_setup *s, lw_ckpt *c, const ch
     return NULL;
   }
   long count;
-  if (lw_ckpt_whole(c, section, "count", &count, 1, UINT32_MAX / 2, 1, err)) return NULL;
+  if (lw_ckpt_whole(c, section, "count", &count, 1, UINT32_MAX / 2, 1, err) ||
+      lw_ckpt_single(c, section, "count", err))
+    return NULL;
   size_t n = (size_t)count, pos = 0, i = 0, lines = 0;
   const char *key, *val;
   int line = 0;
@@ -180,13 +182,7 @@ lw_particles *lw_particles_get(const lw_particles_setup *s, lw_ckpt *c, const ch
     lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu particles", path, n);
     goto out;
   }
-  int counts = 0;
   while (lw_ckpt_next(c, section, &pos, &key, &val, &line)) {
-    /* the first was read above; a second passed unseen */
-    if (!strcmp(key, "count") && counts++) {
-      lw_error_set(err, LW_EINPUT, "%s:%d: [%s] count: given twice (expected one line of it)", path, line, section);
-      goto out;
-    }
     if (!strcmp(key, "count")) continue;
     double v[9];
     int k = strcmp(key, "particle") ? -1 : lw_number_list(val, 0, v, 9);

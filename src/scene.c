@@ -71,12 +71,20 @@ static double least_side(int W, int H) { return fmin(4.0, fmin(W, H)); }
 /* Loads the picture of section.key (scene.image, scene.mask_image,
 ** output.fidelity_reference) at path, relative to the scene file, and fits
 ** it into the margin box; which: its luma, or a mask's inside (image.h). */
+/* A file's path as a key gives it, relative to the scene file, into full
+** (2 * LW_PATH_MAX + 2 bytes). */
+static void scene_relative(const lw_params *p, const char *path, char *full)
+{
+  char dir[LW_PATH_MAX];
+  lw_path_dir(dir, sizeof dir, p->file);
+  lw_path_join(full, 2 * LW_PATH_MAX + 2, dir, path);
+}
+
 static lw_image *load_picture(lw_scene *sc, const lw_params *p, const char *section, const char *key,
                               const char *path, lw_image_channel which, lw_image_place *pl, lw_error *err)
 {
-  char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
-  lw_path_dir(dir, sizeof dir, p->file);
-  lw_path_join(full, sizeof full, dir, path);
+  char full[2 * LW_PATH_MAX + 2];
+  scene_relative(p, path, full);
   lw_image_info info;
   lw_error e2;
   lw_image *img = lw_image_load_channel(full, p->image_max_pixels, which, &info, &e2);
@@ -223,9 +231,8 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
   /* a mask's picture that cannot be read is said before the picture's
   ** pipeline, not after it (25 s under valgrind; seconds on a photograph) */
   if (p->boundary == LW_BND_MASK && p->mask == LW_MASK_IMAGE && p->mask_image[0]) {
-    char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
-    lw_path_dir(dir, sizeof dir, p->file);
-    lw_path_join(full, sizeof full, dir, p->mask_image);
+    char full[2 * LW_PATH_MAX + 2];
+    scene_relative(p, p->mask_image, full);
     lw_image_info info;
     lw_error e2;
     if (lw_image_probe(full, &info, &e2)) return bad_key(p, "scene", "mask_image", e2.code, err, "%s", e2.msg);
@@ -477,9 +484,8 @@ lw_status lw_scene_set_user_term(lw_scene *sc, double coef, lw_user_term_fn fn, 
 ** with its unevenness. */
 static lw_image *load_channel(lw_scene *sc, const lw_params *p, lw_image_channel which, lw_error *err)
 {
-  char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
-  lw_path_dir(dir, sizeof dir, p->file);
-  lw_path_join(full, sizeof full, dir, p->image);
+  char full[2 * LW_PATH_MAX + 2];
+  scene_relative(p, p->image, full);
   lw_image *img = lw_image_load_channel(full, p->image_max_pixels, which, NULL, err);
   if (!img) return NULL;
   if (img->width != sc->image->width || img->height != sc->image->height) {
@@ -615,9 +621,8 @@ static lw_status build_potential(lw_scene *sc, const lw_params *p, double cx, do
 static lw_status field_from_file(lw_scene *sc, const lw_params *p, lw_error *err)
 {
   if (!p->field_file[0]) return bad_key(p, "scene", "field", LW_EINPUT, err, "'file' needs scene.field_file");
-  char dir[LW_PATH_MAX], full[2 * LW_PATH_MAX + 2];
-  lw_path_dir(dir, sizeof dir, p->file);
-  lw_path_join(full, sizeof full, dir, p->field_file);
+  char full[2 * LW_PATH_MAX + 2];
+  scene_relative(p, p->field_file, full);
   lw_error e2;
   lw_grid2d *g = sc->field.grid = lw_fieldfile_read(full, 2, p->field_file_layout == LW_FFL_POINTS, &e2);
   if (!g) return bad_key(p, "scene", "field_file", e2.code, err, "%s", e2.msg);

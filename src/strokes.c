@@ -504,6 +504,7 @@ static lw_status join_pen(const lw_strokes *in, int pen, size_t base, size_t n, 
       if (link[a] != SIZE_MAX) continue;
       const long long cx = cell_of(pt[2 * a], origin[0], reach), cy = cell_of(pt[2 * a + 1], origin[1], reach);
       size_t best = SIZE_MAX;
+      const size_t ra = find(parent, a / 2);
       for (int ox = -1; ox <= 1; ox++)
         for (int oy = -1; oy <= 1; oy++) {
           size_t z, j = cell_run(cells, nx, cx + ox, cy + oy, &z);
@@ -512,13 +513,13 @@ static lw_status join_pen(const lw_strokes *in, int pen, size_t base, size_t n, 
             if (b <= a || b >= best || a / 2 == b / 2 || link[b] != SIZE_MAX ||
                 joinable_gap(pt, dir, a, b, below, reach, dist, cos_max) < 0.0)
               continue;
-            if (find(parent, a / 2) != find(parent, b / 2)) best = b;
+            if (ra != find(parent, b / 2)) best = b;
           }
         }
       if (best == SIZE_MAX) continue;
       link[a] = best;
       link[best] = a;
-      parent[find(parent, a / 2)] = find(parent, best / 2);
+      parent[ra] = find(parent, best / 2);
       rep->joins++;
     }
     next = fmin(2.0 * reach, dist);

@@ -388,7 +388,8 @@ static lw_nurbs_state *state_get(const lw_nurbs_setup *su, lw_ckpt *doc, const c
     return lw_state_missing_section(doc, section, err), NULL;
   size_t n = su->curve->n, i = 0, j = 0, pos = 0;
   long count;
-  if (lw_ckpt_whole(doc, section, "count", &count, 1, 1L << 53, 1, err)) return NULL;
+  if (lw_ckpt_whole(doc, section, "count", &count, 1, 1L << 53, 1, err) || lw_ckpt_single(doc, section, "count", err))
+    return NULL;
   if (count != (long)n) {
     int at = 0;
     lw_ckpt_text(doc, section, "count", &at);
@@ -401,13 +402,7 @@ static lw_nurbs_state *state_get(const lw_nurbs_setup *su, lw_ckpt *doc, const c
   const char *key, *val;
   int line;
   lw_nurbs_state *s = NULL;
-  int counts = 0;
   while (lw_ckpt_next(doc, section, &pos, &key, &val, &line)) {
-    /* the first was read above; a second passed unseen */
-    if (!strcmp(key, "count") && counts++) {
-      lw_error_set(err, LW_EINPUT, "%s:%d: [%s] count: given twice (expected one line of it)", path, line, section);
-      goto out;
-    }
     if (!strcmp(key, "count")) continue;
     double v[3];
     if (!strcmp(key, "log_weight")) {

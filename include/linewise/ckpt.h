@@ -94,6 +94,11 @@ lw_status lw_ckpt_counts_upto(lw_ckpt *c, const char *section, const char *key, 
 lw_status lw_ckpt_whole(lw_ckpt *c, const char *section, const char *key, long *out, long lo, long hi,
                         int required, lw_error *err);
 
+/* LW_EINPUT, naming the second line, where the section holds key more than
+** once: a keyed read takes the first, and bulk reading (lw_ckpt_next) marks
+** the rest read, so a repeated key among bulk data passed unseen. */
+lw_status lw_ckpt_single(lw_ckpt *c, const char *section, const char *key, lw_error *err);
+
 /* Bulk data: the entries of a section in file order.  *pos starts at 0;
 ** returns 1 and the next entry (marked read), 0 at the end of the section. */
 int lw_ckpt_next(lw_ckpt *c, const char *section, size_t *pos, const char **key, const char **value, int *line);
