@@ -378,6 +378,39 @@ static lw_status from_elsewhere(const lw_anneal *a, const char *dir, lw_error *e
   return lw_params_blame(&a->params, "init", "from", err);
 }
 
+/* A file a key names (init.from aside: from_elsewhere) that is one of the
+** run files in dir, which this run removes or writes over: a picture drawn
+** from the run's own final.png was gone when the run was resumed. */
+static lw_status inputs_elsewhere(const lw_anneal *a, const char *dir, lw_error *err)
+{
+  char rd[4096];
+  if (!realpath(dir, rd)) return LW_OK; /* (a new directory holds no run) */
+  const size_t nd = strlen(rd);
+  for (size_t i = 0; i < lw_param_count; i++) {
+    const lw_param_def *d = &lw_param_table[i];
+    const char *path = (const char *)&a->params + d->offset;
+    if (d->type != LW_PT_STRING || strcmp(d->unit, "path") || !path[0] || lw_params_file_idle(&a->params, d))
+      continue;
+    /* the file itself, and the name in its folder (a link there is removed
+    ** as well, whatever it leads to) */
+    char real[2][4096 + LW_PATH_MAX], folder[LW_PATH_MAX];
+    const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+    lw_path_dir(folder, sizeof folder, path);
+    if (!realpath(path, real[0])) real[0][0] = '\0';
+    if (!realpath(folder, real[1]) ||
+        snprintf(real[1] + strlen(real[1]), sizeof real[1] - strlen(real[1]), "/%s", base) < 0)
+      real[1][0] = '\0';
+    for (int k = 0; k < 2; k++) {
+      if (strncmp(real[k], rd, nd) || real[k][nd] != '/' || !lw_runfiles_is_run_file(real[k] + nd + 1)) continue;
+      lw_error_set(err, LW_EINPUT, "'%s' is %s of the run in %s, which this run removes or writes over (and then "
+                   "resume could not read it); expected it elsewhere: a copy outside %s", path, real[k] + nd + 1, dir,
+                   dir);
+      return lw_params_blame(&a->params, d->section, d->key, err);
+    }
+  }
+  return LW_OK;
+}
+
 /* Every key of a's parameters that names a file, made absolute; refused
 ** where that no longer fits on a line of the run's scene.ini, which resume
 ** reads (a picture named "pic.png" from a deep directory wrote a scene.ini
@@ -399,7 +432,8 @@ static lw_status absolute_paths(lw_anneal *a, lw_error *err)
       char size[LW_PATH_MAX + 48] = "too long";
       if (path[0] == '/') snprintf(size, sizeof size, "%zu bytes ('%s')", len, path);
       return lw_error_set(err, LW_EINPUT, "%s: key '%s.%s': '%s' made absolute is %s, and the run's scene.ini "
-                          "(which resume reads) holds %zu on its line; move the file, or run from a shorter path",
+                          "(which resume reads) holds %zu on its line; copy the file to a shorter path (a link to it is "
+                          "followed, which does not shorten it)",
                           where, d->section, d->key, was, size, cap);
     }
     /* a folder named "Fotos ;alt" is a comment from its ';' on, once the
@@ -1154,7 +1188,9 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   ** locale after reading the scene wrote 'pair = 0,02' and JSON that is not */
   if ((s = lw_number_locale_ok(err))) return s;
   if ((s = dir_fits(a, dir, err))) return s;
-  if ((s = absolute_paths(a, err)) || (s = from_elsewhere(a, dir, err)) || (s = read_ladder_file(a, err))) return s;
+  if ((s = absolute_paths(a, err)) || (s = from_elsewhere(a, dir, err)) || (s = inputs_elsewhere(a, dir, err)) ||
+      (s = read_ladder_file(a, err)))
+    return s;
   snprintf(a->dir, sizeof a->dir, "%s", dir);
   a->seed = (unsigned long)a->params.seed;
   a->block = -1;

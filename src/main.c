@@ -134,6 +134,18 @@ static lw_status load_run_dir(const char *dir, lw_params *p, lw_state *st, char 
 
 static lw_status set_option(lw_params *p, const char *assignment, lw_error *err);
 
+/* Whether the --set at argv[i] names a key that a later --set names again:
+** the last one is the value (a script that appends its overrides was
+** refused for a value it replaced). */
+static int set_later(char **argv, int argc, int i)
+{
+  const char *name = argv[i + 1], *eq = strchr(name, '=');
+  if (!eq) return 0;
+  for (int j = i + 2; j + 1 < argc; j++)
+    if (!strcmp(argv[j], "--set") && !strncmp(argv[j + 1], name, (size_t)(eq - name) + 1)) return 1;
+  return 0;
+}
+
 /* For an argument refused as an option of a command whose options are
 ** `options` (NULL-ended; NULL: it has only --set): a file or directory of
 ** that name is what was meant, and "./" says so (options are read before
@@ -256,6 +268,17 @@ static lw_status dir_fits(const char *what, const char *dir, lw_error *err)
                       "relative path is shorter)", what, strlen(dir), RUN_DIR_MAX);
 }
 
+/* LW_EUSAGE where dir is no directory: a scene file given to resume or
+** energy read as "x.ini/state.lw: ... Not a directory". */
+static lw_status run_dir_there(const char *what, const char *dir, const char *how, lw_error *err)
+{
+  struct stat sb;
+  const int gone = stat(dir, &sb) ? errno : 0;
+  if (!gone && S_ISDIR(sb.st_mode)) return LW_OK;
+  return lw_error_set(err, LW_EUSAGE, "%s: '%s': %s; expected the directory a run wrote (its --out, out/NAME by "
+                      "default) %s", what, dir, gone ? strerror(gone) : "a file, not a directory", how);
+}
+
 /* A directory's path without trailing slashes ("run/" named its files
 ** "run//final.svg" in every message); "/" stays. */
 static char *trim_slashes(char *path)
@@ -338,7 +361,9 @@ static int cmd_energy(int argc, char **argv)
                  "[--set SEC.KEY=VAL]...)");
     return fail(&err);
   }
-  if (dir_fits("energy", dir, &err)) return fail(&err);
+  if (dir_fits("energy", dir, &err) ||
+      run_dir_there("energy", dir, "(usage: linewise energy DIR [--set SEC.KEY=VAL]...)", &err))
+    return fail(&err);
   static lw_params p;
   lw_state st;
   char path[LW_PATH_MAX + 32];
@@ -362,6 +387,7 @@ static int cmd_energy(int argc, char **argv)
   for (int i = 0; i < argc && !err.code; i++) {
     if (strcmp(argv[i], "--set")) continue;
     if (i + 1 >= argc) lw_error_set(&err, LW_EUSAGE, "--set: expected section.key=value");
+    else if (set_later(argv, argc, i)) i++;
     else set = !set_option(&p, argv[++i], &err);
   }
   if (err.code || (set && (lw_params_resolve(&p, &err) || lw_anneal_check_keys(&p, NULL, 0, &err)))) {
@@ -1272,7 +1298,12 @@ static int cmd_run(int argc, char **argv)
     }
     if (argv[i][0] != '-') {
       if (scene) {
-        lw_error_set(&err, LW_EUSAGE, "run: one scene file expected, got '%s' and '%s'", scene, argv[i]);
+        /* (--set scene.image=my photo.jpg, or --set scene.page = a5: the
+        ** shell split the value) */
+        const int split = i >= 2 && !strcmp(argv[i - 2], "--set");
+        lw_error_set(&err, LW_EUSAGE, "run: one scene file expected, got '%s' and '%s'%s", scene, argv[i],
+                     split ? " (after --set: no blanks around '=', and a value with blanks in quotes, "
+                             "--set 'scene.image=my photo.jpg')" : "");
         return fail(&err);
       }
       scene = argv[i];
@@ -1292,7 +1323,7 @@ static int cmd_run(int argc, char **argv)
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
     if (!strcmp(argv[i], "--set")) {
       if (!v) { lw_error_set(&err, LW_EUSAGE, "--set: expected section.key=value"); return fail(&err); }
-      if (set_option(&p, v, &err)) return fail(&err);
+      if (!set_later(argv, argc, i) && set_option(&p, v, &err)) return fail(&err);
       i++;
     } else if (!strcmp(argv[i], "--out")) {
       struct stat sb; /* (an option as v was refused above: `--out $DIR --quiet`, DIR empty, wrote ./--quiet) */
@@ -1496,6 +1527,7 @@ static int cmd_resume(int argc, char **argv)
     return fail(&err);
   }
   if (dir_fits("resume", dir, &err)) return fail(&err);
+  if (run_dir_there("resume", dir, RESUME_USAGE, &err)) return fail(&err);
   name_run_dir(dir);
   static lw_anneal a;
   watcher w;

@@ -1059,6 +1059,32 @@ int lw_params_write_list(FILE *f, const lw_param_def *d, const char *value)
   return 1;
 }
 
+/* Why a value a person typed is not d's, where it shows: quotes around it, a
+** comment after it that the reader keeps ('#', or ';' with no blank
+** before), a unit after a number, words for a switch; "" where none does. */
+static void typed_hint(const lw_param_def *d, const char *text, char *hint, size_t n)
+{
+  const size_t len = strlen(text);
+  const int numeric = d->type != LW_PT_CHOICE && d->type != LW_PT_STRING;
+  size_t lead = 0; /* the longest start of text that is a number */
+  double v;
+  for (size_t k = len; k > 0 && !lead; k--)
+    if (lw_number_parse_n(text, k, &v)) lead = k;
+  size_t word = d->type == LW_PT_CHOICE ? strcspn(text, " \t#;") : lead; /* the value, as meant */
+  const char *rest = text + word + strspn(text + word, " \t");
+  *hint = '\0';
+  if (len >= 2 && strchr("\"'", text[0]) && text[len - 1] == text[0])
+    snprintf(hint, n, " (without the quotes)");
+  else if (word && (*rest == '#' || (*rest == ';' && rest == text + word)))
+    snprintf(hint, n, " (a comment after a value starts with ';' after a blank: '%.*s ; ...')",
+             (int)(word < 16 ? word : 16), text);
+  else if (numeric && lead && (isalpha((unsigned char)*rest) || *rest == '%'))
+    snprintf(hint, n, " (the number alone%s%s)", strlen(d->unit) > 1 ? ": it is in " : "",
+             strlen(d->unit) > 1 ? d->unit : "");
+  else if (numeric && !lead && d->type != LW_PT_DOUBLE && d->min == 0.0 && d->max == 1.0)
+    snprintf(hint, n, " (0 = off, 1 = on)");
+}
+
 /* Parses text into the field of d; on failure writes what was expected. */
 static int assign(lw_params *p, const lw_param_def *d, const char *text, char *expected, size_t n)
 {
@@ -1071,9 +1097,10 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     double v;
     const int whole = d->type != LW_PT_DOUBLE;
     range_text(d, range, sizeof range);
-    char hint[64];
+    char hint[96];
     const int thousands = lw_number_separator_hint(text, whole, hint, sizeof hint);
     if (!lw_number_parse(text, &v) || thousands) {
+      if (!hint[0]) typed_hint(d, text, hint, sizeof hint);
       snprintf(expected, n, "a %s %s%s", whole ? "whole number" : "number", range, hint);
       return 0;
     }
@@ -1096,10 +1123,11 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     if (idx < 0) {
       /* (a page named as printed, "A4", was refused without a word of why) */
       const int folded = choice_index_cased(d->choices, text, 1);
-      char word[64] = "";
+      char word[64] = "", hint[96];
       if (folded >= 0) choice_name(d->choices, folded, word, sizeof word);
-      snprintf(expected, n, "one of %s%s%s%s", d->choices, folded >= 0 ? " (in lower case: '" : "", word,
-               folded >= 0 ? "')" : "");
+      typed_hint(d, text, hint, sizeof hint);
+      snprintf(expected, n, "one of %s%s%s%s%s", d->choices, folded >= 0 ? " (in lower case: '" : "", word,
+               folded >= 0 ? "')" : "", folded >= 0 ? "" : hint);
       return 0;
     }
     *(int *)base = idx;
@@ -1131,7 +1159,9 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     int ok = 0;
     if (len > cap)
       snprintf(expected, n, "at most %zu bytes (%s%s)", cap, d->list ? "the list's field" : "a scene line's",
-               !strcmp(d->key, "polygon") ? "; a detailed outline is a picture: boundary = mask" : "");
+               !strcmp(d->key, "polygon")  ? "; a detailed outline is a picture: boundary = mask"
+               : !strcmp(d->unit, "path") ? "; a copy of the file at a shorter path"
+                                           : "");
     else if (!lw_params_text_reads_back(text))
       snprintf(expected, n, "text without control characters, blanks at either end, or ';' at the "
                             "start or after a blank");
@@ -1440,6 +1470,10 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
     return lw_error_set(err, LW_EINPUT, "%s: a folder, not a scene file: %s", path,
                         lw_rundir_holds_run(path) ? "it holds a run, which 'linewise resume' continues"
                                                   : "expected a scene file (.ini, as params/example.ini)");
+  /* (a save that failed left a file of 0 bytes, which drew 100 random lines) */
+  if (!of_run && !stat(path, &sb) && S_ISREG(sb.st_mode) && sb.st_size == 0)
+    return lw_error_set(err, LW_EINPUT, "%s: empty (0 bytes): expected a scene file (a line '[scene]' alone "
+                        "takes every default)", path);
   if (lw_text_plain_file(path, err)) return err->code;
   FILE *f = fopen(path, "r");
   if (!f) return lw_error_set(err, LW_EINPUT, "%s: cannot open scene file: %s", path, strerror(errno));

@@ -55,6 +55,19 @@ int lw_runfiles_is_top(const char *name)
   return in_group(name, "replica-", ".lw");
 }
 
+int lw_runfiles_is_run_file(const char *rel)
+{
+  const size_t ns = strlen(LW_RUNFILES_STASH);
+  if (!strncmp(rel, LW_RUNFILES_STASH, ns) && (!rel[ns] || rel[ns] == '/')) return 1;
+  const char *slash = strchr(rel, '/');
+  if (!slash) return lw_runfiles_is_top(rel);
+  for (size_t g = 1; g < sizeof groups / sizeof groups[0]; g++)
+    if (strlen(groups[g].sub) == (size_t)(slash - rel) && !strncmp(rel, groups[g].sub, (size_t)(slash - rel)) &&
+        !strchr(slash + 1, '/') && in_group(slash + 1, groups[g].prefix, groups[g].suffix))
+      return 1;
+  return 0;
+}
+
 typedef int each_fn(const char *rel, void *ctx);
 
 /* Calls fn with the path relative to root of each run file there ("x.tmp"

@@ -223,6 +223,21 @@ static void thin_note(lw_scene *sc, const lw_params *p, const char *key, const l
            used ? "\n" : "", key, img->width, img->height, w, h, p->segment_length);
 }
 
+/* A picture that no term of the energy reads: it places the splines' start
+** and scores the drawing, but the annealing does not follow it (a scene of
+** "[scene] image = photo.jpg" alone drew random lines without a word). */
+static void unread_picture_note(lw_scene *sc, const lw_params *p)
+{
+  const int read = sc->on[LW_TERM_TONE] || (sc->on[LW_TERM_POTENTIAL] && p->potential == LW_POT_IMAGE) ||
+                   (sc->on[LW_TERM_FIELD] && (p->field == LW_FLD_ETF || p->field == LW_FLD_GRADIENT)) ||
+                   (p->boundary == LW_BND_MASK && p->mask == LW_MASK_ALPHA) || p->ly_names[0];
+  if (read) return;
+  size_t used = strlen(sc->note);
+  snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image: no term of the energy reads the picture, so the "
+           "drawing does not follow it (only the splines' first places do); scene.preset = photo draws a picture, as "
+           "do energy.tone, scene.potential = image or scene.field = etf (docs/IMAGES.md)", used ? "\n" : "");
+}
+
 /* The picture pipeline after loading: resize, blur, flattening, levels, tone curve. */
 static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
 {
@@ -908,6 +923,7 @@ static lw_status scene_build(lw_scene *sc, const lw_params *p, lw_error *err)
 
   if ((st = build_boundary(sc, p, err))) return st;
   if (sc->image) dark_note(sc, p);
+  if (sc->image) unread_picture_note(sc, p);
   if (sc->image && (sc->on[LW_TERM_TONE] || (sc->on[LW_TERM_POTENTIAL] && p->potential == LW_POT_IMAGE)))
     thin_note(sc, p, "image", sc->image, &sc->image_place);
   return build_layers(sc, p, err);

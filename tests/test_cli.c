@@ -1365,7 +1365,24 @@ Test(cli, a_students_slips_are_said_with_the_way_out)
     {"resume t --out=t", "resume: unexpected '--out=t' (usage: "},
     {"run h.ini", "h.ini: an XML or HTML file, not a scene file"},
     {"run bm.ini", "bm.ini:1: key 'BMx' comes before any [section]"},
+    /* a unit, a comment, quotes, words for a switch; a value the shell
+    ** split; a scene file where resume and energy take a run; a file of 0
+    ** bytes (a failed save drew 100 random lines) */
+    {"run u.ini", "u.ini:2: key 'scene.margin': expected a number >= 0 and <= 10000000 (the number alone: it is in "
+     "mm), got '10mm'"},
+    {"run c.ini", "c.ini:2: key 'scene.margin': expected a number >= 0 and <= 10000000 (a comment after a value starts "
+     "with ';' after a blank: '10 ; ...'), got '10 # mm'"},
+    {"run %s/params/minimal.ini --set \"scene.boundary='circle'\"", "(without the quotes), got ''circle''"},
+    {"run %s/params/minimal.ini --set output.pdf=yes", "expected a whole number >= 0 and <= 1 (0 = off, 1 = on), got "
+     "'yes'"},
+    {"run %s/params/minimal.ini --set scene.image=my photo.jpg", "run: one scene file expected, got '"},
+    {"resume q.ini", "resume: 'q.ini': a file, not a directory; expected the directory a run wrote"},
+    {"energy nothere", "energy: 'nothere': No such file or directory; expected the directory a run wrote"},
+    {"run z.ini", "z.ini: empty (0 bytes): expected a scene file (a line '[scene]' alone takes every default)"},
   };
+  write_file("u.ini", "[scene]\nmargin = 10mm\n");
+  write_file("c.ini", "[scene]\nmargin = 10 # mm\n");
+  write_file("z.ini", "");
   write_file("h.ini", "\n<!DOCTYPE html>\n<html>\n");
   write_file("bm.ini", "BMx = 1\n");
   write_file("d.svg", "<svg xmlns=\"http://www.w3.org/2000/svg\"></svg>\n");
@@ -1376,10 +1393,52 @@ Test(cli, a_students_slips_are_said_with_the_way_out)
     cr_assert_eq(lw_test_sh("cd %s && %s %s > out.txt 2> err.txt", dir, lw_test_bin(), args), 2, "%s", args);
     char *e = lw_test_slurp("%s/err.txt", dir);
     cr_assert(e && strstr(e, cases[k][1]) && strchr(e, '\n') == e + strlen(e) - 1 &&
-              (k != 7 || !strstr(e, "two words")) && (k != 0 || strstr(e, "(the bundled photo.ini is /")),
+              (k != 7 || !strstr(e, "two words")) && (k != 0 || strstr(e, "(the bundled photo.ini is /")) &&
+              (k != 14 || strstr(e, "(after --set: no blanks around '=', and a value with blanks in quotes")),
               "%s: %s", args, e);
     free(e);
   }
+}
+
+/* A key given twice by --set takes the last value, and the first is not
+** judged (a script appending its overrides was refused for a width it
+** replaced); energy's --set alike. */
+Test(cli, a_key_set_twice_takes_the_last_value)
+{
+  const char *b = lw_test_bin(), *r = lw_test_root();
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out o --set scene.width=0.5 --set anneal.sweeps=1 "
+                          "--set scene.width=120 --quiet && grep -qx 'width = 120' o/scene.ini && "
+                          "%s energy o --set energy.quadrature=1 --set energy.quadrature=12 > e.txt && grep -q '^total ' e.txt "
+                          "&& { %s run %s/params/minimal.ini --out o2 --set scene.width=120 --set scene.width=0.5 "
+                          "2> err.txt; test $? -eq 2; } && grep -q \"scene.width': expected a value >= 1\" err.txt",
+                          dir, b, r, b, b, r), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+}
+
+/* A picture taken from the run a run replaces (its final.png, a frame) was
+** gone when the run was resumed: refused, the run there kept; a file of the
+** user's in the directory is no run file and draws, with the note that no
+** term of a scene without preset reads its picture. */
+Test(cli, a_file_of_the_run_replaced_is_no_input)
+{
+  const char *b = lw_test_bin(), *r = lw_test_root();
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out o --set anneal.sweeps=2 --quiet && mkdir o/frames "
+                          "&& cp o/final.png o/frames/frame-00002.png && cp o/final.png o/mine.png && cp o/state.lw s.lw",
+                          dir, b, r), 0);
+  static const char *const inputs[] = {"o/final.png", "o/frames/frame-00002.png", "o/./final.png"};
+  for (size_t k = 0; k < sizeof inputs / sizeof *inputs; k++) {
+    cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out o --set scene.image=%s --quiet 2> err.txt",
+                            dir, b, r, inputs[k]), 2, "%s", inputs[k]);
+    char *e = lw_test_slurp("%s/err.txt", dir);
+    char want[128];
+    snprintf(want, sizeof want, "is %s of the run in o, which this run removes or writes over", inputs[k] + 2 + (k == 2) * 2);
+    cr_assert(e && strstr(e, "--set: key 'scene.image': '") && strstr(e, want) && !strchr(e, '\n')[1], "%s", e);
+    free(e);
+    cr_assert_eq(lw_test_sh("cd %s && cmp -s o/state.lw s.lw && test -f o/%s", dir, inputs[k] + 2), 0, "%s", inputs[k]);
+  }
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out o --set scene.image=o/mine.png "
+                          "--set anneal.sweeps=2 2> err.txt && test -f o/mine.png && ! test -e o/frames && "
+                          "grep -q 'note: scene.image: no term of the energy reads the picture, so the drawing does "
+                          "not follow it' err.txt", dir, b, r), 0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
 /* A bundled scene named without its folder, from another directory (or

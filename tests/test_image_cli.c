@@ -192,8 +192,8 @@ Test(image_cli, a_path_too_long_for_the_runs_scene_file_is_refused_before_the_ru
   char cmd[600];
   snprintf(cmd, sizeof cmd, "run %s/scene.ini --out out", name);
   refused_before_the_run(cmd, "scene.ini:4: key 'scene.image': 'good.png' made absolute is ",
-                         "and the run's scene.ini (which resume reads) holds 190 on its line; move the file, or "
-                         "run from a shorter path");
+                         "and the run's scene.ini (which resume reads) holds 190 on its line; copy the file to a "
+                         "shorter path");
 }
 
 /* A folder "Fotos ;alt": written into the run's scene.ini, the path is a

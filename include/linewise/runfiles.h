@@ -72,6 +72,11 @@ lw_status lw_runfiles_drop(const char *dir, lw_error *err);
 ** cut off ("state.lw.tmp"). */
 int lw_runfiles_is_top(const char *name);
 
+/* Whether a path relative to a run directory names one of the run's files
+** there (lw_runfiles_is_top, "frames/frame-00012.png", "plots/energy.png")
+** or anything in the stash: what a run made there removes or writes over. */
+int lw_runfiles_is_run_file(const char *rel);
+
 /* Removes dir's run files: a set-up that failed where no run was before. */
 void lw_runfiles_remove(const char *dir);
 
