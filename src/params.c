@@ -566,7 +566,8 @@ const lw_param_def lw_param_table[] = {
   STRING("output", "pen_colors", pen_colors, "", "",
          "Colours of the pens as `#rrggbb` or `#rgb`, one per pen, separated by spaces; empty = all black."),
   CHOICE("output", "order", order, "2opt", "none|greedy|2opt",
-         "Order of the paths of each pen in final.svg: index order, greedy nearest neighbour from "
+         "Order of the paths of each pen in final.svg: index order, each path in its own direction (the "
+         "plotter's joins link a path's end to another's start alone), greedy nearest neighbour from "
          "home (the page's top-left corner; its lower-left with gcode or hpgl and plot.turn = 0, the "
          "machine's origin), or greedy improved by 2-opt and Or-opt moves; paths may be reversed. Reduces pen-up "
          "travel (reported in summary.json)."),

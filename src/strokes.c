@@ -418,8 +418,11 @@ static double joinable_gap(const double *pt, const double *dir, size_t a, size_t
 ** along x alone scanned every pair of hatching's ends, which share their x,
 ** in every band (4 to 8 times the time of one list where nothing joined). */
 static lw_status join_pen(const lw_strokes *in, int pen, size_t base, size_t n, double dist, double cos_max,
-                          lw_strokes_report *rep, lw_strokes *out, lw_error *err)
+                          int directed, lw_strokes_report *rep, lw_strokes *out, lw_error *err)
 {
+  /* directed: an end where its path is drawn from (end 2p, or 2p + 1 of a
+  ** path drawn backward) joins only an end where one is drawn to */
+#define DRAWN_FROM(e) (((e) & 1) == in->reversed[base + (e) / 2])
   size_t ne = 2 * n;
   double *pt = malloc((ne ? ne : 1) * 2 * sizeof *pt), *dir = malloc((ne ? ne : 1) * 2 * sizeof *dir);
   cell_item *cells = malloc((ne ? ne : 1) * sizeof *cells);
@@ -458,7 +461,7 @@ static lw_status join_pen(const lw_strokes *in, int pen, size_t base, size_t n, 
         size_t z, j = cell_run(cells, nx, cells[i].cx + ahead[k][0], cells[i].cy + ahead[k][1], &z);
         for (j = k ? j : i + 1; j < z; j++) {
           size_t a = cells[i].e, b = cells[j].e;
-          if (a / 2 == b / 2) continue;
+          if (a / 2 == b / 2 || (directed && DRAWN_FROM(a) == DRAWN_FROM(b))) continue;
           const double d = joinable_gap(pt, dir, a, b, below, reach, dist, cos_max);
           if (d < 0.0) continue;
           if (n_cand == budget) {
@@ -511,6 +514,7 @@ static lw_status join_pen(const lw_strokes *in, int pen, size_t base, size_t n, 
           for (; j < z; j++) {
             const size_t b = cells[j].e;
             if (b <= a || b >= best || a / 2 == b / 2 || link[b] != SIZE_MAX ||
+                (directed && DRAWN_FROM(a) == DRAWN_FROM(b)) ||
                 joinable_gap(pt, dir, a, b, below, reach, dist, cos_max) < 0.0)
               continue;
             if (ra != find(parent, b / 2)) best = b;
@@ -529,10 +533,14 @@ static lw_status join_pen(const lw_strokes *in, int pen, size_t base, size_t n, 
     next = fmax(below, 0.0) + 0.25 * (reach - fmax(below, 0.0));
     reach = below; /* (the loop's step keeps below where it was) */
   }
-  /* every chain is open (no cycles), so it is walked from a free end */
+  /* every chain is open (no cycles), so it is walked from a free end;
+  ** directed, from the one its first path is drawn from (output.order =
+  ** none: a signed field's lines were drawn against it) */
   for (size_t p = 0; p < n; p++) {
-    if (seen[p] || (link[2 * p] != SIZE_MAX && link[2 * p + 1] != SIZE_MAX)) continue;
-    size_t e_in = link[2 * p] == SIZE_MAX ? 2 * p : 2 * p + 1, nb = 0, q = p;
+    const size_t from = 2 * p + in->reversed[base + p];
+    if (seen[p] || (link[2 * p] != SIZE_MAX && link[2 * p + 1] != SIZE_MAX) || (directed && link[from] != SIZE_MAX))
+      continue;
+    size_t e_in = directed ? from : link[2 * p] == SIZE_MAX ? 2 * p : 2 * p + 1, nb = 0, q = p;
     for (;;) {
       seen[q] = 1;
       append_piece(in, base + q, (int)(e_in & 1), buf, &nb);
@@ -570,10 +578,11 @@ done:
   free(cand);
   free(buf);
   return s;
+#undef DRAWN_FROM
 }
 
-lw_strokes *lw_strokes_join(const lw_strokes *in, const double *dist, double angle, lw_strokes_report *rep,
-                            lw_error *err)
+lw_strokes *lw_strokes_join(const lw_strokes *in, const double *dist, double angle, int directed,
+                            lw_strokes_report *rep, lw_error *err)
 {
   lw_strokes *out = lw_strokes_new(in->n_pens, err);
   if (!out) return NULL;
@@ -584,7 +593,7 @@ lw_strokes *lw_strokes_join(const lw_strokes *in, const double *dist, double ang
     if (!(dist[k] > 0)) {
       for (size_t j = a; j < z; j++)
         if (copy_path(out, in, j, err)) return fail(out);
-    } else if (join_pen(in, k, a, z - a, dist[k], cos_max, rep, out, err)) {
+    } else if (join_pen(in, k, a, z - a, dist[k], cos_max, directed, rep, out, err)) {
       return fail(out);
     }
   }
@@ -858,7 +867,7 @@ lw_strokes *lw_strokes_prepare(const lw_splines *sp, const lw_plot *plot, const 
   int join = 0;
   for (int k = 0; k < s->n_pens; k++) join |= o->join_dist[k] > 0;
   if (join) {
-    t = lw_strokes_join(s, o->join_dist, o->join_angle, rep, err);
+    t = lw_strokes_join(s, o->join_dist, o->join_angle, o->order == LW_PLOT_ORDER_NONE, rep, err);
     lw_strokes_free(s);
     if (!(s = t)) return NULL;
   }

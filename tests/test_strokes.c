@@ -41,7 +41,7 @@ Test(strokes, joins_close_aligned_ends_and_nothing_else)
   add_line(s, 0, 2, 10.1, 0.05, 10.1, 8); /* C starts near A's end but turns 90 degrees */
   add_line(s, 0, 3, 20.5, 0, 30, 0);    /* D starts 0.5 after B's far end: too far */
   lw_strokes_report rep = {0};
-  lw_strokes *j = lw_strokes_join(s, (const double[]){0.3}, 30 * M_PI / 180, &rep, NULL);
+  lw_strokes *j = lw_strokes_join(s, (const double[]){0.3}, 30 * M_PI / 180, 0, &rep, NULL);
   cr_assert_not_null(j);
   cr_assert_eq(rep.joins, 1);
   cr_assert_eq(j->n, 3, "A+B, C, D");
@@ -61,7 +61,7 @@ Test(strokes, joins_close_aligned_ends_and_nothing_else)
   /* any turn allowed and a wider distance: the nearest ends go first, so
   ** C (0.11 from A's end) takes A's end before B (0.2), and B joins D */
   memset(&rep, 0, sizeof rep);
-  j = lw_strokes_join(s, (const double[]){0.6}, M_PI, &rep, NULL);
+  j = lw_strokes_join(s, (const double[]){0.6}, M_PI, 0, &rep, NULL);
   cr_assert_eq(rep.joins, 2);
   cr_assert_eq(j->n, 2);
   cr_assert_eq(segs(j, 0), 3, "A, a bridge, C");
@@ -77,7 +77,7 @@ Test(strokes, joins_close_aligned_ends_and_nothing_else)
   add_line(s, 0, 0, 0, 0, 10, 0);
   add_line(s, 0, 1, 9.8, 0.1, 20, 0.1);
   memset(&rep, 0, sizeof rep);
-  j = lw_strokes_join(s, (const double[]){0.3}, 30 * M_PI / 180, &rep, NULL);
+  j = lw_strokes_join(s, (const double[]){0.3}, 30 * M_PI / 180, 0, &rep, NULL);
   cr_assert_eq(rep.joins, 0, "a bridge back over the ink");
   lw_strokes_free(j);
   /* 0.02 behind (a tenth of the distance): joined */
@@ -85,7 +85,7 @@ Test(strokes, joins_close_aligned_ends_and_nothing_else)
   s->b[8 * 1 + 2] = 9.98 + (20 - 9.98) / 3;
   s->b[8 * 1 + 4] = 9.98 + 2 * (20 - 9.98) / 3;
   memset(&rep, 0, sizeof rep);
-  j = lw_strokes_join(s, (const double[]){0.3}, 30 * M_PI / 180, &rep, NULL);
+  j = lw_strokes_join(s, (const double[]){0.3}, 30 * M_PI / 180, 0, &rep, NULL);
   cr_assert_eq(rep.joins, 1, "ends that overlap by a hair");
   lw_strokes_free(j);
   lw_strokes_free(s);
@@ -101,7 +101,7 @@ Test(strokes, a_ring_of_strokes_joins_into_one_open_path)
   add_line(s, 0, 2, 9.9, 10, 0.1, 10);
   add_line(s, 0, 3, 0, 9.9, 0, 0.1);
   lw_strokes_report rep = {0};
-  lw_strokes *j = lw_strokes_join(s, (const double[]){0.2}, M_PI, &rep, NULL);
+  lw_strokes *j = lw_strokes_join(s, (const double[]){0.2}, M_PI, 0, &rep, NULL);
   cr_assert_eq(rep.joins, 3);
   cr_assert_eq(j->n, 1);
   cr_assert_eq(segs(j, 0), 7, "four sides and three bridges");
@@ -111,7 +111,7 @@ Test(strokes, a_ring_of_strokes_joins_into_one_open_path)
   lw_strokes_free(j);
   /* a 90 degree corner is above the default 30 degrees */
   memset(&rep, 0, sizeof rep);
-  j = lw_strokes_join(s, (const double[]){0.2}, 30 * M_PI / 180, &rep, NULL);
+  j = lw_strokes_join(s, (const double[]){0.2}, 30 * M_PI / 180, 0, &rep, NULL);
   cr_assert_eq(rep.joins, 0);
   cr_assert_eq(j->n, 4);
   lw_strokes_free(j);
@@ -124,7 +124,7 @@ Test(strokes, joins_stay_within_their_pen)
   add_line(s, 0, 0, 0, 0, 10, 0);
   add_line(s, 1, 1, 10.1, 0, 20, 0);
   lw_strokes_report rep = {0};
-  lw_strokes *j = lw_strokes_join(s, (const double[]){0.3, 0.3}, M_PI, &rep, NULL);
+  lw_strokes *j = lw_strokes_join(s, (const double[]){0.3, 0.3}, M_PI, 0, &rep, NULL);
   cr_assert_eq(rep.joins, 0);
   cr_assert_eq(j->n, 2);
   cr_assert_eq(j->pen_first[1], 1);
@@ -146,7 +146,7 @@ Test(strokes, each_pen_joins_and_drops_by_its_own_width)
   }
   const double width[2] = {0.3, 1.0}, join[2] = {width[0], width[1]}, drop[2] = {3 * width[0], 3 * width[1]};
   lw_strokes_report rep = {0};
-  lw_strokes *j = lw_strokes_join(s, join, M_PI, &rep, NULL);
+  lw_strokes *j = lw_strokes_join(s, join, M_PI, 0, &rep, NULL);
   cr_assert_eq(rep.joins, 1);
   cr_assert(j->n == 5 && j->pen_first[1] == 3, "%zu paths, pen 2 from %zu", j->n, j->pen_first[1]);
   lw_strokes *d = lw_strokes_drop(j, drop, &rep, NULL);
@@ -192,9 +192,11 @@ static void ref_end(const lw_strokes *s, size_t e, double *pt, double *out)
 }
 
 /* The joins strokes.h describes, taken from one list of every pair of ends
-** of one pen of straight one-segment paths: for each chain its two free
-** ends' points, as 4 numbers in the order the chains' first paths come. */
-static size_t ref_join(const lw_strokes *s, double dist, double angle, double *chains)
+** of one pen of straight one-segment paths (directed: a path's end with
+** another's start alone): for each chain its two free ends' points, as 4
+** numbers in the order the chains' first paths come (directed: the chain's
+** start first). */
+static size_t ref_join(const lw_strokes *s, double dist, double angle, int directed, double *chains)
 {
   const size_t n = s->n, ne = 2 * n;
   const double cos_max = cos(angle) - 1e-12;
@@ -211,7 +213,7 @@ static size_t ref_join(const lw_strokes *s, double dist, double angle, double *c
       const double c = -(dir[2 * a] * dir[2 * b] + dir[2 * a + 1] * dir[2 * b + 1]);
       const int hook = gx * dir[2 * a] + gy * dir[2 * a + 1] < -0.1 * dist ||
                        -(gx * dir[2 * b] + gy * dir[2 * b + 1]) < -0.1 * dist;
-      if (a / 2 != b / 2 && d <= dist && c >= cos_max && !(cos_max > -1.0 && hook))
+      if (a / 2 != b / 2 && d <= dist && c >= cos_max && !(cos_max > -1.0 && hook) && !(directed && (a & 1) == (b & 1)))
         pairs[np++] = (ref_pair){d, a, b};
     }
   qsort(pairs, np, sizeof *pairs, ref_by_gap);
@@ -231,7 +233,7 @@ static size_t ref_join(const lw_strokes *s, double dist, double angle, double *c
     if (link[e] != SIZE_MAX) continue;
     size_t f = e ^ 1;
     while (link[f] != SIZE_MAX) f = link[f] ^ 1;
-    if (f < e) continue;
+    if (directed ? (e & 1) : f < e) continue;
     memcpy(chains + 4 * m, pt + 2 * e, 2 * sizeof *chains);
     memcpy(chains + 4 * m + 2, pt + 2 * f, 2 * sizeof *chains);
     m++;
@@ -266,14 +268,15 @@ static void ends_in_order(double *four)
 }
 
 /* The joins of s at one distance and angle against ref_join's: the same
-** count, and chains between the same pairs of free ends. */
-static void joins_as_reference(const lw_strokes *s, double dist, double angle)
+** count, and chains between the same pairs of free ends (directed: from
+** the same start to the same end). */
+static void joins_as_reference(const lw_strokes *s, double dist, double angle, int directed)
 {
   const size_t n = s->n;
   double *want = malloc(4 * n * sizeof *want), *got = malloc(4 * n * sizeof *got);
-  const size_t joins = ref_join(s, dist, angle, want);
+  const size_t joins = ref_join(s, dist, angle, directed, want);
   lw_strokes_report rep = {0};
-  lw_strokes *j = lw_strokes_join(s, (const double[]){dist}, angle, &rep, NULL);
+  lw_strokes *j = lw_strokes_join(s, (const double[]){dist}, angle, directed, &rep, NULL);
   cr_assert_not_null(j);
   cr_assert_eq(rep.joins, joins, "distance %g, angle %g: %zu joins, every pair sorted %zu", dist, angle, rep.joins,
                joins);
@@ -285,8 +288,10 @@ static void joins_as_reference(const lw_strokes *s, double dist, double angle)
     g[1] = first[1];
     g[2] = last[6];
     g[3] = last[7];
-    ends_in_order(g);
-    ends_in_order(want + 4 * p);
+    if (!directed) {
+      ends_in_order(g);
+      ends_in_order(want + 4 * p);
+    }
   }
   qsort(got, j->n, 4 * sizeof *got, by_four);
   qsort(want, j->n, 4 * sizeof *want, by_four);
@@ -294,6 +299,35 @@ static void joins_as_reference(const lw_strokes *s, double dist, double angle)
   lw_strokes_free(j);
   free(want);
   free(got);
+}
+
+/* Under output.order = none (directed) a path keeps the direction it is
+** drawn in: two strokes drawn toward each other are not joined (a signed
+** field's lines came out joined against it), one drawn on from the other's
+** end is, and so is a stroke drawn backward (its reversed flag) whose drawn
+** start meets the other's end. */
+Test(strokes, directed_joins_keep_each_path_drawn_forward)
+{
+  lw_strokes_report rep = {0};
+  for (int k = 0; k < 3; k++) {
+    lw_strokes *s = lw_strokes_new(1, NULL);
+    add_line(s, 0, 0, 0, 0, 10, 0);
+    double b[8];
+    if (k == 0) line(b, 20, 0, 10.1, 0); /* toward the first's end */
+    else if (k == 1) line(b, 10.1, 0, 20, 0); /* on from it */
+    else line(b, 20, 0, 10.1, 0);             /* stored toward it, drawn from it */
+    cr_assert_eq(lw_strokes_add(s, 0, 1, 0, k == 2, b, 1, NULL), LW_OK);
+    for (int directed = 0; directed < 2; directed++) {
+      rep.joins = 0;
+      lw_strokes *j = lw_strokes_join(s, (const double[]){0.5}, M_PI, directed, &rep, NULL);
+      cr_assert_not_null(j);
+      cr_assert_eq(rep.joins, directed && k == 0 ? 0u : 1u, "case %d, directed %d", k, directed);
+      if (directed && k) /* from (0, 0) to (20, 0) */
+        cr_assert(seg(j, 0, 0)[0] == 0.0 && seg(j, 0, segs(j, 0) - 1)[6] == 20.0, "case %d", k);
+      lw_strokes_free(j);
+    }
+    lw_strokes_free(s);
+  }
 }
 
 /* n straight strokes of 1 to 5 mm at random turns, starting at random in a
@@ -325,7 +359,7 @@ Test(strokes, joins_by_bands_are_those_of_every_pair_sorted)
   lw_strokes *s = random_strokes(300, 50, 0, 12345);
   const double dists[] = {0.1, 0.5, 2, 8, 30, 1e6}, angles[] = {30 * M_PI / 180, M_PI};
   for (size_t i = 0; i < sizeof dists / sizeof dists[0]; i++)
-    for (size_t k = 0; k < 2; k++) joins_as_reference(s, dists[i], angles[k]);
+    for (size_t k = 0; k < 4; k++) joins_as_reference(s, dists[i], angles[k % 2], k / 2);
   lw_strokes_free(s);
 }
 
@@ -336,8 +370,9 @@ Test(strokes, joins_by_bands_are_those_of_every_pair_sorted)
 Test(strokes, a_cluster_beside_an_outlier_joins_as_every_pair_sorted)
 {
   lw_strokes *s = random_strokes(800, 10, 1000, 777);
-  joins_as_reference(s, 1e6, 30 * M_PI / 180);
-  joins_as_reference(s, 1e6, M_PI);
+  joins_as_reference(s, 1e6, 30 * M_PI / 180, 0);
+  joins_as_reference(s, 1e6, M_PI, 0);
+  joins_as_reference(s, 1e6, M_PI, 1);
   lw_strokes_free(s);
 }
 
@@ -368,7 +403,7 @@ Test(strokes, ends_that_coincide_join_as_every_pair_sorted)
   }
   const double dists[] = {0.5, 1e6}, angles[] = {30 * M_PI / 180, M_PI};
   for (size_t i = 0; i < 2; i++)
-    for (size_t k = 0; k < 2; k++) joins_as_reference(s, dists[i], angles[k]);
+    for (size_t k = 0; k < 4; k++) joins_as_reference(s, dists[i], angles[k % 2], k / 2);
   lw_strokes_free(s);
 }
 
@@ -383,7 +418,7 @@ Test(strokes, a_pen_joined_whole_takes_no_candidate_per_pair)
     add_line(s, 0, k, x, y, x + 0.5, y + 0.25);
   }
   lw_strokes_report rep = {0};
-  lw_strokes *j = lw_strokes_join(s, (const double[]){1e6}, M_PI, &rep, NULL);
+  lw_strokes *j = lw_strokes_join(s, (const double[]){1e6}, M_PI, 0, &rep, NULL);
   cr_assert_not_null(j);
   cr_assert_eq(rep.joins, n - 1);
   cr_assert_eq(j->n, 1);

@@ -117,16 +117,27 @@ static int mpi_run(const char *bin, const char *dir, int R, int P, int threads, 
   snprintf(cmd, sizeof cmd, "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=%d "
            "mpirun --oversubscribe -n %d %s run %s --out %s/mpi-run 2>%s/mpi.log >/dev/null",
            threads, P, bin, path, dir, dir);
-  if (system(cmd) != 0) return 0;
+  const int ran = system(cmd) == 0;
   snprintf(path, sizeof path, "%s/mpi.log", dir);
   FILE *f = fopen(path, "r");
   int got = 0;
+  /* (from "each:" on: "1 process" and "1 thread" are said in the singular,
+  ** which every row on 2 cores has) */
+  const char *each;
   while (f && fgets(line, sizeof line, f))
-    if (sscanf(line, "linewise: MPI: %*d processes, %*d replicas, %*d threads each: %lf ms a sweep; exchange "
-               "steps %lf ms a sweep (%*f %%) on the quickest process, %lf ms (%*f %%) on the one that waited "
-               "longest; %lf chain moves a sweep of %*d bytes; alone, one reduction of %*d words %lf us, one chain "
-               "move %lf", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]) == MPI_VALUES)
+    if (ran && !strncmp(line, "linewise: MPI: ", 15) && (each = strstr(line, " each: ")) &&
+        sscanf(each, " each: %lf ms a sweep; exchange steps %lf ms a sweep (%*f %%) on the quickest process, %lf "
+               "ms (%*f %%) on the one that waited longest; %lf chain moves a sweep of %*d bytes; alone, one "
+               "reduction of %*d words %lf us, one chain move %lf", &v[0], &v[1], &v[2], &v[3], &v[4],
+               &v[5]) == MPI_VALUES)
       got = 1;
+  /* the log goes with the scratch directory: its lines here */
+  if (!got && f) {
+    rewind(f);
+    fprintf(stderr, "bench: tempering: MPI, %d replicas on %d processes: %s; its log:\n", R, P,
+            ran ? "no report line" : "the run failed");
+    while (fgets(line, sizeof line, f)) fprintf(stderr, "  %s", line);
+  }
   if (f) fclose(f);
   return got;
 }
@@ -165,7 +176,8 @@ static void bench_mpi(bench_ctx *b, FILE *d, const char *dir, int cores)
         if ((ok = mpi_run(bin, dir, rs[i], P, threads, sweeps, run[r]))) t[r] = run[r][0];
       }
       if (!ok) {
-        fprintf(d, "| %d | %d | %d | failed (%s/mpi.log) | | | | | |\n", rs[i], P, threads, dir);
+        fprintf(d, "| %d | %d | %d | failed (its log on the bench's standard error) | | | | | |\n", rs[i], P,
+                threads);
         continue;
       }
       double mid = bench_median(t, reps), *v = run[0];

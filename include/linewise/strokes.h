@@ -110,9 +110,11 @@ lw_status lw_strokes_add(lw_strokes *s, int pen, size_t src, unsigned part, int 
 lw_strokes *lw_strokes_from_plot(const lw_splines *sp, const lw_plot *plot, lw_error *err);
 
 /* Steps 1-3 of the post-pass on in (unchanged), into a new drawing; the
-** report's counts are filled (not the travels). */
-lw_strokes *lw_strokes_join(const lw_strokes *in, const double *dist, double angle, lw_strokes_report *rep,
-                            lw_error *err);
+** report's counts are filled (not the travels).  directed (output.order =
+** none): a join links only the end a path is drawn to with the end another
+** is drawn from, so every path keeps its direction. */
+lw_strokes *lw_strokes_join(const lw_strokes *in, const double *dist, double angle, int directed,
+                            lw_strokes_report *rep, lw_error *err);
 lw_strokes *lw_strokes_crop(const lw_strokes *in, double x0, double y0, double x1, double y1,
                             lw_strokes_report *rep, lw_error *err);
 #define LW_STROKES_DOT_MM 1e-4 /* two of final.svg's last decimals (mm) */
