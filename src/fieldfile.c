@@ -422,35 +422,87 @@ static size_t distinct(double *v, size_t n, double tol, double *u)
   return m;
 }
 
-/* The even spacing of the m sorted values u, or 0 (with *worst the widest
-** gap) where they are not evenly spaced to a thousandth of it. */
-static double even_spacing(const double *u, size_t m, double *worst)
+/* The even spacing of the m sorted values u, or 0 where they are not evenly
+** spaced to a thousandth of it, with *at the gap u[*at - 1] to u[*at]
+** farthest from it and *even what it would be. */
+static double even_spacing(const double *u, size_t m, size_t *at, double *even)
 {
-  if (m < 2) return *worst = 0.0;
-  const double h = (u[m - 1] - u[0]) / (double)(m - 1);
-  *worst = 0.0;
-  for (size_t k = 1; k < m; k++) *worst = fmax(*worst, fabs(u[k] - u[k - 1] - h));
-  return *worst <= 1e-3 * h ? h : 0.0;
+  if (m < 2) return 0.0;
+  const double h = *even = (u[m - 1] - u[0]) / (double)(m - 1);
+  double worst = 0.0;
+  for (size_t k = 1; k < m; k++)
+    if (fabs(u[k] - u[k - 1] - h) > worst) {
+      worst = fabs(u[k] - u[k - 1] - h);
+      *at = k;
+    }
+  return worst <= 1e-3 * h ? h : 0.0;
 }
 
-/* Which column of a header row of names (tokens of line, lower case, quotes
-** and a leading Tecplot "variables" dropped) holds x, y, u and v into
-** col: x or points:0, y or points:1, u or vx, v or vy, else the first
-** vector NAME:0 and NAME:1 besides the points (ParaView's "U:0", "U:1").
-** The count of names, or 0 where x, y, u and v are not all named. */
-static long header_columns(const char *line, int col[4])
+/* The index of the value of the m sorted u nearest v. */
+static size_t nearest_of(const double *u, size_t m, double v)
 {
-  char copy[4096], *save = NULL, *names[64];
+  size_t lo = 0, hi = m; /* the first u >= v in [lo, hi] */
+  while (lo < hi) {
+    const size_t mid = lo + (hi - lo) / 2;
+    if (u[mid] < v) lo = mid + 1;
+    else hi = mid;
+  }
+  if (lo == m) return m - 1;
+  return lo > 0 && v - u[lo - 1] < u[lo] - v ? lo - 1 : lo;
+}
+
+/* The names of a header row into names (lower case, at most 64): words
+** between blanks, commas, ';' or '=', or quoted ("X [m]", "X Velocity":
+** one name each); a unit in brackets after a name dropped ("u (m/s)" is u),
+** and a leading Tecplot "variables".  Their count. */
+static long header_names(char *line, char *names[64])
+{
   long n = 0;
-  snprintf(copy, sizeof copy, "%s", line);
-  for (char *t = strtok_r(copy, " \t,;=", &save); t && n < 64; t = strtok_r(NULL, " \t,;=", &save)) {
-    t += strspn(t, "\"'");
-    t[strcspn(t, "\"'")] = '\0';
-    for (char *c = t; *c; c++) *c = (char)tolower((unsigned char)*c);
+  for (char *c = line; *c && n < 64;) {
+    c += strspn(c, " \t,;=");
+    if (!*c) break;
+    char *t = c;
+    if (*c == '"' || *c == '\'') {
+      const char q = *c++;
+      t = c;
+      c += strcspn(c, q == '"' ? "\"" : "'");
+    } else {
+      c += strcspn(c, " \t,;=");
+    }
+    const int more = *c != '\0';
+    *c = '\0';
+    c += more;
+    size_t len = strlen(t);
+    while (len && (t[len - 1] == ']' || t[len - 1] == ')')) { /* "x [m]", "u (m/s)" */
+      const char want = t[len - 1] == ']' ? '[' : '(';
+      char *open = t + len - 1;
+      while (open > t && *open != want) open--;
+      if (open == t) break;
+      for (len = (size_t)(open - t); len && (t[len - 1] == ' ' || t[len - 1] == '\t'); len--) {}
+      t[len] = '\0';
+    }
+    for (char *k = t; *k; k++) *k = (char)tolower((unsigned char)*k);
     if (*t && !(n == 0 && !strcmp(t, "variables"))) names[n++] = t;
   }
-  static const char *const own[4][4] = {{"x", "points:0", "coordinates:0", NULL}, {"y", "points:1", "coordinates:1",
-                                        NULL}, {"u", "vx", "ux", NULL}, {"v", "vy", "uy", NULL}};
+  return n;
+}
+
+/* Which column of a header row of names (header_names) holds x, y, u and v
+** into col: x or points:0, y or points:1, u or vx, v or vy (and the words
+** of Fluent's "X Velocity"), else the first vector NAME:0 and NAME:1 (or
+** OpenFOAM's NAME_0 and NAME_1) besides the points (ParaView's "U:0",
+** "U:1").  The count of names into *count; that count, or 0 where x, y, u
+** and v are not all named. */
+static long header_columns(const char *line, int col[4], long *count)
+{
+  char copy[4096], *names[64];
+  snprintf(copy, sizeof copy, "%s", line);
+  const long n = *count = header_names(copy, names);
+  static const char *const own[4][8] = {
+      {"x", "points:0", "coordinates:0", "points_0", "x-coordinate", NULL},
+      {"y", "points:1", "coordinates:1", "points_1", "y-coordinate", NULL},
+      {"u", "vx", "ux", "x velocity", "x-velocity", "velocity_x", "vel_x", NULL},
+      {"v", "vy", "uy", "y velocity", "y-velocity", "velocity_y", "vel_y", NULL}};
   for (int c = 0; c < 4; c++) {
     col[c] = -1;
     for (long k = 0; k < n && col[c] < 0; k++)
@@ -459,11 +511,13 @@ static long header_columns(const char *line, int col[4])
   }
   for (long k = 0; k < n && (col[2] < 0 || col[3] < 0); k++) {
     const size_t len = strlen(names[k]), stem = len - 2;
-    if (len < 3 || strcmp(names[k] + stem, ":0") || (stem == 6 && !strncmp(names[k], "points", 6)) ||
+    const char mark = len >= 3 ? names[k][stem] : 0; /* ':' or '_' */
+    if ((mark != ':' && mark != '_') || names[k][stem + 1] != '0' || (stem == 6 && !strncmp(names[k], "points", 6)) ||
         (stem == 11 && !strncmp(names[k], "coordinates", 11)))
       continue;
     for (long m = 0; m < n; m++)
-      if (strlen(names[m]) == stem + 2 && !strncmp(names[m], names[k], stem) && !strcmp(names[m] + stem, ":1")) {
+      if (strlen(names[m]) == stem + 2 && !strncmp(names[m], names[k], stem) && names[m][stem] == mark &&
+          names[m][stem + 1] == '1') {
         col[2] = (int)k;
         col[3] = (int)m;
       }
@@ -480,8 +534,12 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
   values a = {NULL, 0, 0};
   char *buf = NULL;
   size_t bcap = 0;
-  long line = 0, len, got, rows = 0, width = 4;
-  int col[4] = {0, 1, 2, 3};
+  long line = 0, len, got, rows = 0, width = 4, *at = NULL; /* at: each point's line */
+  int col[4] = {0, 1, 2, 3}, understood = 0;
+  /* the last line of words that named not every column, as a header
+  ** row might: its line, its count of names and which it named */
+  long odd_line = 0, odd_count = 0;
+  int odd_named[4] = {-1, -1, -1, -1}, odd_header = 0;
   lw_status s = LW_OK;
   while (!s && (len = lw_text_next_line(f, &buf, &bcap, &line)) >= 0) {
     char *hash = strchr(buf, '#');
@@ -490,11 +548,20 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
     lw_error e2;
     if ((s = text_row(buf, path, line, &a, &got, &e2))) {
       int named[4];
-      const long names = header_columns(buf, named);
+      long count;
+      const long names = header_columns(buf, named, &count);
       if (!rows && s == LW_EINPUT && strpbrk(buf, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ")) {
         if (names) {
           width = names;
           memcpy(col, named, sizeof col);
+          understood = 1;
+        } else {
+          odd_line = line;
+          odd_count = count;
+          memcpy(odd_named, named, sizeof odd_named);
+          /* a header more than a title: it names a column, or its names
+          ** are a CSV's or quoted */
+          odd_header = named[0] >= 0 || named[1] >= 0 || named[2] >= 0 || named[3] >= 0 || strpbrk(buf, ",\"'");
         }
         a.n = before;
         s = LW_OK;
@@ -504,9 +571,31 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
       break;
     }
     if (!got) continue;
+    /* ("x,y,speed,angle": speed taken for u, angle for v, without a word) */
+    if (!rows && !understood && odd_header && odd_count == got) {
+      static const char *const what[4] = {"x", "y", "u", "v"};
+      char missing[32] = "";
+      int left = 0;
+      for (int c = 0; c < 4; c++) left += odd_named[c] < 0;
+      for (int c = 0; c < 4; c++)
+        if (odd_named[c] < 0)
+          snprintf(missing + strlen(missing), sizeof missing - strlen(missing), "%s%s", what[c],
+                   --left > 1 ? ", " : left == 1 ? " or " : "");
+      s = lw_error_set(err, LW_EINPUT, "%s:%ld: a header row of %ld names, none of them %s: expected names x, y, u "
+                       "and v (or Points:0 and :1, vx and vy, a vector's NAME:0 and NAME:1: docs/FORMATS.md, \"Field "
+                       "files\"), or the line made a comment with '#' to take the columns as x y u v",
+                       path, odd_line, odd_count, missing);
+      break;
+    }
     if (got != width)
       s = lw_error_set(err, LW_EINPUT, "%s:%ld: %ld values: expected %ld a line (%s)", path, line, got, width,
                        width == 4 ? "x y u v" : "as the header row names");
+    long *grown = (rows & (rows - 1)) ? at : realloc(at, (rows ? 2 * (size_t)rows : 1) * sizeof *at);
+    if (!s && !grown) s = lw_error_set(err, LW_ENOMEM, "%s: out of memory for the points", path);
+    if (!s) {
+      at = grown;
+      at[rows] = line;
+    }
     rows++;
   }
   if (!s && len == -2) s = lw_error_set(err, errno == ENOMEM ? LW_ENOMEM : LW_EINPUT, "%s:%ld: %s", path, line,
@@ -520,12 +609,12 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
   if (!s && !xs) s = lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu points", path, n);
   lw_grid2d *g = NULL;
   if (!s) {
-    double *ys = xs + n, *ux = xs + 2 * n, *uy = xs + 3 * n, wx, wy;
+    double *ys = xs + n, *ux = xs + 2 * n, *uy = xs + 3 * n;
     for (size_t k = 0; k < n; k++) {
       xs[k] = a.v[k * (size_t)width + (size_t)col[0]];
       ys[k] = a.v[k * (size_t)width + (size_t)col[1]];
       if (!isfinite(xs[k]) || !isfinite(ys[k]))
-        s = lw_error_set(err, LW_EINPUT, "%s: point %zu at (%g, %g): expected finite coordinates", path, k + 1,
+        s = lw_error_set(err, LW_EINPUT, "%s:%ld: the point at (%g, %g): expected finite coordinates", path, at[k],
                          xs[k], ys[k]);
     }
     size_t nx = 0, ny = 0;
@@ -536,14 +625,41 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
       nx = distinct(xs, n, 1e-9 * fmax(hi - lo, 1e-300), ux);
       ny = distinct(ys, n, 1e-9 * fmax(yhi - ylo, 1e-300), uy);
     }
-    double hx = 0, hy = 0;
+    /* each point's node, by its nearest distinct x and y, so that a point
+    ** there twice or a node with none is named by its line and place */
+    unsigned char *seen = NULL;
+    size_t *node = NULL;
+    if (!s && nx * ny <= (size_t)LW_FIELDFILE_NODES_MAX) {
+      seen = calloc(nx * ny, 1);
+      node = malloc(n * sizeof *node);
+      if (!seen || !node) s = lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu points", path, n);
+      for (size_t k = 0; !s && k < n; k++) {
+        const double *pt = a.v + k * (size_t)width;
+        node[k] = nearest_of(uy, ny, pt[col[1]]) * nx + nearest_of(ux, nx, pt[col[0]]);
+        if (!seen[node[k]]++) continue;
+        size_t first = 0;
+        while (node[first] != node[k]) first++;
+        s = lw_error_set(err, LW_EINPUT, "%s:%ld: the point at (%g, %g) is there twice (first on line %ld): expected "
+                         "every node of a regular grid once", path, at[k], pt[col[0]], pt[col[1]], at[first]);
+      }
+      for (size_t m = 0; !s && n < nx * ny && m < nx * ny; m++)
+        if (!seen[m])
+          s = lw_error_set(err, LW_EINPUT, "%s: no point at (%g, %g), a node of the %zu x %zu grid the other points "
+                           "make: expected every node of a regular grid once", path, ux[m % nx], uy[m / nx], nx, ny);
+    }
+    double hx = 0, hy = 0, even = 0;
+    size_t gap = 0;
     if (!s && nx * ny != n)
       s = lw_error_set(err, LW_EINPUT, "%s: %zu points over %zu distinct x and %zu distinct y: expected every node of "
                        "a regular grid once (%zu points)", path, n, nx, ny, nx * ny);
-    else if (!s && ((nx > 1 && !(hx = even_spacing(ux, nx, &wx))) || (ny > 1 && !(hy = even_spacing(uy, ny, &wy)))))
-      s = lw_error_set(err, LW_EINPUT, "%s: the %s spacing is uneven (off by up to %g): expected a regular grid (a "
-                       "stretched one resampled to even spacing)", path, nx > 1 && !hx ? "x" : "y",
-                       nx > 1 && !hx ? wx : wy);
+    else if (!s && ((nx > 1 && !(hx = even_spacing(ux, nx, &gap, &even))) ||
+                    (ny > 1 && !(hy = even_spacing(uy, ny, &gap, &even))))) {
+      const int in_x = nx > 1 && !hx;
+      const double *u = in_x ? ux : uy;
+      s = lw_error_set(err, LW_EINPUT, "%s: the %s spacing is uneven: %s = %g to %g is %g apart, where even spacing "
+                       "is %g: expected a regular grid (a stretched one resampled to even spacing)", path,
+                       in_x ? "x" : "y", in_x ? "x" : "y", u[gap - 1], u[gap], u[gap] - u[gap - 1], even);
+    }
     if (!s && nx * ny > (size_t)LW_FIELDFILE_NODES_MAX)
       s = lw_error_set(err, LW_EINPUT, "%s: %zu points: expected at most %ld", path, n, LW_FIELDFILE_NODES_MAX);
     if (!s) {
@@ -551,18 +667,12 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
       if (!hy) hy = hx;
       g = lw_grid2d_new((int)nx, (int)ny, ncomp, ux[0], uy[0], hx, hy, err);
     }
-    unsigned char *seen = g ? calloc(nx * ny, 1) : NULL;
-    if (g && !seen) s = lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu points", path, n);
-    for (size_t k = 0; seen && !s && k < n; k++) {
-      const double *pt = a.v + k * (size_t)width, px = pt[col[0]], py = pt[col[1]];
-      const size_t i = (size_t)lround((px - g->x0) / hx), j = (size_t)lround((py - g->y0) / hy);
-      if (seen[j * nx + i]++)
-        s = lw_error_set(err, LW_EINPUT, "%s: point %zu at (%g, %g) is there twice: expected every node of a regular "
-                         "grid once", path, k + 1, px, py);
-      double *d = g->data + (j * nx + i) * (size_t)ncomp;
-      for (int c = 0; c < ncomp; c++) d[c] = pt[col[2 + c]];
+    for (size_t k = 0; g && k < n; k++) {
+      double *d = g->data + node[k] * (size_t)ncomp;
+      for (int c = 0; c < ncomp; c++) d[c] = a.v[k * (size_t)width + (size_t)col[2 + c]];
     }
     free(seen);
+    free(node);
     if (s) {
       lw_grid2d_free(g);
       g = NULL;
@@ -570,6 +680,7 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
   }
   free(xs);
   free(a.v);
+  free(at);
   return g;
 }
 

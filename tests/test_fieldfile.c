@@ -520,6 +520,14 @@ Test(fieldfile, a_list_of_points_reads_onto_its_grid)
     "1,-1.5,0,2,0,0\n10,-10.5,0,0,1,0\n2,-2.5,0,4,0,0\n11,-11.5,0,2,1,0\n",
     "TITLE = \"flow\"\nVARIABLES = \"X\", \"Y\", \"U\", \"V\"\nZONE I=3, J=2, F=POINT\n0 0 0 -0.5\n2 0 1 -1.5\n"
     "4 0 2 -2.5\n0 1 10 -10.5\n2 1 11 -11.5\n4 1 12 -12.5\n",
+    /* names with blanks and units, quoted (they were split at the blanks);
+    ** OpenFOAM's NAME_0 and NAME_1 after a z; Fluent's words */
+    "VARIABLES = \"V [m/s]\", \"Y [m]\", \"X [m]\", \"U (m/s)\"\n-0.5 0 0 0\n-1.5 0 2 1\n-2.5 0 4 2\n-10.5 1 0 10\n"
+    "-11.5 1 2 11\n-12.5 1 4 12\n",
+    "x,y,z,U_0,U_1,U_2\n0,0,7,0,-0.5,9\n2,0,7,1,-1.5,9\n4,0,7,2,-2.5,9\n0,1,7,10,-10.5,9\n2,1,7,11,-11.5,9\n"
+    "4,1,7,12,-12.5,9\n",
+    "nodenumber, x-coordinate, y-coordinate, x-velocity, y-velocity\n1,0,0,0,-0.5\n2,2,0,1,-1.5\n3,4,0,2,-2.5\n"
+    "4,0,1,10,-10.5\n5,2,1,11,-11.5\n6,4,1,12,-12.5\n",
   };
   for (size_t k = 0; k < sizeof named / sizeof *named; k++) {
     lw_test_write(path, named[k], strlen(named[k]));
@@ -531,9 +539,18 @@ Test(fieldfile, a_list_of_points_reads_onto_its_grid)
   static const struct {
     const char *text, *word;
   } bad[] = {
-    {"0 0 1 0\n1 0 1 0\n0 1 1 0\n", "3 points over 2 distinct x and 2 distinct y"},
-    {"0 0 1 0\n1 0 1 0\n3 0 1 0\n", "x spacing is uneven"},
-    {"0 0 1 0\n1 0 1 0\n0 0 1 0\n2 0 1 0\n0 1 1 0\n1 1 1 0\n", "twice"},
+    /* each named by its place and line */
+    {"0 0 1 0\n1 0 1 0\n0 1 1 0\n", ": no point at (1, 1), a node of the 2 x 2 grid the other points make"},
+    {"0 0 1 0\n1 0 1 0\n3 0 1 0\n", ": the x spacing is uneven: x = 0 to 1 is 1 apart, where even spacing is 1.5"},
+    {"# a grid\n0 0 1 0\n1 0 1 0\n0 0 1 0\n2 0 1 0\n0 1 1 0\n1 1 1 0\n", ":4: the point at (0, 0) is there twice "
+     "(first on line 2)"},
+    {"x y u v\n0 0 1 0\nnan 0 1 0\n", ":3: the point at (nan, 0): expected finite coordinates"},
+    /* a header whose names choose no column was read as x y u v unsaid
+    ** (speed taken for u, angle for v); a title of words is no header */
+    {"x,y,speed,angle\n0,0,1,0\n1,0,1,0\n", ":1: a header row of 4 names, none of them u or v: expected names x, y, "
+     "u and v"},
+    {"\"a\" \"b\" \"c\" \"d\"\n0 0 1 0\n", ":1: a header row of 4 names, none of them x, y, u or v"},
+    {"flow past a cylinder\n0 0 1 0\n1 0 1 0\n0 1 1 0\n", "no point at (1, 1)"},
     {"0 0 1 0 5\n", "5 values: expected 4 a line"},
     {"x y u v\nx y u v\n", "found none"},
     {"x y u v\n0 0 1 0\nx y u v\n", ":3: value 1 of the row, 'x', is not a number"},
