@@ -1409,7 +1409,7 @@ static int flat_end(const size_t *hist, int b, int end, int step, double plateau
   return 0;
 }
 
-lw_status lw_image_levels(lw_image *img, const float *under, double clip, int tail, double *lo, double *hi,
+lw_status lw_image_levels(lw_image *img, const float *under, double clip, int flat, double *lo, double *hi,
                           lw_error *err)
 {
   size_t n = (size_t)img->width * (size_t)img->height;
@@ -1429,11 +1429,21 @@ lw_status lw_image_levels(lw_image *img, const float *under, double clip, int ta
     int b = 0;
     const double plateau = LW_IMAGE_LEVELS_PLATEAU * (double)count;
     while (b < LEVELS_BINS - 1 && (c += hist[b]) <= cut) b++;
-    if (!flat_end(hist, b, 0, 1, plateau, tail)) l = (double)b / LEVELS_BINS;
+    const double bl = (double)b / LEVELS_BINS;
+    const int l_flat = flat_end(hist, b, 0, 1, plateau, flat >= 1);
     c = 0;
     b = LEVELS_BINS - 1;
     while (b > 0 && (c += hist[b]) <= cut) b--;
-    if (!flat_end(hist, b, LEVELS_BINS - 1, -1, plateau, tail)) h = (double)(b + 1) / LEVELS_BINS;
+    const double bh = (double)(b + 1) / LEVELS_BINS;
+    const int h_flat = flat_end(hist, b, LEVELS_BINS - 1, -1, plateau, flat >= 1);
+    if (!l_flat) l = bl;
+    if (!h_flat) h = bh;
+    /* an end left alone keeps its flat colour from turning white or black
+    ** whole, but with the other end stretched up to it, it went to the
+    ** other side: a DEM's flat sea at 0.458, its land up to 0.464, made
+    ** 0.99 (white) with l at 0; there it is stretched as any end */
+    if (flat >= 2 && l_flat && !h_flat && (bl - l) / (h - l) > 0.5) l = bl;
+    if (flat >= 2 && h_flat && !l_flat && (bh - l) / (h - l) < 0.5) h = bh;
   }
   free(hist);
   if (h - l < LW_IMAGE_LEVELS_MIN_SPAN) {

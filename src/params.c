@@ -120,11 +120,14 @@ const lw_param_def lw_param_table[] = {
       "picture stays so); 0 = of the picture composited over white, as runs before 2026-12-06 "
       "(their darks went to one grey; a run of theirs, whose scene.ini has no line for this key, "
       "resumes so)."),
-  NUM("scene", "image_levels_flat", LW_PT_INT, image_levels_flat, "1", "", 0, 1, 0,
+  NUM("scene", "image_levels_flat", LW_PT_INT, image_levels_flat, "2", "", 0, 2, 0,
       "image_levels on a flat colour: 1 = an end is left alone where one tone holds more than 5 % of the "
       "pixels with no more than 5 % beyond it (a graphic's lightest colour past whose anti-aliased edge or "
-      "JPEG ringing the clip fell turned white whole); 0 = only where the clip falls on such a tone, as "
-      "runs before this key (a run of theirs, whose scene.ini has no line for this key, resumes so)."),
+      "JPEG ringing the clip fell turned white whole); 2 = so, but an end whose flat colour the other end's "
+      "stretch would carry past the middle tone is stretched as any (a low-contrast elevation model's flat "
+      "sea, its darkest, turned white with the whole picture under 1), as runs before 2026-12-07 did not; "
+      "0 = only where the clip falls on such a tone, as runs before this key (a run of theirs, whose "
+      "scene.ini has no line for this key, resumes so)."),
   NUM("scene", "image_gamma", LW_PT_DOUBLE, image_gamma, "1", "", 0, 100, LW_MIN_OPEN,
       "Tone curve t <- t^gamma (after `image_invert`): above 1 darkens the mid-tones."),
   NUM("scene", "image_contrast", LW_PT_DOUBLE, image_contrast, "1", "", 0, 100, 0,

@@ -308,8 +308,8 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
     double lo, hi;
     const float *under = levels_under ? (cover ? cover : sc->image->alpha) : NULL;
     /* (a run begun before the key: the clip's bin alone) */
-    const int tail = p->image_levels_flat && !before_key(p, "image_levels_flat");
-    if ((st = lw_image_levels(sc->image, under, p->image_levels, tail, &lo, &hi, err))) {
+    const int flat = before_key(p, "image_levels_flat") ? 0 : p->image_levels_flat;
+    if ((st = lw_image_levels(sc->image, under, p->image_levels, flat, &lo, &hi, err))) {
       free(cover);
       return st;
     }

@@ -604,6 +604,40 @@ Test(image, levels_stretch_the_tones_between_the_quantiles)
   lw_image_free(img);
 }
 
+/* A low-contrast elevation model: a flat sea at its darkest tone (57 % of
+** the pixels at 0.4578) and land rising to 0.4639.  Its dark end, a flat
+** colour left alone at 0, with the light end stretched down to the land's
+** top made the sea 0.99, all white (an empty drawing); with flat = 2 that end
+** is stretched as any, and the span, under 0.05, widened about its middle:
+** the sea darker than the land, as in the picture.  flat = 1 (runs begun
+** before) keeps the old levels; a flat colour that stays on its side (white
+** paper under a darker picture) is still left alone. */
+Test(image, a_flat_end_is_not_carried_across_the_middle)
+{
+  const int n = 1000;
+  const double sea = 0.4578, top = 0.4639;
+  lw_image *img = lw_image_new(n, 1, 0, NULL);
+  double lo, hi;
+  for (int flat = 1; flat <= 2; flat++) {
+    for (int k = 0; k < n; k++) img->tone[k] = (float)(k < 570 ? sea : sea + (top - sea) * (k - 569) / 430.0);
+    cr_assert_eq(lw_image_levels(img, NULL, 0.01, flat, &lo, &hi, NULL), LW_OK);
+    if (flat == 1) {
+      cr_assert(lo == 0.0 && img->tone[0] > 0.98, "as before: levels %g to %g, sea %g", lo, hi, img->tone[0]);
+      continue;
+    }
+    const double mid = 0.5 * (sea + top);
+    cr_assert(fabs(hi - lo - LW_IMAGE_LEVELS_MIN_SPAN) < 1e-12 && fabs(0.5 * (lo + hi) - mid) < 2.0 / 4096,
+              "levels %g to %g", lo, hi);
+    cr_assert(img->tone[0] < 0.5 && img->tone[n - 1] > img->tone[0] + 0.1, "sea %g, land's top %g", img->tone[0],
+              img->tone[n - 1]);
+  }
+  /* white paper (60 %) under a picture from 0.2 to 0.6: the paper stays white */
+  for (int k = 0; k < n; k++) img->tone[k] = (float)(k < 600 ? 1.0 : 0.2 + 0.4 * (k - 600) / 399.0);
+  cr_assert_eq(lw_image_levels(img, NULL, 0.01, 2, &lo, &hi, NULL), LW_OK);
+  cr_assert(hi == 1.0 && img->tone[0] == 1.0f && lo > 0.2, "levels %g to %g", lo, hi);
+  lw_image_free(img);
+}
+
 /* A half-transparent picture (a faded overlay, a soft cut-out) keeps its
 ** transparency through the levels: its own tones, under the paper the alpha
 ** lets through, are stretched, and composited again.  The levels were taken

@@ -144,10 +144,13 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
 ** LW_IMAGE_LEVELS_PLATEAU of the pixels, is not stretched: a graphic's
 ** flat colours would turn white or black whole (a logo's red disc, its
 ** lightest colour, vanished), where a photograph's ends are tails of a few
-** pixels a tone; with `tail`, also where such a tone has no more than
+** pixels a tone; with `flat` >= 1, also where such a tone has no more than
 ** LW_IMAGE_LEVELS_PLATEAU of the pixels beyond it (anti-aliasing or a JPEG's
-** ringing past a flat colour; scene.image_levels_flat, 0 for runs begun
-** before it).  *lo and *hi receive the tones that became 0 and 1.
+** ringing past a flat colour); with `flat` 2, a flat end whose colour the
+** other end's stretch would carry past the middle tone is stretched as any
+** (a low-contrast elevation model's flat sea, its darkest, went white with
+** all the rest).  scene.image_levels_flat: 0 for runs begun before it, 1
+** before 2026-12-07.  *lo and *hi receive the tones that became 0 and 1.
 ** LW_ENOMEM with err set. */
 #define LW_IMAGE_LEVELS_MIN_SPAN 0.05
 #define LW_IMAGE_LEVELS_PLATEAU 0.05
@@ -159,7 +162,7 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
 ** tones lie mid-range (0.50 to 0.71), and the stretch that makes its
 ** darkest black is what draws it (kept light, it drew one even mat) */
 #define LW_IMAGE_LEVELS_PAPER 0.85
-lw_status lw_image_levels(lw_image *img, const float *under, double clip, int tail, double *lo, double *hi,
+lw_status lw_image_levels(lw_image *img, const float *under, double clip, int flat, double *lo, double *hi,
                           lw_error *err);
 
 /* The tone curve, in this order:
