@@ -1126,7 +1126,8 @@ static void summary(const void *state, lw_json *j)
 ** splines' are of each spline: its length, the squared distance between its
 ** ends, its squared radius of gyration along the arc, 1/L integral of
 ** |r - r_cm|^2 dl, and the cosine between its end tangents; the integrals
-** by an 8-point Gauss rule on every knot span. */
+** by an 8-point Gauss rule on every piece of a knot span that the energy's
+** quadrature takes (lw_dnurbs_span_pieces: a light end point's turn). */
 static const char *const observable_names[] = {"length", "end2", "rg2", "end_cos"};
 
 static void observe(const void *state, double *out)
@@ -1143,14 +1144,16 @@ static void observe(const void *state, double *out)
   lw_nurbs_eval(c, lw_nurbs_u1(c), p1, t1, NULL);
   lw_arc_moments m = {0.0, 0.0, 0.0, 0.0};
   for (size_t sp = k - 1; sp < c->n; sp++) {
-    double a = c->knot[sp], b = c->knot[sp + 1];
-    if (!(b > a)) continue; /* a repeated knot: no span */
-    for (size_t q = 0; q < nq; q++) {
-      double u, wq;
-      gsl_integration_glfixed_point(a, b, q, &u, &wq, gl);
-      lw_nurbs_eval(c, u, pt, d, NULL);
-      lw_arc_moments_add(&m, pt[0] - p0[0], pt[1] - p0[1], wq * hypot(d[0], d[1]));
-    }
+    if (!(c->knot[sp + 1] > c->knot[sp])) continue; /* a repeated knot: no span */
+    double a[LW_DNURBS_PIECES_MAX], b[LW_DNURBS_PIECES_MAX];
+    const int pieces = lw_dnurbs_span_pieces(c, sp, a, b);
+    for (int piece = 0; piece < pieces; piece++)
+      for (size_t q = 0; q < nq; q++) {
+        double u, wq;
+        gsl_integration_glfixed_point(a[piece], b[piece], q, &u, &wq, gl);
+        lw_nurbs_eval(c, u, pt, d, NULL);
+        lw_arc_moments_add(&m, pt[0] - p0[0], pt[1] - p0[1], wq * hypot(d[0], d[1]));
+      }
   }
   gsl_integration_glfixed_table_free(gl);
   lw_spline_shape sh;

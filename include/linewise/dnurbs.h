@@ -37,6 +37,14 @@ typedef struct {
 
 /* The matrices of curve c (its weights frozen) with `gauss` points a span. */
 lw_dnurbs *lw_dnurbs_new(lw_nurbs *c, double alpha, double beta, int gauss, lw_error *err);
+
+/* The pieces knot span s (knot[s] < knot[s + 1]) is integrated over, each
+** with its own Gauss points: the span whole, or where its weights lie more
+** than 2 apart cut at h/2, h/4, ... toward each end, as far as the rational
+** basis's turn there (dnurbs.c).  Their count, at most LW_DNURBS_PIECES_MAX,
+** and their ends into p0 and p1. */
+#define LW_DNURBS_PIECES_MAX 60
+int lw_dnurbs_span_pieces(const lw_nurbs *c, size_t s, double *p0, double *p1);
 void lw_dnurbs_free(lw_dnurbs *d);
 
 /* K, M1 and b again at c's present weights (free weights; d from c). */
