@@ -32,9 +32,11 @@ lw_status lw_nurbs_check_knots(int order, size_t n, const double *knot, size_t n
                         order);
   for (size_t i = k, run = 1; i < n; i++) {
     run = knot[i] == knot[i - 1] ? run + 1 : 1;
-    if (run > k - 1)
+    if (run > k - 1) {
+      while (i + 1 < n && knot[i + 1] == knot[i]) i++, run++; /* the whole run: it said 4 of 5 */
       return lw_error_set(err, LW_EINPUT, "knot %g is repeated %zu times inside: at most k - 1 = %d (the curve "
                           "would break)", knot[i], run, order - 1);
+    }
   }
   return LW_OK;
 }

@@ -1183,14 +1183,16 @@ static void describe(const void *state, int what, char *buf, size_t n)
   else if (what == LW_DESCRIBE_FORBIDDEN)
     snprintf(buf, n, "an energy that is not finite");
   else if (what == LW_DESCRIBE_LOST) {
-    if (n) buf[0] = '\0';
-  } else
     /* (weights 1e8 apart drew 0.29 from a curve of size 1, and only this
-    ** number said so) */
-    snprintf(buf, n, "linewise: final.svg: %zu cubic Beziers, at most %.3g from the curve%s%s\n", s->beziers,
-             s->deviation, lw_nurbs_polynomial(s->c) && s->c->order <= 4 ? " (exact)" : "",
-             s->deviation > s->su->tolerance ? ", more than nurbs.svg_tolerance: the fit's depth, or the curve's "
-                                               "rounding (its size), stopped it there" : "");
+    ** number said so; a warning, so under --quiet too) */
+    if (s->deviation > s->su->tolerance)
+      snprintf(buf, n, "final.svg lies up to %.3g from the curve, more than nurbs.svg_tolerance (%g): the fit's depth, "
+               "or the curve's rounding (its size), stopped it there", s->deviation, s->su->tolerance);
+    else if (n)
+      buf[0] = '\0';
+  } else
+    snprintf(buf, n, "linewise: final.svg: %zu cubic Beziers, at most %.3g from the curve%s\n", s->beziers,
+             s->deviation, lw_nurbs_polynomial(s->c) && s->c->order <= 4 ? " (exact)" : "");
 }
 
 /* The wire's load acts on Monte Carlo too; its ends are held by

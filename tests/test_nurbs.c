@@ -283,6 +283,10 @@ Test(nurbs, bad_knots_and_weights_are_refused_with_the_reason)
   double five[11] = {0, 0, 0, 0, 0, 0.5, 0.75, 1, 1, 1, 1};
   cr_assert_eq(lw_nurbs_check_knots(4, 7, five, 11, &err), LW_EINPUT);
   cr_assert(strstr(err.msg, "repeated more than k = 4 times"), "%s", err.msg);
+  /* the whole run of an inner knot (it said 4 of 5) */
+  double inner[13] = {0, 0, 0, 0, 0.5, 0.5, 0.5, 0.5, 0.5, 1, 1, 1, 1};
+  cr_assert_eq(lw_nurbs_check_knots(4, 9, inner, 13, &err), LW_EINPUT);
+  cr_assert(strstr(err.msg, "knot 0.5 is repeated 5 times inside: at most k - 1 = 3"), "%s", err.msg);
   /* a span of 1e-300 of the range made the energy NaN; knots of 1e300 the
   ** gravity's */
   double thin[11] = {0, 0, 0, 0, 1e-300, 0.5, 0.75, 1, 1, 1, 1};
