@@ -1478,7 +1478,11 @@ static int cmd_run(int argc, char **argv)
     for (size_t k = 0; k < lw_param_count; k++) given += a.params.line[k] != 0;
     if (!given && !a.params.of_run)
       fprintf(stderr, "linewise: note: %s sets no key: every value is the default (docs/PARAMETERS.md)\n", scene);
-    fprintf(stderr, "linewise: scene %s, seed %lu, %s, into %s\n", scene, a.seed, size, dir);
+    /* (a student's final.pdf of Inkscape's in the run's folder went with
+    ** the run it replaced, without a word) */
+    fprintf(stderr, "linewise: scene %s, seed %lu, %s, into %s%s\n", scene, a.seed, size, dir,
+            lw_runfiles_stashed(dir) ? ", replacing the run there: its files (any file of a run's name: final.pdf, "
+                                       "animation.mp4, frames/) go once this run's first sweep is done" : "");
     fprintf(stderr, "linewise: resolved parameters:\n");
     lw_params_write(&a.params, stderr);
   } else if (!out && (!net || !net->rank)) {

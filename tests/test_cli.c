@@ -1438,7 +1438,8 @@ Test(cli, a_file_of_the_run_replaced_is_no_input)
   cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out o --set scene.image=o/mine.png "
                           "--set anneal.sweeps=2 2> err.txt && test -f o/mine.png && ! test -e o/frames && "
                           "grep -q 'note: scene.image: no term of the energy reads the picture, so the drawing does "
-                          "not follow it' err.txt", dir, b, r), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+                          "not follow it' err.txt && grep -q 'into o, replacing the run there: its files' err.txt",
+                          dir, b, r), 0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
 /* A bundled scene named without its folder, from another directory (or

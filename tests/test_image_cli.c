@@ -1265,3 +1265,40 @@ Test(image_cli, a_redraw_from_a_runs_scene_notes_no_key_its_user_never_set)
                    sizeof errs), 0, "%s", errs);
   cr_assert_null(strstr(errs, "no effect"), "%s", errs);
 }
+
+/* Where the frame forbids lines the score takes the picture as paper: a
+** map's sea, dark in the picture and outside its mask, left empty as the
+** mask asks, scored as missing ink (SSIM 0.25 against 0.94 with the sea
+** transparent).  The same land beside a dark sea and beside a white one,
+** masked alike, now score alike; before, the dark sea's MSE was many times
+** the white's. */
+Test(image_cli, the_score_takes_what_the_mask_forbids_as_paper)
+{
+  const int w = 60, h = 40;
+  float *g = malloc(sizeof(float) * w * h), *m = malloc(sizeof(float) * w * h);
+  double mse[2];
+  for (int sea = 0; sea < 2; sea++) {
+    for (int j = 0; j < h; j++)
+      for (int i = 0; i < w; i++) {
+        const int land = i >= w / 2;
+        g[j * w + i] = land ? (float)(0.3 + 0.6 * (i - w / 2) / (w / 2)) : sea ? 0.15f : 1.0f;
+        m[j * w + i] = land ? 0.0f : 1.0f; /* dark = inside */
+      }
+    lw_test_png(lw_test_path("map.png"), w, h, g, NULL);
+    lw_test_png(lw_test_path("land.png"), w, h, m, NULL);
+    write_text("map.ini", "[scene]\nwidth = 64\nheight = 44\nmargin = 2\nimage = map.png\npotential = image\n"
+                          "boundary = mask\nmask = image\nmask_image = land.png\n[init]\nsplines = 30\nsegments = 3\n"
+                          "segment_length = 3\n[energy]\nstrain = 5\nbending = 1\npotential = 1\npair = 0.01\n"
+                          "boundary = 0.1\n[anneal]\nsweeps = 6\nseed = 4\n");
+    char errs[4096];
+    cr_assert_eq(run("run map.ini --out m --quiet", errs, sizeof errs), 0, "%s", errs);
+    char *js = lw_test_slurp("%s/m/summary.json", lw_test_dir), *at = js ? strstr(js, "\"mse\": ") : NULL;
+    cr_assert_not_null(at, "%s", js ? js : "no summary.json");
+    mse[sea] = atof(at + 7);
+    free(js);
+  }
+  free(g);
+  free(m);
+  cr_log_info("MSE with a white sea %g, with a dark one %g", mse[0], mse[1]);
+  cr_assert(mse[1] < 1.5 * mse[0] + 1e-3, "MSE with a dark sea %g, with a white one %g", mse[1], mse[0]);
+}
