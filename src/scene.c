@@ -162,6 +162,7 @@ static lw_grid2d *image_potential(const lw_scene *sc, const lw_image *img, const
 ** all over, and the advice (invert) left nothing to draw. */
 #define DARK_TONE 0.2  /* 80 % dark or darker */
 #define DARK_SHARE 0.5 /* of the picture's pixels in the frame, and of all of them */
+#define LIGHT_SHARE 0.25 /* of all of them 80 % light or lighter: paper around a graphic */
 static void dark_note(lw_scene *sc, const lw_params *p)
 {
   if (!sc->on[LW_TERM_TONE] && !(sc->on[LW_TERM_POTENTIAL] && p->potential == LW_POT_IMAGE)) return;
@@ -171,12 +172,13 @@ static void dark_note(lw_scene *sc, const lw_params *p)
   const int step = (int)ceil(sqrt((double)im->width * im->height / 250000.0));
   /* dark inside the frame, and in the picture as a whole: lettering masked
   ** by its own glyphs is all dark inside and wants just that */
-  size_t dark = 0, seen = 0, dark_all = 0, seen_all = 0;
+  size_t dark = 0, seen = 0, dark_all = 0, seen_all = 0, light_all = 0;
   for (int j = 0; j < im->height; j += step)
     for (int i = 0; i < im->width; i += step) {
       const size_t k = (size_t)j * (size_t)im->width + (size_t)i;
       seen_all++;
       dark_all += im->tone[k] <= DARK_TONE;
+      light_all += im->tone[k] >= 1.0 - DARK_TONE;
       if (!lw_boundary_inside(&sc->boundary, pl->x0 + (i + 0.5) * pl->pixel, pl->y0 + (j + 0.5) * pl->pixel))
         continue;
       seen++;
@@ -196,11 +198,16 @@ static void dark_note(lw_scene *sc, const lw_params *p)
     return;
   }
   if (!seen || (double)dark <= DARK_SHARE * (double)seen || (double)dark_all <= DARK_SHARE * (double)seen_all) return;
+  /* (a black disc on white, half the picture each: the note told its maker
+  ** to invert it, which turns the white surround dark) */
+  const int paper = (double)light_all >= LIGHT_SHARE * (double)seen_all;
   snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image: %.0f %% of the picture is %.0f %% dark or darker "
            "after its tone curve, so the lines there can only hatch evenly at their densest and little of the picture "
            "shows; scene.image_gamma below 1 lightens its mid-tones, %s (docs/IMAGES.md, \"What the preset does not "
            "draw\")", used ? "\n" : "", 100.0 * (double)dark / (double)seen, 100.0 * (1.0 - DARK_TONE),
            p->image_invert ? "scene.image_invert = 0 draws its dark parts (the inversion made it dark)"
+           : paper         ? "while a graphic of flat dark on white paper draws as it is (inverted, its paper would "
+                             "turn dark)"
                            : "scene.image_invert = 1 draws its light parts");
 }
 
@@ -746,9 +753,10 @@ static lw_status build_field(lw_scene *sc, const lw_params *p, double cx, double
       ** "100 %" where field_flat itself left "over 99 %") */
       char share[32] = "all";
       if (gentle[0] < 1.0) snprintf(share, sizeof share, "over %d %%", (int)(100.0 * gentle[0]));
-      used += (size_t)snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field_flat: %s of the picture "
-                               "its tone changes, but slower than field_flat (%g tone/mm), where the field %s; a "
-                               "smaller field_flat follows a smooth picture there (", used ? "\n" : "", share,
+      used += (size_t)snprintf(sc->note + used, sizeof sc->note - used, "%sscene.field_flat: on %s of the picture "
+                               "the tone changes slower than field_flat (%g tone/mm) or not at all, and there the "
+                               "field %s; where that is a smooth picture, not flat colour, a smaller field_flat "
+                               "follows it (", used ? "\n" : "", share,
                                p->field_flat, p->field == LW_FLD_ETF ? "turns to field_angle" : "fades to 0");
       for (int k = 1; k < LW_IMAGEFIELD_GENTLE && used < sizeof sc->note; k++)
         used += (size_t)snprintf(sc->note + used, sizeof sc->note - used, "%s%g leaves %d %%", k > 1 ? ", " : "",

@@ -488,9 +488,10 @@ Test(fieldfile, a_picture_smoother_than_field_flat_gets_a_note)
       else
         /* with the value that follows it (the ramp's 0.0044 tone/mm); all of
         ** it, not "over 100 %" */
-        cr_assert(strstr(sc.note, "scene.field_flat: all of the picture its tone changes") &&
+        cr_assert(strstr(sc.note, "scene.field_flat: on all of the picture the tone changes slower than "
+                                  "field_flat") &&
                   strstr(sc.note, field == LW_FLD_ETF ? "turns to field_angle" : "fades to 0") &&
-                  strstr(sc.note, "smooth picture there (0.001 leaves 0 %, 0.0001 leaves 0 %; docs/IMAGES.md)"),
+                  strstr(sc.note, "follows it (0.001 leaves 0 %, 0.0001 leaves 0 %; docs/IMAGES.md)"),
                   "%s", sc.note);
       lw_scene_clear(&sc);
     }

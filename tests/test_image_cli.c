@@ -712,6 +712,8 @@ Test(image_cli, a_picture_dark_nearly_all_over_gets_a_note)
     lw_test_png(lw_test_path("logo.png"), PICTURE_W, PICTURE_H, g, a);
     picture_scene("logo.png", "[energy]\ntone = 1\n", &sc);
     cr_assert_eq(strstr(sc.note, "dark or darker") != NULL, c == 1, "%d fifths: %s", opaque_fifths[c], sc.note);
+    /* its paper two fifths: no advice to invert it (the paper turns dark) */
+    cr_assert(!strstr(sc.note, "image_invert = 1") && (c == 0 || strstr(sc.note, "draws as it is")), "%s", sc.note);
     lw_scene_clear(&sc);
   }
 }
