@@ -830,7 +830,8 @@ static void idle_keys(const lw_anneal *a, char *idle, size_t size)
        "a constant schedule keeps the rungs at the ladder"},
       {polygon, p->boundary != LW_BND_POLYGON, "scene.boundary is not polygon"},
       {mask, lw_params_file_idle(p, lw_params_find("scene", "mask_image")), "scene.mask is not image"},
-      {field_file, p->field != LW_FLD_FILE, "scene.field is not file"},
+      /* (under energy.field = 0 the system's rule names them) */
+      {field_file, p->field != LW_FLD_FILE && p->field_coef != 0.0, "scene.field is not file"},
       /* (the photo preset's own auto, which a run's scene.ini holds: a redraw
       ** from it noted a key its user never set) */
       {orientation, p->page == LW_PAGE_CUSTOM && !(p->preset == LW_PRESET_PHOTO && p->orientation == LW_ORIENT_AUTO),

@@ -1440,7 +1440,8 @@ static int idle(const lw_params *p, lw_idle_rule rule[LW_IDLE_RULES_MAX])
   ** random strokes without a word) */
   static const char *const field[] = {"scene.field", "scene.field_angle", "scene.field_sigma", "scene.field_flat",
                                       "scene.field_wavelength", "scene.field_amplitude", "scene.field_core",
-                                      "energy.field_mode",
+                                      "energy.field_mode", "scene.field_file", "scene.field_file_y",
+                                      "scene.field_file_scale", "scene.field_file_layout",
                                       "layers.turn", NULL},
                            *const potential[] = {"scene.potential", "scene.potential_value", "scene.potential_angle",
                                                  "scene.potential_scale", "scene.potential_power",

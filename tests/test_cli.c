@@ -1414,6 +1414,21 @@ Test(cli, a_key_set_twice_takes_the_last_value)
                           dir, b, r, b, b, r), 0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
+/* A field file without the field term is named in the note of keys without
+** effect, as the field's other keys are (it was left out), and once only
+** where the field is not file either. */
+Test(cli, a_field_file_without_the_field_term_is_noted)
+{
+  const char *b = lw_test_bin(), *r = lw_test_root();
+  write_file("f.txt", "1 0 1 0\n1 0 1 0\n");
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out o --set anneal.sweeps=0 --set scene.field=%s "
+                          "--set scene.field_file=f.txt 2> err.txt && grep -c 'scene.field_file (--set: energy.field "
+                          "= 0)' err.txt > n.txt && grep -qx 1 n.txt && %s run %s/params/minimal.ini --out o2 "
+                          "--set anneal.sweeps=0 --set scene.field=vortex --set energy.field=-1 --set "
+                          "scene.field_file=f.txt 2> err.txt && grep -q 'scene.field_file (--set: scene.field is not "
+                          "file)' err.txt", dir, b, r, "file", b, r), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+}
+
 /* A picture taken from the run a run replaces (its final.png, a frame) was
 ** gone when the run was resumed: refused, the run there kept; a file of the
 ** user's in the directory is no run file and draws, with the note that no
