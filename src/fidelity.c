@@ -558,6 +558,54 @@ static lw_status orientation(const double *a, const double *b, int w, int h, dou
   return s;
 }
 
+/* Step 6: the share of the marks (darkness of LW_FIDELITY_MARK black or
+** more, unblurred) with no inked pixel (covered LW_FIDELITY_INKED or more)
+** within rx, ry pixels along each axis: a square about each, by a running
+** count along the rows, then the columns, of the inked pixels. */
+static lw_status missed_marks(const double *ink, const double *dark, int w, int h, double rx, double ry, double black,
+                              double *missed, lw_error *err)
+{
+  const size_t n = (size_t)w * (size_t)h;
+  const int ax = (int)ceil(rx), ay = (int)ceil(ry);
+  int *row = malloc(n * sizeof *row), *col = malloc(n * sizeof *col);
+  if (!row || !col) {
+    free(row);
+    free(col);
+    return lw_error_set(err, LW_ENOMEM, "fidelity: out of memory for %d x %d pixels", w, h);
+  }
+  /* row[k]: inked pixels within ax along the row; col[k]: rows within ay of k
+  ** holding such a pixel there */
+  for (int j = 0; j < h; j++) {
+    int c = 0;
+    const double *in = ink + (size_t)j * (size_t)w;
+    for (int i = 0; i < ax && i < w; i++) c += in[i] >= LW_FIDELITY_INKED;
+    for (int i = 0; i < w; i++) {
+      if (i + ax < w) c += in[i + ax] >= LW_FIDELITY_INKED;
+      if (i - ax - 1 >= 0) c -= in[i - ax - 1] >= LW_FIDELITY_INKED;
+      row[(size_t)j * (size_t)w + (size_t)i] = c;
+    }
+  }
+  for (int i = 0; i < w; i++) {
+    int c = 0;
+    for (int j = 0; j < ay && j < h; j++) c += row[(size_t)j * (size_t)w + (size_t)i] > 0;
+    for (int j = 0; j < h; j++) {
+      if (j + ay < h) c += row[(size_t)(j + ay) * (size_t)w + (size_t)i] > 0;
+      if (j - ay - 1 >= 0) c -= row[(size_t)(j - ay - 1) * (size_t)w + (size_t)i] > 0;
+      col[(size_t)j * (size_t)w + (size_t)i] = c;
+    }
+  }
+  size_t marks = 0, bare = 0;
+  for (size_t k = 0; k < n; k++)
+    if (dark[k] >= LW_FIDELITY_MARK * black) {
+      marks++;
+      bare += col[k] == 0;
+    }
+  *missed = marks ? (double)bare / (double)marks : 0.0;
+  free(row);
+  free(col);
+  return LW_OK;
+}
+
 lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, double sy, double white,
                               lw_fidelity *out, lw_error *err)
 {
@@ -610,7 +658,9 @@ lw_status lw_fidelity_compute_strokes(const lw_strokes *st, int pen, const lw_gr
     double t = tone->data[k];
     dark[k] = black * (1.0 - (t < 0 ? 0 : t > 1 ? 1 : t));
   }
-  if (!(s = lw_fidelity_render_strokes(st, pen, tone, pen_width_mm, ink, err)))
+  if (!(s = lw_fidelity_render_strokes(st, pen, tone, pen_width_mm, ink, err)) &&
+      !(s = missed_marks(ink, dark, tone->nx, tone->ny, LW_FIDELITY_MISS_REACH * pen_width_mm / tone->hx,
+                         LW_FIDELITY_MISS_REACH * pen_width_mm / tone->hy, black, &out->missed, err)))
     s = lw_fidelity_compare(ink, dark, tone->nx, tone->ny, sigma_mm / tone->hx, sigma_mm / tone->hy,
                             LW_FIDELITY_WHITE * black, out, err);
   out->sigma_mm = sigma_mm;

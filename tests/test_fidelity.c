@@ -300,6 +300,37 @@ Test(fidelity, stray_ink_is_ink_far_inside_the_white)
   lw_grid2d_free(tone);
 }
 
+/* Missed marks, stray ink's mirror: two dark bars 0.5 mm wide (a 0.3 mm
+** pen); a line along the first alone misses the second (half the marks),
+** along both none; a line 0.3 mm beside each still reaches it (all of it
+** within 3 pen widths), one 1.5 mm off not. */
+Test(fidelity, missed_marks_are_dark_pixels_no_line_came_near)
+{
+  const double px = 0.1, pen = 0.3;
+  const int w = 300, h = 200; /* 30 x 20 mm */
+  lw_grid2d *tone = lw_grid2d_new(w, h, 1, 0.5 * px, 0.5 * px, px, px, NULL);
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) {
+      const double x = (i + 0.5) * px;
+      tone->data[j * w + i] = (x > 5 && x < 5.5) || (x > 20 && x < 20.5) ? 0.0 : 1.0;
+    }
+  static const struct {
+    int n;
+    double x[2], want;
+  } cases[] = {{1, {5.25, 0}, 0.5}, {2, {5.25, 20.25}, 0.0}, {2, {4.7, 20.8}, 0.0}, {2, {3.5, 22}, 1.0}};
+  for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+    size_t segs[2] = {1, 1};
+    lw_splines *sp = lw_splines_new((size_t)cases[k].n, segs, NULL);
+    for (int i = 0; i < cases[k].n; i++) lw_test_straight(sp, (size_t)i, cases[k].x[i], 0, cases[k].x[i], 20);
+    lw_fidelity f;
+    cr_assert_eq(lw_fidelity_compute(sp, tone, pen, 1.0, &f, NULL), LW_OK);
+    /* (within the pixels a line's rendered width spans) */
+    cr_assert(fabs(f.missed - cases[k].want) < 1e-12, "case %zu: missed %g, expected %g", k, f.missed, cases[k].want);
+    lw_splines_free(sp);
+  }
+  lw_grid2d_free(tone);
+}
+
 Test(fidelity, bad_input)
 {
   lw_splines *sp = lw_splines_new(0, NULL, NULL);

@@ -456,7 +456,7 @@ Test(tools, a_sweep_of_a_picture_gathers_the_drawings_scores)
   snprintf(path, sizeof path, "%s/p/sweep.csv", dir);
   csv_read(&t, path);
   const char *want_cols[] = {"close_share", "fidelity_mse", "fidelity_ssim", "fidelity_orientation",
-                             "fidelity_stray", "fidelity_black"};
+                             "fidelity_stray", "fidelity_missed", "fidelity_black"};
   for (size_t i = 0; i < sizeof want_cols / sizeof *want_cols; i++)
     cr_assert(col(&t, want_cols[i]) >= 0, "no column %s", want_cols[i]);
   cr_assert_eq(t.nrow, 2);

@@ -49,6 +49,14 @@
 **    target leaves white for about two sigmas around, so a line along the
 **    edge of a dark area does not count and one across a white background
 **    does.  0 for a drawing without ink.
+** 6. Missed marks, stray ink's mirror: the share of the target's dark pixels
+**    (darkness LW_FIDELITY_MARK of black or more, unblurred) with no inked
+**    pixel (covered LW_FIDELITY_INKED or more) within LW_FIDELITY_MISS_REACH
+**    pen widths along x and y.  A dark area hatched at its density (lines
+**    at most 2.9 pen widths apart at that darkness) has a line within 1.5
+**    widths of every pixel; a mark no line came near -- a letter thinner
+**    than the blurs see -- counts whole, which MSE and SSIM, blurred, barely
+**    see (hairline letters half undrawn scored SSIM 0.94).  0 without marks.
 **
 ** The drawing is scored as plotted (strokes.h: joined, cropped, dropped);
 ** a pen's score renders that pen's paths alone against the same target.
@@ -73,17 +81,21 @@ extern "C" {
 #define LW_FIDELITY_FINE_MAX 16777216.0 /* the fine render's most pixels */
 #define LW_FIDELITY_SIDE_MAX 32767    /* the most pixels a side cairo renders: a longer picture cannot be scored */
 #define LW_FIDELITY_WHITE 0.02        /* blurred darkness under which the target is white paper */
+#define LW_FIDELITY_MARK 0.7          /* darkness (of black) from which a target pixel is a mark */
+#define LW_FIDELITY_INKED 0.25        /* a pixel's ink from which it counts as inked */
+#define LW_FIDELITY_MISS_REACH 3.0    /* pen widths within which a mark's line must lie */
 
 typedef struct {
   double mse;       /* mean squared difference of blurred ink and darkness */
   double ssim;      /* mean structural similarity, -1..1 */
   double orientation; /* orientation agreement, -1..1 (NaN: flat target) */
   double stray;     /* share of the ink on white paper, 0..1 */
+  double missed;    /* share of the dark marks with no line near, 0..1 */
   double sigma_mm;  /* the blur used, mm */
   double black;     /* the ink the target asks where the picture is black, 0..1 */
 } lw_fidelity;
 
-/* Steps 1-5 above for the splines against the tone raster, black 1 (solid
+/* Steps 1-6 above for the splines against the tone raster, black 1 (solid
 ** ink where the picture is black), pen width and blur sigma in mm.
 ** LW_EINPUT for a raster that is not one value per pixel or a width or
 ** sigma that is not positive, LW_ENOMEM. */
@@ -101,7 +113,7 @@ lw_status lw_fidelity_render(const lw_splines *sp, const lw_grid2d *tone, double
 lw_status lw_fidelity_render_strokes(const lw_strokes *s, int pen, const lw_grid2d *tone, double pen_width_mm,
                                      double *ink, lw_error *err);
 
-/* Steps 2-5 for the ink a and the darkness b, w x h (changed in place: blurred),
+/* Steps 2-5 (not 6: lw_fidelity_compute_strokes counts the missed marks) for the ink a and the darkness b, w x h (changed in place: blurred),
 ** blur sigma sx, sy in pixels (0 = none), paper white where the blurred b is
 ** under `white`; out->sigma_mm and out->black are left alone. */
 lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, double sy, double white,
