@@ -144,10 +144,11 @@ static void options(const lw_params *p, const lw_scene *sc, const lw_output_page
 ** sea, a circle's corners (a cartographer's map, its sea empty as the mask
 ** asks, scored SSIM 0.25 for the ink it had no leave to draw, 0.94 against
 ** the same picture with the sea transparent).  NULL where the frame is the
-** page's rectangle (nothing of the picture lies outside it) or memory fails. */
+** page's rectangle (nothing of the picture lies outside it), where it
+** forbids nothing (energy.boundary = 0: lines may leave it) or memory fails. */
 static lw_grid2d *paper_outside(const lw_params *p, const lw_scene *sc, const lw_grid2d *tone, lw_error *err)
 {
-  if (p->boundary == LW_BND_RECT) return NULL;
+  if (p->boundary == LW_BND_RECT || p->boundary_coef == 0.0) return NULL;
   lw_grid2d *g = lw_grid2d_new(tone->nx, tone->ny, 1, tone->x0, tone->y0, tone->hx, tone->hy, err);
   if (!g) return NULL;
   for (int j = 0; j < tone->ny; j++)
@@ -173,7 +174,7 @@ static lw_status score(const lw_params *p, const lw_scene *sc, const lw_strokes 
   if (ref) {
     tone = ref;
     snprintf(rep->reference, sizeof rep->reference, "%s", p->fidelity_reference);
-  } else if (tone && p->boundary != LW_BND_RECT) {
+  } else if (tone && p->boundary != LW_BND_RECT && p->boundary_coef != 0.0) {
     if (!(ref = paper_outside(p, sc, tone, err))) s = err ? err->code : LW_ENOMEM;
     else tone = ref;
   }
@@ -191,7 +192,7 @@ static lw_status score(const lw_params *p, const lw_scene *sc, const lw_strokes 
       lw_grid2d_free(g);
       g = in;
     }
-    if (!g || (!in && p->boundary != LW_BND_RECT)) {
+    if (!g || (!in && p->boundary != LW_BND_RECT && p->boundary_coef != 0.0)) {
       lw_grid2d_free(g);
       s = err ? err->code : LW_ENOMEM;
       break;

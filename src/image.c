@@ -1439,11 +1439,13 @@ lw_status lw_image_levels(lw_image *img, const float *under, double clip, int fl
     if (!l_flat) l = bl;
     if (!h_flat) h = bh;
     /* an end left alone keeps its flat colour from turning white or black
-    ** whole, but with the other end stretched up to it, it went to the
-    ** other side: a DEM's flat sea at 0.458, its land up to 0.464, made
-    ** 0.99 (white) with l at 0; there it is stretched as any end */
-    if (flat >= 2 && l_flat && !h_flat && (bl - l) / (h - l) > 0.5) l = bl;
-    if (flat >= 2 && h_flat && !l_flat && (bh - l) / (h - l) < 0.5) h = bh;
+    ** whole, but with the other end stretched up to it, it crossed the
+    ** middle tone: a DEM's flat sea at 0.458, its land up to 0.464, made
+    ** 0.99 (white) with l at 0; there it is stretched as any end (a flat
+    ** colour that stays on its side of the middle, dark or light, is left
+    ** alone: one that went white that way was what the rule is for) */
+    if (flat >= 2 && l_flat && !h_flat && (bl < 0.5) != ((bl - l) / (h - l) < 0.5)) l = bl;
+    if (flat >= 2 && h_flat && !l_flat && (bh < 0.5) != ((bh - l) / (h - l) < 0.5)) h = bh;
   }
   free(hist);
   if (h - l < LW_IMAGE_LEVELS_MIN_SPAN) {

@@ -142,7 +142,9 @@ static int set_later(char **argv, int argc, int i)
   const char *name = argv[i + 1], *eq = strchr(name, '=');
   if (!eq) return 0;
   for (int j = i + 2; j + 1 < argc; j++)
-    if (!strcmp(argv[j], "--set") && !strncmp(argv[j + 1], name, (size_t)(eq - name) + 1)) return 1;
+    if ((!strcmp(argv[j], "--set") && !strncmp(argv[j + 1], name, (size_t)(eq - name) + 1)) ||
+        (!strcmp(argv[j], "--seed") && !strncmp(name, "anneal.seed=", 12)))
+      return 1;
   return 0;
 }
 
@@ -1270,7 +1272,7 @@ static int cmd_run(int argc, char **argv)
   lw_error_clear(&err);
   const char *scene = NULL, *out = NULL;
   long stop_at = -1, seed = -1;
-  int quiet = 0;
+  int quiet = 0, scene_split = 0;
   static lw_params p;
   /* the scene file first, so --set applies on top of it whatever the order */
   for (int i = 0; i < argc; i++) {
@@ -1297,16 +1299,18 @@ static int cmd_run(int argc, char **argv)
       return fail(&err);
     }
     if (argv[i][0] != '-') {
+      const int split_here = i >= 2 && !strcmp(argv[i - 2], "--set");
       if (scene) {
         /* (--set scene.image=my photo.jpg, or --set scene.page = a5: the
-        ** shell split the value) */
-        const int split = i >= 2 && !strcmp(argv[i - 2], "--set");
+        ** shell split the value, before the scene file or after it) */
+        const int split = split_here || scene_split;
         lw_error_set(&err, LW_EUSAGE, "run: one scene file expected, got '%s' and '%s'%s", scene, argv[i],
                      split ? " (after --set: no blanks around '=', and a value with blanks in quotes, "
                              "--set 'scene.image=my photo.jpg')" : "");
         return fail(&err);
       }
       scene = argv[i];
+      scene_split = split_here;
     }
   }
   if (!scene) {
@@ -1482,7 +1486,8 @@ static int cmd_run(int argc, char **argv)
     ** the run it replaced, without a word) */
     fprintf(stderr, "linewise: scene %s, seed %lu, %s, into %s%s\n", scene, a.seed, size, dir,
             lw_runfiles_stashed(dir) ? ", replacing the run there: its files (any file of a run's name: final.pdf, "
-                                       "animation.mp4, frames/) go once this run's first sweep is done" : "");
+                                       "animation.mp4, frames/frame-N.png) go once this run's first sweep is done"
+                                     : "");
     fprintf(stderr, "linewise: resolved parameters:\n");
     lw_params_write(&a.params, stderr);
   } else if (!out && (!net || !net->rank)) {

@@ -124,8 +124,9 @@ const lw_param_def lw_param_table[] = {
       "image_levels on a flat colour: 1 = an end is left alone where one tone holds more than 5 % of the "
       "pixels with no more than 5 % beyond it (a graphic's lightest colour past whose anti-aliased edge or "
       "JPEG ringing the clip fell turned white whole); 2 = so, but an end whose flat colour the other end's "
-      "stretch would carry past the middle tone is stretched as any (a low-contrast elevation model's flat "
-      "sea, its darkest, turned white with the whole picture under 1), as runs before 2026-12-07 did not; "
+      "stretch would carry across the middle tone, from its side to the other, is stretched as any (a "
+      "low-contrast elevation model's flat sea, its darkest, turned white with the whole picture under 1), as "
+      "runs before 2026-12-07 did not; "
       "0 = only where the clip falls on such a tone, as runs before this key (a run of theirs, whose "
       "scene.ini has no line for this key, resumes so)."),
   NUM("scene", "image_gamma", LW_PT_DOUBLE, image_gamma, "1", "", 0, 100, LW_MIN_OPEN,
@@ -1080,8 +1081,8 @@ static void typed_hint(const lw_param_def *d, const char *text, char *hint, size
   if (len >= 2 && strchr("\"'", text[0]) && text[len - 1] == text[0])
     snprintf(hint, n, " (without the quotes)");
   else if (word && (*rest == '#' || (*rest == ';' && rest == text + word)))
-    snprintf(hint, n, " (a comment after a value starts with ';' after a blank: '%.*s ; ...')",
-             (int)(word < 16 ? word : 16), text);
+    snprintf(hint, n, " (the value alone: in a scene file a comment after it starts with ';' after a blank, "
+             "'%.*s ; ...'; --set takes none)", (int)(word < 16 ? word : 16), text);
   else if (numeric && lead && (isalpha((unsigned char)*rest) || *rest == '%'))
     snprintf(hint, n, " (the number alone%s%s)", strlen(d->unit) > 1 ? ": it is in " : "",
              strlen(d->unit) > 1 ? d->unit : "");
@@ -1101,7 +1102,7 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     double v;
     const int whole = d->type != LW_PT_DOUBLE;
     range_text(d, range, sizeof range);
-    char hint[96];
+    char hint[192];
     const int thousands = lw_number_separator_hint(text, whole, hint, sizeof hint);
     if (!lw_number_parse(text, &v) || thousands) {
       if (!hint[0]) typed_hint(d, text, hint, sizeof hint);
@@ -1127,7 +1128,7 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
     if (idx < 0) {
       /* (a page named as printed, "A4", was refused without a word of why) */
       const int folded = choice_index_cased(d->choices, text, 1);
-      char word[64] = "", hint[96];
+      char word[64] = "", hint[192];
       if (folded >= 0) choice_name(d->choices, folded, word, sizeof word);
       typed_hint(d, text, hint, sizeof hint);
       snprintf(expected, n, "one of %s%s%s%s%s", d->choices, folded >= 0 ? " (in lower case: '" : "", word,
@@ -1188,7 +1189,7 @@ static int assign(lw_params *p, const lw_param_def *d, const char *text, char *e
 void lw_params_defaults(lw_params *p)
 {
   memset(p, 0, sizeof *p);
-  char expected[256];
+  char expected[512];
   for (size_t i = 0; i < lw_param_count; i++) assign(p, &lw_param_table[i], lw_param_table[i].def, expected, sizeof expected);
 }
 
@@ -1444,7 +1445,7 @@ static int on_key(void *user, const char *section, const char *key, const char *
                  rc->p->file, rc->line, section, key, *line);
     return 0;
   }
-  char expected[256], unseen[96];
+  char expected[512], unseen[96];
   if (!assign(rc->p, d, value, expected, sizeof expected)) {
     lw_error_set(rc->err, LW_EINPUT, "%s:%d: key '%s.%s': expected %s, got '%s'%s",
                  rc->p->file, rc->line, section, key, expected, value,
@@ -1624,7 +1625,7 @@ static const struct {
 static void preset_key(lw_params *p, const char *section, const char *key, const char *text)
 {
   const lw_param_def *d = lw_params_find(section, key);
-  char expected[256];
+  char expected[512];
   if (d && !p->line[d - lw_param_table]) assign(p, d, text, expected, sizeof expected);
 }
 
@@ -1915,7 +1916,7 @@ lw_status lw_params_set(lw_params *p, const char *assignment, lw_error *err)
                         "--set %s.%s: not a parameter%s (see `linewise params` or docs/PARAMETERS.md)%s", section, key,
                         hint, lw_text_unseen_char(name, unseen, sizeof unseen));
   }
-  char expected[256], unseen[96];
+  char expected[512], unseen[96];
   const char *v = eq + 1;
   const size_t lv = strlen(v);
   /* (a scene file's values lose their blanks; a tab showed as '?') */

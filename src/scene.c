@@ -232,12 +232,13 @@ static void thin_note(lw_scene *sc, const lw_params *p, const char *key, const l
 
 /* A picture that no term of the energy reads: it places the splines' start
 ** and scores the drawing, but the annealing does not follow it (a scene of
-** "[scene] image = photo.jpg" alone drew random lines without a word). */
+** "[scene] image = photo.jpg" alone drew random lines without a word;
+** layers read it through the same terms, each its own target). */
 static void unread_picture_note(lw_scene *sc, const lw_params *p)
 {
   const int read = sc->on[LW_TERM_TONE] || (sc->on[LW_TERM_POTENTIAL] && p->potential == LW_POT_IMAGE) ||
                    (sc->on[LW_TERM_FIELD] && (p->field == LW_FLD_ETF || p->field == LW_FLD_GRADIENT)) ||
-                   (p->boundary == LW_BND_MASK && p->mask == LW_MASK_ALPHA) || p->ly_names[0];
+                   (p->boundary == LW_BND_MASK && p->mask == LW_MASK_ALPHA);
   if (read) return;
   size_t used = strlen(sc->note);
   snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image: no term of the energy reads the picture, so the "

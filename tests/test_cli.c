@@ -1370,12 +1370,14 @@ Test(cli, a_students_slips_are_said_with_the_way_out)
     ** bytes (a failed save drew 100 random lines) */
     {"run u.ini", "u.ini:2: key 'scene.margin': expected a number >= 0 and <= 10000000 (the number alone: it is in "
      "mm), got '10mm'"},
-    {"run c.ini", "c.ini:2: key 'scene.margin': expected a number >= 0 and <= 10000000 (a comment after a value starts "
-     "with ';' after a blank: '10 ; ...'), got '10 # mm'"},
+    {"run c.ini", "c.ini:2: key 'scene.margin': expected a number >= 0 and <= 10000000 (the value alone: in a scene "
+     "file a comment after it starts with ';' after a blank, '10 ; ...'; --set takes none), got '10 # mm'"},
     {"run %s/params/minimal.ini --set \"scene.boundary='circle'\"", "(without the quotes), got ''circle''"},
     {"run %s/params/minimal.ini --set output.pdf=yes", "expected a whole number >= 0 and <= 1 (0 = off, 1 = on), got "
      "'yes'"},
     {"run %s/params/minimal.ini --set scene.image=my photo.jpg", "run: one scene file expected, got '"},
+    {"run --set scene.image=my photo.jpg %s/params/minimal.ini", "(after --set: no blanks around '=', and a value with "
+     "blanks in quotes"},
     {"resume q.ini", "resume: 'q.ini': a file, not a directory; expected the directory a run wrote"},
     {"energy nothere", "energy: 'nothere': No such file or directory; expected the directory a run wrote"},
     {"run z.ini", "z.ini: empty (0 bytes): expected a scene file (a line '[scene]' alone takes every default)"},
@@ -1410,8 +1412,10 @@ Test(cli, a_key_set_twice_takes_the_last_value)
                           "--set scene.width=120 --quiet && grep -qx 'width = 120' o/scene.ini && "
                           "%s energy o --set energy.quadrature=1 --set energy.quadrature=12 > e.txt && grep -q '^total ' e.txt "
                           "&& { %s run %s/params/minimal.ini --out o2 --set scene.width=120 --set scene.width=0.5 "
-                          "2> err.txt; test $? -eq 2; } && grep -q \"scene.width': expected a value >= 1\" err.txt",
-                          dir, b, r, b, b, r), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+                          "2> err.txt; test $? -eq 2; } && grep -q \"scene.width': expected a value >= 1\" err.txt "
+                          "&& %s run %s/params/minimal.ini --out o3 --set anneal.seed=-3 --seed 5 --set anneal.sweeps=1 "
+                          "--quiet && grep -qx 'seed = 5' o3/scene.ini",
+                          dir, b, r, b, b, r, b, r), 0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
 /* A field file without the field term is named in the note of keys without

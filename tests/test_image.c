@@ -635,6 +635,15 @@ Test(image, a_flat_end_is_not_carried_across_the_middle)
   for (int k = 0; k < n; k++) img->tone[k] = (float)(k < 600 ? 1.0 : 0.2 + 0.4 * (k - 600) / 399.0);
   cr_assert_eq(lw_image_levels(img, NULL, 0.01, 2, &lo, &hi, NULL), LW_OK);
   cr_assert(hi == 1.0 && img->tone[0] == 1.0f && lo > 0.2, "levels %g to %g", lo, hi);
+  /* a flat colour on its own side of the middle stays there, left alone: a
+  ** flat 0.35 as the lightest of a dark logo (60 % from 0 to 0.2) went white,
+  ** a flat 0.6 as the darkest of a pale one (60 % from 0.8 to 1) black */
+  for (int k = 0; k < n; k++) img->tone[k] = (float)(k < 400 ? 0.35 : 0.2 * (k - 400) / 599.0);
+  cr_assert_eq(lw_image_levels(img, NULL, 0.01, 2, &lo, &hi, NULL), LW_OK);
+  cr_assert(hi == 1.0 && img->tone[0] < 0.5, "dark logo: levels %g to %g, its flat colour %g", lo, hi, img->tone[0]);
+  for (int k = 0; k < n; k++) img->tone[k] = (float)(k < 400 ? 0.6 : 0.8 + 0.2 * (k - 400) / 599.0);
+  cr_assert_eq(lw_image_levels(img, NULL, 0.01, 2, &lo, &hi, NULL), LW_OK);
+  cr_assert(lo == 0.0 && img->tone[0] > 0.5, "pale logo: levels %g to %g, its flat colour %g", lo, hi, img->tone[0]);
   lw_image_free(img);
 }
 

@@ -147,7 +147,8 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
 ** pixels a tone; with `flat` >= 1, also where such a tone has no more than
 ** LW_IMAGE_LEVELS_PLATEAU of the pixels beyond it (anti-aliasing or a JPEG's
 ** ringing past a flat colour); with `flat` 2, a flat end whose colour the
-** other end's stretch would carry past the middle tone is stretched as any
+** other end's stretch would carry across the middle tone (from its side to
+** the other) is stretched as any
 ** (a low-contrast elevation model's flat sea, its darkest, went white with
 ** all the rest).  scene.image_levels_flat: 0 for runs begun before it, 1
 ** before 2026-12-07.  *lo and *hi receive the tones that became 0 and 1.
