@@ -458,6 +458,9 @@ static size_t nearest_of(const double *u, size_t m, double v)
 static long header_names(char *line, char *names[64])
 {
   long n = 0;
+  static char index_column[] = "";
+  /* pandas' to_csv: ",x,y,u,v", its index column unnamed */
+  if (line[strspn(line, " \t")] == ',') names[n++] = index_column;
   for (char *c = line; *c && n < 64;) {
     c += strspn(c, " \t,;=");
     if (!*c) break;
@@ -468,6 +471,13 @@ static long header_names(char *line, char *names[64])
       c += strcspn(c, q == '"' ? "\"" : "'");
     } else {
       c += strcspn(c, " \t,;=");
+      /* a unit after the name, unquoted ("x [m],y [m]"): part of it */
+      char *unit = c + strspn(c, " \t"), *close = NULL;
+      if (*unit == '[' || *unit == '(') close = strchr(unit, *unit == '[' ? ']' : ')');
+      if (close) {
+        *c = '\0';
+        c = close;
+      }
     }
     const int more = *c != '\0';
     *c = '\0';
@@ -559,9 +569,10 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
           odd_line = line;
           odd_count = count;
           memcpy(odd_named, named, sizeof odd_named);
-          /* a header more than a title: it names a column, or its names
-          ** are a CSV's or quoted */
-          odd_header = named[0] >= 0 || named[1] >= 0 || named[2] >= 0 || named[3] >= 0 || strpbrk(buf, ",\"'");
+          /* a header more than a title: it names two of the columns (a
+          ** title's words, "Wake flow, Re 100", "flow in x direction",
+          ** name one at most) */
+          odd_header = (named[0] >= 0) + (named[1] >= 0) + (named[2] >= 0) + (named[3] >= 0) >= 2;
         }
         a.n = before;
         s = LW_OK;
@@ -641,6 +652,27 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
         while (node[first] != node[k]) first++;
         s = lw_error_set(err, LW_EINPUT, "%s:%ld: the point at (%g, %g) is there twice (first on line %ld): expected "
                          "every node of a regular grid once", path, at[k], pt[col[0]], pt[col[1]], at[first]);
+      }
+      /* a column or row of few points is a mistyped coordinate more likely
+      ** than many nodes missing ("2.0001" for 2 was said to leave a node at
+      ** (2.0001, 0) without a point) */
+      if (!s && n < nx * ny) {
+        size_t *per = calloc(nx + ny, sizeof *per), few = SIZE_MAX, which = 0;
+        if (!per) s = lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu points", path, n);
+        for (size_t k = 0; per && k < n; k++) per[node[k] % nx]++, per[nx + node[k] / nx]++;
+        for (size_t c = 0; per && c < nx + ny; c++)
+          if (per[c] < few && 2 * per[c] < (c < nx ? ny : nx)) few = per[c], which = c;
+        const int row = which >= nx;
+        for (size_t k = 0; per && few != SIZE_MAX && k < n; k++)
+          if (row ? node[k] / nx == which - nx : node[k] % nx == which) {
+            const double *pt = a.v + k * (size_t)width;
+            s = lw_error_set(err, LW_EINPUT, "%s:%ld: the point at (%g, %g) lies off the grid the others make: its %s "
+                             "is that of %zu point%s, where a %s of the grid holds %zu (a mistyped coordinate?)", path,
+                             at[k], pt[col[0]], pt[col[1]], row ? "y" : "x", few, few == 1 ? "" : "s",
+                             row ? "row" : "column", row ? nx : ny);
+            break;
+          }
+        free(per);
       }
       for (size_t m = 0; !s && n < nx * ny && m < nx * ny; m++)
         if (!seen[m])

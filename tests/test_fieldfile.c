@@ -529,6 +529,9 @@ Test(fieldfile, a_list_of_points_reads_onto_its_grid)
     "4,1,7,12,-12.5,9\n",
     "nodenumber, x-coordinate, y-coordinate, x-velocity, y-velocity\n1,0,0,0,-0.5\n2,2,0,1,-1.5\n3,4,0,2,-2.5\n"
     "4,0,1,10,-10.5\n5,2,1,11,-11.5\n6,4,1,12,-12.5\n",
+    /* units unquoted (a spreadsheet's), and pandas' unnamed index column */
+    "x [m],y [m],u (m/s),v (m/s)\n0,0,0,-0.5\n2,0,1,-1.5\n4,0,2,-2.5\n0,1,10,-10.5\n2,1,11,-11.5\n4,1,12,-12.5\n",
+    ",x,y,u,v\n0,0,0,0,-0.5\n1,2,0,1,-1.5\n2,4,0,2,-2.5\n3,0,1,10,-10.5\n4,2,1,11,-11.5\n5,4,1,12,-12.5\n",
   };
   for (size_t k = 0; k < sizeof named / sizeof *named; k++) {
     lw_test_write(path, named[k], strlen(named[k]));
@@ -546,12 +549,19 @@ Test(fieldfile, a_list_of_points_reads_onto_its_grid)
     {"# a grid\n0 0 1 0\n1 0 1 0\n0 0 1 0\n2 0 1 0\n0 1 1 0\n1 1 1 0\n", ":4: the point at (0, 0) is there twice "
      "(first on line 2)"},
     {"x y u v\n0 0 1 0\nnan 0 1 0\n", ":3: the point at (nan, 0): expected finite coordinates"},
-    /* a header whose names choose no column was read as x y u v unsaid
-    ** (speed taken for u, angle for v); a title of words is no header */
+    /* a header naming two columns but not all was read as x y u v unsaid
+    ** (speed taken for u, angle for v); a title of words naming one at
+    ** most is no header (titles of real exports were refused) */
     {"x,y,speed,angle\n0,0,1,0\n1,0,1,0\n", ":1: a header row of 4 names, none of them u or v: expected names x, y, "
      "u and v"},
-    {"\"a\" \"b\" \"c\" \"d\"\n0 0 1 0\n", ":1: a header row of 4 names, none of them x, y, u or v"},
+    {"\"X [m]\" \"Y [m]\" speed angle\n0 0 1 0\n", ":1: a header row of 4 names, none of them u or v"},
     {"flow past a cylinder\n0 0 1 0\n1 0 1 0\n0 1 1 0\n", "no point at (1, 1)"},
+    /* a mistyped coordinate: its line, not a node of its own column */
+    {"0 0 1 0\n1 0 1 0\n2 0 1 0\n0 1 1 0\n1 1 1 0\n2 1 1 0\n0 2 1 0\n1.0001 2 1 0\n2 2 1 0\n0 3 1 0\n1 3 1 0\n2 3 1 0\n",
+     ":8: the point at (1.0001, 2) lies off the grid the others make: its x is that of 1 point, where a column of the "
+     "grid holds 4"},
+    {"Wake flow, Re 100\n0 0 1 0\n1 0 1 0\n0 1 1 0\n", "no point at (1, 1)"},
+    {"flow in x direction\n0 0 1 0\n1 0 1 0\n0 1 1 0\n", "no point at (1, 1)"},
     {"0 0 1 0 5\n", "5 values: expected 4 a line"},
     {"x y u v\nx y u v\n", "found none"},
     {"x y u v\n0 0 1 0\nx y u v\n", ":3: value 1 of the row, 'x', is not a number"},
