@@ -174,7 +174,7 @@ fuzz: fuzz-build
 AS_ROOT = { [ "$$(id -u)" = 0 ] || { echo "the packages install with apt-get, as root: sudo make $@" >&2; exit 1; }; } &&
 
 deps:
-	@command -v dpkg >/dev/null || { echo "make deps installs Debian packages with apt-get, and this system has no dpkg: install GSL, cairo, libpng, inih, stb and Criterion by its own means (README)"; exit 1; }; \
+	@command -v dpkg >/dev/null || { echo "make deps installs Debian packages with apt-get, and this system has no dpkg: install GSL, cairo, libpng, inih, stb, Criterion and gnuplot by its own means (README)"; exit 1; }; \
 	missing=""; for p in $(DEBS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
 	if [ -n "$$missing" ]; then \
 	  $(AS_ROOT) echo "installing:$$missing" && apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \

@@ -36,14 +36,20 @@ static int span_halvings(const lw_nurbs *c, size_t s, int right)
   const double q = hi / lo, at = c->knot[s + (size_t)right];
   int m = 0;
   for (size_t i = 0; i < n_knots; i++) m += c->knot[i] == at;
-  const int p = (int)k - m < 1 ? 1 : (int)k - m > 3 ? 3 : (int)k - m;
+  const int p = c->pieces < 2 ? 3 : (int)k - m < 1 ? 1 : (int)k - m > 3 ? 3 : (int)k - m;
   /* pieces of h 2^-30 resolve a ratio of 1e27 (1e9 where p = 1), past which
   ** a piece's Gauss points crowd the span's end to rounding; a ratio past
   ** the doubles (a log weight of -709) made the count undefined, and spans
-  ** fell out of the energy */
+  ** fell out of the energy.  Where p < 3 any ratio turns the basis within
+  ** the span (an order 8 curve's end weight of 0.5 read 0.99 of its energy
+  ** whole) */
   if (!(q <= 0x1p90)) return SPAN_HALVINGS_MAX;
-  if (!(q > 2.0)) return 0;
-  const int j = (int)ceil(p == 3 ? log2(cbrt(q)) : p == 2 ? log2(sqrt((double)(k - 1) * q)) : log2((double)(k - 1) * q));
+  if (!(q > (p < 3 ? 1.0 : 2.0))) return 0;
+  /* (p < 3: from a ratio just over 1 as many pieces as at 2, so that the
+  ** count, and the energy with it, does not step as weights near each other
+  ** move: a free-weight quench stalled 1e-3 above the minimum) */
+  const double r = (double)(k - 1) * (q > 2.0 ? q : 2.0);
+  const int j = (int)ceil(p == 3 ? log2(cbrt(q)) : p == 2 ? log2(sqrt(r)) : log2(r));
   return j < SPAN_HALVINGS_MAX ? j : SPAN_HALVINGS_MAX;
 }
 

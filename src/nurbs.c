@@ -109,6 +109,7 @@ static lw_nurbs *alloc_curve(int order, size_t n, lw_error *err)
   if (c) {
     c->order = order;
     c->n = n;
+    c->pieces = 2;
     c->knot = malloc((n + (size_t)order) * sizeof *c->knot);
     c->P = malloc(2 * n * sizeof *c->P);
     c->w = malloc(n * sizeof *c->w);
@@ -144,7 +145,9 @@ lw_nurbs *lw_nurbs_new(int order, size_t n, const double *knot, const double *P,
 
 lw_nurbs *lw_nurbs_copy(const lw_nurbs *c, lw_error *err)
 {
-  return lw_nurbs_new(c->order, c->n, c->knot, c->P, c->w, err);
+  lw_nurbs *d = lw_nurbs_new(c->order, c->n, c->knot, c->P, c->w, err);
+  if (d) d->pieces = c->pieces;
+  return d;
 }
 
 double lw_nurbs_u0(const lw_nurbs *c) { return c->knot[c->order - 1]; }

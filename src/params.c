@@ -872,8 +872,15 @@ const lw_param_def lw_param_table[] = {
       "Gauss-Legendre points per knot span for the matrices M, D and K: at least as many in all as "
       "control points (fewer leave motions that the energy does not see), so at least 2 (a curve "
       "has fewer spans than points; 1 is read only in a run begun before 2026-12-05); `order` "
-      "points make the matrices of a polynomial curve exact. A span whose weights differ by more than "
-      "a factor 2 takes them on each of its pieces toward its ends (docs/NURBS.md)."),
+      "points make the matrices of a polynomial curve exact. A span whose weights differ takes them on "
+      "each of its pieces toward its ends (nurbs.pieces; docs/NURBS.md)."),
+  NUM("nurbs", "pieces", LW_PT_INT, nb_pieces, "2", "", 1, 2, 0,
+      "How a knot span of weights apart is cut toward its ends for the quadrature: 2 = as far as the "
+      "rational basis turns there, h ((k - 1) q)^(-1/p) beside a knot of multiplicity m (p = k - m, 1 to "
+      "3: a clamped end 1), any ratio q of the span's weights at such a knot; 1 = h q^(-1/3) at every "
+      "knot, from a ratio of 2, as runs before 2026-12-07 (a run of theirs, whose scene.ini has no line for "
+      "this key, resumes so): a light end point of weight 0.01 read 0.58 of the energy, an order 8 curve "
+      "with an end weight of 0.5 99 % (docs/NURBS.md)."),
   NUM("nurbs", "fixed", LW_PT_INT, nb_fixed, "0", "", 0, 1e9, 0,
       "Control points held at each end (1 = the ends of the curve; 2 = its end tangents too). "
       "Monte Carlo and the dynamics move only the others. Gravity is the [dynamics] "
@@ -1083,6 +1090,8 @@ static void typed_hint(const lw_param_def *d, const char *text, char *hint, size
   else if (word && (*rest == '#' || (*rest == ';' && rest == text + word)))
     snprintf(hint, n, " (the value alone: in a scene file a comment after it starts with ';' after a blank, "
              "'%.*s ; ...'; --set takes none)", (int)(word < 16 ? word : 16), text);
+  else if (numeric && lead && *rest == '%' && d->max <= 1.0)
+    snprintf(hint, n, " (a share, the number alone: %g for %.*s %%)", v / 100.0, (int)lead, text);
   else if (numeric && lead && (isalpha((unsigned char)*rest) || *rest == '%'))
     snprintf(hint, n, " (the number alone%s%s)", strlen(d->unit) > 1 ? ": it is in " : "",
              strlen(d->unit) > 1 ? d->unit : "");

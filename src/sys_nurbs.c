@@ -228,6 +228,8 @@ lw_nurbs_setup *lw_nurbs_setup_new(const lw_params *p, lw_nurbs *curve, lw_error
     return NULL;
   }
   su->curve = curve;
+  /* (a run begun before the key resumes on the pieces its energy had) */
+  curve->pieces = p->run_written && !lw_params_line(p, "nurbs", "pieces") ? 1 : p->nb_pieces;
   size_t n = su->curve->n;
   if (2 * (size_t)p->nb_fixed > n) {
     lw_error_set(err, LW_EINPUT, "expected at most half of the %zu control points, got %d at each end", n,

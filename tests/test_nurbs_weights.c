@@ -451,6 +451,7 @@ Test(nurbs_weights, a_weight_beside_a_clamped_end_or_a_repeated_knot_keeps_the_e
     const double *knot;
     double w[7];
   } cases[] = {
+      {4, simple, {0.5, 1, 1, 1, 1, 1, 1}},    {4, triple, {1, 1, 1, 0.5, 1, 1, 1}},
       {4, simple, {0.01, 1, 1, 1, 1, 1, 1}},   {4, simple, {1e-4, 1, 1, 1, 1, 1, 1}},
       {4, simple, {1, 1e4, 1, 1, 1, 1, 1}},    {4, simple, {1, 1, 1e4, 1, 1, 1, 1}},
       {4, simple, {1, 1, 1, 1, 1, 1e-3, 1}},   {4, triple, {1, 1, 1, 0.01, 1, 1, 1}},
@@ -479,6 +480,37 @@ Test(nurbs_weights, a_weight_beside_a_clamped_end_or_a_repeated_knot_keeps_the_e
     }
     cr_log_info("case %zu: elastic %.12g, adaptive %.12g", k, got, want);
     cr_assert(fabs(got / want - 1) < 1e-7, "case %zu: %.12g against %.12g", k, got, want);
+    lw_dnurbs_free(d);
+    lw_nurbs_free(c);
+  }
+  /* order 8, 9 points: an end weight or a middle one of 0.5, a ratio of 2,
+  ** which was left whole (the end's 0.94 % low); and the rule of runs
+  ** before 2026-12-07 (pieces = 1) still reads them so */
+  const double knot8[17] = {0, 0, 0, 0, 0, 0, 0, 0, 0.5, 1, 1, 1, 1, 1, 1, 1, 1};
+  const double P8[18] = {-5, 5, -4, 6, -3, 4, -1.5, 5.5, 0, 4, 1.5, 6, 3, 4, 4, 6, 5, 5};
+  for (int k = 0; k < 3; k++) {
+    double w[9] = {1, 1, 1, 1, 1, 1, 1, 1, 1};
+    w[k == 1 ? 4 : 0] = 0.5;
+    lw_error err = {0};
+    lw_nurbs *c = lw_nurbs_new(8, 9, knot8, P8, w, &err);
+    cr_assert_not_null(c, "%s", err.msg);
+    c->pieces = k == 2 ? 1 : 2;
+    lw_dnurbs *d = lw_dnurbs_new(c, 35, 10, 10, &err);
+    cr_assert_not_null(d, "%s", err.msg);
+    const double got = lw_band_energy(d->K, 9, 8, P8);
+    elastic_ctx ctx = {c, 35, 10};
+    gsl_function f = {elastic_density, &ctx};
+    double want = 0;
+    for (int s = 7; s < 9; s++) {
+      double part = 0, abserr = 0;
+      const int st = gsl_integration_qag(&f, knot8[s], knot8[s + 1], 0, 1e-11, 4000, GSL_INTEG_GAUSS61, ws, &part,
+                                         &abserr);
+      cr_assert(!st || abserr < 1e-9 * fabs(part), "order 8: QAG: %s", gsl_strerror(st));
+      want += part;
+    }
+    cr_log_info("order 8, case %d: elastic %.12g, adaptive %.12g", k, got, want);
+    if (k < 2) cr_assert(fabs(got / want - 1) < 1e-7, "order 8, case %d: %.12g against %.12g", k, got, want);
+    else cr_assert(fabs(got / want - 1) > 1e-3, "pieces = 1 reads the whole span: %.12g against %.12g", got, want);
     lw_dnurbs_free(d);
     lw_nurbs_free(c);
   }

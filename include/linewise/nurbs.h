@@ -44,6 +44,7 @@ typedef struct {
   double *knot;   /* n + k, open: k equal values at either end */
   double *P;      /* 2 n: x y of each control point */
   double *w;      /* n weights, > 0 */
+  int pieces;     /* how a span of weights apart is cut (dnurbs.c): 2, by its knots; 1, as before 2026-12-07 */
   gsl_bspline_workspace *ws; /* the basis (scratch) */
   gsl_matrix *dB; /* k x 3 scratch: N, N', N'' of the nonzero functions */
 } lw_nurbs;

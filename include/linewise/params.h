@@ -279,6 +279,7 @@ typedef struct {
   int nb_refine;              /* each knot span cut into this many */
   double nb_alpha, nb_beta;   /* energy coefficients */
   int nb_gauss;               /* Gauss points per knot span */
+  int nb_pieces;              /* a span's pieces: 2 by its knots, 1 as before 2026-12-07 */
   int nb_fixed;               /* control points held at each end */
   int nb_free_weights;        /* 1: the weights are coordinates (s = log w) */
   double nb_step_weight;      /* weight move's half width in s */
