@@ -885,9 +885,13 @@ static void memory_note(lw_anneal *a)
   if (a->mem.peak > 0.0 && peak > a->mem.limit)
     snprintf(a->memory_note, sizeof a->memory_note, "%s%s may take up to about %.3g GB at the drawing, more than "
              "the %.3g GB of %s: short of it the drawing leaves out its scores (summary.json's close_share and "
-             "fidelity null) or fails (its state kept, to resume with more memory); fewer splines%s or a wider "
+             "fidelity null) or fails (its state kept, to resume with more memory); %sfewer splines%s or a wider "
              "output.pen_width take less (docs/PERFORMANCE.md, \"Memory\")", a->mem.what, reps, peak / 1e9,
-             a->mem.limit / 1e9, a->mem.by, a->mem.here > 1 ? " or replicas" : "");
+             a->mem.limit / 1e9, a->mem.by,
+             /* (a camera's picture was 228 of 251 MB, the splines 16: the note
+             ** named only them) */
+             a->params.image[0] ? "a smaller scene.image_max_pixels (57 bytes a pixel while scored), " : "",
+             a->mem.here > 1 ? " or replicas" : "");
 }
 
 /* The threads a parallel region may start (1 built without OpenMP, as the

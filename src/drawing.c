@@ -399,6 +399,21 @@ lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_spli
     lw_path_join(path, sizeof path, dir, "final.gcode");
     s = lw_output_gcode_strokes(st, &page, &po, path, err);
   }
+  /* a file that failed after this state's final.svg was written, and those
+  ** after it, are the drawing of an earlier state: removed, so that none
+  ** stands beside the new final.svg (a full disk left the old final.png) */
+  static const char *const after_svg[] = {"final.png", "final.pdf", "final.hpgl", "final.gcode"};
+  const char *failed = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+  for (int k = 0, from = -1; s && err && k < 4; k++) {
+    if (from < 0 && strcmp(failed, after_svg[k])) continue;
+    from = k;
+    char old[LW_PATH_MAX + 16];
+    lw_path_join(old, sizeof old, dir, after_svg[k]);
+    const size_t m = strlen(err->msg);
+    if (!remove(old))
+      snprintf(err->msg + m, sizeof err->msg - m, "; %s of the state before removed (final.svg is this one's)",
+               after_svg[k]);
+  }
   /* a format turned off since the run's last end (scene.ini edited, then
   ** resumed) leaves no file of the old drawing beside the new: a plotter
   ** was sent a final.gcode that final.svg no longer showed */

@@ -1386,6 +1386,8 @@ static int cmd_run(int argc, char **argv)
   const int asked = quiet;
   if (net && net->rank) quiet = 1;
   watcher_start(&w, quiet);
+  /* (a directory the set-up could not make is not one removed since) */
+  const int was_there = !access(dir, F_OK);
   if (spread_start(lw_anneal_start_net(&a, &p, dir, net, &err), &a, 1, &err)) {
     /* (a failed first write said only that, leaving a directory without a
     ** state.lw: what to do next, as loop_fail says later) */
@@ -1412,7 +1414,15 @@ static int cmd_run(int argc, char **argv)
     ** checkpoint" was said of one that went with it, and "the run that was
     ** in the directory is back as it was" of a run set aside in it, gone or
     ** moved along) */
-    if (err.code == LW_EIO && access(dir, F_OK))
+    /* (a camera's picture under ulimit -v said "out of memory for a 1732 x
+    ** 2309 grid" and no more; 1e6 pixels ran in 77 MB) */
+    if (err.code == LW_ENOMEM) {
+      snprintf(err.msg + n, sizeof err.msg - n, "; in less memory %sfewer splines or fewer threads (--threads 1: "
+               "ulimit -v counts each thread's reserve) make a smaller run (docs/PERFORMANCE.md, \"Memory\")",
+               p.image[0] ? "a smaller scene.image_max_pixels, " : "");
+      stash_note(&err, dir);
+    } else if (err.code == LW_EIO && access(dir, F_OK) &&
+             (was_there || strstr(err.msg, ": cannot create directory: ") == NULL))
       snprintf(err.msg + n, sizeof err.msg - n, "; %s is no longer there: the run's directory was removed or moved "
                "during the set-up (moved, 'linewise resume' where it is now puts back the run that was there, or "
                "goes on from this run's checkpoint)", dir);

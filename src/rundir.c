@@ -35,6 +35,9 @@ lw_status lw_rundir_make(const char *dir, lw_error *err)
 {
   char buf[LW_PATH_MAX];
   snprintf(buf, sizeof buf, "%s", dir);
+  /* the ends of the folders this call made, taken away again where a later
+  ** one fails (a full disk left an empty "x" of --out x/y) */
+  size_t made[64], n_made = 0;
   for (char *c = buf + 1;; c++) {
     if (*c == '/' || *c == '\0') {
       char save = *c;
@@ -42,16 +45,23 @@ lw_status lw_rundir_make(const char *dir, lw_error *err)
       /* a place no directory can be made (a file in the way, /proc, no
       ** permission, a read-only mount) is the user's choice (exit 2, as
       ** --out naming a file); a disk that is full or fails is the machine's */
-      if (mkdir(buf, 0777) && errno != EEXIST) {
+      const int failed = mkdir(buf, 0777);
+      if (failed && errno != EEXIST) {
         const int e = errno, machine = e == ENOSPC || e == EIO || e == EDQUOT || e == ENOMEM;
         /* a relative one under a working directory a log does not show (cron's
         ** /, a read-only folder): "out: cannot create directory" said no where */
         char cwd[LW_PATH_MAX] = "";
         if (!machine && buf[0] != '/' && !getcwd(cwd, sizeof cwd)) cwd[0] = '\0';
-        return lw_error_set(err, machine ? LW_EIO : LW_EUSAGE, "%s: cannot create directory: %s%s%s%s", buf,
-                            strerror(e), cwd[0] ? " (in the working directory " : "", cwd,
-                            cwd[0] ? "; --out names another place)" : "");
+        const lw_status s = lw_error_set(err, machine ? LW_EIO : LW_EUSAGE, "%s: cannot create directory: %s%s%s%s",
+                                         buf, strerror(e), cwd[0] ? " (in the working directory " : "", cwd,
+                                         cwd[0] ? "; --out names another place)" : "");
+        while (n_made) {
+          buf[made[--n_made]] = '\0';
+          rmdir(buf);
+        }
+        return s;
       }
+      if (!failed && n_made < sizeof made / sizeof *made) made[n_made++] = (size_t)(c - buf);
       *c = save;
       if (!save) break;
     }

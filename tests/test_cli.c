@@ -1018,6 +1018,14 @@ Test(cli, a_signal_in_start_up_leaves_a_resumable_run_and_a_size_limit_is_an_err
   /* and that the last checkpoint is whole, and how to go on */
   cr_assert_eq(lw_test_sh("grep -q 'File too large; %s/fp/state.lw holds the checkpoint of sweep 5: ' %s/err.txt", dir,
                           dir), 0);
+  /* an extension whose PNG fails leaves no final.png of the state before
+  ** beside its new final.svg (a full disk left the old one unsaid) */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/fx --quiet --set output.png_scale=20 --set "
+                          "anneal.sweeps=5 && test -f %s/fx/final.png && sh -c 'ulimit -f 60; %s resume %s/fx --sweeps 2 "
+                          "--quiet' 2>%s/err.txt; test $? -eq 1 && grep -q 'File too large; final.png of the state "
+                          "before removed (final.svg is this one.s)' %s/err.txt && ! test -e %s/fx/final.png && test -f "
+                          "%s/fx/final.svg", lw_test_bin(), lw_test_root(), dir, dir, lw_test_bin(), dir, dir, dir, dir,
+                          dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
   /* a resume's too: the checkpoint it read, where it has written none yet */
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --out %s/rf --quiet --stop-at 50 && sh -c 'ulimit -f 30; %s "
                           "resume %s/rf --quiet' 2>%s/err.txt; test $? -eq 1 && grep -q 'File too large; "

@@ -57,7 +57,7 @@ typedef struct lw_anneal {
   char unread[1024];           /* keys the scene sets that only other drivers read, where set, or "" */
   char idle[4096];             /* keys the scene sets that its other settings leave idle, where and why */
   char schedule_note[2048];     /* a schedule whose steps never reach its end (lw_anneal_start), or "" */
-  char memory_note[512];       /* a run expected to take more memory at its peak than it may, or "" */
+  char memory_note[768];       /* a run expected to take more memory at its peak than it may, or "" */
   struct {                     /* what memory_note is made of (anneal.c) */
     double peak, replica, limit; /* the drawing's peak, a further replica's bytes, the limit */
     int here;                  /* replicas in this process */
