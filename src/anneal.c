@@ -1320,6 +1320,7 @@ int lw_anneal_undo_start(lw_anneal *a)
     if (fresh) lw_phase_stash(a->put_back ? 0 : 1);
   } else {
     lw_runfiles_remove(a->dir); /* no run was there: every run file is the set-up's */
+    a->undone = 1;
   }
   return a->put_back;
 }

@@ -262,7 +262,7 @@ lw_status lw_checkpoint_write_timing(const lw_anneal *a, lw_error *err)
   snprintf(aside, sizeof aside, "%s%s", path, a->net && a->net->rank ? ".drawn" : "");
   FILE *f = lw_output_open_tmp(aside, tmp, sizeof tmp, err);
   if (!f) return err->code;
-  fprintf(f, "wall_seconds %.6f\nsweep_seconds %.6f\n", lw_anneal_seconds(a), a->sweep_seconds);
+  fprintf(f, "wall_seconds %.17g\nsweep_seconds %.17g\n", lw_anneal_seconds(a), a->sweep_seconds);
   if (a->untimed) fprintf(f, "untimed_proposals %lu\n", a->untimed);
   return lw_output_commit(f, tmp, path, err);
 }

@@ -916,7 +916,11 @@ static int loop_fail(lw_anneal *a, long began, watcher *w, lw_error *err)
   ** where the directory itself went (removed during the run) */
   char state[LW_PATH_MAX + 16];
   snprintf(state, sizeof state, "%s/state.lw", a->dir);
-  if (err->code == LW_EIO && access(state, F_OK)) {
+  if (a->undone) { /* (its own checkpoint, not one removed by another) */
+    size_t n = strlen(err->msg);
+    snprintf(err->msg + n, sizeof err->msg - n, "; the run's first files are removed, as it had done no sweep: run "
+             "it again once %s", err->code == LW_ENOMEM ? "there is more memory" : "the files can be written");
+  } else if (err->code == LW_EIO && access(state, F_OK)) {
     size_t n = strlen(err->msg);
     snprintf(err->msg + n, sizeof err->msg - n, "; %s is no longer there: the run's directory was removed or moved, "
              "so the run ends (moved, it resumes from its last checkpoint where it is now)", state);
@@ -1392,6 +1396,9 @@ static int cmd_run(int argc, char **argv)
     /* (a failed first write said only that, leaving a directory without a
     ** state.lw: what to do next, as loop_fail says later) */
     const int back = lw_anneal_undo_start(&a); /* (MPI: the network's checkpoint failed) */
+    /* (the set-up's own files, its checkpoint among them, which the undo
+    ** removes where no run was before: "no longer there" was said of them) */
+    const int removed = a.undone;
     if (a.gave_way) { /* (one process: a log of --quiet runs is told too) */
       watcher_stop(&w, LW_PHASE_STOPPED);
       lw_anneal_free(&a);
@@ -1426,9 +1433,12 @@ static int cmd_run(int argc, char **argv)
       snprintf(err.msg + n, sizeof err.msg - n, "; %s is no longer there: the run's directory was removed or moved "
                "during the set-up (moved, 'linewise resume' where it is now puts back the run that was there, or "
                "goes on from this run's checkpoint)", dir);
-    else if (err.code == LW_EIO && lw_phase_last_commit(NULL) >= 0 && access(state, F_OK))
+    else if (err.code == LW_EIO && lw_phase_last_commit(NULL) >= 0 && access(state, F_OK) && !removed)
       snprintf(err.msg + n, sizeof err.msg - n, "; %s is no longer there: the run's directory was removed or moved, "
                "so the run ends (moved, it resumes from its last checkpoint where it is now)", state);
+    else if (err.code == LW_EIO && removed && lw_phase_last_commit(NULL) >= 0)
+      snprintf(err.msg + n, sizeof err.msg - n, "; the run's first files are removed, as it had done no sweep: run "
+               "it again once the files can be written");
     else if (err.code == LW_EIO && !lw_phase_unwritten())
       snprintf(err.msg + n, sizeof err.msg - n, "; the run wrote no checkpoint%s: run it again once the files can "
                "be written", back ? ", and the run that was in the directory is back as it was"

@@ -1426,6 +1426,18 @@ Test(cli, a_key_set_twice_takes_the_last_value)
                           dir, b, r, b, b, r, b, r), 0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
+/* A resume of a finished run redraws it and writes summary.json again: its
+** sweep_seconds came back cut to timing.txt's 6 decimals (a script that
+** resumed every run as a safe retry changed the numbers of finished ones). */
+Test(cli, a_resume_of_a_finished_run_keeps_its_sweep_seconds)
+{
+  cr_assert_eq(lw_test_sh("cd %s && %s run %s/params/minimal.ini --out f --set anneal.sweeps=20 --quiet && grep -o "
+                          "'\"sweep_seconds\": [0-9.e-]*' f/summary.json > a.txt && %s resume f --quiet && grep -o "
+                          "'\"sweep_seconds\": [0-9.e-]*' f/summary.json > b.txt && cmp a.txt b.txt && "
+                          "test $(wc -c < a.txt) -gt 26", dir, lw_test_bin(), lw_test_root(), lw_test_bin()), 0, "%s %s",
+               lw_test_slurp("%s/a.txt", dir), lw_test_slurp("%s/b.txt", dir));
+}
+
 /* A field file without the field term is named in the note of keys without
 ** effect, as the field's other keys are (it was left out), and once only
 ** where the field is not file either. */

@@ -79,6 +79,7 @@ typedef struct lw_anneal {
   int stashed;                 /* the run it replaces is set aside until its first sweep (runfiles.h) */
   int ladder_from_file;        /* tempering.ladder was read from tempering.ladder_file (for messages) */
   int put_back;                /* a set-up that failed put the run it was to replace back */
+  int undone;                  /* ... or, where no run was, removed its own first files (its checkpoint too) */
   int gave_way;                /* the set-up failed as a stop was asked (lw_phase_stopping) */
   char stash_left[LW_ERROR_MSG]; /* why the run replaced stayed in DIR/.replaced ("": it went) */
   unsigned long long scene_hash; /* lw_params_run_hash of scene.ini, kept in state.lw */
