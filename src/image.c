@@ -1410,7 +1410,7 @@ static int flat_end(const size_t *hist, int b, int end, int step, double plateau
 }
 
 lw_status lw_image_levels(lw_image *img, const float *under, double clip, int flat, double *lo, double *hi,
-                          lw_error *err)
+                          int *kept, lw_error *err)
 {
   size_t n = (size_t)img->width * (size_t)img->height;
   size_t *hist = calloc(LEVELS_BINS, sizeof *hist);
@@ -1423,6 +1423,7 @@ lw_status lw_image_levels(lw_image *img, const float *under, double clip, int fl
     count++;
   }
   double l = 0.0, h = 1.0;
+  if (kept) *kept = 0;
   if (count) {
     /* the first bin from each end past `cut` pixels */
     size_t cut = (size_t)floor(clip * (double)count), c = 0;
@@ -1446,6 +1447,7 @@ lw_status lw_image_levels(lw_image *img, const float *under, double clip, int fl
     ** alone: one that went white that way was what the rule is for) */
     if (flat >= 2 && l_flat && !h_flat && (bl < 0.5) != ((bl - l) / (h - l) < 0.5)) l = bl;
     if (flat >= 2 && h_flat && !l_flat && (bh < 0.5) != ((bh - l) / (h - l) < 0.5)) h = bh;
+    if (kept) *kept = (l == 0.0 && l_flat && bl > 0.0) | (h == 1.0 && h_flat && bh < 1.0) << 1;
   }
   free(hist);
   if (h - l < LW_IMAGE_LEVELS_MIN_SPAN) {

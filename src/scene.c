@@ -314,10 +314,11 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
   }
   if (p->image_levels > 0) {
     double lo, hi;
+    int kept;
     const float *under = levels_under ? (cover ? cover : sc->image->alpha) : NULL;
     /* (a run begun before the key: the clip's bin alone) */
     const int flat = before_key(p, "image_levels_flat") ? 0 : p->image_levels_flat;
-    if ((st = lw_image_levels(sc->image, under, p->image_levels, flat, &lo, &hi, err))) {
+    if ((st = lw_image_levels(sc->image, under, p->image_levels, flat, &lo, &hi, &kept, err))) {
       free(cover);
       return st;
     }
@@ -333,9 +334,15 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
                    ? " (its darkest, a light grey, now draws as black: scene.image_levels = 0 keeps a light picture "
                      "light)"
                    : "");
-    else /* a plateau of paper or of black at an end keeps its end */
+    else if (!kept) /* a plateau of paper or of black at an end keeps its end */
       snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_levels: the tones left as they are",
                used ? "\n" : "");
+    else /* (a dim photograph saved as a GIF, its sky one colour of 11 %, kept its tones unsaid why) */
+      snprintf(sc->note + used, sizeof sc->note - used, "%sscene.image_levels: the tones left as they are: %s one "
+               "flat colour of many pixels, as a graphic's (a photograph saved in few colours, a GIF, looks so "
+               "too: there scene.image_gamma and image_contrast set its tones by hand)", used ? "\n" : "",
+               kept == 3 ? "its darkest and its lightest tone are each" : kept == 2 ? "its lightest tone is"
+                                                                                   : "its darkest tone is");
   }
   lw_image_tone_curve(sc->image, cover ? cover : sc->image->alpha, p->image_gamma, p->image_contrast,
                       p->image_invert);

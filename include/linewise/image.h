@@ -151,7 +151,9 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
 ** the other) is stretched as any
 ** (a low-contrast elevation model's flat sea, its darkest, went white with
 ** all the rest).  scene.image_levels_flat: 0 for runs begun before it, 1
-** before 2026-12-07.  *lo and *hi receive the tones that became 0 and 1.
+** before 2026-12-07.  *lo and *hi receive the tones that became 0 and 1,
+** *kept (NULL: not asked) 1 and 2 for the dark and light end left alone as
+** flat colours.
 ** LW_ENOMEM with err set. */
 #define LW_IMAGE_LEVELS_MIN_SPAN 0.05
 #define LW_IMAGE_LEVELS_PLATEAU 0.05
@@ -164,7 +166,7 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
 ** darkest black is what draws it (kept light, it drew one even mat) */
 #define LW_IMAGE_LEVELS_PAPER 0.85
 lw_status lw_image_levels(lw_image *img, const float *under, double clip, int flat, double *lo, double *hi,
-                          lw_error *err);
+                          int *kept, lw_error *err);
 
 /* The tone curve, in this order:
 **     t <- 1 - t                         if invert
