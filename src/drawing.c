@@ -203,6 +203,11 @@ static lw_status score(const lw_params *p, const lw_scene *sc, const lw_strokes 
   }
   lw_grid2d_free(ref);
   rep->has_fidelity = !s;
+  for (int k = 0; k < LW_PLOT_PENS_MAX; k++)
+    rep->pen_width[k] = k < sc->layers.n ? sc->layers.spec[k].pen_width : p->pen_width;
+  /* (as scene.c's note of a strip narrower than two segments) */
+  rep->picture_thin = sc->image && fmin(sc->image->width, sc->image->height) * sc->image_place.pixel <
+                                       2.0 * p->segment_length;
   /* as the close share below: a score of the finished drawing, which its
   ** want of memory must not fail (the run annealed, drew final.svg, then
   ** ended with exit 1 and no summary.json); summary.json's fidelity is null */
@@ -445,10 +450,14 @@ lw_status lw_drawing_frame(const lw_params *p, const lw_scene *sc, const lw_spli
 }
 
 /* The share of missed marks (fidelity.h) from which the run says so: the
-** bundled example, a page of text and a logo miss at most 0.0001, bold
-** capitals on a banner 0.055, hairline letters half undrawn 0.37 (0.02 with
-** a pen fine enough). */
+** bundled example misses 0, a page of text 0.001, photographs up to 0.03,
+** bold capitals with crossbars gone 0.15, hairline letters half undrawn 0.38
+** (0.03 with a pen fine enough); or, in the worst square, the share from
+** which it does: a word left out there, its marks half bare or more. */
 #define MISSED_NOTE 0.1
+#define MISSED_WORST_NOTE 0.5
+
+static int missed_note(const lw_fidelity *f) { return f->missed > MISSED_NOTE || f->missed_worst > MISSED_WORST_NOTE; }
 
 static void fidelity_members(lw_json *j, const lw_fidelity *f)
 {
@@ -629,10 +638,21 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
                  d->pen_fidelity[p].mse, d->pen_fidelity[p].ssim,
                  orientation_text(d->pen_fidelity[p].orientation, o), d->pen_fidelity[p].stray,
                  d->pen_fidelity[p].missed);
-  /* (hairline letters half undrawn scored SSIM 0.94, unsaid) */
-  if (w >= 0 && (k += (size_t)w) < n && d->fidelity.missed > MISSED_NOTE)
-    snprintf(buf + k, n - k, "linewise: note: %.0f %% of the picture's dark marks have no line within %g pen widths: "
-             "marks too thin for the pen, which the blurred scores barely see; a finer output.pen_width or a larger "
-             "page draws them (docs/IMAGES.md, \"Thin lines on white\")\n", 100.0 * d->fidelity.missed,
-             LW_FIDELITY_MISS_REACH);
+  /* (hairline letters half undrawn scored SSIM 0.94, unsaid; a word left
+  ** out beside a figure drawn whole was 0.01 of the marks, a pen's 0.31 of
+  ** its own; not of a picture too thin for the page, said before the run) */
+  const lw_fidelity *f = &d->fidelity;
+  int pen = -1;
+  for (int p = 0; !missed_note(f) && d->n_pens > 1 && p < d->n_pens; p++)
+    if (missed_note(&d->pen_fidelity[p])) f = &d->pen_fidelity[pen = p];
+  if (w < 0 || (k += (size_t)w) >= n || !missed_note(f) || d->picture_thin) return;
+  char who[96] = "the picture's", where[160] = "";
+  if (pen >= 0) snprintf(who, sizeof who, "pen %d%s%s's target's", pen + 1, d->pen_name[pen][0] ? " " : "",
+                         d->pen_name[pen]);
+  if (f->missed_worst > MISSED_WORST_NOTE)
+    snprintf(where, sizeof where, " (%.0f %% in the square of %.3g mm about (%.0f, %.0f) mm)", 100.0 * f->missed_worst,
+             LW_FIDELITY_MISS_CELL * d->pen_width[pen >= 0 ? pen : 0], f->missed_at[0], f->missed_at[1]);
+  snprintf(buf + k, n - k, "linewise: note: %.0f %% of %s dark marks have no line within %g pen widths%s: marks too "
+           "thin for the pen, which the blurred scores barely see; a finer output.pen_width or a larger page draws "
+           "them (docs/IMAGES.md, \"Thin lines on white\")\n", 100.0 * f->missed, who, LW_FIDELITY_MISS_REACH, where);
 }

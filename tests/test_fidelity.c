@@ -303,7 +303,7 @@ Test(fidelity, stray_ink_is_ink_far_inside_the_white)
 /* Missed marks, stray ink's mirror: two dark bars 0.5 mm wide (a 0.3 mm
 ** pen); a line along the first alone misses the second (half the marks),
 ** along both none; a line 0.3 mm beside each still reaches it (all of it
-** within 3 pen widths), one 1.5 mm off not. */
+** within 2 pen widths of the line's ink), one 1.5 mm off not. */
 Test(fidelity, missed_marks_are_dark_pixels_no_line_came_near)
 {
   const double px = 0.1, pen = 0.3;
@@ -326,6 +326,39 @@ Test(fidelity, missed_marks_are_dark_pixels_no_line_came_near)
     cr_assert_eq(lw_fidelity_compute(sp, tone, pen, 1.0, &f, NULL), LW_OK);
     /* (within the pixels a line's rendered width spans) */
     cr_assert(fabs(f.missed - cases[k].want) < 1e-12, "case %zu: missed %g, expected %g", k, f.missed, cases[k].want);
+    lw_splines_free(sp);
+  }
+  lw_grid2d_free(tone);
+}
+
+/* A small mark left bare beside a large area hatched whole: a hundredth of
+** the marks, but all of its square's (the worst square, 25 pen widths a
+** side, names it and where); hatched too, none. */
+Test(fidelity, the_worst_square_finds_a_small_mark_left_bare)
+{
+  const double px = 0.1, pen = 0.3;
+  const int w = 600, h = 400; /* 60 x 40 mm */
+  lw_grid2d *tone = lw_grid2d_new(w, h, 1, 0.5 * px, 0.5 * px, px, px, NULL);
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) {
+      const double x = (i + 0.5) * px, y = (j + 0.5) * px;
+      const int block = x > 5 && x < 35 && y > 5 && y < 35, bar = x > 45 && x < 48 && y > 15 && y < 18;
+      tone->data[j * w + i] = block || bar ? 0.0 : 1.0;
+    }
+  for (int bar = 0; bar < 2; bar++) {
+    size_t n = 61 + (size_t)(bar ? 7 : 0), segs[68];
+    for (size_t i = 0; i < n; i++) segs[i] = 1;
+    lw_splines *sp = lw_splines_new(n, segs, NULL);
+    for (size_t i = 0; i < 61; i++) lw_test_straight(sp, i, 5 + 0.5 * (double)i, 5, 5 + 0.5 * (double)i, 35);
+    for (size_t i = 61; i < n; i++) lw_test_straight(sp, i, 45 + 0.5 * (double)(i - 61), 15, 45 + 0.5 * (double)(i - 61), 18);
+    lw_fidelity f;
+    cr_assert_eq(lw_fidelity_compute(sp, tone, pen, 1.0, &f, NULL), LW_OK);
+    if (!bar)
+      cr_assert(f.missed < 0.02 && f.missed_worst == 1.0 && fabs(f.missed_at[0] - 48.75) < 1e-9 &&
+                    fabs(f.missed_at[1] - 18.75) < 1e-9,
+                "the bar bare: missed %g, worst %g at (%g, %g)", f.missed, f.missed_worst, f.missed_at[0],
+                f.missed_at[1]);
+    else cr_assert(f.missed == 0.0 && f.missed_worst == 0.0, "hatched: missed %g, worst %g", f.missed, f.missed_worst);
     lw_splines_free(sp);
   }
   lw_grid2d_free(tone);

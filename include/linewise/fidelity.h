@@ -57,6 +57,8 @@
 **    widths of every pixel; a mark no line came near -- a letter thinner
 **    than the blurs see -- counts whole, which MSE and SSIM, blurred, barely
 **    see (hairline letters half undrawn scored SSIM 0.94).  0 without marks.
+**    The same share in the worst square of LW_FIDELITY_MISS_CELL pen widths
+**    (off the raster's edge) finds a word left out beside a figure drawn.
 **
 ** The drawing is scored as plotted (strokes.h: joined, cropped, dropped);
 ** a pen's score renders that pen's paths alone against the same target.
@@ -83,7 +85,8 @@ extern "C" {
 #define LW_FIDELITY_WHITE 0.02        /* blurred darkness under which the target is white paper */
 #define LW_FIDELITY_MARK 0.7          /* darkness (of black) from which a target pixel is a mark */
 #define LW_FIDELITY_INKED 0.25        /* a pixel's ink from which it counts as inked */
-#define LW_FIDELITY_MISS_REACH 3.0    /* pen widths within which a mark's line must lie */
+#define LW_FIDELITY_MISS_REACH 2.0    /* pen widths within which a mark's line must lie */
+#define LW_FIDELITY_MISS_CELL 25.0    /* pen widths a side of the squares missed_worst is of */
 
 typedef struct {
   double mse;       /* mean squared difference of blurred ink and darkness */
@@ -91,6 +94,9 @@ typedef struct {
   double orientation; /* orientation agreement, -1..1 (NaN: flat target) */
   double stray;     /* share of the ink on white paper, 0..1 */
   double missed;    /* share of the dark marks with no line near, 0..1 */
+  double missed_worst; /* the same in the worst square of LW_FIDELITY_MISS_CELL pen widths (a fiftieth marks or
+                          more; not on the raster's edge) */
+  double missed_at[2]; /* that square's centre, mm on the page (-1 -1: none) */
   double sigma_mm;  /* the blur used, mm */
   double black;     /* the ink the target asks where the picture is black, 0..1 */
 } lw_fidelity;
