@@ -890,7 +890,7 @@ static void memory_note(lw_anneal *a)
              a->mem.limit / 1e9, a->mem.by,
              /* (a camera's picture was 228 of 251 MB, the splines 16: the note
              ** named only them) */
-             a->params.image[0] ? "a smaller scene.image_max_pixels (57 bytes a pixel while scored), " : "",
+             a->params.image[0] ? "a smaller scene.image_max_pixels (59 bytes a pixel while scored), " : "",
              a->mem.here > 1 ? " or replicas" : "");
 }
 

@@ -208,6 +208,7 @@ static lw_status score(const lw_params *p, const lw_scene *sc, const lw_strokes 
   /* (as scene.c's note of a strip narrower than two segments) */
   rep->picture_thin = sc->image && fmin(sc->image->width, sc->image->height) * sc->image_place.pixel <
                                        2.0 * p->segment_length;
+  rep->frame_not_rect = p->boundary != LW_BND_RECT;
   /* as the close share below: a score of the finished drawing, which its
   ** want of memory must not fail (the run annealed, drew final.svg, then
   ** ended with exit 1 and no summary.json); summary.json's fidelity is null */
@@ -654,5 +655,6 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
              LW_FIDELITY_MISS_CELL * d->pen_width[pen >= 0 ? pen : 0], f->missed_at[0], f->missed_at[1]);
   snprintf(buf + k, n - k, "linewise: note: %.0f %% of %s dark marks have no line within %g pen widths%s: marks too "
            "thin for the pen, which the blurred scores barely see; a finer output.pen_width or a larger page draws "
-           "them (docs/IMAGES.md, \"Thin lines on white\")\n", 100.0 * f->missed, who, LW_FIDELITY_MISS_REACH, where);
+           "them (docs/IMAGES.md, \"Thin lines on white\")%s\n", 100.0 * f->missed, who, LW_FIDELITY_MISS_REACH,
+           where, d->frame_not_rect ? ", unless they lie outside the frame (scene.boundary), where no line goes" : "");
 }

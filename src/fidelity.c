@@ -567,31 +567,34 @@ static lw_status missed_marks(const double *ink, const double *dark, int w, int 
 {
   const size_t n = (size_t)w * (size_t)h;
   const int ax = (int)ceil(rx), ay = (int)ceil(ry);
-  int *row = malloc(n * sizeof *row), *col = malloc(n * sizeof *col);
+  /* a pixel is inked at a share of the ink black asks (a picture's coarse
+  ** pixel under hatching at tone_ink 0.2 never held a quarter) */
+  const double inked = LW_FIDELITY_INKED * black;
+  unsigned char *row = malloc(n), *col = malloc(n); /* (2 bytes a pixel: scoring's peak) */
   if (!row || !col) {
     free(row);
     free(col);
     return lw_error_set(err, LW_ENOMEM, "fidelity: out of memory for %d x %d pixels", w, h);
   }
-  /* row[k]: inked pixels within ax along the row; col[k]: rows within ay of k
-  ** holding such a pixel there */
+  /* row[k]: an inked pixel within ax along the row; col[k]: one of those
+  ** within ay of k along the column (running counts of each window) */
   for (int j = 0; j < h; j++) {
     int c = 0;
     const double *in = ink + (size_t)j * (size_t)w;
-    for (int i = 0; i < ax && i < w; i++) c += in[i] >= LW_FIDELITY_INKED;
+    for (int i = 0; i < ax && i < w; i++) c += in[i] >= inked;
     for (int i = 0; i < w; i++) {
-      if (i + ax < w) c += in[i + ax] >= LW_FIDELITY_INKED;
-      if (i - ax - 1 >= 0) c -= in[i - ax - 1] >= LW_FIDELITY_INKED;
-      row[(size_t)j * (size_t)w + (size_t)i] = c;
+      if (i + ax < w) c += in[i + ax] >= inked;
+      if (i - ax - 1 >= 0) c -= in[i - ax - 1] >= inked;
+      row[(size_t)j * (size_t)w + (size_t)i] = c > 0;
     }
   }
   for (int i = 0; i < w; i++) {
     int c = 0;
-    for (int j = 0; j < ay && j < h; j++) c += row[(size_t)j * (size_t)w + (size_t)i] > 0;
+    for (int j = 0; j < ay && j < h; j++) c += row[(size_t)j * (size_t)w + (size_t)i];
     for (int j = 0; j < h; j++) {
-      if (j + ay < h) c += row[(size_t)(j + ay) * (size_t)w + (size_t)i] > 0;
-      if (j - ay - 1 >= 0) c -= row[(size_t)(j - ay - 1) * (size_t)w + (size_t)i] > 0;
-      col[(size_t)j * (size_t)w + (size_t)i] = c;
+      if (j + ay < h) c += row[(size_t)(j + ay) * (size_t)w + (size_t)i];
+      if (j - ay - 1 >= 0) c -= row[(size_t)(j - ay - 1) * (size_t)w + (size_t)i];
+      col[(size_t)j * (size_t)w + (size_t)i] = c > 0;
     }
   }
   size_t marks = 0, bare = 0;

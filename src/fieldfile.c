@@ -320,8 +320,13 @@ static lw_status text_row(char *s, const char *path, long line, values *a, long 
       tight_sep |= comma && tight;
     }
     const size_t len = strcspn(s, " \t,");
+    /* a value quoted as R's write.csv and pandas' QUOTE_NONNUMERIC write a
+    ** row's name ("1") */
+    const int quoted = len >= 2 && (*s == '"' || *s == '\'') && s[len - 1] == *s;
+    const char *num = s + quoted;
+    const size_t nl = len - 2 * (size_t)quoted;
     double v;
-    if (!lw_number_parse_n(s, len, &v) && !nonfinite_word(s, len, &v) && !out_of_range(s, len, &v)) {
+    if (!lw_number_parse_n(num, nl, &v) && !nonfinite_word(num, nl, &v) && !out_of_range(num, nl, &v)) {
       char unseen[96];
       const char *hint = memchr(s, ';', len) ? " (values separated by ';': expected blanks or commas, and '.' as "
                                                "the decimal point)"
@@ -451,18 +456,58 @@ static size_t nearest_of(const double *u, size_t m, double v)
   return lo > 0 && v - u[lo - 1] < u[lo] - v ? lo - 1 : lo;
 }
 
-/* The names of a header row into names (lower case, at most 64): words
-** between blanks, commas, ';' or '=', or quoted ("X [m]", "X Velocity":
-** one name each); a unit in brackets after a name dropped ("u (m/s)" is u),
-** and a leading Tecplot "variables".  Their count. */
+/* A name as a header holds it: a unit in brackets after it dropped ("x [m]",
+** "u (m/s)"), in lower case. */
+static void name_tidy(char *t)
+{
+  size_t len = strlen(t);
+  while (len && (t[len - 1] == ' ' || t[len - 1] == '\t')) t[--len] = '\0';
+  while (len && (t[len - 1] == ']' || t[len - 1] == ')')) {
+    const char want = t[len - 1] == ']' ? '[' : '(';
+    char *open = t + len - 1;
+    while (open > t && *open != want) open--;
+    if (open == t) break;
+    for (len = (size_t)(open - t); len && (t[len - 1] == ' ' || t[len - 1] == '\t'); len--) {}
+    t[len] = '\0';
+  }
+  for (char *k = t; *k; k++) *k = (char)tolower((unsigned char)*k);
+}
+
+/* The names of a header row into names (at most 64), after a Tecplot
+** "VARIABLES =".  A row with commas (else semicolons) is a CSV's: a name
+** is what lies between them, blanks and all ("X Position", pandas'
+** "Unnamed: 0"), quoted or not, an empty one a column too (pandas' and R's
+** unnamed index: ",x,y,u,v", "\"\",\"x\""), but for a last one after a
+** trailing comma.  Else names lie between blanks, a quoted one whole ("X
+** [m]"), a unit in brackets after an unquoted one part of it.  Their count. */
 static long header_names(char *line, char *names[64])
 {
   long n = 0;
-  static char index_column[] = "";
-  /* pandas' to_csv: ",x,y,u,v", its index column unnamed */
-  if (line[strspn(line, " \t")] == ',') names[n++] = index_column;
-  for (char *c = line; *c && n < 64;) {
-    c += strspn(c, " \t,;=");
+  char *body = line + strspn(line, " \t");
+  if (!strncasecmp(body, "variables", 9) && strchr(" \t=", body[9])) {
+    body += 9 + strspn(body + 9, " \t");
+    if (*body == '=') body++;
+  }
+  const char sep = strchr(body, ',') ? ',' : strchr(body, ';') ? ';' : 0;
+  if (sep) {
+    for (char *c = body; n < 64;) {
+      char *end = strchr(c, sep);
+      if (end) *end = '\0';
+      char *t = c + strspn(c, " \t");
+      if (*t == '"' || *t == '\'') {
+        const char q = *t++;
+        char *close = strchr(t, q);
+        if (close) *close = '\0';
+      }
+      name_tidy(t);
+      if (end || *t) names[n++] = t;
+      if (!end) break;
+      c = end + 1;
+    }
+    return n;
+  }
+  for (char *c = body; *c && n < 64;) {
+    c += strspn(c, " \t=");
     if (!*c) break;
     char *t = c;
     if (*c == '"' || *c == '\'') {
@@ -470,8 +515,8 @@ static long header_names(char *line, char *names[64])
       t = c;
       c += strcspn(c, q == '"' ? "\"" : "'");
     } else {
-      c += strcspn(c, " \t,;=");
-      /* a unit after the name, unquoted ("x [m],y [m]"): part of it */
+      c += strcspn(c, " \t=");
+      /* a unit after the name, unquoted ("x [m] y [m]"): part of it */
       char *unit = c + strspn(c, " \t"), *close = NULL;
       if (*unit == '[' || *unit == '(') close = strchr(unit, *unit == '[' ? ']' : ')');
       if (close) {
@@ -482,17 +527,8 @@ static long header_names(char *line, char *names[64])
     const int more = *c != '\0';
     *c = '\0';
     c += more;
-    size_t len = strlen(t);
-    while (len && (t[len - 1] == ']' || t[len - 1] == ')')) { /* "x [m]", "u (m/s)" */
-      const char want = t[len - 1] == ']' ? '[' : '(';
-      char *open = t + len - 1;
-      while (open > t && *open != want) open--;
-      if (open == t) break;
-      for (len = (size_t)(open - t); len && (t[len - 1] == ' ' || t[len - 1] == '\t'); len--) {}
-      t[len] = '\0';
-    }
-    for (char *k = t; *k; k++) *k = (char)tolower((unsigned char)*k);
-    if (*t && !(n == 0 && !strcmp(t, "variables"))) names[n++] = t;
+    name_tidy(t);
+    if (*t) names[n++] = t;
   }
   return n;
 }
@@ -508,11 +544,13 @@ static long header_columns(const char *line, int col[4], long *count)
   char copy[4096], *names[64];
   snprintf(copy, sizeof copy, "%s", line);
   const long n = *count = header_names(copy, names);
-  static const char *const own[4][8] = {
-      {"x", "points:0", "coordinates:0", "points_0", "x-coordinate", NULL},
-      {"y", "points:1", "coordinates:1", "points_1", "y-coordinate", NULL},
-      {"u", "vx", "ux", "x velocity", "x-velocity", "velocity_x", "vel_x", NULL},
-      {"v", "vy", "uy", "y velocity", "y-velocity", "velocity_y", "vel_y", NULL}};
+  static const char *const own[4][10] = {
+      {"x", "points:0", "coordinates:0", "points_0", "x-coordinate", "x coordinate", "x position", "lon",
+       "longitude", NULL},
+      {"y", "points:1", "coordinates:1", "points_1", "y-coordinate", "y coordinate", "y position", "lat",
+       "latitude", NULL},
+      {"u", "vx", "ux", "x velocity", "x-velocity", "velocity_x", "vel_x", "u velocity", NULL},
+      {"v", "vy", "uy", "y velocity", "y-velocity", "velocity_y", "vel_y", "v velocity", NULL}};
   for (int c = 0; c < 4; c++) {
     col[c] = -1;
     for (long k = 0; k < n && col[c] < 0; k++)
@@ -521,13 +559,13 @@ static long header_columns(const char *line, int col[4], long *count)
   }
   for (long k = 0; k < n && (col[2] < 0 || col[3] < 0); k++) {
     const size_t len = strlen(names[k]), stem = len - 2;
-    const char mark = len >= 3 ? names[k][stem] : 0; /* ':' or '_' */
-    if ((mark != ':' && mark != '_') || names[k][stem + 1] != '0' || (stem == 6 && !strncmp(names[k], "points", 6)) ||
-        (stem == 11 && !strncmp(names[k], "coordinates", 11)))
+    const char mark = len >= 3 ? names[k][stem] : 0, first = len >= 3 ? names[k][stem + 1] : 0; /* ':0', '_0', '_x' */
+    if ((mark != ':' && mark != '_') || (first != '0' && first != 'x') ||
+        (stem == 6 && !strncmp(names[k], "points", 6)) || (stem == 11 && !strncmp(names[k], "coordinates", 11)))
       continue;
     for (long m = 0; m < n; m++)
       if (strlen(names[m]) == stem + 2 && !strncmp(names[m], names[k], stem) && names[m][stem] == mark &&
-          names[m][stem + 1] == '1') {
+          names[m][stem + 1] == (first == '0' ? '1' : 'y')) {
         col[2] = (int)k;
         col[3] = (int)m;
       }
@@ -660,8 +698,16 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
         size_t *per = calloc(nx + ny, sizeof *per), few = SIZE_MAX, which = 0;
         if (!per) s = lw_error_set(err, LW_ENOMEM, "%s: out of memory for %zu points", path, n);
         for (size_t k = 0; per && k < n; k++) per[node[k] % nx]++, per[nx + node[k] / nx]++;
-        for (size_t c = 0; per && c < nx + ny; c++)
-          if (per[c] < few && 2 * per[c] < (c < nx ? ny : nx)) few = per[c], which = c;
+        /* (a column of few points beside another far closer than the grid's
+        ** spacing: a hole in the grid, an obstacle's, has its columns
+        ** evenly spaced and was said mistyped) */
+        for (size_t c = 0; per && c < nx + ny; c++) {
+          const double *u = c < nx ? ux : uy;
+          const size_t m = c < nx ? nx : ny, idx = c < nx ? c : c - nx;
+          const double even = m > 1 ? (u[m - 1] - u[0]) / (double)(m - 1) : 0.0,
+                       near = fmin(idx > 0 ? u[idx] - u[idx - 1] : HUGE_VAL, idx + 1 < m ? u[idx + 1] - u[idx] : HUGE_VAL);
+          if (per[c] < few && 2 * per[c] < (c < nx ? ny : nx) && near < 0.1 * even) few = per[c], which = c;
+        }
         const int row = which >= nx;
         for (size_t k = 0; per && few != SIZE_MAX && k < n; k++)
           if (row ? node[k] / nx == which - nx : node[k] % nx == which) {

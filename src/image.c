@@ -1440,13 +1440,16 @@ lw_status lw_image_levels(lw_image *img, const float *under, double clip, int fl
     if (!l_flat) l = bl;
     if (!h_flat) h = bh;
     /* an end left alone keeps its flat colour from turning white or black
-    ** whole, but with the other end stretched up to it, it crossed the
-    ** middle tone: a DEM's flat sea at 0.458, its land up to 0.464, made
-    ** 0.99 (white) with l at 0; there it is stretched as any end (a flat
-    ** colour that stays on its side of the middle, dark or light, is left
-    ** alone: one that went white that way was what the rule is for) */
-    if (flat >= 2 && l_flat && !h_flat && (bl < 0.5) != ((bl - l) / (h - l) < 0.5)) l = bl;
-    if (flat >= 2 && h_flat && !l_flat && (bh < 0.5) != ((bh - l) / (h - l) < 0.5)) h = bh;
+    ** whole, but with the other end stretched up to it the picture's tones
+    ** were crowded at the far end: a DEM's flat sea at 0.458, its land up to
+    ** 0.464, went to 0.99 and up (white, an empty drawing) with l at 0, and
+    ** one stored signed, its sea at 0.5, alike.  Where its tones would fill
+    ** under LW_IMAGE_LEVELS_CROWDED of the range, that end is stretched as
+    ** any; a graphic's flat colour beside its other tones (a dark logo's
+    ** 0.35 over 0 to 0.2: 0.35 of the range; a disc's 0.33 beside a bar of
+    ** 0.12 to 0.26: 0.24) is left alone */
+    if (flat >= 2 && l_flat && !h_flat && 1.0 - (bl - l) / (h - l) < LW_IMAGE_LEVELS_CROWDED) l = bl;
+    if (flat >= 2 && h_flat && !l_flat && (bh - l) / (h - l) < LW_IMAGE_LEVELS_CROWDED) h = bh;
     if (kept) *kept = (l == 0.0 && l_flat && bl > 0.0) | (h == 1.0 && h_flat && bh < 1.0) << 1;
   }
   free(hist);

@@ -123,10 +123,10 @@ const lw_param_def lw_param_table[] = {
   NUM("scene", "image_levels_flat", LW_PT_INT, image_levels_flat, "2", "", 0, 2, 0,
       "image_levels on a flat colour: 1 = an end is left alone where one tone holds more than 5 % of the "
       "pixels with no more than 5 % beyond it (a graphic's lightest colour past whose anti-aliased edge or "
-      "JPEG ringing the clip fell turned white whole); 2 = so, but an end whose flat colour the other end's "
-      "stretch would carry across the middle tone, from its side to the other, is stretched as any (a "
-      "low-contrast elevation model's flat sea, its darkest, turned white with the whole picture under 1), as "
-      "runs before 2026-12-07 did not; "
+      "JPEG ringing the clip fell turned white whole); 2 = so, but an end left alone beside the other end's "
+      "stretch that would crowd the picture's tones into less than a tenth of the range is stretched as any "
+      "(a low-contrast elevation model's flat sea, its darkest, turned white with the whole picture under 1), "
+      "as runs before 2026-12-07 did not; "
       "0 = only where the clip falls on such a tone, as runs before this key (a run of theirs, whose "
       "scene.ini has no line for this key, resumes so)."),
   NUM("scene", "image_gamma", LW_PT_DOUBLE, image_gamma, "1", "", 0, 100, LW_MIN_OPEN,

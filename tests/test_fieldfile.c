@@ -532,6 +532,16 @@ Test(fieldfile, a_list_of_points_reads_onto_its_grid)
     /* units unquoted (a spreadsheet's), and pandas' unnamed index column */
     "x [m],y [m],u (m/s),v (m/s)\n0,0,0,-0.5\n2,0,1,-1.5\n4,0,2,-2.5\n0,1,10,-10.5\n2,1,11,-11.5\n4,1,12,-12.5\n",
     ",x,y,u,v\n0,0,0,0,-0.5\n1,2,0,1,-1.5\n2,4,0,2,-2.5\n3,0,1,10,-10.5\n4,2,1,11,-11.5\n5,4,1,12,-12.5\n",
+    /* pandas read and written again, R's write.csv (its row names quoted),
+    ** a spreadsheet's names with blanks and units, OpenFOAM's U_x U_y */
+    ",Unnamed: 0,x,y,u,v\n0,0,0,0,0,-0.5\n1,1,2,0,1,-1.5\n2,2,4,0,2,-2.5\n3,3,0,1,10,-10.5\n4,4,2,1,11,-11.5\n"
+    "5,5,4,1,12,-12.5\n",
+    "\"\",\"x\",\"y\",\"u\",\"v\"\n\"1\",0,0,0,-0.5\n\"2\",2,0,1,-1.5\n\"3\",4,0,2,-2.5\n\"4\",0,1,10,-10.5\n"
+    "\"5\",2,1,11,-11.5\n\"6\",4,1,12,-12.5\n",
+    "X Position (m),Y Position (m),U (m/s),V (m/s)\n0,0,0,-0.5\n2,0,1,-1.5\n4,0,2,-2.5\n0,1,10,-10.5\n2,1,11,-11.5\n"
+    "4,1,12,-12.5\n",
+    "x,y,z,U_x,U_y,U_z\n0,0,7,0,-0.5,9\n2,0,7,1,-1.5,9\n4,0,7,2,-2.5,9\n0,1,7,10,-10.5,9\n2,1,7,11,-11.5,9\n"
+    "4,1,7,12,-12.5,9\n",
   };
   for (size_t k = 0; k < sizeof named / sizeof *named; k++) {
     lw_test_write(path, named[k], strlen(named[k]));
@@ -556,6 +566,10 @@ Test(fieldfile, a_list_of_points_reads_onto_its_grid)
      "u and v"},
     {"\"X [m]\" \"Y [m]\" speed angle\n0 0 1 0\n", ":1: a header row of 4 names, none of them u or v"},
     {"flow past a cylinder\n0 0 1 0\n1 0 1 0\n0 1 1 0\n", "no point at (1, 1)"},
+    /* a hole in the grid (an obstacle's): its first node, not a mistyped
+    ** coordinate (its columns evenly spaced) */
+    {"0 0 1 0\n1 0 1 0\n2 0 1 0\n3 0 1 0\n0 1 1 0\n3 1 1 0\n0 2 1 0\n3 2 1 0\n0 3 1 0\n1 3 1 0\n2 3 1 0\n3 3 1 0\n",
+     ": no point at (1, 1), a node of the 4 x 4 grid"},
     /* a mistyped coordinate: its line, not a node of its own column */
     {"0 0 1 0\n1 0 1 0\n2 0 1 0\n0 1 1 0\n1 1 1 0\n2 1 1 0\n0 2 1 0\n1.0001 2 1 0\n2 2 1 0\n0 3 1 0\n1 3 1 0\n2 3 1 0\n",
      ":8: the point at (1.0001, 2) lies off the grid the others make: its x is that of 1 point, where a column of the "

@@ -647,6 +647,20 @@ Test(image, a_flat_end_is_not_carried_across_the_middle)
   for (int k = 0; k < n; k++) img->tone[k] = (float)(k < 400 ? 0.6 : 0.8 + 0.2 * (k - 400) / 599.0);
   cr_assert_eq(lw_image_levels(img, NULL, 0.01, 2, &lo, &hi, NULL, NULL), LW_OK);
   cr_assert(lo == 0.0 && img->tone[0] > 0.5, "pale logo: levels %g to %g, its flat colour %g", lo, hi, img->tone[0]);
+  /* a disc's flat 0.33 (90 %) beside a bar from 0.10 to 0.26: kept, not white */
+  for (int k = 0; k < n; k++) img->tone[k] = (float)(k < 900 ? 0.33 : 0.10 + 0.16 * (k - 900) / 99.0);
+  cr_assert_eq(lw_image_levels(img, NULL, 0.01, 2, &lo, &hi, NULL, NULL), LW_OK);
+  cr_assert(hi == 1.0 && img->tone[0] < 0.5, "disc and bar: levels %g to %g, the disc %g", lo, hi, img->tone[0]);
+  /* crowded at the far end, a flat colour on either side of the middle: a
+  ** signed elevation model's sea at 0.5 (land to 0.504), and a light flat
+  ** sea at 0.40 (land down to 0.394), which went white and black whole */
+  static const double sea2[2] = {0.5, 0.40}, rise[2] = {0.004, -0.006};
+  for (int c = 0; c < 2; c++) {
+    for (int k = 0; k < n; k++) img->tone[k] = (float)(k < 570 ? sea2[c] : sea2[c] + rise[c] * (k - 569) / 430.0);
+    cr_assert_eq(lw_image_levels(img, NULL, 0.01, 2, &lo, &hi, NULL, NULL), LW_OK);
+    cr_assert(fabs(hi - lo - LW_IMAGE_LEVELS_MIN_SPAN) < 1e-12 && img->tone[0] > 0.3 && img->tone[0] < 0.7,
+              "sea %g: levels %g to %g, the sea %g", sea2[c], lo, hi, img->tone[0]);
+  }
   lw_image_free(img);
 }
 

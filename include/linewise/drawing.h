@@ -74,6 +74,7 @@ typedef struct {
   lw_fidelity pen_fidelity[LW_PLOT_PENS_MAX]; /* per pen, when n_pens > 1 */
   double pen_width[LW_PLOT_PENS_MAX];         /* each pen's, mm */
   int picture_thin;                           /* the picture lies narrower than two segments (noted before) */
+  int frame_not_rect;                         /* scene.boundary is not the page's rectangle */
 } lw_drawing_report;
 
 

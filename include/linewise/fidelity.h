@@ -51,7 +51,7 @@
 **    does.  0 for a drawing without ink.
 ** 6. Missed marks, stray ink's mirror: the share of the target's dark pixels
 **    (darkness LW_FIDELITY_MARK of black or more, unblurred) with no inked
-**    pixel (covered LW_FIDELITY_INKED or more) within LW_FIDELITY_MISS_REACH
+**    pixel (covered LW_FIDELITY_INKED of black or more) within LW_FIDELITY_MISS_REACH
 **    pen widths along x and y.  A dark area hatched at its density (lines
 **    at most 2.9 pen widths apart at that darkness) has a line within 1.5
 **    widths of every pixel; a mark no line came near -- a letter thinner
@@ -84,7 +84,7 @@ extern "C" {
 #define LW_FIDELITY_SIDE_MAX 32767    /* the most pixels a side cairo renders: a longer picture cannot be scored */
 #define LW_FIDELITY_WHITE 0.02        /* blurred darkness under which the target is white paper */
 #define LW_FIDELITY_MARK 0.7          /* darkness (of black) from which a target pixel is a mark */
-#define LW_FIDELITY_INKED 0.25        /* a pixel's ink from which it counts as inked */
+#define LW_FIDELITY_INKED 0.25        /* a pixel's ink, of black, from which it counts as inked */
 #define LW_FIDELITY_MISS_REACH 2.0    /* pen widths within which a mark's line must lie */
 #define LW_FIDELITY_MISS_CELL 25.0    /* pen widths a side of the squares missed_worst is of */
 

@@ -146,9 +146,9 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
 ** lightest colour, vanished), where a photograph's ends are tails of a few
 ** pixels a tone; with `flat` >= 1, also where such a tone has no more than
 ** LW_IMAGE_LEVELS_PLATEAU of the pixels beyond it (anti-aliasing or a JPEG's
-** ringing past a flat colour); with `flat` 2, a flat end whose colour the
-** other end's stretch would carry across the middle tone (from its side to
-** the other) is stretched as any
+** ringing past a flat colour); with `flat` 2, a flat end left alone beside
+** the other end's stretch that would crowd the picture's tones into less
+** than LW_IMAGE_LEVELS_CROWDED of the range is stretched as any
 ** (a low-contrast elevation model's flat sea, its darkest, went white with
 ** all the rest).  scene.image_levels_flat: 0 for runs begun before it, 1
 ** before 2026-12-07.  *lo and *hi receive the tones that became 0 and 1,
@@ -157,6 +157,7 @@ lw_status lw_image_flatten(lw_image *img, double radius, double *lo, double *hi,
 ** LW_ENOMEM with err set. */
 #define LW_IMAGE_LEVELS_MIN_SPAN 0.05
 #define LW_IMAGE_LEVELS_PLATEAU 0.05
+#define LW_IMAGE_LEVELS_CROWDED 0.1
 /* A *lo from this tone up is a light picture's darkest (a pale sky's 0.45,
 ** a white board's 0.68; a dim photograph's, the moon's, 0.23), which the
 ** stretch turns black: the run's note says so, and how to keep it light. */
