@@ -1424,9 +1424,14 @@ static int cmd_run(int argc, char **argv)
     /* (a camera's picture under ulimit -v said "out of memory for a 1732 x
     ** 2309 grid" and no more; 1e6 pixels ran in 77 MB) */
     if (err.code == LW_ENOMEM) {
-      snprintf(err.msg + n, sizeof err.msg - n, "; in less memory %sfewer splines or fewer threads (--threads 1: "
-               "ulimit -v counts each thread's reserve) make a smaller run (docs/PERFORMANCE.md, \"Memory\")",
-               p.image[0] ? "a smaller scene.image_max_pixels, " : "");
+      /* (a file is decoded whole before image_max_pixels makes it smaller) */
+      if (strstr(err.msg, "out of memory decoding"))
+        snprintf(err.msg + n, sizeof err.msg - n, "; the picture's file is decoded whole before it is made smaller: "
+                 "a file of fewer pixels, or more memory");
+      else
+        snprintf(err.msg + n, sizeof err.msg - n, "; in less memory %sfewer splines or fewer threads (--threads 1: "
+                 "ulimit -v counts each thread's reserve) make a smaller run (docs/PERFORMANCE.md, \"Memory\")",
+                 p.image[0] ? "a smaller scene.image_max_pixels, " : "");
       stash_note(&err, dir);
     } else if (err.code == LW_EIO && access(dir, F_OK) &&
              (was_there || strstr(err.msg, ": cannot create directory: ") == NULL))
