@@ -639,7 +639,7 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
     if (got != width)
       s = lw_error_set(err, LW_EINPUT, "%s:%ld: %ld values: expected %ld a line (%s)", path, line, got, width,
                        width == 4 ? "x y u v" : "as the header row names");
-    long *grown = (rows & (rows - 1)) ? at : realloc(at, (rows ? 2 * (size_t)rows : 1) * sizeof *at);
+    long *grown = s || (rows & (rows - 1)) ? at : realloc(at, (rows ? 2 * (size_t)rows : 1) * sizeof *at);
     if (!s && !grown) s = lw_error_set(err, LW_ENOMEM, "%s: out of memory for the points", path);
     if (!s) {
       at = grown;
