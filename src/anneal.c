@@ -685,6 +685,10 @@ lw_status lw_anneal_check_keys(const lw_params *p, char *unread, size_t size, lw
   for (size_t i = 0; i < lw_param_count; i++) {
     const lw_param_def *d = &lw_param_table[i];
     if (!lw_params_given(p, d) || key_read(t, v, d)) continue;
+    /* a run's scene.ini, redrawn, writes every key at its run's values: a
+    ** default changed since (image_levels_flat's 1) refused a D-NURBS redraw
+    ** for a picture key no one set */
+    if (p->run_header && p->line[i] > 0) continue;
     char where[LW_PATH_MAX + 32], readers[300];
     lw_params_origin(p, d, where, sizeof where);
     int elsewhere = 0; /* read under another driver */

@@ -451,7 +451,7 @@ lw_status lw_drawing_frame(const lw_params *p, const lw_scene *sc, const lw_spli
 }
 
 /* The share of missed marks (fidelity.h) from which the run says so: the
-** bundled example misses 0, a page of text 0.001, photographs up to 0.03,
+** bundled example misses 0, a few large words 0.001, photographs up to 0.03,
 ** bold capitals with crossbars gone 0.15, hairline letters half undrawn 0.38
 ** (0.03 with a pen fine enough); or, in the worst square, the share from
 ** which it does: a word left out there, its marks half bare or more. */

@@ -139,7 +139,8 @@ static lw_status set_option(lw_params *p, const char *assignment, lw_error *err)
 ** refused for a value it replaced). */
 static int set_later(char **argv, int argc, int i)
 {
-  const char *name = argv[i + 1], *eq = strchr(name, '=');
+  /* (--seed N is --set anneal.seed=N) */
+  const char *name = !strcmp(argv[i], "--seed") ? "anneal.seed=" : argv[i + 1], *eq = strchr(name, '=');
   if (!eq) return 0;
   for (int j = i + 2; j + 1 < argc; j++)
     if ((!strcmp(argv[j], "--set") && !strncmp(argv[j + 1], name, (size_t)(eq - name) + 1)) ||
@@ -1345,6 +1346,10 @@ static int cmd_run(int argc, char **argv)
       out = v;
       i++;
     } else if (!strcmp(argv[i], "--seed")) {
+      if (set_later(argv, argc, i)) { /* the last value is the seed */
+        i++;
+        continue;
+      }
       if (!parse_count("--seed", v, 0, LW_SEED_MAX, &seed, &err)) return fail(&err);
       char buf[64];
       snprintf(buf, sizeof buf, "anneal.seed=%ld", seed);

@@ -876,9 +876,10 @@ const lw_param_def lw_param_table[] = {
       "each of its pieces toward its ends (nurbs.pieces; docs/NURBS.md)."),
   NUM("nurbs", "pieces", LW_PT_INT, nb_pieces, "2", "", 1, 2, 0,
       "How a knot span of weights apart is cut toward its ends for the quadrature: 2 = as far as the "
-      "rational basis turns there, h ((k - 1) q)^(-1/p) beside a knot of multiplicity m (p = k - m, 1 to "
-      "3: a clamped end 1), any ratio q of the span's weights at such a knot; 1 = h q^(-1/3) at every "
-      "knot, from a ratio of 2, as runs before 2026-12-07 (a run of theirs, whose scene.ini has no line for "
+      "rational basis turns there: beside a knot of multiplicity m where p = k - m is under 3 (a clamped "
+      "end: 1) h ((k - 1) q')^(-1/p), q' the ratio q of the span's weights but at least 2, for any q over "
+      "1; elsewhere h q^(-1/3) from a ratio of 2; 1 = h q^(-1/3) at every knot, from a ratio of 2, as runs "
+      "before 2026-12-07 (a run of theirs, whose scene.ini has no line for "
       "this key, resumes so): a light end point of weight 0.01 read 0.58 of the energy, an order 8 curve "
       "with an end weight of 0.5 99 % (docs/NURBS.md)."),
   NUM("nurbs", "fixed", LW_PT_INT, nb_fixed, "0", "", 0, 1e9, 0,
@@ -1087,7 +1088,7 @@ static void typed_hint(const lw_param_def *d, const char *text, char *hint, size
   *hint = '\0';
   if (len >= 2 && strchr("\"'", text[0]) && text[len - 1] == text[0])
     snprintf(hint, n, " (without the quotes)");
-  else if (word && (*rest == '#' || (*rest == ';' && rest == text + word)))
+  else if (word && (*rest == '#' || *rest == ';'))
     snprintf(hint, n, " (the value alone: in a scene file a comment after it starts with ';' after a blank, "
              "'%.*s ; ...'; --set takes none)", (int)(word < 16 ? word : 16), text);
   else if (numeric && lead && *rest == '%' && d->max <= 1.0)

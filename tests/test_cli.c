@@ -1422,8 +1422,9 @@ Test(cli, a_key_set_twice_takes_the_last_value)
                           "&& { %s run %s/params/minimal.ini --out o2 --set scene.width=120 --set scene.width=0.5 "
                           "2> err.txt; test $? -eq 2; } && grep -q \"scene.width': expected a value >= 1\" err.txt "
                           "&& %s run %s/params/minimal.ini --out o3 --set anneal.seed=-3 --seed 5 --set anneal.sweeps=1 "
-                          "--quiet && grep -qx 'seed = 5' o3/scene.ini",
-                          dir, b, r, b, b, r, b, r), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+                          "--quiet && grep -qx 'seed = 5' o3/scene.ini && %s run %s/params/minimal.ini --out o4 --seed -3 "
+                          "--set anneal.seed=6 --set anneal.sweeps=1 --quiet && grep -qx 'seed = 6' o4/scene.ini",
+                          dir, b, r, b, b, r, b, r, b, r), 0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
 /* A resume of a finished run redraws it and writes summary.json again: its
