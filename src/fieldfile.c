@@ -705,7 +705,8 @@ static lw_grid2d *read_points(FILE *f, const char *path, int ncomp, lw_error *er
           const double *u = c < nx ? ux : uy;
           const size_t m = c < nx ? nx : ny, idx = c < nx ? c : c - nx;
           const double even = m > 1 ? (u[m - 1] - u[0]) / (double)(m - 1) : 0.0,
-                       near = fmin(idx > 0 ? u[idx] - u[idx - 1] : HUGE_VAL, idx + 1 < m ? u[idx + 1] - u[idx] : HUGE_VAL);
+                       near = fmin(idx > 0 ? u[idx] - u[idx - 1] : HUGE_VAL,
+                                   idx + 1 < m ? u[idx + 1] - u[idx] : HUGE_VAL);
           if (per[c] < few && 2 * per[c] < (c < nx ? ny : nx) && near < 0.1 * even) few = per[c], which = c;
         }
         const int row = which >= nx;

@@ -119,7 +119,8 @@ lw_status lw_fidelity_render(const lw_splines *sp, const lw_grid2d *tone, double
 lw_status lw_fidelity_render_strokes(const lw_strokes *s, int pen, const lw_grid2d *tone, double pen_width_mm,
                                      double *ink, lw_error *err);
 
-/* Steps 2-5 (not 6: lw_fidelity_compute_strokes counts the missed marks) for the ink a and the darkness b, w x h (changed in place: blurred),
+/* Steps 2-5 (not 6: lw_fidelity_compute_strokes counts the missed marks) for
+** the ink a and the darkness b, w x h (changed in place: blurred),
 ** blur sigma sx, sy in pixels (0 = none), paper white where the blurred b is
 ** under `white`; out->sigma_mm and out->black are left alone. */
 lw_status lw_fidelity_compare(double *a, double *b, int w, int h, double sx, double sy, double white,
