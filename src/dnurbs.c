@@ -33,9 +33,13 @@ static int span_halvings(const lw_nurbs *c, size_t s, int right)
   const size_t k = (size_t)c->order, n_knots = c->n + k;
   double lo = c->w[s + 1 - k], hi = lo;
   for (size_t i = s + 2 - k; i <= s; i++) lo = fmin(lo, c->w[i]), hi = fmax(hi, c->w[i]);
-  const double q = hi / lo, at = c->knot[s + (size_t)right];
-  int m = 0;
-  for (size_t i = 0; i < n_knots; i++) m += c->knot[i] == at;
+  /* the knot's multiplicity, by its equal neighbours (the knots do not
+  ** decrease; every knot asked was O(n) a proposal on a refined wire) */
+  const size_t at = s + (size_t)right;
+  int m = 1;
+  for (size_t i = at; i > 0 && c->knot[i - 1] == c->knot[at]; i--) m++;
+  for (size_t i = at + 1; i < n_knots && c->knot[i] == c->knot[at]; i++) m++;
+  const double q = hi / lo;
   const int p = c->pieces < 2 ? 3 : (int)k - m < 1 ? 1 : (int)k - m > 3 ? 3 : (int)k - m;
   /* pieces of h 2^-30 resolve a ratio of 1e27 (1e9 where p = 1), past which
   ** a piece's Gauss points crowd the span's end to rounding; a ratio past

@@ -300,20 +300,35 @@ Test(fidelity, stray_ink_is_ink_far_inside_the_white)
   lw_grid2d_free(tone);
 }
 
+/* A w x h raster of pixels px mm wide: black where dark(x, y) of a pixel's
+** centre, mm, else white. */
+static lw_grid2d *marks_tone(int w, int h, double px, int (*dark)(double x, double y))
+{
+  lw_grid2d *tone = lw_grid2d_new(w, h, 1, 0.5 * px, 0.5 * px, px, px, NULL);
+  for (int j = 0; j < h; j++)
+    for (int i = 0; i < w; i++) tone->data[j * w + i] = dark((i + 0.5) * px, (j + 0.5) * px) ? 0.0 : 1.0;
+  return tone;
+}
+
+static int two_bars(double x, double y)
+{
+  (void)y;
+  return (x > 5 && x < 5.5) || (x > 20 && x < 20.5);
+}
+
+static int block_and_bar(double x, double y)
+{
+  return (x > 5 && x < 35 && y > 5 && y < 35) || (x > 45 && x < 48 && y > 15 && y < 18);
+}
+
 /* Missed marks, stray ink's mirror: two dark bars 0.5 mm wide (a 0.3 mm
 ** pen); a line along the first alone misses the second (half the marks),
 ** along both none; a line 0.3 mm beside each still reaches it (all of it
 ** within 2 pen widths of the line's ink), one 1.5 mm off not. */
 Test(fidelity, missed_marks_are_dark_pixels_no_line_came_near)
 {
-  const double px = 0.1, pen = 0.3;
-  const int w = 300, h = 200; /* 30 x 20 mm */
-  lw_grid2d *tone = lw_grid2d_new(w, h, 1, 0.5 * px, 0.5 * px, px, px, NULL);
-  for (int j = 0; j < h; j++)
-    for (int i = 0; i < w; i++) {
-      const double x = (i + 0.5) * px;
-      tone->data[j * w + i] = (x > 5 && x < 5.5) || (x > 20 && x < 20.5) ? 0.0 : 1.0;
-    }
+  const double pen = 0.3;
+  lw_grid2d *tone = marks_tone(300, 200, 0.1, two_bars); /* 30 x 20 mm */
   static const struct {
     int n;
     double x[2], want;
@@ -336,15 +351,8 @@ Test(fidelity, missed_marks_are_dark_pixels_no_line_came_near)
 ** side, names it and where); hatched too, none. */
 Test(fidelity, the_worst_square_finds_a_small_mark_left_bare)
 {
-  const double px = 0.1, pen = 0.3;
-  const int w = 600, h = 400; /* 60 x 40 mm */
-  lw_grid2d *tone = lw_grid2d_new(w, h, 1, 0.5 * px, 0.5 * px, px, px, NULL);
-  for (int j = 0; j < h; j++)
-    for (int i = 0; i < w; i++) {
-      const double x = (i + 0.5) * px, y = (j + 0.5) * px;
-      const int block = x > 5 && x < 35 && y > 5 && y < 35, bar = x > 45 && x < 48 && y > 15 && y < 18;
-      tone->data[j * w + i] = block || bar ? 0.0 : 1.0;
-    }
+  const double pen = 0.3;
+  lw_grid2d *tone = marks_tone(600, 400, 0.1, block_and_bar); /* 60 x 40 mm */
   for (int bar = 0; bar < 2; bar++) {
     size_t n = 61 + (size_t)(bar ? 7 : 0), segs[68];
     for (size_t i = 0; i < n; i++) segs[i] = 1;
