@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include "linewise/checkpoint.h"
@@ -172,6 +173,22 @@ void lw_anneal_frames_note(const lw_anneal *a, char *buf, size_t n)
            a->dir, a->frame_before.sweep, a->frame_before.w, a->frame_before.h, w, h);
 }
 
+void lw_anneal_film_note(const lw_anneal *a, char *buf, size_t n)
+{
+  static const char *const what[2] = {"a frame", "a sample"}, *const key[2] = {"frames_every", "samples_every"};
+  const int every[2] = {a->params.frames_every, a->params.samples_every};
+  const double wall = lw_phase_clock() - a->wall_start, cost = a->film_seconds[0] + a->film_seconds[1];
+  buf[0] = '\0';
+  if (!(cost > 1.0 && cost > wall / 3.0)) return;
+  size_t used = 0;
+  for (int k = 0; k < 2; k++)
+    if (a->film_seconds[k] > cost / 4.0 && used < n)
+      used += (size_t)snprintf(buf + used, n - used, "%swriting %s every %d sweeps (output.%s) took %.0f %%",
+                               used ? ", " : "", what[k], every[k], key[k], 100.0 * a->film_seconds[k] / wall);
+  if (used < n)
+    snprintf(buf + used, n - used, " of this run's time: a larger value costs less (the run's results are the same)");
+}
+
 void lw_anneal_drift_note(const lw_anneal *a, char *buf, size_t n)
 {
   buf[0] = '\0';
@@ -274,6 +291,38 @@ static double rung_energy(const lw_anneal *a, int k)
 }
 
 double lw_anneal_energy(const lw_anneal *a) { return rung_energy(a, 0); }
+
+/* n bytes as "3.36 GB", "62.7 MB" or "840 kB" into buf (16 bytes). */
+static const char *bytes_text(double n, char *buf)
+{
+  const char *unit = n >= 1e9 ? "GB" : n >= 1e6 ? "MB" : "kB";
+  snprintf(buf, 16, "%.3g %s", n / (n >= 1e9 ? 1e9 : n >= 1e6 ? 1e6 : 1e3), unit);
+  return buf;
+}
+
+void lw_anneal_frames_disk_note(const lw_anneal *a, char *buf, size_t n, int *warning)
+{
+  buf[0] = '\0';
+  *warning = 0;
+  const long every = a->params.frames_every, from = a->sweep, to = a->end_sweep;
+  long at;
+  unsigned w, h;
+  char path[LW_PATH_MAX + 64], t[3][16];
+  struct stat st;
+  struct statvfs fs;
+  if (!every || to <= from || !rung_here(a, 0) || !lw_runfiles_frame_size(a->dir, LONG_MAX, &at, &w, &h)) return;
+  snprintf(path, sizeof path, "%s/frames/frame-%06ld.png", a->dir, at);
+  if (stat(path, &st) || statvfs(path, &fs)) return;
+  /* those on the grid past the sweep done, and the end's where it is off it */
+  const double frames = (double)(to / every - from / every) + (to % every != 0);
+  const double need = frames * (double)st.st_size, free = (double)fs.f_bavail * (double)fs.f_frsize;
+  if (!(need > free) && !(need > 1e9)) return;
+  *warning = need > free;
+  snprintf(buf, n, "%s/frames/: the %.0f frames still to come (output.frames_every = %ld) take about %s at the %s "
+           "of %s, %s %s free there%s", a->dir, frames, every, bytes_text(need, t[0]), bytes_text(st.st_size, t[1]),
+           strrchr(path, '/') + 1, *warning ? "more than the" : "with", bytes_text(free, t[2]),
+           *warning ? ": the run fails when the disk fills (a larger frames_every takes less)" : "");
+}
 
 /* Schedule and its table (relative to the scene file).  The dynamics has no
 ** temperature: its scene's schedule keys are only noted as unread
@@ -1901,11 +1950,16 @@ static lw_status sweep_files(lw_anneal *a, lw_error *err)
   /* the end has a frame as it has a trace row, on the grid or not: the film
   ** ended short of the drawing (at 180 of 200, at 0 with frames_every past
   ** the sweeps) */
-  if (p->frames_every && (a->sweep % p->frames_every == 0 || lw_anneal_done(a)) && rung_here(a, 0) &&
-      a->sys_type->draw(a->sys->state, p, a->dir, a->sweep, err))
-    return err->code;
-  if (p->samples_every && a->sweep % p->samples_every == 0 && rung_here(a, 0) && write_sample(a, err))
-    return err->code;
+  double t0 = lw_phase_clock();
+  if (p->frames_every && (a->sweep % p->frames_every == 0 || lw_anneal_done(a)) && rung_here(a, 0)) {
+    if (a->sys_type->draw(a->sys->state, p, a->dir, a->sweep, err)) return err->code;
+    a->film_seconds[0] += lw_phase_clock() - t0;
+  }
+  if (p->samples_every && a->sweep % p->samples_every == 0 && rung_here(a, 0)) {
+    t0 = lw_phase_clock();
+    if (write_sample(a, err)) return err->code;
+    a->film_seconds[1] += lw_phase_clock() - t0;
+  }
   if (a->sweep % p->checkpoint_every == 0) return lw_anneal_checkpoint(a, err);
   return LW_OK;
 }

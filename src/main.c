@@ -867,6 +867,16 @@ static void say_stash_left(lw_anneal *a)
   a->stash_left[0] = 0;
 }
 
+/* Frames that will fill the disk: said under --quiet too, as the failure
+** it foretells would be (the process that draws them says it). */
+static void say_frames_disk(const lw_anneal *a, int quiet)
+{
+  char note[LW_PATH_MAX + 256];
+  int warning;
+  lw_anneal_frames_disk_note(a, note, sizeof note, &warning);
+  if (note[0] && (warning || !quiet)) fprintf(stderr, "linewise: %s: %s\n", warning ? "warning" : "note", note);
+}
+
 /* libgomp ends the process (exit 1, "libgomp: Thread creation failed") where
 ** it cannot start a team's threads, which may first happen after the set-up
 ** (a team larger than the last: libgomp lets the threads a smaller team left
@@ -1031,6 +1041,8 @@ static int anneal_loop(lw_anneal *a, long stop_at, int quiet, int asked, watcher
     lw_anneal_checkpoint_note(a, drawn, sizeof drawn);
     if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
     lw_anneal_frames_note(a, drawn, sizeof drawn);
+    if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
+    lw_anneal_film_note(a, drawn, sizeof drawn);
     if (drawn[0]) fprintf(stderr, "linewise: note: %s\n", drawn);
   }
   /* the warnings, of numbers the run got wrong or left out, under --quiet
@@ -1473,6 +1485,7 @@ static int cmd_run(int argc, char **argv)
             "run seeds as that one did, where two seeds could draw the same numbers; --set anneal.seed_version=2 for "
             "a new study (docs/NUMERICS.md, \"Random numbers\")\n", scene);
   if (a.memory_note[0] && (!net || !net->rank)) fprintf(stderr, "linewise: note: %s\n", a.memory_note);
+  say_frames_disk(&a, quiet);
   /* a release spans changes that draw a scene otherwise (each keeps a run
   ** begun before on resume, not a new run of its scene.ini) */
   char this_build[64];
@@ -1602,6 +1615,7 @@ static int cmd_resume(int argc, char **argv)
   watcher_settle(&w);
   /* a resume under the limit that failed its drawing failed again unsaid */
   if (a.memory_note[0] && (!net || !net->rank)) fprintf(stderr, "linewise: note: %s\n", a.memory_note);
+  say_frames_disk(&a, quiet);
   /* (under --quiet too: a study's rates were many times too high unsaid) */
   if (a.untimed_said == 2 && (!net || !net->rank))
     fprintf(stderr, "linewise: note: %s/timing.txt, of a release before 2026-12-04, has the wall time alone: "

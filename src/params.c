@@ -593,7 +593,9 @@ const lw_param_def lw_param_table[] = {
       "(at half strength). Needs an image."),
   NUM("output", "frames_every", LW_PT_INT, frames_every, "0", "sweeps", 0, 2e9, 0,
       "Sweeps between animation frames frames/frame-SSSSSS.png (SSSSSS = the sweep; the first, 000000, "
-      "is the start, and the run's end has one, on the grid or not). 0 = none."),
+      "is the start, and the run's end has one, on the grid or not). A run whose frames still to come would take "
+      "more than the disk has free (a warning) or over 1 GB, at the newest frame's size, says so as it starts; one "
+      "whose frames or samples took over a third of its time, at its end. 0 = none."),
   NUM("output", "fidelity_sigma", LW_PT_DOUBLE, fidelity_sigma, "1", "mm", 1e-6, 1e4, 0,
       "Gaussian blur applied to both the rendered lines and the target (the ink asked for, "
       "energy.tone_ink * darkness) before the fidelity score (MSE, SSIM) compares them; about "

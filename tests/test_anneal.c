@@ -8,6 +8,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -596,6 +598,77 @@ Test(anneal, checkpoints_that_take_most_of_a_run_are_said)
   a.wall_start += 9.5; /* a run of half a second: 0.4 s of checkpoints is no matter */
   a.ckpt_seconds = 0.4;
   lw_anneal_checkpoint_note(&a, note, sizeof note);
+  cr_assert_str_eq(note, "");
+}
+
+/* Frames and samples as checkpoints: a frame a sweep of a small scene made
+** a 0.3-second run take 2 minutes, unsaid.  The note names the key of each
+** that took a quarter of their time or more. */
+Test(anneal, frames_that_take_most_of_a_run_are_said)
+{
+  static lw_anneal a;
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  a.wall_start = (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec - 10.0;
+  a.params.frames_every = 7;
+  a.params.samples_every = 3;
+  char note[512];
+  a.film_seconds[0] = 8.0;
+  a.film_seconds[1] = 0.5;
+  lw_anneal_film_note(&a, note, sizeof note);
+  cr_assert(strstr(note, "writing a frame every 7 sweeps (output.frames_every) took 80 % of this run's time: a "
+                   "larger value costs less") && !strstr(note, "samples_every"), "%s", note);
+  a.film_seconds[0] = 2.0;
+  a.film_seconds[1] = 2.0;
+  lw_anneal_film_note(&a, note, sizeof note);
+  cr_assert(strstr(note, "frame every 7 sweeps (output.frames_every) took 20 %, writing a sample every 3 sweeps "
+                   "(output.samples_every) took 20 % of this run's time"), "%s", note);
+  a.film_seconds[1] = 1.0; /* together under a third */
+  lw_anneal_film_note(&a, note, sizeof note);
+  cr_assert_str_eq(note, "");
+}
+
+/* The frames still to come, at the newest frame's size, against the disk's
+** free space (a warning) or over 1 GB (a note); a run with frames that fit
+** says nothing.  Sparse frame files stand in for large ones. */
+Test(anneal, frames_that_fill_the_disk_are_foretold, .init = make_dir, .fini = remove_dir)
+{
+  static lw_anneal a;
+  snprintf(a.dir, sizeof a.dir, "%s", dir);
+  a.params.frames_every = 7;
+  a.end_sweep = 50;
+  a.pause_at = -1;
+  char path[256], note[512];
+  snprintf(path, sizeof path, "%s/frames", dir);
+  cr_assert_eq(mkdir(path, 0755), 0);
+  const unsigned char png[24] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+                                 0, 0, 1, 0, 0, 0, 1, 0};
+  const struct {
+    long sweep, at, bytes;
+    double frames;
+  } c[] = {{0, 0, 200000000, 8}, {14, 14, 100000000, 6}, {49, 49, 3000000000, 1}, {0, 0, 1000000, 8}};
+  struct statvfs fs;
+  for (size_t k = 0; k < sizeof c / sizeof c[0]; k++) {
+    snprintf(path, sizeof path, "%s/frames/frame-%06ld.png", dir, c[k].at);
+    FILE *f = fopen(path, "wb");
+    cr_assert(f && fwrite(png, 1, sizeof png, f) == sizeof png && !fseek(f, c[k].bytes - 1, SEEK_SET) &&
+              fputc(0, f) == 0 && !fclose(f));
+    a.sweep = c[k].sweep;
+    int warning;
+    lw_anneal_frames_disk_note(&a, note, sizeof note, &warning);
+    cr_assert_eq(statvfs(path, &fs), 0);
+    const double need = c[k].frames * (double)c[k].bytes, free = (double)fs.f_bavail * (double)fs.f_frsize;
+    cr_assert_eq(warning, need > free, "%s", note);
+    if (need > 1e9 || need > free) {
+      char want[128];
+      snprintf(want, sizeof want, "the %.0f frames still to come (output.frames_every = 7) take about", c[k].frames);
+      cr_assert(strstr(note, want) && strstr(note, path + strlen(dir) + 8), "%s", note);
+    } else
+      cr_assert_str_eq(note, "");
+    cr_assert_eq(unlink(path), 0);
+  }
+  a.sweep = 50; /* none to come */
+  lw_anneal_frames_disk_note(&a, note, sizeof note, &(int){0});
   cr_assert_str_eq(note, "");
 }
 

@@ -105,6 +105,7 @@ typedef struct lw_anneal {
   double ckpt_seconds;         /* of it, writing checkpoints (lw_anneal_checkpoint_note) */
   double ckpt_longest;         /* the longest of those writes, and how many there were: a */
   int ckpt_count;              /* process suspended during one is not a checkpoint's cost */
+  double film_seconds[2];      /* of it, writing frames and samples (lw_anneal_film_note) */
   unsigned long untimed;       /* proposals of sweeps no timing.txt timed (a resume without
                                ** one), which proposals_per_second leaves out */
   int untimed_said;            /* this resume found no timing.txt to go on from (1), or one with the wall
@@ -244,6 +245,13 @@ void lw_anneal_checkpoint_note(const lw_anneal *a, char *buf, size_t n);
 /* A note (else "") when the frames a resumed run drew differ in size from
 ** those before it (a drawing key edited in scene.ini): the film mixes them. */
 void lw_anneal_frames_note(const lw_anneal *a, char *buf, size_t n);
+/* The same for frames and samples (output.frames_every, samples_every):
+** a frame a sweep of a small scene made a 0.3-second run take 2 minutes. */
+void lw_anneal_film_note(const lw_anneal *a, char *buf, size_t n);
+/* A note (else "") where the frames still to come at the size of the
+** newest take more than the disk has free (warning = 1), or over 1 GB:
+** 10,000 frames of a page at png_scale 40 (3.5 GB) began unsaid. */
+void lw_anneal_frames_disk_note(const lw_anneal *a, char *buf, size_t n, int *warning);
 /* A note (else "") when a recomputation from scratch moved the running
 ** energy by more than LW_ANNEAL_DRIFT_NOTE of its size (row_drift): a
 ** system row whose commits do not add up its moves' dE (system.h); the
