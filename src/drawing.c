@@ -205,6 +205,7 @@ static lw_status score(const lw_params *p, const lw_scene *sc, const lw_strokes 
   rep->has_fidelity = !s;
   for (int k = 0; k < LW_PLOT_PENS_MAX; k++)
     rep->pen_width[k] = k < sc->layers.n ? sc->layers.spec[k].pen_width : p->pen_width;
+  rep->pen_targets = sc->layers.n;
   /* (as scene.c's note of a strip narrower than two segments) */
   rep->picture_thin = sc->image && fmin(sc->image->width, sc->image->height) * sc->image_place.pixel <
                                        2.0 * p->segment_length;
@@ -641,10 +642,12 @@ void lw_drawing_report_text(const lw_drawing_report *d, char *buf, size_t n)
                  d->pen_fidelity[p].missed);
   /* (hairline letters half undrawn scored SSIM 0.94, unsaid; a word left
   ** out beside a figure drawn whole was 0.01 of the marks, a pen's 0.31 of
-  ** its own; not of a picture too thin for the page, said before the run) */
+  ** its own; not of a picture too thin for the page, said before the run.
+  ** A pen of output.pens draws a share of the tones by design: its marks
+  ** are the whole picture's, and its misses no pen's fault) */
   const lw_fidelity *f = &d->fidelity;
   int pen = -1;
-  for (int p = 0; !missed_note(f) && d->n_pens > 1 && p < d->n_pens; p++)
+  for (int p = 0; !missed_note(f) && d->n_pens > 1 && p < d->n_pens && p < d->pen_targets; p++)
     if (missed_note(&d->pen_fidelity[p])) f = &d->pen_fidelity[pen = p];
   if (w < 0 || (k += (size_t)w) >= n || !missed_note(f) || d->picture_thin) return;
   char who[96] = "the picture's", where[160] = "";

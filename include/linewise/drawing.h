@@ -72,6 +72,7 @@ typedef struct {
   char pen_name[LW_PLOT_PENS_MAX][64];        /* its layer's name, or empty (the messages say "pen k") */
   char empty_why[400];                        /* with no path: what removed the lines, or empty */
   lw_fidelity pen_fidelity[LW_PLOT_PENS_MAX]; /* per pen, when n_pens > 1 */
+  int pen_targets;                            /* the first pens with a target of their own (a layer's) */
   double pen_width[LW_PLOT_PENS_MAX];         /* each pen's, mm */
   int picture_thin;                           /* the picture lies narrower than two segments (noted before) */
   int frame_not_rect;                         /* scene.boundary is not the page's rectangle */
