@@ -2057,7 +2057,7 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
     if (a->block >= 0) {
       double cnt = a->acc_n, mean = cnt > 0 ? a->acc_sum / cnt : 0.0;
       double var = cnt > 1 ? (a->acc_sumsq - cnt * mean * mean) / (cnt - 1) : 0.0;
-      a->prev = (lw_block_stats){mean, var > 0 ? sqrt(var) : 0.0, (long)cnt};
+      a->prev = (lw_block_stats){a->acc_shift + mean, var > 0 ? sqrt(var) : 0.0, (long)cnt};
       a->t_prev = a->t_sched;
     }
     /* steps without a sweep (more steps than sweeps) each take their turn
@@ -2116,9 +2116,11 @@ static lw_status sweep_once(lw_anneal *a, lw_error *err)
   if (a->pt && a->sweep % p->exchange_every == 0 && (s = exchange(a, err))) return s;
   double e = rung_energy(a, 0);
   if (!tuning && isfinite(e)) {
+    if (a->acc_n == 0.0 && !a->acc_unshifted) a->acc_shift = e;
+    const double d = e - a->acc_shift;
     a->acc_n += 1.0;
-    a->acc_sum += e;
-    a->acc_sumsq += e * e;
+    a->acc_sum += d;
+    a->acc_sumsq += d * d;
   }
   int renumber;
   if (refresh_due(a, &renumber)) {

@@ -2,7 +2,7 @@
 ** checkpoint.c -- the run data of state.lw (checkpoint.h), by name:
 **
 **   [run]           scene, seed, sweep (state.h); the schedule's inputs
-**                   (temperature, block, t_prev, prev_stats, block_energy),
+**                   (temperature, block, t_prev, prev_stats, block_energy, block_shift),
 **                   energy_initial, max_drift, size_peak, trace_bytes and
 **                   trace_mark.<move kind>
 **   [chain], [chain K]   rung 0's and rung K's chain: rng, step.<move>,
@@ -224,6 +224,7 @@ void lw_checkpoint_put_run(lw_ckpt_writer *w, const lw_anneal *a, long trace_byt
   lw_ckpt_put(w, "t_prev", "%.17g", a->t_prev);
   lw_ckpt_put(w, "prev_stats", "%.17g %.17g %ld", a->prev.mean, a->prev.sd, a->prev.samples);
   lw_ckpt_put(w, "block_energy", "%.17g %.17g %.17g", a->acc_n, a->acc_sum, a->acc_sumsq);
+  if (!a->acc_unshifted) lw_ckpt_put(w, "block_shift", "%.17g", a->acc_shift);
   lw_ckpt_put(w, "energy_initial", "%.17g", a->energy_initial);
   lw_ckpt_put(w, "max_drift", "%.17g", a->max_drift);
   /* when the energy is next recomputed hangs on them (anneal.c,
@@ -750,6 +751,13 @@ lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, l
     return lw_error_set(err, LW_EINPUT, "%s: [run] block_energy: expected 'samples sum sum-of-squares' with a whole "
                         "number of samples and a sum of squares >= 0", path);
   a->acc_n = v[0]; a->acc_sum = v[1]; a->acc_sumsq = v[2];
+  /* (files before 2026-12-07 lack it: their runs go on summing whole) */
+  a->acc_unshifted = !lw_ckpt_text(doc, "run", "block_shift", &(int){0});
+  a->acc_shift = 0.0;
+  if (!a->acc_unshifted) {
+    NUMS("block_shift", 1, -DBL_MAX, DBL_MAX);
+    a->acc_shift = v[0];
+  }
   NUMS("energy_initial", 1, -DBL_MAX, DBL_MAX); a->energy_initial = v[0];
   NUMS("max_drift", 1, 0, DBL_MAX); a->max_drift = v[0];
 #undef NUMS

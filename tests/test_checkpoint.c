@@ -276,6 +276,11 @@ Test(checkpoint, an_adaptive_schedules_state_is_checked_on_resume)
     cr_expect(err_has(bad[i].msg), "edit '%s': message lacks '%s'", bad[i].sed, bad[i].msg);
   }
   cr_assert_eq(resume_edited("s/^sweep = 25$/sweep = 25/"), 0);
+  /* a file of before 2026-12-07 sums the energies whole, shift 0, to its
+  ** end: its checkpoints write no shift (the step's first sample here) */
+  cr_assert_eq(lw_test_sh("grep -q '^block_shift = ' %s/x/state.lw", dir), 0);
+  cr_assert_eq(resume_edited("/^block_shift = /d"), 0);
+  cr_assert_neq(lw_test_sh("grep -q '^block_shift' %s/x/state.lw", dir), 0);
   cr_assert_eq(lw_test_sh("rm -rf %s/r && %s run %s/tests/fixtures/v1/plain.ini --out %s/r --stop-at 25 --quiet --set "
                           "anneal.schedule=adaptive --set tempering.replicas=2", dir, lw_test_bin(), lw_test_root(),
                           dir), 0);

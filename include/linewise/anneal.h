@@ -87,7 +87,11 @@ typedef struct lw_anneal {
   long block;                  /* current temperature step */
   double t_prev;               /* temperature of the previous step */
   lw_block_stats prev;         /* energy statistics of the previous step */
-  double acc_n, acc_sum, acc_sumsq; /* this step's energy samples (after tuning) */
+  double acc_n, acc_sum, acc_sumsq; /* this step's energy samples (after tuning), less acc_shift */
+  double acc_shift;            /* the step's first sample: summed whole, the energies' squares lost the
+                               ** spread to rounding (the wire at T = 1e-7 read a negative variance) */
+  int acc_unshifted;           /* a run begun before 2026-12-07 sums them whole, acc_shift 0 (state.lw
+                               ** has no block_shift) */
   double max_drift;            /* largest relative drift seen at a check */
   char observables_rounded[256]; /* summary.json's observables of values printed to 10 digits that
                                  ** spread under 3 steps of the last (a resumed run of before 2026-12-07) */
