@@ -649,7 +649,8 @@ const lw_param_def lw_param_table[] = {
          "7475A takes A4 and A3 so)."),
   NUM("plot", "bed_width", LW_PT_DOUBLE, plot_bed_w, "0", "mm", 0, 1e7, 0,
       "How far the plotter reaches along its x axis from its origin (after plot.turn): with "
-      "output.hpgl or output.gcode a scene whose drawing area (the page inset by scene.margin) "
+      "output.hpgl or output.gcode a scene whose drawing area (the page inset by scene.margin; "
+      "with a picture and plot.crop = 1, the picture's rectangle) "
       "reaches further is refused before the run, and the files are checked against it too "
       "(an HP 7475A clips at its hard-clip limits, a GRBL machine stops at its soft limits). "
       "0 = not checked."),
@@ -1755,6 +1756,34 @@ int lw_params_text_reads_back(const char *text)
   return ok;
 }
 
+lw_status lw_params_bed_check(const lw_params *p, const double box[4], const char *what, lw_error *err)
+{
+  if (!p->hpgl && !p->gcode) return LW_OK;
+  char where[LW_PATH_MAX + 32], area[160];
+  const char *bed_key[2] = {"bed_width", "bed_height"}, axis[2] = {'x', 'y'};
+  const double bed[2] = {p->plot_bed_w, p->plot_bed_h};
+  /* the box's far corner on the machine's axes (plotter.c: y up, or turned
+  ** a quarter turn counterclockwise), under either turn */
+  const double reach[2][2] = {{box[2], p->height - box[1]}, {box[3], box[2]}};
+  const double *r = reach[p->plot_turn != 0], *other = reach[p->plot_turn == 0];
+  /* the other turn, where it would fit */
+  const int turn_fits = !(bed[0] > 0.0 && other[0] > bed[0]) && !(bed[1] > 0.0 && other[1] > bed[1]);
+  if (what) snprintf(area, sizeof area, "%s", what);
+  else snprintf(area, sizeof area, "the %g x %g mm page inset by scene.margin = %g", p->width, p->height, p->margin);
+  for (int k = 0; k < 2; k++) {
+    if (!(bed[k] > 0.0) || r[k] <= bed[k]) continue;
+    lw_params_origin(p, lw_params_find("plot", bed_key[k]), where, sizeof where);
+    return lw_error_set(err, LW_EINPUT,
+                        "%s: key 'plot.%s' = %g mm: the drawing area (%s%s) reaches %c = %g mm on the machine; "
+                        "expected a wider margin or a smaller page%s",
+                        where, bed_key[k], bed[k], area, p->plot_turn ? ", turned by plot.turn" : "", axis[k], r[k],
+                        !turn_fits      ? ""
+                        : p->plot_turn ? ", or plot.turn = 0, which fits"
+                                       : ", or plot.turn = 90, which fits");
+  }
+  return LW_OK;
+}
+
 lw_status lw_params_resolve(lw_params *p, lw_error *err)
 {
   char where[LW_PATH_MAX + 32], where_page[LW_PATH_MAX + 32];
@@ -1861,25 +1890,13 @@ lw_status lw_params_resolve(lw_params *p, lw_error *err)
   }
   /* With crop (the default) every stroke is cut inside the page inset by
   ** the margin, so that box decides, on the machine's axes, before a long
-  ** anneal; the writers check the strokes themselves (plotter.h). */
-  const char *bed_key[2] = {"bed_width", "bed_height"}, axis[2] = {'x', 'y'};
-  const double bed[2] = {p->plot_bed_w, p->plot_bed_h};
-  const double reach[2] = {(p->plot_turn ? p->height : p->width) - p->margin,
-                           (p->plot_turn ? p->width : p->height) - p->margin};
-  /* the other turn, where it would fit */
-  const int turn_fits = !(bed[0] > 0.0 && reach[1] > bed[0]) && !(bed[1] > 0.0 && reach[0] > bed[1]);
-  for (int k = 0; (p->hpgl || p->gcode) && k < 2; k++) {
-    if (!(bed[k] > 0.0) || reach[k] <= bed[k]) continue;
-    lw_params_origin(p, lw_params_find("plot", bed_key[k]), where, sizeof where);
-    return lw_error_set(err, LW_EINPUT,
-                        "%s: key 'plot.%s' = %g mm: the drawing area (the %g x %g mm page inset by scene.margin = "
-                        "%g%s) reaches %c = %g mm on the machine; expected a wider margin or a smaller page%s",
-                        where, bed_key[k], bed[k], p->width, p->height, p->margin,
-                        p->plot_turn ? ", turned by plot.turn" : "", axis[k], reach[k],
-                        !turn_fits      ? ""
-                        : p->plot_turn ? ", or plot.turn = 0, which fits"
-                                       : ", or plot.turn = 90, which fits");
-  }
+  ** anneal; the writers check the strokes themselves (plotter.h).  With a
+  ** picture the crop is its rectangle, which the scene checks once it has
+  ** placed it (the page's inset refused a landscape photo on A4 portrait
+  ** that fitted the bed by 45 mm). */
+  const double inset[4] = {p->margin, p->margin, p->width - p->margin, p->height - p->margin};
+  lw_status st = p->crop && p->image[0] ? LW_OK : lw_params_bed_check(p, inset, NULL, err);
+  if (st) return st;
   /* PDF readers take pages of at most 14,400 points a side (5080 mm), and
   ** cairo's PDF of a page of kilometres ran out of memory or crashed */
   if (p->pdf && (p->width > LW_PDF_SIDE_MAX || p->height > LW_PDF_SIDE_MAX)) {

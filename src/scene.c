@@ -283,6 +283,15 @@ static lw_status build_image(lw_scene *sc, const lw_params *p, lw_error *err)
                                    p->height - p->margin);
   }
   if ((st = scored_side_ok(p, "scene", p->image_width > 0 ? "image_width" : "image", sc->image, err))) return st;
+  if (p->crop) { /* (params.c: the strokes are cut to the picture's rectangle) */
+    const lw_image_place *pl = &sc->image_place;
+    const double box[4] = {pl->x0, pl->y0, pl->x0 + sc->image->width * pl->pixel,
+                           pl->y0 + sc->image->height * pl->pixel};
+    char what[160];
+    snprintf(what, sizeof what, "the picture's %.4g x %.4g mm rectangle from (%.4g, %.4g) mm, to which plot.crop cuts "
+             "the strokes", box[2] - box[0], box[3] - box[1], box[0], box[1]);
+    if ((st = lw_params_bed_check(p, box, what, err))) return st;
+  }
   if ((st = lw_image_blur(sc->image, p->image_blur / sc->image_place.pixel, err))) return st;
   if (p->image_flatten > 0) {
     double lo, hi;

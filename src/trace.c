@@ -226,6 +226,8 @@ typedef struct {
                         ** of theirs (and a heat capacity of that energy is off by as much) */
   double r_hat;         /* Gelman and Rubin's potential scale reduction */
   double p_runs;        /* chi-square probability of the runs' means under their error bars */
+  double se_runs;       /* the runs' means' sd over sqrt(runs): an error bar no run's own estimate makes
+                        ** (a slow tail the autocorrelation's sum ends before left wlc's 1.45 times small) */
 } column_stats;
 
 /* Whether a run's column with spread has problem `what` (one run's kinds). */
@@ -259,7 +261,8 @@ static void stat_cell(char *buf, size_t n, int csv, const char *fmt, double v)
 static int has_problem(const column_stats *c, int k, int what)
 {
   if (what == WARN_RUNS) return k > 1 && !isnan(c->p_runs) && (c->p_runs < 1e-3 || c->r_hat > 1.1);
-  if (what == WARN_COARSE) return c->coarse;
+  /* (a window that did not close says the bar is too small: not that it holds) */
+  if (what == WARN_COARSE) return c->coarse && !has_problem(c, k, WARN_OPEN);
   if (what == WARN_ROUNDED) return c->rounded;
   for (int r = 0; r < k; r++)
     if (run_problem(&c->run[r], what)) return 1;
@@ -334,6 +337,7 @@ static void combine(column_stats *c, int k, const double *gap)
   }
   int exact = n_exact == k; /* every run without spread: the means must agree exactly */
   c->mean = m;
+  c->se_runs = sqrt(b / k);
   c->stderr_mean = sqrt(se2);
   c->sd = sqrt(w);
   c->tau_sweeps = tau;
@@ -755,13 +759,13 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
   for (size_t c = 0; c < t[0]->n_cols; c++)
     if (!is_coordinate(t[0]->name[c]) && strlen(t[0]->name[c]) > (size_t)width) width = (int)strlen(t[0]->name[c]);
   if (csv) {
-    fprintf(out, k > 1 ? "column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs\n"
+    fprintf(out, k > 1 ? "column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs,se_runs\n"
                        : "column,n,mean,stderr,sd,tau_sweeps,n_eff,window_closed,drift_z,batch_ratio\n");
   } else {
     if (k > 1) fprintf(out, "%d runs:\n", k);
     for (int r = 0; r < k; r++) stretch_line(out, k > 1 ? "  " : "", t[r], path[r], row[r], n[r], tuned[r]);
     fprintf(out, "%-*s %15s %11s %11s %11s %9s", width, "column", "mean", "stderr", "sd", "tau_sweeps", "n_eff");
-    fprintf(out, k > 1 ? " %8s %9s\n" : "\n", "R_hat", "p_runs");
+    fprintf(out, k > 1 ? " %8s %9s %9s\n" : "\n", "R_hat", "p_runs", "se_runs");
   }
   for (size_t c = 0; c < t[0]->n_cols; c++) {
     const char *name = t[0]->name[c];
@@ -771,7 +775,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
     if (!s->n) {
       /* (in the CSV too, so that scripts see the table's columns) */
       if (!csv) fprintf(out, "%-*s %15s\n", width, name, "(empty)");
-      else if (k > 1) fprintf(out, "%s,%d,0,,,,,,,\n", name, k);
+      else if (k > 1) fprintf(out, "%s,%d,0,,,,,,,,\n", name, k);
       else fprintf(out, "%s,0,,,,,,,,\n", name);
     } else if (k > 1) {
       size_t rows = 0;
@@ -790,17 +794,18 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       if (csv) sd[0] = '\0';
       if (!isnan(q->sd)) stat_cell(sd, sizeof sd, csv, "%.4g", q->sd);
       /* a mean over other temperatures in other runs is no one ensemble's */
-      char mean[32] = "-", se[32] = "-";
-      if (csv) mean[0] = se[0] = '\0';
+      char mean[32] = "-", se[32] = "-", spread[32] = "-";
+      if (csv) mean[0] = se[0] = spread[0] = '\0';
       if (!q->mixed) {
         stat_cell(mean, sizeof mean, csv, "%.9g", q->mean);
         stat_cell(se, sizeof se, csv, "%.4g", q->stderr_mean);
+        stat_cell(spread, sizeof spread, csv, "%.4g", q->se_runs);
       }
       if (csv)
-        fprintf(out, "%s,%d,%zu,%s,%s,%s,%s,%s,%s,%s\n", name, k, rows, mean, se, sd, tau, neff, rh, pr);
+        fprintf(out, "%s,%d,%zu,%s,%s,%s,%s,%s,%s,%s,%s\n", name, k, rows, mean, se, sd, tau, neff, rh, pr, spread);
       else
-        fprintf(out, "%-*s %15s %11s %11s %11s %9s %8s %9s%s\n", width, name, mean, se, sd, tau, neff, rh, pr,
-                flagged(q, k) ? " *" : "");
+        fprintf(out, "%-*s %15s %11s %11s %11s %9s %8s %9s %9s%s\n", width, name, mean, se, sd, tau, neff, rh, pr,
+                spread, flagged(q, k) ? " *" : "");
     } else if (csv) {
       /* tau and n_eff mean nothing for a column without spread: empty, as
       ** the table's '-' and summary.json's null */

@@ -1729,8 +1729,8 @@ Test(cli, a_worm_like_chain_study_matches_kratky_porod_with_the_stats_error_bars
   /* the two runs together: the same chain, so their means agree exactly */
   snprintf(args, sizeof args, "stats %s/wlc %s/half --csv", dir, dir);
   cr_assert_eq(run(args, out, sizeof out, errs, sizeof errs), 0, "%s", errs);
-  cr_assert(strstr(out, "column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs\n") &&
-            strstr(out, "\nobs_end2,2,8002,") && strstr(out, ",1\nobs_rg2,"), "%s", out);
+  cr_assert(strstr(out, "column,runs,n,mean,stderr,sd,tau_sweeps,n_eff,r_hat,p_runs,se_runs\n") &&
+            strstr(out, "\nobs_end2,2,8002,") && strstr(out, ",1,0\nobs_rg2,"), "%s", out);
   /* a run named twice, once through a link (a sweep's `best`): counted once */
   cr_assert_eq(lw_test_sh("ln -s wlc %s/best", dir), 0);
   snprintf(args, sizeof args, "stats %s/best %s/wlc --csv", dir, dir);

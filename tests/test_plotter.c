@@ -687,6 +687,23 @@ Test(plotter, a_page_past_the_bed_is_refused_before_the_run)
             "%s", err);
   free(err);
   cr_assert_neq(lw_test_sh("test -e %s/r", dir), 0, "nothing written");
+  /* with a picture the crop is its rectangle: params/picture.png (600 x 800)
+  ** in the 90 mm square spans x 16.25 to 83.75 (the page's inset refused a
+  ** landscape photo on A4 that fitted the bed by 45 mm) */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set scene.image=%s/params/picture.png --set output.gcode=1 "
+                          "--set plot.bed_width=85 --stop-at 0 --quiet --out %s/p", bin, root, root, dir), 0);
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set scene.image=%s/params/picture.png --set output.gcode=1 "
+                          "--set plot.bed_width=80 --stop-at 0 --quiet --out %s/q 2> %s/err.txt", bin, root, root, dir,
+                          dir), 2);
+  err = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(err, "key 'plot.bed_width' = 80 mm: the drawing area (the picture's 67.5 x 90 mm rectangle from "
+                        "(16.25, 5) mm, to which plot.crop cuts the strokes) reaches x = 83.75 mm on the machine"), "%s",
+            err);
+  free(err);
+  /* uncropped, the strokes may reach the margins */
+  cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set scene.image=%s/params/picture.png --set output.gcode=1 "
+                          "--set plot.bed_width=85 --set plot.crop=0 --stop-at 0 --quiet --out %s/q 2> %s/err.txt",
+                          bin, root, root, dir, dir), 2);
   /* the bed's own size fits; without a machine file the bed is not asked */
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.hpgl=1 --set plot.bed_height=95 --set "
                           "anneal.sweeps=5 --quiet --out %s/r", bin, root, dir), 0);

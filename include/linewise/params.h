@@ -350,6 +350,12 @@ int lw_params_text_reads_back(const char *text);
 ** lw_params_read calls it; call it again after overrides. */
 lw_status lw_params_resolve(lw_params *p, lw_error *err);
 
+/* Refuses (naming plot.bed_width or bed_height) a drawing area, box = x0 y0
+** x1 y1 in page millimetres, that reaches past the machine's bed on its
+** axes under plot.turn, where final.hpgl or final.gcode is written; what:
+** the area in words, NULL for the page inset by scene.margin. */
+lw_status lw_params_bed_check(const lw_params *p, const double box[4], const char *what, lw_error *err);
+
 /* Applies one "section.key=value" override (call lw_params_resolve after
 ** the last one).  A relative path a key names is then found from the scene
 ** file's directory, as in the file; the command line's --set makes it
