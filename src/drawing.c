@@ -298,9 +298,9 @@ void lw_drawing_note(const lw_params *p, char *note, size_t n)
   const int past = vs < LW_HPGL_VS_MIN || vs > LW_HPGL_VS_MAX;
   if (used < n)
     snprintf(note + used, n - used, "%splot.speed_down = %g mm/s is %s (%g to %g mm/s, in steps of 0.1): final.hpgl "
-             "asks %g, and the plot time, reckoned at %g, does not hold for the machine", used ? "\n" : "",
-             p->speed_down, past ? "past what HP-GL's VS takes" : "more than 1 % from what HP-GL's VS writes",
-             10.0 * LW_HPGL_VS_MIN, 10.0 * LW_HPGL_VS_MAX, 10.0 * asked, p->speed_down);
+             "asks %g (VS%g, in cm/s), and the plot time, reckoned at %g, does not hold for the machine",
+             used ? "\n" : "", p->speed_down, past ? "past what HP-GL's VS takes" : "more than 1 % from what HP-GL's VS "
+             "writes", 10.0 * LW_HPGL_VS_MIN, 10.0 * LW_HPGL_VS_MAX, 10.0 * asked, asked, p->speed_down);
 }
 
 lw_status lw_drawing_write(const lw_params *p, const lw_scene *sc, const lw_splines *sp, const lw_grid2d *tone,
