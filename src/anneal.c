@@ -277,6 +277,30 @@ static void dir_file(char *buf, size_t n, const lw_anneal *a, const char *name)
 ** files, and each replica is swept by the process that owns it. */
 static int writes_files(const lw_anneal *a) { return !a->net || a->net->rank == 0; }
 
+/* The run's directory as this process found it, or 0 0.  Its files are
+** written by path: a directory moved aside while the run went on, and
+** another made under its name (a new run), took the old run's checkpoints,
+** and its final files with exit 0, while the new run failed. */
+static void dir_identity(lw_anneal *a)
+{
+  struct stat st;
+  a->dir_id[0] = a->dir_id[1] = 0;
+  if (!stat(a->dir, &st)) a->dir_id[0] = (unsigned long long)st.st_dev, a->dir_id[1] = (unsigned long long)st.st_ino;
+}
+
+/* LW_EIO, dir_moved set, once the path names another directory or none. */
+static lw_status dir_still_ours(lw_anneal *a, lw_error *err)
+{
+  struct stat st;
+  if (!a->dir_id[0] && !a->dir_id[1]) return LW_OK;
+  const int there = !stat(a->dir, &st);
+  if (there && (unsigned long long)st.st_dev == a->dir_id[0] && (unsigned long long)st.st_ino == a->dir_id[1])
+    return LW_OK;
+  a->dir_moved = 1;
+  return lw_error_set(err, LW_EIO, "%s is no longer there: the run's directory was removed or moved%s", a->dir,
+                      there ? ", and another is in its place, which this run leaves alone" : "");
+}
+
 static int replica_here(const lw_anneal *a, int r)
 {
   return !a->net || lw_anneal_net_owner(r, a->n_rep, a->net->size) == a->net->rank;
@@ -1335,6 +1359,7 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
   lw_phase_writing();
   if ((s = lw_rundir_make(dir, err)) || (writes_files(a) && (s = lw_rundir_lock(dir, &a->dir_hold, err))))
     return s;
+  dir_identity(a);
   if (!writes_files(a)) {
     lw_phase_set(NULL);
     return LW_OK;
@@ -1448,6 +1473,7 @@ lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err)
   lw_status se = refuse_finished(a, "lw_anneal_checkpoint", err);
   /* (the locale changed since the start) */
   if (se || (se = lw_number_locale_ok(err)) || (se = lw_anneal_settle(a, err))) return se;
+  if (writes_files(a) && (se = dir_still_ours(a, err))) return se;
   const char *was = lw_phase_get(NULL);
   lw_phase_set("writing state.lw");
   const double t0 = lw_phase_clock();
@@ -1657,6 +1683,7 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
       sl = lw_error_set(err, LW_EIO, "%s: process 0 could not take the run directory (it says why)", dir);
   }
   if (sl) return sl;
+  dir_identity(a);
   /* a run stopped before its first checkpoint left its scene.ini alone */
   if (lw_rundir_unstarted(dir))
     return lw_error_set(err, LW_EINPUT, "%s: no state.lw: the run there stopped before its first checkpoint, so "
@@ -1951,11 +1978,14 @@ static lw_status sweep_files(lw_anneal *a, lw_error *err)
   ** ended short of the drawing (at 180 of 200, at 0 with frames_every past
   ** the sweeps) */
   double t0 = lw_phase_clock();
-  if (p->frames_every && (a->sweep % p->frames_every == 0 || lw_anneal_done(a)) && rung_here(a, 0)) {
+  const int frame = p->frames_every && (a->sweep % p->frames_every == 0 || lw_anneal_done(a)) && rung_here(a, 0),
+            sample = p->samples_every && a->sweep % p->samples_every == 0 && rung_here(a, 0);
+  if ((frame || sample) && dir_still_ours(a, err)) return err->code;
+  if (frame) {
     if (a->sys_type->draw(a->sys->state, p, a->dir, a->sweep, err)) return err->code;
     a->film_seconds[0] += lw_phase_clock() - t0;
   }
-  if (p->samples_every && a->sweep % p->samples_every == 0 && rung_here(a, 0)) {
+  if (sample) {
     t0 = lw_phase_clock();
     if (write_sample(a, err)) return err->code;
     a->film_seconds[1] += lw_phase_clock() - t0;
@@ -2458,6 +2488,7 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
   if (s) return s;
   a->finished = 1;
   if (!rung_here(a, 0)) return LW_OK; /* the process of the coldest replica draws it */
+  if ((s = dir_still_ours(a, err))) return s;
   /* summary.json's energies are the state's, recomputed: the running totals
   ** keep the rounding of every commit since the last check, which the drift
   ** check's floor of 1 lets pass below an energy of 1 (a particle cloud fallen

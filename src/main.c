@@ -932,6 +932,10 @@ static int loop_fail(lw_anneal *a, long began, watcher *w, lw_error *err)
     size_t n = strlen(err->msg);
     snprintf(err->msg + n, sizeof err->msg - n, "; the run's first files are removed, as it had done no sweep: run "
              "it again once %s", err->code == LW_ENOMEM ? "there is more memory" : "the files can be written");
+  } else if (err->code == LW_EIO && a->dir_moved) {
+    size_t n = strlen(err->msg);
+    snprintf(err->msg + n, sizeof err->msg - n, ", so the run ends (moved, it resumes from its last checkpoint where "
+             "it is now)");
   } else if (err->code == LW_EIO && access(state, F_OK)) {
     size_t n = strlen(err->msg);
     snprintf(err->msg + n, sizeof err->msg - n, "; %s is no longer there: the run's directory was removed or moved, "

@@ -1523,8 +1523,28 @@ Test(cli, a_run_whose_directory_is_removed_says_it_is_gone)
   /* (after the sweeps began, or, where rm came during the set-up's last
   ** files, of the set-up) */
   cr_assert(strstr(e, "g/r/state.lw is no longer there: the run's directory was removed or moved, so the run ends") ||
+            strstr(e, "g/r is no longer there: the run's directory was removed or moved, so the run ends") ||
             strstr(e, "g/r is no longer there: the run's directory was removed or moved during the set-up"), "%s", e);
   free(e);
+}
+
+/* A run whose directory is moved aside, another made in its place (a new
+** run there), writes nothing into that one: it took the old run's
+** checkpoints and final files, and ended with exit 0.  The moved run
+** resumes where it is. */
+Test(cli, a_run_whose_directory_is_replaced_leaves_the_new_one_alone)
+{
+  write_file("s.ini", scene_text);
+  cr_assert_eq(lw_test_sh("cd %s && { timeout 120 %s run s.ini --quiet --out m --set anneal.sweeps=1000000 "
+                          "--set output.checkpoint_every=1 2>err.txt & p=$!; i=0; while [ $i -lt 3000 ] && "
+                          "! test -f m/state.lw; do sleep 0.01; i=$((i+1)); done; mv m moved && mkdir m && "
+                          "touch m/mine; wait $p; test $? -eq 1; }", dir, lw_test_bin()),
+               0, "%s", lw_test_slurp("%s/err.txt", dir));
+  char *e = lw_test_slurp("%s/err.txt", dir);
+  cr_assert(strstr(e, "m is no longer there: the run's directory was removed or moved, and another is in its place, "
+                      "which this run leaves alone, so the run ends"), "%s", e);
+  free(e);
+  cr_assert_eq(lw_test_sh("cd %s && test \"$(ls -A m)\" = mine && test -s moved/state.lw", dir), 0);
 }
 
 /* A run into a directory that held another leaves none of the old run's
