@@ -1533,6 +1533,34 @@ static long last_row_sweep(const char *path, long bytes)
   return sweep;
 }
 
+/* The first `bytes` bytes of the trace at path, as a file of its own there. */
+static lw_status copy_trace(const char *path, long bytes, lw_error *err)
+{
+  char tmp[LW_PATH_MAX + 64], buf[65536];
+  FILE *in = fopen(path, "rb");
+  if (!in) return lw_error_set(err, LW_EIO, "%s: cannot read: %s", path, strerror(errno));
+  FILE *out = lw_output_open_tmp(path, tmp, sizeof tmp, err);
+  if (!out) {
+    fclose(in);
+    return err->code;
+  }
+  long done = 0;
+  errno = 0;
+  for (size_t got = 1; done < bytes && got;) {
+    got = fread(buf, 1, bytes - done < (long)sizeof buf ? (size_t)(bytes - done) : sizeof buf, in);
+    if (got && fwrite(buf, 1, got, out) != got) break;
+    done += (long)got;
+  }
+  fclose(in);
+  if (done != bytes) {
+    const int e = errno;
+    lw_output_abort(out, tmp);
+    return lw_error_set(err, LW_EIO, "%s: cannot copy it to a file of this run's own: %s", path,
+                        e ? strerror(e) : "it was cut meanwhile");
+  }
+  return lw_output_commit(out, tmp, path, err);
+}
+
 /* trace.csv back to the checkpoint: rows written after it belong to sweeps
 ** that will run again.  A format-2 checkpoint knows the length it synced;
 ** a format-1 one only its sweep, so complete rows up to it are kept. */
@@ -1572,9 +1600,14 @@ static lw_status truncate_trace(lw_anneal *a, long bytes, lw_error *err)
       return lw_error_set(err, LW_EINPUT, "%s: the rows %s counts end at sweep %ld, but it is at sweep %ld (a row "
                           "every %ld sweeps): the state or the trace was edited, or is of another run",
                           path, state, last, a->sweep, every);
+    /* a trace with other names (a copy of the run made by cp -al or rsync
+    ** --link-dest) is cut and appended to in both: the copy's resume took
+    ** 80 rows off the finished original; so it gets a file of its own */
+    lw_status s = sb.st_nlink > 1 ? copy_trace(path, bytes, err) : LW_OK;
+    if (s) return s;
     /* (a FUSE FAT refuses a truncate to the size a file has: every clean
     ** stop's resume failed there) */
-    if (sb.st_size != bytes && truncate(path, bytes))
+    if (sb.st_nlink < 2 && sb.st_size != bytes && truncate(path, bytes))
       return lw_error_set(err, LW_EIO, "%s: cannot truncate: %s", path, strerror(errno));
     return open_trace(a, 0, err);
   }

@@ -141,7 +141,19 @@ static int denied(const char *path, int dir)
 ** in place and the lock, and the rest by rename, which needs only the
 ** directory, unless it is sticky (/tmp-like) and the file another user's. */
 #define LW_RUNDIR_BUSY "%s: another linewise process is writing this run directory (it holds %s); wait for it to " \
-                       "end, or write another directory"
+                       "end, or write another directory%s"
+
+/* LW_EUSAGE, LW_RUNDIR_BUSY of dir and its lock file path: a lock file with
+** other names is another directory's too (a copy made with hard links),
+** whose run may be the one that holds it. */
+static lw_status busy(const char *dir, const char *path, lw_error *err)
+{
+  struct stat st;
+  const int shared = !lstat(path, &st) && S_ISREG(st.st_mode) && st.st_nlink > 1;
+  return lw_error_set(err, LW_EUSAGE, LW_RUNDIR_BUSY, dir, path, shared ? " (the lock file is a hard link, shared "
+                      "with a copy of the run made with cp -al or rsync --link-dest: the process may be writing the "
+                      "copy; a copy made with cp -r has its own)" : "");
+}
 
 /* Whether another process holds dir's lock, looked at without taking it
 ** for long (a shared lock at once let go); non-blocking: a FIFO planted
@@ -197,7 +209,7 @@ lw_status lw_rundir_writable(const char *dir, lw_error *err)
   ** modes were said, and the run going on not */
   if (lock_busy(dir)) {
     snprintf(path, sizeof path, "%s/.lock", dir);
-    return lw_error_set(err, LW_EUSAGE, LW_RUNDIR_BUSY, dir, path);
+    return busy(dir, path, err);
   }
   return lw_error_set(err, LW_EINPUT, "%s: %s: %s; expected a run directory this user can write", path, what,
                       strerror(e));
@@ -236,7 +248,7 @@ static lw_status hold_lock(const char *dir, const char *path, int fd, const stru
   if (e) {
     close(fd);
     if (e == EWOULDBLOCK)
-      return lw_error_set(err, LW_EUSAGE, LW_RUNDIR_BUSY, dir, path);
+      return busy(dir, path, err);
     /* no locks here (EBADF: an NFS lock on a file we could only read) */
     if (e == ENOLCK || e == EOPNOTSUPP || e == ENOSYS || e == EINVAL || e == EBADF) return LW_OK;
     return lw_error_set(err, LW_EIO, "%s: cannot lock the run directory: %s", path, strerror(e));
@@ -247,6 +259,20 @@ static lw_status hold_lock(const char *dir, const char *path, int fd, const stru
   held[free_slot].count = 1;
   *hold = free_slot + 1;
   return LW_OK;
+}
+
+/* A lock file with other names (a copy of the run made by cp -al or rsync
+** --link-dest) is the copy's lock as well: a run there was said busy while
+** the other ran.  One no process holds is removed, for a file of this
+** directory's own; one held stays (its holder may be writing here). */
+static void unshare_lock(const char *path)
+{
+  struct stat st;
+  if (lstat(path, &st) || !S_ISREG(st.st_mode) || st.st_nlink < 2) return;
+  int fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+  if (fd < 0) return;
+  if (!flock(fd, LOCK_EX | LOCK_NB)) unlink(path);
+  close(fd);
 }
 
 lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
@@ -268,6 +294,7 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
   ** a lock counts only while its file is still the one at the path: else
   ** the one there now is taken, afresh. */
   for (int tries = 0;; tries++) {
+    unshare_lock(path);
     /* never through a link: one planted there made a root's run create any file */
     int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0666);
     if (fd < 0 && errno == EACCES) fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
@@ -289,7 +316,7 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
     if (s || !*hold || (!lstat(path, &now) && now.st_dev == st.st_dev && now.st_ino == st.st_ino)) return s;
     lw_rundir_unlock(*hold);
     *hold = 0;
-    if (tries == 8) return lw_error_set(err, LW_EUSAGE, LW_RUNDIR_BUSY, dir, path);
+    if (tries == 8) return busy(dir, path, err);
   }
 }
 

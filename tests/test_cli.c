@@ -1547,6 +1547,22 @@ Test(cli, a_run_whose_directory_is_replaced_leaves_the_new_one_alone)
   cr_assert_eq(lw_test_sh("cd %s && test \"$(ls -A m)\" = mine && test -s moved/state.lw", dir), 0);
 }
 
+/* A copy made with hard links (cp -al, rsync --link-dest) shares the files
+** a run writes in place: the copy's resume cut the finished original's
+** trace to its own stop, and a run of either was said busy while the other
+** ran.  Each resume takes a trace and a lock file of its own; both end as
+** the run that never stopped. */
+Test(cli, a_copy_made_with_hard_links_is_a_run_of_its_own)
+{
+  write_file("s.ini", scene_text);
+  cr_assert_eq(lw_test_sh("cd %s && B=%s && $B run s.ini --quiet --out whole --set anneal.sweeps=40 && "
+                          "$B run s.ini --quiet --out a --set anneal.sweeps=40 --stop-at 20 && cp -al a b && "
+                          "$B resume a --quiet && cmp a/trace.csv whole/trace.csv && "
+                          "$B resume b --quiet --stop-at 30 && cmp a/trace.csv whole/trace.csv && "
+                          "test \"$(stat -c %%i a/.lock)\" != \"$(stat -c %%i b/.lock)\" && $B resume b --quiet && "
+                          "cmp b/trace.csv whole/trace.csv && cmp b/state.lw whole/state.lw", dir, lw_test_bin()), 0);
+}
+
 /* A run into a directory that held another leaves none of the old run's
 ** files: its machine files, replica states, frames, samples, the film
 ** tools/animate.sh made and the plots of tools/plot-run would be taken for
