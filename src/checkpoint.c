@@ -785,7 +785,9 @@ lw_status lw_checkpoint_restore(lw_anneal *a, lw_ckpt *doc, long *trace_bytes, l
   }
   if (a->pt && (s = get_tempering(doc, a, err))) return s;
   if (a->dyn && (s = get_dynamics(doc, a->dyn, err))) return s;
-  return lw_ckpt_unread(doc, err);
+  /* last, so that what a value's own check finds is named as it */
+  if ((s = lw_ckpt_unread(doc, err))) return s;
+  return lw_ckpt_verify(doc, err);
 }
 
 /* ---- format 1 ----------------------------------------------------------------- */

@@ -8,6 +8,7 @@
 */
 #include "linewise/ckpt.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -40,7 +41,19 @@ struct lw_ckpt {
   size_t n, ecap;
   section *s;
   size_t ns, scap;
+  size_t sum_at;      /* where its last line, "# checksum X", begins, or NONE */
+  int sum_ok;         /* X is the checksum of the bytes before it */
 };
+
+/* FNV-1a, 64 bits: a flipped bit anywhere changes it (a damaged copy of a
+** checkpoint resumed with a node moved in its fourth digit, unseen). */
+static unsigned long long fnv1a(unsigned long long h, const unsigned char *b, size_t n)
+{
+  for (size_t k = 0; k < n; k++) h = (h ^ b[k]) * 0x100000001b3ULL;
+  return h;
+}
+#define FNV_START 0xcbf29ce484222325ULL
+#define SUM_LINE "# checksum "
 
 #define NONE ((size_t)-1)
 
@@ -50,6 +63,7 @@ lw_ckpt *lw_ckpt_new(const char *path)
   if (!c) return NULL;
   snprintf(c->path, sizeof c->path, "%s", path);
   c->header = NONE;
+  c->sum_at = NONE;
   return c;
 }
 
@@ -202,6 +216,28 @@ static lw_status parse(lw_ckpt *c, lw_error *err)
   return LW_OK;
 }
 
+/* The last line, where it is "# checksum" and 16 hex digits, and whether
+** they are the checksum of the bytes before it. */
+static void find_sum(lw_ckpt *c)
+{
+  const size_t n = strlen(SUM_LINE) + 17;
+  const char *line = c->text + c->len - n;
+  char *end;
+  if (c->len < n || (c->len > n && line[-1] != '\n') || strncmp(line, SUM_LINE, strlen(SUM_LINE))) return;
+  const unsigned long long v = strtoull(line + strlen(SUM_LINE), &end, 16);
+  if (end != c->text + c->len - 1 || !isxdigit((unsigned char)line[strlen(SUM_LINE)])) return;
+  c->sum_at = (size_t)(line - c->text);
+  c->sum_ok = fnv1a(FNV_START, (const unsigned char *)c->text, c->sum_at) == v;
+}
+
+lw_status lw_ckpt_verify(const lw_ckpt *c, lw_error *err)
+{
+  if (c->sum_at == NONE || c->sum_ok) return LW_OK;
+  return lw_error_set(err, LW_EINPUT, "%s:%d: its checksum does not match its contents: the file was damaged (a disk's "
+                      "or a copy's fault) or edited since linewise wrote it; a state edited on purpose goes on once "
+                      "this last line is taken out", c->path, c->lines);
+}
+
 lw_status lw_ckpt_read(lw_ckpt **out, const char *path, lw_error *err)
 {
   *out = NULL;
@@ -261,8 +297,10 @@ lw_status lw_ckpt_read(lw_ckpt **out, const char *path, lw_error *err)
     if (c->len && c->text[c->len - 1] != '\n' && !memchr(c->text, '\0', c->len))
       s = lw_error_set(err, LW_EINPUT, "%s:%d: the file ends inside this line: cut short (a partial copy, a full "
                        "disk?); a state written by hand needs a newline after its last line", path, c->lines + 1);
-    else
+    else {
+      find_sum(c); /* (before parse, which cuts the lines' ends) */
       s = parse(c, err);
+    }
     c->len++; /* what store() appends goes after the final NUL */
   }
   if (s) lw_ckpt_free(c);
@@ -513,6 +551,16 @@ void lw_ckpt_put_counts(lw_ckpt_writer *w, const char *key, const unsigned long 
 
 lw_status lw_ckpt_commit(lw_ckpt_writer *w, lw_error *err)
 {
+  /* the checksum of what was written, read back (the MPI writer puts its
+  ** processes' parts in whole) */
+  unsigned long long h = FNV_START;
+  unsigned char buf[65536];
+  size_t got;
+  FILE *back = fflush(w->f) ? NULL : fopen(w->tmp, "rb");
+  while (back && (got = fread(buf, 1, sizeof buf, back)) > 0) h = fnv1a(h, buf, got);
+  if (back && !ferror(back)) fprintf(w->f, SUM_LINE "%016llx\n", h);
+  else fputs("# checksum not taken: the file could not be read back\n", w->f);
+  if (back) fclose(back);
   lw_status s = lw_output_commit(w->f, w->tmp, w->path, err);
   w->f = NULL;
   return s;

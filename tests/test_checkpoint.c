@@ -279,7 +279,7 @@ Test(checkpoint, an_adaptive_schedules_state_is_checked_on_resume)
   /* a file of before 2026-12-07 sums the energies whole, shift 0, to its
   ** end: its checkpoints write no shift (the step's first sample here) */
   cr_assert_eq(lw_test_sh("grep -q '^block_shift = ' %s/x/state.lw", dir), 0);
-  cr_assert_eq(resume_edited("/^block_shift = /d"), 0);
+  cr_assert_eq(resume_edited("/^block_shift = /d;$d"), 0);
   cr_assert_neq(lw_test_sh("grep -q '^block_shift' %s/x/state.lw", dir), 0);
   cr_assert_eq(lw_test_sh("rm -rf %s/r && %s run %s/tests/fixtures/v1/plain.ini --out %s/r --stop-at 25 --quiet --set "
                           "anneal.schedule=adaptive --set tempering.replicas=2", dir, lw_test_bin(), lw_test_root(),
@@ -288,6 +288,26 @@ Test(checkpoint, an_adaptive_schedules_state_is_checked_on_resume)
   cr_expect(err_has("[run] temperature: 5, outside the adaptive schedule") &&
             err_has("range [0.01, 1]: the state was edited"));
   cr_assert_eq(resume_edited("s/^sweep = 25$/sweep = 25/"), 0);
+}
+
+/* A change no value's own check sees (a node moved in its 14th digit, under
+** the energy's 1e-6 check; of 120 single flipped bits 40 resumed) is the
+** checksum's: the last line, of every byte before it.  Taken out, the
+** state is resumed as one edited on purpose; a state without one (older, or
+** written by hand) is read as before. */
+Test(checkpoint, a_change_no_value_check_sees_is_the_checksums)
+{
+  stopped_run();
+  cr_assert_eq(lw_test_sh("tail -n 1 %s/r/state.lw | grep -qx '# checksum [0-9a-f]\\{16\\}'", dir), 0);
+  const char *nudge = "0,/^node = \\([^ ]*\\)[0-9] /s//node = \\11 /";
+  cr_assert_eq(resume_edited(nudge), 2);
+  cr_assert_eq(lw_test_sh("cmp -s %s/r/state.lw %s/x/state.lw", dir, dir), 1, "the edit changed nothing");
+  cr_assert(err_has("x/state.lw:") && err_has(": its checksum does not match its contents: the file was damaged (a "
+                                               "disk's or a copy's fault) or edited since linewise wrote it"));
+  char both[256];
+  snprintf(both, sizeof both, "%s;$d", nudge);
+  cr_assert_eq(resume_edited(both), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(resume_edited("$d"), 0);
 }
 
 /* A state.lw cut short (a partial copy) is said to be.  Cut inside [run] or

@@ -115,6 +115,11 @@ size_t lw_ckpt_count_sections(const lw_ckpt *c, int (*match)(const char *name));
 ** a newer linewise), else LW_OK. */
 lw_status lw_ckpt_unread(const lw_ckpt *c, lw_error *err);
 
+/* LW_EINPUT naming the file where its last line, "# checksum X" (written
+** by lw_ckpt_commit since 2026-12-07), does not match the bytes before it;
+** LW_OK where it does or there is none (an older or a hand-written file). */
+lw_status lw_ckpt_verify(const lw_ckpt *c, lw_error *err);
+
 /* ---- writing ------------------------------------------------------------ */
 
 /* Streams a file to path.tmp; commit renames it over path (a reader never
