@@ -119,6 +119,8 @@ lw_status lw_ckpt_unread(const lw_ckpt *c, lw_error *err);
 ** by lw_ckpt_commit since 2026-12-07), does not match the bytes before it;
 ** LW_OK where it does or there is none (an older or a hand-written file). */
 lw_status lw_ckpt_verify(const lw_ckpt *c, lw_error *err);
+/* Whether the file ends with such a line. */
+int lw_ckpt_summed(const lw_ckpt *c);
 
 /* ---- writing ------------------------------------------------------------ */
 
@@ -128,6 +130,7 @@ typedef struct {
   FILE *f;
   char path[LW_PATH_MAX + 64];
   char tmp[LW_PATH_MAX + 80];
+  int no_sum;  /* commit adds no checksum line (a run's files from before them: lw_anneal.unsummed) */
 } lw_ckpt_writer;
 
 lw_status lw_ckpt_begin(lw_ckpt_writer *w, const char *path, const char *header, lw_error *err);

@@ -416,6 +416,7 @@ static lw_status assemble(lw_anneal *a, const char *all, size_t total, long trac
   lw_ckpt_writer w;
   if (!s && !(s = lw_ckpt_begin(&w, path, LW_STATE_HEADER, err))) {
     int bad = 0;
+    w.no_sum = a->unsummed;
     lw_checkpoint_put_run(&w, a, trace_bytes);
     for (int k = 0; k < n; k++) fwrite(chain[k], 1, clen[k], w.f);
     lw_checkpoint_put_ensemble(&w, a, &bad);
