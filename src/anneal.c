@@ -1388,7 +1388,10 @@ lw_status lw_anneal_start_net(lw_anneal *a, const lw_params *p, const char *dir,
 
 int lw_anneal_undo_start(lw_anneal *a)
 {
-  if (!a->fresh && !a->stashed) return a->put_back;
+  lw_error e0;
+  /* (by path: a directory moved aside meanwhile keeps what is there, and
+  ** one made in its place is another's) */
+  if ((!a->fresh && !a->stashed) || dir_still_ours(a, &e0)) return a->put_back;
   const int fresh = a->fresh;
   a->fresh = 0;
   if (a->stashed) {

@@ -1251,6 +1251,10 @@ static lw_status default_dir(char *dir, size_t size, const char *scene, int *hol
 static void unmake_dir(const char *dir, int hold, int made)
 {
   if ((!hold && !made) || lw_rundir_holds_run(dir)) return;
+  if (hold && !lw_rundir_held_here(dir, hold)) { /* (moved aside: what is there now is another's) */
+    lw_rundir_unlock(hold);
+    return;
+  }
   char path[LW_PATH_MAX + 16];
   lw_path_join(path, sizeof path, dir, ".lock"); /* (made without locks, its file is there all the same) */
   unlink(path);

@@ -320,6 +320,18 @@ lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err)
   }
 }
 
+int lw_rundir_held_here(const char *dir, int hold)
+{
+  char path[LW_PATH_MAX + 16];
+  struct stat st;
+  snprintf(path, sizeof path, "%s/.lock", dir);
+  pthread_mutex_lock(&held_lock);
+  const int here = hold >= 1 && hold <= HELD_MAX && held[hold - 1].count && !lstat(path, &st) &&
+                   held[hold - 1].dev == st.st_dev && held[hold - 1].ino == st.st_ino;
+  pthread_mutex_unlock(&held_lock);
+  return here;
+}
+
 void lw_rundir_unlock(int hold)
 {
   pthread_mutex_lock(&held_lock);

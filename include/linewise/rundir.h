@@ -59,6 +59,10 @@ lw_status lw_rundir_writable(const char *dir, lw_error *err);
 ** this process holds succeeds; each needs its lw_rundir_unlock. */
 lw_status lw_rundir_lock(const char *dir, int *hold, lw_error *err);
 
+/* Whether dir/.lock is still the file lw_rundir_lock's hold locked (the
+** directory was not moved aside, another made in its place). */
+int lw_rundir_held_here(const char *dir, int hold);
+
 /* Gives back one lw_rundir_lock (hold 0: nothing); the last of a directory
 ** releases its lock. */
 void lw_rundir_unlock(int hold);
