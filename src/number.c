@@ -243,9 +243,14 @@ const char *lw_text_unseen_char(const char *value, char *buf, size_t n)
 lw_status lw_text_plain_file(const char *path, lw_error *err)
 {
   struct stat sb;
-  if (stat(path, &sb) || (!S_ISFIFO(sb.st_mode) && !S_ISSOCK(sb.st_mode) && !S_ISDIR(sb.st_mode))) return LW_OK;
+  /* (a terminal, /dev/ptmx, held a read for ever as a FIFO did) */
+  if (stat(path, &sb) || S_ISREG(sb.st_mode)) return LW_OK;
   return lw_error_set(err, LW_EINPUT, "%s: a %s, not a file: expected a file, which linewise reads whole", path,
-                      S_ISFIFO(sb.st_mode) ? "FIFO (named pipe)" : S_ISSOCK(sb.st_mode) ? "socket" : "folder");
+                      S_ISFIFO(sb.st_mode)   ? "FIFO (named pipe)"
+                      : S_ISSOCK(sb.st_mode) ? "socket"
+                      : S_ISDIR(sb.st_mode)  ? "folder"
+                      : S_ISCHR(sb.st_mode)  ? "character device (a terminal, /dev/zero)"
+                                             : "block device");
 }
 
 long lw_text_next_line(FILE *f, char **buf, size_t *cap, long *line)

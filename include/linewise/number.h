@@ -85,10 +85,11 @@ ssize_t lw_text_getline(char **buf, size_t *cap, FILE *f);
 ** or "" if there is none.  buf holds it. */
 const char *lw_text_unseen_char(const char *value, char *buf, size_t n);
 
-/* LW_EINPUT with err where path names a FIFO or a socket, which a reader
-** would wait on for ever (opening a FIFO waits for a writer), or a folder,
-** whose reading fails with no more than "read error"; else LW_OK (a
-** missing file too: its opening says so). */
+/* LW_EINPUT with err where path names what is not a regular file: a FIFO,
+** a socket or a terminal, which a reader would wait on for ever (opening a
+** FIFO waits for a writer), a folder, whose reading fails with no more than
+** "read error", or another device; else LW_OK (a missing file too: its
+** opening says so). */
 lw_status lw_text_plain_file(const char *path, lw_error *err);
 
 /* What a number in a comma or a point locale's writing means to say, as a
