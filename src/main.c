@@ -1455,9 +1455,12 @@ static int cmd_run(int argc, char **argv)
         snprintf(err.msg + n, sizeof err.msg - n, "; the picture's file is decoded whole before it is made smaller: "
                  "a file of fewer pixels, or more memory");
       else
-        snprintf(err.msg + n, sizeof err.msg - n, "; in less memory %sfewer splines or fewer threads (--threads 1: "
+        snprintf(err.msg + n, sizeof err.msg - n, "; in less memory %sfewer %s or fewer threads (--threads 1: "
                  "ulimit -v counts each thread's reserve) make a smaller run (docs/PERFORMANCE.md, \"Memory\")",
-                 p.image[0] ? "a smaller scene.image_max_pixels, " : "");
+                 p.image[0] ? "a smaller scene.image_max_pixels, " : "",
+                 /* (a particle cloud was told to take fewer splines) */
+                 !strcmp(p.system, "particles") ? "particles" : !strcmp(p.system, "nurbs") ? "control points"
+                                                                                          : "splines");
       stash_note(&err, dir);
     } else if (err.code == LW_EIO && access(dir, F_OK) &&
              (was_there || strstr(err.msg, ": cannot create directory: ") == NULL))
