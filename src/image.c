@@ -437,6 +437,21 @@ static lw_status png_chunks_sound(const unsigned char *d, size_t n, const char *
                       "chunk", name, n);
 }
 
+/* A GIF whose screen (the picture's size) its first picture's LZW data
+** could not paint a quarter of: a 35-byte file that said 23000 x 23000 was
+** decoded, 2 GB, all of it background.  Each code is code + 1 bits or
+** more, and the k-th paints at most k + 1 pixels, 4096 past the table's
+** end: a bound no real picture comes near. */
+static lw_status gif_data_enough(const unsigned char *d, double data, unsigned code, const char *name, lw_error *err)
+{
+  const double w = d[6] | d[7] << 8, h = d[8] | d[9] << 8, codes = floor(8.0 * data / (code + 1.0));
+  const double full = fmin(codes, 4095.0), most = full * (full + 3.0) / 2.0 + (codes - full) * 4096.0;
+  if (w * h <= 1e6 || 4.0 * most >= w * h) return LW_OK;
+  return lw_error_set(err, LW_EINPUT, "%s: a GIF of %.0f x %.0f pixels whose data (%.0f bytes) can paint at most %.0f "
+                      "of them: damaged, or made to take memory; expected a picture its data covers", name, w, h, data,
+                      most);
+}
+
 /* stb_image reads missing bytes at the end of a GIF as zeros too, so a
 ** cut file decodes to a picture with a black or garbled foot.  The blocks
 ** are walked to the end of the first picture's data (the one decoded): the
@@ -457,9 +472,11 @@ static lw_status gif_complete(const unsigned char *d, size_t n, const char *name
   }
   if (at + 10 <= n) {
     unsigned flags = d[at + 9];
-    at += 10 + ((flags & 0x80) ? 3u << ((flags & 7) + 1) : 0u) + 1;
-    while (at < n && d[at]) at += (size_t)d[at] + 1;
-    if (at < n) return LW_OK;
+    at += 10 + ((flags & 0x80) ? 3u << ((flags & 7) + 1) : 0u);
+    const unsigned code = at < n ? d[at] : 0; /* the LZW minimum code size */
+    double data = 0;
+    for (at++; at < n && d[at]; at += (size_t)d[at] + 1) data += d[at];
+    if (at < n) return gif_data_enough(d, data, code, name, err);
   }
   return lw_error_set(err, LW_EINPUT, "%s: truncated: the GIF's first picture runs past the end of the file (%zu bytes)",
                       name, n);
