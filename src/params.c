@@ -1,3 +1,4 @@
+#define _XOPEN_SOURCE 700 /* realpath */
 /*
 ** params.c -- the parameter table, the INI reader (inih), --set overrides,
 ** the echo of resolved parameters and the generated docs (params.h).
@@ -1784,9 +1785,47 @@ lw_status lw_params_bed_check(const lw_params *p, const double box[4], const cha
   return LW_OK;
 }
 
+/* Where the environment names LINEWISE_INPUT_ROOT (a service running
+** others' scenes), every file a key names must lie inside that folder, its
+** links followed, checked before any is opened: a scene could name any file
+** the service could read, and a refusal quoted its first line (an API key
+** of a .env file, /etc/shadow's first entry).  A file not there yet is
+** judged by its folder. */
+static lw_status inputs_confined(const lw_params *p, lw_error *err)
+{
+  const char *root_env = getenv("LINEWISE_INPUT_ROOT");
+  char root[4096], dir[LW_PATH_MAX], joined[2 * LW_PATH_MAX + 2], real[4096 + LW_PATH_MAX], where[LW_PATH_MAX + 32];
+  if (!root_env || !root_env[0]) return LW_OK;
+  if (!realpath(root_env, root))
+    return lw_error_set(err, LW_EUSAGE, "LINEWISE_INPUT_ROOT=%s: %s: expected the folder a scene's files must lie in",
+                        root_env, strerror(errno));
+  const size_t n = strlen(root);
+  lw_path_dir(dir, sizeof dir, p->file);
+  for (size_t i = 0; i < lw_param_count; i++) {
+    const lw_param_def *d = &lw_param_table[i];
+    const char *path = (const char *)p + d->offset;
+    if (d->type != LW_PT_STRING || !d->unit || strcmp(d->unit, "path") || !path[0]) continue;
+    lw_path_join(joined, sizeof joined, dir, path);
+    if (!realpath(joined, real)) {
+      char folder[sizeof joined];
+      lw_path_dir(folder, sizeof folder, joined);
+      const char *base = strrchr(joined, '/') ? strrchr(joined, '/') + 1 : joined;
+      if (!realpath(folder, real) || snprintf(real + strlen(real), sizeof real - strlen(real), "/%s", base) < 0)
+        real[0] = '\0';
+    }
+    if (real[0] && !strncmp(real, root, n) && (real[n] == '/' || (n == 1 && root[0] == '/'))) continue;
+    lw_params_origin(p, d, where, sizeof where);
+    return lw_error_set(err, LW_EINPUT, "%s: key '%s.%s': '%s' is not inside LINEWISE_INPUT_ROOT (%s), where this "
+                        "linewise reads a scene's files; expected a file there", where, d->section, d->key, path, root);
+  }
+  return LW_OK;
+}
+
 lw_status lw_params_resolve(lw_params *p, lw_error *err)
 {
   char where[LW_PATH_MAX + 32], where_page[LW_PATH_MAX + 32];
+  lw_status sc = inputs_confined(p, err);
+  if (sc) return sc;
   /* a scene.ini that a run wrote before the key was one runs again as that
   ** run did (the hash of a resume's leaves the missing key out) */
   if (p->run_header && !lw_params_line(p, "anneal", "seed_version")) p->seed_version = 1;

@@ -1550,6 +1550,33 @@ Test(cli, a_run_whose_directory_is_replaced_leaves_the_new_one_alone)
   cr_assert_eq(lw_test_sh("cd %s && test \"$(ls -A m)\" = mine && test -s moved/state.lw", dir), 0);
 }
 
+/* A service running others' scenes confines the files their keys name to
+** LINEWISE_INPUT_ROOT: outside it (a path, a '..', a link inside leading
+** out) each is refused before it is read, and the refusal quotes none of
+** it (a .env file's first line was quoted by the table's reader). */
+Test(cli, a_service_confines_the_files_a_scene_names)
+{
+  cr_assert_eq(lw_test_sh("mkdir %s/job", dir), 0);
+  write_file("job/s.ini", scene_text);
+  write_file("secret.txt", "API_KEY=sk_live_SECRET\n");
+  cr_assert_eq(lw_test_sh("cd %s && ln -s ../secret.txt job/link.txt && cp %s/params/picture.png job/", dir,
+                          lw_test_root()), 0);
+  static const char *const set[] = {"anneal.table=secret.txt", "anneal.table=job/../secret.txt",
+                                    "anneal.table=job/link.txt", "init.from=/etc/passwd"};
+  for (size_t k = 0; k < sizeof set / sizeof set[0]; k++) {
+    cr_assert_eq(lw_test_sh("cd %s && LINEWISE_INPUT_ROOT=job %s run job/s.ini --out job/o --quiet --set "
+                            "anneal.schedule=table --set %s 2> err.txt; test $? -eq 2", dir, lw_test_bin(), set[k]),
+                 0, "%s", set[k]);
+    char *e = lw_test_slurp("%s/err.txt", dir);
+    cr_assert(e && strstr(e, "' is not inside LINEWISE_INPUT_ROOT (") && !strstr(e, "sk_live") && !strstr(e, "root:"),
+              "%s: %s", set[k], e);
+    free(e);
+  }
+  cr_assert_eq(lw_test_sh("cd %s && test ! -e job/o && LINEWISE_INPUT_ROOT=job %s run job/s.ini --out job/o --quiet "
+                          "--set scene.image=job/picture.png --set anneal.sweeps=2 && LINEWISE_INPUT_ROOT=job %s resume "
+                          "job/o --quiet", dir, lw_test_bin(), lw_test_bin()), 0);
+}
+
 /* A copy made with hard links (cp -al, rsync --link-dest) shares the files
 ** a run writes in place: the copy's resume cut the finished original's
 ** trace to its own stop, and a run of either was said busy while the other
