@@ -868,6 +868,15 @@ static void say_stash_left(lw_anneal *a)
   a->stash_left[0] = 0;
 }
 
+/* A --stop-at past the run's end stops nothing: the run finishes (a loop
+** that asked for sweep 250 of 200 got a finished run, unsaid). */
+static void say_stop_past_end(const lw_anneal *a, long stop_at, int quiet)
+{
+  if (!quiet && stop_at > a->end_sweep)
+    fprintf(stderr, "linewise: note: --stop-at %ld is past the run's end at sweep %ld: it runs to its end and "
+            "finishes ('resume --sweeps N' runs past an end)\n", stop_at, a->end_sweep);
+}
+
 /* Frames that will fill the disk: said under --quiet too, as the failure
 ** it foretells would be (the process that draws them says it). */
 static void say_frames_disk(const lw_anneal *a, int quiet)
@@ -1555,6 +1564,7 @@ static int cmd_run(int argc, char **argv)
     if (strcmp(dir, plain))
       fprintf(stderr, "linewise: into %s (%s holds a run; --out names the directory)\n", dir, plain);
   }
+  say_stop_past_end(&a, stop_at, quiet);
   int rc = anneal_loop(&a, stop_at, quiet, asked, &w, &err);
   lw_anneal_free(&a);
   return rc;
@@ -1637,6 +1647,7 @@ static int cmd_resume(int argc, char **argv)
     fprintf(stderr, "linewise: note: %s/timing.txt is missing or unreadable: summary.json's wall_seconds and "
             "sweep_seconds count from this resume on, and proposals_per_second this resume's proposals\n", dir);
   if (!quiet) fprintf(stderr, "linewise: resuming %s at sweep %ld of %ld\n", dir, a.sweep, a.end_sweep);
+  say_stop_past_end(&a, stop_at, quiet);
   int rc = anneal_loop(&a, stop_at, quiet, asked, &w, &err);
   lw_anneal_free(&a);
   return rc;

@@ -1550,6 +1550,20 @@ Test(cli, a_run_whose_directory_is_replaced_leaves_the_new_one_alone)
   cr_assert_eq(lw_test_sh("cd %s && test \"$(ls -A m)\" = mine && test -s moved/state.lw", dir), 0);
 }
 
+/* A --stop-at past the run's end is said: the run finishes (a loop that
+** asked for sweep 250 of 200 got a finished run, unsaid); short of it, no
+** note. */
+Test(cli, a_stop_past_the_end_is_said)
+{
+  write_file("s.ini", scene_text);
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --out a --set anneal.sweeps=6 --stop-at 9 2> err.txt && "
+                          "grep -q 'note: --stop-at 9 is past the run.s end at sweep 6: it runs to its end' err.txt && "
+                          "test -s a/summary.json && %s run s.ini --out b --set anneal.sweeps=6 --stop-at 3 2> err.txt && "
+                          "! grep -q 'note: --stop-at' err.txt && %s resume b --stop-at 7 2> err.txt && "
+                          "grep -q 'note: --stop-at 7 is past' err.txt", dir, lw_test_bin(), lw_test_bin(),
+                          lw_test_bin()), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+}
+
 /* A service running others' scenes confines the files their keys name to
 ** LINEWISE_INPUT_ROOT: outside it (a path, a '..', a link inside leading
 ** out) each is refused before it is read, and the refusal quotes none of
