@@ -288,17 +288,25 @@ static void dir_identity(lw_anneal *a)
   if (!stat(a->dir, &st)) a->dir_id[0] = (unsigned long long)st.st_dev, a->dir_id[1] = (unsigned long long)st.st_ino;
 }
 
-/* LW_EIO, dir_moved set, once the path names another directory or none. */
-static lw_status dir_still_ours(lw_anneal *a, lw_error *err)
+lw_status lw_anneal_dir_ours(const lw_anneal *a, lw_error *err)
 {
   struct stat st;
   if (!a->dir_id[0] && !a->dir_id[1]) return LW_OK;
   const int there = !stat(a->dir, &st);
   if (there && (unsigned long long)st.st_dev == a->dir_id[0] && (unsigned long long)st.st_ino == a->dir_id[1])
     return LW_OK;
-  a->dir_moved = 1;
-  return lw_error_set(err, LW_EIO, "%s is no longer there: the run's directory was removed or moved%s", a->dir,
-                      there ? ", and another is in its place, which this run leaves alone" : "");
+  if (there)
+    return lw_error_set(err, LW_EIO, "%s is another directory now: the run's directory was moved or removed, and "
+                        "another made in its place, which this run leaves alone", a->dir);
+  return lw_error_set(err, LW_EIO, "%s is no longer there: the run's directory was removed or moved", a->dir);
+}
+
+/* The same, dir_moved set. */
+static lw_status dir_still_ours(lw_anneal *a, lw_error *err)
+{
+  lw_status s = lw_anneal_dir_ours(a, err);
+  if (s) a->dir_moved = 1;
+  return s;
 }
 
 static int replica_here(const lw_anneal *a, int r)
@@ -2574,9 +2582,13 @@ lw_status lw_anneal_finish(lw_anneal *a, lw_error *err)
     if (a->quench.ended == LW_QUENCH_STOPPED) return lw_checkpoint_write_timing(a, err);
     a->quenched = 1;
   }
+  /* (again: a quench of a minute, and the drawing, are long enough to move
+  ** the directory in, and another made in its place took the results) */
+  if ((s = dir_still_ours(a, err))) return s;
   lw_phase_set("drawing the final files and scoring them");
   if (a->drawing) *a->drawing = 1;
-  if (!(s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_FINAL, err))) s = write_summary(a, err);
+  if (!(s = a->sys_type->draw(a->sys->state, &a->params, a->dir, LW_DRAW_FINAL, err)) && !(s = dir_still_ours(a, err)))
+    s = write_summary(a, err);
   /* the quench and the drawing counted too: an extension's total took up
   ** the last checkpoint's, before them (4 s of 12 lost on study.ini).  The
   ** run is whole once summary.json is written, which a script takes as its

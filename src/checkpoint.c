@@ -177,8 +177,10 @@ lw_status lw_checkpoint_write_replica(const lw_anneal *a, int k, lw_error *err)
   snprintf(name, sizeof name, "replica-%d.lw", k);
   dir_file(path, sizeof path, a, name);
   lw_ckpt_writer w;
-  lw_status s = lw_ckpt_begin(&w, path, LW_STATE_HEADER, err);
-  if (s) return s;
+  /* (under MPI every process writes its rungs' files: the first one's check
+  ** kept none of the others out of a directory made in its place) */
+  lw_status s = lw_anneal_dir_ours(a, err);
+  if (s || (s = lw_ckpt_begin(&w, path, LW_STATE_HEADER, err))) return s;
   w.no_sum = a->unsummed;
   lw_state_put_header(&w, &head);
   lw_checkpoint_system_section(name, sizeof name, a->sys_type, 0);

@@ -231,6 +231,17 @@ const char *lw_text_unseen_char(const char *value, char *buf, size_t n)
     const unsigned char b = (unsigned char)value[i];
     unsigned cp;
     const int len = b < 0x80 ? 1 : lw_utf8_at((const unsigned char *)value + i, &cp);
+    /* (a Latin-1 scene's "Über" was told to delete its Ü; a CRLF script's
+    ** value to delete its CR) */
+    if (!len && b >= 0x80) {
+      snprintf(buf, n, " (byte %zu is 0x%02X, not UTF-8: a file saved as Latin-1 or 'ANSI'? save it as UTF-8)", i + 1,
+               b);
+      return buf;
+    }
+    if (b == '\r') {
+      snprintf(buf, n, " (byte %zu is 0x0D, a CR: a file saved with CRLF line ends? save it with LF)", i + 1);
+      return buf;
+    }
     if (!len || (b < 0x20 && b != '\t') || b == 0x7f) {
       snprintf(buf, n, " (byte %zu is 0x%02X, not a character of text: delete it)", i + 1, b);
       return buf;

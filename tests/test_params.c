@@ -203,10 +203,12 @@ Test(params, bad_input_names_file_line_and_key)
   cr_assert(strstr(err.msg, "(byte 1 is a byte-order mark, U+FEFF"), "%s", err.msg);
   /* and a byte that is no text (no UTF-8, or a control character) by its number; a letter of UTF-8 is text */
   /* and the look-alikes of a number's characters, by what to type instead */
-  const char *stray[][2] = {{"bark\xff" "er", "(byte 5 is 0xFF, not a character of text: delete it)"},
+  const char *stray[][2] = {{"bark\xff" "er", "(byte 5 is 0xFF, not UTF-8: a file saved as Latin-1 or 'ANSI'? save it "
+                                               "as UTF-8)"},
+                            {"2\r", "(byte 2 is 0x0D, a CR: a file saved with CRLF line ends? save it with LF)"},
                             {"me\x01tropolis", "(byte 3 is 0x01, not a character of text"},
                             {"m\xc3\xa9tropolis", NULL},
-                            {"1\xc0\x85", "(byte 2 is 0xC0, not a character of text"}, /* an overlong form */
+                            {"1\xc0\x85", "(byte 2 is 0xC0, not UTF-8"}, /* an overlong form */
                             {"\xe2\x88\x92" "1", "(byte 1 is a minus sign, U+2212: type '-')"},
                             {"1\xef\xbc\x90", "(byte 2 is a full-width '0', U+FF10: type '0')"},
                             {"0\xef\xbc\x8e" "5", "(byte 2 is a full-width '.', U+FF0E: type '.')"},

@@ -192,6 +192,11 @@ static inline int lw_anneal_paused(const lw_anneal *a) { return a->pause_at >= 0
 ** the first checkpoint). */
 int lw_anneal_undo_start(lw_anneal *a);
 
+/* LW_EIO with a message once a->dir names another directory than the one
+** the run began in (moved aside, another made in its place) or none: its
+** files are written by path, and went into the other. */
+lw_status lw_anneal_dir_ours(const lw_anneal *a, lw_error *err);
+
 /* Writes state.lw now (a clean stop). */
 lw_status lw_anneal_checkpoint(lw_anneal *a, lw_error *err);
 
