@@ -1854,10 +1854,11 @@ lw_status lw_anneal_resume_net(lw_anneal *a, const char *dir, long more, lw_anne
   if (more >= 0 && a->sweep + more < saved_end) a->pause_at = a->sweep + more;
   else if (more >= 0) a->end_sweep = a->sweep + more;
   /* the checksum after every value's own check, which names what it finds,
-  ** and before anything is written; a state without one (begun before
-  ** 2026-12-07) is written on without, to its old release's bytes */
+  ** and before anything is written; a run begun before it (a state without
+  ** block_shift, of the same day) is written on without, to its old
+  ** release's bytes, and one whose line was taken out on purpose with */
   if (st.doc && (s = lw_ckpt_verify(st.doc, err))) goto out;
-  a->unsummed = !st.doc || !lw_ckpt_summed(st.doc);
+  a->unsummed = a->acc_unshifted;
   /* (every process of an MPI run: one that writes nothing must still stop
   ** with the others, not at once) */
   lw_phase_writing();

@@ -43,6 +43,8 @@ struct lw_ckpt {
   size_t ns, scap;
   size_t sum_at;      /* where its last line, "# checksum X", begins, or NONE */
   int sum_ok;         /* X is the checksum of the bytes before it */
+  int sum_misplaced;  /* the line is not the last but blanks, or not of 16 hex digits */
+  int sum_line;
 };
 
 /* FNV-1a, 64 bits: a flipped bit anywhere changes it (a damaged copy of a
@@ -216,30 +218,53 @@ static lw_status parse(lw_ckpt *c, lw_error *err)
   return LW_OK;
 }
 
-/* The last line, where it is "# checksum" and 16 hex digits, and whether
-** they are the checksum of the bytes before it. */
-static void find_sum(lw_ckpt *c)
+/* FNV-1a of n bytes less the CR of each CR LF: a copy with Windows line
+** ends (git's autocrlf, an editor) keeps its sum. */
+static unsigned long long sum_text(const char *t, size_t n)
 {
-  const size_t n = strlen(SUM_LINE) + 17;
-  const char *line = c->text + c->len - n;
-  char *end;
-  if (c->len < n || (c->len > n && line[-1] != '\n') || strncmp(line, SUM_LINE, strlen(SUM_LINE))) return;
-  const unsigned long long v = strtoull(line + strlen(SUM_LINE), &end, 16);
-  if (end != c->text + c->len - 1 || !isxdigit((unsigned char)line[strlen(SUM_LINE)])) return;
-  c->sum_at = (size_t)(line - c->text);
-  /* (a byte order mark an editor put before it is no content: read as without) */
-  const size_t from = c->sum_at >= 3 && !memcmp(c->text, "\xef\xbb\xbf", 3) ? 3 : 0;
-  c->sum_ok = fnv1a(FNV_START, (const unsigned char *)c->text + from, c->sum_at - from) == v;
+  unsigned long long h = FNV_START;
+  for (size_t k = 0; k < n; k++)
+    if (!(t[k] == '\r' && k + 1 < n && t[k + 1] == '\n')) h = fnv1a(h, (const unsigned char *)t + k, 1);
+  return h;
 }
 
-int lw_ckpt_summed(const lw_ckpt *c) { return c->sum_at != NONE; }
+/* The checksum's line, "# checksum" and 16 hex digits: where it begins and
+** whether they are the sum of the bytes before it (a byte order mark an
+** editor put first aside), where it is the last line but blanks; one with
+** lines after it is a misplaced sum (an edit that added them). */
+static void find_sum(lw_ckpt *c)
+{
+  const size_t k = strlen(SUM_LINE);
+  size_t end = c->len;
+  while (end > 0 && strchr(" \t\r\n", c->text[end - 1])) end--;
+  size_t at = NONE;
+  for (size_t i = c->len; i-- > 0;)
+    if ((i == 0 || c->text[i - 1] == '\n') && i + k <= c->len && !strncmp(c->text + i, SUM_LINE, k)) {
+      at = i;
+      break;
+    }
+  if (at == NONE) return;
+  char *stop;
+  const unsigned long long v = strtoull(c->text + at + k, &stop, 16);
+  const int hex = stop == c->text + at + k + 16 && isxdigit((unsigned char)c->text[at + k]);
+  c->sum_at = at;
+  c->sum_line = 1;
+  for (size_t i = 0; i < at; i++) c->sum_line += c->text[i] == '\n';
+  c->sum_misplaced = !hex || stop < c->text + end;
+  const size_t from = at >= 3 && !memcmp(c->text, "\xef\xbb\xbf", 3) ? 3 : 0;
+  c->sum_ok = !c->sum_misplaced && sum_text(c->text + from, at - from) == v;
+}
 
 lw_status lw_ckpt_verify(const lw_ckpt *c, lw_error *err)
 {
   if (c->sum_at == NONE || c->sum_ok) return LW_OK;
+  if (c->sum_misplaced)
+    return lw_error_set(err, LW_EINPUT, "%s: its checksum's line is not its last, or not '# checksum' and 16 hex "
+                        "digits: the file was damaged or edited since linewise wrote it; a state edited on purpose "
+                        "goes on once that line is taken out", c->path);
   return lw_error_set(err, LW_EINPUT, "%s:%d: its checksum does not match its contents: the file was damaged (a disk's "
                       "or a copy's fault) or edited since linewise wrote it; a state edited on purpose goes on once "
-                      "this last line is taken out", c->path, c->lines);
+                      "this line is taken out", c->path, c->sum_line);
 }
 
 lw_status lw_ckpt_read(lw_ckpt **out, const char *path, lw_error *err)

@@ -309,9 +309,23 @@ Test(checkpoint, a_change_no_value_check_sees_is_the_checksums)
   cr_assert_eq(lw_test_sh("cmp -s %s/r/state.lw %s/x/state.lw", dir, dir), 1, "the edit changed nothing");
   cr_assert(err_has("x/state.lw:") && err_has(": its checksum does not match its contents: the file was damaged (a "
                                                "disk's or a copy's fault) or edited since linewise wrote it"));
-  char both[256];
-  snprintf(both, sizeof both, "%s;$d", nudge);
-  cr_assert_eq(resume_edited(both), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+  /* a blank line after it, or Windows line ends, with the nudge: refused
+  ** (each skipped the sum, unsaid); with Windows line ends alone, a copy
+  ** that changed nothing, it resumes */
+  char more[256];
+  snprintf(more, sizeof more, "%s;$s/$/\\n/", nudge);
+  cr_assert_eq(resume_edited(more), 2);
+  snprintf(more, sizeof more, "%s;s/$/\\r/", nudge);
+  cr_assert_eq(resume_edited(more), 2);
+  cr_assert(err_has(": its checksum does not match its contents"));
+  cr_assert_eq(resume_edited("s/$/\\r/"), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+  /* a line after it is an edit too */
+  cr_assert_eq(resume_edited("$s/$/\\n# a note/"), 2);
+  cr_assert(err_has(": its checksum's line is not its last"));
+  /* taken out on purpose, the run goes on, and its next state has one again */
+  snprintf(more, sizeof more, "%s;$d", nudge);
+  cr_assert_eq(resume_edited(more), 0, "%s", lw_test_slurp("%s/err.txt", dir));
+  cr_assert_eq(lw_test_sh("tail -n 1 %s/x/state.lw | grep -q '^# checksum '", dir), 0);
   cr_assert_eq(resume_edited("$d"), 0);
 }
 

@@ -56,7 +56,8 @@ typedef struct lw_anneal {
   int dir_hold;                 /* lw_rundir_lock's hold on dir while it writes there, 0 none */
   unsigned long long dir_id[2]; /* dir's device and inode where the run began here (0 0: not taken) */
   int dir_moved;                /* dir was no longer that directory at a write: the run ended there */
-  int unsummed;                 /* a run begun before 2026-12-07: its state files end with no checksum */
+  int unsummed;                 /* a run begun before 2026-12-07 (acc_unshifted): its state files end with
+                                ** no checksum */
   char unread[1024];           /* keys the scene sets that only other drivers read, where set, or "" */
   char idle[4096];             /* keys the scene sets that its other settings leave idle, where and why */
   char schedule_note[2048];     /* a schedule whose steps never reach its end (lw_anneal_start), or "" */

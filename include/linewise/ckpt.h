@@ -119,8 +119,6 @@ lw_status lw_ckpt_unread(const lw_ckpt *c, lw_error *err);
 ** by lw_ckpt_commit since 2026-12-07), does not match the bytes before it;
 ** LW_OK where it does or there is none (an older or a hand-written file). */
 lw_status lw_ckpt_verify(const lw_ckpt *c, lw_error *err);
-/* Whether the file ends with such a line. */
-int lw_ckpt_summed(const lw_ckpt *c);
 
 /* ---- writing ------------------------------------------------------------ */
 
