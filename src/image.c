@@ -437,18 +437,22 @@ static lw_status png_chunks_sound(const unsigned char *d, size_t n, const char *
                       "chunk", name, n);
 }
 
-/* A GIF whose screen (the picture's size) its first picture's LZW data
-** could not paint a quarter of: a 35-byte file that said 23000 x 23000 was
-** decoded, 2 GB, all of it background.  Each code is code + 1 bits or
-** more, and the k-th paints at most k + 1 pixels, 4096 past the table's
-** end: a bound no real picture comes near. */
-static lw_status gif_data_enough(const unsigned char *d, double data, unsigned code, const char *name, lw_error *err)
+/* A GIF whose screen (the picture's size, which the decoder fills) is
+** large and its first picture's LZW data could not paint a quarter of it:
+** a 35-byte file that said 23000 x 23000 was decoded, 2 GB, all of it
+** background.  Each code is code + 1 bits or more, and the k-th paints at
+** most k + 1 pixels, 4096 past the table's end: a bound no real picture
+** comes near.  Up to 2e7 pixels (80 MB decoded) a small picture on a large
+** screen is decoded as before (a crop ImageMagick kept on its canvas). */
+static lw_status gif_data_enough(const unsigned char *d, const unsigned char *image, double data, unsigned code,
+                                 const char *name, lw_error *err)
 {
   const double w = d[6] | d[7] << 8, h = d[8] | d[9] << 8, codes = floor(8.0 * data / (code + 1.0));
   const double full = fmin(codes, 4095.0), most = full * (full + 3.0) / 2.0 + (codes - full) * 4096.0;
-  if (w * h <= 1e6 || 4.0 * most >= w * h) return LW_OK;
-  return lw_error_set(err, LW_EINPUT, "%s: a GIF of %.0f x %.0f pixels whose data (%.0f bytes) can paint at most %.0f "
-                      "of them: damaged, or made to take memory; expected a picture its data covers", name, w, h, data,
+  if (w * h <= 2e7 || 4.0 * most >= w * h) return LW_OK;
+  return lw_error_set(err, LW_EINPUT, "%s: a GIF whose %.0f x %.0f screen its first picture (%d x %d, %.0f bytes of "
+                      "data) can paint at most %.0f pixels of: damaged, or made to take memory; expected a picture "
+                      "that covers its screen", name, w, h, image[5] | image[6] << 8, image[7] | image[8] << 8, data,
                       most);
 }
 
@@ -471,12 +475,13 @@ static lw_status gif_complete(const unsigned char *d, size_t n, const char *name
     at++;
   }
   if (at + 10 <= n) {
+    const unsigned char *image = d + at;
     unsigned flags = d[at + 9];
     at += 10 + ((flags & 0x80) ? 3u << ((flags & 7) + 1) : 0u);
     const unsigned code = at < n ? d[at] : 0; /* the LZW minimum code size */
     double data = 0;
     for (at++; at < n && d[at]; at += (size_t)d[at] + 1) data += d[at];
-    if (at < n) return gif_data_enough(d, data, code, name, err);
+    if (at < n) return gif_data_enough(d, image, data, code, name, err);
   }
   return lw_error_set(err, LW_EINPUT, "%s: truncated: the GIF's first picture runs past the end of the file (%zu bytes)",
                       name, n);

@@ -183,26 +183,27 @@ Test(image, a_gif_decodes_and_a_gif_cut_short_is_refused)
   lw_image_free(img);
 }
 
-/* A GIF whose screen its data could not paint a quarter of is refused
-** before it is decoded: 35 bytes that said 23000 x 23000 took 2 GB (a 1 x 1
-** picture's data: clear, one pixel, end).  Up to a million pixels such a
-** screen is decoded as before (its background). */
+/* A GIF whose large screen its data could not paint a quarter of is
+** refused before it is decoded: 35 bytes that said 23000 x 23000 took 2 GB
+** (a 1 x 1 picture's data: clear, one pixel, end).  Up to 2e7 pixels such a
+** screen is decoded as before, its background around the picture (a crop
+** ImageMagick kept on its 2000 x 1500 canvas was refused). */
 Test(image, a_gif_whose_data_cannot_cover_its_screen_is_refused_before_decoding)
 {
   unsigned char gif[] = {'G', 'I', 'F', '8', '9', 'a', 0, 0, 0, 0, 0x80, 0, 0, 0, 0, 0, 255, 255, 255,
                          0x2c, 0, 0, 0, 0, 1, 0, 1, 0, 0, 2, 2, 0x04, 0x01, 0, 0x3b};
-  const unsigned sides[][2] = {{23000, 23000}, {2001, 1000}, {1000, 1000}};
+  const unsigned sides[][2] = {{23000, 23000}, {5001, 4000}, {2000, 1500}};
   for (int k = 0; k < 3; k++) {
     gif[6] = sides[k][0] & 255, gif[7] = sides[k][0] >> 8, gif[8] = sides[k][1] & 255, gif[9] = sides[k][1] >> 8;
     lw_error err;
     lw_image *img = lw_image_decode(gif, sizeof gif, "s.gif", 1e7, NULL, &err);
     if (k < 2)
-      cr_assert(!img && err.code == LW_EINPUT && strstr(err.msg, "s.gif: a GIF of ") &&
-                    strstr(err.msg, " pixels whose data (2 bytes) can paint at most 20 of them: damaged, or made to "
-                                    "take memory"),
+      cr_assert(!img && err.code == LW_EINPUT && strstr(err.msg, "s.gif: a GIF whose ") &&
+                    strstr(err.msg, " screen its first picture (1 x 1, 2 bytes of data) can paint at most 20 pixels "
+                                    "of: damaged, or made to take memory"),
                 "%u x %u: %s", sides[k][0], sides[k][1], img ? "decoded" : err.msg);
     else
-      cr_assert(img && img->width == 1000 && img->height == 1000, "%s", img ? "" : err.msg);
+      cr_assert(img && img->width == 2000 && img->height == 1500, "%s", img ? "" : err.msg);
     lw_image_free(img);
   }
 }
