@@ -1796,9 +1796,11 @@ static lw_status inputs_confined(const lw_params *p, lw_error *err)
   const char *root_env = getenv("LINEWISE_INPUT_ROOT");
   char root[4096], dir[LW_PATH_MAX], joined[2 * LW_PATH_MAX + 2], real[4096 + LW_PATH_MAX], where[LW_PATH_MAX + 32];
   if (!root_env || !root_env[0]) return LW_OK;
-  if (!realpath(root_env, root))
+  struct stat st;
+  const int rooted = realpath(root_env, root) != NULL;
+  if (!rooted || stat(root, &st) || !S_ISDIR(st.st_mode))
     return lw_error_set(err, LW_EUSAGE, "LINEWISE_INPUT_ROOT=%s: %s: expected the folder a scene's files must lie in",
-                        root_env, strerror(errno));
+                        root_env, rooted ? "not a folder" : strerror(errno));
   const size_t n = strlen(root);
   lw_path_dir(dir, sizeof dir, p->file);
   for (size_t i = 0; i < lw_param_count; i++) {
@@ -1806,12 +1808,25 @@ static lw_status inputs_confined(const lw_params *p, lw_error *err)
     const char *path = (const char *)p + d->offset;
     if (d->type != LW_PT_STRING || !d->unit || strcmp(d->unit, "path") || !path[0]) continue;
     lw_path_join(joined, sizeof joined, dir, path);
-    if (!realpath(joined, real)) {
-      char folder[sizeof joined];
-      lw_path_dir(folder, sizeof folder, joined);
-      const char *base = strrchr(joined, '/') ? strrchr(joined, '/') + 1 : joined;
-      if (!realpath(folder, real) || snprintf(real + strlen(real), sizeof real - strlen(real), "/%s", base) < 0)
+    /* (the nearest folder above it that is there, and the names below it,
+    ** which no link can lead out of: a missing subfolder was said outside) */
+    size_t cut = strlen(joined);
+    for (;;) {
+      const char keep = joined[cut];
+      joined[cut] = '\0';
+      const int found = realpath(cut ? joined : "/", real) != NULL;
+      joined[cut] = keep;
+      if (found) { /* (a '..' below it could lead out once the folders are made) */
+        if (strstr(joined + cut, "/..")) real[0] = '\0';
+        else snprintf(real + strlen(real), sizeof real - strlen(real), "%s", joined + cut);
+        break;
+      }
+      while (cut > 0 && joined[cut - 1] != '/') cut--;
+      if (cut > 0) cut--;
+      else {
         real[0] = '\0';
+        break;
+      }
     }
     if (real[0] && !strncmp(real, root, n) && (real[n] == '/' || (n == 1 && root[0] == '/'))) continue;
     lw_params_origin(p, d, where, sizeof where);

@@ -1593,6 +1593,16 @@ Test(cli, a_service_confines_the_files_a_scene_names)
   cr_assert_eq(lw_test_sh("cd %s && test ! -e job/o && LINEWISE_INPUT_ROOT=job %s run job/s.ini --out job/o --quiet "
                           "--set scene.image=job/picture.png --set anneal.sweeps=2 && LINEWISE_INPUT_ROOT=job %s resume "
                           "job/o --quiet", dir, lw_test_bin(), lw_test_bin()), 0);
+  /* a missing folder inside is a missing file, not one outside; a '..'
+  ** below it could lead out once it is made; a root that is a file */
+  cr_assert_eq(lw_test_sh("cd %s && LINEWISE_INPUT_ROOT=job %s run job/s.ini --out job/p --set scene.image=job/sub/no.png "
+                          "2>&1 | grep -q 'job/sub/no.png: cannot open the image: No such file'", dir, lw_test_bin()), 0);
+  cr_assert_eq(lw_test_sh("cd %s && LINEWISE_INPUT_ROOT=job %s run job/s.ini --out job/p --set "
+                          "scene.image=job/sub/../../secret.txt 2>&1 | grep -q 'is not inside LINEWISE_INPUT_ROOT'", dir,
+                          lw_test_bin()), 0);
+  cr_assert_eq(lw_test_sh("cd %s && LINEWISE_INPUT_ROOT=job/picture.png %s run job/s.ini --out job/p 2>&1 | grep -q "
+                          "'LINEWISE_INPUT_ROOT=job/picture.png: not a folder: expected the folder'", dir, lw_test_bin()),
+               0);
 }
 
 /* A copy made with hard links (cp -al, rsync --link-dest) shares the files
