@@ -181,10 +181,13 @@ void lw_anneal_film_note(const lw_anneal *a, char *buf, size_t n)
   buf[0] = '\0';
   if (!(cost > 1.0 && cost > wall / 3.0)) return;
   size_t used = 0;
-  for (int k = 0; k < 2; k++)
+  for (int k = 0; k < 2; k++) {
+    char each[32] = "every sweep";
+    if (every[k] > 1) snprintf(each, sizeof each, "every %d sweeps", every[k]);
     if (a->film_seconds[k] > cost / 4.0 && used < n)
-      used += (size_t)snprintf(buf + used, n - used, "%swriting %s every %d sweeps (output.%s) took %.0f %%",
-                               used ? ", " : "", what[k], every[k], key[k], 100.0 * a->film_seconds[k] / wall);
+      used += (size_t)snprintf(buf + used, n - used, "%swriting %s %s (output.%s) took %.0f %%", used ? ", " : "",
+                               what[k], each, key[k], 100.0 * a->film_seconds[k] / wall);
+  }
   if (used < n)
     snprintf(buf + used, n - used, " of this run's time: a larger value costs less (the run's results are the same)");
 }
@@ -324,11 +327,11 @@ static double rung_energy(const lw_anneal *a, int k)
 
 double lw_anneal_energy(const lw_anneal *a) { return rung_energy(a, 0); }
 
-/* n bytes as "3.36 GB", "62.7 MB" or "840 kB" into buf (16 bytes). */
+/* n bytes as "2.2 TB", "3.36 GB", "62.7 MB" or "840 kB" into buf (16 bytes). */
 static const char *bytes_text(double n, char *buf)
 {
-  const char *unit = n >= 1e9 ? "GB" : n >= 1e6 ? "MB" : "kB";
-  snprintf(buf, 16, "%.3g %s", n / (n >= 1e9 ? 1e9 : n >= 1e6 ? 1e6 : 1e3), unit);
+  const char *unit = n >= 1e12 ? "TB" : n >= 1e9 ? "GB" : n >= 1e6 ? "MB" : "kB";
+  snprintf(buf, 16, "%.3g %s", n / (n >= 1e12 ? 1e12 : n >= 1e9 ? 1e9 : n >= 1e6 ? 1e6 : 1e3), unit);
   return buf;
 }
 

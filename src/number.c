@@ -260,7 +260,7 @@ lw_status lw_text_plain_file(const char *path, lw_error *err)
                       S_ISFIFO(sb.st_mode)   ? "FIFO (named pipe)"
                       : S_ISSOCK(sb.st_mode) ? "socket"
                       : S_ISDIR(sb.st_mode)  ? "folder"
-                      : S_ISCHR(sb.st_mode)  ? "character device (a terminal, /dev/zero)"
+                      : S_ISCHR(sb.st_mode)  ? "character device (a terminal, /dev/null, /dev/zero)"
                                              : "block device");
 }
 

@@ -752,7 +752,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       ** agree; nor need a rung's columns where the rungs' temperatures differ */
       cs[c].mixed = column_mixed(t, row, n, k, t[0]->name[c]);
       if (!strncmp(t[0]->name[c], "acc_", 4) || !strncmp(t[0]->name[c], "swap", 4) || cs[c].mixed)
-        cs[c].p_runs = cs[c].r_hat = NAN;
+        cs[c].p_runs = cs[c].r_hat = cs[c].se_runs = NAN; /* (the runs' spread of these is by design) */
     }
   }
   int width = 16; /* the names' column */
@@ -799,7 +799,7 @@ lw_status lw_trace_stats_runs(const lw_trace *const *t, const char *const *path,
       if (!q->mixed) {
         stat_cell(mean, sizeof mean, csv, "%.9g", q->mean);
         stat_cell(se, sizeof se, csv, "%.4g", q->stderr_mean);
-        stat_cell(spread, sizeof spread, csv, "%.4g", q->se_runs);
+        if (!isnan(q->se_runs)) stat_cell(spread, sizeof spread, csv, "%.4g", q->se_runs);
       }
       if (csv)
         fprintf(out, "%s,%d,%zu,%s,%s,%s,%s,%s,%s,%s,%s\n", name, k, rows, mean, se, sd, tau, neff, rh, pr, spread);

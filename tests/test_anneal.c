@@ -626,6 +626,10 @@ Test(anneal, frames_that_take_most_of_a_run_are_said)
   a.film_seconds[1] = 1.0; /* together under a third */
   lw_anneal_film_note(&a, note, sizeof note);
   cr_assert_str_eq(note, "");
+  a.params.frames_every = 1;
+  a.film_seconds[0] = 8.0;
+  lw_anneal_film_note(&a, note, sizeof note);
+  cr_assert(strstr(note, "writing a frame every sweep (output.frames_every) took 80 %"), "%s", note);
 }
 
 /* The frames still to come, at the newest frame's size, against the disk's

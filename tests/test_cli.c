@@ -1969,7 +1969,7 @@ Test(cli, a_fifo_or_an_endless_file_named_by_a_key_is_refused_at_once)
   const char *sets[][2] = {
     {"init.from=%s/fifo", "key 'init.from': %s/fifo: a FIFO (named pipe), not a file"},
     {"anneal.schedule=table --set anneal.table=%s/fifo", "key 'anneal.table': %s/fifo: a FIFO (named pipe)"},
-    {"init.from=/dev/zero%.0s", "key 'init.from': /dev/zero: a character device (a terminal, /dev/zero), not a "
+    {"init.from=/dev/zero%.0s", "key 'init.from': /dev/zero: a character device (a terminal, /dev/null, /dev/zero), not a "
                                "file%.0s"},
     {"anneal.schedule=table --set anneal.table=/dev/zero%.0s", "key 'anneal.table': /dev/zero: a character device%.0s"},
     /* a terminal's master held the read for ever */

@@ -616,11 +616,10 @@ Test(trace, several_runs_agree_or_are_flagged, .init = make_dir, .fini = remove_
     if (shifted) cr_assert(p < 1e-3, "a shift of %g passed the chi-square: p %g", shift[shifted], p);
     else cr_assert(p > 1e-3 && rh < 1.02, "alike runs flagged: R-hat %g, p %g", rh, p);
     if (shifted == 2) cr_assert(rh > 1.1, "a shift of 1.8 sd: R-hat %g", rh);
-    /* an acceptance has no test of the runs: empty fields, as every missing
-    ** value (its means' spread, se_runs, stands) */
-    const char *acc = strstr(out, "\nacc_point,4,16000,");
-    cr_assert(acc && strstr(acc, ",,") && strstr(acc, ",,") < strchr(acc + 1, '\n') && strstr(acc, ",,")[2] != '\n',
-              "%s", out);
+    /* an acceptance has no test of the runs, nor an error bar of their
+    ** spread (each run tunes its own steps): empty fields, as every missing
+    ** value */
+    cr_assert(strstr(out, "\nacc_point,4,16000,") && strstr(out, ",,,\n"), "%s", out);
   }
   /* a run of another scene: its columns differ */
   double rh, p;
