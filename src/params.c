@@ -1375,7 +1375,9 @@ static char *read_line(char *str, int num, void *stream)
     rc->failed = 1;
     return NULL;
   }
-  if (len >= num) {
+  /* (a byte order mark an editor put first is not the line's: it counted) */
+  const size_t bom = rc->line == 1 && !strncmp(rc->buf, "\xEF\xBB\xBF", 3) ? 3 : 0;
+  if (len - (ssize_t)bom >= num) {
     lw_error_set(rc->err, LW_EINPUT, "%s:%d: line longer than %d bytes (the limit of the INI reader; a letter "
                  "outside ASCII takes two or more)", rc->p->file, rc->line, num - 2);
     rc->failed = 1;
@@ -1384,7 +1386,7 @@ static char *read_line(char *str, int num, void *stream)
   /* A run's header among the comments above the first section: a published
   ** scene.ini with a line of notes added above it, or saved by an editor that
   ** puts a BOM first, is still that run's (its random numbers, its presets). */
-  const char *text = rc->buf + (rc->line == 1 && !strncmp(rc->buf, "\xEF\xBB\xBF", 3) ? 3 : 0);
+  const char *text = rc->buf + bom;
   text += strspn(text, " \t");
   if (!rc->content && !strncmp(text, LW_RUN_SCENE_HEADER, strlen(LW_RUN_SCENE_HEADER))) {
     rc->p->run_written = rc->p->of_run;
@@ -1425,7 +1427,7 @@ static char *read_line(char *str, int num, void *stream)
       return NULL;
     }
   }
-  memcpy(str, rc->buf, (size_t)len + 1);
+  memcpy(str, rc->buf + bom, (size_t)len - bom + 1);
   return str;
 }
 
@@ -1541,13 +1543,18 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
   pthread_mutex_unlock(&inih_settings);
   int read_error = ferror(f) ? (errno ? errno : EIO) : 0;
   fclose(f);
+  /* the line's look-alike of '=', '[' or ';' (a Japanese input method's
+  ** full-width forms), or a byte order mark inside the file (two files
+  ** saved with one, joined), by name: the syntax error said no more */
+  char unseen[96] = "";
+  if (r > 0 && r == rc.line && rc.buf) lw_text_unseen_char(rc.buf, unseen, sizeof unseen);
   free(rc.buf);
   if (rc.failed) return LW_EINPUT;
   /* a directory opens but does not read: the user named the wrong thing */
   if (read_error) return lw_error_set(err, LW_EINPUT, "%s: cannot read scene file: %s", path, strerror(read_error));
   if (r > 0)
     return lw_error_set(err, LW_EINPUT,
-                        "%s:%d: syntax error: expected '[section]', 'key = value' or a comment", path, r);
+                        "%s:%d: syntax error: expected '[section]', 'key = value' or a comment%s", path, r, unseen);
   if (r < 0) return lw_error_set(err, LW_ENOMEM, "%s: out of memory while reading", path);
   return resolve ? lw_params_resolve(p, err) : LW_OK;
 }

@@ -1554,6 +1554,33 @@ Test(cli, a_run_whose_directory_is_replaced_leaves_the_new_one_alone)
                           "2>/dev/null && test -s moved/state.lw", dir), 0, "%s", lw_test_slurp("%s/err.txt", dir));
 }
 
+/* A line inih cannot read names its look-alike character: a Japanese
+** input method's full-width '=' or '[' and a byte order mark inside the
+** file (two files saved with one, joined) were a bare syntax error.  A
+** byte order mark is not counted in the first line's 198 bytes. */
+Test(cli, a_syntax_error_names_its_look_alike_character)
+{
+  static const char *const scene[][2] = {
+    {"[scene]\nwidth \xef\xbc\x9d 100\n", "s.ini:2: syntax error: expected '[section]', 'key = value' or a comment "
+                                            "(byte 7 is a full-width '=', U+FF1D: type '=')"},
+    {"\xef\xbc\xbbscene\xef\xbc\xbd\n", "s.ini:1: syntax error: expected '[section]', 'key = value' or a comment "
+                                           "(byte 1 is a full-width '[', U+FF3B: type '[')"},
+    {"[scene]\n\xef\xbb\xbf[anneal]\n", "s.ini:2: syntax error: expected '[section]', 'key = value' or a comment "
+                                       "(byte 1 is a byte-order mark, U+FEFF"}};
+  for (size_t k = 0; k < sizeof scene / sizeof scene[0]; k++) {
+    write_file("s.ini", scene[k][0]);
+    cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --out o --quiet 2> err.txt; test $? -eq 2", dir, lw_test_bin()), 0);
+    char *e = lw_test_slurp("%s/err.txt", dir);
+    cr_assert(e && strstr(e, scene[k][1]), "%s", e);
+    free(e);
+  }
+  char line[256] = "\xef\xbb\xbf; ";
+  memset(line + strlen(line), 'a', 196 - 2);
+  strcat(line, "\r\n[scene]\nwidth = 100\n");
+  write_file("s.ini", line);
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --out b --quiet --stop-at 0", dir, lw_test_bin()), 0);
+}
+
 /* A --stop-at past the run's end is said: the run finishes (a loop that
 ** asked for sweep 250 of 200 got a finished run, unsaid); short of it, no
 ** note. */
