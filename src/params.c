@@ -1268,6 +1268,9 @@ lw_status lw_params_blame(const lw_params *p, const char *section, const char *k
   struct stat sb;
   if (d) value_text(p, d, value, sizeof value);
   lw_text_unseen_char(value, unseen, sizeof unseen);
+  /* a Windows path ("C:\Users\...\photo.jpg", "photos\a.png") named no file */
+  if (!unseen[0] && d && d->unit && !strcmp(d->unit, "path") && strchr(value, '\\') && stat(value, &sb))
+    snprintf(unseen, sizeof unseen, " ('\\' is a letter of a name here, not a folder's end: paths take '/')");
   return lw_error_set(err, err->code, "%s: key '%s.%s': %s%s", where, section, key, msg,
                       strstr(msg, "U+") || (value[0] && !stat(value, &sb)) ? "" : unseen);
 }

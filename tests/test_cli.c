@@ -1579,6 +1579,11 @@ Test(cli, a_syntax_error_names_its_look_alike_character)
   strcat(line, "\r\n[scene]\nwidth = 100\n");
   write_file("s.ini", line);
   cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --out b --quiet --stop-at 0", dir, lw_test_bin()), 0);
+  /* a Windows path names no file: its '\\' is said to be a letter */
+  write_file("s.ini", "[scene]\nimage = photos\\a.png\n");
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --out c --quiet 2>&1 | grep -q \"a.png: cannot open the image: No such "
+                          "file or directory ('.' is a letter of a name here, not a folder's end: paths take '/')\"",
+                          dir, lw_test_bin()), 0);
 }
 
 /* A --stop-at past the run's end is said: the run finishes (a loop that
