@@ -146,8 +146,8 @@ const lw_param_def lw_param_table[] = {
   NUM("scene", "potential_angle", LW_PT_DOUBLE, potential_angle, "0", "degrees", -360, 360, 0,
       "Direction in which the ramp potential rises (0 = +x, 90 = +y, down the page)."),
   NUM("scene", "potential_scale", LW_PT_DOUBLE, potential_scale, "0", "mm", 0, 1e7, 0,
-      "h of the ramp and radial potentials; 0 = automatic (half the page extent along the ramp; "
-      "half the page diagonal for radial)."),
+      "h of the ramp and radial potentials; 0 = automatic (half the page extent along the ramp, "
+      "(W |cos a| + H |sin a|) / 2 at potential_angle a; half the page diagonal for radial)."),
   NUM("scene", "potential_power", LW_PT_DOUBLE, potential_power, "1", "", 0, 100, LW_MIN_OPEN,
       "potential = image: Phi = tone^power. Above 1 the potential is near 0 everywhere but near white, "
       "so energy.potential > 0 costs line where the picture asks for none (stray lines in a white "
@@ -174,7 +174,7 @@ const lw_param_def lw_param_table[] = {
          "Vector field v read by the field term (unit length): constant along `field_angle`, "
          "radial from the centre, vortex around it (v = (-(y - cy), x - cx) / r: clockwise as seen on "
          "the page, whose y points down; both fall to 0 within `field_core` of the centre), waves "
-         "tangent to y = A sin(2 pi x / wavelength) (x from the page's left edge), "
+         "tangent to y = A sin(2 pi x / wavelength) (x from the page's left edge, y down the page), "
          "etf (the picture's edge tangent flow: along edges and isophotes; needs field_mode = axial) "
          "gradient (the picture's tone gradient, toward lighter tone) "
          "or file (a grid of vectors u v from `field_file`: docs/FORMATS.md, \"Field files\"). "
@@ -242,9 +242,11 @@ const lw_param_def lw_param_table[] = {
   STRING("init", "from", from, "", "path",
          "A state.lw to start from instead of random placement (relative to the scene file)."),
   NUM("energy", "strain", LW_PT_DOUBLE, strain, "0", "energy / mm", 0, 1e12, 0,
-      "S: strain S L (L - L0)^2 / L0^2 keeps each spline's length near L0. 0 = off."),
+      "S: strain S L (L - L0)^2 / L0^2 keeps each spline's length near L0, L measured by the run's "
+      "quadrature (energy.quadrature). 0 = off."),
   CHOICE("energy", "strain_mode", strain_mode, "spline", "spline|segment",
-         "Strain per spline (L = whole length) or per segment (each segment against L0/n)."),
+         "Strain per spline (L = whole length) or per segment (each segment against L0/n: the sum over "
+         "segments of S l (l - L0/n)^2 / (L0/n)^2)."),
   NUM("energy", "bending", LW_PT_DOUBLE, bending, "0", "energy mm", 0, 1e12, 0,
       "B: bending B * integral of curvature^2 dl favours gentle curves. 0 = off."),
   NUM("energy", "potential", LW_PT_DOUBLE, potential_coef, "0", "energy / mm", -1e12, 1e12, 0,
@@ -260,7 +262,8 @@ const lw_param_def lw_param_table[] = {
          "drawing's paths keep that direction only with output.order = none, which the plotter's order would "
          "turn where it saves travel)."),
   NUM("energy", "pair", LW_PT_DOUBLE, pair, "0", "energy / mm", 0, 1e12, 0,
-      "C: pair repulsion C * double integral of dl dl / r between different splines. 0 = off."),
+      "C: pair repulsion C * double integral of dl dl / r between different splines, each pair of splines "
+      "once (sum over i < j; none within one spline). 0 = off."),
   NUM("energy", "pair_cutoff", LW_PT_DOUBLE, pair_cutoff, "5", "mm", 0, 1e7, 0,
       "Pair interaction range; the kernel is shifted to 1/r - 1/rc so the energy is continuous. "
       "At least about two length elements (init.segment_length / pair nodes): the placed segments' "
