@@ -259,9 +259,9 @@ lw_status lw_ckpt_verify(const lw_ckpt *c, lw_error *err)
 {
   if (c->sum_at == NONE || c->sum_ok) return LW_OK;
   if (c->sum_misplaced)
-    return lw_error_set(err, LW_EINPUT, "%s: its checksum's line is not its last, or not '# checksum' and 16 hex "
+    return lw_error_set(err, LW_EINPUT, "%s:%d: its checksum's line is not its last, or not '# checksum' and 16 hex "
                         "digits: the file was damaged or edited since linewise wrote it; a state edited on purpose "
-                        "goes on once that line is taken out", c->path);
+                        "goes on once that line is taken out", c->path, c->sum_line);
   return lw_error_set(err, LW_EINPUT, "%s:%d: its checksum does not match its contents: the file was damaged (a disk's "
                       "or a copy's fault) or edited since linewise wrote it; a state edited on purpose goes on once "
                       "this line is taken out", c->path, c->sum_line);

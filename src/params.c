@@ -1553,7 +1553,10 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
   ** full-width forms), or a byte order mark inside the file (two files
   ** saved with one, joined), by name: the syntax error said no more */
   char unseen[96] = "";
-  if (r > 0 && r == rc.line && rc.buf) lw_text_unseen_char(rc.buf, unseen, sizeof unseen);
+  if (r > 0 && r == rc.line && rc.buf) {
+    rc.buf[strcspn(rc.buf, "\r\n")] = '\0'; /* (its end was told to be deleted) */
+    lw_text_unseen_char(rc.buf, unseen, sizeof unseen);
+  }
   free(rc.buf);
   if (rc.failed) return LW_EINPUT;
   /* a directory opens but does not read: the user named the wrong thing */

@@ -1581,9 +1581,13 @@ Test(cli, a_syntax_error_names_its_look_alike_character)
   cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --out b --quiet --stop-at 0", dir, lw_test_bin()), 0);
   /* a Windows path names no file: its '\\' is said to be a letter */
   write_file("s.ini", "[scene]\nimage = photos\\a.png\n");
-  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --out c --quiet 2>&1 | grep -q \"a.png: cannot open the image: No such "
-                          "file or directory ('.' is a letter of a name here, not a folder's end: paths take '/')\"",
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --out c --quiet 2>&1 | grep -qF \"a.png: cannot open the image: No such "
+                          "file or directory ('\\\\' is a letter of a name here, not a folder's end: paths take '/')\"",
                           dir, lw_test_bin()), 0);
+  /* a plain syntax error says no more (its line's end was told to be deleted) */
+  write_file("s.ini", "[scene]\nwidth 100\n");
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --out c --quiet 2>&1 | grep -qx 'linewise: s.ini:2: syntax error: "
+                          "expected .\\[section\\]., .key = value. or a comment'", dir, lw_test_bin()), 0);
 }
 
 /* A --stop-at past the run's end is said: the run finishes (a loop that
