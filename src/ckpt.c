@@ -14,6 +14,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "linewise/number.h"
 #include "linewise/output.h"
@@ -237,16 +238,21 @@ static void find_sum(lw_ckpt *c)
   const size_t k = strlen(SUM_LINE);
   size_t end = c->len;
   while (end > 0 && strchr(" \t\r\n", c->text[end - 1])) end--;
-  size_t at = NONE;
-  for (size_t i = c->len; i-- > 0;)
-    if ((i == 0 || c->text[i - 1] == '\n') && i + k <= c->len && !strncmp(c->text + i, SUM_LINE, k)) {
-      at = i;
-      break;
-    }
+  size_t last = end; /* where the last line but blanks begins */
+  while (last > 0 && c->text[last - 1] != '\n') last--;
+  /* a checksum's line put out of form ("#checksum", indented, upper case)
+  ** is one all the same: read as none, it let a damaged state through */
+  int like = 0;
+  const char *t = c->text + last + strspn(c->text + last, " \t");
+  for (const char *w = t; *t == '#' && w + 8 <= c->text + end && !like; w++) like = !strncasecmp(w, "checksum", 8);
+  size_t at = like ? last : NONE;
+  for (size_t i = c->len; at == NONE && i-- > 0;)
+    if ((i == 0 || c->text[i - 1] == '\n') && i + k <= c->len && !strncmp(c->text + i, SUM_LINE, k)) at = i;
   if (at == NONE) return;
   char *stop;
   const unsigned long long v = strtoull(c->text + at + k, &stop, 16);
-  const int hex = stop == c->text + at + k + 16 && isxdigit((unsigned char)c->text[at + k]);
+  const int hex = !strncmp(c->text + at, SUM_LINE, k) && stop == c->text + at + k + 16 &&
+                  isxdigit((unsigned char)c->text[at + k]);
   c->sum_at = at;
   c->sum_line = 1;
   for (size_t i = 0; i < at; i++) c->sum_line += c->text[i] == '\n';

@@ -83,6 +83,7 @@ static const char usage[] =
   "                      temperature's sweeps (or from output.stats_from), tuning left\n"
   "                      out, and the heat capacity Var(E)/T^2 (each rung's when\n"
   "                      tempering); with several runs (seeds) also whether they agree\n"
+  "                      and the error bar of their means' spread (se_runs)\n"
   "      --reweight N        instead, a tempering run's mean energy and heat capacity\n"
   "                          at N temperatures from the coldest rung's to the hottest's,\n"
   "                          every rung's energies reweighted (multiple histograms);\n"

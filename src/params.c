@@ -1555,7 +1555,8 @@ static lw_status read_file(lw_params *p, const char *path, int of_run, int resol
   char unseen[96] = "";
   if (r > 0 && r == rc.line && rc.buf) {
     rc.buf[strcspn(rc.buf, "\r\n")] = '\0'; /* (its end was told to be deleted) */
-    lw_text_unseen_char(rc.buf, unseen, sizeof unseen);
+    /* (a first line's byte order mark is read as none: it was blamed) */
+    lw_text_unseen_char(rc.buf + (r == 1 && !strncmp(rc.buf, "\xEF\xBB\xBF", 3) ? 3 : 0), unseen, sizeof unseen);
   }
   free(rc.buf);
   if (rc.failed) return LW_EINPUT;
@@ -1832,8 +1833,20 @@ static lw_status inputs_confined(const lw_params *p, lw_error *err)
       joined[cut] = '\0';
       const int found = realpath(cut ? joined : "/", real) != NULL;
       joined[cut] = keep;
-      if (found) { /* (a '..' below it could lead out once the folders are made) */
-        if (strstr(joined + cut, "/..")) real[0] = '\0';
+      if (found) {
+        /* a '..' below it could lead out once the folders are made, and the
+        ** name right below it may be a link that leads nowhere yet (a
+        ** dangling link to a folder outside passed) */
+        struct stat ls;
+        char next[sizeof joined];
+        int out = 0;
+        if (cut < strlen(joined)) {
+          snprintf(next, sizeof next, "%.*s", (int)(cut + 1 + strcspn(joined + cut + 1, "/")), joined);
+          out = !lstat(next, &ls);
+        }
+        for (const char *c = joined + cut; *c && !out; c += strcspn(c + 1, "/") + 1)
+          out = !strncmp(c, "/..", 3) && (c[3] == '/' || !c[3]);
+        if (out) real[0] = '\0';
         else snprintf(real + strlen(real), sizeof real - strlen(real), "%s", joined + cut);
         break;
       }

@@ -319,7 +319,10 @@ Test(checkpoint, a_change_no_value_check_sees_is_the_checksums)
   cr_assert_eq(resume_edited(more), 2);
   cr_assert(err_has(": its checksum does not match its contents"));
   cr_assert_eq(resume_edited("s/$/\\r/"), 0, "%s", lw_test_slurp("%s/err.txt", dir));
-  /* a line after it is an edit too */
+  /* a line after it is an edit too, and so is its line put out of form
+  ** (read as none, it let the damage through) */
+  cr_assert_eq(resume_edited("s/^# checksum/#checksum/"), 2);
+  cr_assert(err_has(": its checksum's line is not its last, or not '# checksum' and 16 hex digits"));
   cr_assert_eq(resume_edited("$s/$/\\n# a note/"), 2);
   cr_assert(err_has("x/state.lw:") && err_has(": its checksum's line is not its last") && !err_has("state.lw: its"));
   /* taken out on purpose, the run goes on, and its next state has one again */
