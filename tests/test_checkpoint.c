@@ -49,7 +49,8 @@ static void resume_fixture_matches_fresh_run(const char *name, const char *const
   ** the state it read; and block_shift and the checksum, which a run begun
   ** before them goes on without */
   for (const char *const *f = files; *f; f++)
-    cr_expect_eq(lw_test_sh("k='^(scene_hash|scene_keys|size_peak|block_shift|# checksum) '; grep -avE \"$k\" %s/old/%s > %s/f1; "
+    cr_expect_eq(lw_test_sh("k='^(scene_hash|scene_keys|size_peak|block_shift|# checksum) '; "
+                            "grep -avE \"$k\" %s/old/%s > %s/f1; "
                             "grep -avE \"$k\" %s/fresh/%s > %s/f2; cmp -s %s/f1 %s/f2", dir, *f, dir, dir, *f, dir,
                             dir, dir),
                  0, "%s: %s differs from an uninterrupted run", name, *f);

@@ -1584,7 +1584,8 @@ Test(cli, a_syntax_error_names_its_look_alike_character)
   cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --out b --quiet --stop-at 0", dir, lw_test_bin()), 0);
   /* a Windows path names no file: its '\\' is said to be a letter */
   write_file("s.ini", "[scene]\nimage = photos\\a.png\n");
-  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --out c --quiet 2>&1 | grep -qF \"a.png: cannot open the image: No such "
+  cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --out c --quiet 2>&1 | grep -qF \"a.png: cannot open the image: "
+                          "No such "
                           "file or directory ('\\\\' is a letter of a name here, not a folder's end: paths take '/')\"",
                           dir, lw_test_bin()), 0);
   /* a plain syntax error says no more (its line's end was told to be deleted) */
@@ -1601,7 +1602,8 @@ Test(cli, a_stop_past_the_end_is_said)
   write_file("s.ini", scene_text);
   cr_assert_eq(lw_test_sh("cd %s && %s run s.ini --out a --set anneal.sweeps=6 --stop-at 9 2> err.txt && "
                           "grep -q 'note: --stop-at 9 is past the run.s end at sweep 6: it runs to its end' err.txt && "
-                          "test -s a/summary.json && %s run s.ini --out b --set anneal.sweeps=6 --stop-at 3 2> err.txt && "
+                          "test -s a/summary.json && "
+                          "%s run s.ini --out b --set anneal.sweeps=6 --stop-at 3 2> err.txt && "
                           "! grep -q 'note: --stop-at' err.txt && %s resume b --stop-at 7 2> err.txt && "
                           "grep -q 'note: --stop-at 7 is past' err.txt", dir, lw_test_bin(), lw_test_bin(),
                           lw_test_bin()), 0, "%s", lw_test_slurp("%s/err.txt", dir));
@@ -1634,20 +1636,23 @@ Test(cli, a_service_confines_the_files_a_scene_names)
                           "job/o --quiet", dir, lw_test_bin(), lw_test_bin()), 0);
   /* a missing folder inside is a missing file, not one outside; a '..'
   ** below it could lead out once it is made; a root that is a file */
-  cr_assert_eq(lw_test_sh("cd %s && LINEWISE_INPUT_ROOT=job %s run job/s.ini --out job/p --set scene.image=job/sub/no.png "
-                          "2>&1 | grep -q 'job/sub/no.png: cannot open the image: No such file'", dir, lw_test_bin()), 0);
+  cr_assert_eq(lw_test_sh("cd %s && LINEWISE_INPUT_ROOT=job %s run job/s.ini --out job/p --set "
+                          "scene.image=job/sub/no.png 2>&1 | grep -q 'job/sub/no.png: cannot open the image: No such "
+                          "file'", dir, lw_test_bin()), 0);
   cr_assert_eq(lw_test_sh("cd %s && LINEWISE_INPUT_ROOT=job %s run job/s.ini --out job/p --set "
                           "scene.image=job/sub/../../secret.txt 2>&1 | grep -q 'is not inside LINEWISE_INPUT_ROOT'", dir,
                           lw_test_bin()), 0);
   /* a link inside that leads nowhere yet: outside (it passed as a missing
   ** folder); a name that merely begins with '..' is a name */
   cr_assert_eq(lw_test_sh("cd %s && ln -s ../nowhere job/dangling && LINEWISE_INPUT_ROOT=job %s run job/s.ini --out "
-                          "job/p --set scene.image=job/dangling/x.png 2>&1 | grep -q 'is not inside LINEWISE_INPUT_ROOT'",
+                          "job/p --set scene.image=job/dangling/x.png 2>&1 | "
+                          "grep -q 'is not inside LINEWISE_INPUT_ROOT'",
                           dir, lw_test_bin()), 0);
   cr_assert_eq(lw_test_sh("cd %s && LINEWISE_INPUT_ROOT=job %s run job/s.ini --out job/p --set scene.image=job/..x.png "
                           "2>&1 | grep -q 'job/..x.png: cannot open the image: No such file'", dir, lw_test_bin()), 0);
   cr_assert_eq(lw_test_sh("cd %s && LINEWISE_INPUT_ROOT=job/picture.png %s run job/s.ini --out job/p 2>&1 | grep -q "
-                          "'LINEWISE_INPUT_ROOT=job/picture.png: not a folder: expected the folder'", dir, lw_test_bin()),
+                          "'LINEWISE_INPUT_ROOT=job/picture.png: not a folder: expected the folder'", dir,
+                          lw_test_bin()),
                0);
 }
 
@@ -2015,7 +2020,8 @@ Test(cli, a_fifo_or_an_endless_file_named_by_a_key_is_refused_at_once)
   const char *sets[][2] = {
     {"init.from=%s/fifo", "key 'init.from': %s/fifo: a FIFO (named pipe), not a file"},
     {"anneal.schedule=table --set anneal.table=%s/fifo", "key 'anneal.table': %s/fifo: a FIFO (named pipe)"},
-    {"init.from=/dev/zero%.0s", "key 'init.from': /dev/zero: a character device (a terminal, /dev/null, /dev/zero), not a "
+    {"init.from=/dev/zero%.0s", "key 'init.from': /dev/zero: a character device (a terminal, /dev/null, /dev/zero), "
+                               "not a "
                                "file%.0s"},
     {"anneal.schedule=table --set anneal.table=/dev/zero%.0s", "key 'anneal.table': /dev/zero: a character device%.0s"},
     /* a terminal's master held the read for ever */

@@ -713,13 +713,13 @@ Test(plotter, a_page_past_the_bed_is_refused_before_the_run)
   /* a pen speed HP-GL cannot ask is said before the run (VS was limited without a word) */
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.hpgl=1 --set plot.speed_down=2000 --stop-at 0 "
                           "--out %s/v 2>&1 | grep -q 'note: plot.speed_down = 2000 mm/s is past what HP-GL.s VS takes "
-                          "(0.1 to 1279.9 mm/s, in steps of 0.1): final.hpgl asks 1279.9 (VS127.99, in cm/s), and the plot time, reckoned "
-                          "at 2000, does not hold'", bin, root, dir), 0);
+                          "(0.1 to 1279.9 mm/s, in steps of 0.1): final.hpgl asks 1279.9 (VS127.99, in cm/s), and the "
+                          "plot time, reckoned at 2000, does not hold'", bin, root, dir), 0);
   /* and one its two decimals round by more than 1 % (1.234 mm/s was 1.2) */
   cr_assert_eq(lw_test_sh("%s run %s/params/minimal.ini --set output.hpgl=1 --set plot.speed_down=1.234 --stop-at 0 "
                           "--out %s/v 2>&1 | grep -q 'note: plot.speed_down = 1.234 mm/s is more than 1 %% from what "
-                          "HP-GL.s VS writes (0.1 to 1279.9 mm/s, in steps of 0.1): final.hpgl asks 1.2 (VS0.12, in cm/s),'", bin, root,
-                          dir), 0);
+                          "HP-GL.s VS writes (0.1 to 1279.9 mm/s, in steps of 0.1): final.hpgl asks 1.2 (VS0.12, in "
+                          "cm/s),'", bin, root, dir), 0);
   cr_assert_neq(lw_test_sh("%s run %s/params/minimal.ini --set output.hpgl=1 --set plot.speed_down=12.3456 --stop-at 0 "
                            "--out %s/v 2>&1 | grep -q 'HP-GL.s VS'", bin, root, dir), 0, "0.4 %% off: no note");
   /* a drawing that leaves the bed only after the anneal (no crop, no
