@@ -588,14 +588,14 @@ void lw_ckpt_put_counts(lw_ckpt_writer *w, const char *key, const unsigned long 
 lw_status lw_ckpt_commit(lw_ckpt_writer *w, lw_error *err)
 {
   /* the checksum of what was written, read back (the MPI writer puts its
-  ** processes' parts in whole) */
+  ** processes' parts in whole); a file that cannot be goes without one,
+  ** which a resume reads as a file written so */
   unsigned long long h = FNV_START;
   unsigned char buf[65536];
   size_t got;
   FILE *back = w->no_sum || fflush(w->f) ? NULL : fopen(w->tmp, "rb");
   while (back && (got = fread(buf, 1, sizeof buf, back)) > 0) h = fnv1a(h, buf, got);
   if (back && !ferror(back)) fprintf(w->f, SUM_LINE "%016llx\n", h);
-  else if (!w->no_sum) fputs("# checksum not taken: the file could not be read back\n", w->f);
   if (back) fclose(back);
   lw_status s = lw_output_commit(w->f, w->tmp, w->path, err);
   w->f = NULL;
