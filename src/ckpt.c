@@ -593,7 +593,13 @@ lw_status lw_ckpt_commit(lw_ckpt_writer *w, lw_error *err)
   unsigned long long h = FNV_START;
   unsigned char buf[65536];
   size_t got;
-  FILE *back = w->no_sum || fflush(w->f) ? NULL : fopen(w->tmp, "rb");
+  if (!w->no_sum && fflush(w->f)) { /* (the write's own error: a later flush had none to give) */
+    const int e = errno;
+    lw_output_abort(w->f, w->tmp);
+    w->f = NULL;
+    return lw_error_set(err, LW_EIO, "%s: write failed: %s", w->path, strerror(e));
+  }
+  FILE *back = w->no_sum ? NULL : fopen(w->tmp, "rb");
   while (back && (got = fread(buf, 1, sizeof buf, back)) > 0) h = fnv1a(h, buf, got);
   if (back && !ferror(back)) fprintf(w->f, SUM_LINE "%016llx\n", h);
   if (back) fclose(back);
