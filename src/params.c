@@ -1802,6 +1802,36 @@ lw_status lw_params_bed_check(const lw_params *p, const double box[4], const cha
   return LW_OK;
 }
 
+/* The real path of file (its links followed) into real, where the file is
+** not there yet too: the nearest folder above it that is there, and the
+** names below it, which no link can lead out of (a missing subfolder was
+** said outside).  0 where none can be given: a '..' below a missing folder
+** could lead out once it is made, and a name right below the folder that
+** is there but resolves not is a link that leads nowhere yet (a dangling
+** link to a folder outside passed). */
+static int real_path_ahead(char *file, char *real, size_t n)
+{
+  for (size_t cut = strlen(file);;) {
+    const char keep = file[cut];
+    file[cut] = '\0';
+    const int found = realpath(cut ? file : "/", real) != NULL;
+    file[cut] = keep;
+    if (found) {
+      if (!file[cut]) return 1;
+      char next[2 * LW_PATH_MAX + 2];
+      struct stat ls;
+      snprintf(next, sizeof next, "%.*s", (int)(cut + 1 + strcspn(file + cut + 1, "/")), file);
+      if (!lstat(next, &ls)) return 0;
+      for (const char *c = file + cut; *c; c += strcspn(c + 1, "/") + 1)
+        if (!strncmp(c, "/..", 3) && (c[3] == '/' || !c[3])) return 0;
+      snprintf(real + strlen(real), n - strlen(real), "%s", file + cut);
+      return 1;
+    }
+    while (cut > 0 && file[cut - 1] != '/') cut--;
+    if (!cut--) return 0;
+  }
+}
+
 /* Where the environment names LINEWISE_INPUT_ROOT (a service running
 ** others' scenes), every file a key names must lie inside that folder, its
 ** links followed, checked before any is opened: a scene could name any file
@@ -1825,38 +1855,7 @@ static lw_status inputs_confined(const lw_params *p, lw_error *err)
     const char *path = (const char *)p + d->offset;
     if (d->type != LW_PT_STRING || !d->unit || strcmp(d->unit, "path") || !path[0]) continue;
     lw_path_join(joined, sizeof joined, dir, path);
-    /* (the nearest folder above it that is there, and the names below it,
-    ** which no link can lead out of: a missing subfolder was said outside) */
-    size_t cut = strlen(joined);
-    for (;;) {
-      const char keep = joined[cut];
-      joined[cut] = '\0';
-      const int found = realpath(cut ? joined : "/", real) != NULL;
-      joined[cut] = keep;
-      if (found) {
-        /* a '..' below it could lead out once the folders are made, and the
-        ** name right below it may be a link that leads nowhere yet (a
-        ** dangling link to a folder outside passed) */
-        struct stat ls;
-        char next[sizeof joined];
-        int out = 0;
-        if (cut < strlen(joined)) {
-          snprintf(next, sizeof next, "%.*s", (int)(cut + 1 + strcspn(joined + cut + 1, "/")), joined);
-          out = !lstat(next, &ls);
-        }
-        for (const char *c = joined + cut; *c && !out; c += strcspn(c + 1, "/") + 1)
-          out = !strncmp(c, "/..", 3) && (c[3] == '/' || !c[3]);
-        if (out) real[0] = '\0';
-        else snprintf(real + strlen(real), sizeof real - strlen(real), "%s", joined + cut);
-        break;
-      }
-      while (cut > 0 && joined[cut - 1] != '/') cut--;
-      if (cut > 0) cut--;
-      else {
-        real[0] = '\0';
-        break;
-      }
-    }
+    if (!real_path_ahead(joined, real, sizeof real)) real[0] = '\0';
     if (real[0] && !strncmp(real, root, n) && (real[n] == '/' || (n == 1 && root[0] == '/'))) continue;
     lw_params_origin(p, d, where, sizeof where);
     return lw_error_set(err, LW_EINPUT, "%s: key '%s.%s': '%s' is not inside LINEWISE_INPUT_ROOT (%s), where this "

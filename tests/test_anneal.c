@@ -747,16 +747,13 @@ Test(run, the_adaptive_rule_steps_by_each_blocks_own_spread)
 ** first; the trace's 17 digits give the spread two-pass here. */
 Test(run, the_adaptive_rule_reads_a_tiny_spread_of_a_large_energy)
 {
-  char path[128];
-  snprintf(path, sizeof path, "%s/wire.ini", dir);
-  FILE *f = fopen(path, "w");
-  cr_assert_not_null(f);
-  fputs("[scene]\nsystem = nurbs\n[nurbs]\norder = 4\npoints = -5 5  -4.17 5  -2.5 5  0 5  2.5 5  4.17 5  5 5\n"
+  cr_assert_eq(lw_test_write_text(dir, "wire.ini", "[scene]\nsystem = nurbs\n[nurbs]\norder = 4\n"
+        "points = -5 5  -4.17 5  -2.5 5  0 5  2.5 5  4.17 5  5 5\n"
         "weights = 1 1 1 1 1 1 1\nknots = 0 0 0 0 0.25 0.5 0.75 1 1 1 1\nalpha = 35\nbeta = 10\ngauss = 10\nfixed = 1\n"
         "[dynamics]\nrho = 30\ngravity_y = -9.8\n[anneal]\nschedule = adaptive\nt_start = 1e-5\nt_end = 1e-12\n"
-        "steps = 10\nsweeps = 4000\nlambda = 0.7\nseed = 1\n[moves]\ntune_sweeps = 50\n[output]\ntrace_every = 1\n", f);
-  fclose(f);
-  cr_assert_eq(sh("%s run %s --out %s/w --quiet", getenv("LW_BIN"), path, dir), 0);
+        "steps = 10\nsweeps = 4000\nlambda = 0.7\nseed = 1\n[moves]\ntune_sweeps = 50\n[output]\n"
+        "trace_every = 1\n"), 0);
+  cr_assert_eq(sh("%s run %s/wire.ini --out %s/w --quiet", getenv("LW_BIN"), dir, dir), 0);
   cr_assert_eq(sh("awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == \"total\") c = i; next } "
                   "{ k = int(($1 - 1) / 400); t[k] = $2; if (($1 - 1) %% 400 >= 50) e[k, n[k]++] = $c } "
                   "END { for (k = 0; k < 9; k++) { m = 0; for (i = 0; i < n[k]; i++) m += e[k, i]; m /= n[k]; "
